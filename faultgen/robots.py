@@ -1,0 +1,367 @@
+"""Load a robot by name: compiled MuJoCo model, element names, nominal parameters, inverse dynamics.
+
+A robot is a folder ``robots/<name>/`` holding ``<name>.xml`` (the MJCF), ``scene.xml`` and a
+README giving the source of every number. The MJCF is the single source of the parameters:
+this module reads them back from the compiled model, so an edited or augmented MJCF is picked
+up without code changes.
+
+Each model pairs six arm joints ``joint{i}`` with six motor-rotor joints ``rotor{i}``, coupled by
+fixed tendons ``gearbox{i}`` (``L = rotor{i} / G - joint{i}``, thesis eq. 6.2a), driven by torque
+actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the custom numerics
+``friction{i}`` and a ``home`` keyframe.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from faultgen.friction import FIELDS as FRICTION_FIELDS
+from faultgen.friction import MotorFriction
+
+N_AXES = 6
+
+
+class UnknownRobotError(ValueError):
+    """Raised by :func:`load` for a name that is neither a known robot nor an MJCF file."""
+
+
+class ModelError(ValueError):
+    """Raised when an MJCF file cannot be compiled or lacks the elements a robot needs.
+
+    The message names the file and, where MuJoCo reports one, the line.
+    """
+
+
+def robots_dir() -> Path:
+    """Folder holding the robot folders: packaged copy in a wheel, ``robots/`` in a checkout."""
+    here = Path(__file__).resolve().parent
+    packaged = here / "_robots"
+    return packaged if packaged.is_dir() else here.parent / "robots"
+
+
+def available() -> dict[str, Path]:
+    """Known robots: name -> path of its MJCF, sorted by name."""
+    root = robots_dir()
+    found = {}
+    if root.is_dir():
+        for folder in sorted(root.iterdir()):
+            xml = folder / f"{folder.name}.xml"
+            if xml.is_file():
+                found[folder.name] = xml
+    return found
+
+
+@dataclass(frozen=True, eq=False)
+class Robot:
+    """A compiled robot model and its nominal parameters, all read from the MJCF.
+
+    Attributes
+    ----------
+    name : str
+        Robot name (the folder name, or the MJCF file stem when loaded from a path).
+    description : str
+        One line describing the model and the source of its numbers.
+    path : Path
+        The MJCF file.
+    model : mujoco.MjModel
+        The compiled model (arm joints, rotors, gearbox tendons, motors).
+    joint_names, rotor_names, gearbox_names, actuator_names : tuple of str
+        Names of the arm joints, rotor joints, gearbox tendons and motors, axis 1..6 in order.
+    gear_ratio : ndarray of shape (6,)
+        Gear ratio G (motor angle / arm angle), dimensionless, positive.
+    motor_inertia : ndarray of shape (6,)
+        Rotor inertia Jm in kg m^2 at the motor side (the rotor joints' armature).
+    gearbox_stiffness : ndarray of shape (6,)
+        Gearbox stiffness K in N m/rad at the arm side (thesis eq. 6.2a).
+    gearbox_damping : ndarray of shape (6,)
+        Gearbox damping D in N m s/rad at the arm side (thesis eq. 6.2a).
+    joint_range : ndarray of shape (6, 2)
+        Arm joint limits in rad.
+    motor_torque_limit : ndarray of shape (6,)
+        Largest motor torque the actuators accept, N m at the motor side.
+    friction : MotorFriction
+        Nominal motor-side friction parameters.
+    home : ndarray of shape (6,)
+        Arm joint angles of the ``home`` keyframe in rad.
+    """
+
+    name: str
+    description: str
+    path: Path
+    model: mujoco.MjModel
+    joint_names: tuple[str, ...]
+    rotor_names: tuple[str, ...]
+    gearbox_names: tuple[str, ...]
+    actuator_names: tuple[str, ...]
+    gear_ratio: np.ndarray
+    motor_inertia: np.ndarray
+    gearbox_stiffness: np.ndarray
+    gearbox_damping: np.ndarray
+    joint_range: np.ndarray
+    motor_torque_limit: np.ndarray
+    friction: MotorFriction
+    home: np.ndarray
+    _inverse: tuple[mujoco.MjModel, mujoco.MjData] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # A private copy for inverse dynamics: a continuous-time integrator keeps mj_inverse a map
+        # from qacc (the discrete integrator would invert its step map), and without constraints
+        # joint limits add no force.
+        model = self.model.__copy__()
+        model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+        model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        object.__setattr__(self, "_inverse", (model, mujoco.MjData(model)))
+
+    @property
+    def arm_qpos(self) -> np.ndarray:
+        """Indices of the arm joints in ``qpos``, ``ndarray of shape (6,)``."""
+        return np.array([self.model.joint(n).qposadr[0] for n in self.joint_names])
+
+    @property
+    def arm_dof(self) -> np.ndarray:
+        """Indices of the arm joints in ``qvel``, ``ndarray of shape (6,)``."""
+        return np.array([self.model.joint(n).dofadr[0] for n in self.joint_names])
+
+    @property
+    def rotor_qpos(self) -> np.ndarray:
+        """Indices of the rotor joints in ``qpos``, ``ndarray of shape (6,)``."""
+        return np.array([self.model.joint(n).qposadr[0] for n in self.rotor_names])
+
+    @property
+    def rotor_dof(self) -> np.ndarray:
+        """Indices of the rotor joints in ``qvel``, ``ndarray of shape (6,)``."""
+        return np.array([self.model.joint(n).dofadr[0] for n in self.rotor_names])
+
+    def rigid_state(self, q: np.ndarray, qd: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Full-model ``qpos`` and ``qvel`` for arm-side angles with an undeflected gearbox.
+
+        Parameters
+        ----------
+        q : ndarray of shape (6,)
+            Arm joint angles in rad.
+        qd : ndarray of shape (6,), optional
+            Arm joint velocities in rad/s; zero when omitted.
+
+        Returns
+        -------
+        qpos : ndarray of shape (nq,)
+            Arm joints at ``q``, rotors at ``G q`` (motor-side rad).
+        qvel : ndarray of shape (nv,)
+            Arm joints at ``qd``, rotors at ``G qd`` (motor-side rad/s).
+        """
+        q = _check_vector("q", q)
+        qd = np.zeros(N_AXES) if qd is None else _check_vector("qd", qd)
+        qpos = np.zeros(self.model.nq)
+        qvel = np.zeros(self.model.nv)
+        qpos[self.arm_qpos] = q
+        qpos[self.rotor_qpos] = self.gear_ratio * q
+        qvel[self.arm_dof] = qd
+        qvel[self.rotor_dof] = self.gear_ratio * qd
+        return qpos, qvel
+
+    def inverse_dynamics(
+        self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, friction: bool = True
+    ) -> np.ndarray:
+        """Arm-side joint torque needed to follow a trajectory, rigid gearbox assumed.
+
+        ``tau = M(q) qdd + C(q, qd) + g(q) - tau_spring(q) + G^2 Jm qdd + G f_m(G qd)``: the
+        rigid-body terms of thesis eq. 6.1 from MuJoCo's recursive Newton-Euler (``mj_inverse``,
+        joint limits ignored), passive joint springs such as the IRB-6700-like axis-2 balancing,
+        the motor inertia reflected through G^2 and, with ``friction=True``, the motor-side static
+        friction of thesis eq. 6.3 reflected through G (the Robotics Toolbox convention).
+
+        Parameters
+        ----------
+        q, qd, qdd : ndarray of shape (n, 6)
+            Arm joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
+        friction : bool, default True
+            Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``).
+
+        Returns
+        -------
+        ndarray of shape (n, 6)
+            Arm-side joint torque in N m (motor torque times G).
+
+        Notes
+        -----
+        Uses one private ``MjData``: do not call it on the same robot from several threads.
+
+        Raises
+        ------
+        ValueError
+            If an input is not of shape (n, 6) with a common n, or holds a non-finite value.
+        """
+        q = _check_trajectory("q", q)
+        qd = _check_trajectory("qd", qd, q.shape[0])
+        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        model, data = self._inverse
+        arm_qpos, arm_dof = self.arm_qpos, self.arm_dof
+        rotor_qpos, rotor_dof = self.rotor_qpos, self.rotor_dof
+        G = self.gear_ratio
+        tau = np.empty_like(q)
+        for k in range(q.shape[0]):
+            data.qpos[arm_qpos] = q[k]
+            data.qpos[rotor_qpos] = G * q[k]
+            data.qvel[arm_dof] = qd[k]
+            data.qvel[rotor_dof] = G * qd[k]
+            data.qacc[arm_dof] = qdd[k]
+            data.qacc[rotor_dof] = G * qdd[k]
+            mujoco.mj_inverse(model, data)
+            # The rigid gearbox carries the rotor's generalized force to the arm through G.
+            tau[k] = data.qfrc_inverse[arm_dof] + G * data.qfrc_inverse[rotor_dof]
+        if friction:
+            tau += G * self.friction.stribeck_torque(G * qd)
+        return tau
+
+
+def _check_vector(name: str, value: np.ndarray) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (N_AXES,):
+        raise ValueError(f"{name} must have shape ({N_AXES},), got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} holds a non-finite value at axis {int(np.argmin(np.isfinite(arr))) + 1}")
+    return arr
+
+
+def _check_trajectory(name: str, value: np.ndarray, n: int | None = None) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != N_AXES or (n is not None and arr.shape[0] != n):
+        expected = f"(n, {N_AXES})" if n is None else f"({n}, {N_AXES})"
+        raise ValueError(f"{name} must have shape {expected}, got {arr.shape}")
+    bad = np.argwhere(~np.isfinite(arr))
+    if bad.size:
+        row, col = bad[0]
+        raise ValueError(f"{name} holds a non-finite value at row {row}, axis {col + 1}")
+    return arr
+
+
+def load(name: str | Path) -> Robot:
+    """Load a robot by name (see :func:`available`) or from the path of an MJCF file.
+
+    Parameters
+    ----------
+    name : str or Path
+        A known robot name such as ``"puma560"`` or ``"irb6700"``, or the path of an MJCF file
+        with the elements listed in this module's docstring.
+
+    Returns
+    -------
+    Robot
+
+    Raises
+    ------
+    UnknownRobotError
+        If ``name`` is neither a known robot nor an existing file; the message lists the known
+        robots.
+    ModelError
+        If the MJCF does not compile (the message names the file and MuJoCo's line) or lacks a
+        required element.
+    """
+    known = available()
+    if str(name) in known:
+        path = known[str(name)]
+    elif Path(name).is_file():
+        path = Path(name)
+    else:
+        listing = ", ".join(known) or "(none found in " + str(robots_dir()) + ")"
+        raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
+    return _from_file(path.resolve())
+
+
+def _from_file(path: Path) -> Robot:
+    try:
+        model = mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as err:
+        raise ModelError(f"{path}: {str(err).strip()}") from err
+
+    def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
+        idx = mujoco.mj_name2id(model, obj_type, element)
+        if idx < 0:
+            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{N_AXES}")
+        return idx
+
+    axes = range(1, N_AXES + 1)
+    joint_names = tuple(f"joint{i}" for i in axes)
+    rotor_names = tuple(f"rotor{i}" for i in axes)
+    gearbox_names = tuple(f"gearbox{i}" for i in axes)
+    actuator_names = tuple(f"motor{i}" for i in axes)
+
+    gear_ratio = np.empty(N_AXES)
+    joint_range = np.empty((N_AXES, 2))
+    motor_inertia = np.empty(N_AXES)
+    torque_limit = np.empty(N_AXES)
+    friction_rows = np.empty((N_AXES, len(FRICTION_FIELDS)))
+    for k in range(N_AXES):
+        j = require("joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
+        r = require("joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
+        t = require("tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
+        a = require("actuator", mujoco.mjtObj.mjOBJ_ACTUATOR, actuator_names[k])
+        f = require("custom numeric", mujoco.mjtObj.mjOBJ_NUMERIC, f"friction{k + 1}")
+        gear_ratio[k] = _gear_ratio(model, path, t, j, r)
+        if model.actuator_trnid[a, 0] != r or model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
+            raise ModelError(f"{path}: actuator {actuator_names[k]!r} must drive joint {rotor_names[k]!r}")
+        joint_range[k] = model.jnt_range[j]
+        motor_inertia[k] = model.dof_armature[model.jnt_dofadr[r]]
+        torque_limit[k] = np.max(np.abs(model.actuator_ctrlrange[a]))
+        size = model.numeric_size[f]
+        if size != len(FRICTION_FIELDS):
+            raise ModelError(
+                f"{path}: numeric 'friction{k + 1}' has {size} values, expected {len(FRICTION_FIELDS)}: "
+                + " ".join(FRICTION_FIELDS)
+            )
+        adr = model.numeric_adr[f]
+        friction_rows[k] = model.numeric_data[adr : adr + size]
+    try:
+        friction = MotorFriction.from_rows(friction_rows)
+    except ValueError as err:
+        raise ModelError(f"{path}: {err}") from err
+
+    tendon_ids = [model.tendon(n).id for n in gearbox_names]
+    key = require("keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
+    joint_qpos = [model.jnt_qposadr[model.joint(n).id] for n in joint_names]
+    description_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "description")
+    description = ""
+    if description_id >= 0:
+        adr, size = model.text_adr[description_id], model.text_size[description_id]
+        description = bytes(model.text_data[adr : adr + size - 1]).decode()
+
+    for k in range(N_AXES):
+        if model.jnt_limited[model.joint(joint_names[k]).id] == 0:
+            raise ModelError(f"{path}: joint {joint_names[k]!r} must be limited (give it a range)")
+
+    return Robot(
+        name=path.stem,
+        description=description,
+        path=path,
+        model=model,
+        joint_names=joint_names,
+        rotor_names=rotor_names,
+        gearbox_names=gearbox_names,
+        actuator_names=actuator_names,
+        gear_ratio=gear_ratio,
+        motor_inertia=motor_inertia,
+        gearbox_stiffness=model.tendon_stiffness[tendon_ids].copy(),
+        gearbox_damping=model.tendon_damping[tendon_ids].copy(),
+        joint_range=joint_range,
+        motor_torque_limit=torque_limit,
+        friction=friction,
+        home=model.key_qpos[key, joint_qpos].copy(),
+    )
+
+
+def _gear_ratio(model: mujoco.MjModel, path: Path, tendon: int, joint: int, rotor: int) -> float:
+    """G of a gearbox tendon ``L = rotor / G - joint``; raises ModelError on any other shape."""
+    name = model.tendon(tendon).name
+    adr, num = model.tendon_adr[tendon], model.tendon_num[tendon]
+    wraps = {int(model.wrap_objid[w]): float(model.wrap_prm[w]) for w in range(adr, adr + num)}
+    fixed = all(model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_JOINT for w in range(adr, adr + num))
+    if not fixed or set(wraps) != {joint, rotor} or wraps[joint] != -1.0 or wraps[rotor] <= 0:
+        raise ModelError(
+            f"{path}: tendon {name!r} must be a fixed tendon with coef 1/G > 0 on its rotor joint "
+            "and coef -1 on its arm joint (thesis eq. 6.2a)"
+        )
+    return 1.0 / wraps[rotor]
