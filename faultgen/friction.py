@@ -88,7 +88,7 @@ class MotorFriction:
                 if not np.isfinite(v) or v < 0 or (positive and v == 0):
                     need = "> 0" if positive else ">= 0"
                     raise ValueError(
-                        f"axis {axis}: friction {f.name} = {v!r} {UNITS[f.name]}, expected a finite value {need}"
+                        f"axis {axis}: friction {f.name} = {float(v)!r} {UNITS[f.name]}, expected a finite value {need}"
                     )
             value.setflags(write=False)
             object.__setattr__(self, f.name, value)
