@@ -14,6 +14,7 @@ actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import mujoco
@@ -116,25 +117,28 @@ class Robot:
         model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
         object.__setattr__(self, "_inverse", (model, mujoco.MjData(model)))
 
-    @property
+    def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
+        return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
+
+    @cached_property
     def arm_qpos(self) -> np.ndarray:
         """Indices of the arm joints in ``qpos``, ``ndarray of shape (6,)``."""
-        return np.array([self.model.joint(n).qposadr[0] for n in self.joint_names])
+        return self._joint_addresses(self.joint_names, "qposadr")
 
-    @property
+    @cached_property
     def arm_dof(self) -> np.ndarray:
         """Indices of the arm joints in ``qvel``, ``ndarray of shape (6,)``."""
-        return np.array([self.model.joint(n).dofadr[0] for n in self.joint_names])
+        return self._joint_addresses(self.joint_names, "dofadr")
 
-    @property
+    @cached_property
     def rotor_qpos(self) -> np.ndarray:
         """Indices of the rotor joints in ``qpos``, ``ndarray of shape (6,)``."""
-        return np.array([self.model.joint(n).qposadr[0] for n in self.rotor_names])
+        return self._joint_addresses(self.rotor_names, "qposadr")
 
-    @property
+    @cached_property
     def rotor_dof(self) -> np.ndarray:
         """Indices of the rotor joints in ``qvel``, ``ndarray of shape (6,)``."""
-        return np.array([self.model.joint(n).dofadr[0] for n in self.rotor_names])
+        return self._joint_addresses(self.rotor_names, "dofadr")
 
     def rigid_state(self, q: np.ndarray, qd: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Full-model ``qpos`` and ``qvel`` for arm-side angles with an undeflected gearbox.
