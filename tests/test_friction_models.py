@@ -1,0 +1,122 @@
+"""The simulated friction models against their equations.
+
+A test rig of six free rotors named like a robot's (``rotor1..6``, each with the robot's motor
+inertia) gets the robot's friction exactly as a simulation does (``friction.add_lugre`` /
+``friction.add_stribeck``); no gearbox or arm is attached, so the rotor feels friction only.
+"""
+
+import mujoco
+import numpy as np
+import pytest
+
+from faultgen import friction, robots
+
+TIMESTEP = 0.0005
+
+
+def rig(robot, model_name, armature=None):
+    spec = mujoco.MjSpec()
+    spec.option.timestep = TIMESTEP
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    for k, name in enumerate(robot.rotor_names):
+        body = spec.worldbody.add_body(name=name)
+        body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1],
+                       armature=float(robot.motor_inertia[k] if armature is None else armature))
+        body.mass = 1e-9
+        body.inertia = [1e-12] * 3
+        body.explicitinertial = True
+    if model_name == "lugre":
+        friction.add_lugre(spec, robot)
+    else:
+        friction.add_stribeck(spec, robot)
+    return spec.compile()
+
+
+def rig_friction(model, data, robot, model_name):
+    """Friction torque on each rotor, N m, positive when opposing positive motion."""
+    if model_name == "lugre":
+        ids = [model.actuator(f"lugre{k + 1}").id for k in range(6)]
+        return -data.actuator_force[ids] + robot.friction.viscous * data.qvel
+    return -data.qfrc_constraint + robot.friction.viscous * data.qvel
+
+
+def step(model, data, robot, model_name):
+    if model_name == "stribeck":  # as faultgen.sim does before every step
+        model.dof_frictionloss[:] = robot.friction.stribeck_level(data.qvel[None])[0]
+    mujoco.mj_step(model, data)
+
+
+@pytest.mark.parametrize("name", ["irb6700", "puma560"])
+@pytest.mark.parametrize("model_name", friction.MODELS)
+def test_friction_at_constant_speed_follows_eq_6_3(name, model_name):
+    """LuGre's steady state and the static model both equal the Stribeck curve (eq. 6.3)."""
+    robot = robots.load(name)
+    # huge rotor inertia: friction cannot change the speed noticeably
+    model = rig(robot, model_name, armature=1e6)
+    data = mujoco.MjData(model)
+    vs = robot.friction.stribeck_velocity
+    for ratio in (0.5, 1.0, 2.0, 6.0):
+        for sign in (1.0, -1.0):
+            mujoco.mj_resetData(model, data)
+            data.qvel[:] = sign * ratio * vs
+            for _ in range(2000):
+                step(model, data, robot, model_name)
+            mujoco.mj_forward(model, data)
+            measured = rig_friction(model, data, robot, model_name)
+            expected = robot.friction.stribeck_torque(data.qvel[None])[0]
+            if model_name == "lugre":  # MuJoCo's LuGre is symmetric: mean Coulomb level
+                mean = (robot.friction.coulomb_pos + robot.friction.coulomb_neg) / 2
+                expected = expected + np.sign(data.qvel) * (mean - np.where(data.qvel > 0, robot.friction.coulomb_pos,
+                                                                             robot.friction.coulomb_neg))
+            np.testing.assert_allclose(measured, expected, rtol=2e-3, err_msg=f"v = {sign * ratio} v_s")
+
+
+@pytest.mark.parametrize("model_name", friction.MODELS)
+def test_breakaway_under_slowly_rising_torque_is_coulomb_plus_static(model_name):
+    robot = robots.load("irb6700")
+    model = rig(robot, model_name)
+    data = mujoco.MjData(model)
+    f = robot.friction
+    breakaway = f.coulomb_pos + f.static
+    duration = 20.0  # s: reach 1.5 times the breakaway level, slowly
+    rate = 1.5 * breakaway / duration
+    found = np.full(6, np.nan)
+    for k in range(int(duration / TIMESTEP)):
+        data.qfrc_applied[:] = rate * k * TIMESTEP
+        step(model, data, robot, model_name)
+        moving = np.isnan(found) & (data.qvel > 0.01 * f.stribeck_velocity)
+        found[moving] = data.qfrc_applied[moving]
+    print(model_name, "breakaway / (f_c + f_s):", found / breakaway)
+    np.testing.assert_allclose(found, breakaway, rtol=0.05)
+
+
+def test_lugre_presliding_displacement_is_force_over_bristle_stiffness():
+    robot = robots.load("irb6700")
+    model = rig(robot, "lugre")
+    data = mujoco.MjData(model)
+    f = robot.friction
+    force = 0.1 * (f.coulomb_pos + f.static)
+    data.qfrc_applied[:] = force
+    for _ in range(int(1.0 / TIMESTEP)):
+        mujoco.mj_step(model, data)
+    print("presliding displacement / (F / sigma_0):", data.qpos / (force / f.bristle_stiffness))
+    assert np.all(np.abs(data.qvel) < 1e-6)  # at rest: stuck, not sliding
+    np.testing.assert_allclose(data.qpos, force / f.bristle_stiffness, rtol=0.1)
+
+
+def test_static_model_sticks_below_breakaway():
+    robot = robots.load("irb6700")
+    model = rig(robot, "stribeck")
+    data = mujoco.MjData(model)
+    data.qfrc_applied[:] = 0.9 * (robot.friction.coulomb_pos + robot.friction.static)
+    for _ in range(int(1.0 / TIMESTEP)):
+        step(model, data, robot, "stribeck")
+    assert np.all(np.abs(data.qpos) < 1e-3)
+
+
+def test_lugre_needs_gamma_2():
+    robot = robots.load("irb6700")
+    rows = robot.friction.as_rows()
+    rows[2, friction.FIELDS.index("stribeck_exponent")] = 1.5
+    with pytest.raises(ValueError, match="axis 3: stribeck_exponent = 1.5"):
+        friction.lugre_parameters(friction.MotorFriction.from_rows(rows))
