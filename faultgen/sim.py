@@ -1,0 +1,400 @@
+"""Stepping: one robot repeating one task for many cycles while chosen axes wear.
+
+Only the cycles that are recorded are simulated. Each starts from the task's start state (at
+rest, gearboxes deflected by the static load, drives on their set-points) with its own wear
+level, so cycles are independent: they are stepped together as the simulations of one
+``mujoco.batch.Batch``, one per cycle, with the wear as per-simulation model fields.
+
+With the ``lugre`` friction model everything that runs at the physics rate (the PID drives,
+LuGre friction, the gearboxes) runs inside MuJoCo, and Python only hands over pre-computed
+set-points and disturbance torques a chunk at a time (``Batch.rollout``). The static
+``stribeck`` model needs its friction level set before every physics step from the rotor speed,
+so it steps from Python and is slower (docs/performance.md gives both figures).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from mujoco import batch as mjbatch
+from tqdm.auto import tqdm
+
+from faultgen import control, friction, robots, sensors, tasks
+from faultgen.wear import WearPlan
+
+#: Physics steps per logging period (0.5 ms steps, 4 ms logging).
+CHUNK_PERIODS = 250  # logging periods per Batch.rollout call (1 s of simulated time)
+
+
+class SimulationDiverged(RuntimeError):
+    """A cycle's state became non-finite or MuJoCo warned; the message names cycle and axis."""
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """One run: a robot repeating a task for ``cycles`` cycles while the axes of ``wear`` wear.
+
+    Attributes
+    ----------
+    robot : str
+        Robot name (``faultgen robots``) or MJCF path.
+    task : str
+        One of :data:`faultgen.tasks.TASKS`.
+    friction : str
+        Friction model, one of :data:`faultgen.friction.MODELS`.
+    wear : WearPlan
+        Worn axes and their schedules; empty for no wear.
+    cycles : int
+        Number of cycles of the run (cycle indices 1..cycles); >= 1.
+    record : tuple of int, optional
+        The cycles to simulate and record; all of them when omitted.
+    seed : int
+        Seed of the disturbance and encoder noise; >= 0.
+    noise : NoiseConfig
+        Disturbance and encoder noise levels.
+    nthread : int
+        Threads for stepping (0: all CPUs).
+
+    Raises
+    ------
+    ValueError
+        On construction, for an unknown robot, task or friction model, cycles < 1, a recorded
+        cycle outside 1..cycles, a negative seed or nthread; the message names the value.
+    """
+
+    robot: str
+    task: str
+    friction: str = "lugre"
+    wear: WearPlan = field(default_factory=lambda: WearPlan({}))
+    cycles: int = 100
+    record: tuple[int, ...] | None = None
+    seed: int = 0
+    noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
+    nthread: int = 0
+
+    def __post_init__(self) -> None:
+        known = robots.available()
+        if self.robot not in known and not Path(self.robot).is_file():
+            raise ValueError(f"unknown robot {self.robot!r}; known robots: {', '.join(known)}")
+        if self.task not in tasks.TASKS:
+            raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
+        friction.check_model(self.friction)
+        if not isinstance(self.cycles, (int, np.integer)) or isinstance(self.cycles, bool) or self.cycles < 1:
+            raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
+        if self.record is not None:
+            record = tuple(int(c) for c in self.record)
+            if not record:
+                raise ValueError("record is empty; give at least one cycle, or omit it to record all")
+            bad = [c for c in record if not 1 <= c <= self.cycles]
+            if bad:
+                raise ValueError(f"recorded cycle {bad[0]} is out of range 1..{self.cycles}")
+            object.__setattr__(self, "record", tuple(sorted(set(record))))
+        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
+        if self.nthread < 0:
+            raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
+
+    @property
+    def recorded_cycles(self) -> np.ndarray:
+        """Indices of the simulated cycles, ``ndarray of shape (n_recorded,)``."""
+        if self.record is None:
+            return np.arange(1, self.cycles + 1)
+        return np.array(self.record)
+
+
+@dataclass(frozen=True)
+class SimModel:
+    """A robot compiled for simulation: PID drives plus one friction model.
+
+    Attributes
+    ----------
+    robot : Robot
+        The nominal robot the model was built from.
+    friction_model : str
+    gains : ServoGains
+    model : mujoco.MjModel
+    drive_ctrl : ndarray of shape (6, 3)
+        ``ctrl`` indices of each drive's (pos, vel, ff) inputs.
+    drive_ids : ndarray of shape (6,)
+        Actuator ids of the drives ``motor{i}``.
+    lugre_ids : ndarray of shape (6,)
+        Actuator ids of the friction actuators ``lugre{i}`` (empty for ``stribeck``).
+    """
+
+    robot: robots.Robot
+    friction_model: str
+    gains: control.ServoGains
+    model: mujoco.MjModel
+    drive_ctrl: np.ndarray
+    drive_ids: np.ndarray
+    lugre_ids: np.ndarray
+
+
+def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
+    """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model.
+
+    Raises
+    ------
+    ValueError
+        For an unknown friction model, or friction parameters the model cannot represent.
+    """
+    friction.check_model(friction_model)
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    gains = control.ServoGains.for_robot(robot)
+    control.add_drives(spec, robot, gains)
+    if friction_model == "lugre":
+        friction.add_lugre(spec, robot)
+    else:
+        friction.add_stribeck(spec, robot)
+    model = spec.compile()
+    drive_ids = np.array([model.actuator(n).id for n in robot.actuator_names])
+    drive_ctrl = model.actuator_ctrladr[drive_ids][:, None] + np.arange(len(control.INPUTS))
+    lugre_ids = np.array(
+        [model.actuator(f"lugre{k + 1}").id for k in range(6)] if friction_model == "lugre" else [], dtype=int
+    )
+    return SimModel(robot, friction_model, gains, model, drive_ctrl, drive_ids, lugre_ids)
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Everything a run recorded. Arrays over recorded cycles come first, then log samples.
+
+    Attributes
+    ----------
+    config : RunConfig
+    t : ndarray of shape (n_log,)
+        Log times within a cycle, s (every 4 ms, first sample 4 ms after the start).
+    cycles : ndarray of shape (n_cycles,)
+        Recorded cycle indices (1-based).
+    q_ref : ndarray of shape (n_log, 6)
+        Reference arm angles at the log times, rad.
+    q_a, q_m : ndarray of shape (n_cycles, n_log, 6)
+        Arm and motor angles as the encoders report them, rad (arm side / motor side).
+    qd_a, qd_m : ndarray of shape (n_cycles, n_log, 6)
+        Arm and motor speeds from the encoders (backward difference), rad/s.
+    tau_m : ndarray of shape (n_cycles, n_log, 6)
+        Motor torque (drive output), N m at the motor side.
+    tau_f : ndarray of shape (n_cycles, n_log, 6)
+        True motor-side friction torque, N m, positive when it opposes positive motion.
+    tau_dist : ndarray of shape (n_cycles, n_log, 6)
+        True load disturbance on the arm joints, N m at the arm side.
+    friction_multiplier : ndarray of shape (n_cycles, 6)
+        True wear multiplier of Coulomb and static friction per cycle and axis.
+    mean_friction_torque : ndarray of shape (n_cycles, 6)
+        Mean absolute true friction torque per cycle and axis, N m at the motor side.
+    tracking_error : ndarray of shape (n_cycles, 6)
+        Largest absolute error of the true arm angle against the reference, rad.
+    stepping_time : float
+        Wall time spent stepping the physics, s (not part of the recorded data).
+    """
+
+    config: RunConfig
+    t: np.ndarray
+    cycles: np.ndarray
+    q_ref: np.ndarray
+    q_a: np.ndarray
+    q_m: np.ndarray
+    qd_a: np.ndarray
+    qd_m: np.ndarray
+    tau_m: np.ndarray
+    tau_f: np.ndarray
+    tau_dist: np.ndarray
+    friction_multiplier: np.ndarray
+    mean_friction_torque: np.ndarray
+    tracking_error: np.ndarray
+    stepping_time: float = field(default=0.0, compare=False)
+
+
+def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``qpos`` and ``qvel`` at rest at arm angles ``q0`` with drives on their set-points.
+
+    The motors sit at ``G q0`` and each gearbox carries the static load: the arm sags by
+    ``tau_static / K`` (thesis eq. 6.2a), so a cycle starts in equilibrium.
+    """
+    qpos, qvel = robot.rigid_state(q0)
+    zeros = np.zeros((1, 6))
+    static = robot.inverse_dynamics(q0[None], zeros, zeros, friction=False)[0]
+    qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness
+    return qpos, qvel
+
+
+def simulate(config: RunConfig, progress: bool = True) -> RunResult:
+    """Run ``config``: simulate its recorded cycles and return what the monitoring recorded.
+
+    Raises
+    ------
+    SimulationDiverged
+        If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
+    """
+    robot = robots.load(config.robot)
+    sim = build(robot, config.friction)
+    path = tasks.load(robot, config.task).trajectory(sim.model.opt.timestep)
+    per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
+    n_steps = _padded_steps(len(path.t) - 1, per_log)
+    q_ref, qd_ref, qdd_ref = (_hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
+    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref)  # (n_steps, 6, 3)
+
+    cycles = config.recorded_cycles
+    multiplier = config.wear.multipliers(cycles)
+    n_log = n_steps // per_log
+    feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
+    sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
+    dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
+
+    stepper = _step_lugre if config.friction == "lugre" else _step_stribeck
+    with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
+              desc=f"{robot.name} {config.task}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
+              "[{elapsed}<{remaining}]") as bar:
+        started = time.perf_counter()
+        raw = stepper(sim, config, cycles, multiplier, path.q[0], inputs, dist, per_log, bar)
+        stepping_time = time.perf_counter() - started
+    return _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
+
+
+def _padded_steps(n: int, per_log: int) -> int:
+    return -(-n // per_log) * per_log
+
+
+def _hold_end(a: np.ndarray, n_steps: int) -> np.ndarray:
+    """The path sampled at every physics step, holding its last sample to reach ``n_steps + 1``."""
+    if len(a) >= n_steps + 1:
+        return a[: n_steps + 1]
+    return np.vstack([a, np.repeat(a[-1:], n_steps + 1 - len(a), axis=0)])
+
+
+@dataclass
+class _Raw:
+    """True signals at the log times, each ``(n_cycles, n_log, 6)``."""
+
+    q_a: np.ndarray
+    q_m: np.ndarray
+    qd_a: np.ndarray
+    qd_m: np.ndarray
+    tau_m: np.ndarray
+    tau_f: np.ndarray
+
+
+def _new_batch(sim: SimModel, config: RunConfig, n_sim: int, q0: np.ndarray) -> mjbatch.Batch:
+    """One simulation per recorded cycle, all at the task's start state."""
+    batch = mjbatch.Batch(sim.model, nsim=n_sim, nthread=config.nthread)
+    batch.qpos, batch.qvel = start_state(sim.robot, q0)
+    batch.act = 0.0
+    return batch
+
+
+def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar) -> _Raw:
+    """All physics in MuJoCo: set-points and disturbances handed over one chunk at a time."""
+    robot, model = sim.robot, sim.model
+    batch = _new_batch(sim, config, len(cycles), q0)
+    bias = batch.expand("actuator_biasprm")
+    bias[:, sim.lugre_ids, 3] *= multiplier  # Coulomb level F_c
+    bias[:, sim.lugre_ids, 4] *= multiplier  # breakaway level F_s
+    n_steps = len(inputs) - 1
+    spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+    ncontrol = model.nu + model.nv
+    out = {name: [] for name in ("qpos", "qvel", "actuator_force")}
+    chunk = CHUNK_PERIODS * per_log
+    for start in range(0, n_steps, chunk):
+        stop = min(start + chunk, n_steps)
+        control_in = np.zeros((len(cycles), stop - start, ncontrol))
+        ctrl = np.zeros((stop - start, model.nu))
+        ctrl[:, sim.drive_ctrl] = inputs[start:stop]
+        control_in[:, :, : model.nu] = ctrl
+        periods = np.arange(start, stop) // per_log
+        control_in[:, :, model.nu + robot.arm_dof] = dist[:, periods]
+        rec = batch.rollout(stop - start, control=control_in, control_spec=spec,
+                            record=("qpos", "qvel", "actuator_force"))
+        _check(sim, batch, cycles, rec["qvel"], start)
+        for name in out:
+            out[name].append(rec[name][:, per_log - 1 :: per_log])
+        bar.update(len(cycles) * (stop - start) * model.opt.timestep)
+    qpos, qvel, force = (np.concatenate(out[n], axis=1) for n in ("qpos", "qvel", "actuator_force"))
+    v_m = qvel[:, :, robot.rotor_dof]
+    # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
+    tau_f = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
+    return _Raw(qpos[:, :, robot.arm_qpos], qpos[:, :, robot.rotor_qpos], qvel[:, :, robot.arm_dof], v_m,
+                force[:, :, sim.drive_ids], tau_f)
+
+
+def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar) -> _Raw:
+    """Static friction: the friction-loss level follows the rotor speed before every step."""
+    robot, model = sim.robot, sim.model
+    batch = _new_batch(sim, config, len(cycles), q0)
+    frictionloss = batch.expand("dof_frictionloss")
+    qvel, qpos = batch.bind("qvel"), batch.bind("qpos")
+    ctrl, applied = batch.bind("ctrl"), batch.bind("qfrc_applied")
+    force, constraint = batch.bind("actuator_force"), batch.bind("qfrc_constraint")
+    n_steps = len(inputs) - 1
+    n_log = n_steps // per_log
+    logs = {n: np.empty((len(cycles), n_log, 6)) for n in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f")}
+    rotor, arm = robot.rotor_dof, robot.arm_dof
+    for step in range(n_steps):
+        frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], multiplier)
+        ctrl[:, sim.drive_ctrl] = inputs[step]
+        applied[:, arm] = dist[:, step // per_log]
+        batch.step()
+        if (step + 1) % per_log == 0:
+            j = (step + 1) // per_log - 1
+            v_m = qvel[:, rotor]
+            logs["q_a"][:, j] = qpos[:, robot.arm_qpos]
+            logs["q_m"][:, j] = qpos[:, robot.rotor_qpos]
+            logs["qd_a"][:, j] = qvel[:, arm]
+            logs["qd_m"][:, j] = v_m
+            logs["tau_m"][:, j] = force[:, sim.drive_ids]
+            logs["tau_f"][:, j] = -constraint[:, rotor] + robot.friction.viscous * v_m
+            bar.update(len(cycles) * per_log * model.opt.timestep)
+            if (j + 1) % CHUNK_PERIODS == 0 or j == n_log - 1:
+                _check(sim, batch, cycles, logs["qd_m"][:, : j + 1], step)
+    return _Raw(**logs)
+
+
+def _check(sim: SimModel, batch, cycles: np.ndarray, velocities: np.ndarray, step: int) -> None:
+    """Raise SimulationDiverged naming the first bad cycle and axis."""
+    warned = np.asarray(batch.warning)
+    bad = np.flatnonzero(~np.all(np.isfinite(velocities.reshape(len(cycles), -1)), axis=1)
+                         | (warned.reshape(len(cycles), -1).sum(axis=1) > 0))
+    if bad.size:
+        i = int(bad[0])
+        v = velocities[i].reshape(-1, velocities.shape[-1])
+        finite = np.where(np.isfinite(v), np.abs(v), np.inf)
+        axis = int(np.argmax(finite.max(axis=0)) % 6) + 1
+        raise SimulationDiverged(
+            f"cycle {int(cycles[i])} diverged near t = {step * sim.model.opt.timestep:.3f} s on axis {axis}"
+            f" ({sim.robot.name}, {sim.friction_model} friction): the state became non-finite or MuJoCo "
+            "warned; check the friction parameters and wear level of that axis"
+        )
+
+
+def _measure(sim, config, cycles, multiplier, q_ref, dist, raw: _Raw, stepping_time: float) -> RunResult:
+    """Apply the sensors to the true signals and compute the per-cycle truth."""
+    n_log = raw.q_a.shape[1]
+    t = np.arange(1, n_log + 1) * sensors.LOG_PERIOD
+    q_a, q_m, qd_a, qd_m = [], [], [], []
+    for i, cycle in enumerate(cycles):
+        angles = sensors.encoder(config.seed, int(cycle), np.hstack([raw.q_a[i], raw.q_m[i]]), config.noise.encoder)
+        speeds = sensors.speed(angles, np.hstack([raw.qd_a[i, 0], raw.qd_m[i, 0]]))
+        q_a.append(angles[:, :6])
+        q_m.append(angles[:, 6:])
+        qd_a.append(speeds[:, :6])
+        qd_m.append(speeds[:, 6:])
+    return RunResult(
+        config=config,
+        t=t,
+        cycles=cycles,
+        q_ref=q_ref,
+        q_a=np.stack(q_a),
+        q_m=np.stack(q_m),
+        qd_a=np.stack(qd_a),
+        qd_m=np.stack(qd_m),
+        tau_m=raw.tau_m,
+        tau_f=raw.tau_f,
+        tau_dist=dist,
+        friction_multiplier=multiplier,
+        mean_friction_torque=np.mean(np.abs(raw.tau_f), axis=1),
+        tracking_error=np.max(np.abs(raw.q_a - q_ref), axis=1),
+        stepping_time=stepping_time,
+    )

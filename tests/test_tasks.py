@@ -1,0 +1,296 @@
+"""Task cycles (thesis ch. 6.3.1, tasks 1-3): rest-to-rest cycles within the limits, weld stops
+at the weld points, a seam followed at constant speed with the configured weave.
+
+Flange positions are measured independently of the planner: MuJoCo forward kinematics of the
+full robot model (rotors included) at ``robot.rigid_state(q)``.
+"""
+
+import itertools
+import shutil
+
+import mujoco
+import numpy as np
+import pytest
+
+from faultgen import robots, tasks
+
+ROBOTS = ["puma560", "irb6700"]
+CASES = [(r, t) for r in ROBOTS for t in tasks.TASKS]
+DT = 0.004  # s
+SEAM_LIMIT_SLACK = 0.01  # relative: the IK-based seam may exceed a limit by numerical noise only
+MM = 1e-3
+
+
+@pytest.fixture(scope="module")
+def loaded():
+    """{robot name: Robot}, loaded once."""
+    return {name: robots.load(name) for name in ROBOTS}
+
+
+@pytest.fixture(scope="module")
+def cycles(loaded):
+    """{(robot, task): (Task, JointPath)} at DT, planned once for the module."""
+    out = {}
+    for robot, name in CASES:
+        task = tasks.load(loaded[robot], name)
+        out[robot, name] = task, task.trajectory(DT)
+    return out
+
+
+def flange_positions(robot, q):
+    """Flange positions (n, 3) in m by forward kinematics of the full model."""
+    data = mujoco.MjData(robot.model)
+    site = robot.model.site("flange").id
+    out = np.empty((len(q), 3))
+    for k, qk in enumerate(q):
+        data.qpos[:], _ = robot.rigid_state(qk)
+        mujoco.mj_kinematics(robot.model, data)
+        out[k] = data.site_xpos[site]
+    return out
+
+
+def rest_runs(path, tol=1e-12):
+    """(first, last) sample indices of maximal runs at rest (zero velocity and acceleration)."""
+    rest = np.all(np.abs(path.qd) <= tol, axis=1) & np.all(np.abs(path.qdd) <= tol, axis=1)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], rest.astype(int), [0]])))
+    return list(zip(edges[::2], edges[1::2] - 1))
+
+
+def seam_segment(path):
+    (segment,) = [s for s in path.segments if s[0] == "seam"]
+    return segment[1], segment[2]
+
+
+def straight_parts(task, positions, margin=0.01):
+    """Per straight seam segment: (keep, along, across) for the positions (n, 3), m.
+
+    ``along`` and ``across`` are the coordinates along the segment line and across it in the
+    seam plane; ``keep`` marks the positions beside the segment at least
+    ``corner_radius + margin`` from its ends (clear of the rounded corners).
+    """
+    vertices = task.seam
+    normal = np.cross(vertices[1] - vertices[0], vertices[2] - vertices[1])
+    normal /= np.linalg.norm(normal)
+    parts = []
+    for a, b in itertools.pairwise(vertices):
+        length = np.linalg.norm(b - a)
+        direction = (b - a) / length
+        lateral = np.cross(normal, direction)
+        along = (positions - a) @ direction
+        across = (positions - a) @ lateral
+        near = (np.abs(across) < 0.02) & (np.abs((positions - a) @ normal) < 0.02)
+        keep = near & (along > task.corner_radius + margin) & (along < length - task.corner_radius - margin)
+        parts.append((keep, along, across))
+    return parts
+
+
+@pytest.mark.parametrize("robot,name", CASES)
+def test_cycle_starts_and_ends_at_the_same_rest_state(cycles, robot, name):
+    task, path = cycles[robot, name]
+    n = len(path.t)
+    assert path.q.shape == path.qd.shape == path.qdd.shape == (n, 6)
+    assert path.t[0] == 0.0
+    np.testing.assert_allclose(np.diff(path.t), DT, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(path.q[0], task.start)
+    np.testing.assert_array_equal(path.q[-1], path.q[0])
+    for arr in (path.qd, path.qdd):
+        np.testing.assert_array_equal(arr[[0, -1]], 0.0)
+    assert path.duration == pytest.approx(path.t[-1])
+    assert (
+        task.process
+        == {"pick_place": "point-to-point", "spot_weld": "discontinuous", "arc_weld": "continuous"}[name]
+    )
+
+
+@pytest.mark.parametrize("robot,name", CASES)
+def test_joint_velocity_and_acceleration_limits_hold(cycles, loaded, robot, name):
+    task, path = cycles[robot, name]
+    low, high = loaded[robot].joint_range.T
+    assert np.all(path.q >= low) and np.all(path.q <= high)
+    slack = SEAM_LIMIT_SLACK if name == "arc_weld" else 1e-9
+    assert np.all(np.abs(path.qd) <= task.velocity_limit * (1 + slack))
+    assert np.all(np.abs(path.qdd) <= task.acceleration_limit * (1 + slack))
+    # the limits are the file's: IRB-6700 speeds as published by ABB
+    if robot == "irb6700":
+        np.testing.assert_allclose(np.degrees(task.velocity_limit), [110, 110, 110, 190, 150, 210])
+
+
+@pytest.mark.parametrize("robot,name", CASES)
+def test_cycle_lasts_6_to_12_s(cycles, robot, name):
+    assert 6.0 <= cycles[robot, name][1].duration <= 12.0
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_pick_place_covers_a_large_part_of_every_range(cycles, loaded, robot):
+    _, path = cycles[robot, "pick_place"]
+    low, high = loaded[robot].joint_range.T
+    span = np.ptp(path.q, axis=0) / (high - low)
+    assert np.all((span >= 0.5) & (span <= 0.8)), span
+    # clear of the limits
+    assert np.all(path.q.min(axis=0) - low >= 0.05 * (high - low))
+    assert np.all(high - path.q.max(axis=0) >= 0.05 * (high - low))
+    # a move at full speed on at least one axis
+    assert np.max(np.abs(path.qd) / cycles[robot, "pick_place"][0].velocity_limit) > 0.99
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_spot_weld_stops_at_every_weld_point(cycles, loaded, robot):
+    task, path = cycles[robot, "spot_weld"]
+    assert 8 <= len(task.points) <= 12
+    dwell_steps = round(task.dwell / DT)
+    stops = [(a, b) for a, b in rest_runs(path) if b - a >= dwell_steps]
+    assert len(stops) == len(task.points)
+    for (first, last), point in zip(stops, task.points):
+        assert (last - first) * DT == pytest.approx(task.dwell, abs=DT / 2)
+        flange = flange_positions(loaded[robot], path.q[[first, (first + last) // 2, last]])
+        assert np.max(np.linalg.norm(flange - point, axis=1)) <= 0.5 * MM
+        np.testing.assert_array_equal(path.target[first : last + 1], np.tile(point, (last - first + 1, 1)))
+    # short moves between neighbouring weld points, at high acceleration
+    moves = [s for s in path.segments if s[0] == "move"][1:-1]
+    assert all((last - first) * DT < 1.0 for _, first, last in moves)
+    assert np.max(np.abs(path.qdd) / task.acceleration_limit) > 0.8
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
+    task, path = cycles[robot, "arc_weld"]
+    first, last = seam_segment(path)
+    flange = flange_positions(loaded[robot], path.q[first : last + 1])
+    target = path.target[first : last + 1]
+    assert not np.any(np.isnan(target))
+    assert np.max(np.linalg.norm(flange - target, axis=1)) <= 0.5 * MM
+    # and the seam runs from the first to the last vertex (the weave starts and ends at zero)
+    np.testing.assert_allclose(flange[0], task.seam[0], atol=0.5 * MM)
+    np.testing.assert_allclose(flange[-1], task.seam[-1], atol=0.5 * MM)
+    # the approach and retract are not on the seam
+    assert np.all(np.isnan(path.target[:first])) and np.all(np.isnan(path.target[last + 1 :]))
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_arc_weld_tool_speed_is_constant_along_the_seam(cycles, loaded, robot):
+    task, path = cycles[robot, "arc_weld"]
+    first, last = seam_segment(path)
+    flange = flange_positions(loaded[robot], path.q[first : last + 1])
+    velocity = np.gradient(flange, DT, axis=0)
+    t = np.arange(len(flange)) * DT
+    cruise = (t > task.ramp_time + 0.05) & (t < t[-1] - task.ramp_time - 0.05)
+    checked = 0
+    for keep, along, _ in straight_parts(task, flange):
+        sel = keep & cruise
+        direction = np.gradient(along, DT)[sel]  # speed along the seam line
+        assert np.all(np.abs(direction / task.tool_speed - 1) < 0.03), (direction.min(), direction.max())
+        checked += sel.sum()
+    assert checked > 0.5 * len(flange)
+    # the weave adds its lateral speed, and on the outside of a corner arc the offset path is longer
+    weave_speed = 2 * np.pi * task.weave_frequency * task.weave_amplitude
+    bound = np.hypot(task.tool_speed, weave_speed) * (1 + task.weave_amplitude / task.corner_radius)
+    assert np.max(np.linalg.norm(velocity, axis=1)) <= 1.02 * bound
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_arc_weld_weave_has_the_configured_amplitude_and_frequency(cycles, loaded, robot):
+    task, path = cycles[robot, "arc_weld"]
+    first, last = seam_segment(path)
+    flange = flange_positions(loaded[robot], path.q[first : last + 1])
+    assert 1 * MM <= task.weave_amplitude <= 5 * MM and 1.0 <= task.weave_frequency <= 3.0
+    for keep, _, across in straight_parts(task, flange):
+        lateral = across[keep]
+        assert np.max(np.abs(lateral)) == pytest.approx(task.weave_amplitude, rel=0.03)
+        assert np.max(np.abs(lateral)) <= task.weave_amplitude + 0.5 * MM
+    # frequency from the zero crossings of the lateral deviation on the longest straight part
+    keep, _, across = max(straight_parts(task, flange), key=lambda part: part[0].sum())
+    idx = np.flatnonzero(keep)
+    crossings = np.sum(np.diff(np.sign(across[idx])) != 0)
+    frequency = crossings / 2 / (len(idx) * DT)
+    assert frequency == pytest.approx(task.weave_frequency, rel=0.1)
+
+
+@pytest.mark.parametrize("robot,name", CASES)
+def test_the_same_call_gives_bit_identical_arrays(cycles, robot, name):
+    task, path = cycles[robot, name]
+    again = task.trajectory(DT)
+    for field in ("t", "q", "qd", "qdd"):
+        assert np.array_equal(getattr(path, field), getattr(again, field))
+    assert np.array_equal(path.target, again.target, equal_nan=True)
+    assert path.segments == again.segments
+
+
+def test_a_finer_step_gives_the_same_cycle(cycles):
+    task, coarse = cycles["puma560", "spot_weld"]
+    fine = task.trajectory(0.001)
+    # every move is rounded up to whole steps: at most one coarse step longer per move
+    assert abs(fine.duration - coarse.duration) <= len(coarse.segments) * DT
+    np.testing.assert_array_equal(fine.q[-1], task.start)
+
+
+def test_unknown_task_lists_the_known_ones(loaded):
+    with pytest.raises(ValueError) as err:
+        tasks.load(loaded["puma560"], "welding")
+    message = str(err.value)
+    assert "'welding'" in message
+    for name in tasks.TASKS:
+        assert name in message
+
+
+def test_bad_time_step_is_refused(cycles):
+    task, _ = cycles["puma560", "pick_place"]
+    for dt in (0.0, -0.004, float("nan")):
+        with pytest.raises(ValueError, match="dt"):
+            task.trajectory(dt)
+
+
+def copy_robot_folder(tmp_path, name):
+    """Copy a robot's MJCF and tasks.toml to tmp_path; return the MJCF path and the toml text."""
+    source = robots.available()[name]
+    shutil.copy(source, tmp_path / source.name)
+    text = (source.parent / "tasks.toml").read_text()
+    return tmp_path / source.name, text
+
+
+@pytest.mark.parametrize(
+    "old,new,task,key",
+    [
+        (
+            "velocity = [100, 95, 100, 150, 130, 110]",
+            "velocity = [100, 95, 100, 150, 130]",
+            "pick_place",
+            "velocity",
+        ),
+        ("dwell = 0.4", "dwel = 0.4", "spot_weld", "dwell"),
+        ("tool_speed = 0.1 ", "tool_speed = -0.1 ", "arc_weld", "tool_speed"),
+        ("start = [0, 92, -122, 30, 0, 0]", "start = [0, 92, -122, 30, 120, 0]", "pick_place", "start"),
+        ("dwell = [0.5, 0.5]", "dwell = [0.5]", "pick_place", "dwell"),
+        (
+            "[0.65, -0.30, 0.30],\n    [0.65, 0.00",
+            "[0.65, -0.30, 0.31],\n    [0.65, 0.00",
+            "arc_weld",
+            "seam",
+        ),
+    ],
+)
+def test_malformed_tasks_file_names_the_file_and_the_key(tmp_path, old, new, task, key):
+    mjcf, text = copy_robot_folder(tmp_path, "puma560")
+    assert old in text
+    (tmp_path / "tasks.toml").write_text(text.replace(old, new, 1))
+    with pytest.raises(ValueError) as err:
+        tasks.load(robots.load(mjcf), task)
+    message = str(err.value)
+    assert str(tmp_path / "tasks.toml") in message and key in message, message
+
+
+def test_missing_or_unparsable_tasks_file_is_reported(tmp_path):
+    mjcf, text = copy_robot_folder(tmp_path, "puma560")
+    robot = robots.load(mjcf)
+    with pytest.raises(ValueError, match="tasks.toml"):
+        tasks.load(robot, "pick_place")
+    (tmp_path / "tasks.toml").write_text(text.replace("[limits]", "[limits", 1))
+    with pytest.raises(ValueError, match="tasks.toml"):
+        tasks.load(robot, "pick_place")
+
+
+def test_a_seam_too_fast_for_the_limits_names_the_axis_and_a_speed_that_fits(tmp_path):
+    mjcf, text = copy_robot_folder(tmp_path, "irb6700")
+    (tmp_path / "tasks.toml").write_text(text.replace("tool_speed = 0.15 ", "tool_speed = 3.0 ", 1))
+    task = tasks.load(robots.load(mjcf), "arc_weld")
+    with pytest.raises(ValueError, match=r"axis \d.*tool_speed of about [0-9.]+ m/s would fit"):
+        task.trajectory(DT)
