@@ -293,31 +293,35 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
     bias = batch.expand("actuator_biasprm")
     bias[:, sim.lugre_ids, 3] *= multiplier  # Coulomb level F_c
     bias[:, sim.lugre_ids, 4] *= multiplier  # breakaway level F_s
-    n_steps = len(inputs) - 1
+    n_sim, n_steps = len(cycles), len(inputs) - 1
     spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
-    ncontrol = model.nu + model.nv
-    out = {name: [] for name in ("qpos", "qvel", "actuator_force")}
-    chunk = CHUNK_PERIODS * per_log
+    chunk = min(CHUNK_PERIODS * per_log, n_steps)
+    # buffers reused by every chunk: rollout inputs and per-substep records
+    control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
+    records = {name: np.empty((n_sim, chunk, size)) for name, size in
+               (("qpos", model.nq), ("qvel", model.nv), ("actuator_force", model.actuator_trnid.shape[0]))}
+    logs = {name: np.empty((n_sim, n_steps // per_log, 6)) for name in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f")}
+    arm_dist = model.nu + robot.arm_dof
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
-        control_in = np.zeros((len(cycles), stop - start, ncontrol))
-        ctrl = np.zeros((stop - start, model.nu))
-        ctrl[:, sim.drive_ctrl] = inputs[start:stop]
-        control_in[:, :, : model.nu] = ctrl
-        periods = np.arange(start, stop) // per_log
-        control_in[:, :, model.nu + robot.arm_dof] = dist[:, periods]
-        rec = batch.rollout(stop - start, control=control_in, control_spec=spec,
-                            record=("qpos", "qvel", "actuator_force"))
-        _check(sim, batch, cycles, rec["qvel"], start)
-        for name in out:
-            out[name].append(rec[name][:, per_log - 1 :: per_log])
-        bar.update(len(cycles) * (stop - start) * model.opt.timestep)
-    qpos, qvel, force = (np.concatenate(out[n], axis=1) for n in ("qpos", "qvel", "actuator_force"))
-    v_m = qvel[:, :, robot.rotor_dof]
-    # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
-    tau_f = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
-    return _Raw(qpos[:, :, robot.arm_qpos], qpos[:, :, robot.rotor_qpos], qvel[:, :, robot.arm_dof], v_m,
-                force[:, :, sim.drive_ids], tau_f)
+        size = stop - start
+        control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
+        control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
+        out = records if size == chunk else {k: np.empty((n_sim, size, v.shape[2])) for k, v in records.items()}
+        batch.rollout(size, control=control_in[:, :size], control_spec=spec, record=tuple(out), out=out)
+        _check(sim, batch, cycles, out["qvel"], start)
+        logged = slice(start // per_log, stop // per_log)
+        qpos, qvel, force = (out[k][:, per_log - 1 :: per_log] for k in ("qpos", "qvel", "actuator_force"))
+        v_m = qvel[:, :, robot.rotor_dof]
+        logs["q_a"][:, logged] = qpos[:, :, robot.arm_qpos]
+        logs["q_m"][:, logged] = qpos[:, :, robot.rotor_qpos]
+        logs["qd_a"][:, logged] = qvel[:, :, robot.arm_dof]
+        logs["qd_m"][:, logged] = v_m
+        logs["tau_m"][:, logged] = force[:, :, sim.drive_ids]
+        # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
+        logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
+        bar.update(n_sim * size * model.opt.timestep)
+    return _Raw(**logs)
 
 
 def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar) -> _Raw:
