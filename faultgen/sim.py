@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -62,8 +61,9 @@ class RunConfig:
     Raises
     ------
     ValueError
-        On construction, for an unknown robot, task or friction model, cycles < 1, a recorded
-        cycle outside 1..cycles, a negative seed or nthread; the message names the value.
+        On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
+        parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
+        1..cycles, a negative seed or nthread; the message names the value.
     """
 
     robot: str
@@ -77,9 +77,7 @@ class RunConfig:
     nthread: int = 0
 
     def __post_init__(self) -> None:
-        known = robots.available()
-        if self.robot not in known and not Path(self.robot).is_file():
-            raise ValueError(f"unknown robot {self.robot!r}; known robots: {', '.join(known)}")
+        robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
         if self.task not in tasks.TASKS:
             raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
         friction.check_model(self.friction)

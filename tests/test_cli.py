@@ -4,10 +4,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pytest
 from typer.testing import CliRunner
 
-from faultgen import robots
+from faultgen import dataset, robots, sim
 from faultgen.cli import app
+from faultgen.wear import WearPlan
 
 runner = CliRunner()
 
@@ -48,3 +51,61 @@ def test_console_script_is_installed():
     assert script.is_file(), f"no console script at {script}: install the project with pip"
     out = subprocess.run([str(script), "robots"], capture_output=True, text=True, check=True).stdout
     assert "puma560" in out and "irb6700" in out
+
+
+def test_simulate_writes_a_file_that_reads_back(tmp_path):
+    out = tmp_path / "run.h5"
+    result = runner.invoke(app, ["simulate", "--task", "spot_weld", "--wear", "2:exp4:20", "--cycles", "100",
+                                 "--record", "1,100", "--seed", "3", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert f"wrote {out}" in result.output
+    assert "1.2000" in result.output  # axis 2's wear multiplier in the last cycle
+    arrays, labels = dataset.read_run(out)
+    assert labels["robot"] == "irb6700" and labels["task"] == "spot_weld" and labels["seed"] == 3
+    assert list(labels["worn_axes"]) == [2]
+    np.testing.assert_array_equal(arrays["cycles"], [1, 100])
+    np.testing.assert_allclose(arrays["friction_multiplier"][:, 1], [np.exp(np.log(1.2) / 1e8), 1.2])
+    # the file holds exactly what the library returns for the same configuration
+    config = sim.RunConfig(robot="irb6700", task="spot_weld", wear=WearPlan.from_specs(["2:exp4:20"], 100),
+                           record=(1, 100), seed=3)
+    direct = sim.simulate(config, progress=False)
+    for name in dataset.ARRAYS:
+        np.testing.assert_array_equal(arrays[name], getattr(direct, name), err_msg=name)
+    assert not list(tmp_path.glob("*.part"))
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--task", "welding"], "unknown task 'welding'"),
+        (["--wear", "7:exp4:20"], "axis 7 is out of range 1..6"),
+        (["--wear", "2:exp4:-10"], "2:exp4:-10"),
+        (["--cycles", "0"], "--cycles 0"),
+        (["--friction", "coulomb"], "unknown friction model 'coulomb'"),
+        (["--record", "1,x"], "--record part 'x'"),
+    ],
+)
+def test_simulate_refuses_bad_input_before_simulating(tmp_path, args, message):
+    out = tmp_path / "run.h5"
+    result = runner.invoke(app, ["simulate", *args, "--no-progress", "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_simulate_refuses_a_robot_file_with_negative_friction(tmp_path):
+    source = robots.available()["irb6700"]
+    model = tmp_path / "worn_robot.xml"
+    model.write_text(source.read_text().replace('<numeric name="friction5" data="0.50', '<numeric name="friction5" data="-0.50'))
+    result = runner.invoke(app, ["simulate", "--robot", str(model), "--no-progress", "-o", str(tmp_path / "r.h5")])
+    assert result.exit_code == 2
+    assert "axis 5: friction coulomb_pos = -0.5" in result.output
+    assert not (tmp_path / "r.h5").exists()
+
+
+def test_simulate_does_not_overwrite_without_asking(tmp_path):
+    out = tmp_path / "run.h5"
+    out.write_text("precious")
+    result = runner.invoke(app, ["simulate", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 2 and "--overwrite" in result.output
+    assert out.read_text() == "precious"

@@ -1,0 +1,117 @@
+"""The simulation core: wear reaches the motor torque, runs repeat bit for bit, long runs stay clean."""
+
+import shutil
+
+import numpy as np
+import pytest
+
+from faultgen import robots, sim, tasks
+from faultgen.sensors import NoiseConfig
+from faultgen.wear import WearPlan
+
+
+def run(task="pick_place", wear=(), robot="irb6700", friction="lugre", **kwargs):
+    plan = WearPlan.from_specs(list(wear), last_cycle=kwargs.get("cycles", 100))
+    return sim.simulate(sim.RunConfig(robot=robot, task=task, friction=friction, wear=plan, **kwargs),
+                        progress=False)
+
+
+@pytest.fixture(scope="module")
+def nominal_last_cycle():
+    return run(record=(100,))
+
+
+@pytest.mark.parametrize("axis", range(1, 7))
+def test_wear_on_an_axis_reaches_its_motor_torque_as_the_added_friction(axis, nominal_last_cycle):
+    """Thesis Table 6.1, qualitatively: 20 % wear on axis i, cycle 100, IRB-6700-like, pick and place.
+
+    The drive of the worn axis supplies the added friction: its extra torque along the direction
+    of motion equals the added friction along it within 10 %; every other axis changes far less.
+    """
+    nominal = nominal_last_cycle
+    worn = run(wear=[f"{axis}:exp4:20"], record=(100,))
+    k = axis - 1
+    assert worn.friction_multiplier[-1, k] == pytest.approx(1.2, rel=1e-12)
+    direction = np.sign(nominal.qd_m[-1, :, k])
+    added_friction = np.mean(direction * (worn.tau_f[-1, :, k] - nominal.tau_f[-1, :, k]))
+    extra_drive = np.mean(direction * (worn.tau_m[-1, :, k] - nominal.tau_m[-1, :, k]))
+    # the added friction is about 20 % of the nominal Coulomb + Stribeck level, not a trace
+    assert added_friction > 0.15 * nominal.mean_friction_torque[-1, k] * 0.2
+    assert extra_drive == pytest.approx(added_friction, rel=0.10)
+    rise = np.mean(np.abs(worn.tau_m[-1]), axis=0) - np.mean(np.abs(nominal.tau_m[-1]), axis=0)
+    others = np.delete(np.abs(rise), k)
+    assert np.all(others < 0.1 * added_friction), rise
+
+
+def test_same_seed_is_bit_identical_and_a_new_seed_changes_only_the_noise():
+    first = run(task="spot_weld", wear=["3:exp4:20"], record=(1, 100), seed=7)
+    again = run(task="spot_weld", wear=["3:exp4:20"], record=(1, 100), seed=7)
+    for name in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f", "tau_dist", "friction_multiplier"):
+        assert np.array_equal(getattr(first, name), getattr(again, name)), name
+    other = run(task="spot_weld", wear=["3:exp4:20"], record=(1, 100), seed=8)
+    assert not np.array_equal(first.tau_dist, other.tau_dist)
+    assert not np.array_equal(first.q_a, other.q_a)
+    np.testing.assert_array_equal(first.friction_multiplier, other.friction_multiplier)
+    np.testing.assert_array_equal(first.q_ref, other.q_ref)
+    # without noise the seed has nothing left to change
+    quiet = NoiseConfig(disturbance=0.0, encoder=0.0)
+    a = run(task="spot_weld", wear=["3:exp4:20"], record=(100,), seed=7, noise=quiet)
+    b = run(task="spot_weld", wear=["3:exp4:20"], record=(100,), seed=8, noise=quiet)
+    assert np.array_equal(a.tau_m, b.tau_m) and np.array_equal(a.q_a, b.q_a)
+
+
+def test_a_cycle_does_not_depend_on_which_other_cycles_are_recorded():
+    alone = run(task="arc_weld", wear=["2:linear:20"], record=(50,), seed=3)
+    among = run(task="arc_weld", wear=["2:linear:20"], record=(10, 50, 90), seed=3)
+    assert np.array_equal(alone.tau_m[0], among.tau_m[1])
+    assert np.array_equal(alone.q_a[0], among.q_a[1])
+
+
+@pytest.mark.parametrize("robot", ["puma560", "irb6700"])
+@pytest.mark.parametrize("task", tasks.TASKS)
+def test_100_cycles_without_warning_or_nan(robot, task):
+    """All six axes wearing, 100 cycles: no MuJoCo warning (a warning raises), nothing non-finite."""
+    wear = [f"{axis}:exp4:20" for axis in range(1, 7)]
+    result = run(task=task, robot=robot, wear=wear, nthread=0)
+    assert result.tau_m.shape[:2] == (100, len(result.t))
+    for name in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f"):
+        assert np.all(np.isfinite(getattr(result, name))), name
+    assert np.all(result.friction_multiplier[-1] == pytest.approx(1.2))
+    # the drives track: the arm stays within 25 mrad of the reference
+    assert np.max(result.tracking_error) < 0.025
+
+
+def test_a_diverging_run_names_cycle_and_axis(tmp_path):
+    """An absurdly stiff gearbox on axis 3 makes the explicit spring unstable."""
+    source = robots.available()["irb6700"]
+    text = source.read_text().replace('<fixed name="gearbox3" stiffness="1.42e6"', '<fixed name="gearbox3" stiffness="1.42e13"')
+    broken = tmp_path / "irb6700_unstable.xml"
+    broken.write_text(text)
+    shutil.copy(source.parent / "tasks.toml", tmp_path / "tasks.toml")
+    with pytest.raises(sim.SimulationDiverged, match=r"cycle 7 diverged near t = [\d.]+ s on axis \d"):
+        run(robot=str(broken), record=(7,), cycles=10)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(task="welding"), "unknown task 'welding'; expected one of: pick_place, spot_weld, arc_weld"),
+        (dict(cycles=0), r"cycles = 0; expected a whole number >= 1"),
+        (dict(friction="coulomb"), "unknown friction model 'coulomb'; expected one of: lugre, stribeck"),
+        (dict(record=(0, 5)), r"recorded cycle 0 is out of range 1..100"),
+        (dict(seed=-1), r"seed = -1; expected a whole number >= 0"),
+        (dict(robot="puma"), "unknown robot 'puma'"),
+    ],
+)
+def test_bad_configuration_is_refused_before_simulation(kwargs, match):
+    config = dict(robot="irb6700", task="pick_place", wear=WearPlan({}), cycles=100)
+    config.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        sim.RunConfig(**config)
+
+
+def test_tracking_error_is_reported_per_task():
+    for task in tasks.TASKS:
+        result = run(task=task, record=(1,))
+        assert result.tracking_error.shape == (1, 6)
+        assert np.all(result.tracking_error > 0)
