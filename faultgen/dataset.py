@@ -117,11 +117,18 @@ def write_run(path: str | Path, result: RunResult, run_id: str = "run", command:
                 ds.attrs["axes"] = axes
                 ds.attrs["description"] = description
             f.attrs["complete"] = True
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def read_run(path: str | Path, run_id: str = "run") -> tuple[dict[str, np.ndarray], dict]:

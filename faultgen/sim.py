@@ -15,7 +15,7 @@ so it steps from Python and is slower (docs/performance.md gives both figures).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import mujoco
 import numpy as np
@@ -25,8 +25,9 @@ from tqdm.auto import tqdm
 from faultgen import control, friction, robots, sensors, tasks
 from faultgen.wear import WearPlan
 
-#: Physics steps per logging period (0.5 ms steps, 4 ms logging).
-CHUNK_PERIODS = 250  # logging periods per Batch.rollout call (1 s of simulated time)
+#: Logging periods handed to MuJoCo per ``Batch.rollout`` call (1 s of simulated time): long
+#: enough that the hand-over costs little, short enough that the per-step records stay small.
+CHUNK_PERIODS = 250
 
 
 class SimulationDiverged(RuntimeError):
@@ -298,7 +299,7 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
     control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
     records = {name: np.empty((n_sim, chunk, size)) for name, size in
                (("qpos", model.nq), ("qvel", model.nv), ("actuator_force", model.actuator_trnid.shape[0]))}
-    logs = {name: np.empty((n_sim, n_steps // per_log, 6)) for name in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f")}
+    logs = {f.name: np.empty((n_sim, n_steps // per_log, 6)) for f in fields(_Raw)}
     arm_dist = model.nu + robot.arm_dof
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
@@ -332,7 +333,7 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
     force, constraint = batch.bind("actuator_force"), batch.bind("qfrc_constraint")
     n_steps = len(inputs) - 1
     n_log = n_steps // per_log
-    logs = {n: np.empty((len(cycles), n_log, 6)) for n in ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f")}
+    logs = {f.name: np.empty((len(cycles), n_log, 6)) for f in fields(_Raw)}
     rotor, arm = robot.rotor_dof, robot.arm_dof
     for step in range(n_steps):
         frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], multiplier)

@@ -109,3 +109,14 @@ def test_simulate_does_not_overwrite_without_asking(tmp_path):
     result = runner.invoke(app, ["simulate", "--no-progress", "-o", str(out)])
     assert result.exit_code == 2 and "--overwrite" in result.output
     assert out.read_text() == "precious"
+
+
+def test_written_file_has_normal_permissions(tmp_path):
+    import os
+
+    out = tmp_path / "run.h5"
+    result = runner.invoke(app, ["simulate", "--record", "1", "--cycles", "2", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    mask = os.umask(0)
+    os.umask(mask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~mask
