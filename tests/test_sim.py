@@ -115,3 +115,16 @@ def test_tracking_error_is_reported_per_task():
         result = run(task=task, record=(1,))
         assert result.tracking_error.shape == (1, 6)
         assert np.all(result.tracking_error > 0)
+
+
+def test_static_friction_model_also_passes_wear_to_the_motor():
+    """The stribeck path (friction level set from Python every step) behaves like the LuGre one."""
+    nominal = run(friction="stribeck", record=(100,))
+    worn = run(friction="stribeck", wear=["5:exp4:20"], record=(100,))
+    again = run(friction="stribeck", wear=["5:exp4:20"], record=(100,))
+    assert np.array_equal(worn.tau_m, again.tau_m)
+    direction = np.sign(nominal.qd_m[-1, :, 4])
+    added = np.mean(direction * (worn.tau_f[-1, :, 4] - nominal.tau_f[-1, :, 4]))
+    extra = np.mean(direction * (worn.tau_m[-1, :, 4] - nominal.tau_m[-1, :, 4]))
+    assert added > 0.05
+    assert extra == pytest.approx(added, rel=0.10)
