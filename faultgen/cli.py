@@ -165,6 +165,122 @@ def simulate_command(
     typer.echo(_summary(result, out))
 
 
+@app.command("sweep")
+def sweep_command(
+    preset: Annotated[
+        Optional[str], typer.Option(help="A named grid: quick (a first look, < 2 min), j2 (thesis ch. 6), c2 (thesis ch. 3).")
+    ] = None,
+    config: Annotated[
+        Optional[Path], typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
+    ] = None,
+    robots_: Annotated[Optional[list[str]], typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
+    tasks_: Annotated[Optional[list[str]], typer.Option("--task", help="Task(s); repeat for several.")] = None,
+    axes: Annotated[Optional[list[int]], typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
+    increases: Annotated[Optional[list[float]], typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
+    schedules: Annotated[Optional[list[str]], typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
+    friction_model: Annotated[Optional[str], typer.Option("--friction", help="lugre or stribeck.")] = None,
+    cycles: Annotated[Optional[int], typer.Option(help="Cycles per run.")] = None,
+    record: Annotated[Optional[str], typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
+    seeds: Annotated[Optional[list[int]], typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
+    scheduler: Annotated[
+        Optional[str], typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
+    progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
+) -> None:
+    """Simulate a grid of runs (robot x task x worn axis x wear x schedule x seed) into one dataset.
+
+    The grid comes from --preset, --config or the options (options override the preset or file).
+    Killed or failed? Run the same command again: finished runs are kept, only missing ones run.
+
+    Examples:
+
+      faultgen sweep --preset quick -o quick.h5
+
+      faultgen sweep --preset j2 --jobs 2 -o j2.h5
+
+      faultgen sweep --robot puma560 --task spot_weld --axis 0 --axis 3 --wear-pct 10 --wear-pct 20 -o s.h5
+    """
+    from faultgen import sweep
+
+    options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
+               "friction": friction_model, "cycles": cycles, "seeds": seeds,
+               "record": list(_parse_cycles(record)) if record else None}
+    options = {k: v for k, v in options.items() if v}
+    try:
+        if config is not None:
+            grid = sweep.Grid.from_toml(config)
+            if options:
+                grid = sweep.Grid(**{**{f: getattr(grid, f) for f in grid.__dataclass_fields__}, **options})
+        elif preset is not None:
+            grid = sweep.Grid.from_preset(preset, **options)
+        else:
+            grid = sweep.Grid(**{"robots": ["irb6700"], "tasks": ["pick_place"], "axes": [0], **options})
+        if jobs < 1:
+            raise ValueError(f"--jobs {jobs}: expected >= 1")
+        if out.exists():
+            raise ValueError(f"{out} exists; remove it or choose another --out")
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    n_runs, done = len(grid.runs()), len(sweep.finished_runs(grid, out))
+    typer.echo(f"{n_runs} runs -> {out}" + (f" on {scheduler}" if scheduler else f" with {jobs} job(s)"))
+    if done:
+        typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as they are")
+    try:
+        sweep.run(grid, out, jobs=jobs, scheduler=scheduler, progress=progress,
+                  command=shlex.join(["faultgen", *sys.argv[1:]]))
+    except sweep.SweepError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(1) from err
+    typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
+               f"  faultgen plot {out} -o {out.with_suffix('.png')}")
+
+
+@app.command("info")
+def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
+    """Summarise a dataset: runs, robots, tasks, worn axes, cycles, provenance."""
+    from faultgen import dataset
+
+    try:
+        typer.echo(dataset.summary(file))
+    except dataset.DatasetError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(1) from err
+
+
+@app.command("validate")
+def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
+    """Check a dataset against the schema (docs/dataset.md); exit 1 with the reasons if it fails."""
+    from faultgen import dataset
+
+    problems = dataset.validate(file)
+    if problems:
+        for problem in problems[:50]:
+            typer.echo(f"invalid: {problem}", err=True)
+        raise typer.Exit(1)
+    typer.echo(f"{file}: valid ({len(dataset.list_runs(file))} runs)")
+
+
+@app.command("plot")
+def plot_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],
+    run: Annotated[Optional[str], typer.Option(help="Plot one run (default: the whole sweep, or its only run).")] = None,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="PNG to write (default: FILE with .png).")] = None,
+) -> None:
+    """Draw per-cycle mean |motor torque| per axis against the true wear, as a PNG."""
+    from faultgen import dataset, plot
+
+    target = out or file.with_suffix(".png")
+    try:
+        plot.plot(file, target, run=run)
+    except (ValueError, dataset.DatasetError) as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(1) from err
+    typer.echo(f"wrote {target}")
+
+
 def _parse_cycles(text: str) -> tuple[int, ...]:
     """'1,50,90-100' -> (1, 50, 90, ..., 100); raises ValueError naming the bad part."""
     cycles: list[int] = []

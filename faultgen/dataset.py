@@ -1,25 +1,25 @@
-"""HDF5 files of simulated runs: writer (atomic) and reader.
+"""HDF5 datasets of simulated runs: schema, atomic writer, reader, validator, summary.
 
-Layout of a file (h5py; every array carries ``units``, ``axes`` and ``description`` attributes)::
+One file holds any number of runs. Layout (h5py; every array carries ``units``, ``axes`` and
+``description`` attributes; docs/dataset.md explains each field)::
 
     /                         attrs: format = "faultgen", format_version, faultgen_version,
+                                     n_runs, command, grid (JSON, sweeps only),
                                      complete (written last: True only for a finished file)
-    /runs/<run id>/           attrs: robot, task, friction_model, cycles, seed, wear (JSON),
-                                     noise (JSON), worn_axes, model_sha256, log_period, command
-        t                     (n_log,)               s, log times within a cycle
-        cycles                (n_cycles,)            1-based indices of the recorded cycles
-        q_ref                 (n_log, 6)             rad, reference arm angles
-        q_a, q_m              (n_cycles, n_log, 6)   rad, encoder angles, arm / motor side
-        qd_a, qd_m            (n_cycles, n_log, 6)   rad/s, encoder speeds, arm / motor side
-        tau_m                 (n_cycles, n_log, 6)   N m, motor torque (motor side)
-        tau_f                 (n_cycles, n_log, 6)   N m, true friction torque (motor side)
-        tau_dist              (n_cycles, n_log, 6)   N m, true load disturbance (arm side)
-        friction_multiplier   (n_cycles, 6)          1, true wear multiplier
-        mean_friction_torque  (n_cycles, 6)          N m, mean |tau_f| per cycle (motor side)
-        tracking_error        (n_cycles, 6)          rad, largest |q_a - q_ref| per cycle
+    /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
+                                     wear JSON, noise JSON) and provenance (faultgen_version,
+                                     model_sha256, log_period, config JSON, command)
+        t, cycles, q_ref                       time base, recorded cycles, reference
+        q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, 6) logged signals, 250 Hz
+        tau_f, tau_dist                        (n_cycles, n_log, 6) truth
+        friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
+        mean_abs_torque, rms_torque                                       (n_cycles, 6) features
+        angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
 
-A file is written under a temporary name in the target folder and renamed into place once
-complete, so a crash or kill never leaves a file at the target path that looks finished.
+A file is written under a temporary name in its target folder and renamed into place once
+complete, so a crash or kill never leaves a file at the target path that looks finished; a
+reader refuses a file whose ``complete`` attribute is not set, and :func:`validate` reports
+truncated or corrupted files instead of letting them be read.
 """
 
 from __future__ import annotations
@@ -28,6 +28,8 @@ import hashlib
 import json
 import os
 import tempfile
+from collections.abc import Iterable
+from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
 
@@ -35,27 +37,40 @@ import h5py
 import numpy as np
 
 from faultgen import __version__, robots, sensors
-from faultgen.sim import RunResult
 
 FORMAT = "faultgen"
 FORMAT_VERSION = 1
+SIGNAL_AXES = "cycle, sample, axis"
 
 #: name -> (units, axes, description) of every array of a run group.
 ARRAYS = {
-    "t": ("s", "sample", "log time within a cycle"),
+    "t": ("s", "sample", "log time within a cycle (250 Hz)"),
     "cycles": ("1", "cycle", "1-based index of each recorded cycle"),
     "q_ref": ("rad", "sample, axis", "reference arm angle"),
-    "q_a": ("rad", "cycle, sample, axis", "arm angle from the encoder"),
-    "q_m": ("rad", "cycle, sample, axis", "motor angle from the encoder (motor side)"),
-    "qd_a": ("rad/s", "cycle, sample, axis", "arm speed, backward difference of q_a"),
-    "qd_m": ("rad/s", "cycle, sample, axis", "motor speed, backward difference of q_m (motor side)"),
-    "tau_m": ("N m", "cycle, sample, axis", "motor torque (drive output, motor side)"),
-    "tau_f": ("N m", "cycle, sample, axis", "true friction torque, motor side, positive opposing positive motion"),
-    "tau_dist": ("N m", "cycle, sample, axis", "true load disturbance on the arm joint (arm side)"),
+    "q_a": ("rad", SIGNAL_AXES, "arm angle from the encoder"),
+    "q_m": ("rad", SIGNAL_AXES, "motor angle from the encoder (motor side)"),
+    "qd_a": ("rad/s", SIGNAL_AXES, "arm speed, backward difference of q_a"),
+    "qd_m": ("rad/s", SIGNAL_AXES, "motor speed, backward difference of q_m (motor side)"),
+    "tau_m": ("N m", SIGNAL_AXES, "motor torque (drive output, motor side)"),
+    "tau_f": ("N m", SIGNAL_AXES, "true friction torque, motor side, positive opposing positive motion"),
+    "tau_dist": ("N m", SIGNAL_AXES, "true load disturbance on the arm joint (arm side)"),
     "friction_multiplier": ("1", "cycle, axis", "true wear multiplier of Coulomb and static friction"),
     "mean_friction_torque": ("N m", "cycle, axis", "mean absolute true friction torque per cycle (motor side)"),
     "tracking_error": ("rad", "cycle, axis", "largest absolute error of the true arm angle against q_ref"),
+    "mean_abs_torque": ("N m", "cycle, axis", "mean absolute motor torque per cycle (motor side)"),
+    "rms_torque": ("N m", "cycle, axis", "RMS motor torque per cycle (motor side)"),
+    "angle_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of the joint range"),
+    "speed_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..max arm speed"),
+    "torque_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..peak motor torque"),
 }
+
+#: Attributes every run group carries.
+RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
+                  "faultgen_version", "model_sha256", "log_period", "config", "command")
+
+
+class DatasetError(ValueError):
+    """A file is not a finished, valid faultgen dataset; the message says what is wrong."""
 
 
 def model_hash(path: Path) -> str:
@@ -63,7 +78,17 @@ def model_hash(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def run_attributes(result: RunResult, command: str = "") -> dict:
+def config_key(config) -> str:
+    """The run configuration as canonical JSON: equal keys mean the same simulation."""
+    return json.dumps({
+        "robot": config.robot, "task": config.task, "friction": config.friction,
+        "wear": config.wear.to_dict(), "cycles": int(config.cycles),
+        "record": [int(c) for c in config.recorded_cycles], "seed": int(config.seed),
+        "noise": asdict(config.noise),
+    }, sort_keys=True)
+
+
+def run_attributes(result, command: str = "") -> dict:
     """Labels and provenance of a run, as HDF5 attributes (strings, numbers, JSON)."""
     config = result.config
     robot = robots.load(config.robot)
@@ -76,53 +101,29 @@ def run_attributes(result: RunResult, command: str = "") -> dict:
         "worn_axes": np.array(config.wear.worn_axes, dtype=int),
         "wear": json.dumps(config.wear.to_dict()),
         "noise": json.dumps(asdict(config.noise)),
+        "faultgen_version": __version__,
         "model_sha256": model_hash(robot.path),
         "log_period": sensors.LOG_PERIOD,
-        "faultgen_version": __version__,
+        "config": config_key(config),
         "command": command,
     }
 
 
-def write_run(path: str | Path, result: RunResult, run_id: str = "run", command: str = "") -> Path:
-    """Write one run to a new HDF5 file at ``path``, atomically.
-
-    Raises
-    ------
-    OSError
-        If the folder cannot be written (the message names it); nothing is left at ``path``.
-    """
-    path = Path(path)
+@contextmanager
+def _atomic(path: Path):
+    """Yield a temporary path beside ``path``; rename it onto ``path`` if the block succeeds."""
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise OSError(f"cannot write {path}: folder {folder} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
     os.close(fd)
     try:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["format"] = FORMAT
-            f.attrs["format_version"] = FORMAT_VERSION
-            f.attrs["faultgen_version"] = __version__
-            f.attrs["complete"] = False
-            group = f.create_group(f"runs/{run_id}")
-            for key, value in run_attributes(result, command).items():
-                group.attrs[key] = value
-            for name, (units, axes, description) in ARRAYS.items():
-                data = np.asarray(getattr(result, name))
-                chunked = data.ndim == 3
-                ds = group.create_dataset(
-                    name, data=data, compression="gzip" if chunked else None,
-                    chunks=(1, data.shape[1], 6) if chunked else None, shuffle=chunked,
-                )
-                ds.attrs["units"] = units
-                ds.attrs["axes"] = axes
-                ds.attrs["description"] = description
-            f.attrs["complete"] = True
+        yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
 
 
 def _umask() -> int:
@@ -131,22 +132,209 @@ def _umask() -> int:
     return mask
 
 
-def read_run(path: str | Path, run_id: str = "run") -> tuple[dict[str, np.ndarray], dict]:
-    """Read one run: its arrays by name and its attributes.
+def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
+    f.attrs["format"] = FORMAT
+    f.attrs["format_version"] = FORMAT_VERSION
+    f.attrs["faultgen_version"] = __version__
+    f.attrs["n_runs"] = n_runs
+    f.attrs["command"] = command
+    f.attrs["grid"] = grid
+
+
+def write_run(path: str | Path, result, run_id: str = "run", command: str = "") -> Path:
+    """Write one run to a new HDF5 file at ``path``, atomically.
 
     Raises
     ------
-    ValueError
-        If the file is not a finished faultgen file or has no such run (the message says which).
+    OSError
+        If the folder does not exist or cannot be written, or the disk is full; nothing is left
+        at ``path`` and no temporary file remains.
     """
-    with h5py.File(path, "r") as f:
+    path = Path(path)
+    with _atomic(path) as tmp, h5py.File(tmp, "w") as f:
+        _write_root(f, 1, command, "")
+        f.attrs["complete"] = False
+        group = f.create_group(f"runs/{run_id}")
+        for key, value in run_attributes(result, command).items():
+            group.attrs[key] = value
+        values = {name: getattr(result, name, None) for name in ARRAYS}
+        values.update(result.features)
+        for name, (units, axes, description) in ARRAYS.items():
+            data = np.asarray(values[name])
+            if axes == SIGNAL_AXES:
+                # 250 Hz signals: float32 (7 digits, finer than the 1e-4 rad encoder noise), one chunk
+                # per cycle, uncompressed: gzip saves only 24 % on these noisy signals at 4.6 times the
+                # write time (docs/dataset.md)
+                ds = group.create_dataset(name, data=data.astype(np.float32), chunks=(1, *data.shape[1:]))
+            else:
+                ds = group.create_dataset(name, data=data, compression="gzip", compression_opts=4, shuffle=True)
+            ds.attrs["units"] = units
+            ds.attrs["axes"] = axes
+            ds.attrs["description"] = description
+        f.attrs["complete"] = True
+    return path
+
+
+def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = "", grid: str = "") -> Path:
+    """Copy the run of each part file (``(run id, part path)``) into one new dataset, atomically.
+
+    Chunks are copied as stored (no recompression). Raises :class:`DatasetError` if a part is not
+    a finished faultgen file.
+    """
+    path = Path(path)
+    parts = list(parts)
+    with _atomic(path) as tmp, h5py.File(tmp, "w") as out:
+        _write_root(out, len(parts), command, grid)
+        out.attrs["complete"] = False
+        runs = out.create_group("runs")
+        for run_id, part in parts:
+            with _open(part) as src:
+                (name,) = list(src["runs"])
+                src.copy(src["runs"][name], runs, name=run_id)
+        out.attrs["complete"] = True
+    return path
+
+
+@contextmanager
+def _open(path: str | Path):
+    """Open a finished faultgen file for reading, or raise DatasetError saying why not."""
+    try:
+        f = h5py.File(path, "r")
+    except FileNotFoundError:
+        raise DatasetError(f"{path}: no such file") from None
+    except OSError as err:
+        raise DatasetError(f"{path}: cannot be opened as HDF5 (truncated or not HDF5): {err}") from None
+    try:
         if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{path} is not a faultgen file (format attribute {f.attrs.get('format')!r})")
+            raise DatasetError(f"{path} is not a faultgen file (format attribute {f.attrs.get('format')!r})")
         if not f.attrs.get("complete", False):
-            raise ValueError(f"{path} is incomplete: its writer did not finish")
-        if f"runs/{run_id}" not in f:
-            raise ValueError(f"{path} has no run {run_id!r}; runs: {', '.join(f['runs'])}")
-        group = f[f"runs/{run_id}"]
+            raise DatasetError(f"{path} is incomplete: its writer did not finish")
+        if "runs" not in f:
+            raise DatasetError(f"{path} has no /runs group")
+        yield f
+    finally:
+        f.close()
+
+
+def list_runs(path: str | Path) -> list[str]:
+    """Run ids of a dataset, in file order."""
+    with _open(path) as f:
+        return list(f["runs"])
+
+
+def read_run(path: str | Path, run_id: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
+    """Read one run: its arrays by name and its attributes (labels and provenance).
+
+    ``run_id`` may be omitted for a file with one run. Raises :class:`DatasetError` if the file is
+    not a finished faultgen file or has no such run.
+    """
+    with _open(path) as f:
+        ids = list(f["runs"])
+        if run_id is None:
+            if len(ids) != 1:
+                raise DatasetError(f"{path} has {len(ids)} runs; name one: {', '.join(ids[:10])}")
+            run_id = ids[0]
+        if run_id not in f["runs"]:
+            raise DatasetError(f"{path} has no run {run_id!r}; runs: {', '.join(ids[:10])}")
+        group = f["runs"][run_id]
         arrays = {name: group[name][()] for name in group}
-        attrs = {key: group.attrs[key] for key in group.attrs}
+        attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
+
+
+def labels(path: str | Path) -> list[dict]:
+    """The labels of every run, one dict per run (with its ``run`` id), in file order."""
+    with _open(path) as f:
+        return [{"run": run_id, **{k: _attr(v) for k, v in f["runs"][run_id].attrs.items()}} for run_id in f["runs"]]
+
+
+def _attr(value):
+    return value.decode() if isinstance(value, bytes) else value
+
+
+def validate(path: str | Path) -> list[str]:
+    """Check a file against the schema; return the problems found (an empty list: valid).
+
+    Opens every array (so corrupted chunks surface), and checks units, shapes, finiteness, that
+    histograms sum to 1, that recorded cycles lie in 1..cycles, and that the run count matches.
+    """
+    problems: list[str] = []
+    try:
+        with _open(path) as f:
+            runs = f["runs"]
+            if f.attrs.get("format_version") != FORMAT_VERSION:
+                problems.append(f"format_version {f.attrs.get('format_version')!r}, expected {FORMAT_VERSION}")
+            if f.attrs.get("n_runs") != len(runs):
+                problems.append(f"n_runs attribute {f.attrs.get('n_runs')!r} but {len(runs)} run groups")
+            if len(runs) == 0:
+                problems.append("no runs")
+            for run_id in runs:
+                problems += [f"run {run_id}: {p}" for p in _validate_run(runs[run_id])]
+    except DatasetError as err:
+        return [str(err)]
+    except (OSError, RuntimeError, KeyError) as err:
+        problems.append(f"cannot read {path}: {err} (corrupted file?)")
+    return problems
+
+
+def _validate_run(group: h5py.Group) -> list[str]:
+    problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
+    missing = [name for name in ARRAYS if name not in group]
+    problems += [f"missing array {name!r}" for name in missing]
+    if missing:
+        return problems
+    data = {}
+    for name, (units, axes, _) in ARRAYS.items():
+        ds = group[name]
+        if _attr(ds.attrs.get("units")) != units or _attr(ds.attrs.get("axes")) != axes:
+            problems.append(f"{name}: units/axes attributes {ds.attrs.get('units')!r}/{ds.attrs.get('axes')!r}, "
+                            f"expected {units!r}/{axes!r}")
+        try:
+            data[name] = ds[()]
+        except (OSError, RuntimeError) as err:
+            problems.append(f"{name}: cannot be read ({err}); the file is corrupted")
+            return problems
+        if not np.all(np.isfinite(data[name])):
+            problems.append(f"{name}: holds non-finite values")
+    n_cycles, n_log = len(data["cycles"]), len(data["t"])
+    for name, (_, axes, _) in ARRAYS.items():
+        expected = {SIGNAL_AXES: (n_cycles, n_log, 6), "cycle, axis": (n_cycles, 6),
+                    "cycle, axis, bin": (n_cycles, 6, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, 6),
+                    "sample": (n_log,), "cycle": (n_cycles,)}[axes]
+        if data[name].shape != expected:
+            problems.append(f"{name}: shape {data[name].shape}, expected {expected}")
+    if problems:
+        return problems
+    cycles = int(group.attrs["cycles"])
+    if np.any(data["cycles"] < 1) or np.any(data["cycles"] > cycles) or np.any(np.diff(data["cycles"]) <= 0):
+        problems.append(f"cycles must increase within 1..{cycles}")
+    for name in ("angle_hist", "speed_hist", "torque_hist"):
+        if not np.allclose(data[name].sum(axis=-1), 1.0):
+            problems.append(f"{name}: a histogram does not sum to 1")
+    if np.any(data["friction_multiplier"] <= 0):
+        problems.append("friction_multiplier: not positive")
+    return problems
+
+
+def summary(path: str | Path) -> str:
+    """A few lines describing a dataset: runs, robots, tasks, wear, cycles, size, provenance."""
+    with _open(path) as f:
+        runs = f["runs"]
+        rows = [{k: _attr(v) for k, v in runs[r].attrs.items()} for r in runs]
+        n_cycles = [runs[r]["cycles"].shape[0] for r in runs]
+        n_log = [runs[r]["t"].shape[0] for r in runs]
+        version, command = _attr(f.attrs.get("faultgen_version")), _attr(f.attrs.get("command", ""))
+    worn = sorted({tuple(int(a) for a in row["worn_axes"]) for row in rows})
+    lines = [
+        f"{path}: {len(rows)} run(s), {Path(path).stat().st_size / 1e6:.1f} MB, written by faultgen {version}",
+        f"  robots:        {', '.join(sorted({r['robot'] for r in rows}))}",
+        f"  tasks:         {', '.join(sorted({r['task'] for r in rows}))}",
+        f"  friction:      {', '.join(sorted({r['friction_model'] for r in rows}))}",
+        f"  worn axes:     {', '.join('none' if not w else '+'.join(map(str, w)) for w in worn)}",
+        f"  seeds:         {', '.join(map(str, sorted({int(r['seed']) for r in rows})))}",
+        f"  cycles:        {min(n_cycles)}-{max(n_cycles)} recorded per run, {sum(n_cycles)} in all; "
+        f"{min(n_log)}-{max(n_log)} samples per cycle at {1 / sensors.LOG_PERIOD:.0f} Hz",
+    ]
+    if command:
+        lines.append(f"  command:       {command}")
+    return "\n".join(lines)

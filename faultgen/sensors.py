@@ -82,3 +82,63 @@ def speed(angles: np.ndarray, first: np.ndarray, period: float = LOG_PERIOD) -> 
     out[0] = first
     out[1:] = np.diff(angles, axis=0) / period
     return out
+
+
+#: Bins of the remote-monitoring histograms (thesis ch. 5.3.1: 12 values per measurement).
+HISTOGRAM_BINS = 12
+
+
+def histogram(values: np.ndarray, low: np.ndarray, high: np.ndarray, bins: int = HISTOGRAM_BINS) -> np.ndarray:
+    """Fraction of samples in each of ``bins`` equal ranges of [low, high], per cycle and axis.
+
+    Parameters
+    ----------
+    values : ndarray of shape (n_cycles, n_samples, 6)
+    low, high : ndarray of shape (6,)
+        Range per axis; values outside it count in the first or last bin.
+
+    Returns
+    -------
+    ndarray of shape (n_cycles, 6, bins)
+        Each row sums to 1.
+    """
+    fraction = (values - low) / (high - low)
+    index = np.clip((fraction * bins).astype(int), 0, bins - 1)
+    counts = np.stack([np.sum(index == b, axis=1) for b in range(bins)], axis=-1)
+    return counts / values.shape[1]
+
+
+def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_range: np.ndarray,
+                   speed_limit: np.ndarray, torque_limit: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-cycle aggregates of a run, as a robot's remote monitoring reports them.
+
+    Parameters
+    ----------
+    q_a, qd_a : ndarray of shape (n_cycles, n_samples, 6)
+        Logged arm angles (rad) and speeds (rad/s).
+    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+        Logged motor torque, N m at the motor side.
+    joint_range : ndarray of shape (6, 2)
+        Joint limits, rad: the design range of the angle histogram.
+    speed_limit : ndarray of shape (6,)
+        Largest arm speed, rad/s: the design maximum of the speed histogram.
+    torque_limit : ndarray of shape (6,)
+        Peak motor torque, N m: the design maximum of the torque histogram.
+
+    Returns
+    -------
+    dict of ndarray
+        ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) in N m (thesis ch. 6.3.2: the mean of
+        absolute torque per cycle); ``angle_hist``, ``speed_hist``, ``torque_hist``
+        (n_cycles, 6, 12): fraction of the cycle's samples in each twelfth of the design range
+        (angle from its lower to its upper limit; |speed| and |torque| from 0 to their design
+        maximum, larger values in the last bin; thesis ch. 5.3.1).
+    """
+    zeros = np.zeros(6)
+    return {
+        "mean_abs_torque": np.mean(np.abs(tau_m), axis=1),
+        "rms_torque": np.sqrt(np.mean(tau_m**2, axis=1)),
+        "angle_hist": histogram(q_a, joint_range[:, 0], joint_range[:, 1]),
+        "speed_hist": histogram(np.abs(qd_a), zeros, speed_limit),
+        "torque_hist": histogram(np.abs(tau_m), zeros, torque_limit),
+    }

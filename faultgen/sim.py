@@ -187,6 +187,10 @@ class RunResult:
         Mean absolute true friction torque per cycle and axis, N m at the motor side.
     tracking_error : ndarray of shape (n_cycles, 6)
         Largest absolute error of the true arm angle against the reference, rad.
+    features : dict of ndarray
+        Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
+        ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
+        ``torque_hist`` (n_cycles, 6, 12).
     stepping_time : float
         Wall time spent stepping the physics, s (not part of the recorded data).
     """
@@ -205,6 +209,7 @@ class RunResult:
     friction_multiplier: np.ndarray
     mean_friction_torque: np.ndarray
     tracking_error: np.ndarray
+    features: dict[str, np.ndarray] = field(default_factory=dict)
     stepping_time: float = field(default=0.0, compare=False)
 
 
@@ -231,7 +236,8 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     """
     robot = robots.load(config.robot)
     sim = build(robot, config.friction)
-    path = tasks.load(robot, config.task).trajectory(sim.model.opt.timestep)
+    task = tasks.load(robot, config.task)
+    path = task.trajectory(sim.model.opt.timestep)
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (_hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
@@ -251,7 +257,10 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         started = time.perf_counter()
         raw = stepper(sim, config, cycles, multiplier, path.q[0], inputs, dist, per_log, bar)
         stepping_time = time.perf_counter() - started
-    return _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
+    result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
+    result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
+                                                  task.velocity_limit, robot.motor_torque_limit))
+    return result
 
 
 def _padded_steps(n: int, per_log: int) -> int:

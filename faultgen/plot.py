@@ -1,0 +1,141 @@
+"""A first look at a dataset: mean absolute motor torque per axis against the true wear, as a PNG.
+
+matplotlib is imported only when :func:`plot` is called (with the Agg backend), so importing this
+module needs neither matplotlib nor a display.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import dataset
+
+TORQUE_LABEL = "mean |motor torque| [N m]"
+WEAR_LABEL = "true wear [%]"
+WEAR_COLOR = "tab:red"
+#: Smallest torque range of a single-run panel, as a fraction of its mean torque: cycle-to-cycle
+#: noise (typically < 0.1 %) is not stretched over the whole panel.
+MIN_SPAN = 0.01
+
+
+def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
+    """Draw the per-cycle mean absolute motor torque of every axis against the true wear, as a PNG.
+
+    One run (``run`` given, or a file with exactly one run): a 2 x 3 grid, one panel per axis
+    ("axis 1" .. "axis 6"); x is the cycle index (1-based), markers are the mean absolute motor
+    torque of the cycle (N m, motor side), and, on a second y axis, a line is the true wear of that
+    axis in percent (friction multiplier - 1) * 100, drawn only where the axis wears. Each torque
+    axis spans at least 1 % of its mean torque, so cycle-to-cycle noise is not mistaken for a
+    trend. The title names the run, robot, task and friction model.
+
+    A whole sweep (several runs, ``run`` omitted): a 2 x 3 grid, one panel per axis j; for every
+    run that wears axis j, a line of its mean absolute motor torque (N m) against its true wear
+    (%), one colour per task; for every run without wear, a dashed horizontal line at the mean over
+    its cycles of the mean absolute torque of axis j, in the colour of its task. The title names
+    the file, the robots and the number of runs.
+
+    Parameters
+    ----------
+    path : path of a faultgen dataset (HDF5).
+    out : path of the PNG to write (suffix ``.png``); its folder must exist.
+    run : str, optional
+        Run id to draw (``faultgen.dataset.list_runs``); required to draw a single run of a sweep.
+
+    Returns
+    -------
+    Path of the PNG written.
+
+    Raises
+    ------
+    ValueError
+        If ``out`` does not end in ``.png``, or ``run`` is not a run of the file (the message
+        names it and lists some run ids).
+    faultgen.dataset.DatasetError
+        If ``path`` is not a finished, valid faultgen dataset.
+    """
+    out = Path(out)
+    if out.suffix.lower() != ".png":
+        raise ValueError(f"cannot write {out}: plots are written as PNG, so the output must end in .png")
+    ids = dataset.list_runs(path)
+    if run is not None and run not in ids:
+        more = ", ..." if len(ids) > 5 else ""
+        raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {', '.join(ids[:5])}{more}")
+    try:
+        import matplotlib
+    except ImportError:
+        raise ImportError("faultgen plot needs matplotlib: pip install matplotlib") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 3, figsize=(14, 7.5))
+    try:
+        if run is not None or len(ids) == 1:
+            _draw_run(fig, axes.ravel(), path, run if run is not None else ids[0])
+        else:
+            _draw_sweep(fig, axes.ravel(), path, ids)
+        fig.savefig(out, dpi=110)
+    finally:
+        plt.close(fig)
+    return out
+
+
+def _draw_run(fig, axes, path, run_id: str) -> None:
+    arrays, attrs = dataset.read_run(path, run_id)
+    cycles, torque = arrays["cycles"], arrays["mean_abs_torque"]
+    wear = (arrays["friction_multiplier"] - 1.0) * 100.0
+    for j, ax in enumerate(axes):
+        ax.plot(cycles, torque[:, j], "o", ms=4, color="tab:blue", label="mean |motor torque|")
+        ax.ticklabel_format(axis="y", useOffset=False)
+        low, high = torque[:, j].min(), torque[:, j].max()
+        half = max(high - low, MIN_SPAN * abs(torque[:, j].mean())) * 0.55  # noise alone stays flat
+        ax.set_ylim((low + high) / 2 - half, (low + high) / 2 + half)
+        ax.set(title=f"axis {j + 1}", xlabel="cycle", ylabel=TORQUE_LABEL)
+        ax.grid(alpha=0.3)
+        if np.any(arrays["friction_multiplier"][:, j] != 1.0):
+            twin = ax.twinx()
+            twin.plot(cycles, wear[:, j], "-", color=WEAR_COLOR, label="true wear")
+            twin.set_ylabel(WEAR_LABEL, color=WEAR_COLOR)
+            twin.tick_params(axis="y", colors=WEAR_COLOR)
+            twin.set_ylim(bottom=min(0.0, wear[:, j].min()))
+            ax.set_title(f"axis {j + 1} (worn)", color=WEAR_COLOR)
+    worn = ", ".join(str(int(a)) for a in attrs["worn_axes"]) or "none"
+    fig.suptitle(f"{run_id}\nrobot {attrs['robot']}, task {attrs['task']}, friction model "
+                 f"{attrs['friction_model']}, worn axes: {worn}; blue dots: mean |motor torque| per cycle, "
+                 f"red line: true wear")
+    fig.tight_layout()
+
+
+def _draw_sweep(fig, axes, path, ids: list[str]) -> None:
+    runs = [dataset.read_run(path, run_id) for run_id in ids]
+    task_names = sorted({attrs["task"] for _, attrs in runs})
+    robot_names = sorted({attrs["robot"] for _, attrs in runs})
+    colors = {task: f"C{i % 10}" for i, task in enumerate(task_names)}
+    styles = {robot: ("-", "--", "-.", ":")[i % 4] for i, robot in enumerate(robot_names)}
+    legend = {}
+    for j, ax in enumerate(axes):
+        drawn = False
+        for arrays, attrs in runs:
+            name = attrs["task"] if len(robot_names) == 1 else f"{attrs['robot']}, {attrs['task']}"
+            torque = arrays["mean_abs_torque"][:, j]
+            if len(attrs["worn_axes"]) == 0:
+                line = ax.axhline(torque.mean(), ls=(0, (5, 3)), lw=1.2, color=colors[attrs["task"]])
+                legend.setdefault(f"{name}, no wear", line)
+                drawn = True
+            elif j + 1 in [int(a) for a in attrs["worn_axes"]]:
+                wear = (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
+                (line,) = ax.plot(wear, torque, marker="o", ms=3, ls=styles[attrs["robot"]],
+                                  color=colors[attrs["task"]])
+                legend.setdefault(name, line)
+                drawn = True
+        if not drawn:
+            ax.text(0.5, 0.5, f"no run wears axis {j + 1}", ha="center", va="center", transform=ax.transAxes)
+        ax.set(title=f"axis {j + 1}", xlabel=f"{WEAR_LABEL} of axis {j + 1}", ylabel=TORQUE_LABEL)
+        ax.grid(alpha=0.3)
+    order = sorted(legend, key=lambda label: (label.endswith("no wear"), label))
+    fig.legend([legend[k] for k in order], order, loc="lower center", ncol=min(len(order), 6), frameon=False)
+    fig.suptitle(f"{Path(path).name}: robots {', '.join(robot_names)}, {len(ids)} runs; "
+                 "lines: runs wearing the axis, dashed: runs without wear")
+    rows = -(-len(order) // 6)
+    fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))

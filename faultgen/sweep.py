@@ -1,0 +1,301 @@
+"""Wear sweeps: a grid of runs (robot x task x worn axis x wear x schedule x seed) into one dataset.
+
+Every run is simulated by a worker (joblib processes locally, or Dask distributed workers) and
+written by that worker to its own part file in ``<out>.parts/``, atomically. When every run is
+there, the parts are merged into the dataset ``<out>`` (renamed into place last) and the part
+folder is removed. Running the same sweep again after a crash or kill resumes: finished parts are
+kept as they are and only the missing runs are simulated.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+import tomllib
+from collections.abc import Callable, Iterator
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from faultgen import dataset, friction, robots, sensors, sim, tasks, wear
+
+#: Named grids. quick: a small grid for a first look (well under 2 minutes on 2 cores).
+#: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
+#: c2: thesis ch. 3 (PUMA 560, 3 tasks x 6 axes x {10, 20} % logistic over 120 hours of one-minute
+#: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled).
+PRESETS = {
+    "quick": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
+                  schedules=["exp4"], cycles=100, record=list(range(10, 101, 10))),
+    "j2": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
+               schedules=["exp4"], cycles=100, record="all"),
+    "c2": dict(robots=["puma560"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[10.0, 20.0],
+               schedules=["logistic"], cycles=120 * 60, record={"period": 60, "first": 10}),
+}
+
+
+class SweepError(RuntimeError):
+    """A sweep could not finish; the message says what to do. Finished runs are kept."""
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The runs of a sweep, as the product of its lists.
+
+    Attributes
+    ----------
+    robots, tasks : list of str
+    axes : list of int
+        Worn axes, 1..6; 0 means a run without wear (one per robot, task and seed).
+    increases : list of float
+        Final wear in percent (20 = Coulomb and static friction 20 % higher at the last cycle).
+    schedules : list of str
+        Wear schedules (:data:`faultgen.wear.SCHEDULES`).
+    friction : str
+        Friction model (:data:`faultgen.friction.MODELS`).
+    cycles : int
+        Cycles per run.
+    record : "all", list of int, or {"period": P, "first": F}
+        Cycles to simulate and record: all, the listed ones, or the first F of every P.
+    seeds : list of int
+    disturbance, encoder : float
+        Noise levels (:class:`faultgen.sensors.NoiseConfig`).
+
+    Raises
+    ------
+    ValueError
+        On construction, naming the first invalid value; nothing is simulated.
+    """
+
+    robots: list[str]
+    tasks: list[str]
+    axes: list[int]
+    increases: list[float] = field(default_factory=lambda: [20.0])
+    schedules: list[str] = field(default_factory=lambda: ["exp4"])
+    friction: str = "lugre"
+    cycles: int = 100
+    record: str | list[int] | dict = "all"
+    seeds: list[int] = field(default_factory=lambda: [0])
+    disturbance: float = 0.01
+    encoder: float = 1e-4
+
+    def __post_init__(self) -> None:
+        for name in ("robots", "tasks", "axes", "increases", "schedules", "seeds"):
+            value = getattr(self, name)
+            if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or not value:
+                raise ValueError(f"grid field {name!r} must be a non-empty list, got {value!r}")
+        for axis in self.axes:
+            if not isinstance(axis, int) or not 0 <= axis <= 6:
+                raise ValueError(f"worn axis {axis!r} is out of range 0..6 (0 = no wear)")
+        friction.check_model(self.friction)
+        for kind in self.schedules:
+            if kind not in wear.SCHEDULES:
+                raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
+        for pct in self.increases:
+            if not np.isfinite(pct) or pct < 0:
+                raise ValueError(f"wear increase {pct!r} % must be a finite number >= 0")
+        self.runs()  # builds and validates every run configuration
+
+    @classmethod
+    def from_preset(cls, name: str, **overrides) -> Grid:
+        """A named grid (:data:`PRESETS`), with fields replaced by ``overrides``."""
+        if name not in PRESETS:
+            raise ValueError(f"unknown preset {name!r}; expected one of: {', '.join(PRESETS)}")
+        return cls(**{**PRESETS[name], **overrides})
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Grid:
+        """Read a grid from a TOML file whose top-level keys are the fields of :class:`Grid`.
+
+        A ``preset = "name"`` key starts from that preset. Unknown keys are refused.
+        """
+        try:
+            data = tomllib.loads(Path(path).read_text())
+        except (OSError, tomllib.TOMLDecodeError) as err:
+            raise ValueError(f"cannot read grid file {path}: {err}") from None
+        known = {f.name for f in fields(cls)} | {"preset"}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"{path}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(known))}")
+        preset = data.pop("preset", None)
+        return cls.from_preset(preset, **data) if preset else cls(**data)
+
+    def recorded_cycles(self) -> tuple[int, ...] | None:
+        """The ``record`` field as cycle indices (None: all)."""
+        if self.record == "all":
+            return None
+        if isinstance(self.record, dict):
+            if set(self.record) != {"period", "first"}:
+                raise ValueError(f"record {self.record!r}: expected {{period = P, first = F}}")
+            period, first = int(self.record["period"]), int(self.record["first"])
+            if not 1 <= first <= period:
+                raise ValueError(f"record {self.record!r}: need 1 <= first <= period")
+            return tuple(k for k in range(1, self.cycles + 1) if (k - 1) % period < first)
+        if isinstance(self.record, (list, tuple)):
+            return tuple(int(c) for c in self.record)
+        raise ValueError(f"record {self.record!r}: expected \"all\", a list of cycles or {{period, first}}")
+
+    def runs(self) -> list[tuple[str, sim.RunConfig]]:
+        """Every run of the grid as ``(run id, RunConfig)``, in a stable order; validates each."""
+        noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
+        record = self.recorded_cycles()
+        out: dict[str, sim.RunConfig] = {}
+        for robot in self.robots:
+            for task in self.tasks:
+                for axis in self.axes:
+                    for pct in [0.0] if axis == 0 else self.increases:
+                        for kind in [None] if axis == 0 else self.schedules:
+                            for seed in self.seeds:
+                                if axis == 0:
+                                    plan, label = wear.WearPlan({}), "nowear"
+                                else:
+                                    plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
+                                    label = f"axis{axis}-{kind}{pct:g}"
+                                run_id = f"{robots.load(robot).name}-{task}-{label}-seed{seed}"
+                                out[run_id] = sim.RunConfig(robot=robot, task=task, friction=self.friction, wear=plan,
+                                                            cycles=self.cycles, record=record, seed=seed, noise=noise,
+                                                            nthread=1)
+        return list(out.items())
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), sort_keys=True)
+
+
+@dataclass(frozen=True)
+class RunStats:
+    """What one worker did: simulated seconds and the wall time of each phase, s."""
+
+    run_id: str
+    simulated: float
+    total: float
+    stepping: float
+    writing: float
+
+
+def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "") -> RunStats:
+    """Worker task: simulate one run and write it to its part file (atomically)."""
+    started = time.perf_counter()
+    result = sim.simulate(config, progress=False)
+    writing = time.perf_counter()
+    dataset.write_run(part, result, run_id=run_id, command=command)
+    done = time.perf_counter()
+    simulated = result.tau_m.shape[0] * result.t[-1]
+    return RunStats(run_id, simulated, done - started, result.stepping_time, done - writing)
+
+
+def parts_folder(out: Path) -> Path:
+    return out.with_name(out.name + ".parts")
+
+
+def _finished(part: Path, config: sim.RunConfig) -> bool:
+    """True if ``part`` is a complete part file of exactly this configuration."""
+    try:
+        (attrs,) = dataset.labels(part)
+    except (dataset.DatasetError, ValueError):
+        return False
+    return attrs.get("config") == dataset.config_key(config)
+
+
+def finished_runs(grid: Grid, out: str | Path) -> list[str]:
+    """Ids of the runs of ``grid`` already finished in the part folder of ``out``."""
+    parts = parts_folder(Path(out))
+    return [run_id for run_id, config in grid.runs() if _finished(parts / f"{run_id}.h5", config)]
+
+
+def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
+        command: str = "", on_run: Callable[[RunStats], None] | None = None) -> Path:
+    """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
+
+    Parameters
+    ----------
+    grid : Grid
+    out : path of the dataset file to write.
+    jobs : int
+        Local worker processes (joblib); ignored with ``scheduler``.
+    scheduler : str, optional
+        Address of a Dask distributed scheduler (``tcp://host:port``); its workers must see the
+        folder of ``out`` (a shared file system).
+    progress : bool
+        Show a progress bar over runs, with the time left.
+    command : str
+        The command line, stored as provenance.
+    on_run : callable, optional
+        Called in this process with the :class:`RunStats` of each run as it finishes.
+
+    Returns
+    -------
+    Path of the dataset.
+
+    Raises
+    ------
+    SweepError
+        If the output folder cannot be written or a run fails (the message names the run and says
+        what to do); every finished run stays in the part folder for the next attempt.
+    """
+    out = Path(out)
+    plan = grid.runs()
+    parts = parts_folder(out)
+    _prepare(out, parts)
+    todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
+    with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
+              desc=f"sweep {out.name}") as bar:
+        for stats in _execute(todo, parts, jobs, scheduler, command):
+            bar.update(1)
+            if on_run is not None:
+                on_run(stats)
+    try:
+        dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
+                      grid=grid.to_json())
+    except OSError as err:
+        raise SweepError(f"cannot write {out}: {err}; every run is kept in {parts}: free space or fix "
+                         "permissions and run the same command again") from err
+    shutil.rmtree(parts)
+    return out
+
+
+def _prepare(out: Path, parts: Path) -> None:
+    """Make the part folder, check it is writable, and drop temporary files of killed writers."""
+    try:
+        parts.mkdir(parents=False, exist_ok=True)
+        probe = parts / ".write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except FileNotFoundError:
+        raise SweepError(f"cannot write {out}: folder {out.parent} does not exist") from None
+    except OSError as err:
+        raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
+    for stale in parts.glob(".*.part"):
+        stale.unlink()
+
+
+def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) -> Iterator[RunStats]:
+    """Run the missing runs; yield the stats of each as it finishes, in completion order."""
+    if not todo:
+        return
+    calls = [(run_id, config, parts / f"{run_id}.h5", command) for run_id, config in todo]
+    try:
+        if scheduler:
+            yield from _execute_dask(calls, scheduler)
+        else:
+            from joblib import Parallel, delayed
+
+            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered")
+            yield from parallel(delayed(simulate_and_write)(*call) for call in calls)
+    except OSError as err:
+        raise SweepError(f"a run could not be written: {err}. Finished runs are kept in {parts}; free space "
+                         "or fix permissions and run the same command again") from err
+
+
+def _execute_dask(calls, scheduler: str) -> Iterator[RunStats]:
+    from distributed import Client, as_completed
+
+    try:
+        client = Client(scheduler, timeout="10s")
+    except OSError as err:
+        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
+    with client:
+        futures = [client.submit(simulate_and_write, *call, key=f"faultgen-{call[0]}", pure=False) for call in calls]
+        for future in as_completed(futures):
+            yield future.result()
