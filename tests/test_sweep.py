@@ -1,0 +1,227 @@
+"""Sweeps: grid validation, resumability after SIGKILL, Dask on loopback, and broken files."""
+
+import errno
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from faultgen import dataset, robots, sweep
+from faultgen.cli import app
+
+runner = CliRunner()
+
+# Small but real: 2 tasks x (no wear + 2 worn axes) = 6 runs of 3 recorded cycles.
+SMALL = dict(robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2, 5], increases=[20.0],
+             schedules=["exp4"], cycles=30, record=[1, 15, 30])
+SMALL_ARGS = ["--robot", "irb6700", "--task", "pick_place", "--task", "spot_weld", "--axis", "0", "--axis", "2",
+              "--axis", "5", "--wear-pct", "20", "--cycles", "30", "--record", "1,15,30"]
+
+
+def assert_same_datasets(a: Path, b: Path) -> None:
+    assert dataset.list_runs(a) == dataset.list_runs(b)
+    for run_id in dataset.list_runs(a):
+        arrays_a, labels_a = dataset.read_run(a, run_id)
+        arrays_b, labels_b = dataset.read_run(b, run_id)
+        assert labels_a["config"] == labels_b["config"]
+        for name in dataset.ARRAYS:
+            np.testing.assert_array_equal(arrays_a[name], arrays_b[name], err_msg=f"{run_id} {name}")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory) -> Path:
+    """The small sweep, uninterrupted, on one local job."""
+    out = tmp_path_factory.mktemp("reference") / "small.h5"
+    return sweep.run(sweep.Grid(**SMALL), out, jobs=1, progress=False)
+
+
+def test_small_sweep_is_valid_and_labelled(reference):
+    assert dataset.validate(reference) == []
+    runs = dataset.labels(reference)
+    assert len(runs) == 6  # no-wear runs are not repeated per wear level or schedule
+    worn = sorted(tuple(int(a) for a in r["worn_axes"]) for r in runs)
+    assert worn == [(), (), (2,), (2,), (5,), (5,)]
+    arrays, labels = dataset.read_run(reference, "irb6700-spot_weld-axis5-exp420-seed0")
+    np.testing.assert_allclose(arrays["friction_multiplier"][:, 4], np.exp(np.log(1.2) * (np.array([1, 15, 30]) / 30) ** 4))
+    assert labels["model_sha256"] == dataset.model_hash(robots.load("irb6700").path)
+    assert labels["task"] == "spot_weld" and labels["friction_model"] == "lugre"
+    assert not sweep.parts_folder(reference).exists()  # parts are removed once merged
+
+
+def test_parallel_jobs_give_the_same_dataset(reference, tmp_path):
+    out = sweep.run(sweep.Grid(**SMALL), tmp_path / "two_jobs.h5", jobs=2, progress=False)
+    assert_same_datasets(reference, out)
+
+
+def test_dask_cluster_on_loopback_gives_the_same_dataset(reference, tmp_path):
+    """A real Dask scheduler and two worker processes on 127.0.0.1."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        out = sweep.run(sweep.Grid(**SMALL), tmp_path / "dask.h5", scheduler=cluster.scheduler_address,
+                        progress=False)
+    assert_same_datasets(reference, out)
+
+
+def test_sigkill_then_same_command_finishes_without_redoing_finished_runs(reference, tmp_path):
+    out = tmp_path / "killed.h5"
+    command = [sys.executable, "-m", "faultgen.cli", "sweep", *SMALL_ARGS, "--jobs", "1", "--no-progress",
+               "-o", str(out)]
+    parts = sweep.parts_folder(out)
+    proc = subprocess.Popen(command, cwd=tmp_path, start_new_session=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and len(list(parts.glob("*.h5"))) < 2:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the CLI and any worker it started
+    proc.wait()
+    assert not out.exists()  # nothing that looks finished
+    finished = sorted(p.name for p in parts.glob("*.h5"))
+    assert 2 <= len(finished) < 6
+    for name in finished:  # every part that exists is complete and valid
+        assert dataset.validate(parts / name) == []
+
+    again = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert f"resuming: {len(finished)} of 6 runs already finished" in again.stdout
+    assert dataset.validate(out) == []
+    assert_same_datasets(reference, out)  # loses nothing: equal to the uninterrupted sweep
+
+
+def test_resume_simulates_only_the_missing_runs(tmp_path):
+    grid = sweep.Grid(**SMALL)
+    out = tmp_path / "partial.h5"
+    parts = sweep.parts_folder(out)
+    parts.mkdir()
+    plan = dict(grid.runs())
+    first = list(plan)[:3]
+    for run_id in first:
+        sweep.simulate_and_write(run_id, plan[run_id], parts / f"{run_id}.h5")
+    stamps = {run_id: (parts / f"{run_id}.h5").stat().st_mtime_ns for run_id in first}
+    (parts / ".stale.h5.abc.part").write_text("left by a killed writer")
+    simulated = []
+    sweep.run(grid, out, jobs=1, progress=False,
+              on_run=lambda stats: (simulated.append(stats.run_id),
+                                    # finished parts are untouched while the others run
+                                    [pytest.fail(f"{r} rewritten") for r in first
+                                     if (parts / f"{r}.h5").stat().st_mtime_ns != stamps[r]]))
+    assert sorted(simulated) == sorted(set(plan) - set(first))
+    assert dataset.validate(out) == []
+
+
+def test_a_part_of_another_configuration_is_redone(tmp_path):
+    grid = sweep.Grid(**SMALL)
+    out = tmp_path / "changed.h5"
+    parts = sweep.parts_folder(out)
+    parts.mkdir()
+    run_id, config = grid.runs()[0]
+    other = sweep.Grid(**{**SMALL, "record": [1, 30]}).runs()[0][1]
+    sweep.simulate_and_write(run_id, other, parts / f"{run_id}.h5")
+    assert run_id not in sweep.finished_runs(grid, out)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--axis", "7"], "worn axis 7 is out of range 0..6"),
+        (["--task", "welding"], "unknown task 'welding'"),
+        (["--wear-pct", "-5", "--axis", "1"], "wear increase -5.0 % must be a finite number >= 0"),
+        (["--schedule", "cubic", "--axis", "1"], "unknown wear schedule 'cubic'"),
+        (["--record", "0,5"], "recorded cycle 0 is out of range"),
+        (["--preset", "huge"], "unknown preset 'huge'"),
+        (["--preset", "quick", "--jobs", "0"], "--jobs 0"),
+    ],
+)
+def test_invalid_grid_is_refused_before_any_simulation(tmp_path, args, message):
+    out = tmp_path / "bad.h5"
+    result = runner.invoke(app, ["sweep", *args, "--no-progress", "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_grid_file_is_read_and_checked(tmp_path):
+    good = tmp_path / "grid.toml"
+    good.write_text('preset = "quick"\ntasks = ["arc_weld"]\naxes = [0, 4]\n')
+    grid = sweep.Grid.from_toml(good)
+    assert [run_id for run_id, _ in grid.runs()] == ["irb6700-arc_weld-nowear-seed0", "irb6700-arc_weld-axis4-exp420-seed0"]
+    bad = tmp_path / "bad.toml"
+    bad.write_text('robots = ["irb6700"]\ntasks = ["pick_place"]\naxes = [0]\nwear = 3\n')
+    with pytest.raises(ValueError, match="unknown key 'wear'"):
+        sweep.Grid.from_toml(bad)
+
+
+def test_unwritable_output_folder_is_a_clear_error(tmp_path, monkeypatch):
+    def refuse(self, *args, **kwargs):
+        raise PermissionError(errno.EACCES, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "mkdir", refuse)
+    with pytest.raises(sweep.SweepError, match=r"cannot write to .*: Permission denied; choose another output path"):
+        sweep.run(sweep.Grid(**SMALL), tmp_path / "x.h5", progress=False)
+
+
+def test_missing_output_folder_is_a_clear_error(tmp_path):
+    with pytest.raises(sweep.SweepError, match="does not exist"):
+        sweep.run(sweep.Grid(**SMALL), tmp_path / "nowhere" / "x.h5", progress=False)
+
+
+def test_full_disk_keeps_earlier_runs_and_the_same_command_then_finishes(reference, tmp_path, monkeypatch):
+    """The third run's write fails with ENOSPC (simulated: h5py raises as it would on a full disk)."""
+    grid = sweep.Grid(**SMALL)
+    out = tmp_path / "full.h5"
+    real_write = dataset.write_run
+    calls = []
+
+    def write_until_full(path, *args, **kwargs):
+        calls.append(path)
+        if len(calls) == 3:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(path, *args, **kwargs)
+
+    monkeypatch.setattr(dataset, "write_run", write_until_full)
+    with pytest.raises(sweep.SweepError, match="No space left on device.*Finished runs are kept"):
+        sweep.run(grid, out, jobs=1, progress=False)
+    parts = sweep.parts_folder(out)
+    kept = sorted(parts.glob("*.h5"))
+    assert len(kept) == 2 and all(dataset.validate(p) == [] for p in kept)
+    assert not list(parts.glob(".*.part")) and not out.exists()
+    monkeypatch.setattr(dataset, "write_run", real_write)
+    sweep.run(grid, out, jobs=1, progress=False)
+    assert_same_datasets(reference, out)
+
+
+def test_corrupted_truncated_and_unfinished_files_are_reported(reference, tmp_path):
+    truncated = tmp_path / "truncated.h5"
+    truncated.write_bytes(reference.read_bytes()[: reference.stat().st_size // 2])
+    assert "truncated" in dataset.validate(truncated)[0]
+
+    corrupted = tmp_path / "corrupted.h5"
+    corrupted.write_bytes(reference.read_bytes())
+    with h5py.File(corrupted, "r") as f:
+        run_id = next(iter(f["runs"]))
+        offset = f["runs"][run_id]["angle_hist"].id.get_chunk_info(0).byte_offset  # a gzip-compressed chunk
+    with open(corrupted, "r+b") as f:
+        f.seek(offset + 8)
+        f.write(b"\xff" * 64)
+    problems = dataset.validate(corrupted)
+    assert problems and "corrupted" in " ".join(problems), problems
+
+    unfinished = tmp_path / "unfinished.h5"
+    unfinished.write_bytes(reference.read_bytes())
+    with h5py.File(unfinished, "r+") as f:
+        f.attrs["complete"] = False
+    assert "incomplete" in dataset.validate(unfinished)[0]
+    with pytest.raises(dataset.DatasetError, match="incomplete"):
+        dataset.read_run(unfinished, run_id)
+
+    result = runner.invoke(app, ["validate", str(truncated)])
+    assert result.exit_code == 1 and "truncated" in result.output
