@@ -23,46 +23,9 @@ from __future__ import annotations
 import argparse
 import time
 
-import mujoco
-import numpy as np
-from mujoco import batch as mjbatch
-
-from faultgen import control, robots, sensors, sim, tasks
+from faultgen import sim, tasks
 from faultgen.wear import WearPlan
-
-
-def _batch(model_sim: sim.SimModel, q0: np.ndarray, n_sim: int, nthread: int) -> mjbatch.Batch:
-    batch = mjbatch.Batch(model_sim.model, nsim=n_sim, nthread=nthread)
-    batch.qpos, batch.qvel = sim.start_state(model_sim.robot, q0)
-    batch.act = 0.0
-    return batch
-
-
-def hold_time(model_sim: sim.SimModel, q0: np.ndarray, n_sim: int, n_steps: int, nthread: int) -> float:
-    """Seconds for ``Batch.step`` to step ``n_sim`` simulations holding ``q0`` for ``n_steps``."""
-    batch = _batch(model_sim, q0, n_sim, nthread)
-    ctrl = np.zeros(model_sim.model.nu)
-    ctrl[model_sim.drive_ctrl[:, 0]] = model_sim.robot.gear_ratio * q0
-    batch.ctrl = ctrl
-    started = time.perf_counter()
-    batch.step(nstep=n_steps)
-    return time.perf_counter() - started
-
-
-def same_work_time(model_sim: sim.SimModel, path, n_sim: int, n_steps: int, nthread: int) -> float:
-    """Seconds for one ``Batch.rollout`` of the simulate workload: same inputs, same records."""
-    model, robot = model_sim.model, model_sim.robot
-    inputs = control.setpoints(robot, path.q, path.qd, path.qdd)
-    inputs = np.vstack([inputs, np.repeat(inputs[-1:], max(0, n_steps - len(inputs)), axis=0)])[:n_steps]
-    rng = np.random.default_rng(0)
-    control_in = np.zeros((n_sim, n_steps, model.nu + model.nv))
-    control_in[:, :, : model.nu][:, :, model_sim.drive_ctrl] = inputs
-    control_in[:, :, model.nu + robot.arm_dof] = rng.standard_normal((n_sim, n_steps, 6))
-    batch = _batch(model_sim, path.q[0], n_sim, nthread)
-    spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
-    started = time.perf_counter()
-    batch.rollout(n_steps, control=control_in, control_spec=spec, record=("qpos", "qvel", "actuator_force"))
-    return time.perf_counter() - started
+from benchmarks_common import hold_seconds, same_work_seconds, simulated_seconds  # sibling module
 
 
 def main() -> None:
@@ -75,23 +38,18 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
 
-    robot = robots.load(args.robot)
-    model_sim = sim.build(robot, args.friction)
     config = sim.RunConfig(robot=args.robot, task=args.task, friction=args.friction, wear=WearPlan({}),
                            cycles=args.cycles, seed=0, nthread=args.threads)
-    result = sim.simulate(config, progress=False)  # warm-up, and the step count
-    n_steps = len(result.t) * int(round(sensors.LOG_PERIOD / model_sim.model.opt.timestep))
-    sim_seconds = args.cycles * n_steps * model_sim.model.opt.timestep
-
-    path = tasks.load(robot, args.task).trajectory(model_sim.model.opt.timestep)
+    sim.simulate(config, progress=False)  # warm-up
+    sim_seconds = simulated_seconds(config)
     ours, same, hold = [], [], []
     for _ in range(args.repeat):
-        hold.append(hold_time(model_sim, path.q[0], args.cycles, n_steps, args.threads))
-        same.append(same_work_time(model_sim, path, args.cycles, n_steps, args.threads))
+        hold.append(hold_seconds(config))
+        same.append(same_work_seconds(config))
         ours.append(sim.simulate(config, progress=False).stepping_time)
     best = {"MuJoCo, hold (Batch.step)": min(hold), "MuJoCo, same work (Batch.rollout)": min(same),
             "faultgen simulate stepping": min(ours)}
-    print(f"{args.robot} {args.task}, {args.friction} friction, {args.cycles} cycles x {n_steps} steps "
+    print(f"{args.robot} {args.task}, {args.friction} friction, {args.cycles} cycles "
           f"({sim_seconds:.0f} simulated s), {args.threads} thread(s), best of {args.repeat}")
     for name, seconds in best.items():
         print(f"{name:<36}{seconds:8.3f} s  {1e3 * seconds / sim_seconds:7.3f} ms per simulated s")

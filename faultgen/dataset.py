@@ -222,11 +222,13 @@ def list_runs(path: str | Path) -> list[str]:
         return list(f["runs"])
 
 
-def read_run(path: str | Path, run_id: str | None = None) -> tuple[dict[str, np.ndarray], dict]:
+def read_run(path: str | Path, run_id: str | None = None,
+             names: Iterable[str] | None = None) -> tuple[dict[str, np.ndarray], dict]:
     """Read one run: its arrays by name and its attributes (labels and provenance).
 
-    ``run_id`` may be omitted for a file with one run. Raises :class:`DatasetError` if the file is
-    not a finished faultgen file or has no such run.
+    ``run_id`` may be omitted for a file with one run; ``names`` limits the arrays read (default:
+    all, see :data:`ARRAYS`). Raises :class:`DatasetError` if the file is not a finished faultgen
+    file, has no such run, or the run has no such array.
     """
     with _open(path) as f:
         ids = list(f["runs"])
@@ -237,7 +239,11 @@ def read_run(path: str | Path, run_id: str | None = None) -> tuple[dict[str, np.
         if run_id not in f["runs"]:
             raise DatasetError(f"{path} has no run {run_id!r}; runs: {', '.join(ids[:10])}")
         group = f["runs"][run_id]
-        arrays = {name: group[name][()] for name in group}
+        wanted = list(group) if names is None else list(names)
+        missing = [name for name in wanted if name not in group]
+        if missing:
+            raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}")
+        arrays = {name: group[name][()] for name in wanted}
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
 

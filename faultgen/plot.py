@@ -1,7 +1,7 @@
 """A first look at a dataset: mean absolute motor torque per axis against the true wear, as a PNG.
 
-matplotlib is imported only when :func:`plot` is called (with the Agg backend), so importing this
-module needs neither matplotlib nor a display.
+matplotlib is imported only when :func:`plot` is called, and the figure is drawn without pyplot,
+so importing this module needs neither matplotlib nor a display, and no global backend changes.
 """
 
 from __future__ import annotations
@@ -60,38 +60,32 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
         raise ValueError(f"cannot write {out}: plots are written as PNG, so the output must end in .png")
     ids = dataset.list_runs(path)
     if run is not None and run not in ids:
-        more = ", ..." if len(ids) > 5 else ""
-        raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {', '.join(ids[:5])}{more}")
-    try:
-        import matplotlib
-    except ImportError:
-        raise ImportError("faultgen plot needs matplotlib: pip install matplotlib") from None
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        listed = ", ".join(ids[:5]) + (", ..." if len(ids) > 5 else "")
+        raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {listed}")
+    from matplotlib.figure import Figure
 
-    fig, axes = plt.subplots(2, 3, figsize=(14, 7.5))
-    try:
-        if run is not None or len(ids) == 1:
-            _draw_run(fig, axes.ravel(), path, run if run is not None else ids[0])
-        else:
-            _draw_sweep(fig, axes.ravel(), path, ids)
-        fig.savefig(out, dpi=110)
-    finally:
-        plt.close(fig)
+    fig = Figure(figsize=(14, 7.5))
+    axes = fig.subplots(2, 3)
+    if run is not None or len(ids) == 1:
+        _draw_run(fig, axes.ravel(), path, run if run is not None else ids[0])
+    else:
+        _draw_sweep(fig, axes.ravel(), path, ids)
+    fig.savefig(out, dpi=110)
     return out
 
 
 def _draw_run(fig, axes, path, run_id: str) -> None:
-    arrays, attrs = dataset.read_run(path, run_id)
+    arrays, attrs = dataset.read_run(path, run_id, names=("cycles", "mean_abs_torque", "friction_multiplier"))
     cycles, torque = arrays["cycles"], arrays["mean_abs_torque"]
     wear = (arrays["friction_multiplier"] - 1.0) * 100.0
     for j, ax in enumerate(axes):
         ax.plot(cycles, torque[:, j], "o", ms=4, color="tab:blue", label="mean |motor torque|")
         ax.ticklabel_format(axis="y", useOffset=False)
         low, high = torque[:, j].min(), torque[:, j].max()
-        half = max(high - low, MIN_SPAN * abs(torque[:, j].mean())) * 0.55  # noise alone stays flat
+        half = max(high - low, MIN_SPAN * abs(torque[:, j].mean()), 1e-9) * 0.55  # noise alone stays flat
         ax.set_ylim((low + high) / 2 - half, (low + high) / 2 + half)
         ax.set(title=f"axis {j + 1}", xlabel="cycle", ylabel=TORQUE_LABEL)
+        ax.locator_params(axis="x", integer=True)
         ax.grid(alpha=0.3)
         if np.any(arrays["friction_multiplier"][:, j] != 1.0):
             twin = ax.twinx()
@@ -101,37 +95,40 @@ def _draw_run(fig, axes, path, run_id: str) -> None:
             twin.set_ylim(bottom=min(0.0, wear[:, j].min()))
             ax.set_title(f"axis {j + 1} (worn)", color=WEAR_COLOR)
     worn = ", ".join(str(int(a)) for a in attrs["worn_axes"]) or "none"
+    key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if worn != "none" else "")
     fig.suptitle(f"{run_id}\nrobot {attrs['robot']}, task {attrs['task']}, friction model "
-                 f"{attrs['friction_model']}, worn axes: {worn}; blue dots: mean |motor torque| per cycle, "
-                 f"red line: true wear")
+                 f"{attrs['friction_model']}, worn axes: {worn}; {key}")
     fig.tight_layout()
 
 
 def _draw_sweep(fig, axes, path, ids: list[str]) -> None:
-    runs = [dataset.read_run(path, run_id) for run_id in ids]
+    runs = []
+    for run_id in ids:  # only the per-cycle arrays drawn: the logged signals can be large
+        runs.append(dataset.read_run(path, run_id, names=("mean_abs_torque", "friction_multiplier")))
     task_names = sorted({attrs["task"] for _, attrs in runs})
     robot_names = sorted({attrs["robot"] for _, attrs in runs})
     colors = {task: f"C{i % 10}" for i, task in enumerate(task_names)}
     styles = {robot: ("-", "--", "-.", ":")[i % 4] for i, robot in enumerate(robot_names)}
+    most = max(float((arrays["friction_multiplier"] - 1.0).max()) * 100.0 for arrays, _ in runs)
     legend = {}
     for j, ax in enumerate(axes):
-        drawn = False
+        worn_here = False
         for arrays, attrs in runs:
             name = attrs["task"] if len(robot_names) == 1 else f"{attrs['robot']}, {attrs['task']}"
             torque = arrays["mean_abs_torque"][:, j]
             if len(attrs["worn_axes"]) == 0:
                 line = ax.axhline(torque.mean(), ls=(0, (5, 3)), lw=1.2, color=colors[attrs["task"]])
                 legend.setdefault(f"{name}, no wear", line)
-                drawn = True
             elif j + 1 in [int(a) for a in attrs["worn_axes"]]:
                 wear = (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
                 (line,) = ax.plot(wear, torque, marker="o", ms=3, ls=styles[attrs["robot"]],
                                   color=colors[attrs["task"]])
                 legend.setdefault(name, line)
-                drawn = True
-        if not drawn:
-            ax.text(0.5, 0.5, f"no run wears axis {j + 1}", ha="center", va="center", transform=ax.transAxes)
-        ax.set(title=f"axis {j + 1}", xlabel=f"{WEAR_LABEL} of axis {j + 1}", ylabel=TORQUE_LABEL)
+                worn_here = True
+        if most > 0:
+            ax.set_xlim(-0.03 * most, 1.03 * most)  # the same wear range in every panel
+        ax.set(title=f"axis {j + 1}" + ("" if worn_here else " (no run wears it)"),
+               xlabel=f"{WEAR_LABEL} of axis {j + 1}", ylabel=TORQUE_LABEL)
         ax.grid(alpha=0.3)
     order = sorted(legend, key=lambda label: (label.endswith("no wear"), label))
     fig.legend([legend[k] for k in order], order, loc="lower center", ncol=min(len(order), 6), frameon=False)

@@ -14,6 +14,7 @@ so it steps from Python and is slower (docs/performance.md gives both figures).
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field, fields
 
@@ -234,14 +235,12 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     """
-    robot = robots.load(config.robot)
-    sim = build(robot, config.friction)
-    task = tasks.load(robot, config.task)
-    path = task.trajectory(sim.model.opt.timestep)
+    model_file = robots.load(config.robot).path
+    sim, task, path, q_ref, inputs = _prepare(config.robot, config.task, config.friction,
+                                              model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    robot = sim.robot
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
-    n_steps = _padded_steps(len(path.t) - 1, per_log)
-    q_ref, qd_ref, qdd_ref = (_hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
-    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref)  # (n_steps, 6, 3)
+    n_steps = len(inputs) - 1
 
     cycles = config.recorded_cycles
     multiplier = config.wear.multipliers(cycles)
@@ -261,6 +260,28 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     return result
+
+
+@functools.lru_cache(maxsize=8)
+def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps: int):
+    """What every run of a robot, task and friction model shares, computed once per process
+    (``file_stamps``, the modification times of the model and task files, renew it on edits).
+
+    The compiled simulation model (``Batch`` works on copies of it), the task path, the reference
+    at every physics step and the drive set-points with their nominal feedforward. Arrays are
+    made read-only so no run can change what the next one gets.
+    """
+    robot = robots.load(robot_name)
+    sim = build(robot, friction_model)
+    task = tasks.load(robot, task_name)
+    path = task.trajectory(sim.model.opt.timestep)
+    per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
+    n_steps = _padded_steps(len(path.t) - 1, per_log)
+    q_ref, qd_ref, qdd_ref = (_hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
+    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
+    for array in (q_ref, inputs):
+        array.setflags(write=False)
+    return sim, task, path, q_ref, inputs
 
 
 def _padded_steps(n: int, per_log: int) -> int:

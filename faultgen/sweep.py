@@ -205,7 +205,8 @@ def finished_runs(grid: Grid, out: str | Path) -> list[str]:
 
 
 def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
-        command: str = "", on_run: Callable[[RunStats], None] | None = None) -> Path:
+        command: str = "", on_run: Callable[[RunStats], None] | None = None,
+        timings: dict | None = None) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
@@ -223,6 +224,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
         The command line, stored as provenance.
     on_run : callable, optional
         Called in this process with the :class:`RunStats` of each run as it finishes.
+    timings : dict, optional
+        Filled with the wall time of the final merge (``"merge"``, s), for benchmarks.
 
     Returns
     -------
@@ -245,12 +248,15 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
             bar.update(1)
             if on_run is not None:
                 on_run(stats)
+    started = time.perf_counter()
     try:
         dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
                       grid=grid.to_json())
     except OSError as err:
         raise SweepError(f"cannot write {out}: {err}; every run is kept in {parts}: free space or fix "
                          "permissions and run the same command again") from err
+    if timings is not None:
+        timings["merge"] = time.perf_counter() - started
     shutil.rmtree(parts)
     return out
 

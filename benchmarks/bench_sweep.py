@@ -1,0 +1,104 @@
+"""Sweep throughput, its ratio to MuJoCo's C stepping, parallel efficiency, HDF5 share, memory.
+
+    python benchmarks/bench_sweep.py [--cycles 20] [--runs 4] [--j2]
+
+In one run of this script, on a grid of IRB-6700-like pick-and-place runs (no wear and worn
+axes 1.., every cycle recorded):
+
+- throughput: simulated seconds per wall second per core, on 1 job;
+- C limit: the same runs' stepping as one ``Batch.rollout`` call each (same set-points and
+  disturbances, no Python in the loop, one thread), and the sweep's wall time over it;
+- parallel efficiency on 2 jobs: t(1 job) / (2 t(2 jobs));
+- HDF5 share: time writing part files plus the final merge, over the workers' busy time;
+- peak memory (RSS of this process and its workers) for the grid and for a grid three times
+  larger: it must not grow with the number of runs;
+- with --j2: wall time of the j2 preset on 2 jobs (thesis ch. 6: 21 runs x 100 cycles).
+
+The last line is ``ratio <float>``: sweep wall time on 1 job over the C limit (goal <= 1.25).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import psutil
+
+from faultgen import sweep
+from benchmarks_common import same_work_seconds  # sibling module
+
+
+def tree_rss() -> int:
+    me = psutil.Process()
+    total = me.memory_info().rss
+    for child in me.children(recursive=True):
+        try:
+            total += child.memory_info().rss
+        except psutil.NoSuchProcess:
+            pass
+    return total
+
+
+def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
+    stats, timings, peak = [], {}, [0]
+    stop = threading.Event()
+
+    def sample() -> None:
+        while not stop.is_set():
+            peak[0] = max(peak[0], tree_rss())
+            time.sleep(0.05)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    started = time.perf_counter()
+    sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", jobs=jobs, progress=False,
+              on_run=stats.append, timings=timings)
+    wall = time.perf_counter() - started
+    stop.set()
+    sampler.join()
+    return dict(wall=wall, stats=stats, merge=timings["merge"], peak=peak[0])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cycles", type=int, default=20, help="cycles per run, all recorded")
+    parser.add_argument("--runs", type=int, default=4, help="runs in the grid (no wear + worn axes), 2..7")
+    parser.add_argument("--j2", action="store_true", help="also time the j2 preset on 2 jobs")
+    args = parser.parse_args()
+    axes = list(range(args.runs))
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=axes, cycles=args.cycles)
+    big = sweep.Grid(robots=["irb6700"], tasks=list(sweep.tasks.TASKS), axes=axes, cycles=args.cycles)
+    folder = Path(tempfile.mkdtemp(prefix="faultgen-bench-"))
+    try:
+        one = timed_sweep(grid, 1, folder)
+        two = timed_sweep(grid, 2, folder)
+        larger = timed_sweep(big, 2, folder)
+        limit = sum(same_work_seconds(config) for _, config in grid.runs())
+        simulated = sum(s.simulated for s in one["stats"])
+        busy = sum(s.total for s in one["stats"])
+        writing = sum(s.writing for s in one["stats"]) + one["merge"]
+        stepping = sum(s.stepping for s in one["stats"])
+        print(f"grid: {len(grid.runs())} runs x {args.cycles} cycles of pick and place, {simulated:.0f} simulated s")
+        print(f"1 job:  wall {one['wall']:.2f} s, throughput {simulated / one['wall']:.1f} simulated s per wall s per core")
+        print(f"        of which stepping {stepping:.2f} s, set-up and features {busy - stepping - writing + one['merge']:.2f} s, "
+              f"HDF5 {writing:.2f} s")
+        print(f"C limit (one Batch.rollout per run, 1 thread): {limit:.2f} s")
+        print(f"2 jobs: wall {two['wall']:.2f} s, parallel efficiency {one['wall'] / (2 * two['wall']):.3f}")
+        print(f"HDF5 share of busy time (1 job): {writing / (busy + one['merge']):.3f}")
+        print(f"peak memory, 2 jobs: {two['peak'] / 1e6:.0f} MB for {len(grid.runs())} runs, "
+              f"{larger['peak'] / 1e6:.0f} MB for {len(big.runs())} runs")
+        if args.j2:
+            started = time.perf_counter()
+            sweep.run(sweep.Grid.from_preset("j2"), folder / "j2.h5", jobs=2, progress=True)
+            print(f"j2 preset, 2 jobs: wall {time.perf_counter() - started:.1f} s")
+        print(f"ratio {one['wall'] / limit:.3f}")
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,63 @@
+"""Baselines shared by the benchmarks: MuJoCo stepping a run's workload with no Python in the loop."""
+
+from __future__ import annotations
+
+import time
+
+import mujoco
+import numpy as np
+from mujoco import batch as mjbatch
+
+from faultgen import control, robots, sensors, sim, tasks
+
+
+def _prepared(config: sim.RunConfig):
+    robot = robots.load(config.robot)
+    model_sim = sim.build(robot, config.friction)
+    path = tasks.load(robot, config.task).trajectory(model_sim.model.opt.timestep)
+    per_log = int(round(sensors.LOG_PERIOD / model_sim.model.opt.timestep))
+    n_steps = -(-(len(path.t) - 1) // per_log) * per_log
+    return robot, model_sim, path, n_steps
+
+
+def _batch(model_sim: sim.SimModel, q0: np.ndarray, n_sim: int, nthread: int) -> mjbatch.Batch:
+    batch = mjbatch.Batch(model_sim.model, nsim=n_sim, nthread=nthread)
+    batch.qpos, batch.qvel = sim.start_state(model_sim.robot, q0)
+    batch.act = 0.0
+    return batch
+
+
+def same_work_seconds(config: sim.RunConfig) -> float:
+    """Seconds for one ``Batch.rollout`` of a run's workload: its recorded cycles, the same
+    set-points and disturbance inputs, the same records, ``config.nthread`` threads."""
+    robot, model_sim, path, n_steps = _prepared(config)
+    model = model_sim.model
+    n_sim = len(config.recorded_cycles)
+    inputs = control.setpoints(robot, path.q, path.qd, path.qdd)
+    inputs = np.vstack([inputs, np.repeat(inputs[-1:], max(0, n_steps - len(inputs)), axis=0)])[:n_steps]
+    control_in = np.zeros((n_sim, n_steps, model.nu + model.nv))
+    control_in[:, :, : model.nu][:, :, model_sim.drive_ctrl] = inputs
+    control_in[:, :, model.nu + robot.arm_dof] = np.random.default_rng(0).standard_normal((n_sim, n_steps, 6))
+    batch = _batch(model_sim, path.q[0], n_sim, config.nthread)
+    spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+    started = time.perf_counter()
+    batch.rollout(n_steps, control=control_in, control_spec=spec, record=("qpos", "qvel", "actuator_force"))
+    return time.perf_counter() - started
+
+
+def hold_seconds(config: sim.RunConfig) -> float:
+    """Seconds for one ``Batch.step`` call stepping the run's cycles with the drives holding still."""
+    robot, model_sim, path, n_steps = _prepared(config)
+    batch = _batch(model_sim, path.q[0], len(config.recorded_cycles), config.nthread)
+    ctrl = np.zeros(model_sim.model.nu)
+    ctrl[model_sim.drive_ctrl[:, 0]] = robot.gear_ratio * path.q[0]
+    batch.ctrl = ctrl
+    started = time.perf_counter()
+    batch.step(nstep=n_steps)
+    return time.perf_counter() - started
+
+
+def simulated_seconds(config: sim.RunConfig) -> float:
+    """Simulated time of a run's recorded cycles, s."""
+    _, model_sim, _, n_steps = _prepared(config)
+    return len(config.recorded_cycles) * n_steps * model_sim.model.opt.timestep

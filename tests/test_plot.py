@@ -1,0 +1,124 @@
+"""faultgen.plot: PNGs of mean absolute motor torque against true wear, for a run and for a sweep."""
+
+import subprocess
+import sys
+
+import h5py
+import matplotlib.image
+import numpy as np
+import pytest
+
+from faultgen import dataset, sweep
+from faultgen.plot import plot
+
+
+@pytest.fixture(scope="module")
+def sweep_file(tmp_path_factory):
+    """Two tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 are recorded: 4 runs."""
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0],
+                      cycles=20, record=[1, 10, 20])
+    return sweep.run(grid, tmp_path_factory.mktemp("plot") / "s.h5", jobs=1, progress=False)
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures plot() draws, kept for inspection when it saves them."""
+    from matplotlib.figure import Figure
+
+    drawn, save = [], Figure.savefig
+
+    def spy(self, *args, **kwargs):
+        drawn.append(self)
+        return save(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", spy)
+    return drawn
+
+
+def assert_png(path):
+    image = matplotlib.image.imread(path)
+    assert image.ndim == 3 and image.shape[1] > 300 and image.shape[0] > 200, image.shape
+    assert image[..., :3].std() > 0, "blank image"
+
+
+def test_sweep_plot_draws_one_panel_per_axis_with_a_line_per_worn_run(sweep_file, tmp_path, figures):
+    out = plot(sweep_file, tmp_path / "sweep.png")
+    assert out == tmp_path / "sweep.png"
+    assert_png(out)
+    (fig,) = figures
+    assert len(fig.axes) == 6
+    assert "s.h5" in fig.get_suptitle() and "4 runs" in fig.get_suptitle()
+    axis2 = fig.axes[1]
+    assert axis2.get_xlabel() == "true wear [%] of axis 2" and "[N m]" in axis2.get_ylabel()
+    worn = [line for line in axis2.get_lines() if len(line.get_xdata()) == 3]
+    assert len(worn) == 2  # one per task
+    assert max(line.get_xdata().max() for line in worn) == pytest.approx(20.0)
+    assert len(fig.axes[0].get_lines()) == 2  # axis 1: only the no-wear levels of both tasks
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert labels == ["pick_place", "spot_weld", "pick_place, no wear", "spot_weld, no wear"]
+
+
+def test_single_run_plot_shows_torque_per_cycle_and_the_wear_of_the_worn_axis(sweep_file, tmp_path, figures):
+    run_id = "irb6700-spot_weld-axis2-exp420-seed0"
+    out = plot(sweep_file, tmp_path / "run.png", run=run_id)
+    assert_png(out)
+    (fig,) = figures
+    assert len(fig.axes) == 7  # six panels and the wear axis of axis 2
+    title = fig.get_suptitle()
+    assert run_id in title and "irb6700" in title and "spot_weld" in title and "lugre" in title
+    arrays, _ = dataset.read_run(sweep_file, run_id)
+    torque = fig.axes[1].get_lines()[0]
+    np.testing.assert_array_equal(torque.get_xdata(), arrays["cycles"])
+    np.testing.assert_allclose(torque.get_ydata(), arrays["mean_abs_torque"][:, 1])
+    wear = fig.axes[6].get_lines()[0]
+    np.testing.assert_allclose(wear.get_ydata(), (arrays["friction_multiplier"][:, 1] - 1) * 100)
+    assert fig.axes[6].get_ylabel() == "true wear [%]"
+
+
+def test_a_file_with_one_run_is_drawn_as_that_run(sweep_file, tmp_path, figures):
+    one = tmp_path / "one.h5"
+    with h5py.File(sweep_file, "r") as src, h5py.File(one, "w") as dst:
+        for key, value in src.attrs.items():
+            dst.attrs[key] = value
+        dst.attrs["n_runs"] = 1
+        src.copy(src["runs/irb6700-pick_place-nowear-seed0"], dst.require_group("runs"), name="only")
+    assert dataset.validate(one) == []
+    assert_png(plot(one, tmp_path / "one.png"))
+    (fig,) = figures
+    assert len(fig.axes) == 6  # no wear: no wear axes
+    assert fig.get_suptitle().startswith("only\n")
+
+
+def test_unknown_run_is_refused_naming_it_and_listing_runs(sweep_file, tmp_path):
+    with pytest.raises(ValueError, match="no run 'irb6700-nope'.*irb6700-pick_place-nowear-seed0"):
+        plot(sweep_file, tmp_path / "x.png", run="irb6700-nope")
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("name", ["plot.pdf", "plot", "plot.PNG.txt"])
+def test_output_that_is_not_png_is_refused(sweep_file, tmp_path, name):
+    with pytest.raises(ValueError, match=r"\.png"):
+        plot(sweep_file, tmp_path / name)
+    assert not (tmp_path / name).exists()
+
+
+def test_invalid_files_raise_dataset_error(tmp_path):
+    incomplete = tmp_path / "incomplete.h5"
+    with h5py.File(incomplete, "w") as f:
+        f.attrs["format"] = dataset.FORMAT
+        f.attrs["complete"] = False
+        f.create_group("runs")
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as f:
+        f["x"] = np.zeros(3)
+    text = tmp_path / "text.h5"
+    text.write_text("not hdf5")
+    for path, message in [(incomplete, "incomplete"), (foreign, "not a faultgen file"), (text, "cannot be opened"),
+                          (tmp_path / "missing.h5", "no such file")]:
+        with pytest.raises(dataset.DatasetError, match=message):
+            plot(path, tmp_path / "x.png")
+
+
+def test_importing_the_module_does_not_import_matplotlib():
+    code = "import sys, faultgen.plot; assert 'matplotlib' not in sys.modules, 'matplotlib imported'"
+    subprocess.run([sys.executable, "-c", code], check=True)
