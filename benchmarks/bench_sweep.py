@@ -1,9 +1,9 @@
 """Sweep throughput, its ratio to MuJoCo's C stepping, parallel efficiency, HDF5 share, memory.
 
-    python benchmarks/bench_sweep.py [--cycles 20] [--runs 4] [--j2]
+    python benchmarks/bench_sweep.py [--cycles 20] [--axes 4] [--j2]
 
 In one run of this script, on a grid of IRB-6700-like pick-and-place runs (no wear and worn
-axes 1.., every cycle recorded):
+axes 1.., two seeds, every cycle recorded):
 
 - throughput: simulated seconds per wall second per core, on 1 job;
 - C limit: the same runs' stepping as one ``Batch.rollout`` call each (same set-points and
@@ -66,12 +66,14 @@ def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cycles", type=int, default=20, help="cycles per run, all recorded")
-    parser.add_argument("--runs", type=int, default=4, help="runs in the grid (no wear + worn axes), 2..7")
+    parser.add_argument("--axes", type=int, default=4, help="no wear + worn axes 1..AXES-1 (2..7), x 2 seeds")
     parser.add_argument("--j2", action="store_true", help="also time the j2 preset on 2 jobs")
     args = parser.parse_args()
-    axes = list(range(args.runs))
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=axes, cycles=args.cycles)
-    big = sweep.Grid(robots=["irb6700"], tasks=list(sweep.tasks.TASKS), axes=axes, cycles=args.cycles)
+    # equal runs, an even number of them: the fair test of 2 jobs; the larger grid has three times
+    # as many runs of the same size, so only the number of runs changes
+    axes = list(range(args.axes))
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=axes, cycles=args.cycles, seeds=[0, 1])
+    big = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=axes, cycles=args.cycles, seeds=list(range(6)))
     folder = Path(tempfile.mkdtemp(prefix="faultgen-bench-"))
     try:
         one = timed_sweep(grid, 1, folder)

@@ -284,6 +284,12 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     return sim, task, path, q_ref, inputs
 
 
+def cycle_duration(robot: str, task: str) -> float:
+    """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle)."""
+    sim, _, _, _, inputs = _prepare(robot, task, "lugre")
+    return (len(inputs) - 1) * sim.model.opt.timestep
+
+
 def _padded_steps(n: int, per_log: int) -> int:
     return -(-n // per_log) * per_log
 

@@ -242,6 +242,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     parts = parts_folder(out)
     _prepare(out, parts)
     todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
+    todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
     with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
               desc=f"sweep {out.name}") as bar:
         for stats in _execute(todo, parts, jobs, scheduler, command):
@@ -259,6 +260,12 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
         timings["merge"] = time.perf_counter() - started
     shutil.rmtree(parts)
     return out
+
+
+def _expected_cost(item: tuple[str, sim.RunConfig]) -> float:
+    """Simulated seconds of a run: recorded cycles times the task's cycle time."""
+    config = item[1]
+    return len(config.recorded_cycles) * sim.cycle_duration(config.robot, config.task)
 
 
 def _prepare(out: Path, parts: Path) -> None:
