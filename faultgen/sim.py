@@ -26,6 +26,10 @@ from tqdm.auto import tqdm
 from faultgen import control, friction, robots, sensors, tasks
 from faultgen.wear import WearPlan
 
+#: Most cycles stepped together in one ``Batch``: bounds the step buffers (about 1 MB per cycle
+#: and second of chunk) when a run records many cycles (the c2 preset records 1200).
+BATCH_CYCLES = 100
+
 #: Logging periods handed to MuJoCo per ``Batch.rollout`` call (1 s of simulated time): long
 #: enough that the hand-over costs little, short enough that the per-step records stay small.
 CHUNK_PERIODS = 250
@@ -254,7 +258,10 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
               desc=f"{robot.name} {config.task}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
               "[{elapsed}<{remaining}]") as bar:
         started = time.perf_counter()
-        raw = stepper(sim, config, cycles, multiplier, path.q[0], inputs, dist, per_log, bar)
+        groups = [slice(i, i + BATCH_CYCLES) for i in range(0, len(cycles), BATCH_CYCLES)]
+        raws = [stepper(sim, config, cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, bar)
+                for g in groups]
+        raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws]) for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,

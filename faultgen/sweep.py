@@ -9,6 +9,7 @@ kept as they are and only the missing runs are simulated.
 
 from __future__ import annotations
 
+import itertools
 import json
 import shutil
 import time
@@ -142,21 +143,19 @@ class Grid:
         noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
         record = self.recorded_cycles()
         out: dict[str, sim.RunConfig] = {}
-        for robot in self.robots:
-            for task in self.tasks:
-                for axis in self.axes:
-                    for pct in [0.0] if axis == 0 else self.increases:
-                        for kind in [None] if axis == 0 else self.schedules:
-                            for seed in self.seeds:
-                                if axis == 0:
-                                    plan, label = wear.WearPlan({}), "nowear"
-                                else:
-                                    plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
-                                    label = f"axis{axis}-{kind}{pct:g}"
-                                run_id = f"{robots.load(robot).name}-{task}-{label}-seed{seed}"
-                                out[run_id] = sim.RunConfig(robot=robot, task=task, friction=self.friction, wear=plan,
-                                                            cycles=self.cycles, record=record, seed=seed, noise=noise,
-                                                            nthread=1)
+        for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
+            name = robots.load(robot).name
+            # a run without wear is one run, whatever the wear levels and schedules of the grid
+            variants = [(None, 0.0)] if axis == 0 else itertools.product(self.schedules, self.increases)
+            for kind, pct in variants:
+                if axis == 0:
+                    plan, label = wear.WearPlan({}), "nowear"
+                else:
+                    plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
+                    label = f"axis{axis}-{kind}{pct:g}"
+                out[f"{name}-{task}-{label}-seed{seed}"] = sim.RunConfig(
+                    robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
+                    seed=seed, noise=noise, nthread=1)
         return list(out.items())
 
     def to_json(self) -> str:

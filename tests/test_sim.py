@@ -128,3 +128,11 @@ def test_static_friction_model_also_passes_wear_to_the_motor():
     extra = np.mean(direction * (worn.tau_m[-1, :, 4] - nominal.tau_m[-1, :, 4]))
     assert added > 0.05
     assert extra == pytest.approx(added, rel=0.10)
+
+
+def test_cycles_beyond_one_batch_are_stepped_in_groups_with_the_same_result(monkeypatch):
+    whole = run(task="pick_place", wear=["6:linear:20"], record=(3, 20, 77), seed=5)
+    monkeypatch.setattr(sim, "BATCH_CYCLES", 2)
+    grouped = run(task="pick_place", wear=["6:linear:20"], record=(3, 20, 77), seed=5)
+    for name in ("q_a", "tau_m", "tau_f", "friction_multiplier"):
+        assert np.array_equal(getattr(whole, name), getattr(grouped, name)), name
