@@ -281,6 +281,91 @@ def plot_command(
     typer.echo(f"wrote {target}")
 
 
+def _analysis_input(file: Path) -> None:
+    """Refuse a dataset that fails validation before any analysis runs on it."""
+    from faultgen import dataset
+
+    problems = dataset.validate(file)
+    if problems:
+        typer.echo(f"error: {file} fails validation (run `faultgen validate {file}`): {problems[0]}", err=True)
+        raise typer.Exit(2)
+
+
+@app.command("bench-isolators")
+def bench_isolators_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
+    bins: Annotated[Optional[list[int]], typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
+    levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
+) -> None:
+    """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
+    worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap."""
+    from analysis import benchmark
+
+    _analysis_input(file)
+    try:
+        wear_levels = [float(x) for x in levels.split(",")]
+        table = benchmark.isolation_table(file, benchmark.default_isolators(bins or (5, 10)), wear_levels,
+                                          progress=progress)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    stem = out or file.with_name(file.stem + "-isolation")
+    written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
+    written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
+    typer.echo(benchmark.markdown(benchmark.isolation_accuracy(table), digits=4))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+@app.command("detect")
+def detect_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
+    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
+    alpha: Annotated[float, typer.Option(help="Significance of the Q limit (0.05: 95 % limit).")] = 0.05,
+    persistence: Annotated[int, typer.Option(help="Samples in a row above the limit to call an onset.")] = 1,
+    period: Annotated[Optional[int], typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
+) -> None:
+    """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout."""
+    from analysis import benchmark
+
+    _analysis_input(file)
+    try:
+        table = benchmark.detection_table(file, variance=variance, alpha=alpha, persistence=persistence,
+                                          period=period, progress=progress)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    written = benchmark.write_outputs(table, out or file.with_name(file.stem + "-detection"))
+    typer.echo(benchmark.markdown(table, digits=4))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+@app.command("classify")
+def classify_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
+    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.")] = 10.0,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
+    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs and the random forest.")] = 0,
+    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
+) -> None:
+    """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""
+    from analysis import benchmark
+
+    _analysis_input(file)
+    try:
+        table = benchmark.classification_table(file, wear_threshold=wear_threshold, n_pairs=pairs or None,
+                                               random_state=seed)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    written = benchmark.write_outputs(table, out or file.with_name(file.stem + "-classification"))
+    typer.echo(benchmark.markdown(table, digits=3))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
 def _parse_cycles(text: str) -> tuple[int, ...]:
     """'1,50,90-100' -> (1, 50, 90, ..., 100); raises ValueError naming the bad part."""
     cycles: list[int] = []

@@ -1,0 +1,253 @@
+"""Run isolators, detectors and classifiers over a faultgen dataset; tables in the thesis's layouts.
+
+- :func:`isolation_table`: every isolator on every run with one worn axis, at each wear level
+  (data up to the first cycle whose true wear reaches it), thesis Table 6.2.
+- :func:`detection_table`: PCA monitoring (Q statistic) of each worn run against the run without
+  wear of the same robot, task and seed; onset of wear and its location, thesis Table 3.5.
+- :func:`classification_table`: AUC of LR / SVM / RF / stacking over preprocessing combinations,
+  leave one worn and one unworn run out, thesis Table 5.2.
+
+Each takes a dataset path and returns a pandas DataFrame; :func:`write_outputs` writes a table as
+CSV and Markdown (and a PNG heatmap for isolation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm.auto import tqdm
+
+from analysis import isolation
+from faultgen import dataset
+
+#: Wear levels of thesis Table 6.2, in percent.
+WEAR_LEVELS = (1.0, 5.0, 10.0, 15.0)
+
+
+def default_isolators(bins: Iterable[int] = (5, 10)) -> dict[str, object]:
+    """Transfer entropy with each bin count (thesis ch. 6), cross-correlation (ch. 3.4.2), and the
+    other registered isolators with their defaults."""
+    chosen = {f"te{b}": isolation.make("transfer_entropy", bins=b) for b in bins}
+    for name in isolation.ISOLATORS:
+        if name != "transfer_entropy":
+            chosen[name] = isolation.make(name)
+    return chosen
+
+
+def _runs(path, names: tuple[str, ...]) -> list[tuple[str, dict, dict]]:
+    """(run id, arrays, labels) of every run of a dataset, reading only ``names``."""
+    out = []
+    for run_id in dataset.list_runs(path):
+        arrays, attrs = dataset.read_run(path, run_id, names=names)
+        out.append((run_id, arrays, attrs))
+    return out
+
+
+def level_cycle(multiplier: np.ndarray, level: float) -> int | None:
+    """Index of the first recorded cycle whose true wear reaches ``level`` percent, or None."""
+    reached = np.flatnonzero((multiplier - 1.0) * 100.0 >= level - 1e-9)
+    return int(reached[0]) if reached.size else None
+
+
+def isolation_table(path, isolators: Mapping[str, object] | None = None, levels: Iterable[float] = WEAR_LEVELS,
+                    signal: str = "mean_abs_torque", progress: bool = True) -> pd.DataFrame:
+    """Which axis each isolator names as the source, per worn run and wear level.
+
+    For a run wearing one axis, the isolator sees the per-cycle ``signal`` (n_cycles, 6) of the
+    recorded cycles up to and including the first one whose true wear reaches the level (thesis
+    ch. 6.4: 10 % wear is cycle 86 of the exp4 schedule). Runs wearing several axes or none are
+    skipped.
+
+    Returns
+    -------
+    DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis, wear_pct,
+    cycles (samples seen), isolator, predicted (0: undecided), correct.
+    """
+    from sklearn.base import clone
+
+    isolators = dict(isolators or default_isolators())
+    rows = []
+    runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) == 1]
+    if not runs:
+        raise ValueError(f"{path} has no run with exactly one worn axis to isolate")
+    for run_id, arrays, attrs in tqdm(runs, desc="isolation", unit="run", disable=not progress):
+        axis = int(attrs["worn_axes"][0])
+        for level in levels:
+            k = level_cycle(arrays["friction_multiplier"][:, axis - 1], level)
+            if k is None:
+                continue
+            X = arrays[signal][: k + 1]
+            for name, prototype in isolators.items():
+                try:
+                    predicted = int(clone(prototype).fit(X).source_axis_)
+                except ValueError:  # too few cycles for this isolator at this level
+                    predicted = 0
+                rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
+                                 wear_pct=level, cycles=k + 1, isolator=name, predicted=predicted,
+                                 correct=predicted == axis))
+    return pd.DataFrame(rows)
+
+
+def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
+    """Accuracy in percent per task and wear level (rows) and isolator (columns), Table 6.2."""
+    accuracy = table.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100).unstack("isolator")
+    return accuracy.round(1)
+
+
+def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
+    """Table 6.2 layout: per task and wear level, a mark per source axis for ``marked`` (default:
+    the first isolator), then the accuracy of every isolator."""
+    isolators = list(dict.fromkeys(table["isolator"]))
+    marked = marked or isolators[0]
+    accuracy = isolation_accuracy(table)
+    head = (["task", "wear %"] + [f"axis {a}" for a in range(1, 7)]
+            + [f"accuracy {name} (%)" for name in isolators])
+    lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
+    for (task, level), group in table[table["isolator"] == marked].groupby(["task", "wear_pct"]):
+        marks = []
+        for axis in range(1, 7):
+            row = group[group["worn_axis"] == axis]
+            marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
+        acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
+        lines.append("| " + " | ".join([task, f"{level:g}", *marks, *acc]) + " |")
+    return f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run).\n\n" + "\n".join(lines)
+
+
+def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
+    """PNG heatmap of accuracy: isolators (rows) x task and wear level (columns)."""
+    from matplotlib.figure import Figure
+
+    accuracy = isolation_accuracy(table).T  # isolators x (task, wear)
+    fig = Figure(figsize=(max(6.0, 0.7 * accuracy.shape[1] + 2), 0.5 * accuracy.shape[0] + 2))
+    ax = fig.subplots()
+    image = ax.imshow(accuracy.to_numpy(dtype=float), vmin=0, vmax=100, cmap="viridis", aspect="auto")
+    ax.set_yticks(range(accuracy.shape[0]), accuracy.index)
+    ax.set_xticks(range(accuracy.shape[1]), [f"{t}\n{w:g} %" for t, w in accuracy.columns], fontsize=8)
+    for i in range(accuracy.shape[0]):
+        for j in range(accuracy.shape[1]):
+            value = accuracy.iat[i, j]
+            ax.text(j, i, f"{value:.0f}", ha="center", va="center", color="white" if value < 60 else "black")
+    fig.colorbar(image, ax=ax, label="source axis isolated (%)")
+    ax.set_title("isolation accuracy per task and wear level")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def _nominal_partner(runs, attrs) -> tuple[str, dict, dict] | None:
+    for run in runs:
+        other = run[2]
+        if (len(other["worn_axes"]) == 0 and other["robot"] == attrs["robot"] and other["task"] == attrs["task"]
+                and other["seed"] == attrs["seed"]):
+            return run
+    return None
+
+
+def group_cycles(cycles: np.ndarray, period: int | None) -> np.ndarray:
+    """Group index of each recorded cycle: ``(cycle - 1) // period`` (e.g. the hour, for period 60
+    one-minute cycles), or one group per recorded cycle when ``period`` is None."""
+    return np.arange(len(cycles)) if period is None else (cycles - 1) // period
+
+
+def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persistence: int = 1,
+                    period: int | None = None, progress: bool = True) -> pd.DataFrame:
+    """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5).
+
+    Features per sample: the KL divergence (eq. 5.4) of each axis's torque histogram against the
+    run's first sample; samples are single recorded cycles, or the averaged histograms of the
+    cycles of each ``period`` (60 for the c2 preset's hours). A PCA monitor (components for
+    ``variance`` of the variance, thesis: 75 %) is fitted on the run without wear of the same
+    robot, task and seed; wear is detected at the first sample whose Q statistic exceeds its
+    ``1 - alpha`` limit for ``persistence`` samples in a row; its location is the axis the
+    cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
+
+    Returns
+    -------
+    DataFrame, one row per worn run: robot, task, run, worn_axis, final_wear_pct, detected,
+    onset (group index, 0-based; NaN if not detected), onset_wear_pct, located_axis, located.
+    """
+    from analysis.monitoring import PCAMonitor, detect_onset
+
+    runs = _runs(path, ("cycles", "torque_hist", "friction_multiplier"))
+    rows = []
+    for run_id, arrays, attrs in tqdm(runs, desc="detection", unit="run", disable=not progress):
+        if len(attrs["worn_axes"]) != 1:
+            continue
+        nominal = _nominal_partner(runs, attrs)
+        if nominal is None:
+            raise ValueError(f"{path}: no run without wear for {attrs['robot']} {attrs['task']} seed {attrs['seed']} "
+                             f"to train the monitor of {run_id}")
+        axis = int(attrs["worn_axes"][0])
+        worn_features, groups = _kl_features(arrays, period)
+        normal_features, _ = _kl_features(nominal[1], period)
+        monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q").fit(normal_features)
+        onset = detect_onset(monitor.predict(worn_features), persistence=persistence)
+        wear = (arrays["friction_multiplier"][:, axis - 1] - 1.0) * 100.0
+        located = 0
+        if onset is not None:
+            located = int(isolation.make("cross_correlation").fit(worn_features[: max(onset + 1, 4)]).source_axis_)
+        rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
+                         final_wear_pct=round(float(wear[-1]), 2), detected=onset is not None,
+                         onset=np.nan if onset is None else int(groups[onset]),
+                         onset_wear_pct=np.nan if onset is None else round(float(wear[groups == groups[onset]].max()), 2),
+                         located_axis=located, located=located == axis))
+    return pd.DataFrame(rows)
+
+
+def _kl_features(arrays: dict, period: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """KL divergence per axis of (grouped) torque histograms against the first, and group ids."""
+    from analysis.features import HistogramKL
+
+    groups = group_cycles(arrays["cycles"], period)
+    unique = np.unique(groups)
+    hist = np.stack([arrays["torque_hist"][groups == g].mean(axis=0) for g in unique])
+    return HistogramKL(reference="first").fit_transform(hist), unique
+
+
+def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,
+                         progress: bool = True, **kwargs) -> pd.DataFrame:
+    """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
+
+    Samples are recorded cycles; features per axis: mean absolute and RMS motor torque, and the KL
+    divergence of the angle, speed and torque histograms against the run's first cycle (thesis
+    ch. 5.3.1-5.3.2). Labels: 1 for cycles of a worn run whose true wear is at least
+    ``wear_threshold`` percent, 0 otherwise; groups are runs (a "robot" of Procedure 1).
+    """
+    from analysis.classify import evaluate
+    from analysis.features import HistogramKL
+
+    names = ("mean_abs_torque", "rms_torque", "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
+    X, y, groups, failed, normal = [], [], [], [], []
+    for run_id, arrays, attrs in _runs(path, names):
+        kl = [HistogramKL(reference="first").fit_transform(arrays[h]) for h in ("angle_hist", "speed_hist", "torque_hist")]
+        X.append(np.hstack([arrays["mean_abs_torque"], arrays["rms_torque"], *kl]))
+        wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
+        y.append((wear >= wear_threshold).astype(int))
+        groups.append(np.full(len(wear), run_id, dtype=object))
+        (failed if len(attrs["worn_axes"]) else normal).append(run_id)
+    if not failed or not normal:
+        raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
+                         f"{len(normal)} unworn)")
+    return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
+                    random_state=random_state, **kwargs)
+
+
+def markdown(table: pd.DataFrame, digits: int = 3) -> str:
+    """A DataFrame as a Markdown table (index included unless it is a plain range)."""
+    frame = table if isinstance(table.index, pd.RangeIndex) else table.reset_index()
+    cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row] for row in frame.itertuples(index=False)]
+    head = [str(c) for c in frame.columns]
+    return "\n".join(["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
+                     + ["| " + " | ".join(row) + " |" for row in cells])
+
+
+def write_outputs(table: pd.DataFrame, stem: Path, text: str | None = None) -> list[Path]:
+    """Write ``table`` as ``<stem>.csv`` and ``text`` (default: the table) as ``<stem>.md``."""
+    stem = Path(stem)
+    csv, md = stem.with_suffix(".csv"), stem.with_suffix(".md")
+    table.to_csv(csv, index=not isinstance(table.index, pd.RangeIndex))
+    md.write_text((text or markdown(table)) + "\n")
+    return [csv, md]
