@@ -1,5 +1,12 @@
-"""Fault detection and isolation modules for faultgen datasets, in scikit-learn style.
+"""Fault detection and isolation for faultgen datasets (and your own), in scikit-learn style.
 
-Planned layout (see docs/architecture.md): features, monitoring (PCA T2 / Q), classify,
-isolation (transfer entropy, cross-correlation) and benchmark. Nothing is implemented yet.
+- :mod:`analysis.features`: KL divergence of histograms (thesis eq. 4.1 / 5.4), differencing,
+  windows (+var3 / +var5), per-cycle statistics.
+- :mod:`analysis.monitoring`: PCA monitor with Hotelling T2 (eq. 2.4) and Q (eq. 2.5-2.6) limits,
+  contributions (eq. 8), onset detection.
+- :mod:`analysis.classify`: LR / SVM / RF / stacking over the preprocessing of Table 5.2,
+  leave-one-failed-and-one-normal-out AUC (Procedure 1) and its statistics (Procedure 2).
+- :mod:`analysis.isolation`: isolators with one interface (transfer entropy, eqs. 6.4-6.5;
+  cross-correlation, ch. 3.4.2; Granger; trend; PCA contribution) and a registry for your own.
+- :mod:`analysis.benchmark`: all of them over a dataset, in the layouts of Tables 6.2, 3.5, 5.2.
 """

@@ -64,11 +64,24 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     Returns
     -------
     DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis, wear_pct,
-    cycles (samples seen), isolator, predicted (0: undecided), correct.
+    cycles (samples seen), isolator, predicted (0: undecided; -1: too few cycles for the
+    isolator), correct.
+
+    Raises
+    ------
+    ValueError
+        If an isolator's parameters are invalid (e.g. bins < 2; the message names it), or the
+        dataset has no run with exactly one worn axis.
     """
     from sklearn.base import clone
 
     isolators = dict(isolators or default_isolators())
+    probe = np.random.default_rng(0).standard_normal((200, 6))
+    for name, prototype in isolators.items():  # bad parameters (bins < 2, ...) raise here, named
+        try:
+            clone(prototype).fit(probe)
+        except ValueError as err:
+            raise ValueError(f"isolator {name}: {err}") from err
     rows = []
     runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) == 1]
     if not runs:
@@ -83,8 +96,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             for name, prototype in isolators.items():
                 try:
                     predicted = int(clone(prototype).fit(X).source_axis_)
-                except ValueError:  # too few cycles for this isolator at this level
-                    predicted = 0
+                except ValueError:  # too few cycles for this isolator at this level: not isolated
+                    predicted = -1
                 rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
                                  wear_pct=level, cycles=k + 1, isolator=name, predicted=predicted,
                                  correct=predicted == axis))
@@ -125,7 +138,8 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     ax = fig.subplots()
     image = ax.imshow(accuracy.to_numpy(dtype=float), vmin=0, vmax=100, cmap="viridis", aspect="auto")
     ax.set_yticks(range(accuracy.shape[0]), accuracy.index)
-    ax.set_xticks(range(accuracy.shape[1]), [f"{t}\n{w:g} %" for t, w in accuracy.columns], fontsize=8)
+    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {w:g} %" for t, w in accuracy.columns], fontsize=8,
+                  rotation=35, ha="right")
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
             value = accuracy.iat[i, j]
@@ -156,22 +170,26 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                     period: int | None = None, progress: bool = True) -> pd.DataFrame:
     """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5).
 
-    Features per sample: the KL divergence (eq. 5.4) of each axis's torque histogram against the
-    run's first sample; samples are single recorded cycles, or the averaged histograms of the
-    cycles of each ``period`` (60 for the c2 preset's hours). A PCA monitor (components for
-    ``variance`` of the variance, thesis: 75 %) is fitted on the run without wear of the same
-    robot, task and seed; wear is detected at the first sample whose Q statistic exceeds its
-    ``1 - alpha`` limit for ``persistence`` samples in a row; its location is the axis the
-    cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
+    Features per sample: for each axis, the KL divergence (eq. 5.4) of the 12-bin histogram of
+    |motor torque|, normalised by the largest |motor torque| of the run without wear (thesis
+    ch. 3.4: "normalized with respect to maximum torque and binned into twelve equal-sized
+    intervals"), against the first sample. A sample is one recorded cycle, or all the cycles of a
+    ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA monitor (components for
+    ``variance`` of the variance, thesis: 75 %; features constant in training are left out) is
+    fitted on the run without wear of the same robot, task and seed; wear is detected at the
+    first sample whose Q statistic exceeds its ``1 - alpha`` limit for ``persistence`` samples in
+    a row; its location is the axis the cross-correlation isolator names (ch. 3.4.2) on the KL
+    features up to that sample.
 
     Returns
     -------
-    DataFrame, one row per worn run: robot, task, run, worn_axis, final_wear_pct, detected,
-    onset (group index, 0-based; NaN if not detected), onset_wear_pct, located_axis, located.
+    DataFrame, one row per worn run: robot, task, run, worn_axis, final_wear_pct, features
+    (axes used), detected, onset (sample index: cycle or period, 0-based; NaN if not detected),
+    onset_wear_pct, located_axis (0: undecided), located.
     """
     from analysis.monitoring import PCAMonitor, detect_onset
 
-    runs = _runs(path, ("cycles", "torque_hist", "friction_multiplier"))
+    runs = _runs(path, ("cycles", "friction_multiplier"))
     rows = []
     for run_id, arrays, attrs in tqdm(runs, desc="detection", unit="run", disable=not progress):
         if len(attrs["worn_axes"]) != 1:
@@ -181,30 +199,47 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
             raise ValueError(f"{path}: no run without wear for {attrs['robot']} {attrs['task']} seed {attrs['seed']} "
                              f"to train the monitor of {run_id}")
         axis = int(attrs["worn_axes"][0])
-        worn_features, groups = _kl_features(arrays, period)
-        normal_features, _ = _kl_features(nominal[1], period)
-        monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q").fit(normal_features)
-        onset = detect_onset(monitor.predict(worn_features), persistence=persistence)
+        normal_torque = np.abs(dataset.read_run(path, nominal[0], names=("tau_m",))[0]["tau_m"])
+        scale = normal_torque.max(axis=(0, 1))
+        normal, _ = _kl_features(normal_torque, nominal[1]["cycles"], scale, period)
+        worn_torque = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
+        worn, groups = _kl_features(worn_torque, arrays["cycles"], scale, period)
+        used = np.flatnonzero(normal.std(axis=0) > 0)
+        monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q")
+        try:
+            monitor.fit(normal[:, used])
+        except ValueError:  # the variance needs every component: keep one back for the Q residual
+            monitor.set_params(n_components=len(used) - 1).fit(normal[:, used])
+        onset = detect_onset(monitor.predict(worn[:, used]), persistence=persistence)
         wear = (arrays["friction_multiplier"][:, axis - 1] - 1.0) * 100.0
         located = 0
         if onset is not None:
-            located = int(isolation.make("cross_correlation").fit(worn_features[: max(onset + 1, 4)]).source_axis_)
+            try:
+                located = int(isolation.make("cross_correlation").fit(worn[: onset + 1]).source_axis_)
+            except ValueError:  # too few samples before the onset to cross-correlate
+                located = 0
         rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
-                         final_wear_pct=round(float(wear[-1]), 2), detected=onset is not None,
-                         onset=np.nan if onset is None else int(groups[onset]),
-                         onset_wear_pct=np.nan if onset is None else round(float(wear[groups == groups[onset]].max()), 2),
+                         final_wear_pct=round(float(wear[-1]), 2), features=" ".join(str(u + 1) for u in used),
+                         detected=onset is not None, onset=np.nan if onset is None else int(onset),
+                         onset_wear_pct=np.nan if onset is None else round(float(wear[groups == onset].max()), 2),
                          located_axis=located, located=located == axis))
     return pd.DataFrame(rows)
 
 
-def _kl_features(arrays: dict, period: int | None) -> tuple[np.ndarray, np.ndarray]:
-    """KL divergence per axis of (grouped) torque histograms against the first, and group ids."""
-    from analysis.features import HistogramKL
+def _kl_features(torque: np.ndarray, cycles: np.ndarray, scale: np.ndarray,
+                 period: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """KL divergence per axis of (grouped) |torque| histograms against the first sample.
 
-    groups = group_cycles(arrays["cycles"], period)
-    unique = np.unique(groups)
-    hist = np.stack([arrays["torque_hist"][groups == g].mean(axis=0) for g in unique])
-    return HistogramKL(reference="first").fit_transform(hist), unique
+    Returns the features (n_samples, 6) and, per recorded cycle, the index of its sample.
+    """
+    from analysis.features import HistogramKL
+    from faultgen.sensors import histogram
+
+    hist = histogram(torque, np.zeros(6), scale)  # (n_cycles, 6, 12), one per recorded cycle
+    groups = group_cycles(cycles, period)
+    _, index = np.unique(groups, return_inverse=True)
+    grouped = np.stack([hist[index == g].mean(axis=0) for g in range(index.max() + 1)])
+    return HistogramKL(reference="first").fit_transform(grouped), index
 
 
 def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,

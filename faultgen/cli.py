@@ -315,6 +315,10 @@ def bench_isolators_command(
     written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
     written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(benchmark.isolation_accuracy(table), digits=4))
+    short = int((table["predicted"] < 0).sum())
+    if short:
+        typer.echo(f"note: {short} of {len(table)} cases had fewer cycles than the isolator needs and count as "
+                   "not isolated; record more cycles")
     typer.echo("wrote " + ", ".join(map(str, written)))
 
 

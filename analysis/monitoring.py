@@ -1,0 +1,261 @@
+"""PCA monitoring with Hotelling's T2 and the Q statistic (SPE), thesis ch. 2.3.3, 3.2.2, 3.4.1.
+
+:class:`PCAMonitor` learns normal operation from features (one row per sample, e.g. the KL
+divergences of :class:`analysis.features.HistogramKL`), and flags samples whose T2 or Q exceeds
+its ``1 - alpha`` limit; :func:`detect_onset` turns the alarms into the onset of a fault.
+
+Notation: ``m`` training samples, ``n_features`` variables, ``k`` retained components. The thesis
+uses ``m`` for both the number of samples (eq. 2.4) and the number of variables (eq. 2.6).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import stats
+from sklearn.base import BaseEstimator
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+STATISTICS = ("q", "t2", "either")
+
+
+class PCAMonitor(BaseEstimator):
+    """PCA model of normal operation with T2 and Q control limits.
+
+    Fit standardises each feature with the training mean and sample standard deviation
+    (``ddof=1``), so the model is the eigen-decomposition of the training correlation matrix:
+    features in different units (N m, bits) weigh equally. The first ``k`` components are kept,
+    the fewest whose cumulative share of the variance is >= ``variance`` (thesis: 75 % in
+    ch. 3.2.2, 85 % in ch. 2.3.3, 90 % in ch. 4.3.3 and 5.3.2), unless ``n_components`` is given.
+
+    For a standardised sample ``z`` (row vector) with scores ``t = z P_k``:
+
+    - ``T2 = t Lambda_k^-1 t^T`` (eq. 2.3), limit ``T2_alpha = k (m - 1) / (m - k)
+      F_(1-alpha)(k, m - k)`` (Jackson 1991; MacGregor & Kourti 1995). The thesis prints eq. 2.4
+      with ``F(k, m - 1; alpha)``; the prefactor ``k (m - 1) / (m - k)`` belongs to an F
+      distribution with ``m - k`` denominator degrees of freedom, which is used here. The printed
+      ``m - 1`` gives a lower limit (more false alarms) for small ``m``, e.g. m = 30, k = 5,
+      alpha = 0.05: 14.76 instead of 15.10 (equal to 4 digits for m in the thousands). The exact limit for a
+      new sample has a further factor ``(m + 1) / m`` (Tracy, Young & Mason 1992), < 1 % for
+      m > 100, left out as in the thesis.
+    - ``Q = ||z - z P_k P_k^T||^2`` (eq. 2.5), limit of Jackson & Mudholkar (1979), eq. 2.6:
+      ``Q_alpha = theta_1 [c_alpha h_0 sqrt(2 theta_2) / theta_1 + 1 + theta_2 h_0 (h_0 - 1) /
+      theta_1^2]^(1 / h_0)`` with ``theta_i = sum_(j > k) lambda_j^i`` over the residual
+      eigenvalues, ``h_0 = 1 - 2 theta_1 theta_3 / (3 theta_2^2)`` and ``c_alpha`` the standard
+      normal quantile at ``1 - alpha``.
+
+    Parameters
+    ----------
+    variance : float, default=0.85
+        Share of the variance the kept components must explain, in (0, 1].
+    alpha : float, default=0.05
+        Significance level: the limits are the ``1 - alpha`` quantiles under normal operation.
+    n_components : int or None, default=None
+        Number of components ``k``, 1 <= k < n_features; overrides ``variance``.
+    statistic : {"either", "q", "t2"}, default="either"
+        What :meth:`predict` alarms on. With ``"either"`` the false-alarm rate is up to
+        ``2 alpha`` (about ``2 alpha - alpha^2`` as T2 and Q are independent for Gaussian data).
+
+    Attributes
+    ----------
+    mean_, scale_ : ndarray of shape (n_features,)
+        Training mean and standard deviation (``ddof=1``) of each feature, in its unit.
+    eigenvalues_ : ndarray of shape (n_features,)
+        All eigenvalues of the training correlation matrix, descending; the first
+        ``n_components_`` are the model's, the rest the residual ones of eq. 2.6.
+    components_ : ndarray of shape (n_components_, n_features)
+        Kept eigenvectors ``P_k^T`` (rows), each with its largest loading positive.
+    explained_variance_ratio_ : ndarray of shape (n_features,)
+        ``eigenvalues_ / sum(eigenvalues_)``.
+    n_components_ : int
+        Components kept, ``k``.
+    n_samples_fit_ : int
+        Training samples, ``m``.
+    t2_limit_, q_limit_ : float
+        Control limits of T2 (eq. 2.4, F with ``m - k`` degrees of freedom) and Q (eq. 2.6).
+    n_features_in_ : int
+        Features seen in fit.
+
+    Raises
+    ------
+    ValueError
+        From :meth:`fit`: invalid parameters (naming the value), fewer than 2 samples or
+        features, non-finite values, a constant feature (naming its index), ``variance`` that
+        needs all components (no residual space for Q), ``k >= m``, or residual eigenvalues
+        that are all zero. From the scoring methods: a number of features other than in fit.
+    """
+
+    def __init__(self, variance: float = 0.85, alpha: float = 0.05, n_components: int | None = None,
+                 statistic: str = "either"):
+        self.variance = variance
+        self.alpha = alpha
+        self.n_components = n_components
+        self.statistic = statistic
+
+    def _check_params(self) -> None:
+        if not 0 < self.variance <= 1:
+            raise ValueError(f"variance = {self.variance!r}; expected a share in (0, 1]")
+        if not 0 < self.alpha < 1:
+            raise ValueError(f"alpha = {self.alpha!r}; expected a significance level in (0, 1)")
+        if self.statistic not in STATISTICS:
+            raise ValueError(f"statistic = {self.statistic!r}; expected one of {', '.join(STATISTICS)}")
+        k = self.n_components
+        if k is not None and (isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1):
+            raise ValueError(f"n_components = {k!r}; expected None or an integer >= 1")
+
+    def fit(self, X, y=None):
+        """Fit the model and limits on normal operation.
+
+        Parameters
+        ----------
+        X : array-like of shape (m, n_features)
+            Features under normal operation, one row per sample, m >= 2, n_features >= 2.
+        y : ignored
+
+        Returns
+        -------
+        self
+        """
+        self._check_params()
+        X = validate_data(self, X, dtype=float, ensure_min_samples=2, ensure_min_features=2)
+        m, n = X.shape
+        mean, scale = X.mean(axis=0), X.std(axis=0, ddof=1)
+        # A constant column has std 0 up to rounding of the mean (~1e-16 |mean|).
+        constant = np.flatnonzero(scale <= 1e-10 * np.abs(mean))
+        if constant.size:
+            j = int(constant[0])
+            raise ValueError(f"feature {j} is constant in the training data (mean {float(mean[j])!r}, std "
+                             f"{float(scale[j])!r}) and cannot be standardised; drop it")
+        Z = (X - mean) / scale
+        eigenvalues, vectors = np.linalg.eigh(Z.T @ Z / (m - 1))
+        eigenvalues, vectors = np.clip(eigenvalues[::-1], 0.0, None), vectors[:, ::-1]
+        vectors *= np.where(vectors[np.abs(vectors).argmax(axis=0), range(n)] < 0, -1.0, 1.0)
+        ratio = eigenvalues / eigenvalues.sum()
+        if self.n_components is None:
+            k = int(np.argmax(np.cumsum(ratio) >= self.variance - 1e-12)) + 1
+            if k >= n:
+                raise ValueError(f"variance = {self.variance!r} needs all {n} components, leaving no "
+                                 "residual space for Q; lower it or set n_components")
+        else:
+            k = int(self.n_components)
+            if k >= n:
+                raise ValueError(f"n_components = {k} must be below n_features = {n} "
+                                 "(Q needs a residual space)")
+        if k >= m:
+            raise ValueError(f"{k} components need more than {k} training samples, got {m}")
+        theta1, theta2, theta3 = (np.sum(eigenvalues[k:] ** i) for i in (1, 2, 3))
+        if theta2 <= 0:
+            raise ValueError(f"the residual eigenvalues beyond component {k} are all zero (features exactly "
+                             "collinear); the Q limit is undefined: use fewer components or features")
+        self.mean_, self.scale_ = mean, scale
+        self.eigenvalues_, self.explained_variance_ratio_ = eigenvalues, ratio
+        self.components_, self.n_components_, self.n_samples_fit_ = vectors[:, :k].T.copy(), k, m
+        self.t2_limit_ = float(k * (m - 1) / (m - k) * stats.f.ppf(1 - self.alpha, k, m - k))
+        self.q_limit_ = _jackson_mudholkar(theta1, theta2, theta3, self.alpha)
+        return self
+
+    def _project(self, X) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Standardised X, scores and residuals of X of shape (n_samples, n_features)."""
+        check_is_fitted(self, "q_limit_")
+        X = validate_data(self, X, dtype=float, reset=False)
+        Z = (X - self.mean_) / self.scale_
+        T = Z @ self.components_.T
+        return Z, T, Z - T @ self.components_
+
+    def score_samples(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """T2 (eq. 2.3) and Q (eq. 2.5) of each sample.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+
+        Returns
+        -------
+        t2, q : ndarray of shape (n_samples,)
+            Dimensionless (standardised features); compare with ``t2_limit_`` and ``q_limit_``.
+            Unlike scikit-learn's outlier detectors, larger means more abnormal.
+        """
+        _, T, E = self._project(X)
+        return np.sum(T**2 / self.eigenvalues_[: self.n_components_], axis=1), np.sum(E**2, axis=1)
+
+    def predict(self, X) -> np.ndarray:
+        """Alarms, ``ndarray of shape (n_samples,)`` of bool: the chosen ``statistic`` above its limit."""
+        t2, q = self.score_samples(X)
+        alarm = {"q": q > self.q_limit_, "t2": t2 > self.t2_limit_}
+        return alarm[self.statistic] if self.statistic in alarm else alarm["q"] | alarm["t2"]
+
+    def contributions(self, X, statistic: str = "q") -> np.ndarray:
+        """Contribution of each feature to Q or T2, for isolating the feature behind an alarm.
+
+        ``"q"``: squared residuals ``e_j^2`` of the standardised sample, which sum to Q (the
+        thesis's Q contribution plots show the residuals ``e_j`` with their sign).
+        ``"t2"``: ``z P_k Lambda_k^(-1/2) P_k^T``, thesis eq. 8 (ch. 2.3.3.2), signed; the sum of
+        their squares is T2. Eq. 8 is printed with ``lambda^(1/2)``; the inverse square root is
+        the form whose squares add up to T2 (PLS_Toolbox ``tcon``, Wise & Gallagher 1996).
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+        statistic : {"q", "t2"}, default="q"
+
+        Returns
+        -------
+        ndarray of shape (n_samples, n_features)
+
+        Raises
+        ------
+        ValueError
+            For another ``statistic``, or a number of features other than in fit.
+        """
+        if statistic not in ("q", "t2"):
+            raise ValueError(f"statistic = {statistic!r}; expected 'q' or 't2'")
+        _, T, E = self._project(X)
+        if statistic == "q":
+            return E**2
+        return (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
+
+
+def _jackson_mudholkar(theta1: float, theta2: float, theta3: float, alpha: float) -> float:
+    """Q limit of eq. 2.6 (Jackson & Mudholkar 1979) from the residual eigenvalue sums."""
+    h0 = 1 - 2 * theta1 * theta3 / (3 * theta2**2)
+    c = stats.norm.ppf(1 - alpha)
+    # (Q / theta1)^h0 is approximately normal; for h0 < 0 the same expression still holds, as the
+    # upper quantile of Q maps to the lower quantile of the decreasing transform.
+    base = c * h0 * np.sqrt(2 * theta2) / theta1 + 1 + theta2 * h0 * (h0 - 1) / theta1**2
+    if h0 == 0 or base <= 0:
+        raise ValueError(f"the Jackson-Mudholkar approximation is undefined for these residual "
+                         f"eigenvalues (h0 = {float(h0)!r}, bracket = {float(base)!r}); choose another "
+                         "number of components")
+    return float(theta1 * base ** (1 / h0))
+
+
+def detect_onset(alarms, persistence: int = 1) -> int | None:
+    """First index from which ``persistence`` consecutive samples are alarms (thesis ch. 3.4.1).
+
+    Parameters
+    ----------
+    alarms : array-like of shape (n_samples,)
+        Alarms in time order, e.g. :meth:`PCAMonitor.predict`; truthy means above the limit.
+    persistence : int, default=1
+        Consecutive alarms needed; the onset is the first sample of the first such run (it is
+        confirmed ``persistence - 1`` samples later).
+
+    Returns
+    -------
+    int or None
+        0-based index of the onset, or None if no run of ``persistence`` alarms occurs.
+
+    Raises
+    ------
+    ValueError
+        If ``alarms`` is not 1-D or ``persistence`` is not an integer >= 1.
+    """
+    a = np.asarray(alarms)
+    if a.ndim != 1:
+        raise ValueError(f"alarms must be 1-D (n_samples,), got shape {a.shape}")
+    if isinstance(persistence, bool) or not isinstance(persistence, (int, np.integer)) or persistence < 1:
+        raise ValueError(f"persistence = {persistence!r}; expected an integer >= 1")
+    if a.size < persistence:
+        return None
+    runs = np.convolve(a.astype(bool).astype(int), np.ones(persistence, dtype=int), mode="valid")
+    hits = np.flatnonzero(runs == persistence)
+    return int(hits[0]) if hits.size else None
