@@ -112,9 +112,9 @@ def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
 
 def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     """Table 6.2 layout: per task and wear level, a mark per source axis for ``marked`` (default:
-    the first isolator), then the accuracy of every isolator."""
+    ``te10``, as the thesis, else the first isolator), then the accuracy of every isolator."""
     isolators = list(dict.fromkeys(table["isolator"]))
-    marked = marked or isolators[0]
+    marked = marked or ("te10" if "te10" in isolators else isolators[0])
     accuracy = isolation_accuracy(table)
     head = (["task", "wear %"] + [f"axis {a}" for a in range(1, 7)]
             + [f"accuracy {name} (%)" for name in isolators])
