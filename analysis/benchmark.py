@@ -267,7 +267,7 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")
     return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
-                    random_state=random_state, **kwargs)
+                    random_state=random_state, progress=progress, **kwargs)
 
 
 def markdown(table: pd.DataFrame, digits: int = 3) -> str:

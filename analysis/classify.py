@@ -33,6 +33,7 @@ from itertools import product
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from tqdm.auto import tqdm
 from sklearn.base import BaseEstimator, clone
 from sklearn.decomposition import PCA
 from sklearn.ensemble import RandomForestClassifier, StackingClassifier
@@ -608,7 +609,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
              classifiers: Iterable[str] | Mapping[str, object] = tuple(CLASSIFIERS),
              preprocessing: Iterable[str] | None = None, *, estimated=None, n_pairs: int | None = None,
              random_state: int | None = 0, label_rule=None, n_jobs: int | None = None,
-             return_aucs: bool = False):
+             return_aucs: bool = False, progress: bool = False):
     """Mean and standard deviation of leave-pair-out AUC per combination and classifier, Table 5.2.
 
     Every combination and classifier is scored by :func:`leave_pair_out_auc` on the same pairs.
@@ -631,6 +632,8 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     return_aucs : bool, default=False
         Also return ``{(classifier, preprocessing): ndarray of AUCs}``, the input of
         :func:`compare_preprocessing`.
+    progress : bool, default=False
+        Show a progress bar over the (preprocessing, classifier) cells.
 
     Returns
     -------
@@ -674,7 +677,8 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     X_est = np.hstack([X, estimated]) if estimated is not None else None
 
     aucs: dict[tuple[str, str], np.ndarray] = {}
-    for name, (column, model) in product(names, models.items()):
+    cells = list(product(names, models.items()))
+    for name, (column, model) in tqdm(cells, desc="classify", unit="cell", disable=not progress):
         pipe = make_pipeline(model, name, random_state=random_state)
         data = X_est if name.startswith(ESTIMATED) else X
         with warnings.catch_warnings():

@@ -357,6 +357,7 @@ def classify_command(
     pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs and the random forest.")] = 0,
     out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""
     from analysis import benchmark
@@ -364,7 +365,7 @@ def classify_command(
     _analysis_input(file)
     try:
         table = benchmark.classification_table(file, wear_threshold=wear_threshold, n_pairs=pairs or None,
-                                               random_state=seed)
+                                               random_state=seed, progress=progress)
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
