@@ -291,6 +291,21 @@ def _analysis_input(file: Path) -> None:
         raise typer.Exit(2)
 
 
+def _table_command(file: Path, out: Optional[Path], suffix: str, digits: int, compute) -> None:
+    """Validate ``file``, compute a table, write it as CSV and Markdown, print it."""
+    from analysis import benchmark
+
+    _analysis_input(file)
+    try:
+        table = compute()
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    written = benchmark.write_outputs(table, out or file.with_name(file.stem + suffix))
+    typer.echo(benchmark.markdown(table, digits=digits))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
 @app.command("bench-isolators")
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
@@ -338,16 +353,8 @@ def detect_command(
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout."""
     from analysis import benchmark
 
-    _analysis_input(file)
-    try:
-        table = benchmark.detection_table(file, variance=variance, alpha=alpha, persistence=persistence,
-                                          period=period, progress=progress)
-    except ValueError as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2) from err
-    written = benchmark.write_outputs(table, out or file.with_name(file.stem + "-detection"))
-    typer.echo(benchmark.markdown(table, digits=4))
-    typer.echo("wrote " + ", ".join(map(str, written)))
+    _table_command(file, out, "-detection", 4, lambda: benchmark.detection_table(
+        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress))
 
 
 @app.command("classify")
@@ -362,16 +369,8 @@ def classify_command(
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""
     from analysis import benchmark
 
-    _analysis_input(file)
-    try:
-        table = benchmark.classification_table(file, wear_threshold=wear_threshold, n_pairs=pairs or None,
-                                               random_state=seed, progress=progress)
-    except ValueError as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2) from err
-    written = benchmark.write_outputs(table, out or file.with_name(file.stem + "-classification"))
-    typer.echo(benchmark.markdown(table, digits=3))
-    typer.echo("wrote " + ", ".join(map(str, written)))
+    _table_command(file, out, "-classification", 3, lambda: benchmark.classification_table(
+        file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress))
 
 
 def _parse_cycles(text: str) -> tuple[int, ...]:
