@@ -21,11 +21,11 @@ The last line is ``ratio <float>``: faultgen stepping time over the same-work ba
 from __future__ import annotations
 
 import argparse
-import time
+
+from benchmarks_common import hold_seconds, same_work_seconds, simulated_seconds  # sibling module
 
 from faultgen import sim, tasks
 from faultgen.wear import WearPlan
-from benchmarks_common import hold_seconds, same_work_seconds, simulated_seconds  # sibling module
 
 
 def main() -> None:

@@ -27,9 +27,9 @@ import time
 from pathlib import Path
 
 import psutil
+from benchmarks_common import same_work_seconds  # sibling module
 
 from faultgen import sweep
-from benchmarks_common import same_work_seconds  # sibling module
 
 
 def tree_rss() -> int:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import shlex
 import sys
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import numpy as np
 import typer
@@ -17,8 +17,10 @@ from faultgen.friction import UNITS as FRICTION_UNITS
 app = typer.Typer(
     help=(
         "Simulate wear faults in industrial robots and analyse them.\n\n"
-        "Start with `faultgen robots` to see the robot models and `faultgen robots NAME` for one "
-        "model's parameters (gear ratios, gearbox stiffness, motor-side friction)."
+        "A first dataset: `faultgen sweep --preset quick -o quick.h5` (under a minute), then "
+        "`faultgen info quick.h5` and `faultgen plot quick.h5`. Analyse it with `faultgen "
+        "bench-isolators`, `detect` and `classify`. `faultgen robots` lists the robot models; "
+        "`faultgen robots NAME` shows one model's parameters."
     ),
     no_args_is_help=True,
     add_completion=False,
@@ -34,7 +36,7 @@ def _version(value: bool) -> None:
 @app.callback()
 def main(
     version: Annotated[
-        Optional[bool],
+        bool | None,
         typer.Option("--version", callback=_version, is_eager=True, help="Print the version and exit."),
     ] = None,
 ) -> None:
@@ -44,7 +46,7 @@ def main(
 @app.command("robots")
 def robots_command(
     name: Annotated[
-        Optional[str],
+        str | None,
         typer.Argument(help="Show the nominal parameters of this robot (or MJCF file) instead of the list."),
     ] = None,
 ) -> None:
@@ -104,7 +106,7 @@ def simulate_command(
         str, typer.Option("--friction", help="Motor-side friction model: lugre (dynamic) or stribeck (static eq. 6.3).")
     ] = "lugre",
     wear: Annotated[
-        Optional[list[str]],
+        list[str] | None,
         typer.Option(
             help="A worn axis as AXIS:KIND:PERCENT[:key=value], e.g. 2:exp4:20 (20 % more Coulomb and static "
             "friction on axis 2 by the last cycle, thesis eq. 6.6). KIND: exp4, logistic, linear, step. Repeat "
@@ -113,7 +115,7 @@ def simulate_command(
     ] = None,
     cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.")] = 100,
     record: Annotated[
-        Optional[str],
+        str | None,
         typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
     ] = None,
     seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.")] = 0,
@@ -137,7 +139,8 @@ def simulate_command(
 
       faultgen simulate --task spot_weld --wear 2:exp4:20 --wear 5:linear:10 --record 1,100 -o two.h5
     """
-    from faultgen import dataset, sensors, sim, wear as wear_module
+    from faultgen import dataset, sensors, sim
+    from faultgen import wear as wear_module
 
     try:
         if out.exists() and not overwrite:
@@ -168,23 +171,23 @@ def simulate_command(
 @app.command("sweep")
 def sweep_command(
     preset: Annotated[
-        Optional[str], typer.Option(help="A named grid: quick (a first look, < 2 min), j2 (thesis ch. 6), c2 (thesis ch. 3).")
+        str | None, typer.Option(help="A named grid: quick (a first look, < 2 min), j2 (thesis ch. 6), c2 (thesis ch. 3).")
     ] = None,
     config: Annotated[
-        Optional[Path], typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
+        Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
     ] = None,
-    robots_: Annotated[Optional[list[str]], typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
-    tasks_: Annotated[Optional[list[str]], typer.Option("--task", help="Task(s); repeat for several.")] = None,
-    axes: Annotated[Optional[list[int]], typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
-    increases: Annotated[Optional[list[float]], typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
-    schedules: Annotated[Optional[list[str]], typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
-    friction_model: Annotated[Optional[str], typer.Option("--friction", help="lugre or stribeck.")] = None,
-    cycles: Annotated[Optional[int], typer.Option(help="Cycles per run.")] = None,
-    record: Annotated[Optional[str], typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
-    seeds: Annotated[Optional[list[int]], typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
+    tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s); repeat for several.")] = None,
+    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
+    increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
+    schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
+    friction_model: Annotated[str | None, typer.Option("--friction", help="lugre or stribeck.")] = None,
+    cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
+    record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
+    seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     scheduler: Annotated[
-        Optional[str], typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
+        str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
     ] = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
@@ -266,8 +269,8 @@ def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen datas
 @app.command("plot")
 def plot_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],
-    run: Annotated[Optional[str], typer.Option(help="Plot one run (default: the whole sweep, or its only run).")] = None,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="PNG to write (default: FILE with .png).")] = None,
+    run: Annotated[str | None, typer.Option(help="Plot one run (default: the whole sweep, or its only run).")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="PNG to write (default: FILE with .png).")] = None,
 ) -> None:
     """Draw per-cycle mean |motor torque| per axis against the true wear, as a PNG."""
     from faultgen import dataset, plot
@@ -291,7 +294,7 @@ def _analysis_input(file: Path) -> None:
         raise typer.Exit(2)
 
 
-def _table_command(file: Path, out: Optional[Path], suffix: str, digits: int, compute) -> None:
+def _table_command(file: Path, out: Path | None, suffix: str, digits: int, compute) -> None:
     """Validate ``file``, compute a table, write it as CSV and Markdown, print it."""
     from analysis import benchmark
 
@@ -309,9 +312,9 @@ def _table_command(file: Path, out: Optional[Path], suffix: str, digits: int, co
 @app.command("bench-isolators")
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
-    bins: Annotated[Optional[list[int]], typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
+    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
@@ -346,8 +349,8 @@ def detect_command(
         int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
                           "limit is then crossed by 5 % of normal samples, so long runs always alarm early.")
     ] = 3,
-    period: Annotated[Optional[int], typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
+    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout."""
@@ -363,7 +366,7 @@ def classify_command(
     wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.")] = 10.0,
     pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs and the random forest.")] = 0,
-    out: Annotated[Optional[Path], typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""

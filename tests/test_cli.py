@@ -43,7 +43,7 @@ def test_unknown_robot_is_an_error_listing_the_known_ones():
 def test_help_teaches_the_first_steps():
     result = runner.invoke(app, ["--help"])
     assert result.exit_code == 0
-    assert "faultgen robots" in result.output
+    assert "faultgen robots" in result.output and "faultgen sweep --preset quick" in result.output
 
 
 def test_console_script_is_installed():

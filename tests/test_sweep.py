@@ -123,7 +123,7 @@ def test_a_part_of_another_configuration_is_redone(tmp_path):
     out = tmp_path / "changed.h5"
     parts = sweep.parts_folder(out)
     parts.mkdir()
-    run_id, config = grid.runs()[0]
+    run_id, _ = grid.runs()[0]
     other = sweep.Grid(**{**SMALL, "record": [1, 30]}).runs()[0][1]
     sweep.simulate_and_write(run_id, other, parts / f"{run_id}.h5")
     assert run_id not in sweep.finished_runs(grid, out)
