@@ -273,6 +273,8 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
 def markdown(table: pd.DataFrame, digits: int = 3) -> str:
     """A DataFrame as a Markdown table (index included unless it is a plain range)."""
     frame = table if isinstance(table.index, pd.RangeIndex) else table.reset_index()
+    if isinstance(frame.columns, pd.MultiIndex):  # ("lr", "mean") -> "lr mean"
+        frame = frame.set_axis([" ".join(str(p) for p in c if p) for c in frame.columns], axis=1)
     cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row] for row in frame.itertuples(index=False)]
     head = [str(c) for c in frame.columns]
     return "\n".join(["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
