@@ -9,6 +9,8 @@ kept as they are and only the missing runs are simulated.
 
 from __future__ import annotations
 
+import ctypes
+import gc
 import itertools
 import json
 import shutil
@@ -180,8 +182,22 @@ def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: 
     writing = time.perf_counter()
     dataset.write_run(part, result, run_id=run_id, command=command)
     done = time.perf_counter()
-    simulated = result.tau_m.shape[0] * result.t[-1]
-    return RunStats(run_id, simulated, done - started, result.stepping_time, done - writing)
+    stats = RunStats(run_id, result.tau_m.shape[0] * result.t[-1], done - started, result.stepping_time,
+                     done - writing)
+    del result
+    _release_memory()
+    return stats
+
+
+def _release_memory() -> None:
+    """Give the run's freed memory back to the OS. glibc keeps freed heap memory, so a worker's
+    resident size would ratchet up run after run, and joblib's workers restart themselves (losing
+    their prepared models) once it grows 300 MB past its size after the first run."""
+    gc.collect()
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):  # not glibc: nothing to trim
+        pass
 
 
 def parts_folder(out: Path) -> Path:
