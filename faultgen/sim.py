@@ -239,9 +239,7 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     """
-    model_file = robots.load(config.robot).path
-    sim, task, path, q_ref, inputs = _prepare(config.robot, config.task, config.friction,
-                                              model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    sim, task, path, q_ref, inputs = _prepared(config.robot, config.task, config.friction)
     robot = sim.robot
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = len(inputs) - 1
@@ -269,6 +267,13 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     return result
 
 
+def _prepared(robot: str, task: str, friction_model: str):
+    """:func:`_prepare`, renewed when the robot's model or task file changes."""
+    model_file = robots.load(robot).path
+    stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    return _prepare(robot, task, friction_model, *stamps)
+
+
 @functools.lru_cache(maxsize=8)
 def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps: int):
     """What every run of a robot, task and friction model shares, computed once per process
@@ -293,7 +298,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
 
 def cycle_duration(robot: str, task: str) -> float:
     """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle)."""
-    sim, _, _, _, inputs = _prepare(robot, task, "lugre")
+    sim, _, _, _, inputs = _prepared(robot, task, "lugre")
     return (len(inputs) - 1) * sim.model.opt.timestep
 
 
