@@ -133,7 +133,8 @@ class Task:
         return result
 
     def _plan(self, path: _Builder) -> None:
-        raise NotImplementedError
+        """Add the task's segments to ``path``: each task class (below) defines its own."""
+        raise NotImplementedError(f"{type(self).__name__} does not define its motion")
 
     def _move(self, path: _Builder, label: str, q_to: np.ndarray) -> None:
         """Append a ruckig rest-to-rest move from the path's last sample to ``q_to``."""
