@@ -190,6 +190,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     from analysis.monitoring import PCAMonitor, detect_onset
 
     runs = _runs(path, ("cycles", "friction_multiplier"))
+    references: dict[str, tuple[np.ndarray, np.ndarray, PCAMonitor]] = {}
     rows = []
     for run_id, arrays, attrs in tqdm(runs, desc="detection", unit="run", disable=not progress):
         if len(attrs["worn_axes"]) != 1:
@@ -199,17 +200,11 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
             raise ValueError(f"{path}: no run without wear for {attrs['robot']} {attrs['task']} seed {attrs['seed']} "
                              f"to train the monitor of {run_id}")
         axis = int(attrs["worn_axes"][0])
-        normal_torque = np.abs(dataset.read_run(path, nominal[0], names=("tau_m",))[0]["tau_m"])
-        scale = normal_torque.max(axis=(0, 1))
-        normal, _ = _kl_features(normal_torque, nominal[1]["cycles"], scale, period)
+        if nominal[0] not in references:  # one reference serves every worn run of its task and seed
+            references[nominal[0]] = _reference_monitor(path, nominal, period, variance, alpha)
+        scale, used, monitor = references[nominal[0]]
         worn_torque = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
         worn, groups = _kl_features(worn_torque, arrays["cycles"], scale, period)
-        used = np.flatnonzero(normal.std(axis=0) > 0)
-        monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q")
-        try:
-            monitor.fit(normal[:, used])
-        except ValueError:  # the variance needs every component: keep one back for the Q residual
-            monitor.set_params(n_components=len(used) - 1).fit(normal[:, used])
         onset = detect_onset(monitor.predict(worn[:, used]), persistence=persistence)
         wear = (arrays["friction_multiplier"][:, axis - 1] - 1.0) * 100.0
         located = 0
@@ -224,6 +219,22 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                          onset_wear_pct=np.nan if onset is None else round(float(wear[groups == onset].max()), 2),
                          located_axis=located, located=located == axis))
     return pd.DataFrame(rows)
+
+
+def _reference_monitor(path, nominal, period: int | None, variance: float, alpha: float):
+    """The torque scale, the features used and the fitted Q monitor of a run without wear."""
+    from analysis.monitoring import PCAMonitor
+
+    torque = np.abs(dataset.read_run(path, nominal[0], names=("tau_m",))[0]["tau_m"])
+    scale = torque.max(axis=(0, 1))
+    normal, _ = _kl_features(torque, nominal[1]["cycles"], scale, period)
+    used = np.flatnonzero(normal.std(axis=0) > 0)  # features constant in training are left out
+    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q")
+    try:
+        monitor.fit(normal[:, used])
+    except ValueError:  # the variance needs every component: keep one back for the Q residual
+        monitor.set_params(n_components=len(used) - 1).fit(normal[:, used])
+    return scale, used, monitor
 
 
 def _kl_features(torque: np.ndarray, cycles: np.ndarray, scale: np.ndarray,
