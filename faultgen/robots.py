@@ -9,6 +9,20 @@ Each model pairs six arm joints ``joint{i}`` with six motor-rotor joints ``rotor
 fixed tendons ``gearbox{i}`` (``L = rotor{i} / G - joint{i}``, thesis eq. 6.2a), driven by torque
 actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the custom numerics
 ``friction{i}`` and a ``home`` keyframe.
+
+Optional elements describe effects the calibration workflow (:mod:`faultgen.calibrate`) adds to
+a model; absent, they are zero:
+
+* custom numeric ``cogging{i}`` = amplitude (N m, motor side), poles (periods per motor
+  revolution), phase (rad): a passive torque ``A sin(p theta_m + phase)`` on rotor ``i``;
+* custom numeric ``torque_offset{i}``: a constant added to the arm-side drive torque, N m;
+* custom numeric ``load_friction{i}``: extra Coulomb friction per unit of gearbox load,
+  ``mu |tau_load|`` at the arm side, dimensionless;
+* custom numeric ``thermal{i}`` = amplitude (fraction), time constant (s): the dry friction
+  (Coulomb plus Stribeck) is multiplied by ``1 + a exp(-t / T)``, ``t`` from the start of the run
+  (a cold gearbox warming up);
+* a dead band on tendon ``gearbox{i}`` (``springlength="-b/2 b/2"``): backlash ``b`` in rad at
+  the arm side.
 """
 
 from __future__ import annotations
@@ -88,6 +102,16 @@ class Robot:
         Nominal motor-side friction parameters.
     home : ndarray of shape (6,)
         Arm joint angles of the ``home`` keyframe in rad.
+    cogging : ndarray of shape (6, 3)
+        Cogging amplitude (N m, motor side), poles and phase (rad) per axis; zero amplitude: none.
+    torque_offset : ndarray of shape (6,)
+        Constant arm-side drive torque offset, N m.
+    load_friction : ndarray of shape (6,)
+        Load-dependent Coulomb friction coefficient mu (arm side ``mu |tau_load|``), 1.
+    thermal : ndarray of shape (6, 2)
+        Warm-up friction drift: amplitude a (1) and time constant T (s) of ``1 + a exp(-t/T)``.
+    backlash : ndarray of shape (6,)
+        Gearbox backlash (dead band width) in rad at the arm side.
     """
 
     name: str
@@ -106,6 +130,11 @@ class Robot:
     motor_torque_limit: np.ndarray
     friction: MotorFriction
     home: np.ndarray
+    cogging: np.ndarray = field(default_factory=lambda: np.zeros((N_AXES, 3)))
+    torque_offset: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
+    load_friction: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
+    thermal: np.ndarray = field(default_factory=lambda: np.tile([0.0, 1.0], (N_AXES, 1)))
+    backlash: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
     _inverse: tuple[mujoco.MjModel, mujoco.MjData] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -168,7 +197,8 @@ class Robot:
         return qpos, qvel
 
     def inverse_dynamics(
-        self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, friction: bool = True
+        self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, friction: bool = True,
+        t: np.ndarray | None = None,
     ) -> np.ndarray:
         """Arm-side joint torque needed to follow a trajectory, rigid gearbox assumed.
 
@@ -183,7 +213,14 @@ class Robot:
         q, qd, qdd : ndarray of shape (n, 6)
             Arm joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
         friction : bool, default True
-            Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``).
+            Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``)
+            and the optional effects of the module docstring (cogging, torque offset,
+            load-dependent friction, warm-up drift). Backlash is a dead band of the flexible
+            gearbox with no rigid-body torque: it is not included (the calibration workflow
+            re-simulates it, :mod:`faultgen.calibrate.resim`).
+        t : ndarray of shape (n,), optional
+            Time since the start of the run in s, for the warm-up drift (:attr:`thermal`);
+            zero when omitted.
 
         Returns
         -------
@@ -202,23 +239,49 @@ class Robot:
         q = _check_trajectory("q", q)
         qd = _check_trajectory("qd", qd, q.shape[0])
         qdd = _check_trajectory("qdd", qdd, q.shape[0])
-        model, data = self._inverse
-        arm_qpos, arm_dof = self.arm_qpos, self.arm_dof
-        rotor_qpos, rotor_dof = self.rotor_qpos, self.rotor_dof
         G = self.gear_ratio
-        tau = np.empty_like(q)
-        for k in range(q.shape[0]):
-            data.qpos[arm_qpos] = q[k]
-            data.qpos[rotor_qpos] = G * q[k]
-            data.qvel[arm_dof] = qd[k]
-            data.qvel[rotor_dof] = G * qd[k]
-            data.qacc[arm_dof] = qdd[k]
-            data.qacc[rotor_dof] = G * qdd[k]
-            mujoco.mj_inverse(model, data)
-            # The rigid gearbox carries the rotor's generalized force to the arm through G.
-            tau[k] = data.qfrc_inverse[arm_dof] + G * data.qfrc_inverse[rotor_dof]
+        tau, load = self._rigid(q, qd, qdd)
         if friction:
             tau += G * self.friction.stribeck_torque(G * qd)
+            tau += self.effect_torque(q, qd, load, t)
+        return tau
+
+    def _rigid(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+        """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``."""
+        model, data = self._inverse
+        G = self.gear_ratio
+        tau = np.empty_like(q)
+        load = np.empty_like(q)
+        for k in range(q.shape[0]):
+            data.qpos[self.arm_qpos] = q[k]
+            data.qpos[self.rotor_qpos] = G * q[k]
+            data.qvel[self.arm_dof] = qd[k]
+            data.qvel[self.rotor_dof] = G * qd[k]
+            data.qacc[self.arm_dof] = qdd[k]
+            data.qacc[self.rotor_dof] = G * qdd[k]
+            mujoco.mj_inverse(model, data)
+            # The rigid gearbox carries the rotor's generalized force to the arm through G.
+            load[k] = data.qfrc_inverse[self.arm_dof]
+            tau[k] = load[k] + G * data.qfrc_inverse[self.rotor_dof]
+        return tau, load
+
+    def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None
+                      ) -> np.ndarray:
+        """Arm-side drive torque of the optional effects (module docstring), N m, shape (n, 6).
+
+        ``load`` is the arm-side gearbox load torque (rigid-body torque of the arm joints), N m;
+        ``t`` the time since the start of the run, s (zero when omitted).
+        """
+        G = self.gear_ratio
+        amplitude, poles, phase = self.cogging.T
+        tau = -G * amplitude * np.sin(poles * G * q + phase)  # the drive holds against cogging
+        tau = tau + self.torque_offset
+        sign = np.sign(qd)
+        tau = tau + self.load_friction * np.abs(load) * sign
+        if np.any(self.thermal[:, 0]):
+            time = np.zeros(len(q)) if t is None else np.asarray(t, dtype=float)
+            drift = self.thermal[:, 0] * np.exp(-time[:, None] / self.thermal[:, 1])
+            tau = tau + drift * G * self.friction.stribeck_level(G * qd) * sign
         return tau
 
 
@@ -276,12 +339,32 @@ def load(name: str | Path) -> Robot:
     return _from_file(path.resolve())
 
 
+def from_spec(spec: mujoco.MjSpec, path: str | Path) -> Robot:
+    """Compile an edited ``MjSpec`` of a robot in memory; ``path`` names it (and locates its
+    ``tasks.toml``) as if it had been written there.
+
+    Raises
+    ------
+    ModelError
+        As :func:`load`.
+    """
+    path = Path(path)
+    try:
+        model = spec.compile()
+    except ValueError as err:
+        raise ModelError(f"{path}: {str(err).strip()}") from err
+    return _from_model(model, path)
+
+
 def _from_file(path: Path) -> Robot:
     try:
         model = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as err:
         raise ModelError(f"{path}: {str(err).strip()}") from err
+    return _from_model(model, path)
 
+
+def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
     def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
         idx = mujoco.mj_name2id(model, obj_type, element)
         if idx < 0:
@@ -325,6 +408,9 @@ def _from_file(path: Path) -> Robot:
         raise ModelError(f"{path}: {err}") from err
 
     tendon_ids = [model.tendon(n).id for n in gearbox_names]
+    extras = {name: _optional_numerics(model, path, name, size, default)
+              for name, (size, default) in OPTIONAL_NUMERICS.items()}
+    backlash = np.diff(model.tendon_lengthspring[tendon_ids], axis=1)[:, 0]
     key = require("keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
     joint_qpos = [model.jnt_qposadr[model.joint(n).id] for n in joint_names]
     description_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "description")
@@ -354,7 +440,36 @@ def _from_file(path: Path) -> Robot:
         motor_torque_limit=torque_limit,
         friction=friction,
         home=model.key_qpos[key, joint_qpos].copy(),
+        backlash=backlash,
+        **extras,
     )
+
+
+#: Optional per-axis custom numerics ``<name>{i}``: number of values and the value when absent.
+OPTIONAL_NUMERICS = {
+    "cogging": (3, (0.0, 0.0, 0.0)),
+    "torque_offset": (1, (0.0,)),
+    "load_friction": (1, (0.0,)),
+    "thermal": (2, (0.0, 1.0)),
+}
+
+
+def _optional_numerics(model: mujoco.MjModel, path: Path, name: str, size: int, default: tuple) -> np.ndarray:
+    """Values of the optional numerics ``<name>1..6``, shape (6, size) (or (6,) for one value)."""
+    rows = np.tile(np.array(default, dtype=float), (N_AXES, 1))
+    for k in range(N_AXES):
+        idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, f"{name}{k + 1}")
+        if idx < 0:
+            continue
+        if model.numeric_size[idx] != size:
+            raise ModelError(f"{path}: numeric '{name}{k + 1}' has {model.numeric_size[idx]} values, expected {size}")
+        adr = model.numeric_adr[idx]
+        rows[k] = model.numeric_data[adr : adr + size]
+    if not np.all(np.isfinite(rows)):
+        raise ModelError(f"{path}: numeric '{name}' holds a non-finite value")
+    if name == "thermal" and np.any(rows[:, 1] <= 0):
+        raise ModelError(f"{path}: numeric 'thermal' needs a time constant > 0 s")
+    return rows[:, 0] if size == 1 else rows
 
 
 def _gear_ratio(model: mujoco.MjModel, path: Path, tendon: int, joint: int, rotor: int) -> float:

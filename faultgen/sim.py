@@ -151,9 +151,16 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
     gains = control.ServoGains.for_robot(robot)
     control.add_drives(spec, robot, gains)
     if friction_model == "lugre":
+        state_dependent = np.any(robot.load_friction) or np.any(robot.thermal[:, 0])
+        if state_dependent:
+            raise ValueError(
+                f"{robot.path}: load-dependent friction and warm-up drift (numerics load_friction, thermal) "
+                "are set from Python every step; simulate this model with --friction stribeck"
+            )
         friction.add_lugre(spec, robot)
     else:
         friction.add_stribeck(spec, robot)
+    _add_effect_forces(spec, robot)
     model = spec.compile()
     drive_ids = np.array([model.actuator(n).id for n in robot.actuator_names])
     drive_ctrl = model.actuator_ctrladr[drive_ids][:, None] + np.arange(len(control.INPUTS))
@@ -161,6 +168,31 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
         [model.actuator(f"lugre{k + 1}").id for k in range(6)] if friction_model == "lugre" else [], dtype=int
     )
     return SimModel(robot, friction_model, gains, model, drive_ctrl, drive_ids, lugre_ids)
+
+
+def _add_effect_forces(spec, robot: robots.Robot) -> None:
+    """Passive rotor forces of the optional effects that MuJoCo computes itself, in place.
+
+    Cogging: a ``dcmotor`` with no input and no electrical branch whose only force is its
+    ``cogging`` term (position-dependent, in C at the physics rate). Torque offset: a ``general``
+    actuator with a constant bias ``-offset / G`` on the rotor, which the drive holds against, so
+    the drive torque referred to the arm side shifts by ``+offset``.
+    """
+    for k, rotor in enumerate(robot.rotor_names):
+        amplitude, poles, phase = robot.cogging[k]
+        if amplitude:
+            actuator = spec.add_actuator(name=f"cogging{k + 1}", target=rotor)
+            actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
+            actuator.set_to_dcmotor(motorconst=[0.0, 0.0], resistance=1.0,
+                                    cogging=[float(amplitude), float(poles), float(phase)], ctrlspec=16)
+        if robot.torque_offset[k]:
+            actuator = spec.add_actuator(name=f"offset{k + 1}", target=rotor)
+            actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
+            actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+            actuator.gainprm[0] = 0.0
+            actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+            actuator.biasprm[:3] = [-float(robot.torque_offset[k] / robot.gear_ratio[k]), 0.0, 0.0]
+            actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
 
 
 @dataclass(frozen=True)
@@ -298,7 +330,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
 
 def cycle_duration(robot: str, task: str) -> float:
     """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle)."""
-    sim, _, _, _, inputs = _prepared(robot, task, "lugre")
+    sim, _, _, _, inputs = _prepared(robot, task, "stribeck")  # builds for any model file
     return (len(inputs) - 1) * sim.model.opt.timestep
 
 
@@ -383,8 +415,18 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
     n_log = n_steps // per_log
     logs = {f.name: np.empty((len(cycles), n_log, 6)) for f in fields(_Raw)}
     rotor, arm = robot.rotor_dof, robot.arm_dof
+    G, K = robot.gear_ratio, robot.gearbox_stiffness
+    dt = model.opt.timestep
+    run_start = (cycles[:, None] - 1) * n_steps * dt  # thermal drift runs over the whole run
+    thermal = np.any(robot.thermal[:, 0])
     for step in range(n_steps):
-        frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], multiplier)
+        level = multiplier
+        if thermal:
+            level = multiplier * (1 + robot.thermal[:, 0] * np.exp(-(run_start + step * dt) / robot.thermal[:, 1]))
+        frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
+        if np.any(robot.load_friction):  # gearbox load from the spring deflection (eq. 6.2a)
+            deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
+            frictionloss[:, rotor] += robot.load_friction * np.abs(K * deflection) / G
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
         batch.step()

@@ -1,0 +1,57 @@
+"""The calibration figure: measured vs simulated torque and the residual before and after, per axis."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def save(result, path: str | Path) -> Path:
+    """Draw ``result`` (a :class:`faultgen.calibrate.Calibration`) into a PNG at ``path``.
+
+    Left column: measured torque and the torque of the nominal and of the calibrated model, per
+    axis. Right column: the residual (measured minus model) before and after. The held-out part,
+    on which the gaps are reported, is shaded. Model torque and residual are left out where the
+    axis is at rest (stiction: no kinetic model predicts it, and nothing is fitted there).
+    """
+    path = Path(path)
+    t = result.time - result.time[0]
+    held = np.flatnonzero(result.held_out.any(axis=1))
+    moving = result.moving
+    nominal = np.where(moving, result.nominal, np.nan)
+    calibrated = np.where(moving, result.calibrated, np.nan)
+    fig, axes = plt.subplots(6, 2, figsize=(13, 14), sharex=True)
+    added = ", ".join(f"{s.effect} (axes {', '.join(map(str, s.axes))})" for s in result.steps) or "nothing"
+    fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
+                 f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
+                 f"{result.gap_after['total_nrmse']:.3f}", fontsize=11)
+    for axis in range(6):
+        left, right = axes[axis]
+        left.plot(t, result.tau[:, axis], color="black", lw=0.8, label="measured")
+        left.plot(t, nominal[:, axis], color="tab:red", lw=0.8, alpha=0.8, label="nominal model")
+        left.plot(t, calibrated[:, axis], color="tab:blue", lw=0.8, alpha=0.8, label="calibrated model")
+        right.plot(t, result.tau[:, axis] - nominal[:, axis], color="tab:red", lw=0.6,
+                   label=f"before (nrmse {result.gap_before['nrmse'][axis]:.3f})")
+        right.plot(t, result.tau[:, axis] - calibrated[:, axis], color="tab:blue", lw=0.6, alpha=0.8,
+                   label=f"after (nrmse {result.gap_after['nrmse'][axis]:.3f})")
+        left.set_ylabel(f"axis {axis + 1}\ntorque, N m")
+        right.set_ylabel("residual, N m")
+        for ax in (left, right):
+            if held.size:
+                ax.axvspan(t[held[0]], t[held[-1]], color="0.9", zorder=0)
+            ax.grid(alpha=0.3)
+        right.legend(loc="upper left", fontsize=7)
+    axes[0, 0].legend(loc="upper left", fontsize=7)
+    axes[0, 0].set_title("torque (held-out part shaded)")
+    axes[0, 1].set_title("residual: measured minus model")
+    for ax in axes[-1]:
+        ax.set_xlabel("time, s")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

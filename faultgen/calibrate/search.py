@@ -1,0 +1,201 @@
+"""Model selection: which effect explains the torque residual, on which axes, with what size.
+
+One step (:func:`best_step`), for the current model and its residual ``r = tau_measured -
+tau_model`` (arm side, N m):
+
+1. Every effect of the library is fitted to the residual of the **fitting part** (the first
+   :data:`FIT_FRACTION` of the record), each axis on its own (the payload on all axes at once),
+   by linear least squares in its linear parameters and a grid search over its nonlinear one.
+2. Each fit is judged on the **held-out part** (the rest of the record, never used to fit): the
+   gain of an axis is how much its normalised RMS error (RMSE over the RMS of the measured
+   torque of that axis) drops. This is the guard against over-fitting: a term that fits noise
+   or a coincidence of the fitting part does not carry over.
+3. An axis is *significant* for an effect when its held-out gain is at least
+   :data:`MIN_GAIN` (absolute, in nrmse) **and** at least :data:`MIN_RELATIVE_GAIN` of that
+   axis's held-out nrmse before the step (a significance threshold on the effect size that noise
+   and the rigid-model mismatch stay under; docs/calibration.md gives the null-case figures).
+4. The effect with the largest total significant gain wins; an effect whose gain is within
+   :data:`TIE` of the best and comes earlier in :data:`faultgen.calibrate.effects.EFFECTS`
+   (fewer parameters or simpler physics) is preferred.
+
+The workflow (:func:`faultgen.calibrate.calibrate`) adds the winner to the model on its
+significant axes, recomputes the residual with the augmented model and repeats until no
+effect is significant on any axis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from scipy.optimize import minimize_scalar
+
+from faultgen.calibrate.effects import EFFECTS, REST_SPEED, Effect, Motion
+
+#: Share of the record (by time, from the start) used for fitting; the rest is held out.
+FIT_FRACTION = 0.7
+#: Smallest held-out nrmse drop of an axis that counts (1 % of that axis's torque RMS).
+MIN_GAIN = 0.01
+#: Smallest held-out nrmse drop of an axis relative to its nrmse before the step.
+MIN_RELATIVE_GAIN = 0.2
+#: Relative gain margin within which an earlier (simpler) effect is preferred.
+TIE = 0.1
+
+
+
+@dataclass(frozen=True)
+class Split:
+    """Per-axis boolean masks ``(n, 6)``: ``fit`` (first part of the record) and ``held_out``
+    (the rest). Both leave out the first and last :data:`EDGE` seconds, where the derivative
+    filter is weakest, and the samples where the axis is at rest (:data:`REST_SPEED`)."""
+
+    fit: np.ndarray
+    held_out: np.ndarray
+
+    EDGE = 0.1
+
+    @classmethod
+    def of(cls, t: np.ndarray, qd: np.ndarray) -> Split:
+        t = np.asarray(t, dtype=float) - float(t[0])
+        inner = (t >= cls.EDGE) & (t <= t[-1] - cls.EDGE)
+        cut = FIT_FRACTION * t[-1]
+        moving = np.abs(np.asarray(qd)) >= REST_SPEED
+        return cls(moving & (inner & (t < cut))[:, None], moving & (inner & (t >= cut))[:, None])
+
+
+def _rms(x: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Per-axis RMS of ``x`` (n, 6) over the samples of ``mask`` (n, 6); 0 where there are none."""
+    count = np.maximum(mask.sum(axis=0), 1)
+    return np.sqrt(np.sum(np.where(mask, x, 0.0) ** 2, axis=0) / count)
+
+
+def gap(tau: np.ndarray, predicted: np.ndarray, mask: np.ndarray) -> dict:
+    """The design document's gap record on the samples of ``mask`` (n, 6), per axis.
+
+    Returns
+    -------
+    dict
+        ``rmse_Nm`` (6 floats, N m), ``nrmse`` (6 floats: RMSE over the RMS of the measured torque
+        of that axis) and ``total_nrmse`` (their mean).
+    """
+    rmse = _rms(tau - predicted, mask)
+    scale = _rms(tau, mask)
+    nrmse = rmse / np.where(scale > 0, scale, 1.0)
+    return {"rmse_Nm": [float(v) for v in rmse], "nrmse": [float(v) for v in nrmse],
+            "total_nrmse": float(np.mean(nrmse))}
+
+
+@dataclass
+class Candidate:
+    """One effect fitted to the current residual.
+
+    Attributes
+    ----------
+    effect : Effect
+    axes : list of int
+        Significant axes, 0-based (all six for a robot-wide effect that is significant).
+    params : dict
+        Per significant axis (1-based string key) or ``"robot"``: the physical parameters.
+    gain : ndarray of shape (6,)
+        Held-out nrmse drop per axis (all axes, significant or not).
+    relative_gain : ndarray of shape (6,)
+        ``gain`` over the held-out nrmse before.
+    contribution : ndarray of shape (n, 6)
+        Fitted torque of the effect, N m (zero on axes that are not significant).
+    """
+
+    effect: Effect
+    axes: list[int]
+    params: dict
+    gain: np.ndarray
+    relative_gain: np.ndarray
+    contribution: np.ndarray
+    all_params: dict = field(default_factory=dict)
+
+    @property
+    def score(self) -> float:
+        """Drop of the held-out ``total_nrmse`` over the significant axes."""
+        return float(np.sum(self.gain[self.axes]) / len(self.gain))
+
+
+
+
+def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
+    if not np.any(phi):
+        return np.zeros(phi.shape[1])
+    return np.linalg.lstsq(phi, y, rcond=None)[0]
+
+
+def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> Candidate:
+    """Fit ``effect`` to ``residual`` (n, 6) on the fitting part; judge it on the held-out part."""
+    held, fit = split.held_out, split.fit
+    scale = _rms(tau, held)
+    scale = np.where(scale > 0, scale, 1.0)
+    before = _rms(residual, held) / scale
+    contribution = np.zeros_like(residual)
+    params: dict = {}
+    if effect.per_axis:
+        for axis in range(residual.shape[1]):
+            best = None
+            rows = fit[:, axis]
+
+            def trial(h):
+                phi, offset = effect.columns(motion, axis, h)
+                theta = _lstsq(phi[rows], residual[rows, axis] - offset[rows])
+                predicted = phi @ theta + offset
+                return float(np.sum((residual[rows, axis] - predicted[rows]) ** 2)), h, theta, predicted
+
+            grid = effect.grid(motion, axis)
+            results = [trial(h) for h in grid]
+            k = min(range(len(results)), key=lambda i: results[i][0])
+            best = results[k]
+            if effect.continuous and len(grid) > 2:  # refine between the grid neighbours, in log
+                bounds = (np.log(grid[max(k - 1, 0)]), np.log(grid[min(k + 1, len(grid) - 1)]))
+                found = minimize_scalar(lambda x: trial(float(np.exp(x)))[0], bounds=bounds, method="bounded",
+                                        options={"xatol": 1e-3})
+                refined = trial(float(np.exp(found.x)))
+                best = min(best, refined, key=lambda r: r[0])
+            _, h, theta, predicted = best
+            contribution[:, axis] = predicted
+            params[str(axis + 1)] = effect.params(motion, axis, theta, h)
+    else:
+        phi, offset = effect.columns(motion, None, None)  # (n, 6, k), (n, 6)
+        weights = 1.0 / scale  # each axis counts by its nrmse
+        rows = (phi * weights[:, None])[fit]  # (m, k): the fitted samples of every axis
+        target = ((residual - offset) * weights)[fit]
+        theta = _lstsq(rows, target)
+        contribution = phi @ theta + offset
+        params["robot"] = effect.params(motion, None, theta, None)
+    after = _rms(residual - contribution, held) / scale
+    gain = before - after
+    relative = gain / np.where(before > 0, before, 1.0)
+    significant = (gain >= MIN_GAIN) & (relative >= MIN_RELATIVE_GAIN)
+    if effect.per_axis:
+        significant &= [effect.admissible(motion, a, params[str(a + 1)]) for a in range(residual.shape[1])]
+        axes = [int(a) for a in np.flatnonzero(significant)]
+        kept = {str(a + 1): params[str(a + 1)] for a in axes}
+    else:
+        # robot-wide: significant as a whole when the mean gain passes both thresholds
+        total_before = float(np.mean(before))
+        total_gain = float(np.mean(gain))
+        whole = (total_gain >= MIN_GAIN and total_gain >= MIN_RELATIVE_GAIN * total_before
+                 and effect.admissible(motion, None, params["robot"]))
+        axes = list(range(residual.shape[1])) if whole else []
+        kept = params if whole else {}
+    mask = np.zeros(residual.shape[1], dtype=bool)
+    mask[axes] = True
+    return Candidate(effect, axes, kept, gain, relative, np.where(mask, contribution, 0.0), params)
+
+
+def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> list[Candidate]:
+    """All effects fitted, best first per the selection rule of this module's docstring."""
+    candidates = [fit_effect(e, motion, residual, tau, split) for e in EFFECTS.values()]
+    order = {e.id: k for k, e in enumerate(EFFECTS.values())}
+    best = max(c.score for c in candidates)
+
+    def key(c: Candidate):
+        near_best = best > 0 and c.score >= (1 - TIE) * best
+        return (not near_best, order[c.effect.id] if near_best else -c.score)
+
+    return sorted(candidates, key=key)

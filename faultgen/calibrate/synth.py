@@ -1,0 +1,183 @@
+"""Hidden-effect data: a "measured" torque log made by our own simulator with one effect switched on.
+
+This is how the calibration workflow is checked (tests/test_calibrate_hidden.py,
+``benchmarks/calibration_accuracy.py``, docs/calibration.md): an effect of the library is drawn
+at a random size on random axes, written into a copy of the robot's MJCF with the same
+:meth:`Effect.apply` the workflow uses, and that model is simulated closed-loop (PID drives,
+flexible gearboxes, static Stribeck friction with stiction, load disturbance, encoder noise;
+:func:`faultgen.sim.simulate`) over several cycles of a task. The log is what a robot controller
+records: ``q = theta_m / G`` from the motor encoders, ``tau = G tau_m`` from the drive torque,
+plus torque-sensor noise. The workflow then gets only that file and the robot's name.
+
+Sizes are drawn relative to the robot: the effect's torque RMS on a chosen axis is a fraction
+``size`` (drawn from :data:`SIZE_RANGE`) of the RMS of that axis's nominal torque along the
+task; nonlinear parameters (Stribeck velocity, cogging poles, warm-up time constant) are drawn
+within the range the workflow searches.
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from faultgen import measured, robots, sensors, sim, tasks
+from faultgen.calibrate.effects import EFFECTS, Motion, get
+
+#: Range of the effect's torque RMS over the axis's nominal torque RMS.
+SIZE_RANGE = (0.5, 1.2)
+#: Physical bounds on drawn parameters: an axis where the drawn size would need more is not
+#: eligible (e.g. load-dependent friction on a wrist axis that carries almost no load).
+LIMITS = {"load_friction_coefficient": 0.8, "amplitude": 3.0, "backlash_rad": 0.05}
+#: Largest share of a motor's torque limit the hidden friction, offset or cogging may take, so
+#: the drive can still move the axis (a stuck axis shows nothing).
+MOTOR_SHARE = 0.4
+#: Smallest size an axis may carry after the bounds.
+MIN_SIZE = 0.45
+#: Torque-sensor noise, standard deviation as a fraction of each axis's torque RMS.
+TORQUE_NOISE = 0.01
+#: Most axes an effect is hidden on.
+MAX_AXES = 3
+
+
+@dataclass(frozen=True)
+class Hidden:
+    """What was hidden in a log: effect id (None for none), axes (1-based) and parameters in
+    the form of ``report.json`` (per axis ``"1".."6"``, or ``"robot"``)."""
+
+    effect: str | None
+    axes: list[int] = field(default_factory=list)
+    params: dict = field(default_factory=dict)
+    size: float = 0.0
+
+
+def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion, np.ndarray]:
+    """The task's reference motion repeated ``cycles`` times at the log rate, and its nominal torque."""
+    duration = sim.cycle_duration(str(robot.path), task)
+    path = tasks.load(robot, task).trajectory(sensors.LOG_PERIOD)
+    n = int(round(duration / sensors.LOG_PERIOD))
+    pad = lambda a: np.vstack([a, np.repeat(a[-1:], max(n - len(a), 0), axis=0)])[:n]  # noqa: E731
+    q, qd, qdd = (np.tile(pad(a), (cycles, 1)) for a in (path.q, path.qd, path.qdd))
+    t = np.arange(len(q)) * sensors.LOG_PERIOD
+    tau = robot.inverse_dynamics(q, qd, qdd, t=t)
+    return Motion.of(robot, t, q, qd, qdd), tau
+
+
+def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task: str = "pick_place",
+         cycles: int = 4) -> Hidden:
+    """Draw a hidden effect of kind ``effect`` (None: nothing) at a random size on random axes.
+
+    Raises
+    ------
+    ValueError
+        For an unknown effect id.
+    """
+    if effect is None:
+        return Hidden(None)
+    kind = get(effect)
+    motion, tau = nominal_motion(robot, task, cycles)
+    size = float(rng.uniform(*SIZE_RANGE))
+    scale = np.sqrt(np.mean(tau**2, axis=0))
+    if not kind.per_axis:
+        phi, offset = kind.columns(motion, None, None)
+        relative = np.sqrt(np.mean(phi[:, :, 0] ** 2, axis=0)) / scale
+        theta = np.array([size / relative.max()])
+        return Hidden(effect, list(range(1, 7)), {"robot": kind.params(motion, None, theta, None)}, size)
+    params, sizes = {}, np.zeros(6)
+    for axis in range(6):
+        grid = kind.grid(motion, axis)
+        if grid == [None]:
+            h = None
+        elif isinstance(grid[0], (int, np.integer)):
+            h = int(rng.choice(grid))
+        else:  # a continuous parameter: log-uniform inside the searched range, off the grid points
+            h = float(np.exp(rng.uniform(np.log(grid[1]), np.log(grid[-2]))))
+        phi, offset = kind.columns(motion, axis, h)
+        if phi.shape[1] == 2:  # amplitude and phase (cogging)
+            phase = rng.uniform(0, 2 * np.pi)
+            unit = phi @ np.array([np.cos(phase), np.sin(phase)])
+        else:
+            unit = phi[:, 0]
+        if not np.any(unit):  # the effect cannot show on this axis (e.g. no Stribeck range)
+            params[str(axis + 1)] = {}
+            continue
+        sign = -1.0 if kind.id in ("torque_offset",) and rng.random() < 0.5 else 1.0
+        amplitude = sign * size * scale[axis] / np.sqrt(np.mean(unit**2))
+        theta = amplitude * (np.array([np.cos(phase), np.sin(phase)]) if phi.shape[1] == 2 else np.ones(1))
+        drawn = kind.params(motion, axis, theta, h)
+        # past a physical bound, shrink the effect to the bound (and note the smaller size)
+        excess = max([abs(v) / LIMITS[k] for k, v in drawn.items() if k in LIMITS] + [1.0,
+                     _motor_share(kind.id, robot, axis, drawn, motion) / MOTOR_SHARE])
+        params[str(axis + 1)] = kind.params(motion, axis, theta / excess, h)
+        sizes[axis] = size / excess
+    eligible = [a for a in range(6) if sizes[a] >= MIN_SIZE]
+    if not eligible:
+        raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {MIN_SIZE} within {LIMITS}")
+    n_axes = int(rng.integers(1, min(MAX_AXES, len(eligible)) + 1))
+    axes = sorted(int(a) for a in rng.choice(eligible, size=n_axes, replace=False))
+    return Hidden(effect, [a + 1 for a in axes], {str(a + 1): params[str(a + 1)] for a in axes},
+                  float(min(sizes[axes])))
+
+
+def _motor_share(effect: str, robot: robots.Robot, axis: int, params: dict, motion: Motion) -> float:
+    """Largest motor torque the hidden effect takes on ``axis``, over the motor's torque limit."""
+    f, G = robot.friction, robot.gear_ratio[axis]
+    dry = max(f.coulomb_pos[axis], f.coulomb_neg[axis]) + f.static[axis]
+    extra = {
+        "coulomb": lambda p: dry + p["coulomb_change_Nm_motor"],
+        "stribeck": lambda p: dry - f.static[axis] + p["static_Nm_motor"],
+        "temperature": lambda p: dry * (1 + p["amplitude"]),
+        "torque_offset": lambda p: abs(p["offset_Nm"]) / G,
+        "cogging": lambda p: p["amplitude_Nm_motor"],
+        "load_dependent_friction": lambda p: p["load_friction_coefficient"] * np.max(np.abs(motion.load[:, axis])) / G,
+    }.get(effect, lambda p: 0.0)
+    return float(extra(params)) / robot.motor_torque_limit[axis]
+
+
+def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path:
+    """Write the robot's MJCF with ``hidden`` applied (and its tasks.toml) into ``folder``."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    if hidden.effect is not None:
+        kind = EFFECTS[hidden.effect]
+        for where, params in hidden.params.items():
+            kind.apply(spec, robot, None if where == "robot" else int(where) - 1, params)
+    path = folder / f"{robot.name}_hidden.xml"
+    path.write_text(spec.to_xml())
+    shutil.copyfile(robot.path.parent / "tasks.toml", folder / "tasks.toml")
+    return path
+
+
+def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str = "pick_place",
+           cycles: int = 4, seed: int = 0) -> Path:
+    """Simulate ``cycles`` cycles of ``task`` on the robot with ``hidden`` switched on and write
+    the log in the measured-data format (CSV, the design document's columns) to ``out``.
+
+    Returns
+    -------
+    Path
+        ``out``.
+    """
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    out = Path(out)
+    model = write_model(robot, hidden, out.parent / f"{out.stem}_model")
+    config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed)
+    run = sim.simulate(config, progress=False)
+    G = robot.gear_ratio
+    duration = sim.cycle_duration(str(model), task)
+    t = np.concatenate([(c - 1) * duration + run.t for c in run.cycles])
+    t = t - t[0]
+    # MuJoCo computes a step's drive torque from the state at the step's start, and the log
+    # holds the angle at its end: pair the torque with the angle it was computed at (semi-implicit
+    # Euler: q_start = q_end - dt v_end). At 1 kHz cogging ripple half a millisecond is half a turn.
+    step = sim.build(robot, "stribeck").model.opt.timestep
+    q = (np.concatenate(run.q_m) - step * np.concatenate(run.qd_m)) / G
+    tau = np.concatenate(run.tau_m) * G
+    rng = np.random.default_rng([seed, 7])
+    tau = tau + rng.normal(size=tau.shape) * TORQUE_NOISE * np.sqrt(np.mean(tau**2, axis=0))
+    measured.write_csv(out, t, q, tau)
+    return out

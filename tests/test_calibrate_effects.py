@@ -1,0 +1,162 @@
+"""The effect library: each effect's fitted torque is what the model it writes computes.
+
+For every effect with a rigid-body torque, ``Phi @ theta + offset`` (what the workflow fits) must
+equal the inverse dynamics of the MJCF the effect writes minus that of the nominal model: that is
+what makes the written model reproduce the fit. Also: the optional numerics round-trip through
+the robot loader, and the simulator builds the passive forces they describe.
+"""
+
+import mujoco
+import numpy as np
+import pytest
+
+from faultgen import robots, sim
+from faultgen.calibrate import effects, synth
+
+ROBOTS = ("puma560", "irb6700")
+
+
+@pytest.fixture(scope="module", params=ROBOTS)
+def setup(request):
+    robot = robots.load(request.param)
+    motion, _ = synth.nominal_motion(robot, "pick_place", 1)
+    return robot, motion
+
+
+# One set of physical parameters per effect, on axis 2 (index 1) unless robot-wide.
+PARAMS = {
+    "torque_offset": {"offset_Nm": 3.5},
+    "coulomb": {"coulomb_change_Nm_motor": 0.05},
+    "viscous": {"viscous_change_Nm_s_per_rad_motor": 2e-3},
+    "stribeck": {"static_Nm_motor": 0.2, "stribeck_velocity_rad_per_s_motor": 7.0},
+    "load_dependent_friction": {"load_friction_coefficient": 0.1},
+    "temperature": {"amplitude": 0.8, "time_constant_s": 3.0},
+    "payload": {"mass_kg": 2.0},
+    "cogging": {"amplitude_Nm_motor": 0.05, "poles": 6, "phase_rad": 0.4},
+}
+
+
+def theta_of(effect, params):
+    """The linear parameters and grid value that give ``params``."""
+    if effect.id == "cogging":
+        a, phi = params["amplitude_Nm_motor"], params["phase_rad"]
+        return np.array([-a * np.cos(phi), -a * np.sin(phi)]), params["poles"]
+    if effect.id == "stribeck":
+        return np.array([params["static_Nm_motor"]]), params["stribeck_velocity_rad_per_s_motor"]
+    if effect.id == "temperature":
+        return np.array([params["amplitude"]]), params["time_constant_s"]
+    return np.array([next(iter(params.values()))]), None
+
+
+def augmented(robot, effect, axis, params, tmp_path):
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    effect.apply(spec, robot, axis, params)
+    path = tmp_path / f"{robot.name}_{effect.id}.xml"
+    path.write_text(spec.to_xml())
+    return robots.load(path)
+
+
+@pytest.mark.parametrize("effect_id", sorted(PARAMS))
+def test_fitted_torque_is_the_written_models_torque(setup, effect_id, tmp_path):
+    robot, motion = setup
+    effect = effects.get(effect_id)
+    axis = None if not effect.per_axis else 1
+    params = PARAMS[effect_id]
+    theta, h = theta_of(effect, params)
+    phi, offset = effect.columns(motion, axis, h)
+    fitted = phi @ theta + offset
+    assert effect.params(motion, axis, theta, h) == pytest.approx(params)
+
+    new = augmented(robot, effect, axis, params, tmp_path)
+    change = (new.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t)
+              - robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t))
+    scale = np.max(np.abs(change))
+    assert scale > 0.1, "the effect must change the torque"
+    # MjSpec.to_xml writes 6 significant digits, so the written gear ratios differ from the
+    # nominal ones by up to ~3e-6 relative: that, not the effect, sets the tolerance.
+    if effect.per_axis:
+        np.testing.assert_allclose(change[:, axis], fitted, atol=3e-3 * scale)
+        others = np.delete(change, axis, axis=1)
+        assert np.max(np.abs(others)) < 3e-3 * scale
+    else:
+        np.testing.assert_allclose(change, fitted, atol=3e-3 * scale)
+
+
+def test_optional_numerics_round_trip_through_the_loader(tmp_path):
+    robot = robots.load("puma560")
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    effects.get("cogging").apply(spec, robot, 3, {"amplitude_Nm_motor": 0.02, "poles": 8, "phase_rad": -1.0})
+    effects.get("torque_offset").apply(spec, robot, 0, {"offset_Nm": -2.0})
+    effects.get("load_dependent_friction").apply(spec, robot, 2, {"load_friction_coefficient": 0.05})
+    effects.get("temperature").apply(spec, robot, 5, {"amplitude": 0.5, "time_constant_s": 30.0})
+    effects.get("backlash").apply(spec, robot, 1, {"backlash_rad": 0.004})
+    path = tmp_path / "p.xml"
+    path.write_text(spec.to_xml())
+    new = robots.load(path)
+    np.testing.assert_allclose(new.cogging[3], [0.02, 8, -1.0])
+    assert new.torque_offset.tolist() == [-2.0, 0, 0, 0, 0, 0]
+    assert new.load_friction[2] == 0.05
+    np.testing.assert_allclose(new.thermal[5], [0.5, 30.0])
+    np.testing.assert_allclose(new.thermal[0], [0.0, 1.0])
+    np.testing.assert_allclose(new.backlash, [0, 0.004, 0, 0, 0, 0])
+    # repeated offsets add up
+    effects.get("torque_offset").apply(spec, robot, 0, {"offset_Nm": 0.5})
+    path.write_text(spec.to_xml())
+    assert robots.load(path).torque_offset[0] == -1.5
+
+
+def test_bad_optional_numeric_is_refused(tmp_path):
+    robot = robots.load("puma560")
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    spec.add_numeric(name="thermal2", data=[0.5, 0.0])
+    path = tmp_path / "bad.xml"
+    path.write_text(spec.to_xml())
+    with pytest.raises(robots.ModelError, match="thermal.*time constant > 0"):
+        robots.load(path)
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    spec.add_numeric(name="cogging1", data=[0.5, 2.0])
+    path.write_text(spec.to_xml())
+    with pytest.raises(robots.ModelError, match="cogging1.*2 values, expected 3"):
+        robots.load(path)
+
+
+def test_simulator_builds_the_passive_forces(tmp_path):
+    robot = robots.load("puma560")
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    effects.get("cogging").apply(spec, robot, 1, {"amplitude_Nm_motor": 0.03, "poles": 4, "phase_rad": 0.2})
+    effects.get("torque_offset").apply(spec, robot, 4, {"offset_Nm": 1.5})
+    path = tmp_path / "p.xml"
+    path.write_text(spec.to_xml())
+    written = robots.load(path)
+    built = sim.build(written, "lugre")
+    model, data = built.model, mujoco.MjData(built.model)
+    rotor2, rotor5 = robot.rotor_dof[1], robot.rotor_dof[4]
+    data.qpos[robot.rotor_qpos[1]] = 0.3
+    mujoco.mj_forward(model, data)
+    cog = model.actuator("cogging2").id
+    assert data.actuator_force[cog] == pytest.approx(0.03 * np.sin(4 * 0.3 + 0.2), rel=1e-9)
+    offset = model.actuator("offset5").id
+    assert data.actuator_force[offset] == pytest.approx(-1.5 / written.gear_ratio[4], rel=1e-12)
+    assert model.actuator_trnid[cog, 0] == model.dof_jntid[rotor2]
+    assert model.actuator_trnid[offset, 0] == model.dof_jntid[rotor5]
+
+
+def test_lugre_refuses_state_dependent_friction(tmp_path):
+    robot = robots.load("puma560")
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    effects.get("temperature").apply(spec, robot, 0, {"amplitude": 0.5, "time_constant_s": 30.0})
+    path = tmp_path / "p.xml"
+    path.write_text(spec.to_xml())
+    with pytest.raises(ValueError, match="--friction stribeck"):
+        sim.build(robots.load(path), "lugre")
+    sim.build(robots.load(path), "stribeck")
+
+
+def test_unknown_effect_lists_the_known_ones():
+    with pytest.raises(ValueError, match="unknown effect 'gravity'.*coulomb"):
+        effects.get("gravity")
+
+
+def test_library_holds_the_design_ids():
+    assert set(effects.EFFECTS) >= {"coulomb", "viscous", "stribeck", "payload", "cogging", "backlash",
+                                    "load_dependent_friction", "temperature", "torque_offset"}

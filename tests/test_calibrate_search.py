@@ -1,0 +1,109 @@
+"""Model selection on residuals made from the effects' own regressors: known values come back.
+
+These use the inverse dynamics only (no stepping), so they are fast; the closed-loop checks are
+in tests/test_calibrate_hidden.py.
+"""
+
+import numpy as np
+import pytest
+
+from faultgen import robots
+from faultgen.calibrate import effects, search, synth
+
+
+@pytest.fixture(scope="module")
+def puma():
+    robot = robots.load("puma560")
+    motion, tau = synth.nominal_motion(robot, "pick_place", 3)
+    return robot, motion, tau
+
+
+def test_gap_against_hand_computation():
+    column_tau = np.array([[1.0, 2.0], [3.0, -2.0], [-1.0, 2.0], [1.0, 0.0]])
+    column_error = np.array([[0.5, 0.0], [-0.5, 1.0], [0.0, 0.0], [9.0, 9.0]])
+    tau = np.tile(column_tau, 3)
+    predicted = tau - np.tile(column_error, 3)
+    mask = np.ones_like(tau, dtype=bool)
+    mask[3] = False  # the last sample is left out
+    gap = search.gap(tau, predicted, mask)
+    rmse0, rms0 = np.sqrt((0.25 + 0.25 + 0) / 3), np.sqrt((1 + 9 + 1) / 3)
+    rmse1, rms1 = np.sqrt((0 + 1 + 0) / 3), np.sqrt((4 + 4 + 4) / 3)
+    assert gap["rmse_Nm"] == pytest.approx([rmse0, rmse1] * 3)
+    assert gap["nrmse"] == pytest.approx([rmse0 / rms0, rmse1 / rms1] * 3)
+    assert gap["total_nrmse"] == pytest.approx((rmse0 / rms0 + rmse1 / rms1) / 2)
+
+
+def test_split_is_in_time_and_leaves_out_rest_and_edges():
+    t = np.arange(0, 10, 0.004)
+    qd = np.ones((len(t), 6))
+    qd[1000:1100, 2] = 0.0  # axis 3 at rest for 0.4 s
+    split = search.Split.of(t + 5.0, qd)
+    assert not np.any(split.fit & split.held_out)
+    fit_times = t[split.fit[:, 0]]
+    held_times = t[split.held_out[:, 0]]
+    assert fit_times.max() < held_times.min()
+    assert held_times.min() == pytest.approx(search.FIT_FRACTION * t[-1], abs=0.005)
+    assert fit_times.min() >= search.Split.EDGE and held_times.max() <= t[-1] - search.Split.EDGE
+    assert not split.fit[1000:1100, 2].any() and split.fit[1000:1100, 1].all()
+
+
+def test_coulomb_comes_back_from_its_own_regressor(puma):
+    robot, motion, tau = puma
+    effect = effects.get("coulomb")
+    phi, _ = effect.columns(motion, 2, None)
+    rng = np.random.default_rng(3)
+    residual = rng.normal(scale=0.01 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
+    residual[:, 2] += phi[:, 0] * 0.07
+    split = search.Split.of(motion.t, motion.qd)
+    ranked = search.rank(motion, residual, tau, split)
+    best = ranked[0]
+    assert best.effect.id == "coulomb" and best.axes == [2]
+    assert best.params["3"]["coulomb_change_Nm_motor"] == pytest.approx(0.07, rel=0.02)
+
+
+def test_payload_mass_comes_back(puma):
+    robot, motion, tau = puma
+    effect = effects.get("payload")
+    phi, _ = effect.columns(motion, None, None)
+    rng = np.random.default_rng(4)
+    residual = phi[:, :, 0] * 1.7 + rng.normal(scale=0.01 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
+    split = search.Split.of(motion.t, motion.qd)
+    best = search.rank(motion, residual, tau, split)[0]
+    assert best.effect.id == "payload" and best.axes == list(range(6))
+    assert best.params["robot"]["mass_kg"] == pytest.approx(1.7, rel=0.02)
+
+
+def test_stribeck_velocity_is_refined_off_the_grid(puma):
+    robot, motion, tau = puma
+    effect = effects.get("stribeck")
+    axis = 5
+    grid = effect.grid(motion, axis)
+    v_s = float(np.sqrt(grid[4] * grid[5]))  # between two grid points
+    phi, offset = effect.columns(motion, axis, v_s)
+    residual = np.zeros_like(tau)
+    residual[:, axis] = phi[:, 0] * 0.02 + offset
+    split = search.Split.of(motion.t, motion.qd)
+    candidate = search.fit_effect(effect, motion, residual, tau, split)
+    params = candidate.all_params[str(axis + 1)]
+    assert params["stribeck_velocity_rad_per_s_motor"] == pytest.approx(v_s, rel=0.01)
+    assert params["static_Nm_motor"] == pytest.approx(0.02, rel=0.01)
+
+
+def test_noise_alone_names_nothing(puma):
+    robot, motion, tau = puma
+    rng = np.random.default_rng(5)
+    residual = rng.normal(scale=0.02 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
+    split = search.Split.of(motion.t, motion.qd)
+    ranked = search.rank(motion, residual, tau, split)
+    assert all(not c.axes for c in ranked)
+
+
+def test_unphysical_fit_is_never_selected(puma):
+    """A residual that only a negative mass would explain is not a payload."""
+    robot, motion, tau = puma
+    phi, _ = effects.get("payload").columns(motion, None, None)
+    residual = -2.0 * phi[:, :, 0]
+    split = search.Split.of(motion.t, motion.qd)
+    candidate = search.fit_effect(effects.get("payload"), motion, residual, tau, split)
+    assert candidate.all_params["robot"]["mass_kg"] == pytest.approx(-2.0, rel=1e-6)
+    assert candidate.axes == []
