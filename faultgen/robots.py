@@ -215,9 +215,10 @@ class Robot:
         friction : bool, default True
             Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``)
             and the optional effects of the module docstring (cogging, torque offset,
-            load-dependent friction, warm-up drift). Backlash is a dead band of the flexible
-            gearbox with no rigid-body torque: it is not included (the calibration workflow
-            re-simulates it, :mod:`faultgen.calibrate.resim`).
+            load-dependent friction, warm-up drift). Backlash ``b`` (without a friction flag) is
+            taken quasi-statically: ``q`` is read as the motor angle over G and the arm's
+            rigid-body terms are evaluated at ``q - (b/2) sign(load)``, where the arm rests on
+            the loaded flank. The transients of crossing the dead band are not modelled.
         t : ndarray of shape (n,), optional
             Time since the start of the run in s, for the warm-up drift (:attr:`thermal`);
             zero when omitted.
@@ -241,20 +242,28 @@ class Robot:
         qdd = _check_trajectory("qdd", qdd, q.shape[0])
         G = self.gear_ratio
         tau, load = self._rigid(q, qd, qdd)
+        if np.any(self.backlash):
+            # Quasi-static dead band: q is the motor angle over G, and the arm trails it by b/2
+            # against the gearbox load; the arm's rigid-body terms are taken there.
+            q_arm = q - self.backlash / 2 * np.sign(load)
+            arm, load = self._rigid(q_arm, qd, qdd, q_motor=q)
+            tau = arm
         if friction:
             tau += G * self.friction.stribeck_torque(G * qd)
             tau += self.effect_torque(q, qd, load, t)
         return tau
 
-    def _rigid(self, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
-        """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``."""
+    def _rigid(self, q, qd, qdd, q_motor=None) -> tuple[np.ndarray, np.ndarray]:
+        """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``
+        (arm at ``q``, rotors at ``G q_motor``, ``q_motor = q`` by default)."""
         model, data = self._inverse
         G = self.gear_ratio
+        q_motor = q if q_motor is None else q_motor
         tau = np.empty_like(q)
         load = np.empty_like(q)
         for k in range(q.shape[0]):
             data.qpos[self.arm_qpos] = q[k]
-            data.qpos[self.rotor_qpos] = G * q[k]
+            data.qpos[self.rotor_qpos] = G * q_motor[k]
             data.qvel[self.arm_dof] = qd[k]
             data.qvel[self.rotor_dof] = G * qd[k]
             data.qacc[self.arm_dof] = qdd[k]

@@ -39,6 +39,10 @@ MOTOR_SHARE = 0.4
 MIN_SIZE = 0.45
 #: Torque-sensor noise, standard deviation as a fraction of each axis's torque RMS.
 TORQUE_NOISE = 0.01
+#: Effects drawn by a physical parameter range instead of a torque size: id -> (name, low, high).
+#: Backlash has no torque size of its own (its quasi-static torque is tiny; see
+#: :class:`faultgen.calibrate.effects.Backlash`): 0.3 to 1.1 degrees at the arm.
+PHYSICAL = {"backlash": ("backlash_rad", 0.005, 0.02)}
 #: Most axes an effect is hidden on.
 MAX_AXES = 3
 
@@ -78,6 +82,11 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     if effect is None:
         return Hidden(None)
     kind = get(effect)
+    if effect in PHYSICAL:
+        name, low, high = PHYSICAL[effect]
+        axes = sorted(int(a) for a in rng.choice(6, size=int(rng.integers(1, MAX_AXES + 1)), replace=False))
+        params = {str(a + 1): {name: float(rng.uniform(low, high))} for a in axes}
+        return Hidden(effect, [a + 1 for a in axes], params, 0.0)
     motion, tau = nominal_motion(robot, task, cycles)
     size = float(rng.uniform(*SIZE_RANGE))
     scale = np.sqrt(np.mean(tau**2, axis=0))

@@ -1,0 +1,98 @@
+"""Hidden-effect checks of ``faultgen calibrate`` on data from our own simulator (both robots).
+
+For every effect id, :mod:`faultgen.calibrate.synth` switches the effect on at a randomly drawn
+size on random axes (seed 0 for every case, fixed before looking at the outcome), simulates
+four closed-loop cycles of the pick-and-place task with sensor noise, and writes the measured
+CSV; the workflow gets only that file and the robot name. It must name the hidden effect first,
+on the hidden axes, and cut the held-out total nrmse at least in half. Without a hidden effect
+it must name nothing.
+
+Backlash is not among them: the workflow models it quasi-statically and does not find it in
+simulated dead bands (docs/calibration.md, accuracy table; the issue's requirement is not met
+for backlash).
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from faultgen import measured, robots, sim
+from faultgen.calibrate import EFFECTS, calibrate, synth
+
+SEED = 0
+FOUND = [e for e in EFFECTS if e != "backlash"]
+
+
+def hidden_case(tmp_path, robot_name, effect, seed=SEED):
+    robot = robots.load(robot_name)
+    hidden = synth.draw(robot, effect, np.random.default_rng(seed))
+    path = synth.record(robot, hidden, tmp_path / "measured.csv", seed=seed)
+    return hidden, calibrate(robot_name, path, tmp_path / "out")
+
+
+@pytest.mark.parametrize("robot_name", ["puma560", "irb6700"])
+@pytest.mark.parametrize("effect", FOUND)
+def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_name, effect):
+    hidden, result = hidden_case(tmp_path, robot_name, effect)
+    assert result.steps, f"nothing found; hidden {hidden}"
+    first = result.steps[0]
+    assert (first.effect, first.axes) == (hidden.effect, hidden.axes), f"hidden {hidden}, found {result.summary()}"
+    assert result.gap_after["total_nrmse"] <= 0.5 * result.gap_before["total_nrmse"], result.summary()
+
+
+@pytest.mark.parametrize("robot_name", ["puma560", "irb6700"])
+def test_nothing_hidden_names_nothing(tmp_path, robot_name):
+    _, result = hidden_case(tmp_path, robot_name, None)
+    assert result.steps == [], result.summary()
+    assert result.gap_after == result.gap_before
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert report["steps"] == []
+
+
+def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
+    hidden, result = hidden_case(tmp_path, "puma560", "payload")
+    out = tmp_path / "out"
+    report = json.loads((out / "report.json").read_text())
+    assert set(report) == {"robot", "measured", "gap_before", "steps", "gap_after", "model_out"}
+    assert report["robot"] == "puma560" and report["measured"].endswith("measured.csv")
+    for gap in (report["gap_before"], report["gap_after"], report["steps"][0]["gap_after"]):
+        assert len(gap["rmse_Nm"]) == 6 and len(gap["nrmse"]) == 6
+        assert gap["total_nrmse"] == pytest.approx(np.mean(gap["nrmse"]))
+    step = report["steps"][0]
+    assert step["effect"] == "payload" and step["axes"] == [1, 2, 3, 4, 5, 6]
+    mass = step["params"]["robot"]["mass_kg"]
+    assert mass == pytest.approx(hidden.params["robot"]["mass_kg"], rel=0.05)
+    assert step["evidence"]["scores"]["payload"] == pytest.approx(step["evidence"]["score"])
+    assert (out / "calibration.png").stat().st_size > 10_000
+    # the augmented model loads, carries the payload, and the simulator runs it
+    model = robots.load(report["model_out"])
+    nominal = robots.load("puma560")
+    added = model.model.body("payload1").mass[0]
+    assert added == pytest.approx(mass, rel=1e-5)
+    run = sim.simulate(sim.RunConfig(robot=report["model_out"], task="pick_place", cycles=1), progress=False)
+    assert np.all(np.isfinite(run.tau_m))
+    assert np.sum(model.model.body_mass) == pytest.approx(np.sum(nominal.model.body_mass) + mass, rel=1e-5)
+
+
+def test_same_seed_same_bytes(tmp_path):
+    robot = robots.load("irb6700")
+    hidden = synth.draw(robot, "coulomb", np.random.default_rng(11))
+    again = synth.draw(robot, "coulomb", np.random.default_rng(11))
+    assert hidden == again
+    a = synth.record(robot, hidden, tmp_path / "a.csv", seed=11)
+    b = synth.record(robot, hidden, tmp_path / "b.csv", seed=11)
+    assert a.read_bytes() == b.read_bytes()
+    first = calibrate("irb6700", a, tmp_path / "one").report()
+    second = calibrate("irb6700", a, tmp_path / "two").report()
+    first.pop("model_out"), second.pop("model_out")
+    assert first == second
+    assert (tmp_path / "one" / "model" / "irb6700_calibrated.xml").read_bytes() == \
+        (tmp_path / "two" / "model" / "irb6700_calibrated.xml").read_bytes()
+
+
+def test_measured_file_is_what_the_reader_accepts(tmp_path):
+    robot = robots.load("puma560")
+    path = synth.record(robot, synth.Hidden(None), tmp_path / "m.csv", seed=1)
+    data = measured.read(path, robot)
+    assert data.duration > 4 * 7.0 and data.velocity_estimated
