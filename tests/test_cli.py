@@ -123,3 +123,64 @@ def test_written_file_has_normal_permissions(tmp_path):
     mask = os.umask(0)
     os.umask(mask)
     assert out.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+def _toolbox_free_log(tmp_path, seconds=6.0, nan_row=None, degrees=False, drop=None):
+    """A short measured log along our PUMA path (nominal torque), optionally broken."""
+    from faultgen import measured
+    from faultgen.calibrate import synth
+
+    robot = robots.load("puma560")
+    motion, tau = synth.nominal_motion(robot, "pick_place", 1)
+    n = int(seconds / 0.004)
+    t, q, tau = motion.t[:n], motion.q[:n].copy(), tau[:n].copy()
+    if nan_row is not None:
+        tau[nan_row, 1] = np.nan
+    if degrees:
+        q = np.degrees(q)
+    path = measured.write_csv(tmp_path / "log.csv", t, q, tau)
+    if drop:
+        import pandas as pd
+
+        pd.read_csv(path).drop(columns=[drop]).to_csv(path, index=False)
+    return path
+
+
+def test_calibrate_prints_the_summary_and_writes_outputs(tmp_path):
+    log = _toolbox_free_log(tmp_path)
+    result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "--out",
+                                 str(tmp_path / "cal")])
+    assert result.exit_code == 0, result.output
+    assert "no significant missing effect found" in result.output
+    assert "gap" in result.output and "report.json" in result.output
+    for name in ("report.json", "calibration.png", "model/puma560_calibrated.xml", "model/tasks.toml"):
+        assert (tmp_path / "cal" / name).is_file(), name
+
+
+@pytest.mark.parametrize("broken, match", [
+    ({"drop": "tau3"}, "tau3"),
+    ({"nan_row": 7}, "row 8"),
+    ({"degrees": True}, "degrees"),
+    ({"seconds": 1.0}, "2 s"),
+])
+def test_calibrate_refuses_bad_measured_data(tmp_path, broken, match):
+    log = _toolbox_free_log(tmp_path, **broken)
+    result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "--out",
+                                 str(tmp_path / "cal")])
+    assert result.exit_code == 2
+    assert "error:" in result.output and match in result.output, result.output
+    assert not (tmp_path / "cal" / "report.json").exists()
+
+
+def test_calibrate_refuses_an_unknown_robot(tmp_path):
+    log = _toolbox_free_log(tmp_path)
+    result = runner.invoke(app, ["calibrate", "--robot", "kuka", "--measured", str(log), "--out", str(tmp_path / "c")])
+    assert result.exit_code == 2
+    assert "unknown robot 'kuka'" in result.output and "puma560" in result.output
+
+
+def test_simulate_accepts_a_model_file(tmp_path):
+    spec_path = robots.load("puma560").path
+    result = runner.invoke(app, ["simulate", "--model", str(spec_path), "--cycles", "1", "--no-progress",
+                                 "--out", str(tmp_path / "r.h5")])
+    assert result.exit_code == 0, result.output
