@@ -59,7 +59,7 @@ def test_nothing_hidden_names_nothing(tmp_path, robot_name):
 
 
 def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
-    hidden, result = hidden_case(tmp_path, "puma560", "payload")
+    hidden, _ = hidden_case(tmp_path, "puma560", "payload")
     out = tmp_path / "out"
     report = json.loads((out / "report.json").read_text())
     assert set(report) == {"robot", "measured", "gap_before", "steps", "gap_after", "model_out"}

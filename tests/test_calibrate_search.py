@@ -48,7 +48,7 @@ def test_split_is_in_time_and_leaves_out_rest_and_edges():
 
 
 def test_coulomb_comes_back_from_its_own_regressor(puma):
-    robot, motion, tau = puma
+    _, motion, tau = puma
     effect = effects.get("coulomb")
     phi, _ = effect.columns(motion, 2, None)
     rng = np.random.default_rng(3)
@@ -62,7 +62,7 @@ def test_coulomb_comes_back_from_its_own_regressor(puma):
 
 
 def test_payload_mass_comes_back(puma):
-    robot, motion, tau = puma
+    _, motion, tau = puma
     effect = effects.get("payload")
     phi, _ = effect.columns(motion, None, None)
     rng = np.random.default_rng(4)
@@ -74,7 +74,7 @@ def test_payload_mass_comes_back(puma):
 
 
 def test_stribeck_velocity_is_refined_off_the_grid(puma):
-    robot, motion, tau = puma
+    _, motion, tau = puma
     effect = effects.get("stribeck")
     axis = 5
     grid = effect.grid(motion, axis)
@@ -90,7 +90,7 @@ def test_stribeck_velocity_is_refined_off_the_grid(puma):
 
 
 def test_noise_alone_names_nothing(puma):
-    robot, motion, tau = puma
+    _, motion, tau = puma
     rng = np.random.default_rng(5)
     residual = rng.normal(scale=0.02 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
     split = search.Split.of(motion.t, motion.qd)
@@ -100,7 +100,7 @@ def test_noise_alone_names_nothing(puma):
 
 def test_unphysical_fit_is_never_selected(puma):
     """A residual that only a negative mass would explain is not a payload."""
-    robot, motion, tau = puma
+    _, motion, tau = puma
     phi, _ = effects.get("payload").columns(motion, None, None)
     residual = -2.0 * phi[:, :, 0]
     split = search.Split.of(motion.t, motion.qd)

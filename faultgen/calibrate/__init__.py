@@ -34,7 +34,7 @@ from faultgen import robots
 from faultgen.calibrate import search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 
-__all__ = ["EFFECTS", "Effect", "Step", "Calibration", "calibrate", "get"]
+__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get"]
 
 #: Most effects added in one calibration.
 MAX_STEPS = 6

@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-
 from scipy.optimize import minimize_scalar
 
 from faultgen.calibrate.effects import EFFECTS, REST_SPEED, Effect, Motion
@@ -127,6 +126,28 @@ def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(phi, y, rcond=None)[0]
 
 
+def _fit_axis(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, axis: int):
+    """Least squares of one axis over the effect's grid, refined between the best grid neighbours
+    when the grid samples a continuous parameter; returns (sse, h, theta, predicted)."""
+
+    def trial(h):
+        phi, offset = effect.columns(motion, axis, h)
+        theta = _lstsq(phi[rows], residual[rows] - offset[rows])
+        predicted = phi @ theta + offset
+        return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
+
+    grid = effect.grid(motion, axis)
+    results = [trial(h) for h in grid]
+    k = min(range(len(results)), key=lambda i: results[i][0])
+    best = results[k]
+    if effect.continuous and len(grid) > 2:  # refine between the grid neighbours, in log
+        bounds = (np.log(grid[max(k - 1, 0)]), np.log(grid[min(k + 1, len(grid) - 1)]))
+        found = minimize_scalar(lambda x: trial(float(np.exp(x)))[0], bounds=bounds, method="bounded",
+                                options={"xatol": 1e-3})
+        best = min(best, trial(float(np.exp(found.x))), key=lambda r: r[0])
+    return best
+
+
 def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> Candidate:
     """Fit ``effect`` to ``residual`` (n, 6) on the fitting part; judge it on the held-out part."""
     held, fit = split.held_out, split.fit
@@ -137,26 +158,7 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     params: dict = {}
     if effect.per_axis:
         for axis in range(residual.shape[1]):
-            best = None
-            rows = fit[:, axis]
-
-            def trial(h):
-                phi, offset = effect.columns(motion, axis, h)
-                theta = _lstsq(phi[rows], residual[rows, axis] - offset[rows])
-                predicted = phi @ theta + offset
-                return float(np.sum((residual[rows, axis] - predicted[rows]) ** 2)), h, theta, predicted
-
-            grid = effect.grid(motion, axis)
-            results = [trial(h) for h in grid]
-            k = min(range(len(results)), key=lambda i: results[i][0])
-            best = results[k]
-            if effect.continuous and len(grid) > 2:  # refine between the grid neighbours, in log
-                bounds = (np.log(grid[max(k - 1, 0)]), np.log(grid[min(k + 1, len(grid) - 1)]))
-                found = minimize_scalar(lambda x: trial(float(np.exp(x)))[0], bounds=bounds, method="bounded",
-                                        options={"xatol": 1e-3})
-                refined = trial(float(np.exp(found.x)))
-                best = min(best, refined, key=lambda r: r[0])
-            _, h, theta, predicted = best
+            _, h, theta, predicted = _fit_axis(effect, motion, residual[:, axis], fit[:, axis], axis)
             contribution[:, axis] = predicted
             params[str(axis + 1)] = effect.params(motion, axis, theta, h)
     else:

@@ -62,8 +62,11 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
     """The task's reference motion repeated ``cycles`` times at the log rate, and its nominal torque."""
     duration = sim.cycle_duration(str(robot.path), task)
     path = tasks.load(robot, task).trajectory(sensors.LOG_PERIOD)
-    n = int(round(duration / sensors.LOG_PERIOD))
-    pad = lambda a: np.vstack([a, np.repeat(a[-1:], max(n - len(a), 0), axis=0)])[:n]  # noqa: E731
+    n = round(duration / sensors.LOG_PERIOD)
+
+    def pad(a):  # hold the last sample to the cycle's end, as the simulator does
+        return np.vstack([a, np.repeat(a[-1:], max(n - len(a), 0), axis=0)])[:n]
+
     q, qd, qdd = (np.tile(pad(a), (cycles, 1)) for a in (path.q, path.qd, path.qdd))
     t = np.arange(len(q)) * sensors.LOG_PERIOD
     tau = robot.inverse_dynamics(q, qd, qdd, t=t)
@@ -91,7 +94,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     size = float(rng.uniform(*SIZE_RANGE))
     scale = np.sqrt(np.mean(tau**2, axis=0))
     if not kind.per_axis:
-        phi, offset = kind.columns(motion, None, None)
+        phi, _ = kind.columns(motion, None, None)
         relative = np.sqrt(np.mean(phi[:, :, 0] ** 2, axis=0)) / scale
         theta = np.array([size / relative.max()])
         return Hidden(effect, list(range(1, 7)), {"robot": kind.params(motion, None, theta, None)}, size)
@@ -104,7 +107,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
             h = int(rng.choice(grid))
         else:  # a continuous parameter: log-uniform inside the searched range, off the grid points
             h = float(np.exp(rng.uniform(np.log(grid[1]), np.log(grid[-2]))))
-        phi, offset = kind.columns(motion, axis, h)
+        phi, _ = kind.columns(motion, axis, h)
         if phi.shape[1] == 2:  # amplitude and phase (cogging)
             phase = rng.uniform(0, 2 * np.pi)
             unit = phi @ np.array([np.cos(phase), np.sin(phase)])
