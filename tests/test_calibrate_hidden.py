@@ -81,6 +81,9 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     run = sim.simulate(sim.RunConfig(robot=report["model_out"], task="pick_place", cycles=1), progress=False)
     assert np.all(np.isfinite(run.tau_m))
     assert np.sum(model.model.body_mass) == pytest.approx(np.sum(nominal.model.body_mass) + mass, rel=1e-5)
+    written = json.loads((out / "model" / "parameters.json").read_text())
+    assert written["payload_kg"] == [pytest.approx(mass, rel=1e-5)]
+    assert written["gear_ratio"] == pytest.approx(nominal.gear_ratio.tolist(), rel=1e-5)
 
 
 def test_same_seed_same_bytes(tmp_path):

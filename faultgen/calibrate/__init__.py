@@ -33,8 +33,9 @@ from faultgen import measured as measured_io
 from faultgen import robots
 from faultgen.calibrate import search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
+from faultgen.friction import FIELDS as FRICTION_FIELDS
 
-__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get"]
+__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters"]
 
 #: Most effects added in one calibration.
 MAX_STEPS = 6
@@ -129,6 +130,9 @@ class Calibration:
                          f"{s.gap_after['total_nrmse']:.4f}  ({values})")
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
+        stateful = {"load_dependent_friction", "temperature"} & {s.effect for s in self.steps}
+        friction = " --friction stribeck" if stateful else ""
+        lines.append(f"simulate it: faultgen simulate --model {self.model_out}{friction}")
         return "\n".join(lines)
 
 
@@ -144,7 +148,8 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         The measured file (design document format) or data already read.
     out : str or Path
         Output folder, created if needed: ``model/<robot>_calibrated.xml`` (with the robot's
-        ``tasks.toml``, so ``faultgen simulate --model`` runs it), ``report.json`` and
+        ``tasks.toml``, so ``faultgen simulate --model`` runs it), ``model/parameters.json``
+        (the augmented model's parameters per axis, SI units), ``report.json`` and
         ``calibration.png``.
     max_steps : int
         Most effects to add.
@@ -211,6 +216,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
                 print(f"step {k + 1}: {best.effect.id} on axes {steps[-1].axes}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
         _write_atomic(model_out, Path(current.path).read_text())
+    _write_atomic(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
 
     result = Calibration(
         robot=nominal.name,
@@ -231,6 +237,28 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
 
     figure.save(result, out / "calibration.png")
     return result
+
+
+def parameters(robot: robots.Robot) -> dict:
+    """A robot's parameters as plain lists over axes 1..6, with their units (``parameters.json``)."""
+    friction = {name: [float(v) for v in getattr(robot.friction, name)] for name in FRICTION_FIELDS}
+    payload = [float(robot.model.body(b).mass[0]) for b in range(robot.model.nbody)
+               if robot.model.body(b).name.startswith("payload")]
+    return {
+        "robot": robot.name,
+        "units": {"gear_ratio": "1", "friction": "motor side, see faultgen.friction.UNITS",
+                  "cogging": "amplitude N m (motor side), poles, phase rad", "torque_offset": "N m (arm side)",
+                  "load_friction": "1", "thermal": "amplitude 1, time constant s", "backlash": "rad (arm side)",
+                  "payload_kg": "kg"},
+        "gear_ratio": [float(v) for v in robot.gear_ratio],
+        "friction": friction,
+        "cogging": robot.cogging.tolist(),
+        "torque_offset": robot.torque_offset.tolist(),
+        "load_friction": robot.load_friction.tolist(),
+        "thermal": robot.thermal.tolist(),
+        "backlash": robot.backlash.tolist(),
+        "payload_kg": payload,
+    }
 
 
 def _evidence(best: search.Candidate, ranked: list[search.Candidate]) -> dict:
