@@ -274,6 +274,26 @@ class Robot:
             tau[k] = load[k] + G * data.qfrc_inverse[self.rotor_dof]
         return tau, load
 
+    def arm_inertia(self, q: np.ndarray) -> np.ndarray:
+        """Diagonal of the arm's joint-space inertia matrix (rotors excluded), kg m^2, shape (n, 6).
+
+        Parameters
+        ----------
+        q : ndarray of shape (n, 6)
+            Arm joint angles in rad.
+        """
+        q = _check_trajectory("q", q)
+        model, data = self._inverse
+        full = np.zeros((model.nv, model.nv))
+        out = np.empty_like(q)
+        for k in range(q.shape[0]):
+            data.qpos[self.arm_qpos] = q[k]
+            data.qpos[self.rotor_qpos] = self.gear_ratio * q[k]
+            mujoco.mj_fwdPosition(model, data)
+            mujoco.mj_fullM(model, data, full)
+            out[k] = full[self.arm_dof, self.arm_dof]
+        return out
+
     def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None
                       ) -> np.ndarray:
         """Arm-side drive torque of the optional effects (module docstring), N m, shape (n, 6).

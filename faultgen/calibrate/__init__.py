@@ -5,8 +5,8 @@ The workflow (:func:`calibrate`, ``faultgen calibrate``):
 
 1. read and check the measured file (:func:`faultgen.measured.read`; velocities and
    accelerations from a Savitzky-Golay filter when the file has none);
-2. predict the torque with the nominal model (:meth:`faultgen.robots.Robot.inverse_dynamics`) and
-   split the record in time into a fitting part and a held-out part
+2. predict the torque with the nominal model (:func:`predict`: the inverse dynamics plus what the
+   flexible gearboxes change, :mod:`faultgen.calibrate.gearbox`) and split the record in time into a fitting part and a held-out part
    (:class:`faultgen.calibrate.search.Split`); every gap is reported on the held-out part;
 3. fit every effect of the library (:mod:`faultgen.calibrate.effects`) to the residual and pick
    the one that explains it best (:mod:`faultgen.calibrate.search`);
@@ -31,11 +31,11 @@ import numpy as np
 
 from faultgen import measured as measured_io
 from faultgen import robots
-from faultgen.calibrate import search
+from faultgen.calibrate import gearbox, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.friction import FIELDS as FRICTION_FIELDS
 
-__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters"]
+__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters", "predict"]
 
 #: Most effects added in one calibration.
 MAX_STEPS = 6
@@ -181,11 +181,10 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     if tasks_file.is_file():
         shutil.copyfile(tasks_file, model_dir / "tasks.toml")
 
-    t = data.t - data.t[0]
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     current = nominal
-    predicted = nominal.inverse_dynamics(data.q, data.qd, data.qdd, t=t)
+    predicted = predict(nominal, data)
     nominal_prediction = predicted
     gap_before = search.gap(tau, predicted, split.held_out)
     steps: list[Step] = []
@@ -204,7 +203,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             trial_path = Path(work) / model_out.name
             trial_path.write_text(spec.to_xml())
             trial = robots.load(trial_path)
-            trial_prediction = trial.inverse_dynamics(data.q, data.qd, data.qdd, t=t)
+            trial_prediction = predict(trial, data)
             after = search.gap(tau, trial_prediction, split.held_out)
             previous = steps[-1].gap_after if steps else gap_before
             if after["total_nrmse"] >= previous["total_nrmse"]:
@@ -237,6 +236,19 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
 
     figure.save(result, out / "calibration.png")
     return result
+
+
+def predict(robot: robots.Robot, data: measured_io.MeasuredData) -> np.ndarray:
+    """A model's drive torque along a measured motion, N m at the arm side, shape (n, 6).
+
+    :meth:`faultgen.robots.Robot.inverse_dynamics` (rigid body, motor inertia, friction and the
+    model's optional effects, time from the first sample) plus the torque of the flexible
+    gearboxes (:func:`faultgen.calibrate.gearbox.compliance_torque`).
+    """
+    t = data.t - data.t[0]
+    rigid = robot.inverse_dynamics(data.q, data.qd, data.qdd, t=t)
+    load = Motion.of(robot, data.t, data.q, data.qd, data.qdd).load
+    return rigid + gearbox.compliance_torque(robot, data.t, data.q, load)
 
 
 def parameters(robot: robots.Robot) -> dict:

@@ -1,0 +1,66 @@
+"""The flexible-gearbox correction against the closed-form response of a spring-mass-damper."""
+
+import numpy as np
+import pytest
+
+from faultgen import robots
+from faultgen.calibrate import gearbox
+
+
+class OneSpring:
+    """Duck-typed robot: six identical axes with constant arm inertia M, stiffness K, damping D."""
+
+    def __init__(self, inertia, stiffness, damping):
+        self.gearbox_stiffness = np.full(6, stiffness)
+        self.gearbox_damping = np.full(6, damping)
+        self._inertia = inertia
+
+    def arm_inertia(self, q):
+        return np.full(q.shape, self._inertia)
+
+
+@pytest.mark.parametrize("hz", [2.0, 12.0, 30.0])
+def test_sinusoidal_load_gives_the_steady_state_of_the_oscillator(hz):
+    M, K, D = 2.0, 2.0e4, 8.0  # resonance 15.9 Hz, damping ratio 0.02
+    robot = OneSpring(M, K, D)
+    t = np.arange(0, 20.0, 0.004)
+    w = 2 * np.pi * hz
+    load = np.outer(np.sin(w * t), np.ones(6)) * 50.0
+    out = gearbox.compliance_torque(robot, t, np.zeros_like(load), load)
+    # e = L / (K - M w^2 + i D w); drive torque change (K + i D w) e - L = L M w^2 / (K - M w^2 + i D w)
+    response = 50.0 * M * w**2 / (K - M * w**2 + 1j * D * w)
+    expected = np.imag(response * np.exp(1j * w * t))
+    late = t > 15.0  # the start transient has decayed (time constant 2M/D = 0.5 s)
+    error = out[late, 0] - expected[late]
+    assert np.sqrt(np.mean(error**2)) <= 0.02 * np.sqrt(np.mean(expected[late] ** 2)) + 1e-9
+
+
+def test_slow_load_is_carried_quasi_statically():
+    robot = OneSpring(1.0, 1.0e5, 20.0)
+    t = np.arange(0, 5.0, 0.004)
+    load = np.outer(30.0 * np.sin(2 * np.pi * 0.2 * t), np.ones(6))
+    out = gearbox.compliance_torque(robot, t, np.zeros_like(load), load)
+    # after the start (0.1 s damping time constant): M e'' with e = load / K, about 1e-4 N m
+    assert np.max(np.abs(out[t > 1.0])) < 1e-3
+
+
+def test_arm_inertia_is_the_mass_matrix_diagonal_with_rotors_held():
+    """Against recursive Newton-Euler: unit arm acceleration, rotors not accelerating, no gravity."""
+    import mujoco
+
+    robot = robots.load("puma560")
+    q = np.tile(robot.home, (2, 1))
+    q[1, 2] += 0.5
+    diagonal = robot.arm_inertia(q)
+    model = robot.model.__copy__()
+    model.opt.gravity[:] = 0
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # at rest, springs are relaxed
+    data = mujoco.MjData(model)
+    for k in range(2):
+        for axis in range(6):
+            data.qpos[:], data.qvel[:] = robot.rigid_state(q[k])
+            data.qvel[:] = 0
+            data.qacc[:] = 0
+            data.qacc[robot.arm_dof[axis]] = 1.0
+            mujoco.mj_inverse(model, data)
+            assert diagonal[k, axis] == pytest.approx(data.qfrc_inverse[robot.arm_dof[axis]], rel=1e-9)
