@@ -29,8 +29,9 @@ from faultgen.calibrate.effects import EFFECTS, Motion, get
 
 #: Range of the effect's torque RMS over the axis's nominal torque RMS.
 SIZE_RANGE = (0.5, 1.2)
-#: Physical bounds on drawn parameters: an axis where the drawn size would need more is not
-#: eligible (e.g. load-dependent friction on a wrist axis that carries almost no load).
+#: Physical bounds on drawn parameters: past one, the effect on that axis is shrunk to the bound,
+#: and an axis left below :data:`MIN_SIZE` is not drawn (e.g. load-dependent friction on a wrist
+#: axis that carries almost no load).
 LIMITS = {"load_friction_coefficient": 0.8, "amplitude": 3.0, "backlash_rad": 0.05}
 #: Largest share of a motor's torque limit the hidden friction, offset or cogging may take, so
 #: the drive can still move the axis (a stuck axis shows nothing).
