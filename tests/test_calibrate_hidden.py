@@ -107,3 +107,19 @@ def test_measured_file_is_what_the_reader_accepts(tmp_path):
     path = synth.record(robot, synth.Hidden(None), tmp_path / "m.csv", seed=1)
     data = measured.read(path, robot)
     assert data.duration > 4 * 7.0 and data.velocity_estimated
+
+
+def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
+    """The loop repeats until nothing is significant: a payload, then Coulomb friction on axis 5
+    (the worked example of docs/calibration.md), and then it stops."""
+    robot = robots.load("puma560")
+    payload = synth.Hidden("payload", [1, 2, 3, 4, 5, 6], {"robot": {"mass_kg": 2.2}})
+    with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
+    coulomb = synth.Hidden("coulomb", [5], {"5": {"coulomb_change_Nm_motor": 0.03}})
+    path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3)
+    result = calibrate("puma560", path, tmp_path / "out")
+    assert [(s.effect, s.axes) for s in result.steps] == [("payload", [1, 2, 3, 4, 5, 6]), ("coulomb", [5])]
+    assert result.steps[0].params["robot"]["mass_kg"] == pytest.approx(2.2, rel=0.03)
+    assert result.steps[1].params["5"]["coulomb_change_Nm_motor"] == pytest.approx(0.03, rel=0.03)
+    assert result.steps[0].gap_after["total_nrmse"] < result.gap_before["total_nrmse"]
+    assert result.gap_after["total_nrmse"] < 0.15 * result.gap_before["total_nrmse"]
