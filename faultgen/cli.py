@@ -182,27 +182,22 @@ def calibrate_command(
 ) -> None:
     """Find what the model misses in a measured torque log, add it, and show the gap shrink.
 
-    The nominal model predicts the measured torque (inverse dynamics along the measured motion);
-    every effect of the library is fitted to the residual on the first 70 % of the record and
-    judged on the last 30 % (held out); the effect that cuts the held-out error most, on the axes
-    where the cut is significant, is written into the model, and the search repeats until nothing
-    significant is left. Effects:
+    The nominal model predicts the measured torque along the measured motion; every effect of
+    the library is fitted to the residual on the first 70 % of the record and judged on the last
+    30 % (held out); the effect that cuts the held-out error most, on the axes where the cut is
+    significant, is written into the model, and the search repeats until nothing significant is
+    left.
 
-    \b
-      torque_offset            constant torque offset
-      coulomb                  Coulomb friction level
-      viscous                  viscous friction
-      stribeck                 Stribeck friction (low-speed hump) and Stribeck velocity
-      load_dependent_friction  friction growing with the gearbox load
-      temperature              friction drifting with time (warm-up)
-      payload                  unmodelled mass at the flange
-      cogging                  torque periodic in the motor angle
-      backlash                 gearbox dead band
+    Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
+    friction), stribeck (low-speed friction hump), load_dependent_friction (friction growing with
+    the gearbox load), temperature (friction drifting with time, warm-up), payload (mass at the
+    flange), cogging (torque periodic in the motor angle), backlash (gearbox dead band,
+    quasi-static).
 
-    Outputs in OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`),
-    report.json (gap before/after per axis, each effect with its axes, parameters and evidence),
-    calibration.png (measured vs simulated torque and the residual before and after, per axis).
-    Method and accuracy: docs/calibration.md.
+    Writes into OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`)
+    and model/parameters.json, report.json (gap before/after per axis, each effect with its axes,
+    parameters and evidence) and calibration.png (measured vs model torque and the residual
+    before and after, per axis). Method and accuracy: docs/calibration.md.
 
     Example:
 
