@@ -160,3 +160,21 @@ def test_unknown_effect_lists_the_known_ones():
 def test_library_holds_the_design_ids():
     assert set(effects.EFFECTS) >= {"coulomb", "viscous", "stribeck", "payload", "cogging", "backlash",
                                     "load_dependent_friction", "temperature", "torque_offset"}
+
+
+def test_backlash_term_is_the_first_order_shift_of_the_written_model(setup, tmp_path):
+    """Quasi-static backlash: the written dead band shifts the arm by b/2 against the load; the
+    regressor is the first-order change of the axis's torque, exact as b -> 0."""
+    robot, motion = setup
+    effect = effects.get("backlash")
+    axis, b = 1, 1e-3
+    phi, offset = effect.columns(motion, axis, None)
+    new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
+    assert new.backlash[axis] == pytest.approx(b, rel=1e-5)
+    change = (new.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
+              - robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False))[:, axis]
+    fitted = phi[:, 0] * b + offset
+    assert np.max(np.abs(fitted)) > 1e-3
+    # away from load reversals (where sign(load) may differ between the two models)
+    steady = np.abs(motion.load[:, axis]) > 0.05 * np.max(np.abs(motion.load[:, axis]))
+    np.testing.assert_allclose(change[steady], fitted[steady], atol=0.02 * np.max(np.abs(fitted)))

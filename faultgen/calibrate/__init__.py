@@ -170,7 +170,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         If ``max_steps`` < 0.
     """
     if max_steps < 0:
-        raise ValueError(f"max_steps = {max_steps}; expected >= 0")
+        raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
     nominal = robots.load(robot)
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
     out = Path(out)
