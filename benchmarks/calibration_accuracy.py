@@ -9,6 +9,7 @@ half of what it was. Prints a markdown table (docs/calibration.md holds the one 
 writes every case to a CSV.
 
     python benchmarks/calibration_accuracy.py --seeds 5 --jobs 2 --csv calibration_cases.csv
+    python benchmarks/calibration_accuracy.py --size-range 0.1 0.3    # smaller effects
 """
 
 from __future__ import annotations
@@ -26,11 +27,11 @@ from faultgen import robots
 from faultgen.calibrate import EFFECTS, calibrate, synth
 
 
-def case(robot_name: str, effect: str | None, seed: int) -> dict:
+def case(robot_name: str, effect: str | None, seed: int, size_range=synth.SIZE_RANGE) -> dict:
     """Run one hidden-effect case and return its outcome."""
     robot = robots.load(robot_name)
     started = time.perf_counter()
-    hidden = synth.draw(robot, effect, np.random.default_rng(seed))
+    hidden = synth.draw(robot, effect, np.random.default_rng(seed), size_range=tuple(size_range))
     with tempfile.TemporaryDirectory() as folder:
         path = synth.record(robot, hidden, Path(folder) / "measured.csv", seed=seed)
         result = calibrate(robot_name, path, Path(folder) / "out")
@@ -67,10 +68,12 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=5, help="seeds per robot and effect (0..N-1)")
     parser.add_argument("--jobs", type=int, default=2, help="parallel worker processes")
     parser.add_argument("--csv", type=Path, default=None, help="write every case here")
+    parser.add_argument("--size-range", type=float, nargs=2, default=synth.SIZE_RANGE, metavar=("LOW", "HIGH"),
+                        help="effect torque RMS over the axis's torque RMS (default: %(default)s)")
     args = parser.parse_args()
     jobs = [(r, e, s) for r in ("puma560", "irb6700") for e in (None, *EFFECTS) for s in range(args.seeds)]
     started = time.perf_counter()
-    rows = Parallel(n_jobs=args.jobs, verbose=5)(delayed(case)(*job) for job in jobs)
+    rows = Parallel(n_jobs=args.jobs, verbose=5)(delayed(case)(*job, args.size_range) for job in jobs)
     cases = pd.DataFrame(rows)
     if args.csv:
         cases.to_csv(args.csv, index=False)

@@ -75,8 +75,11 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
 
 
 def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task: str = "pick_place",
-         cycles: int = 4) -> Hidden:
+         cycles: int = 4, size_range: tuple[float, float] = SIZE_RANGE) -> Hidden:
     """Draw a hidden effect of kind ``effect`` (None: nothing) at a random size on random axes.
+
+    ``size_range`` bounds the size (effect torque RMS over the axis's nominal torque RMS); an axis
+    the physical bounds shrink below ``min(MIN_SIZE, 0.9 * size_range[0])`` is not drawn.
 
     Raises
     ------
@@ -92,7 +95,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         params = {str(a + 1): {name: float(rng.uniform(low, high))} for a in axes}
         return Hidden(effect, [a + 1 for a in axes], params, 0.0)
     motion, tau = nominal_motion(robot, task, cycles)
-    size = float(rng.uniform(*SIZE_RANGE))
+    size = float(rng.uniform(*size_range))
+    min_size = min(MIN_SIZE, 0.9 * size_range[0])
     scale = np.sqrt(np.mean(tau**2, axis=0))
     if not kind.per_axis:
         phi, _ = kind.columns(motion, None, None)
@@ -126,9 +130,9 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
                      _motor_share(kind.id, robot, axis, drawn, motion) / MOTOR_SHARE])
         params[str(axis + 1)] = kind.params(motion, axis, theta / excess, h)
         sizes[axis] = size / excess
-    eligible = [a for a in range(6) if sizes[a] >= MIN_SIZE]
+    eligible = [a for a in range(6) if sizes[a] >= min_size]
     if not eligible:
-        raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {MIN_SIZE} within {LIMITS}")
+        raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within {LIMITS}")
     n_axes = int(rng.integers(1, min(MAX_AXES, len(eligible)) + 1))
     axes = sorted(int(a) for a in rng.choice(eligible, size=n_axes, replace=False))
     return Hidden(effect, [a + 1 for a in axes], {str(a + 1): params[str(a + 1)] for a in axes},
