@@ -13,8 +13,11 @@ class) that knows
 * how it writes itself into the robot's MJCF (:meth:`Effect.apply` on a ``mujoco.MjSpec``).
 
 The torque an effect predicts and the torque the augmented model gives in
-:meth:`faultgen.robots.Robot.inverse_dynamics` are the same function (tests/test_calibrate_effects.py
-checks every effect), so the model the workflow writes reproduces what was fitted.
+:meth:`faultgen.robots.Robot.inverse_dynamics` are the same function (backlash: to first order in
+b; tests/test_calibrate_effects.py checks every effect), so the model the workflow writes
+reproduces what was fitted. The thesis has no calibration chapter: the friction effects refine
+its eq. 6.3 (Coulomb, viscous, Stribeck) and its wear model of eq. 6.6 (friction that changes
+with time); the others are the standard unmodelled effects of robot identification.
 
 All torques here are arm-side drive torques in N m (motor torque times the gear ratio G), the
 unit of the measured ``tau`` columns.
