@@ -154,7 +154,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     max_steps : int
         Most effects to add.
     progress : bool
-        Print one line per step.
+        Show a progress bar while the effects are fitted and print one line per step.
 
     Returns
     -------
@@ -194,7 +194,8 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             shutil.copyfile(tasks_file, Path(work) / "tasks.toml")
         for k in range(max_steps):
             motion = Motion.of(current, data.t, data.q, data.qd, data.qdd)
-            ranked = search.rank(motion, tau - predicted, tau, split)
+            ranked = search.rank(motion, tau - predicted, tau, split, progress=progress,
+                                 label=f"step {k + 1}: fitting effects")
             best = ranked[0]
             if not best.axes:
                 break

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import minimize_scalar
+from tqdm.auto import tqdm
 
 from faultgen.calibrate.effects import EFFECTS, REST_SPEED, Effect, Motion
 
@@ -190,9 +191,12 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     return Candidate(effect, axes, kept, gain, relative, np.where(mask, contribution, 0.0), params)
 
 
-def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> list[Candidate]:
-    """All effects fitted, best first per the selection rule of this module's docstring."""
-    candidates = [fit_effect(e, motion, residual, tau, split) for e in EFFECTS.values()]
+def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split, progress: bool = False,
+         label: str = "fitting effects") -> list[Candidate]:
+    """All effects fitted, best first per the selection rule of this module's docstring
+    (``progress``: a progress bar over the effects, labelled ``label``)."""
+    effects = tqdm(EFFECTS.values(), desc=label, unit="effect", disable=not progress, leave=False)
+    candidates = [fit_effect(e, motion, residual, tau, split) for e in effects]
     order = {e.id: k for k, e in enumerate(EFFECTS.values())}
     best = max(c.score for c in candidates)
 
