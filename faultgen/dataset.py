@@ -26,8 +26,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 from collections.abc import Iterable
 from contextlib import contextmanager
 from dataclasses import asdict
@@ -37,6 +35,7 @@ import h5py
 import numpy as np
 
 from faultgen import __version__, robots, sensors
+from faultgen.atomic import atomic_path
 
 FORMAT = "faultgen"
 FORMAT_VERSION = 1
@@ -109,29 +108,6 @@ def run_attributes(result, command: str = "") -> dict:
     }
 
 
-@contextmanager
-def _atomic(path: Path):
-    """Yield a temporary path beside ``path``; rename it onto ``path`` if the block succeeds."""
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise OSError(f"cannot write {path}: folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=folder)
-    os.close(fd)
-    try:
-        yield Path(tmp)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
     f.attrs["format"] = FORMAT
     f.attrs["format_version"] = FORMAT_VERSION
@@ -151,7 +127,7 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
         at ``path`` and no temporary file remains.
     """
     path = Path(path)
-    with _atomic(path) as tmp, h5py.File(tmp, "w") as f:
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
         _write_root(f, 1, command, "")
         f.attrs["complete"] = False
         group = f.create_group(f"runs/{run_id}")
@@ -183,7 +159,7 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
     """
     path = Path(path)
     parts = list(parts)
-    with _atomic(path) as tmp, h5py.File(tmp, "w") as out:
+    with atomic_path(path) as tmp, h5py.File(tmp, "w") as out:
         _write_root(out, len(parts), command, grid)
         out.attrs["complete"] = False
         runs = out.create_group("runs")

@@ -13,6 +13,7 @@ for backlash).
 """
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -73,6 +74,11 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     assert mass == pytest.approx(hidden.params["robot"]["mass_kg"], rel=0.05)
     assert step["evidence"]["scores"]["payload"] == pytest.approx(step["evidence"]["score"])
     assert (out / "calibration.png").stat().st_size > 10_000
+    mask = os.umask(0)
+    os.umask(mask)
+    for written in (out / "report.json", out / "model" / "puma560_calibrated.xml", out / "model" / "parameters.json"):
+        assert written.stat().st_mode & 0o777 == 0o666 & ~mask, written  # not mkstemp's 0600
+    assert not list(out.rglob("*.part")), "no temporary file is left behind"
     # the augmented model loads, carries the payload, and the simulator runs it
     model = robots.load(report["model_out"])
     nominal = robots.load("puma560")

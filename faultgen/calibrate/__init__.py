@@ -20,7 +20,6 @@ docs/calibration.md explains the method and lists its accuracy on hidden-effect 
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import tempfile
 from dataclasses import dataclass
@@ -29,8 +28,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen import atomic, robots
 from faultgen import measured as measured_io
-from faultgen import robots
 from faultgen.calibrate import gearbox, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.friction import FIELDS as FRICTION_FIELDS
@@ -215,8 +214,8 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             if progress:
                 print(f"step {k + 1}: {best.effect.id} on axes {steps[-1].axes}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
-        _write_atomic(model_out, Path(current.path).read_text())
-    _write_atomic(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
+        atomic.write_text(model_out, Path(current.path).read_text())
+    atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
 
     result = Calibration(
         robot=nominal.name,
@@ -232,7 +231,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         nominal=nominal_prediction,
         calibrated=predicted,
     )
-    _write_atomic(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
+    atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     from faultgen.calibrate import figure
 
     figure.save(result, out / "calibration.png")
@@ -286,12 +285,3 @@ def _evidence(best: search.Candidate, ranked: list[search.Candidate]) -> dict:
                                                        "axes": [a + 1 for a in runner_up.axes]},
         "scores": {c.effect.id: c.score for c in ranked},
     }
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file, so a crash never leaves half a file."""
-    path = Path(path)
-    with tempfile.NamedTemporaryFile("w", dir=path.parent, delete=False, suffix=".tmp") as handle:
-        handle.write(text)
-        tmp = Path(handle.name)
-    os.replace(tmp, path)
