@@ -321,7 +321,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     path = task.trajectory(sim.model.opt.timestep)
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
-    q_ref, qd_ref, qdd_ref = (_hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
+    q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
     inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
@@ -338,8 +338,9 @@ def _padded_steps(n: int, per_log: int) -> int:
     return -(-n // per_log) * per_log
 
 
-def _hold_end(a: np.ndarray, n_steps: int) -> np.ndarray:
-    """The path sampled at every physics step, holding its last sample to reach ``n_steps + 1``."""
+def hold_end(a: np.ndarray, n_steps: int) -> np.ndarray:
+    """The first ``n_steps + 1`` samples of a path ``a`` (n, ...), holding its last sample when it
+    is shorter (a task's path sampled at every physics step, or at every log period)."""
     if len(a) >= n_steps + 1:
         return a[: n_steps + 1]
     return np.vstack([a, np.repeat(a[-1:], n_steps + 1 - len(a), axis=0)])

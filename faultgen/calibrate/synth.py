@@ -64,11 +64,8 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
     duration = sim.cycle_duration(str(robot.path), task)
     path = tasks.load(robot, task).trajectory(sensors.LOG_PERIOD)
     n = round(duration / sensors.LOG_PERIOD)
-
-    def pad(a):  # hold the last sample to the cycle's end, as the simulator does
-        return np.vstack([a, np.repeat(a[-1:], max(n - len(a), 0), axis=0)])[:n]
-
-    q, qd, qdd = (np.tile(pad(a), (cycles, 1)) for a in (path.q, path.qd, path.qdd))
+    # the path held at its last sample to the cycle's end, as the simulator does
+    q, qd, qdd = (np.tile(sim.hold_end(a, n - 1), (cycles, 1)) for a in (path.q, path.qd, path.qdd))
     t = np.arange(len(q)) * sensors.LOG_PERIOD
     tau = robot.inverse_dynamics(q, qd, qdd, t=t)
     return Motion.of(robot, t, q, qd, qdd), tau
