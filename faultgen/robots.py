@@ -246,8 +246,7 @@ class Robot:
             # Quasi-static dead band: q is the motor angle over G, and the arm trails it by b/2
             # against the gearbox load; the arm's rigid-body terms are taken there.
             q_arm = q - self.backlash / 2 * np.sign(load)
-            arm, load = self._rigid(q_arm, qd, qdd, q_motor=q)
-            tau = arm
+            tau, load = self._rigid(q_arm, qd, qdd, q_motor=q)
         if friction:
             tau += G * self.friction.stribeck_torque(G * qd)
             tau += self.effect_torque(q, qd, load, t)

@@ -420,12 +420,13 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
     dt = model.opt.timestep
     run_start = (cycles[:, None] - 1) * n_steps * dt  # thermal drift runs over the whole run
     thermal = np.any(robot.thermal[:, 0])
+    load_friction = np.any(robot.load_friction)
     for step in range(n_steps):
         level = multiplier
         if thermal:
             level = multiplier * (1 + robot.thermal[:, 0] * np.exp(-(run_start + step * dt) / robot.thermal[:, 1]))
         frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
-        if np.any(robot.load_friction):  # gearbox load from the spring deflection (eq. 6.2a)
+        if load_friction:  # gearbox load from the spring deflection (eq. 6.2a)
             deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
             frictionloss[:, rotor] += robot.load_friction * np.abs(K * deflection) / G
         ctrl[:, sim.drive_ctrl] = inputs[step]
