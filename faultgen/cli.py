@@ -204,11 +204,10 @@ def calibrate_command(
       faultgen calibrate --robot puma560 --measured log.csv --out calib
     """
     from faultgen import calibrate
-    from faultgen.measured import MeasuredDataError
 
     try:
         result = calibrate.calibrate(robot, measured, out, max_steps=max_steps, progress=True)
-    except (robots.UnknownRobotError, robots.ModelError, MeasuredDataError, ValueError) as err:
+    except ValueError as err:  # unknown robot, bad model file, refused measured data, bad option
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
     typer.echo(result.summary())

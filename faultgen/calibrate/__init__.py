@@ -183,7 +183,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     current = nominal
-    predicted = predict(nominal, data)
+    predicted, motion = _predict(nominal, data)
     nominal_prediction = predicted
     gap_before = search.gap(tau, predicted, split.held_out)
     steps: list[Step] = []
@@ -192,7 +192,6 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         if tasks_file.is_file():
             shutil.copyfile(tasks_file, Path(work) / "tasks.toml")
         for k in range(max_steps):
-            motion = Motion.of(current, data.t, data.q, data.qd, data.qdd)
             ranked = search.rank(motion, tau - predicted, tau, split, progress=progress,
                                  label=f"step {k + 1}: fitting effects")
             best = ranked[0]
@@ -203,12 +202,12 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             trial_path = Path(work) / model_out.name
             trial_path.write_text(spec.to_xml())
             trial = robots.load(trial_path)
-            trial_prediction = predict(trial, data)
+            trial_prediction, trial_motion = _predict(trial, data)
             after = search.gap(tau, trial_prediction, split.held_out)
             previous = steps[-1].gap_after if steps else gap_before
             if after["total_nrmse"] >= previous["total_nrmse"]:
                 break  # the written model does not do what the fit promised: stop, keep what works
-            current, predicted = trial, trial_prediction
+            current, predicted, motion = trial, trial_prediction, trial_motion
             steps.append(Step(best.effect.id, [a + 1 for a in best.axes], best.params,
                               _evidence(best, ranked), after))
             if progress:
@@ -245,10 +244,14 @@ def predict(robot: robots.Robot, data: measured_io.MeasuredData) -> np.ndarray:
     model's optional effects, time from the first sample) plus the torque of the flexible
     gearboxes (:func:`faultgen.calibrate.gearbox.compliance_torque`).
     """
-    t = data.t - data.t[0]
-    rigid = robot.inverse_dynamics(data.q, data.qd, data.qdd, t=t)
-    load = Motion.of(robot, data.t, data.q, data.qd, data.qdd).load
-    return rigid + gearbox.compliance_torque(robot, data.t, data.q, load)
+    return _predict(robot, data)[0]
+
+
+def _predict(robot: robots.Robot, data: measured_io.MeasuredData) -> tuple[np.ndarray, Motion]:
+    """:func:`predict` and the :class:`Motion` it evaluated (the search fits effects on it)."""
+    motion = Motion.of(robot, data.t, data.q, data.qd, data.qdd)
+    rigid = robot.inverse_dynamics(data.q, data.qd, data.qdd, t=motion.t)
+    return rigid + gearbox.compliance_torque(robot, data.t, data.q, motion.load), motion
 
 
 def parameters(robot: robots.Robot) -> dict:
