@@ -6,7 +6,8 @@ noise written as a measured CSV, and the workflow given only that file and the r
 case is *named* when the first effect added is the hidden one on exactly the hidden axes (for
 no hidden effect: when nothing is added), and *closed* when the held-out total nrmse is at most
 half of what it was. Prints a markdown table (docs/calibration.md holds the one measured) and
-writes every case to a CSV.
+writes every case to a CSV. The table's last column bounds what any model could do: the gap of
+the log with nothing hidden (same seed) over the gap before.
 
     python benchmarks/calibration_accuracy.py --seeds 5 --jobs 2 --csv calibration_cases.csv
     python benchmarks/calibration_accuracy.py --size-range 0.1 0.3    # smaller effects
@@ -50,16 +51,24 @@ def case(robot_name: str, effect: str | None, seed: int, size_range=synth.SIZE_R
 
 
 def table(cases: pd.DataFrame) -> str:
-    """Markdown: per robot and effect, named correctly and gap closed, counts and median ratio."""
-    lines = ["| effect | robot | named first, right axes | gap halved | median after/before |",
-             "| --- | --- | --- | --- | --- |"]
+    """Markdown: per robot and effect, named correctly and gap closed, counts and median ratio.
+
+    The last column is the smallest ratio a perfect model of the hidden effect could reach: the
+    gap of the log with nothing hidden (same robot and seed, so the same noise and disturbance)
+    over the gap before.
+    """
+    null = cases[cases.effect == "none"].set_index(["robot", "seed"]).gap_before
+    floor = cases.apply(lambda c: null.get((c.robot, c.seed), np.nan) / c.gap_before, axis=1)
+    lines = ["| effect | robot | named first, right axes | gap halved | median after/before | median floor/before |",
+             "| --- | --- | --- | --- | --- | --- |"]
     order = ["none", *EFFECTS]
     for effect in order:
         for robot_name, group in cases[cases.effect == effect].groupby("robot", sort=False):
             n = len(group)
             ratio = "-" if effect == "none" else f"{group.ratio.median():.2f}"
+            best = "-" if effect == "none" else f"{floor[group.index].median():.2f}"
             closed = "-" if effect == "none" else f"{group.closed.sum()}/{n}"
-            lines.append(f"| {effect} | {robot_name} | {group.named.sum()}/{n} | {closed} | {ratio} |")
+            lines.append(f"| {effect} | {robot_name} | {group.named.sum()}/{n} | {closed} | {ratio} | {best} |")
     return "\n".join(lines)
 
 

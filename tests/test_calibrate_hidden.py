@@ -8,8 +8,8 @@ on the hidden axes, and cut the held-out total nrmse at least in half. Without a
 it must name nothing.
 
 Backlash is not among them: the workflow models it quasi-statically and does not find it in
-simulated dead bands (docs/calibration.md, accuracy table; the issue's requirement is not met
-for backlash).
+simulated dead bands, and in half of the cases even a perfect model could not halve the gap
+(docs/calibration.md, accuracy table; the issue's requirement is not met for backlash).
 """
 
 import json
@@ -27,9 +27,14 @@ FOUND = [e for e in EFFECTS if e != "backlash"]
 HALF = 0.5
 #: ... except where it is not met. IRB-6700-like cogging: named right, on the right axes, but the
 #: drive sees the detent torque through the soft gearboxes' resonances, so a constant-amplitude
-#: sinusoid in the motor angle leaves part of it (seed 0: 0.146 -> 0.084, ratio 0.58). The
+#: sinusoid in the motor angle leaves part of it (seed 0: 0.134 -> 0.075, ratio 0.55). The
 #: shortfall is reported in docs/calibration.md; this bound keeps it from getting worse.
-SHORT = {("irb6700", "cogging"): 0.65}
+SHORT = {("irb6700", "cogging"): 0.6}
+#: Held-out total nrmse of the nominal model on a log with nothing hidden (seeds 0-4: PUMA 560
+#: 0.0131-0.0133, IRB-6700-like 0.0228-0.0232, docs/calibration.md). Simulated at the robot
+#: models' 0.5 ms step instead of synth.TIMESTEP, the integrator's extra inertia raised them to
+#: 0.025 and 0.039.
+FLOOR = {"puma560": 0.015, "irb6700": 0.026}
 
 
 def hidden_case(tmp_path, robot_name, effect, seed=SEED):
@@ -54,6 +59,7 @@ def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_n
 def test_nothing_hidden_names_nothing(tmp_path, robot_name):
     _, result = hidden_case(tmp_path, robot_name, None)
     assert result.steps == [], result.summary()
+    assert result.gap_before["total_nrmse"] < FLOOR[robot_name]
     assert result.gap_after == result.gap_before
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert report["steps"] == []

@@ -17,7 +17,7 @@ numerical damping) in sub-steps of at most :data:`SUBSTEP`, the load interpolate
 between samples.
 
 On hidden-effect data of the IRB-6700-like arm (locked-arm resonances 10-25 Hz) this takes the
-held-out nrmse of a log with nothing hidden from 0.047 / 0.068 to 0.025 / 0.047 on axes 1 / 2;
+held-out nrmse of a log with nothing hidden from 0.039 / 0.062 to 0.014 / 0.045 on axes 1 / 2;
 on the stiffer PUMA 560 it changes less than 0.001 (docs/calibration.md).
 """
 
