@@ -11,6 +11,7 @@ the log with nothing hidden (same seed) over the gap before.
 
     python benchmarks/calibration_accuracy.py --seeds 5 --jobs 2 --csv calibration_cases.csv
     python benchmarks/calibration_accuracy.py --size-range 0.1 0.3    # smaller effects
+    python benchmarks/calibration_accuracy.py --effects backlash --robots irb6700
 """
 
 from __future__ import annotations
@@ -61,7 +62,7 @@ def table(cases: pd.DataFrame) -> str:
     floor = cases.apply(lambda c: null.get((c.robot, c.seed), np.nan) / c.gap_before, axis=1)
     lines = ["| effect | robot | named first, right axes | gap halved | median after/before | median floor/before |",
              "| --- | --- | --- | --- | --- | --- |"]
-    order = ["none", *EFFECTS]
+    order = ["none", *(e for e in EFFECTS if e in set(cases.effect))]
     for effect in order:
         for robot_name, group in cases[cases.effect == effect].groupby("robot", sort=False):
             n = len(group)
@@ -79,8 +80,11 @@ def main() -> None:
     parser.add_argument("--csv", type=Path, default=None, help="write every case here")
     parser.add_argument("--size-range", type=float, nargs=2, default=synth.SIZE_RANGE, metavar=("LOW", "HIGH"),
                         help="effect torque RMS over the axis's torque RMS (default: %(default)s)")
+    parser.add_argument("--effects", nargs="+", choices=list(EFFECTS), default=list(EFFECTS), metavar="ID",
+                        help="effect ids to hide (default: all); the null case always runs, for the floor")
+    parser.add_argument("--robots", nargs="+", choices=["puma560", "irb6700"], default=["puma560", "irb6700"])
     args = parser.parse_args()
-    jobs = [(r, e, s) for r in ("puma560", "irb6700") for e in (None, *EFFECTS) for s in range(args.seeds)]
+    jobs = [(r, e, s) for r in args.robots for e in (None, *args.effects) for s in range(args.seeds)]
     started = time.perf_counter()
     rows = Parallel(n_jobs=args.jobs, verbose=5)(delayed(case)(*job, args.size_range) for job in jobs)
     cases = pd.DataFrame(rows)

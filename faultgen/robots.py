@@ -218,7 +218,8 @@ class Robot:
             load-dependent friction, warm-up drift). Backlash ``b`` (without a friction flag) is
             taken quasi-statically: ``q`` is read as the motor angle over G and the arm's
             rigid-body terms are evaluated at ``q - (b/2) sign(load)``, where the arm rests on
-            the loaded flank. The transients of crossing the dead band are not modelled.
+            the loaded flank. Crossing the dead band is a matter of the flexible gearbox
+            (:func:`faultgen.calibrate.gearbox.compliance_torque`), not of this rigid model.
         t : ndarray of shape (n,), optional
             Time since the start of the run in s, for the warm-up drift (:attr:`thermal`);
             zero when omitted.
@@ -251,6 +252,28 @@ class Robot:
             tau += G * self.friction.stribeck_torque(G * qd)
             tau += self.effect_torque(q, qd, load, t)
         return tau
+
+    def gearbox_load(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Arm-side load the gearboxes carry along a motion, N m, shape (n, 6).
+
+        The rigid-body torque of the arm joints (thesis eq. 6.1 without motor inertia and
+        friction) with the arm at the motor angle ``q`` (no backlash shift); the input of the
+        flexible-gearbox equation (:mod:`faultgen.calibrate.gearbox`).
+
+        Parameters
+        ----------
+        q, qd, qdd : ndarray of shape (n, 6)
+            Joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
+
+        Raises
+        ------
+        ValueError
+            As :meth:`inverse_dynamics`.
+        """
+        q = _check_trajectory("q", q)
+        qd = _check_trajectory("qd", qd, q.shape[0])
+        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        return self._rigid(q, qd, qdd)[1]
 
     def _rigid(self, q, qd, qdd, q_motor=None) -> tuple[np.ndarray, np.ndarray]:
         """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``

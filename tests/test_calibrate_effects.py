@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from faultgen import robots, sim
-from faultgen.calibrate import effects, synth
+from faultgen.calibrate import effects, gearbox, synth
 
 ROBOTS = ("puma560", "irb6700")
 
@@ -162,19 +162,43 @@ def test_library_holds_the_design_ids():
                                     "load_dependent_friction", "temperature", "torque_offset"}
 
 
-def test_backlash_term_is_the_first_order_shift_of_the_written_model(setup, tmp_path):
-    """Quasi-static backlash: the written dead band shifts the arm by b/2 against the load; the
-    regressor is the first-order change of the axis's torque, exact as b -> 0."""
+def prediction(robot, motion):
+    """:func:`faultgen.calibrate.predict` along a motion: inverse dynamics plus gearbox equation."""
+    m = effects.Motion.of(robot, motion.t, motion.q, motion.qd, motion.qdd)
+    return (robot.inverse_dynamics(m.q, m.qd, m.qdd, t=m.t)
+            + gearbox.compliance_torque(robot, m.t, m.q, m.load))
+
+
+def test_backlash_torque_is_the_written_models_torque(setup, tmp_path):
+    """The dead band's torque (gearbox equation plus quasi-static shift) is what the model it
+    writes predicts, up to the first-order treatment of the shift."""
     robot, motion = setup
     effect = effects.get("backlash")
-    axis, b = 1, 1e-3
-    phi, offset = effect.columns(motion, axis, None)
+    axis, b = 1, 0.01
+    phi, offset = effect.columns(motion, axis, b)
+    assert phi.shape == (len(motion.t), 0)
     new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
     assert new.backlash[axis] == pytest.approx(b, rel=1e-5)
-    change = (new.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
-              - robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False))[:, axis]
-    fitted = phi[:, 0] * b + offset
-    assert np.max(np.abs(fitted)) > 1e-3
-    # away from load reversals (where sign(load) may differ between the two models)
-    steady = np.abs(motion.load[:, axis]) > 0.05 * np.max(np.abs(motion.load[:, axis]))
-    np.testing.assert_allclose(change[steady], fitted[steady], atol=0.02 * np.max(np.abs(fitted)))
+    change = prediction(new, motion) - prediction(robot, motion)
+    scale = np.max(np.abs(change[:, axis]))
+    assert np.sqrt(np.mean(change[:, axis] ** 2)) > 0.05 * np.sqrt(np.mean(prediction(robot, motion)[:, axis] ** 2))
+    np.testing.assert_allclose(change[:, axis], offset, atol=0.02 * scale)
+
+
+def test_backlash_search_recovers_the_width(setup):
+    """Round trip: a residual made of a dead band of known width on one axis, plus noise; the
+    two-pass search finds that width to 1 %."""
+    _, motion = setup
+    effect = effects.get("backlash")
+    axis, b = 1, 0.0123
+    _, change = effect.columns(motion, axis, b)
+    residual = np.zeros_like(motion.q)
+    rng = np.random.default_rng(0)
+    residual[:, axis] = change + 0.05 * np.std(change) * rng.normal(size=len(change))
+    rows = np.ones_like(residual, dtype=bool)
+    found = effect.search(motion, residual, rows)
+    assert found[axis][0] == pytest.approx(b, rel=0.01)
+    np.testing.assert_allclose(found[axis][2], change, atol=0.05 * np.max(np.abs(change)))
+    assert found[axis][1].shape == (0,)
+
+

@@ -158,8 +158,12 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     contribution = np.zeros_like(residual)
     params: dict = {}
     if effect.per_axis:
+        own = effect.search(motion, residual, fit)
         for axis in range(residual.shape[1]):
-            _, h, theta, predicted = _fit_axis(effect, motion, residual[:, axis], fit[:, axis], axis)
+            if own is None:
+                _, h, theta, predicted = _fit_axis(effect, motion, residual[:, axis], fit[:, axis], axis)
+            else:
+                h, theta, predicted = own[axis]
             contribution[:, axis] = predicted
             params[str(axis + 1)] = effect.params(motion, axis, theta, h)
     else:

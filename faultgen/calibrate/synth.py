@@ -40,10 +40,13 @@ MOTOR_SHARE = 0.4
 MIN_SIZE = 0.45
 #: Torque-sensor noise, standard deviation as a fraction of each axis's torque RMS.
 TORQUE_NOISE = 0.01
-#: Effects drawn by a physical parameter range instead of a torque size: id -> (name, low, high).
-#: Backlash has no torque size of its own (its quasi-static torque is tiny; see
-#: :class:`faultgen.calibrate.effects.Backlash`): 0.3 to 1.1 degrees at the arm.
-PHYSICAL = {"backlash": ("backlash_rad", 0.005, 0.02)}
+#: Effects drawn by a physical parameter range instead of a torque size: id -> (name, low, high,
+#: smallest size). Backlash is not linear in its width, so the width is drawn (0.3 to 1.1 degrees
+#: at the arm) and an axis is eligible when the torque the dead band changes along the nominal
+#: task (its :meth:`~faultgen.calibrate.effects.Effect.columns`) has an RMS of at least the
+#: smallest size times the axis's torque RMS: a dead band on an axis whose load never reverses,
+#: or too fast for the gearbox equation to follow, leaves no trace to find.
+PHYSICAL = {"backlash": ("backlash_rad", 0.005, 0.02, 0.15)}
 #: Most axes an effect is hidden on.
 MAX_AXES = 3
 #: Physics step of the hidden-effect simulation, s (the robot models use 0.5 ms). MuJoCo's
@@ -93,15 +96,19 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     if effect is None:
         return Hidden(None)
     kind = get(effect)
-    if effect in PHYSICAL:
-        name, low, high = PHYSICAL[effect]
-        axes = sorted(int(a) for a in rng.choice(6, size=int(rng.integers(1, MAX_AXES + 1)), replace=False))
-        params = {str(a + 1): {name: float(rng.uniform(low, high))} for a in axes}
-        return Hidden(effect, [a + 1 for a in axes], params, 0.0)
     motion, tau = nominal_motion(robot, task, cycles)
+    scale = np.sqrt(np.mean(tau**2, axis=0))
+    if effect in PHYSICAL:
+        name, low, high, min_size = PHYSICAL[effect]
+        params, sizes = {}, np.zeros(6)
+        for axis in range(6):
+            value = float(rng.uniform(low, high))
+            _, change = kind.columns(motion, axis, value)
+            params[str(axis + 1)] = {name: value}
+            sizes[axis] = np.sqrt(np.mean(change**2)) / scale[axis]
+        return _choose(robot, effect, rng, params, sizes, min_size)
     size = float(rng.uniform(*size_range))
     min_size = min(MIN_SIZE, 0.9 * size_range[0])
-    scale = np.sqrt(np.mean(tau**2, axis=0))
     if not kind.per_axis:
         phi, _ = kind.columns(motion, None, None)
         relative = np.sqrt(np.mean(phi[:, :, 0] ** 2, axis=0)) / scale
@@ -134,6 +141,12 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
                      _motor_share(kind.id, robot, axis, drawn, motion) / MOTOR_SHARE])
         params[str(axis + 1)] = kind.params(motion, axis, theta / excess, h)
         sizes[axis] = size / excess
+    return _choose(robot, effect, rng, params, sizes, min_size)
+
+
+def _choose(robot: robots.Robot, effect: str, rng: np.random.Generator, params: dict, sizes: np.ndarray,
+            min_size: float) -> Hidden:
+    """1 to :data:`MAX_AXES` random axes among those whose drawn effect has ``sizes >= min_size``."""
     eligible = [a for a in range(6) if sizes[a] >= min_size]
     if not eligible:
         raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within {LIMITS}")
