@@ -296,8 +296,12 @@ class Robot:
             tau[k] = load[k] + G * data.qfrc_inverse[self.rotor_dof]
         return tau, load
 
-    def arm_inertia(self, q: np.ndarray) -> np.ndarray:
-        """Diagonal of the arm's joint-space inertia matrix (rotors excluded), kg m^2, shape (n, 6).
+    def arm_mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """The arm's joint-space inertia matrix (rotor spin excluded), kg m^2, shape (n, 6, 6).
+
+        The arm block of MuJoCo's mass matrix (``mj_fullM``) with the rotors at ``G q``: what
+        the arm joints' torques need per unit arm acceleration with the rotors held (thesis eq.
+        6.1's ``M(q)``; the rotors' masses ride on the links and are included).
 
         Parameters
         ----------
@@ -307,13 +311,14 @@ class Robot:
         q = _check_trajectory("q", q)
         model, data = self._inverse
         full = np.zeros((model.nv, model.nv))
-        out = np.empty_like(q)
+        out = np.empty((q.shape[0], N_AXES, N_AXES))
+        block = np.ix_(self.arm_dof, self.arm_dof)
         for k in range(q.shape[0]):
             data.qpos[self.arm_qpos] = q[k]
             data.qpos[self.rotor_qpos] = self.gear_ratio * q[k]
             mujoco.mj_fwdPosition(model, data)
             mujoco.mj_fullM(model, data, full)
-            out[k] = full[self.arm_dof, self.arm_dof]
+            out[k] = full[block]
         return out
 
     def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None

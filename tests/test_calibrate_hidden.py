@@ -7,9 +7,10 @@ CSV; the workflow gets only that file and the robot name. It must name the hidde
 on the hidden axes, and cut the held-out total nrmse at least in half. Without a hidden effect
 it must name nothing.
 
-Backlash is not among them: the workflow models it quasi-statically and does not find it in
-simulated dead bands, and in half of the cases even a perfect model could not halve the gap
-(docs/calibration.md, accuracy table; the issue's requirement is not met for backlash).
+Backlash on the PUMA 560 is not among them: the issue's requirement is not met there. Its stiff
+gearboxes turn a dead band into impacts at load reversals that the gearbox equation does not
+reproduce, and a dead band the size of the drawn ones changes the held-out total nrmse to at
+most 2.5 times the floor, so even a perfect model could hardly halve it (docs/calibration.md).
 """
 
 import json
@@ -22,14 +23,18 @@ from faultgen import measured, robots, sim
 from faultgen.calibrate import EFFECTS, calibrate, synth
 
 SEED = 0
-FOUND = [e for e in EFFECTS if e != "backlash"]
+CASES = [(robot_name, effect) for robot_name in ("puma560", "irb6700") for effect in EFFECTS
+         if (robot_name, effect) != ("puma560", "backlash")]
 #: Required held-out gap ratio (after / before): the issue's "at least in half" ...
 HALF = 0.5
 #: ... except where it is not met. IRB-6700-like cogging: named right, on the right axes, but the
 #: drive sees the detent torque through the soft gearboxes' resonances, so a constant-amplitude
 #: sinusoid in the motor angle leaves part of it (seed 0: 0.134 -> 0.075, ratio 0.55). The
 #: shortfall is reported in docs/calibration.md; this bound keeps it from getting worse.
-SHORT = {("irb6700", "cogging"): 0.6}
+#: IRB-6700-like backlash, seed 0 (dead bands of 14.6 and 9.0 mrad on axes 1 and 2): named right,
+#: widths 14.0 and 6.3 mrad, 0.210 -> 0.109 (ratio 0.52); the gearbox equation at the true
+#: widths does no better (0.114), so the shortfall is the model's, not the search's.
+SHORT = {("irb6700", "cogging"): 0.6, ("irb6700", "backlash"): 0.55}
 #: Held-out total nrmse of the nominal model on a log with nothing hidden (seeds 0-4: PUMA 560
 #: 0.0131-0.0133, IRB-6700-like 0.0228-0.0232, docs/calibration.md). Simulated at the robot
 #: models' 0.5 ms step instead of synth.TIMESTEP, the integrator's extra inertia raised them to
@@ -44,8 +49,7 @@ def hidden_case(tmp_path, robot_name, effect, seed=SEED):
     return hidden, calibrate(robot_name, path, tmp_path / "out")
 
 
-@pytest.mark.parametrize("robot_name", ["puma560", "irb6700"])
-@pytest.mark.parametrize("effect", FOUND)
+@pytest.mark.parametrize(("robot_name", "effect"), CASES)
 def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_name, effect):
     hidden, result = hidden_case(tmp_path, robot_name, effect)
     assert result.steps, f"nothing found; hidden {hidden}"

@@ -158,7 +158,7 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     contribution = np.zeros_like(residual)
     params: dict = {}
     if effect.per_axis:
-        own = effect.search(motion, residual, fit)
+        own = effect.search(motion, residual, fit, scale)
         for axis in range(residual.shape[1]):
             if own is None:
                 _, h, theta, predicted = _fit_axis(effect, motion, residual[:, axis], fit[:, axis], axis)
