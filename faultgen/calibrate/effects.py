@@ -337,10 +337,10 @@ class Backlash(Effect):
     IRB-6700-like axis 2 changes the torque of axis 3 through the arm's inertia. :meth:`search`
     therefore adds dead bands one axis at a time (coordinate-wise): every axis the gearbox
     equation integrates and not yet chosen is tried at every width of :data:`GRID` (geometric,
-    steps of 4.5 %; all in one pass of the equation), the best is refined over :data:`REFINE`
-    widths between its neighbours (steps of 0.3 %), and it is kept when it lowers the fitting
-    part's error over all axes (each weighted by its torque RMS) by at least :data:`MIN_DROP`;
-    then the next axis. An axis the equation does not integrate gets only the quasi-static
+    steps of 6 %; all in one pass of the equation), the best is refined over :data:`REFINE`
+    widths between its neighbours (steps of 0.4 %), and it is kept when it lowers the fitting
+    part's error over all axes (each weighted by its torque RMS) by at least :data:`MIN_DROP`
+    and lies inside the searched range; then the next axis. An axis the equation does not integrate gets only the quasi-static
     shift, fitted on its own. The held-out error is sharp in b (an IRB-6700-like log with
     b = 19.3 mrad on axis 2: total nrmse 0.080 at 17.1 mrad, 0.047 at 18.4, 0.124 at 19.9), so a
     coarse grid alone misses it.
@@ -350,7 +350,7 @@ class Backlash(Effect):
     summary = "gearbox backlash (dead band between motor and arm)"
     n_parameters = 0
     #: Dead-band widths searched first, rad at the arm side: 0.2 mrad (0.7 arcmin) to 50 mrad (2.9 deg).
-    GRID = tuple(float(b) for b in np.geomspace(2e-4, 0.05, 128))
+    GRID = tuple(float(b) for b in np.geomspace(2e-4, 0.05, 96))
     #: Widths in the second pass, between the best grid width's neighbours.
     REFINE = 33
     #: Smallest relative drop of the weighted fitting error for which a dead band on one more
@@ -412,7 +412,7 @@ class Backlash(Effect):
             changes = self._change(motion, fine)
             costs = cost(changes)
             j = int(np.argmin(costs))
-            if costs[j] > (1 - self.MIN_DROP) * error:
+            if costs[j] > (1 - self.MIN_DROP) * error or not self._identified(fine[j, axis]):
                 break
             widths, change, error = fine[j], changes[j], float(costs[j])
             free.remove(axis)
@@ -433,7 +433,11 @@ class Backlash(Effect):
         # the smallest width's ringing at load reversals stood in for stick-slip ringing, and
         # took axis 2 of the IRB-6700-like arm from 0.046 to 0.032)
         b = params["backlash_rad"]
-        return self.GRID[1] < b < self.GRID[-2] and b != motion.robot.backlash[axis]
+        return self._identified(b) and b != motion.robot.backlash[axis]
+
+    def _identified(self, width: float) -> bool:
+        """False for a width at either end of :data:`GRID` (the optimum may lie outside it)."""
+        return self.GRID[1] < width < self.GRID[-2]
 
     def apply(self, spec, robot, axis, params):
         half = max(params["backlash_rad"], 0.0) / 2
