@@ -10,7 +10,7 @@ it must name nothing.
 Backlash on the PUMA 560 is not among them: the issue's requirement is not met there. Its stiff
 gearboxes turn a dead band into impacts at load reversals that the gearbox equation does not
 reproduce, and a dead band the size of the drawn ones changes the held-out total nrmse to at
-most 2.5 times the floor, so even a perfect model could hardly halve it (docs/calibration.md).
+most 2.6 times the floor, so even a perfect model could hardly halve it (docs/calibration.md).
 """
 
 import json

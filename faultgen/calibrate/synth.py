@@ -87,7 +87,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     """Draw a hidden effect of kind ``effect`` (None: nothing) at a random size on random axes.
 
     ``size_range`` bounds the size (effect torque RMS over the axis's nominal torque RMS); an axis
-    the physical bounds shrink below ``min(MIN_SIZE, 0.9 * size_range[0])`` is not drawn.
+    the physical bounds shrink below ``min(MIN_SIZE, 0.9 * size_range[0])`` is not drawn. An
+    effect of :data:`PHYSICAL` (backlash) is drawn by its parameter instead, on axes where it shows.
 
     Raises
     ------
