@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots, sim
+from faultgen import calibrate, robots, sim
 from faultgen.calibrate import effects, gearbox, synth
 
 ROBOTS = ("puma560", "irb6700")
@@ -163,10 +163,9 @@ def test_library_holds_the_design_ids():
 
 
 def prediction(robot, motion):
-    """:func:`faultgen.calibrate.predict` along a motion: inverse dynamics plus gearbox equation."""
-    m = effects.Motion.of(robot, motion.t, motion.q, motion.qd, motion.qdd)
-    return (robot.inverse_dynamics(m.q, m.qd, m.qdd, t=m.t)
-            + gearbox.compliance_torque(robot, m.t, m.q, m.load))
+    """:func:`faultgen.calibrate.predict` along a motion (it reads the ``t, q, qd, qdd`` a
+    :class:`Motion` has as a measured file has them)."""
+    return calibrate.predict(robot, motion)
 
 
 def test_backlash_torque_is_the_written_models_torque(setup, tmp_path):
@@ -179,9 +178,10 @@ def test_backlash_torque_is_the_written_models_torque(setup, tmp_path):
     assert phi.shape == (len(motion.t), 0)
     new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
     assert new.backlash[axis] == pytest.approx(b, rel=1e-5)
-    change = prediction(new, motion) - prediction(robot, motion)
+    nominal = prediction(robot, motion)
+    change = prediction(new, motion) - nominal
     scale = np.max(np.abs(change[:, axis]))
-    assert np.sqrt(np.mean(change[:, axis] ** 2)) > 0.05 * np.sqrt(np.mean(prediction(robot, motion)[:, axis] ** 2))
+    assert np.sqrt(np.mean(change[:, axis] ** 2)) > 0.05 * np.sqrt(np.mean(nominal[:, axis] ** 2))
     np.testing.assert_allclose(change[:, axis], offset, atol=0.02 * scale)
 
 
@@ -194,9 +194,10 @@ def test_backlash_search_recovers_the_width(setup, tmp_path):
     effect = effects.get("backlash")
     axis, b = 1, 0.0123
     new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
-    change = prediction(new, motion) - prediction(robot, motion)
+    nominal = prediction(robot, motion)
+    change = prediction(new, motion) - nominal
     rng = np.random.default_rng(0)
-    scale = np.sqrt(np.mean(prediction(robot, motion) ** 2, axis=0))
+    scale = np.sqrt(np.mean(nominal**2, axis=0))
     residual = change + 0.01 * scale * rng.normal(size=change.shape)  # 1 % torque noise
     found = effect.search(motion, residual, np.ones_like(residual, dtype=bool), scale)
     assert found[axis][0] == pytest.approx(b, rel=0.01)
