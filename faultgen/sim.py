@@ -3,7 +3,10 @@
 Only the cycles that are recorded are simulated. Each starts from the task's start state (at
 rest, gearboxes deflected by the static load, drives on their set-points) with its own wear
 level, so cycles are independent: they are stepped together as the simulations of one
-``mujoco.batch.Batch``, one per cycle, with the wear as per-simulation model fields.
+``mujoco.batch.Batch``, one per cycle, with the wear as per-simulation model fields. A run
+without wear can instead step its cycles back to back in one simulation (``back_to_back``), each
+cycle starting from the state the previous one ended in, as a robot's own log runs on: the
+hidden-effect logs of the calibration do (:mod:`faultgen.calibrate.synth`).
 
 With the ``lugre`` friction model everything that runs at the physics rate (the PID drives,
 LuGre friction, the gearboxes) runs inside MuJoCo, and Python only hands over pre-computed
@@ -63,13 +66,18 @@ class RunConfig:
         Disturbance and encoder noise levels.
     nthread : int
         Threads for stepping (0: all CPUs).
+    back_to_back : bool
+        Step the cycles one after the other in one simulation, each starting where the previous
+        one ended (gearbox deflections, backlash flanks, drive integrators carry over), instead of
+        each from the start state. Only without wear and with every cycle recorded.
 
     Raises
     ------
     ValueError
         On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
-        1..cycles, a negative seed or nthread; the message names the value.
+        1..cycles, a negative seed or nthread, or ``back_to_back`` with wear or a ``record``
+        subset; the message names the value.
     """
 
     robot: str
@@ -81,6 +89,7 @@ class RunConfig:
     seed: int = 0
     noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
     nthread: int = 0
+    back_to_back: bool = False
 
     def __post_init__(self) -> None:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
@@ -101,6 +110,10 @@ class RunConfig:
             raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
         if self.nthread < 0:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
+        if self.back_to_back and (self.wear.schedules or self.record not in (None, tuple(range(1, self.cycles + 1)))):
+            raise ValueError("back_to_back runs step every cycle in one simulation without wear; got wear on "
+                             f"axes {list(self.wear.schedules)} and record = {self.record!r}: drop the wear "
+                             "and record, or run the cycles independently")
 
     @property
     def recorded_cycles(self) -> np.ndarray:
@@ -254,12 +267,16 @@ def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.nda
     """``qpos`` and ``qvel`` at rest at arm angles ``q0`` with drives on their set-points.
 
     The motors sit at ``G q0`` and each gearbox carries the static load: the arm sags by
-    ``tau_static / K`` (thesis eq. 6.2a), so a cycle starts in equilibrium.
+    ``tau_static / K`` (thesis eq. 6.2a), and with backlash ``b`` it rests on the loaded flank,
+    ``b / 2`` further, so a cycle starts in equilibrium. An axis without static load (a vertical
+    base axis) starts in the middle of its dead band.
     """
     qpos, qvel = robot.rigid_state(q0)
     zeros = np.zeros((1, 6))
     static = robot.inverse_dynamics(q0[None], zeros, zeros, friction=False)[0]
-    qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness
+    # a load at round-off level (gravity on a vertical axis) has no side to rest on
+    side = np.sign(static) * (np.abs(static) > 1e-9 * max(float(np.abs(static).max()), 1.0))
+    qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness - side * robot.backlash / 2
     return qpos, qvel
 
 
@@ -288,10 +305,16 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
               desc=f"{robot.name} {config.task}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
               "[{elapsed}<{remaining}]") as bar:
         started = time.perf_counter()
-        groups = [slice(i, i + BATCH_CYCLES) for i in range(0, len(cycles), BATCH_CYCLES)]
-        raws = [stepper(sim, config, cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, bar)
-                for g in groups]
-        raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws]) for f in fields(_Raw)})
+        if config.back_to_back:  # one simulation over the cycles' set-points one after the other
+            chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
+            one = stepper(sim, config, cycles[:1], multiplier[:1], path.q[0], chained,
+                          dist.reshape(1, -1, dist.shape[-1]), per_log, bar)
+            raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
+        else:
+            groups = [slice(i, i + BATCH_CYCLES) for i in range(0, len(cycles), BATCH_CYCLES)]
+            raws = [stepper(sim, config, cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, bar)
+                    for g in groups]
+            raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws]) for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,

@@ -2,10 +2,11 @@
 
 import shutil
 
+import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots, sim, tasks
+from faultgen import control, robots, sim, tasks
 from faultgen.sensors import NoiseConfig
 from faultgen.wear import WearPlan
 
@@ -137,3 +138,49 @@ def test_cycles_beyond_one_batch_are_stepped_in_groups_with_the_same_result(monk
     grouped = run(task="pick_place", wear=["6:linear:20"], record=(3, 20, 77), seed=5)
     for name in ("q_a", "tau_m", "tau_f", "friction_multiplier"):
         assert np.array_equal(getattr(whole, name), getattr(grouped, name)), name
+
+
+def test_back_to_back_cycles_carry_the_state_over():
+    """Cycle 1 of a back-to-back run is the independent cycle 1. Cycle 2 goes on from the state
+    cycle 1 ended in: it differs from an independent cycle 2 (which starts from the start state,
+    drive integrators empty) at its start, and the two converge once the drives have settled."""
+    independent = run(task="pick_place", cycles=2, seed=4, friction="stribeck")
+    chained = run(task="pick_place", cycles=2, seed=4, friction="stribeck", back_to_back=True)
+    for name in ("q_a", "q_m", "tau_m"):
+        assert np.array_equal(getattr(independent, name)[0], getattr(chained, name)[0]), name
+    scale = np.abs(independent.tau_m[1]).max(axis=0)
+    change = np.abs(independent.tau_m[1] - chained.tau_m[1]) / scale
+    assert change[independent.t < 0.1].max() > 0.05
+    assert change[independent.t > 2.0].max() < 1e-3
+
+
+@pytest.mark.parametrize("kwargs", [dict(wear=WearPlan.from_specs(["2:linear:20"], 3)), dict(record=(2,))])
+def test_back_to_back_refuses_wear_and_a_record_subset(kwargs):
+    config = dict(robot="irb6700", task="pick_place", cycles=3, back_to_back=True) | kwargs
+    with pytest.raises(ValueError, match="back_to_back runs step every cycle in one simulation without wear"):
+        sim.RunConfig(**config)
+
+
+def test_a_cycle_starts_at_rest_on_the_loaded_flank_of_its_backlash(tmp_path):
+    """With backlash b the start state puts the arm b/2 beyond the static sag, on the flank that
+    carries the load: held by its drives, the arm then stays where it is instead of falling
+    across the dead band."""
+    source = robots.available()["irb6700"]
+    text = source.read_text().replace('name="gearbox2" stiffness="1.42e6" damping="4.53e3" springlength="0"',
+                                      'name="gearbox2" stiffness="1.42e6" damping="4.53e3" springlength="-0.005 0.005"')
+    assert text != source.read_text()
+    model = tmp_path / "irb6700_backlash.xml"
+    model.write_text(text)
+    robot = robots.load(model)
+    assert robot.backlash[1] == pytest.approx(0.01)
+    compiled = sim.build(robot)
+    q0 = np.array([0.3, 0.4, -0.2, 0.0, 0.5, 0.0])
+    data = mujoco.MjData(compiled.model)
+    data.qpos[:], data.qvel[:] = sim.start_state(robot, q0)
+    zeros = np.zeros((1, 6))
+    data.ctrl[compiled.drive_ctrl] = control.setpoints(robot, q0[None], zeros, zeros)[0]
+    start = data.qpos[robot.arm_qpos].copy()
+    for _ in range(round(0.3 / compiled.model.opt.timestep)):
+        mujoco.mj_step(compiled.model, data)
+    # at rest the arm moves by far less than a tenth of the half-width it would fall across
+    assert np.max(np.abs(data.qpos[robot.arm_qpos] - start)) < 0.1 * 0.005

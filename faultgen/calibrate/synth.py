@@ -5,7 +5,9 @@ This is how the calibration workflow is checked (tests/test_calibrate_hidden.py,
 at a random size on random axes, written into a copy of the robot's MJCF with the same
 :meth:`Effect.apply` the workflow uses, and that model is simulated closed-loop (PID drives,
 flexible gearboxes, static Stribeck friction with stiction, load disturbance, encoder noise;
-:func:`faultgen.sim.simulate`) over several cycles of a task. The log is what a robot controller
+:func:`faultgen.sim.simulate`) over several cycles of a task, back to back in one simulation as on
+a robot (each cycle starts where the previous one ended: a dead band's flank, a gearbox still
+ringing). The log is what a robot controller
 records: ``q = theta_m / G`` from the motor encoders, ``tau = G tau_m`` from the drive torque,
 plus torque-sensor noise. The workflow then gets only that file and the robot's name.
 
@@ -203,7 +205,8 @@ def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     out = Path(out)
     model = write_model(robot, hidden, out.parent / f"{out.stem}_model")
-    config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed)
+    config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed,
+                           back_to_back=True)
     run = sim.simulate(config, progress=False)
     G = robot.gear_ratio
     duration = sim.cycle_duration(str(model), task)
