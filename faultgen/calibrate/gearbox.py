@@ -25,7 +25,8 @@ they agree.
 
 On hidden-effect data of the IRB-6700-like arm (locked-arm resonances 6-15 Hz) this takes the
 held-out nrmse of a log with nothing hidden from 0.039 / 0.062 / 0.034 to 0.014 / 0.046 / 0.027
-on axes 1 / 2 / 3 (axis by axis, without the coupling: axis 3 0.036); on the stiffer PUMA 560 it
+on axes 1 / 2 / 3 (axis by axis, without the coupling: axis 3 0.036; logs of independently
+restarted cycles, whose restarts made most of axis 2's 0.046); on the stiffer PUMA 560 it
 changes less than 0.001 (docs/calibration.md). Against an ODE
 solver (LSODA) on a dead-band oscillator of 32 Hz and damping ratio 0.1 the 2 ms sub-steps
 are within 3-4 % RMS of the torque (the impacts' timing; 0.5 % at 0.5 ms sub-steps); on
