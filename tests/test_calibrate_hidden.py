@@ -1,7 +1,8 @@
 """Hidden-effect checks of ``faultgen calibrate`` on data from our own simulator (both robots).
 
 For every effect id, :mod:`faultgen.calibrate.synth` switches the effect on at a randomly drawn
-size on random axes (seed 0 for every case, fixed before looking at the outcome), simulates
+size on random axes (seed 0 for every case, fixed before looking at the outcome; one more case,
+IRB-6700-like backlash of seed 4, because it failed in the accuracy benchmark), simulates
 four closed-loop cycles of the pick-and-place task with sensor noise, and writes the measured
 CSV; the workflow gets only that file and the robot name. It must name the hidden effect first,
 on the hidden axes, and cut the held-out total nrmse at least in half. Without a hidden effect
@@ -24,8 +25,12 @@ from faultgen import measured, robots, sim
 from faultgen.calibrate import EFFECTS, calibrate, synth
 
 SEED = 0
-CASES = [(robot_name, effect) for robot_name in ("puma560", "irb6700") for effect in EFFECTS
+CASES = [(robot_name, effect, SEED) for robot_name in ("puma560", "irb6700") for effect in EFFECTS
          if (robot_name, effect) != ("puma560", "backlash")]
+#: ... and one more seed: IRB-6700-like backlash hidden on axes 1 and 2, where the coupled ringing
+#: they leave on axis 3 was taken for a third dead band while one more axis needed a 10 % drop
+#: of the fitting error (effects.Backlash.MIN_DROP).
+CASES.append(("irb6700", "backlash", 4))
 #: Required held-out gap ratio (after / before): the issue's "at least in half" ...
 HALF = 0.5
 #: ... except where it is not met. IRB-6700-like cogging: named right, on the right axes, but the
@@ -48,9 +53,9 @@ def hidden_case(tmp_path, robot_name, effect, seed=SEED):
     return hidden, calibrate(robot_name, path, tmp_path / "out")
 
 
-@pytest.mark.parametrize(("robot_name", "effect"), CASES)
-def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_name, effect):
-    hidden, result = hidden_case(tmp_path, robot_name, effect)
+@pytest.mark.parametrize(("robot_name", "effect", "seed"), CASES)
+def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_name, effect, seed):
+    hidden, result = hidden_case(tmp_path, robot_name, effect, seed)
     assert result.steps, f"nothing found; hidden {hidden}"
     first = result.steps[0]
     assert (first.effect, first.axes) == (hidden.effect, hidden.axes), f"hidden {hidden}, found {result.summary()}"
