@@ -643,6 +643,30 @@ def _torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
     return notes
 
 
+def acceleration(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Second time derivative of ``x`` by the same Savitzky-Golay filter :func:`read` estimates
+    ``qdd`` with (window :data:`SAVGOL_WINDOW` at the median period, resampled when the period
+    varies): a model signal seen through it can be compared with one made of measured ``qdd``.
+
+    Parameters
+    ----------
+    t : ndarray of shape (n,)
+        Sample times, s, strictly increasing (as :func:`read` checked them).
+    x : ndarray of shape (n, k)
+        Signal per column.
+
+    Returns
+    -------
+    ndarray of shape (n, k)
+        Its filtered second derivative, unit of ``x`` per s^2.
+    """
+    t = np.asarray(t, dtype=float)
+    dt = np.diff(t)
+    period = float(np.median(dt))
+    uniform = bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
+    return _derivatives(t, np.asarray(x, dtype=float), period, _savgol_window(period, len(t)), uniform)[1]
+
+
 def _savgol_window(period: float, n: int) -> int:
     """Odd window length closest to :data:`SAVGOL_WINDOW` s, at least order + 2, at most n."""
     window = 2 * round(SAVGOL_WINDOW / (2 * period)) + 1

@@ -378,11 +378,10 @@ class Backlash(Effect):
                 q[:, axis] += step
                 shifted = robot.inverse_dynamics(q, motion.qd, motion.qdd, friction=False)
                 slope[:, axis] = (shifted - rigid)[:, axis] / step
-            dynamic = gearbox.dynamic_axes(robot, motion.t, motion.q)
-            motion.memo["backlash"] = current, -0.5 * np.sign(motion.load) * slope, dynamic
-        current, shift, _ = motion.memo["backlash"]
-        dynamic = gearbox.compliance_torque(robot, motion.t, motion.q, motion.load, widths) - current
-        return dynamic + (widths - robot.backlash)[:, None, :] * shift
+            motion.memo["backlash"] = current, -0.5 * np.sign(motion.load) * slope
+        current, shift = motion.memo["backlash"]
+        change = gearbox.compliance_torque(robot, motion.t, motion.q, motion.load, widths) - current
+        return change + (widths - robot.backlash)[:, None, :] * shift
 
     def columns(self, motion, axis, h):
         widths = motion.robot.backlash.copy()
@@ -391,8 +390,6 @@ class Backlash(Effect):
 
     def search(self, motion, residual, rows, scale):
         robot = motion.robot
-        self._change(motion, robot.backlash[None])  # fills the memo
-        _, shift, dynamic = motion.memo["backlash"]
         weights = 1.0 / scale**2
 
         def cost(change):  # (k, n, 6) -> (k,): weighted squared error on the fitting part
@@ -401,7 +398,7 @@ class Backlash(Effect):
         widths = robot.backlash.copy()
         change = np.zeros_like(residual)
         error = float(cost(change[None])[0])
-        free = list(np.flatnonzero(dynamic))
+        free = list(range(6))
         grid = np.array(self.GRID)
         while free:
             trials = np.tile(widths, (len(free) * len(grid), 1))
@@ -418,12 +415,6 @@ class Backlash(Effect):
                 break
             widths, change, error = fine[j], changes[j], float(costs[j])
             free.remove(axis)
-        for axis in np.flatnonzero(~dynamic):  # the quasi-static shift alone, axis by axis
-            trial = (grid - robot.backlash[axis])[:, None] * shift[:, axis]  # (k, n)
-            sse = np.sum(np.where(rows[:, axis], residual[:, axis] - trial, 0.0) ** 2, axis=1)
-            k = int(np.argmin(sse))
-            if sse[k] < np.sum(np.where(rows[:, axis], residual[:, axis], 0.0) ** 2):
-                widths[axis], change[:, axis] = grid[k], trial[k]
         return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(6)]
 
     def params(self, motion, axis, theta, h):
