@@ -37,12 +37,26 @@ def test_sinusoidal_load_gives_the_steady_state_of_the_oscillator(hz):
 
 
 def test_slow_load_is_carried_quasi_statically():
+    """Far below the resonance (15.9 Hz) the arm follows the load through the spring, e = load / K,
+    and the drive torque changes by -M e''."""
+    M, K, D = 1.0, 1.0e4, 20.0
+    t = np.arange(0, 5.0, 0.004)
+    w = 2 * np.pi * 0.2
+    load = np.outer(30.0 * np.sin(w * t), np.ones(6))
+    out = gearbox.compliance_torque(OneSpring(M, K, D), t, np.zeros_like(load), load)
+    expected = M * w**2 * load[:, 0] / K  # -M e'' with e = load / K, about 5e-3 N m
+    late = t > 1.0  # after the start (0.1 s damping time constant)
+    np.testing.assert_allclose(out[late, 0], expected[late], atol=0.05 * np.max(np.abs(expected)))
+
+
+def test_stiff_gearbox_without_dead_band_is_rigid():
+    """A resonance above :data:`gearbox.RESOLVED_HZ` (50 Hz here) is not integrated: without a dead
+    band the drive torque is the rigid prediction."""
     robot = OneSpring(1.0, 1.0e5, 20.0)
     t = np.arange(0, 5.0, 0.004)
-    load = np.outer(30.0 * np.sin(2 * np.pi * 0.2 * t), np.ones(6))
-    out = gearbox.compliance_torque(robot, t, np.zeros_like(load), load)
-    # after the start (0.1 s damping time constant): M e'' with e = load / K, about 1e-4 N m
-    assert np.max(np.abs(out[t > 1.0])) < 1e-3
+    load = np.outer(30.0 * np.sin(2 * np.pi * 3.0 * t), np.ones(6))
+    assert not np.any(gearbox.dynamic_axes(robot, t, np.zeros_like(load)))
+    assert not np.any(gearbox.compliance_torque(robot, t, np.zeros_like(load), load))
 
 
 def dead_band_reference(M, K, D, b, t, load):
@@ -68,7 +82,7 @@ def dead_band_reference(M, K, D, b, t, load):
 def test_dead_band_against_an_ode_solver(hz):
     """A load that reverses: the arm crosses the dead band twice a period and lands on the other
     flank; the Newmark steps with the piecewise-linear spring against LSODA."""
-    M, K, D, b = 50.0, 2.0e6, 2000.0, 0.01  # resonance 32 Hz, damping ratio 0.1 (the IRB-6700-like axes 1-3)
+    M, K, D, b = 50.0, 3.2e5, 800.0, 0.01  # resonance 12.7 Hz, damping ratio 0.1 (the IRB-6700-like axes 1-3)
     t = np.arange(0, 3.0, 0.004)
     load = 400.0 * np.sin(2 * np.pi * hz * t) + 100.0 * np.sin(2 * np.pi * 2.3 * hz * t)
     expected = dead_band_reference(M, K, D, b, t, load)
@@ -77,8 +91,9 @@ def test_dead_band_against_an_ode_solver(hz):
     linear = gearbox.compliance_torque(OneSpring(M, K, D), t, np.zeros((len(t), 6)), np.outer(load, np.ones(6)))
     assert np.sqrt(np.mean((expected - linear[:, 0]) ** 2)) > 0.3 * np.sqrt(np.mean(expected**2))
     error = out[:, 0] - expected
-    # 2 ms sub-steps: 4.2 % (1 Hz) and 2.6 % (4 Hz) of the RMS, from the impact timing; 0.5 ms: 0.5 %
-    assert np.sqrt(np.mean(error**2)) <= 0.06 * np.sqrt(np.mean(expected**2))
+    # 2 ms sub-steps: 0.7 % (1 Hz) and 0.4 % (4 Hz) of the RMS, from the impact timing (at a
+    # resonance of 32 Hz, which the equation no longer integrates, it was 4.2 % and 2.6 %)
+    assert np.sqrt(np.mean(error**2)) <= 0.02 * np.sqrt(np.mean(expected**2))
 
 
 def test_dead_band_does_not_show_while_the_load_keeps_its_sign():
@@ -123,3 +138,56 @@ def test_arm_mass_matrix_against_recursive_newton_euler():
             np.testing.assert_allclose(matrix[k, :, axis], data.qfrc_inverse[robot.arm_dof], rtol=1e-9,
                                        atol=1e-9 * np.max(np.abs(matrix[k])))
     np.testing.assert_allclose(matrix, np.swapaxes(matrix, 1, 2))
+
+
+def contact_reference(M, D, b, t, load):
+    """The stiff dead band by events: inside the gap ``M e'' + D e' = load`` by scipy's RK45 until
+    ``|e| = b/2`` (then at rest on that flank), on a flank until the load changes sign."""
+    from scipy.integrate import solve_ivp
+
+    def force(time):
+        return np.interp(time, t, load)
+
+    def crossed(time, state):
+        return abs(state[0]) - b / 2
+    crossed.terminal, crossed.direction = True, 1
+
+    def reversed_(time, state, side):
+        return force(time) * side
+    now, e, v, side = t[0], np.sign(load[0]) * b / 2, 0.0, np.sign(load[0])
+    times, values = [now], [e]
+    while now < t[-1]:
+        if side:  # on a flank: until the load reverses (linear between samples)
+            later = np.flatnonzero((t > now) & (load * side < 0))
+            if not len(later):
+                break
+            k = later[0]
+            now = t[k - 1] + (t[k] - t[k - 1]) * load[k - 1] / (load[k - 1] - load[k])
+            side = 0.0
+            times.append(now), values.append(e)
+            continue
+        solution = solve_ivp(lambda time, y: [y[1], (force(time) - D * y[1]) / M], (now, t[-1]), [e, v],
+                             events=crossed, max_step=1e-3, rtol=1e-9, atol=1e-12, dense_output=True)
+        inside = np.linspace(now, solution.t[-1], max(2, int((solution.t[-1] - now) / 1e-4)))
+        times.extend(inside), values.extend(solution.sol(inside)[0])
+        now = solution.t[-1]
+        e, v = np.sign(solution.y[0, -1]) * b / 2, 0.0
+        side = np.sign(e)
+        times.append(now), values.append(e)
+    times.append(t[-1]), values.append(e)
+    return np.interp(t, np.array(times), np.array(values))
+
+
+def test_stiff_dead_band_against_an_event_solver():
+    """Rigid contact: the arm crosses the dead band whenever the load reverses (damper only) and
+    lands on the other flank at rest; against an event-located ODE solution."""
+    M, D, b = 3.0, 57.0, 0.015  # the PUMA 560's waist: arm inertia, gearbox damping, a 15 mrad dead band
+    t = np.arange(0, 6.0, 0.004)
+    load = 20.0 * np.sin(2 * np.pi * 0.5 * t) + 8.0 * np.sin(2 * np.pi * 1.3 * t)
+    expected = contact_reference(M, D, b, t, load)
+    e = gearbox.contact_deflection(t, np.full((len(t), 2), M), np.full(2, D), np.array([b, 0.0]),
+                                   np.column_stack([load, load]))
+    assert np.ptp(expected) == pytest.approx(b)  # it crosses
+    assert 0.1 < np.mean(np.abs(expected) < b / 2) < 0.9
+    assert np.sqrt(np.mean((e[:, 0] - expected) ** 2)) <= 0.02 * b
+    assert not np.any(e[:, 1])  # no dead band: the arm stays with the motor

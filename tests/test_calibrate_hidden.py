@@ -8,11 +8,11 @@ CSV; the workflow gets only that file and the robot name. It must name the hidde
 on the hidden axes, and cut the held-out total nrmse at least in half. Without a hidden effect
 it must name nothing.
 
-Backlash on the PUMA 560 is not among them: the issue's requirement is not met there. A dead band
-the size of the drawn ones raises the held-out total nrmse to at most 2.6 times the floor, and
-nearly all of it is the torque bump where the floating arm lands on the light motor, whose timing
-the gearbox equation, integrating the arm open loop inside the gap, misses by milliseconds
-(docs/calibration.md).
+Backlash on the PUMA 560 is named but cannot halve the gap: its stiff gearboxes make a dead band
+a small effect on the drive torque (4-9 % of the waist's torque RMS at 5-20 mrad), and the
+held-out total nrmse of the log with nothing hidden is already 50-64 % of the gap before
+(seeds 0-4, docs/calibration.md), so no model could halve it; the test holds it to its measured
+ratio.
 """
 
 import json
@@ -25,8 +25,7 @@ from faultgen import measured, robots, sim
 from faultgen.calibrate import EFFECTS, calibrate, synth
 
 SEED = 0
-CASES = [(robot_name, effect, SEED) for robot_name in ("puma560", "irb6700") for effect in EFFECTS
-         if (robot_name, effect) != ("puma560", "backlash")]
+CASES = [(robot_name, effect, SEED) for robot_name in ("puma560", "irb6700") for effect in EFFECTS]
 #: ... and one more seed: IRB-6700-like backlash hidden on axes 1 and 2, where the coupled ringing
 #: they leave on axis 3 was taken for a third dead band while one more axis needed a 10 % drop
 #: of the fitting error (effects.Backlash.MIN_DROP).
@@ -37,7 +36,10 @@ HALF = 0.5
 #: drive sees the detent torque through the soft gearboxes' resonances, so a constant-amplitude
 #: sinusoid in the motor angle leaves part of it (seed 0: 0.125 -> 0.071, ratio 0.57). The
 #: shortfall is reported in docs/calibration.md; this bound keeps it from getting worse.
-SHORT = {("irb6700", "cogging"): 0.6}
+SHORT = {("irb6700", "cogging"): 0.6,
+         # PUMA 560 backlash: the floor is more than half the gap before (seed 0: 0.0133 of 0.0252),
+         # the model at the fitted width leaves 0.0175, ratio 0.69 (seeds 0-4: 0.69-0.76)
+         ("puma560", "backlash"): 0.75}
 #: Held-out total nrmse of the nominal model on a log with nothing hidden (seeds 0-4: PUMA 560
 #: 0.0131-0.0133, IRB-6700-like 0.0136-0.0138, docs/calibration.md). Simulated at the robot
 #: models' 0.5 ms step instead of synth.TIMESTEP, the integrator's extra inertia raised them to

@@ -324,26 +324,26 @@ class Backlash(Effect):
     The torque of a dead band is not linear in b. Two parts, both what a model with backlash
     predicts (:func:`faultgen.calibrate.predict`):
 
-    * the gearbox equation with the dead band in its spring
-      (:func:`faultgen.calibrate.gearbox.compliance_torque`): when the load reverses, the arm
-      crosses the gap and lands on the other flank, and while it crosses the motor's motion does
-      not reach it, so the drive torque loses the gearbox ringing of the linear model; this part
-      carries the effect on the soft, slow axes whose resonance the sub-steps follow;
+    * the gearbox with the dead band (:func:`faultgen.calibrate.gearbox.compliance_torque`):
+      when the load reverses, the arm crosses the gap and lands on the other flank, and while it
+      crosses the motor's motion does not reach it. On the soft axes whose resonance the
+      measured accelerations resolve (the IRB-6700-like axes 1-3) the gearbox equation carries
+      it, with the dead band in its spring: the drive torque loses the ringing of the linear
+      model. On the stiff axes (the PUMA 560's) it is rigid contact: the floating arm's load is
+      missing from the drive torque while it crosses;
     * quasi-statically, the arm rests on the loaded flank ``b/2`` behind the motor, so its
       rigid-body terms are those at ``q - (b/2) sign(load)``
       (:meth:`faultgen.robots.Robot.inverse_dynamics`), taken here to first order in b.
 
     The effect has no linear parameter, and the axes are coupled: a dead band on the
     IRB-6700-like axis 2 changes the torque of axis 3 through the arm's inertia. :meth:`search`
-    therefore adds dead bands one axis at a time (coordinate-wise): every axis the gearbox
-    equation integrates and not yet chosen is tried at every width of :data:`GRID` (geometric,
-    steps of 6 %; all in one pass of the equation), the best is refined over :data:`REFINE`
-    widths between its neighbours (steps of 0.4 %), and it is kept when it lowers the fitting
-    part's error over all axes (each weighted by its torque RMS) by at least :data:`MIN_DROP`
-    and lies inside the searched range; then the next axis. An axis the equation does not integrate gets only the quasi-static
-    shift, fitted on its own. The held-out error is sharp in b (an IRB-6700-like log with
-    b = 19.3 mrad on axis 2: total nrmse 0.080 at 17.1 mrad, 0.047 at 18.4, 0.124 at 19.9), so a
-    coarse grid alone misses it.
+    therefore adds dead bands one axis at a time (coordinate-wise): every axis not yet chosen
+    is tried at every width of :data:`GRID` (geometric, steps of 6 %; all in one pass), the best
+    is refined over :data:`REFINE` widths between its neighbours (steps of 0.4 %), and it is
+    kept when it lowers the fitting part's error over all axes (each weighted by its torque
+    RMS) by at least :data:`MIN_DROP` and lies inside the searched range; then the next axis.
+    The held-out error is sharp in b (an IRB-6700-like log with b = 19.3 mrad on axis 2: total
+    nrmse 0.080 at 17.1 mrad, 0.047 at 18.4, 0.124 at 19.9), so a coarse grid alone misses it.
     """
 
     id = "backlash"

@@ -23,15 +23,28 @@ each sub-step is linear once it is known which flank every axis is on (or none),
 solved for a guess of the flanks, and again with the flanks the new deflections lie on until
 they agree.
 
-On hidden-effect data of the IRB-6700-like arm (locked-arm resonances 6-15 Hz) this takes the
-held-out nrmse of a log with nothing hidden from 0.039 / 0.062 / 0.034 to 0.014 / 0.046 / 0.027
-on axes 1 / 2 / 3 (axis by axis, without the coupling: axis 3 0.036; logs of independently
-restarted cycles, whose restarts made most of axis 2's 0.046); on the stiffer PUMA 560 it
-changes less than 0.001 (docs/calibration.md). Against an ODE
-solver (LSODA) on a dead-band oscillator of 32 Hz and damping ratio 0.1 the 2 ms sub-steps
-are within 3-4 % RMS of the torque (the impacts' timing; 0.5 % at 0.5 ms sub-steps); on
-hidden-backlash logs of the IRB-6700-like arm 1 ms and 0.5 ms sub-steps changed no nrmse by
-more than 0.0002 (tests/test_calibrate_gearbox.py, docs/calibration.md).
+The equation is integrated only on the axes whose locked-arm resonance the measured
+accelerations resolve (:data:`RESOLVED_HZ`; the derivative filter of :func:`faultgen.measured.read`
+has a pass band of about 20 Hz): a resonance above it rings in the equation, driven by the
+measured motion, while the motor's answering ringing is filtered out of the measured ``qdd``.
+On a stiffer axis (the PUMA 560's; the light wrist axes) the arm follows the motor rigidly,
+and a dead band there is rigid contact (:func:`contact_deflection`): the arm crosses the gap
+when the load reverses, coupled only by the damper, and lands without rebound; its
+``-M e''`` is taken through the same derivative filter as the measured ``qdd``, so the impact's
+momentum, which the motor takes up, cancels against the motor's filtered acceleration as it
+does in the drive torque.
+
+On hidden-effect data of the IRB-6700-like arm (locked-arm resonances 6-15 Hz) the equation
+takes the held-out nrmse of a log with nothing hidden from 0.039 / 0.062 / 0.034 to
+0.014 / 0.046 / 0.027 on axes 1 / 2 / 3 (axis by axis, without the coupling: axis 3 0.036; logs
+of independently restarted cycles, whose restarts made most of axis 2's 0.046). On a PUMA 560
+log with a dead band of 14.6 mrad on axis 1 (resonance 25-40 Hz) the equation at the true width
+gave that axis 0.169 against 0.080 rigid, the rigid contact 0.036 (docs/calibration.md).
+Against an ODE solver (LSODA) on a dead-band oscillator of 12.7 Hz and damping ratio 0.1 the
+2 ms sub-steps are within 0.4-0.7 % RMS of the torque (the impacts' timing); on hidden-backlash
+logs of the IRB-6700-like arm 1 ms and 0.5 ms sub-steps changed no nrmse by more than 0.0002.
+The rigid contact against an event-located ODE solution: within 0.1 % of the width RMS
+(tests/test_calibrate_gearbox.py).
 """
 
 from __future__ import annotations
@@ -65,7 +78,9 @@ CONTACT_SUBSTEP = 5e-4
 
 def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: np.ndarray,
                       backlash: np.ndarray | None = None) -> np.ndarray:
-    """Drive torque the gearbox springs add to the rigid prediction, N m at the arm side.
+    """Drive torque the gearboxes add to the rigid prediction, N m at the arm side: the gearbox
+    equation on the axes whose resonance is resolved (:data:`RESOLVED_HZ`), rigid contact in the
+    dead band on the others (module docstring).
 
     Parameters
     ----------
@@ -86,7 +101,9 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     Returns
     -------
     ndarray of shape (n, 6), or (m, n, 6) for a 2-D ``backlash``
-        ``S(e) + D e' - load`` per sample and axis; zero on the axes carried quasi-statically.
+        ``-M e''``: ``S(e) + D e' - load`` from the gearbox equation, and the rigid contacts'
+        deflection through the measured accelerations' filter; zero from a stiff axis without a
+        dead band.
 
     Raises
     ------
@@ -189,8 +206,9 @@ def contact_deflection(t: np.ndarray, inertia: np.ndarray, damping: np.ndarray, 
 
 def dynamic_axes(robot: robots.Robot, t: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Which axes :func:`compliance_torque` integrates, boolean of shape (6,): those whose
-    locked-arm resonance along the motion the sub-steps follow (:data:`MAX_PHASE`); the others
-    carry their load quasi-statically and get no correction, with or without a dead band."""
+    locked-arm resonance along the motion the measured accelerations resolve
+    (:data:`RESOLVED_HZ`) and the sub-steps follow (:data:`MAX_PHASE`); the others follow the
+    motor rigidly, or by rigid contact inside a dead band."""
     steps, substeps = _substeps(np.asarray(t, dtype=float))
     return _dynamic(robot, robot.arm_mass_matrix(q), float(np.max(steps)) / substeps)
 
