@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from faultgen import calibrate, robots, sim
-from faultgen.calibrate import effects, gearbox, synth
+from faultgen.calibrate import effects, synth
 
 ROBOTS = ("puma560", "irb6700")
 

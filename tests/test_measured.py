@@ -179,6 +179,20 @@ def test_noise_free_acceleration_is_nearly_exact(puma):
     assert qdd_in < 0.06  # achieved 0.041 rad/s^2 of up to 35 rad/s^2: the filter's bias
 
 
+@pytest.mark.parametrize("mean_period", [None, 4e-3])
+def test_acceleration_is_the_readers_filter(puma, mean_period):
+    """``measured.acceleration`` of any signal is what :func:`measured.read` makes of ``q``: the
+    same ``qdd``, uniform (250 Hz) or jittered sampling."""
+    rng = np.random.default_rng(4)
+    t = (np.arange(1000) * 4e-3 if mean_period is None
+         else np.cumsum(rng.uniform(0.5, 1.5, 1000) * mean_period))
+    q, _, _ = sinusoids(puma, t)
+    q = q + NOISE * rng.standard_normal(q.shape)
+    data = measured.from_arrays(t, q, torques(t), puma)
+    np.testing.assert_allclose(measured.acceleration(t, q), data.qdd, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(measured.acceleration(t, q[:, :2]), data.qdd[:, :2], rtol=0, atol=1e-9)
+
+
 @pytest.mark.parametrize("mean_period", [1e-3, 4e-3])
 def test_varying_sample_rate(puma, mean_period):
     """Periods uniform in [0.5, 1.5] x the mean (about 1 kHz and 250 Hz, jittered).

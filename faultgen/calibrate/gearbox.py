@@ -57,8 +57,8 @@ from faultgen import measured, robots
 #: for a 25 Hz resonance (the softest gearbox here); shorter steps changed no figure.
 SUBSTEP = 0.002
 #: Largest resonance frequency times sub-step, rad, of an axis that is integrated (with 2 ms
-#: sub-steps: resonances up to 40 Hz); an axis with a faster one (the light wrist axes) carries
-#: its load quasi-statically, e = load / K, and gets no correction.
+#: sub-steps: resonances up to 40 Hz); an axis with a faster one (the light wrist axes) follows
+#: the motor rigidly (rigid contact inside a dead band), as does one above :data:`RESOLVED_HZ`.
 MAX_PHASE = 0.5
 #: Most re-solves of a sub-step while the axes' flanks (dead band or which side) settle.
 MAX_FLANK_CHANGES = 8
