@@ -152,8 +152,6 @@ def contact_reference(M, D, b, t, load):
         return abs(state[0]) - b / 2
     crossed.terminal, crossed.direction = True, 1
 
-    def reversed_(time, state, side):
-        return force(time) * side
     now, e, v, side = t[0], np.sign(load[0]) * b / 2, 0.0, np.sign(load[0])
     times, values = [now], [e]
     while now < t[-1]:
