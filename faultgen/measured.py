@@ -549,7 +549,7 @@ def _build(
     _check_angles(where, q, robot, label)
 
     window = _savgol_window(period, n)
-    uniform = bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
+    uniform = _is_uniform(dt, period)
     qd_est, qdd = _derivatives(t, q, period, window, uniform)
     filt = f"Savitzky-Golay, order {SAVGOL_ORDER}, window {window} samples ({window * period:.4g} s)"
     if not uniform:
@@ -663,8 +663,14 @@ def acceleration(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     dt = np.diff(t)
     period = float(np.median(dt))
-    uniform = bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
-    return _derivatives(t, np.asarray(x, dtype=float), period, _savgol_window(period, len(t)), uniform)[1]
+    (xdd,) = _derivatives(t, np.asarray(x, dtype=float), period, _savgol_window(period, len(t)),
+                          _is_uniform(dt, period), orders=(2,))
+    return xdd
+
+
+def _is_uniform(dt: np.ndarray, period: float) -> bool:
+    """True when every sample interval is within :data:`UNIFORM_TOLERANCE` of the median ``period``."""
+    return bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
 
 
 def _savgol_window(period: float, n: int) -> int:
@@ -677,21 +683,21 @@ def _savgol_window(period: float, n: int) -> int:
 
 
 def _derivatives(
-    t: np.ndarray, q: np.ndarray, period: float, window: int, uniform: bool
-) -> tuple[np.ndarray, np.ndarray]:
-    """Velocity and acceleration of ``q`` (n, 6) by Savitzky-Golay, resampling if not uniform."""
+    t: np.ndarray, q: np.ndarray, period: float, window: int, uniform: bool, orders: tuple[int, ...] = (1, 2)
+) -> tuple[np.ndarray, ...]:
+    """Derivatives of ``q`` (n, k) of the given ``orders`` by Savitzky-Golay, resampling if not uniform."""
     if uniform:
-        qd = savgol_filter(q, window, SAVGOL_ORDER, deriv=1, delta=period, axis=0, mode="interp")
-        qdd = savgol_filter(q, window, SAVGOL_ORDER, deriv=2, delta=period, axis=0, mode="interp")
-        return qd, qdd
+        return tuple(savgol_filter(q, window, SAVGOL_ORDER, deriv=d, delta=period, axis=0, mode="interp")
+                     for d in orders)
     s = t - t[0]  # relative time: keeps the spline well conditioned for absolute time stamps
     grid = np.arange(math.floor(s[-1] / period) + 1) * period
     if grid[-1] < s[-1]:
         grid = np.append(grid, grid[-1] + period)  # cover the last sample (spline extrapolates a bit)
     q_grid = CubicSpline(s, q, axis=0)(grid)
-    qd_grid = savgol_filter(q_grid, window, SAVGOL_ORDER, deriv=1, delta=period, axis=0, mode="interp")
-    qdd_grid = savgol_filter(q_grid, window, SAVGOL_ORDER, deriv=2, delta=period, axis=0, mode="interp")
-    return CubicSpline(grid, qd_grid, axis=0)(s), CubicSpline(grid, qdd_grid, axis=0)(s)
+    return tuple(
+        CubicSpline(grid, savgol_filter(q_grid, window, SAVGOL_ORDER, deriv=d, delta=period, axis=0, mode="interp"),
+                    axis=0)(s)
+        for d in orders)
 
 
 # --------------------------------------------------------------------------------------------
