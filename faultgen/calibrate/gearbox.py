@@ -129,19 +129,16 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     if len(dynamic):
         out[:, :, dynamic] = _integrate(mass[:, dynamic][:, :, dynamic], K[dynamic], D[dynamic], half, steps,
                                         substeps, load[:, dynamic])[which.ravel()]
-    # the dead bands of the other axes, each on its own: one problem per axis and distinct width
+    # the dead bands of the other axes, each on its own: one problem per distinct (axis, width)
     # (a backlash search varies one axis at a time, so its sets share most widths), all in one pass
     stiff = np.flatnonzero(~is_dynamic & np.any(widths > 0, axis=0))
-    problems = [(axis, np.unique(widths[:, axis], return_inverse=True)) for axis in stiff]
-    if problems:
-        axes = np.concatenate([np.full(len(values), axis) for axis, (values, _) in problems])
-        e = contact_deflection(t, np.einsum("nii->ni", mass)[:, axes], D[axes],
-                               np.concatenate([values for _, (values, _) in problems]), load[:, axes])
-        acceleration = measured.acceleration(t, e).T  # (problems, n)
-        first = 0
-        for axis, (values, which) in problems:
-            out -= mass[None, :, :, axis] * acceleration[first + which][:, :, None]
-            first += len(values)
+    if len(stiff):
+        pairs = np.stack(np.broadcast_arrays(stiff, widths[:, stiff]), axis=-1).reshape(-1, 2)
+        problems, which = np.unique(pairs, axis=0, return_inverse=True)
+        axes = problems[:, 0].astype(int)
+        e = contact_deflection(t, np.einsum("nii->ni", mass)[:, axes], D[axes], problems[:, 1], load[:, axes])
+        acceleration = measured.acceleration(t, e)[:, which.reshape(len(widths), len(stiff))]  # (n, m, s)
+        out -= np.einsum("nja,nma->mnj", mass[:, :, stiff], acceleration)
     return out if width.ndim == 2 else out[0]
 
 
