@@ -94,7 +94,7 @@ def add_drives(spec: mujoco.MjSpec, robot: Robot, gains: ServoGains) -> None:
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
 
 
-def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: float | None = None) -> np.ndarray:
     """Drive inputs along an arm-side reference path, with nominal-model feedforward.
 
     Parameters
@@ -103,6 +103,14 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> n
         The nominal robot (its friction parameters are the unworn ones).
     q, qd, qdd : ndarray of shape (n, 6)
         Reference arm angles (rad), velocities (rad/s) and accelerations (rad/s^2).
+    dt : float, optional
+        The physics step in s, when the rows are the set-points of consecutive steps. MuJoCo's
+        semi-implicit step moves a joint by ``h v+`` (``q+ = q + h v+``), so the velocity it
+        carries is the mean velocity over the step, half a step later than the position; the
+        speed set-point of row ``k`` is then the reference's mean speed over that step,
+        ``G (q[k+1] - q[k]) / dt`` (the last row keeps ``G qd``). With the speed set-point taken at
+        the step's start instead, the drive lags the reference by ``kd h qdd / (2 kp)``, a
+        first-order step error (docs/simulation.md, "Numerical convergence").
 
     Returns
     -------
@@ -110,7 +118,17 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> n
         Per axis: motor-angle set-point G q (rad), motor-speed set-point G qd (rad/s) and
         torque feedforward tau_ff / G (N m, motor side), where tau_ff is
         :meth:`Robot.inverse_dynamics` with nominal friction.
+
+    Raises
+    ------
+    ValueError
+        If ``dt`` is given and not a positive number.
     """
     G = robot.gear_ratio
     feedforward = robot.inverse_dynamics(q, qd, qdd, friction=True) / G
-    return np.stack([G * q, G * qd, feedforward], axis=-1)
+    speed = G * np.asarray(qd, dtype=float)
+    if dt is not None:
+        if not dt > 0:
+            raise ValueError(f"dt = {dt!r}; expected the physics step, a positive number of seconds")
+        speed[:-1] = G * np.diff(q, axis=0) / dt
+    return np.stack([G * q, speed, feedforward], axis=-1)

@@ -193,6 +193,51 @@ def lugre_parameters(friction: MotorFriction) -> np.ndarray:
     )
 
 
+def check_lugre_step(friction: MotorFriction, timestep: float, speed_damping: np.ndarray) -> None:
+    """Refuse LuGre parameters that MuJoCo's ``implicitfast`` step cannot integrate to convergence.
+
+    Two conditions, both measured in docs/simulation.md ("Numerical convergence"):
+
+    * bristle damping sigma_1 must be 0. MuJoCo's ``dcmotor`` treats ``-sigma_1 dz/dt`` as a
+      damping ``-sigma_1 v`` in the implicit step at every speed, but in sliding the bristle sits
+      at its steady state and the force's true speed derivative is about 0: the rotor moves as if
+      its inertia were ``Jm + h sigma_1`` (40-145 % too heavy at 0.5 ms with the earlier
+      ``sigma_1 = 2 sqrt(sigma_0 Jm)``), a first-order step error. Canudas de Wit, Olsson, Astrom
+      & Lischinsky (1995) let sigma_1 vanish away from zero speed; MuJoCo has one constant, so it
+      is 0 and the presliding mode is damped by the drive's speed loop and viscous friction;
+    * ``sigma_0 h < kd + f_v``: the bristle state is advanced with the speed at the start of the
+      step, so at rest the rotor on its bristles is an explicit (forward-Euler) oscillator whose
+      energy grows by ``(1 + h^2 sigma_0 / Jm)`` per step unless the implicit damping removes more.
+
+    Parameters
+    ----------
+    friction : MotorFriction
+    timestep : float
+        Physics step h in s.
+    speed_damping : ndarray of shape (n_axes,)
+        Damping of each rotor by its drive, the speed-loop gain kd in N m s/rad at the motor side.
+
+    Raises
+    ------
+    ValueError
+        Naming the axis, the value and the largest one allowed.
+    """
+    for k in range(len(friction.bristle_damping)):
+        if friction.bristle_damping[k] > 0:
+            raise ValueError(
+                f"axis {k + 1}: bristle_damping = {float(friction.bristle_damping[k])!r} N m s/rad; the lugre model "
+                "needs 0 (MuJoCo integrates it as damping at every speed, which adds h * sigma_1 of rotor "
+                "inertia; docs/simulation.md, 'Numerical convergence'), or use --friction stribeck"
+            )
+        limit = (speed_damping[k] + friction.viscous[k]) / timestep
+        if friction.bristle_stiffness[k] >= limit:
+            raise ValueError(
+                f"axis {k + 1}: bristle_stiffness = {float(friction.bristle_stiffness[k])!r} N m/rad is too stiff for "
+                f"the {timestep * 1e3:g} ms physics step; expected below (kd + viscous) / timestep = {limit:.4g} "
+                "N m/rad (a longer presliding deflection), or a smaller timestep"
+            )
+
+
 def add_lugre(spec, robot) -> None:
     """Add a passive LuGre friction actuator ``lugre{i}`` on every rotor joint, in place.
 

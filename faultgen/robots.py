@@ -27,6 +27,8 @@ a model; absent, they are zero:
 
 from __future__ import annotations
 
+import re
+import shutil
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -393,6 +395,48 @@ def load(name: str | Path) -> Robot:
         listing = ", ".join(known) or "(none found in " + str(robots_dir()) + ")"
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
     return _from_file(path.resolve())
+
+
+def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path:
+    """Copy a robot's folder into ``folder`` with only its physics step changed.
+
+    For convergence studies (``benchmarks/convergence.py``): the copy is the robot's own MJCF with
+    ``<option timestep=...>`` rewritten and nothing else (no re-serialisation, so every other
+    number keeps its digits), beside the robot's ``tasks.toml``.
+
+    Parameters
+    ----------
+    name : str or Path
+        As :func:`load`.
+    timestep : float
+        Physics step in s; 4 ms (the logging period) must be a whole number of steps.
+    folder : str or Path
+        Where the copy goes, as ``folder/<name>/<name>.xml``; created if missing.
+
+    Returns
+    -------
+    Path
+        The copied MJCF, loadable by :func:`load`.
+
+    Raises
+    ------
+    ValueError
+        If ``timestep`` is not positive or does not divide 4 ms, or the MJCF has no
+        ``<option timestep="...">`` to change.
+    """
+    per_log = 0.004 / timestep if timestep > 0 else 0.0
+    if not (timestep > 0 and abs(per_log - round(per_log)) < 1e-9 * per_log and round(per_log) >= 1):
+        raise ValueError(f"timestep = {timestep!r} s; expected a positive step that divides 4 ms")
+    source = load(name).path
+    text, count = re.subn(r'(<option\b[^>]*\btimestep=")[^"]*(")', rf"\g<1>{timestep!r}\g<2>",
+                          source.read_text(), count=1)
+    if not count:
+        raise ValueError(f"{source}: no <option timestep=\"...\"> to change")
+    target = Path(folder) / source.stem
+    target.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(source.parent / "tasks.toml", target / "tasks.toml")
+    (target / source.name).write_text(text)
+    return target / source.name
 
 
 def from_spec(spec: mujoco.MjSpec, path: str | Path) -> Robot:

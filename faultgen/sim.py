@@ -150,6 +150,36 @@ class SimModel:
     drive_ids: np.ndarray
     lugre_ids: np.ndarray
 
+    def applied_force(self, force: np.ndarray, dv_m: np.ndarray) -> np.ndarray:
+        """Actuator forces as the implicit step applied them, from those MuJoCo reports.
+
+        ``mjData.actuator_force`` is each actuator's force at the start of a step, but the
+        ``implicitfast`` step applies it linearised at the end-of-step velocity,
+        ``f + (df/dv) (v+ - v)`` (MuJoCo's ``mjd_actuator_vel``): for a drive ``df/dv = -kd``, for a
+        LuGre actuator ``-sigma_1``; a drive clamped at its torque limit contributes no derivative.
+        Recording the start-of-step value instead would add ``kd h qdd_m`` to every logged motor
+        torque, a first-order step error (docs/simulation.md, "Numerical convergence").
+
+        Parameters
+        ----------
+        force : ndarray of shape (..., n_actuators)
+            ``actuator_force`` of a step, N m at the motor side.
+        dv_m : ndarray of shape (..., 6)
+            Rotor speed change over that step, rad/s.
+
+        Returns
+        -------
+        ndarray of shape (..., n_actuators)
+        """
+        applied = np.array(force, dtype=float)
+        limit = self.robot.motor_torque_limit
+        drives = applied[..., self.drive_ids]
+        free = np.abs(drives) < limit
+        applied[..., self.drive_ids] = np.where(free, drives - self.gains.kd * dv_m, drives)
+        if self.lugre_ids.size:
+            applied[..., self.lugre_ids] -= self.robot.friction.bristle_damping * dv_m
+        return applied
+
 
 def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
     """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model.
@@ -170,6 +200,7 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
                 f"{robot.path}: load-dependent friction and warm-up drift (numerics load_friction, thermal) "
                 "are set from Python every step; simulate this model with --friction stribeck"
             )
+        friction.check_lugre_step(robot.friction, spec.option.timestep, gains.kd)
         friction.add_lugre(spec, robot)
     else:
         friction.add_stribeck(spec, robot)
@@ -345,7 +376,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
-    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
+    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref, sim.model.opt.timestep)  # (n_steps + 1, 6, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
     return sim, task, path, q_ref, inputs
@@ -405,6 +436,7 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
                (("qpos", model.nq), ("qvel", model.nv), ("actuator_force", model.actuator_trnid.shape[0]))}
     logs = {f.name: np.empty((n_sim, n_steps // per_log, 6)) for f in fields(_Raw)}
     arm_dist = model.nu + robot.arm_dof
+    last_qvel = batch.qvel.copy()
     for start in range(0, n_steps, chunk):
         stop = min(start + chunk, n_steps)
         size = stop - start
@@ -416,13 +448,18 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
         logged = slice(start // per_log, stop // per_log)
         qpos, qvel, force = (out[k][:, per_log - 1 :: per_log] for k in ("qpos", "qvel", "actuator_force"))
         v_m = qvel[:, :, robot.rotor_dof]
+        # rotor speeds one step before each logged one (the last of the previous chunk for a 4 ms step)
+        before = out["qvel"][:, per_log - 2 :: per_log] if per_log > 1 else np.concatenate(
+            [last_qvel[:, None], out["qvel"][:, :-1]], axis=1)
+        last_qvel = out["qvel"][:, -1].copy()
+        applied = sim.applied_force(force, v_m - before[:, :, robot.rotor_dof])
         logs["q_a"][:, logged] = qpos[:, :, robot.arm_qpos]
         logs["q_m"][:, logged] = qpos[:, :, robot.rotor_qpos]
         logs["qd_a"][:, logged] = qvel[:, :, robot.arm_dof]
         logs["qd_m"][:, logged] = v_m
-        logs["tau_m"][:, logged] = force[:, :, sim.drive_ids]
+        logs["tau_m"][:, logged] = applied[:, :, sim.drive_ids]
         # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
-        logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
+        logs["tau_f"][:, logged] = -applied[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
         bar.update(n_sim * size * model.opt.timestep)
     return _Raw(**logs)
 
@@ -454,15 +491,18 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
             frictionloss[:, rotor] += robot.load_friction * np.abs(K * deflection) / G
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
+        logged = (step + 1) % per_log == 0
+        if logged:
+            v_before = qvel[:, rotor].copy()
         batch.step()
-        if (step + 1) % per_log == 0:
+        if logged:
             j = (step + 1) // per_log - 1
             v_m = qvel[:, rotor]
             logs["q_a"][:, j] = qpos[:, robot.arm_qpos]
             logs["q_m"][:, j] = qpos[:, robot.rotor_qpos]
             logs["qd_a"][:, j] = qvel[:, arm]
             logs["qd_m"][:, j] = v_m
-            logs["tau_m"][:, j] = force[:, sim.drive_ids]
+            logs["tau_m"][:, j] = sim.applied_force(force, v_m - v_before)[:, sim.drive_ids]
             logs["tau_f"][:, j] = -constraint[:, rotor] + robot.friction.viscous * v_m
             bar.update(len(cycles) * per_log * model.opt.timestep)
             if (j + 1) % CHUNK_PERIODS == 0 or j == n_log - 1:

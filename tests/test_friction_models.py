@@ -2,14 +2,16 @@
 
 A test rig of six free rotors named like a robot's (``rotor1..6``, each with the robot's motor
 inertia) gets the robot's friction exactly as a simulation does (``friction.add_lugre`` /
-``friction.add_stribeck``); no gearbox or arm is attached, so the rotor feels friction only.
+``friction.add_stribeck``); no gearbox or arm is attached, so the rotor feels friction only, and
+the damping of its drive's speed loop (joint damping kd), without which the bristles of the lugre
+model ring without damping (``friction.check_lugre_step``).
 """
 
 import mujoco
 import numpy as np
 import pytest
 
-from faultgen import friction, robots
+from faultgen import control, friction, robots
 
 TIMESTEP = 0.0005
 
@@ -18,10 +20,12 @@ def rig(robot, model_name, armature=None):
     spec = mujoco.MjSpec()
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    kd = control.ServoGains.for_robot(robot).kd
     for k, name in enumerate(robot.rotor_names):
         body = spec.worldbody.add_body(name=name)
         body.add_joint(name=name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1],
-                       armature=float(robot.motor_inertia[k] if armature is None else armature))
+                       armature=float(robot.motor_inertia[k] if armature is None else armature),
+                       damping=float(kd[k]))
         body.mass = 1e-9
         body.inertia = [1e-12] * 3
         body.explicitinertial = True
@@ -85,12 +89,19 @@ def test_breakaway_under_slowly_rising_torque_is_coulomb_plus_static(model_name)
         data.qfrc_applied[:] = rate * k * TIMESTEP
         step(model, data, robot, model_name)
         moving = np.isnan(found) & (data.qvel > 0.01 * f.stribeck_velocity)
-        found[moving] = data.qfrc_applied[moving]
+        # the torque friction takes: the applied one less the drive's damping (lugre rig only)
+        drive = model.dof_damping * data.qvel if model_name == "lugre" else 0.0
+        found[moving] = (data.qfrc_applied - drive)[moving]
     print(model_name, "breakaway / (f_c + f_s):", found / breakaway)
     np.testing.assert_allclose(found, breakaway, rtol=0.05)
 
 
-def test_lugre_presliding_displacement_is_force_over_bristle_stiffness():
+def test_lugre_holds_a_torque_below_breakaway_on_its_bristles():
+    """Under 10 % of the breakaway torque the rotor comes to rest held by its bristles,
+    sigma_0 z = F; its displacement is F / sigma_0 plus what it slipped on the way, which is
+    more than the 5 % of the earlier stiff, critically damped bristles: with sigma_1 = 0 the
+    approach is damped only by the drive (measured 1.16-1.60 at a 0.0625 ms step, 1.18-2.15 at
+    0.5 ms: the presliding slip of the wrists is not converged at the default step)."""
     robot = robots.load("irb6700")
     model = rig(robot, "lugre")
     data = mujoco.MjData(model)
@@ -99,9 +110,12 @@ def test_lugre_presliding_displacement_is_force_over_bristle_stiffness():
     data.qfrc_applied[:] = force
     for _ in range(int(1.0 / TIMESTEP)):
         mujoco.mj_step(model, data)
+    mujoco.mj_forward(model, data)
+    assert np.all(np.abs(data.qvel) < 1e-5)  # at rest: stuck, not sliding
+    np.testing.assert_allclose(rig_friction(model, data, robot, "lugre"), force, rtol=1e-3)
     print("presliding displacement / (F / sigma_0):", data.qpos / (force / f.bristle_stiffness))
-    assert np.all(np.abs(data.qvel) < 1e-6)  # at rest: stuck, not sliding
-    np.testing.assert_allclose(data.qpos, force / f.bristle_stiffness, rtol=0.1)
+    assert np.all(data.qpos >= force / f.bristle_stiffness)
+    assert np.all(data.qpos < 2.5 * force / f.bristle_stiffness)
 
 
 def test_static_model_sticks_below_breakaway():
