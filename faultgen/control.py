@@ -94,7 +94,8 @@ def add_drives(spec: mujoco.MjSpec, robot: Robot, gains: ServoGains) -> None:
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
 
 
-def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: float | None = None) -> np.ndarray:
+def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: float | None = None,
+              end_gain: np.ndarray | None = None) -> np.ndarray:
     """Drive inputs along an arm-side reference path, with nominal-model feedforward.
 
     Parameters
@@ -104,13 +105,19 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: 
     q, qd, qdd : ndarray of shape (n, 6)
         Reference arm angles (rad), velocities (rad/s) and accelerations (rad/s^2).
     dt : float, optional
-        The physics step in s, when the rows are the set-points of consecutive steps. MuJoCo's
-        semi-implicit step moves a joint by ``h v+`` (``q+ = q + h v+``), so the velocity it
-        carries is the mean velocity over the step, half a step later than the position; the
-        speed set-point of row ``k`` is then the reference's mean speed over that step,
-        ``G (q[k+1] - q[k]) / dt`` (the last row keeps ``G qd``). With the speed set-point taken at
-        the step's start instead, the drive lags the reference by ``kd h qdd / (2 kp)``, a
+        The physics step in s, when row ``k`` is the input of the step from ``t_k`` to
+        ``t_k + dt``. MuJoCo's step moves a joint by ``h v+`` (``q+ = q + h v+``), so the velocity it
+        carries is the mean over the step: the speed set-point is then the reference's mean speed
+        over the step, ``G (q[k+1] - q[k]) / dt``, and the feedforward its mean,
+        ``(tau_ff[k] + tau_ff[k+1]) / 2`` (the last row keeps its own). Set-points taken at the
+        step's start instead make the drive lag the reference by ``kd h qdd / (2 kp)``, a
         first-order step error (docs/simulation.md, "Numerical convergence").
+    end_gain : ndarray of shape (6,), optional
+        With ``dt``, when the step evaluates the drives at its end position (MuJoCo's ``discrete``
+        integrator): their position gains kp in N m/rad. The step then sees the position error at
+        ``t_k + dt`` while the drive's integrator sees the one at ``t_k`` (explicit Euler), so the
+        position set-point stays ``G q[k]`` and the feedforward carries the reference's advance
+        over the step, ``kp G (q[k+1] - q[k])``; without it the drive lags one step behind.
 
     Returns
     -------
@@ -125,10 +132,14 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: 
         If ``dt`` is given and not a positive number.
     """
     G = robot.gear_ratio
+    q = np.asarray(q, dtype=float)
     feedforward = robot.inverse_dynamics(q, qd, qdd, friction=True) / G
-    speed = G * np.asarray(qd, dtype=float)
+    inputs = np.stack([G * q, G * np.asarray(qd, dtype=float), feedforward], axis=-1)
     if dt is not None:
         if not dt > 0:
             raise ValueError(f"dt = {dt!r}; expected the physics step, a positive number of seconds")
-        speed[:-1] = G * np.diff(q, axis=0) / dt
-    return np.stack([G * q, speed, feedforward], axis=-1)
+        inputs[:-1, :, 1] = G * np.diff(q, axis=0) / dt
+        inputs[:-1, :, 2] = (feedforward[:-1] + feedforward[1:]) / 2
+        if end_gain is not None:
+            inputs[:-1, :, 2] += end_gain * G * np.diff(q, axis=0)
+    return inputs

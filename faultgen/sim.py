@@ -150,34 +150,42 @@ class SimModel:
     drive_ids: np.ndarray
     lugre_ids: np.ndarray
 
-    def applied_force(self, force: np.ndarray, dv_m: np.ndarray) -> np.ndarray:
+    @property
+    def implicit_position(self) -> bool:
+        """Whether the step is implicit in position too (MuJoCo's ``discrete`` integrator)."""
+        return self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_DISCRETE
+
+    def applied_force(self, force: np.ndarray, v_m: np.ndarray, v_m_before: np.ndarray) -> np.ndarray:
         """Actuator forces as the implicit step applied them, from those MuJoCo reports.
 
-        ``mjData.actuator_force`` is each actuator's force at the start of a step, but the
-        ``implicitfast`` step applies it linearised at the end-of-step velocity,
-        ``f + (df/dv) (v+ - v)`` (MuJoCo's ``mjd_actuator_vel``): for a drive ``df/dv = -kd``, for a
-        LuGre actuator ``-sigma_1``; a drive clamped at its torque limit contributes no derivative.
-        Recording the start-of-step value instead would add ``kd h qdd_m`` to every logged motor
-        torque, a first-order step error (docs/simulation.md, "Numerical convergence").
+        ``mjData.actuator_force`` is each actuator's force at the start of a step, but an implicit
+        step applies it linearised at the end of the step: ``f + (df/dv) (v+ - v)`` under
+        ``implicitfast`` and, under ``discrete``, also ``+ (df/dq) (q+ - q)`` with ``q+ - q = h v+``
+        (MuJoCo's integrator documentation; checked in tests/test_convergence.py). For a drive
+        ``df/dq = -kp`` and ``df/dv = -kd``; a drive clamped at its torque limit contributes no
+        derivative; the passive actuators (LuGre with sigma_1 = 0, cogging, offsets) none.
+        Recording the start-of-step value instead would add ``kd h qdd_m`` (and ``kp h qd_m``) to
+        every logged motor torque, a first-order step error (docs/simulation.md, "Numerical
+        convergence").
 
         Parameters
         ----------
         force : ndarray of shape (..., n_actuators)
             ``actuator_force`` of a step, N m at the motor side.
-        dv_m : ndarray of shape (..., 6)
-            Rotor speed change over that step, rad/s.
+        v_m, v_m_before : ndarray of shape (..., 6)
+            Rotor speeds after and before that step, rad/s.
 
         Returns
         -------
         ndarray of shape (..., n_actuators)
         """
         applied = np.array(force, dtype=float)
-        limit = self.robot.motor_torque_limit
         drives = applied[..., self.drive_ids]
-        free = np.abs(drives) < limit
-        applied[..., self.drive_ids] = np.where(free, drives - self.gains.kd * dv_m, drives)
-        if self.lugre_ids.size:
-            applied[..., self.lugre_ids] -= self.robot.friction.bristle_damping * dv_m
+        change = self.gains.kd * (v_m - v_m_before)
+        if self.implicit_position:
+            change = change + self.gains.kp * self.model.opt.timestep * v_m
+        free = np.abs(drives) < self.robot.motor_torque_limit
+        applied[..., self.drive_ids] = np.where(free, drives - change, drives)
         return applied
 
 
@@ -376,7 +384,8 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
-    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref, sim.model.opt.timestep)  # (n_steps + 1, 6, 3)
+    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref, sim.model.opt.timestep,
+                               sim.gains.kp if sim.implicit_position else None)  # (n_steps + 1, 6, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
     return sim, task, path, q_ref, inputs
@@ -452,7 +461,7 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
         before = out["qvel"][:, per_log - 2 :: per_log] if per_log > 1 else np.concatenate(
             [last_qvel[:, None], out["qvel"][:, :-1]], axis=1)
         last_qvel = out["qvel"][:, -1].copy()
-        applied = sim.applied_force(force, v_m - before[:, :, robot.rotor_dof])
+        applied = sim.applied_force(force, v_m, before[:, :, robot.rotor_dof])
         logs["q_a"][:, logged] = qpos[:, :, robot.arm_qpos]
         logs["q_m"][:, logged] = qpos[:, :, robot.rotor_qpos]
         logs["qd_a"][:, logged] = qvel[:, :, robot.arm_dof]
@@ -502,7 +511,7 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
             logs["q_m"][:, j] = qpos[:, robot.rotor_qpos]
             logs["qd_a"][:, j] = qvel[:, arm]
             logs["qd_m"][:, j] = v_m
-            logs["tau_m"][:, j] = sim.applied_force(force, v_m - v_before)[:, sim.drive_ids]
+            logs["tau_m"][:, j] = sim.applied_force(force, v_m, v_before)[:, sim.drive_ids]
             logs["tau_f"][:, j] = -constraint[:, rotor] + robot.friction.viscous * v_m
             bar.update(len(cycles) * per_log * model.opt.timestep)
             if (j + 1) % CHUNK_PERIODS == 0 or j == n_log - 1:
