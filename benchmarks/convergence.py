@@ -123,6 +123,13 @@ def main() -> None:
     with pd.option_context("display.width", 200, "display.max_rows", 500):
         print(summary[["robot", "task", "friction", "quantity", "axis", "h*1", "limit", "error", "error_h/2",
                        "order_ratio"]].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    if set(args.friction) == set(friction_models.MODELS):
+        print("lugre against the static model at the limit: (lugre - stribeck) / stribeck, per axis, %")
+        limits = table.pivot_table(index=["robot", "task", "quantity", "axis"], columns="friction", values="limit")
+        difference = 100 * (limits["lugre"] - limits["stribeck"]) / limits["stribeck"].abs()
+        for (robot, task, name), part in difference.groupby(level=[0, 1, 2]):
+            if name in ("mean|tau|", "mean|f|"):
+                print(f"  {robot:8} {task:11} {name:10} " + " ".join(f"{v:+7.2f}" for v in part.to_numpy()))
     for name, goal in GOALS.items():
         part = table[table["quantity"] == name]
         print(f"{name:>10}: worst error {part['error'].max():.4f} (goal {goal:g}), "
