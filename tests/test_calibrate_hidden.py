@@ -133,16 +133,19 @@ def test_measured_file_is_what_the_reader_accepts(tmp_path):
 
 
 def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
-    """The loop repeats until nothing is significant: a payload, then Coulomb friction on axis 5
-    (the worked example of docs/calibration.md), and then it stops."""
+    """The loop repeats until nothing is significant: a payload and Coulomb friction on axis 5
+    (the worked example of docs/calibration.md), and then it stops. Which comes first is a near
+    tie of the search's ranking: payload first before the convergence work (0.2372 -> 0.1191 ->
+    0.0129), Coulomb first since (0.2366 -> 0.1304 -> 0.0124); both are found, with their values."""
     robot = robots.load("puma560")
     payload = synth.Hidden("payload", [1, 2, 3, 4, 5, 6], {"robot": {"mass_kg": 2.2}})
     with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
     coulomb = synth.Hidden("coulomb", [5], {"5": {"coulomb_change_Nm_motor": 0.03}})
     path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3)
     result = calibrate("puma560", path, tmp_path / "out")
-    assert [(s.effect, s.axes) for s in result.steps] == [("payload", [1, 2, 3, 4, 5, 6]), ("coulomb", [5])]
-    assert result.steps[0].params["robot"]["mass_kg"] == pytest.approx(2.2, rel=0.03)
-    assert result.steps[1].params["5"]["coulomb_change_Nm_motor"] == pytest.approx(0.03, rel=0.03)
+    found = {s.effect: s for s in result.steps}
+    assert sorted((s.effect, s.axes) for s in result.steps) == [("coulomb", [5]), ("payload", [1, 2, 3, 4, 5, 6])]
+    assert found["payload"].params["robot"]["mass_kg"] == pytest.approx(2.2, rel=0.03)
+    assert found["coulomb"].params["5"]["coulomb_change_Nm_motor"] == pytest.approx(0.03, rel=0.03)
     assert result.steps[0].gap_after["total_nrmse"] < result.gap_before["total_nrmse"]
     assert result.gap_after["total_nrmse"] < 0.15 * result.gap_before["total_nrmse"]
