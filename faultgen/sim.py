@@ -156,17 +156,7 @@ class SimModel:
         return self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_DISCRETE
 
     def applied_force(self, force: np.ndarray, v_m: np.ndarray, v_m_before: np.ndarray) -> np.ndarray:
-        """Actuator forces as the implicit step applied them, from those MuJoCo reports.
-
-        ``mjData.actuator_force`` is each actuator's force at the start of a step, but an implicit
-        step applies it linearised at the end of the step: ``f + (df/dv) (v+ - v)`` under
-        ``implicitfast`` and, under ``discrete``, also ``+ (df/dq) (q+ - q)`` with ``q+ - q = h v+``
-        (MuJoCo's integrator documentation; checked in tests/test_convergence.py). For a drive
-        ``df/dq = -kp`` and ``df/dv = -kd``; a drive clamped at its torque limit contributes no
-        derivative; the passive actuators (LuGre with sigma_1 = 0, cogging, offsets) none.
-        Recording the start-of-step value instead would add ``kd h qdd_m`` (and ``kp h qd_m``) to
-        every logged motor torque, a first-order step error (docs/simulation.md, "Numerical
-        convergence").
+        """:func:`applied_drive_torque` for this model's drives, on ``actuator_force`` rows.
 
         Parameters
         ----------
@@ -178,15 +168,51 @@ class SimModel:
         Returns
         -------
         ndarray of shape (..., n_actuators)
+            ``force`` with the drives' rows as the step applied them (the passive actuators, LuGre
+            with sigma_1 = 0, cogging and offsets, have no speed or position derivative).
         """
         applied = np.array(force, dtype=float)
-        drives = applied[..., self.drive_ids]
-        change = self.gains.kd * (v_m - v_m_before)
-        if self.implicit_position:
-            change = change + self.gains.kp * self.model.opt.timestep * v_m
-        free = np.abs(drives) < self.robot.motor_torque_limit
-        applied[..., self.drive_ids] = np.where(free, drives - change, drives)
+        applied[..., self.drive_ids] = applied_drive_torque(
+            applied[..., self.drive_ids], v_m, v_m_before, self.gains.kp, self.gains.kd,
+            self.robot.motor_torque_limit, self.model.opt.timestep, self.implicit_position)
         return applied
+
+
+def applied_drive_torque(force: np.ndarray, v: np.ndarray, v_before: np.ndarray, kp: np.ndarray,
+                         kd: np.ndarray, limit: np.ndarray, timestep: float, implicit_position: bool) -> np.ndarray:
+    """PID drive torques as MuJoCo's implicit step applied them, from those it reports.
+
+    ``mjData.actuator_force`` is a drive's torque at the start of a step, but an implicit step
+    applies it linearised at the end: ``f - kd (v+ - v)`` under ``implicitfast`` (its speed
+    derivative) and, under ``discrete``, also ``- kp (q+ - q) = - kp h v+`` (its position derivative;
+    MuJoCo's integrator documentation). A drive clamped at its torque limit has no derivative.
+    Recording the start-of-step value would add ``kd h qdd_m`` (and ``kp h qd_m``) to every logged
+    motor torque, a first-order step error (docs/simulation.md, "Numerical convergence"); tested
+    against Newton's law on a driven rotor (tests/test_convergence.py).
+
+    Parameters
+    ----------
+    force : ndarray of shape (..., n)
+        Reported drive torques of a step, N m.
+    v, v_before : ndarray of shape (..., n)
+        Joint speeds after and before that step, rad/s.
+    kp, kd : ndarray of shape (n,)
+        Position gain, N m/rad, and speed gain, N m s/rad.
+    limit : ndarray of shape (n,)
+        Torque limit, N m.
+    timestep : float
+        Physics step h, s.
+    implicit_position : bool
+        Whether the step is implicit in position too (``discrete``).
+
+    Returns
+    -------
+    ndarray of shape (..., n)
+    """
+    change = kd * (v - v_before)
+    if implicit_position:
+        change = change + kp * timestep * v
+    return np.where(np.abs(force) < limit, force - change, force)
 
 
 def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
