@@ -34,17 +34,17 @@ CASES.append(("irb6700", "backlash", 4))
 HALF = 0.5
 #: ... except where it is not met. IRB-6700-like cogging: named right, on the right axes, but the
 #: drive sees the detent torque through the soft gearboxes' resonances, so a constant-amplitude
-#: sinusoid in the motor angle leaves part of it (seed 0: 0.125 -> 0.071, ratio 0.57). The
+#: sinusoid in the motor angle leaves part of it (seed 0: 0.122 -> 0.069, ratio 0.56). The
 #: shortfall is reported in docs/calibration.md; this bound keeps it from getting worse.
 SHORT = {("irb6700", "cogging"): 0.6,
          # PUMA 560 backlash: the floor is more than half the gap before (seed 0: 0.0133 of 0.0252),
          # the model at the fitted width leaves 0.0175, ratio 0.69 (seeds 0-4: 0.69-0.76)
          ("puma560", "backlash"): 0.75}
 #: Held-out total nrmse of the nominal model on a log with nothing hidden (seeds 0-4: PUMA 560
-#: 0.0131-0.0133, IRB-6700-like 0.0136-0.0138, docs/calibration.md). Simulated at the robot
-#: models' 0.5 ms step instead of synth.TIMESTEP, the integrator's extra inertia raised them to
-#: 0.025 and 0.039; with every cycle restarted from the start state instead of back to back, the
-#: IRB's was 0.022.
+#: 0.0126-0.0128, IRB-6700-like 0.0124-0.0126, docs/calibration.md; 0.0131-0.0138 before the
+#: convergence work). Simulated at the 0.5 ms step with the earlier ``implicitfast`` integrator,
+#: its extra inertia raised them to 0.025 and 0.039; with every cycle restarted from the start
+#: state instead of back to back, the IRB's was 0.022.
 FLOOR = {"puma560": 0.015, "irb6700": 0.015}
 
 
