@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
-from faultgen import control, robots, sensors, sim, tasks
+from faultgen import robots, sensors, sim, tasks
 
 
 def _prepared(config: sim.RunConfig):
@@ -33,7 +33,7 @@ def same_work_seconds(config: sim.RunConfig) -> float:
     robot, model_sim, path, n_steps = _prepared(config)
     model = model_sim.model
     n_sim = len(config.recorded_cycles)
-    inputs = control.setpoints(robot, path.q, path.qd, path.qdd, model.opt.timestep)
+    inputs = model_sim.setpoints(path.q, path.qd, path.qdd)
     inputs = np.vstack([inputs, np.repeat(inputs[-1:], max(0, n_steps - len(inputs)), axis=0)])[:n_steps]
     control_in = np.zeros((n_sim, n_steps, model.nu + model.nv))
     control_in[:, :, : model.nu][:, :, model_sim.drive_ctrl] = inputs

@@ -155,6 +155,12 @@ class SimModel:
         """Whether the step is implicit in position too (MuJoCo's ``discrete`` integrator)."""
         return self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_DISCRETE
 
+    def setpoints(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """:func:`faultgen.control.setpoints` of a path sampled at this model's physics step, for its
+        integrator (the drives' position gains when it is implicit in position), ``(n, 6, 3)``."""
+        return control.setpoints(self.robot, q, qd, qdd, self.model.opt.timestep,
+                                 self.gains.kp if self.implicit_position else None)
+
     def applied_force(self, force: np.ndarray, v_m: np.ndarray, v_m_before: np.ndarray) -> np.ndarray:
         """:func:`applied_drive_torque` for this model's drives, on ``actuator_force`` rows.
 
@@ -410,8 +416,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
-    inputs = control.setpoints(robot, q_ref, qd_ref, qdd_ref, sim.model.opt.timestep,
-                               sim.gains.kp if sim.implicit_position else None)  # (n_steps + 1, 6, 3)
+    inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
     return sim, task, path, q_ref, inputs
@@ -494,7 +499,7 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
         logs["qd_m"][:, logged] = v_m
         logs["tau_m"][:, logged] = applied[:, :, sim.drive_ids]
         # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
-        logs["tau_f"][:, logged] = -applied[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
+        logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
         bar.update(n_sim * size * model.opt.timestep)
     return _Raw(**logs)
 
