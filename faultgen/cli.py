@@ -9,12 +9,47 @@ from typing import Annotated
 
 import numpy as np
 import typer
+from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from faultgen import __version__, robots
 from faultgen.friction import FIELDS as FRICTION_FIELDS
 from faultgen.friction import UNITS as FRICTION_UNITS
 
+
+class _PlainHelp:
+    """Help without typer's type tags (``<bool>``, ``<list[int]>``): a flag shows nothing after
+    its name, an option taking a value its metavar, by default the option's name in capitals as
+    argparse writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``)."""
+
+    def get_params(self, ctx):
+        params = super().get_params(ctx)
+        for param in params:
+            if isinstance(param, TyperOption) and param.metavar is None:
+                long_name = max(param.opts, key=len).lstrip("-")
+                param.metavar = "" if param.is_flag else long_name.upper().replace("-", "_")
+            elif isinstance(param, TyperArgument) and param.metavar is None:
+                param.metavar = param.name.upper()
+                param.display_type_rich = _no_type_tag  # typer has no setting for the argument's tag
+        return params
+
+
+def _no_type_tag(ctx) -> None:
+    return None
+
+
+class PlainHelpCommand(_PlainHelp, TyperCommand):
+    """A command whose help has no type tags (:class:`_PlainHelp`)."""
+
+
+class PlainHelpGroup(_PlainHelp, TyperGroup):
+    """The command group, with the same plain help."""
+
+
+#: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
+Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
+
 app = typer.Typer(
+    cls=PlainHelpGroup,
     help=(
         "Simulate wear faults in industrial robots and analyse them.\n\n"
         "A first dataset: `faultgen sweep --preset quick -o quick.h5` (under a minute), then "
@@ -43,7 +78,7 @@ def main(
     """faultgen: labelled wear-fault data for industrial robots."""
 
 
-@app.command("robots")
+@app.command("robots", cls=PlainHelpCommand)
 def robots_command(
     name: Annotated[
         str | None,
@@ -98,7 +133,7 @@ def _describe(robot: robots.Robot) -> str:
     return head + "\n".join(lines)
 
 
-@app.command("simulate")
+@app.command("simulate", cls=PlainHelpCommand)
 def simulate_command(
     robot: Annotated[str, typer.Option(
         "--robot", "--model",
@@ -128,7 +163,7 @@ def simulate_command(
     encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).")] = 1e-4,
     threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.")] = 0,
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")] = Path("run.h5"),
-    overwrite: Annotated[bool, typer.Option(help="Replace OUT if it exists.")] = False,
+    overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """Simulate one run: a robot repeating a task while chosen axes wear, into an HDF5 file.
@@ -146,16 +181,13 @@ def simulate_command(
     from faultgen import wear as wear_module
 
     try:
-        if out.exists() and not overwrite:
-            raise ValueError(f"{out} exists; pass --overwrite to replace it or choose another --out")
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise ValueError(f"folder of --out {out} does not exist")
+        _check_outputs([out], overwrite)
         if cycles < 1:
             raise ValueError(f"--cycles {cycles}: expected a whole number >= 1")
         config = sim.RunConfig(
             robot=robot, task=task, friction=friction_model,
             wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
-            record=_parse_cycles(record) if record else None, seed=seed,
+            record=None if record is None else _parse_cycles(record), seed=seed,
             noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
         )
     except ValueError as err:
@@ -171,7 +203,7 @@ def simulate_command(
     typer.echo(_summary(result, out))
 
 
-@app.command("calibrate")
+@app.command("calibrate", cls=PlainHelpCommand)
 def calibrate_command(
     robot: Annotated[str, typer.Option(help="Robot name (see `faultgen robots`) or MJCF file of the nominal model.")],
     measured: Annotated[Path, typer.Option(
@@ -179,6 +211,7 @@ def calibrate_command(
              "side) and optionally qd1..qd6 (rad/s); at least 2 s at >= 100 Hz.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder (created): model/, report.json, calibration.png.")],
     max_steps: Annotated[int, typer.Option(help="Most effects to add.")] = 6,
+    overwrite: Overwrite = False,
 ) -> None:
     """Find what the model misses in a measured torque log, add it, and show the gap shrink.
 
@@ -206,6 +239,7 @@ def calibrate_command(
     from faultgen import calibrate
 
     try:
+        _check_output_folder(out, overwrite)
         result = calibrate.calibrate(robot, measured, out, max_steps=max_steps, progress=True)
     except ValueError as err:  # unknown robot, bad model file, refused measured data, bad option
         typer.echo(f"error: {err}", err=True)
@@ -214,7 +248,7 @@ def calibrate_command(
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
 
-@app.command("sweep")
+@app.command("sweep", cls=PlainHelpCommand)
 def sweep_command(
     preset: Annotated[
         str | None, typer.Option(help="A named grid: quick (a first look, < 2 min), j2 (thesis ch. 6), c2 (thesis ch. 3).")
@@ -236,6 +270,7 @@ def sweep_command(
         str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
     ] = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
+    overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """Simulate a grid of runs (robot x task x worn axis x wear x schedule x seed) into one dataset.
@@ -255,9 +290,11 @@ def sweep_command(
 
     options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
                "friction": friction_model, "cycles": cycles, "seeds": seeds,
-               "record": list(_parse_cycles(record)) if record else None}
-    options = {k: v for k, v in options.items() if v}
+               "record": record}
+    options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     try:
+        if record is not None:
+            options["record"] = list(_parse_cycles(record))
         if config is not None:
             grid = sweep.Grid.from_toml(config)
             if options:
@@ -268,18 +305,27 @@ def sweep_command(
             grid = sweep.Grid(**{"robots": ["irb6700"], "tasks": ["pick_place"], "axes": [0], **options})
         if jobs < 1:
             raise ValueError(f"--jobs {jobs}: expected >= 1")
-        if out.exists():
-            raise ValueError(f"{out} exists; remove it or choose another --out")
+        _check_outputs([out], overwrite)
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
-    n_runs, done = len(grid.runs()), len(sweep.finished_runs(grid, out))
-    typer.echo(f"{n_runs} runs -> {out}" + (f" on {scheduler}" if scheduler else f" with {jobs} job(s)"))
-    if done:
-        typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as they are")
+    where = f" on {scheduler}" if scheduler else f" with {jobs} job(s)"
+
+    def announce(n_runs: int, done: int) -> None:
+        typer.echo(f"{n_runs} runs -> {out}{where}")
+        if done:
+            typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
+                       "they are")
+
     try:
-        sweep.run(grid, out, jobs=jobs, scheduler=scheduler, progress=progress,
-                  command=shlex.join(["faultgen", *sys.argv[1:]]))
+        sweep.run(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
+                  command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
+    except sweep.SweepRefused as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    except sweep.SweepInterrupted as err:
+        typer.echo(str(err), err=True)
+        raise typer.Exit(130) from err
     except sweep.SweepError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(1) from err
@@ -287,7 +333,7 @@ def sweep_command(
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
 
-@app.command("info")
+@app.command("info", cls=PlainHelpCommand)
 def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Summarise a dataset: runs, robots, tasks, worn axes, cycles, provenance."""
     from faultgen import dataset
@@ -299,7 +345,7 @@ def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (
         raise typer.Exit(1) from err
 
 
-@app.command("validate")
+@app.command("validate", cls=PlainHelpCommand)
 def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Check a dataset against the schema (docs/dataset.md); exit 1 with the reasons if it fails."""
     from faultgen import dataset
@@ -312,62 +358,72 @@ def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen datas
     typer.echo(f"{file}: valid ({len(dataset.list_runs(file))} runs)")
 
 
-@app.command("plot")
+@app.command("plot", cls=PlainHelpCommand)
 def plot_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],
     run: Annotated[str | None, typer.Option(help="Plot one run (default: the whole sweep, or its only run).")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="PNG to write (default: FILE with .png).")] = None,
+    overwrite: Overwrite = False,
 ) -> None:
     """Draw per-cycle mean |motor torque| per axis against the true wear, as a PNG."""
     from faultgen import dataset, plot
 
     target = out or file.with_suffix(".png")
     try:
+        _check_outputs([target], overwrite)
         plot.plot(file, target, run=run)
-    except (ValueError, dataset.DatasetError) as err:
+    except ValueError as err:  # a broken dataset (1); refused: an existing or non-PNG output, an unknown run (2)
         typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(1) from err
+        raise typer.Exit(1 if isinstance(err, dataset.DatasetError) else 2) from err
     typer.echo(f"wrote {target}")
 
 
-def _analysis_input(file: Path) -> None:
-    """Refuse a dataset that fails validation before any analysis runs on it."""
+def _analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
+    """Refuse a dataset that fails validation, or outputs that exist, before any analysis runs."""
     from faultgen import dataset
 
     problems = dataset.validate(file)
     if problems:
         typer.echo(f"error: {file} fails validation (run `faultgen validate {file}`): {problems[0]}", err=True)
         raise typer.Exit(2)
+    try:
+        _check_outputs(outputs, overwrite)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
 
 
-def _table_command(file: Path, out: Path | None, suffix: str, digits: int, compute) -> None:
+def _table_command(file: Path, out: Path | None, overwrite: bool, suffix: str, digits: int, compute) -> None:
     """Validate ``file``, compute a table, write it as CSV and Markdown, print it."""
     from analysis import benchmark
 
-    _analysis_input(file)
+    stem = out or file.with_name(file.stem + suffix)
+    _analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md")], overwrite)
     try:
         table = compute()
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
-    written = benchmark.write_outputs(table, out or file.with_name(file.stem + suffix))
+    written = benchmark.write_outputs(table, stem)
     typer.echo(benchmark.markdown(table, digits=digits))
     typer.echo("wrote " + ", ".join(map(str, written)))
 
 
-@app.command("bench-isolators")
+@app.command("bench-isolators", cls=PlainHelpCommand)
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
     bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
+    overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
     worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap."""
     from analysis import benchmark
 
-    _analysis_input(file)
+    stem = out or file.with_name(file.stem + "-isolation")
+    _analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
     try:
         wear_levels = [float(x) for x in levels.split(",")]
         table = benchmark.isolation_table(file, benchmark.default_isolators(bins or (5, 10)), wear_levels,
@@ -375,7 +431,6 @@ def bench_isolators_command(
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
-    stem = out or file.with_name(file.stem + "-isolation")
     written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
     written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(benchmark.isolation_accuracy(table), digits=4))
@@ -386,7 +441,7 @@ def bench_isolators_command(
     typer.echo("wrote " + ", ".join(map(str, written)))
 
 
-@app.command("detect")
+@app.command("detect", cls=PlainHelpCommand)
 def detect_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
@@ -397,29 +452,52 @@ def detect_command(
     ] = 3,
     period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
+    overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout."""
     from analysis import benchmark
 
-    _table_command(file, out, "-detection", 4, lambda: benchmark.detection_table(
+    _table_command(file, out, overwrite, "-detection", 4, lambda: benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress))
 
 
-@app.command("classify")
+@app.command("classify", cls=PlainHelpCommand)
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
     wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.")] = 10.0,
     pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs and the random forest.")] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
+    overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""
     from analysis import benchmark
 
-    _table_command(file, out, "-classification", 3, lambda: benchmark.classification_table(
+    _table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress))
+
+
+def _check_outputs(files: list[Path], overwrite: bool) -> None:
+    """Refuse, before any work, output files that exist (unless ``overwrite``), are folders, or
+    whose folder does not exist; raises ValueError naming the file and what to do."""
+    for path in files:
+        if path.is_dir():
+            raise ValueError(f"{path} is a folder; --out expects a file name")
+        if path.exists() and not overwrite:
+            raise ValueError(f"{path} exists; pass --overwrite to replace it or choose another --out")
+        folder = path.parent if str(path.parent) else Path(".")
+        if not folder.is_dir():
+            raise ValueError(f"cannot write {path}: folder {folder} does not exist")
+
+
+def _check_output_folder(folder: Path, overwrite: bool) -> None:
+    """Refuse an output folder that is a file, or holds files already (unless ``overwrite``)."""
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{folder} is a file; --out expects a folder to write the results into")
+    if folder.is_dir() and any(folder.iterdir()) and not overwrite:
+        raise ValueError(f"{folder} holds earlier results; pass --overwrite to replace them or choose another --out")
 
 
 def _parse_cycles(text: str) -> tuple[int, ...]:

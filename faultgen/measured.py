@@ -14,7 +14,8 @@ column         unit     meaning
 
 stored as
 
-* a CSV file (``.csv``, or gzip-compressed ``.csv.gz``) with a header row holding the column
+* a CSV file (``.csv``, or gzip-compressed ``.csv.gz``; compression is recognised by the
+  content, so a compressed file named ``.csv`` reads too) with a header row holding the column
   names, comma-separated, one sample per row;
 * an HDF5 file (``.h5`` or ``.hdf5``) with **one 1-D dataset per column at the file root**,
   named as above and all of the same length. A dataset may carry a ``unit`` (or ``units``)
@@ -58,6 +59,7 @@ from __future__ import annotations
 import csv
 import gzip
 import math
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -84,6 +86,7 @@ UNITS.update(dict.fromkeys(TAU_COLUMNS, "N m"))
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
+GZIP_MAGIC = b"\x1f\x8b"
 HDF5_SUFFIXES = (".h5", ".hdf5")
 
 #: Lowest accepted sample rate in Hz (applied to the median sample period).
@@ -298,16 +301,31 @@ def _index_label(i: int) -> str:
 
 
 def _compression(path: Path) -> str | None:
+    """The compression a file written under this name gets: gzip for ``.gz``."""
     return "gzip" if path.name.lower().endswith(".gz") else None
 
 
+def _stored_compression(path: Path) -> str | None:
+    """"gzip" if the file's content starts with gzip's magic bytes (RFC 1952), whatever its name."""
+    try:
+        with open(path, "rb") as fh:
+            return "gzip" if fh.read(2) == GZIP_MAGIC else None
+    except OSError as err:
+        raise MeasuredDataError(f"{path}: cannot read the file: {err}") from err
+
+
 def _read_csv(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
-    """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller."""
-    opener = gzip.open if _compression(path) else open
+    """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
+
+    A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
+    reads like one named ``.csv.gz``.
+    """
+    compression = _stored_compression(path)
+    opener = gzip.open if compression else open
     try:
         with opener(path, "rt", newline="", encoding="utf-8-sig") as fh:
             header = next(csv.reader(fh), None)
-    except (OSError, UnicodeDecodeError, EOFError, csv.Error) as err:
+    except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
     if not header:
         raise MeasuredDataError(
@@ -324,7 +342,7 @@ def _read_csv(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
     # All columns are parsed (extra ones as text) so that a row with too many or too few
     # fields is refused by the parser with its line number instead of being silently cut.
     read_kw = {
-        "compression": _compression(path),
+        "compression": compression,
         "header": 0,
         "names": names,
         "index_col": False,

@@ -3,27 +3,41 @@
 Every run is simulated by a worker (joblib processes locally, or Dask distributed workers) and
 written by that worker to its own part file in ``<out>.parts/``, atomically. When every run is
 there, the parts are merged into the dataset ``<out>`` (renamed into place last) and the part
-folder is removed. Running the same sweep again after a crash or kill resumes: finished parts are
+folder is removed. Running the same sweep again after a crash, kill or Ctrl-C resumes: finished parts are
 kept as they are and only the missing runs are simulated.
+
+A sweep holds a lock on its output (``.<out>.lock`` beside it, an OS file lock through
+``filelock``) for as long as it runs, and names itself in ``<out>.parts/sweep.json``: a second
+sweep on the same output refuses at once, naming the first. The kernel releases the lock of a
+killed sweep, so the next one takes it over (and says so).
 """
 
 from __future__ import annotations
 
 import ctypes
+import datetime
 import gc
 import itertools
 import json
+import logging
+import os
 import shutil
+import socket
+import threading
 import time
 import tomllib
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
+import filelock
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen import dataset, friction, robots, sensors, sim, tasks, wear
+from faultgen import atomic, dataset, friction, robots, sensors, sim, tasks, wear
+
+log = logging.getLogger(__name__)
 
 #: Named grids. quick: a small grid for a first look (well under 2 minutes on 2 cores).
 #: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
@@ -41,6 +55,14 @@ PRESETS = {
 
 class SweepError(RuntimeError):
     """A sweep could not finish; the message says what to do. Finished runs are kept."""
+
+
+class SweepRefused(SweepError):
+    """A sweep refused to start (its output exists, or another sweep is writing it); nothing ran."""
+
+
+class SweepInterrupted(SweepError):
+    """A sweep was interrupted (Ctrl-C); the message says how many runs are kept and how to resume."""
 
 
 @dataclass(frozen=True)
@@ -177,6 +199,9 @@ class RunStats:
 
 def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "") -> RunStats:
     """Worker task: simulate one run and write it to its part file (atomically)."""
+    # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
+    # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
+    tqdm.set_lock(threading.RLock())
     started = time.perf_counter()
     result = sim.simulate(config, progress=False)
     writing = time.perf_counter()
@@ -221,7 +246,8 @@ def finished_runs(grid: Grid, out: str | Path) -> list[str]:
 
 def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
         command: str = "", on_run: Callable[[RunStats], None] | None = None,
-        timings: dict | None = None) -> Path:
+        timings: dict | None = None, overwrite: bool = False,
+        on_start: Callable[[int, int], None] | None = None) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
@@ -241,6 +267,10 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
         Called in this process with the :class:`RunStats` of each run as it finishes.
     timings : dict, optional
         Filled with the wall time of the final merge (``"merge"``, s), for benchmarks.
+    overwrite : bool
+        Replace ``out`` if it exists; by default an existing ``out`` is refused.
+    on_start : callable, optional
+        Called once the sweep holds its output, with (runs in the grid, runs already finished).
 
     Returns
     -------
@@ -248,6 +278,12 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
 
     Raises
     ------
+    SweepRefused
+        Before anything runs, if ``out`` exists (and not ``overwrite``) or another sweep is
+        writing it (the message names that sweep: pid, host, start time, command).
+    SweepInterrupted
+        On Ctrl-C (KeyboardInterrupt): the workers are stopped, and the message says how many
+        runs are kept and how to resume.
     SweepError
         If the output folder cannot be written or a run fails (the message names the run and says
         what to do); every finished run stays in the part folder for the next attempt.
@@ -255,26 +291,92 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     out = Path(out)
     plan = grid.runs()
     parts = parts_folder(out)
-    _prepare(out, parts)
-    todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
-    todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
-    with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
-              desc=f"sweep {out.name}") as bar:
-        for stats in _execute(todo, parts, jobs, scheduler, command):
-            bar.update(1)
-            if on_run is not None:
-                on_run(stats)
-    started = time.perf_counter()
-    try:
-        dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
-                      grid=grid.to_json())
-    except OSError as err:
-        raise SweepError(f"cannot write {out}: {err}; every run is kept in {parts}: free space or fix "
-                         "permissions and run the same command again") from err
-    if timings is not None:
-        timings["merge"] = time.perf_counter() - started
-    shutil.rmtree(parts)
+    with _lock(out, parts):
+        if out.exists() and not overwrite:
+            raise SweepRefused(f"{out} exists; pass --overwrite to replace it or choose another output")
+        _prepare(out, parts)
+        with _claim(out, parts, command):
+            todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
+            todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
+            if on_start is not None:
+                on_start(len(plan), len(plan) - len(todo))
+            try:
+                with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
+                          desc=f"sweep {out.name}") as bar:
+                    for stats in _execute(todo, parts, jobs, scheduler, command):
+                        bar.update(1)
+                        if on_run is not None:
+                            on_run(stats)
+            except KeyboardInterrupt:
+                kept = len(finished_runs(grid, out))
+                raise SweepInterrupted(f"interrupted: {kept} of {len(plan)} runs kept in {parts}; run the same "
+                                       "command to resume") from None
+            started = time.perf_counter()
+            try:
+                dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
+                              grid=grid.to_json())
+            except OSError as err:
+                raise SweepError(f"cannot write {out}: {err}; every run is kept in {parts}: free space or fix "
+                                 "permissions and run the same command again") from err
+            if timings is not None:
+                timings["merge"] = time.perf_counter() - started
+            shutil.rmtree(parts)
     return out
+
+
+def lock_path(out: Path) -> Path:
+    """The lock file a sweep holds while it writes ``out``: hidden, beside it, left in place."""
+    return out.with_name(f".{out.name}.lock")
+
+
+@contextmanager
+def _lock(out: Path, parts: Path) -> Iterator[None]:
+    """Hold the lock of ``out`` (:func:`lock_path`); refuse at once, naming the holder, if it is taken."""
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise SweepError(f"cannot write {out}: folder {out.parent} does not exist")
+    lock = filelock.FileLock(lock_path(out), timeout=0)
+    try:
+        lock.acquire()
+    except filelock.Timeout:
+        raise SweepRefused(f"another sweep is writing {out}: {_describe_holder(parts)}; wait for it to finish or "
+                           "stop it (a killed sweep's lock is taken over by the next one)") from None
+    except OSError as err:
+        raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
+    try:
+        yield
+    finally:
+        lock.release()
+
+
+@contextmanager
+def _claim(out: Path, parts: Path, command: str) -> Iterator[None]:
+    """Name this sweep in ``<parts>/sweep.json`` while it runs (what a refused second sweep prints).
+
+    The record is removed whenever this sweep ends, even by an error or Ctrl-C, so a record found
+    here was left by a killed sweep: that is said, and stale temporary files of ``out`` removed.
+    """
+    record = parts / "sweep.json"
+    try:
+        if record.exists():
+            log.warning("took over %s from a sweep that was killed (%s); its finished runs are kept", out,
+                        _describe_holder(parts))
+        atomic.write_text(record, json.dumps({
+            "pid": os.getpid(), "host": socket.gethostname(), "command": command,
+            "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}))
+        atomic.remove_stale(out)
+        yield
+    finally:
+        record.unlink(missing_ok=True)
+
+
+def _describe_holder(parts: Path) -> str:
+    """'pid 123 on host, started 2026-11-22T12:00:00+00:00: faultgen sweep ...', from the record."""
+    try:
+        holder = json.loads((parts / "sweep.json").read_text())
+        text = f"pid {holder['pid']} on {holder['host']}, started {holder['started']}"
+        return text + (f": {holder['command']}" if holder.get("command") else "")
+    except (OSError, ValueError, KeyError):
+        return "a sweep that has not named itself yet"
 
 
 def _expected_cost(item: tuple[str, sim.RunConfig]) -> float:
@@ -294,7 +396,8 @@ def _prepare(out: Path, parts: Path) -> None:
         raise SweepError(f"cannot write {out}: folder {out.parent} does not exist") from None
     except OSError as err:
         raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
-    for stale in parts.glob(".*.part"):
+    for stale in parts.glob(".*.part"):  # no worker runs while this sweep holds the lock: a killed one left it
+        log.warning("removed %s, an unfinished part left by a killed worker", stale)
         stale.unlink()
 
 
@@ -311,9 +414,21 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) 
 
             parallel = Parallel(n_jobs=jobs, return_as="generator_unordered")
             yield from parallel(delayed(simulate_and_write)(*call) for call in calls)
+    except KeyboardInterrupt:
+        if not scheduler:
+            _stop_local_workers()
+        raise
     except OSError as err:
         raise SweepError(f"a run could not be written: {err}. Finished runs are kept in {parts}; free space "
                          "or fix permissions and run the same command again") from err
+
+
+def _stop_local_workers() -> None:
+    """Shut joblib's worker processes down and wait for them, so that nothing they hold (loky's
+    semaphores) is left for Python's resource tracker to report as leaked at exit."""
+    from joblib.externals.loky import get_reusable_executor
+
+    get_reusable_executor().shutdown(wait=True, kill_workers=True)
 
 
 def _execute_dask(calls, scheduler: str) -> Iterator[RunStats]:

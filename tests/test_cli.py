@@ -1,5 +1,6 @@
 """The `faultgen` command, through its installed entry point and through typer's runner."""
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -184,3 +185,102 @@ def test_simulate_accepts_a_model_file(tmp_path):
     result = runner.invoke(app, ["simulate", "--model", str(spec_path), "--cycles", "1", "--no-progress",
                                  "--out", str(tmp_path / "r.h5")])
     assert result.exit_code == 0, result.output
+
+
+# --------------------------------------------------------------------------------------------
+# Every option honoured or refused, one --overwrite behaviour, plain help (issue 20 items 1, 4, 5, 8)
+
+ONE_RUN = ["--robot", "irb6700", "--task", "pick_place", "--axis", "0", "--no-progress"]
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--cycles", "0", "--record", "1"], "cycles = 0"),
+    (["--cycles", "2", "--record", ""], "--record part ''"),
+    (["--cycles", "2", "--record", "1", "--friction", ""], "unknown friction model ''"),
+])
+def test_sweep_refuses_a_falsy_option_instead_of_dropping_it(tmp_path, args, message):
+    out = tmp_path / "x.h5"
+    result = runner.invoke(app, ["sweep", *ONE_RUN, *args, "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "error:" in result.output and message in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing simulated, nothing written
+
+
+def test_simulate_refuses_an_empty_record_instead_of_recording_all(tmp_path):
+    result = runner.invoke(app, ["simulate", "--record", "", "--cycles", "2", "--no-progress",
+                                 "-o", str(tmp_path / "r.h5")])
+    assert result.exit_code == 2 and "--record part ''" in result.output
+
+
+def test_output_that_is_a_folder_or_a_file_of_the_wrong_kind_is_an_error_line(tmp_path):
+    (tmp_path / "folder.h5").mkdir()
+    result = runner.invoke(app, ["simulate", "--overwrite", "--cycles", "1", "--no-progress",
+                                 "-o", str(tmp_path / "folder.h5")])
+    assert result.exit_code == 2, result.output
+    assert "error:" in result.output and "folder.h5 is a folder" in result.output
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+
+    (tmp_path / "results").write_text("not a folder")
+    log = _toolbox_free_log(tmp_path)
+    result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log),
+                                 "--out", str(tmp_path / "results")])
+    assert result.exit_code == 2, result.output
+    assert "error:" in result.output and "results is a file" in result.output
+    assert (tmp_path / "results").read_text() == "not a folder"
+
+
+def test_sweep_refuses_an_existing_output_unless_overwrite(tmp_path):
+    out = tmp_path / "s.h5"
+    out.write_text("precious")
+    args = ["sweep", *ONE_RUN, "--cycles", "2", "--record", "1", "-o", str(out)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2 and "--overwrite" in result.output
+    assert out.read_text() == "precious"
+    result = runner.invoke(app, [*args, "--overwrite"])
+    assert result.exit_code == 0, result.output
+    assert dataset.validate(out) == []
+
+
+def test_calibrate_and_plot_refuse_to_replace_earlier_results_unless_overwrite(tmp_path):
+    log = _toolbox_free_log(tmp_path)
+    results = tmp_path / "cal"
+    results.mkdir()
+    (results / "report.json").write_text("earlier")
+    args = ["calibrate", "--robot", "puma560", "--measured", str(log), "--out", str(results)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2 and "--overwrite" in result.output
+    assert (results / "report.json").read_text() == "earlier"
+    result = runner.invoke(app, [*args, "--overwrite"])
+    assert result.exit_code == 0, result.output
+    assert (results / "report.json").read_text() != "earlier"
+
+    data = tmp_path / "r.h5"
+    assert runner.invoke(app, ["simulate", "--cycles", "2", "--no-progress", "-o", str(data)]).exit_code == 0
+    png = tmp_path / "r.png"
+    png.write_text("earlier")
+    result = runner.invoke(app, ["plot", str(data)])
+    assert result.exit_code == 2 and "--overwrite" in result.output and png.read_text() == "earlier"
+    assert runner.invoke(app, ["plot", str(data), "--overwrite"]).exit_code == 0
+    assert png.read_bytes().startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize("command", ["bench-isolators", "detect", "classify"])
+def test_analysis_commands_refuse_existing_outputs_before_computing(tmp_path, command):
+    data = tmp_path / "r.h5"
+    assert runner.invoke(app, ["simulate", "--cycles", "2", "--no-progress", "-o", str(data)]).exit_code == 0
+    stem = tmp_path / "table"
+    stem.with_suffix(".md").write_text("earlier")
+    result = runner.invoke(app, [command, str(data), "-o", str(stem)])
+    assert result.exit_code == 2, result.output
+    assert "table.md exists; pass --overwrite" in result.output
+    assert stem.with_suffix(".md").read_text() == "earlier" and not stem.with_suffix(".csv").exists()
+
+
+@pytest.mark.parametrize("command", [[], ["robots"], ["simulate"], ["calibrate"], ["sweep"], ["info"], ["validate"],
+                                     ["plot"], ["bench-isolators"], ["detect"], ["classify"]])
+def test_help_has_no_type_tags(command):
+    result = runner.invoke(app, [*command, "--help"], terminal_width=100)
+    assert result.exit_code == 0, result.output
+    tags = re.findall(r"<(?:bool|int|float|str|path|list\[[a-z]+\])>", result.output)
+    assert tags == [], tags
+    assert "--help" in result.output

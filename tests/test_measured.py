@@ -92,6 +92,19 @@ def test_round_trip(tmp_path, puma, name, with_qd):
         data.q[0, 0] = 0.0  # read-only arrays
 
 
+def test_compression_is_recognised_by_content_not_name(tmp_path, puma):
+    t = np.arange(0, 2.5, 1e-3)
+    q, _, _ = sinusoids(puma, t)
+    tau = torques(t)
+    measured.write_csv(tmp_path / "log.csv.gz", t, q, tau)
+    (tmp_path / "log.csv.gz").rename(tmp_path / "compressed.csv")  # gzip content, plain name
+    measured.write_csv(tmp_path / "log.csv", t, q, tau)
+    (tmp_path / "log.csv").rename(tmp_path / "plain.csv.gz")  # plain content, gzip name
+    for name in ("compressed.csv", "plain.csv.gz"):
+        data = measured.read(tmp_path / name, puma)
+        np.testing.assert_array_equal(data.tau, tau)
+
+
 def test_read_accepts_a_loaded_robot_and_reports_extra_columns(tmp_path, puma):
     frame = good_frame(puma)
     frame.insert(3, "temperature1", 40.0)
@@ -255,9 +268,9 @@ def test_missing_file_unknown_suffix_and_unreadable_files(tmp_path, puma):
     (tmp_path / "folder.csv").mkdir()
     with pytest.raises(MeasuredDataError, match=r"folder\.csv: not a file"):
         measured.read(tmp_path / "folder.csv", puma)
-    (tmp_path / "bad.csv.gz").write_bytes(b"t,q1,q2\n1,2,3\n")  # not gzip
-    with pytest.raises(MeasuredDataError, match=r"bad\.csv\.gz: cannot read the file as CSV"):
-        measured.read(tmp_path / "bad.csv.gz", puma)
+    (tmp_path / "bad.csv").write_bytes(b"\x1f\x8b\x08 cut short")  # gzip magic, then garbage
+    with pytest.raises(MeasuredDataError, match=r"bad\.csv: cannot read the file as CSV"):
+        measured.read(tmp_path / "bad.csv", puma)
     (tmp_path / "bad.h5").write_bytes(b"not an HDF5 file at all")
     with pytest.raises(MeasuredDataError, match=r"bad\.h5: cannot read the file as HDF5"):
         measured.read(tmp_path / "bad.h5", puma)
