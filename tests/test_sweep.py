@@ -93,8 +93,66 @@ def test_sigkill_then_same_command_finishes_without_redoing_finished_runs(refere
     again = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert again.returncode == 0, again.stdout + again.stderr
     assert f"resuming: {len(finished)} of 6 runs already finished" in again.stdout
+    assert "took over" in again.stderr and "from a sweep that was killed" in again.stderr  # its stale lock
     assert dataset.validate(out) == []
     assert_same_datasets(reference, out)  # loses nothing: equal to the uninterrupted sweep
+
+
+def _sweep_command(out: Path, jobs: int = 1) -> list[str]:
+    return [sys.executable, "-m", "faultgen.cli", "sweep", *SMALL_ARGS, "--jobs", str(jobs), "--no-progress",
+            "-o", str(out)]
+
+
+def _wait_for(condition, what: str, seconds: float = 120) -> None:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            pytest.fail(f"waited {seconds} s for {what}")
+        time.sleep(0.05)
+
+
+def test_a_killed_merge_leaves_debris_that_the_next_sweep_removes_and_reports(reference, tmp_path):
+    out = tmp_path / "merged.h5"
+    killed_merge = (f"import os, signal\nfrom faultgen.atomic import atomic_path\n"
+                    f"with atomic_path({str(out)!r}) as tmp:\n    tmp.write_bytes(bytes(10**6))\n"
+                    f"    os.kill(os.getpid(), signal.SIGKILL)")
+    subprocess.run([sys.executable, "-c", killed_merge], check=False)
+    (debris,) = tmp_path.glob(".merged.h5.*.part")
+    again = subprocess.run(_sweep_command(out), cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert not debris.exists()
+    assert f"removed {debris} (1.0 MB), an unfinished write of merged.h5 left by a killed process" in again.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".merged.h5.lock", "merged.h5"]
+    assert_same_datasets(reference, out)
+
+
+def test_ctrl_c_stops_the_workers_and_says_what_is_kept_and_how_to_resume(tmp_path):
+    out = tmp_path / "interrupted.h5"
+    parts = sweep.parts_folder(out)
+    proc = subprocess.Popen(_sweep_command(out, jobs=2), cwd=tmp_path, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for(lambda: len(list(parts.glob("*.h5"))) >= 1, "a finished run")
+    os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does: every process of the group
+    stdout, stderr = proc.communicate(timeout=60)
+    kept = len(list(parts.glob("*.h5")))
+    assert proc.returncode == 130, stdout + stderr
+    assert stderr.strip() == f"interrupted: {kept} of 6 runs kept in {parts}; run the same command to resume"
+    assert not out.exists() and not (parts / "sweep.json").exists()
+
+
+def test_a_second_sweep_on_the_same_output_refuses_at_once_naming_the_first(reference, tmp_path):
+    out = tmp_path / "same.h5"
+    first = subprocess.Popen(_sweep_command(out), cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             text=True)
+    _wait_for(lambda: (sweep.parts_folder(out) / "sweep.json").exists(), "the first sweep to start")
+    second = runner.invoke(app, ["sweep", *SMALL_ARGS, "--no-progress", "-o", str(out)])
+    assert second.exit_code == 2, second.output
+    assert f"error: another sweep is writing {out}: pid {first.pid} on " in second.output
+    assert ", started 20" in second.output and "wait for it to finish or stop it" in second.output
+    assert "runs ->" not in second.output  # refused before it planned or simulated anything
+    output, _ = first.communicate(timeout=300)
+    assert first.returncode == 0, output
+    assert_same_datasets(reference, out)
 
 
 def test_resume_simulates_only_the_missing_runs(tmp_path):
