@@ -6,6 +6,7 @@ so importing this module needs neither matplotlib nor a display, and no global b
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ import numpy as np
 from faultgen import dataset
 
 TORQUE_LABEL = "mean |motor torque| [N m]"
+CHANGE_LABEL = "change of mean |motor torque| [%]"
 WEAR_LABEL = "true wear [%]"
 WEAR_COLOR = "tab:red"
 #: Smallest torque range of a single-run panel, as a fraction of its mean torque: cycle-to-cycle
@@ -21,20 +23,22 @@ MIN_SPAN = 0.01
 
 
 def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
-    """Draw the per-cycle mean absolute motor torque of every axis against the true wear, as a PNG.
+    """Draw how the mean absolute motor torque of every axis follows the true wear, as a PNG.
 
     One run (``run`` given, or a file with exactly one run): a 2 x 3 grid, one panel per axis
     ("axis 1" .. "axis 6"); x is the cycle index (1-based), markers are the mean absolute motor
     torque of the cycle (N m, motor side), and, on a second y axis, a line is the true wear of that
     axis in percent (friction multiplier - 1) * 100, drawn only where the axis wears. Each torque
     axis spans at least 1 % of its mean torque, so cycle-to-cycle noise is not mistaken for a
-    trend. The title names the run, robot, task and friction model.
+    trend. The title describes the run from its labels (:func:`run_title`).
 
     A whole sweep (several runs, ``run`` omitted): a 2 x 3 grid, one panel per axis j; for every
-    run that wears axis j, a line of its mean absolute motor torque (N m) against its true wear
-    (%), one colour per task; for every run without wear, a dashed horizontal line at the mean over
-    its cycles of the mean absolute torque of axis j, in the colour of its task. The title names
-    the file, the robots and the number of runs.
+    run that wears axis j, a line of the change of axis j's mean absolute motor torque, in percent
+    of the unworn run of the same robot, task, seed and friction model on the same cycle, against
+    the true wear of axis j (%), one colour per task. Tasks whose torques differ tenfold share
+    one scale, and the unworn run is the dashed line at 0, so the wear shows on every axis. A worn
+    run without such an unworn run is drawn against its own first recorded cycle, and the title
+    says so. The title names the file, the robots and the number of runs.
 
     Parameters
     ----------
@@ -94,45 +98,74 @@ def _draw_run(fig, axes, path, run_id: str) -> None:
             twin.tick_params(axis="y", colors=WEAR_COLOR)
             twin.set_ylim(bottom=min(0.0, wear[:, j].min()))
             ax.set_title(f"axis {j + 1} (worn)", color=WEAR_COLOR)
-    worn = ", ".join(str(int(a)) for a in attrs["worn_axes"]) or "none"
-    key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if worn != "none" else "")
-    fig.suptitle(f"{run_id}\nrobot {attrs['robot']}, task {attrs['task']}, friction model "
-                 f"{attrs['friction_model']}, worn axes: {worn}; {key}")
+    key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if len(attrs["worn_axes"]) else "")
+    fig.suptitle(f"{run_title(run_id, attrs)}\n{key}")
     fig.tight_layout()
 
 
 def _draw_sweep(fig, axes, path, ids: list[str]) -> None:
     runs = []
     for run_id in ids:  # only the per-cycle arrays drawn: the logged signals can be large
-        runs.append(dataset.read_run(path, run_id, names=("mean_abs_torque", "friction_multiplier")))
+        runs.append(dataset.read_run(path, run_id, names=("cycles", "mean_abs_torque", "friction_multiplier")))
     task_names = sorted({attrs["task"] for _, attrs in runs})
     robot_names = sorted({attrs["robot"] for _, attrs in runs})
     colors = {task: f"C{i % 10}" for i, task in enumerate(task_names)}
     styles = {robot: ("-", "--", "-.", ":")[i % 4] for i, robot in enumerate(robot_names)}
+    unworn = {_reference_key(attrs): arrays for arrays, attrs in runs if len(attrs["worn_axes"]) == 0}
     most = max(float((arrays["friction_multiplier"] - 1.0).max()) * 100.0 for arrays, _ in runs)
-    legend = {}
+    legend, own_first = {}, False
     for j, ax in enumerate(axes):
+        ax.axhline(0.0, color="0.5", lw=1.0, ls=(0, (5, 3)))  # the unworn run
         worn_here = False
         for arrays, attrs in runs:
+            if j + 1 not in [int(a) for a in attrs["worn_axes"]]:
+                continue
+            wear, change, against_own = _change(arrays, unworn.get(_reference_key(attrs)), j)
+            own_first |= against_own
             name = attrs["task"] if len(robot_names) == 1 else f"{attrs['robot']}, {attrs['task']}"
-            torque = arrays["mean_abs_torque"][:, j]
-            if len(attrs["worn_axes"]) == 0:
-                line = ax.axhline(torque.mean(), ls=(0, (5, 3)), lw=1.2, color=colors[attrs["task"]])
-                legend.setdefault(f"{name}, no wear", line)
-            elif j + 1 in [int(a) for a in attrs["worn_axes"]]:
-                wear = (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
-                (line,) = ax.plot(wear, torque, marker="o", ms=3, ls=styles[attrs["robot"]],
-                                  color=colors[attrs["task"]])
-                legend.setdefault(name, line)
-                worn_here = True
+            (line,) = ax.plot(wear, change, marker="o", ms=3, ls=styles[attrs["robot"]], color=colors[attrs["task"]])
+            legend.setdefault(name, line)
+            worn_here = True
         if most > 0:
             ax.set_xlim(-0.03 * most, 1.03 * most)  # the same wear range in every panel
         ax.set(title=f"axis {j + 1}" + ("" if worn_here else " (no run wears it)"),
-               xlabel=f"{WEAR_LABEL} of axis {j + 1}", ylabel=TORQUE_LABEL)
+               xlabel=f"{WEAR_LABEL} of axis {j + 1}", ylabel=CHANGE_LABEL)
         ax.grid(alpha=0.3)
-    order = sorted(legend, key=lambda label: (label.endswith("no wear"), label))
+    order = sorted(legend)
     fig.legend([legend[k] for k in order], order, loc="lower center", ncol=min(len(order), 6), frameon=False)
-    fig.suptitle(f"{Path(path).name}: robots {', '.join(robot_names)}, {len(ids)} runs; "
-                 "lines: runs wearing the axis, dashed: runs without wear")
+    reference = "the unworn run of the same task and seed (dashed line at 0)"
+    if own_first:
+        reference += "; runs without one: their own first recorded cycle"
+    fig.suptitle(f"{Path(path).name}: robots {', '.join(robot_names)}, {len(ids)} runs\nchange of the worn axis's mean "
+                 f"|motor torque| per cycle against {reference}")
     rows = -(-len(order) // 6)
     fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))
+
+
+def _reference_key(attrs: dict) -> tuple:
+    """What a worn run shares with the unworn run it is compared with."""
+    return attrs["robot"], attrs["task"], int(attrs["seed"]), attrs["friction_model"]
+
+
+def _change(arrays: dict, reference: dict | None, j: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    """True wear of axis ``j`` (%) and the change of its mean |motor torque| (%), per cycle.
+
+    Against the unworn ``reference`` run on the cycles both recorded, or, without one, against
+    the run's own first recorded cycle (third value True).
+    """
+    torque, wear = arrays["mean_abs_torque"][:, j], (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
+    if reference is None:
+        return wear, (torque / torque[0] - 1.0) * 100.0, True
+    common, mine, theirs = np.intersect1d(arrays["cycles"], reference["cycles"], return_indices=True)
+    base = reference["mean_abs_torque"][theirs, j]
+    return wear[mine], (torque[mine] / base - 1.0) * 100.0, False
+
+
+def run_title(run_id: str, attrs: dict) -> str:
+    """A run described by its labels: robot, task, worn axes with schedule and final wear, seed,
+    friction model; the run id is added when it says more than the file's default ``run``."""
+    schedules = json.loads(attrs.get("wear") or "{}").get("schedules", [])
+    worn = ", ".join(f"axis {s['axis']} worn ({s['kind']}, +{100 * s['increase']:g} % by cycle {s['last_cycle']})"
+                     for s in schedules) or "no wear"
+    text = f"{attrs['robot']}, {attrs['task']}, {worn}, seed {int(attrs['seed'])}, {attrs['friction_model']} friction"
+    return text if run_id == "run" else f"{run_id}: {text}"

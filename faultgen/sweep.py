@@ -39,7 +39,7 @@ from faultgen import atomic, dataset, friction, robots, sensors, sim, tasks, wea
 
 log = logging.getLogger(__name__)
 
-#: Named grids. quick: a small grid for a first look (well under 2 minutes on 2 cores).
+#: Named grids. quick: a small grid for a first look (under a minute on 2 cores).
 #: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
 #: c2: thesis ch. 3 (PUMA 560, 3 tasks x 6 axes x {10, 20} % logistic over 120 hours of one-minute
 #: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled).

@@ -41,21 +41,46 @@ def assert_png(path):
     assert image[..., :3].std() > 0, "blank image"
 
 
-def test_sweep_plot_draws_one_panel_per_axis_with_a_line_per_worn_run(sweep_file, tmp_path, figures):
+def test_sweep_plot_shows_the_change_against_the_same_tasks_unworn_run(sweep_file, tmp_path, figures):
     out = plot(sweep_file, tmp_path / "sweep.png")
     assert out == tmp_path / "sweep.png"
     assert_png(out)
     (fig,) = figures
     assert len(fig.axes) == 6
     assert "s.h5" in fig.get_suptitle() and "4 runs" in fig.get_suptitle()
+    assert "against the unworn run of the same task and seed" in fig.get_suptitle()
     axis2 = fig.axes[1]
-    assert axis2.get_xlabel() == "true wear [%] of axis 2" and "[N m]" in axis2.get_ylabel()
+    assert axis2.get_xlabel() == "true wear [%] of axis 2"
+    assert axis2.get_ylabel() == "change of mean |motor torque| [%]"
     worn = [line for line in axis2.get_lines() if len(line.get_xdata()) == 3]
     assert len(worn) == 2  # one per task
+    for line, task in zip(worn, ["pick_place", "spot_weld"], strict=True):  # drawn in the file's run order
+        unworn, _ = dataset.read_run(sweep_file, f"irb6700-{task}-nowear-seed0")
+        arrays, _ = dataset.read_run(sweep_file, f"irb6700-{task}-axis2-exp420-seed0")
+        np.testing.assert_allclose(line.get_xdata(), (arrays["friction_multiplier"][:, 1] - 1) * 100)
+        expected = (arrays["mean_abs_torque"][:, 1] / unworn["mean_abs_torque"][:, 1] - 1) * 100
+        np.testing.assert_allclose(line.get_ydata(), expected)
+        assert line.get_ydata()[0] == pytest.approx(0.0, abs=0.05)  # cycle 1: hardly any wear yet
     assert max(line.get_xdata().max() for line in worn) == pytest.approx(20.0)
-    assert len(fig.axes[0].get_lines()) == 2  # axis 1: only the no-wear levels of both tasks
+    assert [list(line.get_ydata()) for line in fig.axes[0].get_lines()] == [[0.0, 0.0]]  # axis 1: the unworn level
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert labels == ["pick_place", "spot_weld", "pick_place, no wear", "spot_weld, no wear"]
+    assert labels == ["pick_place", "spot_weld"]
+
+
+def test_a_worn_run_without_an_unworn_one_is_drawn_against_its_first_cycle(sweep_file, tmp_path, figures):
+    worn_only = tmp_path / "worn.h5"
+    with h5py.File(sweep_file, "r") as src, h5py.File(worn_only, "w") as dst:
+        for key, value in src.attrs.items():
+            dst.attrs[key] = value
+        dst.attrs["n_runs"] = 2
+        for run_id in ("irb6700-pick_place-axis2-exp420-seed0", "irb6700-spot_weld-axis2-exp420-seed0"):
+            src.copy(src[f"runs/{run_id}"], dst.require_group("runs"), name=run_id)
+    assert dataset.validate(worn_only) == []
+    plot(worn_only, tmp_path / "worn.png")
+    (fig,) = figures
+    assert "runs without one: their own first recorded cycle" in fig.get_suptitle()
+    for line in fig.axes[1].get_lines()[1:]:
+        assert line.get_ydata()[0] == 0.0
 
 
 def test_single_run_plot_shows_torque_per_cycle_and_the_wear_of_the_worn_axis(sweep_file, tmp_path, figures):
@@ -86,7 +111,21 @@ def test_a_file_with_one_run_is_drawn_as_that_run(sweep_file, tmp_path, figures)
     assert_png(plot(one, tmp_path / "one.png"))
     (fig,) = figures
     assert len(fig.axes) == 6  # no wear: no wear axes
-    assert fig.get_suptitle().startswith("only\n")
+    assert fig.get_suptitle().startswith("only: irb6700, pick_place, no wear, seed 0, lugre friction\n")
+
+
+def test_a_simulated_run_is_titled_by_what_it_is(tmp_path, figures):
+    from faultgen import sim
+    from faultgen.wear import WearPlan
+
+    config = sim.RunConfig(robot="puma560", task="spot_weld", wear=WearPlan.from_specs(["3:linear:10"], 4),
+                           cycles=4, record=(1, 4), seed=7)
+    out = tmp_path / "one.h5"
+    dataset.write_run(out, sim.simulate(config, progress=False))  # stored as the file's default run id
+    plot(out, tmp_path / "one.png")
+    (fig,) = figures
+    assert fig.get_suptitle().startswith(
+        "puma560, spot_weld, axis 3 worn (linear, +10 % by cycle 4), seed 7, lugre friction\n")
 
 
 def test_unknown_run_is_refused_naming_it_and_listing_runs(sweep_file, tmp_path):
