@@ -365,7 +365,15 @@ def plot_command(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="PNG to write (default: FILE with .png).")] = None,
     overwrite: Overwrite = False,
 ) -> None:
-    """Draw per-cycle mean |motor torque| per axis against the true wear, as a PNG."""
+    """Draw how each axis's mean |motor torque| follows its true wear, as a PNG.
+
+    A sweep: per axis, the change (%) of every run wearing it against the unworn run of the same
+    task and seed. One run (or --run ID): mean |motor torque| per cycle with the true wear.
+
+    Example:
+
+      faultgen plot quick.h5 -o quick.png
+    """
     from faultgen import dataset, plot
 
     target = out or file.with_suffix(".png")

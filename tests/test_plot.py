@@ -35,6 +35,18 @@ def figures(monkeypatch):
     return drawn
 
 
+def _subset(source, path, runs: dict):
+    """A valid dataset at ``path`` holding some runs of ``source`` ({new id: run id})."""
+    with h5py.File(source, "r") as src, h5py.File(path, "w") as dst:
+        for key, value in src.attrs.items():
+            dst.attrs[key] = value
+        dst.attrs["n_runs"] = len(runs)
+        for name, run_id in runs.items():
+            src.copy(src[f"runs/{run_id}"], dst.require_group("runs"), name=name)
+    assert dataset.validate(path) == []
+    return path
+
+
 def assert_png(path):
     image = matplotlib.image.imread(path)
     assert image.ndim == 3 and image.shape[1] > 300 and image.shape[0] > 200, image.shape
@@ -68,19 +80,13 @@ def test_sweep_plot_shows_the_change_against_the_same_tasks_unworn_run(sweep_fil
 
 
 def test_a_worn_run_without_an_unworn_one_is_drawn_against_its_first_cycle(sweep_file, tmp_path, figures):
-    worn_only = tmp_path / "worn.h5"
-    with h5py.File(sweep_file, "r") as src, h5py.File(worn_only, "w") as dst:
-        for key, value in src.attrs.items():
-            dst.attrs[key] = value
-        dst.attrs["n_runs"] = 2
-        for run_id in ("irb6700-pick_place-axis2-exp420-seed0", "irb6700-spot_weld-axis2-exp420-seed0"):
-            src.copy(src[f"runs/{run_id}"], dst.require_group("runs"), name=run_id)
-    assert dataset.validate(worn_only) == []
+    worn = ["irb6700-pick_place-axis2-exp420-seed0", "irb6700-spot_weld-axis2-exp420-seed0"]
+    worn_only = _subset(sweep_file, tmp_path / "worn.h5", {run_id: run_id for run_id in worn})
     plot(worn_only, tmp_path / "worn.png")
     (fig,) = figures
     assert "runs without one: their own first recorded cycle" in fig.get_suptitle()
-    for line in fig.axes[1].get_lines()[1:]:
-        assert line.get_ydata()[0] == 0.0
+    lines = fig.axes[1].get_lines()[1:]  # after the dashed line at 0
+    assert len(lines) == 2 and all(line.get_ydata()[0] == 0.0 for line in lines)
 
 
 def test_single_run_plot_shows_torque_per_cycle_and_the_wear_of_the_worn_axis(sweep_file, tmp_path, figures):
@@ -101,13 +107,7 @@ def test_single_run_plot_shows_torque_per_cycle_and_the_wear_of_the_worn_axis(sw
 
 
 def test_a_file_with_one_run_is_drawn_as_that_run(sweep_file, tmp_path, figures):
-    one = tmp_path / "one.h5"
-    with h5py.File(sweep_file, "r") as src, h5py.File(one, "w") as dst:
-        for key, value in src.attrs.items():
-            dst.attrs[key] = value
-        dst.attrs["n_runs"] = 1
-        src.copy(src["runs/irb6700-pick_place-nowear-seed0"], dst.require_group("runs"), name="only")
-    assert dataset.validate(one) == []
+    one = _subset(sweep_file, tmp_path / "one.h5", {"only": "irb6700-pick_place-nowear-seed0"})
     assert_png(plot(one, tmp_path / "one.png"))
     (fig,) = figures
     assert len(fig.axes) == 6  # no wear: no wear axes
