@@ -21,7 +21,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from faultgen import dataset
+from faultgen.data import dataset
 
 #: Wear levels of thesis Table 6.2, in percent.
 WEAR_LEVELS = (1.0, 5.0, 10.0, 15.0)
@@ -244,7 +244,7 @@ def _kl_features(torque: np.ndarray, cycles: np.ndarray, scale: np.ndarray,
     Returns the features (n_samples, 6) and, per recorded cycle, the index of its sample.
     """
     from analysis.features import HistogramKL
-    from faultgen.sensors import histogram
+    from faultgen.simulation.sensors import histogram
 
     hist = histogram(torque, np.zeros(6), scale)  # (n_cycles, 6, 12), one per recorded cycle
     groups = group_cycles(cycles, period)

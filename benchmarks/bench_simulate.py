@@ -24,8 +24,9 @@ import argparse
 
 from benchmarks_common import hold_seconds, same_work_seconds, simulated_seconds  # sibling module
 
-from faultgen import sim, tasks
-from faultgen.wear import WearPlan
+from faultgen.operation import tasks
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import stepping as sim
 
 
 def main() -> None:

@@ -29,7 +29,7 @@ from pathlib import Path
 import psutil
 from benchmarks_common import same_work_seconds  # sibling module
 
-from faultgen import sweep
+from faultgen.runs import sweep
 
 
 def tree_rss() -> int:

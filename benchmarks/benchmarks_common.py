@@ -8,7 +8,10 @@ import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
 
-from faultgen import robots, sensors, sim, tasks
+from faultgen.model import robots
+from faultgen.operation import tasks
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
 
 
 def _prepared(config: sim.RunConfig):

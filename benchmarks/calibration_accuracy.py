@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from faultgen import robots
 from faultgen.calibrate import EFFECTS, calibrate, synth
+from faultgen.model import robots
 
 
 def case(robot_name: str, effect: str | None, seed: int, size_range=synth.SIZE_RANGE) -> dict:

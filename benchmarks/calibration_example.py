@@ -15,8 +15,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from faultgen import robots
 from faultgen.calibrate import synth
+from faultgen.model import robots
 
 
 def main() -> None:

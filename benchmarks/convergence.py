@@ -41,9 +41,12 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from faultgen import friction as friction_models
-from faultgen import robots, sensors, sim, tasks
-from faultgen.wear import WearPlan
+from faultgen.model import friction as friction_models
+from faultgen.model import robots
+from faultgen.operation import tasks
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
 
 #: Steps as multiples of the model's own: coarser to show where it breaks, finer for the limit.
 FACTORS = (2.0, 1.0, 0.5, 0.25, 0.125)

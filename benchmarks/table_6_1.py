@@ -19,8 +19,9 @@ import argparse
 
 import numpy as np
 
-from faultgen import sim, tasks
-from faultgen.wear import WearPlan
+from faultgen.operation import tasks
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import stepping as sim
 
 
 def last_cycle(task: str, worn_axis: int, friction: str, seed: int) -> sim.RunResult:

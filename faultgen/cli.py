@@ -11,9 +11,10 @@ import numpy as np
 import typer
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
-from faultgen import __version__, robots
-from faultgen.friction import FIELDS as FRICTION_FIELDS
-from faultgen.friction import UNITS as FRICTION_UNITS
+from faultgen import __version__
+from faultgen.model import robots
+from faultgen.model.friction import FIELDS as FRICTION_FIELDS
+from faultgen.model.friction import UNITS as FRICTION_UNITS
 
 
 class _PlainHelp:
@@ -177,8 +178,10 @@ def simulate_command(
 
       faultgen simulate --task spot_weld --wear 2:exp4:20 --wear 5:linear:10 --record 1,100 -o two.h5
     """
-    from faultgen import dataset, sensors, sim
-    from faultgen import wear as wear_module
+    from faultgen.data import dataset
+    from faultgen.operation import wear as wear_module
+    from faultgen.simulation import sensors
+    from faultgen.simulation import stepping as sim
 
     try:
         _check_outputs([out], overwrite)
@@ -286,7 +289,7 @@ def sweep_command(
 
       faultgen sweep --robot puma560 --task spot_weld --axis 0 --axis 3 --wear-pct 10 --wear-pct 20 -o s.h5
     """
-    from faultgen import sweep
+    from faultgen.runs import sweep
 
     options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
                "friction": friction_model, "cycles": cycles, "seeds": seeds,
@@ -336,7 +339,7 @@ def sweep_command(
 @app.command("info", cls=PlainHelpCommand)
 def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Summarise a dataset: runs, robots, tasks, worn axes, cycles, provenance."""
-    from faultgen import dataset
+    from faultgen.data import dataset
 
     try:
         typer.echo(dataset.summary(file))
@@ -348,7 +351,7 @@ def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (
 @app.command("validate", cls=PlainHelpCommand)
 def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Check a dataset against the schema (docs/dataset.md); exit 1 with the reasons if it fails."""
-    from faultgen import dataset
+    from faultgen.data import dataset
 
     problems = dataset.validate(file)
     if problems:
@@ -374,7 +377,8 @@ def plot_command(
 
       faultgen plot quick.h5 -o quick.png
     """
-    from faultgen import dataset, plot
+    from faultgen import plot
+    from faultgen.data import dataset
 
     target = out or file.with_suffix(".png")
     try:
@@ -388,7 +392,7 @@ def plot_command(
 
 def _analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     """Refuse a dataset that fails validation, or outputs that exist, before any analysis runs."""
-    from faultgen import dataset
+    from faultgen.data import dataset
 
     problems = dataset.validate(file)
     if problems:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen import dataset
+from faultgen.data import dataset
 
 TORQUE_LABEL = "mean |motor torque| [N m]"
 CHANGE_LABEL = "change of mean |motor torque| [%]"

@@ -28,11 +28,12 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen import atomic, robots
-from faultgen import measured as measured_io
 from faultgen.calibrate import gearbox, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
-from faultgen.friction import FIELDS as FRICTION_FIELDS
+from faultgen.data import atomic
+from faultgen.data import measured as measured_io
+from faultgen.model import robots
+from faultgen.model.friction import FIELDS as FRICTION_FIELDS
 
 __all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters", "predict"]
 

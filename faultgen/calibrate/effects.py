@@ -33,9 +33,9 @@ from typing import ClassVar
 import mujoco
 import numpy as np
 
-from faultgen import robots
 from faultgen.calibrate import gearbox
-from faultgen.friction import FIELDS as FRICTION_FIELDS
+from faultgen.model import robots
+from faultgen.model.friction import FIELDS as FRICTION_FIELDS
 
 _COULOMB_POS, _COULOMB_NEG, _STATIC, _STRIBECK_VELOCITY = (FRICTION_FIELDS.index(f) for f in (
     "coulomb_pos", "coulomb_neg", "static", "stribeck_velocity"))

@@ -51,7 +51,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from faultgen import measured, robots
+from faultgen.data import measured
+from faultgen.model import robots
 
 #: Longest sub-step, s. The average-acceleration rule's period error is about (w h)^2 / 12: 0.8 %
 #: for a 25 Hz resonance (the softest gearbox here); shorter steps changed no figure.

@@ -26,8 +26,12 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen import measured, robots, sensors, sim, tasks
 from faultgen.calibrate.effects import EFFECTS, Motion, get
+from faultgen.data import measured
+from faultgen.model import robots
+from faultgen.operation import tasks
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
 
 #: Range of the effect's torque RMS over the axis's nominal torque RMS.
 SIZE_RANGE = (0.5, 1.2)

@@ -34,8 +34,10 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from faultgen import __version__, robots, sensors
-from faultgen.atomic import atomic_path
+from faultgen import __version__
+from faultgen.data.atomic import atomic_path
+from faultgen.model import robots
+from faultgen.simulation import sensors
 
 FORMAT = "faultgen"
 FORMAT_VERSION = 1

@@ -36,8 +36,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.friction import FIELDS as FRICTION_FIELDS
-from faultgen.friction import MotorFriction
+from faultgen.model.friction import FIELDS as FRICTION_FIELDS
+from faultgen.model.friction import MotorFriction
 
 N_AXES = 6
 
@@ -55,9 +55,9 @@ class ModelError(ValueError):
 
 def robots_dir() -> Path:
     """Folder holding the robot folders: packaged copy in a wheel, ``robots/`` in a checkout."""
-    here = Path(__file__).resolve().parent
-    packaged = here / "_robots"
-    return packaged if packaged.is_dir() else here.parent / "robots"
+    package = Path(__file__).resolve().parents[1]  # faultgen/
+    packaged = package / "_robots"
+    return packaged if packaged.is_dir() else package.parent / "robots"
 
 
 def available() -> dict[str, Path]:

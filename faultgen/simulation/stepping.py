@@ -26,8 +26,10 @@ import numpy as np
 from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
-from faultgen import control, friction, robots, sensors, tasks
-from faultgen.wear import WearPlan
+from faultgen.model import friction, robots
+from faultgen.operation import tasks
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import control, sensors
 
 #: Most cycles stepped together in one ``Batch``: bounds the step buffers (about 1 MB per cycle
 #: and second of chunk) when a run records many cycles (the c2 preset records 1200).

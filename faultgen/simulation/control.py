@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from faultgen.robots import Robot
+from faultgen.model.robots import Robot
 
 BANDWIDTH_HZ = 5.0
 DAMPING_RATIO = 0.7

@@ -35,7 +35,11 @@ import filelock
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen import atomic, dataset, friction, robots, sensors, sim, tasks, wear
+from faultgen.data import atomic, dataset
+from faultgen.model import friction, robots
+from faultgen.operation import tasks, wear
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
 
 log = logging.getLogger(__name__)
 

@@ -69,7 +69,7 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import savgol_filter
 
-from faultgen import robots
+from faultgen.model import robots
 
 N_AXES = robots.N_AXES
 

@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
-from faultgen import robots
-from faultgen.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
-from faultgen.robots import N_AXES, Robot
+from faultgen.model import robots
+from faultgen.model.robots import N_AXES, Robot
+from faultgen.operation.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
 
 TASKS = ("pick_place", "spot_weld", "arc_weld")
 PROCESSES = {"pick_place": "point-to-point", "spot_weld": "discontinuous", "arc_weld": "continuous"}

@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from faultgen.robots import N_AXES, Robot
+from faultgen.model.robots import N_AXES, Robot
 
 FLANGE = "flange"
 POSITION_TOL = 1e-6  # m: a solve stops once the flange is this close to its target ...

@@ -1,0 +1,3 @@
+"""Simulating a run: the servo drives (``control``), sampling, noise and monitoring aggregates
+(``sensors``) and the stepping of recorded cycles in MuJoCo (``stepping``, also importable as
+``faultgen.sim``). Above ``operation``."""
