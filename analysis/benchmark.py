@@ -1,7 +1,9 @@
 """Run isolators, detectors and classifiers over a faultgen dataset; tables in the thesis's layouts.
 
 - :func:`isolation_table`: every isolator on every run with one worn axis, at each wear level
-  (data up to the first cycle whose true wear reaches it), thesis Table 6.2.
+  (data up to the first cycle whose true wear reaches it), thesis Table 6.2, and on every run
+  without wear, where naming any axis is a false isolation; :func:`isolation_confusion` counts
+  true axis (or none) against named axis (or undecided) per isolator.
 - :func:`detection_table`: PCA monitoring (Q statistic) of each worn run against the run without
   wear of the same robot, task and seed; onset of wear and its location, thesis Table 3.5.
 - :func:`classification_table`: AUC of LR / SVM / RF / stacking over preprocessing combinations,
@@ -25,6 +27,16 @@ from faultgen.data import dataset
 
 #: Wear levels of thesis Table 6.2, in percent.
 WEAR_LEVELS = (1.0, 5.0, 10.0, 15.0)
+#: What an isolator's answer means where it is not an axis number 1..6.
+UNDECIDED, TOO_FEW_CYCLES = 0, -1
+#: The true axis of a run without wear, in the tables.
+NO_FAULT = 0
+
+
+def axis_label(value: int) -> str:
+    """How an axis number is printed: "1".."6", "none" or "undecided" for 0 (a run without wear's
+    true axis, or an isolator that names none), "too few cycles" for -1."""
+    return {UNDECIDED: "undecided", TOO_FEW_CYCLES: "too few cycles"}.get(int(value), str(int(value)))
 
 
 def default_isolators(bins: Iterable[int] = (5, 10)) -> dict[str, object]:
@@ -54,18 +66,20 @@ def level_cycle(multiplier: np.ndarray, level: float) -> int | None:
 
 def isolation_table(path, isolators: Mapping[str, object] | None = None, levels: Iterable[float] = WEAR_LEVELS,
                     signal: str = "mean_abs_torque", progress: bool = True) -> pd.DataFrame:
-    """Which axis each isolator names as the source, per worn run and wear level.
+    """Which axis each isolator names as the source, per run and wear level, healthy runs included.
 
     For a run wearing one axis, the isolator sees the per-cycle ``signal`` (n_cycles, 6) of the
     recorded cycles up to and including the first one whose true wear reaches the level (thesis
-    ch. 6.4: 10 % wear is cycle 86 of the exp4 schedule). Runs wearing several axes or none are
-    skipped.
+    ch. 6.4: 10 % wear is cycle 86 of the exp4 schedule); it is right when it names that axis.
+    A run without wear is shown, for each level, as many cycles as the worn runs of its robot and
+    task saw at that level; it is right only when the isolator names no axis (undecided): naming
+    one is a false isolation. Runs wearing several axes are skipped.
 
     Returns
     -------
-    DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis, wear_pct,
-    cycles (samples seen), isolator, predicted (0: undecided; -1: too few cycles for the
-    isolator), correct.
+    DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis (0: no wear),
+    wear_pct (the level; 0 for a run without wear), cycles (samples seen), isolator, predicted
+    (0: undecided; -1: too few cycles for the isolator), correct.
 
     Raises
     ------
@@ -82,26 +96,95 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             clone(prototype).fit(probe)
         except ValueError as err:
             raise ValueError(f"isolator {name}: {err}") from err
-    rows = []
-    runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) == 1]
-    if not runs:
+    runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) <= 1]
+    worn = [r for r in runs if len(r[2]["worn_axes"]) == 1]
+    if not worn:
         raise ValueError(f"{path} has no run with exactly one worn axis to isolate")
-    for run_id, arrays, attrs in tqdm(runs, desc="isolation", unit="run", disable=not progress):
+    # cycles seen per (robot, task, level): what the worn runs saw, shown to the healthy ones too
+    seen: dict[tuple, int] = {}
+    cases = []
+    for run_id, arrays, attrs in worn:
         axis = int(attrs["worn_axes"][0])
         for level in levels:
             k = level_cycle(arrays["friction_multiplier"][:, axis - 1], level)
-            if k is None:
-                continue
-            X = arrays[signal][: k + 1]
-            for name, prototype in isolators.items():
-                try:
-                    predicted = int(clone(prototype).fit(X).source_axis_)
-                except ValueError:  # too few cycles for this isolator at this level: not isolated
-                    predicted = -1
-                rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
-                                 wear_pct=level, cycles=k + 1, isolator=name, predicted=predicted,
-                                 correct=predicted == axis))
+            if k is not None:
+                seen.setdefault((attrs["robot"], attrs["task"], level), k + 1)
+                cases.append((run_id, arrays, attrs, axis, level, k + 1))
+    for run_id, arrays, attrs in runs:
+        if len(attrs["worn_axes"]) == 0:
+            cases += [(run_id, arrays, attrs, NO_FAULT, 0.0, n) for (robot, task, _), n in seen.items()
+                      if (robot, task) == (attrs["robot"], attrs["task"])]
+    rows = []
+    for run_id, arrays, attrs, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
+        X = arrays[signal][:n]
+        for name, prototype in isolators.items():
+            try:
+                predicted = int(clone(prototype).fit(X).source_axis_)
+            except ValueError:  # too few cycles for this isolator at this level: not isolated
+                predicted = TOO_FEW_CYCLES
+            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
+                             wear_pct=level, cycles=n, isolator=name, predicted=predicted,
+                             correct=predicted == axis))
     return pd.DataFrame(rows)
+
+
+def starved_isolators(table: pd.DataFrame, share: float = 0.5) -> list[str]:
+    """Isolators that named no axis (undecided or too few cycles) in at least ``share`` of the worn
+    cases of an :func:`isolation_table`: a sign the dataset records too few cycles for them."""
+    worn = table[table["worn_axis"] != NO_FAULT]
+    silent = worn["predicted"].isin([UNDECIDED, TOO_FEW_CYCLES]).groupby(worn["isolator"], sort=False).mean()
+    return [name for name, value in silent.items() if value >= share]
+
+
+def isolation_confusion(table: pd.DataFrame) -> pd.DataFrame:
+    """Counts of true axis (rows: none, 1..6) against named axis (columns: undecided, 1..6, too
+    few cycles) per isolator, over every run and level of an :func:`isolation_table`.
+
+    Returns
+    -------
+    DataFrame indexed by (isolator, true axis), one column per answer, integer counts; labels as
+    :func:`axis_label` prints them, with "none" for the true axis of a run without wear.
+    """
+    answers = [UNDECIDED, *range(1, 7), TOO_FEW_CYCLES]
+    counts = (table.groupby(["isolator", "worn_axis", "predicted"]).size().unstack("predicted")
+              .reindex(columns=answers, fill_value=0).fillna(0).astype(int))
+    isolators = list(dict.fromkeys(table["isolator"]))
+    counts = counts.reindex(pd.MultiIndex.from_product([isolators, range(7)]), fill_value=0)
+    counts.index = counts.index.set_names(["isolator", "true axis"]).set_levels(
+        ["none", *map(str, range(1, 7))], level=1)
+    counts.columns = [axis_label(a) for a in answers]
+    return counts
+
+
+def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
+    """PNG of :func:`isolation_confusion`: one matrix per isolator, counts in the cells."""
+    from matplotlib.figure import Figure
+
+    isolators = list(dict.fromkeys(confusion.index.get_level_values("isolator")))
+    cols = min(3, len(isolators))
+    rows = -(-len(isolators) // cols)
+    fig = Figure(figsize=(4.6 * cols, 4.0 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax, name in zip(axes, isolators, strict=False):
+        matrix = confusion.loc[name]
+        values = matrix.to_numpy(dtype=float)
+        share = values / np.maximum(values.sum(axis=1, keepdims=True), 1)
+        ax.imshow(share, vmin=0, vmax=1, cmap="Blues", aspect="auto")
+        for i in range(values.shape[0]):
+            for j in range(values.shape[1]):
+                if values[i, j]:
+                    ax.text(j, i, f"{values[i, j]:.0f}", ha="center", va="center",
+                            color="white" if share[i, j] > 0.6 else "black", fontsize=8)
+        ax.set_xticks(range(values.shape[1]), ["undec.", *map(str, range(1, 7)), "short"], fontsize=8)
+        ax.set_yticks(range(values.shape[0]), matrix.index, fontsize=8)
+        ax.set(title=name, xlabel="named axis", ylabel="true worn axis")
+    for ax in axes[len(isolators):]:
+        ax.set_visible(False)
+    fig.suptitle("isolation confusion: true worn axis (none = run without wear) x named axis "
+                 "(undec. = undecided, short = too few cycles); shade: share of the row")
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    return out
 
 
 def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
@@ -125,8 +208,14 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
             row = group[group["worn_axis"] == axis]
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
         acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
-        lines.append("| " + " | ".join([task, f"{level:g}", *marks, *acc]) + " |")
-    return f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run).\n\n" + "\n".join(lines)
+        lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
+    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). Rows \"no fault\": runs without "
+            "wear, where the accuracy is the share left undecided (naming an axis is a false isolation).\n\n"
+            + "\n".join(lines))
+
+
+def _level_label(level: float) -> str:
+    return "no fault" if level == 0 else f"{level:g}"
 
 
 def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
@@ -138,8 +227,8 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     ax = fig.subplots()
     image = ax.imshow(accuracy.to_numpy(dtype=float), vmin=0, vmax=100, cmap="viridis", aspect="auto")
     ax.set_yticks(range(accuracy.shape[0]), accuracy.index)
-    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {w:g} %" for t, w in accuracy.columns], fontsize=8,
-                  rotation=35, ha="right")
+    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {_level_label(w)}" + (" %" if w else "")
+                                             for t, w in accuracy.columns], fontsize=8, rotation=35, ha="right")
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
             value = accuracy.iat[i, j]
@@ -277,8 +366,33 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     if not failed or not normal:
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")
+    _check_training_sets(path, y, groups, failed, normal, wear_threshold)
     return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
                     random_state=random_state, progress=progress, **kwargs)
+
+
+#: Columns holding an axis number that may be 0 (undecided) or -1 (too few cycles).
+AXIS_COLUMNS = {"predicted", "located_axis"}
+
+
+#: Fewest samples of each class a training set needs: the stacking classifier's 5-fold
+#: cross-validation (:func:`analysis.classify.stacking`) splits each class five ways.
+MIN_CLASS_SAMPLES = 5
+
+
+def _check_training_sets(path, y: list, groups: list, failed: list, normal: list, wear_threshold: float) -> None:
+    """Refuse a dataset whose leave-pair-out training sets lack a class, saying what it lacks."""
+    per_run = {g[0]: (int(labels.sum()), int(len(labels) - labels.sum())) for labels, g in zip(y, groups, strict=True)}
+    totals = np.sum(list(per_run.values()), axis=0)
+    fewest = min((totals[0] - per_run[f][0] - per_run[n][0], totals[1] - per_run[f][1] - per_run[n][1])
+                 for f in failed for n in normal)
+    if min(fewest) < MIN_CLASS_SAMPLES:
+        raise ValueError(
+            f"{path}: this dataset lacks runs for leave-pair-out classification: with one worn and one unworn run "
+            f"held out, the smallest training set has {fewest[0]} failed samples (true wear >= {wear_threshold:g} %) "
+            f"and {fewest[1]} normal ones, and the classifiers need at least {MIN_CLASS_SAMPLES} of each "
+            f"({len(failed)} worn and {len(normal)} unworn runs here). Use `faultgen sweep --preset quick` (18 worn, "
+            "3 unworn runs) or a grid with more runs and recorded cycles")
 
 
 def markdown(table: pd.DataFrame, digits: int = 3) -> str:
@@ -286,6 +400,8 @@ def markdown(table: pd.DataFrame, digits: int = 3) -> str:
     frame = table if isinstance(table.index, pd.RangeIndex) else table.reset_index()
     if isinstance(frame.columns, pd.MultiIndex):  # ("lr", "mean") -> "lr mean"
         frame = frame.set_axis([" ".join(str(p) for p in c if p) for c in frame.columns], axis=1)
+    for column in AXIS_COLUMNS & set(frame.columns):  # 0 and -1 are not axes: say what they mean
+        frame = frame.assign(**{column: frame[column].map(axis_label)})
     cells = [[f"{v:.{digits}g}" if isinstance(v, float) else str(v) for v in row] for row in frame.itertuples(index=False)]
     head = [str(c) for c in frame.columns]
     return "\n".join(["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]

@@ -435,7 +435,9 @@ def bench_isolators_command(
     from analysis import benchmark
 
     stem = out or file.with_name(file.stem + "-isolation")
-    _analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
+    confusion_stem = stem.with_name(stem.name + "-confusion")
+    _analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
+                           confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
     try:
         wear_levels = [float(x) for x in levels.split(",")]
         table = benchmark.isolation_table(file, benchmark.default_isolators(bins or (5, 10)), wear_levels,
@@ -445,11 +447,19 @@ def bench_isolators_command(
         raise typer.Exit(2) from err
     written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
     written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
-    typer.echo(benchmark.markdown(benchmark.isolation_accuracy(table), digits=4))
-    short = int((table["predicted"] < 0).sum())
-    if short:
-        typer.echo(f"note: {short} of {len(table)} cases had fewer cycles than the isolator needs and count as "
-                   "not isolated; record more cycles")
+    confusion = benchmark.isolation_confusion(table)
+    confusion.to_csv(confusion_stem.with_suffix(".csv"))
+    written += [confusion_stem.with_suffix(".csv"), benchmark.confusion_figure(confusion, confusion_stem.with_suffix(".png"))]
+    accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
+    typer.echo(benchmark.markdown(accuracy, digits=4))
+    typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
+               "isolation)")
+    starved = benchmark.starved_isolators(table)
+    if starved:
+        typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
+                   f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
+                   "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
+                   "use `faultgen sweep --preset j2`, or --record with more cycles")
     typer.echo("wrote " + ", ".join(map(str, written)))
 
 

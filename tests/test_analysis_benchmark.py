@@ -31,10 +31,15 @@ def test_isolation_table_runs_every_isolator_at_every_level(small):
     isolators = {"te5": isolation.make("transfer_entropy", bins=5), "trend": isolation.make("trend")}
     table = benchmark.isolation_table(small, isolators, levels=(5.0, 20.0), progress=False)
     assert set(table["isolator"]) == {"te5", "trend"}
-    assert sorted(set(table["worn_axis"])) == [1, 5]
+    assert sorted(set(table["worn_axis"])) == [0, 1, 5]  # 0: the run without wear
     # at 20 % every recorded cycle is used; at 5 % fewer
     full = table[table["wear_pct"] == 20.0]["cycles"]
     assert set(full) == {40} and table[table["wear_pct"] == 5.0]["cycles"].max() < 40
+    # the run without wear is shown as many cycles as the worn runs saw at each level
+    healthy = table[table["worn_axis"] == 0]
+    assert set(healthy["wear_pct"]) == {0.0} and set(healthy["run"]) == {"irb6700-pick_place-nowear-seed0"}
+    assert sorted(set(healthy["cycles"])) == sorted(set(table[table["worn_axis"] > 0]["cycles"]))
+    # right only when it names no axis (0, undecided); naming one is a false isolation
     assert (table["correct"] == (table["predicted"] == table["worn_axis"])).all()
     # the trend of the worn axis's torque gives it away at full wear
     assert table[(table["isolator"] == "trend") & (table["wear_pct"] == 20.0)]["correct"].all()
@@ -42,6 +47,34 @@ def test_isolation_table_runs_every_isolator_at_every_level(small):
     assert list(accuracy.columns) == ["te5", "trend"]
     text = benchmark.isolation_markdown(table, marked="trend")
     assert "| pick_place | 20 | ✓ | - | - | - | ✓ | - |" in text
+    no_fault = accuracy.loc[("pick_place", 0.0)]
+    for name in ("te5", "trend"):
+        rows = healthy[healthy["isolator"] == name]
+        assert no_fault[name] == pytest.approx(100 * (rows["predicted"] == 0).mean())
+    assert "| pick_place | no fault | - | - | - | - | - | - |" in text
+
+
+def test_confusion_counts_true_against_named_axis_per_isolator(small, tmp_path):
+    isolators = {"te5": isolation.make("transfer_entropy", bins=5), "trend": isolation.make("trend")}
+    table = benchmark.isolation_table(small, isolators, levels=(5.0, 20.0), progress=False)
+    confusion = benchmark.isolation_confusion(table)
+    assert list(confusion.columns) == ["undecided", "1", "2", "3", "4", "5", "6", "too few cycles"]
+    assert list(confusion.loc["trend"].index) == ["none", "1", "2", "3", "4", "5", "6"]
+    for name in ("te5", "trend"):
+        rows = table[table["isolator"] == name]
+        assert confusion.loc[name].to_numpy().sum() == len(rows)
+        for true, label in ((0, "none"), (1, "1"), (5, "5")):
+            named = rows[rows["worn_axis"] == true]["predicted"]
+            for answer, column in ((0, "undecided"), (1, "1"), (5, "5"), (-1, "too few cycles")):
+                assert confusion.loc[(name, label), column] == (named == answer).sum()
+    png = benchmark.confusion_figure(confusion, tmp_path / "c.png")
+    assert png.stat().st_size > 10_000
+
+
+def test_markdown_prints_undecided_not_axis_0():
+    table = pd.DataFrame({"run": ["a", "b", "c"], "located_axis": [0, 3, -1]})
+    text = benchmark.markdown(table)
+    assert "| a | undecided |" in text and "| b | 3 |" in text and "| c | too few cycles |" in text
 
 
 def test_detection_flags_worn_runs_against_the_unworn_one(small):
@@ -61,6 +94,10 @@ def test_bench_isolators_command_writes_csv_markdown_and_heatmap(small, tmp_path
     assert {"te5", "cross_correlation", "granger", "trend"} <= set(table["isolator"])
     assert "accuracy te5" in stem.with_suffix(".md").read_text()
     assert stem.with_suffix(".png").stat().st_size > 10_000
+    confusion = pd.read_csv(tmp_path / "iso-confusion.csv", index_col=[0, 1])
+    assert confusion.loc[("trend", "none")].sum() == 2  # the run without wear, at 2 levels
+    assert (tmp_path / "iso-confusion.png").stat().st_size > 10_000
+    assert "no fault" in result.output
 
 
 def test_bins_below_two_are_refused(small, tmp_path):
@@ -80,3 +117,35 @@ def test_analysis_refuses_a_dataset_that_fails_validation(small, tmp_path):
         result = runner.invoke(app, [command, str(broken)])
         assert result.exit_code == 2, (command, result.output)
         assert "fails validation" in result.output and "torque_hist" in result.output
+
+
+@pytest.fixture(scope="module")
+def sparse(tmp_path_factory):
+    """Like the quick preset: every tenth cycle recorded (4 of 40), no wear and two worn axes."""
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=40, record=[10, 20, 30, 40])
+    return sweep.run(grid, tmp_path_factory.mktemp("sparse") / "sparse.h5", jobs=1, progress=False)
+
+
+def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_lacks(sparse, tmp_path):
+    result = runner.invoke(app, ["bench-isolators", str(sparse), "--no-progress", "-o", str(tmp_path / "iso")])
+    assert result.exit_code == 0, result.output
+    assert "note: this dataset lacks cycles: with at most 4 recorded cycles per run" in result.output
+    assert "te10" in result.output.split("note:")[1] and "faultgen sweep --preset j2" in result.output
+
+    result = runner.invoke(app, ["detect", str(sparse), "--no-progress", "-o", str(tmp_path / "det")])
+    assert result.exit_code == 0, result.output
+    table = pd.read_csv(tmp_path / "det.csv")
+    printed = [line for line in result.output.splitlines() if line.startswith("| irb6700")]
+    assert len(printed) == len(table) == 2
+    for line, located in zip(printed, table["located_axis"], strict=True):
+        assert line.split(" | ")[-2] == benchmark.axis_label(located)  # never a bare 0
+    assert all(" | 0 | " not in line.split("|", 10)[-1] for line in printed)
+
+    result = runner.invoke(app, ["classify", str(sparse), "--no-progress", "--pairs", "0", "-o", str(tmp_path / "cls")])
+    # 4 cycles per run: with a pair held out, one worn run of 4 cycles is left to train on
+    assert result.exit_code == 2, result.output
+    message = " ".join(result.output.split())
+    assert "error: " in message and "this dataset lacks runs for leave-pair-out classification" in message
+    assert "the smallest training set has 1 failed samples (true wear >= 10 %) and 3 normal ones" in message
+    assert "faultgen sweep --preset quick" in message
+    assert not (tmp_path / "cls.csv").exists()
