@@ -361,6 +361,33 @@ def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen datas
     typer.echo(f"{file}: valid ({len(dataset.list_runs(file))} runs)")
 
 
+@app.command("export", cls=PlainHelpCommand)
+def export_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Table to write: .csv, .csv.gz or .parquet.")],
+    overwrite: Overwrite = False,
+) -> None:
+    """Write every per-cycle feature of a dataset as one tidy table (CSV or Parquet).
+
+    One row per run, recorded cycle and axis: the run's labels, the true wear of the axis, mean
+    and RMS motor torque, friction torque, tracking error and the 12-bin histograms (a column per
+    bin). Columns and units: docs/dataset.md. Read it with pandas: `pandas.read_parquet(OUT)`.
+
+    Example:
+
+      faultgen export quick.h5 -o quick.parquet
+    """
+    from faultgen.data import dataset
+
+    try:
+        _check_outputs([out], overwrite)
+        dataset.export_features(file, out)
+    except ValueError as err:  # a broken dataset (1); a refused output (2)
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(1 if isinstance(err, dataset.DatasetError) else 2) from err
+    typer.echo(f"wrote {out}")
+
+
 @app.command("plot", cls=PlainHelpCommand)
 def plot_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],

@@ -276,7 +276,7 @@ def test_analysis_commands_refuse_existing_outputs_before_computing(tmp_path, co
     assert stem.with_suffix(".md").read_text() == "earlier" and not stem.with_suffix(".csv").exists()
 
 
-@pytest.mark.parametrize("command", [[], ["robots"], ["simulate"], ["calibrate"], ["sweep"], ["info"], ["validate"],
+@pytest.mark.parametrize("command", [[], ["robots"], ["simulate"], ["calibrate"], ["sweep"], ["info"], ["validate"], ["export"],
                                      ["plot"], ["bench-isolators"], ["detect"], ["classify"]])
 def test_help_has_no_type_tags(command):
     result = runner.invoke(app, [*command, "--help"], terminal_width=100)

@@ -30,9 +30,13 @@ from collections.abc import Iterable
 from contextlib import contextmanager
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import h5py
 import numpy as np
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from faultgen import __version__
 from faultgen.data.atomic import atomic_path
@@ -224,6 +228,78 @@ def read_run(path: str | Path, run_id: str | None = None,
         arrays = {name: group[name][()] for name in wanted}
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
+
+
+#: Labels of a run repeated on every row of :func:`features`.
+FEATURE_LABELS = ("robot", "task", "friction_model", "seed")
+#: Formats :func:`export_features` writes, by file-name ending.
+EXPORT_SUFFIXES = (".csv", ".csv.gz", ".parquet")
+
+
+def features(path: str | Path) -> pd.DataFrame:
+    """Every per-cycle quantity of a dataset as one tidy table, for tools that do not read HDF5.
+
+    One row per (run, recorded cycle, axis); columns: ``run``, the run's labels
+    (:data:`FEATURE_LABELS`), ``worn_axes`` (the run's worn axes as text, "2" or "2 5"; "" for
+    none), ``cycle`` (1-based), ``axis`` (1..6), ``worn`` (this axis wears in this run),
+    ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
+    then every array of :data:`ARRAYS` with axes "cycle, axis" under its own name and every
+    histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` .. ``torque_hist_12``.
+    Values are the stored ones, in the units of :data:`ARRAYS`; ``DataFrame.attrs["units"]`` maps
+    each column to its unit.
+
+    Raises
+    ------
+    DatasetError
+        If ``path`` is not a finished faultgen dataset.
+    """
+    import pandas as pd
+
+    per_cycle = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis"]
+    histograms = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis, bin"]
+    frames = []
+    for run_id in list_runs(path):
+        arrays, attrs = read_run(path, run_id, names=("cycles", *per_cycle, *histograms))
+        n_cycles, n_axes = arrays["friction_multiplier"].shape
+        worn = {int(a) for a in attrs["worn_axes"]}
+        columns = {"run": run_id, **{key: attrs[key] for key in FEATURE_LABELS},
+                   "worn_axes": " ".join(str(a) for a in sorted(worn)),
+                   "cycle": np.repeat(arrays["cycles"], n_axes), "axis": np.tile(np.arange(1, n_axes + 1), n_cycles),
+                   "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
+                   "wear_pct": ((arrays["friction_multiplier"] - 1.0) * 100.0).ravel()}
+        columns.update({name: arrays[name].ravel() for name in per_cycle})
+        for name in histograms:
+            bins = arrays[name].reshape(n_cycles * n_axes, -1)
+            columns.update({f"{name}_{k + 1}": bins[:, k] for k in range(bins.shape[1])})
+        frames.append(pd.DataFrame(columns))
+    table = pd.concat(frames, ignore_index=True)
+    table.attrs["units"] = {"wear_pct": "%", **{name: ARRAYS[name][0] for name in per_cycle},
+                            **{c: ARRAYS[c.rsplit("_", 1)[0]][0] for c in table.columns
+                               if c.rsplit("_", 1)[0] in histograms}}
+    return table
+
+
+def export_features(path: str | Path, out: str | Path) -> Path:
+    """Write :func:`features` of ``path`` to ``out`` (CSV, gzip-compressed CSV or Parquet by its
+    ending, :data:`EXPORT_SUFFIXES`), atomically.
+
+    Raises
+    ------
+    ValueError
+        If ``out`` has another ending (the message lists the accepted ones).
+    DatasetError
+        If ``path`` is not a finished faultgen dataset.
+    """
+    out = Path(out)
+    if not out.name.lower().endswith(EXPORT_SUFFIXES):
+        raise ValueError(f"cannot export to {out}: expected a name ending in {', '.join(EXPORT_SUFFIXES)}")
+    table = features(path)
+    with atomic_path(out) as tmp:
+        if out.name.lower().endswith(".parquet"):
+            table.to_parquet(tmp, index=False)
+        else:
+            table.to_csv(tmp, index=False, compression="gzip" if out.name.lower().endswith(".gz") else None)
+    return out
 
 
 def labels(path: str | Path) -> list[dict]:

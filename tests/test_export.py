@@ -1,0 +1,68 @@
+"""faultgen.dataset.features and `faultgen export`: the tidy table equals the HDF5 arrays."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from faultgen import dataset, sweep
+from faultgen.cli import app
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """No wear and axis 3 worn, spot weld, 3 of 20 cycles recorded: 2 runs."""
+    grid = sweep.Grid(robots=["irb6700"], tasks=["spot_weld"], axes=[0, 3], cycles=20, record=[1, 10, 20])
+    return sweep.run(grid, tmp_path_factory.mktemp("export") / "small.h5", jobs=1, progress=False)
+
+
+def test_features_hold_every_per_cycle_array_value_by_run_cycle_and_axis(small):
+    table = dataset.features(small)
+    assert len(table) == 2 * 3 * 6
+    for run_id in dataset.list_runs(small):
+        arrays, attrs = dataset.read_run(small, run_id)
+        rows = table[table["run"] == run_id]
+        assert (rows[["robot", "task", "friction_model"]].to_numpy() == [attrs["robot"], attrs["task"],
+                                                                       attrs["friction_model"]]).all()
+        assert (rows["seed"] == attrs["seed"]).all()
+        for k, cycle in enumerate(arrays["cycles"]):
+            for axis in range(1, 7):
+                (row,) = rows[(rows["cycle"] == cycle) & (rows["axis"] == axis)].itertuples(index=False)
+                row = row._asdict()
+                assert row["worn"] == (axis in attrs["worn_axes"])
+                assert row["wear_pct"] == (arrays["friction_multiplier"][k, axis - 1] - 1) * 100
+                for name in ("mean_abs_torque", "rms_torque", "mean_friction_torque", "tracking_error",
+                             "friction_multiplier"):
+                    assert row[name] == arrays[name][k, axis - 1], name
+                for name in ("angle_hist", "speed_hist", "torque_hist"):
+                    np.testing.assert_array_equal([row[f"{name}_{b}"] for b in range(1, 13)],
+                                                  arrays[name][k, axis - 1])
+    worn = table[table["run"].str.contains("axis3")]
+    assert set(worn["worn_axes"]) == {"3"} and set(worn[worn["worn"]]["axis"]) == {3}
+    assert worn[worn["axis"] == 3]["wear_pct"].max() == pytest.approx(20.0)
+    assert table.attrs["units"]["mean_abs_torque"] == "N m" and table.attrs["units"]["wear_pct"] == "%"
+
+
+@pytest.mark.parametrize("name", ["features.parquet", "features.csv", "features.csv.gz"])
+def test_export_round_trip(small, tmp_path, name):
+    out = tmp_path / name
+    result = runner.invoke(app, ["export", str(small), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    back = pd.read_parquet(out) if name.endswith(".parquet") else pd.read_csv(out, keep_default_na=False)
+    expected = dataset.features(small)
+    assert list(back.columns) == list(expected.columns)
+    back["worn_axes"] = back["worn_axes"].astype(str)
+    pd.testing.assert_frame_equal(back, expected, check_dtype=False, check_exact=name.endswith(".parquet"),
+                                  rtol=1e-15)
+    assert not list(tmp_path.glob(".*.part"))
+
+
+def test_export_refuses_unknown_formats_and_existing_outputs(small, tmp_path):
+    result = runner.invoke(app, ["export", str(small), "-o", str(tmp_path / "f.xlsx")])
+    assert result.exit_code == 2 and "expected a name ending in .csv, .csv.gz, .parquet" in result.output
+    (tmp_path / "f.csv").write_text("earlier")
+    result = runner.invoke(app, ["export", str(small), "-o", str(tmp_path / "f.csv")])
+    assert result.exit_code == 2 and "--overwrite" in result.output
+    assert (tmp_path / "f.csv").read_text() == "earlier"
