@@ -39,6 +39,45 @@ def axis_label(value: int) -> str:
     return {UNDECIDED: "undecided", TOO_FEW_CYCLES: "too few cycles"}.get(int(value), str(int(value)))
 
 
+def load_estimator(spec: str) -> object:
+    """A user's estimator from ``"package.module:Class"``, built with its defaults (``Class()``).
+
+    The module is imported as Python would, with the current folder searched first, so a file
+    ``mine.py`` beside the dataset serves as ``mine:MyIsolator``. The class must be a
+    scikit-learn estimator (``sklearn.base.BaseEstimator``, e.g. a subclass of
+    :class:`analysis.isolation.Isolator`), so that the benchmarks can ``clone`` it.
+
+    Raises
+    ------
+    ValueError
+        If ``spec`` is not ``module:Class``, the module cannot be imported, it has no such class,
+        or the class is not a scikit-learn estimator; the message names what is wrong.
+    """
+    import importlib
+    import os
+    import sys
+
+    from sklearn.base import BaseEstimator
+
+    module_name, _, class_name = spec.partition(":")
+    if not module_name or not class_name.isidentifier():
+        raise ValueError(f"plug-in {spec!r}: expected package.module:Class, e.g. mine:MyIsolator")
+    if os.getcwd() not in sys.path:
+        sys.path.insert(0, os.getcwd())
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as err:
+        raise ValueError(f"plug-in {spec!r}: cannot import {module_name!r} ({err}); put it in the current folder "
+                         "or on PYTHONPATH") from None
+    cls = getattr(module, class_name, None)
+    if not isinstance(cls, type):
+        raise ValueError(f"plug-in {spec!r}: module {module_name!r} has no class {class_name!r}")
+    if not issubclass(cls, BaseEstimator):
+        raise ValueError(f"plug-in {spec!r}: {class_name} is not a scikit-learn estimator; derive it from "
+                         "analysis.isolation.Isolator or sklearn.base.BaseEstimator")
+    return cls()
+
+
 def default_isolators(bins: Iterable[int] = (5, 10)) -> dict[str, object]:
     """Transfer entropy with each bin count (thesis ch. 6), cross-correlation (ch. 3.4.2), and the
     other registered isolators with their defaults."""
@@ -93,9 +132,12 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     probe = np.random.default_rng(0).standard_normal((200, 6))
     for name, prototype in isolators.items():  # bad parameters (bins < 2, ...) raise here, named
         try:
-            clone(prototype).fit(probe)
+            fitted = clone(prototype).fit(probe)
         except ValueError as err:
             raise ValueError(f"isolator {name}: {err}") from err
+        if not hasattr(fitted, "source_axis_"):
+            raise ValueError(f"isolator {name}: fit(X) set no source_axis_ (the isolator contract of "
+                             "analysis.isolation: 1-based axis, 0 when undecided)")
     runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) <= 1]
     worn = [r for r in runs if len(r[2]["worn_axes"]) == 1]
     if not worn:
@@ -264,7 +306,7 @@ def group_cycles(cycles: np.ndarray, period: int | None) -> np.ndarray:
 
 
 def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persistence: int = 1,
-                    period: int | None = None, progress: bool = True) -> pd.DataFrame:
+                    period: int | None = None, progress: bool = True, detector=None) -> pd.DataFrame:
     """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5).
 
     Features per sample: for each axis, the KL divergence (eq. 5.4) of the 12-bin histogram of
@@ -277,6 +319,10 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     first sample whose Q statistic exceeds its ``1 - alpha`` limit for ``persistence`` samples in
     a row; its location is the axis the cross-correlation isolator names (ch. 3.4.2) on the KL
     features up to that sample.
+
+    ``detector``, a scikit-learn estimator whose ``fit(X)`` learns healthy samples and whose
+    ``predict(X)`` gives one alarm (truthy) per sample, replaces the PCA monitor (``variance`` and
+    ``alpha`` are then unused); it sees the same features.
 
     Returns
     -------
@@ -298,7 +344,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                              f"to train the monitor of {run_id}")
         axis = int(attrs["worn_axes"][0])
         if nominal[0] not in references:  # one reference serves every worn run of its task and seed
-            references[nominal[0]] = _reference_monitor(path, nominal, period, variance, alpha)
+            references[nominal[0]] = _reference_monitor(path, nominal, period, variance, alpha, detector)
         scale, used, monitor = references[nominal[0]]
         worn_torque = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
         worn, groups = _kl_features(worn_torque, arrays["cycles"], scale, period)
@@ -318,14 +364,19 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     return pd.DataFrame(rows)
 
 
-def _reference_monitor(path, nominal, period: int | None, variance: float, alpha: float):
-    """The torque scale, the features used and the fitted Q monitor of a run without wear."""
+def _reference_monitor(path, nominal, period: int | None, variance: float, alpha: float, detector=None):
+    """The torque scale, the features used and the fitted Q monitor (or ``detector``) of a run
+    without wear."""
+    from sklearn.base import clone
+
     from analysis.monitoring import PCAMonitor
 
     torque = np.abs(dataset.read_run(path, nominal[0], names=("tau_m",))[0]["tau_m"])
     scale = torque.max(axis=(0, 1))
     normal, _ = _kl_features(torque, nominal[1]["cycles"], scale, period)
     used = np.flatnonzero(normal.std(axis=0) > 0)  # features constant in training are left out
+    if detector is not None:
+        return scale, used, clone(detector).fit(normal[:, used])
     monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q")
     try:
         monitor.fit(normal[:, used])

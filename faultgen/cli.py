@@ -453,6 +453,11 @@ def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
     bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
+    plugins: Annotated[list[str] | None, typer.Option(
+        "--isolator", metavar="MODULE:CLASS",
+        help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
+             "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
+             "repeat for several.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
@@ -467,8 +472,9 @@ def bench_isolators_command(
                            confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
     try:
         wear_levels = [float(x) for x in levels.split(",")]
-        table = benchmark.isolation_table(file, benchmark.default_isolators(bins or (5, 10)), wear_levels,
-                                          progress=progress)
+        isolators = benchmark.default_isolators(bins or (5, 10))
+        isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
+        table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress)
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
@@ -500,6 +506,11 @@ def detect_command(
                           "limit is then crossed by 5 % of normal samples, so long runs always alarm early.")
     ] = 3,
     period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
+    plugin: Annotated[str | None, typer.Option(
+        "--detector", metavar="MODULE:CLASS",
+        help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
+             "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
+             "current folder).")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
@@ -508,7 +519,8 @@ def detect_command(
     from analysis import benchmark
 
     _table_command(file, out, overwrite, "-detection", 4, lambda: benchmark.detection_table(
-        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress))
+        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
+        detector=benchmark.load_estimator(plugin) if plugin else None))
 
 
 @app.command("classify", cls=PlainHelpCommand)

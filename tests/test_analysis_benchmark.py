@@ -149,3 +149,74 @@ def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_la
     assert "the smallest training set has 1 failed samples (true wear >= 10 %) and 3 normal ones" in message
     assert "faultgen sweep --preset quick" in message
     assert not (tmp_path / "cls.csv").exists()
+
+
+PLUGINS = '''
+import numpy as np
+from sklearn.base import BaseEstimator
+
+from analysis.isolation import Isolator
+
+
+class LargestRise(Isolator):
+    """Names the axis whose signal rose most from the first to the last cycle."""
+
+    def _min_rows(self, n_rows):
+        return 2
+
+    def _scores(self, X):
+        return (X[-1] - X[0]) / np.abs(X[0])
+
+
+class ZScore(BaseEstimator):
+    """Alarms where any feature leaves the healthy mean by more than `limit` standard deviations."""
+
+    def __init__(self, limit=4.0):
+        self.limit = limit
+
+    def fit(self, X, y=None):
+        self.mean_, self.std_ = X.mean(axis=0), X.std(axis=0) + 1e-12
+        return self
+
+    def predict(self, X):
+        return (np.abs((X - self.mean_) / self.std_) > self.limit).any(axis=1)
+
+
+class NotAnEstimator:
+    pass
+'''
+
+
+def test_plug_ins_from_a_users_module_run_through_the_commands(small, tmp_path, monkeypatch):
+    (tmp_path / "user_plugins_a.py").write_text(PLUGINS)
+    monkeypatch.chdir(tmp_path)  # the module lies in the current folder, as a user's would
+    result = runner.invoke(app, ["bench-isolators", str(small), "--bins", "5", "--levels", "5,20", "--no-progress",
+                                 "--isolator", "user_plugins_a:LargestRise", "-o", str(tmp_path / "iso")])
+    assert result.exit_code == 0, result.output
+    table = pd.read_csv(tmp_path / "iso.csv")
+    mine = table[table["isolator"] == "LargestRise"]
+    assert len(mine) == len(table[table["isolator"] == "te5"]) > 0
+    full = mine[mine["wear_pct"] == 20.0]
+    assert (full["predicted"] == full["worn_axis"]).all()  # at 20 % the worn axis rose most
+
+    result = runner.invoke(app, ["detect", str(small), "--no-progress", "--detector", "user_plugins_a:ZScore",
+                                 "-o", str(tmp_path / "det")])
+    assert result.exit_code == 0, result.output
+    detected = pd.read_csv(tmp_path / "det.csv")
+    assert sorted(detected["worn_axis"]) == [1, 5] and detected["detected"].all()
+
+
+@pytest.mark.parametrize(("spec", "message"), [
+    ("user_plugins_b", "expected package.module:Class"),
+    ("no_such_module_xyz:Thing", "cannot import 'no_such_module_xyz'"),
+    ("user_plugins_b:Missing", "has no class 'Missing'"),
+    ("user_plugins_b:NotAnEstimator", "is not a scikit-learn estimator"),
+])
+def test_a_bad_plug_in_is_refused_naming_it(small, tmp_path, monkeypatch, spec, message):
+    (tmp_path / "user_plugins_b.py").write_text(PLUGINS)
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, ["bench-isolators", str(small), "--isolator", spec, "--no-progress",
+                                 "-o", str(tmp_path / "iso")])
+    assert result.exit_code == 2, result.output
+    assert f"error: plug-in {spec!r}" in result.output and message in result.output
+    assert not (tmp_path / "iso.csv").exists()
