@@ -499,6 +499,12 @@ def bench_isolators_command(
 @app.command("detect", cls=PlainHelpCommand)
 def detect_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
+    protocol: Annotated[str, typer.Option(
+        help="Where the monitor learns normal operation: other-seeds (runs without wear of the other seeds: other "
+             "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
+             "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
+             "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
+    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.")] = 20,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
     alpha: Annotated[float, typer.Option(help="Significance of the Q limit (0.05: 95 % limit).")] = 0.05,
     persistence: Annotated[
@@ -515,12 +521,40 @@ def detect_command(
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
-    """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout."""
+    """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout, with the
+    false-alarm rate on healthy runs the monitor did not learn from; summary per task and axis.
+
+    Writes OUT.csv and OUT.md (per run) and OUT-summary.csv (per task, per worn axis, all).
+
+    Example:
+
+      faultgen detect j2.h5 --protocol other-seeds -o j2-detection
+    """
     from analysis import benchmark
 
-    _table_command(file, out, overwrite, "-detection", 4, lambda: benchmark.detection_table(
-        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
-        detector=benchmark.load_estimator(plugin) if plugin else None))
+    stem = out or file.with_name(file.stem + "-detection")
+    summary_csv = stem.with_name(stem.name + "-summary.csv")
+    _analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), summary_csv], overwrite)
+    try:
+        table = benchmark.detection_table(
+            file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
+            detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    summary = benchmark.detection_summary(table)
+    written = benchmark.write_outputs(table, stem)
+    summary.to_csv(summary_csv)
+    typer.echo(benchmark.markdown(table, digits=4))
+    typer.echo("\nsummary (false_alarm_pct: alarms on healthy runs the monitor did not learn from, %):")
+    typer.echo(benchmark.markdown(summary, digits=4))
+    held_in = table[table["protocol"] != "other-seeds"]
+    if protocol == "auto" and len(held_in):
+        typer.echo(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} runs "
+                   f"were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. For "
+                   "false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset quick "
+                   "--seed 0 --seed 1 --seed 2`")
+    typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
 
 
 @app.command("classify", cls=PlainHelpCommand)

@@ -78,11 +78,44 @@ def test_markdown_prints_undecided_not_axis_0():
 
 
 def test_detection_flags_worn_runs_against_the_unworn_one(small):
-    table = benchmark.detection_table(small, progress=False)
+    table = benchmark.detection_table(small, progress=False, protocol="same-run")
     assert sorted(table["worn_axis"]) == [1, 5]
     assert set(table.columns) >= {"detected", "onset", "onset_wear_pct", "located_axis", "located"}
     detected = table[table["detected"]]
     assert (detected["onset_wear_pct"] <= 20.0).all()
+    assert set(table["protocol"]) == {"same-run (in-sample)"}
+    assert set(table["trained_on"]) == {"irb6700-pick_place-nowear-seed0"}
+
+
+@pytest.fixture(scope="module")
+def two_seeds(tmp_path_factory):
+    """Pick and place, no wear and axis 5 worn, seeds 0 and 1, 40 cycles all recorded: 4 runs."""
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 5], cycles=40, seeds=[0, 1])
+    return sweep.run(grid, tmp_path_factory.mktemp("seeds") / "seeds.h5", jobs=1, progress=False)
+
+
+def test_held_out_protocols_learn_from_data_the_tested_run_did_not_produce(two_seeds, small):
+    table = benchmark.detection_table(two_seeds, progress=False, persistence=3)  # auto: other seeds exist
+    assert list(table["protocol"]) == ["other-seeds", "other-seeds"]
+    for row in table.itertuples():  # trained on the other seed's healthy run, judged on its own seed's
+        assert row.trained_on == f"irb6700-pick_place-nowear-seed{1 - row.seed}"
+        assert 0.0 <= row.false_alarm_pct <= 100.0
+    first = benchmark.detection_table(small, progress=False, persistence=3)  # auto, one seed, 40 cycles
+    assert set(first["protocol"]) == {"first-cycles"} and set(first["trained_on"]) == {"samples 1-20 of the run"}
+    assert (first["false_alarm_pct"].notna()).all()
+    assert (first[first["detected"]]["onset"] >= 20).all()  # never inside the samples it learned from
+    summary = benchmark.detection_summary(first)
+    assert summary.loc[("all", "all"), "runs"] == 2
+    assert summary.loc[("all", "all"), "false_alarm_pct"] == pytest.approx(first["false_alarm_pct"].mean(), abs=0.01)
+
+
+def test_a_protocol_the_dataset_cannot_serve_is_refused_saying_what_it_lacks(small):
+    with pytest.raises(ValueError, match="protocol other-seeds needs runs without wear .* another seed than 0"):
+        benchmark.detection_table(small, progress=False, protocol="other-seeds")
+    with pytest.raises(ValueError, match="learns from the first 50 samples of a run and needs more; .* has 40"):
+        benchmark.detection_table(small, progress=False, protocol="first-cycles", first=50)
+    with pytest.raises(ValueError, match="unknown protocol 'held-out'; expected one of: auto, other-seeds"):
+        benchmark.detection_table(small, progress=False, protocol="held-out")
 
 
 def test_bench_isolators_command_writes_csv_markdown_and_heatmap(small, tmp_path):
@@ -134,12 +167,13 @@ def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_la
 
     result = runner.invoke(app, ["detect", str(sparse), "--no-progress", "-o", str(tmp_path / "det")])
     assert result.exit_code == 0, result.output
+    assert "note: this dataset lacks runs without wear of other seeds" in " ".join(result.output.split())
+    assert "--seed 0 --seed 1 --seed 2" in result.output
     table = pd.read_csv(tmp_path / "det.csv")
     printed = [line for line in result.output.splitlines() if line.startswith("| irb6700")]
     assert len(printed) == len(table) == 2
     for line, located in zip(printed, table["located_axis"], strict=True):
         assert line.split(" | ")[-2] == benchmark.axis_label(located)  # never a bare 0
-    assert all(" | 0 | " not in line.split("|", 10)[-1] for line in printed)
 
     result = runner.invoke(app, ["classify", str(sparse), "--no-progress", "--pairs", "0", "-o", str(tmp_path / "cls")])
     # 4 cycles per run: with a pair held out, one worn run of 4 cycles is left to train on
