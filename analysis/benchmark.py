@@ -105,7 +105,8 @@ def level_cycle(multiplier: np.ndarray, level: float) -> int | None:
 
 
 def isolation_table(path, isolators: Mapping[str, object] | None = None, levels: Iterable[float] = WEAR_LEVELS,
-                    signal: str = "mean_abs_torque", progress: bool = True) -> pd.DataFrame:
+                    signal: str = "mean_abs_torque", progress: bool = True,
+                    speed_window: tuple[float, float] | None = None) -> pd.DataFrame:
     """Which axis each isolator names as the source, per run and wear level, healthy runs included.
 
     For a run wearing one axis, the isolator sees the per-cycle ``signal`` (n_cycles, 6) of the
@@ -114,6 +115,11 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     A run without wear is shown, for each level, as many cycles as the worn runs of its robot and
     task saw at that level; it is right only when the isolator names no axis (undecided): naming
     one is a false isolation. Runs wearing several axes are skipped.
+
+    With ``speed_window`` (low, high) in rad/s of motor speed, the per-cycle signal is the mean
+    |motor torque| over the samples whose motor speed lies in the window (thesis ch. 6.3.2,
+    :func:`analysis.features.speed_window_mean`); an axis of a run with a cycle that has no such
+    sample keeps its whole-cycle ``signal`` (column ``windowed``: the axes that were windowed).
 
     Returns
     -------
@@ -139,7 +145,16 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         if not hasattr(fitted, "source_axis_"):
             raise ValueError(f"isolator {name}: fit(X) set no source_axis_ (the isolator contract of "
                              "analysis.isolation: 1-based axis, 0 when undecided)")
-    runs = [r for r in _runs(path, (signal, "friction_multiplier")) if len(r[2]["worn_axes"]) <= 1]
+    names = (signal, "friction_multiplier", *(("tau_m", "qd_m") if speed_window else ()))
+    runs = [r for r in _runs(path, names) if len(r[2]["worn_axes"]) <= 1]
+    windowed = {run_id: np.zeros(6, dtype=bool) for run_id, _, _ in runs}
+    if speed_window:  # the windowed mean where every cycle has samples in the window
+        from analysis.features import speed_window_mean
+
+        for run_id, arrays, _ in runs:
+            inside = speed_window_mean(arrays.pop("tau_m"), arrays.pop("qd_m"), *speed_window)
+            windowed[run_id] = ~np.isnan(inside).any(axis=0)
+            arrays[signal] = np.where(windowed[run_id], inside, arrays[signal])
     worn = [r for r in runs if len(r[2]["worn_axes"]) == 1]
     if not worn:
         raise ValueError(f"{path} has no run with exactly one worn axis to isolate")
@@ -167,8 +182,27 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                 predicted = TOO_FEW_CYCLES
             rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
-                             correct=predicted == axis))
+                             correct=predicted == axis,
+                             windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run_id]))))
     return pd.DataFrame(rows)
+
+
+def motor_speed_coverage(path, speed_window: tuple[float, float]) -> pd.DataFrame:
+    """How a motor-speed window maps to each robot's and task's motor speeds: per robot, task and
+    axis, the 50th and 99th percentile of |motor speed| (rad/s) over the runs without wear, and
+    the share of their samples inside the window (%)."""
+    rows = []
+    for run_id, arrays, attrs in _runs(path, ("qd_m",)):
+        if len(attrs["worn_axes"]):
+            continue
+        speed = np.abs(arrays["qd_m"]).reshape(-1, arrays["qd_m"].shape[-1])
+        inside = (speed >= speed_window[0]) & (speed <= speed_window[1])
+        for a in range(speed.shape[1]):
+            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, axis=a + 1,
+                             p50_rad_s=np.percentile(speed[:, a], 50), p99_rad_s=np.percentile(speed[:, a], 99),
+                             in_window_pct=100.0 * inside[:, a].mean()))
+    table = pd.DataFrame(rows)
+    return table.groupby(["robot", "task", "axis"])[["p50_rad_s", "p99_rad_s", "in_window_pct"]].mean().round(1)
 
 
 #: Cycles per run from which a silent isolator is the method's doing, not the dataset's: thesis

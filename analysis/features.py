@@ -276,3 +276,37 @@ def cycle_statistics(signal) -> dict[str, np.ndarray]:
                          f"axis index {a}) is not finite")
     a = np.abs(x)
     return {"mean_abs": a.mean(axis=1), "rms": np.sqrt(np.mean(x**2, axis=1)), "max_abs": a.max(axis=1)}
+
+
+def speed_window_mean(torque, speed, low: float, high: float) -> np.ndarray:
+    """Mean ``|torque|`` of each cycle over the samples whose ``|speed|`` lies in ``[low, high]``
+    (thesis ch. 6.3.2: 50-120 rad/s of motor speed, "to minimize the effects of load and
+    temperature variation").
+
+    Parameters
+    ----------
+    torque, speed : array-like of shape (n_cycles, n_samples, n_axes)
+        Logged motor torque (N m) and motor speed (rad/s), e.g. the dataset's ``tau_m`` and ``qd_m``.
+    low, high : float
+        The speed window, rad/s, ``0 <= low < high``.
+
+    Returns
+    -------
+    ndarray of shape (n_cycles, n_axes)
+        In the unit of ``torque``; NaN where a cycle has no sample of that axis in the window.
+
+    Raises
+    ------
+    ValueError
+        If the shapes differ, or the window is not ``0 <= low < high``.
+    """
+    t, v = np.abs(np.asarray(torque, dtype=float)), np.abs(np.asarray(speed, dtype=float))
+    if t.shape != v.shape or t.ndim != 3:
+        raise ValueError(f"torque and speed must have the same shape (n_cycles, n_samples, n_axes), got "
+                         f"{t.shape} and {v.shape}")
+    if not 0 <= low < high:
+        raise ValueError(f"speed window [{low!r}, {high!r}] rad/s: expected 0 <= low < high")
+    inside = (v >= low) & (v <= high)
+    count = inside.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, np.where(inside, t, 0.0).sum(axis=1) / count, np.nan)

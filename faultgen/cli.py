@@ -453,6 +453,11 @@ def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
     bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
+    speed_window: Annotated[str | None, typer.Option(
+        metavar="LOW,HIGH",
+        help="Average |motor torque| only over samples whose motor speed lies in LOW..HIGH rad/s (thesis ch. "
+             "6.3.2: 50,120); axes that leave the window empty in some cycle keep the whole-cycle mean. Prints "
+             "how the window covers each task's motor speeds.")] = None,
     plugins: Annotated[list[str] | None, typer.Option(
         "--isolator", metavar="MODULE:CLASS",
         help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
@@ -472,9 +477,10 @@ def bench_isolators_command(
                            confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
     try:
         wear_levels = [float(x) for x in levels.split(",")]
+        window = _parse_window(speed_window) if speed_window is not None else None
         isolators = benchmark.default_isolators(bins or (5, 10))
         isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
-        table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress)
+        table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(2) from err
@@ -483,6 +489,9 @@ def bench_isolators_command(
     confusion = benchmark.isolation_confusion(table)
     confusion.to_csv(confusion_stem.with_suffix(".csv"))
     written += [confusion_stem.with_suffix(".csv"), benchmark.confusion_figure(confusion, confusion_stem.with_suffix(".png"))]
+    if window is not None:
+        typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
+        typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
     accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
     typer.echo(benchmark.markdown(accuracy, digits=4))
     typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
@@ -593,6 +602,17 @@ def _check_output_folder(folder: Path, overwrite: bool) -> None:
         raise ValueError(f"{folder} is a file; --out expects a folder to write the results into")
     if folder.is_dir() and any(folder.iterdir()) and not overwrite:
         raise ValueError(f"{folder} holds earlier results; pass --overwrite to replace them or choose another --out")
+
+
+def _parse_window(text: str) -> tuple[float, float]:
+    """'50,120' -> (50.0, 120.0); raises ValueError naming the text."""
+    try:
+        low, high = (float(x) for x in text.split(","))
+    except ValueError:
+        raise ValueError(f"--speed-window {text!r}: expected LOW,HIGH in rad/s, e.g. 50,120") from None
+    if not 0 <= low < high:
+        raise ValueError(f"--speed-window {text!r}: expected 0 <= LOW < HIGH")
+    return low, high
 
 
 def _parse_cycles(text: str) -> tuple[int, ...]:

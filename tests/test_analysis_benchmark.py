@@ -254,3 +254,23 @@ def test_a_bad_plug_in_is_refused_naming_it(small, tmp_path, monkeypatch, spec, 
     assert result.exit_code == 2, result.output
     assert f"error: plug-in {spec!r}" in result.output and message in result.output
     assert not (tmp_path / "iso.csv").exists()
+
+
+def test_speed_window_changes_the_signal_only_on_axes_whose_cycles_all_reach_it(small, tmp_path):
+    isolators = {"trend": isolation.make("trend")}
+    plain = benchmark.isolation_table(small, isolators, levels=(20.0,), progress=False)
+    window = benchmark.isolation_table(small, isolators, levels=(20.0,), progress=False, speed_window=(50.0, 120.0))
+    coverage = benchmark.motor_speed_coverage(small, (50.0, 120.0))
+    assert list(coverage.columns) == ["p50_rad_s", "p99_rad_s", "in_window_pct"] and len(coverage) == 6
+    windowed = {int(a) for a in window["windowed"].iloc[0].split()}
+    assert set(plain["windowed"]) == {""}
+    for axis in range(1, 7):  # an axis never inside the window cannot be windowed
+        if coverage.loc[("irb6700", "pick_place", axis), "in_window_pct"] == 0:
+            assert axis not in windowed
+    assert windowed, "no axis of pick and place reaches 50-120 rad/s"
+    result = runner.invoke(app, ["bench-isolators", str(small), "--bins", "5", "--levels", "20", "--no-progress",
+                                 "--speed-window", "50,120", "-o", str(tmp_path / "w")])
+    assert result.exit_code == 0, result.output
+    assert "motor speeds against the window 50-120 rad/s" in result.output and "in_window_pct" in result.output
+    result = runner.invoke(app, ["bench-isolators", str(small), "--speed-window", "120", "-o", str(tmp_path / "x")])
+    assert result.exit_code == 2 and "expected LOW,HIGH in rad/s" in result.output

@@ -175,3 +175,25 @@ def test_scikit_learn_estimator_checks(estimator):
     status = {r["check_name"]: r["status"] for r in results}
     assert [n for n, s in status.items() if s == "failed"] == []
     assert all(status[n] == "xfail" for n in ORDER_DEPENDENT)
+
+
+def test_speed_window_mean_averages_only_the_samples_inside_the_window():
+    from analysis.features import speed_window_mean
+
+    rng = np.random.default_rng(3)
+    torque = rng.normal(size=(4, 50, 3))
+    speed = rng.uniform(-150, 150, size=(4, 50, 3))
+    speed[2, :, 1] = 10.0  # axis 2 of cycle 3 never reaches the window
+    got = speed_window_mean(torque, speed, 50.0, 120.0)
+    for c in range(4):
+        for a in range(3):
+            picked = [abs(torque[c, s, a]) for s in range(50) if 50.0 <= abs(speed[c, s, a]) <= 120.0]
+            if picked:
+                assert got[c, a] == pytest.approx(sum(picked) / len(picked), rel=1e-12)
+            else:
+                assert np.isnan(got[c, a])
+    assert np.isnan(got[2, 1])
+    with pytest.raises(ValueError, match=r"speed window \[120.0, 50.0\] rad/s: expected 0 <= low < high"):
+        speed_window_mean(torque, speed, 120.0, 50.0)
+    with pytest.raises(ValueError, match="same shape"):
+        speed_window_mean(torque, speed[:, :10], 50.0, 120.0)
