@@ -89,8 +89,8 @@ def test_detection_flags_worn_runs_against_the_unworn_one(small):
 
 @pytest.fixture(scope="module")
 def two_seeds(tmp_path_factory):
-    """Pick and place, no wear and axis 5 worn, seeds 0 and 1, 40 cycles all recorded: 4 runs."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 5], cycles=40, seeds=[0, 1])
+    """Pick and place, no wear and axis 5 worn, seeds 0 and 1, 20 cycles all recorded: 4 runs."""
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 5], cycles=20, seeds=[0, 1])
     return sweep.run(grid, tmp_path_factory.mktemp("seeds") / "seeds.h5", jobs=1, progress=False)
 
 
