@@ -27,7 +27,8 @@ def accuracy_by_bins(path: Path, task: str, speed_window: tuple[float, float] | 
     if table.empty:
         raise SystemExit(f"{path} has no run of task {task!r} that wears one axis")
     accuracy = table.groupby(["isolator", "wear_pct"])["correct"].mean().mul(100).unstack("wear_pct")
-    return accuracy.rename_axis(index="bins", columns="wear %").round(1)
+    accuracy.columns = [f"{level:g} % wear" for level in accuracy.columns]
+    return accuracy.rename_axis(index="bins").round(1)
 
 
 def figure(accuracy, task: str, out: Path) -> Path:
@@ -36,7 +37,7 @@ def figure(accuracy, task: str, out: Path) -> Path:
     fig = Figure(figsize=(7, 4.5))
     ax = fig.subplots()
     for level in accuracy.columns:
-        ax.plot(accuracy.index, accuracy[level], marker="o", label=f"{level:g} % wear")
+        ax.plot(accuracy.index, accuracy[level], marker="o", label=level)
     ax.set(xlabel="bins", ylabel="source axis isolated (%)", ylim=(-3, 103),
            title=f"transfer entropy against the number of bins, {task} (thesis Fig. 6-5)")
     ax.set_xticks(list(accuracy.index))
