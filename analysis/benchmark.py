@@ -463,19 +463,17 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
 def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
     """Per task and per worn axis (and over all): runs, mean false-alarm rate (%), share detected
     (%), median onset cycle and true wear at detection (%), share located (%)."""
-    def summarise(group):
-        return pd.Series({"runs": len(group), "false_alarm_pct": group["false_alarm_pct"].mean(),
-                          "detected_pct": 100.0 * group["detected"].mean(),
-                          "median_onset_cycle": group["onset_cycle"].median(),
-                          "median_onset_wear_pct": group["onset_wear_pct"].median(),
-                          "located_pct": 100.0 * group["located"].mean()})
+    def percent(flags):
+        return 100.0 * flags.mean()
 
-    parts = [table.groupby("task").apply(summarise, include_groups=False).assign(by="task"),
-             table.groupby("worn_axis").apply(summarise, include_groups=False).assign(by="worn axis"),
-             summarise(table).to_frame("all").T.assign(by="all")]
-    out = pd.concat(parts)
-    out.index = [str(i) for i in out.index]
-    return out.rename_axis("group").reset_index().set_index(["by", "group"]).round(2)
+    aggregate = dict(runs=("run", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
+                     detected_pct=("detected", percent), median_onset_cycle=("onset_cycle", "median"),
+                     median_onset_wear_pct=("onset_wear_pct", "median"), located_pct=("located", percent))
+    parts = [table.groupby(table[key].astype(str)).agg(**aggregate).assign(by=label)
+             for key, label in (("task", "task"), ("worn_axis", "worn axis"))]
+    parts.append(table.groupby(pd.Series("all", index=table.index)).agg(**aggregate).assign(by="all"))
+    out = pd.concat(parts).rename_axis("group").reset_index()
+    return out.set_index(["by", "group"]).round(2)
 
 
 def _same_unit_kind(a: dict, b: dict) -> bool:
