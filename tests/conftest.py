@@ -7,9 +7,36 @@ workers on two cores, each with a BLAS pool as wide as the machine, contend for 
 """
 
 import os
+from pathlib import Path
 
 import numpy  # noqa: F401  (load the BLAS library before limiting it)
+import pytest
+from filelock import FileLock
 from threadpoolctl import threadpool_limits
+
+from faultgen.runs import sweep
 
 if os.environ.get("PYTEST_XDIST_WORKER"):
     threadpool_limits(1)
+
+
+@pytest.fixture(scope="session")
+def shared_sweep(tmp_path_factory, worker_id):
+    """``shared_sweep(name, **grid)``: the path of a sweep dataset built once per test session and
+    read by every pytest-xdist worker (module fixtures would be built once per worker: the 40-cycle
+    analysis dataset took 20 s on each). The xdist recipe: a file lock in the folder the workers'
+    temporary folders share. Tests only read these files; one that edits a dataset copies it."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "shared-sweeps"
+    folder.mkdir(exist_ok=True)
+
+    def build(name: str, **grid) -> Path:
+        out = folder / f"{name}.h5"
+        with FileLock(folder / f"{name}.build-lock"):
+            if not out.exists():
+                sweep.run(sweep.Grid(**grid), out, jobs=1, progress=False)
+        return out
+
+    return build

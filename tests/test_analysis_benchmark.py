@@ -7,17 +7,15 @@ import pytest
 from typer.testing import CliRunner
 
 from analysis import benchmark, isolation
-from faultgen import sweep
 from faultgen.cli import app
 
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def small(tmp_path_factory):
+def small(shared_sweep):
     """Pick and place, no wear and axes 1 and 5 worn (exp4, +20 % over 40 cycles), all recorded."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 1, 5], cycles=40)
-    return sweep.run(grid, tmp_path_factory.mktemp("analysis") / "small.h5", jobs=1, progress=False)
+    return shared_sweep("analysis-small", robots=["irb6700"], tasks=["pick_place"], axes=[0, 1, 5], cycles=40)
 
 
 def test_level_cycle_is_the_first_cycle_reaching_the_wear():
@@ -88,10 +86,10 @@ def test_detection_flags_worn_runs_against_the_unworn_one(small):
 
 
 @pytest.fixture(scope="module")
-def two_seeds(tmp_path_factory):
+def two_seeds(shared_sweep):
     """Pick and place, no wear and axis 5 worn, seeds 0 and 1, 20 cycles all recorded: 4 runs."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 5], cycles=20, seeds=[0, 1])
-    return sweep.run(grid, tmp_path_factory.mktemp("seeds") / "seeds.h5", jobs=1, progress=False)
+    return shared_sweep("analysis-seeds", robots=["irb6700"], tasks=["pick_place"], axes=[0, 5], cycles=20,
+                        seeds=[0, 1])
 
 
 def test_held_out_protocols_learn_from_data_the_tested_run_did_not_produce(two_seeds, small):
@@ -153,10 +151,10 @@ def test_analysis_refuses_a_dataset_that_fails_validation(small, tmp_path):
 
 
 @pytest.fixture(scope="module")
-def sparse(tmp_path_factory):
+def sparse(shared_sweep):
     """Like the quick preset: every tenth cycle recorded (4 of 40), no wear and two worn axes."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=40, record=[10, 20, 30, 40])
-    return sweep.run(grid, tmp_path_factory.mktemp("sparse") / "sparse.h5", jobs=1, progress=False)
+    return shared_sweep("analysis-sparse", robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=40,
+                        record=[10, 20, 30, 40])
 
 
 def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_lacks(sparse, tmp_path):

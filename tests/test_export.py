@@ -5,17 +5,17 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import dataset, sweep
+from faultgen import dataset
 from faultgen.cli import app
 
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def small(tmp_path_factory):
+def small(shared_sweep):
     """No wear and axis 3 worn, spot weld, 3 of 20 cycles recorded: 2 runs."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["spot_weld"], axes=[0, 3], cycles=20, record=[1, 10, 20])
-    return sweep.run(grid, tmp_path_factory.mktemp("export") / "small.h5", jobs=1, progress=False)
+    return shared_sweep("export-small", robots=["irb6700"], tasks=["spot_weld"], axes=[0, 3], cycles=20,
+                        record=[1, 10, 20])
 
 
 def test_features_hold_every_per_cycle_array_value_by_run_cycle_and_axis(small):

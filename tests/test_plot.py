@@ -8,16 +8,15 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from faultgen import dataset, sweep
+from faultgen import dataset
 from faultgen.plot import plot
 
 
 @pytest.fixture(scope="module")
-def sweep_file(tmp_path_factory):
+def sweep_file(shared_sweep):
     """Two tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 are recorded: 4 runs."""
-    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0],
-                      cycles=20, record=[1, 10, 20])
-    return sweep.run(grid, tmp_path_factory.mktemp("plot") / "s.h5", jobs=1, progress=False)
+    return shared_sweep("s", robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0],
+                        cycles=20, record=[1, 10, 20])
 
 
 @pytest.fixture
@@ -115,8 +114,9 @@ def test_a_file_with_one_run_is_drawn_as_that_run(sweep_file, tmp_path, figures)
 
 
 def test_a_simulated_run_is_titled_by_what_it_is(tmp_path, figures):
-    from faultgen import sim
     from faultgen.wear import WearPlan
+
+    from faultgen import sim
 
     config = sim.RunConfig(robot="puma560", task="spot_weld", wear=WearPlan.from_specs(["3:linear:10"], 4),
                            cycles=4, record=(1, 4), seed=7)
