@@ -156,7 +156,7 @@ def _change(arrays: dict, reference: dict | None, j: int) -> tuple[np.ndarray, n
     torque, wear = arrays["mean_abs_torque"][:, j], (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
     if reference is None:
         return wear, (torque / torque[0] - 1.0) * 100.0, True
-    common, mine, theirs = np.intersect1d(arrays["cycles"], reference["cycles"], return_indices=True)
+    _, mine, theirs = np.intersect1d(arrays["cycles"], reference["cycles"], return_indices=True)
     base = reference["mean_abs_torque"][theirs, j]
     return wear[mine], (torque[mine] / base - 1.0) * 100.0, False
 

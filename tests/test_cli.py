@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from faultgen.wear import WearPlan
 from typer.testing import CliRunner
 
 from faultgen import dataset, robots, sim
 from faultgen.cli import app
-from faultgen.wear import WearPlan
 
 runner = CliRunner()
 
