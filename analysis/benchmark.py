@@ -395,6 +395,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         return torque[run_id]
 
     monitors: dict[tuple, tuple] = {}
+    false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy run
     rows = []
     for run_id, arrays, attrs in tqdm(runs, desc="detection", unit="run", disable=not progress):
         if len(attrs["worn_axes"]) != 1:
@@ -403,7 +404,9 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         same = [r for r in healthy if _same_unit_kind(r[2], attrs)]
         own = next((r for r in same if r[2]["seed"] == attrs["seed"]), None)
         others = [r for r in same if r[2]["seed"] != attrs["seed"]]
-        n_samples = len(np.unique(group_cycles(arrays["cycles"], period)))
+        sample_of = group_cycles(arrays["cycles"], period)
+        samples = np.unique(sample_of)
+        n_samples = len(samples)
         used_protocol = protocol
         if protocol == "auto":
             used_protocol = "other-seeds" if others else "first-cycles" if n_samples > first else "same-run"
@@ -419,8 +422,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                 raise ValueError(f"{path}: protocol first-cycles learns from the first {first} samples of a run and "
                                  f"needs more; {run_id} has {n_samples}. Record more cycles, or sweep several "
                                  "seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
-            samples = np.unique(group_cycles(arrays["cycles"], period))
-            keep = np.isin(group_cycles(arrays["cycles"], period), samples[:first])
+            keep = np.isin(sample_of, samples[:first])
             training = [(run_id, abs_torque(run_id)[keep], arrays["cycles"][keep])]
             key, trained_on, heldout, skip = (run_id, first), f"samples 1-{first} of the run", own, first
         else:  # same-run
@@ -429,19 +431,23 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                                  f"{attrs['task']} seed {attrs['seed']}; this dataset has none")
             training = [(own[0], abs_torque(own[0]), own[1]["cycles"])]
             key, trained_on, heldout, skip = (own[0],), own[0], own, 0
-            used_protocol = "same-run (in-sample)"
         if key not in monitors:  # one monitor serves every worn run that learns from the same data
             monitors[key] = _fit_monitor(training, period, variance, alpha, detector,
-                                         fixed_reference=used_protocol != "same-run (in-sample)")
+                                         fixed_reference=used_protocol != "same-run")
+        if used_protocol == "same-run":
+            used_protocol = "same-run (in-sample)"
         scale, reference, used, monitor = monitors[key]
         worn, groups = _kl_features(abs_torque(run_id), arrays["cycles"], scale, period, reference)
         alarms = np.asarray(monitor.predict(worn[:, used]), dtype=bool)
         onset = detect_onset(alarms[skip:], persistence=persistence)
         onset = None if onset is None else onset + skip
-        false_alarm = np.nan
-        if heldout is not None:
-            normal, _ = _kl_features(abs_torque(heldout[0]), heldout[1]["cycles"], scale, period, reference)
-            false_alarm = 100.0 * float(np.mean(np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]))
+        if key not in false_alarms:
+            false_alarms[key] = np.nan
+            if heldout is not None:
+                normal, _ = _kl_features(abs_torque(heldout[0]), heldout[1]["cycles"], scale, period, reference)
+                false_alarms[key] = 100.0 * float(np.mean(np.asarray(monitor.predict(normal[:, used]),
+                                                                      dtype=bool)[skip:]))
+        false_alarm = false_alarms[key]
         wear = (arrays["friction_multiplier"][:, axis - 1] - 1.0) * 100.0
         located = UNDECIDED
         if onset is not None:
