@@ -41,7 +41,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from faultgen.model import friction as friction_models
+from faultgen.effects import friction as friction_models
 from faultgen.model import robots
 from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan

@@ -2,7 +2,8 @@
 
 Data flows one way, through sub-packages by layer (docs/architecture.md; the order is a contract
 that ``lint-imports`` checks in the test suite):
-``model`` (robots, friction) -> ``operation`` (tasks, paths, wear) -> ``simulation`` (drives,
+``effects`` (friction and the other physical effects, one class each) -> ``model`` (robots)
+-> ``operation`` (tasks, paths, wear) -> ``simulation`` (drives,
 sensors, stepping) -> ``data`` (datasets, measured logs) -> ``runs`` (sweeps), ``calibrate`` and
 ``plot`` -> ``cli``; the ``analysis`` package reads the datasets.
 
@@ -24,7 +25,7 @@ except PackageNotFoundError:  # running from a source tree that was not installe
 #: First-round module names -> where the module lives now.
 MOVED = {
     "robots": "faultgen.model.robots",
-    "friction": "faultgen.model.friction",
+    "friction": "faultgen.effects.friction",
     "tasks": "faultgen.operation.tasks",
     "ik": "faultgen.operation.ik",
     "wear": "faultgen.operation.wear",

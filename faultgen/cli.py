@@ -13,8 +13,8 @@ from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from faultgen import __version__
 from faultgen.model import robots
-from faultgen.model.friction import FIELDS as FRICTION_FIELDS
-from faultgen.model.friction import UNITS as FRICTION_UNITS
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import UNITS as FRICTION_UNITS
 
 
 class _PlainHelp:

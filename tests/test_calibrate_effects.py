@@ -10,8 +10,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import calibrate, robots, sim
-from faultgen.calibrate import effects, synth
+from faultgen import calibrate, effects, robots, sim
+from faultgen.calibrate import synth
 
 ROBOTS = ("puma560", "irb6700")
 
@@ -23,29 +23,26 @@ def setup(request):
     return robot, motion
 
 
-# One set of physical parameters per effect, on axis 2 (index 1) unless robot-wide.
-PARAMS = {
-    "torque_offset": {"offset_Nm": 3.5},
-    "coulomb": {"coulomb_change_Nm_motor": 0.05},
-    "viscous": {"viscous_change_Nm_s_per_rad_motor": 2e-3},
-    "stribeck": {"static_Nm_motor": 0.2, "stribeck_velocity_rad_per_s_motor": 7.0},
-    "load_dependent_friction": {"load_friction_coefficient": 0.1},
-    "temperature": {"amplitude": 0.8, "time_constant_s": 3.0},
-    "payload": {"mass_kg": 2.0},
-    "cogging": {"amplitude_Nm_motor": 0.05, "poles": 6, "phase_rad": 0.4},
+# One fitted change (theta, grid value) per effect, on axis 2 (index 1) unless robot-wide, and the
+# absolute parameters it gives on the nominal robot (``None``: the nominal value plus theta).
+CHANGES = {
+    "torque_offset": (np.array([3.5]), None, {"offset": 3.5}),
+    "coulomb": (np.array([0.05]), None, None),
+    "viscous": (np.array([2e-3]), None, None),
+    "stribeck": (np.array([0.2]), 7.0, {"static": 0.2, "stribeck_velocity": 7.0}),
+    "load_dependent_friction": (np.array([0.1]), None, {"coefficient": 0.1}),
+    "temperature": (np.array([0.8]), 3.0, {"amplitude": 0.8, "time_constant": 3.0}),
+    "payload": (np.array([2.0]), None, {"mass": 2.0}),
+    "cogging": (np.array([-0.05 * np.cos(0.4), -0.05 * np.sin(0.4)]), 6, {"amplitude": 0.05, "poles": 6, "phase": 0.4}),
 }
 
 
-def theta_of(effect, params):
-    """The linear parameters and grid value that give ``params``."""
-    if effect.id == "cogging":
-        a, phi = params["amplitude_Nm_motor"], params["phase_rad"]
-        return np.array([-a * np.cos(phi), -a * np.sin(phi)]), params["poles"]
-    if effect.id == "stribeck":
-        return np.array([params["static_Nm_motor"]]), params["stribeck_velocity_rad_per_s_motor"]
-    if effect.id == "temperature":
-        return np.array([params["amplitude"]]), params["time_constant_s"]
-    return np.array([next(iter(params.values()))]), None
+def absolute(robot, effect_id, theta):
+    """The absolute parameters of a friction change ``theta`` on axis 2, from the robot's friction."""
+    f = robot.friction
+    if effect_id == "coulomb":
+        return {"coulomb_pos": f.coulomb_pos[1] + theta[0], "coulomb_neg": f.coulomb_neg[1] + theta[0]}
+    return {"viscous": f.viscous[1] + theta[0]}
 
 
 def augmented(robot, effect, axis, params, tmp_path):
@@ -56,13 +53,13 @@ def augmented(robot, effect, axis, params, tmp_path):
     return robots.load(path)
 
 
-@pytest.mark.parametrize("effect_id", sorted(PARAMS))
+@pytest.mark.parametrize("effect_id", sorted(CHANGES))
 def test_fitted_torque_is_the_written_models_torque(setup, effect_id, tmp_path):
     robot, motion = setup
     effect = effects.get(effect_id)
     axis = None if not effect.per_axis else 1
-    params = PARAMS[effect_id]
-    theta, h = theta_of(effect, params)
+    theta, h, params = CHANGES[effect_id]
+    params = params or absolute(robot, effect_id, theta)
     phi, offset = effect.columns(motion, axis, h)
     fitted = phi @ theta + offset
     assert effect.params(motion, axis, theta, h) == pytest.approx(params)
@@ -85,46 +82,69 @@ def test_fitted_torque_is_the_written_models_torque(setup, effect_id, tmp_path):
 def test_optional_numerics_round_trip_through_the_loader(tmp_path):
     robot = robots.load("puma560")
     spec = mujoco.MjSpec.from_file(str(robot.path))
-    effects.get("cogging").apply(spec, robot, 3, {"amplitude_Nm_motor": 0.02, "poles": 8, "phase_rad": -1.0})
-    effects.get("torque_offset").apply(spec, robot, 0, {"offset_Nm": -2.0})
-    effects.get("load_dependent_friction").apply(spec, robot, 2, {"load_friction_coefficient": 0.05})
-    effects.get("temperature").apply(spec, robot, 5, {"amplitude": 0.5, "time_constant_s": 30.0})
-    effects.get("backlash").apply(spec, robot, 1, {"backlash_rad": 0.004})
+    effects.get("cogging").apply(spec, robot, 3, {"amplitude": 0.02, "poles": 8, "phase": -1.0})
+    effects.get("torque_offset").apply(spec, robot, 0, {"offset": -2.0})
+    effects.get("load_dependent_friction").apply(spec, robot, 2, {"coefficient": 0.05})
+    effects.get("temperature").apply(spec, robot, 5, {"amplitude": 0.5, "time_constant": 30.0})
+    effects.get("backlash").apply(spec, robot, 1, {"width": 0.004})
+    effects.make("payload", mass=1.5).write(spec, robot)
     path = tmp_path / "p.xml"
     path.write_text(spec.to_xml())
     new = robots.load(path)
-    np.testing.assert_allclose(new.cogging[3], [0.02, 8, -1.0])
-    assert new.torque_offset.tolist() == [-2.0, 0, 0, 0, 0, 0]
-    assert new.load_friction[2] == 0.05
-    np.testing.assert_allclose(new.thermal[5], [0.5, 30.0])
-    np.testing.assert_allclose(new.thermal[0], [0.0, 1.0])
-    np.testing.assert_allclose(new.backlash, [0, 0.004, 0, 0, 0, 0])
-    # repeated offsets add up
-    effects.get("torque_offset").apply(spec, robot, 0, {"offset_Nm": 0.5})
+    assert new.effects["cogging"].values(3) == pytest.approx({"amplitude": 0.02, "poles": 8, "phase": -1.0})
+    assert new.effects["torque_offset"].offset.tolist() == [-2.0, 0, 0, 0, 0, 0]
+    assert new.effects["load_dependent_friction"].coefficient[2] == 0.05
+    assert new.effects["temperature"].values(5) == pytest.approx({"amplitude": 0.5, "time_constant": 30.0})
+    assert new.effects["temperature"].values(0) == {"amplitude": 0.0, "time_constant": 1.0}
+    np.testing.assert_allclose(new.effects["backlash"].width, [0, 0.004, 0, 0, 0, 0])
+    assert new.effects["payload"].mass == pytest.approx(1.5)
+    # the numerics are named by the effect ids, and parameters.json uses the same names
+    assert {"cogging4", "torque_offset1", "load_dependent_friction3", "temperature6"} <= {
+        new.model.numeric(k).name for k in range(new.model.nnumeric)}
+    table = calibrate.parameters(new)["effects"]
+    assert table["temperature"]["time_constant"][5] == 30.0 and table["payload"]["mass"] == pytest.approx(1.5)
+    # an offset written again is replaced by the new absolute value
+    effects.get("torque_offset").apply(spec, robot, 0, {"offset": 0.5})
     path.write_text(spec.to_xml())
-    assert robots.load(path).torque_offset[0] == -1.5
+    assert robots.load(path).effects["torque_offset"].offset[0] == 0.5
+
+
+def test_models_written_before_the_effect_names_were_unified_still_load(tmp_path):
+    """``thermal{i}`` and ``load_friction{i}`` were the numerics' first names: still read, and
+    replaced by the current name when the effect is written again."""
+    robot = robots.load("puma560")
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    spec.add_numeric(name="thermal2", data=[0.4, 20.0])
+    spec.add_numeric(name="load_friction3", data=[0.07])
+    path = tmp_path / "old.xml"
+    path.write_text(spec.to_xml())
+    old = robots.load(path)
+    assert old.effects["temperature"].values(1) == {"amplitude": 0.4, "time_constant": 20.0}
+    assert old.effects["load_dependent_friction"].coefficient[2] == 0.07
+    effects.get("temperature").apply(spec, old, 1, {"amplitude": 0.1, "time_constant": 5.0})
+    assert spec.numeric("thermal2") is None and list(spec.numeric("temperature2").data) == [0.1, 5.0]
 
 
 def test_bad_optional_numeric_is_refused(tmp_path):
     robot = robots.load("puma560")
     spec = mujoco.MjSpec.from_file(str(robot.path))
-    spec.add_numeric(name="thermal2", data=[0.5, 0.0])
+    spec.add_numeric(name="temperature2", data=[0.5, 0.0])
     path = tmp_path / "bad.xml"
     path.write_text(spec.to_xml())
-    with pytest.raises(robots.ModelError, match="thermal.*time constant > 0"):
+    with pytest.raises(robots.ModelError, match="temperature.*time constant > 0"):
         robots.load(path)
     spec = mujoco.MjSpec.from_file(str(robot.path))
     spec.add_numeric(name="cogging1", data=[0.5, 2.0])
     path.write_text(spec.to_xml())
-    with pytest.raises(robots.ModelError, match="cogging1.*2 values, expected 3"):
+    with pytest.raises(robots.ModelError, match="cogging1.*2 values, expected 3: amplitude poles phase"):
         robots.load(path)
 
 
 def test_simulator_builds_the_passive_forces(tmp_path):
     robot = robots.load("puma560")
     spec = mujoco.MjSpec.from_file(str(robot.path))
-    effects.get("cogging").apply(spec, robot, 1, {"amplitude_Nm_motor": 0.03, "poles": 4, "phase_rad": 0.2})
-    effects.get("torque_offset").apply(spec, robot, 4, {"offset_Nm": 1.5})
+    effects.get("cogging").apply(spec, robot, 1, {"amplitude": 0.03, "poles": 4, "phase": 0.2})
+    effects.get("torque_offset").apply(spec, robot, 4, {"offset": 1.5})
     path = tmp_path / "p.xml"
     path.write_text(spec.to_xml())
     written = robots.load(path)
@@ -135,7 +155,7 @@ def test_simulator_builds_the_passive_forces(tmp_path):
     mujoco.mj_forward(model, data)
     cog = model.actuator("cogging2").id
     assert data.actuator_force[cog] == pytest.approx(0.03 * np.sin(4 * 0.3 + 0.2), rel=1e-9)
-    offset = model.actuator("offset5").id
+    offset = model.actuator("torque_offset5").id
     assert data.actuator_force[offset] == pytest.approx(-1.5 / written.gear_ratio[4], rel=1e-12)
     assert model.actuator_trnid[cog, 0] == model.dof_jntid[rotor2]
     assert model.actuator_trnid[offset, 0] == model.dof_jntid[rotor5]
@@ -144,7 +164,7 @@ def test_simulator_builds_the_passive_forces(tmp_path):
 def test_lugre_refuses_state_dependent_friction(tmp_path):
     robot = robots.load("puma560")
     spec = mujoco.MjSpec.from_file(str(robot.path))
-    effects.get("temperature").apply(spec, robot, 0, {"amplitude": 0.5, "time_constant_s": 30.0})
+    effects.get("temperature").apply(spec, robot, 0, {"amplitude": 0.5, "time_constant": 30.0})
     path = tmp_path / "p.xml"
     path.write_text(spec.to_xml())
     with pytest.raises(ValueError, match="--friction stribeck"):
@@ -182,8 +202,8 @@ def test_backlash_torque_is_the_written_models_torque(setup, tmp_path):
     axis, b = BACKLASH_AXIS[robot.name], 0.01
     phi, offset = effect.columns(motion, axis, b)
     assert phi.shape == (len(motion.t), 0)
-    new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
-    assert new.backlash[axis] == pytest.approx(b, rel=1e-5)
+    new = augmented(robot, effect, axis, {"width": b}, tmp_path)
+    assert new.effects["backlash"].width[axis] == pytest.approx(b, rel=1e-5)
     nominal = prediction(robot, motion)
     change = prediction(new, motion) - nominal
     scale = np.max(np.abs(change[:, axis]))
@@ -199,7 +219,7 @@ def test_backlash_search_recovers_the_width(setup, tmp_path):
     robot, motion = setup
     effect = effects.get("backlash")
     axis, b = BACKLASH_AXIS[robot.name], 0.0123
-    new = augmented(robot, effect, axis, {"backlash_rad": b}, tmp_path)
+    new = augmented(robot, effect, axis, {"width": b}, tmp_path)
     nominal = prediction(robot, motion)
     change = prediction(new, motion) - nominal
     rng = np.random.default_rng(0)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from faultgen import robots
+from faultgen import effects, robots
 from faultgen.calibrate import gearbox
 
 
@@ -13,7 +13,7 @@ class OneSpring:
     def __init__(self, inertia, stiffness, damping, backlash=0.0):
         self.gearbox_stiffness = np.full(6, stiffness)
         self.gearbox_damping = np.full(6, damping)
-        self.backlash = np.full(6, backlash)
+        self.effects = {"backlash": effects.make("backlash", width=backlash)}
         self._inertia = inertia
 
     def arm_mass_matrix(self, q):

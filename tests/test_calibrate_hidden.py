@@ -80,14 +80,15 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     out = tmp_path / "out"
     report = json.loads((out / "report.json").read_text())
     assert set(report) == {"robot", "measured", "gap_before", "steps", "gap_after", "model_out"}
+    assert report["steps"][0]["units"] == {"mass": "kg"}
     assert report["robot"] == "puma560" and report["measured"].endswith("measured.csv")
     for gap in (report["gap_before"], report["gap_after"], report["steps"][0]["gap_after"]):
         assert len(gap["rmse_Nm"]) == 6 and len(gap["nrmse"]) == 6
         assert gap["total_nrmse"] == pytest.approx(np.mean(gap["nrmse"]))
     step = report["steps"][0]
     assert step["effect"] == "payload" and step["axes"] == [1, 2, 3, 4, 5, 6]
-    mass = step["params"]["robot"]["mass_kg"]
-    assert mass == pytest.approx(hidden.params["robot"]["mass_kg"], rel=0.05)
+    mass = step["params"]["robot"]["mass"]
+    assert mass == pytest.approx(hidden.params["robot"]["mass"], rel=0.05)
     assert step["evidence"]["scores"]["payload"] == pytest.approx(step["evidence"]["score"])
     assert (out / "calibration.png").stat().st_size > 10_000
     mask = os.umask(0)
@@ -104,7 +105,8 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     assert np.all(np.isfinite(run.tau_m))
     assert np.sum(model.model.body_mass) == pytest.approx(np.sum(nominal.model.body_mass) + mass, rel=1e-5)
     written = json.loads((out / "model" / "parameters.json").read_text())
-    assert written["payload_kg"] == [pytest.approx(mass, rel=1e-5)]
+    assert written["effects"]["payload"] == {"mass": pytest.approx(mass, rel=1e-5)}
+    assert written["units"]["effects"]["payload"] == {"mass": "kg"}
     assert written["gear_ratio"] == pytest.approx(nominal.gear_ratio.tolist(), rel=1e-5)
 
 
@@ -138,14 +140,17 @@ def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
     tie of the search's ranking: payload first before the convergence work (0.2372 -> 0.1191 ->
     0.0129), Coulomb first since (0.2366 -> 0.1304 -> 0.0124); both are found, with their values."""
     robot = robots.load("puma560")
-    payload = synth.Hidden("payload", [1, 2, 3, 4, 5, 6], {"robot": {"mass_kg": 2.2}})
+    payload = synth.Hidden("payload", [1, 2, 3, 4, 5, 6], {"robot": {"mass": 2.2}})
     with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
-    coulomb = synth.Hidden("coulomb", [5], {"5": {"coulomb_change_Nm_motor": 0.03}})
+    friction = robot.friction  # both of axis 5's Coulomb levels 0.03 N m higher
+    coulomb = synth.Hidden("coulomb", [5], {"5": {"coulomb_pos": friction.coulomb_pos[4] + 0.03,
+                                                  "coulomb_neg": friction.coulomb_neg[4] + 0.03}})
     path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3)
     result = calibrate("puma560", path, tmp_path / "out")
     found = {s.effect: s for s in result.steps}
     assert sorted((s.effect, s.axes) for s in result.steps) == [("coulomb", [5]), ("payload", [1, 2, 3, 4, 5, 6])]
-    assert found["payload"].params["robot"]["mass_kg"] == pytest.approx(2.2, rel=0.03)
-    assert found["coulomb"].params["5"]["coulomb_change_Nm_motor"] == pytest.approx(0.03, rel=0.03)
+    assert found["payload"].params["robot"]["mass"] == pytest.approx(2.2, rel=0.03)
+    change = found["coulomb"].params["5"]["coulomb_pos"] - robot.friction.coulomb_pos[4]
+    assert change == pytest.approx(0.03, rel=0.03)
     assert result.steps[0].gap_after["total_nrmse"] < result.gap_before["total_nrmse"]
     assert result.gap_after["total_nrmse"] < 0.15 * result.gap_before["total_nrmse"]

@@ -30,18 +30,18 @@ def toolbox_log(tmp_path, robot, motion, effect, params):
     q, qd, qdd = motion.q, motion.qd, motion.qdd
     G = robot.gear_ratio
     if effect == "payload":
-        toolbox.payload(params["robot"]["mass_kg"], [0.0, 0.0, 0.0])
+        toolbox.payload(params["robot"]["mass"], [0.0, 0.0, 0.0])
     tau = np.asarray(toolbox.rne(q, qd, qdd))
     for axis, p in params.items():
         if effect == "stribeck":
             k = int(axis) - 1
             v = G[k] * qd[:, k]
-            hump = p["static_Nm_motor"] * np.exp(-(v / p["stribeck_velocity_rad_per_s_motor"]) ** 2)
+            hump = p["static"] * np.exp(-(v / p["stribeck_velocity"]) ** 2)
             tau[:, k] += G[k] * hump * np.sign(v)
         elif effect == "cogging":
             k = int(axis) - 1
             # the drive holds against the detent torque A sin(p theta_m + phase)
-            tau[:, k] -= G[k] * p["amplitude_Nm_motor"] * np.sin(p["poles"] * G[k] * q[:, k] + p["phase_rad"])
+            tau[:, k] -= G[k] * p["amplitude"] * np.sin(p["poles"] * G[k] * q[:, k] + p["phase"])
     rng = np.random.default_rng(SEED)
     tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     q_logged = q + rng.normal(size=q.shape) * 1e-5
@@ -58,7 +58,7 @@ def test_effect_added_to_toolbox_data_is_named(tmp_path, path, effect):
     assert (first.effect, first.axes) == (effect, hidden.axes), result.summary()
     assert result.gap_after["total_nrmse"] <= 0.5 * result.gap_before["total_nrmse"], result.summary()
     if effect == "payload":
-        assert first.params["robot"]["mass_kg"] == pytest.approx(hidden.params["robot"]["mass_kg"], rel=0.05)
+        assert first.params["robot"]["mass"] == pytest.approx(hidden.params["robot"]["mass"], rel=0.05)
 
 
 def test_toolbox_data_without_an_effect_names_nothing(tmp_path, path):

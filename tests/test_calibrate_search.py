@@ -7,8 +7,8 @@ in tests/test_calibrate_hidden.py.
 import numpy as np
 import pytest
 
-from faultgen import robots
-from faultgen.calibrate import effects, search, synth
+from faultgen import effects, robots
+from faultgen.calibrate import search, synth
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +58,13 @@ def test_coulomb_comes_back_from_its_own_regressor(puma):
     ranked = search.rank(motion, residual, tau, split)
     best = ranked[0]
     assert best.effect.id == "coulomb" and best.axes == [2]
-    assert best.params["3"]["coulomb_change_Nm_motor"] == pytest.approx(0.07, rel=0.02)
+    # parameters are absolute: the nominal levels plus the change, in both directions
+    friction = motion.robot.friction
+    assert best.params["3"]["coulomb_pos"] - friction.coulomb_pos[2] == pytest.approx(0.07, rel=0.02)
+    assert best.params["3"]["coulomb_neg"] - friction.coulomb_neg[2] == pytest.approx(0.07, rel=0.02)
+    fitted = best.fitted(motion.robot)
+    assert fitted.coulomb_pos[2] == best.params["3"]["coulomb_pos"]
+    assert fitted.coulomb_pos[1] == friction.coulomb_pos[1]  # other axes as they were
 
 
 def test_payload_mass_comes_back(puma):
@@ -70,7 +76,7 @@ def test_payload_mass_comes_back(puma):
     split = search.Split.of(motion.t, motion.qd)
     best = search.rank(motion, residual, tau, split)[0]
     assert best.effect.id == "payload" and best.axes == list(range(6))
-    assert best.params["robot"]["mass_kg"] == pytest.approx(1.7, rel=0.02)
+    assert best.params["robot"]["mass"] == pytest.approx(1.7, rel=0.02)
 
 
 def test_stribeck_velocity_is_refined_off_the_grid(puma):
@@ -85,8 +91,8 @@ def test_stribeck_velocity_is_refined_off_the_grid(puma):
     split = search.Split.of(motion.t, motion.qd)
     candidate = search.fit_effect(effect, motion, residual, tau, split)
     params = candidate.all_params[str(axis + 1)]
-    assert params["stribeck_velocity_rad_per_s_motor"] == pytest.approx(v_s, rel=0.01)
-    assert params["static_Nm_motor"] == pytest.approx(0.02, rel=0.01)
+    assert params["stribeck_velocity"] == pytest.approx(v_s, rel=0.01)
+    assert params["static"] == pytest.approx(0.02, rel=0.01)
 
 
 def test_noise_alone_names_nothing(puma):
@@ -105,5 +111,5 @@ def test_unphysical_fit_is_never_selected(puma):
     residual = -2.0 * phi[:, :, 0]
     split = search.Split.of(motion.t, motion.qd)
     candidate = search.fit_effect(effects.get("payload"), motion, residual, tau, split)
-    assert candidate.all_params["robot"]["mass_kg"] == pytest.approx(-2.0, rel=1e-6)
+    assert candidate.all_params["robot"]["mass"] == pytest.approx(-2.0, rel=1e-6)
     assert candidate.axes == []

@@ -178,7 +178,7 @@ def test_a_cycle_starts_at_rest_on_the_loaded_flank_of_its_backlash(tmp_path):
     model = tmp_path / "irb6700_backlash.xml"
     model.write_text(text)
     robot = robots.load(model)
-    assert robot.backlash[1] == pytest.approx(0.01)
+    assert robot.effects["backlash"].width[1] == pytest.approx(0.01)
     compiled = sim.build(robot)
     q0 = np.array([0.3, 0.4, -0.2, 0.0, 0.5, 0.0])
     data = mujoco.MjData(compiled.model)

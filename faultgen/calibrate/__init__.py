@@ -22,7 +22,7 @@ from __future__ import annotations
 import json
 import shutil
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
@@ -30,10 +30,12 @@ import numpy as np
 
 from faultgen.calibrate import gearbox, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
+from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import atomic
 from faultgen.data import measured as measured_io
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
-from faultgen.model.friction import FIELDS as FRICTION_FIELDS
 
 __all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters", "predict"]
 
@@ -52,7 +54,10 @@ class Step:
     axes : list of int
         Axes it was added on, 1-based.
     params : dict
-        Physical parameters per axis (``"1"``..``"6"``) or for the robot (``"robot"``).
+        Absolute physical parameters after the step per axis (``"1"``..``"6"``) or for the robot
+        (``"robot"``), named as the effect names them (:attr:`faultgen.effects.Effect.units`).
+    units : dict
+        The unit of each parameter.
     evidence : dict
         Why it was chosen: held-out gain per axis, the score, the runner-up and every effect's
         score.
@@ -65,6 +70,7 @@ class Step:
     params: dict
     evidence: dict
     gap_after: dict
+    units: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -110,8 +116,8 @@ class Calibration:
             "robot": self.robot,
             "measured": self.measured,
             "gap_before": self.gap_before,
-            "steps": [{"effect": s.effect, "axes": s.axes, "params": s.params, "evidence": s.evidence,
-                       "gap_after": s.gap_after} for s in self.steps],
+            "steps": [{"effect": s.effect, "axes": s.axes, "params": s.params, "units": s.units,
+                       "evidence": s.evidence, "gap_after": s.gap_after} for s in self.steps],
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
         }
@@ -124,14 +130,14 @@ class Calibration:
         for k, s in enumerate(self.steps, start=1):
             values = "; ".join(
                 f"{'axis ' + where if where != 'robot' else 'robot'}: "
-                + ", ".join(f"{name} = {value:.4g}" for name, value in p.items())
+                + ", ".join(f"{name} = {value:.4g}{_unit(s.units.get(name, '1'))}" for name, value in p.items())
                 for where, p in s.params.items())
             lines.append(f"{k}. {s.effect} on axes {', '.join(map(str, s.axes))} -> total nrmse "
                          f"{s.gap_after['total_nrmse']:.4f}  ({values})")
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
-        stateful = {"load_dependent_friction", "temperature"} & {s.effect for s in self.steps}
-        friction = " --friction stribeck" if stateful else ""
+        stepped = any(get(s.effect).stepped for s in self.steps)
+        friction = " --friction stribeck" if stepped else ""
         lines.append(f"simulate it: faultgen simulate --model {self.model_out}{friction}")
         return "\n".join(lines)
 
@@ -198,8 +204,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             best = ranked[0]
             if not best.axes:
                 break
-            for where, params in best.params.items():
-                best.effect.apply(spec, current, None if where == "robot" else int(where) - 1, params)
+            best.fitted(current).write(spec, current, best.axes)
             trial_path = Path(work) / model_out.name
             trial_path.write_text(spec.to_xml())
             trial = robots.load(trial_path)
@@ -210,7 +215,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
                 break  # the written model does not do what the fit promised: stop, keep what works
             current, predicted, motion = trial, trial_prediction, trial_motion
             steps.append(Step(best.effect.id, [a + 1 for a in best.axes], best.params,
-                              _evidence(best, ranked), after))
+                              _evidence(best, ranked), after, dict(best.effect.units)))
             if progress:
                 print(f"step {k + 1}: {best.effect.id} on axes {steps[-1].axes}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
@@ -250,31 +255,30 @@ def predict(robot: robots.Robot, data: measured_io.MeasuredData) -> np.ndarray:
 
 def _predict(robot: robots.Robot, data: measured_io.MeasuredData) -> tuple[np.ndarray, Motion]:
     """:func:`predict` and the :class:`Motion` it evaluated (the search fits effects on it)."""
-    motion = Motion.of(robot, data.t, data.q, data.qd, data.qdd)
+    motion = motion_of(robot, data.t, data.q, data.qd, data.qdd)
     rigid = robot.inverse_dynamics(data.q, data.qd, data.qdd, t=motion.t)
     return rigid + gearbox.compliance_torque(robot, data.t, data.q, motion.load), motion
 
 
 def parameters(robot: robots.Robot) -> dict:
-    """A robot's parameters as plain lists over axes 1..6, with their units (``parameters.json``)."""
+    """A robot's parameters as plain lists over axes 1..6, with their units (``parameters.json``):
+    gear ratios, the motor-side friction (:data:`faultgen.friction.FIELDS`) and every effect the
+    robot carries in its own MJCF elements, by effect id and parameter name
+    (:attr:`faultgen.effects.Effect.units`)."""
     friction = {name: [float(v) for v in getattr(robot.friction, name)] for name in FRICTION_FIELDS}
-    payload = [float(robot.model.body(b).mass[0]) for b in range(robot.model.nbody)
-               if robot.model.body(b).name.startswith("payload")]
     return {
         "robot": robot.name,
-        "units": {"gear_ratio": "1", "friction": "motor side, see faultgen.friction.UNITS",
-                  "cogging": "amplitude N m (motor side), poles, phase rad", "torque_offset": "N m (arm side)",
-                  "load_friction": "1", "thermal": "amplitude 1, time constant s", "backlash": "rad (arm side)",
-                  "payload_kg": "kg"},
+        "units": {"gear_ratio": "1", "friction": {name: f"{unit} (motor side)" for name, unit in FRICTION_UNITS.items()},
+                  "effects": {e.id: dict(e.units) for e in robot.effects.values()}},
         "gear_ratio": [float(v) for v in robot.gear_ratio],
         "friction": friction,
-        "cogging": robot.cogging.tolist(),
-        "torque_offset": robot.torque_offset.tolist(),
-        "load_friction": robot.load_friction.tolist(),
-        "thermal": robot.thermal.tolist(),
-        "backlash": robot.backlash.tolist(),
-        "payload_kg": payload,
+        "effects": {e.id: e.table() for e in robot.effects.values()},
     }
+
+
+def _unit(unit: str) -> str:
+    """`` <unit>`` for a summary line; nothing for a dimensionless parameter."""
+    return "" if unit == "1" else f" {unit}"
 
 
 def _evidence(best: search.Candidate, ranked: list[search.Candidate]) -> dict:

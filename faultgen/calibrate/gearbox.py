@@ -11,7 +11,7 @@ along the motor motion) give
     M(q) e'' + D e' + K e = load(t),
 
 and the drive torque differs from the rigid prediction by ``K e + D e' - load = -M e''``. With
-backlash b (:attr:`Robot.backlash`) the spring has a dead band, ``K e`` becomes
+backlash b (:class:`faultgen.effects.Backlash`) the spring has a dead band, ``K e`` becomes
 ``S(e) = K sign(e) max(|e| - b/2, 0)`` per axis: when the load reverses the arm crosses the
 gap, feels no spring while it does (the motor's motion does not reach it), and lands on the
 other flank. ``M`` is the arm's inertia matrix along the measured motion
@@ -52,6 +52,7 @@ from __future__ import annotations
 import numpy as np
 
 from faultgen.data import measured
+from faultgen.effects import Backlash
 from faultgen.model import robots
 
 #: Longest sub-step, s. The average-acceleration rule's period error is about (w h)^2 / 12: 0.8 %
@@ -89,7 +90,7 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     ----------
     robot : Robot
         Gives K, D (:attr:`Robot.gearbox_stiffness`, ``gearbox_damping``), the arm's inertia
-        matrix (:meth:`Robot.arm_mass_matrix`) and the backlash (:attr:`Robot.backlash`) unless
+        matrix (:meth:`Robot.arm_mass_matrix`) and the backlash (:class:`faultgen.effects.Backlash`) unless
         ``backlash`` is given.
     t : ndarray of shape (n,)
         Sample times, s, increasing.
@@ -114,7 +115,7 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
         If ``backlash`` has a negative entry or its last dimension is not 6.
     """
     t = np.asarray(t, dtype=float)
-    width = np.asarray(robot.backlash if backlash is None else backlash, dtype=float)
+    width = np.asarray(Backlash.of(robot).width if backlash is None else backlash, dtype=float)
     if width.shape[-1:] != (load.shape[1],) or width.ndim > 2 or np.any(width < 0):
         raise ValueError(f"backlash must be widths >= 0 rad of shape (6,) or (m, 6); got {width!r}")
     mass = robot.arm_mass_matrix(q)

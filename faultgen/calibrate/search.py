@@ -15,7 +15,7 @@ tau_model`` (arm side, N m):
    axis's held-out nrmse before the step (a significance threshold on the effect size that noise
    and the rigid-model mismatch stay under; docs/calibration.md gives the null-case figures).
 4. The effect with the largest total significant gain wins; an effect whose gain is within
-   :data:`TIE` of the best and comes earlier in :data:`faultgen.calibrate.effects.EFFECTS`
+   :data:`TIE` of the best and comes earlier in :data:`faultgen.effects.EFFECTS`
    (fewer parameters or simpler physics) is preferred.
 
 The workflow (:func:`faultgen.calibrate.calibrate`) adds the winner to the model on its
@@ -31,7 +31,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from tqdm.auto import tqdm
 
-from faultgen.calibrate.effects import EFFECTS, REST_SPEED, Effect, Motion
+from faultgen.effects import EFFECTS, REST_SPEED, Effect, Motion
 
 #: Share of the record (by time, from the start) used for fitting; the rest is held out.
 FIT_FRACTION = 0.7
@@ -112,6 +112,10 @@ class Candidate:
     relative_gain: np.ndarray
     contribution: np.ndarray
     all_params: dict = field(default_factory=dict)
+
+    def fitted(self, robot) -> Effect:
+        """The effect as fitted: ``robot``'s values of it with the significant axes' new parameters."""
+        return self.effect.fitted(robot, self.params)
 
     @property
     def score(self) -> float:

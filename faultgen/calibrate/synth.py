@@ -26,7 +26,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.calibrate.effects import EFFECTS, Motion, get
+from faultgen.calibrate.effects import Motion, get
+from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import measured
 from faultgen.model import robots
 from faultgen.operation import tasks
@@ -35,10 +36,10 @@ from faultgen.simulation import stepping as sim
 
 #: Range of the effect's torque RMS over the axis's nominal torque RMS.
 SIZE_RANGE = (0.5, 1.2)
-#: Physical bounds on drawn parameters: past one, the effect on that axis is shrunk to the bound,
-#: and an axis left below :data:`MIN_SIZE` is not drawn (e.g. load-dependent friction on a wrist
-#: axis that carries almost no load).
-LIMITS = {"load_friction_coefficient": 0.8, "amplitude": 3.0, "backlash_rad": 0.05}
+#: Physical bounds on drawn parameters are each effect's
+#: :attr:`~faultgen.effects.Effect.draw_limits`: past one, the effect on that axis is shrunk to the
+#: bound, and an axis left below :data:`MIN_SIZE` is not drawn (e.g. load-dependent friction on a
+#: wrist axis that carries almost no load).
 #: Largest share of a motor's torque limit the hidden friction, offset or cogging may take, so
 #: the drive can still move the axis (a stuck axis shows nothing).
 MOTOR_SHARE = 0.4
@@ -46,16 +47,10 @@ MOTOR_SHARE = 0.4
 MIN_SIZE = 0.45
 #: Torque-sensor noise, standard deviation as a fraction of each axis's torque RMS.
 TORQUE_NOISE = 0.01
-#: Effects drawn by a physical parameter range instead of a torque size: id -> (name, low, high,
-#: smallest size, smallest size on a robot where no axis reaches it). Backlash is not linear in
-#: its width, so the width is drawn (0.3 to 1.1 degrees at the arm) and an axis is eligible when
-#: the torque the dead band changes along the nominal task (its
-#: :meth:`~faultgen.calibrate.effects.Effect.columns`) has an RMS of at least the smallest size
-#: times the axis's torque RMS: a dead band on an axis whose load never reverses leaves no trace
-#: to find. On the IRB-6700-like arm (soft gearboxes) axes 1 and 2 reach 15 %; on the PUMA 560
-#: (stiff gearboxes: rigid contact, :mod:`faultgen.calibrate.gearbox`) no axis does, its waist
-#: 4-9 % at 5-20 mrad, about 3-7 times the 1 % torque-sensor noise, so there the axes above 4 %.
-PHYSICAL = {"backlash": ("backlash_rad", 0.005, 0.02, 0.15, 0.04)}
+#: An effect not linear in its parameter (backlash) is drawn by that parameter's range instead of
+#: a torque size (:attr:`~faultgen.effects.Effect.draw_range`): an axis is eligible when the torque
+#: the effect changes along the nominal task (its :meth:`~faultgen.effects.Effect.columns`) has an
+#: RMS of at least the smallest size times the axis's torque RMS.
 #: Most axes an effect is hidden on.
 MAX_AXES = 3
 #: Physics step of the hidden-effect simulation, s (the robot models use 0.5 ms), and its
@@ -89,7 +84,7 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
     q, qd, qdd = (np.tile(sim.hold_end(a, n - 1), (cycles, 1)) for a in (path.q, path.qd, path.qdd))
     t = np.arange(len(q)) * sensors.LOG_PERIOD
     tau = robot.inverse_dynamics(q, qd, qdd, t=t)
-    return Motion.of(robot, t, q, qd, qdd), tau
+    return motion_of(robot, t, q, qd, qdd), tau
 
 
 def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task: str = "pick_place",
@@ -98,7 +93,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
 
     ``size_range`` bounds the size (effect torque RMS over the axis's nominal torque RMS); an axis
     the physical bounds shrink below ``min(MIN_SIZE, 0.9 * size_range[0])`` is not drawn. An
-    effect of :data:`PHYSICAL` (backlash) is drawn by its parameter instead, on axes where it shows.
+    effect with a :attr:`~faultgen.effects.Effect.draw_range` (backlash) is drawn by its parameter
+    instead, on axes where it shows.
 
     Raises
     ------
@@ -110,8 +106,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     kind = get(effect)
     motion, tau = nominal_motion(robot, task, cycles)
     scale = np.sqrt(np.mean(tau**2, axis=0))
-    if effect in PHYSICAL:
-        name, low, high, min_size, fallback = PHYSICAL[effect]
+    if kind.draw_range is not None:
+        name, low, high, min_size, fallback = kind.draw_range
         params, sizes = {}, np.zeros(6)
         for axis in range(6):
             value = float(rng.uniform(low, high))
@@ -136,21 +132,18 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         else:  # a continuous parameter: log-uniform inside the searched range, off the grid points
             h = float(np.exp(rng.uniform(np.log(grid[1]), np.log(grid[-2]))))
         phi, _ = kind.columns(motion, axis, h)
-        if phi.shape[1] == 2:  # amplitude and phase (cogging)
-            phase = rng.uniform(0, 2 * np.pi)
-            unit = phi @ np.array([np.cos(phase), np.sin(phase)])
-        else:
-            unit = phi[:, 0]
+        direction = kind.draw_direction(rng)  # (k,): the cogging phase, or 1
+        unit = phi @ direction
         if not np.any(unit):  # the effect cannot show on this axis (e.g. no Stribeck range)
             params[str(axis + 1)] = {}
             continue
-        sign = -1.0 if kind.id in ("torque_offset",) and rng.random() < 0.5 else 1.0
+        sign = -1.0 if kind.signed and rng.random() < 0.5 else 1.0
         amplitude = sign * size * scale[axis] / np.sqrt(np.mean(unit**2))
-        theta = amplitude * (np.array([np.cos(phase), np.sin(phase)]) if phi.shape[1] == 2 else np.ones(1))
+        theta = amplitude * direction
         drawn = kind.params(motion, axis, theta, h)
         # past a physical bound, shrink the effect to the bound (and note the smaller size)
-        excess = max([abs(v) / LIMITS[k] for k, v in drawn.items() if k in LIMITS] + [1.0,
-                     _motor_share(kind.id, robot, axis, drawn, motion) / MOTOR_SHARE])
+        share = kind.motor_torque(motion, axis, drawn) / robot.motor_torque_limit[axis]
+        excess = max([abs(drawn[k]) / limit for k, limit in kind.draw_limits.items()] + [1.0, share / MOTOR_SHARE])
         params[str(axis + 1)] = kind.params(motion, axis, theta / excess, h)
         sizes[axis] = size / excess
     return _choose(robot, effect, rng, params, sizes, min_size)
@@ -161,26 +154,12 @@ def _choose(robot: robots.Robot, effect: str, rng: np.random.Generator, params: 
     """1 to :data:`MAX_AXES` random axes among those whose drawn effect has ``sizes >= min_size``."""
     eligible = [a for a in range(6) if sizes[a] >= min_size]
     if not eligible:
-        raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within {LIMITS}")
+        raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within "
+                         f"{get(effect).draw_limits}")
     n_axes = int(rng.integers(1, min(MAX_AXES, len(eligible)) + 1))
     axes = sorted(int(a) for a in rng.choice(eligible, size=n_axes, replace=False))
     return Hidden(effect, [a + 1 for a in axes], {str(a + 1): params[str(a + 1)] for a in axes},
                   float(min(sizes[axes])))
-
-
-def _motor_share(effect: str, robot: robots.Robot, axis: int, params: dict, motion: Motion) -> float:
-    """Largest motor torque the hidden effect takes on ``axis``, over the motor's torque limit."""
-    f, G = robot.friction, robot.gear_ratio[axis]
-    dry = max(f.coulomb_pos[axis], f.coulomb_neg[axis]) + f.static[axis]
-    extra = {
-        "coulomb": lambda p: dry + p["coulomb_change_Nm_motor"],
-        "stribeck": lambda p: dry - f.static[axis] + p["static_Nm_motor"],
-        "temperature": lambda p: dry * (1 + p["amplitude"]),
-        "torque_offset": lambda p: abs(p["offset_Nm"]) / G,
-        "cogging": lambda p: p["amplitude_Nm_motor"],
-        "load_dependent_friction": lambda p: p["load_friction_coefficient"] * np.max(np.abs(motion.load[:, axis])) / G,
-    }.get(effect, lambda p: 0.0)
-    return float(extra(params)) / robot.motor_torque_limit[axis]
 
 
 def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path:
@@ -192,9 +171,8 @@ def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path
     spec.option.timestep = TIMESTEP
     spec.option.integrator = INTEGRATOR
     if hidden.effect is not None:
-        kind = EFFECTS[hidden.effect]
-        for where, params in hidden.params.items():
-            kind.apply(spec, robot, None if where == "robot" else int(where) - 1, params)
+        kind = get(hidden.effect)
+        kind.fitted(robot, hidden.params).write(spec, robot, [int(a) - 1 for a in hidden.params if a != "robot"])
     path = folder / f"{robot.name}_hidden.xml"
     path.write_text(spec.to_xml())
     shutil.copyfile(robot.path.parent / "tasks.toml", folder / "tasks.toml")

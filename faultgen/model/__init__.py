@@ -1,2 +1,2 @@
-"""The robot models: MJCF loading, nominal parameters, inverse dynamics (``robots``) and the
-motor-side friction models (``friction``). The lowest layer: imports nothing else of faultgen."""
+"""The robot models: MJCF loading, nominal parameters, the effects a robot carries and its inverse
+dynamics (``robots``). Imports only :mod:`faultgen.effects`, the layer below."""

@@ -10,25 +10,18 @@ fixed tendons ``gearbox{i}`` (``L = rotor{i} / G - joint{i}``, thesis eq. 6.2a),
 actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the custom numerics
 ``friction{i}`` and a ``home`` keyframe.
 
-Optional elements describe effects the calibration workflow (:mod:`faultgen.calibrate`) adds to
-a model; absent, they are zero:
-
-* custom numeric ``cogging{i}`` = amplitude (N m, motor side), poles (periods per motor
-  revolution), phase (rad): a passive torque ``A sin(p theta_m + phase)`` on rotor ``i``;
-* custom numeric ``torque_offset{i}``: a constant added to the arm-side drive torque, N m;
-* custom numeric ``load_friction{i}``: extra Coulomb friction per unit of gearbox load,
-  ``mu |tau_load|`` at the arm side, dimensionless;
-* custom numeric ``thermal{i}`` = amplitude (fraction), time constant (s): the dry friction
-  (Coulomb plus Stribeck) is multiplied by ``1 + a exp(-t / T)``, ``t`` from the start of the run
-  (a cold gearbox warming up);
-* a dead band on tendon ``gearbox{i}`` (``springlength="-b/2 b/2"``): backlash ``b`` in rad at
-  the arm side.
+Further effects a robot may carry (a torque offset, cogging, backlash, a payload, ...) are read
+from their own MJCF elements by their classes in :mod:`faultgen.effects` (absent, they are zero)
+and held in :attr:`Robot.effects`; the inverse dynamics add their torque.
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import re
 import shutil
+import threading
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -36,8 +29,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model.friction import FIELDS as FRICTION_FIELDS
-from faultgen.model.friction import MotorFriction
+from faultgen.effects.base import ModelError, read_all
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import MotorFriction
 
 N_AXES = 6
 
@@ -46,11 +40,8 @@ class UnknownRobotError(ValueError):
     """Raised by :func:`load` for a name that is neither a known robot nor an MJCF file."""
 
 
-class ModelError(ValueError):
-    """Raised when an MJCF file cannot be compiled or lacks the elements a robot needs.
-
-    The message names the file and, where MuJoCo reports one, the line.
-    """
+__all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "from_spec", "load", "robots_dir",
+           "with_timestep"]
 
 
 def robots_dir() -> Path:
@@ -104,16 +95,9 @@ class Robot:
         Nominal motor-side friction parameters.
     home : ndarray of shape (6,)
         Arm joint angles of the ``home`` keyframe in rad.
-    cogging : ndarray of shape (6, 3)
-        Cogging amplitude (N m, motor side), poles and phase (rad) per axis; zero amplitude: none.
-    torque_offset : ndarray of shape (6,)
-        Constant arm-side drive torque offset, N m.
-    load_friction : ndarray of shape (6,)
-        Load-dependent Coulomb friction coefficient mu (arm side ``mu |tau_load|``), 1.
-    thermal : ndarray of shape (6, 2)
-        Warm-up friction drift: amplitude a (1) and time constant T (s) of ``1 + a exp(-t/T)``.
-    backlash : ndarray of shape (6,)
-        Gearbox backlash (dead band width) in rad at the arm side.
+    effects : dict of str to Effect
+        The effects stored in their own MJCF elements (:func:`faultgen.effects.read_all`), by id,
+        each with its absolute parameters (absent ones at their absent values).
     """
 
     name: str
@@ -132,21 +116,40 @@ class Robot:
     motor_torque_limit: np.ndarray
     friction: MotorFriction
     home: np.ndarray
-    cogging: np.ndarray = field(default_factory=lambda: np.zeros((N_AXES, 3)))
-    torque_offset: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
-    load_friction: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
-    thermal: np.ndarray = field(default_factory=lambda: np.tile([0.0, 1.0], (N_AXES, 1)))
-    backlash: np.ndarray = field(default_factory=lambda: np.zeros(N_AXES))
-    _inverse: tuple[mujoco.MjModel, mujoco.MjData] = field(init=False, repr=False)
+    effects: dict = field(default_factory=dict)
+    _threads: threading.local = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        # A private copy for inverse dynamics: a continuous-time integrator keeps mj_inverse a map
-        # from qacc (the discrete integrator would invert its step map), and without constraints
-        # joint limits add no force.
-        model = self.model.__copy__()
-        model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
-        model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-        object.__setattr__(self, "_inverse", (model, mujoco.MjData(model)))
+        # load() hands the same Robot to every caller: its arrays are read-only
+        arrays = [self.gear_ratio, self.motor_inertia, self.gearbox_stiffness, self.gearbox_damping,
+                  self.joint_range, self.motor_torque_limit, self.home]
+        arrays += [getattr(self.friction, name) for name in FRICTION_FIELDS]
+        arrays += [value for effect in self.effects.values() for value in vars(effect)["_values"].values()]
+        for array in arrays:
+            array.setflags(write=False)
+        object.__setattr__(self, "_threads", threading.local())
+
+    @property
+    def _inverse(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """This thread's private copy of the model for inverse dynamics and its ``MjData``: a
+        continuous-time integrator keeps ``mj_inverse`` a map from qacc (the discrete integrator
+        would invert its step map), and without constraints joint limits add no force."""
+        own = getattr(self._threads, "inverse", None)
+        if own is None:
+            model = self.model.__copy__()
+            model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+            model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+            own = self._threads.inverse = (model, mujoco.MjData(model))
+        return own
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state.pop("_threads")
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        object.__setattr__(self, "_threads", threading.local())
 
     def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
         return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
@@ -216,14 +219,15 @@ class Robot:
             Arm joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
         friction : bool, default True
             Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``)
-            and the optional effects of the module docstring (cogging, torque offset,
-            load-dependent friction, warm-up drift). Backlash ``b`` (without a friction flag) is
-            taken quasi-statically: ``q`` is read as the motor angle over G and the arm's
-            rigid-body terms are evaluated at ``q - (b/2) sign(load)``, where the arm rests on
-            the loaded flank. Crossing the dead band is a matter of the flexible gearbox
-            (:func:`faultgen.calibrate.gearbox.compliance_torque`), not of this rigid model.
+            and the torque of the robot's :attr:`effects` (:meth:`faultgen.effects.Effect.torque`).
+            An effect that lets the arm trail the motor (backlash, with or without the friction
+            flag) is taken quasi-statically: ``q`` is read as the motor angle over G and the arm's
+            rigid-body terms are evaluated at ``q`` plus :meth:`arm_offset` (backlash b: the arm
+            rests on the loaded flank, ``q - (b/2) sign(load)``). Crossing a dead band is a matter
+            of the flexible gearbox (:func:`faultgen.calibrate.gearbox.compliance_torque`), not of
+            this rigid model.
         t : ndarray of shape (n,), optional
-            Time since the start of the run in s, for the warm-up drift (:attr:`thermal`);
+            Time since the start of the run in s, for effects that drift with time (warm-up);
             zero when omitted.
 
         Returns
@@ -233,7 +237,7 @@ class Robot:
 
         Notes
         -----
-        Uses one private ``MjData``: do not call it on the same robot from several threads.
+        Uses one private ``MjData`` per thread: safe to call from several threads.
 
         Raises
         ------
@@ -245,11 +249,11 @@ class Robot:
         qdd = _check_trajectory("qdd", qdd, q.shape[0])
         G = self.gear_ratio
         tau, load = self._rigid(q, qd, qdd)
-        if np.any(self.backlash):
-            # Quasi-static dead band: q is the motor angle over G, and the arm trails it by b/2
-            # against the gearbox load; the arm's rigid-body terms are taken there.
-            q_arm = q - self.backlash / 2 * np.sign(load)
-            tau, load = self._rigid(q_arm, qd, qdd, q_motor=q)
+        offset = self.arm_offset(load)
+        if offset is not None:
+            # Quasi-static: q is the motor angle over G, and the arm trails it (a dead band's
+            # flank); the arm's rigid-body terms are taken there.
+            tau, load = self._rigid(q + offset, qd, qdd, q_motor=q)
         if friction:
             tau += G * self.friction.stribeck_torque(G * qd)
             tau += self.effect_torque(q, qd, load, t)
@@ -259,7 +263,7 @@ class Robot:
         """Arm-side load the gearboxes carry along a motion, N m, shape (n, 6).
 
         The rigid-body torque of the arm joints (thesis eq. 6.1 without motor inertia and
-        friction) with the arm at the motor angle ``q`` (no backlash shift); the input of the
+        friction) with the arm at the motor angle ``q`` (no backlash shift, :meth:`arm_offset`); the input of the
         flexible-gearbox equation (:mod:`faultgen.calibrate.gearbox`).
 
         Parameters
@@ -325,22 +329,33 @@ class Robot:
 
     def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None
                       ) -> np.ndarray:
-        """Arm-side drive torque of the optional effects (module docstring), N m, shape (n, 6).
+        """Arm-side drive torque of the robot's :attr:`effects`, N m, shape (n, 6).
 
         ``load`` is the arm-side gearbox load torque (rigid-body torque of the arm joints), N m;
         ``t`` the time since the start of the run, s (zero when omitted).
         """
-        G = self.gear_ratio
-        amplitude, poles, phase = self.cogging.T
-        tau = -G * amplitude * np.sin(poles * G * q + phase)  # the drive holds against cogging
-        tau = tau + self.torque_offset
-        sign = np.sign(qd)
-        tau = tau + self.load_friction * np.abs(load) * sign
-        if np.any(self.thermal[:, 0]):
-            time = np.zeros(len(q)) if t is None else np.asarray(t, dtype=float)
-            drift = self.thermal[:, 0] * np.exp(-time[:, None] / self.thermal[:, 1])
-            tau = tau + drift * G * self.friction.stribeck_level(G * qd) * sign
+        time = np.zeros(len(q)) if t is None else np.asarray(t, dtype=float)
+        tau = np.zeros_like(np.asarray(q, dtype=float))
+        for effect in self.effects.values():
+            if np.any(effect.active()):
+                part = effect.torque(self, q, qd, load, time)
+                if part is not None:
+                    tau = tau + part
         return tau
+
+    def arm_offset(self, load: np.ndarray) -> np.ndarray | None:
+        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, 6), rad, from
+        the :attr:`effects` that let the arm trail the motor (backlash); None when none does."""
+        offsets = [effect.arm_offset(load) for effect in self.effects.values() if np.any(effect.active())]
+        offsets = [o for o in offsets if o is not None]
+        return sum(offsets[1:], offsets[0]) if offsets else None
+
+    def edited(self, edit) -> Robot:
+        """A copy of the robot with ``edit(spec)`` applied to an ``MjSpec`` of its MJCF, compiled in
+        memory (:func:`from_spec`)."""
+        spec = mujoco.MjSpec.from_file(str(self.path))
+        edit(spec)
+        return from_spec(spec, self.path)
 
 
 def _check_vector(name: str, value: np.ndarray) -> np.ndarray:
@@ -376,6 +391,8 @@ def load(name: str | Path) -> Robot:
     Returns
     -------
     Robot
+        Compiled once per process for each MJCF path and content (its bytes' SHA-1; files it
+        includes are not hashed): later calls return the same object, whose arrays are read-only.
 
     Raises
     ------
@@ -394,7 +411,14 @@ def load(name: str | Path) -> Robot:
     else:
         listing = ", ".join(known) or "(none found in " + str(robots_dir()) + ")"
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
-    return _from_file(path.resolve())
+    path = path.resolve()
+    return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+
+
+@functools.lru_cache(maxsize=32)
+def _cached(path: Path, digest: str) -> Robot:
+    """One compiled robot per MJCF path and content (``digest``): an edited file is read again."""
+    return _from_file(path)
 
 
 def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path:
@@ -508,9 +532,7 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
         raise ModelError(f"{path}: {err}") from err
 
     tendon_ids = [model.tendon(n).id for n in gearbox_names]
-    extras = {name: _optional_numerics(model, path, name, size, default)
-              for name, (size, default) in OPTIONAL_NUMERICS.items()}
-    backlash = np.diff(model.tendon_lengthspring[tendon_ids], axis=1)[:, 0]
+    effects = read_all(model, path)
     key = require("keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
     joint_qpos = [model.jnt_qposadr[model.joint(n).id] for n in joint_names]
     description_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "description")
@@ -540,36 +562,8 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
         motor_torque_limit=torque_limit,
         friction=friction,
         home=model.key_qpos[key, joint_qpos].copy(),
-        backlash=backlash,
-        **extras,
+        effects=effects,
     )
-
-
-#: Optional per-axis custom numerics ``<name>{i}``: number of values and the value when absent.
-OPTIONAL_NUMERICS = {
-    "cogging": (3, (0.0, 0.0, 0.0)),
-    "torque_offset": (1, (0.0,)),
-    "load_friction": (1, (0.0,)),
-    "thermal": (2, (0.0, 1.0)),
-}
-
-
-def _optional_numerics(model: mujoco.MjModel, path: Path, name: str, size: int, default: tuple) -> np.ndarray:
-    """Values of the optional numerics ``<name>1..6``, shape (6, size) (or (6,) for one value)."""
-    rows = np.tile(np.array(default, dtype=float), (N_AXES, 1))
-    for k in range(N_AXES):
-        idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, f"{name}{k + 1}")
-        if idx < 0:
-            continue
-        if model.numeric_size[idx] != size:
-            raise ModelError(f"{path}: numeric '{name}{k + 1}' has {model.numeric_size[idx]} values, expected {size}")
-        adr = model.numeric_adr[idx]
-        rows[k] = model.numeric_data[adr : adr + size]
-    if not np.all(np.isfinite(rows)):
-        raise ModelError(f"{path}: numeric '{name}' holds a non-finite value")
-    if name == "thermal" and np.any(rows[:, 1] <= 0):
-        raise ModelError(f"{path}: numeric 'thermal' needs a time constant > 0 s")
-    return rows[:, 0] if size == 1 else rows
 
 
 def _gear_ratio(model: mujoco.MjModel, path: Path, tendon: int, joint: int, rotor: int) -> float:

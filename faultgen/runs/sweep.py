@@ -36,7 +36,8 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.data import atomic, dataset
-from faultgen.model import friction, robots
+from faultgen.effects import friction
+from faultgen.model import robots
 from faultgen.operation import tasks, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim

@@ -26,7 +26,8 @@ import numpy as np
 from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
-from faultgen.model import friction, robots
+from faultgen.effects import friction
+from faultgen.model import robots
 from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import control, sensors
@@ -236,11 +237,11 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
     gains = control.ServoGains.for_robot(robot)
     control.add_drives(spec, robot, gains)
     if friction_model == "lugre":
-        state_dependent = np.any(robot.load_friction) or np.any(robot.thermal[:, 0])
-        if state_dependent:
+        stepped = _stepped(robot)
+        if stepped:
             raise ValueError(
-                f"{robot.path}: load-dependent friction and warm-up drift (numerics load_friction, thermal) "
-                "are set from Python every step; simulate this model with --friction stribeck"
+                f"{robot.path}: {' and '.join(e.summary for e in stepped)} ({', '.join(e.id for e in stepped)}) "
+                "act through the friction level Python sets every step; simulate this model with --friction stribeck"
             )
         friction.check_lugre_step(robot.friction, spec.option.timestep, gains.kd)
         friction.add_lugre(spec, robot)
@@ -257,28 +258,16 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
 
 
 def _add_effect_forces(spec, robot: robots.Robot) -> None:
-    """Passive rotor forces of the optional effects that MuJoCo computes itself, in place.
+    """The MuJoCo elements of the robot's effects (:meth:`faultgen.effects.Effect.add_to_simulation`:
+    cogging, a torque offset), in place."""
+    for effect in robot.effects.values():
+        if np.any(effect.active()):
+            effect.add_to_simulation(spec, robot)
 
-    Cogging: a ``dcmotor`` with no input and no electrical branch whose only force is its
-    ``cogging`` term (position-dependent, in C at the physics rate). Torque offset: a ``general``
-    actuator with a constant bias ``-offset / G`` on the rotor, which the drive holds against, so
-    the drive torque referred to the arm side shifts by ``+offset``.
-    """
-    for k, rotor in enumerate(robot.rotor_names):
-        amplitude, poles, phase = robot.cogging[k]
-        if amplitude:
-            actuator = spec.add_actuator(name=f"cogging{k + 1}", target=rotor)
-            actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
-            actuator.set_to_dcmotor(motorconst=[0.0, 0.0], resistance=1.0,
-                                    cogging=[float(amplitude), float(poles), float(phase)], ctrlspec=16)
-        if robot.torque_offset[k]:
-            actuator = spec.add_actuator(name=f"offset{k + 1}", target=rotor)
-            actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
-            actuator.gaintype = mujoco.mjtGain.mjGAIN_FIXED
-            actuator.gainprm[0] = 0.0
-            actuator.biastype = mujoco.mjtBias.mjBIAS_AFFINE
-            actuator.biasprm[:3] = [-float(robot.torque_offset[k] / robot.gear_ratio[k]), 0.0, 0.0]
-            actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+
+def _stepped(robot: robots.Robot) -> list:
+    """The robot's effects that act through a per-step update of the rotors' dry friction."""
+    return [e for e in robot.effects.values() if e.stepped and np.any(e.active())]
 
 
 @dataclass(frozen=True)
@@ -349,7 +338,10 @@ def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.nda
     static = robot.inverse_dynamics(q0[None], zeros, zeros, friction=False)[0]
     # a load at round-off level (gravity on a vertical axis) has no side to rest on
     side = np.sign(static) * (np.abs(static) > 1e-9 * max(float(np.abs(static).max()), 1.0))
-    qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness - side * robot.backlash / 2
+    qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness
+    offset = robot.arm_offset(side[None])
+    if offset is not None:
+        qpos[robot.arm_qpos] += offset[0]
     return qpos, qvel
 
 
@@ -518,19 +510,23 @@ def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, b
     n_log = n_steps // per_log
     logs = {f.name: np.empty((len(cycles), n_log, 6)) for f in fields(_Raw)}
     rotor, arm = robot.rotor_dof, robot.arm_dof
-    G, K = robot.gear_ratio, robot.gearbox_stiffness
+    G = robot.gear_ratio
     dt = model.opt.timestep
-    run_start = (cycles[:, None] - 1) * n_steps * dt  # thermal drift runs over the whole run
-    thermal = np.any(robot.thermal[:, 0])
-    load_friction = np.any(robot.load_friction)
+    run_start = (cycles[:, None] - 1) * n_steps * dt  # a drift with time runs over the whole run
+    stepped = _stepped(robot)
     for step in range(n_steps):
         level = multiplier
-        if thermal:
-            level = multiplier * (1 + robot.thermal[:, 0] * np.exp(-(run_start + step * dt) / robot.thermal[:, 1]))
+        for effect in stepped:
+            factor = effect.dry_friction_factor(run_start + step * dt)
+            if factor is not None:
+                level = level * factor
         frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
-        if load_friction:  # gearbox load from the spring deflection (eq. 6.2a)
+        if stepped:  # the gearbox deflection (eq. 6.2a) carries the load
             deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
-            frictionloss[:, rotor] += robot.load_friction * np.abs(K * deflection) / G
+            for effect in stepped:
+                extra = effect.dry_friction_extra(robot, deflection)
+                if extra is not None:
+                    frictionloss[:, rotor] += extra
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
         logged = (step + 1) % per_log == 0

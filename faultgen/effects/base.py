@@ -1,0 +1,437 @@
+"""The template every physical effect follows, the registry, and the motion effects are fitted on.
+
+An effect is one class (:class:`Effect`) registered under its stable id (:func:`register`, the
+pattern of :mod:`analysis.isolation`). An instance holds the effect's **absolute** parameters on
+the six axes (or, robot-wide, once), in SI units, under one name each: the same names in the
+MJCF, in ``report.json``, in ``parameters.json`` and in ``Effect.units``. The class knows
+
+* how it is stored in a robot's MJCF (:meth:`Effect.read` from a compiled ``MjModel``,
+  :meth:`Effect.apply` into an ``MjSpec``),
+* its drive torque along a motion (:meth:`Effect.torque`, the robot's inverse dynamics add it;
+  :meth:`Effect.arm_offset` for an effect that moves the arm against the motor),
+* how it acts in the simulation (:meth:`Effect.add_to_simulation`: MuJoCo elements; or a
+  per-step update of the rotors' dry friction, :meth:`Effect.dry_friction_factor` and
+  :meth:`Effect.dry_friction_extra`),
+* its regressors for identification (:meth:`Effect.columns`, :meth:`Effect.grid`, or its own
+  :meth:`Effect.search`) and how fitted values become its parameters (:meth:`Effect.params`),
+* how a hidden effect of it is drawn for the calibration's own checks (:attr:`Effect.signed`,
+  :meth:`Effect.draw_direction`, :attr:`Effect.draw_limits`, :attr:`Effect.draw_range`,
+  :meth:`Effect.motor_torque`).
+
+Code outside :mod:`faultgen.effects` never branches on an effect's id: it calls these methods.
+docs/architecture.md walks through adding an effect.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+import mujoco
+import numpy as np
+
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+
+N_AXES = 6
+
+#: Arm-side speed (rad/s) below which an axis counts as at rest: its friction is then stiction,
+#: any value up to the breakaway torque, which no kinetic model predicts, so those samples of
+#: that axis are neither fitted nor scored (:class:`faultgen.calibrate.search.Split`).
+REST_SPEED = 0.05
+
+
+class ModelError(ValueError):
+    """Raised when an MJCF file cannot be compiled or lacks the elements a robot needs.
+
+    The message names the file and, where MuJoCo reports one, the line.
+    (:class:`faultgen.robots.ModelError` is this class.)
+    """
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A motion and what the current model says about it; every array ``(n, 6)``.
+
+    Attributes
+    ----------
+    robot : faultgen.robots.Robot
+        The current model (nominal, or with the effects added so far).
+    t : ndarray of shape (n,)
+        Time since the first sample, s.
+    q, qd, qdd : ndarray of shape (n, 6)
+        Arm-side angles (rad), velocities (rad/s), accelerations (rad/s^2).
+    load : ndarray of shape (n, 6)
+        Arm-side gearbox load: the rigid-body torque of the arm joints without motor inertia
+        and friction, the arm at the motor angle, N m.
+    compliance : callable, optional
+        The flexible gearbox's torque along the motion,
+        ``compliance(robot, t, q, load, widths=None) -> (n, 6)`` or ``(m, n, 6)`` for dead-band
+        widths ``(m, 6)`` (:func:`faultgen.calibrate.gearbox.compliance_torque`); needed by the
+        effects that change the gearbox (backlash).
+    """
+
+    robot: Any
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    load: np.ndarray
+    compliance: Callable | None = field(default=None, compare=False, repr=False)
+    #: Results an effect computes once per motion for all its grid values (backlash).
+    memo: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @classmethod
+    def of(cls, robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+           compliance: Callable | None = None) -> Motion:
+        """Evaluate ``robot``'s rigid-body load along a motion
+        (:meth:`faultgen.robots.Robot.gearbox_load`); time counts from the first sample."""
+        return cls(robot, np.asarray(t, dtype=float) - float(t[0]), q, qd, qdd, robot.gearbox_load(q, qd, qdd),
+                   compliance)
+
+    @property
+    def motor_velocity(self) -> np.ndarray:
+        """Motor-side velocity ``G qd`` in rad/s, shape (n, 6)."""
+        return self.robot.gear_ratio * self.qd
+
+
+#: Every effect, by id, in the order they are tried in identification (ties go to the earlier,
+#: simpler one): the order of registration, set by the imports of :mod:`faultgen.effects`.
+EFFECTS: dict[str, Effect] = {}
+
+
+def register(cls: type[Effect]) -> type[Effect]:
+    """Class decorator adding an effect class to :data:`EFFECTS` (as an instance with the values
+    of an absent effect) under its ``id``.
+
+    Raises
+    ------
+    ValueError
+        If the id is already registered to another class.
+    """
+    if cls.id in EFFECTS and type(EFFECTS[cls.id]) is not cls:
+        raise ValueError(f"effect {cls.id!r} is already registered to {type(EFFECTS[cls.id]).__name__}")
+    EFFECTS[cls.id] = cls()
+    return cls
+
+
+def get(effect_id: str) -> Effect:
+    """The registered effect ``effect_id`` (absent values); raises ``ValueError`` listing the known ids."""
+    try:
+        return EFFECTS[effect_id]
+    except KeyError:
+        raise ValueError(f"unknown effect {effect_id!r}; known effects: {', '.join(EFFECTS)}") from None
+
+
+def make(effect_id: str, **values) -> Effect:
+    """A new effect ``effect_id`` with the given parameters (each a number for all axes or one
+    value per axis; missing ones at their absent value).
+
+    Raises
+    ------
+    ValueError
+        For an unknown id (the message lists the known ones) or parameter name, or a value of
+        the wrong shape.
+    """
+    return type(get(effect_id))(**values)
+
+
+def read_all(model: mujoco.MjModel, path: Path) -> dict[str, Effect]:
+    """Every effect stored in its own MJCF elements (absent ones at their absent values), by id.
+
+    Raises
+    ------
+    ModelError
+        If an effect's element holds values it cannot take (wrong count, non-finite, out of range).
+    """
+    found = {}
+    for effect_id, prototype in EFFECTS.items():
+        effect = type(prototype).read(model, path)
+        if effect is not None:
+            found[effect_id] = effect
+    return found
+
+
+class Effect:
+    """One physical effect with its parameters. Subclasses set the class attributes and override
+    what applies to them; the defaults describe an effect that does nothing there.
+
+    Parameters
+    ----------
+    **values : float or array_like of shape (6,)
+        Parameters by name (:attr:`units`), one value for all axes or one per axis; a robot-wide
+        effect takes one value each. Missing ones take their :attr:`absent` value.
+
+    Raises
+    ------
+    ValueError
+        For an unknown parameter name or a value of the wrong shape or non-finite.
+
+    Attributes
+    ----------
+    id : str
+        Stable effect id used in ``report.json``.
+    summary : str
+        One line: the physics, for ``--help`` and the report.
+    units : dict
+        Parameter name -> SI unit (and the side it is measured at), in the order of the values
+        in the effect's MJCF numeric.
+    absent : tuple of float
+        Parameter values of an absent effect, in the order of :attr:`units`.
+    per_axis : bool
+        True when the effect has its own parameters on each axis; False for a robot-wide
+        effect (payload), fitted on all axes at once.
+    n_parameters : int
+        Linear parameters per axis (per robot when not ``per_axis``), for the report.
+    continuous : bool
+        True when the grid samples a continuous parameter, refined by a bounded scalar search.
+    stepped : bool
+        True when the simulation realises the effect by a per-step update of the rotors' dry
+        friction from Python, which only the static friction model (``--friction stribeck``) has.
+    numeric, aliases : str
+        Name ``<numeric>{i}`` of the effect's MJCF custom numeric on axis i (None when it is
+        stored otherwise), and earlier names still read.
+    """
+
+    id: ClassVar[str]
+    summary: ClassVar[str]
+    units: ClassVar[dict[str, str]]
+    absent: ClassVar[tuple[float, ...]]
+    per_axis: ClassVar[bool] = True
+    n_parameters: ClassVar[int] = 1
+    continuous: ClassVar[bool] = False
+    stepped: ClassVar[bool] = False
+    numeric: ClassVar[str | None] = None
+    aliases: ClassVar[tuple[str, ...]] = ()
+    #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
+    signed: ClassVar[bool] = False
+    #: Hidden-effect drawing: largest value of a parameter; a drawn effect past it is shrunk to it.
+    draw_limits: ClassVar[dict[str, float]] = {}
+    #: Hidden-effect drawing by a parameter range instead of a torque size, for an effect not
+    #: linear in its parameter: (parameter, low, high, smallest size, smallest size on a robot
+    #: where no axis reaches it); None: drawn by size.
+    draw_range: ClassVar[tuple[str, float, float, float, float] | None] = None
+
+    def __init__(self, **values) -> None:
+        unknown = set(values) - set(self.units)
+        if unknown:
+            raise ValueError(f"{self.id}: unknown parameter {min(unknown)!r}; expected {', '.join(self.units)}")
+        shape = (N_AXES,) if self.per_axis else ()
+        table = {}
+        for k, name in enumerate(self.units):
+            value = np.asarray(values.get(name, self.absent[k]), dtype=float)
+            try:
+                value = np.broadcast_to(value, shape).copy()
+            except ValueError:
+                raise ValueError(f"{self.id}: parameter {name!r} has shape {value.shape}; expected one value"
+                                 + (f" or {N_AXES}, one per axis" if self.per_axis else "")) from None
+            if not np.all(np.isfinite(value)):
+                raise ValueError(f"{self.id}: parameter {name!r} holds a non-finite value")
+            table[name] = value
+        self._values = table
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        values = self.__dict__.get("_values", {})
+        if name in values:
+            return values[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def __repr__(self) -> str:
+        values = ", ".join(f"{k}={v.tolist()}" for k, v in self._values.items())
+        return f"{type(self).__name__}({values})"
+
+    # -- parameters -------------------------------------------------------------------------
+
+    def values(self, axis: int | None = None) -> dict[str, float]:
+        """Parameters of ``axis`` (0-based; None for a robot-wide effect) as plain numbers."""
+        return {k: float(v if axis is None else v[axis]) for k, v in self._values.items()}
+
+    def table(self) -> dict[str, list[float] | float]:
+        """All parameters as plain lists over axes 1..6 (one number when robot-wide), ``parameters.json``."""
+        return {k: v.tolist() for k, v in self._values.items()}
+
+    def active(self) -> np.ndarray:
+        """Per axis (or once), whether the effect differs from its absent values, bool."""
+        differs = [v != a for v, a in zip(self._values.values(), self.absent, strict=True)]
+        return np.any(differs, axis=0)
+
+    @classmethod
+    def of(cls, robot) -> Effect:
+        """The effect of this class a robot carries (:attr:`faultgen.robots.Robot.effects`)."""
+        return robot.effects[cls.id]
+
+    # -- the MJCF -------------------------------------------------------------------------
+
+    @classmethod
+    def read(cls, model: mujoco.MjModel, path: Path) -> Effect | None:
+        """The effect as ``model`` stores it (absent values when it has no element there); None for
+        an effect stored as part of something else (the friction parameters).
+
+        The default reads the custom numerics ``<numeric>{i}`` (or an earlier name,
+        :attr:`aliases`), one value per parameter.
+
+        Raises
+        ------
+        ModelError
+            If a numeric has the wrong number of values or holds values :meth:`check` refuses.
+        """
+        if cls.numeric is None:
+            return None
+        size = len(cls.units)
+        rows = np.tile(np.array(cls.absent, dtype=float), (N_AXES, 1))
+        for k in range(N_AXES):
+            for name in (cls.numeric, *cls.aliases):
+                idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, f"{name}{k + 1}")
+                if idx >= 0:
+                    break
+            if idx < 0:
+                continue
+            if model.numeric_size[idx] != size:
+                raise ModelError(f"{path}: numeric '{name}{k + 1}' has {model.numeric_size[idx]} values, expected "
+                                 f"{size}: {' '.join(cls.units)}")
+            adr = model.numeric_adr[idx]
+            rows[k] = model.numeric_data[adr: adr + size]
+        if not np.all(np.isfinite(rows)):
+            raise ModelError(f"{path}: numeric '{cls.numeric}' holds a non-finite value")
+        problem = cls.check(rows)
+        if problem:
+            raise ModelError(f"{path}: numeric '{cls.numeric}' {problem}")
+        return cls(**{name: rows[:, k] for k, name in enumerate(cls.units)})
+
+    @classmethod
+    def check(cls, rows: np.ndarray) -> str | None:
+        """What is wrong with the stored values ``rows`` (6, n parameters), or None."""
+        return None
+
+    def apply(self, spec: mujoco.MjSpec, robot, axis: int | None, params: dict[str, float]) -> None:
+        """Write the effect with the absolute ``params`` on ``axis`` (0-based; None for robot-wide)
+        into ``spec``. The default writes the numeric ``<numeric>{axis + 1}`` (dropping one of an
+        earlier name)."""
+        name = f"{self.numeric}{axis + 1}"
+        data = [float(params[k]) for k in self.units]
+        for old in self.aliases:
+            element = spec.numeric(f"{old}{axis + 1}")
+            if element is not None:
+                spec.delete(element)
+        existing = spec.numeric(name)
+        if existing is None:
+            spec.add_numeric(name=name, data=data)
+        else:
+            existing.data = data
+
+    def write(self, spec: mujoco.MjSpec, robot, axes: list[int] | None = None) -> None:
+        """Write this instance's parameters on ``axes`` (0-based; all six when omitted; ignored for
+        a robot-wide effect) into ``spec``, over what ``robot`` has there."""
+        if not self.per_axis:
+            self.apply(spec, robot, None, self.values())
+            return
+        for axis in range(N_AXES) if axes is None else axes:
+            self.apply(spec, robot, axis, self.values(axis))
+
+    # -- acting --------------------------------------------------------------------------
+
+    def torque(self, robot, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray
+               ) -> np.ndarray | None:
+        """Arm-side drive torque of the effect along a motion, N m, shape (n, 6), that the
+        rigid-body model does not already carry (None: nothing). ``load`` is the arm-side gearbox
+        load (N m), ``t`` the time since the start of the run (s)."""
+        return None
+
+    def arm_offset(self, load: np.ndarray) -> np.ndarray | None:
+        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, 6), rad, for
+        an effect that lets the arm trail the motor (None: it does not)."""
+        return None
+
+    def add_to_simulation(self, spec: mujoco.MjSpec, robot) -> None:
+        """Add the MuJoCo elements that realise the effect in the simulation, in place (the
+        default adds nothing: the effect is in the MJCF itself, or it is :attr:`stepped`)."""
+
+    def dry_friction_factor(self, time: np.ndarray) -> np.ndarray | None:
+        """Factor on the rotors' dry friction (Coulomb plus Stribeck) at ``time`` (r, 1) s since
+        the start of each run, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
+        return None
+
+    def dry_friction_extra(self, robot, deflection: np.ndarray) -> np.ndarray | None:
+        """Motor-side dry friction the effect adds given the gearbox deflections ``deflection``
+        (r, 6) rad (eq. 6.2a), N m, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
+        return None
+
+    # -- identification ------------------------------------------------------------------
+
+    def grid(self, motion: Motion, axis: int) -> list:
+        """Values of the nonlinear parameter to search; ``[None]`` when the effect is linear."""
+        return [None]
+
+    def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | None:
+        """The effect's own fit of all axes to ``residual`` (n, 6) on the samples of ``rows``
+        (n, 6), axis a weighted by ``1 / scale[a]**2`` (its torque RMS, N m): per axis
+        ``(h, theta, predicted torque (n,))``. None (the default): the generic per-axis least
+        squares over :meth:`grid` and :meth:`columns`."""
+        return None
+
+    def columns(self, motion: Motion, axis: int | None, h) -> tuple[np.ndarray, np.ndarray]:
+        """Regressors ``Phi`` (n, k) and known part ``offset`` (n,) of the torque change of
+        ``axis`` (0-based) over ``motion.robot``, or of all axes ``(n, 6, k)`` / ``(n, 6)`` when
+        not ``per_axis``: the change is ``Phi @ theta + offset``."""
+        raise NotImplementedError
+
+    def params(self, motion: Motion, axis: int | None, theta: np.ndarray, h) -> dict[str, float]:
+        """The absolute parameters (:attr:`units`) of ``axis`` after the fitted change ``theta``
+        (with grid value ``h``) over ``motion.robot``."""
+        raise NotImplementedError
+
+    def admissible(self, motion: Motion, axis: int | None, params: dict[str, float]) -> bool:
+        """False when ``params`` are not physical for the current model (a negative mass or
+        backlash, a friction level below zero); such a fit is never selected."""
+        return True
+
+    def fitted(self, robot, params: dict) -> Effect:
+        """A new instance: ``robot``'s values of this effect with ``params`` (per axis ``"1"``..
+        ``"6"``, or ``"robot"``) in place."""
+        current = self.current(robot)
+        table = {k: v.copy() for k, v in current._values.items()}
+        for where, values in params.items():
+            for name, value in values.items():
+                if where == "robot":
+                    table[name] = np.asarray(value, dtype=float)
+                else:
+                    table[name][int(where) - 1] = value
+        return type(self)(**table)
+
+    def current(self, robot) -> Effect:
+        """This effect's values in ``robot`` (the absent values when the robot does not carry it)."""
+        return robot.effects.get(self.id, type(self)())
+
+    # -- hidden-effect drawing -----------------------------------------------------------
+
+    def draw_direction(self, rng: np.random.Generator) -> np.ndarray:
+        """Unit direction of the linear parameters of a drawn hidden effect, shape (k,)."""
+        return np.ones(1)
+
+    def motor_torque(self, motion: Motion, axis: int, params: dict[str, float]) -> float:
+        """Largest motor torque (N m) the effect with ``params`` takes on ``axis`` along ``motion``
+        (hidden-effect drawing keeps it within a share of the motor's torque limit)."""
+        return 0.0
+
+
+class FrictionParameter(Effect):
+    """An effect that changes parameters of the robot's motor-side friction (thesis eq. 6.3):
+    stored in the ``friction{i}`` numerics (:mod:`faultgen.effects.friction`), acting through the
+    friction model in the simulation and in the inverse dynamics; its parameters are named as
+    :data:`faultgen.friction.FIELDS` names them. A fitted change may give a negative level, which
+    :meth:`Effect.admissible` refuses; :meth:`apply` writes at least zero."""
+
+    @classmethod
+    def read(cls, model, path):
+        return None  # part of the robot's friction, read with it
+
+    def current(self, robot) -> Effect:
+        return type(self)(**{name: getattr(robot.friction, name) for name in self.units})
+
+    def apply(self, spec, robot, axis, params):
+        element = spec.numeric(f"friction{axis + 1}")
+        row = [float(v) for v in element.data]
+        for name in self.units:
+            row[FRICTION_FIELDS.index(name)] = max(float(params[name]), 0.0)  # magnitudes
+        element.data = row

@@ -1,0 +1,40 @@
+"""Coulomb friction of another level (thesis eq. 6.3's f_c, both directions shifted alike)."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from faultgen.effects.base import FrictionParameter, register
+
+
+@register
+class Coulomb(FrictionParameter):
+    """Coulomb friction levels ``coulomb_pos`` / ``coulomb_neg`` (N m, motor side, magnitudes for
+    positive / negative speed; thesis eq. 6.3).
+
+    Identified as one change ``df_c`` of both levels: the arm-side drive torque changes by
+    ``G df_c sign(qd)``; a fit that would take a level below zero is not admissible.
+    """
+
+    id = "coulomb"
+    summary = "Coulomb friction level differs (constant torque against the motion)"
+    units: ClassVar[dict[str, str]] = {"coulomb_pos": "N m (motor side)", "coulomb_neg": "N m (motor side)"}
+    absent = (0.0, 0.0)
+
+    def columns(self, motion, axis, h):
+        G = motion.robot.gear_ratio[axis]
+        return G * np.sign(motion.qd[:, axis])[:, None], np.zeros(len(motion.t))
+
+    def params(self, motion, axis, theta, h):
+        f = motion.robot.friction
+        return {"coulomb_pos": float(f.coulomb_pos[axis] + theta[0]),
+                "coulomb_neg": float(f.coulomb_neg[axis] + theta[0])}
+
+    def admissible(self, motion, axis, params):
+        return min(params["coulomb_pos"], params["coulomb_neg"]) >= 0
+
+    def motor_torque(self, motion, axis, params):
+        f = motion.robot.friction
+        return max(params["coulomb_pos"], params["coulomb_neg"]) + f.static[axis]
