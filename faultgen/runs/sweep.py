@@ -126,7 +126,8 @@ class Grid:
         for pct in self.increases:
             if not np.isfinite(pct) or pct < 0:
                 raise ValueError(f"wear increase {pct!r} % must be a finite number >= 0")
-        self.runs()  # builds and validates every run configuration
+        # builds and validates every run configuration, once: runs() returns these
+        object.__setattr__(self, "_runs", self._build_runs())
 
     @classmethod
     def from_preset(cls, name: str, **overrides) -> Grid:
@@ -168,7 +169,11 @@ class Grid:
         raise ValueError(f"record {self.record!r}: expected \"all\", a list of cycles or {{period, first}}")
 
     def runs(self) -> list[tuple[str, sim.RunConfig]]:
-        """Every run of the grid as ``(run id, RunConfig)``, in a stable order; validates each."""
+        """Every run of the grid as ``(run id, RunConfig)``, in a stable order (built and validated
+        once, when the grid is made)."""
+        return list(self._runs)
+
+    def _build_runs(self) -> list[tuple[str, sim.RunConfig]]:
         noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
         record = self.recorded_cycles()
         out: dict[str, sim.RunConfig] = {}
