@@ -28,7 +28,8 @@ def main() -> None:
     robot = robots.load("puma560")
     friction = robot.friction  # both Coulomb levels of axis 5 0.03 N m (motor side) higher
     hidden = {"payload": {"robot": {"mass": 2.2}},
-              "coulomb": {"5": {"coulomb_pos": friction.coulomb_pos[4] + 0.03, "coulomb_neg": friction.coulomb_neg[4] + 0.03}}}
+              "coulomb": {"5": {"coulomb_pos": float(friction.coulomb_pos[4] + 0.03),
+                                "coulomb_neg": float(friction.coulomb_neg[4] + 0.03)}}}
     model = synth.write_model(robot, synth.Hidden("payload", [1, 2, 3, 4, 5, 6], hidden["payload"]),
                               args.out / "hidden_model")
     with_both = robots.load(model)

@@ -5,7 +5,9 @@ tau_model`` (arm side, N m):
 
 1. Every effect of the library is fitted to the residual of the **fitting part** (the first
    :data:`FIT_FRACTION` of the record), each axis on its own (the payload on all axes at once),
-   by linear least squares in its linear parameters and a grid search over its nonlinear one.
+   by linear least squares in its linear parameters and a grid search over its nonlinear one
+   (the optimisers :class:`AxisLeastSquares` and :class:`RobotLeastSquares`; an effect not linear
+   in its parameter brings its own, :meth:`faultgen.effects.Effect.search`).
 2. Each fit is judged on the **held-out part** (the rest of the record, never used to fit): the
    gain of an axis is how much its normalised RMS error (RMSE over the RMS of the measured
    torque of that axis) drops. This is the guard against over-fitting: a term that fits noise
@@ -131,26 +133,48 @@ def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(phi, y, rcond=None)[0]
 
 
-def _fit_axis(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, axis: int):
-    """Least squares of one axis over the effect's grid, refined between the best grid neighbours
-    when the grid samples a continuous parameter; returns (sse, h, theta, predicted)."""
+class AxisLeastSquares:
+    """The default optimiser of a per-axis effect (the PySINDy split: the effect gives the
+    regressors, the optimiser fits them): per axis, linear least squares in the linear parameters
+    at every value of the effect's :meth:`~faultgen.effects.Effect.grid`, the best refined between
+    its grid neighbours (bounded scalar search in log) when the grid samples a continuous parameter."""
 
-    def trial(h):
-        phi, offset = effect.columns(motion, axis, h)
-        theta = _lstsq(phi[rows], residual[rows] - offset[rows])
-        predicted = phi @ theta + offset
-        return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
+    def fit(self, effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray,
+            scale: np.ndarray) -> list[tuple]:
+        """Per axis ``(h, theta, predicted torque (n,))`` fitted to ``residual`` (n, 6) on ``rows``."""
+        return [self._axis(effect, motion, residual[:, a], rows[:, a], a)[1:] for a in range(residual.shape[1])]
 
-    grid = effect.grid(motion, axis)
-    results = [trial(h) for h in grid]
-    k = min(range(len(results)), key=lambda i: results[i][0])
-    best = results[k]
-    if effect.continuous and len(grid) > 2:  # refine between the grid neighbours, in log
-        bounds = (np.log(grid[max(k - 1, 0)]), np.log(grid[min(k + 1, len(grid) - 1)]))
-        found = minimize_scalar(lambda x: trial(float(np.exp(x)))[0], bounds=bounds, method="bounded",
-                                options={"xatol": 1e-3})
-        best = min(best, trial(float(np.exp(found.x))), key=lambda r: r[0])
-    return best
+    @staticmethod
+    def _axis(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, axis: int):
+        def trial(h):
+            phi, offset = effect.columns(motion, axis, h)
+            theta = _lstsq(phi[rows], residual[rows] - offset[rows])
+            predicted = phi @ theta + offset
+            return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
+
+        grid = effect.grid(motion, axis)
+        results = [trial(h) for h in grid]
+        k = min(range(len(results)), key=lambda i: results[i][0])
+        best = results[k]
+        if effect.continuous and len(grid) > 2:  # refine between the grid neighbours, in log
+            bounds = (np.log(grid[max(k - 1, 0)]), np.log(grid[min(k + 1, len(grid) - 1)]))
+            found = minimize_scalar(lambda x: trial(float(np.exp(x)))[0], bounds=bounds, method="bounded",
+                                    options={"xatol": 1e-3})
+            best = min(best, trial(float(np.exp(found.x))), key=lambda r: r[0])
+        return best
+
+
+class RobotLeastSquares:
+    """The optimiser of a robot-wide effect (payload): one least squares over the fitted samples of
+    all axes at once, each axis weighted by ``1 / scale`` so that it counts by its nrmse."""
+
+    def fit(self, effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray,
+            scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(theta, predicted torque (n, 6))`` fitted to ``residual`` (n, 6) on ``rows``."""
+        phi, offset = effect.columns(motion, None, None)  # (n, 6, k), (n, 6)
+        weights = 1.0 / scale
+        theta = _lstsq((phi * weights[:, None])[rows], ((residual - offset) * weights)[rows])
+        return theta, phi @ theta + offset
 
 
 def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> Candidate:
@@ -161,22 +185,13 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     before = _rms(residual, held) / scale
     contribution = np.zeros_like(residual)
     params: dict = {}
-    if effect.per_axis:
-        own = effect.search(motion, residual, fit, scale)
-        for axis in range(residual.shape[1]):
-            if own is None:
-                _, h, theta, predicted = _fit_axis(effect, motion, residual[:, axis], fit[:, axis], axis)
-            else:
-                h, theta, predicted = own[axis]
+    if effect.per_axis:  # the effect's own search (backlash), else the default optimiser
+        fits = effect.search(motion, residual, fit, scale) or AxisLeastSquares().fit(effect, motion, residual, fit, scale)
+        for axis, (h, theta, predicted) in enumerate(fits):
             contribution[:, axis] = predicted
             params[str(axis + 1)] = effect.params(motion, axis, theta, h)
     else:
-        phi, offset = effect.columns(motion, None, None)  # (n, 6, k), (n, 6)
-        weights = 1.0 / scale  # each axis counts by its nrmse
-        rows = (phi * weights[:, None])[fit]  # (m, k): the fitted samples of every axis
-        target = ((residual - offset) * weights)[fit]
-        theta = _lstsq(rows, target)
-        contribution = phi @ theta + offset
+        theta, contribution = RobotLeastSquares().fit(effect, motion, residual, fit, scale)
         params["robot"] = effect.params(motion, None, theta, None)
     after = _rms(residual - contribution, held) / scale
     gain = before - after

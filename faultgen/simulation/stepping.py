@@ -353,9 +353,10 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     """
-    sim, task, path, q_ref, inputs = _prepared(config.robot, config.task, config.friction)
+    prepared = _prepared(config.robot, config.task, config.friction)
+    sim, task, path, q_ref, inputs = prepared.sim, prepared.task, prepared.path, prepared.q_ref, prepared.inputs
     robot = sim.robot
-    per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
+    per_log = prepared.per_log
     n_steps = len(inputs) - 1
 
     cycles = config.recorded_cycles
@@ -372,13 +373,13 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         started = time.perf_counter()
         if config.back_to_back:  # one simulation over the cycles' set-points one after the other
             chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
-            one = stepper(sim, config, cycles[:1], multiplier[:1], path.q[0], chained,
-                          dist.reshape(1, -1, dist.shape[-1]), per_log, bar)
+            one = stepper(sim, _Work(cycles[:1], multiplier[:1], path.q[0], chained,
+                                     dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
             raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
         else:
             groups = [slice(i, i + BATCH_CYCLES) for i in range(0, len(cycles), BATCH_CYCLES)]
-            raws = [stepper(sim, config, cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, bar)
-                    for g in groups]
+            raws = [stepper(sim, _Work(cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, config.nthread),
+                            bar) for g in groups]
             raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws]) for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
@@ -387,7 +388,52 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     return result
 
 
-def _prepared(robot: str, task: str, friction_model: str):
+@dataclass(frozen=True)
+class Prepared:
+    """What every run of a robot, task and friction model shares (read-only arrays).
+
+    Attributes
+    ----------
+    sim : SimModel
+        The compiled simulation model (``Batch`` works on copies of it).
+    task : faultgen.tasks.Task
+    path : faultgen.tasks.JointPath
+        The task's path sampled at every physics step.
+    q_ref : ndarray of shape (n_steps + 1, 6)
+        Reference arm angles at every physics step, rad (held at the end to a whole log period).
+    inputs : ndarray of shape (n_steps + 1, 6, 3)
+        Drive set-points (angle, speed, feedforward) at every physics step, motor side.
+    """
+
+    sim: SimModel
+    task: tasks.Task
+    path: tasks.JointPath
+    q_ref: np.ndarray
+    inputs: np.ndarray
+
+    @property
+    def per_log(self) -> int:
+        """Physics steps per log period."""
+        return int(round(sensors.LOG_PERIOD / self.sim.model.opt.timestep))
+
+
+@dataclass(frozen=True)
+class _Work:
+    """One batch of simulations stepped together: recorded ``cycles`` (n,), their wear
+    ``multiplier`` (n, 6), the start angles ``q0`` (6,), the drive ``inputs`` at every physics step
+    (n_steps + 1, 6, 3), the load disturbance ``dist`` per log period (n, n_log, 6), physics steps
+    per log period and MuJoCo threads."""
+
+    cycles: np.ndarray
+    multiplier: np.ndarray
+    q0: np.ndarray
+    inputs: np.ndarray
+    dist: np.ndarray
+    per_log: int
+    nthread: int
+
+
+def _prepared(robot: str, task: str, friction_model: str) -> Prepared:
     """:func:`_prepare`, renewed when the robot's model or task file changes."""
     model_file = robots.load(robot).path
     stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
@@ -395,13 +441,10 @@ def _prepared(robot: str, task: str, friction_model: str):
 
 
 @functools.lru_cache(maxsize=8)
-def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps: int):
-    """What every run of a robot, task and friction model shares, computed once per process
+def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps: int) -> Prepared:
+    """The :class:`Prepared` of a robot, task and friction model, computed once per process
     (``file_stamps``, the modification times of the model and task files, renew it on edits).
-
-    The compiled simulation model (``Batch`` works on copies of it), the task path, the reference
-    at every physics step and the drive set-points with their nominal feedforward. Arrays are
-    made read-only so no run can change what the next one gets.
+    Arrays are made read-only so no run can change what the next one gets.
     """
     robot = robots.load(robot_name)
     sim = build(robot, friction_model)
@@ -413,13 +456,13 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
-    return sim, task, path, q_ref, inputs
+    return Prepared(sim, task, path, q_ref, inputs)
 
 
 def cycle_duration(robot: str, task: str) -> float:
     """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle)."""
-    sim, _, _, _, inputs = _prepared(robot, task, "stribeck")  # builds for any model file
-    return (len(inputs) - 1) * sim.model.opt.timestep
+    prepared = _prepared(robot, task, "stribeck")  # builds for any model file
+    return (len(prepared.inputs) - 1) * prepared.sim.model.opt.timestep
 
 
 def _padded_steps(n: int, per_log: int) -> int:
@@ -446,18 +489,19 @@ class _Raw:
     tau_f: np.ndarray
 
 
-def _new_batch(sim: SimModel, config: RunConfig, n_sim: int, q0: np.ndarray) -> mjbatch.Batch:
+def _new_batch(sim: SimModel, work: _Work) -> mjbatch.Batch:
     """One simulation per recorded cycle, all at the task's start state."""
-    batch = mjbatch.Batch(sim.model, nsim=n_sim, nthread=config.nthread)
-    batch.qpos, batch.qvel = start_state(sim.robot, q0)
+    batch = mjbatch.Batch(sim.model, nsim=len(work.cycles), nthread=work.nthread)
+    batch.qpos, batch.qvel = start_state(sim.robot, work.q0)
     batch.act = 0.0
     return batch
 
 
-def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar) -> _Raw:
+def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
     """All physics in MuJoCo: set-points and disturbances handed over one chunk at a time."""
     robot, model = sim.robot, sim.model
-    batch = _new_batch(sim, config, len(cycles), q0)
+    cycles, multiplier, inputs, dist, per_log = work.cycles, work.multiplier, work.inputs, work.dist, work.per_log
+    batch = _new_batch(sim, work)
     bias = batch.expand("actuator_biasprm")
     bias[:, sim.lugre_ids, 3] *= multiplier  # Coulomb level F_c
     bias[:, sim.lugre_ids, 4] *= multiplier  # breakaway level F_s
@@ -498,10 +542,11 @@ def _step_lugre(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar)
     return _Raw(**logs)
 
 
-def _step_stribeck(sim, config, cycles, multiplier, q0, inputs, dist, per_log, bar) -> _Raw:
+def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     """Static friction: the friction-loss level follows the rotor speed before every step."""
     robot, model = sim.robot, sim.model
-    batch = _new_batch(sim, config, len(cycles), q0)
+    cycles, multiplier, inputs, dist, per_log = work.cycles, work.multiplier, work.inputs, work.dist, work.per_log
+    batch = _new_batch(sim, work)
     frictionloss = batch.expand("dof_frictionloss")
     qvel, qpos = batch.bind("qvel"), batch.bind("qpos")
     ctrl, applied = batch.bind("ctrl"), batch.bind("qfrc_applied")
