@@ -8,7 +8,7 @@ The workflow (:func:`calibrate`, ``faultgen calibrate``):
 2. predict the torque with the nominal model (:func:`predict`: the inverse dynamics plus what the
    flexible gearboxes change, :mod:`faultgen.calibrate.gearbox`) and split the record in time into a fitting part and a held-out part
    (:class:`faultgen.calibrate.search.Split`); every gap is reported on the held-out part;
-3. fit every effect of the library (:mod:`faultgen.calibrate.effects`) to the residual and pick
+3. fit every effect of the library (:mod:`faultgen.effects`) to the residual and pick
    the one that explains it best (:mod:`faultgen.calibrate.search`);
 4. write it into the model (MJCF), recompute the residual with the augmented model and repeat
    until no effect is significant;
