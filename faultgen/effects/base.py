@@ -168,6 +168,9 @@ class Effect:
     ValueError
         For an unknown parameter name or a value of the wrong shape or non-finite.
 
+    Each parameter is a read-only attribute of that name (``effect.offset``, ndarray of shape (6,),
+    or a 0-d array when robot-wide); :meth:`values` and :meth:`table` give plain numbers.
+
     Attributes
     ----------
     id : str
@@ -228,6 +231,7 @@ class Effect:
                                  + (f" or {N_AXES}, one per axis" if self.per_axis else "")) from None
             if not np.all(np.isfinite(value)):
                 raise ValueError(f"{self.id}: parameter {name!r} holds a non-finite value")
+            value.setflags(write=False)  # an instance is a value: a change makes a new one (fitted)
             table[name] = value
         self._values = table
 

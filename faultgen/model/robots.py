@@ -123,8 +123,7 @@ class Robot:
         # load() hands the same Robot to every caller: its arrays are read-only
         arrays = [self.gear_ratio, self.motor_inertia, self.gearbox_stiffness, self.gearbox_damping,
                   self.joint_range, self.motor_torque_limit, self.home]
-        arrays += [getattr(self.friction, name) for name in FRICTION_FIELDS]
-        arrays += [value for effect in self.effects.values() for value in vars(effect)["_values"].values()]
+        arrays += [getattr(self.friction, name) for name in FRICTION_FIELDS]  # effects are read-only already
         for array in arrays:
             array.setflags(write=False)
         object.__setattr__(self, "_threads", threading.local())
@@ -392,7 +391,8 @@ def load(name: str | Path) -> Robot:
     -------
     Robot
         Compiled once per process for each MJCF path and content (its bytes' SHA-1; files it
-        includes are not hashed): later calls return the same object, whose arrays are read-only.
+        includes are not hashed): later calls return the same object, whose arrays are read-only
+        (do not change its ``model`` either; :meth:`Robot.edited` makes a changed copy).
 
     Raises
     ------
