@@ -11,7 +11,7 @@ along the motor motion) give
     M(q) e'' + D e' + K e = load(t),
 
 and the drive torque differs from the rigid prediction by ``K e + D e' - load = -M e''``. With
-backlash b (:class:`faultgen.effects.Backlash`) the spring has a dead band, ``K e`` becomes
+backlash b (:class:`faultgen.effects.backlash.Backlash`) the spring has a dead band, ``K e`` becomes
 ``S(e) = K sign(e) max(|e| - b/2, 0)`` per axis: when the load reverses the arm crosses the
 gap, feels no spring while it does (the motor's motion does not reach it), and lands on the
 other flank. ``M`` is the arm's inertia matrix along the measured motion
@@ -52,7 +52,7 @@ from __future__ import annotations
 import numpy as np
 
 from faultgen.data import measured
-from faultgen.effects import Backlash
+from faultgen.effects.backlash import Backlash
 from faultgen.model import robots
 
 #: Longest sub-step, s. The average-acceleration rule's period error is about (w h)^2 / 12: 0.8 %
@@ -90,7 +90,7 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     ----------
     robot : Robot
         Gives K, D (:attr:`Robot.gearbox_stiffness`, ``gearbox_damping``), the arm's inertia
-        matrix (:meth:`Robot.arm_mass_matrix`) and the backlash (:class:`faultgen.effects.Backlash`) unless
+        matrix (:meth:`Robot.arm_mass_matrix`) and the backlash (:class:`faultgen.effects.backlash.Backlash`) unless
         ``backlash`` is given.
     t : ndarray of shape (n,)
         Sample times, s, increasing.

@@ -18,10 +18,15 @@ cogging                    amplitude (N m, motor side), poles (1), phase    nume
 backlash                   width (rad, arm side)                            tendon gearbox{i} springlength
 =========================  ===============================================  ======================
 
-The table's order is the registration order, the order in which the calibration tries them.
+The table's order is the effects' :attr:`~faultgen.effects.base.Effect.rank`, the order in which
+the calibration tries them. Every module of this package but ``base`` and ``friction`` is one
+effect, imported (and so registered) with the package.
 This is the lowest layer of faultgen: it imports nothing else of it (the robot it is given is
 used through its attributes).
 """
+
+import importlib
+import pkgutil
 
 from faultgen.effects.base import (
     EFFECTS,
@@ -36,21 +41,11 @@ from faultgen.effects.base import (
     register,
 )
 
-# Registration order is identification order: keep it (ties in the calibration go to the earlier).
-# isort: off
-from faultgen.effects.torque_offset import TorqueOffset
-from faultgen.effects.coulomb import Coulomb
-from faultgen.effects.viscous import Viscous
-from faultgen.effects.stribeck import Stribeck
-from faultgen.effects.load_dependent_friction import LoadDependentFriction
-from faultgen.effects.temperature import Temperature
-from faultgen.effects.payload import Payload
-from faultgen.effects.cogging import Cogging
-from faultgen.effects.backlash import Backlash
-# isort: on
+# Every other module of this package defines one effect, registered when it is imported: adding
+# an effect is adding a module.
+for _module in pkgutil.iter_modules(__path__):
+    if _module.name not in ("base", "friction"):
+        importlib.import_module(f"{__name__}.{_module.name}")
 
-__all__ = [
-    "EFFECTS", "REST_SPEED", "Backlash", "Cogging", "Coulomb", "Effect", "FrictionParameter",
-    "LoadDependentFriction", "ModelError", "Motion", "Payload", "Stribeck", "Temperature", "TorqueOffset",
-    "Viscous", "get", "make", "read_all", "register",
-]
+__all__ = ["EFFECTS", "REST_SPEED", "Effect", "FrictionParameter", "ModelError", "Motion", "get", "make", "read_all",
+           "register"]

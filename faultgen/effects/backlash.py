@@ -44,6 +44,7 @@ class Backlash(Effect):
     """
 
     id = "backlash"
+    rank = 90
     summary = "gearbox backlash (dead band between motor and arm)"
     units: ClassVar[dict[str, str]] = {"width": "rad (arm side)"}
     absent = (0.0,)

@@ -97,7 +97,7 @@ class Motion:
 
 
 #: Every effect, by id, in the order they are tried in identification (ties go to the earlier,
-#: simpler one): the order of registration, set by the imports of :mod:`faultgen.effects`.
+#: simpler one): by :attr:`Effect.rank`.
 EFFECTS: dict[str, Effect] = {}
 
 
@@ -113,6 +113,9 @@ def register(cls: type[Effect]) -> type[Effect]:
     if cls.id in EFFECTS and type(EFFECTS[cls.id]) is not cls:
         raise ValueError(f"effect {cls.id!r} is already registered to {type(EFFECTS[cls.id]).__name__}")
     EFFECTS[cls.id] = cls()
+    ordered = sorted(EFFECTS.items(), key=lambda item: (item[1].rank, item[0]))
+    EFFECTS.clear()
+    EFFECTS.update(ordered)
     return cls
 
 
@@ -175,6 +178,9 @@ class Effect:
     ----------
     id : str
         Stable effect id used in ``report.json``.
+    rank : int
+        Place in the calibration's search order (:data:`EFFECTS`; ties go to the lower rank: the
+        simpler effect, with fewer parameters).
     summary : str
         One line: the physics, for ``--help`` and the report.
     units : dict
@@ -198,6 +204,7 @@ class Effect:
     """
 
     id: ClassVar[str]
+    rank: ClassVar[int] = 100
     summary: ClassVar[str]
     units: ClassVar[dict[str, str]]
     absent: ClassVar[tuple[float, ...]]

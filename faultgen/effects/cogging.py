@@ -23,6 +23,7 @@ class Cogging(Effect):
     """
 
     id = "cogging"
+    rank = 80
     summary = "cogging torque (periodic in the motor angle)"
     units: ClassVar[dict[str, str]] = {"amplitude": "N m (motor side)", "poles": "1", "phase": "rad"}
     absent = (0.0, 0.0, 0.0)

@@ -19,6 +19,7 @@ class Coulomb(FrictionParameter):
     """
 
     id = "coulomb"
+    rank = 20
     summary = "Coulomb friction level differs (constant torque against the motion)"
     units: ClassVar[dict[str, str]] = {"coulomb_pos": "N m (motor side)", "coulomb_neg": "N m (motor side)"}
     absent = (0.0, 0.0)

@@ -21,6 +21,7 @@ class LoadDependentFriction(Effect):
     """
 
     id = "load_dependent_friction"
+    rank = 50
     summary = "friction that grows with the gearbox load"
     units: ClassVar[dict[str, str]] = {"coefficient": "1"}
     absent = (0.0,)

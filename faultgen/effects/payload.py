@@ -21,6 +21,7 @@ class Payload(Effect):
     """
 
     id = "payload"
+    rank = 70
     summary = "an unmodelled payload (mass at the flange)"
     units: ClassVar[dict[str, str]] = {"mass": "kg"}
     absent = (0.0,)

@@ -21,6 +21,7 @@ class Stribeck(FrictionParameter):
     """
 
     id = "stribeck"
+    rank = 40
     summary = "Stribeck friction (extra friction at low speed, fading with speed) differs"
     units: ClassVar[dict[str, str]] = {"static": "N m (motor side)", "stribeck_velocity": "rad/s (motor side)"}
     absent = (0.0, 1.0)

@@ -22,6 +22,7 @@ class Temperature(Effect):
     """
 
     id = "temperature"
+    rank = 60
     summary = "friction drifting with time (a gearbox warming up)"
     units: ClassVar[dict[str, str]] = {"amplitude": "1", "time_constant": "s"}
     absent = (0.0, 1.0)

@@ -21,6 +21,7 @@ class TorqueOffset(Effect):
     """
 
     id = "torque_offset"
+    rank = 10
     summary = "a constant torque offset"
     units: ClassVar[dict[str, str]] = {"offset": "N m (arm side)"}
     absent = (0.0,)

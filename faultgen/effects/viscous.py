@@ -17,6 +17,7 @@ class Viscous(FrictionParameter):
     """
 
     id = "viscous"
+    rank = 30
     summary = "viscous friction differs (torque proportional to speed)"
     units: ClassVar[dict[str, str]] = {"viscous": "N m s/rad (motor side)"}
     absent = (0.0,)
