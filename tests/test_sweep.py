@@ -127,10 +127,19 @@ def test_a_killed_merge_leaves_debris_that_the_next_sweep_removes_and_reports(tm
     assert dataset.validate(out) == []
 
 
+def _as_a_terminal_starts_it() -> None:
+    """A shell starts a foreground command with SIGINT at its default action and unblocked. The
+    test process may have inherited it ignored (an xdist worker once had: the sweep then ran to the
+    end and exited 0), and an ignored signal stays ignored across exec, as ``nohup`` relies on."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def test_ctrl_c_stops_the_workers_and_says_what_is_kept_and_how_to_resume(tmp_path):
     out = tmp_path / "interrupted.h5"
     parts = sweep.parts_folder(out)
     proc = subprocess.Popen(_sweep_command(out, jobs=2), cwd=tmp_path, start_new_session=True,
+                            preexec_fn=_as_a_terminal_starts_it,  # noqa: PLW1509 (no threads of ours here)
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     _wait_for(lambda: len(list(parts.glob("*.h5"))) >= 1, "a finished run")
     os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does: every process of the group
