@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-import mujoco
 import numpy as np
 
 from faultgen.effects.base import Effect, register
+from faultgen.effects.friction import add_passive_dcmotor
 
 
 @register
@@ -39,10 +39,8 @@ class Cogging(Effect):
         for k, rotor in enumerate(robot.rotor_names):
             if not self.amplitude[k]:
                 continue
-            actuator = spec.add_actuator(name=f"cogging{k + 1}", target=rotor)
-            actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
-            actuator.set_to_dcmotor(motorconst=[0.0, 0.0], resistance=1.0, ctrlspec=16,
-                                    cogging=[float(self.amplitude[k]), float(self.poles[k]), float(self.phase[k])])
+            add_passive_dcmotor(spec, f"cogging{k + 1}", rotor,
+                                cogging=[float(self.amplitude[k]), float(self.poles[k]), float(self.phase[k])])
 
     def grid(self, motion, axis):
         return list(self.POLES)

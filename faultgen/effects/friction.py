@@ -250,11 +250,18 @@ def add_lugre(spec, robot) -> None:
     """
     table = lugre_parameters(robot.friction)
     for k, rotor in enumerate(robot.rotor_names):
-        actuator = spec.add_actuator(name=f"lugre{k + 1}", target=rotor)
-        actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
-        actuator.set_to_dcmotor(motorconst=[0.0, 0.0], resistance=1.0, lugre=[float(v) for v in table[k]],
-                                ctrlspec=16)  # input "none"
+        actuator = add_passive_dcmotor(spec, f"lugre{k + 1}", rotor, lugre=[float(v) for v in table[k]])
         actuator.damping[0] = float(robot.friction.viscous[k])
+
+
+def add_passive_dcmotor(spec, name: str, rotor: str, **terms):
+    """Add a ``dcmotor`` actuator ``name`` on the joint ``rotor`` with no input (``ctrlspec`` 16,
+    "none") and no electrical branch, whose only force is its ``terms`` (``lugre=...``,
+    ``cogging=...``: MuJoCo computes them in C at the physics rate); returns the actuator."""
+    actuator = spec.add_actuator(name=name, target=rotor)
+    actuator.trntype = mujoco.mjtTrn.mjTRN_JOINT
+    actuator.set_to_dcmotor(motorconst=[0.0, 0.0], resistance=1.0, ctrlspec=16, **terms)
+    return actuator
 
 
 def add_stribeck(spec, robot) -> None:

@@ -27,6 +27,7 @@ from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
 from faultgen.effects import friction
+from faultgen.effects.base import Effect
 from faultgen.model import robots
 from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan
@@ -558,20 +559,18 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     G = robot.gear_ratio
     dt = model.opt.timestep
     run_start = (cycles[:, None] - 1) * n_steps * dt  # a drift with time runs over the whole run
-    stepped = _stepped(robot)
+    # the stepped effects that scale the dry friction and those that add to it, sorted once
+    factors = [e for e in _stepped(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
+    extras = [e for e in _stepped(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
     for step in range(n_steps):
         level = multiplier
-        for effect in stepped:
-            factor = effect.dry_friction_factor(run_start + step * dt)
-            if factor is not None:
-                level = level * factor
+        for effect in factors:
+            level = level * effect.dry_friction_factor(run_start + step * dt)
         frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
-        if stepped:  # the gearbox deflection (eq. 6.2a) carries the load
+        if extras:  # the gearbox deflection (eq. 6.2a) carries the load
             deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
-            for effect in stepped:
-                extra = effect.dry_friction_extra(robot, deflection)
-                if extra is not None:
-                    frictionloss[:, rotor] += extra
+            for effect in extras:
+                frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection)
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
         logged = (step + 1) % per_log == 0
