@@ -24,6 +24,7 @@ from tqdm.auto import tqdm
 
 from analysis import isolation
 from analysis.monitoring import detect_onset
+from faultgen import axes
 from faultgen.data import dataset
 
 #: Wear levels of thesis Table 6.2, in percent.
@@ -164,7 +165,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     for run_id, arrays, attrs in worn:
         axis = int(attrs["worn_axes"][0])
         for level in levels:
-            k = level_cycle(arrays["friction_multiplier"][:, axis - 1], level)
+            k = level_cycle(arrays["friction_multiplier"][:, axes.index(axis)], level)
             if k is not None:
                 seen.setdefault((attrs["robot"], attrs["task"], level), k + 1)
                 cases.append((run_id, arrays, attrs, axis, level, k + 1))
@@ -198,7 +199,7 @@ def motor_speed_coverage(path, speed_window: tuple[float, float]) -> pd.DataFram
         speed = np.abs(arrays["qd_m"]).reshape(-1, arrays["qd_m"].shape[-1])
         inside = (speed >= speed_window[0]) & (speed <= speed_window[1])
         for a in range(speed.shape[1]):
-            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, axis=a + 1,
+            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, axis=axes.number(a),
                              p50_rad_s=np.percentile(speed[:, a], 50), p99_rad_s=np.percentile(speed[:, a], 99),
                              in_window_pct=100.0 * inside[:, a].mean()))
     table = pd.DataFrame(rows)
@@ -249,8 +250,8 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
     cols = min(3, len(isolators))
     rows = -(-len(isolators) // cols)
     fig = Figure(figsize=(4.6 * cols, 4.0 * rows))
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
-    for ax, name in zip(axes, isolators, strict=False):
+    panels = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax, name in zip(panels, isolators, strict=False):
         matrix = confusion.loc[name]
         values = matrix.to_numpy(dtype=float)
         share = values / np.maximum(values.sum(axis=1, keepdims=True), 1)
@@ -263,7 +264,7 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
         ax.set_xticks(range(values.shape[1]), ["undec.", *map(str, range(1, 7)), "short"], fontsize=8)
         ax.set_yticks(range(values.shape[0]), matrix.index, fontsize=8)
         ax.set(title=name, xlabel="named axis", ylabel="true worn axis")
-    for ax in axes[len(isolators):]:
+    for ax in panels[len(isolators):]:
         ax.set_visible(False)
     fig.suptitle("isolation confusion: true worn axis (none = run without wear) x named axis "
                  "(undec. = undecided, short = too few cycles); shade: share of the row")

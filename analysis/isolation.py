@@ -17,6 +17,8 @@ from sklearn.base import BaseEstimator
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_array
 
+from faultgen import axes
+
 #: Isolator classes by name, for :func:`make`; extend with :func:`register`.
 ISOLATORS: dict[str, type] = {}
 
@@ -65,7 +67,7 @@ def _pick(scores: np.ndarray) -> int:
     if np.isnan(scores).any():
         return 0
     best = np.flatnonzero((scores == scores.max()) | np.isclose(scores, scores.max(), rtol=1e-9, atol=1e-12))
-    return int(best[0]) + 1 if best.size == 1 else 0
+    return axes.number(best[0]) if best.size == 1 else 0
 
 
 class Isolator(BaseEstimator):
@@ -396,7 +398,7 @@ def source_from_lags(lag, allow_zero_lag: bool = False) -> int:
     ok = ((lag < 0) | ~off).all(axis=1)
     if allow_zero_lag:
         ok = ((lag <= 0) | ~off).all(axis=1) & ((lag < 0) & off).any(axis=1)
-    return int(np.flatnonzero(ok)[0]) + 1 if ok.sum() == 1 else 0
+    return axes.number(np.flatnonzero(ok)[0]) if ok.sum() == 1 else 0
 
 
 # --- baselines an expert would compare against ---------------------------------------------------

@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
+from faultgen import axes
 from faultgen.calibrate import EFFECTS, calibrate, synth
 from faultgen.model import robots
 
@@ -41,11 +42,11 @@ def case(robot_name: str, effect: str | None, seed: int, size_range=synth.SIZE_R
     if effect is None:
         named = first is None
     else:
-        named = first is not None and first.effect == effect and first.axes == hidden.axes
+        named = first is not None and first.effect.id == effect and first.axes == hidden.axes
     before, after = result.gap_before["total_nrmse"], result.gap_after["total_nrmse"]
     return {
-        "robot": robot_name, "effect": effect or "none", "seed": seed, "hidden_axes": hidden.axes,
-        "size": round(hidden.size, 3), "found": " | ".join(f"{s.effect} {s.axes}" for s in result.steps) or "-",
+        "robot": robot_name, "effect": effect or "none", "seed": seed, "hidden_axes": axes.numbers(hidden.axes),
+        "size": round(hidden.size, 3), "found": " | ".join(f"{s.effect.id} {axes.numbers(s.axes)}" for s in result.steps) or "-",
         "named": named, "gap_before": before, "gap_after": after, "ratio": after / before,
         "closed": effect is None or after <= 0.5 * before, "seconds": time.perf_counter() - started,
     }

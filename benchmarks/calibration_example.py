@@ -27,14 +27,12 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     robot = robots.load("puma560")
     friction = robot.friction  # both Coulomb levels of axis 5 0.03 N m (motor side) higher
-    hidden = {"payload": {"robot": {"mass": 2.2}},
-              "coulomb": {"5": {"coulomb_pos": float(friction.coulomb_pos[4] + 0.03),
-                                "coulomb_neg": float(friction.coulomb_neg[4] + 0.03)}}}
-    model = synth.write_model(robot, synth.Hidden("payload", [1, 2, 3, 4, 5, 6], hidden["payload"]),
-                              args.out / "hidden_model")
-    with_both = robots.load(model)
-    log = synth.record(with_both, synth.Hidden("coulomb", [5], hidden["coulomb"]), args.out / "measured.csv", seed=3)
-    print(f"hidden: {hidden}\nmeasured log: {log}", flush=True)
+    payload = synth.Hidden.of(robot, "payload", {None: {"mass": 2.2}})
+    coulomb = synth.Hidden.of(robot, "coulomb", {4: {"coulomb_pos": float(friction.coulomb_pos[4] + 0.03),
+                                                     "coulomb_neg": float(friction.coulomb_neg[4] + 0.03)}})
+    with_both = robots.load(synth.write_model(robot, payload, args.out / "hidden_model"))
+    log = synth.record(with_both, coulomb, args.out / "measured.csv", seed=3)
+    print(f"hidden: {payload}, {coulomb}\nmeasured log: {log}", flush=True)
     subprocess.run([sys.executable, "-m", "faultgen.cli", "calibrate", "--robot", "puma560", "--measured", str(log),
                     "--out", str(args.out / "calibration")], check=True)
     args.figure.parent.mkdir(parents=True, exist_ok=True)

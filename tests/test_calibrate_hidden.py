@@ -60,7 +60,7 @@ def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_n
     hidden, result = hidden_case(tmp_path, robot_name, effect, seed)
     assert result.steps, f"nothing found; hidden {hidden}"
     first = result.steps[0]
-    assert (first.effect, first.axes) == (hidden.effect, hidden.axes), f"hidden {hidden}, found {result.summary()}"
+    assert (first.effect.id, first.axes) == (hidden.effect.id, hidden.axes), f"hidden {hidden}, found {result.summary()}"
     bound = SHORT.get((robot_name, effect), HALF)
     assert result.gap_after["total_nrmse"] <= bound * result.gap_before["total_nrmse"], result.summary()
 
@@ -88,7 +88,7 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     step = report["steps"][0]
     assert step["effect"] == "payload" and step["axes"] == [1, 2, 3, 4, 5, 6]
     mass = step["params"]["robot"]["mass"]
-    assert mass == pytest.approx(hidden.params["robot"]["mass"], rel=0.05)
+    assert mass == pytest.approx(hidden.effect.mass, rel=0.05)
     assert step["evidence"]["scores"]["payload"] == pytest.approx(step["evidence"]["score"])
     assert (out / "calibration.png").stat().st_size > 10_000
     mask = os.umask(0)
@@ -140,17 +140,17 @@ def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
     tie of the search's ranking: payload first before the convergence work (0.2372 -> 0.1191 ->
     0.0129), Coulomb first since (0.2366 -> 0.1304 -> 0.0124); both are found, with their values."""
     robot = robots.load("puma560")
-    payload = synth.Hidden("payload", [1, 2, 3, 4, 5, 6], {"robot": {"mass": 2.2}})
+    payload = synth.Hidden.of(robot, "payload", {None: {"mass": 2.2}})
     with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
     friction = robot.friction  # both of axis 5's Coulomb levels 0.03 N m higher
-    coulomb = synth.Hidden("coulomb", [5], {"5": {"coulomb_pos": friction.coulomb_pos[4] + 0.03,
-                                                  "coulomb_neg": friction.coulomb_neg[4] + 0.03}})
+    coulomb = synth.Hidden.of(robot, "coulomb", {4: {"coulomb_pos": friction.coulomb_pos[4] + 0.03,
+                                                     "coulomb_neg": friction.coulomb_neg[4] + 0.03}})
     path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3)
     result = calibrate("puma560", path, tmp_path / "out")
-    found = {s.effect: s for s in result.steps}
-    assert sorted((s.effect, s.axes) for s in result.steps) == [("coulomb", [5]), ("payload", [1, 2, 3, 4, 5, 6])]
-    assert found["payload"].params["robot"]["mass"] == pytest.approx(2.2, rel=0.03)
-    change = found["coulomb"].params["5"]["coulomb_pos"] - robot.friction.coulomb_pos[4]
+    found = {s.effect.id: s for s in result.steps}
+    assert sorted((s.effect.id, s.axes) for s in result.steps) == [("coulomb", [4]), ("payload", [0, 1, 2, 3, 4, 5])]
+    assert found["payload"].effect.mass == pytest.approx(2.2, rel=0.03)
+    change = found["coulomb"].effect.coulomb_pos[4] - robot.friction.coulomb_pos[4]
     assert change == pytest.approx(0.03, rel=0.03)
     assert result.steps[0].gap_after["total_nrmse"] < result.gap_before["total_nrmse"]
     assert result.gap_after["total_nrmse"] < 0.15 * result.gap_before["total_nrmse"]

@@ -25,21 +25,21 @@ def path():
     return robot, motion
 
 
-def toolbox_log(tmp_path, robot, motion, effect, params):
+def toolbox_log(tmp_path, robot, motion, hidden):
     toolbox = rtb.models.DH.Puma560()
     q, qd, qdd = motion.q, motion.qd, motion.qdd
     G = robot.gear_ratio
+    effect = hidden.effect.id if hidden.effect is not None else None
     if effect == "payload":
-        toolbox.payload(params["robot"]["mass"], [0.0, 0.0, 0.0])
+        toolbox.payload(float(hidden.effect.mass), [0.0, 0.0, 0.0])
     tau = np.asarray(toolbox.rne(q, qd, qdd))
-    for axis, p in params.items():
+    for k in hidden.axes if effect in ("stribeck", "cogging") else []:
+        p = hidden.effect.values(k)
         if effect == "stribeck":
-            k = int(axis) - 1
             v = G[k] * qd[:, k]
             hump = p["static"] * np.exp(-(v / p["stribeck_velocity"]) ** 2)
             tau[:, k] += G[k] * hump * np.sign(v)
         elif effect == "cogging":
-            k = int(axis) - 1
             # the drive holds against the detent torque A sin(p theta_m + phase)
             tau[:, k] -= G[k] * p["amplitude"] * np.sin(p["poles"] * G[k] * q[:, k] + p["phase"])
     rng = np.random.default_rng(SEED)
@@ -52,16 +52,16 @@ def toolbox_log(tmp_path, robot, motion, effect, params):
 def test_effect_added_to_toolbox_data_is_named(tmp_path, path, effect):
     robot, motion = path
     hidden = synth.draw(robot, effect, np.random.default_rng(SEED))
-    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, effect, hidden.params), tmp_path / "out")
+    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, hidden), tmp_path / "out")
     assert result.steps, f"nothing found; hidden {hidden}"
     first = result.steps[0]
-    assert (first.effect, first.axes) == (effect, hidden.axes), result.summary()
+    assert (first.effect.id, first.axes) == (effect, hidden.axes), result.summary()
     assert result.gap_after["total_nrmse"] <= 0.5 * result.gap_before["total_nrmse"], result.summary()
     if effect == "payload":
-        assert first.params["robot"]["mass"] == pytest.approx(hidden.params["robot"]["mass"], rel=0.05)
+        assert first.effect.mass == pytest.approx(hidden.effect.mass, rel=0.05)
 
 
 def test_toolbox_data_without_an_effect_names_nothing(tmp_path, path):
     robot, motion = path
-    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, None, {}), tmp_path / "out")
+    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, synth.Hidden(None)), tmp_path / "out")
     assert result.steps == [], result.summary()

@@ -60,11 +60,11 @@ def test_coulomb_comes_back_from_its_own_regressor(puma):
     assert best.effect.id == "coulomb" and best.axes == [2]
     # parameters are absolute: the nominal levels plus the change, in both directions
     friction = motion.robot.friction
-    assert best.params["3"]["coulomb_pos"] - friction.coulomb_pos[2] == pytest.approx(0.07, rel=0.02)
-    assert best.params["3"]["coulomb_neg"] - friction.coulomb_neg[2] == pytest.approx(0.07, rel=0.02)
-    fitted = best.fitted(motion.robot)
-    assert fitted.coulomb_pos[2] == best.params["3"]["coulomb_pos"]
-    assert fitted.coulomb_pos[1] == friction.coulomb_pos[1]  # other axes as they were
+    assert best.effect.coulomb_pos[2] - friction.coulomb_pos[2] == pytest.approx(0.07, rel=0.02)
+    assert best.effect.coulomb_neg[2] - friction.coulomb_neg[2] == pytest.approx(0.07, rel=0.02)
+    # report.json numbers the axis as a user does and gives only the significant one
+    assert best.effect.report(best.axes) == {"3": {"coulomb_pos": best.effect.coulomb_pos[2],
+                                                   "coulomb_neg": best.effect.coulomb_neg[2]}}
 
 
 def test_payload_mass_comes_back(puma):
@@ -76,7 +76,8 @@ def test_payload_mass_comes_back(puma):
     split = search.Split.of(motion.t, motion.qd)
     best = search.rank(motion, residual, tau, split)[0]
     assert best.effect.id == "payload" and best.axes == list(range(6))
-    assert best.params["robot"]["mass"] == pytest.approx(1.7, rel=0.02)
+    assert best.effect.mass == pytest.approx(1.7, rel=0.02)
+    assert best.effect.report(best.axes) == {"robot": {"mass": float(best.effect.mass)}}
 
 
 def test_stribeck_velocity_is_refined_off_the_grid(puma):
@@ -90,7 +91,7 @@ def test_stribeck_velocity_is_refined_off_the_grid(puma):
     residual[:, axis] = phi[:, 0] * 0.02 + offset
     split = search.Split.of(motion.t, motion.qd)
     candidate = search.fit_effect(effect, motion, residual, tau, split)
-    params = candidate.all_params[str(axis + 1)]
+    params = candidate.effect.values(axis)
     assert params["stribeck_velocity"] == pytest.approx(v_s, rel=0.01)
     assert params["static"] == pytest.approx(0.02, rel=0.01)
 
@@ -111,5 +112,5 @@ def test_unphysical_fit_is_never_selected(puma):
     residual = -2.0 * phi[:, :, 0]
     split = search.Split.of(motion.t, motion.qd)
     candidate = search.fit_effect(effects.get("payload"), motion, residual, tau, split)
-    assert candidate.all_params["robot"]["mass"] == pytest.approx(-2.0, rel=1e-6)
+    assert candidate.effect.mass == pytest.approx(-2.0, rel=1e-6)
     assert candidate.axes == []

@@ -22,12 +22,13 @@ from __future__ import annotations
 import json
 import shutil
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from faultgen import axes
 from faultgen.calibrate import gearbox, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
@@ -49,28 +50,28 @@ class Step:
 
     Attributes
     ----------
-    effect : str
-        Effect id.
+    effect : Effect
+        The effect as the model holds it after the step: absolute parameters on every axis, in SI
+        units (:attr:`faultgen.effects.Effect.units`); the step changed them on ``axes`` only.
     axes : list of int
-        Axes it was added on, 1-based.
-    params : dict
-        Absolute physical parameters after the step per axis (``"1"``..``"6"``) or for the robot
-        (``"robot"``), named as the effect names them (:attr:`faultgen.effects.Effect.units`).
-    units : dict
-        The unit of each parameter.
+        Axes it was added on, 0-based (:meth:`record` numbers them 1..6).
     evidence : dict
         Why it was chosen: held-out gain per axis, the score, the runner-up and every effect's
-        score.
+        score (axes numbered 1..6).
     gap_after : dict
         Held-out gap of the model with this and all earlier effects (see :func:`search.gap`).
     """
 
-    effect: str
+    effect: Effect
     axes: list[int]
-    params: dict
     evidence: dict
     gap_after: dict
-    units: dict = field(default_factory=dict)
+
+    def record(self) -> dict:
+        """The step in ``report.json``: effect id, axes numbered 1..6, the parameters on them
+        (:meth:`faultgen.effects.Effect.report`) with their units, the evidence and the gap after."""
+        return {"effect": self.effect.id, "axes": axes.numbers(self.axes), "params": self.effect.report(self.axes),
+                "units": dict(self.effect.units), "evidence": self.evidence, "gap_after": self.gap_after}
 
 
 @dataclass(frozen=True)
@@ -116,8 +117,7 @@ class Calibration:
             "robot": self.robot,
             "measured": self.measured,
             "gap_before": self.gap_before,
-            "steps": [{"effect": s.effect, "axes": s.axes, "params": s.params, "units": s.units,
-                       "evidence": s.evidence, "gap_after": s.gap_after} for s in self.steps],
+            "steps": [s.record() for s in self.steps],
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
         }
@@ -127,16 +127,17 @@ class Calibration:
         lines = [f"{self.robot}: held-out total nrmse {self.gap_before['total_nrmse']:.4f} (nominal model)"]
         if not self.steps:
             lines.append("no significant missing effect found")
-        for k, s in enumerate(self.steps, start=1):
+        for k, step in enumerate(self.steps, start=1):
+            s = step.record()
             values = "; ".join(
                 f"{'axis ' + where if where != 'robot' else 'robot'}: "
-                + ", ".join(f"{name} = {value:.4g}{_unit(s.units.get(name, '1'))}" for name, value in p.items())
-                for where, p in s.params.items())
-            lines.append(f"{k}. {s.effect} on axes {', '.join(map(str, s.axes))} -> total nrmse "
-                         f"{s.gap_after['total_nrmse']:.4f}  ({values})")
+                + ", ".join(f"{name} = {value:.4g}{_unit(s['units'][name])}" for name, value in p.items())
+                for where, p in s["params"].items())
+            lines.append(f"{k}. {s['effect']} on axes {', '.join(map(str, s['axes']))} -> total nrmse "
+                         f"{s['gap_after']['total_nrmse']:.4f}  ({values})")
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
-        stepped = any(get(s.effect).stepped for s in self.steps)
+        stepped = any(s.effect.stepped for s in self.steps)
         friction = " --friction stribeck" if stepped else ""
         lines.append(f"simulate it: faultgen simulate --model {self.model_out}{friction}")
         return "\n".join(lines)
@@ -204,7 +205,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             best = ranked[0]
             if not best.axes:
                 break
-            best.fitted(current).write(spec, current, best.axes)
+            best.effect.write(spec, current, best.axes)
             trial_path = Path(work) / model_out.name
             trial_path.write_text(spec.to_xml())
             trial = robots.load(trial_path)
@@ -214,10 +215,9 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             if after["total_nrmse"] >= previous["total_nrmse"]:
                 break  # the written model does not do what the fit promised: stop, keep what works
             current, predicted, motion = trial, trial_prediction, trial_motion
-            steps.append(Step(best.effect.id, [a + 1 for a in best.axes], best.params,
-                              _evidence(best, ranked), after, dict(best.effect.units)))
+            steps.append(Step(best.effect, best.axes, _evidence(best, ranked), after))
             if progress:
-                print(f"step {k + 1}: {best.effect.id} on axes {steps[-1].axes}, held-out total nrmse "
+                print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
         atomic.write_text(model_out, Path(current.path).read_text())
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
@@ -290,6 +290,6 @@ def _evidence(best: search.Candidate, ranked: list[search.Candidate]) -> dict:
         "heldout_gain_nrmse": [float(g) for g in best.gain],
         "relative_gain": [float(g) for g in best.relative_gain],
         "runner_up": None if runner_up is None else {"effect": runner_up.effect.id, "score": runner_up.score,
-                                                       "axes": [a + 1 for a in runner_up.axes]},
+                                                       "axes": axes.numbers(runner_up.axes)},
         "scores": {c.effect.id: c.score for c in ranked},
     }

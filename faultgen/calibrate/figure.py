@@ -26,7 +26,8 @@ def save(result, path: str | Path) -> Path:
     nominal = np.where(moving, result.nominal, np.nan)
     calibrated = np.where(moving, result.calibrated, np.nan)
     fig, axes = plt.subplots(6, 2, figsize=(13, 14), sharex=True)
-    added = ", ".join(f"{s.effect} (axes {', '.join(map(str, s.axes))})" for s in result.steps) or "nothing"
+    added = ", ".join(f"{s['effect']} (axes {', '.join(map(str, s['axes']))})"
+                      for s in (step.record() for step in result.steps)) or "nothing"
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
                  f"{result.gap_after['total_nrmse']:.3f}", fontsize=11)

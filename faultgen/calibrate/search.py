@@ -27,7 +27,7 @@ effect is significant on any axis.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -95,10 +95,11 @@ class Candidate:
     Attributes
     ----------
     effect : Effect
+        The fitted effect: the current model's values of it with the fitted parameters on every
+        axis (robot-wide: the fitted ones), significant or not, absolute, in SI units.
     axes : list of int
-        Significant axes, 0-based (all six for a robot-wide effect that is significant).
-    params : dict
-        Per significant axis (1-based string key) or ``"robot"``: the physical parameters.
+        Significant axes, 0-based (all six for a robot-wide effect that is significant; none when
+        the effect explains nothing). Only these are written into the model.
     gain : ndarray of shape (6,)
         Held-out nrmse drop per axis (all axes, significant or not).
     relative_gain : ndarray of shape (6,)
@@ -109,22 +110,14 @@ class Candidate:
 
     effect: Effect
     axes: list[int]
-    params: dict
     gain: np.ndarray
     relative_gain: np.ndarray
     contribution: np.ndarray
-    all_params: dict = field(default_factory=dict)
-
-    def fitted(self, robot) -> Effect:
-        """The effect as fitted: ``robot``'s values of it with the significant axes' new parameters."""
-        return self.effect.fitted(robot, self.params)
 
     @property
     def score(self) -> float:
         """Drop of the held-out ``total_nrmse`` over the significant axes."""
         return float(np.sum(self.gain[self.axes]) / len(self.gain))
-
-
 
 
 def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -184,34 +177,33 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     scale = np.where(scale > 0, scale, 1.0)
     before = _rms(residual, held) / scale
     contribution = np.zeros_like(residual)
-    params: dict = {}
     if effect.per_axis:  # the effect's own search (backlash), else the default optimiser
         fits = effect.search(motion, residual, fit, scale) or AxisLeastSquares().fit(effect, motion, residual, fit, scale)
+        params = {}
         for axis, (h, theta, predicted) in enumerate(fits):
             contribution[:, axis] = predicted
-            params[str(axis + 1)] = effect.params(motion, axis, theta, h)
+            params[axis] = effect.params(motion, axis, theta, h)
     else:
         theta, contribution = RobotLeastSquares().fit(effect, motion, residual, fit, scale)
-        params["robot"] = effect.params(motion, None, theta, None)
+        params = {None: effect.params(motion, None, theta, None)}
+    fitted = effect.fitted(motion.robot, params)
     after = _rms(residual - contribution, held) / scale
     gain = before - after
     relative = gain / np.where(before > 0, before, 1.0)
     significant = (gain >= MIN_GAIN) & (relative >= MIN_RELATIVE_GAIN)
     if effect.per_axis:
-        significant &= [effect.admissible(motion, a, params[str(a + 1)]) for a in range(residual.shape[1])]
+        significant &= [effect.admissible(motion, a, params[a]) for a in range(residual.shape[1])]
         axes = [int(a) for a in np.flatnonzero(significant)]
-        kept = {str(a + 1): params[str(a + 1)] for a in axes}
     else:
         # robot-wide: significant as a whole when the mean gain passes both thresholds
         total_before = float(np.mean(before))
         total_gain = float(np.mean(gain))
         whole = (total_gain >= MIN_GAIN and total_gain >= MIN_RELATIVE_GAIN * total_before
-                 and effect.admissible(motion, None, params["robot"]))
+                 and effect.admissible(motion, None, params[None]))
         axes = list(range(residual.shape[1])) if whole else []
-        kept = params if whole else {}
     mask = np.zeros(residual.shape[1], dtype=bool)
     mask[axes] = True
-    return Candidate(effect, axes, kept, gain, relative, np.where(mask, contribution, 0.0), params)
+    return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0))
 
 
 def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split, progress: bool = False,

@@ -26,7 +26,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.calibrate.effects import Motion, get
+from faultgen import axes
+from faultgen.axes import N_AXES
+from faultgen.calibrate.effects import Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import measured
 from faultgen.model import robots
@@ -66,13 +68,40 @@ INTEGRATOR = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
 
 @dataclass(frozen=True)
 class Hidden:
-    """What was hidden in a log: effect id (None for none), axes (1-based) and parameters in
-    the form of ``report.json`` (per axis ``"1".."6"``, or ``"robot"``)."""
+    """What was hidden in a log.
 
-    effect: str | None
+    Attributes
+    ----------
+    effect : Effect or None
+        The robot's effect with the hidden parameters (absolute, SI units) on ``axes``; None when
+        nothing is hidden.
+    axes : list of int
+        The axes it was hidden on, 0-based (all six for a robot-wide effect).
+    size : float
+        The smallest size on those axes (effect torque RMS over the axis's nominal torque RMS).
+    """
+
+    effect: Effect | None
     axes: list[int] = field(default_factory=list)
-    params: dict = field(default_factory=dict)
     size: float = 0.0
+
+    @classmethod
+    def of(cls, robot: robots.Robot, effect: str, params: dict[int | None, dict[str, float]],
+           size: float = 0.0) -> Hidden:
+        """``robot``'s effect ``effect`` with ``params`` in place, keyed by axis (0-based; None for
+        a robot-wide effect, which is hidden on all six)."""
+        kind = get(effect)
+        hidden_on = list(range(N_AXES)) if not kind.per_axis else sorted(params)
+        return cls(kind.fitted(robot, params), hidden_on, size)
+
+    def record(self) -> dict:
+        """As ``report.json`` gives a step: effect id, axes numbered 1..6 and the parameters on them."""
+        if self.effect is None:
+            return {"effect": None, "axes": [], "params": {}}
+        return {"effect": self.effect.id, "axes": axes.numbers(self.axes), "params": self.effect.report(self.axes)}
+
+    def __str__(self) -> str:
+        return str(self.record())
 
 
 def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion, np.ndarray]:
@@ -108,11 +137,11 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     scale = np.sqrt(np.mean(tau**2, axis=0))
     if kind.draw_range is not None:
         name, low, high, min_size, fallback = kind.draw_range
-        params, sizes = {}, np.zeros(6)
-        for axis in range(6):
+        params, sizes = {}, np.zeros(N_AXES)
+        for axis in range(N_AXES):
             value = float(rng.uniform(low, high))
             _, change = kind.columns(motion, axis, value)
-            params[str(axis + 1)] = {name: value}
+            params[axis] = {name: value}
             sizes[axis] = np.sqrt(np.mean(change**2)) / scale[axis]
         return _choose(robot, effect, rng, params, sizes, min_size if np.any(sizes >= min_size) else fallback)
     size = float(rng.uniform(*size_range))
@@ -121,9 +150,9 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         phi, _ = kind.columns(motion, None, None)
         relative = np.sqrt(np.mean(phi[:, :, 0] ** 2, axis=0)) / scale
         theta = np.array([size / relative.max()])
-        return Hidden(effect, list(range(1, 7)), {"robot": kind.params(motion, None, theta, None)}, size)
-    params, sizes = {}, np.zeros(6)
-    for axis in range(6):
+        return Hidden.of(robot, effect, {None: kind.params(motion, None, theta, None)}, size)
+    params, sizes = {}, np.zeros(N_AXES)
+    for axis in range(N_AXES):
         grid = kind.grid(motion, axis)
         if grid == [None]:
             h = None
@@ -135,7 +164,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         direction = kind.draw_direction(rng)  # (k,): the cogging phase, or 1
         unit = phi @ direction
         if not np.any(unit):  # the effect cannot show on this axis (e.g. no Stribeck range)
-            params[str(axis + 1)] = {}
+            params[axis] = {}
             continue
         sign = -1.0 if kind.signed and rng.random() < 0.5 else 1.0
         amplitude = sign * size * scale[axis] / np.sqrt(np.mean(unit**2))
@@ -144,7 +173,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         # past a physical bound, shrink the effect to the bound (and note the smaller size)
         share = kind.motor_torque(motion, axis, drawn) / robot.motor_torque_limit[axis]
         excess = max([abs(drawn[k]) / limit for k, limit in kind.draw_limits.items()] + [1.0, share / MOTOR_SHARE])
-        params[str(axis + 1)] = kind.params(motion, axis, theta / excess, h)
+        params[axis] = kind.params(motion, axis, theta / excess, h)
         sizes[axis] = size / excess
     return _choose(robot, effect, rng, params, sizes, min_size)
 
@@ -152,14 +181,13 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
 def _choose(robot: robots.Robot, effect: str, rng: np.random.Generator, params: dict, sizes: np.ndarray,
             min_size: float) -> Hidden:
     """1 to :data:`MAX_AXES` random axes among those whose drawn effect has ``sizes >= min_size``."""
-    eligible = [a for a in range(6) if sizes[a] >= min_size]
+    eligible = [a for a in range(N_AXES) if sizes[a] >= min_size]
     if not eligible:
         raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within "
                          f"{get(effect).draw_limits}")
     n_axes = int(rng.integers(1, min(MAX_AXES, len(eligible)) + 1))
-    axes = sorted(int(a) for a in rng.choice(eligible, size=n_axes, replace=False))
-    return Hidden(effect, [a + 1 for a in axes], {str(a + 1): params[str(a + 1)] for a in axes},
-                  float(min(sizes[axes])))
+    chosen = sorted(int(a) for a in rng.choice(eligible, size=n_axes, replace=False))
+    return Hidden.of(robot, effect, {a: params[a] for a in chosen}, float(min(sizes[chosen])))
 
 
 def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path:
@@ -171,8 +199,7 @@ def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path
     spec.option.timestep = TIMESTEP
     spec.option.integrator = INTEGRATOR
     if hidden.effect is not None:
-        kind = get(hidden.effect)
-        kind.fitted(robot, hidden.params).write(spec, robot, [int(a) - 1 for a in hidden.params if a != "robot"])
+        hidden.effect.write(spec, robot, hidden.axes)
     path = folder / f"{robot.name}_hidden.xml"
     path.write_text(spec.to_xml())
     shutil.copyfile(robot.path.parent / "tasks.toml", folder / "tasks.toml")

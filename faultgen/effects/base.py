@@ -32,9 +32,9 @@ from typing import Any, ClassVar
 import mujoco
 import numpy as np
 
+from faultgen import axes as axis_numbers
+from faultgen.axes import N_AXES
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
-
-N_AXES = 6
 
 #: Arm-side speed (rad/s) below which an axis counts as at rest: its friction is then stiction,
 #: any value up to the breakaway torque, which no kinetic model predicts, so those samples of
@@ -214,6 +214,8 @@ class Effect:
     stepped: ClassVar[bool] = False
     numeric: ClassVar[str | None] = None
     aliases: ClassVar[tuple[str, ...]] = ()
+    #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
+    counts: ClassVar[tuple[str, ...]] = ()
     #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
     signed: ClassVar[bool] = False
     #: Hidden-effect drawing: largest value of a parameter; a drawn effect past it is shrunk to it.
@@ -252,15 +254,34 @@ class Effect:
         values = ", ".join(f"{k}={v.tolist()}" for k, v in self._values.items())
         return f"{type(self).__name__}({values})"
 
+    def __eq__(self, other: object) -> bool:
+        """Same effect with the same parameters (an instance is a value)."""
+        if type(other) is not type(self):
+            return NotImplemented
+        return all(np.array_equal(v, other._values[k]) for k, v in self._values.items())
+
+    __hash__ = None  # equal by value, and its arrays are not hashed
+
     # -- parameters -------------------------------------------------------------------------
 
     def values(self, axis: int | None = None) -> dict[str, float]:
-        """Parameters of ``axis`` (0-based; None for a robot-wide effect) as plain numbers."""
-        return {k: float(v if axis is None else v[axis]) for k, v in self._values.items()}
+        """Parameters of ``axis`` (0-based; None for a robot-wide effect) as plain numbers (int for
+        the :attr:`counts`)."""
+        return {k: self._plain(k, v if axis is None else v[axis]) for k, v in self._values.items()}
 
     def table(self) -> dict[str, list[float] | float]:
         """All parameters as plain lists over axes 1..6 (one number when robot-wide), ``parameters.json``."""
-        return {k: v.tolist() for k, v in self._values.items()}
+        return {k: [self._plain(k, x) for x in v] if v.ndim else self._plain(k, v) for k, v in self._values.items()}
+
+    def _plain(self, name: str, value) -> float | int:
+        return int(value) if name in self.counts else float(value)
+
+    def report(self, axes: list[int]) -> dict[str, dict[str, float]]:
+        """The parameters on ``axes`` (0-based) as ``report.json`` gives them: keyed by the axis
+        number a user reads (``"1"``..``"6"``), or ``"robot"`` for a robot-wide effect."""
+        if not self.per_axis:
+            return {"robot": self.values()}
+        return {str(axis_numbers.number(a)): self.values(a) for a in axes}
 
     def active(self) -> np.ndarray:
         """Per axis (or once), whether the effect differs from its absent values, bool."""
@@ -397,17 +418,17 @@ class Effect:
         backlash, a friction level below zero); such a fit is never selected."""
         return True
 
-    def fitted(self, robot, params: dict) -> Effect:
-        """A new instance: ``robot``'s values of this effect with ``params`` (per axis ``"1"``..
-        ``"6"``, or ``"robot"``) in place."""
+    def fitted(self, robot, params: dict[int | None, dict[str, float]]) -> Effect:
+        """A new instance: ``robot``'s values of this effect with ``params`` in place, keyed by
+        axis (0-based), or by None for a robot-wide effect; a parameter not given keeps its value."""
         current = self.current(robot)
         table = {k: v.copy() for k, v in current._values.items()}
-        for where, values in params.items():
+        for axis, values in params.items():
             for name, value in values.items():
-                if where == "robot":
+                if axis is None:
                     table[name] = np.asarray(value, dtype=float)
                 else:
-                    table[name][int(where) - 1] = value
+                    table[name][axis] = value
         return type(self)(**table)
 
     def current(self, robot) -> Effect:

@@ -29,6 +29,7 @@ class Cogging(Effect):
     absent = (0.0, 0.0, 0.0)
     numeric = "cogging"
     n_parameters = 2
+    counts = ("poles",)
     POLES = tuple(range(1, 25))
 
     def torque(self, robot, q, qd, load, t):

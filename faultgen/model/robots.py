@@ -29,11 +29,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen.axes import N_AXES
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import MotorFriction
-
-N_AXES = 6
 
 
 class UnknownRobotError(ValueError):

@@ -29,12 +29,12 @@ from types import MappingProxyType
 
 import numpy as np
 
+from faultgen import axes
+from faultgen.axes import N_AXES
+
 #: Known schedule kinds.
 SCHEDULES = ("exp4", "logistic", "linear", "step")
 
-#: Number of axes of a robot (same as :data:`faultgen.robots.N_AXES`; not imported to keep this
-#: module free of MuJoCo).
-N_AXES = 6
 
 #: Optional parameters of each kind and their defaults (``None``: derived from ``last_cycle``).
 _PARAMS: dict[str, dict[str, float | None]] = {
@@ -275,7 +275,7 @@ class WearPlan:
             raise ValueError(f"cycles must be an int or a 1-D int array, got shape {k.shape}")
         out = np.ones((k.shape[0], N_AXES))
         for axis, schedule in self.schedules.items():
-            out[:, axis - 1] = schedule.multiplier(k)
+            out[:, axes.index(axis)] = schedule.multiplier(k)
         return out
 
     def to_dict(self) -> dict[str, object]:
