@@ -222,7 +222,8 @@ def calibrate_command(
     the library is fitted to the residual on the first 70 % of the record and judged on the last
     30 % (held out); the effect that cuts the held-out error most, on the axes where the cut is
     significant, is written into the model, and the search repeats until nothing significant is
-    left.
+    left. A log the robot cannot explain (another robot, motor-side torque, a column in another
+    unit or with the other sign) is refused before anything is written, naming what to check.
 
     Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
     friction), stribeck (low-speed friction hump), load_dependent_friction (friction growing with

@@ -4,7 +4,8 @@ missing physical effect, add it to the model, and show the gap shrink.
 The workflow (:func:`calibrate`, ``faultgen calibrate``):
 
 1. read and check the measured file (:func:`faultgen.measured.read`; velocities and
-   accelerations from a Savitzky-Golay filter when the file has none);
+   accelerations from a Savitzky-Golay filter when the file has none), and refuse a log the robot
+   cannot explain (:mod:`faultgen.calibrate.plausibility`) before writing anything;
 2. predict the torque with the nominal model (:func:`predict`: the inverse dynamics plus what the
    flexible gearboxes change, :mod:`faultgen.calibrate.gearbox`) and split the record in time into a fitting part and a held-out part
    (:class:`faultgen.calibrate.search.Split`); every gap is reported on the held-out part;
@@ -29,16 +30,18 @@ import mujoco
 import numpy as np
 
 from faultgen import axes
-from faultgen.calibrate import gearbox, search
+from faultgen.calibrate import gearbox, plausibility, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
+from faultgen.calibrate.plausibility import ImplausibleLogError
 from faultgen.data import atomic
 from faultgen.data import measured as measured_io
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
 
-__all__ = ["EFFECTS", "Calibration", "Effect", "Step", "calibrate", "get", "parameters", "predict"]
+__all__ = ["EFFECTS", "Calibration", "Effect", "ImplausibleLogError", "Step", "calibrate", "get", "parameters",
+           "predict"]
 
 #: Most effects added in one calibration.
 MAX_STEPS = 6
@@ -173,6 +176,9 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         For an unknown robot or a broken model file.
     MeasuredDataError
         For a measured file the reader refuses (the message names the column or row).
+    ImplausibleLogError
+        For a log the nominal model cannot explain (another robot, motor-side torque, a column in
+        another unit or sign; :mod:`faultgen.calibrate.plausibility`); nothing is written.
     ValueError
         If ``max_steps`` < 0.
     """
@@ -180,6 +186,14 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
     nominal = robots.load(robot)
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
+    split = search.Split.of(data.t, data.qd)
+    tau = np.asarray(data.tau)
+    current = nominal
+    predicted, motion = _predict(nominal, data)
+    nominal_prediction = predicted
+    moving = np.abs(data.qd) >= search.REST_SPEED
+    plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+
     out = Path(out)
     model_dir = out / "model"
     model_dir.mkdir(parents=True, exist_ok=True)
@@ -187,12 +201,6 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     tasks_file = nominal.path.parent / "tasks.toml"
     if tasks_file.is_file():
         shutil.copyfile(tasks_file, model_dir / "tasks.toml")
-
-    split = search.Split.of(data.t, data.qd)
-    tau = np.asarray(data.tau)
-    current = nominal
-    predicted, motion = _predict(nominal, data)
-    nominal_prediction = predicted
     gap_before = search.gap(tau, predicted, split.held_out)
     steps: list[Step] = []
     spec = mujoco.MjSpec.from_file(str(nominal.path))
@@ -231,7 +239,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         model_out=model_out,
         time=np.asarray(data.t),
         held_out=split.held_out,
-        moving=np.abs(data.qd) >= search.REST_SPEED,
+        moving=moving,
         tau=tau,
         nominal=nominal_prediction,
         calibrated=predicted,

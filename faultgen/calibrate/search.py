@@ -15,7 +15,8 @@ tau_model`` (arm side, N m):
 3. An axis is *significant* for an effect when its held-out gain is at least
    :data:`MIN_GAIN` (absolute, in nrmse) **and** at least :data:`MIN_RELATIVE_GAIN` of that
    axis's held-out nrmse before the step (a significance threshold on the effect size that noise
-   and the rigid-model mismatch stay under; docs/calibration.md gives the null-case figures).
+   and the rigid-model mismatch stay under; docs/calibration.md gives the null-case figures), and
+   the fit is physical: within the effect's bounds and the motor's torque limit.
 4. The effect with the largest total significant gain wins; an effect whose gain is within
    :data:`TIE` of the best and comes earlier in :data:`faultgen.effects.EFFECTS`
    (fewer parameters or simpler physics) is preferred.
@@ -192,7 +193,7 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     relative = gain / np.where(before > 0, before, 1.0)
     significant = (gain >= MIN_GAIN) & (relative >= MIN_RELATIVE_GAIN)
     if effect.per_axis:
-        significant &= [effect.admissible(motion, a, params[a]) for a in range(residual.shape[1])]
+        significant &= [_physical(effect, motion, a, params[a]) for a in range(residual.shape[1])]
         axes = [int(a) for a in np.flatnonzero(significant)]
     else:
         # robot-wide: significant as a whole when the mean gain passes both thresholds
@@ -204,6 +205,14 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     mask = np.zeros(residual.shape[1], dtype=bool)
     mask[axes] = True
     return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0))
+
+
+def _physical(effect: Effect, motion: Motion, axis: int, params: dict[str, float]) -> bool:
+    """Whether a per-axis fit may be written: the effect's own bounds (:meth:`Effect.admissible`)
+    and a torque the motor can give (:meth:`Effect.motor_torque` within the motor's torque limit,
+    e.g. no offset above the axis's rated torque)."""
+    limit = motion.robot.motor_torque_limit[axis]
+    return bool(effect.admissible(motion, axis, params) and effect.motor_torque(motion, axis, params) <= limit)
 
 
 def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split, progress: bool = False,

@@ -443,7 +443,9 @@ class Effect:
 
     def motor_torque(self, motion: Motion, axis: int, params: dict[str, float]) -> float:
         """Largest motor torque (N m) the effect with ``params`` takes on ``axis`` along ``motion``
-        (hidden-effect drawing keeps it within a share of the motor's torque limit)."""
+        (0: it takes none of its own). A fit above the motor's torque limit is never selected
+        (:func:`faultgen.calibrate.search.fit_effect`), and hidden-effect drawing keeps it within a
+        share of that limit."""
         return 0.0
 
 

@@ -33,17 +33,27 @@ class Payload(Effect):
         return cls(mass=sum(masses))
 
     def columns(self, motion, axis, h):
-        robot = motion.robot
-        unit = robot.edited(lambda spec: self.apply(spec, robot, None, {"mass": self.current(robot).mass + 1.0}))
-        with_mass = unit.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
-        without = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
-        return (with_mass - without)[:, :, None], np.zeros_like(with_mass)
+        if "payload" not in motion.memo:  # the fit and the torque bound both need it
+            robot = motion.robot
+            unit = robot.edited(lambda spec: self.apply(spec, robot, None, {"mass": self.current(robot).mass + 1.0}))
+            with_mass = unit.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
+            without = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
+            motion.memo["payload"] = (with_mass - without)[:, :, None]
+        phi = motion.memo["payload"]
+        return phi, np.zeros(phi.shape[:2])
 
     def params(self, motion, axis, theta, h):
         return {"mass": float(self.current(motion.robot).mass + theta[0])}
 
     def admissible(self, motion, axis, params):
-        return params["mass"] > self.current(motion.robot).mass
+        """A payload adds mass, and no more than the drives can carry along the motion: the
+        added mass's torque stays within every motor's torque limit."""
+        added = params["mass"] - self.current(motion.robot).mass
+        if added <= 0:
+            return False
+        phi, _ = self.columns(motion, None, None)
+        peak = np.max(np.abs(phi[:, :, 0]), axis=0) * added / motion.robot.gear_ratio  # motor side, N m
+        return bool(np.all(peak <= motion.robot.motor_torque_limit))
 
     def apply(self, spec, robot, axis, params):
         """Add a body ``payload{n}`` at the flange carrying the mass ``params["mass"]`` exceeds the

@@ -31,3 +31,6 @@ class Viscous(FrictionParameter):
 
     def admissible(self, motion, axis, params):
         return params["viscous"] >= 0
+
+    def motor_torque(self, motion, axis, params):
+        return params["viscous"] * float(np.max(np.abs(motion.motor_velocity[:, axis])))
