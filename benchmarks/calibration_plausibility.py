@@ -54,13 +54,8 @@ def own_log(robot_name: str, effect: str | None, seed: int) -> dict:
 
 def toolbox_logs() -> dict:
     puma, irb = robots.load("puma560"), robots.load("irb6700")
-    low = np.maximum(puma.joint_range[:, 0], irb.joint_range[:, 0])
-    high = np.minimum(puma.joint_range[:, 1], irb.joint_range[:, 1])
-    t = np.arange(0.0, 40.0, 0.002)
-    shape = np.sin(2 * np.pi * 0.1 * t)[:, None] * [1, 0.8, 0.6, 1, 0.7, 1] + 0.3 * np.sin(2 * np.pi * 0.23 * t + 1)[:, None]
-    q = (low + high) / 2 + 0.35 * (high - low) / 2 * shape
-    qd = np.gradient(q, t, axis=0)
-    tau = np.asarray(rtb.models.DH.Puma560().rne(q, qd, np.gradient(qd, t, axis=0)))
+    t, q, qd, qdd = synth.excitation([puma, irb], 40.0, 0.002)
+    tau = np.asarray(rtb.models.DH.Puma560().rne(q, qd, qdd))
     tau = tau + np.random.default_rng(0).normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     as_puma = measured.from_arrays(t, q, tau, robot=puma)
     as_irb = measured.from_arrays(t, q, tau, robot=irb)

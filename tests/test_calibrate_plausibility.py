@@ -18,15 +18,8 @@ from faultgen.effects import get
 
 @pytest.fixture(scope="module")
 def excitation():
-    """20 s at 250 Hz of two sines per axis inside the joint ranges of both robots."""
-    puma, irb = robots.load("puma560"), robots.load("irb6700")
-    low = np.maximum(puma.joint_range[:, 0], irb.joint_range[:, 0])
-    high = np.minimum(puma.joint_range[:, 1], irb.joint_range[:, 1])
-    t = np.arange(0.0, 20.0, 0.004)
-    shape = np.sin(2 * np.pi * 0.1 * t)[:, None] * [1, 0.8, 0.6, 1, 0.7, 1] + 0.3 * np.sin(2 * np.pi * 0.23 * t + 1)[:, None]
-    q = (low + high) / 2 + 0.35 * (high - low) / 2 * shape
-    qd = np.gradient(q, t, axis=0)
-    return t, q, qd, np.gradient(qd, t, axis=0)
+    """20 s at 250 Hz inside the joint ranges of both robots."""
+    return synth.excitation([robots.load("puma560"), robots.load("irb6700")], 20.0, 0.004)
 
 
 def puma_log(excitation):

@@ -116,6 +116,23 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
     return motion_of(robot, t, q, qd, qdd), tau
 
 
+def excitation(robot_list: list[robots.Robot], duration: float, period: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A smooth motion inside the joint ranges of every robot of ``robot_list`` (two sines per axis,
+    0.1 and 0.23 Hz, over 35 % of the common range around its middle), sampled every ``period`` s
+    for ``duration`` s: ``t`` (n,), ``q`` (rad), ``qd`` (rad/s), ``qdd`` (rad/s^2), each (n, 6).
+    A log along it passes every robot's joint-range check, so only its torque tells the robots
+    apart (the plausibility guard's check, :mod:`faultgen.calibrate.plausibility`)."""
+    low = np.max([r.joint_range[:, 0] for r in robot_list], axis=0)
+    high = np.min([r.joint_range[:, 1] for r in robot_list], axis=0)
+    t = np.arange(0.0, duration, period)
+    shape = (np.sin(2 * np.pi * 0.1 * t)[:, None] * [1.0, 0.8, 0.6, 1.0, 0.7, 1.0]
+             + 0.3 * np.sin(2 * np.pi * 0.23 * t + 1.0)[:, None])
+    q = (low + high) / 2 + 0.35 * (high - low) / 2 * shape
+    qd = np.gradient(q, t, axis=0)
+    return t, q, qd, np.gradient(qd, t, axis=0)
+
+
 def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task: str = "pick_place",
          cycles: int = 4, size_range: tuple[float, float] = SIZE_RANGE) -> Hidden:
     """Draw a hidden effect of kind ``effect`` (None: nothing) at a random size on random axes.
