@@ -14,6 +14,7 @@ import pytest
 
 from faultgen import calibrate, effects, robots, sim
 from faultgen.calibrate import synth
+from faultgen.effects import payload
 
 ROBOTS = ("puma560", "irb6700")
 
@@ -34,7 +35,10 @@ CHANGES = {
     "stribeck": (np.array([0.2]), 7.0, {"static": 0.2, "stribeck_velocity": 7.0}),
     "load_dependent_friction": (np.array([0.1]), None, {"coefficient": 0.1}),
     "temperature": (np.array([0.8]), 3.0, {"amplitude": 0.8, "time_constant": 3.0}),
-    "payload": (np.array([2.0]), None, {"mass": 2.0}),
+    # 2 kg, centre of mass (0.02, -0.03, 0.05) m, inertia about it diag(0.01, 0.02, 0.015) kg m^2
+    "payload": (payload.barycentric(2.0, [0.02, -0.03, 0.05], [0.01, 0.02, 0.015, 0, 0, 0]), None,
+                {"mass": 2.0, "com_x": 0.02, "com_y": -0.03, "com_z": 0.05, "ixx": 0.01, "iyy": 0.02, "izz": 0.015,
+                 "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}),
     "cogging": (np.array([-0.05 * np.cos(0.4), -0.05 * np.sin(0.4)]), 6, {"amplitude": 0.05, "poles": 6, "phase": 0.4}),
 }
 
@@ -252,3 +256,21 @@ def test_backlash_search_recovers_the_width(setup, tmp_path):
     assert [found[a][0] for a in others] == [0.0] * len(others)
 
 
+
+
+def test_payload_barycentric_parameters_round_trip_through_the_mjcf(tmp_path):
+    """A payload with its centre of mass off the flange and a full inertia, written into the IRB's
+    MJCF (whose flange frame is turned against its link) and read back; and the barycentric
+    parameters against the parallel-axis theorem worked by hand."""
+    robot = robots.load("irb6700")
+    values = {"mass": 12.0, "com_x": 0.05, "com_y": -0.02, "com_z": 0.15,
+              "ixx": 0.3, "iyy": 0.4, "izz": 0.2, "ixy": 0.01, "ixz": -0.02, "iyz": 0.03}
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    effects.make("payload", **values).write(spec, robot)
+    path = tmp_path / "payload.xml"
+    path.write_text(spec.to_xml())
+    assert effects.get("payload").of(robots.load(path)).values() == pytest.approx(values, abs=1e-6)
+    phi = payload.barycentric(2.0, [0.0, 0.0, 0.1], [0.0] * 6)
+    assert phi.tolist() == pytest.approx([2.0, 0.0, 0.0, 0.2, 0.02, 0.02, 0.0, 0.0, 0.0, 0.0])
+    assert payload.consistent(2.0, np.zeros(3), [0.1, 0.1, 0.3, 0, 0, 0]) is False  # triangle inequality
+    assert payload.consistent(2.0, np.array([0.0, 0.0, 0.6]), [0.0] * 6) is False  # too far from the flange

@@ -80,7 +80,7 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     out = tmp_path / "out"
     report = json.loads((out / "report.json").read_text())
     assert set(report) == {"robot", "measured", "gap_before", "steps", "gap_after", "model_out"}
-    assert report["steps"][0]["units"] == {"mass": "kg"}
+    assert report["steps"][0]["units"]["mass"] == "kg" and report["steps"][0]["units"]["com_x"] == "m (flange frame)"
     assert report["robot"] == "puma560" and report["measured"].endswith("measured.csv")
     for gap in (report["gap_before"], report["gap_after"], report["steps"][0]["gap_after"]):
         assert len(gap["rmse_Nm"]) == 6 and len(gap["nrmse"]) == 6
@@ -105,8 +105,8 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     assert np.all(np.isfinite(run.tau_m))
     assert np.sum(model.model.body_mass) == pytest.approx(np.sum(nominal.model.body_mass) + mass, rel=1e-5)
     written = json.loads((out / "model" / "parameters.json").read_text())
-    assert written["effects"]["payload"] == {"mass": pytest.approx(mass, rel=1e-5)}
-    assert written["units"]["effects"]["payload"] == {"mass": "kg"}
+    assert written["effects"]["payload"]["mass"] == pytest.approx(mass, rel=1e-5)
+    assert written["units"]["effects"]["payload"]["mass"] == "kg"
     assert written["gear_ratio"] == pytest.approx(nominal.gear_ratio.tolist(), rel=1e-5)
 
 

@@ -77,7 +77,9 @@ def test_payload_mass_comes_back(puma):
     best = search.rank(motion, residual, tau, split)[0]
     assert best.effect.id == "payload" and best.axes == list(range(6))
     assert best.effect.mass == pytest.approx(1.7, rel=0.02)
-    assert best.effect.report(best.axes) == {"robot": {"mass": float(best.effect.mass)}}
+    assert best.effect.report(best.axes) == {"robot": best.effect.values()}
+    # a residual a point mass at the flange explains is fitted at the first level: mass only
+    assert best.effect.values()["com_z"] == 0.0 and best.effect.values()["ixx"] == 0.0
 
 
 def test_stribeck_velocity_is_refined_off_the_grid(puma):

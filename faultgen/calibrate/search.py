@@ -185,7 +185,9 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
             contribution[:, axis] = predicted
             params[axis] = effect.params(motion, axis, theta, h)
     else:
-        theta, contribution = RobotLeastSquares().fit(effect, motion, residual, fit, scale)
+        found = effect.search(motion, residual, fit, scale)  # its own (payload), else the default
+        theta, contribution = found if found is not None else RobotLeastSquares().fit(effect, motion, residual, fit,
+                                                                                       scale)
         params = {None: effect.params(motion, None, theta, None)}
     fitted = effect.fitted(motion.robot, params)
     after = _rms(residual - contribution, held) / scale

@@ -165,8 +165,9 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     min_size = min(MIN_SIZE, 0.9 * size_range[0])
     if not kind.per_axis:
         phi, _ = kind.columns(motion, None, None)
-        relative = np.sqrt(np.mean(phi[:, :, 0] ** 2, axis=0)) / scale
-        theta = np.array([size / relative.max()])
+        direction = kind.draw_direction(rng)  # (k,): the payload's barycentric parameters
+        relative = np.sqrt(np.mean((phi @ direction) ** 2, axis=0)) / scale
+        theta = size / relative.max() * direction
         return Hidden.of(robot, effect, {None: kind.params(motion, None, theta, None)}, size)
     params, sizes = {}, np.zeros(N_AXES)
     for axis in range(N_AXES):

@@ -395,11 +395,12 @@ class Effect:
         """Values of the nonlinear parameter to search; ``[None]`` when the effect is linear."""
         return [None]
 
-    def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | None:
+    def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | tuple | None:
         """The effect's own fit of all axes to ``residual`` (n, 6) on the samples of ``rows``
         (n, 6), axis a weighted by ``1 / scale[a]**2`` (its torque RMS, N m): per axis
-        ``(h, theta, predicted torque (n,))``. None (the default): the generic per-axis least
-        squares over :meth:`grid` and :meth:`columns`."""
+        ``(h, theta, predicted torque (n,))``, or for a robot-wide effect ``(theta, predicted
+        torque (n, 6))``. None (the default): the generic least squares over :meth:`grid` and
+        :meth:`columns` (per axis, or over all axes at once for a robot-wide effect)."""
         return None
 
     def columns(self, motion: Motion, axis: int | None, h) -> tuple[np.ndarray, np.ndarray]:
