@@ -160,15 +160,27 @@ class AxisLeastSquares:
 
 class RobotLeastSquares:
     """The optimiser of a robot-wide effect (payload): one least squares over the fitted samples of
-    all axes at once, each axis weighted by ``1 / scale`` so that it counts by its nrmse."""
+    all axes at once, each axis weighted by ``1 / scale`` so that it counts by its nrmse. An effect
+    with nested :attr:`~faultgen.effects.Effect.levels` is fitted at each (its leading columns
+    only), and the most detailed level is kept whose fit is admissible and lowers the Bayesian
+    information criterion ``N ln(SSE / N) + k ln(N)`` (N weighted residuals, k parameters) on the
+    fitting part: a parameter the motion does not excite is left at its current value."""
 
     def fit(self, effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray,
             scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(theta, predicted torque (n, 6))`` fitted to ``residual`` (n, 6) on ``rows``."""
         phi, offset = effect.columns(motion, None, None)  # (n, 6, k), (n, 6)
         weights = 1.0 / scale
-        theta = _lstsq((phi * weights[:, None])[rows], ((residual - offset) * weights)[rows])
-        return theta, phi @ theta + offset
+        design, target = (phi * weights[:, None])[rows], ((residual - offset) * weights)[rows]
+        best, best_bic = None, np.inf
+        for level in effect.levels or (phi.shape[-1],):
+            theta = np.zeros(phi.shape[-1])
+            theta[:level] = _lstsq(design[:, :level], target)
+            sse = max(float(np.sum((target - design @ theta) ** 2)), 1e-300)
+            bic = target.size * np.log(sse / target.size) + level * np.log(target.size)
+            if best is None or (bic < best_bic and effect.admissible(motion, None, effect.params(motion, None, theta, None))):
+                best, best_bic = theta, bic
+        return best, phi @ best + offset
 
 
 def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split) -> Candidate:
@@ -185,9 +197,7 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
             contribution[:, axis] = predicted
             params[axis] = effect.params(motion, axis, theta, h)
     else:
-        found = effect.search(motion, residual, fit, scale)  # its own (payload), else the default
-        theta, contribution = found if found is not None else RobotLeastSquares().fit(effect, motion, residual, fit,
-                                                                                       scale)
+        theta, contribution = RobotLeastSquares().fit(effect, motion, residual, fit, scale)
         params = {None: effect.params(motion, None, theta, None)}
     fitted = effect.fitted(motion.robot, params)
     after = _rms(residual - contribution, held) / scale

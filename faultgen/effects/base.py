@@ -216,6 +216,10 @@ class Effect:
     aliases: ClassVar[tuple[str, ...]] = ()
     #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
     counts: ClassVar[tuple[str, ...]] = ()
+    #: Robot-wide identification: numbers of leading linear parameters fitted at each level of
+    #: detail, simplest first (the optimiser keeps the most detailed admissible level the Bayesian
+    #: information criterion supports); None: all at once.
+    levels: ClassVar[tuple[int, ...] | None] = None
     #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
     signed: ClassVar[bool] = False
     #: Hidden-effect drawing: largest value of a parameter; a drawn effect past it is shrunk to it.
@@ -395,12 +399,11 @@ class Effect:
         """Values of the nonlinear parameter to search; ``[None]`` when the effect is linear."""
         return [None]
 
-    def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | tuple | None:
+    def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | None:
         """The effect's own fit of all axes to ``residual`` (n, 6) on the samples of ``rows``
         (n, 6), axis a weighted by ``1 / scale[a]**2`` (its torque RMS, N m): per axis
-        ``(h, theta, predicted torque (n,))``, or for a robot-wide effect ``(theta, predicted
-        torque (n, 6))``. None (the default): the generic least squares over :meth:`grid` and
-        :meth:`columns` (per axis, or over all axes at once for a robot-wide effect)."""
+        ``(h, theta, predicted torque (n,))``. None (the default): the generic per-axis least
+        squares over :meth:`grid` and :meth:`columns`."""
         return None
 
     def columns(self, motion: Motion, axis: int | None, h) -> tuple[np.ndarray, np.ndarray]:

@@ -76,10 +76,10 @@ class Payload(Effect):
     Its torque is the rigid-body model's (the body is part of the MJCF, so the simulation and the
     inverse dynamics carry it). Identified by its barycentric parameters (:func:`barycentric`), in
     which the torque is linear: the regressor of each is the inverse dynamics with ten bodies of
-    known parameters added one at a time, solved for the unit changes; fitted by least squares at
-    three levels (mass; mass and centre of mass; all ten), keeping the most detailed one that is
-    physically consistent (:func:`consistent`) and that the motion excites (Bayesian information
-    criterion on the fitting part).
+    known parameters added one at a time, solved for the unit changes; fitted at three
+    :attr:`levels` (mass; mass and centre of mass; all ten), of which the calibration's optimiser
+    keeps the most detailed one that is admissible (physically consistent, :func:`consistent`, and
+    within the drives' torque) and that the motion excites (Bayesian information criterion).
     """
 
     id = "payload"
@@ -91,8 +91,7 @@ class Payload(Effect):
     absent = (0.0,) * 10
     per_axis = False
     n_parameters = 10
-    #: Parameters fitted at each level of detail: mass; with the centre of mass; with the inertia.
-    LEVELS = (1, 4, 10)
+    levels = (1, 4, 10)  # mass; with the centre of mass; with the inertia
 
     # -- the MJCF ------------------------------------------------------------------------------
 
@@ -176,25 +175,6 @@ class Payload(Effect):
             motion.memo["payload"] = solved.T.reshape(*without.shape, 10)
         phi = motion.memo["payload"]
         return phi, np.zeros(phi.shape[:2])
-
-    def search(self, motion, residual, rows, scale):
-        """Least squares of the barycentric changes at each of :data:`LEVELS` (each axis weighted by
-        ``1 / scale``); the most detailed level whose result is physically consistent and lowers
-        the Bayesian information criterion. Returns ``(theta (10,), predicted torque (n, 6))``."""
-        phi, _ = self.columns(motion, None, None)
-        weights = 1.0 / scale
-        design, target = (phi * weights[:, None])[rows], (residual * weights)[rows]
-        current = barycentric(*self._current_inertial(motion.robot))
-        best, best_bic = np.zeros(10), np.inf
-        for level in self.LEVELS:
-            theta = np.zeros(10)
-            if np.any(design[:, :level]):
-                theta[:level] = np.linalg.lstsq(design[:, :level], target, rcond=None)[0]
-            sse = float(np.sum((target - design @ theta) ** 2))
-            bic = target.size * np.log(max(sse, 1e-300) / target.size) + level * np.log(target.size)
-            if bic < best_bic and (level == 1 or consistent(*from_barycentric(current + theta))):
-                best, best_bic = theta, bic
-        return best, phi @ best
 
     def params(self, motion, axis, theta, h):
         mass, com, inertia = from_barycentric(barycentric(*self._current_inertial(motion.robot)) + theta)
