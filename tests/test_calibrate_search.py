@@ -116,3 +116,39 @@ def test_unphysical_fit_is_never_selected(puma):
     candidate = search.fit_effect(effects.get("payload"), motion, residual, tau, split)
     assert candidate.effect.mass == pytest.approx(-2.0, rel=1e-6)
     assert candidate.axes == []
+
+
+def _least_squares_error(phi, noise, rows):
+    """The textbook standard error of a one-column least-squares fit with noise of std ``noise``."""
+    return noise * np.sqrt(1.0 / np.sum(phi[rows] ** 2))
+
+
+def test_jackknife_standard_error_matches_least_squares_on_white_noise(puma):
+    _, motion, tau = puma
+    effect = effects.get("viscous")
+    phi, _ = effect.columns(motion, 2, None)
+    noise = 0.02 * np.sqrt(np.mean(tau[:, 2] ** 2))
+    residual = np.zeros_like(tau)
+    residual[:, 2] = phi[:, 0] * 2e-3 + np.random.default_rng(8).normal(scale=noise, size=len(tau))
+    split = search.Split.of(motion.t, motion.qd)
+    error = search.standard_errors(effect, motion, residual, tau, split, [2])[2]["viscous"]
+    expected = _least_squares_error(phi[:, 0], noise, split.fit[:, 2])
+    assert 0.5 < error / expected < 1.5
+    fitted = search.fit_effect(effect, motion, residual, tau, split).effect.viscous[2]
+    assert abs(fitted - motion.robot.friction.viscous[2] - 2e-3) < 3 * error
+
+
+def test_jackknife_standard_error_sees_noise_correlated_in_time(puma):
+    """A slow drift in the residual makes neighbouring samples agree; the least-squares formula
+    takes them as independent and is too small, the blocks of time are not fooled."""
+    _, motion, tau = puma
+    effect = effects.get("viscous")
+    phi, _ = effect.columns(motion, 2, None)
+    noise = 0.02 * np.sqrt(np.mean(tau[:, 2] ** 2))
+    white = np.random.default_rng(9).normal(size=len(tau))
+    drift = np.convolve(white, np.ones(250) / np.sqrt(250), mode="same")  # 1 s moving sum, same std
+    residual = np.zeros_like(tau)
+    residual[:, 2] = phi[:, 0] * 2e-3 + noise * drift
+    split = search.Split.of(motion.t, motion.qd)
+    error = search.standard_errors(effect, motion, residual, tau, split, [2])[2]["viscous"]
+    assert error > 3 * _least_squares_error(phi[:, 0], noise, split.fit[:, 2])

@@ -23,7 +23,7 @@ from __future__ import annotations
 import json
 import shutil
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
@@ -59,22 +59,30 @@ class Step:
     axes : list of int
         Axes it was added on, 0-based (:meth:`record` numbers them 1..6).
     evidence : dict
-        Why it was chosen: held-out gain per axis, the score, the runner-up and every effect's
-        score (axes numbered 1..6).
+        Why it was chosen: held-out gain per axis, the score, the runner-up, the margin (score
+        minus the runner-up's, in held-out total nrmse) and every effect's score (axes numbered 1..6).
     gap_after : dict
         Held-out gap of the model with this and all earlier effects (see :func:`search.gap`).
+    standard_errors : dict
+        Standard error of each fitted parameter (:func:`search.standard_errors`), keyed by axis
+        (0-based; None when robot-wide), in the parameter's unit.
     """
 
     effect: Effect
     axes: list[int]
     evidence: dict
     gap_after: dict
+    standard_errors: dict = field(default_factory=dict)
 
     def record(self) -> dict:
         """The step in ``report.json``: effect id, axes numbered 1..6, the parameters on them
-        (:meth:`faultgen.effects.Effect.report`) with their units, the evidence and the gap after."""
+        (:meth:`faultgen.effects.Effect.report`) with their standard errors (keyed the same way)
+        and units, the evidence and the gap after."""
+        errors = {"robot" if key is None else str(axes.number(key)): values
+                  for key, values in self.standard_errors.items()}
         return {"effect": self.effect.id, "axes": axes.numbers(self.axes), "params": self.effect.report(self.axes),
-                "units": dict(self.effect.units), "evidence": self.evidence, "gap_after": self.gap_after}
+                "standard_errors": errors, "units": dict(self.effect.units), "evidence": self.evidence,
+                "gap_after": self.gap_after}
 
 
 @dataclass(frozen=True)
@@ -134,7 +142,8 @@ class Calibration:
             s = step.record()
             values = "; ".join(
                 f"{'axis ' + where if where != 'robot' else 'robot'}: "
-                + ", ".join(f"{name} = {value:.4g}{_unit(s['units'][name])}" for name, value in p.items())
+                + ", ".join(f"{name} = {value:.4g} ± {s['standard_errors'].get(where, {}).get(name, np.nan):.2g}"
+                            f"{_unit(s['units'][name])}" for name, value in p.items())
                 for where, p in s["params"].items())
             lines.append(f"{k}. {s['effect']} on axes {', '.join(map(str, s['axes']))} -> total nrmse "
                          f"{s['gap_after']['total_nrmse']:.4f}  ({values})")
@@ -222,8 +231,9 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             previous = steps[-1].gap_after if steps else gap_before
             if after["total_nrmse"] >= previous["total_nrmse"]:
                 break  # the written model does not do what the fit promised: stop, keep what works
+            errors = search.standard_errors(best.effect, motion, tau - predicted, tau, split, best.axes)
             current, predicted, motion = trial, trial_prediction, trial_motion
-            steps.append(Step(best.effect, best.axes, _evidence(best, ranked), after))
+            steps.append(Step(best.effect, best.axes, _evidence(best, ranked), after, errors))
             if progress:
                 print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
@@ -299,5 +309,7 @@ def _evidence(best: search.Candidate, ranked: list[search.Candidate]) -> dict:
         "relative_gain": [float(g) for g in best.relative_gain],
         "runner_up": None if runner_up is None else {"effect": runner_up.effect.id, "score": runner_up.score,
                                                        "axes": axes.numbers(runner_up.axes)},
+        # how far ahead of the runner-up the chosen effect is, in held-out total nrmse
+        "margin": best.score - (runner_up.score if runner_up is not None else 0.0),
         "scores": {c.effect.id: c.score for c in ranked},
     }

@@ -44,6 +44,8 @@ MIN_GAIN = 0.01
 MIN_RELATIVE_GAIN = 0.2
 #: Relative gain margin within which an earlier (simpler) effect is preferred.
 TIE = 0.1
+#: Blocks of the fitting part for the jackknife standard errors (:func:`standard_errors`).
+JACKKNIFE_BLOCKS = 10
 
 
 
@@ -189,16 +191,7 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     scale = _rms(tau, held)
     scale = np.where(scale > 0, scale, 1.0)
     before = _rms(residual, held) / scale
-    contribution = np.zeros_like(residual)
-    if effect.per_axis:  # the effect's own search (backlash), else the default optimiser
-        fits = effect.search(motion, residual, fit, scale) or AxisLeastSquares().fit(effect, motion, residual, fit, scale)
-        params = {}
-        for axis, (h, theta, predicted) in enumerate(fits):
-            contribution[:, axis] = predicted
-            params[axis] = effect.params(motion, axis, theta, h)
-    else:
-        theta, contribution = RobotLeastSquares().fit(effect, motion, residual, fit, scale)
-        params = {None: effect.params(motion, None, theta, None)}
+    params, contribution = _fit(effect, motion, residual, fit, scale)
     fitted = effect.fitted(motion.robot, params)
     after = _rms(residual - contribution, held) / scale
     gain = before - after
@@ -217,6 +210,56 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     mask = np.zeros(residual.shape[1], dtype=bool)
     mask[axes] = True
     return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0))
+
+
+def _fit(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray
+         ) -> tuple[dict, np.ndarray]:
+    """``effect`` fitted to ``residual`` (n, 6) on the samples of ``rows`` by its optimiser: the
+    parameters keyed by axis (0-based; None when robot-wide) and the fitted torque (n, 6)."""
+    if not effect.per_axis:
+        theta, contribution = RobotLeastSquares().fit(effect, motion, residual, rows, scale)
+        return {None: effect.params(motion, None, theta, None)}, contribution
+    # the effect's own search (backlash), else the default optimiser
+    fits = effect.search(motion, residual, rows, scale) or AxisLeastSquares().fit(effect, motion, residual, rows, scale)
+    contribution = np.zeros_like(residual)
+    params = {}
+    for axis, (h, theta, predicted) in enumerate(fits):
+        contribution[:, axis] = predicted
+        params[axis] = effect.params(motion, axis, theta, h)
+    return params, contribution
+
+
+def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split,
+                    axes: list[int], blocks: int = JACKKNIFE_BLOCKS) -> dict:
+    """Standard errors of ``effect``'s fitted parameters on ``axes`` (0-based), by the delete-one-
+    block jackknife over time (Kunsch 1989): the fitting part is cut into ``blocks`` contiguous
+    blocks, the effect is fitted again with each left out, and the spread of the ``blocks`` fits
+    gives ``se = sqrt((B - 1) / B * sum (p_b - mean p)^2)``. Blocks of time keep the residual's
+    correlation in time (drift, ringing), which a least-squares covariance would take for
+    independent samples. A parameter chosen from a grid (pole count) has 0 when no block moves it.
+
+    Returns
+    -------
+    dict
+        Keyed like the fit's parameters (axis, 0-based; None when robot-wide): parameter name ->
+        standard error, in the parameter's unit.
+    """
+    scale = _rms(tau, split.held_out)
+    scale = np.where(scale > 0, scale, 1.0)
+    fitting = np.flatnonzero(split.fit.any(axis=1))
+    edges = np.linspace(fitting[0], fitting[-1] + 1, blocks + 1).round().astype(int)
+    replicates = []
+    for low, high in zip(edges[:-1], edges[1:], strict=True):
+        rows = split.fit.copy()
+        rows[low:high] = False
+        replicates.append(_fit(effect, motion, residual, rows, scale)[0])
+    keys = [None] if not effect.per_axis else axes
+    errors = {}
+    for key in keys:
+        values = np.array([[r[key][name] for name in replicates[0][key]] for r in replicates], dtype=float)
+        spread = np.sqrt((blocks - 1) / blocks * np.sum((values - values.mean(axis=0)) ** 2, axis=0))
+        errors[key] = {name: float(v) for name, v in zip(replicates[0][key], spread, strict=True)}
+    return errors
 
 
 def _physical(effect: Effect, motion: Motion, axis: int, params: dict[str, float]) -> bool:
