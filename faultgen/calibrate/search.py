@@ -28,6 +28,7 @@ effect is significant on any axis.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -249,7 +250,7 @@ def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: n
     fitting = np.flatnonzero(split.fit.any(axis=1))
     edges = np.linspace(fitting[0], fitting[-1] + 1, blocks + 1).round().astype(int)
     replicates = []
-    for low, high in zip(edges[:-1], edges[1:], strict=True):
+    for low, high in itertools.pairwise(edges):
         rows = split.fit.copy()
         rows[low:high] = False
         replicates.append(_fit(effect, motion, residual, rows, scale)[0])
