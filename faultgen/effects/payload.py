@@ -114,18 +114,17 @@ class Payload(Effect):
             inertia = site_rotation.T @ inertia @ site_rotation
             phi += barycentric(float(model.body_mass[b]), com, _six(inertia))
         mass, com, inertia = from_barycentric(phi)
-        return cls(mass=mass, com_x=com[0], com_y=com[1], com_z=com[2], **dict(zip(INERTIA, inertia, strict=True)))
+        return cls(**_named(mass, com, inertia))
 
     def apply(self, spec, robot, axis, params):
         """Replace any ``payload{n}`` bodies by one body ``payload1`` at the flange carrying
         ``params`` (none when the mass is 0). A point mass gets :data:`POINT_INERTIA`."""
         for body in [b for b in spec.bodies if b.name.startswith("payload")]:
             spec.delete(body)
-        mass = float(params["mass"])
+        mass, com, inertia = _inertial(params)
         if mass <= 0:
             return
-        self._add_body(spec, robot, "payload1", mass, [params[k] for k in ("com_x", "com_y", "com_z")],
-                       [params[k] for k in INERTIA])
+        self._add_body(spec, robot, "payload1", mass, com, inertia)
 
     @staticmethod
     def _add_body(spec, robot, name, mass, com, inertia) -> None:
@@ -177,20 +176,17 @@ class Payload(Effect):
         return phi, np.zeros(phi.shape[:2])
 
     def params(self, motion, axis, theta, h):
-        mass, com, inertia = from_barycentric(barycentric(*self._current_inertial(motion.robot)) + theta)
-        return {"mass": mass, "com_x": float(com[0]), "com_y": float(com[1]), "com_z": float(com[2]),
-                **{name: float(v) for name, v in zip(INERTIA, inertia, strict=True)}}
+        return _named(*from_barycentric(barycentric(*self._current_inertial(motion.robot)) + theta))
 
     def admissible(self, motion, axis, params):
         """A payload adds mass; it is physically consistent (:func:`consistent`); and the drives can
         carry it along the motion: its torque stays within every motor's torque limit."""
         current = self._current_inertial(motion.robot)
-        com = np.array([params["com_x"], params["com_y"], params["com_z"]])
-        inertia = np.array([params[k] for k in INERTIA])
-        if not params["mass"] > current[0] or not consistent(params["mass"], com, inertia):
+        mass, com, inertia = _inertial(params)
+        if not mass > current[0] or not consistent(mass, com, inertia):
             return False
         phi, _ = self.columns(motion, None, None)
-        change = phi @ (barycentric(params["mass"], com, inertia) - barycentric(*current))
+        change = phi @ (barycentric(mass, com, inertia) - barycentric(*current))
         peak = np.max(np.abs(change), axis=0) / motion.robot.gear_ratio  # motor side, N m
         return bool(np.all(peak <= motion.robot.motor_torque_limit))
 
@@ -199,9 +195,19 @@ class Payload(Effect):
         return np.eye(10)[0]
 
     def _current_inertial(self, robot) -> tuple[float, np.ndarray, np.ndarray]:
-        current = self.current(robot)
-        return (float(current.mass), np.array([float(current.com_x), float(current.com_y), float(current.com_z)]),
-                np.array([float(getattr(current, k)) for k in INERTIA]))
+        return _inertial(self.current(robot).values())
+
+
+def _inertial(values: dict[str, float]) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(mass, com (3,), inertia (6,))`` from the named parameters."""
+    return (float(values["mass"]), np.array([values[k] for k in ("com_x", "com_y", "com_z")], dtype=float),
+            np.array([values[k] for k in INERTIA], dtype=float))
+
+
+def _named(mass: float, com: np.ndarray, inertia: np.ndarray) -> dict[str, float]:
+    """The named parameters of ``(mass, com, inertia)``, inverse of :func:`_inertial`."""
+    return {"mass": float(mass), **{k: float(v) for k, v in zip(("com_x", "com_y", "com_z"), com, strict=True)},
+            **{k: float(v) for k, v in zip(INERTIA, inertia, strict=True)}}
 
 
 def _rotation(quat) -> np.ndarray:
