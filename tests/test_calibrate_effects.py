@@ -254,6 +254,12 @@ def test_backlash_search_recovers_the_width(setup, tmp_path):
     np.testing.assert_allclose(found[axis][2], change[:, axis], atol=0.05 * np.max(np.abs(change[:, axis])))
     others = [a for a in range(6) if a != axis]
     assert [found[a][0] for a in others] == [0.0] * len(others)
+    # a jackknife replicate starts from its fit (here 15 % off, beyond one span) and refines
+    # locally to the same width as the full search, changing no other axis
+    start = effect.fitted(robot, {axis: {"width": 1.15 * found[axis][0]}})
+    again = start.replicate(motion, residual, np.ones_like(residual, dtype=bool), scale, [axis])
+    assert again[axis][0] == pytest.approx(found[axis][0], rel=2e-3)
+    assert [again[a][0] for a in others] == [0.0] * len(others)
 
 
 

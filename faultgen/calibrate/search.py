@@ -213,15 +213,19 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0))
 
 
-def _fit(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray
-         ) -> tuple[dict, np.ndarray]:
+def _fit(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray,
+         near: list[int] | None = None) -> tuple[dict, np.ndarray]:
     """``effect`` fitted to ``residual`` (n, 6) on the samples of ``rows`` by its optimiser: the
-    parameters keyed by axis (0-based; None when robot-wide) and the fitted torque (n, 6)."""
+    parameters keyed by axis (0-based; None when robot-wide) and the fitted torque (n, 6).
+    ``near``: ``effect`` is a fit and this a jackknife replicate of it on these axes
+    (:meth:`Effect.replicate`)."""
     if not effect.per_axis:
         theta, contribution = RobotLeastSquares().fit(effect, motion, residual, rows, scale)
         return {None: effect.params(motion, None, theta, None)}, contribution
     # the effect's own search (backlash), else the default optimiser
-    fits = effect.search(motion, residual, rows, scale) or AxisLeastSquares().fit(effect, motion, residual, rows, scale)
+    fits = ((near is not None and effect.replicate(motion, residual, rows, scale, near))
+            or effect.search(motion, residual, rows, scale)
+            or AxisLeastSquares().fit(effect, motion, residual, rows, scale))
     contribution = np.zeros_like(residual)
     params = {}
     for axis, (h, theta, predicted) in enumerate(fits):
@@ -234,7 +238,8 @@ def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: n
                     axes: list[int], blocks: int = JACKKNIFE_BLOCKS) -> dict:
     """Standard errors of ``effect``'s fitted parameters on ``axes`` (0-based), by the delete-one-
     block jackknife over time (Kunsch 1989): the fitting part is cut into ``blocks`` contiguous
-    blocks, the effect is fitted again with each left out, and the spread of the ``blocks`` fits
+    blocks, the effect is fitted again with each left out (near its fit where it
+    can, :meth:`Effect.replicate`), and the spread of the ``blocks`` fits
     gives ``se = sqrt((B - 1) / B * sum (p_b - mean p)^2)``. Blocks of time keep the residual's
     correlation in time (drift, ringing), which a least-squares covariance would take for
     independent samples. A parameter chosen from a grid (pole count) has 0 when no block moves it.
@@ -253,7 +258,7 @@ def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: n
     for low, high in itertools.pairwise(edges):
         rows = split.fit.copy()
         rows[low:high] = False
-        replicates.append(_fit(effect, motion, residual, rows, scale)[0])
+        replicates.append(_fit(effect, motion, residual, rows, scale, near=axes)[0])
     keys = [None] if not effect.per_axis else axes
     errors = {}
     for key in keys:

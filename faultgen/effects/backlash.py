@@ -61,6 +61,9 @@ class Backlash(Effect):
     GRID = tuple(float(b) for b in np.geomspace(2e-4, 0.05, 96))
     #: Widths in the second pass, between the best grid width's neighbours.
     REFINE = 33
+    #: Factor either side of a fitted width over which a jackknife replicate refines it (two
+    #: :data:`GRID` steps).
+    SPAN = 1.06**2
     #: Smallest relative drop of the weighted fitting error for which a dead band on one more
     #: axis is kept. A dead band on one axis leaves coupled ringing on its neighbours that a
     #: small dead band there stands in for: at 0.01 a hidden-backlash log of the IRB-6700-like
@@ -111,12 +114,14 @@ class Backlash(Effect):
         widths[axis] = h
         return np.zeros((len(motion.t), 0)), self._change(motion, widths[None])[0, :, axis]
 
-    def search(self, motion, residual, rows, scale):
+    @staticmethod
+    def _cost(residual, rows, scale):
+        """Weighted squared error on the fitting part of a torque change, (k, n, 6) -> (k,)."""
         weights = 1.0 / scale**2
+        return lambda change: np.sum(np.where(rows, residual - change, 0.0) ** 2, axis=1) @ weights
 
-        def cost(change):  # (k, n, 6) -> (k,): weighted squared error on the fitting part
-            return np.sum(np.where(rows, residual - change, 0.0) ** 2, axis=1) @ weights
-
+    def search(self, motion, residual, rows, scale):
+        cost = self._cost(residual, rows, scale)
         widths = self.current(motion.robot).width.copy()
         change = np.zeros_like(residual)
         error = float(cost(change[None])[0])
@@ -137,6 +142,31 @@ class Backlash(Effect):
                 break
             widths, change, error = fine[j], changes[j], float(costs[j])
             free.remove(axis)
+        return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(N_AXES)]
+
+    def replicate(self, motion, residual, rows, scale, axes):
+        # each fitted axis refined over REFINE widths within SPAN of its value (re-centred while
+        # the best is at an edge), then over REFINE widths between the best one's neighbours (steps
+        # of 0.05 %), one axis after the other: 12-25 times fewer trials than :meth:`search`;
+        # the replicates' widths move by 0.3-3 % (2-cycle hidden-effect logs)
+        cost = self._cost(residual, rows, scale)
+        widths = self.width.copy()
+
+        def best(axis, low, high):
+            fine = np.tile(widths, (self.REFINE, 1))
+            fine[:, axis] = np.geomspace(low, high, self.REFINE)
+            j = int(np.argmin(cost(self._change(motion, fine))))
+            return fine, j
+
+        for axis in axes:
+            for _ in range(4):
+                fine, j = best(axis, widths[axis] / self.SPAN, widths[axis] * self.SPAN)
+                widths = fine[j]
+                if 0 < j < self.REFINE - 1:
+                    break
+            fine, j = best(axis, fine[max(j - 1, 0), axis], fine[min(j + 1, self.REFINE - 1), axis])
+            widths = fine[j]
+        change = self._change(motion, widths[None])[0]
         return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(N_AXES)]
 
     def params(self, motion, axis, theta, h):

@@ -406,6 +406,14 @@ class Effect:
         squares over :meth:`grid` and :meth:`columns`."""
         return None
 
+    def replicate(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray,
+                  axes: list[int]) -> list | None:
+        """A jackknife replicate of this *fitted* effect (:func:`faultgen.calibrate.search.
+        standard_errors`): its fit to ``residual`` on ``rows`` like :meth:`search`, allowed to
+        start from its own values on ``axes`` (0-based), since a replicate leaves out one block of
+        the data and lands near the full fit. None (the default): fitted afresh."""
+        return None
+
     def columns(self, motion: Motion, axis: int | None, h) -> tuple[np.ndarray, np.ndarray]:
         """Regressors ``Phi`` (n, k) and known part ``offset`` (n,) of the torque change of
         ``axis`` (0-based) over ``motion.robot``, or of all axes ``(n, 6, k)`` / ``(n, 6)`` when
