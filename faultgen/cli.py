@@ -49,6 +49,47 @@ class PlainHelpGroup(_PlainHelp, TyperGroup):
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 
+#: Operating-condition options of `simulate` and `sweep` (faultgen.operation.conditions).
+Temperature = Annotated[bool, typer.Option(
+    "--temperature", help="Joint temperature on: hall air 20 degC +- 5 K seasonal +- 2 K daily, joints warming "
+    "15 K over a shift (1 h time constant), friction following the gear oil's viscosity (docs/simulation.md).")]
+PayloadParts = Annotated[str | None, typer.Option(
+    "--payloads", help="Parts carried, MASS:SIZE in kg:m, comma-separated, e.g. 20:0.2,80:0.4 (uniform cubes "
+    "hanging from the flange; the controller knows each).")]
+PayloadPattern = Annotated[str, typer.Option(
+    help="Which part each cycle carries: alternate, blocks (10 cycles each) or random.")]
+UnitSpreadFlag = Annotated[bool, typer.Option(
+    "--unit-spread", help="The run's robot draws its own friction levels (15 % log-normal per axis) and link masses "
+    "(2 %) from its seed; the controller keeps the nominal model.")]
+CyclesPerDay = Annotated[int, typer.Option(
+    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).")]
+StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
+
+
+def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
+                start_day: float) -> dict | None:
+    """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
+    no condition is on. Raises ValueError naming a malformed ``--payloads`` part."""
+    table: dict = {}
+    if temperature:
+        table["thermal"] = {}
+    if payloads:
+        masses, sizes = [], []
+        for part in payloads.split(","):
+            try:
+                mass, size = (float(v) for v in part.split(":"))
+            except ValueError:
+                raise ValueError(f"--payloads part {part.strip()!r}: expected MASS:SIZE in kg:m, e.g. 20:0.2") from None
+            masses.append(mass)
+            sizes.append(size)
+        table["payloads"] = {"masses": masses, "sizes": sizes, "pattern": pattern}
+    if spread:
+        table["spread"] = {}
+    if not table:
+        return None
+    return {**table, "cycles_per_day": cycles_per_day, "start_day": start_day}
+
+
 app = typer.Typer(
     cls=PlainHelpGroup,
     help=(
@@ -163,6 +204,12 @@ def simulate_command(
     ] = 0.01,
     encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).")] = 1e-4,
     threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.")] = 0,
+    temperature: Temperature = False,
+    payloads: PayloadParts = None,
+    payload_pattern: PayloadPattern = "alternate",
+    unit_spread: UnitSpreadFlag = False,
+    cycles_per_day: CyclesPerDay = 1,
+    start_day: StartDay = 0.0,
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")] = Path("run.h5"),
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
@@ -177,8 +224,11 @@ def simulate_command(
       faultgen simulate --robot irb6700 --task pick_place --wear 1:exp4:20 --cycles 100 -o axis1.h5
 
       faultgen simulate --task spot_weld --wear 2:exp4:20 --wear 5:linear:10 --record 1,100 -o two.h5
+
+      faultgen simulate --wear 3:exp4:20 --temperature --payloads 20:0.2,80:0.4 --unit-spread -o real.h5
     """
     from faultgen.data import dataset
+    from faultgen.operation import conditions as conditions_module
     from faultgen.operation import wear as wear_module
     from faultgen.simulation import sensors
     from faultgen.simulation import stepping as sim
@@ -192,6 +242,8 @@ def simulate_command(
             wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
             record=None if record is None else _parse_cycles(record), seed=seed,
             noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
+            conditions=conditions_module.Conditions.from_dict(
+                _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day) or {}),
         )
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
@@ -270,6 +322,12 @@ def sweep_command(
     cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
     record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
     seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    temperature: Temperature = False,
+    payloads: PayloadParts = None,
+    payload_pattern: PayloadPattern = "alternate",
+    unit_spread: UnitSpreadFlag = False,
+    cycles_per_day: CyclesPerDay = 1,
+    start_day: StartDay = 0.0,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
@@ -290,6 +348,8 @@ def sweep_command(
       faultgen sweep --preset j2 --jobs 2 -o j2.h5
 
       faultgen sweep --robot puma560 --task spot_weld --axis 0 --axis 3 --wear-pct 10 --wear-pct 20 -o s.h5
+
+      faultgen sweep --preset j2 --temperature --unit-spread -o j2-conditions.h5
     """
     from faultgen.runs import sweep
 
@@ -298,6 +358,9 @@ def sweep_command(
                "record": record}
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     try:
+        table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day)
+        if table is not None:
+            options["conditions"] = table
         if record is not None:
             options["record"] = list(_parse_cycles(record))
         if config is not None:
@@ -650,6 +713,17 @@ def _summary(result, out: Path) -> str:
         " " * 30 + "".join(f"{'axis ' + str(i):>11}" for i in range(1, 7)),
     ]
     lines += [f"{title:<30}" + "".join(f"{v:>11{fmt}}" for v in values) for title, values, fmt in rows]
+    c = result.conditions
+    if c is not None:
+        lines.append(f"conditions, last cycle: day {c.day[last]:.0f} at {c.hour[last]:.1f} h; dry friction x "
+                     + " ".join(f"{v:.3f}" for v in c.dry_friction_factor[last]) + ", viscous x "
+                     + " ".join(f"{v:.3f}" for v in c.viscous_factor[last]))
+        if config.conditions.thermal is not None:
+            lines.append(f"  joint temperature {np.min(c.joint_temperature):.1f}..{np.max(c.joint_temperature):.1f} degC "
+                         "over the recorded cycles")
+        if config.conditions.payloads is not None:
+            lines.append("  payload mass per cycle [kg]: " + " ".join(f"{m:g}" for m in c.payload_mass[:12])
+                         + (" ..." if len(c.payload_mass) > 12 else ""))
     lines.append(f"read it with: python -c \"from faultgen import dataset; a, labels = dataset.read_run('{out}')\"")
     return "\n".join(lines)
 

@@ -15,6 +15,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
         friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
         mean_abs_torque, rms_torque                                       (n_cycles, 6) features
         angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
+        day, hour, joint_temperature, ...      operating conditions per cycle, truth (only runs
+                                               with conditions: CONDITION_ARRAYS; attr conditions)
 
 A file is written under a temporary name in its target folder and renamed into place once
 complete, so a crash or kill never leaves a file at the target path that looks finished; a
@@ -69,6 +71,22 @@ ARRAYS = {
     "torque_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..peak motor torque"),
 }
 
+#: name -> (units, axes, description, condition that writes it) of the operating-condition
+#: arrays (:mod:`faultgen.operation.conditions`), written for a run that has conditions: the
+#: calendar and the friction factors always, the rest when their condition is on.
+CONDITION_ARRAYS = {
+    "day": ("d", "cycle", "day of the year of the cycle (counts on past 365)", None),
+    "hour": ("h", "cycle", "time of day of the cycle", None),
+    "dry_friction_factor": ("1", "cycle, axis", ("multiplier of Coulomb and static friction from temperature and "
+                                                 "unit spread (wear not included)"), None),
+    "viscous_factor": ("1", "cycle, axis", "multiplier of viscous friction from temperature and unit spread", None),
+    "ambient_temperature": ("degC", "cycle", "air temperature", "thermal"),
+    "joint_temperature": ("degC", "cycle, axis", "joint temperature", "thermal"),
+    "payload_part": ("1", "cycle", "index of the part carried (into the conditions' payload masses)", "payloads"),
+    "payload_mass": ("kg", "cycle", "mass of the part carried", "payloads"),
+    "link_mass_factor": ("1", "axis", "multiplier of each link's mass and inertia (this unit's)", "spread"),
+}
+
 #: Attributes every run group carries.
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
@@ -85,12 +103,15 @@ def model_hash(path: Path) -> str:
 
 def config_key(config) -> str:
     """The run configuration as canonical JSON: equal keys mean the same simulation."""
-    return json.dumps({
+    key = {
         "robot": config.robot, "task": config.task, "friction": config.friction,
         "wear": config.wear.to_dict(), "cycles": int(config.cycles),
         "record": [int(c) for c in config.recorded_cycles], "seed": int(config.seed),
         "noise": asdict(config.noise),
-    }, sort_keys=True)
+    }
+    if config.conditions.active:  # runs without conditions keep the keys they had before conditions existed
+        key["conditions"] = config.conditions.to_dict()
+    return json.dumps(key, sort_keys=True)
 
 
 def run_attributes(result, command: str = "") -> dict:
@@ -111,7 +132,16 @@ def run_attributes(result, command: str = "") -> dict:
         "log_period": sensors.LOG_PERIOD,
         "config": config_key(config),
         "command": command,
+        **({"conditions": json.dumps(config.conditions.to_dict())} if config.conditions.active else {}),
     }
+
+
+def _condition_arrays(conditions: dict | None) -> list[str]:
+    """The :data:`CONDITION_ARRAYS` a run with ``conditions`` (its JSON labels; None: none) has."""
+    if not conditions:
+        return []
+    return [name for name, (*_, condition) in CONDITION_ARRAYS.items()
+            if condition is None or conditions.get(condition) is not None]
 
 
 def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
@@ -150,6 +180,13 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
                 ds = group.create_dataset(name, data=data.astype(np.float32), chunks=(1, *data.shape[1:]))
             else:
                 ds = group.create_dataset(name, data=data, compression="gzip", compression_opts=4, shuffle=True)
+            ds.attrs["units"] = units
+            ds.attrs["axes"] = axes
+            ds.attrs["description"] = description
+        conditions = result.config.conditions
+        for name in _condition_arrays(conditions.to_dict() if conditions.active else None):
+            units, axes, description, _ = CONDITION_ARRAYS[name]
+            ds = group.create_dataset(name, data=np.asarray(getattr(result.conditions, name)))
             ds.attrs["units"] = units
             ds.attrs["axes"] = axes
             ds.attrs["description"] = description
@@ -244,7 +281,9 @@ def features(path: str | Path) -> pd.DataFrame:
     none), ``cycle`` (1-based), ``axis`` (1..6), ``worn`` (this axis wears in this run),
     ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
     then every array of :data:`ARRAYS` with axes "cycle, axis" under its own name and every
-    histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` .. ``torque_hist_12``.
+    histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` .. ``torque_hist_12``,
+    and, for runs with operating conditions, each of their :data:`CONDITION_ARRAYS` (a per-cycle
+    value on each of the cycle's rows, a per-axis one on each axis's; empty for runs without).
     Values are the stored ones, in the units of :data:`ARRAYS`; ``DataFrame.attrs["units"]`` maps
     each column to its unit.
 
@@ -261,6 +300,8 @@ def features(path: str | Path) -> pd.DataFrame:
     for run_id in list_runs(path):
         arrays, attrs = read_run(path, run_id, names=("cycles", *per_cycle, *histograms))
         n_cycles, n_axes = arrays["friction_multiplier"].shape
+        present = _condition_arrays(json.loads(attrs["conditions"]) if "conditions" in attrs else None)
+        conditions = read_run(path, run_id, names=present)[0] if present else {}
         worn = {int(a) for a in attrs["worn_axes"]}
         columns = {"run": run_id, **{key: attrs[key] for key in FEATURE_LABELS},
                    "worn_axes": " ".join(str(a) for a in sorted(worn)),
@@ -268,12 +309,17 @@ def features(path: str | Path) -> pd.DataFrame:
                    "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
                    "wear_pct": ((arrays["friction_multiplier"] - 1.0) * 100.0).ravel()}
         columns.update({name: arrays[name].ravel() for name in per_cycle})
+        for name, values in conditions.items():  # per cycle, per axis or per unit, to rows
+            axes = CONDITION_ARRAYS[name][1]
+            columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)
+                             if axes == "cycle" else np.tile(values, n_cycles))
         for name in histograms:
             bins = arrays[name].reshape(n_cycles * n_axes, -1)
             columns.update({f"{name}_{k + 1}": bins[:, k] for k in range(bins.shape[1])})
         frames.append(pd.DataFrame(columns))
     table = pd.concat(frames, ignore_index=True)
     table.attrs["units"] = {"wear_pct": "%", **{name: ARRAYS[name][0] for name in per_cycle},
+                            **{name: CONDITION_ARRAYS[name][0] for name in CONDITION_ARRAYS if name in table},
                             **{c: ARRAYS[c.rsplit("_", 1)[0]][0] for c in table.columns
                                if c.rsplit("_", 1)[0] in histograms}}
     return table
@@ -339,12 +385,17 @@ def validate(path: str | Path) -> list[str]:
 
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
-    missing = [name for name in ARRAYS if name not in group]
+    try:
+        conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
+    except ValueError:
+        return [*problems, "conditions attribute is not JSON"]
+    schema = {**ARRAYS, **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
+    missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:
         return problems
     data = {}
-    for name, (units, axes, _) in ARRAYS.items():
+    for name, (units, axes, _) in schema.items():
         ds = group[name]
         if _attr(ds.attrs.get("units")) != units or _attr(ds.attrs.get("axes")) != axes:
             problems.append(f"{name}: units/axes attributes {ds.attrs.get('units')!r}/{ds.attrs.get('axes')!r}, "
@@ -357,10 +408,10 @@ def _validate_run(group: h5py.Group) -> list[str]:
         if not np.all(np.isfinite(data[name])):
             problems.append(f"{name}: holds non-finite values")
     n_cycles, n_log = len(data["cycles"]), len(data["t"])
-    for name, (_, axes, _) in ARRAYS.items():
+    for name, (_, axes, _) in schema.items():
         expected = {SIGNAL_AXES: (n_cycles, n_log, 6), "cycle, axis": (n_cycles, 6),
                     "cycle, axis, bin": (n_cycles, 6, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, 6),
-                    "sample": (n_log,), "cycle": (n_cycles,)}[axes]
+                    "sample": (n_log,), "cycle": (n_cycles,), "axis": (6,)}[axes]
         if data[name].shape != expected:
             problems.append(f"{name}: shape {data[name].shape}, expected {expected}")
     if problems:
@@ -371,8 +422,9 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name in ("angle_hist", "speed_hist", "torque_hist"):
         if not np.allclose(data[name].sum(axis=-1), 1.0):
             problems.append(f"{name}: a histogram does not sum to 1")
-    if np.any(data["friction_multiplier"] <= 0):
-        problems.append("friction_multiplier: not positive")
+    for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
+        if name in data and np.any(data[name] <= 0):
+            problems.append(f"{name}: not positive")
     return problems
 
 

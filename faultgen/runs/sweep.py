@@ -39,6 +39,7 @@ from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
 from faultgen.operation import tasks, wear
+from faultgen.operation.conditions import Conditions
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -92,6 +93,10 @@ class Grid:
     seeds : list of int
     disturbance, encoder : float
         Noise levels (:class:`faultgen.sensors.NoiseConfig`).
+    conditions : dict or None
+        Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
+        ``temperature``, ``payloads``, ``spread`` tables, ``cycles_per_day``, ``start_day``); None:
+        none, the runs differ from their references only by wear.
 
     Raises
     ------
@@ -110,6 +115,7 @@ class Grid:
     seeds: list[int] = field(default_factory=lambda: [0])
     disturbance: float = 0.01
     encoder: float = 1e-4
+    conditions: dict | None = None
 
     def __post_init__(self) -> None:
         for name in ("robots", "tasks", "axes", "increases", "schedules", "seeds"):
@@ -176,6 +182,9 @@ class Grid:
     def _build_runs(self) -> list[tuple[str, sim.RunConfig]]:
         noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
         record = self.recorded_cycles()
+        if self.conditions is not None and not isinstance(self.conditions, dict):
+            raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
+        conditions = Conditions.from_dict(self.conditions or {})
         out: dict[str, sim.RunConfig] = {}
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
             name = robots.load(robot).name
@@ -189,7 +198,7 @@ class Grid:
                     label = f"axis{axis}-{kind}{pct:g}"
                 out[f"{name}-{task}-{label}-seed{seed}"] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1)
+                    seed=seed, noise=noise, nthread=1, conditions=conditions)
         return list(out.items())
 
     def to_json(self) -> str:

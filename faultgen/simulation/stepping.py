@@ -28,8 +28,10 @@ from tqdm.auto import tqdm
 
 from faultgen.effects import friction
 from faultgen.effects.base import Effect
+from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation import tasks
+from faultgen.operation.conditions import Conditions, CycleConditions
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import control, sensors
 
@@ -74,14 +76,17 @@ class RunConfig:
         Step the cycles one after the other in one simulation, each starting where the previous
         one ended (gearbox deflections, backlash flanks, drive integrators carry over), instead of
         each from the start state. Only without wear and with every cycle recorded.
+    conditions : Conditions
+        Operating conditions over the cycles (joint temperature, payloads, unit spread;
+        :mod:`faultgen.operation.conditions`); none by default.
 
     Raises
     ------
     ValueError
         On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
-        1..cycles, a negative seed or nthread, or ``back_to_back`` with wear or a ``record``
-        subset; the message names the value.
+        1..cycles, a negative seed or nthread, or ``back_to_back`` with wear, operating conditions
+        or a ``record`` subset; the message names the value.
     """
 
     robot: str
@@ -94,6 +99,7 @@ class RunConfig:
     noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
     nthread: int = 0
     back_to_back: bool = False
+    conditions: Conditions = field(default_factory=Conditions)
 
     def __post_init__(self) -> None:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
@@ -114,10 +120,14 @@ class RunConfig:
             raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
         if self.nthread < 0:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
-        if self.back_to_back and (self.wear.schedules or self.record not in (None, tuple(range(1, self.cycles + 1)))):
-            raise ValueError("back_to_back runs step every cycle in one simulation without wear; got wear on "
-                             f"axes {list(self.wear.schedules)} and record = {self.record!r}: drop the wear "
-                             "and record, or run the cycles independently")
+        if not isinstance(self.conditions, Conditions):
+            raise TypeError(f"conditions: expected a Conditions, got {type(self.conditions).__name__}")
+        if self.back_to_back and (self.wear.schedules or self.conditions.active
+                                  or self.record not in (None, tuple(range(1, self.cycles + 1)))):
+            raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "
+                             f"conditions; got wear on axes {list(self.wear.schedules)}, conditions "
+                             f"{'on' if self.conditions.active else 'off'} and record = {self.record!r}: drop "
+                             "them, or run the cycles independently")
 
     @property
     def recorded_cycles(self) -> np.ndarray:
@@ -225,8 +235,9 @@ def applied_drive_torque(force: np.ndarray, v: np.ndarray, v_before: np.ndarray,
     return np.where(np.abs(force) < limit, force - change, force)
 
 
-def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
-    """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model.
+def build(robot: robots.Robot, friction_model: str = "lugre", edit=None) -> SimModel:
+    """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model;
+    ``edit(spec)``, when given, is applied to the MJCF first (as :meth:`Robot.edited` made ``robot``).
 
     Raises
     ------
@@ -235,6 +246,8 @@ def build(robot: robots.Robot, friction_model: str = "lugre") -> SimModel:
     """
     friction.check_model(friction_model)
     spec = mujoco.MjSpec.from_file(str(robot.path))
+    if edit is not None:
+        edit(spec)
     gains = control.ServoGains.for_robot(robot)
     control.add_drives(spec, robot, gains)
     if friction_model == "lugre":
@@ -304,6 +317,8 @@ class RunResult:
         Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
         ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
         ``torque_hist`` (n_cycles, 6, 12).
+    conditions : CycleConditions or None
+        The operating conditions of each recorded cycle (None when the run has none).
     stepping_time : float
         Wall time spent stepping the physics, s (not part of the recorded data).
     """
@@ -323,6 +338,7 @@ class RunResult:
     mean_friction_torque: np.ndarray
     tracking_error: np.ndarray
     features: dict[str, np.ndarray] = field(default_factory=dict)
+    conditions: CycleConditions | None = None
     stepping_time: float = field(default=0.0, compare=False)
 
 
@@ -366,6 +382,8 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
     dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
+    conditions = config.conditions.evaluate(config.seed, cycles) if config.conditions.active else None
+    plant = _Plant.of(multiplier, conditions)
 
     stepper = _step_lugre if config.friction == "lugre" else _step_stribeck
     with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
@@ -374,16 +392,25 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         started = time.perf_counter()
         if config.back_to_back:  # one simulation over the cycles' set-points one after the other
             chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
-            one = stepper(sim, _Work(cycles[:1], multiplier[:1], path.q[0], chained,
+            one = stepper(sim, _Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
             raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
-        else:
-            groups = [slice(i, i + BATCH_CYCLES) for i in range(0, len(cycles), BATCH_CYCLES)]
-            raws = [stepper(sim, _Work(cycles[g], multiplier[g], path.q[0], inputs, dist[g], per_log, config.nthread),
-                            bar) for g in groups]
-            raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws]) for f in fields(_Raw)})
+        else:  # the cycles of each payload (its own model and feedforward) in batches of BATCH_CYCLES
+            parts = conditions.payload_part if conditions is not None else np.full(len(cycles), -1)
+            order, raws = [], []
+            for part in np.unique(parts):
+                carrying = np.flatnonzero(parts == part)
+                variant = prepared if part < 0 else _prepared(
+                    config.robot, config.task, config.friction, config.conditions.payloads.parameters(int(part)))
+                for i in range(0, len(carrying), BATCH_CYCLES):
+                    g = carrying[i:i + BATCH_CYCLES]
+                    raws.append(stepper(variant.sim, _Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
+                                                           dist[g], per_log, config.nthread), bar))
+                    order.append(g)
+            back = np.argsort(np.concatenate(order))  # to the order of the cycles
+            raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
-    result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time)
+    result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     return result
@@ -419,14 +446,48 @@ class Prepared:
 
 
 @dataclass(frozen=True)
+class _Plant:
+    """How each simulated cycle's robot differs from the nominal model: multipliers of the dry
+    (Coulomb and static: wear, temperature, unit) and the viscous friction (n, 6), and of each
+    link's mass and inertia (6,)."""
+
+    dry: np.ndarray
+    viscous: np.ndarray
+    link_mass: np.ndarray
+
+    @classmethod
+    def of(cls, wear: np.ndarray, conditions: CycleConditions | None) -> _Plant:
+        if conditions is None:
+            return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]))
+        return cls(wear * conditions.dry_friction_factor, conditions.viscous_factor, conditions.link_mass_factor)
+
+    def take(self, rows) -> _Plant:
+        return _Plant(self.dry[rows], self.viscous[rows], self.link_mass)
+
+    def apply(self, sim: SimModel, batch) -> None:
+        """The viscous and link-mass changes as per-simulation model fields of ``batch`` (the dry
+        friction is set by each stepper); nothing is expanded where nothing changes."""
+        robot, model = sim.robot, sim.model
+        if np.any(self.viscous != 1):
+            if sim.friction_model == "lugre":
+                batch.expand("actuator_damping")[:, sim.lugre_ids] *= self.viscous
+            else:
+                batch.expand("dof_damping")[:, robot.rotor_dof] *= self.viscous
+        if np.any(self.link_mass != 1):
+            links = model.jnt_bodyid[[model.joint(n).id for n in robot.joint_names]]
+            batch.expand("body_mass")[:, links] *= self.link_mass
+            batch.expand("body_inertia")[:, links] *= self.link_mass[:, None]
+
+
+@dataclass(frozen=True)
 class _Work:
-    """One batch of simulations stepped together: recorded ``cycles`` (n,), their wear
-    ``multiplier`` (n, 6), the start angles ``q0`` (6,), the drive ``inputs`` at every physics step
+    """One batch of simulations stepped together: recorded ``cycles`` (n,), their ``plant`` (wear
+    and conditions), the start angles ``q0`` (6,), the drive ``inputs`` at every physics step
     (n_steps + 1, 6, 3), the load disturbance ``dist`` per log period (n, n_log, 6), physics steps
     per log period and MuJoCo threads."""
 
     cycles: np.ndarray
-    multiplier: np.ndarray
+    plant: _Plant
     q0: np.ndarray
     inputs: np.ndarray
     dist: np.ndarray
@@ -434,11 +495,37 @@ class _Work:
     nthread: int
 
 
-def _prepared(robot: str, task: str, friction_model: str) -> Prepared:
-    """:func:`_prepare`, renewed when the robot's model or task file changes."""
+def _prepared(robot: str, task: str, friction_model: str, payload: dict | None = None) -> Prepared:
+    """:func:`_prepare`, renewed when the robot's model or task file changes; ``payload``: the
+    :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries."""
     model_file = robots.load(robot).path
     stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
-    return _prepare(robot, task, friction_model, *stamps)
+    if payload is None:
+        return _prepare(robot, task, friction_model, *stamps)
+    return _prepare_carrying(robot, task, friction_model, tuple(sorted(payload.items())), *stamps)
+
+
+@functools.lru_cache(maxsize=16)
+def _prepare_carrying(robot_name: str, task_name: str, friction_model: str, payload: tuple, *file_stamps: int
+                      ) -> Prepared:
+    """The :class:`Prepared` of a robot carrying a payload (``(name, value)`` pairs of the
+    :class:`~faultgen.effects.payload.Payload` parameters, written as a body at the flange): the
+    nominal task path, and a model and feedforward with the payload in them (the controller knows
+    the load it carries)."""
+    nominal = _prepare(robot_name, task_name, friction_model, *file_stamps)
+    robot = robots.load(robot_name)
+    load = Payload(**dict(payload))
+
+    def carry(spec):
+        load.write(spec, robot)
+
+    carrying = robot.edited(carry)
+    sim = build(carrying, friction_model, edit=carry)
+    n_steps = len(nominal.inputs) - 1
+    path = nominal.path
+    inputs = sim.setpoints(nominal.q_ref, *(hold_end(a, n_steps) for a in (path.qd, path.qdd)))
+    inputs.setflags(write=False)
+    return Prepared(sim, nominal.task, path, nominal.q_ref, inputs)
 
 
 @functools.lru_cache(maxsize=8)
@@ -495,17 +582,19 @@ def _new_batch(sim: SimModel, work: _Work) -> mjbatch.Batch:
     batch = mjbatch.Batch(sim.model, nsim=len(work.cycles), nthread=work.nthread)
     batch.qpos, batch.qvel = start_state(sim.robot, work.q0)
     batch.act = 0.0
+    work.plant.apply(sim, batch)
     return batch
 
 
 def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
     """All physics in MuJoCo: set-points and disturbances handed over one chunk at a time."""
     robot, model = sim.robot, sim.model
-    cycles, multiplier, inputs, dist, per_log = work.cycles, work.multiplier, work.inputs, work.dist, work.per_log
+    cycles, dry, inputs, dist, per_log = work.cycles, work.plant.dry, work.inputs, work.dist, work.per_log
+    viscous = robot.friction.viscous * work.plant.viscous[:, None, :]
     batch = _new_batch(sim, work)
     bias = batch.expand("actuator_biasprm")
-    bias[:, sim.lugre_ids, 3] *= multiplier  # Coulomb level F_c
-    bias[:, sim.lugre_ids, 4] *= multiplier  # breakaway level F_s
+    bias[:, sim.lugre_ids, 3] *= dry  # Coulomb level F_c
+    bias[:, sim.lugre_ids, 4] *= dry  # breakaway level F_s
     n_sim, n_steps = len(cycles), len(inputs) - 1
     spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
     chunk = min(CHUNK_PERIODS * per_log, n_steps)
@@ -538,7 +627,7 @@ def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
         logs["qd_m"][:, logged] = v_m
         logs["tau_m"][:, logged] = applied[:, :, sim.drive_ids]
         # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
-        logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + robot.friction.viscous * v_m
+        logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + viscous * v_m
         bar.update(n_sim * size * model.opt.timestep)
     return _Raw(**logs)
 
@@ -546,7 +635,8 @@ def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
 def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     """Static friction: the friction-loss level follows the rotor speed before every step."""
     robot, model = sim.robot, sim.model
-    cycles, multiplier, inputs, dist, per_log = work.cycles, work.multiplier, work.inputs, work.dist, work.per_log
+    cycles, dry, inputs, dist, per_log = work.cycles, work.plant.dry, work.inputs, work.dist, work.per_log
+    viscous = robot.friction.viscous * work.plant.viscous
     batch = _new_batch(sim, work)
     frictionloss = batch.expand("dof_frictionloss")
     qvel, qpos = batch.bind("qvel"), batch.bind("qpos")
@@ -563,7 +653,7 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     factors = [e for e in _stepped(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
     extras = [e for e in _stepped(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
     for step in range(n_steps):
-        level = multiplier
+        level = dry
         for effect in factors:
             level = level * effect.dry_friction_factor(run_start + step * dt)
         frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
@@ -585,7 +675,7 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
             logs["qd_a"][:, j] = qvel[:, arm]
             logs["qd_m"][:, j] = v_m
             logs["tau_m"][:, j] = sim.applied_force(force, v_m, v_before)[:, sim.drive_ids]
-            logs["tau_f"][:, j] = -constraint[:, rotor] + robot.friction.viscous * v_m
+            logs["tau_f"][:, j] = -constraint[:, rotor] + viscous * v_m
             bar.update(len(cycles) * per_log * model.opt.timestep)
             if (j + 1) % CHUNK_PERIODS == 0 or j == n_log - 1:
                 _check(sim, batch, cycles, logs["qd_m"][:, : j + 1], step)
@@ -609,7 +699,8 @@ def _check(sim: SimModel, batch, cycles: np.ndarray, velocities: np.ndarray, ste
         )
 
 
-def _measure(sim, config, cycles, multiplier, q_ref, dist, raw: _Raw, stepping_time: float) -> RunResult:
+def _measure(sim, config, cycles, multiplier, q_ref, dist, raw: _Raw, stepping_time: float,
+             conditions: CycleConditions | None = None) -> RunResult:
     """Apply the sensors to the true signals and compute the per-cycle truth."""
     n_log = raw.q_a.shape[1]
     t = np.arange(1, n_log + 1) * sensors.LOG_PERIOD
@@ -636,5 +727,6 @@ def _measure(sim, config, cycles, multiplier, q_ref, dist, raw: _Raw, stepping_t
         friction_multiplier=multiplier,
         mean_friction_torque=np.mean(np.abs(raw.tau_f), axis=1),
         tracking_error=np.max(np.abs(raw.q_a - q_ref), axis=1),
+        conditions=conditions,
         stepping_time=stepping_time,
     )

@@ -1,0 +1,359 @@
+"""Operating conditions over the cycles of a run: joint temperature, payload, unit-to-unit spread.
+
+On real robots friction and torque move with the joints' temperature and the load as much as
+with wear (Bittencourt & Gunnarsson 2012; thesis ch. 5.3 and ref. [103]), and no two units of a
+type are alike. A dataset whose runs differ only by wear flatters every detector and isolator;
+these conditions dial realism in. Like wear (:mod:`faultgen.operation.wear`) they are schedules
+over a run's cycles, evaluated for the recorded ones (:meth:`Conditions.evaluate`) and written to
+the dataset as truth, per cycle.
+
+**The robot's calendar.** Recorded cycle ``k`` (1-based) runs on day ``(k - 1) // cycles_per_day``
+of the run, counted from ``start_day`` (day of the year of cycle 1), at a time of day drawn
+uniformly within the production hours from the run's seed: a 100-cycle run with one cycle a day
+spans 100 days of the robot's life, which is what a wear schedule over 100 cycles stands for.
+
+**Joint temperature** (:class:`Temperature`): the ambient air of the hall, a seasonal and a
+daily cosine around a mean, plus the heat of running: a joint that starts cold at the start of
+a shift approaches ``rise`` above ambient with the joint's thermal time constant,
+``T = T_amb + rise (1 - exp(-s / tau))``, ``s`` the time since the shift started (a stop between
+shifts is long against ``tau``, so a shift starts at ambient). Friction follows the joint
+temperature through :func:`faultgen.effects.temperature.friction_factors` (the oil's viscosity,
+ASTM D341; Petroff's law for the viscous part).
+
+**Payload** (:class:`Payloads`): the part the robot carries in a cycle, one of a set, chosen by a
+pattern (alternating, in blocks, or at random); each part a uniform cube hanging from the flange
+(:class:`faultgen.effects.payload.Payload`). The controller knows the part (the load data an
+industrial program sets before each move), so its feedforward carries it.
+
+**Unit-to-unit spread** (:class:`UnitSpread`): the run's robot draws its own friction levels
+(Coulomb and static, viscous; per axis, log-normal) and link masses (per link, normal) around the
+nominal model, from the run's seed; the controller keeps the nominal model.
+
+The numbers of the defaults are ours and stated as such in the attribute docs: no published
+plant record of joint temperatures or unit spread was at hand (docs/simulation.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from faultgen.axes import N_AXES
+from faultgen.effects import temperature as temperature_law
+
+#: Seconds in a day.
+DAY = 86400.0
+#: Random streams of the conditions (the sensors use 0 and 1 per cycle).
+_TIME_OF_DAY, _PAYLOAD, _UNIT = 10, 11, 12
+#: Payload patterns.
+PATTERNS = ("alternate", "blocks", "random")
+
+
+def _finite(name: str, value: float, low: float = -math.inf, high: float = math.inf) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or not low <= value <= high:
+        raise ValueError(f"{name} = {value!r}: expected a number within {low:g}..{high:g}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Temperature:
+    """Joint temperature over the robot's calendar (module docstring); deg C, K, h, s.
+
+    Attributes
+    ----------
+    ambient : float
+        Yearly mean air temperature of the hall, deg C (default 20: a heated factory hall).
+    seasonal : float
+        Amplitude of the seasonal cosine, K, warmest on ``warmest_day`` (default 5 K, day 200).
+    daily : float
+        Amplitude of the daily cosine, K, warmest at 15:00 (default 2 K).
+    rise : float
+        Joint temperature above ambient after a long time running, K (default 15: the nominal
+        friction holds at 20 + 15 deg C, :data:`faultgen.effects.temperature.REFERENCE_TEMPERATURE`).
+    time_constant : float
+        Thermal time constant of a joint, s (default 3600).
+    shift : tuple of float
+        Production hours, start and end, h (default 6 to 22: two shifts).
+    warmest_day : float
+        Day of the year of the seasonal maximum (default 200, mid-July in the northern hemisphere).
+
+    Raises
+    ------
+    ValueError
+        On construction, for a value outside its range; the message names it.
+    """
+
+    ambient: float = 20.0
+    seasonal: float = 5.0
+    daily: float = 2.0
+    rise: float = 15.0
+    time_constant: float = 3600.0
+    shift: tuple[float, float] = (6.0, 22.0)
+    warmest_day: float = 200.0
+
+    def __post_init__(self) -> None:
+        _finite("ambient", self.ambient, -20, 60)
+        _finite("seasonal", self.seasonal, 0, 30)
+        _finite("daily", self.daily, 0, 15)
+        _finite("rise", self.rise, 0, 60)
+        _finite("time_constant", self.time_constant, 60, 10 * DAY)
+        _finite("warmest_day", self.warmest_day, 0, 366)
+        if len(self.shift) != 2:
+            raise ValueError(f"shift = {self.shift!r}: expected (start, end) in hours")
+        start, end = (_finite("shift hour", h, 0, 24) for h in self.shift)
+        if not start < end:
+            raise ValueError(f"shift = {self.shift!r}: the start must come before the end")
+        object.__setattr__(self, "shift", (start, end))
+
+    def ambient_at(self, day: np.ndarray, hour: np.ndarray) -> np.ndarray:
+        """Air temperature, deg C, on day of the year ``day`` at ``hour`` (arrays of one shape)."""
+        season = np.cos(2 * np.pi * (np.asarray(day) - self.warmest_day) / 365.0)
+        daily = np.cos(2 * np.pi * (np.asarray(hour) - 15.0) / 24.0)
+        return self.ambient + self.seasonal * season + self.daily * daily
+
+    def joint_at(self, day: np.ndarray, hour: np.ndarray) -> np.ndarray:
+        """Joint temperature, deg C, at ``hour`` of ``day`` within a shift (module docstring)."""
+        running = (np.asarray(hour) - self.shift[0]) * 3600.0
+        return self.ambient_at(day, hour) + self.rise * (1 - np.exp(-running / self.time_constant))
+
+
+@dataclass(frozen=True)
+class Payloads:
+    """The parts a robot carries, one per cycle.
+
+    Attributes
+    ----------
+    masses : tuple of float
+        Mass of each part, kg (>= 0; 0 is an empty gripper).
+    sizes : tuple of float
+        Edge of each part, m: a uniform cube whose centre hangs ``size / 2`` below the flange
+        (along its z axis), inertia ``m size^2 / 6`` about each axis; one per mass.
+    pattern : str
+        ``alternate`` (parts in turn), ``blocks`` (``block`` cycles of each in turn) or ``random``
+        (each cycle a part drawn with equal odds from the run's seed).
+    block : int
+        Cycles per block of the ``blocks`` pattern.
+
+    Raises
+    ------
+    ValueError
+        On construction, for an empty set, masses and sizes of different lengths, a negative or
+        non-finite value, an unknown pattern or a block < 1.
+    """
+
+    masses: tuple[float, ...]
+    sizes: tuple[float, ...]
+    pattern: str = "alternate"
+    block: int = 10
+
+    def __post_init__(self) -> None:
+        masses = tuple(_finite("payload mass", m, 0, 1000) for m in self.masses)
+        sizes = tuple(_finite("payload size", s, 0, 1.0) for s in self.sizes)
+        if not masses or len(masses) != len(sizes):
+            raise ValueError(f"payloads: {len(masses)} masses and {len(sizes)} sizes; expected one size per mass, "
+                             "at least one part")
+        if self.pattern not in PATTERNS:
+            raise ValueError(f"payload pattern {self.pattern!r}: expected one of {', '.join(PATTERNS)}")
+        if isinstance(self.block, bool) or not isinstance(self.block, (int, np.integer)) or self.block < 1:
+            raise ValueError(f"payload block = {self.block!r}: expected a whole number of cycles >= 1")
+        object.__setattr__(self, "masses", masses)
+        object.__setattr__(self, "sizes", sizes)
+
+    def index(self, seed: int, cycles: np.ndarray) -> np.ndarray:
+        """The part carried in each of ``cycles`` (1-based), indices into :attr:`masses`."""
+        k = np.asarray(cycles) - 1
+        n = len(self.masses)
+        if self.pattern == "alternate":
+            return k % n
+        if self.pattern == "blocks":
+            return (k // self.block) % n
+        return np.array([np.random.default_rng([seed, int(c), _PAYLOAD]).integers(n) for c in cycles], dtype=int)
+
+    def parameters(self, part: int) -> dict[str, float]:
+        """The :class:`faultgen.effects.payload.Payload` parameters of part ``part``."""
+        mass, size = self.masses[part], self.sizes[part]
+        moment = mass * size**2 / 6
+        return {"mass": mass, "com_x": 0.0, "com_y": 0.0, "com_z": size / 2,
+                "ixx": moment, "iyy": moment, "izz": moment, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
+
+
+@dataclass(frozen=True)
+class UnitSpread:
+    """How far a unit's robot is from the nominal model; relative standard deviations.
+
+    Attributes
+    ----------
+    dry_friction : float
+        Of the Coulomb and static levels per axis (log-normal, one draw per axis for both; default
+        0.15).
+    viscous_friction : float
+        Of the viscous coefficient per axis (log-normal; default 0.15).
+    link_mass : float
+        Of each link's mass and inertia (normal, clipped at 3 standard deviations; default 0.02,
+        a casting tolerance).
+
+    The defaults are ours, not a published spread: a unit's friction within about +-30 % of the
+    type's (two standard deviations).
+
+    Raises
+    ------
+    ValueError
+        On construction, for a value outside 0..0.5.
+    """
+
+    dry_friction: float = 0.15
+    viscous_friction: float = 0.15
+    link_mass: float = 0.02
+
+    def __post_init__(self) -> None:
+        for name in ("dry_friction", "viscous_friction", "link_mass"):
+            _finite(f"unit spread {name}", getattr(self, name), 0, 0.5)
+
+    def draw(self, seed: int) -> dict[str, np.ndarray]:
+        """The unit's multipliers, from ``seed``: ``dry_friction``, ``viscous_friction``, ``link_mass``, each
+        ``ndarray of shape (6,)`` (axis / link 1..6), > 0."""
+        rng = np.random.default_rng([seed, 0, _UNIT])
+        normal = rng.standard_normal((3, N_AXES))
+        return {"dry_friction": np.exp(self.dry_friction * normal[0] - self.dry_friction**2 / 2),
+                "viscous_friction": np.exp(self.viscous_friction * normal[1] - self.viscous_friction**2 / 2),
+                "link_mass": 1 + self.link_mass * np.clip(normal[2], -3, 3)}
+
+
+@dataclass(frozen=True)
+class CycleConditions:
+    """The conditions at each recorded cycle of a run (truth, written to the dataset).
+
+    Attributes
+    ----------
+    day : ndarray of shape (n,)
+        Day of the year (may pass 365 on long runs), d.
+    hour : ndarray of shape (n,)
+        Time of day, h.
+    ambient_temperature : ndarray of shape (n,)
+        deg C.
+    joint_temperature : ndarray of shape (n, 6)
+        deg C.
+    dry_friction_factor, viscous_factor : ndarray of shape (n, 6)
+        Multipliers of the Coulomb and static, and of the viscous friction, from temperature and
+        unit spread (wear not included).
+    payload_part : ndarray of shape (n,)
+        Index of the part carried (-1: none scheduled).
+    payload_mass : ndarray of shape (n,)
+        kg.
+    link_mass_factor : ndarray of shape (6,)
+        Multiplier of each link's mass and inertia (the unit's).
+    """
+
+    day: np.ndarray
+    hour: np.ndarray
+    ambient_temperature: np.ndarray
+    joint_temperature: np.ndarray
+    dry_friction_factor: np.ndarray
+    viscous_factor: np.ndarray
+    payload_part: np.ndarray
+    payload_mass: np.ndarray
+    link_mass_factor: np.ndarray
+
+
+@dataclass(frozen=True)
+class Conditions:
+    """The operating conditions of a run; all off by default (the run differs from its reference
+    only by wear).
+
+    Attributes
+    ----------
+    thermal : Temperature or None
+        Joint temperature (the CLI's ``--temperature``).
+    payloads : Payloads or None
+    spread : UnitSpread or None
+    cycles_per_day : int
+        Recorded-cycle index to calendar day (module docstring); >= 1.
+    start_day : float
+        Day of the year of cycle 1, 0..365.
+
+    Raises
+    ------
+    ValueError
+        On construction, for ``cycles_per_day`` < 1 or ``start_day`` outside 0..365.
+    TypeError
+        For a condition of the wrong type.
+    """
+
+    thermal: Temperature | None = None
+    payloads: Payloads | None = None
+    spread: UnitSpread | None = None
+    cycles_per_day: int = 1
+    start_day: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name, kind in (("thermal", Temperature), ("payloads", Payloads), ("spread", UnitSpread)):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, kind):
+                raise TypeError(f"conditions {name}: expected a {kind.__name__} or None, got {type(value).__name__}")
+        if isinstance(self.cycles_per_day, bool) or not isinstance(self.cycles_per_day, (int, np.integer)) \
+                or self.cycles_per_day < 1:
+            raise ValueError(f"cycles_per_day = {self.cycles_per_day!r}: expected a whole number >= 1")
+        _finite("start_day", self.start_day, 0, 365)
+
+    @property
+    def active(self) -> bool:
+        """Whether any condition is on."""
+        return any(c is not None for c in (self.thermal, self.payloads, self.spread))
+
+    def evaluate(self, seed: int, cycles: np.ndarray) -> CycleConditions:
+        """The conditions at ``cycles`` (1-based recorded cycle indices, shape (n,)) of a run with
+        ``seed``: bit-identical for the same seed and cycles, whichever other cycles are recorded."""
+        cycles = np.asarray(cycles, dtype=int)
+        n = len(cycles)
+        day = self.start_day + (cycles - 1) // self.cycles_per_day
+        start, end = self.thermal.shift if self.thermal else (6.0, 22.0)
+        hour = np.array([start + (end - start) * np.random.default_rng([seed, int(c), _TIME_OF_DAY]).random()
+                         for c in cycles])
+        ambient = np.full(n, np.nan)
+        joint = np.full((n, N_AXES), np.nan)
+        dry, viscous = np.ones((n, N_AXES)), np.ones((n, N_AXES))
+        if self.thermal is not None:
+            ambient = self.thermal.ambient_at(day, hour)
+            joint = np.repeat(self.thermal.joint_at(day, hour)[:, None], N_AXES, axis=1)
+            dry, viscous = temperature_law.friction_factors(joint)
+        link_mass = np.ones(N_AXES)
+        if self.spread is not None:
+            unit = self.spread.draw(seed)
+            dry, viscous, link_mass = dry * unit["dry_friction"], viscous * unit["viscous_friction"], unit["link_mass"]
+        part, mass = np.full(n, -1), np.zeros(n)
+        if self.payloads is not None:
+            part = self.payloads.index(seed, cycles)
+            mass = np.array(self.payloads.masses)[part]
+        return CycleConditions(day=day.astype(float), hour=hour, ambient_temperature=ambient, joint_temperature=joint,
+                               dry_friction_factor=dry, viscous_factor=viscous, payload_part=part, payload_mass=mass,
+                               link_mass_factor=link_mass)
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable labels (None for a condition that is off)."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Conditions:
+        """Inverse of :meth:`to_dict`; unknown keys are refused with their name."""
+        known = {"thermal": Temperature, "payloads": Payloads, "spread": UnitSpread}
+        unknown = sorted(set(data) - set(known) - {"cycles_per_day", "start_day"})
+        if unknown:
+            raise ValueError(f"conditions: unknown key {unknown[0]!r}; expected: "
+                             f"{', '.join([*known, 'cycles_per_day', 'start_day'])}")
+        parts = {}
+        for name, kind in known.items():
+            value = data.get(name)
+            if value is not None:
+                if not isinstance(value, dict):
+                    raise ValueError(f"conditions {name}: expected a table of settings, got {value!r}")
+                names = {f for f in kind.__dataclass_fields__}
+                bad = sorted(set(value) - names)
+                if bad:
+                    raise ValueError(f"conditions {name}: unknown setting {bad[0]!r}; expected: {', '.join(sorted(names))}")
+                value = {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
+                parts[name] = kind(**value)
+        return cls(**parts, **{k: data[k] for k in ("cycles_per_day", "start_day") if k in data})
+
