@@ -16,6 +16,7 @@ CSV and Markdown (and a PNG heatmap for isolation).
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -349,7 +350,9 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
 
     Features per sample: for each axis, the KL divergence (eq. 5.4) of the 12-bin histogram of
     |motor torque|, normalised by the largest |motor torque| of the training data (thesis ch. 3.4:
-    "normalized with respect to maximum torque and binned into twelve equal-sized intervals"),
+    "normalized with respect to maximum torque and binned into twelve equal-sized intervals"; a
+    dataset recorded without signals, such as a fleet's daily records, gives its stored histograms,
+    binned to the motor's peak torque),
     against the run's first sample under same-run (the thesis's), and against the mean histogram
     of the training samples under the held-out protocols: one noisy first cycle shifts every later
     divergence of its run, which a monitor that learned other runs reads as a fault (j2, three
@@ -391,8 +394,13 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     torque: dict[str, np.ndarray] = {}
 
     def abs_torque(run_id: str) -> np.ndarray:
+        """|motor torque| of a run, or its stored torque histograms when it has no signals."""
         if run_id not in torque:
-            torque[run_id] = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
+            labels = next(r[2] for r in runs if r[0] == run_id)
+            if labels.get("signals", True):
+                torque[run_id] = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
+            else:
+                torque[run_id] = StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
         return torque[run_id]
 
     monitors: dict[tuple, tuple] = {}
@@ -497,7 +505,8 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
 
     from analysis.monitoring import PCAMonitor
 
-    scale = np.max([t.max(axis=(0, 1)) for _, t, _ in training], axis=0)
+    stored = [isinstance(t, StoredHistograms) for _, t, _ in training]
+    scale = None if any(stored) else np.max([t.max(axis=(0, 1)) for _, t, _ in training], axis=0)
     reference = None
     if fixed_reference:
         reference = np.concatenate([_histograms(t, cycles, scale, period)[0] for _, t, cycles in training]).mean(axis=0)
@@ -513,13 +522,25 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     return scale, reference, used, monitor
 
 
-def _histograms(torque: np.ndarray, cycles: np.ndarray, scale: np.ndarray,
+@dataclass(frozen=True)
+class StoredHistograms:
+    """The per-cycle torque histograms a run recorded without signals (``torque_hist``, (n, 6, 12),
+    binned over 0 .. the motor's peak torque), standing in for its |motor torque| in detection."""
+
+    hist: np.ndarray
+
+
+def _histograms(torque: np.ndarray | StoredHistograms, cycles: np.ndarray, scale: np.ndarray | None,
                 period: int | None) -> tuple[np.ndarray, np.ndarray]:
     """12-bin |torque| histograms per sample (n_samples, 6, 12), a sample being a recorded cycle or
-    a ``period`` of them, and per recorded cycle the index of its sample."""
+    a ``period`` of them, and per recorded cycle the index of its sample. A run recorded without
+    signals gives its stored histograms (:class:`StoredHistograms`; ``scale`` unused)."""
     from faultgen.simulation.sensors import histogram
 
-    hist = histogram(torque, np.zeros(6), scale)  # (n_cycles, 6, 12), one per recorded cycle
+    if isinstance(torque, StoredHistograms):
+        hist = torque.hist
+    else:
+        hist = histogram(torque, np.zeros(6), scale)  # (n_cycles, 6, 12), one per recorded cycle
     groups = group_cycles(cycles, period)
     _, index = np.unique(groups, return_inverse=True)
     return np.stack([hist[index == g].mean(axis=0) for g in range(index.max() + 1)]), index

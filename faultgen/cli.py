@@ -401,6 +401,66 @@ def sweep_command(
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
 
+@app.command("fleet", cls=PlainHelpCommand)
+def fleet_command(
+    size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).")] = 26,
+    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).")] = 13,
+    days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.")] = 60,
+    cycles_per_day: Annotated[int, typer.Option(
+        help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).")] = 2,
+    failure_wear: Annotated[float, typer.Option(
+        help="Coulomb and static friction increase of the failing axis on the failure day, %.")] = 50.0,
+    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.")] = 0,
+    jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
+    overwrite: Overwrite = False,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
+) -> None:
+    """Simulate a fleet like the thesis's 26 robots (ch. 5): daily remote-monitoring records.
+
+    Half the robots develop a gearbox fault (friction wear of one drawn axis, rising from a drawn
+    day to failure on the last day), half stay healthy; each robot has its own model, process,
+    parts, hall climate and unit spread (docs/simulation.md, "Operating conditions and fleets").
+    Killed? Run the same command again: finished robots are kept.
+
+    Examples:
+
+      faultgen fleet -o fleet.h5
+
+      faultgen classify fleet.h5 --wear-threshold 10
+    """
+    from faultgen.runs import fleet, sweep
+
+    try:
+        plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
+                           failure_wear=failure_wear, seed=seed)
+        if jobs < 1:
+            raise ValueError(f"--jobs {jobs}: expected >= 1")
+        _check_outputs([out], overwrite)
+    except ValueError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+
+    def announce(n_runs: int, done: int) -> None:
+        typer.echo(f"{n_runs} robots x {days} days -> {out} with {jobs} job(s)"
+                   + (f"; resuming, {done} robots already finished" if done else ""))
+
+    try:
+        sweep.run(plan, out, jobs=jobs, progress=progress, overwrite=overwrite,
+                  command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
+    except sweep.SweepRefused as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(2) from err
+    except sweep.SweepInterrupted as err:
+        typer.echo(str(err), err=True)
+        raise typer.Exit(130) from err
+    except sweep.SweepError as err:
+        typer.echo(f"error: {err}", err=True)
+        raise typer.Exit(1) from err
+    typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
+               f"  faultgen detect {out}")
+
+
 @app.command("info", cls=PlainHelpCommand)
 def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Summarise a dataset: runs, robots, tasks, worn axes, cycles, provenance."""

@@ -210,7 +210,9 @@ FORM = r"the form is AXIS:KIND:PERCENT\[:key=value,\.\.\.\], e\.g\. '2:exp4:20'"
         ("2:logistic:10:shape=0", r"logistic shape 0\.0 is invalid; expected a finite number > 0"),
         ("2:step:10:step_cycle=4.5", r"option step_cycle=4\.5 is not an int"),
         ("2:step:10:step_cycle=101", r"step_cycle 101 is out of range 1\.\.100 \(last_cycle\)"),
-        ("2:exp4:20:shape=1", r"exp4 schedule has no parameter 'shape'; it takes no parameters"),
+        ("2:exp4:20:shape=1", r"exp4 schedule has no parameter 'shape'; it takes parameters: onset"),
+        ("2:linear:20:shape=1", r"linear schedule has no parameter 'shape'; it takes no parameters"),
+        ("2:exp4:20:onset=100", r"exp4 onset 100 is invalid; expected an int in 0..99"),
         (
             "2:logistic:20:step_cycle=3",
             r"logistic schedule has no parameter 'step_cycle'; it takes parameters: shape",

@@ -109,8 +109,13 @@ def config_key(config) -> str:
         "record": [int(c) for c in config.recorded_cycles], "seed": int(config.seed),
         "noise": asdict(config.noise),
     }
-    if config.conditions.active:  # runs without conditions keep the keys they had before conditions existed
+    # a run keeps the key it had before these options existed when it does not use them
+    if config.conditions.active:
         key["conditions"] = config.conditions.to_dict()
+    if not config.signals:
+        key["signals"] = False
+    if config.daily:
+        key["daily"] = True
     return json.dumps(key, sort_keys=True)
 
 
@@ -133,6 +138,8 @@ def run_attributes(result, command: str = "") -> dict:
         "config": config_key(config),
         "command": command,
         **({"conditions": json.dumps(config.conditions.to_dict())} if config.conditions.active else {}),
+        "signals": bool(config.signals),
+        "sample": "day" if config.daily else "cycle",
     }
 
 
@@ -172,6 +179,8 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
         values = {name: getattr(result, name, None) for name in ARRAYS}
         values.update(result.features)
         for name, (units, axes, description) in ARRAYS.items():
+            if axes == SIGNAL_AXES and not result.config.signals:
+                continue  # features only
             data = np.asarray(values[name])
             if axes == SIGNAL_AXES:
                 # 250 Hz signals: float32 (7 digits, finer than the 1e-4 rad encoder noise), one chunk
@@ -261,7 +270,11 @@ def read_run(path: str | Path, run_id: str | None = None,
         wanted = list(group) if names is None else list(names)
         missing = [name for name in wanted if name not in group]
         if missing:
-            raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}")
+            why = ""
+            if not group.attrs.get("signals", True) and ARRAYS.get(missing[0], ("", ""))[1] == SIGNAL_AXES:
+                why = ("; it was recorded without signals (features only): simulate it again with signals "
+                       "(`faultgen sweep` without --features-only) to use this command")
+            raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}{why}")
         arrays = {name: group[name][()] for name in wanted}
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
@@ -389,7 +402,9 @@ def _validate_run(group: h5py.Group) -> list[str]:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
         return [*problems, "conditions attribute is not JSON"]
-    schema = {**ARRAYS, **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
+    signals = bool(group.attrs.get("signals", True))
+    schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
+              **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
     missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:
@@ -437,6 +452,8 @@ def summary(path: str | Path) -> str:
         n_log = [runs[r]["t"].shape[0] for r in runs]
         version, command = _attr(f.attrs.get("faultgen_version")), _attr(f.attrs.get("command", ""))
     worn = sorted({tuple(int(a) for a in row["worn_axes"]) for row in rows})
+    daily = any(row.get("sample") == "day" for row in rows)
+    signals = all(row.get("signals", True) for row in rows)
     lines = [
         f"{path}: {len(rows)} run(s), {Path(path).stat().st_size / 1e6:.1f} MB, written by faultgen {version}",
         f"  robots:        {', '.join(sorted({r['robot'] for r in rows}))}",
@@ -444,9 +461,14 @@ def summary(path: str | Path) -> str:
         f"  friction:      {', '.join(sorted({r['friction_model'] for r in rows}))}",
         f"  worn axes:     {', '.join('none' if not w else '+'.join(map(str, w)) for w in worn)}",
         f"  seeds:         {', '.join(map(str, sorted({int(r['seed']) for r in rows})))}",
-        f"  cycles:        {min(n_cycles)}-{max(n_cycles)} recorded per run, {sum(n_cycles)} in all; "
-        f"{min(n_log)}-{max(n_log)} samples per cycle at {1 / sensors.LOG_PERIOD:.0f} Hz",
+        f"  {'days' if daily else 'cycles'}:{' ' * (14 - (4 if daily else 6))}{min(n_cycles)}-{max(n_cycles)} "
+        f"{'daily records' if daily else 'recorded'} per run, {sum(n_cycles)} in all; "
+        + (f"{min(n_log)}-{max(n_log)} samples per cycle at {1 / sensors.LOG_PERIOD:.0f} Hz" if signals
+           else "features and truth only (no 250 Hz signals)"),
     ]
+    if any("conditions" in row for row in rows):
+        lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
+                     "(temperature, payloads, unit spread: CONDITION_ARRAYS)")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)

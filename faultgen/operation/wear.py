@@ -10,7 +10,9 @@ of a run its own schedule.
 Schedules (``increase`` = p, ``last_cycle`` = K):
 
 ``exp4``
-    ``m(k) = exp(c1 k^4)``, ``c1 = ln(1 + p) / K^4`` (thesis eq. 6.6).
+    ``m(k) = exp(c1 k^4)``, ``c1 = ln(1 + p) / K^4`` (thesis eq. 6.6); with an ``onset`` cycle
+    k0 the same rise starts there: ``m(k) = exp(c1 max(k - k0, 0)^4)``, ``c1 = ln(1 + p) / (K - k0)^4``
+    (a fleet's robots start wearing on different days).
 ``logistic``
     ``m(k) = 1 + p (s(k) - 1/2) / (s(K) - 1/2)``, ``s(k) = 1 / (1 + exp(-(c2 k)^4))``,
     ``c2 = shape / K`` (thesis eq. 3.7, see :class:`Schedule`).
@@ -38,15 +40,18 @@ SCHEDULES = ("exp4", "logistic", "linear", "step")
 
 #: Optional parameters of each kind and their defaults (``None``: derived from ``last_cycle``).
 _PARAMS: dict[str, dict[str, float | None]] = {
-    "exp4": {},
+    "exp4": {"onset": 0},
     "logistic": {"shape": 1.5},
     "linear": {},
     "step": {"step_cycle": None},
 }
 
+#: Schedule parameters that are cycle numbers.
+_INT_PARAMS = ("step_cycle", "onset")
+
 _SPEC_FORM = (
-    "the form is AXIS:KIND:PERCENT[:key=value,...], e.g. '2:exp4:20', '3:logistic:10:shape=2' "
-    "or '5:step:20:step_cycle=40'"
+    "the form is AXIS:KIND:PERCENT[:key=value,...], e.g. '2:exp4:20', '2:exp4:50:onset=40', "
+    "'3:logistic:10:shape=2' or '5:step:20:step_cycle=40'"
 )
 
 
@@ -67,9 +72,10 @@ class Schedule:
     last_cycle : int
         Cycle K >= 1 at which the multiplier reaches ``1 + increase``.
     params : mapping
-        Kind-specific parameters, filled with their defaults: ``shape`` (logistic, dimensionless,
-        > 0, default 1.5) and ``step_cycle`` (step, 1..K, default ``K // 2 + 1``, so that the
-        second half of the cycles is worn). Read-only.
+        Kind-specific parameters, filled with their defaults: ``onset`` (exp4, the cycle the rise
+        starts from, 0..K-1, default 0), ``shape`` (logistic, dimensionless, > 0, default 1.5) and
+        ``step_cycle`` (step, 1..K, default ``K // 2 + 1``, so that the second half of the cycles
+        is worn). Read-only.
 
     Notes
     -----
@@ -134,6 +140,11 @@ class Schedule:
             params["shape"] = float(shape)
             if _half_tanh(params["shape"], 1.0) == 0:
                 raise ValueError(f"logistic shape {shape!r} is too small to compute; expected e.g. 0.5 .. 5")
+        if self.kind == "exp4":
+            onset = params["onset"]
+            if not _is_int(onset) or not 0 <= onset < last:
+                raise ValueError(f"exp4 onset {onset!r} is invalid; expected an int in 0..{last - 1} (below last_cycle)")
+            params["onset"] = int(onset)
         if self.kind == "step":
             step = last // 2 + 1 if params["step_cycle"] is None else params["step_cycle"]
             if not _is_int(step):
@@ -147,10 +158,12 @@ class Schedule:
 
     @property
     def constants(self) -> dict[str, float | int]:
-        """Parameters and derived constants: ``c1`` (exp4), ``shape`` and ``c2`` (logistic),
-        ``step_cycle`` (step); empty for linear."""
+        """Parameters and derived constants: ``c1`` (exp4, and its ``onset`` when not 0), ``shape``
+        and ``c2`` (logistic), ``step_cycle`` (step); empty for linear."""
         if self.kind == "exp4":
-            return {"c1": math.log1p(self.increase) / float(self.last_cycle) ** 4}
+            onset = self.params["onset"]
+            c1 = {"c1": math.log1p(self.increase) / float(self.last_cycle - onset) ** 4}
+            return {**c1, "onset": onset} if onset else c1
         if self.kind == "logistic":
             return {"shape": self.params["shape"], "c2": self.params["shape"] / self.last_cycle}
         return dict(self.params)
@@ -176,7 +189,7 @@ class Schedule:
         kf = _cycles(k).astype(float)
         p, last, c = self.increase, self.last_cycle, self.constants
         if self.kind == "exp4":
-            return np.exp(c["c1"] * kf**4)
+            return np.exp(c["c1"] * np.maximum(kf - self.params["onset"], 0.0) ** 4)
         if self.kind == "logistic":
             return 1.0 + p * _half_tanh(c["c2"], kf) / _half_tanh(c["shape"], 1.0)
         if self.kind == "linear":
@@ -334,9 +347,9 @@ def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
             if not sep or not key or not value:
                 raise fail(f"option {option!r} is not key=value")
             try:
-                params[key] = int(value) if key == "step_cycle" else float(value)
+                params[key] = int(value) if key in _INT_PARAMS else float(value)
             except ValueError:
-                expected = "an int" if key == "step_cycle" else "a number"
+                expected = "an int" if key in _INT_PARAMS else "a number"
                 raise fail(f"option {key}={value} is not {expected}") from None
     try:
         return _check_axis(axis), Schedule(kind, percent / 100.0, last_cycle, params)

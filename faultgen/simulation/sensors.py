@@ -86,6 +86,8 @@ def speed(angles: np.ndarray, first: np.ndarray, period: float = LOG_PERIOD) -> 
 
 #: Bins of the remote-monitoring histograms (thesis ch. 5.3.1: 12 values per measurement).
 HISTOGRAM_BINS = 12
+#: The per-cycle histograms of :func:`cycle_features`.
+HISTOGRAMS = ("angle_hist", "speed_hist", "torque_hist")
 
 
 def histogram(values: np.ndarray, low: np.ndarray, high: np.ndarray, bins: int = HISTOGRAM_BINS) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import mujoco
 import numpy as np
@@ -79,14 +79,21 @@ class RunConfig:
     conditions : Conditions
         Operating conditions over the cycles (joint temperature, payloads, unit spread;
         :mod:`faultgen.operation.conditions`); none by default.
+    signals : bool
+        Keep the 250 Hz signals in the dataset (False: the per-cycle features and truth only).
+    daily : bool
+        Record one remote-monitoring sample per day of ``conditions.cycles_per_day`` cycles, the
+        day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
+        cycle is simulated, no signals are kept.
 
     Raises
     ------
     ValueError
         On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
-        1..cycles, a negative seed or nthread, or ``back_to_back`` with wear, operating conditions
-        or a ``record`` subset; the message names the value.
+        1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions
+        or a ``record`` subset, or ``daily`` with a ``record`` subset, signals, or cycles that are
+        not whole days; the message names the value.
     """
 
     robot: str
@@ -100,6 +107,8 @@ class RunConfig:
     nthread: int = 0
     back_to_back: bool = False
     conditions: Conditions = field(default_factory=Conditions)
+    signals: bool = True
+    daily: bool = False
 
     def __post_init__(self) -> None:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
@@ -128,6 +137,11 @@ class RunConfig:
                              f"conditions; got wear on axes {list(self.wear.schedules)}, conditions "
                              f"{'on' if self.conditions.active else 'off'} and record = {self.record!r}: drop "
                              "them, or run the cycles independently")
+        if self.daily:
+            per_day = self.conditions.cycles_per_day
+            if self.record is not None or self.signals or self.cycles % per_day:
+                raise ValueError(f"daily records need every cycle recorded, no signals and whole days: got record = "
+                                 f"{self.record!r}, signals = {self.signals}, {self.cycles} cycles at {per_day} a day")
 
     @property
     def recorded_cycles(self) -> np.ndarray:
@@ -413,7 +427,44 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
-    return result
+    return daily_record(result) if config.daily else result
+
+
+def daily_record(result: RunResult) -> RunResult:
+    """The remote-monitoring record of ``result`` once a day (thesis ch. 5.3.2): of each day's
+    ``cycles_per_day`` cycles the largest value of every per-cycle feature and truth (histogram
+    bins too, each histogram then scaled back to a sum of 1; the wear of the day's last cycle), the
+    operating conditions' mean (temperatures, friction factors) or largest value (payload mass),
+    the day's first part. ``cycles`` becomes the day number (1-based); no signals are kept.
+
+    Returns
+    -------
+    RunResult
+        With ``(n_days, ...)`` arrays where ``result`` had ``(n_cycles, ...)`` and signals of shape
+        ``(n_days, 0, 6)``.
+    """
+    per_day = result.config.conditions.cycles_per_day
+    n_days = len(result.cycles) // per_day
+
+    def days(a, reduce=np.max):
+        return reduce(np.asarray(a)[: n_days * per_day].reshape(n_days, per_day, *np.shape(a)[1:]), axis=1)
+
+    features = {name: days(v) for name, v in result.features.items()}
+    for name in sensors.HISTOGRAMS:
+        features[name] = features[name] / features[name].sum(axis=-1, keepdims=True)
+    conditions = result.conditions
+    if conditions is not None:
+        first = {name: getattr(conditions, name)[::per_day][:n_days] for name in ("day", "payload_part")}
+        conditions = replace(conditions, **first, link_mass_factor=conditions.link_mass_factor,
+                             payload_mass=days(conditions.payload_mass),
+                             **{name: days(getattr(conditions, name), np.mean) for name in
+                                ("hour", "ambient_temperature", "joint_temperature", "dry_friction_factor",
+                                 "viscous_factor")})
+    empty = np.zeros((n_days, 0, 6))
+    return replace(result, cycles=np.arange(1, n_days + 1), q_a=empty, q_m=empty, qd_a=empty, qd_m=empty,
+                   tau_m=empty, tau_f=empty, tau_dist=empty, friction_multiplier=days(result.friction_multiplier),
+                   mean_friction_torque=days(result.mean_friction_torque), tracking_error=days(result.tracking_error),
+                   features=features, conditions=conditions)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,157 @@
+"""A fleet of robots recorded as daily remote-monitoring features, like the thesis's 26 (ch. 5.3.1).
+
+The thesis's classifiers (ch. 5) were trained on 26 six-axis robots, 13 that reported a gearbox
+failure and 13 that did not, in different processes, of different sizes and loads, each reporting
+once to four times a day 12-bin histograms of angle, speed and torque per axis plus speed and
+torque indicators, resampled to the day's maximum (ch. 5.3.1-5.3.2). :class:`Fleet` draws such a
+fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one run per robot:
+
+- both robot models, in turn; a process (task) per robot; parts of two sizes that the robot picks
+  at random, sized to the model; its own hall climate (mean, seasonal swing, the day of the year
+  its record starts), warm-up over each shift; its own unit-to-unit spread of friction and link
+  masses (:mod:`faultgen.operation.conditions`);
+- a failing robot's gearbox wears on one drawn axis, its Coulomb and static friction rising on the
+  exp4 schedule (thesis eq. 6.6) from a drawn onset day to ``failure_wear`` percent on its last
+  day, the failure day; a healthy robot does not wear;
+- every day ``cycles_per_day`` cycles are simulated and reduced to one daily record, the day's
+  maximum (:func:`faultgen.simulation.stepping.daily_record`); no 250 Hz signals are kept.
+
+Labels: a run's ``worn_axes`` (empty: healthy), its wear schedule (``last_cycle`` /
+``cycles_per_day`` is the failure day) and the true wear per day (``friction_multiplier``); the
+draws of every robot are in the dataset's grid JSON (:meth:`Fleet.to_json`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from faultgen.model import robots as robot_models
+from faultgen.operation import conditions, tasks, wear
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
+
+#: Parts of two sizes per robot model: (mass range kg, edge range m) of the small and the big
+#: part. Ours, sized to each model's rated load (IRB-6700-like: 200 kg; PUMA 560: 2.5 kg).
+PARTS = {
+    "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
+    "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
+}
+
+
+def _number(name: str, value, low: float, high: float, whole: bool = False):
+    ok = isinstance(value, (int, np.integer)) if whole else isinstance(value, (int, float, np.integer, np.floating))
+    if isinstance(value, bool) or not ok or not np.isfinite(value) or not low <= value <= high:
+        kind = "a whole number" if whole else "a number"
+        raise ValueError(f"fleet {name} = {value!r}: expected {kind} within {low:g}..{high:g}")
+    return value
+
+
+@dataclass(frozen=True)
+class Fleet:
+    """The fleet's settings; every draw comes from ``seed``.
+
+    Attributes
+    ----------
+    size : int
+        Robots in the fleet (thesis: 26).
+    failing : int
+        Of them, robots whose gearbox fails (thesis: 13).
+    days : int
+        Days each robot is recorded; a failing robot fails on the last one.
+    cycles_per_day : int
+        Cycles simulated per day, reduced to the day's maximum (thesis: 1 to 4 samples a day).
+    failure_wear : float
+        Coulomb and static friction increase of the failing axis on the failure day, %.
+    onset : tuple of int, optional
+        First and last day on which a failing robot's wear may start (drawn uniformly); default
+        from a sixth to seven twelfths of the days (10 to 35 of 60), so that every failing robot
+        wears for at least its last 25 days.
+    models : tuple of str
+        Robot models, taken in turn.
+    seed : int
+    friction : str
+        Friction model of every run.
+
+    Raises
+    ------
+    ValueError
+        On construction, for a value outside its range (named), an onset window that does not fit
+        the days, or an unknown robot model.
+    """
+
+    size: int = 26
+    failing: int = 13
+    days: int = 60
+    cycles_per_day: int = 2
+    failure_wear: float = 50.0
+    onset: tuple[int, int] | None = None
+    models: tuple[str, ...] = ("irb6700", "puma560")
+    seed: int = 0
+    friction: str = "lugre"
+
+    def __post_init__(self) -> None:
+        _number("size", self.size, 2, 10000, whole=True)
+        _number("failing", self.failing, 1, self.size - 1, whole=True)
+        _number("days", self.days, 5, 3650, whole=True)
+        _number("cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
+        _number("failure_wear", self.failure_wear, 0, 1000)
+        _number("seed", self.seed, 0, 2**31, whole=True)
+        onset = self.onset if self.onset is not None else (self.days // 6, self.days * 7 // 12)
+        first, last = (int(_number("onset day", d, 1, self.days - 1, whole=True)) for d in onset)
+        if first > last:
+            raise ValueError(f"fleet onset = {self.onset!r}: expected (first day, last day) with first <= last")
+        for model in self.models:
+            robot_models.load(model)  # UnknownRobotError names the known ones
+        object.__setattr__(self, "onset", (first, last))
+        object.__setattr__(self, "models", tuple(self.models))
+
+    def robots(self) -> list[dict]:
+        """The draws of every robot, in order: ``run`` id, ``model``, ``task``, ``failing``,
+        ``axis`` (worn axis 1..6, 0 for a healthy robot), ``onset_day``, ``failure_day``,
+        ``seed`` and the operating ``conditions`` table."""
+        order = np.random.default_rng([self.seed, 0]).permutation(self.size)
+        failing = set(order[: self.failing].tolist())
+        out = []
+        for i in range(self.size):
+            rng = np.random.default_rng([self.seed, i + 1])
+            model = self.models[i % len(self.models)]
+            task = str(rng.choice(tasks.TASKS))
+            axis = int(rng.integers(1, 7))
+            onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
+            (small_mass, small_size), (big_mass, big_size) = PARTS.get(model, PARTS["irb6700"])
+            parts = {"masses": [round(float(rng.uniform(*small_mass)), 2), round(float(rng.uniform(*big_mass)), 2)],
+                     "sizes": [round(float(rng.uniform(*small_size)), 3), round(float(rng.uniform(*big_size)), 3)],
+                     "pattern": "random"}
+            climate = {"ambient": round(float(rng.uniform(16.0, 24.0)), 1),
+                       "seasonal": round(float(rng.uniform(2.0, 8.0)), 1)}
+            table = {"thermal": climate, "payloads": parts, "spread": {}, "cycles_per_day": self.cycles_per_day,
+                     "start_day": float(rng.integers(0, 365))}
+            fails = i in failing
+            out.append({"run": f"robot{i + 1:02d}-{model}-{task}-{'failing' if fails else 'healthy'}",
+                        "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,
+                        "onset_day": onset_day if fails else None, "failure_day": self.days if fails else None,
+                        "seed": self.seed * 10000 + i, "conditions": table})
+        return out
+
+    def runs(self) -> list[tuple[str, sim.RunConfig]]:
+        """``(run id, RunConfig)`` of every robot (:meth:`robots`), daily records without signals."""
+        cycles = self.days * self.cycles_per_day
+        out = []
+        for robot in self.robots():
+            plan = wear.WearPlan({})
+            if robot["failing"]:
+                spec = f"{robot['axis']}:exp4:{self.failure_wear:g}:onset={(robot['onset_day'] - 1) * self.cycles_per_day}"
+                plan = wear.WearPlan.from_specs([spec], last_cycle=cycles)
+            config = sim.RunConfig(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
+                                   cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
+                                   conditions=conditions.Conditions.from_dict(robot["conditions"]),
+                                   signals=False, daily=True)
+            out.append((robot["run"], config))
+        return out
+
+    def to_json(self) -> str:
+        """The settings and every robot's draws, stored with the dataset."""
+        return json.dumps({"fleet": asdict(self), "robots": self.robots()}, sort_keys=True)

@@ -1,0 +1,114 @@
+"""The fleet: its draws, daily records (the day's maximum), features-only files, the same seed
+giving the same fleet bit for bit, and refusals of bad settings."""
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+from faultgen.data import dataset
+from faultgen.operation import conditions as c
+from faultgen.operation import wear
+from faultgen.runs.fleet import Fleet
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
+
+
+def test_the_fleet_draws_half_failing_robots_of_both_models():
+    fleet = Fleet()
+    robots = fleet.robots()
+    assert len(robots) == 26 and sum(r["failing"] for r in robots) == 13
+    assert {r["model"] for r in robots} == {"irb6700", "puma560"}
+    assert len({r["task"] for r in robots}) == 3
+    for run_id, config in fleet.runs():
+        robot = next(r for r in robots if r["run"] == run_id)
+        assert config.daily and not config.signals and config.cycles == 60 * 2
+        assert config.wear.worn_axes == ((robot["axis"],) if robot["failing"] else ())
+        if robot["failing"]:  # wear starts on the drawn day and reaches failure on the last one
+            k = np.array([(robot["onset_day"] - 1) * 2, config.cycles])
+            assert config.wear.multipliers(k)[:, robot["axis"] - 1] == pytest.approx([1.0, 1.5])
+            assert 10 <= robot["onset_day"] <= 35
+    assert fleet.to_json() == Fleet().to_json()
+    assert fleet.to_json() != Fleet(seed=1).to_json()
+    assert len({r["seed"] for r in robots}) == 26
+
+
+@pytest.mark.parametrize(("settings", "message"), [
+    ({"failing": 26}, r"fleet failing = 26: expected a whole number within 1..25"),
+    ({"days": 3}, r"fleet days = 3"),
+    ({"onset": (40, 30)}, r"first <= last"),
+    ({"onset": (0, 30)}, r"fleet onset day = 0"),
+    ({"cycles_per_day": 0}, r"fleet cycles_per_day = 0"),
+    ({"models": ("kuka",)}, r"kuka"),
+])
+def test_bad_fleet_settings_are_refused_with_the_value_named(settings, message):
+    with pytest.raises(ValueError, match=message):
+        Fleet(**settings)
+
+
+def test_exp4_with_an_onset_at_known_cycles():
+    schedule = wear.Schedule("exp4", 0.5, 100, {"onset": 40})
+    m = schedule.multiplier(np.array([0, 40, 70, 100]))
+    assert m == pytest.approx([1.0, 1.0, 1.5 ** (1 / 16), 1.5])
+    assert schedule.to_dict()["onset"] == 40
+    assert "onset" not in wear.Schedule("exp4", 0.5, 100).to_dict()  # labels of runs without one unchanged
+
+
+def test_a_daily_record_is_the_days_maximum():
+    """Two cycles a day: each daily value is the larger of the two cycles' values (histograms
+    scaled back to a sum of 1), the wear that of the day's last cycle, the temperature their mean."""
+    conditions = c.Conditions(thermal=c.Temperature(), spread=c.UnitSpread(), cycles_per_day=2)
+    plan = wear.WearPlan.from_specs(["2:exp4:40:onset=1"], last_cycle=6)
+    common = dict(robot="puma560", task="spot_weld", wear=plan, cycles=6, nthread=1, seed=4, conditions=conditions)
+    cycles = sim.simulate(sim.RunConfig(**common), progress=False)
+    days = sim.simulate(sim.RunConfig(**common, signals=False, daily=True), progress=False)
+    assert days.cycles.tolist() == [1, 2, 3] and days.tau_m.shape == (3, 0, 6)
+
+    def pairs(a):
+        return a.reshape(3, 2, *a.shape[1:])
+
+    np.testing.assert_array_equal(days.features["mean_abs_torque"], pairs(cycles.features["mean_abs_torque"]).max(axis=1))
+    np.testing.assert_array_equal(days.friction_multiplier, cycles.friction_multiplier[1::2])
+    hist = pairs(cycles.features["speed_hist"]).max(axis=1)
+    np.testing.assert_allclose(days.features["speed_hist"], hist / hist.sum(axis=-1, keepdims=True))
+    np.testing.assert_allclose(days.conditions.joint_temperature,
+                               pairs(cycles.conditions.joint_temperature).mean(axis=1))
+
+
+def test_a_small_fleet_runs_validates_and_repeats_bit_for_bit(tmp_path):
+    runner = CliRunner()
+    files = []
+    for name in ("a.h5", "b.h5"):
+        out = tmp_path / name
+        result = runner.invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
+                                     "--jobs", "1", "--no-progress", "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        files.append(out)
+    assert dataset.validate(files[0]) == []
+    labels = dataset.labels(files[0])
+    assert sorted(len(row["worn_axes"]) for row in labels) == [0, 1]
+    assert all(row["sample"] == "day" and not row["signals"] for row in labels)
+    with h5py.File(files[0]) as f:
+        assert json.loads(f.attrs["grid"])["fleet"]["size"] == 2
+        assert "tau_m" not in f["runs"][labels[0]["run"]]
+    for row in labels:
+        first, _ = dataset.read_run(files[0], row["run"])
+        again, _ = dataset.read_run(files[1], row["run"])
+        assert first.keys() == again.keys()
+        for name in first:
+            np.testing.assert_array_equal(first[name], again[name], err_msg=name)
+
+
+def test_features_only_runs_say_what_they_lack(tmp_path):
+    config = sim.RunConfig("puma560", "pick_place", cycles=2, nthread=1, signals=False,
+                           noise=sensors.NoiseConfig(0.0, 0.0))
+    dataset.write_run(tmp_path / "f.h5", sim.simulate(config, progress=False))
+    assert dataset.validate(tmp_path / "f.h5") == []
+    with pytest.raises(dataset.DatasetError, match="recorded without signals"):
+        dataset.read_run(tmp_path / "f.h5", names=("tau_m",))
+    with pytest.raises(ValueError, match="daily records need every cycle recorded, no signals and whole days"):
+        sim.RunConfig("puma560", "pick_place", cycles=3, daily=True, signals=False,
+                      conditions=c.Conditions(spread=c.UnitSpread(), cycles_per_day=2))
