@@ -62,7 +62,8 @@ def test_a_daily_record_is_the_days_maximum():
     scaled back to a sum of 1), the wear that of the day's last cycle, the temperature their mean."""
     conditions = c.Conditions(thermal=c.Temperature(), spread=c.UnitSpread(), cycles_per_day=2)
     plan = wear.WearPlan.from_specs(["2:exp4:40:onset=1"], last_cycle=6)
-    common = dict(robot="puma560", task="spot_weld", wear=plan, cycles=6, nthread=1, seed=4, conditions=conditions)
+    common = {"robot": "puma560", "task": "spot_weld", "wear": plan, "cycles": 6, "nthread": 1, "seed": 4,
+              "conditions": conditions}
     cycles = sim.simulate(sim.RunConfig(**common), progress=False)
     days = sim.simulate(sim.RunConfig(**common, signals=False, daily=True), progress=False)
     assert days.cycles.tolist() == [1, 2, 3] and days.tau_m.shape == (3, 0, 6)
