@@ -59,6 +59,8 @@ def test_calendar_and_payload_patterns_at_known_cycles():
     assert some.hour.tolist() == every.hour[[2, 7]].tolist()
     assert every.day.tolist() == [100, 100, 100, 100, 101, 101, 101, 101]
     assert np.all((every.hour >= 6) & (every.hour < 22))
+    scheduled = c.Conditions(cycles_per_day=2, hours=(8, 16)).evaluate(0, np.array([1, 2, 3]))
+    assert scheduled.hour.tolist() == [8, 16, 8] and scheduled.day.tolist() == [0, 0, 1]
     part = c.Payloads(*parts).parameters(1)
     assert part["mass"] == 2.0 and part["com_z"] == 0.05 and part["ixx"] == pytest.approx(2.0 * 0.01 / 6)
 
@@ -83,6 +85,7 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     (lambda: c.Payloads((1.0,), (0.1,), pattern="zig"), r"payload pattern 'zig'"),
     (lambda: c.UnitSpread(dry_friction=0.9), r"unit spread dry_friction = 0.9"),
     (lambda: c.Conditions(cycles_per_day=0), r"cycles_per_day = 0"),
+    (lambda: c.Conditions(hours=(8, 16)), r"hours = \(8, 16\): expected 1 \(cycles_per_day\) times of day"),
     (lambda: c.Conditions.from_dict({"humidity": {}}), r"unknown key 'humidity'"),
     (lambda: c.Conditions.from_dict({"thermal": {"rise_K": 3}}), r"unknown setting 'rise_K'"),
     (lambda: sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], conditions={"spread": {"mass": 1}}),

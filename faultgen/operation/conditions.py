@@ -9,8 +9,10 @@ the dataset as truth, per cycle.
 
 **The robot's calendar.** Recorded cycle ``k`` (1-based) runs on day ``(k - 1) // cycles_per_day``
 of the run, counted from ``start_day`` (day of the year of cycle 1), at a time of day drawn
-uniformly within the production hours from the run's seed: a 100-cycle run with one cycle a day
-spans 100 days of the robot's life, which is what a wear schedule over 100 cycles stands for.
+uniformly within the production hours from the run's seed, or at fixed ``hours`` (a controller
+that collects its data on a schedule, at the same time every day: thesis ch. 5.3.2): a 100-cycle
+run with one cycle a day spans 100 days of the robot's life, which is what a wear schedule over
+100 cycles stands for.
 
 **Joint temperature** (:class:`Temperature`): the ambient air of the hall, a seasonal and a
 daily cosine around a mean, plus the heat of running: a joint that starts cold at the start of
@@ -273,11 +275,15 @@ class Conditions:
         Recorded-cycle index to calendar day (module docstring); >= 1.
     start_day : float
         Day of the year of cycle 1, 0..365.
+    hours : tuple of float, optional
+        Time of day (h) of each of a day's ``cycles_per_day`` cycles, in order; default: each
+        drawn uniformly within the production hours.
 
     Raises
     ------
     ValueError
-        On construction, for ``cycles_per_day`` < 1 or ``start_day`` outside 0..365.
+        On construction, for ``cycles_per_day`` < 1, ``start_day`` outside 0..365, or ``hours``
+        that are not ``cycles_per_day`` times within 0..24.
     TypeError
         For a condition of the wrong type.
     """
@@ -287,6 +293,7 @@ class Conditions:
     spread: UnitSpread | None = None
     cycles_per_day: int = 1
     start_day: float = 0.0
+    hours: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         for name, kind in (("thermal", Temperature), ("payloads", Payloads), ("spread", UnitSpread)):
@@ -297,6 +304,11 @@ class Conditions:
                 or self.cycles_per_day < 1:
             raise ValueError(f"cycles_per_day = {self.cycles_per_day!r}: expected a whole number >= 1")
         _finite("start_day", self.start_day, 0, 365)
+        if self.hours is not None:
+            hours = tuple(_finite("hour", h, 0, 24) for h in self.hours)
+            if len(hours) != self.cycles_per_day:
+                raise ValueError(f"hours = {self.hours!r}: expected {self.cycles_per_day} (cycles_per_day) times of day")
+            object.__setattr__(self, "hours", hours)
 
     @property
     def active(self) -> bool:
@@ -310,8 +322,11 @@ class Conditions:
         n = len(cycles)
         day = self.start_day + (cycles - 1) // self.cycles_per_day
         start, end = self.thermal.shift if self.thermal else (6.0, 22.0)
-        hour = np.array([start + (end - start) * np.random.default_rng([seed, int(c), _TIME_OF_DAY]).random()
-                         for c in cycles])
+        if self.hours is not None:
+            hour = np.array(self.hours)[(cycles - 1) % self.cycles_per_day]
+        else:
+            hour = np.array([start + (end - start) * np.random.default_rng([seed, int(c), _TIME_OF_DAY]).random()
+                             for c in cycles])
         ambient = np.full(n, np.nan)
         joint = np.full((n, N_AXES), np.nan)
         dry, viscous = np.ones((n, N_AXES)), np.ones((n, N_AXES))
@@ -339,10 +354,10 @@ class Conditions:
     def from_dict(cls, data: dict) -> Conditions:
         """Inverse of :meth:`to_dict`; unknown keys are refused with their name."""
         known = {"thermal": Temperature, "payloads": Payloads, "spread": UnitSpread}
-        unknown = sorted(set(data) - set(known) - {"cycles_per_day", "start_day"})
+        plain = ("cycles_per_day", "start_day", "hours")
+        unknown = sorted(set(data) - set(known) - set(plain))
         if unknown:
-            raise ValueError(f"conditions: unknown key {unknown[0]!r}; expected: "
-                             f"{', '.join([*known, 'cycles_per_day', 'start_day'])}")
+            raise ValueError(f"conditions: unknown key {unknown[0]!r}; expected: {', '.join([*known, *plain])}")
         parts = {}
         for name, kind in known.items():
             value = data.get(name)
@@ -355,5 +370,6 @@ class Conditions:
                     raise ValueError(f"conditions {name}: unknown setting {bad[0]!r}; expected: {', '.join(sorted(names))}")
                 value = {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
                 parts[name] = kind(**value)
-        return cls(**parts, **{k: data[k] for k in ("cycles_per_day", "start_day") if k in data})
+        rest = {k: tuple(data[k]) if isinstance(data[k], list) else data[k] for k in plain if data.get(k) is not None}
+        return cls(**parts, **rest)
 

@@ -8,8 +8,8 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
 
 - both robot models, in turn; a process (task) per robot; parts of two sizes that the robot picks
   at random, sized to the model; its own hall climate (mean, seasonal swing, the day of the year
-  its record starts), warm-up over each shift; its own unit-to-unit spread of friction and link
-  masses (:mod:`faultgen.operation.conditions`);
+  its record starts), warm-up over each shift, its daily records taken at the same hours every day;
+  its own unit-to-unit spread of friction and link masses (:mod:`faultgen.operation.conditions`);
 - a failing robot's gearbox wears on one drawn axis, its Coulomb and static friction rising on the
   exp4 schedule (thesis eq. 6.6) from a drawn onset day to ``failure_wear`` percent on its last
   day, the failure day; a healthy robot does not wear;
@@ -128,13 +128,20 @@ class Fleet:
             climate = {"ambient": round(float(rng.uniform(16.0, 24.0)), 1),
                        "seasonal": round(float(rng.uniform(2.0, 8.0)), 1)}
             table = {"thermal": climate, "payloads": parts, "spread": {}, "cycles_per_day": self.cycles_per_day,
-                     "start_day": float(rng.integers(0, 365))}
+                     "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
             fails = i in failing
             out.append({"run": f"robot{i + 1:02d}-{model}-{task}-{'failing' if fails else 'healthy'}",
                         "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,
                         "onset_day": onset_day if fails else None, "failure_day": self.days if fails else None,
                         "seed": self.seed * 10000 + i, "conditions": table})
         return out
+
+    def hours(self) -> list[float]:
+        """Times of day of a day's cycles, h: spread evenly over the production hours (6 to 22),
+        the same every day, as a controller collects its data on a schedule (thesis ch. 5.3.2)."""
+        start, end = conditions.Temperature().shift
+        step = (end - start) / self.cycles_per_day
+        return [start + step * (k + 0.5) for k in range(self.cycles_per_day)]
 
     def runs(self) -> list[tuple[str, sim.RunConfig]]:
         """``(run id, RunConfig)`` of every robot (:meth:`robots`), daily records without signals."""
