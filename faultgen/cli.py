@@ -328,6 +328,9 @@ def sweep_command(
     unit_spread: UnitSpreadFlag = False,
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
+    features_only: Annotated[bool, typer.Option(
+        "--features-only", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a fraction of "
+        "the size; only bench-isolators --speed-window needs the signals).")] = False,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
@@ -361,6 +364,8 @@ def sweep_command(
         table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day)
         if table is not None:
             options["conditions"] = table
+        if features_only:
+            options["signals"] = False
         if record is not None:
             options["record"] = list(_parse_cycles(record))
         if config is not None:

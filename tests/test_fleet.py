@@ -113,3 +113,21 @@ def test_features_only_runs_say_what_they_lack(tmp_path):
     with pytest.raises(ValueError, match="daily records need every cycle recorded, no signals and whole days"):
         sim.RunConfig("puma560", "pick_place", cycles=3, daily=True, signals=False,
                       conditions=c.Conditions(spread=c.UnitSpread(), cycles_per_day=2))
+
+
+def test_a_features_only_sweep_is_small_and_isolates(tmp_path):
+    """`faultgen sweep --features-only`: no signals in the file, a fraction of the size, and the
+    isolation benchmark runs on the stored per-cycle features."""
+    from analysis import benchmark
+    from faultgen.runs import sweep
+
+    common = {"robots": ["puma560"], "tasks": ["spot_weld"], "axes": [0, 2], "cycles": 20, "record": [5, 10, 15, 20]}
+    full, light = tmp_path / "full.h5", tmp_path / "light.h5"
+    sweep.run(sweep.Grid(**common), full, progress=False)
+    sweep.run(sweep.Grid(**common, signals=False), light, progress=False)
+    assert dataset.validate(light) == []
+    assert light.stat().st_size < 0.2 * full.stat().st_size
+    table = benchmark.isolation_table(light, progress=False)
+    assert set(table["worn_axis"]) == {0, 2}
+    same = benchmark.isolation_table(full, progress=False)
+    assert table["predicted"].tolist() == same["predicted"].tolist()

@@ -95,8 +95,12 @@ class Grid:
         Noise levels (:class:`faultgen.sensors.NoiseConfig`).
     conditions : dict or None
         Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
-        ``temperature``, ``payloads``, ``spread`` tables, ``cycles_per_day``, ``start_day``); None:
+        ``thermal``, ``payloads``, ``spread`` tables, ``cycles_per_day``, ``start_day``, ``hours``); None:
         none, the runs differ from their references only by wear.
+    signals : bool
+        Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
+        isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
+        window of ``bench-isolators`` needs the signals).
 
     Raises
     ------
@@ -116,6 +120,7 @@ class Grid:
     disturbance: float = 0.01
     encoder: float = 1e-4
     conditions: dict | None = None
+    signals: bool = True
 
     def __post_init__(self) -> None:
         for name in ("robots", "tasks", "axes", "increases", "schedules", "seeds"):
@@ -198,7 +203,7 @@ class Grid:
                     label = f"axis{axis}-{kind}{pct:g}"
                 out[f"{name}-{task}-{label}-seed{seed}"] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1, conditions=conditions)
+                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals))
         return list(out.items())
 
     def to_json(self) -> str:
