@@ -15,6 +15,7 @@ CSV and Markdown (and a PNG heatmap for isolation).
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -100,6 +101,17 @@ def _runs(path, names: tuple[str, ...]) -> list[tuple[str, dict, dict]]:
     return out
 
 
+def fault_progress(path, run_id: str, arrays: dict, attrs: dict, axis: int) -> np.ndarray:
+    """Per recorded cycle, the worn axis's true friction multiplier; for a run whose fault is not
+    friction wear (attribute ``fault``: a growing backlash, cogging, offset), 1 + its parameter's
+    change as a fraction of the final change, so that a level of L % means L % of the final value."""
+    if "fault" not in attrs:
+        return arrays["friction_multiplier"][:, axes.index(axis)]
+    fault = json.loads(attrs["fault"])
+    value = dataset.read_run(path, run_id, names=("fault_value",))[0]["fault_value"]
+    return 1.0 + (value - fault["start"]) / (fault["final"] - fault["start"])
+
+
 def level_cycle(multiplier: np.ndarray, level: float) -> int | None:
     """Index of the first recorded cycle whose true wear reaches ``level`` percent, or None."""
     reached = np.flatnonzero((multiplier - 1.0) * 100.0 >= level - 1e-9)
@@ -113,7 +125,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
 
     For a run wearing one axis, the isolator sees the per-cycle ``signal`` (n_cycles, 6) of the
     recorded cycles up to and including the first one whose true wear reaches the level (thesis
-    ch. 6.4: 10 % wear is cycle 86 of the exp4 schedule); it is right when it names that axis.
+    ch. 6.4: 10 % wear is cycle 86 of the exp4 schedule; for a fault other than friction wear, the
+    level is a share of its final value, :func:`fault_progress`); it is right when it names that axis.
     A run without wear is shown, for each level, as many cycles as the worn runs of its robot and
     task saw at that level; it is right only when the isolator names no axis (undecided): naming
     one is a false isolation. Runs wearing several axes are skipped.
@@ -165,8 +178,9 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     cases = []
     for run_id, arrays, attrs in worn:
         axis = int(attrs["worn_axes"][0])
+        grown = fault_progress(path, run_id, arrays, attrs, axis)
         for level in levels:
-            k = level_cycle(arrays["friction_multiplier"][:, axes.index(axis)], level)
+            k = level_cycle(grown, level)
             if k is not None:
                 seen.setdefault((attrs["robot"], attrs["task"], level), k + 1)
                 cases.append((run_id, arrays, attrs, axis, level, k + 1))
@@ -457,7 +471,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                 false_alarms[key] = 100.0 * float(np.mean(np.asarray(monitor.predict(normal[:, used]),
                                                                       dtype=bool)[skip:]))
         false_alarm = false_alarms[key]
-        wear = (arrays["friction_multiplier"][:, axis - 1] - 1.0) * 100.0
+        wear = (fault_progress(path, run_id, arrays, attrs, axis) - 1.0) * 100.0
         located = UNDECIDED
         if onset is not None:
             try:
@@ -579,6 +593,8 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         kl = [HistogramKL(reference="first").fit_transform(arrays[h]) for h in ("angle_hist", "speed_hist", "torque_hist")]
         X.append(np.hstack([arrays["mean_abs_torque"], arrays["rms_torque"], *kl]))
         wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
+        if "fault" in attrs:  # a fault other than friction wear: its share of the final value
+            wear = (fault_progress(path, run_id, arrays, attrs, int(attrs["worn_axes"][0])) - 1.0) * 100.0
         y.append((wear >= wear_threshold).astype(int))
         groups.append(np.full(len(wear), run_id, dtype=object))
         (failed if len(attrs["worn_axes"]) else normal).append(run_id)

@@ -204,6 +204,11 @@ def simulate_command(
     ] = 0.01,
     encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).")] = 1e-4,
     threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.")] = 0,
+    fault: Annotated[str | None, typer.Option(
+        help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
+        "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
+        "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
+        "warm-up).")] = None,
     temperature: Temperature = False,
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
@@ -229,6 +234,7 @@ def simulate_command(
     """
     from faultgen.data import dataset
     from faultgen.operation import conditions as conditions_module
+    from faultgen.operation import faults as faults_module
     from faultgen.operation import wear as wear_module
     from faultgen.simulation import sensors
     from faultgen.simulation import stepping as sim
@@ -244,6 +250,7 @@ def simulate_command(
             noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
             conditions=conditions_module.Conditions.from_dict(
                 _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day) or {}),
+            fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
         )
     except ValueError as err:
         typer.echo(f"error: {err}", err=True)
@@ -322,6 +329,9 @@ def sweep_command(
     cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
     record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
     seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    fault: Annotated[str | None, typer.Option(
+        help="Instead of friction wear, each worn axis gets this fault: EFFECT:PARAMETER:FINAL[:key=value,...], "
+        "e.g. backlash:width:0.01 or cogging:amplitude:0.05:poles=8 (see `simulate --fault`).")] = None,
     temperature: Temperature = False,
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
@@ -366,6 +376,8 @@ def sweep_command(
             options["conditions"] = table
         if features_only:
             options["signals"] = False
+        if fault is not None:
+            options["fault"] = fault
         if record is not None:
             options["record"] = list(_parse_cycles(record))
         if config is not None:

@@ -87,6 +87,10 @@ CONDITION_ARRAYS = {
     "link_mass_factor": ("1", "axis", "multiplier of each link's mass and inertia (this unit's)", "spread"),
 }
 
+#: Units attribute of ``fault_value`` (runs with a fault other than friction wear): the unit is the
+#: fault parameter's, named by the effect (``faultgen.effects``), so the array says where to look.
+FAULT_UNITS = "of the fault parameter"
+
 #: Attributes every run group carries.
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
@@ -116,6 +120,8 @@ def config_key(config) -> str:
         key["signals"] = False
     if config.daily:
         key["daily"] = True
+    if config.fault is not None:
+        key["fault"] = config.fault.to_dict()
     return json.dumps(key, sort_keys=True)
 
 
@@ -129,7 +135,8 @@ def run_attributes(result, command: str = "") -> dict:
         "friction_model": config.friction,
         "cycles": int(config.cycles),
         "seed": int(config.seed),
-        "worn_axes": np.array(config.wear.worn_axes, dtype=int),
+        "worn_axes": np.array(sorted({*config.wear.worn_axes, *([config.fault.axis] if config.fault else [])}),
+                              dtype=int),
         "wear": json.dumps(config.wear.to_dict()),
         "noise": json.dumps(asdict(config.noise)),
         "faultgen_version": __version__,
@@ -140,6 +147,7 @@ def run_attributes(result, command: str = "") -> dict:
         **({"conditions": json.dumps(config.conditions.to_dict())} if config.conditions.active else {}),
         "signals": bool(config.signals),
         "sample": "day" if config.daily else "cycle",
+        **({"fault": json.dumps(config.fault.to_dict())} if config.fault is not None else {}),
     }
 
 
@@ -199,6 +207,11 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
             ds.attrs["units"] = units
             ds.attrs["axes"] = axes
             ds.attrs["description"] = description
+        if result.fault_value is not None:
+            ds = group.create_dataset("fault_value", data=np.asarray(result.fault_value, dtype=float))
+            ds.attrs["units"] = FAULT_UNITS
+            ds.attrs["axes"] = "cycle"
+            ds.attrs["description"] = "the growing fault's parameter at each cycle (unit of the parameter: attr fault)"
         f.attrs["complete"] = True
     return path
 
@@ -405,6 +418,8 @@ def _validate_run(group: h5py.Group) -> list[str]:
     signals = bool(group.attrs.get("signals", True))
     schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
+    if "fault" in group.attrs:
+        schema["fault_value"] = (FAULT_UNITS, "cycle", "")
     missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:

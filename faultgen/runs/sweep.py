@@ -38,7 +38,7 @@ from tqdm.auto import tqdm
 from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
-from faultgen.operation import tasks, wear
+from faultgen.operation import faults, tasks, wear
 from faultgen.operation.conditions import Conditions
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -97,6 +97,11 @@ class Grid:
         Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
         ``thermal``, ``payloads``, ``spread`` tables, ``cycles_per_day``, ``start_day``, ``hours``); None:
         none, the runs differ from their references only by wear.
+    fault : str or None
+        A fault other than friction wear for the worn axes, ``EFFECT:PARAMETER:FINAL[:key=value,...]``
+        (:func:`faultgen.operation.faults.parse_fault` without the axis, e.g. ``backlash:width:0.01``):
+        each axis of ``axes`` but 0 gets it instead of friction wear (``increases`` and ``schedules``
+        are then unused; ``kind=...`` shapes its growth).
     signals : bool
         Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
         isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
@@ -120,6 +125,7 @@ class Grid:
     disturbance: float = 0.01
     encoder: float = 1e-4
     conditions: dict | None = None
+    fault: str | None = None
     signals: bool = True
 
     def __post_init__(self) -> None:
@@ -194,16 +200,21 @@ class Grid:
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
             name = robots.load(robot).name
             # a run without wear is one run, whatever the wear levels and schedules of the grid
-            variants = [(None, 0.0)] if axis == 0 else itertools.product(self.schedules, self.increases)
+            variants = [(None, 0.0)] if axis == 0 or self.fault else itertools.product(self.schedules, self.increases)
             for kind, pct in variants:
+                plan, fault = wear.WearPlan({}), None
                 if axis == 0:
-                    plan, label = wear.WearPlan({}), "nowear"
+                    label = "nowear"
+                elif self.fault:
+                    effect, _, rest = str(self.fault).partition(":")
+                    fault = faults.parse_fault(f"{effect}:{axis}:{rest}", last_cycle=self.cycles)
+                    label = f"axis{axis}-{fault.effect}{fault.final:g}"
                 else:
                     plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
                     label = f"axis{axis}-{kind}{pct:g}"
                 out[f"{name}-{task}-{label}-seed{seed}"] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals))
+                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault)
         return list(out.items())
 
     def to_json(self) -> str:

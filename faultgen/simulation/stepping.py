@@ -18,6 +18,7 @@ so it steps from Python and is slower (docs/performance.md gives both figures).
 from __future__ import annotations
 
 import functools
+import json
 import time
 from dataclasses import dataclass, field, fields, replace
 
@@ -26,12 +27,14 @@ import numpy as np
 from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
+from faultgen import effects as effects_registry
 from faultgen.effects import friction
 from faultgen.effects.base import Effect
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation import tasks
 from faultgen.operation.conditions import Conditions, CycleConditions
+from faultgen.operation.faults import Fault
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import control, sensors
 
@@ -81,6 +84,9 @@ class RunConfig:
         :mod:`faultgen.operation.conditions`); none by default.
     signals : bool
         Keep the 250 Hz signals in the dataset (False: the per-cycle features and truth only).
+    fault : Fault or None
+        A fault other than friction wear: an effect's parameter growing over the cycles
+        (:mod:`faultgen.operation.faults`); the controller does not know it.
     daily : bool
         Record one remote-monitoring sample per day of ``conditions.cycles_per_day`` cycles, the
         day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
@@ -109,6 +115,7 @@ class RunConfig:
     conditions: Conditions = field(default_factory=Conditions)
     signals: bool = True
     daily: bool = False
+    fault: Fault | None = None
 
     def __post_init__(self) -> None:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
@@ -131,6 +138,19 @@ class RunConfig:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
         if not isinstance(self.conditions, Conditions):
             raise TypeError(f"conditions: expected a Conditions, got {type(self.conditions).__name__}")
+        if self.fault is not None:
+            if not isinstance(self.fault, Fault):
+                raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
+            if self.fault.last_cycle != self.cycles:
+                raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
+            if self.fault.effect in robots.load(self.robot).effects and np.any(
+                    robots.load(self.robot).effects[self.fault.effect].active()):
+                raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
+                                 "needs a robot without it")
+            if self.back_to_back or (self.conditions.payloads is not None and not type(
+                    effects_registry.get(self.fault.effect)).per_axis):
+                raise ValueError("a fault runs its cycles independently (no back_to_back), and a robot-wide fault "
+                                 "(payload) cannot be combined with payload conditions")
         if self.back_to_back and (self.wear.schedules or self.conditions.active
                                   or self.record not in (None, tuple(range(1, self.cycles + 1)))):
             raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "
@@ -333,6 +353,8 @@ class RunResult:
         ``torque_hist`` (n_cycles, 6, 12).
     conditions : CycleConditions or None
         The operating conditions of each recorded cycle (None when the run has none).
+    fault_value : ndarray of shape (n_cycles,) or None
+        The growing fault's parameter at each recorded cycle (None without a fault).
     stepping_time : float
         Wall time spent stepping the physics, s (not part of the recorded data).
     """
@@ -353,6 +375,7 @@ class RunResult:
     tracking_error: np.ndarray
     features: dict[str, np.ndarray] = field(default_factory=dict)
     conditions: CycleConditions | None = None
+    fault_value: np.ndarray | None = None
     stepping_time: float = field(default=0.0, compare=False)
 
 
@@ -397,7 +420,7 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
     dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
     conditions = config.conditions.evaluate(config.seed, cycles) if config.conditions.active else None
-    plant = _Plant.of(multiplier, conditions)
+    plant = _Plant.of(multiplier, conditions, None if config.fault is None else config.fault.values(cycles))
 
     stepper = _step_lugre if config.friction == "lugre" else _step_stribeck
     with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
@@ -414,17 +437,21 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
             order, raws = [], []
             for part in np.unique(parts):
                 carrying = np.flatnonzero(parts == part)
-                variant = prepared if part < 0 else _prepared(
-                    config.robot, config.task, config.friction, config.conditions.payloads.parameters(int(part)))
+                payload = None if part < 0 else config.conditions.payloads.parameters(int(part))
+                variant = prepared if payload is None and config.fault is None else _prepared(
+                    config.robot, config.task, config.friction, payload, config.fault)
                 for i in range(0, len(carrying), BATCH_CYCLES):
                     g = carrying[i:i + BATCH_CYCLES]
+                    fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
                     raws.append(stepper(variant.sim, _Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
-                                                           dist[g], per_log, config.nthread), bar))
+                                                           dist[g], per_log, config.nthread, fault), bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
             raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
+    if config.fault is not None:
+        result = replace(result, fault_value=config.fault.values(cycles))
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     return daily_record(result) if config.daily else result
@@ -433,7 +460,7 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
 def daily_record(result: RunResult) -> RunResult:
     """The remote-monitoring record of ``result`` once a day (thesis ch. 5.3.2): of each day's
     ``cycles_per_day`` cycles the largest value of every per-cycle feature and truth (histogram
-    bins too, each histogram then scaled back to a sum of 1; the wear of the day's last cycle), the
+    bins too, each histogram then scaled back to a sum of 1; the wear and fault of the day's last cycle), the
     operating conditions' mean (temperatures, friction factors) or largest value (payload mass),
     the day's first part. ``cycles`` becomes the day number (1-based); no signals are kept.
 
@@ -464,7 +491,8 @@ def daily_record(result: RunResult) -> RunResult:
     return replace(result, cycles=np.arange(1, n_days + 1), q_a=empty, q_m=empty, qd_a=empty, qd_m=empty,
                    tau_m=empty, tau_f=empty, tau_dist=empty, friction_multiplier=days(result.friction_multiplier),
                    mean_friction_torque=days(result.mean_friction_torque), tracking_error=days(result.tracking_error),
-                   features=features, conditions=conditions)
+                   features=features, conditions=conditions,
+                   fault_value=None if result.fault_value is None else result.fault_value[per_day - 1::per_day][:n_days])
 
 
 @dataclass(frozen=True)
@@ -482,6 +510,9 @@ class Prepared:
         Reference arm angles at every physics step, rad (held at the end to a whole log period).
     inputs : ndarray of shape (n_steps + 1, 6, 3)
         Drive set-points (angle, speed, feedforward) at every physics step, motor side.
+    fault_fields : tuple
+        For a model with a growing fault: the fields its parameter moves (:func:`_affine_fields`),
+        set per simulation from each cycle's value.
     """
 
     sim: SimModel
@@ -489,6 +520,7 @@ class Prepared:
     path: tasks.JointPath
     q_ref: np.ndarray
     inputs: np.ndarray
+    fault_fields: tuple = ()
 
     @property
     def per_log(self) -> int:
@@ -505,15 +537,26 @@ class _Plant:
     dry: np.ndarray
     viscous: np.ndarray
     link_mass: np.ndarray
+    fault: np.ndarray | None = None
 
     @classmethod
-    def of(cls, wear: np.ndarray, conditions: CycleConditions | None) -> _Plant:
+    def of(cls, wear: np.ndarray, conditions: CycleConditions | None, fault: np.ndarray | None = None) -> _Plant:
         if conditions is None:
-            return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]))
-        return cls(wear * conditions.dry_friction_factor, conditions.viscous_factor, conditions.link_mass_factor)
+            return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]), fault)
+        return cls(wear * conditions.dry_friction_factor, conditions.viscous_factor, conditions.link_mass_factor,
+                   fault)
 
     def take(self, rows) -> _Plant:
-        return _Plant(self.dry[rows], self.viscous[rows], self.link_mass)
+        return _Plant(self.dry[rows], self.viscous[rows], self.link_mass,
+                      None if self.fault is None else self.fault[rows])
+
+    def set_fault(self, batch, fault_fields: tuple, final: float) -> None:
+        """Each simulation's fault parameter (:attr:`fault`, per cycle) into the fields it moves."""
+        for name, index, at_final, slope in fault_fields:
+            values = batch.expand(name)
+            flat = values.reshape(values.shape[0], -1)
+            flat[:, index] = at_final + (self.fault[:, None] - final) * slope
+            values[...] = flat.reshape(values.shape)
 
     def apply(self, sim: SimModel, batch) -> None:
         """The viscous and link-mass changes as per-simulation model fields of ``batch`` (the dry
@@ -535,7 +578,7 @@ class _Work:
     """One batch of simulations stepped together: recorded ``cycles`` (n,), their ``plant`` (wear
     and conditions), the start angles ``q0`` (6,), the drive ``inputs`` at every physics step
     (n_steps + 1, 6, 3), the load disturbance ``dist`` per log period (n, n_log, 6), physics steps
-    per log period and MuJoCo threads."""
+    per log period, MuJoCo threads, and for a fault the fields it moves and its final value."""
 
     cycles: np.ndarray
     plant: _Plant
@@ -544,39 +587,94 @@ class _Work:
     dist: np.ndarray
     per_log: int
     nthread: int
+    fault: tuple | None = None
 
 
-def _prepared(robot: str, task: str, friction_model: str, payload: dict | None = None) -> Prepared:
+def _prepared(robot: str, task: str, friction_model: str, payload: dict | None = None,
+              fault: Fault | None = None) -> Prepared:
     """:func:`_prepare`, renewed when the robot's model or task file changes; ``payload``: the
-    :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries."""
+    :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
+    a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
     model_file = robots.load(robot).path
     stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
-    if payload is None:
+    if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
-    return _prepare_carrying(robot, task, friction_model, tuple(sorted(payload.items())), *stamps)
+    key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
+    return _prepare_variant(robot, task, friction_model, None if payload is None else tuple(sorted(payload.items())),
+                            key, *stamps)
 
 
 @functools.lru_cache(maxsize=16)
-def _prepare_carrying(robot_name: str, task_name: str, friction_model: str, payload: tuple, *file_stamps: int
-                      ) -> Prepared:
+def _prepare_variant(robot_name: str, task_name: str, friction_model: str, payload: tuple | None, fault: str | None,
+                     *file_stamps: int) -> Prepared:
     """The :class:`Prepared` of a robot carrying a payload (``(name, value)`` pairs of the
-    :class:`~faultgen.effects.payload.Payload` parameters, written as a body at the flange): the
-    nominal task path, and a model and feedforward with the payload in them (the controller knows
-    the load it carries)."""
+    :class:`~faultgen.effects.payload.Payload` parameters, written as a body at the flange) and/or
+    with a growing fault (a :class:`Fault` as JSON): the nominal task path; a model with the payload
+    and the fault's effect in it (at its final value; :attr:`Prepared.fault_fields` move it per
+    simulation), and a feedforward with the payload only (the controller knows the load it carries,
+    not the fault)."""
     nominal = _prepare(robot_name, task_name, friction_model, *file_stamps)
     robot = robots.load(robot_name)
-    load = Payload(**dict(payload))
+    load = None if payload is None else Payload(**dict(payload))
 
     def carry(spec):
-        load.write(spec, robot)
+        if load is not None:
+            load.write(spec, robot)
 
-    carrying = robot.edited(carry)
-    sim = build(carrying, friction_model, edit=carry)
+    controller = robot.edited(carry) if load is not None else robot
+    fields_ = ()
+    if fault is None:
+        sim = build(controller, friction_model, edit=carry)
+    else:
+        spec = Fault(**{k: v for k, v in json.loads(fault).items()})
+
+        def faulty(value):
+            def edit(mjspec):
+                carry(mjspec)
+                effect = spec.at(value)
+                effect.write(mjspec, controller, None if not effect.per_axis else [spec.axis - 1])
+                effect.add_to_simulation(mjspec, controller)
+            return build(controller, friction_model, edit=edit)
+
+        sim = faulty(spec.final)
+        fields_ = _affine_fields(sim.model, faulty((spec.start + spec.final) / 2).model, spec.final,
+                                 (spec.start + spec.final) / 2, faulty(spec.start + 0.25 * (spec.final - spec.start)).model,
+                                 spec.start + 0.25 * (spec.final - spec.start))
     n_steps = len(nominal.inputs) - 1
     path = nominal.path
     inputs = sim.setpoints(nominal.q_ref, *(hold_end(a, n_steps) for a in (path.qd, path.qdd)))
     inputs.setflags(write=False)
-    return Prepared(sim, nominal.task, path, nominal.q_ref, inputs)
+    return Prepared(sim, nominal.task, path, nominal.q_ref, inputs, fields_)
+
+
+def _affine_fields(model, other, value: float, other_value: float, check, check_value: float) -> tuple:
+    """The model fields a fault's parameter moves, as ``(field, flat indices, values at value,
+    change per unit)``: found by comparing the models compiled at two values of it, and checked
+    affine at a third (the effect's MJCF form is linear in the parameter for every schedulable
+    effect: a dead band's spring lengths, a cogging amplitude, an offset's bias, a body's mass).
+
+    Raises
+    ------
+    ValueError
+        If the models differ in structure or a field is not affine in the parameter.
+    """
+    out = []
+    for name in dir(model):
+        a = getattr(model, name, None)
+        if name.startswith("_") or not isinstance(a, np.ndarray) or a.dtype.kind != "f":
+            continue
+        b, c = getattr(other, name), getattr(check, name)
+        if a.shape != b.shape or a.shape != c.shape:
+            raise ValueError(f"the fault changes the model's structure ({name}); it cannot grow per cycle")
+        changed = np.flatnonzero((a != b).ravel())
+        if changed.size == 0:
+            continue
+        slope = (a.ravel()[changed] - b.ravel()[changed]) / (value - other_value)
+        expected = a.ravel()[changed] + slope * (check_value - value)
+        if not np.allclose(c.ravel()[changed], expected, rtol=1e-9, atol=1e-12):
+            raise ValueError(f"the fault's parameter moves model field {name} non-linearly; it cannot grow per cycle")
+        out.append((name, changed, a.ravel()[changed].copy(), slope))
+    return tuple(out)
 
 
 @functools.lru_cache(maxsize=8)
@@ -634,6 +732,8 @@ def _new_batch(sim: SimModel, work: _Work) -> mjbatch.Batch:
     batch.qpos, batch.qvel = start_state(sim.robot, work.q0)
     batch.act = 0.0
     work.plant.apply(sim, batch)
+    if work.fault is not None:
+        work.plant.set_fault(batch, *work.fault)
     return batch
 
 

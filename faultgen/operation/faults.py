@@ -1,0 +1,163 @@
+"""Faults other than friction wear: one effect's parameter growing over a run's cycles.
+
+Friction wear (:mod:`faultgen.operation.wear`) is one fault; the effects the calibration
+identifies (:mod:`faultgen.effects`) give others: a gearbox whose backlash grows, a motor whose
+cogging grows, a drifting torque offset. A :class:`Fault` names the effect,
+the axis, the parameter and its value at the last cycle; the value grows from ``start`` on the
+shape of a wear schedule kind (``linear`` by default; ``exp4``, ``logistic``, ``step`` as in
+:mod:`~faultgen.operation.wear`). The effect's own MJCF form (:meth:`Effect.apply`) puts it into
+the simulated robot, so the fault is the same physics the calibration identifies; the controller
+does not know it. Effects that act through a per-step update of the friction level (``stepped``:
+load-dependent friction, warm-up) cannot be scheduled this way (their per-cycle counterparts are
+the operating conditions, :mod:`faultgen.operation.conditions`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from faultgen import effects
+from faultgen.axes import N_AXES
+from faultgen.effects.base import Effect
+from faultgen.operation import wear
+
+_SPEC_FORM = ("the form is EFFECT:AXIS:PARAMETER:FINAL[:key=value,...], e.g. 'backlash:2:width:0.01', "
+              "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4'")
+
+
+@dataclass(frozen=True)
+class Fault:
+    """An effect's parameter on one axis growing over the cycles of a run; validated on construction.
+
+    Attributes
+    ----------
+    effect : str
+        Effect id (:data:`faultgen.effects.EFFECTS`), not a ``stepped`` one.
+    axis : int
+        1..6 (a robot-wide effect, payload, cannot be a growing fault).
+    parameter : str
+        The parameter that grows (one of the effect's :attr:`~faultgen.effects.Effect.units`).
+    final : float
+        Its value at ``last_cycle``, in the parameter's unit.
+    last_cycle : int
+        The run's last cycle, >= 1.
+    kind : str
+        Shape of the growth: a wear schedule kind; the value is ``start + (final - start) g(k)``
+        with ``g`` the schedule's rise as a fraction of its final rise.
+    start : float
+        Value at cycle 0 (default 0: a fault that appears).
+    others : dict
+        The effect's other parameters on the axis (e.g. cogging ``poles`` and ``phase``); those
+        not given keep the effect's absent values.
+
+    Raises
+    ------
+    ValueError
+        For an unknown effect (listing them), a stepped effect, an axis out of range or of the
+        wrong kind for the effect, an unknown parameter, a non-finite value, or a value the
+        effect does not admit; the message names it.
+    """
+
+    effect: str
+    axis: int
+    parameter: str
+    final: float
+    last_cycle: int
+    kind: str = "linear"
+    start: float = 0.0
+    others: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        kind = effects.get(self.effect)  # ValueError lists the known ids
+        if kind.stepped:
+            raise ValueError(f"fault effect {self.effect!r} acts through a per-step friction update and cannot grow "
+                             "over cycles; use the operating conditions (--temperature) or the static friction model")
+        if not kind.per_axis:
+            raise ValueError(f"fault effect {self.effect!r} is robot-wide; a growing fault sits on one axis (parts "
+                             "changing per cycle are an operating condition: --payloads)")
+        if isinstance(self.axis, bool) or not isinstance(self.axis, (int, np.integer)) or not 1 <= self.axis <= N_AXES:
+            raise ValueError(f"fault axis {self.axis!r}: expected 1..6")
+        names = list(kind.units)
+        for name in [self.parameter, *self.others]:
+            if name not in names:
+                raise ValueError(f"{self.effect} has no parameter {name!r}; it has: {', '.join(names)}")
+        if self.parameter in self.others:
+            raise ValueError(f"fault parameter {self.parameter!r} is also given as another parameter")
+        for name, value in (("final", self.final), ("start", self.start), *self.others.items()):
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value):
+                raise ValueError(f"fault {name} = {value!r}: expected a finite number")
+        if self.final == self.start:
+            raise ValueError(f"fault final = start = {self.final!r}: a fault must change its parameter")
+        wear.Schedule(self.kind, 1.0, self.last_cycle)  # names a bad kind or last cycle
+        for value in (self.start, self.final):
+            if value < 0 and not kind.signed:
+                raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} takes values >= 0")
+            instance = self.at(value)
+            problem = type(kind).check(np.array([instance.values(self.axis - 1)[n] for n in names])[None])
+            if problem:
+                raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} {problem}")
+
+    def values(self, cycles) -> np.ndarray:
+        """The parameter at ``cycles`` (ints >= 0, any shape), in its unit."""
+        rise = wear.Schedule(self.kind, 1.0, self.last_cycle).multiplier(np.asarray(cycles)) - 1.0
+        return self.start + (self.final - self.start) * rise
+
+    def at(self, value: float) -> Effect:
+        """The effect with the parameter at ``value`` (and :attr:`others`) on the fault's axis,
+        absent on the others."""
+        cls = type(effects.get(self.effect))
+        values = {**self.others, self.parameter: float(value)}
+        table = {}
+        for k, name in enumerate(cls.units):
+            column = np.full(N_AXES, cls.absent[k], dtype=float)
+            if name in values:
+                column[self.axis - 1] = values[name]
+            table[name] = column
+        return cls(**table)
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable labels."""
+        return {"effect": self.effect, "axis": self.axis, "parameter": self.parameter, "final": self.final,
+                "start": self.start, "kind": self.kind, "last_cycle": self.last_cycle, "others": dict(self.others)}
+
+
+def parse_fault(spec: str, last_cycle: int) -> Fault:
+    """A :class:`Fault` from ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]`` (options: ``kind``,
+    ``start`` and the effect's other parameters). Raises ValueError quoting the spec and the form."""
+
+    def fail(reason: str) -> ValueError:
+        return ValueError(f"bad fault spec {spec!r}: {reason}; {_SPEC_FORM}")
+
+    parts = [p.strip() for p in spec.strip().split(":")]
+    if len(parts) not in (4, 5):
+        raise fail(f"it has {len(parts)} ':'-separated field(s), expected 4 or 5")
+    effect, axis_text, parameter, final_text = parts[:4]
+    try:
+        axis, final = int(axis_text), float(final_text)
+    except ValueError:
+        raise fail("AXIS must be an int and FINAL a number") from None
+    options, kind, start = {}, "linear", 0.0
+    if len(parts) == 5:
+        for option in parts[4].split(","):
+            key, sep, value = (s.strip() for s in option.partition("="))
+            if not sep or not key or not value:
+                raise fail(f"option {option!r} is not key=value")
+            if key == "kind":
+                kind = value
+                continue
+            try:
+                number = float(value)
+            except ValueError:
+                raise fail(f"option {key}={value} is not a number") from None
+            if key == "start":
+                start = number
+            else:
+                options[key] = number
+    try:
+        return Fault(effect, axis, parameter, final, last_cycle, kind=kind, start=start, others=options)
+    except ValueError as err:
+        raise fail(str(err)) from None
