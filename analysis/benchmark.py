@@ -543,6 +543,10 @@ class StoredHistograms:
 
     hist: np.ndarray
 
+    def __getitem__(self, rows) -> StoredHistograms:
+        """The histograms of some cycles (``rows``, as for an array of |torque|)."""
+        return StoredHistograms(self.hist[rows])
+
 
 def _histograms(torque: np.ndarray | StoredHistograms, cycles: np.ndarray, scale: np.ndarray | None,
                 period: int | None) -> tuple[np.ndarray, np.ndarray]:

@@ -428,6 +428,9 @@ def fleet_command(
     failure_wear: Annotated[float, typer.Option(
         help="Coulomb and static friction increase of the failing axis on the failure day, %.")] = 50.0,
     seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.")] = 0,
+    conditions: Annotated[bool, typer.Option(
+        help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
+        "process and fault.")] = True,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
@@ -450,7 +453,7 @@ def fleet_command(
 
     try:
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
-                           failure_wear=failure_wear, seed=seed)
+                           failure_wear=failure_wear, seed=seed, conditions=conditions)
         if jobs < 1:
             raise ValueError(f"--jobs {jobs}: expected >= 1")
         _check_outputs([out], overwrite)

@@ -74,6 +74,9 @@ class Fleet:
     seed : int
     friction : str
         Friction model of every run.
+    conditions : bool
+        Each robot's operating conditions (climate, parts, unit spread); False: none, the robots
+        differ only by model, process and fault (an ablation: what the conditions do).
 
     Raises
     ------
@@ -91,6 +94,7 @@ class Fleet:
     models: tuple[str, ...] = ("irb6700", "puma560")
     seed: int = 0
     friction: str = "lugre"
+    conditions: bool = True
 
     def __post_init__(self) -> None:
         _number("size", self.size, 2, 10000, whole=True)
@@ -129,6 +133,8 @@ class Fleet:
                        "seasonal": round(float(rng.uniform(2.0, 8.0)), 1)}
             table = {"thermal": climate, "payloads": parts, "spread": {}, "cycles_per_day": self.cycles_per_day,
                      "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
+            if not self.conditions:  # the same draws, none of them used: only the calendar
+                table = {"cycles_per_day": self.cycles_per_day, "hours": self.hours()}
             fails = i in failing
             out.append({"run": f"robot{i + 1:02d}-{model}-{task}-{'failing' if fails else 'healthy'}",
                         "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,
