@@ -626,20 +626,18 @@ def _prepare_variant(robot_name: str, task_name: str, friction_model: str, paylo
     if fault is None:
         sim = build(controller, friction_model, edit=carry)
     else:
-        spec = Fault(**{k: v for k, v in json.loads(fault).items()})
+        grown = Fault(**json.loads(fault))
 
-        def faulty(value):
+        def model_at(value: float) -> SimModel:
             def edit(mjspec):
                 carry(mjspec)
-                effect = spec.at(value)
-                effect.write(mjspec, controller, None if not effect.per_axis else [spec.axis - 1])
+                effect = grown.at(value)
+                effect.write(mjspec, controller, [grown.axis - 1])
                 effect.add_to_simulation(mjspec, controller)
             return build(controller, friction_model, edit=edit)
 
-        sim = faulty(spec.final)
-        fields_ = _affine_fields(sim.model, faulty((spec.start + spec.final) / 2).model, spec.final,
-                                 (spec.start + spec.final) / 2, faulty(spec.start + 0.25 * (spec.final - spec.start)).model,
-                                 spec.start + 0.25 * (spec.final - spec.start))
+        sim = model_at(grown.final)
+        fields_ = _affine_fields(model_at, grown.start, grown.final, sim.model)
     n_steps = len(nominal.inputs) - 1
     path = nominal.path
     inputs = sim.setpoints(nominal.q_ref, *(hold_end(a, n_steps) for a in (path.qd, path.qdd)))
@@ -647,17 +645,20 @@ def _prepare_variant(robot_name: str, task_name: str, friction_model: str, paylo
     return Prepared(sim, nominal.task, path, nominal.q_ref, inputs, fields_)
 
 
-def _affine_fields(model, other, value: float, other_value: float, check, check_value: float) -> tuple:
-    """The model fields a fault's parameter moves, as ``(field, flat indices, values at value,
-    change per unit)``: found by comparing the models compiled at two values of it, and checked
-    affine at a third (the effect's MJCF form is linear in the parameter for every schedulable
-    effect: a dead band's spring lengths, a cogging amplitude, an offset's bias, a body's mass).
+def _affine_fields(model_at, start: float, final: float, model) -> tuple:
+    """The model fields a fault's parameter moves, as ``(field, flat indices, values at final,
+    change per unit)``: found by comparing ``model`` (compiled at ``final``) with the model
+    ``model_at(value)`` compiled half way from ``start``, and checked affine at a quarter (the
+    effect's MJCF form is linear in the parameter for every schedulable effect: a dead band's spring
+    lengths, a cogging amplitude, an offset's bias, a friction level).
 
     Raises
     ------
     ValueError
         If the models differ in structure or a field is not affine in the parameter.
     """
+    value, other_value, check_value = final, start + 0.5 * (final - start), start + 0.25 * (final - start)
+    other, check = model_at(other_value).model, model_at(check_value).model
     out = []
     for name in dir(model):
         a = getattr(model, name, None)
