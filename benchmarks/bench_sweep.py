@@ -22,45 +22,22 @@ from __future__ import annotations
 import argparse
 import shutil
 import tempfile
-import threading
 import time
 from pathlib import Path
 
-import psutil
-from benchmarks_common import same_work_seconds  # sibling module
+from benchmarks_common import PeakRSS, same_work_seconds  # sibling module
 
 from faultgen.runs import sweep
 
 
-def tree_rss() -> int:
-    me = psutil.Process()
-    total = me.memory_info().rss
-    for child in me.children(recursive=True):
-        try:
-            total += child.memory_info().rss
-        except psutil.NoSuchProcess:
-            pass
-    return total
-
-
 def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
-    stats, timings, peak = [], {}, [0]
-    stop = threading.Event()
-
-    def sample() -> None:
-        while not stop.is_set():
-            peak[0] = max(peak[0], tree_rss())
-            time.sleep(0.05)
-
-    sampler = threading.Thread(target=sample, daemon=True)
-    sampler.start()
-    started = time.perf_counter()
-    sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", jobs=jobs, progress=False,
-              on_run=stats.append, timings=timings)
-    wall = time.perf_counter() - started
-    stop.set()
-    sampler.join()
-    return dict(wall=wall, stats=stats, merge=timings["merge"], peak=peak[0])
+    stats, timings = [], {}
+    with PeakRSS() as memory:
+        started = time.perf_counter()
+        sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", jobs=jobs, progress=False,
+                  on_run=stats.append, timings=timings)
+        wall = time.perf_counter() - started
+    return dict(wall=wall, stats=stats, merge=timings["merge"], peak=memory.peak)
 
 
 def main() -> None:

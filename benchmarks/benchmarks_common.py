@@ -1,8 +1,11 @@
-"""Baselines shared by the benchmarks: MuJoCo stepping a run's workload with no Python in the loop."""
+"""Shared by the benchmarks: MuJoCo stepping a run's workload with no Python in the loop (the
+baseline), and the peak memory of a process and its workers."""
 
 from __future__ import annotations
 
+import threading
 import time
+from typing import Self
 
 import mujoco
 import numpy as np
@@ -12,6 +15,40 @@ from faultgen.model import robots
 from faultgen.operation import tasks
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+
+
+def tree_rss() -> int:
+    """Resident set of this process and all its children, bytes."""
+    import psutil
+
+    me = psutil.Process()
+    total = me.memory_info().rss
+    for child in me.children(recursive=True):
+        try:
+            total += child.memory_info().rss
+        except psutil.NoSuchProcess:
+            pass
+    return total
+
+
+class PeakRSS:
+    """Context manager sampling :func:`tree_rss` every 50 ms; ``peak`` (bytes) after it exits."""
+
+    def __enter__(self) -> Self:
+        self.peak, self._stop = 0, threading.Event()
+
+        def sample() -> None:
+            while not self._stop.is_set():
+                self.peak = max(self.peak, tree_rss())
+                time.sleep(0.05)
+
+        self._thread = threading.Thread(target=sample, daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        self._thread.join()
 
 
 def _prepared(config: sim.RunConfig):

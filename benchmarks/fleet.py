@@ -17,44 +17,22 @@ from __future__ import annotations
 
 import argparse
 import tempfile
-import threading
 import time
 from pathlib import Path
 
-import psutil
+from benchmarks_common import PeakRSS  # sibling module
 
 from faultgen.data import dataset
 from faultgen.runs import fleet, sweep
 
 
-def tree_rss() -> int:
-    me = psutil.Process()
-    total = me.memory_info().rss
-    for child in me.children(recursive=True):
-        try:
-            total += child.memory_info().rss
-        except psutil.NoSuchProcess:
-            pass
-    return total
-
-
 def timed(plan: fleet.Fleet, jobs: int, out: Path) -> tuple[float, int]:
     """Wall time (s) and peak RSS of the process tree (bytes) of one fleet."""
-    peak, stop = [0], threading.Event()
-
-    def sample() -> None:
-        while not stop.is_set():
-            peak[0] = max(peak[0], tree_rss())
-            time.sleep(0.05)
-
-    sampler = threading.Thread(target=sample, daemon=True)
-    sampler.start()
-    started = time.perf_counter()
-    sweep.run(plan, out, jobs=jobs, progress=False)
-    wall = time.perf_counter() - started
-    stop.set()
-    sampler.join()
-    return wall, peak[0]
+    with PeakRSS() as memory:
+        started = time.perf_counter()
+        sweep.run(plan, out, jobs=jobs, progress=False)
+        wall = time.perf_counter() - started
+    return wall, memory.peak
 
 
 def main() -> None:

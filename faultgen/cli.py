@@ -402,18 +402,7 @@ def sweep_command(
             typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
                        "they are")
 
-    try:
-        sweep.run(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
-                  command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
-    except sweep.SweepRefused as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(2) from err
-    except sweep.SweepInterrupted as err:
-        typer.echo(str(err), err=True)
-        raise typer.Exit(130) from err
-    except sweep.SweepError as err:
-        typer.echo(f"error: {err}", err=True)
-        raise typer.Exit(1) from err
+    _run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce)
     typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
@@ -449,7 +438,7 @@ def fleet_command(
 
       faultgen classify fleet.h5 --wear-threshold 10
     """
-    from faultgen.runs import fleet, sweep
+    from faultgen.runs import fleet
 
     try:
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
@@ -465,8 +454,19 @@ def fleet_command(
         typer.echo(f"{n_runs} robots x {days} days -> {out} with {jobs} job(s)"
                    + (f"; resuming, {done} robots already finished" if done else ""))
 
+    _run_sweep(plan, out, jobs=jobs, scheduler=None, progress=progress, overwrite=overwrite, announce=announce)
+    typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
+               f"  faultgen detect {out}")
+
+
+def _run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
+               announce) -> None:
+    """:func:`faultgen.runs.sweep.run` for a command: its errors as messages and exit codes (2
+    refused before anything ran, 130 interrupted with the finished runs kept, 1 a run failed)."""
+    from faultgen.runs import sweep
+
     try:
-        sweep.run(plan, out, jobs=jobs, progress=progress, overwrite=overwrite,
+        sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
                   command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
     except sweep.SweepRefused as err:
         typer.echo(f"error: {err}", err=True)
@@ -477,8 +477,6 @@ def fleet_command(
     except sweep.SweepError as err:
         typer.echo(f"error: {err}", err=True)
         raise typer.Exit(1) from err
-    typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
-               f"  faultgen detect {out}")
 
 
 @app.command("info", cls=PlainHelpCommand)
