@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
 
 import mujoco
@@ -27,7 +28,6 @@ import numpy as np
 from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
-from faultgen import effects as effects_registry
 from faultgen.effects import friction
 from faultgen.effects.base import Effect
 from faultgen.effects.payload import Payload
@@ -97,9 +97,10 @@ class RunConfig:
     ValueError
         On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
-        1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions
-        or a ``record`` subset, or ``daily`` with a ``record`` subset, signals, or cycles that are
-        not whole days; the message names the value.
+        1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
+        a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
+        are not whole days, or a fault whose last cycle is not the run's or whose effect the robot
+        already carries; the message names the value.
     """
 
     robot: str
@@ -147,10 +148,8 @@ class RunConfig:
                     robots.load(self.robot).effects[self.fault.effect].active()):
                 raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
                                  "needs a robot without it")
-            if self.back_to_back or (self.conditions.payloads is not None and not type(
-                    effects_registry.get(self.fault.effect)).per_axis):
-                raise ValueError("a fault runs its cycles independently (no back_to_back), and a robot-wide fault "
-                                 "(payload) cannot be combined with payload conditions")
+            if self.back_to_back:
+                raise ValueError("a fault grows from cycle to cycle: run the cycles independently (no back_to_back)")
         if self.back_to_back and (self.wear.schedules or self.conditions.active
                                   or self.record not in (None, tuple(range(1, self.cycles + 1)))):
             raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "
@@ -269,7 +268,8 @@ def applied_drive_torque(force: np.ndarray, v: np.ndarray, v_before: np.ndarray,
     return np.where(np.abs(force) < limit, force - change, force)
 
 
-def build(robot: robots.Robot, friction_model: str = "lugre", edit=None) -> SimModel:
+def build(robot: robots.Robot, friction_model: str = "lugre",
+          edit: Callable[[mujoco.MjSpec], None] | None = None) -> SimModel:
     """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model;
     ``edit(spec)``, when given, is applied to the MJCF first (as :meth:`Robot.edited` made ``robot``).
 
@@ -450,8 +450,8 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
             raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(_Raw)})
         stepping_time = time.perf_counter() - started
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
-    if config.fault is not None:
-        result = replace(result, fault_value=config.fault.values(cycles))
+    if plant.fault is not None:
+        result = replace(result, fault_value=plant.fault)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     return daily_record(result) if config.daily else result
@@ -531,8 +531,8 @@ class Prepared:
 @dataclass(frozen=True)
 class _Plant:
     """How each simulated cycle's robot differs from the nominal model: multipliers of the dry
-    (Coulomb and static: wear, temperature, unit) and the viscous friction (n, 6), and of each
-    link's mass and inertia (6,)."""
+    (Coulomb and static: wear, temperature, unit) and the viscous friction (n, 6), of each link's
+    mass and inertia (6,), and a growing fault's parameter (n,) (None without one)."""
 
     dry: np.ndarray
     viscous: np.ndarray
