@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
@@ -56,9 +57,9 @@ class Fault:
     Raises
     ------
     ValueError
-        For an unknown effect (listing them), a stepped effect, an axis out of range or of the
-        wrong kind for the effect, an unknown parameter, a non-finite value, or a value the
-        effect does not admit; the message names it.
+        For an unknown effect (listing them), a stepped or robot-wide effect, an axis outside
+        1..6, an unknown parameter, a non-finite value, a final value equal to the start, a bad
+        schedule kind, or a value the effect does not admit; the message names it.
     """
 
     effect: str
@@ -71,16 +72,16 @@ class Fault:
     others: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        kind = effects.get(self.effect)  # ValueError lists the known ids
-        if kind.stepped:
+        prototype = effects.get(self.effect)  # ValueError lists the known ids
+        if prototype.stepped:
             raise ValueError(f"fault effect {self.effect!r} acts through a per-step friction update and cannot grow "
                              "over cycles; use the operating conditions (--temperature) or the static friction model")
-        if not kind.per_axis:
+        if not prototype.per_axis:
             raise ValueError(f"fault effect {self.effect!r} is robot-wide; a growing fault sits on one axis (parts "
                              "changing per cycle are an operating condition: --payloads)")
         if isinstance(self.axis, bool) or not isinstance(self.axis, (int, np.integer)) or not 1 <= self.axis <= N_AXES:
             raise ValueError(f"fault axis {self.axis!r}: expected 1..6")
-        names = list(kind.units)
+        names = list(prototype.units)
         for name in [self.parameter, *self.others]:
             if name not in names:
                 raise ValueError(f"{self.effect} has no parameter {name!r}; it has: {', '.join(names)}")
@@ -93,11 +94,12 @@ class Fault:
         if self.final == self.start:
             raise ValueError(f"fault final = start = {self.final!r}: a fault must change its parameter")
         wear.Schedule(self.kind, 1.0, self.last_cycle)  # names a bad kind or last cycle
+        object.__setattr__(self, "others", MappingProxyType(dict(self.others)))
         for value in (self.start, self.final):
-            if value < 0 and not kind.signed:
+            if value < 0 and not prototype.signed:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} takes values >= 0")
             instance = self.at(value)
-            problem = type(kind).check(np.array([instance.values(self.axis - 1)[n] for n in names])[None])
+            problem = type(prototype).check(np.array([instance.values(self.axis - 1)[n] for n in names])[None])
             if problem:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} {problem}")
 
