@@ -321,7 +321,7 @@ class Conditions:
         cycles = np.asarray(cycles, dtype=int)
         n = len(cycles)
         day = self.start_day + (cycles - 1) // self.cycles_per_day
-        start, end = self.thermal.shift if self.thermal else (6.0, 22.0)
+        start, end = (self.thermal or Temperature()).shift
         if self.hours is not None:
             hour = np.array(self.hours)[(cycles - 1) % self.cycles_per_day]
         else:
@@ -364,7 +364,7 @@ class Conditions:
             if value is not None:
                 if not isinstance(value, dict):
                     raise ValueError(f"conditions {name}: expected a table of settings, got {value!r}")
-                names = {f for f in kind.__dataclass_fields__}
+                names = set(kind.__dataclass_fields__)
                 bad = sorted(set(value) - names)
                 if bad:
                     raise ValueError(f"conditions {name}: unknown setting {bad[0]!r}; expected: {', '.join(sorted(names))}")
