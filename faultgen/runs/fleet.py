@@ -82,7 +82,7 @@ class Fleet:
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
-        the days, or an unknown robot model.
+        the days, or a robot model that is unknown or has no parts sized in :data:`PARTS`.
     """
 
     size: int = 26
@@ -109,6 +109,9 @@ class Fleet:
             raise ValueError(f"fleet onset = {self.onset!r}: expected (first day, last day) with first <= last")
         for model in self.models:
             robot_models.load(model)  # UnknownRobotError names the known ones
+            if model not in PARTS:
+                raise ValueError(f"fleet model {model!r}: its parts are not sized; models with parts: "
+                                 f"{', '.join(PARTS)} (add it to faultgen.runs.fleet.PARTS)")
         object.__setattr__(self, "onset", (first, last))
         object.__setattr__(self, "models", tuple(self.models))
 
@@ -125,7 +128,7 @@ class Fleet:
             task = str(rng.choice(tasks.TASKS))
             axis = int(rng.integers(1, 7))
             onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
-            (small_mass, small_size), (big_mass, big_size) = PARTS.get(model, PARTS["irb6700"])
+            (small_mass, small_size), (big_mass, big_size) = PARTS[model]
             parts = {"masses": [round(float(rng.uniform(*small_mass)), 2), round(float(rng.uniform(*big_mass)), 2)],
                      "sizes": [round(float(rng.uniform(*small_size)), 3), round(float(rng.uniform(*big_size)), 3)],
                      "pattern": "random"}
