@@ -87,9 +87,11 @@ CONDITION_ARRAYS = {
     "link_mass_factor": ("1", "axis", "multiplier of each link's mass and inertia (this unit's)", "spread"),
 }
 
-#: Units attribute of ``fault_value`` (runs with a fault other than friction wear): the unit is the
+#: The array of a run whose fault is not friction wear (attribute ``fault``): its units are the
 #: fault parameter's, named by the effect (``faultgen.effects``), so the array says where to look.
-FAULT_UNITS = "of the fault parameter"
+FAULT_ARRAYS = {
+    "fault_value": ("of the fault parameter", "cycle", "the growing fault's parameter at each cycle (attr fault)"),
+}
 
 #: Attributes every run group carries.
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
@@ -186,10 +188,15 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
             group.attrs[key] = value
         values = {name: getattr(result, name, None) for name in ARRAYS}
         values.update(result.features)
-        for name, (units, axes, description) in ARRAYS.items():
-            if axes == SIGNAL_AXES and not result.config.signals:
-                continue  # features only
-            data = np.asarray(values[name])
+        arrays = [(name, values[name], spec) for name, spec in ARRAYS.items()
+                  if spec[1] != SIGNAL_AXES or result.config.signals]  # features only: no signals
+        conditions = result.config.conditions
+        arrays += [(name, getattr(result.conditions, name), CONDITION_ARRAYS[name][:3])
+                   for name in _condition_arrays(conditions.to_dict() if conditions.active else None)]
+        if result.fault_value is not None:
+            arrays.append(("fault_value", result.fault_value, FAULT_ARRAYS["fault_value"]))
+        for name, value, (units, axes, description) in arrays:
+            data = np.asarray(value)
             if axes == SIGNAL_AXES:
                 # 250 Hz signals: float32 (7 digits, finer than the 1e-4 rad encoder noise), one chunk
                 # per cycle, uncompressed: gzip saves only 24 % on these noisy signals at 4.6 times the
@@ -200,18 +207,6 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
             ds.attrs["units"] = units
             ds.attrs["axes"] = axes
             ds.attrs["description"] = description
-        conditions = result.config.conditions
-        for name in _condition_arrays(conditions.to_dict() if conditions.active else None):
-            units, axes, description, _ = CONDITION_ARRAYS[name]
-            ds = group.create_dataset(name, data=np.asarray(getattr(result.conditions, name)))
-            ds.attrs["units"] = units
-            ds.attrs["axes"] = axes
-            ds.attrs["description"] = description
-        if result.fault_value is not None:
-            ds = group.create_dataset("fault_value", data=np.asarray(result.fault_value, dtype=float))
-            ds.attrs["units"] = FAULT_UNITS
-            ds.attrs["axes"] = "cycle"
-            ds.attrs["description"] = "the growing fault's parameter at each cycle (unit of the parameter: attr fault)"
         f.attrs["complete"] = True
     return path
 
@@ -419,7 +414,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
     schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
     if "fault" in group.attrs:
-        schema["fault_value"] = (FAULT_UNITS, "cycle", "")
+        schema.update(FAULT_ARRAYS)
     missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:
