@@ -131,3 +131,10 @@ def test_a_features_only_sweep_is_small_and_isolates(tmp_path):
     assert set(table["worn_axis"]) == {0, 2}
     same = benchmark.isolation_table(full, progress=False)
     assert table["predicted"].tolist() == same["predicted"].tolist()
+
+
+def test_the_fleet_command_refuses_bad_settings_before_simulating(tmp_path):
+    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "2", "-o", str(tmp_path / "f.h5")])
+    assert result.exit_code == 2
+    assert "error: fleet failing = 2: expected a whole number within 1..1" in result.output
+    assert not (tmp_path / "f.h5").exists() and not list(tmp_path.iterdir())
