@@ -53,11 +53,14 @@ _TIME_OF_DAY, _PAYLOAD, _UNIT = 10, 11, 12
 PATTERNS = ("alternate", "blocks", "random")
 
 
-def _finite(name: str, value: float, low: float = -math.inf, high: float = math.inf) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or not low <= value <= high:
-        raise ValueError(f"{name} = {value!r}: expected a number within {low:g}..{high:g}")
-    return float(value)
+def check_number(name: str, value, low: float = -math.inf, high: float = math.inf, whole: bool = False) -> float | int:
+    """``value`` as a float (an int when ``whole``), or ValueError naming ``name``, the value and
+    the range when it is not a finite number (whole number) within ``low..high``."""
+    kinds = (int, np.integer) if whole else (int, float, np.integer, np.floating)
+    if isinstance(value, bool) or not isinstance(value, kinds) or not np.isfinite(value) or not low <= value <= high:
+        kind = "a whole number" if whole else "a number"
+        raise ValueError(f"{name} = {value!r}: expected {kind} within {low:g}..{high:g}")
+    return int(value) if whole else float(value)
 
 
 @dataclass(frozen=True)
@@ -97,15 +100,15 @@ class Temperature:
     warmest_day: float = 200.0
 
     def __post_init__(self) -> None:
-        _finite("ambient", self.ambient, -20, 60)
-        _finite("seasonal", self.seasonal, 0, 30)
-        _finite("daily", self.daily, 0, 15)
-        _finite("rise", self.rise, 0, 60)
-        _finite("time_constant", self.time_constant, 60, 10 * DAY)
-        _finite("warmest_day", self.warmest_day, 0, 366)
+        check_number("ambient", self.ambient, -20, 60)
+        check_number("seasonal", self.seasonal, 0, 30)
+        check_number("daily", self.daily, 0, 15)
+        check_number("rise", self.rise, 0, 60)
+        check_number("time_constant", self.time_constant, 60, 10 * DAY)
+        check_number("warmest_day", self.warmest_day, 0, 366)
         if len(self.shift) != 2:
             raise ValueError(f"shift = {self.shift!r}: expected (start, end) in hours")
-        start, end = (_finite("shift hour", h, 0, 24) for h in self.shift)
+        start, end = (check_number("shift hour", h, 0, 24) for h in self.shift)
         if not start < end:
             raise ValueError(f"shift = {self.shift!r}: the start must come before the end")
         object.__setattr__(self, "shift", (start, end))
@@ -152,8 +155,8 @@ class Payloads:
     block: int = 10
 
     def __post_init__(self) -> None:
-        masses = tuple(_finite("payload mass", m, 0, 1000) for m in self.masses)
-        sizes = tuple(_finite("payload size", s, 0, 1.0) for s in self.sizes)
+        masses = tuple(check_number("payload mass", m, 0, 1000) for m in self.masses)
+        sizes = tuple(check_number("payload size", s, 0, 1.0) for s in self.sizes)
         if not masses or len(masses) != len(sizes):
             raise ValueError(f"payloads: {len(masses)} masses and {len(sizes)} sizes; expected one size per mass, "
                              "at least one part")
@@ -212,7 +215,7 @@ class UnitSpread:
 
     def __post_init__(self) -> None:
         for name in ("dry_friction", "viscous_friction", "link_mass"):
-            _finite(f"unit spread {name}", getattr(self, name), 0, 0.5)
+            check_number(f"unit spread {name}", getattr(self, name), 0, 0.5)
 
     def draw(self, seed: int) -> dict[str, np.ndarray]:
         """The unit's multipliers, from ``seed``: ``dry_friction``, ``viscous_friction``, ``link_mass``, each
@@ -303,9 +306,9 @@ class Conditions:
         if isinstance(self.cycles_per_day, bool) or not isinstance(self.cycles_per_day, (int, np.integer)) \
                 or self.cycles_per_day < 1:
             raise ValueError(f"cycles_per_day = {self.cycles_per_day!r}: expected a whole number >= 1")
-        _finite("start_day", self.start_day, 0, 365)
+        check_number("start_day", self.start_day, 0, 365)
         if self.hours is not None:
-            hours = tuple(_finite("hour", h, 0, 24) for h in self.hours)
+            hours = tuple(check_number("hour", h, 0, 24) for h in self.hours)
             if len(hours) != self.cycles_per_day:
                 raise ValueError(f"hours = {self.hours!r}: expected {self.cycles_per_day} (cycles_per_day) times of day")
             object.__setattr__(self, "hours", hours)

@@ -30,6 +30,7 @@ import numpy as np
 
 from faultgen.model import robots as robot_models
 from faultgen.operation import conditions, tasks, wear
+from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -39,14 +40,6 @@ PARTS = {
     "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
     "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
 }
-
-
-def _number(name: str, value, low: float, high: float, whole: bool = False):
-    ok = isinstance(value, (int, np.integer)) if whole else isinstance(value, (int, float, np.integer, np.floating))
-    if isinstance(value, bool) or not ok or not np.isfinite(value) or not low <= value <= high:
-        kind = "a whole number" if whole else "a number"
-        raise ValueError(f"fleet {name} = {value!r}: expected {kind} within {low:g}..{high:g}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -97,14 +90,14 @@ class Fleet:
     conditions: bool = True
 
     def __post_init__(self) -> None:
-        _number("size", self.size, 2, 10000, whole=True)
-        _number("failing", self.failing, 1, self.size - 1, whole=True)
-        _number("days", self.days, 5, 3650, whole=True)
-        _number("cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
-        _number("failure_wear", self.failure_wear, 0, 1000)
-        _number("seed", self.seed, 0, 2**31, whole=True)
+        check_number("fleet size", self.size, 2, 10000, whole=True)
+        check_number("fleet failing", self.failing, 1, self.size - 1, whole=True)
+        check_number("fleet days", self.days, 5, 3650, whole=True)
+        check_number("fleet cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
+        check_number("fleet failure_wear", self.failure_wear, 0, 1000)
+        check_number("fleet seed", self.seed, 0, 2**31, whole=True)
         onset = self.onset if self.onset is not None else (self.days // 6, self.days * 7 // 12)
-        first, last = (int(_number("onset day", d, 1, self.days - 1, whole=True)) for d in onset)
+        first, last = (check_number("fleet onset day", d, 1, self.days - 1, whole=True) for d in onset)
         if first > last:
             raise ValueError(f"fleet onset = {self.onset!r}: expected (first day, last day) with first <= last")
         for model in self.models:
