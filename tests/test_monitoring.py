@@ -88,6 +88,26 @@ def test_false_alarm_rate_is_alpha_on_normal_data():
     assert abs(q_rate - 0.05) < 0.01
 
 
+def test_cross_validated_q_limit_holds_alpha_on_new_data():
+    """With few training samples the in-sample residual eigenvalues are too small, so the limit of
+    eq. 2.6 alarms more than alpha on new normal data; residual moments taken out of fold (cv)
+    bring the rate back to alpha. Reference: the known generating distribution (fresh samples)."""
+    mixing = np.diag([3.0, 2.5, 2.0, 1.5, 1.0, 0.6]) @ np.random.default_rng(10).normal(size=(6, 6))
+    rates = {}
+    for cv in (None, 20):
+        rng = np.random.default_rng(11)
+        monitors = [PCAMonitor(n_components=5, statistic="q", cv=cv).fit(gaussian(rng, mixing, 60)) for _ in range(40)]
+        rates[cv] = np.mean([m.predict(gaussian(rng, mixing, 4000)).mean() for m in monitors])
+    print(f"false alarms on new data at alpha 5 %: in-sample {rates[None]:.4f}, 20 folds {rates[20]:.4f}")
+    assert rates[None] > 0.065
+    assert abs(rates[20] - 0.05) < 0.012
+    in_sample = PCAMonitor(n_components=5, statistic="q").fit(gaussian(np.random.default_rng(1), mixing, 60))
+    folded = PCAMonitor(n_components=5, statistic="q", cv=20).fit(gaussian(np.random.default_rng(1), mixing, 60))
+    assert folded.q_limit_ > in_sample.q_limit_
+    np.testing.assert_array_equal(folded.components_, in_sample.components_)  # only the limit changes
+    assert folded.t2_limit_ == in_sample.t2_limit_
+
+
 def test_offset_in_one_feature_is_detected_and_isolated_by_q():
     rng = np.random.default_rng(1)
     mixing = rng.normal(size=(6, 6))
@@ -144,7 +164,8 @@ def test_fit_errors_name_the_problem():
         PCAMonitor(n_components=2).fit(independent[:2])
     for params, pattern in [({"alpha": 1.5}, "alpha = 1.5"), ({"variance": 0.0}, "variance = 0.0"),
                             ({"statistic": "spe"}, "statistic = 'spe'"),
-                            ({"n_components": 0}, "n_components = 0")]:
+                            ({"n_components": 0}, "n_components = 0"), ({"cv": 1}, "cv = 1; expected None"),
+                            ({"cv": 300, "n_components": 1}, "cv = 300 folds need at least 300 training samples")]:
         with pytest.raises(ValueError, match=pattern):
             PCAMonitor(**params).fit(independent)
     collinear = np.column_stack([independent[:, 0], 2 * independent[:, 0], independent[:, 1]])
