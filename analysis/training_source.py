@@ -26,6 +26,7 @@ truth (friction torque, tracking error, wear, temperatures) is not a measurement
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 from pathlib import Path
 
 import numpy as np
@@ -138,11 +139,11 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
     """The features used and the Q monitor fitted on detrended training signals ``X``."""
     X = _detrend(X)
     used = _varying(X)
-    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=folds)
+    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=None if folds is None else min(folds, len(X)))
     try:
         monitor.fit(X[:, used])
     except ValueError:  # the variance needs every component: keep one back for the Q residual
-        monitor.set_params(n_components=len(used) - 1).fit(X[:, used])
+        monitor.set_params(n_components=min(len(used) - 1, len(X) - 3)).fit(X[:, used])
     return used, monitor
 
 
@@ -194,7 +195,11 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     for kind, reference, robot in tqdm(plan, desc="training-source study", unit="case", disable=not progress):
         key = (kind, reference[0])
         if key not in models:
-            models[key] = _fit(reference[4][kind][0][train], variance, alpha, limit_folds)
+            try:
+                models[key] = _fit(reference[4][kind][0][train], variance, alpha, limit_folds)
+            except ValueError as err:
+                raise ValueError(f"{path}: the {kind} model of {reference[0]} cannot be fitted on "
+                                 f"{window.training_days} training days ({err}); use more training days") from err
         used, monitor = models[key]
         q = monitor.score_samples(robot[4][kind][0][test][:, used])[1]
         cases.append(dict(source="OTO" if robot is reference else "OTM", signal=kind, condition=robot[3],
@@ -216,8 +221,7 @@ def group_means(cases: pd.DataFrame) -> pd.DataFrame:
     """Mean and standard error of the mean of each descriptor per training source, signal type
     and robot condition (the bars of thesis Figs. 4-4 to 4-6)."""
     grouped = cases.groupby(["source", "signal", "condition"])[list(DESCRIPTORS)]
-    means, sems = grouped.mean(), grouped.sem()
-    return means.join(sems, lsuffix="_mean", rsuffix="_sem").reset_index()
+    return grouped.mean().add_suffix("_mean").join(grouped.sem().add_suffix("_sem")).reset_index()
 
 
 def anova(cases: pd.DataFrame) -> pd.DataFrame:
@@ -230,10 +234,21 @@ def anova(cases: pd.DataFrame) -> pd.DataFrame:
     -------
     DataFrame: descriptor, term (``source``, ``signal``, ``condition`` and their products joined
     by ``*``; ``Error``), df, sum_sq, mean_sq, F, p.
+
+    Raises
+    ------
+    ValueError
+        If a cell of the design has no test case (its interactions cannot be estimated); the
+        message names the cells.
     """
     import statsmodels.formula.api as smf
     from statsmodels.stats.anova import anova_lm
 
+    empty = design(cases).query("test_cases == 0")
+    if len(empty):
+        cells = ", ".join("/".join(row) for row in empty[["source", "signal", "condition"]].itertuples(index=False))
+        raise ValueError(f"the three-way ANOVA needs test cases in every cell; none in {cells}. A fleet needs "
+                         "two normal robots of one model for OTM normal cases (`faultgen fleet` has 13 of 26)")
     names = {"C(source, Sum)": "source", "C(signal, Sum)": "signal", "C(condition, Sum)": "condition",
              "Residual": "Error"}
     tables = []
@@ -266,8 +281,11 @@ def tukey(cases: pd.DataFrame, alpha: float = 0.05) -> pd.DataFrame:
     rows = []
     for descriptor in DESCRIPTORS:
         result = pairwise_tukeyhsd(cases[descriptor].to_numpy(dtype=float), cell.to_numpy(), alpha=alpha)
-        table = pd.DataFrame(result.summary().data[1:], columns=result.summary().data[0])
-        rows.append(table.rename(columns={"p-adj": "p_adj"}).assign(descriptor=descriptor))
+        first, second = np.array(list(combinations(result.groupsunique, 2))).T  # the results' pair order
+        rows.append(pd.DataFrame({"descriptor": descriptor, "group1": first, "group2": second,
+                                  "meandiff": result.meandiffs, "p_adj": result.pvalues,
+                                  "lower": result.confint[:, 0], "upper": result.confint[:, 1],
+                                  "reject": result.reject}))
     out = pd.concat(rows, ignore_index=True)
     pair = out["group1"].str.rsplit("/", n=1).str[0] == out["group2"].str.rsplit("/", n=1).str[0]
     out["failure_vs_normal"] = pair

@@ -182,6 +182,12 @@ def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_la
     assert "faultgen sweep --preset quick" in message
     assert not (tmp_path / "cls.csv").exists()
 
+    result = runner.invoke(app, ["training-source", str(sparse), "--no-progress", "-o", str(tmp_path / "ch4")])
+    assert result.exit_code == 2, result.output
+    message = " ".join(result.output.split())
+    assert "has 4 records, the study needs 60" in message and "a fleet (`faultgen fleet`) records 60 days" in message
+    assert not list(tmp_path.glob("ch4*"))
+
 
 PLUGINS = '''
 import numpy as np
