@@ -48,6 +48,7 @@ class PlainHelpGroup(_PlainHelp, TyperGroup):
 
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
+QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q limit (0.05: 95 % limit).")]
 
 #: Operating-condition options of `simulate` and `sweep` (faultgen.operation.conditions).
 Temperature = Annotated[bool, typer.Option(
@@ -658,7 +659,7 @@ def detect_command(
              "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
     first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.")] = 20,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
-    alpha: Annotated[float, typer.Option(help="Significance of the Q limit (0.05: 95 % limit).")] = 0.05,
+    alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
              "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
@@ -721,7 +722,7 @@ def training_source_command(
     test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).")] = 15,
     gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).")] = 5,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).")] = 0.90,
-    alpha: Annotated[float, typer.Option(help="Significance of the Q limit (0.05: 95 % limit).")] = 0.05,
+    alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
              "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
@@ -736,8 +737,7 @@ def training_source_command(
     signals; the Q residual's coefficient of variation, samples above the limit and lead time
     are compared by a three-way ANOVA and Tukey's HSD (Tables 4.2-4.4, Figs. 4-4 to 4-6).
 
-    Writes OUT-cases.csv (one row per test case), OUT-anova.csv, OUT-tukey.csv, OUT.md (all
-    tables) and OUT.png (the figures).
+    Writes OUT-cases.csv (one row per test case), OUT-anova.csv, OUT-tukey.csv, OUT.md, OUT.png.
 
     Example:
 
