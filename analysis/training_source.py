@@ -148,14 +148,18 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
 
 
 def study(path, window: Window = Window(), variance: float = 0.90, alpha: float = 0.05,
-          limit_folds: int | None = None, progress: bool = True) -> pd.DataFrame:
+          limit_folds: int | None = 20, progress: bool = True) -> pd.DataFrame:
     """Every test case of thesis Table 4.1 on the runs of ``path`` and its descriptors.
 
     Each run is a robot: failing (``robot condition`` failure) if it has worn axes or a fault,
     otherwise normal. Per signal type, a PCA model (components for ``variance`` of the variance,
     thesis: 90 %; features constant in training left out; linear trends removed from the training
-    days, ch. 4.3.2) learns the training days, and the Q residuals of the test days against the
-    ``1 - alpha`` limit (eq. 2.6) give the :func:`descriptors`. OTO: each robot learns its own
+    days, ch. 4.3.2) learns the training days (days 2 to ``training_days``: the first has no
+    difference), and the Q residuals of the test days against the ``1 - alpha`` limit give the
+    :func:`descriptors`. The limit is eq. 2.6's with residual moments taken over ``limit_folds``
+    folds (:class:`~analysis.monitoring.PCAMonitor` ``cv``, at most one fold per day; None: the
+    thesis's in-sample limit, crossed on most test days of normal robots when the features are
+    nearly as many as the training days). OTO: each robot learns its own
     training days. OTM: each normal robot's training days serve, in turn, as the model for every
     other robot of the same model (robot label).
 
