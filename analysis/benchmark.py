@@ -25,7 +25,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from analysis.monitoring import detect_onset
+from analysis.monitoring import detect_onset, varying_columns
 from faultgen import axes
 from faultgen.data import dataset
 
@@ -533,7 +533,7 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     if fixed_reference:
         reference = np.concatenate([_histograms(t, cycles, scale, period)[0] for _, t, cycles in training]).mean(axis=0)
     normal = np.vstack([_kl_features(t, cycles, scale, period, reference)[0] for _, t, cycles in training])
-    used = np.flatnonzero(normal.std(axis=0) > 0)  # features constant in training are left out
+    used = varying_columns(normal)  # features constant in training are left out
     if detector is not None:
         return scale, reference, used, clone(detector).fit(normal[:, used])
     monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=folds)

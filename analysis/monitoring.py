@@ -231,21 +231,39 @@ class PCAMonitor(BaseEstimator):
         return (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
 
 
+def varying_columns(X) -> np.ndarray:
+    """Indices of the columns of ``X`` (n_samples, n_features) that vary beyond rounding: sample
+    standard deviation above 1e-9 of the column's largest magnitude and above 1e-12 in its unit.
+    A KL divergence that is zero up to rounding (an axis whose torque never leaves the first bin)
+    has a standard deviation of ~1e-16; standardised, that noise would be a feature."""
+    X = np.asarray(X, dtype=float)
+    spread = X.std(axis=0)
+    return np.flatnonzero(spread > np.maximum(1e-9 * np.abs(X).max(axis=0), 1e-12))
+
+
 def _out_of_fold_eigenvalues(X: np.ndarray, k: int, folds: int) -> np.ndarray:
     """Eigenvalues of the covariance of the Q residuals of ``X`` (m, n) when each of ``folds``
-    contiguous blocks is projected on the ``k``-component model of the other blocks."""
+    contiguous blocks is projected on the ``k``-component model of the other blocks. Each fold
+    standardises with its own mean and standard deviation (``ddof=1``); a feature constant within
+    a fold (it varies only in the held-out block) takes the whole training set's deviation."""
     from sklearn.model_selection import KFold
 
     m = len(X)
     if folds > m:
         raise ValueError(f"cv = {folds} folds need at least {folds} training samples, got {m}")
+    overall = X.std(axis=0, ddof=1)
     residuals = []
     for fit_rows, held_rows in KFold(n_splits=folds).split(X):
         if len(fit_rows) <= k + 1:
             raise ValueError(f"cv = {folds}: a fold leaves {len(fit_rows)} samples to fit {k} components; "
                              "use fewer folds or more training samples")
-        part = PCAMonitor(n_components=k, statistic="q").fit(X[fit_rows])
-        residuals.append(part._project(X[held_rows])[2])
+        part = X[fit_rows]
+        mean, scale = part.mean(axis=0), part.std(axis=0, ddof=1)
+        scale = np.where(scale > 1e-10 * np.abs(mean), scale, overall)
+        Z = (part - mean) / scale
+        vectors = np.linalg.eigh(Z.T @ Z / (len(part) - 1))[1][:, ::-1][:, :k]
+        held = (X[held_rows] - mean) / scale
+        residuals.append(held - held @ vectors @ vectors.T)
     E = np.vstack(residuals)
     return np.clip(np.linalg.eigvalsh(E.T @ E / (m - 1))[::-1], 0.0, None)
 

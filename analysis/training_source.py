@@ -35,7 +35,7 @@ from scipy import signal as scipy_signal
 from tqdm.auto import tqdm
 
 from analysis.features import kl_divergence
-from analysis.monitoring import PCAMonitor
+from analysis.monitoring import PCAMonitor, varying_columns
 from faultgen.data import dataset
 
 SOURCES = ("OTM", "OTO")
@@ -119,12 +119,6 @@ def _detrend(X: np.ndarray) -> np.ndarray:
     return scipy_signal.detrend(X, axis=0, type="linear") + X.mean(axis=0)
 
 
-def _varying(X: np.ndarray) -> np.ndarray:
-    """Columns that vary in training beyond rounding (a constant one cannot be standardised)."""
-    spread = X.std(axis=0)
-    return np.flatnonzero(spread > 1e-9 * np.maximum(np.abs(X).max(axis=0), 1e-12))
-
-
 def descriptors(q: np.ndarray, limit: float) -> dict[str, float]:
     """Ch. 4.3.3 descriptors of the test days' Q residuals ``q`` (n_test,) against ``limit``:
     coefficient of variation (sample std / mean), NSAT, and lead time: the test days left,
@@ -138,7 +132,7 @@ def descriptors(q: np.ndarray, limit: float) -> dict[str, float]:
 def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tuple[np.ndarray, PCAMonitor]:
     """The features used and the Q monitor fitted on detrended training signals ``X``."""
     X = _detrend(X)
-    used = _varying(X)
+    used = varying_columns(X)
     monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=None if folds is None else min(folds, len(X)))
     try:
         monitor.fit(X[:, used])

@@ -9,7 +9,7 @@ from sklearn.pipeline import make_pipeline
 from sklearn.utils.estimator_checks import check_estimator
 
 from analysis.features import Difference, WindowConcat
-from analysis.monitoring import PCAMonitor, detect_onset
+from analysis.monitoring import PCAMonitor, detect_onset, varying_columns
 
 # A fixed small training set: 8 samples of 4 features with different scales and correlations.
 SMALL = np.array([
@@ -106,6 +106,21 @@ def test_cross_validated_q_limit_holds_alpha_on_new_data():
     assert folded.q_limit_ > in_sample.q_limit_
     np.testing.assert_array_equal(folded.components_, in_sample.components_)  # only the limit changes
     assert folded.t2_limit_ == in_sample.t2_limit_
+
+
+def test_cross_validated_limit_with_a_feature_that_varies_in_one_block_only():
+    X = np.random.default_rng(12).normal(size=(100, 4))
+    X[:, 3] = 0.0
+    X[95:, 3] = [0.1, 0.3, 0.2, 0.5, 0.4]  # constant in every fold that leaves the last block in
+    monitor = PCAMonitor(n_components=2, statistic="q", cv=20).fit(X)
+    assert np.isfinite(monitor.q_limit_) and monitor.q_limit_ > 0
+
+
+def test_varying_columns_leave_out_rounding_noise():
+    X = np.random.default_rng(13).normal(size=(50, 4))
+    X[:, 1] = 4e-15 + np.random.default_rng(14).normal(scale=1e-16, size=50)  # a KL of zero up to rounding
+    X[:, 2] = 1e3 + np.random.default_rng(15).normal(scale=1e-8, size=50)  # constant but for rounding of 1e3
+    np.testing.assert_array_equal(varying_columns(X), [0, 3])
 
 
 def test_offset_in_one_feature_is_detected_and_isolated_by_q():
