@@ -25,11 +25,13 @@ OIL_VISCOSITY = {40.0: 220.0, 100.0: 19.0}
 DRY_SHARE = 0.25
 
 
-def oil_viscosity(temperature) -> np.ndarray:
+def oil_viscosity(temperature, points: dict[float, float] = OIL_VISCOSITY) -> np.ndarray:
     """Kinematic viscosity of the gearbox oil at ``temperature`` (deg C, any shape), mm^2/s, by
     Walther's equation ``log10 log10(nu + 0.7) = A - B log10(T / 1 K)`` (ASTM D341, the standard
-    viscosity-temperature relation of petroleum oils) through :data:`OIL_VISCOSITY`."""
-    (t1, nu1), (t2, nu2) = sorted(OIL_VISCOSITY.items())
+    viscosity-temperature relation of petroleum oils) through two ``points`` {deg C: mm^2/s}
+    (default :data:`OIL_VISCOSITY`). Checked against published mineral-oil viscosities at 30, 60
+    and 100 deg C (tests/test_conditions.py)."""
+    (t1, nu1), (t2, nu2) = sorted(points.items())
 
     def walther(nu):
         return np.log10(np.log10(nu + 0.7))
