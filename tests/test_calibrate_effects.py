@@ -30,7 +30,7 @@ def setup(request):
 # absolute parameters it gives on the nominal robot (``None``: the nominal value plus theta).
 CHANGES = {
     "torque_offset": (np.array([3.5]), None, {"offset": 3.5}),
-    "coulomb": (np.array([0.05]), None, None),
+    "coulomb": (np.array([0.05, 0.02]), None, None),  # both directions, then the positive one more
     "viscous": (np.array([2e-3]), None, None),
     "stribeck": (np.array([0.2]), 7.0, {"static": 0.2, "stribeck_velocity": 7.0}),
     "load_dependent_friction": (np.array([0.1]), None, {"coefficient": 0.1}),
@@ -47,7 +47,7 @@ def absolute(robot, effect_id, theta):
     """The absolute parameters of a friction change ``theta`` on axis 2, from the robot's friction."""
     f = robot.friction
     if effect_id == "coulomb":
-        return {"coulomb_pos": f.coulomb_pos[1] + theta[0], "coulomb_neg": f.coulomb_neg[1] + theta[0]}
+        return {"coulomb_pos": f.coulomb_pos[1] + theta[0] + theta[1], "coulomb_neg": f.coulomb_neg[1] + theta[0]}
     return {"viscous": f.viscous[1] + theta[0]}
 
 

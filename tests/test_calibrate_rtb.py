@@ -86,3 +86,22 @@ def test_payload_mass_and_centre_of_mass_from_toolbox_data(tmp_path, path, com):
     found = np.array([first.effect.com_x, first.effect.com_y, first.effect.com_z], dtype=float)
     assert np.linalg.norm(found - com) < 0.01
     assert result.gap_after["total_nrmse"] <= 0.1 * result.gap_before["total_nrmse"], result.summary()
+
+
+def test_coulomb_change_in_one_direction_is_fitted_per_direction(tmp_path, path):
+    """A drive whose Coulomb level rose for positive speed only (+50 % on axis 2, a form our
+    effect draws never make): the fit takes the second level, one change per direction, and the
+    levels come back per direction."""
+    robot, motion = path
+    k, rise = 1, 0.5 * robot.friction.coulomb_pos[1]
+    tau = np.asarray(rtb.models.DH.Puma560().rne(motion.q, motion.qd, motion.qdd))
+    tau[:, k] += robot.gear_ratio[k] * rise * (motion.qd[:, k] > 0)
+    rng = np.random.default_rng(SEED)
+    tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    log = measured.write_csv(tmp_path / "toolbox.csv", motion.t, motion.q + rng.normal(size=motion.q.shape) * 1e-5, tau)
+    result = calibrate("puma560", log, tmp_path / "out")
+    first = result.steps[0]
+    assert (first.effect.id, first.axes) == ("coulomb", [k]), result.summary()
+    found = first.effect.values(k)
+    assert found["coulomb_pos"] == pytest.approx(robot.friction.coulomb_pos[k] + rise, rel=0.1)
+    assert found["coulomb_neg"] == pytest.approx(robot.friction.coulomb_neg[k], abs=0.2 * rise)

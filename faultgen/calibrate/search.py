@@ -130,11 +130,29 @@ def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(phi, y, rcond=None)[0]
 
 
+def _nested(design: np.ndarray, target: np.ndarray, levels: tuple[int, ...] | None, admissible) -> np.ndarray:
+    """Least squares of ``target`` (m,) on the leading ``level`` columns of ``design`` (m, k) at
+    each of ``levels`` (simplest first; None: all columns at once), keeping the most detailed level
+    whose fit is ``admissible(theta)`` and lowers the Bayesian information criterion
+    ``m ln(SSE / m) + level ln(m)``: a parameter the data do not support stays at zero."""
+    best, best_bic = None, np.inf
+    for level in levels or (design.shape[-1],):
+        theta = np.zeros(design.shape[-1])
+        theta[:level] = _lstsq(design[:, :level], target)
+        sse = max(float(np.sum((target - design @ theta) ** 2)), 1e-300)
+        bic = target.size * np.log(sse / target.size) + level * np.log(target.size)
+        if best is None or (bic < best_bic and admissible(theta)):
+            best, best_bic = theta, bic
+    return best
+
+
 class AxisLeastSquares:
     """The default optimiser of a per-axis effect (the PySINDy split: the effect gives the
     regressors, the optimiser fits them): per axis, linear least squares in the linear parameters
-    at every value of the effect's :meth:`~faultgen.effects.Effect.grid`, the best refined between
-    its grid neighbours (bounded scalar search in log) when the grid samples a continuous parameter."""
+    at every value of the effect's :meth:`~faultgen.effects.Effect.grid` (at each of its nested
+    :attr:`~faultgen.effects.Effect.levels`, as :class:`RobotLeastSquares` does), the best refined
+    between its grid neighbours (bounded scalar search in log) when the grid samples a continuous
+    parameter."""
 
     def fit(self, effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray,
             scale: np.ndarray) -> list[tuple]:
@@ -145,7 +163,8 @@ class AxisLeastSquares:
     def _axis(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, axis: int):
         def trial(h):
             phi, offset = effect.columns(motion, axis, h)
-            theta = _lstsq(phi[rows], residual[rows] - offset[rows])
+            theta = _nested(phi[rows], residual[rows] - offset[rows], effect.levels,
+                            lambda th: effect.admissible(motion, axis, effect.params(motion, axis, th, h)))
             predicted = phi @ theta + offset
             return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
 
@@ -175,14 +194,8 @@ class RobotLeastSquares:
         phi, offset = effect.columns(motion, None, None)  # (n, 6, k), (n, 6)
         weights = 1.0 / scale
         design, target = (phi * weights[:, None])[rows], ((residual - offset) * weights)[rows]
-        best, best_bic = None, np.inf
-        for level in effect.levels or (phi.shape[-1],):
-            theta = np.zeros(phi.shape[-1])
-            theta[:level] = _lstsq(design[:, :level], target)
-            sse = max(float(np.sum((target - design @ theta) ** 2)), 1e-300)
-            bic = target.size * np.log(sse / target.size) + level * np.log(target.size)
-            if best is None or (bic < best_bic and effect.admissible(motion, None, effect.params(motion, None, theta, None))):
-                best, best_bic = theta, bic
+        best = _nested(design, target, effect.levels,
+                       lambda th: effect.admissible(motion, None, effect.params(motion, None, th, None)))
         return best, phi @ best + offset
 
 

@@ -216,9 +216,9 @@ class Effect:
     aliases: ClassVar[tuple[str, ...]] = ()
     #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
     counts: ClassVar[tuple[str, ...]] = ()
-    #: Robot-wide identification: numbers of leading linear parameters fitted at each level of
-    #: detail, simplest first (the optimiser keeps the most detailed admissible level the Bayesian
-    #: information criterion supports); None: all at once.
+    #: Numbers of leading linear parameters (columns) fitted at each level of detail, simplest first
+    #: (the optimiser keeps the most detailed admissible level the Bayesian information criterion
+    #: supports, per axis for a per-axis effect); None: all at once.
     levels: ClassVar[tuple[int, ...] | None] = None
     #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
     signed: ClassVar[bool] = False
