@@ -7,7 +7,7 @@ a PCA model of normal operation learnt
 - one-to-one (OTO): from its own first ``training_days`` days (thesis Fig. 4-2 b), or
 - one-to-many (OTM): from the first ``training_days`` days of one reference robot, in turn every
   healthy robot of the same model (Fig. 4-2 a; a reference of another model is not a model of
-  this robot's operation: its torques are in other units of scale),
+  this robot's operation: its torques are on another scale),
 
 on three signal types (ch. 4.3.2): the raw measurements, the absolute difference between two
 successive days, and both combined. The descriptors of the Q residual over the test days (ch.
