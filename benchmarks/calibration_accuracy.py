@@ -66,9 +66,9 @@ def table(cases: pd.DataFrame) -> str:
     floor = cases.apply(lambda c: null.get((c.robot, c.seed), np.nan) / c.gap_before, axis=1)
     # at least half of the gap above the floor closed: before - after >= (before - floor) / 2
     reachable = (1 - cases.ratio) >= 0.5 * (1 - floor)
-    lines = ["| effect | robot | named first, right axes | gap halved | half the gap above the floor closed | "
-             "median after/before | median floor/before |",
-             "| --- | --- | --- | --- | --- | --- | --- |"]
+    header = ("| effect | robot | named first, right axes | gap halved | half the gap above the floor closed | "
+              "median after/before | median floor/before |")
+    lines = [header, "| --- | --- | --- | --- | --- | --- | --- |"]
     order = ["none", *(e for e in EFFECTS if e in set(cases.effect))]
     for effect in order:
         for robot_name, group in cases[cases.effect == effect].groupby("robot", sort=False):
