@@ -25,7 +25,7 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from analysis.monitoring import detect_onset, varying_columns
+from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen import axes
 from faultgen.data import dataset
 
@@ -525,8 +525,6 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     PCA monitor's ``cv`` (out-of-sample Q limit)."""
     from sklearn.base import clone
 
-    from analysis.monitoring import PCAMonitor
-
     stored = [isinstance(t, StoredHistograms) for _, t, _ in training]
     scale = None if any(stored) else np.max([t.max(axis=(0, 1)) for _, t, _ in training], axis=0)
     reference = None
@@ -536,12 +534,7 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     used = varying_columns(normal)  # features constant in training are left out
     if detector is not None:
         return scale, reference, used, clone(detector).fit(normal[:, used])
-    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=folds)
-    try:
-        monitor.fit(normal[:, used])
-    except ValueError:  # the variance needs every component: keep one back for the Q residual
-        monitor.set_params(n_components=len(used) - 1).fit(normal[:, used])
-    return scale, reference, used, monitor
+    return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
 
 
 @dataclass(frozen=True)

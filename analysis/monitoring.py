@@ -231,6 +231,19 @@ class PCAMonitor(BaseEstimator):
         return (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
 
 
+def fit_q_monitor(X, variance: float, alpha: float, cv: int | None = None) -> PCAMonitor:
+    """A :class:`PCAMonitor` alarming on Q, fitted on ``X`` (m, n_features). Where ``variance``
+    would need every component (no residual space for Q, as with a few weakly correlated
+    features), it keeps ``min(n_features - 1, m - 3)`` components instead: one feature's worth of
+    residual, and room for a fold of ``cv`` to fit them."""
+    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=cv)
+    try:
+        return monitor.fit(X)
+    except ValueError:
+        m, n = np.shape(X)
+        return monitor.set_params(n_components=min(n - 1, m - 3)).fit(X)
+
+
 def varying_columns(X) -> np.ndarray:
     """Indices of the columns of ``X`` (n_samples, n_features) that vary beyond rounding: sample
     standard deviation above 1e-9 of the column's largest magnitude and above 1e-12 in its unit.

@@ -35,7 +35,7 @@ from scipy import signal as scipy_signal
 from tqdm.auto import tqdm
 
 from analysis.features import kl_divergence
-from analysis.monitoring import PCAMonitor, varying_columns
+from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.data import dataset
 
 SOURCES = ("OTM", "OTO")
@@ -133,12 +133,7 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
     """The features used and the Q monitor fitted on detrended training signals ``X``."""
     X = _detrend(X)
     used = varying_columns(X)
-    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=None if folds is None else min(folds, len(X)))
-    try:
-        monitor.fit(X[:, used])
-    except ValueError:  # the variance needs every component: keep one back for the Q residual
-        monitor.set_params(n_components=min(len(used) - 1, len(X) - 3)).fit(X[:, used])
-    return used, monitor
+    return used, fit_q_monitor(X[:, used], variance, alpha, cv=None if folds is None else min(folds, len(X)))
 
 
 def study(path, window: Window = Window(), variance: float = 0.90, alpha: float = 0.05,

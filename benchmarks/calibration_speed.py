@@ -34,19 +34,22 @@ GOAL = 60.0
 DURATION, PERIOD = 40.0, 0.002
 
 
+def coulomb_rise(robot: robots.Robot, qd: np.ndarray, axis: int) -> np.ndarray:
+    """Arm-side torque (n,) of a Coulomb level 30 % above the model's mean level on ``axis``."""
+    coulomb = 0.5 * (robot.friction.coulomb_pos[axis] + robot.friction.coulomb_neg[axis])
+    return 0.3 * coulomb * robot.gear_ratio[axis] * np.sign(qd[:, axis])
+
+
 def logs() -> dict[str, tuple[robots.Robot, measured.MeasuredData]]:
     puma, irb = robots.load("puma560"), robots.load("irb6700")
     t, q, qd, qdd = synth.excitation([puma, irb], DURATION, PERIOD)
     tau = np.asarray(rtb.models.DH.Puma560().rne(q, qd, qdd))
     tau = tau + np.random.default_rng(0).normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     worn = tau.copy()
-    axis = 1
-    coulomb = 0.5 * (puma.friction.coulomb_pos[axis] + puma.friction.coulomb_neg[axis])
-    worn[:, axis] += 0.3 * coulomb * puma.gear_ratio[axis] * np.sign(qd[:, axis])
+    worn[:, 1] += coulomb_rise(puma, qd, 1)
     own = predict(irb, measured.from_arrays(t, q, np.zeros_like(tau), robot=irb))  # our own inverse dynamics
     own = own + np.random.default_rng(1).normal(size=own.shape) * 0.01 * np.sqrt(np.mean(own**2, axis=0))
-    coulomb = 0.5 * (irb.friction.coulomb_pos[axis] + irb.friction.coulomb_neg[axis])
-    own[:, axis] += 0.3 * coulomb * irb.gear_ratio[axis] * np.sign(qd[:, axis])
+    own[:, 1] += coulomb_rise(irb, qd, 1)
     return {"toolbox PUMA 560": (puma, measured.from_arrays(t, q, tau, robot=puma)),
             "toolbox PUMA 560, Coulomb +30 % on axis 2": (puma, measured.from_arrays(t, q, worn, robot=puma)),
             "IRB-6700-like (own inverse dynamics), Coulomb +30 % on axis 2": (irb, measured.from_arrays(t, q, own, robot=irb))}
