@@ -49,6 +49,7 @@ The rigid contact against an event-located ODE solution: within 0.1 % of the wid
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from faultgen.data import measured
@@ -181,30 +182,10 @@ def contact_deflection(t: np.ndarray, inertia: np.ndarray, damping: np.ndarray, 
         The deflection at the samples, rad; it starts on the loaded flank.
     """
     half = np.asarray(width, dtype=float) / 2
-    flank = np.sign(load[0]) * (half > 0)  # +1 / -1 on a flank, 0 in the gap (or no dead band)
-    e = flank * half
-    v = np.zeros_like(half)
-    out = np.empty((len(load), len(half)))
-    out[0] = e
     steps = np.diff(t)
     substeps = max(1, int(np.ceil(float(np.max(steps)) / CONTACT_SUBSTEP)))
-    fractions = np.arange(1, substeps + 1) / substeps
-    for k in range(1, len(load)):
-        h = steps[k - 1] / substeps
-        # inside the gap: m e'' + D e' = load, the damper implicit (Euler backward in e')
-        gain, decay = h / inertia[k], 1 + h * damping / inertia[k]
-        for fraction in fractions:
-            f = load[k - 1] + fraction * (load[k] - load[k - 1])
-            flank = np.where(flank * f < 0, 0.0, flank)  # the load reverses: the arm leaves
-            free = flank == 0
-            v = np.where(free, (v + gain * f) / decay, 0.0)
-            e = e + h * v
-            landed = free & (np.abs(e) >= half)
-            flank = np.where(landed, np.sign(e), flank)
-            e = np.where(landed, flank * half, e)
-            v = np.where(landed, 0.0, v)
-        out[k] = e
-    return out
+    return _contact(np.ascontiguousarray(inertia, dtype=float), np.asarray(damping, dtype=float), half, steps,
+                    substeps, np.ascontiguousarray(load, dtype=float))
 
 
 def dynamic_axes(robot: robots.Robot, t: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -232,46 +213,105 @@ def _dynamic(robot: robots.Robot, mass: np.ndarray, h_max: float) -> np.ndarray:
 def _integrate(mass, K, D, half, steps, substeps, load):
     """``-M e''`` of ``M e'' + D e' + S(e) = load`` along the samples, (m, n, d), for the ``m``
     dead-band half-widths ``half`` (m, d); ``mass`` (n, d, d), ``load`` (n, d)."""
-    m, d = half.shape
-    # start at rest, on the loaded flank
-    e = load[0] / K + np.sign(load[0]) * half
-    v = np.zeros((m, d))
-    a = np.zeros((m, d))
-    # flank of each axis: +1 / -1 on the positive / negative flank, 0 inside the dead band
-    flank = np.sign(e) * (np.abs(e) > half)
-    out = np.zeros((m, len(load), d))
+    d = half.shape[1]
     # the step's matrix M + D h/2 + (K h^2/4 on the engaged axes) takes one of 2^d forms per
     # sample: invert them all up front (the step then costs a gather and a product)
     patterns = (np.arange(2**d)[:, None] >> np.arange(d)) & 1  # (2^d, d): 1 = on a flank
-    code = 2 ** np.arange(d)
     h_all = steps / substeps
     diagonal = D * h_all[:, None, None] / 2 + patterns * K * (h_all**2)[:, None, None] / 4  # (n, 2^d, d)
     inverse = np.linalg.inv(mass[:, None] + diagonal[..., None] * np.eye(d))  # (n, 2^d, d, d)
-    fractions = np.arange(1, substeps + 1) / substeps
-    for k in range(1, len(load)):
-        h = h_all[k]
-        inverses = inverse[k]
-        for fraction in fractions:
-            # the load is interpolated across the sample interval: M e'' is a small difference
-            # of large terms, and holding the load for a whole sample would shift it by half a
-            # sample (an error of load' dt / 2)
-            f = load[k - 1] + fraction * (load[k] - load[k - 1])
-            # Newmark average acceleration (trapezoidal rule): unconditionally stable, no
-            # numerical damping of the resonance
-            predicted_e = e + h * v + h * h / 4 * a
-            predicted_v = v + h / 2 * a
-            # S(e) = K (e - flank b/2) on a flank, 0 in the dead band: for a guess of the
-            # flanks the step is linear; solve, take the flanks the new deflection lies on and
-            # repeat until they agree (an active set; one or two solves per sub-step)
-            for _ in range(MAX_FLANK_CHANGES):
-                engaged = np.abs(flank)
-                rhs = f - D * predicted_v - engaged * K * (predicted_e - flank * half)
-                a_new = np.einsum("mij,mj->mi", inverses[engaged.astype(int) @ code], rhs)
-                e_new = predicted_e + h * h / 4 * a_new
-                landed = np.sign(e_new) * (np.abs(e_new) > half)
-                if np.array_equal(landed, flank):
-                    break
-                flank = landed
-            e, v, a = e_new, predicted_v + h / 2 * a_new, a_new
-        out[:, k] = -a @ mass[k].T  # = S(e) + D e' - load
+    return _newmark(np.ascontiguousarray(mass), inverse, np.asarray(K, dtype=float), np.asarray(D, dtype=float),
+                    np.ascontiguousarray(half), h_all, substeps, np.ascontiguousarray(load, dtype=float))
+
+
+@numba.njit(cache=True)
+def _newmark(mass, inverse, K, D, half, h_all, substeps, load):
+    """The time loop of :func:`_integrate`, compiled (a sub-step is a few 3 x 3 products, which
+    NumPy calls would spend their time dispatching); ``inverse`` (n, 2^d, d, d) holds the
+    step's matrices for every pattern of engaged axes."""
+    m, d = half.shape
+    n = load.shape[0]
+    out = np.zeros((m, n, d))
+    e, v, a = np.empty(d), np.empty(d), np.empty(d)
+    flank, landed = np.empty(d), np.empty(d)
+    pe, pv, rhs, a_new, e_new = np.empty(d), np.empty(d), np.empty(d), np.empty(d), np.empty(d)
+    for j in range(m):
+        # start at rest, on the loaded flank
+        for i in range(d):
+            e[i] = load[0, i] / K[i] + np.sign(load[0, i]) * half[j, i]
+            v[i] = 0.0
+            a[i] = 0.0
+            # +1 / -1 on the positive / negative flank, 0 inside the dead band
+            flank[i] = np.sign(e[i]) if abs(e[i]) > half[j, i] else 0.0
+        for k in range(1, n):
+            h = h_all[k]
+            for s in range(1, substeps + 1):
+                fraction = s / substeps
+                for i in range(d):
+                    # the load is interpolated across the sample interval: M e'' is a small
+                    # difference of large terms, and holding the load for a whole sample would
+                    # shift it by half a sample (an error of load' dt / 2)
+                    pe[i] = e[i] + h * v[i] + h * h / 4 * a[i]  # Newmark average acceleration
+                    pv[i] = v[i] + h / 2 * a[i]
+                # S(e) = K (e - flank b/2) on a flank, 0 in the dead band: for a guess of the
+                # flanks the step is linear; solve, take the flanks the new deflection lies on
+                # and repeat until they agree (an active set; one or two solves per sub-step)
+                for _ in range(MAX_FLANK_CHANGES):
+                    code = 0
+                    for i in range(d):
+                        f = load[k - 1, i] + fraction * (load[k, i] - load[k - 1, i])
+                        engaged = abs(flank[i])
+                        code += int(engaged) << i
+                        rhs[i] = f - D[i] * pv[i] - engaged * K[i] * (pe[i] - flank[i] * half[j, i])
+                    same = True
+                    for i in range(d):
+                        acc = 0.0
+                        for l in range(d):
+                            acc += inverse[k, code, i, l] * rhs[l]
+                        a_new[i] = acc
+                        e_new[i] = pe[i] + h * h / 4 * acc
+                        landed[i] = np.sign(e_new[i]) if abs(e_new[i]) > half[j, i] else 0.0
+                        same = same and landed[i] == flank[i]
+                    if same:
+                        break
+                    for i in range(d):
+                        flank[i] = landed[i]
+                for i in range(d):
+                    e[i], v[i], a[i] = e_new[i], pv[i] + h / 2 * a_new[i], a_new[i]
+            for i in range(d):
+                acc = 0.0
+                for l in range(d):
+                    acc += mass[k, i, l] * a[l]
+                out[j, k, i] = -acc  # = S(e) + D e' - load
+    return out
+
+
+@numba.njit(cache=True)
+def _contact(inertia, damping, half, steps, substeps, load):
+    """The time loop of :func:`contact_deflection`, compiled, one problem after the other."""
+    n, p = load.shape
+    out = np.empty((n, p))
+    for j in range(p):
+        flank = np.sign(load[0, j]) if half[j] > 0 else 0.0  # +1 / -1 on a flank, 0 in the gap
+        e = flank * half[j]
+        v = 0.0
+        out[0, j] = e
+        for k in range(1, n):
+            h = steps[k - 1] / substeps
+            # inside the gap: m e'' + D e' = load, the damper implicit (Euler backward in e')
+            gain, decay = h / inertia[k, j], 1 + h * damping[j] / inertia[k, j]
+            for s in range(1, substeps + 1):
+                f = load[k - 1, j] + s / substeps * (load[k, j] - load[k - 1, j])
+                if flank * f < 0:
+                    flank = 0.0  # the load reverses: the arm leaves
+                if flank == 0:
+                    v = (v + gain * f) / decay
+                    e = e + h * v
+                    if abs(e) >= half[j]:  # landed
+                        flank = np.sign(e)
+                        e = flank * half[j]
+                        v = 0.0
+                else:
+                    v = 0.0
+            out[k, j] = e
     return out
