@@ -32,7 +32,7 @@ CHANGES = {
     "torque_offset": (np.array([3.5]), None, {"offset": 3.5}),
     "coulomb": (np.array([0.05, 0.02]), None, None),  # both directions, then the positive one more
     "viscous": (np.array([2e-3]), None, None),
-    "stribeck": (np.array([0.2]), 7.0, {"static": 0.2, "stribeck_velocity": 7.0}),
+    "stribeck": (np.array([0.2]), (7.0, 1.3), {"static": 0.2, "stribeck_velocity": 7.0, "stribeck_exponent": 1.3}),
     "load_dependent_friction": (np.array([0.1]), None, {"coefficient": 0.1}),
     "temperature": (np.array([0.8]), 3.0, {"amplitude": 0.8, "time_constant": 3.0}),
     # 2 kg, centre of mass (0.02, -0.03, 0.05) m, inertia about it diag(0.01, 0.02, 0.015) kg m^2

@@ -82,19 +82,22 @@ def test_payload_mass_comes_back(puma):
     assert best.effect.values()["com_z"] == 0.0 and best.effect.values()["ixx"] == 0.0
 
 
-def test_stribeck_velocity_is_refined_off_the_grid(puma):
+def test_stribeck_velocity_and_exponent_are_refined_off_the_grid(puma):
+    """A hump of exponent 1.15 (between the tried 1 and 1.25) at a velocity between two grid points:
+    both come back, and the static level."""
     _, motion, tau = puma
     effect = effects.get("stribeck")
     axis = 5
     grid = effect.grid(motion, axis)
     v_s = float(np.sqrt(grid[4] * grid[5]))  # between two grid points
-    phi, offset = effect.columns(motion, axis, v_s)
+    phi, offset = effect.columns(motion, axis, (v_s, 1.15))
     residual = np.zeros_like(tau)
     residual[:, axis] = phi[:, 0] * 0.02 + offset
     split = search.Split.of(motion.t, motion.qd)
     candidate = search.fit_effect(effect, motion, residual, tau, split)
     params = candidate.effect.values(axis)
     assert params["stribeck_velocity"] == pytest.approx(v_s, rel=0.01)
+    assert params["stribeck_exponent"] == pytest.approx(1.15, rel=0.01)
     assert params["static"] == pytest.approx(0.02, rel=0.01)
 
 

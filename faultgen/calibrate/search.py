@@ -47,6 +47,8 @@ MIN_RELATIVE_GAIN = 0.2
 TIE = 0.1
 #: Blocks of the fitting part for the jackknife standard errors (:func:`standard_errors`).
 JACKKNIFE_BLOCKS = 10
+#: Rounds of a nested fit whose unfitted parameters follow from the fitted ones (:func:`_nested`).
+COMPLETE_ITERATIONS = 4
 
 
 
@@ -130,15 +132,22 @@ def _lstsq(phi: np.ndarray, y: np.ndarray) -> np.ndarray:
     return np.linalg.lstsq(phi, y, rcond=None)[0]
 
 
-def _nested(design: np.ndarray, target: np.ndarray, levels: tuple[int, ...] | None, admissible) -> np.ndarray:
+def _nested(design: np.ndarray, target: np.ndarray, levels: tuple[int, ...] | None, admissible,
+            complete=None) -> np.ndarray:
     """Least squares of ``target`` (m,) on the leading ``level`` columns of ``design`` (m, k) at
     each of ``levels`` (simplest first; None: all columns at once), keeping the most detailed level
     whose fit is ``admissible(theta)`` and lowers the Bayesian information criterion
-    ``m ln(SSE / m) + level ln(m)``: a parameter the data do not support stays at zero."""
+    ``m ln(SSE / m) + level ln(m)``: a parameter the data do not support stays at zero, or at what
+    ``complete(theta, level)`` (:meth:`Effect.complete`) makes of it, fitted again with the
+    completed columns held (:data:`COMPLETE_ITERATIONS` rounds)."""
     best, best_bic = None, np.inf
-    for level in levels or (design.shape[-1],):
-        theta = np.zeros(design.shape[-1])
-        theta[:level] = _lstsq(design[:, :level], target)
+    k = design.shape[-1]
+    for level in levels or (k,):
+        theta = np.zeros(k)
+        for _ in range(COMPLETE_ITERATIONS if complete is not None and level < k else 1):
+            theta[:level] = _lstsq(design[:, :level], target - design[:, level:] @ theta[level:])
+            if complete is not None:
+                theta = complete(theta, level)
         sse = max(float(np.sum((target - design @ theta) ** 2)), 1e-300)
         bic = target.size * np.log(sse / target.size) + level * np.log(target.size)
         if best is None or (bic < best_bic and admissible(theta)):
@@ -164,7 +173,8 @@ class AxisLeastSquares:
         def trial(h):
             phi, offset = effect.columns(motion, axis, h)
             theta = _nested(phi[rows], residual[rows] - offset[rows], effect.levels,
-                            lambda th: effect.admissible(motion, axis, effect.params(motion, axis, th, h)))
+                            lambda th: effect.admissible(motion, axis, effect.params(motion, axis, th, h)),
+                            lambda th, level: effect.complete(motion, axis, th, level))
             predicted = phi @ theta + offset
             return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
 
@@ -195,7 +205,8 @@ class RobotLeastSquares:
         weights = 1.0 / scale
         design, target = (phi * weights[:, None])[rows], ((residual - offset) * weights)[rows]
         best = _nested(design, target, effect.levels,
-                       lambda th: effect.admissible(motion, None, effect.params(motion, None, th, None)))
+                       lambda th: effect.admissible(motion, None, effect.params(motion, None, th, None)),
+                       lambda th, level: effect.complete(motion, None, th, level))
         return best, phi @ best + offset
 
 

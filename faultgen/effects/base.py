@@ -425,6 +425,12 @@ class Effect:
         (with grid value ``h``) over ``motion.robot``."""
         raise NotImplementedError
 
+    def complete(self, motion: Motion, axis: int | None, theta: np.ndarray, level: int) -> np.ndarray:
+        """The full change ``theta`` (k,) when only its first ``level`` entries were fitted (a
+        nested :attr:`levels` fit): the others set to what those imply (the payload's inertia
+        about the flange from its mass and centre of mass). Default: left as they are (zero)."""
+        return theta
+
     def admissible(self, motion: Motion, axis: int | None, params: dict[str, float]) -> bool:
         """False when ``params`` are not physical for the current model (a negative mass or
         backlash, a friction level below zero); such a fit is never selected."""

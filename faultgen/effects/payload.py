@@ -77,7 +77,7 @@ class Payload(Effect):
     inverse dynamics carry it). Identified by its barycentric parameters (:func:`barycentric`), in
     which the torque is linear: the regressor of each is the inverse dynamics with ten bodies of
     known parameters added one at a time, solved for the unit changes; fitted at three
-    :attr:`levels` (mass; mass and centre of mass; all ten), of which the calibration's optimiser
+    :attr:`levels` (mass; mass and centre of mass, the inertia about it kept; all ten), of which the calibration's optimiser
     keeps the most detailed one that is admissible (physically consistent, :func:`consistent`, and
     within the drives' torque) and that the motion excites (Bayesian information criterion).
     """
@@ -177,6 +177,21 @@ class Payload(Effect):
 
     def params(self, motion, axis, theta, h):
         return _named(*from_barycentric(barycentric(*self._current_inertial(motion.robot)) + theta))
+
+    def complete(self, motion, axis, theta, level):
+        """At the mass level the current centre of mass and inertia are kept, at the centre-of-mass
+        level the current inertia about the centre of mass: the flange inertia (and first
+        moments) those imply, not zero (zero flange inertia would leave a centre of mass off the
+        flange with a negative inertia about itself)."""
+        if level >= len(theta):
+            return theta
+        current_mass, current_com, current_inertia = self._current_inertial(motion.robot)
+        current = barycentric(current_mass, current_com, current_inertia)
+        mass = float(current[0] + theta[0])
+        if not mass > 0:
+            return theta
+        com = current_com if level < 4 else (current[1:4] + theta[1:4]) / mass
+        return barycentric(mass, com, current_inertia) - current
 
     def admissible(self, motion, axis, params):
         """A payload adds mass; it is physically consistent (:func:`consistent`); and the drives can

@@ -1,53 +1,117 @@
-"""A Stribeck hump of another size and velocity (thesis eq. 6.3's f_s and v_s)."""
+"""A Stribeck hump of another size, velocity and exponent (thesis eq. 6.3's f_s, v_s and delta)."""
 
 from __future__ import annotations
 
 from typing import ClassVar
 
 import numpy as np
+from scipy.optimize import minimize
 
 from faultgen.effects.base import REST_SPEED, FrictionParameter, register
+
+#: Stribeck exponents tried (``delta`` of eq. 6.3's ``exp(-|v/v_s|^delta)``): the literature's
+#: range, 0.5 (Armstrong-Helouvry, Dupont & Canudas de Wit 1994) to 2 (the Gaussian curve of the
+#: robot models); the best is refined between its neighbours.
+EXPONENTS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
+#: How far (in e-folds of the hump, ``|v/v_s|^delta``) the largest Stribeck velocity tried has
+#: fallen at the 95th-percentile motor speed.
+DECAY = 4.0
+#: The refinement's value outside the bounds (finite, so the simplex's convergence test stays defined).
+OUTSIDE = 1e300
 
 
 @register
 class Stribeck(FrictionParameter):
-    """Static friction excess ``static`` (N m) and Stribeck velocity ``stribeck_velocity`` (rad/s),
-    motor side: eq. 6.3's ``f_s exp(-|v/v_s|^gamma) sign(v)``.
+    """Static friction excess ``static`` (N m), Stribeck velocity ``stribeck_velocity`` (rad/s),
+    motor side, and Stribeck exponent ``stribeck_exponent``: eq. 6.3's
+    ``f_s exp(-|v/v_s|^delta) sign(v)``.
 
-    Identified by replacing the model's term with one of a new f_s (linear) and v_s, searched up to
-    0.3 times the 95th-percentile motor speed (so a hump is never a disguised Coulomb step), down to
-    a tenth of that or three times the rest speed (:data:`REST_SPEED`, below which nothing is
-    fitted); gamma is kept.
+    Identified by replacing the model's term with one of a new f_s (linear), v_s and delta, per
+    axis: v_s searched over :meth:`grid` (between the rest speed, :data:`REST_SPEED`, below which
+    nothing is fitted, and the speed where the hump would not have fallen within the log's motor
+    speeds) at every exponent of :data:`EXPONENTS`; the best pair refined by a simplex search in
+    (log v_s, delta) inside those bounds. An exponent other than 2
+    is simulated by the static friction model only (``--friction stribeck``: MuJoCo's LuGre
+    has the Gaussian curve).
     """
 
     id = "stribeck"
     rank = 40
     summary = "Stribeck friction (extra friction at low speed, fading with speed) differs"
-    units: ClassVar[dict[str, str]] = {"static": "N m (motor side)", "stribeck_velocity": "rad/s (motor side)"}
-    absent = (0.0, 1.0)
+    units: ClassVar[dict[str, str]] = {"static": "N m (motor side)", "stribeck_velocity": "rad/s (motor side)",
+                                       "stribeck_exponent": "1"}
+    absent = (0.0, 1.0, 2.0)
     continuous = True
 
-    def grid(self, motion, axis):
-        v = np.abs(motion.motor_velocity[:, axis])
-        top = 0.3 * float(np.percentile(v, 95))
-        low = max(3 * REST_SPEED * motion.robot.gear_ratio[axis], top / 10)
+    def grid(self, motion, axis, exponent=None):
+        """Stribeck velocities (rad/s, motor side) to try at ``exponent`` (default: the model's):
+        from the rest speed (the hump there at least e^-1 of f_s, so its fall shows where the
+        calibration fits) up to where it has fallen to e^-4 (2 %) at the 95th-percentile motor
+        speed (so the hump is never a disguised Coulomb step); ``[None]`` when that range is
+        shorter than a factor 2."""
+        exponent = float(motion.robot.friction.stribeck_exponent[axis]) if exponent is None else exponent
+        top = float(np.percentile(np.abs(motion.motor_velocity[:, axis]), 95)) / DECAY ** (1 / exponent)
+        low = REST_SPEED * motion.robot.gear_ratio[axis]
         return list(np.geomspace(low, top, 12)) if top > 2 * low else [None]
 
-    def _shape(self, motion, axis, v_s):
-        gamma = motion.robot.friction.stribeck_exponent[axis]
+    @staticmethod
+    def _shape(motion, axis, v_s, exponent):
         v = motion.motor_velocity[:, axis]
-        return np.exp(-np.abs(v / v_s) ** gamma) * np.sign(v)
+        return np.exp(-np.abs(v / v_s) ** exponent) * np.sign(v)
+
+    def _velocity_exponent(self, motion, axis, h):
+        """``h`` is a Stribeck velocity (the model's exponent kept) or a (velocity, exponent) pair."""
+        return h if isinstance(h, tuple) else (h, float(motion.robot.friction.stribeck_exponent[axis]))
 
     def columns(self, motion, axis, h):
         G = motion.robot.gear_ratio[axis]
         f = motion.robot.friction
         if h is None:
             return np.zeros((len(motion.t), 1)), np.zeros(len(motion.t))
-        old = G * f.static[axis] * self._shape(motion, axis, f.stribeck_velocity[axis])
-        return (G * self._shape(motion, axis, h))[:, None], -old
+        v_s, exponent = self._velocity_exponent(motion, axis, h)
+        old = G * f.static[axis] * self._shape(motion, axis, f.stribeck_velocity[axis], f.stribeck_exponent[axis])
+        return (G * self._shape(motion, axis, v_s, exponent))[:, None], -old
+
+    def search(self, motion, residual, rows, scale):
+        return [self._fit_axis(motion, residual[:, a], rows[:, a], a) for a in range(residual.shape[1])]
+
+    def _fit_axis(self, motion, residual, rows, axis):
+        """``(h, theta, predicted)`` of one axis: least squares in f_s at every (v_s, delta) of
+        the grids, the best refined (class docstring); ``h = (v_s, delta)``."""
+        grids = {exponent: self.grid(motion, axis, exponent) for exponent in EXPONENTS}
+        grids = {exponent: grid for exponent, grid in grids.items() if grid != [None]}
+        if not grids:
+            return None, np.zeros(1), self.columns(motion, axis, None)[1]
+
+        def trial(h):
+            phi, offset = self.columns(motion, axis, h)
+            x, y = phi[rows, 0], residual[rows] - offset[rows]
+            theta = np.array([x @ y / (x @ x)]) if x @ x > 0 else np.zeros(1)
+            predicted = phi @ theta + offset
+            return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
+
+        def refined(x):  # (log v_s, delta), kept inside the grid of that delta
+            v_s, exponent = float(np.exp(x[0])), float(x[1])
+            if not EXPONENTS[0] <= exponent <= EXPONENTS[-1]:
+                return OUTSIDE
+            grid = self.grid(motion, axis, exponent)
+            return trial((v_s, exponent))[0] if grid != [None] and grid[0] <= v_s <= grid[-1] else OUTSIDE
+
+        results = [trial((float(v_s), exponent)) for exponent, grid in grids.items() for v_s in grid]
+        best = min(results, key=lambda r: r[0])
+        v_s, exponent = best[1]
+        found = minimize(refined, [np.log(v_s), exponent], method="Nelder-Mead",
+                         options={"xatol": 1e-3, "fatol": 0.0, "maxiter": 200})
+        if found.fun < OUTSIDE:
+            best = min(best, trial((float(np.exp(found.x[0])), float(found.x[1]))), key=lambda r: r[0])
+        return best[1:]
 
     def params(self, motion, axis, theta, h):
-        return {"static": float(theta[0]), "stribeck_velocity": float(h or 1.0)}
+        if h is None:
+            return {"static": float(theta[0]), "stribeck_velocity": 1.0,
+                    "stribeck_exponent": float(motion.robot.friction.stribeck_exponent[axis])}
+        v_s, exponent = self._velocity_exponent(motion, axis, h)
+        return {"static": float(theta[0]), "stribeck_velocity": float(v_s), "stribeck_exponent": float(exponent)}
 
     def admissible(self, motion, axis, params):
         return params["static"] >= 0

@@ -1,0 +1,99 @@
+"""``faultgen calibrate`` on logs of another simulator: the independent-simulator test set.
+
+28 logs made with roboticstoolbox-python's dynamics (tests/independent_set.py: the PUMA 560 of
+the toolbox and the IRB-6700-like arm as a toolbox ``DHRobot``, a Fourier excitation, effects
+in forms that differ from faultgen's own, 250-1000 Hz, 30-60 s, 4 without an effect). For each,
+the workflow gets the CSV and the robot name; a log is *named* when the first effects added
+are the hidden ones on exactly the hidden axes (any order; none for a null log) and *halved*
+when the held-out total nrmse is at most half of what it was. Prints one row per log and a
+summary, writes the rows to a CSV; the last line is ``named and halved <share of effect logs>``.
+The fast part of the set runs as tests (tests/test_calibrate_independent.py).
+
+    python benchmarks/calibration_independent.py --jobs 2 --csv independent.csv   # about 15 min
+    python benchmarks/calibration_independent.py --from-csv independent.csv       # the table again
+    python benchmarks/calibration_independent.py --cases irb6700-03 puma560-07
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+from joblib import Parallel, delayed
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import independent_set  # tests/independent_set.py: the set has one definition, shared with the tests
+
+from faultgen import axes
+from faultgen.calibrate import calibrate
+
+
+def run(case: independent_set.Case) -> dict:
+    """Make one log, calibrate it, judge the outcome."""
+    started = time.perf_counter()
+    with tempfile.TemporaryDirectory() as folder:
+        path, hidden = independent_set.make(case, folder)
+        result = calibrate(case.robot, path, Path(folder) / "out")
+    verdict = independent_set.judge(hidden, result)
+    return {
+        "log": case.name, "robot": case.robot, "rate_Hz": case.rate, "duration_s": case.duration,
+        "velocities": case.velocities,
+        "hidden": " | ".join(f"{form} {axes.numbers(p['axes'])}" for form, p in hidden.forms.items()) or "-",
+        "found": " | ".join(f"{effect} {axes.numbers(on)}" for effect, on in verdict["found"]) or "-",
+        "named": verdict["named"], "halved": verdict["halved"], "gap_before": verdict["before"],
+        "gap_after": verdict["after"], "mass_error": verdict.get("mass_error"),
+        "com_error_m": verdict.get("com_error"), "seconds": time.perf_counter() - started,
+    }
+
+
+def table(rows: pd.DataFrame) -> str:
+    """Markdown: one row per log, then the counts the issue asks for."""
+    lines = ["| log | Hz | s | qd | hidden | found | named | halved | gap before -> after | payload mass / com error |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in rows.itertuples():
+        payload = "-" if pd.isna(r.mass_error) else f"{100 * r.mass_error:.2f} % / {100 * r.com_error_m:.2f} cm"
+        halved = "-" if pd.isna(r.halved) else ("yes" if r.halved else "no")
+        lines.append(f"| {r.log} | {r.rate_Hz:g} | {r.duration_s:g} | {'yes' if r.velocities else 'no'} | {r.hidden} | "
+                     f"{r.found} | {'yes' if r.named else 'no'} | {halved} | {r.gap_before:.4f} -> {r.gap_after:.4f} | "
+                     f"{payload} |")
+    effect = rows[rows.hidden != "-"]
+    null = rows[rows.hidden == "-"]
+    both = effect.named & effect.halved.astype(bool)
+    lines += ["", f"effect logs named first on the right axes with the gap halved: {int(both.sum())} of {len(effect)}",
+              f"null logs with nothing named: {int(null.named.sum())} of {len(null)}"]
+    payload = rows.dropna(subset=["mass_error"])
+    if len(payload):
+        lines.append(f"payload logs: mass error at most {100 * payload.mass_error.max():.2f} %, centre of mass "
+                     f"at most {100 * payload.com_error_m.max():.2f} cm ({len(payload)} logs)")
+    lines.append(f"named and halved {both.mean():.3f}")
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--cases", nargs="*", default=[], help="only logs whose name contains one of these")
+    parser.add_argument("--jobs", type=int, default=2, help="logs calibrated in parallel (default 2)")
+    parser.add_argument("--csv", type=Path, help="write every log's outcome here")
+    parser.add_argument("--from-csv", type=Path, help="print the table of an earlier run's CSV, run nothing")
+    args = parser.parse_args()
+    if args.from_csv:
+        print(table(pd.read_csv(args.from_csv)))
+        return
+    cases = [c for c in independent_set.CASES if not args.cases or any(n in c.name for n in args.cases)]
+    if not cases:
+        parser.error(f"no log name contains any of {args.cases}; names: {[c.name for c in independent_set.CASES]}")
+    started = time.perf_counter()
+    rows = pd.DataFrame(Parallel(n_jobs=args.jobs, verbose=5)(delayed(run)(c) for c in cases))
+    if args.csv:
+        rows.to_csv(args.csv, index=False)
+    print(f"{len(cases)} logs in {time.perf_counter() - started:.0f} s with {args.jobs} jobs "
+          f"(longest calibration {rows.seconds.max():.0f} s)")
+    print(table(rows))
+
+
+if __name__ == "__main__":
+    main()
