@@ -5,7 +5,9 @@ parameters, reflected motor inertia and Coulomb + viscous friction) along our pi
 path, four cycles at 250 Hz, with one effect added by the toolbox or by a formula written here
 (not by our effect classes): a payload (``Puma560.payload``), a Stribeck hump, cogging. Sizes and
 axes are drawn as in :mod:`faultgen.calibrate.synth`; 1 % torque noise and 1e-5 rad encoder
-noise are added. The workflow gets the CSV and the robot name only.
+noise are added. The workflow gets the CSV and the robot name only. The null log and payloads
+with their centre of mass off the flange are in the independent test set
+(tests/test_calibrate_independent.py), along a Fourier excitation.
 """
 
 import numpy as np
@@ -59,33 +61,6 @@ def test_effect_added_to_toolbox_data_is_named(tmp_path, path, effect):
     assert result.gap_after["total_nrmse"] <= 0.5 * result.gap_before["total_nrmse"], result.summary()
     if effect == "payload":
         assert first.effect.mass == pytest.approx(hidden.effect.mass, rel=0.05)
-
-
-def test_toolbox_data_without_an_effect_names_nothing(tmp_path, path):
-    robot, motion = path
-    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, synth.Hidden(None)), tmp_path / "out")
-    assert result.steps == [], result.summary()
-
-
-@pytest.mark.parametrize("com", [(0.0, 0.0, 0.08), (0.1, 0.05, 0.05)])
-def test_payload_mass_and_centre_of_mass_from_toolbox_data(tmp_path, path, com):
-    """The first round reported a 2.5 kg payload 8 cm from the flange as torque offsets on axes 2,
-    3 and 5; the toolbox adds it to link 6 as a point mass at ``com`` (the link-6 frame is the
-    flange frame of our PUMA 560)."""
-    robot, motion = path
-    toolbox = rtb.models.DH.Puma560()
-    toolbox.payload(2.5, com)
-    tau = np.asarray(toolbox.rne(motion.q, motion.qd, motion.qdd))
-    rng = np.random.default_rng(SEED)
-    tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
-    log = measured.write_csv(tmp_path / "toolbox.csv", motion.t, motion.q + rng.normal(size=motion.q.shape) * 1e-5, tau)
-    result = calibrate("puma560", log, tmp_path / "out")
-    first = result.steps[0]
-    assert first.effect.id == "payload", result.summary()
-    assert first.effect.mass == pytest.approx(2.5, rel=0.03)
-    found = np.array([first.effect.com_x, first.effect.com_y, first.effect.com_z], dtype=float)
-    assert np.linalg.norm(found - com) < 0.01
-    assert result.gap_after["total_nrmse"] <= 0.1 * result.gap_before["total_nrmse"], result.summary()
 
 
 def test_coulomb_change_in_one_direction_is_fitted_per_direction(tmp_path, path):
