@@ -50,7 +50,10 @@ class Stribeck(FrictionParameter):
         speed (so the hump is never a disguised Coulomb step); ``[None]`` when that range is
         shorter than a factor 2."""
         exponent = float(motion.robot.friction.stribeck_exponent[axis]) if exponent is None else exponent
-        top = float(np.percentile(np.abs(motion.motor_velocity[:, axis]), 95)) / DECAY ** (1 / exponent)
+        key = ("stribeck_p95", axis)
+        if key not in motion.memo:
+            motion.memo[key] = float(np.percentile(np.abs(motion.motor_velocity[:, axis]), 95))
+        top = motion.memo[key] / DECAY ** (1 / exponent)
         low = REST_SPEED * motion.robot.gear_ratio[axis]
         return list(np.geomspace(low, top, 12)) if top > 2 * low else [None]
 
@@ -75,36 +78,53 @@ class Stribeck(FrictionParameter):
     def search(self, motion, residual, rows, scale):
         return [self._fit_axis(motion, residual[:, a], rows[:, a], a) for a in range(residual.shape[1])]
 
-    def _fit_axis(self, motion, residual, rows, axis):
+    def replicate(self, motion, residual, rows, scale, axes):
+        # a jackknife replicate: the simplex started from the fit's own (v_s, delta) on ``axes``,
+        # no grid; the other axes are not reported
+        own = {a: (float(self.values(a)["stribeck_velocity"]), float(self.values(a)["stribeck_exponent"]))
+               for a in axes}
+        return [self._fit_axis(motion, residual[:, a], rows[:, a], a, own[a]) if a in own
+                else (None, np.zeros(1), self.columns(motion, a, None)[1]) for a in range(residual.shape[1])]
+
+    def _fit_axis(self, motion, residual, rows, axis, start=None):
         """``(h, theta, predicted)`` of one axis: least squares in f_s at every (v_s, delta) of
-        the grids, the best refined (class docstring); ``h = (v_s, delta)``."""
+        the grids (or only at ``start``), the best refined (class docstring); ``h = (v_s, delta)``."""
         grids = {exponent: self.grid(motion, axis, exponent) for exponent in EXPONENTS}
         grids = {exponent: grid for exponent, grid in grids.items() if grid != [None]}
+        _, offset = self.columns(motion, axis, None if not grids else (1.0, 2.0))
         if not grids:
-            return None, np.zeros(1), self.columns(motion, axis, None)[1]
+            return None, np.zeros(1), offset
+        G = motion.robot.gear_ratio[axis]
+        v = motion.motor_velocity[rows, axis]
+        speed, direction = np.abs(v), np.sign(v)
+        y = residual[rows] - offset[rows]
+        yy = float(y @ y)
 
-        def trial(h):
-            phi, offset = self.columns(motion, axis, h)
-            x, y = phi[rows, 0], residual[rows] - offset[rows]
-            theta = np.array([x @ y / (x @ x)]) if x @ x > 0 else np.zeros(1)
-            predicted = phi @ theta + offset
-            return float(np.sum((residual[rows] - predicted[rows]) ** 2)), h, theta, predicted
+        def sse(v_s, exponent):  # of the least-squares f_s: |y|^2 - (x.y)^2 / |x|^2
+            x = G * np.exp(-((speed / v_s) ** exponent)) * direction
+            xx = float(x @ x)
+            return yy - float(x @ y) ** 2 / xx if xx > 0 else yy
 
-        def refined(x):  # (log v_s, delta), kept inside the grid of that delta
-            v_s, exponent = float(np.exp(x[0])), float(x[1])
+        def refined(z):  # (log v_s, delta), kept inside the grid of that delta
+            v_s, exponent = float(np.exp(z[0])), float(z[1])
             if not EXPONENTS[0] <= exponent <= EXPONENTS[-1]:
                 return OUTSIDE
             grid = self.grid(motion, axis, exponent)
-            return trial((v_s, exponent))[0] if grid != [None] and grid[0] <= v_s <= grid[-1] else OUTSIDE
+            return sse(v_s, exponent) if grid != [None] and grid[0] <= v_s <= grid[-1] else OUTSIDE
 
-        results = [trial((float(v_s), exponent)) for exponent, grid in grids.items() for v_s in grid]
-        best = min(results, key=lambda r: r[0])
-        v_s, exponent = best[1]
-        found = minimize(refined, [np.log(v_s), exponent], method="Nelder-Mead",
-                         options={"xatol": 1e-3, "fatol": 0.0, "maxiter": 200})
-        if found.fun < OUTSIDE:
-            best = min(best, trial((float(np.exp(found.x[0])), float(found.x[1]))), key=lambda r: r[0])
-        return best[1:]
+        if start is None:
+            best = min(((float(v_s), exponent) for exponent, grid in grids.items() for v_s in grid),
+                       key=lambda h: sse(*h))
+        else:
+            best = start
+        found = minimize(refined, [np.log(best[0]), best[1]], method="Nelder-Mead",
+                         options={"xatol": 1e-3, "fatol": 1e-9 * yy, "maxiter": 200})
+        if found.fun < min(OUTSIDE, sse(*best)):
+            best = (float(np.exp(found.x[0])), float(found.x[1]))
+        phi, offset = self.columns(motion, axis, best)
+        x = phi[rows, 0]
+        theta = np.array([x @ y / (x @ x)]) if x @ x > 0 else np.zeros(1)
+        return best, theta, phi @ theta + offset
 
     def params(self, motion, axis, theta, h):
         if h is None:
