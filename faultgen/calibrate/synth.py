@@ -171,7 +171,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         return Hidden.of(robot, effect, {None: kind.params(motion, None, theta, None)}, size)
     params, sizes = {}, np.zeros(N_AXES)
     for axis in range(N_AXES):
-        grid = kind.grid(motion, axis)
+        grid = kind.draw_grid(motion, axis)
         if grid == [None]:
             h = None
         elif isinstance(grid[0], (int, np.integer)):

@@ -455,6 +455,11 @@ class Effect:
 
     # -- hidden-effect drawing -----------------------------------------------------------
 
+    def draw_grid(self, motion: Motion, axis: int) -> list:
+        """Values of the nonlinear parameter a hidden effect is drawn between (inside the second
+        and the last-but-one); default: the searched :meth:`grid`."""
+        return self.grid(motion, axis)
+
     def draw_direction(self, rng: np.random.Generator) -> np.ndarray:
         """Unit direction of the linear parameters of a drawn hidden effect, shape (k,)."""
         return np.ones(1)

@@ -13,6 +13,15 @@ from faultgen.effects.base import REST_SPEED, FrictionParameter, register
 #: range, 0.5 (Armstrong-Helouvry, Dupont & Canudas de Wit 1994) to 2 (the Gaussian curve of the
 #: robot models); the best is refined between its neighbours.
 EXPONENTS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
+#: Lowest Stribeck velocity tried, in rest speeds (:data:`REST_SPEED`) at the motor: the hump at
+#: the rest speed is then at least exp(-(1/2)^delta) of f_s (78 % Gaussian), so most of its fall
+#: shows above the rest speed, where the calibration fits.
+LOWEST = 2.0
+#: Lowest Stribeck velocity of a drawn hidden hump (:meth:`Stribeck.draw_grid`), in rest speeds:
+#: 3, the search's lower end before the exponent was fitted. Drawn from 1 or 2 rest speeds, the
+#: own-simulator humps sat mostly below the rest speed, sized up to 6-9 times the Coulomb level to
+#: reach their torque size, and the PUMA 560 stribeck cases were named in 2 and 4 of 5.
+DRAW_LOWEST = 3.0
 #: How far (in e-folds of the hump, ``|v/v_s|^delta``) the largest Stribeck velocity tried has
 #: fallen at the 95th-percentile motor speed.
 DECAY = 4.0
@@ -27,8 +36,8 @@ class Stribeck(FrictionParameter):
     ``f_s exp(-|v/v_s|^delta) sign(v)``.
 
     Identified by replacing the model's term with one of a new f_s (linear), v_s and delta, per
-    axis: v_s searched over :meth:`grid` (between the rest speed, :data:`REST_SPEED`, below which
-    nothing is fitted, and the speed where the hump would not have fallen within the log's motor
+    axis: v_s searched over :meth:`grid` (between twice the rest speed, :data:`REST_SPEED`, below
+    which nothing is fitted, and the speed where the hump would not have fallen within the log's motor
     speeds) at every exponent of :data:`EXPONENTS`; the best pair refined by a simplex search in
     (log v_s, delta) inside those bounds. An exponent other than 2
     is simulated by the static friction model only (``--friction stribeck``: MuJoCo's LuGre
@@ -43,18 +52,20 @@ class Stribeck(FrictionParameter):
     absent = (0.0, 1.0, 2.0)
     continuous = True
 
-    def grid(self, motion, axis, exponent=None):
+    def draw_grid(self, motion, axis):
+        return self.grid(motion, axis, lowest=DRAW_LOWEST)
+
+    def grid(self, motion, axis, exponent=None, lowest=LOWEST):
         """Stribeck velocities (rad/s, motor side) to try at ``exponent`` (default: the model's):
-        from the rest speed (the hump there at least e^-1 of f_s, so its fall shows where the
-        calibration fits) up to where it has fallen to e^-4 (2 %) at the 95th-percentile motor
-        speed (so the hump is never a disguised Coulomb step); ``[None]`` when that range is
-        shorter than a factor 2."""
+        from :data:`LOWEST` rest speeds (so the hump's fall shows where the calibration fits) up
+        to where it has fallen to e^-4 (2 %) at the 95th-percentile motor speed (so the hump is
+        never a disguised Coulomb step); ``[None]`` when that range is shorter than a factor 2."""
         exponent = float(motion.robot.friction.stribeck_exponent[axis]) if exponent is None else exponent
         key = ("stribeck_p95", axis)
         if key not in motion.memo:
             motion.memo[key] = float(np.percentile(np.abs(motion.motor_velocity[:, axis]), 95))
         top = motion.memo[key] / DECAY ** (1 / exponent)
-        low = REST_SPEED * motion.robot.gear_ratio[axis]
+        low = lowest * REST_SPEED * motion.robot.gear_ratio[axis]
         return list(np.geomspace(low, top, 12)) if top > 2 * low else [None]
 
     @staticmethod
