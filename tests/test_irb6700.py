@@ -3,12 +3,9 @@
 import mujoco
 import numpy as np
 import pytest
-import roboticstoolbox as rtb  # test dependency: an independent kinematics and dynamics engine
 from toolbox_robots import irb6700, irb6700_balance_torque
 
 from faultgen import robots
-
-PI = np.pi
 
 
 @pytest.fixture(scope="module")
@@ -18,23 +15,14 @@ def irb():
 
 @pytest.fixture(scope="module")
 def dh_model():
-    """Standard DH model of the IRB 6700-200/2.60 from the published dimensions.
+    """Standard DH model of the IRB 6700-200/2.60 from the published dimensions
+    (:func:`toolbox_robots.irb6700`, whose dynamics this kinematics check does not use).
 
     Base 0.78 m, shoulder offset 0.32 m, upper arm 1.125 m, wrist offset 0.2 m, forearm
     1.1425 m, flange 0.2 m; joint directions and zero pose of the ROS-Industrial description
     (lower arm vertical, forearm along +x at zero).
     """
-    return rtb.DHRobot(
-        [
-            rtb.RevoluteDH(d=0.78, a=0.32, alpha=-PI / 2),
-            rtb.RevoluteDH(a=1.125, offset=-PI / 2),
-            rtb.RevoluteDH(a=0.2, alpha=-PI / 2),
-            rtb.RevoluteDH(d=1.1425, alpha=PI / 2),
-            rtb.RevoluteDH(alpha=-PI / 2),
-            rtb.RevoluteDH(d=0.2),
-        ],
-        name="irb6700-200-260 DH",
-    )
+    return irb6700()
 
 
 def flange_pose(robot, q):
