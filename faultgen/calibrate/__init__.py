@@ -222,6 +222,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     spec = mujoco.MjSpec.from_file(str(nominal.path))
     befores: list[Effect] = []  # each step's effect as the model held it before the step
     with tempfile.TemporaryDirectory(dir=model_dir) as work:
+        trial_path = Path(work) / model_out.name
         if tasks_file.is_file():
             shutil.copyfile(tasks_file, Path(work) / "tasks.toml")
         for k in range(max_steps):
@@ -230,24 +231,25 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
             best = ranked[0]
             if not best.axes:
                 break
-            befores.append(best.effect.current(current))
-            best.effect.write(spec, current, best.axes)
-            trial_path = Path(work) / model_out.name
-            trial_path.write_text(spec.to_xml())
-            trial = robots.load(trial_path)
+            trial_spec = mujoco.MjSpec.from_string(spec.to_xml())
+            best.effect.write(trial_spec, current, best.axes)
+            trial = robots.load(_write(trial_spec, trial_path))
             trial_prediction, trial_motion = _predict(trial, data)
             after = search.gap(tau, trial_prediction, split.held_out)
             previous = steps[-1].gap_after if steps else gap_before
             if after["total_nrmse"] >= previous["total_nrmse"]:
+                if steps:  # the model file keeps the last model taken, not this trial
+                    _write(spec, trial_path)
                 break  # the written model does not do what the fit promised: stop, keep what works
             errors = search.standard_errors(best.effect, motion, tau - predicted, tau, split, best.axes)
-            current, predicted, motion = trial, trial_prediction, trial_motion
+            befores.append(best.effect.current(current))
+            spec, current, predicted, motion = trial_spec, trial, trial_prediction, trial_motion
             steps.append(Step(best.effect, best.axes, _evidence(best, ranked), after, errors))
             if progress:
                 print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
                       f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
         if len(steps) > 1:
-            spec, current, predicted = _refit(spec, steps, befores, data, tau, split, Path(work) / model_out.name)
+            current, predicted = _refit(spec, current, predicted, steps, befores, data, tau, split, trial_path)
         atomic.write_text(model_out, Path(current.path).read_text())
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
 
@@ -310,17 +312,16 @@ def _unit(unit: str) -> str:
     return "" if unit == "1" else f" {unit}"
 
 
-def _refit(spec: mujoco.MjSpec, steps: list[Step], befores: list[Effect], data: measured_io.MeasuredData,
-           tau: np.ndarray, split: search.Split, path: Path) -> tuple[mujoco.MjSpec, robots.Robot, np.ndarray]:
+def _refit(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray, steps: list[Step],
+           befores: list[Effect], data: measured_io.MeasuredData, tau: np.ndarray, split: search.Split,
+           path: Path) -> tuple[robots.Robot, np.ndarray]:
     """Backfitting over the steps (Hastie & Tibshirani 1990), :data:`REFIT_ROUNDS` rounds: each
     step's effect is taken out of the final model (back to ``befores``), fitted again on its axes to the residual
     the *other* effects leave, and put back when that lowers the held-out gap. A step fitted while
     a later effect was still missing (a payload's mass taking up part of a friction change) comes
     back to its own size. ``steps`` is updated in place (effect and standard errors; the evidence
-    and the gap after each step stay those of the forward pass). Returns the spec, the model and
-    its prediction."""
-    current = robots.load(_write(spec, path))
-    predicted, _ = _predict(current, data)
+    and the gap after each step stay those of the forward pass). ``spec``, ``current`` (written at
+    ``path``) and ``predicted`` are the final model; returns the model kept and its prediction."""
     best_gap = search.gap(tau, predicted, split.held_out)["total_nrmse"]
     for j, step in [(j, s) for _ in range(REFIT_ROUNDS) for j, s in enumerate(steps)]:
         without = mujoco.MjSpec.from_string(spec.to_xml())
@@ -341,8 +342,8 @@ def _refit(spec: mujoco.MjSpec, steps: list[Step], befores: list[Effect], data: 
             errors = search.standard_errors(effect, motion, residual, tau, split, step.axes)
             steps[j] = Step(effect, step.axes, step.evidence, step.gap_after, errors)
             spec, current, predicted, best_gap = trial_spec, trial, trial_prediction, trial_gap
-    _write(spec, path)  # the model file holds what was kept
-    return spec, current, predicted
+    _write(spec, path)  # the model file (``current.path``) holds what was kept
+    return current, predicted
 
 
 def _write(spec: mujoco.MjSpec, path: Path) -> Path:
