@@ -11,7 +11,7 @@ from faultgen.effects.base import REST_SPEED, FrictionParameter, register
 
 #: Stribeck exponents tried (``delta`` of eq. 6.3's ``exp(-|v/v_s|^delta)``): the literature's
 #: range, 0.5 (Armstrong-Helouvry, Dupont & Canudas de Wit 1994) to 2 (the Gaussian curve of the
-#: robot models); the best is refined between its neighbours.
+#: robot models); the best is refined by a simplex search with the Stribeck velocity.
 EXPONENTS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
 #: Lowest Stribeck velocity tried, in rest speeds (:data:`REST_SPEED`) at the motor: the hump at
 #: the rest speed is then at least exp(-(1/2)^delta) of f_s (78 % Gaussian), so most of its fall
@@ -79,12 +79,16 @@ class Stribeck(FrictionParameter):
 
     def columns(self, motion, axis, h):
         G = motion.robot.gear_ratio[axis]
-        f = motion.robot.friction
         if h is None:
             return np.zeros((len(motion.t), 1)), np.zeros(len(motion.t))
         v_s, exponent = self._velocity_exponent(motion, axis, h)
-        old = G * f.static[axis] * self._shape(motion, axis, f.stribeck_velocity[axis], f.stribeck_exponent[axis])
-        return (G * self._shape(motion, axis, v_s, exponent))[:, None], -old
+        return (G * self._shape(motion, axis, v_s, exponent))[:, None], -self._model_hump(motion, axis)
+
+    def _model_hump(self, motion, axis):
+        """The model's own Stribeck term of ``axis`` along the motion, N m at the arm side, (n,)."""
+        f = motion.robot.friction
+        G = motion.robot.gear_ratio[axis]
+        return G * f.static[axis] * self._shape(motion, axis, f.stribeck_velocity[axis], f.stribeck_exponent[axis])
 
     def search(self, motion, residual, rows, scale):
         return [self._fit_axis(motion, residual[:, a], rows[:, a], a) for a in range(residual.shape[1])]
@@ -102,9 +106,9 @@ class Stribeck(FrictionParameter):
         the grids (or only at ``start``), the best refined (class docstring); ``h = (v_s, delta)``."""
         grids = {exponent: self.grid(motion, axis, exponent) for exponent in EXPONENTS}
         grids = {exponent: grid for exponent, grid in grids.items() if grid != [None]}
-        _, offset = self.columns(motion, axis, None if not grids else (1.0, 2.0))
         if not grids:
-            return None, np.zeros(1), offset
+            return None, np.zeros(1), self.columns(motion, axis, None)[1]
+        offset = -self._model_hump(motion, axis)
         G = motion.robot.gear_ratio[axis]
         v = motion.motor_velocity[rows, axis]
         speed, direction = np.abs(v), np.sign(v)
