@@ -17,7 +17,7 @@ faultgen's own (:class:`Hidden`):
   calibration fits, above the rest speed);
 * ``load_gravity`` / ``load_total``: friction ``mu |load| sign(v)`` with the load the gravity torque
   (Bittencourt & Gunnarsson 2012) or the whole transmitted torque (Bittencourt, Wernholt,
-  Sander-Tavallaey & Brogardh 2010); faultgen fits only the second form;
+  Sander-Tavallaey & Brogardh 2010), the load computed by the toolbox;
 * ``warm_up``: the whole friction (Coulomb and viscous, as the toolbox has it) times
   ``1 + a exp(-t / T)``; faultgen's warm-up scales the dry friction only.
 
@@ -215,12 +215,12 @@ def make(case: Case, folder: str | Path) -> tuple[Path, Hidden]:
             tau[:, axes] += G[axes] * static * np.exp(-np.abs(v[:, axes] / velocity) ** exponent) * direction[:, axes]
         elif form in ("load_gravity", "load_total"):
             axes = _axes(rng, [1, 2], 2)
-            if form == "load_gravity":
+            if form == "load_gravity":  # gravity and, on the IRB, the balancing spring
                 load = np.asarray(model.gravload(q))
-            else:  # the transmitted torque: the links' rigid-body torque, motor inertia and friction left out
+                if case.robot == "irb6700":
+                    load = load + toolbox_robots.irb6700_balance_torque(q)
+            else:  # the transmitted torque: the rigid-body torque (spring included), motor inertia left out
                 load = rigid - G**2 * np.array([link.Jm for link in model.links]) * qdd
-            if case.robot == "irb6700":
-                load = load + toolbox_robots.irb6700_balance_torque(q)
             # a coefficient that makes the added friction 20-40 % of the axis's Coulomb level (RMS)
             size = rng.uniform(0.2, 0.4, len(axes)) * G[axes] * coulomb[axes]
             mu = size / np.sqrt(np.mean(load[:, axes] ** 2, axis=0))

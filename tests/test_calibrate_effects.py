@@ -33,7 +33,7 @@ CHANGES = {
     "coulomb": (np.array([0.05, 0.02]), None, None),  # both directions, then the positive one more
     "viscous": (np.array([2e-3]), None, None),
     "stribeck": (np.array([0.2]), (7.0, 1.3), {"static": 0.2, "stribeck_velocity": 7.0, "stribeck_exponent": 1.3}),
-    "load_dependent_friction": (np.array([0.1]), None, {"coefficient": 0.1}),
+    "load_dependent_friction": (np.array([0.1]), 1, {"coefficient": 0.1, "gravity_load": 1}),  # the static form
     "temperature": (np.array([0.8]), 3.0, {"amplitude": 0.8, "time_constant": 3.0}),
     # 2 kg, centre of mass (0.02, -0.03, 0.05) m, inertia about it diag(0.01, 0.02, 0.015) kg m^2
     "payload": (payload.barycentric(2.0, [0.02, -0.03, 0.05], [0.01, 0.02, 0.015, 0, 0, 0]), None,
@@ -126,7 +126,7 @@ def test_models_written_before_the_effect_names_were_unified_still_load(tmp_path
     path.write_text(spec.to_xml())
     old = robots.load(path)
     assert old.effects["temperature"].values(1) == {"amplitude": 0.4, "time_constant": 20.0}
-    assert old.effects["load_dependent_friction"].coefficient[2] == 0.07
+    assert old.effects["load_dependent_friction"].values(2) == {"coefficient": 0.07, "gravity_load": 0}
     effects.get("temperature").apply(spec, old, 1, {"amplitude": 0.1, "time_constant": 5.0})
     assert spec.numeric("thermal2") is None and list(spec.numeric("temperature2").data) == [0.1, 5.0]
 
@@ -143,6 +143,11 @@ def test_bad_optional_numeric_is_refused(tmp_path):
     spec.add_numeric(name="cogging1", data=[0.5, 2.0])
     path.write_text(spec.to_xml())
     with pytest.raises(robots.ModelError, match="cogging1.*2 values, expected 3: amplitude poles phase"):
+        robots.load(path)
+    spec = mujoco.MjSpec.from_file(str(robot.path))
+    spec.add_numeric(name="load_dependent_friction3", data=[0.1, 0.5])
+    path.write_text(spec.to_xml())
+    with pytest.raises(robots.ModelError, match="load_dependent_friction.*gravity_load = 0.5; expected 0 or 1"):
         robots.load(path)
 
 

@@ -10,10 +10,10 @@ id                         parameters (SI)                                  MJCF
 torque_offset              offset (N m, arm side)                           numeric torque_offset{i}
 coulomb                    coulomb_pos, coulomb_neg (N m, motor side)       numeric friction{i}
 viscous                    viscous (N m s/rad, motor side)                  numeric friction{i}
-stribeck                   static (N m), stribeck_velocity (rad/s), motor   numeric friction{i}
-load_dependent_friction    coefficient (1)                                  numeric load_dependent_friction{i}
+stribeck                   static, stribeck_velocity, stribeck_exponent     numeric friction{i}
+load_dependent_friction    coefficient (1), gravity_load (0 or 1)           numeric load_dependent_friction{i}
 temperature                amplitude (1), time_constant (s)                 numeric temperature{i}
-payload                    mass (kg), robot-wide                            bodies payload{n} at the flange
+payload                    mass, com, inertia (kg, m, kg m^2), robot-wide   body payload1 at the flange
 cogging                    amplitude (N m, motor side), poles (1), phase    numeric cogging{i}
 backlash                   width (rad, arm side)                            tendon gearbox{i} springlength
 =========================  ===============================================  ======================

@@ -91,6 +91,14 @@ class Motion:
                    compliance)
 
     @property
+    def static_load(self) -> np.ndarray:
+        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, 6): gravity and joint
+        springs (:meth:`faultgen.robots.Robot.static_load`), computed once per motion."""
+        if "static_load" not in self.memo:
+            self.memo["static_load"] = self.robot.static_load(self.q)
+        return self.memo["static_load"]
+
+    @property
     def motor_velocity(self) -> np.ndarray:
         """Motor-side velocity ``G qd`` in rad/s, shape (n, 6)."""
         return self.robot.gear_ratio * self.qd
@@ -214,6 +222,9 @@ class Effect:
     stepped: ClassVar[bool] = False
     numeric: ClassVar[str | None] = None
     aliases: ClassVar[tuple[str, ...]] = ()
+    #: Leading values a stored numeric must hold (the rest read as absent: a parameter added
+    #: later); None: all of them.
+    required: ClassVar[int | None] = None
     #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
     counts: ClassVar[tuple[str, ...]] = ()
     #: Numbers of leading linear parameters (columns) fitted at each level of detail, simplest first
@@ -305,7 +316,7 @@ class Effect:
         an effect stored as part of something else (the friction parameters).
 
         The default reads the custom numerics ``<numeric>{i}`` (or an earlier name,
-        :attr:`aliases`), one value per parameter.
+        :attr:`aliases`), one value per parameter (at least the :attr:`required` leading ones).
 
         Raises
         ------
@@ -323,11 +334,12 @@ class Effect:
                     break
             if idx < 0:
                 continue
-            if model.numeric_size[idx] != size:
-                raise ModelError(f"{path}: numeric '{name}{k + 1}' has {model.numeric_size[idx]} values, expected "
+            given = int(model.numeric_size[idx])
+            if not (cls.required or size) <= given <= size:
+                raise ModelError(f"{path}: numeric '{name}{k + 1}' has {given} values, expected "
                                  f"{size}: {' '.join(cls.units)}")
             adr = model.numeric_adr[idx]
-            rows[k] = model.numeric_data[adr: adr + size]
+            rows[k, :given] = model.numeric_data[adr: adr + given]
         if not np.all(np.isfinite(rows)):
             raise ModelError(f"{path}: numeric '{cls.numeric}' holds a non-finite value")
         problem = cls.check(rows)
@@ -388,9 +400,12 @@ class Effect:
         the start of each run, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
         return None
 
-    def dry_friction_extra(self, robot, deflection: np.ndarray) -> np.ndarray | None:
+    def dry_friction_extra(self, robot, deflection: np.ndarray, static_load: Callable[[], np.ndarray]
+                           ) -> np.ndarray | None:
         """Motor-side dry friction the effect adds given the gearbox deflections ``deflection``
-        (r, 6) rad (eq. 6.2a), N m, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
+        (r, 6) rad (eq. 6.2a) and ``static_load()``, the arm-side torque (r, 6) that would hold the
+        arms still where they are (:meth:`faultgen.robots.Robot.static_load_of`; computed only when
+        called), N m, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
         return None
 
     # -- identification ------------------------------------------------------------------

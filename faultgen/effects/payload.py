@@ -159,15 +159,19 @@ class Payload(Effect):
     )
 
     def columns(self, motion, axis, h):
-        """The torque per unit change of each barycentric parameter, N m per unit, shape (n, 6, 10)."""
+        """The torque per unit change of each barycentric parameter, N m per unit, shape (n, 6, 10).
+
+        Taken with the model's friction and effects: friction growing with the gearbox load grows
+        with the payload's share of it too, ``c sign(tau_load) sign(qd)`` times the payload's
+        own torque (linear while the load keeps its sign, which the probes' 1 kg barely moves)."""
         if "payload" not in motion.memo:  # the fit, the bound and the drawing all need it
             robot = motion.robot
-            without = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
+            without = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t)
             changes, probes = [], []
             for k, (mass, com, inertia) in enumerate(self.PROBES):
                 probe = robot.edited(lambda spec, m=mass, c=com, i=inertia, k=k:
                                      self._add_body(spec, robot, f"probe{k}", m, c, i))
-                changes.append(probe.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False) - without)
+                changes.append(probe.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t) - without)
                 probes.append(barycentric(mass, com, inertia))
             # changes[k] = Y @ probes[k] for every probe: solve for Y
             solved = np.linalg.solve(np.array(probes), np.stack(changes, axis=-1).reshape(-1, 10).T)

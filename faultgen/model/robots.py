@@ -279,6 +279,57 @@ class Robot:
         qdd = _check_trajectory("qdd", qdd, q.shape[0])
         return self._rigid(q, qd, qdd)[1]
 
+    def static_load(self, q: np.ndarray) -> np.ndarray:
+        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, 6): gravity plus the
+        joints' passive springs (the IRB-6700-like axis-2 balancing), the static gearbox load of
+        load-dependent friction's gravity form (Bittencourt & Gunnarsson 2012). :meth:`gearbox_load`
+        at zero speed and acceleration.
+
+        Parameters
+        ----------
+        q : ndarray of shape (n, 6)
+            Arm joint angles in rad.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`inverse_dynamics`.
+        """
+        q = _check_trajectory("q", q)
+        zero = np.zeros_like(q)
+        return self._rigid(q, zero, zero)[1]
+
+    def static_load_of(self, subtree_com: np.ndarray, xanchor: np.ndarray, xaxis: np.ndarray,
+                       qpos: np.ndarray) -> np.ndarray:
+        """:meth:`static_load` from MuJoCo's position-stage fields of r simulations, N m, (r, 6):
+        ``-a . ((c - p) x m g) + k (q - q_spring)`` per arm joint (axis ``a``, anchor ``p``, mass
+        ``m`` and centre ``c`` of the body subtree it carries, spring stiffness ``k``). For a
+        simulation stepping many runs at once, where ``mj_inverse`` per run would cost too much.
+
+        Parameters
+        ----------
+        subtree_com : ndarray of shape (r, nbody, 3)
+        xanchor, xaxis : ndarray of shape (r, njnt, 3)
+        qpos : ndarray of shape (r, nq)
+        """
+        joints, bodies, mass, gravity, stiffness, rest = self._static_terms
+        lever = subtree_com[:, bodies] - xanchor[:, joints]  # (r, 6, 3), m
+        # -a . ((c - p) x m g) = m a^T [g]x (c - p), [g]x v = g x v: a product, not a cross product
+        moment = np.sum((xaxis[:, joints] @ gravity) * lever, axis=-1)
+        return mass * moment + stiffness * (qpos[:, self.arm_qpos] - rest)
+
+    @cached_property
+    def _static_terms(self) -> tuple:
+        """Arm joint ids, the bodies they carry, those subtrees' masses (kg), the gravity's cross-
+        product matrix ``[g]x`` (3, 3), the joints' spring stiffness and rest angles."""
+        model = self.model
+        joints = np.array([model.joint(n).id for n in self.joint_names])
+        bodies = model.jnt_bodyid[joints]
+        g = model.opt.gravity
+        cross = np.array([[0.0, -g[2], g[1]], [g[2], 0.0, -g[0]], [-g[1], g[0], 0.0]])
+        return (joints, bodies, model.body_subtreemass[bodies].copy(), cross, model.jnt_stiffness[joints].copy(),
+                model.qpos_spring[self.arm_qpos].copy())
+
     def _rigid(self, q, qd, qdd, q_motor=None) -> tuple[np.ndarray, np.ndarray]:
         """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``
         (arm at ``q``, rotors at ``G q_motor``, ``q_motor = q`` by default)."""

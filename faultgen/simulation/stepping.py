@@ -804,6 +804,13 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     # the stepped effects that scale the dry friction and those that add to it, sorted once
     factors = [e for e in _stepped(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
     extras = [e for e in _stepped(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
+    if extras:  # the static load from the last step's kinematics, for those that ask for it
+        kinematics = [batch.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
+        batch.forward()  # the start state's, for the first step
+
+        def static_load() -> np.ndarray:
+            return robot.static_load_of(*kinematics, qpos)
+
     for step in range(n_steps):
         level = dry
         for effect in factors:
@@ -812,7 +819,7 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
         if extras:  # the gearbox deflection (eq. 6.2a) carries the load
             deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
             for effect in extras:
-                frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection)
+                frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
         logged = (step + 1) % per_log == 0
