@@ -336,20 +336,21 @@ class Robot:
         model, data = self._inverse
         G = self.gear_ratio
         q_motor = q if q_motor is None else q_motor
-        tau = np.empty_like(q)
-        load = np.empty_like(q)
-        for k in range(q.shape[0]):
-            data.qpos[self.arm_qpos] = q[k]
-            data.qpos[self.rotor_qpos] = G * q_motor[k]
-            data.qvel[self.arm_dof] = qd[k]
-            data.qvel[self.rotor_dof] = G * qd[k]
-            data.qacc[self.arm_dof] = qdd[k]
-            data.qacc[self.rotor_dof] = G * qdd[k]
+        n = q.shape[0]
+        # whole states first, so the loop only copies rows (the per-sample indexing cost more
+        # than mj_inverse itself)
+        qpos, qvel, qacc = (np.tile(x, (n, 1)) for x in (data.qpos, data.qvel, data.qacc))
+        qpos[:, self.arm_qpos], qpos[:, self.rotor_qpos] = q, G * q_motor
+        qvel[:, self.arm_dof], qvel[:, self.rotor_dof] = qd, G * qd
+        qacc[:, self.arm_dof], qacc[:, self.rotor_dof] = qdd, G * qdd
+        force = np.empty((n, model.nv))
+        for k in range(n):
+            data.qpos[:], data.qvel[:], data.qacc[:] = qpos[k], qvel[k], qacc[k]
             mujoco.mj_inverse(model, data)
-            # The rigid gearbox carries the rotor's generalized force to the arm through G.
-            load[k] = data.qfrc_inverse[self.arm_dof]
-            tau[k] = load[k] + G * data.qfrc_inverse[self.rotor_dof]
-        return tau, load
+            force[k] = data.qfrc_inverse
+        # The rigid gearbox carries the rotor's generalized force to the arm through G.
+        load = force[:, self.arm_dof]
+        return load + G * force[:, self.rotor_dof], load
 
     def arm_mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """The arm's joint-space inertia matrix (rotor spin excluded), kg m^2, shape (n, 6, 6).
@@ -365,16 +366,16 @@ class Robot:
         """
         q = _check_trajectory("q", q)
         model, data = self._inverse
-        full = np.zeros((model.nv, model.nv))
-        out = np.empty((q.shape[0], N_AXES, N_AXES))
-        block = np.ix_(self.arm_dof, self.arm_dof)
+        qpos = np.tile(data.qpos, (q.shape[0], 1))
+        qpos[:, self.arm_qpos], qpos[:, self.rotor_qpos] = q, self.gear_ratio * q
+        full = np.zeros((q.shape[0], model.nv, model.nv))
         for k in range(q.shape[0]):
-            data.qpos[self.arm_qpos] = q[k]
-            data.qpos[self.rotor_qpos] = self.gear_ratio * q[k]
-            mujoco.mj_fwdPosition(model, data)
-            mujoco.mj_fullM(model, data, full)
-            out[k] = full[block]
-        return out
+            data.qpos[:] = qpos[k]
+            mujoco.mj_kinematics(model, data)  # the stages the mass matrix needs, not all of mj_fwdPosition
+            mujoco.mj_comPos(model, data)
+            mujoco.mj_makeM(model, data)
+            mujoco.mj_fullM(model, data, full[k])
+        return full[np.ix_(np.arange(q.shape[0]), self.arm_dof, self.arm_dof)]
 
     def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None
                       ) -> np.ndarray:
