@@ -5,7 +5,9 @@ effects added in forms faultgen does not use itself (tests/independent_set.py); 
 the CSV and the robot name only. The whole set (28 logs) is a benchmark,
 ``python benchmarks/calibration_independent.py`` (docs/calibration.md); these four cover a null
 log, a payload with its centre of mass off the flange and inertia on the other robot, a
-Stribeck hump with an exponent other than 2, and friction growing with the gravity load.
+Stribeck hump with an exponent other than 2, and a payload with friction growing with the
+transmitted load (the load friction grows with the payload's share of the load: the payload's
+mass within 3 % only when its regressors carry that, docs/calibration.md).
 """
 
 import independent_set
@@ -17,7 +19,7 @@ from faultgen import robots
 from faultgen.calibrate import calibrate
 from faultgen.effects.payload import Payload
 
-FAST = ["puma560-01-none", "irb6700-03-payload", "puma560-07-stribeck_exponent", "puma560-09-load_gravity"]
+FAST = ["puma560-01-none", "irb6700-03-payload", "puma560-07-stribeck_exponent", "puma560-14-load_total+payload"]
 
 
 @pytest.mark.parametrize("name", FAST)
