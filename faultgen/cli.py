@@ -287,9 +287,9 @@ def calibrate_command(
 
     Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
     friction), stribeck (low-speed friction hump), load_dependent_friction (friction growing with
-    the gearbox load), temperature (friction drifting with time, warm-up), payload (mass, centre
-    of mass and inertia at the flange), cogging (torque periodic in the motor angle), backlash
-    (gearbox dead band in the flexible-gearbox equation). Every fitted parameter is reported with
+    the gearbox load: the transmitted torque or the gravity load), temperature (friction drifting
+    with time, warm-up), payload (mass, centre of mass and inertia at the flange), cogging (torque
+    periodic in the motor angle), backlash (gearbox dead band in the flexible-gearbox equation). Every fitted parameter is reported with
     its standard error.
 
     Writes into OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`)
