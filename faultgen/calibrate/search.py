@@ -258,6 +258,81 @@ def _fit(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray,
     return params, contribution
 
 
+@dataclass(frozen=True)
+class JointFit:
+    """An effect fitted on one axis together with changes of the level effects already there
+    (:func:`fit_jointly`): absolute parameters of each, and the held-out nrmse gain that the
+    effect adds beyond re-fitting those levels alone."""
+
+    params: dict[str, float]
+    others: list[dict[str, float]]
+    gain: float
+    relative_gain: float
+    #: Jackknife standard errors (as :func:`standard_errors`): the effect's, then each other's.
+    standard_errors: list[dict[str, float]]
+
+
+def fit_jointly(effect: Effect, others: list[Effect], motion: Motion, residual: np.ndarray, tau: np.ndarray,
+                split: Split, axis: int) -> JointFit | None:
+    """``effect`` on ``axis`` (0-based) fitted to ``residual`` (n, 6) on the fitting part at every
+    value of its grid, together with a change of each of ``others``: effects the model already
+    holds on that axis whose parameters are linear (grid ``[None]``: a torque offset, a Coulomb
+    or viscous level), re-opened because an earlier fit of them, made while ``effect`` was
+    missing, took up part of it (a Coulomb level fitted during a warm-up takes up its early excess).
+    The gain counted is the held-out nrmse drop beyond what re-fitting ``others`` alone gives, so
+    ``effect`` earns it. None when that gain is not significant (:data:`MIN_GAIN`,
+    :data:`MIN_RELATIVE_GAIN`) or a fit is not physical."""
+    held, rows = split.held_out[:, axis], split.fit[:, axis]
+    r = residual[:, axis]
+    scale = _rms(tau, split.held_out)[axis] or 1.0
+    before = float(np.sqrt(np.mean(r[held] ** 2)) / scale) if held.any() else 0.0
+    parts = [other.columns(motion, axis, None) for other in others]
+    known = np.column_stack([phi for phi, _ in parts])
+    known_offset = np.sum([offset for _, offset in parts], axis=0)
+    sizes = np.cumsum([0] + [phi.shape[1] for phi, _ in parts])
+
+    def after(design, offset, theta):
+        return float(np.sqrt(np.mean((r[held] - design[held] @ theta - offset[held]) ** 2)) / scale)
+
+    alone = _lstsq(known[rows], (r - known_offset)[rows])
+    reopened = after(known, known_offset, alone)
+    grid = []  # (h, design, known part) per grid value
+    for h in effect.grid(motion, axis):
+        phi, offset = effect.columns(motion, axis, h)
+        grid.append((h, np.column_stack([known, phi]), known_offset + offset))
+
+    def fit(keep):  # the best grid value on the samples of keep: (h, theta, design, known part)
+        fits = [(h, _lstsq(design[keep], (r - total)[keep]), design, total) for h, design, total in grid]
+        return min(fits, key=lambda f: float(np.sum((r[keep] - f[2][keep] @ f[1] - f[3][keep]) ** 2)))
+
+    def named(h, theta):
+        return [effect.params(motion, axis, theta[sizes[-1]:], h)] + [
+            other.params(motion, axis, theta[a:b], None) for other, a, b in zip(others, sizes, sizes[1:])]
+
+    h, theta, design, total = fit(rows)
+    error = after(design, total, theta)
+    fitted = named(h, theta)
+    gain = reopened - error
+    relative = gain / before if before > 0 else 0.0
+    physical = _physical(effect, motion, axis, fitted[0]) and all(
+        other.admissible(motion, axis, p) for other, p in zip(others, fitted[1:], strict=True))
+    if gain < MIN_GAIN or relative < MIN_RELATIVE_GAIN or not physical:
+        return None
+    # delete-one-block jackknife over the fitting part, the grid value chosen again in each
+    replicates = []
+    for block in np.array_split(np.flatnonzero(rows), JACKKNIFE_BLOCKS):
+        keep = rows.copy()
+        keep[block] = False
+        replicate = fit(keep)
+        replicates.append(named(replicate[0], replicate[1]))
+    errors = []
+    for k, values in enumerate(fitted):
+        table = np.array([[rep[k][name] for name in values] for rep in replicates], dtype=float)
+        spread = np.sqrt((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * np.sum((table - table.mean(axis=0)) ** 2, axis=0))
+        errors.append({name: float(v) for name, v in zip(values, spread, strict=True)})
+    return JointFit(fitted[0], fitted[1:], gain, relative, errors)
+
+
 def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split,
                     axes: list[int], blocks: int = JACKKNIFE_BLOCKS) -> dict:
     """Standard errors of ``effect``'s fitted parameters on ``axes`` (0-based), by the delete-one-
