@@ -155,3 +155,34 @@ def test_jackknife_standard_error_sees_noise_correlated_in_time(puma):
     split = search.Split.of(motion.t, motion.qd)
     error = search.standard_errors(effect, motion, residual, tau, split, [2])[2]["viscous"]
     assert error > 3 * _least_squares_error(phi[:, 0], noise, split.fit[:, 2])
+
+
+def test_warm_up_hidden_by_a_coulomb_level_is_found_jointly_with_it(puma):
+    """A warm-up on axis 2 whose early excess a Coulomb level fitted before it took up: the warm-up
+    alone then fits the held-out part worse than nothing; fitted together with a change of that
+    level it comes back, and the level returns to where it was."""
+    _, motion, tau = puma
+    axis, amplitude, time_constant = 1, 0.5, 25.0
+    temperature, coulomb = effects.get("temperature"), effects.get("coulomb")
+    warm_up = temperature.columns(motion, axis, time_constant)[0][:, 0] * amplitude
+    split = search.Split.of(motion.t, motion.qd)
+    rng = np.random.default_rng(5)
+    residual = rng.normal(scale=0.01 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
+    residual[:, axis] += warm_up
+    # the level a Coulomb fit made of it on the fitting part, taken out as the model would have it
+    level = coulomb.columns(motion, axis, None)[0][:, :1]
+    taken = np.linalg.lstsq(level[split.fit[:, axis]], residual[split.fit[:, axis], axis], rcond=None)[0]
+    residual[:, axis] -= level @ taken
+    alone = search.fit_effect(temperature, motion, residual, tau, split)
+    assert axis not in alone.axes and alone.gain[axis] < search.MIN_GAIN
+
+    found = search.fit_jointly(temperature, [coulomb], motion, residual, tau, split, axis)
+    assert found is not None and found.gain >= search.MIN_GAIN
+    assert found.params["amplitude"] == pytest.approx(amplitude, rel=0.1)
+    assert found.params["time_constant"] == pytest.approx(time_constant, rel=0.3)  # on the search grid
+    nominal = motion.robot.friction.coulomb_neg[axis]
+    assert found.others[0]["coulomb_neg"] - nominal == pytest.approx(-taken[0], rel=0.1)
+    assert set(found.standard_errors[0]) == {"amplitude", "time_constant"}
+    # noise alone on that axis gives nothing
+    quiet = rng.normal(scale=0.01 * np.sqrt(np.mean(tau**2, axis=0)), size=tau.shape)
+    assert search.fit_jointly(temperature, [coulomb], motion, quiet, tau, split, axis) is None
