@@ -325,11 +325,7 @@ def fit_jointly(effect: Effect, others: list[Effect], motion: Motion, residual: 
         keep[block] = False
         replicate = fit(keep)
         replicates.append(named(replicate[0], replicate[1]))
-    errors = []
-    for k, values in enumerate(fitted):
-        table = np.array([[rep[k][name] for name in values] for rep in replicates], dtype=float)
-        spread = np.sqrt((JACKKNIFE_BLOCKS - 1) / JACKKNIFE_BLOCKS * np.sum((table - table.mean(axis=0)) ** 2, axis=0))
-        errors.append({name: float(v) for name, v in zip(values, spread, strict=True)})
+    errors = [_jackknife([rep[k] for rep in replicates]) for k in range(len(fitted))]
     return JointFit(fitted[0], fitted[1:], gain, relative, errors)
 
 
@@ -359,12 +355,17 @@ def standard_errors(effect: Effect, motion: Motion, residual: np.ndarray, tau: n
         rows[low:high] = False
         replicates.append(_fit(effect, motion, residual, rows, scale, near=axes)[0])
     keys = [None] if not effect.per_axis else axes
-    errors = {}
-    for key in keys:
-        values = np.array([[r[key][name] for name in replicates[0][key]] for r in replicates], dtype=float)
-        spread = np.sqrt((blocks - 1) / blocks * np.sum((values - values.mean(axis=0)) ** 2, axis=0))
-        errors[key] = {name: float(v) for name, v in zip(replicates[0][key], spread, strict=True)}
-    return errors
+    return {key: _jackknife([r[key] for r in replicates]) for key in keys}
+
+
+def _jackknife(replicates: list[dict[str, float]]) -> dict[str, float]:
+    """Delete-one-block jackknife standard error of each parameter from its B replicate values:
+    ``sqrt((B - 1) / B * sum (p_b - mean p)^2)``."""
+    names = list(replicates[0])
+    values = np.array([[r[name] for name in names] for r in replicates], dtype=float)
+    b = len(replicates)
+    spread = np.sqrt((b - 1) / b * np.sum((values - values.mean(axis=0)) ** 2, axis=0))
+    return {name: float(v) for name, v in zip(names, spread, strict=True)}
 
 
 def _physical(effect: Effect, motion: Motion, axis: int, params: dict[str, float]) -> bool:
