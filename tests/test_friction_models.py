@@ -78,6 +78,9 @@ def test_friction_at_constant_speed_follows_eq_6_3(name, model_name):
 
 @pytest.mark.parametrize("model_name", friction.MODELS)
 def test_breakaway_under_slowly_rising_torque_is_coulomb_plus_static(model_name):
+    """The breakaway torque, the largest friction torque the rotor takes as the applied torque
+    rises slowly past it, is f_c + f_s. (LuGre creeps before it breaks away: its presliding speed
+    is the torque rate / (sigma_0 (1 - F / F_s)), so a speed threshold would find it early.)"""
     robot = robots.load("irb6700")
     model = rig(robot, model_name)
     data = mujoco.MjData(model)
@@ -85,22 +88,21 @@ def test_breakaway_under_slowly_rising_torque_is_coulomb_plus_static(model_name)
     breakaway = f.coulomb_pos + f.static
     duration = 20.0  # s: reach 1.5 times the breakaway level, slowly
     rate = 1.5 * breakaway / duration
-    found = np.full(6, np.nan)
+    largest = np.zeros(6)
     for k in range(int(duration / TIMESTEP)):
         data.qfrc_applied[:] = rate * k * TIMESTEP
         step(model, data, robot, model_name)
-        moving = np.isnan(found) & (data.qvel > 0.01 * f.stribeck_velocity)
-        # the torque friction takes: the applied one less the drive's damping (lugre rig only)
-        drive = model.dof_damping * data.qvel if model_name == "lugre" else 0.0
-        found[moving] = (data.qfrc_applied - drive)[moving]
-    print(model_name, "breakaway / (f_c + f_s):", found / breakaway)
-    np.testing.assert_allclose(found, breakaway, rtol=0.05)
+        mujoco.mj_forward(model, data)
+        largest = np.maximum(largest, rig_friction(model, data, robot, model_name) - f.viscous * data.qvel)
+    assert np.all(data.qvel > 0.05 * f.stribeck_velocity)  # every rotor broke away (lugre rig: damped by kd)
+    print(model_name, "breakaway / (f_c + f_s):", largest / breakaway)
+    np.testing.assert_allclose(largest, breakaway, rtol=0.01)
 
 
 def test_lugre_holds_a_torque_below_breakaway_on_its_bristles():
     """Under 10 % of the breakaway torque the rotor comes to rest held by its bristles,
-    sigma_0 z = F; its displacement is F / sigma_0 plus what it slipped on the way (1.05-1.32 at
-    0.5 ms, 1.05-1.28 at a 0.0625 ms step: the approach is damped only by the drive, sigma_1 = 0)."""
+    sigma_0 z = F; its displacement is F / sigma_0 plus what it slipped on the way (1.05-1.19 at
+    0.5 ms, 1.05-1.19 at a 0.0625 ms step: the approach is damped only by the drive, sigma_1 = 0)."""
     robot = robots.load("irb6700")
     model = rig(robot, "lugre")
     data = mujoco.MjData(model)
@@ -114,7 +116,7 @@ def test_lugre_holds_a_torque_below_breakaway_on_its_bristles():
     np.testing.assert_allclose(rig_friction(model, data, robot, "lugre"), force, rtol=1e-3)
     print("presliding displacement / (F / sigma_0):", data.qpos / (force / f.bristle_stiffness))
     assert np.all(data.qpos >= force / f.bristle_stiffness)
-    assert np.all(data.qpos < 1.4 * force / f.bristle_stiffness)
+    assert np.all(data.qpos < 1.25 * force / f.bristle_stiffness)
 
 
 def test_static_model_sticks_below_breakaway():
@@ -132,4 +134,4 @@ def test_lugre_needs_gamma_2():
     rows = robot.friction.as_rows()
     rows[2, friction.FIELDS.index("stribeck_exponent")] = 1.5
     with pytest.raises(ValueError, match="axis 3: stribeck_exponent = 1.5"):
-        friction.lugre_parameters(friction.MotorFriction.from_rows(rows))
+        friction.lugre_parameters(friction.MotorFriction.from_rows(rows), 0.0005)

@@ -164,14 +164,24 @@ def check_model(name: str) -> str:
     return name
 
 
-def lugre_parameters(friction: MotorFriction) -> np.ndarray:
+def lugre_parameters(friction: MotorFriction, timestep: float) -> np.ndarray:
     """MuJoCo ``dcmotor`` ``lugre`` attribute per axis, ``ndarray of shape (n_axes, 5)``.
 
-    Columns: bristle stiffness sigma_0 (N m/rad), bristle damping sigma_1 (N m s/rad), Coulomb
-    level F_c (N m), breakaway level F_s = F_c + f_s (N m) and Stribeck velocity (rad/s). MuJoCo's
-    LuGre is direction-symmetric with a Gaussian Stribeck curve: its steady state is
+    Columns: bristle stiffness sigma_0 (N m/rad), MuJoCo's damping slot (N m s/rad, see below),
+    Coulomb level F_c (N m), breakaway level F_s = F_c + f_s (N m) and Stribeck velocity (rad/s).
+    MuJoCo's LuGre is direction-symmetric with a Gaussian Stribeck curve: its steady state is
     F_c + (F_s - F_c) exp(-(v / v_s)^2), thesis eq. 6.3 with gamma = 2 (checked in
     tests/test_friction_models.py). The Coulomb level is the mean of the two directions.
+
+    The damping slot is not the model's bristle damping (which must be 0,
+    :func:`check_lugre_step`) but ``sigma_0 h / 2`` for the physics step ``timestep`` = h: MuJoCo
+    applies ``-sigma_0 z - sigma_1 dz/dt`` with the bristle state z and its rate at the start of
+    the step, so this makes the force ``-sigma_0 (z + h/2 dz/dt)``, the bristle force at the
+    step's midpoint. In presliding (dz/dt = v) it is the midpoint rule, whose error is second
+    order in h where the start-of-step force's is first order; in sliding dz/dt is about 0 and
+    the force is the steady state. Its side effect, the implicit step's ``h sigma_1`` of rotor
+    inertia (see :func:`check_lugre_step`), is ``sigma_0 h^2 / 2``: second order too, 0.03-0.09 %
+    of the robots' rotor inertias at 0.5 ms (0.32 % on the PUMA 560's axis 1). docs/simulation.md, "Numerical convergence".
 
     Raises
     ------
@@ -187,7 +197,7 @@ def lugre_parameters(friction: MotorFriction) -> np.ndarray:
         )
     coulomb = (friction.coulomb_pos + friction.coulomb_neg) / 2
     return np.stack(
-        [friction.bristle_stiffness, friction.bristle_damping, coulomb, coulomb + friction.static,
+        [friction.bristle_stiffness, friction.bristle_stiffness * timestep / 2, coulomb, coulomb + friction.static,
          friction.stribeck_velocity],
         axis=1,
     )
@@ -207,9 +217,11 @@ def check_lugre_step(friction: MotorFriction, timestep: float, speed_damping: np
       is 0 and the presliding mode is damped by the drive's speed loop and viscous friction;
     * ``sigma_0 h < kd + f_v``: the bristle state is advanced with the speed at the start of the
       step, so at rest the rotor on its bristles is an explicit (forward-Euler) oscillator whose
-      energy grows by ``(1 + h^2 sigma_0 / Jm)`` per step unless the implicit damping removes more.
-      Inside the bound it is stable, not yet accurate: the robots' 40 mrad presliding deflection
-      keeps ``sigma_0 h`` at 1.5-14 % of ``kd + f_v`` (robots/<robot>/README.md).
+      energy grows by ``(1 + h^2 sigma_0 / Jm)`` per step unless the implicit damping removes more
+      (the drive's kd, f_v and the midpoint term ``sigma_0 h / 2`` of :func:`lugre_parameters`:
+      with it, ``sigma_0 h < 2 (kd + f_v)`` would do; the bound keeps a factor 2 in hand). Inside
+      the bound it is stable, not yet accurate: the robots' 80 mrad presliding deflection keeps
+      ``sigma_0 h`` at 0.7-6.9 % of ``kd + f_v`` (robots/<robot>/README.md).
 
     Parameters
     ----------
@@ -248,7 +260,7 @@ def add_lugre(spec, robot) -> None:
     f_v as the actuator's damping. The bristle deflection is its activation state, integrated by
     MuJoCo at the physics rate. Wear scales ``actuator_biasprm[:, 3:5]`` (F_c and F_s).
     """
-    table = lugre_parameters(robot.friction)
+    table = lugre_parameters(robot.friction, spec.option.timestep)
     for k, rotor in enumerate(robot.rotor_names):
         actuator = add_passive_dcmotor(spec, f"lugre{k + 1}", rotor, lugre=[float(v) for v in table[k]])
         actuator.damping[0] = float(robot.friction.viscous[k])
