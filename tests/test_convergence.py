@@ -52,9 +52,9 @@ def test_lugre_refuses_bristle_damping_and_too_stiff_bristles():
     damped = friction.MotorFriction.from_rows(rows)
     with pytest.raises(ValueError, match="axis 3: bristle_damping = 6.2 N m s/rad; the lugre model needs 0"):
         friction.check_lugre_step(damped, H, np.full(6, 1.0))
-    with pytest.raises(ValueError, match=r"axis 1: bristle_stiffness = 12.5 N m/rad is too stiff for the 0.5 ms"):
-        friction.check_lugre_step(robot.friction, H, np.full(6, 0.002))  # 12.5 * 0.5 ms > 0.002 + 3e-3
-    friction.check_lugre_step(robot.friction, H, np.full(6, 0.02))  # 12.5 N m/rad * 0.5 ms < 0.02 + 1e-3
+    with pytest.raises(ValueError, match=r"axis 1: bristle_stiffness = 10.0 N m/rad is too stiff for the 0.5 ms"):
+        friction.check_lugre_step(robot.friction, H, np.full(6, 0.001))  # 10 * 0.5 ms > 0.001 + 3e-3
+    friction.check_lugre_step(robot.friction, H, np.full(6, 0.02))  # 10 N m/rad * 0.5 ms < 0.02 + 1e-3
 
 
 def cycle_features(robot: str, friction_model: str, timestep: float, folder) -> dict[str, np.ndarray]:

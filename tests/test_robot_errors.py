@@ -83,7 +83,9 @@ def test_negative_friction_parameter_names_axis_and_field(tmp_path):
 
 def test_friction_numeric_of_wrong_length_is_refused(tmp_path):
     path = copy_robot(tmp_path)
-    text = path.read_text().replace('data="0.126 0.071 0.020 0.5 2 0.817e-3 2.462 0"', 'data="0.126"')
+    original = path.read_text()
+    text = original.replace('data="0.126 0.071 0.020 0.5 2 0.817e-3 0.985 0"', 'data="0.126"')
+    assert text != original
     path.write_text(text)
     with pytest.raises(robots.ModelError, match="friction2.*1 values, expected 8"):
         robots.load(path)

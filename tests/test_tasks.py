@@ -215,11 +215,18 @@ def test_the_same_call_gives_bit_identical_arrays(cycles, robot, name):
     assert path.segments == again.segments
 
 
-def test_a_finer_step_gives_the_same_cycle(cycles):
-    task, coarse = cycles["puma560", "spot_weld"]
-    fine = task.trajectory(0.001)
-    # every move is rounded up to whole steps: at most one coarse step longer per move
-    assert abs(fine.duration - coarse.duration) <= len(coarse.segments) * DT
+@pytest.mark.parametrize("robot,name", CASES)
+def test_a_finer_step_samples_the_same_path(cycles, robot, name):
+    """Every segment lasts whole 4 ms planning periods, so a finer step gives the same path at
+    more instants: the physics step must not change the cycle (a convergence study refines the
+    step and compares; docs/simulation.md)."""
+    task, coarse = cycles[robot, name]
+    fine = task.trajectory(DT / 8)
+    assert fine.duration == pytest.approx(coarse.duration, abs=1e-12)
+    assert [(label, 8 * a, 8 * b) for label, a, b in coarse.segments] == list(fine.segments)
+    for field in ("q", "qd", "qdd"):
+        np.testing.assert_allclose(getattr(fine, field)[::8], getattr(coarse, field), rtol=0, atol=1e-9,
+                                   err_msg=field)
     np.testing.assert_array_equal(fine.q[-1], task.start)
 
 
@@ -237,6 +244,8 @@ def test_bad_time_step_is_refused(cycles):
     for dt in (0.0, -0.004, float("nan")):
         with pytest.raises(ValueError, match="dt"):
             task.trajectory(dt)
+    with pytest.raises(ValueError, match=r"dt = 0.003 s does not divide the 4 ms planning period"):
+        task.trajectory(0.003)
 
 
 def copy_robot_folder(tmp_path, name):

@@ -180,8 +180,8 @@ def lugre_parameters(friction: MotorFriction, timestep: float) -> np.ndarray:
     step's midpoint. In presliding (dz/dt = v) it is the midpoint rule, whose error is second
     order in h where the start-of-step force's is first order; in sliding dz/dt is about 0 and
     the force is the steady state. Its side effect, the implicit step's ``h sigma_1`` of rotor
-    inertia (see :func:`check_lugre_step`), is ``sigma_0 h^2 / 2``: second order too, 0.03-0.09 %
-    of the robots' rotor inertias at 0.5 ms (0.32 % on the PUMA 560's axis 1). docs/simulation.md, "Numerical convergence".
+    inertia (see :func:`check_lugre_step`), is ``sigma_0 h^2 / 2``: second order too, 0.02-0.07 %
+    of the robots' rotor inertias at 0.5 ms (0.26 % on the PUMA 560's axis 1). docs/simulation.md, "Numerical convergence".
 
     Raises
     ------
@@ -220,8 +220,8 @@ def check_lugre_step(friction: MotorFriction, timestep: float, speed_damping: np
       energy grows by ``(1 + h^2 sigma_0 / Jm)`` per step unless the implicit damping removes more
       (the drive's kd, f_v and the midpoint term ``sigma_0 h / 2`` of :func:`lugre_parameters`:
       with it, ``sigma_0 h < 2 (kd + f_v)`` would do; the bound keeps a factor 2 in hand). Inside
-      the bound it is stable, not yet accurate: the robots' 80 mrad presliding deflection keeps
-      ``sigma_0 h`` at 0.7-6.9 % of ``kd + f_v`` (robots/<robot>/README.md).
+      the bound it is stable, not yet accurate: the robots' 100 mrad presliding deflection keeps
+      ``sigma_0 h`` at 0.6-5.5 % of ``kd + f_v`` (robots/<robot>/README.md).
 
     Parameters
     ----------

@@ -8,12 +8,16 @@ and :func:`load` reads them into a :class:`Task`, whose :meth:`Task.trajectory` 
 :class:`JointPath`:
 
 - point-to-point moves: ruckig (jerk-limited, time-optimal, rest to rest, all axes finishing
-  together, duration a whole number of steps);
+  together, duration a whole number of planning periods, :data:`PLAN_PERIOD`);
 - weld points and seam: flange IK with mink on an arm-only model (:mod:`faultgen.ik`);
 - the seam: IK every 10 ms along the tool path, a clamped cubic spline through the solutions
   sampled at dt, its derivatives giving qd and qdd.
 
-Every cycle starts and ends at the task's ``start`` angles at rest, so cycles repeat.
+Every cycle starts and ends at the task's ``start`` angles at rest, so cycles repeat. Every
+segment lasts whole planning periods, so the path is one continuous function of time, whatever
+step ``dt`` samples it (the physics step or the 4 ms log period): a finer physics step refines
+the simulation of the same cycle, not a different cycle (docs/simulation.md, "Numerical
+convergence").
 """
 
 from __future__ import annotations
@@ -33,6 +37,9 @@ from faultgen.operation.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
 TASKS = ("pick_place", "spot_weld", "arc_weld")
 PROCESSES = {"pick_place": "point-to-point", "spot_weld": "discontinuous", "arc_weld": "continuous"}
 IK_STEP = 0.01  # s: knot step of the seam IK; the spline interpolates in between
+#: s: every move, dwell and seam lasts a whole number of these (the thesis's 4 ms sampling period,
+#: ch. 6.3.2), so a path sampled at any step that divides it is the same path.
+PLAN_PERIOD = 0.004
 SEAM_TOLERANCE = 5e-4  # m: largest allowed flange distance from the commanded seam point
 SEAM_LIMIT_TOLERANCE = 0.01  # relative excess over a velocity/acceleration limit allowed on the seam
 LIMIT_TOLERANCE = 1e-9  # relative (velocity, acceleration) and rad (position) elsewhere
@@ -111,7 +118,9 @@ class Task:
         Parameters
         ----------
         dt : float
-            Time step in s, e.g. 0.004 (the thesis's sampling) or the 0.0005 simulation step.
+            Time step in s that divides :data:`PLAN_PERIOD` (4 ms) into whole steps, e.g. 0.004
+            (the thesis's sampling) or the 0.0005 simulation step. The path does not depend on
+            it: a finer ``dt`` gives the same path at more instants.
 
         Returns
         -------
@@ -121,11 +130,15 @@ class Task:
         Raises
         ------
         ValueError
-            If ``dt`` is not positive, IK fails, the flange leaves the seam by more than 0.5 mm,
-            or the path breaks a joint range, velocity or acceleration limit.
+            If ``dt`` is not a positive step that divides 4 ms, IK fails, the flange leaves the
+            seam by more than 0.5 mm, or the path breaks a joint range, velocity or acceleration
+            limit.
         """
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be a positive number of seconds, got {dt!r}")
+        if abs(PLAN_PERIOD / dt - round(PLAN_PERIOD / dt)) > 1e-9:
+            raise ValueError(f"dt = {dt!r} s does not divide the {PLAN_PERIOD * 1e3:g} ms planning period into whole "
+                             "steps; expected e.g. 0.004, 0.002, 0.001 or 0.0005")
         path = _Builder(self.start, float(dt))
         self._plan(path)
         result = path.build()
@@ -138,7 +151,7 @@ class Task:
 
     def _move(self, path: _Builder, label: str, q_to: np.ndarray) -> None:
         """Append a ruckig rest-to-rest move from the path's last sample to ``q_to``."""
-        otg = Ruckig(N_AXES, path.dt)
+        otg = Ruckig(N_AXES, PLAN_PERIOD)
         inp = InputParameter(N_AXES)
         inp.current_position, inp.target_position = path.last, q_to
         inp.current_velocity = inp.current_acceleration = np.zeros(N_AXES)
@@ -220,7 +233,8 @@ class ArcWeldTask(Task):
 
     The seam is a polyline with corners rounded to ``corner_radius``. The tool speeds up from
     rest to ``tool_speed`` in ``ramp_time`` (raised-cosine acceleration; the ramp is lengthened
-    by less than dt so the seam lasts whole steps), keeps that speed and stops at the seam end.
+    by less than :data:`PLAN_PERIOD` so the seam lasts whole planning periods), keeps that speed
+    and stops at the seam end.
     The weave ``weave_amplitude * sin(pi m s / L)`` runs across the seam in its plane, with s
     the arc length, L the seam length and m the whole number of half periods nearest to
     ``2 weave_frequency L / tool_speed``: the weave starts and ends on the seam and, at
@@ -259,14 +273,15 @@ class ArcWeldTask(Task):
         """The seam polyline with rounded corners."""
         return Seam(self.seam, self.corner_radius, self.tool_rotation[:, 2])
 
-    def seam_duration(self, dt: float) -> float:
-        """Seam time in s: ``L / tool_speed + ramp_time`` rounded up to whole steps of ``dt``."""
-        return math.ceil((self.geometry().length / self.tool_speed + self.ramp_time) / dt - 1e-9) * dt
+    def seam_duration(self) -> float:
+        """Seam time in s: ``L / tool_speed + ramp_time`` rounded up to whole :data:`PLAN_PERIOD`."""
+        periods = math.ceil((self.geometry().length / self.tool_speed + self.ramp_time) / PLAN_PERIOD - 1e-9)
+        return periods * PLAN_PERIOD
 
-    def tool_path(self, t: np.ndarray, dt: float) -> np.ndarray:
+    def tool_path(self, t: np.ndarray) -> np.ndarray:
         """Commanded flange positions, shape (n, 3) in m, at times t (n,) in s since the seam start."""
         seam = self.geometry()
-        duration = self.seam_duration(dt)
+        duration = self.seam_duration()
         ramp = duration - seam.length / self.tool_speed
         s = ramp_arc_length(t, self.tool_speed, ramp, duration)
         position, tangent = seam.evaluate(s)
@@ -277,9 +292,9 @@ class ArcWeldTask(Task):
     def _plan(self, path):
         ik = FlangeIK(self.robot, self.start)
         rotation, back = self.tool_rotation, -self.standoff * self.tool_rotation[:, 2]
-        duration = self.seam_duration(path.dt)
+        duration = self.seam_duration()
         knots = np.linspace(0.0, duration, math.ceil(duration / IK_STEP - 1e-9) + 1)
-        points = self.tool_path(knots, path.dt)
+        points = self.tool_path(knots)
         q_above = self._solve(ik, "approach point", points[0] + back, rotation, self.start)
         q_seam = self._solve(ik, "seam start", points[0], rotation, q_above)
         self._move(path, "approach", q_above)
@@ -290,7 +305,7 @@ class ArcWeldTask(Task):
             q, qd, qdd = ik.follow(knots, points, rotation, q_seam, t)
         except ValueError as err:
             raise ValueError(f"{self.robot_name} {self.name}, seam: {err}") from err
-        target = self.tool_path(t, path.dt)
+        target = self.tool_path(t)
         self._check_seam(ik.deviation(q, target), qd, qdd, path.count - 1, path.dt)
         path.add("seam", q, qd, qdd, target=target, tolerance=SEAM_LIMIT_TOLERANCE)
 
@@ -351,7 +366,7 @@ class _Builder:
         self.count += steps
 
     def hold(self, label: str, duration: float, target: np.ndarray | None = None) -> None:
-        steps = round(duration / self.dt)
+        steps = round(duration / PLAN_PERIOD) * round(PLAN_PERIOD / self.dt)
         q = np.repeat(self.last[None], steps + 1, axis=0)
         zero = np.zeros_like(q)
         self.add(label, q, zero, zero, None if target is None else np.repeat(target[None], steps + 1, axis=0))
