@@ -499,8 +499,7 @@ class _Table:
 
     def __init__(self, path: Path, data: dict, name: str, keys: tuple[str, ...]) -> None:
         if not isinstance(data.get(name), dict):
-            # a file error, not a type error
-            raise ValueError(f"{path}: missing table [{name}]")
+            raise ValueError(f"{path}: missing table [{name}]")  # noqa: TRY004 (a file error, not a type error)
         self.path, self.name, self.data = path, name, data[name]
         for key in self.data:
             if key not in keys:
