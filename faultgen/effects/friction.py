@@ -181,7 +181,8 @@ def lugre_parameters(friction: MotorFriction, timestep: float) -> np.ndarray:
     order in h where the start-of-step force's is first order; in sliding dz/dt is about 0 and
     the force is the steady state. Its side effect, the implicit step's ``h sigma_1`` of rotor
     inertia (see :func:`check_lugre_step`), is ``sigma_0 h^2 / 2``: second order too, 0.02-0.07 %
-    of the robots' rotor inertias at 0.5 ms (0.26 % on the PUMA 560's axis 1). docs/simulation.md, "Numerical convergence".
+    of the robots' rotor inertias at 0.5 ms (0.26 % on the PUMA 560's axis 1).
+    docs/simulation.md, "Numerical convergence", items 1 and 6.
 
     Raises
     ------
