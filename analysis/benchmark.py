@@ -28,6 +28,8 @@ from analysis import isolation
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen import axes
 from faultgen.data import dataset
+from faultgen.model import robots
+from faultgen.simulation import sensors
 
 #: Wear levels of thesis Table 6.2, in percent.
 WEAR_LEVELS = (1.0, 5.0, 10.0, 15.0)
@@ -363,23 +365,25 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     with the false-alarm rate on healthy data the monitor did not learn from.
 
     Features per sample: for each axis, the KL divergence (eq. 5.4) of the 12-bin histogram of
-    |motor torque|, normalised by the largest |motor torque| of the training data (thesis ch. 3.4:
-    "normalized with respect to maximum torque and binned into twelve equal-sized intervals"; a
-    dataset recorded without signals, such as a fleet's daily records, gives its stored histograms,
-    binned to the motor's peak torque),
-    against the run's first sample under same-run (the thesis's), and against the mean histogram
+    |motor torque|, normalised by the largest |motor torque| of the training data rounded up to a
+    whole percent of the peak motor torque (thesis ch. 3.4: "normalized with respect to maximum
+    torque and binned into twelve equal-sized intervals"; :func:`detection_scale`). The bins are
+    formed from each cycle's fine counts (:func:`torque_record`), so a run recorded with signals and
+    the same run recorded without give the same table (daily records, a fleet's, have only their
+    stored 12-bin histograms, binned to the motor's peak torque, and use those). The divergence is
+    taken against the run's first sample under same-run (the thesis's), and against the mean histogram
     of the training samples under the held-out protocols: one noisy first cycle shifts every later
     divergence of its run, which a monitor that learned other runs reads as a fault (j2, three
-    seeds, other-seeds, 95 % limit: 19.1 % false alarms against the first sample, 8.7 % against
-    the training mean). A sample is one recorded cycle, or all the cycles of a
-    ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA monitor (components for
+    seeds, other-seeds, 95 % limit, in-sample: 19.1 % false alarms against the first sample,
+    8.7 % against the training mean, on 2026-11-22's physics). A sample is one recorded cycle, or
+    all the cycles of a ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA monitor (components for
     ``variance`` of the variance, thesis: 75 %; features constant in training are left out) learns
     normal operation as ``protocol`` says (:data:`PROTOCOLS`; ``first`` samples for first-cycles);
     wear is detected at the first sample (after the training ones) whose Q statistic exceeds its
     ``1 - alpha`` limit for ``persistence`` samples in a row. Under the held-out protocols the Q
     limit is estimated out of sample over ``limit_folds`` folds of the training samples
     (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample, eq. 2.6 as in the thesis):
-    j2, three seeds, other-seeds, alpha 5 %: 8.7 % false alarms in-sample, 6.0 % with 20 folds;
+    j2, three seeds, other-seeds, alpha 5 %: 9.0 % false alarms in-sample, 6.2 % with 20 folds;
     same-run always uses the in-sample limit; its location is the axis the
     cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
 
@@ -411,16 +415,12 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         raise ValueError(f"limit_folds = {limit_folds!r}; expected None (the in-sample Q limit) or a number of folds >= 2")
     runs = _runs(path, ("cycles", "friction_multiplier"))
     healthy = [r for r in runs if len(r[2]["worn_axes"]) == 0]
-    torque: dict[str, np.ndarray] = {}
+    torque: dict[str, np.ndarray | StoredHistograms] = {}
 
-    def abs_torque(run_id: str) -> np.ndarray:
-        """|motor torque| of a run, or its stored torque histograms when it has no signals."""
+    def torque_of(run_id: str) -> np.ndarray | StoredHistograms:
+        """A run's per-cycle |motor torque| counts (:func:`torque_record`), read once."""
         if run_id not in torque:
-            labels = next(r[2] for r in runs if r[0] == run_id)
-            if labels.get("signals", True):
-                torque[run_id] = np.abs(dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"])
-            else:
-                torque[run_id] = StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
+            torque[run_id] = torque_record(path, run_id, next(r[2] for r in runs if r[0] == run_id))
         return torque[run_id]
 
     monitors: dict[tuple, tuple] = {}
@@ -444,7 +444,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                 raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {attrs['robot']} "
                                  f"{attrs['task']} with another seed than {attrs['seed']}; this dataset has none. Sweep "
                                  "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
-            training = [(r[0], abs_torque(r[0]), r[1]["cycles"]) for r in others]
+            training = [(r[0], torque_of(r[0]), r[1]["cycles"]) for r in others]
             key, trained_on, heldout, skip = tuple(r[0] for r in others), " ".join(r[0] for r in others), own, 0
         elif used_protocol == "first-cycles":
             if n_samples <= first:
@@ -452,13 +452,13 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
                                  f"needs more; {run_id} has {n_samples}. Record more cycles, or sweep several "
                                  "seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
             keep = np.isin(sample_of, samples[:first])
-            training = [(run_id, abs_torque(run_id)[keep], arrays["cycles"][keep])]
+            training = [(run_id, torque_of(run_id)[keep], arrays["cycles"][keep])]
             key, trained_on, heldout, skip = (run_id, first), f"samples 1-{first} of the run", own, first
         else:  # same-run
             if own is None:
                 raise ValueError(f"{path}: protocol same-run needs the run without wear of {attrs['robot']} "
                                  f"{attrs['task']} seed {attrs['seed']}; this dataset has none")
-            training = [(own[0], abs_torque(own[0]), own[1]["cycles"])]
+            training = [(own[0], torque_of(own[0]), own[1]["cycles"])]
             key, trained_on, heldout, skip = (own[0],), own[0], own, 0
         if key not in monitors:  # one monitor serves every worn run that learns from the same data
             held_out = used_protocol != "same-run"
@@ -467,14 +467,14 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         if used_protocol == "same-run":
             used_protocol = "same-run (in-sample)"
         scale, reference, used, monitor = monitors[key]
-        worn, groups = _kl_features(abs_torque(run_id), arrays["cycles"], scale, period, reference)
+        worn, groups = _kl_features(torque_of(run_id), arrays["cycles"], scale, period, reference)
         alarms = np.asarray(monitor.predict(worn[:, used]), dtype=bool)
         onset = detect_onset(alarms[skip:], persistence=persistence)
         onset = None if onset is None else onset + skip
         if key not in false_alarms:
             false_alarms[key] = np.nan
             if heldout is not None:
-                normal, _ = _kl_features(abs_torque(heldout[0]), heldout[1]["cycles"], scale, period, reference)
+                normal, _ = _kl_features(torque_of(heldout[0]), heldout[1]["cycles"], scale, period, reference)
                 false_alarms[key] = 100.0 * float(np.mean(np.asarray(monitor.predict(normal[:, used]),
                                                                       dtype=bool)[skip:]))
         false_alarm = false_alarms[key]
@@ -518,15 +518,15 @@ def _same_unit_kind(a: dict, b: dict) -> bool:
 
 def _fit_monitor(training: list, period: int | None, variance: float, alpha: float, detector=None,
                  fixed_reference: bool = False, folds: int | None = None):
-    """The torque scale, the KL reference (None: each run's first sample), the features used and
-    the monitor (or ``detector``) fitted on the KL features of ``training``, a list of (run id,
-    |torque| (n_cycles, n_log, 6), cycles). With ``fixed_reference`` the reference is the mean
-    histogram of all training samples, shared by every run the monitor judges; ``folds`` is the
-    PCA monitor's ``cv`` (out-of-sample Q limit)."""
+    """The torque scale (:func:`detection_scale`), the KL reference (None: each run's first
+    sample), the features used and the monitor (or ``detector``) fitted on the KL features of
+    ``training``, a list of (run id, its :func:`torque_record`, cycles). With ``fixed_reference``
+    the reference is the mean histogram of all training samples, shared by every run the monitor
+    judges; ``folds`` is the PCA monitor's ``cv`` (out-of-sample Q limit)."""
     from sklearn.base import clone
 
     stored = [isinstance(t, StoredHistograms) for _, t, _ in training]
-    scale = None if any(stored) else np.max([t.max(axis=(0, 1)) for _, t, _ in training], axis=0)
+    scale = None if any(stored) else detection_scale([t for _, t, _ in training])
     reference = None
     if fixed_reference:
         reference = np.concatenate([_histograms(t, cycles, scale, period)[0] for _, t, cycles in training]).mean(axis=0)
@@ -537,29 +537,76 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
 
 
+def torque_record(path, run_id: str, labels: dict) -> np.ndarray | StoredHistograms:
+    """What detection bins a run's |motor torque| from: its per-cycle counts in fine bins of
+    0 .. peak motor torque (``torque_counts``, (n_cycles, 6, 1200),
+    :func:`faultgen.simulation.sensors.torque_counts`), computed from the stored signals, else
+    read as stored (a run recorded without signals); the two are equal bit for bit for the same
+    run. A run that has neither (a daily record, or a file written before the counts existed)
+    gives its 12-bin ``torque_hist`` (:class:`StoredHistograms`).
+
+    Raises
+    ------
+    faultgen.data.dataset.DatasetError
+        If the run lacks ``tau_m`` though it says it has signals, or lacks ``torque_hist``.
+    """
+    if labels.get("signals", True):
+        tau_m = dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"]
+        return sensors.torque_counts(tau_m, robots.load(labels["robot"]).motor_torque_limit)
+    try:
+        return dataset.read_run(path, run_id, names=("torque_counts",))[0]["torque_counts"]
+    except dataset.DatasetError:  # no counts: the stored 12-bin histograms are all there is
+        return StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
+
+
+def detection_scale(counts: list[np.ndarray]) -> np.ndarray:
+    """The range of detection's 12 torque bins per axis, as fine bins of :func:`torque_record`
+    per detection bin: the training data's largest |motor torque| rounded up to the next whole
+    percent of the peak motor torque (thesis ch. 3.4 normalises by the largest torque; rounded so
+    that a run's stored counts give the same bins as its signals).
+
+    Parameters
+    ----------
+    counts : list of ndarray of shape (n_cycles, 6, 1200)
+        The training runs' torque counts.
+
+    Returns
+    -------
+    ndarray of int, shape (6,)
+        Fine bins per detection bin, 1 .. 100 (the scale in percent of peak torque).
+    """
+    occupied = np.any(np.concatenate(counts) > 0, axis=0)  # (6, 1200)
+    highest = sensors.TORQUE_COUNT_BINS - 1 - np.argmax(occupied[:, ::-1], axis=1)
+    return highest // sensors.HISTOGRAM_BINS + 1
+
+
+def binned_torque(counts: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """12-bin |torque| histograms per cycle, (n_cycles, 6, 12), from fine counts (n_cycles, 6,
+    1200) and ``scale`` fine bins per bin (:func:`detection_scale`); larger values in the last."""
+    counts = counts.astype(np.int64)
+    hist = np.stack([np.add.reduceat(counts[:, axis], np.arange(sensors.HISTOGRAM_BINS) * step, axis=-1)
+                     for axis, step in enumerate(scale)], axis=1)
+    return hist / counts.sum(axis=-1, keepdims=True)
+
+
 @dataclass(frozen=True)
 class StoredHistograms:
-    """The per-cycle torque histograms a run recorded without signals (``torque_hist``, (n, 6, 12),
-    binned over 0 .. the motor's peak torque), standing in for its |motor torque| in detection."""
+    """The per-cycle torque histograms a run recorded without signals or counts (``torque_hist``,
+    (n, 6, 12), binned over 0 .. the motor's peak torque), standing in for its counts in detection."""
 
     hist: np.ndarray
 
     def __getitem__(self, rows) -> StoredHistograms:
-        """The histograms of some cycles (``rows``, as for an array of |torque|)."""
+        """The histograms of some cycles (``rows``, as for an array of counts)."""
         return StoredHistograms(self.hist[rows])
 
 
 def _histograms(torque: np.ndarray | StoredHistograms, cycles: np.ndarray, scale: np.ndarray | None,
                 period: int | None) -> tuple[np.ndarray, np.ndarray]:
     """12-bin |torque| histograms per sample (n_samples, 6, 12), a sample being a recorded cycle or
-    a ``period`` of them, and per recorded cycle the index of its sample. A run recorded without
-    signals gives its stored histograms (:class:`StoredHistograms`; ``scale`` unused)."""
-    from faultgen.simulation.sensors import histogram
-
-    if isinstance(torque, StoredHistograms):
-        hist = torque.hist
-    else:
-        hist = histogram(torque, np.zeros(6), scale)  # (n_cycles, 6, 12), one per recorded cycle
+    a ``period`` of them, and per recorded cycle the index of its sample. ``torque`` is a
+    :func:`torque_record`; stored 12-bin histograms are used as they are (``scale`` unused)."""
+    hist = torque.hist if isinstance(torque, StoredHistograms) else binned_torque(torque, scale)
     groups = group_cycles(cycles, period)
     _, index = np.unique(groups, return_inverse=True)
     return np.stack([hist[index == g].mean(axis=0) for g in range(index.max() + 1)]), index

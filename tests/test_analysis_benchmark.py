@@ -148,6 +148,13 @@ def test_analysis_refuses_a_dataset_that_fails_validation(small, tmp_path):
         result = runner.invoke(app, [command, str(broken)])
         assert result.exit_code == 2, (command, result.output)
         assert "fails validation" in result.output and "torque_hist" in result.output
+    broken.write_bytes(small.read_bytes())
+    with h5py.File(broken, "r+") as f:
+        counts = f["runs"][run]["torque_counts"]
+        counts[0, 0, 0] += 1  # one sample too many in a cycle's counts
+    result = runner.invoke(app, ["detect", str(broken)])
+    assert result.exit_code == 2, result.output
+    assert "torque_counts: not counts of the" in " ".join(result.output.split())
 
 
 @pytest.fixture(scope="module")

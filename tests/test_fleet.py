@@ -5,6 +5,7 @@ import json
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
@@ -131,6 +132,35 @@ def test_a_features_only_sweep_is_small_and_isolates(tmp_path):
     assert set(table["worn_axis"]) == {0, 2}
     same = benchmark.isolation_table(full, progress=False)
     assert table["predicted"].tolist() == same["predicted"].tolist()
+
+
+def test_detection_gives_the_same_table_with_and_without_signals(tmp_path):
+    """The stored fine torque counts equal those computed from the stored signals, bit for bit, so
+    `faultgen detect` gives the same table on a features-only sweep as on the same sweep with signals
+    (the scale of its bins rounded to whole percent of the peak torque, the training maximum inside
+    the last bin)."""
+    from analysis import benchmark
+    from faultgen.model import robots
+    from faultgen.runs import sweep
+
+    common = {"robots": ["puma560"], "tasks": ["spot_weld"], "axes": [0, 2], "cycles": 12, "increases": [60.0]}
+    full, light = tmp_path / "full.h5", tmp_path / "light.h5"
+    sweep.run(sweep.Grid(**common), full, progress=False)
+    sweep.run(sweep.Grid(**common, signals=False), light, progress=False)
+    peak = robots.load("puma560").motor_torque_limit
+    for run_id in dataset.list_runs(full):
+        signals, _ = dataset.read_run(full, run_id, names=("tau_m", "torque_counts"))
+        stored, _ = dataset.read_run(light, run_id, names=("torque_counts",))
+        np.testing.assert_array_equal(stored["torque_counts"], sensors.torque_counts(signals["tau_m"], peak))
+        np.testing.assert_array_equal(stored["torque_counts"], signals["torque_counts"])
+        assert stored["torque_counts"].sum(axis=-1).min() == signals["tau_m"].shape[1]
+    scale = benchmark.detection_scale([stored["torque_counts"]])
+    largest = np.abs(signals["tau_m"].astype(np.float64)).max(axis=(0, 1))
+    assert np.all((scale - 1) / 100 * peak <= largest) and np.all(largest < scale / 100 * peak)
+    with_signals = benchmark.detection_table(full, protocol="same-run", progress=False)
+    features_only = benchmark.detection_table(light, protocol="same-run", progress=False)
+    pd.testing.assert_frame_equal(features_only, with_signals)
+    assert with_signals["detected"].all()  # 60 % wear in 12 cycles: a table worth comparing
 
 
 def test_the_fleet_command_refuses_bad_settings_before_simulating(tmp_path):

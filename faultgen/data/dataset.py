@@ -15,6 +15,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
         friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
         mean_abs_torque, rms_torque                                       (n_cycles, 6) features
         angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
+        torque_counts          (n_cycles, 6, 1200) samples per fine |tau_m| bin, what detection
+                               bins from (COUNT_ARRAYS; runs recorded per cycle since it exists)
         day, hour, joint_temperature, ...      operating conditions per cycle, truth (only runs
                                                with conditions: CONDITION_ARRAYS; attr conditions)
 
@@ -69,6 +71,14 @@ ARRAYS = {
     "angle_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of the joint range"),
     "speed_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..max arm speed"),
     "torque_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..peak motor torque"),
+}
+
+#: name -> (units, axes, description) of the per-cycle sample counts of every run recorded per
+#: cycle (not daily records; files written before they existed lack them, and stay valid).
+COUNT_AXES = "cycle, axis, fine bin"
+COUNT_ARRAYS = {
+    "torque_counts": ("1", COUNT_AXES, (f"samples of the cycle in each 1/{sensors.TORQUE_COUNT_BINS} of 0..peak "
+                                        "motor torque (|tau_m| as stored, larger in the last bin)")),
 }
 
 #: name -> (units, axes, description, condition that writes it) of the operating-condition
@@ -195,6 +205,7 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
                    for name in _condition_arrays(conditions.to_dict() if conditions.active else None)]
         if result.fault_value is not None:
             arrays.append(("fault_value", result.fault_value, FAULT_ARRAYS["fault_value"]))
+        arrays += [(name, values[name], spec) for name, spec in COUNT_ARRAYS.items() if name in values]
         for name, value, (units, axes, description) in arrays:
             data = np.asarray(value)
             if axes == SIGNAL_AXES:
@@ -415,6 +426,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
     if "fault" in group.attrs:
         schema.update(FAULT_ARRAYS)
+    schema.update({name: spec for name, spec in COUNT_ARRAYS.items() if name in group})
     missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:
@@ -436,6 +448,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name, (_, axes, _) in schema.items():
         expected = {SIGNAL_AXES: (n_cycles, n_log, 6), "cycle, axis": (n_cycles, 6),
                     "cycle, axis, bin": (n_cycles, 6, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, 6),
+                    COUNT_AXES: (n_cycles, 6, sensors.TORQUE_COUNT_BINS),
                     "sample": (n_log,), "cycle": (n_cycles,), "axis": (6,)}[axes]
         if data[name].shape != expected:
             problems.append(f"{name}: shape {data[name].shape}, expected {expected}")
@@ -447,6 +460,9 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name in ("angle_hist", "speed_hist", "torque_hist"):
         if not np.allclose(data[name].sum(axis=-1), 1.0):
             problems.append(f"{name}: a histogram does not sum to 1")
+    for name in COUNT_ARRAYS:
+        if name in data and (data[name].dtype.kind != "u" or np.any(data[name].sum(axis=-1) != n_log)):
+            problems.append(f"{name}: not counts of the {n_log} samples of each cycle")
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
             problems.append(f"{name}: not positive")

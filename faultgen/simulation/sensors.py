@@ -110,6 +110,41 @@ def histogram(values: np.ndarray, low: np.ndarray, high: np.ndarray, bins: int =
     return counts / values.shape[1]
 
 
+#: Fine bins of the per-cycle torque counts (:func:`torque_counts`), each 1/1200 of the peak motor
+#: torque: 12 per percent of it, so that 12 equal bins over 0 .. any whole percent of the peak
+#: torque are whole groups of them (the detection's binning, ``analysis.benchmark.detection_table``).
+TORQUE_COUNT_BINS = 1200
+
+
+def torque_counts(tau_m: np.ndarray, torque_limit: np.ndarray) -> np.ndarray:
+    """Samples of each cycle per fine bin of |motor torque|, the record detection bins from.
+
+    |tau_m| is taken as a dataset stores it (float32), so the counts of a run recorded without
+    signals equal those computed again from a stored run's signals, bit for bit.
+
+    Parameters
+    ----------
+    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+        Logged motor torque, N m at the motor side.
+    torque_limit : ndarray of shape (6,)
+        Peak motor torque, N m: the range 0 .. peak is cut into :data:`TORQUE_COUNT_BINS` equal
+        bins; larger values count in the last.
+
+    Returns
+    -------
+    ndarray of shape (n_cycles, 6, TORQUE_COUNT_BINS)
+        Unsigned integer counts (the smallest type holding ``n_samples``); each row sums to
+        ``n_samples``.
+    """
+    magnitude = np.abs(np.asarray(tau_m, dtype=np.float32)).astype(np.float64)
+    scale = TORQUE_COUNT_BINS / np.asarray(torque_limit, dtype=np.float64)
+    index = np.minimum((magnitude * scale).astype(np.int64), TORQUE_COUNT_BINS - 1)
+    n_cycles, n_samples, n_axes = index.shape
+    offset = (np.arange(n_cycles)[:, None, None] * n_axes + np.arange(n_axes)) * TORQUE_COUNT_BINS
+    counts = np.bincount((index + offset).ravel(), minlength=n_cycles * n_axes * TORQUE_COUNT_BINS)
+    return counts.reshape(n_cycles, n_axes, TORQUE_COUNT_BINS).astype(np.min_scalar_type(n_samples))
+
+
 def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_range: np.ndarray,
                    speed_limit: np.ndarray, torque_limit: np.ndarray) -> dict[str, np.ndarray]:
     """Per-cycle aggregates of a run, as a robot's remote monitoring reports them.

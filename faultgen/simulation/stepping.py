@@ -350,7 +350,8 @@ class RunResult:
     features : dict of ndarray
         Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
         ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
-        ``torque_hist`` (n_cycles, 6, 12).
+        ``torque_hist`` (n_cycles, 6, 12); per recorded cycle (not in daily records) also
+        ``torque_counts`` (n_cycles, 6, 1200), :func:`faultgen.sensors.torque_counts`.
     conditions : CycleConditions or None
         The operating conditions of each recorded cycle (None when the run has none).
     fault_value : ndarray of shape (n_cycles,) or None
@@ -454,7 +455,10 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         result = replace(result, fault_value=plant.fault)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
-    return daily_record(result) if config.daily else result
+    if config.daily:
+        return daily_record(result)
+    result.features["torque_counts"] = sensors.torque_counts(result.tau_m, robot.motor_torque_limit)
+    return result
 
 
 def daily_record(result: RunResult) -> RunResult:
