@@ -316,7 +316,7 @@ def calibrate_command(
 @app.command("sweep", cls=PlainHelpCommand)
 def sweep_command(
     preset: Annotated[
-        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, about 3 min), c2 (thesis ch. 3, about 45 min).")
+        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, about 3 min), c2 (thesis ch. 3, about 45 min, features only).")
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
@@ -339,9 +339,11 @@ def sweep_command(
     unit_spread: UnitSpreadFlag = False,
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
-    features_only: Annotated[bool, typer.Option(
-        "--features-only", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a fraction of "
-        "the size; only bench-isolators --speed-window needs the signals).")] = False,
+    features_only: Annotated[bool | None, typer.Option(
+        "--features-only/--signals", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a "
+        "fraction of the size; detect and classify give the same tables, only bench-isolators --speed-window needs "
+        "the signals), or keep the signals. Default: the preset's (c2: features only), else signals.",
+        show_default=False)] = None,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     scheduler: Annotated[
         str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
@@ -375,8 +377,8 @@ def sweep_command(
         table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day)
         if table is not None:
             options["conditions"] = table
-        if features_only:
-            options["signals"] = False
+        if features_only is not None:
+            options["signals"] = not features_only
         if fault is not None:
             options["fault"] = fault
         if record is not None:

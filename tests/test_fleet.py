@@ -134,6 +134,17 @@ def test_a_features_only_sweep_is_small_and_isolates(tmp_path):
     assert table["predicted"].tolist() == same["predicted"].tolist()
 
 
+def test_the_c2_preset_keeps_features_only_unless_asked_for_signals(tmp_path):
+    small = ["--preset", "c2", "--task", "spot_weld", "--axis", "0", "--cycles", "2", "--record", "2", "--no-progress"]
+    for flag, has_signals in (([], False), (["--signals"], True), (["--features-only"], False)):
+        out = tmp_path / f"c2{''.join(flag)}.h5"
+        result = CliRunner().invoke(app, ["sweep", *small, *flag, "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        with h5py.File(out) as f:
+            run = f["runs"][next(iter(f["runs"]))]
+            assert ("tau_m" in run) is has_signals and "torque_counts" in run, flag
+
+
 def test_detection_gives_the_same_table_with_and_without_signals(tmp_path):
     """The stored fine torque counts equal those computed from the stored signals, bit for bit, so
     `faultgen detect` gives the same table on a features-only sweep as on the same sweep with signals

@@ -48,14 +48,15 @@ log = logging.getLogger(__name__)
 #: Named grids. quick: a small grid for a first look (under a minute on 2 cores).
 #: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
 #: c2: thesis ch. 3 (PUMA 560, 3 tasks x 6 axes x {10, 20} % logistic over 120 hours of one-minute
-#: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled).
+#: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled); features
+#: only unless ``signals=True`` (the signals would take 16 GB; detection gives the same table without).
 PRESETS = {
     "quick": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
                   schedules=["exp4"], cycles=100, record=list(range(10, 101, 10))),
     "j2": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
                schedules=["exp4"], cycles=100, record="all"),
     "c2": dict(robots=["puma560"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[10.0, 20.0],
-               schedules=["logistic"], cycles=120 * 60, record={"period": 60, "first": 10}),
+               schedules=["logistic"], cycles=120 * 60, record={"period": 60, "first": 10}, signals=False),
 }
 
 
