@@ -106,8 +106,16 @@ def histogram(values: np.ndarray, low: np.ndarray, high: np.ndarray, bins: int =
     """
     fraction = (values - low) / (high - low)
     index = np.clip((fraction * bins).astype(int), 0, bins - 1)
-    counts = np.stack([np.sum(index == b, axis=1) for b in range(bins)], axis=-1)
-    return counts / values.shape[1]
+    return _bin_counts(index, bins) / values.shape[1]
+
+
+def _bin_counts(index: np.ndarray, bins: int) -> np.ndarray:
+    """Samples per bin of each cycle and axis, (n_cycles, n_axes, bins), from bin indices
+    (n_cycles, n_samples, n_axes) within 0 .. bins - 1."""
+    n_cycles, _, n_axes = index.shape
+    offset = (np.arange(n_cycles)[:, None, None] * n_axes + np.arange(n_axes)) * bins
+    counts = np.bincount((index + offset).ravel(), minlength=n_cycles * n_axes * bins)
+    return counts.reshape(n_cycles, n_axes, bins)
 
 
 #: Fine bins of the per-cycle torque counts (:func:`torque_counts`), each 1/1200 of the peak motor
@@ -139,10 +147,7 @@ def torque_counts(tau_m: np.ndarray, torque_limit: np.ndarray) -> np.ndarray:
     magnitude = np.abs(np.asarray(tau_m, dtype=np.float32)).astype(np.float64)
     scale = TORQUE_COUNT_BINS / np.asarray(torque_limit, dtype=np.float64)
     index = np.minimum((magnitude * scale).astype(np.int64), TORQUE_COUNT_BINS - 1)
-    n_cycles, n_samples, n_axes = index.shape
-    offset = (np.arange(n_cycles)[:, None, None] * n_axes + np.arange(n_axes)) * TORQUE_COUNT_BINS
-    counts = np.bincount((index + offset).ravel(), minlength=n_cycles * n_axes * TORQUE_COUNT_BINS)
-    return counts.reshape(n_cycles, n_axes, TORQUE_COUNT_BINS).astype(np.min_scalar_type(n_samples))
+    return _bin_counts(index, TORQUE_COUNT_BINS).astype(np.min_scalar_type(index.shape[1]))
 
 
 def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_range: np.ndarray,
