@@ -376,8 +376,9 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     divergence of its run, which a monitor that learned other runs reads as a fault (j2, three
     seeds, other-seeds, 95 % limit, in-sample: 19.1 % false alarms against the first sample,
     8.7 % against the training mean, on 2026-11-22's physics). A sample is one recorded cycle, or
-    all the cycles of a ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA monitor (components for
-    ``variance`` of the variance, thesis: 75 %; features constant in training are left out) learns
+    all the cycles of a ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA
+    monitor (components for ``variance`` of the variance, thesis: 75 %; features constant in
+    training are left out) learns
     normal operation as ``protocol`` says (:data:`PROTOCOLS`; ``first`` samples for first-cycles);
     wear is detected at the first sample (after the training ones) whose Q statistic exceeds its
     ``1 - alpha`` limit for ``persistence`` samples in a row. Under the held-out protocols the Q
@@ -540,23 +541,25 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
 def torque_record(path, run_id: str, labels: dict) -> np.ndarray | StoredHistograms:
     """What detection bins a run's |motor torque| from: its per-cycle counts in fine bins of
     0 .. peak motor torque (``torque_counts``, (n_cycles, 6, 1200),
-    :func:`faultgen.simulation.sensors.torque_counts`), computed from the stored signals, else
-    read as stored (a run recorded without signals); the two are equal bit for bit for the same
-    run. A run that has neither (a daily record, or a file written before the counts existed)
+    :func:`faultgen.simulation.sensors.torque_counts`), read as stored, or computed from the
+    stored signals for a file written before the counts existed; the two are equal bit for bit
+    for the same run. A run that has neither (a daily record, or an old file without signals)
     gives its 12-bin ``torque_hist`` (:class:`StoredHistograms`).
 
     Raises
     ------
     faultgen.data.dataset.DatasetError
-        If the run lacks ``tau_m`` though it says it has signals, or lacks ``torque_hist``.
+        If the run has no counts and lacks ``tau_m`` though it says it has signals, or lacks
+        ``torque_hist``.
     """
+    try:  # the stored counts: a small array, where the signals are the largest part of a file
+        return dataset.read_run(path, run_id, names=("torque_counts",))[0]["torque_counts"]
+    except dataset.DatasetError:
+        pass
     if labels.get("signals", True):
         tau_m = dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"]
         return sensors.torque_counts(tau_m, robots.load(labels["robot"]).motor_torque_limit)
-    try:
-        return dataset.read_run(path, run_id, names=("torque_counts",))[0]["torque_counts"]
-    except dataset.DatasetError:  # no counts: the stored 12-bin histograms are all there is
-        return StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
+    return StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
 
 
 def detection_scale(counts: list[np.ndarray]) -> np.ndarray:
