@@ -62,13 +62,19 @@ PayloadPattern = Annotated[str, typer.Option(
 UnitSpreadFlag = Annotated[bool, typer.Option(
     "--unit-spread", help="The run's robot draws its own friction levels (15 % log-normal per axis) and link masses "
     "(2 %) from its seed; the controller keeps the nominal model.")]
+TaskMixTasks = Annotated[str | None, typer.Option(
+    "--task-mix", metavar="TASK,TASK,...",
+    help="Each cycle runs one of these tasks (the run's own among them), e.g. pick_place,spot_weld; needs "
+    "--features-only (cycles of different tasks differ in length).")]
+TaskMixPattern = Annotated[str, typer.Option(
+    help="Which task each cycle runs: alternate, blocks (10 cycles each) or random.")]
 CyclesPerDay = Annotated[int, typer.Option(
     help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).")]
 StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
 
 
 def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
-                start_day: float) -> dict | None:
+                start_day: float, task_mix: str | None = None, task_pattern: str = "alternate") -> dict | None:
     """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
     no condition is on. Raises ValueError naming a malformed ``--payloads`` part."""
     table: dict = {}
@@ -86,6 +92,8 @@ def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: b
         table["payloads"] = {"masses": masses, "sizes": sizes, "pattern": pattern}
     if spread:
         table["spread"] = {}
+    if task_mix:
+        table["task_mix"] = {"tasks": [t.strip() for t in task_mix.split(",")], "pattern": task_pattern}
     if not table:
         return None
     return {**table, "cycles_per_day": cycles_per_day, "start_day": start_day}
@@ -337,6 +345,8 @@ def sweep_command(
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
     unit_spread: UnitSpreadFlag = False,
+    task_mix: TaskMixTasks = None,
+    task_pattern: TaskMixPattern = "alternate",
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
     features_only: Annotated[bool | None, typer.Option(
@@ -366,6 +376,8 @@ def sweep_command(
       faultgen sweep --robot puma560 --task spot_weld --axis 0 --axis 3 --wear-pct 10 --wear-pct 20 -o s.h5
 
       faultgen sweep --preset j2 --temperature --unit-spread -o j2-conditions.h5
+
+      faultgen sweep --task pick_place --axis 0 --axis 2 --task-mix pick_place,spot_weld --features-only -o mix.h5
     """
     from faultgen.runs import sweep
 
@@ -374,7 +386,8 @@ def sweep_command(
                "record": record}
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     try:
-        table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day)
+        table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
+                            task_mix, task_pattern)
         if table is not None:
             options["conditions"] = table
         if features_only is not None:
@@ -423,6 +436,9 @@ def fleet_command(
     conditions: Annotated[bool, typer.Option(
         help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
         "process and fault.")] = True,
+    task_mix: Annotated[bool, typer.Option(
+        "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
+        "its cycles (default: one task per robot).")] = False,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
@@ -445,7 +461,7 @@ def fleet_command(
 
     try:
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
-                           failure_wear=failure_wear, seed=seed, conditions=conditions)
+                           failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix)
         if jobs < 1:
             raise ValueError(f"--jobs {jobs}: expected >= 1")
         _check_outputs([out], overwrite)

@@ -1,9 +1,11 @@
 """Operating conditions: the temperature law, each schedule at known cycles, the physics the
-simulation applies against the labels it writes, and refusals of bad settings."""
+simulation applies against the labels it writes, a task mix's cycles against runs of one task,
+and refusals of bad settings."""
 
 import json
 import shutil
 
+import h5py
 import mujoco
 import numpy as np
 import pytest
@@ -14,6 +16,7 @@ from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.effects import temperature as law
 from faultgen.operation import conditions as c
+from faultgen.operation import wear
 from faultgen.runs import sweep
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -88,6 +91,24 @@ def test_calendar_and_payload_patterns_at_known_cycles():
     assert part["mass"] == 2.0 and part["com_z"] == 0.05 and part["ixx"] == pytest.approx(2.0 * 0.01 / 6)
 
 
+def test_task_mix_patterns_at_known_cycles():
+    cycles = np.arange(1, 9)
+    tasks = ("pick_place", "spot_weld", "arc_weld")
+    assert c.TaskMix(tasks).index(0, cycles).tolist() == [0, 1, 2, 0, 1, 2, 0, 1]
+    assert c.TaskMix(tasks, "blocks", block=3).index(0, cycles).tolist() == [0, 0, 0, 1, 1, 1, 2, 2]
+    drawn = c.TaskMix(tasks, "random").index(5, cycles)
+    assert set(drawn.tolist()) <= {0, 1, 2} and len(set(drawn.tolist())) > 1
+    assert c.TaskMix(tasks, "random").index(5, np.array([3, 8])).tolist() == drawn[[2, 7]].tolist()
+    # its own random stream: not the payloads' draws
+    assert drawn.tolist() != c.Payloads((1.0, 2.0, 3.0), (0.1,) * 3, "random").index(5, cycles).tolist()
+    conditions = c.Conditions(task_mix=c.TaskMix(("spot_weld", "pick_place"), "blocks", block=2))
+    every = conditions.evaluate(0, cycles)
+    assert every.task_index.tolist() == [0, 0, 1, 1, 0, 0, 1, 1]
+    assert every.tasks(conditions.task_mix, "pick_place")[:3].tolist() == ["spot_weld", "spot_weld", "pick_place"]
+    assert c.Conditions(thermal=c.Temperature()).evaluate(0, cycles).task_index.tolist() == [-1] * 8
+    assert c.Conditions.from_dict(json.loads(json.dumps(conditions.to_dict()))) == conditions
+
+
 def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     spread = c.UnitSpread(dry_friction=0.15, viscous_friction=0.1, link_mass=0.02)
     first = spread.draw(3)
@@ -107,6 +128,15 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     (lambda: c.Payloads((-1.0,), (0.1,)), r"payload mass = -1.0"),
     (lambda: c.Payloads((1.0,), (0.1,), pattern="zig"), r"payload pattern 'zig'"),
     (lambda: c.UnitSpread(dry_friction=0.9), r"unit spread dry_friction = 0.9"),
+    (lambda: c.TaskMix(()), r"task mix: no task given"),
+    (lambda: c.TaskMix(("pick_place", "welding")), r"task mix: unknown task 'welding'"),
+    (lambda: c.TaskMix(("pick_place",), pattern="zig"), r"task mix pattern 'zig'"),
+    (lambda: c.TaskMix(("pick_place",), pattern="blocks", block=0), r"task mix block = 0"),
+    (lambda: sim.RunConfig("puma560", "arc_weld", signals=False,
+                           conditions=c.Conditions(task_mix=c.TaskMix(("pick_place", "spot_weld")))),
+     r"task 'arc_weld' is not in the task mix \(pick_place, spot_weld\)"),
+    (lambda: sim.RunConfig("puma560", "pick_place", conditions=c.Conditions(task_mix=c.TaskMix(("pick_place",)))),
+     r"a task mix \(pick_place\) keeps no signals"),
     (lambda: c.Conditions(cycles_per_day=0), r"cycles_per_day = 0"),
     (lambda: c.Conditions(hours=(8, 16)), r"hours = \(8, 16\): expected 1 \(cycles_per_day\) times of day"),
     (lambda: c.Conditions.from_dict({"humidity": {}}), r"unknown key 'humidity'"),
@@ -166,7 +196,57 @@ def test_runs_without_conditions_keep_their_keys_and_files():
     config = sim.RunConfig("puma560", "pick_place", cycles=2)
     assert "conditions" not in json.loads(dataset.config_key(config))
     with_spread = sim.RunConfig("puma560", "pick_place", cycles=2, conditions=c.Conditions(spread=c.UnitSpread()))
-    assert json.loads(dataset.config_key(with_spread))["conditions"]["spread"]["dry_friction"] == 0.15
+    key = json.loads(dataset.config_key(with_spread))["conditions"]
+    assert key["spread"]["dry_friction"] == 0.15 and "task_mix" not in key  # keys from before the task mix
+
+
+def test_a_task_mix_runs_each_cycle_as_a_run_of_its_task(tmp_path):
+    """Cycles alternating two tasks: each cycle's features and truth are bit for bit those of the
+    same cycle of a run of its task alone (same seed, same wear); the file validates, labels each
+    cycle's task, and its validator still catches a miscounted cycle of either task."""
+    plan = wear.WearPlan.from_specs(["2:exp4:30"], last_cycle=4)
+    common = {"robot": "puma560", "wear": plan, "cycles": 4, "nthread": 1, "seed": 3, "signals": False}
+    mix = c.Conditions(task_mix=c.TaskMix(("spot_weld", "pick_place")))
+    mixed = sim.simulate(sim.RunConfig(task="pick_place", conditions=mix, **common), progress=False)
+    alone = {task: sim.simulate(sim.RunConfig(task=task, **common), progress=False)
+             for task in ("spot_weld", "pick_place")}
+    assert mixed.conditions.task_index.tolist() == [0, 1, 0, 1] and mixed.cycles.tolist() == [1, 2, 3, 4]
+    assert mixed.tau_m.shape == (4, 0, 6) and np.array_equal(mixed.q_ref, alone["pick_place"].q_ref)
+    for k, task in enumerate(["spot_weld", "pick_place"] * 2):
+        for name, values in mixed.features.items():
+            np.testing.assert_array_equal(values[k], alone[task].features[name][k], err_msg=f"cycle {k + 1} {name}")
+        for name in ("friction_multiplier", "mean_friction_torque", "tracking_error"):
+            np.testing.assert_array_equal(getattr(mixed, name)[k], getattr(alone[task], name)[k])
+    assert not np.array_equal(mixed.features["mean_abs_torque"][0], mixed.features["mean_abs_torque"][1])
+    path = dataset.write_run(tmp_path / "mix.h5", mixed)
+    assert dataset.validate(path) == []
+    arrays, attrs = dataset.read_run(path)
+    assert arrays["task_index"].tolist() == [0, 1, 0, 1] and attrs["task"] == "pick_place"
+    for row in (0, 1):  # a spot-weld cycle, then a pick-and-place one, miscounted
+        with h5py.File(path, "r+") as f:
+            counts = f["runs/run/torque_counts"]
+            counts[row, 0, 0] += 1
+        assert any("torque_counts: not counts" in p for p in dataset.validate(path)), row
+        with h5py.File(path, "r+") as f:
+            f["runs/run/torque_counts"][row, 0, 0] -= 1
+    with h5py.File(path, "r+") as f:
+        f["runs/run/task_index"][1] = 2
+    assert dataset.validate(path) == ["run run: task_index: outside 0..1 (the task mix's tasks)"]
+
+
+def test_the_sweep_command_takes_a_task_mix_with_features_only(tmp_path):
+    runner = CliRunner()
+    args = ["sweep", "--robot", "puma560", "--task", "pick_place", "--axis", "0", "--cycles", "2", "--jobs", "1",
+            "--no-progress", "--task-mix", "pick_place,spot_weld", "-o", str(tmp_path / "mix.h5")]
+    refused = runner.invoke(app, args)
+    assert refused.exit_code == 2 and "keeps no signals" in refused.output and "--features-only" in refused.output
+    assert not (tmp_path / "mix.h5").exists()
+    done = runner.invoke(app, [*args, "--features-only", "--task-pattern", "blocks"])
+    assert done.exit_code == 0, done.output
+    assert dataset.validate(tmp_path / "mix.h5") == []
+    unknown = runner.invoke(app, [*args[:-2], "--task-mix", "pick_place,welding", "--features-only",
+                                  "-o", str(tmp_path / "never.h5")])
+    assert unknown.exit_code == 2 and "unknown task 'welding'" in unknown.output
 
 
 def test_a_sweep_grid_takes_conditions_from_toml(tmp_path):

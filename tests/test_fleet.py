@@ -37,6 +37,18 @@ def test_the_fleet_draws_half_failing_robots_of_both_models():
     assert len({r["seed"] for r in robots}) == 26
 
 
+def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
+    """--task-mix adds each robot's second task (another task, drawn last) and changes nothing else
+    the fleet draws, so fleets measured before it existed stay as they were."""
+    plain, mixed = Fleet().robots(), Fleet(task_mix=True).robots()
+    for one, other in zip(plain, mixed, strict=True):
+        mix = other["conditions"].pop("task_mix")
+        assert one == other and "task_mix" not in one["conditions"]
+        assert mix["tasks"][0] == one["task"] and mix["tasks"][1] != one["task"] and mix["pattern"] == "random"
+    configs = dict(Fleet(task_mix=True).runs())
+    assert all(config.conditions.task_mix is not None and not config.signals for config in configs.values())
+
+
 @pytest.mark.parametrize(("settings", "message"), [
     ({"failing": 26}, r"fleet failing = 26: expected a whole number within 1..25"),
     ({"days": 3}, r"fleet days = 3"),

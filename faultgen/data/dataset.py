@@ -95,6 +95,7 @@ CONDITION_ARRAYS = {
     "payload_part": ("1", "cycle", "index of the part carried (into the conditions' payload masses)", "payloads"),
     "payload_mass": ("kg", "cycle", "mass of the part carried", "payloads"),
     "link_mass_factor": ("1", "axis", "multiplier of each link's mass and inertia (this unit's)", "spread"),
+    "task_index": ("1", "cycle", "index of the task the cycle ran (into the conditions' task_mix tasks)", "task_mix"),
 }
 
 #: The array of a run whose fault is not friction wear (attribute ``fault``): its units are the
@@ -460,13 +461,29 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name in ("angle_hist", "speed_hist", "torque_hist"):
         if not np.allclose(data[name].sum(axis=-1), 1.0):
             problems.append(f"{name}: a histogram does not sum to 1")
+    mix = (conditions or {}).get("task_mix")
+    if mix is not None and np.any((data["task_index"] < 0) | (data["task_index"] >= len(mix["tasks"]))):
+        return [*problems, f"task_index: outside 0..{len(mix['tasks']) - 1} (the task mix's tasks)"]
     for name in COUNT_ARRAYS:
-        if name in data and (data[name].dtype.kind != "u" or np.any(data[name].sum(axis=-1) != n_log)):
+        if name in data and (data[name].dtype.kind != "u" or not _counts_fit(data[name].sum(axis=-1), n_log, data,
+                                                                            conditions, _attr(group.attrs["task"]))):
             problems.append(f"{name}: not counts of the {n_log} samples of each cycle")
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
             problems.append(f"{name}: not positive")
     return problems
+
+
+def _counts_fit(totals: np.ndarray, n_log: int, data: dict, conditions: dict | None, task: str) -> bool:
+    """Whether per-cycle sample counts ``totals`` (n_cycles, 6) count each cycle's samples: ``n_log``
+    (the run's task's) for every cycle, or with a task mix for the cycles of the run's own task,
+    and one number for all axes and cycles of each other task (its path, not stored, sets it)."""
+    mix = (conditions or {}).get("task_mix")
+    if mix is None:
+        return bool(np.all(totals == n_log))
+    tasks = np.array([*mix["tasks"], task], dtype=object)[data["task_index"]]
+    return all(np.all(totals[tasks == name] == (n_log if name == task else totals[tasks == name][0, 0]))
+               for name in set(tasks))
 
 
 def summary(path: str | Path) -> str:
@@ -494,7 +511,7 @@ def summary(path: str | Path) -> str:
     ]
     if any("conditions" in row for row in rows):
         lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
-                     "(temperature, payloads, unit spread: CONDITION_ARRAYS)")
+                     "(temperature, payloads, task mix, unit spread: CONDITION_ARRAYS)")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)

@@ -1,4 +1,4 @@
-"""Operating conditions over the cycles of a run: joint temperature, payload, unit-to-unit spread.
+"""Operating conditions over the cycles of a run: joint temperature, payload, task mix, unit-to-unit spread.
 
 On real robots friction and torque move with the joints' temperature and the load as much as
 with wear (Bittencourt & Gunnarsson 2012; thesis ch. 5.3 and ref. [103]), and no two units of a
@@ -27,6 +27,11 @@ pattern (alternating, in blocks, or at random); each part a uniform cube hanging
 (:class:`faultgen.effects.payload.Payload`). The controller knows the part (the load data an
 industrial program sets before each move), so its feedforward carries it.
 
+**Task mix** (:class:`TaskMix`): the program a cycle runs, one of a set of tasks, chosen by the same
+patterns, as a robot that welds one product and handles another (the thesis's robots served
+several processes, ch. 5.3.1). Each cycle runs its task's own path and feedforward; cycles of
+different tasks differ in length, so a run with a task mix keeps features and truth only.
+
 **Unit-to-unit spread** (:class:`UnitSpread`): the run's robot draws its own friction levels
 (Coulomb and static, viscous; per axis, log-normal) and link masses (per link, normal) around the
 nominal model, from the run's seed; the controller keeps the nominal model.
@@ -44,12 +49,13 @@ import numpy as np
 
 from faultgen.axes import N_AXES
 from faultgen.effects import temperature as temperature_law
+from faultgen.operation.tasks import TASKS
 
 #: Seconds in a day.
 DAY = 86400.0
 #: Random streams of the conditions (the sensors use 0 and 1 per cycle).
-_TIME_OF_DAY, _PAYLOAD, _UNIT = 10, 11, 12
-#: Payload patterns.
+_TIME_OF_DAY, _PAYLOAD, _UNIT, _TASK = 10, 11, 12, 13
+#: How a set of choices (payloads, tasks) is scheduled over the cycles.
 PATTERNS = ("alternate", "blocks", "random")
 
 
@@ -61,6 +67,25 @@ def check_number(name: str, value, low: float = -math.inf, high: float = math.in
         kind = "a whole number" if whole else "a number"
         raise ValueError(f"{name} = {value!r}: expected {kind} within {low:g}..{high:g}")
     return int(value) if whole else float(value)
+
+
+def _check_pattern(what: str, pattern: str, block) -> None:
+    """Refuse an unknown ``pattern`` or a ``block`` that is not a whole number >= 1, naming ``what``."""
+    if pattern not in PATTERNS:
+        raise ValueError(f"{what} pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
+    if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 1:
+        raise ValueError(f"{what} block = {block!r}: expected a whole number of cycles >= 1")
+
+
+def _schedule(pattern: str, block: int, n: int, seed: int, cycles: np.ndarray, stream: int) -> np.ndarray:
+    """The choice (0..n-1) of each of ``cycles`` (1-based): in turn (``alternate``), ``block``
+    cycles each in turn (``blocks``), or drawn with equal odds from (seed, cycle, stream) (``random``)."""
+    k = np.asarray(cycles) - 1
+    if pattern == "alternate":
+        return k % n
+    if pattern == "blocks":
+        return (k // block) % n
+    return np.array([np.random.default_rng([seed, int(c), stream]).integers(n) for c in cycles], dtype=int)
 
 
 @dataclass(frozen=True)
@@ -160,22 +185,13 @@ class Payloads:
         if not masses or len(masses) != len(sizes):
             raise ValueError(f"payloads: {len(masses)} masses and {len(sizes)} sizes; expected one size per mass, "
                              "at least one part")
-        if self.pattern not in PATTERNS:
-            raise ValueError(f"payload pattern {self.pattern!r}: expected one of {', '.join(PATTERNS)}")
-        if isinstance(self.block, bool) or not isinstance(self.block, (int, np.integer)) or self.block < 1:
-            raise ValueError(f"payload block = {self.block!r}: expected a whole number of cycles >= 1")
+        _check_pattern("payload", self.pattern, self.block)
         object.__setattr__(self, "masses", masses)
         object.__setattr__(self, "sizes", sizes)
 
     def index(self, seed: int, cycles: np.ndarray) -> np.ndarray:
         """The part carried in each of ``cycles`` (1-based), indices into :attr:`masses`."""
-        k = np.asarray(cycles) - 1
-        n = len(self.masses)
-        if self.pattern == "alternate":
-            return k % n
-        if self.pattern == "blocks":
-            return (k // self.block) % n
-        return np.array([np.random.default_rng([seed, int(c), _PAYLOAD]).integers(n) for c in cycles], dtype=int)
+        return _schedule(self.pattern, self.block, len(self.masses), seed, cycles, _PAYLOAD)
 
     def parameters(self, part: int) -> dict[str, float]:
         """The :class:`faultgen.effects.payload.Payload` parameters of part ``part``."""
@@ -183,6 +199,46 @@ class Payloads:
         moment = mass * size**2 / 6
         return {"mass": mass, "com_x": 0.0, "com_y": 0.0, "com_z": size / 2,
                 "ixx": moment, "iyy": moment, "izz": moment, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
+
+
+@dataclass(frozen=True)
+class TaskMix:
+    """The tasks a robot runs, one per cycle (module docstring).
+
+    Attributes
+    ----------
+    tasks : tuple of str
+        Tasks of :data:`faultgen.operation.tasks.TASKS`; the run's own task must be one of them.
+        A task may be listed more than once to run it more often.
+    pattern : str
+        ``alternate`` (tasks in turn), ``blocks`` (``block`` cycles of each in turn) or ``random``
+        (each cycle a task drawn with equal odds from the run's seed).
+    block : int
+        Cycles per block of the ``blocks`` pattern.
+
+    Raises
+    ------
+    ValueError
+        On construction, for no task, an unknown task, an unknown pattern or a block < 1.
+    """
+
+    tasks: tuple[str, ...]
+    pattern: str = "alternate"
+    block: int = 10
+
+    def __post_init__(self) -> None:
+        tasks = tuple(self.tasks) if not isinstance(self.tasks, str) else (self.tasks,)
+        if not tasks:
+            raise ValueError("task mix: no task given; expected one or more of " + ", ".join(TASKS))
+        for task in tasks:
+            if task not in TASKS:
+                raise ValueError(f"task mix: unknown task {task!r}; expected one of {', '.join(TASKS)}")
+        _check_pattern("task mix", self.pattern, self.block)
+        object.__setattr__(self, "tasks", tasks)
+
+    def index(self, seed: int, cycles: np.ndarray) -> np.ndarray:
+        """The task run in each of ``cycles`` (1-based), indices into :attr:`tasks`."""
+        return _schedule(self.pattern, self.block, len(self.tasks), seed, cycles, _TASK)
 
 
 @dataclass(frozen=True)
@@ -250,6 +306,8 @@ class CycleConditions:
         kg.
     link_mass_factor : ndarray of shape (6,)
         Multiplier of each link's mass and inertia (the unit's).
+    task_index : ndarray of shape (n,)
+        Index of the task the cycle ran, into the task mix's tasks (-1: no mix, the run's task).
     """
 
     day: np.ndarray
@@ -261,6 +319,13 @@ class CycleConditions:
     payload_part: np.ndarray
     payload_mass: np.ndarray
     link_mass_factor: np.ndarray
+    task_index: np.ndarray
+
+    def tasks(self, mix: TaskMix | None, own: str) -> np.ndarray:
+        """The task name of each cycle, ``ndarray of shape (n,)`` of str: the mix's, or ``own`` (the
+        run's task) where no mix is scheduled."""
+        names = np.array([*(mix.tasks if mix is not None else ()), own], dtype=object)
+        return names[np.where(self.task_index >= 0, self.task_index, len(names) - 1)]
 
 
 @dataclass(frozen=True)
@@ -274,6 +339,8 @@ class Conditions:
         Joint temperature (the CLI's ``--temperature``).
     payloads : Payloads or None
     spread : UnitSpread or None
+    task_mix : TaskMix or None
+        The task of each cycle (the CLI's ``--task-mix``); None: every cycle runs the run's task.
     cycles_per_day : int
         Recorded-cycle index to calendar day (module docstring); >= 1.
     start_day : float
@@ -294,12 +361,14 @@ class Conditions:
     thermal: Temperature | None = None
     payloads: Payloads | None = None
     spread: UnitSpread | None = None
+    task_mix: TaskMix | None = None
     cycles_per_day: int = 1
     start_day: float = 0.0
     hours: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        for name, kind in (("thermal", Temperature), ("payloads", Payloads), ("spread", UnitSpread)):
+        for name, kind in (("thermal", Temperature), ("payloads", Payloads), ("spread", UnitSpread),
+                           ("task_mix", TaskMix)):
             value = getattr(self, name)
             if value is not None and not isinstance(value, kind):
                 raise TypeError(f"conditions {name}: expected a {kind.__name__} or None, got {type(value).__name__}")
@@ -316,7 +385,7 @@ class Conditions:
     @property
     def active(self) -> bool:
         """Whether any condition is on."""
-        return any(c is not None for c in (self.thermal, self.payloads, self.spread))
+        return any(c is not None for c in (self.thermal, self.payloads, self.spread, self.task_mix))
 
     def evaluate(self, seed: int, cycles: np.ndarray) -> CycleConditions:
         """The conditions at ``cycles`` (1-based recorded cycle indices, shape (n,)) of a run with
@@ -345,18 +414,23 @@ class Conditions:
         if self.payloads is not None:
             part = self.payloads.index(seed, cycles)
             mass = np.array(self.payloads.masses)[part]
+        task = self.task_mix.index(seed, cycles) if self.task_mix is not None else np.full(n, -1)
         return CycleConditions(day=day.astype(float), hour=hour, ambient_temperature=ambient, joint_temperature=joint,
                                dry_friction_factor=dry, viscous_factor=viscous, payload_part=part, payload_mass=mass,
-                               link_mass_factor=link_mass)
+                               link_mass_factor=link_mass, task_index=task)
 
     def to_dict(self) -> dict:
-        """JSON-serialisable labels (None for a condition that is off)."""
-        return asdict(self)
+        """JSON-serialisable labels (None for a condition that is off; no ``task_mix`` key without
+        one, so runs keep the labels and keys they had before the task mix existed)."""
+        table = asdict(self)
+        if self.task_mix is None:
+            del table["task_mix"]
+        return table
 
     @classmethod
     def from_dict(cls, data: dict) -> Conditions:
         """Inverse of :meth:`to_dict`; unknown keys are refused with their name."""
-        known = {"thermal": Temperature, "payloads": Payloads, "spread": UnitSpread}
+        known = {"thermal": Temperature, "payloads": Payloads, "spread": UnitSpread, "task_mix": TaskMix}
         plain = ("cycles_per_day", "start_day", "hours")
         unknown = sorted(set(data) - set(known) - set(plain))
         if unknown:

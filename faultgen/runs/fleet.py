@@ -6,7 +6,8 @@ once to four times a day 12-bin histograms of angle, speed and torque per axis p
 torque indicators, resampled to the day's maximum (ch. 5.3.1-5.3.2). :class:`Fleet` draws such a
 fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one run per robot:
 
-- both robot models, in turn; a process (task) per robot; parts of two sizes that the robot picks
+- both robot models, in turn; a process (task) per robot, or with ``task_mix`` two, its own and a
+  second drawn from the others, one of them drawn for each cycle; parts of two sizes that the robot picks
   at random, sized to the model; its own hall climate (mean, seasonal swing, the day of the year
   its record starts), warm-up over each shift, its daily records taken at the same hours every day;
   its own unit-to-unit spread of friction and link masses (:mod:`faultgen.operation.conditions`);
@@ -70,6 +71,10 @@ class Fleet:
     conditions : bool
         Each robot's operating conditions (climate, parts, unit spread); False: none, the robots
         differ only by model, process and fault (an ablation: what the conditions do).
+    task_mix : bool
+        Each robot runs a second task, drawn from the other two, in a random half of its cycles
+        (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
+        so the fleet's draws and records are those of the fleets measured before it existed.
 
     Raises
     ------
@@ -88,6 +93,7 @@ class Fleet:
     seed: int = 0
     friction: str = "lugre"
     conditions: bool = True
+    task_mix: bool = False
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -109,9 +115,9 @@ class Fleet:
         object.__setattr__(self, "models", tuple(self.models))
 
     def robots(self) -> list[dict]:
-        """The draws of every robot, in order: ``run`` id, ``model``, ``task``, ``failing``,
-        ``axis`` (worn axis 1..6, 0 for a healthy robot), ``onset_day``, ``failure_day``,
-        ``seed`` and the operating ``conditions`` table."""
+        """The draws of every robot, in order: ``run`` id, ``model``, ``task`` (its own; with a task
+        mix the second is in the conditions table), ``failing``, ``axis`` (worn axis 1..6, 0 for a
+        healthy robot), ``onset_day``, ``failure_day``, ``seed`` and the operating ``conditions`` table."""
         order = np.random.default_rng([self.seed, 0]).permutation(self.size)
         failing = set(order[: self.failing].tolist())
         out = []
@@ -131,6 +137,9 @@ class Fleet:
                      "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
             if not self.conditions:  # the same draws, none of them used: only the calendar
                 table = {"cycles_per_day": self.cycles_per_day, "hours": self.hours()}
+            second = str(rng.choice([t for t in tasks.TASKS if t != task]))  # drawn last: the draws above stay
+            if self.task_mix:
+                table["task_mix"] = {"tasks": [task, second], "pattern": "random"}
             fails = i in failing
             out.append({"run": f"robot{i + 1:02d}-{model}-{task}-{'failing' if fails else 'healthy'}",
                         "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,

@@ -99,8 +99,9 @@ class RunConfig:
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
         1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
         a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
-        are not whole days, or a fault whose last cycle is not the run's or whose effect the robot
-        already carries; the message names the value.
+        are not whole days, a fault whose last cycle is not the run's or whose effect the robot
+        already carries, or a task mix without the run's task or with signals; the message names the
+        value.
     """
 
     robot: str
@@ -156,6 +157,13 @@ class RunConfig:
                              f"conditions; got wear on axes {list(self.wear.schedules)}, conditions "
                              f"{'on' if self.conditions.active else 'off'} and record = {self.record!r}: drop "
                              "them, or run the cycles independently")
+        mix = self.conditions.task_mix
+        if mix is not None and self.task not in mix.tasks:
+            raise ValueError(f"task {self.task!r} is not in the task mix ({', '.join(mix.tasks)}); a run's own task "
+                             "must be one of the tasks its cycles run")
+        if mix is not None and self.signals:
+            raise ValueError(f"a task mix ({', '.join(mix.tasks)}) keeps no signals: cycles of different tasks differ "
+                             "in length; record features only (--features-only, signals=False)")
         if self.daily:
             per_day = self.conditions.cycles_per_day
             if self.record is not None or self.signals or self.cycles % per_day:
@@ -403,29 +411,48 @@ def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.nda
 def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     """Run ``config``: simulate its recorded cycles and return what the monitoring recorded.
 
+    With a task mix (:class:`faultgen.operation.conditions.TaskMix`) the cycles of each task are
+    simulated together on that task's path, and the per-cycle results are put back in cycle order
+    (no signals: cycles of different tasks differ in length).
+
     Raises
     ------
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     """
-    prepared = _prepared(config.robot, config.task, config.friction)
+    cycles = config.recorded_cycles
+    conditions = config.conditions.evaluate(config.seed, cycles) if config.conditions.active else None
+    mix = config.conditions.task_mix
+    if mix is None:
+        result = _simulate_task(config, config.task, cycles, conditions, progress)
+    else:
+        task_of = conditions.tasks(mix, config.task)
+        groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
+        result = _merge_tasks(config, groups, [
+            _simulate_task(config, task_of[g[0]], cycles[g], _take(conditions, g), progress) for g in groups])
+    return daily_record(result) if config.daily else result
+
+
+def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, conditions: CycleConditions | None,
+                   progress: bool) -> RunResult:
+    """The recorded ``cycles`` of ``config`` that run ``task_name``, with their ``conditions``:
+    stepped, measured, their per-cycle features (and torque counts unless daily) computed."""
+    prepared = _prepared(config.robot, task_name, config.friction)
     sim, task, path, q_ref, inputs = prepared.sim, prepared.task, prepared.path, prepared.q_ref, prepared.inputs
     robot = sim.robot
     per_log = prepared.per_log
     n_steps = len(inputs) - 1
 
-    cycles = config.recorded_cycles
     multiplier = config.wear.multipliers(cycles)
     n_log = n_steps // per_log
     feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
     dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
-    conditions = config.conditions.evaluate(config.seed, cycles) if config.conditions.active else None
     plant = _Plant.of(multiplier, conditions, None if config.fault is None else config.fault.values(cycles))
 
     stepper = _step_lugre if config.friction == "lugre" else _step_stribeck
     with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
-              desc=f"{robot.name} {config.task}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
+              desc=f"{robot.name} {task_name}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
               "[{elapsed}<{remaining}]") as bar:
         started = time.perf_counter()
         if config.back_to_back:  # one simulation over the cycles' set-points one after the other
@@ -440,7 +467,7 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
                 carrying = np.flatnonzero(parts == part)
                 payload = None if part < 0 else config.conditions.payloads.parameters(int(part))
                 variant = prepared if payload is None and config.fault is None else _prepared(
-                    config.robot, config.task, config.friction, payload, config.fault)
+                    config.robot, task_name, config.friction, payload, config.fault)
                 for i in range(0, len(carrying), BATCH_CYCLES):
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
@@ -455,10 +482,41 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         result = replace(result, fault_value=plant.fault)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
-    if config.daily:
-        return daily_record(result)
-    result.features["torque_counts"] = sensors.torque_counts(result.tau_m, robot.motor_torque_limit)
+    if not config.daily:
+        result.features["torque_counts"] = sensors.torque_counts(result.tau_m, robot.motor_torque_limit)
     return result
+
+
+def _take(conditions: CycleConditions, rows: np.ndarray) -> CycleConditions:
+    """The conditions of some cycles (the unit's link masses are the run's)."""
+    return replace(conditions, **{f.name: getattr(conditions, f.name)[rows] for f in fields(conditions)
+                                  if f.name != "link_mass_factor"})
+
+
+def _merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunResult]) -> RunResult:
+    """One run's result from the results of its tasks' cycles (``groups``: their rows in the run's
+    recorded cycles): per-cycle arrays in cycle order, no signals, the time base and reference of
+    the run's own task."""
+    back = np.argsort(np.concatenate(groups))
+
+    def joined(get):
+        return np.concatenate([get(r) for r in parts])[back]
+
+    own = _prepared(config.robot, config.task, config.friction)
+    n_log = (len(own.inputs) - 1) // own.per_log
+    empty = np.zeros((len(back), 0, 6))
+    conditions = replace(parts[0].conditions, **{f.name: joined(lambda r, n=f.name: getattr(r.conditions, n))
+                                                 for f in fields(CycleConditions) if f.name != "link_mass_factor"})
+    return RunResult(
+        config=config, t=np.arange(1, n_log + 1) * sensors.LOG_PERIOD, cycles=joined(lambda r: r.cycles),
+        q_ref=own.q_ref[own.per_log::own.per_log], q_a=empty, q_m=empty, qd_a=empty, qd_m=empty, tau_m=empty,
+        tau_f=empty, tau_dist=empty, friction_multiplier=joined(lambda r: r.friction_multiplier),
+        mean_friction_torque=joined(lambda r: r.mean_friction_torque),
+        tracking_error=joined(lambda r: r.tracking_error),
+        features={name: joined(lambda r, n=name: r.features[n]) for name in parts[0].features},
+        conditions=conditions,
+        fault_value=None if parts[0].fault_value is None else joined(lambda r: r.fault_value),
+        stepping_time=sum(r.stepping_time for r in parts))
 
 
 def daily_record(result: RunResult) -> RunResult:
@@ -466,7 +524,7 @@ def daily_record(result: RunResult) -> RunResult:
     ``cycles_per_day`` cycles the largest value of every per-cycle feature and truth (histogram
     bins too, each histogram then scaled back to a sum of 1; the wear and fault of the day's last cycle), the
     operating conditions' mean (temperatures, friction factors) or largest value (payload mass),
-    the day's first part. ``cycles`` becomes the day number (1-based); no signals are kept.
+    the day's first part and task. ``cycles`` becomes the day number (1-based); no signals are kept.
 
     Returns
     -------
@@ -485,7 +543,7 @@ def daily_record(result: RunResult) -> RunResult:
         features[name] = features[name] / features[name].sum(axis=-1, keepdims=True)
     conditions = result.conditions
     if conditions is not None:
-        first = {name: getattr(conditions, name)[::per_day][:n_days] for name in ("day", "payload_part")}
+        first = {name: getattr(conditions, name)[::per_day][:n_days] for name in ("day", "payload_part", "task_index")}
         conditions = replace(conditions, **first, link_mass_factor=conditions.link_mass_factor,
                              payload_mass=days(conditions.payload_mass),
                              **{name: days(getattr(conditions, name), np.mean) for name in
