@@ -324,7 +324,7 @@ def calibrate_command(
 @app.command("sweep", cls=PlainHelpCommand)
 def sweep_command(
     preset: Annotated[
-        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, about 3 min), c2 (thesis ch. 3, about 70 min, features only).")
+        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
