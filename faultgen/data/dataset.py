@@ -466,7 +466,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
         return [*problems, f"task_index: outside 0..{len(mix['tasks']) - 1} (the task mix's tasks)"]
     for name in COUNT_ARRAYS:
         if name in data and (data[name].dtype.kind != "u" or not _counts_fit(data[name].sum(axis=-1), n_log, data,
-                                                                            conditions, _attr(group.attrs["task"]))):
+                                                                            conditions, _attr(group.attrs.get("task")))):
             problems.append(f"{name}: not counts of the {n_log} samples of each cycle")
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
@@ -481,7 +481,7 @@ def _counts_fit(totals: np.ndarray, n_log: int, data: dict, conditions: dict | N
     mix = (conditions or {}).get("task_mix")
     if mix is None:
         return bool(np.all(totals == n_log))
-    tasks = np.array([*mix["tasks"], task], dtype=object)[data["task_index"]]
+    tasks = np.array(mix["tasks"], dtype=object)[data["task_index"]]
     return all(np.all(totals[tasks == name] == (n_log if name == task else totals[tasks == name][0, 0]))
                for name in set(tasks))
 

@@ -28,7 +28,7 @@ pattern (alternating, in blocks, or at random); each part a uniform cube hanging
 industrial program sets before each move), so its feedforward carries it.
 
 **Task mix** (:class:`TaskMix`): the program a cycle runs, one of a set of tasks, chosen by the same
-patterns, as a robot that welds one product and handles another (the thesis's robots served
+patterns, as a robot that welds one product and handles another (the thesis's fleet spanned
 several processes, ch. 5.3.1). Each cycle runs its task's own path and feedforward; cycles of
 different tasks differ in length, so a run with a task mix keeps features and truth only.
 
