@@ -96,8 +96,8 @@ class Grid:
         Noise levels (:class:`faultgen.sensors.NoiseConfig`).
     conditions : dict or None
         Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
-        ``thermal``, ``payloads``, ``spread`` tables, ``cycles_per_day``, ``start_day``, ``hours``); None:
-        none, the runs differ from their references only by wear.
+        ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,
+        ``hours``); None: none, the runs differ from their references only by wear.
     fault : str or None
         A fault other than friction wear for the worn axes, ``EFFECT:PARAMETER:FINAL[:key=value,...]``
         (:func:`faultgen.operation.faults.parse_fault` without the axis, e.g. ``backlash:width:0.01``):

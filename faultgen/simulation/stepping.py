@@ -80,7 +80,7 @@ class RunConfig:
         one ended (gearbox deflections, backlash flanks, drive integrators carry over), instead of
         each from the start state. Only without wear and with every cycle recorded.
     conditions : Conditions
-        Operating conditions over the cycles (joint temperature, payloads, unit spread;
+        Operating conditions over the cycles (joint temperature, payloads, task mix, unit spread;
         :mod:`faultgen.operation.conditions`); none by default.
     signals : bool
         Keep the 250 Hz signals in the dataset (False: the per-cycle features and truth only).
