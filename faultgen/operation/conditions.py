@@ -69,12 +69,13 @@ def check_number(name: str, value, low: float = -math.inf, high: float = math.in
     return int(value) if whole else float(value)
 
 
-def _check_pattern(what: str, pattern: str, block) -> None:
-    """Refuse an unknown ``pattern`` or a ``block`` that is not a whole number >= 1, naming ``what``."""
+def _check_pattern(pattern: str, block, pattern_name: str, block_name: str) -> None:
+    """Refuse an unknown ``pattern`` or a ``block`` that is not a whole number >= 1; the message
+    names the setting (``pattern_name``, ``block_name``) and the value."""
     if pattern not in PATTERNS:
-        raise ValueError(f"{what} pattern {pattern!r}: expected one of {', '.join(PATTERNS)}")
+        raise ValueError(f"{pattern_name} {pattern!r}: expected one of {', '.join(PATTERNS)}")
     if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 1:
-        raise ValueError(f"{what} block = {block!r}: expected a whole number of cycles >= 1")
+        raise ValueError(f"{block_name} = {block!r}: expected a whole number of cycles >= 1")
 
 
 def _schedule(pattern: str, block: int, n: int, seed: int, cycles: np.ndarray, stream: int) -> np.ndarray:
@@ -185,7 +186,7 @@ class Payloads:
         if not masses or len(masses) != len(sizes):
             raise ValueError(f"payloads: {len(masses)} masses and {len(sizes)} sizes; expected one size per mass, "
                              "at least one part")
-        _check_pattern("payload", self.pattern, self.block)
+        _check_pattern(self.pattern, self.block, "payload pattern", "payload block")
         object.__setattr__(self, "masses", masses)
         object.__setattr__(self, "sizes", sizes)
 
@@ -233,7 +234,7 @@ class TaskMix:
         for task in tasks:
             if task not in TASKS:
                 raise ValueError(f"task mix: unknown task {task!r}; expected one of {', '.join(TASKS)}")
-        _check_pattern("task mix", self.pattern, self.block)
+        _check_pattern(self.pattern, self.block, "task mix pattern", "task mix block")
         object.__setattr__(self, "tasks", tasks)
 
     def index(self, seed: int, cycles: np.ndarray) -> np.ndarray:
