@@ -104,7 +104,7 @@ def test_task_mix_patterns_at_known_cycles():
     conditions = c.Conditions(task_mix=c.TaskMix(("spot_weld", "pick_place"), "blocks", block=2))
     every = conditions.evaluate(0, cycles)
     assert every.task_index.tolist() == [0, 0, 1, 1, 0, 0, 1, 1]
-    assert every.tasks(conditions.task_mix, "pick_place")[:3].tolist() == ["spot_weld", "spot_weld", "pick_place"]
+    assert every.tasks(conditions.task_mix)[:3].tolist() == ["spot_weld", "spot_weld", "pick_place"]
     assert c.Conditions(thermal=c.Temperature()).evaluate(0, cycles).task_index.tolist() == [-1] * 8
     assert c.Conditions.from_dict(json.loads(json.dumps(conditions.to_dict()))) == conditions
 

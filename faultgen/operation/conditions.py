@@ -322,11 +322,10 @@ class CycleConditions:
     link_mass_factor: np.ndarray
     task_index: np.ndarray
 
-    def tasks(self, mix: TaskMix | None, own: str) -> np.ndarray:
-        """The task name of each cycle, ``ndarray of shape (n,)`` of str: the mix's, or ``own`` (the
-        run's task) where no mix is scheduled."""
-        names = np.array([*(mix.tasks if mix is not None else ()), own], dtype=object)
-        return names[np.where(self.task_index >= 0, self.task_index, len(names) - 1)]
+    def tasks(self, mix: TaskMix) -> np.ndarray:
+        """The task name of each cycle under the task mix ``mix`` that scheduled them,
+        ``ndarray of shape (n,)`` of str."""
+        return np.array(mix.tasks, dtype=object)[self.task_index]
 
 
 @dataclass(frozen=True)

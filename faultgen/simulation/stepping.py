@@ -426,7 +426,7 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     if mix is None:
         result = _simulate_task(config, config.task, cycles, conditions, progress)
     else:
-        task_of = conditions.tasks(mix, config.task)
+        task_of = conditions.tasks(mix)
         groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
         result = _merge_tasks(config, groups, [
             _simulate_task(config, task_of[g[0]], cycles[g], _take(conditions, g), progress) for g in groups])
