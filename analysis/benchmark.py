@@ -634,19 +634,32 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
                          progress: bool = True, **kwargs) -> pd.DataFrame:
     """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
 
-    Samples are recorded cycles; features per axis: mean absolute and RMS motor torque, and the KL
-    divergence of the angle, speed and torque histograms against the run's first cycle (thesis
-    ch. 5.3.1-5.3.2). Labels: 1 for cycles of a worn run whose true wear is at least
-    ``wear_threshold`` percent, 0 otherwise; groups are runs (a "robot" of Procedure 1).
+    Samples are recorded cycles (days in a fleet), in time order; the features per axis are those
+    of thesis Table 5.1: the speed and torque indicators (:func:`analysis.features.duty_indicators`
+    over the run's samples, each standing for the same production time) and the KL divergence of
+    the angle, speed and torque histograms against the run's first sample (ch. 5.3.1-5.3.2); the
+    estimated speed and torque of the "+estM" rows are each sample's own average speed and
+    average load torque (what :func:`analysis.features.estimates_from_indicators` gives back).
+    A dataset with runs simulated before the duty was recorded (no ``average_speed``) uses the
+    mean absolute and RMS motor torque in place of the indicators and has no "+estM" rows.
+    Labels: 1 for samples of a worn run whose true wear is at least ``wear_threshold`` percent, 0
+    otherwise; groups are runs (a "robot" of Procedure 1). ``kwargs`` go to
+    :func:`analysis.classify.evaluate`.
     """
     from analysis.classify import evaluate
-    from analysis.features import HistogramKL
+    from analysis.features import HistogramKL, duty_indicators
 
-    names = ("mean_abs_torque", "rms_torque", "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
-    X, y, groups, failed, normal = [], [], [], [], []
+    duty = set(dataset.runs_with(path, dataset.DUTY_ARRAYS)) == set(dataset.list_runs(path))
+    levels = tuple(dataset.DUTY_ARRAYS) if duty else ("mean_abs_torque", "rms_torque")
+    names = (*levels, "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
+    X, estimated, y, groups, failed, normal = [], [], [], [], [], []
     for run_id, arrays, attrs in _runs(path, names):
         kl = [HistogramKL(reference="first").fit_transform(arrays[h]) for h in ("angle_hist", "speed_hist", "torque_hist")]
-        X.append(np.hstack([arrays["mean_abs_torque"], arrays["rms_torque"], *kl]))
+        if duty:
+            X.append(np.hstack([*duty_indicators(arrays["average_speed"], arrays["average_load_torque"]), *kl]))
+            estimated.append(np.hstack([arrays["average_speed"], arrays["average_load_torque"]]))
+        else:
+            X.append(np.hstack([arrays["mean_abs_torque"], arrays["rms_torque"], *kl]))
         wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
         if "fault" in attrs:  # a fault other than friction wear: its share of the final value
             wear = (fault_progress(path, run_id, arrays, attrs, int(attrs["worn_axes"][0])) - 1.0) * 100.0
@@ -658,7 +671,8 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
                          f"{len(normal)} unworn)")
     _check_training_sets(path, y, groups, failed, normal, wear_threshold)
     return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
-                    random_state=random_state, progress=progress, **kwargs)
+                    random_state=random_state, progress=progress,
+                    estimated=np.vstack(estimated) if duty else None, **kwargs)
 
 
 #: Columns holding an axis number that may be 0 (undecided) or -1 (too few cycles).

@@ -6,7 +6,9 @@ The preprocessing steps of thesis ch. 5.3.2, as scikit-learn transformers so the
 - :class:`HistogramKL`: each 12-bin histogram becomes one KL divergence (eq. 5.4), against the
   first sample or, differenced, against the previous one;
 - :class:`Difference`: ``|X_k - X_(k-1)|`` ("+diff");
-- :class:`WindowConcat`: the last ``width`` samples side by side ("+var3", "+var5").
+- :class:`WindowConcat`: the last ``width`` samples side by side ("+var3", "+var5");
+- :func:`duty_indicators` and :func:`estimates_from_indicators`: the speed and torque indicators
+  of Table 5.1 from each sample's duty, and back ("+estM").
 
 Samples are in time order (rows: recorded cycles, hours or days); the transformers that look at
 neighbouring rows treat each array they transform as one time series.
@@ -17,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator, OneToOneFeatureMixin, TransformerMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
+
+from faultgen.simulation.sensors import LOAD_EXPONENT
 
 #: Histograms must sum to 1 within this tolerance.
 SUM_TOLERANCE = 1e-6
@@ -310,3 +314,114 @@ def speed_window_mean(torque, speed, low: float, high: float) -> np.ndarray:
     count = inside.sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(count > 0, np.where(inside, t, 0.0).sum(axis=1) / count, np.nan)
+
+
+def _check_duty(name_a: str, a, name_b: str, b, production_time) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Two (n_samples, n_axes) arrays of finite values >= 0 and the production time per sample
+    (n_samples,) of finite values > 0 (default 1 each), or ValueError naming the fault."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.ndim != 2 or a.shape != b.shape:
+        raise ValueError(f"{name_a} and {name_b} must have the same shape (n_samples, n_axes), got {a.shape} "
+                         f"and {b.shape}")
+    for name, x in ((name_a, a), (name_b, b)):
+        bad = np.argwhere(~np.isfinite(x) | (x < 0))
+        if bad.size:
+            k, j = bad[0]
+            raise ValueError(f"{name}[{k}, {j}] = {float(x[k, j])!r}: expected a finite value >= 0")
+    d = np.ones(len(a)) if production_time is None else np.asarray(production_time, dtype=float)
+    if d.shape != (len(a),) or not np.all(np.isfinite(d) & (d > 0)):
+        raise ValueError(f"production_time must hold {len(a)} finite values > 0 (one per sample), got "
+                         f"{np.array2string(d, threshold=6)}")
+    return a, b, d
+
+
+def duty_indicators(average_speed, average_load_torque, production_time=None,
+                    exponent: float = LOAD_EXPONENT) -> tuple[np.ndarray, np.ndarray]:
+    """The speed and torque indicators of each sample: the axis's duty over its production so far.
+
+    Thesis Table 5.1 lists a speed indicator (rad/s, "function of actual speed and production
+    time") and a torque indicator (N m, "function of actual speed, actual torque and production
+    time"), invertible with the production time difference; their forms are not disclosed
+    (ch. 5.3.1). faultgen's are the life averages a reducer's duty is rated by, accumulated over
+    the production time ``P_k = D_1 + ... + D_k`` up to sample ``k``:
+
+    - speed indicator ``S_k = sum(n_i D_i) / P_k`` (average output speed, Harmonic Drive SHG
+      manual eq. 42.2);
+    - torque indicator ``T_k = (sum(n_i D_i T_i^p) / sum(n_i D_i))^(1/p)`` (mean load weighted by
+      revolutions, ISO 281, ``p`` = 10/3),
+
+    from each sample's average speed ``n_i`` and average load torque ``T_i``
+    (:func:`faultgen.simulation.sensors.duty`). :func:`estimates_from_indicators` inverts them.
+
+    Parameters
+    ----------
+    average_speed, average_load_torque : array-like of shape (n_samples, n_axes)
+        Per sample (a recorded cycle or a day, in time order), rad/s and N m, e.g. the dataset's
+        ``average_speed`` and ``average_load_torque``.
+    production_time : array-like of shape (n_samples,) or None, default=None
+        Production time each sample stands for, ``D_i`` in any unit (it cancels); None: equal.
+    exponent : float, default=10/3
+
+    Returns
+    -------
+    speed_indicator : ndarray of shape (n_samples, n_axes)
+        rad/s.
+    torque_indicator : ndarray of shape (n_samples, n_axes)
+        N m; NaN while the axis has not moved (no revolutions to weight by).
+
+    Raises
+    ------
+    ValueError
+        If the arrays differ in shape or are not 2-D, hold a negative or non-finite value, or
+        ``production_time`` does not hold one finite value > 0 per sample (the message names it).
+    """
+    n, t, d = _check_duty("average_speed", average_speed, "average_load_torque", average_load_torque,
+                          production_time)
+    revolutions = np.cumsum(n * d[:, None], axis=0)
+    load = np.cumsum(n * d[:, None] * t**exponent, axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        torque = np.where(revolutions > 0, load / revolutions, np.nan) ** (1.0 / exponent)
+    return revolutions / np.cumsum(d)[:, None], torque
+
+
+def estimates_from_indicators(speed_indicator, torque_indicator, production_time=None,
+                              exponent: float = LOAD_EXPONENT) -> tuple[np.ndarray, np.ndarray]:
+    """Each sample's estimated speed and torque from the indicators, the inverse of
+    :func:`duty_indicators` (thesis ch. 5.3.2, "Augmenting measurement data with estimates of
+    torque and speed", +estM).
+
+    With ``P_k`` the production time up to sample ``k`` and ``D_k = P_k - P_(k-1)`` its difference:
+    ``n_k = (S_k P_k - S_(k-1) P_(k-1)) / D_k`` and ``T_k = ((T_k^p S_k P_k - T_(k-1)^p S_(k-1)
+    P_(k-1)) / (n_k D_k))^(1/p)`` (``P_0 = 0``).
+
+    Parameters
+    ----------
+    speed_indicator : array-like of shape (n_samples, n_axes)
+        rad/s, time order.
+    torque_indicator : array-like of shape (n_samples, n_axes)
+        N m; NaN where the axis has not moved yet (as :func:`duty_indicators` gives).
+    production_time, exponent
+        As in :func:`duty_indicators`.
+
+    Returns
+    -------
+    estimated_speed, estimated_torque : ndarray of shape (n_samples, n_axes)
+        rad/s and N m. The torque of a sample in which the axis did not move is NaN: it adds
+        nothing to the torque indicator, so it cannot be recovered. Rounding grows with the number
+        of samples and the spread of the loads: 1200 samples of loads drawn from 1-50 N m come
+        back within a relative 3e-7 (speeds 4e-12).
+
+    Raises
+    ------
+    ValueError
+        As :func:`duty_indicators` (NaN is accepted in ``torque_indicator``).
+    """
+    s, _, d = _check_duty("speed_indicator", speed_indicator, "torque_indicator",
+                          np.nan_to_num(np.asarray(torque_indicator, dtype=float), nan=0.0), production_time)
+    t = np.asarray(torque_indicator, dtype=float)
+    revolutions = s * np.cumsum(d)[:, None]
+    load = np.nan_to_num(t**exponent, nan=0.0) * revolutions
+    step = np.diff(revolutions, axis=0, prepend=0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        torque = np.where(step > 0, np.diff(load, axis=0, prepend=0.0) / step, np.nan)
+    return step / d[:, None], np.maximum(torque, 0.0) ** (1.0 / exponent)

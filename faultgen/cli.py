@@ -809,7 +809,18 @@ def classify_command(
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
 ) -> None:
-    """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout."""
+    """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout.
+
+    A sample is a recorded cycle (a day in a fleet). Its features per axis are those of thesis
+    Table 5.1: the speed and torque indicators (the axis's average speed and mean load over its
+    production so far) and the KL divergences of its angle, speed and torque histograms against
+    the run's first sample; the "+estM" rows add each sample's own average speed and load. A
+    sample is 'failed' when its true wear reaches --wear-threshold. Procedure 1 holds out one
+    worn and one unworn run at a time, trains on the rest and scores the pair by AUC; --pairs 0
+    takes every pair, as the thesis did (about 8 times the default's time).
+
+    Example: faultgen fleet -o fleet.h5 && faultgen classify fleet.h5
+    """
     from analysis import benchmark
 
     _table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(

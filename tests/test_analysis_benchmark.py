@@ -285,3 +285,36 @@ def test_speed_window_changes_the_signal_only_on_axes_whose_cycles_all_reach_it(
     assert "motor speeds against the window 50-120 rad/s" in result.output and "in_window_pct" in result.output
     result = runner.invoke(app, ["bench-isolators", str(small), "--speed-window", "120", "-o", str(tmp_path / "x")])
     assert result.exit_code == 2 and "expected LOW,HIGH in rad/s" in result.output
+
+
+def test_classification_features_are_the_indicators_and_the_estimates(small, tmp_path, monkeypatch):
+    from analysis import classify
+    from analysis.features import duty_indicators
+    from faultgen import dataset
+
+    seen = {}
+    monkeypatch.setattr(classify, "evaluate", lambda X, *args, estimated=None, **kw: seen.update(X=X, est=estimated))
+    benchmark.classification_table(small, progress=False)
+    first = dataset.list_runs(small)[0]
+    arrays, _ = dataset.read_run(small, first, names=dataset.DUTY_ARRAYS)
+    n = len(arrays["average_speed"])
+    speed, torque = duty_indicators(arrays["average_speed"], arrays["average_load_torque"])
+    assert seen["X"].shape[1] == 30  # per axis: two indicators and three KL divergences (Table 5.1 without +estM)
+    np.testing.assert_array_equal(seen["X"][:n, :12], np.hstack([speed, torque]))
+    np.testing.assert_array_equal(seen["est"][:n], np.hstack([arrays["average_speed"], arrays["average_load_torque"]]))
+
+    old = tmp_path / "old.h5"  # runs simulated before the duty was recorded: the torque levels, no +estM
+    old.write_bytes(small.read_bytes())
+    with h5py.File(old, "r+") as f:
+        del f["runs"][first]["average_speed"], f["runs"][first]["average_load_torque"]
+    benchmark.classification_table(old, progress=False)
+    levels, _ = dataset.read_run(old, first, names=("mean_abs_torque", "rms_torque"))
+    np.testing.assert_array_equal(seen["X"][:n, :12], np.hstack([levels["mean_abs_torque"], levels["rms_torque"]]))
+    assert seen["est"] is None
+
+
+def test_classification_table_scores_the_estimates_rows(small):
+    table = benchmark.classification_table(small, progress=False, classifiers=["lr"],
+                                           preprocessing=["control", "+estM"])
+    assert list(table.index) == ["control", "+estM"]
+    assert np.isfinite(table[("lr", "mean")]).all()

@@ -1,5 +1,6 @@
 """faultgen.dataset.features and `faultgen export`: the tidy table equals the HDF5 arrays."""
 
+import h5py
 import numpy as np
 import pandas as pd
 import pytest
@@ -34,7 +35,7 @@ def test_features_hold_every_per_cycle_array_value_by_run_cycle_and_axis(small):
                 assert row["worn"] == (axis in attrs["worn_axes"])
                 assert row["wear_pct"] == (arrays["friction_multiplier"][k, axis - 1] - 1) * 100
                 for name in ("mean_abs_torque", "rms_torque", "mean_friction_torque", "tracking_error",
-                             "friction_multiplier"):
+                             "friction_multiplier", "average_speed", "average_load_torque"):
                     assert row[name] == arrays[name][k, axis - 1], name
                 for name in ("angle_hist", "speed_hist", "torque_hist"):
                     np.testing.assert_array_equal([row[f"{name}_{b}"] for b in range(1, 13)],
@@ -43,6 +44,27 @@ def test_features_hold_every_per_cycle_array_value_by_run_cycle_and_axis(small):
     assert set(worn["worn_axes"]) == {"3"} and set(worn[worn["worn"]]["axis"]) == {3}
     assert worn[worn["axis"] == 3]["wear_pct"].max() == pytest.approx(20.0)
     assert table.attrs["units"]["mean_abs_torque"] == "N m" and table.attrs["units"]["wear_pct"] == "%"
+    assert table.attrs["units"]["average_speed"] == "rad/s"
+
+
+def test_duty_arrays_are_checked_and_files_written_before_them_stay_valid(small, tmp_path):
+    copy = tmp_path / "copy.h5"
+    copy.write_bytes(small.read_bytes())
+    run = dataset.list_runs(copy)[0]
+    with h5py.File(copy, "r+") as f:
+        f["runs"][run]["average_load_torque"][0, 2] = -1.0
+    assert f"run {run}: average_load_torque: negative" in dataset.validate(copy)
+    with h5py.File(copy, "r+") as f:
+        del f["runs"][run]["average_load_torque"]
+    assert dataset.validate(copy) == [(f"run {run}: has one of the duty arrays average_speed, average_load_torque "
+                                       "but not the other")]
+    with h5py.File(copy, "r+") as f:  # as a run simulated before the duty was recorded
+        del f["runs"][run]["average_speed"]
+    assert dataset.validate(copy) == []
+    assert dataset.runs_with(copy, dataset.DUTY_ARRAYS) == dataset.list_runs(copy)[1:]
+    table = dataset.features(copy)
+    assert table[table["run"] == run]["average_speed"].isna().all()
+    assert table[table["run"] != run]["average_speed"].notna().all()
 
 
 @pytest.mark.parametrize("name", ["features.parquet", "features.csv", "features.csv.gz"])

@@ -6,7 +6,15 @@ from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 from sklearn.utils.estimator_checks import check_estimator
 
-from analysis.features import Difference, HistogramKL, WindowConcat, cycle_statistics, kl_divergence
+from analysis.features import (
+    Difference,
+    HistogramKL,
+    WindowConcat,
+    cycle_statistics,
+    duty_indicators,
+    estimates_from_indicators,
+    kl_divergence,
+)
 
 LOG2_3 = np.log2(3.0)
 
@@ -197,3 +205,43 @@ def test_speed_window_mean_averages_only_the_samples_inside_the_window():
         speed_window_mean(torque, speed, 120.0, 50.0)
     with pytest.raises(ValueError, match="same shape"):
         speed_window_mean(torque, speed[:, :10], 50.0, 120.0)
+
+
+def test_duty_indicators_by_hand_and_back():
+    p = 10.0 / 3.0
+    speed = np.array([[1.0, 0.0], [3.0, 2.0]])
+    torque = np.array([[2.0, 5.0], [4.0, 6.0]])
+    s, t = duty_indicators(speed, torque)
+    np.testing.assert_allclose(s, [[1.0, 0.0], [2.0, 1.0]])
+    assert t[0, 0] == pytest.approx(2.0) and np.isnan(t[0, 1])  # axis 2 has not moved yet
+    assert t[1, 0] == pytest.approx(((1 * 2.0**p + 3 * 4.0**p) / 4) ** (1 / p))
+    assert t[1, 1] == pytest.approx(6.0)  # only its moving sample counts
+    n, tau = estimates_from_indicators(s, t)
+    np.testing.assert_allclose(n, speed, atol=1e-15)
+    assert tau[0, 0] == pytest.approx(2.0) and np.isnan(tau[0, 1]) and tau[1, 1] == pytest.approx(6.0)
+    # unequal production time: a day of twice the production weighs twice
+    s, _ = duty_indicators(speed, torque, production_time=[1.0, 2.0])
+    assert s[1, 0] == pytest.approx((1.0 + 3.0 * 2) / 3)
+
+
+def test_estimates_from_indicators_invert_a_long_record():
+    rng = np.random.default_rng(5)
+    speed, torque = rng.uniform(0.1, 2.0, (1200, 6)), rng.uniform(1.0, 50.0, (1200, 6))
+    hours = rng.uniform(0.5, 2.0, 1200)
+    n, tau = estimates_from_indicators(*duty_indicators(speed, torque, hours), hours)
+    np.testing.assert_allclose(n, speed, rtol=1e-10)
+    np.testing.assert_allclose(tau, torque, rtol=1e-6)  # the docstring's figure: 3e-7
+
+
+def test_duty_indicators_refuse_bad_input_naming_it():
+    good = np.ones((3, 6))
+    with pytest.raises(ValueError, match=r"average_speed\[1, 4\] = -0.5: expected a finite value >= 0"):
+        bad = good.copy()
+        bad[1, 4] = -0.5
+        duty_indicators(bad, good)
+    with pytest.raises(ValueError, match=r"same shape \(n_samples, n_axes\), got \(3, 6\) and \(2, 6\)"):
+        duty_indicators(good, good[:2])
+    with pytest.raises(ValueError, match="production_time must hold 3 finite values > 0"):
+        duty_indicators(good, good, production_time=[1.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match=r"torque_indicator\[0, 0\] = -1.0"):
+        estimates_from_indicators(good, -good)

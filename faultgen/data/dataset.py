@@ -14,6 +14,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
         tau_f, tau_dist                        (n_cycles, n_log, 6) truth
         friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
         mean_abs_torque, rms_torque                                       (n_cycles, 6) features
+        average_speed, average_load_torque     (n_cycles, 6) each axis's duty (DUTY_ARRAYS; runs
+                                               simulated since it exists)
         angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
         torque_counts          (n_cycles, 6, 1200) samples per fine |tau_m| bin, what detection
                                bins from (COUNT_ARRAYS; runs recorded per cycle since it exists)
@@ -79,6 +81,15 @@ COUNT_AXES = "cycle, axis, fine bin"
 COUNT_ARRAYS = {
     "torque_counts": ("1", COUNT_AXES, (f"samples of the cycle in each 1/{sensors.TORQUE_COUNT_BINS} of 0..peak "
                                         "motor torque (|tau_m| as stored, larger in the last bin)")),
+}
+
+#: name -> (units, axes, description) of each axis's duty per cycle (:func:`faultgen.simulation.sensors.duty`),
+#: what the speed and torque indicators are made from; files written before it existed lack it,
+#: and stay valid.
+DUTY_ARRAYS = {
+    "average_speed": ("rad/s", "cycle, axis", "mean |qd_a| per cycle, the gearbox's average output speed"),
+    "average_load_torque": ("N m", "cycle, axis", (f"(mean(|qd_a| |tau_m|^p) / mean |qd_a|)^(1/p) per cycle, "
+                                                   f"p = {sensors.LOAD_EXPONENT:.4g} (motor side)")),
 }
 
 #: name -> (units, axes, description, condition that writes it) of the operating-condition
@@ -206,7 +217,8 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
                    for name in _condition_arrays(conditions.to_dict() if conditions.active else None)]
         if result.fault_value is not None:
             arrays.append(("fault_value", result.fault_value, FAULT_ARRAYS["fault_value"]))
-        arrays += [(name, values[name], spec) for name, spec in COUNT_ARRAYS.items() if name in values]
+        arrays += [(name, values[name], spec) for name, spec in {**DUTY_ARRAYS, **COUNT_ARRAYS}.items()
+                   if name in values]
         for name, value, (units, axes, description) in arrays:
             data = np.asarray(value)
             if axes == SIGNAL_AXES:
@@ -270,6 +282,14 @@ def list_runs(path: str | Path) -> list[str]:
         return list(f["runs"])
 
 
+def runs_with(path: str | Path, names: Iterable[str]) -> list[str]:
+    """Run ids of a dataset, in file order, that hold every array of ``names`` (e.g. the
+    :data:`DUTY_ARRAYS`, which runs simulated before they existed lack)."""
+    names = list(names)
+    with _open(path) as f:
+        return [run_id for run_id in f["runs"] if all(name in f["runs"][run_id] for name in names)]
+
+
 def read_run(path: str | Path, run_id: str | None = None,
              names: Iterable[str] | None = None) -> tuple[dict[str, np.ndarray], dict]:
     """Read one run: its arrays by name and its attributes (labels and provenance).
@@ -313,7 +333,8 @@ def features(path: str | Path) -> pd.DataFrame:
     (:data:`FEATURE_LABELS`), ``worn_axes`` (the run's worn axes as text, "2" or "2 5"; "" for
     none), ``cycle`` (1-based), ``axis`` (1..6), ``worn`` (this axis wears in this run),
     ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
-    then every array of :data:`ARRAYS` with axes "cycle, axis" under its own name and every
+    then every array of :data:`ARRAYS` with axes "cycle, axis" and of :data:`DUTY_ARRAYS` (empty for
+    runs without) under its own name and every
     histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` .. ``torque_hist_12``,
     and, for runs with operating conditions, each of their :data:`CONDITION_ARRAYS` (a per-cycle
     value on each of the cycle's rows, a per-axis one on each axis's; empty for runs without).
@@ -330,8 +351,10 @@ def features(path: str | Path) -> pd.DataFrame:
     per_cycle = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis"]
     histograms = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis, bin"]
     frames = []
+    with_duty = runs_with(path, DUTY_ARRAYS)
     for run_id in list_runs(path):
-        arrays, attrs = read_run(path, run_id, names=("cycles", *per_cycle, *histograms))
+        duty = list(DUTY_ARRAYS) if run_id in with_duty else []
+        arrays, attrs = read_run(path, run_id, names=("cycles", *per_cycle, *duty, *histograms))
         n_cycles, n_axes = arrays["friction_multiplier"].shape
         present = _condition_arrays(json.loads(attrs["conditions"]) if "conditions" in attrs else None)
         conditions = read_run(path, run_id, names=present)[0] if present else {}
@@ -341,7 +364,7 @@ def features(path: str | Path) -> pd.DataFrame:
                    "cycle": np.repeat(arrays["cycles"], n_axes), "axis": np.tile(np.arange(1, n_axes + 1), n_cycles),
                    "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
                    "wear_pct": ((arrays["friction_multiplier"] - 1.0) * 100.0).ravel()}
-        columns.update({name: arrays[name].ravel() for name in per_cycle})
+        columns.update({name: arrays[name].ravel() for name in (*per_cycle, *duty)})
         for name, values in conditions.items():  # per cycle, per axis or per unit, to rows
             axes = CONDITION_ARRAYS[name][1]
             columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)
@@ -352,6 +375,7 @@ def features(path: str | Path) -> pd.DataFrame:
         frames.append(pd.DataFrame(columns))
     table = pd.concat(frames, ignore_index=True)
     table.attrs["units"] = {"wear_pct": "%", **{name: ARRAYS[name][0] for name in per_cycle},
+                            **{name: DUTY_ARRAYS[name][0] for name in DUTY_ARRAYS if name in table},
                             **{name: CONDITION_ARRAYS[name][0] for name in CONDITION_ARRAYS if name in table},
                             **{c: ARRAYS[c.rsplit("_", 1)[0]][0] for c in table.columns
                                if c.rsplit("_", 1)[0] in histograms}}
@@ -427,7 +451,9 @@ def _validate_run(group: h5py.Group) -> list[str]:
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
     if "fault" in group.attrs:
         schema.update(FAULT_ARRAYS)
-    schema.update({name: spec for name, spec in COUNT_ARRAYS.items() if name in group})
+    schema.update({name: spec for name, spec in {**DUTY_ARRAYS, **COUNT_ARRAYS}.items() if name in group})
+    if sum(name in group for name in DUTY_ARRAYS) == 1:
+        problems.append(f"has one of the duty arrays {', '.join(DUTY_ARRAYS)} but not the other")
     missing = [name for name in schema if name not in group]
     problems += [f"missing array {name!r}" for name in missing]
     if missing:
@@ -471,6 +497,9 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
             problems.append(f"{name}: not positive")
+    for name in DUTY_ARRAYS:
+        if name in data and np.any(data[name] < 0):
+            problems.append(f"{name}: negative")
     return problems
 
 

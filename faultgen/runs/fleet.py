@@ -15,7 +15,9 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   exp4 schedule (thesis eq. 6.6) from a drawn onset day to ``failure_wear`` percent on its last
   day, the failure day; a healthy robot does not wear;
 - every day ``cycles_per_day`` cycles are simulated and reduced to one daily record, the day's
-  maximum (:func:`faultgen.simulation.stepping.daily_record`); no 250 Hz signals are kept.
+  maximum (:func:`faultgen.simulation.stepping.daily_record`): the histograms and each axis's
+  duty (average speed and load torque, from which ``analysis.features.duty_indicators`` makes the
+  speed and torque indicators); no 250 Hz signals are kept.
 
 Labels: a run's ``worn_axes`` (empty: healthy), its wear schedule (``last_cycle`` /
 ``cycles_per_day`` is the failure day) and the true wear per day (``friction_multiplier``); the

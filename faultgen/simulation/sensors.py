@@ -171,7 +171,8 @@ def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_r
     -------
     dict of ndarray
         ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) in N m (thesis ch. 6.3.2: the mean of
-        absolute torque per cycle); ``angle_hist``, ``speed_hist``, ``torque_hist``
+        absolute torque per cycle); ``average_speed`` (rad/s) and ``average_load_torque`` (N m),
+        (n_cycles, 6), :func:`duty`; ``angle_hist``, ``speed_hist``, ``torque_hist``
         (n_cycles, 6, 12): fraction of the cycle's samples in each twelfth of the design range
         (angle from its lower to its upper limit; |speed| and |torque| from 0 to their design
         maximum, larger values in the last bin; thesis ch. 5.3.1).
@@ -183,4 +184,46 @@ def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_r
         "angle_hist": histogram(q_a, joint_range[:, 0], joint_range[:, 1]),
         "speed_hist": histogram(np.abs(qd_a), zeros, speed_limit),
         "torque_hist": histogram(np.abs(tau_m), zeros, torque_limit),
+        **duty(qd_a, tau_m),
     }
+
+
+#: Life exponent ``p`` of the average load torque: 10/3, that of roller bearings (ISO 281), the
+#: cross-roller output bearings of robot reducers (Harmonic Drive SHG manual, table 42.4).
+LOAD_EXPONENT = 10.0 / 3.0
+#: The per-cycle duty of each axis that :func:`duty` computes, what the speed and torque
+#: indicators of thesis ch. 5.3.1 are made from (``analysis.features.duty_indicators``).
+DUTY = ("average_speed", "average_load_torque")
+
+
+def duty(qd_a: np.ndarray, tau_m: np.ndarray, exponent: float = LOAD_EXPONENT) -> dict[str, np.ndarray]:
+    """Average speed and average load torque of each cycle and axis, the duty a gearbox is sized by.
+
+    The thesis's speed and torque indicators are undisclosed "invertible functions of actual speed,
+    actual torque, production time and production time difference" (ch. 5.3.1, Table 5.1).
+    faultgen records the two quantities by which reducer and bearing makers rate life under a
+    varying duty: the average output speed ``n_av = mean |qd_a|`` (Harmonic Drive SHG manual,
+    eq. 42.2) and the average load torque ``T_av = (mean(|qd_a| |tau_m|^p) / n_av)^(1/p)``, the
+    speed-weighted mean load of ISO 281 with ``p`` = :data:`LOAD_EXPONENT`. A worn axis needs more
+    torque at the same speeds, so ``T_av`` rises with its friction, more at its loaded moments
+    than ``mean |tau_m|`` does.
+
+    Parameters
+    ----------
+    qd_a : ndarray of shape (n_cycles, n_samples, 6)
+        Logged arm speed, rad/s (the gearbox's output).
+    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+        Logged motor torque, N m at the motor side.
+    exponent : float, default=LOAD_EXPONENT
+
+    Returns
+    -------
+    dict of ndarray of shape (n_cycles, 6)
+        ``average_speed`` in rad/s and ``average_load_torque`` in N m at the motor side. An axis
+        that does not move in a cycle has ``average_speed`` 0 and a time-weighted mean load.
+    """
+    speed, load = np.abs(qd_a), np.abs(tau_m) ** exponent
+    average_speed = speed.mean(axis=1)
+    weighted = (speed * load).mean(axis=1)
+    mean_load = np.divide(weighted, average_speed, out=load.mean(axis=1), where=average_speed > 0)
+    return {"average_speed": average_speed, "average_load_torque": mean_load ** (1.0 / exponent)}

@@ -357,7 +357,8 @@ class RunResult:
         Largest absolute error of the true arm angle against the reference, rad.
     features : dict of ndarray
         Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
-        ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
+        ``mean_abs_torque``, ``rms_torque``, ``average_speed``, ``average_load_torque``
+        (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
         ``torque_hist`` (n_cycles, 6, 12); per recorded cycle (not in daily records) also
         ``torque_counts`` (n_cycles, 6, 1200), :func:`faultgen.sensors.torque_counts`.
     conditions : CycleConditions or None
