@@ -630,8 +630,13 @@ def _kl_features(torque: np.ndarray, cycles: np.ndarray, scale: np.ndarray, peri
     return kl_divergence(grouped, reference[None]), index
 
 
+#: Samples the thesis's classifiers saw per robot before its prediction horizon (ch. 5.3.3: "T-13
+#: to T-3" for a horizon of 3 days, T the failure day).
+THESIS_WINDOW = 10
+
+
 def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,
-                         progress: bool = True, **kwargs) -> pd.DataFrame:
+                         progress: bool = True, horizon: int | None = None, **kwargs) -> pd.DataFrame:
     """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
 
     Samples are recorded cycles (days in a fleet), in time order; the features per axis are those
@@ -643,9 +648,23 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     A dataset with runs simulated before the duty was recorded (no ``average_speed``) uses the
     mean absolute and RMS motor torque in place of the indicators and has no "+estM" rows.
     Labels: 1 for samples of a worn run whose true wear is at least ``wear_threshold`` percent, 0
-    otherwise; groups are runs (a "robot" of Procedure 1). ``kwargs`` go to
+    otherwise; groups are runs (a "robot" of Procedure 1). With ``horizon`` the thesis's protocol
+    instead (ch. 5.3.3; its Table 5.2 used 3 days): each run keeps the samples from ``horizon +``
+    :data:`THESIS_WINDOW` to ``horizon`` before its last one (the failure day T of a failing
+    robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
+    worn run is labelled 1 (the robot's state), of an unworn run 0. ``kwargs`` go to
     :func:`analysis.classify.evaluate`.
+
+    Raises
+    ------
+    ValueError
+        If ``horizon`` is not an integer >= 0 or a run is too short for it (the message names the
+        run and its samples), or the training sets would lack a class (see
+        :func:`_check_training_sets`).
     """
+    if horizon is not None and (isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer))
+                                or horizon < 0):
+        raise ValueError(f"horizon = {horizon!r}: expected an integer >= 0 (samples before the last one)")
     from analysis.classify import evaluate
     from analysis.features import HistogramKL, duty_indicators
 
@@ -664,12 +683,24 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         if "fault" in attrs:  # a fault other than friction wear: its share of the final value
             wear = (fault_progress(path, run_id, arrays, attrs, int(attrs["worn_axes"][0])) - 1.0) * 100.0
         y.append((wear >= wear_threshold).astype(int))
-        groups.append(np.full(len(wear), run_id, dtype=object))
+        if horizon is not None:  # the thesis's window and the robot's state
+            n = len(wear)
+            if n < horizon + THESIS_WINDOW + 1:
+                raise ValueError(f"{path}: run {run_id} has {n} samples; horizon {horizon} needs at least "
+                                 f"{horizon + THESIS_WINDOW + 1} (a window of {THESIS_WINDOW + 1} ending {horizon} "
+                                 "before the last)")
+            keep = slice(n - 1 - horizon - THESIS_WINDOW, n - horizon)
+            X[-1] = X[-1][keep]
+            if duty:
+                estimated[-1] = estimated[-1][keep]
+            y[-1] = np.full(THESIS_WINDOW + 1, int(len(attrs["worn_axes"]) > 0))
+        groups.append(np.full(len(y[-1]), run_id, dtype=object))
         (failed if len(attrs["worn_axes"]) else normal).append(run_id)
     if not failed or not normal:
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")
-    _check_training_sets(path, y, groups, failed, normal, wear_threshold)
+    _check_training_sets(path, y, groups, failed, normal, f"true wear >= {wear_threshold:g} %" if horizon is None
+                         else f"worn runs' last {THESIS_WINDOW + 1} before the horizon")
     return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
                     random_state=random_state, progress=progress,
                     estimated=np.vstack(estimated) if duty else None, **kwargs)
@@ -684,8 +715,9 @@ AXIS_COLUMNS = {"predicted", "located_axis"}
 MIN_CLASS_SAMPLES = 5
 
 
-def _check_training_sets(path, y: list, groups: list, failed: list, normal: list, wear_threshold: float) -> None:
-    """Refuse a dataset whose leave-pair-out training sets lack a class, saying what it lacks."""
+def _check_training_sets(path, y: list, groups: list, failed: list, normal: list, failed_means: str) -> None:
+    """Refuse a dataset whose leave-pair-out training sets lack a class, saying what it lacks
+    (``failed_means``: what makes a sample failed, for the message)."""
     per_run = {g[0]: (int(labels.sum()), int(len(labels) - labels.sum())) for labels, g in zip(y, groups, strict=True)}
     totals = np.sum(list(per_run.values()), axis=0)
     fewest = min((totals[0] - per_run[f][0] - per_run[n][0], totals[1] - per_run[f][1] - per_run[n][1])
@@ -693,7 +725,7 @@ def _check_training_sets(path, y: list, groups: list, failed: list, normal: list
     if min(fewest) < MIN_CLASS_SAMPLES:
         raise ValueError(
             f"{path}: this dataset lacks runs for leave-pair-out classification: with one worn and one unworn run "
-            f"held out, the smallest training set has {fewest[0]} failed samples (true wear >= {wear_threshold:g} %) "
+            f"held out, the smallest training set has {fewest[0]} failed samples ({failed_means}) "
             f"and {fewest[1]} normal ones, and the classifiers need at least {MIN_CLASS_SAMPLES} of each "
             f"({len(failed)} worn and {len(normal)} unworn runs here). Use `faultgen sweep --preset quick` (18 worn, "
             "3 unworn runs) or a grid with more runs and recorded cycles")

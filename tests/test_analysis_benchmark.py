@@ -318,3 +318,26 @@ def test_classification_table_scores_the_estimates_rows(small):
                                            preprocessing=["control", "+estM"])
     assert list(table.index) == ["control", "+estM"]
     assert np.isfinite(table[("lr", "mean")]).all()
+
+
+def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypatch):
+    from analysis import classify
+    from faultgen import dataset
+
+    # one unworn run: held out, it leaves no healthy robot to train on
+    with pytest.raises(ValueError, match=r"has 11 failed samples \(worn runs' last 11 before the horizon\) and 0 normal"):
+        benchmark.classification_table(small, progress=False, horizon=3)
+    seen = []
+    monkeypatch.setattr(classify, "evaluate", lambda X, y, groups, *a, estimated=None, **kw: seen.append((X, y, groups)))
+    monkeypatch.setattr(benchmark, "_check_training_sets", lambda *args: None)
+    benchmark.classification_table(small, progress=False)
+    benchmark.classification_table(small, progress=False, horizon=3)
+    (X, _, groups), (Xw, yw, groups_w) = seen
+    for run_id in dataset.list_runs(small):  # 40 cycles: the 27th to the 37th (T-13 .. T-3 of T = 40)
+        np.testing.assert_array_equal(Xw[groups_w == run_id], X[groups == run_id][26:37])
+        worn = "nowear" not in run_id
+        assert (yw[groups_w == run_id] == int(worn)).all() and (groups_w == run_id).sum() == 11
+    with pytest.raises(ValueError, match="has 40 samples; horizon 30 needs at least 41"):
+        benchmark.classification_table(small, progress=False, horizon=30)
+    with pytest.raises(ValueError, match="horizon = -1: expected an integer >= 0"):
+        benchmark.classification_table(small, progress=False, horizon=-1)
