@@ -666,19 +666,15 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
                                 or horizon < 0):
         raise ValueError(f"horizon = {horizon!r}: expected an integer >= 0 (samples before the last one)")
     from analysis.classify import evaluate
-    from analysis.features import HistogramKL, duty_indicators
 
     duty = set(dataset.runs_with(path, dataset.DUTY_ARRAYS)) == set(dataset.list_runs(path))
     levels = tuple(dataset.DUTY_ARRAYS) if duty else ("mean_abs_torque", "rms_torque")
     names = (*levels, "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
     X, estimated, y, groups, failed, normal = [], [], [], [], [], []
     for run_id, arrays, attrs in _runs(path, names):
-        kl = [HistogramKL(reference="first").fit_transform(arrays[h]) for h in ("angle_hist", "speed_hist", "torque_hist")]
+        X.append(_table_5_1(arrays, duty))
         if duty:
-            X.append(np.hstack([*duty_indicators(arrays["average_speed"], arrays["average_load_torque"]), *kl]))
             estimated.append(np.hstack([arrays["average_speed"], arrays["average_load_torque"]]))
-        else:
-            X.append(np.hstack([arrays["mean_abs_torque"], arrays["rms_torque"], *kl]))
         wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
         if "fault" in attrs:  # a fault other than friction wear: its share of the final value
             wear = (fault_progress(path, run_id, arrays, attrs, int(attrs["worn_axes"][0])) - 1.0) * 100.0
@@ -704,6 +700,18 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
                     random_state=random_state, progress=progress,
                     estimated=np.vstack(estimated) if duty else None, **kwargs)
+
+
+def _table_5_1(arrays: dict, duty: bool) -> np.ndarray:
+    """A run's control features (n_samples, 30): per axis the speed and torque indicators (with
+    ``duty``; else the mean absolute and RMS motor torque) and the KL divergences of the angle,
+    speed and torque histograms against the first sample (thesis Table 5.1 without the estimates)."""
+    from analysis.features import HistogramKL, duty_indicators
+
+    kl = [HistogramKL(reference="first").fit_transform(arrays[h]) for h in ("angle_hist", "speed_hist", "torque_hist")]
+    levels = (duty_indicators(arrays["average_speed"], arrays["average_load_torque"]) if duty
+              else (arrays["mean_abs_torque"], arrays["rms_torque"]))
+    return np.hstack([*levels, *kl])
 
 
 #: Columns holding an axis number that may be 0 (undecided) or -1 (too few cycles).
