@@ -6,6 +6,8 @@
   "+diff", "+var3", "+pca", "+diff+var3+pca", ...) as lists of transformer steps, and
   :func:`make_pipeline` to put one in front of a classifier;
 - :func:`leave_pair_out_auc`: Procedure 1, leave one failed and one normal robot out, ROC AUC;
+- :func:`permuted_roles`: the chance level of Procedure 1 on the same robots, labels exchanged
+  between runs (a group-level permutation test);
 - :func:`compare_preprocessing`: Procedure 2, Levene, then Welch ANOVA + Games-Howell or ANOVA +
   Tukey HSD (pingouin);
 - :func:`evaluate`: every classifier with every combination, Table 5.2's layout.
@@ -488,6 +490,75 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     return (aucs, pairs) if return_pairs else aucs
 
 
+def permuted_roles(labels, groups, failed_groups, normal_groups, n_permutations: int,
+                   random_state: int | None = 0) -> list[tuple[np.ndarray, list, list]]:
+    """Label sets of Procedure 1 with the runs' roles exchanged at random: the null of a permutation test.
+
+    Each permutation gives every run the label sequence of another run with as many samples (a
+    random permutation within each sample count), so a run that inherits a failed run's
+    sequence becomes failed. The number of failed runs and every label sequence are kept; only
+    their link to the features is broken. Leave-pair-out AUC on these labels is the chance level
+    of the dataset's robots, which is not 0.5 when samples of one robot are alike: a held-out
+    robot's closest training robots are then its own kind with one member fewer in its class (a
+    bias towards AUC < 0.5; Ojala & Garriga 2010, JMLR 11, test 1, permute labels within the
+    structure the data has; Airola et al. 2011, CSDA 55, on leave-pair-out AUC).
+
+    Parameters
+    ----------
+    labels : array-like of shape (n_samples,)
+        0/1 labels (:func:`make_labels`).
+    groups : array-like of shape (n_samples,)
+        Run of each sample; each run's rows in time order.
+    failed_groups, normal_groups : sequence
+        Runs with and without wear.
+    n_permutations : int
+        Label sets to draw, >= 1.
+    random_state : int or None, default=0
+        Seed of ``numpy.random.default_rng``.
+
+    Returns
+    -------
+    list of (labels, failed, normal)
+        ``n_permutations`` label arrays of shape (n_samples,) and the runs that are failed and
+        normal under each; a run takes the role of the run whose sequence it got (none if that run
+        is in neither list).
+
+    Raises
+    ------
+    ValueError
+        If ``n_permutations`` is not an integer >= 1.
+    """
+    if isinstance(n_permutations, bool) or not isinstance(n_permutations, (int, np.integer)) or n_permutations < 1:
+        raise ValueError(f"n_permutations = {n_permutations!r}; expected an integer >= 1")
+    labels, groups = np.asarray(labels), np.asarray(groups)
+    failed, normal = set(failed_groups), set(normal_groups)
+    runs = list(pd.unique(groups))
+    rows = {g: np.flatnonzero(groups == g) for g in runs}
+    strata: dict[int, list] = {}
+    for g in runs:
+        strata.setdefault(rows[g].size, []).append(g)
+    rng = np.random.default_rng(random_state)
+    out = []
+    for _ in range(n_permutations):
+        permuted, new_failed, new_normal = np.empty_like(labels), [], []
+        for members in strata.values():
+            for g, donor in zip(members, rng.permutation(np.array(members, dtype=object)), strict=True):
+                permuted[rows[g]] = labels[rows[donor]]
+                if donor in failed:
+                    new_failed.append(g)
+                elif donor in normal:
+                    new_normal.append(g)
+        out.append((permuted, new_failed, new_normal))
+    return out
+
+
+def null_p_value(observed: float, null: np.ndarray) -> float:
+    """Permutation p-value of a mean AUC: (1 + #(null >= observed)) / (1 + n), a NaN null value
+    counted as reaching it (Phipson & Smyth 2010: never 0, exact for a permutation test)."""
+    null = np.asarray(null, dtype=float)
+    return float((1 + np.sum(~(null < observed))) / (1 + null.size))
+
+
 # --------------------------------------------------------------------------------------------
 # Procedure 2
 
@@ -609,7 +680,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
              classifiers: Iterable[str] | Mapping[str, object] = tuple(CLASSIFIERS),
              preprocessing: Iterable[str] | None = None, *, estimated=None, n_pairs: int | None = None,
              random_state: int | None = 0, label_rule=None, n_jobs: int | None = None,
-             return_aucs: bool = False, progress: bool = False):
+             permutations: int = 0, return_aucs: bool = False, progress: bool = False):
     """Mean and standard deviation of leave-pair-out AUC per combination and classifier, Table 5.2.
 
     Every combination and classifier is scored by :func:`leave_pair_out_auc` on the same pairs.
@@ -628,7 +699,13 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         appended as columns to ``X`` for the combinations starting with ``+estM``; required by
         them. faultgen has no such block of its own; pass e.g. model-based estimates.
     n_pairs, random_state, label_rule, n_jobs
-        As in :func:`leave_pair_out_auc`; ``random_state`` also seeds the classifiers.
+        As in :func:`leave_pair_out_auc`; ``random_state`` also seeds the classifiers and the
+        permutations.
+    permutations : int, default=0
+        With ``K >= 1``, also the chance level of every cell: the mean AUC on each of ``K`` label
+        sets with the runs' roles exchanged (:func:`permuted_roles`, the same sets for every
+        cell), reported as their mean (column ``"null"``) and the permutation p-value of the
+        observed mean (``"p"``, :func:`null_p_value`). Costs ``K`` times the table.
     return_aucs : bool, default=False
         Also return ``{(classifier, preprocessing): ndarray of AUCs}``, the input of
         :func:`compare_preprocessing`.
@@ -640,7 +717,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     table : pandas.DataFrame
         Index ``preprocessing`` (in the order given), columns a MultiIndex ``(classifier,
         "mean" | "std")``: mean and sample standard deviation (ddof 1) of the AUCs, NaN pairs
-        left out.
+        left out; with ``permutations`` also ``"null"`` and ``"p"`` per classifier.
     aucs : dict
         Only with ``return_aucs=True``.
 
@@ -648,9 +725,12 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     ------
     ValueError
         As :func:`leave_pair_out_auc`; for an unknown classifier or combination; for ``+estM``
-        without ``estimated``, or ``estimated`` with other rows than ``X``.
+        without ``estimated``, or ``estimated`` with other rows than ``X``; for ``permutations``
+        not an integer >= 0.
     """
     X, y, groups, failed, normal = _check_inputs(X, y, groups, failed_groups, normal_groups)
+    if isinstance(permutations, bool) or not isinstance(permutations, (int, np.integer)) or permutations < 0:
+        raise ValueError(f"permutations = {permutations!r}; expected an integer >= 0 (0: no chance level)")
     if estimated is not None:
         estimated = np.asarray(estimated, dtype=float)
         if estimated.ndim == 1:
@@ -675,25 +755,36 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
             models[c] = c
     labels = make_labels(y, groups, failed, label_rule)
     X_est = np.hstack([X, estimated]) if estimated is not None else None
+    roles = permuted_roles(labels, groups, failed, normal, permutations, random_state) if permutations else []
 
     aucs: dict[tuple[str, str], np.ndarray] = {}
+    null: dict[tuple[str, str], np.ndarray] = {}
     cells = list(product(names, models.items()))
     for name, (column, model) in tqdm(cells, desc="classify", unit="cell", disable=not progress):
         pipe = make_pipeline(model, name, random_state=random_state)
         data = X_est if name.startswith(ESTIMATED) else X
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UndefinedAUCWarning)  # summarised once below
+            warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
             aucs[column, name] = leave_pair_out_auc(pipe, data, labels, groups, failed, normal,
                                                     n_pairs=n_pairs, random_state=random_state, n_jobs=n_jobs)
+            null[column, name] = np.array([
+                np.nanmean(leave_pair_out_auc(pipe, data, permuted, groups, f, n, n_pairs=n_pairs,
+                                              random_state=random_state, n_jobs=n_jobs))
+                for permuted, f, n in roles])
     n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
     if n_nan - {0}:
         warnings.warn(f"up to {max(n_nan)} held-out pairs per cell have no AUC (one class only); they are "
                       "left out of mean and std", UndefinedAUCWarning, stacklevel=2)
 
-    columns = pd.MultiIndex.from_product([list(models), ["mean", "std"]], names=["classifier", "statistic"])
+    statistics = ["mean", "std", "null", "p"] if permutations else ["mean", "std"]
+    columns = pd.MultiIndex.from_product([list(models), statistics], names=["classifier", "statistic"])
     table = pd.DataFrame(index=pd.Index(names, name="preprocessing"), columns=columns, dtype=float)
     for (column, name), a in aucs.items():
         valid = a[~np.isnan(a)]
         table.loc[name, (column, "mean")] = valid.mean() if valid.size else np.nan
         table.loc[name, (column, "std")] = valid.std(ddof=1) if valid.size > 1 else np.nan
+        if permutations:
+            table.loc[name, (column, "null")] = np.nanmean(null[column, name])
+            table.loc[name, (column, "p")] = null_p_value(table.loc[name, (column, "mean")], null[column, name])
     return (table, aucs) if return_aucs else table

@@ -808,7 +808,16 @@ def classify_command(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
         "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0)] = None,
-    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs and the random forest.")] = 0,
+    permutations: Annotated[int, typer.Option(
+        help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
+        "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
+        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0)] = 0,
+    classifiers: Annotated[list[str] | None, typer.Option(
+        "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")] = None,
+    preprocessing: Annotated[list[str] | None, typer.Option(
+        "--preprocessing", help="Only this row of Table 5.2 (control, +diff, +estM+diff+var3+pca, ...); repeat for "
+        "several. Default all.")] = None,
+    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Annotated[bool, typer.Option(help="Show a progress bar.")] = True,
@@ -823,15 +832,24 @@ def classify_command(
     worn and one unworn run at a time, trains on the rest and scores the pair by AUC; --pairs 0
     takes every pair, as the thesis did.
 
-    Example (the thesis's Table 5.2: its window before failure, every pair):
+    Robots of one kind (process, model) look alike, so chance is not 0.5 here: --permutations
+    measures it on the same robots, and 'p' says whether the AUC beats it.
+
+    Examples (the thesis's Table 5.2: its window before failure, every pair; then the chance
+    level of two cells):
 
       faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
+
+      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
     """
     from analysis import benchmark
 
+    cells = {"classifiers": classifiers} if classifiers else {}
+    if preprocessing:
+        cells["preprocessing"] = preprocessing
     _table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
-        horizon=horizon))
+        horizon=horizon, permutations=permutations, **cells))
 
 
 def _check_outputs(files: list[Path], overwrite: bool) -> None:

@@ -320,6 +320,21 @@ def test_classification_table_scores_the_estimates_rows(small):
     assert np.isfinite(table[("lr", "mean")]).all()
 
 
+def test_classify_command_scores_chosen_cells_and_their_chance_level(small, tmp_path):
+    result = runner.invoke(app, ["classify", str(small), "--classifier", "lr", "--preprocessing", "control",
+                                 "--preprocessing", "+diff", "--permutations", "2", "--no-progress",
+                                 "-o", str(tmp_path / "c")])
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.output.splitlines() if line.startswith("|")]
+    assert lines[0] == "| preprocessing | lr mean | lr std | lr null | lr p |"
+    assert [line.split(" | ")[0] for line in lines[2:]] == ["| control", "| +diff"]
+    assert (tmp_path / "c.csv").exists()
+    result = runner.invoke(app, ["classify", str(small), "--classifier", "knn", "--no-progress",
+                                 "-o", str(tmp_path / "k")])
+    assert result.exit_code == 2 and "unknown classifier 'knn'" in result.output
+    assert not (tmp_path / "k.csv").exists()
+
+
 def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypatch):
     from analysis import classify
     from faultgen import dataset

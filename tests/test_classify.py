@@ -179,6 +179,69 @@ def test_bad_inputs_are_named():
         classify.leave_pair_out_auc(factory, X, y[:-1], groups, failed, normal)
 
 
+# ---------------------------------------------------------------------------- chance level
+
+
+def test_permuted_roles_exchange_whole_label_sequences_between_runs_of_equal_length():
+    _, y, groups, failed, normal = runs(n_failed=3, n_normal=3, n_cycles=12)
+    y = y.copy()
+    y[groups == "worn1"] = (np.arange(12) >= 9).astype(int)  # one failed run with its own sequence
+    groups = np.concatenate([groups, np.full(5, "short", dtype=object)])  # alone in its length: stays put
+    y = np.concatenate([y, np.zeros(5, dtype=int)])
+    normal = [*normal, "short"]
+    roles = classify.permuted_roles(y, groups, failed, normal, 50, random_state=1)
+    assert len(roles) == 50
+    sequences = {g: y[groups == g] for g in failed + normal}
+    worn1_went_elsewhere = False
+    for labels, f, n in roles:
+        assert len(f) == len(failed) and sorted(f + n) == sorted(failed + normal)
+        donors = []
+        for g in f + n:  # each run carries one donor's whole sequence, failed ones from failed runs
+            match = [d for d in (failed if g in f else normal) if np.array_equal(labels[groups == g], sequences[d])]
+            assert match, (g, labels[groups == g])
+            donors.append(match[0])
+        assert "short" in n and np.array_equal(labels[groups == "short"], sequences["short"])
+        assert sum(np.array_equal(labels[groups == g], sequences["worn1"]) for g in f) == 1
+        worn1_went_elsewhere |= not np.array_equal(labels[groups == "worn1"], sequences["worn1"])
+        assert classify.make_labels(labels, groups, f).sum() == y.sum()
+    assert worn1_went_elsewhere
+    assert sum(set(f) != set(failed) for _, f, _ in roles) > 40  # the roles really move
+    again = classify.permuted_roles(y, groups, failed, normal, 50, random_state=1)
+    for (a, fa, na), (b, fb, nb) in zip(roles, again, strict=True):  # seeded: the same sets again
+        assert np.array_equal(a, b) and fa == fb and na == nb
+    with pytest.raises(ValueError, match="n_permutations = 0; expected an integer >= 1"):
+        classify.permuted_roles(y, groups, failed, normal, 0)
+
+
+def test_null_p_value_counts_the_observation_and_nan_as_reaching_it():
+    assert classify.null_p_value(0.7, np.array([0.5, 0.7, 0.8, np.nan])) == pytest.approx(4 / 5)
+    assert classify.null_p_value(0.9, np.array([0.5, 0.6, 0.4])) == pytest.approx(1 / 4)
+
+
+def test_evaluate_reports_the_chance_level_of_each_cell():
+    X, y, groups, failed, normal = runs(n_failed=5, n_normal=5, n_cycles=16)
+    table, aucs = classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], preprocessing=["control", "+diff"],
+                                    n_pairs=6, permutations=9, return_aucs=True)
+    assert list(table.columns) == [("lr", s) for s in ("mean", "std", "null", "p")]
+    for name in table.index:  # by hand: the same label sets for every cell, Procedure 1 on each
+        null = [np.nanmean(classify.leave_pair_out_auc(classify.make_pipeline("lr", name), X, labels, groups, f, n,
+                                                      n_pairs=6, random_state=0))
+                for labels, f, n in classify.permuted_roles(y, groups, failed, normal, 9, random_state=0)]
+        assert table.loc[name, ("lr", "null")] == pytest.approx(np.mean(null))
+        assert table.loc[name, ("lr", "p")] == pytest.approx(classify.null_p_value(aucs["lr", name].mean(), null))
+    # the drift of the failed runs is found; with the roles exchanged half the "failed" runs do not drift
+    assert table.loc["control", ("lr", "mean")] > 0.95
+    assert table.loc["control", ("lr", "null")] < 0.8
+    assert table.loc["control", ("lr", "p")] == pytest.approx(0.1)  # no exchange reaches it: 1 / (1 + 9)
+    without = classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], preprocessing=["control"], n_pairs=6)
+    assert list(without.columns) == [("lr", "mean"), ("lr", "std")]
+    assert without.loc["control", ("lr", "mean")] == table.loc["control", ("lr", "mean")]
+    for bad in (-1, True, 2.5):
+        with pytest.raises(ValueError, match=f"permutations = {bad!r}; expected an integer >= 0"):
+            classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], preprocessing=["control"],
+                              permutations=bad)
+
+
 # ---------------------------------------------------------------------------- Procedure 2
 
 
