@@ -498,10 +498,9 @@ def permuted_roles(labels, groups, failed_groups, normal_groups, n_permutations:
     random permutation within each sample count), so a run that inherits a failed run's
     sequence becomes failed. The number of failed runs and every label sequence are kept; only
     their link to the features is broken. Leave-pair-out AUC on these labels is the chance level
-    of the dataset's robots, which is not 0.5 when samples of one robot are alike: a held-out
-    robot's closest training robots are then its own kind with one member fewer in its class (a
-    bias towards AUC < 0.5; Ojala & Garriga 2010, JMLR 11, test 1, permute labels within the
-    structure the data has; Airola et al. 2011, CSDA 55, on leave-pair-out AUC).
+    of the dataset's robots: when samples of one robot are alike a held-out pair is ranked robot
+    against robot, so it spreads widely around 0.5 (Ojala & Garriga 2010, JMLR 11, test 1,
+    labels permuted at the level at which they were given).
 
     Parameters
     ----------
