@@ -195,11 +195,9 @@ def test_permuted_roles_exchange_whole_label_sequences_between_runs_of_equal_len
     worn1_went_elsewhere = False
     for labels, f, n in roles:
         assert len(f) == len(failed) and sorted(f + n) == sorted(failed + normal)
-        donors = []
         for g in f + n:  # each run carries one donor's whole sequence, failed ones from failed runs
-            match = [d for d in (failed if g in f else normal) if np.array_equal(labels[groups == g], sequences[d])]
-            assert match, (g, labels[groups == g])
-            donors.append(match[0])
+            assert any(np.array_equal(labels[groups == g], sequences[d]) for d in (failed if g in f else normal)), \
+                (g, labels[groups == g])
         assert "short" in n and np.array_equal(labels[groups == "short"], sequences["short"])
         assert sum(np.array_equal(labels[groups == g], sequences["worn1"]) for g in f) == 1
         worn1_went_elsewhere |= not np.array_equal(labels[groups == "worn1"], sequences["worn1"])
