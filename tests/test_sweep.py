@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+import weakref
 from pathlib import Path
 
 import h5py
@@ -148,6 +149,52 @@ def test_ctrl_c_stops_the_workers_and_says_what_is_kept_and_how_to_resume(tmp_pa
     assert proc.returncode == 130, stdout + stderr
     assert stderr.strip() == f"interrupted: {kept} of 6 runs kept in {parts}; run the same command to resume"
     assert not out.exists() and not (parts / "sweep.json").exists()
+
+
+@pytest.fixture
+def ctrl_c_raises():
+    """SIGINT at Python's default (KeyboardInterrupt), as in a terminal; an xdist worker may ignore it."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_a_ctrl_c_landing_in_a_weakref_callback_is_not_printed_but_stops_the_sweep(ctrl_c_raises, capfd):
+    """The race behind a CI failure: the SIGINT of Ctrl-C reached the main process while it ran a
+    weakref callback, and Python printed "Exception ignored ... KeyboardInterrupt" before the
+    sweep's message. A callback raising KeyboardInterrupt is what that SIGINT becomes there."""
+
+    class Part:
+        pass
+
+    def callback(_) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt), sweep._CtrlC():
+        part = Part()
+        ref = weakref.ref(part, callback)
+        del part  # the callback runs here and its KeyboardInterrupt cannot propagate
+        time.sleep(10)  # the interrupt sent again 0.1 s later ends this
+        pytest.fail("the interrupt swallowed in the weakref callback did not reach the main flow")
+    assert ref() is None
+    assert capfd.readouterr().err == ""
+
+
+def test_once_the_sweep_stops_a_second_ctrl_c_is_not_raised_in_its_clean_up(ctrl_c_raises):
+    try:
+        with sweep._CtrlC() as ctrl_c:
+            with pytest.raises(KeyboardInterrupt):
+                signal.raise_signal(signal.SIGINT)
+            try:
+                signal.raise_signal(signal.SIGINT)
+            except KeyboardInterrupt:
+                signal.raise_signal(signal.SIGINT)  # while the first is handled: not raised
+                ctrl_c.stopping = True
+            signal.raise_signal(signal.SIGINT)  # once stopping: not raised
+    except KeyboardInterrupt:
+        pytest.fail("a second SIGINT was raised while the sweep was stopping")
+    with pytest.raises(KeyboardInterrupt):  # outside the sweep SIGINT raises again
+        signal.raise_signal(signal.SIGINT)
 
 
 def test_a_second_sweep_on_the_same_output_refuses_at_once_naming_the_first(reference, tmp_path):

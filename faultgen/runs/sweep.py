@@ -22,7 +22,9 @@ import json
 import logging
 import os
 import shutil
+import signal
 import socket
+import sys
 import threading
 import time
 import tomllib
@@ -30,6 +32,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
+from typing import Self
 
 import filelock
 import numpy as np
@@ -336,17 +339,19 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
             todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
             if on_start is not None:
                 on_start(len(plan), len(plan) - len(todo))
-            try:
-                with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
-                          desc=f"sweep {out.name}") as bar:
-                    for stats in _execute(todo, parts, jobs, scheduler, command):
-                        bar.update(1)
-                        if on_run is not None:
-                            on_run(stats)
-            except KeyboardInterrupt:
-                kept = len(finished_runs(grid, out))
-                raise SweepInterrupted(f"interrupted: {kept} of {len(plan)} runs kept in {parts}; run the same "
-                                       "command to resume") from None
+            with _CtrlC() as ctrl_c:
+                try:
+                    with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
+                              desc=f"sweep {out.name}") as bar:
+                        for stats in _execute(todo, parts, jobs, scheduler, command):
+                            bar.update(1)
+                            if on_run is not None:
+                                on_run(stats)
+                except KeyboardInterrupt:
+                    ctrl_c.stopping = True
+                    kept = len(finished_runs(grid, out))
+                    raise SweepInterrupted(f"interrupted: {kept} of {len(plan)} runs kept in {parts}; run the "
+                                           "same command to resume") from None
             started = time.perf_counter()
             try:
                 dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
@@ -435,6 +440,58 @@ def _prepare(out: Path, parts: Path) -> None:
     for stale in parts.glob(".*.part"):  # no worker runs while this sweep holds the lock: a killed one left it
         log.warning("removed %s, an unfinished part left by a killed worker", stale)
         stale.unlink()
+
+
+class _CtrlC:
+    """While a sweep runs, every Ctrl-C stops it once, wherever in this process it lands.
+
+    Python raises a SIGINT as KeyboardInterrupt in whatever the main thread runs at that moment.
+    If that is a weakref callback or a ``__del__`` (joblib and loky free locks and queues through
+    such callbacks while the workers' results are collected), the exception cannot propagate:
+    Python prints "Exception ignored in ... KeyboardInterrupt" and goes on as if no key had been
+    pressed. Within this block such an interrupt is not printed but sent again as SIGINT 0.1 s
+    later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
+    KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
+    Ctrl-C, or a worker's interrupt arriving after the sweep's own) is not raised inside the
+    clean-up. Only in the main thread and when SIGINT raises KeyboardInterrupt (not under
+    ``nohup``); otherwise the block changes nothing.
+    """
+
+    RESEND_AFTER = 0.1  # s: a callback is over long before; a person does not notice
+
+    def __enter__(self) -> Self:
+        self.stopping = False
+        self._resends: list[threading.Timer] = []
+        self._previous_handler = signal.getsignal(signal.SIGINT)
+        self._active = (threading.current_thread() is threading.main_thread()
+                        and self._previous_handler is signal.default_int_handler)
+        if self._active:
+            self._previous_hook = sys.unraisablehook
+            sys.unraisablehook = self._unraisable
+            signal.signal(signal.SIGINT, self._on_sigint)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if not self._active:
+            return
+        for resend in self._resends:
+            resend.cancel()
+        signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
+        sys.unraisablehook = self._previous_hook
+
+    def _on_sigint(self, signum, frame) -> None:
+        if self.stopping or isinstance(sys.exc_info()[1], KeyboardInterrupt):
+            return
+        raise KeyboardInterrupt
+
+    def _unraisable(self, unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            self._previous_hook(unraisable)
+        elif not self.stopping:
+            resend = threading.Timer(self.RESEND_AFTER, os.kill, (os.getpid(), signal.SIGINT))
+            resend.daemon = True
+            resend.start()
+            self._resends.append(resend)
 
 
 def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) -> Iterator[RunStats]:
