@@ -419,19 +419,41 @@ def select_pairs(failed_groups, normal_groups, n_pairs: int | None = None,
     return [pairs[i] for i in chosen]
 
 
-def _pair_auc(factory, X, labels, groups, pair) -> float:
-    test = np.isin(groups, list(pair))
-    train = ~test
-    if np.unique(labels[train]).size < 2 or np.unique(labels[test]).size < 2:
+def matched_rows(labels, groups, pair) -> np.ndarray:
+    """Rows a time-matched AUC compares: the failed samples of ``pair``'s failed run and the
+    samples of its normal run at the same positions in its record (k-th sample against k-th
+    sample, counted from the start; positions the normal run does not reach are left out).
+
+    Returns
+    -------
+    ndarray of bool of shape (n_samples,)
+    """
+    failed, normal = pair
+    failed_rows, normal_rows = np.flatnonzero(groups == failed), np.flatnonzero(groups == normal)
+    positions = np.flatnonzero(labels[failed_rows] == 1)
+    positions = positions[positions < normal_rows.size]
+    rows = np.zeros(len(groups), dtype=bool)
+    rows[failed_rows[positions]] = rows[normal_rows[positions]] = True
+    return rows
+
+
+def _pair_auc(factory, X, labels, groups, pair, matched: bool = False) -> float:
+    held = np.isin(groups, list(pair))
+    train = ~held
+    # the held-out runs are scored whole (differencing needs each sample's predecessor); a
+    # time-matched AUC then ranks only the failed samples against the same days of the normal run
+    test = matched_rows(labels, groups, pair)[held] if matched else np.ones(int(held.sum()), dtype=bool)
+    if np.unique(labels[train]).size < 2 or np.unique(labels[held][test]).size < 2:
         return np.nan
     model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else clone(factory)
     fit_by_run(model, X[train], labels[train], groups[train])
-    return float(roc_auc_score(labels[test], score_by_run(model, X[test], groups[test])))
+    scores = score_by_run(model, X[held], groups[held])
+    return float(roc_auc_score(labels[held][test], scores[test]))
 
 
 def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_groups, *,
                        n_pairs: int | None = None, random_state: int | None = 0, label_rule=None,
-                       n_jobs: int | None = None, return_pairs: bool = False):
+                       matched: bool = False, n_jobs: int | None = None, return_pairs: bool = False):
     """ROC AUC with one failed and one normal run held out, thesis Procedure 1.
 
     For each pair (failed run ``i``, normal run ``j``): fit a new model on the samples of all
@@ -458,6 +480,14 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
         Seed of the pair subset.
     label_rule : None, float or callable, default=None
         See :func:`make_labels`; None means ``y`` holds 0/1 labels.
+    matched : bool, default=False
+        A time control: rank the failed samples of ``i`` only against the samples of ``j`` at the
+        same positions in its record (:func:`matched_rows`), not against ``i``'s own earlier
+        samples and ``j``'s other days. When a failed run's failed samples are its last ones
+        (labels by wear), anything that changes along a record (season, a life-average indicator
+        settling) tells late from early samples without any fault; matched, it cannot. Changes
+        nothing where every sample of ``i`` is failed and the runs are as long (the thesis's
+        window, ``analysis.benchmark.classification_table(horizon=...)``).
     n_jobs : int or None, default=None
         Pairs in parallel with joblib (None: one at a time).
     return_pairs : bool, default=False
@@ -483,9 +513,9 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     labels = make_labels(y, groups, failed, label_rule)
     pairs = select_pairs(failed, normal, n_pairs, random_state)
     if n_jobs is None:
-        aucs = [_pair_auc(pipeline_factory, X, labels, groups, p) for p in pairs]
+        aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
     else:
-        jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p) for p in pairs)
+        jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
         aucs = Parallel(n_jobs=n_jobs)(jobs)
     aucs = np.asarray(aucs, dtype=float)
     n_nan = int(np.isnan(aucs).sum())
@@ -683,7 +713,7 @@ def compare_preprocessing(aucs: Mapping[str, Iterable[float]], alpha: float = AL
 def evaluate(X, y, groups, failed_groups, normal_groups,
              classifiers: Iterable[str] | Mapping[str, object] = tuple(CLASSIFIERS),
              preprocessing: Iterable[str] | None = None, *, estimated=None, n_pairs: int | None = None,
-             random_state: int | None = 0, label_rule=None, n_jobs: int | None = None,
+             random_state: int | None = 0, label_rule=None, matched: bool = False, n_jobs: int | None = None,
              permutations: int = 0, return_aucs: bool = False, progress: bool = False):
     """Mean and standard deviation of leave-pair-out AUC per combination and classifier, Table 5.2.
 
@@ -702,7 +732,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         Estimated quantities (thesis ch. 5.3.2: torque and speed estimated from the indicators),
         appended as columns to ``X`` for the combinations starting with ``+estM``; required by
         them. faultgen has no such block of its own; pass e.g. model-based estimates.
-    n_pairs, random_state, label_rule, n_jobs
+    n_pairs, random_state, label_rule, matched, n_jobs
         As in :func:`leave_pair_out_auc`; ``random_state`` also seeds the classifiers and the
         permutations.
     permutations : int, default=0
@@ -770,11 +800,11 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UndefinedAUCWarning)  # summarised once below
             warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
-            aucs[column, name] = leave_pair_out_auc(pipe, data, labels, groups, failed, normal,
-                                                    n_pairs=n_pairs, random_state=random_state, n_jobs=n_jobs)
+            aucs[column, name] = leave_pair_out_auc(pipe, data, labels, groups, failed, normal, n_pairs=n_pairs,
+                                                    random_state=random_state, matched=matched, n_jobs=n_jobs)
             null[column, name] = np.array([
                 np.nanmean(leave_pair_out_auc(pipe, data, permuted, groups, f, n, n_pairs=n_pairs,
-                                              random_state=random_state, n_jobs=n_jobs))
+                                              random_state=random_state, matched=matched, n_jobs=n_jobs))
                 for permuted, f, n in roles])
     n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
     if n_nan - {0}:

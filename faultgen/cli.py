@@ -808,6 +808,11 @@ def classify_command(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
         "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0)] = None,
+    matched_days: Annotated[bool, typer.Option(
+        "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
+        "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
+        "wear put a failing robot's failed days last, so whatever drifts along a record (season, the indicators "
+        "settling) scores without any fault; matched it cannot. No change with --horizon.")] = False,
     permutations: Annotated[int, typer.Option(
         help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
         "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
@@ -833,7 +838,10 @@ def classify_command(
     takes every pair, as the thesis did.
 
     Robots of one kind (process, model) look alike, so chance is not 0.5 here: --permutations
-    measures it on the same robots, and 'p' says whether the AUC beats it.
+    measures it on the same robots, and 'p' says whether the AUC beats it. With labels by wear a
+    failing robot's failed days are its last, so a classifier that only learns when in the record
+    a day lies scores well above 0.5; --matched-days compares them with the same days of the
+    healthy robot instead.
 
     Examples (the thesis's Table 5.2: its window before failure, every pair; then the chance
     level of two cells):
@@ -841,6 +849,8 @@ def classify_command(
       faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
 
       faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
+
+      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
     """
     from analysis import benchmark
 
@@ -849,7 +859,7 @@ def classify_command(
         cells["preprocessing"] = preprocessing
     _table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
-        horizon=horizon, permutations=permutations, **cells))
+        horizon=horizon, permutations=permutations, matched=matched_days, **cells))
 
 
 def _check_outputs(files: list[Path], overwrite: bool) -> None:

@@ -335,6 +335,21 @@ def test_classify_command_scores_chosen_cells_and_their_chance_level(small, tmp_
     assert not (tmp_path / "k.csv").exists()
 
 
+def test_classify_command_hands_the_time_control_to_the_library(small, tmp_path, monkeypatch):
+    seen = []
+
+    def table(path, **kwargs):
+        seen.append(kwargs["matched"])
+        return pd.DataFrame({("lr", "mean"): [0.5]}, index=pd.Index(["control"], name="preprocessing"))
+
+    monkeypatch.setattr(benchmark, "classification_table", table)
+    for flag, out in (["--matched-days"], "m"), ([], "u"):
+        result = runner.invoke(app, ["classify", str(small), *flag, "--no-progress", "-o", str(tmp_path / out)])
+        assert result.exit_code == 0, result.output
+    assert seen == [True, False]
+    assert "--matched-days" in runner.invoke(app, ["classify", "--help"]).output
+
+
 def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypatch):
     from analysis import classify
     from faultgen import dataset

@@ -240,6 +240,49 @@ def test_evaluate_reports_the_chance_level_of_each_cell():
                               permutations=bad)
 
 
+def test_matched_rows_pair_each_failed_sample_with_the_same_day_of_the_normal_run():
+    labels = np.array([0, 0, 1, 1, 0, 0, 0])
+    groups = np.array(["f"] * 4 + ["n"] * 3, dtype=object)
+    # the failed run's day 3 against the normal run's day 3; its day 4 has no match and is left out
+    assert classify.matched_rows(labels, groups, ("f", "n")).tolist() == [False, False, True, False, False, False, True]
+
+
+def time_cue_runs(fault, n_failed=6, n_normal=6, days=40, seed=0):
+    """Runs whose feature 0 follows the day of the record in every run (a season, a life-average
+    indicator settling), whose failed runs' last third is labelled failed (labels by wear), and
+    whose feature 1 rises by ``fault`` on those days."""
+    rng = np.random.default_rng(seed)
+    failed, normal = [f"worn{i}" for i in range(n_failed)], [f"nowear{i}" for i in range(n_normal)]
+    t = np.arange(days)
+    X, y, groups = [], [], []
+    for run in failed + normal:
+        labels = (t >= 2 * days // 3).astype(int) if run in failed else np.zeros(days, dtype=int)
+        X.append(np.column_stack([t / days, fault * labels]) + rng.normal(0, 0.1, (days, 2)))
+        y.append(labels)
+        groups.append(np.full(days, run, dtype=object))
+    return np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_matched_days_take_away_the_time_cue_and_keep_the_fault(seed):
+    lr = lambda: classify.make_pipeline("lr")
+    X, y, groups, failed, normal = time_cue_runs(fault=0.0, seed=seed)
+    # no fault: late days are told from early ones (measured 0.87-0.88) ...
+    assert classify.leave_pair_out_auc(lr, X, y, groups, failed, normal).mean() > 0.8
+    # ... but not from the same days of a healthy run (0.47-0.49)
+    assert abs(classify.leave_pair_out_auc(lr, X, y, groups, failed, normal, matched=True).mean() - 0.5) < 0.1
+    X, y, groups, failed, normal = time_cue_runs(fault=0.3, seed=seed)
+    assert classify.leave_pair_out_auc(lr, X, y, groups, failed, normal, matched=True).mean() > 0.9  # 0.97-0.98
+
+
+def test_matched_days_change_nothing_when_every_sample_of_a_failed_run_is_failed():
+    X, _, groups, failed, normal = runs(n_failed=3, n_normal=3, n_cycles=12)
+    state = np.isin(groups, failed).astype(int)  # the thesis's window: labelled by the robot's state
+    pipe = lambda: classify.make_pipeline("lr", "+diff")
+    np.testing.assert_array_equal(classify.leave_pair_out_auc(pipe, X, state, groups, failed, normal, matched=True),
+                                  classify.leave_pair_out_auc(pipe, X, state, groups, failed, normal))
+
+
 # ---------------------------------------------------------------------------- Procedure 2
 
 
