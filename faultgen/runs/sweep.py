@@ -452,8 +452,8 @@ class _CtrlC:
     pressed. Within this block such an interrupt is not printed but sent again as SIGINT 0.1 s
     later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
     KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
-    Ctrl-C, or a worker's interrupt arriving after the sweep's own) is not raised inside the
-    clean-up. Only in the main thread and when SIGINT raises KeyboardInterrupt (not under
+    Ctrl-C, or one sent again after the workers' own interrupts already stopped the sweep) is not
+    raised inside the clean-up. Only in the main thread and when SIGINT raises KeyboardInterrupt (not under
     ``nohup``); otherwise the block changes nothing.
     """
 
