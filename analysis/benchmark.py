@@ -27,6 +27,7 @@ from tqdm.auto import tqdm
 from analysis import isolation
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen import axes
+from faultgen.checks import is_whole
 from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.simulation import sensors
@@ -662,8 +663,7 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         run and its samples), or the training sets would lack a class (see
         :func:`_check_training_sets`).
     """
-    if horizon is not None and (isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer))
-                                or horizon < 0):
+    if horizon is not None and not is_whole(horizon, 0):
         raise ValueError(f"horizon = {horizon!r}: expected an integer >= 0 (samples before the last one)")
     from analysis.classify import evaluate
 

@@ -46,6 +46,7 @@ from sklearn.svm import SVC
 from tqdm.auto import tqdm
 
 from analysis.features import Difference, WindowConcat
+from faultgen.checks import is_whole
 
 #: Step types applied to each run on its own (they look at neighbouring rows; both are stateless).
 SEQUENCE_STEPS = (Difference, WindowConcat)
@@ -309,18 +310,13 @@ def score_by_run(estimator, X, groups) -> np.ndarray:
 # Labels
 
 
-def _is_integer(value, least: int) -> bool:
-    """Whether ``value`` is an integer (not a bool) of at least ``least``."""
-    return not isinstance(value, bool) and isinstance(value, (int, np.integer)) and value >= least
-
-
 def last_samples(n: int) -> Callable:
     """Labelling rule: the last ``n`` samples of each failed run are 1, all others 0.
 
     The thesis's rule (ch. 5.3.3): the samples shortly before the failure are "failed". Use as
     ``label_rule=last_samples(10)``; ``y`` is then ignored.
     """
-    if not _is_integer(n, least=1):
+    if not is_whole(n, 1):
         raise ValueError(f"n = {n!r}; expected an integer >= 1")
 
     def rule(y, groups, failed_groups):
@@ -562,7 +558,7 @@ def permuted_roles(labels, groups, failed_groups, normal_groups, n_permutations:
     ValueError
         If ``n_permutations`` is not an integer >= 1.
     """
-    if not _is_integer(n_permutations, least=1):
+    if not is_whole(n_permutations, 1):
         raise ValueError(f"n_permutations = {n_permutations!r}; expected an integer >= 1")
     labels, groups = np.asarray(labels), np.asarray(groups)
     failed, normal = set(failed_groups), set(normal_groups)
@@ -763,7 +759,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         not an integer >= 0.
     """
     X, y, groups, failed, normal = _check_inputs(X, y, groups, failed_groups, normal_groups)
-    if not _is_integer(permutations, least=0):
+    if not is_whole(permutations, 0):
         raise ValueError(f"permutations = {permutations!r}; expected an integer >= 0 (0: no chance level)")
     if estimated is not None:
         estimated = np.asarray(estimated, dtype=float)

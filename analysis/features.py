@@ -20,6 +20,7 @@ import numpy as np
 from sklearn.base import BaseEstimator, OneToOneFeatureMixin, TransformerMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from faultgen.checks import is_whole
 from faultgen.simulation.sensors import LOAD_EXPONENT
 
 #: Histograms must sum to 1 within this tolerance.
@@ -223,7 +224,7 @@ class WindowConcat(TransformerMixin, BaseEstimator):
 
     def fit(self, X, y=None):
         """Check ``width`` and ``X`` of shape (n_samples, n_features). Returns ``self``."""
-        if isinstance(self.width, bool) or not isinstance(self.width, (int, np.integer)) or self.width < 1:
+        if not is_whole(self.width, 1):
             raise ValueError(f"width = {self.width!r}; expected an integer >= 1")
         validate_data(self, X, dtype=float)
         return self

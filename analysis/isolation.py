@@ -18,6 +18,7 @@ from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_array
 
 from faultgen import axes
+from faultgen.checks import is_whole
 
 #: Isolator classes by name, for :func:`make`; extend with :func:`register`.
 ISOLATORS: dict[str, type] = {}
@@ -57,7 +58,7 @@ def make(name: str, **params) -> BaseEstimator:
 
 
 def _integer(owner: str, name: str, value, low: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
+    if not is_whole(value, low):
         raise ValueError(f"{owner}: {name} = {value!r}, expected an integer >= {low}")
     return int(value)
 

@@ -15,6 +15,8 @@ from scipy import stats
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from faultgen.checks import is_whole
+
 STATISTICS = ("q", "t2", "either")
 
 
@@ -112,10 +114,10 @@ class PCAMonitor(BaseEstimator):
         if self.statistic not in STATISTICS:
             raise ValueError(f"statistic = {self.statistic!r}; expected one of {', '.join(STATISTICS)}")
         k = self.n_components
-        if k is not None and (isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1):
+        if k is not None and not is_whole(k, 1):
             raise ValueError(f"n_components = {k!r}; expected None or an integer >= 1")
         f = self.cv
-        if f is not None and (isinstance(f, bool) or not isinstance(f, (int, np.integer)) or f < 2):
+        if f is not None and not is_whole(f, 2):
             raise ValueError(f"cv = {f!r}; expected None (in-sample Q limit) or a number of folds >= 2")
 
     def fit(self, X, y=None):
@@ -319,7 +321,7 @@ def detect_onset(alarms, persistence: int = 1) -> int | None:
     a = np.asarray(alarms)
     if a.ndim != 1:
         raise ValueError(f"alarms must be 1-D (n_samples,), got shape {a.shape}")
-    if isinstance(persistence, bool) or not isinstance(persistence, (int, np.integer)) or persistence < 1:
+    if not is_whole(persistence, 1):
         raise ValueError(f"persistence = {persistence!r}; expected an integer >= 1")
     if a.size < persistence:
         return None

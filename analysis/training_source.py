@@ -36,6 +36,7 @@ from tqdm.auto import tqdm
 
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
+from faultgen.checks import is_whole
 from faultgen.data import dataset
 
 SOURCES = ("OTM", "OTO")
@@ -62,7 +63,7 @@ class Window:
     def __post_init__(self):
         for name, least in (("training_days", 3), ("test_days", 1), ("gap_days", 0)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < least:
+            if not is_whole(value, least):
                 raise ValueError(f"{name} = {value!r}; expected an integer >= {least}")
 
     @property

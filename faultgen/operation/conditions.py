@@ -48,6 +48,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from faultgen.axes import N_AXES
+from faultgen.checks import is_whole
 from faultgen.effects import temperature as temperature_law
 from faultgen.operation.tasks import TASKS
 
@@ -74,7 +75,7 @@ def _check_pattern(pattern: str, block, pattern_name: str, block_name: str) -> N
     names the setting (``pattern_name``, ``block_name``) and the value."""
     if pattern not in PATTERNS:
         raise ValueError(f"{pattern_name} {pattern!r}: expected one of {', '.join(PATTERNS)}")
-    if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or block < 1:
+    if not is_whole(block, 1):
         raise ValueError(f"{block_name} = {block!r}: expected a whole number of cycles >= 1")
 
 
@@ -372,8 +373,7 @@ class Conditions:
             value = getattr(self, name)
             if value is not None and not isinstance(value, kind):
                 raise TypeError(f"conditions {name}: expected a {kind.__name__} or None, got {type(value).__name__}")
-        if isinstance(self.cycles_per_day, bool) or not isinstance(self.cycles_per_day, (int, np.integer)) \
-                or self.cycles_per_day < 1:
+        if not is_whole(self.cycles_per_day, 1):
             raise ValueError(f"cycles_per_day = {self.cycles_per_day!r}: expected a whole number >= 1")
         check_number("start_day", self.start_day, 0, 365)
         if self.hours is not None:

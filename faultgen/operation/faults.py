@@ -22,6 +22,7 @@ import numpy as np
 
 from faultgen import effects
 from faultgen.axes import N_AXES
+from faultgen.checks import is_whole
 from faultgen.effects.base import Effect
 from faultgen.operation import wear
 
@@ -79,7 +80,7 @@ class Fault:
         if not prototype.per_axis:
             raise ValueError(f"fault effect {self.effect!r} is robot-wide; a growing fault sits on one axis (parts "
                              "changing per cycle are an operating condition: --payloads)")
-        if isinstance(self.axis, bool) or not isinstance(self.axis, (int, np.integer)) or not 1 <= self.axis <= N_AXES:
+        if not is_whole(self.axis) or not 1 <= self.axis <= N_AXES:
             raise ValueError(f"fault axis {self.axis!r}: expected 1..6")
         names = list(prototype.units)
         for name in [self.parameter, *self.others]:
