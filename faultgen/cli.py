@@ -844,7 +844,7 @@ def classify_command(
     healthy robot instead.
 
     Examples (the thesis's Table 5.2: its window before failure, every pair; then the chance
-    level of two cells):
+    level of two cells on labels by wear; then of one with the time control):
 
       faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
 
