@@ -33,6 +33,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.axes import N_AXES
+from faultgen.checks import is_whole
 
 #: Known schedule kinds.
 SCHEDULES = ("exp4", "logistic", "linear", "step")
@@ -53,10 +54,6 @@ _SPEC_FORM = (
     "the form is AXIS:KIND:PERCENT[:key=value,...], e.g. '2:exp4:20', '2:exp4:50:onset=40', "
     "'3:logistic:10:shape=2' or '5:step:20:step_cycle=40'"
 )
-
-
-def _is_int(value: object) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 @dataclass(frozen=True)
@@ -121,7 +118,7 @@ class Schedule:
             raise ValueError(f"wear increase {increase!r} is not finite; {expected}")
         if increase < 0:
             raise ValueError(f"wear increase {increase!r} is negative; {expected}")
-        if not _is_int(self.last_cycle) or self.last_cycle < 1:
+        if not is_whole(self.last_cycle, 1):
             raise ValueError(f"last_cycle {self.last_cycle!r} is invalid; expected an int >= 1 such as 100")
         last = int(self.last_cycle)
         known = _PARAMS[self.kind]
@@ -142,12 +139,12 @@ class Schedule:
                 raise ValueError(f"logistic shape {shape!r} is too small to compute; expected e.g. 0.5 .. 5")
         if self.kind == "exp4":
             onset = params["onset"]
-            if not _is_int(onset) or not 0 <= onset < last:
+            if not is_whole(onset) or not 0 <= onset < last:
                 raise ValueError(f"exp4 onset {onset!r} is invalid; expected an int in 0..{last - 1} (below last_cycle)")
             params["onset"] = int(onset)
         if self.kind == "step":
             step = last // 2 + 1 if params["step_cycle"] is None else params["step_cycle"]
-            if not _is_int(step):
+            if not is_whole(step):
                 raise ValueError(f"step_cycle {step!r} is not an int; expected one in 1..{last} (last_cycle)")
             if not 1 <= step <= last:
                 raise ValueError(f"step_cycle {step!r} is out of range 1..{last} (last_cycle)")
@@ -220,7 +217,7 @@ def _cycles(k: int | np.ndarray) -> np.ndarray:
 
 
 def _check_axis(axis: object) -> int:
-    if not _is_int(axis) or not 1 <= axis <= N_AXES:
+    if not is_whole(axis) or not 1 <= axis <= N_AXES:
         raise ValueError(f"axis {axis!r} is out of range 1..{N_AXES}")
     return int(axis)
 

@@ -28,6 +28,7 @@ import numpy as np
 from mujoco import batch as mjbatch
 from tqdm.auto import tqdm
 
+from faultgen.checks import is_whole
 from faultgen.effects import friction
 from faultgen.effects.base import Effect
 from faultgen.effects.payload import Payload
@@ -124,7 +125,7 @@ class RunConfig:
         if self.task not in tasks.TASKS:
             raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
         friction.check_model(self.friction)
-        if not isinstance(self.cycles, (int, np.integer)) or isinstance(self.cycles, bool) or self.cycles < 1:
+        if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
         if self.record is not None:
             record = tuple(int(c) for c in self.record)
