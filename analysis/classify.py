@@ -438,13 +438,13 @@ def _pair_auc(factory, X, labels, groups, pair, matched: bool = False) -> float:
     train = ~held
     # the held-out runs are scored whole (differencing needs each sample's predecessor); a
     # time-matched AUC then ranks only the failed samples against the same days of the normal run
-    test = matched_rows(labels, groups, pair)[held] if matched else np.ones(int(held.sum()), dtype=bool)
-    if np.unique(labels[train]).size < 2 or np.unique(labels[held][test]).size < 2:
+    test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
+    truth = labels[held][test]
+    if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
         return np.nan
     model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else clone(factory)
     fit_by_run(model, X[train], labels[train], groups[train])
-    scores = score_by_run(model, X[held], groups[held])
-    return float(roc_auc_score(labels[held][test], scores[test]))
+    return float(roc_auc_score(truth, score_by_run(model, X[held], groups[held])[test]))
 
 
 def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_groups, *,
