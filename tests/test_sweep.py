@@ -180,6 +180,34 @@ def test_a_ctrl_c_landing_in_a_weakref_callback_is_not_printed_but_stops_the_swe
     assert capfd.readouterr().err == ""
 
 
+@pytest.mark.parametrize("in_a_worker", [True, False])
+def test_a_worker_does_not_print_an_interrupt_it_cannot_raise(monkeypatch, in_a_worker):
+    """The same race in a worker process (it gets the Ctrl-C too): there the interrupt is dropped,
+    as the sweep's process stops the workers; other unraisable exceptions still reach the hook."""
+    reached = []
+    monkeypatch.setattr(sys, "unraisablehook", reached.append)  # stands for Python's printing hook
+    monkeypatch.setattr(sweep, "simulate_and_write", lambda *call: call)
+    sweep_pid = os.getpid() + 1 if in_a_worker else os.getpid()
+    assert sweep._in_worker(sweep_pid, "run", "config") == ("run", "config")
+    hook = sys.unraisablehook
+    sweep._in_worker(sweep_pid, "next run", "config")
+    assert sys.unraisablehook == hook  # a worker's next run does not wrap the hook again
+
+    class Part:
+        pass
+
+    for error in (KeyboardInterrupt(), ValueError("kept")):
+        def callback(_, error=error) -> None:
+            raise error
+
+        part = Part()
+        ref = weakref.ref(part, callback)
+        del part
+        assert ref() is None
+    expected = [ValueError] if in_a_worker else [KeyboardInterrupt, ValueError]
+    assert [type(u.exc_value) for u in reached] == expected
+
+
 def test_once_the_sweep_stops_a_second_ctrl_c_is_not_raised_in_its_clean_up(ctrl_c_raises):
     try:
         with sweep._CtrlC() as ctrl_c:

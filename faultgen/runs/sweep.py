@@ -253,6 +253,35 @@ def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: 
     return stats
 
 
+def _in_worker(sweep_pid: int, *call) -> RunStats:
+    """:func:`simulate_and_write` as a joblib worker runs it for the sweep of process ``sweep_pid``.
+
+    A Ctrl-C reaches the workers too (they are in the terminal's process group). One that lands
+    in a weakref callback or a ``__del__`` of a worker cannot be raised there, and Python would
+    print "Exception ignored ... KeyboardInterrupt" in the middle of the sweep's message; a worker
+    does not print it: the sweep's own process handles the Ctrl-C and stops the workers
+    (:class:`_CtrlC`). In the sweep's own process (joblib with one job) nothing changes.
+    """
+    if os.getpid() != sweep_pid:
+        _quiet_unraisable_interrupts()
+    return simulate_and_write(*call)
+
+
+def _quiet_unraisable_interrupts() -> None:
+    """From now on, a KeyboardInterrupt that cannot be raised is not printed (this process only;
+    every other unraisable exception still goes to the hook there was before)."""
+    previous = sys.unraisablehook
+    if getattr(previous, "quiet_interrupts", False):  # a worker runs many runs: set once
+        return
+
+    def hook(unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            previous(unraisable)
+
+    hook.quiet_interrupts = True
+    sys.unraisablehook = hook
+
+
 def _release_memory() -> None:
     """Give the run's freed memory back to the OS. glibc keeps freed heap memory, so a worker's
     resident size would ratchet up run after run, and joblib's workers restart themselves (losing
@@ -506,7 +535,7 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) 
             from joblib import Parallel, delayed
 
             parallel = Parallel(n_jobs=jobs, return_as="generator_unordered")
-            yield from parallel(delayed(simulate_and_write)(*call) for call in calls)
+            yield from parallel(delayed(_in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:
             _stop_local_workers()
