@@ -413,7 +413,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     """
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; expected one of: {', '.join(PROTOCOLS)}")
-    if limit_folds is not None and (isinstance(limit_folds, bool) or limit_folds < 2):
+    if limit_folds is not None and not is_whole(limit_folds, 2):
         raise ValueError(f"limit_folds = {limit_folds!r}; expected None (the in-sample Q limit) or a number of folds >= 2")
     runs = _runs(path, ("cycles", "friction_multiplier"))
     healthy = [r for r in runs if len(r[2]["worn_axes"]) == 0]

@@ -114,6 +114,9 @@ def test_a_protocol_the_dataset_cannot_serve_is_refused_saying_what_it_lacks(sma
         benchmark.detection_table(small, progress=False, protocol="first-cycles", first=50)
     with pytest.raises(ValueError, match="unknown protocol 'held-out'; expected one of: auto, other-seeds"):
         benchmark.detection_table(small, progress=False, protocol="held-out")
+    for folds in (1, 2.5, True):
+        with pytest.raises(ValueError, match=rf"limit_folds = {folds!r}; expected None .* number of folds >= 2"):
+            benchmark.detection_table(small, progress=False, limit_folds=folds)
 
 
 def test_bench_isolators_command_writes_csv_markdown_and_heatmap(small, tmp_path):
