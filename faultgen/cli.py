@@ -62,6 +62,11 @@ PayloadPattern = Annotated[str, typer.Option(
 UnitSpreadFlag = Annotated[bool, typer.Option(
     "--unit-spread", help="The run's robot draws its own friction levels (15 % log-normal per axis) and link masses "
     "(2 %) from its seed; the controller keeps the nominal model.")]
+GearLoss = Annotated[float, typer.Option(
+    "--gear-loss", metavar="C",
+    help="With --unit-spread: each unit's gearboxes also lose a share of the transmitted torque as Coulomb friction, "
+    "drawn per axis uniformly in 0..C (1 minus the gear efficiency under load; e.g. 0.1). Needs --friction "
+    "stribeck. Default 0: none.")]
 TaskMixTasks = Annotated[str | None, typer.Option(
     "--task-mix", metavar="TASK,TASK,...",
     help="Each cycle runs one of these tasks (the run's own among them), e.g. pick_place,spot_weld; needs "
@@ -74,9 +79,11 @@ StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
 
 
 def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
-                start_day: float, task_mix: str | None = None, task_pattern: str = "alternate") -> dict | None:
+                start_day: float, task_mix: str | None = None, task_pattern: str = "alternate",
+                gear_loss: float = 0.0) -> dict | None:
     """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
-    no condition is on. Raises ValueError naming a malformed ``--payloads`` part."""
+    no condition is on. Raises ValueError naming a malformed ``--payloads`` part, or a
+    ``--gear-loss`` without ``--unit-spread``."""
     table: dict = {}
     if temperature:
         table["thermal"] = {}
@@ -90,8 +97,10 @@ def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: b
             masses.append(mass)
             sizes.append(size)
         table["payloads"] = {"masses": masses, "sizes": sizes, "pattern": pattern}
+    if gear_loss and not spread:
+        raise ValueError(f"--gear-loss {gear_loss:g} is a part of the unit spread: add --unit-spread")
     if spread:
-        table["spread"] = {}
+        table["spread"] = {"gear_loss": gear_loss} if gear_loss else {}
     if task_mix:
         table["task_mix"] = {"tasks": [t.strip() for t in task_mix.split(",")], "pattern": task_pattern}
     if not table:
@@ -222,6 +231,7 @@ def simulate_command(
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
     unit_spread: UnitSpreadFlag = False,
+    gear_loss: GearLoss = 0.0,
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")] = Path("run.h5"),
@@ -240,6 +250,8 @@ def simulate_command(
       faultgen simulate --task spot_weld --wear 2:exp4:20 --wear 5:linear:10 --record 1,100 -o two.h5
 
       faultgen simulate --wear 3:exp4:20 --temperature --payloads 20:0.2,80:0.4 --unit-spread -o real.h5
+
+      faultgen simulate --friction stribeck --wear 2:exp4:20 --unit-spread --gear-loss 0.1 -o lossy.h5
     """
     from faultgen.data import dataset
     from faultgen.operation import conditions as conditions_module
@@ -258,7 +270,8 @@ def simulate_command(
             record=None if record is None else _parse_cycles(record), seed=seed,
             noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
             conditions=conditions_module.Conditions.from_dict(
-                _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day) or {}),
+                _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
+                            gear_loss=gear_loss) or {}),
             fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
         )
     except ValueError as err:
@@ -345,6 +358,7 @@ def sweep_command(
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
     unit_spread: UnitSpreadFlag = False,
+    gear_loss: GearLoss = 0.0,
     task_mix: TaskMixTasks = None,
     task_pattern: TaskMixPattern = "alternate",
     cycles_per_day: CyclesPerDay = 1,
@@ -387,7 +401,7 @@ def sweep_command(
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     try:
         table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
-                            task_mix, task_pattern)
+                            task_mix, task_pattern, gear_loss)
         if table is not None:
             options["conditions"] = table
         if features_only is not None:
@@ -935,6 +949,8 @@ def _summary(result, out: Path) -> str:
         if config.conditions.thermal is not None:
             lines.append(f"  joint temperature {np.min(c.joint_temperature):.1f}..{np.max(c.joint_temperature):.1f} degC "
                          "over the recorded cycles")
+        if np.any(c.gear_loss):
+            lines.append("  gear loss (load-dependent friction coefficient) " + " ".join(f"{v:.3f}" for v in c.gear_loss))
         if config.conditions.payloads is not None:
             lines.append("  payload mass per cycle [kg]: " + " ".join(f"{m:g}" for m in c.payload_mass[:12])
                          + (" ..." if len(c.payload_mass) > 12 else ""))

@@ -119,6 +119,12 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     assert np.mean(draws) == pytest.approx(1.0, abs=0.01)  # log-normal with mean 1
     masses = np.array([spread.draw(seed)["link_mass"] for seed in range(2000)])
     assert np.all(np.abs(masses - 1) <= 0.06 + 1e-12)  # clipped at 3 standard deviations
+    assert np.array_equal(first["gear_loss"], np.zeros(6))  # off by default
+    lossy = c.UnitSpread(dry_friction=0.15, viscous_friction=0.1, link_mass=0.02, gear_loss=0.2)
+    assert all(np.array_equal(lossy.draw(3)[k], first[k]) for k in first if k != "gear_loss")  # drawn last
+    losses = np.array([lossy.draw(seed)["gear_loss"] for seed in range(2000)])
+    assert losses.min() >= 0 and losses.max() <= 0.2 and losses.max() > 0.199
+    assert np.mean(losses) == pytest.approx(0.1, abs=0.003)  # uniform in 0..0.2
 
 
 @pytest.mark.parametrize(("make", "message"), [
@@ -128,6 +134,9 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     (lambda: c.Payloads((-1.0,), (0.1,)), r"payload mass = -1.0"),
     (lambda: c.Payloads((1.0,), (0.1,), pattern="zig"), r"payload pattern 'zig'"),
     (lambda: c.UnitSpread(dry_friction=0.9), r"unit spread dry_friction = 0.9"),
+    (lambda: c.UnitSpread(gear_loss=-0.1), r"unit spread gear_loss = -0.1: expected a number within 0..0.5"),
+    (lambda: sim.RunConfig("puma560", "pick_place", conditions=c.Conditions(spread=c.UnitSpread(gear_loss=0.1))),
+     r"unit spread gear_loss = 0.1 needs the static friction model \(friction='stribeck'"),
     (lambda: c.TaskMix(()), r"task mix: no task given"),
     (lambda: c.TaskMix(("pick_place", "welding")), r"task mix: unknown task 'welding'"),
     (lambda: c.TaskMix(("pick_place",), pattern="zig"), r"task mix pattern 'zig'"),
@@ -171,6 +180,55 @@ def test_friction_applied_is_the_law_with_the_written_labels(tmp_path):
     assert dataset.validate(tmp_path / "run.h5") == []
 
 
+def test_a_units_gear_loss_is_the_load_dependent_friction_effect_with_the_written_labels(tmp_path):
+    """A unit spread with a gear loss (the rest of the spread off): the friction torque the static
+    model applied on every fast-sliding sample is eq. 6.3 plus the shared load-dependent friction
+    effect (coefficient x |transmitted load| / G at the motor, the load from the logged gearbox
+    deflection, eq. 6.2a) with the labelled coefficients, within 1 % (the logged speed and
+    deflection are those of the step after the one the level was set on), and it raises the
+    friction of the loaded axes (a run without the loss has eq. 6.3 alone)."""
+    spread = c.UnitSpread(dry_friction=0.0, viscous_friction=0.0, link_mass=0.0, gear_loss=0.3)
+    config = sim.RunConfig("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5, noise=QUIET,
+                           conditions=c.Conditions(spread=spread))
+    path = dataset.write_run(tmp_path / "lossy.h5", sim.simulate(config, progress=False))
+    assert dataset.validate(path) == []
+    arrays, attrs = dataset.read_run(path)
+    assert json.loads(attrs["conditions"])["spread"]["gear_loss"] == 0.3
+    loss = arrays["gear_loss"]
+    np.testing.assert_array_equal(loss, spread.draw(5)["gear_loss"])
+    assert np.all((loss > 0) & (loss <= 0.3))
+    robot = robots.load("puma560")
+    friction = robot.friction
+    v = arrays["qd_m"][0]
+    deflection = arrays["q_m"][0] / robot.gear_ratio - arrays["q_a"][0]
+    extra = effects.make("load_dependent_friction", coefficient=loss).dry_friction_extra(robot, deflection, None)
+    expected = (friction.stribeck_level(v, np.ones(6)) + extra) * np.sign(v) + friction.viscous * v
+    fast = np.abs(v) > 20
+    error = np.abs(arrays["tau_f"][0] - expected)[fast] / np.abs(expected[fast])
+    assert np.percentile(error, 99) < 0.01
+    plain = sim.simulate(sim.RunConfig("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5,
+                                       noise=QUIET), progress=False)
+    raised = np.mean(np.abs(arrays["tau_f"][0]), axis=0) / np.mean(np.abs(plain.tau_f[0]), axis=0)
+    assert raised[1] > 1.05, raised  # the shoulder carries the arm's weight
+
+
+def test_cli_gear_loss_is_drawn_and_labelled_and_needs_the_spread_and_static_friction(tmp_path):
+    runner = CliRunner()
+    alone = runner.invoke(app, ["simulate", "--robot", "puma560", "--gear-loss", "0.1", "-o", str(tmp_path / "a.h5")])
+    assert alone.exit_code == 2 and "--gear-loss 0.1 is a part of the unit spread: add --unit-spread" in alone.output
+    lugre = runner.invoke(app, ["simulate", "--robot", "puma560", "--unit-spread", "--gear-loss", "0.1",
+                                "-o", str(tmp_path / "b.h5")])
+    assert lugre.exit_code == 2 and "needs the static friction model" in lugre.output
+    assert "--friction stribeck" in lugre.output
+    assert not list(tmp_path.iterdir())
+    done = runner.invoke(app, ["simulate", "--robot", "puma560", "--friction", "stribeck", "--cycles", "1",
+                               "--unit-spread", "--gear-loss", "0.1", "--no-progress", "-o", str(tmp_path / "c.h5")])
+    assert done.exit_code == 0, done.output
+    drawn = c.UnitSpread(gear_loss=0.1).draw(0)["gear_loss"]
+    assert "gear loss (load-dependent friction coefficient) " + " ".join(f"{v:.3f}" for v in drawn) in done.output
+    assert np.array_equal(dataset.read_run(tmp_path / "c.h5", names=("gear_loss",))[0]["gear_loss"], drawn)
+
+
 def test_a_cycle_carrying_a_part_is_a_run_of_the_robot_with_that_part(tmp_path):
     """Cycles switch parts: each carrying cycle's torques are those of a run whose MJCF carries the
     part (the controller knows it in both), within 0.2 %; the empty cycle is the nominal run."""
@@ -198,6 +256,7 @@ def test_runs_without_conditions_keep_their_keys_and_files():
     with_spread = sim.RunConfig("puma560", "pick_place", cycles=2, conditions=c.Conditions(spread=c.UnitSpread()))
     key = json.loads(dataset.config_key(with_spread))["conditions"]
     assert key["spread"]["dry_friction"] == 0.15 and "task_mix" not in key  # keys from before the task mix
+    assert "gear_loss" not in key["spread"]  # nor the gear loss, when it is off
 
 
 def test_a_task_mix_runs_each_cycle_as_a_run_of_its_task(tmp_path):

@@ -94,7 +94,8 @@ DUTY_ARRAYS = {
 
 #: name -> (units, axes, description, condition that writes it) of the operating-condition
 #: arrays (:mod:`faultgen.operation.conditions`), written for a run that has conditions: the
-#: calendar and the friction factors always, the rest when their condition is on.
+#: calendar and the friction factors always, the rest when their condition is on
+#: (``condition.setting``: when that setting of the condition is on, not 0).
 CONDITION_ARRAYS = {
     "day": ("d", "cycle", "day of the year of the cycle (counts on past 365)", None),
     "hour": ("h", "cycle", "time of day of the cycle", None),
@@ -107,6 +108,8 @@ CONDITION_ARRAYS = {
     "payload_mass": ("kg", "cycle", "mass of the part carried", "payloads"),
     "link_mass_factor": ("1", "axis", "multiplier of each link's mass and inertia (this unit's)", "spread"),
     "task_index": ("1", "cycle", "index of the task the cycle ran (into the conditions' task_mix tasks)", "task_mix"),
+    "gear_loss": ("1", "axis", ("load-dependent friction coefficient this unit's gearbox adds (share of the "
+                                "transmitted torque lost as Coulomb friction)"), "spread.gear_loss"),
 }
 
 #: The array of a run whose fault is not friction wear (attribute ``fault``): its units are the
@@ -179,8 +182,15 @@ def _condition_arrays(conditions: dict | None) -> list[str]:
     """The :data:`CONDITION_ARRAYS` a run with ``conditions`` (its JSON labels; None: none) has."""
     if not conditions:
         return []
-    return [name for name, (*_, condition) in CONDITION_ARRAYS.items()
-            if condition is None or conditions.get(condition) is not None]
+
+    def on(condition: str | None) -> bool:
+        if condition is None:
+            return True
+        name, _, setting = condition.partition(".")
+        table = conditions.get(name)
+        return table is not None and (not setting or bool(table.get(setting)))
+
+    return [name for name, (*_, condition) in CONDITION_ARRAYS.items() if on(condition)]
 
 
 def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
@@ -497,7 +507,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
             problems.append(f"{name}: not positive")
-    for name in DUTY_ARRAYS:
+    for name in (*DUTY_ARRAYS, "gear_loss"):
         if name in data and np.any(data[name] < 0):
             problems.append(f"{name}: negative")
     return problems

@@ -33,8 +33,10 @@ several processes, ch. 5.3.1). Each cycle runs its task's own path and feedforwa
 different tasks differ in length, so a run with a task mix keeps features and truth only.
 
 **Unit-to-unit spread** (:class:`UnitSpread`): the run's robot draws its own friction levels
-(Coulomb and static, viscous; per axis, log-normal) and link masses (per link, normal) around the
-nominal model, from the run's seed; the controller keeps the nominal model.
+(Coulomb and static, viscous; per axis, log-normal), link masses (per link, normal) and, when asked
+for, a gearbox loss growing with the load (per axis, uniform; the shared
+:class:`faultgen.effects.load_dependent_friction.LoadDependentFriction`) around the nominal model,
+from the run's seed; the controller keeps the nominal model.
 
 The numbers of the defaults are ours and stated as such in the attribute docs: no published
 plant record of joint temperatures or unit spread was at hand (docs/simulation.md).
@@ -44,6 +46,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -257,6 +260,13 @@ class UnitSpread:
     link_mass : float
         Of each link's mass and inertia (normal, clipped at 3 standard deviations; default 0.02,
         a casting tolerance).
+    gear_loss : float
+        Largest load-dependent friction coefficient a unit's gearbox adds per axis, drawn uniformly
+        in 0..``gear_loss`` (dimensionless: the share of the transmitted torque lost as Coulomb
+        friction, 1 minus the gearbox's efficiency under load; the transmitted-load form of
+        :class:`~faultgen.effects.load_dependent_friction.LoadDependentFriction`, added to the
+        model's own). Default 0: off. A per-step update, so only the static friction model
+        (``friction="stribeck"``) carries it.
 
     The defaults are ours, not a published spread: a unit's friction within about +-30 % of the
     type's (two standard deviations).
@@ -270,19 +280,23 @@ class UnitSpread:
     dry_friction: float = 0.15
     viscous_friction: float = 0.15
     link_mass: float = 0.02
+    gear_loss: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("dry_friction", "viscous_friction", "link_mass"):
+        for name in ("dry_friction", "viscous_friction", "link_mass", "gear_loss"):
             check_number(f"unit spread {name}", getattr(self, name), 0, 0.5)
 
     def draw(self, seed: int) -> dict[str, np.ndarray]:
-        """The unit's multipliers, from ``seed``: ``dry_friction``, ``viscous_friction``, ``link_mass``, each
-        ``ndarray of shape (6,)`` (axis / link 1..6), > 0."""
+        """The unit's draws, from ``seed``, each ``ndarray of shape (6,)`` (axis / link 1..6): the
+        multipliers ``dry_friction``, ``viscous_friction``, ``link_mass`` (> 0) and the load-dependent
+        friction coefficient ``gear_loss`` (0..:attr:`gear_loss`, drawn last, so that the other
+        draws of a seed do not depend on it)."""
         rng = np.random.default_rng([seed, 0, _UNIT])
         normal = rng.standard_normal((3, N_AXES))
         return {"dry_friction": np.exp(self.dry_friction * normal[0] - self.dry_friction**2 / 2),
                 "viscous_friction": np.exp(self.viscous_friction * normal[1] - self.viscous_friction**2 / 2),
-                "link_mass": 1 + self.link_mass * np.clip(normal[2], -3, 3)}
+                "link_mass": 1 + self.link_mass * np.clip(normal[2], -3, 3),
+                "gear_loss": self.gear_loss * rng.random(N_AXES)}
 
 
 @dataclass(frozen=True)
@@ -310,6 +324,9 @@ class CycleConditions:
         Multiplier of each link's mass and inertia (the unit's).
     task_index : ndarray of shape (n,)
         Index of the task the cycle ran, into the task mix's tasks (-1: no mix, the run's task).
+    gear_loss : ndarray of shape (6,)
+        Load-dependent friction coefficient the unit's gearbox adds per axis (:attr:`UnitSpread.gear_loss`;
+        zeros without).
     """
 
     day: np.ndarray
@@ -322,6 +339,10 @@ class CycleConditions:
     payload_mass: np.ndarray
     link_mass_factor: np.ndarray
     task_index: np.ndarray
+    gear_loss: np.ndarray
+
+    #: The fields that hold the unit's values, one per axis or link (the others: one row per cycle).
+    PER_UNIT: ClassVar[tuple[str, ...]] = ("link_mass_factor", "gear_loss")
 
     def tasks(self, mix: TaskMix) -> np.ndarray:
         """The task name of each cycle under the task mix ``mix`` that scheduled them,
@@ -406,10 +427,11 @@ class Conditions:
             ambient = self.thermal.ambient_at(day, hour)
             joint = np.repeat(self.thermal.joint_at(day, hour)[:, None], N_AXES, axis=1)
             dry, viscous = temperature_law.friction_factors(joint)
-        link_mass = np.ones(N_AXES)
+        link_mass, gear_loss = np.ones(N_AXES), np.zeros(N_AXES)
         if self.spread is not None:
             unit = self.spread.draw(seed)
             dry, viscous, link_mass = dry * unit["dry_friction"], viscous * unit["viscous_friction"], unit["link_mass"]
+            gear_loss = unit["gear_loss"]
         part, mass = np.full(n, -1), np.zeros(n)
         if self.payloads is not None:
             part = self.payloads.index(seed, cycles)
@@ -417,14 +439,17 @@ class Conditions:
         task = self.task_mix.index(seed, cycles) if self.task_mix is not None else np.full(n, -1)
         return CycleConditions(day=day.astype(float), hour=hour, ambient_temperature=ambient, joint_temperature=joint,
                                dry_friction_factor=dry, viscous_factor=viscous, payload_part=part, payload_mass=mass,
-                               link_mass_factor=link_mass, task_index=task)
+                               link_mass_factor=link_mass, task_index=task, gear_loss=gear_loss)
 
     def to_dict(self) -> dict:
         """JSON-serialisable labels (None for a condition that is off; no ``task_mix`` key without
-        one, so runs keep the labels and keys they had before the task mix existed)."""
+        one and no spread ``gear_loss`` when it is 0, so runs keep the labels and keys they had
+        before these existed)."""
         table = asdict(self)
         if self.task_mix is None:
             del table["task_mix"]
+        if self.spread is not None and self.spread.gear_loss == 0:
+            del table["spread"]["gear_loss"]
         return table
 
     @classmethod

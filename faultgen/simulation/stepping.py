@@ -31,6 +31,7 @@ from tqdm.auto import tqdm
 from faultgen.checks import is_whole
 from faultgen.effects import friction
 from faultgen.effects.base import Effect
+from faultgen.effects.load_dependent_friction import LoadDependentFriction
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation import tasks
@@ -101,8 +102,8 @@ class RunConfig:
         1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
         a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
         are not whole days, a fault whose last cycle is not the run's or whose effect the robot
-        already carries, or a task mix without the run's task or with signals; the message names the
-        value.
+        already carries, a task mix without the run's task or with signals, or a unit spread with a
+        gear loss under the ``lugre`` friction model; the message names the value.
     """
 
     robot: str
@@ -135,7 +136,7 @@ class RunConfig:
             if bad:
                 raise ValueError(f"recorded cycle {bad[0]} is out of range 1..{self.cycles}")
             object.__setattr__(self, "record", tuple(sorted(set(record))))
-        if not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+        if not is_whole(self.seed, 0):
             raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
         if self.nthread < 0:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
@@ -165,6 +166,11 @@ class RunConfig:
         if mix is not None and self.signals:
             raise ValueError(f"a task mix ({', '.join(mix.tasks)}) keeps no signals: cycles of different tasks differ "
                              "in length; record features only (--features-only, signals=False)")
+        spread = self.conditions.spread
+        if spread is not None and spread.gear_loss > 0 and self.friction == "lugre":
+            raise ValueError(f"unit spread gear_loss = {spread.gear_loss!r} needs the static friction model "
+                             "(friction='stribeck', --friction stribeck): friction growing with the load is "
+                             "updated every step from Python, and the lugre model runs inside MuJoCo")
         if self.daily:
             per_day = self.conditions.cycles_per_day
             if self.record is not None or self.signals or self.cycles % per_day:
@@ -490,9 +496,9 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
 
 
 def _take(conditions: CycleConditions, rows: np.ndarray) -> CycleConditions:
-    """The conditions of some cycles (the unit's link masses are the run's)."""
+    """The conditions of some cycles (the unit's values are the run's)."""
     return replace(conditions, **{f.name: getattr(conditions, f.name)[rows] for f in fields(conditions)
-                                  if f.name != "link_mass_factor"})
+                                  if f.name not in CycleConditions.PER_UNIT})
 
 
 def _merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunResult]) -> RunResult:
@@ -508,7 +514,8 @@ def _merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunRes
     n_log = (len(own.inputs) - 1) // own.per_log
     empty = np.zeros((len(back), 0, 6))
     conditions = replace(parts[0].conditions, **{f.name: joined(lambda r, n=f.name: getattr(r.conditions, n))
-                                                 for f in fields(CycleConditions) if f.name != "link_mass_factor"})
+                                                 for f in fields(CycleConditions)
+                                                 if f.name not in CycleConditions.PER_UNIT})
     return RunResult(
         config=config, t=np.arange(1, n_log + 1) * sensors.LOG_PERIOD, cycles=joined(lambda r: r.cycles),
         q_ref=own.q_ref[own.per_log::own.per_log], q_a=empty, q_m=empty, qd_a=empty, qd_m=empty, tau_m=empty,
@@ -546,8 +553,7 @@ def daily_record(result: RunResult) -> RunResult:
     conditions = result.conditions
     if conditions is not None:
         first = {name: getattr(conditions, name)[::per_day][:n_days] for name in ("day", "payload_part", "task_index")}
-        conditions = replace(conditions, **first, link_mass_factor=conditions.link_mass_factor,
-                             payload_mass=days(conditions.payload_mass),
+        conditions = replace(conditions, **first, payload_mass=days(conditions.payload_mass),
                              **{name: days(getattr(conditions, name), np.mean) for name in
                                 ("hour", "ambient_temperature", "joint_temperature", "dry_friction_factor",
                                  "viscous_factor")})
@@ -596,23 +602,25 @@ class Prepared:
 class _Plant:
     """How each simulated cycle's robot differs from the nominal model: multipliers of the dry
     (Coulomb and static: wear, temperature, unit) and the viscous friction (n, 6), of each link's
-    mass and inertia (6,), and a growing fault's parameter (n,) (None without one)."""
+    mass and inertia (6,), a growing fault's parameter (n,) (None without one), and the unit's
+    gearbox loss growing with the load (6,), a load-dependent friction coefficient (zeros: none)."""
 
     dry: np.ndarray
     viscous: np.ndarray
     link_mass: np.ndarray
     fault: np.ndarray | None = None
+    gear_loss: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
     @classmethod
     def of(cls, wear: np.ndarray, conditions: CycleConditions | None, fault: np.ndarray | None = None) -> _Plant:
         if conditions is None:
             return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]), fault)
         return cls(wear * conditions.dry_friction_factor, conditions.viscous_factor, conditions.link_mass_factor,
-                   fault)
+                   fault, conditions.gear_loss)
 
     def take(self, rows) -> _Plant:
         return _Plant(self.dry[rows], self.viscous[rows], self.link_mass,
-                      None if self.fault is None else self.fault[rows])
+                      None if self.fault is None else self.fault[rows], self.gear_loss)
 
     def set_fault(self, batch, fault_fields: tuple, final: float) -> None:
         """Each simulation's fault parameter (:attr:`fault`, per cycle) into the fields it moves."""
@@ -868,6 +876,8 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     # the stepped effects that scale the dry friction and those that add to it, sorted once
     factors = [e for e in _stepped(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
     extras = [e for e in _stepped(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
+    if np.any(work.plant.gear_loss):  # the unit's gearbox loss: the same effect, on top of the model's
+        extras.append(LoadDependentFriction(coefficient=work.plant.gear_loss))
     if extras:  # the static load from the last step's kinematics, for those that ask for it
         kinematics = [batch.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
         batch.forward()  # the start state's, for the first step
