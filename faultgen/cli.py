@@ -453,6 +453,13 @@ def fleet_command(
     task_mix: Annotated[bool, typer.Option(
         "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
         "its cycles (default: one task per robot).")] = False,
+    friction_model: Annotated[str, typer.Option(
+        "--friction", help="Motor-side friction model of every robot: lugre (dynamic, the default) or stribeck "
+        "(static eq. 6.3; needed for --gear-loss; about twice the time).")] = "lugre",
+    gear_loss: Annotated[float, typer.Option(
+        "--gear-loss", metavar="C", help="Each unit's gearboxes also lose a share of the transmitted torque as "
+        "Coulomb friction, drawn per axis in 0..C (1 minus the gear efficiency under load); needs --friction "
+        "stribeck.")] = 0.0,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
@@ -470,12 +477,15 @@ def fleet_command(
       faultgen fleet -o fleet.h5
 
       faultgen classify fleet.h5 --wear-threshold 10
+
+      faultgen fleet --friction stribeck --gear-loss 0.1 -o fleet-lossy.h5
     """
     from faultgen.runs import fleet
 
     try:
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
-                           failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix)
+                           failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
+                           friction=friction_model, gear_loss=gear_loss)
         if jobs < 1:
             raise ValueError(f"--jobs {jobs}: expected >= 1")
         _check_outputs([out], overwrite)

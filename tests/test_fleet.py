@@ -56,6 +56,10 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"onset": (0, 30)}, r"fleet onset day = 0"),
     ({"cycles_per_day": 0}, r"fleet cycles_per_day = 0"),
     ({"models": ("kuka",)}, r"kuka"),
+    ({"friction": "coulomb"}, r"unknown friction model 'coulomb'"),
+    ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
+    ({"gear_loss": 0.1}, r"fleet gear_loss = 0.1 needs friction 'stribeck' \(--friction stribeck; got 'lugre'\)"),
+    ({"gear_loss": 0.1, "friction": "stribeck", "conditions": False}, r"and the conditions \(got conditions = False\)"),
 ])
 def test_bad_fleet_settings_are_refused_with_the_value_named(settings, message):
     with pytest.raises(ValueError, match=message):
@@ -114,6 +118,28 @@ def test_a_small_fleet_runs_validates_and_repeats_bit_for_bit(tmp_path):
         assert first.keys() == again.keys()
         for name in first:
             np.testing.assert_array_equal(first[name], again[name], err_msg=name)
+
+
+def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path):
+    """--gear-loss adds each unit's gear loss to its spread and changes nothing else the fleet
+    draws; the default fleet's settings are stored as before; each robot's file carries its
+    unit's draw, and the small fleet validates."""
+    plain, lossy = Fleet(friction="stribeck").robots(), Fleet(friction="stribeck", gear_loss=0.1).robots()
+    for one, other in zip(plain, lossy, strict=True):
+        assert other["conditions"]["spread"].pop("gear_loss") == 0.1
+        assert one == other
+    assert "gear_loss" not in json.loads(Fleet().to_json())["fleet"]
+    out = tmp_path / "lossy.h5"
+    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
+                                      "--friction", "stribeck", "--gear-loss", "0.1", "--jobs", "1", "--no-progress",
+                                      "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert dataset.validate(out) == []
+    fleet = Fleet(size=2, failing=1, days=6, cycles_per_day=1, friction="stribeck", gear_loss=0.1)
+    for run_id, config in fleet.runs():
+        arrays, _ = dataset.read_run(out, run_id, names=("gear_loss",))
+        np.testing.assert_array_equal(arrays["gear_loss"], config.conditions.spread.draw(config.seed)["gear_loss"])
+        assert config.friction == "stribeck" and np.all(arrays["gear_loss"] > 0)
 
 
 def test_features_only_runs_say_what_they_lack(tmp_path):

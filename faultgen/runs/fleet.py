@@ -10,7 +10,8 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   second drawn from the others, one of them drawn for each cycle; parts of two sizes that the robot picks
   at random, sized to the model; its own hall climate (mean, seasonal swing, the day of the year
   its record starts), warm-up over each shift, its daily records taken at the same hours every day;
-  its own unit-to-unit spread of friction and link masses (:mod:`faultgen.operation.conditions`);
+  its own unit-to-unit spread of friction and link masses, and with ``gear_loss`` of gear efficiency
+  (:mod:`faultgen.operation.conditions`);
 - a failing robot's gearbox wears on one drawn axis, its Coulomb and static friction rising on the
   exp4 schedule (thesis eq. 6.6) from a drawn onset day to ``failure_wear`` percent on its last
   day, the failure day; a healthy robot does not wear;
@@ -31,6 +32,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from faultgen.effects import friction as friction_models
 from faultgen.model import robots as robot_models
 from faultgen.operation import conditions, tasks, wear
 from faultgen.operation.conditions import check_number
@@ -77,12 +79,18 @@ class Fleet:
         Each robot runs a second task, drawn from the other two, in a random half of its cycles
         (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
         so the fleet's draws and records are those of the fleets measured before it existed.
+    gear_loss : float
+        Each unit's gearboxes lose a share of the transmitted torque as Coulomb friction, drawn per
+        axis in 0..``gear_loss`` (:attr:`faultgen.operation.conditions.UnitSpread.gear_loss`); needs
+        ``friction="stribeck"`` and the conditions. Default 0: off, the fleet's draws and records
+        those of the fleets measured before it existed.
 
     Raises
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
-        the days, or a robot model that is unknown or has no parts sized in :data:`PARTS`.
+        the days, a robot model that is unknown or has no parts sized in :data:`PARTS`, or a gear
+        loss without the conditions or under the ``lugre`` friction model.
     """
 
     size: int = 26
@@ -96,6 +104,7 @@ class Fleet:
     friction: str = "lugre"
     conditions: bool = True
     task_mix: bool = False
+    gear_loss: float = 0.0
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -104,6 +113,12 @@ class Fleet:
         check_number("fleet cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
         check_number("fleet failure_wear", self.failure_wear, 0, 1000)
         check_number("fleet seed", self.seed, 0, 2**31, whole=True)
+        friction_models.check_model(self.friction)
+        check_number("fleet gear_loss", self.gear_loss, 0, 0.5)
+        if self.gear_loss and (self.friction != "stribeck" or not self.conditions):
+            raise ValueError(f"fleet gear_loss = {self.gear_loss!r} needs friction 'stribeck' (--friction stribeck; "
+                             f"got {self.friction!r}) and the conditions (got conditions = {self.conditions}): "
+                             "the gear loss is a part of the unit spread, updated every step by the static model")
         onset = self.onset if self.onset is not None else (self.days // 6, self.days * 7 // 12)
         first, last = (check_number("fleet onset day", d, 1, self.days - 1, whole=True) for d in onset)
         if first > last:
@@ -135,7 +150,8 @@ class Fleet:
                      "pattern": "random"}
             climate = {"ambient": round(float(rng.uniform(16.0, 24.0)), 1),
                        "seasonal": round(float(rng.uniform(2.0, 8.0)), 1)}
-            table = {"thermal": climate, "payloads": parts, "spread": {}, "cycles_per_day": self.cycles_per_day,
+            spread = {"gear_loss": self.gear_loss} if self.gear_loss else {}
+            table = {"thermal": climate, "payloads": parts, "spread": spread, "cycles_per_day": self.cycles_per_day,
                      "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
             if not self.conditions:  # the same draws, none of them used: only the calendar
                 table = {"cycles_per_day": self.cycles_per_day, "hours": self.hours()}
@@ -174,4 +190,7 @@ class Fleet:
 
     def to_json(self) -> str:
         """The settings and every robot's draws, stored with the dataset."""
-        return json.dumps({"fleet": asdict(self), "robots": self.robots()}, sort_keys=True)
+        settings = asdict(self)
+        if not self.gear_loss:  # the settings of fleets made before it existed
+            del settings["gear_loss"]
+        return json.dumps({"fleet": settings, "robots": self.robots()}, sort_keys=True)
