@@ -460,6 +460,10 @@ def fleet_command(
         "--gear-loss", metavar="C", help="Each unit's gearboxes also lose a share of the transmitted torque as "
         "Coulomb friction, drawn per axis in 0..C (1 minus the gear efficiency under load); needs --friction "
         "stribeck.")] = 0.0,
+    fault: Annotated[str | None, typer.Option(
+        help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
+        "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
+        "backlash:width:0.01 (see `simulate --fault`); the same FINAL on both robot models.")] = None,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
@@ -479,13 +483,15 @@ def fleet_command(
       faultgen classify fleet.h5 --wear-threshold 10
 
       faultgen fleet --friction stribeck --gear-loss 0.1 -o fleet-lossy.h5
+
+      faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
     """
     from faultgen.runs import fleet
 
     try:
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
                            failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
-                           friction=friction_model, gear_loss=gear_loss)
+                           friction=friction_model, gear_loss=gear_loss, fault=fault)
         if jobs < 1:
             raise ValueError(f"--jobs {jobs}: expected >= 1")
         _check_outputs([out], overwrite)

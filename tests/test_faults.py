@@ -25,6 +25,11 @@ def test_fault_values_at_known_cycles():
     cogging = parse_fault("cogging:3:amplitude:0.05:poles=8,phase=1", last_cycle=10)
     assert cogging.at(0.02).values(2) == pytest.approx({"amplitude": 0.02, "poles": 8, "phase": 1.0})
     assert cogging.at(0.02).values(0)["amplitude"] == 0.0
+    # with an onset: the start value up to it, then exp4's rise over the cycles after it
+    late = parse_fault("cogging:3:amplitude:0.05:kind=exp4,onset=60", last_cycle=100)
+    assert late.values(np.array([0, 60, 80, 100])) == pytest.approx([0.0, 0.0, 0.05 * (2 ** (1 / 16) - 1), 0.05],
+                                                                   rel=1e-9)
+    assert late.to_dict()["onset"] == 60 and "onset" not in grown.to_dict()  # labels without one unchanged
 
 
 @pytest.mark.parametrize(("spec", "message"), [
@@ -36,6 +41,9 @@ def test_fault_values_at_known_cycles():
     ("backlash:2:width:0", r"a fault must change its parameter"),
     ("backlash:2:width", r"expected 4 or 5"),
     ("cogging:2:amplitude:0.1:kind=exp5", r"unknown wear schedule 'exp5'"),
+    ("cogging:2:amplitude:0.1:kind=exp4,onset=10", r"exp4 onset 10 is invalid; expected an int in 0..9"),
+    ("cogging:2:amplitude:0.1:onset=3", r"linear schedule has no parameter 'onset'"),
+    ("cogging:2:amplitude:0.1:kind=exp4,onset=2.5", r"option onset=2.5 is not a whole cycle"),
 ])
 def test_bad_fault_specs_are_refused_with_the_value_named(spec, message):
     with pytest.raises(ValueError, match=message):

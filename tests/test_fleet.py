@@ -60,6 +60,8 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
     ({"gear_loss": 0.1}, r"fleet gear_loss = 0.1 needs friction 'stribeck' \(--friction stribeck; got 'lugre'\)"),
     ({"gear_loss": 0.1, "friction": "stribeck", "conditions": False}, r"and the conditions \(got conditions = False\)"),
+    ({"fault": "backlash:width:0.01:kind=linear"}, r"fleet fault 'backlash:width:0.01:kind=linear': the fleet sets"),
+    ({"fault": "backlash:gap:0.01"}, r"fleet fault 'backlash:gap:0.01': .*backlash has no parameter 'gap'"),
 ])
 def test_bad_fleet_settings_are_refused_with_the_value_named(settings, message):
     with pytest.raises(ValueError, match=message):
@@ -140,6 +142,33 @@ def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path)
         arrays, _ = dataset.read_run(out, run_id, names=("gear_loss",))
         np.testing.assert_array_equal(arrays["gear_loss"], config.conditions.spread.draw(config.seed)["gear_loss"])
         assert config.friction == "stribeck" and np.all(arrays["gear_loss"] > 0)
+
+
+def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(tmp_path):
+    """--fault: each failing robot's drawn axis gets the fault instead of friction wear, growing on
+    exp4 from its drawn onset day to FINAL on the failure day; the healthy robots, every draw and
+    the default fleet's stored settings are unchanged; the file validates and labels the fault's
+    value per day."""
+    plain, faulty = Fleet(), Fleet(fault="backlash:width:0.01")
+    assert plain.robots() == faulty.robots() and "fault" not in json.loads(plain.to_json())["fleet"]
+    for (run_id, config), robot in zip(faulty.runs(), faulty.robots(), strict=True):
+        assert not config.wear.schedules
+        if not robot["failing"]:
+            assert config.fault is None
+            continue
+        onset = (robot["onset_day"] - 1) * 2
+        assert (config.fault.effect, config.fault.axis, config.fault.kind) == ("backlash", robot["axis"], "exp4")
+        assert config.fault.values(np.array([0, onset, config.cycles])) == pytest.approx([0.0, 0.0, 0.01])
+    out = tmp_path / "backlash.h5"
+    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
+                                      "--fault", "backlash:width:0.01", "--jobs", "1", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert dataset.validate(out) == []
+    small = Fleet(size=2, failing=1, days=6, cycles_per_day=1, fault="backlash:width:0.01")
+    failing = next((run_id, config) for run_id, config in small.runs() if config.fault is not None)
+    arrays, attrs = dataset.read_run(out, failing[0], names=("fault_value",))
+    np.testing.assert_allclose(arrays["fault_value"], failing[1].fault.values(np.arange(1, 7)), rtol=1e-12)
+    assert arrays["fault_value"][-1] == pytest.approx(0.01) and json.loads(attrs["fault"]) == failing[1].fault.to_dict()
 
 
 def test_features_only_runs_say_what_they_lack(tmp_path):

@@ -54,13 +54,16 @@ class Fault:
     others : dict
         The effect's other parameters on the axis (e.g. cogging ``poles`` and ``phase``); those
         not given keep the effect's absent values.
+    onset : int
+        Last cycle at the start value, with the ``exp4`` kind (the wear schedule's onset: the
+        growth runs from it to ``last_cycle``); default 0, growing from cycle 0.
 
     Raises
     ------
     ValueError
         For an unknown effect (listing them), a stepped or robot-wide effect, an axis outside
         1..6, an unknown parameter, a non-finite value, a final value equal to the start, a bad
-        schedule kind, or a value the effect does not admit; the message names it.
+        schedule kind or onset, or a value the effect does not admit; the message names it.
     """
 
     effect: str
@@ -71,6 +74,7 @@ class Fault:
     kind: str = "linear"
     start: float = 0.0
     others: dict = field(default_factory=dict)
+    onset: int = 0
 
     def __post_init__(self) -> None:
         prototype = effects.get(self.effect)  # ValueError lists the known ids
@@ -94,7 +98,7 @@ class Fault:
                 raise ValueError(f"fault {name} = {value!r}: expected a finite number")
         if self.final == self.start:
             raise ValueError(f"fault final = start = {self.final!r}: a fault must change its parameter")
-        wear.Schedule(self.kind, 1.0, self.last_cycle)  # names a bad kind or last cycle
+        self._schedule()  # names a bad kind, last cycle or onset
         object.__setattr__(self, "others", MappingProxyType(dict(self.others)))
         for value in (self.start, self.final):
             if value < 0 and not prototype.signed:
@@ -104,9 +108,13 @@ class Fault:
             if problem:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} {problem}")
 
+    def _schedule(self) -> wear.Schedule:
+        """The growth's shape: a wear schedule of a unit rise."""
+        return wear.Schedule(self.kind, 1.0, self.last_cycle, {"onset": self.onset} if self.onset else {})
+
     def values(self, cycles) -> np.ndarray:
         """The parameter at ``cycles`` (ints >= 0, any shape), in its unit."""
-        rise = wear.Schedule(self.kind, 1.0, self.last_cycle).multiplier(np.asarray(cycles)) - 1.0
+        rise = self._schedule().multiplier(np.asarray(cycles)) - 1.0
         return self.start + (self.final - self.start) * rise
 
     def at(self, value: float) -> Effect:
@@ -123,14 +131,15 @@ class Fault:
         return cls(**table)
 
     def to_dict(self) -> dict:
-        """JSON-serialisable labels."""
-        return {"effect": self.effect, "axis": self.axis, "parameter": self.parameter, "final": self.final,
-                "start": self.start, "kind": self.kind, "last_cycle": self.last_cycle, "others": dict(self.others)}
+        """JSON-serialisable labels (``onset`` only when not 0, so faults without one keep their labels)."""
+        table = {"effect": self.effect, "axis": self.axis, "parameter": self.parameter, "final": self.final,
+                 "start": self.start, "kind": self.kind, "last_cycle": self.last_cycle, "others": dict(self.others)}
+        return {**table, "onset": self.onset} if self.onset else table
 
 
 def parse_fault(spec: str, last_cycle: int) -> Fault:
     """A :class:`Fault` from ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]`` (options: ``kind``,
-    ``start`` and the effect's other parameters). Raises ValueError quoting the spec and the form."""
+    ``start``, ``onset`` and the effect's other parameters). Raises ValueError quoting the spec and the form."""
 
     def fail(reason: str) -> ValueError:
         return ValueError(f"bad fault spec {spec!r}: {reason}; {_SPEC_FORM}")
@@ -143,7 +152,7 @@ def parse_fault(spec: str, last_cycle: int) -> Fault:
         axis, final = int(axis_text), float(final_text)
     except ValueError:
         raise fail("AXIS must be an int and FINAL a number") from None
-    options, kind, start = {}, "linear", 0.0
+    options, kind, start, onset = {}, "linear", 0.0, 0
     if len(parts) == 5:
         for option in parts[4].split(","):
             key, sep, value = (s.strip() for s in option.partition("="))
@@ -158,9 +167,13 @@ def parse_fault(spec: str, last_cycle: int) -> Fault:
                 raise fail(f"option {key}={value} is not a number") from None
             if key == "start":
                 start = number
+            elif key == "onset":
+                if not number.is_integer():
+                    raise fail(f"option onset={value} is not a whole cycle")
+                onset = int(number)
             else:
                 options[key] = number
     try:
-        return Fault(effect, axis, parameter, final, last_cycle, kind=kind, start=start, others=options)
+        return Fault(effect, axis, parameter, final, last_cycle, kind=kind, start=start, others=options, onset=onset)
     except ValueError as err:
         raise fail(str(err)) from None

@@ -14,7 +14,8 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   (:mod:`faultgen.operation.conditions`);
 - a failing robot's gearbox wears on one drawn axis, its Coulomb and static friction rising on the
   exp4 schedule (thesis eq. 6.6) from a drawn onset day to ``failure_wear`` percent on its last
-  day, the failure day; a healthy robot does not wear;
+  day, the failure day (or, with ``fault``, another effect's parameter grows on that axis on the
+  same schedule, :mod:`faultgen.operation.faults`); a healthy robot does not wear;
 - every day ``cycles_per_day`` cycles are simulated and reduced to one daily record, the day's
   maximum (:func:`faultgen.simulation.stepping.daily_record`): the histograms and each axis's
   duty (average speed and load torque, from which ``analysis.features.duty_indicators`` makes the
@@ -34,7 +35,7 @@ import numpy as np
 
 from faultgen.effects import friction as friction_models
 from faultgen.model import robots as robot_models
-from faultgen.operation import conditions, tasks, wear
+from faultgen.operation import conditions, faults, tasks, wear
 from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -79,6 +80,11 @@ class Fleet:
         Each robot runs a second task, drawn from the other two, in a random half of its cycles
         (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
         so the fleet's draws and records are those of the fleets measured before it existed.
+    fault : str or None
+        Instead of friction wear, a failing robot's drawn axis gets this fault,
+        ``EFFECT:PARAMETER:FINAL[:key=value,...]`` (the sweep's ``--fault``, e.g.
+        ``backlash:width:0.01``), growing on the exp4 schedule from its onset day to FINAL on the
+        failure day; FINAL is the same on both robot models. None (default): friction wear.
     gear_loss : float
         Each unit's gearboxes lose a share of the transmitted torque as Coulomb friction, drawn per
         axis in 0..``gear_loss`` (:attr:`faultgen.operation.conditions.UnitSpread.gear_loss`); needs
@@ -89,8 +95,9 @@ class Fleet:
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
-        the days, a robot model that is unknown or has no parts sized in :data:`PARTS`, or a gear
-        loss without the conditions or under the ``lugre`` friction model.
+        the days, a robot model that is unknown or has no parts sized in :data:`PARTS`, a gear
+        loss without the conditions or under the ``lugre`` friction model, or a bad ``fault`` spec
+        (one that sets its own ``kind`` or ``onset`` included: the fleet sets them).
     """
 
     size: int = 26
@@ -105,6 +112,7 @@ class Fleet:
     conditions: bool = True
     task_mix: bool = False
     gear_loss: float = 0.0
+    fault: str | None = None
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -129,6 +137,11 @@ class Fleet:
                 raise ValueError(f"fleet model {model!r}: its parts are not sized; models with parts: "
                                  f"{', '.join(PARTS)} (add it to faultgen.runs.fleet.PARTS)")
         object.__setattr__(self, "onset", (first, last))
+        if self.fault is not None:
+            if any(f"{key}=" in str(self.fault) for key in ("kind", "onset")):
+                raise ValueError(f"fleet fault {self.fault!r}: the fleet sets its kind (exp4) and onset (the drawn "
+                                 "onset day); give EFFECT:PARAMETER:FINAL[:key=value,...] without them")
+            self._fault(1, first)  # a bad spec is named now, not when the runs are built
         object.__setattr__(self, "models", tuple(self.models))
 
     def robots(self) -> list[dict]:
@@ -177,20 +190,33 @@ class Fleet:
         cycles = self.days * self.cycles_per_day
         out = []
         for robot in self.robots():
-            plan = wear.WearPlan({})
-            if robot["failing"]:
+            plan, fault = wear.WearPlan({}), None
+            if robot["failing"] and self.fault is not None:
+                fault = self._fault(robot["axis"], robot["onset_day"])
+            elif robot["failing"]:
                 spec = f"{robot['axis']}:exp4:{self.failure_wear:g}:onset={(robot['onset_day'] - 1) * self.cycles_per_day}"
                 plan = wear.WearPlan.from_specs([spec], last_cycle=cycles)
             config = sim.RunConfig(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
                                    cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
                                    conditions=conditions.Conditions.from_dict(robot["conditions"]),
-                                   signals=False, daily=True)
+                                   signals=False, daily=True, fault=fault)
             out.append((robot["run"], config))
         return out
+
+    def _fault(self, axis: int, onset_day: int) -> faults.Fault:
+        """The fault of a robot failing on ``axis`` from ``onset_day``."""
+        effect, _, rest = str(self.fault).partition(":")
+        options = "kind=exp4" + (f",onset={(onset_day - 1) * self.cycles_per_day}" if onset_day > 1 else "")
+        spec = f"{effect}:{axis}:{rest}" + (f",{options}" if rest.count(":") == 2 else f":{options}")
+        try:
+            return faults.parse_fault(spec, last_cycle=self.days * self.cycles_per_day)
+        except ValueError as err:
+            raise ValueError(f"fleet fault {self.fault!r}: {err}") from None
 
     def to_json(self) -> str:
         """The settings and every robot's draws, stored with the dataset."""
         settings = asdict(self)
-        if not self.gear_loss:  # the settings of fleets made before it existed
-            del settings["gear_loss"]
+        for name in ("gear_loss", "fault"):  # the settings of fleets made before they existed
+            if not settings[name]:
+                del settings[name]
         return json.dumps({"fleet": settings, "robots": self.robots()}, sort_keys=True)
