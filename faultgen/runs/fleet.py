@@ -29,7 +29,7 @@ draws of every robot are in the dataset's grid JSON (:meth:`Fleet.to_json`).
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -206,10 +206,9 @@ class Fleet:
     def _fault(self, axis: int, onset_day: int) -> faults.Fault:
         """The fault of a robot failing on ``axis`` from ``onset_day``."""
         effect, _, rest = str(self.fault).partition(":")
-        options = "kind=exp4" + (f",onset={(onset_day - 1) * self.cycles_per_day}" if onset_day > 1 else "")
-        spec = f"{effect}:{axis}:{rest}" + (f",{options}" if rest.count(":") == 2 else f":{options}")
         try:
-            return faults.parse_fault(spec, last_cycle=self.days * self.cycles_per_day)
+            fault = faults.parse_fault(f"{effect}:{axis}:{rest}", last_cycle=self.days * self.cycles_per_day)
+            return replace(fault, kind="exp4", onset=(onset_day - 1) * self.cycles_per_day)
         except ValueError as err:
             raise ValueError(f"fleet fault {self.fault!r}: {err}") from None
 
