@@ -5,8 +5,9 @@
 For every worn run of each file: the worn axis's mean load torque per sample (the dataset's
 ``average_load_torque``, N m, what the "+estM" block of ``faultgen classify`` adds), its change
 from the samples before the wear starts (true friction multiplier 1) to the failed samples (true
-wear at least ``--threshold`` percent, the labels of ``faultgen classify``), in percent of the level
-before, and the same change over the sample-to-sample standard deviation before (a z-score). A
+wear at least ``--threshold`` percent, the labels of ``faultgen classify``; for a fault other than
+friction wear, that share of its final value, ``analysis.benchmark.fault_progress``), in percent
+of the level before, and the same change over the sample-to-sample standard deviation before (a z-score). A
 fault a classifier can find on a robot's own record has a large z; where the conditions move the
 load more from day to day than the wear does, z falls below 1. docs/reproduction.md ("What the
 operating conditions do to detection") holds the figures of the fleets measured.
@@ -19,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.benchmark import fault_progress
 from faultgen import axes
 from faultgen.data import dataset
 
@@ -32,7 +34,7 @@ def visibility(path: Path, threshold: float) -> list[dict]:
         if not len(attrs["worn_axes"]):
             continue
         axis = axes.index(int(attrs["worn_axes"][0]))
-        wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
+        wear = (fault_progress(path, run_id, arrays, attrs, axes.number(axis)) - 1.0) * 100.0
         load = arrays["average_load_torque"][:, axis]
         before, failed = load[wear == 0.0], load[wear >= threshold]
         if before.size < 2 or not failed.size:
