@@ -441,6 +441,9 @@ def sweep_command(
 def fleet_command(
     size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).")] = 26,
     failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).")] = 13,
+    models: Annotated[list[str] | None, typer.Option(
+        "--robot", help="Robot model(s) of the fleet, taken in turn; repeat for several (default: irb6700 and "
+        "puma560). One model makes every robot that model, e.g. for a fault whose FINAL suits only it.")] = None,
     days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.")] = 60,
     cycles_per_day: Annotated[int, typer.Option(
         help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).")] = 2,
@@ -463,7 +466,7 @@ def fleet_command(
     fault: Annotated[str | None, typer.Option(
         help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
         "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
-        "backlash:width:0.01 (see `simulate --fault`); the same FINAL on both robot models.")] = None,
+        "backlash:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
     jobs: Annotated[int, typer.Option(help="Local worker processes.")] = 2,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
@@ -485,11 +488,14 @@ def fleet_command(
       faultgen fleet --friction stribeck --gear-loss 0.1 -o fleet-lossy.h5
 
       faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
+
+      faultgen fleet --robot irb6700 --fault cogging:amplitude:0.5:poles=8 -o fleet-cogging.h5
     """
     from faultgen.runs import fleet
 
     try:
-        plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day,
+        chosen = {"models": tuple(models)} if models else {}
+        plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
                            failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
                            friction=friction_model, gear_loss=gear_loss, fault=fault)
         if jobs < 1:

@@ -56,6 +56,9 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"onset": (0, 30)}, r"fleet onset day = 0"),
     ({"cycles_per_day": 0}, r"fleet cycles_per_day = 0"),
     ({"models": ("kuka",)}, r"kuka"),
+    ({"models": ()}, r"fleet models = \(\): expected one or more different robot model names"),
+    ({"models": ("irb6700", "irb6700")}, r"fleet models = \('irb6700', 'irb6700'\): expected one or more different"),
+    ({"models": "irb6700"}, r"fleet models = 'irb6700': expected"),
     ({"friction": "coulomb"}, r"unknown friction model 'coulomb'"),
     ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
     ({"gear_loss": 0.1}, r"fleet gear_loss = 0.1 needs friction 'stribeck' \(--friction stribeck; got 'lugre'\)"),
@@ -253,3 +256,22 @@ def test_the_fleet_command_refuses_bad_settings_before_simulating(tmp_path):
     assert result.exit_code == 2
     assert "error: fleet failing = 2: expected a whole number within 1..1" in result.output
     assert not (tmp_path / "f.h5").exists() and not list(tmp_path.iterdir())
+
+
+def test_the_fleet_command_takes_its_robot_models_in_turn(tmp_path, monkeypatch):
+    """--robot (repeated) sets the fleet's models: every robot of a one-model fleet is that model,
+    and with two the order given is the order taken; every other draw is the default fleet's."""
+    from faultgen import cli
+
+    plans = []
+    monkeypatch.setattr(cli, "_run_sweep", lambda plan, out, **kwargs: plans.append(plan))
+    for robots in (["irb6700"], ["puma560", "irb6700"]):
+        args = ["fleet", "-o", str(tmp_path / "f.h5")] + [x for r in robots for x in ("--robot", r)]
+        assert CliRunner().invoke(app, args).exit_code == 0
+    one, two = (plan.robots() for plan in plans)
+    assert plans[0].models == ("irb6700",) and {r["model"] for r in one} == {"irb6700"}
+    assert [r["model"] for r in two[:4]] == ["puma560", "irb6700", "puma560", "irb6700"]
+    default = Fleet().robots()
+    assert [(r["task"], r["failing"], r["axis"]) for r in one] == [(r["task"], r["failing"], r["axis"]) for r in default]
+    result = CliRunner().invoke(app, ["fleet", "--robot", "kuka", "-o", str(tmp_path / "k.h5")])
+    assert result.exit_code == 2 and "kuka" in result.output and not (tmp_path / "k.h5").exists()

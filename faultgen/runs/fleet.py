@@ -69,7 +69,8 @@ class Fleet:
         from a sixth to seven twelfths of the days (10 to 35 of 60), so that every failing robot
         wears for at least its last 25 days.
     models : tuple of str
-        Robot models, taken in turn.
+        Robot models, taken in turn (robot i is ``models[i % len(models)]``); each needs its parts
+        in :data:`PARTS`. Default both, the IRB-6700-like arm first.
     seed : int
     friction : str
         Friction model of every run.
@@ -95,9 +96,10 @@ class Fleet:
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
-        the days, a robot model that is unknown or has no parts sized in :data:`PARTS`, a gear
-        loss without the conditions or under the ``lugre`` friction model, or a bad ``fault`` spec
-        (one that sets its own ``kind`` or ``onset`` included: the fleet sets them).
+        the days, no robot model or one named twice, a model that is unknown or has no parts sized in
+        :data:`PARTS`, a gear loss without the conditions or under the ``lugre`` friction model, or a
+        bad ``fault`` spec (one that sets its own ``kind`` or ``onset`` included: the fleet sets
+        them).
     """
 
     size: int = 26
@@ -131,6 +133,9 @@ class Fleet:
         first, last = (check_number("fleet onset day", d, 1, self.days - 1, whole=True) for d in onset)
         if first > last:
             raise ValueError(f"fleet onset = {self.onset!r}: expected (first day, last day) with first <= last")
+        if isinstance(self.models, str) or not self.models or len(set(self.models)) != len(tuple(self.models)):
+            raise ValueError(f"fleet models = {self.models!r}: expected one or more different robot model names, "
+                             f"e.g. ('irb6700',) or {tuple(PARTS)!r}")
         for model in self.models:
             robot_models.load(model)  # UnknownRobotError names the known ones
             if model not in PARTS:
