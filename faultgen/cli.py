@@ -54,6 +54,10 @@ QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q li
 Temperature = Annotated[bool, typer.Option(
     "--temperature", help="Joint temperature on: hall air 20 degC +- 5 K seasonal +- 2 K daily, joints warming "
     "15 K over a shift (1 h time constant), friction following the gear oil's viscosity (docs/simulation.md).")]
+DryShare = Annotated[float | None, typer.Option(
+    "--dry-share", metavar="S", help="With --temperature: the exponent of the oil viscosity's ratio that the dry "
+    "(Coulomb, Stribeck) friction follows, 0..1; default 0.25 (ours, not measured), 0: only the viscous friction "
+    "moves with temperature, 1: the dry moves as much.", show_default=False)]
 PayloadParts = Annotated[str | None, typer.Option(
     "--payloads", help="Parts carried, MASS:SIZE in kg:m, comma-separated, e.g. 20:0.2,80:0.4 (uniform cubes "
     "hanging from the flange; the controller knows each).")]
@@ -80,13 +84,15 @@ StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
 
 def _conditions(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
                 start_day: float, task_mix: str | None = None, task_pattern: str = "alternate",
-                gear_loss: float = 0.0) -> dict | None:
+                gear_loss: float = 0.0, dry_share: float | None = None) -> dict | None:
     """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
-    no condition is on. Raises ValueError naming a malformed ``--payloads`` part, or a
-    ``--gear-loss`` without ``--unit-spread``."""
+    no condition is on. Raises ValueError naming a malformed ``--payloads`` part, a
+    ``--gear-loss`` without ``--unit-spread`` or a ``--dry-share`` without ``--temperature``."""
     table: dict = {}
+    if dry_share is not None and not temperature:
+        raise ValueError(f"--dry-share {dry_share:g} sets how friction follows the joint temperature: add --temperature")
     if temperature:
-        table["thermal"] = {}
+        table["thermal"] = {} if dry_share is None else {"dry_share": dry_share}
     if payloads:
         masses, sizes = [], []
         for part in payloads.split(","):
@@ -228,6 +234,7 @@ def simulate_command(
         "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
         "warm-up).")] = None,
     temperature: Temperature = False,
+    dry_share: DryShare = None,
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
     unit_spread: UnitSpreadFlag = False,
@@ -271,7 +278,7 @@ def simulate_command(
             noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
             conditions=conditions_module.Conditions.from_dict(
                 _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
-                            gear_loss=gear_loss) or {}),
+                            gear_loss=gear_loss, dry_share=dry_share) or {}),
             fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
         )
     except ValueError as err:
@@ -355,6 +362,7 @@ def sweep_command(
         help="Instead of friction wear, each worn axis gets this fault: EFFECT:PARAMETER:FINAL[:key=value,...], "
         "e.g. backlash:width:0.01 or cogging:amplitude:0.05:poles=8 (see `simulate --fault`).")] = None,
     temperature: Temperature = False,
+    dry_share: DryShare = None,
     payloads: PayloadParts = None,
     payload_pattern: PayloadPattern = "alternate",
     unit_spread: UnitSpreadFlag = False,
@@ -401,7 +409,7 @@ def sweep_command(
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     try:
         table = _conditions(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
-                            task_mix, task_pattern, gear_loss)
+                            task_mix, task_pattern, gear_loss, dry_share)
         if table is not None:
             options["conditions"] = table
         if features_only is not None:
@@ -459,6 +467,10 @@ def fleet_command(
     friction_model: Annotated[str, typer.Option(
         "--friction", help="Motor-side friction model of every robot: lugre (dynamic, the default) or stribeck "
         "(static eq. 6.3; needed for --gear-loss; the fleet took 12 min instead of 9 on 2 cores).")] = "lugre",
+    dry_share: Annotated[float | None, typer.Option(
+        "--dry-share", metavar="S", help="The exponent of the oil viscosity's ratio that every robot's dry friction "
+        "follows with its joint temperature, 0..1; default 0.25 (ours, not measured), 0: only the viscous friction "
+        "moves with temperature.", show_default=False)] = None,
     gear_loss: Annotated[float, typer.Option(
         "--gear-loss", metavar="C", help="Each unit's gearboxes also lose a share of the transmitted torque as "
         "Coulomb friction, drawn per axis in 0..C (1 minus the gear efficiency under load); needs --friction "
@@ -495,6 +507,8 @@ def fleet_command(
 
     try:
         chosen = {"models": tuple(models)} if models else {}
+        if dry_share is not None:
+            chosen["dry_share"] = dry_share
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
                            failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
                            friction=friction_model, gear_loss=gear_loss, fault=fault)

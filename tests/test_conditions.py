@@ -45,6 +45,39 @@ PUBLISHED_OILS = [(38, 12.1, 5.3), (153, 34, 9.1), (250, 50.5, 12.6), (810, 135,
                   (165, 30.0, 6.8), (310, 44.2, 9.4), (2000, 180, 24)]
 
 
+def test_the_dry_share_sets_how_far_dry_friction_follows_the_viscosity():
+    """0: the dry friction stays at its nominal level whatever the temperature; 1: it moves as the
+    viscous; the default is DRY_SHARE. A run's Temperature carries it into the per-cycle factors
+    and labels, and its labels name it only when it is not the default (runs made before keep theirs)."""
+    temperature = np.array([10.0, 20.0, 35.0, 50.0])
+    dry, viscous = law.friction_factors(temperature, dry_share=0)
+    assert np.all(dry == 1.0)
+    assert law.friction_factors(temperature, dry_share=1)[0] == pytest.approx(viscous, rel=1e-12)
+    assert law.friction_factors(temperature)[0] == pytest.approx(viscous**law.DRY_SHARE, rel=1e-12)
+    cycles = np.arange(1, 6)
+    default, flat = (c.Conditions(thermal=c.Temperature(**share), cycles_per_day=2) for share in ({}, {"dry_share": 0}))
+    at_default, at_flat = default.evaluate(4, cycles), flat.evaluate(4, cycles)
+    assert np.all(at_flat.dry_friction_factor == 1.0) and np.ptp(at_default.dry_friction_factor) > 0.05
+    np.testing.assert_array_equal(at_flat.viscous_factor, at_default.viscous_factor)
+    np.testing.assert_array_equal(at_flat.joint_temperature, at_default.joint_temperature)
+    assert "dry_share" not in default.to_dict()["thermal"] and flat.to_dict()["thermal"]["dry_share"] == 0.0
+    assert c.Conditions.from_dict(flat.to_dict()) == flat and c.Conditions.from_dict(default.to_dict()) == default
+
+
+def test_cli_dry_share_needs_the_temperature_and_is_labelled(tmp_path):
+    runner = CliRunner()
+    refused = runner.invoke(app, ["simulate", "--robot", "puma560", "--dry-share", "0.5", "-o", str(tmp_path / "a.h5")])
+    assert refused.exit_code == 2 and "--dry-share 0.5 sets how friction follows the joint temperature: add " \
+        "--temperature" in refused.output and not list(tmp_path.iterdir())
+    out = tmp_path / "b.h5"
+    result = runner.invoke(app, ["simulate", "--robot", "puma560", "--cycles", "2", "--temperature", "--dry-share", "0",
+                                 "--no-progress", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    arrays, attrs = dataset.read_run(out, names=("dry_friction_factor", "viscous_factor"))
+    assert json.loads(attrs["conditions"])["thermal"]["dry_share"] == 0.0
+    assert np.all(arrays["dry_friction_factor"] == 1.0) and np.all(arrays["viscous_factor"] > 1.1)
+
+
 def test_walther_law_predicts_published_oil_viscosities():
     """The viscosity-temperature law of the friction factors against published data it was not
     fitted to: through each oil's 30 and 100 deg C values it predicts the 60 deg C one (density
@@ -150,6 +183,10 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     (lambda: c.Conditions(hours=(8, 16)), r"hours = \(8, 16\): expected 1 \(cycles_per_day\) times of day"),
     (lambda: c.Conditions.from_dict({"humidity": {}}), r"unknown key 'humidity'"),
     (lambda: c.Conditions.from_dict({"thermal": {"rise_K": 3}}), r"unknown setting 'rise_K'"),
+    (lambda: c.Temperature(dry_share=1.5), r"thermal dry_share = 1.5: expected a number within 0..1"),
+    (lambda: c.Temperature(dry_share=True), r"thermal dry_share = True"),
+    (lambda: law.friction_factors(35.0, dry_share=-0.1), r"dry_share = -0.1: expected a number within 0..1"),
+    (lambda: law.friction_factors(35.0, dry_share="0.3"), r"dry_share = '0.3'"),
     (lambda: sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], conditions={"spread": {"mass": 1}}),
      r"conditions spread: unknown setting 'mass'"),
 ])

@@ -59,6 +59,8 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"models": ()}, r"fleet models = \(\): expected one or more different robot model names"),
     ({"models": ("irb6700", "irb6700")}, r"fleet models = \('irb6700', 'irb6700'\): expected one or more different"),
     ({"models": "irb6700"}, r"fleet models = 'irb6700': expected"),
+    ({"dry_share": 1.5}, r"fleet dry_share = 1.5: expected a number within 0..1"),
+    ({"dry_share": 0.0, "conditions": False}, r"fleet dry_share = 0.0 sets how friction follows the joint temperature"),
     ({"friction": "coulomb"}, r"unknown friction model 'coulomb'"),
     ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
     ({"gear_loss": 0.1}, r"fleet gear_loss = 0.1 needs friction 'stribeck' \(--friction stribeck; got 'lugre'\)"),
@@ -275,3 +277,16 @@ def test_the_fleet_command_takes_its_robot_models_in_turn(tmp_path, monkeypatch)
     assert [(r["task"], r["failing"], r["axis"]) for r in one] == [(r["task"], r["failing"], r["axis"]) for r in default]
     result = CliRunner().invoke(app, ["fleet", "--robot", "kuka", "-o", str(tmp_path / "k.h5")])
     assert result.exit_code == 2 and "kuka" in result.output and not (tmp_path / "k.h5").exists()
+
+
+def test_a_fleet_with_another_dry_share_keeps_every_other_draw():
+    """--dry-share sets how every robot's dry friction follows its joint temperature; every other
+    draw is the default fleet's, and the default fleet's stored settings do not name it."""
+    plain, flat = Fleet().robots(), Fleet(dry_share=0.0).robots()
+    for one, other in zip(plain, flat, strict=True):
+        assert other["conditions"]["thermal"].pop("dry_share") == 0.0
+        assert one == other
+    assert "dry_share" not in json.loads(Fleet().to_json())["fleet"]
+    assert json.loads(Fleet(dry_share=0.0).to_json())["fleet"]["dry_share"] == 0.0
+    config = dict(Fleet(dry_share=0.0).runs())[flat[0]["run"]]
+    assert config.conditions.thermal.dry_share == 0.0

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 from typing import ClassVar
 
 import numpy as np
@@ -21,7 +22,8 @@ OIL_VISCOSITY = {40.0: 220.0, 100.0: 19.0}
 #: friction falls with temperature less than in a full oil film (Bittencourt, Wernholt,
 #: Sander-Tavallaey & Brogardh 2010 and Bittencourt & Gunnarsson 2012 report the larger change at
 #: high speeds); with 1/4 a joint at 20 deg C has 30 % more dry and 2.9 times the viscous friction
-#: of one at :data:`REFERENCE_TEMPERATURE`.
+#: of one at :data:`REFERENCE_TEMPERATURE`. The default of
+#: :attr:`faultgen.operation.conditions.Temperature.dry_share`, which a run can set (0..1).
 DRY_SHARE = 0.25
 
 
@@ -41,14 +43,15 @@ def oil_viscosity(temperature, points: dict[float, float] = OIL_VISCOSITY) -> np
     return 10 ** (10 ** (offset - slope * np.log10(np.asarray(temperature, dtype=float) + 273.15))) - 0.7
 
 
-def friction_factors(temperature) -> tuple[np.ndarray, np.ndarray]:
+def friction_factors(temperature, dry_share: float = DRY_SHARE) -> tuple[np.ndarray, np.ndarray]:
     """Multipliers of the dry (Coulomb and Stribeck) and of the viscous friction of a joint at
     ``temperature`` (deg C, any shape) over their values at :data:`REFERENCE_TEMPERATURE`.
 
     The viscous friction of a full oil film is proportional to the oil's viscosity (Petroff's
     law), :func:`oil_viscosity`; the dry friction follows the viscosity's ratio to the power
-    :data:`DRY_SHARE`. Both fall with temperature, as measured on robot joints (Bittencourt &
-    Gunnarsson 2012), the viscous part most.
+    ``dry_share`` (default :data:`DRY_SHARE`; 0: the dry friction does not move with
+    temperature, 1: it moves as the viscous). Both fall with temperature, as measured on robot
+    joints (Bittencourt & Gunnarsson 2012), the viscous part most.
 
     Returns
     -------
@@ -59,14 +62,17 @@ def friction_factors(temperature) -> tuple[np.ndarray, np.ndarray]:
     ------
     ValueError
         For a temperature that is not finite or outside -20..120 deg C (outside a mineral gear
-        oil's working range).
+        oil's working range), or a ``dry_share`` that is not a number within 0..1.
     """
+    if isinstance(dry_share, bool) or not isinstance(dry_share, numbers.Real) or not 0 <= dry_share <= 1:
+        raise ValueError(f"dry_share = {dry_share!r}: expected a number within 0..1 (the exponent of the viscosity "
+                         f"ratio that dry friction follows; default {DRY_SHARE})")
     temperature = np.asarray(temperature, dtype=float)
     if not np.all(np.isfinite(temperature)) or np.any((temperature < -20) | (temperature > 120)):
         raise ValueError(f"joint temperature {np.min(temperature):g}..{np.max(temperature):g} deg C: expected "
                          "finite values within -20..120 deg C")
     viscous = oil_viscosity(temperature) / oil_viscosity(REFERENCE_TEMPERATURE)
-    return viscous**DRY_SHARE, viscous
+    return viscous**dry_share, viscous
 
 
 @register

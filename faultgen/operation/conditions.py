@@ -114,6 +114,11 @@ class Temperature:
         Production hours, start and end, h (default 6 to 22: two shifts).
     warmest_day : float
         Day of the year of the seasonal maximum (default 200, mid-July in the northern hemisphere).
+    dry_share : float
+        Exponent of the oil viscosity's ratio that the dry friction follows, 0..1
+        (:func:`faultgen.effects.temperature.friction_factors`; default
+        :data:`faultgen.effects.temperature.DRY_SHARE`, 0.25, chosen, not measured; 0: only the
+        viscous friction moves with temperature).
 
     Raises
     ------
@@ -128,9 +133,11 @@ class Temperature:
     time_constant: float = 3600.0
     shift: tuple[float, float] = (6.0, 22.0)
     warmest_day: float = 200.0
+    dry_share: float = temperature_law.DRY_SHARE
 
     def __post_init__(self) -> None:
         check_number("ambient", self.ambient, -20, 60)
+        object.__setattr__(self, "dry_share", check_number("thermal dry_share", self.dry_share, 0, 1))
         check_number("seasonal", self.seasonal, 0, 30)
         check_number("daily", self.daily, 0, 15)
         check_number("rise", self.rise, 0, 60)
@@ -426,7 +433,7 @@ class Conditions:
         if self.thermal is not None:
             ambient = self.thermal.ambient_at(day, hour)
             joint = np.repeat(self.thermal.joint_at(day, hour)[:, None], N_AXES, axis=1)
-            dry, viscous = temperature_law.friction_factors(joint)
+            dry, viscous = temperature_law.friction_factors(joint, self.thermal.dry_share)
         link_mass, gear_loss = np.ones(N_AXES), np.zeros(N_AXES)
         if self.spread is not None:
             unit = self.spread.draw(seed)
@@ -443,13 +450,15 @@ class Conditions:
 
     def to_dict(self) -> dict:
         """JSON-serialisable labels (None for a condition that is off; no ``task_mix`` key without
-        one and no spread ``gear_loss`` when it is 0, so runs keep the labels and keys they had
-        before these existed)."""
+        one, no spread ``gear_loss`` when it is 0 and no thermal ``dry_share`` at its default, so
+        runs keep the labels and keys they had before these existed)."""
         table = asdict(self)
         if self.task_mix is None:
             del table["task_mix"]
         if self.spread is not None and self.spread.gear_loss == 0:
             del table["spread"]["gear_loss"]
+        if self.thermal is not None and self.thermal.dry_share == temperature_law.DRY_SHARE:
+            del table["thermal"]["dry_share"]
         return table
 
     @classmethod

@@ -34,6 +34,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from faultgen.effects import friction as friction_models
+from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots as robot_models
 from faultgen.operation import conditions, faults, tasks, wear
 from faultgen.operation.conditions import check_number
@@ -91,15 +92,21 @@ class Fleet:
         axis in 0..``gear_loss`` (:attr:`faultgen.operation.conditions.UnitSpread.gear_loss`); needs
         ``friction="stribeck"`` and the conditions. Default 0: off, the fleet's draws and records
         those of the fleets measured before it existed.
+    dry_share : float
+        Exponent of the gear oil viscosity's ratio that every robot's dry friction follows with its
+        joint temperature, 0..1 (:attr:`faultgen.operation.conditions.Temperature.dry_share`;
+        default :data:`faultgen.effects.temperature.DRY_SHARE`, chosen, not measured); needs the
+        conditions. At the default the fleet's draws, records and stored settings are those of the
+        fleets measured before it could be set.
 
     Raises
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
         the days, no robot model or one named twice, a model that is unknown or has no parts sized in
-        :data:`PARTS`, a gear loss without the conditions or under the ``lugre`` friction model, or a
-        bad ``fault`` spec (one that sets its own ``kind`` or ``onset`` included: the fleet sets
-        them).
+        :data:`PARTS`, a gear loss without the conditions or under the ``lugre`` friction model, a
+        dry share other than the default without the conditions, or a bad ``fault`` spec (one that
+        sets its own ``kind`` or ``onset`` included: the fleet sets them).
     """
 
     size: int = 26
@@ -115,6 +122,7 @@ class Fleet:
     task_mix: bool = False
     gear_loss: float = 0.0
     fault: str | None = None
+    dry_share: float = temperature_law.DRY_SHARE
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -129,6 +137,10 @@ class Fleet:
             raise ValueError(f"fleet gear_loss = {self.gear_loss!r} needs friction 'stribeck' (--friction stribeck; "
                              f"got {self.friction!r}) and the conditions (got conditions = {self.conditions}): "
                              "the gear loss is a part of the unit spread, updated every step by the static model")
+        check_number("fleet dry_share", self.dry_share, 0, 1)
+        if self.dry_share != temperature_law.DRY_SHARE and not self.conditions:
+            raise ValueError(f"fleet dry_share = {self.dry_share!r} sets how friction follows the joint temperature, "
+                             "one of the conditions (got conditions = False): drop one of the two")
         onset = self.onset if self.onset is not None else (self.days // 6, self.days * 7 // 12)
         first, last = (check_number("fleet onset day", d, 1, self.days - 1, whole=True) for d in onset)
         if first > last:
@@ -168,6 +180,8 @@ class Fleet:
                      "pattern": "random"}
             climate = {"ambient": round(float(rng.uniform(16.0, 24.0)), 1),
                        "seasonal": round(float(rng.uniform(2.0, 8.0)), 1)}
+            if self.dry_share != temperature_law.DRY_SHARE:
+                climate["dry_share"] = self.dry_share
             spread = {"gear_loss": self.gear_loss} if self.gear_loss else {}
             table = {"thermal": climate, "payloads": parts, "spread": spread, "cycles_per_day": self.cycles_per_day,
                      "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
@@ -223,4 +237,6 @@ class Fleet:
         for name in ("gear_loss", "fault"):  # the settings of fleets made before they existed
             if not settings[name]:
                 del settings[name]
+        if self.dry_share == temperature_law.DRY_SHARE:
+            del settings["dry_share"]
         return json.dumps({"fleet": settings, "robots": self.robots()}, sort_keys=True)
