@@ -137,12 +137,12 @@ class Temperature:
 
     def __post_init__(self) -> None:
         check_number("ambient", self.ambient, -20, 60)
-        object.__setattr__(self, "dry_share", check_number("thermal dry_share", self.dry_share, 0, 1))
         check_number("seasonal", self.seasonal, 0, 30)
         check_number("daily", self.daily, 0, 15)
         check_number("rise", self.rise, 0, 60)
         check_number("time_constant", self.time_constant, 60, 10 * DAY)
         check_number("warmest_day", self.warmest_day, 0, 366)
+        object.__setattr__(self, "dry_share", check_number("thermal dry_share", self.dry_share, 0, 1))
         if len(self.shift) != 2:
             raise ValueError(f"shift = {self.shift!r}: expected (start, end) in hours")
         start, end = (check_number("shift hour", h, 0, 24) for h in self.shift)

@@ -137,7 +137,7 @@ class Fleet:
             raise ValueError(f"fleet gear_loss = {self.gear_loss!r} needs friction 'stribeck' (--friction stribeck; "
                              f"got {self.friction!r}) and the conditions (got conditions = {self.conditions}): "
                              "the gear loss is a part of the unit spread, updated every step by the static model")
-        check_number("fleet dry_share", self.dry_share, 0, 1)
+        object.__setattr__(self, "dry_share", check_number("fleet dry_share", self.dry_share, 0, 1))
         if self.dry_share != temperature_law.DRY_SHARE and not self.conditions:
             raise ValueError(f"fleet dry_share = {self.dry_share!r} sets how friction follows the joint temperature, "
                              "one of the conditions (got conditions = False): drop one of the two")
