@@ -461,6 +461,10 @@ def fleet_command(
     conditions: Annotated[bool, typer.Option(
         help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
         "process and fault.")] = True,
+    without: Annotated[list[str] | None, typer.Option(
+        "--without", metavar="CONDITION", help="Leave one condition out of every robot, the others drawn as in the "
+        "full fleet: thermal (hall climate, warm-up), payloads (the parts) or spread (unit spread); repeat for "
+        "several.", show_default=False)] = None,
     task_mix: Annotated[bool, typer.Option(
         "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
         "its cycles (default: one task per robot).")] = False,
@@ -502,6 +506,8 @@ def fleet_command(
       faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
 
       faultgen fleet --robot irb6700 --fault cogging:amplitude:0.5:poles=8 -o fleet-cogging.h5
+
+      faultgen fleet --without payloads -o fleet-no-parts.h5
     """
     from faultgen.runs import fleet
 
@@ -509,6 +515,8 @@ def fleet_command(
         chosen = {"models": tuple(models)} if models else {}
         if dry_share is not None:
             chosen["dry_share"] = dry_share
+        if without:
+            chosen["without"] = tuple(without)
         plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
                            failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
                            friction=friction_model, gear_loss=gear_loss, fault=fault)

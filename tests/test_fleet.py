@@ -60,6 +60,11 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"models": ("irb6700", "irb6700")}, r"fleet models = \('irb6700', 'irb6700'\): expected one or more different"),
     ({"models": "irb6700"}, r"fleet models = 'irb6700': expected"),
     ({"dry_share": 1.5}, r"fleet dry_share = 1.5: expected a number within 0..1"),
+    ({"without": ("humidity",)}, r"fleet without = \('humidity',\): expected some of thermal, payloads, spread"),
+    ({"without": "thermal"}, r"fleet without = 'thermal': expected some of"),
+    ({"without": ("thermal",), "conditions": False}, r"which are all off \(conditions = False\)"),
+    ({"without": ("spread",), "gear_loss": 0.1, "friction": "stribeck"}, r"fleet without 'spread' and gear_loss = 0.1"),
+    ({"without": ("thermal",), "dry_share": 0.0}, r"fleet without 'thermal' and dry_share = 0.0"),
     ({"dry_share": 0.0, "conditions": False}, r"fleet dry_share = 0.0 sets how friction follows the joint temperature"),
     ({"friction": "coulomb"}, r"unknown friction model 'coulomb'"),
     ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
@@ -262,7 +267,8 @@ def test_the_fleet_command_refuses_bad_settings_before_simulating(tmp_path):
 
 def test_the_fleet_command_takes_its_robot_models_in_turn(tmp_path, monkeypatch):
     """--robot (repeated) sets the fleet's models: every robot of a one-model fleet is that model,
-    and with two the order given is the order taken; every other draw is the default fleet's."""
+    and with two the order given is the order taken; every other draw is the default fleet's.
+    --without (repeated) reaches the fleet too."""
     from faultgen import cli
 
     plans = []
@@ -275,6 +281,9 @@ def test_the_fleet_command_takes_its_robot_models_in_turn(tmp_path, monkeypatch)
     assert [r["model"] for r in two[:4]] == ["puma560", "irb6700", "puma560", "irb6700"]
     default = Fleet().robots()
     assert [(r["task"], r["failing"], r["axis"]) for r in one] == [(r["task"], r["failing"], r["axis"]) for r in default]
+    assert CliRunner().invoke(app, ["fleet", "--without", "payloads", "--without", "spread", "-o",
+                                    str(tmp_path / "f.h5")]).exit_code == 0
+    assert plans[2].without == ("payloads", "spread")
     result = CliRunner().invoke(app, ["fleet", "--robot", "kuka", "-o", str(tmp_path / "k.h5")])
     assert result.exit_code == 2 and "kuka" in result.output and not (tmp_path / "k.h5").exists()
 
@@ -290,3 +299,18 @@ def test_a_fleet_with_another_dry_share_keeps_every_other_draw():
     assert json.loads(Fleet(dry_share=0.0).to_json())["fleet"]["dry_share"] == 0.0
     config = dict(Fleet(dry_share=0.0).runs())[flat[0]["run"]]
     assert config.conditions.thermal.dry_share == 0.0
+
+
+def test_a_fleet_without_one_condition_keeps_the_others_as_drawn():
+    """--without leaves the named conditions out of every robot; the kept ones, and every other
+    draw, are the full fleet's, and the full fleet's stored settings do not name it."""
+    full = Fleet().robots()
+    for without in (("thermal",), ("payloads",), ("spread", "thermal")):
+        for one, other in zip(full, Fleet(without=without).robots(), strict=True):
+            kept = {k: v for k, v in one["conditions"].items() if k not in without}
+            assert other["conditions"] == kept and {**one, "conditions": kept} == other
+    assert Fleet(without=("spread", "thermal")).without == ("thermal", "spread")
+    assert "without" not in json.loads(Fleet().to_json())["fleet"]
+    config = dict(Fleet(without=("payloads",)).runs())[full[0]["run"]]
+    assert config.conditions.payloads is None and config.conditions.thermal is not None
+    assert config.conditions.spread is not None

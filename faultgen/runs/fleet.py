@@ -47,6 +47,9 @@ PARTS = {
     "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
     "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
 }
+#: The conditions a fleet's robot has, as :class:`faultgen.operation.conditions.Conditions` names
+#: them: hall climate and warm-up, parts, unit spread (``Fleet.without`` leaves some out).
+CONDITIONS = ("thermal", "payloads", "spread")
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,10 @@ class Fleet:
     conditions : bool
         Each robot's operating conditions (climate, parts, unit spread); False: none, the robots
         differ only by model, process and fault (an ablation: what the conditions do).
+    without : tuple of str
+        Conditions left out of every robot, some of :data:`CONDITIONS` (``thermal``: the hall
+        climate and warm-up; ``payloads``: the parts; ``spread``: the unit spread), the others kept
+        with the same draws: the ablation of one condition at a time. Default none.
     task_mix : bool
         Each robot runs a second task, drawn from the other two, in a random half of its cycles
         (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
@@ -105,8 +112,10 @@ class Fleet:
         On construction, for a value outside its range (named), an onset window that does not fit
         the days, no robot model or one named twice, a model that is unknown or has no parts sized in
         :data:`PARTS`, a gear loss without the conditions or under the ``lugre`` friction model, a
-        dry share other than the default without the conditions, or a bad ``fault`` spec (one that
-        sets its own ``kind`` or ``onset`` included: the fleet sets them).
+        dry share other than the default without the conditions, a ``without`` naming an unknown
+        condition, given with the conditions off or dropping what the gear loss or dry share needs,
+        or a bad ``fault`` spec (one that sets its own ``kind`` or ``onset`` included: the fleet
+        sets them).
     """
 
     size: int = 26
@@ -123,6 +132,7 @@ class Fleet:
     gear_loss: float = 0.0
     fault: str | None = None
     dry_share: float = temperature_law.DRY_SHARE
+    without: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -141,6 +151,7 @@ class Fleet:
         if self.dry_share != temperature_law.DRY_SHARE and not self.conditions:
             raise ValueError(f"fleet dry_share = {self.dry_share!r} sets how friction follows the joint temperature, "
                              "one of the conditions (got conditions = False): drop one of the two")
+        self._check_without()
         onset = self.onset if self.onset is not None else (self.days // 6, self.days * 7 // 12)
         first, last = (check_number("fleet onset day", d, 1, self.days - 1, whole=True) for d in onset)
         if first > last:
@@ -160,6 +171,23 @@ class Fleet:
                                  "onset day); give EFFECT:PARAMETER:FINAL[:key=value,...] without them")
             self._fault(1, first)  # a bad spec is named now, not when the runs are built
         object.__setattr__(self, "models", tuple(self.models))
+
+    def _check_without(self) -> None:
+        """Refuse a ``without`` that names an unknown condition, comes with the conditions off, or
+        drops what the gear loss or the dry share needs; store it in :data:`CONDITIONS` order."""
+        without = self.without
+        if isinstance(without, str) or any(name not in CONDITIONS for name in without):
+            raise ValueError(f"fleet without = {without!r}: expected some of {', '.join(CONDITIONS)}")
+        if without and not self.conditions:
+            raise ValueError(f"fleet without = {tuple(without)!r} leaves out some of the conditions, which are all off "
+                             "(conditions = False): drop one of the two")
+        if "spread" in without and self.gear_loss:
+            raise ValueError(f"fleet without 'spread' and gear_loss = {self.gear_loss!r}: the gear loss is a part of "
+                             "the unit spread")
+        if "thermal" in without and self.dry_share != temperature_law.DRY_SHARE:
+            raise ValueError(f"fleet without 'thermal' and dry_share = {self.dry_share!r}: the dry share sets how "
+                             "friction follows the joint temperature")
+        object.__setattr__(self, "without", tuple(name for name in CONDITIONS if name in without))
 
     def robots(self) -> list[dict]:
         """The draws of every robot, in order: ``run`` id, ``model``, ``task`` (its own; with a task
@@ -187,6 +215,8 @@ class Fleet:
                      "start_day": float(rng.integers(0, 365)), "hours": self.hours()}
             if not self.conditions:  # the same draws, none of them used: only the calendar
                 table = {"cycles_per_day": self.cycles_per_day, "hours": self.hours()}
+            for name in self.without:  # drawn all the same, so the kept conditions are as in the full fleet
+                del table[name]
             second = str(rng.choice([t for t in tasks.TASKS if t != task]))  # drawn last: the draws above stay
             if self.task_mix:
                 table["task_mix"] = {"tasks": [task, second], "pattern": "random"}
@@ -239,4 +269,6 @@ class Fleet:
                 del settings[name]
         if self.dry_share == temperature_law.DRY_SHARE:
             del settings["dry_share"]
+        if not self.without:
+            del settings["without"]
         return json.dumps({"fleet": settings, "robots": self.robots()}, sort_keys=True)
