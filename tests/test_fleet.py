@@ -265,7 +265,7 @@ def test_the_fleet_command_refuses_bad_settings_before_simulating(tmp_path):
     assert not (tmp_path / "f.h5").exists() and not list(tmp_path.iterdir())
 
 
-def test_the_fleet_command_takes_its_robot_models_in_turn(tmp_path, monkeypatch):
+def test_the_fleet_command_passes_its_robot_models_and_left_out_conditions(tmp_path, monkeypatch):
     """--robot (repeated) sets the fleet's models: every robot of a one-model fleet is that model,
     and with two the order given is the order taken; every other draw is the default fleet's.
     --without (repeated) reaches the fleet too."""
