@@ -264,11 +264,8 @@ class Fleet:
     def to_json(self) -> str:
         """The settings and every robot's draws, stored with the dataset."""
         settings = asdict(self)
-        for name in ("gear_loss", "fault"):  # the settings of fleets made before they existed
-            if not settings[name]:
+        later = {"gear_loss": 0.0, "fault": None, "dry_share": temperature_law.DRY_SHARE, "without": ()}
+        for name, default in later.items():  # at their defaults, the settings of fleets made before they existed
+            if settings[name] == default:
                 del settings[name]
-        if self.dry_share == temperature_law.DRY_SHARE:
-            del settings["dry_share"]
-        if not self.without:
-            del settings["without"]
         return json.dumps({"fleet": settings, "robots": self.robots()}, sort_keys=True)
