@@ -62,6 +62,7 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"dry_share": 1.5}, r"fleet dry_share = 1.5: expected a number within 0..1"),
     ({"without": ("humidity",)}, r"fleet without = \('humidity',\): expected some of thermal, payloads, spread"),
     ({"without": "thermal"}, r"fleet without = 'thermal': expected some of"),
+    ({"without": None}, r"fleet without = None: expected some of"),
     ({"without": ("thermal",), "conditions": False}, r"which are all off \(conditions = False\)"),
     ({"without": ("spread",), "gear_loss": 0.1, "friction": "stribeck"}, r"fleet without 'spread' and gear_loss = 0.1"),
     ({"without": ("thermal",), "dry_share": 0.0}, r"fleet without 'thermal' and dry_share = 0.0"),

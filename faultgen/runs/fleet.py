@@ -176,7 +176,7 @@ class Fleet:
         """Refuse a ``without`` that names an unknown condition, comes with the conditions off, or
         drops what the gear loss or the dry share needs; store it in :data:`CONDITIONS` order."""
         without = self.without
-        if isinstance(without, str) or any(name not in CONDITIONS for name in without):
+        if not isinstance(without, tuple | list) or any(name not in CONDITIONS for name in without):
             raise ValueError(f"fleet without = {without!r}: expected some of {', '.join(CONDITIONS)}")
         if without and not self.conditions:
             raise ValueError(f"fleet without = {tuple(without)!r} leaves out some of the conditions, which are all off "
