@@ -1,7 +1,8 @@
-"""One definition of "a whole number" for every check of a setting at a boundary.
+"""One definition of "a whole number" and of "a number within a range" for every check of a
+setting at a boundary.
 
 The messages stay with the checks (each names its setting and what it expects); only the test
-is shared, so that ``True``, ``2.0`` or ``"3"`` are refused the same way everywhere.
+is shared, so that ``True``, ``2.0``, ``"3"`` or NaN are refused the same way everywhere.
 """
 
 from __future__ import annotations
@@ -14,3 +15,10 @@ def is_whole(value, least: int | None = None) -> bool:
     (no lower bound when None)."""
     return (not isinstance(value, bool) and isinstance(value, (int, np.integer))
             and (least is None or value >= least))
+
+
+def is_number(value, low: float = -np.inf, high: float = np.inf) -> bool:
+    """Whether ``value`` is a finite real number (Python or NumPy; a bool is not one) within
+    ``low..high``."""
+    return (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+            and bool(np.isfinite(value)) and low <= value <= high)

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import numbers
 from typing import ClassVar
 
 import numpy as np
 
+from faultgen.checks import is_number
 from faultgen.effects.base import Effect, register
 
 #: Joint temperature at which a robot's nominal friction parameters hold, deg C: a joint warmed up
@@ -64,7 +64,7 @@ def friction_factors(temperature, dry_share: float = DRY_SHARE) -> tuple[np.ndar
         For a temperature that is not finite or outside -20..120 deg C (outside a mineral gear
         oil's working range), or a ``dry_share`` that is not a number within 0..1.
     """
-    if isinstance(dry_share, bool) or not isinstance(dry_share, numbers.Real) or not 0 <= dry_share <= 1:
+    if not is_number(dry_share, 0, 1):
         raise ValueError(f"dry_share = {dry_share!r}: expected a number within 0..1 (the exponent of the viscosity "
                          f"ratio that dry friction follows; default {DRY_SHARE})")
     temperature = np.asarray(temperature, dtype=float)

@@ -51,7 +51,7 @@ from typing import ClassVar
 import numpy as np
 
 from faultgen.axes import N_AXES
-from faultgen.checks import is_whole
+from faultgen.checks import is_number, is_whole
 from faultgen.effects import temperature as temperature_law
 from faultgen.operation.tasks import TASKS
 
@@ -66,8 +66,8 @@ PATTERNS = ("alternate", "blocks", "random")
 def check_number(name: str, value, low: float = -math.inf, high: float = math.inf, whole: bool = False) -> float | int:
     """``value`` as a float (an int when ``whole``), or ValueError naming ``name``, the value and
     the range when it is not a finite number (whole number) within ``low..high``."""
-    kinds = (int, np.integer) if whole else (int, float, np.integer, np.floating)
-    if isinstance(value, bool) or not isinstance(value, kinds) or not np.isfinite(value) or not low <= value <= high:
+    ok = is_whole(value) and low <= value <= high if whole else is_number(value, low, high)
+    if not ok:
         kind = "a whole number" if whole else "a number"
         raise ValueError(f"{name} = {value!r}: expected {kind} within {low:g}..{high:g}")
     return int(value) if whole else float(value)
