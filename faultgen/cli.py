@@ -55,9 +55,10 @@ Temperature = Annotated[bool, typer.Option(
     "--temperature", help="Joint temperature on: hall air 20 degC +- 5 K seasonal +- 2 K daily, joints warming "
     "15 K over a shift (1 h time constant), friction following the gear oil's viscosity (docs/simulation.md).")]
 DryShare = Annotated[float | None, typer.Option(
-    "--dry-share", metavar="S", help="With --temperature: the exponent of the oil viscosity's ratio that the dry "
-    "(Coulomb, Stribeck) friction follows, 0..1; default 0.25 (ours, not measured), 0: only the viscous friction "
-    "moves with temperature, 1: the dry moves as much.", show_default=False)]
+    "--dry-share", metavar="S", help="The exponent of the oil viscosity's ratio that the dry (Coulomb, Stribeck) "
+    "friction follows with the joint temperature, 0..1; default 0.25 (ours, not measured), 0: only the viscous "
+    "friction moves with temperature, 1: the dry moves as much. Needs the temperature (--temperature; on by "
+    "default in a fleet).", show_default=False)]
 PayloadParts = Annotated[str | None, typer.Option(
     "--payloads", help="Parts carried, MASS:SIZE in kg:m, comma-separated, e.g. 20:0.2,80:0.4 (uniform cubes "
     "hanging from the flange; the controller knows each).")]
@@ -471,10 +472,7 @@ def fleet_command(
     friction_model: Annotated[str, typer.Option(
         "--friction", help="Motor-side friction model of every robot: lugre (dynamic, the default) or stribeck "
         "(static eq. 6.3; needed for --gear-loss; the fleet took 12 min instead of 9 on 2 cores).")] = "lugre",
-    dry_share: Annotated[float | None, typer.Option(
-        "--dry-share", metavar="S", help="The exponent of the oil viscosity's ratio that every robot's dry friction "
-        "follows with its joint temperature, 0..1; default 0.25 (ours, not measured), 0: only the viscous friction "
-        "moves with temperature.", show_default=False)] = None,
+    dry_share: DryShare = None,
     gear_loss: Annotated[float, typer.Option(
         "--gear-loss", metavar="C", help="Each unit's gearboxes also lose a share of the transmitted torque as "
         "Coulomb friction, drawn per axis in 0..C (1 minus the gear efficiency under load); needs --friction "
