@@ -18,7 +18,8 @@ per axis i (1..N, from the base out), the elements :mod:`faultgen.model.robots` 
 ``friction{i}``
     a custom numeric with the motor-side friction parameters (``faultgen.effects.friction.FIELDS``);
 
-and a ``home`` keyframe with the rotors at ``G q`` (undeflected gearboxes). The arm's actuators,
+a ``home`` keyframe with the rotors at ``G q`` (undeflected gearboxes), and a site ``flange`` if the
+arm has none (:func:`_add_flange`). The arm's actuators,
 sensors, tendons and keyframes go (the drivetrain replaces them), its geoms stop colliding (the
 robot moves in free space), and the physics step becomes faultgen's (0.5 ms, discrete-time
 implicit integrator). ``puma560`` and ``irb6700`` are built this way from their ``arm.xml`` and
@@ -245,6 +246,8 @@ def build(arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = 
         target.attach_body(link, "", "")
         spec.delete(link)
 
+    if not any(site.name == "flange" for site in spec.sites):
+        _add_flange(spec, joints[-1].body)
     for i, drive in enumerate(drivetrain.axes, start=1):
         tendon = spec.add_tendon(name=f"gearbox{i}", stiffness=[drive.gearbox_stiffness, 0, 0],
                                  damping=[drive.gearbox_damping, 0, 0], springlength=[0, 0])
@@ -268,6 +271,24 @@ def build(arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = 
         qpos[model.joint(f"rotor{i}").qposadr[0]] = drive.gear_ratio * q[i - 1]
     spec.add_key(name="home", qpos=qpos.tolist())
     return spec
+
+
+#: Names of the tool flange body in ROS-Industrial and Menagerie descriptions, in order of preference.
+FLANGE_BODIES = ("tool0", "flange", "attachment", "ee_link", "link_ee", "tool")
+
+
+def _add_flange(spec: mujoco.MjSpec, last: str) -> None:
+    """A site ``flange`` (the payload's mount and the tasks' tool point): on a joint-free body the
+    last link carries that is named as a flange (:data:`FLANGE_BODIES`), else at the last link's
+    origin."""
+    body = spec.body(last)
+    below = [b for b in body.find_all(mujoco.mjtObj.mjOBJ_BODY) if not b.joints]
+    for wanted in FLANGE_BODIES:
+        for candidate in below:
+            if candidate.name.lower() == wanted or candidate.name.lower().endswith("_" + wanted):
+                candidate.add_site(name="flange")
+                return
+    body.add_site(name="flange")
 
 
 def to_xml(spec: mujoco.MjSpec) -> str:

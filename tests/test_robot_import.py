@@ -1,0 +1,182 @@
+"""Arms from URDF, MJCF and DH tables: inverse dynamics against libraries faultgen did not write,
+and bad arms refused with the element named.
+
+Independent: Pinocchio's RNEA on the same URDF (as compiled: meshes left out, missing inertials
+filled in, ``Arm.urdf``) and roboticstoolbox-python's ``rne`` on the same DH numbers; the
+kinematics, the inertia transformations and the dynamics code are theirs. Shared: the numbers,
+and the reflected motor inertia G^2 (Jm + rotor body inertia) qdd, added to theirs by formula.
+"""
+
+import math
+import tomllib
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import roboticstoolbox as rtb
+import rtbdata
+
+from faultgen import robots
+from faultgen.model import builder, importers, sizing
+
+XACRO = Path(rtbdata.__file__).parent / "xacro"
+URDFS = {
+    "kr210": XACRO / "kuka_description/kuka_kr210/urdf/kr210l150.urdf",
+    "irb140": XACRO / "abb_irb140_description/urdf/irb140.urdf",
+    "iiwa14": XACRO / "kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf",
+}
+UR5 = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
+BOUND = 1e-6  # relative RMS per axis
+
+
+def robot_of(arm):
+    drive, _, _ = sizing.size(arm)
+    return robots.from_spec(builder.build(arm.spec, drive, source=str(arm.source)), Path("/nonexistent/arm.xml"))
+
+
+def motion(robot, n=40, seed=0):
+    rng = np.random.default_rng(seed)
+    low, high = robot.joint_range.T
+    q = rng.uniform(low, high, (n, robot.n_axes))
+    return q, rng.normal(0, 1, q.shape), rng.normal(0, 2, q.shape)
+
+
+def relative_rms(ours, ref):
+    return np.sqrt(np.mean((ours - ref) ** 2, axis=0)) / np.sqrt(np.mean(ref**2, axis=0))
+
+
+@pytest.mark.parametrize("name", sorted(URDFS))
+def test_urdf_robot_inverse_dynamics_matches_pinocchio(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", importers.GeometryDropped)
+        arm = importers.read(URDFS[name])
+    robot = robot_of(arm)
+    assert robot.n_axes == (7 if name == "iiwa14" else 6)
+    model = pin.buildModelFromXML(arm.urdf)
+    data = model.createData()
+    idx = [model.joints[model.getJointId(j.name)].idx_q for j in arm.joints]
+    q, qd, qdd = motion(robot)
+    reflected = robot.gear_ratio**2 * (robot.motor_inertia + builder.ROTOR_INERTIA)
+    ref = np.empty_like(q)
+    for k in range(len(q)):
+        qq, vv, aa = np.zeros(model.nq), np.zeros(model.nv), np.zeros(model.nv)
+        qq[idx], vv[idx], aa[idx] = q[k], qd[k], qdd[k]
+        ref[k] = pin.rnea(model, data, qq, vv, aa)[idx] + reflected * qdd[k]
+    ours = robot.inverse_dynamics(q, qd, qdd, friction=False)
+    assert np.all(relative_rms(ours, ref) < BOUND), relative_rms(ours, ref)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_dh_robot_inverse_dynamics_matches_roboticstoolbox(convention, tmp_path):
+    text = UR5.read_text().replace('convention = "standard"', f'convention = "{convention}"')
+    path = tmp_path / "ur5.toml"
+    path.write_text(text)
+    rows = tomllib.loads(text)["link"]
+    robot = robot_of(importers.read(path))
+    kind = rtb.RevoluteDH if convention == "standard" else rtb.RevoluteMDH
+    links = [kind(d=r["d"], a=r["a"], alpha=r["alpha"], m=r["mass"], r=r["com"],
+                  I=[r["inertia"][0], r["inertia"][1], r["inertia"][2], r["inertia"][3], r["inertia"][5],
+                     r["inertia"][4]],
+                  G=robot.gear_ratio[k], Jm=robot.motor_inertia[k] + builder.ROTOR_INERTIA, qlim=r["qlim"])
+             for k, r in enumerate(rows)]
+    reference = rtb.DHRobot(links, gravity=[0, 0, -9.81])
+    q, qd, qdd = motion(robot)
+    ref = np.array([reference.rne(q[k], qd[k], qdd[k]) for k in range(len(q))])
+    ours = robot.inverse_dynamics(q, qd, qdd, friction=False)
+    assert np.all(relative_rms(ours, ref) < BOUND), relative_rms(ours, ref)
+
+
+def test_dh_table_limits_size_the_drivetrain():
+    arm = importers.read(UR5)
+    drive, origin, payload = sizing.size(arm)
+    assert payload == 5.0
+    G = np.array([a.gear_ratio for a in drive.axes])
+    np.testing.assert_allclose(G, sizing.MOTOR_SPEED / math.pi)
+    peak = np.array([a.motor_torque_limit for a in drive.axes]) * G
+    np.testing.assert_allclose(peak, [150, 150, 150, 28, 28, 28])
+    assert origin[1]["gear_ratio"].startswith("sized: G = 470")
+    given, _, _ = sizing.size(arm, {2: {"gear_ratio": 101.0}})
+    assert given.axes[1].gear_ratio == 101.0 and given.axes[0].gear_ratio == drive.axes[0].gear_ratio
+
+
+def test_urdf_meshes_it_cannot_use_are_dropped_with_one_warning():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        importers.read(URDFS["kr210"])
+    dropped = [w for w in caught if issubclass(w.category, importers.GeometryDropped)]
+    assert len(dropped) == 1 and "7 meshes left out" in str(dropped[0].message)
+
+
+# ------------------------------------------------------------------------------- refusals --
+
+def urdf(joints="revolute " * 6, limits=True, inertia="0.1 0.1 0.1", extra=""):
+    links = ['<link name="base"/>']
+    body = []
+    for k, kind in enumerate(joints.split()):
+        limit = '<limit lower="-1" upper="1" effort="0" velocity="2"/>' if limits else ""
+        ixx, iyy, izz = inertia.split()
+        links.append(f'<link name="l{k}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>'
+                     f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+        parent = "base" if k == 0 else f"l{k - 1}"
+        body.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="l{k}"/>'
+                    f'<origin xyz="0 0 0.2"/><axis xyz="0 {k % 2} {1 - k % 2}"/>{limit}</joint>')
+    return f'<robot name="test">{"".join(links)}{"".join(body)}{extra}</robot>'
+
+
+REFUSED = {
+    "floating base": (urdf("floating " + "revolute " * 6), r"joint 'j0' is floating"),
+    "prismatic joint": (urdf("revolute prismatic " + "revolute " * 4), r"joint 'j1' is prismatic"),
+    "too few joints": (urdf("revolute " * 4), r"4 revolute joints .*expected 5 to 7"),
+    "too many joints": (urdf("revolute " * 8), r"8 revolute joints .*expected 5 to 7"),
+    "missing limits": (urdf(limits=False), r"joint 'j0' has no joint limits"),
+    "continuous joint": (urdf("continuous " + "revolute " * 5), r"joint 'j0' is continuous"),
+    "non-positive-definite inertia": (urdf(inertia="0.1 0.1 0.5"), r"l0"),
+    "zero inertia": (urdf(inertia="0 0 0"), r"l0"),
+    "closed chain": (urdf(extra='<joint name="loop" type="fixed"><parent link="l5"/><child link="l1"/></joint>'),
+                     r"link 'l1' has two parent joints"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(REFUSED))
+def test_bad_urdf_is_refused_with_the_element_named(case, tmp_path):
+    text, message = REFUSED[case]
+    path = tmp_path / "arm.urdf"
+    path.write_text(text)
+    with pytest.raises(builder.ArmError, match=message):
+        importers.read(path)
+
+
+def test_good_test_urdf_is_accepted(tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(urdf())
+    assert [j.name for j in importers.read(path).joints] == [f"j{k}" for k in range(6)]
+
+
+def test_mjcf_closed_chain_is_refused(tmp_path):
+    spec = robots.robots_dir() / "puma560" / "arm.xml"
+    text = spec.read_text().replace("</mujoco>", '<equality><connect name="loop" body1="link6" body2="link2" '
+                                                  'anchor="0 0 0"/></equality></mujoco>')
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    with pytest.raises(builder.ArmError, match="equality constraint 'loop' closes a chain"):
+        importers.read(path)
+
+
+def test_dh_row_without_limits_is_refused(tmp_path):
+    path = tmp_path / "ur5.toml"
+    text = UR5.read_text()
+    first = text.index("qlim =")
+    path.write_text(text[:first] + text[text.index("\n", first) + 1:])
+    with pytest.raises(builder.ArmError, match="link 1: qlim is missing"):
+        importers.read(path)
+
+
+def test_mjcf_arm_reads_back_the_built_in_robot():
+    arm = importers.read(robots.robots_dir() / "puma560" / "arm.xml")
+    drive = robots.drivetrain_of(robots.load("puma560"))
+    model = builder.build(arm.spec, drive).compile()
+    reference = robots.load("puma560").model
+    np.testing.assert_array_equal(model.body_inertia, reference.body_inertia)
+    np.testing.assert_array_equal(model.tendon_stiffness, reference.tendon_stiffness)
