@@ -151,11 +151,20 @@ def size(arm, given: dict[int, dict[str, float]] | None = None, payload: float |
                 notes[key] = "sized: " + RULES[key]
             return mine[key]
 
-        speed = arm.speed_limit[k] if not math.isnan(arm.speed_limit[k]) else DEFAULT_SPEED[wrist]
+        known_speed = not math.isnan(arm.speed_limit[k])
+        speed = arm.speed_limit[k] if known_speed else DEFAULT_SPEED[wrist]
         G = put("gear_ratio", MOTOR_SPEED / speed)
+        if "gear_ratio" not in given.get(axis, {}):
+            notes["gear_ratio"] += (f" ({speed:.4g} rad/s from the source)" if known_speed
+                                    else f" (no speed limit in the source: {speed:g} rad/s assumed)")
         effort = arm.effort_limit[k]
         peak = effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
         torque = put("motor_torque_limit", peak / G)
+        if "motor_torque_limit" not in given.get(axis, {}):
+            notes["motor_torque_limit"] = (f"sized: the source's effort limit {effort:.4g} N m / G" if not math.isnan(effort)
+                                           else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
+                                           f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
+                                           f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s")
         jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
         f = RESONANCE[wrist]
         stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
