@@ -66,3 +66,16 @@ def test_existing_folder_is_not_overwritten(tmp_path):
     result = run("robots", "add", "ur5", "--from", UR5, "-o", tmp_path)
     assert result.exit_code == 2 and "not an empty folder" in result.output
     assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
+
+
+def test_fleet_parts_follow_the_rated_payload(tmp_path):
+    from faultgen.model import sizing
+    from faultgen.runs.fleet import PARTS
+
+    # the shares reproduce the IRB-6700-like arm's part masses from its 200 kg
+    (small, _), (big, _) = sizing.fleet_parts(200.0)
+    assert small == PARTS["irb6700"][0][0] and big == PARTS["irb6700"][1][0]
+    out = tmp_path / "ur5"
+    assert run("robots", "add", "ur5", "--from", UR5, "-o", out).exit_code == 0
+    assert robots.load(out).rated_payload == 5.0  # the DH table's rated_payload
+    assert np.isnan(robots.load("puma560").rated_payload)

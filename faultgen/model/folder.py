@@ -108,6 +108,7 @@ def add(name: str, source: str | Path, out: str | Path, drivetrain: str | Path |
     spec.modelname = name
     if not any(t.name == "description" for t in spec.texts):
         spec.add_text(name="description", data=arm.description)
+    spec.add_numeric(name=robots.RATED_PAYLOAD, data=[payload])  # kg: the fleet's parts (sizing.fleet_parts)
     text = builder.to_xml(spec)
 
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -48,6 +48,11 @@ __all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_
            "with_timestep"]
 
 
+#: Name of the custom numeric holding a robot's rated payload in kg (robots added by ``faultgen robots
+#: add`` have one; :attr:`Robot.rated_payload`).
+RATED_PAYLOAD = "rated_payload"
+
+
 def robots_dir() -> Path:
     """Folder holding the robot folders: packaged copy in a wheel, ``robots/`` in a checkout."""
     package = Path(__file__).resolve().parents[1]  # faultgen/
@@ -153,6 +158,13 @@ class Robot:
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         object.__setattr__(self, "_threads", threading.local())
+
+    @cached_property
+    def rated_payload(self) -> float:
+        """Rated payload in kg from the model's ``rated_payload`` numeric; NaN when it has none (the
+        built-in robots: their parts are in ``faultgen.runs.fleet.PARTS``)."""
+        idx = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_NUMERIC, RATED_PAYLOAD)
+        return float(self.model.numeric_data[self.model.numeric_adr[idx]]) if idx >= 0 else float("nan")
 
     @property
     def n_axes(self) -> int:
