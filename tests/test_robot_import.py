@@ -180,3 +180,36 @@ def test_mjcf_arm_reads_back_the_built_in_robot():
     reference = robots.load("puma560").model
     np.testing.assert_array_equal(model.body_inertia, reference.body_inertia)
     np.testing.assert_array_equal(model.tendon_stiffness, reference.tendon_stiffness)
+
+
+def test_xacro_is_expanded_and_its_packages_found_in_the_folders_above(tmp_path):
+    package = tmp_path / "my_arm_description"
+    (package / "urdf").mkdir(parents=True)
+    text = urdf()
+    # a macro file in the package, included by $(find ...) from a top file with a property
+    links = text[text.index(">") + 1 : text.rindex("</robot>")]
+    (package / "urdf" / "macro.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="arm">'
+        + links.replace('upper="1"', 'upper="${limit}"') + "</xacro:macro></robot>")
+    top = tmp_path / "robot" / "arm.urdf.xacro"
+    top.parent.mkdir()
+    top.write_text('<robot name="xarm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                   '<xacro:property name="limit" value="1.5"/>'
+                   '<xacro:include filename="$(find my_arm_support)/urdf/macro.xacro"/><xacro:arm/></robot>')
+    arm = importers.read(top)
+    assert arm.kind == "xacro" and [j.range for j in arm.joints] == [(-1.0, 1.5)] * 6
+
+
+def test_menagerie_style_mjcf_loses_its_actuators_and_joint_friction_and_keeps_its_torque_limits(tmp_path):
+    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
+    text = text.replace('<joint name="joint2" class="arm"', '<joint name="joint2" class="arm" damping="3" frictionloss="1"')
+    text = text.replace("</mujoco>", '<actuator><position name="servo2" joint="joint2" kp="100" forcelimited="true" '
+                                      'forcerange="-97 97"/></actuator></mujoco>')
+    path = tmp_path / "menagerie_like.xml"
+    path.write_text(text)
+    arm = importers.read(path)
+    assert arm.effort_limit[1] == 97.0 and np.isnan(arm.effort_limit[0])
+    assert any("joint2" in note and "damping" in note for note in arm.notes)
+    model = builder.build(arm.spec, robots.drivetrain_of(robots.load("puma560"))).compile()
+    assert model.nu == 6 and all(model.actuator(k).name == f"motor{k + 1}" for k in range(6))
+    assert model.dof_damping.max() == 0 and model.dof_frictionloss.max() == 0

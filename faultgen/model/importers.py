@@ -123,8 +123,8 @@ def read(path: str | Path) -> Arm:
 def _expand_xacro(path: Path) -> str:
     """The URDF of a xacro file, by ``xacrodoc``. A ``$(find pkg)`` that ROS cannot resolve (no
     ROS installation, a description copied out of its workspace) is looked for in the folders
-    above the file: a folder named ``pkg``, or ``pkg`` without its ``_support`` / ``_description``
-    suffix (ROS-Industrial's ``kuka_kr210_support`` in ``kuka_description/kuka_kr210``)."""
+    above the file (:func:`_find_package`: ROS-Industrial's ``kuka_kr210_support`` is found as
+    ``kuka_description/kuka_kr210``)."""
     try:
         from xacrodoc import XacroDoc, packages
     except ImportError as err:  # pragma: no cover - a declared dependency
@@ -147,10 +147,21 @@ def _expand_xacro(path: Path) -> str:
 
 
 def _find_package(package: str, start: Path) -> Path | None:
-    stems = [package] + [package[: -len(s)] for s in ("_support", "_description") if package.endswith(s)]
+    """A folder for ROS package ``package`` in (or two levels below) the three folders above ``start``:
+    named as the package, both names compared without a ``_support`` / ``_description`` suffix."""
+
+    def stem(name: str) -> str:
+        for suffix in ("_support", "_description"):
+            if name.endswith(suffix):
+                return name[: -len(suffix)]
+        return name
+
     for folder in [start, *start.parents][:3]:
         for candidate in [*folder.glob("*"), *folder.glob("*/*")]:
-            if candidate.name in stems and candidate.is_dir():
+            if candidate.name == package and candidate.is_dir():
+                return candidate
+        for candidate in [*folder.glob("*"), *folder.glob("*/*")]:
+            if stem(candidate.name) == stem(package) and candidate.is_dir():
                 return candidate
     return None
 
