@@ -10,7 +10,7 @@ inertia law fitted through the PUMA 560's measured motors:
 - arm-side peak torque ``tau_peak``: the source's effort limit, else
   ``1.5 max_q |g_i(q)| + max_q M_ii(q) qd_max / 0.5 s`` (gravity with the rated payload at the last
   link over 256 poses, plus reaching top speed in half a second);
-- motor torque limit ``tau_peak / G``;
+- motor torque limit ``tau_peak / G``, at least 0.27 N m (unless the source gives the effort limit);
 - motor inertia ``Jm = 1.2e-4 kg m^2 (T_max / 1 N m)^1.05``;
 - gearbox stiffness ``K = (2 pi f)^2 G^2 Jm``, f = 10 Hz (main axes) or 25 Hz (wrist axes), damping
   ``D = 0.2 sqrt(K G^2 Jm)`` (damping ratio 0.1);
@@ -37,6 +37,9 @@ DEFAULT_SPEED = (2.0, 4.0)
 GRAVITY_MARGIN, RAMP_TIME = 1.5, 0.5
 #: Poses sampled for the gravity and inertia maxima, and their seed.
 POSES, SEED = 256, 0
+#: Smallest motor torque limit the peak-torque rule gives, N m (the PUMA 560's wrist motors, 0.27-0.31
+#: N m: light wrists would otherwise get motors no catalogue sells).
+MIN_MOTOR_TORQUE = 0.27
 #: Motor inertia law Jm = JM_SCALE * T_max ** JM_EXPONENT (kg m^2, T_max in N m).
 JM_SCALE, JM_EXPONENT = 1.2e-4, 1.05
 #: Locked-arm motor resonance, Hz: main axes, wrist axes; damping ratio of that mode.
@@ -159,12 +162,13 @@ def size(arm, given: dict[int, dict[str, float]] | None = None, payload: float |
                                     else f" (no speed limit in the source: {speed:g} rad/s assumed)")
         effort = arm.effort_limit[k]
         peak = effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
-        torque = put("motor_torque_limit", peak / G)
+        torque = put("motor_torque_limit", peak / G if not math.isnan(effort) else max(peak / G, MIN_MOTOR_TORQUE))
         if "motor_torque_limit" not in given.get(axis, {}):
             notes["motor_torque_limit"] = (f"sized: the source's effort limit {effort:.4g} N m / G" if not math.isnan(effort)
                                            else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
                                            f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
-                                           f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s")
+                                           f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
+                                           f"{MIN_MOTOR_TORQUE:g} N m")
         jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
         f = RESONANCE[wrist]
         stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
