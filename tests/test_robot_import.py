@@ -213,3 +213,28 @@ def test_menagerie_style_mjcf_loses_its_actuators_and_joint_friction_and_keeps_i
     model = builder.build(arm.spec, robots.drivetrain_of(robots.load("puma560"))).compile()
     assert model.nu == 6 and all(model.actuator(k).name == f"motor{k + 1}" for k in range(6))
     assert model.dof_damping.max() == 0 and model.dof_frictionloss.max() == 0
+
+
+# (five axes need faultgen.effects to count axes from the model too: issue 37's other half)
+@pytest.mark.parametrize("n", [7])
+def test_robots_of_seven_axes_have_arrays_of_that_length(n, tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(urdf("revolute " * n))
+    robot = robot_of(importers.read(path))
+    assert robot.n_axes == n and robot.joint_names == tuple(f"joint{i}" for i in range(1, n + 1))
+    for array in (robot.gear_ratio, robot.motor_inertia, robot.gearbox_stiffness, robot.motor_torque_limit,
+                  robot.home, robot.friction.coulomb_pos):
+        assert array.shape == (n,)
+    q, qd, qdd = motion(robot, n=3)
+    assert robot.inverse_dynamics(q, qd, qdd).shape == (3, n)
+    with pytest.raises(ValueError, match=rf"qd must have shape \(3, {n}\)"):
+        robot.inverse_dynamics(q, qd[:, :-1], qdd)
+
+
+def test_mjcf_floating_base_is_refused(tmp_path):
+    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
+    text = text.replace('<body name="base" childclass="puma560">', '<body name="base" childclass="puma560"><freejoint name="float"/>')
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    with pytest.raises(builder.ArmError, match="joint 'float' is a free joint: a floating base"):
+        importers.read(path)

@@ -89,6 +89,14 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
         more than 7 revolute joints, joints not in one serial chain, a revolute joint without
         limits, or a moving body with zero mass or an inertia that is not positive definite.
     """
+    # the joint kinds first: a floating base often fails to compile for another reason (a massless base)
+    for joint in spec.joints:
+        label = joint.name or "(unnamed)"
+        if joint.type == mujoco.mjtJoint.mjJNT_FREE:
+            raise ArmError(f"{source}: joint {label!r} is a free joint: a floating base; a robot arm must be "
+                           "fixed to the world")
+        if joint.type == mujoco.mjtJoint.mjJNT_SLIDE:
+            raise ArmError(f"{source}: joint {label!r} is prismatic; faultgen models revolute axes only")
     model = _compile(spec, source)
 
     def name(kind: mujoco.mjtObj, i: int) -> str:
