@@ -15,7 +15,9 @@ from faultgen.model import builder, drivetrain
 @pytest.mark.parametrize("name", ["puma560", "irb6700"])
 def test_built_in_robot_is_its_arm_plus_its_drivetrain(name):
     folder = robots.robots_dir() / name
-    assert (folder / f"{name}.xml").read_text() == builder.build_files(folder / "arm.xml", folder / "drivetrain.toml")
+    assert (folder / f"{name}.xml").read_text() == builder.build_files(
+        folder / "arm.xml", folder / "drivetrain.toml"
+    )
 
 
 @pytest.mark.parametrize("name", ["puma560", "irb6700"])
@@ -59,11 +61,11 @@ def test_rotor_sits_on_the_link_carrying_the_motor_coaxial_with_its_joint():
         assert model.body_parentid[model.jnt_bodyid[rotor]] == model.body_parentid[model.jnt_bodyid[arm]]
 
 
-
-
 def test_drivetrain_with_unknown_key_is_refused(tmp_path):
     path = tmp_path / "drivetrain.toml"
-    path.write_text(robots.drivetrain_of(robots.load("puma560")).to_toml().replace("viscous =", "viscosity =", 1))
+    path.write_text(
+        robots.drivetrain_of(robots.load("puma560")).to_toml().replace("viscous =", "viscosity =", 1)
+    )
     with pytest.raises(drivetrain.DrivetrainError, match=r"axis 1: unknown key 'viscosity'"):
         drivetrain.read(path, 6)
 

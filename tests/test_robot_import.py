@@ -33,7 +33,9 @@ BOUND = 1e-6  # relative RMS per axis
 
 def robot_of(arm):
     drive, _, _ = sizing.size(arm)
-    return robots.from_spec(builder.build(arm.spec, drive, source=str(arm.source)), Path("/nonexistent/arm.xml"))
+    return robots.from_spec(
+        builder.build(arm.spec, drive, source=str(arm.source)), Path("/nonexistent/arm.xml")
+    )
 
 
 def motion(robot, n=40, seed=0):
@@ -76,11 +78,27 @@ def test_dh_robot_inverse_dynamics_matches_roboticstoolbox(convention, tmp_path)
     rows = tomllib.loads(text)["link"]
     robot = robot_of(importers.read(path))
     kind = rtb.RevoluteDH if convention == "standard" else rtb.RevoluteMDH
-    links = [kind(d=r["d"], a=r["a"], alpha=r["alpha"], m=r["mass"], r=r["com"],
-                  I=[r["inertia"][0], r["inertia"][1], r["inertia"][2], r["inertia"][3], r["inertia"][5],
-                     r["inertia"][4]],
-                  G=robot.gear_ratio[k], Jm=robot.motor_inertia[k] + builder.ROTOR_INERTIA, qlim=r["qlim"])
-             for k, r in enumerate(rows)]
+    links = [
+        kind(
+            d=r["d"],
+            a=r["a"],
+            alpha=r["alpha"],
+            m=r["mass"],
+            r=r["com"],
+            I=[
+                r["inertia"][0],
+                r["inertia"][1],
+                r["inertia"][2],
+                r["inertia"][3],
+                r["inertia"][5],
+                r["inertia"][4],
+            ],
+            G=robot.gear_ratio[k],
+            Jm=robot.motor_inertia[k] + builder.ROTOR_INERTIA,
+            qlim=r["qlim"],
+        )
+        for k, r in enumerate(rows)
+    ]
     reference = rtb.DHRobot(links, gravity=[0, 0, -9.81])
     q, qd, qdd = motion(robot)
     ref = np.array([reference.rne(q[k], qd[k], qdd[k]) for k in range(len(q))])
@@ -111,17 +129,22 @@ def test_urdf_meshes_it_cannot_use_are_dropped_with_one_warning():
 
 # ------------------------------------------------------------------------------- refusals --
 
+
 def urdf(joints="revolute " * 6, limits=True, inertia="0.1 0.1 0.1", extra=""):
     links = ['<link name="base"/>']
     body = []
     for k, kind in enumerate(joints.split()):
         limit = '<limit lower="-1" upper="1" effort="0" velocity="2"/>' if limits else ""
         ixx, iyy, izz = inertia.split()
-        links.append(f'<link name="l{k}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>'
-                     f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+        links.append(
+            f'<link name="l{k}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>'
+            f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        )
         parent = "base" if k == 0 else f"l{k - 1}"
-        body.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="l{k}"/>'
-                    f'<origin xyz="0 0 0.2"/><axis xyz="0 {k % 2} {1 - k % 2}"/>{limit}</joint>')
+        body.append(
+            f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="l{k}"/>'
+            f'<origin xyz="0 0 0.2"/><axis xyz="0 {k % 2} {1 - k % 2}"/>{limit}</joint>'
+        )
     return f'<robot name="test">{"".join(links)}{"".join(body)}{extra}</robot>'
 
 
@@ -134,8 +157,10 @@ REFUSED = {
     "continuous joint": (urdf("continuous " + "revolute " * 5), r"joint 'j0' is continuous"),
     "non-positive-definite inertia": (urdf(inertia="0.1 0.1 0.5"), r"l0"),
     "zero inertia": (urdf(inertia="0 0 0"), r"l0"),
-    "closed chain": (urdf(extra='<joint name="loop" type="fixed"><parent link="l5"/><child link="l1"/></joint>'),
-                     r"link 'l1' has two parent joints"),
+    "closed chain": (
+        urdf(extra='<joint name="loop" type="fixed"><parent link="l5"/><child link="l1"/></joint>'),
+        r"link 'l1' has two parent joints",
+    ),
 }
 
 
@@ -156,8 +181,10 @@ def test_good_test_urdf_is_accepted(tmp_path):
 
 def test_mjcf_closed_chain_is_refused(tmp_path):
     spec = robots.robots_dir() / "puma560" / "arm.xml"
-    text = spec.read_text().replace("</mujoco>", '<equality><connect name="loop" body1="link6" body2="link2" '
-                                                  'anchor="0 0 0"/></equality></mujoco>')
+    text = spec.read_text().replace(
+        "</mujoco>",
+        '<equality><connect name="loop" body1="link6" body2="link2" anchor="0 0 0"/></equality></mujoco>',
+    )
     path = tmp_path / "arm.xml"
     path.write_text(text)
     with pytest.raises(builder.ArmError, match="equality constraint 'loop' closes a chain"):
@@ -168,7 +195,7 @@ def test_dh_row_without_limits_is_refused(tmp_path):
     path = tmp_path / "ur5.toml"
     text = UR5.read_text()
     first = text.index("qlim =")
-    path.write_text(text[:first] + text[text.index("\n", first) + 1:])
+    path.write_text(text[:first] + text[text.index("\n", first) + 1 :])
     with pytest.raises(builder.ArmError, match="link 1: qlim is missing"):
         importers.read(path)
 
@@ -190,21 +217,30 @@ def test_xacro_is_expanded_and_its_packages_found_in_the_folders_above(tmp_path)
     links = text[text.index(">") + 1 : text.rindex("</robot>")]
     (package / "urdf" / "macro.xacro").write_text(
         '<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="arm">'
-        + links.replace('upper="1"', 'upper="${limit}"') + "</xacro:macro></robot>")
+        + links.replace('upper="1"', 'upper="${limit}"')
+        + "</xacro:macro></robot>"
+    )
     top = tmp_path / "robot" / "arm.urdf.xacro"
     top.parent.mkdir()
-    top.write_text('<robot name="xarm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
-                   '<xacro:property name="limit" value="1.5"/>'
-                   '<xacro:include filename="$(find my_arm_support)/urdf/macro.xacro"/><xacro:arm/></robot>')
+    top.write_text(
+        '<robot name="xarm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:property name="limit" value="1.5"/>'
+        '<xacro:include filename="$(find my_arm_support)/urdf/macro.xacro"/><xacro:arm/></robot>'
+    )
     arm = importers.read(top)
     assert arm.kind == "xacro" and [j.range for j in arm.joints] == [(-1.0, 1.5)] * 6
 
 
 def test_menagerie_style_mjcf_loses_its_actuators_and_joint_friction_and_keeps_its_torque_limits(tmp_path):
     text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
-    text = text.replace('<joint name="joint2" class="arm"', '<joint name="joint2" class="arm" damping="3" frictionloss="1"')
-    text = text.replace("</mujoco>", '<actuator><position name="servo2" joint="joint2" kp="100" forcelimited="true" '
-                                      'forcerange="-97 97"/></actuator></mujoco>')
+    text = text.replace(
+        '<joint name="joint2" class="arm"', '<joint name="joint2" class="arm" damping="3" frictionloss="1"'
+    )
+    text = text.replace(
+        "</mujoco>",
+        '<actuator><position name="servo2" joint="joint2" kp="100" forcelimited="true" '
+        'forcerange="-97 97"/></actuator></mujoco>',
+    )
     path = tmp_path / "menagerie_like.xml"
     path.write_text(text)
     arm = importers.read(path)
@@ -222,8 +258,14 @@ def test_robots_of_seven_axes_have_arrays_of_that_length(n, tmp_path):
     path.write_text(urdf("revolute " * n))
     robot = robot_of(importers.read(path))
     assert robot.n_axes == n and robot.joint_names == tuple(f"joint{i}" for i in range(1, n + 1))
-    for array in (robot.gear_ratio, robot.motor_inertia, robot.gearbox_stiffness, robot.motor_torque_limit,
-                  robot.home, robot.friction.coulomb_pos):
+    for array in (
+        robot.gear_ratio,
+        robot.motor_inertia,
+        robot.gearbox_stiffness,
+        robot.motor_torque_limit,
+        robot.home,
+        robot.friction.coulomb_pos,
+    ):
         assert array.shape == (n,)
     q, qd, qdd = motion(robot, n=3)
     assert robot.inverse_dynamics(q, qd, qdd).shape == (3, n)
@@ -233,7 +275,10 @@ def test_robots_of_seven_axes_have_arrays_of_that_length(n, tmp_path):
 
 def test_mjcf_floating_base_is_refused(tmp_path):
     text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
-    text = text.replace('<body name="base" childclass="puma560">', '<body name="base" childclass="puma560"><freejoint name="float"/>')
+    text = text.replace(
+        '<body name="base" childclass="puma560">',
+        '<body name="base" childclass="puma560"><freejoint name="float"/>',
+    )
     path = tmp_path / "arm.xml"
     path.write_text(text)
     with pytest.raises(builder.ArmError, match="joint 'float' is a free joint: a floating base"):

@@ -23,15 +23,22 @@ def test_robot_added_from_a_dh_table_loads_plans_and_says_where_numbers_came_fro
     out = tmp_path / "ur5"
     result = run("robots", "add", "ur5", "--from", UR5, "--drivetrain", drive, "-o", out)
     assert result.exit_code == 0, result.output
-    assert sorted(p.name for p in out.iterdir()) == ["README.md", "drivetrain.toml", "scene.xml", "tasks.toml",
-                                                     "ur5.xml"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "README.md",
+        "drivetrain.toml",
+        "scene.xml",
+        "tasks.toml",
+        "ur5.xml",
+    ]
     robot = robots.load(out)
     assert robot.n_axes == 6 and robot.gear_ratio[1] == 1 / (1 / 101.0) and robot.motor_inertia[1] == 3e-5
     # the capacity the table gives (150 N m on axes 1-3, 28 N m on the wrist)
     np.testing.assert_allclose(robot.motor_torque_limit * robot.gear_ratio, [150, 150, 150, 28, 28, 28])
     readme = (out / "README.md").read_text()
     assert "gear_ratio, axis 2: given in --drivetrain" in readme
-    assert "gear_ratio, axis 1: sized: G = 470 rad/s / joint speed limit (3.142 rad/s from the source)" in readme
+    assert (
+        "gear_ratio, axis 1: sized: G = 470 rad/s / joint speed limit (3.142 rad/s from the source)" in readme
+    )
     assert "sized: the source's effort limit 150 N m / G" in readme
     # the tasks plan, and stay within the motors' capacity
     for name in tasks.TASKS:
@@ -40,7 +47,12 @@ def test_robot_added_from_a_dh_table_loads_plans_and_says_where_numbers_came_fro
         assert np.all(np.abs(tau) <= robot.motor_torque_limit * robot.gear_ratio)
     # the drivetrain.toml written is the model's, and rebuilding from it gives the same model
     again = tmp_path / "again"
-    assert run("robots", "add", "ur5", "--from", UR5, "--drivetrain", out / "drivetrain.toml", "-o", again).exit_code == 0
+    assert (
+        run(
+            "robots", "add", "ur5", "--from", UR5, "--drivetrain", out / "drivetrain.toml", "-o", again
+        ).exit_code
+        == 0
+    )
     assert (again / "ur5.xml").read_text() == (out / "ur5.xml").read_text()
 
 

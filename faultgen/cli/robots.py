@@ -21,8 +21,8 @@ from faultgen.operation import taskgen
 def robots_command(
     name: Annotated[
         str | None,
-        typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) instead of "
-                            "the list; or `add` to add a robot."),
+        typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) "
+                            "instead of the list; or `add` to add a robot."),
     ] = None,
     new_name: Annotated[str | None, typer.Argument(help="With `add`: the new robot's name.")] = None,
     source: Annotated[
@@ -31,12 +31,16 @@ def robots_command(
     ] = None,
     drivetrain: Annotated[
         Path | None,
-        typer.Option(help="With `add`: a drivetrain.toml with some or all drivetrain numbers; the rest are sized."),
+        typer.Option(help="With `add`: a drivetrain.toml with some or all drivetrain numbers; the rest are "
+                          "sized."),
     ] = None,
     payload: Annotated[
-        float | None, typer.Option(help="With `add`: rated payload in kg (default: the source's, else sized).")
+        float | None,
+        typer.Option(help="With `add`: rated payload in kg (default: the source's, else sized)."),
     ] = None,
-    out: Annotated[Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")] = None,
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
+    ] = None,
 ) -> None:
     """List the robot models, show one model's nominal parameters, or add a robot from an arm file.
 
@@ -60,14 +64,15 @@ def robots_command(
                              "faultgen robots add kr210 --from kr210l150.urdf -o kr210")
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", importers.GeometryDropped)
-            added = folder.add(new_name, source, out, drivetrain=drivetrain, payload=payload, tasks=taskgen.generate)
+            added = folder.add(new_name, source, out, drivetrain=drivetrain, payload=payload,
+                               tasks=taskgen.generate)
         for warning in caught:
             typer.echo(f"warning: {warning.message}", err=True)
         robot = added.robot
         typer.echo(f"{robot.name}: {robot.n_axes} axes from {added.arm.kind} {source} -> {added.folder} "
                    f"(rated payload {added.payload:.4g} kg; provenance in {added.folder / 'README.md'})")
         return
-    if new_name is not None or source is not None or drivetrain is not None or payload is not None or out is not None:
+    if any(value is not None for value in (new_name, source, drivetrain, payload, out)):
         raise ValueError("NAME, --from, --drivetrain, --payload and -o go with `faultgen robots add`")
     if name is None:
         known = robots.available()

@@ -93,8 +93,10 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
     for joint in spec.joints:
         label = joint.name or "(unnamed)"
         if joint.type == mujoco.mjtJoint.mjJNT_FREE:
-            raise ArmError(f"{source}: joint {label!r} is a free joint: a floating base; a robot arm must be "
-                           "fixed to the world")
+            raise ArmError(
+                f"{source}: joint {label!r} is a free joint: a floating base; a robot arm must be "
+                "fixed to the world"
+            )
         if joint.type == mujoco.mjtJoint.mjJNT_SLIDE:
             raise ArmError(f"{source}: joint {label!r} is prismatic; faultgen models revolute axes only")
     model = _compile(spec, source)
@@ -106,37 +108,49 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
         kind = model.jnt_type[j]
         jname = name(mujoco.mjtObj.mjOBJ_JOINT, j)
         if kind == mujoco.mjtJoint.mjJNT_FREE:
-            raise ArmError(f"{source}: joint {jname!r} is a free joint: a floating base; a robot arm must be "
-                           "fixed to the world")
+            raise ArmError(
+                f"{source}: joint {jname!r} is a free joint: a floating base; a robot arm must be "
+                "fixed to the world"
+            )
         if kind == mujoco.mjtJoint.mjJNT_BALL:
             raise ArmError(f"{source}: joint {jname!r} is a ball joint; expected revolute joints only")
         if kind == mujoco.mjtJoint.mjJNT_SLIDE:
             raise ArmError(f"{source}: joint {jname!r} is prismatic; faultgen models revolute axes only")
     if model.neq:
-        raise ArmError(f"{source}: equality constraint {name(mujoco.mjtObj.mjOBJ_EQUALITY, 0)!r} closes a chain; "
-                       "expected an open serial chain")
+        raise ArmError(
+            f"{source}: equality constraint {name(mujoco.mjtObj.mjOBJ_EQUALITY, 0)!r} closes a chain; "
+            "expected an open serial chain"
+        )
     n = model.njnt
     if not MIN_AXES <= n <= MAX_AXES:
         raise ArmError(f"{source}: {n} revolute joints; expected {MIN_AXES} to {MAX_AXES} in a serial chain")
     joints = list(range(n))  # compiled order is depth first from the base
     for j in joints:
         if model.body_jntnum[model.jnt_bodyid[j]] != 1:
-            raise ArmError(f"{source}: body {name(mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j])!r} carries "
-                           f"{model.body_jntnum[model.jnt_bodyid[j]]} joints; expected one per link")
+            raise ArmError(
+                f"{source}: body {name(mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j])!r} carries "
+                f"{model.body_jntnum[model.jnt_bodyid[j]]} joints; expected one per link"
+            )
     for a, b in zip(joints, joints[1:]):
         body, ancestor = model.jnt_bodyid[b], model.jnt_bodyid[a]
         while body and body != ancestor:
             body = model.body_parentid[body]
         if body != ancestor:
-            raise ArmError(f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, b)!r} is not on the chain through "
-                           f"joint {name(mujoco.mjtObj.mjOBJ_JOINT, a)!r}; expected one serial chain")
+            raise ArmError(
+                f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, b)!r} is not on the chain through "
+                f"joint {name(mujoco.mjtObj.mjOBJ_JOINT, a)!r}; expected one serial chain"
+            )
     for j in joints:
         if not model.jnt_limited[j]:
-            raise ArmError(f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, j)!r} has no limits; give it a range")
+            raise ArmError(
+                f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, j)!r} has no limits; give it a range"
+            )
         low, high = model.jnt_range[j]
         if not low < high:
-            raise ArmError(f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, j)!r} has range {low!r}..{high!r}; "
-                           "expected lower < upper")
+            raise ArmError(
+                f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, j)!r} has range {low!r}..{high!r}; "
+                "expected lower < upper"
+            )
     first = model.jnt_bodyid[0]
     for body in range(1, model.nbody):
         moving = body == first
@@ -150,13 +164,25 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
         bname = name(mujoco.mjtObj.mjOBJ_BODY, body)
         carries = model.body_jntnum[body] > 0
         if carries and (model.body_mass[body] <= 0 or np.any(inertia <= 0)):
-            raise ArmError(f"{source}: body {bname!r} has mass {model.body_mass[body]!r} kg and principal inertia "
-                           f"{inertia.tolist()} kg m^2; a link needs mass and a positive-definite inertia")
-        if model.body_mass[body] > 0 and (np.any(inertia <= 0) or 2 * inertia.max() > inertia.sum() * (1 + 1e-9)):
-            raise ArmError(f"{source}: body {bname!r} has principal inertia {inertia.tolist()} kg m^2; expected a "
-                           "positive-definite tensor (each moment <= the sum of the other two)")
-    return [ArmJoint(name(mujoco.mjtObj.mjOBJ_JOINT, j), name(mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j]),
-                     (float(model.jnt_range[j, 0]), float(model.jnt_range[j, 1]))) for j in joints]
+            raise ArmError(
+                f"{source}: body {bname!r} has mass {model.body_mass[body]!r} kg and principal inertia "
+                f"{inertia.tolist()} kg m^2; a link needs mass and a positive-definite inertia"
+            )
+        if model.body_mass[body] > 0 and (
+            np.any(inertia <= 0) or 2 * inertia.max() > inertia.sum() * (1 + 1e-9)
+        ):
+            raise ArmError(
+                f"{source}: body {bname!r} has principal inertia {inertia.tolist()} kg m^2; expected a "
+                "positive-definite tensor (each moment <= the sum of the other two)"
+            )
+    return [
+        ArmJoint(
+            name(mujoco.mjtObj.mjOBJ_JOINT, j),
+            name(mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j]),
+            (float(model.jnt_range[j, 0]), float(model.jnt_range[j, 1])),
+        )
+        for j in joints
+    ]
 
 
 def _name_everything(spec: mujoco.MjSpec) -> None:
@@ -172,8 +198,9 @@ def _name_everything(spec: mujoco.MjSpec) -> None:
                 taken.add(label)
 
 
-def build(arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = None,
-          source: str = "arm") -> mujoco.MjSpec:
+def build(
+    arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = None, source: str = "arm"
+) -> mujoco.MjSpec:
     """A faultgen robot: the arm with its drivetrain (this module's docstring lists what is added).
 
     Parameters
@@ -245,8 +272,13 @@ def build(arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = 
             rotor.set_frame(frame)
         rotor.explicitinertial = True
         rotor.mass, rotor.inertia, rotor.ipos = ROTOR_MASS, [ROTOR_INERTIA] * 3, [0, 0, 0]
-        rotor.add_joint(name=f"rotor{i}", type=mujoco.mjtJoint.mjJNT_HINGE, pos=arm_joint.pos,
-                        axis=arm_joint.axis, armature=drive.motor_inertia)
+        rotor.add_joint(
+            name=f"rotor{i}",
+            type=mujoco.mjtJoint.mjJNT_HINGE,
+            pos=arm_joint.pos,
+            axis=arm_joint.axis,
+            armature=drive.motor_inertia,
+        )
         # the link goes after its rotor, as written by hand before (the tree order fixes qpos order)
         # (a link placed straight in its parent body goes into an identity frame, ``mount{i}``: MjSpec
         # attaches to frames only)
@@ -257,8 +289,12 @@ def build(arm: mujoco.MjSpec, drivetrain: Drivetrain, home: np.ndarray | None = 
     if not any(site.name == "flange" for site in spec.sites):
         _add_flange(spec, joints[-1].body)
     for i, drive in enumerate(drivetrain.axes, start=1):
-        tendon = spec.add_tendon(name=f"gearbox{i}", stiffness=[drive.gearbox_stiffness, 0, 0],
-                                 damping=[drive.gearbox_damping, 0, 0], springlength=[0, 0])
+        tendon = spec.add_tendon(
+            name=f"gearbox{i}",
+            stiffness=[drive.gearbox_stiffness, 0, 0],
+            damping=[drive.gearbox_damping, 0, 0],
+            springlength=[0, 0],
+        )
         tendon.wrap_joint(f"rotor{i}", 1.0 / drive.gear_ratio)
         tendon.wrap_joint(f"joint{i}", -1.0)
     for i, drive in enumerate(drivetrain.axes, start=1):
@@ -311,8 +347,10 @@ def to_xml(spec: mujoco.MjSpec) -> str:
     for name in dir(built):
         ours = getattr(built, name)
         if isinstance(ours, np.ndarray) and not np.array_equal(ours, getattr(read, name)):
-            raise RuntimeError(f"the MJCF text of {spec.modelname!r} compiles to a different {name}; "
-                               "this is a bug in faultgen.model.builder")
+            raise RuntimeError(
+                f"the MJCF text of {spec.modelname!r} compiles to a different {name}; "
+                "this is a bug in faultgen.model.builder"
+            )
     return text
 
 
@@ -333,9 +371,11 @@ def build_files(arm_path: str | Path, drivetrain_path: str | Path) -> str:
         raise ArmError(f"{arm_path}: {str(err).strip()}") from None
     n = len(check_arm(arm, str(arm_path)))
     spec = build(arm, read_drivetrain(drivetrain_path, n), source=str(arm_path))
-    return (f"<!-- Built by faultgen.model.builder from {arm_path.name} (the arm) and "
-            f"{Path(drivetrain_path).name} (its drivetrain); edit those and rebuild, not this file. -->\n"
-            + to_xml(spec))
+    return (
+        f"<!-- Built by faultgen.model.builder from {arm_path.name} (the arm) and "
+        f"{Path(drivetrain_path).name} (its drivetrain); edit those and rebuild, not this file. -->\n"
+        + to_xml(spec)
+    )
 
 
 if __name__ == "__main__":  # python -m faultgen.model.builder robots/NAME [...]: rebuild NAME.xml

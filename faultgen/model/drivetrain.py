@@ -34,8 +34,14 @@ UNITS = {
 }
 
 #: Fields that must be strictly positive (the others must be >= 0).
-POSITIVE = ("gear_ratio", "motor_inertia", "gearbox_stiffness", "motor_torque_limit", "stribeck_velocity",
-            "stribeck_exponent")
+POSITIVE = (
+    "gear_ratio",
+    "motor_inertia",
+    "gearbox_stiffness",
+    "motor_torque_limit",
+    "stribeck_velocity",
+    "stribeck_exponent",
+)
 
 
 class DrivetrainError(ValueError):
@@ -75,7 +81,9 @@ class AxisDrive:
             need_positive = f.name in POSITIVE
             if not math.isfinite(value) or value < 0 or (need_positive and value == 0):
                 need = "> 0" if need_positive else ">= 0"
-                raise DrivetrainError(f"{f.name} = {value!r}; expected a finite value {need} ({UNITS[f.name]})")
+                raise DrivetrainError(
+                    f"{f.name} = {value!r}; expected a finite value {need} ({UNITS[f.name]})"
+                )
             object.__setattr__(self, f.name, value)
 
     @property
@@ -98,7 +106,9 @@ class Drivetrain:
         return len(self.axes)
 
     @classmethod
-    def from_table(cls, table: dict[int, dict[str, float]], n_axes: int, source: str = "drivetrain") -> Drivetrain:
+    def from_table(
+        cls, table: dict[int, dict[str, float]], n_axes: int, source: str = "drivetrain"
+    ) -> Drivetrain:
         """A full drivetrain from ``{axis number: {key: value}}`` (as :func:`read_table` gives).
 
         Raises
@@ -161,7 +171,9 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
         raise DrivetrainError(f"{path}: cannot read a TOML drivetrain table: {err}") from None
     unknown = sorted(set(data) - {"axis"})
     if unknown:
-        raise DrivetrainError(f"{path}: unknown key {unknown[0]!r}; expected only [axis.1] .. [axis.{n_axes}] tables")
+        raise DrivetrainError(
+            f"{path}: unknown key {unknown[0]!r}; expected only [axis.1] .. [axis.{n_axes}] tables"
+        )
     axes = data.get("axis", {})
     if not isinstance(axes, dict):
         raise DrivetrainError(f"{path}: 'axis' must be tables [axis.1] .. [axis.{n_axes}]")
@@ -177,14 +189,17 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
             raise DrivetrainError(f"{path}: axis.{label} must be a table")
         bad = sorted(set(values) - set(KEYS))
         if bad:
-            raise DrivetrainError(f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}")
+            raise DrivetrainError(
+                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}"
+            )
         for key, value in values.items():
             ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
             positive = key in POSITIVE
             if not ok or value < 0 or (positive and value == 0):
                 need = "> 0" if positive else ">= 0"
-                raise DrivetrainError(f"{path}: axis {axis}: {key} = {value!r}; expected a finite number {need} "
-                                      f"({UNITS[key]})")
+                raise DrivetrainError(
+                    f"{path}: axis {axis}: {key} = {value!r}; expected a finite number {need} ({UNITS[key]})"
+                )
         table[axis] = {k: float(v) for k, v in values.items()}
     if not partial:
         Drivetrain.from_table(table, n_axes, str(path))

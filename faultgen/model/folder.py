@@ -63,9 +63,14 @@ SCENE = """<mujoco model="{name} scene">
 """
 
 
-def add(name: str, source: str | Path, out: str | Path, drivetrain: str | Path | None = None,
-        payload: float | None = None, tasks: Callable[[robots.Robot, importers.Arm, float], str] | None = None
-        ) -> Added:
+def add(
+    name: str,
+    source: str | Path,
+    out: str | Path,
+    drivetrain: str | Path | None = None,
+    payload: float | None = None,
+    tasks: Callable[[robots.Robot, importers.Arm, float], str] | None = None,
+) -> Added:
     """Write the robot folder ``out`` for the arm in ``source``.
 
     Parameters
@@ -119,11 +124,15 @@ def add(name: str, source: str | Path, out: str | Path, drivetrain: str | Path |
         robot = robots.load(stage / f"{name}.xml")
         size = reach(robot)
         (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
-        header = (f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
-                  f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
-                  f"--drivetrain drivetrain.toml -o NEW_FOLDER")
-        notes = {axis: {k: ("given in --drivetrain" if v == "given" else v) for k, v in keys.items()}
-                 for axis, keys in origin.items()}
+        header = (
+            f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
+            f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
+            f"--drivetrain drivetrain.toml -o NEW_FOLDER"
+        )
+        notes = {
+            axis: {k: ("given in --drivetrain" if v == "given" else v) for k, v in keys.items()}
+            for axis, keys in origin.items()
+        }
         (stage / "drivetrain.toml").write_text(drive.to_toml(notes=notes, header=header))
         if arm.urdf:
             (stage / "urdf_used.urdf").write_text(arm.urdf)
@@ -179,37 +188,56 @@ def readme(name: str, arm: importers.Arm, drive, origin: dict, payload: float, d
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
     n = len(arm.joints)
     lines = [
-        f"# {name}", "",
-        f"{arm.description}. Added by `faultgen robots add {name} --from {arm.source.name}"
-        + (f" --drivetrain {Path(drivetrain).name}" if drivetrain else "") + "` (docs/robots.md, \"Your own robot\").",
+        f"# {name}",
         "",
-        "Files: `" + name + ".xml` (the robot: arm + drivetrain, built by `faultgen.model.builder`), `scene.xml` "
-        "(include-only: floor and light), `drivetrain.toml` (every drivetrain number, with its provenance as a "
+        f"{arm.description}. Added by `faultgen robots add {name} --from {arm.source.name}"
+        + (f" --drivetrain {Path(drivetrain).name}" if drivetrain else "")
+        + '` (docs/robots.md, "Your own robot").',
+        "",
+        "Files: `"
+        + name
+        + ".xml` (the robot: arm + drivetrain, built by `faultgen.model.builder`), `scene.xml` "
+        "(include-only: floor and light), `drivetrain.toml` (every drivetrain number, with its provenance "
+        "as a "
         "comment), `tasks.toml` (the three thesis tasks, generated; edit freely), this README"
-        + (", `urdf_used.urdf` (the URDF as compiled: unusable meshes left out, missing inertials filled in)"
-           if arm.urdf else "") + ".",
+        + (
+            ", `urdf_used.urdf` (the URDF as compiled: unusable meshes left out, missing inertials filled in)"
+            if arm.urdf
+            else ""
+        )
+        + ".",
         "",
         "## Arm (from the source file)",
         "",
         f"Kinematics, joint limits, link masses, centres of mass and inertias are the {arm.kind} file's "
         f"`{arm.source.name}`, as MuJoCo's compiler reads it. Rated payload: {payload:.4g} kg "
-        + ("(from the source)." if not math.isnan(arm.payload) and payload == arm.payload
-           else f"(sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass, unless given with --payload)."),
+        + (
+            "(from the source)."
+            if not math.isnan(arm.payload) and payload == arm.payload
+            else f"(sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass, unless given with --payload)."
+        ),
         "",
         "| axis | joint | source joint | range (rad) | speed limit (rad/s) | effort limit (N m) |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for k, joint in enumerate(arm.joints):
-        lines.append(f"| {k + 1} | `joint{k + 1}` | `{joint.name}` | {joint.range[0]:.6g} .. {joint.range[1]:.6g} | "
-                     f"{_cell(arm.speed_limit[k])} | {_cell(arm.effort_limit[k])} |")
+        lines.append(
+            f"| {k + 1} | `joint{k + 1}` | `{joint.name}` | {joint.range[0]:.6g} .. {joint.range[1]:.6g} | "
+            f"{_cell(arm.speed_limit[k])} | {_cell(arm.effort_limit[k])} |"
+        )
     if arm.notes:
         lines += ["", "Changes made while reading:", ""] + [f"- {note}" for note in arm.notes]
     lines += [
-        "", "## Drivetrain (gear ratio, motor inertia, gearbox stiffness and damping, motor torque limit, "
-        "motor-side friction)", "",
-        "Per axis: the value, then where it came from: `given` (from `--drivetrain`) or `sized` with the rule "
-        "(docs/robots.md, \"Your own robot\", gives each rule's numbers and sources). Units: "
-        + "; ".join(f"{k}: {u}" for k, u in UNITS.items()) + ".", "",
+        "",
+        "## Drivetrain (gear ratio, motor inertia, gearbox stiffness and damping, motor torque limit, "
+        "motor-side friction)",
+        "",
+        "Per axis: the value, then where it came from: `given` (from `--drivetrain`) or `sized` with the "
+        "rule "
+        '(docs/robots.md, "Your own robot", gives each rule\'s numbers and sources). Units: '
+        + "; ".join(f"{k}: {u}" for k, u in UNITS.items())
+        + ".",
+        "",
         "| quantity | " + " | ".join(f"axis {i}" for i in range(1, n + 1)) + " |",
         "| --- |" + " --- |" * n,
     ]
@@ -223,10 +251,17 @@ def readme(name: str, arm: importers.Arm, drive, origin: dict, payload: float, d
         else:
             for i, label in enumerate(labels, start=1):
                 lines.append(f"- {key}, axis {i}: {label.replace('given', 'given in --drivetrain')}")
-    lines += ["", "## Model", "",
-              f"{robot.n_axes} axes. Per axis i: `joint{{i}}` (arm joint), `rotor{{i}}` (motor rotor, armature = Jm), "
-              "`gearbox{i}` (fixed tendon, coefficients 1/G and -1, thesis eq. 6.2a), `motor{i}` (torque actuator), "
-              "`friction{i}` (motor-side friction numerics); a `home` keyframe and a `flange` site.", ""]
+    lines += [
+        "",
+        "## Model",
+        "",
+        f"{robot.n_axes} axes. Per axis i: `joint{{i}}` (arm joint), `rotor{{i}}` (motor rotor, "
+        "armature = Jm), "
+        "`gearbox{i}` (fixed tendon, coefficients 1/G and -1, thesis eq. 6.2a), `motor{i}` (torque "
+        "actuator), "
+        "`friction{i}` (motor-side friction numerics); a `home` keyframe and a `flange` site.",
+        "",
+    ]
     return "\n".join(lines)
 
 

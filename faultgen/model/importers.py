@@ -117,7 +117,9 @@ def read(path: str | Path) -> Arm:
         if root.tag == "robot":
             return _read_urdf(text, path, "URDF")
         return _read_mjcf(path)
-    raise ArmError(f"{path}: unknown arm file type {suffix!r}; expected .urdf, .xacro, .xml (MJCF) or .toml (DH table)")
+    raise ArmError(
+        f"{path}: unknown arm file type {suffix!r}; expected .urdf, .xacro, .xml (MJCF) or .toml (DH table)"
+    )
 
 
 def _expand_xacro(path: Path) -> str:
@@ -140,8 +142,10 @@ def _expand_xacro(path: Path) -> str:
             package = missing.group(1)
             found = _find_package(package, path.parent)
             if package in tried or found is None:
-                raise ArmError(f"{path}: xacro names package {package!r}, found neither by ROS nor in the folders "
-                               "above the file") from None
+                raise ArmError(
+                    f"{path}: xacro names package {package!r}, found neither by ROS nor in the folders "
+                    "above the file"
+                ) from None
             tried.add(package)
             packages.update_package_cache({package: str(found)})
 
@@ -171,14 +175,14 @@ def _resolve_mesh(filename: str, base: Path) -> Path | None:
     for as ``pkg/rest`` (and ``rest``) in the folders above the URDF; ``file://`` and relative paths
     from the URDF's folder."""
     if filename.startswith("package://"):
-        package, _, rest = filename[len("package://"):].partition("/")
+        package, _, rest = filename[len("package://") :].partition("/")
         for folder in [base, *base.parents]:
             for candidate in (folder / package / rest, folder / rest):
                 if candidate.is_file():
                     return candidate.resolve()
         return None
     if filename.startswith("file://"):
-        filename = filename[len("file://"):]
+        filename = filename[len("file://") :]
     candidate = Path(filename) if Path(filename).is_absolute() else base / filename
     return candidate.resolve() if candidate.is_file() else None
 
@@ -199,8 +203,10 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
         parent, child = joint.find("parent"), joint.find("child")
         if parent is not None and child is not None:
             if child.get("link") in parents:
-                raise ArmError(f"{path}: link {child.get('link')!r} has two parent joints: a closed chain; "
-                               "expected a serial chain")
+                raise ArmError(
+                    f"{path}: link {child.get('link')!r} has two parent joints: a closed chain; "
+                    "expected a serial chain"
+                )
             parents[child.get("link")] = parent.get("link")
         if kind_ == "floating":
             raise ArmError(f"{path}: joint {name!r} is floating: a floating base; a robot arm must be fixed")
@@ -209,19 +215,25 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
         if kind_ == "prismatic":
             raise ArmError(f"{path}: joint {name!r} is prismatic; faultgen models revolute axes only")
         if kind_ == "continuous":
-            raise ArmError(f"{path}: joint {name!r} is continuous (no joint limits); give it type revolute "
-                           "with <limit lower upper>")
+            raise ArmError(
+                f"{path}: joint {name!r} is continuous (no joint limits); give it type revolute "
+                "with <limit lower upper>"
+            )
         if kind_ == "revolute":
             limit = joint.find("limit")
             if limit is None or limit.get("lower") is None or limit.get("upper") is None:
-                raise ArmError(f"{path}: joint {name!r} has no joint limits; expected <limit lower=... upper=...>")
+                raise ArmError(
+                    f"{path}: joint {name!r} has no joint limits; expected <limit lower=... upper=...>"
+                )
             names.append(name)
             speed[name] = float(limit.get("velocity", "nan") or "nan")
             e = float(limit.get("effort", "nan") or "nan")
             effort[name] = e if e > 0 else math.nan
         if joint.find("mimic") is not None:
-            raise ArmError(f"{path}: joint {name!r} mimics another joint: a coupled (closed) chain; expected "
-                           "independent joints")
+            raise ArmError(
+                f"{path}: joint {name!r} mimics another joint: a coupled (closed) chain; expected "
+                "independent joints"
+            )
         dynamics = joint.find("dynamics")
         if dynamics is not None:
             joint.remove(dynamics)
@@ -229,8 +241,10 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
     for link, parent in parents.items():
         children.setdefault(parent, []).append(link)
     if not MIN_AXES <= len(names) <= MAX_AXES:
-        raise ArmError(f"{path}: {len(names)} revolute joints ({', '.join(names) or 'none'}); expected "
-                       f"{MIN_AXES} to {MAX_AXES} in a serial chain")
+        raise ArmError(
+            f"{path}: {len(names)} revolute joints ({', '.join(names) or 'none'}); expected "
+            f"{MIN_AXES} to {MAX_AXES} in a serial chain"
+        )
     # geometry MuJoCo cannot load goes, with one warning
     dropped = []
     for link in root.iter("link"):
@@ -246,9 +260,12 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
                 else:
                     mesh.set("filename", str(resolved))
     if dropped:
-        warnings.warn(f"{path}: {len(dropped)} meshes left out (dynamics need no geometry; MuJoCo loads "
-                      f"{', '.join(MESH_TYPES)} files that resolve), e.g. {dropped[0]}", GeometryDropped,
-                      stacklevel=3)
+        warnings.warn(
+            f"{path}: {len(dropped)} meshes left out (dynamics need no geometry; MuJoCo loads "
+            f"{', '.join(MESH_TYPES)} files that resolve), e.g. {dropped[0]}",
+            GeometryDropped,
+            stacklevel=3,
+        )
         notes.append(f"{len(dropped)} meshes left out: COLLADA or unresolvable (dynamics need no geometry)")
     # MuJoCo options for the URDF compiler: keep visual geoms, full mesh paths, every link a body
     extension = root.find("mujoco")
@@ -263,21 +280,34 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
     spec = _urdf_spec(root, path)
     filled = _fill_inertials(root, spec, path)
     if filled:
-        warnings.warn(f"{path}: links {', '.join(filled)} have no <inertial>; theirs are computed from their meshes "
-                      f"at {DENSITY:g} kg/m^3 (MuJoCo's compiler)", GeometryDropped, stacklevel=3)
-        notes.append(f"links {', '.join(filled)}: no <inertial> in the URDF; mass, centre of mass and inertia "
-                     f"computed from their meshes as uniform solids of {DENSITY:g} kg/m^3 by MuJoCo's compiler "
-                     "(written into urdf_used.urdf)")
+        warnings.warn(
+            f"{path}: links {', '.join(filled)} have no <inertial>; theirs are computed from their meshes "
+            f"at {DENSITY:g} kg/m^3 (MuJoCo's compiler)",
+            GeometryDropped,
+            stacklevel=3,
+        )
+        notes.append(
+            f"links {', '.join(filled)}: no <inertial> in the URDF; mass, centre of mass and inertia "
+            f"computed from their meshes as uniform solids of {DENSITY:g} kg/m^3 by MuJoCo's compiler "
+            "(written into urdf_used.urdf)"
+        )
         spec = _urdf_spec(root, path)
     joints = check_arm(spec, str(path))
     extension = root.find("mujoco")
     root.remove(extension)
     urdf = ET.tostring(root, encoding="unicode")
     root.append(extension)
-    return Arm(spec=spec, kind=kind, source=path, joints=joints,
-               speed_limit=np.array([speed.get(j.name, math.nan) for j in joints]),
-               effort_limit=np.array([effort.get(j.name, math.nan) for j in joints]),
-               description=f"{root.get('name', path.stem)} from {kind} {path.name}", notes=notes, urdf=urdf)
+    return Arm(
+        spec=spec,
+        kind=kind,
+        source=path,
+        joints=joints,
+        speed_limit=np.array([speed.get(j.name, math.nan) for j in joints]),
+        effort_limit=np.array([effort.get(j.name, math.nan) for j in joints]),
+        description=f"{root.get('name', path.stem)} from {kind} {path.name}",
+        notes=notes,
+        urdf=urdf,
+    )
 
 
 #: Density of the solids a link without <inertial> is taken to be, kg/m^3 (MuJoCo's default).
@@ -312,8 +342,12 @@ def _fill_inertials(root: ET.Element, spec: mujoco.MjSpec, path: Path) -> list[s
         w, x, y, z = model.body_iquat[body]
         rpy = Rotation.from_quat([x, y, z, w]).as_euler("xyz")
         inertial = ET.SubElement(link, "inertial")
-        ET.SubElement(inertial, "origin", xyz=" ".join(repr(float(v)) for v in model.body_ipos[body]),
-                      rpy=" ".join(repr(float(v)) for v in rpy))
+        ET.SubElement(
+            inertial,
+            "origin",
+            xyz=" ".join(repr(float(v)) for v in model.body_ipos[body]),
+            rpy=" ".join(repr(float(v)) for v in rpy),
+        )
         ET.SubElement(inertial, "mass", value=repr(float(model.body_mass[body])))
         ixx, iyy, izz = (repr(float(v)) for v in model.body_inertia[body])
         ET.SubElement(inertial, "inertia", ixx=ixx, iyy=iyy, izz=izz, ixy="0", ixz="0", iyz="0")
@@ -333,13 +367,22 @@ def _read_mjcf(path: Path) -> Arm:
     notes = []
     joints = check_arm(spec, str(path))
     for joint in spec.joints:
-        changed = [k for k in ("damping", "frictionloss", "armature") if np.any(np.asarray(getattr(joint, k)) != 0)]
+        changed = [
+            k for k in ("damping", "frictionloss", "armature") if np.any(np.asarray(getattr(joint, k)) != 0)
+        ]
         if changed:
             notes.append(f"joint {joint.name!r}: {', '.join(changed)} set to 0 (the drivetrain models them)")
             joint.damping, joint.frictionloss, joint.armature = 0.0 * np.asarray(joint.damping), 0.0, 0.0
-    return Arm(spec=spec, kind="MJCF", source=path, joints=joints,
-               speed_limit=np.full(len(joints), math.nan), effort_limit=_mjcf_effort(spec, joints),
-               description=f"{spec.modelname or path.stem} from MJCF {path.name}", notes=notes)
+    return Arm(
+        spec=spec,
+        kind="MJCF",
+        source=path,
+        joints=joints,
+        speed_limit=np.full(len(joints), math.nan),
+        effort_limit=_mjcf_effort(spec, joints),
+        description=f"{spec.modelname or path.stem} from MJCF {path.name}",
+        notes=notes,
+    )
 
 
 def _mjcf_effort(spec: mujoco.MjSpec, joints: list[ArmJoint]) -> np.ndarray:
@@ -354,7 +397,10 @@ def _mjcf_effort(spec: mujoco.MjSpec, joints: list[ArmJoint]) -> np.ndarray:
     for a in range(model.nu):
         if model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT or not model.actuator_forcelimited[a]:
             continue
-        k = next((k for k, joint in enumerate(joints) if model.joint(joint.name).id == model.actuator_trnid[a, 0]), None)
+        k = next(
+            (k for k, joint in enumerate(joints) if model.joint(joint.name).id == model.actuator_trnid[a, 0]),
+            None,
+        )
         if k is not None and math.isnan(effort[k]) and model.actuator_forcerange[a, 1] > 0:
             effort[k] = float(model.actuator_forcerange[a, 1] * abs(model.actuator_gear[a, 0]))
     return effort
@@ -366,9 +412,13 @@ def _mjcf_without_meshes(path: Path, message: str) -> mujoco.MjSpec:
     meshes = {m.get("name") or Path(m.get("file", "")).stem for m in root.iter("mesh")}
     for parent in list(root.iter()):
         for child in list(parent):
-            if child.tag == "mesh" or (child.tag == "geom" and (child.get("mesh") in meshes or child.get("type") == "mesh")):
+            if child.tag == "mesh" or (
+                child.tag == "geom" and (child.get("mesh") in meshes or child.get("type") == "mesh")
+            ):
                 parent.remove(child)
-    warnings.warn(f"{path}: meshes left out (dynamics need no geometry): {message}", GeometryDropped, stacklevel=4)
+    warnings.warn(
+        f"{path}: meshes left out (dynamics need no geometry): {message}", GeometryDropped, stacklevel=4
+    )
     try:
         return mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except ValueError as err:
@@ -401,8 +451,11 @@ def _number(path: Path, where: str, key: str, value, length: int | None = None) 
         if not ok:
             raise ArmError(f"{path}: {where}: {key} = {value!r}; expected a finite number")
         return float(value)
-    ok = (isinstance(value, list) and len(value) == length
-          and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value))
+    ok = (
+        isinstance(value, list)
+        and len(value) == length
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+    )
     if not ok:
         raise ArmError(f"{path}: {where}: {key} = {value!r}; expected {length} finite numbers")
     return [float(v) for v in value]
@@ -438,10 +491,14 @@ def _read_dh(path: Path) -> Arm:
             raise ArmError(f"{path}: {where} must be a table")
         bad = sorted(set(row) - DH_KEYS)
         if bad:
-            raise ArmError(f"{path}: {where}: unknown key {bad[0]!r}; expected some of: {', '.join(sorted(DH_KEYS))}")
+            raise ArmError(
+                f"{path}: {where}: unknown key {bad[0]!r}; expected some of: {', '.join(sorted(DH_KEYS))}"
+            )
         for key in ("d", "a", "alpha", "mass", "com", "inertia", "qlim"):
             if key not in row:
-                raise ArmError(f"{path}: {where}: {key} is missing" + ("; a joint needs limits" if key == "qlim" else ""))
+                raise ArmError(
+                    f"{path}: {where}: {key} is missing" + ("; a joint needs limits" if key == "qlim" else "")
+                )
         d, a, alpha = (_number(path, where, k, row[k]) for k in ("d", "a", "alpha"))
         offset = _number(path, where, "offset", row.get("offset", 0.0))
         mass = _number(path, where, "mass", row["mass"])
@@ -450,11 +507,18 @@ def _read_dh(path: Path) -> Arm:
         qlim = _number(path, where, "qlim", row["qlim"], 2)
         if not qlim[0] < qlim[1]:
             raise ArmError(f"{path}: {where}: qlim = {qlim!r}; expected lower < upper")
-        tensor = np.array([[inertia[0], inertia[3], inertia[4]], [inertia[3], inertia[1], inertia[5]],
-                           [inertia[4], inertia[5], inertia[2]]])
+        tensor = np.array(
+            [
+                [inertia[0], inertia[3], inertia[4]],
+                [inertia[3], inertia[1], inertia[5]],
+                [inertia[4], inertia[5], inertia[2]],
+            ]
+        )
         if mass <= 0 or np.any(np.linalg.eigvalsh(tensor) <= 0):
-            raise ArmError(f"{path}: {where}: mass {mass!r} kg, inertia {inertia!r} kg m^2; a link needs a positive "
-                           "mass and a positive-definite inertia")
+            raise ArmError(
+                f"{path}: {where}: mass {mass!r} kg, inertia {inertia!r} kg m^2; a link needs a positive "
+                "mass and a positive-definite inertia"
+            )
         speed.append(_number(path, where, "speed", row["speed"]) if "speed" in row else math.nan)
         effort.append(_number(path, where, "effort", row["effort"]) if "effort" in row else math.nan)
         if convention == "standard":
@@ -476,14 +540,24 @@ def _read_dh(path: Path) -> Arm:
         _set_inertial(body, inertial_in, mass, com, tensor)
         parent = frame
     arm_joints = check_arm(spec, str(path))
-    payload = _number(path, "top", "rated_payload", data["rated_payload"]) if "rated_payload" in data else math.nan
-    return Arm(spec=spec, kind="DH table", source=path, joints=arm_joints, speed_limit=np.array(speed),
-               effort_limit=np.array(effort), payload=payload,
-               description=str(data.get("description", f"{name} from the {convention} DH table {path.name}")))
+    payload = (
+        _number(path, "top", "rated_payload", data["rated_payload"]) if "rated_payload" in data else math.nan
+    )
+    return Arm(
+        spec=spec,
+        kind="DH table",
+        source=path,
+        joints=arm_joints,
+        speed_limit=np.array(speed),
+        effort_limit=np.array(effort),
+        payload=payload,
+        description=str(data.get("description", f"{name} from the {convention} DH table {path.name}")),
+    )
 
 
-def _set_inertial(body: mujoco.MjsBody, frame: mujoco.MjsFrame, mass: float, com: list[float],
-                  tensor: np.ndarray) -> None:
+def _set_inertial(
+    body: mujoco.MjsBody, frame: mujoco.MjsFrame, mass: float, com: list[float], tensor: np.ndarray
+) -> None:
     """The body's inertial from a centre of mass and an inertia tensor given in ``frame`` (a child
     frame of the body)."""
     rotation = np.zeros(9)

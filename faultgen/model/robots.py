@@ -44,8 +44,8 @@ class UnknownRobotError(ValueError):
     """Raised by :func:`load` for a name that is neither a known robot nor an MJCF file or robot folder."""
 
 
-__all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_of", "from_spec", "load", "robots_dir",
-           "with_timestep"]
+__all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_of", "from_spec", "load",
+           "robots_dir", "with_timestep"]
 
 
 #: Name of the custom numeric holding a robot's rated payload in kg (robots added by ``faultgen robots
@@ -501,8 +501,8 @@ def _folder_model(folder: Path) -> Path:
     candidates = sorted(p for p in folder.glob("*.xml") if p.name not in ("scene.xml", "arm.xml"))
     if len(candidates) != 1:
         found = ", ".join(p.name for p in candidates) or "none"
-        raise UnknownRobotError(f"{folder}: not a robot folder; expected {own.name} or exactly one robot .xml "
-                                f"(found: {found})")
+        raise UnknownRobotError(f"{folder}: not a robot folder; expected {own.name} or exactly one robot "
+                                f".xml (found: {found})")
     return candidates[0]
 
 

@@ -56,10 +56,11 @@ PAYLOAD_SHARE, PAYLOAD_DENSITY = 0.15, 1000.0
 #: The rule of each key, as the robot's README names it.
 RULES = {
     "gear_ratio": f"G = {MOTOR_SPEED:g} rad/s / joint speed limit",
-    "motor_torque_limit": f"arm-side peak torque / G; peak = effort limit, else {GRAVITY_MARGIN:g} x max gravity "
-                          f"torque (rated payload) + max M_ii x speed limit / {RAMP_TIME:g} s",
+    "motor_torque_limit": f"arm-side peak torque / G; peak = effort limit, else {GRAVITY_MARGIN:g} x max "
+    f"gravity torque (rated payload) + max M_ii x speed limit / {RAMP_TIME:g} s",
     "motor_inertia": f"Jm = {JM_SCALE:g} kg m^2 x (motor torque limit / N m)^{JM_EXPONENT:g}",
-    "gearbox_stiffness": f"K = (2 pi f)^2 G^2 Jm, f = {RESONANCE[0]:g} Hz main / {RESONANCE[1]:g} Hz wrist axes",
+    "gearbox_stiffness": f"K = (2 pi f)^2 G^2 Jm, f = {RESONANCE[0]:g} Hz main / {RESONANCE[1]:g} Hz "
+    "wrist axes",
     "gearbox_damping": f"D = 2 x {DAMPING_RATIO:g} x sqrt(K G^2 Jm)",
     "coulomb_pos": f"{COULOMB_SHARE:.0%} of the motor torque limit",
     "coulomb_neg": f"{COULOMB_SHARE:.0%} of the motor torque limit",
@@ -87,8 +88,9 @@ def arm_loads(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[np.nda
         # a solid sphere of water's density, its centre one radius out along the last axis
         radius = (3 * payload / (4 * math.pi * PAYLOAD_DENSITY)) ** (1 / 3)
         axis = model.jnt_axis[model.joint(joints[-1].name).id]
-        load = last.add_body(name="__payload", pos=(model.jnt_pos[model.joint(joints[-1].name).id]
-                                                     + radius * axis).tolist())
+        load = last.add_body(
+            name="__payload", pos=(model.jnt_pos[model.joint(joints[-1].name).id] + radius * axis).tolist()
+        )
         load.explicitinertial = True
         load.mass, load.inertia = payload, [0.4 * payload * radius**2] * 3
     model = spec.compile()
@@ -111,8 +113,9 @@ def arm_loads(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[np.nda
     return gravity, inertia
 
 
-def size(arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None
-         ) -> tuple[Drivetrain, dict[int, dict[str, str]], float]:
+def size(
+    arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None
+) -> tuple[Drivetrain, dict[int, dict[str, str]], float]:
     """A full drivetrain for ``arm`` (:class:`faultgen.model.importers.Arm`): the values ``given``
     (``{axis: {key: value}}``, e.g. a partial ``--drivetrain``) and the rest sized by :data:`RULES`.
 
@@ -158,17 +161,27 @@ def size(arm, given: dict[int, dict[str, float]] | None = None, payload: float |
         speed = arm.speed_limit[k] if known_speed else DEFAULT_SPEED[wrist]
         G = put("gear_ratio", MOTOR_SPEED / speed)
         if "gear_ratio" not in given.get(axis, {}):
-            notes["gear_ratio"] += (f" ({speed:.4g} rad/s from the source)" if known_speed
-                                    else f" (no speed limit in the source: {speed:g} rad/s assumed)")
+            notes["gear_ratio"] += (
+                f" ({speed:.4g} rad/s from the source)"
+                if known_speed
+                else f" (no speed limit in the source: {speed:g} rad/s assumed)"
+            )
         effort = arm.effort_limit[k]
-        peak = effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
-        torque = put("motor_torque_limit", peak / G if not math.isnan(effort) else max(peak / G, MIN_MOTOR_TORQUE))
+        peak = (
+            effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
+        )
+        torque = put(
+            "motor_torque_limit", peak / G if not math.isnan(effort) else max(peak / G, MIN_MOTOR_TORQUE)
+        )
         if "motor_torque_limit" not in given.get(axis, {}):
-            notes["motor_torque_limit"] = (f"sized: the source's effort limit {effort:.4g} N m / G" if not math.isnan(effort)
-                                           else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
-                                           f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
-                                           f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
-                                           f"{MIN_MOTOR_TORQUE:g} N m")
+            notes["motor_torque_limit"] = (
+                f"sized: the source's effort limit {effort:.4g} N m / G"
+                if not math.isnan(effort)
+                else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
+                f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
+                f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
+                f"{MIN_MOTOR_TORQUE:g} N m"
+            )
         jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
         f = RESONANCE[wrist]
         stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)

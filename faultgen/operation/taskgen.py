@@ -12,8 +12,8 @@
 - ``[spot_weld]`` and ``[arc_weld]``: a U-shaped flange of a horizontal panel (ten weld points; the
   seam through its corners) centred under the flange of a posture found by a seeded search over
   the joint ranges: flange 40-75 % of the reach out from axis 1, between half the reach below and
-  30 % of it above the first joint's anchor, tool axis within 35 deg of straight down, the panel's size a fixed share of the reach (0.1 m weld spacing at the
-  IRB-6700-like arm's reach, at most).
+  30 % of it above the first joint's anchor, tool axis within 35 deg of straight down; weld
+  spacing 3.5 % of the reach, within 0.02-0.1 m.
 
 Each candidate is held to today's task checks before it is kept: the tasks load and plan
 (:meth:`Task.trajectory`: joint limits, IK within tolerance along the seam and at every weld
@@ -50,7 +50,18 @@ SCALES = (1.0, 0.7, 0.5, 0.35, 0.25, 0.15, 0.1)
 #: Weld spacing as a share of the reach, and its bounds, m.
 SPACING_SHARE, SPACING_BOUNDS = 0.035, (0.02, 0.1)
 #: U-shaped weld pattern: (radial, tangential) offsets from the panel centre in weld spacings.
-PATTERN = [(-1, -2.5), (0, -2.5), (1, -2.5), (1, -1.5), (1, -0.5), (1, 0.5), (1, 1.5), (1, 2.5), (0, 2.5), (-1, 2.5)]
+PATTERN = [
+    (-1, -2.5),
+    (0, -2.5),
+    (1, -2.5),
+    (1, -1.5),
+    (1, -0.5),
+    (1, 0.5),
+    (1, 1.5),
+    (1, 2.5),
+    (0, 2.5),
+    (-1, 2.5),
+]
 #: Posture candidates searched, and the seed of the search.
 CANDIDATES, SEED = 400, 0
 
@@ -86,8 +97,13 @@ def _weld_postures(robot: Robot, reach: float, base: np.ndarray) -> list[np.ndar
     radial = np.linalg.norm(positions[:, :2] - base[:2], axis=1) / reach
     down = -rotations[:, 2, 2]  # tool (flange z) axis against world -z
     height = positions[:, 2] - base[2]
-    fits = ((radial > 0.4) & (radial < 0.75) & (down > math.cos(math.radians(35))) & (height > -0.5 * reach)
-            & (height < 0.3 * reach))
+    fits = (
+        (radial > 0.4)
+        & (radial < 0.75)
+        & (down > math.cos(math.radians(35)))
+        & (height > -0.5 * reach)
+        & (height < 0.3 * reach)
+    )
     order = np.lexsort((np.abs(radial - 0.55), -down))
     return [q[k] for k in order if fits[k]]
 
@@ -101,8 +117,13 @@ def _panel(robot: Robot, q: np.ndarray, reach: float, base: np.ndarray) -> dict:
     points = [position + spacing * (a * u + b * v) for a, b in PATTERN]
     seam = [points[0], points[2], points[7], points[9]]
     seam_length = sum(np.linalg.norm(b - a) for a, b in zip(seam, seam[1:]))
-    return {"rotation": rotation, "points": points, "seam": seam, "spacing": spacing,
-            "tool_speed": float(np.clip(seam_length / 6.0, 0.01, 0.15))}
+    return {
+        "rotation": rotation,
+        "points": points,
+        "seam": seam,
+        "spacing": spacing,
+        "tool_speed": float(np.clip(seam_length / 6.0, 0.01, 0.15)),
+    }
 
 
 def _text(robot: Robot, velocity, acceleration, start_pp, pick, place, q_weld, panel, scale) -> str:
@@ -117,7 +138,8 @@ def _text(robot: Robot, velocity, acceleration, start_pp, pick, place, q_weld, p
         "",
         "[limits]",
         f"velocity = {_deg(velocity)}  # deg/s, the source's joint speed limits (or the sizing's assumption)",
-        f"acceleration = {_deg(acceleration)}  # deg/s^2: full speed in {RAMP[0]:g} s (main), {RAMP[1]:g} s (wrist)",
+        f"acceleration = {_deg(acceleration)}  # deg/s^2: full speed in {RAMP[0]:g} s (main), "
+        f"{RAMP[1]:g} s (wrist)",
         f"jerk = {_deg(JERK_RATE * acceleration)}  # deg/s^3: full acceleration in {1 / JERK_RATE:g} s",
         "",
         "[pick_place]",
@@ -200,7 +222,9 @@ def generate(robot: Robot, arm=None, payload: float | None = None) -> str:
     n = robot.n_axes
     wrist = np.arange(n) >= sizing.main_axes(n)
     speed = np.full(n, np.nan) if arm is None else np.asarray(arm.speed_limit, dtype=float)
-    velocity = np.where(np.isnan(speed), np.where(wrist, sizing.DEFAULT_SPEED[1], sizing.DEFAULT_SPEED[0]), speed)
+    velocity = np.where(
+        np.isnan(speed), np.where(wrist, sizing.DEFAULT_SPEED[1], sizing.DEFAULT_SPEED[0]), speed
+    )
     acceleration = velocity / np.where(wrist, RAMP[1], RAMP[0])
     low, high = robot.joint_range.T
     middle = (low + high) / 2
@@ -215,8 +239,12 @@ def generate(robot: Robot, arm=None, payload: float | None = None) -> str:
     target = Path(robot.path).parent / "tasks.toml"
     check = _can_check(robot)
     if not check:
-        warnings.warn(f"{robot.name}: {n} axes; this version's task planner reads 6, so the generated tasks are "
-                      "written unchecked", UserWarning, stacklevel=2)
+        warnings.warn(
+            f"{robot.name}: {n} axes; this version's task planner reads 6, so the generated tasks are "
+            "written unchecked",
+            UserWarning,
+            stacklevel=2,
+        )
     failures = []
     for q_weld in _weld_postures(robot, reach, base)[:12]:
         panel = _panel(robot, q_weld, reach, base)
@@ -228,16 +256,22 @@ def generate(robot: Robot, arm=None, payload: float | None = None) -> str:
             for name in task_module.TASKS:
                 for value in SCALES:
                     scale[name] = value
-                    target.write_text(_text(robot, velocity, acceleration, middle, pick, place, q_weld, panel, scale))
+                    target.write_text(
+                        _text(robot, velocity, acceleration, middle, pick, place, q_weld, panel, scale)
+                    )
                     if _checked(robot, name) <= TORQUE_SHARE:
                         break
                 else:
-                    raise ValueError(f"{name}: drive torque above {TORQUE_SHARE:.0%} of capacity even at scale "
-                                     f"{SCALES[-1]}")
+                    raise ValueError(
+                        f"{name}: drive torque above {TORQUE_SHARE:.0%} of capacity even at scale "
+                        f"{SCALES[-1]}"
+                    )
         except ValueError as err:
             failures.append(str(err))
             continue
         return _text(robot, velocity, acceleration, middle, pick, place, q_weld, panel, scale)
     reason = failures[-1] if failures else "no posture puts the tool down within 40-75 % of the reach"
-    raise ValueError(f"{robot.name}: no weld tasks found that plan within the limits and torque capacity ({reason}); "
-                     "write tasks.toml by hand (robots/irb6700/tasks.toml shows the format)")
+    raise ValueError(
+        f"{robot.name}: no weld tasks found that plan within the limits and torque capacity ({reason}); "
+        "write tasks.toml by hand (robots/irb6700/tasks.toml shows the format)"
+    )
