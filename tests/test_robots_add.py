@@ -91,3 +91,38 @@ def test_fleet_parts_follow_the_rated_payload(tmp_path):
     assert run("robots", "add", "ur5", "--from", UR5, "-o", out).exit_code == 0
     assert robots.load(out).rated_payload == 5.0  # the DH table's rated_payload
     assert np.isnan(robots.load("puma560").rated_payload)
+
+
+def test_a_built_in_robot_added_from_its_own_arm_and_drivetrain_has_its_dynamics(tmp_path):
+    from faultgen.model import folder
+
+    source = robots.robots_dir() / "irb6700"
+    added = folder.add(
+        "irb_copy",
+        source / "arm.xml",
+        tmp_path / "irb_copy",
+        drivetrain=source / "drivetrain.toml",
+        payload=200.0,
+    )
+    ours, reference = added.robot, robots.load("irb6700")
+    rng = np.random.default_rng(3)
+    q = rng.uniform(*reference.joint_range.T, (20, 6))
+    qd, qdd = rng.normal(0, 1, q.shape), rng.normal(0, 2, q.shape)
+    np.testing.assert_array_equal(ours.inverse_dynamics(q, qd, qdd), reference.inverse_dynamics(q, qd, qdd))
+    for field in (
+        "body_mass",
+        "body_inertia",
+        "jnt_stiffness",
+        "tendon_stiffness",
+        "tendon_damping",
+        "wrap_prm",
+        "actuator_ctrlrange",
+        "dof_armature",
+        "key_qpos",
+    ):
+        np.testing.assert_array_equal(
+            getattr(ours.model, field), getattr(reference.model, field), err_msg=field
+        )
+    readme = (tmp_path / "irb_copy" / "README.md").read_text()
+    assert "gear_ratio, all axes: given in --drivetrain" in readme
+    assert "Rated payload: 200 kg (given with --payload)" in readme

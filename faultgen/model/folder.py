@@ -108,6 +108,13 @@ def add(
     arm = importers.read(source)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
+    payload_origin = (
+        "given with --payload"
+        if payload is not None
+        else "from the source"
+        if not math.isnan(arm.payload)
+        else f"sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass"
+    )
     drive, origin, payload = sizing.size(arm, given, payload)
     spec = builder.build(arm.spec, drive, source=str(source))
     spec.modelname = name
@@ -138,7 +145,9 @@ def add(
             (stage / "urdf_used.urdf").write_text(arm.urdf)
         if tasks is not None:
             (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
-        (stage / "README.md").write_text(readme(name, arm, drive, origin, payload, drivetrain, robot))
+        (stage / "README.md").write_text(
+            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin)
+        )
         if out.exists():
             out.rmdir()
         stage.rename(out)
@@ -183,7 +192,16 @@ def reach(robot: robots.Robot) -> float:
     return reach
 
 
-def readme(name: str, arm: importers.Arm, drive, origin: dict, payload: float, drivetrain, robot) -> str:
+def readme(
+    name: str,
+    arm: importers.Arm,
+    drive,
+    origin: dict,
+    payload: float,
+    drivetrain,
+    robot,
+    payload_origin: str = "",
+) -> str:
     """README.md of an added robot: where the arm came from, and per axis where every drivetrain
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
     n = len(arm.joints)
@@ -211,11 +229,7 @@ def readme(name: str, arm: importers.Arm, drive, origin: dict, payload: float, d
         "",
         f"Kinematics, joint limits, link masses, centres of mass and inertias are the {arm.kind} file's "
         f"`{arm.source.name}`, as MuJoCo's compiler reads it. Rated payload: {payload:.4g} kg "
-        + (
-            "(from the source)."
-            if not math.isnan(arm.payload) and payload == arm.payload
-            else f"(sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass, unless given with --payload)."
-        ),
+        f"({payload_origin}).",
         "",
         "| axis | joint | source joint | range (rad) | speed limit (rad/s) | effort limit (N m) |",
         "| --- | --- | --- | --- | --- | --- |",
