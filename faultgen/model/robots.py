@@ -517,7 +517,7 @@ def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path
 
     For convergence studies (``benchmarks/convergence.py``): the copy is the robot's own MJCF with
     ``<option timestep=...>`` rewritten and nothing else (no re-serialisation, so every other
-    number keeps its digits), beside the robot's ``tasks.toml``.
+    number keeps its digits), beside the robot's ``tasks.toml`` (and its ``meshes`` folder, if any).
 
     Parameters
     ----------
@@ -550,6 +550,8 @@ def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path
     target = Path(folder) / source.stem
     target.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(source.parent / "tasks.toml", target / "tasks.toml")
+    if (source.parent / "meshes").is_dir():  # an added robot's meshes, named relative to its MJCF
+        shutil.copytree(source.parent / "meshes", target / "meshes", dirs_exist_ok=True)
     (target / source.name).write_text(text)
     return target / source.name
 
