@@ -3,7 +3,7 @@
 :func:`add` reads the arm (:mod:`faultgen.model.importers`), completes its drivetrain from
 ``--drivetrain`` and the sizing rules (:mod:`faultgen.model.sizing`), builds the robot
 (:mod:`faultgen.model.builder`) and writes ``NAME.xml``, ``scene.xml``, ``drivetrain.toml``,
-``README.md`` (provenance of every number), the meshes it kept, and ``tasks.toml`` from a callable
+``README.md`` (provenance of every number) and ``tasks.toml`` from a callable
 of the layer above (:mod:`faultgen.operation.taskgen`), which gets the staged robot. Everything is
 written into a hidden folder beside ``out`` and renamed to ``out`` only when all of it is written
 and the robot loads: an error or a kill leaves no folder that looks complete.
@@ -116,6 +116,12 @@ def add(
         else f"sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass"
     )
     drive, origin, payload = sizing.size(arm, given, payload)
+    dropped = _skeleton(arm.spec, str(source))
+    if dropped:
+        arm.notes.append(
+            f"{dropped} meshes replaced by a capsule skeleton (massless, no contacts): the robot's "
+            "MJCF must load wherever faultgen copies it, and dynamics need no geometry"
+        )
     spec = builder.build(arm.spec, drive, source=str(source))
     spec.modelname = name
     if not any(t.name == "description" for t in spec.texts):
@@ -126,7 +132,6 @@ def add(
     out.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     try:
-        text = _copy_meshes(spec, text, stage)
         (stage / f"{name}.xml").write_text(text)
         robot = robots.load(stage / f"{name}.xml")
         size = reach(robot)
@@ -157,21 +162,31 @@ def add(
     return Added(out, robots.load(out / f"{name}.xml"), arm, payload)
 
 
-def _copy_meshes(spec: mujoco.MjSpec, text: str, stage: Path) -> str:
-    """Copy the mesh files the robot uses into ``stage/meshes`` and point the MJCF text at them."""
-    files = sorted({m.file for m in spec.meshes if m.file and Path(m.file).is_absolute()})
-    if not files:
-        return text
-    (stage / "meshes").mkdir()
-    used = set()
-    for file in files:
-        target = Path(file).name
-        while target in used:
-            target = "_" + target
-        used.add(target)
-        shutil.copyfile(file, stage / "meshes" / target)
-        text = text.replace(f'file="{file}"', f'file="meshes/{target}"')
-    return text
+def _skeleton(spec: mujoco.MjSpec, source: str) -> int:
+    """Replace the arm's mesh geoms by capsules from each link's origin to the next link's (a
+    skeleton to look at, massless and without contacts); return how many meshes went. A robot
+    folder's MJCF is copied elsewhere by other commands (calibration, convergence studies), where
+    mesh files named relative to it would not be found; dynamics need no geometry."""
+    meshes = [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]
+    if not meshes:
+        return 0
+    for geom in meshes:
+        spec.delete(geom)
+    for mesh in list(spec.meshes):
+        spec.delete(mesh)
+    model = spec.copy().compile()
+    extent = float(np.max(np.linalg.norm(model.body_pos, axis=1))) or 0.1
+    for body in range(1, model.nbody):
+        parent = model.body_parentid[body]
+        offset = model.body_pos[body]
+        if parent == 0 or np.linalg.norm(offset) < 1e-6:
+            continue
+        geom = spec.body(model.body(parent).name).add_geom(
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, *offset.tolist()], size=[0.15 * extent, 0, 0]
+        )
+        geom.contype, geom.conaffinity, geom.group, geom.mass = 0, 0, 2, 0.0
+        geom.rgba = [0.75, 0.75, 0.78, 1.0]
+    return len(meshes)
 
 
 def reach(robot: robots.Robot) -> float:
