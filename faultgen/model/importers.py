@@ -26,6 +26,7 @@ by ``xacrodoc`` first. A DH table is a TOML file (docs/robots.md, "Your own robo
 
 from __future__ import annotations
 
+import copy
 import math
 import re
 import tomllib
@@ -322,11 +323,16 @@ def _urdf_spec(root: ET.Element, path: Path) -> mujoco.MjSpec:
 
 
 def _fill_inertials(root: ET.Element, spec: mujoco.MjSpec, path: Path) -> list[str]:
-    """Write an ``<inertial>`` into each link that has none but has geometry MuJoCo can weigh
-    (uniform solids of :data:`DENSITY`); return those links' names. A link with neither stays
+    """Write an ``<inertial>`` into each link that has none but has collision geometry MuJoCo can
+    weigh (uniform solids of :data:`DENSITY`); return those links' names. A link with neither stays
     massless (and :func:`check_arm` refuses it if it moves)."""
+    # weigh the collision geometry only: a URDF's visual meshes repeat it (and would count twice)
+    solids = copy.deepcopy(root)
+    for link in solids.iter("link"):
+        for visual in link.findall("visual"):
+            link.remove(visual)
     try:
-        model = spec.copy().compile()
+        model = mujoco.MjSpec.from_string(ET.tostring(solids, encoding="unicode")).compile()
     except ValueError:
         return []  # check_arm names the body
     from scipy.spatial.transform import Rotation
