@@ -283,3 +283,20 @@ def test_mjcf_floating_base_is_refused(tmp_path):
     path.write_text(text)
     with pytest.raises(builder.ArmError, match="joint 'float' is a free joint: a floating base"):
         importers.read(path)
+
+
+def test_mjcf_with_missing_mesh_files_is_read_without_them_and_one_warning(tmp_path):
+    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
+    text = text.replace(
+        "<worldbody>", '<asset><mesh name="shell" file="gone/shell.stl"/></asset><worldbody>', 1
+    )
+    text = text.replace(
+        '<site name="dh2"/>', '<site name="dh2"/><geom type="mesh" mesh="shell" mass="0"/>', 1
+    )
+    path = tmp_path / "arm.xml"
+    path.write_text(text)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        arm = importers.read(path)
+    assert [w.category for w in caught] == [importers.GeometryDropped]
+    assert len(arm.joints) == 6 and not arm.spec.meshes

@@ -365,11 +365,13 @@ def _read_mjcf(path: Path) -> Arm:
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as err:
+        raise ArmError(f"{path}: {str(err).strip()}") from None
+    try:
+        spec.copy().compile()
+    except ValueError as err:  # check_arm names any other error, after the joint kinds
         message = str(err).strip()
-        if "mesh" not in message.lower() and "file" not in message.lower():
-            raise ArmError(f"{path}: {message}") from None
-        # an asset it cannot load: read again without geometry files
-        spec = _mjcf_without_meshes(path, message)
+        if "error opening file" in message.lower() or "mesh" in message.lower():
+            spec = _mjcf_without_meshes(path, message)  # an asset it cannot load: read without mesh files
     notes = []
     joints = check_arm(spec, str(path))
     for joint in spec.joints:
