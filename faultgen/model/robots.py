@@ -29,7 +29,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.axes import N_AXES
+from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import MotorFriction
@@ -152,6 +152,11 @@ class Robot:
     def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
         return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
 
+    @property
+    def n_axes(self) -> int:
+        """Number of axes N (5..7), read from the model (its joints ``joint1`` .. ``jointN``)."""
+        return len(self.joint_names)
+
     @cached_property
     def arm_qpos(self) -> np.ndarray:
         """Indices of the arm joints in ``qpos``, ``ndarray of shape (6,)``."""
@@ -189,8 +194,8 @@ class Robot:
         qvel : ndarray of shape (nv,)
             Arm joints at ``qd``, rotors at ``G qd`` (motor-side rad/s).
         """
-        q = _check_vector("q", q)
-        qd = np.zeros(N_AXES) if qd is None else _check_vector("qd", qd)
+        q = _check_vector("q", q, self.n_axes)
+        qd = np.zeros(self.n_axes) if qd is None else _check_vector("qd", qd, self.n_axes)
         qpos = np.zeros(self.model.nq)
         qvel = np.zeros(self.model.nv)
         qpos[self.arm_qpos] = q
@@ -242,9 +247,9 @@ class Robot:
         ValueError
             If an input is not of shape (n, 6) with a common n, or holds a non-finite value.
         """
-        q = _check_trajectory("q", q)
-        qd = _check_trajectory("qd", qd, q.shape[0])
-        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        q = _check_trajectory("q", q, None, self.n_axes)
+        qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
+        qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         G = self.gear_ratio
         tau, load = self._rigid(q, qd, qdd)
         offset = self.arm_offset(load)
@@ -274,9 +279,9 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q)
-        qd = _check_trajectory("qd", qd, q.shape[0])
-        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        q = _check_trajectory("q", q, None, self.n_axes)
+        qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
+        qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         return self._rigid(q, qd, qdd)[1]
 
     def static_load(self, q: np.ndarray) -> np.ndarray:
@@ -295,7 +300,7 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q)
+        q = _check_trajectory("q", q, None, self.n_axes)
         zero = np.zeros_like(q)
         return self._rigid(q, zero, zero)[1]
 
@@ -364,7 +369,7 @@ class Robot:
         q : ndarray of shape (n, 6)
             Arm joint angles in rad.
         """
-        q = _check_trajectory("q", q)
+        q = _check_trajectory("q", q, None, self.n_axes)
         model, data = self._inverse
         qpos = np.tile(data.qpos, (q.shape[0], 1))
         qpos[:, self.arm_qpos], qpos[:, self.rotor_qpos] = q, self.gear_ratio * q
@@ -408,19 +413,19 @@ class Robot:
         return from_spec(spec, self.path)
 
 
-def _check_vector(name: str, value: np.ndarray) -> np.ndarray:
+def _check_vector(name: str, value: np.ndarray, n_axes: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
-    if arr.shape != (N_AXES,):
-        raise ValueError(f"{name} must have shape ({N_AXES},), got {arr.shape}")
+    if arr.shape != (n_axes,):
+        raise ValueError(f"{name} must have shape ({n_axes},), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} holds a non-finite value at axis {int(np.argmin(np.isfinite(arr))) + 1}")
     return arr
 
 
-def _check_trajectory(name: str, value: np.ndarray, n: int | None = None) -> np.ndarray:
+def _check_trajectory(name: str, value: np.ndarray, n: int | None, n_axes: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
-    if arr.ndim != 2 or arr.shape[1] != N_AXES or (n is not None and arr.shape[0] != n):
-        expected = f"(n, {N_AXES})" if n is None else f"({n}, {N_AXES})"
+    if arr.ndim != 2 or arr.shape[1] != n_axes or (n is not None and arr.shape[0] != n):
+        expected = f"(n, {n_axes})" if n is None else f"({n}, {n_axes})"
         raise ValueError(f"{name} must have shape {expected}, got {arr.shape}")
     bad = np.argwhere(~np.isfinite(arr))
     if bad.size:
@@ -543,21 +548,25 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
     def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
         idx = mujoco.mj_name2id(model, obj_type, element)
         if idx < 0:
-            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{N_AXES}")
+            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{n_axes}")
         return idx
 
-    axes = range(1, N_AXES + 1)
-    joint_names = tuple(f"joint{i}" for i in axes)
-    rotor_names = tuple(f"rotor{i}" for i in axes)
-    gearbox_names = tuple(f"gearbox{i}" for i in axes)
-    actuator_names = tuple(f"motor{i}" for i in axes)
+    n_axes = axes.count(model)
+    if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
+        raise ModelError(f"{path}: {n_axes} arm joints joint1..joint{n_axes}; a robot has "
+                         f"{axes.MIN_AXES}..{axes.MAX_AXES} (joint1, joint2, ... in order)")
+    numbers = range(1, n_axes + 1)
+    joint_names = tuple(f"joint{i}" for i in numbers)
+    rotor_names = tuple(f"rotor{i}" for i in numbers)
+    gearbox_names = tuple(f"gearbox{i}" for i in numbers)
+    actuator_names = tuple(f"motor{i}" for i in numbers)
 
-    gear_ratio = np.empty(N_AXES)
-    joint_range = np.empty((N_AXES, 2))
-    motor_inertia = np.empty(N_AXES)
-    torque_limit = np.empty(N_AXES)
-    friction_rows = np.empty((N_AXES, len(FRICTION_FIELDS)))
-    for k in range(N_AXES):
+    gear_ratio = np.empty(n_axes)
+    joint_range = np.empty((n_axes, 2))
+    motor_inertia = np.empty(n_axes)
+    torque_limit = np.empty(n_axes)
+    friction_rows = np.empty((n_axes, len(FRICTION_FIELDS)))
+    for k in range(n_axes):
         j = require("joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
         r = require("joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
         t = require("tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
@@ -592,7 +601,7 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
         adr, size = model.text_adr[description_id], model.text_size[description_id]
         description = bytes(model.text_data[adr : adr + size - 1]).decode()
 
-    for k in range(N_AXES):
+    for k in range(n_axes):
         if model.jnt_limited[model.joint(joint_names[k]).id] == 0:
             raise ModelError(f"{path}: joint {joint_names[k]!r} must be limited (give it a range)")
 

@@ -125,7 +125,7 @@ class RunConfig:
     fault: Fault | None = None
 
     def __post_init__(self) -> None:
-        robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
+        n_axes = robots.load(self.robot).n_axes  # UnknownRobotError / ModelError (ValueErrors) name the problem
         if self.task not in tasks.TASKS:
             raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
         friction.check_model(self.friction)
@@ -141,6 +141,9 @@ class RunConfig:
             object.__setattr__(self, "record", tuple(sorted(set(record))))
         if not is_whole(self.seed, 0):
             raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
+        if not isinstance(self.wear, WearPlan):
+            raise TypeError(f"wear: expected a WearPlan, got {type(self.wear).__name__}")
+        self.wear.check(n_axes)  # "axis 7 is out of range 1..6"
         if self.nthread < 0:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
         if not isinstance(self.conditions, Conditions):
@@ -148,6 +151,7 @@ class RunConfig:
         if self.fault is not None:
             if not isinstance(self.fault, Fault):
                 raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
+            self.fault.check(n_axes)
             if self.fault.last_cycle != self.cycles:
                 raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
             if self.fault.effect in robots.load(self.robot).effects and np.any(
@@ -199,11 +203,11 @@ class SimModel:
     friction_model : str
     gains : ServoGains
     model : mujoco.MjModel
-    drive_ctrl : ndarray of shape (6, 3)
+    drive_ctrl : ndarray of shape (N, 3)
         ``ctrl`` indices of each drive's (pos, vel, ff) inputs.
-    drive_ids : ndarray of shape (6,)
+    drive_ids : ndarray of shape (N,)
         Actuator ids of the drives ``motor{i}``.
-    lugre_ids : ndarray of shape (6,)
+    lugre_ids : ndarray of shape (N,)
         Actuator ids of the friction actuators ``lugre{i}`` (empty for ``stribeck``).
     """
 
@@ -222,7 +226,7 @@ class SimModel:
 
     def setpoints(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """:func:`faultgen.control.setpoints` of a path sampled at this model's physics step, for its
-        integrator (the drives' position gains when it is implicit in position), ``(n, 6, 3)``."""
+        integrator (the drives' position gains when it is implicit in position), ``(n, N, 3)``."""
         return control.setpoints(self.robot, q, qd, qdd, self.model.opt.timestep,
                                  self.gains.kp if self.implicit_position else None)
 
@@ -233,7 +237,7 @@ class SimModel:
         ----------
         force : ndarray of shape (..., n_actuators)
             ``actuator_force`` of a step, N m at the motor side.
-        v_m, v_m_before : ndarray of shape (..., 6)
+        v_m, v_m_before : ndarray of shape (..., N)
             Rotor speeds after and before that step, rad/s.
 
         Returns
@@ -318,7 +322,7 @@ def build(robot: robots.Robot, friction_model: str = "lugre",
     drive_ids = np.array([model.actuator(n).id for n in robot.actuator_names])
     drive_ctrl = model.actuator_ctrladr[drive_ids][:, None] + np.arange(len(control.INPUTS))
     lugre_ids = np.array(
-        [model.actuator(f"lugre{k + 1}").id for k in range(6)] if friction_model == "lugre" else [], dtype=int
+        [model.actuator(f"lugre{k + 1}").id for k in range(robot.n_axes)] if friction_model == "lugre" else [], dtype=int
     )
     return SimModel(robot, friction_model, gains, model, drive_ctrl, drive_ids, lugre_ids)
 
@@ -347,30 +351,30 @@ class RunResult:
         Log times within a cycle, s (every 4 ms, first sample 4 ms after the start).
     cycles : ndarray of shape (n_cycles,)
         Recorded cycle indices (1-based).
-    q_ref : ndarray of shape (n_log, 6)
+    q_ref : ndarray of shape (n_log, N)
         Reference arm angles at the log times, rad.
-    q_a, q_m : ndarray of shape (n_cycles, n_log, 6)
+    q_a, q_m : ndarray of shape (n_cycles, n_log, N)
         Arm and motor angles as the encoders report them, rad (arm side / motor side).
-    qd_a, qd_m : ndarray of shape (n_cycles, n_log, 6)
+    qd_a, qd_m : ndarray of shape (n_cycles, n_log, N)
         Arm and motor speeds from the encoders (backward difference), rad/s.
-    tau_m : ndarray of shape (n_cycles, n_log, 6)
+    tau_m : ndarray of shape (n_cycles, n_log, N)
         Motor torque (drive output), N m at the motor side.
-    tau_f : ndarray of shape (n_cycles, n_log, 6)
+    tau_f : ndarray of shape (n_cycles, n_log, N)
         True motor-side friction torque, N m, positive when it opposes positive motion.
-    tau_dist : ndarray of shape (n_cycles, n_log, 6)
+    tau_dist : ndarray of shape (n_cycles, n_log, N)
         True load disturbance on the arm joints, N m at the arm side.
-    friction_multiplier : ndarray of shape (n_cycles, 6)
+    friction_multiplier : ndarray of shape (n_cycles, N)
         True wear multiplier of Coulomb and static friction per cycle and axis.
-    mean_friction_torque : ndarray of shape (n_cycles, 6)
+    mean_friction_torque : ndarray of shape (n_cycles, N)
         Mean absolute true friction torque per cycle and axis, N m at the motor side.
-    tracking_error : ndarray of shape (n_cycles, 6)
+    tracking_error : ndarray of shape (n_cycles, N)
         Largest absolute error of the true arm angle against the reference, rad.
     features : dict of ndarray
         Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
         ``mean_abs_torque``, ``rms_torque``, ``average_speed``, ``average_load_torque``
-        (n_cycles, 6) and ``angle_hist``, ``speed_hist``,
-        ``torque_hist`` (n_cycles, 6, 12); per recorded cycle (not in daily records) also
-        ``torque_counts`` (n_cycles, 6, 1200), :func:`faultgen.sensors.torque_counts`.
+        (n_cycles, N) and ``angle_hist``, ``speed_hist``,
+        ``torque_hist`` (n_cycles, N, 12); per recorded cycle (not in daily records) also
+        ``torque_counts`` (n_cycles, N, 1200), :func:`faultgen.sensors.torque_counts`.
     conditions : CycleConditions or None
         The operating conditions of each recorded cycle (None when the run has none).
     fault_value : ndarray of shape (n_cycles,) or None
@@ -408,7 +412,7 @@ def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.nda
     base axis) starts in the middle of its dead band.
     """
     qpos, qvel = robot.rigid_state(q0)
-    zeros = np.zeros((1, 6))
+    zeros = np.zeros((1, robot.n_axes))
     static = robot.inverse_dynamics(q0[None], zeros, zeros, friction=False)[0]
     # a load at round-off level (gravity on a vertical axis) has no side to rest on
     side = np.sign(static) * (np.abs(static) > 1e-9 * max(float(np.abs(static).max()), 1.0))
@@ -432,7 +436,8 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     """
     cycles = config.recorded_cycles
-    conditions = config.conditions.evaluate(config.seed, cycles) if config.conditions.active else None
+    n_axes = robots.load(config.robot).n_axes
+    conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     mix = config.conditions.task_mix
     if mix is None:
         result = _simulate_task(config, config.task, cycles, conditions, progress)
@@ -454,7 +459,7 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     per_log = prepared.per_log
     n_steps = len(inputs) - 1
 
-    multiplier = config.wear.multipliers(cycles)
+    multiplier = config.wear.multipliers(cycles, robot.n_axes)
     n_log = n_steps // per_log
     feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
@@ -470,7 +475,7 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
             chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
             one = stepper(sim, _Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
-            raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
+            raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, robot.n_axes) for f in fields(_Raw)})
         else:  # the cycles of each payload (its own model and feedforward) in batches of BATCH_CYCLES
             parts = conditions.payload_part if conditions is not None else np.full(len(cycles), -1)
             order, raws = [], []
@@ -515,7 +520,7 @@ def _merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunRes
 
     own = _prepared(config.robot, config.task, config.friction)
     n_log = (len(own.inputs) - 1) // own.per_log
-    empty = np.zeros((len(back), 0, 6))
+    empty = np.zeros((len(back), 0, parts[0].friction_multiplier.shape[1]))
     conditions = replace(parts[0].conditions, **{f.name: joined(lambda r, n=f.name: getattr(r.conditions, n))
                                                  for f in fields(CycleConditions)
                                                  if f.name not in CycleConditions.PER_UNIT})
@@ -542,7 +547,7 @@ def daily_record(result: RunResult) -> RunResult:
     -------
     RunResult
         With ``(n_days, ...)`` arrays where ``result`` had ``(n_cycles, ...)`` and signals of shape
-        ``(n_days, 0, 6)``.
+        ``(n_days, 0, N)``.
     """
     per_day = result.config.conditions.cycles_per_day
     n_days = len(result.cycles) // per_day
@@ -560,7 +565,7 @@ def daily_record(result: RunResult) -> RunResult:
                              **{name: days(getattr(conditions, name), np.mean) for name in
                                 ("hour", "ambient_temperature", "joint_temperature", "dry_friction_factor",
                                  "viscous_factor")})
-    empty = np.zeros((n_days, 0, 6))
+    empty = np.zeros((n_days, 0, result.friction_multiplier.shape[1]))
     return replace(result, cycles=np.arange(1, n_days + 1), q_a=empty, q_m=empty, qd_a=empty, qd_m=empty,
                    tau_m=empty, tau_f=empty, tau_dist=empty, friction_multiplier=days(result.friction_multiplier),
                    mean_friction_torque=days(result.mean_friction_torque), tracking_error=days(result.tracking_error),
@@ -579,9 +584,9 @@ class Prepared:
     task : faultgen.tasks.Task
     path : faultgen.tasks.JointPath
         The task's path sampled at every physics step.
-    q_ref : ndarray of shape (n_steps + 1, 6)
+    q_ref : ndarray of shape (n_steps + 1, N)
         Reference arm angles at every physics step, rad (held at the end to a whole log period).
-    inputs : ndarray of shape (n_steps + 1, 6, 3)
+    inputs : ndarray of shape (n_steps + 1, N, 3)
         Drive set-points (angle, speed, feedforward) at every physics step, motor side.
     fault_fields : tuple
         For a model with a growing fault: the fields its parameter moves (:func:`_affine_fields`),
@@ -604,20 +609,20 @@ class Prepared:
 @dataclass(frozen=True)
 class _Plant:
     """How each simulated cycle's robot differs from the nominal model: multipliers of the dry
-    (Coulomb and static: wear, temperature, unit) and the viscous friction (n, 6), of each link's
-    mass and inertia (6,), a growing fault's parameter (n,) (None without one), and the unit's
-    gearbox loss growing with the load (6,), a load-dependent friction coefficient (zeros: none)."""
+    (Coulomb and static: wear, temperature, unit) and the viscous friction (n, N), of each link's
+    mass and inertia (N,), a growing fault's parameter (n,) (None without one), and the unit's
+    gearbox loss growing with the load (N,), a load-dependent friction coefficient (zeros: none)."""
 
     dry: np.ndarray
     viscous: np.ndarray
     link_mass: np.ndarray
     fault: np.ndarray | None = None
-    gear_loss: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    gear_loss: np.ndarray | None = None  # set by of(); zeros of the robot's axes without a spread
 
     @classmethod
     def of(cls, wear: np.ndarray, conditions: CycleConditions | None, fault: np.ndarray | None = None) -> _Plant:
         if conditions is None:
-            return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]), fault)
+            return cls(wear, np.ones_like(wear), np.ones(wear.shape[1]), fault, np.zeros(wear.shape[1]))
         return cls(wear * conditions.dry_friction_factor, conditions.viscous_factor, conditions.link_mass_factor,
                    fault, conditions.gear_loss)
 
@@ -651,8 +656,8 @@ class _Plant:
 @dataclass(frozen=True)
 class _Work:
     """One batch of simulations stepped together: recorded ``cycles`` (n,), their ``plant`` (wear
-    and conditions), the start angles ``q0`` (6,), the drive ``inputs`` at every physics step
-    (n_steps + 1, 6, 3), the load disturbance ``dist`` per log period (n, n_log, 6), physics steps
+    and conditions), the start angles ``q0`` (N,), the drive ``inputs`` at every physics step
+    (n_steps + 1, N, 3), the load disturbance ``dist`` per log period (n, n_log, N), physics steps
     per log period, MuJoCo threads, and for a fault the fields it moves and its final value."""
 
     cycles: np.ndarray
@@ -706,7 +711,7 @@ def _prepare_variant(robot_name: str, task_name: str, friction_model: str, paylo
         def model_at(value: float) -> SimModel:
             def edit(mjspec):
                 carry(mjspec)
-                effect = grown.at(value)
+                effect = grown.at(value, controller.n_axes)
                 effect.write(mjspec, controller, [grown.axis - 1])
                 effect.add_to_simulation(mjspec, controller)
             return build(controller, friction_model, edit=edit)
@@ -766,7 +771,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
-    inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
+    inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, N, 3)
     for array in (q_ref, inputs):
         array.setflags(write=False)
     return Prepared(sim, task, path, q_ref, inputs)
@@ -792,7 +797,7 @@ def hold_end(a: np.ndarray, n_steps: int) -> np.ndarray:
 
 @dataclass
 class _Raw:
-    """True signals at the log times, each ``(n_cycles, n_log, 6)``."""
+    """True signals at the log times, each ``(n_cycles, n_log, N)``."""
 
     q_a: np.ndarray
     q_m: np.ndarray
@@ -829,7 +834,7 @@ def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
     control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
     records = {name: np.empty((n_sim, chunk, size)) for name, size in
                (("qpos", model.nq), ("qvel", model.nv), ("actuator_force", model.actuator_trnid.shape[0]))}
-    logs = {f.name: np.empty((n_sim, n_steps // per_log, 6)) for f in fields(_Raw)}
+    logs = {f.name: np.empty((n_sim, n_steps // per_log, robot.n_axes)) for f in fields(_Raw)}
     arm_dist = model.nu + robot.arm_dof
     last_qvel = batch.qvel.copy()
     for start in range(0, n_steps, chunk):
@@ -871,7 +876,7 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
     force, constraint = batch.bind("actuator_force"), batch.bind("qfrc_constraint")
     n_steps = len(inputs) - 1
     n_log = n_steps // per_log
-    logs = {f.name: np.empty((len(cycles), n_log, 6)) for f in fields(_Raw)}
+    logs = {f.name: np.empty((len(cycles), n_log, robot.n_axes)) for f in fields(_Raw)}
     rotor, arm = robot.rotor_dof, robot.arm_dof
     G = robot.gear_ratio
     dt = model.opt.timestep
@@ -927,7 +932,7 @@ def _check(sim: SimModel, batch, cycles: np.ndarray, velocities: np.ndarray, ste
         i = int(bad[0])
         v = velocities[i].reshape(-1, velocities.shape[-1])
         finite = np.where(np.isfinite(v), np.abs(v), np.inf)
-        axis = int(np.argmax(finite.max(axis=0)) % 6) + 1
+        axis = int(np.argmax(finite.max(axis=0)) % sim.robot.n_axes) + 1
         raise SimulationDiverged(
             f"cycle {int(cycles[i])} diverged near t = {step * sim.model.opt.timestep:.3f} s on axis {axis}"
             f" ({sim.robot.name}, {sim.friction_model} friction): the state became non-finite or MuJoCo "
@@ -938,16 +943,16 @@ def _check(sim: SimModel, batch, cycles: np.ndarray, velocities: np.ndarray, ste
 def _measure(sim, config, cycles, multiplier, q_ref, dist, raw: _Raw, stepping_time: float,
              conditions: CycleConditions | None = None) -> RunResult:
     """Apply the sensors to the true signals and compute the per-cycle truth."""
-    n_log = raw.q_a.shape[1]
+    n_log, n_axes = raw.q_a.shape[1], raw.q_a.shape[2]
     t = np.arange(1, n_log + 1) * sensors.LOG_PERIOD
     q_a, q_m, qd_a, qd_m = [], [], [], []
     for i, cycle in enumerate(cycles):
         angles = sensors.encoder(config.seed, int(cycle), np.hstack([raw.q_a[i], raw.q_m[i]]), config.noise.encoder)
         speeds = sensors.speed(angles, np.hstack([raw.qd_a[i, 0], raw.qd_m[i, 0]]))
-        q_a.append(angles[:, :6])
-        q_m.append(angles[:, 6:])
-        qd_a.append(speeds[:, :6])
-        qd_m.append(speeds[:, 6:])
+        q_a.append(angles[:, :n_axes])
+        q_m.append(angles[:, n_axes:])
+        qd_a.append(speeds[:, :n_axes])
+        qd_m.append(speeds[:, n_axes:])
     return RunResult(
         config=config,
         t=t,
