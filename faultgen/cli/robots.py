@@ -18,7 +18,8 @@ from faultgen.model import robots
 def robots_command(
     name: Annotated[
         str | None,
-        typer.Argument(help="Show the nominal parameters of this robot (or MJCF file) instead of the list."),
+        typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) instead of "
+                       "the list."),
     ] = None,
 ) -> None:
     """List the robot models, or show one model's nominal parameters.

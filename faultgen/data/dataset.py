@@ -559,7 +559,7 @@ def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
         n_axes = group.attrs["n_axes"]
         if not (np.ndim(n_axes) == 0 and np.issubdtype(np.asarray(n_axes).dtype, np.integer)
                 and axis_numbers.MIN_AXES <= int(n_axes) <= axis_numbers.MAX_AXES):
-            return 0, [f"n_axes attribute {n_axes!r}, expected a whole number "
+            return 0, [f"n_axes attribute {n_axes}, expected a whole number "
                        f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}"]
         n_axes = int(n_axes)
     else:

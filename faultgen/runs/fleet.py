@@ -45,7 +45,7 @@ from faultgen.simulation import stepping as sim
 
 #: Parts of two sizes of the shipped robot models: (mass range kg, edge range m) of the small and
 #: the big part. Ours, sized to each model's rated load (IRB-6700-like: 200 kg; PUMA 560: 2.5 kg).
-#: Any other model's parts come from its rated payload (:func:`parts`), no entry needed.
+#: Any other model's parts come from its rated payload (:func:`sized_parts`), no entry needed.
 PARTS = {
     "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
     "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
@@ -94,7 +94,7 @@ def rated_payload(robot) -> float:
     return float(PAYLOAD_SHARE * max(capacity.min(), 0.0))
 
 
-def parts(robot) -> tuple:
+def sized_parts(robot) -> tuple:
     """(mass range kg, edge range m) of the small and the big part of a robot model: its
     :data:`PARTS` entry, else :data:`PART_SHARES` of its :func:`rated_payload` as cubes of
     :data:`PART_DENSITY`, rounded to 3 significant digits.
@@ -142,7 +142,7 @@ class Fleet:
         wears for at least its last 25 days.
     models : tuple of str
         Robot models (names, robot folders or MJCF paths, mixed; any number of axes), taken in turn
-        (robot i is ``models[i % len(models)]``); their parts from :func:`parts`. Default both
+        (robot i is ``models[i % len(models)]``); their parts from :func:`sized_parts`. Default both
         shipped arms, the IRB-6700-like arm first.
     seed : int
     friction : str
@@ -180,7 +180,7 @@ class Fleet:
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
         the days, no robot model or one named twice, a model that is unknown or whose parts cannot
-        be sized (:func:`parts`), a gear loss without the conditions or under the ``lugre`` friction model, a
+        be sized (:func:`sized_parts`), a gear loss without the conditions or under the ``lugre`` friction model, a
         dry share other than the default without the conditions, a ``without`` naming an unknown
         condition, given with the conditions off or dropping what the gear loss or dry share needs,
         or a bad ``fault`` spec (one that sets its own ``kind`` or ``onset`` included: the fleet
@@ -230,7 +230,7 @@ class Fleet:
                              f"e.g. ('irb6700',) or {tuple(PARTS)!r}")
         for model in self.models:
             try:
-                parts(robot_models.load(model))  # UnknownRobotError names the known ones
+                sized_parts(robot_models.load(model))  # UnknownRobotError names the known ones
             except robot_models.UnknownRobotError:
                 raise
             except ValueError as err:
@@ -274,7 +274,7 @@ class Fleet:
             robot_model = robot_models.load(model)
             axis = int(rng.integers(1, robot_model.n_axes + 1))
             onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
-            (small_mass, small_size), (big_mass, big_size) = parts(robot_model)
+            (small_mass, small_size), (big_mass, big_size) = sized_parts(robot_model)
             parts = {"masses": [round(float(rng.uniform(*small_mass)), 2), round(float(rng.uniform(*big_mass)), 2)],
                      "sizes": [round(float(rng.uniform(*small_size)), 3), round(float(rng.uniform(*big_size)), 3)],
                      "pattern": "random"}
