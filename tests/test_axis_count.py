@@ -119,6 +119,7 @@ def test_seven_axis_simulate_validate_and_isolate(arms, tmp_path):
     confusion = (tmp_path / "iso-confusion.csv").read_text().splitlines()
     assert confusion[0] == "isolator,true axis,undecided,1,2,3,4,5,6,7,too few cycles"
     assert "| axis 7 |" in (tmp_path / "iso.md").read_text()
+    assert runner.invoke(app, ["plot", str(swept), "-o", str(tmp_path / "sweep.png")]).exit_code == 0
 
 
 def test_the_validator_uses_the_runs_own_axes(arms, tmp_path):

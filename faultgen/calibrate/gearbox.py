@@ -117,6 +117,8 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     """
     t = np.asarray(t, dtype=float)
     width = np.asarray(Backlash.of(robot).width if backlash is None else backlash, dtype=float)
+    if width.ndim == 0:  # one width for every axis (an effect made without the robot's axis count)
+        width = np.full(load.shape[1], float(width))
     if width.shape[-1:] != (load.shape[1],) or width.ndim > 2 or np.any(width < 0):
         raise ValueError(f"backlash must be widths >= 0 rad of shape ({load.shape[1]},) or (m, {load.shape[1]}); "
                          f"got {width!r}")
