@@ -120,6 +120,10 @@ def test_seven_axis_simulate_validate_and_isolate(arms, tmp_path):
     assert confusion[0] == "isolator,true axis,undecided,1,2,3,4,5,6,7,too few cycles"
     assert "| axis 7 |" in (tmp_path / "iso.md").read_text()
     assert runner.invoke(app, ["plot", str(swept), "-o", str(tmp_path / "sweep.png")]).exit_code == 0
+    result = runner.invoke(app, ["detect", str(swept), "--protocol", "same-run", "--no-progress", "-o",
+                                 str(tmp_path / "det")])
+    assert result.exit_code == 0, result.output
+    assert "| 1 2 3 4 5 6 7 |" in (tmp_path / "det.md").read_text()  # the monitor's features: all 7 axes
 
 
 def test_the_validator_uses_the_runs_own_axes(arms, tmp_path):
