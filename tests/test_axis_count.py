@@ -178,3 +178,12 @@ def test_fleet_parts_come_from_the_rated_payload(arms):
     for row, (_, config) in zip(drawn, mixed.runs(), strict=True):
         assert 0 <= row["axis"] <= robots.load(row["model"]).n_axes
         assert config.conditions.payloads.masses[1] <= fleet.sized_parts(robots.load(row["model"]))[1][0][1]
+
+
+def test_a_sweep_refuses_two_models_of_one_name(arms, tmp_path):
+    from faultgen.runs import sweep
+
+    other = axis_robots.make(tmp_path, 7)  # another folder, the same name puma7
+    with pytest.raises(ValueError, match=r"both named 'puma7'; run ids need different names"):
+        sweep.Grid(robots=[str(arms[7]), str(other)], tasks=["pick_place"], axes=[0], cycles=2)
+    assert len(sweep.Grid(robots=[str(arms[7]), str(arms[5])], tasks=["pick_place"], axes=[0, 5], cycles=2).runs()) == 4

@@ -210,6 +210,12 @@ class Grid:
             raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
         conditions = Conditions.from_dict(self.conditions or {})
         out: dict[str, sim.RunConfig] = {}
+        named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
+        for robot in self.robots:
+            first = named.setdefault(robots.load(robot).name, str(robot))
+            if first != str(robot) and robots.load(first).path != robots.load(robot).path:
+                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
+                                 "run ids need different names (rename one folder or MJCF file)")
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
             name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
             if axis > n_axes:
