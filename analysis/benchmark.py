@@ -704,6 +704,12 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
             y[-1] = np.full(THESIS_WINDOW + 1, int(len(attrs["worn_axes"]) > 0))
         groups.append(np.full(len(y[-1]), run_id, dtype=object))
         (failed if len(attrs["worn_axes"]) else normal).append(run_id)
+    widths = {x.shape[1] // 5: g[0] for x, g in zip(X, groups, strict=True)}  # 5 features per axis
+    if len(widths) > 1:
+        runs = ", ".join(f"{run}: {n} axes" for n, run in sorted(widths.items()))
+        raise ValueError(f"{path}: runs of robots with different numbers of axes ({runs}) cannot share one "
+                         "classifier, whose features are per axis; classify each robot model's runs apart (e.g. a "
+                         "fleet of one --robot)")
     if not failed or not normal:
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")

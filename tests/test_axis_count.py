@@ -187,3 +187,17 @@ def test_a_sweep_refuses_two_models_of_one_name(arms, tmp_path):
     with pytest.raises(ValueError, match=r"both named 'puma7'; run ids need different names"):
         sweep.Grid(robots=[str(arms[7]), str(other)], tasks=["pick_place"], axes=[0], cycles=2)
     assert len(sweep.Grid(robots=[str(arms[7]), str(arms[5])], tasks=["pick_place"], axes=[0, 5], cycles=2).runs()) == 4
+
+
+def test_classification_refuses_to_pool_robots_of_different_axis_counts(arms, tmp_path):
+    from analysis.benchmark import classification_table
+
+    parts = []
+    for n in (5, 7):
+        result = sim.simulate(sim.RunConfig(robot=str(arms[n]), task="pick_place", cycles=1, signals=False),
+                              progress=False)
+        parts.append((f"puma{n}", dataset.write_run(tmp_path / f"{n}.h5", result)))
+    mixed = dataset.merge(parts, tmp_path / "mixed.h5")
+    assert dataset.validate(mixed) == []
+    with pytest.raises(ValueError, match=r"puma5: 5 axes, puma7: 7 axes\) cannot share one classifier"):
+        classification_table(mixed, progress=False)
