@@ -183,7 +183,10 @@ class Effect:
         For an unknown parameter name or a value of the wrong shape or non-finite.
 
     Each parameter is a read-only attribute of that name (``effect.offset``, ndarray of shape (N,),
-    or a 0-d array when robot-wide); :meth:`values` and :meth:`table` give plain numbers.
+    or a 0-d array when robot-wide or made with one value for all axes and no ``n_axes``; such an
+    effect gives that value for every axis in :meth:`values` and :meth:`write`, and is sized by the
+    robot where it meets one: :meth:`current`, :meth:`fitted`); :meth:`values` and :meth:`table`
+    give plain numbers.
 
     Attributes
     ----------
