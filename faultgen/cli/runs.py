@@ -22,7 +22,8 @@ from faultgen.cli.options import (
 def simulate_command(
     robot: Annotated[str, typer.Option(
         "--robot", "--model",
-        help="Robot name (see `faultgen robots`) or MJCF file, e.g. the model `faultgen calibrate` wrote.")] = "irb6700",
+        help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
+        "model `faultgen calibrate` wrote.")] = "irb6700",
     task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3).")] = "pick_place",
     friction_model: Friction = "lugre",
     wear: Annotated[
@@ -108,9 +109,9 @@ def sweep_command(
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
     ] = None,
-    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
+    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")] = None,
     tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s); repeat for several.")] = None,
-    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
+    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.")] = None,
     increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
     schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
     friction_model: Friction = None,
@@ -202,8 +203,9 @@ def fleet_command(
     size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).")] = 26,
     failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).")] = 13,
     models: Annotated[list[str] | None, typer.Option(
-        "--robot", help="Robot model(s) of the fleet, taken in turn; repeat for several (default: irb6700 and "
-        "puma560). One model makes every robot that model, e.g. for a fault whose FINAL suits only it.")] = None,
+        "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
+        "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
+        "fault whose FINAL suits only it. Parts are sized from each model's rated payload (docs/simulation.md).")] = None,
     days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.")] = 60,
     cycles_per_day: Annotated[int, typer.Option(
         help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).")] = 2,

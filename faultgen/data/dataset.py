@@ -8,16 +8,18 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      complete (written last: True only for a finished file)
     /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
                                      wear JSON, noise JSON) and provenance (faultgen_version,
-                                     model_sha256, log_period, config JSON, command)
+                                     model_sha256, log_period, config JSON, command; since robots
+                                     of 5-7 axes: n_axes, drivetrain JSON)
         t, cycles, q_ref                       time base, recorded cycles, reference
-        q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, 6) logged signals, 250 Hz
-        tau_f, tau_dist                        (n_cycles, n_log, 6) truth
-        friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
-        mean_abs_torque, rms_torque                                       (n_cycles, 6) features
-        average_speed, average_load_torque     (n_cycles, 6) each axis's duty (DUTY_ARRAYS; runs
+        q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, N) logged signals, 250 Hz, N the
+                                               robot's axes (attr n_axes; 6 in files before it)
+        tau_f, tau_dist                        (n_cycles, n_log, N) truth
+        friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, N) truth
+        mean_abs_torque, rms_torque                                       (n_cycles, N) features
+        average_speed, average_load_torque     (n_cycles, N) each axis's duty (DUTY_ARRAYS; runs
                                                simulated since it exists)
-        angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
-        torque_counts          (n_cycles, 6, 1200) samples per fine |tau_m| bin, what detection
+        angle_hist, speed_hist, torque_hist                               (n_cycles, N, 12) features
+        torque_counts          (n_cycles, N, 1200) samples per fine |tau_m| bin, what detection
                                bins from (COUNT_ARRAYS; runs recorded per cycle since it exists)
         day, hour, joint_temperature, ...      operating conditions per cycle, truth (only runs
                                                with conditions: CONDITION_ARRAYS; attr conditions)
@@ -45,7 +47,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 from faultgen import __version__
+from faultgen import axes as axis_numbers
 from faultgen.data.atomic import atomic_path
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
 from faultgen.simulation import sensors
 
@@ -123,6 +128,16 @@ RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axe
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
 
 
+#: Attributes of a run written since robots of 5 to 7 axes exist (files before them lack them and
+#: stay valid: their robots had six axes): ``n_axes`` (int) and ``drivetrain`` (JSON,
+#: :func:`drivetrain`).
+ROBOT_ATTRIBUTES = ("n_axes", "drivetrain")
+
+#: The drivetrain numbers a run records (:func:`drivetrain`): Robot attribute -> SI unit.
+DRIVETRAIN = {"gear_ratio": "1", "motor_inertia": "kg m^2", "gearbox_stiffness": "N m/rad",
+              "gearbox_damping": "N m s/rad", "motor_torque_limit": "N m"}
+
+
 class DatasetError(ValueError):
     """A file is not a finished, valid faultgen dataset; the message says what is wrong."""
 
@@ -133,6 +148,17 @@ class DatasetError(ValueError):
 def model_hash(path: Path) -> str:
     """SHA-256 of a robot's MJCF file, hex."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def drivetrain(robot) -> dict:
+    """The drivetrain a run was simulated with, per axis 1..N, as plain lists: :data:`DRIVETRAIN`
+    (gear ratio, motor inertia at the motor side, gearbox stiffness and damping at the arm side,
+    motor torque limit) and ``friction``, the nominal motor-side friction parameters
+    (:data:`faultgen.effects.friction.FIELDS`, motor side), with ``units`` naming each unit."""
+    table = {name: [float(x) for x in getattr(robot, name)] for name in DRIVETRAIN}
+    table["friction"] = {name: [float(x) for x in getattr(robot.friction, name)] for name in FRICTION_FIELDS}
+    table["units"] = {**DRIVETRAIN, **{f"friction.{name}": FRICTION_UNITS[name] for name in FRICTION_FIELDS}}
+    return table
 
 
 def config_key(config) -> str:
@@ -171,6 +197,8 @@ def run_attributes(result, command: str = "") -> dict:
         "noise": json.dumps(asdict(config.noise)),
         "faultgen_version": __version__,
         "model_sha256": model_hash(robot.path),
+        "n_axes": int(robot.n_axes),
+        "drivetrain": json.dumps(drivetrain(robot)),
         "log_period": sensors.LOG_PERIOD,
         "config": config_key(config),
         "command": command,
@@ -344,7 +372,7 @@ def features(path: str | Path) -> pd.DataFrame:
 
     One row per (run, recorded cycle, axis); columns: ``run``, the run's labels
     (:data:`FEATURE_LABELS`), ``worn_axes`` (the run's worn axes as text, "2" or "2 5"; "" for
-    none), ``cycle`` (1-based), ``axis`` (1..6), ``worn`` (this axis wears in this run),
+    none), ``cycle`` (1-based), ``axis`` (1..N), ``worn`` (this axis wears in this run),
     ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
     then every array of :data:`ARRAYS` with axes "cycle, axis" and of :data:`DUTY_ARRAYS` (empty for
     runs without) under its own name and every
@@ -485,11 +513,14 @@ def _validate_run(group: h5py.Group) -> list[str]:
         if not np.all(np.isfinite(data[name])):
             problems.append(f"{name}: holds non-finite values")
     n_cycles, n_log = len(data["cycles"]), len(data["t"])
+    n_axes, robot_problems = _robot_attributes(group, data)
+    if robot_problems:
+        return [*problems, *robot_problems]
     for name, (_, axes, _) in schema.items():
-        expected = {SIGNAL_AXES: (n_cycles, n_log, 6), "cycle, axis": (n_cycles, 6),
-                    "cycle, axis, bin": (n_cycles, 6, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, 6),
-                    COUNT_AXES: (n_cycles, 6, sensors.TORQUE_COUNT_BINS),
-                    "sample": (n_log,), "cycle": (n_cycles,), "axis": (6,)}[axes]
+        expected = {SIGNAL_AXES: (n_cycles, n_log, n_axes), "cycle, axis": (n_cycles, n_axes),
+                    "cycle, axis, bin": (n_cycles, n_axes, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, n_axes),
+                    COUNT_AXES: (n_cycles, n_axes, sensors.TORQUE_COUNT_BINS),
+                    "sample": (n_log,), "cycle": (n_cycles,), "axis": (n_axes,)}[axes]
         if data[name].shape != expected:
             problems.append(f"{name}: shape {data[name].shape}, expected {expected}")
     if problems:
@@ -516,8 +547,48 @@ def _validate_run(group: h5py.Group) -> list[str]:
     return problems
 
 
+def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
+    """The run's number of axes N and what is wrong with its :data:`ROBOT_ATTRIBUTES` and worn axes.
+
+    N is the ``n_axes`` attribute (5..7); a run written before it existed has the axes of its
+    ``friction_multiplier`` (six, the only robots then). ``drivetrain``, when present, must be JSON
+    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers.
+    """
+    problems = []
+    if "n_axes" in group.attrs:
+        n_axes = group.attrs["n_axes"]
+        if not (np.ndim(n_axes) == 0 and np.issubdtype(np.asarray(n_axes).dtype, np.integer)
+                and axis_numbers.MIN_AXES <= int(n_axes) <= axis_numbers.MAX_AXES):
+            return 0, [f"n_axes attribute {n_axes}, expected a whole number "
+                       f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}"]
+        n_axes = int(n_axes)
+    else:
+        shape = np.shape(data["friction_multiplier"])
+        n_axes = shape[1] if len(shape) == 2 else 0
+    worn = [int(a) for a in np.atleast_1d(group.attrs.get("worn_axes", []))]
+    bad = [a for a in worn if not 1 <= a <= n_axes]
+    if bad:
+        problems.append(f"worn_axes: axis {bad[0]} is out of range 1..{n_axes}")
+    if "drivetrain" in group.attrs:
+        try:
+            table = json.loads(_attr(group.attrs["drivetrain"]))
+            entries = {**{name: table[name] for name in DRIVETRAIN},
+                       **{f"friction.{name}": table["friction"][name] for name in FRICTION_FIELDS}}
+        except (ValueError, KeyError, TypeError) as err:
+            return n_axes, [*problems, f"drivetrain attribute is not the drivetrain JSON (missing or bad {err})"]
+        for name, values in entries.items():
+            ok = isinstance(values, list) and len(values) == n_axes and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in values)
+            if not ok:
+                problems.append(f"drivetrain {name}: expected {n_axes} finite numbers, got {values!r}")
+                break
+    elif "n_axes" in group.attrs:
+        problems.append("has the n_axes attribute but not drivetrain")
+    return n_axes, problems
+
+
 def _counts_fit(totals: np.ndarray, n_log: int, data: dict, conditions: dict | None, task: str) -> bool:
-    """Whether per-cycle sample counts ``totals`` (n_cycles, 6) count each cycle's samples: ``n_log``
+    """Whether per-cycle sample counts ``totals`` (n_cycles, N) count each cycle's samples: ``n_log``
     (the run's task's) for every cycle, or with a task mix for the cycles of the run's own task,
     and one number for all axes and cycles of each other task (its path, not stored, sets it)."""
     mix = (conditions or {}).get("task_mix")

@@ -34,13 +34,12 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen.axes import MAX_AXES, MIN_AXES
 from faultgen.model.drivetrain import Drivetrain
 from faultgen.model.drivetrain import read as read_drivetrain
 
 #: faultgen's physics step, s, and integrator (docs/simulation.md).
 TIMESTEP = 0.0005
-#: Fewest and most revolute axes a robot may have.
-MIN_AXES, MAX_AXES = 5, 7
 #: Mass (kg) and principal inertia (kg m^2) of a rotor body: its inertia about its axis is the
 #: joint's armature; the body only carries the joint.
 ROTOR_MASS, ROTOR_INERTIA = 1e-9, 1e-12

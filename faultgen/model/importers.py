@@ -38,7 +38,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model.builder import MAX_AXES, MIN_AXES, ArmError, ArmJoint, check_arm
+from faultgen.axes import MAX_AXES, MIN_AXES
+from faultgen.model.builder import ArmError, ArmJoint, check_arm
 
 #: Mesh file types MuJoCo loads.
 MESH_TYPES = (".stl", ".obj", ".msh")

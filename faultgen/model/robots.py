@@ -32,12 +32,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.axes import N_AXES  # noqa: F401  re-exported for operation/ (ik, tasks) until they count axes
+from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import MotorFriction
 from faultgen.model import drivetrain
-from faultgen.model.builder import MAX_AXES, MIN_AXES
 
 
 class UnknownRobotError(ValueError):
@@ -174,6 +173,11 @@ class Robot:
     def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
         return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
 
+    @property
+    def n_axes(self) -> int:
+        """Number of axes N (5..7), read from the model (its joints ``joint1`` .. ``jointN``)."""
+        return len(self.joint_names)
+
     @cached_property
     def arm_qpos(self) -> np.ndarray:
         """Indices of the arm joints in ``qpos``, ``ndarray of shape (N,)``."""
@@ -264,7 +268,7 @@ class Robot:
         ValueError
             If an input is not of shape (n, N) with a common n, or holds a non-finite value.
         """
-        q = _check_trajectory("q", q, n_axes=self.n_axes)
+        q = _check_trajectory("q", q, None, self.n_axes)
         qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
         qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         G = self.gear_ratio
@@ -296,7 +300,7 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q, n_axes=self.n_axes)
+        q = _check_trajectory("q", q, None, self.n_axes)
         qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
         qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         return self._rigid(q, qd, qdd)[1]
@@ -317,7 +321,7 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q, n_axes=self.n_axes)
+        q = _check_trajectory("q", q, None, self.n_axes)
         zero = np.zeros_like(q)
         return self._rigid(q, zero, zero)[1]
 
@@ -386,7 +390,7 @@ class Robot:
         q : ndarray of shape (n, N)
             Arm joint angles in rad.
         """
-        q = _check_trajectory("q", q, n_axes=self.n_axes)
+        q = _check_trajectory("q", q, None, self.n_axes)
         model, data = self._inverse
         qpos = np.tile(data.qpos, (q.shape[0], 1))
         qpos[:, self.arm_qpos], qpos[:, self.rotor_qpos] = q, self.gear_ratio * q
@@ -439,7 +443,7 @@ def _check_vector(name: str, value: np.ndarray, n_axes: int) -> np.ndarray:
     return arr
 
 
-def _check_trajectory(name: str, value: np.ndarray, n: int | None = None, n_axes: int = 0) -> np.ndarray:
+def _check_trajectory(name: str, value: np.ndarray, n: int | None, n_axes: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
     if arr.ndim != 2 or arr.shape[1] != n_axes or (n is not None and arr.shape[0] != n):
         expected = f"(n, {n_axes})" if n is None else f"({n}, {n_axes})"
@@ -585,37 +589,33 @@ def drivetrain_of(robot: Robot) -> drivetrain.Drivetrain:
     """The robot's drivetrain as data (:class:`faultgen.model.drivetrain.Drivetrain`), read back
     from its compiled model: what ``drivetrain.toml`` of its folder holds."""
     rows = robot.friction.as_rows()
-    axes = []
+    drives = []
     for k in range(robot.n_axes):
         values = dict(gear_ratio=float(robot.gear_ratio[k]), motor_inertia=float(robot.motor_inertia[k]),
                       gearbox_stiffness=float(robot.gearbox_stiffness[k]),
                       gearbox_damping=float(robot.gearbox_damping[k]),
                       motor_torque_limit=float(robot.motor_torque_limit[k]))
         values.update({name: float(rows[k, j]) for j, name in enumerate(FRICTION_FIELDS)})
-        axes.append(drivetrain.AxisDrive(**values))
-    return drivetrain.Drivetrain(tuple(axes))
+        drives.append(drivetrain.AxisDrive(**values))
+    return drivetrain.Drivetrain(tuple(drives))
 
 
 def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
-    n_axes = 0
-    while mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"joint{n_axes + 1}") >= 0:
-        n_axes += 1
-    if not MIN_AXES <= n_axes <= MAX_AXES:
-        raise ModelError(f"{path}: arm joints joint1..joint{n_axes} found ({n_axes} axes); a robot needs "
-                         f"{MIN_AXES} to {MAX_AXES} axes named joint1, joint2, ...")
-
     def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
         idx = mujoco.mj_name2id(model, obj_type, element)
         if idx < 0:
-            raise ModelError(f"{path}: no {kind} named {element!r}; a robot of {n_axes} axes needs {kind}s "
-                             f"1..{n_axes}")
+            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{n_axes}")
         return idx
 
-    axes = range(1, n_axes + 1)
-    joint_names = tuple(f"joint{i}" for i in axes)
-    rotor_names = tuple(f"rotor{i}" for i in axes)
-    gearbox_names = tuple(f"gearbox{i}" for i in axes)
-    actuator_names = tuple(f"motor{i}" for i in axes)
+    n_axes = axes.count(model)
+    if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
+        raise ModelError(f"{path}: {n_axes} arm joints joint1..joint{n_axes}; a robot has "
+                         f"{axes.MIN_AXES}..{axes.MAX_AXES} (joint1, joint2, ... in order)")
+    numbers = range(1, n_axes + 1)
+    joint_names = tuple(f"joint{i}" for i in numbers)
+    rotor_names = tuple(f"rotor{i}" for i in numbers)
+    gearbox_names = tuple(f"gearbox{i}" for i in numbers)
+    actuator_names = tuple(f"motor{i}" for i in numbers)
 
     gear_ratio = np.empty(n_axes)
     joint_range = np.empty((n_axes, 2))

@@ -38,6 +38,7 @@ import filelock
 import numpy as np
 from tqdm.auto import tqdm
 
+from faultgen import axes as axis_numbers
 from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
@@ -91,7 +92,7 @@ class Grid:
     ----------
     robots, tasks : list of str
     axes : list of int
-        Worn axes, 1..6; 0 means a run without wear (one per robot, task and seed).
+        Worn axes, 1..N of every robot of the grid; 0 means a run without wear (one per robot, task and seed).
     increases : list of float
         Final wear in percent (20 = Coulomb and static friction 20 % higher at the last cycle).
     schedules : list of str
@@ -146,8 +147,8 @@ class Grid:
             if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or not value:
                 raise ValueError(f"grid field {name!r} must be a non-empty list, got {value!r}")
         for axis in self.axes:
-            if not isinstance(axis, int) or not 0 <= axis <= 6:
-                raise ValueError(f"worn axis {axis!r} is out of range 0..6 (0 = no wear)")
+            if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
+                raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
         friction.check_model(self.friction)
         for kind in self.schedules:
             if kind not in wear.SCHEDULES:
@@ -209,8 +210,16 @@ class Grid:
             raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
         conditions = Conditions.from_dict(self.conditions or {})
         out: dict[str, sim.RunConfig] = {}
+        named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
+        for robot in self.robots:
+            first = named.setdefault(robots.load(robot).name, str(robot))
+            if first != str(robot) and robots.load(first).path != robots.load(robot).path:
+                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
+                                 "run ids need different names (rename one folder or MJCF file)")
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
-            name = robots.load(robot).name
+            name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
+            if axis > n_axes:
+                raise ValueError(f"worn axis {axis} is out of range 0..{n_axes} of robot {name} (0 = no wear)")
             # a run without wear is one run, whatever the wear levels and schedules of the grid
             variants = [(None, 0.0)] if axis == 0 or self.fault else itertools.product(self.schedules, self.increases)
             for kind, pct in variants:
