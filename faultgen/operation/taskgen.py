@@ -25,13 +25,11 @@ motor torque x G), the speed and acceleration scales lowered step by step until 
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from faultgen import axes as axis_numbers
 from faultgen.model import folder, sizing
 from faultgen.model.robots import Robot
 from faultgen.operation import tasks as task_module
@@ -174,7 +172,7 @@ def _text(robot: Robot, velocity, acceleration, start_pp, pick, place, q_weld, p
         *[f"    {_vec(p)}," for p in panel["seam"]],
         "]",
         f"corner_radius = {round(0.3 * s, 4):g}",
-        f"tool_speed = {round(panel['tool_speed'], 4):g}",
+        f"tool_speed = {round(panel['tool_speed'] * scale['arc_weld'], 4):g}",
         "ramp_time = 0.3",
         f"weave_amplitude = {round(min(0.003, 0.03 * s), 5):g}",
         "weave_frequency = 2.0",
@@ -193,11 +191,6 @@ def _checked(robot: Robot, name: str) -> float:
     path = task.trajectory(DT)
     tau = robot.inverse_dynamics(path.q, path.qd, path.qdd)
     return float(np.max(np.abs(tau) / (robot.motor_torque_limit * robot.gear_ratio)))
-
-
-def _can_check(robot: Robot) -> bool:
-    fixed = getattr(axis_numbers, "N_AXES", None)  # the planners counted six axes until issue 37
-    return fixed is None or fixed == robot.n_axes
 
 
 def generate(robot: Robot, arm=None, payload: float | None = None) -> str:
@@ -237,35 +230,25 @@ def generate(robot: Robot, arm=None, payload: float | None = None) -> str:
     mujoco.mj_kinematics(robot.model, data)
     base = data.xanchor[robot.model.joint("joint1").id].copy()
     target = Path(robot.path).parent / "tasks.toml"
-    check = _can_check(robot)
-    if not check:
-        warnings.warn(
-            f"{robot.name}: {n} axes; this version's task planner reads 6, so the generated tasks are "
-            "written unchecked",
-            UserWarning,
-            stacklevel=2,
-        )
     failures = []
     for q_weld in _weld_postures(robot, reach, base)[:12]:
         panel = _panel(robot, q_weld, reach, base)
         scale = dict.fromkeys(task_module.TASKS, 1.0)
-        text = _text(robot, velocity, acceleration, middle, pick, place, q_weld, panel, scale)
-        if not check:
-            return text
         try:
             for name in task_module.TASKS:
+                why = f"drive torque above {TORQUE_SHARE:.0%} of capacity"
                 for value in SCALES:
                     scale[name] = value
                     target.write_text(
                         _text(robot, velocity, acceleration, middle, pick, place, q_weld, panel, scale)
                     )
-                    if _checked(robot, name) <= TORQUE_SHARE:
-                        break
+                    try:  # a limit the path exceeds at this speed: slower, as for the torque
+                        if _checked(robot, name) <= TORQUE_SHARE:
+                            break
+                    except ValueError as err:
+                        why = str(err)
                 else:
-                    raise ValueError(
-                        f"{name}: drive torque above {TORQUE_SHARE:.0%} of capacity even at scale "
-                        f"{SCALES[-1]}"
-                    )
+                    raise ValueError(f"{name} even at speed scale {SCALES[-1]}: {why}")
         except ValueError as err:
             failures.append(str(err))
             continue
