@@ -35,8 +35,6 @@ from faultgen.model.robots import Robot
 from faultgen.operation import tasks as task_module
 from faultgen.operation.ik import FLANGE
 
-#: Planning step for the checks, s (the logging period).
-DT = 0.004
 #: Share of the motor torque capacity the tasks may use.
 TORQUE_SHARE = 0.9
 #: Time to full speed, s (main, wrist axes); jerk = JERK_RATE x acceleration per second.
@@ -188,7 +186,7 @@ def _checked(robot: Robot, name: str) -> float:
     """Plan task ``name`` from the robot folder's tasks.toml; return its peak drive torque as a
     share of the motor capacity (raises ValueError if it does not plan)."""
     task = task_module.load(robot, name)
-    path = task.trajectory(DT)
+    path = task.trajectory(robot.model.opt.timestep)  # as the simulation plans it, so both check alike
     tau = robot.inverse_dynamics(path.q, path.qd, path.qdd)
     return float(np.max(np.abs(tau) / (robot.motor_torque_limit * robot.gear_ratio)))
 
