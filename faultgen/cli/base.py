@@ -37,8 +37,9 @@ class Command(_PlainHelp, TyperCommand):
     An error the library raises for a user's input or file reaches the user as one line,
     ``error: <message>``, and an exit code: the exception's ``exit_code`` where it has one (a
     broken dataset 1, a simulation that diverged 1, an interrupted sweep 130, whose message is
-    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done). Any other
-    exception is a defect and keeps its traceback.
+    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done), 1 for an
+    ``OSError`` (a full disk, a read-only folder: :func:`describe_os_error`). Any other exception is
+    a defect and keeps its traceback.
     """
 
     def invoke(self, ctx: click.Context):
@@ -46,6 +47,9 @@ class Command(_PlainHelp, TyperCommand):
             return super().invoke(ctx)
         except (click.exceptions.Exit, click.exceptions.Abort, click.ClickException):
             raise
+        except OSError as err:  # a full disk, a read-only folder, a file that vanished: no traceback
+            typer.echo(f"error: {describe_os_error(err)}", err=True)
+            raise typer.Exit(1) from err
         except Exception as err:
             code = getattr(err, "exit_code", None)
             if code is None and not isinstance(err, ValueError):
@@ -53,6 +57,21 @@ class Command(_PlainHelp, TyperCommand):
             prefix = getattr(err, "message_prefix", "error: ")
             typer.echo(f"{prefix}{err}", err=True)
             raise typer.Exit(2 if code is None else code) from err
+
+
+def describe_os_error(err: OSError) -> str:
+    """One line for an I/O failure: the file, what went wrong, and what to do about it."""
+    import errno
+
+    text = err.strerror or str(err)
+    if err.filename and str(err.filename) not in text:
+        text = f"{err.filename}: {text}"
+    advice = {errno.ENOSPC: "free some space or choose another output",
+              errno.EFBIG: "the file-size limit (ulimit -f) was reached; raise it or write less",
+              errno.EROFS: "the file system is read-only; choose another output",
+              errno.EACCES: "no permission; fix the folder's permissions or choose another output",
+              errno.EDQUOT: "the disk quota is exceeded; free some space or choose another output"}.get(err.errno)
+    return f"{text} ({advice})" if advice else text
 
 
 class Group(_PlainHelp, TyperGroup):

@@ -94,6 +94,9 @@ def simulate_command(
                              gear_loss=gear_loss, dry_share=dry_share) or {}),
         fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
     )
+    from faultgen.data import atomic
+
+    atomic.check_writable(out, dataset.estimated_size(config))  # a read-only or full disk: before simulating
     result = sim.simulate(config, progress=progress)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     dataset.write_run(out, result, command=command)
