@@ -45,7 +45,7 @@ class Command(_PlainHelp, TyperCommand):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
-        except (click.exceptions.Exit, click.exceptions.Abort, click.ClickException):
+        except (click.exceptions.Exit, typer.Exit, click.exceptions.Abort, click.ClickException):
             raise
         except OSError as err:  # a full disk, a read-only folder, a file that vanished: no traceback
             typer.echo(f"error: {describe_os_error(err)}", err=True)

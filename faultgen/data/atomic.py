@@ -6,6 +6,7 @@ import glob
 import logging
 import os
 import re
+import shutil
 import socket
 import tempfile
 from collections.abc import Iterator
@@ -45,6 +46,40 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         raise
 
 
+@contextmanager
+def atomic_folder(path: str | Path) -> Iterator[Path]:
+    """Yield a new hidden folder beside ``path`` to write into; when the block succeeds it
+    replaces ``path`` (an existing ``path`` is moved aside, the new folder renamed into place, the
+    old one removed). On any exception the new folder is removed and ``path`` is untouched; a
+    kill leaves only the hidden folder (``.<name>.<pid>@<host>.<random>.part``), which the next
+    write of ``path`` removes (:func:`remove_stale`).
+
+    Raises
+    ------
+    OSError
+        If the folder of ``path`` does not exist or cannot be written.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OSError(f"cannot write {path}: folder {folder} does not exist")
+    remove_stale(path)
+    staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder))
+    try:
+        os.chmod(staging, 0o777 & ~_umask())
+        yield staging
+        if path.exists():
+            old = staging.with_name(staging.name[:-len(".part")] + ".old.part")
+            os.replace(path, old)
+            os.replace(staging, path)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(staging, path)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+
+
 def remove_stale(path: str | Path) -> list[Path]:
     """Remove the temporary files of ``path`` (:func:`atomic_path`) whose writer was killed.
 
@@ -67,8 +102,12 @@ def remove_stale(path: str | Path) -> list[Path]:
         if match is None or match[2] != _host() or _running(int(match[1])):
             continue
         try:
-            size = candidate.stat().st_size
-            candidate.unlink()
+            if candidate.is_dir():  # a folder written whole (:func:`atomic_folder`)
+                size = sum(f.stat().st_size for f in candidate.rglob("*") if f.is_file())
+                shutil.rmtree(candidate)
+            else:
+                size = candidate.stat().st_size
+                candidate.unlink()
         except FileNotFoundError:  # removed by another writer meanwhile
             continue
         log.warning("removed %s (%.1f MB), an unfinished write of %s left by a killed process (pid %s)",

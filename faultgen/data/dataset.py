@@ -30,6 +30,7 @@ truncated or corrupted files instead of letting them be read.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 from collections.abc import Iterable
@@ -288,11 +289,20 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
 @contextmanager
 def _open(path: str | Path):
     """Open a finished faultgen file for reading, or raise DatasetError saying why not."""
+    writer = _writer_of(Path(path))
+    if writer is not None:
+        raise DatasetError(f"{path} is in use: process {writer} is writing it (the finished file appears under "
+                           "its own name when it is done)")
     try:
         f = h5py.File(path, "r")
     except FileNotFoundError:
         raise DatasetError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise DatasetError(f"{path} is a folder, not a dataset file") from None
     except OSError as err:
+        if err.errno == errno.EAGAIN or "unable to lock file" in str(err).lower():
+            raise DatasetError(f"{path} is in use: another process has it open for writing; wait for it to "
+                               "finish") from None
         raise DatasetError(f"{path}: cannot be opened as HDF5 (truncated or not HDF5): {err}") from None
     try:
         if f.attrs.get("format") != FORMAT:
@@ -301,9 +311,28 @@ def _open(path: str | Path):
             raise DatasetError(f"{path} is incomplete: its writer did not finish")
         if "runs" not in f:
             raise DatasetError(f"{path} has no /runs group")
+        if f.attrs.get("format_version") != FORMAT_VERSION:
+            raise DatasetError(f"{path} has format_version {_attr(f.attrs.get('format_version')).item() if hasattr(f.attrs.get('format_version'), 'item') else f.attrs.get('format_version')!r}; this faultgen "
+                               f"reads version {FORMAT_VERSION}")
+        if len(f["runs"]) == 0:
+            raise DatasetError(f"{path} has no runs (its /runs group is empty)")
         yield f
     finally:
         f.close()
+
+
+def _writer_of(path: Path) -> int | None:
+    """The pid of the running process writing ``path``, if it is the temporary file of an atomic
+    write (``.<name>.<pid>@<host>.<random>.part``, :func:`faultgen.data.atomic.atomic_path`) of a
+    process that still runs on this host; else None."""
+    import re
+
+    from faultgen.data import atomic
+
+    match = re.fullmatch(r"\.(.+)\.(\d+)@(.+)\.[^.]+\.part", path.name)
+    if match is None or match[3] != atomic._host() or not atomic._running(int(match[2])):
+        return None
+    return int(match[2])
 
 
 def list_runs(path: str | Path) -> list[str]:
@@ -345,7 +374,14 @@ def read_run(path: str | Path, run_id: str | None = None,
                 why = ("; it was recorded without signals (features only): simulate it again with signals "
                        "(`faultgen sweep` without --features-only) to use this command")
             raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}{why}")
+        problems = _attribute_problems(group)
+        if problems:
+            raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every problem)")
         arrays = {name: group[name][()] for name in wanted}
+        for name, value in arrays.items():
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise DatasetError(f"{path}: run {run_id!r}: {name} holds non-finite values; the file is corrupted "
+                                   f"(faultgen validate {path})")
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
 
@@ -438,6 +474,11 @@ def export_features(path: str | Path, out: str | Path) -> Path:
 def labels(path: str | Path) -> list[dict]:
     """The labels of every run, one dict per run (with its ``run`` id), in file order."""
     with _open(path) as f:
+        for run_id in f["runs"]:
+            problems = _attribute_problems(f["runs"][run_id])
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         return [{"run": run_id, **{k: _attr(v) for k, v in f["runs"][run_id].attrs.items()}} for run_id in f["runs"]]
 
 
@@ -470,12 +511,66 @@ def validate(path: str | Path) -> list[str]:
     return problems
 
 
+def _attribute_problems(group: h5py.Group) -> list[str]:
+    """What is wrong with the attributes of a run group: each present attribute must parse into
+    its type and range (a whole number of cycles >= 1, worn axes among 1..6, JSON tables, a
+    known friction model, a positive log period, ...); the missing ones are listed by
+    :func:`_validate_run`."""
+    from faultgen.effects import friction
+
+    problems = []
+    attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
+
+    def whole(value) -> bool:
+        return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+    checks = {
+        "robot": (lambda v: isinstance(v, str) and bool(v), "a robot name"),
+        "task": (lambda v: isinstance(v, str) and bool(v), "a task name"),
+        "friction_model": (lambda v: v in friction.MODELS, f"one of {', '.join(friction.MODELS)}"),
+        "cycles": (lambda v: whole(v) and v >= 1, "a whole number >= 1"),
+        "seed": (lambda v: whole(v) and v >= 0, "a whole number >= 0"),
+        "worn_axes": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu"
+                      and bool(np.all((v >= 1) & (v <= 6))), "a list of axes among 1..6"),
+        "log_period": (lambda v: isinstance(v, (float, np.floating)) and np.isfinite(v) and v > 0,
+                       "a positive number of seconds"),
+        "signals": (lambda v: isinstance(v, (bool, np.bool_)), "true or false"),
+        "sample": (lambda v: v in ("cycle", "day"), "'cycle' or 'day'"),
+        "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
+                      "a list of axes"),
+    }
+    for key, (ok, expected) in checks.items():
+        if key in attrs:
+            try:
+                good = bool(ok(attrs[key]))
+            except (TypeError, ValueError):
+                good = False
+            if not good:
+                problems.append(f"attribute {key!r} is {attrs[key]!r}, expected {expected}")
+    for key in ("wear", "noise", "config", "conditions", "fault"):
+        if key in attrs:
+            try:
+                table = json.loads(attrs[key])
+            except (TypeError, ValueError):
+                problems.append(f"attribute {key!r} is not JSON: {str(attrs[key])[:40]!r}")
+                continue
+            if not isinstance(table, dict):
+                problems.append(f"attribute {key!r} is {str(attrs[key])[:40]!r}, expected a JSON table")
+    return problems
+
+
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
+    problems += _attribute_problems(group)
+    if "saturated" in group.attrs and len(group.attrs["saturated"]):
+        problems.append(f"axes {', '.join(str(int(a)) for a in group.attrs['saturated'])}: the motor saturated "
+                        "(the drive torque reached its limit): the run does not follow its task")
     try:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
         return [*problems, "conditions attribute is not JSON"]
+    if problems:
+        return problems
     signals = bool(group.attrs.get("signals", True))
     schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
@@ -549,6 +644,13 @@ def summary(path: str | Path) -> str:
     """A few lines describing a dataset: runs, robots, tasks, wear, cycles, size, provenance."""
     with _open(path) as f:
         runs = f["runs"]
+        for run_id in runs:
+            problems = [f"missing attribute {a!r}" for a in ("robot", "task", "friction_model", "seed", "worn_axes")
+                        if a not in runs[run_id].attrs] + _attribute_problems(runs[run_id])
+            problems += [f"missing array {a!r}" for a in ("cycles", "t") if a not in runs[run_id]]
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         rows = [{k: _attr(v) for k, v in runs[r].attrs.items()} for r in runs]
         n_cycles = [runs[r]["cycles"].shape[0] for r in runs]
         n_log = [runs[r]["t"].shape[0] for r in runs]
