@@ -179,6 +179,8 @@ def run_attributes(result, command: str = "") -> dict:
         "signals": bool(config.signals),
         "sample": "day" if config.daily else "cycle",
         **({"fault": json.dumps(config.fault.to_dict())} if config.fault is not None else {}),
+        # axes whose motor saturated (a wear or fault too large for the drive): validate reports them
+        **({"saturated": np.asarray(result.saturated, dtype=int)} if len(getattr(result, "saturated", ())) else {}),
     }
 
 

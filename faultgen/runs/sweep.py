@@ -166,8 +166,24 @@ class Grid:
             if kind not in wear.SCHEDULES:
                 raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
         for pct in self.increases:
-            if not np.isfinite(pct) or pct < 0:
-                raise ValueError(f"wear increase {pct!r} % must be a finite number >= 0")
+            if isinstance(pct, bool) or not isinstance(pct, (int, float)) or not np.isfinite(pct) or pct < 0:
+                raise ValueError(f"grid increases (--wear-pct): {pct!r} % must be a finite number >= 0")
+            if pct > 100 * wear.MAX_INCREASE:
+                raise ValueError(f"grid increases (--wear-pct): {pct:g} % is beyond the bound of "
+                                 f"{100 * wear.MAX_INCREASE:g} % (faultgen.operation.wear.MAX_INCREASE)")
+        for name in ("cycles",):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"grid {name} (--{name}) = {value!r}: expected a whole number >= 1")
+        for seed in self.seeds:
+            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+                raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number >= 0")
+        if not isinstance(self.signals, bool):
+            raise ValueError(f"grid signals = {self.signals!r}: expected true or false (a TOML boolean, not a string)")
+        for name in ("disturbance", "encoder"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+                raise ValueError(f"grid {name} = {value!r}: expected a finite number >= 0")
         # builds and validates every run configuration, once: runs() returns these
         object.__setattr__(self, "_runs", self._build_runs())
 
@@ -193,6 +209,11 @@ class Grid:
         if unknown:
             raise ValueError(f"{path}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(known))}")
         preset = data.pop("preset", None)
+        if not preset:
+            missing = [f.name for f in fields(cls) if f.name in ("robots", "tasks", "axes") and f.name not in data]
+            if missing:
+                raise ValueError(f"{path}: no key {missing[0]!r} (and no preset); a grid file needs robots, tasks "
+                                 "and axes, or preset = \"quick\" (or j2, c2)")
         return cls.from_preset(preset, **data) if preset else cls(**data)
 
     def recorded_cycles(self) -> tuple[int, ...] | None:

@@ -49,6 +49,11 @@ BATCH_CYCLES = 100
 CHUNK_PERIODS = 250
 
 
+#: Share of an axis's motor torque limit at which its drive counts as saturated (the drive's
+#: control range clips the torque at the limit itself).
+SATURATION = 0.999
+
+
 class SimulationDiverged(RuntimeError):
     """A cycle's state became non-finite or MuJoCo warned; the message names cycle and axis."""
 
@@ -397,6 +402,9 @@ class RunResult:
     conditions: CycleConditions | None = None
     fault_value: np.ndarray | None = None
     stepping_time: float = field(default=0.0, compare=False)
+    #: Axes (1-based) whose drive torque reached its limit (:attr:`Robot.motor_torque_limit`) in some
+    #: recorded cycle: the run does not follow its task there (dataset label ``saturated``).
+    saturated: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
 
 def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -491,6 +499,9 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     result = _measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
     if plant.fault is not None:
         result = replace(result, fault_value=plant.fault)
+    if result.tau_m.size:
+        peak = np.max(np.abs(result.tau_m), axis=(0, 1))
+        result = replace(result, saturated=np.flatnonzero(peak >= SATURATION * robot.motor_torque_limit) + 1)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     if not config.daily:
@@ -528,6 +539,7 @@ def _merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunRes
         features={name: joined(lambda r, n=name: r.features[n]) for name in parts[0].features},
         conditions=conditions,
         fault_value=None if parts[0].fault_value is None else joined(lambda r: r.fault_value),
+        saturated=np.unique(np.concatenate([r.saturated for r in parts])).astype(int),
         stepping_time=sum(r.stepping_time for r in parts))
 
 
