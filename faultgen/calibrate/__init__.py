@@ -164,8 +164,8 @@ class Calibration:
 
 #: Most rows the search works on. A longer log is averaged down to this many (:func:`decimate`):
 #: the search's regressors take about 28 kB per row (a 10^6-row log asked for 25.7 GiB), so
-#: 60 000 rows keep ``faultgen calibrate`` within 3 GB (docs/calibration.md, "Long logs").
-MAX_ROWS = 60_000
+#: 25 000 rows keep ``faultgen calibrate`` within 3 GB (60 000 took 5.7 GB; docs/calibration.md, "Long logs").
+MAX_ROWS = 25_000
 
 
 def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,

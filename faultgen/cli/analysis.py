@@ -20,6 +20,9 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     problems = dataset.validate(file)
     if problems:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
+    if not any(len(row["worn_axes"]) for row in dataset.labels(file)):
+        raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
+                         "runs with runs without wear; sweep with --axis 1..6 too")
     check_outputs(outputs, overwrite)
 
 
