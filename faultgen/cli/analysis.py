@@ -70,11 +70,16 @@ def bench_isolators_command(
     """
     from analysis import benchmark
 
+    try:
+        wear_levels = [float(x) for x in levels.split(",")]
+    except ValueError:
+        raise ValueError(f"--levels {levels!r}: expected wear levels in %, comma-separated, e.g. 1,5,10,15") from None
+    if not all(0 < w <= 100 * 5 for w in wear_levels):  # faultgen.operation.wear.MAX_INCREASE
+        raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
     stem = out or file.with_name(file.stem + "-isolation")
     confusion_stem = stem.with_name(stem.name + "-confusion")
     analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
                            confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
-    wear_levels = [float(x) for x in levels.split(",")]
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
     isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})

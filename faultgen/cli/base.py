@@ -80,7 +80,8 @@ class Group(_PlainHelp, TyperGroup):
 
 def check_outputs(files: list[Path], overwrite: bool) -> None:
     """Refuse, before any work, output files that exist (unless ``overwrite``), are folders, or
-    whose folder does not exist; raises ValueError naming the file and what to do."""
+    whose folder does not exist (ValueError naming the file and what to do), or whose folder
+    cannot be written (OSError naming the folder and the reason)."""
     for path in files:
         if path.is_dir():
             raise ValueError(f"{path} is a folder; --out expects a file name")
@@ -89,6 +90,9 @@ def check_outputs(files: list[Path], overwrite: bool) -> None:
         folder = path.parent if str(path.parent) else Path(".")
         if not folder.is_dir():
             raise ValueError(f"cannot write {path}: folder {folder} does not exist")
+        from faultgen.data import atomic
+
+        atomic.check_writable(path)  # a read-only folder: OSError (exit 1) before any work
 
 
 def check_output_folder(folder: Path, overwrite: bool) -> None:

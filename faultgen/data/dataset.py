@@ -548,7 +548,9 @@ def _attribute_problems(group: h5py.Group) -> list[str]:
             except (TypeError, ValueError):
                 good = False
             if not good:
-                problems.append(f"attribute {key!r} is {attrs[key]!r}, expected {expected}")
+                value = attrs[key]
+                shown = value.tolist() if isinstance(value, (np.ndarray, np.generic)) else value
+                problems.append(f"attribute {key!r} is {shown!r}, expected {expected}")
     for key in ("wear", "noise", "config", "conditions", "fault"):
         if key in attrs:
             try:

@@ -310,6 +310,12 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
     return simulate_and_write(*call)
 
 
+def _start_worker(sweep_pid: int) -> None:
+    """A loky worker's initializer: watch the sweep's process from the worker's start."""
+    if os.getpid() != sweep_pid:
+        _watch_parent(sweep_pid)
+
+
 _WATCHED: set[int] = set()
 
 
@@ -677,8 +683,11 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) 
             yield from _execute_dask(calls, scheduler)
         else:
             from joblib import Parallel, delayed
+            from joblib._parallel_backends import LokyBackend
 
-            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered")
+            # every worker watches the sweep from its start, idle or not (:func:`_watch_parent`)
+            backend = LokyBackend(initializer=_start_worker, initargs=(os.getpid(),))
+            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
             yield from parallel(delayed(_in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:
