@@ -4,7 +4,6 @@ Tests that wait on another process synchronise on what it does (a file appearing
 ending), polling with a generous deadline, never on a fixed sleep: they pass on a loaded machine.
 """
 
-import json
 import os
 import resource
 import signal
