@@ -306,7 +306,6 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
     """
     if os.getpid() != sweep_pid:
         _quiet_unraisable_interrupts()
-        _watch_parent(sweep_pid)
     return simulate_and_write(*call)
 
 
@@ -326,21 +325,21 @@ def _watch_parent(sweep_pid: int, period: float = 0.5) -> None:
     loky's workers would go on simulating the rest of the grid, then idle for minutes (issue 42).
     The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
     Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
-    (a worker of a worker's executor, or another OS); either way the worker ends at once, its
-    unfinished part left as a hidden temporary file that the next sweep removes. Set once per
-    worker process.
+    (another OS); either way the worker ends at once, its unfinished part left as a hidden
+    temporary file that the next sweep removes. Set once per worker process, from its start (the
+    loky initializer :func:`_start_worker`); a process whose parent is not the sweep's is left
+    alone.
     """
-    if sweep_pid in _WATCHED:
+    if sweep_pid in _WATCHED or os.getppid() != sweep_pid:  # not a worker the sweep started: nothing to watch
         return
     _WATCHED.add(sweep_pid)
-    if os.getppid() == sweep_pid:
-        try:
-            libc = ctypes.CDLL("libc.so.6", use_errno=True)
-            libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-        except (OSError, AttributeError):  # not Linux: the thread below does it
-            pass
-        if os.getppid() != sweep_pid:  # the sweep ended before the request was made
-            os._exit(1)
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the thread below does it
+        pass
+    if os.getppid() != sweep_pid:  # the sweep ended before the request was made
+        os._exit(1)
 
     def watch() -> None:
         while True:
@@ -351,7 +350,7 @@ def _watch_parent(sweep_pid: int, period: float = 0.5) -> None:
                 os._exit(1)
             except PermissionError:
                 pass
-            if os.getppid() == 1:  # orphaned: the sweep's process (whatever pid it has now) is gone
+            if os.getppid() != sweep_pid:  # orphaned (reparented to init or a subreaper): the sweep is gone
                 os._exit(1)
 
     threading.Thread(target=watch, name="faultgen-watch-sweep", daemon=True).start()
