@@ -48,9 +48,10 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
 
 @contextmanager
 def atomic_folder(path: str | Path) -> Iterator[Path]:
-    """Yield a new hidden folder beside ``path`` to write into; when the block succeeds it
-    replaces ``path`` (an existing ``path`` is moved aside, the new folder renamed into place, the
-    old one removed). On any exception the new folder is removed and ``path`` is untouched; a
+    """Yield a new hidden folder beside ``path`` to write into; when the block succeeds it is
+    renamed to ``path`` (one rename: all or nothing). If ``path`` is an existing folder, each entry
+    written replaces the entry of that name in it (one rename each; other files of ``path`` are
+    kept). On any exception the new folder is removed and ``path`` is untouched; a
     kill leaves only the hidden folder (``.<name>.<pid>@<host>.<random>.part``), which the next
     write of ``path`` removes (:func:`remove_stale`).
 
@@ -68,11 +69,17 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     try:
         os.chmod(staging, 0o777 & ~_umask())
         yield staging
-        if path.exists():
-            old = staging.with_name(staging.name[:-len(".part")] + ".old.part")
-            os.replace(path, old)
-            os.replace(staging, path)
-            shutil.rmtree(old, ignore_errors=True)
+        if path.is_dir():  # keep what else the folder holds: replace only what was written, entry by entry
+            aside = staging / ".replaced"
+            aside.mkdir()
+            for entry in sorted(staging.iterdir()):
+                if entry == aside:
+                    continue
+                target = path / entry.name
+                if target.exists() or target.is_symlink():
+                    os.replace(target, aside / entry.name)
+                os.replace(entry, target)
+            shutil.rmtree(staging, ignore_errors=True)
         else:
             os.replace(staging, path)
     except BaseException:
