@@ -101,6 +101,9 @@ def check_output_folder(folder: Path, overwrite: bool) -> None:
         raise ValueError(f"{folder} is a file; --out expects a folder to write the results into")
     if folder.is_dir() and any(folder.iterdir()) and not overwrite:
         raise ValueError(f"{folder} holds earlier results; pass --overwrite to replace them or choose another --out")
+    from faultgen.data import atomic
+
+    atomic.check_writable(folder)  # its parent folder, where the results are written first: OSError (exit 1)
 
 
 def parse_window(text: str) -> tuple[float, float]:
