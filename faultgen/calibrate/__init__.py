@@ -189,6 +189,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
         if progress:
             print(data.notes[-1], flush=True)
     out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
     with atomic.atomic_folder(out) as staging:
         result = _calibrate(robot, data, staging, max_steps=max_steps, progress=progress)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))

@@ -103,7 +103,10 @@ def check_output_folder(folder: Path, overwrite: bool) -> None:
         raise ValueError(f"{folder} holds earlier results; pass --overwrite to replace them or choose another --out")
     from faultgen.data import atomic
 
-    atomic.check_writable(folder)  # its parent folder, where the results are written first: OSError (exit 1)
+    existing = folder.absolute().parent
+    while not existing.exists():  # calibrate creates the missing folders
+        existing = existing.parent
+    atomic.check_writable(existing / folder.name)  # where the results are written first: OSError (exit 1)
 
 
 def parse_window(text: str) -> tuple[float, float]:
