@@ -20,10 +20,10 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     problems = dataset.validate(file)
     if problems:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
+    check_outputs(outputs, overwrite)
     if not any(len(row["worn_axes"]) for row in dataset.labels(file)):
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")
-    check_outputs(outputs, overwrite)
 
 
 def table_command(file: Path, out: Path | None, overwrite: bool, suffix: str, digits: int, compute) -> None:

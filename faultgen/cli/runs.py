@@ -117,7 +117,7 @@ def sweep_command(
     increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
     schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
     friction_model: Friction = None,
-    cycles: Annotated[int | None, typer.Option(help="Cycles per run.", min=1)] = None,
+    cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
     record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
     seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
     fault: Annotated[str | None, typer.Option(

@@ -174,7 +174,7 @@ class Grid:
         for name in ("cycles",):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"grid {name} (--{name}) = {value!r}: expected a whole number >= 1")
+                raise ValueError(f"grid {name} = {value!r} (--{name}): expected a whole number >= 1")
         for seed in self.seeds:
             if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
                 raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number >= 0")
