@@ -310,9 +310,13 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
 
 
 def _start_worker(sweep_pid: int) -> None:
-    """A loky worker's initializer: watch the sweep's process from the worker's start."""
-    if os.getpid() != sweep_pid:
-        _watch_parent(sweep_pid)
+    """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
+    whose sweep ended while it started (it has another parent already) ends at once."""
+    if os.getpid() == sweep_pid:
+        return
+    if os.getppid() != sweep_pid:
+        os._exit(1)
+    _watch_parent(sweep_pid)
 
 
 _WATCHED: set[int] = set()
