@@ -38,15 +38,28 @@ def wait_for(condition, what: str, seconds: float = 180) -> None:
         time.sleep(0.05)
 
 
-def children(pid: int) -> list[psutil.Process]:
-    try:
-        return psutil.Process(pid).children(recursive=True)
-    except psutil.NoSuchProcess:
-        return []
+def marked(mark: str) -> list[psutil.Process]:
+    """Every running process whose environment carries ``FAULTGEN_TEST_MARK=mark``: a process the
+    test started and all its descendants, whoever their parent is now (an orphan's is init)."""
+    found = []
+    for p in psutil.process_iter():
+        try:
+            if p.environ().get("FAULTGEN_TEST_MARK") == mark and p.status() != psutil.STATUS_ZOMBIE:
+                found.append(p)
+        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
+            pass
+    return found
 
 
-def all_gone(processes: list[psutil.Process]) -> bool:
-    return not [p for p in processes if p.is_running() and p.status() != psutil.STATUS_ZOMBIE]
+def workers(mark: str) -> list[psutil.Process]:
+    out = []
+    for p in marked(mark):
+        try:
+            if "popen_loky_posix" in " ".join(p.cmdline()):
+                out.append(p)
+        except (psutil.NoSuchProcess, psutil.ZombieProcess):
+            pass
+    return out
 
 
 # -- group 1: a killed sweep stops its workers; SIGTERM is handled like Ctrl-C ---------------------
@@ -55,18 +68,18 @@ def all_gone(processes: list[psutil.Process]) -> bool:
 def test_a_killed_sweep_leaves_no_worker_running(tmp_path, how):
     out = tmp_path / "killed.h5"
     parts = sweep.parts_folder(out)
+    mark = str(tmp_path)
     proc = subprocess.Popen([*CLI, "sweep", *GRID_ARGS, "--jobs", "2", "-o", str(out)], cwd=tmp_path,
-                            start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            env={**os.environ, "FAULTGEN_TEST_MARK": mark}, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        wait_for(lambda: (parts / "sweep.json").exists() and len(children(proc.pid)) >= 2, "two workers")
-        workers = children(proc.pid)
+        wait_for(lambda: (parts / "sweep.json").exists() and len(workers(mark)) >= 2, "two workers")
         proc.send_signal(how)  # the sweep's own process only, as `kill PID` does
         stdout, stderr = proc.communicate(timeout=120)
-        wait_for(lambda: all_gone(workers), "the workers to end", seconds=10)
+        # every process the sweep started (workers, resource trackers) ends: none is left orphaned
+        wait_for(lambda: not marked(mark), "every process of the sweep to end", seconds=10)
     finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)
-        for p in children(proc.pid):
+        for p in marked(mark):
             p.kill()
     assert not out.exists()
     if how == signal.SIGTERM:
