@@ -404,7 +404,7 @@ class RunResult:
     stepping_time: float = field(default=0.0, compare=False)
     #: Axes (1-based) whose drive torque reached its limit (:attr:`Robot.motor_torque_limit`) in some
     #: recorded cycle: the run does not follow its task there (dataset label ``saturated``).
-    saturated: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    saturated: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int), compare=False)
 
 
 def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
