@@ -321,6 +321,7 @@ def test_a_run_whose_motor_saturates_is_labelled_and_fails_validation(tmp_path):
     assert 2 in list(labels["saturated"])
     checked = runner.invoke(app, ["validate", str(out)])
     assert checked.exit_code == 1 and "the motor saturated" in checked.output
+    assert "saturated:     1 run(s)" in runner.invoke(app, ["info", str(out)]).output
 
 
 # -- group 8: inputs the commands did not expect ----------------------------------------------------

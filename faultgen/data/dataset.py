@@ -677,6 +677,10 @@ def summary(path: str | Path) -> str:
     if any("conditions" in row for row in rows):
         lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
                      "(temperature, payloads, task mix, unit spread: CONDITION_ARRAYS)")
+    saturated = [row for row in rows if len(row.get("saturated", ()))]
+    if saturated:
+        lines.append(f"  saturated:     {len(saturated)} run(s) whose motors reached their torque limit (they do not "
+                     "follow their task; `faultgen validate` lists them)")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)
