@@ -86,7 +86,10 @@ def test_a_killed_sweep_leaves_no_worker_running(tmp_path, how):
         kept = len(list(parts.glob("*.h5")))
         assert proc.returncode == 143, stdout + stderr
         assert stderr.strip() == (f"terminated (SIGTERM): {kept} of 4 runs kept in {parts}; run the same command "
-                                  "to resume")
+                                  "to resume" if kept else
+                                  "terminated (SIGTERM): none of the 4 runs had finished; run the same command to "
+                                  "start again")
+        assert kept or not parts.exists()  # no empty part folder
         assert not (tmp_path / ".killed.h5.lock").exists()
 
 

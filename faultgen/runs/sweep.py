@@ -478,6 +478,9 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                         kept = len(finished_runs(grid, out))
                         what, code = (("terminated (SIGTERM)", 143) if isinstance(interrupt, _Terminated)
                                       else ("interrupted", 130))
+                        if not kept:  # the part folder goes too: nothing to point at
+                            raise SweepInterrupted(f"{what}: none of the {len(plan)} runs had finished; run the "
+                                                   "same command to start again", code) from None
                         raise SweepInterrupted(f"{what}: {kept} of {len(plan)} runs kept in {parts}; run the "
                                                "same command to resume", code) from None
                 started = time.perf_counter()
