@@ -80,7 +80,10 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
         _draw_run(fig, axes[:n_axes], path, run if run is not None else ids[0])
     else:
         _draw_sweep(fig, axes[:n_axes], path, ids)
-    fig.savefig(out, dpi=110)
+    from faultgen.data.atomic import atomic_path
+
+    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
+        fig.savefig(tmp, dpi=110, format="png")
     return out
 
 

@@ -84,7 +84,7 @@ def test_simulate_writes_a_file_that_reads_back(tmp_path):
         (["--task", "welding"], "unknown task 'welding'"),
         (["--wear", "7:exp4:20"], "axis 7 is out of range 1..6"),
         (["--wear", "2:exp4:-10"], "2:exp4:-10"),
-        (["--cycles", "0"], "--cycles 0"),
+        (["--cycles", "0"], "'--cycles'"),  # typer's range: "Invalid value for '--cycles'"
         (["--friction", "coulomb"], "unknown friction model 'coulomb'"),
         (["--record", "1,x"], "--record part 'x'"),
     ],

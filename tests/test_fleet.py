@@ -51,10 +51,10 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
 
 @pytest.mark.parametrize(("settings", "message"), [
     ({"failing": 26}, r"fleet failing = 26: expected a whole number within 1..25"),
-    ({"days": 3}, r"fleet days = 3"),
+    ({"days": 3}, r"fleet days \(--days\) = 3"),
     ({"onset": (40, 30)}, r"first <= last"),
     ({"onset": (0, 30)}, r"fleet onset day = 0"),
-    ({"cycles_per_day": 0}, r"fleet cycles_per_day = 0"),
+    ({"cycles_per_day": 0}, r"fleet cycles_per_day \(--cycles-per-day\) = 0"),
     ({"models": ("kuka",)}, r"kuka"),
     ({"models": ()}, r"fleet models = \(\): expected one or more different robot model names"),
     ({"models": ("irb6700", "irb6700")}, r"fleet models = \('irb6700', 'irb6700'\): expected one or more different"),

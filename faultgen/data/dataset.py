@@ -32,6 +32,7 @@ truncated or corrupted files instead of letting them be read.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 from collections.abc import Iterable
@@ -48,7 +49,7 @@ if TYPE_CHECKING:
 
 from faultgen import __version__
 from faultgen import axes as axis_numbers
-from faultgen.data.atomic import atomic_path
+from faultgen.data.atomic import atomic_path, hdf5_writer
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -206,6 +207,8 @@ def run_attributes(result, command: str = "") -> dict:
         "signals": bool(config.signals),
         "sample": "day" if config.daily else "cycle",
         **({"fault": json.dumps(config.fault.to_dict())} if config.fault is not None else {}),
+        # axes whose motor saturated (a wear or fault too large for the drive): validate reports them
+        **({"saturated": np.asarray(result.saturated, dtype=int)} if len(getattr(result, "saturated", ())) else {}),
     }
 
 
@@ -222,6 +225,22 @@ def _condition_arrays(conditions: dict | None) -> list[str]:
         return table is not None and (not setting or bool(table.get(setting)))
 
     return [name for name, (*_, condition) in CONDITION_ARRAYS.items() if on(condition)]
+
+
+def estimated_size(config) -> int:
+    """Bytes the file of a run of ``config`` (:class:`faultgen.simulation.stepping.RunConfig`)
+    takes, about: its signals as float32 (seven arrays of (recorded cycles, samples, axes)) when
+    kept, and 20 kB of features per recorded cycle (measured: 2 cycles of pick_place on the
+    IRB-6700-like arm with signals, 721 kB; this estimate 666 kB). What the commands check is free
+    before they start (:func:`faultgen.data.atomic.check_writable`)."""
+    from faultgen.simulation import stepping as sim
+
+    n_cycles = len(config.recorded_cycles)
+    per_cycle = 20_000
+    if config.signals:
+        n_log = int(sim.cycle_duration(config.robot, config.task) / sensors.LOG_PERIOD) + 1
+        per_cycle += 7 * 4 * n_log * robots.load(config.robot).n_axes
+    return n_cycles * per_cycle + 50_000
 
 
 def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
@@ -243,7 +262,7 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
         at ``path`` and no temporary file remains.
     """
     path = Path(path)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with hdf5_writer(path) as f:
         _write_root(f, 1, command, "")
         f.attrs["complete"] = False
         group = f.create_group(f"runs/{run_id}")
@@ -284,7 +303,7 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
     """
     path = Path(path)
     parts = list(parts)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as out:
+    with hdf5_writer(path) as out:
         _write_root(out, len(parts), command, grid)
         out.attrs["complete"] = False
         runs = out.create_group("runs")
@@ -299,11 +318,20 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
 @contextmanager
 def _open(path: str | Path):
     """Open a finished faultgen file for reading, or raise DatasetError saying why not."""
+    writer = _writer_of(Path(path))
+    if writer is not None:
+        raise DatasetError(f"{path} is in use: process {writer} is writing it (the finished file appears under "
+                           "its own name when it is done)")
     try:
         f = h5py.File(path, "r")
     except FileNotFoundError:
         raise DatasetError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise DatasetError(f"{path} is a folder, not a dataset file") from None
     except OSError as err:
+        if err.errno == errno.EAGAIN or "unable to lock file" in str(err).lower():
+            raise DatasetError(f"{path} is in use: another process has it open for writing; wait for it to "
+                               "finish") from None
         raise DatasetError(f"{path}: cannot be opened as HDF5 (truncated or not HDF5): {err}") from None
     try:
         if f.attrs.get("format") != FORMAT:
@@ -312,9 +340,28 @@ def _open(path: str | Path):
             raise DatasetError(f"{path} is incomplete: its writer did not finish")
         if "runs" not in f:
             raise DatasetError(f"{path} has no /runs group")
+        if f.attrs.get("format_version") != FORMAT_VERSION:
+            raise DatasetError(f"{path} has format_version {_attr(f.attrs.get('format_version')).item() if hasattr(f.attrs.get('format_version'), 'item') else f.attrs.get('format_version')!r}; this faultgen "
+                               f"reads version {FORMAT_VERSION}")
+        if len(f["runs"]) == 0:
+            raise DatasetError(f"{path} has no runs (its /runs group is empty)")
         yield f
     finally:
         f.close()
+
+
+def _writer_of(path: Path) -> int | None:
+    """The pid of the running process writing ``path``, if it is the temporary file of an atomic
+    write (``.<name>.<pid>@<host>.<random>.part``, :func:`faultgen.data.atomic.atomic_path`) of a
+    process that still runs on this host; else None."""
+    import re
+
+    from faultgen.data import atomic
+
+    match = re.fullmatch(r"\.(.+)\.(\d+)@(.+)\.[^.]+\.part", path.name)
+    if match is None or match[3] != atomic._host() or not atomic._running(int(match[2])):
+        return None
+    return int(match[2])
 
 
 def list_runs(path: str | Path) -> list[str]:
@@ -356,7 +403,14 @@ def read_run(path: str | Path, run_id: str | None = None,
                 why = ("; it was recorded without signals (features only): simulate it again with signals "
                        "(`faultgen sweep` without --features-only) to use this command")
             raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}{why}")
+        problems = _attribute_problems(group)
+        if problems:
+            raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every problem)")
         arrays = {name: group[name][()] for name in wanted}
+        for name, value in arrays.items():
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise DatasetError(f"{path}: run {run_id!r}: {name} holds non-finite values; the file is corrupted "
+                                   f"(faultgen validate {path})")
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
 
@@ -449,6 +503,11 @@ def export_features(path: str | Path, out: str | Path) -> Path:
 def labels(path: str | Path) -> list[dict]:
     """The labels of every run, one dict per run (with its ``run`` id), in file order."""
     with _open(path) as f:
+        for run_id in f["runs"]:
+            problems = _attribute_problems(f["runs"][run_id])
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         return [{"run": run_id, **{k: _attr(v) for k, v in f["runs"][run_id].attrs.items()}} for run_id in f["runs"]]
 
 
@@ -481,12 +540,71 @@ def validate(path: str | Path) -> list[str]:
     return problems
 
 
+def _attribute_problems(group: h5py.Group) -> list[str]:
+    """What is wrong with the attributes of a run group: each present attribute must parse into
+    its type and range (a whole number of cycles >= 1, worn axes among 1..N, JSON tables, a
+    known friction model, a positive log period, ...); the missing ones are listed by
+    :func:`_validate_run`."""
+    from faultgen.effects import friction
+
+    problems = []
+    attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
+
+    def whole(value) -> bool:
+        return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+    n_axes = attrs.get("n_axes", 6)  # files before the number of axes was stored hold 6
+    if not whole(n_axes) or not axis_numbers.MIN_AXES <= n_axes <= axis_numbers.MAX_AXES:
+        n_axes = axis_numbers.MAX_AXES  # a bad n_axes is reported by _validate_run
+    checks = {
+        "robot": (lambda v: isinstance(v, str) and bool(v), "a robot name"),
+        "task": (lambda v: isinstance(v, str) and bool(v), "a task name"),
+        "friction_model": (lambda v: v in friction.MODELS, f"one of {', '.join(friction.MODELS)}"),
+        "cycles": (lambda v: whole(v) and v >= 1, "a whole number >= 1"),
+        "seed": (lambda v: whole(v) and v >= 0, "a whole number >= 0"),
+        "worn_axes": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu"
+                      and bool(np.all((v >= 1) & (v <= n_axes))), f"a list of axes among 1..{n_axes}"),
+        "log_period": (lambda v: isinstance(v, (float, np.floating)) and np.isfinite(v) and v > 0,
+                       "a positive number of seconds"),
+        "signals": (lambda v: isinstance(v, (bool, np.bool_)), "true or false"),
+        "sample": (lambda v: v in ("cycle", "day"), "'cycle' or 'day'"),
+        "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
+                      "a list of axes"),
+    }
+    for key, (ok, expected) in checks.items():
+        if key in attrs:
+            try:
+                good = bool(ok(attrs[key]))
+            except (TypeError, ValueError):
+                good = False
+            if not good:
+                value = attrs[key]
+                shown = value.tolist() if isinstance(value, (np.ndarray, np.generic)) else value
+                problems.append(f"attribute {key!r} is {shown!r}, expected {expected}")
+    for key in ("wear", "noise", "config", "conditions", "fault"):
+        if key in attrs:
+            try:
+                table = json.loads(attrs[key])
+            except (TypeError, ValueError):
+                problems.append(f"attribute {key!r} is not JSON: {str(attrs[key])[:40]!r}")
+                continue
+            if not isinstance(table, dict):
+                problems.append(f"attribute {key!r} is {str(attrs[key])[:40]!r}, expected a JSON table")
+    return problems
+
+
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
+    problems += _attribute_problems(group)
+    if "saturated" in group.attrs and len(group.attrs["saturated"]):
+        problems.append(f"axes {', '.join(str(int(a)) for a in group.attrs['saturated'])}: the motor saturated "
+                        "(the drive torque reached its limit): the run does not follow its task")
     try:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
         return [*problems, "conditions attribute is not JSON"]
+    if problems:
+        return problems
     signals = bool(group.attrs.get("signals", True))
     schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
@@ -603,6 +721,13 @@ def summary(path: str | Path) -> str:
     """A few lines describing a dataset: runs, robots, tasks, wear, cycles, size, provenance."""
     with _open(path) as f:
         runs = f["runs"]
+        for run_id in runs:
+            problems = [f"missing attribute {a!r}" for a in ("robot", "task", "friction_model", "seed", "worn_axes")
+                        if a not in runs[run_id].attrs] + _attribute_problems(runs[run_id])
+            problems += [f"missing array {a!r}" for a in ("cycles", "t") if a not in runs[run_id]]
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         rows = [{k: _attr(v) for k, v in runs[r].attrs.items()} for r in runs]
         n_cycles = [runs[r]["cycles"].shape[0] for r in runs]
         n_log = [runs[r]["t"].shape[0] for r in runs]
@@ -625,6 +750,10 @@ def summary(path: str | Path) -> str:
     if any("conditions" in row for row in rows):
         lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
                      "(temperature, payloads, task mix, unit spread: CONDITION_ARRAYS)")
+    saturated = [row for row in rows if len(row.get("saturated", ()))]
+    if saturated:
+        lines.append(f"  saturated:     {len(saturated)} run(s) whose motors reached their torque limit (they do not "
+                     "follow their task; `faultgen validate` lists them)")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)

@@ -817,7 +817,9 @@ def write_hdf5(
     if not path.name.lower().endswith(HDF5_SUFFIXES):
         raise ValueError(f"{path}: write_hdf5 writes {' or '.join(HDF5_SUFFIXES)} files")
     table = _table(t, q, tau, qd)
-    with h5py.File(path, "w") as fh:
+    from faultgen.data.atomic import hdf5_writer
+
+    with hdf5_writer(path) as fh:  # a full disk: OSError, never a crash nor a partial file
         for name, values in table.items():
             ds = fh.create_dataset(name, data=values)
             ds.attrs["unit"] = UNITS[name]

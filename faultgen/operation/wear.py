@@ -55,6 +55,12 @@ _SPEC_FORM = (
 )
 
 
+#: Largest final wear increase accepted, as a fraction (5: Coulomb and static friction six times
+#: their new level). The thesis's failing gearboxes reach tens of percent (ch. 5-6); far beyond,
+#: the motors saturate and the run no longer follows its task (issue 42: +1e9 gave 781 mrad).
+MAX_INCREASE = 5.0
+
+
 @dataclass(frozen=True)
 class Schedule:
     """Friction multiplier of one axis over the cycles of a run; validated on construction.
@@ -117,6 +123,10 @@ class Schedule:
             raise ValueError(f"wear increase {increase!r} is not finite; {expected}")
         if increase < 0:
             raise ValueError(f"wear increase {increase!r} is negative; {expected}")
+        if increase > MAX_INCREASE:
+            raise ValueError(f"wear increase {increase:g} (+{100 * increase:g} %) is beyond the bound of "
+                             f"{MAX_INCREASE:g} (+{100 * MAX_INCREASE:g} %, friction x{1 + MAX_INCREASE:g}): a gearbox "
+                             "has failed long before, and the motors saturate")
         if not is_whole(self.last_cycle, 1):
             raise ValueError(f"last_cycle {self.last_cycle!r} is invalid; expected an int >= 1 such as 100")
         last = int(self.last_cycle)

@@ -206,9 +206,10 @@ class Fleet:
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
         check_number("fleet failing", self.failing, 1, self.size - 1, whole=True)
-        check_number("fleet days", self.days, 5, 3650, whole=True)
-        check_number("fleet cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
-        check_number("fleet failure_wear", self.failure_wear, 0, 1000)
+        # the smallest fleet record whose default onset window (days // 6 .. 7 days // 12) holds a day
+        check_number("fleet days (--days)", self.days, 6, 3650, whole=True)
+        check_number("fleet cycles_per_day (--cycles-per-day)", self.cycles_per_day, 1, 24, whole=True)
+        check_number("fleet failure_wear (--failure-wear)", self.failure_wear, 0, 100 * wear.MAX_INCREASE)
         check_number("fleet seed", self.seed, 0, 2**31, whole=True)
         friction_models.check_model(self.friction)
         check_number("fleet gear_loss", self.gear_loss, 0, 0.5)

@@ -57,7 +57,11 @@ def prepared_for(robot: str, task: str, friction_model: str, payload: dict | Non
     :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
     a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
     model_file = robots.load(robot).path
-    stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    tasks_file = model_file.parent / "tasks.toml"
+    if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
+        raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
+                         "with it (the model `faultgen calibrate` writes has one)")
+    stamps = (model_file.stat().st_mtime_ns, tasks_file.stat().st_mtime_ns)
     if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
     key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)

@@ -75,6 +75,9 @@ class RunResult:
     conditions: CycleConditions | None = None
     fault_value: np.ndarray | None = None
     stepping_time: float = field(default=0.0, compare=False)
+    #: Axes (1-based) whose drive torque reached its limit (:attr:`Robot.motor_torque_limit`) in some
+    #: recorded cycle: the run does not follow its task there (dataset label ``saturated``).
+    saturated: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int), compare=False)
 
 
 def measure(sim, config, cycles, multiplier, q_ref, dist, raw: Raw, stepping_time: float,
@@ -140,6 +143,7 @@ def merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunResu
         features={name: joined(lambda r, n=name: r.features[n]) for name in parts[0].features},
         conditions=conditions,
         fault_value=None if parts[0].fault_value is None else joined(lambda r: r.fault_value),
+        saturated=np.unique(np.concatenate([r.saturated for r in parts])).astype(int),
         stepping_time=sum(r.stepping_time for r in parts))
 
 

@@ -41,6 +41,10 @@ __all__ = ["BATCH_CYCLES", "CHUNK_PERIODS", "Prepared", "RunConfig", "RunResult"
 #: and second of chunk) when a run records many cycles (the c2 preset records 1200).
 BATCH_CYCLES = 100
 
+#: Share of an axis's motor torque limit at which its drive counts as saturated (the drive's
+#: control range clips the torque at the limit itself).
+SATURATION = 0.999
+
 #: Earlier private names, for scripts that reach them (benchmarks/setup_time.py clears the cache).
 _prepared = prepared_for
 _ = _prepare, _prepare_variant
@@ -119,6 +123,9 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     result = measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
     if plant.fault is not None:
         result = replace(result, fault_value=plant.fault)
+    if result.tau_m.size:
+        peak = np.max(np.abs(result.tau_m), axis=(0, 1))
+        result = replace(result, saturated=np.flatnonzero(peak >= SATURATION * robot.motor_torque_limit) + 1)
     result.features.update(sensors.cycle_features(result.q_a, result.qd_a, result.tau_m, robot.joint_range,
                                                   task.velocity_limit, robot.motor_torque_limit))
     if not config.daily:
