@@ -21,6 +21,7 @@ import functools
 import json
 import time
 from collections.abc import Callable
+from pathlib import Path
 from dataclasses import dataclass, field, fields, replace
 
 import mujoco
@@ -34,7 +35,7 @@ from faultgen.effects.base import Effect
 from faultgen.effects.load_dependent_friction import LoadDependentFriction
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs, tasks
 from faultgen.operation.conditions import Conditions, CycleConditions
 from faultgen.operation.faults import Fault
 from faultgen.operation.wear import WearPlan
@@ -65,7 +66,8 @@ class RunConfig:
     robot : str
         Robot name (``faultgen robots``) or MJCF path.
     task : str
-        One of :data:`faultgen.tasks.TASKS`.
+        One of :data:`faultgen.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
+        (``.csv``, ``.h5``): :func:`faultgen.operation.programs.load`.
     friction : str
         Friction model, one of :data:`faultgen.friction.MODELS`.
     wear : WearPlan
@@ -126,8 +128,9 @@ class RunConfig:
 
     def __post_init__(self) -> None:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
-        if self.task not in tasks.TASKS:
-            raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
+        programs.check_name(self.task)  # a thesis task, or a program / joint log file
+        if programs.is_file_task(self.task):  # checked before any simulation (segment and value named)
+            _prepared(self.robot, self.task, "stribeck")
         friction.check_model(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
@@ -468,6 +471,9 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
         started = time.perf_counter()
         if config.back_to_back:  # one simulation over the cycles' set-points one after the other
             chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
+            if prepared.grips:
+                raise ValueError(f"{task_name} grips and releases a payload within the cycle; back_to_back runs "
+                                 "do not switch it")
             one = stepper(sim, _Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
             raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
@@ -483,7 +489,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
                     raws.append(stepper(variant.sim, _Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
-                                                           dist[g], per_log, config.nthread, fault), bar))
+                                                           dist[g], per_log, config.nthread, fault, variant.grips),
+                                        bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
             raw = _Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(_Raw)})
@@ -586,6 +593,9 @@ class Prepared:
     fault_fields : tuple
         For a model with a growing fault: the fields its parameter moves (:func:`_affine_fields`),
         set per simulation from each cycle's value.
+    grips : tuple
+        For a program that grips and releases a payload: ``(physics step, gripped body's values)``
+        where its mass changes (:func:`_apply_grips`).
     """
 
     sim: SimModel
@@ -594,6 +604,7 @@ class Prepared:
     q_ref: np.ndarray
     inputs: np.ndarray
     fault_fields: tuple = ()
+    grips: tuple = ()
 
     @property
     def per_log(self) -> int:
@@ -663,6 +674,7 @@ class _Work:
     per_log: int
     nthread: int
     fault: tuple | None = None
+    grips: tuple = ()
 
 
 def _prepared(robot: str, task: str, friction_model: str, payload: dict | None = None,
@@ -672,6 +684,8 @@ def _prepared(robot: str, task: str, friction_model: str, payload: dict | None =
     a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
     model_file = robots.load(robot).path
     stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    if programs.is_file_task(task):  # a program or log: renewed when it changes
+        stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
     if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
     key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
@@ -689,6 +703,9 @@ def _prepare_variant(robot_name: str, task_name: str, friction_model: str, paylo
     simulation), and a feedforward with the payload only (the controller knows the load it carries,
     not the fault)."""
     nominal = _prepare(robot_name, task_name, friction_model, *file_stamps)
+    if nominal.grips:
+        raise ValueError(f"{task_name} grips and releases a payload within the cycle; it runs without the payload "
+                         "condition (--payloads) and without a growing fault")
     robot = robots.load(robot_name)
     load = None if payload is None else Payload(**dict(payload))
 
@@ -760,16 +777,54 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     Arrays are made read-only so no run can change what the next one gets.
     """
     robot = robots.load(robot_name)
-    sim = build(robot, friction_model)
-    task = tasks.load(robot, task_name)
-    path = task.trajectory(sim.model.opt.timestep)
+    task = programs.load(robot, task_name)
+    path = task.trajectory(robot.model.opt.timestep)
+    loads = getattr(path, "loads", ())
+    sim = build(robot, friction_model, edit=(lambda spec: _add_grip(spec, robot, loads[0].params)) if loads else None)
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
     inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, 6, 3)
+    grips = ()
+    if loads:  # the drives know the part they carry: its feedforward where the program grips it
+        body = sim.model.body(GRIP_BODY).id
+        events = {0: (body, 0.0, np.zeros(3), np.zeros(3), np.array([1.0, 0, 0, 0]))}
+        for load in loads:
+            carrying = robot.edited(lambda spec, p=load.params: _add_grip(spec, robot, p))
+            with_load = replace(sim, robot=carrying).setpoints(q_ref, qd_ref, qdd_ref)
+            inputs[load.first:load.last] = with_load[load.first:load.last]
+            grip = carrying.model.body(GRIP_BODY)
+            events[load.first] = (body, float(grip.mass[0]), grip.inertia.copy(), grip.ipos.copy(), grip.iquat.copy())
+            events[load.last] = events[0]
+        grips = tuple(sorted(events.items()))
     for array in (q_ref, inputs):
         array.setflags(write=False)
-    return Prepared(sim, task, path, q_ref, inputs)
+    return Prepared(sim, task, path, q_ref, inputs, grips=grips)
+
+
+#: The body a program's gripped payload is (its mass switched per simulation as the program grips and
+#: releases; not named ``payload*``, which the payload condition and calibration own).
+GRIP_BODY = "gripped"
+
+
+def _add_grip(spec, robot: robots.Robot, params: dict) -> None:
+    """A body :data:`GRIP_BODY` at the flange with a payload's parameters (the shared
+    :class:`~faultgen.effects.payload.Payload`'s body)."""
+    mass = params["mass"]
+    com = np.array([params[k] for k in ("com_x", "com_y", "com_z")])
+    inertia = np.array([params[k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")])
+    Payload._add_body(spec, robot, GRIP_BODY, max(mass, 1e-9), com, inertia)
+
+
+def _apply_grips(batch, grips: tuple, step: int) -> None:
+    """Set the gripped body's mass and inertia at physics ``step`` where a program grips or releases
+    (``grips``: ``(step, (body, mass, inertia, ipos, iquat))`` pairs); the same for every simulation."""
+    for at, (body, mass, inertia, ipos, iquat) in grips:
+        if at == step:
+            batch.expand("body_mass")[:, body] = mass
+            batch.expand("body_inertia")[:, body] = inertia
+            batch.expand("body_ipos")[:, body] = ipos
+            batch.expand("body_iquat")[:, body] = iquat
 
 
 def cycle_duration(robot: str, task: str) -> float:
@@ -832,8 +887,10 @@ def _step_lugre(sim: SimModel, work: _Work, bar) -> _Raw:
     logs = {f.name: np.empty((n_sim, n_steps // per_log, 6)) for f in fields(_Raw)}
     arm_dist = model.nu + robot.arm_dof
     last_qvel = batch.qvel.copy()
-    for start in range(0, n_steps, chunk):
-        stop = min(start + chunk, n_steps)
+    # chunks also break where a program grips or releases a payload (whole log periods: segment boundaries)
+    starts = sorted({*range(0, n_steps, chunk), *(at for at, _ in work.grips if 0 < at < n_steps)})
+    for start, stop in zip(starts, [*starts[1:], n_steps]):
+        _apply_grips(batch, work.grips, start)
         size = stop - start
         control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
         control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
@@ -897,6 +954,8 @@ def _step_stribeck(sim: SimModel, work: _Work, bar) -> _Raw:
             deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
             for effect in extras:
                 frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
+        if work.grips:
+            _apply_grips(batch, work.grips, step)
         ctrl[:, sim.drive_ctrl] = inputs[step]
         applied[:, arm] = dist[:, step // per_log]
         logged = (step + 1) % per_log == 0
