@@ -258,6 +258,8 @@ class Seam:
         d = d / lengths[:, None]
         turns = [np.cross(a, b) for a, b in itertools.pairwise(d) if np.linalg.norm(np.cross(a, b)) > 1e-9]
         normal = turns[0] if turns else np.cross(np.cross(d[0], tool_axis), d[0])
+        if not np.linalg.norm(normal) > 1e-9:  # a straight line along the tool axis: any plane holds it
+            normal = np.cross(d[0], np.eye(3)[int(np.argmin(np.abs(d[0])))])
         self.normal = normal / np.linalg.norm(normal)
         if np.max(np.abs((v - v[0]) @ self.normal)) > 1e-9:
             raise ValueError("seam vertices must lie in one plane")
