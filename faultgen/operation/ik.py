@@ -161,18 +161,25 @@ class FlangeIK:
             float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])),
         )
 
-    def nearest(self, position: np.ndarray, q_init: np.ndarray) -> float:
+    def nearest(self, position: np.ndarray, q_init: np.ndarray, starts: int = 16) -> float:
         """Distance in m from ``position`` to the nearest flange position the arm reaches within its
-        joint ranges, in any orientation: the same iteration as :meth:`solve` on the position alone,
-        from ``q_init`` (a local minimum: the nearest point of the branch the arm is on)."""
+        joint ranges, in any orientation: the iteration of :meth:`solve` on the position alone, from
+        ``q_init``, the range centres and ``starts`` angles drawn uniformly within the ranges (a fixed
+        seed), the smallest of the local minima (a joint limit can stop one start short)."""
         frame = mink.FrameTask(FLANGE, "site", position_cost=1.0, orientation_cost=0.0, lm_damping=1.0)
-        frame.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.identity(), np.asarray(position, float)))
-        config = self.configuration
-        config.update(np.asarray(q_init, float))
-        for _ in range(4 * MAX_ITERATIONS):
-            velocity = mink.solve_ik(config, [frame], 1.0, "daqp", damping=1e-9, limits=self.limits)
-            config.integrate_inplace(velocity, 1.0)
-        return float(np.linalg.norm(self.flange(config.q)[0] - np.asarray(position, float)))
+        target = np.asarray(position, float)
+        frame.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.identity(), target))
+        low, high = self.model.jnt_range[:, 0], self.model.jnt_range[:, 1]
+        inits = [np.asarray(q_init, float), (low + high) / 2,
+                 *np.random.default_rng(0).uniform(low, high, (starts, len(low)))]
+        config, best = self.configuration, np.inf
+        for q0 in inits:
+            config.update(q0)
+            for _ in range(MAX_ITERATIONS):
+                velocity = mink.solve_ik(config, [frame], 1.0, "daqp", damping=1e-9, limits=self.limits)
+                config.integrate_inplace(velocity, 1.0)
+            best = min(best, float(np.linalg.norm(self.flange(config.q)[0] - target)))
+        return best
 
     def follow(
         self, knots: np.ndarray, points: np.ndarray, rotation: np.ndarray, q_start: np.ndarray, t: np.ndarray

@@ -130,7 +130,7 @@ class RunConfig:
         robots.load(self.robot)  # UnknownRobotError / ModelError (ValueErrors) name the problem
         programs.check_name(self.task)  # a thesis task, or a program / joint log file
         if programs.is_file_task(self.task):  # checked before any simulation (segment and value named)
-            _prepared(self.robot, self.task, "stribeck")
+            _task_path(self.robot, self.task, *_stamps(self.robot, self.task))
         friction.check_model(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
@@ -682,15 +682,31 @@ def _prepared(robot: str, task: str, friction_model: str, payload: dict | None =
     """:func:`_prepare`, renewed when the robot's model or task file changes; ``payload``: the
     :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
     a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
-    model_file = robots.load(robot).path
-    stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
-    if programs.is_file_task(task):  # a program or log: renewed when it changes
-        stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
+    stamps = _stamps(robot, task)
     if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
     key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
     return _prepare_variant(robot, task, friction_model, None if payload is None else tuple(sorted(payload.items())),
                             key, *stamps)
+
+
+def _stamps(robot: str, task: str) -> tuple[int, ...]:
+    """Modification times of the robot's model and task files (and size of a program or log file):
+    what renews the cached preparations."""
+    model_file = robots.load(robot).path
+    stamps = (model_file.stat().st_mtime_ns, (model_file.parent / "tasks.toml").stat().st_mtime_ns)
+    if programs.is_file_task(task):
+        stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
+    return stamps
+
+
+@functools.lru_cache(maxsize=16)
+def _task_path(robot_name: str, task_name: str, *file_stamps: int):
+    """The task (thesis task, program or replayed log) and its checked path at the robot's physics
+    step, once per process (``file_stamps`` renew it on edits)."""
+    robot = robots.load(robot_name)
+    task = programs.load(robot, task_name)
+    return task, task.trajectory(robot.model.opt.timestep)
 
 
 @functools.lru_cache(maxsize=16)
@@ -777,8 +793,7 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     Arrays are made read-only so no run can change what the next one gets.
     """
     robot = robots.load(robot_name)
-    task = programs.load(robot, task_name)
-    path = task.trajectory(robot.model.opt.timestep)
+    task, path = _task_path(robot_name, task_name, *file_stamps)
     loads = getattr(path, "loads", ())
     sim = build(robot, friction_model, edit=(lambda spec: _add_grip(spec, robot, loads[0].params)) if loads else None)
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
@@ -825,6 +840,9 @@ def _apply_grips(batch, grips: tuple, step: int) -> None:
             batch.expand("body_inertia")[:, body] = inertia
             batch.expand("body_ipos")[:, body] = ipos
             batch.expand("body_iquat")[:, body] = iquat
+            # the constants MuJoCo derives from the masses (constraint weights, subtree masses) follow,
+            # so an empty gripper is the same model whatever part the program grips
+            batch.set_const()
 
 
 def cycle_duration(robot: str, task: str) -> float:
