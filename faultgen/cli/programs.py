@@ -11,12 +11,25 @@ from faultgen.cli.base import Command, Group, check_outputs
 from faultgen.cli.main import app
 from faultgen.cli.options import Overwrite
 
-tasks_app = typer.Typer(
-    cls=Group, no_args_is_help=True, rich_markup_mode=None,
-    help="A robot's programs: the thesis tasks (pick_place, spot_weld, arc_weld) and program files. Export a "
-    "task as a program file to edit, then run it with `faultgen simulate --task FILE` (docs/simulation.md, "
-    "\"Your own programs\").")
+tasks_app = typer.Typer(cls=Group, no_args_is_help=True, rich_markup_mode=None)
 app.add_typer(tasks_app, name="tasks")
+
+
+@tasks_app.callback()
+def tasks_group() -> None:
+    """A robot's programs: the thesis tasks (pick_place, spot_weld, arc_weld) and program files.
+
+    Export a task as a program file to edit, then run it with `faultgen simulate --task FILE`
+    (docs/simulation.md, "Your own programs"). A joint log (.csv: t, q1..qN in rad) runs as a task
+    the same way.
+
+    Examples:
+
+    \b
+      faultgen tasks list irb6700
+      faultgen tasks export irb6700 spot_weld -o sw.toml
+      faultgen simulate --robot irb6700 --task sw.toml --cycles 10 -o sw.h5
+    """
 
 
 @tasks_app.command("list", cls=Command)

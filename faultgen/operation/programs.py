@@ -364,7 +364,7 @@ class _Planner:
     def _grip(self, s: Segment) -> None:
         if self.gripped is not None:
             self.fail(s, f"the tool already holds the payload gripped in segment {self.gripped[2]}; release it first")
-        self.gripped = (self.path.count - 1, s.values["payload"], str(s.number))
+        self.gripped = (self.path.count - 1, s.values["part"], str(s.number))
 
     def _release(self, s: Segment) -> None:
         if self.gripped is None:
@@ -655,7 +655,7 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
             inertia = t.array("inertia", (6,), finite_only=True) if "inertia" in table else np.zeros(6)
             params = {"mass": mass, **dict(zip(("com_x", "com_y", "com_z"), map(float, com), strict=True)),
                       **dict(zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), map(float, inertia), strict=True))}
-        values["payload"] = params
+        values["part"] = params
     label_ = table.get("label", default_label)
     if not isinstance(label_, str) or not label_:
         t.fail("label", f"expected a non-empty string, got {label_!r}")
