@@ -766,25 +766,13 @@ def export(robot: Robot | str, name: str) -> str:
     source = robot.path.parent / "tasks.toml"
     data = tomllib.loads(source.read_text())
     t, limits = data[name], data["limits"]
-    lines = [
-        f"# Thesis ch. 6.3.1 task {TASKS.index(name) + 1} ({PROCESSES[name]}) of {robot.name}, exported from "
-        f"{source.name} by `faultgen tasks export`.",
-        "# Units: joint angles in deg, positions in m (world frame), times in s, speeds in m/s.",
-        f"name = {_toml(name)}",
-        f"robot = {_toml(robot.name)}",
-        f"process = {_toml(PROCESSES[name])}",
-        f"start = {_toml(t['start'])}  # deg",
-        f"velocity_scale = {_toml(t['velocity_scale'])}",
-        f"acceleration_scale = {_toml(t['acceleration_scale'])}",
-        "",
-        "[limits]  # joint limits for planning, axes 1..N",
-        f"velocity = {_toml(limits['velocity'])}  # deg/s",
-        f"acceleration = {_toml(limits['acceleration'])}  # deg/s^2",
-        f"jerk = {_toml(limits['jerk'])}  # deg/s^3",
-    ]
+    header = (f"Thesis ch. 6.3.1 task {TASKS.index(name) + 1} ({PROCESSES[name]}) of {robot.name}, exported from "
+              f"{source.name} by `faultgen tasks export`.")
+    program = {"name": name, "robot": robot.name, "process": PROCESSES[name], "start": t["start"],
+               "velocity_scale": t["velocity_scale"], "acceleration_scale": t["acceleration_scale"],
+               "limits": {key: limits[key] for key in LIMIT_KEYS}}
     if "tool_z" in t:
-        lines += ["", "[tool]  # flange orientation at Cartesian targets (world frame)",
-                  f"z = {_toml(t['tool_z'])}", f"x = {_toml(t['tool_x'])}"]
+        program["tool"] = {"z": t["tool_z"], "x": t["tool_x"]}
     segments: list[dict] = []
     if name == "pick_place":
         for q, rest in zip(t["waypoints"], t["dwell"], strict=True):
@@ -805,7 +793,59 @@ def export(robot: Robot | str, name: str) -> str:
             {"type": "move", "standoff": t["standoff"], "label": "retract"},
             {"type": "move", "to": t["start"], "label": "retract"},
         ]
-    for segment in segments:
+    program["segment"] = segments
+    return dumps(program, header)
+
+
+#: Comments :func:`dumps` writes beside the values it knows.
+_UNITS = {"start": "deg", "velocity": "deg/s", "acceleration": "deg/s^2", "jerk": "deg/s^3"}
+
+
+def dumps(program: dict, header: str = "") -> str:
+    """A program file's text from the table a program file reads as (``tomllib.loads`` of it): what
+    a program generator (a robot builder writing thesis-like tasks) calls. Numbers are written as
+    Python writes them, so they read back to the same floats.
+
+    Parameters
+    ----------
+    program : dict
+        ``name``, ``start`` (deg) and ``segment`` (a list of tables), optionally ``robot``,
+        ``process``, ``description``, ``velocity_scale``, ``acceleration_scale``, ``limits``
+        (``velocity``, ``acceleration``, ``jerk`` in deg/s, deg/s^2, deg/s^3) and ``tool`` (``z``,
+        ``x``, ``offset``); see the module docstring.
+    header : str
+        A comment for the file's top (one line or several).
+
+    Raises
+    ------
+    ProgramError
+        For a key :func:`parse` would not read (checked without a robot; :func:`parse` checks the
+        values).
+    """
+    _Values("program", "", program, TOP_KEYS)
+    for key in ("limits", "tool"):
+        _Values("program", f"[{key}] ", program.get(key, {}), LIMIT_KEYS if key == "limits" else TOOL_KEYS)
+    for k, table in enumerate(program.get("segment", [])):
+        kind = table.get("type") if isinstance(table, dict) else None
+        if kind not in SEGMENT_KEYS:
+            raise ProgramError(f"program: segment {k + 1}: type = {kind!r}; expected one of {', '.join(SEGMENT_KEYS)}")
+        _Values("program", f"segment {k + 1} ({kind}) ", table, ("type", "label", *SEGMENT_KEYS[kind]))
+    lines = [f"# {line}" for line in header.splitlines()]
+    if header:
+        lines.append("# Units: joint angles in deg, positions in m (world frame), times in s, speeds in m/s.")
+    for key in TOP_KEYS:
+        if key in program and key not in ("limits", "tool", "segment"):
+            unit = f"  # {_UNITS[key]}" if key in _UNITS else ""
+            lines.append(f"{key} = {_toml(program[key])}{unit}")
+    for key, title in (("limits", "joint limits for planning, axes 1..N"),
+                       ("tool", "flange orientation at Cartesian targets (world frame); offset: tool centre point, "
+                                "m, flange frame")):
+        if key in program:
+            lines += ["", f"[{key}]  # {title}"]
+            for name, value in program[key].items():
+                unit = f"  # {_UNITS[name]}" if key == "limits" and name in _UNITS else ""
+                lines.append(f"{name} = {_toml(value)}{unit}")
+    for segment in program.get("segment", []):
         lines += ["", "[[segment]]"] + [f"{key} = {_toml(value)}" for key, value in segment.items()]
     return "\n".join(lines) + "\n"
 
