@@ -474,6 +474,9 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
             if prepared.grips:
                 raise ValueError(f"{task_name} grips and releases a payload within the cycle; back_to_back runs "
                                  "do not switch it")
+            if not np.array_equal(path.q[0], path.q[-1]):
+                raise ValueError(f"{task_name} ends {np.max(np.abs(path.q[-1] - path.q[0])):.4g} rad away from where it "
+                                 "starts; back_to_back runs need a cycle that returns to its start")
             one = stepper(sim, _Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
             raw = _Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, 6) for f in fields(_Raw)})
