@@ -297,3 +297,69 @@ def test_a_gripped_payload_loads_the_simulated_arm_as_its_inverse_dynamics_says(
     # before the grip the two runs are the same: the gripper is empty, whatever part it will take
     before = runs[0].t <= path.t[1600]
     np.testing.assert_allclose(runs[0].tau_m[0, before], runs[1].tau_m[0, before], rtol=0, atol=1e-6)
+
+
+def test_linear_and_circular_segments_keep_the_tool_on_the_line_and_the_arc(tmp_path):
+    """Flange positions by MuJoCo forward kinematics of the full model (rotors included), not the IK's
+    arm-only model: on the line and on the circle through the three points within 0.5 mm, at the
+    commanded tool speed between the ramps."""
+    text = HEAD + """[[segment]]
+type = "move"
+pose = [1.55, -0.25, 0.8]
+[[segment]]
+type = "linear"
+to = [1.55, 0.25, 0.8]
+speed = 0.2
+ramp_time = 0.2
+[[segment]]
+type = "circular"
+via = [1.75, 0.45, 0.8]
+to = [1.95, 0.25, 0.8]
+speed = 0.2
+ramp_time = 0.2
+[[segment]]
+type = "move"
+to = [0, 20, 15, 0, 80, 0]
+"""
+    robot = robots.load("irb6700")
+    path = programs.parse(text, robot).trajectory(0.004)
+    assert [s[0] for s in path.segments] == ["move", "linear", "circular", "move"]
+    data = mujoco.MjData(robot.model)
+    site = robot.model.site("flange").id
+
+    def flange(rows):
+        out = []
+        for q in path.q[rows]:
+            data.qpos[:], _ = robot.rigid_state(q)
+            mujoco.mj_kinematics(robot.model, data)
+            out.append(data.site_xpos[site].copy())
+        return np.array(out)
+
+    _, a, b = path.segments[1]
+    line = flange(slice(a, b + 1))
+    assert np.max(np.abs(line[:, [0, 2]] - [1.55, 0.8])) < 5e-4
+    np.testing.assert_allclose(line[[0, -1], 1], [-0.25, 0.25], atol=5e-4)
+    _, a, b = path.segments[2]
+    arc = flange(slice(a, b + 1))
+    radius = np.linalg.norm(arc[:, :2] - [1.75, 0.25], axis=1)  # the circle through the three points
+    assert np.max(np.abs(radius - 0.2)) < 5e-4 and np.max(np.abs(arc[:, 2] - 0.8)) < 5e-4
+    assert arc[len(arc) // 2, 1] > 0.44  # through via, not the short way
+    speed = np.linalg.norm(np.diff(arc, axis=0), axis=1) / 0.004
+    middle = speed[len(speed) // 4: -len(speed) // 4]
+    np.testing.assert_allclose(middle, 0.2, rtol=0.01)
+
+
+def test_the_task_mix_and_the_fleet_take_program_files(tmp_path):
+    from faultgen.operation.conditions import TaskMix
+    from faultgen.runs.fleet import Fleet
+
+    program = write(tmp_path, "mine.toml", programs.export("irb6700", "spot_weld"))
+    assert TaskMix((str(program), "pick_place")).tasks == (str(program), "pick_place")
+    with pytest.raises(ValueError, match="task mix: task file .*missing.toml.* does not exist"):
+        TaskMix((str(tmp_path / "missing.toml"),))
+    fleet = Fleet(size=4, failing=2, days=6, models=("irb6700",), tasks=(str(program), "arc_weld"))
+    drawn = {robot["task"] for robot in fleet.robots()}
+    assert drawn <= {str(program), "arc_weld"}
+    assert any("-mine-" in run_id for run_id, _ in fleet.runs())
+    assert json.loads(fleet.to_json())["fleet"]["tasks"] == [str(program), "arc_weld"]
+    assert "tasks" not in json.loads(Fleet(size=4, failing=2, days=6).to_json())["fleet"]
