@@ -288,7 +288,7 @@ def test_a_gripped_payload_loads_the_simulated_arm_as_its_inverse_dynamics_says(
     carried = (runs[0].t > path.t[first]) & (runs[0].t <= path.t[last])
     change = ((runs[0].tau_m[0, carried] - runs[1].tau_m[0, carried]) * robot.gear_ratio).mean(axis=0)
     rows = np.round(runs[0].t[carried] / robot.model.opt.timestep).astype(int)
-    carrying = robot.edited(lambda spec: sim._add_grip(spec, robot, path.loads[0].params))
+    carrying = robot.edited(lambda spec: programs.add_part(spec, robot, path.loads[0].params))
     q, qd, qdd = path.q[rows], path.qd[rows], path.qdd[rows]
     expected = (carrying.inverse_dynamics(q, qd, qdd, friction=False)
                 - robot.inverse_dynamics(q, qd, qdd, friction=False)).mean(axis=0)

@@ -503,6 +503,20 @@ class _Planner:
         check_torque(self.p.robot, path, lambda k: self.segment_at(k), self.fail)
 
 
+#: The body a program's gripped part is, at the flange (not named ``payload*``: those are the robot's
+#: own payload effect and the payload condition's, which a grip adds to rather than replaces).
+GRIP_BODY = "gripped"
+
+
+def add_part(spec, robot: Robot, params: dict) -> None:
+    """Add a gripped part to an ``MjSpec`` of ``robot``: a body :data:`GRIP_BODY` at the flange with the
+    :class:`~faultgen.effects.payload.Payload` parameters ``params`` (the shared payload's body)."""
+    mass = params["mass"]
+    com = np.array([params[k] for k in ("com_x", "com_y", "com_z")])
+    inertia = np.array([params[k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")])
+    Payload._add_body(spec, robot, GRIP_BODY, max(mass, 1e-9), com, inertia)
+
+
 def check_torque(robot: Robot, path: JointPath, segment_at, fail) -> None:
     """Refuse a path whose arm-side torque (:meth:`Robot.inverse_dynamics`, the payloads of
     ``path.loads`` included) exceeds the drives' capacity, peak motor torque x gear ratio."""
@@ -510,7 +524,7 @@ def check_torque(robot: Robot, path: JointPath, segment_at, fail) -> None:
     rows = np.arange(0, len(path.t), stride)  # every planning period is enough for a peak
     tau = robot.inverse_dynamics(path.q[rows], path.qd[rows], path.qdd[rows])
     for load in path.loads:
-        carrying = robot.edited(lambda spec, p=load.params: Payload(**p).write(spec, robot))
+        carrying = robot.edited(lambda spec, p=load.params: add_part(spec, robot, p))
         sel = (rows >= load.first) & (rows <= load.last)
         if np.any(sel):
             tau[sel] = carrying.inverse_dynamics(path.q[rows[sel]], path.qd[rows[sel]], path.qdd[rows[sel]])

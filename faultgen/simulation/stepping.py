@@ -820,18 +820,9 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     return Prepared(sim, task, path, q_ref, inputs, grips=grips)
 
 
-#: The body a program's gripped payload is (its mass switched per simulation as the program grips and
-#: releases; not named ``payload*``, which the payload condition and calibration own).
-GRIP_BODY = "gripped"
-
-
-def _add_grip(spec, robot: robots.Robot, params: dict) -> None:
-    """A body :data:`GRIP_BODY` at the flange with a payload's parameters (the shared
-    :class:`~faultgen.effects.payload.Payload`'s body)."""
-    mass = params["mass"]
-    com = np.array([params[k] for k in ("com_x", "com_y", "com_z")])
-    inertia = np.array([params[k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")])
-    Payload._add_body(spec, robot, GRIP_BODY, max(mass, 1e-9), com, inertia)
+#: The body a program's gripped part is (its mass switched per simulation as the program grips and releases).
+GRIP_BODY = programs.GRIP_BODY
+_add_grip = programs.add_part
 
 
 def _apply_grips(batch, grips: tuple, step: int) -> None:
