@@ -24,7 +24,7 @@ def simulate_command(
         "--robot", "--model",
         help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
         "model `faultgen calibrate` wrote.")] = "irb6700",
-    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3).")] = "pick_place",
+    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3), a program file (.toml, `faultgen tasks`) or a joint log to replay (.csv with t, q1..qN in rad).")] = "pick_place",
     friction_model: Friction = "lugre",
     wear: Annotated[
         list[str] | None,
@@ -113,7 +113,7 @@ def sweep_command(
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
     ] = None,
     robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")] = None,
-    tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s); repeat for several.")] = None,
+    tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s): a thesis task name, a program file (.toml) or a joint log (.csv); repeat for several.")] = None,
     axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.")] = None,
     increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
     schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
@@ -227,6 +227,9 @@ def fleet_command(
     task_mix: Annotated[bool, typer.Option(
         "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
         "its cycles (default: one task per robot).")] = False,
+    task_pool: Annotated[list[str] | None, typer.Option(
+        "--task", help="The tasks robots draw their process from: thesis task names, program files (.toml) or "
+        "joint logs (.csv); repeat for several (default: pick_place, spot_weld, arc_weld).")] = None,
     friction_model: Friction = "lugre",
     dry_share: DryShare = None,
     gear_loss: GearLoss = 0.0,
@@ -263,6 +266,8 @@ def fleet_command(
         chosen["dry_share"] = dry_share
     if without:
         chosen["without"] = tuple(without)
+    if task_pool:
+        chosen["tasks"] = tuple(task_pool)
     plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
                        failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
                        friction=friction_model, gear_loss=gear_loss, fault=fault)

@@ -7,6 +7,7 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      n_runs, command, grid (JSON, sweeps only),
                                      complete (written last: True only for a finished file)
     /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
+                                     a program file's or log's program: name, file, sha256, program_text;
                                      wear JSON, noise JSON) and provenance (faultgen_version,
                                      model_sha256, log_period, config JSON, command; since robots
                                      of 5-7 axes: n_axes, drivetrain JSON)
@@ -53,6 +54,7 @@ from faultgen.data.atomic import atomic_path, hdf5_writer
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
+from faultgen.operation import programs
 from faultgen.simulation import sensors
 
 FORMAT = "faultgen"
@@ -166,6 +168,7 @@ def config_key(config) -> str:
     """The run configuration as canonical JSON: equal keys mean the same simulation."""
     key = {
         "robot": config.robot, "task": config.task, "friction": config.friction,
+        **({"program_sha256": program["sha256"]} if (program := programs.record(config.task)) else {}),
         "wear": config.wear.to_dict(), "cycles": int(config.cycles),
         "record": [int(c) for c in config.recorded_cycles], "seed": int(config.seed),
         "noise": asdict(config.noise),
@@ -186,9 +189,13 @@ def run_attributes(result, command: str = "") -> dict:
     """Labels and provenance of a run, as HDF5 attributes (strings, numbers, JSON)."""
     config = result.config
     robot = robots.load(config.robot)
+    program = programs.record(config.task)  # a program file or a replayed log: what makes it again
     return {
         "robot": robot.name,
-        "task": config.task,
+        "task": config.task if program is None else program["name"],
+        **({} if program is None else {
+            "program": json.dumps({k: v for k, v in program.items() if k != "text"}),
+            **({"program_text": program["text"]} if "text" in program else {})}),
         "friction_model": config.friction,
         "cycles": int(config.cycles),
         "seed": int(config.seed),
@@ -590,6 +597,23 @@ def _attribute_problems(group: h5py.Group) -> list[str]:
     return problems
 
 
+def _program_problems(attrs) -> list[str]:
+    """A run of a program file or replayed log (attribute ``program``: JSON name, file, sha256; a
+    program's text in ``program_text``): the JSON reads, and the stored text is the one hashed."""
+    if "program" not in attrs:
+        return ["program_text without a program attribute"] if "program_text" in attrs else []
+    try:
+        program = json.loads(_attr(attrs["program"]))
+        digest = program["sha256"]
+    except (ValueError, KeyError, TypeError):
+        return ["program attribute is not JSON with a sha256"]
+    if "program_text" in attrs:
+        text = _attr(attrs["program_text"])
+        if hashlib.sha256(text.encode()).hexdigest() != digest:
+            return [f"program_text does not hash to the program's sha256 {digest[:12]}..."]
+    return []
+
+
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
     problems += _attribute_problems(group)
@@ -600,6 +624,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
         return [*problems, "conditions attribute is not JSON"]
+    problems += _program_problems(group.attrs)
     if problems:
         return problems
     signals = bool(group.attrs.get("signals", True))

@@ -66,10 +66,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicSpline
-from scipy.signal import savgol_filter
 
 from faultgen import axes
+from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
+from faultgen.derivatives import derivatives as _derivatives
+from faultgen.derivatives import is_uniform as _is_uniform
+from faultgen.derivatives import savgol_window as _savgol_window
 from faultgen.model import robots
 
 #: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
@@ -104,11 +106,8 @@ MIN_RATE = 100.0
 MAX_GAP = 0.05
 #: Shortest accepted recording in s (last minus first sample time).
 MIN_DURATION = 2.0
-#: Savitzky-Golay window in s (rounded to an odd number of samples) and polynomial order.
-SAVGOL_WINDOW = 0.05
-SAVGOL_ORDER = 3
-#: Sampling counts as uniform when every period is within this fraction of the median.
-UNIFORM_TOLERANCE = 1e-3
+# SAVGOL_WINDOW, SAVGOL_ORDER, UNIFORM_TOLERANCE: the Savitzky-Golay estimator's settings, imported
+# from faultgen.derivatives (shared with replayed task logs, faultgen.operation.replay)
 #: Joint angles may exceed the robot's joint range by this much (rad) before being refused.
 JOINT_RANGE_TOLERANCE = 0.05
 #: Angles beyond a full turn plus this margin (rad) cannot be radians of a revolute arm joint.
@@ -699,38 +698,6 @@ def acceleration(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     (xdd,) = _derivatives(t, np.asarray(x, dtype=float), period, _savgol_window(period, len(t)),
                           _is_uniform(dt, period), orders=(2,))
     return xdd
-
-
-def _is_uniform(dt: np.ndarray, period: float) -> bool:
-    """True when every sample interval is within :data:`UNIFORM_TOLERANCE` of the median ``period``."""
-    return bool(np.max(np.abs(dt - period)) <= UNIFORM_TOLERANCE * period)
-
-
-def _savgol_window(period: float, n: int) -> int:
-    """Odd window length closest to :data:`SAVGOL_WINDOW` s, at least order + 2, at most n."""
-    window = 2 * round(SAVGOL_WINDOW / (2 * period)) + 1
-    shortest = SAVGOL_ORDER + 2 if SAVGOL_ORDER % 2 else SAVGOL_ORDER + 3  # odd, > order + 1
-    window = max(window, shortest)
-    largest = n if n % 2 else n - 1
-    return min(window, largest)
-
-
-def _derivatives(
-    t: np.ndarray, q: np.ndarray, period: float, window: int, uniform: bool, orders: tuple[int, ...] = (1, 2)
-) -> tuple[np.ndarray, ...]:
-    """Derivatives of ``q`` (n, k) of the given ``orders`` by Savitzky-Golay, resampling if not uniform."""
-    if uniform:
-        return tuple(savgol_filter(q, window, SAVGOL_ORDER, deriv=d, delta=period, axis=0, mode="interp")
-                     for d in orders)
-    s = t - t[0]  # relative time: keeps the spline well conditioned for absolute time stamps
-    grid = np.arange(math.floor(s[-1] / period) + 1) * period
-    if grid[-1] < s[-1]:
-        grid = np.append(grid, grid[-1] + period)  # cover the last sample (spline extrapolates a bit)
-    q_grid = CubicSpline(s, q, axis=0)(grid)
-    return tuple(
-        CubicSpline(grid, savgol_filter(q_grid, window, SAVGOL_ORDER, deriv=d, delta=period, axis=0, mode="interp"),
-                    axis=0)(s)
-        for d in orders)
 
 
 # --------------------------------------------------------------------------------------------

@@ -52,6 +52,7 @@ import numpy as np
 
 from faultgen.checks import is_number, is_whole
 from faultgen.effects import temperature as temperature_law
+from faultgen.operation import programs
 from faultgen.operation.tasks import TASKS
 
 #: Seconds in a day.
@@ -219,7 +220,8 @@ class TaskMix:
     Attributes
     ----------
     tasks : tuple of str
-        Tasks of :data:`faultgen.operation.tasks.TASKS`; the run's own task must be one of them.
+        Tasks of :data:`faultgen.operation.tasks.TASKS` or program / joint log files
+        (:func:`faultgen.operation.programs.load`); the run's own task must be one of them.
         A task may be listed more than once to run it more often.
     pattern : str
         ``alternate`` (tasks in turn), ``blocks`` (``block`` cycles of each in turn) or ``random``
@@ -242,8 +244,10 @@ class TaskMix:
         if not tasks:
             raise ValueError("task mix: no task given; expected one or more of " + ", ".join(TASKS))
         for task in tasks:
-            if task not in TASKS:
-                raise ValueError(f"task mix: unknown task {task!r}; expected one of {', '.join(TASKS)}")
+            try:
+                programs.check_name(task)  # a thesis task, or a program / joint log file
+            except ValueError as err:
+                raise ValueError(f"task mix: {err}") from None
         _check_pattern(self.pattern, self.block, "task mix pattern", "task mix block")
         object.__setattr__(self, "tasks", tasks)
 

@@ -26,6 +26,15 @@ POSTURE_COST = 1e-3  # posture task weight (mink cost, per rad)
 POLISH_BELOW = 1e-4  # m or rad: closer than this, iterate without the posture task (no bias)
 
 
+class Unreachable(ValueError):
+    """IK found no arm angles for a flange pose; ``position_error`` (m) and ``orientation_error``
+    (rad) are what remained of the target when the iteration stopped."""
+
+    def __init__(self, message: str, position_error: float, orientation_error: float) -> None:
+        super().__init__(message)
+        self.position_error, self.orientation_error = position_error, orientation_error
+
+
 def arm_model(robot: Robot) -> mujoco.MjModel:
     """Arm-only copy of a robot's model: the six arm joints, no rotors, tendons or motors.
 
@@ -146,10 +155,31 @@ class FlangeIK:
             tasks = [self.frame] if np.linalg.norm(error) < POLISH_BELOW else [self.frame, self.posture]
             velocity = mink.solve_ik(config, tasks, 1.0, "daqp", damping=1e-9, limits=self.limits)
             config.integrate_inplace(velocity, 1.0)
-        raise ValueError(
+        raise Unreachable(
             f"IK did not converge to flange position {np.round(position, 4).tolist()} m: "
-            f"remaining error {np.linalg.norm(error[:3]):.2e} m, {np.linalg.norm(error[3:]):.2e} rad"
+            f"remaining error {np.linalg.norm(error[:3]):.2e} m, {np.linalg.norm(error[3:]):.2e} rad",
+            float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])),
         )
+
+    def nearest(self, position: np.ndarray, q_init: np.ndarray, starts: int = 16) -> float:
+        """Distance in m from ``position`` to the nearest flange position the arm reaches within its
+        joint ranges, in any orientation: the iteration of :meth:`solve` on the position alone, from
+        ``q_init``, the range centres and ``starts`` angles drawn uniformly within the ranges (a fixed
+        seed), the smallest of the local minima (a joint limit can stop one start short)."""
+        frame = mink.FrameTask(FLANGE, "site", position_cost=1.0, orientation_cost=0.0, lm_damping=1.0)
+        target = np.asarray(position, float)
+        frame.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.identity(), target))
+        low, high = self.model.jnt_range[:, 0], self.model.jnt_range[:, 1]
+        inits = [np.asarray(q_init, float), (low + high) / 2,
+                 *np.random.default_rng(0).uniform(low, high, (starts, len(low)))]
+        config, best = self.configuration, np.inf
+        for q0 in inits:
+            config.update(q0)
+            for _ in range(MAX_ITERATIONS):
+                velocity = mink.solve_ik(config, [frame], 1.0, "daqp", damping=1e-9, limits=self.limits)
+                config.integrate_inplace(velocity, 1.0)
+            best = min(best, float(np.linalg.norm(self.flange(config.q)[0] - target)))
+        return best
 
     def follow(
         self, knots: np.ndarray, points: np.ndarray, rotation: np.ndarray, q_start: np.ndarray, t: np.ndarray
@@ -235,6 +265,8 @@ class Seam:
         d = d / lengths[:, None]
         turns = [np.cross(a, b) for a, b in itertools.pairwise(d) if np.linalg.norm(np.cross(a, b)) > 1e-9]
         normal = turns[0] if turns else np.cross(np.cross(d[0], tool_axis), d[0])
+        if not np.linalg.norm(normal) > 1e-9:  # a straight line along the tool axis: any plane holds it
+            normal = np.cross(d[0], np.eye(3)[int(np.argmin(np.abs(d[0])))])
         self.normal = normal / np.linalg.norm(normal)
         if np.max(np.abs((v - v[0]) @ self.normal)) > 1e-9:
             raise ValueError("seam vertices must lie in one plane")
@@ -287,6 +319,45 @@ class Seam:
                 position[sel] = start + radius * (np.sin(phi) * d_in + (1 - np.cos(phi)) * d_mid)
                 tangent[sel] = np.cos(phi) * d_in + np.sin(phi) * d_mid
         return position, tangent
+
+
+class Arc:
+    """A circular arc through three points, parameterised by arc length (the same interface as
+    :class:`Seam`: ``normal``, ``length``, ``evaluate``).
+
+    Parameters
+    ----------
+    start, via, end : ndarray of shape (3,)
+        Points in m: the arc runs from ``start`` through ``via`` to ``end``.
+
+    Raises
+    ------
+    ValueError
+        If the points are (nearly) on one line or two coincide.
+    """
+
+    def __init__(self, start: np.ndarray, via: np.ndarray, end: np.ndarray) -> None:
+        a, b, c = (np.asarray(p, float) for p in (start, via, end))
+        n = np.cross(b - a, c - a)
+        scale = max(np.linalg.norm(b - a), np.linalg.norm(c - a), 1e-12)
+        if not np.linalg.norm(n) > 1e-6 * scale**2:
+            raise ValueError("the arc's start, via and end points are on one line (or two coincide)")
+        self.normal = n / np.linalg.norm(n)
+        # circumcentre of the triangle a, b, c
+        ab, ac = b - a, c - a
+        centre = a + (np.dot(ac, ac) * np.cross(n, ab) - np.dot(ab, ab) * np.cross(n, ac)) / (2 * np.dot(n, n))
+        self.centre, self.radius = centre, float(np.linalg.norm(a - centre))
+        self._u = (a - centre) / self.radius
+        self._v = np.cross(self.normal, self._u)
+        d = c - centre
+        angle = float(np.arctan2(np.dot(d, self._v), np.dot(d, self._u))) % (2 * np.pi)
+        self.length = self.radius * angle
+
+    def evaluate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and unit tangents, each ``(n, 3)``, at arc lengths ``s`` (n,) in m."""
+        phi = np.clip(np.asarray(s, float), 0.0, self.length)[:, None] / self.radius
+        position = self.centre + self.radius * (np.cos(phi) * self._u + np.sin(phi) * self._v)
+        return position, -np.sin(phi) * self._u + np.cos(phi) * self._v
 
 
 def ramp_arc_length(t: np.ndarray, speed: float, ramp: float, duration: float) -> np.ndarray:

@@ -62,7 +62,10 @@ class JointPath:
     segments : tuple of (str, int, int)
         ``(label, first, last)``: consecutive parts of the cycle as inclusive sample indices
         (neighbours share their boundary sample). Labels: ``move``, ``dwell`` (task 1),
-        ``weld`` (task 2), ``approach``, ``seam``, ``retract`` (task 3).
+        ``weld`` (task 2), ``approach``, ``seam``, ``retract`` (task 3); a program's own labels.
+    loads : tuple of faultgen.operation.programs.Load
+        Payloads a program grips and releases within the cycle (sample ranges and parameters);
+        empty for the thesis tasks.
     """
 
     t: np.ndarray
@@ -71,6 +74,7 @@ class JointPath:
     qdd: np.ndarray
     target: np.ndarray
     segments: tuple[tuple[str, int, int], ...]
+    loads: tuple = ()
 
     @property
     def duration(self) -> float:
@@ -151,24 +155,9 @@ class Task:
 
     def _move(self, path: _Builder, label: str, q_to: np.ndarray) -> None:
         """Append a ruckig rest-to-rest move from the path's last sample to ``q_to``."""
-        n = len(q_to)
-        otg = Ruckig(n, PLAN_PERIOD)
-        inp = InputParameter(n)
-        inp.current_position, inp.target_position = path.last, q_to
-        inp.current_velocity = inp.current_acceleration = np.zeros(n)
-        inp.target_velocity = inp.target_acceleration = np.zeros(n)
-        inp.max_velocity = self.velocity_scale * self.velocity_limit
-        inp.max_acceleration = self.acceleration_scale * self.acceleration_limit
-        inp.max_jerk = self.jerk_limit
-        inp.duration_discretization = DurationDiscretization.Discrete
-        trajectory = Trajectory(n)
-        if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
-            raise ValueError(f"{self.robot_name} {self.name}: ruckig found no move to {np.round(q_to, 4)}")
-        steps = round(trajectory.duration / path.dt)
-        samples = [trajectory.at_time(k * path.dt) for k in range(steps)]
-        q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, n)
-        qd = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
-        qdd = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
+        q, qd, qdd = ptp(path.last, q_to, self.velocity_scale * self.velocity_limit,
+                         self.acceleration_scale * self.acceleration_limit, self.jerk_limit, path.dt,
+                         f"{self.robot_name} {self.name}")
         path.add(label, q, qd, qdd)
 
     def _solve(self, ik: FlangeIK, what: str, position, rotation, q_init) -> np.ndarray:
@@ -337,12 +326,60 @@ class ArcWeldTask(Task):
             )
 
 
+def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray,
+        dt: float, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A ruckig rest-to-rest joint move (jerk-limited, time-optimal, all axes finishing together,
+    lasting whole :data:`PLAN_PERIOD`), sampled every ``dt`` s.
+
+    Parameters
+    ----------
+    q_from, q_to : ndarray of shape (N,)
+        Start and end arm angles, rad (N the robot's axes).
+    velocity, acceleration, jerk : ndarray of shape (N,)
+        Limits of the move, rad/s, rad/s^2, rad/s^3.
+    dt : float
+        Sample step, s.
+    where : str
+        Names the move in an error message.
+
+    Returns
+    -------
+    q, qd, qdd : ndarray of shape (n, N)
+        From ``q_from`` to ``q_to`` inclusive; the first and last samples at rest.
+
+    Raises
+    ------
+    ValueError
+        If ruckig finds no move.
+    """
+    n = len(q_from)
+    otg = Ruckig(n, PLAN_PERIOD)
+    inp = InputParameter(n)
+    inp.current_position, inp.target_position = q_from, q_to
+    inp.current_velocity = inp.current_acceleration = np.zeros(n)
+    inp.target_velocity = inp.target_acceleration = np.zeros(n)
+    inp.max_velocity = velocity
+    inp.max_acceleration = acceleration
+    inp.max_jerk = jerk
+    inp.duration_discretization = DurationDiscretization.Discrete
+    trajectory = Trajectory(n)
+    if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
+        raise ValueError(f"{where}: ruckig found no move to {np.round(q_to, 4)}")
+    steps = round(trajectory.duration / dt)
+    samples = [trajectory.at_time(k * dt) for k in range(steps)]
+    q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, n)
+    qd = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
+    qdd = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
+    return q, qd, qdd
+
+
 class _Builder:
     """Collects path pieces; each piece starts at the previous piece's last sample."""
 
     def __init__(self, q0: np.ndarray, dt: float) -> None:
         self.dt = dt
-        self.q, self.qd, self.qdd = [q0[None].copy()], [np.zeros((1, len(q0)))], [np.zeros((1, len(q0)))]
+        n = len(q0)  # the robot's axes
+        self.q, self.qd, self.qdd = [q0[None].copy()], [np.zeros((1, n))], [np.zeros((1, n))]
         self.target = [np.full((1, 3), np.nan)]
         self.tolerance = [np.zeros(1)]
         self.segments: list[tuple[str, int, int]] = []
@@ -442,6 +479,7 @@ def load(robot: Robot | str, name: str) -> Task:
         if key not in ("limits", *TASKS):
             raise ValueError(f"{path}: unknown table [{key}]; expected [limits] and {', '.join(TASKS)}")
     limits = _Table(path, data, "limits", ("velocity", "acceleration", "jerk"))
+    n_axes = len(robot.joint_names)
     table = _Table(path, data, name, _KEYS[name])
     start = table.angles("start", robot)
     common = {
@@ -449,9 +487,9 @@ def load(robot: Robot | str, name: str) -> Task:
         "robot_name": robot.name,
         "process": PROCESSES[name],
         "source": path,
-        "velocity_limit": limits.array("velocity", (robot.n_axes,), np.pi / 180, positive=True),
-        "acceleration_limit": limits.array("acceleration", (robot.n_axes,), np.pi / 180, positive=True),
-        "jerk_limit": limits.array("jerk", (robot.n_axes,), np.pi / 180, positive=True),
+        "velocity_limit": limits.array("velocity", (n_axes,), np.pi / 180, positive=True),
+        "acceleration_limit": limits.array("acceleration", (n_axes,), np.pi / 180, positive=True),
+        "jerk_limit": limits.array("jerk", (n_axes,), np.pi / 180, positive=True),
         "start": start[0],
         "velocity_scale": table.fraction("velocity_scale"),
         "acceleration_scale": table.fraction("acceleration_scale"),
@@ -552,7 +590,7 @@ class _Table:
 
     def angles(self, key: str, robot: Robot, many: bool = False) -> np.ndarray:
         """Joint angles given in deg, one (6,) or ``many`` (m, 6), as rad (m, 6) within the ranges."""
-        n = robot.n_axes
+        n = len(robot.joint_names)
         q = self.array(key, (None, n) if many else (n,), np.pi / 180).reshape(-1, n)
         low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
         bad = np.argwhere((q < low) | (q > high))

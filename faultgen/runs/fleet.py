@@ -38,7 +38,7 @@ from faultgen.effects import friction as friction_models
 from faultgen.effects.payload import Payload
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots as robot_models
-from faultgen.operation import conditions, faults, tasks, wear
+from faultgen.operation import conditions, faults, programs, tasks, wear
 from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -154,6 +154,10 @@ class Fleet:
         Conditions left out of every robot, some of :data:`CONDITIONS` (``thermal``: the hall
         climate and warm-up; ``payloads``: the parts; ``spread``: the unit spread), the others kept
         with the same draws: the ablation of one condition at a time. Default none.
+    tasks : tuple of str
+        The pool each robot draws its process from: thesis task names, program files or joint logs
+        (:func:`faultgen.operation.programs.load`). Default the three thesis tasks (the draws and
+        stored settings of the fleets made before the pool could be set).
     task_mix : bool
         Each robot runs a second task, drawn from the other two, in a random half of its cycles
         (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
@@ -202,6 +206,7 @@ class Fleet:
     fault: str | None = None
     dry_share: float = temperature_law.DRY_SHARE
     without: tuple[str, ...] = ()
+    tasks: tuple[str, ...] = tasks.TASKS
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -243,6 +248,16 @@ class Fleet:
                                  "onset day); give EFFECT:PARAMETER:FINAL[:key=value,...] without them")
             self._fault(1, first)  # a bad spec is named now, not when the runs are built
         object.__setattr__(self, "models", tuple(self.models))
+        pool = self.tasks
+        if isinstance(pool, str) or not pool or len(set(pool)) != len(tuple(pool)):
+            raise ValueError(f"fleet tasks = {pool!r}: expected one or more different tasks (thesis task names, "
+                             "program files or joint logs)")
+        for task in pool:
+            programs.check_name(task)
+        if self.task_mix and len(pool) < 2:
+            raise ValueError(f"fleet task_mix draws a second task from the pool, which holds only {tuple(pool)!r}; "
+                             "give two or more tasks")
+        object.__setattr__(self, "tasks", tuple(pool))
 
     def _check_without(self) -> None:
         """Refuse a ``without`` that names an unknown condition, comes with the conditions off, or
@@ -271,7 +286,7 @@ class Fleet:
         for i in range(self.size):
             rng = np.random.default_rng([self.seed, i + 1])
             model = self.models[i % len(self.models)]
-            task = str(rng.choice(tasks.TASKS))
+            task = str(rng.choice(self.tasks))
             robot_model = robot_models.load(model)
             axis = int(rng.integers(1, robot_model.n_axes + 1))
             onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
@@ -290,11 +305,11 @@ class Fleet:
                 table = {"cycles_per_day": self.cycles_per_day, "hours": self.hours()}
             for name in self.without:  # drawn all the same, so the kept conditions are as in the full fleet
                 del table[name]
-            second = str(rng.choice([t for t in tasks.TASKS if t != task]))  # drawn last: the draws above stay
+            second = str(rng.choice([t for t in self.tasks if t != task]))  # drawn last: the draws above stay
             if self.task_mix:
                 table["task_mix"] = {"tasks": [task, second], "pattern": "random"}
             fails = i in failing
-            out.append({"run": f"robot{i + 1:02d}-{robot_model.name}-{task}-{'failing' if fails else 'healthy'}",
+            out.append({"run": f"robot{i + 1:02d}-{robot_model.name}-{programs.label(task)}-{'failing' if fails else 'healthy'}",
                         "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,
                         "onset_day": onset_day if fails else None, "failure_day": self.days if fails else None,
                         "seed": self.seed * 10000 + i, "conditions": table})
@@ -337,7 +352,8 @@ class Fleet:
     def to_json(self) -> str:
         """The settings and every robot's draws, stored with the dataset."""
         settings = asdict(self)
-        later = {"gear_loss": 0.0, "fault": None, "dry_share": temperature_law.DRY_SHARE, "without": ()}
+        later = {"gear_loss": 0.0, "fault": None, "dry_share": temperature_law.DRY_SHARE, "without": (),
+                 "tasks": tasks.TASKS}
         for name, default in later.items():  # at their defaults, the settings of fleets made before they existed
             if settings[name] == default:
                 del settings[name]

@@ -47,7 +47,7 @@ from faultgen import axes as axis_numbers
 from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
-from faultgen.operation import faults, tasks, wear
+from faultgen.operation import faults, programs, tasks, wear
 from faultgen.operation.conditions import Conditions
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -267,7 +267,7 @@ class Grid:
                 else:
                     plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
                     label = f"axis{axis}-{kind}{pct:g}"
-                out[f"{name}-{task}-{label}-seed{seed}"] = sim.RunConfig(
+                out[f"{name}-{programs.label(task)}-{label}-seed{seed}"] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
                     seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault)
         return list(out.items())

@@ -93,7 +93,8 @@ class Work:
     """One batch of simulations stepped together: recorded ``cycles`` (n,), their ``plant`` (wear
     and conditions), the start angles ``q0`` (N,), the drive ``inputs`` at every physics step
     (n_steps + 1, N, 3), the load disturbance ``dist`` per log period (n, n_log, N), physics steps
-    per log period, MuJoCo threads, and for a fault the fields it moves and its final value."""
+    per log period, MuJoCo threads, for a fault the fields it moves and its final value, and for a
+    program that grips a part the steps where its mass changes (:func:`apply_grips`)."""
 
     cycles: np.ndarray
     plant: Plant
@@ -103,6 +104,7 @@ class Work:
     per_log: int
     nthread: int
     fault: tuple | None = None
+    grips: tuple = ()
 
 
 @dataclass
@@ -126,6 +128,20 @@ def new_batch(sim, work: Work) -> mjbatch.Batch:
     if work.fault is not None:
         work.plant.set_fault(batch, *work.fault)
     return batch
+
+
+def apply_grips(batch, grips: tuple, step: int) -> None:
+    """Set the gripped body's mass and inertia at physics ``step`` where a program grips or releases
+    (``grips``: ``(step, (body, mass, inertia, ipos, iquat))`` pairs); the same for every simulation."""
+    for at, (body, mass, inertia, ipos, iquat) in grips:
+        if at == step:
+            batch.expand("body_mass")[:, body] = mass
+            batch.expand("body_inertia")[:, body] = inertia
+            batch.expand("body_ipos")[:, body] = ipos
+            batch.expand("body_iquat")[:, body] = iquat
+            # the constants MuJoCo derives from the masses (constraint weights, subtree masses) follow,
+            # so an empty gripper is the same model whatever part the program grips
+            batch.set_const()
 
 
 def check_diverged(sim, batch, cycles: np.ndarray, velocities: np.ndarray, step: int) -> None:

@@ -8,11 +8,11 @@ import numpy as np
 
 from faultgen.checks import is_whole
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs
 from faultgen.operation.conditions import Conditions
 from faultgen.operation.faults import Fault
 from faultgen.operation.wear import WearPlan
-from faultgen.simulation import friction_models, sensors
+from faultgen.simulation import friction_models, prepare, sensors
 
 
 @dataclass(frozen=True)
@@ -24,7 +24,8 @@ class RunConfig:
     robot : str
         Robot name (``faultgen robots``) or MJCF path.
     task : str
-        One of :data:`faultgen.tasks.TASKS`.
+        One of :data:`faultgen.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
+        (``.csv``, ``.h5``): :func:`faultgen.operation.programs.load`.
     friction : str
         Friction model, one of :data:`faultgen.friction.MODELS`.
     wear : WearPlan
@@ -85,8 +86,9 @@ class RunConfig:
 
     def __post_init__(self) -> None:
         n_axes = robots.load(self.robot).n_axes  # UnknownRobotError / ModelError (ValueErrors) name the problem
-        if self.task not in tasks.TASKS:
-            raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
+        programs.check_name(self.task)  # a thesis task, or a program / joint log file
+        if programs.is_file_task(self.task):  # checked before any simulation (segment and value named)
+            prepare.task_path(self.robot, self.task, *prepare.file_stamps(self.robot, self.task))
         stepping = friction_models.get(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")

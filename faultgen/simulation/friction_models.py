@@ -20,7 +20,7 @@ from faultgen.effects import friction
 from faultgen.effects.base import Effect
 from faultgen.effects.load_dependent_friction import LoadDependentFriction
 from faultgen.model import robots
-from faultgen.simulation.batch import CHUNK_PERIODS, Raw, Work, check_diverged, new_batch
+from faultgen.simulation.batch import CHUNK_PERIODS, Raw, Work, apply_grips, check_diverged, new_batch
 
 
 def stepped_effects(robot: robots.Robot) -> list:
@@ -99,8 +99,10 @@ class LuGre(FrictionModel):
         logs = {f.name: np.empty((n_sim, n_steps // per_log, robot.n_axes)) for f in fields(Raw)}
         arm_dist = model.nu + robot.arm_dof
         last_qvel = batch.qvel.copy()
-        for start in range(0, n_steps, chunk):
-            stop = min(start + chunk, n_steps)
+        # chunks also break where a program grips or releases a payload (whole log periods: segment boundaries)
+        starts = sorted({*range(0, n_steps, chunk), *(at for at, _ in work.grips if 0 < at < n_steps)})
+        for start, stop in zip(starts, [*starts[1:], n_steps]):
+            apply_grips(batch, work.grips, start)
             size = stop - start
             control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
             control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
@@ -176,6 +178,8 @@ class Stribeck(FrictionModel):
                 deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
                 for effect in extras:
                     frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
+            if work.grips:
+                apply_grips(batch, work.grips, step)
             ctrl[:, sim.drive_ctrl] = inputs[step]
             applied[:, arm] = dist[:, step // per_log]
             logged = (step + 1) % per_log == 0

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import functools
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs, tasks
 from faultgen.operation.faults import Fault
 from faultgen.simulation import sensors
 from faultgen.simulation.model import SimModel, build
@@ -36,6 +37,9 @@ class Prepared:
     fault_fields : tuple
         For a model with a growing fault: the fields its parameter moves (:func:`_affine_fields`),
         set per simulation from each cycle's value.
+    grips : tuple
+        For a program that grips and releases a payload: ``(physics step, gripped body's values)``
+        where its mass changes (:func:`faultgen.simulation.batch.apply_grips`).
     """
 
     sim: SimModel
@@ -44,6 +48,7 @@ class Prepared:
     q_ref: np.ndarray
     inputs: np.ndarray
     fault_fields: tuple = ()
+    grips: tuple = ()
 
     @property
     def per_log(self) -> int:
@@ -56,17 +61,36 @@ def prepared_for(robot: str, task: str, friction_model: str, payload: dict | Non
     """:func:`_prepare`, renewed when the robot's model or task file changes; ``payload``: the
     :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
     a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
+    stamps = file_stamps(robot, task)
+    if payload is None and fault is None:
+        return _prepare(robot, task, friction_model, *stamps)
+    key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
+    return _prepare_variant(robot, task, friction_model, None if payload is None else tuple(sorted(payload.items())),
+                            key, *stamps)
+
+
+def file_stamps(robot: str, task: str) -> tuple[int, ...]:
+    """Modification times of the robot's model and task files (and of a program or log file, with
+    its size): what renews the cached preparations. Raises ValueError for a model file copied
+    without its ``tasks.toml``."""
     model_file = robots.load(robot).path
     tasks_file = model_file.parent / "tasks.toml"
     if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
                          "with it (the model `faultgen calibrate` writes has one)")
     stamps = (model_file.stat().st_mtime_ns, tasks_file.stat().st_mtime_ns)
-    if payload is None and fault is None:
-        return _prepare(robot, task, friction_model, *stamps)
-    key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
-    return _prepare_variant(robot, task, friction_model, None if payload is None else tuple(sorted(payload.items())),
-                            key, *stamps)
+    if programs.is_file_task(task):
+        stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
+    return stamps
+
+
+@functools.lru_cache(maxsize=16)
+def task_path(robot_name: str, task_name: str, *file_stamps: int):
+    """The task (thesis task, program or replayed log) and its checked path at the robot's physics
+    step, once per process (``file_stamps`` renew it on edits)."""
+    robot = robots.load(robot_name)
+    task = programs.load(robot, task_name)
+    return task, task.trajectory(robot.model.opt.timestep)
 
 
 @functools.lru_cache(maxsize=16)
@@ -79,6 +103,9 @@ def _prepare_variant(robot_name: str, task_name: str, friction_model: str, paylo
     simulation), and a feedforward with the payload only (the controller knows the load it carries,
     not the fault)."""
     nominal = _prepare(robot_name, task_name, friction_model, *file_stamps)
+    if nominal.grips:
+        raise ValueError(f"{task_name} grips and releases a payload within the cycle; it runs without the payload "
+                         "condition (--payloads) and without a growing fault")
     robot = robots.load(robot_name)
     load = None if payload is None else Payload(**dict(payload))
 
@@ -150,16 +177,29 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
     Arrays are made read-only so no run can change what the next one gets.
     """
     robot = robots.load(robot_name)
-    sim = build(robot, friction_model)
-    task = tasks.load(robot, task_name)
-    path = task.trajectory(sim.model.opt.timestep)
+    task, path = task_path(robot_name, task_name, *file_stamps)
+    loads = getattr(path, "loads", ())
+    sim = build(robot, friction_model,
+                edit=(lambda spec: programs.add_part(spec, robot, loads[0].params)) if loads else None)
     per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
     inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, N, 3)
+    grips = ()
+    if loads:  # the drives know the part they carry: its feedforward where the program grips it
+        body = sim.model.body(programs.GRIP_BODY).id
+        events = {0: (body, 0.0, np.zeros(3), np.zeros(3), np.array([1.0, 0, 0, 0]))}
+        for load in loads:
+            carrying = robot.edited(lambda spec, p=load.params: programs.add_part(spec, robot, p))
+            with_load = replace(sim, robot=carrying).setpoints(q_ref, qd_ref, qdd_ref)
+            inputs[load.first:load.last] = with_load[load.first:load.last]
+            grip = carrying.model.body(programs.GRIP_BODY)
+            events[load.first] = (body, float(grip.mass[0]), grip.inertia.copy(), grip.ipos.copy(), grip.iquat.copy())
+            events[load.last] = events[0]
+        grips = tuple(sorted(events.items()))
     for array in (q_ref, inputs):
         array.setflags(write=False)
-    return Prepared(sim, task, path, q_ref, inputs)
+    return Prepared(sim, task, path, q_ref, inputs, grips=grips)
 
 
 def cycle_duration(robot: str, task: str) -> float:

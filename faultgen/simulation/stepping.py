@@ -100,6 +100,12 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
         started = time.perf_counter()
         if config.back_to_back:  # one simulation over the cycles' set-points one after the other
             chained = np.concatenate([inputs[:-1]] * len(cycles) + [inputs[-1:]])
+            if prepared.grips:
+                raise ValueError(f"{task_name} grips and releases a payload within the cycle; back_to_back runs "
+                                 "do not switch it")
+            if not np.array_equal(path.q[0], path.q[-1]):
+                raise ValueError(f"{task_name} ends {np.max(np.abs(path.q[-1] - path.q[0])):.4g} rad away from where it "
+                                 "starts; back_to_back runs need a cycle that returns to its start")
             one = stepper(sim, Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
             raw = Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, robot.n_axes) for f in fields(Raw)})
@@ -115,7 +121,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
                     raws.append(stepper(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
-                                                           dist[g], per_log, config.nthread, fault), bar))
+                                                           dist[g], per_log, config.nthread, fault, variant.grips),
+                                        bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
             raw = Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(Raw)})
