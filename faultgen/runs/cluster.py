@@ -39,7 +39,7 @@ import numpy as np
 from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
-from faultgen.runs.sweep import RunStats, SweepError, _release_memory, simulate_and_write
+from faultgen.runs.sweep import RunStats, SweepError, SweepRefused, _release_memory, simulate_and_write
 from faultgen.simulation import stepping as sim
 
 #: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
@@ -140,8 +140,10 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
 
     Raises
     ------
+    SweepRefused
+        If the scheduler cannot be reached (nothing ran).
     SweepError
-        If the scheduler cannot be reached or is lost, a worker runs another robot model, with
+        If the scheduler is lost, a worker runs another robot model, with
         ``shared`` if a worker cannot see ``parts``, or (after every other run finished) if runs
         failed: the message names the first and how many; every finished run is kept.
     OSError
@@ -152,7 +154,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
     except (OSError, ValueError) as err:
-        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
+        raise SweepRefused(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
     folder = parts.resolve()
     with client:
         if shared:
