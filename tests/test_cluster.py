@@ -96,29 +96,32 @@ class Cluster:
             self.kill(name)
 
 
-@pytest.fixture(scope="module")
-def cluster(tmp_path_factory):
-    cluster = Cluster(tmp_path_factory.mktemp("cluster"))
-    try:
-        for name in ("w1", "w2"):
-            cluster.start_worker(name)
-        yield cluster
-    finally:
-        cluster.close()
-
-
-@pytest.fixture(scope="module")
+@pytest.fixture
 def reference(shared_sweep) -> Path:
     """The small sweep of tests/test_sweep.py on one local job (built once per session)."""
     return shared_sweep("sweep-reference", **SMALL)
 
 
-@pytest.fixture
-def client_folder(tmp_path, monkeypatch) -> Path:
-    """The client's working directory, where OUT is (``out/``); no worker is told its path."""
-    (tmp_path / "out").mkdir()
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
+def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(reference, tmp_path, monkeypatch,
+                                                                                subtests):
+    """One test on one cluster (pytest-xdist would start a cluster in each of its workers that
+    got one of several tests), each case a subtest: a sweep and a fleet equal the local ones, a
+    shared folder, a worker killed mid-run, the client killed mid-run."""
+    client_folder = tmp_path / "client"  # the client's working directory, OUT in out/; no worker gets its path
+    (client_folder / "out").mkdir(parents=True)
+    (tmp_path / "cluster").mkdir()
+    monkeypatch.chdir(client_folder)
+    cluster = Cluster(tmp_path / "cluster")
+    try:
+        for name in ("w1", "w2"):
+            cluster.start_worker(name)
+        for case in (sweep_and_fleet_equal_the_local_ones, with_a_shared_folder_the_workers_write_the_parts,
+                     a_worker_killed_mid_run_loses_only_that_run_to_another_worker,
+                     a_killed_client_resumes_to_the_same_dataset):
+            with subtests.test(case.__name__.replace("_", " ")):
+                case(cluster, reference, client_folder)
+    finally:
+        cluster.close()
 
 
 def assert_same_files(a: Path, b: Path) -> None:
@@ -146,7 +149,7 @@ def where_runs_went(output: str) -> dict[str, str]:
     return dict(re.findall(r"^(\S+): (tcp://[^,]+), ", output, flags=re.MULTILINE))
 
 
-def test_a_sweep_and_a_fleet_run_on_workers_that_cannot_see_out(cluster, reference, client_folder):
+def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder):
     runner = CliRunner()
     result = runner.invoke(app, ["sweep", *SMALL_ARGS, "--scheduler", cluster.address, "--no-progress",
                                  "-o", "out/s.h5"])
@@ -169,7 +172,7 @@ def test_a_sweep_and_a_fleet_run_on_workers_that_cannot_see_out(cluster, referen
         assert not (cluster.root / name / "out").exists()
 
 
-def test_with_a_shared_folder_the_workers_write_the_parts(cluster, reference, client_folder):
+def with_a_shared_folder_the_workers_write_the_parts(cluster, reference, client_folder):
     result = CliRunner().invoke(app, ["sweep", *SMALL_ARGS[:4], "--axis", "0", "--axis", "5", *SMALL_ARGS[-4:],
                                       "--scheduler", cluster.address, "--shared-folder", "--no-progress",
                                       "-o", "out/shared.h5"])
@@ -182,7 +185,7 @@ def test_with_a_shared_folder_the_workers_write_the_parts(cluster, reference, cl
                 assert np.array_equal(f["runs"][run_id][name][()], g["runs"][run_id][name][()]), name
 
 
-def test_a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, reference, client_folder):
+def a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, reference, client_folder):
     victim = cluster.start_worker("victim")
     kept, failure = [], []
 
@@ -208,7 +211,7 @@ def test_a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, 
     assert_same_datasets(reference, Path("out/k.h5"))
 
 
-def test_a_killed_client_resumes_to_the_same_dataset(cluster, reference, client_folder):
+def a_killed_client_resumes_to_the_same_dataset(cluster, reference, client_folder):
     command = [sys.executable, "-m", "faultgen.cli", "sweep", *SMALL_ARGS, "--scheduler", cluster.address,
                "--no-progress", "-o", "out/c.h5"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
