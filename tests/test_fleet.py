@@ -315,3 +315,29 @@ def test_a_fleet_without_one_condition_keeps_the_others_as_drawn():
     config = dict(Fleet(without=("payloads",)).runs())[full[0]["run"]]
     assert config.conditions.payloads is None and config.conditions.thermal is not None
     assert config.conditions.spread is not None
+
+
+def test_a_daily_run_is_stepped_in_blocks_of_days_with_the_same_arrays(monkeypatch):
+    """A fleet robot's cycles are stepped a block of whole days at a time, each reduced to its days
+    before the next (its memory does not grow with its days), and give the arrays of one block."""
+    config = dict(Fleet(size=2, failing=1, days=6, onset=(1, 3), task_mix=True, seed=2).runs())
+    run_id = next(r for r in config if "failing" in r)
+    stepped = []
+    step = sim._simulate_task
+    monkeypatch.setattr(sim, "_simulate_task", lambda c, task, cycles, *rest: stepped.append(len(cycles)) or step(
+        c, task, cycles, *rest))
+    monkeypatch.setattr(sim, "DAILY_BLOCK_CYCLES", 1000)
+    whole = sim.simulate(config[run_id], progress=False)
+    assert sum(stepped) == 12
+    stepped.clear()
+    monkeypatch.setattr(sim, "DAILY_BLOCK_CYCLES", 5)  # two days of two cycles at a time
+    blocks = sim.simulate(config[run_id], progress=False)
+    assert sum(stepped) == 12 and max(stepped) <= 4
+    assert blocks.cycles.tolist() == whole.cycles.tolist() == [1, 2, 3, 4, 5, 6]
+    for name in ("friction_multiplier", "mean_friction_torque", "tracking_error", "tau_m"):
+        assert np.array_equal(getattr(blocks, name), getattr(whole, name)), name
+    assert blocks.features.keys() == whole.features.keys()
+    for name, value in whole.features.items():
+        assert np.array_equal(blocks.features[name], value), name
+    for name in ("day", "joint_temperature", "payload_mass", "task_index", "link_mass_factor"):
+        assert np.array_equal(getattr(blocks.conditions, name), getattr(whole.conditions, name)), name

@@ -13,6 +13,14 @@ import typer
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
 Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run is started; more than the CPU cores only slows each down).", min=1, max=1024)]
+Scheduler = Annotated[str | None, typer.Option(
+    help="Run on the Dask cluster of this scheduler (tcp://host:port) instead of local processes: its workers need "
+    "faultgen, not OUT's folder; each run comes back to this process, which writes it (docs/dataset.md, "
+    "\"Running on a cluster\").")]
+SharedFolder = Annotated[bool, typer.Option(
+    "--shared-folder", help="With --scheduler: the workers write their runs into OUT's folder themselves, which "
+    "they must all see at the same absolute path (a shared file system; checked first): the client then only merges "
+    "(docs/performance.md, \"Scaling out\", says when that is faster).")]
 QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q limit (0.05: 95 % limit).", min=1e-9, max=0.5)]
 Friction = Annotated[str | None, typer.Option(
     "--friction", help="Motor-side friction model: lugre (dynamic) or stribeck (static eq. 6.3; needed for "

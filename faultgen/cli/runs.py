@@ -13,8 +13,8 @@ import typer
 from faultgen.cli.base import Command, check_outputs, parse_cycles
 from faultgen.cli.main import app
 from faultgen.cli.options import (
-    CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress, StartDay,
-    TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
+    CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress, Scheduler,
+    SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
 )
 
 
@@ -140,9 +140,8 @@ def sweep_command(
         "the signals), or keep the signals. Default: the preset's (c2: features only), else signals.",
         show_default=False)] = None,
     jobs: Jobs = 2,
-    scheduler: Annotated[
-        str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
-    ] = None,
+    scheduler: Scheduler = None,
+    shared_folder: SharedFolder = False,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -197,7 +196,8 @@ def sweep_command(
             typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
                        "they are")
 
-    run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce)
+    run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
+              shared=shared_folder)
     typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
@@ -238,6 +238,8 @@ def fleet_command(
         "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
         "backlash:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
     jobs: Jobs = 2,
+    scheduler: Scheduler = None,
+    shared_folder: SharedFolder = False,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -258,6 +260,7 @@ def fleet_command(
       faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
       faultgen fleet --robot irb6700 --fault cogging:amplitude:0.5:poles=8 -o fleet-cogging.h5
       faultgen fleet --without payloads -o fleet-no-parts.h5
+      faultgen fleet --robots 500 --days 365 --scheduler tcp://10.0.0.5:8786 -o fleet-500.h5
     """
     from faultgen.runs import fleet
 
@@ -275,21 +278,27 @@ def fleet_command(
         raise ValueError(f"--jobs {jobs}: expected >= 1")
     check_outputs([out], overwrite)
 
+    where = f" on {scheduler}" if scheduler else f" with {jobs} job(s)"
+
     def announce(n_runs: int, done: int) -> None:
-        typer.echo(f"{n_runs} robots x {days} days -> {out} with {jobs} job(s)"
+        typer.echo(f"{n_runs} robots x {days} days -> {out}{where}"
                    + (f"; resuming, {done} robots already finished" if done else ""))
 
-    run_sweep(plan, out, jobs=jobs, scheduler=None, progress=progress, overwrite=overwrite, announce=announce)
+    run_sweep(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
+              shared=shared_folder)
     typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
                f"  faultgen detect {out}")
 
 
 def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
-              announce) -> None:
+              announce, shared: bool = False) -> None:
     """:func:`faultgen.runs.sweep.run` for a command, recording the command line in the dataset.
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
-    before anything ran, 130 interrupted with the finished runs kept, 1 a run failed."""
+    before anything ran, 130 interrupted with the finished runs kept, 1 a run failed. On a
+    cluster, each run's worker is printed as the run is kept."""
     import os
+
+    from tqdm.auto import tqdm
 
     from faultgen.runs import sweep
 
@@ -297,8 +306,15 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
     if scheduler is None and jobs > cores:
         typer.echo(f"warning: --jobs {jobs} is more than the {cores} CPU cores: the runs share them and each takes "
                    f"longer (and memory: about 150 MB per worker); --jobs {cores} is as fast", err=True)
+    if shared and not scheduler:
+        raise ValueError("--shared-folder is for the workers of a Dask cluster: add --scheduler ADDRESS, or drop it")
+
+    def where(stats) -> None:
+        tqdm.write(f"{stats.run_id}: {stats.worker}, {stats.total:.1f} s, worker peak {stats.memory / 1e6:.0f} MB")
+
     sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
-              command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
+              command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared,
+              on_run=where if scheduler else None)
 
 
 def summary(result, out: Path) -> str:

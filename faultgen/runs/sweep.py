@@ -1,7 +1,8 @@
 """Wear sweeps: a grid of runs (robot x task x worn axis x wear x schedule x seed) into one dataset.
 
 Every run is simulated by a worker (joblib processes locally, or Dask distributed workers) and
-written by that worker to its own part file in ``<out>.parts/``, atomically. When every run is
+written to its own part file in ``<out>.parts/``, atomically: by a local worker itself, by this
+process for a Dask worker, which sends the run back (:mod:`faultgen.runs.cluster`). When every run is
 there, the parts are merged into the dataset ``<out>`` (renamed into place last) and the part
 folder is removed. Running the same sweep again after a crash, kill or Ctrl-C resumes: finished parts are
 kept as they are and only the missing runs are simulated.
@@ -278,13 +279,18 @@ class Grid:
 
 @dataclass(frozen=True)
 class RunStats:
-    """What one worker did: simulated seconds and the wall time of each phase, s."""
+    """What one worker did: simulated seconds and the wall time of each phase, s; on a Dask
+    cluster also where (``worker``, its address) and the worker process's peak resident set so far
+    (``memory``, bytes; 0 for local workers). A run sent back through Dask is written by the client:
+    ``writing`` is then the client's time."""
 
     run_id: str
     simulated: float
     total: float
     stepping: float
     writing: float
+    worker: str = ""
+    memory: int = 0
 
 
 def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "") -> RunStats:
@@ -417,7 +423,7 @@ def finished_runs(grid: Grid, out: str | Path) -> list[str]:
 def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
         command: str = "", on_run: Callable[[RunStats], None] | None = None,
         timings: dict | None = None, overwrite: bool = False,
-        on_start: Callable[[int, int], None] | None = None) -> Path:
+        on_start: Callable[[int, int], None] | None = None, shared: bool = False) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
@@ -427,8 +433,9 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     jobs : int
         Local worker processes (joblib); ignored with ``scheduler``.
     scheduler : str, optional
-        Address of a Dask distributed scheduler (``tcp://host:port``); its workers must see the
-        folder of ``out`` (a shared file system).
+        Address of a Dask distributed scheduler (``tcp://host:port``). Its workers send each run
+        back to this process, which writes it (:mod:`faultgen.runs.cluster`): they need not see
+        the folder of ``out``.
     progress : bool
         Show a progress bar over runs, with the time left.
     command : str
@@ -441,6 +448,9 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
         Replace ``out`` if it exists; by default an existing ``out`` is refused.
     on_start : callable, optional
         Called once the sweep holds its output, with (runs in the grid, runs already finished).
+    shared : bool
+        With ``scheduler``: the workers write the part files themselves, in the folder of ``out``,
+        which they must all see at its absolute path (a shared file system; checked first).
 
     Returns
     -------
@@ -478,7 +488,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                     try:
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
-                            for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command):
+                            for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command,
+                                                  shared, bar):
                                 bar.update(1)
                                 if on_run is not None:
                                     on_run(stats)
@@ -688,14 +699,17 @@ class _CtrlC:
             self._resends.append(resend)
 
 
-def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) -> Iterator[RunStats]:
+def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, shared: bool = False,
+             bar=None) -> Iterator[RunStats]:
     """Run the missing runs; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
     calls = [(run_id, config, parts / f"{run_id}.h5", command) for run_id, config in todo]
     try:
         if scheduler:
-            yield from _execute_dask(calls, scheduler)
+            from faultgen.runs import cluster
+
+            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
@@ -719,16 +733,3 @@ def _stop_local_workers() -> None:
     from joblib.externals.loky import get_reusable_executor
 
     get_reusable_executor().shutdown(wait=True, kill_workers=True)
-
-
-def _execute_dask(calls, scheduler: str) -> Iterator[RunStats]:
-    from distributed import Client, as_completed
-
-    try:
-        client = Client(scheduler, timeout="10s")
-    except OSError as err:
-        raise SweepError(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
-    with client:
-        futures = [client.submit(simulate_and_write, *call, key=f"faultgen-{call[0]}", pure=False) for call in calls]
-        for future in as_completed(futures):
-            yield future.result()

@@ -45,6 +45,10 @@ BATCH_CYCLES = 100
 #: control range clips the torque at the limit itself).
 SATURATION = 0.999
 
+#: Cycles of a daily-record run (a fleet's robot) stepped and reduced to their days before the next
+#: ones are stepped (rounded down to whole days, at least one): bounds a run's memory, whatever its days.
+DAILY_BLOCK_CYCLES = 20
+
 #: Earlier private names, for scripts that reach them (benchmarks/setup_time.py clears the cache).
 _prepared = prepared_for
 _ = _prepare, _prepare_variant
@@ -65,15 +69,51 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     cycles = config.recorded_cycles
     n_axes = robots.load(config.robot).n_axes
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
+    if not config.daily:
+        return _simulate_cycles(config, cycles, conditions, progress)
+    # daily records: a block of whole days at a time, each reduced to its days before the next is
+    # stepped, so that a run's memory does not grow with its days (cycles are independent: the
+    # same arrays as all at once, tests/test_fleet.py)
+    size = max(1, DAILY_BLOCK_CYCLES // config.conditions.cycles_per_day) * config.conditions.cycles_per_day
+    blocks = [np.arange(i, min(i + size, len(cycles))) for i in range(0, len(cycles), size)]
+    return _join_days([daily_record(_simulate_cycles(
+        config, cycles[rows], None if conditions is None else take(conditions, rows), progress)) for rows in blocks])
+
+
+def _simulate_cycles(config: RunConfig, cycles: np.ndarray, conditions: CycleConditions | None,
+                     progress: bool) -> RunResult:
+    """The recorded ``cycles`` of ``config`` with their ``conditions``, every cycle kept."""
     mix = config.conditions.task_mix
     if mix is None:
-        result = _simulate_task(config, config.task, cycles, conditions, progress)
-    else:
-        task_of = conditions.tasks(mix)
-        groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
-        result = merge_tasks(config, groups, [
-            _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress) for g in groups])
-    return daily_record(result) if config.daily else result
+        return _simulate_task(config, config.task, cycles, conditions, progress)
+    task_of = conditions.tasks(mix)
+    groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
+    return merge_tasks(config, groups, [
+        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress) for g in groups])
+
+
+def _join_days(blocks: list[RunResult]) -> RunResult:
+    """One daily record from the daily records of consecutive blocks of whole days."""
+    if len(blocks) == 1:
+        return blocks[0]
+    first = blocks[0]
+
+    def joined(get):
+        return np.concatenate([get(block) for block in blocks])
+
+    conditions = first.conditions
+    if conditions is not None:
+        conditions = replace(conditions, **{f.name: joined(lambda b, n=f.name: getattr(b.conditions, n))
+                                            for f in fields(CycleConditions) if f.name not in CycleConditions.PER_UNIT})
+    signals = {name: joined(lambda b, n=name: getattr(b, n)) for name in
+               ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f", "tau_dist", "friction_multiplier",
+                "mean_friction_torque", "tracking_error")}
+    return replace(first, cycles=np.arange(1, sum(len(b.cycles) for b in blocks) + 1), **signals,
+                   features={name: joined(lambda b, n=name: b.features[n]) for name in first.features},
+                   conditions=conditions,
+                   fault_value=None if first.fault_value is None else joined(lambda b: b.fault_value),
+                   saturated=np.unique(joined(lambda b: b.saturated)).astype(int),
+                   stepping_time=sum(b.stepping_time for b in blocks))
 
 
 def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, conditions: CycleConditions | None,

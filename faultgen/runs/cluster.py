@@ -1,0 +1,241 @@
+"""Sweeps and fleets on a Dask cluster whose workers share no file system with this process.
+
+A worker simulates a run (a grid point of a sweep, a robot of a fleet) and hands its result back
+through Dask: the arrays and labels of :class:`faultgen.simulation.stepping.RunResult`, with the
+signals already as the dataset stores them (float32) or left out when the run keeps none. This
+process, the Dask client, writes each result to the run's part file as it arrives, atomically,
+and :func:`faultgen.runs.sweep.run` merges the parts as it does for local workers. So:
+
+- a run is kept once the client has written it. A client that is killed loses only the runs
+  its workers were simulating; the same command run again resumes from the part files;
+- a worker that is lost mid-run (killed, its machine gone) loses only that run: the scheduler
+  gives it to another worker (Dask's own rescheduling; a run that has lost
+  ``distributed.scheduler.allowed-failures`` workers, 3 by default, fails with ``KilledWorker``);
+- a run that raises (a simulation that diverged) is not retried, as the simulation is
+  deterministic; the other runs go on and are kept, and the sweep then fails naming it.
+
+The workers never receive a path: a task is a run id and its :class:`RunConfig`. They need the
+same faultgen (and robot models) installed; a worker whose robot model differs from this
+process's (its SHA-256) is refused, as its run would be labelled with the wrong model.
+
+With ``shared=True`` the workers instead write their part files themselves into the part
+folder, which every worker must see at the same absolute path (a shared file system, checked
+before any run is sent): the client then only merges. docs/performance.md says when that is
+faster.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import resource
+import time
+from collections.abc import Iterator
+from concurrent.futures import CancelledError
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import __version__
+from faultgen.data import dataset
+from faultgen.model import robots
+from faultgen.runs.sweep import RunStats, SweepError, SweepRefused, _release_memory, simulate_and_write
+from faultgen.simulation import stepping as sim
+
+#: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
+SIGNALS = tuple(name for name, (_, axes, _) in dataset.ARRAYS.items() if axes == dataset.SIGNAL_AXES)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a worker hands back for one run.
+
+    Attributes
+    ----------
+    result : RunResult
+        The run, as :func:`for_transfer` slims it.
+    worker : str
+        Address of the worker that simulated it (``tcp://host:port``).
+    model_sha256 : str
+        SHA-256 of the robot's MJCF file on that worker.
+    faultgen_version : str
+    simulated, total, stepping : float
+        Simulated seconds of the run; the worker's wall time for it and of its stepping, s.
+    memory : int
+        Peak resident set of the worker process so far, bytes.
+    """
+
+    result: sim.RunResult
+    worker: str
+    model_sha256: str
+    faultgen_version: str
+    simulated: float
+    total: float
+    stepping: float
+    memory: int
+
+
+def for_transfer(result: sim.RunResult) -> sim.RunResult:
+    """``result`` with no more than its part file stores: the signals as float32 (the dataset's
+    type for them, so the file is bit for bit the same), or empty (``(n_cycles, 0, n_axes)``) when
+    the run keeps no signals. A run with signals then crosses the network at half the size."""
+    if result.config.signals:
+        return replace(result, **{name: np.asarray(getattr(result, name), dtype=np.float32) for name in SIGNALS})
+    return replace(result, **{name: np.asarray(getattr(result, name))[:, :0] for name in SIGNALS})
+
+
+def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
+    """Worker task: simulate one run and return it (:class:`Outcome`); writes nothing."""
+    from distributed import get_worker
+
+    started = time.perf_counter()
+    result = sim.simulate(config, progress=False)
+    total = time.perf_counter() - started
+    slim = for_transfer(result)
+    simulated = result.tau_m.shape[0] * result.t[-1]
+    del result
+    _release_memory()
+    return Outcome(slim, get_worker().address, dataset.model_hash(robots.load(config.robot).path), __version__,
+                   simulated, total, slim.stepping_time, _peak_memory())
+
+
+def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str) -> RunStats:
+    """Worker task with a shared file system: simulate one run and write its part file there."""
+    from distributed import get_worker
+
+    stats = simulate_and_write(run_id, config, Path(part), command)
+    return replace(stats, worker=get_worker().address, memory=_peak_memory())
+
+
+def _peak_memory() -> int:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
+
+
+def task_key(run_id: str, config: sim.RunConfig) -> str:
+    """The Dask key of a run: its id and a digest of its configuration, so that the dashboard
+    names the run, and two sweeps on one cluster share a task only when it is the same simulation."""
+    digest = hashlib.sha256(dataset.config_key(config).encode()).hexdigest()[:16]
+    return f"faultgen-{run_id}-{digest}"
+
+
+def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, command: str = "",
+            shared: bool = False, bar=None) -> Iterator[RunStats]:
+    """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
+    the worker's address) once its part file is written, in completion order.
+
+    Parameters
+    ----------
+    todo : list of (run id, RunConfig)
+        In the order to submit them (longest first).
+    parts : Path
+        The sweep's part folder (this process's; ``shared``: the workers' too).
+    scheduler : str
+        ``tcp://host:port`` of a Dask scheduler.
+    command : str
+        Provenance stored with every run.
+    shared : bool
+        The workers write the part files themselves (they must see ``parts`` at its absolute path).
+    bar : tqdm, optional
+        A progress bar whose postfix shows the workers the scheduler has after each run.
+
+    Raises
+    ------
+    SweepRefused
+        If the scheduler cannot be reached (nothing ran).
+    SweepError
+        If the scheduler is lost, a worker runs another robot model, with
+        ``shared`` if a worker cannot see ``parts``, or (after every other run finished) if runs
+        failed: the message names the first and how many; every finished run is kept.
+    OSError
+        If a part file cannot be written (from :func:`faultgen.data.dataset.write_run`).
+    """
+    from distributed import Client, KilledWorker, as_completed
+
+    try:
+        client = Client(scheduler, timeout="10s", set_as_default=False)
+    except (OSError, ValueError) as err:
+        raise SweepRefused(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
+    folder = parts.resolve()
+    with client:
+        if shared:
+            _check_shared(client, folder)
+        run_of = {}
+        futures = []
+        for run_id, config in todo:
+            key = task_key(run_id, config)
+            run_of[key] = run_id
+            if shared:
+                futures.append(client.submit(write_shared, run_id, config, str(folder / f"{run_id}.h5"), command,
+                                             key=key))
+            else:
+                futures.append(client.submit(simulate_remote, run_id, config, key=key))
+        configs = dict(todo)
+        failed: list[str] = []
+        finished = as_completed(futures, loop=client.loop)
+        del futures  # as_completed holds each future until it is handed out: a written run's result is freed
+        for future in finished:
+            run_id = run_of[future.key]
+            try:
+                value = future.result()
+            except KilledWorker as err:
+                failed.append(f"{run_id} lost every worker that ran it ({err})")
+                continue
+            except CancelledError as err:
+                raise SweepError(f"lost the Dask scheduler at {scheduler} ({err or 'cancelled'}); finished runs are "
+                                 f"kept in {parts}: run the same command again") from None
+            except Exception as err:  # the run's own error, raised on its worker
+                failed.append(f"{run_id}: {type(err).__name__}: {err}")
+                continue
+            finally:
+                future.release()
+            if shared:
+                yield value
+            else:
+                problem = _mismatch(value, configs[run_id])
+                if problem:
+                    failed.append(f"{run_id}: {problem}")
+                    continue
+                yield _write(run_id, value, parts / f"{run_id}.h5", command)
+            if bar is not None:
+                bar.set_postfix_str(_cluster_state(client), refresh=False)
+        if failed:
+            raise SweepError(f"{len(failed)} of {len(todo)} runs failed on the cluster; the others are kept in {parts}. "
+                             f"First: {failed[0]}")
+
+
+def _write(run_id: str, outcome: Outcome, part: Path, command: str) -> RunStats:
+    """Write a worker's run to its part file (atomically, :func:`faultgen.data.dataset.write_run`)."""
+    started = time.perf_counter()
+    dataset.write_run(part, outcome.result, run_id=run_id, command=command)
+    return RunStats(run_id, outcome.simulated, outcome.total, outcome.stepping, time.perf_counter() - started,
+                    worker=outcome.worker, memory=outcome.memory)
+
+
+def _mismatch(outcome: Outcome, config: sim.RunConfig) -> str:
+    """Why a worker's run cannot be labelled as this process would label it ('' if it can)."""
+    ours = dataset.model_hash(robots.load(config.robot).path)
+    if outcome.model_sha256 != ours:
+        return (f"worker {outcome.worker} simulated another {config.robot} model (MJCF SHA-256 "
+                f"{outcome.model_sha256[:12]}, here {ours[:12]}, faultgen {outcome.faultgen_version} there, "
+                f"{__version__} here): install the same faultgen and robot models on every worker")
+    return ""
+
+
+def _check_shared(client, folder: Path) -> None:
+    """Refuse ``shared`` unless every worker sees ``folder`` (at the same absolute path)."""
+    seen = client.run(_sees, str(folder))
+    blind = sorted(address for address, ok in seen.items() if not ok)
+    if blind:
+        raise SweepError(f"worker {blind[0]} cannot see {folder} ({len(blind)} of {len(seen)} workers): drop "
+                         "--shared-folder to send the runs back through Dask, or mount the folder at the same path "
+                         "on every worker")
+
+
+def _sees(path: str) -> bool:
+    return Path(path).is_dir()
+
+
+def _cluster_state(client) -> str:
+    """'2 workers, 2 threads' as the scheduler has them now."""
+    workers = client.scheduler_info()["workers"].values()
+    return f"{len(workers)} workers, {sum(w.get('nthreads', 0) for w in workers)} threads"
