@@ -17,6 +17,7 @@ from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation.faults import parse_fault
 from faultgen.operation.wear import WearPlan
+from faultgen.model import sizing
 from faultgen.runs import fleet
 from faultgen.simulation import stepping as sim
 
@@ -171,7 +172,7 @@ def test_fleet_parts_come_from_the_rated_payload(arms):
     assert 3.0 < payload < fleet.rated_payload(robots.load("puma560"))
     (small, small_edge), (big, _) = fleet.sized_parts(seven)
     assert small == (float(f"{0.05 * payload:.3g}"), float(f"{0.2 * payload:.3g}")) and big[1] < payload
-    assert small_edge[0] == pytest.approx((small[0] / fleet.PART_DENSITY) ** (1 / 3), rel=1e-2)
+    assert small_edge[0] == pytest.approx((small[0] / sizing.PART_DENSITY) ** (1 / 3), rel=1e-2)
     mixed = fleet.Fleet(size=4, failing=2, days=6, cycles_per_day=1, models=(str(arms[7]), "puma560", str(arms[5])))
     drawn = mixed.robots()
     assert [r["run"].split("-")[1] for r in drawn] == ["puma7", "puma560", "puma5", "puma7"]

@@ -199,10 +199,10 @@ def size(
     return Drivetrain.from_table(table, n, "sized drivetrain"), origin, float(payload)
 
 
-#: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3,
-#: sets the edge of a cube of that mass. The shares are those of the IRB-6700-like arm's parts
-#: (faultgen.runs.fleet.PARTS: 10-40 and 60-120 kg of 200 kg).
-PART_SHARES, PART_DENSITY = ((0.05, 0.2), (0.3, 0.6)), 1500.0
+#: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3
+#: (aluminium), sets the edge of a cube of that mass. The shares are those of the IRB-6700-like
+#: arm's parts (faultgen.runs.fleet.PARTS: 10-40 and 60-120 kg of 200 kg).
+PART_SHARES, PART_DENSITY = ((0.05, 0.2), (0.3, 0.6)), 2700.0
 
 
 def fleet_parts(rated_payload: float) -> tuple:
@@ -217,8 +217,8 @@ def fleet_parts(rated_payload: float) -> tuple:
     if not (isinstance(rated_payload, (int, float)) and math.isfinite(rated_payload) and rated_payload > 0):
         raise ValueError(f"rated payload = {rated_payload!r} kg; expected a finite number > 0")
     out = []
-    for low, high in PART_SHARES:
-        masses = (round(low * rated_payload, 3), round(high * rated_payload, 3))
-        edges = tuple(round((m / PART_DENSITY) ** (1 / 3), 3) for m in masses)
+    for shares in PART_SHARES:  # rounded to 3 significant digits
+        masses = tuple(float(f"{share * rated_payload:.3g}") for share in shares)
+        edges = tuple(float(f"{(m / PART_DENSITY) ** (1 / 3):.3g}") for m in masses)
         out.append((masses, edges))
     return tuple(out)

@@ -31,13 +31,13 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, replace
 
-import mujoco
 import numpy as np
 
 from faultgen.effects import friction as friction_models
 from faultgen.effects.payload import Payload
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots as robot_models
+from faultgen.model import sizing
 from faultgen.operation import conditions, faults, programs, tasks, wear
 from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
@@ -50,12 +50,6 @@ PARTS = {
     "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
     "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
 }
-#: Mass range of the small and the big part as shares of the rated payload (the IRB-6700-like
-#: arm's parts of :data:`PARTS` over its 200 kg).
-PART_SHARES = ((0.05, 0.2), (0.3, 0.6))
-#: Density of a part, kg/m^3 (aluminium): a part is a cube of this density, so its edge follows
-#: from its mass.
-PART_DENSITY = 2700.0
 #: The fallback rated payload is this share of the static payload capacity (:func:`rated_payload`):
 #: the share that puts the rule within a factor of two of both shipped arms' rated payloads.
 PAYLOAD_SHARE = 0.25
@@ -74,14 +68,11 @@ def rated_payload(robot) -> float:
     ValueError
         If the numeric is not one positive finite value, or no axis carries a payload's weight.
     """
-    model = robot.model
-    idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, "rated_payload")
-    if idx >= 0:
-        adr, size = model.numeric_adr[idx], model.numeric_size[idx]
-        value = model.numeric_data[adr:adr + size]
-        if size != 1 or not np.isfinite(value[0]) or value[0] <= 0:
-            raise ValueError(f"{robot.path}: numeric 'rated_payload' = {value.tolist()}; expected one mass > 0 kg")
-        return float(value[0])
+    given = robot.rated_payload  # NaN when the model has no such numeric
+    if not np.isnan(given):
+        if not (np.isfinite(given) and given > 0):
+            raise ValueError(f"{robot.path}: numeric 'rated_payload' = {given!r}; expected one mass > 0 kg")
+        return given
     low, high = robot.joint_range.T
     q = np.vstack([robot.home, low + (high - low) * np.random.default_rng(0).random((200, robot.n_axes))])
     arm = np.abs(robot.static_load(q)).max(axis=0)
@@ -96,8 +87,8 @@ def rated_payload(robot) -> float:
 
 def sized_parts(robot) -> tuple:
     """(mass range kg, edge range m) of the small and the big part of a robot model: its
-    :data:`PARTS` entry, else :data:`PART_SHARES` of its :func:`rated_payload` as cubes of
-    :data:`PART_DENSITY`, rounded to 3 significant digits.
+    :data:`PARTS` entry, else :func:`faultgen.model.sizing.fleet_parts` of its :func:`rated_payload`
+    (shares of it, as aluminium cubes).
 
     Raises
     ------
@@ -109,12 +100,7 @@ def sized_parts(robot) -> tuple:
     payload = rated_payload(robot)
     if payload <= 0:
         raise ValueError(f"{robot.name}: the arm's own weight leaves no payload within its motor torque limits")
-    out = []
-    for shares in PART_SHARES:
-        masses = tuple(float(f"{share * payload:.3g}") for share in shares)
-        edges = tuple(float(f"{(m / PART_DENSITY) ** (1 / 3):.3g}") for m in masses)
-        out.append((masses, edges))
-    return tuple(out)
+    return sizing.fleet_parts(payload)
 #: The conditions a fleet's robot has, as :class:`faultgen.operation.conditions.Conditions` names
 #: them: hall climate and warm-up, parts, unit spread (``Fleet.without`` leaves some out).
 CONDITIONS = ("thermal", "payloads", "spread")
