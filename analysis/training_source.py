@@ -37,7 +37,7 @@ from tqdm.auto import tqdm
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
-from faultgen.data import dataset
+from faultgen.data import reader
 
 SOURCES = ("OTM", "OTO")
 SIGNAL_TYPES = ("raw", "difference", "combined")
@@ -166,14 +166,13 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
         normal robot, or has no model with two robots for OTM (the message names the preset).
     """
     runs = []
-    for run_id in dataset.list_runs(path):
-        arrays, attrs = dataset.read_run(path, run_id, names=SCALARS + HISTOGRAMS)
-        try:
-            made = signals(arrays, window)
-        except ValueError as err:
-            raise ValueError(f"{path}: run {run_id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
-        failing = len(attrs["worn_axes"]) > 0 or bool(attrs.get("fault"))
-        runs.append((run_id, attrs["robot"], attrs["task"], "failure" if failing else "normal", made))
+    with reader.open(path) as data:
+        for run in data.runs:
+            try:
+                made = signals({name: run.array(name) for name in SCALARS + HISTOGRAMS}, window)
+            except ValueError as err:
+                raise ValueError(f"{path}: run {run.id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
+            runs.append((run.id, run.robot, run.task, "failure" if run.failing else "normal", made))
     counts = {c: sum(r[3] == c for r in runs) for c in CONDITIONS}
     if not all(counts.values()):
         raise ValueError(f"{path}: the study compares failing and normal robots; this dataset has {counts['failure']} "
