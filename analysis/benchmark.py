@@ -409,6 +409,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     DataFrame, one row per worn run: robot, task, run, seed, worn_axis, final_wear_pct, protocol
     (as used; "same-run (in-sample)"), trained_on (runs, or cycles of the run), false_alarm_pct
     (NaN without a healthy run to measure it on), false_alarm_runs (how many), fault_begins_cycle,
+    trained_on_fault (the fault began inside the first-cycles training samples),
     alarms_before_fault_pct (alarm share of the tested run's samples after training and before the
     fault begins; NaN if none), features (axes used), detected, onset (sample index, 0-based; NaN
     if not detected), onset_cycle (1-based cycle of that sample's first recorded cycle),
@@ -469,8 +470,9 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         samples = np.unique(sample_of)
         n_samples = len(samples)
         used_protocol = protocol
-        if protocol == "auto":
-            used_protocol = "other-seeds" if others else "first-cycles" if n_samples > first else "same-run"
+        if protocol == "auto":  # a fleet's robots are units of their own: each learns its first days (thesis ch. 4)
+            used_protocol = ("first-cycles" if data.kind == "fleet" and n_samples > first else "other-seeds" if others
+                             else "first-cycles" if n_samples > first else "same-run")
         if used_protocol == "other-seeds":
             if not others:
                 raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
@@ -479,6 +481,8 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             training = [(r.id, torque_of(r), r.recorded) for r in others]
             key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
                 [own] if own else [], 0
+            if own is None and len(others) > 1:  # no healthy run of the tested seed: each other one in turn
+                heldout = [("leave-one-out", r, [o for o in others if o is not r]) for r in others]
         elif used_protocol == "first-cycles":
             if n_samples <= first:
                 raise ValueError(f"{path}: protocol first-cycles learns from the first {first} samples of a run and "
@@ -512,7 +516,14 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         if key not in false_alarms:
             rates = []
             for normal_run in heldout:
-                if used_protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
+                if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
+                    _, normal_run, rest = normal_run
+                    n_scale, n_reference, n_used, n_monitor = _fit_monitor(
+                        [(r.id, torque_of(r), r.recorded) for r in rest], period, variance, alpha, detector,
+                        fixed_reference=True, folds=limit_folds)
+                    normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
+                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)
+                elif used_protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
                     normal_of = group_cycles(normal_run.recorded, period)
                     if len(np.unique(normal_of)) <= first:
                         continue
@@ -540,6 +551,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
                          trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
                          fault_begins_cycle=np.nan if begins is None else int(run.recorded[begins]),
+                         trained_on_fault=begins is not None and int(groups[begins]) < skip,
                          alarms_before_fault_pct=round(100.0 * float(before.mean()), 2) if before.size else np.nan,
                          features=" ".join(str(u + 1) for u in used), detected=onset is not None,
                          onset=np.nan if onset is None else int(onset),
@@ -564,13 +576,16 @@ DETECTION_COLUMNS = {
     "fault_begins_cycle": "the first recorded cycle with true wear (fault) above 0; an alarm before it is a "
                           "false alarm (alarms_before_fault_pct), never a detection",
     "false_alarm_pct": "share of alarm samples on healthy runs (false_alarm_runs of them); see the protocol",
+    "trained_on_fault": "the fault began inside the samples the monitor learned from (first-cycles): it learned "
+                        "faulty data as normal",
 }
 
 
 def false_alarm_meaning(protocols: Iterable[str]) -> str:
     """What ``false_alarm_pct`` measured under each of ``protocols`` (as the table's column names them)."""
     meaning = {
-        "other-seeds": "the monitor judging the run without wear of the tested seed, which it did not learn from",
+        "other-seeds": "the monitor judging the run without wear of the tested seed, which it did not learn from "
+                       "(without one: each other healthy run judged by a monitor of the rest)",
         "first-cycles": "each healthy run of the same kind (else robot model) judged by a monitor learnt from its "
                         "own first samples, after them: held out",
         "same-run (in-sample)": "the training run itself: in-sample, optimistic",
