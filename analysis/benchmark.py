@@ -430,6 +430,7 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     with opened(path) as data:
         table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
                                    limit_folds)
+        table.attrs["dataset_kind"] = data.kind
     return (table, charts) if return_charts else table
 
 
@@ -591,6 +592,71 @@ def false_alarm_meaning(protocols: Iterable[str]) -> str:
         "same-run (in-sample)": "the training run itself: in-sample, optimistic",
     }
     return "; ".join(f"{p}: {meaning.get(p, p)}" for p in dict.fromkeys(protocols))
+
+
+def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
+    """Notes on a :func:`detection_table` that fit its dataset (a sweep or a fleet): where the
+    monitor learned the fault, where it alarmed before the fault began, which data would serve
+    better. Empty when there is nothing to say."""
+    notes = []
+    kind = table.attrs.get("dataset_kind", "sweep")
+    held_in = table[table["protocol"] != "other-seeds"]
+    if protocol == "auto" and len(held_in) and kind != "fleet":
+        notes.append(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} "
+                     f"runs were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. "
+                     "For false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset "
+                     "quick --seed 0 --seed 1 --seed 2`")
+    if kind == "fleet" and (table["protocol"] == "first-cycles").any():
+        notes.append("note: a fleet's robots each learn their own first days (first-cycles, thesis ch. 4 OTO); "
+                     "false_alarm_pct is that protocol on the fleet's healthy robots. For monitors learnt from other "
+                     "robots, compared with their own, run `faultgen training-source` on a 60-day fleet")
+    learned = table[table["trained_on_fault"]] if "trained_on_fault" in table else table.iloc[:0]
+    if len(learned):
+        earliest = int(learned["fault_begins_cycle"].min())
+        notes.append(f"note: in {len(learned)} of {len(table)} runs the fault began inside the samples the monitor "
+                     f"learned as normal (trained_on_fault; earliest at cycle {earliest}): a smaller --first (below "
+                     f"{earliest}) keeps training before it, or record longer before the fault")
+    noisy = table[table["alarms_before_fault_pct"] >= 50]
+    if len(noisy):
+        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the fault "
+                     "begins (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
+                     "detections say little")
+    return "\n".join(notes)
+
+
+def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
+    """PNG of the Q and T2 charts of :func:`detection_table` (``return_charts=True``): per worn run
+    (the first ``most``), Q and T2 against the cycle (a day in a fleet) on a log scale, with the
+    limit (dashed), the samples the monitor learned from (shaded), where the fault begins (dotted)
+    and the onset called (red). A detector without statistics shows its alarms instead."""
+    from matplotlib.figure import Figure
+
+    shown = list(charts.items())[:most]
+    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8))
+    panels = fig.subplots(max(1, len(shown)), 2, squeeze=False)
+    for (run_id, chart), row in zip(shown, panels, strict=False):
+        x = chart["cycle"]
+        for ax, name in zip(row, ("q", "t2"), strict=True):
+            if name in chart:
+                ax.semilogy(x, np.maximum(chart[name], 1e-12), ".-", lw=0.8, ms=3, color="C0")
+                ax.axhline(chart[f"{name}_limit"], ls="--", color="k", lw=0.8)
+            else:
+                ax.step(x, chart["alarm"].astype(int), where="mid")
+            if chart["trained"]:
+                ax.axvspan(x[0], x[min(chart["trained"], len(x)) - 1], color="0.85", lw=0)
+            if chart["begins"] is not None:
+                ax.axvline(x[chart["begins"]], ls=":", color="C2", lw=1.2)
+            if chart["onset"] is not None:
+                ax.axvline(x[chart["onset"]], color="C3", lw=1.2)
+            ax.set_ylabel({"q": "Q", "t2": "T2"}[name])
+            ax.set_title(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})", fontsize=8)
+    for ax in panels[-1]:
+        ax.set_xlabel("cycle (a day in a fleet)")
+    fig.suptitle("PCA monitoring per worn run: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
+                 "normal; dotted green: fault begins; red: onset called", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    return out
 
 
 def detection_summary(table: pd.DataFrame) -> pd.DataFrame:

@@ -127,9 +127,11 @@ def detect_command(
     progress: Progress = True,
 ) -> None:
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout, with the
-    false-alarm rate on healthy runs the monitor did not learn from; summary per task and axis.
+    false-alarm rate on healthy runs; summary per task and axis. No detection is counted before the
+    fault begins: alarms before it are false alarms (column alarms_before_fault_pct).
 
-    Writes OUT.csv and OUT.md (per run) and OUT-summary.csv (per task, per worn axis, all).
+    Writes OUT.csv and OUT.md (per run), OUT-summary.csv (per task, per worn axis, all) and OUT.png
+    (the Q and T2 charts of each worn run with their limits, the fault's start and the onset).
 
     Example:
 
@@ -140,23 +142,23 @@ def detect_command(
 
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), summary_csv], overwrite)
-    table = benchmark.detection_table(
+    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv],
+                   overwrite)
+    table, charts = benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
         detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
-        limit_folds=limit_folds or None)
+        limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
     written = benchmark.write_outputs(table, stem)
     summary.to_csv(summary_csv)
     typer.echo(benchmark.markdown(table, digits=4))
-    typer.echo("\nsummary (false_alarm_pct: alarms on healthy runs the monitor did not learn from, %):")
+    typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
+    typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
     typer.echo(benchmark.markdown(summary, digits=4))
-    held_in = table[table["protocol"] != "other-seeds"]
-    if protocol == "auto" and len(held_in):
-        typer.echo(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} runs "
-                   f"were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. For "
-                   "false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset quick "
-                   "--seed 0 --seed 1 --seed 2`")
+    advice = benchmark.detection_advice(table, protocol)
+    if advice:
+        typer.echo(advice)
+    written.append(benchmark.detection_figure(charts, stem.with_suffix(".png")))
     typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
 
 
