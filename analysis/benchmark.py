@@ -893,6 +893,107 @@ def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | Non
                                 np.concatenate(groups), failed, normal)
 
 
+#: Permutations of the cheap chance estimate ``faultgen classify`` makes by default (one cell).
+CHANCE_PERMUTATIONS = 5
+
+
+def chance_estimate(inputs: ClassificationInputs, n_pairs: int | None = 20, random_state: int = 0,
+                    permutations: int = CHANCE_PERMUTATIONS, n_jobs: int | None = None, matched: bool = False,
+                    classifier: str = "lr", preprocessing: str = "control") -> dict:
+    """A cheap chance level of a classification on these robots: the mean leave-pair-out AUC of one
+    cell (``classifier`` on ``preprocessing``) over ``permutations`` label sets with the runs'
+    roles exchanged (:func:`analysis.classify.permuted_roles`), on the same pairs as the table.
+
+    It costs ``permutations`` times one cell (a table has up to 76). It is one cell's chance level,
+    an estimate for the others (classifiers differ in how far they overfit robots): ``faultgen
+    classify --permutations K`` measures every cell.
+
+    Returns
+    -------
+    dict: cell ("lr control"), permutations, null (mean AUC under exchange), null_values (per
+    label set), auc (the cell's AUC on the true labels), p (:func:`analysis.classify.null_p_value`).
+    """
+    from analysis.classify import evaluate, null_p_value
+
+    table, aucs = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, classifiers=[classifier],
+                           preprocessing=[preprocessing], estimated=inputs.estimated, n_pairs=n_pairs,
+                           random_state=random_state, permutations=permutations, n_jobs=n_jobs, matched=matched,
+                           return_aucs=True)
+    null = float(table.loc[preprocessing, (classifier, "null")])
+    return {"cell": f"{classifier} {preprocessing}", "permutations": permutations, "null": null,
+            "auc": float(table.loc[preprocessing, (classifier, "mean")]), "p": float(table.loc[preprocessing, (classifier, "p")])}
+
+
+def classification_tidy(table: pd.DataFrame) -> pd.DataFrame:
+    """A :func:`classification_table` as a tidy table: one row per (preprocessing, classifier)
+    cell, one header row; columns preprocessing, steps (what the combination does, in order),
+    classifier, auc_mean, auc_std and, where measured, auc_null and p."""
+    from analysis.classify import describe_preprocessing
+
+    long = table.stack("classifier", future_stack=True).reset_index()
+    long = long.rename(columns={"mean": "auc_mean", "std": "auc_std", "null": "auc_null"})
+    long.insert(1, "steps", long["preprocessing"].map(describe_preprocessing))
+    long.columns.name = None
+    return long
+
+
+def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon: int | None, wear_threshold: float,
+                           matched: bool, chance: dict | None, command: str) -> str:
+    """The caption of a classification table: what the cells are, how samples were labelled, the
+    chance level (measured per cell, estimated on one, or not measured with the command that
+    measures it), and why two orders of the same steps are two rows."""
+    labels = (f"the thesis's window (T-{horizon + 10} to T-{horizon}) labelled by the robot's state" if horizon is not None
+              else f"every sample labelled failed when its true wear reaches {wear_threshold:g} %")
+    parts = [f"Leave-pair-out ROC AUC (mean and std over {'every' if n_pairs is None else n_pairs} held-out "
+             f"(worn, unworn) run pair(s), thesis Procedure 1 and Table 5.2) per preprocessing (rows) and classifier; "
+             f"{labels}{'; time-matched (--matched-days)' if matched else ''}."]
+    if any(c == "null" for c in table.columns.get_level_values(-1)):
+        parts.append("Chance level measured per cell: auc_null, the mean AUC with the runs' labels exchanged, and p, "
+                     "the permutation p-value of the AUC.")
+    elif chance is not None:
+        parts.append(f"Chance level on these robots (estimated on one cell, {chance['cell']}, with "
+                     f"{chance['permutations']} label exchanges): {chance['null']:.2f}, not 0.5; that cell's AUC "
+                     f"{chance['auc']:.2f}, p {chance['p']:.2f} (with {chance['permutations']} exchanges p cannot go "
+                     f"below {1 / (chance['permutations'] + 1):.2f}). Every cell's: `{command} --permutations 19`.")
+    else:
+        parts.append(f"Chance level not measured: `{command} --permutations 19` measures it per cell.")
+    parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
+                 "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
+    return " ".join(parts)
+
+
+def classification_heatmap(table: pd.DataFrame, out: Path, chance: dict | None = None) -> Path:
+    """PNG heatmap of a classification table's mean AUC (preprocessing x classifier), coloured
+    around the chance level (the per-cell null where measured, else ``chance``'s estimate, else
+    0.5, said in the title), the value in each cell (and p where measured)."""
+    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.figure import Figure
+
+    means = table.xs("mean", axis=1, level="statistic")
+    measured = "null" in table.columns.get_level_values("statistic")
+    centre = (float(np.nanmean(table.xs("null", axis=1, level="statistic").to_numpy())) if measured
+              else chance["null"] if chance is not None else 0.5)
+    what = ("mean of the measured chance levels" if measured else
+            f"chance estimated on {chance['cell']}" if chance is not None else "0.5, chance not measured")
+    fig = Figure(figsize=(1.3 * means.shape[1] + 3.2, 0.38 * means.shape[0] + 1.8))
+    ax = fig.subplots()
+    image = ax.imshow(means.to_numpy(dtype=float), cmap="RdBu_r", aspect="auto",
+                      norm=TwoSlopeNorm(vcenter=min(max(centre, 0.01), 0.99), vmin=0.0, vmax=1.0))
+    ax.set_xticks(range(means.shape[1]), means.columns)
+    ax.set_yticks(range(means.shape[0]), means.index, fontsize=8)
+    for i in range(means.shape[0]):
+        for j in range(means.shape[1]):
+            text = f"{means.iat[i, j]:.2f}"
+            if measured:
+                text += f"\np {table[(means.columns[j], 'p')].iat[i]:.2f}"
+            ax.text(j, i, text, ha="center", va="center", fontsize=7)
+    fig.colorbar(image, ax=ax, label=f"AUC (white: {centre:.2f}, {what})")
+    ax.set_title("leave-pair-out AUC per preprocessing and classifier", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    return out
+
+
 def _table_5_1(arrays: dict, duty: bool) -> np.ndarray:
     """A run's control features (n_samples, 30): per axis the speed and torque indicators (with
     ``duty``; else the mean absolute and RMS motor torque) and the KL divergences of the angle,
