@@ -127,7 +127,27 @@ def descriptors(q: np.ndarray, limit: float) -> dict[str, float]:
     the days before the failure, thesis ch. 4.3.3)."""
     above = np.flatnonzero(q > limit)
     return {"cov_q": float(np.std(q, ddof=1) / np.mean(q)), "nsat": int(above.size),
-            "lead_time_days": int(len(q) - above[0]) if above.size else 0}
+            "lead_time_days": int(len(q) - above[0]) if above.size else 0, "test_days": int(len(q)),
+            "saturated": bool(above.size == len(q))}
+
+
+def normal_false_alarms(cases: pd.DataFrame) -> pd.DataFrame:
+    """What the descriptors mean on normal robots, which never fail: every test day above the
+    limit is a false alarm and the "lead time" is only how early the first false alarm came.
+    Per training source and signal type: normal-robot cases, their mean false-alarm share of the
+    test days (%), and the cases whose limit is saturated (every test day above it: the model does
+    not describe that robot at all, e.g. OTM across robots of different loads).
+
+    Returns
+    -------
+    DataFrame indexed by (source, signal): cases, false_alarm_pct, saturated, saturated_pct.
+    """
+    normal = cases[cases["condition"] == "normal"]
+    grouped = normal.assign(false_alarm_pct=100.0 * normal["nsat"] / normal["test_days"]).groupby(["source", "signal"])
+    out = grouped.agg(cases=("nsat", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
+                      saturated=("saturated", "sum"))
+    out["saturated_pct"] = 100.0 * out["saturated"] / out["cases"]
+    return out.round(1)
 
 
 def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tuple[np.ndarray, PCAMonitor]:
@@ -157,7 +177,9 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     -------
     DataFrame, one row per test case: source (OTM/OTO), signal (raw/difference/combined),
     condition (failure/normal), robot (run id), model (robot label), task, reference (run id of
-    the training robot), features (used), components (k), q_limit, cov_q, nsat, lead_time_days.
+    the training robot), features (used), components (k), q_limit, cov_q, nsat, lead_time_days,
+    test_days, saturated (every test day above the limit). On a normal robot nsat counts false
+    alarms and lead_time_days the time since the first one (:func:`normal_false_alarms`).
 
     Raises
     ------

@@ -192,7 +192,18 @@ def training_source_command(
                      progress=progress)
     parts = ["Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
              "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
-             + benchmark.markdown(ts.group_means(cases))]
+             + benchmark.markdown(ts.group_means(cases)),
+             "Normal robots never fail: their days above the limit are false alarms (nsat) and their lead_time_days "
+             "only how early the first false alarm came. Per training source and signal, their false-alarm share "
+             "of the test days and the cases whose limit is saturated (every test day above it):\n\n"
+             + benchmark.markdown(ts.normal_false_alarms(cases))]
+    saturated = cases[cases["saturated"] & (cases["condition"] == "normal")]
+    if len(saturated):
+        parts.append(f"Note: the limit is saturated in {len(saturated)} of {int((cases['condition'] == 'normal').sum())} "
+                     "normal-robot cases (all their test days above it: "
+                     + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
+                     + "); there the model does not describe the robot, and a failing robot's alarms in the same "
+                     "cell say nothing about its fault")
     tukey = None
     try:
         anova, tukey = ts.anova(cases), ts.tukey(cases)
