@@ -202,7 +202,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                 predicted = TOO_FEW_CYCLES
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
-                             correct=predicted == axis,
+                             answer=axis_label(predicted), correct=predicted == axis,
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id]))))
     return pd.DataFrame(rows)
 
@@ -298,6 +298,16 @@ def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
     return accuracy.round(1)
 
 
+def isolation_decided(table: pd.DataFrame) -> pd.DataFrame:
+    """Share of cases in which each isolator named an axis (right or wrong), %, per task and wear
+    level (rows; "no fault": runs without wear) and isolator (columns). An isolator that never
+    decides scores 100 % on the "no fault" rows of :func:`isolation_accuracy` and 0 % on the
+    others; this table says so."""
+    named = ~table["predicted"].isin([UNDECIDED, TOO_FEW_CYCLES])
+    decided = named.groupby([table["task"], table["wear_pct"], table["isolator"]]).mean().mul(100).unstack("isolator")
+    return decided.round(1)
+
+
 def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     """Table 6.2 layout: per task and wear level, a mark per source axis for ``marked`` (default:
     ``te10``, as the thesis, else the first isolator), then the accuracy of every isolator."""
@@ -314,9 +324,13 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
         acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
         lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
+    decided = isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct")
     return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). Rows \"no fault\": runs without "
             "wear, where the accuracy is the share left undecided (naming an axis is a false isolation).\n\n"
-            + "\n".join(lines))
+            + "\n".join(lines)
+            + "\n\nCases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
+            "cycles). An isolator that never decides scores 100 % on \"no fault\" and 0 % elsewhere:\n\n"
+            + markdown(decided, digits=4))
 
 
 def _level_label(level: float) -> str:
@@ -797,7 +811,8 @@ THESIS_WINDOW = 10
 
 
 def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,
-                         progress: bool = True, horizon: int | None = None, **kwargs) -> pd.DataFrame:
+                         progress: bool = True, horizon: int | None = None, chance: bool = False,
+                         **kwargs) -> pd.DataFrame:
     """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
 
     Samples are recorded cycles (days in a fleet), in time order; the features per axis are those
@@ -813,8 +828,10 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     instead (ch. 5.3.3; its Table 5.2 used 3 days): each run keeps the samples from ``horizon +``
     :data:`THESIS_WINDOW` to ``horizon`` before its last one (the failure day T of a failing
     robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
-    worn run is labelled 1 (the robot's state), of an unworn run 0. ``kwargs`` go to
-    :func:`analysis.classify.evaluate`.
+    worn run is labelled 1 (the robot's state), of an unworn run 0. With ``chance`` (and no
+    ``permutations``) the table's ``attrs["chance"]`` holds a cheap chance level,
+    :func:`chance_estimate`. ``kwargs`` go to :func:`analysis.classify.evaluate` (``n_jobs``:
+    pairs in parallel).
 
     Raises
     ------
@@ -826,8 +843,12 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     from analysis.classify import evaluate
 
     inputs = classification_inputs(path, wear_threshold, horizon)
-    return evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
-                    random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
+    table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
+                     random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
+    if chance and not kwargs.get("permutations"):
+        table.attrs["chance"] = chance_estimate(inputs, n_pairs=n_pairs, random_state=random_state,
+                                                n_jobs=kwargs.get("n_jobs"), matched=kwargs.get("matched", False))
+    return table
 
 
 @dataclass(frozen=True, eq=False)
@@ -930,7 +951,8 @@ def classification_tidy(table: pd.DataFrame) -> pd.DataFrame:
     classifier, auc_mean, auc_std and, where measured, auc_null and p."""
     from analysis.classify import describe_preprocessing
 
-    long = table.stack("classifier", future_stack=True).reset_index()
+    long = table.stack(0, future_stack=True).reset_index()
+    long = long.rename(columns={long.columns[1]: "classifier"})
     long = long.rename(columns={"mean": "auc_mean", "std": "auc_std", "null": "auc_null"})
     long.insert(1, "steps", long["preprocessing"].map(describe_preprocessing))
     long.columns.name = None
@@ -969,9 +991,9 @@ def classification_heatmap(table: pd.DataFrame, out: Path, chance: dict | None =
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.figure import Figure
 
-    means = table.xs("mean", axis=1, level="statistic")
-    measured = "null" in table.columns.get_level_values("statistic")
-    centre = (float(np.nanmean(table.xs("null", axis=1, level="statistic").to_numpy())) if measured
+    means = table.xs("mean", axis=1, level=-1)
+    measured = "null" in table.columns.get_level_values(-1)
+    centre = (float(np.nanmean(table.xs("null", axis=1, level=-1).to_numpy())) if measured
               else chance["null"] if chance is not None else 0.5)
     what = ("mean of the measured chance levels" if measured else
             f"chance estimated on {chance['cell']}" if chance is not None else "0.5, chance not measured")

@@ -1,6 +1,7 @@
 """analysis.benchmark and the bench-isolators / detect / classify commands on a small real dataset."""
 
 import h5py
+from sklearn.base import BaseEstimator
 import numpy as np
 import pandas as pd
 import pytest
@@ -374,3 +375,22 @@ def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypa
         benchmark.classification_table(small, progress=False, horizon=30)
     with pytest.raises(ValueError, match="horizon = -1: expected an integer >= 0"):
         benchmark.classification_table(small, progress=False, horizon=-1)
+
+
+class NeverDecides(BaseEstimator):
+    """An isolator that names no axis, ever (issue 40: it scored 100 % on "no fault" unexplained)."""
+
+    def fit(self, X, y=None):
+        self.source_axis_ = 0
+        return self
+
+
+def test_an_isolator_that_never_decides_is_shown_undecided_not_just_right_on_healthy_runs(small):
+    isolators = {"never": NeverDecides(), "trend": isolation.make("trend")}
+    table = benchmark.isolation_table(small, isolators, levels=(20.0,), progress=False)
+    assert set(table.loc[table["isolator"] == "never", "answer"]) == {"undecided"}
+    accuracy, decided = benchmark.isolation_accuracy(table), benchmark.isolation_decided(table)
+    assert accuracy.loc[("pick_place", 0.0), "never"] == 100.0  # right on the healthy run, by never deciding
+    assert decided.loc[("pick_place", 0.0), "never"] == 0.0 and decided.loc[("pick_place", 20.0), "never"] == 0.0
+    assert decided.loc[("pick_place", 20.0), "trend"] == 100.0
+    assert "never decides scores 100 % on \"no fault\"" in benchmark.isolation_markdown(table, marked="trend")

@@ -75,7 +75,11 @@ def bench_isolators_command(
     accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
     typer.echo(benchmark.markdown(accuracy, digits=4))
     typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
-               "isolation)")
+               "isolation). In the CSV, predicted 0 is undecided and -1 too few cycles (column answer spells it).")
+    typer.echo("\ncases in which each isolator named an axis, right or wrong (%); one that never decides scores 100 % on "
+               "\"no fault\" and 0 % elsewhere:")
+    typer.echo(benchmark.markdown(benchmark.isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct"),
+                                  digits=4))
     starved = benchmark.starved_isolators(table)
     if starved:
         typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
@@ -284,30 +288,25 @@ def classify_command(
       faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
     """
     import shlex
-    import sys
 
     from analysis import benchmark
-    from analysis.classify import evaluate
 
     cells = {"classifiers": classifiers} if classifiers else {}
     if preprocessing:
         cells["preprocessing"] = preprocessing
     stem = out or file.with_name(file.stem + "-classification")
     analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
-    n_jobs = jobs or -1
-    inputs = benchmark.classification_inputs(file, wear_threshold, horizon)
-    table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, estimated=inputs.estimated,
-                     n_pairs=pairs or None, random_state=seed, progress=progress, permutations=permutations,
-                     matched=matched_days, n_jobs=n_jobs, **cells)
-    estimate = None
-    if chance and not permutations:
-        estimate = benchmark.chance_estimate(inputs, n_pairs=pairs or None, random_state=seed, n_jobs=n_jobs,
-                                             matched=matched_days)
-    command = "faultgen classify " + " ".join(shlex.quote(a) for a in sys.argv[2:] if a not in ("--overwrite",))
+    table = benchmark.classification_table(
+        file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
+        horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1, **cells)
+    estimate = table.attrs.get("chance")
+    command = " ".join(["faultgen classify", shlex.quote(str(file)), *([f"--horizon {horizon}"] if horizon is not None else []),
+                        *(["--matched-days"] if matched_days else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
+                        *(f"--classifier {c}" for c in classifiers or []),
+                        *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
     caption = benchmark.classification_caption(table, n_pairs=pairs or None, horizon=horizon,
                                                wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
-                                               command=command if sys.argv[1:2] == ["classify"] else
-                                               f"faultgen classify {file}")
+                                               command=command)
     text = benchmark.markdown(table, digits=3) + "\n\n" + caption
     benchmark.classification_tidy(table).to_csv(stem.with_suffix(".csv"), index=False)
     stem.with_suffix(".md").write_text(text + "\n")
