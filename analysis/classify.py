@@ -586,7 +586,8 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     labels = make_labels(y, groups, failed, label_rule)
     pairs = select_pairs(failed, normal, n_pairs, random_state)
     if n_jobs is None:
-        aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
+        with threadpool_limits(limits=1):  # small fits: see evaluate
+            aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
     else:
         jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
         aucs = Parallel(n_jobs=n_jobs)(jobs)
