@@ -114,3 +114,24 @@ def test_detect_on_a_fleet_counts_false_alarms_on_its_healthy_robots_and_no_dete
     assert benchmark.false_alarm_meaning(table["protocol"]).startswith("first-cycles: each healthy run")
     assert "sweep several seeds" not in benchmark.detection_advice(table)
 
+
+
+def test_the_dataset_card_explains_wear_labels_units_and_bins(fleet):
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+    from faultgen.model import robots
+
+    result = CliRunner().invoke(app, ["info", str(fleet), "--card"])
+    assert result.exit_code == 0, result.output
+    text = result.output
+    for heading in ("## What 20 % wear means", "## Labels", "## Arrays and units", "## Histogram bin edges",
+                    "## Provenance and versions"):
+        assert heading in text
+    irb = robots.load("irb6700")
+    coulomb = irb.friction.coulomb_pos[2]
+    assert f"| irb6700 | 3 | {coulomb:.3g} | +{0.2 * coulomb:.3g} |" in text
+    assert "| average_load_torque | N m | cycle, axis |" in text and "| joint_temperature | degC |" in text
+    assert "| tau_m |" not in text  # a fleet stores no signals: the card lists what the file holds
+    with h5py.File(fleet, "r") as f:  # a library-made fleet stores no command
+        assert f"command: `{f.attrs['command'] or '(not stored)'}`" in text
