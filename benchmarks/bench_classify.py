@@ -74,6 +74,7 @@ def main() -> None:
     parser.add_argument("--fleet", type=Path, help="A fleet for the stacking check (step 3).")
     parser.add_argument("--pairs", type=int, default=20)
     parser.add_argument("--skip-cli", action="store_true", help="Skip step 1's timed commands.")
+    parser.add_argument("--only-cli", action="store_true", help="Step 1 only.")
     args = parser.parse_args()
 
     from analysis import benchmark, classify
@@ -96,6 +97,8 @@ def main() -> None:
             print(f"faultgen classify (defaults):    {t_cli:7.1f} s wall, {cpu:7.1f} s CPU   "
                   f"(load now {os.getloadavg()[0]:.1f})")
 
+        if args.only_cli:
+            return
         inputs = benchmark.classification_inputs(path)
         names = [n for n in classify.PREPROCESSING if inputs.estimated is not None or not n.startswith("+estM")]
         columns = list(classify.CLASSIFIERS)
@@ -122,11 +125,8 @@ def main() -> None:
         print(f"  same AUC in every cell, all three:      {same}")
 
         if args.fleet is not None:
-            from sklearn.model_selection import StratifiedKFold
-
             fleet = benchmark.classification_inputs(args.fleet, horizon=3)
-            by_sample = classify.stacking(0)
-            by_sample.set_params(stacking__cv=StratifiedKFold(5))  # an object: fit_by_run keeps it
+            by_sample = classify.stacking(0, inner_cv="sample")
             subset = ["control", "+pca", "+var3+pca", "+diff", "+diff+pca"]
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", classify.UndefinedAUCWarning)
