@@ -179,6 +179,10 @@ def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_la
     assert "note: this dataset lacks runs without wear of other seeds" in " ".join(result.output.split())
     assert "--seed 0 --seed 1 --seed 2" in result.output
     table = pd.read_csv(tmp_path / "det.csv")
+    # issue 40: the header says what false_alarm_pct measured under the protocol the rows used
+    assert set(table["protocol"]) == {"same-run (in-sample)"}
+    assert "summary (false_alarm_pct, %: same-run (in-sample): the training run itself: in-sample" in result.output
+    assert "did not learn from" not in result.output.split("summary (")[1].splitlines()[0]
     printed = [line for line in result.output.splitlines() if line.startswith("| irb6700")]
     assert len(printed) == len(table) == 2
     for line, located in zip(printed, table["located_axis"], strict=True):
