@@ -142,7 +142,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     -------
     DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis (0: no wear),
     wear_pct (the level; 0 for a run without wear), cycles (samples seen), isolator, predicted
-    (0: undecided; -1: too few cycles for the isolator), correct.
+    (0: undecided; -1: too few cycles for the isolator), correct, windowed, n_axes (the run's
+    robot's axes N).
 
     Raises
     ------
@@ -203,7 +204,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
                              answer=axis_label(predicted), correct=predicted == axis,
-                             windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id]))))
+                             windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
+                             n_axes=X.shape[1]))
     return pd.DataFrame(rows)
 
 
@@ -241,22 +243,30 @@ def starved_isolators(table: pd.DataFrame, share: float = 0.5) -> list[str]:
     return [name for name, value in silent.items() if value >= share]
 
 
+def _table_axes(table: pd.DataFrame) -> int:
+    """The most axes of a robot in an :func:`isolation_table` (its ``n_axes`` column; a table made
+    before that column existed: six)."""
+    return int(table["n_axes"].max()) if "n_axes" in table else 6
+
+
 def isolation_confusion(table: pd.DataFrame) -> pd.DataFrame:
-    """Counts of true axis (rows: none, 1..6) against named axis (columns: undecided, 1..6, too
-    few cycles) per isolator, over every run and level of an :func:`isolation_table`.
+    """Counts of true axis (rows: none, 1..N) against named axis (columns: undecided, 1..N, too
+    few cycles) per isolator, over every run and level of an :func:`isolation_table` (N the most
+    axes of its robots).
 
     Returns
     -------
     DataFrame indexed by (isolator, true axis), one column per answer, integer counts; labels as
     :func:`axis_label` prints them, with "none" for the true axis of a run without wear.
     """
-    answers = [UNDECIDED, *range(1, 7), TOO_FEW_CYCLES]
+    n_axes = _table_axes(table)
+    answers = [UNDECIDED, *range(1, n_axes + 1), TOO_FEW_CYCLES]
     counts = (table.groupby(["isolator", "worn_axis", "predicted"]).size().unstack("predicted")
               .reindex(columns=answers, fill_value=0).fillna(0).astype(int))
     isolators = list(dict.fromkeys(table["isolator"]))
-    counts = counts.reindex(pd.MultiIndex.from_product([isolators, range(7)]), fill_value=0)
+    counts = counts.reindex(pd.MultiIndex.from_product([isolators, range(n_axes + 1)]), fill_value=0)
     counts.index = counts.index.set_names(["isolator", "true axis"]).set_levels(
-        ["none", *map(str, range(1, 7))], level=1)
+        ["none", *map(str, range(1, n_axes + 1))], level=1)
     counts.columns = [axis_label(a) for a in answers]
     return counts
 
@@ -280,7 +290,8 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
                 if values[i, j]:
                     ax.text(j, i, f"{values[i, j]:.0f}", ha="center", va="center",
                             color="white" if share[i, j] > 0.6 else "black", fontsize=8)
-        ax.set_xticks(range(values.shape[1]), ["undec.", *map(str, range(1, 7)), "short"], fontsize=8)
+        ax.set_xticks(range(values.shape[1]), ["undec.", *map(str, range(1, values.shape[1] - 1)), "short"],
+                      fontsize=8)
         ax.set_yticks(range(values.shape[0]), matrix.index, fontsize=8)
         ax.set(title=name, xlabel="named axis", ylabel="true worn axis")
     for ax in panels[len(isolators):]:
@@ -314,12 +325,13 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     isolators = list(dict.fromkeys(table["isolator"]))
     marked = marked or ("te10" if "te10" in isolators else isolators[0])
     accuracy = isolation_accuracy(table)
-    head = (["task", "wear %"] + [f"axis {a}" for a in range(1, 7)]
+    n_axes = _table_axes(table)
+    head = (["task", "wear %"] + [f"axis {a}" for a in range(1, n_axes + 1)]
             + [f"accuracy {name} (%)" for name in isolators])
     lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
     for (task, level), group in table[table["isolator"] == marked].groupby(["task", "wear_pct"]):
         marks = []
-        for axis in range(1, 7):
+        for axis in range(1, n_axes + 1):
             row = group[group["worn_axis"] == axis]
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
         acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
@@ -905,6 +917,12 @@ def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | Non
             y[-1] = np.full(THESIS_WINDOW + 1, int(len(run.worn_axes) > 0))
         groups.append(np.full(len(y[-1]), run_id, dtype=object))
         (failed if len(run.worn_axes) else normal).append(run_id)
+    widths = {x.shape[1] // 5: g[0] for x, g in zip(X, groups, strict=True)}  # 5 features per axis
+    if len(widths) > 1:
+        runs = ", ".join(f"{run}: {n} axes" for n, run in sorted(widths.items()))
+        raise ValueError(f"{path}: runs of robots with different numbers of axes ({runs}) cannot share one "
+                         "classifier, whose features are per axis; classify each robot model's runs apart (e.g. a "
+                         "fleet of one --robot)")
     if not failed or not normal:
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")

@@ -26,7 +26,7 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     """Draw how the mean absolute motor torque of every axis follows the true wear, as a PNG.
 
     One run (``run`` given, or a file with exactly one run): a 2 x 3 grid, one panel per axis
-    ("axis 1" .. "axis 6"); x is the cycle index (1-based), markers are the mean absolute motor
+    ("axis 1" .. "axis N", two rows); x is the cycle index (1-based), markers are the mean absolute motor
     torque of the cycle (N m, motor side), and, on a second y axis, a line is the true wear of that
     axis in percent (friction multiplier - 1) * 100, drawn only where the axis wears. Each torque
     axis spans at least 1 % of its mean torque, so cycle-to-cycle noise is not mistaken for a
@@ -73,13 +73,22 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     with reader.open(path) as data:
         if run is None and data.kind == "fleet" and len(ids) > 1:
             return _draw_fleet(data, out)
-    fig = Figure(figsize=(14, 7.5))
-    axes = fig.subplots(2, 3)
+    shown = [run] if run is not None else ids
+    n_axes = max(dataset.read_run(path, i, names=("friction_multiplier",))[0]["friction_multiplier"].shape[1]
+                 for i in shown)  # the most axes of the robots drawn: one panel each, two rows
+    columns = -(-n_axes // 2)
+    fig = Figure(figsize=(14 * columns / 3, 7.5))
+    axes = fig.subplots(2, columns).ravel()
+    for ax in axes[n_axes:]:
+        ax.set_visible(False)
     if run is not None or len(ids) == 1:
-        _draw_run(fig, axes.ravel(), path, run if run is not None else ids[0])
+        _draw_run(fig, axes[:n_axes], path, run if run is not None else ids[0])
     else:
-        _draw_sweep(fig, axes.ravel(), path, ids)
-    fig.savefig(out, dpi=110)
+        _draw_sweep(fig, axes[:n_axes], path, ids)
+    from faultgen.data.atomic import atomic_path
+
+    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
+        fig.savefig(tmp, dpi=110, format="png")
     return out
 
 
@@ -138,7 +147,10 @@ def _draw_fleet(data, out: Path) -> Path:
                  f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running median "
                  "over 7 days (blue: the worn axis, its days as dots; grey: the other axes); red: the worn axis's true "
                  "wear", fontsize=10)
-    fig.savefig(out, dpi=100)
+    from faultgen.data.atomic import atomic_path
+
+    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
+        fig.savefig(tmp, dpi=100, format="png")
     return out
 
 

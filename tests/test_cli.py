@@ -84,7 +84,7 @@ def test_simulate_writes_a_file_that_reads_back(tmp_path):
         (["--task", "welding"], "unknown task 'welding'"),
         (["--wear", "7:exp4:20"], "axis 7 is out of range 1..6"),
         (["--wear", "2:exp4:-10"], "2:exp4:-10"),
-        (["--cycles", "0"], "--cycles 0"),
+        (["--cycles", "0"], "'--cycles'"),  # typer's range: "Invalid value for '--cycles'"
         (["--friction", "coulomb"], "unknown friction model 'coulomb'"),
         (["--record", "1,x"], "--record part 'x'"),
     ],
@@ -100,7 +100,7 @@ def test_simulate_refuses_bad_input_before_simulating(tmp_path, args, message):
 def test_simulate_refuses_a_robot_file_with_negative_friction(tmp_path):
     source = robots.available()["irb6700"]
     model = tmp_path / "worn_robot.xml"
-    model.write_text(source.read_text().replace('<numeric name="friction5" data="0.50', '<numeric name="friction5" data="-0.50'))
+    model.write_text(source.read_text().replace('<numeric name="friction5" data="0.5 ', '<numeric name="friction5" data="-0.5 '))
     result = runner.invoke(app, ["simulate", "--robot", str(model), "--no-progress", "-o", str(tmp_path / "r.h5")])
     assert result.exit_code == 2
     assert "axis 5: friction coulomb_pos = -0.5" in result.output

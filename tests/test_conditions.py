@@ -56,7 +56,7 @@ def test_the_dry_share_sets_how_far_dry_friction_follows_the_viscosity():
     assert law.friction_factors(temperature)[0] == pytest.approx(viscous**law.DRY_SHARE, rel=1e-12)
     cycles = np.arange(1, 6)
     default, flat = (c.Conditions(thermal=c.Temperature(**share), cycles_per_day=2) for share in ({}, {"dry_share": 0}))
-    at_default, at_flat = default.evaluate(4, cycles), flat.evaluate(4, cycles)
+    at_default, at_flat = default.evaluate(4, cycles, 6), flat.evaluate(4, cycles, 6)
     assert np.all(at_flat.dry_friction_factor == 1.0) and np.ptp(at_default.dry_friction_factor) > 0.05
     np.testing.assert_array_equal(at_flat.viscous_factor, at_default.viscous_factor)
     np.testing.assert_array_equal(at_flat.joint_temperature, at_default.joint_temperature)
@@ -113,12 +113,12 @@ def test_calendar_and_payload_patterns_at_known_cycles():
     # a cycle's draws do not depend on which other cycles are recorded
     conditions = c.Conditions(thermal=c.Temperature(), payloads=c.Payloads(*parts, pattern="random"),
                               cycles_per_day=4, start_day=100)
-    every, some = conditions.evaluate(5, cycles), conditions.evaluate(5, np.array([3, 8]))
+    every, some = conditions.evaluate(5, cycles, 6), conditions.evaluate(5, np.array([3, 8]), 6)
     assert some.payload_part.tolist() == every.payload_part[[2, 7]].tolist()
     assert some.hour.tolist() == every.hour[[2, 7]].tolist()
     assert every.day.tolist() == [100, 100, 100, 100, 101, 101, 101, 101]
     assert np.all((every.hour >= 6) & (every.hour < 22))
-    scheduled = c.Conditions(cycles_per_day=2, hours=(8, 16)).evaluate(0, np.array([1, 2, 3]))
+    scheduled = c.Conditions(cycles_per_day=2, hours=(8, 16)).evaluate(0, np.array([1, 2, 3]), 6)
     assert scheduled.hour.tolist() == [8, 16, 8] and scheduled.day.tolist() == [0, 0, 1]
     part = c.Payloads(*parts).parameters(1)
     assert part["mass"] == 2.0 and part["com_z"] == 0.05 and part["ixx"] == pytest.approx(2.0 * 0.01 / 6)
@@ -135,27 +135,27 @@ def test_task_mix_patterns_at_known_cycles():
     # its own random stream: not the payloads' draws
     assert drawn.tolist() != c.Payloads((1.0, 2.0, 3.0), (0.1,) * 3, "random").index(5, cycles).tolist()
     conditions = c.Conditions(task_mix=c.TaskMix(("spot_weld", "pick_place"), "blocks", block=2))
-    every = conditions.evaluate(0, cycles)
+    every = conditions.evaluate(0, cycles, 6)
     assert every.task_index.tolist() == [0, 0, 1, 1, 0, 0, 1, 1]
     assert every.tasks(conditions.task_mix)[:3].tolist() == ["spot_weld", "spot_weld", "pick_place"]
-    assert c.Conditions(thermal=c.Temperature()).evaluate(0, cycles).task_index.tolist() == [-1] * 8
+    assert c.Conditions(thermal=c.Temperature()).evaluate(0, cycles, 6).task_index.tolist() == [-1] * 8
     assert c.Conditions.from_dict(json.loads(json.dumps(conditions.to_dict()))) == conditions
 
 
 def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     spread = c.UnitSpread(dry_friction=0.15, viscous_friction=0.1, link_mass=0.02)
-    first = spread.draw(3)
-    assert all(np.array_equal(first[k], spread.draw(3)[k]) for k in first)
-    assert not np.array_equal(first["dry_friction"], spread.draw(4)["dry_friction"])
-    draws = np.array([spread.draw(seed)["dry_friction"] for seed in range(2000)])
+    first = spread.draw(3, 6)
+    assert all(np.array_equal(first[k], spread.draw(3, 6)[k]) for k in first)
+    assert not np.array_equal(first["dry_friction"], spread.draw(4, 6)["dry_friction"])
+    draws = np.array([spread.draw(seed, 6)["dry_friction"] for seed in range(2000)])
     assert np.std(np.log(draws)) == pytest.approx(0.15, rel=0.05)
     assert np.mean(draws) == pytest.approx(1.0, abs=0.01)  # log-normal with mean 1
-    masses = np.array([spread.draw(seed)["link_mass"] for seed in range(2000)])
+    masses = np.array([spread.draw(seed, 6)["link_mass"] for seed in range(2000)])
     assert np.all(np.abs(masses - 1) <= 0.06 + 1e-12)  # clipped at 3 standard deviations
     assert np.array_equal(first["gear_loss"], np.zeros(6))  # off by default
     lossy = c.UnitSpread(dry_friction=0.15, viscous_friction=0.1, link_mass=0.02, gear_loss=0.2)
-    assert all(np.array_equal(lossy.draw(3)[k], first[k]) for k in first if k != "gear_loss")  # drawn last
-    losses = np.array([lossy.draw(seed)["gear_loss"] for seed in range(2000)])
+    assert all(np.array_equal(lossy.draw(3, 6)[k], first[k]) for k in first if k != "gear_loss")  # drawn last
+    losses = np.array([lossy.draw(seed, 6)["gear_loss"] for seed in range(2000)])
     assert losses.min() >= 0 and losses.max() <= 0.2 and losses.max() > 0.199
     assert np.mean(losses) == pytest.approx(0.1, abs=0.003)  # uniform in 0..0.2
 
@@ -232,7 +232,7 @@ def test_a_units_gear_loss_is_the_load_dependent_friction_effect_with_the_writte
     arrays, attrs = dataset.read_run(path)
     assert json.loads(attrs["conditions"])["spread"]["gear_loss"] == 0.3
     loss = arrays["gear_loss"]
-    np.testing.assert_array_equal(loss, spread.draw(5)["gear_loss"])
+    np.testing.assert_array_equal(loss, spread.draw(5, 6)["gear_loss"])
     assert np.all((loss > 0) & (loss <= 0.3))
     robot = robots.load("puma560")
     friction = robot.friction
@@ -261,7 +261,7 @@ def test_cli_gear_loss_is_drawn_and_labelled_and_needs_the_spread_and_static_fri
     done = runner.invoke(app, ["simulate", "--robot", "puma560", "--friction", "stribeck", "--cycles", "1",
                                "--unit-spread", "--gear-loss", "0.1", "--no-progress", "-o", str(tmp_path / "c.h5")])
     assert done.exit_code == 0, done.output
-    drawn = c.UnitSpread(gear_loss=0.1).draw(0)["gear_loss"]
+    drawn = c.UnitSpread(gear_loss=0.1).draw(0, 6)["gear_loss"]
     assert "gear loss (load-dependent friction coefficient) " + " ".join(f"{v:.3f}" for v in drawn) in done.output
     assert np.array_equal(dataset.read_run(tmp_path / "c.h5", names=("gear_loss",))[0]["gear_loss"], drawn)
 

@@ -23,8 +23,8 @@ def test_fault_values_at_known_cycles():
     # the growth follows the schedule's rise at +100 %: exp4 at half the cycles, 2 ** (1 / 16) - 1
     assert grown.values(np.array([0, 50, 100])) == pytest.approx([5.0, 5.0 - 25 * (2 ** (1 / 16) - 1), -20.0], rel=1e-9)
     cogging = parse_fault("cogging:3:amplitude:0.05:poles=8,phase=1", last_cycle=10)
-    assert cogging.at(0.02).values(2) == pytest.approx({"amplitude": 0.02, "poles": 8, "phase": 1.0})
-    assert cogging.at(0.02).values(0)["amplitude"] == 0.0
+    assert cogging.at(0.02, 6).values(2) == pytest.approx({"amplitude": 0.02, "poles": 8, "phase": 1.0})
+    assert cogging.at(0.02, 6).values(0)["amplitude"] == 0.0
     # with an onset: the start value up to it, then exp4's rise over the cycles after it
     late = parse_fault("cogging:3:amplitude:0.05:kind=exp4,onset=60", last_cycle=100)
     assert late.values(np.array([0, 60, 80, 100])) == pytest.approx([0.0, 0.0, 0.05 * (2 ** (1 / 16) - 1), 0.05],
@@ -35,7 +35,7 @@ def test_fault_values_at_known_cycles():
 @pytest.mark.parametrize(("spec", "message"), [
     ("payload:1:mass:2", r"'payload' is robot-wide"),
     ("temperature:2:amplitude:0.3", r"per-step friction update"),
-    ("backlash:7:width:0.01", r"fault axis 7: expected 1..6"),
+    ("backlash:8:width:0.01", r"fault axis 8: expected 1..7"),
     ("backlash:2:gap:0.01", r"backlash has no parameter 'gap'; it has: width"),
     ("backlash:2:width:-0.01", r"backlash takes values >= 0"),
     ("backlash:2:width:0", r"a fault must change its parameter"),

@@ -30,7 +30,7 @@ def test_the_fleet_draws_half_failing_robots_of_both_models():
         assert config.wear.worn_axes == ((robot["axis"],) if robot["failing"] else ())
         if robot["failing"]:  # wear starts on the drawn day and reaches failure on the last one
             k = np.array([(robot["onset_day"] - 1) * 2, config.cycles])
-            assert config.wear.multipliers(k)[:, robot["axis"] - 1] == pytest.approx([1.0, 1.5])
+            assert config.wear.multipliers(k, 6)[:, robot["axis"] - 1] == pytest.approx([1.0, 1.5])
             assert 10 <= robot["onset_day"] <= 35
     assert fleet.to_json() == Fleet().to_json()
     assert fleet.to_json() != Fleet(seed=1).to_json()
@@ -51,10 +51,10 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
 
 @pytest.mark.parametrize(("settings", "message"), [
     ({"failing": 26}, r"fleet failing = 26: expected a whole number within 1..25"),
-    ({"days": 3}, r"fleet days = 3"),
+    ({"days": 3}, r"fleet days \(--days\) = 3"),
     ({"onset": (40, 30)}, r"first <= last"),
     ({"onset": (0, 30)}, r"fleet onset day = 0"),
-    ({"cycles_per_day": 0}, r"fleet cycles_per_day = 0"),
+    ({"cycles_per_day": 0}, r"fleet cycles_per_day \(--cycles-per-day\) = 0"),
     ({"models": ("kuka",)}, r"kuka"),
     ({"models": ()}, r"fleet models = \(\): expected one or more different robot model names"),
     ({"models": ("irb6700", "irb6700")}, r"fleet models = \('irb6700', 'irb6700'\): expected one or more different"),
@@ -151,7 +151,7 @@ def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path)
     fleet = Fleet(size=2, failing=1, days=6, cycles_per_day=1, friction="stribeck", gear_loss=0.1)
     for run_id, config in fleet.runs():
         arrays, _ = dataset.read_run(out, run_id, names=("gear_loss",))
-        np.testing.assert_array_equal(arrays["gear_loss"], config.conditions.spread.draw(config.seed)["gear_loss"])
+        np.testing.assert_array_equal(arrays["gear_loss"], config.conditions.spread.draw(config.seed, 6)["gear_loss"])
         assert config.friction == "stribeck" and np.all(arrays["gear_loss"] > 0)
 
 

@@ -117,7 +117,7 @@ def test_read_accepts_a_loaded_robot_and_reports_extra_columns(tmp_path, puma):
 def test_hdf5_extra_datasets_and_groups_are_reported(tmp_path, puma):
     path = tmp_path / "extra.h5"
     frame = good_frame(puma)
-    measured.write_hdf5(path, frame["t"], frame[list(measured.Q_COLUMNS)], frame[list(measured.TAU_COLUMNS)])
+    measured.write_hdf5(path, frame["t"], frame[list(measured.column_names(6)[0])], frame[list(measured.column_names(6)[2])])
     with h5py.File(path, "a") as fh:
         fh["current1"] = np.zeros(len(frame))
         fh.create_group("meta")
@@ -232,7 +232,7 @@ def test_given_velocity_is_used_and_checked(tmp_path, puma):
     frame = good_frame(puma, with_qd=True)
     data = measured.read(write_frame(frame, tmp_path / "v.csv"), puma)
     assert not data.velocity_estimated
-    np.testing.assert_array_equal(data.qd, frame[list(measured.QD_COLUMNS)].to_numpy())
+    np.testing.assert_array_equal(data.qd, frame[list(measured.column_names(6)[1])].to_numpy())
     assert data.notes[-1].startswith("qd from the file; qdd estimated from q")
 
     frame["qd4"] = np.rad2deg(frame["qd4"])
@@ -458,8 +458,8 @@ def test_hdf5_refusals(tmp_path, puma):
     frame = good_frame(puma)
     t, q, tau = (
         frame["t"].to_numpy(),
-        frame[list(measured.Q_COLUMNS)].to_numpy(),
-        frame[list(measured.TAU_COLUMNS)].to_numpy(),
+        frame[list(measured.column_names(6)[0])].to_numpy(),
+        frame[list(measured.column_names(6)[2])].to_numpy(),
     )
 
     path = measured.write_hdf5(tmp_path / "nan.h5", t, q, tau)

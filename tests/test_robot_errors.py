@@ -74,7 +74,7 @@ def test_gearbox_with_wrong_coefficients_is_refused(tmp_path):
 def test_negative_friction_parameter_names_axis_and_field(tmp_path):
     path = copy_robot(tmp_path)
     text = path.read_text().replace(
-        '<numeric name="friction4" data="11.2e-3', '<numeric name="friction4" data="-11.2e-3'
+        '<numeric name="friction4" data="0.0112', '<numeric name="friction4" data="-0.0112'
     )
     path.write_text(text)
     with pytest.raises(robots.ModelError, match=r"axis 4: friction coulomb_pos = -0\.0112"):
@@ -84,7 +84,7 @@ def test_negative_friction_parameter_names_axis_and_field(tmp_path):
 def test_friction_numeric_of_wrong_length_is_refused(tmp_path):
     path = copy_robot(tmp_path)
     original = path.read_text()
-    text = original.replace('data="0.126 0.071 0.020 0.5 2 0.817e-3 0.985 0"', 'data="0.126"')
+    text = original.replace('data="0.126 0.071 0.02 0.5 2 0.000817 0.985 0"', 'data="0.126"')
     assert text != original
     path.write_text(text)
     with pytest.raises(robots.ModelError, match="friction2.*1 values, expected 8"):

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from faultgen.wear import N_AXES, SCHEDULES, Schedule, WearPlan, parse_wear
+from faultgen.wear import SCHEDULES, Schedule, WearPlan, parse_wear
 
 CYCLES = np.arange(0, 101)
 
@@ -124,8 +124,8 @@ def test_plan_gives_each_worn_axis_its_own_schedule():
     step = Schedule("step", 0.1, 100, {"step_cycle": 30})
     plan = WearPlan({5: step, 2: exp4})
     assert plan.worn_axes == (2, 5)
-    m = plan.multipliers(CYCLES)
-    assert m.shape == (101, N_AXES)
+    m = plan.multipliers(CYCLES, 6)
+    assert m.shape == (101, 6)
     np.testing.assert_array_equal(m[:, 1], exp4.multiplier(CYCLES))
     np.testing.assert_array_equal(m[:, 4], step.multiplier(CYCLES))
     np.testing.assert_array_equal(m[:, [0, 2, 3, 5]], 1.0)
@@ -145,9 +145,9 @@ def test_plan_to_dict():
 def test_empty_plan_is_no_wear():
     plan = WearPlan()
     assert plan.worn_axes == ()
-    np.testing.assert_array_equal(plan.multipliers(np.array([0, 1, 2])), np.ones((3, N_AXES)))
+    np.testing.assert_array_equal(plan.multipliers(np.array([0, 1, 2]), 6), np.ones((3, 6)))
     assert plan.to_dict() == {"worn_axes": [], "schedules": []}
-    assert WearPlan({2: Schedule("exp4", 0.2, 100)}).multipliers([]).shape == (0, N_AXES)
+    assert WearPlan({2: Schedule("exp4", 0.2, 100)}).multipliers([], 5).shape == (0, 5)
 
 
 def test_plan_from_specs():
@@ -158,10 +158,14 @@ def test_plan_from_specs():
         WearPlan.from_specs(["2:exp4:20", "2:linear:10"], 100)
 
 
-def test_n_axes_matches_robots():
-    from faultgen import robots
-
-    assert N_AXES == robots.N_AXES
+def test_a_plan_is_held_to_the_robots_axes():
+    """A plan accepts any axis a robot can have (1..7); a run holds it to its robot's N."""
+    plan = WearPlan({7: Schedule("linear", 0.2, 100)})
+    assert plan.multipliers(np.array([100]), 7)[0].tolist() == [1, 1, 1, 1, 1, 1, 1.2]
+    with pytest.raises(ValueError, match=r"^axis 7 is out of range 1\.\.6$"):
+        plan.multipliers(np.array([100]), 6)
+    with pytest.raises(ValueError, match=r"^axis 7 is out of range 1\.\.5$"):
+        plan.check(5)
 
 
 # --- parse_wear ------------------------------------------------------------------------------
@@ -199,8 +203,8 @@ FORM = r"the form is AXIS:KIND:PERCENT\[:key=value,\.\.\.\], e\.g\. '2:exp4:20'"
         ("2:exp4", r"it has 2 ':'-separated field\(s\), expected 3 or 4"),
         ("2:exp4:20:shape=1:x", r"it has 5 ':'-separated field\(s\)"),
         ("x:exp4:20", r"AXIS 'x' is not an int"),
-        ("7:exp4:20", r"axis 7 is out of range 1\.\.6"),
-        ("0:exp4:20", r"axis 0 is out of range 1\.\.6"),
+        ("8:exp4:20", r"axis 8 is out of range 1\.\.7"),
+        ("0:exp4:20", r"axis 0 is out of range 1\.\.7"),
         ("2:cubic:20", r"unknown wear schedule 'cubic'; known schedules: exp4, logistic, linear, step"),
         ("2:exp4:20%", r"PERCENT '20%' is not a number"),
         ("2:exp4:-10", r"PERCENT -10 is not a finite number >= 0 \(20 means \+20 % friction\)"),
@@ -290,12 +294,12 @@ def test_multiplier_rejects_bad_cycles(k, message):
     with pytest.raises(ValueError, match=message):
         Schedule("linear", 0.2, 100).multiplier(k)
     with pytest.raises(ValueError, match=message):
-        WearPlan().multipliers(k)
+        WearPlan().multipliers(k, 6)
 
 
-@pytest.mark.parametrize("axis", [0, 7, -1, True, 2.0])
+@pytest.mark.parametrize("axis", [0, 8, -1, True, 2.0])
 def test_plan_rejects_bad_axes(axis):
-    with pytest.raises(ValueError, match=rf"^axis {axis!r} is out of range 1\.\.6$"):
+    with pytest.raises(ValueError, match=rf"^axis {axis!r} is out of range 1\.\.7$"):
         WearPlan({axis: Schedule("exp4", 0.2, 100)})
 
 
@@ -303,4 +307,4 @@ def test_plan_rejects_non_schedules_and_2d_cycles():
     with pytest.raises(TypeError, match=r"axis 2: expected a Schedule, got str"):
         WearPlan({2: "2:exp4:20"})
     with pytest.raises(ValueError, match=r"cycles must be an int or a 1-D int array, got shape \(2, 2\)"):
-        WearPlan().multipliers(np.ones((2, 2), dtype=int))
+        WearPlan().multipliers(np.ones((2, 2), dtype=int), 6)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import json
 import shutil
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import mujoco
@@ -162,8 +162,85 @@ class Calibration:
         return "\n".join(lines)
 
 
+#: Most rows the search works on. A longer log is averaged down to this many (:func:`decimate`):
+#: the search's regressors take about 28 kB per row (a 10^6-row log asked for 25.7 GiB), so
+#: 25 000 rows keep ``faultgen calibrate`` within 3 GB (60 000 took 5.7 GB; docs/calibration.md, "Long logs").
+MAX_ROWS = 25_000
+
+
 def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False) -> Calibration:
+    """:func:`_calibrate` into a hidden folder beside ``out``, renamed to ``out`` once every output
+    is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
+    leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
+    log longer than :data:`MAX_ROWS` rows is first averaged down to that many (:func:`decimate`),
+    so memory stays bounded whatever the log's length. A log on which no joint moves is refused
+    (:class:`ImplausibleLogError`, naming the joints and how little they move)."""
+    nominal = robots.load(robot)
+    if isinstance(measured, measured_io.MeasuredData):
+        data = measured
+    else:
+        if progress:
+            print(f"reading {measured}", flush=True)
+        data = measured_io.read(measured, nominal)
+    _check_motion(data)
+    if len(data) > MAX_ROWS:
+        data = decimate(data, MAX_ROWS)
+        if progress:
+            print(data.notes[-1], flush=True)
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with atomic.atomic_folder(out) as staging:
+        result = _calibrate(robot, data, staging, max_steps=max_steps, progress=progress)
+        result = replace(result, model_out=out / result.model_out.relative_to(staging))
+        atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
+    return result
+
+
+def decimate(data: measured_io.MeasuredData, rows: int) -> measured_io.MeasuredData:
+    """A long log reduced to at most ``rows`` rows: every column averaged over blocks of ``k`` =
+    ceil(n / rows) consecutive samples (one filter for the angles, speeds, accelerations and
+    torques alike, so a relation linear in them holds between the averages as between the
+    samples), one row per block. The velocities and accelerations were estimated at the full rate
+    before. Cost: sign changes of the speed (Coulomb friction) and ripple faster than k samples
+    (cogging) are smoothed over a block; the torque noise averages down by sqrt(k), but the fit has
+    k times fewer rows, so parameter standard errors are about those of the whole log.
+    """
+    n = len(data)
+    k = -(-n // rows)
+    if k <= 1:
+        return data
+    m = n // k
+
+    def blocks(a: np.ndarray) -> np.ndarray:
+        return a[: m * k].reshape(m, k, *a.shape[1:]).mean(axis=1)
+
+    note = f"decimated: {n} rows averaged over blocks of {k} to {m} (calibrate.MAX_ROWS = {MAX_ROWS})"
+    return measured_io.MeasuredData(t=blocks(data.t), q=blocks(data.q), qd=blocks(data.qd), qdd=blocks(data.qdd),
+                                    tau=blocks(data.tau), source=data.source,
+                                    velocity_estimated=data.velocity_estimated, robot=data.robot,
+                                    notes=(*data.notes, note))
+
+
+#: Fewest samples at which a joint must move (|qd| >= REST_SPEED) for the log to calibrate anything.
+MIN_MOVING = 100
+
+
+def _check_motion(data: measured_io.MeasuredData) -> None:
+    """Refuse a log on which no joint moves: nothing can be identified (raises ImplausibleLogError
+    naming each joint's largest speed)."""
+    moving = np.sum(np.abs(data.qd) >= search.REST_SPEED, axis=0)
+    if np.all(moving < MIN_MOVING):
+        peak = np.max(np.abs(data.qd), axis=0) if len(data) else np.zeros(len(moving))
+        joints = ", ".join(f"{a} (largest |qd| {v:.2g} rad/s)" for a, v in zip(axes.numbers(range(len(moving))), peak))
+        raise ImplausibleLogError(
+            f"{data.source}: no joint moves: joints {joints} stay below {search.REST_SPEED:g} rad/s in all but "
+            f"{int(np.max(moving))} of {len(data)} samples (at least {MIN_MOVING} needed); give a log in which the "
+            "robot moves (an excitation or a task program)")
+
+
+def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,
+               max_steps: int = MAX_STEPS, progress: bool = False) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``.
 
     Parameters

@@ -25,13 +25,14 @@ def save(result, path: str | Path) -> Path:
     moving = result.moving
     nominal = np.where(moving, result.nominal, np.nan)
     calibrated = np.where(moving, result.calibrated, np.nan)
-    fig, axes = plt.subplots(6, 2, figsize=(13, 14), sharex=True)
+    n_axes = result.tau.shape[1]
+    fig, axes = plt.subplots(n_axes, 2, figsize=(13, 14 * n_axes / 6), sharex=True)
     added = ", ".join(f"{s['effect']} (axes {', '.join(map(str, s['axes']))})"
                       for s in (step.record() for step in result.steps)) or "nothing"
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
                  f"{result.gap_after['total_nrmse']:.3f}", fontsize=11)
-    for axis in range(6):
+    for axis in range(n_axes):
         left, right = axes[axis]
         left.plot(t, result.tau[:, axis], color="black", lw=0.8, label="measured")
         left.plot(t, nominal[:, axis], color="tab:red", lw=0.8, alpha=0.8, label="nominal model")

@@ -113,12 +113,15 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     Raises
     ------
     ValueError
-        If ``backlash`` has a negative entry or its last dimension is not 6.
+        If ``backlash`` has a negative entry or its last dimension is not the robot's N.
     """
     t = np.asarray(t, dtype=float)
     width = np.asarray(Backlash.of(robot).width if backlash is None else backlash, dtype=float)
+    if width.ndim == 0:  # one width for every axis (an effect made without the robot's axis count)
+        width = np.full(load.shape[1], float(width))
     if width.shape[-1:] != (load.shape[1],) or width.ndim > 2 or np.any(width < 0):
-        raise ValueError(f"backlash must be widths >= 0 rad of shape (6,) or (m, 6); got {width!r}")
+        raise ValueError(f"backlash must be widths >= 0 rad of shape ({load.shape[1]},) or (m, {load.shape[1]}); "
+                         f"got {width!r}")
     mass = robot.arm_mass_matrix(q)
     K, D = robot.gearbox_stiffness, robot.gearbox_damping
     steps, substeps = _substeps(t)

@@ -27,7 +27,6 @@ import mujoco
 import numpy as np
 
 from faultgen import axes
-from faultgen.axes import N_AXES
 from faultgen.calibrate.effects import Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import measured
@@ -89,13 +88,13 @@ class Hidden:
     def of(cls, robot: robots.Robot, effect: str, params: dict[int | None, dict[str, float]],
            size: float = 0.0) -> Hidden:
         """``robot``'s effect ``effect`` with ``params`` in place, keyed by axis (0-based; None for
-        a robot-wide effect, which is hidden on all six)."""
+        a robot-wide effect, which is hidden on all of the robot's axes)."""
         kind = get(effect)
-        hidden_on = list(range(N_AXES)) if not kind.per_axis else sorted(params)
+        hidden_on = list(range(robot.n_axes)) if not kind.per_axis else sorted(params)
         return cls(kind.fitted(robot, params), hidden_on, size)
 
     def record(self) -> dict:
-        """As ``report.json`` gives a step: effect id, axes numbered 1..6 and the parameters on them."""
+        """As ``report.json`` gives a step: effect id, axes numbered 1..N and the parameters on them."""
         if self.effect is None:
             return {"effect": None, "axes": [], "params": {}}
         return {"effect": self.effect.id, "axes": axes.numbers(self.axes), "params": self.effect.report(self.axes)}
@@ -116,17 +115,25 @@ def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion,
     return motion_of(robot, t, q, qd, qdd), tau
 
 
+#: Amplitude of the slower sine on axes 1..7 (a robot of N axes takes the first N).
+EXCITATION_SHARES = np.array([1.0, 0.8, 0.6, 1.0, 0.7, 1.0, 0.8])
+
+
 def excitation(robot_list: list[robots.Robot], duration: float, period: float
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A smooth motion inside the joint ranges of every robot of ``robot_list`` (two sines per axis,
     0.1 and 0.23 Hz, over 35 % of the common range around its middle), sampled every ``period`` s
-    for ``duration`` s: ``t`` (n,), ``q`` (rad), ``qd`` (rad/s), ``qdd`` (rad/s^2), each (n, 6).
+    for ``duration`` s: ``t`` (n,), ``q`` (rad), ``qd`` (rad/s), ``qdd`` (rad/s^2), each (n, N).
     A log along it passes every robot's joint-range check, so only its torque tells the robots
     apart (the plausibility guard's check, :mod:`faultgen.calibrate.plausibility`)."""
+    n_axes = {r.n_axes for r in robot_list}
+    if len(n_axes) != 1:
+        raise ValueError(f"robots {', '.join(r.name for r in robot_list)} differ in their number of axes "
+                         f"({sorted(n_axes)}); one excitation fits robots of one N")
     low = np.max([r.joint_range[:, 0] for r in robot_list], axis=0)
     high = np.min([r.joint_range[:, 1] for r in robot_list], axis=0)
     t = np.arange(0.0, duration, period)
-    shape = (np.sin(2 * np.pi * 0.1 * t)[:, None] * [1.0, 0.8, 0.6, 1.0, 0.7, 1.0]
+    shape = (np.sin(2 * np.pi * 0.1 * t)[:, None] * EXCITATION_SHARES[: len(low)]
              + 0.3 * np.sin(2 * np.pi * 0.23 * t + 1.0)[:, None])
     q = (low + high) / 2 + 0.35 * (high - low) / 2 * shape
     qd = np.gradient(q, t, axis=0)
@@ -154,8 +161,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
     scale = np.sqrt(np.mean(tau**2, axis=0))
     if kind.draw_range is not None:
         name, low, high, min_size, fallback = kind.draw_range
-        params, sizes = {}, np.zeros(N_AXES)
-        for axis in range(N_AXES):
+        params, sizes = {}, np.zeros(robot.n_axes)
+        for axis in range(robot.n_axes):
             value = float(rng.uniform(low, high))
             _, change = kind.columns(motion, axis, value)
             params[axis] = {name: value}
@@ -169,8 +176,8 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
         relative = np.sqrt(np.mean((phi @ direction) ** 2, axis=0)) / scale
         theta = size / relative.max() * direction
         return Hidden.of(robot, effect, {None: kind.params(motion, None, theta, None)}, size)
-    params, sizes = {}, np.zeros(N_AXES)
-    for axis in range(N_AXES):
+    params, sizes = {}, np.zeros(robot.n_axes)
+    for axis in range(robot.n_axes):
         grid = kind.draw_grid(motion, axis)
         if grid == [None]:
             h = None
@@ -199,7 +206,7 @@ def draw(robot: robots.Robot, effect: str | None, rng: np.random.Generator, task
 def _choose(robot: robots.Robot, effect: str, rng: np.random.Generator, params: dict, sizes: np.ndarray,
             min_size: float) -> Hidden:
     """1 to :data:`MAX_AXES` random axes among those whose drawn effect has ``sizes >= min_size``."""
-    eligible = [a for a in range(N_AXES) if sizes[a] >= min_size]
+    eligible = [a for a in range(robot.n_axes) if sizes[a] >= min_size]
     if not eligible:
         raise ValueError(f"{robot.name}: no axis can carry {effect} at a size >= {min_size} within "
                          f"{get(effect).draw_limits}")

@@ -21,6 +21,9 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     if problems:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
     check_outputs(outputs, overwrite)
+    if not any(len(row["worn_axes"]) for row in dataset.labels(file)):
+        raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
+                         "runs with runs without wear; sweep with --axis 1..6 too")
 
 
 @app.command("bench-isolators", cls=Command)
@@ -55,11 +58,16 @@ def bench_isolators_command(
     """
     from analysis import benchmark
 
+    try:
+        wear_levels = [float(x) for x in levels.split(",")]
+    except ValueError:
+        raise ValueError(f"--levels {levels!r}: expected wear levels in %, comma-separated, e.g. 1,5,10,15") from None
+    if not all(0 < w <= 100 * 5 for w in wear_levels):  # faultgen.operation.wear.MAX_INCREASE
+        raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
     stem = out or file.with_name(file.stem + "-isolation")
     confusion_stem = stem.with_name(stem.name + "-confusion")
     analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
                            confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
-    wear_levels = [float(x) for x in levels.split(",")]
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
     isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
@@ -97,18 +105,18 @@ def detect_command(
              "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
              "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
              "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
-    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.")] = 20,
-    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
+    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1)] = 20,
+    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)] = 0.75,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
              "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
-             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.")] = 20,
+             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0)] = 20,
     persistence: Annotated[
         int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
-                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.")
+                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1)
     ] = 3,
-    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
+    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1)] = None,
     plugin: Annotated[str | None, typer.Option(
         "--detector", metavar="MODULE:CLASS",
         help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
@@ -157,15 +165,15 @@ def detect_command(
 @app.command("training-source", cls=Command)
 def training_source_command(
     file: Annotated[Path, typer.Argument(help="A fleet (`faultgen fleet`): daily records of failing and normal robots.")],
-    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).")] = 40,
-    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).")] = 15,
-    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).")] = 5,
-    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).")] = 0.90,
+    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).", min=2)] = 40,
+    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).", min=1)] = 15,
+    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0)] = 5,
+    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).", min=0.0, max=1.0)] = 0.90,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
              "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
-             "many as the training days.")] = 20,
+             "many as the training days.", min=0)] = 20,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -231,8 +239,8 @@ def training_source_command(
 @app.command("classify", cls=Command)
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
-    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.")] = 10.0,
-    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
+    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0)] = 10.0,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0)] = 20,
     horizon: Annotated[int | None, typer.Option(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "

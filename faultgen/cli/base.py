@@ -37,15 +37,19 @@ class Command(_PlainHelp, TyperCommand):
     An error the library raises for a user's input or file reaches the user as one line,
     ``error: <message>``, and an exit code: the exception's ``exit_code`` where it has one (a
     broken dataset 1, a simulation that diverged 1, an interrupted sweep 130, whose message is
-    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done). Any other
-    exception is a defect and keeps its traceback.
+    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done), 1 for an
+    ``OSError`` (a full disk, a read-only folder: :func:`describe_os_error`). Any other exception is
+    a defect and keeps its traceback.
     """
 
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
-        except (click.exceptions.Exit, click.exceptions.Abort, click.ClickException):
+        except (click.exceptions.Exit, typer.Exit, click.exceptions.Abort, click.ClickException):
             raise
+        except OSError as err:  # a full disk, a read-only folder, a file that vanished: no traceback
+            typer.echo(f"error: {describe_os_error(err)}", err=True)
+            raise typer.Exit(1) from err
         except Exception as err:
             code = getattr(err, "exit_code", None)
             if code is None and not isinstance(err, ValueError):
@@ -55,13 +59,29 @@ class Command(_PlainHelp, TyperCommand):
             raise typer.Exit(2 if code is None else code) from err
 
 
+def describe_os_error(err: OSError) -> str:
+    """One line for an I/O failure: the file, what went wrong, and what to do about it."""
+    import errno
+
+    text = err.strerror or str(err)
+    if err.filename and str(err.filename) not in text:
+        text = f"{err.filename}: {text}"
+    advice = {errno.ENOSPC: "free some space or choose another output",
+              errno.EFBIG: "the file-size limit (ulimit -f) was reached; raise it or write less",
+              errno.EROFS: "the file system is read-only; choose another output",
+              errno.EACCES: "no permission; fix the folder's permissions or choose another output",
+              errno.EDQUOT: "the disk quota is exceeded; free some space or choose another output"}.get(err.errno)
+    return f"{text} ({advice})" if advice else text
+
+
 class Group(_PlainHelp, TyperGroup):
     """A command group, with the same plain help."""
 
 
 def check_outputs(files: list[Path], overwrite: bool) -> None:
     """Refuse, before any work, output files that exist (unless ``overwrite``), are folders, or
-    whose folder does not exist; raises ValueError naming the file and what to do."""
+    whose folder does not exist (ValueError naming the file and what to do), or whose folder
+    cannot be written (OSError naming the folder and the reason)."""
     for path in files:
         if path.is_dir():
             raise ValueError(f"{path} is a folder; --out expects a file name")
@@ -70,6 +90,9 @@ def check_outputs(files: list[Path], overwrite: bool) -> None:
         folder = path.parent if str(path.parent) else Path(".")
         if not folder.is_dir():
             raise ValueError(f"cannot write {path}: folder {folder} does not exist")
+        from faultgen.data import atomic
+
+        atomic.check_writable(path)  # a read-only folder: OSError (exit 1) before any work
 
 
 def check_output_folder(folder: Path, overwrite: bool) -> None:
@@ -78,6 +101,12 @@ def check_output_folder(folder: Path, overwrite: bool) -> None:
         raise ValueError(f"{folder} is a file; --out expects a folder to write the results into")
     if folder.is_dir() and any(folder.iterdir()) and not overwrite:
         raise ValueError(f"{folder} holds earlier results; pass --overwrite to replace them or choose another --out")
+    from faultgen.data import atomic
+
+    existing = folder.absolute().parent
+    while not existing.exists():  # calibrate creates the missing folders
+        existing = existing.parent
+    atomic.check_writable(existing / folder.name)  # where the results are written first: OSError (exit 1)
 
 
 def parse_window(text: str) -> tuple[float, float]:

@@ -14,12 +14,12 @@ from faultgen.cli.options import Overwrite
 
 @app.command("calibrate", cls=Command)
 def calibrate_command(
-    robot: Annotated[str, typer.Option(help="Robot name (see `faultgen robots`) or MJCF file of the nominal model.")],
+    robot: Annotated[str, typer.Option(help="Robot name (see `faultgen robots`), robot folder or MJCF file of the nominal model.")],
     measured: Annotated[Path, typer.Option(
         help="Measured torque log: CSV (.csv, .csv.gz) or HDF5 with columns t, q1..q6 (rad), tau1..tau6 (N m, arm "
              "side) and optionally qd1..qd6 (rad/s); at least 2 s at >= 100 Hz.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder (created): model/, report.json, calibration.png.")],
-    max_steps: Annotated[int, typer.Option(help="Most effects to add.")] = 6,
+    max_steps: Annotated[int, typer.Option(help="Most effects to add.", min=0, max=20)] = 6,
     overwrite: Overwrite = False,
 ) -> None:
     """Find what the model misses in a measured torque log, add it, and show the gap shrink.

@@ -12,8 +12,8 @@ import typer
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
-Jobs = Annotated[int, typer.Option(help="Local worker processes.")]
-QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q limit (0.05: 95 % limit).")]
+Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run is started; more than the CPU cores only slows each down).", min=1, max=1024)]
+QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q limit (0.05: 95 % limit).", min=1e-9, max=0.5)]
 Friction = Annotated[str | None, typer.Option(
     "--friction", help="Motor-side friction model: lugre (dynamic) or stribeck (static eq. 6.3; needed for "
     "calibrated load-dependent friction, warm-up drift and --gear-loss).")]
@@ -22,7 +22,7 @@ Temperature = Annotated[bool, typer.Option(
     "--temperature", help="Joint temperature on: hall air 20 degC +- 5 K seasonal +- 2 K daily, joints warming "
     "15 K over a shift (1 h time constant), friction following the gear oil's viscosity (docs/simulation.md).")]
 DryShare = Annotated[float | None, typer.Option(
-    "--dry-share", metavar="S", help="The exponent of the oil viscosity's ratio that the dry (Coulomb, Stribeck) "
+    "--dry-share", metavar="S", min=0.0, max=1.0, help="The exponent of the oil viscosity's ratio that the dry (Coulomb, Stribeck) "
     "friction follows with the joint temperature, 0..1; default 0.25 (ours, not measured), 0: only the viscous "
     "friction moves with temperature, 1: the dry moves as much. Needs the temperature (--temperature; on by "
     "default in a fleet).", show_default=False)]
@@ -35,7 +35,7 @@ UnitSpreadFlag = Annotated[bool, typer.Option(
     "--unit-spread", help="The run's robot draws its own friction levels (15 % log-normal per axis) and link masses "
     "(2 %) from its seed; the controller keeps the nominal model.")]
 GearLoss = Annotated[float, typer.Option(
-    "--gear-loss", metavar="C",
+    "--gear-loss", metavar="C", min=0.0, max=1.0,
     help="Each unit's gearboxes also lose a share of the transmitted torque as Coulomb friction, drawn per axis "
     "uniformly in 0..C (1 minus the gear efficiency under load; e.g. 0.1). Needs --friction stribeck, and "
     "--unit-spread outside a fleet. Default 0: none.")]
@@ -46,8 +46,8 @@ TaskMixTasks = Annotated[str | None, typer.Option(
 TaskMixPattern = Annotated[str, typer.Option(
     help="Which task each cycle runs: alternate, blocks (10 cycles each) or random.")]
 CyclesPerDay = Annotated[int, typer.Option(
-    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).")]
-StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
+    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).", min=1)]
+StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.", min=0.0, max=366.0)]
 
 
 def conditions_table(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
 from typing import Annotated
 
 import numpy as np
@@ -11,24 +13,67 @@ from faultgen.cli.base import Command
 from faultgen.cli.main import app
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
-from faultgen.model import robots
+from faultgen.model import folder, importers, robots
+from faultgen.operation import taskgen
 
 
 @app.command("robots", cls=Command)
 def robots_command(
     name: Annotated[
         str | None,
-        typer.Argument(help="Show the nominal parameters of this robot (or MJCF file) instead of the list."),
+        typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) "
+                            "instead of the list; or `add` to add a robot."),
+    ] = None,
+    new_name: Annotated[str | None, typer.Argument(help="With `add`: the new robot's name.")] = None,
+    source: Annotated[
+        Path | None,
+        typer.Option("--from", help="With `add`: the arm, a URDF, xacro, plain MJCF or DH table (.toml)."),
+    ] = None,
+    drivetrain: Annotated[
+        Path | None,
+        typer.Option(help="With `add`: a drivetrain.toml with some or all drivetrain numbers; the rest are "
+                          "sized."),
+    ] = None,
+    payload: Annotated[
+        float | None,
+        typer.Option(help="With `add`: rated payload in kg (default: the source's, else sized)."),
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
     ] = None,
 ) -> None:
-    """List the robot models, or show one model's nominal parameters.
+    """List the robot models, show one model's nominal parameters, or add a robot from an arm file.
+
+    `faultgen robots add NAME --from FILE -o DIR` writes DIR with NAME.xml (the arm with rotors,
+    gearboxes, motors and motor friction), scene.xml, drivetrain.toml, tasks.toml (the three thesis
+    tasks, generated and checked) and README.md (where every number came from). Every command then
+    takes DIR as its robot. docs/robots.md, "Your own robot", gives the file formats and the sizing
+    rules.
 
     Examples:
 
     \b
       faultgen robots            # one line per robot
       faultgen robots irb6700    # gear ratios, stiffness, friction per axis, SI units
+      faultgen robots add kr210 --from kr210l150.urdf -o kr210
+      faultgen robots add ur5 --from ur5_dh.toml --drivetrain my_drives.toml -o ur5
     """
+    if name == "add":
+        if new_name is None or source is None or out is None:
+            raise ValueError("robots add needs NAME, --from FILE and -o DIR, e.g. "
+                             "faultgen robots add kr210 --from kr210l150.urdf -o kr210")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", importers.GeometryDropped)
+            added = folder.add(new_name, source, out, drivetrain=drivetrain, payload=payload,
+                               tasks=taskgen.generate)
+        for warning in caught:
+            typer.echo(f"warning: {warning.message}", err=True)
+        robot = added.robot
+        typer.echo(f"{robot.name}: {robot.n_axes} axes from {added.arm.kind} {source} -> {added.folder} "
+                   f"(rated payload {added.payload:.4g} kg; provenance in {added.folder / 'README.md'})")
+        return
+    if any(value is not None for value in (new_name, source, drivetrain, payload, out)):
+        raise ValueError("NAME, --from, --drivetrain, --payload and -o go with `faultgen robots add`")
     if name is None:
         known = robots.available()
         if not known:

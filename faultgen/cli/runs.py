@@ -22,7 +22,8 @@ from faultgen.cli.options import (
 def simulate_command(
     robot: Annotated[str, typer.Option(
         "--robot", "--model",
-        help="Robot name (see `faultgen robots`) or MJCF file, e.g. the model `faultgen calibrate` wrote.")] = "irb6700",
+        help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
+        "model `faultgen calibrate` wrote.")] = "irb6700",
     task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3).")] = "pick_place",
     friction_model: Friction = "lugre",
     wear: Annotated[
@@ -33,17 +34,17 @@ def simulate_command(
             "for several axes. No --wear: no wear."
         ),
     ] = None,
-    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.")] = 100,
+    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.", min=1)] = 100,
     record: Annotated[
         str | None,
         typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.")] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.", min=0)] = 0,
     disturbance: Annotated[
-        float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).")
+        float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).", min=0.0, max=1.0)
     ] = 0.01,
-    encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).")] = 1e-4,
-    threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.")] = 0,
+    encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).", min=0.0, max=0.1)] = 1e-4,
+    threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.", min=0, max=1024)] = 0,
     fault: Annotated[str | None, typer.Option(
         help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
         "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
@@ -94,6 +95,9 @@ def simulate_command(
                              gear_loss=gear_loss, dry_share=dry_share) or {}),
         fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
     )
+    from faultgen.data import atomic
+
+    atomic.check_writable(out, dataset.estimated_size(config))  # a read-only or full disk: before simulating
     result = sim.simulate(config, progress=progress)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     dataset.write_run(out, result, command=command)
@@ -108,9 +112,9 @@ def sweep_command(
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
     ] = None,
-    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
+    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")] = None,
     tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s); repeat for several.")] = None,
-    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
+    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.")] = None,
     increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
     schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
     friction_model: Friction = None,
@@ -187,7 +191,8 @@ def sweep_command(
     where = f" on {scheduler}" if scheduler else f" with {jobs} job(s)"
 
     def announce(n_runs: int, done: int) -> None:
-        typer.echo(f"{n_runs} runs -> {out}{where}")
+        used = where if scheduler or jobs <= n_runs - done else f" with {max(n_runs - done, 1)} job(s) (one per run)"
+        typer.echo(f"{n_runs} runs -> {out}{used}")
         if done:
             typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
                        "they are")
@@ -199,17 +204,19 @@ def sweep_command(
 
 @app.command("fleet", cls=Command)
 def fleet_command(
-    size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).")] = 26,
-    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).")] = 13,
+    size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).", min=2, max=10000)] = 26,
+    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).", min=1)] = 13,
     models: Annotated[list[str] | None, typer.Option(
-        "--robot", help="Robot model(s) of the fleet, taken in turn; repeat for several (default: irb6700 and "
-        "puma560). One model makes every robot that model, e.g. for a fault whose FINAL suits only it.")] = None,
-    days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.")] = 60,
+        "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
+        "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
+        "fault whose FINAL suits only it. Parts are sized from each model's rated payload (docs/simulation.md).")] = None,
+    days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.", min=6, max=3650)] = 60,
     cycles_per_day: Annotated[int, typer.Option(
-        help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).")] = 2,
+        help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).", min=1, max=24)] = 2,
     failure_wear: Annotated[float, typer.Option(
-        help="Coulomb and static friction increase of the failing axis on the failure day, %.")] = 50.0,
-    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.")] = 0,
+        help="Coulomb and static friction increase of the failing axis on the failure day, %.", min=0.0,
+        max=500.0)] = 50.0,
+    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.", min=0)] = 0,
     conditions: Annotated[bool, typer.Option(
         help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
         "process and fault.")] = True,
@@ -277,8 +284,14 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
     """:func:`faultgen.runs.sweep.run` for a command, recording the command line in the dataset.
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
     before anything ran, 130 interrupted with the finished runs kept, 1 a run failed."""
+    import os
+
     from faultgen.runs import sweep
 
+    cores = os.cpu_count() or 1
+    if scheduler is None and jobs > cores:
+        typer.echo(f"warning: --jobs {jobs} is more than the {cores} CPU cores: the runs share them and each takes "
+                   f"longer (and memory: about 150 MB per worker); --jobs {cores} is as fast", err=True)
     sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
               command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
 

@@ -6,6 +6,7 @@ import glob
 import logging
 import os
 import re
+import shutil
 import socket
 import tempfile
 from collections.abc import Iterator
@@ -45,6 +46,47 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         raise
 
 
+@contextmanager
+def atomic_folder(path: str | Path) -> Iterator[Path]:
+    """Yield a new hidden folder beside ``path`` to write into; when the block succeeds it is
+    renamed to ``path`` (one rename: all or nothing). If ``path`` is an existing folder, each entry
+    written replaces the entry of that name in it (one rename each; other files of ``path`` are
+    kept). On any exception the new folder is removed and ``path`` is untouched; a
+    kill leaves only the hidden folder (``.<name>.<pid>@<host>.<random>.part``), which the next
+    write of ``path`` removes (:func:`remove_stale`).
+
+    Raises
+    ------
+    OSError
+        If the folder of ``path`` does not exist or cannot be written.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OSError(f"cannot write {path}: folder {folder} does not exist")
+    remove_stale(path)
+    staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder))
+    try:
+        os.chmod(staging, 0o777 & ~_umask())
+        yield staging
+        if path.is_dir():  # keep what else the folder holds: replace only what was written, entry by entry
+            aside = staging / ".replaced"
+            aside.mkdir()
+            for entry in sorted(staging.iterdir()):
+                if entry == aside:
+                    continue
+                target = path / entry.name
+                if target.exists() or target.is_symlink():
+                    os.replace(target, aside / entry.name)
+                os.replace(entry, target)
+            shutil.rmtree(staging, ignore_errors=True)
+        else:
+            os.replace(staging, path)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+
+
 def remove_stale(path: str | Path) -> list[Path]:
     """Remove the temporary files of ``path`` (:func:`atomic_path`) whose writer was killed.
 
@@ -67,14 +109,159 @@ def remove_stale(path: str | Path) -> list[Path]:
         if match is None or match[2] != _host() or _running(int(match[1])):
             continue
         try:
-            size = candidate.stat().st_size
-            candidate.unlink()
+            if candidate.is_dir():  # a folder written whole (:func:`atomic_folder`)
+                size = sum(f.stat().st_size for f in candidate.rglob("*") if f.is_file())
+                shutil.rmtree(candidate)
+            else:
+                size = candidate.stat().st_size
+                candidate.unlink()
         except FileNotFoundError:  # removed by another writer meanwhile
             continue
         log.warning("removed %s (%.1f MB), an unfinished write of %s left by a killed process (pid %s)",
                     candidate, size / 1e6, path.name, match[1])
         removed.append(candidate)
     return removed
+
+
+class _WriteSink:
+    """An unbuffered file for h5py's ``fileobj`` driver that never reports a write failure to HDF5.
+
+    HDF5 cannot recover from a failed write: when the disk is full (ENOSPC), a file-size limit is
+    reached (EFBIG) or the device fails (EIO), closing the file fails part-way, HDF5 frees part of
+    the file's state, and h5py's next close of the same id reads freed memory and crashes the
+    interpreter with a segmentation fault (h5py issues 914 and 1642, seen here as rc 139 with
+    148 KB free). So the first failed write is kept in :attr:`error` and every later write, seek
+    or truncate only moves the position: HDF5 finishes and closes normally, and the caller
+    (:func:`hdf5_writer`) raises the kept error and removes the unfinished file.
+    """
+
+    def __init__(self, path: Path) -> None:
+        self._file = open(path, "r+b", buffering=0)
+        self.error: OSError | None = None
+        self._position = 0
+
+    def write(self, data) -> int:
+        size = len(memoryview(data).cast("B"))
+        if self.error is None:
+            try:
+                self._file.seek(self._position)
+                view = memoryview(data).cast("B")
+                while view:  # a raw write may write part of the buffer
+                    written = self._file.write(view)
+                    view = view[written:]
+            except OSError as err:
+                self.error = err
+        self._position += size
+        return size
+
+    def read(self, size: int = -1) -> bytes:
+        self._file.seek(self._position)
+        data = self._file.read(size)
+        self._position += len(data)
+        return data
+
+    def readinto(self, buffer) -> int:
+        self._file.seek(self._position)
+        n = self._file.readinto(buffer)
+        self._position += n or 0
+        return n
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        if whence == 0:
+            self._position = offset
+        elif whence == 1:
+            self._position += offset
+        else:
+            self._position = max(self._file.seek(0, 2), self._position) + offset
+        return self._position
+
+    def tell(self) -> int:
+        return self._position
+
+    def truncate(self, size: int | None = None) -> int:
+        if self.error is None:
+            try:
+                self._file.truncate(self._position if size is None else size)
+            except OSError as err:
+                self.error = err
+        return self._position if size is None else size
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        try:
+            os.fsync(self._file.fileno())  # a delayed-allocation file system reports ENOSPC here
+        except OSError as err:
+            self.error = self.error or err
+        finally:
+            self._file.close()
+
+
+@contextmanager
+def hdf5_writer(path: str | Path) -> Iterator["h5py.File"]:
+    """Open a new HDF5 file to be written at ``path``, atomically (:func:`atomic_path`), so that
+    an I/O failure (full disk, file-size limit, failing device) raises an :class:`OSError` naming
+    ``path`` and never crashes the interpreter (:class:`_WriteSink`); nothing is left at ``path``
+    and the temporary file is removed.
+
+    Raises
+    ------
+    OSError
+        If the folder does not exist or cannot be written, or a write failed.
+    """
+    import h5py
+
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        sink = _WriteSink(tmp)
+        try:
+            with h5py.File(sink, "w", driver="fileobj") as f:
+                yield f
+        finally:
+            sink.close()
+        if sink.error is not None:
+            err = sink.error
+            raise OSError(err.errno, f"cannot write {path}: {err.strerror or err}") from None
+
+
+def check_writable(path: str | Path, needed: int = 0) -> None:
+    """Check, before any work, that a file can be written at ``path``: its folder exists, a file
+    can be created in it (a probe file, created and removed: this sees a read-only file system, a
+    folder without write permission and a full disk alike), and it has ``needed`` bytes free.
+
+    Raises
+    ------
+    OSError
+        Naming the folder and the reason (errno ENOENT, EROFS, EACCES, ENOSPC, ...).
+    """
+    import errno
+    import shutil
+
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OSError(errno.ENOENT, f"cannot write {path}: folder {folder} does not exist")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.probe.", dir=folder)
+    except OSError as err:
+        raise OSError(err.errno, f"cannot write in {folder}: {err.strerror}") from None
+    try:
+        os.close(fd)
+    finally:
+        os.unlink(probe)
+    free = shutil.disk_usage(folder).free
+    if needed > free:
+        raise OSError(errno.ENOSPC, f"cannot write {path}: it needs about {_size(needed)} and {folder} has "
+                      f"{_size(free)} free")
+
+
+def _size(n: float) -> str:
+    for unit in ("bytes", "KB", "MB", "GB"):
+        if n < 1000 or unit == "GB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1000
+    return f"{n:.1f} TB"
 
 
 def write_text(path: str | Path, text: str) -> None:

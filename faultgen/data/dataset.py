@@ -8,16 +8,18 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      complete (written last: True only for a finished file)
     /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
                                      wear JSON, noise JSON) and provenance (faultgen_version,
-                                     model_sha256, log_period, config JSON, command)
+                                     model_sha256, log_period, config JSON, command; since robots
+                                     of 5-7 axes: n_axes, drivetrain JSON)
         t, cycles, q_ref                       time base, recorded cycles, reference
-        q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, 6) logged signals, 250 Hz
-        tau_f, tau_dist                        (n_cycles, n_log, 6) truth
-        friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, 6) truth
-        mean_abs_torque, rms_torque                                       (n_cycles, 6) features
-        average_speed, average_load_torque     (n_cycles, 6) each axis's duty (DUTY_ARRAYS; runs
+        q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, N) logged signals, 250 Hz, N the
+                                               robot's axes (attr n_axes; 6 in files before it)
+        tau_f, tau_dist                        (n_cycles, n_log, N) truth
+        friction_multiplier, mean_friction_torque, tracking_error        (n_cycles, N) truth
+        mean_abs_torque, rms_torque                                       (n_cycles, N) features
+        average_speed, average_load_torque     (n_cycles, N) each axis's duty (DUTY_ARRAYS; runs
                                                simulated since it exists)
-        angle_hist, speed_hist, torque_hist                               (n_cycles, 6, 12) features
-        torque_counts          (n_cycles, 6, 1200) samples per fine |tau_m| bin, what detection
+        angle_hist, speed_hist, torque_hist                               (n_cycles, N, 12) features
+        torque_counts          (n_cycles, N, 1200) samples per fine |tau_m| bin, what detection
                                bins from (COUNT_ARRAYS; runs recorded per cycle since it exists)
         day, hour, joint_temperature, ...      operating conditions per cycle, truth (only runs
                                                with conditions: CONDITION_ARRAYS; attr conditions)
@@ -30,6 +32,7 @@ truncated or corrupted files instead of letting them be read.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 from collections.abc import Iterable
@@ -45,7 +48,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 from faultgen import __version__
-from faultgen.data.atomic import atomic_path
+from faultgen import axes as axis_numbers
+from faultgen.data.atomic import atomic_path, hdf5_writer
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
 from faultgen.simulation import sensors
 
@@ -123,6 +129,16 @@ RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axe
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
 
 
+#: Attributes of a run written since robots of 5 to 7 axes exist (files before them lack them and
+#: stay valid: their robots had six axes): ``n_axes`` (int) and ``drivetrain`` (JSON,
+#: :func:`drivetrain`).
+ROBOT_ATTRIBUTES = ("n_axes", "drivetrain")
+
+#: The drivetrain numbers a run records (:func:`drivetrain`): Robot attribute -> SI unit.
+DRIVETRAIN = {"gear_ratio": "1", "motor_inertia": "kg m^2", "gearbox_stiffness": "N m/rad",
+              "gearbox_damping": "N m s/rad", "motor_torque_limit": "N m"}
+
+
 class DatasetError(ValueError):
     """A file is not a finished, valid faultgen dataset; the message says what is wrong."""
 
@@ -133,6 +149,17 @@ class DatasetError(ValueError):
 def model_hash(path: Path) -> str:
     """SHA-256 of a robot's MJCF file, hex."""
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def drivetrain(robot) -> dict:
+    """The drivetrain a run was simulated with, per axis 1..N, as plain lists: :data:`DRIVETRAIN`
+    (gear ratio, motor inertia at the motor side, gearbox stiffness and damping at the arm side,
+    motor torque limit) and ``friction``, the nominal motor-side friction parameters
+    (:data:`faultgen.effects.friction.FIELDS`, motor side), with ``units`` naming each unit."""
+    table = {name: [float(x) for x in getattr(robot, name)] for name in DRIVETRAIN}
+    table["friction"] = {name: [float(x) for x in getattr(robot.friction, name)] for name in FRICTION_FIELDS}
+    table["units"] = {**DRIVETRAIN, **{f"friction.{name}": FRICTION_UNITS[name] for name in FRICTION_FIELDS}}
+    return table
 
 
 def config_key(config) -> str:
@@ -171,6 +198,8 @@ def run_attributes(result, command: str = "") -> dict:
         "noise": json.dumps(asdict(config.noise)),
         "faultgen_version": __version__,
         "model_sha256": model_hash(robot.path),
+        "n_axes": int(robot.n_axes),
+        "drivetrain": json.dumps(drivetrain(robot)),
         "log_period": sensors.LOG_PERIOD,
         "config": config_key(config),
         "command": command,
@@ -178,6 +207,8 @@ def run_attributes(result, command: str = "") -> dict:
         "signals": bool(config.signals),
         "sample": "day" if config.daily else "cycle",
         **({"fault": json.dumps(config.fault.to_dict())} if config.fault is not None else {}),
+        # axes whose motor saturated (a wear or fault too large for the drive): validate reports them
+        **({"saturated": np.asarray(result.saturated, dtype=int)} if len(getattr(result, "saturated", ())) else {}),
     }
 
 
@@ -194,6 +225,22 @@ def _condition_arrays(conditions: dict | None) -> list[str]:
         return table is not None and (not setting or bool(table.get(setting)))
 
     return [name for name, (*_, condition) in CONDITION_ARRAYS.items() if on(condition)]
+
+
+def estimated_size(config) -> int:
+    """Bytes the file of a run of ``config`` (:class:`faultgen.simulation.stepping.RunConfig`)
+    takes, about: its signals as float32 (seven arrays of (recorded cycles, samples, axes)) when
+    kept, and 20 kB of features per recorded cycle (measured: 2 cycles of pick_place on the
+    IRB-6700-like arm with signals, 721 kB; this estimate 666 kB). What the commands check is free
+    before they start (:func:`faultgen.data.atomic.check_writable`)."""
+    from faultgen.simulation import stepping as sim
+
+    n_cycles = len(config.recorded_cycles)
+    per_cycle = 20_000
+    if config.signals:
+        n_log = int(sim.cycle_duration(config.robot, config.task) / sensors.LOG_PERIOD) + 1
+        per_cycle += 7 * 4 * n_log * robots.load(config.robot).n_axes
+    return n_cycles * per_cycle + 50_000
 
 
 def _write_root(f: h5py.File, n_runs: int, command: str, grid: str) -> None:
@@ -215,7 +262,7 @@ def write_run(path: str | Path, result, run_id: str = "run", command: str = "") 
         at ``path`` and no temporary file remains.
     """
     path = Path(path)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as f:
+    with hdf5_writer(path) as f:
         _write_root(f, 1, command, "")
         f.attrs["complete"] = False
         group = f.create_group(f"runs/{run_id}")
@@ -256,7 +303,7 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
     """
     path = Path(path)
     parts = list(parts)
-    with atomic_path(path) as tmp, h5py.File(tmp, "w") as out:
+    with hdf5_writer(path) as out:
         _write_root(out, len(parts), command, grid)
         out.attrs["complete"] = False
         runs = out.create_group("runs")
@@ -271,11 +318,20 @@ def merge(parts: Iterable[tuple[str, Path]], path: str | Path, command: str = ""
 @contextmanager
 def _open(path: str | Path):
     """Open a finished faultgen file for reading, or raise DatasetError saying why not."""
+    writer = _writer_of(Path(path))
+    if writer is not None:
+        raise DatasetError(f"{path} is in use: process {writer} is writing it (the finished file appears under "
+                           "its own name when it is done)")
     try:
         f = h5py.File(path, "r")
     except FileNotFoundError:
         raise DatasetError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise DatasetError(f"{path} is a folder, not a dataset file") from None
     except OSError as err:
+        if err.errno == errno.EAGAIN or "unable to lock file" in str(err).lower():
+            raise DatasetError(f"{path} is in use: another process has it open for writing; wait for it to "
+                               "finish") from None
         raise DatasetError(f"{path}: cannot be opened as HDF5 (truncated or not HDF5): {err}") from None
     try:
         if f.attrs.get("format") != FORMAT:
@@ -284,9 +340,28 @@ def _open(path: str | Path):
             raise DatasetError(f"{path} is incomplete: its writer did not finish")
         if "runs" not in f:
             raise DatasetError(f"{path} has no /runs group")
+        if f.attrs.get("format_version") != FORMAT_VERSION:
+            raise DatasetError(f"{path} has format_version {_attr(f.attrs.get('format_version')).item() if hasattr(f.attrs.get('format_version'), 'item') else f.attrs.get('format_version')!r}; this faultgen "
+                               f"reads version {FORMAT_VERSION}")
+        if len(f["runs"]) == 0:
+            raise DatasetError(f"{path} has no runs (its /runs group is empty)")
         yield f
     finally:
         f.close()
+
+
+def _writer_of(path: Path) -> int | None:
+    """The pid of the running process writing ``path``, if it is the temporary file of an atomic
+    write (``.<name>.<pid>@<host>.<random>.part``, :func:`faultgen.data.atomic.atomic_path`) of a
+    process that still runs on this host; else None."""
+    import re
+
+    from faultgen.data import atomic
+
+    match = re.fullmatch(r"\.(.+)\.(\d+)@(.+)\.[^.]+\.part", path.name)
+    if match is None or match[3] != atomic._host() or not atomic._running(int(match[2])):
+        return None
+    return int(match[2])
 
 
 def list_runs(path: str | Path) -> list[str]:
@@ -328,7 +403,14 @@ def read_run(path: str | Path, run_id: str | None = None,
                 why = ("; it was recorded without signals (features only): simulate it again with signals "
                        "(`faultgen sweep` without --features-only) to use this command")
             raise DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}{why}")
+        problems = _attribute_problems(group)
+        if problems:
+            raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every problem)")
         arrays = {name: group[name][()] for name in wanted}
+        for name, value in arrays.items():
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise DatasetError(f"{path}: run {run_id!r}: {name} holds non-finite values; the file is corrupted "
+                                   f"(faultgen validate {path})")
         attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
     return arrays, attrs
 
@@ -344,7 +426,7 @@ def features(path: str | Path) -> pd.DataFrame:
 
     One row per (run, recorded cycle, axis); columns: ``run``, the run's labels
     (:data:`FEATURE_LABELS`), ``worn_axes`` (the run's worn axes as text, "2" or "2 5"; "" for
-    none), ``cycle`` (1-based), ``axis`` (1..6), ``worn`` (this axis wears in this run),
+    none), ``cycle`` (1-based), ``axis`` (1..N), ``worn`` (this axis wears in this run),
     ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
     then every array of :data:`ARRAYS` with axes "cycle, axis" and of :data:`DUTY_ARRAYS` (empty for
     runs without) under its own name and every
@@ -391,6 +473,11 @@ def export_features(path: str | Path, out: str | Path) -> Path:
 def labels(path: str | Path) -> list[dict]:
     """The labels of every run, one dict per run (with its ``run`` id), in file order."""
     with _open(path) as f:
+        for run_id in f["runs"]:
+            problems = _attribute_problems(f["runs"][run_id])
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         return [{"run": run_id, **{k: _attr(v) for k, v in f["runs"][run_id].attrs.items()}} for run_id in f["runs"]]
 
 
@@ -423,12 +510,68 @@ def validate(path: str | Path) -> list[str]:
     return problems
 
 
+def _attribute_problems(group: h5py.Group) -> list[str]:
+    """What is wrong with the attributes of a run group: each present attribute must parse into
+    its type and range (a whole number of cycles >= 1, worn axes as axis numbers, JSON tables, a
+    known friction model, a positive log period, ...); the missing ones are listed by
+    :func:`_validate_run`."""
+    from faultgen.effects import friction
+
+    problems = []
+    attrs = {key: _attr(group.attrs[key]) for key in group.attrs}
+
+    def whole(value) -> bool:
+        return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+    checks = {
+        "robot": (lambda v: isinstance(v, str) and bool(v), "a robot name"),
+        "task": (lambda v: isinstance(v, str) and bool(v), "a task name"),
+        "friction_model": (lambda v: v in friction.MODELS, f"one of {', '.join(friction.MODELS)}"),
+        "cycles": (lambda v: whole(v) and v >= 1, "a whole number >= 1"),
+        "seed": (lambda v: whole(v) and v >= 0, "a whole number >= 0"),
+        "worn_axes": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu"
+                      and bool(np.all(v >= 1)), "a list of axis numbers"),  # within the run's N: _validate_run
+        "log_period": (lambda v: isinstance(v, (float, np.floating)) and np.isfinite(v) and v > 0,
+                       "a positive number of seconds"),
+        "signals": (lambda v: isinstance(v, (bool, np.bool_)), "true or false"),
+        "sample": (lambda v: v in ("cycle", "day"), "'cycle' or 'day'"),
+        "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
+                      "a list of axes"),
+    }
+    for key, (ok, expected) in checks.items():
+        if key in attrs:
+            try:
+                good = bool(ok(attrs[key]))
+            except (TypeError, ValueError):
+                good = False
+            if not good:
+                value = attrs[key]
+                shown = value.tolist() if isinstance(value, (np.ndarray, np.generic)) else value
+                problems.append(f"attribute {key!r} is {shown!r}, expected {expected}")
+    for key in ("wear", "noise", "config", "conditions", "fault"):
+        if key in attrs:
+            try:
+                table = json.loads(attrs[key])
+            except (TypeError, ValueError):
+                problems.append(f"attribute {key!r} is not JSON: {str(attrs[key])[:40]!r}")
+                continue
+            if not isinstance(table, dict):
+                problems.append(f"attribute {key!r} is {str(attrs[key])[:40]!r}, expected a JSON table")
+    return problems
+
+
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
+    problems += _attribute_problems(group)
+    if "saturated" in group.attrs and len(group.attrs["saturated"]):
+        problems.append(f"axes {', '.join(str(int(a)) for a in group.attrs['saturated'])}: the motor saturated "
+                        "(the drive torque reached its limit): the run does not follow its task")
     try:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
         return [*problems, "conditions attribute is not JSON"]
+    if problems:
+        return problems
     signals = bool(group.attrs.get("signals", True))
     schema = {**{name: value for name, value in ARRAYS.items() if signals or value[1] != SIGNAL_AXES},
               **{name: CONDITION_ARRAYS[name][:3] for name in _condition_arrays(conditions)}}
@@ -455,11 +598,14 @@ def _validate_run(group: h5py.Group) -> list[str]:
         if not np.all(np.isfinite(data[name])):
             problems.append(f"{name}: holds non-finite values")
     n_cycles, n_log = len(data["cycles"]), len(data["t"])
+    n_axes, robot_problems = _robot_attributes(group, data)
+    if robot_problems:
+        return [*problems, *robot_problems]
     for name, (_, axes, _) in schema.items():
-        expected = {SIGNAL_AXES: (n_cycles, n_log, 6), "cycle, axis": (n_cycles, 6),
-                    "cycle, axis, bin": (n_cycles, 6, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, 6),
-                    COUNT_AXES: (n_cycles, 6, sensors.TORQUE_COUNT_BINS),
-                    "sample": (n_log,), "cycle": (n_cycles,), "axis": (6,)}[axes]
+        expected = {SIGNAL_AXES: (n_cycles, n_log, n_axes), "cycle, axis": (n_cycles, n_axes),
+                    "cycle, axis, bin": (n_cycles, n_axes, sensors.HISTOGRAM_BINS), "sample, axis": (n_log, n_axes),
+                    COUNT_AXES: (n_cycles, n_axes, sensors.TORQUE_COUNT_BINS),
+                    "sample": (n_log,), "cycle": (n_cycles,), "axis": (n_axes,)}[axes]
         if data[name].shape != expected:
             problems.append(f"{name}: shape {data[name].shape}, expected {expected}")
     if problems:
@@ -486,8 +632,48 @@ def _validate_run(group: h5py.Group) -> list[str]:
     return problems
 
 
+def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
+    """The run's number of axes N and what is wrong with its :data:`ROBOT_ATTRIBUTES` and worn axes.
+
+    N is the ``n_axes`` attribute (5..7); a run written before it existed has the axes of its
+    ``friction_multiplier`` (six, the only robots then). ``drivetrain``, when present, must be JSON
+    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers.
+    """
+    problems = []
+    if "n_axes" in group.attrs:
+        n_axes = group.attrs["n_axes"]
+        if not (np.ndim(n_axes) == 0 and np.issubdtype(np.asarray(n_axes).dtype, np.integer)
+                and axis_numbers.MIN_AXES <= int(n_axes) <= axis_numbers.MAX_AXES):
+            return 0, [f"n_axes attribute {n_axes}, expected a whole number "
+                       f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}"]
+        n_axes = int(n_axes)
+    else:
+        shape = np.shape(data["friction_multiplier"])
+        n_axes = shape[1] if len(shape) == 2 else 0
+    worn = [int(a) for a in np.atleast_1d(group.attrs.get("worn_axes", []))]
+    bad = [a for a in worn if not 1 <= a <= n_axes]
+    if bad:
+        problems.append(f"worn_axes: axis {bad[0]} is out of range 1..{n_axes}")
+    if "drivetrain" in group.attrs:
+        try:
+            table = json.loads(_attr(group.attrs["drivetrain"]))
+            entries = {**{name: table[name] for name in DRIVETRAIN},
+                       **{f"friction.{name}": table["friction"][name] for name in FRICTION_FIELDS}}
+        except (ValueError, KeyError, TypeError) as err:
+            return n_axes, [*problems, f"drivetrain attribute is not the drivetrain JSON (missing or bad {err})"]
+        for name, values in entries.items():
+            ok = isinstance(values, list) and len(values) == n_axes and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in values)
+            if not ok:
+                problems.append(f"drivetrain {name}: expected {n_axes} finite numbers, got {values!r}")
+                break
+    elif "n_axes" in group.attrs:
+        problems.append("has the n_axes attribute but not drivetrain")
+    return n_axes, problems
+
+
 def _counts_fit(totals: np.ndarray, n_log: int, data: dict, conditions: dict | None, task: str) -> bool:
-    """Whether per-cycle sample counts ``totals`` (n_cycles, 6) count each cycle's samples: ``n_log``
+    """Whether per-cycle sample counts ``totals`` (n_cycles, N) count each cycle's samples: ``n_log``
     (the run's task's) for every cycle, or with a task mix for the cycles of the run's own task,
     and one number for all axes and cycles of each other task (its path, not stored, sets it)."""
     mix = (conditions or {}).get("task_mix")
@@ -502,6 +688,13 @@ def summary(path: str | Path) -> str:
     """A few lines describing a dataset: runs, robots, tasks, wear, cycles, size, provenance."""
     with _open(path) as f:
         runs = f["runs"]
+        for run_id in runs:
+            problems = [f"missing attribute {a!r}" for a in ("robot", "task", "friction_model", "seed", "worn_axes")
+                        if a not in runs[run_id].attrs] + _attribute_problems(runs[run_id])
+            problems += [f"missing array {a!r}" for a in ("cycles", "t") if a not in runs[run_id]]
+            if problems:
+                raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
         rows = [{k: _attr(v) for k, v in runs[r].attrs.items()} for r in runs]
         n_cycles = [runs[r]["cycles"].shape[0] for r in runs]
         n_log = [runs[r]["t"].shape[0] for r in runs]
@@ -524,6 +717,10 @@ def summary(path: str | Path) -> str:
     if any("conditions" in row for row in rows):
         lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
                      "(temperature, payloads, task mix, unit spread: CONDITION_ARRAYS)")
+    saturated = [row for row in rows if len(row.get("saturated", ()))]
+    if saturated:
+        lines.append(f"  saturated:     {len(saturated)} run(s) whose motors reached their torque limit (they do not "
+                     "follow their task; `faultgen validate` lists them)")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)

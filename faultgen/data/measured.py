@@ -7,9 +7,9 @@ workflow)": one column per signal,
 column         unit     meaning
 =============  =======  ==================================================================
 ``t``          s        sample time, strictly increasing, constant or varying rate >= 100 Hz
-``q1..q6``     rad      arm-side joint angles
-``tau1..tau6`` N m      arm-side joint torque (motor torque referred through the gear ratio)
-``qd1..qd6``   rad/s    optional: joint velocities; estimated from ``q`` when absent
+``q1..qN``     rad      arm-side joint angles (N the robot's axes, 5..7)
+``tau1..tauN`` N m      arm-side joint torque (motor torque referred through the gear ratio)
+``qd1..qdN``   rad/s    optional: joint velocities; estimated from ``q`` when absent
 =============  =======  ==================================================================
 
 stored as
@@ -23,7 +23,7 @@ stored as
   Columns inside a group are not looked for: export them to the root.
 
 Other columns (CSV) or root datasets (HDF5) are allowed and ignored; their names are listed in
-:attr:`MeasuredData.notes`. The ``qd`` columns are all six or none.
+:attr:`MeasuredData.notes`. The ``qd`` columns are all N or none.
 
 Row numbers in messages
 -----------------------
@@ -69,20 +69,29 @@ import pandas as pd
 from scipy.interpolate import CubicSpline
 from scipy.signal import savgol_filter
 
+from faultgen import axes
 from faultgen.model import robots
 
-N_AXES = robots.N_AXES
-
-#: Column names of the format.
+#: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
 T_COLUMN = "t"
-Q_COLUMNS = tuple(f"q{i}" for i in range(1, N_AXES + 1))
-QD_COLUMNS = tuple(f"qd{i}" for i in range(1, N_AXES + 1))
-TAU_COLUMNS = tuple(f"tau{i}" for i in range(1, N_AXES + 1))
-REQUIRED_COLUMNS = (T_COLUMN, *Q_COLUMNS, *TAU_COLUMNS)
 
-#: Unit of each column (written as the ``unit`` attribute of HDF5 datasets).
-UNITS = {T_COLUMN: "s", **dict.fromkeys(Q_COLUMNS, "rad"), **dict.fromkeys(QD_COLUMNS, "rad/s")}
-UNITS.update(dict.fromkeys(TAU_COLUMNS, "N m"))
+
+def column_names(n_axes: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    """The angle, velocity and torque columns of a robot of ``n_axes`` axes: ``q1..qN``,
+    ``qd1..qdN``, ``tau1..tauN``."""
+    numbers = range(1, n_axes + 1)
+    return tuple(f"q{i}" for i in numbers), tuple(f"qd{i}" for i in numbers), tuple(f"tau{i}" for i in numbers)
+
+
+def _required(n_axes: int) -> tuple[str, ...]:
+    q, _, tau = column_names(n_axes)
+    return (T_COLUMN, *q, *tau)
+
+
+#: Unit of each column of any robot (written as the ``unit`` attribute of HDF5 datasets).
+UNITS = {T_COLUMN: "s"}
+for _q, _qd, _tau in zip(*column_names(axes.MAX_AXES), strict=True):
+    UNITS.update({_q: "rad", _qd: "rad/s", _tau: "N m"})
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
@@ -122,14 +131,14 @@ class MeasuredData:
     ----------
     t : ndarray of shape (n,)
         Sample times in s as in the file, strictly increasing.
-    q : ndarray of shape (n, 6)
-        Arm-side joint angles in rad.
-    qd : ndarray of shape (n, 6)
+    q : ndarray of shape (n, N)
+        Arm-side joint angles in rad (N the robot's axes).
+    qd : ndarray of shape (n, N)
         Arm-side joint velocities in rad/s: the file's ``qd`` columns, or estimated from ``q``
         (see :attr:`velocity_estimated`).
-    qdd : ndarray of shape (n, 6)
+    qdd : ndarray of shape (n, N)
         Arm-side joint accelerations in rad/s^2, always estimated from ``q``.
-    tau : ndarray of shape (n, 6)
+    tau : ndarray of shape (n, N)
         Arm-side joint torques in N m.
     source : Path
         The file read (``Path("<arrays>")`` for :func:`from_arrays` without a source).
@@ -160,10 +169,11 @@ class MeasuredData:
             raise ValueError(f"t must have shape (n,), got {t.shape}")
         t.setflags(write=False)
         object.__setattr__(self, "t", t)
+        n_axes = np.shape(self.q)[1] if np.ndim(self.q) == 2 else None
         for name in ("q", "qd", "qdd", "tau"):
             arr = np.array(getattr(self, name), dtype=float)
-            if arr.shape != (t.shape[0], N_AXES):
-                raise ValueError(f"{name} must have shape ({t.shape[0]}, {N_AXES}), got {arr.shape}")
+            if n_axes is None or arr.shape != (t.shape[0], n_axes):
+                raise ValueError(f"{name} must have shape ({t.shape[0]}, N) alike, got {arr.shape}")
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
         object.__setattr__(self, "source", Path(self.source))
@@ -235,9 +245,9 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     if not path.is_file():
         raise MeasuredDataError(f"{path}: not a file")
     if kind == "csv":
-        columns, extra, row_label = _read_csv(path)
+        columns, extra, row_label = _read_csv(path, robot.n_axes)
     else:
-        columns, extra, row_label = _read_hdf5(path)
+        columns, extra, row_label = _read_hdf5(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
     return _build(columns, robot, path, row_label, notes)
 
@@ -256,11 +266,11 @@ def from_arrays(
     ----------
     t : array_like of shape (n,)
         Sample times in s.
-    q, tau : array_like of shape (n, 6)
-        Arm-side joint angles (rad) and torques (N m).
+    q, tau : array_like of shape (n, N)
+        Arm-side joint angles (rad) and torques (N m), N the robot's axes.
     robot : str, Path or robots.Robot
         As for :func:`read`.
-    qd : array_like of shape (n, 6), optional
+    qd : array_like of shape (n, N), optional
         Arm-side joint velocities in rad/s; estimated from ``q`` when omitted.
     source : str or Path, optional
         Recorded as :attr:`MeasuredData.source` and used in messages; ``<arrays>`` by default.
@@ -276,7 +286,7 @@ def from_arrays(
     """
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     where = Path(source) if source is not None else Path("<arrays>")
-    columns = _columns_from_arrays(where, t, q, tau, qd)
+    columns = _columns_from_arrays(where, t, q, tau, qd, robot.n_axes)
     return _build(columns, robot, where, _index_label, [])
 
 
@@ -314,7 +324,7 @@ def _stored_compression(path: Path) -> str | None:
         raise MeasuredDataError(f"{path}: cannot read the file: {err}") from err
 
 
-def _read_csv(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
+def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
     """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
 
     A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
@@ -329,7 +339,7 @@ def _read_csv(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
     if not header:
         raise MeasuredDataError(
-            f"{path}: the file is empty; expected a header row with the columns t, q1..q6, tau1..tau6"
+            f"{path}: the file is empty; expected a header row with the columns t, q1..q{n_axes}, tau1..tau{n_axes}"
         )
     names = [h.strip() for h in header]
     duplicated = sorted({n for n in names if names.count(n) > 1})
@@ -337,7 +347,7 @@ def _read_csv(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
         raise MeasuredDataError(
             f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header"
         )
-    wanted, extra = _select_columns(path, names)
+    wanted, extra = _select_columns(path, names, n_axes)
 
     # All columns are parsed (extra ones as text) so that a row with too many or too few
     # fields is refused by the parser with its line number instead of being silently cut.
@@ -404,10 +414,12 @@ def _describe_bad_cell(raw: str) -> str:
     return f"value {raw!r} is not finite" if not math.isfinite(value) else f"value {raw!r} not understood"
 
 
-def _select_columns(path: Path, names: list[str]) -> tuple[list[str], list[str]]:
+def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str], list[str]]:
     """Columns to read (required, plus all qd when present) and the extra ones; refuse missing."""
     present = set(names)
-    missing = [c for c in REQUIRED_COLUMNS if c not in present]
+    n = n_axes
+    qd_columns = column_names(n)[1]
+    missing = [c for c in _required(n) if c not in present]
     if missing:
         shown = names if len(names) <= 40 else [*names[:40], f"... ({len(names)} in all)"]
         hint = ""
@@ -417,21 +429,21 @@ def _select_columns(path: Path, names: list[str]) -> tuple[list[str], list[str]]
             hint = "; the header seems to use tabs as separator, expected ','"
         raise MeasuredDataError(
             f"{path}: missing column(s) {', '.join(missing)}; found columns: {', '.join(shown) or '(none)'}"
-            f"; required: t, q1..q6, tau1..tau6 (qd1..qd6 optional){hint}"
+            f"; required: t, q1..q{n}, tau1..tau{n} (qd1..qd{n} optional){hint}"
         )
-    qd_present = [c for c in QD_COLUMNS if c in present]
-    if qd_present and len(qd_present) != N_AXES:
-        qd_missing = [c for c in QD_COLUMNS if c not in present]
+    qd_present = [c for c in qd_columns if c in present]
+    if qd_present and len(qd_present) != n:
+        qd_missing = [c for c in qd_columns if c not in present]
         raise MeasuredDataError(
             f"{path}: velocity columns {', '.join(qd_present)} present but {', '.join(qd_missing)} missing; "
-            "give all of qd1..qd6 or none (then they are estimated from q)"
+            f"give all of qd1..qd{n} or none (then they are estimated from q)"
         )
-    wanted = [*REQUIRED_COLUMNS, *qd_present]
+    wanted = [*_required(n), *qd_present]
     extra = [n for n in names if n not in wanted]
     return wanted, extra
 
 
-def _read_hdf5(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
+def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
     try:
         fh = h5py.File(path, "r")
     except OSError as err:
@@ -441,7 +453,7 @@ def _read_hdf5(path: Path) -> tuple[dict[str, np.ndarray], list[str], object]:
         datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
         groups = [n for n in names if isinstance(fh[n], h5py.Group)]
         try:
-            wanted, extra = _select_columns(path, datasets)
+            wanted, extra = _select_columns(path, datasets, n_axes)
         except MeasuredDataError as err:
             if groups:
                 raise MeasuredDataError(
@@ -482,19 +494,20 @@ def _unit_key(unit: str) -> str:
     return "".join(ch for ch in unit.lower() if ch not in " *.·")
 
 
-def _columns_from_arrays(where: Path, t, q, tau, qd) -> dict[str, np.ndarray]:
+def _columns_from_arrays(where: Path, t, q, tau, qd, n_axes: int) -> dict[str, np.ndarray]:
     t = np.asarray(t, dtype=float)
     if t.ndim != 1:
         raise MeasuredDataError(f"{where}: t must have shape (n,), got {t.shape}")
-    blocks = {"q": (q, Q_COLUMNS), "tau": (tau, TAU_COLUMNS)}
+    q_columns, qd_columns, tau_columns = column_names(n_axes)
+    blocks = {"q": (q, q_columns), "tau": (tau, tau_columns)}
     if qd is not None:
-        blocks["qd"] = (qd, QD_COLUMNS)
+        blocks["qd"] = (qd, qd_columns)
     columns = {T_COLUMN: t}
     for label, (arr, names) in blocks.items():
         arr = np.asarray(arr, dtype=float)
-        if arr.shape != (t.shape[0], N_AXES):
+        if arr.shape != (t.shape[0], n_axes):
             raise MeasuredDataError(
-                f"{where}: {label} must have shape ({t.shape[0]}, {N_AXES}), got {arr.shape}"
+                f"{where}: {label} must have shape ({t.shape[0]}, {n_axes}), got {arr.shape}"
             )
         columns.update({name: arr[:, k] for k, name in enumerate(names)})
     _refuse_non_finite(where, columns, list(columns), _index_label)
@@ -562,8 +575,9 @@ def _build(
             f"the longest {dt[gap]:.6g} s before {label(gap + 1)}"
         )
 
-    q = np.column_stack([columns[c] for c in Q_COLUMNS])
-    tau = np.column_stack([columns[c] for c in TAU_COLUMNS])
+    q_columns, qd_columns, tau_columns = column_names(robot.n_axes)
+    q = np.column_stack([columns[c] for c in q_columns])
+    tau = np.column_stack([columns[c] for c in tau_columns])
     _check_angles(where, q, robot, label)
 
     window = _savgol_window(period, n)
@@ -575,12 +589,12 @@ def _build(
             f"sample period varies ({dt.min():.6g}..{dt.max():.6g} s): q resampled at the median period "
             f"{period:.6g} s with a cubic spline for differentiation, derivatives interpolated back"
         )
-    estimated = QD_COLUMNS[0] not in columns
+    estimated = qd_columns[0] not in columns
     if estimated:
         qd = qd_est
         notes.append(f"qd and qdd estimated from q: {filt}")
     else:
-        qd = np.column_stack([columns[c] for c in QD_COLUMNS])
+        qd = np.column_stack([columns[c] for c in qd_columns])
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
         notes.extend(_check_velocities(where, qd, qd_est, window))
     notes.extend(_torque_notes(tau, robot))
@@ -601,7 +615,7 @@ def _build(
 def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> None:
     """Refuse angle columns in degrees or outside the joint range (plus tolerance)."""
     tol = JOINT_RANGE_TOLERANCE
-    for k, name in enumerate(Q_COLUMNS):
+    for k, name in enumerate(column_names(robot.n_axes)[0]):
         lo, hi = robot.joint_range[k]
         col = q[:, k]
         outside = np.flatnonzero((col < lo - tol) | (col > hi + tol))
@@ -630,7 +644,8 @@ def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: i
     """Refuse qd columns in deg/s; note columns that disagree with the derivative of q."""
     notes = []
     inner = slice(window, qd.shape[0] - window) if qd.shape[0] > 4 * window else slice(None)
-    for k, name in enumerate(QD_COLUMNS):
+    q_columns, qd_columns, _ = column_names(qd.shape[1])
+    for k, name in enumerate(qd_columns):
         given, est = qd[inner, k], qd_est[inner, k]
         power = float(np.dot(est, est))
         if power / max(est.size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
@@ -639,11 +654,11 @@ def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: i
         if 40.0 <= slope <= 80.0:
             raise MeasuredDataError(
                 f"{where}: column {name} looks like deg/s (it is {slope:.4g} times the derivative of "
-                f"{Q_COLUMNS[k]}); expected rad/s"
+                f"{q_columns[k]}); expected rad/s"
             )
         if not 0.8 <= slope <= 1.25:
             notes.append(
-                f"column {name} is {slope:.3g} times the derivative of {Q_COLUMNS[k]}; check its sign and unit"
+                f"column {name} is {slope:.3g} times the derivative of {q_columns[k]}; check its sign and unit"
             )
     return notes
 
@@ -651,7 +666,7 @@ def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: i
 def _torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
     limit = robot.gear_ratio * robot.motor_torque_limit
     notes = []
-    for k, name in enumerate(TAU_COLUMNS):
+    for k, name in enumerate(column_names(robot.n_axes)[2]):
         peak = float(np.max(np.abs(tau[:, k])))
         if peak > 1.5 * limit[k]:
             notes.append(
@@ -726,16 +741,20 @@ def _table(t, q, tau, qd) -> dict[str, np.ndarray]:
     t = np.asarray(t, dtype=float)
     if t.ndim != 1:
         raise ValueError(f"t must have shape (n,), got {t.shape}")
+    n_axes = np.shape(q)[1] if np.ndim(q) == 2 else 0  # the robot's N, as q gives it
+    if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
+        raise ValueError(f"q must have shape ({t.shape[0]}, N), N {axes.MIN_AXES}..{axes.MAX_AXES}, got {np.shape(q)}")
+    q_columns, qd_columns, tau_columns = column_names(n_axes)
     blocks = (
-        [("q", q, Q_COLUMNS)]
-        + ([("qd", qd, QD_COLUMNS)] if qd is not None else [])
-        + [("tau", tau, TAU_COLUMNS)]
+        [("q", q, q_columns)]
+        + ([("qd", qd, qd_columns)] if qd is not None else [])
+        + [("tau", tau, tau_columns)]
     )
     table = {T_COLUMN: t}
     for label, arr, names in blocks:
         arr = np.asarray(arr, dtype=float)
-        if arr.shape != (t.shape[0], N_AXES):
-            raise ValueError(f"{label} must have shape ({t.shape[0]}, {N_AXES}), got {arr.shape}")
+        if arr.shape != (t.shape[0], n_axes):
+            raise ValueError(f"{label} must have shape ({t.shape[0]}, {n_axes}), got {arr.shape}")
         table.update({name: arr[:, k] for k, name in enumerate(names)})
     return table
 
@@ -745,7 +764,7 @@ def write_csv(
 ) -> Path:
     """Write measured data as CSV (gzip-compressed when the name ends in ``.csv.gz``).
 
-    Columns ``t, q1..q6[, qd1..qd6], tau1..tau6`` with a header row; floats are written with
+    Columns ``t, q1..qN[, qd1..qdN], tau1..tauN`` (N the columns of ``q``) with a header row; floats are written with
     the shortest representation that reads back to the same float64. The values are not
     checked (so tests can write files that :func:`read` refuses), only the shapes.
 
@@ -755,9 +774,9 @@ def write_csv(
         Ending in ``.csv`` or ``.csv.gz``.
     t : array_like of shape (n,)
         Sample times in s.
-    q, tau : array_like of shape (n, 6)
-        Arm-side joint angles (rad) and torques (N m).
-    qd : array_like of shape (n, 6), optional
+    q, tau : array_like of shape (n, N)
+        Arm-side joint angles (rad) and torques (N m), N = 5..7 axes.
+    qd : array_like of shape (n, N), optional
         Arm-side joint velocities in rad/s; no ``qd`` columns when omitted.
 
     Returns
@@ -798,7 +817,9 @@ def write_hdf5(
     if not path.name.lower().endswith(HDF5_SUFFIXES):
         raise ValueError(f"{path}: write_hdf5 writes {' or '.join(HDF5_SUFFIXES)} files")
     table = _table(t, q, tau, qd)
-    with h5py.File(path, "w") as fh:
+    from faultgen.data.atomic import hdf5_writer
+
+    with hdf5_writer(path) as fh:  # a full disk: OSError, never a crash nor a partial file
         for name, values in table.items():
             ds = fh.create_dataset(name, data=values)
             ds.attrs["unit"] = UNITS[name]

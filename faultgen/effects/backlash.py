@@ -6,7 +6,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from faultgen.effects.base import N_AXES, Effect, ModelError, register
+from faultgen import axes
+from faultgen.effects.base import Effect, ModelError, register
 
 
 @register
@@ -74,7 +75,7 @@ class Backlash(Effect):
 
     @classmethod
     def read(cls, model, path):
-        ids = [model.tendon(f"gearbox{k + 1}").id for k in range(N_AXES)]
+        ids = [model.tendon(f"gearbox{k + 1}").id for k in range(axes.count(model))]
         width = np.diff(model.tendon_lengthspring[ids], axis=1)[:, 0]
         if np.any(width < 0):
             raise ModelError(f"{path}: a gearbox tendon's springlength must be an interval -b/2 b/2 with b >= 0")
@@ -91,7 +92,7 @@ class Backlash(Effect):
         return list(self.GRID)
 
     def _change(self, motion, widths: np.ndarray) -> np.ndarray:
-        """Torque change, (m, n, 6) N m, of the dead-band widths ``widths`` (m, 6) rad over the
+        """Torque change, (m, n, N) N m, of the dead-band widths ``widths`` (m, N) rad over the
         current model: the gearbox equation's and, to first order, the quasi-static shift's."""
         robot = motion.robot
         if "backlash" not in motion.memo:
@@ -99,7 +100,7 @@ class Backlash(Effect):
             step = 1e-4
             rigid = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, friction=False)
             slope = np.empty_like(rigid)
-            for axis in range(N_AXES):  # d(rigid torque of the axis)/d(its angle), the arm moved alone
+            for axis in range(robot.n_axes):  # d(rigid torque of the axis)/d(its angle), the arm moved alone
                 q = motion.q.copy()
                 q[:, axis] += step
                 shifted = robot.inverse_dynamics(q, motion.qd, motion.qdd, friction=False)
@@ -116,7 +117,7 @@ class Backlash(Effect):
 
     @staticmethod
     def _cost(residual, rows, scale):
-        """Weighted squared error on the fitting part of a torque change, (k, n, 6) -> (k,)."""
+        """Weighted squared error on the fitting part of a torque change, (k, n, N) -> (k,)."""
         weights = 1.0 / scale**2
         return lambda change: np.sum(np.where(rows, residual - change, 0.0) ** 2, axis=1) @ weights
 
@@ -125,7 +126,7 @@ class Backlash(Effect):
         widths = self.current(motion.robot).width.copy()
         change = np.zeros_like(residual)
         error = float(cost(change[None])[0])
-        free = list(range(N_AXES))
+        free = list(range(motion.robot.n_axes))
         grid = np.array(self.GRID)
         while free:
             trials = np.tile(widths, (len(free) * len(grid), 1))
@@ -142,7 +143,7 @@ class Backlash(Effect):
                 break
             widths, change, error = fine[j], changes[j], float(costs[j])
             free.remove(axis)
-        return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(N_AXES)]
+        return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(len(widths))]
 
     def replicate(self, motion, residual, rows, scale, axes):
         # each fitted axis refined over REFINE widths within SPAN of its value (re-centred while
@@ -167,7 +168,7 @@ class Backlash(Effect):
             fine, j = best(axis, fine[max(j - 1, 0), axis], fine[min(j + 1, self.REFINE - 1), axis])
             widths = fine[j]
         change = self._change(motion, widths[None])[0]
-        return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(N_AXES)]
+        return [(float(widths[a]), np.zeros(0), change[:, a]) for a in range(len(widths))]
 
     def params(self, motion, axis, theta, h):
         return {"width": float(h)}

@@ -33,7 +33,6 @@ import mujoco
 import numpy as np
 
 from faultgen import axes as axis_numbers
-from faultgen.axes import N_AXES
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 
 #: Arm-side speed (rad/s) below which an axis counts as at rest: its friction is then stiction,
@@ -52,7 +51,7 @@ class ModelError(ValueError):
 
 @dataclass(frozen=True)
 class Motion:
-    """A motion and what the current model says about it; every array ``(n, 6)``.
+    """A motion and what the current model says about it; every array ``(n, N)``.
 
     Attributes
     ----------
@@ -60,15 +59,15 @@ class Motion:
         The current model (nominal, or with the effects added so far).
     t : ndarray of shape (n,)
         Time since the first sample, s.
-    q, qd, qdd : ndarray of shape (n, 6)
+    q, qd, qdd : ndarray of shape (n, N)
         Arm-side angles (rad), velocities (rad/s), accelerations (rad/s^2).
-    load : ndarray of shape (n, 6)
+    load : ndarray of shape (n, N)
         Arm-side gearbox load: the rigid-body torque of the arm joints without motor inertia
         and friction, the arm at the motor angle, N m.
     compliance : callable, optional
         The flexible gearbox's torque along the motion,
-        ``compliance(robot, t, q, load, widths=None) -> (n, 6)`` or ``(m, n, 6)`` for dead-band
-        widths ``(m, 6)`` (:func:`faultgen.calibrate.gearbox.compliance_torque`); needed by the
+        ``compliance(robot, t, q, load, widths=None) -> (n, N)`` or ``(m, n, N)`` for dead-band
+        widths ``(m, N)`` (:func:`faultgen.calibrate.gearbox.compliance_torque`); needed by the
         effects that change the gearbox (backlash).
     """
 
@@ -92,7 +91,7 @@ class Motion:
 
     @property
     def static_load(self) -> np.ndarray:
-        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, 6): gravity and joint
+        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, N): gravity and joint
         springs (:meth:`faultgen.robots.Robot.static_load`), computed once per motion."""
         if "static_load" not in self.memo:
             self.memo["static_load"] = self.robot.static_load(self.q)
@@ -100,7 +99,7 @@ class Motion:
 
     @property
     def motor_velocity(self) -> np.ndarray:
-        """Motor-side velocity ``G qd`` in rad/s, shape (n, 6)."""
+        """Motor-side velocity ``G qd`` in rad/s, shape (n, N)."""
         return self.robot.gear_ratio * self.qd
 
 
@@ -170,7 +169,11 @@ class Effect:
 
     Parameters
     ----------
-    **values : float or array_like of shape (6,)
+    n_axes : int, optional
+        The robot's number of axes N, for a per-axis effect given no value per axis (without it,
+        the length of the values given per axis; with neither, the effect holds one value for all
+        axes of any robot, as the registry's prototypes do).
+    **values : float or array_like of shape (N,)
         Parameters by name (:attr:`units`), one value for all axes or one per axis; a robot-wide
         effect takes one value each. Missing ones take their :attr:`absent` value.
 
@@ -179,8 +182,11 @@ class Effect:
     ValueError
         For an unknown parameter name or a value of the wrong shape or non-finite.
 
-    Each parameter is a read-only attribute of that name (``effect.offset``, ndarray of shape (6,),
-    or a 0-d array when robot-wide); :meth:`values` and :meth:`table` give plain numbers.
+    Each parameter is a read-only attribute of that name (``effect.offset``, ndarray of shape (N,),
+    or a 0-d array when robot-wide or made with one value for all axes and no ``n_axes``; such an
+    effect gives that value for every axis in :meth:`values` and :meth:`write`, and is sized by the
+    robot where it meets one: :meth:`current`, :meth:`fitted`); :meth:`values` and :meth:`table`
+    give plain numbers.
 
     Attributes
     ----------
@@ -240,11 +246,13 @@ class Effect:
     #: where no axis reaches it); None: drawn by size.
     draw_range: ClassVar[tuple[str, float, float, float, float] | None] = None
 
-    def __init__(self, **values) -> None:
+    def __init__(self, *, n_axes: int | None = None, **values) -> None:
         unknown = set(values) - set(self.units)
         if unknown:
             raise ValueError(f"{self.id}: unknown parameter {min(unknown)!r}; expected {', '.join(self.units)}")
-        shape = (N_AXES,) if self.per_axis else ()
+        if self.per_axis and n_axes is None:  # the axes of the first value given per axis, if any
+            n_axes = next((np.shape(v)[0] for v in values.values() if np.ndim(v) == 1), None)
+        shape = (n_axes,) if self.per_axis and n_axes is not None else ()
         table = {}
         for k, name in enumerate(self.units):
             value = np.asarray(values.get(name, self.absent[k]), dtype=float)
@@ -252,7 +260,7 @@ class Effect:
                 value = np.broadcast_to(value, shape).copy()
             except ValueError:
                 raise ValueError(f"{self.id}: parameter {name!r} has shape {value.shape}; expected one value"
-                                 + (f" or {N_AXES}, one per axis" if self.per_axis else "")) from None
+                                 + (f" or {n_axes}, one per axis" if self.per_axis else "")) from None
             if not np.all(np.isfinite(value)):
                 raise ValueError(f"{self.id}: parameter {name!r} holds a non-finite value")
             value.setflags(write=False)  # an instance is a value: a change makes a new one (fitted)
@@ -282,10 +290,10 @@ class Effect:
     def values(self, axis: int | None = None) -> dict[str, float]:
         """Parameters of ``axis`` (0-based; None for a robot-wide effect) as plain numbers (int for
         the :attr:`counts`)."""
-        return {k: self._plain(k, v if axis is None else v[axis]) for k, v in self._values.items()}
+        return {k: self._plain(k, v if axis is None or v.ndim == 0 else v[axis]) for k, v in self._values.items()}
 
     def table(self) -> dict[str, list[float] | float]:
-        """All parameters as plain lists over axes 1..6 (one number when robot-wide), ``parameters.json``."""
+        """All parameters as plain lists over axes 1..N (one number when robot-wide), ``parameters.json``."""
         return {k: [self._plain(k, x) for x in v] if v.ndim else self._plain(k, v) for k, v in self._values.items()}
 
     def _plain(self, name: str, value) -> float | int:
@@ -326,8 +334,9 @@ class Effect:
         if cls.numeric is None:
             return None
         size = len(cls.units)
-        rows = np.tile(np.array(cls.absent, dtype=float), (N_AXES, 1))
-        for k in range(N_AXES):
+        n_axes = axis_numbers.count(model)
+        rows = np.tile(np.array(cls.absent, dtype=float), (n_axes, 1))
+        for k in range(n_axes):
             for name in (cls.numeric, *cls.aliases):
                 idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, f"{name}{k + 1}")
                 if idx >= 0:
@@ -345,11 +354,11 @@ class Effect:
         problem = cls.check(rows)
         if problem:
             raise ModelError(f"{path}: numeric '{cls.numeric}' {problem}")
-        return cls(**{name: rows[:, k] for k, name in enumerate(cls.units)})
+        return cls(n_axes=n_axes, **{name: rows[:, k] for k, name in enumerate(cls.units)})
 
     @classmethod
     def check(cls, rows: np.ndarray) -> str | None:
-        """What is wrong with the stored values ``rows`` (6, n parameters), or None."""
+        """What is wrong with the stored values ``rows`` (N, n parameters), or None."""
         return None
 
     def apply(self, spec: mujoco.MjSpec, robot, axis: int | None, params: dict[str, float]) -> None:
@@ -369,25 +378,25 @@ class Effect:
             existing.data = data
 
     def write(self, spec: mujoco.MjSpec, robot, axes: list[int] | None = None) -> None:
-        """Write this instance's parameters on ``axes`` (0-based; all six when omitted; ignored for
+        """Write this instance's parameters on ``axes`` (0-based; all of the robot's when omitted; ignored for
         a robot-wide effect) into ``spec``, over what ``robot`` has there."""
         if not self.per_axis:
             self.apply(spec, robot, None, self.values())
             return
-        for axis in range(N_AXES) if axes is None else axes:
+        for axis in range(robot.n_axes) if axes is None else axes:
             self.apply(spec, robot, axis, self.values(axis))
 
     # -- acting --------------------------------------------------------------------------
 
     def torque(self, robot, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray
                ) -> np.ndarray | None:
-        """Arm-side drive torque of the effect along a motion, N m, shape (n, 6), that the
+        """Arm-side drive torque of the effect along a motion, N m, shape (n, N), that the
         rigid-body model does not already carry (None: nothing). ``load`` is the arm-side gearbox
         load (N m), ``t`` the time since the start of the run (s)."""
         return None
 
     def arm_offset(self, load: np.ndarray) -> np.ndarray | None:
-        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, 6), rad, for
+        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, N), rad, for
         an effect that lets the arm trail the motor (None: it does not)."""
         return None
 
@@ -397,15 +406,15 @@ class Effect:
 
     def dry_friction_factor(self, time: np.ndarray) -> np.ndarray | None:
         """Factor on the rotors' dry friction (Coulomb plus Stribeck) at ``time`` (r, 1) s since
-        the start of each run, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
+        the start of each run, shape (r, N); None: none. Only for a :attr:`stepped` effect."""
         return None
 
     def dry_friction_extra(self, robot, deflection: np.ndarray, static_load: Callable[[], np.ndarray]
                            ) -> np.ndarray | None:
         """Motor-side dry friction the effect adds given the gearbox deflections ``deflection``
-        (r, 6) rad (eq. 6.2a) and ``static_load()``, the arm-side torque (r, 6) that would hold the
+        (r, N) rad (eq. 6.2a) and ``static_load()``, the arm-side torque (r, N) that would hold the
         arms still where they are (:meth:`faultgen.robots.Robot.static_load_of`; computed only when
-        called), N m, shape (r, 6); None: none. Only for a :attr:`stepped` effect."""
+        called), N m, shape (r, N); None: none. Only for a :attr:`stepped` effect."""
         return None
 
     # -- identification ------------------------------------------------------------------
@@ -415,8 +424,8 @@ class Effect:
         return [None]
 
     def search(self, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray) -> list | None:
-        """The effect's own fit of all axes to ``residual`` (n, 6) on the samples of ``rows``
-        (n, 6), axis a weighted by ``1 / scale[a]**2`` (its torque RMS, N m): per axis
+        """The effect's own fit of all axes to ``residual`` (n, N) on the samples of ``rows``
+        (n, N), axis a weighted by ``1 / scale[a]**2`` (its torque RMS, N m): per axis
         ``(h, theta, predicted torque (n,))``. None (the default): the generic per-axis least
         squares over :meth:`grid` and :meth:`columns`."""
         return None
@@ -431,7 +440,7 @@ class Effect:
 
     def columns(self, motion: Motion, axis: int | None, h) -> tuple[np.ndarray, np.ndarray]:
         """Regressors ``Phi`` (n, k) and known part ``offset`` (n,) of the torque change of
-        ``axis`` (0-based) over ``motion.robot``, or of all axes ``(n, 6, k)`` / ``(n, 6)`` when
+        ``axis`` (0-based) over ``motion.robot``, or of all axes ``(n, N, k)`` / ``(n, N)`` when
         not ``per_axis``: the change is ``Phi @ theta + offset``."""
         raise NotImplementedError
 
@@ -462,11 +471,11 @@ class Effect:
                     table[name] = np.asarray(value, dtype=float)
                 else:
                     table[name][axis] = value
-        return type(self)(**table)
+        return type(self)(n_axes=robot.n_axes, **table)
 
     def current(self, robot) -> Effect:
         """This effect's values in ``robot`` (the absent values when the robot does not carry it)."""
-        return robot.effects.get(self.id, type(self)())
+        return robot.effects.get(self.id, type(self)(n_axes=robot.n_axes))
 
     # -- hidden-effect drawing -----------------------------------------------------------
 

@@ -1,11 +1,14 @@
 """Load a robot by name: compiled MuJoCo model, element names, nominal parameters, inverse dynamics.
 
-A robot is a folder ``robots/<name>/`` holding ``<name>.xml`` (the MJCF), ``scene.xml`` and a
-README giving the source of every number. The MJCF is the single source of the parameters:
-this module reads them back from the compiled model, so an edited or augmented MJCF is picked
-up without code changes.
+A robot is a folder ``robots/<name>/`` (or any folder given by path) holding ``<name>.xml`` (the
+MJCF), ``scene.xml``, ``tasks.toml``, ``drivetrain.toml`` and a README giving the source of every
+number. ``<name>.xml`` is built by :func:`faultgen.model.builder.build` from an arm and its
+drivetrain (``faultgen robots add``; the built-in robots from their ``arm.xml``). The MJCF is the
+single source of the parameters: this module reads them back from the compiled model, so an
+edited or augmented MJCF is picked up without code changes.
 
-Each model pairs six arm joints ``joint{i}`` with six motor-rotor joints ``rotor{i}``, coupled by
+Each model pairs N arm joints ``joint{i}`` (5 <= N <= 7, read from the model: ``joint1``,
+``joint2``, ... as far as they go) with N motor-rotor joints ``rotor{i}``, coupled by
 fixed tendons ``gearbox{i}`` (``L = rotor{i} / G - joint{i}``, thesis eq. 6.2a), driven by torque
 actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the custom numerics
 ``friction{i}`` and a ``home`` keyframe.
@@ -29,18 +32,24 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.axes import N_AXES
+from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import MotorFriction
+from faultgen.model import drivetrain
 
 
 class UnknownRobotError(ValueError):
-    """Raised by :func:`load` for a name that is neither a known robot nor an MJCF file."""
+    """Raised by :func:`load` for a name that is neither a known robot nor an MJCF file or robot folder."""
 
 
-__all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "from_spec", "load", "robots_dir",
-           "with_timestep"]
+__all__ = ["ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_of", "from_spec", "load",
+           "robots_dir", "with_timestep"]
+
+
+#: Name of the custom numeric holding a robot's rated payload in kg (robots added by ``faultgen robots
+#: add`` have one; :attr:`Robot.rated_payload`).
+RATED_PAYLOAD = "rated_payload"
 
 
 def robots_dir() -> Path:
@@ -77,22 +86,22 @@ class Robot:
     model : mujoco.MjModel
         The compiled model (arm joints, rotors, gearbox tendons, motors).
     joint_names, rotor_names, gearbox_names, actuator_names : tuple of str
-        Names of the arm joints, rotor joints, gearbox tendons and motors, axis 1..6 in order.
-    gear_ratio : ndarray of shape (6,)
+        Names of the arm joints, rotor joints, gearbox tendons and motors, axis 1..N in order.
+    gear_ratio : ndarray of shape (N,)
         Gear ratio G (motor angle / arm angle), dimensionless, positive.
-    motor_inertia : ndarray of shape (6,)
+    motor_inertia : ndarray of shape (N,)
         Rotor inertia Jm in kg m^2 at the motor side (the rotor joints' armature).
-    gearbox_stiffness : ndarray of shape (6,)
+    gearbox_stiffness : ndarray of shape (N,)
         Gearbox stiffness K in N m/rad at the arm side (thesis eq. 6.2a).
-    gearbox_damping : ndarray of shape (6,)
+    gearbox_damping : ndarray of shape (N,)
         Gearbox damping D in N m s/rad at the arm side (thesis eq. 6.2a).
-    joint_range : ndarray of shape (6, 2)
+    joint_range : ndarray of shape (N, 2)
         Arm joint limits in rad.
-    motor_torque_limit : ndarray of shape (6,)
+    motor_torque_limit : ndarray of shape (N,)
         Largest motor torque the actuators accept, N m at the motor side.
     friction : MotorFriction
         Nominal motor-side friction parameters.
-    home : ndarray of shape (6,)
+    home : ndarray of shape (N,)
         Arm joint angles of the ``home`` keyframe in rad.
     effects : dict of str to Effect
         The effects stored in their own MJCF elements (:func:`faultgen.effects.read_all`), by id,
@@ -149,27 +158,44 @@ class Robot:
         self.__dict__.update(state)
         object.__setattr__(self, "_threads", threading.local())
 
+    @cached_property
+    def rated_payload(self) -> float:
+        """Rated payload in kg from the model's ``rated_payload`` numeric; NaN when it has none (the
+        built-in robots: their parts are in ``faultgen.runs.fleet.PARTS``)."""
+        idx = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_NUMERIC, RATED_PAYLOAD)
+        return float(self.model.numeric_data[self.model.numeric_adr[idx]]) if idx >= 0 else float("nan")
+
+    @property
+    def n_axes(self) -> int:
+        """Number of axes N (5 to 7), read from the model (``joint1`` .. ``jointN``)."""
+        return len(self.joint_names)
+
     def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
         return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
 
+    @property
+    def n_axes(self) -> int:
+        """Number of axes N (5..7), read from the model (its joints ``joint1`` .. ``jointN``)."""
+        return len(self.joint_names)
+
     @cached_property
     def arm_qpos(self) -> np.ndarray:
-        """Indices of the arm joints in ``qpos``, ``ndarray of shape (6,)``."""
+        """Indices of the arm joints in ``qpos``, ``ndarray of shape (N,)``."""
         return self._joint_addresses(self.joint_names, "qposadr")
 
     @cached_property
     def arm_dof(self) -> np.ndarray:
-        """Indices of the arm joints in ``qvel``, ``ndarray of shape (6,)``."""
+        """Indices of the arm joints in ``qvel``, ``ndarray of shape (N,)``."""
         return self._joint_addresses(self.joint_names, "dofadr")
 
     @cached_property
     def rotor_qpos(self) -> np.ndarray:
-        """Indices of the rotor joints in ``qpos``, ``ndarray of shape (6,)``."""
+        """Indices of the rotor joints in ``qpos``, ``ndarray of shape (N,)``."""
         return self._joint_addresses(self.rotor_names, "qposadr")
 
     @cached_property
     def rotor_dof(self) -> np.ndarray:
-        """Indices of the rotor joints in ``qvel``, ``ndarray of shape (6,)``."""
+        """Indices of the rotor joints in ``qvel``, ``ndarray of shape (N,)``."""
         return self._joint_addresses(self.rotor_names, "dofadr")
 
     def rigid_state(self, q: np.ndarray, qd: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -177,9 +203,9 @@ class Robot:
 
         Parameters
         ----------
-        q : ndarray of shape (6,)
+        q : ndarray of shape (N,)
             Arm joint angles in rad.
-        qd : ndarray of shape (6,), optional
+        qd : ndarray of shape (N,), optional
             Arm joint velocities in rad/s; zero when omitted.
 
         Returns
@@ -189,8 +215,8 @@ class Robot:
         qvel : ndarray of shape (nv,)
             Arm joints at ``qd``, rotors at ``G qd`` (motor-side rad/s).
         """
-        q = _check_vector("q", q)
-        qd = np.zeros(N_AXES) if qd is None else _check_vector("qd", qd)
+        q = _check_vector("q", q, self.n_axes)
+        qd = np.zeros(self.n_axes) if qd is None else _check_vector("qd", qd, self.n_axes)
         qpos = np.zeros(self.model.nq)
         qvel = np.zeros(self.model.nv)
         qpos[self.arm_qpos] = q
@@ -213,7 +239,7 @@ class Robot:
 
         Parameters
         ----------
-        q, qd, qdd : ndarray of shape (n, 6)
+        q, qd, qdd : ndarray of shape (n, N)
             Arm joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
         friction : bool, default True
             Include motor-side friction (:meth:`MotorFriction.stribeck_torque` at ``G qd``)
@@ -230,7 +256,7 @@ class Robot:
 
         Returns
         -------
-        ndarray of shape (n, 6)
+        ndarray of shape (n, N)
             Arm-side joint torque in N m (motor torque times G).
 
         Notes
@@ -240,11 +266,11 @@ class Robot:
         Raises
         ------
         ValueError
-            If an input is not of shape (n, 6) with a common n, or holds a non-finite value.
+            If an input is not of shape (n, N) with a common n, or holds a non-finite value.
         """
-        q = _check_trajectory("q", q)
-        qd = _check_trajectory("qd", qd, q.shape[0])
-        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        q = _check_trajectory("q", q, None, self.n_axes)
+        qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
+        qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         G = self.gear_ratio
         tau, load = self._rigid(q, qd, qdd)
         offset = self.arm_offset(load)
@@ -258,7 +284,7 @@ class Robot:
         return tau
 
     def gearbox_load(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """Arm-side load the gearboxes carry along a motion, N m, shape (n, 6).
+        """Arm-side load the gearboxes carry along a motion, N m, shape (n, N).
 
         The rigid-body torque of the arm joints (thesis eq. 6.1 without motor inertia and
         friction) with the arm at the motor angle ``q`` (no backlash shift, :meth:`arm_offset`); the input of the
@@ -266,7 +292,7 @@ class Robot:
 
         Parameters
         ----------
-        q, qd, qdd : ndarray of shape (n, 6)
+        q, qd, qdd : ndarray of shape (n, N)
             Joint angles (rad), velocities (rad/s) and accelerations (rad/s^2).
 
         Raises
@@ -274,20 +300,20 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q)
-        qd = _check_trajectory("qd", qd, q.shape[0])
-        qdd = _check_trajectory("qdd", qdd, q.shape[0])
+        q = _check_trajectory("q", q, None, self.n_axes)
+        qd = _check_trajectory("qd", qd, q.shape[0], self.n_axes)
+        qdd = _check_trajectory("qdd", qdd, q.shape[0], self.n_axes)
         return self._rigid(q, qd, qdd)[1]
 
     def static_load(self, q: np.ndarray) -> np.ndarray:
-        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, 6): gravity plus the
+        """Arm-side torque that holds the arm still at ``q``, N m, shape (n, N): gravity plus the
         joints' passive springs (the IRB-6700-like axis-2 balancing), the static gearbox load of
         load-dependent friction's gravity form (Bittencourt & Gunnarsson 2012). :meth:`gearbox_load`
         at zero speed and acceleration.
 
         Parameters
         ----------
-        q : ndarray of shape (n, 6)
+        q : ndarray of shape (n, N)
             Arm joint angles in rad.
 
         Raises
@@ -295,13 +321,13 @@ class Robot:
         ValueError
             As :meth:`inverse_dynamics`.
         """
-        q = _check_trajectory("q", q)
+        q = _check_trajectory("q", q, None, self.n_axes)
         zero = np.zeros_like(q)
         return self._rigid(q, zero, zero)[1]
 
     def static_load_of(self, subtree_com: np.ndarray, xanchor: np.ndarray, xaxis: np.ndarray,
                        qpos: np.ndarray) -> np.ndarray:
-        """:meth:`static_load` from MuJoCo's position-stage fields of r simulations, N m, (r, 6):
+        """:meth:`static_load` from MuJoCo's position-stage fields of r simulations, N m, (r, N):
         ``-a . ((c - p) x m g) + k (q - q_spring)`` per arm joint (axis ``a``, anchor ``p``, mass
         ``m`` and centre ``c`` of the body subtree it carries, spring stiffness ``k``). For a
         simulation stepping many runs at once, where ``mj_inverse`` per run would cost too much.
@@ -313,7 +339,7 @@ class Robot:
         qpos : ndarray of shape (r, nq)
         """
         joints, bodies, mass, gravity, stiffness, rest = self._static_terms
-        lever = subtree_com[:, bodies] - xanchor[:, joints]  # (r, 6, 3), m
+        lever = subtree_com[:, bodies] - xanchor[:, joints]  # (r, N, 3), m
         # -a . ((c - p) x m g) = m a^T [g]x (c - p), [g]x v = g x v: a product, not a cross product
         moment = np.sum((xaxis[:, joints] @ gravity) * lever, axis=-1)
         return mass * moment + stiffness * (qpos[:, self.arm_qpos] - rest)
@@ -331,7 +357,7 @@ class Robot:
                 model.qpos_spring[self.arm_qpos].copy())
 
     def _rigid(self, q, qd, qdd, q_motor=None) -> tuple[np.ndarray, np.ndarray]:
-        """Rigid-body drive torque and arm-side gearbox load, both (n, 6), by ``mj_inverse``
+        """Rigid-body drive torque and arm-side gearbox load, both (n, N), by ``mj_inverse``
         (arm at ``q``, rotors at ``G q_motor``, ``q_motor = q`` by default)."""
         model, data = self._inverse
         G = self.gear_ratio
@@ -353,7 +379,7 @@ class Robot:
         return load + G * force[:, self.rotor_dof], load
 
     def arm_mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """The arm's joint-space inertia matrix (rotor spin excluded), kg m^2, shape (n, 6, 6).
+        """The arm's joint-space inertia matrix (rotor spin excluded), kg m^2, shape (n, N, N).
 
         The arm block of MuJoCo's mass matrix (``mj_fullM``) with the rotors at ``G q``: what
         the arm joints' torques need per unit arm acceleration with the rotors held (thesis eq.
@@ -361,10 +387,10 @@ class Robot:
 
         Parameters
         ----------
-        q : ndarray of shape (n, 6)
+        q : ndarray of shape (n, N)
             Arm joint angles in rad.
         """
-        q = _check_trajectory("q", q)
+        q = _check_trajectory("q", q, None, self.n_axes)
         model, data = self._inverse
         qpos = np.tile(data.qpos, (q.shape[0], 1))
         qpos[:, self.arm_qpos], qpos[:, self.rotor_qpos] = q, self.gear_ratio * q
@@ -379,7 +405,7 @@ class Robot:
 
     def effect_torque(self, q: np.ndarray, qd: np.ndarray, load: np.ndarray, t: np.ndarray | None = None
                       ) -> np.ndarray:
-        """Arm-side drive torque of the robot's :attr:`effects`, N m, shape (n, 6).
+        """Arm-side drive torque of the robot's :attr:`effects`, N m, shape (n, N).
 
         ``load`` is the arm-side gearbox load torque (rigid-body torque of the arm joints), N m;
         ``t`` the time since the start of the run, s (zero when omitted).
@@ -394,7 +420,7 @@ class Robot:
         return tau
 
     def arm_offset(self, load: np.ndarray) -> np.ndarray | None:
-        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, 6), rad, from
+        """Arm angle minus motor angle over G under the arm-side gearbox ``load`` (n, N), rad, from
         the :attr:`effects` that let the arm trail the motor (backlash); None when none does."""
         offsets = [effect.arm_offset(load) for effect in self.effects.values() if np.any(effect.active())]
         offsets = [o for o in offsets if o is not None]
@@ -408,19 +434,19 @@ class Robot:
         return from_spec(spec, self.path)
 
 
-def _check_vector(name: str, value: np.ndarray) -> np.ndarray:
+def _check_vector(name: str, value: np.ndarray, n_axes: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
-    if arr.shape != (N_AXES,):
-        raise ValueError(f"{name} must have shape ({N_AXES},), got {arr.shape}")
+    if arr.shape != (n_axes,):
+        raise ValueError(f"{name} must have shape ({n_axes},), got {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} holds a non-finite value at axis {int(np.argmin(np.isfinite(arr))) + 1}")
     return arr
 
 
-def _check_trajectory(name: str, value: np.ndarray, n: int | None = None) -> np.ndarray:
+def _check_trajectory(name: str, value: np.ndarray, n: int | None, n_axes: int) -> np.ndarray:
     arr = np.asarray(value, dtype=float)
-    if arr.ndim != 2 or arr.shape[1] != N_AXES or (n is not None and arr.shape[0] != n):
-        expected = f"(n, {N_AXES})" if n is None else f"({n}, {N_AXES})"
+    if arr.ndim != 2 or arr.shape[1] != n_axes or (n is not None and arr.shape[0] != n):
+        expected = f"(n, {n_axes})" if n is None else f"({n}, {n_axes})"
         raise ValueError(f"{name} must have shape {expected}, got {arr.shape}")
     bad = np.argwhere(~np.isfinite(arr))
     if bad.size:
@@ -430,12 +456,14 @@ def _check_trajectory(name: str, value: np.ndarray, n: int | None = None) -> np.
 
 
 def load(name: str | Path) -> Robot:
-    """Load a robot by name (see :func:`available`) or from the path of an MJCF file.
+    """Load a robot by name (see :func:`available`), from a robot folder or from an MJCF file.
 
     Parameters
     ----------
     name : str or Path
-        A known robot name such as ``"puma560"`` or ``"irb6700"``, or the path of an MJCF file
+        A known robot name such as ``"puma560"`` or ``"irb6700"``; the path of a robot folder
+        (``faultgen robots add`` writes one: ``<folder name>.xml`` in it is the robot, or else its
+        only ``.xml`` file other than ``scene.xml`` and ``arm.xml``); or the path of an MJCF file
         with the elements listed in this module's docstring.
 
     Returns
@@ -448,22 +476,38 @@ def load(name: str | Path) -> Robot:
     Raises
     ------
     UnknownRobotError
-        If ``name`` is neither a known robot nor an existing file; the message lists the known
-        robots.
+        If ``name`` is neither a known robot nor an existing file or robot folder; the message
+        lists the known robots.
     ModelError
         If the MJCF does not compile (the message names the file and MuJoCo's line) or lacks a
-        required element.
+        required element. (A folder's ``drivetrain.toml`` records the numbers its MJCF was built
+        with; the MJCF is what loads, so rebuild it after editing the table.)
     """
     known = available()
     if str(name) in known:
         path = known[str(name)]
     elif Path(name).is_file():
         path = Path(name)
+    elif Path(name).is_dir():
+        path = _folder_model(Path(name))
     else:
         listing = ", ".join(known) or "(none found in " + str(robots_dir()) + ")"
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
     path = path.resolve()
     return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+
+
+def _folder_model(folder: Path) -> Path:
+    """The robot MJCF of a robot folder (see :func:`load`)."""
+    own = folder / f"{folder.resolve().name}.xml"
+    if own.is_file():
+        return own
+    candidates = sorted(p for p in folder.glob("*.xml") if p.name not in ("scene.xml", "arm.xml"))
+    if len(candidates) != 1:
+        found = ", ".join(p.name for p in candidates) or "none"
+        raise UnknownRobotError(f"{folder}: not a robot folder; expected {own.name} or exactly one robot "
+                                f".xml (found: {found})")
+    return candidates[0]
 
 
 @functools.lru_cache(maxsize=32)
@@ -477,7 +521,7 @@ def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path
 
     For convergence studies (``benchmarks/convergence.py``): the copy is the robot's own MJCF with
     ``<option timestep=...>`` rewritten and nothing else (no re-serialisation, so every other
-    number keeps its digits), beside the robot's ``tasks.toml``.
+    number keeps its digits), beside the robot's ``tasks.toml`` (and its ``meshes`` folder, if any).
 
     Parameters
     ----------
@@ -510,6 +554,8 @@ def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path
     target = Path(folder) / source.stem
     target.mkdir(parents=True, exist_ok=True)
     shutil.copyfile(source.parent / "tasks.toml", target / "tasks.toml")
+    if (source.parent / "meshes").is_dir():  # an added robot's meshes, named relative to its MJCF
+        shutil.copytree(source.parent / "meshes", target / "meshes", dirs_exist_ok=True)
     (target / source.name).write_text(text)
     return target / source.name
 
@@ -539,25 +585,44 @@ def _from_file(path: Path) -> Robot:
     return _from_model(model, path)
 
 
+def drivetrain_of(robot: Robot) -> drivetrain.Drivetrain:
+    """The robot's drivetrain as data (:class:`faultgen.model.drivetrain.Drivetrain`), read back
+    from its compiled model: what ``drivetrain.toml`` of its folder holds."""
+    rows = robot.friction.as_rows()
+    drives = []
+    for k in range(robot.n_axes):
+        values = dict(gear_ratio=float(robot.gear_ratio[k]), motor_inertia=float(robot.motor_inertia[k]),
+                      gearbox_stiffness=float(robot.gearbox_stiffness[k]),
+                      gearbox_damping=float(robot.gearbox_damping[k]),
+                      motor_torque_limit=float(robot.motor_torque_limit[k]))
+        values.update({name: float(rows[k, j]) for j, name in enumerate(FRICTION_FIELDS)})
+        drives.append(drivetrain.AxisDrive(**values))
+    return drivetrain.Drivetrain(tuple(drives))
+
+
 def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
     def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
         idx = mujoco.mj_name2id(model, obj_type, element)
         if idx < 0:
-            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{N_AXES}")
+            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{n_axes}")
         return idx
 
-    axes = range(1, N_AXES + 1)
-    joint_names = tuple(f"joint{i}" for i in axes)
-    rotor_names = tuple(f"rotor{i}" for i in axes)
-    gearbox_names = tuple(f"gearbox{i}" for i in axes)
-    actuator_names = tuple(f"motor{i}" for i in axes)
+    n_axes = axes.count(model)
+    if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
+        raise ModelError(f"{path}: {n_axes} arm joints joint1..joint{n_axes}; a robot has "
+                         f"{axes.MIN_AXES}..{axes.MAX_AXES} (joint1, joint2, ... in order)")
+    numbers = range(1, n_axes + 1)
+    joint_names = tuple(f"joint{i}" for i in numbers)
+    rotor_names = tuple(f"rotor{i}" for i in numbers)
+    gearbox_names = tuple(f"gearbox{i}" for i in numbers)
+    actuator_names = tuple(f"motor{i}" for i in numbers)
 
-    gear_ratio = np.empty(N_AXES)
-    joint_range = np.empty((N_AXES, 2))
-    motor_inertia = np.empty(N_AXES)
-    torque_limit = np.empty(N_AXES)
-    friction_rows = np.empty((N_AXES, len(FRICTION_FIELDS)))
-    for k in range(N_AXES):
+    gear_ratio = np.empty(n_axes)
+    joint_range = np.empty((n_axes, 2))
+    motor_inertia = np.empty(n_axes)
+    torque_limit = np.empty(n_axes)
+    friction_rows = np.empty((n_axes, len(FRICTION_FIELDS)))
+    for k in range(n_axes):
         j = require("joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
         r = require("joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
         t = require("tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
@@ -592,7 +657,7 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
         adr, size = model.text_adr[description_id], model.text_size[description_id]
         description = bytes(model.text_data[adr : adr + size - 1]).decode()
 
-    for k in range(N_AXES):
+    for k in range(n_axes):
         if model.jnt_limited[model.joint(joint_names[k]).id] == 0:
             raise ModelError(f"{path}: joint {joint_names[k]!r} must be limited (give it a range)")
 

@@ -50,7 +50,6 @@ from typing import ClassVar
 
 import numpy as np
 
-from faultgen.axes import N_AXES
 from faultgen.checks import is_number, is_whole
 from faultgen.effects import temperature as temperature_law
 from faultgen.operation.tasks import TASKS
@@ -293,17 +292,18 @@ class UnitSpread:
         for name in ("dry_friction", "viscous_friction", "link_mass", "gear_loss"):
             check_number(f"unit spread {name}", getattr(self, name), 0, 0.5)
 
-    def draw(self, seed: int) -> dict[str, np.ndarray]:
-        """The unit's draws, from ``seed``, each ``ndarray of shape (6,)`` (axis / link 1..6): the
+    def draw(self, seed: int, n_axes: int) -> dict[str, np.ndarray]:
+        """The unit's draws, from ``seed``, each ``ndarray of shape (N,)`` (axis / link 1..N of a
+        robot of ``n_axes`` = N axes; a six-axis robot's draws are those it always had): the
         multipliers ``dry_friction``, ``viscous_friction``, ``link_mass`` (> 0) and the load-dependent
         friction coefficient ``gear_loss`` (0..:attr:`gear_loss`, drawn last, so that the other
         draws of a seed do not depend on it)."""
         rng = np.random.default_rng([seed, 0, _UNIT])
-        normal = rng.standard_normal((3, N_AXES))
+        normal = rng.standard_normal((3, n_axes))
         return {"dry_friction": np.exp(self.dry_friction * normal[0] - self.dry_friction**2 / 2),
                 "viscous_friction": np.exp(self.viscous_friction * normal[1] - self.viscous_friction**2 / 2),
                 "link_mass": 1 + self.link_mass * np.clip(normal[2], -3, 3),
-                "gear_loss": self.gear_loss * rng.random(N_AXES)}
+                "gear_loss": self.gear_loss * rng.random(n_axes)}
 
 
 @dataclass(frozen=True)
@@ -318,20 +318,20 @@ class CycleConditions:
         Time of day, h.
     ambient_temperature : ndarray of shape (n,)
         deg C.
-    joint_temperature : ndarray of shape (n, 6)
+    joint_temperature : ndarray of shape (n, N)
         deg C.
-    dry_friction_factor, viscous_factor : ndarray of shape (n, 6)
+    dry_friction_factor, viscous_factor : ndarray of shape (n, N)
         Multipliers of the Coulomb and static, and of the viscous friction, from temperature and
         unit spread (wear not included).
     payload_part : ndarray of shape (n,)
         Index of the part carried (-1: none scheduled).
     payload_mass : ndarray of shape (n,)
         kg.
-    link_mass_factor : ndarray of shape (6,)
+    link_mass_factor : ndarray of shape (N,)
         Multiplier of each link's mass and inertia (the unit's).
     task_index : ndarray of shape (n,)
         Index of the task the cycle ran, into the task mix's tasks (-1: no mix, the run's task).
-    gear_loss : ndarray of shape (6,)
+    gear_loss : ndarray of shape (N,)
         Load-dependent friction coefficient the unit's gearbox adds per axis (:attr:`UnitSpread.gear_loss`;
         zeros without).
     """
@@ -415,9 +415,10 @@ class Conditions:
         """Whether any condition is on."""
         return any(c is not None for c in (self.thermal, self.payloads, self.spread, self.task_mix))
 
-    def evaluate(self, seed: int, cycles: np.ndarray) -> CycleConditions:
+    def evaluate(self, seed: int, cycles: np.ndarray, n_axes: int) -> CycleConditions:
         """The conditions at ``cycles`` (1-based recorded cycle indices, shape (n,)) of a run with
-        ``seed``: bit-identical for the same seed and cycles, whichever other cycles are recorded."""
+        ``seed`` on a robot of ``n_axes`` axes: bit-identical for the same seed and cycles, whichever
+        other cycles are recorded."""
         cycles = np.asarray(cycles, dtype=int)
         n = len(cycles)
         day = self.start_day + (cycles - 1) // self.cycles_per_day
@@ -428,15 +429,15 @@ class Conditions:
             hour = np.array([start + (end - start) * np.random.default_rng([seed, int(c), _TIME_OF_DAY]).random()
                              for c in cycles])
         ambient = np.full(n, np.nan)
-        joint = np.full((n, N_AXES), np.nan)
-        dry, viscous = np.ones((n, N_AXES)), np.ones((n, N_AXES))
+        joint = np.full((n, n_axes), np.nan)
+        dry, viscous = np.ones((n, n_axes)), np.ones((n, n_axes))
         if self.thermal is not None:
             ambient = self.thermal.ambient_at(day, hour)
-            joint = np.repeat(self.thermal.joint_at(day, hour)[:, None], N_AXES, axis=1)
+            joint = np.repeat(self.thermal.joint_at(day, hour)[:, None], n_axes, axis=1)
             dry, viscous = temperature_law.friction_factors(joint, self.thermal.dry_share)
-        link_mass, gear_loss = np.ones(N_AXES), np.zeros(N_AXES)
+        link_mass, gear_loss = np.ones(n_axes), np.zeros(n_axes)
         if self.spread is not None:
-            unit = self.spread.draw(seed)
+            unit = self.spread.draw(seed, n_axes)
             dry, viscous, link_mass = dry * unit["dry_friction"], viscous * unit["viscous_friction"], unit["link_mass"]
             gear_loss = unit["gear_loss"]
         part, mass = np.full(n, -1), np.zeros(n)

@@ -21,7 +21,7 @@ from types import MappingProxyType
 import numpy as np
 
 from faultgen import effects
-from faultgen.axes import N_AXES
+from faultgen import axes
 from faultgen.checks import is_whole
 from faultgen.effects.base import Effect
 from faultgen.operation import wear
@@ -39,7 +39,7 @@ class Fault:
     effect : str
         Effect id (:data:`faultgen.effects.EFFECTS`), not a ``stepped`` one.
     axis : int
-        1..6 (a robot-wide effect, payload, cannot be a growing fault).
+        1..N, N the robot's axes (5..7; a run checks it, :meth:`check`; a robot-wide effect, payload, cannot be a growing fault).
     parameter : str
         The parameter that grows (one of the effect's :attr:`~faultgen.effects.Effect.units`).
     final : float
@@ -62,7 +62,7 @@ class Fault:
     ------
     ValueError
         For an unknown effect (listing them), a stepped or robot-wide effect, an axis outside
-        1..6, an unknown parameter, a non-finite value, a final value equal to the start, a bad
+        1..7, an unknown parameter, a non-finite value, a final value equal to the start, a bad
         schedule kind or onset, or a value the effect does not admit; the message names it.
     """
 
@@ -84,8 +84,8 @@ class Fault:
         if not prototype.per_axis:
             raise ValueError(f"fault effect {self.effect!r} is robot-wide; a growing fault sits on one axis (parts "
                              "changing per cycle are an operating condition: --payloads)")
-        if not is_whole(self.axis) or not 1 <= self.axis <= N_AXES:
-            raise ValueError(f"fault axis {self.axis!r}: expected 1..6")
+        if not is_whole(self.axis) or not 1 <= self.axis <= axes.MAX_AXES:
+            raise ValueError(f"fault axis {self.axis!r}: expected 1..{axes.MAX_AXES}")
         names = list(prototype.units)
         for name in [self.parameter, *self.others]:
             if name not in names:
@@ -103,7 +103,7 @@ class Fault:
         for value in (self.start, self.final):
             if value < 0 and not prototype.signed:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} takes values >= 0")
-            instance = self.at(value)
+            instance = self.at(value, max(self.axis, axes.MIN_AXES))
             problem = type(prototype).check(np.array([instance.values(self.axis - 1)[n] for n in names])[None])
             if problem:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} {problem}")
@@ -117,14 +117,20 @@ class Fault:
         rise = self._schedule().multiplier(np.asarray(cycles)) - 1.0
         return self.start + (self.final - self.start) * rise
 
-    def at(self, value: float) -> Effect:
+    def check(self, n_axes: int) -> None:
+        """Raise ValueError when a robot of ``n_axes`` axes has no axis :attr:`axis`."""
+        if self.axis > n_axes:
+            raise ValueError(f"fault axis {self.axis} is out of range 1..{n_axes}")
+
+    def at(self, value: float, n_axes: int) -> Effect:
         """The effect with the parameter at ``value`` (and :attr:`others`) on the fault's axis,
-        absent on the others."""
+        absent on the others of a robot of ``n_axes`` axes."""
+        self.check(n_axes)
         cls = type(effects.get(self.effect))
         values = {**self.others, self.parameter: float(value)}
         table = {}
         for k, name in enumerate(cls.units):
-            column = np.full(N_AXES, cls.absent[k], dtype=float)
+            column = np.full(n_axes, cls.absent[k], dtype=float)
             if name in values:
                 column[self.axis - 1] = values[name]
             table[name] = column

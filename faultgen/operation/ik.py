@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from faultgen.model.robots import N_AXES, Robot
+from faultgen.model.robots import Robot
 
 FLANGE = "flange"
 POSITION_TOL = 1e-6  # m: a solve stops once the flange is this close to its target ...
@@ -46,7 +46,7 @@ def arm_model(robot: Robot) -> mujoco.MjModel:
         spec.delete(spec.body(name))
     model = spec.compile()
     names = tuple(model.joint(i).name for i in range(model.njnt))
-    if names != robot.joint_names or model.nq != N_AXES:
+    if names != robot.joint_names or model.nq != robot.n_axes:
         raise ValueError(f"{robot.path}: arm-only model has joints {names}, expected {robot.joint_names}")
     return model
 

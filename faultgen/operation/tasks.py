@@ -31,7 +31,7 @@ import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
 from faultgen.model import robots
-from faultgen.model.robots import N_AXES, Robot
+from faultgen.model.robots import Robot
 from faultgen.operation.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
 
 TASKS = ("pick_place", "spot_weld", "arc_weld")
@@ -151,23 +151,24 @@ class Task:
 
     def _move(self, path: _Builder, label: str, q_to: np.ndarray) -> None:
         """Append a ruckig rest-to-rest move from the path's last sample to ``q_to``."""
-        otg = Ruckig(N_AXES, PLAN_PERIOD)
-        inp = InputParameter(N_AXES)
+        n = len(q_to)
+        otg = Ruckig(n, PLAN_PERIOD)
+        inp = InputParameter(n)
         inp.current_position, inp.target_position = path.last, q_to
-        inp.current_velocity = inp.current_acceleration = np.zeros(N_AXES)
-        inp.target_velocity = inp.target_acceleration = np.zeros(N_AXES)
+        inp.current_velocity = inp.current_acceleration = np.zeros(n)
+        inp.target_velocity = inp.target_acceleration = np.zeros(n)
         inp.max_velocity = self.velocity_scale * self.velocity_limit
         inp.max_acceleration = self.acceleration_scale * self.acceleration_limit
         inp.max_jerk = self.jerk_limit
         inp.duration_discretization = DurationDiscretization.Discrete
-        trajectory = Trajectory(N_AXES)
+        trajectory = Trajectory(n)
         if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
             raise ValueError(f"{self.robot_name} {self.name}: ruckig found no move to {np.round(q_to, 4)}")
         steps = round(trajectory.duration / path.dt)
         samples = [trajectory.at_time(k * path.dt) for k in range(steps)]
-        q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, N_AXES)
-        qd = np.array([s[1] for s in samples] + [np.zeros(N_AXES)]).reshape(-1, N_AXES)
-        qdd = np.array([s[2] for s in samples] + [np.zeros(N_AXES)]).reshape(-1, N_AXES)
+        q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, n)
+        qd = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
+        qdd = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
         path.add(label, q, qd, qdd)
 
     def _solve(self, ik: FlangeIK, what: str, position, rotation, q_init) -> np.ndarray:
@@ -341,7 +342,7 @@ class _Builder:
 
     def __init__(self, q0: np.ndarray, dt: float) -> None:
         self.dt = dt
-        self.q, self.qd, self.qdd = [q0[None].copy()], [np.zeros((1, N_AXES))], [np.zeros((1, N_AXES))]
+        self.q, self.qd, self.qdd = [q0[None].copy()], [np.zeros((1, len(q0)))], [np.zeros((1, len(q0)))]
         self.target = [np.full((1, 3), np.nan)]
         self.tolerance = [np.zeros(1)]
         self.segments: list[tuple[str, int, int]] = []
@@ -448,9 +449,9 @@ def load(robot: Robot | str, name: str) -> Task:
         "robot_name": robot.name,
         "process": PROCESSES[name],
         "source": path,
-        "velocity_limit": limits.array("velocity", (N_AXES,), np.pi / 180, positive=True),
-        "acceleration_limit": limits.array("acceleration", (N_AXES,), np.pi / 180, positive=True),
-        "jerk_limit": limits.array("jerk", (N_AXES,), np.pi / 180, positive=True),
+        "velocity_limit": limits.array("velocity", (robot.n_axes,), np.pi / 180, positive=True),
+        "acceleration_limit": limits.array("acceleration", (robot.n_axes,), np.pi / 180, positive=True),
+        "jerk_limit": limits.array("jerk", (robot.n_axes,), np.pi / 180, positive=True),
         "start": start[0],
         "velocity_scale": table.fraction("velocity_scale"),
         "acceleration_scale": table.fraction("acceleration_scale"),
@@ -551,7 +552,8 @@ class _Table:
 
     def angles(self, key: str, robot: Robot, many: bool = False) -> np.ndarray:
         """Joint angles given in deg, one (6,) or ``many`` (m, 6), as rad (m, 6) within the ranges."""
-        q = self.array(key, (None, N_AXES) if many else (N_AXES,), np.pi / 180).reshape(-1, N_AXES)
+        n = robot.n_axes
+        q = self.array(key, (None, n) if many else (n,), np.pi / 180).reshape(-1, n)
         low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
         bad = np.argwhere((q < low) | (q > high))
         if bad.size:

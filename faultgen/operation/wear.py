@@ -32,7 +32,6 @@ from types import MappingProxyType
 import numpy as np
 
 from faultgen import axes
-from faultgen.axes import N_AXES
 from faultgen.checks import is_whole
 
 #: Known schedule kinds.
@@ -54,6 +53,12 @@ _SPEC_FORM = (
     "the form is AXIS:KIND:PERCENT[:key=value,...], e.g. '2:exp4:20', '2:exp4:50:onset=40', "
     "'3:logistic:10:shape=2' or '5:step:20:step_cycle=40'"
 )
+
+
+#: Largest final wear increase accepted, as a fraction (5: Coulomb and static friction six times
+#: their new level). The thesis's failing gearboxes reach tens of percent (ch. 5-6); far beyond,
+#: the motors saturate and the run no longer follows its task (issue 42: +1e9 gave 781 mrad).
+MAX_INCREASE = 5.0
 
 
 @dataclass(frozen=True)
@@ -118,6 +123,10 @@ class Schedule:
             raise ValueError(f"wear increase {increase!r} is not finite; {expected}")
         if increase < 0:
             raise ValueError(f"wear increase {increase!r} is negative; {expected}")
+        if increase > MAX_INCREASE:
+            raise ValueError(f"wear increase {increase:g} (+{100 * increase:g} %) is beyond the bound of "
+                             f"{MAX_INCREASE:g} (+{100 * MAX_INCREASE:g} %, friction x{1 + MAX_INCREASE:g}): a gearbox "
+                             "has failed long before, and the motors saturate")
         if not is_whole(self.last_cycle, 1):
             raise ValueError(f"last_cycle {self.last_cycle!r} is invalid; expected an int >= 1 such as 100")
         last = int(self.last_cycle)
@@ -217,9 +226,7 @@ def _cycles(k: int | np.ndarray) -> np.ndarray:
 
 
 def _check_axis(axis: object) -> int:
-    if not is_whole(axis) or not 1 <= axis <= N_AXES:
-        raise ValueError(f"axis {axis!r} is out of range 1..{N_AXES}")
-    return int(axis)
+    return axes.check(axis)  # 1..7 here; a run checks against its robot's N (WearPlan.check)
 
 
 @dataclass(frozen=True)
@@ -229,12 +236,14 @@ class WearPlan:
     Attributes
     ----------
     schedules : mapping of int to Schedule
-        1-based axis number (1..6) -> schedule, sorted by axis. Read-only.
+        1-based axis number (1..N) -> schedule, sorted by axis. Read-only. A plan does not know its
+        robot: construction accepts any axis a robot can have (1..7); :meth:`check` and
+        :meth:`multipliers` hold it to a robot's N.
 
     Raises
     ------
     ValueError
-        On construction, for an axis outside 1..6.
+        On construction, for an axis outside 1..7.
     TypeError
         On construction, for a value that is not a :class:`Schedule`.
     """
@@ -267,25 +276,39 @@ class WearPlan:
         """1-based numbers of the worn axes, ascending."""
         return tuple(self.schedules)
 
-    def multipliers(self, cycles: int | np.ndarray) -> np.ndarray:
+    def check(self, n_axes: int) -> None:
+        """Raise ValueError naming the first worn axis a robot of ``n_axes`` axes does not have
+        ("axis 7 is out of range 1..6")."""
+        for axis in self.schedules:
+            axes.index(axis, n_axes)
+
+    def multipliers(self, cycles: int | np.ndarray, n_axes: int) -> np.ndarray:
         """Friction multiplier of every axis at each cycle.
 
         Parameters
         ----------
         cycles : int or ndarray of int of shape (n,)
             Cycle indices >= 0.
+        n_axes : int
+            The robot's number of axes N (``Robot.n_axes``).
 
         Returns
         -------
-        ndarray of shape (n, 6)
+        ndarray of shape (n, N)
             Dimensionless multipliers, column ``i - 1`` for axis ``i``; 1.0 for unworn axes.
+
+        Raises
+        ------
+        ValueError
+            For a bad cycle index, or a worn axis outside 1..N.
         """
         k = np.atleast_1d(_cycles(cycles))
         if k.ndim != 1:
             raise ValueError(f"cycles must be an int or a 1-D int array, got shape {k.shape}")
-        out = np.ones((k.shape[0], N_AXES))
+        self.check(n_axes)
+        out = np.ones((k.shape[0], n_axes))
         for axis, schedule in self.schedules.items():
-            out[:, axes.index(axis)] = schedule.multiplier(k)
+            out[:, axes.index(axis, n_axes)] = schedule.multiplier(k)
         return out
 
     def to_dict(self) -> dict[str, object]:
@@ -310,7 +333,7 @@ def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
     Returns
     -------
     axis : int
-        1-based axis number, 1..6.
+        1-based axis number, 1..7 (a run holds it to its robot's N).
     schedule : Schedule
 
     Raises

@@ -31,9 +31,11 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, replace
 
+import mujoco
 import numpy as np
 
 from faultgen.effects import friction as friction_models
+from faultgen.effects.payload import Payload
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots as robot_models
 from faultgen.operation import conditions, faults, tasks, wear
@@ -41,12 +43,78 @@ from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
-#: Parts of two sizes per robot model: (mass range kg, edge range m) of the small and the big
-#: part. Ours, sized to each model's rated load (IRB-6700-like: 200 kg; PUMA 560: 2.5 kg).
+#: Parts of two sizes of the shipped robot models: (mass range kg, edge range m) of the small and
+#: the big part. Ours, sized to each model's rated load (IRB-6700-like: 200 kg; PUMA 560: 2.5 kg).
+#: Any other model's parts come from its rated payload (:func:`sized_parts`), no entry needed.
 PARTS = {
     "irb6700": (((10.0, 40.0), (0.15, 0.3)), ((60.0, 120.0), (0.3, 0.5))),
     "puma560": (((0.2, 0.8), (0.03, 0.06)), ((1.0, 2.0), (0.06, 0.1))),
 }
+#: Mass range of the small and the big part as shares of the rated payload (the IRB-6700-like
+#: arm's parts of :data:`PARTS` over its 200 kg).
+PART_SHARES = ((0.05, 0.2), (0.3, 0.6))
+#: Density of a part, kg/m^3 (aluminium): a part is a cube of this density, so its edge follows
+#: from its mass.
+PART_DENSITY = 2700.0
+#: The fallback rated payload is this share of the static payload capacity (:func:`rated_payload`):
+#: the share that puts the rule within a factor of two of both shipped arms' rated payloads.
+PAYLOAD_SHARE = 0.25
+
+
+def rated_payload(robot) -> float:
+    """A robot's rated payload, kg: the MJCF custom numeric ``rated_payload`` (one value, kg) when
+    the model has one, else :data:`PAYLOAD_SHARE` of its static payload capacity: the largest
+    mass at the flange whose gravity torque, added to the arm's own, stays within every axis's
+    peak arm-side torque (gear ratio x motor torque limit) over the home pose and 200 poses drawn
+    (seed 0) within the joint ranges. Rule against the shipped arms: PUMA 560 4.6 kg (rated 2.5 kg),
+    IRB-6700-like 99 kg (rated 150-300 kg by variant; ours 200 kg).
+
+    Raises
+    ------
+    ValueError
+        If the numeric is not one positive finite value, or no axis carries a payload's weight.
+    """
+    model = robot.model
+    idx = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, "rated_payload")
+    if idx >= 0:
+        adr, size = model.numeric_adr[idx], model.numeric_size[idx]
+        value = model.numeric_data[adr:adr + size]
+        if size != 1 or not np.isfinite(value[0]) or value[0] <= 0:
+            raise ValueError(f"{robot.path}: numeric 'rated_payload' = {value.tolist()}; expected one mass > 0 kg")
+        return float(value[0])
+    low, high = robot.joint_range.T
+    q = np.vstack([robot.home, low + (high - low) * np.random.default_rng(0).random((200, robot.n_axes))])
+    arm = np.abs(robot.static_load(q)).max(axis=0)
+    carrying = robot.edited(lambda spec: Payload(mass=1.0).write(spec, robot))
+    per_kg = np.abs(carrying.static_load(q) - robot.static_load(q)).max(axis=0)  # N m per kg
+    loaded = per_kg > 1e-6 * per_kg.max() if per_kg.max() > 0 else per_kg > 0
+    if not np.any(loaded):
+        raise ValueError(f"{robot.name}: no axis carries the weight of a payload at its flange")
+    capacity = (robot.gear_ratio * robot.motor_torque_limit - arm)[loaded] / per_kg[loaded]
+    return float(PAYLOAD_SHARE * max(capacity.min(), 0.0))
+
+
+def sized_parts(robot) -> tuple:
+    """(mass range kg, edge range m) of the small and the big part of a robot model: its
+    :data:`PARTS` entry, else :data:`PART_SHARES` of its :func:`rated_payload` as cubes of
+    :data:`PART_DENSITY`, rounded to 3 significant digits.
+
+    Raises
+    ------
+    ValueError
+        As :func:`rated_payload`, or for a rated payload of zero.
+    """
+    if robot.name in PARTS and robot.path.parent.parent == robot_models.robots_dir():
+        return PARTS[robot.name]
+    payload = rated_payload(robot)
+    if payload <= 0:
+        raise ValueError(f"{robot.name}: the arm's own weight leaves no payload within its motor torque limits")
+    out = []
+    for shares in PART_SHARES:
+        masses = tuple(float(f"{share * payload:.3g}") for share in shares)
+        edges = tuple(float(f"{(m / PART_DENSITY) ** (1 / 3):.3g}") for m in masses)
+        out.append((masses, edges))
+    return tuple(out)
 #: The conditions a fleet's robot has, as :class:`faultgen.operation.conditions.Conditions` names
 #: them: hall climate and warm-up, parts, unit spread (``Fleet.without`` leaves some out).
 CONDITIONS = ("thermal", "payloads", "spread")
@@ -73,8 +141,9 @@ class Fleet:
         from a sixth to seven twelfths of the days (10 to 35 of 60), so that every failing robot
         wears for at least its last 25 days.
     models : tuple of str
-        Robot models, taken in turn (robot i is ``models[i % len(models)]``); each needs its parts
-        in :data:`PARTS`. Default both, the IRB-6700-like arm first.
+        Robot models (names, robot folders or MJCF paths, mixed; any number of axes), taken in turn
+        (robot i is ``models[i % len(models)]``); their parts from :func:`sized_parts`. Default both
+        shipped arms, the IRB-6700-like arm first.
     seed : int
     friction : str
         Friction model of every run.
@@ -110,8 +179,8 @@ class Fleet:
     ------
     ValueError
         On construction, for a value outside its range (named), an onset window that does not fit
-        the days, no robot model or one named twice, a model that is unknown or has no parts sized in
-        :data:`PARTS`, a gear loss without the conditions or under the ``lugre`` friction model, a
+        the days, no robot model or one named twice, a model that is unknown or whose parts cannot
+        be sized (:func:`sized_parts`), a gear loss without the conditions or under the ``lugre`` friction model, a
         dry share other than the default without the conditions, a ``without`` naming an unknown
         condition, given with the conditions off or dropping what the gear loss or dry share needs,
         or a bad ``fault`` spec (one that sets its own ``kind`` or ``onset`` included: the fleet
@@ -137,9 +206,10 @@ class Fleet:
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
         check_number("fleet failing", self.failing, 1, self.size - 1, whole=True)
-        check_number("fleet days", self.days, 5, 3650, whole=True)
-        check_number("fleet cycles_per_day", self.cycles_per_day, 1, 24, whole=True)
-        check_number("fleet failure_wear", self.failure_wear, 0, 1000)
+        # the smallest fleet record whose default onset window (days // 6 .. 7 days // 12) holds a day
+        check_number("fleet days (--days)", self.days, 6, 3650, whole=True)
+        check_number("fleet cycles_per_day (--cycles-per-day)", self.cycles_per_day, 1, 24, whole=True)
+        check_number("fleet failure_wear (--failure-wear)", self.failure_wear, 0, 100 * wear.MAX_INCREASE)
         check_number("fleet seed", self.seed, 0, 2**31, whole=True)
         friction_models.check_model(self.friction)
         check_number("fleet gear_loss", self.gear_loss, 0, 0.5)
@@ -160,10 +230,12 @@ class Fleet:
             raise ValueError(f"fleet models = {self.models!r}: expected one or more different robot model names, "
                              f"e.g. ('irb6700',) or {tuple(PARTS)!r}")
         for model in self.models:
-            robot_models.load(model)  # UnknownRobotError names the known ones
-            if model not in PARTS:
-                raise ValueError(f"fleet model {model!r}: its parts are not sized; models with parts: "
-                                 f"{', '.join(PARTS)} (add it to faultgen.runs.fleet.PARTS)")
+            try:
+                sized_parts(robot_models.load(model))  # UnknownRobotError names the known ones
+            except robot_models.UnknownRobotError:
+                raise
+            except ValueError as err:
+                raise ValueError(f"fleet model {model!r}: its parts cannot be sized: {err}") from None
         object.__setattr__(self, "onset", (first, last))
         if self.fault is not None:
             if any(f"{key}=" in str(self.fault) for key in ("kind", "onset")):
@@ -191,7 +263,7 @@ class Fleet:
 
     def robots(self) -> list[dict]:
         """The draws of every robot, in order: ``run`` id, ``model``, ``task`` (its own; with a task
-        mix the second is in the conditions table), ``failing``, ``axis`` (worn axis 1..6, 0 for a
+        mix the second is in the conditions table), ``failing``, ``axis`` (worn axis 1..N of its model, 0 for a
         healthy robot), ``onset_day``, ``failure_day``, ``seed`` and the operating ``conditions`` table."""
         order = np.random.default_rng([self.seed, 0]).permutation(self.size)
         failing = set(order[: self.failing].tolist())
@@ -200,9 +272,10 @@ class Fleet:
             rng = np.random.default_rng([self.seed, i + 1])
             model = self.models[i % len(self.models)]
             task = str(rng.choice(tasks.TASKS))
-            axis = int(rng.integers(1, 7))
+            robot_model = robot_models.load(model)
+            axis = int(rng.integers(1, robot_model.n_axes + 1))
             onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
-            (small_mass, small_size), (big_mass, big_size) = PARTS[model]
+            (small_mass, small_size), (big_mass, big_size) = sized_parts(robot_model)
             parts = {"masses": [round(float(rng.uniform(*small_mass)), 2), round(float(rng.uniform(*big_mass)), 2)],
                      "sizes": [round(float(rng.uniform(*small_size)), 3), round(float(rng.uniform(*big_size)), 3)],
                      "pattern": "random"}
@@ -221,7 +294,7 @@ class Fleet:
             if self.task_mix:
                 table["task_mix"] = {"tasks": [task, second], "pattern": "random"}
             fails = i in failing
-            out.append({"run": f"robot{i + 1:02d}-{model}-{task}-{'failing' if fails else 'healthy'}",
+            out.append({"run": f"robot{i + 1:02d}-{robot_model.name}-{task}-{'failing' if fails else 'healthy'}",
                         "model": model, "task": task, "failing": fails, "axis": axis if fails else 0,
                         "onset_day": onset_day if fails else None, "failure_day": self.days if fails else None,
                         "seed": self.seed * 10000 + i, "conditions": table})

@@ -6,16 +6,22 @@ there, the parts are merged into the dataset ``<out>`` (renamed into place last)
 folder is removed. Running the same sweep again after a crash, kill or Ctrl-C resumes: finished parts are
 kept as they are and only the missing runs are simulated.
 
-A sweep holds a lock on its output (``.<out>.lock`` beside it, an OS file lock through
-``filelock``) for as long as it runs, and names itself in ``<out>.parts/sweep.json``: a second
-sweep on the same output refuses at once, naming the first. The kernel releases the lock of a
-killed sweep, so the next one takes it over (and says so).
+A sweep holds a lock on its output (``.<out>.lock`` beside it, an OS file lock, ``flock``)
+for as long as it runs, and names itself in ``<out>.parts/sweep.json``: a second sweep on the
+same output refuses at once, naming the first. The kernel releases the lock of a killed sweep, so
+the next one takes it over (and says so). The lock file is removed when the sweep ends.
+
+Whatever ends the sweep's own process (Ctrl-C, SIGTERM, SIGKILL), its local workers end too:
+each watches its parent and exits within a second of it (:func:`_watch_parent`); a SIGTERM is
+handled as a Ctrl-C (the workers are stopped, the message says what is kept and how to resume).
 """
 
 from __future__ import annotations
 
 import ctypes
 import datetime
+import errno
+import fcntl
 import gc
 import itertools
 import json
@@ -34,10 +40,10 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Self
 
-import filelock
 import numpy as np
 from tqdm.auto import tqdm
 
+from faultgen import axes as axis_numbers
 from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
@@ -79,8 +85,16 @@ class SweepRefused(SweepError):
 class SweepInterrupted(SweepError):
     """A sweep was interrupted (Ctrl-C); the message says how many runs are kept and how to resume."""
 
-    exit_code = 130  # as a shell reports a process ended by SIGINT
+    exit_code = 130  # as a shell reports a process ended by SIGINT (143 for SIGTERM)
     message_prefix = ""  # a report of what was kept, not an error
+
+    def __init__(self, message: str, exit_code: int = 130) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where a Ctrl-C would be, so that a sweep stops the same way (:class:`_CtrlC`)."""
 
 
 @dataclass(frozen=True)
@@ -91,7 +105,7 @@ class Grid:
     ----------
     robots, tasks : list of str
     axes : list of int
-        Worn axes, 1..6; 0 means a run without wear (one per robot, task and seed).
+        Worn axes, 1..N of every robot of the grid; 0 means a run without wear (one per robot, task and seed).
     increases : list of float
         Final wear in percent (20 = Coulomb and static friction 20 % higher at the last cycle).
     schedules : list of str
@@ -146,15 +160,31 @@ class Grid:
             if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or not value:
                 raise ValueError(f"grid field {name!r} must be a non-empty list, got {value!r}")
         for axis in self.axes:
-            if not isinstance(axis, int) or not 0 <= axis <= 6:
-                raise ValueError(f"worn axis {axis!r} is out of range 0..6 (0 = no wear)")
+            if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
+                raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
         friction.check_model(self.friction)
         for kind in self.schedules:
             if kind not in wear.SCHEDULES:
                 raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
         for pct in self.increases:
-            if not np.isfinite(pct) or pct < 0:
-                raise ValueError(f"wear increase {pct!r} % must be a finite number >= 0")
+            if isinstance(pct, bool) or not isinstance(pct, (int, float)) or not np.isfinite(pct) or pct < 0:
+                raise ValueError(f"grid increases (--wear-pct): {pct!r} % must be a finite number >= 0")
+            if pct > 100 * wear.MAX_INCREASE:
+                raise ValueError(f"grid increases (--wear-pct): {pct:g} % is beyond the bound of "
+                                 f"{100 * wear.MAX_INCREASE:g} % (faultgen.operation.wear.MAX_INCREASE)")
+        for name in ("cycles",):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise ValueError(f"grid {name} = {value!r} (--{name}): expected a whole number >= 1")
+        for seed in self.seeds:
+            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+                raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number >= 0")
+        if not isinstance(self.signals, bool):
+            raise ValueError(f"grid signals = {self.signals!r}: expected true or false (a TOML boolean, not a string)")
+        for name in ("disturbance", "encoder"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+                raise ValueError(f"grid {name} = {value!r}: expected a finite number >= 0")
         # builds and validates every run configuration, once: runs() returns these
         object.__setattr__(self, "_runs", self._build_runs())
 
@@ -180,6 +210,11 @@ class Grid:
         if unknown:
             raise ValueError(f"{path}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(known))}")
         preset = data.pop("preset", None)
+        if not preset:
+            missing = [f.name for f in fields(cls) if f.name in ("robots", "tasks", "axes") and f.name not in data]
+            if missing:
+                raise ValueError(f"{path}: no key {missing[0]!r} (and no preset); a grid file needs robots, tasks "
+                                 "and axes, or preset = \"quick\" (or j2, c2)")
         return cls.from_preset(preset, **data) if preset else cls(**data)
 
     def recorded_cycles(self) -> tuple[int, ...] | None:
@@ -209,8 +244,16 @@ class Grid:
             raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
         conditions = Conditions.from_dict(self.conditions or {})
         out: dict[str, sim.RunConfig] = {}
+        named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
+        for robot in self.robots:
+            first = named.setdefault(robots.load(robot).name, str(robot))
+            if first != str(robot) and robots.load(first).path != robots.load(robot).path:
+                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
+                                 "run ids need different names (rename one folder or MJCF file)")
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
-            name = robots.load(robot).name
+            name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
+            if axis > n_axes:
+                raise ValueError(f"worn axis {axis} is out of range 0..{n_axes} of robot {name} (0 = no wear)")
             # a run without wear is one run, whatever the wear levels and schedules of the grid
             variants = [(None, 0.0)] if axis == 0 or self.fault else itertools.product(self.schedules, self.increases)
             for kind, pct in variants:
@@ -273,6 +316,57 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
     if os.getpid() != sweep_pid:
         _quiet_unraisable_interrupts()
     return simulate_and_write(*call)
+
+
+def _start_worker(sweep_pid: int) -> None:
+    """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
+    whose sweep ended while it started (it has another parent already) ends at once."""
+    if os.getpid() == sweep_pid:
+        return
+    if os.getppid() != sweep_pid:
+        os._exit(1)
+    _watch_parent(sweep_pid)
+
+
+_WATCHED: set[int] = set()
+
+
+def _watch_parent(sweep_pid: int, period: float = 0.5) -> None:
+    """End this worker process within ``period`` s once the sweep's process ``sweep_pid`` is gone.
+
+    A killed sweep (SIGKILL, or SIGTERM under a process manager) cannot stop its workers, and
+    loky's workers would go on simulating the rest of the grid, then idle for minutes (issue 42).
+    The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
+    Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
+    (another OS); either way the worker ends at once, its unfinished part left as a hidden
+    temporary file that the next sweep removes. Set once per worker process, from its start (the
+    loky initializer :func:`_start_worker`); a process whose parent is not the sweep's is left
+    alone.
+    """
+    if sweep_pid in _WATCHED or os.getppid() != sweep_pid:  # not a worker the sweep started: nothing to watch
+        return
+    _WATCHED.add(sweep_pid)
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the thread below does it
+        pass
+    if os.getppid() != sweep_pid:  # the sweep ended before the request was made
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(period)
+            try:
+                os.kill(sweep_pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:
+                pass
+            if os.getppid() != sweep_pid:  # orphaned (reparented to init or a subreaper): the sweep is gone
+                os._exit(1)
+
+    threading.Thread(target=watch, name="faultgen-watch-sweep", daemon=True).start()
 
 
 def _quiet_unraisable_interrupts() -> None:
@@ -367,63 +461,112 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     out = Path(out)
     plan = grid.runs()
     parts = parts_folder(out)
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise SweepRefused(f"jobs {jobs!r}: expected a whole number >= 1")
     with _lock(out, parts):
         if out.exists() and not overwrite:
             raise SweepRefused(f"{out} exists; pass --overwrite to replace it or choose another output")
-        _prepare(out, parts)
-        with _claim(out, parts, command):
-            todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
-            todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
-            if on_start is not None:
-                on_start(len(plan), len(plan) - len(todo))
-            with _CtrlC() as ctrl_c:
+        try:
+            _prepare(out, parts)
+            with _claim(out, parts, command):
+                todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
+                todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
+                _check_space(out, parts, plan, todo)
+                if on_start is not None:
+                    on_start(len(plan), len(plan) - len(todo))
+                with _CtrlC() as ctrl_c:
+                    try:
+                        with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
+                                  desc=f"sweep {out.name}") as bar:
+                            for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command):
+                                bar.update(1)
+                                if on_run is not None:
+                                    on_run(stats)
+                    except KeyboardInterrupt as interrupt:
+                        ctrl_c.stopping = True
+                        kept = len(finished_runs(grid, out))
+                        what, code = (("terminated (SIGTERM)", 143) if isinstance(interrupt, _Terminated)
+                                      else ("interrupted", 130))
+                        if not kept:  # the part folder goes too: nothing to point at
+                            raise SweepInterrupted(f"{what}: none of the {len(plan)} runs had finished; run the "
+                                                   "same command to start again", code) from None
+                        raise SweepInterrupted(f"{what}: {kept} of {len(plan)} runs kept in {parts}; run the "
+                                               "same command to resume", code) from None
+                started = time.perf_counter()
                 try:
-                    with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
-                              desc=f"sweep {out.name}") as bar:
-                        for stats in _execute(todo, parts, jobs, scheduler, command):
-                            bar.update(1)
-                            if on_run is not None:
-                                on_run(stats)
-                except KeyboardInterrupt:
-                    ctrl_c.stopping = True
-                    kept = len(finished_runs(grid, out))
-                    raise SweepInterrupted(f"interrupted: {kept} of {len(plan)} runs kept in {parts}; run the "
-                                           "same command to resume") from None
-            started = time.perf_counter()
-            try:
-                dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
-                              grid=grid.to_json())
-            except OSError as err:
-                raise SweepError(f"cannot write {out}: {err}; every run is kept in {parts}: free space or fix "
-                                 "permissions and run the same command again") from err
-            if timings is not None:
-                timings["merge"] = time.perf_counter() - started
-            shutil.rmtree(parts)
+                    dataset.merge([(run_id, parts / f"{run_id}.h5") for run_id, _ in plan], out, command=command,
+                                  grid=grid.to_json())
+                except OSError as err:
+                    raise SweepError(f"cannot write {out}: {err.strerror or err}; every run is kept in {parts}: "
+                                     "free space or fix permissions and run the same command again") from None
+                if timings is not None:
+                    timings["merge"] = time.perf_counter() - started
+        except BaseException:
+            _remove_if_empty(parts)  # no debris: a sweep that kept nothing leaves no part folder
+            raise
+        shutil.rmtree(parts)
     return out
 
 
 def lock_path(out: Path) -> Path:
-    """The lock file a sweep holds while it writes ``out``: hidden, beside it, left in place."""
+    """The lock file a sweep holds while it writes ``out``: hidden, beside it, removed when the
+    sweep ends (a killed sweep's stays, empty, until the next sweep of ``out`` ends)."""
     return out.with_name(f".{out.name}.lock")
 
 
 @contextmanager
 def _lock(out: Path, parts: Path) -> Iterator[None]:
-    """Hold the lock of ``out`` (:func:`lock_path`); refuse at once, naming the holder, if it is taken."""
+    """Hold the lock of ``out`` (:func:`lock_path`); refuse at once, naming the holder, if it is taken.
+
+    An exclusive ``flock`` on the lock file. The holder removes the file before it lets the lock
+    go, so a sweep that opened the file just before must find, once it holds the lock, that the
+    path still names the file it locked; if not, it tries again on the new file.
+    """
     if not (out.parent if str(out.parent) else Path(".")).is_dir():
         raise SweepError(f"cannot write {out}: folder {out.parent} does not exist")
-    lock = filelock.FileLock(lock_path(out), timeout=0)
-    try:
-        lock.acquire()
-    except filelock.Timeout:
-        raise SweepRefused(f"another sweep is writing {out}: {_describe_holder(parts)}; wait for it to finish or "
-                           "stop it (a killed sweep's lock is taken over by the next one)") from None
-    except OSError as err:
-        raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
+    path = lock_path(out)
+    while True:
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise SweepRefused(f"another sweep is writing {out}: {_describe_holder(parts)}; wait for it to finish "
+                               "or stop it (a killed sweep's lock is taken over by the next one)") from None
+        try:
+            if os.stat(path).st_ino == os.fstat(fd).st_ino:
+                break
+        except FileNotFoundError:
+            pass
+        os.close(fd)  # the holder removed the file we opened: lock the new one
     try:
         yield
     finally:
-        lock.release()
+        try:
+            path.unlink(missing_ok=True)
+        finally:
+            os.close(fd)
+
+
+def _remove_if_empty(folder: Path) -> None:
+    try:
+        folder.rmdir()
+    except OSError:  # holds finished runs, or is gone
+        pass
+
+
+def _check_space(out: Path, parts: Path, plan, todo) -> None:
+    """Refuse, before any run, a sweep whose parts and merged dataset would not fit on the disk."""
+    needed = sum(dataset.estimated_size(config) for _, config in todo)
+    needed += sum(dataset.estimated_size(config) for _, config in plan)  # the merged dataset
+    try:
+        atomic.check_writable(parts / "x.h5", needed)
+    except OSError as err:
+        raise SweepRefused(f"{err.strerror}; free some space or choose another output (finished runs are kept "
+                           f"in {parts})" if err.errno == errno.ENOSPC else f"{err.strerror}") from None
 
 
 @contextmanager
@@ -438,9 +581,13 @@ def _claim(out: Path, parts: Path, command: str) -> Iterator[None]:
         if record.exists():
             log.warning("took over %s from a sweep that was killed (%s); its finished runs are kept", out,
                         _describe_holder(parts))
-        atomic.write_text(record, json.dumps({
-            "pid": os.getpid(), "host": socket.gethostname(), "command": command,
-            "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}))
+        try:
+            atomic.write_text(record, json.dumps({
+                "pid": os.getpid(), "host": socket.gethostname(), "command": command,
+                "started": datetime.datetime.now().astimezone().isoformat(timespec="seconds")}))
+        except OSError as err:
+            raise SweepError(f"cannot write {record}: {err.strerror or err}; free some space or choose another "
+                             "output") from None
         atomic.remove_stale(out)
         yield
     finally:
@@ -473,6 +620,7 @@ def _prepare(out: Path, parts: Path) -> None:
     except FileNotFoundError:
         raise SweepError(f"cannot write {out}: folder {out.parent} does not exist") from None
     except OSError as err:
+        _remove_if_empty(parts)
         raise SweepError(f"cannot write to {out.parent}: {err.strerror}; choose another output path") from None
     for stale in parts.glob(".*.part"):  # no worker runs while this sweep holds the lock: a killed one left it
         log.warning("removed %s, an unfinished part left by a killed worker", stale)
@@ -486,7 +634,8 @@ class _CtrlC:
     If that is a weakref callback or a ``__del__`` (joblib and loky free locks and queues through
     such callbacks while the workers' results are collected), the exception cannot propagate:
     Python prints "Exception ignored in ... KeyboardInterrupt" and goes on as if no key had been
-    pressed. Within this block such an interrupt is not printed but sent again as SIGINT 0.1 s
+    pressed. A SIGTERM is raised as :class:`_Terminated`, a KeyboardInterrupt, and stops the sweep
+    the same way. Within this block such an interrupt is not printed but sent again as SIGINT 0.1 s
     later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
     KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
     Ctrl-C, or one sent again after the workers' own interrupts already stopped the sweep) is not
@@ -506,6 +655,7 @@ class _CtrlC:
             self._previous_hook = sys.unraisablehook
             sys.unraisablehook = self._unraisable
             signal.signal(signal.SIGINT, self._on_sigint)
+            self._previous_term = signal.signal(signal.SIGTERM, self._on_sigterm)
         return self
 
     def __exit__(self, *exc) -> None:
@@ -514,6 +664,7 @@ class _CtrlC:
         for resend in self._resends:
             resend.cancel()
         signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
+        signal.signal(signal.SIGTERM, self._previous_term)
         sys.unraisablehook = self._previous_hook
 
     def _on_sigint(self, signum, frame) -> None:
@@ -521,11 +672,17 @@ class _CtrlC:
             return
         raise KeyboardInterrupt
 
+    def _on_sigterm(self, signum, frame) -> None:
+        if self.stopping or isinstance(sys.exc_info()[1], KeyboardInterrupt):
+            return
+        raise _Terminated
+
     def _unraisable(self, unraisable) -> None:
         if not isinstance(unraisable.exc_value, KeyboardInterrupt):
             self._previous_hook(unraisable)
         elif not self.stopping:
-            resend = threading.Timer(self.RESEND_AFTER, os.kill, (os.getpid(), signal.SIGINT))
+            again = signal.SIGTERM if isinstance(unraisable.exc_value, _Terminated) else signal.SIGINT
+            resend = threading.Timer(self.RESEND_AFTER, os.kill, (os.getpid(), again))
             resend.daemon = True
             resend.start()
             self._resends.append(resend)
@@ -541,8 +698,11 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str) 
             yield from _execute_dask(calls, scheduler)
         else:
             from joblib import Parallel, delayed
+            from joblib._parallel_backends import LokyBackend
 
-            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered")
+            # every worker watches the sweep from its start, idle or not (:func:`_watch_parent`)
+            backend = LokyBackend(initializer=_start_worker, initargs=(os.getpid(),))
+            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
             yield from parallel(delayed(_in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:

@@ -39,7 +39,7 @@ INPUTS = ("pos", "vel", "ff")
 
 @dataclass(frozen=True)
 class ServoGains:
-    """Motor-side PID gains of the six drives, each an ``ndarray of shape (6,)``.
+    """Motor-side PID gains of the N drives, each an ``ndarray of shape (N,)``.
 
     Attributes
     ----------
@@ -102,7 +102,7 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: 
     ----------
     robot : Robot
         The nominal robot (its friction parameters are the unworn ones).
-    q, qd, qdd : ndarray of shape (n, 6)
+    q, qd, qdd : ndarray of shape (n, N)
         Reference arm angles (rad), velocities (rad/s) and accelerations (rad/s^2).
     dt : float, optional
         The physics step in s, when row ``k`` is the input of the step from ``t_k`` to
@@ -112,7 +112,7 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: 
         ``(tau_ff[k] + tau_ff[k+1]) / 2`` (the last row keeps its own). Set-points taken at the
         step's start instead make the drive lag the reference by ``kd h qdd / (2 kp)``, a
         first-order step error (docs/simulation.md, "Numerical convergence").
-    end_gain : ndarray of shape (6,), optional
+    end_gain : ndarray of shape (N,), optional
         With ``dt``, when the step evaluates the drives at its end position (MuJoCo's ``discrete``
         integrator): their position gains kp in N m/rad. The step then sees the position error at
         ``t_k + dt`` while the drive's integrator sees the one at ``t_k`` (explicit Euler), so the
@@ -121,7 +121,7 @@ def setpoints(robot: Robot, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, dt: 
 
     Returns
     -------
-    ndarray of shape (n, 6, 3)
+    ndarray of shape (n, N, 3)
         Per axis: motor-angle set-point G q (rad), motor-speed set-point G qd (rad/s) and
         torque feedforward tau_ff / G (N m, motor side), where tau_ff is
         :meth:`Robot.inverse_dynamics` with nominal friction.

@@ -58,9 +58,9 @@ def cycle_rng(seed: int, cycle: int, stream: int) -> np.random.Generator:
 
 
 def disturbance(seed: int, cycle: int, n_periods: int, sigma: np.ndarray) -> np.ndarray:
-    """Load disturbance torque, ``ndarray of shape (n_periods, 6)`` in N m at the arm side.
+    """Load disturbance torque, ``ndarray of shape (n_periods, N)`` in N m at the arm side.
 
-    ``sigma`` is the per-axis standard deviation, ``ndarray of shape (6,)`` in N m.
+    ``sigma`` is the per-axis standard deviation, ``ndarray of shape (N,)`` in N m.
     """
     return cycle_rng(seed, cycle, _DISTURBANCE_STREAM).standard_normal((n_periods, sigma.size)) * sigma
 
@@ -95,13 +95,13 @@ def histogram(values: np.ndarray, low: np.ndarray, high: np.ndarray, bins: int =
 
     Parameters
     ----------
-    values : ndarray of shape (n_cycles, n_samples, 6)
-    low, high : ndarray of shape (6,)
+    values : ndarray of shape (n_cycles, n_samples, N)
+    low, high : ndarray of shape (N,)
         Range per axis; values outside it count in the first or last bin.
 
     Returns
     -------
-    ndarray of shape (n_cycles, 6, bins)
+    ndarray of shape (n_cycles, N, bins)
         Each row sums to 1.
     """
     fraction = (values - low) / (high - low)
@@ -132,15 +132,15 @@ def torque_counts(tau_m: np.ndarray, torque_limit: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+    tau_m : ndarray of shape (n_cycles, n_samples, N)
         Logged motor torque, N m at the motor side.
-    torque_limit : ndarray of shape (6,)
+    torque_limit : ndarray of shape (N,)
         Peak motor torque, N m: the range 0 .. peak is cut into :data:`TORQUE_COUNT_BINS` equal
         bins; larger values count in the last.
 
     Returns
     -------
-    ndarray of shape (n_cycles, 6, TORQUE_COUNT_BINS)
+    ndarray of shape (n_cycles, N, TORQUE_COUNT_BINS)
         Unsigned integer counts (the smallest type holding ``n_samples``); each row sums to
         ``n_samples``.
     """
@@ -156,28 +156,28 @@ def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_r
 
     Parameters
     ----------
-    q_a, qd_a : ndarray of shape (n_cycles, n_samples, 6)
+    q_a, qd_a : ndarray of shape (n_cycles, n_samples, N)
         Logged arm angles (rad) and speeds (rad/s).
-    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+    tau_m : ndarray of shape (n_cycles, n_samples, N)
         Logged motor torque, N m at the motor side.
-    joint_range : ndarray of shape (6, 2)
+    joint_range : ndarray of shape (N, 2)
         Joint limits, rad: the design range of the angle histogram.
-    speed_limit : ndarray of shape (6,)
+    speed_limit : ndarray of shape (N,)
         Largest arm speed, rad/s: the design maximum of the speed histogram.
-    torque_limit : ndarray of shape (6,)
+    torque_limit : ndarray of shape (N,)
         Peak motor torque, N m: the design maximum of the torque histogram.
 
     Returns
     -------
     dict of ndarray
-        ``mean_abs_torque``, ``rms_torque`` (n_cycles, 6) in N m (thesis ch. 6.3.2: the mean of
+        ``mean_abs_torque``, ``rms_torque`` (n_cycles, N) in N m (thesis ch. 6.3.2: the mean of
         absolute torque per cycle); ``average_speed`` (rad/s) and ``average_load_torque`` (N m),
-        (n_cycles, 6), :func:`duty`; ``angle_hist``, ``speed_hist``, ``torque_hist``
-        (n_cycles, 6, 12): fraction of the cycle's samples in each twelfth of the design range
+        (n_cycles, N), :func:`duty`; ``angle_hist``, ``speed_hist``, ``torque_hist``
+        (n_cycles, N, 12): fraction of the cycle's samples in each twelfth of the design range
         (angle from its lower to its upper limit; |speed| and |torque| from 0 to their design
         maximum, larger values in the last bin; thesis ch. 5.3.1).
     """
-    zeros = np.zeros(6)
+    zeros = np.zeros(len(joint_range))
     return {
         "mean_abs_torque": np.mean(np.abs(tau_m), axis=1),
         "rms_torque": np.sqrt(np.mean(tau_m**2, axis=1)),
@@ -210,15 +210,15 @@ def duty(qd_a: np.ndarray, tau_m: np.ndarray, exponent: float = LOAD_EXPONENT) -
 
     Parameters
     ----------
-    qd_a : ndarray of shape (n_cycles, n_samples, 6)
+    qd_a : ndarray of shape (n_cycles, n_samples, N)
         Logged arm speed, rad/s (the gearbox's output).
-    tau_m : ndarray of shape (n_cycles, n_samples, 6)
+    tau_m : ndarray of shape (n_cycles, n_samples, N)
         Logged motor torque, N m at the motor side.
     exponent : float, default=LOAD_EXPONENT
 
     Returns
     -------
-    dict of ndarray of shape (n_cycles, 6)
+    dict of ndarray of shape (n_cycles, N)
         ``average_speed`` in rad/s and ``average_load_torque`` in N m at the motor side. An axis
         that does not move in a cycle has ``average_speed`` 0 and a time-weighted mean load.
     """

@@ -1,0 +1,212 @@
+"""A robot's drivetrain as data: per axis gear ratio, motor, gearbox and motor-side friction.
+
+The drivetrain is what faultgen adds to an arm (a URDF, a plain MJCF, a DH table) and what wear
+acts on. :class:`AxisDrive` holds one axis, :class:`Drivetrain` all N of them; ``drivetrain.toml``
+in a robot folder stores them, one table per axis::
+
+    [axis.1]
+    gear_ratio = 62.6111          # 1, motor angle / arm angle
+    motor_inertia = 0.0002        # kg m^2, motor side
+    ...
+
+:func:`read_table` reads such a file (a full one, or the partial one ``--drivetrain`` may give),
+:meth:`Drivetrain.to_toml` writes one with every number at full precision.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+from faultgen.effects.friction import UNITS as FRICTION_UNITS
+
+#: Unit and meaning of every field of :class:`AxisDrive`, in file order.
+UNITS = {
+    "gear_ratio": "1, motor angle / arm angle",
+    "motor_inertia": "kg m^2, motor side (rotor and brake)",
+    "gearbox_stiffness": "N m/rad, arm side (thesis eq. 6.2a)",
+    "gearbox_damping": "N m s/rad, arm side (thesis eq. 6.2a)",
+    "motor_torque_limit": "N m, motor side (actuator ctrlrange)",
+    **{name: FRICTION_UNITS[name] + ", motor side" for name in FRICTION_FIELDS},
+}
+
+#: Fields that must be strictly positive (the others must be >= 0).
+POSITIVE = (
+    "gear_ratio",
+    "motor_inertia",
+    "gearbox_stiffness",
+    "motor_torque_limit",
+    "stribeck_velocity",
+    "stribeck_exponent",
+)
+
+
+class DrivetrainError(ValueError):
+    """A drivetrain table that cannot be used: the message names the file, axis and key."""
+
+
+@dataclass(frozen=True)
+class AxisDrive:
+    """The drivetrain of one axis; units in :data:`UNITS`.
+
+    Raises
+    ------
+    DrivetrainError
+        If a value is not finite, is negative, or is zero where :data:`POSITIVE` needs > 0.
+    """
+
+    gear_ratio: float
+    motor_inertia: float
+    gearbox_stiffness: float
+    gearbox_damping: float
+    motor_torque_limit: float
+    coulomb_pos: float
+    coulomb_neg: float
+    static: float
+    stribeck_velocity: float
+    stribeck_exponent: float
+    viscous: float
+    bristle_stiffness: float
+    bristle_damping: float
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise DrivetrainError(f"{f.name} = {value!r}; expected a number ({UNITS[f.name]})")
+            value = float(value)
+            need_positive = f.name in POSITIVE
+            if not math.isfinite(value) or value < 0 or (need_positive and value == 0):
+                need = "> 0" if need_positive else ">= 0"
+                raise DrivetrainError(
+                    f"{f.name} = {value!r}; expected a finite value {need} ({UNITS[f.name]})"
+                )
+            object.__setattr__(self, f.name, value)
+
+    @property
+    def friction_row(self) -> list[float]:
+        """The motor-side friction values in the order of ``friction{i}`` (:data:`FRICTION_FIELDS`)."""
+        return [getattr(self, name) for name in FRICTION_FIELDS]
+
+
+#: Keys of one axis table, in file order.
+KEYS = tuple(f.name for f in fields(AxisDrive))
+
+
+@dataclass(frozen=True)
+class Drivetrain:
+    """The drivetrain of all N axes, axis 1 first (``axes[k]`` is axis k + 1)."""
+
+    axes: tuple[AxisDrive, ...]
+
+    def __len__(self) -> int:
+        return len(self.axes)
+
+    @classmethod
+    def from_table(
+        cls, table: dict[int, dict[str, float]], n_axes: int, source: str = "drivetrain"
+    ) -> Drivetrain:
+        """A full drivetrain from ``{axis number: {key: value}}`` (as :func:`read_table` gives).
+
+        Raises
+        ------
+        DrivetrainError
+            If an axis 1..n_axes or a key of one is missing, or a value is out of range.
+        """
+        axes = []
+        for axis in range(1, n_axes + 1):
+            if axis not in table:
+                raise DrivetrainError(f"{source}: axis {axis} is missing; the arm has {n_axes} axes")
+            missing = [k for k in KEYS if k not in table[axis]]
+            if missing:
+                raise DrivetrainError(f"{source}: axis {axis} lacks {', '.join(missing)}")
+            try:
+                axes.append(AxisDrive(**{k: table[axis][k] for k in KEYS}))
+            except DrivetrainError as err:
+                raise DrivetrainError(f"{source}: axis {axis}: {err}") from None
+        return cls(tuple(axes))
+
+    def to_toml(self, notes: dict[int, dict[str, str]] | None = None, header: str = "") -> str:
+        """The drivetrain as ``drivetrain.toml`` text, every number at full precision (``repr``);
+        ``notes[axis][key]`` is written as a comment after the value (its source)."""
+        lines = [f"# {line}" if line else "#" for line in header.splitlines()]
+        lines += ["# Units: " + "; ".join(f"{k}: {u}" for k, u in UNITS.items()), ""]
+        for axis, drive in enumerate(self.axes, start=1):
+            lines.append(f"[axis.{axis}]")
+            for key, value in asdict(drive).items():
+                note = (notes or {}).get(axis, {}).get(key)
+                lines.append(f"{key} = {value!r}" + (f"  # {note}" if note else ""))
+            lines.append("")
+        return "\n".join(lines)
+
+
+def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int, dict[str, float]]:
+    """Read a ``drivetrain.toml``: ``{axis number: {key: value}}``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    n_axes : int
+        The arm's number of axes N; tables ``[axis.1]`` .. ``[axis.N]`` are expected.
+    partial : bool, default False
+        Accept missing axes and keys (``--drivetrain`` may give only some numbers; the others
+        are sized). Values given are still checked.
+
+    Raises
+    ------
+    DrivetrainError
+        If the file is not TOML, has a key other than ``axis`` at the top or an unknown key in an
+        axis table, names an axis outside 1..N, gives a value that is not a finite number or is
+        negative (or zero where :data:`POSITIVE` needs > 0), or (``partial=False``) lacks an axis
+        or a key. The message names the file, the axis and the key.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise DrivetrainError(f"{path}: cannot read a TOML drivetrain table: {err}") from None
+    unknown = sorted(set(data) - {"axis"})
+    if unknown:
+        raise DrivetrainError(
+            f"{path}: unknown key {unknown[0]!r}; expected only [axis.1] .. [axis.{n_axes}] tables"
+        )
+    axes = data.get("axis", {})
+    if not isinstance(axes, dict):
+        raise DrivetrainError(f"{path}: 'axis' must be tables [axis.1] .. [axis.{n_axes}]")
+    table: dict[int, dict[str, float]] = {}
+    for label, values in axes.items():
+        try:
+            axis = int(label)
+        except ValueError:
+            axis = 0
+        if not 1 <= axis <= n_axes or str(axis) != str(label):
+            raise DrivetrainError(f"{path}: [axis.{label}] is not an axis of this arm (1..{n_axes})")
+        if not isinstance(values, dict):
+            raise DrivetrainError(f"{path}: axis.{label} must be a table")
+        bad = sorted(set(values) - set(KEYS))
+        if bad:
+            raise DrivetrainError(
+                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}"
+            )
+        for key, value in values.items():
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+            positive = key in POSITIVE
+            if not ok or value < 0 or (positive and value == 0):
+                need = "> 0" if positive else ">= 0"
+                raise DrivetrainError(
+                    f"{path}: axis {axis}: {key} = {value!r}; expected a finite number {need} ({UNITS[key]})"
+                )
+        table[axis] = {k: float(v) for k, v in values.items()}
+    if not partial:
+        Drivetrain.from_table(table, n_axes, str(path))
+    return table
+
+
+def read(path: str | Path, n_axes: int) -> Drivetrain:
+    """A full :class:`Drivetrain` from a ``drivetrain.toml``; raises :class:`DrivetrainError` as
+    :func:`read_table`."""
+    return Drivetrain.from_table(read_table(path, n_axes), n_axes, str(path))

@@ -1,0 +1,151 @@
+"""One run's configuration (:class:`RunConfig`), validated on construction."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from faultgen.checks import is_whole
+from faultgen.model import robots
+from faultgen.operation import tasks
+from faultgen.operation.conditions import Conditions
+from faultgen.operation.faults import Fault
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import friction_models, sensors
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """One run: a robot repeating a task for ``cycles`` cycles while the axes of ``wear`` wear.
+
+    Attributes
+    ----------
+    robot : str
+        Robot name (``faultgen robots``) or MJCF path.
+    task : str
+        One of :data:`faultgen.tasks.TASKS`.
+    friction : str
+        Friction model, one of :data:`faultgen.friction.MODELS`.
+    wear : WearPlan
+        Worn axes and their schedules; empty for no wear.
+    cycles : int
+        Number of cycles of the run (cycle indices 1..cycles); >= 1.
+    record : tuple of int, optional
+        The cycles to simulate and record; all of them when omitted.
+    seed : int
+        Seed of the disturbance and encoder noise; >= 0.
+    noise : NoiseConfig
+        Disturbance and encoder noise levels.
+    nthread : int
+        Threads for stepping (0: all CPUs).
+    back_to_back : bool
+        Step the cycles one after the other in one simulation, each starting where the previous
+        one ended (gearbox deflections, backlash flanks, drive integrators carry over), instead of
+        each from the start state. Only without wear and with every cycle recorded.
+    conditions : Conditions
+        Operating conditions over the cycles (joint temperature, payloads, task mix, unit spread;
+        :mod:`faultgen.operation.conditions`); none by default.
+    signals : bool
+        Keep the 250 Hz signals in the dataset (False: the per-cycle features and truth only).
+    fault : Fault or None
+        A fault other than friction wear: an effect's parameter growing over the cycles
+        (:mod:`faultgen.operation.faults`); the controller does not know it.
+    daily : bool
+        Record one remote-monitoring sample per day of ``conditions.cycles_per_day`` cycles, the
+        day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
+        cycle is simulated, no signals are kept.
+
+    Raises
+    ------
+    ValueError
+        On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
+        parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
+        1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
+        a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
+        are not whole days, a fault whose last cycle is not the run's or whose effect the robot
+        already carries, a task mix without the run's task or with signals, or a unit spread with a
+        gear loss under the ``lugre`` friction model; the message names the value.
+    """
+
+    robot: str
+    task: str
+    friction: str = "lugre"
+    wear: WearPlan = field(default_factory=lambda: WearPlan({}))
+    cycles: int = 100
+    record: tuple[int, ...] | None = None
+    seed: int = 0
+    noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
+    nthread: int = 0
+    back_to_back: bool = False
+    conditions: Conditions = field(default_factory=Conditions)
+    signals: bool = True
+    daily: bool = False
+    fault: Fault | None = None
+
+    def __post_init__(self) -> None:
+        n_axes = robots.load(self.robot).n_axes  # UnknownRobotError / ModelError (ValueErrors) name the problem
+        if self.task not in tasks.TASKS:
+            raise ValueError(f"unknown task {self.task!r}; expected one of: {', '.join(tasks.TASKS)}")
+        stepping = friction_models.get(self.friction)
+        if not is_whole(self.cycles, 1):
+            raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
+        if self.record is not None:
+            record = tuple(int(c) for c in self.record)
+            if not record:
+                raise ValueError("record is empty; give at least one cycle, or omit it to record all")
+            bad = [c for c in record if not 1 <= c <= self.cycles]
+            if bad:
+                raise ValueError(f"recorded cycle {bad[0]} is out of range 1..{self.cycles}")
+            object.__setattr__(self, "record", tuple(sorted(set(record))))
+        if not is_whole(self.seed, 0):
+            raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
+        if not isinstance(self.wear, WearPlan):
+            raise TypeError(f"wear: expected a WearPlan, got {type(self.wear).__name__}")
+        self.wear.check(n_axes)  # "axis 7 is out of range 1..6"
+        if self.nthread < 0:
+            raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
+        if not isinstance(self.conditions, Conditions):
+            raise TypeError(f"conditions: expected a Conditions, got {type(self.conditions).__name__}")
+        if self.fault is not None:
+            if not isinstance(self.fault, Fault):
+                raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
+            self.fault.check(n_axes)
+            if self.fault.last_cycle != self.cycles:
+                raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
+            if self.fault.effect in robots.load(self.robot).effects and np.any(
+                    robots.load(self.robot).effects[self.fault.effect].active()):
+                raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
+                                 "needs a robot without it")
+            if self.back_to_back:
+                raise ValueError("a fault grows from cycle to cycle: run the cycles independently (no back_to_back)")
+        if self.back_to_back and (self.wear.schedules or self.conditions.active
+                                  or self.record not in (None, tuple(range(1, self.cycles + 1)))):
+            raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "
+                             f"conditions; got wear on axes {list(self.wear.schedules)}, conditions "
+                             f"{'on' if self.conditions.active else 'off'} and record = {self.record!r}: drop "
+                             "them, or run the cycles independently")
+        mix = self.conditions.task_mix
+        if mix is not None and self.task not in mix.tasks:
+            raise ValueError(f"task {self.task!r} is not in the task mix ({', '.join(mix.tasks)}); a run's own task "
+                             "must be one of the tasks its cycles run")
+        if mix is not None and self.signals:
+            raise ValueError(f"a task mix ({', '.join(mix.tasks)}) keeps no signals: cycles of different tasks differ "
+                             "in length; record features only (--features-only, signals=False)")
+        spread = self.conditions.spread
+        if spread is not None and spread.gear_loss > 0 and not stepping.per_step:
+            raise ValueError(f"unit spread gear_loss = {spread.gear_loss!r} needs the static friction model "
+                             "(friction='stribeck', --friction stribeck): friction growing with the load is "
+                             "updated every step from Python, and the lugre model runs inside MuJoCo")
+        if self.daily:
+            per_day = self.conditions.cycles_per_day
+            if self.record is not None or self.signals or self.cycles % per_day:
+                raise ValueError(f"daily records need every cycle recorded, no signals and whole days: got record = "
+                                 f"{self.record!r}, signals = {self.signals}, {self.cycles} cycles at {per_day} a day")
+
+    @property
+    def recorded_cycles(self) -> np.ndarray:
+        """Indices of the simulated cycles, ``ndarray of shape (n_recorded,)``."""
+        if self.record is None:
+            return np.arange(1, self.cycles + 1)
+        return np.array(self.record)
