@@ -127,7 +127,11 @@ class Run:
                     why = ("; it was recorded without signals (features only): simulate it again with signals "
                            "(`faultgen sweep` without --features-only)")
                 raise dataset.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}{why}")
-            self._cache[name] = group[name][()]
+            value = group[name][()]
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise dataset.DatasetError(f"{self._source.path}: run {self.id!r}: {name} holds non-finite values; the "
+                                           f"file is corrupted (faultgen validate {self._source.path})")
+            self._cache[name] = value
         return self._cache[name]
 
     def has(self, *names: str) -> bool:
@@ -217,9 +221,16 @@ class Dataset(Sequence):
         self.command = str(dataset._attr(attrs.get("command", "")))
         self.faultgen_version = str(dataset._attr(attrs.get("faultgen_version", "")))
         self.grid = _json(attrs.get("grid"))
-        self.runs: tuple[Run, ...] = tuple(
-            _run(run_id, {k: dataset._attr(v) for k, v in self._file["runs"][run_id].attrs.items()}, self)
-            for run_id in self._file["runs"])
+        runs = []
+        for run_id in self._file["runs"]:
+            group = self._file["runs"][run_id]
+            problems = dataset._attribute_problems(group)  # labels that do not parse: named, not a crash
+            if problems:
+                self.close()
+                raise dataset.DatasetError(f"{self.path}: run {run_id!r}: {problems[0]} (faultgen validate {self.path} "
+                                           "lists every problem)")
+            runs.append(_run(run_id, {k: dataset._attr(v) for k, v in group.attrs.items()}, self))
+        self.runs: tuple[Run, ...] = tuple(runs)
         self._by_id = {run.id: run for run in self.runs}
 
     def _group(self, run_id: str):
@@ -332,7 +343,8 @@ def open(path: str | Path) -> Dataset:  # noqa: A001 (faultgen.open, as the buil
     ------
     faultgen.data.dataset.DatasetError
         If ``path`` does not exist, is not HDF5, is not a faultgen file or is incomplete (its
-        writer did not finish); the message says which.
+        writer did not finish), or a run's labels do not parse; the message says which. Reading an
+        array that holds non-finite values raises it too.
     """
     return Dataset(path)
 
