@@ -15,8 +15,8 @@ CSV and Markdown (and a PNG heatmap for isolation).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,7 +28,7 @@ from analysis import isolation
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen import axes
 from faultgen.checks import is_whole
-from faultgen.data import dataset
+from faultgen.data import dataset, reader
 from faultgen.model import robots
 from faultgen.simulation import sensors
 
@@ -95,24 +95,23 @@ def default_isolators(bins: Iterable[int] = (5, 10)) -> dict[str, object]:
     return chosen
 
 
-def _runs(path, names: tuple[str, ...]) -> list[tuple[str, dict, dict]]:
-    """(run id, arrays, labels) of every run of a dataset, reading only ``names``."""
-    out = []
-    for run_id in dataset.list_runs(path):
-        arrays, attrs = dataset.read_run(path, run_id, names=names)
-        out.append((run_id, arrays, attrs))
-    return out
+@contextmanager
+def opened(source):
+    """A :class:`faultgen.data.reader.Dataset` from a path (opened here, closed after) or as given."""
+    if isinstance(source, reader.Dataset):
+        yield source
+    else:
+        with reader.open(source) as data:
+            yield data
 
 
-def fault_progress(path, run_id: str, arrays: dict, attrs: dict, axis: int) -> np.ndarray:
+def fault_progress(run: reader.Run, axis: int) -> np.ndarray:
     """Per recorded cycle, the worn axis's true friction multiplier; for a run whose fault is not
-    friction wear (attribute ``fault``: a growing backlash, cogging, offset), 1 + its parameter's
+    friction wear (``run.fault``: a growing backlash, cogging, offset), 1 + its parameter's
     change as a fraction of the final change, so that a level of L % means L % of the final value."""
-    if "fault" not in attrs:
-        return arrays["friction_multiplier"][:, axes.index(axis)]
-    fault = json.loads(attrs["fault"])
-    value = dataset.read_run(path, run_id, names=("fault_value",))[0]["fault_value"]
-    return 1.0 + (value - fault["start"]) / (fault["final"] - fault["start"])
+    if run.fault is None:
+        return run.array("friction_multiplier")[:, axes.index(axis)]
+    return 1.0 + run.fault_level / 100.0
 
 
 def level_cycle(multiplier: np.ndarray, level: float) -> int | None:
@@ -164,46 +163,48 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         if not hasattr(fitted, "source_axis_"):
             raise ValueError(f"isolator {name}: fit(X) set no source_axis_ (the isolator contract of "
                              "analysis.isolation: 1-based axis, 0 when undecided)")
-    names = (signal, "friction_multiplier", *(("tau_m", "qd_m") if speed_window else ()))
-    runs = [r for r in _runs(path, names) if len(r[2]["worn_axes"]) <= 1]
-    windowed = {run_id: np.zeros(arrays[signal].shape[1], dtype=bool) for run_id, arrays, _ in runs}
-    if speed_window:  # the windowed mean where every cycle has samples in the window
-        from analysis.features import speed_window_mean
+    with opened(path) as data:
+        runs = [r for r in data.runs if len(r.worn_axes) <= 1]
+        values = {r.id: r.array(signal) for r in runs}
+        windowed = {r.id: np.zeros(values[r.id].shape[1], dtype=bool) for r in runs}
+        if speed_window:  # the windowed mean where every cycle has samples in the window
+            from analysis.features import speed_window_mean
 
-        for run_id, arrays, _ in runs:
-            inside = speed_window_mean(arrays.pop("tau_m"), arrays.pop("qd_m"), *speed_window)
-            windowed[run_id] = ~np.isnan(inside).any(axis=0)
-            arrays[signal] = np.where(windowed[run_id], inside, arrays[signal])
-    worn = [r for r in runs if len(r[2]["worn_axes"]) == 1]
-    if not worn:
-        raise ValueError(f"{path} has no run with exactly one worn axis to isolate")
-    # cycles seen per (robot, task, level): what the worn runs saw, shown to the healthy ones too
-    seen: dict[tuple, int] = {}
-    cases = []
-    for run_id, arrays, attrs in worn:
-        axis = int(attrs["worn_axes"][0])
-        grown = fault_progress(path, run_id, arrays, attrs, axis)
-        for level in levels:
-            k = level_cycle(grown, level)
-            if k is not None:
-                seen.setdefault((attrs["robot"], attrs["task"], level), k + 1)
-                cases.append((run_id, arrays, attrs, axis, level, k + 1))
-    for run_id, arrays, attrs in runs:
-        if len(attrs["worn_axes"]) == 0:
-            cases += [(run_id, arrays, attrs, NO_FAULT, 0.0, n) for (robot, task, _), n in seen.items()
-                      if (robot, task) == (attrs["robot"], attrs["task"])]
+            for run in runs:
+                inside = speed_window_mean(run.signal("tau_m"), run.signal("qd_m"), *speed_window)
+                run._cache.pop("tau_m"), run._cache.pop("qd_m")  # large: not kept
+                windowed[run.id] = ~np.isnan(inside).any(axis=0)
+                values[run.id] = np.where(windowed[run.id], inside, values[run.id])
+        worn = [r for r in runs if len(r.worn_axes) == 1]
+        if not worn:
+            raise ValueError(f"{data.path} has no run with exactly one worn axis to isolate")
+        # cycles seen per (robot, task, level): what the worn runs saw, shown to the healthy ones too
+        seen: dict[tuple, int] = {}
+        cases = []
+        for run in worn:
+            axis = run.worn_axes[0]
+            grown = fault_progress(run, axis)
+            for level in levels:
+                k = level_cycle(grown, level)
+                if k is not None:
+                    seen.setdefault((run.robot, run.task, level), k + 1)
+                    cases.append((run, axis, level, k + 1))
+        for run in runs:
+            if not run.worn_axes:
+                cases += [(run, NO_FAULT, 0.0, n) for (robot, task, _), n in seen.items()
+                          if (robot, task) == (run.robot, run.task)]
     rows = []
-    for run_id, arrays, attrs, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
-        X = arrays[signal][:n]
+    for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
+        X = values[run.id][:n]
         for name, prototype in isolators.items():
             try:
                 predicted = int(clone(prototype).fit(X).source_axis_)
             except ValueError:  # too few cycles for this isolator at this level: not isolated
                 predicted = TOO_FEW_CYCLES
-            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, worn_axis=axis,
+            rows.append(dict(robot=run.robot, task=run.task, run=run.id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
-                             correct=predicted == axis,
-                             windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run_id])),
+                             answer=axis_label(predicted), correct=predicted == axis,
+                             windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
                              n_axes=X.shape[1]))
     return pd.DataFrame(rows)
 
@@ -213,15 +214,15 @@ def motor_speed_coverage(path, speed_window: tuple[float, float]) -> pd.DataFram
     axis, the 50th and 99th percentile of |motor speed| (rad/s) over the runs without wear, and
     the share of their samples inside the window (%)."""
     rows = []
-    for run_id, arrays, attrs in _runs(path, ("qd_m",)):
-        if len(attrs["worn_axes"]):
-            continue
-        speed = np.abs(arrays["qd_m"]).reshape(-1, arrays["qd_m"].shape[-1])
-        inside = (speed >= speed_window[0]) & (speed <= speed_window[1])
-        for a in range(speed.shape[1]):
-            rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, axis=axes.number(a),
-                             p50_rad_s=np.percentile(speed[:, a], 50), p99_rad_s=np.percentile(speed[:, a], 99),
-                             in_window_pct=100.0 * inside[:, a].mean()))
+    with opened(path) as data:
+        for run in data.healthy:
+            qd_m = run.signal("qd_m")
+            speed = np.abs(qd_m).reshape(-1, qd_m.shape[-1])
+            inside = (speed >= speed_window[0]) & (speed <= speed_window[1])
+            for a in range(speed.shape[1]):
+                rows.append(dict(robot=run.robot, task=run.task, run=run.id, axis=axes.number(a),
+                                 p50_rad_s=np.percentile(speed[:, a], 50), p99_rad_s=np.percentile(speed[:, a], 99),
+                                 in_window_pct=100.0 * inside[:, a].mean()))
     table = pd.DataFrame(rows)
     return table.groupby(["robot", "task", "axis"])[["p50_rad_s", "p99_rad_s", "in_window_pct"]].mean().round(1)
 
@@ -308,6 +309,16 @@ def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
     return accuracy.round(1)
 
 
+def isolation_decided(table: pd.DataFrame) -> pd.DataFrame:
+    """Share of cases in which each isolator named an axis (right or wrong), %, per task and wear
+    level (rows; "no fault": runs without wear) and isolator (columns). An isolator that never
+    decides scores 100 % on the "no fault" rows of :func:`isolation_accuracy` and 0 % on the
+    others; this table says so."""
+    named = ~table["predicted"].isin([UNDECIDED, TOO_FEW_CYCLES])
+    decided = named.groupby([table["task"], table["wear_pct"], table["isolator"]]).mean().mul(100).unstack("isolator")
+    return decided.round(1)
+
+
 def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     """Table 6.2 layout: per task and wear level, a mark per source axis for ``marked`` (default:
     ``te10``, as the thesis, else the first isolator), then the accuracy of every isolator."""
@@ -325,9 +336,13 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
         acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
         lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
+    decided = isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct")
     return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). Rows \"no fault\": runs without "
             "wear, where the accuracy is the share left undecided (naming an axis is a false isolation).\n\n"
-            + "\n".join(lines))
+            + "\n".join(lines)
+            + "\n\nCases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
+            "cycles). An isolator that never decides scores 100 % on \"no fault\" and 0 % elsewhere:\n\n"
+            + markdown(decided, digits=4))
 
 
 def _level_label(level: float) -> str:
@@ -373,7 +388,7 @@ PROTOCOLS = ("auto", "other-seeds", "first-cycles", "same-run")
 
 def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persistence: int = 1,
                     period: int | None = None, progress: bool = True, detector=None, protocol: str = "auto",
-                    first: int = 20, limit_folds: int | None = 20) -> pd.DataFrame:
+                    first: int = 20, limit_folds: int | None = 20, return_charts: bool = False):
     """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5),
     with the false-alarm rate on healthy data the monitor did not learn from.
 
@@ -393,17 +408,23 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     monitor (components for ``variance`` of the variance, thesis: 75 %; features constant in
     training are left out) learns
     normal operation as ``protocol`` says (:data:`PROTOCOLS`; ``first`` samples for first-cycles);
-    wear is detected at the first sample (after the training ones) whose Q statistic exceeds its
-    ``1 - alpha`` limit for ``persistence`` samples in a row. Under the held-out protocols the Q
+    wear is detected at the first sample (after the training ones, and at or after the first
+    sample with true wear or fault above 0: ``fault_begins_cycle``) whose Q statistic exceeds its
+    ``1 - alpha`` limit for ``persistence`` samples in a row; alarms before the fault begins are
+    false alarms (``alarms_before_fault_pct``), never a detection (a fleet's failing robots wear
+    from a drawn onset day). Under the held-out protocols the Q
     limit is estimated out of sample over ``limit_folds`` folds of the training samples
     (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample, eq. 2.6 as in the thesis):
     j2, three seeds, other-seeds, alpha 5 %: 9.0 % false alarms in-sample, 6.2 % with 20 folds;
     same-run always uses the in-sample limit; its location is the axis the
     cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
 
-    The false-alarm rate is the share of alarm samples on a run without wear that the monitor did
-    not learn from: the one of the tested seed (other-seeds, first-cycles). Under same-run it is
-    measured on the training run itself (in-sample, said in the ``protocol`` column).
+    The false-alarm rate is the share of alarm samples on runs without wear that the monitor did
+    not learn from (:func:`false_alarm_meaning`): under other-seeds the run of the tested seed;
+    under first-cycles every healthy run of the same robot, task and friction model (else of the
+    same robot model: a fleet's healthy robots), each judged by the protocol itself, a monitor
+    learnt from its own first ``first`` samples, after them. Under same-run it is measured on the
+    training run itself (in-sample, said in the ``protocol`` column).
 
     ``detector``, a scikit-learn estimator whose ``fit(X)`` learns healthy samples and whose
     ``predict(X)`` gives one alarm (truthy) per sample, replaces the PCA monitor (``variance`` and
@@ -413,9 +434,14 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     -------
     DataFrame, one row per worn run: robot, task, run, seed, worn_axis, final_wear_pct, protocol
     (as used; "same-run (in-sample)"), trained_on (runs, or cycles of the run), false_alarm_pct
-    (NaN without a held-out healthy run), features (axes used), detected, onset (sample index,
-    0-based; NaN if not detected), onset_cycle (1-based cycle of that sample's first recorded
-    cycle), onset_wear_pct, located_axis (0: undecided), located.
+    (NaN without a healthy run to measure it on), false_alarm_runs (how many), fault_begins_cycle,
+    trained_on_fault (the fault began inside the first-cycles training samples),
+    alarms_before_fault_pct (alarm share of the tested run's samples after training and before the
+    fault begins; NaN if none), features (axes used), detected, onset (sample index, 0-based; NaN
+    if not detected), onset_cycle (1-based cycle of that sample's first recorded cycle),
+    onset_wear_pct, located_axis (0: undecided), located. With ``return_charts`` also a dict run
+    id -> its chart data (per sample: cycle, wear_pct, alarm, t2, q; t2_limit, q_limit, trained,
+    begins, onset), what :func:`detection_figure` draws.
 
     Raises
     ------
@@ -427,87 +453,236 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         raise ValueError(f"unknown protocol {protocol!r}; expected one of: {', '.join(PROTOCOLS)}")
     if limit_folds is not None and not is_whole(limit_folds, 2):
         raise ValueError(f"limit_folds = {limit_folds!r}; expected None (the in-sample Q limit) or a number of folds >= 2")
-    runs = _runs(path, ("cycles", "friction_multiplier"))
-    healthy = [r for r in runs if len(r[2]["worn_axes"]) == 0]
+    with opened(path) as data:
+        table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
+                                   limit_folds)
+        table.attrs["dataset_kind"] = data.kind
+    return (table, charts) if return_charts else table
+
+
+def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
+               limit_folds) -> tuple[pd.DataFrame, dict]:
+    path = data.path
+    runs = data.runs
+    healthy = data.healthy
     torque: dict[str, np.ndarray | StoredHistograms] = {}
 
-    def torque_of(run_id: str) -> np.ndarray | StoredHistograms:
+    def torque_of(run: reader.Run) -> np.ndarray | StoredHistograms:
         """A run's per-cycle |motor torque| counts (:func:`torque_record`), read once."""
-        if run_id not in torque:
-            torque[run_id] = torque_record(path, run_id, next(r[2] for r in runs if r[0] == run_id))
-        return torque[run_id]
+        if run.id not in torque:
+            torque[run.id] = torque_record(run)
+        return torque[run.id]
+
+    def similar(run: reader.Run) -> list[reader.Run]:
+        """Healthy runs to measure false alarms on under first-cycles: of the same kind (robot,
+        task, friction), else of the same robot model (a fleet's robots each have their own task),
+        else all."""
+        for match in (lambda r: _same_unit_kind(r, run), lambda r: r.robot == run.robot, lambda r: True):
+            chosen = [r for r in healthy if match(r)]
+            if chosen:
+                return chosen
+        return []
 
     monitors: dict[tuple, tuple] = {}
-    false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy run
-    rows = []
-    for run_id, arrays, attrs in tqdm(runs, desc="detection", unit="run", disable=not progress):
-        if len(attrs["worn_axes"]) != 1:
+    false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy runs
+    rows, charts = [], {}
+    for run in tqdm(runs, desc="detection", unit="run", disable=not progress):
+        if len(run.worn_axes) != 1:
             continue
-        axis = int(attrs["worn_axes"][0])
-        same = [r for r in healthy if _same_unit_kind(r[2], attrs)]
-        own = next((r for r in same if r[2]["seed"] == attrs["seed"]), None)
-        others = [r for r in same if r[2]["seed"] != attrs["seed"]]
-        sample_of = group_cycles(arrays["cycles"], period)
+        axis = run.worn_axes[0]
+        same = [r for r in healthy if _same_unit_kind(r, run)]
+        own = next((r for r in same if r.seed == run.seed), None)
+        others = [r for r in same if r.seed != run.seed]
+        sample_of = group_cycles(run.recorded, period)
         samples = np.unique(sample_of)
         n_samples = len(samples)
         used_protocol = protocol
-        if protocol == "auto":
-            used_protocol = "other-seeds" if others else "first-cycles" if n_samples > first else "same-run"
+        if protocol == "auto":  # a fleet's robots are units of their own: each learns its first days (thesis ch. 4)
+            used_protocol = ("first-cycles" if data.kind == "fleet" and n_samples > first else "other-seeds" if others
+                             else "first-cycles" if n_samples > first else "same-run")
         if used_protocol == "other-seeds":
             if not others:
-                raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {attrs['robot']} "
-                                 f"{attrs['task']} with another seed than {attrs['seed']}; this dataset has none. Sweep "
+                raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
+                                 f"{run.task} with another seed than {run.seed}; this dataset has none. Sweep "
                                  "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
-            training = [(r[0], torque_of(r[0]), r[1]["cycles"]) for r in others]
-            key, trained_on, heldout, skip = tuple(r[0] for r in others), " ".join(r[0] for r in others), own, 0
+            training = [(r.id, torque_of(r), r.recorded) for r in others]
+            key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
+                [own] if own else [], 0
+            if own is None and len(others) > 1:  # no healthy run of the tested seed: each other one in turn
+                heldout = [("leave-one-out", r, [o for o in others if o is not r]) for r in others]
         elif used_protocol == "first-cycles":
             if n_samples <= first:
                 raise ValueError(f"{path}: protocol first-cycles learns from the first {first} samples of a run and "
-                                 f"needs more; {run_id} has {n_samples}. Record more cycles, or sweep several "
+                                 f"needs more; {run.id} has {n_samples}. Record more cycles, or sweep several "
                                  "seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
             keep = np.isin(sample_of, samples[:first])
-            training = [(run_id, torque_of(run_id)[keep], arrays["cycles"][keep])]
-            key, trained_on, heldout, skip = (run_id, first), f"samples 1-{first} of the run", own, first
+            training = [(run.id, torque_of(run)[keep], run.recorded[keep])]
+            key, trained_on, heldout, skip = (run.id, first), f"samples 1-{first} of the run", similar(run), first
         else:  # same-run
             if own is None:
-                raise ValueError(f"{path}: protocol same-run needs the run without wear of {attrs['robot']} "
-                                 f"{attrs['task']} seed {attrs['seed']}; this dataset has none")
-            training = [(own[0], torque_of(own[0]), own[1]["cycles"])]
-            key, trained_on, heldout, skip = (own[0],), own[0], own, 0
+                raise ValueError(f"{path}: protocol same-run needs the run without wear of {run.robot} "
+                                 f"{run.task} seed {run.seed}; this dataset has none")
+            training = [(own.id, torque_of(own), own.recorded)]
+            key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
+        held_out = used_protocol != "same-run"
         if key not in monitors:  # one monitor serves every worn run that learns from the same data
-            held_out = used_protocol != "same-run"
             monitors[key] = _fit_monitor(training, period, variance, alpha, detector, fixed_reference=held_out,
                                          folds=limit_folds if held_out else None)
         if used_protocol == "same-run":
             used_protocol = "same-run (in-sample)"
         scale, reference, used, monitor = monitors[key]
-        worn, groups = _kl_features(torque_of(run_id), arrays["cycles"], scale, period, reference)
+        worn, groups = _kl_features(torque_of(run), run.recorded, scale, period, reference)
         alarms = np.asarray(monitor.predict(worn[:, used]), dtype=bool)
-        onset = detect_onset(alarms[skip:], persistence=persistence)
-        onset = None if onset is None else onset + skip
+        # the fault's first sample: an alarm before it is a false alarm, never a detection
+        begins = run.fault_begins
+        start = len(alarms) if begins is None else int(groups[begins])
+        first_tested = max(skip, start)
+        onset = detect_onset(alarms[first_tested:], persistence=persistence)
+        onset = None if onset is None else onset + first_tested
+        before = alarms[skip:start]
         if key not in false_alarms:
-            false_alarms[key] = np.nan
-            if heldout is not None:
-                normal, _ = _kl_features(torque_of(heldout[0]), heldout[1]["cycles"], scale, period, reference)
-                false_alarms[key] = 100.0 * float(np.mean(np.asarray(monitor.predict(normal[:, used]),
-                                                                      dtype=bool)[skip:]))
-        false_alarm = false_alarms[key]
-        wear = (fault_progress(path, run_id, arrays, attrs, axis) - 1.0) * 100.0
+            rates = []
+            for normal_run in heldout:
+                if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
+                    _, normal_run, rest = normal_run
+                    n_scale, n_reference, n_used, n_monitor = _fit_monitor(
+                        [(r.id, torque_of(r), r.recorded) for r in rest], period, variance, alpha, detector,
+                        fixed_reference=True, folds=limit_folds)
+                    normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
+                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)
+                elif used_protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
+                    normal_of = group_cycles(normal_run.recorded, period)
+                    if len(np.unique(normal_of)) <= first:
+                        continue
+                    own_keep = np.isin(normal_of, np.unique(normal_of)[:first])
+                    fitted = _fit_monitor([(normal_run.id, torque_of(normal_run)[own_keep],
+                                            normal_run.recorded[own_keep])], period, variance, alpha, detector,
+                                          fixed_reference=True, folds=limit_folds)
+                    n_scale, n_reference, n_used, n_monitor = fitted
+                    normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
+                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)[first:]
+                else:
+                    normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, scale, period, reference)
+                    flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
+                rates.append(100.0 * float(np.mean(flags)))
+            false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates))
+        false_alarm, n_normal = false_alarms[key]
+        wear = fault_progress(run, axis) * 100.0 - 100.0
         located = UNDECIDED
         if onset is not None:
             try:
                 located = int(isolation.make("cross_correlation").fit(worn[: onset + 1]).source_axis_)
             except ValueError:  # too few samples before the onset to cross-correlate
                 located = UNDECIDED
-        rows.append(dict(robot=attrs["robot"], task=attrs["task"], run=run_id, seed=int(attrs["seed"]),
+        rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
-                         trained_on=trained_on, false_alarm_pct=round(false_alarm, 2),
+                         trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
+                         fault_begins_cycle=np.nan if begins is None else int(run.recorded[begins]),
+                         trained_on_fault=begins is not None and int(groups[begins]) < skip,
+                         alarms_before_fault_pct=round(100.0 * float(before.mean()), 2) if before.size else np.nan,
                          features=" ".join(str(u + 1) for u in used), detected=onset is not None,
                          onset=np.nan if onset is None else int(onset),
-                         onset_cycle=np.nan if onset is None else int(arrays["cycles"][groups == onset][0]),
+                         onset_cycle=np.nan if onset is None else int(run.recorded[groups == onset][0]),
                          onset_wear_pct=np.nan if onset is None else round(float(wear[groups == onset].max()), 2),
                          located_axis=located, located=located == axis))
-    return pd.DataFrame(rows)
+        chart = {"sample": np.arange(len(alarms)),
+                 "cycle": np.array([run.recorded[groups == g][0] for g in range(len(alarms))]),
+                 "wear_pct": np.array([wear[groups == g].max() for g in range(len(alarms))]), "alarm": alarms}
+        if hasattr(monitor, "score_samples") and hasattr(monitor, "q_limit_"):
+            t2, q = monitor.score_samples(worn[:, used])
+            chart.update(t2=t2, q=q, t2_limit=monitor.t2_limit_, q_limit=monitor.q_limit_)
+        charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
+                              protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
+    return pd.DataFrame(rows), charts
+
+
+#: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
+DETECTION_COLUMNS = {
+    "onset": "the first sample (0-based) of the first run of PERSISTENCE alarms at or after the fault begins",
+    "onset_cycle": "the 1-based cycle (a day in a fleet) of that sample",
+    "fault_begins_cycle": "the first recorded cycle with true wear (fault) above 0; an alarm before it is a "
+                          "false alarm (alarms_before_fault_pct), never a detection",
+    "false_alarm_pct": "share of alarm samples on healthy runs (false_alarm_runs of them); see the protocol",
+    "trained_on_fault": "the fault began inside the samples the monitor learned from (first-cycles): it learned "
+                        "faulty data as normal",
+}
+
+
+def false_alarm_meaning(protocols: Iterable[str]) -> str:
+    """What ``false_alarm_pct`` measured under each of ``protocols`` (as the table's column names them)."""
+    meaning = {
+        "other-seeds": "the monitor judging the run without wear of the tested seed, which it did not learn from "
+                       "(without one: each other healthy run judged by a monitor of the rest)",
+        "first-cycles": "each healthy run of the same kind (else robot model) judged by a monitor learnt from its "
+                        "own first samples, after them: held out",
+        "same-run (in-sample)": "the training run itself: in-sample, optimistic",
+    }
+    return "; ".join(f"{p}: {meaning.get(p, p)}" for p in dict.fromkeys(protocols))
+
+
+def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
+    """Notes on a :func:`detection_table` that fit its dataset (a sweep or a fleet): where the
+    monitor learned the fault, where it alarmed before the fault began, which data would serve
+    better. Empty when there is nothing to say."""
+    notes = []
+    kind = table.attrs.get("dataset_kind", "sweep")
+    held_in = table[table["protocol"] != "other-seeds"]
+    if protocol == "auto" and len(held_in) and kind != "fleet":
+        notes.append(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} "
+                     f"runs were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. "
+                     "For false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset "
+                     "quick --seed 0 --seed 1 --seed 2`")
+    if kind == "fleet" and (table["protocol"] == "first-cycles").any():
+        notes.append("note: a fleet's robots each learn their own first days (first-cycles, thesis ch. 4 OTO); "
+                     "false_alarm_pct is that protocol on the fleet's healthy robots. For monitors learnt from other "
+                     "robots, compared with their own, run `faultgen training-source` on a 60-day fleet")
+    learned = table[table["trained_on_fault"]] if "trained_on_fault" in table else table.iloc[:0]
+    if len(learned):
+        earliest = int(learned["fault_begins_cycle"].min())
+        notes.append(f"note: in {len(learned)} of {len(table)} runs the fault began inside the samples the monitor "
+                     f"learned as normal (trained_on_fault; earliest at cycle {earliest}): a smaller --first (below "
+                     f"{earliest}) keeps training before it, or record longer before the fault")
+    noisy = table[table["alarms_before_fault_pct"] >= 50]
+    if len(noisy):
+        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the fault "
+                     "begins (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
+                     "detections say little")
+    return "\n".join(notes)
+
+
+def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
+    """PNG of the Q and T2 charts of :func:`detection_table` (``return_charts=True``): per worn run
+    (the first ``most``), Q and T2 against the cycle (a day in a fleet) on a log scale, with the
+    limit (dashed), the samples the monitor learned from (shaded), where the fault begins (dotted)
+    and the onset called (red). A detector without statistics shows its alarms instead."""
+    from matplotlib.figure import Figure
+
+    shown = list(charts.items())[:most]
+    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8))
+    panels = fig.subplots(max(1, len(shown)), 2, squeeze=False)
+    for (run_id, chart), row in zip(shown, panels, strict=False):
+        x = chart["cycle"]
+        for ax, name in zip(row, ("q", "t2"), strict=True):
+            if name in chart:
+                ax.semilogy(x, np.maximum(chart[name], 1e-12), ".-", lw=0.8, ms=3, color="C0")
+                ax.axhline(chart[f"{name}_limit"], ls="--", color="k", lw=0.8)
+            else:
+                ax.step(x, chart["alarm"].astype(int), where="mid")
+            if chart["trained"]:
+                ax.axvspan(x[0], x[min(chart["trained"], len(x)) - 1], color="0.85", lw=0)
+            if chart["begins"] is not None:
+                ax.axvline(x[chart["begins"]], ls=":", color="C2", lw=1.2)
+            if chart["onset"] is not None:
+                ax.axvline(x[chart["onset"]], color="C3", lw=1.2)
+            ax.set_ylabel({"q": "Q", "t2": "T2"}[name])
+            ax.set_title(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})", fontsize=8)
+    for ax in panels[-1]:
+        ax.set_xlabel("cycle (a day in a fleet)")
+    fig.suptitle("PCA monitoring per worn run: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
+                 "normal; dotted green: fault begins; red: onset called", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+    return out
 
 
 def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
@@ -526,8 +701,8 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
     return out.set_index(["by", "group"]).round(2)
 
 
-def _same_unit_kind(a: dict, b: dict) -> bool:
-    return (a["robot"], a["task"], a["friction_model"]) == (b["robot"], b["task"], b["friction_model"])
+def _same_unit_kind(a: reader.Run, b: reader.Run) -> bool:
+    return (a.robot, a.task, a.friction_model) == (b.robot, b.task, b.friction_model)
 
 
 def _fit_monitor(training: list, period: int | None, variance: float, alpha: float, detector=None,
@@ -551,7 +726,7 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
 
 
-def torque_record(path, run_id: str, labels: dict) -> np.ndarray | StoredHistograms:
+def torque_record(run: reader.Run) -> np.ndarray | StoredHistograms:
     """What detection bins a run's |motor torque| from: its per-cycle counts in fine bins of
     0 .. peak motor torque (``torque_counts``, (n_cycles, 6, 1200),
     :func:`faultgen.simulation.sensors.torque_counts`), read as stored, or computed from the
@@ -565,14 +740,13 @@ def torque_record(path, run_id: str, labels: dict) -> np.ndarray | StoredHistogr
         If the run has no counts and lacks ``tau_m`` though it says it has signals, or lacks
         ``torque_hist``.
     """
-    try:  # the stored counts: a small array, where the signals are the largest part of a file
-        return dataset.read_run(path, run_id, names=("torque_counts",))[0]["torque_counts"]
-    except dataset.DatasetError:
-        pass
-    if labels.get("signals", True):
-        tau_m = dataset.read_run(path, run_id, names=("tau_m",))[0]["tau_m"]
-        return sensors.torque_counts(tau_m, robots.load(labels["robot"]).motor_torque_limit)
-    return StoredHistograms(dataset.read_run(path, run_id, names=("torque_hist",))[0]["torque_hist"])
+    if run.has("torque_counts"):  # the stored counts: a small array, where the signals are the largest part
+        return run.array("torque_counts")
+    if run.has_signals:
+        tau_m = run.signal("tau_m")
+        run._cache.pop("tau_m")  # the largest array of a file: not kept
+        return sensors.torque_counts(tau_m, robots.load(run.robot).motor_torque_limit)
+    return StoredHistograms(run.array("torque_hist"))
 
 
 def detection_scale(counts: list[np.ndarray]) -> np.ndarray:
@@ -649,7 +823,8 @@ THESIS_WINDOW = 10
 
 
 def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,
-                         progress: bool = True, horizon: int | None = None, **kwargs) -> pd.DataFrame:
+                         progress: bool = True, horizon: int | None = None, chance: bool = False,
+                         **kwargs) -> pd.DataFrame:
     """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
 
     Samples are recorded cycles (days in a fleet), in time order; the features per axis are those
@@ -665,8 +840,10 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     instead (ch. 5.3.3; its Table 5.2 used 3 days): each run keeps the samples from ``horizon +``
     :data:`THESIS_WINDOW` to ``horizon`` before its last one (the failure day T of a failing
     robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
-    worn run is labelled 1 (the robot's state), of an unworn run 0. ``kwargs`` go to
-    :func:`analysis.classify.evaluate`.
+    worn run is labelled 1 (the robot's state), of an unworn run 0. With ``chance`` (and no
+    ``permutations``) the table's ``attrs["chance"]`` holds a cheap chance level,
+    :func:`chance_estimate`. ``kwargs`` go to :func:`analysis.classify.evaluate` (``n_jobs``:
+    pairs in parallel).
 
     Raises
     ------
@@ -675,21 +852,57 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         run and its samples), or the training sets would lack a class (see
         :func:`_check_training_sets`).
     """
-    if horizon is not None and not is_whole(horizon, 0):
-        raise ValueError(f"horizon = {horizon!r}: expected an integer >= 0 (samples before the last one)")
     from analysis.classify import evaluate
 
-    duty = set(dataset.runs_with(path, dataset.DUTY_ARRAYS)) == set(dataset.list_runs(path))
-    levels = tuple(dataset.DUTY_ARRAYS) if duty else ("mean_abs_torque", "rms_torque")
-    names = (*levels, "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
+    inputs = classification_inputs(path, wear_threshold, horizon)
+    table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
+                     random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
+    if chance and not kwargs.get("permutations"):
+        table.attrs["chance"] = chance_estimate(inputs, n_pairs=n_pairs, random_state=random_state,
+                                                n_jobs=kwargs.get("n_jobs"), matched=kwargs.get("matched", False))
+    return table
+
+
+@dataclass(frozen=True, eq=False)
+class ClassificationInputs:
+    """What :func:`analysis.classify.evaluate` classifies: features ``X`` (n_samples, 30), the
+    estimated quantities (n_samples, 12) or None, 0/1 labels ``y``, the run of each sample
+    (``groups``), and the worn (``failed``) and unworn (``normal``) runs."""
+
+    X: np.ndarray
+    estimated: np.ndarray | None
+    y: np.ndarray
+    groups: np.ndarray
+    failed: list
+    normal: list
+
+
+def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | None = None) -> ClassificationInputs:
+    """Table 5.1's features and labels of every run of a dataset (see :func:`classification_table`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`classification_table`.
+    """
+    if horizon is not None and not is_whole(horizon, 0):
+        raise ValueError(f"horizon = {horizon!r}: expected an integer >= 0 (samples before the last one)")
+    with opened(path) as data:
+        duty = all(run.has(*dataset.DUTY_ARRAYS) for run in data.runs)
+        levels = tuple(dataset.DUTY_ARRAYS) if duty else ("mean_abs_torque", "rms_torque")
+        names = (*levels, "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
+        records = [(run, {name: run.array(name) for name in names}) for run in data.runs]
+        path = data.path
+        fault_levels = {run.id: run.fault_level for run, _ in records if run.fault is not None}
     X, estimated, y, groups, failed, normal = [], [], [], [], [], []
-    for run_id, arrays, attrs in _runs(path, names):
+    for run, arrays in records:
+        run_id = run.id
         X.append(_table_5_1(arrays, duty))
         if duty:
             estimated.append(np.hstack([arrays["average_speed"], arrays["average_load_torque"]]))
         wear = (arrays["friction_multiplier"].max(axis=1) - 1.0) * 100.0
-        if "fault" in attrs:  # a fault other than friction wear: its share of the final value
-            wear = (fault_progress(path, run_id, arrays, attrs, int(attrs["worn_axes"][0])) - 1.0) * 100.0
+        if run.fault is not None:  # a fault other than friction wear: its share of the final value
+            wear = fault_levels[run_id]
         y.append((wear >= wear_threshold).astype(int))
         if horizon is not None:  # the thesis's window and the robot's state
             n = len(wear)
@@ -701,9 +914,9 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
             X[-1] = X[-1][keep]
             if duty:
                 estimated[-1] = estimated[-1][keep]
-            y[-1] = np.full(THESIS_WINDOW + 1, int(len(attrs["worn_axes"]) > 0))
+            y[-1] = np.full(THESIS_WINDOW + 1, int(len(run.worn_axes) > 0))
         groups.append(np.full(len(y[-1]), run_id, dtype=object))
-        (failed if len(attrs["worn_axes"]) else normal).append(run_id)
+        (failed if len(run.worn_axes) else normal).append(run_id)
     widths = {x.shape[1] // 5: g[0] for x, g in zip(X, groups, strict=True)}  # 5 features per axis
     if len(widths) > 1:
         runs = ", ".join(f"{run}: {n} axes" for n, run in sorted(widths.items()))
@@ -715,9 +928,110 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
                          f"{len(normal)} unworn)")
     _check_training_sets(path, y, groups, failed, normal, f"true wear >= {wear_threshold:g} %" if horizon is None
                          else f"worn runs' last {THESIS_WINDOW + 1} before the horizon")
-    return evaluate(np.vstack(X), np.concatenate(y), np.concatenate(groups), failed, normal, n_pairs=n_pairs,
-                    random_state=random_state, progress=progress,
-                    estimated=np.vstack(estimated) if duty else None, **kwargs)
+    return ClassificationInputs(np.vstack(X), np.vstack(estimated) if duty else None, np.concatenate(y),
+                                np.concatenate(groups), failed, normal)
+
+
+#: Permutations of the cheap chance estimate ``faultgen classify`` makes by default (one cell).
+CHANCE_PERMUTATIONS = 5
+
+
+def chance_estimate(inputs: ClassificationInputs, n_pairs: int | None = 20, random_state: int = 0,
+                    permutations: int = CHANCE_PERMUTATIONS, n_jobs: int | None = None, matched: bool = False,
+                    classifier: str = "lr", preprocessing: str = "control") -> dict:
+    """A cheap chance level of a classification on these robots: the mean leave-pair-out AUC of one
+    cell (``classifier`` on ``preprocessing``) over ``permutations`` label sets with the runs'
+    roles exchanged (:func:`analysis.classify.permuted_roles`), on the same pairs as the table.
+
+    It costs ``permutations`` times one cell (a table has up to 76). It is one cell's chance level,
+    an estimate for the others (classifiers differ in how far they overfit robots): ``faultgen
+    classify --permutations K`` measures every cell.
+
+    Returns
+    -------
+    dict: cell ("lr control"), permutations, null (mean AUC under exchange), null_values (per
+    label set), auc (the cell's AUC on the true labels), p (:func:`analysis.classify.null_p_value`).
+    """
+    from analysis.classify import evaluate, null_p_value
+
+    table, aucs = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, classifiers=[classifier],
+                           preprocessing=[preprocessing], estimated=inputs.estimated, n_pairs=n_pairs,
+                           random_state=random_state, permutations=permutations, n_jobs=n_jobs, matched=matched,
+                           return_aucs=True)
+    null = float(table.loc[preprocessing, (classifier, "null")])
+    return {"cell": f"{classifier} {preprocessing}", "permutations": permutations, "null": null,
+            "auc": float(table.loc[preprocessing, (classifier, "mean")]), "p": float(table.loc[preprocessing, (classifier, "p")])}
+
+
+def classification_tidy(table: pd.DataFrame) -> pd.DataFrame:
+    """A :func:`classification_table` as a tidy table: one row per (preprocessing, classifier)
+    cell, one header row; columns preprocessing, steps (what the combination does, in order),
+    classifier, auc_mean, auc_std and, where measured, auc_null and p."""
+    from analysis.classify import describe_preprocessing
+
+    long = table.stack(0, future_stack=True).reset_index()
+    long = long.rename(columns={long.columns[1]: "classifier"})
+    long = long.rename(columns={"mean": "auc_mean", "std": "auc_std", "null": "auc_null"})
+    long.insert(1, "steps", long["preprocessing"].map(describe_preprocessing))
+    long.columns.name = None
+    return long
+
+
+def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon: int | None, wear_threshold: float,
+                           matched: bool, chance: dict | None, command: str) -> str:
+    """The caption of a classification table: what the cells are, how samples were labelled, the
+    chance level (measured per cell, estimated on one, or not measured with the command that
+    measures it), and why two orders of the same steps are two rows."""
+    labels = (f"the thesis's window (T-{horizon + 10} to T-{horizon}) labelled by the robot's state" if horizon is not None
+              else f"every sample labelled failed when its true wear reaches {wear_threshold:g} %")
+    parts = [f"Leave-pair-out ROC AUC (mean and std over {'every' if n_pairs is None else n_pairs} held-out "
+             f"(worn, unworn) run pair(s), thesis Procedure 1 and Table 5.2) per preprocessing (rows) and classifier; "
+             f"{labels}{'; time-matched (--matched-days)' if matched else ''}."]
+    if any(c == "null" for c in table.columns.get_level_values(-1)):
+        parts.append("Chance level measured per cell: auc_null, the mean AUC with the runs' labels exchanged, and p, "
+                     "the permutation p-value of the AUC.")
+    elif chance is not None:
+        parts.append(f"Chance level on these robots (estimated on one cell, {chance['cell']}, with "
+                     f"{chance['permutations']} label exchanges): {chance['null']:.2f}, not 0.5; that cell's AUC "
+                     f"{chance['auc']:.2f}, p {chance['p']:.2f} (with {chance['permutations']} exchanges p cannot go "
+                     f"below {1 / (chance['permutations'] + 1):.2f}). Every cell's: `{command} --permutations 19`.")
+    else:
+        parts.append(f"Chance level not measured: `{command} --permutations 19` measures it per cell.")
+    parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
+                 "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
+    return " ".join(parts)
+
+
+def classification_heatmap(table: pd.DataFrame, out: Path, chance: dict | None = None) -> Path:
+    """PNG heatmap of a classification table's mean AUC (preprocessing x classifier), coloured
+    around the chance level (the per-cell null where measured, else ``chance``'s estimate, else
+    0.5, said in the title), the value in each cell (and p where measured)."""
+    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.figure import Figure
+
+    means = table.xs("mean", axis=1, level=-1)
+    measured = "null" in table.columns.get_level_values(-1)
+    centre = (float(np.nanmean(table.xs("null", axis=1, level=-1).to_numpy())) if measured
+              else chance["null"] if chance is not None else 0.5)
+    what = ("mean of the measured chance levels" if measured else
+            f"chance estimated on {chance['cell']}" if chance is not None else "0.5, chance not measured")
+    fig = Figure(figsize=(1.3 * means.shape[1] + 3.2, 0.38 * means.shape[0] + 1.8))
+    ax = fig.subplots()
+    image = ax.imshow(means.to_numpy(dtype=float), cmap="RdBu_r", aspect="auto",
+                      norm=TwoSlopeNorm(vcenter=min(max(centre, 0.01), 0.99), vmin=0.0, vmax=1.0))
+    ax.set_xticks(range(means.shape[1]), means.columns)
+    ax.set_yticks(range(means.shape[0]), means.index, fontsize=8)
+    for i in range(means.shape[0]):
+        for j in range(means.shape[1]):
+            text = f"{means.iat[i, j]:.2f}"
+            if measured:
+                text += f"\np {table[(means.columns[j], 'p')].iat[i]:.2f}"
+            ax.text(j, i, text, ha="center", va="center", fontsize=7)
+    fig.colorbar(image, ax=ax, label=f"AUC (white: {centre:.2f}, {what})")
+    ax.set_title("leave-pair-out AUC per preprocessing and classifier", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    return out
 
 
 def _table_5_1(arrays: dict, duty: bool) -> np.ndarray:

@@ -43,6 +43,7 @@ from sklearn.metrics import roc_auc_score
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
+from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
 from analysis.features import Difference, WindowConcat
@@ -92,14 +93,23 @@ def random_forest(random_state: int | None = 0) -> Pipeline:
     return Pipeline([("rf", RandomForestClassifier(n_estimators=100, random_state=random_state))])
 
 
-def stacking(random_state: int | None = 0) -> Pipeline:
+def stacking(random_state: int | None = 0, inner_cv: str = "run") -> Pipeline:
     """Ensemble stack of thesis Fig. 5-3: LR and SVM base classifiers, LR meta-classifier.
 
     The meta-classifier is trained on 5-fold cross-validated base outputs (LR probabilities, SVM
-    decision values; ``StackingClassifier`` defaults), on standardised features.
+    decision values), on standardised features. ``inner_cv="run"``: :func:`fit_by_run` splits the
+    folds by run (:func:`run_folds`), so the base outputs it learns from are, as at test time,
+    those of robots the base classifiers did not see. ``"sample"``: scikit-learn's stratified
+    folds over samples, what faultgen used before (a run's days on both sides of a fold).
+    Measured on an 8-robot fleet (docs/analysis.md, "stacking"): by run scores lower, below
+    chance without differencing.
     """
+    from sklearn.model_selection import StratifiedKFold
+
+    if inner_cv not in ("run", "sample"):
+        raise ValueError(f"inner_cv = {inner_cv!r}; expected 'run' or 'sample'")
     stack = StackingClassifier(estimators=[("lr", _lr(random_state)), ("svm", _svc(random_state))],
-                               final_estimator=_lr(random_state), cv=5)
+                               final_estimator=_lr(random_state), cv=5 if inner_cv == "run" else StratifiedKFold(5))
     return Pipeline([("scale", StandardScaler()), ("stacking", stack)])
 
 
@@ -176,6 +186,20 @@ def preprocessing_steps(name: str) -> list[tuple[str, BaseEstimator]]:
                 unique, i = f"{step_name}_{i}", i + 1
             steps.append((unique, step))
     return steps
+
+
+def describe_preprocessing(name: str) -> str:
+    """What a combination does, step by step in its order, e.g. ``"+diff+pca+var3"`` -> "difference,
+    then PCA (90 % variance), then windows of 3": the order of the tokens is the order of the steps."""
+    words = []
+    for step_name, step in preprocessing_steps(name):
+        if isinstance(step, Difference):
+            words.append("difference")
+        elif isinstance(step, WindowConcat):
+            words.append(f"windows of {step.width}")
+        elif isinstance(step, PCA):
+            words.append(f"PCA of the standardised features ({100 * PCA_VARIANCE:g} % variance)")
+    return ", then ".join((["estimates added"] if name.startswith(ESTIMATED) else []) + words) or "none"
 
 
 #: Combination name -> its steps (templates: :func:`make_pipeline` clones them). Table 5.2's
@@ -284,9 +308,33 @@ def fit_by_run(estimator, X, y, groups):
     -------
     The fitted ``estimator``.
     """
-    Xt, final = _transform(estimator, np.asarray(X), np.asarray(groups), y, fit=True)
+    groups = np.asarray(groups)
+    Xt, final = _transform(estimator, np.asarray(X), groups, y, fit=True)
+    if isinstance(final, StackingClassifier) and isinstance(final.cv, int | None):
+        final.set_params(cv=run_folds(y, groups, 5 if final.cv is None else final.cv))
     final.fit(Xt, y)
     return estimator
+
+
+def run_folds(y, groups, n_splits: int = 5) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Cross-validation folds that split by run, not by sample: every run's samples in one fold
+    (``StratifiedGroupKFold``, classes balanced across folds as far as whole runs allow).
+
+    :func:`fit_by_run` gives these to a stacking classifier's inner cross-validation: split by
+    sample, its base classifiers learn other days of the very runs whose out-of-fold outputs
+    train the meta-classifier, which then learns how the base outputs look on known robots
+    (docs/analysis.md, "stacking"). Fewer runs than ``n_splits``: one fold per run.
+
+    Returns
+    -------
+    list of (train indices, test indices)
+    """
+    from sklearn.model_selection import StratifiedGroupKFold
+
+    y, groups = np.asarray(y), np.asarray(groups)
+    n_runs = len(pd.unique(groups))
+    folds = StratifiedGroupKFold(n_splits=max(2, min(n_splits, n_runs)))
+    return list(folds.split(np.zeros((len(y), 1)), y, groups))
 
 
 def score_by_run(estimator, X, groups) -> np.ndarray:
@@ -447,6 +495,44 @@ def _pair_auc(factory, X, labels, groups, pair, matched: bool = False) -> float:
     return float(roc_auc_score(truth, score_by_run(model, X[held], groups[held])[test]))
 
 
+def _run_steps(steps: list, X: np.ndarray, groups: np.ndarray, y=None, fit: bool = False) -> np.ndarray:
+    """Apply preprocessing ``steps`` (fitted in place with ``fit``) as :func:`fit_by_run` does."""
+    Xt = X
+    for step in steps:
+        if isinstance(step, SEQUENCE_STEPS):
+            Xt = _per_run(step, Xt, groups)
+        elif fit:
+            Xt = step.fit_transform(Xt, y)
+        else:
+            Xt = step.transform(Xt)
+    return Xt
+
+
+def _pair_cells(X, X_est, labels, groups, pair, names, models, random_state, matched) -> np.ndarray:
+    """AUCs of one held-out pair for every (preprocessing, classifier) cell, in ``product(names,
+    models)`` order: each preprocessing fitted once on the training runs, then every classifier on
+    its output. The same numbers as :func:`_pair_auc` on each cell's whole pipeline."""
+    held = np.isin(groups, list(pair))
+    train = ~held
+    test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
+    truth = labels[held][test]
+    out = np.full(len(names) * len(models), np.nan)
+    if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
+        return out
+    k = 0
+    for name in names:
+        data = X_est if name.startswith(ESTIMATED) else X
+        steps = [step for _, step in preprocessing_steps(name)]
+        X_train = _run_steps(steps, data[train], groups[train], labels[train], fit=True)
+        X_test = _run_steps(steps, data[held], groups[held])
+        for model in models.values():
+            clf = make_pipeline(model, "control", random_state=random_state)
+            fit_by_run(clf, X_train, labels[train], groups[train])
+            out[k] = roc_auc_score(truth, score_by_run(clf, X_test, groups[held])[test])
+            k += 1
+    return out
+
+
 def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_groups, *,
                        n_pairs: int | None = None, random_state: int | None = 0, label_rule=None,
                        matched: bool = False, n_jobs: int | None = None, return_pairs: bool = False):
@@ -509,7 +595,8 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     labels = make_labels(y, groups, failed, label_rule)
     pairs = select_pairs(failed, normal, n_pairs, random_state)
     if n_jobs is None:
-        aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
+        with threadpool_limits(limits=1):  # small fits: see evaluate
+            aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
     else:
         jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
         aucs = Parallel(n_jobs=n_jobs)(jobs)
@@ -787,21 +874,27 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     X_est = np.hstack([X, estimated]) if estimated is not None else None
     roles = permuted_roles(labels, groups, failed, normal, permutations, random_state) if permutations else []
 
+    # one job per (label set, held-out pair): every cell of the pair, each preprocessing computed once
+    label_sets = [(labels, failed, normal), *roles]
+    jobs = [(k, pair) for k, (_, f, n) in enumerate(label_sets) for pair in select_pairs(f, n, n_pairs, random_state)]
+    run = delayed(_pair_cells)
+    tasks = (run(X, X_est, label_sets[k][0], groups, pair, names, models, random_state, matched) for k, pair in jobs)
+    # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
+    # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
+    # joblib's workers limit theirs alike
+    with threadpool_limits(limits=1):
+        results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(tasks)
+        per_job = np.array(list(tqdm(results, total=len(jobs), desc="classify", unit="pair", disable=not progress)))
+    per_job = per_job.reshape(len(jobs), len(names) * len(models))
+    set_of = np.array([k for k, _ in jobs])
+    cells = [(name, column) for name in names for column in models]
     aucs: dict[tuple[str, str], np.ndarray] = {}
     null: dict[tuple[str, str], np.ndarray] = {}
-    cells = list(product(names, models.items()))
-    for name, (column, model) in tqdm(cells, desc="classify", unit="cell", disable=not progress):
-        pipe = make_pipeline(model, name, random_state=random_state)
-        data = X_est if name.startswith(ESTIMATED) else X
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UndefinedAUCWarning)  # summarised once below
-            warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
-            aucs[column, name] = leave_pair_out_auc(pipe, data, labels, groups, failed, normal, n_pairs=n_pairs,
-                                                    random_state=random_state, matched=matched, n_jobs=n_jobs)
-            null[column, name] = np.array([
-                np.nanmean(leave_pair_out_auc(pipe, data, permuted, groups, f, n, n_pairs=n_pairs,
-                                              random_state=random_state, matched=matched, n_jobs=n_jobs))
-                for permuted, f, n in roles])
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
+        for c, (name, column) in enumerate(cells):
+            aucs[column, name] = per_job[set_of == 0, c]
+            null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, len(label_sets))])
     n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
     if n_nan - {0}:
         warnings.warn(f"up to {max(n_nan)} held-out pairs per cell have no AUC (one class only); they are "

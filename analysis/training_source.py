@@ -37,7 +37,7 @@ from tqdm.auto import tqdm
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
-from faultgen.data import dataset
+from faultgen.data import reader
 
 SOURCES = ("OTM", "OTO")
 SIGNAL_TYPES = ("raw", "difference", "combined")
@@ -127,7 +127,27 @@ def descriptors(q: np.ndarray, limit: float) -> dict[str, float]:
     the days before the failure, thesis ch. 4.3.3)."""
     above = np.flatnonzero(q > limit)
     return {"cov_q": float(np.std(q, ddof=1) / np.mean(q)), "nsat": int(above.size),
-            "lead_time_days": int(len(q) - above[0]) if above.size else 0}
+            "lead_time_days": int(len(q) - above[0]) if above.size else 0, "test_days": int(len(q)),
+            "saturated": bool(above.size == len(q))}
+
+
+def normal_false_alarms(cases: pd.DataFrame) -> pd.DataFrame:
+    """What the descriptors mean on normal robots, which never fail: every test day above the
+    limit is a false alarm and the "lead time" is only how early the first false alarm came.
+    Per training source and signal type: normal-robot cases, their mean false-alarm share of the
+    test days (%), and the cases whose limit is saturated (every test day above it: the model does
+    not describe that robot at all, e.g. OTM across robots of different loads).
+
+    Returns
+    -------
+    DataFrame indexed by (source, signal): cases, false_alarm_pct, saturated, saturated_pct.
+    """
+    normal = cases[cases["condition"] == "normal"]
+    grouped = normal.assign(false_alarm_pct=100.0 * normal["nsat"] / normal["test_days"]).groupby(["source", "signal"])
+    out = grouped.agg(cases=("nsat", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
+                      saturated=("saturated", "sum"))
+    out["saturated_pct"] = 100.0 * out["saturated"] / out["cases"]
+    return out.round(1)
 
 
 def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tuple[np.ndarray, PCAMonitor]:
@@ -157,7 +177,9 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     -------
     DataFrame, one row per test case: source (OTM/OTO), signal (raw/difference/combined),
     condition (failure/normal), robot (run id), model (robot label), task, reference (run id of
-    the training robot), features (used), components (k), q_limit, cov_q, nsat, lead_time_days.
+    the training robot), features (used), components (k), q_limit, cov_q, nsat, lead_time_days,
+    test_days, saturated (every test day above the limit). On a normal robot nsat counts false
+    alarms and lead_time_days the time since the first one (:func:`normal_false_alarms`).
 
     Raises
     ------
@@ -166,14 +188,13 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
         normal robot, or has no model with two robots for OTM (the message names the preset).
     """
     runs = []
-    for run_id in dataset.list_runs(path):
-        arrays, attrs = dataset.read_run(path, run_id, names=SCALARS + HISTOGRAMS)
-        try:
-            made = signals(arrays, window)
-        except ValueError as err:
-            raise ValueError(f"{path}: run {run_id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
-        failing = len(attrs["worn_axes"]) > 0 or bool(attrs.get("fault"))
-        runs.append((run_id, attrs["robot"], attrs["task"], "failure" if failing else "normal", made))
+    with reader.open(path) as data:
+        for run in data.runs:
+            try:
+                made = signals({name: run.array(name) for name in SCALARS + HISTOGRAMS}, window)
+            except ValueError as err:
+                raise ValueError(f"{path}: run {run.id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
+            runs.append((run.id, run.robot, run.task, "failure" if run.failing else "normal", made))
     counts = {c: sum(r[3] == c for r in runs) for c in CONDITIONS}
     if not all(counts.values()):
         raise ValueError(f"{path}: the study compares failing and normal robots; this dataset has {counts['failure']} "

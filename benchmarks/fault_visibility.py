@@ -22,25 +22,25 @@ import numpy as np
 
 from analysis.benchmark import fault_progress
 from faultgen import axes
-from faultgen.data import dataset
+from faultgen.data import reader
 
 
 def visibility(path: Path, threshold: float) -> list[dict]:
     """One row per worn run of ``path``: robot, task, worn axis (1..6), samples before the wear and
     failed, change of the worn axis's mean load torque (%) and its z-score."""
     rows = []
-    for run_id in dataset.list_runs(path):
-        arrays, attrs = dataset.read_run(path, run_id, names=("average_load_torque", "friction_multiplier"))
-        if not len(attrs["worn_axes"]):
-            continue
-        axis = axes.index(int(attrs["worn_axes"][0]))
-        wear = (fault_progress(path, run_id, arrays, attrs, axes.number(axis)) - 1.0) * 100.0
-        load = arrays["average_load_torque"][:, axis]
+    with reader.open(path) as data:
+        runs = [(run, fault_progress(run, run.worn_axes[0]), run.array("average_load_torque"))
+                for run in data.failing]
+    for run, grown, loads in runs:
+        axis = axes.index(run.worn_axes[0])
+        wear = (grown - 1.0) * 100.0
+        load = loads[:, axis]
         before, failed = load[wear == 0.0], load[wear >= threshold]
         if before.size < 2 or not failed.size:
             continue
         change = failed.mean() - before.mean()
-        rows.append({"run": run_id, "axis": axes.number(axis), "before": before.size, "failed": failed.size,
+        rows.append({"run": run.id, "axis": axes.number(axis), "before": before.size, "failed": failed.size,
                      "change %": 100.0 * change / before.mean(), "z": change / before.std(ddof=1)})
     return rows
 

@@ -7,6 +7,10 @@ that ``lint-imports`` checks in the test suite):
 sensors, stepping) -> ``data`` (datasets, measured logs) -> ``runs`` (sweeps), ``calibrate`` and
 ``plot`` -> ``cli``; the ``analysis`` package reads the datasets.
 
+The public API, what a user imports from ``faultgen`` (loaded on first use, so ``import
+faultgen`` stays cheap): :data:`PUBLIC` names each, e.g. ``faultgen.open(path)`` (a typed
+:class:`~faultgen.data.reader.Dataset`), ``faultgen.simulate(config)``, ``faultgen.load_robot(name)``.
+
 The modules' first-round names keep working: ``faultgen.robots`` is ``faultgen.model.robots``
 (the same module object), and likewise for :data:`MOVED`.
 """
@@ -57,7 +61,33 @@ class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         module.__spec__ = module.__spec__.loader_state
 
 
+#: The public API: name -> (module, attribute), imported when first used.
+PUBLIC = {
+    "open": ("faultgen.data.reader", "open"),
+    "Dataset": ("faultgen.data.reader", "Dataset"),
+    "Run": ("faultgen.data.reader", "Run"),
+    "DatasetError": ("faultgen.data.dataset", "DatasetError"),
+    "validate": ("faultgen.data.dataset", "validate"),
+    "load_robot": ("faultgen.model.robots", "load"),
+    "available_robots": ("faultgen.model.robots", "available"),
+    "RunConfig": ("faultgen.simulation.stepping", "RunConfig"),
+    "simulate": ("faultgen.simulation.stepping", "simulate"),
+    "write_run": ("faultgen.data.dataset", "write_run"),
+    "Grid": ("faultgen.runs.sweep", "Grid"),
+    "run_sweep": ("faultgen.runs.sweep", "run"),
+    "Fleet": ("faultgen.runs.fleet", "Fleet"),
+}
+__all__ = ["__version__", *PUBLIC]
+
+
+def __dir__():
+    return sorted({*globals(), *PUBLIC})
+
+
 def __getattr__(name):  # ``faultgen.robots`` without importing it first
+    if name in PUBLIC:
+        module, attribute = PUBLIC[name]
+        return getattr(importlib.import_module(module), attribute)
     if name in MOVED:
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -68,6 +68,11 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
         raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {listed}")
     from matplotlib.figure import Figure
 
+    from faultgen.data import reader
+
+    with reader.open(path) as data:
+        if run is None and data.kind == "fleet" and len(ids) > 1:
+            return _draw_fleet(data, out)
     shown = [run] if run is not None else ids
     n_axes = max(dataset.read_run(path, i, names=("friction_multiplier",))[0]["friction_multiplier"].shape[1]
                  for i in shown)  # the most axes of the robots drawn: one panel each, two rows
@@ -84,6 +89,68 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
 
     with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
         fig.savefig(tmp, dpi=110, format="png")
+    return out
+
+
+#: Days at the start of each robot's record that the fleet plot measures the change from.
+BASELINE_DAYS = 5
+
+
+def _draw_fleet(data, out: Path) -> Path:
+    """A fleet (daily records of robots, ``faultgen fleet``): one panel per robot, in file order.
+    Against the day of its record: the change of each axis's mean |motor torque| from its median
+    over the first :data:`BASELINE_DAYS` days (%), as its running median over 7 days (the parts a
+    robot carries change the torque from day to day; the worn axis bold, its days as dots, the
+    others thin grey) and, on a second y axis, the worn axis's true wear (%, red). Healthy robots show their
+    six axes only: what a monitor sees when nothing wears."""
+    import pandas as pd
+    from matplotlib.figure import Figure
+
+    runs = data.runs
+    cols = min(4, len(runs))
+    rows = -(-len(runs) // cols)
+    fig = Figure(figsize=(4.2 * cols, 2.6 * rows + 1.2), layout="constrained")
+    panels = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax, run in zip(panels, runs, strict=False):
+        days = run.recorded
+        torque = run.array("mean_abs_torque")
+        base = np.median(torque[:BASELINE_DAYS], axis=0)
+        change = (torque / np.where(base == 0, 1.0, base) - 1.0) * 100.0
+        worn = [a - 1 for a in run.worn_axes]
+        # the parts a robot carries change its torque from day to day: lines through the days
+        # zigzag, so the days are dots and the line is their running median over a week
+        trend = pd.DataFrame(change).rolling(7, center=True, min_periods=1).median().to_numpy()
+        for j in range(change.shape[1]):
+            if j not in worn:
+                ax.plot(days, trend[:, j], "-", lw=0.7, color="0.65")
+        for j in worn:
+            ax.plot(days, change[:, j], ".", ms=3, color="tab:blue", alpha=0.5)
+            ax.plot(days, trend[:, j], "-", lw=1.6, color="tab:blue", label=f"axis {j + 1}")
+        ax.axhline(0.0, color="0.4", lw=0.6)
+        ax.set_ylabel(CHANGE_LABEL.replace("change of ", "").replace(" [%]", "\nchange [%]"), fontsize=7)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+        state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
+        ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
+                     color=WEAR_COLOR if run.failing else "black")
+        if run.failing:
+            twin = ax.twinx()
+            twin.plot(days, run.fault_level, "-", color=WEAR_COLOR, lw=1.2)
+            twin.set_ylim(bottom=0.0)
+            twin.set_ylabel(WEAR_LABEL, color=WEAR_COLOR, fontsize=7)
+            twin.tick_params(axis="y", colors=WEAR_COLOR, labelsize=7)
+    for ax in panels[len(runs):]:
+        ax.set_visible(False)
+    for ax in panels[max(0, len(runs) - cols):len(runs)]:
+        ax.set_xlabel("day of the record", fontsize=8)
+    fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
+                 f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running median "
+                 "over 7 days (blue: the worn axis, its days as dots; grey: the other axes); red: the worn axis's true "
+                 "wear", fontsize=10)
+    from faultgen.data.atomic import atomic_path
+
+    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
+        fig.savefig(tmp, dpi=100, format="png")
     return out
 
 

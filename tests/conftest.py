@@ -40,3 +40,25 @@ def shared_sweep(tmp_path_factory, worker_id):
         return out
 
     return build
+
+
+@pytest.fixture(scope="session")
+def shared_fleet(tmp_path_factory, worker_id):
+    """``shared_fleet(name, **settings)``: the path of a fleet (``faultgen.runs.fleet.Fleet``)
+    built once per test session, as :func:`shared_sweep` builds sweeps."""
+    from faultgen.runs.fleet import Fleet
+
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "shared-sweeps"
+    folder.mkdir(exist_ok=True)
+
+    def build(name: str, **settings) -> Path:
+        out = folder / f"{name}.h5"
+        with FileLock(folder / f"{name}.build-lock"):
+            if not out.exists():
+                sweep.run(Fleet(**settings), out, jobs=1, progress=False)
+        return out
+
+    return build

@@ -1,6 +1,7 @@
 """analysis.benchmark and the bench-isolators / detect / classify commands on a small real dataset."""
 
 import h5py
+from sklearn.base import BaseEstimator
 import numpy as np
 import pandas as pd
 import pytest
@@ -178,6 +179,10 @@ def test_on_a_quick_like_dataset_each_command_prints_a_table_or_what_the_data_la
     assert "note: this dataset lacks runs without wear of other seeds" in " ".join(result.output.split())
     assert "--seed 0 --seed 1 --seed 2" in result.output
     table = pd.read_csv(tmp_path / "det.csv")
+    # issue 40: the header says what false_alarm_pct measured under the protocol the rows used
+    assert set(table["protocol"]) == {"same-run (in-sample)"}
+    assert "summary (false_alarm_pct, %: same-run (in-sample): the training run itself: in-sample" in result.output
+    assert "did not learn from" not in result.output.split("summary (")[1].splitlines()[0]
     printed = [line for line in result.output.splitlines() if line.startswith("| irb6700")]
     assert len(printed) == len(table) == 2
     for line, located in zip(printed, table["located_axis"], strict=True):
@@ -374,3 +379,22 @@ def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypa
         benchmark.classification_table(small, progress=False, horizon=30)
     with pytest.raises(ValueError, match="horizon = -1: expected an integer >= 0"):
         benchmark.classification_table(small, progress=False, horizon=-1)
+
+
+class NeverDecides(BaseEstimator):
+    """An isolator that names no axis, ever (issue 40: it scored 100 % on "no fault" unexplained)."""
+
+    def fit(self, X, y=None):
+        self.source_axis_ = 0
+        return self
+
+
+def test_an_isolator_that_never_decides_is_shown_undecided_not_just_right_on_healthy_runs(small):
+    isolators = {"never": NeverDecides(), "trend": isolation.make("trend")}
+    table = benchmark.isolation_table(small, isolators, levels=(20.0,), progress=False)
+    assert set(table.loc[table["isolator"] == "never", "answer"]) == {"undecided"}
+    accuracy, decided = benchmark.isolation_accuracy(table), benchmark.isolation_decided(table)
+    assert accuracy.loc[("pick_place", 0.0), "never"] == 100.0  # right on the healthy run, by never deciding
+    assert decided.loc[("pick_place", 0.0), "never"] == 0.0 and decided.loc[("pick_place", 20.0), "never"] == 0.0
+    assert decided.loc[("pick_place", 20.0), "trend"] == 100.0
+    assert "never decides scores 100 % on \"no fault\"" in benchmark.isolation_markdown(table, marked="trend")

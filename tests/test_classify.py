@@ -416,3 +416,55 @@ def test_evaluate_gives_table_5_2_layout():
     with pytest.raises(ValueError, match="needs the estimated quantities"):
         classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], preprocessing=["+estM"],
                           n_pairs=1)
+
+
+def test_evaluate_fits_each_preprocessing_once_per_pair_and_gives_the_per_cell_aucs_in_parallel():
+    """Issue 40: one job per held-out pair, every cell of it on a preprocessing fitted once, on two
+    processes: the same AUC in every cell as Procedure 1 run cell by cell with whole pipelines."""
+    X, y, groups, failed, normal = runs(n_failed=4, n_normal=3, n_cycles=18)
+    names = ["control", "+diff+pca+var3", "+diff+var3+pca"]
+    _, aucs = classify.evaluate(X, y, groups, failed, normal, preprocessing=names, n_pairs=3, random_state=0,
+                                n_jobs=2, return_aucs=True)
+    for (column, name), got in aucs.items():
+        expected = classify.leave_pair_out_auc(classify.make_pipeline(column, name), X, y, groups, failed, normal,
+                                               n_pairs=3, random_state=0)
+        np.testing.assert_array_equal(got, expected)
+    assert not np.array_equal(aucs["lr", "+diff+pca+var3"], aucs["lr", "+diff+var3+pca"])  # order is step order
+    assert classify.describe_preprocessing("+diff+pca+var3").index("PCA") < \
+        classify.describe_preprocessing("+diff+pca+var3").index("windows of 3")
+
+
+def test_stacking_cross_validates_by_run_never_splitting_one():
+    from sklearn.ensemble import StackingClassifier
+
+    X, y, groups, failed, normal = runs(n_failed=4, n_normal=4, n_cycles=12)
+    labels = classify.make_labels(y, groups, failed)
+    model = classify.fit_by_run(classify.make_pipeline("stacking"), X, labels, groups)
+    stack = model[-1]
+    assert isinstance(stack, StackingClassifier) and len(stack.cv) == 5
+    tested = np.concatenate([test for _, test in stack.cv])
+    assert sorted(tested) == list(range(len(y)))  # every sample out of fold once
+    for train, test in stack.cv:
+        assert not set(groups[train]) & set(groups[test])  # a run's days all on one side
+
+
+def test_classification_outputs_a_tidy_table_and_a_caption_with_the_chance_level(tmp_path):
+    from analysis import benchmark
+
+    X, y, groups, failed, normal = runs(n_failed=4, n_normal=4, n_cycles=16)
+    table = classify.evaluate(X, y, groups, failed, normal, classifiers=["lr", "svm"], preprocessing=["control", "+diff"],
+                              n_pairs=4)
+    tidy = benchmark.classification_tidy(table)
+    tidy.to_csv(tmp_path / "t.csv", index=False)
+    back = pd.read_csv(tmp_path / "t.csv")
+    assert list(back.columns) == ["preprocessing", "steps", "classifier", "auc_mean", "auc_std"] and len(back) == 4
+    assert back.set_index(["preprocessing", "classifier"]).loc[("+diff", "svm"), "auc_mean"] == \
+        pytest.approx(table.loc["+diff", ("svm", "mean")])
+    caption = benchmark.classification_caption(table, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
+                                               chance=None, command="faultgen classify x.h5")
+    assert "Chance level not measured: `faultgen classify x.h5 --permutations 19`" in caption
+    chance = {"cell": "lr control", "permutations": 5, "null": 0.81, "auc": 0.9, "p": 0.33}
+    caption = benchmark.classification_caption(table, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
+                                               chance=chance, command="faultgen classify x.h5")
+    assert "0.81, not 0.5" in caption and "+diff+pca+var3 concatenates windows of PCA scores" in caption
+    assert benchmark.classification_heatmap(table, tmp_path / "h.png", chance).stat().st_size > 0

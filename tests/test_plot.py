@@ -161,3 +161,24 @@ def test_invalid_files_raise_dataset_error(tmp_path):
 def test_importing_the_module_does_not_import_matplotlib():
     code = "import sys, faultgen.plot; assert 'matplotlib' not in sys.modules, 'matplotlib imported'"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_a_fleet_is_drawn_per_robot_with_its_wear_against_the_day(shared_fleet, tmp_path, figures):
+    """Issue 40: `faultgen plot fleet.h5` drew the sweep's wear-vs-change panels (zigzag lines
+    between robots, an axis no robot wears left empty, the title cut). Now one panel per robot."""
+    import faultgen
+
+    fleet = shared_fleet("reader-fleet", size=4, failing=2, days=24, cycles_per_day=1)
+    out = plot(fleet, tmp_path / "fleet.png")
+    assert_png(out)
+    (fig,) = figures
+    shown = [ax for ax in fig.axes if ax.get_visible() and ax.get_title()]
+    with faultgen.open(fleet) as data:
+        assert [ax.get_title().splitlines()[0] for ax in shown] == [run.id for run in data.runs]
+        for ax, run in zip(shown, data.runs, strict=True):
+            x = ax.lines[0].get_xdata()
+            np.testing.assert_array_equal(x, run.recorded)  # against the day of the record
+            if run.failing:  # the twin axis carries the true wear
+                twin = [t for t in fig.axes if t is not ax and t.bbox.bounds == ax.bbox.bounds]
+                np.testing.assert_allclose(twin[0].lines[0].get_ydata(), run.fault_level)
+    assert fig.get_layout_engine() is not None  # constrained: the title is laid out, not cut

@@ -19,6 +19,7 @@ def test_descriptors_by_hand():
     assert d["lead_time_days"] == 3  # first above the limit on test day 3 of 5: days 3, 4, 5 left
     assert d["cov_q"] == pytest.approx(np.std(q, ddof=1) / 3.0)
     assert ts.descriptors(q, limit=10.0)["lead_time_days"] == 0
+    assert not d["saturated"] and d["test_days"] == 5 and ts.descriptors(q, limit=0.5)["saturated"]
 
 
 def test_signals_by_hand():
@@ -134,3 +135,12 @@ def test_training_source_command_on_a_small_fleet(tmp_path):
     oto = cases[cases["source"] == "OTO"]
     assert (oto["robot"] == oto["reference"]).all()
     assert "Tukey HSD" in result.output and "Three-way ANOVA" in result.output
+    # issue 40: a normal robot's days above the limit are reported as false alarms, a saturated limit flagged
+    assert "Normal robots never fail: their days above the limit are false alarms" in result.output
+    table = ts.normal_false_alarms(cases)
+    normal = cases[cases["condition"] == "normal"]
+    for (source, signal), row in table.iterrows():
+        mine = normal[(normal["source"] == source) & (normal["signal"] == signal)]
+        assert row["false_alarm_pct"] == pytest.approx((100 * mine["nsat"] / 3).mean(), abs=0.05)
+        assert row["saturated"] == (mine["nsat"] == 3).sum()
+    assert ("the limit is saturated in" in result.output) == bool((normal["nsat"] == 3).any())

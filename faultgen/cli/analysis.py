@@ -26,18 +26,6 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
                          "runs with runs without wear; sweep with --axis 1..6 too")
 
 
-def table_command(file: Path, out: Path | None, overwrite: bool, suffix: str, digits: int, compute) -> None:
-    """Validate ``file``, compute a table, write it as CSV and Markdown, print it."""
-    from analysis import benchmark
-
-    stem = out or file.with_name(file.stem + suffix)
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md")], overwrite)
-    table = compute()
-    written = benchmark.write_outputs(table, stem)
-    typer.echo(benchmark.markdown(table, digits=digits))
-    typer.echo("wrote " + ", ".join(map(str, written)))
-
-
 @app.command("bench-isolators", cls=Command)
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
@@ -95,7 +83,11 @@ def bench_isolators_command(
     accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
     typer.echo(benchmark.markdown(accuracy, digits=4))
     typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
-               "isolation)")
+               "isolation). In the CSV, predicted 0 is undecided and -1 too few cycles (column answer spells it).")
+    typer.echo("\ncases in which each isolator named an axis, right or wrong (%); one that never decides scores 100 % on "
+               "\"no fault\" and 0 % elsewhere:")
+    typer.echo(benchmark.markdown(benchmark.isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct"),
+                                  digits=4))
     starved = benchmark.starved_isolators(table)
     if starved:
         typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
@@ -135,9 +127,11 @@ def detect_command(
     progress: Progress = True,
 ) -> None:
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout, with the
-    false-alarm rate on healthy runs the monitor did not learn from; summary per task and axis.
+    false-alarm rate on healthy runs; summary per task and axis. No detection is counted before the
+    fault begins: alarms before it are false alarms (column alarms_before_fault_pct).
 
-    Writes OUT.csv and OUT.md (per run) and OUT-summary.csv (per task, per worn axis, all).
+    Writes OUT.csv and OUT.md (per run), OUT-summary.csv (per task, per worn axis, all) and OUT.png
+    (the Q and T2 charts of each worn run with their limits, the fault's start and the onset).
 
     Example:
 
@@ -148,23 +142,23 @@ def detect_command(
 
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), summary_csv], overwrite)
-    table = benchmark.detection_table(
+    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv],
+                   overwrite)
+    table, charts = benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
         detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
-        limit_folds=limit_folds or None)
+        limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
     written = benchmark.write_outputs(table, stem)
     summary.to_csv(summary_csv)
     typer.echo(benchmark.markdown(table, digits=4))
-    typer.echo("\nsummary (false_alarm_pct: alarms on healthy runs the monitor did not learn from, %):")
+    typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
+    typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
     typer.echo(benchmark.markdown(summary, digits=4))
-    held_in = table[table["protocol"] != "other-seeds"]
-    if protocol == "auto" and len(held_in):
-        typer.echo(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} runs "
-                   f"were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. For "
-                   "false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset quick "
-                   "--seed 0 --seed 1 --seed 2`")
+    advice = benchmark.detection_advice(table, protocol)
+    if advice:
+        typer.echo(advice)
+    written.append(benchmark.detection_figure(charts, stem.with_suffix(".png")))
     typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
 
 
@@ -210,7 +204,18 @@ def training_source_command(
                      progress=progress)
     parts = ["Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
              "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
-             + benchmark.markdown(ts.group_means(cases))]
+             + benchmark.markdown(ts.group_means(cases)),
+             "Normal robots never fail: their days above the limit are false alarms (nsat) and their lead_time_days "
+             "only how early the first false alarm came. Per training source and signal, their false-alarm share "
+             "of the test days and the cases whose limit is saturated (every test day above it):\n\n"
+             + benchmark.markdown(ts.normal_false_alarms(cases))]
+    saturated = cases[cases["saturated"] & (cases["condition"] == "normal")]
+    if len(saturated):
+        parts.append(f"Note: the limit is saturated in {len(saturated)} of {int((cases['condition'] == 'normal').sum())} "
+                     "normal-robot cases (all their test days above it: "
+                     + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
+                     + "); there the model does not describe the robot, and a failing robot's alarms in the same "
+                     "cell say nothing about its fault")
     tukey = None
     try:
         anova, tukey = ts.anova(cases), ts.tukey(cases)
@@ -255,11 +260,18 @@ def classify_command(
         "--preprocessing", help="Only this row of Table 5.2 (control, +diff, +estM+diff+var3+pca, ...); repeat for "
         "several. Default all.")] = None,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
+    chance: Annotated[bool, typer.Option(
+        help="Without --permutations, estimate the chance level cheaply on one cell (lr control, "
+        "5 label exchanges, about a tenth of the table's time) and give it in the caption.")] = True,
+    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0)] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout.
+
+    Writes OUT.csv (tidy: one row per cell), OUT.md (the table with its caption) and OUT.png (a
+    heatmap coloured around the chance level).
 
     A sample is a recorded cycle (a day in a fleet). Its features per axis are those of thesis
     Table 5.1: the speed and torque indicators (the axis's average speed and mean load over its
@@ -283,11 +295,29 @@ def classify_command(
       faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
       faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
     """
+    import shlex
+
     from analysis import benchmark
 
     cells = {"classifiers": classifiers} if classifiers else {}
     if preprocessing:
         cells["preprocessing"] = preprocessing
-    table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(
+    stem = out or file.with_name(file.stem + "-classification")
+    analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
+    table = benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
-        horizon=horizon, permutations=permutations, matched=matched_days, **cells))
+        horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1, **cells)
+    estimate = table.attrs.get("chance")
+    command = " ".join(["faultgen classify", shlex.quote(str(file)), *([f"--horizon {horizon}"] if horizon is not None else []),
+                        *(["--matched-days"] if matched_days else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
+                        *(f"--classifier {c}" for c in classifiers or []),
+                        *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
+    caption = benchmark.classification_caption(table, n_pairs=pairs or None, horizon=horizon,
+                                               wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
+                                               command=command)
+    text = benchmark.markdown(table, digits=3) + "\n\n" + caption
+    benchmark.classification_tidy(table).to_csv(stem.with_suffix(".csv"), index=False)
+    stem.with_suffix(".md").write_text(text + "\n")
+    benchmark.classification_heatmap(table, stem.with_suffix(".png"), estimate)
+    typer.echo(text)
+    typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))

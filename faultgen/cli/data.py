@@ -13,16 +13,27 @@ from faultgen.cli.options import Overwrite
 
 
 @app.command("info", cls=Command)
-def info_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
+def info_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")],
+    show_card: Annotated[bool, typer.Option(
+        "--card", help="Print the dataset card instead (Markdown): what 20 % wear means physically, label "
+        "definitions, units, histogram bin edges, the command, versions.")] = False,
+) -> None:
     """Summarise a dataset: runs, robots, tasks, worn axes, cycles, provenance.
 
-    Example:
+    Examples:
 
     \b
       faultgen info quick.h5
+      faultgen info quick.h5 --card > quick-card.md
     """
     from faultgen.data import dataset
 
+    if show_card:
+        from faultgen.data.card import card
+
+        typer.echo(card(file))
+        return
     typer.echo(dataset.summary(file))
 
 

@@ -347,7 +347,7 @@ def summary(result, out: Path) -> str:
         if config.conditions.payloads is not None:
             lines.append("  payload mass per cycle [kg]: " + " ".join(f"{m:g}" for m in c.payload_mass[:12])
                          + (" ..." if len(c.payload_mass) > 12 else ""))
-    lines.append(f"read it with: python -c \"from faultgen import dataset; a, labels = dataset.read_run('{out}')\"")
+    lines.append(f"read it with: python -c \"import faultgen; run = faultgen.open('{out}').runs[0]; print(run, run.wear.max())\"")
     return "\n".join(lines)
 
 

@@ -448,40 +448,10 @@ def features(path: str | Path) -> pd.DataFrame:
     DatasetError
         If ``path`` is not a finished faultgen dataset.
     """
-    import pandas as pd
+    from faultgen.data import reader  # the typed reader builds the table, with the file opened once
 
-    per_cycle = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis"]
-    histograms = [name for name, (_, axes, _) in ARRAYS.items() if axes == "cycle, axis, bin"]
-    frames = []
-    with_duty = runs_with(path, DUTY_ARRAYS)
-    for run_id in list_runs(path):
-        duty = list(DUTY_ARRAYS) if run_id in with_duty else []
-        arrays, attrs = read_run(path, run_id, names=("cycles", *per_cycle, *duty, *histograms))
-        n_cycles, n_axes = arrays["friction_multiplier"].shape
-        present = _condition_arrays(json.loads(attrs["conditions"]) if "conditions" in attrs else None)
-        conditions = read_run(path, run_id, names=present)[0] if present else {}
-        worn = {int(a) for a in attrs["worn_axes"]}
-        columns = {"run": run_id, **{key: attrs[key] for key in FEATURE_LABELS},
-                   "worn_axes": " ".join(str(a) for a in sorted(worn)),
-                   "cycle": np.repeat(arrays["cycles"], n_axes), "axis": np.tile(np.arange(1, n_axes + 1), n_cycles),
-                   "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
-                   "wear_pct": ((arrays["friction_multiplier"] - 1.0) * 100.0).ravel()}
-        columns.update({name: arrays[name].ravel() for name in (*per_cycle, *duty)})
-        for name, values in conditions.items():  # per cycle, per axis or per unit, to rows
-            axes = CONDITION_ARRAYS[name][1]
-            columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)
-                             if axes == "cycle" else np.tile(values, n_cycles))
-        for name in histograms:
-            bins = arrays[name].reshape(n_cycles * n_axes, -1)
-            columns.update({f"{name}_{k + 1}": bins[:, k] for k in range(bins.shape[1])})
-        frames.append(pd.DataFrame(columns))
-    table = pd.concat(frames, ignore_index=True)
-    table.attrs["units"] = {"wear_pct": "%", **{name: ARRAYS[name][0] for name in per_cycle},
-                            **{name: DUTY_ARRAYS[name][0] for name in DUTY_ARRAYS if name in table},
-                            **{name: CONDITION_ARRAYS[name][0] for name in CONDITION_ARRAYS if name in table},
-                            **{c: ARRAYS[c.rsplit("_", 1)[0]][0] for c in table.columns
-                               if c.rsplit("_", 1)[0] in histograms}}
-    return table
+    with reader.open(path) as data:
+        return data.features()
 
 
 def export_features(path: str | Path, out: str | Path) -> Path:

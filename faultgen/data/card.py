@@ -1,0 +1,124 @@
+"""A dataset card: what a faultgen dataset holds and what its numbers mean, as Markdown.
+
+``faultgen info FILE --card`` prints it. Built from the file (labels, the command, the version
+that wrote it), the robot models it names (friction, joint ranges, torque limits) and the
+schema tables of :mod:`faultgen.data.dataset`, so it cannot drift from what is stored.
+"""
+
+from __future__ import annotations
+
+import platform
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import __version__
+from faultgen.data import dataset, reader
+from faultgen.simulation import sensors
+
+#: The wear level the card explains in physical terms.
+EXAMPLE_WEAR = 20.0
+
+
+def _version(name: str) -> str:
+    try:
+        return version(name)
+    except PackageNotFoundError:
+        return "not installed"
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def _table(head, rows) -> list[str]:
+    return [_row(head), "|" + " --- |" * len(head), *(_row(r) for r in rows)]
+
+
+def card(path: str | Path) -> str:
+    """The card of the dataset at ``path``, Markdown: contents, what ``EXAMPLE_WEAR`` % wear means
+    physically per robot and axis, label definitions, units of every stored array, histogram bin
+    edges, the command that wrote it and the versions.
+
+    Raises
+    ------
+    faultgen.data.dataset.DatasetError
+        If ``path`` is not a finished faultgen dataset.
+    """
+    from faultgen.model import robots
+    from faultgen.operation import tasks
+
+    with reader.open(path) as data:
+        runs = data.runs
+        names = sorted({name for run in runs for name in run.names})
+        kind, command, written_by = data.kind, data.command, data.faultgen_version
+        shas = {run.robot: run.provenance["model_sha256"] for run in runs}
+    robot_names = sorted({r.robot for r in runs})
+    pairs = sorted({(r.robot, r.task) for r in runs})
+    lines = [f"# Dataset card: {Path(path).name}", "",
+             f"A faultgen {kind}: {len(runs)} run(s) ({sum(r.failing for r in runs)} with wear or a fault), robots "
+             f"{', '.join(robot_names)}, tasks {', '.join(sorted({r.task for r in runs}))}; a sample is "
+             + ("a day's record (the day's maximum of its cycles)" if any(r.sample == "day" for r in runs)
+                else "one recorded cycle") + ".", ""]
+
+    lines += [f"## What {EXAMPLE_WEAR:g} % wear means", "",
+              f"Wear multiplies an axis's Coulomb and static friction: {EXAMPLE_WEAR:g} % wear is "
+              f"{1 + EXAMPLE_WEAR / 100:g} times the new gearbox's (`friction_multiplier` "
+              f"{1 + EXAMPLE_WEAR / 100:g}; wear_pct = (friction_multiplier - 1) x 100). Viscous friction is "
+              "unchanged. Per axis, the Coulomb friction (positive direction) new and its increase, at the motor "
+              "and at the arm joint (times the gear ratio), the model's nominal values (with a unit spread, "
+              "`dry_friction_factor` scales each unit's):", ""]
+    rows = []
+    for name in robot_names:
+        robot = robots.load(name)
+        for a in range(len(robot.gear_ratio)):
+            coulomb = float(robot.friction.coulomb_pos[a])
+            rise = coulomb * EXAMPLE_WEAR / 100
+            rows.append([name, a + 1, f"{coulomb:.3g}", f"+{rise:.3g}", f"{robot.gear_ratio[a]:.4g}",
+                         f"+{rise * robot.gear_ratio[a]:.3g}",
+                         f"{100 * rise / float(robot.motor_torque_limit[a]):.2g}"])
+    lines += _table(["robot", "axis", "Coulomb new, N m (motor)", f"+{EXAMPLE_WEAR:g} %, N m (motor)", "gear ratio",
+                     f"+{EXAMPLE_WEAR:g} %, N m (arm)", "% of peak motor torque"], rows)
+
+    lines += ["", "## Labels", "",
+              "- `worn_axes`: axes (1-based) that wear or carry the fault; none: a healthy run (a normal robot).",
+              "- `wear_pct` / `Run.wear`: true wear of each axis per sample, % (above); `Run.fault_level`: the "
+              "fault's growth, % (friction wear: the worn axis's wear; another fault: its parameter's share of "
+              "its final change).",
+              "- `Run.fault_begins`: the first sample with the fault above 0; alarms before it are false alarms.",
+              "- `fault`: a fault other than friction wear (effect, parameter, axis, start, final).",
+              "- `seed`: the unit (noise and draws); in a fleet each robot has its own.",
+              "- `conditions`: operating conditions (temperature, parts, task mix, unit spread), when on.", ""]
+
+    lines += ["## Arrays and units", ""]
+    rows = [[name, *reader.SCHEMA[name]] for name in names if name in reader.SCHEMA]
+    lines += _table(["array", "units", "axes", "description"], rows)
+
+    lines += ["", "## Histogram bin edges", "",
+              f"Each histogram has {sensors.HISTOGRAM_BINS} equal bins; values are fractions of the samples of the "
+              "cycle (a day's record: of its maximum cycle). Edges per axis, lowest to highest:", ""]
+    rows = []
+    for name in robot_names:
+        robot = robots.load(name)
+        low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
+        rows.append([name, "", "angle_hist", "rad", "joint range: " + "; ".join(
+            f"{lo:.3g}..{hi:.3g}" for lo, hi in zip(low, high, strict=True))])
+        rows.append([name, "", "torque_hist", "N m (motor)", "0..peak motor torque: " + "; ".join(
+            f"0..{t:.3g}" for t in robot.motor_torque_limit)])
+    for name, task in pairs:
+        limit = tasks.load(name, task).velocity_limit
+        rows.append([name, task, "speed_hist", "rad/s (arm)", "0..the task's speed limit: " + "; ".join(
+            f"0..{v:.3g}" for v in limit)])
+    lines += _table(["robot", "task", "histogram", "units", f"range per axis 1..N, split in {sensors.HISTOGRAM_BINS}"],
+                    rows)
+
+    lines += ["", "## Provenance and versions", "",
+              f"- command: `{command or '(not stored)'}`",
+              f"- written by faultgen {written_by}; this card by faultgen {__version__}",
+              "- robot models (SHA-256 of the MJCF): " + "; ".join(f"{k} {v[:12]}" for k, v in sorted(shas.items())),
+              f"- Python {platform.python_version()}, MuJoCo {_version('mujoco')}, numpy {np.__version__}, "
+              f"h5py {_version('h5py')}",
+              f"- reading: `import faultgen; data = faultgen.open({str(path)!r})`; `data.runs`, `data.features()`",
+              f"- schema: format {dataset.FORMAT} version {dataset.FORMAT_VERSION}; docs/dataset.md"]
+    return "\n".join(lines)

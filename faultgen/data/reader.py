@@ -1,0 +1,351 @@
+"""Typed reading of a faultgen dataset: :func:`open` gives a :class:`Dataset` of :class:`Run` records.
+
+The HDF5 layout (:mod:`faultgen.data.dataset`, docs/dataset.md) stays behind this module: a run's
+labels are typed fields (tuples of 1-based axes, parsed JSON, ints), its per-cycle truth and
+features are arrays read when first asked for, and the file is opened once for all reads::
+
+    import faultgen
+
+    with faultgen.open("quick.h5") as data:
+        for run in data.runs:
+            print(run.id, run.robot, run.task, run.worn_axes, run.wear.max())   # wear: (cycles, axes), %
+        table = data.features()                                                 # tidy, one row per cycle and axis
+
+Arrays are named as in :data:`faultgen.data.dataset.ARRAYS` (and the duty, count, condition and
+fault tables beside it); :meth:`Run.array` reads any of them, :meth:`Run.signal` the 250 Hz
+signals (``tau_m``, ``q_a``, ...), and each read is cached on the run.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator, Sequence
+from contextlib import ExitStack
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from faultgen.data import dataset
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: Every array a run group may hold -> (units, axes, description), from the tables of
+#: :mod:`faultgen.data.dataset`.
+SCHEMA: dict[str, tuple[str, str, str]] = {
+    **dataset.ARRAYS, **dataset.DUTY_ARRAYS, **dataset.COUNT_ARRAYS,
+    **{name: spec[:3] for name, spec in dataset.CONDITION_ARRAYS.items()}, **dataset.FAULT_ARRAYS,
+}
+
+
+def _json(value) -> Any:
+    value = dataset._attr(value)
+    return json.loads(value) if isinstance(value, str) and value else None
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of a dataset: a simulated robot unit doing one task (in a fleet, one robot's record).
+
+    Attributes
+    ----------
+    id : str
+        The run's name in the file (``/runs/<id>``).
+    robot, task, friction_model : str
+        Robot model, task program and friction model (labels).
+    seed : int
+        The unit's seed (noise, draws).
+    cycles : int
+        Cycles simulated (a fleet: days times cycles per day).
+    worn_axes : tuple of int
+        Axes (1-based, ``faultgen.axes``) that wear or carry the fault; empty for a healthy run.
+    wear_schedule : dict
+        The wear schedule as written (``faultgen.operation.wear``: kind, per-axis final wear, ...).
+    fault : dict or None
+        A fault other than friction wear (``faultgen.operation.faults``: effect, parameter, axis,
+        start, final, ...), None for friction wear or none.
+    conditions : dict or None
+        Operating conditions (``faultgen.operation.conditions``), None without.
+    noise : dict
+        Sensor noise settings.
+    sample : {"cycle", "day"}
+        What a recorded sample is: one cycle, or a day's record (fleets).
+    has_signals : bool
+        Whether the 250 Hz signals are stored (False: features and truth only).
+    provenance : dict
+        faultgen_version, model_sha256, log_period (s), command, config (parsed JSON).
+    """
+
+    id: str
+    robot: str
+    task: str
+    friction_model: str
+    seed: int
+    cycles: int
+    worn_axes: tuple[int, ...]
+    wear_schedule: dict = field(repr=False)
+    fault: dict | None
+    conditions: dict | None = field(repr=False)
+    noise: dict = field(repr=False)
+    sample: str
+    has_signals: bool
+    provenance: dict = field(repr=False)
+    _source: Dataset | None = field(default=None, repr=False, compare=False)
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def failing(self) -> bool:
+        """Whether the run wears or carries a fault (a failing robot of a fleet)."""
+        return bool(self.worn_axes) or self.fault is not None
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The arrays this run holds, in file order."""
+        return tuple(self._group())
+
+    def _group(self):
+        if self._source is None:
+            raise dataset.DatasetError(f"run {self.id!r} is not attached to an open dataset")
+        return self._source._group(self.id)
+
+    def array(self, name: str) -> np.ndarray:
+        """The stored array ``name`` (:data:`SCHEMA`: units and axes), read on first use, cached.
+
+        Raises
+        ------
+        faultgen.data.dataset.DatasetError
+            If the run has no such array (the message says why, e.g. recorded without signals),
+            or the dataset was closed.
+        """
+        if name not in self._cache:
+            group = self._group()
+            if name not in group:
+                why = ""
+                if not self.has_signals and SCHEMA.get(name, ("", ""))[1] == dataset.SIGNAL_AXES:
+                    why = ("; it was recorded without signals (features only): simulate it again with signals "
+                           "(`faultgen sweep` without --features-only)")
+                raise dataset.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}{why}")
+            value = group[name][()]
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise dataset.DatasetError(f"{self._source.path}: run {self.id!r}: {name} holds non-finite values; the "
+                                           f"file is corrupted (faultgen validate {self._source.path})")
+            self._cache[name] = value
+        return self._cache[name]
+
+    def has(self, *names: str) -> bool:
+        """Whether the run holds every array of ``names``."""
+        group = self._group()
+        return all(name in group for name in names)
+
+    def signal(self, name: str = "tau_m") -> np.ndarray:
+        """A 250 Hz signal, ndarray of shape (n_cycles, n_log, n_axes) in its units (:data:`SCHEMA`)."""
+        if SCHEMA.get(name, ("", ""))[1] != dataset.SIGNAL_AXES:
+            raise ValueError(f"{name!r} is not a 250 Hz signal; expected one of: "
+                             + ", ".join(n for n, s in SCHEMA.items() if s[1] == dataset.SIGNAL_AXES))
+        return self.array(name)
+
+    @property
+    def recorded(self) -> np.ndarray:
+        """1-based index of each recorded cycle, ndarray of int of shape (n_cycles,)."""
+        return self.array("cycles")
+
+    @property
+    def wear(self) -> np.ndarray:
+        """True friction wear per recorded cycle and axis, ndarray of shape (n_cycles, n_axes), in %:
+        ``(friction_multiplier - 1) * 100``; 20 % is Coulomb and static friction 1.2 times new."""
+        return (self.array("friction_multiplier") - 1.0) * 100.0
+
+    @property
+    def fault_level(self) -> np.ndarray:
+        """Per recorded cycle, how far the run's fault has grown, %: the worn axis's friction wear
+        (the largest over its worn axes), or for a fault other than friction wear its parameter's
+        change as a share of its final change (0 % at ``start``, 100 % at ``final``). Zeros for a
+        healthy run. ndarray of shape (n_cycles,)."""
+        if self.fault is not None:
+            value = self.array("fault_value")
+            return 100.0 * (value - self.fault["start"]) / (self.fault["final"] - self.fault["start"])
+        if not self.worn_axes:
+            return np.zeros(len(self.recorded))
+        return self.wear[:, [a - 1 for a in self.worn_axes]].max(axis=1)
+
+    @property
+    def fault_begins(self) -> int | None:
+        """Index (0-based) of the first recorded sample at which the fault has begun (``fault_level
+        > 0``), None for a healthy run or one whose fault never starts within the record."""
+        grown = np.flatnonzero(self.fault_level > 1e-9)
+        return int(grown[0]) if self.failing and grown.size else None
+
+
+def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
+    config = _json(attrs.get("config")) or {}
+    return Run(
+        id=run_id, robot=str(attrs["robot"]), task=str(attrs["task"]), friction_model=str(attrs["friction_model"]),
+        seed=int(attrs["seed"]), cycles=int(attrs["cycles"]),
+        worn_axes=tuple(int(a) for a in np.atleast_1d(attrs["worn_axes"])),
+        wear_schedule=_json(attrs.get("wear")) or {}, fault=_json(attrs.get("fault")),
+        conditions=_json(attrs.get("conditions")), noise=_json(attrs.get("noise")) or {},
+        sample=str(attrs.get("sample", "cycle")), has_signals=bool(attrs.get("signals", True)),
+        provenance={"faultgen_version": str(attrs.get("faultgen_version", "")),
+                    "model_sha256": str(attrs.get("model_sha256", "")),
+                    "log_period": float(attrs.get("log_period", np.nan)), "command": str(attrs.get("command", "")),
+                    "config": config},
+        _source=source)
+
+
+class Dataset(Sequence):
+    """A finished faultgen dataset, opened once (read-only); a sequence of its :class:`Run`.
+
+    Use as a context manager (``with faultgen.open(path) as data:``) or call :meth:`close`. Runs
+    are listed at opening (labels only); their arrays are read when asked for.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+    runs : tuple of Run
+        In file order.
+    command : str
+        The command that wrote the file.
+    faultgen_version : str
+        The version that wrote it.
+    grid : dict or None
+        The sweep's grid or the fleet's settings (parsed JSON), None if not stored.
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self._stack = ExitStack()
+        self._file = self._stack.enter_context(dataset._open(self.path))
+        attrs = self._file.attrs
+        self.command = str(dataset._attr(attrs.get("command", "")))
+        self.faultgen_version = str(dataset._attr(attrs.get("faultgen_version", "")))
+        self.grid = _json(attrs.get("grid"))
+        runs = []
+        for run_id in self._file["runs"]:
+            group = self._file["runs"][run_id]
+            problems = dataset._attribute_problems(group)  # labels that do not parse: named, not a crash
+            if problems:
+                self.close()
+                raise dataset.DatasetError(f"{self.path}: run {run_id!r}: {problems[0]} (faultgen validate {self.path} "
+                                           "lists every problem)")
+            runs.append(_run(run_id, {k: dataset._attr(v) for k, v in group.attrs.items()}, self))
+        self.runs: tuple[Run, ...] = tuple(runs)
+        self._by_id = {run.id: run for run in self.runs}
+
+    def _group(self, run_id: str):
+        if self._file is None:
+            raise dataset.DatasetError(f"{self.path} is closed; read runs inside `with faultgen.open(...)`")
+        return self._file["runs"][run_id]
+
+    def close(self) -> None:
+        """Close the file (runs keep what they read)."""
+        self._stack.close()
+        self._file = None
+
+    def __enter__(self) -> Dataset:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __len__(self) -> int:
+        return len(self.runs)
+
+    def __getitem__(self, key):
+        """A run by position (int, slice) or by id (str); raises KeyError naming the runs."""
+        if isinstance(key, str):
+            if key not in self._by_id:
+                raise KeyError(f"{self.path} has no run {key!r}; runs: {', '.join(list(self._by_id)[:10])}")
+            return self._by_id[key]
+        return self.runs[key]
+
+    def __iter__(self) -> Iterator[Run]:
+        return iter(self.runs)
+
+    def __repr__(self) -> str:
+        return f"<faultgen.Dataset {self.path} ({len(self.runs)} runs, {self.kind})>"
+
+    @property
+    def kind(self) -> str:
+        """"fleet" (daily records of robots, `faultgen fleet`), "sweep" or "run" (one run)."""
+        if isinstance(self.grid, dict) and "fleet" in self.grid or any(r.sample == "day" for r in self.runs):
+            return "fleet"
+        return "sweep" if len(self.runs) > 1 or self.grid else "run"
+
+    @property
+    def healthy(self) -> tuple[Run, ...]:
+        """Runs without wear or fault."""
+        return tuple(r for r in self.runs if not r.failing)
+
+    @property
+    def failing(self) -> tuple[Run, ...]:
+        """Runs with wear or a fault."""
+        return tuple(r for r in self.runs if r.failing)
+
+    def labels(self) -> pd.DataFrame:
+        """One row per run: id, robot, task, friction_model, seed, cycles, worn_axes (text, "2 5"),
+        fault (effect:parameter or ""), sample, has_signals."""
+        import pandas as pd
+
+        return pd.DataFrame([dict(run=r.id, robot=r.robot, task=r.task, friction_model=r.friction_model,
+                                  seed=r.seed, cycles=r.cycles, worn_axes=" ".join(map(str, r.worn_axes)),
+                                  fault="" if r.fault is None else f"{r.fault.get('effect')}:{r.fault.get('parameter')}",
+                                  sample=r.sample, has_signals=r.has_signals) for r in self.runs])
+
+    def features(self) -> pd.DataFrame:
+        """Every per-cycle quantity as one tidy table: one row per (run, recorded cycle, axis).
+
+        Columns: ``run``, the labels of :data:`faultgen.data.dataset.FEATURE_LABELS`, ``worn_axes``
+        (text, "2" or "2 5"; "" for none), ``cycle`` (1-based), ``axis`` (1..N), ``worn``,
+        ``wear_pct`` (true wear of the axis, %), every "cycle, axis" array of
+        :data:`faultgen.data.dataset.ARRAYS` and of the duty arrays (empty for runs without), each
+        histogram as one column per bin (``torque_hist_1`` ..), and the operating-condition arrays
+        of runs that have them. ``DataFrame.attrs["units"]`` maps each column to its unit.
+        """
+        import pandas as pd
+
+        arrays = dataset.ARRAYS
+        per_cycle = [name for name, (_, axes, _) in arrays.items() if axes == "cycle, axis"]
+        histograms = [name for name, (_, axes, _) in arrays.items() if axes == "cycle, axis, bin"]
+        frames = []
+        for run in self.runs:
+            n_cycles, n_axes = run.array("friction_multiplier").shape
+            worn = set(run.worn_axes)
+            columns = {"run": run.id, "robot": run.robot, "task": run.task, "friction_model": run.friction_model,
+                       "seed": run.seed, "worn_axes": " ".join(str(a) for a in sorted(worn)),
+                       "cycle": np.repeat(run.recorded, n_axes), "axis": np.tile(np.arange(1, n_axes + 1), n_cycles),
+                       "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
+                       "wear_pct": run.wear.ravel()}
+            duty = list(dataset.DUTY_ARRAYS) if run.has(*dataset.DUTY_ARRAYS) else []
+            columns.update({name: run.array(name).ravel() for name in (*per_cycle, *duty)})
+            for name in dataset._condition_arrays(run.conditions):  # per cycle, per axis or per unit, to rows
+                values, axes = run.array(name), dataset.CONDITION_ARRAYS[name][1]
+                columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)
+                                 if axes == "cycle" else np.tile(values, n_cycles))
+            for name in histograms:
+                bins = run.array(name).reshape(n_cycles * n_axes, -1)
+                columns.update({f"{name}_{k + 1}": bins[:, k] for k in range(bins.shape[1])})
+            frames.append(pd.DataFrame(columns))
+        table = pd.concat(frames, ignore_index=True)
+        table.attrs["units"] = {"wear_pct": "%", **{name: arrays[name][0] for name in per_cycle},
+                                **{name: spec[0] for name, spec in dataset.DUTY_ARRAYS.items() if name in table},
+                                **{name: spec[0] for name, spec in dataset.CONDITION_ARRAYS.items() if name in table},
+                                **{c: arrays[c.rsplit("_", 1)[0]][0] for c in table.columns
+                                   if c.rsplit("_", 1)[0] in histograms}}
+        return table
+
+
+def open(path: str | Path) -> Dataset:  # noqa: A001 (faultgen.open, as the builtin for files)
+    """Open a finished faultgen dataset for reading: a :class:`Dataset` (a context manager).
+
+    Raises
+    ------
+    faultgen.data.dataset.DatasetError
+        If ``path`` does not exist, is not HDF5, is not a faultgen file or is incomplete (its
+        writer did not finish), or a run's labels do not parse; the message says which. Reading an
+        array that holds non-finite values raises it too.
+    """
+    return Dataset(path)
+
+
