@@ -7,12 +7,15 @@ motion. The long version, with the payload-free floor, is ``benchmarks/calibrati
 (docs/calibration.md, "A robot added from a URDF, against Pinocchio").
 """
 
+import dataclasses
 import json
 
+import numpy as np
 import pinocchio_log
 import pytest
 
-from faultgen.calibrate import calibrate
+from faultgen.calibrate import calibrate, gearbox
+from faultgen.data import measured
 
 
 @pytest.fixture(scope="module")
@@ -33,3 +36,24 @@ def test_payload_hidden_in_a_pinocchio_log_is_named_and_the_gap_halved(kr210, tm
     fitted = steps[0]["params"]["robot"]
     assert abs(fitted["mass"] / hidden.mass - 1) < 0.05, fitted["mass"]
     assert abs(fitted["com_x"] - hidden.com[0]) < 0.01, fitted["com_x"]
+
+
+def test_payload_comes_back_exactly_from_exact_derivatives_on_a_rigid_model(kr210, tmp_path, monkeypatch):
+    """The same, noise-free, with the log's exact velocities and accelerations (instead of the
+    derivative filter's) and every gearbox rigid (Pinocchio's arm is): what is left is the payload
+    identification itself against Pinocchio's dynamics, and all ten parameters come back."""
+    monkeypatch.setattr(gearbox, "RESOLVED_HZ", 0.0)  # no axis gets the flexible-gearbox equation
+    hidden = pinocchio_log.HiddenPayload(mass=120.0)
+    t, q, qd, qdd = pinocchio_log.motion(kr210, cycles=1)
+    tau = pinocchio_log.arm_torque(kr210, q, qd, qdd, hidden)
+    data = dataclasses.replace(measured.from_arrays(t, q, tau, str(kr210), qd=qd), qdd=qdd)
+    result = calibrate(str(kr210), data, tmp_path / "calib", max_steps=1)
+    assert [s.effect.id for s in result.steps] == ["payload"]
+    assert result.gap_after["total_nrmse"] < 1e-4 * result.gap_before["total_nrmse"]
+    fitted = result.steps[0].record()["params"]["robot"]
+    a, b, c = hidden.size
+    inertia = hidden.mass / 12 * np.array([b * b + c * c, a * a + c * c, a * a + b * b, 0, 0, 0])
+    expected = {"mass": hidden.mass, **dict(zip(("com_x", "com_y", "com_z"), hidden.com)),
+                **dict(zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), inertia))}
+    for name, value in expected.items():
+        assert fitted[name] == pytest.approx(value, rel=1e-4, abs=1e-4), (name, fitted[name], value)
