@@ -66,6 +66,13 @@ class Case:
     duration: float
     velocities: bool
     seed: int
+    #: Share of each axis's half range the excitation spans (default 0.3 everywhere); a smaller one
+    #: on the axes that carry gravity keeps their gravity load nearly constant (round 3 cases).
+    range_share: tuple[float, ...] | None = None
+    #: Fewest axes a per-axis form is hidden on (default 1; round 3: a multi-axis hump).
+    min_axes: int = 1
+    #: A designed excitation (:mod:`faultgen.calibrate.excitation`) instead of the random Fourier one.
+    designed: bool = False
 
 
 def _cases() -> list[Case]:
@@ -91,6 +98,19 @@ def _cases() -> list[Case]:
             label = "+".join(forms) or "none"
             cases.append(Case(f"{robot}-{k + 1:02d}-{label}", robot, forms, rate, duration, velocities,
                               seed=100 * robot_seed + k))
+    # round 3 (issue 39), added after the 28 above: friction growing with a nearly constant gravity
+    # load (the shoulder and elbow swing over 3 % of their half range: |gravity| hardly changes, so
+    # the friction looks like a Coulomb level), and a payload with a Stribeck hump on two or three axes
+    narrow = (0.3, 0.03, 0.03, 0.3, 0.3, 0.3)
+    for robot_seed, robot in enumerate(("puma560", "irb6700")):
+        cases += [
+            Case(f"{robot}-15-load_gravity-narrow", robot, ("load_gravity",), 500, 40, False,
+                 seed=100 * robot_seed + 14, range_share=narrow),
+            Case(f"{robot}-16-payload+stribeck_exponent-multi", robot, ("payload", "stribeck_exponent"), 500, 40,
+                 True, seed=100 * robot_seed + 15, min_axes=2),
+            Case(f"{robot}-17-load_gravity-narrow-designed", robot, ("load_gravity",), 500, 40, False,
+                 seed=100 * robot_seed + 14, range_share=narrow, designed=True),
+        ]
     return cases
 
 
@@ -108,12 +128,13 @@ class Hidden:
         return [(NAMED_AS[form], sorted(p["axes"])) for form, p in self.forms.items()]
 
 
-def excitation(robot: robots.Robot, rate: float, duration: float, rng: np.random.Generator):
+def excitation(robot: robots.Robot, rate: float, duration: float, rng: np.random.Generator,
+               range_share: tuple[float, ...] | None = None):
     """Fourier excitation: t (n,), q, qd, qdd (n, 6), analytic derivatives.
 
     Per axis ``q0 + sum_l a_l sin(l w t) + b_l cos(l w t)``, w = 2 pi 0.1 rad/s, l = 1..5, with
-    ``a_l, b_l ~ N(0, 1/l)``, scaled so the axis stays within 30 % of its half range around the
-    range's middle and its speed within :data:`TOP_SPEED`."""
+    ``a_l, b_l ~ N(0, 1/l)``, scaled so the axis stays within 30 % (or ``range_share``, per axis) of
+    its half range around the range's middle and its speed within :data:`TOP_SPEED`."""
     t = np.arange(0.0, duration, 1.0 / rate)
     w = 2 * np.pi * 0.1 * np.arange(1, 6)
     a, b = rng.normal(size=(2, 5, 6)) / np.arange(1, 6)[None, :, None]
@@ -123,7 +144,8 @@ def excitation(robot: robots.Robot, rate: float, duration: float, rng: np.random
     accel = -(s * w**2) @ a - (c * w**2) @ b
     low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
     top = np.repeat(TOP_SPEED[robot.name], 3)
-    scale = np.minimum(0.3 * (high - low) / 2 / np.max(np.abs(shape), axis=0), top / np.max(np.abs(speed), axis=0))
+    share = np.full(6, 0.3) if range_share is None else np.asarray(range_share, dtype=float)
+    scale = np.minimum(share * (high - low) / 2 / np.max(np.abs(shape), axis=0), top / np.max(np.abs(speed), axis=0))
     return t, (low + high) / 2 + scale * shape, scale * speed, scale * accel
 
 
@@ -175,15 +197,27 @@ def draw_payload(robot_name: str, rng: np.random.Generator) -> dict:
     return {"axes": list(range(6)), "mass": mass, "com": com, "inertia": rotation @ np.diag(principal) @ rotation.T}
 
 
-def _axes(rng: np.random.Generator, pool: list[int], most: int) -> list[int]:
-    return sorted(rng.choice(pool, size=rng.integers(1, most + 1), replace=False).tolist())
+def _axes(rng: np.random.Generator, pool: list[int], most: int, least: int = 1) -> list[int]:
+    return sorted(rng.choice(pool, size=rng.integers(least, most + 1), replace=False).tolist())
+
+
+def designed_excitation(robot: robots.Robot, rate: float, duration: float):
+    """The excitation :func:`faultgen.calibrate.excitation.design` makes for ``robot``, repeated over
+    ``duration`` and sampled at ``rate``: t (n,), q, qd, qdd (n, 6), analytic derivatives."""
+    from faultgen.calibrate import excitation as designed
+
+    trajectory = designed.design(robot)
+    t = np.arange(0.0, duration, 1.0 / rate)
+    return (t, *trajectory.sample(t))
 
 
 def make(case: Case, folder: str | Path) -> tuple[Path, Hidden]:
     """Write the case's log under ``folder``; returns its path and what was hidden in it."""
     robot = robots.load(case.robot)
     rng = np.random.default_rng(case.seed)
-    t, q, qd, qdd = excitation(robot, case.rate, case.duration, rng)
+    t, q, qd, qdd = excitation(robot, case.rate, case.duration, rng, case.range_share)
+    if case.designed:  # the draws above keep the effect's sizes and axes those of the undesigned twin
+        t, q, qd, qdd = designed_excitation(robot, case.rate, case.duration)
     model = toolbox(case.robot)
     G = robot.gear_ratio
     coulomb = np.array([link.Tc[0] - link.Tc[1] for link in model.links]) / 2  # mean level, motor side
@@ -207,7 +241,7 @@ def make(case: Case, folder: str | Path) -> tuple[Path, Hidden]:
             hidden.forms[form] = {"axes": axes, "rise_pos": up * coulomb[axes], "rise_neg": down * coulomb[axes]}
             tau[:, axes] += G[axes] * coulomb[axes] * np.where(qd[:, axes] > 0, up, -down)
         elif form == "stribeck_exponent":
-            axes = _axes(rng, [0, 1, 2], 3)
+            axes = _axes(rng, [0, 1, 2], 3, case.min_axes)
             static = rng.uniform(0.5, 0.8, len(axes)) * coulomb[axes]
             velocity = rng.uniform(2, 6, len(axes)) * REST_SPEED * G[axes]  # shows above the rest speed
             exponent = rng.uniform(1.0, 2.0, len(axes))

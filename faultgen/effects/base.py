@@ -231,6 +231,9 @@ class Effect:
     #: (the optimiser keeps the most detailed admissible level the Bayesian information criterion
     #: supports, per axis for a per-axis effect); None: all at once.
     levels: ClassVar[tuple[int, ...] | None] = None
+    #: What motion tells this effect apart from the others (the calibration's report says it when
+    #: a log cannot, :func:`faultgen.calibrate.search.compare`).
+    excited_by: ClassVar[str] = ""
     #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
     signed: ClassVar[bool] = False
     #: Hidden-effect drawing: largest value of a parameter; a drawn effect past it is shrunk to it.
