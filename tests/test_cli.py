@@ -284,3 +284,26 @@ def test_help_has_no_type_tags(command):
     tags = re.findall(r"<(?:bool|int|float|str|path|list\[[a-z]+\])>", result.output)
     assert tags == [], tags
     assert "--help" in result.output
+
+
+@pytest.mark.parametrize("width", [60, 80, 100])
+def test_help_reflows_to_any_width_and_keeps_every_example_on_one_line(width):
+    """Every command's help fits the terminal: paragraphs reflow to its width, nothing is cut
+    with an ellipsis, and each example (a line of the docstring's \\b block) is printed whole
+    on one line, so it can be pasted."""
+    import typer.main
+
+    group = typer.main.get_command(app)
+    for name, command in group.commands.items():
+        result = runner.invoke(app, [name, "--help"], terminal_width=width)
+        assert result.exit_code == 0, result.output
+        assert "\u2026" not in result.output, name
+        examples = [line.strip() for line in (command.callback.__doc__ or "").splitlines()
+                    if line.strip().startswith("faultgen ")]
+        assert examples, f"{name} --help shows no example"
+        printed = [line.strip() for line in result.output.splitlines()]
+        for example in examples:
+            assert example in printed, f"{name}: example not on one line at width {width}: {example}"
+        too_long = [line for line in result.output.splitlines()
+                    if len(line) > width and line.strip() not in examples]
+        assert too_long == [], (name, too_long)

@@ -270,10 +270,10 @@ def test_the_fleet_command_passes_its_robot_models_and_left_out_conditions(tmp_p
     """--robot (repeated) sets the fleet's models: every robot of a one-model fleet is that model,
     and with two the order given is the order taken; every other draw is the default fleet's.
     --without (repeated) reaches the fleet too."""
-    from faultgen import cli
+    from faultgen.cli import runs as run_commands
 
     plans = []
-    monkeypatch.setattr(cli, "_run_sweep", lambda plan, out, **kwargs: plans.append(plan))
+    monkeypatch.setattr(run_commands, "run_sweep", lambda plan, out, **kwargs: plans.append(plan))
     for robots in (["irb6700"], ["puma560", "irb6700"]):
         args = ["fleet", "-o", str(tmp_path / "f.h5")] + [x for r in robots for x in ("--robot", r)]
         assert CliRunner().invoke(app, args).exit_code == 0

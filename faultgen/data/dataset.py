@@ -126,6 +126,9 @@ RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axe
 class DatasetError(ValueError):
     """A file is not a finished, valid faultgen dataset; the message says what is wrong."""
 
+    #: The command line's exit code for it (faultgen.cli.base.Command): the file, not the input, is bad.
+    exit_code = 1
+
 
 def model_hash(path: Path) -> str:
     """SHA-256 of a robot's MJCF file, hex."""

@@ -52,6 +52,9 @@ CHUNK_PERIODS = 250
 class SimulationDiverged(RuntimeError):
     """A cycle's state became non-finite or MuJoCo warned; the message names cycle and axis."""
 
+    #: The command line's exit code for it (faultgen.cli.base.Command).
+    exit_code = 1
+
 
 @dataclass(frozen=True)
 class RunConfig:

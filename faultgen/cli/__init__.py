@@ -1,0 +1,14 @@
+"""The ``faultgen`` command: parse arguments, call the library, print. Nothing else lives here.
+
+One module per command group, each adding its commands to :data:`app` when imported: ``robots``
+(the robot models), ``runs`` (``simulate``, ``sweep``, ``fleet``), ``calibration``
+(``calibrate``), ``data`` (``info``, ``validate``, ``export``, ``plot``) and ``analysis``
+(``bench-isolators``, ``detect``, ``training-source``, ``classify``); ``faultgen --help`` lists
+them in that order. ``base`` holds the help layout and the one error handler every command
+shares; ``options`` the options several commands declare.
+"""
+
+from faultgen.cli.main import app
+from faultgen.cli import robots, runs, calibration, data, analysis
+
+__all__ = ["analysis", "app", "calibration", "data", "robots", "runs"]

@@ -1,0 +1,285 @@
+"""``faultgen bench-isolators``, ``detect``, ``training-source`` and ``classify``: the fault
+detection and isolation methods of the ``analysis`` package run on a dataset."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from faultgen.cli.base import Command, check_outputs, parse_window
+from faultgen.cli.main import app
+from faultgen.cli.options import Overwrite, Progress, QAlpha
+
+
+def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
+    """Refuse a dataset that fails validation, or outputs that exist, before any analysis runs."""
+    from faultgen.data import dataset
+
+    problems = dataset.validate(file)
+    if problems:
+        raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
+    check_outputs(outputs, overwrite)
+
+
+def table_command(file: Path, out: Path | None, overwrite: bool, suffix: str, digits: int, compute) -> None:
+    """Validate ``file``, compute a table, write it as CSV and Markdown, print it."""
+    from analysis import benchmark
+
+    stem = out or file.with_name(file.stem + suffix)
+    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md")], overwrite)
+    table = compute()
+    written = benchmark.write_outputs(table, stem)
+    typer.echo(benchmark.markdown(table, digits=digits))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+@app.command("bench-isolators", cls=Command)
+def bench_isolators_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
+    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
+    levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
+    speed_window: Annotated[str | None, typer.Option(
+        metavar="LOW,HIGH",
+        help="Average |motor torque| only over samples whose motor speed lies in LOW..HIGH rad/s (thesis ch. "
+             "6.3.2: 50,120); axes that leave the window empty in some cycle keep the whole-cycle mean. Prints "
+             "how the window covers each task's motor speeds.")] = None,
+    plugins: Annotated[list[str] | None, typer.Option(
+        "--isolator", metavar="MODULE:CLASS",
+        help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
+             "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
+             "repeat for several.")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
+    worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
+
+    Examples (the thesis's Table 6.2 on its grid; then averaging only over the motor speeds of
+    thesis ch. 6.3.2; then with your own isolator from mine.py):
+
+    \b
+      faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
+      faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
+      faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
+    """
+    from analysis import benchmark
+
+    stem = out or file.with_name(file.stem + "-isolation")
+    confusion_stem = stem.with_name(stem.name + "-confusion")
+    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
+                           confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
+    wear_levels = [float(x) for x in levels.split(",")]
+    window = parse_window(speed_window) if speed_window is not None else None
+    isolators = benchmark.default_isolators(bins or (5, 10))
+    isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
+    table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
+    written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
+    written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
+    confusion = benchmark.isolation_confusion(table)
+    confusion.to_csv(confusion_stem.with_suffix(".csv"))
+    written += [confusion_stem.with_suffix(".csv"), benchmark.confusion_figure(confusion, confusion_stem.with_suffix(".png"))]
+    if window is not None:
+        typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
+        typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
+    accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
+    typer.echo(benchmark.markdown(accuracy, digits=4))
+    typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
+               "isolation)")
+    starved = benchmark.starved_isolators(table)
+    if starved:
+        typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
+                   f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
+                   "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
+                   "use `faultgen sweep --preset j2`, or --record with more cycles")
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+@app.command("detect", cls=Command)
+def detect_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
+    protocol: Annotated[str, typer.Option(
+        help="Where the monitor learns normal operation: other-seeds (runs without wear of the other seeds: other "
+             "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
+             "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
+             "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
+    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.")] = 20,
+    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).")] = 0.75,
+    alpha: QAlpha = 0.05,
+    limit_folds: Annotated[int, typer.Option(
+        help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
+             "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
+             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.")] = 20,
+    persistence: Annotated[
+        int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
+                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.")
+    ] = 3,
+    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).")] = None,
+    plugin: Annotated[str | None, typer.Option(
+        "--detector", metavar="MODULE:CLASS",
+        help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
+             "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
+             "current folder).")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout, with the
+    false-alarm rate on healthy runs the monitor did not learn from; summary per task and axis.
+
+    Writes OUT.csv and OUT.md (per run) and OUT-summary.csv (per task, per worn axis, all).
+
+    Example:
+
+    \b
+      faultgen detect j2.h5 --protocol other-seeds -o j2-detection
+    """
+    from analysis import benchmark
+
+    stem = out or file.with_name(file.stem + "-detection")
+    summary_csv = stem.with_name(stem.name + "-summary.csv")
+    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), summary_csv], overwrite)
+    table = benchmark.detection_table(
+        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
+        detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
+        limit_folds=limit_folds or None)
+    summary = benchmark.detection_summary(table)
+    written = benchmark.write_outputs(table, stem)
+    summary.to_csv(summary_csv)
+    typer.echo(benchmark.markdown(table, digits=4))
+    typer.echo("\nsummary (false_alarm_pct: alarms on healthy runs the monitor did not learn from, %):")
+    typer.echo(benchmark.markdown(summary, digits=4))
+    held_in = table[table["protocol"] != "other-seeds"]
+    if protocol == "auto" and len(held_in):
+        typer.echo(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} runs "
+                   f"were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. For "
+                   "false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset quick "
+                   "--seed 0 --seed 1 --seed 2`")
+    typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
+
+
+@app.command("training-source", cls=Command)
+def training_source_command(
+    file: Annotated[Path, typer.Argument(help="A fleet (`faultgen fleet`): daily records of failing and normal robots.")],
+    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).")] = 40,
+    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).")] = 15,
+    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).")] = 5,
+    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).")] = 0.90,
+    alpha: QAlpha = 0.05,
+    limit_folds: Annotated[int, typer.Option(
+        help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
+             "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
+             "many as the training days.")] = 20,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """The training-source study of thesis chapter 4 (Table 4.1) on a fleet. Each robot is tested on its
+    test days by a PCA model learnt from its own first days (one-to-one, OTO) or from those of
+    each normal robot of its model (one-to-many, OTM), on raw, absolute-difference and combined
+    signals; the Q residual's coefficient of variation, samples above the limit and lead time
+    are compared by a three-way ANOVA and Tukey's HSD (Tables 4.2-4.4, Figs. 4-4 to 4-6).
+
+    Writes OUT-cases.csv (one row per test case), OUT-anova.csv, OUT-tukey.csv, OUT.md, OUT.png.
+
+    Example:
+
+    \b
+      faultgen fleet -o fleet.h5 && faultgen training-source fleet.h5 -o fleet-ch4
+    """
+    from analysis import benchmark
+    from analysis import training_source as ts
+
+    stem = out or file.with_name(file.stem + "-training-source")
+    paths = {name: stem.with_name(stem.name + suffix) for name, suffix in
+             (("cases", "-cases.csv"), ("anova", "-anova.csv"), ("tukey", "-tukey.csv"), ("md", ".md"),
+              ("png", ".png"))}
+    analysis_input(file, list(paths.values()), overwrite)
+    window = ts.Window(training_days, test_days, gap_days)
+    cases = ts.study(file, window, variance=variance, alpha=alpha, limit_folds=limit_folds or None,
+                     progress=progress)
+    parts = ["Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
+             "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
+             + benchmark.markdown(ts.group_means(cases))]
+    tukey = None
+    try:
+        anova, tukey = ts.anova(cases), ts.tukey(cases)
+    except ValueError as err:  # an empty cell: the cases and means stand, the tests cannot be run
+        parts.append(f"No ANOVA or Tukey HSD: {err}")
+        del paths["anova"], paths["tukey"]
+    else:
+        parts += ["Three-way ANOVA, type III (thesis Tables 4.2-4.4):\n\n" + benchmark.markdown(anova),
+                  "Tukey HSD, failure against normal robots per training source and signal type (the starred bars "
+                  "of thesis Figs. 4-4 to 4-6):\n\n" + benchmark.markdown(ts.failure_vs_normal(tukey))]
+        anova.to_csv(paths["anova"], index=False)
+        tukey.to_csv(paths["tukey"], index=False)
+    text = "\n\n".join(parts)
+    cases.to_csv(paths["cases"], index=False)
+    paths["md"].write_text(text + "\n")
+    ts.figure(cases, paths["png"], marked=tukey)
+    typer.echo(text)
+    typer.echo("wrote " + ", ".join(map(str, paths.values())))
+
+
+@app.command("classify", cls=Command)
+def classify_command(
+    file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
+    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.")] = 10.0,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.")] = 20,
+    horizon: Annotated[int | None, typer.Option(
+        help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
+        "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
+        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0)] = None,
+    matched_days: Annotated[bool, typer.Option(
+        "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
+        "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
+        "wear put a failing robot's failed days last, so whatever drifts along a record (season, the indicators "
+        "settling) scores without any fault; matched it cannot. No change with --horizon.")] = False,
+    permutations: Annotated[int, typer.Option(
+        help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
+        "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
+        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0)] = 0,
+    classifiers: Annotated[list[str] | None, typer.Option(
+        "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")] = None,
+    preprocessing: Annotated[list[str] | None, typer.Option(
+        "--preprocessing", help="Only this row of Table 5.2 (control, +diff, +estM+diff+var3+pca, ...); repeat for "
+        "several. Default all.")] = None,
+    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout.
+
+    A sample is a recorded cycle (a day in a fleet). Its features per axis are those of thesis
+    Table 5.1: the speed and torque indicators (the axis's average speed and mean load over its
+    production so far) and the KL divergences of its angle, speed and torque histograms against
+    the run's first sample; the "+estM" rows add each sample's own average speed and load. A
+    sample is 'failed' when its true wear reaches --wear-threshold. Procedure 1 holds out one
+    worn and one unworn run at a time, trains on the rest and scores the pair by AUC; --pairs 0
+    takes every pair, as the thesis did.
+
+    Robots of one kind (process, model) look alike, so chance is not 0.5 here: --permutations
+    measures it on the same robots, and 'p' says whether the AUC beats it. With labels by wear a
+    failing robot's failed days are its last, so a classifier that only learns when in the record
+    a day lies scores well above 0.5; --matched-days compares them with the same days of the
+    healthy robot instead.
+
+    Examples (the thesis's Table 5.2: its window before failure, every pair; then the chance
+    level of two cells on labels by wear; then of one with the time control):
+
+    \b
+      faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
+      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
+      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
+    """
+    from analysis import benchmark
+
+    cells = {"classifiers": classifiers} if classifiers else {}
+    if preprocessing:
+        cells["preprocessing"] = preprocessing
+    table_command(file, out, overwrite, "-classification", 3, lambda: benchmark.classification_table(
+        file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
+        horizon=horizon, permutations=permutations, matched=matched_days, **cells))

@@ -1,0 +1,82 @@
+"""Options that several commands share, declared once: the output, progress and parallelism
+options, and the operating conditions of `simulate`, `sweep` and `fleet`
+(faultgen.operation.conditions), with :func:`conditions_table` turning the latter into the
+library's conditions table."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+
+#: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
+Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
+Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
+Jobs = Annotated[int, typer.Option(help="Local worker processes.")]
+QAlpha = Annotated[float, typer.Option("--alpha", help="Significance of the Q limit (0.05: 95 % limit).")]
+Friction = Annotated[str | None, typer.Option(
+    "--friction", help="Motor-side friction model: lugre (dynamic) or stribeck (static eq. 6.3; needed for "
+    "calibrated load-dependent friction, warm-up drift and --gear-loss).")]
+
+Temperature = Annotated[bool, typer.Option(
+    "--temperature", help="Joint temperature on: hall air 20 degC +- 5 K seasonal +- 2 K daily, joints warming "
+    "15 K over a shift (1 h time constant), friction following the gear oil's viscosity (docs/simulation.md).")]
+DryShare = Annotated[float | None, typer.Option(
+    "--dry-share", metavar="S", help="The exponent of the oil viscosity's ratio that the dry (Coulomb, Stribeck) "
+    "friction follows with the joint temperature, 0..1; default 0.25 (ours, not measured), 0: only the viscous "
+    "friction moves with temperature, 1: the dry moves as much. Needs the temperature (--temperature; on by "
+    "default in a fleet).", show_default=False)]
+PayloadParts = Annotated[str | None, typer.Option(
+    "--payloads", help="Parts carried, MASS:SIZE in kg:m, comma-separated, e.g. 20:0.2,80:0.4 (uniform cubes "
+    "hanging from the flange; the controller knows each).")]
+PayloadPattern = Annotated[str, typer.Option(
+    help="Which part each cycle carries: alternate, blocks (10 cycles each) or random.")]
+UnitSpreadFlag = Annotated[bool, typer.Option(
+    "--unit-spread", help="The run's robot draws its own friction levels (15 % log-normal per axis) and link masses "
+    "(2 %) from its seed; the controller keeps the nominal model.")]
+GearLoss = Annotated[float, typer.Option(
+    "--gear-loss", metavar="C",
+    help="Each unit's gearboxes also lose a share of the transmitted torque as Coulomb friction, drawn per axis "
+    "uniformly in 0..C (1 minus the gear efficiency under load; e.g. 0.1). Needs --friction stribeck, and "
+    "--unit-spread outside a fleet. Default 0: none.")]
+TaskMixTasks = Annotated[str | None, typer.Option(
+    "--task-mix", metavar="TASK,TASK,...",
+    help="Each cycle runs one of these tasks (the run's own among them), e.g. pick_place,spot_weld; needs "
+    "--features-only (cycles of different tasks differ in length).")]
+TaskMixPattern = Annotated[str, typer.Option(
+    help="Which task each cycle runs: alternate, blocks (10 cycles each) or random.")]
+CyclesPerDay = Annotated[int, typer.Option(
+    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).")]
+StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.")]
+
+
+def conditions_table(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
+                     start_day: float, task_mix: str | None = None, task_pattern: str = "alternate",
+                     gear_loss: float = 0.0, dry_share: float | None = None) -> dict | None:
+    """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
+    no condition is on. Raises ValueError naming a malformed ``--payloads`` part, a
+    ``--gear-loss`` without ``--unit-spread`` or a ``--dry-share`` without ``--temperature``."""
+    table: dict = {}
+    if dry_share is not None and not temperature:
+        raise ValueError(f"--dry-share {dry_share:g} sets how friction follows the joint temperature: add --temperature")
+    if temperature:
+        table["thermal"] = {} if dry_share is None else {"dry_share": dry_share}
+    if payloads:
+        masses, sizes = [], []
+        for part in payloads.split(","):
+            try:
+                mass, size = (float(v) for v in part.split(":"))
+            except ValueError:
+                raise ValueError(f"--payloads part {part.strip()!r}: expected MASS:SIZE in kg:m, e.g. 20:0.2") from None
+            masses.append(mass)
+            sizes.append(size)
+        table["payloads"] = {"masses": masses, "sizes": sizes, "pattern": pattern}
+    if gear_loss and not spread:
+        raise ValueError(f"--gear-loss {gear_loss:g} is a part of the unit spread: add --unit-spread")
+    if spread:
+        table["spread"] = {"gear_loss": gear_loss} if gear_loss else {}
+    if task_mix:
+        table["task_mix"] = {"tasks": [t.strip() for t in task_mix.split(",")], "pattern": task_pattern}
+    if not table:
+        return None
+    return {**table, "cycles_per_day": cycles_per_day, "start_day": start_day}

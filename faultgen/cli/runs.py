@@ -1,0 +1,319 @@
+"""``faultgen simulate``, ``sweep`` and ``fleet``: runs of the simulator into labelled datasets."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from faultgen.cli.base import Command, check_outputs, parse_cycles
+from faultgen.cli.main import app
+from faultgen.cli.options import (
+    CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress, StartDay,
+    TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
+)
+
+
+@app.command("simulate", cls=Command)
+def simulate_command(
+    robot: Annotated[str, typer.Option(
+        "--robot", "--model",
+        help="Robot name (see `faultgen robots`) or MJCF file, e.g. the model `faultgen calibrate` wrote.")] = "irb6700",
+    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3).")] = "pick_place",
+    friction_model: Friction = "lugre",
+    wear: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="A worn axis as AXIS:KIND:PERCENT[:key=value], e.g. 2:exp4:20 (20 % more Coulomb and static "
+            "friction on axis 2 by the last cycle, thesis eq. 6.6). KIND: exp4, logistic, linear, step. Repeat "
+            "for several axes. No --wear: no wear."
+        ),
+    ] = None,
+    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.")] = 100,
+    record: Annotated[
+        str | None,
+        typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.")] = 0,
+    disturbance: Annotated[
+        float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).")
+    ] = 0.01,
+    encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).")] = 1e-4,
+    threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.")] = 0,
+    fault: Annotated[str | None, typer.Option(
+        help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
+        "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
+        "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
+        "warm-up).")] = None,
+    temperature: Temperature = False,
+    dry_share: DryShare = None,
+    payloads: PayloadParts = None,
+    payload_pattern: PayloadPattern = "alternate",
+    unit_spread: UnitSpreadFlag = False,
+    gear_loss: GearLoss = 0.0,
+    cycles_per_day: CyclesPerDay = 1,
+    start_day: StartDay = 0.0,
+    out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")] = Path("run.h5"),
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """Simulate one run: a robot repeating a task while chosen axes wear, into an HDF5 file.
+
+    Only the recorded cycles are simulated, all at once, each from the task's start state with its
+    own wear level. Signals are logged at 250 Hz.
+
+    Examples:
+
+    \b
+      faultgen simulate --robot irb6700 --task pick_place --wear 1:exp4:20 --cycles 100 -o axis1.h5
+      faultgen simulate --task spot_weld --wear 2:exp4:20 --wear 5:linear:10 --record 1,100 -o two.h5
+      faultgen simulate --wear 3:exp4:20 --temperature --payloads 20:0.2,80:0.4 --unit-spread -o real.h5
+      faultgen simulate --friction stribeck --wear 2:exp4:20 --unit-spread --gear-loss 0.1 -o lossy.h5
+    """
+    from faultgen.data import dataset
+    from faultgen.operation import conditions as conditions_module
+    from faultgen.operation import faults as faults_module
+    from faultgen.operation import wear as wear_module
+    from faultgen.simulation import sensors
+    from faultgen.simulation import stepping as sim
+
+    check_outputs([out], overwrite)
+    if cycles < 1:
+        raise ValueError(f"--cycles {cycles}: expected a whole number >= 1")
+    config = sim.RunConfig(
+        robot=robot, task=task, friction=friction_model,
+        wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
+        record=None if record is None else parse_cycles(record), seed=seed,
+        noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
+        conditions=conditions_module.Conditions.from_dict(
+            conditions_table(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
+                             gear_loss=gear_loss, dry_share=dry_share) or {}),
+        fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
+    )
+    result = sim.simulate(config, progress=progress)
+    command = shlex.join(["faultgen", *sys.argv[1:]])
+    dataset.write_run(out, result, command=command)
+    typer.echo(summary(result, out))
+
+
+@app.command("sweep", cls=Command)
+def sweep_command(
+    preset: Annotated[
+        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
+    ] = None,
+    config: Annotated[
+        Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
+    ] = None,
+    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s); repeat for several.")] = None,
+    tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s); repeat for several.")] = None,
+    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..6, or 0 for a run without wear; repeat.")] = None,
+    increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
+    schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
+    friction_model: Friction = None,
+    cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
+    record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
+    seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    fault: Annotated[str | None, typer.Option(
+        help="Instead of friction wear, each worn axis gets this fault: EFFECT:PARAMETER:FINAL[:key=value,...], "
+        "e.g. backlash:width:0.01 or cogging:amplitude:0.05:poles=8 (see `simulate --fault`).")] = None,
+    temperature: Temperature = False,
+    dry_share: DryShare = None,
+    payloads: PayloadParts = None,
+    payload_pattern: PayloadPattern = "alternate",
+    unit_spread: UnitSpreadFlag = False,
+    gear_loss: GearLoss = 0.0,
+    task_mix: TaskMixTasks = None,
+    task_pattern: TaskMixPattern = "alternate",
+    cycles_per_day: CyclesPerDay = 1,
+    start_day: StartDay = 0.0,
+    features_only: Annotated[bool | None, typer.Option(
+        "--features-only/--signals", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a "
+        "fraction of the size; detect and classify give the same tables, only bench-isolators --speed-window needs "
+        "the signals), or keep the signals. Default: the preset's (c2: features only), else signals.",
+        show_default=False)] = None,
+    jobs: Jobs = 2,
+    scheduler: Annotated[
+        str | None, typer.Option(help="Dask scheduler address (tcp://host:port) to run on a cluster; workers must see OUT's folder.")
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """Simulate a grid of runs (robot x task x worn axis x wear x schedule x seed) into one dataset.
+
+    The grid comes from --preset, --config or the options (options override the preset or file).
+    Killed or failed? Run the same command again: finished runs are kept, only missing ones run.
+
+    Examples:
+
+    \b
+      faultgen sweep --preset quick -o quick.h5
+      faultgen sweep --preset j2 --jobs 2 -o j2.h5
+      faultgen sweep --robot puma560 --task spot_weld --axis 0 --axis 3 --wear-pct 10 --wear-pct 20 -o s.h5
+      faultgen sweep --preset j2 --temperature --unit-spread -o j2-conditions.h5
+      faultgen sweep --task pick_place --axis 0 --axis 2 --task-mix pick_place,spot_weld --features-only -o mix.h5
+    """
+    from faultgen.runs import sweep
+
+    options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
+               "friction": friction_model, "cycles": cycles, "seeds": seeds,
+               "record": record}
+    options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
+    table = conditions_table(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
+                             task_mix, task_pattern, gear_loss, dry_share)
+    if table is not None:
+        options["conditions"] = table
+    if features_only is not None:
+        options["signals"] = not features_only
+    if fault is not None:
+        options["fault"] = fault
+    if record is not None:
+        options["record"] = list(parse_cycles(record))
+    if config is not None:
+        grid = sweep.Grid.from_toml(config)
+        if options:
+            grid = sweep.Grid(**{**{f: getattr(grid, f) for f in grid.__dataclass_fields__}, **options})
+    elif preset is not None:
+        grid = sweep.Grid.from_preset(preset, **options)
+    else:
+        grid = sweep.Grid(**{"robots": ["irb6700"], "tasks": ["pick_place"], "axes": [0], **options})
+    if jobs < 1:
+        raise ValueError(f"--jobs {jobs}: expected >= 1")
+    check_outputs([out], overwrite)
+    where = f" on {scheduler}" if scheduler else f" with {jobs} job(s)"
+
+    def announce(n_runs: int, done: int) -> None:
+        typer.echo(f"{n_runs} runs -> {out}{where}")
+        if done:
+            typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
+                       "they are")
+
+    run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce)
+    typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
+               f"  faultgen plot {out} -o {out.with_suffix('.png')}")
+
+
+@app.command("fleet", cls=Command)
+def fleet_command(
+    size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).")] = 26,
+    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).")] = 13,
+    models: Annotated[list[str] | None, typer.Option(
+        "--robot", help="Robot model(s) of the fleet, taken in turn; repeat for several (default: irb6700 and "
+        "puma560). One model makes every robot that model, e.g. for a fault whose FINAL suits only it.")] = None,
+    days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.")] = 60,
+    cycles_per_day: Annotated[int, typer.Option(
+        help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).")] = 2,
+    failure_wear: Annotated[float, typer.Option(
+        help="Coulomb and static friction increase of the failing axis on the failure day, %.")] = 50.0,
+    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.")] = 0,
+    conditions: Annotated[bool, typer.Option(
+        help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
+        "process and fault.")] = True,
+    without: Annotated[list[str] | None, typer.Option(
+        "--without", metavar="CONDITION", help="Leave one condition out of every robot, the others drawn as in the "
+        "full fleet: thermal (hall climate, warm-up), payloads (the parts) or spread (unit spread); repeat for "
+        "several.", show_default=False)] = None,
+    task_mix: Annotated[bool, typer.Option(
+        "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
+        "its cycles (default: one task per robot).")] = False,
+    friction_model: Friction = "lugre",
+    dry_share: DryShare = None,
+    gear_loss: GearLoss = 0.0,
+    fault: Annotated[str | None, typer.Option(
+        help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
+        "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
+        "backlash:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
+    jobs: Jobs = 2,
+    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
+    overwrite: Overwrite = False,
+    progress: Progress = True,
+) -> None:
+    """Simulate a fleet like the thesis's 26 robots (chapter 5) as daily remote-monitoring records.
+
+    Half the robots develop a gearbox fault (friction wear of one drawn axis, rising from a drawn
+    day to failure on the last day), half stay healthy; each robot has its own model, process,
+    parts, hall climate and unit spread (docs/simulation.md, "Operating conditions and fleets").
+    Killed? Run the same command again: finished robots are kept.
+
+    Examples:
+
+    \b
+      faultgen fleet -o fleet.h5
+      faultgen classify fleet.h5 --wear-threshold 10
+      faultgen fleet --friction stribeck --gear-loss 0.1 -o fleet-lossy.h5
+      faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
+      faultgen fleet --robot irb6700 --fault cogging:amplitude:0.5:poles=8 -o fleet-cogging.h5
+      faultgen fleet --without payloads -o fleet-no-parts.h5
+    """
+    from faultgen.runs import fleet
+
+    chosen = {"models": tuple(models)} if models else {}
+    if dry_share is not None:
+        chosen["dry_share"] = dry_share
+    if without:
+        chosen["without"] = tuple(without)
+    plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
+                       failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
+                       friction=friction_model, gear_loss=gear_loss, fault=fault)
+    if jobs < 1:
+        raise ValueError(f"--jobs {jobs}: expected >= 1")
+    check_outputs([out], overwrite)
+
+    def announce(n_runs: int, done: int) -> None:
+        typer.echo(f"{n_runs} robots x {days} days -> {out} with {jobs} job(s)"
+                   + (f"; resuming, {done} robots already finished" if done else ""))
+
+    run_sweep(plan, out, jobs=jobs, scheduler=None, progress=progress, overwrite=overwrite, announce=announce)
+    typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
+               f"  faultgen detect {out}")
+
+
+def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
+              announce) -> None:
+    """:func:`faultgen.runs.sweep.run` for a command, recording the command line in the dataset.
+    Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
+    before anything ran, 130 interrupted with the finished runs kept, 1 a run failed."""
+    from faultgen.runs import sweep
+
+    sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
+              command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce)
+
+
+def summary(result, out: Path) -> str:
+    """What a user wants to see after a run: where it is and what happened per axis."""
+    last = -1
+    mean_torque = np.mean(np.abs(result.tau_m[last]), axis=0)
+    rows = [
+        ("wear multiplier, last cycle", result.friction_multiplier[last], ".4f"),
+        ("mean |motor torque| [N m]", mean_torque, ".4g"),
+        ("mean |friction torque| [N m]", result.mean_friction_torque[last], ".4g"),
+        ("max tracking error [mrad]", 1e3 * np.max(result.tracking_error, axis=0), ".3g"),
+    ]
+    config = result.config
+    lines = [
+        f"wrote {out}: {config.robot} {config.task}, {config.friction} friction, {len(result.cycles)} recorded "
+        f"cycle(s) of {result.t[-1]:.2f} s (last: cycle {int(result.cycles[last])} of {config.cycles})",
+        " " * 30 + "".join(f"{'axis ' + str(i):>11}" for i in range(1, result.tau_m.shape[-1] + 1)),
+    ]
+    lines += [f"{title:<30}" + "".join(f"{v:>11{fmt}}" for v in values) for title, values, fmt in rows]
+    c = result.conditions
+    if c is not None:
+        lines.append(f"conditions, last cycle: day {c.day[last]:.0f} at {c.hour[last]:.1f} h; dry friction x "
+                     + " ".join(f"{v:.3f}" for v in c.dry_friction_factor[last]) + ", viscous x "
+                     + " ".join(f"{v:.3f}" for v in c.viscous_factor[last]))
+        if config.conditions.thermal is not None:
+            lines.append(f"  joint temperature {np.min(c.joint_temperature):.1f}..{np.max(c.joint_temperature):.1f} degC "
+                         "over the recorded cycles")
+        if np.any(c.gear_loss):
+            lines.append("  gear loss (load-dependent friction coefficient) " + " ".join(f"{v:.3f}" for v in c.gear_loss))
+        if config.conditions.payloads is not None:
+            lines.append("  payload mass per cycle [kg]: " + " ".join(f"{m:g}" for m in c.payload_mass[:12])
+                         + (" ..." if len(c.payload_mass) > 12 else ""))
+    lines.append(f"read it with: python -c \"from faultgen import dataset; a, labels = dataset.read_run('{out}')\"")
+    return "\n".join(lines)
+
+
