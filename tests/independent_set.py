@@ -99,9 +99,10 @@ def _cases() -> list[Case]:
             cases.append(Case(f"{robot}-{k + 1:02d}-{label}", robot, forms, rate, duration, velocities,
                               seed=100 * robot_seed + k))
     # round 3 (issue 39), added after the 28 above: friction growing with a nearly constant gravity
-    # load (the shoulder and elbow swing over 3 % of their half range: |gravity| hardly changes, so
-    # the friction looks like a Coulomb level), and a payload with a Stribeck hump on two or three axes
-    narrow = (0.3, 0.03, 0.03, 0.3, 0.3, 0.3)
+    # load (the shoulder and elbow swing over 6 % of their half range around a pose where both
+    # carry much of it: |gravity| changes by about 1 %, so the friction looks like a Coulomb level),
+    # and a payload with a Stribeck hump on two or three axes
+    narrow = (0.3, 0.06, 0.06, 0.3, 0.3, 0.3)
     for robot_seed, robot in enumerate(("puma560", "irb6700")):
         cases += [
             Case(f"{robot}-15-load_gravity-narrow", robot, ("load_gravity",), 500, 40, False,
@@ -129,7 +130,7 @@ class Hidden:
 
 
 def excitation(robot: robots.Robot, rate: float, duration: float, rng: np.random.Generator,
-               range_share: tuple[float, ...] | None = None):
+               range_share: tuple[float, ...] | None = None, middle: np.ndarray | None = None):
     """Fourier excitation: t (n,), q, qd, qdd (n, 6), analytic derivatives.
 
     Per axis ``q0 + sum_l a_l sin(l w t) + b_l cos(l w t)``, w = 2 pi 0.1 rad/s, l = 1..5, with
@@ -146,7 +147,22 @@ def excitation(robot: robots.Robot, rate: float, duration: float, rng: np.random
     top = np.repeat(TOP_SPEED[robot.name], 3)
     share = np.full(6, 0.3) if range_share is None else np.asarray(range_share, dtype=float)
     scale = np.minimum(share * (high - low) / 2 / np.max(np.abs(shape), axis=0), top / np.max(np.abs(speed), axis=0))
-    return t, (low + high) / 2 + scale * shape, scale * speed, scale * accel
+    centre = (low + high) / 2 if middle is None else middle
+    return t, centre + scale * shape, scale * speed, scale * accel
+
+
+def heavy_pose(robot: robots.Robot, model: rtb.DHRobot) -> np.ndarray:
+    """The middle of every joint range, with axes 2 and 3 where the smaller of their gravity
+    torques (the toolbox's ``gravload``, relative to each axis's largest) is largest, on a 25 x 25
+    grid over the middle 60 % of their ranges: a pose where both carry a large, steady gravity load."""
+    low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
+    middle = (low + high) / 2
+    grid = [np.linspace(m - 0.3 * (h - lo), m + 0.3 * (h - lo), 25)
+            for m, lo, h in zip(middle[1:3], low[1:3], high[1:3], strict=True)]
+    poses = np.array([[*middle[:1], a, b, *middle[3:]] for a in grid[0] for b in grid[1]])
+    load = np.abs(np.asarray(model.gravload(poses)))[:, 1:3]
+    best = int(np.argmax(np.min(load / load.max(axis=0), axis=1)))
+    return poses[best]
 
 
 def toolbox(robot_name: str) -> rtb.DHRobot:
@@ -215,10 +231,11 @@ def make(case: Case, folder: str | Path) -> tuple[Path, Hidden]:
     """Write the case's log under ``folder``; returns its path and what was hidden in it."""
     robot = robots.load(case.robot)
     rng = np.random.default_rng(case.seed)
-    t, q, qd, qdd = excitation(robot, case.rate, case.duration, rng, case.range_share)
+    model = toolbox(case.robot)
+    middle = heavy_pose(robot, model) if case.range_share is not None else None
+    t, q, qd, qdd = excitation(robot, case.rate, case.duration, rng, case.range_share, middle)
     if case.designed:  # the draws above keep the effect's sizes and axes those of the undesigned twin
         t, q, qd, qdd = designed_excitation(robot, case.rate, case.duration)
-    model = toolbox(case.robot)
     G = robot.gear_ratio
     coulomb = np.array([link.Tc[0] - link.Tc[1] for link in model.links]) / 2  # mean level, motor side
     hidden = Hidden()

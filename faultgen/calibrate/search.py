@@ -174,6 +174,8 @@ def _nested(design: np.ndarray, target: np.ndarray, levels: tuple[int, ...] | No
     completed columns held (:data:`COMPLETE_ITERATIONS` rounds)."""
     best, best_bic = None, np.inf
     k = design.shape[-1]
+    if target.size == 0:  # an axis that never moves faster than the rest speed: nothing to fit
+        return np.zeros(k)
     for level in levels or (k,):
         theta = np.zeros(k)
         for _ in range(COMPLETE_ITERATIONS if complete is not None and level < k else 1):
