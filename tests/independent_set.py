@@ -297,8 +297,21 @@ def judge(hidden: Hidden, result) -> dict:
     got = [(step.effect.id, list(step.axes)) for step in result.steps]
     named = sorted(got[: len(want)]) == want and (bool(want) or not got)
     before, after = result.gap_before["total_nrmse"], result.gap_after["total_nrmse"]
+    # round 3: a step the log cannot separate from another lists both; the truth among them counts
+    tied = [sorted({step.effect.id, *step.evidence.get("ambiguous_with", [])}) for step in result.steps]
+    first = list(zip(got, tied, strict=True))[: len(want)]
+
+    def covered(effect, on):
+        return any(on == axes and (effect == name or effect in names) for (name, axes), names in first)
+
     verdict = {"named": named, "halved": after <= 0.5 * before if want else None, "before": before,
-               "after": after, "found": got, "hidden": want}
+               "after": after, "found": got, "hidden": want,
+               "ambiguous": [f"{'/'.join(names)} {[a + 1 for a in axes]}" for (_, axes), names in zip(got, tied,
+                                                                                                    strict=True)
+                             if len(names) > 1],
+               "named_or_ambiguous": named or (len(first) == len(want) and all(covered(e, on) for e, on in want)),
+               # every hidden effect on all its axes, in any step
+               "all_axes": all(any(name == e and set(on) <= set(axes) for name, axes in got) for e, on in want)}
     if "payload" in hidden.forms:
         p = hidden.forms["payload"]
         step = next((s for s in result.steps if s.effect.id == "payload"), None)

@@ -28,16 +28,18 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import minimize
 
+from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
 from faultgen.calibrate.effects import get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import atomic
 from faultgen.model import robots
 from faultgen.operation import tasks
 
-#: Effects whose regressors the design separates, simplest first. Left out: the warm-up (it is
-#: told apart by the log's length from a cold start, not by the motion), cogging and backlash
-#: (their regressors need the motor angle and gearbox state at the log's rate, not the plan's).
-EFFECTS = ("torque_offset", "coulomb", "viscous", "stribeck", "load_dependent_friction", "payload")
+#: Effects whose regressors the design separates, simplest first: every effect of the library
+#: that is :attr:`~faultgen.effects.Effect.designable` (left out: the warm-up, told apart by the
+#: log's length from a cold start, not by the motion; cogging and backlash, whose regressors need
+#: the motor angle and gearbox state at the log's rate, not the plan's).
+EFFECTS = tuple(effect.id for effect in ALL_EFFECTS.values() if effect.designable)
 #: Harmonics and fundamental period (s) of the series (Swevers et al. 1997 use 5 and 10 s).
 HARMONICS = 5
 PERIOD = 10.0

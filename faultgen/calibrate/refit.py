@@ -67,8 +67,8 @@ class Refit:
 
 def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[list[Refit], float, float]:
     """Fit the continuous parameters of ``result``'s steps (a :class:`faultgen.calibrate.Calibration`)
-    again with ``mujoco.sysid`` on the calibrated model, starting from faultgen's values, on the
-    measured ``data`` the calibration used.
+    again with ``mujoco.sysid`` on the calibrated model, starting from the nominal model's values
+    (the effect absent), on the measured ``data`` the calibration used.
 
     Returns
     -------
@@ -118,15 +118,8 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
             get(effect_id).apply(spec, robot, axis, values)
         return spec
 
-    folder = model_path.parent
-
     def residual_of(vector: np.ndarray) -> np.ndarray:
-        path = folder / f".refit-{id(vector)}.xml"
-        try:
-            path.write_text(spec_with(vector).to_xml())
-            model = robots.load(path)
-        finally:
-            path.unlink(missing_ok=True)
+        model = robots.from_spec(spec_with(vector), model_path)  # compiled in memory: no rounding to text
         predicted = predict(model, data)[rows]  # the whole log: the gearbox term integrates in time
         error = (tau[rows] - predicted) / scale
         return error[mask]
@@ -137,10 +130,14 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
             return [np.column_stack([residual_of(x[:, k]) for k in range(x.shape[1])])], None, None
         return [residual_of(x)], None, None
 
+    # sysid starts where the nominal model is (the effect absent), not at faultgen's answer; its
+    # bounds reach five times past faultgen's change
+    nominal = robots.load(result.robot)
     params = sysid.ParameterDict()
     for k, (step, axis, name, value, se) in enumerate(entries):
-        width = max(10 * se, 0.5 * abs(value), 1e-6)
-        params.add(sysid.Parameter(f"p{k}", value, value - width, value + width))
+        start = float(get(step.effect.id).current(nominal).values(axis)[name])
+        width = max(5 * abs(value - start), 0.5 * abs(start), 1e-3)
+        params.add(sysid.Parameter(f"p{k}", start, start - width, start + width))
     started = time.perf_counter()
     found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
     elapsed = time.perf_counter() - started
@@ -149,11 +146,6 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     _, half = sysid.calculate_intervals([residual], np.asarray(outcome.jac), alpha=ALPHA)
     refits = [Refit(step.effect.id, name, None if axis is None else axis_numbers.number(axis), value, Z_95 * se,
                     float(v), float(h)) for (step, axis, name, value, se), v, h in zip(entries, x, half, strict=True)]
-    path = folder / ".refit-final.xml"
-    try:
-        path.write_text(spec_with(x).to_xml())
-        gap = search.gap(tau, predict(robots.load(path), data), split.held_out)["total_nrmse"]
-    finally:
-        path.unlink(missing_ok=True)
+    gap = search.gap(tau, predict(robots.from_spec(spec_with(x), model_path), data), split.held_out)["total_nrmse"]
     return refits, elapsed, gap
 

@@ -45,6 +45,7 @@ class Backlash(Effect):
 
     id = "backlash"
     rank = 90
+    designable = False
     excited_by = (
         "reversals of the transmitted torque (accelerations that change the gearbox load's sign)")
     summary = "gearbox backlash (dead band between motor and arm)"

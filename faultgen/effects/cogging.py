@@ -24,6 +24,7 @@ class Cogging(Effect):
 
     id = "cogging"
     rank = 80
+    designable = False
     excited_by = (
         "slow steady motion over several motor revolutions (the ripple repeats with the motor angle)")
     summary = "cogging torque (periodic in the motor angle)"

@@ -92,6 +92,7 @@ class Temperature(Effect):
 
     id = "temperature"
     rank = 60
+    designable = False
     excited_by = (
         "a long log from a cold start (the warm-up fades with its time constant, a level does not)")
     summary = "friction drifting with time (a gearbox warming up)"
