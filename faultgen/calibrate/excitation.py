@@ -48,7 +48,7 @@ RANGE_SHARE = 0.8
 #: Share of the planning velocity and acceleration limits the excitation may use.
 LIMIT_SHARE = 0.9
 #: Samples per period on which the condition number is evaluated while optimising.
-SAMPLES = 150
+SAMPLES = 100
 
 
 @dataclass(frozen=True)
@@ -218,12 +218,14 @@ def condition_number(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.n
     """Condition number (largest over smallest singular value) of :func:`regressor` along a motion
     (inf when a column is zero or two are parallel)."""
     matrix, _ = regressor(robot, t, q, qd, qdd, effects, keep)
-    sv = np.linalg.svd(matrix, compute_uv=False)
-    return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    # singular values as the square roots of the Gram matrix's eigenvalues (k x k, k << n): the
+    # same to well within the design's needs up to a condition number of about 1e7
+    eigen = np.linalg.eigvalsh(matrix.T @ matrix)
+    return float(np.sqrt(eigen[-1] / eigen[0])) if eigen[0] > 0 else float("inf")
 
 
 def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float = PERIOD, seed: int = 0,
-           iterations: int = 15, effects: tuple[str, ...] = EFFECTS) -> Excitation:
+           iterations: int = 8, effects: tuple[str, ...] = EFFECTS) -> Excitation:
     """An excitation for ``robot`` (name, MJCF path or loaded model) optimised for a small
     regressor condition number (module docstring).
 

@@ -62,7 +62,7 @@ def excitation_command(
     out: Annotated[Path, typer.Option("--out", "-o", help="CSV file to write: columns t, q1..qN (s, rad).")],
     period: Annotated[float, typer.Option(help="Fundamental period of the Fourier series, s.")] = 10.0,
     harmonics: Annotated[int, typer.Option(help="Harmonics of the Fourier series.")] = 5,
-    iterations: Annotated[int, typer.Option(help="Most optimiser iterations.")] = 15,
+    iterations: Annotated[int, typer.Option(help="Most optimiser iterations.")] = 8,
     seed: Annotated[int, typer.Option(help="Seed of the optimiser's random start.")] = 0,
     overwrite: Overwrite = False,
 ) -> None:
