@@ -117,8 +117,8 @@ def test_reopen_finds_an_effect_below_the_absolute_threshold_on_an_axis_above_it
 
 def test_excitation_keeps_the_limits_starts_at_rest_and_conditions_better_than_its_start():
     robot = robots.load("puma560")
-    start = excitation.design(robot, harmonics=3, iterations=0)
-    designed = excitation.design(robot, harmonics=3, iterations=3)
+    start = excitation.design(robot, harmonics=2, iterations=0)
+    designed = excitation.design(robot, harmonics=2, iterations=2)
     assert designed.condition_number < start.condition_number
     t = np.linspace(0, designed.period, 4001)
     q, qd, qdd = designed.sample(t)
@@ -134,3 +134,20 @@ def test_excitation_keeps_the_limits_starts_at_rest_and_conditions_better_than_i
     assert header == "t,q1,q2,q3,q4,q5,q6"
     assert np.allclose(np.array(first.split(","), dtype=float)[1:], q[0], atol=1e-8)
     assert len(text.splitlines()) == 1 + round(designed.period / 0.004) + 1
+
+
+def test_excitation_command_writes_a_replayable_csv_and_refuses_to_overwrite(tmp_path):
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+
+    out = tmp_path / "exc.csv"
+    args = ["excitation", "puma560", "-o", str(out), "--iterations", "0", "--harmonics", "2"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "condition number" in result.output
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table.shape == (round(10.0 / 0.004) + 1, 7)
+    assert np.allclose(np.diff(table[:, 0]), 0.004)
+    again = CliRunner().invoke(app, args)
+    assert again.exit_code != 0 and "exists" in again.output

@@ -10,10 +10,13 @@ The workflow (:func:`calibrate`, ``faultgen calibrate``):
    flexible gearboxes change, :mod:`faultgen.calibrate.gearbox`) and split the record in time into a fitting part and a held-out part
    (:class:`faultgen.calibrate.search.Split`); every gap is reported on the held-out part;
 3. fit every effect of the library (:mod:`faultgen.effects`) to the residual and pick
-   the one that explains it best (:mod:`faultgen.calibrate.search`);
-4. write it into the model (MJCF), recompute the residual with the augmented model and repeat
-   until no effect is significant; with two or more effects, fit each again with the others in
-   place (backfitting, :func:`_refit`);
+   the one that explains it best by its held-out information criterion; when the log cannot tell
+   two effects apart, fit the simpler and say so, with both candidates' evidence and the motion
+   that would separate them (:mod:`faultgen.calibrate.search`, :meth:`Calibration.ambiguous`);
+4. write it into the model (MJCF), recompute the residual with the augmented model, search every
+   axis still above its noise floor again for the effects already named (:func:`_complete`), and
+   repeat until no effect is significant; with two or more effects, fit each again with the
+   others in place (backfitting, :func:`_refit`);
 5. write the augmented model, ``report.json`` (design document contract) and a figure.
 
 docs/calibration.md explains the method and lists its accuracy on hidden-effect data.

@@ -267,7 +267,9 @@ def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float 
         value = condition_number(model, t, *_series(q0, a, b, period, t), effects, keep)
         return float(np.log(value)) if np.isfinite(value) else 50.0
 
-    found = minimize(cost, start.ravel(), method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-4})
-    best = found.x if found.fun <= cost(start.ravel()) else start.ravel()
+    best = start.ravel()
+    if iterations > 0:
+        found = minimize(cost, best, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-4})
+        best = found.x if found.fun <= cost(best) else best
     q0, a, b = trajectory(best)
     return Excitation(model.name, period, q0, a, b, float(np.exp(cost(best))))

@@ -28,7 +28,8 @@ def calibrate_command(
     the library is fitted to the residual on the first 70 % of the record and judged on the last
     30 % (held out); the effect that cuts the held-out error most, on the axes where the cut is
     significant, is written into the model, and the search repeats until nothing significant is
-    left. A log the robot cannot explain (another robot, motor-side torque, a column in another
+    left. When the log cannot tell two effects apart (held-out AIC within 2), the simpler is fitted
+    and the summary, report.json and the figure say so, with the motion that would separate them. A log the robot cannot explain (another robot, motor-side torque, a column in another
     unit or with the other sign) is refused before anything is written, naming what to check.
 
     Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
