@@ -104,12 +104,19 @@ def main() -> None:
         print(table(pd.read_csv(args.from_csv)))
         return
     cases = [c for c in independent_set.CASES if not args.cases or any(n in c.name for n in args.cases)]
+    if args.cases:  # in the order given
+        cases.sort(key=lambda c: min(k for k, n in enumerate(args.cases) if n in c.name))
     if not cases:
         parser.error(f"no log name contains any of {args.cases}; names: {[c.name for c in independent_set.CASES]}")
     started = time.perf_counter()
-    rows = pd.DataFrame(Parallel(n_jobs=args.jobs, verbose=5)(delayed(run)(c) for c in cases))
-    if args.csv:
-        rows.to_csv(args.csv, index=False)
+    done = []
+    # rows as they finish: a run cut short keeps the logs that finished in the CSV
+    for row in Parallel(n_jobs=args.jobs, verbose=5, return_as="generator_unordered")(delayed(run)(c) for c in cases):
+        done.append(row)
+        if args.csv:
+            pd.DataFrame(done).to_csv(args.csv, index=False)
+    order = {c.name: k for k, c in enumerate(cases)}
+    rows = pd.DataFrame(sorted(done, key=lambda r: order[r["log"]]))
     print(f"{len(cases)} logs in {time.perf_counter() - started:.0f} s with {args.jobs} jobs "
           f"(longest calibration {rows.seconds.max():.0f} s)")
     print(table(rows))
