@@ -68,7 +68,9 @@ class Refit:
 def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[list[Refit], float, float]:
     """Fit the continuous parameters of ``result``'s steps (a :class:`faultgen.calibrate.Calibration`)
     again with ``mujoco.sysid`` on the calibrated model, starting from the nominal model's values
-    (the effect absent), on the measured ``data`` the calibration used.
+    (the effect absent; 20 % off faultgen's values when the model cannot be compiled there, an
+    absent payload having no positive-definite inertia), on the measured ``data`` the calibration
+    used.
 
     Returns
     -------
@@ -118,8 +120,13 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
             get(effect_id).apply(spec, robot, axis, values)
         return spec
 
+    size = int(mask.sum())
+
     def residual_of(vector: np.ndarray) -> np.ndarray:
-        model = robots.from_spec(spec_with(vector), model_path)  # compiled in memory: no rounding to text
+        try:
+            model = robots.from_spec(spec_with(vector), model_path)  # compiled in memory: no rounding to text
+        except robots.ModelError:  # e.g. an inertia that is not positive definite: a step to refuse
+            return np.full(size, 1e3)
         predicted = predict(model, data)[rows]  # the whole log: the gearbox term integrates in time
         error = (tau[rows] - predicted) / scale
         return error[mask]
@@ -133,9 +140,14 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     # sysid starts where the nominal model is (the effect absent), not at faultgen's answer; its
     # bounds reach five times past faultgen's change
     nominal = robots.load(result.robot)
+    starts = np.array([float(get(step.effect.id).current(nominal).values(axis)[name])
+                       for step, axis, name, _, _ in entries])
+    try:
+        robots.from_spec(spec_with(starts), model_path)
+    except robots.ModelError:  # an absent payload has no inertia to start from: 20 % off faultgen's values
+        starts = np.array([1.2 * value for _, _, _, value, _ in entries])
     params = sysid.ParameterDict()
-    for k, (step, axis, name, value, se) in enumerate(entries):
-        start = float(get(step.effect.id).current(nominal).values(axis)[name])
+    for k, ((step, axis, name, value, se), start) in enumerate(zip(entries, starts, strict=True)):
         width = max(5 * abs(value - start), 0.5 * abs(start), 1e-3)
         params.add(sysid.Parameter(f"p{k}", start, start - width, start + width))
     started = time.perf_counter()
