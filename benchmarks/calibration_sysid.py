@@ -97,10 +97,12 @@ def main() -> None:
     names = [c.name for c in independent_set.CASES if any(n in c.name for n in args.cases)]
     if not names:
         parser.error(f"no log name contains any of {args.cases}")
-    rows = pd.DataFrame([row for name in names for row in run(name)])
-    if args.csv:
-        rows.to_csv(args.csv, index=False)
-    print(table(rows))
+    done = []
+    for name in names:  # the CSV grows log by log: a run cut short keeps what finished
+        done += run(name)
+        if args.csv:
+            pd.DataFrame(done).to_csv(args.csv, index=False)
+    print(table(pd.DataFrame(done)))
 
 
 if __name__ == "__main__":
