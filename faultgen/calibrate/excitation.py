@@ -47,8 +47,10 @@ PERIOD = 10.0
 RANGE_SHARE = 0.8
 #: Share of the planning velocity and acceleration limits the excitation may use.
 LIMIT_SHARE = 0.9
-#: Samples per period on which the condition number is evaluated while optimising.
+#: Samples per period on which the condition number is evaluated while optimising, and on which
+#: the design's figure is reported (:attr:`Excitation.condition_number`).
 SAMPLES = 100
+FINE_SAMPLES = 1000
 
 
 @dataclass(frozen=True)
@@ -65,7 +67,8 @@ class Excitation:
     a, b : ndarray of shape (L, N)
         Sine and cosine coefficients of the velocity, rad/s.
     condition_number : float
-        Of the stacked, column-normalised regressors (:func:`condition_number`) on one period.
+        Of the stacked, column-normalised regressors (:func:`condition_number`) on one period
+        sampled :data:`FINE_SAMPLES` times.
     """
 
     robot: str
@@ -272,4 +275,6 @@ def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float 
         found = minimize(cost, best, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-4})
         best = found.x if found.fun <= cost(best) else best
     q0, a, b = trajectory(best)
-    return Excitation(model.name, period, q0, a, b, float(np.exp(cost(best))))
+    fine = np.linspace(0.0, period, FINE_SAMPLES, endpoint=False)  # the figure reported: on a fine sampling
+    return Excitation(model.name, period, q0, a, b, condition_number(model, fine, *_series(q0, a, b, period, fine),
+                                                                     effects))
