@@ -1,6 +1,8 @@
 """``faultgen calibrate`` on logs of another simulator: the independent-simulator test set.
 
-28 logs made with roboticstoolbox-python's dynamics (tests/independent_set.py: the PUMA 560 of
+28 logs (and 6 of round 3, issue 39: friction on a nearly constant gravity load, on the default and
+on a designed excitation, and a payload with a multi-axis Stribeck hump) made with
+roboticstoolbox-python's dynamics (tests/independent_set.py: the PUMA 560 of
 the toolbox and the IRB-6700-like arm as a toolbox ``DHRobot``, a Fourier excitation, effects
 in forms that differ from faultgen's own, 250-1000 Hz, 30-60 s, 4 without an effect). For each,
 the workflow gets the CSV and the robot name; a log is *named* when the first effects added
