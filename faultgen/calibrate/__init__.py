@@ -485,7 +485,7 @@ def _complete(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray,
         if not kind.per_axis or not open_axes:
             continue
         residual = tau - predicted
-        found, gains = search.reopen(kind, motion, residual, tau, split, open_axes)
+        found, gains = search.reopen(kind, motion, residual, tau, split, open_axes, floor)
         if not found.axes:
             continue
         trial_spec = mujoco.MjSpec.from_string(spec.to_xml())

@@ -61,6 +61,9 @@ REOPEN_EVIDENCE = 10.0
 #: An axis is still open when its held-out nrmse is above this multiple of its noise floor
 #: (:func:`noise_floor`).
 ABOVE_FLOOR = 1.2
+#: Share of an open axis's held-out nrmse above its noise floor that a re-searched effect must
+#: close (:func:`reopen`): a model mismatch the effect fits a little of is not the effect.
+REOPEN_SHARE = 0.5
 #: Blocks of the fitting part for the jackknife standard errors (:func:`standard_errors`).
 JACKKNIFE_BLOCKS = 10
 #: Rounds of a nested fit whose unfitted parameters follow from the fitted ones (:func:`_nested`).
@@ -546,12 +549,13 @@ def order(candidates: list[Candidate], residual: np.ndarray, split: Split) -> li
 
 
 def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split,
-           axes: list[int]) -> tuple[Candidate, dict[int, float]]:
+           axes: list[int], floor: np.ndarray | None = None) -> tuple[Candidate, dict[int, float]]:
     """``effect`` (already in the model on other axes) fitted again to ``residual`` (n, N) and
     judged on each of ``axes`` (0-based; those still above their noise floor) by its held-out
     evidence alone: the AIC gain ``n_eff ln(SSE_before / SSE_after) - 2 k`` of that axis
-    (:func:`held_out_aic`) must be at least :data:`REOPEN_EVIDENCE`, the held-out error must drop
-    and the fit be physical. The absolute gain threshold :data:`MIN_GAIN` does not apply: an
+    (:func:`held_out_aic`) must be at least :data:`REOPEN_EVIDENCE`, the held-out nrmse must drop
+    by at least :data:`REOPEN_SHARE` of its excess over ``floor`` (N,; default
+    :func:`noise_floor` of ``tau``), and the fit be physical. The absolute gain threshold :data:`MIN_GAIN` does not apply: an
     effect a first search found on some axes may be smaller than 1 % of the torque on another
     (a large payload added first leaves a hump there that is small beside the axis's torque).
 
@@ -573,7 +577,11 @@ def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray
         if not held[:, a].any() or after[a] <= 0 or before[a] <= 0:
             continue
         gains[a] = float(n_eff[a] * np.log(before[a] / after[a]) - 2 * k)
-    passing = sorted(a for a, g in gains.items() if g >= REOPEN_EVIDENCE and fit.gain[a] > 0 and fit.physical[a])
+    floor = noise_floor(tau, held) if floor is None else np.asarray(floor)
+    scale = _rms(tau, held)
+    excess = np.sqrt(before) / np.where(scale > 0, scale, 1.0) - floor  # held-out nrmse above the floor
+    passing = sorted(a for a, g in gains.items() if g >= REOPEN_EVIDENCE and fit.physical[a]
+                     and fit.gain[a] > 0 and fit.gain[a] >= REOPEN_SHARE * excess[a])
     mask = np.zeros(residual.shape[1], dtype=bool)
     mask[passing] = True
     found = Candidate(fit.effect, passing, fit.gain, fit.relative_gain, np.where(mask, fit.fitted_torque, 0.0),
