@@ -1,6 +1,8 @@
 """``faultgen calibrate`` on logs of another simulator: the independent-simulator test set.
 
-28 logs made with roboticstoolbox-python's dynamics (tests/independent_set.py: the PUMA 560 of
+28 logs (and 6 of round 3, issue 39: friction on a nearly constant gravity load, on the default and
+on a designed excitation, and a payload with a multi-axis Stribeck hump) made with
+roboticstoolbox-python's dynamics (tests/independent_set.py: the PUMA 560 of
 the toolbox and the IRB-6700-like arm as a toolbox ``DHRobot``, a Fourier excitation, effects
 in forms that differ from faultgen's own, 250-1000 Hz, 30-60 s, 4 without an effect). For each,
 the workflow gets the CSV and the robot name; a log is *named* when the first effects added
@@ -50,6 +52,8 @@ def run(case: independent_set.Case) -> dict:
         "hidden": " | ".join(f"{form} {axes.numbers(p['axes'])}" for form, p in hidden.forms.items()) or "-",
         "found": " | ".join(f"{effect} {axes.numbers(on)}" for effect, on in verdict["found"]) or "-",
         "named": verdict["named"], "halved": verdict["halved"], "gap_before": verdict["before"],
+        "ambiguous": "; ".join(verdict["ambiguous"]) or "-", "named_or_ambiguous": verdict["named_or_ambiguous"],
+        "all_axes": verdict["all_axes"],
         "gap_after": verdict["after"], "floor": floor.gap_before["total_nrmse"], "mass_error": verdict.get("mass_error"),
         "com_error_m": verdict.get("com_error"), "seconds": time.perf_counter() - started,
     }
@@ -58,14 +62,23 @@ def run(case: independent_set.Case) -> dict:
 def table(rows: pd.DataFrame) -> str:
     """Markdown: one row per log, then the counts the issue asks for."""
     lines = [("| log | Hz | s | qd | hidden | found | named | halved | gap before -> after | floor | "
-              "payload mass / com error |"),
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "payload mass / com error | not separable (fitted the first) |"),
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows.itertuples():
         payload = "-" if pd.isna(r.mass_error) else f"{100 * r.mass_error:.2f} % / {100 * r.com_error_m:.2f} cm"
         halved = "-" if pd.isna(r.halved) else ("yes" if r.halved else "no")
         lines.append(f"| {r.log} | {r.rate_Hz:g} | {r.duration_s:g} | {'yes' if r.velocities else 'no'} | {r.hidden} | "
                      f"{r.found} | {'yes' if r.named else 'no'} | {halved} | {r.gap_before:.4f} -> {r.gap_after:.4f} | "
-                     f"{r.floor:.4f} | {payload} |")
+                     f"{r.floor:.4f} | {payload} | {getattr(r, 'ambiguous', '-')} |")
+    if "all_axes" in rows:  # round 3 (issue 39): the new logs, judged as the issue asks
+        new = rows[rows.log.str.contains("-1[5-9]-")]
+        for r in new.itertuples():
+            lines.append(f"round 3: {r.log}: named right or not separable with the truth among the candidates: "
+                         f"{'yes' if r.named_or_ambiguous else 'no'}; every hidden effect on all its axes: "
+                         f"{'yes' if r.all_axes else 'no'}")
+        rows = rows[~rows.log.str.contains("-1[5-9]-")]  # the counts below are those of the original 28
+        lines.append(f"round 3 logs: {int(new.named_or_ambiguous.sum())} of {len(new)} named right or not separable "
+                     f"with the truth among the candidates; {int(new.all_axes.sum())} of {len(new)} on all axes")
     effect = rows[rows.hidden != "-"]
     null = rows[rows.hidden == "-"]
     both = effect.named & effect.halved.astype(bool)
@@ -93,12 +106,19 @@ def main() -> None:
         print(table(pd.read_csv(args.from_csv)))
         return
     cases = [c for c in independent_set.CASES if not args.cases or any(n in c.name for n in args.cases)]
+    if args.cases:  # in the order given
+        cases.sort(key=lambda c: min(k for k, n in enumerate(args.cases) if n in c.name))
     if not cases:
         parser.error(f"no log name contains any of {args.cases}; names: {[c.name for c in independent_set.CASES]}")
     started = time.perf_counter()
-    rows = pd.DataFrame(Parallel(n_jobs=args.jobs, verbose=5)(delayed(run)(c) for c in cases))
-    if args.csv:
-        rows.to_csv(args.csv, index=False)
+    done = []
+    # rows as they finish: a run cut short keeps the logs that finished in the CSV
+    for row in Parallel(n_jobs=args.jobs, verbose=5, return_as="generator_unordered")(delayed(run)(c) for c in cases):
+        done.append(row)
+        if args.csv:
+            pd.DataFrame(done).to_csv(args.csv, index=False)
+    order = {c.name: k for k, c in enumerate(cases)}
+    rows = pd.DataFrame(sorted(done, key=lambda r: order[r["log"]]))
     print(f"{len(cases)} logs in {time.perf_counter() - started:.0f} s with {args.jobs} jobs "
           f"(longest calibration {rows.seconds.max():.0f} s)")
     print(table(rows))

@@ -29,9 +29,13 @@ def save(result, path: str | Path) -> Path:
     fig, axes = plt.subplots(n_axes, 2, figsize=(13, 14 * n_axes / 6), sharex=True)
     added = ", ".join(f"{s['effect']} (axes {', '.join(map(str, s['axes']))})"
                       for s in (step.record() for step in result.steps)) or "nothing"
+    ambiguous = "".join(
+        f"\nstep {a['step']}: not separable on this log: "
+        + " / ".join(f"{c['effect']} (dAIC {c['delta_aic']:.1f})" for c in a["candidates"])
+        + f"; fitted {a['fitted']}" for a in result.ambiguous())
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
-                 f"{result.gap_after['total_nrmse']:.3f}", fontsize=11)
+                 f"{result.gap_after['total_nrmse']:.3f}{ambiguous}", fontsize=11)
     for axis in range(n_axes):
         left, right = axes[axis]
         left.plot(t, result.tau[:, axis], color="black", lw=0.8, label="measured")

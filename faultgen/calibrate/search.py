@@ -17,9 +17,16 @@ tau_model`` (arm side, N m):
    axis's held-out nrmse before the step (a significance threshold on the effect size that noise
    and the rigid-model mismatch stay under; docs/calibration.md gives the null-case figures), and
    the fit is physical: within the effect's bounds and the motor's torque limit.
-4. The effect with the largest total significant gain wins; an effect whose gain is within
-   :data:`TIE` of the best and comes earlier in :data:`faultgen.effects.EFFECTS`
-   (fewer parameters or simpler physics) is preferred.
+4. The candidates with significant axes are compared by an information criterion on the
+   held-out part (:func:`held_out_aic`): Akaike's criterion of the Gaussian held-out likelihood,
+   each axis with its own noise variance and its *effective* number of samples (the held-out
+   count over the residual's integrated autocorrelation time, so that a smooth, correlated
+   residual does not count as thousands of independent samples), penalised by twice the
+   parameters fitted. Candidates within :data:`SEPARABLE` of the best (Burnham & Anderson 2002,
+   *Model Selection and Multimodel Inference*, 2nd ed., sec. 2.6: a difference of at most 2 means
+   substantial support for both) are **not separable on this log**: the simplest of them (earliest
+   in :data:`faultgen.effects.EFFECTS`) is fitted and the step's evidence lists them all with
+   their AIC differences, Akaike weights and evidence ratios (:func:`compare`).
 
 The workflow (:func:`faultgen.calibrate.calibrate`) adds the winner to the model on its
 significant axes, recomputes the residual with the augmented model and repeats until no
@@ -35,6 +42,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from tqdm.auto import tqdm
 
+from faultgen import axes as axis_numbers
 from faultgen.effects import EFFECTS, REST_SPEED, Effect, Motion
 
 #: Share of the record (by time, from the start) used for fitting; the rest is held out.
@@ -43,8 +51,19 @@ FIT_FRACTION = 0.7
 MIN_GAIN = 0.01
 #: Smallest held-out nrmse drop of an axis relative to its nrmse before the step.
 MIN_RELATIVE_GAIN = 0.2
-#: Relative gain margin within which an earlier (simpler) effect is preferred.
-TIE = 0.1
+#: Held-out AIC difference up to which two effects are not separable on a log (Burnham & Anderson
+#: 2002, sec. 2.6: 0-2 substantial support for both); the simpler one is fitted.
+SEPARABLE = 2.0
+#: Held-out AIC gain an effect already in the model must give on an axis still above its noise
+#: floor to be added there (:func:`reopen`; Burnham & Anderson 2002, sec. 2.6: above 10 the model
+#: without it has essentially no support).
+REOPEN_EVIDENCE = 10.0
+#: An axis is still open when its held-out nrmse is above this multiple of its noise floor
+#: (:func:`noise_floor`).
+ABOVE_FLOOR = 1.2
+#: Share of an open axis's held-out nrmse above its noise floor that a re-searched effect must
+#: close (:func:`reopen`): a model mismatch the effect fits a little of is not the effect.
+REOPEN_SHARE = 0.5
 #: Blocks of the fitting part for the jackknife standard errors (:func:`standard_errors`).
 JACKKNIFE_BLOCKS = 10
 #: Rounds of a nested fit whose unfitted parameters follow from the fitted ones (:func:`_nested`).
@@ -112,6 +131,12 @@ class Candidate:
         ``gain`` over the held-out nrmse before.
     contribution : ndarray of shape (n, 6)
         Fitted torque of the effect, N m (zero on axes that are not significant).
+    fitted_torque : ndarray of shape (n, 6)
+        Fitted torque on every axis, significant or not, N m (:func:`reopen` tries the others).
+    physical : ndarray of shape (6,)
+        Whether the fit of each axis may be written (:func:`_physical`).
+    parameters : int
+        Parameters fitted per axis (once when robot-wide), for the information criterion.
     """
 
     effect: Effect
@@ -119,6 +144,16 @@ class Candidate:
     gain: np.ndarray
     relative_gain: np.ndarray
     contribution: np.ndarray
+    fitted_torque: np.ndarray | None = None
+    physical: np.ndarray | None = None
+    parameters: int = 1
+
+    @property
+    def fitted_parameters(self) -> int:
+        """Parameters the step would add: per significant axis, or once when robot-wide."""
+        if not self.axes:
+            return 0
+        return self.parameters * (len(self.axes) if self.effect.per_axis else 1)
 
     @property
     def score(self) -> float:
@@ -142,6 +177,8 @@ def _nested(design: np.ndarray, target: np.ndarray, levels: tuple[int, ...] | No
     completed columns held (:data:`COMPLETE_ITERATIONS` rounds)."""
     best, best_bic = None, np.inf
     k = design.shape[-1]
+    if target.size == 0:  # an axis that never moves faster than the rest speed: nothing to fit
+        return np.zeros(k)
     for level in levels or (k,):
         theta = np.zeros(k)
         for _ in range(COMPLETE_ITERATIONS if complete is not None and level < k else 1):
@@ -222,8 +259,10 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
     gain = before - after
     relative = gain / np.where(before > 0, before, 1.0)
     significant = (gain >= MIN_GAIN) & (relative >= MIN_RELATIVE_GAIN)
+    physical = np.ones(residual.shape[1], dtype=bool)
     if effect.per_axis:
-        significant &= [_physical(effect, motion, a, params[a]) for a in range(residual.shape[1])]
+        physical = np.array([_physical(effect, motion, a, params[a]) for a in range(residual.shape[1])])
+        significant &= physical
         axes = [int(a) for a in np.flatnonzero(significant)]
     else:
         # robot-wide: significant as a whole when the mean gain passes both thresholds
@@ -234,7 +273,17 @@ def fit_effect(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.nda
         axes = list(range(residual.shape[1])) if whole else []
     mask = np.zeros(residual.shape[1], dtype=bool)
     mask[axes] = True
-    return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0))
+    return Candidate(fitted, axes, gain, relative, np.where(mask, contribution, 0.0), contribution, physical,
+                     parameter_count(effect))
+
+
+def parameter_count(effect: Effect) -> int:
+    """Parameters an effect fits per axis (once when robot-wide): its linear ones plus one for a
+    nonlinear parameter chosen from a grid or by its own search (a Stribeck velocity, a
+    load-friction form, a backlash width)."""
+    nonlinear = effect.per_axis and (effect.continuous or type(effect).grid is not Effect.grid
+                                     or type(effect).search is not Effect.search)
+    return int(effect.n_parameters) + int(nonlinear)
 
 
 def _fit(effect: Effect, motion: Motion, residual: np.ndarray, rows: np.ndarray, scale: np.ndarray,
@@ -376,17 +425,165 @@ def _physical(effect: Effect, motion: Motion, axis: int, params: dict[str, float
     return bool(effect.admissible(motion, axis, params) and effect.motor_torque(motion, axis, params) <= limit)
 
 
+def noise_floor(tau: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Per-axis nrmse a perfect model would leave on the samples of ``mask`` (n, N): the torque
+    sensor's noise, estimated from the second differences of ``tau`` (n, N) (N m) by their median
+    absolute deviation (white noise ``e`` has ``var(e[t+1] - 2 e[t] + e[t-1]) = 6 var(e)``; the
+    median keeps the steps of a friction reversal out), over the torque RMS on ``mask``.
+
+    Returns
+    -------
+    ndarray of shape (N,)
+        Noise standard deviation over the axis's torque RMS (0 for an axis without samples).
+    """
+    tau = np.asarray(tau, dtype=float)
+    second = tau[2:] - 2 * tau[1:-1] + tau[:-2]
+    inner = np.asarray(mask)[1:-1]
+    sigma = np.array([1.4826 * np.median(np.abs(second[inner[:, a], a] - np.median(second[inner[:, a], a])))
+                      / np.sqrt(6) if inner[:, a].any() else 0.0 for a in range(tau.shape[1])])
+    scale = _rms(tau, mask)
+    return np.where(scale > 0, sigma / np.where(scale > 0, scale, 1.0), 0.0)
+
+
+def effective_samples(residual: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """Per axis, the number of independent samples the residual (n, N) on ``mask`` (n, N) is worth:
+    the sample count over the integrated autocorrelation time ``1 + 2 sum_k rho_k``, summed up to
+    the first lag whose autocorrelation is not positive (Geyer 1992's initial positive sequence, in
+    its simplest form). White noise gives the sample count; a smooth residual far fewer.
+
+    Returns
+    -------
+    ndarray of shape (N,)
+        At least 1 where the axis has samples, 0 where it has none.
+    """
+    out = np.zeros(residual.shape[1])
+    for a in range(residual.shape[1]):
+        x = residual[mask[:, a], a]
+        m = x.size
+        if m < 3:
+            out[a] = float(m)
+            continue
+        x = x - x.mean()
+        spectrum = np.fft.rfft(x, 2 * m)
+        acf = np.fft.irfft(spectrum * np.conj(spectrum))[:m]
+        if acf[0] <= 0:
+            out[a] = float(m)
+            continue
+        rho = acf[1:] / acf[0]
+        stop = np.flatnonzero(rho <= 0)
+        rho = rho[: stop[0] if stop.size else rho.size]
+        out[a] = max(1.0, m / max(1.0, 1.0 + 2.0 * float(np.sum(rho))))
+    return out
+
+
+def held_out_aic(residual: np.ndarray, contribution: np.ndarray, held: np.ndarray, n_eff: np.ndarray,
+                 parameters: int) -> float:
+    """Akaike's information criterion of a model on the held-out part, up to a constant that is the
+    same for every model of the same residual: ``sum_a n_eff_a ln(SSE_a / m_a) + 2 k`` with
+    ``SSE_a`` the held-out sum of squares of ``residual - contribution`` (n, N) on axis a,
+    ``m_a`` its held-out samples, ``n_eff_a`` their effective number (:func:`effective_samples`)
+    and ``k`` the parameters fitted. Each axis has its own Gaussian noise variance, estimated by
+    ``SSE_a / m_a`` (Akaike 1974; Burnham & Anderson 2002, sec. 2.2)."""
+    error = np.where(held, residual - contribution, 0.0)
+    count = np.maximum(held.sum(axis=0), 1)
+    mse = np.maximum(np.sum(error**2, axis=0) / count, 1e-300)
+    used = held.any(axis=0)
+    return float(np.sum(n_eff[used] * np.log(mse[used])) + 2 * parameters)
+
+
+def compare(candidates: list[Candidate], residual: np.ndarray, split: Split,
+            reference: Candidate | None = None) -> dict[str, dict]:
+    """Held-out evidence of each candidate with significant axes (:func:`held_out_aic`), keyed by
+    effect id: ``aic``, ``delta_aic`` (over the best), ``weight`` (the Akaike weight
+    ``exp(-delta/2) / sum exp(-delta_j/2)``), ``evidence_ratio`` (the best's weight over its own,
+    ``exp(delta/2)``), ``axes`` (1..N) and ``separable`` (``delta_aic > SEPARABLE``; the best is
+    not separable from itself). The effective sample sizes are those of the residual ``reference``
+    leaves (default: the best by AIC), the same for every candidate."""
+    held = split.held_out
+    live = [c for c in candidates if c.axes]
+    if not live:
+        return {}
+    if reference is None:
+        crude = effective_samples(residual, held)
+        reference = min(live, key=lambda c: held_out_aic(residual, c.contribution, held, crude, c.fitted_parameters))
+    n_eff = effective_samples(residual - reference.contribution, held)
+    aic = {c.effect.id: held_out_aic(residual, c.contribution, held, n_eff, c.fitted_parameters) for c in live}
+    best = min(aic.values())
+    delta = {k: v - best for k, v in aic.items()}
+    total = sum(np.exp(-d / 2) for d in delta.values())
+    return {c.effect.id: {"aic": aic[c.effect.id], "delta_aic": delta[c.effect.id],
+                          "weight": float(np.exp(-delta[c.effect.id] / 2) / total),
+                          "evidence_ratio": float(np.exp(min(delta[c.effect.id], 1400.0) / 2)),
+                          "axes": axis_numbers.numbers(c.axes), "separable": bool(delta[c.effect.id] > SEPARABLE)}
+            for c in live}
+
+
 def rank(motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split, progress: bool = False,
          label: str = "fitting effects") -> list[Candidate]:
     """All effects fitted, best first per the selection rule of this module's docstring
-    (``progress``: a progress bar over the effects, labelled ``label``)."""
+    (``progress``: a progress bar over the effects, labelled ``label``): first the effect fitted
+    (the simplest of those not separable from the best by held-out AIC), then the others with
+    significant axes by AIC, then the rest by score."""
     effects = tqdm(EFFECTS.values(), desc=label, unit="effect", disable=not progress, leave=False)
     candidates = [fit_effect(e, motion, residual, tau, split) for e in effects]
-    order = {e.id: k for k, e in enumerate(EFFECTS.values())}
-    best = max(c.score for c in candidates)
+    return order(candidates, residual, split)
+
+
+def order(candidates: list[Candidate], residual: np.ndarray, split: Split) -> list[Candidate]:
+    """``candidates`` (fitted to ``residual``) in the order :func:`rank` gives."""
+    place = {e.id: k for k, e in enumerate(EFFECTS.values())}
+    evidence = compare(candidates, residual, split)
+    if not evidence:
+        return sorted(candidates, key=lambda c: (-c.score, place.get(c.effect.id, len(place))))
+    tied = [c for c in candidates if c.effect.id in evidence and not evidence[c.effect.id]["separable"]]
+    chosen = min(tied, key=lambda c: place.get(c.effect.id, len(place)))
 
     def key(c: Candidate):
-        near_best = best > 0 and c.score >= (1 - TIE) * best
-        return (not near_best, order[c.effect.id] if near_best else -c.score)
+        if c is chosen:
+            return (0, 0.0)
+        if c.effect.id in evidence:
+            return (1, evidence[c.effect.id]["delta_aic"])
+        return (2, -c.score)
 
     return sorted(candidates, key=key)
+
+
+def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray, split: Split,
+           axes: list[int], floor: np.ndarray | None = None) -> tuple[Candidate, dict[int, float]]:
+    """``effect`` (already in the model on other axes) fitted again to ``residual`` (n, N) and
+    judged on each of ``axes`` (0-based; those still above their noise floor) by its held-out
+    evidence alone: the AIC gain ``n_eff ln(SSE_before / SSE_after) - 2 k`` of that axis
+    (:func:`held_out_aic`) must be at least :data:`REOPEN_EVIDENCE`, the held-out nrmse must drop
+    by at least :data:`REOPEN_SHARE` of its excess over ``floor`` (N,; default
+    :func:`noise_floor` of ``tau``), and the fit be physical. The absolute gain threshold :data:`MIN_GAIN` does not apply: an
+    effect a first search found on some axes may be smaller than 1 % of the torque on another
+    (a large payload added first leaves a hump there that is small beside the axis's torque).
+
+    Returns
+    -------
+    (Candidate, dict)
+        The fit (``axes`` the axes that pass, ``contribution`` on them only) and the AIC gain of
+        every axis tried.
+    """
+    fit = fit_effect(effect, motion, residual, tau, split)
+    held = split.held_out
+    k = parameter_count(effect)
+    n_eff = effective_samples(residual - fit.fitted_torque, held)
+    count = np.maximum(held.sum(axis=0), 1)
+    before = np.sum(np.where(held, residual, 0.0) ** 2, axis=0) / count
+    after = np.sum(np.where(held, residual - fit.fitted_torque, 0.0) ** 2, axis=0) / count
+    gains = {}
+    for a in axes:
+        if not held[:, a].any() or after[a] <= 0 or before[a] <= 0:
+            continue
+        gains[a] = float(n_eff[a] * np.log(before[a] / after[a]) - 2 * k)
+    floor = noise_floor(tau, held) if floor is None else np.asarray(floor)
+    scale = _rms(tau, held)
+    excess = np.sqrt(before) / np.where(scale > 0, scale, 1.0) - floor  # held-out nrmse above the floor
+    passing = sorted(a for a, g in gains.items() if g >= REOPEN_EVIDENCE and fit.physical[a]
+                     and fit.gain[a] > 0 and fit.gain[a] >= REOPEN_SHARE * excess[a])
+    mask = np.zeros(residual.shape[1], dtype=bool)
+    mask[passing] = True
+    found = Candidate(fit.effect, passing, fit.gain, fit.relative_gain, np.where(mask, fit.fitted_torque, 0.0),
+                      fit.fitted_torque, fit.physical, k)
+    return found, gains

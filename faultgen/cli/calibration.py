@@ -28,7 +28,8 @@ def calibrate_command(
     the library is fitted to the residual on the first 70 % of the record and judged on the last
     30 % (held out); the effect that cuts the held-out error most, on the axes where the cut is
     significant, is written into the model, and the search repeats until nothing significant is
-    left. A log the robot cannot explain (another robot, motor-side torque, a column in another
+    left. When the log cannot tell two effects apart (held-out AIC within 2), the simpler is fitted
+    and the summary, report.json and the figure say so, with the motion that would separate them. A log the robot cannot explain (another robot, motor-side torque, a column in another
     unit or with the other sign) is refused before anything is written, naming what to check.
 
     Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
@@ -54,3 +55,36 @@ def calibrate_command(
     result = calibrate.calibrate(robot, measured, out, max_steps=max_steps, progress=True)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
+
+
+@app.command("excitation", cls=Command)
+def excitation_command(
+    robot: Annotated[str, typer.Argument(help="Robot name (see `faultgen robots`) or MJCF file.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="CSV file to write: columns t, q1..qN (s, rad).")],
+    period: Annotated[float, typer.Option(help="Fundamental period of the Fourier series, s.")] = 10.0,
+    harmonics: Annotated[int, typer.Option(help="Harmonics of the Fourier series.")] = 5,
+    iterations: Annotated[int, typer.Option(help="Most optimiser iterations.")] = 8,
+    seed: Annotated[int, typer.Option(help="Seed of the optimiser's random start.")] = 0,
+    overwrite: Overwrite = False,
+) -> None:
+    """Design a periodic excitation on which a torque log tells the calibration's effects apart.
+
+    A finite Fourier series per axis (Swevers et al. 1997), at rest at its start and end, within
+    the joint ranges and the planning velocity and acceleration limits of the robot's tasks.toml,
+    optimised for a small condition number of the effects' stacked regressors. Written at the
+    planning period (4 ms), one period, as a program for `--task FILE.csv`. Method:
+    docs/calibration.md.
+
+    Example:
+
+    \b
+      faultgen excitation puma560 -o excitation.csv
+    """
+    from faultgen.calibrate import excitation
+    from faultgen.cli.base import check_outputs
+
+    check_outputs([out], overwrite)
+    designed = excitation.design(robot, harmonics=harmonics, period=period, seed=seed, iterations=iterations)
+    designed.write(out)
+    typer.echo(f"wrote {out}: {designed.period:g} s period, {len(designed.a)} harmonics, regressor condition "
+               f"number {designed.condition_number:.1f}")

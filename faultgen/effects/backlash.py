@@ -46,6 +46,9 @@ class Backlash(Effect):
 
     id = "backlash"
     rank = 90
+    designable = False
+    excited_by = (
+        "reversals of the transmitted torque (accelerations that change the gearbox load's sign)")
     summary = "gearbox backlash (dead band between motor and arm)"
     units: ClassVar[dict[str, str]] = {"width": "rad (arm side)"}
     absent = (0.0,)

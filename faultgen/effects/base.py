@@ -237,6 +237,13 @@ class Effect:
     #: (the optimiser keeps the most detailed admissible level the Bayesian information criterion
     #: supports, per axis for a per-axis effect); None: all at once.
     levels: ClassVar[tuple[int, ...] | None] = None
+    #: What motion tells this effect apart from the others (the calibration's report says it when
+    #: a log cannot, :func:`faultgen.calibrate.search.compare`).
+    excited_by: ClassVar[str] = ""
+    #: Whether the excitation design (:mod:`faultgen.calibrate.excitation`) separates this effect
+    #: by the motion's shape: False for one told apart by the log's length (a warm-up) or whose
+    #: regressors need the motor angle or gearbox state at the log's rate (cogging, backlash).
+    designable: ClassVar[bool] = True
     #: Hidden-effect drawing (:mod:`faultgen.calibrate.synth`): may the drawn effect be negative.
     signed: ClassVar[bool] = False
     #: Hidden-effect drawing: largest value of a parameter; a drawn effect past it is shrunk to it.

@@ -24,6 +24,9 @@ class Cogging(Effect):
 
     id = "cogging"
     rank = 80
+    designable = False
+    excited_by = (
+        "slow steady motion over several motor revolutions (the ripple repeats with the motor angle)")
     summary = "cogging torque (periodic in the motor angle)"
     units: ClassVar[dict[str, str]] = {"amplitude": "N m (motor side)", "poles": "1", "phase": "rad"}
     absent = (0.0, 0.0, 0.0)

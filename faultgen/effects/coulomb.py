@@ -24,6 +24,9 @@ class Coulomb(FrictionParameter):
 
     id = "coulomb"
     rank = 20
+    excited_by = (
+        "reversals at several speeds under a steady load (a Coulomb level keeps its size at every speed "
+        "and load)")
     summary = "Coulomb friction level differs (constant torque against the motion)"
     units: ClassVar[dict[str, str]] = {"coulomb_pos": "N m (motor side)", "coulomb_neg": "N m (motor side)"}
     absent = (0.0, 0.0)

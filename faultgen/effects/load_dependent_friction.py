@@ -35,6 +35,9 @@ class LoadDependentFriction(Effect):
 
     id = "load_dependent_friction"
     rank = 50
+    excited_by = (
+        "motion under a load that changes while the axis moves: wide swings of the axes that carry "
+        "gravity (the friction follows |load|)")
     summary = "friction that grows with the gearbox load"
     units: ClassVar[dict[str, str]] = {"coefficient": "1", "gravity_load": "1"}
     absent = (0.0, 0.0)

@@ -84,6 +84,9 @@ class Payload(Effect):
 
     id = "payload"
     rank = 70
+    excited_by = (
+        "poses and accelerations of the forearm and wrist that change the payload's gravity and inertia "
+        "torques")
     summary = "an unmodelled payload (mass, centre of mass and inertia at the flange)"
     units: ClassVar[dict[str, str]] = {
         "mass": "kg", "com_x": "m (flange frame)", "com_y": "m (flange frame)", "com_z": "m (flange frame)",

@@ -46,6 +46,9 @@ class Stribeck(FrictionParameter):
 
     id = "stribeck"
     rank = 40
+    excited_by = (
+        "slow passes from the rest speed to a few times the Stribeck velocity (the hump falls off with "
+        "the speed)")
     summary = "Stribeck friction (extra friction at low speed, fading with speed) differs"
     units: ClassVar[dict[str, str]] = {"static": "N m (motor side)", "stribeck_velocity": "rad/s (motor side)",
                                        "stribeck_exponent": "1"}

@@ -92,6 +92,9 @@ class Temperature(Effect):
 
     id = "temperature"
     rank = 60
+    designable = False
+    excited_by = (
+        "a long log from a cold start (the warm-up fades with its time constant, a level does not)")
     summary = "friction drifting with time (a gearbox warming up)"
     units: ClassVar[dict[str, str]] = {"amplitude": "1", "time_constant": "s"}
     absent = (0.0, 1.0)

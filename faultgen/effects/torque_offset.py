@@ -22,6 +22,9 @@ class TorqueOffset(Effect):
 
     id = "torque_offset"
     rank = 10
+    excited_by = (
+        "motion in both directions over the range of loads (an offset keeps its sign when the speed "
+        "reverses)")
     summary = "a constant torque offset"
     units: ClassVar[dict[str, str]] = {"offset": "N m (arm side)"}
     absent = (0.0,)

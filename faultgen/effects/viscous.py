@@ -18,6 +18,8 @@ class Viscous(FrictionParameter):
 
     id = "viscous"
     rank = 30
+    excited_by = (
+        "a wide range of steady speeds (viscous friction grows with the speed, a dry level does not)")
     summary = "viscous friction differs (torque proportional to speed)"
     units: ClassVar[dict[str, str]] = {"viscous": "N m s/rad (motor side)"}
     absent = (0.0,)

@@ -1,0 +1,280 @@
+"""Excitation design: a periodic joint trajectory on which a torque log tells the library's effects apart.
+
+A finite Fourier series per axis (Swevers, Ganseman, Tukel, De Schutter & Van Brussel 1997,
+"Optimal robot excitation and identification", IEEE Trans. Robot. Autom. 13(5), eq. 5)::
+
+    q_i(t) = q0_i + sum_l a_il / (w l) sin(w l t) - b_il / (w l) cos(w l t),   l = 1..L, w = 2 pi / T
+
+so ``qd_i = sum_l a_il cos(w l t) + b_il sin(w l t)``. The coefficients are chosen to minimise
+the condition number of the stacked regressors of the effects the calibration searches
+(:func:`regressor`: per axis the columns of each effect, :meth:`faultgen.effects.Effect.columns`,
+block-diagonal over the axes, with the robot-wide payload's columns across them; every column
+scaled to unit norm), the criterion of Swevers et al. (sec. IV.A; Gautier & Khalil 1992): two
+effects whose columns are nearly parallel on a motion cannot be told apart on a log of it, and the
+condition number is large. Limits hold by construction: the velocity and acceleration are zero at
+``t = 0`` (``sum_l a_il = 0``, ``sum_l l b_il = 0``, so the trajectory starts and ends at rest and
+can be repeated), and each axis's series is scaled down until it stays within its share of the
+joint range and within the planning velocity and acceleration limits of the robot's
+``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser is scipy's L-BFGS-B on the
+logarithm of the condition number, from a seeded random start: same seed, same trajectory.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import minimize
+
+from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
+from faultgen.calibrate.effects import get
+from faultgen.calibrate.effects import motion as motion_of
+from faultgen.data import atomic
+from faultgen.model import robots
+from faultgen.operation import tasks
+
+#: Effects whose regressors the design separates, simplest first: every effect of the library
+#: that is :attr:`~faultgen.effects.Effect.designable` (left out: the warm-up, told apart by the
+#: log's length from a cold start, not by the motion; cogging and backlash, whose regressors need
+#: the motor angle and gearbox state at the log's rate, not the plan's).
+EFFECTS = tuple(effect.id for effect in ALL_EFFECTS.values() if effect.designable)
+#: Harmonics and fundamental period (s) of the series (Swevers et al. 1997 use 5 and 10 s).
+HARMONICS = 5
+PERIOD = 10.0
+#: Share of each axis's half range around its middle the excitation may use.
+RANGE_SHARE = 0.8
+#: Share of the planning velocity and acceleration limits the excitation may use.
+LIMIT_SHARE = 0.9
+#: Samples per period on which the condition number is evaluated while optimising, and on which
+#: the design's figure is reported (:attr:`Excitation.condition_number`).
+SAMPLES = 100
+FINE_SAMPLES = 1000
+
+
+@dataclass(frozen=True)
+class Excitation:
+    """A periodic excitation trajectory (module docstring).
+
+    Attributes
+    ----------
+    robot : str
+    period : float
+        Fundamental period T, s.
+    q0 : ndarray of shape (N,)
+        Offsets, rad.
+    a, b : ndarray of shape (L, N)
+        Sine and cosine coefficients of the velocity, rad/s.
+    condition_number : float
+        Of the stacked, column-normalised regressors (:func:`condition_number`) on one period
+        sampled :data:`FINE_SAMPLES` times.
+    """
+
+    robot: str
+    period: float
+    q0: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    condition_number: float = float("nan")
+
+    def sample(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Angles (rad), velocities (rad/s), accelerations (rad/s^2) at times ``t`` (n,) s, each (n, N)."""
+        return _series(self.q0, self.a, self.b, self.period, np.asarray(t, dtype=float))
+
+    def to_csv(self, dt: float = tasks.PLAN_PERIOD, periods: int = 1) -> str:
+        """The trajectory as CSV text: columns ``t, q1..qN`` (s, rad) every ``dt`` s over ``periods``
+        periods, the last sample back at the first pose (a program for ``--task log.csv``).
+
+        Raises
+        ------
+        ValueError
+            If ``dt`` is not positive or ``periods`` < 1.
+        """
+        if not dt > 0 or periods < 1:
+            raise ValueError(f"dt = {dt} s and periods = {periods}; expected dt > 0 and periods >= 1")
+        steps = int(round(periods * self.period / dt))
+        t = np.arange(steps + 1) * dt
+        q = self.sample(t)[0]
+        buffer = io.StringIO()
+        header = ",".join(["t", *[f"q{i + 1}" for i in range(q.shape[1])]])
+        np.savetxt(buffer, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.9g")
+        return buffer.getvalue()
+
+    def write(self, path: str | Path, dt: float = tasks.PLAN_PERIOD, periods: int = 1) -> Path:
+        """Write :meth:`to_csv` to ``path`` atomically; returns the path."""
+        path = Path(path)
+        atomic.write_text(path, self.to_csv(dt, periods))
+        return path
+
+
+def _series(q0, a, b, period, t):
+    w = 2 * np.pi / period
+    harmonics = np.arange(1, a.shape[0] + 1)
+    phase = np.outer(t, w * harmonics)  # (n, L)
+    s, c = np.sin(phase), np.cos(phase)
+    wl = (w * harmonics)[:, None]
+    q = q0 + s @ (a / wl) - c @ (b / wl)
+    qd = c @ a + s @ b
+    qdd = -(s * (w * harmonics)) @ a + (c * (w * harmonics)) @ b
+    return q, qd, qdd
+
+
+def limits(robot: robots.Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint range (N, 2) rad, velocity (N,) rad/s and acceleration (N,) rad/s^2 limits: the
+    model's joint ranges and the planning limits of its ``tasks.toml``."""
+    task = tasks.load(robot, tasks.TASKS[0])
+    return np.asarray(robot.joint_range, dtype=float), task.velocity_limit, task.acceleration_limit
+
+
+def _at_rest(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Project the coefficients onto zero velocity (``sum_l a_l = 0``) and zero acceleration
+    (``sum_l l b_l = 0``) at ``t = 0``."""
+    harmonics = np.arange(1, a.shape[0] + 1, dtype=float)[:, None]
+    a = a - a.mean(axis=0)
+    b = b - harmonics * np.sum(harmonics * b, axis=0) / np.sum(harmonics**2)
+    return a, b
+
+
+def _within_limits(robot_limits, a, b, period, t):
+    """Scale each axis's coefficients so the series stays within its limits; returns q0, a, b."""
+    joint_range, velocity, acceleration = robot_limits
+    middle = joint_range.mean(axis=1)
+    zero = np.zeros_like(middle)
+    q, qd, qdd = _series(zero, a, b, period, t)
+    q = q - (q.max(axis=0) + q.min(axis=0)) / 2  # centred on the range's middle
+    half = RANGE_SHARE * (joint_range[:, 1] - joint_range[:, 0]) / 2
+    tiny = 1e-12
+    scale = np.minimum.reduce([half / np.maximum(np.abs(q).max(axis=0), tiny),
+                               LIMIT_SHARE * velocity / np.maximum(np.abs(qd).max(axis=0), tiny),
+                               LIMIT_SHARE * acceleration / np.maximum(np.abs(qdd).max(axis=0), tiny)])
+    a, b = a * scale, b * scale
+    raw = _series(zero, a, b, period, t)[0]
+    q0 = middle - (raw.max(axis=0) + raw.min(axis=0)) / 2
+    return q0, a, b
+
+
+def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+              effects: tuple[str, ...] = EFFECTS, keep: list | None = None) -> tuple[np.ndarray, list]:
+    """The stacked regressors of ``effects`` along a motion: rows ``(n N)`` (axis by axis), columns
+    the per-axis effects' columns on each axis (block-diagonal) and the robot-wide ones across
+    the axes, each scaled to unit norm. A per-axis effect with a nonlinear parameter is taken at
+    the middle of its search grid (:meth:`faultgen.effects.Effect.grid`), every value when the grid
+    has at most three (the load-friction forms).
+
+    ``keep``: the columns to take, as returned by an earlier call (so a design keeps one set);
+    None: every column that is not (to 1e-6) a combination of earlier ones on this motion
+    (Coulomb's "positive direction" column is one with the offset and Coulomb's own).
+
+    Returns
+    -------
+    (ndarray of shape (n N, k), list)
+        The matrix and the keys of its columns ``(effect id, axis or None, grid value, column)``.
+    """
+    motion = motion_of(robot, t, q, qd, qdd)
+    n, n_axes = q.shape
+    columns, keys = [], []
+    for effect_id in effects:
+        effect = get(effect_id)
+        if not effect.per_axis:
+            phi, _ = effect.columns(motion, None, None)  # (n, N, k)
+            for c in range(phi.shape[2]):
+                columns.append(phi[:, :, c].T.reshape(-1))
+                keys.append((effect_id, None, None, c))
+            continue
+        for axis in range(n_axes):
+            grid = effect.grid(motion, axis)
+            chosen = grid if len(grid) <= 3 else [grid[len(grid) // 2]]
+            for h in chosen:
+                phi, _ = effect.columns(motion, axis, h)
+                for c in range(phi.shape[1]):
+                    column = np.zeros((n_axes, n))
+                    column[axis] = phi[:, c]
+                    columns.append(column.reshape(-1))
+                    keys.append((effect_id, axis, h, c))
+    if keep is not None:  # same effects, same columns; a grid value of this motion replaces the kept one
+        chosen = []
+        for key in keep:
+            matches = [i for i, k in enumerate(keys) if k[0] == key[0] and k[1] == key[1] and k[3] == key[3]
+                       and (k[2] == key[2] or not isinstance(key[2], (int, np.integer)))]
+            chosen.append(matches[0] if matches else None)
+        matrix = np.column_stack([columns[i] if i is not None else np.zeros(n * n_axes) for i in chosen])
+        return _normalised(matrix), list(keep)
+    matrix = _normalised(np.column_stack(columns))
+    kept, basis = [], np.zeros((matrix.shape[0], 0))
+    for i in range(matrix.shape[1]):  # Gram-Schmidt: keep a column with a part outside the span so far
+        rest = matrix[:, i] - basis @ (basis.T @ matrix[:, i])
+        size = float(np.linalg.norm(rest))
+        if size > 1e-6:
+            kept.append(i)
+            basis = np.column_stack([basis, rest / size])
+    return matrix[:, kept], [keys[i] for i in kept]
+
+
+def _normalised(matrix: np.ndarray) -> np.ndarray:
+    norms = np.linalg.norm(matrix, axis=0)
+    return matrix / np.where(norms > 0, norms, 1.0)
+
+
+def condition_number(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
+                     effects: tuple[str, ...] = EFFECTS, keep: list | None = None) -> float:
+    """Condition number (largest over smallest singular value) of :func:`regressor` along a motion
+    (inf when a column is zero or two are parallel)."""
+    matrix, _ = regressor(robot, t, q, qd, qdd, effects, keep)
+    # singular values as the square roots of the Gram matrix's eigenvalues (k x k, k << n): the
+    # same to well within the design's needs up to a condition number of about 1e7
+    eigen = np.linalg.eigvalsh(matrix.T @ matrix)
+    return float(np.sqrt(eigen[-1] / eigen[0])) if eigen[0] > 0 else float("inf")
+
+
+def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float = PERIOD, seed: int = 0,
+           iterations: int = 8, effects: tuple[str, ...] = EFFECTS) -> Excitation:
+    """An excitation for ``robot`` (name, MJCF path or loaded model) optimised for a small
+    regressor condition number (module docstring).
+
+    Parameters
+    ----------
+    harmonics : int
+        L, at least 1.
+    period : float
+        T in s, > 0.
+    seed : int
+        Of the random start.
+    iterations : int
+        Most L-BFGS-B iterations (each costs about ``2 L N`` evaluations of the regressors).
+
+    Raises
+    ------
+    ValueError
+        For ``harmonics`` < 1, ``period`` <= 0 or ``iterations`` < 0.
+    """
+    if harmonics < 1 or not period > 0 or iterations < 0:
+        raise ValueError(f"harmonics = {harmonics}, period = {period} s, iterations = {iterations}; expected "
+                         "harmonics >= 1, period > 0 and iterations >= 0")
+    model = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    bounds = limits(model)
+    n_axes = len(model.gear_ratio)
+    t = np.linspace(0.0, period, SAMPLES, endpoint=False)
+    rng = np.random.default_rng(seed)
+    start = rng.normal(size=(2, harmonics, n_axes)) / np.arange(1, harmonics + 1)[None, :, None]
+
+    def trajectory(x):
+        a, b = _at_rest(*x.reshape(2, harmonics, n_axes))
+        return _within_limits(bounds, a, b, period, t)
+
+    q0, a, b = trajectory(start.ravel())
+    _, keep = regressor(model, t, *_series(q0, a, b, period, t), effects)
+
+    def cost(x):
+        q0, a, b = trajectory(x)
+        value = condition_number(model, t, *_series(q0, a, b, period, t), effects, keep)
+        return float(np.log(value)) if np.isfinite(value) else 50.0
+
+    best = start.ravel()
+    if iterations > 0:
+        found = minimize(cost, best, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-4})
+        best = found.x if found.fun <= cost(best) else best
+    q0, a, b = trajectory(best)
+    fine = np.linspace(0.0, period, FINE_SAMPLES, endpoint=False)  # the figure reported: on a fine sampling
+    return Excitation(model.name, period, q0, a, b, condition_number(model, fine, *_series(q0, a, b, period, fine),
+                                                                     effects))
