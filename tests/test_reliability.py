@@ -315,7 +315,7 @@ def test_a_grid_file_key_out_of_range_is_refused_naming_it(tmp_path, text, named
     assert named in result.output and "Traceback" not in result.output and "TypeError" not in result.output
 
 
-def test_a_run_whose_motor_saturates_is_labelled_and_fails_validation(tmp_path):
+def test_a_run_whose_motor_saturates_is_labelled_and_flagged_by_validate(tmp_path):
     out = tmp_path / "saturated.h5"
     result = runner.invoke(app, ["simulate", "--fault", "torque_offset:2:offset:1e4", "--cycles", "1", "--no-progress",
                                  "-o", str(out)])
@@ -323,7 +323,8 @@ def test_a_run_whose_motor_saturates_is_labelled_and_fails_validation(tmp_path):
     (labels,) = dataset.labels(out)
     assert 2 in list(labels["saturated"])
     checked = runner.invoke(app, ["validate", str(out)])
-    assert checked.exit_code == 1 and "the motor saturated" in checked.output
+    # valid (a fleet's hardest moves may touch a limit), but named
+    assert checked.exit_code == 0 and "warning: run" in checked.output and "axes 2, 3: the motor saturated" in checked.output
     assert "saturated:     1 run(s)" in runner.invoke(app, ["info", str(out)]).output
 
 

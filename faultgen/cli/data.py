@@ -41,6 +41,9 @@ def info_command(
 def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen dataset (HDF5).")]) -> None:
     """Check a dataset against the schema (docs/dataset.md); exit 1 with the reasons if it fails.
 
+    Runs whose motors saturated (their drive torque reached its limit) are named as warnings: the
+    file is valid, but those runs do not follow their task where the drive is at its limit.
+
     Example:
 
     \b
@@ -54,6 +57,8 @@ def validate_command(file: Annotated[Path, typer.Argument(help="A faultgen datas
             typer.echo(f"invalid: {problem}", err=True)
         raise typer.Exit(1)
     typer.echo(f"{file}: valid ({len(dataset.list_runs(file))} runs)")
+    for warning in dataset.saturation_warnings(file):
+        typer.echo(f"warning: {warning}", err=True)
 
 
 @app.command("export", cls=Command)

@@ -517,6 +517,28 @@ def validate(path: str | Path) -> list[str]:
     return problems
 
 
+def saturation_warnings(path: str | Path) -> list[str]:
+    """The runs whose motors reached their torque limit (label ``saturated``), one line each.
+
+    The file is valid, and a fleet's hardest moves may touch a limit for a moment; but where a drive
+    is at its limit the run does not follow its task (a wear or fault beyond what the drive can
+    carry), so ``faultgen validate`` and ``info`` name them.
+
+    Raises
+    ------
+    DatasetError
+        If ``path`` is not a faultgen dataset.
+    """
+    out = []
+    with _open(path) as f:
+        for run_id, group in f["runs"].items():
+            axes = [int(a) for a in np.atleast_1d(group.attrs.get("saturated", []))]
+            if axes:
+                out.append(f"run {run_id}: axes {', '.join(map(str, axes))}: the motor saturated (the drive torque "
+                           "reached its limit): the run does not follow its task there")
+    return out
+
+
 def _attribute_problems(group: h5py.Group) -> list[str]:
     """What is wrong with the attributes of a run group: each present attribute must parse into
     its type and range (a whole number of cycles >= 1, worn axes as axis numbers, JSON tables, a
@@ -587,9 +609,6 @@ def _program_problems(attrs) -> list[str]:
 def _validate_run(group: h5py.Group) -> list[str]:
     problems = [f"missing attribute {a!r}" for a in RUN_ATTRIBUTES if a not in group.attrs]
     problems += _attribute_problems(group)
-    if "saturated" in group.attrs and len(group.attrs["saturated"]):
-        problems.append(f"axes {', '.join(str(int(a)) for a in group.attrs['saturated'])}: the motor saturated "
-                        "(the drive torque reached its limit): the run does not follow its task")
     try:
         conditions = json.loads(_attr(group.attrs["conditions"])) if "conditions" in group.attrs else None
     except ValueError:
