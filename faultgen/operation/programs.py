@@ -58,7 +58,7 @@ from faultgen.operation import ik as ik_module
 from faultgen.operation.ik import Arc, FlangeIK, Seam, ramp_arc_length, tool_rotation
 from faultgen.operation.tasks import (
     IK_STEP, LIMIT_TOLERANCE, PLAN_PERIOD, PROCESSES, SEAM_LIMIT_TOLERANCE, SEAM_TOLERANCE, TASKS, JointPath,
-    _Builder, ptp,
+    _Builder, _Table, ptp,
 )
 
 #: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
@@ -577,7 +577,7 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
         except ValueError as err:
             raise ProgramError(f"{where}: [tool] z, x: {err}") from err
     if "offset" in tool.data:
-        offset = tool.array("offset", (3,), finite_only=True)
+        offset = tool.array("offset", (3,))
     raw = data.get("segment", [])
     if not isinstance(raw, list) or not raw:
         raise ProgramError(f"{where}: no [[segment]] tables; a program needs at least one")
@@ -630,7 +630,7 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
             if "standoff" in table:
                 t.fail("standoff", "a standoff goes with a Cartesian pose, not with joint angles")
         if "pose" in table:
-            values["pose"] = t.array("pose", (3,), finite_only=True)
+            values["pose"] = t.array("pose", (3,))
         if "standoff" in table:
             values["standoff"] = t.number("standoff", minimum=0.0)
         if not given and "standoff" not in table:
@@ -643,12 +643,12 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
         if abs(values["time"] / PLAN_PERIOD - round(values["time"] / PLAN_PERIOD)) > 1e-9:
             t.fail("time", f"{values['time']} s is not a whole number of {PLAN_PERIOD * 1e3:g} ms planning periods")
     elif kind in ("linear", "circular"):
-        values["to"] = t.array("to", (3,), finite_only=True)
+        values["to"] = t.array("to", (3,))
         if kind == "circular":
-            values["via"] = t.array("via", (3,), finite_only=True)
+            values["via"] = t.array("via", (3,))
         values["speed"], values["ramp_time"] = t.number("speed"), t.number("ramp_time")
     elif kind == "seam":
-        values["vertices"] = t.array("vertices", (None, 3), finite_only=True)
+        values["vertices"] = t.array("vertices", (None, 3))
         if len(values["vertices"]) < 2:
             t.fail("vertices", "expected at least two points")
         values["corner_radius"] = t.number("corner_radius", minimum=0.0)
@@ -665,8 +665,8 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
             params = {"mass": mass, "com_x": 0.0, "com_y": 0.0, "com_z": size / 2,
                       "ixx": moment, "iyy": moment, "izz": moment, "ixy": 0.0, "ixz": 0.0, "iyz": 0.0}
         else:
-            com = t.array("com", (3,), finite_only=True) if "com" in table else np.zeros(3)
-            inertia = t.array("inertia", (6,), finite_only=True) if "inertia" in table else np.zeros(6)
+            com = t.array("com", (3,)) if "com" in table else np.zeros(3)
+            inertia = t.array("inertia", (6,)) if "inertia" in table else np.zeros(6)
             params = {"mass": mass, **dict(zip(("com_x", "com_y", "com_z"), map(float, com), strict=True)),
                       **dict(zip(("ixx", "iyy", "izz", "ixy", "ixz", "iyz"), map(float, inertia), strict=True))}
         values["part"] = params
@@ -676,24 +676,18 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
     return Segment(number, kind, label_, values)
 
 
-class _Values:
-    """One table of a program file; every error names the file, the table and the key."""
+class _Values(_Table):
+    """One table of a program file; every error names the file, the table and the key (the values
+    are read as a tasks.toml's are, :class:`faultgen.operation.tasks._Table`)."""
 
     def __init__(self, where: str, prefix: str, data, keys: tuple[str, ...]) -> None:
         if not isinstance(data, dict):
             raise ProgramError(f"{where}: {prefix.strip() or 'file'}: expected a table, got {data!r}")
-        self.where, self.prefix, self.data = where, prefix, data
-        for key in data:
-            if key not in keys:
-                self.fail(key, f"unknown key; expected one of {', '.join(keys)}")
+        self.where, self.prefix = where, prefix
+        self._take(data, keys)
 
     def fail(self, key: str, problem: str):
         raise ProgramError(f"{self.where}: {self.prefix}{key}: {problem}")
-
-    def get(self, key: str):
-        if key not in self.data:
-            self.fail(key, "missing")
-        return self.data[key]
 
     def text(self, key: str) -> str:
         value = self.get(key)
@@ -701,48 +695,9 @@ class _Values:
             self.fail(key, f"expected a non-empty string, got {value!r}")
         return value
 
-    def array(self, key, shape, scale=1.0, positive=False, finite_only=False) -> np.ndarray:
-        value = self.get(key)
-        try:
-            arr = np.array(value, dtype=float)
-        except (TypeError, ValueError):
-            self.fail(key, f"expected numbers, got {value!r}")
-        expected = tuple(arr.shape[i] if n is None and arr.ndim == len(shape) else n for i, n in enumerate(shape))
-        if arr.shape != expected or arr.size == 0:
-            self.fail(key, f"expected shape {tuple('m' if n is None else n for n in shape)}, got {arr.shape}")
-        if not np.all(np.isfinite(arr)) or (positive and np.any(arr <= 0)):
-            self.fail(key, f"expected finite{' positive' if positive else ''} numbers, got {value!r}")
-        return arr * scale
-
-    def number(self, key: str, minimum: float | None = None) -> float:
-        value = self.get(key)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            self.fail(key, f"expected a number, got {value!r}")
-        if (minimum is None and value <= 0) or (minimum is not None and value < minimum):
-            self.fail(key, f"expected a {'positive' if minimum is None else 'non-negative'} number, got {value}")
-        return float(value)
-
-    def fraction(self, key: str, default: float | None = None) -> float:
-        if default is not None and key not in self.data:
-            return default
-        value = self.number(key)
-        if value > 1:
-            self.fail(key, f"expected a fraction in (0, 1], got {value}")
-        return value
-
     def angles(self, key: str, robot: Robot) -> np.ndarray:
         """Joint angles given in deg, shape (N,), as rad within the joint ranges."""
-        n = len(robot.joint_names)
-        q = self.array(key, (n,), np.pi / 180).reshape(-1, n)
-        low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
-        bad = np.argwhere((q < low) | (q > high))
-        if bad.size:
-            _, axis = bad[0]
-            value = q[0, axis]
-            edge = low[axis] if value < low[axis] else high[axis]
-            self.fail(key, f"axis {axis + 1} at {np.degrees(value):.2f} deg is {abs(np.degrees(value - edge)):.2f} deg "
-                      f"outside its range {np.degrees(low[axis]):.1f}..{np.degrees(high[axis]):.1f} deg")
-        return q[0]
+        return super().angles(key, robot)[0]
 
 
 # -- export --------------------------------------------------------------------------------------

@@ -534,13 +534,20 @@ _KEYS = {
 
 
 class _Table:
-    """One table of a tasks.toml; every error names the file, the table and the key."""
+    """One table of a tasks.toml; every error names the file, the table and the key. The reader of
+    a program file's tables (:class:`faultgen.operation.programs._Values`) is this one, naming its
+    tables its own way (:meth:`fail`)."""
 
     def __init__(self, path: Path, data: dict, name: str, keys: tuple[str, ...]) -> None:
         if not isinstance(data.get(name), dict):
             raise ValueError(f"{path}: missing table [{name}]")  # noqa: TRY004 (a file error, not a type error)
-        self.path, self.name, self.data = path, name, data[name]
-        for key in self.data:
+        self.path, self.name = path, name
+        self._take(data[name], keys)
+
+    def _take(self, data: dict, keys: tuple[str, ...]) -> None:
+        """Hold the table ``data``, refusing a key not among ``keys``."""
+        self.data = data
+        for key in data:
             if key not in keys:
                 self.fail(key, f"unknown key; expected one of {', '.join(keys)}")
 
@@ -569,7 +576,7 @@ class _Table:
             or (nonnegative and np.any(arr < 0))
         ):
             sign = " positive" if positive else " non-negative" if nonnegative else ""
-            self.fail(key, f"expected finite{sign} numbers")
+            self.fail(key, f"expected finite{sign} numbers, got {value!r}")
         return arr * scale
 
     def number(self, key: str, minimum: float | None = None) -> float:
@@ -582,7 +589,9 @@ class _Table:
             )
         return float(value)
 
-    def fraction(self, key: str) -> float:
+    def fraction(self, key: str, default: float | None = None) -> float:
+        if default is not None and key not in self.data:
+            return default
         value = self.number(key)
         if value > 1:
             self.fail(key, f"expected a fraction in (0, 1], got {value}")
@@ -596,11 +605,10 @@ class _Table:
         bad = np.argwhere((q < low) | (q > high))
         if bad.size:
             row, axis = bad[0]
-            self.fail(
-                key,
-                f"axis {axis + 1} at {np.degrees(q[row, axis]):.2f} deg is outside its range "
-                f"{np.degrees(low[axis]):.1f}..{np.degrees(high[axis]):.1f} deg",
-            )
+            value = q[row, axis]
+            edge = low[axis] if value < low[axis] else high[axis]
+            self.fail(key, f"axis {axis + 1} at {np.degrees(value):.2f} deg is {abs(np.degrees(value - edge)):.2f} deg "
+                      f"outside its range {np.degrees(low[axis]):.1f}..{np.degrees(high[axis]):.1f} deg")
         return q
 
     def rotation(self) -> np.ndarray:
