@@ -278,15 +278,7 @@ def _per_run(step, X: np.ndarray, groups: np.ndarray) -> np.ndarray:
 
 def _transform(estimator, X, groups, y=None, fit: bool = False) -> tuple[np.ndarray, object]:
     steps = _steps(estimator)
-    Xt = X
-    for step in steps[:-1]:
-        if isinstance(step, SEQUENCE_STEPS):
-            Xt = _per_run(step, Xt, groups)
-        elif fit:
-            Xt = step.fit_transform(Xt, y)
-        else:
-            Xt = step.transform(Xt)
-    return Xt, steps[-1]
+    return _run_steps(steps[:-1], X, groups, y, fit), steps[-1]
 
 
 def fit_by_run(estimator, X, y, groups):
