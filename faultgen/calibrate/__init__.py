@@ -336,11 +336,8 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
             best = ranked[0]
             if not best.axes:
                 break
-            trial_spec = mujoco.MjSpec.from_string(spec.to_xml())
-            best.effect.write(trial_spec, current, best.axes)
-            trial = robots.load(_write(trial_spec, trial_path))
-            trial_prediction, trial_motion = _predict(trial, data)
-            after = search.gap(tau, trial_prediction, split.held_out)
+            trial_spec, trial, trial_prediction, trial_motion, after = _with_effect(
+                spec, current, best.effect, best.axes, trial_path, data, tau, split.held_out)
             previous = steps[-1].gap_after if steps else gap_before
             if after["total_nrmse"] >= previous["total_nrmse"]:
                 if steps:  # the model file keeps the last model taken, not this trial
@@ -441,11 +438,9 @@ def _refit(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray, st
         params = ({a: candidate.effect.values(a) for a in step.axes} if candidate.effect.per_axis
                   else {None: candidate.effect.values()})
         effect = step.effect.fitted(reduced, params)
-        trial_spec = mujoco.MjSpec.from_string(without.to_xml())
-        effect.write(trial_spec, reduced, step.axes)
-        trial = robots.load(_write(trial_spec, path))
-        trial_prediction, _ = _predict(trial, data)
-        trial_gap = search.gap(tau, trial_prediction, split.held_out)["total_nrmse"]
+        trial_spec, trial, trial_prediction, _, trial_gap = _with_effect(
+            without, reduced, effect, step.axes, path, data, tau, split.held_out)
+        trial_gap = trial_gap["total_nrmse"]
         if trial_gap < best_gap:
             errors = search.standard_errors(effect, motion, residual, tau, split, step.axes)
             steps[j] = Step(effect, step.axes, step.evidence, step.gap_after, errors)
@@ -501,6 +496,18 @@ def _extend(current: robots.Robot, predicted: np.ndarray, steps: list[Step], dat
             steps[i] = Step(get(step.effect.id).current(trial), sorted({*step.axes, axis}) if i == j else step.axes,
                             evidence, step.gap_after, errors)
     return current, predicted
+
+
+def _with_effect(spec: mujoco.MjSpec, robot: robots.Robot, effect, axes, path: Path,
+                 data: measured_io.MeasuredData, tau: np.ndarray, held_out: np.ndarray) -> tuple:
+    """A copy of ``spec`` with ``effect`` written on ``axes`` (array indices), saved at ``path`` and
+    loaded: the trial spec, its robot, its prediction and motion along the log, and its held-out gap
+    (:func:`search.gap`)."""
+    trial_spec = mujoco.MjSpec.from_string(spec.to_xml())
+    effect.write(trial_spec, robot, axes)
+    trial = robots.load(_write(trial_spec, path))
+    prediction, motion = _predict(trial, data)
+    return trial_spec, trial, prediction, motion, search.gap(tau, prediction, held_out)
 
 
 def _write(spec: mujoco.MjSpec, path: Path) -> Path:
@@ -565,11 +572,8 @@ def _complete(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray,
         found, gains = search.reopen(kind, motion, residual, tau, split, open_axes, floor)
         if not found.axes:
             continue
-        trial_spec = mujoco.MjSpec.from_string(spec.to_xml())
-        found.effect.write(trial_spec, current, found.axes)
-        trial = robots.load(_write(trial_spec, path))
-        trial_prediction, trial_motion = _predict(trial, data)
-        after = search.gap(tau, trial_prediction, split.held_out)
+        trial_spec, trial, trial_prediction, trial_motion, after = _with_effect(
+            spec, current, found.effect, found.axes, path, data, tau, split.held_out)
         if after["total_nrmse"] >= now["total_nrmse"]:
             _write(spec, path)
             continue
