@@ -243,6 +243,9 @@ class Effect:
     required: ClassVar[int | None] = None
     #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
     counts: ClassVar[tuple[str, ...]] = ()
+    #: Named groups of parameters a relative fault scales together (:class:`faultgen.operation.faults.Fault`,
+    #: friction wear: the motor friction's ``dry``); none by default.
+    groups: ClassVar[dict[str, tuple[str, ...]]] = {}
     #: Numbers of leading linear parameters (columns) fitted at each level of detail, simplest first
     #: (the optimiser keeps the most detailed admissible level the Bayesian information criterion
     #: supports, per axis for a per-axis effect); None: all at once.
