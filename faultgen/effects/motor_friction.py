@@ -157,6 +157,11 @@ class MotorFriction(Effect):
         except ValueError as err:
             raise ModelError(f"{path}: {err}") from err
 
+    @classmethod
+    def of(cls, robot) -> MotorFriction:
+        """The robot's motor friction (``robot.friction``; every robot carries it)."""
+        return robot.friction
+
     def current(self, robot) -> MotorFriction:
         return robot.friction
 
