@@ -497,6 +497,17 @@ class Effect:
         """This effect's values in ``robot`` (the absent values when the robot does not carry it)."""
         return robot.effects.get(self.id, type(self)(n_axes=robot.n_axes))
 
+    def scaled(self, axis: int, parameters: tuple[str, ...], factor: float) -> Effect:
+        """A new instance with ``parameters`` of ``axis`` (0-based) multiplied by ``factor``: a
+        relative fault's effect (:meth:`faultgen.operation.faults.Fault.scaled`). Raises
+        ValueError for a robot-wide effect or one without values per axis."""
+        if not self.per_axis or any(v.ndim == 0 for v in self._values.values()):
+            raise ValueError(f"{self.id}: scaled() needs values per axis")
+        table = {k: v.copy() for k, v in self._values.items()}
+        for name in parameters:
+            table[name][axis] = table[name][axis] * factor
+        return type(self)(**table)
+
     # -- hidden-effect drawing -----------------------------------------------------------
 
     def draw_grid(self, motion: Motion, axis: int) -> list:

@@ -165,13 +165,6 @@ class MotorFriction(Effect):
     def current(self, robot) -> MotorFriction:
         return robot.friction
 
-    def scaled(self, axis: int, parameters: tuple[str, ...], factor: float) -> MotorFriction:
-        """A new instance with ``parameters`` of ``axis`` (0-based) multiplied by ``factor`` (a relative fault)."""
-        table = {k: v.copy() for k, v in self._values.items()}
-        for name in parameters:
-            table[name][axis] = table[name][axis] * factor
-        return type(self)(**table)
-
     def stribeck_torque(self, v_m: np.ndarray) -> np.ndarray:
         """Static friction torque at the motor side, thesis eq. 6.3.
 

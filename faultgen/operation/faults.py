@@ -201,6 +201,8 @@ class Fault:
         with the fault's parameters on its axis multiplied by :meth:`values` there."""
         if not self.relative:
             raise ValueError(f"the {self.effect} fault is absolute; at() gives its effect at a value")
+        if type(nominal) is not type(effects.get(self.effect)):
+            raise ValueError(f"the fault is on {self.effect}; got a {type(nominal).__name__}")
         self.check(np.shape(getattr(nominal, self.parameters[0]))[0])
         return nominal.scaled(self.axis - 1, self.parameters, float(self.values(np.array([cycle]))[0]))
 
@@ -211,7 +213,10 @@ class Fault:
 
     def at(self, value: float, n_axes: int) -> Effect:
         """The effect with the parameter at ``value`` (and :attr:`others`) on the fault's axis,
-        absent on the others of a robot of ``n_axes`` axes."""
+        absent on the others of a robot of ``n_axes`` axes. An absolute fault only (a relative one
+        scales the robot's own values: :meth:`scaled`)."""
+        if self.relative:
+            raise ValueError(f"the {self.effect} fault is relative; scaled() gives its effect at a cycle")
         self.check(n_axes)
         cls = type(effects.get(self.effect))
         values = {**self.others, self.parameter: float(value)}
