@@ -66,8 +66,9 @@ class RunConfig:
         1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
         a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
         are not whole days, a relative fault as ``fault`` (friction wear is ``wear``), a fault
-        whose last cycle is not the run's or whose effect the robot already carries, a task mix without the run's task or with signals, or a unit spread with a
-        gear loss under the ``lugre`` friction model; the message names the value.
+        whose last cycle is not the run's or whose effect the robot already carries, a task mix
+        without the run's task or with signals, or a unit spread with a gear loss under the
+        ``lugre`` friction model; the message names the value.
     """
 
     robot: str
