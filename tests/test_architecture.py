@@ -80,10 +80,10 @@ def test_no_code_outside_the_effects_package_names_an_effect():
     """One definition per effect: outside ``faultgen/effects/`` no code holds an effect id as a
     string (user-facing text aside: ids inside longer strings are not matched). ``stribeck`` is
     also the static friction model's name (``--friction stribeck``), so it is left out here."""
-    from faultgen.effects import EFFECTS
+    from faultgen.effects import REGISTRY
     from faultgen.effects.friction import MODELS
 
-    ids = set(EFFECTS) - set(MODELS)
+    ids = set(REGISTRY) - set(MODELS)
     assert len(ids) >= 8
     found = []
     for tree in ("faultgen", "analysis"):

@@ -198,8 +198,10 @@ def test_every_module_of_the_effects_package_is_a_registered_effect():
     """The package imports its modules itself: a new effect is one new file."""
     folder = Path(effects.__file__).parent
     modules = {p.stem for p in folder.glob("*.py")} - {"__init__", "base", "friction"}
-    registered = {type(e).__module__.rpartition(".")[2] for e in effects.EFFECTS.values()}
+    registered = {type(e).__module__.rpartition(".")[2] for e in effects.REGISTRY.values()}
     assert modules == registered
+    # the calibration's candidates are every registered effect but the nominal motor friction
+    assert list(effects.EFFECTS) == [k for k in effects.REGISTRY if k != effects.MotorFriction.id]
 
 
 def test_an_effect_id_is_registered_once():

@@ -49,7 +49,7 @@ def simulate_command(
         help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
         "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
         "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
-        "warm-up).")] = None,
+        "warm-up, nor the motor friction and its parts coulomb, viscous, stribeck: their fault is --wear).")] = None,
     temperature: Temperature = False,
     dry_share: DryShare = None,
     payloads: PayloadParts = None,

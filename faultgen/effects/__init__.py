@@ -1,12 +1,18 @@
 """Physical effects, one class each, shared by the robot model, the simulation and the calibration.
 
-The motor-side friction models (:mod:`faultgen.effects.friction`: thesis eq. 6.3, LuGre) and the
-effects a robot may carry beyond them, each in its own module and registered under a stable id
-(:mod:`faultgen.effects.base` gives the template and the registry):
+The robot's nominal motor-side friction (``motor_friction``, :mod:`faultgen.effects.motor_friction`:
+thesis eq. 6.3 and the LuGre bristles; every robot carries it) and the effects a robot may carry
+beyond it, each in its own module and registered under a stable id (:mod:`faultgen.effects.base`
+gives the template and the registry, :data:`REGISTRY`; :data:`EFFECTS` are the calibration's
+candidates, all but ``motor_friction``; :mod:`faultgen.effects.friction` puts the friction into
+MuJoCo as the simulation's LuGre or static model):
 
 =========================  ===============================================  ======================
 id                         parameters (SI)                                  MJCF
 =========================  ===============================================  ======================
+motor_friction             coulomb_pos, coulomb_neg, static,                numeric friction{i}
+                           stribeck_velocity, stribeck_exponent, viscous,
+                           bristle_stiffness, bristle_damping (motor side)
 torque_offset              offset (N m, arm side)                           numeric torque_offset{i}
 coulomb                    coulomb_pos, coulomb_neg (N m, motor side)       numeric friction{i}
 viscous                    viscous (N m s/rad, motor side)                  numeric friction{i}
@@ -19,8 +25,10 @@ backlash                   width (rad, arm side)                            tend
 =========================  ===============================================  ======================
 
 The table's order is the effects' :attr:`~faultgen.effects.base.Effect.rank`, the order in which
-the calibration tries them. Every module of this package but ``base`` and ``friction`` is one
-effect, imported (and so registered) with the package.
+the calibration tries them (``motor_friction`` is not tried). Every module of this package but
+``base`` and ``friction`` is one effect, imported (and so registered) with the package
+(``motor_friction`` also holds :class:`FrictionParameter`, the base of the effects that change
+part of it).
 This is the lowest layer of faultgen: it imports nothing else of it (the robot it is given is
 used through its attributes).
 """
@@ -30,9 +38,9 @@ import pkgutil
 
 from faultgen.effects.base import (
     EFFECTS,
+    REGISTRY,
     REST_SPEED,
     Effect,
-    FrictionParameter,
     ModelError,
     Motion,
     get,
@@ -40,6 +48,7 @@ from faultgen.effects.base import (
     read_all,
     register,
 )
+from faultgen.effects.motor_friction import FrictionParameter, MotorFriction
 
 # Every other module of this package defines one effect, registered when it is imported: adding
 # an effect is adding a module.
@@ -47,5 +56,5 @@ for _module in pkgutil.iter_modules(__path__):
     if _module.name not in ("base", "friction"):
         importlib.import_module(f"{__name__}.{_module.name}")
 
-__all__ = ["EFFECTS", "REST_SPEED", "Effect", "FrictionParameter", "ModelError", "Motion", "get", "make", "read_all",
-           "register"]
+__all__ = ["EFFECTS", "REGISTRY", "REST_SPEED", "Effect", "FrictionParameter", "ModelError", "MotorFriction", "Motion",
+           "get", "make", "read_all", "register"]

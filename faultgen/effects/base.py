@@ -33,7 +33,6 @@ import mujoco
 import numpy as np
 
 from faultgen import axes as axis_numbers
-from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 
 #: Arm-side speed (rad/s) below which an axis counts as at rest: its friction is then stiction,
 #: any value up to the breakaway torque, which no kinetic model predicts, so those samples of
@@ -103,35 +102,43 @@ class Motion:
         return self.robot.gear_ratio * self.qd
 
 
-#: Every effect, by id, in the order they are tried in identification (ties go to the earlier,
-#: simpler one): by :attr:`Effect.rank`.
+#: Every registered effect, by id, by :attr:`Effect.rank`: what a robot's MJCF is read into
+#: (:func:`read_all`), :func:`get` and :func:`make` know and a fault may grow.
+REGISTRY: dict[str, Effect] = {}
+
+#: The calibration's candidates (:attr:`Effect.candidate`), by id, in the order they are tried in
+#: identification (ties go to the earlier, simpler one): by :attr:`Effect.rank`. The robot's nominal
+#: motor friction (``motor_friction``) is registered but no candidate: the calibration changes parts of it.
 EFFECTS: dict[str, Effect] = {}
 
 
 def register(cls: type[Effect]) -> type[Effect]:
-    """Class decorator adding an effect class to :data:`EFFECTS` (as an instance with the values
-    of an absent effect) under its ``id``.
+    """Class decorator adding an effect class to :data:`REGISTRY` (and, when a calibration
+    :attr:`~Effect.candidate`, to :data:`EFFECTS`) as an instance with the values of an absent
+    effect, under its ``id``.
 
     Raises
     ------
     ValueError
         If the id is already registered to another class.
     """
-    if cls.id in EFFECTS and type(EFFECTS[cls.id]) is not cls:
-        raise ValueError(f"effect {cls.id!r} is already registered to {type(EFFECTS[cls.id]).__name__}")
-    EFFECTS[cls.id] = cls()
-    ordered = sorted(EFFECTS.items(), key=lambda item: (item[1].rank, item[0]))
+    if cls.id in REGISTRY and type(REGISTRY[cls.id]) is not cls:
+        raise ValueError(f"effect {cls.id!r} is already registered to {type(REGISTRY[cls.id]).__name__}")
+    REGISTRY[cls.id] = cls()
+    ordered = sorted(REGISTRY.items(), key=lambda item: (item[1].rank, item[0]))
+    REGISTRY.clear()
+    REGISTRY.update(ordered)
     EFFECTS.clear()
-    EFFECTS.update(ordered)
+    EFFECTS.update((k, e) for k, e in ordered if e.candidate)
     return cls
 
 
 def get(effect_id: str) -> Effect:
     """The registered effect ``effect_id`` (absent values); raises ``ValueError`` listing the known ids."""
     try:
-        return EFFECTS[effect_id]
+        return REGISTRY[effect_id]
     except KeyError:
-        raise ValueError(f"unknown effect {effect_id!r}; known effects: {', '.join(EFFECTS)}") from None
+        raise ValueError(f"unknown effect {effect_id!r}; known effects: {', '.join(REGISTRY)}") from None
 
 
 def make(effect_id: str, **values) -> Effect:
@@ -156,7 +163,7 @@ def read_all(model: mujoco.MjModel, path: Path) -> dict[str, Effect]:
         If an effect's element holds values it cannot take (wrong count, non-finite, out of range).
     """
     found = {}
-    for effect_id, prototype in EFFECTS.items():
+    for effect_id, prototype in REGISTRY.items():
         effect = type(prototype).read(model, path)
         if effect is not None:
             found[effect_id] = effect
@@ -219,6 +226,9 @@ class Effect:
 
     id: ClassVar[str]
     rank: ClassVar[int] = 100
+    #: Whether the calibration tries the effect as an explanation of a misfit (:data:`EFFECTS`);
+    #: False for the robot's nominal motor friction, which every robot carries.
+    candidate: ClassVar[bool] = True
     summary: ClassVar[str]
     units: ClassVar[dict[str, str]]
     absent: ClassVar[tuple[float, ...]]
@@ -233,6 +243,9 @@ class Effect:
     required: ClassVar[int | None] = None
     #: Parameters that are whole numbers (a pole count): given as int wherever they are reported.
     counts: ClassVar[tuple[str, ...]] = ()
+    #: Named groups of parameters a relative fault scales together (:class:`faultgen.operation.faults.Fault`,
+    #: friction wear: the motor friction's ``dry``); none by default.
+    groups: ClassVar[dict[str, tuple[str, ...]]] = {}
     #: Numbers of leading linear parameters (columns) fitted at each level of detail, simplest first
     #: (the optimiser keeps the most detailed admissible level the Bayesian information criterion
     #: supports, per axis for a per-axis effect); None: all at once.
@@ -484,6 +497,17 @@ class Effect:
         """This effect's values in ``robot`` (the absent values when the robot does not carry it)."""
         return robot.effects.get(self.id, type(self)(n_axes=robot.n_axes))
 
+    def scaled(self, axis: int, parameters: tuple[str, ...], factor: float) -> Effect:
+        """A new instance with ``parameters`` of ``axis`` (0-based) multiplied by ``factor``: a
+        relative fault's effect (:meth:`faultgen.operation.faults.Fault.scaled`). Raises
+        ValueError for a robot-wide effect or one without values per axis."""
+        if not self.per_axis or any(v.ndim == 0 for v in self._values.values()):
+            raise ValueError(f"{self.id}: scaled() needs values per axis")
+        table = {k: v.copy() for k, v in self._values.items()}
+        for name in parameters:
+            table[name][axis] = table[name][axis] * factor
+        return type(self)(**table)
+
     # -- hidden-effect drawing -----------------------------------------------------------
 
     def draw_grid(self, motion: Motion, axis: int) -> list:
@@ -501,25 +525,3 @@ class Effect:
         (:func:`faultgen.calibrate.search.fit_effect`), and hidden-effect drawing keeps it within a
         share of that limit."""
         return 0.0
-
-
-class FrictionParameter(Effect):
-    """An effect that changes parameters of the robot's motor-side friction (thesis eq. 6.3):
-    stored in the ``friction{i}`` numerics (:mod:`faultgen.effects.friction`), acting through the
-    friction model in the simulation and in the inverse dynamics; its parameters are named as
-    :data:`faultgen.friction.FIELDS` names them. A fitted change may give a negative level, which
-    :meth:`Effect.admissible` refuses; :meth:`apply` writes at least zero."""
-
-    @classmethod
-    def read(cls, model, path):
-        return None  # part of the robot's friction, read with it
-
-    def current(self, robot) -> Effect:
-        return type(self)(**{name: getattr(robot.friction, name) for name in self.units})
-
-    def apply(self, spec, robot, axis, params):
-        element = spec.numeric(f"friction{axis + 1}")
-        row = [float(v) for v in element.data]
-        for name in self.units:
-            row[FRICTION_FIELDS.index(name)] = max(float(params[name]), 0.0)  # magnitudes
-        element.data = row

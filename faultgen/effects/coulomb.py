@@ -6,7 +6,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from faultgen.effects.base import FrictionParameter, register
+from faultgen.effects.base import register
+from faultgen.effects.motor_friction import FrictionParameter
 
 
 @register

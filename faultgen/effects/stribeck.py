@@ -7,7 +7,8 @@ from typing import ClassVar
 import numpy as np
 from scipy.optimize import minimize
 
-from faultgen.effects.base import REST_SPEED, FrictionParameter, register
+from faultgen.effects.base import REST_SPEED, register
+from faultgen.effects.motor_friction import FrictionParameter
 
 #: Stribeck exponents tried (``delta`` of eq. 6.3's ``exp(-|v/v_s|^delta)``): the literature's
 #: range, 0.5 (Armstrong-Helouvry, Dupont & Canudas de Wit 1994) to 2 (the Gaussian curve of the

@@ -35,6 +35,7 @@ import mujoco
 import numpy as np
 
 from faultgen.axes import MAX_AXES, MIN_AXES
+from faultgen.effects.motor_friction import MotorFriction
 from faultgen.model.drivetrain import Drivetrain
 from faultgen.model.drivetrain import read as read_drivetrain
 
@@ -301,8 +302,10 @@ def build(
         motor.set_to_motor()
         motor.ctrlrange = [-drive.motor_torque_limit, drive.motor_torque_limit]
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
-    for i, drive in enumerate(drivetrain.axes, start=1):
-        spec.add_numeric(name=f"friction{i}", data=drive.friction_row)
+    # the motor friction is a registered effect: written by its own MJCF form (numerics friction{i})
+    friction = MotorFriction.from_rows(np.array([drive.friction_row for drive in drivetrain.axes]))
+    for axis in range(len(drivetrain.axes)):
+        friction.apply(spec, None, axis, friction.values(axis))
 
     model = _compile(spec, source)
     q = arm_home if home is None else np.asarray(home, dtype=float)

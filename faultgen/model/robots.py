@@ -13,9 +13,12 @@ fixed tendons ``gearbox{i}`` (``L = rotor{i} / G - joint{i}``, thesis eq. 6.2a),
 actuators ``motor{i}`` on the rotors, with motor-side friction parameters in the custom numerics
 ``friction{i}`` and a ``home`` keyframe.
 
-Further effects a robot may carry (a torque offset, cogging, backlash, a payload, ...) are read
-from their own MJCF elements by their classes in :mod:`faultgen.effects` (absent, they are zero)
-and held in :attr:`Robot.effects`; the inverse dynamics add their torque.
+Every effect is read from its own MJCF elements by its class in :mod:`faultgen.effects`
+(:func:`faultgen.effects.read_all`): the motor-side friction, which every robot carries, is the
+registered effect ``motor_friction`` (:class:`faultgen.effects.motor_friction.MotorFriction`,
+held as :attr:`Robot.friction`); the further effects a robot may carry (a torque offset,
+cogging, backlash, a payload, ...; absent, they are zero) are held in :attr:`Robot.effects`. The
+inverse dynamics add the friction's eq. 6.3 torque and the effects' torques.
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ import numpy as np
 from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
-from faultgen.effects.friction import MotorFriction
+from faultgen.effects.motor_friction import MotorFriction
 from faultgen.model import drivetrain
 
 
@@ -100,12 +103,14 @@ class Robot:
     motor_torque_limit : ndarray of shape (N,)
         Largest motor torque the actuators accept, N m at the motor side.
     friction : MotorFriction
-        Nominal motor-side friction parameters.
+        Nominal motor-side friction parameters: the registered effect ``motor_friction``
+        (:mod:`faultgen.effects.motor_friction`), read from the ``friction{i}`` numerics.
     home : ndarray of shape (N,)
         Arm joint angles of the ``home`` keyframe in rad.
     effects : dict of str to Effect
         The effects stored in their own MJCF elements (:func:`faultgen.effects.read_all`), by id,
-        each with its absolute parameters (absent ones at their absent values).
+        each with its absolute parameters (absent ones at their absent values); all but the
+        motor friction, which is :attr:`friction`.
     """
 
     name: str
@@ -621,34 +626,23 @@ def _from_model(model: mujoco.MjModel, path: Path) -> Robot:
     joint_range = np.empty((n_axes, 2))
     motor_inertia = np.empty(n_axes)
     torque_limit = np.empty(n_axes)
-    friction_rows = np.empty((n_axes, len(FRICTION_FIELDS)))
     for k in range(n_axes):
         j = require("joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
         r = require("joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
         t = require("tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
         a = require("actuator", mujoco.mjtObj.mjOBJ_ACTUATOR, actuator_names[k])
-        f = require("custom numeric", mujoco.mjtObj.mjOBJ_NUMERIC, f"friction{k + 1}")
         gear_ratio[k] = _gear_ratio(model, path, t, j, r)
         if model.actuator_trnid[a, 0] != r or model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
             raise ModelError(f"{path}: actuator {actuator_names[k]!r} must drive joint {rotor_names[k]!r}")
         joint_range[k] = model.jnt_range[j]
         motor_inertia[k] = model.dof_armature[model.jnt_dofadr[r]]
         torque_limit[k] = np.max(np.abs(model.actuator_ctrlrange[a]))
-        size = model.numeric_size[f]
-        if size != len(FRICTION_FIELDS):
-            raise ModelError(
-                f"{path}: numeric 'friction{k + 1}' has {size} values, expected {len(FRICTION_FIELDS)}: "
-                + " ".join(FRICTION_FIELDS)
-            )
-        adr = model.numeric_adr[f]
-        friction_rows[k] = model.numeric_data[adr : adr + size]
-    try:
-        friction = MotorFriction.from_rows(friction_rows)
-    except ValueError as err:
-        raise ModelError(f"{path}: {err}") from err
+    # the motor friction is a registered effect read with the others (MotorFriction.read: the
+    # numerics friction1..frictionN, all required); the robot holds it as ``friction``
+    effects = read_all(model, path)
+    friction = effects.pop(MotorFriction.id)
 
     tendon_ids = [model.tendon(n).id for n in gearbox_names]
-    effects = read_all(model, path)
     key = require("keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
     joint_qpos = [model.jnt_qposadr[model.joint(n).id] for n in joint_names]
     description_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "description")

@@ -1,15 +1,29 @@
-"""Faults other than friction wear: one effect's parameter growing over a run's cycles.
+"""Faults: one effect's parameter growing over a run's cycles, friction wear among them.
 
-Friction wear (:mod:`faultgen.operation.wear`) is one fault; the effects the calibration
-identifies (:mod:`faultgen.effects`) give others: a gearbox whose backlash grows, a motor whose
-cogging grows, a drifting torque offset. A :class:`Fault` names the effect,
-the axis, the parameter and its value at the last cycle; the value grows from ``start`` on the
-shape of a wear schedule kind (``linear`` by default; ``exp4``, ``logistic``, ``step`` as in
-:mod:`~faultgen.operation.wear`). The effect's own MJCF form (:meth:`Effect.apply`) puts it into
-the simulated robot, so the fault is the same physics the calibration identifies; the controller
-does not know it. Effects that act through a per-step update of the friction level (``stepped``:
-load-dependent friction, warm-up) cannot be scheduled this way (their per-cycle counterparts are
-the operating conditions, :mod:`faultgen.operation.conditions`).
+A :class:`Fault` names the effect (:mod:`faultgen.effects`), the axis, the parameter and how it
+grows, on the shape of a wear schedule (:class:`faultgen.operation.wear.Schedule`: ``linear`` by
+default; ``exp4``, ``logistic``, ``step``). It grows in one of two ways:
+
+``absolute`` (``--fault``)
+    the parameter's value goes from ``start`` to ``final`` at the last cycle: a gearbox whose
+    backlash grows, a motor whose cogging grows, a drifting torque offset. The effect's own MJCF
+    form (:meth:`Effect.apply`) puts it into the simulated robot, so the fault is the same physics
+    the calibration identifies; the controller does not know it.
+``relative`` (friction wear, ``--wear``)
+    the robot's own value of the parameter is multiplied by the schedule's multiplier
+    ``m(k)``, with ``m(0) = 1`` and ``m(K) = 1 + final``: thesis eq. 6.6 for ``exp4``,
+    ``m(k) = (1 + p)^((k/K)^4)``. Friction wear is such a fault on the motor friction's ``dry``
+    parameters (Coulomb both directions and static friction; :class:`faultgen.effects.MotorFriction`),
+    one per worn axis (:meth:`faultgen.operation.wear.WearPlan.faults` turns a wear spec into
+    one); the simulation applies :func:`dry_multipliers` to the rotors' dry friction level.
+
+Effects that act through a per-step update of the friction level (``stepped``: load-dependent
+friction, warm-up) cannot be scheduled (their per-cycle counterparts are the operating conditions,
+:mod:`faultgen.operation.conditions`). The motor friction and the calibration's effects that change
+part of it (Coulomb, viscous, Stribeck) take no absolute fault: both friction models set the rotors'
+friction from the robot's nominal friction, so such a fault would move only the MJCF numeric and
+change nothing simulated (before issue 37 it was accepted and silently did that); friction wear is
+their fault.
 """
 
 from __future__ import annotations
@@ -24,7 +38,11 @@ from faultgen import effects
 from faultgen import axes
 from faultgen.checks import is_whole
 from faultgen.effects.base import Effect
+from faultgen.effects.motor_friction import FrictionParameter, MotorFriction
 from faultgen.operation import wear
+
+#: How a fault's parameter grows (:attr:`Fault.growth`).
+GROWTHS = ("absolute", "relative")
 
 _SPEC_FORM = ("the form is EFFECT:AXIS:PARAMETER:FINAL[:key=value,...], e.g. 'backlash:2:width:0.01', "
               "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4'")
@@ -41,29 +59,40 @@ class Fault:
     axis : int
         1..N, N the robot's axes (5..7; a run checks it, :meth:`check`; a robot-wide effect, payload, cannot be a growing fault).
     parameter : str
-        The parameter that grows (one of the effect's :attr:`~faultgen.effects.Effect.units`).
+        The parameter that grows (one of the effect's :attr:`~faultgen.effects.Effect.units`), or
+        with ``relative`` growth one of its parameter :attr:`~faultgen.effects.Effect.groups`
+        (the motor friction's ``dry``: Coulomb both directions and static friction).
     final : float
-        Its value at ``last_cycle``, in the parameter's unit.
+        With ``absolute`` growth its value at ``last_cycle``, in the parameter's unit; with
+        ``relative`` growth its increase there as a fraction (0.2: +20 %, 1.2 times its value).
     last_cycle : int
         The run's last cycle, >= 1.
     kind : str
-        Shape of the growth: a wear schedule kind; the value is ``start + (final - start) g(k)``
-        with ``g`` the schedule's rise as a fraction of its final rise.
+        Shape of the growth: a wear schedule kind. Absolute: the value is
+        ``start + (final - start) g(k)`` with ``g`` the schedule's rise as a fraction of its final
+        rise. Relative: the value is multiplied by the schedule's ``m(k)`` (thesis eq. 6.6 for exp4).
     start : float
-        Value at cycle 0 (default 0: a fault that appears).
+        Absolute: value at cycle 0 (default 0: a fault that appears). Relative: must be 0.
     others : dict
         The effect's other parameters on the axis (e.g. cogging ``poles`` and ``phase``); those
-        not given keep the effect's absent values.
+        not given keep the effect's absent values. Absolute only.
     onset : int
         Last cycle at the start value, with the ``exp4`` kind (the wear schedule's onset: the
         growth runs from it to ``last_cycle``); default 0, growing from cycle 0.
+    growth : str
+        ``absolute`` (default) or ``relative`` (:data:`GROWTHS`; module docstring).
+    options : dict
+        Further schedule parameters (:attr:`faultgen.operation.wear.Schedule.params`: logistic
+        ``shape``, step ``step_cycle``), default none.
 
     Raises
     ------
     ValueError
-        For an unknown effect (listing them), a stepped or robot-wide effect, an axis outside
-        1..7, an unknown parameter, a non-finite value, a final value equal to the start, a bad
-        schedule kind or onset, or a value the effect does not admit; the message names it.
+        For an unknown effect (listing them), a stepped or robot-wide effect, an absolute fault on
+        the motor friction or an effect that changes part of it (friction wear is their fault), an
+        axis outside 1..7, an unknown parameter or group, a non-finite value, a final value equal
+        to the start, a bad schedule kind, onset or option, a relative fault that does not start
+        at 0 or takes other parameters, or a value the effect does not admit; the message names it.
     """
 
     effect: str
@@ -75,9 +104,23 @@ class Fault:
     start: float = 0.0
     others: dict = field(default_factory=dict)
     onset: int = 0
+    growth: str = "absolute"
+    options: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         prototype = effects.get(self.effect)  # ValueError lists the known ids
+        if self.growth not in GROWTHS:
+            raise ValueError(f"fault growth {self.growth!r}: expected one of {', '.join(GROWTHS)}")
+        object.__setattr__(self, "options", MappingProxyType(dict(self.options)))
+        if self.relative:
+            self._check_relative(prototype)
+            return
+        if isinstance(prototype, (MotorFriction, FrictionParameter)):
+            raise ValueError(
+                f"fault effect {self.effect!r} is part of the motor friction, which both friction models set from "
+                "the robot's nominal values: an absolute fault on it would change nothing simulated. Its fault is "
+                "friction wear, which grows the Coulomb and static friction: --wear AXIS:KIND:PERCENT (e.g. "
+                "--wear 2:exp4:20)")
         if prototype.stepped:
             raise ValueError(f"fault effect {self.effect!r} acts through a per-step friction update and cannot grow "
                              "over cycles; use the operating conditions (--temperature) or the static friction model")
@@ -108,14 +151,60 @@ class Fault:
             if problem:
                 raise ValueError(f"fault {self.parameter} = {value!r}: {self.effect} {problem}")
 
+    def _check_relative(self, prototype: Effect) -> None:
+        groups = type(prototype).groups
+        if self.parameter not in groups:
+            has = f"it has: {', '.join(groups)}" if groups else "it has none"
+            raise ValueError(f"a relative fault grows a parameter group of its effect; {self.effect} has no group "
+                             f"{self.parameter!r} ({has})")
+        if not is_whole(self.axis) or not 1 <= self.axis <= axes.MAX_AXES:
+            raise ValueError(f"fault axis {self.axis!r}: expected 1..{axes.MAX_AXES}")
+        if self.start != 0 or self.others:
+            raise ValueError("a relative fault starts from the robot's own value (start = 0, no other parameters); "
+                             f"got start = {self.start!r}, others = {dict(self.others)!r}")
+        self._schedule()  # names a bad kind, increase, last cycle or option
+        object.__setattr__(self, "others", MappingProxyType({}))
+
+    @property
+    def relative(self) -> bool:
+        """Whether the fault multiplies the robot's own value (friction wear) rather than setting one."""
+        return self.growth == "relative"
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """The parameters the fault changes: :attr:`parameter`, or the members of its group."""
+        return type(effects.get(self.effect)).groups.get(self.parameter, (self.parameter,))
+
     def _schedule(self) -> wear.Schedule:
-        """The growth's shape: a wear schedule of a unit rise."""
-        return wear.Schedule(self.kind, 1.0, self.last_cycle, {"onset": self.onset} if self.onset else {})
+        """The growth's shape: a wear schedule of the relative increase, or of a unit rise."""
+        params = {**({"onset": self.onset} if self.onset else {}), **self.options}
+        return wear.Schedule(self.kind, self.final if self.relative else 1.0, self.last_cycle, params)
+
+    @property
+    def schedule(self) -> wear.Schedule:
+        """The schedule of a relative fault (its multiplier is the fault's value); ValueError for an absolute one."""
+        if not self.relative:
+            raise ValueError(f"the {self.effect} fault is absolute; only a relative fault has a multiplier schedule")
+        return self._schedule()
 
     def values(self, cycles) -> np.ndarray:
-        """The parameter at ``cycles`` (ints >= 0, any shape), in its unit."""
+        """The parameter at ``cycles`` (ints >= 0, any shape): absolute, in its unit; relative,
+        the dimensionless multiplier of the robot's own value (:meth:`wear.Schedule.multiplier`,
+        thesis eq. 6.6 for ``exp4``)."""
+        if self.relative:
+            return self._schedule().multiplier(np.asarray(cycles))
         rise = self._schedule().multiplier(np.asarray(cycles)) - 1.0
         return self.start + (self.final - self.start) * rise
+
+    def scaled(self, nominal: Effect, cycle: int) -> Effect:
+        """A relative fault's effect at ``cycle``: ``nominal`` (the robot's, e.g. ``robot.friction``)
+        with the fault's parameters on its axis multiplied by :meth:`values` there."""
+        if not self.relative:
+            raise ValueError(f"the {self.effect} fault is absolute; at() gives its effect at a value")
+        if type(nominal) is not type(effects.get(self.effect)):
+            raise ValueError(f"the fault is on {self.effect}; got a {type(nominal).__name__}")
+        self.check(np.shape(getattr(nominal, self.parameters[0]))[0])
+        return nominal.scaled(self.axis - 1, self.parameters, float(self.values(np.array([cycle]))[0]))
 
     def check(self, n_axes: int) -> None:
         """Raise ValueError when a robot of ``n_axes`` axes has no axis :attr:`axis`."""
@@ -124,7 +213,10 @@ class Fault:
 
     def at(self, value: float, n_axes: int) -> Effect:
         """The effect with the parameter at ``value`` (and :attr:`others`) on the fault's axis,
-        absent on the others of a robot of ``n_axes`` axes."""
+        absent on the others of a robot of ``n_axes`` axes. An absolute fault only (a relative one
+        scales the robot's own values: :meth:`scaled`)."""
+        if self.relative:
+            raise ValueError(f"the {self.effect} fault is relative; scaled() gives its effect at a cycle")
         self.check(n_axes)
         cls = type(effects.get(self.effect))
         values = {**self.others, self.parameter: float(value)}
@@ -137,10 +229,55 @@ class Fault:
         return cls(**table)
 
     def to_dict(self) -> dict:
-        """JSON-serialisable labels (``onset`` only when not 0, so faults without one keep their labels)."""
+        """JSON-serialisable labels (``onset``, ``growth`` and ``options`` only when not their
+        defaults, so absolute faults without them keep their labels)."""
         table = {"effect": self.effect, "axis": self.axis, "parameter": self.parameter, "final": self.final,
                  "start": self.start, "kind": self.kind, "last_cycle": self.last_cycle, "others": dict(self.others)}
-        return {**table, "onset": self.onset} if self.onset else table
+        if self.onset:
+            table["onset"] = self.onset
+        if self.relative:
+            table["growth"] = self.growth
+        if self.options:
+            table["options"] = dict(self.options)
+        return table
+
+
+def dry_multipliers(faults, cycles, n_axes: int) -> np.ndarray:
+    """The multiplier of each axis's dry friction (Coulomb and static) at each cycle: the relative
+    faults on the motor friction's ``dry`` group (friction wear), 1 elsewhere.
+
+    Parameters
+    ----------
+    faults : iterable of Fault
+        A run's faults; the absolute ones are not friction wear and are passed over.
+    cycles : ndarray of int of shape (n,)
+        Cycle indices >= 0.
+    n_axes : int
+        The robot's number of axes N.
+
+    Returns
+    -------
+    ndarray of shape (n, N)
+        Dimensionless, column ``i - 1`` for axis ``i``.
+
+    Raises
+    ------
+    ValueError
+        For an axis outside 1..N, or two faults on the dry friction of one axis.
+    """
+    k = np.atleast_1d(np.asarray(cycles))
+    out = np.ones((k.shape[0], n_axes))
+    seen = {}
+    for fault in faults:
+        if not (fault.relative and fault.effect == MotorFriction.id and fault.parameter in MotorFriction.groups):
+            continue
+        fault.check(n_axes)
+        if fault.axis in seen:
+            raise ValueError(f"axis {fault.axis} has two friction wear faults ({seen[fault.axis]} and "
+                             f"{fault.to_dict()}); give one per axis")
+        seen[fault.axis] = fault.to_dict()
+        out[:, axes.index(fault.axis, n_axes)] = fault.values(k)
+    return out
 
 
 def parse_fault(spec: str, last_cycle: int) -> Fault:

@@ -5,7 +5,11 @@ A :class:`Schedule` maps ``k`` to a dimensionless multiplier ``m(k)`` with ``m(0
 ``m(last_cycle) = 1 + increase``, which the simulator applies to the Coulomb (both signs, stored
 as magnitudes) and static friction of one axis (thesis ch. 6.3.1: wear raises f_c and f_s).
 Beyond ``last_cycle`` each formula simply continues. A :class:`WearPlan` gives each worn axis
-of a run its own schedule.
+of a run its own schedule: it parses the wear specs (``--wear 2:exp4:20``) and labels the run,
+and is turned into one relative :class:`faultgen.operation.faults.Fault` per worn axis on the
+motor friction's ``dry`` parameters (:meth:`WearPlan.faults`), which is how the simulation
+applies it (:func:`faultgen.operation.faults.dry_multipliers`): friction wear is a fault, and
+every fault's shape is a :class:`Schedule`.
 
 Schedules (``increase`` = p, ``last_cycle`` = K):
 
@@ -33,6 +37,10 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.checks import is_whole
+from faultgen.effects.motor_friction import MotorFriction
+
+#: The motor friction's parameter group friction wear raises (:attr:`MotorFriction.groups`).
+DRY = "dry"
 
 #: Known schedule kinds.
 SCHEDULES = ("exp4", "logistic", "linear", "step")
@@ -271,6 +279,19 @@ class WearPlan:
             schedules[axis], seen[axis] = schedule, spec
         return cls(schedules)
 
+    def faults(self) -> tuple:
+        """The plan as faults: per worn axis a relative :class:`faultgen.operation.faults.Fault` on
+        the motor friction's ``dry`` group (Coulomb both directions and static friction) growing on
+        its schedule, :meth:`Schedule.multiplier` as its value; in axis order."""
+        from faultgen.operation.faults import Fault  # faults shapes its growth with this module's Schedule
+
+        out = []
+        for axis, s in self.schedules.items():
+            options = {k: v for k, v in s.params.items() if k != "onset"}
+            out.append(Fault(MotorFriction.id, axis, DRY, s.increase, s.last_cycle, kind=s.kind,
+                             onset=s.params.get("onset", 0), growth="relative", options=options))
+        return tuple(out)
+
     @property
     def worn_axes(self) -> tuple[int, ...]:
         """1-based numbers of the worn axes, ascending."""
@@ -302,14 +323,13 @@ class WearPlan:
         ValueError
             For a bad cycle index, or a worn axis outside 1..N.
         """
+        from faultgen.operation.faults import dry_multipliers
+
         k = np.atleast_1d(_cycles(cycles))
         if k.ndim != 1:
             raise ValueError(f"cycles must be an int or a 1-D int array, got shape {k.shape}")
         self.check(n_axes)
-        out = np.ones((k.shape[0], n_axes))
-        for axis, schedule in self.schedules.items():
-            out[:, axes.index(axis, n_axes)] = schedule.multiplier(k)
-        return out
+        return dry_multipliers(self.faults(), k, n_axes)
 
     def to_dict(self) -> dict[str, object]:
         """JSON-serialisable labels: ``worn_axes`` and one schedule dict (with ``axis``) per axis."""

@@ -29,7 +29,8 @@ class RunConfig:
     friction : str
         Friction model, one of :data:`faultgen.friction.MODELS`.
     wear : WearPlan
-        Worn axes and their schedules; empty for no wear.
+        Worn axes and their schedules; empty for no wear. The simulation applies it as faults
+        (:attr:`faults`: one relative fault on the motor friction per worn axis).
     cycles : int
         Number of cycles of the run (cycle indices 1..cycles); >= 1.
     record : tuple of int, optional
@@ -51,7 +52,7 @@ class RunConfig:
         Keep the 250 Hz signals in the dataset (False: the per-cycle features and truth only).
     fault : Fault or None
         A fault other than friction wear: an effect's parameter growing over the cycles
-        (:mod:`faultgen.operation.faults`); the controller does not know it.
+        (:mod:`faultgen.operation.faults`), absolute; the controller does not know it.
     daily : bool
         Record one remote-monitoring sample per day of ``conditions.cycles_per_day`` cycles, the
         day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
@@ -64,9 +65,10 @@ class RunConfig:
         parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
         1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
         a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
-        are not whole days, a fault whose last cycle is not the run's or whose effect the robot
-        already carries, a task mix without the run's task or with signals, or a unit spread with a
-        gear loss under the ``lugre`` friction model; the message names the value.
+        are not whole days, a relative fault as ``fault`` (friction wear is ``wear``), a fault
+        whose last cycle is not the run's or whose effect the robot already carries, a task mix
+        without the run's task or with signals, or a unit spread with a gear loss under the
+        ``lugre`` friction model; the message names the value.
     """
 
     robot: str
@@ -112,6 +114,10 @@ class RunConfig:
         if self.fault is not None:
             if not isinstance(self.fault, Fault):
                 raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
+            if self.fault.relative:
+                raise ValueError(f"fault {self.fault.to_dict()} is relative growth of the motor friction: friction wear, "
+                                 "given as wear (WearPlan, --wear AXIS:KIND:PERCENT), whose labels and truth array the "
+                                 "dataset keeps")
             self.fault.check(n_axes)
             if self.fault.last_cycle != self.cycles:
                 raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
@@ -144,6 +150,11 @@ class RunConfig:
             if self.record is not None or self.signals or self.cycles % per_day:
                 raise ValueError(f"daily records need every cycle recorded, no signals and whole days: got record = "
                                  f"{self.record!r}, signals = {self.signals}, {self.cycles} cycles at {per_day} a day")
+
+    @property
+    def faults(self) -> tuple[Fault, ...]:
+        """Every fault of the run: friction wear (:meth:`WearPlan.faults`, relative) and :attr:`fault`."""
+        return self.wear.faults() + (() if self.fault is None else (self.fault,))
 
     @property
     def recorded_cycles(self) -> np.ndarray:

@@ -26,6 +26,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.model import robots
+from faultgen.operation import faults
 from faultgen.operation.conditions import CycleConditions
 from faultgen.simulation import friction_models, sensors
 from faultgen.simulation.batch import CHUNK_PERIODS, Plant, Raw, SimulationDiverged, Work, start_state
@@ -126,7 +127,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     per_log = prepared.per_log
     n_steps = len(inputs) - 1
 
-    multiplier = config.wear.multipliers(cycles, robot.n_axes)
+    # friction wear is a fault: the relative faults on the motor friction scale each cycle's dry friction
+    multiplier = faults.dry_multipliers(config.faults, cycles, robot.n_axes)
     n_log = n_steps // per_log
     feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
