@@ -45,7 +45,7 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     path : path of a faultgen dataset (HDF5).
     out : path of the PNG to write (suffix ``.png``); its folder must exist.
     run : str, optional
-        Run id to draw (``faultgen.dataset.list_runs``); required to draw a single run of a sweep.
+        Run id to draw (``faultgen.data.dataset.list_runs``); required to draw a single run of a sweep.
 
     Returns
     -------
@@ -56,7 +56,7 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     ValueError
         If ``out`` does not end in ``.png``, or ``run`` is not a run of the file (the message
         names it and lists some run ids).
-    faultgen.dataset.DatasetError
+    faultgen.data.dataset.DatasetError
         If ``path`` is not a finished, valid faultgen dataset.
     """
     out = Path(out)
