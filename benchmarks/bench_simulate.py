@@ -1,7 +1,7 @@
 """Cost of `faultgen simulate`'s stepping against MuJoCo's own C stepping of the same model.
 
-Measured: the stepping phase of ``faultgen.sim.simulate`` (set-point and disturbance hand-over a
-chunk at a time, recording, divergence checks). Baselines, on the very model `faultgen simulate`
+Measured: the stepping phase of ``faultgen.simulation.stepping.simulate`` (set-point and disturbance
+hand-over a chunk at a time, recording, divergence checks). Baselines, on the very model `faultgen simulate`
 compiles (robot + PID drives + friction), the same number of simulations, steps and threads, no
 Python in the loop:
 

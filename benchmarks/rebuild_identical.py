@@ -17,7 +17,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen import robots
+from faultgen.model import robots
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -11,14 +11,14 @@ The public API, what a user imports from ``faultgen`` (loaded on first use, so `
 faultgen`` stays cheap): :data:`PUBLIC` names each, e.g. ``faultgen.open(path)`` (a typed
 :class:`~faultgen.data.reader.Dataset`), ``faultgen.simulate(config)``, ``faultgen.load_robot(name)``.
 
-The modules' first-round names keep working: ``faultgen.robots`` is ``faultgen.model.robots``
-(the same module object), and likewise for :data:`MOVED`.
+One module is public by name too: ``faultgen.robots`` is :mod:`faultgen.model.robots`, so that
+``faultgen.robots.load(DIR)`` loads a robot folder (docs/robots.md). It is an attribute, not an
+import path (``import faultgen.robots`` fails); the library and its tests use the layered name.
+The other first-round module names (``sim``, ``dataset``, ``sweep``, ... before the sub-packages)
+are gone; docs/architecture.md says where each module lives.
 """
 
 import importlib
-import importlib.abc
-import importlib.util
-import sys
 from importlib.metadata import PackageNotFoundError, version
 
 try:
@@ -26,42 +26,8 @@ try:
 except PackageNotFoundError:  # running from a source tree that was not installed
     __version__ = "0.0.0+unknown"
 
-#: First-round module names -> where the module lives now.
-MOVED = {
-    "robots": "faultgen.model.robots",
-    "friction": "faultgen.effects.friction",
-    "tasks": "faultgen.operation.tasks",
-    "ik": "faultgen.operation.ik",
-    "wear": "faultgen.operation.wear",
-    "control": "faultgen.simulation.control",
-    "sensors": "faultgen.simulation.sensors",
-    "sim": "faultgen.simulation.stepping",
-    "dataset": "faultgen.data.dataset",
-    "measured": "faultgen.data.measured",
-    "atomic": "faultgen.data.atomic",
-    "sweep": "faultgen.runs.sweep",
-}
-
-
-class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Import ``faultgen.<old name>`` as the module it moved to (:data:`MOVED`), loaded once."""
-
-    def find_spec(self, fullname, path=None, target=None):
-        prefix, _, name = fullname.partition(".")
-        if prefix == __name__ and name in MOVED:
-            return importlib.util.spec_from_loader(fullname, self)
-        return None
-
-    def create_module(self, spec):
-        module = importlib.import_module(MOVED[spec.name.partition(".")[2]])
-        spec.loader_state = module.__spec__  # importlib sets the alias's spec on the module next
-        return module
-
-    def exec_module(self, module):  # executed under its own name by create_module
-        module.__spec__ = module.__spec__.loader_state
-
-
-#: The public API: name -> (module, attribute), imported when first used.
+#: The public API: name -> (module, attribute), imported when first used; attribute ``None``
+#: names the module itself.
 PUBLIC = {
     "open": ("faultgen.data.reader", "open"),
     "Dataset": ("faultgen.data.reader", "Dataset"),
@@ -70,12 +36,13 @@ PUBLIC = {
     "validate": ("faultgen.data.dataset", "validate"),
     "load_robot": ("faultgen.model.robots", "load"),
     "available_robots": ("faultgen.model.robots", "available"),
-    "RunConfig": ("faultgen.simulation.stepping", "RunConfig"),
+    "RunConfig": ("faultgen.simulation.config", "RunConfig"),
     "simulate": ("faultgen.simulation.stepping", "simulate"),
     "write_run": ("faultgen.data.dataset", "write_run"),
     "Grid": ("faultgen.runs.sweep", "Grid"),
     "run_sweep": ("faultgen.runs.sweep", "run"),
     "Fleet": ("faultgen.runs.fleet", "Fleet"),
+    "robots": ("faultgen.model.robots", None),
 }
 __all__ = ["__version__", *PUBLIC]
 
@@ -84,13 +51,10 @@ def __dir__():
     return sorted({*globals(), *PUBLIC})
 
 
-def __getattr__(name):  # ``faultgen.robots`` without importing it first
+def __getattr__(name):  # ``faultgen.open`` without importing the reader first
     if name in PUBLIC:
         module, attribute = PUBLIC[name]
-        return getattr(importlib.import_module(module), attribute)
-    if name in MOVED:
-        return importlib.import_module(f"{__name__}.{name}")
+        module = importlib.import_module(module)
+        return module if attribute is None else getattr(module, attribute)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-
-sys.meta_path.append(_MovedModules())

@@ -6,12 +6,11 @@ so importing this module needs neither matplotlib nor a display, and no global b
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import dataset
+from faultgen.data import reader
 
 TORQUE_LABEL = "mean |motor torque| [N m]"
 CHANGE_LABEL = "change of mean |motor torque| [%]"
@@ -45,7 +44,7 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     path : path of a faultgen dataset (HDF5).
     out : path of the PNG to write (suffix ``.png``); its folder must exist.
     run : str, optional
-        Run id to draw (``faultgen.dataset.list_runs``); required to draw a single run of a sweep.
+        Run id to draw (:attr:`faultgen.data.reader.Run.id`); required to draw a single run of a sweep.
 
     Returns
     -------
@@ -56,40 +55,43 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
     ValueError
         If ``out`` does not end in ``.png``, or ``run`` is not a run of the file (the message
         names it and lists some run ids).
-    faultgen.dataset.DatasetError
+    faultgen.data.dataset.DatasetError
         If ``path`` is not a finished, valid faultgen dataset.
     """
     out = Path(out)
     if out.suffix.lower() != ".png":
         raise ValueError(f"cannot write {out}: plots are written as PNG, so the output must end in .png")
-    ids = dataset.list_runs(path)
-    if run is not None and run not in ids:
-        listed = ", ".join(ids[:5]) + (", ..." if len(ids) > 5 else "")
-        raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {listed}")
-    from matplotlib.figure import Figure
-
-    from faultgen.data import reader
-
     with reader.open(path) as data:
+        ids = [r.id for r in data.runs]
+        if run is not None and run not in ids:
+            listed = ", ".join(ids[:5]) + (", ..." if len(ids) > 5 else "")
+            raise ValueError(f"{path} has no run {run!r}; its {len(ids)} runs include: {listed}")
         if run is None and data.kind == "fleet" and len(ids) > 1:
             return _draw_fleet(data, out)
-    shown = [run] if run is not None else ids
-    n_axes = max(dataset.read_run(path, i, names=("friction_multiplier",))[0]["friction_multiplier"].shape[1]
-                 for i in shown)  # the most axes of the robots drawn: one panel each, two rows
-    columns = -(-n_axes // 2)
-    fig = Figure(figsize=(14 * columns / 3, 7.5))
-    axes = fig.subplots(2, columns).ravel()
-    for ax in axes[n_axes:]:
-        ax.set_visible(False)
-    if run is not None or len(ids) == 1:
-        _draw_run(fig, axes[:n_axes], path, run if run is not None else ids[0])
-    else:
-        _draw_sweep(fig, axes[:n_axes], path, ids)
+        fig = _draw(data, run)
     from faultgen.data.atomic import atomic_path
 
     with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
         fig.savefig(tmp, dpi=110, format="png")
     return out
+
+
+def _draw(data: reader.Dataset, run: str | None):
+    """The figure of one run (``run``, or the file's only run) or of a sweep (``run`` None)."""
+    from matplotlib.figure import Figure
+
+    shown = [data[run]] if run is not None else data.runs
+    n_axes = max(r.array("friction_multiplier").shape[1] for r in shown)  # the most axes of the robots
+    columns = -(-n_axes // 2)  # drawn: one panel each, two rows
+    fig = Figure(figsize=(14 * columns / 3, 7.5))
+    axes = fig.subplots(2, columns).ravel()
+    for ax in axes[n_axes:]:
+        ax.set_visible(False)
+    if len(shown) == 1:
+        _draw_run(fig, axes[:n_axes], shown[0])
+    else:
+        _draw_sweep(fig, axes[:n_axes], data)
+    return fig
 
 
 #: Days at the start of each robot's record that the fleet plot measures the change from.
@@ -154,10 +156,8 @@ def _draw_fleet(data, out: Path) -> Path:
     return out
 
 
-def _draw_run(fig, axes, path, run_id: str) -> None:
-    arrays, attrs = dataset.read_run(path, run_id, names=("cycles", "mean_abs_torque", "friction_multiplier"))
-    cycles, torque = arrays["cycles"], arrays["mean_abs_torque"]
-    wear = (arrays["friction_multiplier"] - 1.0) * 100.0
+def _draw_run(fig, axes, run: reader.Run) -> None:
+    cycles, torque, wear = run.recorded, run.array("mean_abs_torque"), run.wear
     for j, ax in enumerate(axes):
         ax.plot(cycles, torque[:, j], "o", ms=4, color="tab:blue", label="mean |motor torque|")
         ax.ticklabel_format(axis="y", useOffset=False)
@@ -167,39 +167,37 @@ def _draw_run(fig, axes, path, run_id: str) -> None:
         ax.set(title=f"axis {j + 1}", xlabel="cycle", ylabel=TORQUE_LABEL)
         ax.locator_params(axis="x", integer=True)
         ax.grid(alpha=0.3)
-        if np.any(arrays["friction_multiplier"][:, j] != 1.0):
+        if np.any(run.array("friction_multiplier")[:, j] != 1.0):
             twin = ax.twinx()
             twin.plot(cycles, wear[:, j], "-", color=WEAR_COLOR, label="true wear")
             twin.set_ylabel(WEAR_LABEL, color=WEAR_COLOR)
             twin.tick_params(axis="y", colors=WEAR_COLOR)
             twin.set_ylim(bottom=min(0.0, wear[:, j].min()))
             ax.set_title(f"axis {j + 1} (worn)", color=WEAR_COLOR)
-    key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if len(attrs["worn_axes"]) else "")
-    fig.suptitle(f"{run_title(run_id, attrs)}\n{key}")
+    key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if run.worn_axes else "")
+    fig.suptitle(f"{run_title(run)}\n{key}")
     fig.tight_layout()
 
 
-def _draw_sweep(fig, axes, path, ids: list[str]) -> None:
-    runs = []
-    for run_id in ids:  # only the per-cycle arrays drawn: the logged signals can be large
-        runs.append(dataset.read_run(path, run_id, names=("cycles", "mean_abs_torque", "friction_multiplier")))
-    task_names = sorted({attrs["task"] for _, attrs in runs})
-    robot_names = sorted({attrs["robot"] for _, attrs in runs})
+def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
+    runs = data.runs  # only the per-cycle arrays are read: the logged signals can be large
+    task_names = sorted({run.task for run in runs})
+    robot_names = sorted({run.robot for run in runs})
     colors = {task: f"C{i % 10}" for i, task in enumerate(task_names)}
     styles = {robot: ("-", "--", "-.", ":")[i % 4] for i, robot in enumerate(robot_names)}
-    unworn = {_reference_key(attrs): arrays for arrays, attrs in runs if len(attrs["worn_axes"]) == 0}
-    most = max(float((arrays["friction_multiplier"] - 1.0).max()) * 100.0 for arrays, _ in runs)
+    unworn = {_reference_key(run): run for run in runs if not run.worn_axes}
+    most = max(float((run.array("friction_multiplier") - 1.0).max()) * 100.0 for run in runs)
     legend, own_first = {}, False
     for j, ax in enumerate(axes):
         ax.axhline(0.0, color="0.5", lw=1.0, ls=(0, (5, 3)))  # the unworn run
         worn_here = False
-        for arrays, attrs in runs:
-            if j + 1 not in [int(a) for a in attrs["worn_axes"]]:
+        for run in runs:
+            if j + 1 not in run.worn_axes:
                 continue
-            wear, change, against_own = _change(arrays, unworn.get(_reference_key(attrs)), j)
+            wear, change, against_own = _change(run, unworn.get(_reference_key(run)), j)
             own_first |= against_own
-            name = attrs["task"] if len(robot_names) == 1 else f"{attrs['robot']}, {attrs['task']}"
-            (line,) = ax.plot(wear, change, marker="o", ms=3, ls=styles[attrs["robot"]], color=colors[attrs["task"]])
+            name = run.task if len(robot_names) == 1 else f"{run.robot}, {run.task}"
+            (line,) = ax.plot(wear, change, marker="o", ms=3, ls=styles[run.robot], color=colors[run.task])
             legend.setdefault(name, line)
             worn_here = True
         if most > 0:
@@ -212,36 +210,36 @@ def _draw_sweep(fig, axes, path, ids: list[str]) -> None:
     reference = "the unworn run of the same task and seed (dashed line at 0)"
     if own_first:
         reference += "; runs without one: their own first recorded cycle"
-    fig.suptitle(f"{Path(path).name}: robots {', '.join(robot_names)}, {len(ids)} runs\nchange of the worn axis's mean "
+    fig.suptitle(f"{data.path.name}: robots {', '.join(robot_names)}, {len(runs)} runs\nchange of the worn axis's mean "
                  f"|motor torque| per cycle against {reference}")
     rows = -(-len(order) // 6)
     fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))
 
 
-def _reference_key(attrs: dict) -> tuple:
+def _reference_key(run: reader.Run) -> tuple:
     """What a worn run shares with the unworn run it is compared with."""
-    return attrs["robot"], attrs["task"], int(attrs["seed"]), attrs["friction_model"]
+    return run.robot, run.task, run.seed, run.friction_model
 
 
-def _change(arrays: dict, reference: dict | None, j: int) -> tuple[np.ndarray, np.ndarray, bool]:
+def _change(run: reader.Run, reference: reader.Run | None, j: int) -> tuple[np.ndarray, np.ndarray, bool]:
     """True wear of axis ``j`` (%) and the change of its mean |motor torque| (%), per cycle.
 
     Against the unworn ``reference`` run on the cycles both recorded, or, without one, against
     the run's own first recorded cycle (third value True).
     """
-    torque, wear = arrays["mean_abs_torque"][:, j], (arrays["friction_multiplier"][:, j] - 1.0) * 100.0
+    torque, wear = run.array("mean_abs_torque")[:, j], run.wear[:, j]
     if reference is None:
         return wear, (torque / torque[0] - 1.0) * 100.0, True
-    _, mine, theirs = np.intersect1d(arrays["cycles"], reference["cycles"], return_indices=True)
-    base = reference["mean_abs_torque"][theirs, j]
+    _, mine, theirs = np.intersect1d(run.recorded, reference.recorded, return_indices=True)
+    base = reference.array("mean_abs_torque")[theirs, j]
     return wear[mine], (torque[mine] / base - 1.0) * 100.0, False
 
 
-def run_title(run_id: str, attrs: dict) -> str:
+def run_title(run: reader.Run) -> str:
     """A run described by its labels: robot, task, worn axes with schedule and final wear, seed,
     friction model; the run id is added when it says more than the file's default ``run``."""
-    schedules = json.loads(attrs.get("wear") or "{}").get("schedules", [])
+    schedules = run.wear_schedule.get("schedules", [])
     worn = ", ".join(f"axis {s['axis']} worn ({s['kind']}, +{100 * s['increase']:g} % by cycle {s['last_cycle']})"
                      for s in schedules) or "no wear"
-    text = f"{attrs['robot']}, {attrs['task']}, {worn}, seed {int(attrs['seed'])}, {attrs['friction_model']} friction"
-    return text if run_id == "run" else f"{run_id}: {text}"
+    text = f"{run.robot}, {run.task}, {worn}, seed {run.seed}, {run.friction_model} friction"
+    return text if run.id == "run" else f"{run.id}: {text}"

@@ -37,8 +37,9 @@ import numpy as np
 import roboticstoolbox as rtb
 import toolbox_robots
 
-from faultgen import measured, robots
+from faultgen.data import measured
 from faultgen.effects import REST_SPEED
+from faultgen.model import robots
 
 #: What faultgen should name each hidden form (its effect ids).
 NAMED_AS = {"payload": "payload", "coulomb_per_direction": "coulomb", "stribeck_exponent": "stribeck",

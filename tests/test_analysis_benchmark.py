@@ -298,7 +298,7 @@ def test_speed_window_changes_the_signal_only_on_axes_whose_cycles_all_reach_it(
 def test_classification_features_are_the_indicators_and_the_estimates(small, tmp_path, monkeypatch):
     from analysis import classify
     from analysis.features import duty_indicators
-    from faultgen import dataset
+    from faultgen.data import dataset
 
     seen = {}
     monkeypatch.setattr(classify, "evaluate", lambda X, *args, estimated=None, **kw: seen.update(X=X, est=estimated))
@@ -360,7 +360,7 @@ def test_classify_command_hands_the_time_control_to_the_library(small, tmp_path,
 
 def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypatch):
     from analysis import classify
-    from faultgen import dataset
+    from faultgen.data import dataset
 
     # one unworn run: held out, it leaves no healthy robot to train on
     with pytest.raises(ValueError, match=r"has 11 failed samples \(worn runs' last 11 before the horizon\) and 0 normal"):

@@ -1,7 +1,9 @@
-"""The package layout as a contract: layers checked by import-linter, first-round names kept."""
+"""The package layout as a contract: layers checked by import-linter, modules by their layered
+names only, an explicit public API."""
 
 import ast
 import importlib
+import re
 import shutil
 import subprocess
 import sys
@@ -54,21 +56,78 @@ def _imports(path: Path) -> list[str]:
     return names
 
 
-def test_the_library_imports_modules_by_their_layered_names():
-    # import-linter sees `from faultgen import robots` as an import of the package root, so a
-    # first-round name would hide a back-running import from the contract.
-    old = {f"faultgen.{name}" for name in faultgen.MOVED}
-    for path in sorted([*(ROOT / "faultgen").rglob("*.py"), *(ROOT / "analysis").rglob("*.py")]):
+#: The first-round module names (before the sub-packages) and where each module lives now.
+FIRST_ROUND = {
+    "robots": "faultgen.model.robots",
+    "friction": "faultgen.effects.friction",
+    "tasks": "faultgen.operation.tasks",
+    "ik": "faultgen.operation.ik",
+    "wear": "faultgen.operation.wear",
+    "control": "faultgen.simulation.control",
+    "sensors": "faultgen.simulation.sensors",
+    "sim": "faultgen.simulation.stepping",
+    "dataset": "faultgen.data.dataset",
+    "measured": "faultgen.data.measured",
+    "atomic": "faultgen.data.atomic",
+    "sweep": "faultgen.runs.sweep",
+}
+
+
+def _sources() -> list[Path]:
+    return sorted(path for tree in ("faultgen", "analysis", "tests", "benchmarks", "docs")
+                  for path in (ROOT / tree).rglob("*.py") if "_robots" not in path.parts)
+
+
+def test_nothing_imports_a_first_round_module_name():
+    # import-linter sees `from faultgen import robots` as an import of the package root, so even the
+    # public alias faultgen.robots would hide a back-running import from the contract.
+    old = {f"faultgen.{name}" for name in FIRST_ROUND}
+    for path in _sources():
         stale = [name for name in _imports(path) if name in old or name.rsplit(".", 1)[0] in old]
-        assert stale == [], f"{path.relative_to(ROOT)} imports {stale}; use the names in faultgen.MOVED"
+        assert stale == [], f"{path.relative_to(ROOT)} imports {stale}; use the layered names ({FIRST_ROUND})"
 
 
-@pytest.mark.parametrize("old", sorted(faultgen.MOVED))
-def test_first_round_module_names_are_the_moved_modules(old):
-    moved = importlib.import_module(faultgen.MOVED[old])
-    assert importlib.import_module(f"faultgen.{old}") is moved
-    assert getattr(faultgen, old) is moved
-    assert moved.__spec__.name == faultgen.MOVED[old]  # the module keeps its own identity
+def test_no_code_or_document_names_a_first_round_module():
+    """Docstrings, comments and documents name modules by their layered names too; only the user
+    documents may show the public alias ``faultgen.robots`` (``faultgen.robots.load(DIR)``)."""
+    anywhere = re.compile(r"faultgen\.(" + "|".join(sorted(set(FIRST_ROUND) - {"robots"})) + r")\b")
+    alias = re.compile(r"faultgen\.robots\b")
+    found = []
+    for path in [*_sources(), *(ROOT / "docs").glob("*.md"), ROOT / "README.md"]:
+        if path == Path(__file__).resolve():
+            continue
+        for number, line in enumerate(path.read_text().splitlines(), 1):
+            code = path.suffix == ".py" and path != ROOT / "faultgen" / "__init__.py"
+            if anywhere.search(line) or (code and alias.search(line)):
+                found.append(f"{path.relative_to(ROOT)}:{number}: {line.strip()}")
+    assert not found, "first-round module names:\n" + "\n".join(found)
+
+
+@pytest.mark.parametrize("old", sorted(FIRST_ROUND))
+def test_first_round_module_names_no_longer_import(old):
+    importlib.import_module(FIRST_ROUND[old])  # the layered name does
+    with pytest.raises(ModuleNotFoundError, match=f"faultgen.{old}"):
+        importlib.import_module(f"faultgen.{old}")
+    if old != "robots":  # the one public module alias, below
+        with pytest.raises(AttributeError, match=old):
+            getattr(faultgen, old)
+
+
+def test_faultgen_installs_no_import_hook():
+    hooks = [finder for finder in sys.meta_path if type(finder).__module__.startswith("faultgen")]
+    assert hooks == []
+
+
+def test_the_public_names_resolve_to_the_layered_modules():
+    for name, (module, attribute) in faultgen.PUBLIC.items():
+        module = importlib.import_module(module)
+        assert getattr(faultgen, name) is (module if attribute is None else getattr(module, attribute)), name
+    from faultgen.model import robots  # issue 37's `faultgen.robots.load(DIR)`
+
+    assert faultgen.robots is robots and faultgen.robots.load is robots.load is faultgen.load_robot
+    assert set(faultgen.PUBLIC) <= set(dir(faultgen)) and set(faultgen.__all__) == {"__version__", *faultgen.PUBLIC}
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        faultgen.nothing  # noqa: B018
 
 
 def _string_constants(path: Path) -> list[tuple[int, str]]:

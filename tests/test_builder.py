@@ -8,8 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots
-from faultgen.model import builder, drivetrain
+from faultgen.model import builder, drivetrain, robots
 
 
 @pytest.mark.parametrize("name", ["puma560", "irb6700"])

@@ -12,9 +12,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import calibrate, effects, robots, sim
+from faultgen import calibrate, effects
 from faultgen.calibrate import synth
 from faultgen.effects import payload
+from faultgen.model import robots
+from faultgen.simulation import stepping as sim
 
 ROBOTS = ("puma560", "irb6700")
 

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from faultgen import effects, robots
+from faultgen import effects
 from faultgen.calibrate import gearbox
+from faultgen.model import robots
 
 
 class OneSpring:

@@ -29,8 +29,10 @@ import os
 import numpy as np
 import pytest
 
-from faultgen import measured, robots, sim
 from faultgen.calibrate import EFFECTS, calibrate, synth
+from faultgen.data import measured
+from faultgen.model import robots
+from faultgen.simulation import stepping as sim
 
 SEED = 0
 #: Each effect on one robot, alternating in the order of EFFECTS (this order puts PUMA 560

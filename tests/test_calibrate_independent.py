@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from independent_set import CASES, judge, make
 
-from faultgen import robots
 from faultgen.calibrate import calibrate
 from faultgen.effects.payload import Payload
+from faultgen.model import robots
 
 FAST = ["puma560-01-none", "irb6700-03-payload", "puma560-07-stribeck_exponent", "puma560-14-load_total+payload"]
 

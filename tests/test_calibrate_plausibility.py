@@ -10,10 +10,11 @@ import pytest
 import roboticstoolbox as rtb  # test dependency, declared in pyproject.toml [test]
 from typer.testing import CliRunner
 
-from faultgen import measured, robots
 from faultgen.calibrate import ImplausibleLogError, calibrate, plausibility, predict, search, synth
 from faultgen.cli import app
+from faultgen.data import measured
 from faultgen.effects import get
+from faultgen.model import robots
 
 
 @pytest.fixture(scope="module")

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 import roboticstoolbox as rtb  # test dependency, declared in pyproject.toml [test]
 
-from faultgen import measured, robots
 from faultgen.calibrate import calibrate, synth
+from faultgen.data import measured
+from faultgen.model import robots
 
 SEED = 0
 

@@ -7,8 +7,9 @@ in tests/test_calibrate_hidden.py.
 import numpy as np
 import pytest
 
-from faultgen import effects, robots
+from faultgen import effects
 from faultgen.calibrate import search, synth
+from faultgen.model import robots
 
 
 @pytest.fixture(scope="module")

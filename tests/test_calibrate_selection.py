@@ -4,10 +4,10 @@ and the excitation design, on synthetic data where the answer is known."""
 import numpy as np
 import pytest
 
-from faultgen import robots
 from faultgen.calibrate import excitation, search
 from faultgen.calibrate.effects import get
 from faultgen.calibrate.effects import motion as motion_of
+from faultgen.model import robots
 
 
 def _split(n: int, axes: int = 6) -> search.Split:

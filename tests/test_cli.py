@@ -7,11 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from faultgen.wear import WearPlan
 from typer.testing import CliRunner
 
-from faultgen import dataset, robots, sim
 from faultgen.cli import app
+from faultgen.data import dataset
+from faultgen.model import robots
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import stepping as sim
 
 runner = CliRunner()
 
@@ -128,8 +130,8 @@ def test_written_file_has_normal_permissions(tmp_path):
 
 def _toolbox_free_log(tmp_path, seconds=6.0, nan_row=None, degrees=False, drop=None):
     """A short measured log along our PUMA path (nominal torque), optionally broken."""
-    from faultgen import measured
     from faultgen.calibrate import synth
+    from faultgen.data import measured
 
     robot = robots.load("puma560")
     motion, tau = synth.nominal_motion(robot, "pick_place", 1)

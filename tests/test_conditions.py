@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import effects, robots
+from faultgen import effects
 from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.effects import temperature as law
+from faultgen.model import robots
 from faultgen.operation import conditions as c
 from faultgen.operation import wear
 from faultgen.runs import sweep

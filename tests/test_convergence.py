@@ -9,7 +9,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import friction, robots, sensors, sim
+from faultgen.effects import friction
+from faultgen.model import robots
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
 
 JM = 0.006  # kg m^2, the IRB-6700-like arm's axis-1 rotor
 H = 0.0005

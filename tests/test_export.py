@@ -1,4 +1,4 @@
-"""faultgen.dataset.features and `faultgen export`: the tidy table equals the HDF5 arrays."""
+"""faultgen.data.dataset.features and `faultgen export`: the tidy table equals the HDF5 arrays."""
 
 import h5py
 import numpy as np
@@ -6,8 +6,8 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import dataset
 from faultgen.cli import app
+from faultgen.data import dataset
 
 runner = CliRunner()
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from faultgen.friction import FIELDS, MotorFriction
+from faultgen.effects.friction import FIELDS, MotorFriction
 
 
 def one_axis(**overrides):

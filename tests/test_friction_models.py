@@ -11,7 +11,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import control, friction, robots
+from faultgen.effects import friction
+from faultgen.model import robots
+from faultgen.simulation import control
 
 TIMESTEP = 0.0005
 
@@ -45,7 +47,7 @@ def rig_friction(model, data, robot, model_name):
 
 
 def step(model, data, robot, model_name):
-    if model_name == "stribeck":  # as faultgen.sim does before every step
+    if model_name == "stribeck":  # as faultgen.simulation.friction_models does before every step
         model.dof_frictionloss[:] = robot.friction.stribeck_level(data.qvel[None])[0]
     mujoco.mj_step(model, data)
 

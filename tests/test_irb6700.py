@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from toolbox_robots import irb6700, irb6700_balance_torque
 
-from faultgen import robots
+from faultgen.model import robots
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,8 @@ import roboticstoolbox as rtb  # test dependency, declared in pyproject.toml [te
 from mujoco import batch as mjbatch
 from toolbox_robots import irb6700, irb6700_balance_torque
 
-from faultgen import robots
 from faultgen.calibrate import calibrate, synth
+from faultgen.model import robots
 
 
 @pytest.mark.parametrize("name", ["puma560", "irb6700"])

@@ -11,8 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from faultgen import measured, robots
-from faultgen.measured import MeasuredDataError
+from faultgen.data import measured
+from faultgen.data.measured import MeasuredDataError
+from faultgen.model import robots
 
 NOISE = 1e-5  # rad, standard deviation of the noise added to q (about a 19-bit arm encoder)
 

@@ -8,7 +8,7 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from faultgen import dataset
+from faultgen.data import dataset
 from faultgen.plot import plot
 
 
@@ -114,9 +114,8 @@ def test_a_file_with_one_run_is_drawn_as_that_run(sweep_file, tmp_path, figures)
 
 
 def test_a_simulated_run_is_titled_by_what_it_is(tmp_path, figures):
-    from faultgen.wear import WearPlan
-
-    from faultgen import sim
+    from faultgen.operation.wear import WearPlan
+    from faultgen.simulation import stepping as sim
 
     config = sim.RunConfig(robot="puma560", task="spot_weld", wear=WearPlan.from_specs(["3:linear:10"], 4),
                            cycles=4, record=(1, 4), seed=7)

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import robots
 from faultgen.cli import app
 from faultgen.data import dataset, measured
+from faultgen.model import robots
 from faultgen.operation import programs, replay, tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import sensors

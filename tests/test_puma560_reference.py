@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import roboticstoolbox as rtb  # test dependency, declared in pyproject.toml [test]
 
-from faultgen import robots
+from faultgen.model import robots
 
 N_SAMPLES = 1000
 

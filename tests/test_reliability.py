@@ -18,8 +18,9 @@ import psutil
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import dataset, sweep
 from faultgen.cli import app
+from faultgen.data import dataset
+from faultgen.runs import sweep
 
 runner = CliRunner()
 CLI = [sys.executable, "-m", "faultgen.cli"]

@@ -6,7 +6,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from faultgen import robots
+from faultgen.model import robots
 
 
 def test_a_robot_is_compiled_once_and_an_edited_file_again(tmp_path, monkeypatch):

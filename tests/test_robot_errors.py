@@ -6,7 +6,7 @@ import shutil
 import numpy as np
 import pytest
 
-from faultgen import robots
+from faultgen.model import robots
 
 
 def test_unknown_robot_lists_the_known_ones():

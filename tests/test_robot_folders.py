@@ -7,7 +7,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots
+from faultgen.model import robots
 
 ROBOTS = sorted(robots.available())
 

@@ -18,8 +18,7 @@ import pytest
 import roboticstoolbox as rtb
 import rtbdata
 
-from faultgen import robots
-from faultgen.model import builder, importers, sizing
+from faultgen.model import builder, importers, robots, sizing
 
 XACRO = Path(rtbdata.__file__).parent / "xacro"
 URDFS = {

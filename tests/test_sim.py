@@ -6,9 +6,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import control, robots, sim, tasks
-from faultgen.sensors import NoiseConfig
-from faultgen.wear import WearPlan
+from faultgen.model import robots
+from faultgen.operation import tasks
+from faultgen.operation.wear import WearPlan
+from faultgen.simulation import control
+from faultgen.simulation import stepping as sim
+from faultgen.simulation.sensors import NoiseConfig
 
 
 def run(task="pick_place", wear=(), robot="irb6700", friction="lugre", **kwargs):

@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots
+from faultgen.model import robots
 
 ROBOTS = ["puma560", "irb6700"]
 DURATION = 10.0  # s

@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from faultgen import dataset, robots, sweep
 from faultgen.cli import app
+from faultgen.data import dataset
+from faultgen.model import robots
+from faultgen.runs import sweep
 
 runner = CliRunner()
 
@@ -113,7 +115,7 @@ def _wait_for(condition, what: str, seconds: float = 120) -> None:
 
 def test_a_killed_merge_leaves_debris_that_the_next_sweep_removes_and_reports(tmp_path):
     out = tmp_path / "merged.h5"
-    killed_merge = (f"import os, signal\nfrom faultgen.atomic import atomic_path\n"
+    killed_merge = (f"import os, signal\nfrom faultgen.data.atomic import atomic_path\n"
                     f"with atomic_path({str(out)!r}) as tmp:\n    tmp.write_bytes(bytes(10**6))\n"
                     f"    os.kill(os.getpid(), signal.SIGKILL)")
     subprocess.run([sys.executable, "-c", killed_merge], check=False)

@@ -12,7 +12,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from faultgen import robots, tasks
+from faultgen.model import robots
+from faultgen.operation import tasks
 
 ROBOTS = ["puma560", "irb6700"]
 CASES = [(r, t) for r in ROBOTS for t in tasks.TASKS]

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from faultgen.wear import SCHEDULES, Schedule, WearPlan, parse_wear
+from faultgen.operation.wear import SCHEDULES, Schedule, WearPlan, parse_wear
 
 CYCLES = np.arange(0, 101)
 

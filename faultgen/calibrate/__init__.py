@@ -3,7 +3,7 @@ missing physical effect, add it to the model, and show the gap shrink.
 
 The workflow (:func:`calibrate`, ``faultgen calibrate``):
 
-1. read and check the measured file (:func:`faultgen.measured.read`; velocities and
+1. read and check the measured file (:func:`faultgen.data.measured.read`; velocities and
    accelerations from a Savitzky-Golay filter when the file has none), and refuse a log the robot
    cannot explain (:mod:`faultgen.calibrate.plausibility`) before writing anything;
 2. predict the torque with the nominal model (:func:`predict`: the inverse dynamics plus what the
@@ -382,7 +382,7 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
 def predict(robot: robots.Robot, data: measured_io.MeasuredData) -> np.ndarray:
     """A model's drive torque along a measured motion, N m at the arm side, shape (n, 6).
 
-    :meth:`faultgen.robots.Robot.inverse_dynamics` (rigid body, motor inertia, friction and the
+    :meth:`faultgen.model.robots.Robot.inverse_dynamics` (rigid body, motor inertia, friction and the
     model's optional effects, time from the first sample) plus the torque of the flexible
     gearboxes (:func:`faultgen.calibrate.gearbox.compliance_torque`).
     """
@@ -398,7 +398,7 @@ def _predict(robot: robots.Robot, data: measured_io.MeasuredData) -> tuple[np.nd
 
 def parameters(robot: robots.Robot) -> dict:
     """A robot's parameters as plain lists over axes 1..6, with their units (``parameters.json``):
-    gear ratios, the motor-side friction (:data:`faultgen.friction.FIELDS`) and every effect the
+    gear ratios, the motor-side friction (:data:`faultgen.effects.friction.FIELDS`) and every effect the
     robot carries in its own MJCF elements, by effect id and parameter name
     (:attr:`faultgen.effects.Effect.units`)."""
     friction = {name: [float(v) for v in getattr(robot.friction, name)] for name in FRICTION_FIELDS}

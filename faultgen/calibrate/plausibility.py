@@ -57,7 +57,7 @@ def check(robot, tau: np.ndarray, predicted: np.ndarray, moving: np.ndarray) -> 
 
     Parameters
     ----------
-    robot : faultgen.robots.Robot
+    robot : faultgen.model.robots.Robot
         The nominal model (its name and gear ratios go into the message).
     tau, predicted : ndarray of shape (n, 6)
         Measured and predicted arm-side drive torque, N m.

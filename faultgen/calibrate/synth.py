@@ -5,8 +5,8 @@ This is how the calibration workflow is checked (tests/test_calibrate_hidden.py,
 at a random size on random axes, written into a copy of the robot's MJCF with the same
 :meth:`Effect.apply` the workflow uses, and that model is simulated closed-loop (PID drives,
 flexible gearboxes, static Stribeck friction with stiction, load disturbance, encoder noise;
-:func:`faultgen.sim.simulate`) over several cycles of a task, back to back in one simulation as on
-a robot (each cycle starts where the previous one ended: a dead band's flank, a gearbox still
+:func:`faultgen.simulation.stepping.simulate`) over several cycles of a task, back to back in one
+simulation as on a robot (each cycle starts where the previous one ended: a dead band's flank, a gearbox still
 ringing). The log is what a robot controller
 records: ``q = theta_m / G`` from the motor encoders, ``tau = G tau_m`` from the drive torque,
 plus torque-sensor noise. The workflow then gets only that file and the robot's name.

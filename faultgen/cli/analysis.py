@@ -15,13 +15,15 @@ from faultgen.cli.options import Overwrite, Progress, QAlpha
 
 def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     """Refuse a dataset that fails validation, or outputs that exist, before any analysis runs."""
-    from faultgen.data import dataset
+    from faultgen.data import dataset, reader
 
     problems = dataset.validate(file)
     if problems:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
     check_outputs(outputs, overwrite)
-    if not any(len(row["worn_axes"]) for row in dataset.labels(file)):
+    with reader.open(file) as data:
+        failing = data.failing
+    if not failing:
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")
 

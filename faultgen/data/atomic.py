@@ -92,7 +92,7 @@ def remove_stale(path: str | Path) -> list[Path]:
 
     A temporary file is stale when its writer ran on this host and no process with its pid runs
     any more. Files of a running writer, of another host (a shared file system) or not named by
-    :func:`atomic_path` are left alone. Each removal is logged (logger ``faultgen.atomic``,
+    :func:`atomic_path` are left alone. Each removal is logged (logger ``faultgen.data.atomic``,
     level WARNING, so it is printed unless logging is configured otherwise).
 
     Returns

@@ -204,7 +204,7 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     path : str or Path
         A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` file (suffix case-insensitive).
     robot : str, Path or robots.Robot
-        The robot the data was recorded on: a name for :func:`faultgen.robots.load` (checked
+        The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
         before the file is opened) or a loaded robot. Its joint range is used to recognise
         angles in degrees and angles out of range.
 

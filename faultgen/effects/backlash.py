@@ -31,7 +31,7 @@ class Backlash(Effect):
       crosses;
     * quasi-statically, the arm rests on the loaded flank ``width/2`` behind the motor, so its
       rigid-body terms are those at ``q - (width/2) sign(load)``
-      (:meth:`faultgen.robots.Robot.inverse_dynamics`), taken here to first order in the width.
+      (:meth:`faultgen.model.robots.Robot.inverse_dynamics`), taken here to first order in the width.
 
     The effect has no linear parameter, and the axes are coupled: a dead band on the
     IRB-6700-like axis 2 changes the torque of axis 3 through the arm's inertia. :meth:`search`

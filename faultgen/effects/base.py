@@ -44,7 +44,7 @@ class ModelError(ValueError):
     """Raised when an MJCF file cannot be compiled or lacks the elements a robot needs.
 
     The message names the file and, where MuJoCo reports one, the line.
-    (:class:`faultgen.robots.ModelError` is this class.)
+    (:class:`faultgen.model.robots.ModelError` is this class.)
     """
 
 
@@ -54,7 +54,7 @@ class Motion:
 
     Attributes
     ----------
-    robot : faultgen.robots.Robot
+    robot : faultgen.model.robots.Robot
         The current model (nominal, or with the effects added so far).
     t : ndarray of shape (n,)
         Time since the first sample, s.
@@ -84,14 +84,14 @@ class Motion:
     def of(cls, robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
            compliance: Callable | None = None) -> Motion:
         """Evaluate ``robot``'s rigid-body load along a motion
-        (:meth:`faultgen.robots.Robot.gearbox_load`); time counts from the first sample."""
+        (:meth:`faultgen.model.robots.Robot.gearbox_load`); time counts from the first sample."""
         return cls(robot, np.asarray(t, dtype=float) - float(t[0]), q, qd, qdd, robot.gearbox_load(q, qd, qdd),
                    compliance)
 
     @property
     def static_load(self) -> np.ndarray:
         """Arm-side torque that holds the arm still at ``q``, N m, shape (n, N): gravity and joint
-        springs (:meth:`faultgen.robots.Robot.static_load`), computed once per motion."""
+        springs (:meth:`faultgen.model.robots.Robot.static_load`), computed once per motion."""
         if "static_load" not in self.memo:
             self.memo["static_load"] = self.robot.static_load(self.q)
         return self.memo["static_load"]
@@ -333,7 +333,7 @@ class Effect:
 
     @classmethod
     def of(cls, robot) -> Effect:
-        """The effect of this class a robot carries (:attr:`faultgen.robots.Robot.effects`)."""
+        """The effect of this class a robot carries (:attr:`faultgen.model.robots.Robot.effects`)."""
         return robot.effects[cls.id]
 
     # -- the MJCF -------------------------------------------------------------------------
@@ -433,7 +433,7 @@ class Effect:
                            ) -> np.ndarray | None:
         """Motor-side dry friction the effect adds given the gearbox deflections ``deflection``
         (r, N) rad (eq. 6.2a) and ``static_load()``, the arm-side torque (r, N) that would hold the
-        arms still where they are (:meth:`faultgen.robots.Robot.static_load_of`; computed only when
+        arms still where they are (:meth:`faultgen.model.robots.Robot.static_load_of`; computed only when
         called), N m, shape (r, N); None: none. Only for a :attr:`stepped` effect."""
         return None
 

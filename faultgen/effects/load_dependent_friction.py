@@ -20,7 +20,7 @@ class LoadDependentFriction(Effect):
     * 0, the whole transmitted torque: ``tau_load`` the arm-side gearbox load, the rigid-body
       torque of the arm joints (Bittencourt, Wernholt, Sander-Tavallaey & Brogardh 2010);
     * 1, the static load: ``tau_load`` the torque that holds the arm still where it is, gravity
-      and the balancing spring (:meth:`faultgen.robots.Robot.static_load`; Bittencourt &
+      and the balancing spring (:meth:`faultgen.model.robots.Robot.static_load`; Bittencourt &
       Gunnarsson 2012 load the joint by gravity).
 
     MJCF: custom numeric ``load_dependent_friction{i}`` = coefficient, gravity_load
@@ -28,7 +28,7 @@ class LoadDependentFriction(Effect):
 
     In the simulation the rotor's dry friction gains ``coefficient |tau_load| / G`` every step,
     the transmitted load from the gearbox spring's deflection ``e`` as ``K e`` (eq. 6.2a), the
-    static load from the last step's kinematics (:meth:`faultgen.robots.Robot.static_load_of`): a
+    static load from the last step's kinematics (:meth:`faultgen.model.robots.Robot.static_load_of`): a
     per-step update, so only the static friction model carries it. Identified per form, the
     coefficient by least squares.
     """

@@ -1,7 +1,7 @@
 """Flange inverse kinematics (mink, daqp QP solver) and Cartesian tool paths for task planning.
 
 The robot models carry six motor-rotor joints besides the six arm joints (see
-:mod:`faultgen.robots`). A rotor is a leaf body that moves nothing else, so it has no effect on
+:mod:`faultgen.model.robots`). A rotor is a leaf body that moves nothing else, so it has no effect on
 the flange; IK therefore runs on an *arm-only* copy of the model built with ``mujoco.MjSpec``
 (rotor bodies, gearbox tendons, motors and keyframes deleted). Its ``qpos`` is exactly the six
 arm angles in axis order, so no index bookkeeping or frozen-joint constraints are needed.

@@ -9,7 +9,7 @@ and :func:`load` reads them into a :class:`Task`, whose :meth:`Task.trajectory` 
 
 - point-to-point moves: ruckig (jerk-limited, time-optimal, rest to rest, all axes finishing
   together, duration a whole number of planning periods, :data:`PLAN_PERIOD`);
-- weld points and seam: flange IK with mink on an arm-only model (:mod:`faultgen.ik`);
+- weld points and seam: flange IK with mink on an arm-only model (:mod:`faultgen.operation.ik`);
 - the seam: IK every 10 ms along the tool path, a clamped cubic spline through the solutions
   sampled at dt, its derivatives giving qd and qdd.
 
@@ -449,7 +449,7 @@ def load(robot: Robot | str, name: str) -> Task:
     Parameters
     ----------
     robot : Robot or str
-        A loaded robot, or a name or MJCF path for :func:`faultgen.robots.load`.
+        A loaded robot, or a name or MJCF path for :func:`faultgen.model.robots.load`.
     name : str
         One of :data:`TASKS`.
 

@@ -110,16 +110,16 @@ class Grid:
     increases : list of float
         Final wear in percent (20 = Coulomb and static friction 20 % higher at the last cycle).
     schedules : list of str
-        Wear schedules (:data:`faultgen.wear.SCHEDULES`).
+        Wear schedules (:data:`faultgen.operation.wear.SCHEDULES`).
     friction : str
-        Friction model (:data:`faultgen.friction.MODELS`).
+        Friction model (:data:`faultgen.effects.friction.MODELS`).
     cycles : int
         Cycles per run.
     record : "all", list of int, or {"period": P, "first": F}
         Cycles to simulate and record: all, the listed ones, or the first F of every P.
     seeds : list of int
     disturbance, encoder : float
-        Noise levels (:class:`faultgen.sensors.NoiseConfig`).
+        Noise levels (:class:`faultgen.simulation.sensors.NoiseConfig`).
     conditions : dict or None
         Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
         ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,

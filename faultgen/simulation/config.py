@@ -24,10 +24,10 @@ class RunConfig:
     robot : str
         Robot name (``faultgen robots``) or MJCF path.
     task : str
-        One of :data:`faultgen.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
+        One of :data:`faultgen.operation.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
         (``.csv``, ``.h5``): :func:`faultgen.operation.programs.load`.
     friction : str
-        Friction model, one of :data:`faultgen.friction.MODELS`.
+        Friction model, one of :data:`faultgen.effects.friction.MODELS`.
     wear : WearPlan
         Worn axes and their schedules; empty for no wear. The simulation applies it as faults
         (:attr:`faults`: one relative fault on the motor friction per worn axis).

@@ -52,8 +52,9 @@ class SimModel:
         return self.model.opt.integrator == mujoco.mjtIntegrator.mjINT_DISCRETE
 
     def setpoints(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
-        """:func:`faultgen.control.setpoints` of a path sampled at this model's physics step, for its
-        integrator (the drives' position gains when it is implicit in position), ``(n, N, 3)``."""
+        """:func:`faultgen.simulation.control.setpoints` of a path sampled at this model's physics
+        step, for its integrator (the drives' position gains when it is implicit in position),
+        ``(n, N, 3)``."""
         return control.setpoints(self.robot, q, qd, qdd, self.model.opt.timestep,
                                  self.gains.kp if self.implicit_position else None)
 
@@ -119,7 +120,7 @@ def applied_drive_torque(force: np.ndarray, v: np.ndarray, v_before: np.ndarray,
 
 def build(robot: robots.Robot, friction_model: str = "lugre",
           edit: Callable[[mujoco.MjSpec], None] | None = None) -> SimModel:
-    """Compile ``robot`` with PID drives (:mod:`faultgen.control`) and a friction model;
+    """Compile ``robot`` with PID drives (:mod:`faultgen.simulation.control`) and a friction model;
     ``edit(spec)``, when given, is applied to the MJCF first (as :meth:`Robot.edited` made ``robot``).
 
     Raises

@@ -27,8 +27,8 @@ class Prepared:
     ----------
     sim : SimModel
         The compiled simulation model (``Batch`` works on copies of it).
-    task : faultgen.tasks.Task
-    path : faultgen.tasks.JointPath
+    task : faultgen.operation.tasks.Task
+    path : faultgen.operation.tasks.JointPath
         The task's path sampled at every physics step.
     q_ref : ndarray of shape (n_steps + 1, N)
         Reference arm angles at every physics step, rad (held at the end to a whole log period).

@@ -44,11 +44,11 @@ class RunResult:
     tracking_error : ndarray of shape (n_cycles, N)
         Largest absolute error of the true arm angle against the reference, rad.
     features : dict of ndarray
-        Per-cycle remote-monitoring aggregates (:func:`faultgen.sensors.cycle_features`):
+        Per-cycle remote-monitoring aggregates (:func:`faultgen.simulation.sensors.cycle_features`):
         ``mean_abs_torque``, ``rms_torque``, ``average_speed``, ``average_load_torque``
         (n_cycles, N) and ``angle_hist``, ``speed_hist``,
         ``torque_hist`` (n_cycles, N, 12); per recorded cycle (not in daily records) also
-        ``torque_counts`` (n_cycles, N, 1200), :func:`faultgen.sensors.torque_counts`.
+        ``torque_counts`` (n_cycles, N, 1200), :func:`faultgen.simulation.sensors.torque_counts`.
     conditions : CycleConditions or None
         The operating conditions of each recorded cycle (None when the run has none).
     fault_value : ndarray of shape (n_cycles,) or None

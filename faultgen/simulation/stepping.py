@@ -14,7 +14,7 @@ MuJoCo, ``stribeck`` from Python). This module runs a configuration; its parts a
 compiled :class:`SimModel`), :mod:`~faultgen.simulation.prepare` (what runs of a robot and task share,
 cached), :mod:`~faultgen.simulation.batch` (cycles stepped together) and
 :mod:`~faultgen.simulation.results` (:class:`RunResult`, task mixes, daily records). Their public
-names are importable from here, as ``faultgen.sim`` has always given them.
+names are importable from here too.
 """
 
 from __future__ import annotations
