@@ -434,10 +434,13 @@ def _refit(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray, st
         reduced = robots.load(_write(without, path))
         reduced_prediction, motion = _predict(reduced, data)
         residual = tau - reduced_prediction
-        candidate = search.fit_effect(get(step.effect.id), motion, residual, tau, split)
+        kind = get(step.effect.id)
+        if "completed" in step.evidence:  # fitted on its re-searched axes as the re-search did
+            kind = search.reopened(kind)
+        candidate = search.fit_effect(kind, motion, residual, tau, split)
         params = ({a: candidate.effect.values(a) for a in step.axes} if candidate.effect.per_axis
                   else {None: candidate.effect.values()})
-        effect = step.effect.fitted(reduced, params)
+        effect = kind.fitted(reduced, params)  # of the type fitted (its grid for the jackknife)
         trial_spec, trial, trial_prediction, _, trial_gap = _with_effect(
             without, reduced, effect, step.axes, path, data, tau, split.held_out)
         trial_gap = trial_gap["total_nrmse"]
