@@ -222,10 +222,10 @@ class Refined:
 
 
 def refine_stribeck(motion, residual: np.ndarray, tau: np.ndarray, split: search.Split, axes: list[int],
-                    max_iters: int = REFINE_ITERATIONS) -> Refined:
+                    max_iters: int = REFINE_ITERATIONS, start: dict | None = None) -> Refined:
     """The Stribeck hump on ``axes`` (0-based) fitted again by ``mujoco.sysid.optimize``: level,
-    velocity and exponent of every axis jointly and continuously, from the values the model of
-    ``motion`` holds (faultgen's fit), to the residual ``residual = tau - prediction`` (n, N, N m)
+    velocity and exponent of every axis jointly and continuously, from ``start`` (per axis the three
+    values; default: those the model of ``motion`` holds, faultgen's fit), to the residual ``residual = tau - prediction`` (n, N, N m)
     of that model on the fitting part of ``split``, each axis over its held-out torque RMS (the
     quantity faultgen's search minimises). The torque change of a hump is the effect's own
     regressor (:meth:`faultgen.effects.stribeck.Stribeck.columns`, which the model written with
@@ -246,7 +246,9 @@ def refine_stribeck(motion, residual: np.ndarray, tau: np.ndarray, split: search
     held = split.held_out
     scale = search._rms(tau, held)
     scale = np.where(scale > 0, scale, 1.0)
-    start = {a: {name: float(kind.current(robot).values(a)[name]) for name in names} for a in axes}
+    if start is None:
+        start = {a: {name: float(kind.current(robot).values(a)[name]) for name in names} for a in axes}
+    start = {a: {name: float(start[a][name]) for name in names} for a in axes}
     rows = {a: split.fit[:, a] for a in axes}
     low, high, x0 = [], [], []
     for a in axes:
