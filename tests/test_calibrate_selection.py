@@ -117,9 +117,10 @@ def test_reopen_finds_an_effect_below_the_absolute_threshold_on_an_axis_above_it
 
 def test_excitation_keeps_the_limits_starts_at_rest_and_conditions_better_than_its_start():
     robot = robots.load("puma560")
-    start = excitation.design(robot, harmonics=2, iterations=0)
-    designed = excitation.design(robot, harmonics=2, iterations=2)
-    assert designed.condition_number < start.condition_number  # both on 1000 samples of the period
+    designed = excitation.design(robot, harmonics=5, iterations=1, starts=2)
+    # the optimiser improves on the best random start, which is no worse than the first (1000 samples)
+    assert designed.condition_number < 0.98 * designed.best_start_condition_number
+    assert designed.best_start_condition_number <= 1.02 * designed.start_condition_number
     t = np.linspace(0, designed.period, 4001)
     q, qd, qdd = designed.sample(t)
     joint_range, velocity, acceleration = excitation.limits(robot)
@@ -129,7 +130,8 @@ def test_excitation_keeps_the_limits_starts_at_rest_and_conditions_better_than_i
     assert np.allclose(q[0], q[-1])
     # the condition number it reports is that of its regressors on 1000 samples of the period
     fine = np.linspace(0, designed.period, excitation.FINE_SAMPLES, endpoint=False)
-    assert excitation.condition_number(robot, fine, *designed.sample(fine)) == pytest.approx(designed.condition_number)
+    assert excitation.condition_number(robot, fine, *designed.sample(fine), keep=list(designed.columns)) == \
+        pytest.approx(designed.condition_number)
     text = designed.to_csv()
     header, first = text.splitlines()[:2]
     assert header == "t,q1,q2,q3,q4,q5,q6"
