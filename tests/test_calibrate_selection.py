@@ -145,10 +145,10 @@ def test_excitation_command_writes_a_replayable_csv_and_refuses_to_overwrite(tmp
     from faultgen.cli import app
 
     out = tmp_path / "exc.csv"
-    args = ["excitation", "puma560", "-o", str(out), "--iterations", "0", "--harmonics", "2"]
+    args = ["excitation", "puma560", "-o", str(out), "--iterations", "0", "--harmonics", "2", "--starts", "2"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
-    assert "condition number" in result.output
+    assert "condition number" in result.output and "first random start" in result.output
     table = np.loadtxt(out, delimiter=",", skiprows=1)
     assert table.shape == (round(10.0 / 0.004) + 1, 7)
     assert np.allclose(np.diff(table[:, 0]), 0.004)

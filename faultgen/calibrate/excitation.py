@@ -15,8 +15,11 @@ condition number is large. Limits hold by construction: the velocity and acceler
 ``t = 0`` (``sum_l a_il = 0``, ``sum_l l b_il = 0``, so the trajectory starts and ends at rest and
 can be repeated), and each axis's series is scaled down until it stays within its share of the
 joint range and within the planning velocity and acceleration limits of the robot's
-``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser is scipy's L-BFGS-B on the
-logarithm of the condition number, from a seeded random start: same seed, same trajectory.
+``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser (:func:`design`) scores
+:data:`STARTS` seeded random coefficient sets and runs scipy's L-BFGS-B on the logarithm of the
+condition number from the best, with the regressor columns and their grid values fixed (a
+criterion continuous in the coefficients) and a finite-difference step (:data:`STEP`) wide enough
+to average over the jumps of the ``sign(qd)`` columns: same seed, same trajectory.
 """
 
 from __future__ import annotations

@@ -67,7 +67,8 @@ def excitation_command(
     period: Annotated[float, typer.Option(help="Fundamental period of the Fourier series, s.")] = 10.0,
     harmonics: Annotated[int, typer.Option(help="Harmonics of the Fourier series.")] = 5,
     iterations: Annotated[int, typer.Option(help="Most optimiser iterations.")] = 8,
-    seed: Annotated[int, typer.Option(help="Seed of the optimiser's random start.")] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of the optimiser's random starts.")] = 0,
+    starts: Annotated[int, typer.Option(help="Random starts scored; the best is optimised.", min=1)] = 8,
     overwrite: Overwrite = False,
 ) -> None:
     """Design a periodic excitation on which a torque log tells the calibration's effects apart.
@@ -87,7 +88,9 @@ def excitation_command(
     from faultgen.cli.base import check_outputs
 
     check_outputs([out], overwrite)
-    designed = excitation.design(robot, harmonics=harmonics, period=period, seed=seed, iterations=iterations)
+    designed = excitation.design(robot, harmonics=harmonics, period=period, seed=seed, iterations=iterations,
+                                 starts=starts)
     designed.write(out)
     typer.echo(f"wrote {out}: {designed.period:g} s period, {len(designed.a)} harmonics, regressor condition "
-               f"number {designed.condition_number:.1f}")
+               f"number {designed.condition_number:.1f} (first random start {designed.start_condition_number:.1f}, "
+               f"best of the random starts {designed.best_start_condition_number:.1f})")
