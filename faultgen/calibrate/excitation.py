@@ -32,6 +32,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
+from faultgen.calibrate.effects import REST_SPEED
 from faultgen.calibrate.effects import get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import atomic
@@ -188,8 +189,9 @@ def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
 
     ``keep``: the columns to take, as returned by an earlier call, at the grid values chosen then (so
     a design keeps one set and its criterion does not jump where this motion's grid would move);
-    None: every column that is not (to 1e-6) a combination of earlier ones on this motion
-    (Coulomb's "positive direction" column is one with the offset and Coulomb's own).
+    None: every column that is not (to 1e-6) a combination of earlier ones on the samples of this
+    motion where the axis moves (Coulomb's "positive direction" column is one with the offset and
+    Coulomb's own).
 
     Returns
     -------
@@ -227,9 +229,14 @@ def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                     columns.append(column.reshape(-1))
                     keys.append((effect_id, axis, h, c))
     matrix = _normalised(np.column_stack(columns))
+    # which columns are combinations of earlier ones is judged on the samples where the axis moves:
+    # Coulomb's "positive direction" column is the offset's minus Coulomb's own there, and differs
+    # only at the few samples at rest, which come and go as the motion changes
+    moving = (np.abs(qd) >= REST_SPEED).T.reshape(-1)
+    judged = _normalised(np.where(moving[:, None], matrix, 0.0))
     kept, basis = [], np.zeros((matrix.shape[0], 0))
     for i in range(matrix.shape[1]):  # Gram-Schmidt: keep a column with a part outside the span so far
-        rest = matrix[:, i] - basis @ (basis.T @ matrix[:, i])
+        rest = judged[:, i] - basis @ (basis.T @ judged[:, i])
         size = float(np.linalg.norm(rest))
         if size > 1e-6:
             kept.append(i)
