@@ -217,6 +217,8 @@ def test_sysid_refines_a_stribeck_hump_to_its_truth_within_its_intervals(puma_mo
         half = found.half_width[axis][name]
         assert 0 < half < 0.1 * value
         assert abs(found.params[axis][name] - value) < 3 * half, name
+    again = refit.refine_stribeck(motion, residual, tau + residual, split, [axis], start={axis: start})
+    assert again.params == found.params and again.half_width == found.half_width  # deterministic
 
 
 def test_without_the_sysid_extra_the_stribeck_fit_stays_and_says_why(puma_motion, monkeypatch, capsys):
