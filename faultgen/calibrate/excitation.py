@@ -15,8 +15,11 @@ condition number is large. Limits hold by construction: the velocity and acceler
 ``t = 0`` (``sum_l a_il = 0``, ``sum_l l b_il = 0``, so the trajectory starts and ends at rest and
 can be repeated), and each axis's series is scaled down until it stays within its share of the
 joint range and within the planning velocity and acceleration limits of the robot's
-``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser is scipy's L-BFGS-B on the
-logarithm of the condition number, from a seeded random start: same seed, same trajectory.
+``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser (:func:`design`) scores
+:data:`STARTS` seeded random coefficient sets and runs scipy's L-BFGS-B on the logarithm of the
+condition number from the best, with the regressor columns and their grid values fixed (a
+criterion continuous in the coefficients) and a finite-difference step (:data:`STEP`) wide enough
+to average over the jumps of the ``sign(qd)`` columns: same seed, same trajectory.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
+from faultgen.calibrate.effects import REST_SPEED
 from faultgen.calibrate.effects import get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import atomic
@@ -51,6 +55,17 @@ LIMIT_SHARE = 0.9
 #: the design's figure is reported (:attr:`Excitation.condition_number`).
 SAMPLES = 100
 FINE_SAMPLES = 1000
+#: Seeded random starts scored, how many of the best are optimised, and the most L-BFGS-B
+#: iterations of each (:func:`design`).
+STARTS = 8
+LOCAL = 1
+ITERATIONS = 8
+#: Finite-difference step of the gradient, in the coefficients (of order 1 at the start). The
+#: criterion jumps where a zero crossing of a joint speed passes a sample (the Coulomb and
+#: Stribeck columns hold ``sign(qd)``): a step of 1e-4 (the first cut) saw mostly those jumps, and
+#: L-BFGS-B's line search failed at once (PUMA 560, 5 harmonics: 75.0 -> 75.0 in 976 evaluations);
+#: 1e-2 averages over them (75.0 -> 17.7 in 3 iterations, 244 evaluations; 2026-11-24).
+STEP = 1e-2
 
 
 @dataclass(frozen=True)
@@ -69,6 +84,13 @@ class Excitation:
     condition_number : float
         Of the stacked, column-normalised regressors (:func:`condition_number`) on one period
         sampled :data:`FINE_SAMPLES` times.
+    start_condition_number, best_start_condition_number : float
+        The same of the first random start (what an unoptimised random excitation within the
+        same limits gives) and of the best of the random starts, before the local optimisation.
+    columns : tuple
+        The regressor columns of the criterion (:func:`regressor`'s ``keep``: effect id, axis,
+        grid value, column); ``condition_number(robot, t, q, qd, qdd, keep=list(columns))`` scores
+        any other motion on the same columns.
     """
 
     robot: str
@@ -77,6 +99,9 @@ class Excitation:
     a: np.ndarray
     b: np.ndarray
     condition_number: float = float("nan")
+    start_condition_number: float = float("nan")
+    best_start_condition_number: float = float("nan")
+    columns: tuple = ()
 
     def sample(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Angles (rad), velocities (rad/s), accelerations (rad/s^2) at times ``t`` (n,) s, each (n, N)."""
@@ -162,9 +187,11 @@ def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     the middle of its search grid (:meth:`faultgen.effects.Effect.grid`), every value when the grid
     has at most three (the load-friction forms).
 
-    ``keep``: the columns to take, as returned by an earlier call (so a design keeps one set);
-    None: every column that is not (to 1e-6) a combination of earlier ones on this motion
-    (Coulomb's "positive direction" column is one with the offset and Coulomb's own).
+    ``keep``: the columns to take, as returned by an earlier call, at the grid values chosen then (so
+    a design keeps one set and its criterion does not jump where this motion's grid would move);
+    None: every column that is not (to 1e-6) a combination of earlier ones on the samples of this
+    motion where the axis moves (Coulomb's "positive direction" column is one with the offset and
+    Coulomb's own).
 
     Returns
     -------
@@ -173,6 +200,15 @@ def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
     """
     motion = motion_of(robot, t, q, qd, qdd)
     n, n_axes = q.shape
+    if keep is not None:  # the same columns at the same grid values: a criterion continuous in the motion
+        matrix = np.zeros((n * n_axes, len(keep)))
+        for c, (effect_id, axis, h, k) in enumerate(keep):
+            phi, _ = get(effect_id).columns(motion, axis, h)
+            if axis is None:
+                matrix[:, c] = phi[:, :, k].T.reshape(-1)
+            else:
+                matrix[axis * n:(axis + 1) * n, c] = phi[:, k]
+        return _normalised(matrix), list(keep)
     columns, keys = [], []
     for effect_id in effects:
         effect = get(effect_id)
@@ -192,18 +228,15 @@ def regressor(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.ndarray,
                     column[axis] = phi[:, c]
                     columns.append(column.reshape(-1))
                     keys.append((effect_id, axis, h, c))
-    if keep is not None:  # same effects, same columns; a grid value of this motion replaces the kept one
-        chosen = []
-        for key in keep:
-            matches = [i for i, k in enumerate(keys) if k[0] == key[0] and k[1] == key[1] and k[3] == key[3]
-                       and (k[2] == key[2] or not isinstance(key[2], (int, np.integer)))]
-            chosen.append(matches[0] if matches else None)
-        matrix = np.column_stack([columns[i] if i is not None else np.zeros(n * n_axes) for i in chosen])
-        return _normalised(matrix), list(keep)
     matrix = _normalised(np.column_stack(columns))
+    # which columns are combinations of earlier ones is judged on the samples where the axis moves:
+    # Coulomb's "positive direction" column is the offset's minus Coulomb's own there, and differs
+    # only at the few samples at rest, which come and go as the motion changes
+    moving = (np.abs(qd) >= REST_SPEED).T.reshape(-1)
+    judged = _normalised(np.where(moving[:, None], matrix, 0.0))
     kept, basis = [], np.zeros((matrix.shape[0], 0))
     for i in range(matrix.shape[1]):  # Gram-Schmidt: keep a column with a part outside the span so far
-        rest = matrix[:, i] - basis @ (basis.T @ matrix[:, i])
+        rest = judged[:, i] - basis @ (basis.T @ judged[:, i])
         size = float(np.linalg.norm(rest))
         if size > 1e-6:
             kept.append(i)
@@ -228,9 +261,12 @@ def condition_number(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.n
 
 
 def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float = PERIOD, seed: int = 0,
-           iterations: int = 8, effects: tuple[str, ...] = EFFECTS) -> Excitation:
+           iterations: int = ITERATIONS, effects: tuple[str, ...] = EFFECTS, starts: int = STARTS) -> Excitation:
     """An excitation for ``robot`` (name, MJCF path or loaded model) optimised for a small
-    regressor condition number (module docstring).
+    regressor condition number (module docstring): ``starts`` seeded random coefficient sets are
+    scored, and the best :data:`LOCAL` of them optimised by L-BFGS-B on the logarithm of the
+    condition number (finite-difference gradients), the columns and grid values fixed at those of
+    the first start (:func:`regressor`'s ``keep``) so the criterion is continuous in the coefficients.
 
     Parameters
     ----------
@@ -239,30 +275,34 @@ def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float 
     period : float
         T in s, > 0.
     seed : int
-        Of the random start.
+        Of the random starts.
     iterations : int
-        Most L-BFGS-B iterations (each costs about ``2 L N`` evaluations of the regressors).
+        Most L-BFGS-B iterations per optimised start (each costs about ``2 L N`` evaluations of
+        the regressors); 0: the best start as it is.
+    starts : int
+        Random starts scored, at least 1.
 
     Raises
     ------
     ValueError
-        For ``harmonics`` < 1, ``period`` <= 0 or ``iterations`` < 0.
+        For ``harmonics`` < 1, ``period`` <= 0, ``iterations`` < 0 or ``starts`` < 1.
     """
-    if harmonics < 1 or not period > 0 or iterations < 0:
-        raise ValueError(f"harmonics = {harmonics}, period = {period} s, iterations = {iterations}; expected "
-                         "harmonics >= 1, period > 0 and iterations >= 0")
+    if harmonics < 1 or not period > 0 or iterations < 0 or starts < 1:
+        raise ValueError(f"harmonics = {harmonics}, period = {period} s, iterations = {iterations}, starts = "
+                         f"{starts}; expected harmonics >= 1, period > 0, iterations >= 0 and starts >= 1")
     model = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     bounds = limits(model)
     n_axes = len(model.gear_ratio)
     t = np.linspace(0.0, period, SAMPLES, endpoint=False)
     rng = np.random.default_rng(seed)
-    start = rng.normal(size=(2, harmonics, n_axes)) / np.arange(1, harmonics + 1)[None, :, None]
+    draws = [(rng.normal(size=(2, harmonics, n_axes)) / np.arange(1, harmonics + 1)[None, :, None]).ravel()
+             for _ in range(starts)]
 
     def trajectory(x):
         a, b = _at_rest(*x.reshape(2, harmonics, n_axes))
         return _within_limits(bounds, a, b, period, t)
 
-    q0, a, b = trajectory(start.ravel())
+    q0, a, b = trajectory(draws[0])
     _, keep = regressor(model, t, *_series(q0, a, b, period, t), effects)
 
     def cost(x):
@@ -270,11 +310,19 @@ def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float 
         value = condition_number(model, t, *_series(q0, a, b, period, t), effects, keep)
         return float(np.log(value)) if np.isfinite(value) else 50.0
 
-    best = start.ravel()
+    scored = sorted((cost(x), k) for k, x in enumerate(draws))
+    best_cost, best = scored[0][0], draws[scored[0][1]]
     if iterations > 0:
-        found = minimize(cost, best, method="L-BFGS-B", options={"maxiter": iterations, "eps": 1e-4})
-        best = found.x if found.fun <= cost(best) else best
-    q0, a, b = trajectory(best)
-    fine = np.linspace(0.0, period, FINE_SAMPLES, endpoint=False)  # the figure reported: on a fine sampling
-    return Excitation(model.name, period, q0, a, b, condition_number(model, fine, *_series(q0, a, b, period, fine),
-                                                                     effects))
+        for _, k in scored[:LOCAL]:
+            found = minimize(cost, draws[k], method="L-BFGS-B", options={"maxiter": iterations, "eps": STEP})
+            if found.fun < best_cost:
+                best_cost, best = float(found.fun), found.x
+    fine = np.linspace(0.0, period, FINE_SAMPLES, endpoint=False)  # the figures reported: on a fine sampling
+
+    def reported(x):
+        q0, a, b = trajectory(x)
+        return q0, a, b, condition_number(model, fine, *_series(q0, a, b, period, fine), effects, keep)
+
+    q0, a, b, value = reported(best)
+    return Excitation(model.name, period, q0, a, b, value, start_condition_number=reported(draws[0])[3],
+                      best_start_condition_number=reported(draws[scored[0][1]])[3], columns=tuple(keep))

@@ -161,3 +161,138 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     gap = search.gap(tau, predict(robots.from_spec(spec_with(x), model_path), data), split.held_out)["total_nrmse"]
     return refits, elapsed, gap
 
+
+
+# -- inside the calibration: the Stribeck hump refined by sysid (issue 39, item 4) ------------------
+
+#: Most Levenberg-Marquardt iterations of the refinement (:func:`refine_stribeck`).
+REFINE_ITERATIONS = 50
+#: Bounds of the refinement, relative to faultgen's fit: the level 0 to 3 times it, the Stribeck
+#: velocity between one rest speed at the motor and twice the 95th-percentile motor speed, the
+#: exponent over the literature's range of :data:`faultgen.effects.stribeck.EXPONENTS`.
+LEVEL_REACH = 3.0
+INSTALL = "pip install 'faultgen[sysid]' (or 'mujoco[sysid]')"
+
+
+class SysidUnavailable(ImportError):
+    """``mujoco.sysid`` or its optional dependencies (the ``mujoco[sysid]`` extra) are missing."""
+
+
+def sysid_module():
+    """The ``mujoco.sysid`` module, with its optional dependencies.
+
+    Raises
+    ------
+    SysidUnavailable
+        When the module or its dependencies are not installed (MuJoCo imports the module without
+        them but leaves it empty); the message says what to install.
+    """
+    try:
+        from mujoco import sysid
+    except ImportError as error:  # a MuJoCo older than 4.0
+        raise SysidUnavailable(f"mujoco.sysid is not available ({error}); {INSTALL}") from error
+    if not hasattr(sysid, "optimize"):
+        raise SysidUnavailable(f"mujoco.sysid's optional dependencies are not installed; {INSTALL}")
+    return sysid
+
+
+@dataclass(frozen=True)
+class Refined:
+    """The Stribeck hump of some axes as ``mujoco.sysid`` fitted it (:func:`refine_stribeck`).
+
+    Attributes
+    ----------
+    params, start : dict
+        Per axis (0-based): ``static`` (N m), ``stribeck_velocity`` (rad/s), both motor side, and
+        ``stribeck_exponent``; sysid's values and faultgen's, from which it started.
+    half_width : dict
+        Per axis, the 95 % half width of each (``sysid.calculate_intervals``), same units.
+    cost, start_cost : float
+        Sum of squares of the normalised fitting-part residual at sysid's values and at faultgen's.
+    seconds : float
+        Wall time of ``sysid.optimize``.
+    """
+
+    params: dict
+    start: dict
+    half_width: dict
+    cost: float
+    start_cost: float
+    seconds: float
+
+
+def refine_stribeck(motion, residual: np.ndarray, tau: np.ndarray, split: search.Split, axes: list[int],
+                    max_iters: int = REFINE_ITERATIONS, start: dict | None = None) -> Refined:
+    """The Stribeck hump on ``axes`` (0-based) fitted again by ``mujoco.sysid.optimize``: level,
+    velocity and exponent of every axis jointly and continuously, from ``start`` (per axis the three
+    values; default: those the model of ``motion`` holds, faultgen's fit), to the residual ``residual = tau - prediction`` (n, N, N m)
+    of that model on the fitting part of ``split``, each axis over its held-out torque RMS (the
+    quantity faultgen's search minimises). The torque change of a hump is the effect's own
+    regressor (:meth:`faultgen.effects.stribeck.Stribeck.columns`, which the model written with
+    it reproduces, tests/test_calibrate_effects.py), so no model is compiled while fitting;
+    parameters are scaled by their start values so the solver sees numbers near 1. Deterministic.
+
+    Raises
+    ------
+    SysidUnavailable
+        Without the ``mujoco[sysid]`` extra.
+    """
+    sysid = sysid_module()
+    from faultgen.effects import REST_SPEED
+
+    kind = get("stribeck")
+    robot = motion.robot
+    names = ("static", "stribeck_velocity", "stribeck_exponent")
+    held = split.held_out
+    scale = search._rms(tau, held)
+    scale = np.where(scale > 0, scale, 1.0)
+    if start is None:
+        start = {a: {name: float(kind.current(robot).values(a)[name]) for name in names} for a in axes}
+    start = {a: {name: float(start[a][name]) for name in names} for a in axes}
+    rows = {a: split.fit[:, a] for a in axes}
+    low, high, x0 = [], [], []
+    for a in axes:
+        G = robot.gear_ratio[a]
+        p95 = float(np.percentile(np.abs(motion.motor_velocity[:, a]), 95))
+        s = start[a]
+        bounds = [(0.0, LEVEL_REACH * max(s["static"], 1e-6)),
+                  (min(REST_SPEED * G, s["stribeck_velocity"]), max(2 * p95, s["stribeck_velocity"])),
+                  (min(0.5, s["stribeck_exponent"]), max(2.0, s["stribeck_exponent"]))]
+        for name, (lo, hi) in zip(names, bounds, strict=True):
+            unit = max(abs(s[name]), 1e-9)
+            low.append(lo / unit)
+            high.append(hi / unit)
+            x0.append(s[name] / unit)
+    units = np.array([max(abs(start[a][name]), 1e-9) for a in axes for name in names])
+
+    def values_of(x) -> dict:
+        v = np.asarray(x, dtype=float) * units
+        return {a: dict(zip(names, map(float, v[3 * k: 3 * k + 3]), strict=True)) for k, a in enumerate(axes)}
+
+    def residual_of(x) -> np.ndarray:
+        parts = []
+        for a, p in values_of(x).items():
+            phi, offset = kind.columns(motion, a, (p["stribeck_velocity"], p["stribeck_exponent"]))
+            change = phi[:, 0] * p["static"] + offset
+            parts.append(((residual[:, a] - change) / scale[a])[rows[a]])
+        return np.concatenate(parts)
+
+    def residual_fn(x, params):
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:  # mujoco.minimize asks for several points at once
+            return [np.column_stack([residual_of(x[:, k]) for k in range(x.shape[1])])], None, None
+        return [residual_of(x)], None, None
+
+    params = sysid.ParameterDict()
+    for k, (value, lo, hi) in enumerate(zip(x0, low, high, strict=True)):
+        params.add(sysid.Parameter(f"p{k}", value, lo, hi))
+    started = time.perf_counter()
+    found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
+    seconds = time.perf_counter() - started
+    x = found.as_vector()
+    at_optimum = residual_of(x)
+    _, half = sysid.calculate_intervals([at_optimum], np.asarray(outcome.jac), alpha=ALPHA)
+    half = np.asarray(half, dtype=float) * units
+    widths = {a: dict(zip(names, map(float, half[3 * k: 3 * k + 3]), strict=True)) for k, a in enumerate(axes)}
+    return Refined(values_of(x), start, widths, float(at_optimum @ at_optimum),
+                   float(np.sum(residual_of(np.asarray(x0)) ** 2)), seconds)

@@ -3,6 +3,7 @@ centre of mass and inertia, and identified as the standard barycentric parameter
 
 from __future__ import annotations
 
+import weakref
 from typing import ClassVar
 
 import mujoco
@@ -18,6 +19,8 @@ INERTIA = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 #: Smallest principal moment MuJoCo is given, kg m^2 per kg: a point mass has none, MuJoCo needs
 #: a positive one, and 1e-9 kg m^2 per kg changes no torque.
 POINT_INERTIA = 1e-9
+#: Each robot object's probe models (:meth:`Payload._probe_models`), dropped with the robot.
+_PROBE_MODELS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def _matrix(six) -> np.ndarray:
@@ -171,9 +174,7 @@ class Payload(Effect):
             robot = motion.robot
             without = robot.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t)
             changes, probes = [], []
-            for k, (mass, com, inertia) in enumerate(self.PROBES):
-                probe = robot.edited(lambda spec, m=mass, c=com, i=inertia, k=k:
-                                     self._add_body(spec, robot, f"probe{k}", m, c, i))
+            for (mass, com, inertia), probe in zip(self.PROBES, self._probe_models(robot), strict=True):
                 changes.append(probe.inverse_dynamics(motion.q, motion.qd, motion.qdd, t=motion.t) - without)
                 probes.append(barycentric(mass, com, inertia))
             # changes[k] = Y @ probes[k] for every probe: solve for Y
@@ -181,6 +182,15 @@ class Payload(Effect):
             motion.memo["payload"] = solved.T.reshape(*without.shape, 10)
         phi = motion.memo["payload"]
         return phi, np.zeros(phi.shape[:2])
+
+    def _probe_models(self, robot) -> list:
+        """The robot with each of :data:`PROBES` added, compiled once per robot object (an
+        excitation design evaluates the regressors along thousands of motions of one robot)."""
+        if robot not in _PROBE_MODELS:
+            _PROBE_MODELS[robot] = [robot.edited(lambda spec, m=mass, c=com, i=inertia, k=k:
+                                                 self._add_body(spec, robot, f"probe{k}", m, c, i))
+                                    for k, (mass, com, inertia) in enumerate(self.PROBES)]
+        return _PROBE_MODELS[robot]
 
     def params(self, motion, axis, theta, h):
         return _named(*from_barycentric(barycentric(*self._current_inertial(motion.robot)) + theta))

@@ -26,6 +26,14 @@ DRAW_LOWEST = 3.0
 #: How far (in e-folds of the hump, ``|v/v_s|^delta``) the largest Stribeck velocity tried has
 #: fallen at the 95th-percentile motor speed.
 DECAY = 4.0
+#: :data:`DECAY` of the per-axis re-search (:meth:`Stribeck.reopened`): on an axis searched again
+#: for a hump the log already shows on other axes, the largest Stribeck velocity tried has fallen
+#: one e-fold at the 95th-percentile motor speed. The first search's 4 keeps a hump from standing
+#: in for a Coulomb step on its own evidence; the re-search has the other axes' evidence, and a
+#: shoulder that never reaches the speed where its hump has fallen (the IRB-6700-like axis 2 of
+#: the independent set's ``irb6700-16``: 95th-percentile motor speed 1.5 Stribeck velocities)
+#: would otherwise never be offered the hump.
+REOPEN_DECAY = 1.0
 #: The refinement's value outside the bounds (finite, so the simplex's convergence test stays defined).
 OUTSIDE = 1e300
 
@@ -55,6 +63,14 @@ class Stribeck(FrictionParameter):
                                        "stribeck_exponent": "1"}
     absent = (0.0, 1.0, 2.0)
     continuous = True
+    #: Fall of the largest Stribeck velocity tried at the 95th-percentile motor speed, e-folds.
+    decay = DECAY
+
+    def reopened(self) -> Stribeck:
+        """The effect as the per-axis re-search fits it (:func:`faultgen.calibrate.search.reopen`):
+        Stribeck velocities up to :data:`REOPEN_DECAY` (an unregistered subclass, so the fits made
+        with it, :meth:`fitted`, keep its grid)."""
+        return ReopenedStribeck()
 
     def draw_grid(self, motion, axis):
         return self.grid(motion, axis, lowest=DRAW_LOWEST)
@@ -62,13 +78,13 @@ class Stribeck(FrictionParameter):
     def grid(self, motion, axis, exponent=None, lowest=LOWEST):
         """Stribeck velocities (rad/s, motor side) to try at ``exponent`` (default: the model's):
         from :data:`LOWEST` rest speeds (so the hump's fall shows where the calibration fits) up
-        to where it has fallen to e^-4 (2 %) at the 95th-percentile motor speed (so the hump is
+        to where it has fallen to e^-4 (2 %; :attr:`decay`) at the 95th-percentile motor speed (so the hump is
         never a disguised Coulomb step); ``[None]`` when that range is shorter than a factor 2."""
         exponent = float(motion.robot.friction.stribeck_exponent[axis]) if exponent is None else exponent
         key = ("stribeck_p95", axis)
         if key not in motion.memo:
             motion.memo[key] = float(np.percentile(np.abs(motion.motor_velocity[:, axis]), 95))
-        top = motion.memo[key] / DECAY ** (1 / exponent)
+        top = motion.memo[key] / self.decay ** (1 / exponent)
         low = lowest * REST_SPEED * motion.robot.gear_ratio[axis]
         return list(np.geomspace(low, top, 12)) if top > 2 * low else [None]
 
@@ -159,3 +175,9 @@ class Stribeck(FrictionParameter):
         f = motion.robot.friction
         dry = max(f.coulomb_pos[axis], f.coulomb_neg[axis]) + f.static[axis]
         return dry - f.static[axis] + params["static"]
+
+
+class ReopenedStribeck(Stribeck):
+    """:class:`Stribeck` with the re-search's wider grid (:data:`REOPEN_DECAY`); not registered."""
+
+    decay = REOPEN_DECAY
