@@ -596,6 +596,5 @@ def reopened(effect: Effect) -> Effect:
     completed fit it: the effect's own ``reopened()`` variant where it has one (a Stribeck hump
     tried up to higher Stribeck velocities, :data:`faultgen.effects.stribeck.REOPEN_DECAY`: the
     other axes' evidence stands for the hump, so one whose fall the log shows only in part may be
-    offered), else ``effect`` itself."""
-    variant = getattr(effect, "reopened", None)
-    return variant() if callable(variant) else effect
+    offered), else ``effect`` itself (:meth:`Effect.reopened`)."""
+    return effect.reopened()

@@ -508,6 +508,12 @@ class Effect:
             table[name][axis] = table[name][axis] * factor
         return type(self)(**table)
 
+    def reopened(self) -> Effect:
+        """The effect as the calibration's per-axis re-search fits it
+        (:func:`faultgen.calibrate.search.reopen`): itself, unless a subclass offers a wider variant
+        there (:meth:`faultgen.effects.stribeck.Stribeck.reopened`)."""
+        return self
+
     # -- hidden-effect drawing -----------------------------------------------------------
 
     def draw_grid(self, motion: Motion, axis: int) -> list:
