@@ -311,8 +311,9 @@ def judge(hidden: Hidden, result) -> dict:
                                                                                                     strict=True)
                              if len(names) > 1],
                "named_or_ambiguous": named or (len(first) == len(want) and all(covered(e, on) for e, on in want)),
-               # every hidden effect on all its axes, in any step
-               "all_axes": all(any(name == e and set(on) <= set(axes) for name, axes in got) for e, on in want)}
+               # every hidden effect on all its axes, in any step (named, or among a step's inseparable candidates)
+               "all_axes": all(any((name == e or e in names) and set(on) <= set(axes)
+                                   for (name, axes), names in zip(got, tied, strict=True)) for e, on in want)}
     if "payload" in hidden.forms:
         p = hidden.forms["payload"]
         step = next((s for s in result.steps if s.effect.id == "payload"), None)
