@@ -135,6 +135,11 @@ TABLE_5_2 = (
     "+estM+diff+var3+pca",
 )
 
+#: The rows ``faultgen classify`` computes unless asked for more (``--full``): each step of Table 5.2
+#: alone and the fullest combination without and with the estimates, in Table 5.2's order; 7 of
+#: the 19 of :data:`PREPROCESSING`, at about 0.36 of their cost (docs/performance.md, "classify").
+SHORT_TABLE = ("control", "+estM", "+diff", "+pca", "+var3", "+diff+var3+pca", "+estM+diff+var3+pca")
+
 
 def preprocessing_steps(name: str) -> list[tuple[str, BaseEstimator]]:
     """Transformer steps of a combination such as ``"+diff+var3+pca"``, applied in its order.
