@@ -857,7 +857,8 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
 
     inputs = classification_inputs(path, wear_threshold, horizon)
     if short and kwargs.get("preprocessing") is None:
-        kwargs["preprocessing"] = [n for n in SHORT_TABLE if inputs.estimated is not None or not n.startswith(ESTIMATED)]
+        kwargs["preprocessing"] = [n for n in SHORT_TABLE
+                                   if inputs.estimated is not None or not n.startswith(ESTIMATED)]
     table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
                      random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
     if chance and not kwargs.get("permutations"):
@@ -1005,7 +1006,8 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
         parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
                      "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
     if short:
-        parts.append(f"Rows: each step alone and the fullest combinations; every row of Table 5.2: `{command} --full`.")
+        parts.append("Rows: each step alone and the fullest combinations; every row of Table 5.2: "
+                     f"`{command} --full`.")
     return " ".join(parts)
 
 
