@@ -25,6 +25,7 @@ In one run of this script:
 
 Wall times on a shared machine are upper bounds; ratios of commands timed in one run hold
 better, and CPU time (user + system, workers included) best. The script prints ``uptime``'s load.
+"""
 from __future__ import annotations
 
 import argparse
