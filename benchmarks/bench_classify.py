@@ -1,6 +1,6 @@
 """Classification speed: `faultgen classify` against a plain scikit-learn loop and the sweep that made the data.
 
-    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--fleet fleet.h5 [--make-fleet]] [--skip-cli]
+    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--fleet fleet.h5 [--make-fleet]] [--steps 1,2,3,4]
 
 In one run of this script:
 
@@ -85,9 +85,9 @@ def main() -> None:
     parser.add_argument("--fleet", type=Path, help="A fleet for steps 3 and 4.")
     parser.add_argument("--make-fleet", action="store_true", help="Make --fleet first with `faultgen fleet`, timed.")
     parser.add_argument("--pairs", type=int, default=20)
-    parser.add_argument("--skip-cli", action="store_true", help="Skip step 1's timed commands.")
-    parser.add_argument("--only-cli", action="store_true", help="Steps 1 and 4 only.")
+    parser.add_argument("--steps", default="1,2,3,4", help="Steps to run (3 and 4 need --fleet); default all.")
     args = parser.parse_args()
+    steps = {int(k) for k in args.steps.split(",")}
 
     from analysis import benchmark, classify
 
@@ -100,15 +100,15 @@ def main() -> None:
     try:
         path = args.dataset
         sweep = None
-        if path is None:
+        if path is None and steps & {1, 2}:
             path = folder / "quick.h5"
             command = [faultgen(), "sweep", "--preset", "quick", "-o", str(path), "--no-progress"]
-            if not args.skip_cli:
+            if 1 in steps:
                 sweep = timed(command)
                 print(f"faultgen sweep --preset quick:   {sweep[0]:7.1f} s wall, {sweep[1]:7.1f} s CPU   ({load()})")
             else:
                 subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
-        if not args.skip_cli:
+        if 1 in steps:
             for flag in ([], ["--full"]):
                 t = timed([faultgen(), "classify", str(path), *flag, "-o", str(folder / "cls"), "--no-progress",
                            "--overwrite"])
@@ -117,7 +117,7 @@ def main() -> None:
                 if sweep is not None:
                     print("  " + ratio_line(what, t, sweep, "the sweep"))
 
-        if not args.only_cli:
+        if 2 in steps:
             inputs = benchmark.classification_inputs(path)
             rows = classify.PREPROCESSING if args.full else classify.SHORT_TABLE
             names = [n for n in rows if inputs.estimated is not None or not n.startswith(classify.ESTIMATED)]
@@ -151,9 +151,9 @@ def main() -> None:
             if args.make_fleet:
                 made = timed([faultgen(), "fleet", "-o", str(args.fleet), "--no-progress", "--overwrite"])
                 print(f"faultgen fleet (default, 26 robots): {made[0]:7.1f} s wall, {made[1]:7.1f} s CPU   ({load()})")
-            if not args.only_cli:
+            if 3 in steps:
                 stacking_check(args.fleet)
-            for flag in ([], ["--full"]):
+            for flag in ([], ["--full"]) if 4 in steps else ():
                 t = timed([faultgen(), "classify", str(args.fleet), "--horizon", "3", "--pairs", "0", *flag,
                            "-o", str(folder / "fleet-cls"), "--no-progress", "--overwrite"])
                 what = f"classify {args.fleet.name} --horizon 3 --pairs 0 {' '.join(flag)}"
