@@ -122,13 +122,13 @@ def main() -> None:
             rows = classify.PREPROCESSING if args.full else classify.SHORT_TABLE
             names = [n for n in rows if inputs.estimated is not None or not n.startswith(classify.ESTIMATED)]
             columns = list(classify.CLASSIFIERS)
-            started = time.perf_counter()
+            started, cpu = time.perf_counter(), time.process_time()
             with threadpool_limits(limits=1):  # as evaluate: one BLAS thread (tiny fits)
                 plain = plain_loop(inputs, names, columns, args.pairs, 0)
-            t_plain = time.perf_counter() - started
+            t_plain, cpu_plain = time.perf_counter() - started, time.process_time() - cpu
             times, tables = {}, {}
             for jobs in (1, 2):
-                started = time.perf_counter()
+                started, cpu = time.perf_counter(), time.process_time()
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", classify.UndefinedAUCWarning)
                     tables[jobs] = classify.evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal,
@@ -136,12 +136,15 @@ def main() -> None:
                                                      n_pairs=args.pairs, random_state=0, n_jobs=jobs,
                                                      return_aucs=True)[1]
                 times[jobs] = time.perf_counter() - started
+                if jobs == 1:
+                    cpu_shared = time.process_time() - cpu
             same = all(np.array_equal(plain[k], tables[1][k], equal_nan=True)
                        and np.array_equal(plain[k], tables[2][k], equal_nan=True) for k in plain)
             print(f"{len(names)} preprocessings x {len(columns)} classifiers x {args.pairs} pairs on {path.name} "
                   f"({load()}):")
-            print(f"  plain scikit-learn loop, 1 process:     {t_plain:7.1f} s")
-            print(f"  shared preprocessing, 1 process:        {times[1]:7.1f} s   ({t_plain / times[1]:.2f}x)")
+            print(f"  plain scikit-learn loop, 1 process:     {t_plain:7.1f} s wall, {cpu_plain:7.1f} s CPU")
+            print(f"  shared preprocessing, 1 process:        {times[1]:7.1f} s wall, {cpu_shared:7.1f} s CPU "
+                  f"({cpu_plain / cpu_shared:.2f}x less CPU)")
             print(f"  shared preprocessing, 2 processes:      {times[2]:7.1f} s   ({t_plain / times[2]:.2f}x)")
             print(f"  parallel efficiency t(1) / (2 t(2)):    {times[1] / (2 * times[2]):7.2f}")
             print(f"  same AUC in every cell, all three:      {same}")
