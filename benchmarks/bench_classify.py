@@ -170,6 +170,8 @@ def main() -> None:
 
 def stacking_check(path: Path) -> None:
     """Step 3: stacking with its inner CV by sample and by run, and LR alone, on the thesis protocol."""
+    from scipy.stats import wilcoxon
+
     from analysis import benchmark, classify
 
     fleet = benchmark.classification_inputs(path, horizon=3)
@@ -177,15 +179,20 @@ def stacking_check(path: Path) -> None:
     subset = ["control", "+pca", "+var3+pca", "+diff", "+diff+pca"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", classify.UndefinedAUCWarning)
-        table = classify.evaluate(fleet.X, fleet.y, fleet.groups, fleet.failed, fleet.normal,
-                                  classifiers={"by run": classify.stacking(0), "by sample": by_sample,
-                                               "lr": classify.logistic_regression(0)},
-                                  preprocessing=subset, n_pairs=None, random_state=0, n_jobs=2)
-    print(f"stacking's inner CV on {path.name} (--horizon 3, every pair), mean AUC (std):")
+        table, aucs = classify.evaluate(fleet.X, fleet.y, fleet.groups, fleet.failed, fleet.normal,
+                                        classifiers={"by run": classify.stacking(0), "by sample": by_sample,
+                                                     "lr": classify.logistic_regression(0)},
+                                        preprocessing=subset, n_pairs=None, random_state=0, n_jobs=2,
+                                        return_aucs=True)
+    print(f"stacking's inner CV on {path.name} (--horizon 3, every pair), mean AUC (std); by run - by sample "
+          "pair by pair: mean, pairs higher / lower, Wilcoxon signed-rank p:")
     for name in subset:
+        d = aucs["by run", name] - aucs["by sample", name]
+        d = d[~np.isnan(d)]
         print(f"  {name:12s} " + "  ".join(f"{c} {table.loc[name, (c, 'mean')]:.2f} "
                                            f"({table.loc[name, (c, 'std')]:.2f})"
-                                           for c in ("by sample", "by run", "lr")))
+                                           for c in ("by sample", "by run", "lr"))
+              + f"  diff {d.mean():+.2f}, {int((d > 0).sum())} / {int((d < 0).sum())}, p {wilcoxon(d).pvalue:.2g}")
 
 
 if __name__ == "__main__":
