@@ -291,8 +291,9 @@ def classify_command(
     a day lies scores well above 0.5; --matched-days compares them with the same days of the
     healthy robot instead.
 
-    By default seven rows of Table 5.2 (each step alone and the fullest combinations) are
-    computed; --full computes every row, as the thesis did.
+    By default seven rows of Table 5.2 are computed (each step alone and the fullest
+    combinations); --full computes every row, the thesis's fifteen and four more, in about 2.7
+    times the time.
 
     Examples (the thesis's protocol: its window before failure, every pair; the same with every
     row of Table 5.2; then the chance level of two cells on labels by wear; then of one with the
