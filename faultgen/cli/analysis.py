@@ -261,7 +261,7 @@ def classify_command(
         "several. Default: see --full.")] = None,
     full: Annotated[bool, typer.Option(
         "--full", help="Every row: Table 5.2's fifteen and four more (+var5, +diff+var3, +diff+var5+pca, "
-        "+estM+diff+var5+pca), about 2.7 times the time. Default seven rows, each step alone and the fullest "
+        "+estM+diff+var5+pca), 2 to 3 times the time. Default seven rows, each step alone and the fullest "
         "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
     chance: Annotated[bool, typer.Option(
@@ -292,8 +292,8 @@ def classify_command(
     healthy robot instead.
 
     By default seven rows of Table 5.2 are computed (each step alone and the fullest
-    combinations); --full computes every row, the thesis's fifteen and four more, in about 2.7
-    times the time.
+    combinations); --full computes every row, the thesis's fifteen and four more, in 2 to 3 times
+    the time.
 
     Examples (the thesis's protocol: its window before failure, every pair; the same with every
     row of Table 5.2; then the chance level of two cells on labels by wear; then of one with the
