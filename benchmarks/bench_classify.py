@@ -84,7 +84,7 @@ def main() -> None:
     parser.add_argument("--full", action="store_true", help="Step 2 on every row (default: classify's seven).")
     parser.add_argument("--fleet", type=Path, help="A fleet for steps 3 and 4.")
     parser.add_argument("--make-fleet", action="store_true", help="Make --fleet first with `faultgen fleet`, timed.")
-    parser.add_argument("--pairs", type=int, default=20)
+    parser.add_argument("--pairs", type=int, default=20, help="Held-out pairs of step 2 (classify's default, 20).")
     parser.add_argument("--steps", default="1,2,3,4", help="Steps to run (3 and 4 need --fleet); default all.")
     args = parser.parse_args()
     steps = {int(k) for k in args.steps.split(",")}
