@@ -824,7 +824,7 @@ THESIS_WINDOW = 10
 
 def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None = 20, random_state: int = 0,
                          progress: bool = True, horizon: int | None = None, chance: bool = False,
-                         **kwargs) -> pd.DataFrame:
+                         short: bool = False, **kwargs) -> pd.DataFrame:
     """Mean and std of leave-pair-out AUC per preprocessing (rows) and classifier (columns), Table 5.2.
 
     Samples are recorded cycles (days in a fleet), in time order; the features per axis are those
@@ -842,8 +842,9 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
     worn run is labelled 1 (the robot's state), of an unworn run 0. With ``chance`` (and no
     ``permutations``) the table's ``attrs["chance"]`` holds a cheap chance level,
-    :func:`chance_estimate`. ``kwargs`` go to :func:`analysis.classify.evaluate` (``n_jobs``:
-    pairs in parallel).
+    :func:`chance_estimate`. With ``short`` (and no ``preprocessing``) only the rows of
+    :data:`analysis.classify.SHORT_TABLE` the dataset has (no "+estM" ones without the duty).
+    ``kwargs`` go to :func:`analysis.classify.evaluate` (``n_jobs``: pairs in parallel).
 
     Raises
     ------
@@ -852,9 +853,12 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         run and its samples), or the training sets would lack a class (see
         :func:`_check_training_sets`).
     """
-    from analysis.classify import evaluate
+    from analysis.classify import ESTIMATED, SHORT_TABLE, evaluate
 
     inputs = classification_inputs(path, wear_threshold, horizon)
+    if short and kwargs.get("preprocessing") is None:
+        kwargs["preprocessing"] = [n for n in SHORT_TABLE
+                                   if inputs.estimated is not None or not n.startswith(ESTIMATED)]
     table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
                      random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
     if chance and not kwargs.get("permutations"):
@@ -978,10 +982,11 @@ def classification_tidy(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon: int | None, wear_threshold: float,
-                           matched: bool, chance: dict | None, command: str) -> str:
+                           matched: bool, chance: dict | None, command: str, short: bool = False) -> str:
     """The caption of a classification table: what the cells are, how samples were labelled, the
     chance level (measured per cell, estimated on one, or not measured with the command that
-    measures it), and why two orders of the same steps are two rows."""
+    measures it), why two orders of the same steps are two rows (when both are), and with ``short``
+    (the default rows of ``faultgen classify``) how to get every row."""
     labels = (f"the thesis's window (T-{horizon + 10} to T-{horizon}) labelled by the robot's state" if horizon is not None
               else f"every sample labelled failed when its true wear reaches {wear_threshold:g} %")
     parts = [f"Leave-pair-out ROC AUC (mean and std over {'every' if n_pairs is None else n_pairs} held-out "
@@ -997,8 +1002,12 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
                      f"below {1 / (chance['permutations'] + 1):.2f}). Every cell's: `{command} --permutations 19`.")
     else:
         parts.append(f"Chance level not measured: `{command} --permutations 19` measures it per cell.")
-    parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
-                 "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
+    if {"+diff+pca+var3", "+diff+var3+pca"} <= set(table.index):
+        parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
+                     "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
+    if short:
+        parts.append("Rows: each step alone and the fullest combinations; every row of Table 5.2: "
+                     f"`{command} --full`.")
     return " ".join(parts)
 
 

@@ -101,8 +101,10 @@ def stacking(random_state: int | None = 0, inner_cv: str = "run") -> Pipeline:
     folds by run (:func:`run_folds`), so the base outputs it learns from are, as at test time,
     those of robots the base classifiers did not see. ``"sample"``: scikit-learn's stratified
     folds over samples, what faultgen used before (a run's days on both sides of a fold).
-    Measured on an 8-robot fleet (docs/analysis.md, "stacking"): by run scores lower, below
-    chance without differencing.
+    Measured (docs/analysis.md, "Stacking's inner cross-validation"): on the default 26-robot
+    fleet the two splits are within 0.10 of each other (by run higher with PCA, lower elsewhere),
+    both below LR alone; on an 8-robot fleet by run scores far lower, below chance without
+    differencing (grouped folds on few robots bias the out-of-fold outputs against the labels).
     """
     from sklearn.model_selection import StratifiedKFold
 
@@ -134,6 +136,11 @@ TABLE_5_2 = (
     "+var3+pca", "+estM+diff+pca", "+estM+var3+pca", "+diff+pca+var3", "+diff+var3+pca",
     "+estM+diff+var3+pca",
 )
+
+#: The rows ``faultgen classify`` computes unless asked for more (``--full``): each step of Table 5.2
+#: alone and the fullest combination without and with the estimates, in Table 5.2's order; 7 of
+#: the 19 of :data:`PREPROCESSING`, at about 0.36 of their cost (docs/performance.md, "classify").
+SHORT_TABLE = ("control", "+estM", "+diff", "+pca", "+var3", "+diff+var3+pca", "+estM+diff+var3+pca")
 
 
 def preprocessing_steps(name: str) -> list[tuple[str, BaseEstimator]]:

@@ -466,5 +466,54 @@ def test_classification_outputs_a_tidy_table_and_a_caption_with_the_chance_level
     chance = {"cell": "lr control", "permutations": 5, "null": 0.81, "auc": 0.9, "p": 0.33}
     caption = benchmark.classification_caption(table, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
                                                chance=chance, command="faultgen classify x.h5")
-    assert "0.81, not 0.5" in caption and "+diff+pca+var3 concatenates windows of PCA scores" in caption
+    assert "0.81, not 0.5" in caption and "Token order" not in caption and "--full" not in caption
+    both = table.rename(index={"control": "+diff+pca+var3", "+diff": "+diff+var3+pca"})
+    caption = benchmark.classification_caption(both, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
+                                               chance=chance, command="faultgen classify x.h5", short=True)
+    assert "+diff+pca+var3 concatenates windows of PCA scores" in caption
+    assert "every row of Table 5.2: `faultgen classify x.h5 --full`" in caption
     assert benchmark.classification_heatmap(table, tmp_path / "h.png", chance).stat().st_size > 0
+
+
+def test_the_short_table_is_its_rows_of_the_full_one_with_the_same_aucs():
+    """Issue 40: `faultgen classify` computes SHORT_TABLE's rows by default; each is the cell the full
+    table has (same pairs, same seeds), and the short table is each step alone and the fullest
+    combinations, in Table 5.2's order."""
+    assert [n for n in classify.TABLE_5_2 if n in classify.SHORT_TABLE] == list(classify.SHORT_TABLE)
+    singles = {t for n in classify.SHORT_TABLE for t in ["+" + t for t in n[1:].split("+")] if n != "control"}
+    assert singles == {"+estM", "+diff", "+pca", "+var3"}
+    X, y, groups, failed, normal = runs(n_failed=3, n_normal=3, n_cycles=14)
+    estimated = X[:, :2] ** 2
+    _, short = classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], estimated=estimated,
+                                 preprocessing=classify.SHORT_TABLE, n_pairs=3, return_aucs=True)
+    _, full = classify.evaluate(X, y, groups, failed, normal, classifiers=["lr"], estimated=estimated,
+                                n_pairs=3, return_aucs=True)
+    assert len(full) == len(classify.PREPROCESSING) and set(short) < set(full)
+    for cell, aucs in short.items():
+        np.testing.assert_array_equal(aucs, full[cell])
+
+
+def test_classify_command_computes_the_short_table_unless_full(tmp_path, monkeypatch):
+    from typer.testing import CliRunner
+
+    from analysis import benchmark
+    from faultgen.cli import analysis as cli_analysis
+    from faultgen.cli import app
+
+    seen = []
+
+    def table(path, **kwargs):
+        seen.append(kwargs["short"])
+        return pd.DataFrame({("lr", "mean"): [0.5]}, index=pd.Index(["control"], name="preprocessing"))
+
+    monkeypatch.setattr(benchmark, "classification_table", table)
+    monkeypatch.setattr(cli_analysis, "analysis_input", lambda *args: None)  # no dataset: the hand-off only
+    runner = CliRunner()
+    outputs = []
+    for flag, out in ([], "s"), (["--full"], "f"):
+        result = runner.invoke(app, ["classify", str(tmp_path / "d.h5"), *flag, "--no-progress", "-o", str(tmp_path / out)])
+        assert result.exit_code == 0, result.output
+        outputs.append(" ".join(result.output.split()))
+    assert seen == [True, False]
+    assert "--full`." in outputs[0] and "--full`." not in outputs[1]
+    assert "--full" in " ".join(runner.invoke(app, ["classify", "--help"]).output.split())
