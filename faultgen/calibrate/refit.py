@@ -65,6 +65,28 @@ class Refit:
     sysid_half_width: float
 
 
+def _optimize(sysid, residual_of, starts, low, high, max_iters: int):
+    """Minimise the stacked residual ``residual_of(x)`` over ``x`` within ``[low, high]`` from
+    ``starts`` with ``sysid.optimize`` (MuJoCo's Levenberg-Marquardt); return the optimum, its 95 %
+    half widths (``sysid.calculate_intervals`` from the Jacobian) and the wall time in s."""
+
+    def residual_fn(x, params):
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:  # mujoco.minimize asks for several points at once
+            return [np.column_stack([residual_of(x[:, k]) for k in range(x.shape[1])])], None, None
+        return [residual_of(x)], None, None
+
+    params = sysid.ParameterDict()
+    for k, (value, lo, hi) in enumerate(zip(starts, low, high, strict=True)):
+        params.add(sysid.Parameter(f"p{k}", value, lo, hi))
+    started = time.perf_counter()
+    found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
+    seconds = time.perf_counter() - started
+    x = found.as_vector()
+    _, half = sysid.calculate_intervals([residual_of(x)], np.asarray(outcome.jac), alpha=ALPHA)
+    return x, half, seconds
+
+
 def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[list[Refit], float, float]:
     """Fit the continuous parameters of ``result``'s steps (a :class:`faultgen.calibrate.Calibration`)
     again with ``mujoco.sysid`` on the calibrated model, starting from the nominal model's values
@@ -131,12 +153,6 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
         error = (tau[rows] - predicted) / scale
         return error[mask]
 
-    def residual_fn(x, params):
-        x = np.asarray(x, dtype=float)
-        if x.ndim == 2:  # mujoco.minimize asks for several points at once
-            return [np.column_stack([residual_of(x[:, k]) for k in range(x.shape[1])])], None, None
-        return [residual_of(x)], None, None
-
     # sysid starts where the nominal model is (the effect absent), not at faultgen's answer; its
     # bounds reach five times past faultgen's change
     nominal = robots.load(result.robot)
@@ -146,16 +162,9 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
         robots.from_spec(spec_with(starts), model_path)
     except robots.ModelError:  # an absent payload has no inertia to start from: 20 % off faultgen's values
         starts = np.array([1.2 * value for _, _, _, value, _ in entries])
-    params = sysid.ParameterDict()
-    for k, ((step, axis, name, value, se), start) in enumerate(zip(entries, starts, strict=True)):
-        width = max(5 * abs(value - start), 0.5 * abs(start), 1e-3)
-        params.add(sysid.Parameter(f"p{k}", start, start - width, start + width))
-    started = time.perf_counter()
-    found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
-    elapsed = time.perf_counter() - started
-    x = found.as_vector()
-    residual = residual_of(x)
-    _, half = sysid.calculate_intervals([residual], np.asarray(outcome.jac), alpha=ALPHA)
+    width = np.array([max(5 * abs(value - start), 0.5 * abs(start), 1e-3)
+                      for (_, _, _, value, _), start in zip(entries, starts, strict=True)])
+    x, half, elapsed = _optimize(sysid, residual_of, starts, starts - width, starts + width, max_iters)
     refits = [Refit(step.effect.id, name, None if axis is None else axis_numbers.number(axis), value, Z_95 * se,
                     float(v), float(h)) for (step, axis, name, value, se), v, h in zip(entries, x, half, strict=True)]
     gap = search.gap(tau, predict(robots.from_spec(spec_with(x), model_path), data), split.held_out)["total_nrmse"]
@@ -277,21 +286,8 @@ def refine_stribeck(motion, residual: np.ndarray, tau: np.ndarray, split: search
             parts.append(((residual[:, a] - change) / scale[a])[rows[a]])
         return np.concatenate(parts)
 
-    def residual_fn(x, params):
-        x = np.asarray(x, dtype=float)
-        if x.ndim == 2:  # mujoco.minimize asks for several points at once
-            return [np.column_stack([residual_of(x[:, k]) for k in range(x.shape[1])])], None, None
-        return [residual_of(x)], None, None
-
-    params = sysid.ParameterDict()
-    for k, (value, lo, hi) in enumerate(zip(x0, low, high, strict=True)):
-        params.add(sysid.Parameter(f"p{k}", value, lo, hi))
-    started = time.perf_counter()
-    found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
-    seconds = time.perf_counter() - started
-    x = found.as_vector()
+    x, half, seconds = _optimize(sysid, residual_of, x0, low, high, max_iters)
     at_optimum = residual_of(x)
-    _, half = sysid.calculate_intervals([at_optimum], np.asarray(outcome.jac), alpha=ALPHA)
     half = np.asarray(half, dtype=float) * units
     widths = {a: dict(zip(names, map(float, half[3 * k: 3 * k + 3]), strict=True)) for k, a in enumerate(axes)}
     return Refined(values_of(x), start, widths, float(at_optimum @ at_optimum),
