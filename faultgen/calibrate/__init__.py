@@ -450,7 +450,7 @@ def _refit(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray, st
         residual = tau - reduced_prediction
         kind = get(step.effect.id)
         if "completed" in step.evidence:  # fitted on its re-searched axes as the re-search did
-            kind = search.reopened(kind)
+            kind = kind.reopened()
         candidate = search.fit_effect(kind, motion, residual, tau, split)
         params = ({a: candidate.effect.values(a) for a in step.axes} if candidate.effect.per_axis
                   else {None: candidate.effect.values()})

@@ -552,8 +552,8 @@ def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray
            axes: list[int], floor: np.ndarray | None = None) -> tuple[Candidate, dict[int, float]]:
     """``effect`` (already in the model on other axes) fitted again to ``residual`` (n, N) and
     judged on each of ``axes`` (0-based; those still above their noise floor) by its held-out
-    evidence alone (fitted as :func:`reopened` gives it: a Stribeck hump with a wider velocity
-    grid): the AIC gain ``n_eff ln(SSE_before / SSE_after) - 2 k`` of that axis
+    evidence alone (fitted as :meth:`Effect.reopened` gives it: a Stribeck hump with a wider
+    velocity grid): the AIC gain ``n_eff ln(SSE_before / SSE_after) - 2 k`` of that axis
     (:func:`held_out_aic`) must be at least :data:`REOPEN_EVIDENCE`, the held-out nrmse must drop
     by at least :data:`REOPEN_SHARE` of its excess over ``floor`` (N,; default
     :func:`noise_floor` of ``tau``), and the fit be physical. The absolute gain threshold :data:`MIN_GAIN` does not apply: an
@@ -566,7 +566,7 @@ def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray
         The fit (``axes`` the axes that pass, ``contribution`` on them only) and the AIC gain of
         every axis tried.
     """
-    effect = reopened(effect)
+    effect = effect.reopened()
     fit = fit_effect(effect, motion, residual, tau, split)
     held = split.held_out
     k = parameter_count(effect)
@@ -589,12 +589,3 @@ def reopen(effect: Effect, motion: Motion, residual: np.ndarray, tau: np.ndarray
     found = Candidate(fit.effect, passing, fit.gain, fit.relative_gain, np.where(mask, fit.fitted_torque, 0.0),
                       fit.fitted_torque, fit.physical, k)
     return found, gains
-
-
-def reopened(effect: Effect) -> Effect:
-    """``effect`` as the per-axis re-search (:func:`reopen`) and the backfitting of a step it
-    completed fit it: the effect's own ``reopened()`` variant where it has one (a Stribeck hump
-    tried up to higher Stribeck velocities, :data:`faultgen.effects.stribeck.REOPEN_DECAY`: the
-    other axes' evidence stands for the hump, so one whose fall the log shows only in part may be
-    offered), else ``effect`` itself (:meth:`Effect.reopened`)."""
-    return effect.reopened()

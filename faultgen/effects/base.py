@@ -509,9 +509,10 @@ class Effect:
         return type(self)(**table)
 
     def reopened(self) -> Effect:
-        """The effect as the calibration's per-axis re-search fits it
-        (:func:`faultgen.calibrate.search.reopen`): itself, unless a subclass offers a wider variant
-        there (:meth:`faultgen.effects.stribeck.Stribeck.reopened`)."""
+        """The effect as the calibration's per-axis re-search (:func:`faultgen.calibrate.search.reopen`)
+        and the backfitting of a step it completed fit it: itself, unless a subclass offers a wider
+        variant there (:meth:`faultgen.effects.stribeck.Stribeck.reopened`: the other axes' evidence
+        stands for the hump, so one whose fall the log shows only in part may be offered)."""
         return self
 
     # -- hidden-effect drawing -----------------------------------------------------------
