@@ -26,6 +26,12 @@ URDFS = {
     "irb140": XACRO / "abb_irb140_description/urdf/irb140.urdf",
     "iiwa14": XACRO / "kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf",
 }
+#: The ROS packages their meshes name (``package://NAME/...``), as a user gives them with --package.
+PACKAGES = {
+    "kuka_kr210_support": XACRO / "kuka_description/kuka_kr210",
+    "abb_irb140_support": XACRO / "abb_irb140_description",
+    "kuka_lbr_iiwa_support": XACRO / "kuka_description/kuka_lbr_iiwa",
+}
 UR5 = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 BOUND = 1e-6  # relative RMS per axis
 
@@ -52,7 +58,7 @@ def relative_rms(ours, ref):
 def test_urdf_robot_inverse_dynamics_matches_pinocchio(name):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", importers.GeometryDropped)
-        arm = importers.read(URDFS[name])
+        arm = importers.read(URDFS[name], PACKAGES)
     robot = robot_of(arm)
     assert robot.n_axes == (7 if name == "iiwa14" else 6)
     model = pin.buildModelFromXML(arm.urdf)
@@ -121,7 +127,7 @@ def test_dh_table_limits_size_the_drivetrain():
 def test_urdf_meshes_it_cannot_use_are_dropped_with_one_warning():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        importers.read(URDFS["kr210"])
+        importers.read(URDFS["kr210"], PACKAGES)
     dropped = [w for w in caught if issubclass(w.category, importers.GeometryDropped)]
     assert len(dropped) == 1 and "7 meshes left out" in str(dropped[0].message)
 
@@ -208,7 +214,7 @@ def test_mjcf_arm_reads_back_the_built_in_robot():
     np.testing.assert_array_equal(model.tendon_stiffness, reference.tendon_stiffness)
 
 
-def test_xacro_is_expanded_and_its_packages_found_in_the_folders_above(tmp_path):
+def test_xacro_is_expanded_and_its_packages_found_in_the_folders_named(tmp_path):
     package = tmp_path / "my_arm_description"
     (package / "urdf").mkdir(parents=True)
     text = urdf()
@@ -226,7 +232,9 @@ def test_xacro_is_expanded_and_its_packages_found_in_the_folders_above(tmp_path)
         '<xacro:property name="limit" value="1.5"/>'
         '<xacro:include filename="$(find my_arm_support)/urdf/macro.xacro"/><xacro:arm/></robot>'
     )
-    arm = importers.read(top)
+    with pytest.raises(builder.ArmError, match=r"--package my_arm_support=DIR \(a folder .*my_arm_description is near"):
+        importers.read(top)
+    arm = importers.read(top, {"my_arm_support": package})
     assert arm.kind == "xacro" and [j.range for j in arm.joints] == [(-1.0, 1.5)] * 6
 
 

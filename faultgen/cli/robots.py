@@ -41,6 +41,12 @@ def robots_command(
     out: Annotated[
         Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
     ] = None,
+    package: Annotated[
+        list[str] | None,
+        typer.Option(help="With `add`: NAME=DIR, the folder of ROS package NAME, for `package://NAME/...` "
+                          "meshes and xacro's `$(find NAME)` (repeatable). The source reads only its own "
+                          "folder and these."),
+    ] = None,
 ) -> None:
     """List the robot models, show one model's nominal parameters, or add a robot from an arm file.
 
@@ -57,23 +63,31 @@ def robots_command(
       faultgen robots irb6700    # gear ratios, stiffness, friction per axis, SI units
       faultgen robots add kr210 --from kr210l150.urdf -o kr210
       faultgen robots add ur5 --from ur5_dh.toml --drivetrain my_drives.toml -o ur5
+      faultgen robots add kr210x --from kuka_kr210/urdf/kr210l150.xacro \\
+          --package kuka_kr210_support=kuka_kr210 -o kr210x
     """
     if name == "add":
         if new_name is None or source is None or out is None:
             raise ValueError("robots add needs NAME, --from FILE and -o DIR, e.g. "
                              "faultgen robots add kr210 --from kr210l150.urdf -o kr210")
+        packages = {}
+        for item in package or []:
+            key, sep, value = item.partition("=")
+            if not sep or not key or not value:
+                raise ValueError(f"--package {item!r}; expected NAME=DIR, e.g. --package kuka_kr210_support=kuka_kr210")
+            packages[key] = Path(value)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", importers.GeometryDropped)
             added = folder.add(new_name, source, out, drivetrain=drivetrain, payload=payload,
-                               tasks=taskgen.generate)
+                               tasks=taskgen.generate, packages=packages)
         for warning in caught:
             typer.echo(f"warning: {warning.message}", err=True)
         robot = added.robot
         typer.echo(f"{robot.name}: {robot.n_axes} axes from {added.arm.kind} {source} -> {added.folder} "
                    f"(rated payload {added.payload:.4g} kg; provenance in {added.folder / 'README.md'})")
         return
-    if any(value is not None for value in (new_name, source, drivetrain, payload, out)):
-        raise ValueError("NAME, --from, --drivetrain, --payload and -o go with `faultgen robots add`")
+    if any(value is not None for value in (new_name, source, drivetrain, payload, out)) or package:
+        raise ValueError("NAME, --from, --drivetrain, --payload, --package and -o go with `faultgen robots add`")
     if name is None:
         known = robots.available()
         if not known:

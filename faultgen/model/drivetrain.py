@@ -22,6 +22,7 @@ from pathlib import Path
 
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
+from faultgen.model.sources import read_text
 
 #: Unit and meaning of every field of :class:`AxisDrive`, in file order.
 UNITS = {
@@ -42,6 +43,29 @@ POSITIVE = (
     "stribeck_velocity",
     "stribeck_exponent",
 )
+
+
+#: Bounds of every field, (low, high) in its unit: far outside any industrial drive (gear ratios
+#: 1..300, motor inertias 1e-5..0.05 kg m^2, stiffness 1e4..1e7 N m/rad, Stribeck exponents 0.5..2),
+#: and inside what the sizing and the integrator compute without overflow. ``low`` 0 with the key in
+#: :data:`POSITIVE` means > 0.
+BOUNDS = {
+    "gear_ratio": (0.1, 1e4),
+    "motor_inertia": (0.0, 1e3),
+    "gearbox_stiffness": (0.0, 1e10),
+    "gearbox_damping": (0.0, 1e8),
+    "motor_torque_limit": (0.0, 1e6),
+    "coulomb_pos": (0.0, 1e6),
+    "coulomb_neg": (0.0, 1e6),
+    "static": (0.0, 1e6),
+    "stribeck_velocity": (0.0, 1e4),
+    "stribeck_exponent": (0.0, 10.0),
+    "viscous": (0.0, 1e6),
+    "bristle_stiffness": (0.0, 1e10),
+    "bristle_damping": (0.0, 1e8),
+}
+#: Largest ``drivetrain.toml`` read, bytes (a 7-axis table is about 3 kB).
+MAX_TABLE_BYTES = 1_000_000
 
 
 class DrivetrainError(ValueError):
@@ -79,8 +103,9 @@ class AxisDrive:
                 raise DrivetrainError(f"{f.name} = {value!r}; expected a number ({UNITS[f.name]})")
             value = float(value)
             need_positive = f.name in POSITIVE
-            if not math.isfinite(value) or value < 0 or (need_positive and value == 0):
-                need = "> 0" if need_positive else ">= 0"
+            low, high = BOUNDS[f.name]
+            if not math.isfinite(value) or not low <= value <= high or (need_positive and value == 0):
+                need = f"{'> ' if need_positive and low == 0 else '>= '}{low:g} and <= {high:g}"
                 raise DrivetrainError(
                     f"{f.name} = {value!r}; expected a finite value {need} ({UNITS[f.name]})"
                 )
@@ -166,8 +191,8 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        data = tomllib.loads(read_text(path, MAX_TABLE_BYTES, "drivetrain table", DrivetrainError))
+    except (OSError, tomllib.TOMLDecodeError, RecursionError) as err:
         raise DrivetrainError(f"{path}: cannot read a TOML drivetrain table: {err}") from None
     unknown = sorted(set(data) - {"axis"})
     if unknown:

@@ -11,8 +11,11 @@ and the robot loads: an error or a kill leaves no folder that looks complete.
 
 from __future__ import annotations
 
+import glob
 import math
+import os
 import re
+import socket
 import shutil
 import tempfile
 from collections.abc import Callable
@@ -22,7 +25,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model import builder, importers, robots, sizing
+from faultgen.model import builder, importers, limits, robots, sizing
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
@@ -70,6 +73,7 @@ def add(
     drivetrain: str | Path | None = None,
     payload: float | None = None,
     tasks: Callable[[robots.Robot, importers.Arm, float], str] | None = None,
+    packages: dict[str, str | Path] | None = None,
 ) -> Added:
     """Write the robot folder ``out`` for the arm in ``source``.
 
@@ -87,6 +91,9 @@ def add(
         Rated payload in kg (sizing and fleet parts); by default the source's, else sized.
     tasks : callable, optional
         ``tasks(robot, arm, payload) -> str``: the ``tasks.toml`` text for the staged robot.
+    packages : dict of str to path, optional
+        ROS package name -> folder, for ``package://`` meshes and xacro's ``$(find NAME)``; the
+        source may read only its own folder and these (:func:`faultgen.model.importers.read`).
 
     Returns
     -------
@@ -100,12 +107,12 @@ def add(
     """
     if not NAME.match(name):
         raise ValueError(f"robot name {name!r}; expected a letter, then letters, digits, '_' or '-'")
-    if payload is not None and not (math.isfinite(payload) and payload >= 0):
-        raise ValueError(f"payload = {payload!r} kg; expected a finite number >= 0")
+    if payload is not None and not (math.isfinite(payload) and 0 <= payload <= limits.MAX_PAYLOAD):
+        raise ValueError(f"payload = {payload!r} kg; expected a number in 0 .. {limits.MAX_PAYLOAD:g} kg")
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
-    arm = importers.read(source)
+    arm = importers.read(source, packages)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
     payload_origin = (
@@ -130,7 +137,8 @@ def add(
     text = builder.to_xml(spec)
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    remove_stale(out)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-", dir=out.parent))
     try:
         (stage / f"{name}.xml").write_text(text)
         robot = robots.load(stage / f"{name}.xml")
@@ -160,6 +168,27 @@ def add(
         shutil.rmtree(stage, ignore_errors=True)
         raise
     return Added(out, robots.load(out / f"{name}.xml"), arm, payload)
+
+
+def remove_stale(out: Path) -> list[Path]:
+    """Remove the hidden staging folders of ``out`` (``.NAME.partial-PID@HOST-*``) that a killed
+    ``robots add`` left: those of this host whose process no longer runs. Return them."""
+    pattern = re.compile(rf"\.{re.escape(out.name)}\.partial-(\d+)@(.+)-[^-]+")
+    removed = []
+    for candidate in out.parent.glob(f".{glob.escape(out.name)}.partial-*"):
+        match = pattern.fullmatch(candidate.name)
+        if match is None or match[2] != socket.gethostname() or not candidate.is_dir():
+            continue
+        try:
+            os.kill(int(match[1]), 0)
+            continue  # its writer still runs
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            continue  # a running process of another user
+        shutil.rmtree(candidate, ignore_errors=True)
+        removed.append(candidate)
+    return removed
 
 
 def _skeleton(spec: mujoco.MjSpec, source: str) -> int:

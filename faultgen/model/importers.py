@@ -39,6 +39,7 @@ import mujoco
 import numpy as np
 
 from faultgen.axes import MAX_AXES, MIN_AXES
+from faultgen.model import limits, mjcf, sources, xacro
 from faultgen.model.builder import ArmError, ArmJoint, check_arm
 
 #: Mesh file types MuJoCo loads.
@@ -89,113 +90,111 @@ class Arm:
     urdf: str = ""
 
 
-def read(path: str | Path) -> Arm:
+def read(path: str | Path, packages: dict[str, str | Path] | None = None) -> Arm:
     """Read an arm from ``path``: ``.urdf``, ``.xacro`` (``.urdf.xacro``), ``.xml`` (MJCF, or URDF
     when its root is ``<robot>``) or ``.toml`` (a DH table, this module's docstring).
+
+    Only ``path``'s folder and the ``packages`` folders are read (:mod:`faultgen.model.sources`):
+    includes, meshes and other files named outside them are refused, and ``package://NAME/...``
+    and ``$(find NAME)`` resolve only through ``packages``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The arm file, a regular file of at most ``sources.MAX_DESCRIPTION_BYTES``.
+    packages : dict of str to path, optional
+        ROS package name -> folder (``faultgen robots add --package NAME=DIR``).
 
     Raises
     ------
     ArmError
         If the file is missing or of another type, or describes an arm faultgen cannot model
         (:func:`faultgen.model.builder.check_arm`; URDF: also a floating, planar, prismatic or
-        continuous joint, or a revolute joint without ``<limit>``), naming the element.
+        continuous joint, or a revolute joint without ``<limit>``), or a value is out of the
+        bounds of :mod:`faultgen.model.limits`, naming the element; or it names a file outside the
+        folders it may read, an MJCF plugin or a xacro construct that would run code.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ArmError(f"{path}: no such file")
+    arm = _read(path, sources.check_packages(packages))
+    limits.check_model(arm.spec, path)
+    for k, joint in enumerate(arm.joints):
+        where = f"joint {joint.name!r}"
+        for key, values, high, unit in (
+            ("speed limit", arm.speed_limit, limits.MAX_SPEED, "rad/s"),
+            ("effort limit", arm.effort_limit, limits.MAX_EFFORT, "N m"),
+        ):
+            if not math.isnan(values[k]):
+                limits.number(path, where, key, float(values[k]), 0.0, high, unit)
+    return arm
+
+
+def _read(path: Path, packages: dict[str, Path]) -> Arm:
     suffix = path.suffix.lower()
+    if suffix not in (".xacro", ".urdf", ".toml", ".xml"):
+        raise ArmError(
+            f"{path}: unknown arm file type {suffix!r}; expected .urdf, .xacro, .xml (MJCF) or .toml (DH table)"
+        )
     if suffix == ".xacro":
-        return _read_urdf(_expand_xacro(path), path, "xacro")
+        sources.read_bytes(path, what="xacro file", error=ArmError)
+        return _read_urdf(xacro.expand(path, packages), path, "xacro", packages)
+    text = sources.read_text(path, what="robot description", error=ArmError)
     if suffix == ".urdf":
-        return _read_urdf(path.read_text(), path, "URDF")
+        return _read_urdf(text, path, "URDF", packages)
     if suffix == ".toml":
-        return _read_dh(path)
-    if suffix == ".xml":
-        text = path.read_text()
-        try:
-            root = ET.fromstring(text)
-        except ET.ParseError as err:
-            raise ArmError(f"{path}: not XML: {err}") from None
-        if root.tag == "robot":
-            return _read_urdf(text, path, "URDF")
-        return _read_mjcf(path)
-    raise ArmError(
-        f"{path}: unknown arm file type {suffix!r}; expected .urdf, .xacro, .xml (MJCF) or .toml (DH table)"
-    )
-
-
-def _expand_xacro(path: Path) -> str:
-    """The URDF of a xacro file, by ``xacrodoc``. A ``$(find pkg)`` that ROS cannot resolve (no
-    ROS installation, a description copied out of its workspace) is looked for in the folders
-    above the file (:func:`_find_package`: ROS-Industrial's ``kuka_kr210_support`` is found as
-    ``kuka_description/kuka_kr210``)."""
+        return _read_dh(path, text)
     try:
-        from xacrodoc import XacroDoc, packages
-    except ImportError as err:  # pragma: no cover - a declared dependency
-        raise ArmError(f"{path}: reading xacro needs the xacrodoc package ({err})") from None
-    tried = set()
-    while True:
-        try:
-            return XacroDoc.from_file(str(path), resolve_packages=False).to_urdf_string()
-        except Exception as err:  # xacrodoc wraps what it raises; name the file and its message
-            missing = re.search(r"Package not found: (\S+)", str(err))
-            if missing is None:
-                raise ArmError(f"{path}: xacro expansion failed: {err}") from None
-            package = missing.group(1)
-            found = _find_package(package, path.parent)
-            if package in tried or found is None:
-                raise ArmError(
-                    f"{path}: xacro names package {package!r}, found neither by ROS nor in the folders "
-                    "above the file"
-                ) from None
-            tried.add(package)
-            packages.update_package_cache({package: str(found)})
+        root = ET.fromstring(text)
+    except ET.ParseError as err:
+        raise ArmError(f"{path}: not XML: {err}") from None
+    if root.tag == "robot":
+        return _read_urdf(text, path, "URDF", packages)
+    mjcf.check_files(path, root, packages)
+    return _read_mjcf(path)
 
 
-def _find_package(package: str, start: Path) -> Path | None:
-    """A folder for ROS package ``package`` in (or two levels below) the three folders above ``start``:
-    named as the package, both names compared without a ``_support`` / ``_description`` suffix."""
+def _resolve_mesh(filename: str, path: Path, packages: dict[str, Path]) -> Path | None:
+    """The mesh file a URDF names, or None if it cannot be found: ``package://pkg/rest`` is
+    ``rest`` in the folder named for ``pkg`` (``--package``), else in the URDF's folder; ``file://``
+    and relative paths from the URDF's folder.
 
-    def stem(name: str) -> str:
-        for suffix in ("_support", "_description"):
-            if name.endswith(suffix):
-                return name[: -len(suffix)]
-        return name
-
-    for folder in [start, *start.parents][:3]:
-        for candidate in [*folder.glob("*"), *folder.glob("*/*")]:
-            if candidate.name == package and candidate.is_dir():
-                return candidate
-        for candidate in [*folder.glob("*"), *folder.glob("*/*")]:
-            if stem(candidate.name) == stem(package) and candidate.is_dir():
-                return candidate
+    Raises
+    ------
+    ArmError
+        If the name leads outside the URDF's folder and the package folders (an absolute path,
+        ``..``, a symbolic link out).
+    """
+    base = path.parent
+    allowed = sources.roots(path, packages)
+    if filename.startswith("package://"):
+        package, _, rest = filename[len("package://") :].partition("/")
+        candidates = [packages[package] / rest] if package in packages else []
+        candidates.append(base / rest)
+    else:
+        name = filename[len("file://") :] if filename.startswith("file://") else filename
+        candidates = [Path(name) if Path(name).is_absolute() else base / name]
+    for candidate in candidates:
+        if not any(sources.inside(candidate, root) for root in allowed):
+            raise ArmError(
+                f'{path}: <mesh filename="{filename}"> is outside the folder {base.resolve()} and the '
+                "--package folders; a robot description may read only those"
+            )
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate.resolve()
     return None
 
 
-def _resolve_mesh(filename: str, base: Path) -> Path | None:
-    """The mesh file a URDF names, or None if it cannot be found: ``package://pkg/rest`` is looked
-    for as ``pkg/rest`` (and ``rest``) in the folders above the URDF; ``file://`` and relative paths
-    from the URDF's folder."""
-    if filename.startswith("package://"):
-        package, _, rest = filename[len("package://") :].partition("/")
-        for folder in [base, *base.parents]:
-            for candidate in (folder / package / rest, folder / rest):
-                if candidate.is_file():
-                    return candidate.resolve()
-        return None
-    if filename.startswith("file://"):
-        filename = filename[len("file://") :]
-    candidate = Path(filename) if Path(filename).is_absolute() else base / filename
-    return candidate.resolve() if candidate.is_file() else None
-
-
-def _read_urdf(text: str, path: Path, kind: str) -> Arm:
+def _read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Arm:
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
         raise ArmError(f"{path}: not XML: {err}") from None
     if root.tag != "robot":
         raise ArmError(f"{path}: root element <{root.tag}>; a URDF has <robot>")
+    links = sum(1 for _ in root.iter("link"))
+    if links > mjcf.MAX_LINKS:
+        raise ArmError(f"{path}: {links} links; a robot arm description may have at most {mjcf.MAX_LINKS}")
+    limits.check_urdf(root, path)
     notes = []
     speed, effort, names = {}, {}, []
     children: dict[str, list[str]] = {}
@@ -228,8 +227,9 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
                     f"{path}: joint {name!r} has no joint limits; expected <limit lower=... upper=...>"
                 )
             names.append(name)
-            speed[name] = float(limit.get("velocity", "nan") or "nan")
-            e = float(limit.get("effort", "nan") or "nan")
+            # 0 or absent: not given (ROS-Industrial writes effort="0"); limits.check_urdf bounds them
+            v, e = (float(limit.get(key) or 0) for key in ("velocity", "effort"))
+            speed[name] = v if v > 0 else math.nan
             effort[name] = e if e > 0 else math.nan
         if joint.find("mimic") is not None:
             raise ArmError(
@@ -248,34 +248,50 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
             f"{MIN_AXES} to {MAX_AXES} in a serial chain"
         )
     # geometry MuJoCo cannot load goes, with one warning
-    dropped = []
+    dropped, named = [], {}
     for link in root.iter("link"):
         for tag in ("visual", "collision"):
             for element in list(link.findall(tag)):
                 mesh = element.find("geometry/mesh")
                 if mesh is None:
                     continue
-                resolved = _resolve_mesh(mesh.get("filename", ""), path.parent)
+                resolved = _resolve_mesh(mesh.get("filename", ""), path, packages)
                 if resolved is None or resolved.suffix.lower() not in MESH_TYPES:
                     dropped.append(mesh.get("filename", ""))
                     link.remove(element)
                 else:
+                    named[mesh] = mesh.get("filename", "")
                     mesh.set("filename", str(resolved))
     if dropped:
+        unnamed = sorted(
+            {f[len("package://") :].partition("/")[0] for f in dropped if f.startswith("package://")} - set(packages)
+        )
         warnings.warn(
             f"{path}: {len(dropped)} meshes left out (dynamics need no geometry; MuJoCo loads "
-            f"{', '.join(MESH_TYPES)} files that resolve), e.g. {dropped[0]}",
+            f"{', '.join(MESH_TYPES)} files that resolve), e.g. {dropped[0]}"
+            + (
+                f"; name the folder of package {unnamed[0]!r} with --package {unnamed[0]}=DIR"
+                + sources.hint(unnamed[0], path.parent)
+                if unnamed
+                else ""
+            ),
             GeometryDropped,
             stacklevel=3,
         )
         notes.append(f"{len(dropped)} meshes left out: COLLADA or unresolvable (dynamics need no geometry)")
-    # MuJoCo options for the URDF compiler: keep visual geoms, full mesh paths, every link a body
+    # MuJoCo options for the URDF compiler: keep visual geoms, full mesh paths, every link a body;
+    # of the source's own <mujoco> only compiler settings that read no file are kept
     extension = root.find("mujoco")
     if extension is None:
         extension = ET.SubElement(root, "mujoco")
+    for child in list(extension):
+        if child.tag != "compiler":
+            extension.remove(child)
     compiler = extension.find("compiler")
     if compiler is None:
         compiler = ET.SubElement(extension, "compiler")
+    for key in ("meshdir", "texturedir", "assetdir"):
+        compiler.attrib.pop(key, None)
     compiler.set("strippath", "false")
     compiler.set("discardvisual", "false")
     compiler.set("fusestatic", "false")
@@ -297,8 +313,9 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
     joints = check_arm(spec, str(path))
     extension = root.find("mujoco")
     root.remove(extension)
+    for mesh, filename in named.items():  # the written URDF keeps the source's names, no local path
+        mesh.set("filename", filename)
     urdf = ET.tostring(root, encoding="unicode")
-    root.append(extension)
     return Arm(
         spec=spec,
         kind=kind,
@@ -306,7 +323,7 @@ def _read_urdf(text: str, path: Path, kind: str) -> Arm:
         joints=joints,
         speed_limit=np.array([speed.get(j.name, math.nan) for j in joints]),
         effort_limit=np.array([effort.get(j.name, math.nan) for j in joints]),
-        description=f"{root.get('name', path.stem)} from {kind} {path.name}",
+        description=limits.text(path, "robot name", f"{root.get('name', path.stem)} from {kind} {path.name}"),
         notes=notes,
         urdf=urdf,
     )
@@ -373,6 +390,8 @@ def _read_mjcf(path: Path) -> Arm:
         message = str(err).strip()
         if "error opening file" in message.lower() or "mesh" in message.lower():
             spec = _mjcf_without_meshes(path, message)  # an asset it cannot load: read without mesh files
+    for text in spec.texts:
+        limits.text(path, f"<text name={text.name!r}>", text.data)
     notes = []
     joints = check_arm(spec, str(path))
     for joint in spec.joints:
@@ -389,7 +408,7 @@ def _read_mjcf(path: Path) -> Arm:
         joints=joints,
         speed_limit=np.full(len(joints), math.nan),
         effort_limit=_mjcf_effort(spec, joints),
-        description=f"{spec.modelname or path.stem} from MJCF {path.name}",
+        description=limits.text(path, "model name", f"{spec.modelname or path.stem} from MJCF {path.name}"),
         notes=notes,
     )
 
@@ -454,26 +473,36 @@ def _quat_mul(p: list[float], q: list[float]) -> list[float]:
     return out.tolist()
 
 
+#: DH table key -> (low, high, unit): the physical bounds (:mod:`faultgen.model.limits`).
+DH_BOUNDS = {
+    "d": (-limits.MAX_LENGTH, limits.MAX_LENGTH, "m"),
+    "a": (-limits.MAX_LENGTH, limits.MAX_LENGTH, "m"),
+    "alpha": (-limits.MAX_ANGLE, limits.MAX_ANGLE, "rad"),
+    "offset": (-limits.MAX_ANGLE, limits.MAX_ANGLE, "rad"),
+    "mass": (0.0, limits.MAX_MASS, "kg"),
+    "com": (-limits.MAX_LENGTH, limits.MAX_LENGTH, "m"),
+    "inertia": (-limits.MAX_INERTIA, limits.MAX_INERTIA, "kg m^2"),
+    "qlim": (-limits.MAX_ANGLE, limits.MAX_ANGLE, "rad"),
+    "speed": (1e-3, limits.MAX_SPEED, "rad/s"),
+    "effort": (1e-3, limits.MAX_EFFORT, "N m"),
+    "rated_payload": (0.0, limits.MAX_PAYLOAD, "kg"),
+    "gravity": (-limits.MAX_GRAVITY, limits.MAX_GRAVITY, "m/s^2"),
+}
+
+
 def _number(path: Path, where: str, key: str, value, length: int | None = None) -> float | list[float]:
+    low, high, unit = DH_BOUNDS[key]
     if length is None:
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-        if not ok:
-            raise ArmError(f"{path}: {where}: {key} = {value!r}; expected a finite number")
-        return float(value)
-    ok = (
-        isinstance(value, list)
-        and len(value) == length
-        and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
-    )
-    if not ok:
-        raise ArmError(f"{path}: {where}: {key} = {value!r}; expected {length} finite numbers")
-    return [float(v) for v in value]
+        return limits.number(path, where, key, value, low, high, unit)
+    if not isinstance(value, list) or len(value) != length:
+        raise ArmError(f"{path}: {where}: {key} = {value!r}; expected {length} numbers in {low:g} .. {high:g} {unit}")
+    return [limits.number(path, where, key, v, low, high, unit) for v in value]
 
 
-def _read_dh(path: Path) -> Arm:
+def _read_dh(path: Path, text: str) -> Arm:
     try:
-        data = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        data = tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as err:
         raise ArmError(f"{path}: not a TOML DH table: {err}") from None
     unknown = sorted(set(data) - DH_TOP)
     if unknown:
@@ -485,7 +514,7 @@ def _read_dh(path: Path) -> Arm:
     if not isinstance(links, list) or not MIN_AXES <= len(links) <= MAX_AXES:
         count = len(links) if isinstance(links, list) else 0
         raise ArmError(f"{path}: {count} [[link]] rows (revolute joints); expected {MIN_AXES} to {MAX_AXES}")
-    name = str(data.get("name", path.stem))
+    name = limits.text(path, "name", data.get("name", path.stem))
     spec = mujoco.MjSpec()
     spec.modelname = name
     spec.compiler.degree = False
@@ -560,7 +589,9 @@ def _read_dh(path: Path) -> Arm:
         speed_limit=np.array(speed),
         effort_limit=np.array(effort),
         payload=payload,
-        description=str(data.get("description", f"{name} from the {convention} DH table {path.name}")),
+        description=limits.text(
+            path, "description", data.get("description", f"{name} from the {convention} DH table {path.name}")
+        ),
     )
 
 

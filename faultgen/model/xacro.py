@@ -1,0 +1,523 @@
+"""Expand a xacro file to URDF without running code: faultgen's own restricted expander.
+
+xacro's own processor (and ``xacrodoc``, which calls it) evaluates ``${...}`` with Python's
+``eval`` behind a name filter that strings get past, and offers ``$(env)``, ``$(cwd)``,
+``load_yaml`` and includes from anywhere: a xacro from a stranger could run commands and copy
+files into the robot. This expander understands the part of xacro robot descriptions use and
+refuses the rest, naming the construct and the file (:class:`~faultgen.model.builder.ArmError`):
+
+- ``xacro:property`` (``value``, ``default``, a block as its body, ``scope="parent"|"global"``),
+  looked up lazily as xacro does; ``xacro:arg`` with a literal default and ``$(arg name)``;
+- ``xacro:macro`` with parameters ``p``, ``p:=default``, ``p:=^``, ``p:=^|default``, ``*block``
+  and ``**blocks``; ``xacro:insert_block``; ``xacro:if`` / ``xacro:unless``;
+- ``xacro:include`` of a file inside the top file's folder or a package folder the caller names
+  (``$(find pkg)`` gives only those; ``$(dirname)`` the including file's folder); a relative name
+  is resolved against the including file's folder;
+- ``${expr}`` by an evaluator over Python's syntax tree that knows numbers, strings, ``True`` /
+  ``False``, property names, ``+ - * / // % **``, comparisons, ``and or not``, ``a if c else b``,
+  ``pi``, ``e`` and the math functions of :data:`FUNCTIONS` (also as ``math.NAME``): no attribute
+  access, subscripts, keywords, comprehensions or lambdas, no other function.
+
+Bounds: :data:`MAX_FILE_BYTES` per file, :data:`MAX_INCLUDE_DEPTH` nested includes,
+:data:`MAX_ELEMENTS` elements in the expanded document, :data:`MAX_CALL_DEPTH` nested macro calls,
+:data:`MAX_TEXT` characters in one evaluated string.
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import math
+import operator
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from faultgen.model.builder import ArmError
+from faultgen.model.sources import hint, inside, read_bytes
+
+MAX_FILE_BYTES = 10_000_000
+MAX_INCLUDE_DEPTH = 20
+MAX_ELEMENTS = 200_000
+MAX_CALL_DEPTH = 50
+MAX_TEXT = 100_000
+
+#: Functions a ``${...}`` expression may call (``math.NAME`` alike).
+FUNCTIONS = {
+    **{
+        name: getattr(math, name)
+        for name in (
+            "sin cos tan asin acos atan atan2 sinh cosh tanh sqrt exp log log10 radians degrees "
+            "fabs floor ceil hypot copysign"
+        ).split()
+    },
+    "abs": abs,
+    "min": min,
+    "max": max,
+    "round": round,
+    "int": int,
+    "float": float,
+}
+CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False}
+
+_BINARY = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.FloorDiv: operator.floordiv,
+    ast.Mod: operator.mod,
+    ast.Pow: operator.pow,
+}
+_COMPARE = {
+    ast.Eq: operator.eq,
+    ast.NotEq: operator.ne,
+    ast.Lt: operator.lt,
+    ast.LtE: operator.le,
+    ast.Gt: operator.gt,
+    ast.GtE: operator.ge,
+}
+
+
+def is_xacro_namespace(tag: str) -> bool:
+    return tag.startswith("{") and tag[1 : tag.index("}")].rstrip("/#").endswith("xacro")
+
+
+def _local(tag: str) -> str:
+    return tag.split("}", 1)[1] if tag.startswith("{") else tag
+
+
+class _Undefined(Exception):
+    pass
+
+
+class _Scope:
+    """Properties (lazily evaluated text, or a block) with a parent scope, as xacro's ``Table``."""
+
+    def __init__(self, parent: _Scope | None = None):
+        self.parent, self.raw, self.done, self.busy = parent, {}, {}, set()
+
+    def root(self) -> _Scope:
+        return self if self.parent is None else self.parent.root()
+
+    def define(self, name: str, value, evaluated: bool = False) -> None:
+        self.raw[name] = value
+        self.done.pop(name, None)
+        if evaluated:
+            self.done[name] = value
+
+    def has(self, name: str) -> bool:
+        return name in self.raw or (self.parent is not None and self.parent.has(name))
+
+    def get(self, name: str, expander: _Expander):
+        if name in self.done:
+            return self.done[name]
+        if name in self.raw:
+            if name in self.busy:
+                raise ArmError(f"{expander.where}: property {name!r} is defined in terms of itself")
+            value = self.raw[name]
+            if isinstance(value, str):
+                self.busy.add(name)
+                try:
+                    value = _literal(expander.text(value, self))
+                finally:
+                    self.busy.discard(name)
+            self.done[name] = value
+            return value
+        if self.parent is None:
+            raise _Undefined(name)
+        return self.parent.get(name, expander)
+
+
+def _literal(value):
+    """A property's text as xacro takes it: quoted -> the string, else int, float or bool if it
+    reads as one."""
+    if not isinstance(value, str):
+        return value
+    if len(value) >= 2 and value[0] == value[-1] == "'":
+        return value[1:-1]
+    if "_" in value:
+        return value
+    for convert in (int, float):
+        try:
+            return convert(value)
+        except ValueError:
+            pass
+    return {"true": True, "True": True, "false": False, "False": False}.get(value, value)
+
+
+def _truth(value, where: str, what: str) -> bool:
+    if isinstance(value, str):
+        value = _literal(value.strip())
+    if isinstance(value, (bool, int, float)) and not isinstance(value, str):
+        return bool(value)
+    raise ArmError(f"{where}: {what} = {value!r}; expected true, false, 1 or 0")
+
+
+def _text_of(value) -> str:
+    return str(value)
+
+
+class _Expander:
+    def __init__(self, top: Path, packages: dict[str, Path]):
+        self.top = top
+        self.roots = [top.parent.resolve(), *(Path(p).resolve() for p in packages.values())]
+        self.packages = {name: Path(p).resolve() for name, p in packages.items()}
+        self.files: list[Path] = []
+        self.args: dict[str, str] = {}
+        self.macros: dict[str, tuple[list, ET.Element]] = {}
+        self.elements = 0
+        self.calls = 0
+
+    @property
+    def where(self) -> str:
+        return str(self.files[-1] if self.files else self.top)
+
+    def refuse(self, construct: str, why: str = "") -> ArmError:
+        return ArmError(
+            f"{self.where}: xacro {construct} refused{': ' + why if why else ''} (faultgen expands xacro "
+            "without running code: properties, macros, if/unless, include from the file's folder or a "
+            "--package folder, arg with a literal default, ${} arithmetic and math functions)"
+        )
+
+    # ---------------------------------------------------------------------- files --
+    def parse(self, path: Path) -> ET.Element:
+        if len(self.files) >= MAX_INCLUDE_DEPTH:
+            raise self.refuse(f"include of {path}", f"more than {MAX_INCLUDE_DEPTH} nested includes")
+        if path in self.files:
+            raise self.refuse(f"include of {path}", "it includes itself")
+        data = read_bytes(path, MAX_FILE_BYTES, "xacro file", ArmError)
+        try:
+            return ET.fromstring(data)
+        except ET.ParseError as err:
+            raise ArmError(f"{path}: not XML: {err}") from None
+
+    def resolve_include(self, name: str) -> Path:
+        base = self.files[-1].parent
+        path = Path(name) if Path(name).is_absolute() else base / name
+        resolved = path.resolve()
+        if not any(inside(resolved, root) for root in self.roots):
+            raise self.refuse(
+                f'include filename="{name}"',
+                f"{resolved} is outside the xacro's folder {self.roots[0]} and the --package folders",
+            )
+        return resolved
+
+    # ---------------------------------------------------------------------- text --
+    def text(self, text: str, scope: _Scope):
+        """Evaluate ``$(...)`` and ``${...}`` in ``text``: the value itself if the text is one
+        ``${...}``, else the pieces joined as a string."""
+        pieces = []
+        i = 0
+        while i < len(text):
+            j = text.find("$", i)
+            if j < 0 or j + 1 >= len(text):
+                pieces.append(text[i:])
+                break
+            pieces.append(text[i:j])
+            opener = text[j + 1]
+            if opener == "$" and j + 2 < len(text) and text[j + 2] in "{(":  # $${ and $$( escape
+                pieces.append(text[j + 1 : j + 3])
+                i = j + 3
+                continue
+            if opener not in "{(":
+                pieces.append("$")
+                i = j + 1
+                continue
+            close = "}" if opener == "{" else ")"
+            depth, k = 0, j + 1
+            while k < len(text):
+                depth += text[k] == opener
+                depth -= text[k] == close
+                if depth == 0:
+                    break
+                k += 1
+            if depth:
+                raise self.refuse(f"text {text!r}", f"unclosed ${opener}")
+            inner = text[j + 2 : k]
+            pieces.append(self.expression(inner, scope) if opener == "{" else self.substitution(inner, scope))
+            i = k + 1
+        pieces = [p for p in pieces if not (isinstance(p, str) and p == "")]
+        if len(pieces) == 1:
+            return pieces[0]
+        out = "".join(_text_of(p) for p in pieces)
+        if len(out) > MAX_TEXT:
+            raise self.refuse(f"text {text[:60]!r}...", f"it evaluates to more than {MAX_TEXT} characters")
+        return out
+
+    def substitution(self, inner: str, scope: _Scope) -> str:
+        words = inner.split()
+        if not words:
+            raise self.refuse("$()")
+        command, rest = words[0], words[1:]
+        if command == "arg" and len(rest) == 1:
+            if rest[0] not in self.args:
+                raise self.refuse(f"$(arg {rest[0]})", "no xacro:arg of that name (or no default) before it")
+            return self.args[rest[0]]
+        if command == "find" and len(rest) == 1:
+            if rest[0] not in self.packages:
+                raise ArmError(
+                    f"{self.where}: xacro names package {rest[0]!r} ($(find {rest[0]})); give its folder "
+                    f"with --package {rest[0]}=DIR" + hint(rest[0], self.top.parent)
+                )
+            return str(self.packages[rest[0]])
+        if command == "dirname" and not rest:
+            return str(self.files[-1].parent)
+        raise self.refuse(f"$({inner})", f"$({command}) is not supported")
+
+    def expression(self, source: str, scope: _Scope):
+        try:
+            tree = ast.parse(source.strip(), mode="eval")
+        except SyntaxError:
+            raise self.refuse(f"${{{source}}}", "not an expression") from None
+        try:
+            return self.value(tree.body, scope, source)
+        except _Undefined as err:
+            raise ArmError(f"{self.where}: ${{{source}}}: no property {err.args[0]!r}") from None
+        except (ArithmeticError, TypeError, ValueError) as err:
+            raise ArmError(f"{self.where}: ${{{source}}}: {err}") from None
+
+    def value(self, node: ast.AST, scope: _Scope, source: str):
+        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float, str, bool)):
+            return node.value
+        if isinstance(node, ast.Name):
+            if "__" in node.id:
+                raise self.refuse(f"${{{source}}}", f"name {node.id!r}")
+            if scope.has(node.id):
+                return scope.get(node.id, self)
+            if node.id in CONSTANTS:
+                return CONSTANTS[node.id]
+            raise _Undefined(node.id)
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            left, right = self.value(node.left, scope, source), self.value(node.right, scope, source)
+            if isinstance(node.op, ast.Add) and isinstance(left, str) and isinstance(right, str):
+                return left + right
+            if not all(isinstance(v, (int, float)) for v in (left, right)):
+                raise self.refuse(f"${{{source}}}", f"{type(node.op).__name__} of {left!r} and {right!r}")
+            if isinstance(node.op, ast.Pow):
+                left, right = float(left), float(right)  # no integer powers of unbounded size
+            return _BINARY[type(node.op)](left, right)
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd, ast.Not)):
+            operand = self.value(node.operand, scope, source)
+            if isinstance(node.op, ast.Not):
+                return not operand
+            if not isinstance(operand, (int, float)):
+                raise self.refuse(f"${{{source}}}", f"sign of {operand!r}")
+            return -operand if isinstance(node.op, ast.USub) else +operand
+        if isinstance(node, ast.BoolOp):
+            result = None
+            for operand in node.values:
+                result = self.value(operand, scope, source)
+                if isinstance(node.op, ast.And) != bool(result):
+                    return result
+            return result
+        if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
+            left = self.value(node.left, scope, source)
+            for op, right_node in zip(node.ops, node.comparators):
+                right = self.value(right_node, scope, source)
+                if not _COMPARE[type(op)](left, right):
+                    return False
+                left = right
+            return True
+        if isinstance(node, ast.IfExp):
+            test = self.value(node.test, scope, source)
+            return self.value(node.body if test else node.orelse, scope, source)
+        if isinstance(node, ast.Call) and not node.keywords:
+            name = _function_name(node.func)
+            if name not in FUNCTIONS:
+                what = ast.unparse(node.func)
+                raise self.refuse(f"${{{source}}}", f"function {what}() (allowed: {', '.join(sorted(FUNCTIONS))})")
+            args = [self.value(a, scope, source) for a in node.args]
+            if not all(isinstance(a, (int, float)) for a in args):
+                raise self.refuse(f"${{{source}}}", f"{name}() of {args!r}")
+            return FUNCTIONS[name](*args)
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "math":
+            if node.attr in ("pi", "e"):
+                return CONSTANTS[node.attr]
+        raise self.refuse(f"${{{source}}}", f"{type(node).__name__} {ast.unparse(node)!r}")
+
+    # ---------------------------------------------------------------------- elements --
+    def count(self, n: int = 1) -> None:
+        self.elements += n
+        if self.elements > MAX_ELEMENTS:
+            raise self.refuse("document", f"it expands to more than {MAX_ELEMENTS} elements")
+
+    def children(self, parent: ET.Element, scope: _Scope) -> list[ET.Element]:
+        """Expand ``parent``'s children in place; return them."""
+        out = []
+        for child in list(parent):
+            out.extend(self.element(child, scope))
+        tail_text = parent.text
+        for child in list(parent):
+            parent.remove(child)
+        parent.text = tail_text
+        for child in out:
+            parent.append(child)
+        return out
+
+    def element(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        if not isinstance(node.tag, str):  # comments, processing instructions
+            return []
+        if not is_xacro_namespace(node.tag):
+            self.count()
+            for key, value in list(node.attrib.items()):
+                if is_xacro_namespace(key):
+                    raise self.refuse(f"attribute {_local(key)}")
+                node.set(key, _text_of(self.text(value, scope)))
+            if node.text and node.text.strip():
+                node.text = _text_of(self.text(node.text, scope))
+            self.children(node, scope)
+            return [node]
+        tag = _local(node.tag)
+        handler = getattr(self, f"tag_{tag}", None)
+        if handler is not None:
+            return handler(node, scope)
+        if tag in self.macros:
+            return self.call(tag, node, scope)
+        raise self.refuse(f"<xacro:{tag}>", "no macro of that name is defined before it" if tag.isidentifier() else "")
+
+    def tag_include(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        if set(node.attrib) - {"filename"}:
+            raise self.refuse(f"<xacro:include {' '.join(sorted(node.attrib))}>", "only filename is supported")
+        name = _text_of(self.text(node.get("filename", ""), scope))
+        path = self.resolve_include(name)
+        root = self.parse(path)
+        self.files.append(path)
+        try:
+            return self.children(root, scope)
+        finally:
+            self.files.pop()
+
+    def tag_property(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        name = node.get("name", "")
+        if not name.isidentifier() or "__" in name:
+            raise self.refuse(f'<xacro:property name="{name}">', "a property needs an identifier as its name")
+        target = {"parent": scope.parent or scope, "global": scope.root()}.get(node.get("scope", ""), scope)
+        if "default" in node.attrib:
+            if not target.has(name):
+                target.define(name, node.get("default"))
+            return []
+        if "value" in node.attrib:
+            target.define(name, node.get("value"))
+        else:
+            target.define(name, [copy.deepcopy(c) for c in node if isinstance(c.tag, str)], evaluated=True)
+        return []
+
+    def tag_arg(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        name = node.get("name", "")
+        if "default" in node.attrib and name not in self.args:
+            self.args[name] = _text_of(self.text(node.get("default"), scope))
+        return []
+
+    def tag_macro(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        name = node.get("name", "")
+        params = []
+        words = re.findall(r"""(?:[^\s'"]+|'[^']*'|"[^"]*")+""", node.get("params", ""))  # p:='a b': one
+        for word in words:
+            param, _, default = word.partition(":=")
+            kind = "block" if param.startswith("*") else "value"
+            if param.startswith("**"):
+                kind = "blocks"
+            params.append((param.lstrip("*"), kind, default if ":=" in word else None))
+        self.macros[name] = (params, node)
+        return []
+
+    def _condition(self, node: ET.Element, scope: _Scope, negate: bool) -> list[ET.Element]:
+        tag = "unless" if negate else "if"
+        value = self.text(node.get("value", ""), scope)
+        if _truth(value, self.where, f'<xacro:{tag} value="{node.get("value", "")}">') != negate:
+            holder = copy.copy(node)
+            return self.children(holder, scope)
+        return []
+
+    def tag_if(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        return self._condition(node, scope, negate=False)
+
+    def tag_unless(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        return self._condition(node, scope, negate=True)
+
+    def tag_insert_block(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        name = node.get("name", "")
+        try:
+            block = scope.get(name, self)
+        except _Undefined:
+            raise self.refuse(f'<xacro:insert_block name="{name}">', "no block of that name") from None
+        if not isinstance(block, list):
+            raise self.refuse(f'<xacro:insert_block name="{name}">', "it names a property, not a block")
+        holder = ET.Element("holder")
+        holder.extend(copy.deepcopy(block))
+        return self.children(holder, scope)
+
+    def call(self, name: str, node: ET.Element, scope: _Scope) -> list[ET.Element]:
+        self.calls += 1
+        if self.calls > MAX_CALL_DEPTH:
+            raise self.refuse(f"<xacro:{name}>", f"more than {MAX_CALL_DEPTH} nested macro calls")
+        try:
+            params, body = self.macros[name]
+            inner = _Scope(scope)
+            given = dict(node.attrib)
+            blocks = [c for c in node if isinstance(c.tag, str)]
+            for param, kind, default in params:
+                if kind == "block":
+                    if not blocks:
+                        raise self.refuse(f"<xacro:{name}>", f"block parameter *{param} not given")
+                    inner.define(param, [blocks.pop(0)], evaluated=True)
+                elif kind == "blocks":
+                    inner.define(param, blocks, evaluated=True)
+                    blocks = []
+                elif param in given:
+                    inner.define(param, _literal(self.text(given.pop(param), scope)), evaluated=True)
+                elif default is not None and default.startswith("^"):
+                    if scope.has(param):
+                        inner.define(param, scope.get(param, self), evaluated=True)
+                    elif default.startswith("^|"):
+                        inner.define(param, _literal(self.text(default[2:], scope)), evaluated=True)
+                    else:
+                        raise self.refuse(f"<xacro:{name}>", f"parameter {param} not given nor set outside")
+                elif default is not None:
+                    inner.define(param, _literal(self.text(default, inner)), evaluated=True)
+                else:
+                    raise self.refuse(f"<xacro:{name}>", f"parameter {param} not given")
+            if given:
+                raise self.refuse(f"<xacro:{name}>", f"unknown parameter {sorted(given)[0]}")
+            holder = copy.deepcopy(body)
+            return self.children(holder, inner)
+        finally:
+            self.calls -= 1
+
+
+def _function_name(func: ast.AST) -> str | None:
+    if isinstance(func, ast.Name):
+        return func.id
+    if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name) and func.value.id == "math":
+        return func.attr
+    return None
+
+
+def expand(path: str | Path, packages: dict[str, str | Path] | None = None) -> str:
+    """The URDF text of the xacro file ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The top xacro file; includes may read files inside its folder.
+    packages : dict of str to path, optional
+        ROS package name -> folder: what ``$(find NAME)`` gives; includes may read inside them.
+
+    Raises
+    ------
+    ArmError
+        Naming the file and the construct refused or the expression that failed.
+    """
+    path = Path(path)
+    expander = _Expander(path, {k: Path(v) for k, v in (packages or {}).items()})
+    root = expander.parse(path.resolve())
+    expander.files.append(path.resolve())
+    scope = _Scope()
+    if is_xacro_namespace(root.tag):
+        raise expander.refuse(f"<xacro:{_local(root.tag)}> as the root")
+    expander.element(root, scope)
+    for key in [k for k in root.attrib if is_xacro_namespace(k)]:
+        del root.attrib[key]
+    text = ET.tostring(root, encoding="unicode")
+    return re.sub(r'\s+xmlns:\w+="[^"]*xacro[^"]*"', "", text)
