@@ -112,6 +112,8 @@ def add(
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
+    if out.parent.is_dir():
+        remove_stale(out)  # a killed add's staging folder, before anything can fail
     arm = importers.read(source, packages)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
@@ -137,7 +139,6 @@ def add(
     text = builder.to_xml(spec)
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale(out)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-", dir=out.parent))
     try:
         (stage / f"{name}.xml").write_text(text)

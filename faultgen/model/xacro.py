@@ -176,8 +176,7 @@ class _Expander:
     def refuse(self, construct: str, why: str = "") -> ArmError:
         return ArmError(
             f"{self.where}: xacro {construct} refused{': ' + why if why else ''} (faultgen expands xacro "
-            "without running code: properties, macros, if/unless, include from the file's folder or a "
-            "--package folder, arg with a literal default, ${} arithmetic and math functions)"
+            'without running code; docs/robots.md, "xacro", lists what it takes)'
         )
 
     # ---------------------------------------------------------------------- files --
@@ -269,13 +268,15 @@ class _Expander:
         try:
             tree = ast.parse(source.strip(), mode="eval")
         except SyntaxError:
-            raise self.refuse(f"${{{source}}}", "not an expression") from None
+            raise self.refuse(f"${{{_short(source)}}}", "not an expression") from None
         try:
-            return self.value(tree.body, scope, source)
+            return self.value(tree.body, scope, _short(source))
+        except ArmError:
+            raise
         except _Undefined as err:
-            raise ArmError(f"{self.where}: ${{{source}}}: no property {err.args[0]!r}") from None
+            raise ArmError(f"{self.where}: ${{{_short(source)}}}: no property {err.args[0]!r}") from None
         except (ArithmeticError, TypeError, ValueError) as err:
-            raise ArmError(f"{self.where}: ${{{source}}}: {err}") from None
+            raise ArmError(f"{self.where}: ${{{_short(source)}}}: {err}") from None
 
     def value(self, node: ast.AST, scope: _Scope, source: str):
         if isinstance(node, ast.Constant) and isinstance(node.value, (int, float, str, bool)):
@@ -325,7 +326,7 @@ class _Expander:
         if isinstance(node, ast.Call) and not node.keywords:
             name = _function_name(node.func)
             if name not in FUNCTIONS:
-                what = ast.unparse(node.func)
+                what = _short(ast.unparse(node.func))
                 raise self.refuse(f"${{{source}}}", f"function {what}() (allowed: {', '.join(sorted(FUNCTIONS))})")
             args = [self.value(a, scope, source) for a in node.args]
             if not all(isinstance(a, (int, float)) for a in args):
@@ -334,7 +335,10 @@ class _Expander:
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "math":
             if node.attr in ("pi", "e"):
                 return CONSTANTS[node.attr]
-        raise self.refuse(f"${{{source}}}", f"{type(node).__name__} {ast.unparse(node)!r}")
+        kind = {ast.Attribute: "attribute access", ast.Subscript: "subscript", ast.Call: "call"}.get(
+            type(node), type(node).__name__
+        )
+        raise self.refuse(f"${{{source}}}", f"{kind} {_short(ast.unparse(node))!r}")
 
     # ---------------------------------------------------------------------- elements --
     def count(self, n: int = 1) -> None:
@@ -484,6 +488,10 @@ class _Expander:
             return self.children(holder, inner)
         finally:
             self.calls -= 1
+
+
+def _short(text: str, n: int = 60) -> str:
+    return text if len(text) <= n else text[: n - 3] + "..."
 
 
 def _function_name(func: ast.AST) -> str | None:

@@ -1,0 +1,257 @@
+"""Robot descriptions from strangers (issue 50, item 1): `faultgen robots add` runs no code, reads
+only the source's folder and the --package folders, and refuses every such attempt with exit 2,
+the construct named and nothing written. Each exploit here worked on main at 41791db (the dunder
+one ran a shell command; load_yaml, env and outside includes copied files into the robot).
+
+Independent check: the xacro expander's URDF equals xacrodoc's (xacro's own processor) on
+rtb-data's third-party xacros.
+"""
+
+import struct
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+import rtbdata
+import xacrodoc
+import xacrodoc.packages
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+from faultgen.model import robots
+
+XACRO_NS = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+SECRET = "s3cr3t-do-not-copy"
+
+
+def run(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def urdf(extra="", name="test", mesh=""):
+    """A six-axis URDF; ``extra`` goes inside <robot>, ``mesh`` (a filename) on the first link."""
+    links = ['<link name="base"/>']
+    joints = []
+    for k in range(6):
+        geometry = (
+            f'<collision><geometry><mesh filename="{mesh}"/></geometry></collision>' if mesh and k == 0 else ""
+        )
+        links.append(
+            f'<link name="l{k}"><inertial><mass value="1"/><origin xyz="0 0 0.1"/>'
+            f'<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>{geometry}</link>'
+        )
+        parent = "base" if k == 0 else f"l{k - 1}"
+        joints.append(
+            f'<joint name="j{k}" type="revolute"><parent link="{parent}"/><child link="l{k}"/>'
+            f'<origin xyz="0 0 0.2"/><axis xyz="0 {k % 2} {1 - k % 2}"/>'
+            '<limit lower="-1" upper="1" effort="0" velocity="2"/></joint>'
+        )
+    return f'<robot name="{name}" {XACRO_NS}>{"".join(links)}{"".join(joints)}{extra}</robot>'
+
+
+def stl(path):
+    """A binary STL tetrahedron of 0.1 m."""
+    v = [(0, 0, 0), (0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)]
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    data = b"\0" * 80 + struct.pack("<I", len(faces))
+    for face in faces:
+        data += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v[i]) for i in face) + b"\0\0"
+    path.write_bytes(data)
+    return path
+
+
+def refused(tmp_path, source, *construct, extra=()):
+    """`robots add` of ``source``: exit 2, one line naming every ``construct``, nothing written,
+    no secret anywhere."""
+    out = tmp_path / "out" / "robot"
+    result = run("robots", "add", "robot", "--from", source, "-o", out, *extra)
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    for word in construct:
+        assert word in lines[0], lines[0]
+    # nothing written (no robot folder, no staging folder), so the secret is nowhere but its file
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
+    assert SECRET not in result.output
+    return lines[0]
+
+
+@pytest.fixture
+def folder(tmp_path):
+    """The source's folder (tmp_path/robot) beside a secret outside it (tmp_path/secret.yaml)."""
+    (tmp_path / "secret.yaml").write_text(f"key: {SECRET}\n")
+    (tmp_path / "robot").mkdir()
+    return tmp_path / "robot"
+
+
+def test_a_xacro_cannot_run_a_command_through_dunder_strings(tmp_path, folder):
+    marker = tmp_path / "PWNED"
+    # python.vars + strings joined into dunder names: on 41791db this reached os.system
+    base = "python.type(0).mro()[1]"
+    subclasses = f"python.vars(python.type)['_'+'_subclasses_'+'_']({base})"
+    wrap = f"[c for c in {subclasses} if 'wrap_close' in python.repr(c)][0]"
+    init = f"python.vars({wrap})['_'+'_init_'+'_']"
+    member = f"python.vars(python.type({init}))['_'+'_globals_'+'_']"
+    globs = f"python.vars(python.type({member}))['_'+'_get_'+'_']({member}, {init})"
+    expr = f"{globs}['system']('touch {marker}')"
+    source = folder / "arm.urdf.xacro"
+    source.write_text(urdf(f'<xacro:property name="x" value="${{{expr}}}"/><link name="z${{x}}"/>'))
+    refused(tmp_path, source, str(source), "python.vars")
+    assert not marker.exists()
+
+
+@pytest.mark.parametrize(
+    "payload, construct",
+    [
+        ('<link name="${xacro.load_yaml(\'SECRET_FILE\')[\'key\']}"/>', "xacro.load_yaml"),
+        ('<link name="$(env HOME)"/>', "$(env HOME)"),
+        ('<xacro:arg name="p" default="$(env PATH)"/><link name="$(arg p)"/>', "$(env PATH)"),
+        ('<link name="$(cwd)"/>', "$(cwd)"),
+        ('<link name="$(optenv HOME x)"/>', "$(optenv HOME x)"),
+        ('<link name="$(eval 1 + 1)"/>', "$(eval 1 + 1)"),
+        ('<link name="${eval(\'1\')}"/>', "eval"),
+        ('<link name="${(1).real}"/>', "attribute access"),
+        ('<link name="${x.y}"/>', "attribute access"),
+    ],
+)
+def test_a_xacro_cannot_read_files_or_the_environment(tmp_path, folder, payload, construct):
+    source = folder / "arm.urdf.xacro"
+    source.write_text(urdf(payload.replace("SECRET_FILE", str(tmp_path / "secret.yaml"))))
+    refused(tmp_path, source, str(source), construct)
+
+
+@pytest.mark.parametrize("where", ["absolute", "relative"])
+def test_a_xacro_includes_only_from_its_own_folder(tmp_path, folder, where):
+    outside = tmp_path / "outside.xacro"
+    outside.write_text(f'<robot {XACRO_NS}><link name="{SECRET}"/></robot>')
+    name = str(outside) if where == "absolute" else "../outside.xacro"
+    source = folder / "arm.urdf.xacro"
+    source.write_text(urdf(f'<xacro:include filename="{name}"/>'))
+    refused(tmp_path, source, "xacro include", name, "outside")
+
+
+def test_a_xacro_include_resolves_against_its_own_folder_and_a_named_package(tmp_path, folder, monkeypatch):
+    # a file of the same name in the current folder must not be the one read
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "part.xacro").write_text(f'<robot {XACRO_NS}><link name="{SECRET}"/></robot>')
+    (folder / "part.xacro").write_text(f'<robot {XACRO_NS}><link name="mine"/></robot>')
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "m.xacro").write_text(
+        f'<robot {XACRO_NS}><xacro:macro name="m" params="n *b">'
+        '<link name="${n}"><xacro:insert_block name="b"/></link></xacro:macro></robot>'
+    )
+    source = folder / "arm.urdf.xacro"
+    source.write_text(
+        f'<robot name="r" {XACRO_NS}><xacro:include filename="part.xacro"/>'
+        '<xacro:include filename="$(find pkg)/m.xacro"/><xacro:m n="${round(2*pi, 3)}"><inertial/></xacro:m>'
+        "</robot>"
+    )
+    from faultgen.model import xacro
+
+    text = xacro.expand(source, {"pkg": package})
+    root = ET.fromstring(text)
+    assert [link.get("name") for link in root.iter("link")] == ["mine", "6.283"]
+    assert root.find("link/inertial") is not None and SECRET not in text
+
+
+@pytest.mark.parametrize("where", ["absolute", "relative", "package"])
+def test_a_urdf_mesh_outside_its_folder_is_refused(tmp_path, folder, where):
+    mesh = stl(tmp_path / "x.stl")
+    name = {"absolute": str(mesh), "relative": "../x.stl", "package": "package://p/../../x.stl"}[where]
+    source = folder / "arm.urdf"
+    source.write_text(urdf(mesh=name))
+    refused(tmp_path, source, str(source), f'<mesh filename="{name}">', "outside")
+
+
+def mjcf(tmp_path, extra):
+    source = tmp_path / "robot" / "arm.xml"
+    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
+    source.write_text(text.replace("</mujoco>", f"{extra}</mujoco>"))
+    return source
+
+
+def test_an_mjcf_include_outside_its_folder_is_refused(tmp_path, folder):
+    outside = tmp_path / "outside.xml"
+    outside.write_text(f'<mujoco><custom><text name="leak" data="{SECRET}"/></custom></mujoco>')
+    source = mjcf(tmp_path, f'<include file="{outside}"/>')
+    refused(tmp_path, source, str(source), f'<include file="{outside}">', "outside")
+
+
+def test_an_mjcf_mesh_outside_its_folder_is_refused(tmp_path, folder):
+    stl(tmp_path / "x.stl")
+    source = mjcf(tmp_path, '<asset><mesh name="m" file="../x.stl"/></asset>')
+    refused(tmp_path, source, str(source), '<mesh file="../x.stl">', "outside")
+
+
+def test_an_mjcf_plugin_is_refused(tmp_path, folder):
+    source = mjcf(tmp_path, '<extension><plugin plugin="mujoco.elasticity.cable"/></extension>')
+    refused(tmp_path, source, str(source), "<extension>", "plugin")
+
+
+@pytest.mark.parametrize("kind", ["urdf", "dh"])
+def test_a_name_that_would_end_the_mjcf_cdata_is_refused(tmp_path, folder, kind):
+    injected = f']]&gt;&lt;include file=&quot;{tmp_path}/secret.yaml&quot;/&gt;&lt;![CDATA['
+    if kind == "urdf":
+        source = folder / "arm.urdf"
+        source.write_text(urdf(name=injected))
+    else:
+        source = folder / "arm.toml"
+        text = (Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml").read_text()
+        source.write_text(text.replace('description = "', 'description = "]]><include file=\\"x\\"/>'))
+    line = refused(tmp_path, source, str(source), "']]>'")
+    assert "bug in faultgen" not in line
+
+
+def test_a_killed_adds_staging_folder_is_removed_by_the_next_add(tmp_path, folder):
+    import socket
+
+    (tmp_path / "out").mkdir()
+    stale = tmp_path / "out" / f".robot.partial-999999999@{socket.gethostname()}-abc123"
+    (stale / "sub").mkdir(parents=True)
+    source = folder / "arm.urdf"
+    source.write_text(urdf(mesh="/nonexistent/x.stl"))
+    refused(tmp_path, source, "<mesh")
+    assert not stale.exists()
+
+
+def test_xacro_expansion_equals_xacro_s_own_on_rtb_data(tmp_path):
+    """Independent check: xacrodoc (xacro's processor) and faultgen's expander give the same URDF
+    (elements, attributes, numbers to 12 digits) for rtb-data's arms."""
+    from faultgen.model import xacro
+
+    root = Path(rtbdata.__file__).parent / "xacro"
+    kuka = root / "kuka_description"
+    packages = {
+        "abb_irb140": root / "abb_irb140_description",
+        "kuka_resources": kuka / "kuka_resources",
+        **{f"kuka_{k}_support": kuka / f"kuka_{k}" for k in ("kr6", "kr16", "kr120", "lbr_iiwa")},
+        "qut_frankie_description": root / "qut_frankie_description",
+    }
+    files = [
+        "abb_irb140_description/urdf/irb140.xacro",
+        "kuka_description/kuka_kr6/urdf/kr6r700sixx.xacro",
+        "kuka_description/kuka_kr16/urdf/kr16_2.xacro",
+        "kuka_description/kuka_kr120/urdf/kr120r2500pro.xacro",
+        "kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.xacro",
+        "qut_frankie_description/robots/panda_arm.urdf.xacro",
+        "trossen_descriptions/urdf/wx250s.urdf.xacro",
+        "unimation_puma560_description/urdf/puma560_robot.urdf.xacro",
+    ]
+    xacrodoc.packages.update_package_cache({k: str(v) for k, v in packages.items()})
+
+    def canonical(e):
+        def number(text):
+            try:
+                return repr(round(float(text), 12))
+            except ValueError:
+                return text
+
+        attrs = tuple(sorted((k, " ".join(number(w) for w in v.split())) for k, v in e.attrib.items()))
+        return e.tag, attrs, (e.text or "").strip(), tuple(canonical(c) for c in e if isinstance(c.tag, str))
+
+    for name in files:
+        ours = xacro.expand(root / name, packages)
+        theirs = xacrodoc.XacroDoc.from_file(str(root / name), resolve_packages=False).to_urdf_string()
+        assert canonical(ET.fromstring(ours)) == canonical(ET.fromstring(theirs)), name
+        assert sum(1 for _ in ET.fromstring(ours).iter("joint")) >= 6, name
