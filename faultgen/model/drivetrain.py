@@ -55,12 +55,9 @@ BOUNDS = {
     "gearbox_stiffness": (0.0, 1e10),
     "gearbox_damping": (0.0, 1e8),
     "motor_torque_limit": (0.0, 1e6),
-    "coulomb_pos": (0.0, 1e6),
-    "coulomb_neg": (0.0, 1e6),
-    "static": (0.0, 1e6),
+    **{name: (0.0, 1e6) for name in FRICTION_FIELDS},  # N m, N m s/rad: Coulomb, static, viscous
     "stribeck_velocity": (0.0, 1e4),
     "stribeck_exponent": (0.0, 10.0),
-    "viscous": (0.0, 1e6),
     "bristle_stiffness": (0.0, 1e10),
     "bristle_damping": (0.0, 1e8),
 }
@@ -70,6 +67,25 @@ MAX_TABLE_BYTES = 1_000_000
 
 class DrivetrainError(ValueError):
     """A drivetrain table that cannot be used: the message names the file, axis and key."""
+
+
+def check_value(key: str, value) -> float:
+    """``value`` of field ``key`` as a float within :data:`BOUNDS` (> 0 for :data:`POSITIVE`).
+
+    Raises
+    ------
+    DrivetrainError
+        Naming the key, the value and the range.
+    """
+    low, high = BOUNDS[key]
+    positive = key in POSITIVE
+    need = f"{'> ' if positive and low == 0 else '>= '}{low:g} and <= {high:g}"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise DrivetrainError(f"{key} = {value!r}; expected a number {need} ({UNITS[key]})")
+    value = float(value)
+    if not math.isfinite(value) or not low <= value <= high or (positive and value == 0):
+        raise DrivetrainError(f"{key} = {value!r}; expected a finite value {need} ({UNITS[key]})")
+    return value
 
 
 @dataclass(frozen=True)
@@ -98,18 +114,7 @@ class AxisDrive:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise DrivetrainError(f"{f.name} = {value!r}; expected a number ({UNITS[f.name]})")
-            value = float(value)
-            need_positive = f.name in POSITIVE
-            low, high = BOUNDS[f.name]
-            if not math.isfinite(value) or not low <= value <= high or (need_positive and value == 0):
-                need = f"{'> ' if need_positive and low == 0 else '>= '}{low:g} and <= {high:g}"
-                raise DrivetrainError(
-                    f"{f.name} = {value!r}; expected a finite value {need} ({UNITS[f.name]})"
-                )
-            object.__setattr__(self, f.name, value)
+            object.__setattr__(self, f.name, check_value(f.name, getattr(self, f.name)))
 
     @property
     def friction_row(self) -> list[float]:
@@ -217,15 +222,10 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
             raise DrivetrainError(
                 f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}"
             )
-        for key, value in values.items():
-            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-            positive = key in POSITIVE
-            if not ok or value < 0 or (positive and value == 0):
-                need = "> 0" if positive else ">= 0"
-                raise DrivetrainError(
-                    f"{path}: axis {axis}: {key} = {value!r}; expected a finite number {need} ({UNITS[key]})"
-                )
-        table[axis] = {k: float(v) for k, v in values.items()}
+        try:
+            table[axis] = {k: check_value(k, v) for k, v in values.items()}
+        except DrivetrainError as err:
+            raise DrivetrainError(f"{path}: axis {axis}: {err}") from None
     if not partial:
         Drivetrain.from_table(table, n_axes, str(path))
     return table
