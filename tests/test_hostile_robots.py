@@ -255,3 +255,27 @@ def test_xacro_expansion_equals_xacro_s_own_on_rtb_data(tmp_path):
         theirs = xacrodoc.XacroDoc.from_file(str(root / name), resolve_packages=False).to_urdf_string()
         assert canonical(ET.fromstring(ours)) == canonical(ET.fromstring(theirs)), name
         assert sum(1 for _ in ET.fromstring(ours).iter("joint")) >= 6, name
+
+
+@pytest.mark.parametrize("kind", ["urdf", "mjcf"])
+def test_the_written_robot_names_no_file_of_the_machine_it_was_added_on(tmp_path, folder, kind):
+    from faultgen.model import folder as robot_folder
+
+    (folder / "meshes").mkdir()
+    stl(folder / "meshes" / "x.stl")
+    if kind == "urdf":
+        source = folder / "arm.urdf"
+        source.write_text(urdf(mesh="meshes/x.stl"))
+    else:
+        source = mjcf(
+            tmp_path,
+            '<compiler meshdir="meshes"/><asset><mesh name="m" file="x.stl"/></asset>'
+            '<worldbody><body name="stand"><geom type="mesh" mesh="m" mass="0"/></body></worldbody>',
+        )
+    added = robot_folder.add("robot", source, tmp_path / "out")
+    written = {p.name: p.read_text() for p in added.folder.iterdir()}
+    assert all(str(tmp_path) not in text for text in written.values())
+    assert ("urdf_used.urdf" in written) == (kind == "urdf")
+    if kind == "urdf":  # the URDF as compiled keeps the source's relative name
+        assert 'filename="meshes/x.stl"' in written["urdf_used.urdf"]
+    assert "file=" not in written["robot.xml"] and "meshdir" not in written["robot.xml"]

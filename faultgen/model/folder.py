@@ -192,12 +192,28 @@ def remove_stale(out: Path) -> list[Path]:
     return removed
 
 
+def _drop_files(spec: mujoco.MjSpec) -> None:
+    """Leave no file name in the robot: unused meshes, height fields, skins and file textures go
+    (materials keep their colours), and the asset folders are cleared."""
+    for geom in [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_HFIELD]:
+        spec.delete(geom)
+    textures = {t.name for t in spec.textures if t.file or any(getattr(t, "cubefiles", []) or [])}
+    for material in spec.materials:
+        if any(name in textures for name in material.textures):
+            material.textures = [""] * len(material.textures)
+    for element in [*spec.hfields, *spec.skins, *(t for t in spec.textures if t.name in textures)]:
+        spec.delete(element)
+    spec.meshdir = spec.texturedir = ""
+    spec.compiler.meshdir = spec.compiler.texturedir = ""
+
+
 def _skeleton(spec: mujoco.MjSpec, source: str) -> int:
     """Replace the arm's mesh geoms by capsules from each link's origin to the next link's (a
     skeleton to look at, massless and without contacts); return how many meshes went. A robot
     folder's MJCF is copied elsewhere by other commands (calibration, convergence studies), where
     mesh files named relative to it would not be found; dynamics need no geometry."""
     meshes = [g for g in spec.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH]
+    _drop_files(spec)
     if not meshes:
         return 0
     for geom in meshes:

@@ -38,7 +38,7 @@ from faultgen.model.sources import hint, inside, read_bytes
 
 MAX_FILE_BYTES = 10_000_000
 MAX_INCLUDE_DEPTH = 20
-MAX_ELEMENTS = 200_000
+MAX_ELEMENTS = 50_000  # a 7-axis URDF has a few hundred; the link bound (mjcf.MAX_LINKS) is 500
 MAX_CALL_DEPTH = 50
 MAX_TEXT = 100_000
 
@@ -401,7 +401,9 @@ class _Expander:
             if not target.has(name):
                 target.define(name, node.get("default"))
             return []
-        if "value" in node.attrib:
+        if "value" in node.attrib and target is not scope:  # xacro evaluates these where they stand
+            target.define(name, _literal(self.text(node.get("value"), scope)), evaluated=True)
+        elif "value" in node.attrib:
             target.define(name, node.get("value"))
         else:
             target.define(name, [copy.deepcopy(c) for c in node if isinstance(c.tag, str)], evaluated=True)
