@@ -28,6 +28,13 @@ SOURCES = {
     "iiwa14": XACRO / "kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf",
     "ur5": ROOT / "docs/examples/ur5_dh.toml",
 }
+#: The ROS packages their meshes name, as `--package NAME=DIR` gives them (the source reads only
+#: its own folder and these).
+PACKAGES = {
+    "kuka_kr210_support": XACRO / "kuka_description/kuka_kr210",
+    "abb_irb140_support": XACRO / "abb_irb140_description",
+    "kuka_lbr_iiwa_support": XACRO / "kuka_description/kuka_lbr_iiwa",
+}
 
 
 def pinocchio_error(added) -> float:
@@ -58,7 +65,7 @@ def main() -> None:
     warnings.simplefilter("ignore")
     for name, source in SOURCES.items():
         start = time.perf_counter()
-        added = folder.add(name, source, out / name, tasks=taskgen.generate)
+        added = folder.add(name, source, out / name, tasks=taskgen.generate, packages=PACKAGES)
         seconds = time.perf_counter() - start
         r = added.robot
         fmt = lambda a: "[" + ", ".join(f"{v:.3g}" for v in a) + "]"  # noqa: E731

@@ -86,11 +86,13 @@ def motion(folder: Path, cycles: int) -> tuple[np.ndarray, np.ndarray, np.ndarra
 
 
 def add_kr210(out: Path) -> Path:
-    """``faultgen robots add kr210 --from <rtb-data's kr210l150.urdf> -o out``, as the library call
-    (:func:`faultgen.model.folder.add` with the generated tasks, as the command makes it)."""
+    """``faultgen robots add kr210 --from <rtb-data's kr210l150.urdf> --package
+    kuka_kr210_support=<its folder> -o out``, as the library call (:func:`faultgen.model.folder.add`
+    with the generated tasks, as the command makes it)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", importers.GeometryDropped)
-        add_robot("kr210", KR210_URDF, Path(out), tasks=taskgen.generate)
+        add_robot("kr210", KR210_URDF, Path(out), tasks=taskgen.generate,
+                  packages={"kuka_kr210_support": KR210_URDF.parents[1]})
     return Path(out)
 
 
