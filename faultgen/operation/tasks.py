@@ -23,13 +23,13 @@ convergence").
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
+from faultgen import inputs
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
@@ -471,10 +471,7 @@ def load(robot: Robot | str, name: str) -> Task:
     path = robot.path.parent / "tasks.toml"
     if not path.is_file():
         raise ValueError(f"{path}: no tasks file for robot {robot.name!r}")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"{path}: {err}") from err
+    data = inputs.read_toml(path, "tasks file")
     for key in data:
         if key not in ("limits", *TASKS):
             raise ValueError(f"{path}: unknown table [{key}]; expected [limits] and {', '.join(TASKS)}")
