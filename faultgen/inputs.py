@@ -235,15 +235,30 @@ def is_gzip(path: str | Path) -> bool:
         return fh.read(2) == b"\x1f\x8b"
 
 
-def open_text(path: str | Path, what: str, max_bytes: int | None = None) -> io.TextIOWrapper:
-    """A UTF-8 text reader over the regular file ``path`` (of at most ``max_bytes`` bytes on disk),
+def open_bytes(path: str | Path, what: str, max_bytes: int | None = None) -> io.BufferedIOBase:
+    """A binary reader over the regular file ``path`` (of at most ``max_bytes`` bytes on disk),
     inflating it when it is gzip-compressed (recognised by content) with the bomb check of
     :class:`_BoundedInflate`. Close it (or use ``with``)."""
     path = regular_file(path, what, max_bytes)
     if is_gzip(path):
-        raw: io.RawIOBase = _BoundedInflate(path, what)
-        return io.TextIOWrapper(io.BufferedReader(raw, 2**20), encoding="utf-8", newline="")
-    return open(path, encoding="utf-8", newline="")
+        return io.BufferedReader(_BoundedInflate(path, what), 2**20)
+    return open(path, "rb")
+
+
+def open_text(path: str | Path, what: str, max_bytes: int | None = None) -> io.TextIOWrapper:
+    """:func:`open_bytes` as UTF-8 text (a byte-order mark skipped), newlines as in the file."""
+    return io.TextIOWrapper(open_bytes(path, what, max_bytes), encoding="utf-8-sig", newline="")
+
+
+def count_lines(path: str | Path, what: str) -> int:
+    """Lines of the (possibly gzip-compressed) text file ``path``, a last line without a newline
+    counted; read in blocks, so memory stays flat whatever the length (gzip bombs refused)."""
+    lines, last = 0, b"\n"
+    with open_bytes(path, what) as fh:
+        while block := fh.read(2**22):
+            lines += block.count(b"\n")
+            last = block[-1:]
+    return lines + (last != b"\n")
 
 
 # --------------------------------------------------------------------------------------------------

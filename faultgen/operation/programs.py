@@ -58,7 +58,7 @@ from faultgen.operation import ik as ik_module
 from faultgen.operation.ik import Arc, FlangeIK, Seam, ramp_arc_length, tool_rotation
 from faultgen.operation.tasks import (
     IK_STEP, LIMIT_TOLERANCE, PLAN_PERIOD, PROCESSES, SEAM_LIMIT_TOLERANCE, SEAM_TOLERANCE, TASKS, JointPath,
-    _Builder, _Table, ptp,
+    CycleTooLong, _Builder, _Table, ptp,
 )
 
 #: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
@@ -302,7 +302,10 @@ class _Planner:
     def run(self) -> JointPath:
         for segment in self.p.segments:
             first = self.path.count - 1
-            getattr(self, f"_{segment.type}")(segment)
+            try:
+                getattr(self, f"_{segment.type}")(segment)
+            except CycleTooLong as err:  # a path longer than a cycle may be, refused before it is sampled
+                self.fail(segment, err.reason)
             self.spans.append((segment, first, self.path.count - 1))
         if self.gripped is not None:
             self.fail(None, f"the payload gripped in segment {self.gripped[2]} is still held at the end of the "
