@@ -16,13 +16,12 @@ in a robot folder stores them, one table per axis::
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from faultgen import inputs
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
-from faultgen.model.sources import read_text
 
 #: Unit and meaning of every field of :class:`AxisDrive`, in file order.
 UNITS = {
@@ -61,10 +60,6 @@ BOUNDS = {
     "bristle_stiffness": (0.0, 1e10),
     "bristle_damping": (0.0, 1e8),
 }
-#: Largest ``drivetrain.toml`` read, bytes (a 7-axis table is about 3 kB).
-MAX_TABLE_BYTES = 1_000_000
-
-
 class DrivetrainError(ValueError):
     """A drivetrain table that cannot be used: the message names the file, axis and key."""
 
@@ -196,9 +191,9 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
     """
     path = Path(path)
     try:
-        data = tomllib.loads(read_text(path, MAX_TABLE_BYTES, "drivetrain table", DrivetrainError))
-    except (OSError, tomllib.TOMLDecodeError, RecursionError) as err:
-        raise DrivetrainError(f"{path}: cannot read a TOML drivetrain table: {err}") from None
+        data = inputs.read_toml(path, "TOML drivetrain table")
+    except inputs.InputError as err:
+        raise DrivetrainError(str(err)) from None
     unknown = sorted(set(data) - {"axis"})
     if unknown:
         raise DrivetrainError(

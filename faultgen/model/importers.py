@@ -29,7 +29,6 @@ from __future__ import annotations
 import copy
 import math
 import re
-import tomllib
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -38,6 +37,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen import inputs
 from faultgen.axes import MAX_AXES, MIN_AXES
 from faultgen.model import limits, mjcf, sources, xacro
 from faultgen.model.builder import ArmError, ArmJoint, check_arm
@@ -137,11 +137,11 @@ def _read(path: Path, packages: dict[str, Path]) -> Arm:
     if suffix == ".xacro":
         sources.read_bytes(path, what="xacro file", error=ArmError)
         return _read_urdf(xacro.expand(path, packages), path, "xacro", packages)
+    if suffix == ".toml":
+        return _read_dh(path)
     text = sources.read_text(path, what="robot description", error=ArmError)
     if suffix == ".urdf":
         return _read_urdf(text, path, "URDF", packages)
-    if suffix == ".toml":
-        return _read_dh(path, text)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as err:
@@ -499,11 +499,11 @@ def _number(path: Path, where: str, key: str, value, length: int | None = None) 
     return [limits.number(path, where, key, v, low, high, unit) for v in value]
 
 
-def _read_dh(path: Path, text: str) -> Arm:
+def _read_dh(path: Path) -> Arm:
     try:
-        data = tomllib.loads(text)
-    except (tomllib.TOMLDecodeError, RecursionError) as err:
-        raise ArmError(f"{path}: not a TOML DH table: {err}") from None
+        data = inputs.read_toml(path, "TOML DH table")
+    except inputs.InputError as err:
+        raise ArmError(str(err)) from None
     unknown = sorted(set(data) - DH_TOP)
     if unknown:
         raise ArmError(f"{path}: unknown key {unknown[0]!r}; expected some of: {', '.join(sorted(DH_TOP))}")

@@ -8,12 +8,12 @@ bounded size (:func:`read_bytes`), so a description cannot pull in ``/etc/passwd
 
 from __future__ import annotations
 
-import os
-import stat
 from pathlib import Path
 
+from faultgen import inputs
 
-#: Largest robot description or drivetrain table read, bytes (the largest rtb-data URDF is 60 kB).
+
+#: Largest robot description (URDF, xacro, MJCF file) read, bytes (rtb-data's largest URDF has 8 kB).
 MAX_DESCRIPTION_BYTES = 10_000_000
 
 
@@ -45,38 +45,27 @@ def check_packages(packages: dict[str, str | Path] | None) -> dict[str, Path]:
 def read_bytes(
     path: str | Path, limit: int = MAX_DESCRIPTION_BYTES, what: str = "file", error: type[ValueError] = ValueError
 ) -> bytes:
-    """The bytes of a regular file of at most ``limit`` bytes.
+    """The bytes of a regular file of at most ``limit`` bytes (:func:`faultgen.inputs.read_bytes`).
 
     Raises
     ------
     ValueError
         (``error``) If ``path`` is missing, not a regular file (a device, a pipe, a folder) or larger.
     """
-    path = Path(path)
     try:
-        info = os.stat(path)
-    except OSError as err:
-        raise error(f"{path}: cannot read the {what}: {err.strerror}") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise error(f"{path}: not a regular file; expected a {what}")
-    if info.st_size > limit:
-        raise error(f"{path}: {info.st_size} bytes; a {what} may have at most {limit}")
-    with open(path, "rb") as handle:
-        data = handle.read(limit + 1)
-    if len(data) > limit:
-        raise error(f"{path}: more than {limit} bytes; a {what} may have at most {limit}")
-    return data
+        return inputs.read_bytes(path, what, limit)
+    except inputs.InputError as err:
+        raise error(str(err)) from None
 
 
 def read_text(
     path: str | Path, limit: int = MAX_DESCRIPTION_BYTES, what: str = "file", error: type[ValueError] = ValueError
 ) -> str:
     """:func:`read_bytes` decoded as UTF-8, the error naming the file and the byte offset."""
-    data = read_bytes(path, limit, what, error)
     try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as err:
-        raise error(f"{path}: not UTF-8 text (byte {err.start}: {data[err.start:err.start + 1]!r})") from None
+        return inputs.read_text(path, what, limit)
+    except inputs.InputError as err:
+        raise error(str(err)) from None
 
 
 def find_package(package: str, start: Path) -> Path | None:
