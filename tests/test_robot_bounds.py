@@ -10,15 +10,10 @@ import re
 from pathlib import Path
 
 import pytest
-from typer.testing import CliRunner
 
-from faultgen.cli import app
+from robot_sources import refused
 
 UR5 = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
-
-
-def run(*args):
-    return CliRunner().invoke(app, [str(a) for a in args])
 
 
 DEFAULT = 'lower="-1" upper="1" effort="0" velocity="2"'
@@ -41,18 +36,6 @@ def urdf(limit=DEFAULT, mass="1", fixed=0):
         links.append(f'<link name="f{k}"/>')
         joints.append(f'<joint name="fj{k}" type="fixed"><parent link="l5"/><child link="f{k}"/></joint>')
     return f'<robot name="test">{"".join(links)}{"".join(joints)}</robot>'
-
-
-def refused(tmp_path, source, *words, extra=()):
-    out = tmp_path / "out" / "robot"
-    result = run("robots", "add", "robot", "--from", source, "-o", out, *extra)
-    assert result.exit_code == 2, result.output
-    lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
-    for word in words:
-        assert word in lines[0], lines[0]
-    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
-    return lines[0]
 
 
 RANGE = {
@@ -80,7 +63,8 @@ def test_a_urdf_limit_out_of_bounds_is_refused_naming_the_joint_and_attribute(tm
     limit = {"lower": "-1", "upper": "1", "effort": "0", "velocity": "2", attribute: value}
     source = tmp_path / "arm.urdf"
     source.write_text(urdf(" ".join(f'{k}="{v}"' for k, v in limit.items())))
-    refused(tmp_path, source, str(source), "joint 'j2'", f"<limit {attribute}>", repr(float(value)) if value != "abc" else "'abc'", RANGE[attribute])
+    shown = "'abc'" if value == "abc" else repr(float(value))
+    refused(tmp_path, source, str(source), "joint 'j2'", f"<limit {attribute}>", shown, RANGE[attribute])
 
 
 def test_a_urdf_lower_limit_above_the_upper_is_refused(tmp_path):

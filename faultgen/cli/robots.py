@@ -73,7 +73,8 @@ def robots_command(
         for item in package or []:
             key, sep, value = item.partition("=")
             if not sep or not key or not value:
-                raise ValueError(f"--package {item!r}; expected NAME=DIR, e.g. --package kuka_kr210_support=kuka_kr210")
+                raise ValueError(f"--package {item!r}; expected NAME=DIR, e.g. "
+                                 "--package kuka_kr210_support=kuka_kr210")
             packages[key] = Path(value)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", importers.GeometryDropped)

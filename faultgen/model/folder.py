@@ -139,7 +139,8 @@ def add(
     text = builder.to_xml(spec)
 
     out.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-", dir=out.parent))
+    prefix = f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-"  # remove_stale's pattern
+    stage = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
     try:
         (stage / f"{name}.xml").write_text(text)
         robot = robots.load(stage / f"{name}.xml")

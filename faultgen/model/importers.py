@@ -8,7 +8,8 @@ is written; geometry that cannot be loaded (COLLADA meshes, ``package://`` paths
 resolve) is dropped with one warning, since dynamics need no geometry.
 
 URDF goes through MuJoCo's own URDF compiler (``MjSpec.from_string``); xacro is expanded to URDF
-by faultgen's own expander first (:mod:`faultgen.model.xacro`: no code runs). A DH table is a TOML file (docs/robots.md, "Your own robot")::
+by faultgen's own expander first (:mod:`faultgen.model.xacro`: no code runs). A DH table is a
+TOML file (docs/robots.md, "Your own robot")::
 
     convention = "standard"        # or "modified" (Craig)
     [[link]]                       # one per axis, base first

@@ -60,25 +60,25 @@ def check_files(path: Path, root: ET.Element, packages: dict[str, Path]) -> None
                     if node.tag in ("include", "model", "attach"):
                         folder = ""
                     target = Path(value) if Path(value).is_absolute() else current.parent / folder / value
-                    if not any(inside(target, r) for r in allowed):
-                        raise ArmError(
-                            f'{current}: <{node.tag} {key}="{value}"> names {target.resolve()}, outside the '
-                            f"folder {allowed[0]} and the --package folders; a robot description may read "
-                            "only those"
-                        )
+                    _check_inside(current, f'<{node.tag} {key}="{value}">', target, allowed)
                     if node.tag == "include":
                         seen += 1
                         if seen > MAX_INCLUDES:
                             raise ArmError(f"{path}: more than {MAX_INCLUDES} includes")
                         try:
-                            pending.append((target, ET.fromstring(read_text(target, what="MJCF include", error=ArmError))))
+                            text = read_text(target, what="MJCF include", error=ArmError)
+                            pending.append((target, ET.fromstring(text)))
                         except ET.ParseError as err:
                             raise ArmError(f"{target}: not XML: {err}") from None
             for key in ("meshdir", "texturedir", "assetdir"):
                 if node.tag == "compiler" and key in node.attrib:
-                    target = current.parent / node.get(key)
-                    if not any(inside(target, r) for r in allowed):
-                        raise ArmError(
-                            f'{current}: <compiler {key}="{node.get(key)}"> is outside the folder {allowed[0]} '
-                            "and the --package folders; a robot description may read only those"
-                        )
+                    construct = f'<compiler {key}="{node.get(key)}">'
+                    _check_inside(current, construct, current.parent / node.get(key), allowed)
+
+
+def _check_inside(current: Path, construct: str, target: Path, allowed: list[Path]) -> None:
+    if not any(inside(target, root) for root in allowed):
+        raise ArmError(
+            f"{current}: {construct} names {target.resolve()}, outside the folder {allowed[0]} and the "
+            "--package folders; a robot description may read only those"
+        )
