@@ -141,10 +141,12 @@ def test_a_xacro_include_resolves_against_its_own_folder_and_a_named_package(tmp
     assert root.find("link/inertial") is not None and SECRET not in text
 
 
-@pytest.mark.parametrize("where", ["absolute", "relative", "package"])
+@pytest.mark.parametrize("where", ["absolute", "relative", "package", "symlink"])
 def test_a_urdf_mesh_outside_its_folder_is_refused(tmp_path, folder, where):
     mesh = stl(tmp_path / "x.stl")
-    name = {"absolute": str(mesh), "relative": "../x.stl", "package": "package://p/../../x.stl"}[where]
+    (folder / "link.stl").symlink_to(mesh)
+    name = {"absolute": str(mesh), "relative": "../x.stl", "package": "package://p/../../x.stl",
+            "symlink": "link.stl"}[where]
     source = folder / "arm.urdf"
     source.write_text(urdf(mesh=name))
     refused(tmp_path, source, str(source), f'<mesh filename="{name}">', "outside")
@@ -168,6 +170,14 @@ def test_an_mjcf_mesh_outside_its_folder_is_refused(tmp_path, folder):
     stl(tmp_path / "x.stl")
     source = mjcf(tmp_path, '<asset><mesh name="m" file="../x.stl"/></asset>')
     refused(tmp_path, source, str(source), '<mesh file="../x.stl">', "outside")
+
+
+def test_an_mjcf_include_s_names_are_taken_from_the_main_file_s_folder_as_mujoco_does(tmp_path, folder):
+    stl(tmp_path / "x.stl")
+    (folder / "sub").mkdir()
+    (folder / "sub" / "assets.xml").write_text('<mujoco><asset><mesh name="m" file="../x.stl"/></asset></mujoco>')
+    source = mjcf(tmp_path, '<include file="sub/assets.xml"/>')
+    refused(tmp_path, source, str(folder / "sub" / "assets.xml"), '<mesh file="../x.stl">', "outside")
 
 
 def test_an_mjcf_plugin_is_refused(tmp_path, folder):

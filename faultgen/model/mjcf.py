@@ -59,7 +59,8 @@ def check_files(path: Path, root: ET.Element, packages: dict[str, Path]) -> None
                     folder = compiler.get(_DIRS.get(node.tag, ""), compiler.get("assetdir", ""))
                     if node.tag in ("include", "model", "attach"):
                         folder = ""
-                    target = Path(value) if Path(value).is_absolute() else current.parent / folder / value
+                    # MuJoCo takes every relative name (includes' too) from the main file's folder
+                    target = Path(value) if Path(value).is_absolute() else path.parent / folder / value
                     _check_inside(current, f'<{node.tag} {key}="{value}">', target, allowed)
                     if node.tag == "include":
                         seen += 1
@@ -73,7 +74,7 @@ def check_files(path: Path, root: ET.Element, packages: dict[str, Path]) -> None
             for key in ("meshdir", "texturedir", "assetdir"):
                 if node.tag == "compiler" and key in node.attrib:
                     construct = f'<compiler {key}="{node.get(key)}">'
-                    _check_inside(current, construct, current.parent / node.get(key), allowed)
+                    _check_inside(current, construct, path.parent / node.get(key), allowed)
 
 
 def _check_inside(current: Path, construct: str, target: Path, allowed: list[Path]) -> None:
