@@ -259,3 +259,10 @@ def test_the_written_robot_names_no_file_of_the_machine_it_was_added_on(tmp_path
     if kind == "urdf":  # the URDF as compiled keeps the source's relative name
         assert 'filename="meshes/x.stl"' in written["urdf_used.urdf"]
     assert "file=" not in written["robot.xml"] and "meshdir" not in written["robot.xml"]
+
+
+def test_a_urdf_whose_masses_need_an_unnamed_package_says_which_package_to_name(tmp_path):
+    import rtbdata
+
+    iiwa = Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"
+    refused(tmp_path, iiwa, "link_1", "--package kuka_lbr_iiwa_support=DIR", "kuka_lbr_iiwa is near the file")

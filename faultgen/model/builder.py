@@ -63,7 +63,7 @@ def _compile(spec: mujoco.MjSpec, source: str) -> mujoco.MjModel:
     try:
         return spec.copy().compile()
     except ValueError as err:
-        raise ArmError(f"{source}: {str(err).strip()}") from None
+        raise ArmError(f"{source}: " + "; ".join(line.strip() for line in str(err).strip().splitlines())) from None
 
 
 def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:

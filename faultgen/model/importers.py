@@ -249,7 +249,7 @@ def _read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> A
             f"{MIN_AXES} to {MAX_AXES} in a serial chain"
         )
     # geometry MuJoCo cannot load goes, with one warning
-    dropped, named = [], {}
+    dropped, named, unnamed = [], {}, []
     for link in root.iter("link"):
         for tag in ("visual", "collision"):
             for element in list(link.findall(tag)):
@@ -311,7 +311,15 @@ def _read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> A
             "(written into urdf_used.urdf)"
         )
         spec = _urdf_spec(root, path)
-    joints = check_arm(spec, str(path))
+    try:
+        joints = check_arm(spec, str(path))
+    except ArmError as err:
+        if dropped and unnamed:  # the likely cause: link masses came from meshes left out
+            raise ArmError(
+                f"{err}; {len(dropped)} meshes were left out, those of package {unnamed[0]!r} as no "
+                f"--package {unnamed[0]}=DIR names its folder" + sources.hint(unnamed[0], path.parent)
+            ) from None
+        raise
     extension = root.find("mujoco")
     root.remove(extension)
     for mesh, filename in named.items():  # the written URDF keeps the source's names, no local path
