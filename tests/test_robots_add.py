@@ -126,3 +126,29 @@ def test_a_built_in_robot_added_from_its_own_arm_and_drivetrain_has_its_dynamics
     readme = (tmp_path / "irb_copy" / "README.md").read_text()
     assert "gear_ratio, all axes: given in --drivetrain" in readme
     assert "Rated payload: 200 kg (given with --payload)" in readme
+
+
+def test_a_killed_add_leaves_a_hidden_staging_folder_that_the_next_add_removes(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ur5"
+    import faultgen
+
+    env = {**os.environ, "PYTHONPATH": str(Path(faultgen.__file__).resolve().parents[1])}  # this faultgen
+    command = [sys.executable, "-m", "faultgen.cli", "robots", "add", "ur5", "--from", str(UR5), "-o", str(out)]
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    staged = []
+    while not staged and process.poll() is None and time.monotonic() < deadline:
+        staged = [p for p in tmp_path.glob(".ur5.partial-*") if (p / "ur5.xml").exists()]
+        time.sleep(0.02)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert staged and staged[0].exists() and not out.exists()  # killed while staging
+    result = run("robots", "add", "ur5", "--from", UR5, "-o", out)
+    assert result.exit_code == 0, result.output
+    assert [p.name for p in tmp_path.iterdir()] == ["ur5"]
