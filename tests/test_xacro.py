@@ -81,3 +81,25 @@ def test_a_file_that_expands_exponentially_is_refused(tmp_path):
 def test_a_file_that_includes_itself_is_refused(tmp_path):
     with pytest.raises(ArmError, match="includes itself"):
         expand(tmp_path, '<xacro:include filename="top.xacro"/>')
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        # properties doubling a string: 2^40 characters
+        ('<xacro:property name="p0" value="ab"/>'
+         + "".join(f'<xacro:property name="p{k}" value="${{p{k - 1} + p{k - 1}}}"/>' for k in range(1, 41))
+         + '<link name="${p40}"/>', "a string of more than"),
+        ('<link name="${' + "+".join(["1"] * 100_000) + '}"/>', "nested too deeply"),
+        ("".join(f'<xacro:property name="q{k}" value="${{q{k - 1}}}"/>' for k in range(1, 20_000))
+         + '<xacro:property name="q0" value="1"/><link name="${q19999}"/>', "nested too deeply"),
+        ('<link name="${' + "*".join(["99999999999"] * 40) + '}"/>', ""),
+    ],
+)
+def test_expressions_that_would_grow_without_bound_are_refused_or_kept_small(tmp_path, body, message):
+    if message:
+        with pytest.raises(ArmError, match=message):
+            expand(tmp_path, body)
+    else:  # a product of large integers becomes a float, refused as out of range past 1e308
+        with pytest.raises(ArmError, match="out of range"):
+            expand(tmp_path, body)

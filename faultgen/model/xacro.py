@@ -273,6 +273,8 @@ class _Expander:
             return self.value(tree.body, scope, _short(source))
         except ArmError:
             raise
+        except RecursionError:
+            raise self.refuse(f"${{{_short(source)}}}", "nested too deeply") from None
         except _Undefined as err:
             raise ArmError(f"{self.where}: ${{{_short(source)}}}: no property {err.args[0]!r}") from None
         except (ArithmeticError, TypeError, ValueError) as err:
@@ -292,12 +294,19 @@ class _Expander:
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
             left, right = self.value(node.left, scope, source), self.value(node.right, scope, source)
             if isinstance(node.op, ast.Add) and isinstance(left, str) and isinstance(right, str):
+                if len(left) + len(right) > MAX_TEXT:
+                    raise self.refuse(f"${{{source}}}", f"a string of more than {MAX_TEXT} characters")
                 return left + right
             if not all(isinstance(v, (int, float)) for v in (left, right)):
                 raise self.refuse(f"${{{source}}}", f"{type(node.op).__name__} of {left!r} and {right!r}")
             if isinstance(node.op, ast.Pow):
                 left, right = float(left), float(right)  # no integer powers of unbounded size
-            return _BINARY[type(node.op)](left, right)
+            result = _BINARY[type(node.op)](left, right)
+            # no integers of unbounded size (their arithmetic slows down with their length)
+            result = float(result) if isinstance(result, int) and abs(result) > 2**63 else result
+            if isinstance(result, float) and not math.isfinite(result):
+                raise ArmError(f"{self.where}: ${{{source}}}: {result} (out of range)")
+            return result
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd, ast.Not)):
             operand = self.value(node.operand, scope, source)
             if isinstance(node.op, ast.Not):
@@ -526,7 +535,10 @@ def expand(path: str | Path, packages: dict[str, str | Path] | None = None) -> s
     scope = _Scope()
     if is_xacro_namespace(root.tag):
         raise expander.refuse(f"<xacro:{_local(root.tag)}> as the root")
-    expander.element(root, scope)
+    try:
+        expander.element(root, scope)
+    except RecursionError:  # elements or properties nested thousands deep
+        raise expander.refuse("document", "elements or properties nested too deeply") from None
     for key in [k for k in root.attrib if is_xacro_namespace(k)]:
         del root.attrib[key]
     text = ET.tostring(root, encoding="unicode")
