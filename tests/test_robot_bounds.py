@@ -167,3 +167,11 @@ def test_a_drivetrain_value_out_of_bounds_is_refused(tmp_path, key, value, expec
 def test_a_drivetrain_that_is_not_a_regular_file_is_refused(tmp_path, device):
     drive = Path(device) if device.startswith("/") else tmp_path
     refused(tmp_path, UR5, str(drive), "not a regular file", extra=("--drivetrain", drive))
+
+
+@pytest.mark.parametrize("suffix", [".urdf", ".xml", ".xacro"])
+def test_a_description_nested_thousands_deep_is_refused(tmp_path, suffix):
+    source = tmp_path / f"arm{suffix}"
+    deep = "<a>" * 50_000 + "</a>" * 50_000
+    source.write_text(urdf().replace('<link name="base"/>', f'<link name="base">{deep}</link>'))
+    refused(tmp_path, source, "arm" + suffix, "nested more than 200 deep")

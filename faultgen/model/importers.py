@@ -143,10 +143,7 @@ def _read(path: Path, packages: dict[str, Path]) -> Arm:
     text = sources.read_text(path, what="robot description", error=ArmError)
     if suffix == ".urdf":
         return _read_urdf(text, path, "URDF", packages)
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as err:
-        raise ArmError(f"{path}: not XML: {err}") from None
+    root = sources.parse_xml(text, path, ArmError)
     if root.tag == "robot":
         return _read_urdf(text, path, "URDF", packages)
     mjcf.check_files(path, root, packages)
@@ -186,10 +183,7 @@ def _resolve_mesh(filename: str, path: Path, packages: dict[str, Path]) -> Path 
 
 
 def _read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Arm:
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as err:
-        raise ArmError(f"{path}: not XML: {err}") from None
+    root = sources.parse_xml(text, path, ArmError)
     if root.tag != "robot":
         raise ArmError(f"{path}: root element <{root.tag}>; a URDF has <robot>")
     links = sum(1 for _ in root.iter("link"))

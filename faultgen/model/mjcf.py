@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from faultgen.model.builder import ArmError
-from faultgen.model.sources import inside, read_text, roots
+from faultgen.model.sources import inside, parse_xml, read_text, roots
 
 #: Most bodies (links) an arm description may have: a 7-axis arm with its tool and sensor frames
 #: has tens; a description with more is refused before MuJoCo compiles it.
@@ -66,11 +66,8 @@ def check_files(path: Path, root: ET.Element, packages: dict[str, Path]) -> None
                         seen += 1
                         if seen > MAX_INCLUDES:
                             raise ArmError(f"{path}: more than {MAX_INCLUDES} includes")
-                        try:
-                            text = read_text(target, what="MJCF include", error=ArmError)
-                            pending.append((target, ET.fromstring(text)))
-                        except ET.ParseError as err:
-                            raise ArmError(f"{target}: not XML: {err}") from None
+                        text = read_text(target, what="MJCF include", error=ArmError)
+                        pending.append((target, parse_xml(text, target, ArmError)))
             for key in ("meshdir", "texturedir", "assetdir"):
                 if node.tag == "compiler" and key in node.attrib:
                     construct = f'<compiler {key}="{node.get(key)}">'

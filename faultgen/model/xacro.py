@@ -34,7 +34,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from faultgen.model.builder import ArmError
-from faultgen.model.sources import hint, inside, read_bytes
+from faultgen.model.sources import hint, inside, parse_xml, read_bytes
 
 MAX_FILE_BYTES = 10_000_000
 MAX_INCLUDE_DEPTH = 20
@@ -185,11 +185,7 @@ class _Expander:
             raise self.refuse(f"include of {path}", f"more than {MAX_INCLUDE_DEPTH} nested includes")
         if path in self.files:
             raise self.refuse(f"include of {path}", "it includes itself")
-        data = read_bytes(path, MAX_FILE_BYTES, "xacro file", ArmError)
-        try:
-            return ET.fromstring(data)
-        except ET.ParseError as err:
-            raise ArmError(f"{path}: not XML: {err}") from None
+        return parse_xml(read_bytes(path, MAX_FILE_BYTES, "xacro file", ArmError), path, ArmError)
 
     def resolve_include(self, name: str) -> Path:
         base = self.files[-1].parent
