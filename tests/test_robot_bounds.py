@@ -39,8 +39,8 @@ def urdf(limit=DEFAULT, mass="1", fixed=0):
 
 
 RANGE = {
-    "velocity": "in 0 .. 100 rad/s",
-    "effort": "in 0 .. 1e+06 N m",
+    "velocity": " 100 rad/s",
+    "effort": " 1e+06 N m",
     "lower": "in -100 .. 100 rad",
     "upper": "in -100 .. 100 rad",
 }
@@ -54,6 +54,8 @@ RANGE = {
         ("velocity", "nan"),
         ("velocity", "abc"),
         ("velocity", "-2"),
+        ("velocity", "1e-300"),
+        ("effort", "1e-300"),
         ("lower", "-inf"),
         ("lower", "-1e300"),
         ("upper", "1e300"),
@@ -175,3 +177,21 @@ def test_a_description_nested_thousands_deep_is_refused(tmp_path, suffix):
     deep = "<a>" * 50_000 + "</a>" * 50_000
     source.write_text(urdf().replace('<link name="base"/>', f'<link name="base">{deep}</link>'))
     refused(tmp_path, source, "arm" + suffix, "nested more than 200 deep")
+
+
+@pytest.mark.parametrize(
+    "old, new, words",
+    [
+        (r'mass="[^"]*"', 'mass="inf"', ("body 'link1'", "mass = inf", "0 .. 100000 kg")),
+        (r'range="[^"]*"', 'range="-1e300 1e300"', ("joint 'joint1'", "range = -1e+300", "-100 .. 100 rad")),
+        ("</mujoco>", '<option gravity="0 0 -1e300"/></mujoco>', ("<option gravity>", "-100 .. 100 m/s^2")),
+        ("</mujoco>", '<actuator><motor joint="joint2" forcelimited="true" forcerange="-1e-300 1e-300"/></actuator>'
+         "</mujoco>", ("joint 'joint2'", "effort limit = 1e-300", "0.001 .. 1e+06 N m")),
+    ],
+)
+def test_an_mjcf_value_out_of_bounds_is_refused(tmp_path, old, new, words):
+    from faultgen.model import robots
+
+    source = tmp_path / "arm.xml"
+    source.write_text(re.sub(old, new, (robots.robots_dir() / "puma560" / "arm.xml").read_text(), count=1))
+    refused(tmp_path, source, str(source), *words)

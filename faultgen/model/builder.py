@@ -59,11 +59,16 @@ class ArmJoint:
     range: tuple[float, float]
 
 
+def one_line(err: Exception) -> str:
+    """MuJoCo's message of ``err`` on one line (it puts the element on a second one)."""
+    return "; ".join(line.strip() for line in str(err).strip().splitlines() if line.strip())
+
+
 def _compile(spec: mujoco.MjSpec, source: str) -> mujoco.MjModel:
     try:
         return spec.copy().compile()
     except ValueError as err:
-        raise ArmError(f"{source}: " + "; ".join(line.strip() for line in str(err).strip().splitlines())) from None
+        raise ArmError(f"{source}: {one_line(err)}") from None
 
 
 def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:

@@ -41,7 +41,7 @@ import numpy as np
 from faultgen import inputs
 from faultgen.axes import MAX_AXES, MIN_AXES
 from faultgen.model import limits, mjcf, sources, xacro
-from faultgen.model.builder import ArmError, ArmJoint, check_arm
+from faultgen.model.builder import ArmError, ArmJoint, check_arm, one_line
 
 #: Mesh file types MuJoCo loads.
 MESH_TYPES = (".stl", ".obj", ".msh")
@@ -120,12 +120,12 @@ def read(path: str | Path, packages: dict[str, str | Path] | None = None) -> Arm
     limits.check_model(arm.spec, path)
     for k, joint in enumerate(arm.joints):
         where = f"joint {joint.name!r}"
-        for key, values, high, unit in (
-            ("speed limit", arm.speed_limit, limits.MAX_SPEED, "rad/s"),
-            ("effort limit", arm.effort_limit, limits.MAX_EFFORT, "N m"),
+        for key, values, low, high, unit in (
+            ("speed limit", arm.speed_limit, limits.MIN_SPEED, limits.MAX_SPEED, "rad/s"),
+            ("effort limit", arm.effort_limit, limits.MIN_EFFORT, limits.MAX_EFFORT, "N m"),
         ):
             if not math.isnan(values[k]):
-                limits.number(path, where, key, float(values[k]), 0.0, high, unit)
+                limits.number(path, where, key, float(values[k]), low, high, unit)
     return arm
 
 
@@ -340,7 +340,7 @@ def _urdf_spec(root: ET.Element, path: Path) -> mujoco.MjSpec:
     try:
         return mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except ValueError as err:
-        raise ArmError(f"{path}: MuJoCo's URDF compiler: {str(err).strip()}") from None
+        raise ArmError(f"{path}: MuJoCo's URDF compiler: {one_line(err)}") from None
 
 
 def _fill_inertials(root: ET.Element, spec: mujoco.MjSpec, path: Path) -> list[str]:
@@ -386,7 +386,7 @@ def _read_mjcf(path: Path) -> Arm:
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as err:
-        raise ArmError(f"{path}: {str(err).strip()}") from None
+        raise ArmError(f"{path}: {one_line(err)}") from None
     try:
         spec.copy().compile()
     except ValueError as err:  # check_arm names any other error, after the joint kinds
@@ -453,7 +453,7 @@ def _mjcf_without_meshes(path: Path, message: str) -> mujoco.MjSpec:
     try:
         return mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
     except ValueError as err:
-        raise ArmError(f"{path}: {str(err).strip()}") from None
+        raise ArmError(f"{path}: {one_line(err)}") from None
 
 
 # ---------------------------------------------------------------------------------------- DH --
@@ -486,8 +486,8 @@ DH_BOUNDS = {
     "com": (-limits.MAX_LENGTH, limits.MAX_LENGTH, "m"),
     "inertia": (-limits.MAX_INERTIA, limits.MAX_INERTIA, "kg m^2"),
     "qlim": (-limits.MAX_ANGLE, limits.MAX_ANGLE, "rad"),
-    "speed": (1e-3, limits.MAX_SPEED, "rad/s"),
-    "effort": (1e-3, limits.MAX_EFFORT, "N m"),
+    "speed": (limits.MIN_SPEED, limits.MAX_SPEED, "rad/s"),
+    "effort": (limits.MIN_EFFORT, limits.MAX_EFFORT, "N m"),
     "rated_payload": (0.0, limits.MAX_PAYLOAD, "kg"),
     "gravity": (-limits.MAX_GRAVITY, limits.MAX_GRAVITY, "m/s^2"),
 }

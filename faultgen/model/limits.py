@@ -25,6 +25,9 @@ MAX_ANGLE = 100.0
 MAX_SPEED = 100.0
 #: N m: joint torque limits (a 2 t payload arm's axis 2: about 1e5).
 MAX_EFFORT = 1e6
+#: rad/s and N m: the smallest speed and torque limits a source may give (0 in a URDF: none given);
+#: below them the sizing's gear ratio and motor overflow.
+MIN_SPEED, MIN_EFFORT = 1e-3, 1e-3
 #: kg: one link's mass (a heavy arm's base: about 2 t).
 MAX_MASS = 1e5
 #: kg m^2: one link's principal inertia.
@@ -89,6 +92,13 @@ def check_urdf(root: ET.Element, path: Path) -> None:
                             value = word
                         number(path, where, f'<{sub.rsplit("/", 1)[-1]} {key}>', value, low, high, unit)
         limit = element.find("limit")
+        for key, low, unit in (("velocity", MIN_SPEED, "rad/s"), ("effort", MIN_EFFORT, "N m")):
+            value = float((limit.get(key) or "0").strip() or 0) if limit is not None else 0.0
+            if 0 < value < low:
+                raise ArmError(
+                    f"{path}: {where}: <limit {key}> = {value!r}; expected 0 (not given) or a number in "
+                    f"{low:g} .. {MAX_SPEED if key == 'velocity' else MAX_EFFORT:g} {unit}"
+                )
         if element.tag == "joint" and element.get("type") == "revolute" and limit is not None:
             lower, upper = limit.get("lower"), limit.get("upper")
             if lower is not None and upper is not None and not float(lower) < float(upper):
@@ -100,6 +110,8 @@ def check_urdf(root: ET.Element, path: Path) -> None:
 def check_model(spec: mujoco.MjSpec, path: Path | str) -> None:
     """The compiled arm's masses, inertias, positions and joint ranges within the bounds (what a
     source of any kind gives; MJCF values reach MuJoCo unchecked otherwise)."""
+    for value in spec.option.gravity:
+        number(path, "<option gravity>", "gravity", float(value), -MAX_GRAVITY, MAX_GRAVITY, "m/s^2")
     model = spec.copy().compile()
     for body in range(1, model.nbody):
         name = model.body(body).name or f"#{body}"
