@@ -196,7 +196,8 @@ def size(
         put("bristle_damping", 0.0)
         table[axis] = {key: mine[key] for key in KEYS}
         origin[axis] = notes
-    return Drivetrain.from_table(table, n, "sized drivetrain"), origin, float(payload)
+    source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
+    return Drivetrain.from_table(table, n, source), origin, float(payload)
 
 
 #: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3
