@@ -146,8 +146,13 @@ def test_a_dh_rated_payload_out_of_bounds_is_refused(tmp_path, value):
     refused(tmp_path, source, str(source), "rated_payload", "in 0 .. 10000 kg")
 
 
-def test_payload_option_out_of_bounds_is_refused(tmp_path):
-    refused(tmp_path, UR5, "payload = 1e+30", "0 .. 10000 kg", extra=("--payload", "1e30"))
+@pytest.mark.parametrize("payload", [1e30, -1.0, float("nan")])
+def test_a_payload_out_of_bounds_is_refused_by_the_library(tmp_path, payload):
+    from faultgen.model import folder
+
+    with pytest.raises(ValueError, match=r"payload = .* kg; expected a number in 0 \.\. 10000 kg"):
+        folder.add("robot", UR5, tmp_path / "out", payload=payload)
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize(
