@@ -164,11 +164,7 @@ class _Hdf5:
     def __init__(self, path: Path, n_axes: int):
         self.path = path
         with measured._open_hdf5(path) as fh:
-            import h5py
-
-            datasets = [n for n in fh if isinstance(fh[n], h5py.Dataset)]
-            self.wanted, self.extra = measured._select_columns(path, datasets, n_axes)
-            self.extra += [f"{g}/ (group)" for g in fh if g not in datasets]
+            self.wanted, self.extra = measured.hdf5_columns(fh, path, n_axes)
             lengths = {name: fh[name].shape for name in self.wanted}
         shapes = set(lengths.values())
         if len(shapes) != 1 or len(next(iter(shapes))) != 1:
