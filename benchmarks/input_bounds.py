@@ -157,6 +157,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="skip the 10^7-row log")
     parser.add_argument("--sizes", type=int, nargs="+", help="log lengths (rows) to run; the first is the baseline")
     parser.add_argument("--no-bombs", action="store_true", help="only the logs")
+    parser.add_argument("--no-logs", action="store_true", help="only the bombs")
     args = parser.parse_args()
     folder = Path(args.folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -174,7 +175,7 @@ def main() -> None:
         print(f"| {kind} | {name} ({path.stat().st_size / 1e6:.2f} MB) | {r['outcome']}: {r.get('message', '')[:90]} | "
               f"{r['seconds']:.1f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused, < {BOMB_S:g} s, "
               f"< {BOMB_MB} MB) |", flush=True)
-    sizes = args.sizes or (SIZES[:2] if args.quick else SIZES)
+    sizes = [] if args.no_logs else args.sizes or (SIZES[:2] if args.quick else SIZES)
     for kind in ("calibrate", "replay"):
         base = None
         for rows in sizes:
