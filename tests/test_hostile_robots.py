@@ -266,3 +266,16 @@ def test_a_urdf_whose_masses_need_an_unnamed_package_says_which_package_to_name(
 
     iiwa = Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_lbr_iiwa/urdf/lbr_iiwa_14_r820.urdf"
     refused(tmp_path, iiwa, "link_1", "--package kuka_lbr_iiwa_support=DIR", "kuka_lbr_iiwa is near the file")
+
+
+@pytest.mark.parametrize("kind", ["mesh", "include"])
+def test_a_loop_of_symbolic_links_is_refused(tmp_path, folder, kind):
+    (folder / "a.xacro").symlink_to(folder / "b.xacro")
+    (folder / "b.xacro").symlink_to(folder / "a.xacro")
+    if kind == "mesh":
+        source = folder / "arm.urdf"
+        source.write_text(urdf(mesh="a.xacro"))
+    else:
+        source = folder / "arm.urdf.xacro"
+        source.write_text(urdf('<xacro:include filename="a.xacro"/>'))
+    refused(tmp_path, source, str(source), "a.xacro")

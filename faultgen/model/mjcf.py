@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from faultgen.model.builder import ArmError
-from faultgen.model.sources import inside, parse_xml, read_text, roots
+from faultgen.model.sources import inside, parse_xml, read_text, resolved, roots
 
 #: Most bodies (links) an arm description may have: a 7-axis arm with its tool and sensor frames
 #: has tens; a description with more is refused before MuJoCo compiles it.
@@ -77,6 +77,6 @@ def check_files(path: Path, root: ET.Element, packages: dict[str, Path]) -> None
 def _check_inside(current: Path, construct: str, target: Path, allowed: list[Path]) -> None:
     if not any(inside(target, root) for root in allowed):
         raise ArmError(
-            f"{current}: {construct} names {target.resolve()}, outside the folder {allowed[0]} and the "
+            f"{current}: {construct} names {resolved(target)}, outside the folder {allowed[0]} and the "
             "--package folders; a robot description may read only those"
         )

@@ -22,12 +22,21 @@ MAX_DESCRIPTION_BYTES = 10_000_000
 
 
 def inside(path: Path, root: Path) -> bool:
-    """Whether ``path`` (resolved, symbolic links followed) lies in the folder ``root``."""
+    """Whether ``path`` (resolved, symbolic links followed) lies in the folder ``root``; False for
+    a path that does not resolve (a loop of symbolic links)."""
     try:
         Path(path).resolve().relative_to(Path(root).resolve())
-    except ValueError:
+    except (ValueError, RuntimeError, OSError):
         return False
     return True
+
+
+def resolved(path: Path) -> Path:
+    """``path`` with symbolic links followed, or as given when they loop."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError):
+        return Path(path)
 
 
 def roots(source: Path, packages: dict[str, Path] | None) -> list[Path]:

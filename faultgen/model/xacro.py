@@ -35,6 +35,7 @@ from pathlib import Path
 
 from faultgen.model.builder import ArmError
 from faultgen.model.sources import hint, inside, parse_xml, read_bytes
+from faultgen.model.sources import resolved as resolve
 
 MAX_FILE_BYTES = 10_000_000
 MAX_INCLUDE_DEPTH = 20
@@ -190,7 +191,7 @@ class _Expander:
     def resolve_include(self, name: str) -> Path:
         base = self.files[-1].parent
         path = Path(name) if Path(name).is_absolute() else base / name
-        resolved = path.resolve()
+        resolved = resolve(path)
         if not any(inside(resolved, root) for root in self.roots):
             raise self.refuse(
                 f'include filename="{name}"',
