@@ -357,12 +357,7 @@ class _Expander:
         out = []
         for child in list(parent):
             out.extend(self.element(child, scope))
-        tail_text = parent.text
-        for child in list(parent):
-            parent.remove(child)
-        parent.text = tail_text
-        for child in out:
-            parent.append(child)
+        parent[:] = out
         return out
 
     def element(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
@@ -384,7 +379,9 @@ class _Expander:
             return handler(node, scope)
         if tag in self.macros:
             return self.call(tag, node, scope)
-        raise self.refuse(f"<xacro:{tag}>", "no macro of that name is defined before it" if tag.isidentifier() else "")
+        if tag in ("element", "attribute", "call", "eval-comments", "load_yaml"):
+            raise self.refuse(f"<xacro:{tag}>", "not supported")
+        raise self.refuse(f"<xacro:{tag}>", "no macro of that name is defined before it")
 
     def tag_include(self, node: ET.Element, scope: _Scope) -> list[ET.Element]:
         if set(node.attrib) - {"filename"}:
