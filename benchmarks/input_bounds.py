@@ -158,6 +158,7 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", help="log lengths (rows) to run; the first is the baseline")
     parser.add_argument("--no-bombs", action="store_true", help="only the logs")
     parser.add_argument("--no-logs", action="store_true", help="only the bombs")
+    parser.add_argument("--kinds", nargs="+", default=["calibrate", "replay"], help="what to run on the logs")
     args = parser.parse_args()
     folder = Path(args.folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -176,7 +177,7 @@ def main() -> None:
               f"{r['seconds']:.1f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused, < {BOMB_S:g} s, "
               f"< {BOMB_MB} MB) |", flush=True)
     sizes = [] if args.no_logs else args.sizes or (SIZES[:2] if args.quick else SIZES)
-    for kind in ("calibrate", "replay"):
+    for kind in args.kinds:
         base = None
         for rows in sizes:
             log = make_log(folder, rows)

@@ -272,15 +272,35 @@ def _link_refusal(f, name: str, link) -> str | None:
     if isinstance(link, h5py.ExternalLink):
         return f"/{name} is an external link to {link.filename}:{link.path}"
     if isinstance(link, h5py.SoftLink):
-        target = link.path if link.path.startswith("/") else f"{name.rpartition('/')[0]}/{link.path}"
-        try:
-            f[target]
-        except (KeyError, OSError, ValueError):
+        if not _resolves_inside(f, f"/{name.rpartition('/')[0]}", link.path, 0):
             return f"/{name} is a soft link to {link.path}, which does not resolve inside the file"
         return None
     if not isinstance(link, h5py.HardLink):
         return f"/{name} is a user-defined link"
     return None
+
+
+def _resolves_inside(f, base: str, target: str, depth: int) -> bool:
+    """Whether the soft-link ``target`` (relative to the group ``base``) names an object of ``f``
+    through hard and soft links only: resolved one link at a time, so an external link on the way
+    is never followed (opening ``f[target]`` would follow it into the other file)."""
+    import h5py
+
+    if depth > 16:  # a soft-link loop
+        return False
+    group = f["/"] if target.startswith("/") else f[base]
+    parts = [part for part in target.split("/") if part and part != "."]
+    for i, part in enumerate(parts):
+        if not isinstance(group, h5py.Group) or part == "..":
+            return False
+        link = group.get(part, getlink=True)
+        if isinstance(link, h5py.SoftLink):
+            rest = "/".join([link.path, *parts[i + 1:]])
+            return _resolves_inside(f, group.name, rest, depth + 1)
+        if not isinstance(link, h5py.HardLink):
+            return False  # missing, external or user-defined
+        group = group[part]
+    return True
 
 
 def _dataset_refusal(f, name: str) -> str | None:

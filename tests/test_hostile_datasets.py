@@ -3,6 +3,7 @@ declared shapes of 447 GiB, text where numbers belong, groups where arrays belon
 groups and absurd attributes. Every command that reads a dataset, and ``faultgen.open``, refuses
 each with exit 2 (a ``ValueError``), the file and the item named, no traceback, nothing written."""
 
+import re
 import shutil
 
 import h5py
@@ -98,7 +99,7 @@ def _refused(result, path, message):
     line = result.output.strip()
     assert line.startswith("error: ") and "\n" not in line and "Traceback" not in line, line
     assert str(path) in line
-    assert __import__("re").search(message, line), line
+    assert re.search(message, line), line
 
 
 @pytest.mark.parametrize("command", [["validate"], ["info"], ["info", "--card"], ["plot"], ["detect"]])

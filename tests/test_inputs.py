@@ -166,3 +166,20 @@ def test_a_file_that_is_not_hdf5_is_refused(tmp_path):
     with pytest.raises(InputError, match="text.h5: not a readable HDF5 file"):
         with inputs.open_hdf5(path):
             pass
+
+
+def test_a_soft_link_through_an_external_link_is_refused_without_following_it(tmp_path, other):
+    """A soft link whose path runs through an external link: resolving it with ``f[path]`` would
+    open the other file (and find /runs/x there), so each link on its path is read, not followed."""
+    def build(f):
+        f["a_soft"] = h5py.SoftLink("/z_ext/x")  # walked before /z_ext
+        f["z_ext"] = h5py.ExternalLink("other.h5", "/runs")
+    with pytest.raises(InputError, match="/a_soft is a soft link to /z_ext/x, which does not resolve inside"):
+        with inputs.open_hdf5(_write(tmp_path / "hostile.h5", build)):
+            pass
+    def loop(f):
+        f["s1"] = h5py.SoftLink("/s2")
+        f["s2"] = h5py.SoftLink("/s1")
+    with pytest.raises(InputError, match="/s1 is a soft link to /s2, which does not resolve"):
+        with inputs.open_hdf5(_write(tmp_path / "loop.h5", loop)):
+            pass

@@ -27,6 +27,7 @@ joint range (by how much), and a motor torque above the drives' capacity.
 
 from __future__ import annotations
 
+import csv
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -303,28 +304,48 @@ def _read_hdf5(path: Path, wanted: list[str]) -> np.ndarray:
 
 
 def _read_csv(path: Path, wanted: list[str]) -> np.ndarray:
-    blocks, rows = [], 0
+    """Two passes: the first reads only ``t``, block by block, keeping nothing but its first value and
+    the row count, so a log longer than a cycle is refused before any of it is kept; the second
+    reads the wanted columns."""
+    first, rows = None, 0
+    for block in _csv_blocks(path, wanted, wanted[:1]):
+        first = block[0, 0] if first is None else first
+        rows += len(block)
+        _check_length(path, np.array([first, block[-1, 0]]), rows)
+    blocks = list(_csv_blocks(path, wanted, wanted))
+    return np.concatenate(blocks) if blocks else np.empty((0, len(wanted)))
+
+
+def _csv_blocks(path: Path, wanted: list[str], columns: list[str]):
+    """The ``columns`` of a CSV log as float blocks of :data:`BLOCK_ROWS` rows (empty ones skipped),
+    after checking that its header has every one of ``wanted``."""
+    _check_header(path, wanted)
     with inputs.open_text(path, "joint log") as f:
         try:
-            reader = pd.read_csv(f, skipinitialspace=True, chunksize=BLOCK_ROWS)
+            reader = pd.read_csv(f, skipinitialspace=True, chunksize=BLOCK_ROWS,
+                                 usecols=lambda name: str(name).strip() in columns)
             for table in reader:
                 table.columns = [str(c).strip() for c in table.columns]
-                missing = [c for c in wanted if c not in table.columns]
-                if missing:
-                    raise ProgramError(f"{path}: no column {missing[0]!r}; a joint log needs {', '.join(wanted)} "
-                                       f"(rad), got {', '.join(table.columns)}")
+                if not len(table):
+                    continue
                 try:
-                    block = table[wanted].to_numpy(dtype=float)
+                    yield table[columns].to_numpy(dtype=float)
                 except ValueError as err:
                     raise ProgramError(f"{path}: a value in columns {', '.join(wanted)} is not a number ({err})") \
                         from None
-                if not len(block):
-                    continue
-                blocks.append(block)
-                rows += len(block)
-                _check_length(path, np.array([blocks[0][0, 0], block[-1, 0]]), rows)
         except (ValueError, OSError, pd.errors.ParserError) as err:
             if isinstance(err, (ProgramError, inputs.InputError)):
                 raise
             raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from err
-    return np.concatenate(blocks) if blocks else np.empty((0, len(wanted)))
+
+
+def _check_header(path: Path, wanted: list[str]) -> None:
+    try:
+        with inputs.open_text(path, "joint log") as f:
+            header = [name.strip() for name in next(csv.reader(f), [])]
+    except (UnicodeDecodeError, OSError, csv.Error) as err:
+        raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from None
+    missing = [c for c in wanted if c not in header]
+    if missing:
+        raise ProgramError(f"{path}: no column {missing[0]!r}; a joint log needs {', '.join(wanted)} (rad), "
+                           f"got {', '.join(header)}")
