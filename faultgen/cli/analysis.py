@@ -8,9 +8,12 @@ from typing import Annotated
 
 import typer
 
+from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
-from faultgen.cli.options import Overwrite, Progress, QAlpha
+from faultgen.cli.options import (
+    MAX_CYCLES, MAX_DAYS, MAX_FOLDS, MAX_PAIRS, MAX_PERMUTATIONS, MAX_SAMPLES, Overwrite, Progress, QAlpha,
+)
 
 
 def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
@@ -31,7 +34,7 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
 @app.command("bench-isolators", cls=Command)
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
-    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
+    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.", min=2, max=100)] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
     speed_window: Annotated[str | None, typer.Option(
         metavar="LOW,HIGH",
@@ -107,18 +110,18 @@ def detect_command(
              "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
              "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
              "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
-    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1)] = 20,
+    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1, max=MAX_SAMPLES)] = 20,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)] = 0.75,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
              "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
-             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0)] = 20,
+             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0, max=MAX_FOLDS)] = 20,
     persistence: Annotated[
         int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
-                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1)
+                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1, max=MAX_SAMPLES)
     ] = 3,
-    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1)] = None,
+    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1, max=MAX_CYCLES)] = None,
     plugin: Annotated[str | None, typer.Option(
         "--detector", metavar="MODULE:CLASS",
         help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
@@ -167,15 +170,15 @@ def detect_command(
 @app.command("training-source", cls=Command)
 def training_source_command(
     file: Annotated[Path, typer.Argument(help="A fleet (`faultgen fleet`): daily records of failing and normal robots.")],
-    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).", min=2)] = 40,
-    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).", min=1)] = 15,
-    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0)] = 5,
+    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).", min=2, max=MAX_DAYS)] = 40,
+    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).", min=1, max=MAX_DAYS)] = 15,
+    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0, max=MAX_DAYS)] = 5,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).", min=0.0, max=1.0)] = 0.90,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
              "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
-             "many as the training days.", min=0)] = 20,
+             "many as the training days.", min=0, max=MAX_FOLDS)] = 20,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -241,12 +244,12 @@ def training_source_command(
 @app.command("classify", cls=Command)
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
-    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0)] = 10.0,
-    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0)] = 20,
+    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0, max=500.0)] = 10.0,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0, max=MAX_PAIRS)] = 20,
     horizon: Annotated[int | None, typer.Option(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
-        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0)] = None,
+        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0, max=MAX_DAYS)] = None,
     matched_days: Annotated[bool, typer.Option(
         "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
         "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
@@ -255,7 +258,7 @@ def classify_command(
     permutations: Annotated[int, typer.Option(
         help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
         "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
-        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0)] = 0,
+        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0, max=MAX_PERMUTATIONS)] = 0,
     classifiers: Annotated[list[str] | None, typer.Option(
         "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")] = None,
     preprocessing: Annotated[list[str] | None, typer.Option(
@@ -265,11 +268,11 @@ def classify_command(
         "--full", help="Every row: Table 5.2's fifteen and four more (+var5, +diff+var3, +diff+var5+pca, "
         "+estM+diff+var5+pca), 2 to 3 times the time. Default seven rows, each step alone and the fullest "
         "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
-    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
+    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.", min=0, max=MAX_SEED)] = 0,
     chance: Annotated[bool, typer.Option(
         help="Without --permutations, estimate the chance level cheaply on one cell (lr control, "
         "5 label exchanges, on quick.h5 2 % of the default table's CPU time) and give it in the caption.")] = True,
-    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0)] = 0,
+    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0, max=1024)] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,

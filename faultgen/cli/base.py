@@ -10,10 +10,80 @@ import typer
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 
+#: The usage error the command line raises and catches: typer's own copy of click's where typer
+#: carries one (typer >= 0.29), else click's.
+_UsageError = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
+_USAGE_ERRORS = (click.UsageError, _UsageError)
+
+
+class OptionError(_UsageError):
+    """A refused option value, argument or command name, shown as the one line every refusal of
+    the command line is: ``error: --period '1e20': Input should be a valid integer (expected
+    1..100000; faultgen detect --help)``, exit 2."""
+
+    exit_code = 2
+
+    def show(self, file=None) -> None:
+        typer.echo(f"error: {self.message}", err=True)
+
+
+def one_line(err: Exception, args: list[str] | None = None) -> OptionError:
+    """The :class:`OptionError` of a click usage error: the option, the value given (found in
+    ``args``), the reason, the expected range (a typer ``min``/``max``) and where help is."""
+    param = getattr(err, "param", None)
+    text = (getattr(err, "message", None) or str(err)).rstrip(".")
+    if type(err).__name__ == "MissingParameter" and param is not None:
+        kind = "option" if getattr(param, "opts", [""])[0].startswith("-") else "argument"
+        name = max(param.opts, key=len) if kind == "option" else param.name.upper()
+        text = f"missing {kind} {name}"
+    elif param is not None:
+        names = [n for n in getattr(param, "opts", []) if n.startswith("--")] or list(getattr(param, "opts", []))
+        name = max(names, key=len) if names else param.name.upper()
+        given = _given(param, args or [])
+        low, high = getattr(param, "min", None), getattr(param, "max", None)
+        if low is not None or high is not None:  # typer's "Input should be less than ..." says half of it
+            text = "" if text.startswith("Input should be ") and " than " in text else f"{text}; "
+            text += f"expected {expected_range(low, high)}"
+        text = f"{name}{'' if given is None else ' ' + repr(given)}: {text}"
+    ctx = getattr(err, "ctx", None)
+    if ctx is not None:
+        text += f"; see {ctx.command_path} --help"
+    return OptionError(" ".join(text.split()))
+
+
+def expected_range(low, high) -> str:
+    """'1..1024', 'at least 1' or 'at most 0.5': a numeric option's range as a message says it."""
+    if low is not None and high is not None:
+        return f"{low:g}..{high:g}" if isinstance(low, float) or isinstance(high, float) else f"{low}..{high}"
+    return f"at least {low}" if low is not None else f"at most {high}"
+
+
+def _given(param, args: list[str]) -> str | None:
+    """The text given on the command line for ``param`` (its last occurrence), if any."""
+    found = None
+    for i, arg in enumerate(args):
+        for opt in getattr(param, "opts", []):
+            if arg == opt and i + 1 < len(args):
+                found = args[i + 1]
+            elif opt.startswith("--") and arg.startswith(opt + "="):
+                found = arg[len(opt) + 1:]
+    return found
+
+
 class _PlainHelp:
     """Help without type tags (``<bool>``, ``<list[int]>``): a flag shows nothing after its name,
     an option taking a value its metavar, by default the option's name in capitals as argparse
     writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``)."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        """Parse ``args``; a refused value or a misspelt option is one line (:func:`one_line`)."""
+        given = list(args)
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _USAGE_ERRORS as err:
+            if type(err).__name__ == "NoArgsIsHelpError":  # a bare command shows its help
+                raise
+            raise one_line(err, given) from None
 
     def get_params(self, ctx):
         params = super().get_params(ctx)
@@ -75,7 +145,15 @@ def describe_os_error(err: OSError) -> str:
 
 
 class Group(_PlainHelp, TyperGroup):
-    """A command group, with the same plain help."""
+    """A command group, with the same plain help and one-line usage errors."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except _USAGE_ERRORS as err:  # an unknown command
+            if type(err).__name__ == "NoArgsIsHelpError":
+                raise
+            raise one_line(err) from None
 
 
 def check_outputs(files: list[Path], overwrite: bool) -> None:

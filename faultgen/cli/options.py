@@ -9,6 +9,16 @@ from typing import Annotated
 
 import typer
 
+#: Upper bounds of the command-line counts (each far above any use, each keeping the work and its
+#: memory finite): cycles of a run, days of a record, samples, Q-limit folds, held-out pairs and
+#: label permutations.
+MAX_CYCLES = 1_000_000
+MAX_DAYS = 3650
+MAX_SAMPLES = 1_000_000
+MAX_FOLDS = 1000
+MAX_PAIRS = 100_000
+MAX_PERMUTATIONS = 10_000
+
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
@@ -54,7 +64,7 @@ TaskMixTasks = Annotated[str | None, typer.Option(
 TaskMixPattern = Annotated[str, typer.Option(
     help="Which task each cycle runs: alternate, blocks (10 cycles each) or random.")]
 CyclesPerDay = Annotated[int, typer.Option(
-    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).", min=1)]
+    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).", min=1, max=MAX_CYCLES)]
 StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.", min=0.0, max=366.0)]
 
 
