@@ -62,6 +62,7 @@ def bench_isolators_command(
       faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
     """
     from analysis import benchmark
+    from analysis import plugins as plugins_
 
     try:
         wear_levels = [float(x) for x in levels.split(",")]
@@ -75,7 +76,7 @@ def bench_isolators_command(
                            confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
-    isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
+    isolators.update({spec.rpartition(":")[2]: plugins_.load(spec, "isolator") for spec in plugins or []})
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
     written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
     written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
@@ -144,6 +145,7 @@ def detect_command(
       faultgen detect j2.h5 --protocol other-seeds -o j2-detection
     """
     from analysis import benchmark
+    from analysis import plugins as plugins_
 
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
@@ -151,7 +153,7 @@ def detect_command(
                    overwrite)
     table, charts = benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
-        detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
+        detector=plugins_.load(plugin, "detector") if plugin else None, protocol=protocol, first=first,
         limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
     written = benchmark.write_outputs(table, stem)
