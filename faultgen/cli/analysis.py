@@ -45,7 +45,8 @@ def bench_isolators_command(
         "--isolator", metavar="MODULE:CLASS",
         help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
              "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
-             "repeat for several.")] = None,
+             "repeat for several. The module is imported and so runs as code: name only modules you trust "
+             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -127,7 +128,8 @@ def detect_command(
         "--detector", metavar="MODULE:CLASS",
         help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
              "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
-             "current folder).")] = None,
+             "current folder). The module is imported and so runs as code: name only modules you trust "
+             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,

@@ -309,6 +309,10 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
                    f"longer (and memory: about 150 MB per worker); --jobs {cores} is as fast", err=True)
     if shared and not scheduler:
         raise ValueError("--shared-folder is for the workers of a Dask cluster: add --scheduler ADDRESS, or drop it")
+    if scheduler:  # a Dask scheduler must answer there, before any work
+        from faultgen.runs import cluster
+
+        cluster.probe(scheduler)
 
     def where(stats) -> None:
         tqdm.write(f"{stats.run_id}: {stats.worker}, {stats.total:.1f} s, worker peak {stats.memory / 1e6:.0f} MB")
