@@ -11,6 +11,7 @@ import typer
 from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
+from faultgen.data import atomic
 from faultgen.cli.options import (
     MAX_CYCLES, MAX_DAYS, MAX_FOLDS, MAX_PAIRS, MAX_PERMUTATIONS, MAX_SAMPLES, Overwrite, Progress, QAlpha,
 )
@@ -73,17 +74,19 @@ def bench_isolators_command(
         raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
     stem = out or file.with_name(file.stem + "-isolation")
     confusion_stem = stem.with_name(stem.name + "-confusion")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
-                           confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
+    written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
+               confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")]
+    analysis_input(file, written, overwrite)
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
     isolators.update({spec.rpartition(":")[2]: plugins_.load(spec, "isolator") for spec in plugins or []})
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
-    written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
-    written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
-    confusion = benchmark.isolation_confusion(table)
-    confusion.to_csv(confusion_stem.with_suffix(".csv"))
-    written += [confusion_stem.with_suffix(".csv"), benchmark.confusion_figure(confusion, confusion_stem.with_suffix(".png"))]
+    with atomic.output_set(written) as staged:  # all five outputs, or none
+        benchmark.write_outputs(table, staged(stem), benchmark.isolation_markdown(table))
+        benchmark.isolation_heatmap(table, staged(stem.with_suffix(".png")))
+        confusion = benchmark.isolation_confusion(table)
+        confusion.to_csv(staged(confusion_stem.with_suffix(".csv")))
+        benchmark.confusion_figure(confusion, staged(confusion_stem.with_suffix(".png")))
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
         typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
@@ -151,15 +154,17 @@ def detect_command(
 
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv],
-                   overwrite)
+    written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv]
+    analysis_input(file, written, overwrite)
     table, charts = benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
         detector=plugins_.load(plugin, "detector") if plugin else None, protocol=protocol, first=first,
         limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
-    written = benchmark.write_outputs(table, stem)
-    summary.to_csv(summary_csv)
+    with atomic.output_set(written) as staged:  # all four outputs, or none
+        benchmark.write_outputs(table, staged(stem))
+        summary.to_csv(staged(summary_csv))
+        benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(table, digits=4))
     typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
     typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
@@ -167,8 +172,7 @@ def detect_command(
     advice = benchmark.detection_advice(table, protocol)
     if advice:
         typer.echo(advice)
-    written.append(benchmark.detection_figure(charts, stem.with_suffix(".png")))
-    typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
+    typer.echo("wrote " + ", ".join(map(str, written)))
 
 
 @app.command("training-source", cls=Command)
@@ -225,7 +229,7 @@ def training_source_command(
                      + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
                      + "); there the model does not describe the robot, and a failing robot's alarms in the same "
                      "cell say nothing about its fault")
-    tukey = None
+    anova = tukey = None
     try:
         anova, tukey = ts.anova(cases), ts.tukey(cases)
     except ValueError as err:  # an empty cell: the cases and means stand, the tests cannot be run
@@ -235,12 +239,14 @@ def training_source_command(
         parts += ["Three-way ANOVA, type III (thesis Tables 4.2-4.4):\n\n" + benchmark.markdown(anova),
                   "Tukey HSD, failure against normal robots per training source and signal type (the starred bars "
                   "of thesis Figs. 4-4 to 4-6):\n\n" + benchmark.markdown(ts.failure_vs_normal(tukey))]
-        anova.to_csv(paths["anova"], index=False)
-        tukey.to_csv(paths["tukey"], index=False)
     text = "\n\n".join(parts)
-    cases.to_csv(paths["cases"], index=False)
-    paths["md"].write_text(text + "\n")
-    ts.figure(cases, paths["png"], marked=tukey)
+    with atomic.output_set(paths.values()) as staged:  # all outputs, or none
+        if tukey is not None:
+            anova.to_csv(staged(paths["anova"]), index=False)
+            tukey.to_csv(staged(paths["tukey"]), index=False)
+        cases.to_csv(staged(paths["cases"]), index=False)
+        staged(paths["md"]).write_text(text + "\n")
+        ts.figure(cases, staged(paths["png"]), marked=tukey)
     typer.echo(text)
     typer.echo("wrote " + ", ".join(map(str, paths.values())))
 
@@ -337,8 +343,9 @@ def classify_command(
                                                wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
                                                command=command, short=not (full or preprocessing))
     text = benchmark.markdown(table, digits=3) + "\n\n" + caption
-    benchmark.classification_tidy(table).to_csv(stem.with_suffix(".csv"), index=False)
-    stem.with_suffix(".md").write_text(text + "\n")
-    benchmark.classification_heatmap(table, stem.with_suffix(".png"), estimate)
+    with atomic.output_set([stem.with_suffix(s) for s in (".csv", ".md", ".png")]) as staged:  # all, or none
+        benchmark.classification_tidy(table).to_csv(staged(stem.with_suffix(".csv")), index=False)
+        staged(stem.with_suffix(".md")).write_text(text + "\n")
+        benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")), estimate)
     typer.echo(text)
     typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))
