@@ -86,3 +86,12 @@ def test_a_simulation_mujoco_warns_about_leaves_no_mujoco_log(tmp_path, monkeypa
                                  "--no-progress", "-o", "x.h5"])
     assert result.exit_code == 1 and "diverged" in result.output, result.output
     assert list(tmp_path.iterdir()) == []  # no MUJOCO_LOG.TXT, no output
+
+
+def test_a_failed_write_of_one_file_names_it(tmp_path):
+    target = tmp_path / "sw.toml"
+    with pytest.raises(OSError) as raised:
+        with atomic.atomic_path(target):
+            raise OSError(errno.ENOSPC, "No space left on device")  # as a write on a full disk: no file named
+    assert str(raised.value) == f"[Errno 28] cannot write {target}: No space left on device"
+    assert list(tmp_path.iterdir()) == []

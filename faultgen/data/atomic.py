@@ -47,8 +47,9 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         os.replace(tmp, path)
     except OSError as err:
         Path(tmp).unlink(missing_ok=True)
-        if err.filename is not None and Path(err.filename) == Path(tmp):
-            raise _naming(err, path) from None
+        named = (err.strerror or "").startswith("cannot write")  # hdf5_writer's error already names it
+        if (err.filename is None and not named) or (err.filename is not None and Path(err.filename) == Path(tmp)):
+            raise _naming(err, path) from None  # a full disk names no file: name the one asked for
         raise
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
