@@ -107,3 +107,13 @@ def test_a_numeric_option_is_taken_or_refused_in_one_line(command, option, value
     lines = result.output.strip().splitlines()  # a progress line ("reading FILE") may come first
     errors = [line for line in lines if line.startswith("error: ")]
     assert len(errors) == 1 and lines[-1] == errors[0], (value, lines)
+
+
+def test_a_library_message_of_several_lines_is_one_line(tmp_path):
+    model = tmp_path / "negative_mass.xml"  # MuJoCo's compiler error has a second line, "Element name ..."
+    model.write_text('<mujoco><worldbody><body><joint type="hinge"/><geom size="0.1" mass="-1"/></body>'
+                     "</worldbody></mujoco>")
+    result = runner.invoke(app, ["robots", str(model)])
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {model}: ") and "negative" in lines[0], lines

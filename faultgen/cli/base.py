@@ -105,7 +105,7 @@ class Command(_PlainHelp, TyperCommand):
     """A faultgen command: plain help, and the one error handler of the command line.
 
     An error the library raises for a user's input or file reaches the user as one line,
-    ``error: <message>``, and an exit code: the exception's ``exit_code`` where it has one (a
+    ``error: <message>`` (a message of several lines joined with "; "), and an exit code: the exception's ``exit_code`` where it has one (a
     broken dataset 1, a simulation that diverged 1, an interrupted sweep 130, whose message is
     printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done), 1 for an
     ``OSError`` (a full disk, a read-only folder: :func:`describe_os_error`). Any other exception is
@@ -125,7 +125,10 @@ class Command(_PlainHelp, TyperCommand):
             if code is None and not isinstance(err, ValueError):
                 raise
             prefix = getattr(err, "message_prefix", "error: ")
-            typer.echo(f"{prefix}{err}", err=True)
+            text = str(err)
+            if prefix:  # one line, whatever the library below wrote (MuJoCo's compiler adds "\nElement ...")
+                text = "; ".join(line.strip() for line in text.splitlines() if line.strip())
+            typer.echo(f"{prefix}{text}", err=True)
             raise typer.Exit(2 if code is None else code) from err
 
 
