@@ -6,6 +6,7 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
+from faultgen.model import robots
 from faultgen.operation import programs
 
 runner = CliRunner()
@@ -46,5 +47,6 @@ def test_a_program_value_out_of_range_is_refused_naming_file_and_key(exported, t
 def test_the_programs_the_project_ships_still_read(exported):
     program = programs.parse(exported, "irb6700")
     assert program.process == "point-to-point" and program.robot_name == "irb6700"
-    shipped = programs.read("robots/irb6700/programs/palletize.toml", "irb6700")
+    robot = robots.load("irb6700")
+    shipped = programs.read(robot.path.parent / "programs" / "palletize.toml", robot)
     assert shipped.process == "palletizing"
