@@ -1,5 +1,6 @@
-"""What every command shares: its help layout, its one error handler, and the checks of outputs
-and of the option values that several commands parse."""
+"""What every command shares: its help layout, its one error handler (a library's refusal and a
+parsing error alike one line, ``error: ...``), and the checks of outputs and of the option values
+that several commands parse."""
 
 from __future__ import annotations
 
@@ -17,9 +18,9 @@ _USAGE_ERRORS = (click.UsageError, _UsageError)
 
 
 class OptionError(_UsageError):
-    """A refused option value, argument or command name, shown as the one line every refusal of
-    the command line is: ``error: --period '1e20': Input should be a valid integer (expected
-    1..100000; faultgen detect --help)``, exit 2."""
+    """A refused option value, a misspelt option, a missing argument or an unknown command, shown
+    as the one line every refusal of the command line is (click showed a usage block and
+    ``Error: ...``): ``error: --jobs '0': expected 1..1024; see faultgen sweep --help``, exit 2."""
 
     exit_code = 2
 
@@ -37,7 +38,8 @@ def one_line(err: Exception, args: list[str] | None = None) -> OptionError:
         name = max(param.opts, key=len) if kind == "option" else param.name.upper()
         text = f"missing {kind} {name}"
     elif param is not None:
-        names = [n for n in getattr(param, "opts", []) if n.startswith("--")] or list(getattr(param, "opts", []))
+        opts = list(getattr(param, "opts", []))
+        names = [n for n in opts if n.startswith("--")] or opts
         name = max(names, key=len) if names else param.name.upper()
         given = _given(param, args or [])
         low, high = getattr(param, "min", None), getattr(param, "max", None)
@@ -73,7 +75,8 @@ def _given(param, args: list[str]) -> str | None:
 class _PlainHelp:
     """Help without type tags (``<bool>``, ``<list[int]>``): a flag shows nothing after its name,
     an option taking a value its metavar, by default the option's name in capitals as argparse
-    writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``)."""
+    writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``). And parsing
+    errors as one line (:func:`one_line`)."""
 
     def make_context(self, info_name, args, parent=None, **extra):
         """Parse ``args``; a refused value or a misspelt option is one line (:func:`one_line`)."""
@@ -105,11 +108,11 @@ class Command(_PlainHelp, TyperCommand):
     """A faultgen command: plain help, and the one error handler of the command line.
 
     An error the library raises for a user's input or file reaches the user as one line,
-    ``error: <message>`` (a message of several lines joined with "; "), and an exit code: the exception's ``exit_code`` where it has one (a
-    broken dataset 1, a simulation that diverged 1, an interrupted sweep 130, whose message is
-    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done), 1 for an
-    ``OSError`` (a full disk, a read-only folder: :func:`describe_os_error`). Any other exception is
-    a defect and keeps its traceback.
+    ``error: <message>`` (a message of several lines joined with "; "), and an exit code: the
+    exception's ``exit_code`` where it has one (a broken dataset 1, a simulation that diverged 1,
+    an interrupted sweep 130, whose message is printed as it is), else 2 for a ``ValueError``
+    (refused input: nothing was done), 1 for an ``OSError`` (a full disk, a read-only folder:
+    :func:`describe_os_error`). Any other exception is a defect and keeps its traceback.
     """
 
     def invoke(self, ctx: click.Context):
