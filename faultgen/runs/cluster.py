@@ -151,9 +151,11 @@ def check_address(address: str) -> tuple[str, str, int]:
 
 
 def probe(address: str, timeout: float | None = None) -> None:
-    """Check, in at most about ``2 * timeout`` seconds and before any Dask client is made, that a
-    Dask scheduler answers at ``address`` (a plain TCP address: its greeting, a Dask handshake
-    message, is read and checked; a TLS address is checked by the client's own handshake).
+    """Check, in at most about ``2 * timeout`` seconds (default :data:`PROBE_TIMEOUT`) and before
+    any Dask client is made, that a Dask scheduler answers at ``address``: its greeting, a Dask
+    handshake message, is read (over TLS with Dask's configured certificates for ``tls://``) and
+    checked, its announced length first, so that another server's bytes are never taken for the
+    length of a message to allocate (a web server's: 3 EiB).
 
     Raises
     ------
