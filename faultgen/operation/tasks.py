@@ -40,10 +40,6 @@ IK_STEP = 0.01  # s: knot step of the seam IK; the spline interpolates in betwee
 #: s: every move, dwell and seam lasts a whole number of these (the thesis's 4 ms sampling period,
 #: ch. 6.3.2), so a path sampled at any step that divides it is the same path.
 PLAN_PERIOD = 0.004
-#: The smallest speed or acceleration scale a task or program takes: 1 % of the limits (a robot's
-#: slowest override; below it the planner's arithmetic fails, RuckigError at 1e-300 and an
-#: invalid result at an acceleration scale of 1e-9, and a cycle would last hours).
-MIN_SCALE = 0.01
 SEAM_TOLERANCE = 5e-4  # m: largest allowed flange distance from the commanded seam point
 SEAM_LIMIT_TOLERANCE = 0.01  # relative excess over a velocity/acceleration limit allowed on the seam
 LIMIT_TOLERANCE = 1e-9  # relative (velocity, acceleration) and rad (position) elsewhere
@@ -535,6 +531,12 @@ _KEYS = {
         *("weave_amplitude", "weave_frequency", "standoff"),
     ),
 }
+
+
+#: The smallest speed or acceleration scale a task or program takes: 1 % of the limits (a robot's
+#: slowest override; below it the planner's arithmetic fails, RuckigError at 1e-300 and an
+#: invalid result at an acceleration scale of 1e-9, and a cycle would last hours).
+MIN_SCALE = 0.01
 
 
 def _numbers_only(value) -> bool:
