@@ -46,45 +46,6 @@ def axis_label(value: int) -> str:
     return {UNDECIDED: "undecided", TOO_FEW_CYCLES: "too few cycles"}.get(int(value), str(int(value)))
 
 
-def load_estimator(spec: str) -> object:
-    """A user's estimator from ``"package.module:Class"``, built with its defaults (``Class()``).
-
-    The module is imported as Python would, with the current folder searched first, so a file
-    ``mine.py`` beside the dataset serves as ``mine:MyIsolator``. The class must be a
-    scikit-learn estimator (``sklearn.base.BaseEstimator``, e.g. a subclass of
-    :class:`analysis.isolation.Isolator`), so that the benchmarks can ``clone`` it.
-
-    Raises
-    ------
-    ValueError
-        If ``spec`` is not ``module:Class``, the module cannot be imported, it has no such class,
-        or the class is not a scikit-learn estimator; the message names what is wrong.
-    """
-    import importlib
-    import os
-    import sys
-
-    from sklearn.base import BaseEstimator
-
-    module_name, _, class_name = spec.partition(":")
-    if not module_name or not class_name.isidentifier():
-        raise ValueError(f"plug-in {spec!r}: expected package.module:Class, e.g. mine:MyIsolator")
-    if os.getcwd() not in sys.path:
-        sys.path.insert(0, os.getcwd())
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as err:
-        raise ValueError(f"plug-in {spec!r}: cannot import {module_name!r} ({err}); put it in the current folder "
-                         "or on PYTHONPATH") from None
-    cls = getattr(module, class_name, None)
-    if not isinstance(cls, type):
-        raise ValueError(f"plug-in {spec!r}: module {module_name!r} has no class {class_name!r}")
-    if not issubclass(cls, BaseEstimator):
-        raise ValueError(f"plug-in {spec!r}: {class_name} is not a scikit-learn estimator; derive it from "
-                         "analysis.isolation.Isolator or sklearn.base.BaseEstimator")
-    return cls()
-
-
 def default_isolators(bins: Iterable[int] = (5, 10)) -> dict[str, object]:
     """Transfer entropy with each bin count (thesis ch. 6), cross-correlation (ch. 3.4.2), and the
     other registered isolators with their defaults."""

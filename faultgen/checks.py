@@ -22,3 +22,9 @@ def is_number(value, low: float = -np.inf, high: float = np.inf) -> bool:
     ``low..high``."""
     return (not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
             and bool(np.isfinite(value)) and low <= value <= high)
+
+
+#: The largest seed anywhere (command line, grid files, the library): the seeds NumPy's legacy
+#: generators and scikit-learn's ``random_state`` take (0..2**32 - 1), so one seed means the same
+#: run in every part of faultgen and fits an HDF5 integer attribute.
+MAX_SEED = 2**32 - 1

@@ -138,7 +138,7 @@ def test_bench_isolators_command_writes_csv_markdown_and_heatmap(small, tmp_path
 def test_bins_below_two_are_refused(small, tmp_path):
     result = runner.invoke(app, ["bench-isolators", str(small), "--bins", "1", "--no-progress", "-o", str(tmp_path / "x")])
     assert result.exit_code == 2
-    assert "bins = 1" in result.output
+    assert "--bins '1': expected 2..100" in result.output  # refused at the option, before any work
 
 
 def test_analysis_refuses_a_dataset_that_fails_validation(small, tmp_path):

@@ -86,7 +86,7 @@ def test_simulate_writes_a_file_that_reads_back(tmp_path):
         (["--task", "welding"], "unknown task 'welding'"),
         (["--wear", "7:exp4:20"], "axis 7 is out of range 1..6"),
         (["--wear", "2:exp4:-10"], "2:exp4:-10"),
-        (["--cycles", "0"], "'--cycles'"),  # typer's range: "Invalid value for '--cycles'"
+        (["--cycles", "0"], "--cycles '0': expected 1..1000000"),  # typer's range, as one line
         (["--friction", "coulomb"], "unknown friction model 'coulomb'"),
         (["--record", "1,x"], "--record part 'x'"),
     ],
@@ -196,7 +196,7 @@ ONE_RUN = ["--robot", "irb6700", "--task", "pick_place", "--axis", "0", "--no-pr
 
 
 @pytest.mark.parametrize(("args", "message"), [
-    (["--cycles", "0", "--record", "1"], "cycles = 0"),
+    (["--cycles", "0", "--record", "1"], "--cycles '0': expected 1..1000000"),
     (["--cycles", "2", "--record", ""], "--record part ''"),
     (["--cycles", "2", "--record", "1", "--friction", ""], "unknown friction model ''"),
 ])

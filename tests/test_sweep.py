@@ -279,11 +279,11 @@ def test_a_part_of_another_configuration_is_redone(tmp_path):
     [
         (["--axis", "7"], "worn axis 7 is out of range 0..6"),
         (["--task", "welding"], "unknown task 'welding'"),
-        (["--wear-pct", "-5", "--axis", "1"], "(--wear-pct): -5.0 % must be a finite number >= 0"),
+        (["--wear-pct", "-5", "--axis", "1"], "--wear-pct '-5': expected 0..500"),
         (["--schedule", "cubic", "--axis", "1"], "unknown wear schedule 'cubic'"),
         (["--record", "0,5"], "recorded cycle 0 is out of range"),
         (["--preset", "huge"], "unknown preset 'huge'"),
-        (["--preset", "quick", "--jobs", "0"], "'--jobs'"),  # typer's range: "Invalid value for '--jobs'"
+        (["--preset", "quick", "--jobs", "0"], "--jobs '0': expected 1..1024"),  # typer's range, as one line
     ],
 )
 def test_invalid_grid_is_refused_before_any_simulation(tmp_path, args, message):

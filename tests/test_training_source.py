@@ -1,6 +1,7 @@
 """The training-source study of thesis ch. 4: signals and descriptors by hand, the ANOVA against
 hand sums of squares, Tukey's HSD against SciPy's, and `faultgen training-source` on a small fleet."""
 
+import errno
 import numpy as np
 import pandas as pd
 import pytest
@@ -114,8 +115,18 @@ def test_training_source_command_on_a_small_fleet(tmp_path):
     assert refused.exit_code == 2
     assert "has 14 records, the study needs 60" in refused.output and "faultgen fleet" in refused.output
     assert not list(tmp_path.glob("ch4*"))
-    result = runner.invoke(app, ["training-source", str(fleet), "-o", str(stem), "--training-days", "9",
-                                 "--test-days", "3", "--gap-days", "1", "--no-progress"])
+    args = ["training-source", str(fleet), "-o", str(stem), "--training-days", "9", "--test-days", "3", "--gap-days",
+            "1", "--no-progress"]
+
+    def disk_full(cases, out, marked=None):  # the last of the five writes fails as on a full disk
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(ts, "figure", disk_full)
+        failed = runner.invoke(app, args)
+    assert failed.exit_code == 1 and "No space left on device" in failed.output, failed.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fleet.h5"]  # none of the outputs (issue 50 item 6)
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     for suffix in ("-cases.csv", "-anova.csv", "-tukey.csv", ".md", ".png"):
         assert stem.with_name("ch4" + suffix).stat().st_size > 0

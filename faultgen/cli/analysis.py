@@ -8,9 +8,13 @@ from typing import Annotated
 
 import typer
 
+from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
-from faultgen.cli.options import Overwrite, Progress, QAlpha
+from faultgen.data import atomic
+from faultgen.cli.options import (
+    MAX_CYCLES, MAX_DAYS, MAX_FOLDS, MAX_PAIRS, MAX_PERMUTATIONS, MAX_SAMPLES, Overwrite, Progress, QAlpha,
+)
 
 
 def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
@@ -31,7 +35,7 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
 @app.command("bench-isolators", cls=Command)
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
-    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.")] = None,
+    bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.", min=2, max=100)] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
     speed_window: Annotated[str | None, typer.Option(
         metavar="LOW,HIGH",
@@ -42,7 +46,8 @@ def bench_isolators_command(
         "--isolator", metavar="MODULE:CLASS",
         help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
              "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
-             "repeat for several.")] = None,
+             "repeat for several. The module is imported and so runs as code: name only modules you trust "
+             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -59,6 +64,7 @@ def bench_isolators_command(
       faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
     """
     from analysis import benchmark
+    from analysis import plugins as plugins_
 
     try:
         wear_levels = [float(x) for x in levels.split(",")]
@@ -68,17 +74,19 @@ def bench_isolators_command(
         raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
     stem = out or file.with_name(file.stem + "-isolation")
     confusion_stem = stem.with_name(stem.name + "-confusion")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
-                           confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")], overwrite)
+    written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
+               confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")]
+    analysis_input(file, written, overwrite)
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
-    isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
+    isolators.update({spec.rpartition(":")[2]: plugins_.load(spec, "isolator") for spec in plugins or []})
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
-    written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
-    written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
-    confusion = benchmark.isolation_confusion(table)
-    confusion.to_csv(confusion_stem.with_suffix(".csv"))
-    written += [confusion_stem.with_suffix(".csv"), benchmark.confusion_figure(confusion, confusion_stem.with_suffix(".png"))]
+    with atomic.output_set(written) as staged:  # all five outputs, or none
+        benchmark.write_outputs(table, staged(stem), benchmark.isolation_markdown(table))
+        benchmark.isolation_heatmap(table, staged(stem.with_suffix(".png")))
+        confusion = benchmark.isolation_confusion(table)
+        confusion.to_csv(staged(confusion_stem.with_suffix(".csv")))
+        benchmark.confusion_figure(confusion, staged(confusion_stem.with_suffix(".png")))
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
         typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
@@ -107,23 +115,24 @@ def detect_command(
              "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
              "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
              "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
-    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1)] = 20,
+    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1, max=MAX_SAMPLES)] = 20,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)] = 0.75,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
              "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
-             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0)] = 20,
+             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0, max=MAX_FOLDS)] = 20,
     persistence: Annotated[
         int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
-                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1)
+                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1, max=MAX_SAMPLES)
     ] = 3,
-    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1)] = None,
+    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1, max=MAX_CYCLES)] = None,
     plugin: Annotated[str | None, typer.Option(
         "--detector", metavar="MODULE:CLASS",
         help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
              "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
-             "current folder).")] = None,
+             "current folder). The module is imported and so runs as code: name only modules you trust "
+             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -141,18 +150,21 @@ def detect_command(
       faultgen detect j2.h5 --protocol other-seeds -o j2-detection
     """
     from analysis import benchmark
+    from analysis import plugins as plugins_
 
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
-    analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv],
-                   overwrite)
+    written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv]
+    analysis_input(file, written, overwrite)
     table, charts = benchmark.detection_table(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
-        detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
+        detector=plugins_.load(plugin, "detector") if plugin else None, protocol=protocol, first=first,
         limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
-    written = benchmark.write_outputs(table, stem)
-    summary.to_csv(summary_csv)
+    with atomic.output_set(written) as staged:  # all four outputs, or none
+        benchmark.write_outputs(table, staged(stem))
+        summary.to_csv(staged(summary_csv))
+        benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(table, digits=4))
     typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
     typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
@@ -160,22 +172,21 @@ def detect_command(
     advice = benchmark.detection_advice(table, protocol)
     if advice:
         typer.echo(advice)
-    written.append(benchmark.detection_figure(charts, stem.with_suffix(".png")))
-    typer.echo("wrote " + ", ".join(map(str, [*written, summary_csv])))
+    typer.echo("wrote " + ", ".join(map(str, written)))
 
 
 @app.command("training-source", cls=Command)
 def training_source_command(
     file: Annotated[Path, typer.Argument(help="A fleet (`faultgen fleet`): daily records of failing and normal robots.")],
-    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).", min=2)] = 40,
-    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).", min=1)] = 15,
-    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0)] = 5,
+    training_days: Annotated[int, typer.Option(help="Days each PCA model learns (thesis ch. 4.3.2: 40).", min=2, max=MAX_DAYS)] = 40,
+    test_days: Annotated[int, typer.Option(help="Days tested after them (thesis: 15).", min=1, max=MAX_DAYS)] = 15,
+    gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0, max=MAX_DAYS)] = 5,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).", min=0.0, max=1.0)] = 0.90,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
         help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
              "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
-             "many as the training days.", min=0)] = 20,
+             "many as the training days.", min=0, max=MAX_FOLDS)] = 20,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -218,7 +229,7 @@ def training_source_command(
                      + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
                      + "); there the model does not describe the robot, and a failing robot's alarms in the same "
                      "cell say nothing about its fault")
-    tukey = None
+    anova = tukey = None
     try:
         anova, tukey = ts.anova(cases), ts.tukey(cases)
     except ValueError as err:  # an empty cell: the cases and means stand, the tests cannot be run
@@ -228,12 +239,14 @@ def training_source_command(
         parts += ["Three-way ANOVA, type III (thesis Tables 4.2-4.4):\n\n" + benchmark.markdown(anova),
                   "Tukey HSD, failure against normal robots per training source and signal type (the starred bars "
                   "of thesis Figs. 4-4 to 4-6):\n\n" + benchmark.markdown(ts.failure_vs_normal(tukey))]
-        anova.to_csv(paths["anova"], index=False)
-        tukey.to_csv(paths["tukey"], index=False)
     text = "\n\n".join(parts)
-    cases.to_csv(paths["cases"], index=False)
-    paths["md"].write_text(text + "\n")
-    ts.figure(cases, paths["png"], marked=tukey)
+    with atomic.output_set(paths.values()) as staged:  # all outputs, or none
+        if tukey is not None:
+            anova.to_csv(staged(paths["anova"]), index=False)
+            tukey.to_csv(staged(paths["tukey"]), index=False)
+        cases.to_csv(staged(paths["cases"]), index=False)
+        staged(paths["md"]).write_text(text + "\n")
+        ts.figure(cases, staged(paths["png"]), marked=tukey)
     typer.echo(text)
     typer.echo("wrote " + ", ".join(map(str, paths.values())))
 
@@ -241,12 +254,12 @@ def training_source_command(
 @app.command("classify", cls=Command)
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
-    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0)] = 10.0,
-    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0)] = 20,
+    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0, max=500.0)] = 10.0,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0, max=MAX_PAIRS)] = 20,
     horizon: Annotated[int | None, typer.Option(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
-        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0)] = None,
+        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0, max=MAX_DAYS)] = None,
     matched_days: Annotated[bool, typer.Option(
         "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
         "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
@@ -255,7 +268,7 @@ def classify_command(
     permutations: Annotated[int, typer.Option(
         help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
         "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
-        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0)] = 0,
+        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0, max=MAX_PERMUTATIONS)] = 0,
     classifiers: Annotated[list[str] | None, typer.Option(
         "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")] = None,
     preprocessing: Annotated[list[str] | None, typer.Option(
@@ -265,11 +278,11 @@ def classify_command(
         "--full", help="Every row: Table 5.2's fifteen and four more (+var5, +diff+var3, +diff+var5+pca, "
         "+estM+diff+var5+pca), 2 to 3 times the time. Default seven rows, each step alone and the fullest "
         "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
-    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
+    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.", min=0, max=MAX_SEED)] = 0,
     chance: Annotated[bool, typer.Option(
         help="Without --permutations, estimate the chance level cheaply on one cell (lr control, "
         "5 label exchanges, on quick.h5 2 % of the default table's CPU time) and give it in the caption.")] = True,
-    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0)] = 0,
+    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0, max=1024)] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -330,8 +343,9 @@ def classify_command(
                                                wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
                                                command=command, short=not (full or preprocessing))
     text = benchmark.markdown(table, digits=3) + "\n\n" + caption
-    benchmark.classification_tidy(table).to_csv(stem.with_suffix(".csv"), index=False)
-    stem.with_suffix(".md").write_text(text + "\n")
-    benchmark.classification_heatmap(table, stem.with_suffix(".png"), estimate)
+    with atomic.output_set([stem.with_suffix(s) for s in (".csv", ".md", ".png")]) as staged:  # all, or none
+        benchmark.classification_tidy(table).to_csv(staged(stem.with_suffix(".csv")), index=False)
+        staged(stem.with_suffix(".md")).write_text(text + "\n")
+        benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")), estimate)
     typer.echo(text)
     typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))

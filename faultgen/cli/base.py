@@ -1,5 +1,6 @@
-"""What every command shares: its help layout, its one error handler, and the checks of outputs
-and of the option values that several commands parse."""
+"""What every command shares: its help layout, its one error handler (a library's refusal and a
+parsing error alike one line, ``error: ...``), and the checks of outputs and of the option values
+that several commands parse."""
 
 from __future__ import annotations
 
@@ -10,10 +11,82 @@ import typer
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 
+#: The usage error the command line raises and catches: typer's own copy of click's where typer
+#: carries one (typer >= 0.29), else click's.
+_UsageError = next(cls for cls in typer.BadParameter.__mro__ if cls.__name__ == "UsageError")
+_USAGE_ERRORS = (click.UsageError, _UsageError)
+
+
+class OptionError(_UsageError):
+    """A refused option value, a misspelt option, a missing argument or an unknown command, shown
+    as the one line every refusal of the command line is (click showed a usage block and
+    ``Error: ...``): ``error: --jobs '0': expected 1..1024; see faultgen sweep --help``, exit 2."""
+
+    exit_code = 2
+
+    def show(self, file=None) -> None:
+        typer.echo(f"error: {self.message}", err=True)
+
+
+def one_line(err: Exception, args: list[str] | None = None) -> OptionError:
+    """The :class:`OptionError` of a click usage error: the option, the value given (found in
+    ``args``), the reason, the expected range (a typer ``min``/``max``) and where help is."""
+    param = getattr(err, "param", None)
+    text = (getattr(err, "message", None) or str(err)).rstrip(".")
+    if type(err).__name__ == "MissingParameter" and param is not None:
+        kind = "option" if getattr(param, "opts", [""])[0].startswith("-") else "argument"
+        name = max(param.opts, key=len) if kind == "option" else param.name.upper()
+        text = f"missing {kind} {name}"
+    elif param is not None:
+        opts = list(getattr(param, "opts", []))
+        names = [n for n in opts if n.startswith("--")] or opts
+        name = max(names, key=len) if names else param.name.upper()
+        given = _given(param, args or [])
+        low, high = getattr(param, "min", None), getattr(param, "max", None)
+        if low is not None or high is not None:  # typer's "Input should be less than ..." says half of it
+            text = "" if text.startswith("Input should be ") and " than " in text else f"{text}; "
+            text += f"expected {expected_range(low, high)}"
+        text = f"{name}{'' if given is None else ' ' + repr(given)}: {text}"
+    ctx = getattr(err, "ctx", None)
+    if ctx is not None:
+        text += f"; see {ctx.command_path} --help"
+    return OptionError(" ".join(text.split()))
+
+
+def expected_range(low, high) -> str:
+    """'1..1024', 'at least 1' or 'at most 0.5': a numeric option's range as a message says it."""
+    if low is not None and high is not None:
+        return f"{low:g}..{high:g}" if isinstance(low, float) or isinstance(high, float) else f"{low}..{high}"
+    return f"at least {low}" if low is not None else f"at most {high}"
+
+
+def _given(param, args: list[str]) -> str | None:
+    """The text given on the command line for ``param`` (its last occurrence), if any."""
+    found = None
+    for i, arg in enumerate(args):
+        for opt in getattr(param, "opts", []):
+            if arg == opt and i + 1 < len(args):
+                found = args[i + 1]
+            elif opt.startswith("--") and arg.startswith(opt + "="):
+                found = arg[len(opt) + 1:]
+    return found
+
+
 class _PlainHelp:
     """Help without type tags (``<bool>``, ``<list[int]>``): a flag shows nothing after its name,
     an option taking a value its metavar, by default the option's name in capitals as argparse
-    writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``)."""
+    writes it (``--cycles CYCLES``), and an argument its name in capitals (``FILE``). And parsing
+    errors as one line (:func:`one_line`)."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        """Parse ``args``; a refused value or a misspelt option is one line (:func:`one_line`)."""
+        given = list(args)
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except _USAGE_ERRORS as err:
+            if type(err).__name__ == "NoArgsIsHelpError":  # a bare command shows its help
+                raise
+            raise one_line(err, given) from None
 
     def get_params(self, ctx):
         params = super().get_params(ctx)
@@ -35,11 +108,11 @@ class Command(_PlainHelp, TyperCommand):
     """A faultgen command: plain help, and the one error handler of the command line.
 
     An error the library raises for a user's input or file reaches the user as one line,
-    ``error: <message>``, and an exit code: the exception's ``exit_code`` where it has one (a
-    broken dataset 1, a simulation that diverged 1, an interrupted sweep 130, whose message is
-    printed as it is), else 2 for a ``ValueError`` (refused input: nothing was done), 1 for an
-    ``OSError`` (a full disk, a read-only folder: :func:`describe_os_error`). Any other exception is
-    a defect and keeps its traceback.
+    ``error: <message>`` (a message of several lines joined with "; "), and an exit code: the
+    exception's ``exit_code`` where it has one (a broken dataset 1, a simulation that diverged 1,
+    an interrupted sweep 130, whose message is printed as it is), else 2 for a ``ValueError``
+    (refused input: nothing was done), 1 for an ``OSError`` (a full disk, a read-only folder:
+    :func:`describe_os_error`). Any other exception is a defect and keeps its traceback.
     """
 
     def invoke(self, ctx: click.Context):
@@ -55,7 +128,10 @@ class Command(_PlainHelp, TyperCommand):
             if code is None and not isinstance(err, ValueError):
                 raise
             prefix = getattr(err, "message_prefix", "error: ")
-            typer.echo(f"{prefix}{err}", err=True)
+            text = str(err)
+            if prefix:  # one line, whatever the library below wrote (MuJoCo's compiler adds "\nElement ...")
+                text = "; ".join(line.strip() for line in text.splitlines() if line.strip())
+            typer.echo(f"{prefix}{text}", err=True)
             raise typer.Exit(2 if code is None else code) from err
 
 
@@ -75,7 +151,15 @@ def describe_os_error(err: OSError) -> str:
 
 
 class Group(_PlainHelp, TyperGroup):
-    """A command group, with the same plain help."""
+    """A command group, with the same plain help and one-line usage errors."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except _USAGE_ERRORS as err:  # an unknown command
+            if type(err).__name__ == "NoArgsIsHelpError":
+                raise
+            raise one_line(err) from None
 
 
 def check_outputs(files: list[Path], overwrite: bool) -> None:

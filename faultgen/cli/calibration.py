@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_output_folder
 from faultgen.cli.main import app
 from faultgen.cli.options import Overwrite
@@ -64,11 +65,11 @@ def calibrate_command(
 def excitation_command(
     robot: Annotated[str, typer.Argument(help="Robot name (see `faultgen robots`) or MJCF file.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="CSV file to write: columns t, q1..qN (s, rad).")],
-    period: Annotated[float, typer.Option(help="Fundamental period of the Fourier series, s.")] = 10.0,
-    harmonics: Annotated[int, typer.Option(help="Harmonics of the Fourier series.")] = 5,
-    iterations: Annotated[int, typer.Option(help="Most optimiser iterations.")] = 8,
-    seed: Annotated[int, typer.Option(help="Seed of the optimiser's random starts.")] = 0,
-    starts: Annotated[int, typer.Option(help="Random starts scored; the best is optimised.", min=1)] = 8,
+    period: Annotated[float, typer.Option(help="Fundamental period of the Fourier series, s.", min=0.1, max=600.0)] = 10.0,
+    harmonics: Annotated[int, typer.Option(help="Harmonics of the Fourier series.", min=1, max=50)] = 5,
+    iterations: Annotated[int, typer.Option(help="Most optimiser iterations.", min=0, max=1000)] = 8,
+    seed: Annotated[int, typer.Option(help="Seed of the optimiser's random starts.", min=0, max=MAX_SEED)] = 0,
+    starts: Annotated[int, typer.Option(help="Random starts scored; the best is optimised.", min=1, max=1000)] = 8,
     overwrite: Overwrite = False,
 ) -> None:
     """Design a periodic excitation on which a torque log tells the calibration's effects apart.

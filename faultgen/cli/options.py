@@ -9,14 +9,41 @@ from typing import Annotated
 
 import typer
 
+#: Upper bounds of the command-line counts (each far above any use, each keeping the work and its
+#: memory finite): cycles of a run, days of a record, samples, Q-limit folds, held-out pairs and
+#: label permutations.
+MAX_CYCLES = 1_000_000
+MAX_DAYS = 3650
+MAX_SAMPLES = 1_000_000
+MAX_FOLDS = 1000
+MAX_PAIRS = 100_000
+MAX_PERMUTATIONS = 10_000
+
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
 Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run is started; more than the CPU cores only slows each down).", min=1, max=1024)]
+
+
+def _scheduler_address(value: str | None) -> str | None:
+    """The ``--scheduler`` address, its form checked before any work (typer callback)."""
+    if value is not None:
+        from faultgen.runs import cluster
+
+        try:
+            cluster.check_address(value)
+        except ValueError as err:
+            raise typer.BadParameter(str(err)) from None
+    return value
+
+
 Scheduler = Annotated[str | None, typer.Option(
-    help="Run on the Dask cluster of this scheduler (tcp://host:port) instead of local processes: its workers need "
-    "faultgen, not OUT's folder; each run comes back to this process, which writes it (docs/dataset.md, "
-    "\"Running on a cluster\").")]
+    callback=_scheduler_address,
+    help="Run on the Dask cluster of this scheduler (tcp://HOST:PORT, or tls://HOST:PORT with Dask's TLS "
+    "configuration) instead of local processes: its workers need faultgen, not OUT's folder; each run comes back "
+    "to this process, which writes it (docs/dataset.md, \"Running on a cluster\"). Dask sends tasks and results "
+    "as pickles, which run code when read: name only a scheduler you trust, on a network you trust, or use TLS "
+    "(docs/reliability.md, \"Threat model\"). An address where no Dask scheduler answers is refused in seconds.")]
 SharedFolder = Annotated[bool, typer.Option(
     "--shared-folder", help="With --scheduler: the workers write their runs into OUT's folder themselves, which "
     "they must all see at the same absolute path (a shared file system; checked first): the client then only merges "
@@ -54,7 +81,7 @@ TaskMixTasks = Annotated[str | None, typer.Option(
 TaskMixPattern = Annotated[str, typer.Option(
     help="Which task each cycle runs: alternate, blocks (10 cycles each) or random.")]
 CyclesPerDay = Annotated[int, typer.Option(
-    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).", min=1)]
+    help="Recorded cycles per day of the robot's life (the calendar of the temperature; default: one a day).", min=1, max=MAX_CYCLES)]
 StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.", min=0.0, max=366.0)]
 
 

@@ -16,6 +16,9 @@ from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import folder, importers, robots
 from faultgen.operation import taskgen
 
+#: The largest rated payload `robots add --payload` takes, kg.
+MAX_PAYLOAD = 10_000.0
+
 
 @app.command("robots", cls=Command)
 def robots_command(
@@ -36,7 +39,8 @@ def robots_command(
     ] = None,
     payload: Annotated[
         float | None,
-        typer.Option(help="With `add`: rated payload in kg (default: the source's, else sized)."),
+        typer.Option(help="With `add`: rated payload in kg, 0..10000 (the largest industrial arms carry about 2300; "
+                          "default: the source's, else sized).", min=0.0, max=MAX_PAYLOAD),
     ] = None,
     out: Annotated[
         Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")

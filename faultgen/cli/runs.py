@@ -10,11 +10,12 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_cycles
 from faultgen.cli.main import app
 from faultgen.cli.options import (
-    CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress, Scheduler,
-    SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
+    MAX_CYCLES, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress,
+    Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
 )
 
 
@@ -34,12 +35,12 @@ def simulate_command(
             "for several axes. No --wear: no wear."
         ),
     ] = None,
-    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.", min=1)] = 100,
+    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.", min=1, max=MAX_CYCLES)] = 100,
     record: Annotated[
         str | None,
         typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.", min=0)] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.", min=0, max=MAX_SEED)] = 0,
     disturbance: Annotated[
         float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).", min=0.0, max=1.0)
     ] = 0.01,
@@ -114,13 +115,13 @@ def sweep_command(
     ] = None,
     robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")] = None,
     tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s): a thesis task name, a program file (.toml) or a joint log (.csv); repeat for several.")] = None,
-    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.")] = None,
-    increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.")] = None,
+    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.", min=0, max=7)] = None,
+    increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.", min=0.0, max=500.0)] = None,
     schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
     friction_model: Friction = None,
-    cycles: Annotated[int | None, typer.Option(help="Cycles per run.")] = None,
+    cycles: Annotated[int | None, typer.Option(help="Cycles per run.", min=1, max=MAX_CYCLES)] = None,
     record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
-    seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.")] = None,
+    seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.", min=0, max=MAX_SEED)] = None,
     fault: Annotated[str | None, typer.Option(
         help="Instead of friction wear, each worn axis gets this fault: EFFECT:PARAMETER:FINAL[:key=value,...], "
         "e.g. backlash:width:0.01 or cogging:amplitude:0.05:poles=8 (see `simulate --fault`).")] = None,
@@ -205,7 +206,7 @@ def sweep_command(
 @app.command("fleet", cls=Command)
 def fleet_command(
     size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).", min=2, max=10000)] = 26,
-    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).", min=1)] = 13,
+    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).", min=1, max=10000)] = 13,
     models: Annotated[list[str] | None, typer.Option(
         "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
         "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
@@ -216,7 +217,7 @@ def fleet_command(
     failure_wear: Annotated[float, typer.Option(
         help="Coulomb and static friction increase of the failing axis on the failure day, %.", min=0.0,
         max=500.0)] = 50.0,
-    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.", min=0)] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.", min=0, max=MAX_SEED)] = 0,
     conditions: Annotated[bool, typer.Option(
         help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
         "process and fault.")] = True,
@@ -308,6 +309,10 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
                    f"longer (and memory: about 150 MB per worker); --jobs {cores} is as fast", err=True)
     if shared and not scheduler:
         raise ValueError("--shared-folder is for the workers of a Dask cluster: add --scheduler ADDRESS, or drop it")
+    if scheduler:  # a Dask scheduler must answer there, before any work
+        from faultgen.runs import cluster
+
+        cluster.probe(scheduler)
 
     def where(stats) -> None:
         tqdm.write(f"{stats.run_id}: {stats.worker}, {stats.total:.1f} s, worker peak {stats.memory / 1e6:.0f} MB")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import glob
 import logging
 import os
@@ -9,7 +10,7 @@ import re
 import shutil
 import socket
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -35,15 +36,94 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     if not folder.is_dir():
         raise OSError(f"cannot write {path}: folder {folder} does not exist")
     remove_stale(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder)
+    except OSError as err:  # a read-only folder: name the file asked for, not the hidden temporary one
+        raise _naming(err, path) from None
     os.close(fd)
     try:
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file normal permissions
         os.replace(tmp, path)
+    except OSError as err:
+        Path(tmp).unlink(missing_ok=True)
+        named = (err.strerror or "").startswith("cannot write")  # hdf5_writer's error already names it
+        if (err.filename is None and not named) or (err.filename is not None and Path(err.filename) == Path(tmp)):
+            raise _naming(err, path) from None  # a full disk names no file: name the one asked for
+        raise
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _naming(err: OSError, path: Path | str) -> OSError:
+    """``err`` as an OSError naming ``path`` (the output a user asked for) instead of a hidden
+    temporary file or folder beside it, with the same errno."""
+    reason = err.strerror or str(err)
+    return OSError(err.errno, f"cannot write {path}: {reason}")
+
+
+@contextmanager
+def output_set(paths: Iterable[str | Path]) -> Iterator[Callable[[str | Path], Path]]:
+    """Write the outputs of one command as a set: all of them appear, or none.
+
+    Yields ``staged``: ``staged(target)`` is where to write ``target`` (any file in the folder of
+    one of ``paths``; a stem a writer extends with suffixes works too): a hidden folder beside it
+    (``.<name>.<pid>@<host>.<random>.part``, named after the first of ``paths`` in that folder).
+    When the block succeeds, every file written there is renamed onto its target, each rename
+    replacing an existing file; on any exception nothing is renamed (earlier outputs of the same
+    names are untouched), the hidden folders are removed, and an ``OSError`` about a staged file
+    names its target instead. A kill leaves only the hidden folders, which the next write of the
+    same outputs removes (:func:`remove_stale`). Only a kill during the renames themselves (one
+    system call per file, after every file is complete) can leave part of a set.
+
+    Raises
+    ------
+    OSError
+        If a folder does not exist or cannot be written, or a write failed (naming the target).
+    """
+    targets = [Path(p) for p in paths]
+    stages: dict[Path, Path] = {}
+    try:
+        for target in targets:
+            folder = target.parent if str(target.parent) else Path(".")
+            if folder in stages:
+                continue
+            if not folder.is_dir():
+                raise OSError(errno.ENOENT, f"cannot write {target}: folder {folder} does not exist")
+            for other in targets:
+                remove_stale(other)
+            try:
+                stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.{os.getpid()}@{_host()}.", suffix=".part",
+                                              dir=folder))
+            except OSError as err:
+                raise _naming(err, target) from None
+            os.chmod(stage, 0o777 & ~_umask())
+            stages[folder] = stage
+
+        def staged(path: str | Path) -> Path:
+            path = Path(path)
+            folder = path.parent if str(path.parent) else Path(".")
+            if folder not in stages:
+                raise ValueError(f"{path} is not in the folder of an output of this set ({', '.join(map(str, targets))})")
+            return stages[folder] / path.name
+
+        try:
+            yield staged
+        except OSError as err:
+            for folder, stage in stages.items():
+                if err.filename is not None and Path(err.filename).parent == stage:
+                    raise _naming(err, folder / Path(err.filename).name) from None
+            if err.filename is None:  # a failed write names no file (ENOSPC, EFBIG): name the set
+                raise _naming(err, ", ".join(map(str, targets))) from None
+            raise
+        for folder, stage in stages.items():
+            for entry in sorted(stage.iterdir()):
+                os.chmod(entry, 0o666 & ~_umask())
+                os.replace(entry, folder / entry.name)
+    finally:
+        for stage in stages.values():
+            shutil.rmtree(stage, ignore_errors=True)
 
 
 @contextmanager
@@ -65,7 +145,10 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     if not folder.is_dir():
         raise OSError(f"cannot write {path}: folder {folder} does not exist")
     remove_stale(path)
-    staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder))
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder))
+    except OSError as err:  # a read-only folder: name the folder asked for, not the hidden one
+        raise _naming(err, path) from None
     try:
         os.chmod(staging, 0o777 & ~_umask())
         yield staging
@@ -235,9 +318,6 @@ def check_writable(path: str | Path, needed: int = 0) -> None:
     OSError
         Naming the folder and the reason (errno ENOENT, EROFS, EACCES, ENOSPC, ...).
     """
-    import errno
-    import shutil
-
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
@@ -245,7 +325,10 @@ def check_writable(path: str | Path, needed: int = 0) -> None:
     try:
         fd, probe = tempfile.mkstemp(prefix=f".{path.name}.probe.", dir=folder)
     except OSError as err:
-        raise OSError(err.errno, f"cannot write in {folder}: {err.strerror}") from None
+        reason = err.strerror
+        if err.errno == errno.ENOENT:  # the folder exists, yet a file cannot be made in it (/proc)
+            reason = "this folder takes no new files (a virtual file system such as /proc or /sys)"
+        raise OSError(err.errno, f"cannot write in {folder}: {reason}") from None
     try:
         os.close(fd)
     finally:

@@ -74,6 +74,12 @@ SEGMENT_KEYS = {
     "grip": ("mass", "size", "com", "inertia"),
     "release": (),
 }
+#: What a program's ``process`` key may say (a label the user reads; the motion is the segments'):
+#: the thesis's three processes (ch. 6.3.1), the robot applications of industry, or "program", the
+#: default. A closed list, so that a typo or a stray value is refused, naming the key.
+PROGRAM_PROCESSES = (*PROCESSES.values(), "program", "handling", "pick and place", "palletizing", "packaging",
+                     "machine tending", "assembly", "spot welding", "arc welding", "laser welding", "cutting",
+                     "painting", "dispensing", "gluing", "grinding", "polishing", "deburring", "inspection")
 TOP_KEYS = ("name", "robot", "process", "description", "start", "velocity_scale", "acceleration_scale", "limits",
             "tool", "segment")
 LIMIT_KEYS = ("velocity", "acceleration", "jerk")
@@ -571,6 +577,13 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
         raise ProgramError(str(err)) from None
     top = _Values(where, "", data, TOP_KEYS)
     name = top.text("name")
+    if "robot" in data:
+        _check_robot(top, robot)
+    process = "program"
+    if "process" in data:
+        process = top.text("process")
+        if process not in PROGRAM_PROCESSES:
+            top.fail("process", f"{process!r} is not a process; expected one of {', '.join(PROGRAM_PROCESSES)}")
     limits = _limits(data, robot, where)
     start = top.angles("start", robot)
     tool = _Values(where, "[tool] ", data.get("tool", {}), TOOL_KEYS)
@@ -591,11 +604,21 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
         first = next(s for s in segments if s.type in ("linear", "circular", "seam", "move") and "to" not in s.values)
         raise ProgramError(f"{where}: {first.name}: a Cartesian target needs the tool orientation; add [tool] z and x")
     return Program(
-        name=name, robot_name=robot.name, process=str(data.get("process", "program")), source=source, text=text,
+        name=name, robot_name=robot.name, process=process, source=source, text=text,
         velocity_limit=limits[0], acceleration_limit=limits[1], jerk_limit=limits[2], start=start,
         velocity_scale=top.fraction("velocity_scale", 1.0), acceleration_scale=top.fraction("acceleration_scale", 1.0),
         tool_rotation=rotation, tool_offset=offset, segments=segments, robot=robot,
     )
+
+
+def _check_robot(top: "_Values", robot: Robot) -> None:
+    """Refuse a program whose ``robot`` key names another robot than the one it runs on (its joint
+    angles, poses and limits were written for that robot). A model ``faultgen calibrate`` wrote,
+    ``<robot>_calibrated``, runs the programs of ``<robot>``."""
+    named = top.text("robot")
+    if robot.name not in (named, f"{named}_calibrated"):
+        top.fail("robot", f"the program is for {named!r}, not for {robot.name!r} (its angles, poses and limits are "
+                          f"that robot's); run it with --robot {named}, or write {robot.name!r} there")
 
 
 def _limits(data: dict, robot: Robot, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

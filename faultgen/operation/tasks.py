@@ -558,6 +558,19 @@ _KEYS = {
 }
 
 
+#: The smallest speed or acceleration scale a task or program takes: 1 % of the limits (a robot's
+#: slowest override; below it the planner's arithmetic fails, RuckigError at 1e-300 and an
+#: invalid result at an acceleration scale of 1e-9, and a cycle would last hours).
+MIN_SCALE = 0.01
+
+
+def _numbers_only(value) -> bool:
+    """Whether ``value`` is a number or a (nested) list of them: no string, no bool."""
+    if isinstance(value, list):
+        return all(_numbers_only(v) for v in value)
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 class _Table:
     """One table of a tasks.toml; every error names the file, the table and the key. The reader of
     a program file's tables (:class:`faultgen.operation.programs._Values`) is this one, naming its
@@ -586,6 +599,8 @@ class _Table:
 
     def array(self, key, shape, scale=1.0, positive=False, nonnegative=False) -> np.ndarray:
         value = self.get(key)
+        if not _numbers_only(value):  # NumPy would read "1" as 1.0 and True as 1.0
+            self.fail(key, f"expected numbers, got {value!r}")
         try:
             arr = np.array(value, dtype=float)
         except (TypeError, ValueError):
@@ -615,11 +630,12 @@ class _Table:
         return float(value)
 
     def fraction(self, key: str, default: float | None = None) -> float:
+        """A speed or acceleration scale: a fraction of the limit in :data:`MIN_SCALE`..1."""
         if default is not None and key not in self.data:
             return default
         value = self.number(key)
-        if value > 1:
-            self.fail(key, f"expected a fraction in (0, 1], got {value}")
+        if not MIN_SCALE <= value <= 1:
+            self.fail(key, f"expected a fraction of the limit in {MIN_SCALE:g}..1, got {value}")
         return value
 
     def angles(self, key: str, robot: Robot, many: bool = False) -> np.ndarray:

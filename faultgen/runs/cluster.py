@@ -27,6 +27,7 @@ faster.
 from __future__ import annotations
 
 import hashlib
+import re
 import resource
 import time
 from collections.abc import Iterator
@@ -118,6 +119,111 @@ def task_key(run_id: str, config: sim.RunConfig) -> str:
     return f"faultgen-{run_id}-{digest}"
 
 
+#: The protocols ``--scheduler`` takes: plain TCP, and TLS (Dask's ``distributed.comm.tls``
+#: certificates from its configuration). Dask's others (inproc, ucx, ws) are not for a sweep.
+PROTOCOLS = ("tcp", "tls")
+_ADDRESS = re.compile(r"(?P<protocol>[a-z]+)://(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9][A-Za-z0-9._-]*):(?P<port>[0-9]{1,5})")
+#: Seconds to wait for a scheduler to accept the connection and send its greeting.
+PROBE_TIMEOUT = 5.0
+#: The largest greeting a Dask scheduler sends (its handshake is under 100 bytes): a peer that
+#: announces more is not one (a web server's first bytes read as a length ask for exabytes).
+MAX_GREETING = 65536
+
+
+def check_address(address: str) -> tuple[str, str, int]:
+    """(protocol, host, port) of a scheduler's address ``tcp://HOST:PORT`` or ``tls://HOST:PORT``.
+
+    Raises
+    ------
+    ValueError
+        Saying what is wrong and the form expected (the caller names the address).
+    """
+    match = _ADDRESS.fullmatch(address.strip())
+    expected = "expected tcp://HOST:PORT or tls://HOST:PORT, e.g. tcp://10.0.0.5:8786"
+    if match is None:
+        raise ValueError(f"not a Dask scheduler's address; {expected}")
+    if match["protocol"] not in PROTOCOLS:
+        raise ValueError(f"protocol {match['protocol']!r} is not taken; {expected}")
+    port = int(match["port"])
+    if not 1 <= port <= 65535:
+        raise ValueError(f"port {port} is out of range 1..65535")
+    return match["protocol"], match["host"].strip("[]"), port
+
+
+def probe(address: str, timeout: float | None = None) -> None:
+    """Check, in at most about ``2 * timeout`` seconds (default :data:`PROBE_TIMEOUT`) and before
+    any Dask client is made, that a Dask scheduler answers at ``address``: its greeting, a Dask
+    handshake message, is read (over TLS with Dask's configured certificates for ``tls://``) and
+    checked, its announced length first, so that another server's bytes are never taken for the
+    length of a message to allocate (a web server's: 3 EiB).
+
+    Raises
+    ------
+    SweepRefused
+        If the address is malformed (:func:`check_address`), ``tls://`` without Dask's TLS
+        configuration, nothing listens there, nothing answers within ``timeout`` (or the TLS
+        handshake fails), or what answers is not a Dask scheduler; one line naming the address.
+    """
+    import socket
+    import struct
+
+    timeout = PROBE_TIMEOUT if timeout is None else timeout
+    try:
+        protocol, host, port = check_address(address)
+    except ValueError as err:
+        raise SweepRefused(f"scheduler {address!r}: {err}") from None
+    context = None
+    if protocol == "tls":
+        from distributed.security import Security
+
+        context = Security().get_connection_args("client").get("ssl_context")
+        if context is None:
+            raise SweepRefused(f"scheduler {address!r}: tls:// needs Dask's TLS configuration (distributed.comm.tls: "
+                               "ca-file, and the client's cert and key); none is set")
+    fail = f"no Dask scheduler answers at {address}"
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as plain:
+            conn = plain if context is None else context.wrap_socket(plain, server_hostname=host)
+            conn.settimeout(timeout)
+            size = struct.unpack("<Q", _read(conn, 8))[0]
+            if size > MAX_GREETING:
+                raise SweepRefused(f"{fail}: what answers there is not a Dask scheduler (it sent no Dask handshake)")
+            greeting = _read(conn, size)
+    except OSError as err:  # refused, unreachable, timed out, closed early, a failed TLS handshake
+        raise SweepRefused(f"{fail}: {' '.join(str(err.strerror or err).split())}") from None
+    if not _is_handshake(greeting):
+        raise SweepRefused(f"{fail}: what answers there is not a Dask scheduler (it sent no Dask handshake)")
+
+
+def _read(conn, size: int) -> bytes:
+    data = bytearray()
+    while len(data) < size:
+        chunk = conn.recv(size - len(data))
+        if not chunk:
+            raise OSError("the connection was closed")
+        data += chunk
+    return bytes(data)
+
+
+def _is_handshake(message: bytes) -> bool:
+    """Whether ``message`` is a Dask handshake: frames (a count, their lengths, the frames) whose
+    first is a msgpack map naming the peer's pickle protocol (distributed.comm.core.Comm.handshake_info)."""
+    import struct
+
+    import msgpack
+
+    try:
+        count = struct.unpack_from("<Q", message)[0]
+        if not 1 <= count <= 16:
+            return False
+        lengths = struct.unpack_from(f"<{count}Q", message, 8)
+        start = 8 * (count + 1)
+        info = msgpack.unpackb(message[start:start + lengths[0]])
+    except (struct.error, ValueError, msgpack.UnpackException, TypeError):
+        return False
+    return isinstance(info, dict) and "pickle-protocol" in info
+
+
 def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, command: str = "",
             shared: bool = False, bar=None) -> Iterator[RunStats]:
     """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
@@ -141,7 +247,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     Raises
     ------
     SweepRefused
-        If the scheduler cannot be reached (nothing ran).
+        If the address is malformed, or no Dask scheduler answers there (:func:`probe`; nothing ran).
     SweepError
         If the scheduler is lost, a worker runs another robot model, with
         ``shared`` if a worker cannot see ``parts``, or (after every other run finished) if runs
@@ -151,10 +257,11 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     """
     from distributed import Client, KilledWorker, as_completed
 
+    probe(scheduler)
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
-    except (OSError, ValueError) as err:
-        raise SweepRefused(f"cannot reach the Dask scheduler at {scheduler}: {err}") from None
+    except Exception as err:  # TLS without certificates, a scheduler gone since the probe, ...
+        raise SweepRefused(f"cannot reach the Dask scheduler at {scheduler}: {' '.join(str(err).split())}") from None
     folder = parts.resolve()
     with client:
         if shared:

@@ -1,0 +1,180 @@
+"""A user's detector or isolator, named ``module:Class`` on the command line (``detect
+--detector``, ``bench-isolators --isolator``), loaded and held to its contract.
+
+A plug-in is executed code: importing its module runs whatever the module does, with the user's
+rights, as ``python -c "import module"`` would. Name only modules you trust (docs/reliability.md,
+"Threat model"). What this module adds is that a plug-in that fails, or answers outside its
+contract, stops the command with one line naming it (:class:`PluginError`, exit 2), before any
+output is written, instead of a traceback or a table built on a wrong answer:
+
+- its module must import (any exception: refused), the class must be a scikit-learn estimator
+  and ``Class()`` must succeed;
+- an isolator's ``fit(X)``, X of shape (n_cycles, N), must set ``source_axis_`` to a whole number
+  in 0..N (0: undecided). A ``ValueError`` from ``fit`` keeps its meaning in the isolator contract
+  (too few cycles for this isolator); any other exception is refused;
+- a detector's ``fit(X)`` and ``predict(X)`` must not raise, and ``predict(X)`` must give one
+  finite alarm per sample (shape (n_samples,)).
+
+The current folder is searched first while the module is imported, and only then: ``sys.path``
+is left as it was, so a later import in faultgen never finds a file of the current folder.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+
+import numpy as np
+from sklearn.base import BaseEstimator
+
+from faultgen.checks import is_whole
+
+ROLES = ("isolator", "detector")
+
+
+class PluginError(Exception):
+    """A plug-in that failed or broke its contract; the command line prints it as one line and
+    exits with :attr:`exit_code` (2: the plug-in is refused)."""
+
+    exit_code = 2
+
+
+def load(spec: str, role: str) -> "Plugin":
+    """The plug-in ``spec`` (``"package.module:Class"``), imported and built once with its
+    defaults to check it, as a :class:`Plugin` the benchmarks can clone and fit.
+
+    Raises
+    ------
+    PluginError
+        If ``spec`` is not ``module:Class``, the module cannot be imported (any exception while
+        importing it), it has no such class, the class is not a scikit-learn estimator
+        (``sklearn.base.BaseEstimator``) or ``Class()`` raises; the message names the plug-in.
+    """
+    if role not in ROLES:
+        raise ValueError(f"role {role!r}: expected one of {', '.join(ROLES)}")
+    plugin = Plugin(spec, role)
+    plugin._build()
+    return plugin
+
+
+def _estimator_class(spec: str) -> type:
+    module_name, _, class_name = spec.partition(":")
+    if not module_name or not class_name.isidentifier():
+        raise PluginError(f"plug-in {spec!r}: expected package.module:Class, e.g. mine:MyIsolator")
+    module = sys.modules.get(module_name)
+    if module is None:
+        added = os.getcwd() not in sys.path
+        if added:  # the current folder first, for this import only
+            sys.path.insert(0, os.getcwd())
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError as err:
+            raise PluginError(f"plug-in {spec!r}: cannot import {module_name!r} ({err}); put it in the current "
+                              "folder or on PYTHONPATH") from None
+        except (Exception, SystemExit) as err:  # SyntaxError, sys.exit(), whatever the module's own code raised
+            raise PluginError(f"plug-in {spec!r}: importing {module_name!r} failed: {_what(err)}") from None
+        finally:
+            if added and os.getcwd() in sys.path:
+                sys.path.remove(os.getcwd())
+    cls = getattr(module, class_name, None)
+    if not isinstance(cls, type):
+        raise PluginError(f"plug-in {spec!r}: module {module_name!r} has no class {class_name!r}")
+    if not issubclass(cls, BaseEstimator):
+        raise PluginError(f"plug-in {spec!r}: {class_name} is not a scikit-learn estimator; derive it from "
+                          "analysis.isolation.Isolator or sklearn.base.BaseEstimator")
+    return cls
+
+
+def _what(err: BaseException) -> str:
+    """'TypeError: message' of an exception, on one line."""
+    return " ".join(f"{type(err).__name__}: {err}".split())
+
+
+class Plugin(BaseEstimator):
+    """A user's estimator behind a guard that holds it to its role's contract.
+
+    Parameters
+    ----------
+    spec : str
+        ``"package.module:Class"``; the estimator is ``Class()``.
+    role : {"isolator", "detector"}
+
+    Attributes
+    ----------
+    estimator_ : BaseEstimator
+        The user's estimator, fitted.
+    source_axis_ : int
+        An isolator's answer, 1..N, or 0 (undecided).
+    """
+
+    def __init__(self, spec: str = "", role: str = "isolator"):
+        self.spec = spec
+        self.role = role
+
+    def _build(self) -> BaseEstimator:
+        cls = _estimator_class(self.spec)
+        try:
+            return cls()
+        except Exception as err:
+            raise PluginError(f"plug-in {self.spec!r}: {cls.__name__}() failed: {_what(err)}") from None
+
+    def fit(self, X, y=None) -> "Plugin":
+        """Fit the user's estimator on ``X`` (n_samples, n_features) and check what it set.
+
+        Raises
+        ------
+        ValueError
+            An isolator's own ValueError (too few rows for it), unchanged.
+        PluginError
+            If ``fit`` raised anything else (a detector: anything), or an isolator's
+            ``source_axis_`` is missing or not a whole number in 0..N.
+        """
+        X = np.asarray(X)
+        estimator = self._build()
+        try:
+            estimator.fit(X)
+        except ValueError as err:
+            if self.role == "isolator":  # the isolator contract's "too few cycles"
+                raise
+            raise PluginError(f"plug-in {self.spec!r}: fit(X) of X {X.shape} failed: {_what(err)}") from None
+        except Exception as err:
+            raise PluginError(f"plug-in {self.spec!r}: fit(X) of X {X.shape} failed: {_what(err)}") from None
+        self.estimator_ = estimator
+        if self.role == "isolator":
+            axis = getattr(estimator, "source_axis_", None)
+            if isinstance(axis, (float, np.floating)) and float(axis).is_integer():
+                axis = int(axis)
+            if not is_whole(axis, 0) or axis > X.shape[1]:
+                raise PluginError(f"plug-in {self.spec!r}: fit(X) set source_axis_ = {axis!r}; the isolator "
+                                  f"contract is a whole number 1..{X.shape[1]} (the axis), or 0 when undecided")
+            self.source_axis_ = int(axis)
+        return self
+
+    def predict(self, X) -> np.ndarray:
+        """A detector's alarms for ``X`` (n_samples, n_features): bool array of shape (n_samples,).
+
+        Raises
+        ------
+        PluginError
+            If ``predict`` raised, or its answer is not one finite number (or bool) per sample.
+        """
+        X = np.asarray(X)
+        try:
+            alarms = self.estimator_.predict(X)
+            alarms = np.asarray(alarms)
+        except Exception as err:
+            raise PluginError(f"plug-in {self.spec!r}: predict(X) of X {X.shape} failed: {_what(err)}") from None
+        finite = alarms.dtype.kind in "biuf" and (alarms.dtype.kind != "f" or bool(np.isfinite(alarms).all()))
+        if alarms.shape != (len(X),) or not finite:
+            raise PluginError(f"plug-in {self.spec!r}: predict(X) gave {_describe(alarms)} for X {X.shape}; the "
+                              f"detector contract is one finite alarm (bool or 0/1) per sample, shape ({len(X)},)")
+        return alarms.astype(bool)
+
+
+def _describe(values: np.ndarray) -> str:
+    """'shape (3,), dtype float64, with NaN or inf' of an answer, for a message."""
+    text = f"shape {values.shape}, dtype {values.dtype}"
+    if values.dtype.kind == "f" and not np.isfinite(values).all():
+        text += ", with NaN or inf"
+    return text
