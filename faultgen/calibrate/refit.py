@@ -180,7 +180,7 @@ REFINE_ITERATIONS = 50
 #: velocity between one rest speed at the motor and twice the 95th-percentile motor speed, the
 #: exponent over the literature's range of :data:`faultgen.effects.stribeck.EXPONENTS`.
 LEVEL_REACH = 3.0
-INSTALL = "pip install 'faultgen[sysid]' (or 'mujoco[sysid]')"
+INSTALL = "pip install 'mujoco[sysid]' (or, in a clone of faultgen, pip install '.[sysid]')"
 
 
 class SysidUnavailable(ImportError):
