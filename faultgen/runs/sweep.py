@@ -37,7 +37,7 @@ import time
 import tomllib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Self
 
@@ -125,10 +125,11 @@ class Grid:
         ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,
         ``hours``); None: none, the runs differ from their references only by wear.
     fault : str or None
-        A fault other than friction wear for the worn axes, ``EFFECT:PARAMETER:FINAL[:key=value,...]``
-        (:func:`faultgen.operation.faults.parse_fault` without the axis, e.g. ``backlash:width:0.01``):
-        each axis of ``axes`` but 0 gets it instead of friction wear (``increases`` and ``schedules``
-        are then unused; ``kind=...`` shapes its growth).
+        A fault other than friction wear for the worn axes, ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]``
+        (:class:`faultgen.operation.faults.FaultSpec`, the one fault text of every command): with
+        AXIS ``each`` (``backlash:each:width:0.01``) each axis of ``axes`` but 0 gets it instead of friction
+        wear; with a number, ``axes`` may wear only that axis (and 0). ``increases`` and
+        ``schedules`` are then unused; ``kind=...`` shapes its growth.
     signals : bool
         Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
         isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
@@ -164,6 +165,15 @@ class Grid:
             if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
                 raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
         friction.check_model(self.friction)
+        if self.fault is not None:
+            spec = faults.FaultSpec.parse(self.fault)
+            worn = sorted(set(self.axes) - {0})
+            if spec.axis is not None and worn != [spec.axis]:
+                raise ValueError(
+                    f"fault {self.fault!r} is on axis {spec.axis} but the grid wears axes "
+                    f"{', '.join(map(str, worn)) or 'none'}: give --axis 0 --axis {spec.axis}, or write "
+                    f"{str(replace(spec, axis=None))!r} "
+                    "to give each worn axis the fault in turn")
         for kind in self.schedules:
             if kind not in wear.SCHEDULES:
                 raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
@@ -262,8 +272,7 @@ class Grid:
                 if axis == 0:
                     label = "nowear"
                 elif self.fault:
-                    effect, _, rest = str(self.fault).partition(":")
-                    fault = faults.parse_fault(f"{effect}:{axis}:{rest}", last_cycle=self.cycles)
+                    fault = faults.FaultSpec.parse(self.fault).fault(self.cycles, axis=axis)
                     label = f"axis{axis}-{fault.effect}{fault.final:g}"
                 else:
                     plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
