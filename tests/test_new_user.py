@@ -1,0 +1,149 @@
+"""Issue 51, items 3 and 6: defaults that work on the data they are given, one fault text for
+every command, and a distribution name a user can install."""
+
+import re
+import tomllib
+from pathlib import Path
+
+import h5py
+import pytest
+from typer.main import get_command
+from typer.testing import CliRunner
+
+import faultgen
+from faultgen.cli import app
+from faultgen.operation import faults
+from faultgen.runs import sweep
+from faultgen.runs.fleet import Fleet
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+
+def invoke(*args: str):
+    return runner.invoke(app, [*args, "--no-progress"] if args[0] in ("simulate", "sweep", "fleet", "detect")
+                         else list(args))
+
+
+# -- item 6: the distribution name ----------------------------------------------------------------
+
+
+def test_the_distribution_is_not_named_like_the_unrelated_project_on_pypi():
+    """``faultgen`` on PyPI is someone else's 0.1.0 (2026-01): the project installs as
+    ``faultgen-robots``, its import name and command stay ``faultgen``, and the README's
+    commands install from the clone."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert project["name"] == faultgen.DISTRIBUTION == "faultgen-robots"
+    assert project["scripts"] == {"faultgen": "faultgen.cli:app"}
+    readme = (ROOT / "README.md").read_text()
+    assert "pip install faultgen-robots" in readme and "Do not `pip install faultgen`" in readme
+    commands = re.findall(r"```bash\n(.*?)\n```", readme, re.S)
+    installs = [re.search(r"pip install (.*?) &&", c).group(1) for c in commands if "pip install" in c]
+    assert installs == [".", '-e ".[test]"']  # from the clone, whatever the index holds
+    for text in [readme, *(p.read_text() for p in (ROOT / "docs").glob("*.md"))]:
+        assert "pip install 'faultgen[" not in text and "pip install faultgen " not in text
+
+
+# -- item 3: defaults that follow the data ------------------------------------------------------
+
+
+def test_the_failing_robots_follow_the_fleet_size():
+    assert Fleet(size=8, days=20).failing == 4
+    assert Fleet(size=5, days=20).failing == 2
+    assert Fleet().failing == 13  # the thesis's 13 of 26
+    assert Fleet(size=8, failing=3, days=20).failing == 3
+
+
+def test_a_small_fleet_and_the_detect_it_suggests_run_and_say_their_protocol(tmp_path):
+    """`faultgen fleet --robots N --days D` (on 41791db: --failing 13 refused any fleet under 14
+    robots) and then the `faultgen detect` it suggests (on 41791db: "protocol same-run needs the
+    run without wear" on a fleet of 20 days or fewer): auto picks first-cycles, fits --first to
+    the fleet's days and says so."""
+    out = tmp_path / "f.h5"
+    result = invoke("fleet", "--robots", "4", "--days", "12", "--cycles-per-day", "1", "--jobs", "1", "-o", str(out))
+    assert result.exit_code == 0, result.output
+    assert f"faultgen detect {out}" in result.output
+    result = invoke("detect", str(out))
+    assert result.exit_code == 0, result.output
+    assert ("protocol auto -> first-cycles: a fleet: each robot is a unit of its own and learns its first 6 days"
+            in result.output)
+    table = (tmp_path / "f-detection.csv").read_text()
+    assert "samples 1-6 of the run" in table
+
+
+def test_a_first_cycles_limit_over_more_folds_than_samples_is_fitted_or_names_the_option():
+    from analysis import benchmark
+
+    assert benchmark.fitted_first(None, 40) == 20
+    assert benchmark.fitted_first(None, 20) == 10
+    assert benchmark.fitted_first(7, 20) == 7
+
+
+# -- item 3: one fault text ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("text", ["backlash:2:width:0.01", "cogging:3:amplitude:0.05:poles=8",
+                                  "torque_offset:1:offset:20:kind=exp4,onset=3", "backlash:each:width:0.01"])
+def test_the_fault_text_is_parsed_once_and_written_back_the_same(text):
+    spec = faults.FaultSpec.parse(text)
+    assert str(spec) == text
+    fault = spec.fault(10, axis=spec.axis or 2)
+    assert fault.axis == (spec.axis or 2)
+    if spec.axis is not None:
+        assert fault == faults.parse_fault(text, 10)
+        assert fault.text() == text
+
+
+def test_the_fault_without_an_axis_is_refused_with_the_form_that_works():
+    with pytest.raises(ValueError) as err:
+        faults.FaultSpec.parse("backlash:width:0.01")
+    assert "'backlash:each:width:0.01'" in str(err.value)
+    grid = sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 3], cycles=2,
+                      fault="backlash:each:width:0.01")  # the recommended form works
+    assert [run_id for run_id, _ in grid.runs()] == [
+        "irb6700-pick_place-nowear-seed0", "irb6700-pick_place-axis2-backlash0.01-seed0",
+        "irb6700-pick_place-axis3-backlash0.01-seed0"]
+    with pytest.raises(ValueError, match=r"is on axis 2 but the grid wears axes 2, 3: give --axis 0 --axis 2, or "
+                                         r"write 'backlash:each:width:0.01'"):
+        sweep.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 3], cycles=2, fault="backlash:2:width:0.01")
+    with pytest.raises(ValueError, match="AXIS 'each' stands for a sweep's or a fleet's worn axis"):
+        faults.parse_fault("backlash:each:width:0.01", 10)
+    with pytest.raises(ValueError, match="the fleet sets the kind"):
+        Fleet(size=4, days=12, fault="backlash:2:width:0.01")
+
+
+def test_the_readmes_fault_runs_in_a_sweep_and_shows_in_simulate_and_info(tmp_path):
+    """The README's `--fault backlash:2:width:0.01`: refused by `sweep` on 41791db with an error
+    recommending a form it also refused; now one text for simulate, sweep and fleet, printed by
+    `simulate` and `faultgen info`."""
+    out = tmp_path / "s.h5"
+    result = invoke("sweep", "--fault", "backlash:2:width:0.01", "--cycles", "2", "--jobs", "1", "-o", str(out))
+    assert result.exit_code == 0, result.output
+    with h5py.File(out) as f:
+        assert sorted(f["runs"]) == ["irb6700-pick_place-axis2-backlash0.01-seed0", "irb6700-pick_place-nowear-seed0"]
+    result = invoke("info", str(out))
+    assert result.exit_code == 0, result.output
+    assert "faults:        backlash:2:width:0.01 (1 run)" in result.output
+    one = tmp_path / "one.h5"
+    result = invoke("simulate", "--fault", "cogging:3:amplitude:0.05:poles=8", "--temperature", "--cycles", "2",
+                    "-o", str(one))
+    assert result.exit_code == 0, result.output
+    assert "fault cogging:3:amplitude:0.05:poles=8: cogging amplitude on axis 3 grows linear from 0 to 0.05" \
+        in result.output
+    result = invoke("info", str(one))
+    assert "faults:        cogging:3:amplitude:0.05:poles=8 (1 run)" in result.output
+    assert "CONDITION_ARRAYS" not in result.output and "operating conditions: thermal" in result.output
+
+
+# -- item 5: the command list -------------------------------------------------------------------
+
+
+def test_the_command_list_gives_each_command_its_whole_first_sentence():
+    """`faultgen --help` cut every description with "..." (click's 45-character short help)."""
+    group = get_command(app)
+    listing = runner.invoke(app, ["--help"], terminal_width=300).output
+    for name, command in group.commands.items():
+        line = next(line for line in listing.splitlines() if line.strip().startswith(name + " "))
+        summary = line.strip()[len(name):].strip()
+        assert not summary.endswith("...") or summary.endswith(", ...)"), line
+        assert summary.endswith("."), line
