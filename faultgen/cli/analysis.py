@@ -51,12 +51,12 @@ def bench_isolators_command(
     worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
 
     Examples (the thesis's Table 6.2 on its grid; then averaging only over the motor speeds of
-    thesis ch. 6.3.2; then with your own isolator from mine.py):
+    thesis ch. 6.3.2; then with your own isolator, mine.py of docs/analysis.md):
 
     \b
       faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
       faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
-      faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
+      faultgen bench-isolators j2.h5 --isolator mine:LargestRise
     """
     from analysis import benchmark
 

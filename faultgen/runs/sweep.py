@@ -302,14 +302,19 @@ class RunStats:
     memory: int = 0
 
 
-def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "") -> RunStats:
-    """Worker task: simulate one run and write it to its part file (atomically)."""
+def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
+                       labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task: simulate one run and write it to its part file (atomically), labelled with
+    ``labelled`` (the client's configuration when ``config`` names its robot or program by an
+    absolute path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`)."""
     # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
     # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
     tqdm.set_lock(threading.RLock())
     started = time.perf_counter()
     result = sim.simulate(config, progress=False)
     writing = time.perf_counter()
+    if labelled is not None:
+        result = replace(result, config=labelled)
     dataset.write_run(part, result, run_id=run_id, command=command)
     done = time.perf_counter()
     stats = RunStats(run_id, result.tau_m.shape[0] * result.t[-1], done - started, result.stepping_time,
@@ -713,7 +718,8 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
     """Run the missing runs; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
-    calls = [(run_id, config, parts / f"{run_id}.h5", command) for run_id, config in todo]
+    # absolute: a worker process keeps the folder it started in, which need not be this one's now
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command) for run_id, config in todo]
     try:
         if scheduler:
             from faultgen.runs import cluster

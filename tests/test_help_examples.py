@@ -1,0 +1,159 @@
+"""Every example in every command's ``--help`` runs (issue 51, item 3).
+
+The examples are read from the help text itself, one test per help page, each page in a folder
+of its own holding what the docs tell a user to make before it (``quick.h5``, ``j2.h5``,
+``fleet.h5``, a program, a URDF, ``mine.py``), each made by its documented command. The data
+they make is kept small: every ``simulate`` and ``sweep`` an example runs gets fewer cycles
+appended (``--cycles 3 --record 1-3``: click takes an option's last value) and every ``fleet``
+fewer robots, days and cycles a day; the rest of each command line is the example's own. A
+``--scheduler`` address is replaced by the address of a local Dask cluster.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+import shlex
+import shutil
+from pathlib import Path
+
+import pytest
+import rtbdata
+from filelock import FileLock
+from typer.main import get_command
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+#: Appended to the data-making commands of the examples: small data, the example's own options.
+SMALL = {"simulate": ["--cycles", "2", "--record", "1-2"], "sweep": ["--cycles", "3", "--record", "1-3"],
+         "fleet": ["--robots", "4", "--days", "12", "--cycles-per-day", "1"]}
+#: The thesis's training-source window is 40 + 15 + 5 days: its fleet keeps the 60 days.
+SMALL_FLEET_DAYS = {"training-source": "60"}
+
+
+def pages() -> dict[str, list[str]]:
+    """Command path -> the example lines of its ``--help``."""
+    out = {}
+
+    def walk(command, path):
+        if hasattr(command, "commands"):
+            for name, sub in command.commands.items():
+                walk(sub, [*path, name])
+        if path:
+            text = runner.invoke(app, [*path, "--help"], terminal_width=300).output
+            lines = [line.strip() for line in text.splitlines() if line.strip().startswith("faultgen ")]
+            if lines:
+                out[" ".join(path)] = lines
+
+    walk(get_command(app), [])
+    return out
+
+
+PAGES = pages()
+
+
+def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
+    """``argv`` (after ``faultgen``) with the small-data options appended, the scheduler replaced."""
+    extra = list(SMALL.get(argv[0], []))
+    if argv[0] == "fleet" and page in SMALL_FLEET_DAYS:
+        extra[extra.index("--days") + 1] = SMALL_FLEET_DAYS[page]
+    argv = [scheduler if a.startswith("tcp://") and scheduler else a for a in argv]
+    return [*argv, *extra]
+
+
+def run_line(line: str, page: str, scheduler: str | None) -> None:
+    """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments."""
+    for part in line.split("&&"):
+        words = shlex.split(part, comments=True)
+        target = None
+        if ">" in words:
+            words, target = words[:words.index(">")], words[words.index(">") + 1]
+        assert words[0] == "faultgen", line
+        for produced in (words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--out")):
+            path = Path(produced)  # the example makes it: a file the docs' earlier step made is remade here
+            if path.is_file():
+                path.unlink()
+        result = runner.invoke(app, small(words[1:], page, scheduler))
+        assert result.exit_code == 0, f"{line}\n{result.output}"
+        if target:
+            Path(target).write_text(result.output)
+
+
+# -- what the docs tell a user to make before the examples ------------------------------------------
+
+def mine_py(folder: Path) -> None:
+    """docs/analysis.md's mine.py, as written there."""
+    text = (ROOT / "docs/analysis.md").read_text()
+    block = re.search(r"```python\n(# mine.py, beside the dataset\n.*?)```", text, re.S).group(1)
+    (folder / "mine.py").write_text(block)
+
+
+#: file -> the documented command that makes it (run with the small-data options) or a maker.
+MADE = {
+    "quick.h5": "faultgen sweep --preset quick -o quick.h5",
+    "j2.h5": "faultgen sweep --preset j2 -o j2.h5",
+    "fleet.h5": "faultgen fleet -o fleet.h5",
+    "my_program.toml": "faultgen tasks export irb6700 arc_weld -o my_program.toml",
+    "kr210l150.urdf": lambda folder: shutil.copy(
+        Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf", folder),
+    "ur5_dh.toml": lambda folder: shutil.copy(ROOT / "docs/examples/ur5_dh.toml", folder),
+    # docs/robots.md: "--drivetrain gives some or all drivetrain numbers (tables [axis.1] .. [axis.N])"
+    "my_drives.toml": lambda folder: (folder / "my_drives.toml").write_text("[axis.1]\ngear_ratio = 100.0\n"),
+    "mine.py": mine_py,
+}
+
+
+@pytest.fixture(scope="session")
+def made(tmp_path_factory, worker_id):
+    """``made(name)``: the path of a file of :data:`MADE`, made once per session."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "help-examples-made"
+    folder.mkdir(exist_ok=True)
+
+    def make(name: str) -> Path:
+        with FileLock(folder / f"{name}.lock"):
+            if not (folder / name).exists():
+                maker = MADE[name]
+                if callable(maker):
+                    maker(folder)
+                else:
+                    with contextlib.chdir(folder):
+                        result = runner.invoke(app, small(shlex.split(maker)[1:], "", None))
+                    assert result.exit_code == 0, f"{maker}\n{result.output}"
+        return folder / name
+
+    return make
+
+
+def test_every_help_page_has_examples_and_they_are_all_read():
+    assert len(PAGES) >= 18 and sum(map(len, PAGES.values())) >= 45
+    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export"} <= set(PAGES)
+
+
+@pytest.mark.parametrize("page", sorted(PAGES))
+def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
+    lines = PAGES[page]
+    needed = {word for line in lines for word in re.split(r"[\s:]+", line) if word in MADE}
+    needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
+    for name in sorted(needed):
+        if not any(f"-o {name}" in line for line in lines):  # the page makes it itself
+            shutil.copy(made(name), tmp_path / name)
+    monkeypatch.chdir(tmp_path)
+    scheduler = None
+    if any("--scheduler" in line for line in lines):
+        from distributed import LocalCluster
+
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+        scheduler = cluster.scheduler_address
+    try:
+        for line in lines:
+            run_line(line, page, scheduler)
+    finally:
+        if scheduler:
+            cluster.close()
