@@ -56,7 +56,7 @@ def bench_isolators_command(
     \b
       faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
       faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
-      faultgen bench-isolators j2.h5 --isolator mine:LargestRise
+      faultgen bench-isolators j2.h5 --isolator mine:LargestRise -o j2-mine
     """
     from analysis import benchmark
 
@@ -312,9 +312,9 @@ def classify_command(
 
     \b
       faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
-      faultgen classify fleet.h5 --horizon 3 --pairs 0 --full
-      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
-      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
+      faultgen classify fleet.h5 --horizon 3 --pairs 0 --full -o fleet-full
+      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19 -o fleet-lr
+      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19 -o fleet-matched
     """
     import shlex
 
