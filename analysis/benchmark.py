@@ -688,15 +688,17 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
     return "\n".join(notes)
 
 
-def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
+def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
     """PNG of the Q and T2 charts of :func:`detection_table` (``return_charts=True``): per worn run
-    (the first ``most``), Q and T2 against the cycle (a day in a fleet) on a log scale, with the
+    (every one, up to ``most``: the title then says how many are shown), Q and T2 against the
+    cycle (a day in a fleet) on a log scale, with the
     limit (dashed), the samples the monitor learned from (shaded), where the fault begins (dotted)
     and the onset called (red). A detector without statistics shows its alarms instead."""
     from matplotlib.figure import Figure
 
     shown = list(charts.items())[:most]
-    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8))
+    # constrained layout leaves the title its own room above the first row
+    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8), layout="constrained")
     panels = fig.subplots(max(1, len(shown)), 2, squeeze=False)
     for (run_id, chart), row in zip(shown, panels, strict=False):
         x = chart["cycle"]
@@ -716,9 +718,10 @@ def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
             ax.set_title(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})", fontsize=8)
     for ax in panels[-1]:
         ax.set_xlabel("cycle (a day in a fleet)")
-    fig.suptitle("PCA monitoring per worn run: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
-                 "normal; dotted green: fault begins; red: onset called", fontsize=9)
-    fig.tight_layout()
+    count = (f"all {len(charts)} worn runs" if len(shown) == len(charts)
+             else f"the first {len(shown)} of {len(charts)} worn runs (every run in the table)")
+    fig.suptitle(f"PCA monitoring, {count}: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
+                 "normal;\ndotted green: fault begins; red: onset called", fontsize=9)
     fig.savefig(out, dpi=100)
     return out
 

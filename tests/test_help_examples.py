@@ -15,6 +15,7 @@ import contextlib
 import re
 import shlex
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -172,3 +173,14 @@ def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
     finally:
         if scheduler:
             cluster.close()
+    # run in the checkout, the examples would leave `git status` clean: all they write is ignored
+    # (but your own sources: a robot folder of `robots add`, a program of `tasks export`)
+    sources = {w[w.index("-o") + 1] for line in lines for part in line.split("&&")
+               if (w := shlex.split(part, comments=True))[1:3] in (["robots", "add"], ["tasks", "export"])}
+    written = sorted(p.name + ("/" if p.is_dir() else "") for p in tmp_path.iterdir()
+                     if p.name not in needed | sources and p.name != "__pycache__")
+    if written:
+        check = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", "-v", "-n", *written],
+                               capture_output=True, text=True)
+        unignored = [line.split("\t")[-1] for line in check.stdout.splitlines() if line.startswith("::")]
+        assert not unignored, f"{page}: not in .gitignore: {unignored}"

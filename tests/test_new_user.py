@@ -204,3 +204,41 @@ def test_the_sysid_refit_prints_nothing_to_the_console(capfd):
     np.testing.assert_allclose(x, [0.3, 0.7], atol=1e-6)
     printed = capfd.readouterr()
     assert "iter:" not in printed.out and "box bound" not in printed.err and printed.out == ""
+
+
+def _saved_figures(monkeypatch):
+    from matplotlib.figure import Figure
+
+    drawn, save = [], Figure.savefig
+
+    def spy(self, *args, **kwargs):
+        drawn.append(self)
+        return save(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", spy)
+    return drawn
+
+
+def test_the_detection_figure_shows_every_worn_run_below_its_title(tmp_path, monkeypatch):
+    """j2's 18 worn runs: the PNG showed 12 (spot weld missing) and its title overlapped the first
+    row (41791db)."""
+    import numpy as np
+
+    from analysis import benchmark
+
+    drawn = _saved_figures(monkeypatch)
+    n = 12
+    charts = {f"irb6700-{task}-axis{axis}-exp420-seed0": {
+        "sample": np.arange(n), "cycle": np.arange(1, n + 1), "wear_pct": np.linspace(0, 20, n),
+        "alarm": np.arange(n) > 8, "q": np.linspace(1, 5, n), "t2": np.linspace(1, 3, n), "q_limit": 4.0,
+        "t2_limit": 2.5, "trained": 0, "onset": 9, "begins": 1, "protocol": "same-run (in-sample)",
+        "robot": "irb6700", "task": task, "worn_axis": axis}
+        for task in ("pick_place", "spot_weld", "arc_weld") for axis in range(1, 7)}
+    benchmark.detection_figure(charts, tmp_path / "d.png")
+    (fig,) = drawn
+    titles = {ax.get_title() for ax in fig.axes}
+    assert len(fig.axes) == 36 and all(any(run in t for t in titles) for run in charts)
+    assert "all 18 worn runs" in fig._suptitle.get_text()
+    fig.canvas.draw()
+    title_bottom = fig._suptitle.get_window_extent().y0
+    assert all(ax.get_tightbbox().y1 <= title_bottom + 1 for ax in fig.axes)
