@@ -242,3 +242,18 @@ def test_the_detection_figure_shows_every_worn_run_below_its_title(tmp_path, mon
     fig.canvas.draw()
     title_bottom = fig._suptitle.get_window_extent().y0
     assert all(ax.get_tightbbox().y1 <= title_bottom + 1 for ax in fig.axes)
+
+
+def test_the_fleet_plot_draws_no_trend_from_a_partial_week_and_marks_the_parts(tmp_path, monkeypatch):
+    """A healthy robot read -33 % on the last day of a 20-day fleet: the running median at the
+    record's end was the median of four days, most of them carrying the lighter part."""
+    import numpy as np
+
+    from faultgen import plot
+
+    change = np.zeros((20, 2))
+    change[-3:, 0] = -33.0  # the last days: the lighter part
+    trend = plot.running_median(change)
+    assert np.all(np.isnan(trend[:3])) and np.all(np.isnan(trend[-3:]))
+    np.testing.assert_array_equal(trend[3:-3], 0.0)
+    assert plot.TREND_DAYS == 7
