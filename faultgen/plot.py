@@ -164,7 +164,7 @@ def _draw_fleet(data, out: Path) -> Path:
         ax.set_xlabel("day of the record", fontsize=8)
     fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
                  f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running median "
-                 f"over {TREND_DAYS} days where the week is whole (blue: the worn axis, its days as dots; grey: the "
+                 f"over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; grey: the "
                  "other axes); red: the worn axis's true wear; green ticks: days with the lighter part", fontsize=10)
     from faultgen.data.atomic import atomic_path
 
