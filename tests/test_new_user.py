@@ -257,3 +257,36 @@ def test_the_fleet_plot_draws_no_trend_from_a_partial_week_and_marks_the_parts(t
     assert np.all(np.isnan(trend[:3])) and np.all(np.isnan(trend[-3:]))
     np.testing.assert_array_equal(trend[3:-3], 0.0)
     assert plot.TREND_DAYS == 7
+
+
+def test_a_sweep_in_the_background_terminated_with_its_group_says_how_to_resume(tmp_path):
+    """`timeout`, a process manager or a closed terminal sends SIGTERM to the whole process group,
+    and a sweep started in the background has SIGINT ignored: on 41791db it died on the SIGTERM
+    without a word while loky's resource tracker reported leaked semaphores. Now it stops its
+    workers and says what is kept and how to resume, and nothing else."""
+    import os
+    import signal
+    import subprocess
+
+    from test_reliability import CLI, GRID_ARGS, marked, wait_for, workers
+
+    out = tmp_path / "killed.h5"
+    parts = sweep.parts_folder(out)
+    mark = str(tmp_path)
+    proc = subprocess.Popen([*CLI, "sweep", *GRID_ARGS, "--jobs", "2", "-o", str(out)], cwd=tmp_path,
+                            env={**os.environ, "FAULTGEN_TEST_MARK": mark}, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),  # a background job
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for(lambda: (parts / "sweep.json").exists() and len(workers(mark)) >= 2, "two workers")
+        os.killpg(proc.pid, signal.SIGTERM)  # the sweep, its workers and loky's resource tracker
+        stdout, stderr = proc.communicate(timeout=120)
+        wait_for(lambda: not marked(mark), "every process of the sweep to end", seconds=10)
+    finally:
+        for p in marked(mark):
+            p.kill()
+    kept = len(list(parts.glob("*.h5")))
+    assert proc.returncode == 143, stdout + stderr
+    assert stderr.strip() == (f"terminated (SIGTERM): {kept} of 4 runs kept in {parts}; run the same command to "
+                              "resume" if kept else "terminated (SIGTERM): none of the 4 runs had finished; run the "
+                              "same command to start again")

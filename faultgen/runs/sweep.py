@@ -340,12 +340,32 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
 
 def _start_worker(sweep_pid: int) -> None:
     """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
-    whose sweep ended while it started (it has another parent already) ends at once."""
+    whose sweep ended while it started (it has another parent already) ends at once. A SIGTERM
+    sent to the whole process group (``timeout``, a process manager, a closed terminal) is the
+    sweep's to handle: it stops its workers and says what is kept and how to resume; a worker that
+    ended on it first left loky's semaphores for Python to report as leaked, and the sweep no word."""
     if os.getpid() == sweep_pid:
         return
     if os.getppid() != sweep_pid:
         os._exit(1)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     _watch_parent(sweep_pid)
+
+
+def _start_resource_tracker() -> None:
+    """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
+    workers do (:func:`_start_worker`): a group-wide SIGTERM must not end it before the sweep has
+    stopped its workers and released their semaphores (it then reports them as leaked). It ends
+    when the sweep's process does."""
+    from joblib.externals.loky.backend import resource_tracker
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)  # inherited by the process started now
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 _WATCHED: set[int] = set()
@@ -664,8 +684,8 @@ class _CtrlC:
     later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
     KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
     Ctrl-C, or one sent again after the workers' own interrupts already stopped the sweep) is not
-    raised inside the clean-up. Only in the main thread and when SIGINT raises KeyboardInterrupt (not under
-    ``nohup``); otherwise the block changes nothing.
+    raised inside the clean-up. Only in the main thread; SIGINT only when it raises
+    KeyboardInterrupt (not under ``nohup`` or in a background job), SIGTERM always.
     """
 
     RESEND_AFTER = 0.1  # s: a callback is over long before; a person does not notice
@@ -674,21 +694,25 @@ class _CtrlC:
         self.stopping = False
         self._resends: list[threading.Timer] = []
         self._previous_handler = signal.getsignal(signal.SIGINT)
-        self._active = (threading.current_thread() is threading.main_thread()
-                        and self._previous_handler is signal.default_int_handler)
-        if self._active:
+        self._main = threading.current_thread() is threading.main_thread()
+        # SIGTERM is handled in any case (a sweep started in the background, where SIGINT is
+        # ignored, died on it silently, issue 51); SIGINT only where it raises KeyboardInterrupt
+        self._active = self._main and self._previous_handler is signal.default_int_handler
+        if self._main:
             self._previous_hook = sys.unraisablehook
             sys.unraisablehook = self._unraisable
-            signal.signal(signal.SIGINT, self._on_sigint)
             self._previous_term = signal.signal(signal.SIGTERM, self._on_sigterm)
+        if self._active:
+            signal.signal(signal.SIGINT, self._on_sigint)
         return self
 
     def __exit__(self, *exc) -> None:
-        if not self._active:
+        if not self._main:
             return
         for resend in self._resends:
             resend.cancel()
-        signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
+        if self._active:
+            signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
         signal.signal(signal.SIGTERM, self._previous_term)
         sys.unraisablehook = self._previous_hook
 
@@ -729,6 +753,7 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
 
+            _start_resource_tracker()
             # every worker watches the sweep from its start, idle or not (:func:`_watch_parent`)
             backend = LokyBackend(initializer=_start_worker, initargs=(os.getpid(),))
             parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
