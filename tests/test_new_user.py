@@ -290,3 +290,15 @@ def test_a_sweep_in_the_background_terminated_with_its_group_says_how_to_resume(
     assert stderr.strip() == (f"terminated (SIGTERM): {kept} of 4 runs kept in {parts}; run the same command to "
                               "resume" if kept else "terminated (SIGTERM): none of the 4 runs had finished; run the "
                               "same command to start again")
+
+
+def test_the_quick_sweeps_time_is_given_in_one_place():
+    """It was given four ways (13 s, 23 s, 24 s, "under a minute"): now only docs/performance.md
+    gives it, and the README, the dataset docs and `sweep --help` point there."""
+    duration = re.compile(r"\b\d+(\.\d+)? ?s\b|minute")
+    texts = {p.name: p.read_text() for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]}
+    texts["sweep --help"] = runner.invoke(app, ["sweep", "--help"], terminal_width=1000).output
+    places = [name for name, text in texts.items() for line in text.splitlines()
+              if re.search(r"(--preset quick|quick \(a first look|`quick` wear sweep)", line)
+              and duration.search(line) and "classify" not in line]
+    assert set(places) == {"performance.md"}, places  # its table, and the baseline of its ratio tables

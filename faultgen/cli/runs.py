@@ -107,7 +107,7 @@ def simulate_command(
 @app.command("sweep", cls=Command)
 def sweep_command(
     preset: Annotated[
-        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
+        str | None, typer.Option(help="A named grid: quick (a first look, 21 runs; its time: docs/performance.md), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
