@@ -24,6 +24,7 @@ from faultgen.model import robots
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=Path("calib_example"))
+    parser.add_argument("--cycles", type=int, default=4, help="Cycles of pick and place in the log (the docs': 4)")
     parser.add_argument("--figure", type=Path, default=None,
                         help="Also copy the figure here (docs/images/calibration_example.png refreshes the docs')")
     args = parser.parse_args()
@@ -34,7 +35,7 @@ def main() -> None:
     coulomb = synth.Hidden.of(robot, "coulomb", {4: {"coulomb_pos": float(friction.coulomb_pos[4] + 0.03),
                                                      "coulomb_neg": float(friction.coulomb_neg[4] + 0.03)}})
     with_both = robots.load(synth.write_model(robot, payload, args.out / "hidden_model"))
-    log = synth.record(with_both, coulomb, args.out / "measured.csv", seed=3)
+    log = synth.record(with_both, coulomb, args.out / "measured.csv", seed=3, cycles=args.cycles)
     print(f"hidden: {payload}, {coulomb}\nmeasured log: {log}", flush=True)
     subprocess.run([sys.executable, "-m", "faultgen.cli", "calibrate", "--robot", "puma560", "--measured", str(log),
                     "--out", str(args.out / "calibration")], check=True)

@@ -302,3 +302,26 @@ def test_the_quick_sweeps_time_is_given_in_one_place():
               if re.search(r"(--preset quick|quick \(a first look|`quick` wear sweep)", line)
               and duration.search(line) and "classify" not in line]
     assert set(places) == {"performance.md"}, places  # its table, and the baseline of its ratio tables
+
+
+def test_the_calibration_example_writes_only_into_its_out_folder(tmp_path):
+    """`benchmarks/calibration_example.py --out DIR` overwrote the tracked
+    docs/images/calibration_example.png (41791db); with a one-cycle log it runs and leaves the
+    checkout as it was."""
+    import os
+    import subprocess
+    import sys
+
+    def status():
+        return subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=all"],
+                              capture_output=True, text=True, check=True).stdout
+
+    image = ROOT / "docs/images/calibration_example.png"
+    before, stamp = status(), image.stat().st_mtime_ns
+    result = subprocess.run([sys.executable, str(ROOT / "benchmarks/calibration_example.py"), "--out", "ex",
+                             "--cycles", "1"], cwd=tmp_path, capture_output=True, text=True,
+                            env={**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])})
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "figure: ex/calibration/calibration.png" in result.stdout
+    assert (tmp_path / "ex/calibration/report.json").is_file()
+    assert image.stat().st_mtime_ns == stamp and status() == before
