@@ -15,6 +15,7 @@ from faultgen.cli import app
 from faultgen.operation import faults
 from faultgen.runs import sweep
 from faultgen.runs.fleet import Fleet
+from test_plot import figures  # noqa: F401 - the fixture: the figures a command saves
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
@@ -206,27 +207,13 @@ def test_the_sysid_refit_prints_nothing_to_the_console(capfd):
     assert "iter:" not in printed.out and "box bound" not in printed.err and printed.out == ""
 
 
-def _saved_figures(monkeypatch):
-    from matplotlib.figure import Figure
-
-    drawn, save = [], Figure.savefig
-
-    def spy(self, *args, **kwargs):
-        drawn.append(self)
-        return save(self, *args, **kwargs)
-
-    monkeypatch.setattr(Figure, "savefig", spy)
-    return drawn
-
-
-def test_the_detection_figure_shows_every_worn_run_below_its_title(tmp_path, monkeypatch):
+def test_the_detection_figure_shows_every_worn_run_below_its_title(tmp_path, figures):
     """j2's 18 worn runs: the PNG showed 12 (spot weld missing) and its title overlapped the first
     row (41791db)."""
     import numpy as np
 
     from analysis import benchmark
 
-    drawn = _saved_figures(monkeypatch)
     n = 12
     charts = {f"irb6700-{task}-axis{axis}-exp420-seed0": {
         "sample": np.arange(n), "cycle": np.arange(1, n + 1), "wear_pct": np.linspace(0, 20, n),
@@ -235,7 +222,7 @@ def test_the_detection_figure_shows_every_worn_run_below_its_title(tmp_path, mon
         "robot": "irb6700", "task": task, "worn_axis": axis}
         for task in ("pick_place", "spot_weld", "arc_weld") for axis in range(1, 7)}
     benchmark.detection_figure(charts, tmp_path / "d.png")
-    (fig,) = drawn
+    (fig,) = figures
     titles = {ax.get_title() for ax in fig.axes}
     assert len(fig.axes) == 36 and all(any(run in t for t in titles) for run in charts)
     assert "all 18 worn runs" in fig._suptitle.get_text()
@@ -320,7 +307,8 @@ def test_the_calibration_example_writes_only_into_its_out_folder(tmp_path):
     before, stamp = status(), image.stat().st_mtime_ns
     result = subprocess.run([sys.executable, str(ROOT / "benchmarks/calibration_example.py"), "--out", "ex",
                              "--cycles", "1"], cwd=tmp_path, capture_output=True, text=True,
-                            env={**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])})
+                            env={**os.environ,
+                                 "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])})
     assert result.returncode == 0, result.stdout + result.stderr
     assert "figure: ex/calibration/calibration.png" in result.stdout
     assert (tmp_path / "ex/calibration/report.json").is_file()

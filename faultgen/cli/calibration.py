@@ -106,7 +106,8 @@ def hidden_log_command(
              "backlash, ...), or none.")] = "coulomb",
     seed: Annotated[int, typer.Option(help="Seed of the effect's draw (size, axes) and of the noise.", min=0)] = 0,
     cycles: Annotated[int, typer.Option(help="Cycles of the task in the log, back to back.", min=1, max=100)] = 4,
-    task: Annotated[str, typer.Option(help="The task the robot runs (a thesis task or a program file).")] = "pick_place",
+    task: Annotated[str, typer.Option(
+        help="The task the robot runs (a thesis task or a program file).")] = "pick_place",
     overwrite: Overwrite = False,
 ) -> None:
     """Make a torque log of a robot with a hidden effect, to try `faultgen calibrate` on.

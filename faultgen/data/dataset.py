@@ -760,7 +760,8 @@ def summary(path: str | Path) -> str:
            else "features and truth only (no 250 Hz signals)"),
     ]
     if any("conditions" in row for row in rows):
-        kinds = sorted({key for row in rows if "conditions" in row for key, value in json.loads(row["conditions"]).items()
+        tables = [json.loads(row["conditions"]) for row in rows if "conditions" in row]
+        kinds = sorted({key for table in tables for key, value in table.items()
                         if key in ("thermal", "payloads", "spread", "task_mix") and value})
         lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions: "
                      f"{', '.join(kinds)} (their per-cycle arrays: `faultgen info FILE --card`, docs/dataset.md)")

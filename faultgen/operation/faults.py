@@ -395,7 +395,8 @@ class FaultSpec:
                    *([f"onset={self.onset}"] if self.onset is not None else []),
                    *(f"{k}={v:g}" for k, v in self.others.items())]
         axis = ANY_AXIS if self.axis is None else str(self.axis)
-        return ":".join([self.effect, axis, self.parameter, f"{self.final:g}", *([",".join(options)] if options else [])])
+        fields = [self.effect, axis, self.parameter, f"{self.final:g}"]
+        return ":".join([*fields, ",".join(options)] if options else fields)
 
 
 def _is_axis(text: str) -> bool:
