@@ -389,6 +389,8 @@ PROTOCOLS = ("auto", "other-seeds", "first-cycles", "same-run")
 #: The samples first-cycles learns from when ``first`` is not given; a run with no more samples
 #: than this learns from its first half (:func:`fitted_first`).
 FIRST = 20
+#: The fewest samples ``auto`` lets a fleet's robot learn from (a PCA monitor and its folds).
+MIN_FIRST = 5
 
 
 def fitted_first(first: int | None, n_samples: int) -> int:
@@ -477,18 +479,19 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
 
 
 def _auto_protocol(kind: str, others: list, own, n_samples: int, first: int | None) -> tuple[str, str]:
-    """The protocol ``auto`` picks for one worn run, and why (a sentence for the user)."""
+    """The protocol ``auto`` picks for one worn run, and why (a sentence for the user). On a fleet
+    ``first`` is fitted to the record (:func:`fitted_first`); a sweep's choice is as before."""
     n_first = fitted_first(first, n_samples)
-    if kind == "fleet" and 2 <= n_first < n_samples:
+    if kind == "fleet" and MIN_FIRST <= n_first < n_samples:
         return "first-cycles", (f"a fleet: each robot is a unit of its own and learns its first {n_first} days "
                                 "(thesis ch. 4, one-to-one)")
     if others:
         return "other-seeds", "the dataset has runs without wear of other seeds (other units)"
-    if 2 <= n_first < n_samples:
-        return "first-cycles", (f"no run without wear of another seed; each run learns its first {n_first} samples "
-                                "(sweep --seed 0 --seed 1 --seed 2 for other-seeds)")
+    if (first or FIRST) < n_samples:
+        return "first-cycles", (f"no run without wear of another seed; each run learns its first {first or FIRST} "
+                                "samples (sweep --seed 0 --seed 1 --seed 2 for other-seeds)")
     if own is not None:
-        return "same-run", (f"no run without wear of another seed and runs of {n_samples} samples, too short to "
+        return "same-run", (f"no run without wear of another seed and runs of {n_samples} samples, too few to "
                             "learn from their first ones; the run without wear of the same seed (in-sample)")
     raise ValueError(f"no protocol fits: no run without wear of another seed or of the same seed, and runs of "
                      f"{n_samples} samples, too few to learn from their first ones (--first); record more cycles "

@@ -103,7 +103,7 @@ def hidden_log_command(
     out: Annotated[Path, typer.Option("--out", "-o", help="CSV log to write (the measured-log format).")],
     effect: Annotated[str, typer.Option(
         help="The hidden effect, one of `faultgen calibrate --help`'s effects (coulomb, payload, cogging, "
-             "backlash, ...), or none.")] = "coulomb",
+             "backlash, ...), or none.")],
     seed: Annotated[int, typer.Option(help="Seed of the effect's draw (size, axes) and of the noise.", min=0)] = 0,
     cycles: Annotated[int, typer.Option(help="Cycles of the task in the log, back to back.", min=1, max=100)] = 4,
     task: Annotated[str, typer.Option(
