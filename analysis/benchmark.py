@@ -342,14 +342,29 @@ def group_cycles(cycles: np.ndarray, period: int | None) -> np.ndarray:
 #: other-seeds: the runs without wear of the same robot, task and friction model but other seeds
 #: (other units); first-cycles: the first samples of the tested run itself (its "first days",
 #: thesis ch. 4); same-run: the run without wear of the same seed (thesis ch. 3.4, optimistic: its
-#: noise is the tested run's). auto: other-seeds where the dataset has them, else first-cycles
-#: where the run has more samples than it learns from, else same-run.
+#: noise is the tested run's). auto: on a fleet first-cycles (each robot is a unit of its own);
+#: on a sweep other-seeds where the dataset has them, else first-cycles where the run has more
+#: samples than it learns from, else same-run where the run without wear of the seed exists.
 PROTOCOLS = ("auto", "other-seeds", "first-cycles", "same-run")
+
+#: The samples first-cycles learns from when ``first`` is not given; a run with no more samples
+#: than this learns from its first half (:func:`fitted_first`).
+FIRST = 20
+#: The fewest samples ``auto`` lets a fleet's robot learn from (a PCA monitor and its folds).
+MIN_FIRST = 5
+
+
+def fitted_first(first: int | None, n_samples: int) -> int:
+    """The samples first-cycles learns from on a run of ``n_samples``: ``first`` as given, else
+    :data:`FIRST`, or half the run (rounded down) when the run has no more samples than that."""
+    if first is not None:
+        return first
+    return FIRST if n_samples > FIRST else n_samples // 2
 
 
 def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persistence: int = 1,
                     period: int | None = None, progress: bool = True, detector=None, protocol: str = "auto",
-                    first: int = 20, limit_folds: int | None = 20, return_charts: bool = False):
+                    first: int | None = None, limit_folds: int | None = 20, return_charts: bool = False):
     """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5),
     with the false-alarm rate on healthy data the monitor did not learn from.
 
@@ -368,14 +383,16 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     all the cycles of a ``period`` (60 for the c2 preset's hours of one-minute cycles). A PCA
     monitor (components for ``variance`` of the variance, thesis: 75 %; features constant in
     training are left out) learns
-    normal operation as ``protocol`` says (:data:`PROTOCOLS`; ``first`` samples for first-cycles);
+    normal operation as ``protocol`` says (:data:`PROTOCOLS`; ``first`` samples for first-cycles,
+    None: :func:`fitted_first`, 20 or half a shorter run);
     wear is detected at the first sample (after the training ones, and at or after the first
     sample with true wear or fault above 0: ``fault_begins_cycle``) whose Q statistic exceeds its
     ``1 - alpha`` limit for ``persistence`` samples in a row; alarms before the fault begins are
     false alarms (``alarms_before_fault_pct``), never a detection (a fleet's failing robots wear
     from a drawn onset day). Under the held-out protocols the Q
-    limit is estimated out of sample over ``limit_folds`` folds of the training samples
-    (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample, eq. 2.6 as in the thesis):
+    limit is estimated out of sample over ``limit_folds`` folds of the training samples, at most
+    one fold per training sample (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample,
+    eq. 2.6 as in the thesis):
     j2, three seeds, other-seeds, alpha 5 %: 9.0 % false alarms in-sample, 6.2 % with 20 folds;
     same-run always uses the in-sample limit; its location is the axis the
     cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
@@ -418,7 +435,28 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
                                    limit_folds)
         table.attrs["dataset_kind"] = data.kind
+        table.attrs["protocol_reasons"] = charts.pop("_reasons")
     return (table, charts) if return_charts else table
+
+
+def _auto_protocol(kind: str, others: list, own, n_samples: int, first: int | None) -> tuple[str, str]:
+    """The protocol ``auto`` picks for one worn run, and why (a sentence for the user). On a fleet
+    ``first`` is fitted to the record (:func:`fitted_first`); a sweep's choice is as before."""
+    n_first = fitted_first(first, n_samples)
+    if kind == "fleet" and MIN_FIRST <= n_first < n_samples:
+        return "first-cycles", (f"a fleet: each robot is a unit of its own and learns its first {n_first} days "
+                                "(thesis ch. 4, one-to-one)")
+    if others:
+        return "other-seeds", "the dataset has runs without wear of other seeds (other units)"
+    if (first or FIRST) < n_samples:
+        return "first-cycles", (f"no run without wear of another seed; each run learns its first {first or FIRST} "
+                                "samples (sweep --seed 0 --seed 1 --seed 2 for other-seeds)")
+    if own is not None:
+        return "same-run", (f"no run without wear of another seed and runs of {n_samples} samples, too few to "
+                            "learn from their first ones; the run without wear of the same seed (in-sample)")
+    raise ValueError(f"no protocol fits: no run without wear of another seed or of the same seed, and runs of "
+                     f"{n_samples} samples, too few to learn from their first ones (--first); record more cycles "
+                     "or sweep with --axis 0 and several seeds")
 
 
 def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
@@ -446,7 +484,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
 
     monitors: dict[tuple, tuple] = {}
     false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy runs
-    rows, charts = [], {}
+    rows, charts, reasons = [], {}, {}
     for run in tqdm(runs, desc="detection", unit="run", disable=not progress):
         if len(run.worn_axes) != 1:
             continue
@@ -457,10 +495,10 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         sample_of = group_cycles(run.recorded, period)
         samples = np.unique(sample_of)
         n_samples = len(samples)
-        used_protocol = protocol
+        used_protocol, n_first = protocol, fitted_first(first, n_samples)
         if protocol == "auto":  # a fleet's robots are units of their own: each learns its first days (thesis ch. 4)
-            used_protocol = ("first-cycles" if data.kind == "fleet" and n_samples > first else "other-seeds" if others
-                             else "first-cycles" if n_samples > first else "same-run")
+            used_protocol, reason = _auto_protocol(data.kind, others, own, n_samples, first)
+            reasons[used_protocol] = reason
         if used_protocol == "other-seeds":
             if not others:
                 raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
@@ -472,23 +510,25 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             if own is None and len(others) > 1:  # no healthy run of the tested seed: each other one in turn
                 heldout = [("leave-one-out", r, [o for o in others if o is not r]) for r in others]
         elif used_protocol == "first-cycles":
-            if n_samples <= first:
-                raise ValueError(f"{path}: protocol first-cycles learns from the first {first} samples of a run and "
-                                 f"needs more; {run.id} has {n_samples}. Record more cycles, or sweep several "
-                                 "seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
-            keep = np.isin(sample_of, samples[:first])
+            if n_samples <= n_first:
+                raise ValueError(f"{path}: protocol first-cycles learns from the first {n_first} samples of a run and "
+                                 f"needs more; {run.id} has {n_samples}. Give a smaller --first, record more cycles, "
+                                 "or sweep several seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
+            keep = np.isin(sample_of, samples[:n_first])
             training = [(run.id, torque_of(run)[keep], run.recorded[keep])]
-            key, trained_on, heldout, skip = (run.id, first), f"samples 1-{first} of the run", similar(run), first
+            key, trained_on, heldout, skip = (run.id, n_first), f"samples 1-{n_first} of the run", similar(run), n_first
         else:  # same-run
             if own is None:
                 raise ValueError(f"{path}: protocol same-run needs the run without wear of {run.robot} "
-                                 f"{run.task} seed {run.seed}; this dataset has none")
+                                 f"{run.task} seed {run.seed}; this dataset has none: use --protocol first-cycles "
+                                 "(or auto)")
             training = [(own.id, torque_of(own), own.recorded)]
             key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
         held_out = used_protocol != "same-run"
         if key not in monitors:  # one monitor serves every worn run that learns from the same data
             monitors[key] = _fit_monitor(training, period, variance, alpha, detector, fixed_reference=held_out,
                                          folds=limit_folds if held_out else None)
+
         if used_protocol == "same-run":
             used_protocol = "same-run (in-sample)"
         scale, reference, used, monitor = monitors[key]
@@ -513,15 +553,15 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                     flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)
                 elif used_protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
                     normal_of = group_cycles(normal_run.recorded, period)
-                    if len(np.unique(normal_of)) <= first:
+                    if len(np.unique(normal_of)) <= n_first:
                         continue
-                    own_keep = np.isin(normal_of, np.unique(normal_of)[:first])
+                    own_keep = np.isin(normal_of, np.unique(normal_of)[:n_first])
                     fitted = _fit_monitor([(normal_run.id, torque_of(normal_run)[own_keep],
                                             normal_run.recorded[own_keep])], period, variance, alpha, detector,
                                           fixed_reference=True, folds=limit_folds)
                     n_scale, n_reference, n_used, n_monitor = fitted
                     normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
-                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)[first:]
+                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)[n_first:]
                 else:
                     normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, scale, period, reference)
                     flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
@@ -554,6 +594,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             chart.update(t2=t2, q=q, t2_limit=monitor.t2_limit_, q_limit=monitor.q_limit_)
         charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
                               protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
+    charts["_reasons"] = reasons
     return pd.DataFrame(rows), charts
 
 
@@ -611,15 +652,17 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
     return "\n".join(notes)
 
 
-def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
+def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
     """PNG of the Q and T2 charts of :func:`detection_table` (``return_charts=True``): per worn run
-    (the first ``most``), Q and T2 against the cycle (a day in a fleet) on a log scale, with the
+    (every one, up to ``most``: the title then says how many are shown), Q and T2 against the
+    cycle (a day in a fleet) on a log scale, with the
     limit (dashed), the samples the monitor learned from (shaded), where the fault begins (dotted)
     and the onset called (red). A detector without statistics shows its alarms instead."""
     from matplotlib.figure import Figure
 
     shown = list(charts.items())[:most]
-    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8))
+    # constrained layout leaves the title its own room above the first row
+    fig = Figure(figsize=(11, 2.3 * max(1, len(shown)) + 0.8), layout="constrained")
     panels = fig.subplots(max(1, len(shown)), 2, squeeze=False)
     for (run_id, chart), row in zip(shown, panels, strict=False):
         x = chart["cycle"]
@@ -639,9 +682,10 @@ def detection_figure(charts: dict, out: Path, most: int = 12) -> Path:
             ax.set_title(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})", fontsize=8)
     for ax in panels[-1]:
         ax.set_xlabel("cycle (a day in a fleet)")
-    fig.suptitle("PCA monitoring per worn run: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
-                 "normal; dotted green: fault begins; red: onset called", fontsize=9)
-    fig.tight_layout()
+    count = (f"all {len(charts)} worn runs" if len(shown) == len(charts)
+             else f"the first {len(shown)} of {len(charts)} worn runs (every run in the table)")
+    fig.suptitle(f"PCA monitoring, {count}: Q (left) and T2 (right); dashed: 1 - alpha limit; grey: learned as "
+                 "normal;\ndotted green: fault begins; red: onset called", fontsize=9)
     fig.savefig(out, dpi=100)
     return out
 
@@ -684,7 +728,15 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     used = varying_columns(normal)  # features constant in training are left out
     if detector is not None:
         return scale, reference, used, clone(detector).fit(normal[:, used])
-    return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
+    if folds is not None:
+        folds = min(folds, len(normal))  # at most one fold per training sample
+    try:
+        return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
+    except ValueError as err:
+        if folds is None:
+            raise
+        raise ValueError(f"the out-of-sample Q limit over {folds} folds of {len(normal)} training samples: {err}; "
+                         "give fewer folds (--limit-folds 5) or 0 (the in-sample limit)") from None
 
 
 def torque_record(run: reader.Run) -> np.ndarray | StoredHistograms:

@@ -24,7 +24,6 @@ import numpy as np
 from faultgen.calibrate import search
 from faultgen.data import measured
 from faultgen.model import robots
-from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -40,9 +39,7 @@ def main() -> None:
     config = sim.RunConfig(robot="puma560", task=str(log), cycles=1, seed=0, friction="stribeck",
                            noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0))
     result = sim.simulate(config, progress=False)
-    task = programs.load(robot, str(log))
-    offset = task.offset(robot.model.opt.timestep)
-    t_log = data.t - data.t[0] + offset
+    t_log = data.t - data.t[0]  # the run starts at the log's first sample (faultgen.operation.replay)
     inside = t_log <= result.t[-1]
     tau_sim = np.column_stack([np.interp(t_log, result.t, result.tau_m[0, :, k] * robot.gear_ratio[k])
                                for k in range(6)])
@@ -50,7 +47,7 @@ def main() -> None:
     mask = split.held_out & inside[:, None]
     replayed = search.gap(data.tau, tau_sim, mask)
     before = report["gap_before"]
-    print(f"log {log}: {len(data.t)} samples, {data.t[-1] - data.t[0]:.2f} s; run-in {offset:.3f} s; "
+    print(f"log {log}: {len(data.t)} samples, {data.t[-1] - data.t[0]:.2f} s; "
           f"{int(inside.sum())} samples inside the replayed cycle")
     print(f"{'':24}" + "".join(f"{'axis ' + str(k + 1):>10}" for k in range(6)) + f"{'total':>10}")
     print(f"{'calibrate gap_before':24}" + "".join(f"{v:10.4f}" for v in before["nrmse"])

@@ -21,8 +21,11 @@ are gone; docs/architecture.md says where each module lives.
 import importlib
 from importlib.metadata import PackageNotFoundError, version
 
+#: The distribution name (pyproject.toml): ``faultgen`` on PyPI is an unrelated project.
+DISTRIBUTION = "faultgen-robots"
+
 try:
-    __version__ = version("faultgen")
+    __version__ = version(DISTRIBUTION)
 except PackageNotFoundError:  # running from a source tree that was not installed
     __version__ = "0.0.0+unknown"
 

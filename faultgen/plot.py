@@ -96,16 +96,28 @@ def _draw(data: reader.Dataset, run: str | None):
 
 #: Days at the start of each robot's record that the fleet plot measures the change from.
 BASELINE_DAYS = 5
+#: Days of the fleet plot's running median.
+TREND_DAYS = 7
+
+
+def running_median(values: np.ndarray, days: int = TREND_DAYS) -> np.ndarray:
+    """The centred running median of ``values`` (n_days, n) over ``days`` days, NaN where the
+    window is not full: at a record's ends a median of three or four days is one part's torque,
+    not the trend (a healthy robot's last day read -33 % on a 20-day fleet, issue 51)."""
+    import pandas as pd
+
+    return pd.DataFrame(values).rolling(days, center=True, min_periods=days).median().to_numpy()
 
 
 def _draw_fleet(data, out: Path) -> Path:
     """A fleet (daily records of robots, ``faultgen fleet``): one panel per robot, in file order.
     Against the day of its record: the change of each axis's mean |motor torque| from its median
-    over the first :data:`BASELINE_DAYS` days (%), as its running median over 7 days (the parts a
-    robot carries change the torque from day to day; the worn axis bold, its days as dots, the
-    others thin grey) and, on a second y axis, the worn axis's true wear (%, red). Healthy robots show their
-    six axes only: what a monitor sees when nothing wears."""
-    import pandas as pd
+    over the first :data:`BASELINE_DAYS` days (%), as its running median over 7 days
+    (:func:`running_median`, drawn where the week is whole; the parts a robot carries change the
+    torque from day to day; the worn axis bold, its days as dots, the others thin grey), the days
+    the robot's record carries its lighter part as ticks along the bottom, and, on a second y axis,
+    the worn axis's true wear (%, red). Healthy robots show their six axes only: what a monitor sees
+    when nothing wears."""
     from matplotlib.figure import Figure
 
     runs = data.runs
@@ -121,13 +133,18 @@ def _draw_fleet(data, out: Path) -> Path:
         worn = [a - 1 for a in run.worn_axes]
         # the parts a robot carries change its torque from day to day: lines through the days
         # zigzag, so the days are dots and the line is their running median over a week
-        trend = pd.DataFrame(change).rolling(7, center=True, min_periods=1).median().to_numpy()
+        trend = running_median(change)
         for j in range(change.shape[1]):
             if j not in worn:
                 ax.plot(days, trend[:, j], "-", lw=0.7, color="0.65")
         for j in worn:
             ax.plot(days, change[:, j], ".", ms=3, color="tab:blue", alpha=0.5)
             ax.plot(days, trend[:, j], "-", lw=1.6, color="tab:blue", label=f"axis {j + 1}")
+        if run.has("payload_mass"):  # the part of each day's record: the lighter one ticked
+            mass = run.array("payload_mass")
+            light = mass < mass.max()
+            ax.plot(days[light], np.zeros(int(light.sum())), "|", ms=6, color="tab:green",
+                    transform=ax.get_xaxis_transform(), label="lighter part")
         ax.axhline(0.0, color="0.4", lw=0.6)
         ax.set_ylabel(CHANGE_LABEL.replace("change of ", "").replace(" [%]", "\nchange [%]"), fontsize=7)
         ax.tick_params(labelsize=7)
@@ -147,8 +164,8 @@ def _draw_fleet(data, out: Path) -> Path:
         ax.set_xlabel("day of the record", fontsize=8)
     fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
                  f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running median "
-                 "over 7 days (blue: the worn axis, its days as dots; grey: the other axes); red: the worn axis's true "
-                 "wear", fontsize=10)
+                 f"over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; grey: the "
+                 "other axes); red: the worn axis's true wear; green ticks: days with the lighter part", fontsize=10)
     from faultgen.data.atomic import atomic_path
 
     with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG

@@ -117,11 +117,44 @@ def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(re
             cluster.start_worker(name)
         for case in (sweep_and_fleet_equal_the_local_ones, with_a_shared_folder_the_workers_write_the_parts,
                      a_worker_killed_mid_run_loses_only_that_run_to_another_worker,
-                     a_killed_client_resumes_to_the_same_dataset):
+                     a_killed_client_resumes_to_the_same_dataset,
+                     a_relative_robot_folder_and_program_run_on_the_workers):
             with subtests.test(case.__name__.replace("_", " ")):
                 case(cluster, reference, client_folder)
     finally:
         cluster.close()
+
+
+def a_relative_robot_folder_and_program_run_on_the_workers(cluster, reference, client_folder):
+    """`--robot kr6 --task mine.toml`, paths relative to the client's folder (issue 51: the workers,
+    each in a folder of its own, failed with "unknown robot 'kr6'"): the client sends its absolute
+    paths, the runs are labelled with the paths as given; a path a worker lacks is named with the
+    worker, and a sweep none of whose runs finished does not speak of runs kept."""
+    import shutil
+
+    from faultgen.runs import cluster as cluster_runs
+
+    shutil.copytree(REPO / "robots/puma560", client_folder / "kr6")
+    runner = CliRunner()
+    assert runner.invoke(app, ["tasks", "export", "kr6", "spot_weld", "-o", "mine.toml"]).exit_code == 0
+    out = client_folder / "out/kr6.h5"
+    result = runner.invoke(app, ["sweep", "--robot", "kr6", "--task", "mine.toml", "--axis", "0", "--axis", "2",
+                                 "--cycles", "2", "--scheduler", cluster.address, "--no-progress", "-o", "out/kr6.h5"])
+    assert result.exit_code == 0, result.output
+    assert dataset.validate(out) == []
+    with h5py.File(out) as f:
+        assert len(f["runs"]) == 2
+        for run in f["runs"].values():
+            config = json.loads(run.attrs["config"])
+            assert config["robot"] == "kr6" and config["task"] == "mine.toml"
+    config = sweep.Grid(robots=["kr6"], tasks=["mine.toml"], axes=[0], cycles=1).runs()[0][1]
+    sent = cluster_runs.for_workers(config)
+    assert sent.robot == str(client_folder / "kr6") and sent.task == str(client_folder / "mine.toml")
+    assert cluster_runs.for_workers(sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0],
+                                               cycles=1).runs()[0][1]).robot == "puma560"
+    lost = cluster_runs.failure_message(["r1: worker tcp://w has no /x/kr6"], 1, client_folder / "out/p.parts")
+    assert "none of the 1 runs finished" in lost and "kept" not in lost
+    assert "the 1 that finished are kept in" in cluster_runs.failure_message(["r1: x"], 2, Path("p.parts"))
 
 
 def assert_same_files(a: Path, b: Path) -> None:

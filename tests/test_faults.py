@@ -79,7 +79,7 @@ def test_a_fault_sweep_labels_every_cycle_and_isolates(tmp_path):
     from analysis import benchmark
 
     grid = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0, 3], cycles=8, record=[2, 4, 6, 8],
-                      fault="cogging:amplitude:0.05:poles=8")
+                      fault="cogging:each:amplitude:0.05:poles=8")
     out = sweep.run(grid, tmp_path / "faults.h5", progress=False)
     assert dataset.validate(out) == []
     rows = {row["run"]: row for row in dataset.labels(out)}

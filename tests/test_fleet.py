@@ -71,8 +71,8 @@ def test_a_fleet_with_a_task_mix_keeps_every_other_draw():
     ({"gear_loss": 0.7, "friction": "stribeck"}, r"fleet gear_loss = 0.7: expected a number within 0..0.5"),
     ({"gear_loss": 0.1}, r"fleet gear_loss = 0.1 needs friction 'stribeck' \(--friction stribeck; got 'lugre'\)"),
     ({"gear_loss": 0.1, "friction": "stribeck", "conditions": False}, r"and the conditions \(got conditions = False\)"),
-    ({"fault": "backlash:width:0.01:kind=linear"}, r"fleet fault 'backlash:width:0.01:kind=linear': the fleet sets"),
-    ({"fault": "backlash:gap:0.01"}, r"fleet fault 'backlash:gap:0.01': .*backlash has no parameter 'gap'"),
+    ({"fault": "backlash:each:width:0.01:kind=linear"}, r"fleet fault 'backlash:each:width:0.01:kind=linear': the fleet sets"),
+    ({"fault": "backlash:each:gap:0.01"}, r"fleet fault 'backlash:each:gap:0.01': .*backlash has no parameter 'gap'"),
 ])
 def test_bad_fleet_settings_are_refused_with_the_value_named(settings, message):
     with pytest.raises(ValueError, match=message):
@@ -160,7 +160,7 @@ def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(tm
     exp4 from its drawn onset day to FINAL on the failure day; the healthy robots, every draw and
     the default fleet's stored settings are unchanged; the file validates and labels the fault's
     value per day."""
-    plain, faulty = Fleet(), Fleet(fault="backlash:width:0.01")
+    plain, faulty = Fleet(), Fleet(fault="backlash:each:width:0.01")
     assert plain.robots() == faulty.robots() and "fault" not in json.loads(plain.to_json())["fleet"]
     for (run_id, config), robot in zip(faulty.runs(), faulty.robots(), strict=True):
         assert not config.wear.schedules
@@ -172,10 +172,10 @@ def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(tm
         assert config.fault.values(np.array([0, onset, config.cycles])) == pytest.approx([0.0, 0.0, 0.01])
     out = tmp_path / "backlash.h5"
     result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
-                                      "--fault", "backlash:width:0.01", "--jobs", "1", "--no-progress", "-o", str(out)])
+                                      "--fault", "backlash:each:width:0.01", "--jobs", "1", "--no-progress", "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert dataset.validate(out) == []
-    small = Fleet(size=2, failing=1, days=6, cycles_per_day=1, fault="backlash:width:0.01")
+    small = Fleet(size=2, failing=1, days=6, cycles_per_day=1, fault="backlash:each:width:0.01")
     failing = next((run_id, config) for run_id, config in small.runs() if config.fault is not None)
     arrays, attrs = dataset.read_run(out, failing[0], names=("fault_value",))
     np.testing.assert_allclose(arrays["fault_value"], failing[1].fault.values(np.arange(1, 7)), rtol=1e-12)

@@ -125,12 +125,17 @@ def test_the_dataset_card_explains_wear_labels_units_and_bins(fleet):
     result = CliRunner().invoke(app, ["info", str(fleet), "--card"])
     assert result.exit_code == 0, result.output
     text = result.output
-    for heading in ("## What 20 % wear means", "## Labels", "## Arrays and units", "## Histogram bin edges",
+    import faultgen
+
+    with faultgen.open(fleet) as data:  # the card explains the fleet's own largest wear (issue 51: 20 % at 50 %)
+        largest = round(max(float(run.wear.max()) for run in data.runs), 1)
+    assert largest == 50.0
+    for heading in ("## What 50 % wear means", "## Labels", "## Arrays and units", "## Histogram bin edges",
                     "## Provenance and versions"):
         assert heading in text
     irb = robots.load("irb6700")
     coulomb = irb.friction.coulomb_pos[2]
-    assert f"| irb6700 | 3 | {coulomb:.3g} | +{0.2 * coulomb:.3g} |" in text
+    assert f"| irb6700 | 3 | {coulomb:.3g} | +{0.5 * coulomb:.3g} |" in text
     assert "| average_load_torque | N m | cycle, axis |" in text and "| joint_temperature | degC |" in text
     assert "| tau_m |" not in text  # a fleet stores no signals: the card lists what the file holds
     with h5py.File(fleet, "r") as f:  # a library-made fleet stores no command

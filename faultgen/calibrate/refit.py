@@ -19,6 +19,8 @@ compares the two on the independent-simulator logs (docs/calibration.md).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,6 +67,20 @@ class Refit:
     sysid_half_width: float
 
 
+@contextlib.contextmanager
+def _quiet_sysid():
+    """``mujoco.sysid``'s absl warnings (a start at a bound, conditioning) kept from the user's
+    console while it runs: the calibration reports the refit's outcome itself."""
+    from absl import logging as absl_logging
+
+    before = absl_logging.get_verbosity()
+    absl_logging.set_verbosity(absl_logging.ERROR)
+    try:
+        yield
+    finally:
+        absl_logging.set_verbosity(before)
+
+
 def _optimize(sysid, residual_of, starts, low, high, max_iters: int):
     """Minimise the stacked residual ``residual_of(x)`` over ``x`` within ``[low, high]`` from
     ``starts`` with ``sysid.optimize`` (MuJoCo's Levenberg-Marquardt); return the optimum, its 95 %
@@ -80,7 +96,11 @@ def _optimize(sysid, residual_of, starts, low, high, max_iters: int):
     for k, (value, lo, hi) in enumerate(zip(starts, low, high, strict=True)):
         params.add(sysid.Parameter(f"p{k}", value, lo, hi))
     started = time.perf_counter()
-    found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters)
+    with _quiet_sysid():
+        # output=: MuJoCo's Levenberg-Marquardt prints an "iter:" line per step to stdout otherwise
+        # (sysid.optimize's own verbose= is its summary table, not the backend's)
+        found, outcome = sysid.optimize(params, residual_fn, optimizer="mujoco", verbose=False, max_iters=max_iters,
+                                        output=io.StringIO())
     seconds = time.perf_counter() - started
     x = found.as_vector()
     _, half = sysid.calculate_intervals([residual_of(x)], np.asarray(outcome.jac), alpha=ALPHA)
@@ -180,7 +200,7 @@ REFINE_ITERATIONS = 50
 #: velocity between one rest speed at the motor and twice the 95th-percentile motor speed, the
 #: exponent over the literature's range of :data:`faultgen.effects.stribeck.EXPONENTS`.
 LEVEL_REACH = 3.0
-INSTALL = "pip install 'faultgen[sysid]' (or 'mujoco[sysid]')"
+INSTALL = "pip install 'mujoco[sysid]' (or, in a clone of faultgen, pip install '.[sysid]')"
 
 
 class SysidUnavailable(ImportError):

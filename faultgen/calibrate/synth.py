@@ -232,9 +232,11 @@ def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path
 
 
 def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str = "pick_place",
-           cycles: int = 4, seed: int = 0) -> Path:
+           cycles: int = 4, seed: int = 0, progress: bool = False) -> Path:
     """Simulate ``cycles`` cycles of ``task`` on the robot with ``hidden`` switched on and write
-    the log in the measured-data format (CSV, the design document's columns) to ``out``.
+    the log in the measured-data format (CSV, the design document's columns) to ``out``; the
+    model with the hidden effect goes beside it, in ``OUT-STEM_model/``. ``progress`` draws the
+    simulation's progress bar (``faultgen hidden-log``).
 
     Returns
     -------
@@ -246,7 +248,7 @@ def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str
     model = write_model(robot, hidden, out.parent / f"{out.stem}_model")
     config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed,
                            back_to_back=True)
-    run = sim.simulate(config, progress=False)
+    run = sim.simulate(config, progress=progress)
     G = robot.gear_ratio
     duration = sim.cycle_duration(str(model), task)
     t = np.concatenate([(c - 1) * duration + run.t for c in run.cycles])

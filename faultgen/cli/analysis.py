@@ -56,12 +56,12 @@ def bench_isolators_command(
     worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
 
     Examples (the thesis's Table 6.2 on its grid; then averaging only over the motor speeds of
-    thesis ch. 6.3.2; then with your own isolator from mine.py):
+    thesis ch. 6.3.2; then with your own isolator, mine.py of docs/analysis.md):
 
     \b
       faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
       faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
-      faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
+      faultgen bench-isolators j2.h5 --isolator mine:LargestRise -o j2-mine
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
@@ -113,9 +113,13 @@ def detect_command(
     protocol: Annotated[str, typer.Option(
         help="Where the monitor learns normal operation: other-seeds (runs without wear of the other seeds: other "
              "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
-             "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (other-seeds where "
-             "the dataset has several seeds, else first-cycles where runs are longer than --first, else same-run).")] = "auto",
-    first: Annotated[int, typer.Option(help="Samples the first-cycles protocol learns from.", min=1, max=MAX_SAMPLES)] = 20,
+             "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (on a fleet "
+             "first-cycles, each robot its own first days; on a sweep other-seeds where the dataset has several "
+             "seeds, else first-cycles where runs are longer than --first, else same-run). The protocol used and "
+             "why is printed.")] = "auto",
+    first: Annotated[int | None, typer.Option(
+        help="Samples the first-cycles protocol learns from. Default: 20, or the first half of a run of 20 samples "
+             "or fewer (a 20-day fleet learns its first 10 days).", min=1, max=MAX_SAMPLES, show_default=False)] = None,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)] = 0.75,
     alpha: QAlpha = 0.05,
     limit_folds: Annotated[int, typer.Option(
@@ -147,7 +151,10 @@ def detect_command(
     Example:
 
     \b
-      faultgen detect j2.h5 --protocol other-seeds -o j2-detection
+      faultgen detect quick.h5
+      faultgen fleet --robots 8 --days 20 -o fleet8.h5 && faultgen detect fleet8.h5
+      faultgen sweep --preset quick --seed 0 --seed 1 -o quick-seeds.h5
+      faultgen detect quick-seeds.h5 --protocol other-seeds -o quick-seeds-detection
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
@@ -160,6 +167,8 @@ def detect_command(
         file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
         detector=plugins_.load(plugin, "detector") if plugin else None, protocol=protocol, first=first,
         limit_folds=limit_folds or None, return_charts=True)
+    for used, reason in table.attrs["protocol_reasons"].items():
+        typer.echo(f"protocol auto -> {used}: {reason}")
     summary = benchmark.detection_summary(table)
     with atomic.output_set(written) as staged:  # all four outputs, or none
         benchmark.write_outputs(table, staged(stem))
@@ -316,9 +325,9 @@ def classify_command(
 
     \b
       faultgen fleet -o fleet.h5 && faultgen classify fleet.h5 --horizon 3 --pairs 0
-      faultgen classify fleet.h5 --horizon 3 --pairs 0 --full
-      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
-      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
+      faultgen classify fleet.h5 --horizon 3 --pairs 0 --full -o fleet-full
+      faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19 -o fleet-lr
+      faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19 -o fleet-matched
     """
     import shlex
 

@@ -100,6 +100,12 @@ class _PlainHelp:
         return params
 
 
+    def get_short_help_str(self, limit: int = 45) -> str:
+        """The command's line in ``faultgen --help``: the first sentence of its help, whole (click
+        cuts it at 45 characters with "...")."""
+        return super().get_short_help_str(limit=1000)
+
+
 def _no_type_tag(ctx) -> None:
     return None
 

@@ -48,9 +48,10 @@ def calibrate_command(
     parameters and evidence) and calibration.png (measured vs model torque and the residual
     before and after, per axis). Method and accuracy: docs/calibration.md.
 
-    Example:
+    Example (on a log with a hidden effect, `faultgen hidden-log`):
 
     \b
+      faultgen hidden-log puma560 --effect coulomb --cycles 2 -o log.csv
       faultgen calibrate --robot puma560 --measured log.csv --out calib
     """
     from faultgen import calibrate
@@ -95,3 +96,45 @@ def excitation_command(
     typer.echo(f"wrote {out}: {designed.period:g} s period, {len(designed.a)} harmonics, regressor condition "
                f"number {designed.condition_number:.1f} (first random start {designed.start_condition_number:.1f}, "
                f"best of the random starts {designed.best_start_condition_number:.1f})")
+
+
+@app.command("hidden-log", cls=Command)
+def hidden_log_command(
+    robot: Annotated[str, typer.Argument(help="Robot name (see `faultgen robots`), robot folder or MJCF file.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="CSV log to write (the measured-log format).")],
+    effect: Annotated[str, typer.Option(
+        help="The hidden effect, one of `faultgen calibrate --help`'s effects (coulomb, payload, cogging, "
+             "backlash, ...), or none.")],
+    seed: Annotated[int, typer.Option(help="Seed of the effect's draw (size, axes) and of the noise.", min=0)] = 0,
+    cycles: Annotated[int, typer.Option(help="Cycles of the task in the log, back to back.", min=1, max=100)] = 4,
+    task: Annotated[str, typer.Option(
+        help="The task the robot runs (a thesis task or a program file).")] = "pick_place",
+    overwrite: Overwrite = False,
+) -> None:
+    """Make a torque log of a robot with a hidden effect, to try `faultgen calibrate` on.
+
+    The effect is drawn at a random size on random axes (faultgen.calibrate.synth, the data of
+    docs/calibration.md's accuracy tables), switched on in a copy of the model (written beside
+    the log, in OUT-STEM_model/), and the robot runs the task at a 0.1 ms step; the log has the
+    measured-log columns t, q1..qN, tau1..tauN with 1 % torque noise. What was hidden is printed.
+
+    Example:
+
+    \b
+      faultgen hidden-log puma560 --effect payload --seed 1 -o log.csv
+      faultgen calibrate --robot puma560 --measured log.csv --out calib
+    """
+    import numpy as np
+
+    from faultgen.calibrate import synth
+    from faultgen.cli.base import check_outputs
+    from faultgen.model import robots
+
+    check_outputs([out], overwrite)
+    model = robots.load(robot)
+    hidden = synth.draw(model, None if effect == "none" else effect, np.random.default_rng(seed), task=task,
+                        cycles=cycles)
+    typer.echo(f"{model.name}: hidden {hidden}; simulating {cycles} cycle(s) of {task} at a 0.1 ms step", err=True)
+    synth.record(model, hidden, out, task=task, cycles=cycles, seed=seed, progress=True)
+    typer.echo(f"wrote {out}: {model.name} {task}, {cycles} cycle(s), hidden {hidden}\n"
+               f"calibrate it: faultgen calibrate --robot {robot} --measured {out} --out calib")

@@ -108,7 +108,7 @@ def simulate_command(
 @app.command("sweep", cls=Command)
 def sweep_command(
     preset: Annotated[
-        str | None, typer.Option(help="A named grid: quick (a first look, under a minute on 2 cores), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
+        str | None, typer.Option(help="A named grid: quick (a first look, 21 runs; its time: docs/performance.md), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
@@ -123,8 +123,10 @@ def sweep_command(
     record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
     seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.", min=0, max=MAX_SEED)] = None,
     fault: Annotated[str | None, typer.Option(
-        help="Instead of friction wear, each worn axis gets this fault: EFFECT:PARAMETER:FINAL[:key=value,...], "
-        "e.g. backlash:width:0.01 or cogging:amplitude:0.05:poles=8 (see `simulate --fault`).")] = None,
+        help="Instead of friction wear, a fault (the form of `simulate --fault`): EFFECT:AXIS:PARAMETER:FINAL"
+        "[:key=value,...], AXIS 'each' for every worn axis in turn (e.g. backlash:each:width:0.01 with --axis 0 "
+        "--axis 2 --axis 3) or a number (backlash:2:width:0.01: with no --axis, the grid is the run without wear "
+        "and axis 2).")] = None,
     temperature: Temperature = False,
     dry_share: DryShare = None,
     payloads: PayloadParts = None,
@@ -161,6 +163,7 @@ def sweep_command(
       faultgen sweep --preset j2 --temperature --unit-spread -o j2-conditions.h5
       faultgen sweep --task pick_place --axis 0 --axis 2 --task-mix pick_place,spot_weld --features-only -o mix.h5
     """
+    from faultgen.operation import faults
     from faultgen.runs import sweep
 
     options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
@@ -175,6 +178,9 @@ def sweep_command(
         options["signals"] = not features_only
     if fault is not None:
         options["fault"] = fault
+        on = faults.FaultSpec.parse(fault).axis
+        if on is not None and axes is None:  # a fault on a named axis: beside the run without wear
+            options["axes"] = [0, on]
     if record is not None:
         options["record"] = list(parse_cycles(record))
     if config is not None:
@@ -206,7 +212,9 @@ def sweep_command(
 @app.command("fleet", cls=Command)
 def fleet_command(
     size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).", min=2, max=10000)] = 26,
-    failing: Annotated[int, typer.Option(help="Of them, robots whose gearbox fails (thesis: 13).", min=1, max=10000)] = 13,
+    failing: Annotated[int | None, typer.Option(
+        help="Of them, robots whose gearbox fails (thesis: 13 of 26). Default: half of --robots, rounded down.",
+        min=1, max=10000, show_default=False)] = None,
     models: Annotated[list[str] | None, typer.Option(
         "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
         "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
@@ -237,7 +245,7 @@ def fleet_command(
     fault: Annotated[str | None, typer.Option(
         help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
         "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
-        "backlash:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
+        "backlash:each:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
@@ -258,8 +266,8 @@ def fleet_command(
       faultgen fleet -o fleet.h5
       faultgen classify fleet.h5 --wear-threshold 10
       faultgen fleet --friction stribeck --gear-loss 0.1 -o fleet-lossy.h5
-      faultgen fleet --fault backlash:width:0.01 -o fleet-backlash.h5
-      faultgen fleet --robot irb6700 --fault cogging:amplitude:0.5:poles=8 -o fleet-cogging.h5
+      faultgen fleet --fault backlash:each:width:0.01 -o fleet-backlash.h5
+      faultgen fleet --robot irb6700 --fault cogging:each:amplitude:0.5:poles=8 -o fleet-cogging.h5
       faultgen fleet --without payloads -o fleet-no-parts.h5
       faultgen fleet --robots 500 --days 365 --scheduler tcp://10.0.0.5:8786 -o fleet-500.h5
     """
@@ -339,6 +347,12 @@ def summary(result, out: Path) -> str:
         " " * 30 + "".join(f"{'axis ' + str(i):>11}" for i in range(1, result.tau_m.shape[-1] + 1)),
     ]
     lines += [f"{title:<30}" + "".join(f"{v:>11{fmt}}" for v in values) for title, values, fmt in rows]
+    if config.fault is not None:
+        fault = config.fault
+        value = fault.values(np.array([int(result.cycles[last])]))[0]
+        lines.append(f"fault {fault.text()}: {fault.effect} {fault.parameter} on axis {fault.axis} grows {fault.kind} "
+                     f"from {fault.start:g} to {fault.final:g} at cycle {config.cycles}; {value:.4g} at the last "
+                     "recorded cycle")
     c = result.conditions
     if c is not None:
         lines.append(f"conditions, last cycle: day {c.day[last]:.0f} at {c.hour[last]:.1f} h; dry friction x "

@@ -17,7 +17,8 @@ from faultgen import __version__
 from faultgen.data import dataset, reader
 from faultgen.simulation import sensors
 
-#: The wear level the card explains in physical terms.
+#: The wear level the card explains in physical terms when the dataset has no friction wear; a
+#: dataset with wear is explained at its largest (a fleet's 50 %, a quick sweep's 20 %).
 EXAMPLE_WEAR = 20.0
 
 
@@ -37,7 +38,8 @@ def _table(head, rows) -> list[str]:
 
 
 def card(path: str | Path) -> str:
-    """The card of the dataset at ``path``, Markdown: contents, what ``EXAMPLE_WEAR`` % wear means
+    """The card of the dataset at ``path``, Markdown: contents, what its largest wear (else
+    ``EXAMPLE_WEAR`` %) means
     physically per robot and axis, label definitions, units of every stored array, histogram bin
     edges, the command that wrote it and the versions.
 
@@ -54,6 +56,8 @@ def card(path: str | Path) -> str:
         names = sorted({name for run in runs for name in run.names})
         kind, command, written_by = data.kind, data.command, data.faultgen_version
         shas = {run.robot: run.provenance["model_sha256"] for run in runs}
+        largest = max((float(run.wear.max()) for run in runs), default=0.0)
+    wear_pct = round(largest, 1) if largest > 0.05 else EXAMPLE_WEAR
     robot_names = sorted({r.robot for r in runs})
     pairs = sorted({(r.robot, r.task) for r in runs})
     lines = [f"# Dataset card: {Path(path).name}", "",
@@ -62,10 +66,12 @@ def card(path: str | Path) -> str:
              + ("a day's record (the day's maximum of its cycles)" if any(r.sample == "day" for r in runs)
                 else "one recorded cycle") + ".", ""]
 
-    lines += [f"## What {EXAMPLE_WEAR:g} % wear means", "",
-              f"Wear multiplies an axis's Coulomb and static friction: {EXAMPLE_WEAR:g} % wear is "
-              f"{1 + EXAMPLE_WEAR / 100:g} times the new gearbox's (`friction_multiplier` "
-              f"{1 + EXAMPLE_WEAR / 100:g}; wear_pct = (friction_multiplier - 1) x 100). Viscous friction is "
+    lines += [f"## What {wear_pct:g} % wear means", "",
+              (f"{wear_pct:g} % is the largest wear in this dataset. " if largest > 0.05 else
+               f"This dataset has no friction wear; {wear_pct:g} % as an example. ")
+              + f"Wear multiplies an axis's Coulomb and static friction: {wear_pct:g} % wear is "
+              f"{1 + wear_pct / 100:g} times the new gearbox's (`friction_multiplier` "
+              f"{1 + wear_pct / 100:g}; wear_pct = (friction_multiplier - 1) x 100). Viscous friction is "
               "unchanged. Per axis, the Coulomb friction (positive direction) new and its increase, at the motor "
               "and at the arm joint (times the gear ratio), the model's nominal values (with a unit spread, "
               "`dry_friction_factor` scales each unit's):", ""]
@@ -74,12 +80,12 @@ def card(path: str | Path) -> str:
         robot = robots.load(name)
         for a in range(len(robot.gear_ratio)):
             coulomb = float(robot.friction.coulomb_pos[a])
-            rise = coulomb * EXAMPLE_WEAR / 100
+            rise = coulomb * wear_pct / 100
             rows.append([name, a + 1, f"{coulomb:.3g}", f"+{rise:.3g}", f"{robot.gear_ratio[a]:.4g}",
                          f"+{rise * robot.gear_ratio[a]:.3g}",
                          f"{100 * rise / float(robot.motor_torque_limit[a]):.2g}"])
-    lines += _table(["robot", "axis", "Coulomb new, N m (motor)", f"+{EXAMPLE_WEAR:g} %, N m (motor)", "gear ratio",
-                     f"+{EXAMPLE_WEAR:g} %, N m (arm)", "% of peak motor torque"], rows)
+    lines += _table(["robot", "axis", "Coulomb new, N m (motor)", f"+{wear_pct:g} %, N m (motor)", "gear ratio",
+                     f"+{wear_pct:g} %, N m (arm)", "% of peak motor torque"], rows)
 
     lines += ["", "## Labels", "",
               "- `worn_axes`: axes (1-based) that wear or carry the fault; none: a healthy run (a normal robot).",

@@ -57,6 +57,7 @@ from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
 from faultgen.operation import programs
+from faultgen.operation.faults import Fault
 from faultgen.simulation import sensors
 
 FORMAT = "faultgen"
@@ -771,8 +772,16 @@ def summary(path: str | Path) -> str:
            else "features and truth only (no 250 Hz signals)"),
     ]
     if any("conditions" in row for row in rows):
-        lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions "
-                     "(temperature, payloads, task mix, unit spread: CONDITION_ARRAYS)")
+        tables = [json.loads(row["conditions"]) for row in rows if "conditions" in row]
+        kinds = sorted({key for table in tables for key, value in table.items()
+                        if key in ("thermal", "payloads", "spread", "task_mix") and value})
+        lines.append(f"  conditions:    {sum('conditions' in row for row in rows)} run(s) with operating conditions: "
+                     f"{', '.join(kinds)} (their per-cycle arrays: `faultgen info FILE --card`, docs/dataset.md)")
+    with_fault = [Fault(**json.loads(row["fault"])).text() for row in rows if "fault" in row]
+    if with_fault:
+        counts = {text: with_fault.count(text) for text in dict.fromkeys(with_fault)}
+        lines.append("  faults:        " + ", ".join(f"{text} ({n} run{'s' * (n > 1)})" for text, n in counts.items())
+                     + " (EFFECT:AXIS:PARAMETER:FINAL, other than friction wear)")
     saturated = [row for row in rows if len(row.get("saturated", ()))]
     if saturated:
         lines.append(f"  saturated:     {len(saturated)} run(s) whose motors reached their torque limit (they do not "

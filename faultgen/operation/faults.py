@@ -29,7 +29,7 @@ their fault.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
@@ -45,7 +45,8 @@ from faultgen.operation import wear
 GROWTHS = ("absolute", "relative")
 
 _SPEC_FORM = ("the form is EFFECT:AXIS:PARAMETER:FINAL[:key=value,...], e.g. 'backlash:2:width:0.01', "
-              "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4'")
+              "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4' (AXIS 'each' in a sweep "
+              "or a fleet: each worn axis)")
 
 
 @dataclass(frozen=True)
@@ -228,6 +229,15 @@ class Fault:
             table[name] = column
         return cls(**table)
 
+    def text(self) -> str:
+        """The fault text that makes this fault again (:class:`FaultSpec`), e.g. ``backlash:2:width:0.01``;
+        a relative fault (friction wear) is not written so and gives its labels instead."""
+        if self.relative:
+            return f"{self.effect} {self.parameter} x{1 + self.final:g} on axis {self.axis} ({self.kind})"
+        return str(FaultSpec(self.effect, self.axis, self.parameter, self.final,
+                             None if self.kind == "linear" else self.kind, self.start, self.onset or None,
+                             dict(self.others)))
+
     def to_dict(self) -> dict:
         """JSON-serialisable labels (``onset``, ``growth`` and ``options`` only when not their
         defaults, so absolute faults without them keep their labels)."""
@@ -280,43 +290,128 @@ def dry_multipliers(faults, cycles, n_axes: int) -> np.ndarray:
     return out
 
 
-def parse_fault(spec: str, last_cycle: int) -> Fault:
-    """A :class:`Fault` from ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]`` (options: ``kind``,
-    ``start``, ``onset`` and the effect's other parameters). Raises ValueError quoting the spec and the form."""
+#: The axis placeholder of a sweep's or fleet's fault text: the swept or drawn axis.
+ANY_AXIS = "each"
 
-    def fail(reason: str) -> ValueError:
-        return ValueError(f"bad fault spec {spec!r}: {reason}; {_SPEC_FORM}")
 
-    parts = [p.strip() for p in spec.strip().split(":")]
-    if len(parts) not in (4, 5):
-        raise fail(f"it has {len(parts)} ':'-separated field(s), expected 4 or 5")
-    effect, axis_text, parameter, final_text = parts[:4]
-    try:
-        axis, final = int(axis_text), float(final_text)
-    except ValueError:
-        raise fail("AXIS must be an int and FINAL a number") from None
-    options, kind, start, onset = {}, "linear", 0.0, 0
-    if len(parts) == 5:
-        for option in parts[4].split(","):
-            key, sep, value = (s.strip() for s in option.partition("="))
-            if not sep or not key or not value:
-                raise fail(f"option {option!r} is not key=value")
-            if key == "kind":
-                kind = value
-                continue
-            try:
+@dataclass(frozen=True)
+class FaultSpec:
+    """The fault text every command takes, parsed once: ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]``.
+
+    ``simulate --fault`` names its axis (``backlash:2:width:0.01``). A sweep or a fleet takes the
+    same text; there ``AXIS`` may be ``each`` (:data:`ANY_AXIS`; not ``*``, which a shell would
+    expand): the axis each run wears (a sweep's ``--axis``, a fleet's drawn axis),
+    ``backlash:each:width:0.01``. Options: ``kind`` (wear schedule
+    kind), ``start``, ``onset`` (a whole cycle) and the effect's other parameters.
+
+    Attributes
+    ----------
+    effect, parameter : str
+        As in :class:`Fault` (checked when a :class:`Fault` is made: :meth:`fault`).
+    axis : int or None
+        1..7, or None for ``each``.
+    final : float
+        The parameter's value at the last cycle, in its unit.
+    kind : str or None
+        The schedule kind given, None if not (:class:`Fault`'s default, linear).
+    start : float
+    onset : int or None
+    others : dict
+        The effect's other parameters given.
+    """
+
+    effect: str
+    axis: int | None
+    parameter: str
+    final: float
+    kind: str | None = None
+    start: float = 0.0
+    onset: int | None = None
+    others: dict = field(default_factory=dict)
+
+    @classmethod
+    def parse(cls, spec: str) -> "FaultSpec":
+        """Parse ``spec``; ValueError quoting it and the form (the text a command refuses)."""
+
+        def fail(reason: str) -> ValueError:
+            return ValueError(f"bad fault spec {spec!r}: {reason}; {_SPEC_FORM}")
+
+        parts = [p.strip() for p in str(spec).strip().split(":")]
+        if len(parts) in (3, 4) and not _is_axis(parts[1]) and _is_number(parts[2]):
+            # the old sweep/fleet form without the axis: name the one form
+            fixed = ":".join([parts[0], ANY_AXIS, *parts[1:]])
+            raise fail(f"it has no AXIS; in a sweep or a fleet write {ANY_AXIS!r} for the worn axis: {fixed!r}")
+        if len(parts) not in (4, 5):
+            raise fail(f"it has {len(parts)} ':'-separated field(s), expected 4 or 5")
+        effect, axis_text, parameter, final_text = parts[:4]
+        if not _is_axis(axis_text):
+            raise fail(f"AXIS {axis_text!r} must be a whole number (or {ANY_AXIS!r} in a sweep or a fleet)")
+        if not _is_number(final_text):
+            raise fail(f"FINAL {final_text!r} must be a number")
+        axis = None if axis_text == ANY_AXIS else int(axis_text)
+        kind, start, onset, others = None, 0.0, None, {}
+        if len(parts) == 5:
+            for option in parts[4].split(","):
+                key, sep, value = (s.strip() for s in option.partition("="))
+                if not sep or not key or not value:
+                    raise fail(f"option {option!r} is not key=value")
+                if key == "kind":
+                    kind = value
+                    continue
+                if not _is_number(value):
+                    raise fail(f"option {key}={value} is not a number")
                 number = float(value)
-            except ValueError:
-                raise fail(f"option {key}={value} is not a number") from None
-            if key == "start":
-                start = number
-            elif key == "onset":
-                if not number.is_integer():
-                    raise fail(f"option onset={value} is not a whole cycle")
-                onset = int(number)
-            else:
-                options[key] = number
+                if key == "start":
+                    start = number
+                elif key == "onset":
+                    if not number.is_integer():
+                        raise fail(f"option onset={value} is not a whole cycle")
+                    onset = int(number)
+                else:
+                    others[key] = number
+        return cls(effect, axis, parameter, float(final_text), kind, start, onset, others)
+
+    def fault(self, last_cycle: int, axis: int | None = None, **changes) -> Fault:
+        """The :class:`Fault` on ``axis`` (a sweep's or fleet's worn axis; default the spec's own),
+        ``changes`` overriding its fields (a fleet sets ``kind`` and ``onset``). ValueError when
+        neither gives an axis, when ``axis`` differs from a numbered one, or for a bad fault (its message)."""
+        if axis is None:
+            axis = self.axis
+        if axis is None:
+            raise ValueError(f"fault {str(self)!r}: AXIS {ANY_AXIS!r} stands for a sweep's or a fleet's worn axis; "
+                             "name the axis here, e.g. " + repr(str(replace(self, axis=2))))
+        if self.axis is not None and axis != self.axis:
+            raise ValueError(f"fault {str(self)!r} is on axis {self.axis}, not on the worn axis {axis}; write "
+                             f"{ANY_AXIS!r} for the axis to give each worn axis the fault")
+        fields = {"kind": self.kind or "linear", "start": self.start, "others": dict(self.others),
+                  "onset": self.onset or 0, **changes}
+        try:
+            return Fault(self.effect, axis, self.parameter, self.final, last_cycle, **fields)
+        except ValueError as err:
+            raise ValueError(f"bad fault spec {str(self)!r}: {err}; {_SPEC_FORM}") from None
+
+    def __str__(self) -> str:
+        options = [*([f"kind={self.kind}"] if self.kind else []), *([f"start={self.start:g}"] if self.start else []),
+                   *([f"onset={self.onset}"] if self.onset is not None else []),
+                   *(f"{k}={v:g}" for k, v in self.others.items())]
+        axis = ANY_AXIS if self.axis is None else str(self.axis)
+        fields = [self.effect, axis, self.parameter, f"{self.final:g}"]
+        return ":".join([*fields, ",".join(options)] if options else fields)
+
+
+def _is_axis(text: str) -> bool:
+    return text == ANY_AXIS or text.isdigit()
+
+
+def _is_number(text: str) -> bool:
     try:
-        return Fault(effect, axis, parameter, final, last_cycle, kind=kind, start=start, others=options, onset=onset)
-    except ValueError as err:
-        raise fail(str(err)) from None
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def parse_fault(spec: str, last_cycle: int) -> Fault:
+    """A :class:`Fault` from ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]`` with a numbered axis
+    (:class:`FaultSpec`). Raises ValueError quoting the spec and the form."""
+    return FaultSpec.parse(spec).fault(last_cycle)

@@ -14,10 +14,18 @@ The reference (:meth:`Replay.trajectory`):
 - angles, velocities and accelerations each a cubic spline through the log's samples, sampled at
   the step ``dt``; the log's motion is cut to whole planning periods (the last < 4 ms dropped), so
   the path is one function of time whatever step samples it, and equals the log at its times;
-- a log that does not start (end) at rest gets a run-in (run-out): a ruckig jerk-limited ramp from
-  rest into the log's first state (from its last state to rest), within the robot's planning
-  limits (its folder's ``tasks.toml`` ``[limits]``). At rest means every axis below
-  :data:`REST_SPEED` and :data:`REST_ACCELERATION`; such an end is set exactly at rest.
+- time 0 of the run is the log's first sample: the run starts in the log's first state, at rest
+  or, for a log that starts moving (a snippet of continuous motion), at its first velocity and
+  acceleration (:func:`faultgen.simulation.batch.start_state`), so the recorded reference
+  ``q_ref`` is the log at the recorded times;
+- a log that does not end at rest gets a run-out: a ruckig jerk-limited ramp from its last state
+  to rest, within the robot's planning limits (its folder's ``tasks.toml`` ``[limits]``), after
+  the log's times. At rest means every axis below :data:`REST_SPEED` and
+  :data:`REST_ACCELERATION`; such an end is set exactly at rest.
+
+Before issue 51 a log that did not start at rest got a run-in, a ramp from rest into its first
+state, which shifted the whole log later in the run: the recorded reference was off the log at the
+recorded times by up to 0.8 rad.
 
 Refused before any simulation (:class:`faultgen.operation.programs.ProgramError`, naming the file,
 the row and the value): a missing column, a non-finite value, time not increasing, a log shorter than
@@ -70,9 +78,9 @@ class Replay:
     qd, qdd : ndarray of shape (n, N)
         Their velocity and acceleration (rad/s, rad/s^2) by the calibration's estimator.
     velocity_limit, acceleration_limit, jerk_limit : ndarray of shape (N,)
-        Planning limits of the run-in and run-out, rad/s, rad/s^2, rad/s^3.
+        Planning limits of the run-out, rad/s, rad/s^2, rad/s^3.
     start : ndarray of shape (N,)
-        Where the cycle starts at rest, rad (the log's first angles, or the run-in's start).
+        Where the cycle starts, rad: the log's first angles.
     robot : Robot
     """
 
@@ -95,15 +103,9 @@ class Replay:
         """The replayed part of the log, s: whole planning periods."""
         return np.floor(self.t[-1] / PLAN_PERIOD + 1e-9) * PLAN_PERIOD
 
-    def run_in(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The ramp from rest into the log's first state, sampled at ``dt`` ((n, N) each), or None."""
-        return _ramp(self, self.q[0], self.qd[0], self.qdd[0], dt, reverse=True)
-
     def trajectory(self, dt: float) -> JointPath:
-        """The reference sampled every ``dt`` s: run-in, the log, run-out (module docstring).
-
-        The log's first sample is at ``offset(dt)`` s into the path; segments are labelled
-        ``run-in``, ``replay`` and ``run-out``.
+        """The reference sampled every ``dt`` s: the log from its first sample at time 0, then the
+        run-out (module docstring); segments are labelled ``replay`` and ``run-out``.
 
         Raises
         ------
@@ -113,16 +115,10 @@ class Replay:
         steps = round(self.duration / dt)
         times = np.arange(steps + 1) * dt
         q, qd, qdd = (CubicSpline(self.t, x, axis=0)(times) for x in (self.q, self.qd, self.qdd))
-        pieces, labels = [], []
-        before = self.run_in(dt)
-        if before is None:
+        if _at_rest(qd[0], qdd[0]):
             qd[0], qdd[0] = 0.0, 0.0
-        else:
-            pieces.append(before)
-            labels.append("run-in")
-        pieces.append((q, qd, qdd))
-        labels.append("replay")
-        after = _ramp(self, q[-1], qd[-1], qdd[-1], dt, reverse=False)
+        pieces, labels = [(q, qd, qdd)], ["replay"]
+        after = _run_out(self, q[-1], qd[-1], qdd[-1], dt)
         if after is None:
             qd[-1], qdd[-1] = 0.0, 0.0
         else:
@@ -153,23 +149,23 @@ class Replay:
         check_torque(self.robot, path, lambda k: next(name for name, a, b in segments if a <= k <= b), fail)
         return path
 
-    def offset(self, dt: float) -> float:
-        """Time in the path of the log's first sample, s (the run-in's length)."""
-        before = self.run_in(dt)
-        return 0.0 if before is None else (len(before[0]) - 1) * dt
+
+def _at_rest(qd: np.ndarray, qdd: np.ndarray) -> bool:
+    """Whether every axis is below :data:`REST_SPEED` and :data:`REST_ACCELERATION`."""
+    return bool(np.all(np.abs(qd) <= REST_SPEED) and np.all(np.abs(qdd) <= REST_ACCELERATION))
 
 
-def _ramp(replay: Replay, q, qd, qdd, dt: float, reverse: bool):
-    """A ruckig velocity-interface ramp from (q, qd, qdd) to rest, sampled at ``dt``; reversed in time
-    (a ramp from rest into the state) when ``reverse``. None when the state is at rest."""
-    if np.all(np.abs(qd) <= REST_SPEED) and np.all(np.abs(qdd) <= REST_ACCELERATION):
+def _run_out(replay: Replay, q, qd, qdd, dt: float):
+    """A ruckig velocity-interface ramp from (q, qd, qdd) to rest, sampled at ``dt``; None when the
+    state is at rest."""
+    if _at_rest(qd, qdd):
         return None
     n = len(q)
     otg = Ruckig(n, PLAN_PERIOD)
     inp = InputParameter(n)
     inp.control_interface = ControlInterface.Velocity
     inp.current_position = q
-    inp.current_velocity = -qd if reverse else qd
+    inp.current_velocity = qd
     inp.current_acceleration = qdd
     inp.target_velocity = inp.target_acceleration = np.zeros(n)
     inp.max_velocity = replay.velocity_limit
@@ -180,12 +176,12 @@ def _ramp(replay: Replay, q, qd, qdd, dt: float, reverse: bool):
     over = np.abs(qdd) > replay.acceleration_limit
     if np.any(over):
         axis = int(np.argmax(over))
-        raise ProgramError(f"{replay.source} (replay): the log {'starts' if reverse else 'ends'} moving with an "
+        raise ProgramError(f"{replay.source} (replay): the log ends moving with an "
                            f"acceleration of {qdd[axis]:.4g} rad/s^2 on axis {axis + 1}, above the planning limit "
-                           f"{replay.acceleration_limit[axis]:.4g} rad/s^2 the ramp {'into' if reverse else 'out of'} "
+                           f"{replay.acceleration_limit[axis]:.4g} rad/s^2 the ramp out of "
                            "it may use")
     if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
-        raise ProgramError(f"{replay.source} (replay): ruckig found no ramp {'into' if reverse else 'out of'} the "
+        raise ProgramError(f"{replay.source} (replay): ruckig found no ramp out of the "
                            "log's motion within the robot's planning limits")
     steps = round(trajectory.duration / dt)
     samples = [trajectory.at_time(k * dt) for k in range(steps)]
@@ -193,8 +189,6 @@ def _ramp(replay: Replay, q, qd, qdd, dt: float, reverse: bool):
     pos = np.array([s[0] for s in samples] + [rest[0]]).reshape(-1, n)
     vel = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
     acc = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
-    if reverse:  # time runs backwards: angles in reverse order, velocities change sign
-        return pos[::-1].copy(), -vel[::-1], acc[::-1].copy()
     return pos, vel, acc
 
 
@@ -251,9 +245,6 @@ def read(path: str | Path, robot: Robot | str) -> Replay:
     replay = Replay(name=label(str(path)), robot_name=robot.name, process="replay", source=path, t=t - t[0], q=q,
                     qd=qd, qdd=qdd, velocity_limit=velocity, acceleration_limit=acceleration, jerk_limit=jerk,
                     start=q[0], robot=robot)
-    before = replay.run_in(PLAN_PERIOD)
-    if before is not None:
-        object.__setattr__(replay, "start", before[0][0])
     return replay
 
 

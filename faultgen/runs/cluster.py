@@ -14,9 +14,14 @@ and :func:`faultgen.runs.sweep.run` merges the parts as it does for local worker
 - a run that raises (a simulation that diverged) is not retried, as the simulation is
   deterministic; the other runs go on and are kept, and the sweep then fails naming it.
 
-The workers never receive a path: a task is a run id and its :class:`RunConfig`. They need the
-same faultgen (and robot models) installed; a worker whose robot model differs from this
-process's (its SHA-256) is refused, as its run would be labelled with the wrong model.
+A task is a run id and its :class:`RunConfig`. A robot or program given as a relative path (a
+robot folder ``kr6``, a program ``mine.toml``) is sent as this process's absolute path
+(:func:`for_workers`): a worker runs in a folder of its own, so it must see that path (the same
+machine, or the folder at the same path on every worker); the part files are labelled with the
+configuration as given. A worker that cannot find it fails the run naming the worker and the
+path. The workers need the same faultgen (and robot models) installed; a worker whose robot model
+differs from this process's (its SHA-256) is refused, as its run would be labelled with the wrong
+model.
 
 With ``shared=True`` the workers instead write their part files themselves into the part
 folder, which every worker must see at the same absolute path (a shared file system, checked
@@ -85,10 +90,34 @@ def for_transfer(result: sim.RunResult) -> sim.RunResult:
     return replace(result, **{name: np.asarray(getattr(result, name))[:, :0] for name in SIGNALS})
 
 
+def for_workers(config: sim.RunConfig) -> sim.RunConfig:
+    """``config`` with its robot and task, where they are paths on this machine (a robot folder or
+    MJCF file that is not a known robot name, a program or log file), made absolute: a worker's
+    folder is not this process's."""
+    changes = {}
+    if str(config.robot) not in robots.available() and Path(config.robot).exists():
+        changes["robot"] = str(Path(config.robot).absolute())
+    if Path(config.task).is_file():
+        changes["task"] = str(Path(config.task).absolute())
+    return replace(config, **changes) if changes else config
+
+
+def _missing_on_worker(config: sim.RunConfig) -> str:
+    """The path of ``config`` this worker does not have ('' if it has them)."""
+    for path in (config.robot, config.task):
+        if Path(path).is_absolute() and not Path(path).exists():
+            return path
+    return ""
+
+
 def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
     """Worker task: simulate one run and return it (:class:`Outcome`); writes nothing."""
     from distributed import get_worker
 
+    missing = _missing_on_worker(config)
+    if missing:
+        raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
+                                "client sees it): put it at the same path on every worker, or run the sweep there")
     started = time.perf_counter()
     result = sim.simulate(config, progress=False)
     total = time.perf_counter() - started
@@ -100,11 +129,17 @@ def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
                    simulated, total, slim.stepping_time, _peak_memory())
 
 
-def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str) -> RunStats:
-    """Worker task with a shared file system: simulate one run and write its part file there."""
+def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str,
+                 labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task with a shared file system: simulate one run and write its part file there,
+    labelled with ``labelled`` (the client's configuration)."""
     from distributed import get_worker
 
-    stats = simulate_and_write(run_id, config, Path(part), command)
+    missing = _missing_on_worker(config)
+    if missing:
+        raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
+                                "client sees it): put it at the same path on every worker")
+    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled)
     return replace(stats, worker=get_worker().address, memory=_peak_memory())
 
 
@@ -271,11 +306,12 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
         for run_id, config in todo:
             key = task_key(run_id, config)
             run_of[key] = run_id
+            sent = for_workers(config)
             if shared:
-                futures.append(client.submit(write_shared, run_id, config, str(folder / f"{run_id}.h5"), command,
-                                             key=key))
+                futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
+                                             None if sent is config else config, key=key))
             else:
-                futures.append(client.submit(simulate_remote, run_id, config, key=key))
+                futures.append(client.submit(simulate_remote, run_id, sent, key=key))
         configs = dict(todo)
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)
@@ -302,12 +338,21 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
                 if problem:
                     failed.append(f"{run_id}: {problem}")
                     continue
-                yield _write(run_id, value, parts / f"{run_id}.h5", command)
+                yield _write(run_id, replace(value, result=replace(value.result, config=configs[run_id])),
+                             parts / f"{run_id}.h5", command)
             if bar is not None:
                 bar.set_postfix_str(_cluster_state(client), refresh=False)
         if failed:
-            raise SweepError(f"{len(failed)} of {len(todo)} runs failed on the cluster; the others are kept in {parts}. "
-                             f"First: {failed[0]}")
+            raise SweepError(failure_message(failed, len(todo), parts))
+
+
+def failure_message(failed: list[str], n_runs: int, parts: Path) -> str:
+    """What a sweep whose ``failed`` runs (one line each) of ``n_runs`` failed on the cluster says."""
+    if len(failed) == n_runs:
+        kept = f"none of the {n_runs} runs finished"
+    else:
+        kept = f"the {n_runs - len(failed)} that finished are kept in {parts}"
+    return f"{len(failed)} of {n_runs} runs failed on the cluster; {kept}. First: {failed[0]}"
 
 
 def _write(run_id: str, outcome: Outcome, part: Path, command: str) -> RunStats:

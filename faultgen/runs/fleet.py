@@ -114,8 +114,8 @@ class Fleet:
     ----------
     size : int
         Robots in the fleet (thesis: 26).
-    failing : int
-        Of them, robots whose gearbox fails (thesis: 13).
+    failing : int, optional
+        Of them, robots whose gearbox fails (thesis: 13 of 26); default half the fleet, rounded down.
     days : int
         Days each robot is recorded; a failing robot fails on the last one.
     cycles_per_day : int
@@ -150,8 +150,9 @@ class Fleet:
         so the fleet's draws and records are those of the fleets measured before it existed.
     fault : str or None
         Instead of friction wear, a failing robot's drawn axis gets this fault,
-        ``EFFECT:PARAMETER:FINAL[:key=value,...]`` (the sweep's ``--fault``, e.g.
-        ``backlash:width:0.01``), growing on the exp4 schedule from its onset day to FINAL on the
+        ``EFFECT:each:PARAMETER:FINAL[:key=value,...]`` (:class:`faultgen.operation.faults.FaultSpec`, the
+        one fault text of every command, AXIS ``each``: the drawn axis; e.g.
+        ``backlash:each:width:0.01``), growing on the exp4 schedule from its onset day to FINAL on the
         failure day; FINAL is the same on both robot models. None (default): friction wear.
     gear_loss : float
         Each unit's gearboxes lose a share of the transmitted torque as Coulomb friction, drawn per
@@ -178,7 +179,7 @@ class Fleet:
     """
 
     size: int = 26
-    failing: int = 13
+    failing: int | None = None
     days: int = 60
     cycles_per_day: int = 2
     failure_wear: float = 50.0
@@ -196,6 +197,8 @@ class Fleet:
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
+        if self.failing is None:
+            object.__setattr__(self, "failing", self.size // 2)
         check_number("fleet failing", self.failing, 1, self.size - 1, whole=True)
         # the smallest fleet record whose default onset window (days // 6 .. 7 days // 12) holds a day
         check_number("fleet days (--days)", self.days, 6, 3650, whole=True)
@@ -229,9 +232,12 @@ class Fleet:
                 raise ValueError(f"fleet model {model!r}: its parts cannot be sized: {err}") from None
         object.__setattr__(self, "onset", (first, last))
         if self.fault is not None:
-            if any(f"{key}=" in str(self.fault) for key in ("kind", "onset")):
-                raise ValueError(f"fleet fault {self.fault!r}: the fleet sets its kind (exp4) and onset (the drawn "
-                                 "onset day); give EFFECT:PARAMETER:FINAL[:key=value,...] without them")
+            spec = faults.FaultSpec.parse(self.fault)
+            if spec.axis is not None or spec.kind is not None or spec.onset is not None:
+                raise ValueError(f"fleet fault {self.fault!r}: the fleet sets the kind (exp4) and onset (the drawn "
+                                 "onset day) and draws each failing robot's axis; give EFFECT:each:PARAMETER:FINAL"
+                                 f"[:key=value,...] without them, e.g. "
+                                 f"{str(replace(spec, axis=None, kind=None, onset=None))!r}")
             self._fault(1, first)  # a bad spec is named now, not when the runs are built
         object.__setattr__(self, "models", tuple(self.models))
         pool = self.tasks
@@ -328,10 +334,9 @@ class Fleet:
 
     def _fault(self, axis: int, onset_day: int) -> faults.Fault:
         """The fault of a robot failing on ``axis`` from ``onset_day``."""
-        effect, _, rest = str(self.fault).partition(":")
         try:
-            fault = faults.parse_fault(f"{effect}:{axis}:{rest}", last_cycle=self.days * self.cycles_per_day)
-            return replace(fault, kind="exp4", onset=(onset_day - 1) * self.cycles_per_day)
+            return faults.FaultSpec.parse(self.fault).fault(
+                self.days * self.cycles_per_day, axis=axis, kind="exp4", onset=(onset_day - 1) * self.cycles_per_day)
         except ValueError as err:
             raise ValueError(f"fleet fault {self.fault!r}: {err}") from None
 

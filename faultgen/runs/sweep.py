@@ -36,7 +36,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Self
 
@@ -125,10 +125,11 @@ class Grid:
         ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,
         ``hours``); None: none, the runs differ from their references only by wear.
     fault : str or None
-        A fault other than friction wear for the worn axes, ``EFFECT:PARAMETER:FINAL[:key=value,...]``
-        (:func:`faultgen.operation.faults.parse_fault` without the axis, e.g. ``backlash:width:0.01``):
-        each axis of ``axes`` but 0 gets it instead of friction wear (``increases`` and ``schedules``
-        are then unused; ``kind=...`` shapes its growth).
+        A fault other than friction wear for the worn axes, ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]``
+        (:class:`faultgen.operation.faults.FaultSpec`, the one fault text of every command): with
+        AXIS ``each`` (``backlash:each:width:0.01``) each axis of ``axes`` but 0 gets it instead of friction
+        wear; with a number, ``axes`` may wear only that axis (and 0). ``increases`` and
+        ``schedules`` are then unused; ``kind=...`` shapes its growth.
     signals : bool
         Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
         isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
@@ -164,6 +165,15 @@ class Grid:
             if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
                 raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
         friction.check_model(self.friction)
+        if self.fault is not None:
+            spec = faults.FaultSpec.parse(self.fault)
+            worn = sorted(set(self.axes) - {0})
+            if spec.axis is not None and worn != [spec.axis]:
+                raise ValueError(
+                    f"fault {self.fault!r} is on axis {spec.axis} but the grid wears axes "
+                    f"{', '.join(map(str, worn)) or 'none'}: give --axis 0 --axis {spec.axis}, or write "
+                    f"{str(replace(spec, axis=None))!r} "
+                    "to give each worn axis the fault in turn")
         for kind in self.schedules:
             if kind not in wear.SCHEDULES:
                 raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
@@ -259,8 +269,7 @@ class Grid:
                 if axis == 0:
                     label = "nowear"
                 elif self.fault:
-                    effect, _, rest = str(self.fault).partition(":")
-                    fault = faults.parse_fault(f"{effect}:{axis}:{rest}", last_cycle=self.cycles)
+                    fault = faults.FaultSpec.parse(self.fault).fault(self.cycles, axis=axis)
                     label = f"axis{axis}-{fault.effect}{fault.final:g}"
                 else:
                     plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
@@ -290,14 +299,19 @@ class RunStats:
     memory: int = 0
 
 
-def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "") -> RunStats:
-    """Worker task: simulate one run and write it to its part file (atomically)."""
+def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
+                       labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task: simulate one run and write it to its part file (atomically), labelled with
+    ``labelled`` (the client's configuration when ``config`` names its robot or program by an
+    absolute path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`)."""
     # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
     # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
     tqdm.set_lock(threading.RLock())
     started = time.perf_counter()
     result = sim.simulate(config, progress=False)
     writing = time.perf_counter()
+    if labelled is not None:
+        result = replace(result, config=labelled)
     dataset.write_run(part, result, run_id=run_id, command=command)
     done = time.perf_counter()
     stats = RunStats(run_id, result.tau_m.shape[0] * result.t[-1], done - started, result.stepping_time,
@@ -323,12 +337,32 @@ def _in_worker(sweep_pid: int, *call) -> RunStats:
 
 def _start_worker(sweep_pid: int) -> None:
     """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
-    whose sweep ended while it started (it has another parent already) ends at once."""
+    whose sweep ended while it started (it has another parent already) ends at once. A SIGTERM
+    sent to the whole process group (``timeout``, a process manager, a closed terminal) is the
+    sweep's to handle: it stops its workers and says what is kept and how to resume; a worker that
+    ended on it first left loky's semaphores for Python to report as leaked, and the sweep no word."""
     if os.getpid() == sweep_pid:
         return
     if os.getppid() != sweep_pid:
         os._exit(1)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
     _watch_parent(sweep_pid)
+
+
+def _start_resource_tracker() -> None:
+    """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
+    workers do (:func:`_start_worker`): a group-wide SIGTERM must not end it before the sweep has
+    stopped its workers and released their semaphores (it then reports them as leaked). It ends
+    when the sweep's process does."""
+    from joblib.externals.loky.backend import resource_tracker
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)  # inherited by the process started now
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 _WATCHED: set[int] = set()
@@ -647,8 +681,8 @@ class _CtrlC:
     later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
     KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
     Ctrl-C, or one sent again after the workers' own interrupts already stopped the sweep) is not
-    raised inside the clean-up. Only in the main thread and when SIGINT raises KeyboardInterrupt (not under
-    ``nohup``); otherwise the block changes nothing.
+    raised inside the clean-up. Only in the main thread; SIGINT only when it raises
+    KeyboardInterrupt (not under ``nohup`` or in a background job), SIGTERM always.
     """
 
     RESEND_AFTER = 0.1  # s: a callback is over long before; a person does not notice
@@ -657,21 +691,25 @@ class _CtrlC:
         self.stopping = False
         self._resends: list[threading.Timer] = []
         self._previous_handler = signal.getsignal(signal.SIGINT)
-        self._active = (threading.current_thread() is threading.main_thread()
-                        and self._previous_handler is signal.default_int_handler)
-        if self._active:
+        self._main = threading.current_thread() is threading.main_thread()
+        # SIGTERM is handled in any case (a sweep started in the background, where SIGINT is
+        # ignored, died on it silently, issue 51); SIGINT only where it raises KeyboardInterrupt
+        self._active = self._main and self._previous_handler is signal.default_int_handler
+        if self._main:
             self._previous_hook = sys.unraisablehook
             sys.unraisablehook = self._unraisable
-            signal.signal(signal.SIGINT, self._on_sigint)
             self._previous_term = signal.signal(signal.SIGTERM, self._on_sigterm)
+        if self._active:
+            signal.signal(signal.SIGINT, self._on_sigint)
         return self
 
     def __exit__(self, *exc) -> None:
-        if not self._active:
+        if not self._main:
             return
         for resend in self._resends:
             resend.cancel()
-        signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
+        if self._active:
+            signal.signal(signal.SIGINT, self._previous_handler)  # a pending SIGINT is handled before, by ours
         signal.signal(signal.SIGTERM, self._previous_term)
         sys.unraisablehook = self._previous_hook
 
@@ -701,7 +739,8 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
     """Run the missing runs; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
-    calls = [(run_id, config, parts / f"{run_id}.h5", command) for run_id, config in todo]
+    # absolute: a worker process keeps the folder it started in, which need not be this one's now
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command) for run_id, config in todo]
     try:
         if scheduler:
             from faultgen.runs import cluster
@@ -711,6 +750,7 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
 
+            _start_resource_tracker()
             # every worker watches the sweep from its start, idle or not (:func:`_watch_parent`)
             backend = LokyBackend(initializer=_start_worker, initargs=(os.getpid(),))
             parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)

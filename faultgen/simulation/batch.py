@@ -24,17 +24,25 @@ class SimulationDiverged(RuntimeError):
     exit_code = 1
 
 
-def start_state(robot: robots.Robot, q0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``qpos`` and ``qvel`` at rest at arm angles ``q0`` with drives on their set-points.
+def start_state(robot: robots.Robot, q0: np.ndarray, qd0: np.ndarray | None = None,
+                qdd0: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``qpos`` and ``qvel`` at arm angles ``q0`` (rad), at rest or, for a replayed log that starts
+    moving, at velocity ``qd0`` (rad/s) and acceleration ``qdd0`` (rad/s^2), with drives on their
+    set-points.
 
-    The motors sit at ``G q0`` and each gearbox carries the static load: the arm sags by
-    ``tau_static / K`` (thesis eq. 6.2a), and with backlash ``b`` it rests on the loaded flank,
-    ``b / 2`` further, so a cycle starts in equilibrium. An axis without static load (a vertical
-    base axis) starts in the middle of its dead band.
+    The motors sit at ``G q0`` (turning at ``G qd0``) and each gearbox carries its load, the
+    static one at rest, the arm-side torque of the motion (rigid-body inverse dynamics without the
+    motor's inertia and friction) when moving: the arm lags by ``tau / K`` (thesis eq. 6.2a), and
+    with backlash ``b`` it rests on the loaded flank, ``b / 2`` further, so a cycle starts in
+    equilibrium. An axis without load (a vertical base axis at rest) starts in the middle of its
+    dead band.
     """
-    qpos, qvel = robot.rigid_state(q0)
-    zeros = np.zeros((1, robot.n_axes))
-    static = robot.inverse_dynamics(q0[None], zeros, zeros, friction=False)[0]
+    zeros = np.zeros(robot.n_axes)
+    qd0 = zeros if qd0 is None else np.asarray(qd0, dtype=float)
+    qdd0 = zeros if qdd0 is None else np.asarray(qdd0, dtype=float)
+    qpos, qvel = robot.rigid_state(q0, qd0)
+    static = robot.inverse_dynamics(q0[None], qd0[None], qdd0[None], friction=False)[0]
+    static = static - robot.gear_ratio ** 2 * robot.motor_inertia * qdd0  # the rotor's share is not the gearbox's
     # a load at round-off level (gravity on a vertical axis) has no side to rest on
     side = np.sign(static) * (np.abs(static) > 1e-9 * max(float(np.abs(static).max()), 1.0))
     qpos[robot.arm_qpos] = q0 - static / robot.gearbox_stiffness
@@ -105,6 +113,8 @@ class Work:
     nthread: int
     fault: tuple | None = None
     grips: tuple = ()
+    qd0: np.ndarray | None = None
+    qdd0: np.ndarray | None = None
 
 
 @dataclass
@@ -122,7 +132,7 @@ class Raw:
 def new_batch(sim, work: Work) -> mjbatch.Batch:
     """One simulation per recorded cycle, all at the task's start state."""
     batch = mjbatch.Batch(sim.model, nsim=len(work.cycles), nthread=work.nthread)
-    batch.qpos, batch.qvel = start_state(sim.robot, work.q0)
+    batch.qpos, batch.qvel = start_state(sim.robot, work.q0, work.qd0, work.qdd0)
     batch.act = 0.0
     work.plant.apply(sim, batch)
     if work.fault is not None:

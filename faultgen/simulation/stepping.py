@@ -149,7 +149,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                 raise ValueError(f"{task_name} ends {np.max(np.abs(path.q[-1] - path.q[0])):.4g} rad away from where it "
                                  "starts; back_to_back runs need a cycle that returns to its start")
             one = stepper(sim, Work(cycles[:1], plant.take([0]), path.q[0], chained,
-                                     dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread), bar)
+                                     dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread,
+                                     qd0=path.qd[0], qdd0=path.qdd[0]), bar)
             raw = Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, robot.n_axes) for f in fields(Raw)})
         else:  # the cycles of each payload (its own model and feedforward) in batches of BATCH_CYCLES
             parts = conditions.payload_part if conditions is not None else np.full(len(cycles), -1)
@@ -163,8 +164,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
                     raws.append(stepper(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
-                                                           dist[g], per_log, config.nthread, fault, variant.grips),
-                                        bar))
+                                                           dist[g], per_log, config.nthread, fault, variant.grips,
+                                                           path.qd[0], path.qdd[0]), bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
             raw = Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(Raw)})

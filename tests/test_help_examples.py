@@ -1,0 +1,191 @@
+"""Every example in every command's ``--help`` runs (issue 51, item 3), and what it writes is in
+``.gitignore`` (run in the checkout, it would leave ``git status`` clean).
+
+The examples are read from the help text itself, one test per help page, each page in a folder
+of its own holding what the docs tell a user to make before it (``quick.h5``, ``j2.h5``,
+``fleet.h5``, a program, a URDF, ``mine.py``), each made once by its documented command (an
+example that is that same command gets the file made so: same seed, the same file). The data is
+kept small (:data:`SMALL`, appended: click takes an option's last value): a ``simulate`` or
+``sweep`` records fewer cycles, a sweep that does not choose them one task and two axes, a
+``fleet`` has fewer robots, days and cycles a day; ``classify``, ``training-source``,
+``excitation`` and ``hidden-log`` do less work. The rest of each command line is the example's
+own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+import shlex
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+import rtbdata
+from filelock import FileLock
+from typer.main import get_command
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+#: Appended to the data-making and the slowest commands of the examples: small data, the
+#: example's own options otherwise. A sweep records 10 cycles, as the quick preset does.
+SMALL = {"simulate": ["--cycles", "2", "--record", "1-2"], "sweep": ["--cycles", "10", "--record", "1-10"],
+         "fleet": ["--robots", "2", "--days", "6", "--cycles-per-day", "1"], "hidden-log": ["--cycles", "1"],
+         "excitation": ["--iterations", "1", "--starts", "2"],
+         # three held-out pairs of failing and healthy robots, not every pair (the slowest examples)
+         "classify": ["--pairs", "3"],
+         # the thesis's window (40 + 15 + 5 days) on the small fleet's 16
+         "training-source": ["--training-days", "8", "--test-days", "4", "--gap-days", "2"]}
+#: The fleets the docs analyse: enough robots and days for classify's leave-pair-out and horizon.
+ANALYSED_FLEETS = {"fleet.h5": ["--robots", "8", "--days", "16", "--cycles-per-day", "1"],
+                   "fleet8.h5": ["--robots", "4", "--days", "12", "--cycles-per-day", "1"]}
+
+
+def pages() -> dict[str, list[str]]:
+    """Command path -> the example lines of its ``--help``."""
+    out = {}
+
+    def walk(command, path):
+        if hasattr(command, "commands"):
+            for name, sub in command.commands.items():
+                walk(sub, [*path, name])
+        if path:
+            text = runner.invoke(app, [*path, "--help"], terminal_width=300).output
+            lines = [line.strip() for line in text.splitlines() if line.strip().startswith("faultgen ")]
+            if lines:
+                out[" ".join(path)] = lines
+
+    walk(get_command(app), [])
+    return out
+
+
+PAGES = pages()
+
+
+def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
+    """``argv`` (after ``faultgen``) with the small-data options appended, the scheduler replaced;
+    a sweep that does not choose its tasks or axes runs pick and place, without wear and on axis 2."""
+    extra = list(SMALL.get(argv[0], []))
+    if argv[0] == "fleet" and argv[argv.index("-o") + 1] in ANALYSED_FLEETS:
+        extra = ANALYSED_FLEETS[argv[argv.index("-o") + 1]]
+    if argv[0] == "sweep":
+        extra += [] if "--task" in argv else ["--task", "pick_place"]
+        extra += [] if "--axis" in argv else ["--axis", "0", "--axis", "2"]
+    argv = [scheduler if a.startswith("tcp://") and scheduler else a for a in argv]
+    return [*argv, *extra]
+
+
+def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path]) -> None:
+    """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments."""
+    for part in line.split("&&"):
+        words = shlex.split(part, comments=True)
+        target = None
+        if ">" in words:
+            words, target = words[:words.index(">")], words[words.index(">") + 1]
+        assert words[0] == "faultgen", line
+        outputs = [words[i + 1] for i, w in enumerate(words[:-1]) if w in ("-o", "--out")]
+        for produced in outputs:
+            path = Path(produced)  # the example makes it: a file the docs' earlier step made is remade here
+            if path.is_file():
+                path.unlink()
+        same = [name for name in outputs if name in made_files and shlex.split(MADE[name]) == words]
+        if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
+            shutil.copy(made_files[same[0]], same[0])
+            continue
+        result = runner.invoke(app, small(words[1:], page, scheduler))
+        assert result.exit_code == 0, f"{line}\n{result.output}"
+        if target:
+            Path(target).write_text(result.output)
+
+
+# -- what the docs tell a user to make before the examples ------------------------------------------
+
+def mine_py(folder: Path) -> None:
+    """docs/analysis.md's mine.py, as written there."""
+    text = (ROOT / "docs/analysis.md").read_text()
+    block = re.search(r"```python\n(# mine.py, beside the dataset\n.*?)```", text, re.S).group(1)
+    (folder / "mine.py").write_text(block)
+
+
+#: file -> the documented command that makes it (run with the small-data options) or a maker.
+MADE = {
+    "quick.h5": "faultgen sweep --preset quick -o quick.h5",
+    "j2.h5": "faultgen sweep --preset j2 -o j2.h5",
+    "fleet.h5": "faultgen fleet -o fleet.h5",
+    "my_program.toml": "faultgen tasks export irb6700 arc_weld -o my_program.toml",
+    "kr210l150.urdf": lambda folder: shutil.copy(
+        Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf", folder),
+    "ur5_dh.toml": lambda folder: shutil.copy(ROOT / "docs/examples/ur5_dh.toml", folder),
+    # docs/robots.md: "--drivetrain gives some or all drivetrain numbers (tables [axis.1] .. [axis.N])"
+    "my_drives.toml": lambda folder: (folder / "my_drives.toml").write_text("[axis.1]\ngear_ratio = 100.0\n"),
+    "mine.py": mine_py,
+}
+
+
+@pytest.fixture(scope="session")
+def made(tmp_path_factory, worker_id):
+    """``made(name)``: the path of a file of :data:`MADE`, made once per session."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "help-examples-made"
+    folder.mkdir(exist_ok=True)
+
+    def make(name: str) -> Path:
+        with FileLock(folder / f"{name}.lock"):
+            if not (folder / name).exists():
+                maker = MADE[name]
+                if callable(maker):
+                    maker(folder)
+                else:
+                    with contextlib.chdir(folder):
+                        result = runner.invoke(app, small(shlex.split(maker)[1:], "", None))
+                    assert result.exit_code == 0, f"{maker}\n{result.output}"
+        return folder / name
+
+    return make
+
+
+def test_every_help_page_has_examples_and_they_are_all_read():
+    assert len(PAGES) >= 18 and sum(map(len, PAGES.values())) >= 45
+    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export"} <= set(PAGES)
+
+
+@pytest.mark.parametrize("page", sorted(PAGES))
+def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
+    lines = PAGES[page]
+    needed = {word for line in lines for word in re.split(r"[\s:]+", line) if word in MADE}
+    needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
+    made_files = {name: made(name) for name in sorted(needed)}
+    for name in sorted(needed):
+        if not any(f"-o {name}" in line for line in lines):  # the page makes it itself
+            shutil.copy(made_files[name], tmp_path / name)
+    monkeypatch.chdir(tmp_path)
+    scheduler = None
+    if any("--scheduler" in line for line in lines):
+        from distributed import LocalCluster
+
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+        scheduler = cluster.scheduler_address
+    try:
+        for line in lines:
+            run_line(line, page, scheduler, made_files)
+    finally:
+        if scheduler:
+            cluster.close()
+    # run in the checkout, the examples would leave `git status` clean: all they write is ignored
+    # (but your own sources: a robot folder of `robots add`, a program of `tasks export`)
+    sources = {w[w.index("-o") + 1] for line in lines for part in line.split("&&")
+               if (w := shlex.split(part, comments=True))[1:3] in (["robots", "add"], ["tasks", "export"])}
+    written = sorted(p.name + ("/" if p.is_dir() else "") for p in tmp_path.iterdir()
+                     if p.name not in needed | sources and p.name != "__pycache__")
+    if written:
+        check = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", "-v", "-n", *written],
+                               capture_output=True, text=True)
+        unignored = [line.split("\t")[-1] for line in check.stdout.splitlines() if line.startswith("::")]
+        assert not unignored, f"{page}: not in .gitignore: {unignored}"
