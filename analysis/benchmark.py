@@ -178,7 +178,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         worn = [r for r in runs if len(r.worn_axes) == 1]
         if not worn:
             raise ValueError(f"{data.path} has no run with exactly one worn axis to isolate")
-        # cycles seen per (robot, task, level): what the worn runs saw, shown to the healthy ones too
+        # cycles seen per (setup, level): what the worn runs saw, shown to the healthy runs of the same
+        # robot, program, friction and conditions (reader.Run.setup) too
         seen: dict[tuple, int] = {}
         cases = []
         for run in worn:
@@ -187,12 +188,11 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             for level in levels:
                 k = level_cycle(grown, level)
                 if k is not None:
-                    seen.setdefault((run.robot, run.task, level), k + 1)
+                    seen.setdefault((run.setup, level), k + 1)
                     cases.append((run, axis, level, k + 1))
         for run in runs:
             if not run.worn_axes:
-                cases += [(run, NO_FAULT, 0.0, n) for (robot, task, _), n in seen.items()
-                          if (robot, task) == (run.robot, run.task)]
+                cases += [(run, NO_FAULT, 0.0, n) for (setup, _), n in seen.items() if setup == run.setup]
     rows = []
     for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
         X = values[run.id][:n]
@@ -503,7 +503,8 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         if used_protocol == "other-seeds":
             if not others:
                 raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
-                                 f"{run.task} with another seed than {run.seed}; this dataset has none. Sweep "
+                                 f"{run.task} with another seed than {run.seed}; this dataset has none"
+                                 f"{_unlike(run, healthy)}. Sweep "
                                  "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
             training = [(r.id, torque_of(r), r.recorded) for r in others]
             key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
@@ -521,7 +522,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         else:  # same-run
             if own is None:
                 raise ValueError(f"{path}: protocol same-run needs the run without wear of {run.robot} "
-                                 f"{run.task} seed {run.seed}; this dataset has none")
+                                 f"{run.task} seed {run.seed}; this dataset has none{_unlike(run, healthy)}")
             training = [(own.id, torque_of(own), own.recorded)]
             key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
         held_out = used_protocol != "same-run"
@@ -702,7 +703,19 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def _same_unit_kind(a: reader.Run, b: reader.Run) -> bool:
-    return (a.robot, a.task, a.friction_model) == (b.robot, b.task, b.friction_model)
+    """Whether ``a`` and ``b`` may be compared: same robot, program (its hash), friction model and
+    operating conditions (:attr:`faultgen.data.reader.Run.setup`)."""
+    return a.setup == b.setup
+
+
+def _unlike(run: reader.Run, healthy: Iterable[reader.Run]) -> str:
+    """For an error: the healthy runs of ``run``'s robot and task label that differ in setup, and how."""
+    unlike = [(r, reader.difference(run, r)) for r in healthy if (r.robot, r.task) == (run.robot, run.task)]
+    unlike = [(r, why) for r, why in unlike if why]
+    if not unlike:
+        return ""
+    return (f" ({len(unlike)} runs without wear of that label are not comparable with it: {unlike[0][0].id} differs "
+            f"in {unlike[0][1]})")
 
 
 def _fit_monitor(training: list, period: int | None, variance: float, alpha: float, detector=None,

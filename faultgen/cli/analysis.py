@@ -22,7 +22,9 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
     check_outputs(outputs, overwrite)
     with reader.open(file) as data:
-        failing = data.failing
+        failing, unhashed = data.failing, data.unhashed
+    if unhashed:  # old files: runs are paired by their task label alone
+        typer.echo(unhashed)
     if not failing:
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")

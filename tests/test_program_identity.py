@@ -1,0 +1,142 @@
+"""A run's program is identified by what it is (its text's hash), not by the label it inherits:
+an edited export gets its own label, a sweep refuses two programs under one label, and no
+analysis pairs runs of different programs (issue 51, item 1)."""
+
+import hashlib
+
+import h5py
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from analysis import benchmark
+from faultgen import plot as plotting
+from faultgen.cli import app
+from faultgen.data import dataset, reader
+from faultgen.operation import programs
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def sweep_file(shared_sweep):
+    """Two tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 are recorded (as test_plot)."""
+    return shared_sweep("s", robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0],
+                        cycles=20, record=[1, 10, 20])
+
+
+def _edited(folder, name=None):
+    """The spot weld exported and edited (slower, first pose moved), as ``folder/mine2.toml``."""
+    text = programs.export("irb6700", "spot_weld")
+    assert "velocity_scale = 1.0" in text and "pose = [1.55, -0.25, 0.8]" in text
+    text = text.replace("velocity_scale = 1.0", "velocity_scale = 0.6", 1)
+    text = text.replace("pose = [1.55, -0.25, 0.8]", "pose = [1.57, -0.25, 0.8]", 1)
+    if name is not None:
+        text = text.replace('name = "spot_weld"', f'name = "{name}"', 1)
+    path = folder / "mine2.toml"
+    path.write_text(text)
+    return path
+
+
+def test_an_edited_export_is_labelled_by_its_file_and_an_unedited_one_is_the_task(tmp_path):
+    builtin = programs.identity("irb6700", "spot_weld")
+    assert builtin == ("spot_weld", hashlib.sha256(programs.export("irb6700", "spot_weld").encode()).hexdigest())
+    same = tmp_path / "mine.toml"
+    same.write_text(programs.export("irb6700", "spot_weld"))
+    assert programs.identity("irb6700", str(same)) == builtin  # the same program, bit for bit
+    edited = _edited(tmp_path)
+    label, digest = programs.identity("irb6700", str(edited))
+    assert label == "mine2" and digest == hashlib.sha256(edited.read_bytes()).hexdigest() != builtin[1]
+    renamed = _edited(tmp_path, name="slow_weld")  # a name of its own is kept
+    assert programs.identity("irb6700", str(renamed))[0] == "slow_weld"
+
+
+def test_a_sweep_refuses_two_programs_under_one_label_and_writes_nothing(tmp_path):
+    a = _edited(tmp_path, name="myweld").rename(tmp_path / "a.toml")
+    b = tmp_path / "b.toml"
+    b.write_text(programs.export("irb6700", "spot_weld").replace('name = "spot_weld"', 'name = "myweld"'))
+    out = tmp_path / "bad.h5"
+    result = runner.invoke(app, ["sweep", "--task", str(a), "--task", str(b), "--axis", "0", "--cycles", "2",
+                                 "-o", str(out), "--no-progress"])
+    assert result.exit_code == 2, result.output
+    assert "different programs" in result.output and "'myweld'" in result.output
+    assert list(tmp_path.glob("bad*")) == []
+
+
+def test_every_run_records_its_programs_hash_and_the_validator_checks_it(sweep_file, tmp_path):
+    with reader.open(sweep_file) as data:
+        for run in data.runs:
+            assert run.program_sha256 == programs.identity("irb6700", run.task)[1]
+            assert run.program == run.program_sha256
+        assert data.unhashed == ""
+    bad = tmp_path / "bad.h5"
+    bad.write_bytes(sweep_file.read_bytes())
+    with h5py.File(bad, "a") as f:
+        f["runs"][next(iter(f["runs"]))].attrs[dataset.PROGRAM_ATTRIBUTE] = "not-a-hash"
+    assert any("program_sha256" in p and "64 hex digits" in p for p in dataset.validate(bad))
+
+
+def _mixed(source, path, *, drop_hash=False):
+    """The spot weld's worn run beside the pick and place's unworn run relabelled ``spot_weld``: two
+    programs under one label, as an older faultgen wrote them for an edited export."""
+    runs = {"irb6700-spot_weld-axis2-exp420-seed0": "irb6700-spot_weld-axis2-exp420-seed0",
+            "irb6700-spot_weld-nowear-seed0": "irb6700-pick_place-nowear-seed0"}
+    with h5py.File(source, "r") as src, h5py.File(path, "w") as dst:
+        for key, value in src.attrs.items():
+            dst.attrs[key] = value
+        dst.attrs["n_runs"] = len(runs)
+        for name, run_id in runs.items():
+            src.copy(src[f"runs/{run_id}"], dst.require_group("runs"), name=name)
+            dst[f"runs/{name}"].attrs["task"] = "spot_weld"
+            if drop_hash:
+                del dst[f"runs/{name}"].attrs[dataset.PROGRAM_ATTRIBUTE]
+    assert dataset.validate(path) == []
+    return path
+
+
+def test_detect_never_pairs_runs_of_different_programs(sweep_file, tmp_path):
+    mixed = _mixed(sweep_file, tmp_path / "mixed.h5")
+    with pytest.raises(ValueError, match=r"same-run needs the run without wear .* not comparable with it: "
+                                         r"irb6700-spot_weld-nowear-seed0 differs in program spot_weld"):
+        benchmark.detection_table(mixed, progress=False, protocol="same-run")
+    result = runner.invoke(app, ["detect", str(mixed), "--protocol", "same-run", "--no-progress",
+                                 "-o", str(tmp_path / "det")])
+    assert result.exit_code == 2 and "differs in program" in result.output, result.output
+
+
+def test_plot_never_draws_a_worn_run_against_another_programs_unworn_run(sweep_file, tmp_path, monkeypatch):
+    mixed = _mixed(sweep_file, tmp_path / "mixed.h5")
+    references = []
+    change = plotting._change
+
+    def spy(run, reference, j):
+        references.append(reference)
+        return change(run, reference, j)
+
+    monkeypatch.setattr(plotting, "_change", spy)
+    plotting.plot(mixed, tmp_path / "mixed.png")
+    assert references == [None]  # against its own first cycle, not the pick and place's run
+    with reader.open(sweep_file) as data:  # the right pairing still pairs
+        worn = data["irb6700-spot_weld-axis2-exp420-seed0"]
+        unworn = [r for r in data.healthy if plotting._reference_key(r) == plotting._reference_key(worn)]
+        assert [r.id for r in unworn] == ["irb6700-spot_weld-nowear-seed0"]
+
+
+def test_a_file_without_hashes_is_paired_by_label_and_says_so(sweep_file, tmp_path):
+    old = _mixed(sweep_file, tmp_path / "old.h5", drop_hash=True)
+    with reader.open(old) as data:
+        assert all(r.program_sha256 is None and r.program == "task:spot_weld" for r in data.runs)
+        assert "paired by their task label alone" in data.unhashed
+    result = runner.invoke(app, ["plot", str(old), "-o", str(tmp_path / "old.png")])
+    assert result.exit_code == 0, result.output
+    assert "paired by their task label alone" in " ".join(result.output.split())
+
+
+def test_isolation_shows_healthy_runs_only_the_cycles_of_their_own_programs_worn_runs(sweep_file, tmp_path):
+    mixed = _mixed(sweep_file, tmp_path / "mixed.h5")
+    table = benchmark.isolation_table(mixed, levels=[5.0], progress=False)
+    assert (table["worn_axis"] != 0).all()  # the relabelled unworn run is of another program: not a case
+    table = benchmark.isolation_table(sweep_file, levels=[5.0], progress=False)
+    healthy = table[table["worn_axis"] == 0]
+    assert set(healthy["run"]) == {"irb6700-pick_place-nowear-seed0", "irb6700-spot_weld-nowear-seed0"}
+    assert np.all(healthy.groupby("run").size() == len(set(table["isolator"])))
