@@ -51,7 +51,7 @@ with faultgen.open(path) as data:
     for run in data.runs[:4]:
         print(run.id, run.task, "worn axes", run.worn_axes, "final wear %", run.wear[-1].round(1))
     labels = data.labels()
-labels.head()
+print(labels.head())
 
 # %% [markdown]
 # ## 3. Which axis wears? The isolation table (thesis Table 6.2)
@@ -89,9 +89,9 @@ benchmark.detection_figure(charts, "tutorial-detection.png")
 # %%
 table = benchmark.classification_table(path, classifiers=["lr", "svm"], preprocessing=["control", "+diff"],
                                        n_pairs=4, progress=False, chance=True, n_jobs=1)
-print(benchmark.markdown(table))
-print(table.attrs["chance"])
-benchmark.classification_tidy(table)
+print(benchmark.markdown(benchmark.classification_printed(table)))
+print(benchmark.classification_verdict(table))
+print(benchmark.classification_tidy(table))
 
 # %% [markdown]
 # ## 6. Everything per cycle, as a pandas table

@@ -269,8 +269,9 @@ def classify_command(
         "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.")] = 0,
     chance: Annotated[bool, typer.Option(
-        help="Without --permutations, estimate the chance level cheaply on one cell (lr control, "
-        "5 label exchanges, on quick.h5 2 % of the default table's CPU time) and give it in the caption.")] = True,
+        help="Without --permutations, measure each row's chance level on lr (19 label exchanges, about half the "
+        "default table's time again) and judge every cell against it: columns chance, p and above_chance, and a "
+        "verdict line. --no-chance: not measured, no verdict.")] = True,
     jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0)] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
@@ -289,8 +290,10 @@ def classify_command(
     worn and one unworn run at a time, trains on the rest and scores the pair by AUC; --pairs 0
     takes every pair, as the thesis did.
 
-    Robots of one kind (process, model) look alike, so chance is not 0.5 here: --permutations
-    measures it on the same robots, and 'p' says whether the AUC beats it. With labels by wear a
+    Robots of one kind (process, model) look alike, so chance is not 0.5 here: by default each
+    row's chance level is measured on lr with the runs' labels exchanged, every cell gets its
+    permutation p-value and above_chance (p <= 0.05), and a verdict line says whether any cell
+    beats chance; --permutations measures the chance level of every cell instead. With labels by wear a
     failing robot's failed days are its last, so a classifier that only learns when in the record
     a day lies scores well above 0.5; --matched-days compares them with the same days of the
     healthy robot instead.
@@ -322,18 +325,18 @@ def classify_command(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
         horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1,
         short=not full, **cells)
-    estimate = table.attrs.get("chance")
     command = " ".join(["faultgen classify", shlex.quote(str(file)), *([f"--horizon {horizon}"] if horizon is not None else []),
                         *(["--matched-days"] if matched_days else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
                         *(["--full"] if full else []),
                         *(f"--classifier {c}" for c in classifiers or []),
                         *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
     caption = benchmark.classification_caption(table, n_pairs=pairs or None, horizon=horizon,
-                                               wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
+                                               wear_threshold=wear_threshold, matched=matched_days,
                                                command=command, short=not (full or preprocessing))
-    text = benchmark.markdown(table, digits=3) + "\n\n" + caption
+    text = (benchmark.markdown(benchmark.classification_printed(table), digits=3) + "\n\n" + caption + "\n\n"
+            + benchmark.classification_verdict(table, command))
     benchmark.classification_tidy(table).to_csv(stem.with_suffix(".csv"), index=False)
     stem.with_suffix(".md").write_text(text + "\n")
-    benchmark.classification_heatmap(table, stem.with_suffix(".png"), estimate)
+    benchmark.classification_heatmap(table, stem.with_suffix(".png"))
     typer.echo(text)
     typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))
