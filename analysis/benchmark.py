@@ -143,7 +143,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis (0: no wear),
     wear_pct (the level; 0 for a run without wear), cycles (samples seen), isolator, predicted
     (0: undecided; -1: too few cycles for the isolator), correct, windowed, n_axes (the run's
-    robot's axes N).
+    robot's axes N), needed (the fewest cycles the isolator runs on; NaN for a plugin). A case with
+    too few cycles is not applicable: :func:`isolation_accuracy` leaves it out.
 
     Raises
     ------
@@ -193,6 +194,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         for run in runs:
             if not run.worn_axes:
                 cases += [(run, NO_FAULT, 0.0, n) for (setup, _), n in seen.items() if setup == run.setup]
+    needed = {name: isolation.min_rows(prototype) for name, prototype in isolators.items()}
     rows = []
     for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
         X = values[run.id][:n]
@@ -205,7 +207,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
                              answer=axis_label(predicted), correct=predicted == axis,
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
-                             n_axes=X.shape[1]))
+                             n_axes=X.shape[1], needed=np.nan if needed[name] is None else needed[name]))
     return pd.DataFrame(rows)
 
 
@@ -304,9 +306,37 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
 
 
 def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
-    """Accuracy in percent per task and wear level (rows) and isolator (columns), Table 6.2."""
-    accuracy = table.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100).unstack("isolator")
-    return accuracy.round(1)
+    """Accuracy in percent per task and wear level (rows) and isolator (columns), Table 6.2.
+
+    One rule everywhere: a case the isolator ran on is right when it names the worn axis, or, on a
+    run without wear, when it names none (undecided); so an isolator that runs and never decides
+    scores 100 % on "no fault" and 0 % elsewhere. A case it could not run on (fewer cycles than it
+    needs: predicted -1) is not applicable and left out; a cell with no applicable case is NaN,
+    which :func:`isolation_accuracy_text` spells "not applicable: N cycles < M needed"."""
+    applicable = table[table["predicted"] != TOO_FEW_CYCLES]
+    accuracy = (applicable.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100)
+                .reindex(pd.MultiIndex.from_frame(table[["task", "wear_pct", "isolator"]].drop_duplicates()))
+                .unstack("isolator"))
+    return accuracy.sort_index().astype(float).round(1)
+
+
+def isolation_accuracy_text(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`isolation_accuracy` as text: each cell its percentage, or where no case was
+    applicable "not applicable: N cycles < M needed" (N the most cycles its cases saw, M the
+    isolator's need)."""
+    accuracy = isolation_accuracy(table)
+    seen = table.groupby(["task", "wear_pct", "isolator"])[["cycles", "needed"]].max()
+    out = accuracy.astype(object)
+    for key in accuracy.index:
+        for name in accuracy.columns:
+            value = accuracy.loc[key, name]
+            if np.isnan(value):
+                cycles, need = seen.loc[(*key, name)]
+                out.loc[key, name] = (f"not applicable: {int(cycles)} cycles < {int(need)} needed" if np.isfinite(need)
+                                      else f"not applicable: {int(cycles)} cycles too few")
+            else:
+                out.loc[key, name] = f"{value:.1f}"
+    return out
 
 
 def isolation_decided(table: pd.DataFrame) -> pd.DataFrame:
@@ -324,7 +354,7 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     ``te10``, as the thesis, else the first isolator), then the accuracy of every isolator."""
     isolators = list(dict.fromkeys(table["isolator"]))
     marked = marked or ("te10" if "te10" in isolators else isolators[0])
-    accuracy = isolation_accuracy(table)
+    accuracy = isolation_accuracy_text(table)
     n_axes = _table_axes(table)
     head = (["task", "wear %"] + [f"axis {a}" for a in range(1, n_axes + 1)]
             + [f"accuracy {name} (%)" for name in isolators])
@@ -334,15 +364,21 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
         for axis in range(1, n_axes + 1):
             row = group[group["worn_axis"] == axis]
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
-        acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
+        acc = [accuracy.loc[(task, level), name] for name in isolators]
         lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
     decided = isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct")
-    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). Rows \"no fault\": runs without "
-            "wear, where the accuracy is the share left undecided (naming an axis is a false isolation).\n\n"
+    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). {ACCURACY_RULE}\n\n"
             + "\n".join(lines)
             + "\n\nCases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
-            "cycles). An isolator that never decides scores 100 % on \"no fault\" and 0 % elsewhere:\n\n"
+            "cycles):\n\n"
             + markdown(decided, digits=4))
+
+
+#: How :func:`isolation_accuracy` scores, said wherever its numbers are printed.
+ACCURACY_RULE = ("Accuracy: the share of cases an isolator ran on in which it named the worn axis, or on rows \"no "
+                 "fault\" (runs without wear) named none (naming an axis there is a false isolation); so one that "
+                 "never decides scores 100 % on \"no fault\" and 0 % elsewhere. Cases with fewer cycles than it needs "
+                 "are not scored: \"not applicable: N cycles < M needed\".")
 
 
 def _level_label(level: float) -> str:
@@ -363,9 +399,10 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
             value = accuracy.iat[i, j]
-            ax.text(j, i, f"{value:.0f}", ha="center", va="center", color="white" if value < 60 else "black")
+            ax.text(j, i, "n/a" if np.isnan(value) else f"{value:.0f}", ha="center", va="center",
+                    color="white" if np.isnan(value) or value < 60 else "black")
     fig.colorbar(image, ax=ax, label="source axis isolated (%)")
-    ax.set_title("isolation accuracy per task and wear level")
+    ax.set_title("isolation accuracy per task and wear level (n/a: too few cycles for the isolator)")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     return out
@@ -658,9 +695,9 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
         where = (f"at sample {int(earliest)}, cycle {int(learned['fault_begins_cycle'].min())}"
                  if np.isfinite(earliest) else f"at cycle {int(learned['fault_begins_cycle'].min())}")
         if np.isfinite(earliest) and earliest - 1 >= fewest:
-            remedy = f"--first {int(earliest) - 1} (or fewer, at least {fewest}) keeps training before it"
+            remedy = f"A --first of {int(earliest) - 1} (or fewer, at least {fewest}) keeps training before it"
         else:
-            remedy = (f"no --first avoids it (the monitor needs at least {fewest} training samples"
+            remedy = (f"No --first avoids it (the monitor needs at least {fewest} training samples"
                       f"{f' with --limit-folds {folds}' if folds else ''}); learn from runs without wear instead: "
                       f"{seeds} for --protocol other-seeds, or record cycles before the wear begins")
         notes.append(f"note: {len(learned)} of {len(table)} runs are left out of the summary: the fault began inside "
@@ -676,17 +713,26 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
                      f"interval {worst['false_alarm_ci_pct']} %): the Q limit does not hold on healthy data the monitor "
                      "did not learn, so alarms come sooner than alpha promises; more training data or --limit-folds "
                      "helps")
-    detected = table[table["detected"]]
-    unlocated = detected[~detected["located"].astype(bool)]
-    if len(unlocated) and len(unlocated) == len(detected):  # located_pct 0: say why
+    counted = table[~table["trained_on_fault"]] if "trained_on_fault" in table else table
+    detected = counted[counted["detected"]]
+    if len(detected) and not detected["located"].astype(bool).any():  # located_pct 0: say why
         need = isolation.min_rows(isolation.make("cross_correlation"))
-        samples = unlocated["onset"].astype(int) + 1
-        short = int((unlocated["located_axis"] == TOO_FEW_CYCLES).sum())
-        notes.append(f"note: located_pct is 0: no detected run was located, because the onset came after "
-                     f"{int(samples.min())}-{int(samples.max())} samples (median {int(samples.median())}), too few to "
-                     f"locate: cross-correlation needs at least {need} samples to run ({short} runs had fewer) and, "
-                     "with lags up to a quarter of them, tens of samples to tell the axes apart (it named none: "
-                     "'undecided'). Record more cycles (--record all) to locate")
+        short = detected[detected["located_axis"] == TOO_FEW_CYCLES]
+        undecided = detected[detected["located_axis"] == UNDECIDED]
+        why = []
+        if len(short):
+            why.append(f"in {len(short)} the onset came after {int(short['onset'].max()) + 1} samples or fewer, too few "
+                       f"to locate (cross-correlation needs at least {need})")
+        if len(undecided):
+            samples = undecided["onset"].astype(int) + 1
+            why.append(f"in {len(undecided)} cross-correlation named no axis (undecided) on the "
+                       f"{int(samples.min())}-{int(samples.max())} samples up to the onset: no axis's features led "
+                       "the others'")
+        wrong = len(detected) - len(short) - len(undecided)
+        if wrong:
+            why.append(f"in {wrong} it named another axis than the worn one")
+        notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): {'; '.join(why)}. Location needs "
+                     "more samples before the onset: record more cycles (--record all)")
     noisy = table[table["alarms_before_fault_pct"] >= 50]
     if len(noisy):
         notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the fault "

@@ -84,12 +84,11 @@ def bench_isolators_command(
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
         typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
-    accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
+    accuracy = benchmark.isolation_accuracy_text(table).rename(index={0.0: "no fault"}, level="wear_pct")
     typer.echo(benchmark.markdown(accuracy, digits=4))
-    typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
-               "isolation). In the CSV, predicted 0 is undecided and -1 too few cycles (column answer spells it).")
-    typer.echo("\ncases in which each isolator named an axis, right or wrong (%); one that never decides scores 100 % on "
-               "\"no fault\" and 0 % elsewhere:")
+    typer.echo(benchmark.ACCURACY_RULE + " In the CSV, predicted 0 is undecided and -1 too few cycles (column answer "
+               "spells it; needed: the isolator's fewest cycles).")
+    typer.echo("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few cycles):")
     typer.echo(benchmark.markdown(benchmark.isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct"),
                                   digits=4))
     starved = benchmark.starved_isolators(table)
