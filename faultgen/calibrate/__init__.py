@@ -92,6 +92,33 @@ class Step:
                 "gap_after": self.gap_after}
 
 
+#: An axis whose held-out nrmse after the search is above this many times the median axis's is
+#: named as left unexplained (summary, report.json, figure): the total gap can fall a lot while
+#: one axis keeps most of its residual.
+UNEXPLAINED_RATIO = 3.0
+
+
+def unexplained(gap_before: dict, gap_after: dict, steps: list[Step], searches: int | None = None) -> list[dict]:
+    """The axes the search left unexplained: held-out nrmse after it above :data:`UNEXPLAINED_RATIO`
+    times the median axis's. Per axis (numbered 1..N): its nrmse before and after, the median,
+    the ratio, the effects added on it (with their step) and what was tried on it: every effect
+    of :data:`faultgen.effects.EFFECTS`, fitted to the residual at each step of the search, none
+    significant on it beyond those added; ``searches``: how many times the effects were fitted
+    (default: one more than the steps, the search that found nothing more)."""
+    nrmse = np.asarray(gap_after["nrmse"], dtype=float)
+    median = float(np.median(nrmse))
+    if not median > 0:
+        return []
+    found = []
+    for axis in np.flatnonzero(nrmse > UNEXPLAINED_RATIO * median):
+        found.append({"axis": axes.number(int(axis)), "nrmse": float(nrmse[axis]),
+                      "nrmse_before": float(gap_before["nrmse"][axis]), "median_nrmse": median,
+                      "ratio": float(nrmse[axis] / median),
+                      "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(steps, start=1) if axis in s.axes],
+                      "tried": list(EFFECTS), "searches": len(steps) + 1 if searches is None else searches})
+    return found
+
+
 @dataclass(frozen=True)
 class Calibration:
     """What :func:`calibrate` found.
@@ -114,6 +141,9 @@ class Calibration:
         Mask of the samples where the axis moves (faster than the rest speed).
     tau, nominal, calibrated : ndarray of shape (n, 6)
         Measured torque and the torque of the nominal and of the augmented model, N m.
+    searches : int or None
+        How many times every effect was fitted to the residual (the steps, and the search that
+        found nothing more when there was one).
     """
 
     robot: str
@@ -128,6 +158,7 @@ class Calibration:
     tau: np.ndarray
     nominal: np.ndarray
     calibrated: np.ndarray
+    searches: int | None = None
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""
@@ -139,7 +170,12 @@ class Calibration:
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
             "ambiguous": self.ambiguous(),
+            "unexplained": self.unexplained(),
         }
+
+    def unexplained(self) -> list[dict]:
+        """The axes left unexplained after the search (:func:`unexplained`)."""
+        return unexplained(self.gap_before, self.gap_after, self.steps, self.searches)
 
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
@@ -188,6 +224,8 @@ class Calibration:
                 lines.append(f"   a designed excitation: faultgen excitation {self.robot} -o excitation.csv")
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
+        for u in self.unexplained():
+            lines.append(unexplained_line(u, self.robot))
         # the static model: for a per-step friction update, or a Stribeck curve MuJoCo's LuGre
         # (Gaussian only) cannot represent
         static_only = any(s.effect.stepped for s in self.steps) or any(
@@ -195,6 +233,16 @@ class Calibration:
         friction = " --friction stribeck" if static_only else ""
         lines.append(f"simulate it: faultgen simulate --model {self.model_out}{friction}")
         return "\n".join(lines)
+
+
+def unexplained_line(found: dict, robot: str) -> str:
+    """One line of the summary for an axis of :func:`unexplained`."""
+    added = f"added on it: {', '.join(found['added'])}" if found["added"] else "nothing added on it"
+    return (f"axis {found['axis']} LEFT UNEXPLAINED: held-out nrmse {found['nrmse_before']:.4f} -> {found['nrmse']:.4f}, "
+            f"{found['ratio']:.1f}x the median axis's {found['median_nrmse']:.4f}; tried: every effect "
+            f"({', '.join(found['tried'])}) fitted to its residual at each of {found['searches']} search steps; "
+            f"{added}. Its residual is in the figure; an effect the log does not excite, or one outside the "
+            f"library: a designed excitation, faultgen excitation {robot} -o excitation.csv")
 
 
 #: Most rows the search works on. A longer log is averaged down to this many (:func:`decimate`):
@@ -341,8 +389,10 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
         trial_path = Path(work) / model_out.name
         if tasks_file.is_file():
             shutil.copyfile(tasks_file, Path(work) / "tasks.toml")
+        searches = 0
         for k in range(max_steps):
             residual = tau - predicted
+            searches += 1
             ranked = search.rank(motion, residual, tau, split, progress=progress,
                                  label=f"step {k + 1}: fitting effects")
             best = ranked[0]
@@ -385,6 +435,7 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
         tau=tau,
         nominal=nominal_prediction,
         calibrated=predicted,
+        searches=searches,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     from faultgen.calibrate import figure
