@@ -1173,8 +1173,8 @@ def classification_verdict(table: pd.DataFrame, command: str = "faultgen classif
                 f"{CHANCE_ALPHA * above.size:.2g} of {above.size} would pass by chance alone on average{others}")
     reason = (f" (with {k} label exchanges p cannot go below {1 / (k + 1):.2f}: use --permutations 19)"
               if k and 1 / (k + 1) > CHANCE_ALPHA else "")
-    return (f"verdict: no judged cell is above chance at the {100 * CHANCE_ALPHA:g} % level{reason}: these AUCs "
-            f"({np.nanmin(means.to_numpy()):.2f}-{np.nanmax(means.to_numpy()):.2f}) are what the classifiers reach "
+    return (f"verdict: no judged cell is above chance at the {100 * CHANCE_ALPHA:g} % level{reason}: the AUCs of "
+            f"{', '.join(judged)} ({np.nanmin(means.to_numpy()):.2f}-{np.nanmax(means.to_numpy()):.2f}) are what it reaches "
             f"with the runs' labels exchanged (chance {np.nanmin(null.to_numpy()):.2f}-{np.nanmax(null.to_numpy()):.2f}), "
             "so they do not show that worn samples are told from healthy ones. More data would help: more worn and "
             "unworn runs (several seeds: --seed 0 --seed 1 --seed 2, or more robots in a fleet) and more recorded "
