@@ -140,3 +140,28 @@ def test_isolation_shows_healthy_runs_only_the_cycles_of_their_own_programs_worn
     healthy = table[table["worn_axis"] == 0]
     assert set(healthy["run"]) == {"irb6700-pick_place-nowear-seed0", "irb6700-spot_weld-nowear-seed0"}
     assert np.all(healthy.groupby("run").size() == len(set(table["isolator"])))
+
+
+def test_the_issues_sweep_written_the_old_way_is_still_paired_by_program(tmp_path):
+    """The issue's workflow: the spot weld and its edited export, which an older faultgen labelled
+    both `spot_weld` and wrote without program_sha256. The edited program's runs still carry their
+    file's hash (attribute `program`), so detect pairs each worn run with its own program's run."""
+    from faultgen.runs import sweep
+
+    edited = _edited(tmp_path)
+    path = tmp_path / "mixed.h5"
+    sweep.run(sweep.Grid(robots=["irb6700"], tasks=["spot_weld", str(edited)], axes=[0, 2], cycles=4, signals=False),
+              path, jobs=1, progress=False)
+    with h5py.File(path, "a") as f:  # as written before the hash: one label, no program_sha256
+        for group in f["runs"].values():
+            group.attrs["task"] = "spot_weld"
+            del group.attrs[dataset.PROGRAM_ATTRIBUTE]
+    with reader.open(path) as data:
+        by_id = {r.id: r for r in data.runs}
+        assert by_id["irb6700-mine2-nowear-seed0"].program == hashlib.sha256(edited.read_bytes()).hexdigest()
+        assert by_id["irb6700-spot_weld-nowear-seed0"].program == "task:spot_weld"
+        assert "2 of 4 runs" in data.unhashed
+    table = benchmark.detection_table(path, progress=False, protocol="same-run")
+    assert dict(zip(table["run"], table["trained_on"], strict=True)) == {
+        "irb6700-mine2-axis2-exp420-seed0": "irb6700-mine2-nowear-seed0",
+        "irb6700-spot_weld-axis2-exp420-seed0": "irb6700-spot_weld-nowear-seed0"}

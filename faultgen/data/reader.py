@@ -77,8 +77,9 @@ class Run:
     provenance : dict
         faultgen_version, model_sha256, log_period (s), command, config (parsed JSON).
     program_sha256 : str or None
-        SHA-256 (hex) of the program's text (:func:`faultgen.operation.programs.identity`); None in
-        files written before it was recorded.
+        SHA-256 (hex) of the program's text (:func:`faultgen.operation.programs.identity`). In files
+        written before it was recorded: a program file's or log's hash from the ``program``
+        attribute, None for a thesis task.
     """
 
     id: str
@@ -226,7 +227,9 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
                     "model_sha256": str(attrs.get("model_sha256", "")),
                     "log_period": float(attrs.get("log_period", np.nan)), "command": str(attrs.get("command", "")),
                     "config": config},
-        program_sha256=str(attrs[dataset.PROGRAM_ATTRIBUTE]) if dataset.PROGRAM_ATTRIBUTE in attrs else None,
+        # files written before the attribute: a program file's or log's runs kept its hash in `program`
+        program_sha256=str(attrs[dataset.PROGRAM_ATTRIBUTE]) if dataset.PROGRAM_ATTRIBUTE in attrs
+        else (_json(attrs.get("program")) or {}).get("sha256"),
         _source=source)
 
 
