@@ -165,3 +165,26 @@ def test_the_issues_sweep_written_the_old_way_is_still_paired_by_program(tmp_pat
     assert dict(zip(table["run"], table["trained_on"], strict=True)) == {
         "irb6700-mine2-axis2-exp420-seed0": "irb6700-mine2-nowear-seed0",
         "irb6700-spot_weld-axis2-exp420-seed0": "irb6700-spot_weld-nowear-seed0"}
+
+
+def test_runs_of_another_robot_friction_or_conditions_are_not_comparable_and_the_reason_is_named():
+    def run(**changes):
+        base = dict(id="r", robot="irb6700", task="spot_weld", friction_model="lugre", seed=0, cycles=10,
+                    worn_axes=(), wear_schedule={}, fault=None, conditions=None, noise={}, sample="cycle",
+                    has_signals=True, provenance={"model_sha256": "m"}, program_sha256="a" * 64)
+        return reader.Run(**{**base, **changes})
+
+    a = run()
+    assert reader.difference(a, run(seed=1)) == "" and a.setup == run(seed=1).setup
+    assert reader.difference(a, run(robot="puma560")) == "robot irb6700 vs puma560"
+    assert reader.difference(a, run(provenance={"model_sha256": "other"})) == "robot model of irb6700"
+    assert reader.difference(a, run(program_sha256="b" * 64)).startswith("program spot_weld (aaaaaaaa) vs")
+    assert reader.difference(a, run(friction_model="stribeck")) == "friction model lugre vs stribeck"
+    hot = run(conditions={"thermal": {"ambient": 35.0}, "payloads": None})
+    assert reader.difference(a, hot) == "operating conditions" and a.setup != hot.setup
+    assert hot.setup != run(conditions={"thermal": {"ambient": 20.0}, "payloads": None}).setup
+    # a fleet's robots each draw their own climate: compared when the same conditions are on
+    day = {"sample": "day"}
+    assert run(conditions={"thermal": {"ambient": 35.0}}, **day).setup == \
+        run(conditions={"thermal": {"ambient": 20.0}}, **day).setup
+    assert run(conditions={"thermal": {"ambient": 35.0}}, **day).setup != run(conditions=None, **day).setup

@@ -115,9 +115,22 @@ class Run:
     def setup(self) -> tuple:
         """What two runs must share to be compared (a worn run with its unworn reference, a monitor
         with the runs it judges): robot (name and model hash), program, friction model and
-        operating conditions. :func:`difference` says in words what two setups do not share."""
+        operating conditions (:attr:`conditions_key`). :func:`difference` says in words what two
+        setups do not share."""
         return (self.robot, self.provenance.get("model_sha256", ""), self.program, self.friction_model,
-                json.dumps(self.conditions, sort_keys=True))
+                self.conditions_key)
+
+    @property
+    def conditions_key(self) -> str:
+        """The operating conditions two runs must share to be compared: all of them for a run of a
+        sweep; for a fleet's robot (daily records), which conditions are on, as each robot is a unit
+        with its own draw of the fleet's climate, payloads and spread (thesis ch. 4-5 compare
+        robots)."""
+        if not self.conditions:
+            return ""
+        if self.sample == "day":
+            return json.dumps(sorted(k for k, v in self.conditions.items() if v is not None))
+        return json.dumps(self.conditions, sort_keys=True)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -209,7 +222,7 @@ def difference(a: Run, b: Run) -> str:
         parts.append(f"program {shown}")
     if a.friction_model != b.friction_model:
         parts.append(f"friction model {a.friction_model} vs {b.friction_model}")
-    if a.conditions != b.conditions:
+    if a.conditions_key != b.conditions_key:
         parts.append("operating conditions")
     return ", ".join(parts)
 
