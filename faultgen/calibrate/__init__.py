@@ -38,6 +38,7 @@ from faultgen.calibrate import gearbox, plausibility, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.calibrate.plausibility import ImplausibleLogError
+from faultgen.calibrate.leftover import UNEXPLAINED_RATIO, unexplained, unexplained_line
 from faultgen.data import atomic
 from faultgen.data import measured as measured_io
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
@@ -90,33 +91,6 @@ class Step:
         return {"effect": self.effect.id, "axes": axes.numbers(self.axes), "params": self.effect.report(self.axes),
                 "standard_errors": errors, "units": dict(self.effect.units), "evidence": self.evidence,
                 "gap_after": self.gap_after}
-
-
-#: An axis whose held-out nrmse after the search is above this many times the median axis's is
-#: named as left unexplained (summary, report.json, figure): the total gap can fall a lot while
-#: one axis keeps most of its residual.
-UNEXPLAINED_RATIO = 3.0
-
-
-def unexplained(gap_before: dict, gap_after: dict, steps: list[Step], searches: int | None = None) -> list[dict]:
-    """The axes the search left unexplained: held-out nrmse after it above :data:`UNEXPLAINED_RATIO`
-    times the median axis's. Per axis (numbered 1..N): its nrmse before and after, the median,
-    the ratio, the effects added on it (with their step) and what was tried on it: every effect
-    of :data:`faultgen.effects.EFFECTS`, fitted to the residual at each step of the search, none
-    significant on it beyond those added; ``searches``: how many times the effects were fitted
-    (default: one more than the steps, the search that found nothing more)."""
-    nrmse = np.asarray(gap_after["nrmse"], dtype=float)
-    median = float(np.median(nrmse))
-    if not median > 0:
-        return []
-    found = []
-    for axis in np.flatnonzero(nrmse > UNEXPLAINED_RATIO * median):
-        found.append({"axis": axes.number(int(axis)), "nrmse": float(nrmse[axis]),
-                      "nrmse_before": float(gap_before["nrmse"][axis]), "median_nrmse": median,
-                      "ratio": float(nrmse[axis] / median),
-                      "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(steps, start=1) if axis in s.axes],
-                      "tried": list(EFFECTS), "searches": len(steps) + 1 if searches is None else searches})
-    return found
 
 
 @dataclass(frozen=True)
@@ -233,16 +207,6 @@ class Calibration:
         friction = " --friction stribeck" if static_only else ""
         lines.append(f"simulate it: faultgen simulate --model {self.model_out}{friction}")
         return "\n".join(lines)
-
-
-def unexplained_line(found: dict, robot: str) -> str:
-    """One line of the summary for an axis of :func:`unexplained`."""
-    added = f"added on it: {', '.join(found['added'])}" if found["added"] else "nothing added on it"
-    return (f"axis {found['axis']} LEFT UNEXPLAINED: held-out nrmse {found['nrmse_before']:.4f} -> {found['nrmse']:.4f}, "
-            f"{found['ratio']:.1f}x the median axis's {found['median_nrmse']:.4f}; tried: every effect "
-            f"({', '.join(found['tried'])}) fitted to its residual at each of {found['searches']} search steps; "
-            f"{added}. Its residual is in the figure; an effect the log does not excite, or one outside the "
-            f"library: a designed excitation, faultgen excitation {robot} -o excitation.csv")
 
 
 #: Most rows the search works on. A longer log is averaged down to this many (:func:`decimate`):
