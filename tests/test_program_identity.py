@@ -14,6 +14,7 @@ from faultgen import plot as plotting
 from faultgen.cli import app
 from faultgen.data import dataset, reader
 from faultgen.operation import programs
+from test_plot import _subset  # a valid dataset of some runs of another
 
 runner = CliRunner()
 
@@ -79,17 +80,13 @@ def test_every_run_records_its_programs_hash_and_the_validator_checks_it(sweep_f
 def _mixed(source, path, *, drop_hash=False):
     """The spot weld's worn run beside the pick and place's unworn run relabelled ``spot_weld``: two
     programs under one label, as an older faultgen wrote them for an edited export."""
-    runs = {"irb6700-spot_weld-axis2-exp420-seed0": "irb6700-spot_weld-axis2-exp420-seed0",
-            "irb6700-spot_weld-nowear-seed0": "irb6700-pick_place-nowear-seed0"}
-    with h5py.File(source, "r") as src, h5py.File(path, "w") as dst:
-        for key, value in src.attrs.items():
-            dst.attrs[key] = value
-        dst.attrs["n_runs"] = len(runs)
-        for name, run_id in runs.items():
-            src.copy(src[f"runs/{run_id}"], dst.require_group("runs"), name=name)
-            dst[f"runs/{name}"].attrs["task"] = "spot_weld"
+    _subset(source, path, {"irb6700-spot_weld-axis2-exp420-seed0": "irb6700-spot_weld-axis2-exp420-seed0",
+                           "irb6700-spot_weld-nowear-seed0": "irb6700-pick_place-nowear-seed0"})
+    with h5py.File(path, "a") as f:
+        for group in f["runs"].values():
+            group.attrs["task"] = "spot_weld"
             if drop_hash:
-                del dst[f"runs/{name}"].attrs[dataset.PROGRAM_ATTRIBUTE]
+                del group.attrs[dataset.PROGRAM_ATTRIBUTE]
     assert dataset.validate(path) == []
     return path
 
