@@ -135,6 +135,10 @@ def detect_command(
 
     Writes OUT.csv and OUT.md (per run), OUT-summary.csv (per task, per worn axis, all) and OUT.png
     (the Q and T2 charts of each worn run with their limits, the fault's start and the onset).
+    The summary leaves out runs whose monitor learned the fault as normal (trained_on_fault,
+    column left_out); notes under it say what else the numbers rest on: a held-out false-alarm
+    rate above alpha by more than its 95 % interval, why nothing was located, and advice the
+    dataset can follow.
 
     Example:
 
