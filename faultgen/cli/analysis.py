@@ -160,7 +160,10 @@ def detect_command(
     summary.to_csv(summary_csv)
     typer.echo(benchmark.markdown(table, digits=4))
     typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
-    typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
+    left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
+    rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
+             if left_out else "")
+    typer.echo(f"\nsummary ({rests}false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
     typer.echo(benchmark.markdown(summary, digits=4))
     advice = benchmark.detection_advice(table, protocol)
     if advice:
