@@ -44,6 +44,15 @@ def test_runs_trained_on_the_fault_are_left_out_of_the_summary_and_the_advice_is
     assert "--preset quick" not in advice
 
 
+def test_detect_says_what_its_summary_rests_on(small, tmp_path):
+    result = runner.invoke(app, ["detect", str(small), "--protocol", "first-cycles", "--no-progress",
+                                 "-o", str(tmp_path / "d")])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "summary (of 0 of 2 runs: 2 left out, their monitor learned the fault;" in text
+    assert "2 of 2 runs are left out of the summary" in text
+
+
 def test_the_advice_suggests_the_datasets_own_sweep_with_seeds():
     assert benchmark._with_seeds("faultgen sweep --preset j2 -o j2.h5 --no-progress") == \
         "faultgen sweep --preset j2 --seed 0 --seed 1 --seed 2 -o j2-seeds.h5"
