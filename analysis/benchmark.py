@@ -104,7 +104,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     DataFrame with one row per (run, level, isolator): robot, task, run, worn_axis (0: no wear),
     wear_pct (the level; 0 for a run without wear), cycles (samples seen), isolator, predicted
     (0: undecided; -1: too few cycles for the isolator), correct, windowed, n_axes (the run's
-    robot's axes N).
+    robot's axes N), needed (the fewest cycles the isolator runs on; NaN for a plugin). A case with
+    too few cycles is not applicable: :func:`isolation_accuracy` leaves it out.
 
     Raises
     ------
@@ -139,7 +140,8 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         worn = [r for r in runs if len(r.worn_axes) == 1]
         if not worn:
             raise ValueError(f"{data.path} has no run with exactly one worn axis to isolate")
-        # cycles seen per (robot, task, level): what the worn runs saw, shown to the healthy ones too
+        # cycles seen per (setup, level): what the worn runs saw, shown to the healthy runs of the same
+        # robot, program, friction and conditions (reader.Run.setup) too
         seen: dict[tuple, int] = {}
         cases = []
         for run in worn:
@@ -148,12 +150,12 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             for level in levels:
                 k = level_cycle(grown, level)
                 if k is not None:
-                    seen.setdefault((run.robot, run.task, level), k + 1)
+                    seen.setdefault((run.setup, level), k + 1)
                     cases.append((run, axis, level, k + 1))
         for run in runs:
             if not run.worn_axes:
-                cases += [(run, NO_FAULT, 0.0, n) for (robot, task, _), n in seen.items()
-                          if (robot, task) == (run.robot, run.task)]
+                cases += [(run, NO_FAULT, 0.0, n) for (setup, _), n in seen.items() if setup == run.setup]
+    needed = {name: isolation.min_rows(prototype) for name, prototype in isolators.items()}
     rows = []
     for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
         X = values[run.id][:n]
@@ -166,7 +168,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
                              answer=axis_label(predicted), correct=predicted == axis,
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
-                             n_axes=X.shape[1]))
+                             n_axes=X.shape[1], needed=np.nan if needed[name] is None else needed[name]))
     return pd.DataFrame(rows)
 
 
@@ -265,9 +267,37 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
 
 
 def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
-    """Accuracy in percent per task and wear level (rows) and isolator (columns), Table 6.2."""
-    accuracy = table.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100).unstack("isolator")
-    return accuracy.round(1)
+    """Accuracy in percent per task and wear level (rows) and isolator (columns), Table 6.2.
+
+    One rule everywhere: a case the isolator ran on is right when it names the worn axis, or, on a
+    run without wear, when it names none (undecided); so an isolator that runs and never decides
+    scores 100 % on "no fault" and 0 % elsewhere. A case it could not run on (fewer cycles than it
+    needs: predicted -1) is not applicable and left out; a cell with no applicable case is NaN,
+    which :func:`isolation_accuracy_text` spells "not applicable: N cycles < M needed"."""
+    applicable = table[table["predicted"] != TOO_FEW_CYCLES]
+    accuracy = (applicable.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100)
+                .reindex(pd.MultiIndex.from_frame(table[["task", "wear_pct", "isolator"]].drop_duplicates()))
+                .unstack("isolator"))
+    return accuracy.sort_index().astype(float).round(1)
+
+
+def isolation_accuracy_text(table: pd.DataFrame) -> pd.DataFrame:
+    """:func:`isolation_accuracy` as text: each cell its percentage, or where no case was
+    applicable "not applicable: N cycles < M needed" (N the most cycles its cases saw, M the
+    isolator's need)."""
+    accuracy = isolation_accuracy(table)
+    seen = table.groupby(["task", "wear_pct", "isolator"])[["cycles", "needed"]].max()
+    out = accuracy.astype(object)
+    for key in accuracy.index:
+        for name in accuracy.columns:
+            value = accuracy.loc[key, name]
+            if np.isnan(value):
+                cycles, need = seen.loc[(*key, name)]
+                out.loc[key, name] = (f"not applicable: {int(cycles)} cycles < {int(need)} needed" if np.isfinite(need)
+                                      else f"not applicable: {int(cycles)} cycles too few")
+            else:
+                out.loc[key, name] = f"{value:.1f}"
+    return out
 
 
 def isolation_decided(table: pd.DataFrame) -> pd.DataFrame:
@@ -285,7 +315,7 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     ``te10``, as the thesis, else the first isolator), then the accuracy of every isolator."""
     isolators = list(dict.fromkeys(table["isolator"]))
     marked = marked or ("te10" if "te10" in isolators else isolators[0])
-    accuracy = isolation_accuracy(table)
+    accuracy = isolation_accuracy_text(table)
     n_axes = _table_axes(table)
     head = (["task", "wear %"] + [f"axis {a}" for a in range(1, n_axes + 1)]
             + [f"accuracy {name} (%)" for name in isolators])
@@ -295,15 +325,21 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
         for axis in range(1, n_axes + 1):
             row = group[group["worn_axis"] == axis]
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
-        acc = [f"{accuracy.loc[(task, level), name]:.1f}" for name in isolators]
+        acc = [accuracy.loc[(task, level), name] for name in isolators]
         lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
     decided = isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct")
-    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). Rows \"no fault\": runs without "
-            "wear, where the accuracy is the share left undecided (naming an axis is a false isolation).\n\n"
+    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). {ACCURACY_RULE}\n\n"
             + "\n".join(lines)
             + "\n\nCases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
-            "cycles). An isolator that never decides scores 100 % on \"no fault\" and 0 % elsewhere:\n\n"
+            "cycles):\n\n"
             + markdown(decided, digits=4))
+
+
+#: How :func:`isolation_accuracy` scores, said wherever its numbers are printed.
+ACCURACY_RULE = ("Accuracy: the share of cases an isolator ran on in which it named the worn axis, or on rows \"no "
+                 "fault\" (runs without wear) named none (naming an axis there is a false isolation); so one that "
+                 "never decides scores 100 % on \"no fault\" and 0 % elsewhere. Cases with fewer cycles than it needs "
+                 "are not scored: \"not applicable: N cycles < M needed\".")
 
 
 def _level_label(level: float) -> str:
@@ -324,9 +360,10 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
             value = accuracy.iat[i, j]
-            ax.text(j, i, f"{value:.0f}", ha="center", va="center", color="white" if value < 60 else "black")
+            ax.text(j, i, "n/a" if np.isnan(value) else f"{value:.0f}", ha="center", va="center",
+                    color="white" if np.isnan(value) or value < 60 else "black")
     fig.colorbar(image, ax=ax, label="source axis isolated (%)")
-    ax.set_title("isolation accuracy per task and wear level")
+    ax.set_title("isolation accuracy per task and wear level (n/a: too few cycles for the isolator)")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     return out
@@ -434,8 +471,8 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     with opened(path) as data:
         table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
                                    limit_folds)
-        table.attrs["dataset_kind"] = data.kind
-        table.attrs["protocol_reasons"] = charts.pop("_reasons")
+        table.attrs.update(dataset_kind=data.kind, command=data.command, first=first, limit_folds=limit_folds,
+                           alpha=alpha, protocol_reasons=charts.pop("_reasons"))
     return (table, charts) if return_charts else table
 
 
@@ -502,7 +539,8 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         if used_protocol == "other-seeds":
             if not others:
                 raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
-                                 f"{run.task} with another seed than {run.seed}; this dataset has none. Sweep "
+                                 f"{run.task} with another seed than {run.seed}; this dataset has none"
+                                 f"{_unlike(run, healthy)}. Sweep "
                                  "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
             training = [(r.id, torque_of(r), r.recorded) for r in others]
             key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
@@ -520,8 +558,8 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         else:  # same-run
             if own is None:
                 raise ValueError(f"{path}: protocol same-run needs the run without wear of {run.robot} "
-                                 f"{run.task} seed {run.seed}; this dataset has none: use --protocol first-cycles "
-                                 "(or auto)")
+                                 f"{run.task} seed {run.seed}; this dataset has none{_unlike(run, healthy)}: use "
+                                 "--protocol first-cycles (or auto)")
             training = [(own.id, torque_of(own), own.recorded)]
             key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
         held_out = used_protocol != "same-run"
@@ -542,7 +580,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         onset = None if onset is None else onset + first_tested
         before = alarms[skip:start]
         if key not in false_alarms:
-            rates = []
+            rates, counts = [], [0, 0]  # and alarms, samples over the healthy runs: the interval
             for normal_run in heldout:
                 if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
                     _, normal_run, rest = normal_run
@@ -566,18 +604,22 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                     normal, _ = _kl_features(torque_of(normal_run), normal_run.recorded, scale, period, reference)
                     flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
                 rates.append(100.0 * float(np.mean(flags)))
-            false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates))
-        false_alarm, n_normal = false_alarms[key]
+                counts[0] += int(np.sum(flags))
+                counts[1] += int(flags.size)
+            false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates), false_alarm_interval(*counts))
+        false_alarm, n_normal, (low, high) = false_alarms[key]
         wear = fault_progress(run, axis) * 100.0 - 100.0
         located = UNDECIDED
         if onset is not None:
             try:
                 located = int(isolation.make("cross_correlation").fit(worn[: onset + 1]).source_axis_)
-            except ValueError:  # too few samples before the onset to cross-correlate
-                located = UNDECIDED
+            except ValueError:  # too few samples up to the onset to cross-correlate: said, not undecided
+                located = TOO_FEW_CYCLES
         rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
                          trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
+                         false_alarm_ci_pct=f"{low:.1f}-{high:.1f}" if np.isfinite(low) else "",
+                         false_alarm_above_alpha=bool(low > 100.0 * alpha),
                          fault_begins_cycle=np.nan if begins is None else int(run.recorded[begins]),
                          trained_on_fault=begins is not None and int(groups[begins]) < skip,
                          alarms_before_fault_pct=round(100.0 * float(before.mean()), 2) if before.size else np.nan,
@@ -594,8 +636,11 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             chart.update(t2=t2, q=q, t2_limit=monitor.t2_limit_, q_limit=monitor.q_limit_)
         charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
                               protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
+    table = pd.DataFrame(rows)
+    # what detection_advice needs: the sample each fault begins at (what --first must stay below)
+    table.attrs["fault_begins_sample"] = {r: c["begins"] for r, c in charts.items() if c["begins"] is not None}
     charts["_reasons"] = reasons
-    return pd.DataFrame(rows), charts
+    return table, charts
 
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
@@ -623,33 +668,93 @@ def false_alarm_meaning(protocols: Iterable[str]) -> str:
 
 
 def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
-    """Notes on a :func:`detection_table` that fit its dataset (a sweep or a fleet): where the
-    monitor learned the fault, where it alarmed before the fault began, which data would serve
-    better. Empty when there is nothing to say."""
+    """Notes on a :func:`detection_table` that fit its dataset (a sweep or a fleet): runs left out of
+    the summary because the monitor learned the fault, held-out false-alarm rates above the
+    nominal alpha, runs detected too early to locate, alarms before the fault began, and which
+    data would serve better (only advice the dataset can follow). Empty when there is nothing to
+    say."""
     notes = []
     kind = table.attrs.get("dataset_kind", "sweep")
+    command = table.attrs.get("command", "")
+    seeds = (f"sweep this dataset's grid again with several seeds: `{_with_seeds(command)}`"
+             if command.startswith("faultgen sweep") else "sweep its grid with several seeds (--seed 0 --seed 1 --seed 2)")
     held_in = table[table["protocol"] != "other-seeds"]
     if protocol == "auto" and len(held_in) and kind != "fleet":
         notes.append(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} "
                      f"runs were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. "
-                     "For false alarms on healthy runs of other units, sweep several seeds: `faultgen sweep --preset "
-                     "quick --seed 0 --seed 1 --seed 2`")
+                     f"For false alarms on healthy runs of other units, {seeds}")
     if kind == "fleet" and (table["protocol"] == "first-cycles").any():
         notes.append("note: a fleet's robots each learn their own first days (first-cycles, thesis ch. 4 OTO); "
                      "false_alarm_pct is that protocol on the fleet's healthy robots. For monitors learnt from other "
                      "robots, compared with their own, run `faultgen training-source` on a 60-day fleet")
     learned = table[table["trained_on_fault"]] if "trained_on_fault" in table else table.iloc[:0]
     if len(learned):
-        earliest = int(learned["fault_begins_cycle"].min())
-        notes.append(f"note: in {len(learned)} of {len(table)} runs the fault began inside the samples the monitor "
-                     f"learned as normal (trained_on_fault; earliest at cycle {earliest}): a smaller --first (below "
-                     f"{earliest}) keeps training before it, or record longer before the fault")
+        begins = table.attrs.get("fault_begins_sample", {})
+        earliest = min((begins.get(r, np.inf) for r in learned["run"]), default=np.inf)
+        folds = table.attrs.get("limit_folds") or 0
+        fewest = max(folds, 3)  # a monitor's training samples: --limit-folds folds, else a few
+        where = (f"at sample {int(earliest)}, cycle {int(learned['fault_begins_cycle'].min())}"
+                 if np.isfinite(earliest) else f"at cycle {int(learned['fault_begins_cycle'].min())}")
+        if np.isfinite(earliest) and earliest - 1 >= fewest:
+            remedy = f"A --first of {int(earliest) - 1} (or fewer, at least {fewest}) keeps training before it"
+        else:
+            remedy = (f"No --first avoids it (the monitor needs at least {fewest} training samples"
+                      f"{f' with --limit-folds {folds}' if folds else ''}); learn from runs without wear instead: "
+                      f"{seeds} for --protocol other-seeds, or record cycles before the wear begins")
+        notes.append(f"note: {len(learned)} of {len(table)} runs are left out of the summary: the fault began inside "
+                     f"the samples their monitor learned as normal (trained_on_fault; earliest {where}), so their "
+                     f"detections say nothing. {remedy}")
+    alpha = 100.0 * table.attrs.get("alpha", 0.05)
+    high = table[table["false_alarm_above_alpha"] & ~table["protocol"].str.startswith("same-run")] \
+        if "false_alarm_above_alpha" in table else table.iloc[:0]
+    if len(high):
+        worst = high.loc[high["false_alarm_pct"].idxmax()]
+        notes.append(f"note: in {len(high)} of {len(table)} runs the held-out false-alarm rate is above the nominal "
+                     f"{alpha:g} % by more than its 95 % interval (e.g. {worst['run']}: {worst['false_alarm_pct']:g} %, "
+                     f"interval {worst['false_alarm_ci_pct']} %): the Q limit does not hold on healthy data the monitor "
+                     "did not learn, so alarms come sooner than alpha promises; more training data or --limit-folds "
+                     "helps")
+    counted = table[~table["trained_on_fault"]] if "trained_on_fault" in table else table
+    detected = counted[counted["detected"]]
+    if len(detected) and not detected["located"].astype(bool).any():  # located_pct 0: say why
+        need = isolation.min_rows(isolation.make("cross_correlation"))
+        short = detected[detected["located_axis"] == TOO_FEW_CYCLES]
+        undecided = detected[detected["located_axis"] == UNDECIDED]
+        why = []
+        if len(short):
+            why.append(f"in {len(short)} the onset came after {int(short['onset'].max()) + 1} samples or fewer, too few "
+                       f"to locate (cross-correlation needs at least {need})")
+        if len(undecided):
+            samples = undecided["onset"].astype(int) + 1
+            why.append(f"in {len(undecided)} cross-correlation named no axis (undecided) on the "
+                       f"{int(samples.min())}-{int(samples.max())} samples up to the onset: no axis's features led "
+                       "the others'")
+        wrong = len(detected) - len(short) - len(undecided)
+        if wrong:
+            why.append(f"in {wrong} it named another axis than the worn one")
+        notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): {'; '.join(why)}. Location needs "
+                     "more samples before the onset: record more cycles (--record all)")
     noisy = table[table["alarms_before_fault_pct"] >= 50]
     if len(noisy):
         notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the fault "
                      "begins (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
                      "detections say little")
     return "\n".join(notes)
+
+
+def _with_seeds(command: str) -> str:
+    """The sweep ``command`` that made a dataset, with three seeds and a new output file."""
+    import shlex
+
+    words, kept, out = shlex.split(command), [], Path("sweep.h5")
+    while words:
+        word = words.pop(0)
+        if word in ("-o", "--out", "--seed") and words:
+            value = words.pop(0)
+            out = Path(value) if word != "--seed" else out
+        elif word not in ("--no-progress", "--resume", "--overwrite"):
+            kept.append(word)
+    return shlex.join([*kept, "--seed", "0", "--seed", "1", "--seed", "2", "-o", str(out.with_name(out.stem + "-seeds.h5"))])
 
 
 def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
@@ -691,23 +796,55 @@ def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
 
 
 def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """Per task and per worn axis (and over all): runs, mean false-alarm rate (%), share detected
-    (%), median onset cycle and true wear at detection (%), share located (%)."""
+    """Per task and per worn axis (and over all): runs counted, left_out (runs whose monitor learned
+    the fault as normal, ``trained_on_fault``: their detections say nothing, so none of the other
+    columns rests on them), mean false-alarm rate (%), share detected (%), median onset cycle and
+    true wear at detection (%), share located (%)."""
     def percent(flags):
-        return 100.0 * flags.mean()
+        return 100.0 * flags.mean() if len(flags) else np.nan
 
+    learned = table["trained_on_fault"].astype(bool) if "trained_on_fault" in table else pd.Series(False, table.index)
     aggregate = dict(runs=("run", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
                      detected_pct=("detected", percent), median_onset_cycle=("onset_cycle", "median"),
                      median_onset_wear_pct=("onset_wear_pct", "median"), located_pct=("located", percent))
-    parts = [table.groupby(table[key].astype(str)).agg(**aggregate).assign(by=label)
-             for key, label in (("task", "task"), ("worn_axis", "worn axis"))]
-    parts.append(table.groupby(pd.Series("all", index=table.index)).agg(**aggregate).assign(by="all"))
+    parts = []
+    for key, label in (("task", "task"), ("worn_axis", "worn axis"), (None, "all")):
+        by = table[key].astype(str) if key else pd.Series("all", index=table.index)
+        kept = table[~learned].groupby(by[~learned]).agg(**aggregate).reindex(sorted(set(by)))
+        kept["runs"] = kept["runs"].fillna(0).astype(int)
+        kept.insert(1, "left_out", learned.groupby(by).sum().reindex(kept.index).astype(int))
+        parts.append(kept.assign(by=label))
     out = pd.concat(parts).rename_axis("group").reset_index()
     return out.set_index(["by", "group"]).round(2)
 
 
+def false_alarm_interval(alarms: int, samples: int, level: float = 0.95) -> tuple[float, float]:
+    """Clopper-Pearson ``level`` interval of a false-alarm rate, % (``scipy.stats.binomtest``),
+    from the alarms among the healthy samples judged; (nan, nan) without samples. Samples of a run
+    are correlated, so the interval is if anything too narrow: a rate whose interval lies above
+    the nominal alpha is above it."""
+    if samples == 0:
+        return np.nan, np.nan
+    from scipy.stats import binomtest
+
+    ci = binomtest(int(alarms), int(samples)).proportion_ci(confidence_level=level, method="exact")
+    return round(100.0 * ci.low, 2), round(100.0 * ci.high, 2)
+
+
 def _same_unit_kind(a: reader.Run, b: reader.Run) -> bool:
-    return (a.robot, a.task, a.friction_model) == (b.robot, b.task, b.friction_model)
+    """Whether ``a`` and ``b`` may be compared: same robot, program (its hash), friction model and
+    operating conditions (:attr:`faultgen.data.reader.Run.setup`)."""
+    return a.setup == b.setup
+
+
+def _unlike(run: reader.Run, healthy: Iterable[reader.Run]) -> str:
+    """For an error: the healthy runs of ``run``'s robot and task label that differ in setup, and how."""
+    unlike = [(r, reader.difference(run, r)) for r in healthy if (r.robot, r.task) == (run.robot, run.task)]
+    unlike = [(r, why) for r, why in unlike if why]
+    if not unlike:
+        return ""
+    return (f" ({len(unlike)} runs without wear of that label are not comparable with it: {unlike[0][0].id} differs "
+            f"in {unlike[0][1]})")
 
 
 def _fit_monitor(training: list, period: int | None, variance: float, alpha: float, detector=None,
@@ -854,8 +991,11 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     :data:`THESIS_WINDOW` to ``horizon`` before its last one (the failure day T of a failing
     robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
     worn run is labelled 1 (the robot's state), of an unworn run 0. With ``chance`` (and no
-    ``permutations``) the table's ``attrs["chance"]`` holds a cheap chance level,
-    :func:`chance_estimate`. With ``short`` (and no ``preprocessing``) only the rows of
+    ``permutations``) every row's chance level is measured on :data:`CHANCE_CLASSIFIER`
+    (:func:`row_chance`) and every cell judged against it; with ``permutations`` each cell against
+    its own; either way :func:`with_verdict` adds the chance level, the p-value and
+    ``above_chance``, and ``attrs`` hold ``pairs`` (held-out pairs scored) and ``chance_source``
+    ("cell": every cell measured; a classifier's name: only its cells, the default; None: not measured). With ``short`` (and no ``preprocessing``) only the rows of
     :data:`analysis.classify.SHORT_TABLE` the dataset has (no "+estM" ones without the duty).
     ``kwargs`` go to :func:`analysis.classify.evaluate` (``n_jobs``: pairs in parallel).
 
@@ -866,7 +1006,7 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         run and its samples), or the training sets would lack a class (see
         :func:`_check_training_sets`).
     """
-    from analysis.classify import ESTIMATED, SHORT_TABLE, evaluate
+    from analysis.classify import ESTIMATED, SHORT_TABLE, evaluate, select_pairs
 
     inputs = classification_inputs(path, wear_threshold, horizon)
     if short and kwargs.get("preprocessing") is None:
@@ -874,9 +1014,19 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
                                    if inputs.estimated is not None or not n.startswith(ESTIMATED)]
     table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
                      random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
-    if chance and not kwargs.get("permutations"):
-        table.attrs["chance"] = chance_estimate(inputs, n_pairs=n_pairs, random_state=random_state,
-                                                n_jobs=kwargs.get("n_jobs"), matched=kwargs.get("matched", False))
+    null_values = {key: np.array(v) for key, v in table.attrs.pop("null_values", {}).items()}
+    source = "cell" if null_values else None
+    if chance and not null_values:  # the cheapest classifier's cells, each against its own chance level
+        columns = list(dict.fromkeys(table.columns.get_level_values(0)))
+        judged = CHANCE_CLASSIFIER if CHANCE_CLASSIFIER in columns else columns[0]
+        rows = list(table.index)
+        measured = row_chance(inputs, rows, n_pairs=n_pairs, random_state=random_state, n_jobs=kwargs.get("n_jobs"),
+                              matched=kwargs.get("matched", False), classifier=judged)
+        null_values = {f"{judged} {row}": measured[row] for row in rows}
+        source = judged
+    table = with_verdict(table, null_values)
+    table.attrs.update(pairs=len(select_pairs(inputs.failed, inputs.normal, n_pairs, random_state)),
+                       chance_source=source)
     return table
 
 
@@ -949,72 +1099,172 @@ def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | Non
                                 np.concatenate(groups), failed, normal)
 
 
-#: Permutations of the cheap chance estimate ``faultgen classify`` makes by default (one cell).
-CHANCE_PERMUTATIONS = 5
+#: Label exchanges of the chance level ``faultgen classify`` measures per row by default: with 19
+#: the smallest permutation p-value is 1/20, so a cell can be above chance at the 5 % level.
+CHANCE_PERMUTATIONS = 19
+
+#: The classifier whose AUC with exchanged labels is each row's chance level by default: the
+#: cheapest (a row costs 19 of its fits per pair, about half the default table's time in all).
+CHANCE_CLASSIFIER = "lr"
+
+#: A cell is above chance when its permutation p-value is at most this.
+CHANCE_ALPHA = 0.05
 
 
-def chance_estimate(inputs: ClassificationInputs, n_pairs: int | None = 20, random_state: int = 0,
-                    permutations: int = CHANCE_PERMUTATIONS, n_jobs: int | None = None, matched: bool = False,
-                    classifier: str = "lr", preprocessing: str = "control") -> dict:
-    """A cheap chance level of a classification on these robots: the mean leave-pair-out AUC of one
-    cell (``classifier`` on ``preprocessing``) over ``permutations`` label sets with the runs'
-    roles exchanged (:func:`analysis.classify.permuted_roles`), on the same pairs as the table.
+def row_chance(inputs: ClassificationInputs, rows: list[str], n_pairs: int | None = 20, random_state: int = 0,
+               permutations: int = CHANCE_PERMUTATIONS, n_jobs: int | None = None, matched: bool = False,
+               classifier: str = CHANCE_CLASSIFIER) -> dict[str, np.ndarray]:
+    """The chance level of each preprocessing row on these robots: the mean leave-pair-out AUC of
+    ``classifier`` on ``permutations`` label sets with the runs' roles exchanged
+    (:func:`analysis.classify.permuted_roles`), on the same pairs as the table.
 
-    It costs ``permutations`` times one cell (a table has up to 76). It is one cell's chance level,
-    an estimate for the others (classifiers differ in how far they overfit robots): ``faultgen
-    classify --permutations K`` measures every cell.
+    Robots of one kind (process, model) look alike, so chance is not 0.5. It is measured on one
+    classifier per row; one that fits runs more closely (rf, stacking) may have a higher chance
+    level, which ``faultgen classify --permutations K`` measures cell by cell.
 
     Returns
     -------
-    dict: cell ("lr control"), permutations, null (mean AUC under exchange), null_values (per
-    label set), auc (the cell's AUC on the true labels), p (:func:`analysis.classify.null_p_value`).
+    dict: row -> ndarray of shape (permutations,), the exchanged mean AUCs.
     """
-    from analysis.classify import evaluate, null_p_value
+    from analysis.classify import evaluate
 
-    table, aucs = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, classifiers=[classifier],
-                           preprocessing=[preprocessing], estimated=inputs.estimated, n_pairs=n_pairs,
-                           random_state=random_state, permutations=permutations, n_jobs=n_jobs, matched=matched,
-                           return_aucs=True)
-    null = float(table.loc[preprocessing, (classifier, "null")])
-    return {"cell": f"{classifier} {preprocessing}", "permutations": permutations, "null": null,
-            "auc": float(table.loc[preprocessing, (classifier, "mean")]), "p": float(table.loc[preprocessing, (classifier, "p")])}
+    table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, classifiers=[classifier],
+                     preprocessing=rows, estimated=inputs.estimated, n_pairs=n_pairs, random_state=random_state,
+                     permutations=permutations, n_jobs=n_jobs, matched=matched)
+    return {row: np.array(table.attrs["null_values"][f"{classifier} {row}"]) for row in rows}
+
+
+def with_verdict(table: pd.DataFrame, null_values: Mapping[str, np.ndarray]) -> pd.DataFrame:
+    """``table`` (:func:`analysis.classify.evaluate`) with each cell judged against chance: per
+    classifier ``null`` (the mean exchanged AUC), ``p`` (:func:`analysis.classify.null_p_value`
+    of the cell's mean AUC against ``null_values["<classifier> <row>"]``) and ``above`` (p at most
+    :data:`CHANCE_ALPHA`; None for a classifier without null values: not judged). Without
+    ``null_values`` the table is returned as it is (not measured)."""
+    from analysis.classify import null_p_value
+
+    if not null_values:
+        return table
+    out = {}
+    for column in dict.fromkeys(table.columns.get_level_values(0)):
+        out[column, "mean"], out[column, "std"] = table[column, "mean"], table[column, "std"]
+        if f"{column} {table.index[0]}" not in null_values:  # not measured: no verdict, not a False one
+            out[column, "null"] = out[column, "p"] = pd.Series(np.nan, index=table.index)
+            out[column, "above"] = pd.Series(None, index=table.index, dtype=object)
+            continue
+        null = {row: null_values[f"{column} {row}"] for row in table.index}
+        out[column, "null"] = pd.Series({row: float(np.nanmean(v)) for row, v in null.items()})
+        out[column, "p"] = pd.Series({row: null_p_value(table.loc[row, (column, "mean")], null[row])
+                                      for row in table.index})
+        out[column, "above"] = (out[column, "p"] <= CHANCE_ALPHA).astype(object)
+    judged = pd.DataFrame(out, index=table.index)
+    judged.columns = judged.columns.set_names(table.columns.names)
+    judged.attrs.update(table.attrs, permutations=min(len(v) for v in null_values.values()))
+    return judged
+
+
+def classification_verdict(table: pd.DataFrame, command: str = "faultgen classify FILE") -> str:
+    """One line saying whether any judged cell of a :func:`classification_table` is above chance,
+    which classifiers were not judged, and when none is above, that its AUCs are no finding and
+    what would help."""
+    if "above" not in table.columns.get_level_values(-1):
+        return (f"verdict: not judged: the chance level was not measured (`{command} --permutations 19` measures it), "
+                "so these AUCs cannot be read as better than chance")
+    above = table.xs("above", axis=1, level=-1)
+    judged = [c for c in above.columns if above[c].notna().all()]
+    above = above[judged].astype(bool)
+    means, null = table.xs("mean", axis=1, level=-1)[judged], table.xs("null", axis=1, level=-1)[judged]
+    unjudged = [c for c in table.columns.get_level_values(0).unique() if c not in judged]
+    others = (f"; {', '.join(unjudged)} not judged (their chance level may be higher than {', '.join(judged)}'s: "
+              f"`{command} --permutations 19` measures every cell)" if unjudged else "")
+    k = int(table.attrs.get("permutations", 0))
+    if above.to_numpy().any():
+        best = means.where(above).stack().idxmax()
+        return (f"verdict: {int(above.to_numpy().sum())} of {above.size} judged cells above chance at the "
+                f"{100 * CHANCE_ALPHA:g} % level (best: {best[1]} {best[0]}, AUC {means.loc[best]:.2f} against chance "
+                f"{null.loc[best]:.2f}, p {table.loc[best[0], (best[1], 'p')]:.2f}); at {100 * CHANCE_ALPHA:g} % each, "
+                f"{CHANCE_ALPHA * above.size:.2g} of {above.size} would pass by chance alone on average{others}")
+    reason = (f" (with {k} label exchanges p cannot go below {1 / (k + 1):.2f}: use --permutations 19)"
+              if k and 1 / (k + 1) > CHANCE_ALPHA else "")
+    return (f"verdict: no judged cell is above chance at the {100 * CHANCE_ALPHA:g} % level{reason}: the AUCs of "
+            f"{', '.join(judged)} ({np.nanmin(means.to_numpy()):.2f}-{np.nanmax(means.to_numpy()):.2f}) are what it reaches "
+            f"with the runs' labels exchanged (chance {np.nanmin(null.to_numpy()):.2f}-{np.nanmax(null.to_numpy()):.2f}), "
+            "so they do not show that worn samples are told from healthy ones. More data would help: more worn and "
+            "unworn runs (several seeds: --seed 0 --seed 1 --seed 2, or more robots in a fleet) and more recorded "
+            f"cycles per run (--record all, more --cycles or --days){others}")
+
+
+def classification_printed(table: pd.DataFrame) -> pd.DataFrame:
+    """A :func:`classification_table` as ``faultgen classify`` prints it: per classifier mean, std
+    and, where judged, p; the chance level (one column when only one classifier or every one
+    shares it, else per classifier) and ``above_chance``, the classifiers above chance in the row
+    ("none"; the unjudged ones are named in the verdict)."""
+    if "above" not in table.columns.get_level_values(-1):
+        return table
+    classifiers = list(dict.fromkeys(table.columns.get_level_values(0)))
+    judged = [c for c in classifiers if table[c, "above"].notna().all()]
+    null = table.xs("null", axis=1, level=-1)[judged]
+    shared = bool((null.nunique(axis=1) <= 1).all())
+    out = {}
+    for c in classifiers:
+        out[c, "mean"], out[c, "std"] = table[c, "mean"], table[c, "std"]
+        if c in judged:
+            out[c, "p"] = table[c, "p"]
+            if not shared:
+                out[c, "chance"] = table[c, "null"]
+    if shared:
+        out["chance", ""] = null.iloc[:, 0]
+    above = table.xs("above", axis=1, level=-1)[judged].astype(bool)
+    out["above_chance", ""] = above.apply(lambda row: " ".join(c for c in judged if row[c]) or "none", axis=1)
+    return pd.DataFrame(out, index=table.index)
 
 
 def classification_tidy(table: pd.DataFrame) -> pd.DataFrame:
     """A :func:`classification_table` as a tidy table: one row per (preprocessing, classifier)
     cell, one header row; columns preprocessing, steps (what the combination does, in order),
-    classifier, auc_mean, auc_std and, where measured, auc_null and p."""
+    classifier, auc_mean, auc_std and, where chance was measured, auc_null (the chance level), p,
+    above_chance (p at most :data:`CHANCE_ALPHA`; empty where the cell was not judged: by default
+    only each row's lr cell is)."""
     from analysis.classify import describe_preprocessing
 
     long = table.stack(0, future_stack=True).reset_index()
     long = long.rename(columns={long.columns[1]: "classifier"})
-    long = long.rename(columns={"mean": "auc_mean", "std": "auc_std", "null": "auc_null"})
+    long = long.rename(columns={"mean": "auc_mean", "std": "auc_std", "null": "auc_null", "above": "above_chance"})
     long.insert(1, "steps", long["preprocessing"].map(describe_preprocessing))
     long.columns.name = None
     return long
 
 
 def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon: int | None, wear_threshold: float,
-                           matched: bool, chance: dict | None, command: str, short: bool = False) -> str:
-    """The caption of a classification table: what the cells are, how samples were labelled, the
-    chance level (measured per cell, estimated on one, or not measured with the command that
-    measures it), why two orders of the same steps are two rows (when both are), and with ``short``
-    (the default rows of ``faultgen classify``) how to get every row."""
+                           matched: bool, command: str, short: bool = False) -> str:
+    """The caption of a classification table: what the cells are (and over how many held-out pairs,
+    as scored: ``attrs["pairs"]``), how samples were labelled, the chance level and how each cell
+    is judged against it (per cell, per row on lr, or not measured with the command that measures
+    it), why two orders of the same steps are two rows (when both are), and with ``short`` (the
+    default rows of ``faultgen classify``) how to get every row."""
     labels = (f"the thesis's window (T-{horizon + 10} to T-{horizon}) labelled by the robot's state" if horizon is not None
               else f"every sample labelled failed when its true wear reaches {wear_threshold:g} %")
-    parts = [f"Leave-pair-out ROC AUC (mean and std over {'every' if n_pairs is None else n_pairs} held-out "
+    pairs = table.attrs.get("pairs", "every" if n_pairs is None else n_pairs)
+    parts = [f"Leave-pair-out ROC AUC (mean and std over {pairs} held-out "
              f"(worn, unworn) run pair(s), thesis Procedure 1 and Table 5.2) per preprocessing (rows) and classifier; "
              f"{labels}{'; time-matched (--matched-days)' if matched else ''}."]
-    if any(c == "null" for c in table.columns.get_level_values(-1)):
-        parts.append("Chance level measured per cell: auc_null, the mean AUC with the runs' labels exchanged, and p, "
-                     "the permutation p-value of the AUC.")
-    elif chance is not None:
-        parts.append(f"Chance level on these robots (estimated on one cell, {chance['cell']}, with "
-                     f"{chance['permutations']} label exchanges): {chance['null']:.2f}, not 0.5; that cell's AUC "
-                     f"{chance['auc']:.2f}, p {chance['p']:.2f} (with {chance['permutations']} exchanges p cannot go "
-                     f"below {1 / (chance['permutations'] + 1):.2f}). Every cell's: `{command} --permutations 19`.")
+    source = table.attrs.get("chance_source")
+    k = table.attrs.get("permutations", 0)
+    level = f"p at most {CHANCE_ALPHA:g}"
+    if source == "cell":
+        parts.append(f"Chance level measured per cell: null, the mean AUC with the runs' labels exchanged ({k} times), "
+                     f"and p, the permutation p-value of the AUC; above_chance: {level}.")
+    elif source is not None:
+        parts.append(f"Chance level per row (column chance): the mean AUC of {source} on that row with the runs' "
+                     f"labels exchanged {k} times (robots of one kind look alike, so it is not 0.5); p: {source}'s AUC "
+                     f"against those {k} exchanged AUCs; above_chance: the classifiers with {level}. The other "
+                     f"classifiers are not judged (one that fits runs more closely can have a higher chance level, "
+                     f"docs/analysis.md): `{command} --permutations 19` measures every cell.")
     else:
-        parts.append(f"Chance level not measured: `{command} --permutations 19` measures it per cell.")
+        parts.append(f"Chance level not measured, so no cell can be read as better than chance: "
+                     f"`{command} --permutations 19` measures it per cell.")
+    if source is not None and k and 1 / (k + 1) > CHANCE_ALPHA:
+        parts.append(f"With {k} exchanges p cannot go below {1 / (k + 1):.2f}, so no cell can be above chance at "
+                     f"{CHANCE_ALPHA:g}: use --permutations 19 or more.")
     if {"+diff+pca+var3", "+diff+var3+pca"} <= set(table.index):
         parts.append("Token order is step order: +diff+pca+var3 concatenates windows of PCA scores, +diff+var3+pca "
                      "takes PCA of the concatenated windows; the thesis's Table 5.2 lists both.")
@@ -1024,19 +1274,17 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
     return " ".join(parts)
 
 
-def classification_heatmap(table: pd.DataFrame, out: Path, chance: dict | None = None) -> Path:
+def classification_heatmap(table: pd.DataFrame, out: Path) -> Path:
     """PNG heatmap of a classification table's mean AUC (preprocessing x classifier), coloured
-    around the chance level (the per-cell null where measured, else ``chance``'s estimate, else
-    0.5, said in the title), the value in each cell (and p where measured)."""
+    around the chance level (the mean of the measured ones, else 0.5, said in the title), the
+    value in each cell, its p and a star where it is above chance, where measured."""
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.figure import Figure
 
     means = table.xs("mean", axis=1, level=-1)
     measured = "null" in table.columns.get_level_values(-1)
-    centre = (float(np.nanmean(table.xs("null", axis=1, level=-1).to_numpy())) if measured
-              else chance["null"] if chance is not None else 0.5)
-    what = ("mean of the measured chance levels" if measured else
-            f"chance estimated on {chance['cell']}" if chance is not None else "0.5, chance not measured")
+    centre = float(np.nanmean(table.xs("null", axis=1, level=-1).to_numpy(dtype=float))) if measured else 0.5
+    what = "mean of the measured chance levels" if measured else "0.5, chance not measured"
     fig = Figure(figsize=(1.3 * means.shape[1] + 3.2, 0.38 * means.shape[0] + 1.8))
     ax = fig.subplots()
     image = ax.imshow(means.to_numpy(dtype=float), cmap="RdBu_r", aspect="auto",
@@ -1047,10 +1295,16 @@ def classification_heatmap(table: pd.DataFrame, out: Path, chance: dict | None =
         for j in range(means.shape[1]):
             text = f"{means.iat[i, j]:.2f}"
             if measured:
-                text += f"\np {table[(means.columns[j], 'p')].iat[i]:.2f}"
+                column = means.columns[j]
+                if table[(column, "above")].iat[i] is not None:
+                    text += f"\np {table[(column, 'p')].iat[i]:.2f}" + (" *" if table[(column, "above")].iat[i] else "")
             ax.text(j, i, text, ha="center", va="center", fontsize=7)
     fig.colorbar(image, ax=ax, label=f"AUC (white: {centre:.2f}, {what})")
-    ax.set_title("leave-pair-out AUC per preprocessing and classifier", fontsize=9)
+    title = "leave-pair-out AUC per preprocessing and classifier"
+    if measured:
+        above = int((table.xs("above", axis=1, level=-1) == True).to_numpy().sum())  # noqa: E712 (None: not judged)
+        title += f"\n*: above chance (p <= {CHANCE_ALPHA:g}): {above} cells; without p: not judged"
+    ax.set_title(title, fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     return out

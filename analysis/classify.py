@@ -833,7 +833,8 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     table : pandas.DataFrame
         Index ``preprocessing`` (in the order given), columns a MultiIndex ``(classifier,
         "mean" | "std")``: mean and sample standard deviation (ddof 1) of the AUCs, NaN pairs
-        left out; with ``permutations`` also ``"null"`` and ``"p"`` per classifier.
+        left out; with ``permutations`` also ``"null"`` and ``"p"`` per classifier, and
+        ``attrs["null_values"]``: ``"<classifier> <preprocessing>"`` -> the K exchanged mean AUCs.
     aucs : dict
         Only with ``return_aucs=True``.
 
@@ -909,4 +910,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         if permutations:
             table.loc[name, (column, "null")] = np.nanmean(null[column, name])
             table.loc[name, (column, "p")] = null_p_value(table.loc[name, (column, "mean")], null[column, name])
+    if permutations:  # each cell's mean AUC per exchanged label set: what its p-value counts against
+        table.attrs["null_values"] = {f"{column} {name}": [float(v) for v in values]
+                                      for (column, name), values in null.items()}
     return (table, aucs) if return_aucs else table

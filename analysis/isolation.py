@@ -57,6 +57,14 @@ def make(name: str, **params) -> BaseEstimator:
     return ISOLATORS[name](**params)
 
 
+def min_rows(isolator, n_rows: int = 1_000_000) -> int | None:
+    """Fewest cycles (rows of ``X``) ``isolator`` fits on: what an :class:`Isolator` needs; None for
+    another estimator (a plugin), whose need is unknown until it fails. ``n_rows`` is the length
+    asked about, for isolators whose need depends on it (none of the registered ones). Raises
+    ValueError for invalid parameters, as ``fit`` would."""
+    return int(isolator._min_rows(n_rows)) if isinstance(isolator, Isolator) else None
+
+
 def _integer(owner: str, name: str, value, low: int) -> int:
     if not is_whole(value, low):
         raise ValueError(f"{owner}: {name} = {value!r}, expected an integer >= {low}")

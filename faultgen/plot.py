@@ -33,7 +33,8 @@ def plot(path: str | Path, out: str | Path, run: str | None = None) -> Path:
 
     A whole sweep (several runs, ``run`` omitted): a 2 x 3 grid, one panel per axis j; for every
     run that wears axis j, a line of the change of axis j's mean absolute motor torque, in percent
-    of the unworn run of the same robot, task, seed and friction model on the same cycle, against
+    of the unworn run of the same robot, program (its hash: :attr:`faultgen.data.reader.Run.setup`),
+    conditions, seed and friction model on the same cycle, against
     the true wear of axis j (%), one colour per task. Tasks whose torques differ tenfold share
     one scale, and the unworn run is the dashed line at 0, so the wear shows on every axis. A worn
     run without such an unworn run is drawn against its own first recorded cycle, and the title
@@ -202,7 +203,10 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
     robot_names = sorted({run.robot for run in runs})
     colors = {task: f"C{i % 10}" for i, task in enumerate(task_names)}
     styles = {robot: ("-", "--", "-.", ":")[i % 4] for i, robot in enumerate(robot_names)}
-    unworn = {_reference_key(run): run for run in runs if not run.worn_axes}
+    unworn: dict[tuple, list] = {}
+    for run in runs:
+        if not run.worn_axes:
+            unworn.setdefault(_reference_key(run), []).append(run)
     most = max(float((run.array("friction_multiplier") - 1.0).max()) * 100.0 for run in runs)
     legend, own_first = {}, False
     for j, ax in enumerate(axes):
@@ -211,7 +215,8 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
         for run in runs:
             if j + 1 not in run.worn_axes:
                 continue
-            wear, change, against_own = _change(run, unworn.get(_reference_key(run)), j)
+            references = unworn.get(_reference_key(run), [])  # two alike: an ambiguous label, no pairing
+            wear, change, against_own = _change(run, references[0] if len(references) == 1 else None, j)
             own_first |= against_own
             name = run.task if len(robot_names) == 1 else f"{run.robot}, {run.task}"
             (line,) = ax.plot(wear, change, marker="o", ms=3, ls=styles[run.robot], color=colors[run.task])
@@ -224,7 +229,7 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
         ax.grid(alpha=0.3)
     order = sorted(legend)
     fig.legend([legend[k] for k in order], order, loc="lower center", ncol=min(len(order), 6), frameon=False)
-    reference = "the unworn run of the same task and seed (dashed line at 0)"
+    reference = "the unworn run of the same program, conditions and seed (dashed line at 0)"
     if own_first:
         reference += "; runs without one: their own first recorded cycle"
     fig.suptitle(f"{data.path.name}: robots {', '.join(robot_names)}, {len(runs)} runs\nchange of the worn axis's mean "
@@ -234,8 +239,9 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
 
 
 def _reference_key(run: reader.Run) -> tuple:
-    """What a worn run shares with the unworn run it is compared with."""
-    return run.robot, run.task, run.seed, run.friction_model
+    """What a worn run shares with the unworn run it is compared with: robot, program (its hash),
+    friction model, operating conditions (:attr:`faultgen.data.reader.Run.setup`) and seed."""
+    return run.setup, run.seed
 
 
 def _change(run: reader.Run, reference: reader.Run | None, j: int) -> tuple[np.ndarray, np.ndarray, bool]:

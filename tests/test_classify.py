@@ -461,18 +461,22 @@ def test_classification_outputs_a_tidy_table_and_a_caption_with_the_chance_level
     assert back.set_index(["preprocessing", "classifier"]).loc[("+diff", "svm"), "auc_mean"] == \
         pytest.approx(table.loc["+diff", ("svm", "mean")])
     caption = benchmark.classification_caption(table, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
-                                               chance=None, command="faultgen classify x.h5")
-    assert "Chance level not measured: `faultgen classify x.h5 --permutations 19`" in caption
-    chance = {"cell": "lr control", "permutations": 5, "null": 0.81, "auc": 0.9, "p": 0.33}
-    caption = benchmark.classification_caption(table, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
-                                               chance=chance, command="faultgen classify x.h5")
-    assert "0.81, not 0.5" in caption and "Token order" not in caption and "--full" not in caption
-    both = table.rename(index={"control": "+diff+pca+var3", "+diff": "+diff+var3+pca"})
+                                               command="faultgen classify x.h5")
+    assert "Chance level not measured, so no cell can be read as better than chance: " \
+           "`faultgen classify x.h5 --permutations 19`" in caption
+    judged = benchmark.with_verdict(table, {f"lr {row}": np.full(19, 0.81) for row in table.index})
+    judged.attrs.update(chance_source="lr", pairs=4)
+    caption = benchmark.classification_caption(judged, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
+                                               command="faultgen classify x.h5")
+    assert "Chance level per row (column chance): the mean AUC of lr on that row" in caption
+    assert "Token order" not in caption and "--full" not in caption
+    both = judged.rename(index={"control": "+diff+pca+var3", "+diff": "+diff+var3+pca"})
     caption = benchmark.classification_caption(both, n_pairs=4, horizon=None, wear_threshold=10, matched=False,
-                                               chance=chance, command="faultgen classify x.h5", short=True)
+                                               command="faultgen classify x.h5", short=True)
     assert "+diff+pca+var3 concatenates windows of PCA scores" in caption
     assert "every row of Table 5.2: `faultgen classify x.h5 --full`" in caption
-    assert benchmark.classification_heatmap(table, tmp_path / "h.png", chance).stat().st_size > 0
+    assert benchmark.classification_heatmap(judged, tmp_path / "h.png").stat().st_size > 0
+    assert benchmark.classification_heatmap(table, tmp_path / "h0.png").stat().st_size > 0
 
 
 def test_the_short_table_is_its_rows_of_the_full_one_with_the_same_aucs():

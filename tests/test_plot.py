@@ -59,7 +59,7 @@ def test_sweep_plot_shows_the_change_against_the_same_tasks_unworn_run(sweep_fil
     (fig,) = figures
     assert len(fig.axes) == 6
     assert "s.h5" in fig.get_suptitle() and "4 runs" in fig.get_suptitle()
-    assert "against the unworn run of the same task and seed" in fig.get_suptitle()
+    assert "against the unworn run of the same program, conditions and seed" in fig.get_suptitle()
     axis2 = fig.axes[1]
     assert axis2.get_xlabel() == "true wear [%] of axis 2"
     assert axis2.get_ylabel() == "change of mean |motor torque| [%]"

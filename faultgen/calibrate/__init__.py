@@ -38,6 +38,7 @@ from faultgen.calibrate import gearbox, plausibility, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.calibrate.plausibility import ImplausibleLogError
+from faultgen.calibrate.leftover import UNEXPLAINED_RATIO, unexplained, unexplained_line
 from faultgen.data import atomic, longlog
 from faultgen.data import measured as measured_io
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
@@ -114,6 +115,9 @@ class Calibration:
         Mask of the samples where the axis moves (faster than the rest speed).
     tau, nominal, calibrated : ndarray of shape (n, 6)
         Measured torque and the torque of the nominal and of the augmented model, N m.
+    searches : int or None
+        How many times every effect was fitted to the residual (the steps, and the search that
+        found nothing more when there was one).
     """
 
     robot: str
@@ -128,6 +132,7 @@ class Calibration:
     tau: np.ndarray
     nominal: np.ndarray
     calibrated: np.ndarray
+    searches: int | None = None
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""
@@ -139,7 +144,12 @@ class Calibration:
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
             "ambiguous": self.ambiguous(),
+            "unexplained": self.unexplained(),
         }
+
+    def unexplained(self) -> list[dict]:
+        """The axes left unexplained after the search (:func:`unexplained`)."""
+        return unexplained(self.gap_before, self.gap_after, self.steps, self.searches)
 
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
@@ -188,6 +198,8 @@ class Calibration:
                 lines.append(f"   a designed excitation: faultgen excitation {self.robot} -o excitation.csv")
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
+        for u in self.unexplained():
+            lines.append(unexplained_line(u, self.robot))
         # the static model: for a per-step friction update, or a Stribeck curve MuJoCo's LuGre
         # (Gaussian only) cannot represent
         static_only = any(s.effect.stepped for s in self.steps) or any(
@@ -343,8 +355,10 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
         trial_path = Path(work) / model_out.name
         if tasks_file.is_file():
             shutil.copyfile(tasks_file, Path(work) / "tasks.toml")
+        searches = 0
         for k in range(max_steps):
             residual = tau - predicted
+            searches += 1
             ranked = search.rank(motion, residual, tau, split, progress=progress,
                                  label=f"step {k + 1}: fitting effects")
             best = ranked[0]
@@ -387,6 +401,7 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
         tau=tau,
         nominal=nominal_prediction,
         calibrated=predicted,
+        searches=searches,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     from faultgen.calibrate import figure

@@ -33,9 +33,14 @@ def save(result, path: str | Path) -> Path:
         f"\nstep {a['step']}: not separable on this log: "
         + " / ".join(f"{c['effect']} (dAIC {c['delta_aic']:.1f})" for c in a["candidates"])
         + f"; fitted {a['fitted']}" for a in result.ambiguous())
+    left_over = {u["axis"]: u for u in result.unexplained()}
+    unexplained = "".join(f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} = {u['ratio']:.1f}x the median "
+                          f"axis's; every effect tried on it, added: {', '.join(u['added']) or 'none'}"
+                          for a, u in left_over.items())
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
-                 f"{result.gap_after['total_nrmse']:.3f}{ambiguous}", fontsize=11)
+                 f"{result.gap_after['total_nrmse']:.3f}{ambiguous}{unexplained}", fontsize=11,
+                 color="tab:red" if left_over else "black")
     for axis in range(n_axes):
         left, right = axes[axis]
         left.plot(t, result.tau[:, axis], color="black", lw=0.8, label="measured")
@@ -45,7 +50,8 @@ def save(result, path: str | Path) -> Path:
                    label=f"before (nrmse {result.gap_before['nrmse'][axis]:.3f})")
         right.plot(t, result.tau[:, axis] - calibrated[:, axis], color="tab:blue", lw=0.6, alpha=0.8,
                    label=f"after (nrmse {result.gap_after['nrmse'][axis]:.3f})")
-        left.set_ylabel(f"axis {axis + 1}\ntorque, N m")
+        left.set_ylabel(f"axis {axis + 1}" + (" UNEXPLAINED" if axis + 1 in left_over else "") + "\ntorque, N m",
+                        color="tab:red" if axis + 1 in left_over else "black")
         right.set_ylabel("residual, N m")
         for ax in (left, right):
             if held.size:

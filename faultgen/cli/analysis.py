@@ -26,7 +26,9 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
         raise ValueError(f"{file} fails validation (run `faultgen validate {file}`): {problems[0]}")
     check_outputs(outputs, overwrite)
     with reader.open(file) as data:
-        failing = data.failing
+        failing, unhashed = data.failing, data.unhashed
+    if unhashed:  # old files: runs are paired by their task label alone
+        typer.echo(unhashed)
     if not failing:
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")
@@ -90,12 +92,11 @@ def bench_isolators_command(
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
         typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
-    accuracy = benchmark.isolation_accuracy(table).rename(index={0.0: "no fault"}, level="wear_pct")
+    accuracy = benchmark.isolation_accuracy_text(table).rename(index={0.0: "no fault"}, level="wear_pct")
     typer.echo(benchmark.markdown(accuracy, digits=4))
-    typer.echo("wear_pct \"no fault\": runs without wear, accuracy = share left undecided (naming an axis is a false "
-               "isolation). In the CSV, predicted 0 is undecided and -1 too few cycles (column answer spells it).")
-    typer.echo("\ncases in which each isolator named an axis, right or wrong (%); one that never decides scores 100 % on "
-               "\"no fault\" and 0 % elsewhere:")
+    typer.echo(benchmark.ACCURACY_RULE + " In the CSV, predicted 0 is undecided and -1 too few cycles (column answer "
+               "spells it; needed: the isolator's fewest cycles).")
+    typer.echo("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few cycles):")
     typer.echo(benchmark.markdown(benchmark.isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct"),
                                   digits=4))
     starved = benchmark.starved_isolators(table)
@@ -147,6 +148,10 @@ def detect_command(
 
     Writes OUT.csv and OUT.md (per run), OUT-summary.csv (per task, per worn axis, all) and OUT.png
     (the Q and T2 charts of each worn run with their limits, the fault's start and the onset).
+    The summary leaves out runs whose monitor learned the fault as normal (trained_on_fault,
+    column left_out); notes under it say what else the numbers rest on: a held-out false-alarm
+    rate above alpha by more than its 95 % interval, why nothing was located, and advice the
+    dataset can follow.
 
     Example:
 
@@ -176,7 +181,10 @@ def detect_command(
         benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(table, digits=4))
     typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
-    typer.echo(f"\nsummary (false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
+    left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
+    rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
+             if left_out else "")
+    typer.echo(f"\nsummary ({rests}false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
     typer.echo(benchmark.markdown(summary, digits=4))
     advice = benchmark.detection_advice(table, protocol)
     if advice:
@@ -289,8 +297,9 @@ def classify_command(
         "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
     seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.", min=0, max=MAX_SEED)] = 0,
     chance: Annotated[bool, typer.Option(
-        help="Without --permutations, estimate the chance level cheaply on one cell (lr control, "
-        "5 label exchanges, on quick.h5 2 % of the default table's CPU time) and give it in the caption.")] = True,
+        help="Without --permutations, measure each row's chance level on lr (19 label exchanges, about half the "
+        "default table's time again) and judge every cell against it: columns chance, p and above_chance, and a "
+        "verdict line. --no-chance: not measured, no verdict.")] = True,
     jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0, max=1024)] = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
@@ -309,8 +318,10 @@ def classify_command(
     worn and one unworn run at a time, trains on the rest and scores the pair by AUC; --pairs 0
     takes every pair, as the thesis did.
 
-    Robots of one kind (process, model) look alike, so chance is not 0.5 here: --permutations
-    measures it on the same robots, and 'p' says whether the AUC beats it. With labels by wear a
+    Robots of one kind (process, model) look alike, so chance is not 0.5 here: by default each
+    row's chance level is measured on lr with the runs' labels exchanged, every cell gets its
+    permutation p-value and above_chance (p <= 0.05), and a verdict line says whether any cell
+    beats chance; --permutations measures the chance level of every cell instead. With labels by wear a
     failing robot's failed days are its last, so a classifier that only learns when in the record
     a day lies scores well above 0.5; --matched-days compares them with the same days of the
     healthy robot instead.
@@ -342,19 +353,19 @@ def classify_command(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
         horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1,
         short=not full, **cells)
-    estimate = table.attrs.get("chance")
     command = " ".join(["faultgen classify", shlex.quote(str(file)), *([f"--horizon {horizon}"] if horizon is not None else []),
                         *(["--matched-days"] if matched_days else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
                         *(["--full"] if full else []),
                         *(f"--classifier {c}" for c in classifiers or []),
                         *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
     caption = benchmark.classification_caption(table, n_pairs=pairs or None, horizon=horizon,
-                                               wear_threshold=wear_threshold, matched=matched_days, chance=estimate,
+                                               wear_threshold=wear_threshold, matched=matched_days,
                                                command=command, short=not (full or preprocessing))
-    text = benchmark.markdown(table, digits=3) + "\n\n" + caption
+    text = (benchmark.markdown(benchmark.classification_printed(table), digits=3) + "\n\n" + caption + "\n\n"
+            + benchmark.classification_verdict(table, command))
     with atomic.output_set([stem.with_suffix(s) for s in (".csv", ".md", ".png")]) as staged:  # all, or none
         benchmark.classification_tidy(table).to_csv(staged(stem.with_suffix(".csv")), index=False)
         staged(stem.with_suffix(".md")).write_text(text + "\n")
-        benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")), estimate)
+        benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")))
     typer.echo(text)
     typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))

@@ -95,7 +95,7 @@ def plot_command(
     """Draw how each axis's mean |motor torque| follows its true wear, as a PNG.
 
     A sweep: per axis, the change (%) of every run wearing it against the unworn run of the same
-    task and seed. One run (or --run ID): mean |motor torque| per cycle with the true wear.
+    program (its hash), conditions and seed. One run (or --run ID): mean |motor torque| per cycle with the true wear.
 
     Example:
 
@@ -103,8 +103,12 @@ def plot_command(
       faultgen plot quick.h5 -o quick.png
     """
     from faultgen import plot
+    from faultgen.data import reader
 
     target = out or file.with_suffix(".png")
     check_outputs([target], overwrite)
     plot.plot(file, target, run=run)
+    with reader.open(file) as data:
+        if data.unhashed:  # old files: the unworn reference is found by the task label alone
+            typer.echo(data.unhashed)
     typer.echo(f"wrote {target}")

@@ -7,6 +7,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      n_runs, command, grid (JSON, sweeps only),
                                      complete (written last: True only for a finished file)
     /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
+                                     program_sha256: what the program is (PROGRAM_ATTRIBUTE;
+                                     older files lack it),
                                      a program file's or log's program: name, file, sha256, program_text;
                                      wear JSON, noise JSON) and provenance (faultgen_version,
                                      model_sha256, log_period, config JSON, command; since robots
@@ -140,6 +142,11 @@ RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axe
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
 
 
+#: The attribute that says what a run's program is (:func:`faultgen.operation.programs.identity`):
+#: the SHA-256 of its text, hex. Runs written before it lack it; readers then fall back to the
+#: ``task`` label (:attr:`faultgen.data.reader.Run.program`) and analyses say so.
+PROGRAM_ATTRIBUTE = "program_sha256"
+
 #: Attributes of a run written since robots of 5 to 7 axes exist (files before them lack them and
 #: stay valid: their robots had six axes): ``n_axes`` (int) and ``drivetrain`` (JSON,
 #: :func:`drivetrain`).
@@ -199,9 +206,11 @@ def run_attributes(result, command: str = "") -> dict:
     config = result.config
     robot = robots.load(config.robot)
     program = programs.record(config.task)  # a program file or a replayed log: what makes it again
+    label, digest = programs.identity(robot, config.task)
     return {
         "robot": robot.name,
-        "task": config.task if program is None else program["name"],
+        "task": label,
+        "program_sha256": digest,
         **({} if program is None else {
             "program": json.dumps({k: v for k, v in program.items() if k != "text"}),
             **({"program_text": program["text"]} if "text" in program else {})}),
@@ -577,6 +586,8 @@ def _attribute_problems(group: h5py.Group) -> list[str]:
                        "a positive number of seconds"),
         "signals": (lambda v: isinstance(v, (bool, np.bool_)), "true or false"),
         "sample": (lambda v: v in ("cycle", "day"), "'cycle' or 'day'"),
+        PROGRAM_ATTRIBUTE: (lambda v: isinstance(v, str) and len(v) == 64
+                            and all(c in "0123456789abcdef" for c in v), "64 hex digits (a SHA-256)"),
         "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
                       "a list of axes"),
     }
@@ -612,6 +623,9 @@ def _program_problems(attrs) -> list[str]:
         digest = program["sha256"]
     except (ValueError, KeyError, TypeError):
         return ["program attribute is not JSON with a sha256"]
+    if PROGRAM_ATTRIBUTE in attrs and _attr(attrs[PROGRAM_ATTRIBUTE]) != digest:
+        return [f"{PROGRAM_ATTRIBUTE} {str(_attr(attrs[PROGRAM_ATTRIBUTE]))[:12]}... is not the program's sha256 "
+                f"{digest[:12]}..."]
     if "program_text" in attrs:
         text = _attr(attrs["program_text"])
         if hashlib.sha256(text.encode()).hexdigest() != digest:

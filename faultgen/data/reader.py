@@ -77,6 +77,10 @@ class Run:
         Whether the 250 Hz signals are stored (False: features and truth only).
     provenance : dict
         faultgen_version, model_sha256, log_period (s), command, config (parsed JSON).
+    program_sha256 : str or None
+        SHA-256 (hex) of the program's text (:func:`faultgen.operation.programs.identity`). In files
+        written before it was recorded: a program file's or log's hash from the ``program``
+        attribute, None for a thesis task.
     """
 
     id: str
@@ -93,6 +97,7 @@ class Run:
     sample: str
     has_signals: bool
     provenance: dict = field(repr=False)
+    program_sha256: str | None = field(default=None, repr=False)
     _source: Dataset | None = field(default=None, repr=False, compare=False)
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -100,6 +105,33 @@ class Run:
     def failing(self) -> bool:
         """Whether the run wears or carries a fault (a failing robot of a fleet)."""
         return bool(self.worn_axes) or self.fault is not None
+
+    @property
+    def program(self) -> str:
+        """What the run's program is: its SHA-256, or, in a file written before runs carried it,
+        ``"task:<label>"`` (two programs under one label then look alike: :attr:`Dataset.unhashed`)."""
+        return self.program_sha256 or f"task:{self.task}"
+
+    @property
+    def setup(self) -> tuple:
+        """What two runs must share to be compared (a worn run with its unworn reference, a monitor
+        with the runs it judges): robot (name and model hash), program, friction model and
+        operating conditions (:attr:`conditions_key`). :func:`difference` says in words what two
+        setups do not share."""
+        return (self.robot, self.provenance.get("model_sha256", ""), self.program, self.friction_model,
+                self.conditions_key)
+
+    @property
+    def conditions_key(self) -> str:
+        """The operating conditions two runs must share to be compared: all of them for a run of a
+        sweep; for a fleet's robot (daily records), which conditions are on, as each robot is a unit
+        with its own draw of the fleet's climate, payloads and spread (thesis ch. 4-5 compare
+        robots)."""
+        if not self.conditions:
+            return ""
+        if self.sample == "day":
+            return json.dumps(sorted(k for k, v in self.conditions.items() if v is not None))
+        return json.dumps(self.conditions, sort_keys=True)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -179,6 +211,23 @@ class Run:
         return int(grown[0]) if self.failing and grown.size else None
 
 
+def difference(a: Run, b: Run) -> str:
+    """What the :attr:`Run.setup` of ``a`` and ``b`` do not share, in words ("" if nothing): the runs
+    an analysis must not compare, and why."""
+    parts = []
+    if (a.robot, a.provenance.get("model_sha256")) != (b.robot, b.provenance.get("model_sha256")):
+        parts.append(f"robot {a.robot} vs {b.robot}" if a.robot != b.robot else f"robot model of {a.robot}")
+    if a.program != b.program:
+        shown = (f"{a.task} ({a.program[:8]}) vs {b.task} ({b.program[:8]})" if a.program_sha256 and b.program_sha256
+                 else f"{a.task} vs {b.task}")
+        parts.append(f"program {shown}")
+    if a.friction_model != b.friction_model:
+        parts.append(f"friction model {a.friction_model} vs {b.friction_model}")
+    if a.conditions_key != b.conditions_key:
+        parts.append("operating conditions")
+    return ", ".join(parts)
+
+
 def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
     config = _json(attrs.get("config")) or {}
     return Run(
@@ -192,6 +241,9 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
                     "model_sha256": str(attrs.get("model_sha256", "")),
                     "log_period": float(attrs.get("log_period", np.nan)), "command": str(attrs.get("command", "")),
                     "config": config},
+        # files written before the attribute: a program file's or log's runs kept its hash in `program`
+        program_sha256=str(attrs[dataset.PROGRAM_ATTRIBUTE]) if dataset.PROGRAM_ATTRIBUTE in attrs
+        else (_json(attrs.get("program")) or {}).get("sha256"),
         _source=source)
 
 
@@ -273,6 +325,17 @@ class Dataset(Sequence):
         if isinstance(self.grid, dict) and "fleet" in self.grid or any(r.sample == "day" for r in self.runs):
             return "fleet"
         return "sweep" if len(self.runs) > 1 or self.grid else "run"
+
+    @property
+    def unhashed(self) -> str:
+        """A note when runs lack the program hash (files written before it): analyses then pair them
+        by their ``task`` label alone, which two different programs may share; "" otherwise."""
+        old = [r for r in self.runs if r.program_sha256 is None]
+        if not old:
+            return ""
+        return (f"note: {len(old)} of {len(self.runs)} runs of {self.path.name} were written before runs recorded "
+                "their program's hash (program_sha256): they are paired by their task label alone, so two programs "
+                "saved under one label would be compared; simulate them again with this version to be sure")
 
     @property
     def healthy(self) -> tuple[Run, ...]:

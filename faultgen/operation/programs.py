@@ -172,6 +172,37 @@ def record(task: str) -> dict | None:
     return out
 
 
+def identity(robot: Robot | str, task: str) -> tuple[str, str]:
+    """What a run's program is: ``(label, sha256)``.
+
+    ``sha256`` is the hex digest of the program's text: a program file's or log's bytes, and for a
+    thesis task the program file :func:`export` writes for ``robot`` (so a task exported and left
+    unchanged is the same program as the task). ``label`` is what the dataset calls it (its
+    ``task`` attribute): the thesis name; a program file's ``name`` key, except that a file
+    carrying a thesis task's name without being that task (an exported task, edited) is labelled by
+    its file name (:func:`label`); a log's file name. Analyses pair runs by the hash, never by the
+    label alone (two programs may share a label in files written before the hash existed).
+
+    Raises
+    ------
+    ValueError
+        For an unknown task or missing file (:func:`check_name`).
+    """
+    check_name(task)
+    if task in TASKS:
+        return task, hashlib.sha256(export(robot, task).encode()).hexdigest()
+    record_ = record(task)
+    name, digest = record_["name"], record_["sha256"]
+    if name in TASKS:
+        try:
+            builtin = identity(robot, name)[1]
+        except ValueError:  # the robot has no such thesis task: the file is not it
+            builtin = ""
+        if digest != builtin:
+            name = label(task)
+    return name, digest
+
+
 # -- the program ---------------------------------------------------------------------------------
 
 

@@ -258,6 +258,7 @@ class Grid:
             if first != str(robot) and robots.load(first).path != robots.load(robot).path:
                 raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
                                  "run ids need different names (rename one folder or MJCF file)")
+        self._check_programs()
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
             name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
             if axis > n_axes:
@@ -274,10 +275,27 @@ class Grid:
                 else:
                     plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
                     label = f"axis{axis}-{kind}{pct:g}"
-                out[f"{name}-{programs.label(task)}-{label}-seed{seed}"] = sim.RunConfig(
+                run_id = f"{name}-{programs.label(task)}-{label}-seed{seed}"
+                if run_id in out and out[run_id].task != task:
+                    raise ValueError(f"tasks {out[run_id].task!r} and {task!r} would both make run {run_id!r}; "
+                                     "give the program files different file names")
+                out[run_id] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
                     seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault)
         return list(out.items())
+
+    def _check_programs(self) -> None:
+        """Refuse two different programs under one label (a run's ``task``): analyses would take
+        one for the other (:func:`faultgen.operation.programs.identity` labels an edited export by
+        its file name; two files of one ``name`` still collide)."""
+        seen: dict[tuple[str, str], tuple[str, str]] = {}  # (robot, label) -> (task as given, program hash)
+        for robot, task in itertools.product(self.robots, self.tasks):
+            label, digest = programs.identity(robot, task)
+            first, first_digest = seen.setdefault((robots.load(robot).name, label), (task, digest))
+            if first_digest != digest:
+                raise ValueError(f"tasks {first!r} and {task!r} are different programs (sha256 {first_digest[:12]}... "
+                                 f"and {digest[:12]}...) under one label {label!r}: give the program file its own "
+                                 "`name` (or file name) so the dataset can tell them apart")
 
     def to_json(self) -> str:
         return json.dumps(asdict(self), sort_keys=True)
