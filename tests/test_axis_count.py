@@ -13,6 +13,7 @@ import axis_robots
 from faultgen.cli import app
 from faultgen.data import dataset, measured
 from faultgen.effects import make
+from faultgen.inputs import InputError
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation.faults import parse_fault
@@ -136,7 +137,6 @@ def test_the_validator_uses_the_runs_own_axes(arms, tmp_path):
     for name, value, problem in [
         ("drivetrain", json.dumps({**json.loads(h5py.File(path)["runs/run"].attrs["drivetrain"]),
                                    "gear_ratio": [1.0] * 6}), "drivetrain gear_ratio: expected 5 finite numbers"),
-        ("n_axes", 7, "drivetrain gear_ratio: expected 7 finite numbers"),
         ("n_axes", 8, "n_axes attribute 8, expected a whole number 5..7"),
         ("worn_axes", np.array([6]), "worn_axes: axis 6 is out of range 1..5"),
     ]:
@@ -144,6 +144,12 @@ def test_the_validator_uses_the_runs_own_axes(arms, tmp_path):
         with h5py.File(broken, "a") as f:
             f["runs/run"].attrs[name] = value
         assert any(problem in p for p in dataset.validate(broken)), (name, dataset.validate(broken))
+    # n_axes 7 on a 5-axis run: its arrays disagree with it, refused before any array is read (issue 50)
+    broken.write_bytes(path.read_bytes())
+    with h5py.File(broken, "a") as f:
+        f["runs/run"].attrs["n_axes"] = 7
+    with pytest.raises(InputError, match=r"q_ref has shape \(\d+, 5\); \(\d+, 7\) is expected"):
+        dataset.validate(broken)
     with h5py.File(broken, "a") as f:  # a file written before the attributes existed: six axes, still valid
         f["runs/run"].attrs["worn_axes"] = np.array([], dtype=int)
         del f["runs/run"].attrs["n_axes"], f["runs/run"].attrs["drivetrain"]

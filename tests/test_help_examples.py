@@ -120,6 +120,9 @@ MADE = {
     "my_program.toml": "faultgen tasks export irb6700 arc_weld -o my_program.toml",
     "kr210l150.urdf": lambda folder: shutil.copy(
         Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf", folder),
+    # a ROS package folder as a vendor ships it (rtb-data's copy): the xacro, its macros, the meshes
+    "kuka_kr120": lambda folder: shutil.copytree(
+        Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr120", folder / "kuka_kr120"),
     "ur5_dh.toml": lambda folder: shutil.copy(ROOT / "docs/examples/ur5_dh.toml", folder),
     # docs/robots.md: "--drivetrain gives some or all drivetrain numbers (tables [axis.1] .. [axis.N])"
     "my_drives.toml": lambda folder: (folder / "my_drives.toml").write_text("[axis.1]\ngear_ratio = 100.0\n"),
@@ -159,18 +162,19 @@ def test_every_help_page_has_examples_and_they_are_all_read():
 @pytest.mark.parametrize("page", sorted(PAGES))
 def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
     lines = PAGES[page]
-    needed = {word for line in lines for word in re.split(r"[\s:]+", line) if word in MADE}
+    needed = {word for line in lines for word in re.split(r"[\s:/=]+", line) if word in MADE}
     needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
     made_files = {name: made(name) for name in sorted(needed)}
     for name in sorted(needed):
         if not any(f"-o {name}" in line for line in lines):  # the page makes it itself
-            shutil.copy(made_files[name], tmp_path / name)
+            (shutil.copytree if made_files[name].is_dir() else shutil.copy)(made_files[name], tmp_path / name)
     monkeypatch.chdir(tmp_path)
     scheduler = None
     if any("--scheduler" in line for line in lines):
         from distributed import LocalCluster
 
-        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None)
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://",
+                               dashboard_address=None)
         scheduler = cluster.scheduler_address
     try:
         for line in lines:

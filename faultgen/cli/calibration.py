@@ -105,7 +105,7 @@ def hidden_log_command(
     effect: Annotated[str, typer.Option(
         help="The hidden effect, one of `faultgen calibrate --help`'s effects (coulomb, payload, cogging, "
              "backlash, ...), or none.")],
-    seed: Annotated[int, typer.Option(help="Seed of the effect's draw (size, axes) and of the noise.", min=0)] = 0,
+    seed: Annotated[int, typer.Option(help="Seed of the effect's draw (size, axes) and of the noise.", min=0, max=MAX_SEED)] = 0,
     cycles: Annotated[int, typer.Option(help="Cycles of the task in the log, back to back.", min=1, max=100)] = 4,
     task: Annotated[str, typer.Option(
         help="The task the robot runs (a thesis task or a program file).")] = "pick_place",

@@ -67,7 +67,7 @@ def robots_command(
       faultgen robots irb6700    # gear ratios, stiffness, friction per axis, SI units
       faultgen robots add kr210 --from kr210l150.urdf -o kr210
       faultgen robots add ur5 --from ur5_dh.toml --drivetrain my_drives.toml -o ur5
-      faultgen robots add kr120 --from kr120r2500pro.xacro --package kuka_kr120_support=kuka_kr120 -o kr120
+      faultgen robots add kr120 --from kuka_kr120/urdf/kr120r2500pro.xacro --package kuka_kr120_support=kuka_kr120 -o kr120
     """
     if name == "add":
         if new_name is None or source is None or out is None:
