@@ -8,7 +8,9 @@ from __future__ import annotations
 from datetime import date, timedelta
 from pathlib import Path
 
+import h5py
 import numpy as np
+import pandas as pd
 
 from faultgen.data import measured
 
@@ -36,16 +38,17 @@ def log_signals(robot, day: int, seed: int, wear: np.ndarray, cycles: int = 2, c
 
 
 def write_log(path: Path, robot, day: int, seed: int, wear: np.ndarray, **kw) -> Path:
-    """One log at ``path`` (.csv, .csv.gz or .h5) with a ``cycle`` column (CSV)."""
+    """One log at ``path`` (.csv, .csv.gz or .h5) with a ``cycle`` column."""
     t, q, qd, tau, cycle = log_signals(robot, day, seed, wear, **kw)
     if path.name.endswith((".h5", ".hdf5")):
-        return measured.write_hdf5(path, t, q, tau, qd)
-    measured.write_csv(path, t, q, tau, qd)
-    import pandas as pd
-
-    frame = pd.read_csv(path)
-    frame["cycle"] = cycle
-    frame.to_csv(path, index=False)
+        measured.write_hdf5(path, t, q, tau, qd)
+        with h5py.File(path, "a") as fh:
+            fh["cycle"] = cycle
+        return path
+    q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
+    frame = pd.DataFrame({"t": t, **dict(zip(q_names, q.T)), **dict(zip(qd_names, qd.T)),
+                          **dict(zip(tau_names, tau.T)), "cycle": cycle})
+    frame.to_csv(path, index=False, compression="gzip" if path.name.endswith(".gz") else None)
     return path
 
 

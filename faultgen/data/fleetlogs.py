@@ -52,7 +52,7 @@ from faultgen.simulation import sensors
 #: that reads it as a wear; healthy and unknown logs hold 1).
 WORN_MARK = 2.0
 #: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
-MEASURED = "measured"
+MEASURED = dataset.MEASURED
 #: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
 #: The group of the manifest in an imported dataset.
