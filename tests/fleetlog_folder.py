@@ -5,7 +5,7 @@ Coulomb friction growing) from a given day. Not a simulation: a layout and signa
 
 from __future__ import annotations
 
-from datetime import date, timedelta
+from datetime import date, timedelta  # noqa: F401 (date: the tests start fleets on other days)
 from pathlib import Path
 
 import h5py

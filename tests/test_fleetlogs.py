@@ -13,6 +13,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
@@ -261,3 +262,56 @@ def test_every_command_reads_an_imported_fleet(imported, tmp_path, args):
     assert result.exit_code == 0, result.output
     written = sorted(p.name for p in tmp_path.iterdir())
     assert args[0] in ("validate", "info") or written, written
+
+
+@pytest.fixture(scope="module")
+def other(tmp_path_factory, puma):
+    """A second imported fleet of the same robot (other units: other noise, other worn axes)."""
+    folder = tmp_path_factory.mktemp("other")
+    worn = {1: (1, 6, 0.25), 3: (5, 6, 0.25)}
+    logs = fleetlog_folder.write_fleet(folder / "LOGS", puma, units=5, days=20, worn=worn, suffix=".h5",
+                                       start=fleetlog_folder.date(2025, 1, 1))
+    rows = [f"u{u + 1},2025-01-07,onset,{axis}" for u, (axis, _, _) in worn.items()]
+    (logs / "events.csv").write_text("unit,stamp,event,axis\n" + "\n".join(rows) + "\n")
+    fleetlogs.import_logs(logs, folder / "other.h5", robot="puma560", progress=False)
+    return folder / "other.h5"
+
+
+def test_detect_trained_on_another_dataset_states_it_and_finds_the_wear(imported, other, tmp_path):
+    result = runner.invoke(app, ["detect", str(imported), "--train", str(other), "--first", "6", "--no-progress",
+                                 "-o", str(tmp_path / "d")])
+    assert result.exit_code == 0, result.output
+    table = pd.read_csv(tmp_path / "d.csv")
+    assert list(table["run"]) == ["u1", "u3", "u5"]
+    assert table["protocol"].str.startswith("another dataset (other.h5), each unit's features centred and scaled by "
+                                            "its own first 6 records").all()
+    assert (table["trained_on"] == "3 runs without wear of other.h5").all()
+    assert table["detected"].all() and (table["onset_cycle"] >= table["fault_begins_cycle"]).all()
+    result = runner.invoke(app, ["detect", str(imported), "--train", str(other), "--protocol", "same-run"])
+    assert result.exit_code == 2 and "drop --protocol" in result.output
+
+
+def test_classify_and_bench_isolators_trained_on_another_dataset(imported, other, tmp_path):
+    result = runner.invoke(app, ["classify", str(imported), "--train", str(other), "--classifier", "lr",
+                                 "--preprocessing", "control", "--no-progress", "-o", str(tmp_path / "c")])
+    assert result.exit_code == 0, result.output
+    assert "protocol: another dataset (other.h5)" in result.output and "tested on 3 worn and 3 unworn runs" in result.output
+    table = pd.read_csv(tmp_path / "c.csv", header=[0, 1], index_col=0)
+    cell = table.loc["control", "lr"]  # other axes wear in the training fleet: no claim on the AUC's size here
+    assert 0 <= cell["auc"] <= 1 and 0 <= cell["null"] <= 1 and 0 < cell["p"] <= 1
+    result = runner.invoke(app, ["bench-isolators", str(imported), "--train", str(other), "--no-progress",
+                                 "-o", str(tmp_path / "i")])
+    assert result.exit_code == 0, result.output
+    assert "protocol: pca_contribution: another dataset (other.h5)" in result.output
+    result = runner.invoke(app, ["bench-isolators", str(imported), "--no-progress", "-o", str(tmp_path / "j")])
+    assert "protocol: own history" in result.output
+
+
+def test_a_training_set_of_another_robot_is_refused(imported, tmp_path):
+    irb = robots.load("irb6700")
+    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", irb, units=2, days=8, suffix=".h5")
+    fleetlogs.import_logs(logs, tmp_path / "irb.h5", robot=irb, progress=False)
+    result = runner.invoke(app, ["detect", str(imported), "--train", str(tmp_path / "irb.h5"), "--first", "4",
+                                 "--no-progress", "-o", str(tmp_path / "d")])
+    assert result.exit_code == 2, result.output
+    assert "robots 'irb6700' and 'puma560'" in result.output and "differ in their joint range" in result.output
