@@ -299,8 +299,8 @@ def test_classify_and_bench_isolators_trained_on_another_dataset(imported, other
     table = pd.read_csv(tmp_path / "c.csv", header=[0, 1], index_col=0)
     cell = table.loc["control", "lr"]  # other axes wear in the training fleet: no claim on the AUC's size here
     assert 0 <= cell["auc"] <= 1 and 0 <= cell["null"] <= 1 and 0 < cell["p"] <= 1
-    result = runner.invoke(app, ["bench-isolators", str(imported), "--train", str(other), "--no-progress",
-                                 "-o", str(tmp_path / "i")])
+    result = runner.invoke(app, ["bench-isolators", str(imported), "--train", str(other), "--baseline", "6",
+                                 "--no-progress", "-o", str(tmp_path / "i")])
     assert result.exit_code == 0, result.output
     assert "protocol: pca_contribution: another dataset (other.h5)" in result.output
     result = runner.invoke(app, ["bench-isolators", str(imported), "--no-progress", "-o", str(tmp_path / "j")])

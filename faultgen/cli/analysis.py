@@ -64,6 +64,8 @@ def bench_isolators_command(
     overwrite: Overwrite = False,
     progress: Progress = True,
     train: Train = None,
+    baseline: Annotated[int, typer.Option(help="With --train: the first cycles of each unit its signal is centred "
+                                               "and scaled by (pca_contribution's reference cycles).", min=2)] = 20,
 ) -> None:
     """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
     worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
@@ -97,7 +99,7 @@ def bench_isolators_command(
         from analysis import crossdata
 
         training_input(train)
-        isolators, stated = crossdata.trained_isolators(isolators, train, file)
+        isolators, stated = crossdata.trained_isolators(isolators, train, file, baseline=baseline)
         stated = "protocol: " + stated
     typer.echo(stated)
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
