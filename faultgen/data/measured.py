@@ -62,9 +62,9 @@ taken from ``q``. Torque is used as it is.
 from __future__ import annotations
 
 import csv
-import gzip
 import math
 import zlib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,7 +72,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from faultgen import axes
+from faultgen import axes, inputs
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
@@ -117,7 +117,8 @@ UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
-GZIP_MAGIC = b"\x1f\x8b"
+#: Most rows a log may have (a day at 1 kHz); a longer one, or an HDF5 log declaring more, is refused.
+MAX_ROWS = 100_000_000
 HDF5_SUFFIXES = (".h5", ".hdf5")
 
 #: Lowest accepted sample rate in Hz (applied to the median sample period).
@@ -277,10 +278,7 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     path = Path(path)
     kind = _kind(path)
-    if not path.exists():
-        raise MeasuredDataError(f"{path}: no such file")
-    if not path.is_file():
-        raise MeasuredDataError(f"{path}: not a file")
+    _regular(path)
     if kind == "csv":
         columns, extra, row_label = _read_csv(path, robot.n_axes)
     else:
@@ -339,6 +337,14 @@ def _kind(path: Path) -> str:
     )
 
 
+def _regular(path: Path) -> None:
+    """Refuse a missing file, a folder, a device or a FIFO (faultgen.inputs), as MeasuredDataError."""
+    try:
+        inputs.regular_file(path, "measured log")
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
+
+
 def _csv_label(i: int) -> str:
     return f"data row {i + 1} (line {i + 2})"
 
@@ -352,26 +358,17 @@ def _compression(path: Path) -> str | None:
     return "gzip" if path.name.lower().endswith(".gz") else None
 
 
-def _stored_compression(path: Path) -> str | None:
-    """"gzip" if the file's content starts with gzip's magic bytes (RFC 1952), whatever its name."""
-    try:
-        with open(path, "rb") as fh:
-            return "gzip" if fh.read(2) == GZIP_MAGIC else None
-    except OSError as err:
-        raise MeasuredDataError(f"{path}: cannot read the file: {err}") from err
-
-
 def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
     """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
 
     A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
     reads like one named ``.csv.gz``.
     """
-    compression = _stored_compression(path)
-    opener = gzip.open if compression else open
     try:
-        with opener(path, "rt", newline="", encoding="utf-8-sig") as fh:
+        with inputs.open_text(path, "measured log") as fh:
             header = next(csv.reader(fh), None)
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
     except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
     if not header:
@@ -389,25 +386,29 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
     # All columns are parsed (extra ones as text) so that a row with too many or too few
     # fields is refused by the parser with its line number instead of being silently cut.
     read_kw = {
-        "compression": compression,
         "header": 0,
         "names": names,
         "index_col": False,
         "skip_blank_lines": False,
-        "encoding": "utf-8-sig",
     }
     try:
         try:
             # Fast path: numbers throughout. Anything else is diagnosed from the text below.
             dtypes = {name: (float if name in wanted else str) for name in names}
-            frame = pd.read_csv(path, dtype=dtypes, **read_kw)
+            with inputs.open_text(path, "measured log") as fh:
+                frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
             clean = bool(np.isfinite(frame[wanted].to_numpy(dtype=float)).all())
+        except inputs.InputError:
+            raise
         except (ValueError, TypeError):
             clean = False
         if not clean:
-            text = pd.read_csv(path, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
+            with inputs.open_text(path, "measured log") as fh:
+                text = pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
             text = _drop_trailing_blank_rows(text)
             frame = _numbers_from_text(path, text, wanted)
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
     columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
@@ -484,11 +485,7 @@ def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str
 
 
 def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
-    try:
-        fh = h5py.File(path, "r")
-    except OSError as err:
-        raise MeasuredDataError(f"{path}: cannot read the file as HDF5: {err}") from err
-    with fh:
+    with _open_hdf5(path) as fh:
         names = list(fh.keys())
         datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
         groups = [n for n in names if isinstance(fh[n], h5py.Group)]
@@ -518,6 +515,9 @@ def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str
                     raise MeasuredDataError(
                         f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}"
                     )
+            if ds.shape[0] > MAX_ROWS:
+                raise MeasuredDataError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
+                                        f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
             if length is None:
                 length = ds.shape[0]
             elif ds.shape[0] != length:
@@ -528,6 +528,22 @@ def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str
             columns[name] = np.asarray(ds[()], dtype=float)
     _refuse_non_finite(path, columns, wanted, _index_label)
     return columns, extra, _index_label
+
+
+@contextmanager
+def _open_hdf5(path: Path):
+    """The HDF5 log, opened read-only after faultgen.inputs refused links and virtual datasets that
+    reach other files (MeasuredDataError naming the link)."""
+    try:
+        fh = h5py.File(path, "r")
+    except OSError as err:
+        raise MeasuredDataError(f"{path}: cannot read the file as HDF5: {err}") from err
+    with fh:
+        try:
+            inputs.check_hdf5_links(fh, path)
+        except inputs.InputError as err:
+            raise MeasuredDataError(str(err)) from None
+        yield fh
 
 
 def _unit_key(unit: str) -> str:
@@ -573,10 +589,10 @@ def _refuse_non_finite(where: Path, columns: dict[str, np.ndarray], order: list[
 # Checks and derivatives
 
 
-def _build(
-    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str]
-) -> MeasuredData:
-    t = columns[T_COLUMN]
+def check_time(t: np.ndarray, where: Path, label, notes: list[str]) -> tuple[np.ndarray, float]:
+    """Refuse sample times that do not increase, a median period above 1 / :data:`MIN_RATE`, a gap
+    above :data:`MAX_GAP` or a span below :data:`MIN_DURATION`; note long gaps in ``notes``. Returns
+    the intervals and the median period, s."""
     n = t.shape[0]
     if n < 2:
         raise MeasuredDataError(
@@ -614,6 +630,15 @@ def _build(
             f"{long_gaps.size} sampling interval(s) longer than twice the median period {period:.6g} s, "
             f"the longest {dt[gap]:.6g} s before {label(gap + 1)}"
         )
+    return dt, period
+
+
+def _build(
+    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str]
+) -> MeasuredData:
+    t = columns[T_COLUMN]
+    n = t.shape[0]
+    dt, period = check_time(t, where, label, notes)
 
     q_columns, qd_columns, tau_columns = column_names(robot.n_axes)
     q = np.column_stack([columns[c] for c in q_columns])
@@ -701,17 +726,28 @@ def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> Non
         )
 
 
+def velocity_rows(n: int, window: int) -> slice:
+    """The rows over which given velocities are compared with the derivative of q (away from the ends)."""
+    return slice(window, n - window) if n > 4 * window else slice(None)
+
+
 def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: int) -> list[str]:
     """Refuse qd columns in deg/s; note columns that disagree with the derivative of q."""
+    inner = velocity_rows(qd.shape[0], window)
+    given, est = qd[inner], qd_est[inner]
+    return velocity_verdicts(where, np.einsum("ij,ij->j", est, est), np.einsum("ij,ij->j", est, given), len(est))
+
+
+def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: int) -> list[str]:
+    """:func:`_check_velocities` from the sums over its rows: per axis, ``power`` = sum of the
+    estimated speed squared, ``cross`` = sum of estimated times given speed, over ``size`` rows."""
     notes = []
-    inner = slice(window, qd.shape[0] - window) if qd.shape[0] > 4 * window else slice(None)
-    q_columns, qd_columns, _ = column_names(qd.shape[1])
+    q_columns, qd_columns, _ = column_names(len(power))
     for k, name in enumerate(qd_columns):
-        given, est = qd[inner, k], qd_est[inner, k]
-        power = float(np.dot(est, est))
-        if power / max(est.size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
+        power_k = float(power[k])
+        if power_k / max(size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
             continue
-        slope = float(np.dot(est, given) / power)
+        slope = float(cross[k] / power_k)
         if 40.0 <= slope <= 80.0:
             raise MeasuredDataError(
                 f"{where}: column {name} looks like deg/s (it is {slope:.4g} times the derivative of "
