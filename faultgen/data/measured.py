@@ -325,6 +325,39 @@ def from_arrays(
     return _build(columns, robot, where, _index_label, [])
 
 
+def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
+                 label=None) -> MeasuredData:
+    """Check and complete the columns of a log in another layout, mapped onto this format's names
+    (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
+    ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
+
+    Parameters
+    ----------
+    columns : dict of ndarray of shape (n,)
+    robot : str, Path or robots.Robot
+    source : str or Path
+        The file they came from, named in messages.
+    label : callable, optional
+        Data row index -> its description in messages (default: 1-based row and 0-based index).
+
+    Raises
+    ------
+    MeasuredDataError
+        As :func:`read`: a missing column, a non-finite value, times, rates, angles out of range.
+    """
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    where = Path(source)
+    label = label or _index_label
+    names = list(columns)
+    wanted, _ = _select_columns(where, names, robot.n_axes)
+    lengths = {len(np.asarray(columns[name])) for name in wanted}
+    if len(lengths) > 1:
+        raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
+    values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
+    _refuse_non_finite(where, values, wanted, label)
+    return _build(values, robot, where, label, [])
+
+
 def _kind(path: Path) -> str:
     name = path.name.lower()
     if name.endswith(CSV_SUFFIXES):
