@@ -31,7 +31,7 @@ from sklearn.base import clone
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from analysis.benchmark import UNDECIDED, fault_progress, opened
+from analysis.benchmark import fault_progress, locate_onset, opened
 from analysis.features import kl_divergence
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen.data import reader
@@ -162,12 +162,7 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
             onset = None if onset is None else onset + tested
             before = alarms[first:start]
             wear = fault_progress(run, axis) * 100.0 - 100.0
-            located = UNDECIDED
-            if onset is not None:
-                try:
-                    located = int(isolation.make("cross_correlation").fit(features[: onset + 1]).source_axis_)
-                except ValueError:  # too few records before the onset to cross-correlate
-                    located = UNDECIDED
+            located = locate_onset(features, onset)
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed, worn_axis=axis,
                              final_wear_pct=round(float(wear[-1]), 2), protocol=label,
                              trained_on=f"{len(learnt)} runs without wear of {source.path.name}",

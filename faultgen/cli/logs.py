@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import shlex
 import sys
 from pathlib import Path
@@ -68,7 +69,7 @@ def import_command(
                 raise ValueError(f"--torque-constants {torque_constants!r}: expected numbers, comma-separated "
                                  "(N m/A per joint)") from None
         adapter = adapters.make(log_format, **options)
-        read = {"reader": adapter.read, "suffixes": adapter.suffixes}
+        read = {"reader": functools.partial(adapter.read, accelerations=False), "suffixes": adapter.suffixes}
     elif torque_constants is not None:
         raise ValueError("--torque-constants reads UR's actual_current columns: give it with --format ur-rtde")
 

@@ -55,10 +55,11 @@ class Adapter:
     def columns(self, path: Path, robot: robots.Robot) -> tuple[dict[str, np.ndarray], Callable[[int], str]]:
         raise NotImplementedError
 
-    def read(self, path: Path, robot: robots.Robot) -> measured.MeasuredData:
-        """Read and check one log (:func:`faultgen.data.measured.from_columns`)."""
+    def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
+        """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
+        as :func:`faultgen.data.measured.read`)."""
         columns, label = self.columns(Path(path), robot)
-        return measured.from_columns(columns, robot, path, label)
+        return measured.from_columns(columns, robot, path, label, accelerations)
 
 
 def make(name: str, **options) -> Adapter:

@@ -157,7 +157,8 @@ class MeasuredData:
         Arm-side joint velocities in rad/s: the file's ``qd`` columns, or estimated from ``q``
         (see :attr:`velocity_estimated`).
     qdd : ndarray of shape (n, N)
-        Arm-side joint accelerations in rad/s^2, always estimated from ``q``.
+        Arm-side joint accelerations in rad/s^2, estimated from ``q`` (NaN when read with
+        ``accelerations=False``).
     tau : ndarray of shape (n, N)
         Arm-side joint torques in N m.
     source : Path
@@ -235,7 +236,7 @@ class MeasuredData:
 # Reading
 
 
-def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
+def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
     """Read, check and complete a measured-data file (format in the module docstring).
 
     Parameters
@@ -246,6 +247,9 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
         The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
         before the file is opened) or a loaded robot. Its joint range is used to recognise
         angles in degrees and angles out of range.
+    accelerations : bool, default True
+        Estimate ``qdd``; False leaves it NaN and saves its filter (a reader that needs no
+        accelerations: an imported fleet's features, :mod:`faultgen.data.fleetlogs`).
 
     Returns
     -------
@@ -284,7 +288,7 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     else:
         columns, extra, row_label = _read_hdf5(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
-    return _build(columns, robot, path, row_label, notes)
+    return _build(columns, robot, path, row_label, notes, accelerations)
 
 
 def from_arrays(
@@ -326,7 +330,7 @@ def from_arrays(
 
 
 def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
-                 label=None) -> MeasuredData:
+                 label=None, accelerations: bool = True) -> MeasuredData:
     """Check and complete the columns of a log in another layout, mapped onto this format's names
     (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
     ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
@@ -355,7 +359,7 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
         raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
     values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
     _refuse_non_finite(where, values, wanted, label)
-    return _build(values, robot, where, label, [])
+    return _build(values, robot, where, label, [], accelerations)
 
 
 def _kind(path: Path) -> str:
@@ -430,7 +434,9 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
             dtypes = {name: (float if name in wanted else str) for name in names}
             with inputs.open_text(path, "measured log") as fh:
                 frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
-            clean = bool(np.isfinite(frame[wanted].to_numpy(dtype=float)).all())
+            # every column wanted (the common case): no reindexed copy of the frame
+            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
+            clean = bool(np.isfinite(values).all())
         except inputs.InputError:
             raise
         except (ValueError, TypeError):
@@ -444,7 +450,10 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
         raise MeasuredDataError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-    columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+    if clean:  # the fast path's values, column by column
+        columns = {name: values[:, k] for k, name in enumerate(wanted)}
+    else:
+        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, _csv_label
 
 
@@ -667,7 +676,8 @@ def check_time(t: np.ndarray, where: Path, label, notes: list[str]) -> tuple[np.
 
 
 def _build(
-    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str]
+    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str],
+    accelerations: bool = True,
 ) -> MeasuredData:
     t = columns[T_COLUMN]
     n = t.shape[0]
@@ -680,7 +690,12 @@ def _build(
 
     window = _savgol_window(period, n)
     uniform = _is_uniform(dt, period)
-    qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    if accelerations:
+        qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    else:  # a reader that needs no qdd (an imported fleet's features) saves its filter
+        (qd_est,) = _derivatives(t, q, period, window, uniform, orders=(1,))
+        qdd = np.full_like(q, np.nan)
+        notes.append("qdd not estimated (accelerations=False): NaN")
     filt = f"Savitzky-Golay, order {SAVGOL_ORDER}, window {window} samples ({window * period:.4g} s)"
     if not uniform:
         notes.append(
