@@ -1,12 +1,12 @@
 """`faultgen logs import` (issue 46): the time to import N logs against the time to read the same
 files with pandas alone, in one run, and the import's peak memory at 100 and 1000 logs.
 
-The logs: a fleet of puma560 units, daily logs of two 2.5 s cycles at 250 Hz (1250 rows, t, q1..6,
-qd1..6, tau1..6 and cycle; tests/fleetlog_folder.py), CSV. The import's peak memory: a process of its own under ``/usr/bin/time -v`` (peak resident
-memory of the whole process, Python and its imports included); the baseline reads every file with
-``pandas.read_csv``;
-both timed in this process, alternating, the least of three kept (the machine is shared). Prints a
-Markdown table and, last, ``ratio <import / pandas at the largest N>``.
+The logs: a fleet of puma560 units, daily logs of two 2.5 s cycles at 250 Hz (1250 rows: t, q1..6,
+qd1..6, tau1..6 and cycle; tests/fleetlog_folder.py), CSV. The baseline reads every file with
+``pandas.read_csv``; it and the import are timed in this process, alternating, the least of three
+kept (the machine is shared). The import's peak memory: a process of its own under
+``/usr/bin/time -v`` (the whole process, Python and its imports included). Prints a Markdown table
+and, last, ``ratio <import / pandas at the largest N>``.
 
     python benchmarks/logs_import.py [folder]
 """
