@@ -14,9 +14,21 @@ from faultgen.cli.base import Command, Group
 from faultgen.cli.main import app
 from faultgen.cli.options import Progress
 
-logs_app = typer.Typer(cls=Group, no_args_is_help=True, add_completion=False, rich_markup_mode=None,
-                       help="Your robots' measured logs: import a fleet's folder of logs into a dataset.")
+logs_app = typer.Typer(cls=Group, no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 app.add_typer(logs_app, name="logs")
+
+
+@logs_app.callback()
+def logs_group() -> None:
+    """Your robots' measured logs: import a fleet's folder of logs (LOGS/<unit>/<stamp>.csv) into a
+    dataset that every command reads (docs/dataset.md, "A fleet's logs").
+
+    Examples:
+
+    \b
+      faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5
+      faultgen detect fleet-logs.h5 --train nominal-fleet.h5
+    """
 
 
 @logs_app.command("import", cls=Command)
