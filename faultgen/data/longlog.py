@@ -105,7 +105,7 @@ class _Csv:
         self.names = [h.strip() for h in header or []]
         self.wanted, self.extra = (measured._select_columns(path, self.names, n_axes) if header
                                    else ([], []))
-        self.rows = max(lines - 1, 0)  # an upper bound: trailing blank lines count here
+        self.rows = max(lines - 1, 0) if self.wanted else 0  # an upper bound: blank lines count here
         if self.rows > measured.MAX_ROWS:
             raise measured.MeasuredDataError(f"{path}: {self.rows} data rows; a log has at most {measured.MAX_ROWS} "
                                              "(MAX_ROWS: a day at 1 kHz)")
@@ -114,6 +114,8 @@ class _Csv:
         start = 0
         for frame in self._frames(size, float):
             block = frame.to_numpy(dtype=float)
+            if not len(block):
+                continue
             if not np.isfinite(block).all():
                 self._refuse(size)
             yield start, block
@@ -164,11 +166,7 @@ class _Hdf5:
     def __init__(self, path: Path, n_axes: int):
         self.path = path
         with measured._open_hdf5(path) as fh:
-            import h5py
-
-            datasets = [n for n in fh if isinstance(fh[n], h5py.Dataset)]
-            self.wanted, self.extra = measured._select_columns(path, datasets, n_axes)
-            self.extra += [f"{g}/ (group)" for g in fh if g not in datasets]
+            self.wanted, self.extra = measured.hdf5_columns(fh, path, n_axes)
             lengths = {name: fh[name].shape for name in self.wanted}
         shapes = set(lengths.values())
         if len(shapes) != 1 or len(next(iter(shapes))) != 1:
@@ -219,12 +217,17 @@ class _Reader:
             for i in np.unique(np.concatenate(rows)):
                 kept[start + int(i)] = block[i]
         order = sorted(kept)
+        if not order:
+            return np.empty(0), np.empty((0, len(self.source.wanted))), np.empty(0, dtype=int)
         return np.concatenate(times), np.array([kept[i] for i in order]), np.array(order)
 
     def read(self) -> tuple[measured.MeasuredData, Motion]:
         path, label = self.path, self.source.label
         t, kept, kept_rows = self._first_pass()
         n = len(t)
+        if n <= self.rows:  # fewer rows than lines (blank lines): read whole, as a short log
+            data = measured.read(path, self.robot)
+            return data, motion(data.qd, self.rest_speed)
         notes = [f"ignored extra columns: {', '.join(self.source.extra)}"] if self.source.extra else []
         dt, period = measured.check_time(t, path, label, notes)
         measured._check_angles(path, kept[:, self.q_cols], self.robot, lambda i: label(int(kept_rows[i])))

@@ -528,18 +528,7 @@ def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str
 
 def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
     with _open_hdf5(path) as fh:
-        names = list(fh.keys())
-        datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
-        groups = [n for n in names if isinstance(fh[n], h5py.Group)]
-        try:
-            wanted, extra = _select_columns(path, datasets, n_axes)
-        except MeasuredDataError as err:
-            if groups:
-                raise MeasuredDataError(
-                    f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
-                ) from None
-            raise
-        extra = extra + [f"{g}/ (group)" for g in groups]
+        wanted, extra = hdf5_columns(fh, path, n_axes)
         columns = {}
         length = None
         for name in wanted:
@@ -570,6 +559,23 @@ def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str
             columns[name] = np.asarray(ds[()], dtype=float)
     _refuse_non_finite(path, columns, wanted, _index_label)
     return columns, extra, _index_label
+
+
+def hdf5_columns(fh: h5py.File, path: Path, n_axes: int) -> tuple[list[str], list[str]]:
+    """The root datasets to read (required, plus all qd when present) and the extra ones (groups
+    among them, marked); refuse missing columns, naming the groups at the root that hold none."""
+    names = list(fh.keys())
+    datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
+    groups = [n for n in names if isinstance(fh[n], h5py.Group)]
+    try:
+        wanted, extra = _select_columns(path, datasets, n_axes)
+    except MeasuredDataError as err:
+        if groups:
+            raise MeasuredDataError(
+                f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
+            ) from None
+        raise
+    return wanted, extra + [f"{g}/ (group)" for g in groups]
 
 
 @contextmanager

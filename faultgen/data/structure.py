@@ -36,7 +36,8 @@ def _dims(axes: str, n_cycles: int, n_log: int, n_axes: int | None, bins: dict[s
 def check_runs(f: h5py.File, path: str | Path, schema: dict[str, str], bins: dict[str, int],
                kinds=lambda name: "fiub") -> None:
     """Refuse a dataset whose ``/runs`` holds anything but run groups carrying :data:`LABELS`, a
-    ``cycles`` attribute outside 1..:data:`MAX_CYCLES`, or an array of ``schema`` (name -> axes,
+    ``cycles`` attribute above :data:`MAX_CYCLES` (one that is not a whole number >= 1 is for
+    ``faultgen validate`` to report, exit 1), or an array of ``schema`` (name -> axes,
     e.g. "cycle, axis") that is not a numeric dataset of the shape its run's ``cycles`` and ``t``
     arrays and ``n_axes`` attribute imply (``bins``: the lengths of the other axes, e.g. bin -> 12);
     ``kinds(name)``: the NumPy type kinds the array may hold (text for an imported fleet's stamps).
@@ -58,13 +59,14 @@ def check_runs(f: h5py.File, path: str | Path, schema: dict[str, str], bins: dic
         if missing:
             raise inputs.InputError(f"{where}: no attribute {missing[0]!r}; every run carries {', '.join(LABELS)}")
         cycles = group.attrs["cycles"]
-        if not checks.is_whole(cycles, 1) or cycles > MAX_CYCLES:
+        if checks.is_number(cycles) and cycles > MAX_CYCLES:  # not a whole number >= 1: validate says so
             raise inputs.InputError(f"{where}: attribute 'cycles' is {np.asarray(cycles).tolist()!r}; a whole "
                                     f"number 1..{MAX_CYCLES} is expected")
+        cycles = int(cycles) if checks.is_whole(cycles, 1) else MAX_CYCLES
         n_axes = group.attrs.get("n_axes")
         n_axes = int(n_axes) if checks.is_whole(n_axes, axis_numbers.MIN_AXES) and n_axes <= axis_numbers.MAX_AXES \
             else None
-        n_cycles = _length(group, "cycles", path, int(cycles), "the run's cycles attribute")
+        n_cycles = _length(group, "cycles", path, cycles, "the run's cycles attribute")
         n_log = _length(group, "t", path, MAX_LOG_SAMPLES, "an hour at 250 Hz")
         for name, axes in schema.items():
             if name not in group:
