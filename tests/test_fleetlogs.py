@@ -199,7 +199,7 @@ def test_a_changed_log_is_named_and_reimported_only_when_asked(logs, tmp_path, p
 
 
 def test_a_killed_import_leaves_no_complete_looking_file_and_the_rerun_finishes(tmp_path, puma):
-    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=2, days=20, suffix=".csv.gz")
+    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=2, days=12, suffix=".csv.gz")
     out = tmp_path / "f.h5"
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[1]))
     command = [sys.executable, "-m", "faultgen.cli", "logs", "import", str(logs), "--robot", "puma560", "-o", str(out)]
@@ -212,7 +212,7 @@ def test_a_killed_import_leaves_no_complete_looking_file_and_the_rerun_finishes(
     assert child.returncode == -signal.SIGKILL, "the import ended before it could be killed"
     assert not out.exists()
     summary = fleetlogs.import_logs(logs, out, robot="puma560", progress=False)
-    assert len(summary.imported) == 40 and dataset.validate(out) == []
+    assert len(summary.imported) == 24 and dataset.validate(out) == []
     assert not list(tmp_path.glob(".f.h5.*.part"))
 
 
@@ -379,3 +379,29 @@ def test_a_voraus_ad_parquet_imports_with_its_motor_torque_referred_to_the_arm(t
     result = runner.invoke(app, ["logs", "import", str(tmp_path / "V"), "--robot", "puma560", "--format", "voraus",
                                  "-o", str(tmp_path / "v2.h5"), "--no-progress"])
     assert result.exit_code == 2 and "missing column(s) motor_torque_4 of the voraus-AD layout" in result.output
+
+
+def test_stamps_sort_as_numbers_or_times_and_a_unit_mixing_them_is_refused(tmp_path, puma):
+    unit = tmp_path / "LOGS" / "press7"
+    unit.mkdir(parents=True)
+    for seq in (10, 2, 1):
+        fleetlog_folder.write_log(unit / f"{seq}.csv.gz", puma, seq, 0, np.zeros(6))
+    fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "f.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "f.h5") as data:
+        assert [s.decode() for s in data["press7"].array("stamp")] == ["1", "2", "10"]
+        np.testing.assert_array_equal(data["press7"].array("stamp_key"), [1.0, 2.0, 10.0])
+    timed = tmp_path / "T" / "cell"
+    timed.mkdir(parents=True)
+    for stamp in ("2026-03-01T14-00-00", "2026-03-01T08:30:00", "2026-03-01"):
+        fleetlog_folder.write_log(timed / f"{stamp}.h5", puma, 1, 0, np.zeros(6))
+    fleetlogs.import_logs(tmp_path / "T", tmp_path / "t.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "t.h5") as data:
+        assert [s.decode() for s in data["cell"].array("stamp")] == ["2026-03-01", "2026-03-01T08:30:00",
+                                                                    "2026-03-01T14-00-00"]
+    fleetlog_folder.write_log(unit / "2026-03-01.csv", puma, 1, 0, np.zeros(6))
+    with pytest.raises(ValueError, match="mix dates and sequence numbers"):
+        fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "g.h5", robot="puma560", progress=False)
+    (unit / "2026-03-01.csv").unlink()
+    fleetlog_folder.write_log(unit / "2.h5", puma, 1, 0, np.zeros(6))
+    with pytest.raises(ValueError, match="have the same stamp"):
+        fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "g.h5", robot="puma560", progress=False)
