@@ -568,7 +568,12 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates))
         false_alarm, n_normal = false_alarms[key]
         wear = fault_progress(run, axis) * 100.0 - 100.0
-        located = locate_onset(worn, onset)
+        located = UNDECIDED
+        if onset is not None:
+            try:
+                located = int(isolation.make("cross_correlation").fit(worn[: onset + 1]).source_axis_)
+            except ValueError:  # too few samples before the onset to cross-correlate
+                located = UNDECIDED
         rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
                          trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
@@ -589,18 +594,6 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
                               protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
     return pd.DataFrame(rows), charts
-
-
-def locate_onset(features: np.ndarray, onset: int | None) -> int:
-    """The axis (1..N) the cross-correlation isolator (thesis ch. 3.4.2) names on the detection
-    ``features`` (n_samples, N) up to and including the ``onset`` sample; :data:`UNDECIDED` without
-    an onset or with too few samples before it."""
-    if onset is None:
-        return UNDECIDED
-    try:
-        return int(isolation.make("cross_correlation").fit(features[: onset + 1]).source_axis_)
-    except ValueError:  # too few samples before the onset to cross-correlate
-        return UNDECIDED
 
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
