@@ -405,3 +405,15 @@ def test_stamps_sort_as_numbers_or_times_and_a_unit_mixing_them_is_refused(tmp_p
     fleetlog_folder.write_log(unit / "2.h5", puma, 1, 0, np.zeros(6))
     with pytest.raises(ValueError, match="have the same stamp"):
         fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "g.h5", robot="puma560", progress=False)
+
+
+def test_training_source_with_another_dataset_as_the_one_to_many_source(imported, other, tmp_path):
+    result = runner.invoke(app, ["training-source", str(imported), "--train", str(other), "--training-days", "10",
+                                 "--test-days", "8", "--gap-days", "2", "--no-progress", "-o", str(tmp_path / "t")])
+    assert result.exit_code == 0, result.output
+    assert "protocol: OTO, own history" in result.output and f"another dataset (each normal robot of {other}" in \
+        result.output
+    cases = pd.read_csv(tmp_path / "t-cases.csv")
+    otm = cases[cases["source"] == "OTM"]
+    assert set(otm["reference"]) == {"other.h5:u1", "other.h5:u3", "other.h5:u5"}
+    assert len(otm) == 3 * 6 * 3 and (cases[cases["source"] == "OTO"]["reference"] == cases[cases["source"] == "OTO"]["robot"]).all()

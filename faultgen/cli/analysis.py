@@ -222,6 +222,7 @@ def training_source_command(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
+    train: Train = None,
 ) -> None:
     """The training-source study of thesis chapter 4 (Table 4.1) on a fleet. Each robot is tested on its
     test days by a PCA model learnt from its own first days (one-to-one, OTO) or from those of
@@ -235,6 +236,7 @@ def training_source_command(
 
     \b
       faultgen fleet -o fleet.h5 && faultgen training-source fleet.h5 -o fleet-ch4
+      faultgen training-source logs.h5 --train fleet.h5 --training-days 20 --test-days 10
     """
     from analysis import benchmark
     from analysis import training_source as ts
@@ -244,10 +246,16 @@ def training_source_command(
              (("cases", "-cases.csv"), ("anova", "-anova.csv"), ("tukey", "-tukey.csv"), ("md", ".md"),
               ("png", ".png"))}
     analysis_input(file, list(paths.values()), overwrite)
+    if train is not None:
+        training_input(train)
     window = ts.Window(training_days, test_days, gap_days)
     cases = ts.study(file, window, variance=variance, alpha=alpha, limit_folds=limit_folds or None,
-                     progress=progress)
-    parts = ["Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
+                     progress=progress, train=train)
+    protocol = ("protocol: OTO, own history (each robot its own training days); OTM, "
+                + (f"another dataset (each normal robot of {train} of the same model)" if train is not None
+                   else "other robots of this dataset (each normal robot of the same model)"))
+    parts = [protocol,
+             "Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
              "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
              + benchmark.markdown(ts.group_means(cases)),
              "Normal robots never fail: their days above the limit are false alarms (nsat) and their lead_time_days "
