@@ -157,8 +157,21 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
     return used, fit_q_monitor(X[:, used], variance, alpha, cv=None if folds is None else min(folds, len(X)))
 
 
+def _robots(path, window: Window) -> list[tuple]:
+    """(run id, robot label, task, condition, signals) of every run of ``path`` (:func:`signals`)."""
+    runs = []
+    with reader.open(path) as data:
+        for run in data.runs:
+            try:
+                made = signals({name: run.array(name) for name in SCALARS + HISTOGRAMS}, window)
+            except ValueError as err:
+                raise ValueError(f"{path}: run {run.id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
+            runs.append((run.id, run.robot, run.task, "failure" if run.failing else "normal", made))
+    return runs
+
+
 def study(path, window: Window = Window(), variance: float = 0.90, alpha: float = 0.05,
-          limit_folds: int | None = 20, progress: bool = True) -> pd.DataFrame:
+          limit_folds: int | None = 20, progress: bool = True, train=None) -> pd.DataFrame:
     """Every test case of thesis Table 4.1 on the runs of ``path`` and its descriptors.
 
     Each run is a robot: failing (``robot condition`` failure) if it has worn axes or a fault,
@@ -171,7 +184,10 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     thesis's in-sample limit, crossed on most test days of normal robots when the features are
     nearly as many as the training days). OTO: each robot learns its own
     training days. OTM: each normal robot's training days serve, in turn, as the model for every
-    other robot of the same model (robot label).
+    other robot of the same model (robot label). With ``train`` (another dataset, its features
+    comparable: :func:`analysis.crossdata.check_comparable`), OTM's models are the normal robots of
+    ``train`` instead, each serving every robot of ``path`` of its model (column ``reference``:
+    ``<train file>:<run id>``): one-to-many across datasets (issue 46, "another dataset").
 
     Returns
     -------
@@ -187,25 +203,29 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
         If a run has fewer records than the window needs, or the dataset lacks a failing or a
         normal robot, or has no model with two robots for OTM (the message names the preset).
     """
-    runs = []
-    with reader.open(path) as data:
-        for run in data.runs:
-            try:
-                made = signals({name: run.array(name) for name in SCALARS + HISTOGRAMS}, window)
-            except ValueError as err:
-                raise ValueError(f"{path}: run {run.id} has {err}; a fleet (`faultgen fleet`) records 60 days") from err
-            runs.append((run.id, run.robot, run.task, "failure" if run.failing else "normal", made))
+    other = train  # the name `train` is the training days' slice below
+    runs = _robots(path, window)
     counts = {c: sum(r[3] == c for r in runs) for c in CONDITIONS}
     if not all(counts.values()):
         raise ValueError(f"{path}: the study compares failing and normal robots; this dataset has {counts['failure']} "
                          f"failing and {counts['normal']} normal. Use a fleet: `faultgen fleet -o fleet.h5`")
     train, test = slice(0, window.training_days - 1), slice(window.training_days - 1, window.days - 1 - window.gap_days)
     cases = []
-    plan = [(kind, reference, robot) for kind in SIGNAL_TYPES for reference in runs
-            for robot in runs if robot is reference or (reference[3] == "normal" and robot[1] == reference[1])]
+    if other is None:
+        plan = [(kind, reference, robot) for kind in SIGNAL_TYPES for reference in runs
+                for robot in runs if robot is reference or (reference[3] == "normal" and robot[1] == reference[1])]
+    else:  # OTM's models from the normal robots of another dataset
+        from analysis import crossdata
+
+        with reader.open(other) as source, reader.open(path) as data:
+            crossdata.check_comparable(source, data)
+        normal = [(f"{Path(other).name}:{r[0]}", *r[1:]) for r in _robots(other, window) if r[3] == "normal"]
+        plan = [(kind, reference, robot) for kind in SIGNAL_TYPES for robot in runs
+                for reference in [robot, *(r for r in normal if r[1] == robot[1])]]
     if not any(robot is not reference for _, reference, robot in plan):
         raise ValueError(f"{path}: one-to-many needs a normal robot and another robot of the same model; "
-                         "this dataset has none. Use a fleet: `faultgen fleet -o fleet.h5`")
+                         + ("this dataset has none. Use a fleet: `faultgen fleet -o fleet.h5`" if other is None else
+                            f"{other} has no normal robot of this dataset's models"))
     models: dict[tuple, tuple] = {}
     for kind, reference, robot in tqdm(plan, desc="training-source study", unit="case", disable=not progress):
         key = (kind, reference[0])

@@ -10,6 +10,11 @@ column         unit     meaning
 ``q1..qN``     rad      arm-side joint angles (N the robot's axes, 5..7)
 ``tau1..tauN`` N m      arm-side joint torque (motor torque referred through the gear ratio)
 ``qd1..qdN``   rad/s    optional: joint velocities; estimated from ``q`` when absent
+``temperature1..N``  degC  optional: joint temperatures (all N or none; read, not used by the
+                       calibration: an imported fleet stores them, :mod:`faultgen.data.fleetlogs`)
+``payload``    kg       optional: mass of the part carried
+``cycle``      1        optional: the cycle each sample belongs to (whole numbers, never
+                       decreasing): a log of several cycles (:mod:`faultgen.data.fleetlogs`)
 =============  =======  ==================================================================
 
 stored as
@@ -72,6 +77,8 @@ from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE 
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
 from faultgen.derivatives import savgol_window as _savgol_window
+from faultgen.effects.payload import Payload
+from faultgen.effects.temperature import Temperature
 from faultgen.model import robots
 
 #: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
@@ -94,6 +101,19 @@ def _required(n_axes: int) -> tuple[str, ...]:
 UNITS = {T_COLUMN: "s"}
 for _q, _qd, _tau in zip(*column_names(axes.MAX_AXES), strict=True):
     UNITS.update({_q: "rad", _qd: "rad/s", _tau: "N m"})
+#: The optional columns of operating conditions are named as the effects that model them
+#: (:mod:`faultgen.effects`): ``temperature1..N`` (all N or none), the joint temperatures, and
+#: ``payload``, the payload mass; ``cycle`` is the cycle number of each sample.
+TEMPERATURE_PREFIX, PAYLOAD_COLUMN, CYCLE_COLUMN = Temperature.id, Payload.id, "cycle"
+
+
+def temperature_columns(n_axes: int) -> tuple[str, ...]:
+    """The joint-temperature columns of a robot of ``n_axes`` axes: ``temperature1..N``."""
+    return tuple(TEMPERATURE_PREFIX + str(i) for i in range(1, n_axes + 1))
+
+
+UNITS.update({name: "degC" for name in temperature_columns(axes.MAX_AXES)})
+UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
@@ -137,7 +157,8 @@ class MeasuredData:
         Arm-side joint velocities in rad/s: the file's ``qd`` columns, or estimated from ``q``
         (see :attr:`velocity_estimated`).
     qdd : ndarray of shape (n, N)
-        Arm-side joint accelerations in rad/s^2, always estimated from ``q``.
+        Arm-side joint accelerations in rad/s^2, estimated from ``q`` (NaN when read with
+        ``accelerations=False``).
     tau : ndarray of shape (n, N)
         Arm-side joint torques in N m.
     source : Path
@@ -146,6 +167,12 @@ class MeasuredData:
         True when ``qd`` was estimated from ``q`` (the file had no ``qd`` columns).
     robot : str
         Name of the robot the data was checked against.
+    joint_temperature : ndarray of shape (n, N) or None
+        Joint temperatures in degC (the file's ``temperature1..N`` columns), None without.
+    payload_mass : ndarray of shape (n,) or None
+        Payload mass in kg (the ``payload`` column), None without.
+    cycle : ndarray of int of shape (n,) or None
+        The cycle of each sample (the ``cycle`` column: whole, never decreasing), None without.
     notes : tuple of str
         Remarks that did not refuse the data: ignored extra columns, the derivative filter
         used, resampling, sampling gaps, suspicious torque magnitudes.
@@ -162,6 +189,9 @@ class MeasuredData:
     velocity_estimated: bool
     robot: str = ""
     notes: tuple[str, ...] = field(default=())
+    joint_temperature: np.ndarray | None = None
+    payload_mass: np.ndarray | None = None
+    cycle: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         t = np.array(self.t, dtype=float)
@@ -176,6 +206,15 @@ class MeasuredData:
                 raise ValueError(f"{name} must have shape ({t.shape[0]}, N) alike, got {arr.shape}")
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
+        for name, shape, dtype in (("joint_temperature", (t.shape[0], n_axes), float),
+                                   ("payload_mass", (t.shape[0],), float),
+                                   ("cycle", (t.shape[0],), np.int64)):
+            if getattr(self, name) is not None:
+                arr = np.array(getattr(self, name), dtype=dtype)
+                if arr.shape != shape:
+                    raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
+                arr.setflags(write=False)
+                object.__setattr__(self, name, arr)
         object.__setattr__(self, "source", Path(self.source))
         object.__setattr__(self, "notes", tuple(self.notes))
 
@@ -197,7 +236,7 @@ class MeasuredData:
 # Reading
 
 
-def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
+def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
     """Read, check and complete a measured-data file (format in the module docstring).
 
     Parameters
@@ -208,6 +247,9 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
         The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
         before the file is opened) or a loaded robot. Its joint range is used to recognise
         angles in degrees and angles out of range.
+    accelerations : bool, default True
+        Estimate ``qdd``; False leaves it NaN and saves its filter (a reader that needs no
+        accelerations: an imported fleet's features, :mod:`faultgen.data.fleetlogs`).
 
     Returns
     -------
@@ -246,7 +288,7 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     else:
         columns, extra, row_label = _read_hdf5(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
-    return _build(columns, robot, path, row_label, notes)
+    return _build(columns, robot, path, row_label, notes, accelerations)
 
 
 def from_arrays(
@@ -285,6 +327,39 @@ def from_arrays(
     where = Path(source) if source is not None else Path("<arrays>")
     columns = _columns_from_arrays(where, t, q, tau, qd, robot.n_axes)
     return _build(columns, robot, where, _index_label, [])
+
+
+def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
+                 label=None, accelerations: bool = True) -> MeasuredData:
+    """Check and complete the columns of a log in another layout, mapped onto this format's names
+    (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
+    ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
+
+    Parameters
+    ----------
+    columns : dict of ndarray of shape (n,)
+    robot : str, Path or robots.Robot
+    source : str or Path
+        The file they came from, named in messages.
+    label : callable, optional
+        Data row index -> its description in messages (default: 1-based row and 0-based index).
+
+    Raises
+    ------
+    MeasuredDataError
+        As :func:`read`: a missing column, a non-finite value, times, rates, angles out of range.
+    """
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    where = Path(source)
+    label = label or _index_label
+    names = list(columns)
+    wanted, _ = _select_columns(where, names, robot.n_axes)
+    lengths = {len(np.asarray(columns[name])) for name in wanted}
+    if len(lengths) > 1:
+        raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
+    values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
+    _refuse_non_finite(where, values, wanted, label)
+    return _build(values, robot, where, label, [], accelerations)
 
 
 def _kind(path: Path) -> str:
@@ -359,7 +434,9 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
             dtypes = {name: (float if name in wanted else str) for name in names}
             with inputs.open_text(path, "measured log") as fh:
                 frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
-            clean = bool(np.isfinite(frame[wanted].to_numpy(dtype=float)).all())
+            # every column wanted (the common case): no reindexed copy of the frame
+            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
+            clean = bool(np.isfinite(values).all())
         except inputs.InputError:
             raise
         except (ValueError, TypeError):
@@ -373,7 +450,10 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
         raise MeasuredDataError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-    columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+    if clean:  # the fast path's values, column by column
+        columns = {name: values[:, k] for k, name in enumerate(wanted)}
+    else:
+        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, _csv_label
 
 
@@ -439,6 +519,9 @@ def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str
             f"give all of qd1..qd{n} or none (then they are estimated from q)"
         )
     wanted = [*_required(n), *qd_present]
+    if all(c in present for c in temperature_columns(n)):  # some of them only: ignored, named as extra
+        wanted += temperature_columns(n)
+    wanted += [c for c in (PAYLOAD_COLUMN, CYCLE_COLUMN) if c in present]
     extra = [n for n in names if n not in wanted]
     return wanted, extra
 
@@ -599,7 +682,8 @@ def check_time(t: np.ndarray, where: Path, label, notes: list[str]) -> tuple[np.
 
 
 def _build(
-    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str]
+    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str],
+    accelerations: bool = True,
 ) -> MeasuredData:
     t = columns[T_COLUMN]
     n = t.shape[0]
@@ -612,7 +696,12 @@ def _build(
 
     window = _savgol_window(period, n)
     uniform = _is_uniform(dt, period)
-    qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    if accelerations:
+        qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    else:  # a reader that needs no qdd (an imported fleet's features) saves its filter
+        (qd_est,) = _derivatives(t, q, period, window, uniform, orders=(1,))
+        qdd = np.full_like(q, np.nan)
+        notes.append("qdd not estimated (accelerations=False): NaN")
     filt = f"Savitzky-Golay, order {SAVGOL_ORDER}, window {window} samples ({window * period:.4g} s)"
     if not uniform:
         notes.append(
@@ -628,6 +717,9 @@ def _build(
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
         notes.extend(_check_velocities(where, qd, qd_est, window))
     notes.extend(_torque_notes(tau, robot))
+    temperature = (np.column_stack([columns[c] for c in temperature_columns(robot.n_axes)])
+                   if temperature_columns(robot.n_axes)[0] in columns else None)
+    cycle = _cycles(where, columns[CYCLE_COLUMN], label) if CYCLE_COLUMN in columns else None
 
     return MeasuredData(
         t=t,
@@ -639,7 +731,25 @@ def _build(
         velocity_estimated=estimated,
         robot=robot.name,
         notes=tuple(notes),
+        joint_temperature=temperature,
+        payload_mass=columns.get(PAYLOAD_COLUMN),
+        cycle=cycle,
     )
+
+
+def _cycles(where: Path, values: np.ndarray, label) -> np.ndarray:
+    """The ``cycle`` column as whole numbers that never decrease, or refused at the first row that is not."""
+    fractional = np.flatnonzero(values != np.round(values))
+    if fractional.size:
+        i = int(fractional[0])
+        raise MeasuredDataError(f"{where}: {label(i)}, column {CYCLE_COLUMN}: value {values[i]!r}; expected a whole "
+                                "cycle number")
+    back = np.flatnonzero(np.diff(values) < 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN} goes back at {label(i)}: {values[i]:g} after "
+                                f"{values[i - 1]:g}; expected the samples of each cycle together, cycles in order")
+    return values.astype(np.int64)
 
 
 def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> None:

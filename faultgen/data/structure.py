@@ -33,12 +33,14 @@ def _dims(axes: str, n_cycles: int, n_log: int, n_axes: int | None, bins: dict[s
     return tuple(sizes[name.strip()] for name in axes.split(","))
 
 
-def check_runs(f: h5py.File, path: str | Path, schema: dict[str, str], bins: dict[str, int]) -> None:
+def check_runs(f: h5py.File, path: str | Path, schema: dict[str, str], bins: dict[str, int],
+               kinds=lambda name: "fiub") -> None:
     """Refuse a dataset whose ``/runs`` holds anything but run groups carrying :data:`LABELS`, a
     ``cycles`` attribute above :data:`MAX_CYCLES` (one that is not a whole number >= 1 is for
     ``faultgen validate`` to report, exit 1), or an array of ``schema`` (name -> axes,
     e.g. "cycle, axis") that is not a numeric dataset of the shape its run's ``cycles`` and ``t``
-    arrays and ``n_axes`` attribute imply (``bins``: the lengths of the other axes, e.g. bin -> 12).
+    arrays and ``n_axes`` attribute imply (``bins``: the lengths of the other axes, e.g. bin -> 12);
+    ``kinds(name)``: the NumPy type kinds the array may hold (text for an imported fleet's stamps).
 
     Raises
     ------
@@ -70,7 +72,7 @@ def check_runs(f: h5py.File, path: str | Path, schema: dict[str, str], bins: dic
             if name not in group:
                 continue
             shape = _dims(axes, n_cycles, n_log, n_axes, bins)
-            ds = inputs.bounded_dataset(group, name, path, shape)
+            ds = inputs.bounded_dataset(group, name, path, shape, kinds=kinds(name))
             if n_axes is None and "axis" in axes:
                 found = ds.shape[[a.strip() for a in axes.split(",")].index("axis")]
                 if not axis_numbers.MIN_AXES <= found <= axis_numbers.MAX_AXES:
