@@ -18,7 +18,8 @@ and what is ours:
   ``Jm``.
 - **Conditions: ours**: a seasonal hall temperature (each unit its own mean and swing, on the
   calendar of its stamps: January cold) plus the joints' warm-up; a product change every week
-  between two parts per unit (drawn masses); Gaussian torque noise (:data:`NOISE` of each axis's
+  between two parts per unit (drawn masses; aluminium cubes hanging from the flange, as declared
+  in the robot's load data); Gaussian torque noise (:data:`NOISE` of each axis's
   torque RMS) and angle noise.
 - **Wear: ours**: on a worn unit, one axis's Coulomb and Stribeck friction grow linearly from an
   onset day to :attr:`FleetSpec.final_wear` percent on the last day.
@@ -58,6 +59,9 @@ VISCOUS_PER_K = 0.02
 #: Torque noise per sample, a share of each axis's torque RMS; angle noise, rad.
 NOISE = 0.005
 ANGLE_NOISE = 1e-5
+#: The parts are aluminium cubes hanging from the flange (their centre half an edge below it, along
+#: the flange's z axis): the load data a robot's program declares, which the monitor is told.
+PART_DENSITY = 2700.0
 #: Axes that may wear (the KR210's axis 6 motor is rated 3 N m: its friction is at the noise floor).
 WEARABLE = (1, 2, 3, 4, 5)
 
@@ -100,10 +104,10 @@ def _motion(folder: str, rate: float):
 
 @lru_cache(maxsize=64)
 def _rigid(folder: str, rate: float, mass: float) -> np.ndarray:
-    """Pinocchio's RNEA torque of the motion with a payload of ``mass`` kg (a box sized to it)."""
+    """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`)."""
     _, q, qd, qdd = _motion(folder, rate)
-    edge = float(np.clip((mass / 2700.0) ** (1 / 3), 0.1, 0.6))  # an aluminium cube
-    payload = pinocchio_log.HiddenPayload(mass=mass, com=(0.1, 0.0, 0.0), size=(edge, edge, edge))
+    edge = (mass / PART_DENSITY) ** (1 / 3)
+    payload = pinocchio_log.HiddenPayload(mass=mass, com=(0.0, 0.0, edge / 2), size=(edge, edge, edge))
     model = pinocchio_log.pinocchio_model(Path(folder) / "urdf_used.urdf", payload if mass > 0 else None)
     data = model.createData()
     return np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
@@ -206,4 +210,28 @@ def read_truth(path: Path) -> dict[str, dict]:
             unit["wear"].append(float(row["wear_percent"]))
     for unit in out.values():
         unit["wear"] = np.array(unit["wear"])
+    return out
+
+
+def evaluate(truth_path: Path, alarms_path: Path) -> dict[str, dict]:
+    """Each unit's outcome from ``truth.csv`` and a monitor's ``alarms.csv``: ``axis`` (worn, 0
+    healthy), ``alarm`` (first_alarm stamp or ""), ``day`` of the alarm (1-based) and ``wear`` at it
+    (%), ``day10`` / ``day40`` (first day with wear >= 10 / 40 %), ``delay`` (alarm day - day10),
+    ``source`` (the alarm's axis or 0), ``in_window`` (10 % <= wear at alarm < 40 %)."""
+    truth = read_truth(truth_path)
+    out = {}
+    with open(alarms_path, newline="") as f:
+        alarms = {row["unit"]: row for row in csv.DictReader(f)}
+    for unit, t in truth.items():
+        row = alarms.get(unit, {})
+        stamp = row.get("first_alarm", "")
+        day = t["stamps"].index(stamp) + 1 if stamp else None
+        wear = t["wear"]
+        day10 = int(np.argmax(wear >= 10)) + 1 if np.any(wear >= 10) else None
+        day40 = int(np.argmax(wear >= 40)) + 1 if np.any(wear >= 40) else None
+        at = float(wear[day - 1]) if day else None
+        out[unit] = {"axis": t["axis"], "alarm": stamp, "day": day, "wear": at, "day10": day10, "day40": day40,
+                     "delay": (day - day10) if day and day10 else None,
+                     "source": int(row["source_axis"]) if row.get("source_axis") else 0,
+                     "in_window": at is not None and 10.0 <= at < 40.0}
     return out

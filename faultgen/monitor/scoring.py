@@ -1,0 +1,166 @@
+"""One unit's monitor, fed its logs one at a time in stamp order (:class:`UnitMonitor`).
+
+A log arrives as its residual: the features minus the twin's expectation at the log's payload
+(protocol ``twin``), or the features themselves (protocol ``own``). The first ``train`` logs are
+the unit's own normal operation. On them, per feature, the monitor learns
+
+- the unit's offset (the residual's mean: what neither the model nor the calibration explains,
+  and the unit-to-unit spread: the per-unit normalisation of thesis ch. 4),
+- the residual's slope with the logged joint temperature (least squares; the seasonal change of
+  friction, which the unit's first weeks see only a little of and which is extrapolated
+  linearly),
+- its noise (the standard deviation left, ``ddof = 2``),
+
+and fits :class:`analysis.monitoring.PCAMonitor` (Hotelling's T2 and Q, thesis eq. 2.3-2.6; the
+Q limit out-of-fold, ``cv = 5``) on the standardised residuals. Every later log is standardised
+the same way and scored; an alarm is T2 or Q above its ``1 - alpha`` limit, and a unit's alarm is
+persistent from the first of ``persistence`` consecutive alarming logs (thesis ch. 3.4.1,
+:func:`analysis.monitoring.detect_onset`). Each log's axes are ranked: with the twin by how
+closely the residual points along each axis's wear signature
+(:func:`analysis.isolation.signature_scores`), without it by each axis's share of Q (thesis eq.
+3.3-3.4). The source axis of a persistent alarm is the first of the ranking of the mean
+residual over the logs that made it persistent.
+
+State is small and bounded per log (a row of scores each); the object pickles, so a rerun on a
+grown folder continues where the last one stopped.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.isolation import signature_scores
+from analysis.monitoring import PCAMonitor
+
+PROTOCOLS = ("twin", "own")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """``protocol`` (:data:`PROTOCOLS`), ``train`` logs of normal operation, ``alpha``, PCA
+    ``variance``, ``persistence`` (consecutive alarming logs)."""
+
+    protocol: str = "twin"
+    train: int = 28
+    alpha: float = 0.01
+    variance: float = 0.85
+    persistence: int = 5
+
+    def __post_init__(self) -> None:
+        if self.protocol not in PROTOCOLS:
+            raise ValueError(f"protocol = {self.protocol!r}; expected one of {', '.join(PROTOCOLS)}")
+        if not (isinstance(self.train, int) and self.train >= 10):
+            raise ValueError(f"train = {self.train!r} logs; expected a whole number >= 10 (the unit's normal "
+                             "operation, from which its offset, temperature slope and noise are learned)")
+        if not 0 < self.alpha < 0.5:
+            raise ValueError(f"alpha = {self.alpha!r}; expected a significance level in (0, 0.5)")
+        if not (isinstance(self.persistence, int) and self.persistence >= 1):
+            raise ValueError(f"persistence = {self.persistence!r}; expected a whole number of logs >= 1")
+
+
+class UnitMonitor:
+    """The monitor of one unit (module docstring). ``signatures`` (n_axes, n_features): each axis's
+    wear signature in feature units per % (protocol ``twin``), or None."""
+
+    def __init__(self, unit: str, settings: Settings, n_axes: int, signatures: np.ndarray | None = None):
+        self.unit, self.settings, self.n_axes = unit, settings, n_axes
+        self.signatures = signatures
+        self.training: list[tuple[str, np.ndarray, float]] = []
+        self.pca: PCAMonitor | None = None
+        self.window: deque = deque(maxlen=settings.persistence)
+        self.run = 0
+        self.first_alarm: str | None = None
+        self.source_axis: int | None = None
+        self.statistic = ""
+        self.limit = float("nan")
+        self.evidence = ""
+        self.rows: list[dict] = []
+        self.last_stamp: str | None = None
+
+    # -- learning -------------------------------------------------------------------------------
+    def _fit(self) -> None:
+        stamps = [s for s, _, _ in self.training]
+        E = np.stack([e for _, e, _ in self.training])
+        T = np.array([t for _, _, t in self.training])
+        self.mean_ = E.mean(axis=0)
+        self.temperature_ = float(np.mean(T)) if np.all(np.isfinite(T)) else float("nan")
+        self.slope_ = np.zeros(E.shape[1])
+        dof = 1
+        if np.isfinite(self.temperature_) and np.ptp(T) > 0:
+            tc = T - self.temperature_
+            self.slope_ = tc @ (E - self.mean_) / (tc @ tc)
+            dof = 2
+        R = E - self.mean_ - np.outer(T - self.temperature_ if dof == 2 else np.zeros(len(T)), self.slope_)
+        scale = np.sqrt((R**2).sum(axis=0) / (len(R) - dof))
+        self.scale_ = np.where(scale > 0, scale, 1.0)
+        Z = R / self.scale_
+        self.pca = PCAMonitor(variance=self.settings.variance, alpha=self.settings.alpha, cv=5).fit(Z)
+        self.training = []
+        for stamp, z in zip(stamps, Z):
+            self._score(stamp, z, phase="training")
+
+    def _standardise(self, e: np.ndarray, temperature: float) -> np.ndarray:
+        shift = self.slope_ * (temperature - self.temperature_) if np.isfinite(self.temperature_) else 0.0
+        return (e - self.mean_ - shift) / self.scale_
+
+    # -- ranking --------------------------------------------------------------------------------
+    def axis_scores(self, z: np.ndarray) -> np.ndarray:
+        """Each axis's isolation score for standardised residual(s) ``z`` (larger: more likely)."""
+        if self.signatures is not None:
+            return signature_scores(z, self.signatures / self.scale_)
+        contributions = self.pca.contributions(np.atleast_2d(z), "q").mean(axis=0)
+        return contributions.reshape(-1, self.n_axes).sum(axis=0)
+
+    # -- scoring --------------------------------------------------------------------------------
+    def add(self, stamp: str, residual: np.ndarray, temperature: float) -> None:
+        """Take the next log (``stamp`` later than every earlier one)."""
+        self.last_stamp = stamp
+        if self.pca is None:
+            self.training.append((stamp, np.asarray(residual, dtype=float), float(temperature)))
+            if len(self.training) == self.settings.train:
+                self._fit()
+            return
+        self._score(stamp, self._standardise(np.asarray(residual, dtype=float), temperature), phase="monitoring")
+
+    def _score(self, stamp: str, z: np.ndarray, phase: str) -> None:
+        t2, q = (float(v[0]) for v in self.pca.score_samples(z[None]))
+        alarm = q > self.pca.q_limit_ or t2 > self.pca.t2_limit_
+        scores = self.axis_scores(z)
+        ranking = np.argsort(-scores, kind="stable") + 1
+        if phase == "monitoring":
+            self.run = self.run + 1 if alarm else 0
+            self.window.append((stamp, z, t2, q))
+            if self.first_alarm is None and self.run >= self.settings.persistence:
+                self._raise()
+        self.rows.append({"unit": self.unit, "stamp": stamp, "phase": phase, "Q": q, "Q_limit": self.pca.q_limit_,
+                          "T2": t2, "T2_limit": self.pca.t2_limit_, "alarm": int(alarm),
+                          "ranking": " ".join(str(a) for a in ranking),
+                          **{f"score{i + 1}": float(s) for i, s in enumerate(scores)}})
+
+    def _raise(self) -> None:
+        stamps, Z, t2, q = zip(*self.window)
+        self.first_alarm = stamps[0]
+        mean = np.mean(Z, axis=0)
+        scores = self.axis_scores(mean)
+        order = np.argsort(-scores, kind="stable")
+        self.source_axis = int(order[0]) + 1
+        q_ratio, t2_ratio = np.mean(q) / self.pca.q_limit_, np.mean(t2) / self.pca.t2_limit_
+        self.statistic = "Q" if q_ratio >= t2_ratio else "T2"
+        value = float(np.mean(q) if self.statistic == "Q" else np.mean(t2))
+        self.limit = float(self.pca.q_limit_ if self.statistic == "Q" else self.pca.t2_limit_)
+        how = "wear signature match" if self.signatures is not None else "share of Q"
+        self.evidence = (f"{self.statistic} {value:.3g} (mean of {len(stamps)} logs from {stamps[0]} to {stamps[-1]}) "
+                         f"> limit {self.limit:.3g} at alpha {self.settings.alpha:g}; axis {self.source_axis} first by "
+                         f"{how} ({scores[order[0]]:.3g}; next axis {order[1] + 1}: {scores[order[1]]:.3g})")
+
+    def alarm_row(self) -> dict:
+        """The unit's row of alarms.csv."""
+        return {"unit": self.unit, "first_alarm": self.first_alarm or "",
+                "source_axis": "" if self.source_axis is None else self.source_axis,
+                "statistic": self.statistic, "limit": "" if np.isnan(self.limit) else f"{self.limit:.6g}",
+                "evidence": self.evidence if self.first_alarm else
+                (f"no persistent alarm in {len(self.rows)} logs" if self.pca is not None else
+                 f"still learning: {len(self.training)} of {self.settings.train} logs")}
