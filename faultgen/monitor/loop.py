@@ -23,6 +23,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+import mujoco
 import numpy as np
 from tqdm.auto import tqdm
 
@@ -131,14 +132,14 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 twins[twin_key] = Twin(unit.model, Path(unit.program), cache / "cycles", unit.reference_payload)
             twin = twins[twin_key]
             unit.monitor.signatures = twin.signatures
+        bar.set_postfix_str(name)
         for log in unit_logs:
-            bar.set_postfix_str(f"{name} {log.stamp}")
             reading = fleet_logs.read(nominal, log)
             residual = reading.vector
             if twin is not None:
                 at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
                 residual = residual - twin.expected(at, reading.payload)
-            unit.monitor.add(log.stamp, residual, reading.temperature)
+            unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload)
             bar.update()
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
@@ -190,7 +191,20 @@ def _model(nominal, settings: Settings, calibrated, calibrate: bool, first, cach
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             run_calibration(str(nominal.path), first.path, folder, max_steps=CALIBRATION_STEPS, progress=False)
-    return str(folder / "model" / f"{nominal.name}_calibrated.xml")
+    return str(_without_payload(folder / "model" / f"{nominal.name}_calibrated.xml"))
+
+
+def _without_payload(path: Path) -> Path:
+    """The calibrated model without the payload its log carried (``payload*`` bodies, the
+    calibration's ``payload`` effect): the twin carries each log's declared part instead. Written
+    beside it (same assets and ``tasks.toml``) as ``<name>_twin.xml``."""
+    target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
+    if not target.is_file():
+        spec = mujoco.MjSpec.from_file(str(path))
+        for body in [b for b in spec.bodies if b.name.startswith("payload")]:
+            spec.delete(body)
+        atomic.write_text(target, spec.to_xml())
+    return target
 
 
 def _program(nominal, path: Path, programs: list) -> str:

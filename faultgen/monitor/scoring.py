@@ -6,10 +6,11 @@ the unit's own normal operation. On them, per feature, the monitor learns
 
 - the unit's offset (the residual's mean: what neither the model nor the calibration explains,
   and the unit-to-unit spread: the per-unit normalisation of thesis ch. 4),
-- the residual's slope with the logged joint temperature (least squares; the seasonal change of
-  friction, which the unit's first weeks see only a little of and which is extrapolated
-  linearly),
-- its noise (the standard deviation left, ``ddof = 2``),
+- the residual's slopes with the logged conditions that vary over those logs, joint temperature
+  and payload (least squares; linear extrapolation beyond them: the seasonal change of friction,
+  which the first weeks see only a little of, and the part of a payload's effect the twin gets
+  wrong, or without the twin all of it),
+- its noise (the standard deviation left, ``ddof`` = 1 + the slopes),
 
 and fits :class:`analysis.monitoring.PCAMonitor` (Hotelling's T2 and Q, thesis eq. 2.3-2.6; the
 Q limit out-of-fold, ``cv = 5``) on the standardised residuals. Every later log is standardised
@@ -84,17 +85,16 @@ class UnitMonitor:
     def _fit(self) -> None:
         stamps = [s for s, _, _ in self.training]
         E = np.stack([e for _, e, _ in self.training])
-        T = np.array([t for _, _, t in self.training])
+        C = np.array([c for _, _, c in self.training])  # (m, 2): temperature, payload
         self.mean_ = E.mean(axis=0)
-        self.temperature_ = float(np.mean(T)) if np.all(np.isfinite(T)) else float("nan")
-        self.slope_ = np.zeros(E.shape[1])
-        dof = 1
-        if np.isfinite(self.temperature_) and np.ptp(T) > 0:
-            tc = T - self.temperature_
-            self.slope_ = tc @ (E - self.mean_) / (tc @ tc)
-            dof = 2
-        R = E - self.mean_ - np.outer(T - self.temperature_ if dof == 2 else np.zeros(len(T)), self.slope_)
-        scale = np.sqrt((R**2).sum(axis=0) / (len(R) - dof))
+        # the conditions that vary over the learning logs (and are logged) become regressors
+        finite = np.all(np.isfinite(C), axis=0)
+        self.condition_mean_ = np.where(finite, np.nanmean(np.where(np.isfinite(C), C, 0.0), axis=0), 0.0)
+        self.regressors_ = np.flatnonzero(finite & (np.ptp(np.where(np.isfinite(C), C, 0.0), axis=0) > 0))
+        X = C[:, self.regressors_] - self.condition_mean_[self.regressors_]
+        self.slope_ = np.linalg.lstsq(X, E - self.mean_, rcond=None)[0] if X.shape[1] else np.zeros((0, E.shape[1]))
+        R = E - self.mean_ - X @ self.slope_
+        scale = np.sqrt((R**2).sum(axis=0) / (len(R) - 1 - X.shape[1]))
         self.scale_ = np.where(scale > 0, scale, 1.0)
         Z = R / self.scale_
         self.pca = PCAMonitor(variance=self.settings.variance, alpha=self.settings.alpha, cv=5).fit(Z)
@@ -102,9 +102,9 @@ class UnitMonitor:
         for stamp, z in zip(stamps, Z):
             self._score(stamp, z, phase="training")
 
-    def _standardise(self, e: np.ndarray, temperature: float) -> np.ndarray:
-        shift = self.slope_ * (temperature - self.temperature_) if np.isfinite(self.temperature_) else 0.0
-        return (e - self.mean_ - shift) / self.scale_
+    def _standardise(self, e: np.ndarray, conditions: np.ndarray) -> np.ndarray:
+        x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
+        return (e - self.mean_ - x @ self.slope_) / self.scale_
 
     # -- ranking --------------------------------------------------------------------------------
     def axis_scores(self, z: np.ndarray) -> np.ndarray:
@@ -115,15 +115,17 @@ class UnitMonitor:
         return contributions.reshape(-1, self.n_axes).sum(axis=0)
 
     # -- scoring --------------------------------------------------------------------------------
-    def add(self, stamp: str, residual: np.ndarray, temperature: float) -> None:
-        """Take the next log (``stamp`` later than every earlier one)."""
+    def add(self, stamp: str, residual: np.ndarray, temperature: float, payload: float) -> None:
+        """Take the next log (``stamp`` later than every earlier one): its residual (n_features,),
+        mean joint temperature (deg C, NaN when not logged) and payload (kg)."""
         self.last_stamp = stamp
+        conditions = np.array([temperature, payload], dtype=float)
         if self.pca is None:
-            self.training.append((stamp, np.asarray(residual, dtype=float), float(temperature)))
+            self.training.append((stamp, np.asarray(residual, dtype=float), conditions))
             if len(self.training) == self.settings.train:
                 self._fit()
             return
-        self._score(stamp, self._standardise(np.asarray(residual, dtype=float), temperature), phase="monitoring")
+        self._score(stamp, self._standardise(np.asarray(residual, dtype=float), conditions), phase="monitoring")
 
     def _score(self, stamp: str, z: np.ndarray, phase: str) -> None:
         t2, q = (float(v[0]) for v in self.pca.score_samples(z[None]))

@@ -1,0 +1,129 @@
+"""``faultgen monitor`` on a small fleet made by a simulator that is not faultgen
+(tests/independent_fleet.py: Pinocchio's dynamics of rtb-data's KR210 URDF, our own motor-side
+friction, seasons, payload changes, noise, wear on one unit). The full check, 12 units x 120
+days, is ``benchmarks/monitor_loop.py`` (docs/analysis.md, "Monitor your own robots")."""
+
+import filecmp
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import independent_fleet
+import pytest
+
+from faultgen.monitor import loop
+from faultgen.monitor.scoring import Settings
+
+# three units, 30 days; unit 1 healthy, units 2 and 3 by the seed; wear from day 12-13 to 60 % on day 30
+SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=30, seed=5, onset=(12, 13))
+SETTINGS = Settings(train=10, persistence=3)
+
+
+@pytest.fixture(scope="module")
+def fleet(tmp_path_factory):
+    root = tmp_path_factory.mktemp("fleet")
+    robot, logs, truth = independent_fleet.write_fleet(root, SPEC)
+    return robot, logs, truth
+
+
+@pytest.fixture(scope="module")
+def monitored(fleet, tmp_path_factory):
+    robot, logs, truth = fleet
+    out = tmp_path_factory.mktemp("monitor") / "out"
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    return out
+
+
+def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_healthy_do_not(fleet, monitored):
+    _, _, truth = fleet
+    outcome = independent_fleet.evaluate(truth, monitored / "alarms.csv")
+    worn = [u for u, o in outcome.items() if o["axis"]]
+    assert len(worn) == 1, outcome
+    for unit, o in outcome.items():
+        if o["axis"]:
+            assert o["in_window"], (unit, o)  # 10 % <= wear at the first alarm < 40 %
+            assert o["source"] == o["axis"], (unit, o)
+        else:
+            assert not o["alarm"], (unit, o)
+    assert {p.name for p in monitored.glob("*.png")} == {f"{u}.png" for u in outcome}
+
+
+def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
+    robot, _, _ = fleet
+    _, logs, _ = independent_fleet.write_fleet(tmp_path / "again", SPEC, robot=robot)
+    out = tmp_path / "out"
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    for name in ("alarms.csv", "scores.csv"):
+        assert filecmp.cmp(out / name, monitored / name, shallow=False), name
+
+
+def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    partial = tmp_path / "logs"
+    keep = 20
+    for unit in logs.iterdir():
+        (partial / unit.name).mkdir(parents=True)
+        for log in sorted(unit.iterdir())[:keep]:
+            os.link(log, partial / unit.name / log.name)
+    out = tmp_path / "out"
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
+    first = (out / "scores.csv").read_text().splitlines()
+    assert len(first) == 1 + SPEC.units * keep
+    for unit in logs.iterdir():  # the rest of the month arrives
+        for log in sorted(unit.iterdir())[keep:]:
+            os.link(log, partial / unit.name / log.name)
+    before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
+    scored = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
+    assert all(len(m.rows) == SPEC.days for m in scored)
+    # the old rows are kept as they were, the new ones equal a run over the whole folder at once
+    assert (out / "scores.csv").read_text() == (monitored / "scores.csv").read_text()
+    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
+    assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
+
+
+def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    out = tmp_path / "out"
+    folder = tmp_path / "logs" / "unit01"
+    folder.mkdir(parents=True)
+    units = sorted(logs.iterdir())
+    files = sorted(units[0].iterdir())
+    for log in files[1:12]:
+        os.link(log, folder / log.name)
+    loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    os.link(files[0], folder / files[0].name)
+    with pytest.raises(ValueError, match=f"{files[0].name}.*older than the last scored log of unit01"):
+        loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+               "--no-calibrate", "--train", "10", "--persistence", "3"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not (out / ".cache" / "cycles").is_dir() or not any((out / ".cache" / "cycles").iterdir()):
+        assert process.poll() is None and time.monotonic() < deadline, "the monitor ended before it was killed"
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert not (out / "alarms.csv").exists() and not (out / "scores.csv").exists()
+    assert not list(out.glob("*.png"))
+    result = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
+
+
+def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
+    robot, _, _ = fleet
+    with pytest.raises(ValueError, match="protocol = 'magic'"):
+        Settings(protocol="magic")
+    (tmp_path / "logs").mkdir()
+    with pytest.raises(ValueError, match="no unit folder with a log"):
+        loop.monitor(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False)
+    assert not (tmp_path / "out").exists()
