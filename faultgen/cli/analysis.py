@@ -12,6 +12,14 @@ from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
 from faultgen.cli.options import Overwrite, Progress, QAlpha
 
+#: ``--train OTHER.h5`` of every detector and isolator command (analysis.crossdata).
+Train = Annotated[Path | None, typer.Option(
+    "--train", metavar="OTHER.h5",
+    help="Learn normal operation (or the classes) from this other dataset instead of FILE itself, e.g. simulated "
+         "nominal data for an imported fleet's logs; its robots must have FILE's axes, ranges and limits. Each unit's "
+         "features are centred and scaled by its own first records (thesis ch. 4); the output states the protocol "
+         "(own history, another dataset, the twin).")]
+
 
 def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     """Refuse a dataset that fails validation, or outputs that exist, before any analysis runs."""
@@ -26,6 +34,15 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     if not failing:
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")
+
+
+def training_input(train: Path) -> None:
+    """Refuse a ``--train`` dataset that fails validation, before any analysis runs."""
+    from faultgen.data import dataset
+
+    problems = dataset.validate(train)
+    if problems:
+        raise ValueError(f"--train {train} fails validation (run `faultgen validate {train}`): {problems[0]}")
 
 
 @app.command("bench-isolators", cls=Command)
@@ -46,6 +63,9 @@ def bench_isolators_command(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
+    train: Train = None,
+    baseline: Annotated[int, typer.Option(help="With --train: the first cycles of each unit its signal is centred "
+                                               "and scaled by (pca_contribution's reference cycles).", min=2)] = 20,
 ) -> None:
     """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
     worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
@@ -57,6 +77,7 @@ def bench_isolators_command(
       faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
       faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
       faultgen bench-isolators j2.h5 --isolator mine:MyIsolator
+      faultgen bench-isolators logs.h5 --train nominal.h5
     """
     from analysis import benchmark
 
@@ -73,6 +94,14 @@ def bench_isolators_command(
     window = parse_window(speed_window) if speed_window is not None else None
     isolators = benchmark.default_isolators(bins or (5, 10))
     isolators.update({spec.rpartition(":")[2]: benchmark.load_estimator(spec) for spec in plugins or []})
+    stated = "protocol: own history (each isolator reads the tested run's own cycles)"
+    if train is not None:
+        from analysis import crossdata
+
+        training_input(train)
+        isolators, stated = crossdata.trained_isolators(isolators, train, file, baseline=baseline)
+        stated = "protocol: " + stated
+    typer.echo(stated)
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
     written = benchmark.write_outputs(table, stem, benchmark.isolation_markdown(table))
     written.append(benchmark.isolation_heatmap(table, stem.with_suffix(".png")))
@@ -127,6 +156,7 @@ def detect_command(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
+    train: Train = None,
 ) -> None:
     """PCA onset detection (Q statistic) and location per worn run, thesis Table 3.5 layout, with the
     false-alarm rate on healthy runs; summary per task and axis. No detection is counted before the
@@ -139,6 +169,7 @@ def detect_command(
 
     \b
       faultgen detect j2.h5 --protocol other-seeds -o j2-detection
+      faultgen detect logs.h5 --train nominal.h5 --first 10
     """
     from analysis import benchmark
 
@@ -146,10 +177,22 @@ def detect_command(
     summary_csv = stem.with_name(stem.name + "-summary.csv")
     analysis_input(file, [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv],
                    overwrite)
-    table, charts = benchmark.detection_table(
-        file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
-        detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
-        limit_folds=limit_folds or None, return_charts=True)
+    if train is not None:  # another dataset learns normal operation (analysis.crossdata)
+        from analysis import crossdata
+
+        if protocol != "auto" or period is not None:
+            raise ValueError("--train sets the protocol (another dataset, each unit referred to its own first --first "
+                             "records); drop --protocol and --period")
+        training_input(train)
+        table, charts = crossdata.detection_across(
+            file, train, first=first, variance=variance, alpha=alpha, persistence=persistence,
+            limit_folds=limit_folds or None, detector=benchmark.load_estimator(plugin) if plugin else None,
+            progress=progress)
+    else:
+        table, charts = benchmark.detection_table(
+            file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
+            detector=benchmark.load_estimator(plugin) if plugin else None, protocol=protocol, first=first,
+            limit_folds=limit_folds or None, return_charts=True)
     summary = benchmark.detection_summary(table)
     written = benchmark.write_outputs(table, stem)
     summary.to_csv(summary_csv)
@@ -273,6 +316,9 @@ def classify_command(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
+    train: Train = None,
+    baseline: Annotated[int, typer.Option(help="With --train: the first records of each unit its features are "
+                                               "centred and scaled by.", min=2)] = 5,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout.
 
@@ -306,6 +352,7 @@ def classify_command(
       faultgen classify fleet.h5 --horizon 3 --pairs 0 --full
       faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19
       faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19
+      faultgen classify logs.h5 --train fleet.h5 --classifier lr --classifier rf
     """
     import shlex
 
@@ -316,6 +363,24 @@ def classify_command(
         cells["preprocessing"] = preprocessing
     stem = out or file.with_name(file.stem + "-classification")
     analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
+    if train is not None:  # fitted on another dataset, scored on FILE (analysis.crossdata)
+        from analysis import crossdata
+
+        if horizon is not None or matched_days:
+            raise ValueError("--train labels FILE's samples by --wear-threshold; drop --horizon and --matched-days")
+        training_input(train)
+        table = crossdata.classification_across(
+            file, train, wear_threshold=wear_threshold, baseline=baseline, random_state=seed, progress=progress,
+            permutations=permutations or 19, **({"classifiers": classifiers} if classifiers else {}),
+            preprocessing=preprocessing or None)
+        text = (benchmark.markdown(table, digits=3) + f"\n\nprotocol: {table.attrs['protocol']}. auc: the samples of "
+                f"{file} ranked by a model fitted on {train}; null: its mean over label sets with the tested runs' roles "
+                "exchanged (the chance level on these robots); p: the permutation p-value.")
+        table.to_csv(stem.with_suffix(".csv"))
+        stem.with_suffix(".md").write_text(text + "\n")
+        typer.echo(text)
+        typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md")))
+        return
     table = benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
         horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1,

@@ -47,7 +47,7 @@ def card(path: str | Path) -> str:
         If ``path`` is not a finished faultgen dataset.
     """
     from faultgen.model import robots
-    from faultgen.operation import tasks
+    from faultgen.operation import programs, tasks
 
     with reader.open(path) as data:
         runs = data.runs
@@ -55,11 +55,14 @@ def card(path: str | Path) -> str:
         kind, command, written_by = data.kind, data.command, data.faultgen_version
         shas = {run.robot: run.provenance["model_sha256"] for run in runs}
     robot_names = sorted({r.robot for r in runs})
-    pairs = sorted({(r.robot, r.task) for r in runs})
+    pairs = sorted({(r.robot, r.task) for r in runs if not r.measured})
+    measured_robots = sorted({r.robot for r in runs if r.measured})
     lines = [f"# Dataset card: {Path(path).name}", "",
              f"A faultgen {kind}: {len(runs)} run(s) ({sum(r.failing for r in runs)} with wear or a fault), robots "
              f"{', '.join(robot_names)}, tasks {', '.join(sorted({r.task for r in runs}))}; a sample is "
-             + ("a day's record (the day's maximum of its cycles)" if any(r.sample == "day" for r in runs)
+             + ("a log's record (the largest of its cycles' features, as a simulated day's)"
+                if any(r.sample == "log" for r in runs)
+                else "a day's record (the day's maximum of its cycles)" if any(r.sample == "day" for r in runs)
                 else "one recorded cycle") + ".", ""]
 
     lines += [f"## What {EXAMPLE_WEAR:g} % wear means", "",
@@ -89,7 +92,11 @@ def card(path: str | Path) -> str:
               "- `Run.fault_begins`: the first sample with the fault above 0; alarms before it are false alarms.",
               "- `fault`: a fault other than friction wear (effect, parameter, axis, start, final).",
               "- `seed`: the unit (noise and draws); in a fleet each robot has its own.",
-              "- `conditions`: operating conditions (temperature, parts, task mix, unit spread), when on.", ""]
+              "- `conditions`: operating conditions (temperature, parts, task mix, unit spread), when on.",
+              *(["- units imported from measured logs (`faultgen logs import`, task `measured`): no true wear is "
+                 "measured; `label` per log and axis is 1 worn, 0 healthy, -1 unknown, from the logs' events, and "
+                 "`friction_multiplier` holds it as a wear (2 on worn logs, 1 elsewhere)."] if measured_robots else []),
+              ""]
 
     lines += ["## Arrays and units", ""]
     rows = [[name, *reader.SCHEMA[name]] for name in names if name in reader.SCHEMA]
@@ -110,6 +117,10 @@ def card(path: str | Path) -> str:
         limit = tasks.load(name, task).velocity_limit
         rows.append([name, task, "speed_hist", "rad/s (arm)", "0..the task's speed limit: " + "; ".join(
             f"0..{v:.3g}" for v in limit)])
+    for name in measured_robots:
+        limit = programs.robot_limits(name)[0]
+        rows.append([name, dataset.MEASURED, "speed_hist", "rad/s (arm)", "0..the robot's speed limit (tasks.toml "
+                     "[limits], as its thesis tasks): " + "; ".join(f"0..{v:.3g}" for v in limit)])
     lines += _table(["robot", "task", "histogram", "units", f"range per axis 1..N, split in {sensors.HISTOGRAM_BINS}"],
                     rows)
 

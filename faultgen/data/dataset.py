@@ -126,6 +126,28 @@ FAULT_ARRAYS = {
     "fault_value": ("of the fault parameter", "cycle", "the growing fault's parameter at each cycle (attr fault)"),
 }
 
+#: name -> (units, axes, description) of what a run imported from measured logs holds beside the
+#: features (attribute ``source = "measured"``, :mod:`faultgen.data.fleetlogs`): a record is a log;
+#: ``joint_temperature`` and ``payload_mass`` only when every log of the unit has them. Such a run has
+#: no simulated truth (``mean_friction_torque``, ``tracking_error``); its ``friction_multiplier`` holds
+#: the labels (2 on worn logs, 1 elsewhere, ``faultgen.data.fleetlogs.WORN_MARK``).
+MEASURED_ARRAYS = {
+    "label": ("1", "cycle, axis", "per log and axis: 1 worn, 0 healthy, -1 unknown (from the logs' events.csv)"),
+    "stamp": ("", "cycle", "the log's stamp, as in its file name (ISO date or date-time, or a sequence number)"),
+    "stamp_key": ("s since 1970-01-01 UTC, or 1 for sequence numbers", "cycle", "the stamp as a number, increasing"),
+    "log_file": ("", "cycle", "the log's file, <unit>/<name>, relative to the logs folder"),
+    "log_cycles": ("1", "cycle", "cycles in the log, reduced to its record as a simulated day's are"),
+    "log_duration": ("s", "cycle", "recorded time span of the log"),
+    "joint_temperature": ("degC", "cycle, axis", "the log's mean joint temperature"),
+    "payload_mass": ("kg", "cycle", "the largest payload mass in the log"),
+}
+#: The :data:`MEASURED_ARRAYS` an imported run holds only when its logs have them.
+MEASURED_OPTIONAL = ("joint_temperature", "payload_mass")
+#: The simulated truths a measured run lacks.
+SIMULATED_TRUTH = ("mean_friction_torque", "tracking_error")
+#: The ``source`` attribute of a run imported from measured logs (absent: simulated).
+MEASURED = "measured"
+
 #: Attributes every run group carries.
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
@@ -555,7 +577,8 @@ def _attribute_problems(group: h5py.Group) -> list[str]:
     checks = {
         "robot": (lambda v: isinstance(v, str) and bool(v), "a robot name"),
         "task": (lambda v: isinstance(v, str) and bool(v), "a task name"),
-        "friction_model": (lambda v: v in friction.MODELS, f"one of {', '.join(friction.MODELS)}"),
+        "friction_model": (lambda v: v in friction.MODELS or (v == MEASURED and attrs.get("source") == MEASURED),
+                           f"one of {', '.join(friction.MODELS)}"),
         "cycles": (lambda v: whole(v) and v >= 1, "a whole number >= 1"),
         "seed": (lambda v: whole(v) and v >= 0, "a whole number >= 0"),
         "worn_axes": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu"
@@ -563,7 +586,8 @@ def _attribute_problems(group: h5py.Group) -> list[str]:
         "log_period": (lambda v: isinstance(v, (float, np.floating)) and np.isfinite(v) and v > 0,
                        "a positive number of seconds"),
         "signals": (lambda v: isinstance(v, (bool, np.bool_)), "true or false"),
-        "sample": (lambda v: v in ("cycle", "day"), "'cycle' or 'day'"),
+        "sample": (lambda v: v in ("cycle", "day", "log"), "'cycle', 'day' or 'log'"),
+        "source": (lambda v: v == MEASURED, f"{MEASURED!r} (absent for a simulated run)"),
         "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
                       "a list of axes"),
     }
@@ -622,6 +646,11 @@ def _validate_run(group: h5py.Group) -> list[str]:
     if "fault" in group.attrs:
         schema.update(FAULT_ARRAYS)
     schema.update({name: spec for name, spec in {**DUTY_ARRAYS, **COUNT_ARRAYS}.items() if name in group})
+    if _attr(group.attrs.get("source")) == MEASURED:
+        for name in SIMULATED_TRUTH:
+            del schema[name]
+        schema.update({name: spec for name, spec in MEASURED_ARRAYS.items()
+                       if name not in MEASURED_OPTIONAL or name in group})
     if sum(name in group for name in DUTY_ARRAYS) == 1:
         problems.append(f"has one of the duty arrays {', '.join(DUTY_ARRAYS)} but not the other")
     missing = [name for name in schema if name not in group]
@@ -639,7 +668,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
         except (OSError, RuntimeError) as err:
             problems.append(f"{name}: cannot be read ({err}); the file is corrupted")
             return problems
-        if not np.all(np.isfinite(data[name])):
+        if data[name].dtype.kind in "fiu" and not np.all(np.isfinite(data[name])):
             problems.append(f"{name}: holds non-finite values")
     n_cycles, n_log = len(data["cycles"]), len(data["t"])
     n_axes, robot_problems = _robot_attributes(group, data)
@@ -667,6 +696,10 @@ def _validate_run(group: h5py.Group) -> list[str]:
         if name in data and (data[name].dtype.kind != "u" or not _counts_fit(data[name].sum(axis=-1), n_log, data,
                                                                             conditions, _attr(group.attrs.get("task")))):
             problems.append(f"{name}: not counts of the {n_log} samples of each cycle")
+    if "label" in data and not np.all(np.isin(data["label"], (-1, 0, 1))):
+        problems.append("label: not -1 (unknown), 0 (healthy) or 1 (worn)")
+    if "stamp_key" in data and np.any(np.diff(data["stamp_key"]) <= 0):
+        problems.append("stamp_key: the logs are not in increasing stamp order")
     for name in ("friction_multiplier", "dry_friction_factor", "viscous_factor", "link_mass_factor"):
         if name in data and np.any(data[name] <= 0):
             problems.append(f"{name}: not positive")
@@ -744,7 +777,9 @@ def summary(path: str | Path) -> str:
         n_log = [runs[r]["t"].shape[0] for r in runs]
         version, command = _attr(f.attrs.get("faultgen_version")), _attr(f.attrs.get("command", ""))
     worn = sorted({tuple(int(a) for a in row["worn_axes"]) for row in rows})
-    daily = any(row.get("sample") == "day" for row in rows)
+    daily = any(row.get("sample") in ("day", "log") for row in rows)
+    logs = any(row.get("sample") == "log" for row in rows)
+    what, record = ("logs", "log records") if logs else ("days", "daily records") if daily else ("cycles", "recorded")
     signals = all(row.get("signals", True) for row in rows)
     lines = [
         f"{path}: {len(rows)} run(s), {Path(path).stat().st_size / 1e6:.1f} MB, written by faultgen {version}",
@@ -753,8 +788,8 @@ def summary(path: str | Path) -> str:
         f"  friction:      {', '.join(sorted({r['friction_model'] for r in rows}))}",
         f"  worn axes:     {', '.join('none' if not w else '+'.join(map(str, w)) for w in worn)}",
         f"  seeds:         {', '.join(map(str, sorted({int(r['seed']) for r in rows})))}",
-        f"  {'days' if daily else 'cycles'}:{' ' * (14 - (4 if daily else 6))}{min(n_cycles)}-{max(n_cycles)} "
-        f"{'daily records' if daily else 'recorded'} per run, {sum(n_cycles)} in all; "
+        f"  {what}:{' ' * (14 - len(what))}{min(n_cycles)}-{max(n_cycles)} "
+        f"{record} per run, {sum(n_cycles)} in all; "
         + (f"{min(n_log)}-{max(n_log)} samples per cycle at {1 / sensors.LOG_PERIOD:.0f} Hz" if signals
            else "features and truth only (no 250 Hz signals)"),
     ]
@@ -765,6 +800,10 @@ def summary(path: str | Path) -> str:
     if saturated:
         lines.append(f"  saturated:     {len(saturated)} run(s) whose motors reached their torque limit (they do not "
                      "follow their task; `faultgen validate` lists them)")
+    measured = [row for row in rows if row.get("source") == MEASURED]
+    if measured:
+        lines.append(f"  measured:      {len(measured)} unit(s) imported from logs (`faultgen logs import`): labels from "
+                     "their events, no simulated truth")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)

@@ -10,6 +10,11 @@ column         unit     meaning
 ``q1..qN``     rad      arm-side joint angles (N the robot's axes, 5..7)
 ``tau1..tauN`` N m      arm-side joint torque (motor torque referred through the gear ratio)
 ``qd1..qdN``   rad/s    optional: joint velocities; estimated from ``q`` when absent
+``temperature1..N``  degC  optional: joint temperatures (all N or none; read, not used by the
+                       calibration: an imported fleet stores them, :mod:`faultgen.data.fleetlogs`)
+``payload``    kg       optional: mass of the part carried
+``cycle``      1        optional: the cycle each sample belongs to (whole numbers, never
+                       decreasing): a log of several cycles (:mod:`faultgen.data.fleetlogs`)
 =============  =======  ==================================================================
 
 stored as
@@ -72,6 +77,8 @@ from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE 
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
 from faultgen.derivatives import savgol_window as _savgol_window
+from faultgen.effects.payload import Payload
+from faultgen.effects.temperature import Temperature
 from faultgen.model import robots
 
 #: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
@@ -94,6 +101,19 @@ def _required(n_axes: int) -> tuple[str, ...]:
 UNITS = {T_COLUMN: "s"}
 for _q, _qd, _tau in zip(*column_names(axes.MAX_AXES), strict=True):
     UNITS.update({_q: "rad", _qd: "rad/s", _tau: "N m"})
+#: The optional columns of operating conditions are named as the effects that model them
+#: (:mod:`faultgen.effects`): ``temperature1..N`` (all N or none), the joint temperatures, and
+#: ``payload``, the payload mass; ``cycle`` is the cycle number of each sample.
+TEMPERATURE_PREFIX, PAYLOAD_COLUMN, CYCLE_COLUMN = Temperature.id, Payload.id, "cycle"
+
+
+def temperature_columns(n_axes: int) -> tuple[str, ...]:
+    """The joint-temperature columns of a robot of ``n_axes`` axes: ``temperature1..N``."""
+    return tuple(TEMPERATURE_PREFIX + str(i) for i in range(1, n_axes + 1))
+
+
+UNITS.update({name: "degC" for name in temperature_columns(axes.MAX_AXES)})
+UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
@@ -145,6 +165,12 @@ class MeasuredData:
         True when ``qd`` was estimated from ``q`` (the file had no ``qd`` columns).
     robot : str
         Name of the robot the data was checked against.
+    joint_temperature : ndarray of shape (n, N) or None
+        Joint temperatures in degC (the file's ``temperature1..N`` columns), None without.
+    payload_mass : ndarray of shape (n,) or None
+        Payload mass in kg (the ``payload`` column), None without.
+    cycle : ndarray of int of shape (n,) or None
+        The cycle of each sample (the ``cycle`` column: whole, never decreasing), None without.
     notes : tuple of str
         Remarks that did not refuse the data: ignored extra columns, the derivative filter
         used, resampling, sampling gaps, suspicious torque magnitudes.
@@ -161,6 +187,9 @@ class MeasuredData:
     velocity_estimated: bool
     robot: str = ""
     notes: tuple[str, ...] = field(default=())
+    joint_temperature: np.ndarray | None = None
+    payload_mass: np.ndarray | None = None
+    cycle: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         t = np.array(self.t, dtype=float)
@@ -175,6 +204,15 @@ class MeasuredData:
                 raise ValueError(f"{name} must have shape ({t.shape[0]}, N) alike, got {arr.shape}")
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
+        for name, shape, dtype in (("joint_temperature", (t.shape[0], n_axes), float),
+                                   ("payload_mass", (t.shape[0],), float),
+                                   ("cycle", (t.shape[0],), np.int64)):
+            if getattr(self, name) is not None:
+                arr = np.array(getattr(self, name), dtype=dtype)
+                if arr.shape != shape:
+                    raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
+                arr.setflags(write=False)
+                object.__setattr__(self, name, arr)
         object.__setattr__(self, "source", Path(self.source))
         object.__setattr__(self, "notes", tuple(self.notes))
 
@@ -438,6 +476,9 @@ def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str
             f"give all of qd1..qd{n} or none (then they are estimated from q)"
         )
     wanted = [*_required(n), *qd_present]
+    if all(c in present for c in temperature_columns(n)):  # some of them only: ignored, named as extra
+        wanted += temperature_columns(n)
+    wanted += [c for c in (PAYLOAD_COLUMN, CYCLE_COLUMN) if c in present]
     extra = [n for n in names if n not in wanted]
     return wanted, extra
 
@@ -597,6 +638,9 @@ def _build(
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
         notes.extend(_check_velocities(where, qd, qd_est, window))
     notes.extend(_torque_notes(tau, robot))
+    temperature = (np.column_stack([columns[c] for c in temperature_columns(robot.n_axes)])
+                   if temperature_columns(robot.n_axes)[0] in columns else None)
+    cycle = _cycles(where, columns[CYCLE_COLUMN], label) if CYCLE_COLUMN in columns else None
 
     return MeasuredData(
         t=t,
@@ -608,7 +652,25 @@ def _build(
         velocity_estimated=estimated,
         robot=robot.name,
         notes=tuple(notes),
+        joint_temperature=temperature,
+        payload_mass=columns.get(PAYLOAD_COLUMN),
+        cycle=cycle,
     )
+
+
+def _cycles(where: Path, values: np.ndarray, label) -> np.ndarray:
+    """The ``cycle`` column as whole numbers that never decrease, or refused at the first row that is not."""
+    fractional = np.flatnonzero(values != np.round(values))
+    if fractional.size:
+        i = int(fractional[0])
+        raise MeasuredDataError(f"{where}: {label(i)}, column {CYCLE_COLUMN}: value {values[i]!r}; expected a whole "
+                                "cycle number")
+    back = np.flatnonzero(np.diff(values) < 0)
+    if back.size:
+        i = int(back[0]) + 1
+        raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN} goes back at {label(i)}: {values[i]:g} after "
+                                f"{values[i - 1]:g}; expected the samples of each cycle together, cycles in order")
+    return values.astype(np.int64)
 
 
 def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> None:

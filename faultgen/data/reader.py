@@ -70,12 +70,16 @@ class Run:
         Operating conditions (``faultgen.operation.conditions``), None without.
     noise : dict
         Sensor noise settings.
-    sample : {"cycle", "day"}
-        What a recorded sample is: one cycle, or a day's record (fleets).
+    sample : {"cycle", "day", "log"}
+        What a recorded sample is: one cycle, a day's record (fleets), or a log's record (a fleet
+        imported from measured logs, ``faultgen logs import``).
     has_signals : bool
         Whether the 250 Hz signals are stored (False: features and truth only).
     provenance : dict
         faultgen_version, model_sha256, log_period (s), command, config (parsed JSON).
+    measured : bool
+        True for a unit imported from measured logs (``faultgen logs import``): its records are
+        logs, its wear the labels of its events (:data:`faultgen.data.dataset.MEASURED_ARRAYS`).
     """
 
     id: str
@@ -92,6 +96,7 @@ class Run:
     sample: str
     has_signals: bool
     provenance: dict = field(repr=False)
+    measured: bool = False
     _source: Dataset | None = field(default=None, repr=False, compare=False)
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -191,7 +196,7 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
                     "model_sha256": str(attrs.get("model_sha256", "")),
                     "log_period": float(attrs.get("log_period", np.nan)), "command": str(attrs.get("command", "")),
                     "config": config},
-        _source=source)
+        measured=attrs.get("source") == dataset.MEASURED, _source=source)
 
 
 class Dataset(Sequence):
@@ -269,7 +274,7 @@ class Dataset(Sequence):
     @property
     def kind(self) -> str:
         """"fleet" (daily records of robots, `faultgen fleet`), "sweep" or "run" (one run)."""
-        if isinstance(self.grid, dict) and "fleet" in self.grid or any(r.sample == "day" for r in self.runs):
+        if isinstance(self.grid, dict) and "fleet" in self.grid or any(r.sample in ("day", "log") for r in self.runs):
             return "fleet"
         return "sweep" if len(self.runs) > 1 or self.grid else "run"
 
@@ -318,7 +323,8 @@ class Dataset(Sequence):
                        "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
                        "wear_pct": run.wear.ravel()}
             duty = list(dataset.DUTY_ARRAYS) if run.has(*dataset.DUTY_ARRAYS) else []
-            columns.update({name: run.array(name).ravel() for name in (*per_cycle, *duty)})
+            columns.update({name: run.array(name).ravel() if run.has(name) else np.full(n_cycles * n_axes, np.nan)
+                            for name in (*per_cycle, *duty)})  # an imported run has no simulated truth: NaN
             for name in dataset._condition_arrays(run.conditions):  # per cycle, per axis or per unit, to rows
                 values, axes = run.array(name), dataset.CONDITION_ARRAYS[name][1]
                 columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)

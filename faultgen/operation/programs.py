@@ -594,6 +594,20 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
     )
 
 
+def robot_limits(robot: Robot | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The joint velocity, acceleration and jerk limits of a robot folder (its ``tasks.toml``
+    ``[limits]``), rad/s, rad/s^2, rad/s^3, each of shape (N,): the limits the thesis tasks are
+    planned to, and the speed histogram's design maximum of their per-cycle features.
+
+    Raises
+    ------
+    ProgramError
+        If the folder has no ``tasks.toml`` or its ``[limits]`` are missing or malformed.
+    """
+    robot = robot if isinstance(robot, Robot) else robots.load(robot)
+    return _limits({}, robot, f"{robot.name} limits")
+
+
 def _limits(data: dict, robot: Robot, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The program's ``[limits]``, else the robot folder's ``tasks.toml`` ones, in rad."""
     table, origin = data.get("limits"), where

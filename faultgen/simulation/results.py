@@ -164,11 +164,9 @@ def daily_record(result: RunResult) -> RunResult:
     n_days = len(result.cycles) // per_day
 
     def days(a, reduce=np.max):
-        return reduce(np.asarray(a)[: n_days * per_day].reshape(n_days, per_day, *np.shape(a)[1:]), axis=1)
+        return sensors.by_day(a, per_day, reduce)
 
-    features = {name: days(v) for name, v in result.features.items()}
-    for name in sensors.HISTOGRAMS:
-        features[name] = features[name] / features[name].sum(axis=-1, keepdims=True)
+    features = sensors.daily_features(result.features, per_day)
     conditions = result.conditions
     if conditions is not None:
         first = {name: getattr(conditions, name)[::per_day][:n_days] for name in ("day", "payload_part", "task_index")}

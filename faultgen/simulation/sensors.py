@@ -188,6 +188,39 @@ def cycle_features(q_a: np.ndarray, qd_a: np.ndarray, tau_m: np.ndarray, joint_r
     }
 
 
+def daily_features(features: dict[str, np.ndarray], per_day: int) -> dict[str, np.ndarray]:
+    """The remote-monitoring record of each day from its cycles' :func:`cycle_features` (thesis
+    ch. 5.3.2): of each ``per_day`` consecutive cycles the largest value of every feature, histogram
+    bins too, each histogram then scaled back to a sum of 1. A simulated fleet's daily records
+    (:func:`faultgen.simulation.results.daily_record`) and an imported log's record
+    (:mod:`faultgen.data.fleetlogs`, a log's cycles as one day) both come from here.
+
+    Parameters
+    ----------
+    features : dict of ndarray
+        Per-cycle features, each of shape (n_cycles, ...).
+    per_day : int
+        Cycles per day; trailing cycles that do not fill a day are dropped.
+
+    Returns
+    -------
+    dict of ndarray
+        The same names, each of shape (n_cycles // per_day, ...).
+    """
+    out = {name: by_day(value, per_day) for name, value in features.items()}
+    for name in HISTOGRAMS:
+        if name in out:
+            out[name] = out[name] / out[name].sum(axis=-1, keepdims=True)
+    return out
+
+
+def by_day(values: np.ndarray, per_day: int, reduce=np.max) -> np.ndarray:
+    """``reduce`` (default the largest value) over each ``per_day`` consecutive rows of ``values``
+    (n_cycles, ...) -> (n_cycles // per_day, ...); trailing rows that do not fill a day are dropped."""
+    n_days = len(values) // per_day
+    return reduce(np.asarray(values)[: n_days * per_day].reshape(n_days, per_day, *np.shape(values)[1:]), axis=1)
+
+
 #: Life exponent ``p`` of the average load torque: 10/3, that of roller bearings (ISO 281), the
 #: cross-roller output bearings of robot reducers (Harmonic Drive SHG manual, table 42.4).
 LOAD_EXPONENT = 10.0 / 3.0

@@ -1,0 +1,407 @@
+"""A fleet's measured logs as a faultgen dataset (``faultgen logs import``).
+
+A folder of logs (:mod:`faultgen.data.logfolder`: ``LOGS/<unit>/<stamp>.csv|.csv.gz|.h5`` and an
+optional ``LOGS/events.csv``) becomes a dataset like a simulated fleet's (``faultgen fleet``):
+one run per unit, one record per log in stamp order, so that ``validate``, ``info``, ``plot`` and
+every analysis command read it as they read a fleet.
+
+The record of a log is computed by the code that makes a simulated fleet's daily records: each
+cycle of the log (its ``cycle`` column; without one the log is one cycle) goes through
+:func:`faultgen.simulation.sensors.cycle_features` (the motor torque is the log's arm-side torque
+divided by the gear ratio; the histograms' design ranges are the robot's joint range, the velocity
+limit of its folder's ``tasks.toml`` and its peak motor torque, as for its simulated tasks), and
+the log's cycles are reduced to one record by :func:`faultgen.simulation.sensors.daily_features`,
+as a simulated day's cycles are.
+
+What an imported run holds beside the features (docs/dataset.md, "An imported fleet"):
+``label`` (per log and axis: 1 worn, 0 healthy, -1 unknown, from the events), ``stamp``,
+``stamp_key``, ``log_cycles``, ``log_duration`` and, when every log of the unit has them,
+``joint_temperature`` (mean over the log) and ``payload_mass`` (its largest value);
+:data:`faultgen.data.dataset.MEASURED_ARRAYS`. No truth is measured: ``friction_multiplier`` holds
+the labels as every analysis reads a wear (:data:`WORN_MARK` on worn logs, 1 elsewhere) and the
+simulated truths ``mean_friction_torque`` and ``tracking_error`` are absent.
+
+The dataset keeps a manifest (``/import``: each imported file's name and SHA-256): importing again
+into the same output imports only the files that are new, keeps the records of the others (also
+of files no longer in the folder), and refuses a file whose content changed since it was imported
+(naming it), unless ``reimport_changed``. Every write is atomic
+(:func:`faultgen.data.atomic.hdf5_writer`): a failure or a kill leaves the previous dataset as it
+was, and no file that looks complete.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+from tqdm.auto import tqdm
+
+from faultgen import __version__
+from faultgen.data import dataset, logfolder, measured
+from faultgen.data.atomic import check_writable, hdf5_writer
+from faultgen.model import robots
+from faultgen.operation import programs
+from faultgen.simulation import sensors
+
+#: ``friction_multiplier`` of a log labelled worn: a mark, not a measured wear (100 % to an analysis
+#: that reads it as a wear; healthy and unknown logs hold 1).
+WORN_MARK = 2.0
+#: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
+MEASURED = dataset.MEASURED
+#: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
+SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
+#: The group of the manifest in an imported dataset.
+MANIFEST = "import"
+
+#: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.data.measured.read`, or an
+#: adapter's, :mod:`faultgen.data.adapters`).
+Reader = Callable[[Path, robots.Robot], measured.MeasuredData]
+
+
+@dataclass
+class ImportSummary:
+    """What an import did.
+
+    Attributes
+    ----------
+    out : Path
+    robot : str
+    units : int
+        Runs in the dataset.
+    imported : list of str
+        Logs read now (``<unit>/<file>``), re-imported changed ones included.
+    kept : int
+        Records kept from the previous import (their files unchanged, or gone from the folder).
+    gone : list of str
+        Of them, the logs whose files are no longer in the folder.
+    reimported : list of str
+        Logs whose content changed since their import, imported again (``reimport_changed``).
+    skipped : list of (str, str)
+        Bad files passed over (``skip_bad``): name and reason.
+    labels : dict
+        Logs with a worn axis, logs all healthy, the others (unknown), over the whole dataset.
+    written : bool
+        False when nothing was new (the dataset was left as it was).
+    """
+
+    out: Path
+    robot: str
+    units: int = 0
+    imported: list[str] = field(default_factory=list)
+    kept: int = 0
+    gone: list[str] = field(default_factory=list)
+    reimported: list[str] = field(default_factory=list)
+    skipped: list[tuple[str, str]] = field(default_factory=list)
+    labels: dict = field(default_factory=dict)
+    written: bool = True
+
+    def __str__(self) -> str:
+        records = len(self.imported) + self.kept
+        lines = [f"{self.out}: {self.units} unit(s), {records} log record(s) of {self.robot}"
+                 + ("" if self.written else " (nothing new: left as it was)"),
+                 f"  imported now:  {len(self.imported)}"
+                 + (f" ({len(self.reimported)} changed since their import, imported again)" if self.reimported else ""),
+                 f"  kept:          {self.kept} imported before" + (f", {len(self.gone)} of them no longer in the folder"
+                                                                    if self.gone else "")]
+        if self.labels:
+            lines.append(f"  labels:        {self.labels.get('worn', 0)} worn, {self.labels.get('healthy', 0)} healthy, "
+                         f"{self.labels.get('unknown', 0)} unknown (events.csv; logs without an event are unknown)")
+        if self.skipped:
+            lines.append(f"  skipped:       {len(self.skipped)} bad file(s):")
+            lines += [f"    {name}: {reason}" for name, reason in self.skipped]
+        return "\n".join(lines)
+
+
+def sha256(path: Path) -> str:
+    """SHA-256 of a file's content, hex, read in blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np.ndarray) -> dict[str, np.ndarray]:
+    """The record of one log: its cycles' :func:`~faultgen.simulation.sensors.cycle_features`,
+    reduced to one by :func:`~faultgen.simulation.sensors.daily_features` (module docstring).
+
+    Parameters
+    ----------
+    data : MeasuredData
+        The log, checked (:func:`faultgen.data.measured.read`).
+    robot : Robot
+        Its robot: gear ratio (arm-side torque -> motor torque), joint range, peak motor torque.
+    speed_limit : ndarray of shape (N,)
+        The speed histogram's design maximum, rad/s (:func:`faultgen.operation.programs.robot_limits`).
+
+    Returns
+    -------
+    dict of ndarray
+        The fleet's per-record features, each of shape (1, N) or (1, N, 12), and ``log_cycles``
+        (1,), ``log_duration`` (1,) s, ``joint_temperature`` (1, N) degC and ``payload_mass`` (1,)
+        kg when the log has them.
+    """
+    tau_m = data.tau / robot.gear_ratio  # arm-side torque referred to the motor side
+    if data.cycle is None:
+        slices = [slice(None)]
+    else:
+        starts = np.flatnonzero(np.diff(data.cycle)) + 1
+        edges = [0, *starts.tolist(), len(data.cycle)]
+        slices = [slice(a, b) for a, b in zip(edges, edges[1:])]
+    per_cycle = [sensors.cycle_features(data.q[None, s], data.qd[None, s], tau_m[None, s], robot.joint_range,
+                                        speed_limit, robot.motor_torque_limit) for s in slices]
+    joined = {name: np.concatenate([f[name] for f in per_cycle]) for name in per_cycle[0]}
+    record = sensors.daily_features(joined, len(per_cycle))
+    record["log_cycles"] = np.array([len(slices)])
+    record["log_duration"] = np.array([data.duration])
+    if data.joint_temperature is not None:
+        record["joint_temperature"] = data.joint_temperature.mean(axis=0)[None]
+    if data.payload_mass is not None:
+        record["payload_mass"] = np.array([data.payload_mass.max()])
+    return record
+
+
+def _feature_specs() -> dict[str, tuple[str, str, str]]:
+    """The per-record arrays of a simulated fleet's run that an imported run holds too."""
+    names = ("friction_multiplier", "mean_abs_torque", "rms_torque", "angle_hist", "speed_hist", "torque_hist")
+    return {**{name: dataset.ARRAYS[name] for name in names}, **dataset.DUTY_ARRAYS}
+
+
+class _Previous:
+    """The dataset a previous import wrote at ``out`` (or none): its manifest and its runs' records."""
+
+    def __init__(self, out: Path, robot: robots.Robot):
+        self.files: dict[str, str] = {}
+        self.events_sha256 = ""
+        self.runs: dict[str, dict] = {}
+        self.path = out
+        if not out.exists():
+            return
+        with dataset._open(out) as f:
+            if MANIFEST not in f:
+                raise ValueError(f"{out} exists and is not an imported fleet (no /{MANIFEST} manifest); choose another "
+                                 "-o, or remove it")
+            manifest = f[MANIFEST]
+            name = dataset._attr(manifest.attrs.get("robot"))
+            if name != robot.name or dataset._attr(manifest.attrs.get("model_sha256")) != dataset.model_hash(robot.path):
+                raise ValueError(f"{out} holds logs of robot {name!r} (model {str(manifest.attrs.get('model_sha256'))[:12]}); "
+                                 f"this import is for {robot.name!r} (model {dataset.model_hash(robot.path)[:12]}): "
+                                 "give its robot, or another -o")
+            self.files = dict(zip((n.decode() for n in manifest["file"][()]),
+                                  (h.decode() for h in manifest["sha256"][()]), strict=True))
+            self.events_sha256 = dataset._attr(manifest.attrs.get("events_sha256", ""))
+            self.runs = {unit: {"names": [n.decode() for n in group["log_file"][()]],
+                                "log_period": float(group.attrs["log_period"])} for unit, group in f["runs"].items()}
+
+    def records(self, unit: str) -> dict[str, np.ndarray]:
+        """Every array of a unit's previous run (features only: small), by name."""
+        with dataset._open(self.path) as f:
+            group = f["runs"][unit]
+            return {name: group[name][()] for name in group}
+
+
+def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, progress: bool = True,
+                reimport_changed: bool = False, reader: Reader | None = None, suffixes: tuple[str, ...] = SUFFIXES,
+                command: str = "") -> ImportSummary:
+    """Import a fleet's folder of logs into a faultgen dataset (module docstring), atomically.
+
+    Parameters
+    ----------
+    logs_dir : Path
+        ``LOGS/<unit>/<stamp>.<csv|csv.gz|h5>`` and optionally ``LOGS/events.csv``
+        (:mod:`faultgen.data.logfolder`).
+    out : Path
+        The dataset. If it exists it must be an earlier import of the same robot: the new logs are
+        added to it (module docstring).
+    robot : str, Path or Robot
+        The robot of every unit (a name, a robot folder, or a loaded robot).
+    skip_bad : bool
+        Pass over bad files (not a log, a stamp that does not parse, a log the reader refuses),
+        listing them in the summary; without it the first one is refused.
+    progress : bool
+        A progress bar over the logs read.
+    reimport_changed : bool
+        Import again a file whose content changed since it was imported; without it, refused.
+    reader : callable, optional
+        ``(path, robot) -> MeasuredData`` of one log; default :func:`faultgen.data.measured.read`
+        (an adapter's: :func:`faultgen.data.adapters.reader`).
+    suffixes : tuple of str
+        The file endings of logs (lower case), the reader's.
+    command : str
+        The command line, stored as provenance.
+
+    Returns
+    -------
+    ImportSummary
+
+    Raises
+    ------
+    ValueError
+        For a bad folder layout or events file (:mod:`faultgen.data.logfolder`), a bad log without
+        ``skip_bad`` (its file and row named: :class:`faultgen.data.measured.MeasuredDataError`), a
+        file changed since its import without ``reimport_changed``, an ``out`` that is not an import
+        of this robot, or no log to import at all. Nothing is written.
+    OSError
+        If ``out`` cannot be written (nothing is left at ``out`` but what was there).
+    """
+    logs_dir, out = Path(logs_dir), Path(out)
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    read = reader or measured.read
+    speed_limit = programs.robot_limits(robot)[0]
+    units, not_logs = logfolder.scan(logs_dir, suffixes)
+    if not_logs and not skip_bad:
+        name, reason = not_logs[0]
+        raise ValueError(f"{logs_dir / name}: {reason} (--skip-bad passes over bad files and lists them)")
+    events_path = logs_dir / "events.csv"
+    events = logfolder.read_events(events_path, units, robot.n_axes) if events_path.is_file() else []
+    events_sha = sha256(events_path) if events_path.is_file() else ""
+    previous = _Previous(out, robot)
+    summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
+
+    # what each unit's records will be, in stamp order: kept from the previous import, or read now
+    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str]]] = {}
+    for unit, logs in units.items():
+        entries = []
+        for log in logs:
+            digest = sha256(log.path)
+            before = previous.files.get(log.name)
+            if before is None or before == digest:
+                entries.append((log.key, log.name, None if before else log, digest))
+                continue
+            if not reimport_changed:
+                raise ValueError(f"{log.path} changed since it was imported into {out} (SHA-256 {before[:12]}... then, "
+                                 f"{digest[:12]}... now); put the imported content back, or give --reimport-changed "
+                                 "to import it again")
+            summary.reimported.append(log.name)
+            entries.append((log.key, log.name, log, digest))
+        plan[unit] = entries
+    present = {log.name for logs in units.values() for log in logs}
+    for unit, run in previous.runs.items():  # records whose files left the folder: kept
+        gone = [name for name in run["names"] if name not in present]
+        summary.gone += gone
+        if gone:
+            plan.setdefault(unit, [])
+    new = [entry for entries in plan.values() for entry in entries if entry[2] is not None]
+    if previous.files and not new and events_sha == previous.events_sha256:
+        summary.written = False
+        summary.kept = len(previous.files)
+        summary.units = len(previous.runs)
+        return summary
+    check_writable(out)
+
+    manifest: dict[str, str] = {}
+    with hdf5_writer(out) as f, tqdm(total=len(new), desc="import", unit="log", disable=not progress) as bar:
+        dataset._write_root(f, 0, command, "")
+        f.attrs["complete"] = False
+        runs = f.create_group("runs")
+        for unit in sorted(plan):
+            old = previous.records(unit) if unit in previous.runs else None
+            rows = _rows(unit, plan[unit], old, read, robot, speed_limit, skip_bad, summary, bar)
+            if not rows:
+                continue
+            unit_events = [e for e in events if e.unit == unit]
+            period = previous.runs.get(unit, {}).get("log_period", sensors.LOG_PERIOD)
+            _write_unit(runs, unit, rows, robot, unit_events, command, summary, period)
+            manifest.update({row["log_file"]: row["sha256"] for row in rows})
+        if not len(runs):
+            raise ValueError(f"{logs_dir}: no log could be imported ({len(summary.skipped)} bad file(s): "
+                             f"{summary.skipped[0][0] if summary.skipped else 'none'}...)")
+        f.attrs["n_runs"] = len(runs)
+        group = f.create_group(MANIFEST)
+        names = sorted(manifest)
+        group.create_dataset("file", data=np.array(names, dtype=object), dtype=h5py.string_dtype())
+        group.create_dataset("sha256", data=np.array([manifest[n] for n in names], dtype=object),
+                             dtype=h5py.string_dtype())
+        group.attrs.update({"robot": robot.name, "model_sha256": dataset.model_hash(robot.path),
+                            "logs": str(logs_dir.resolve()), "events_sha256": events_sha,
+                            "faultgen_version": __version__})
+        f.attrs["complete"] = True
+    summary.units = len(plan)
+    return summary
+
+
+def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) -> list[dict]:
+    """A unit's records in stamp order: kept ones from ``old`` (the previous run's arrays), new ones
+    read (one log at a time); bad logs refused, or with ``skip_bad`` listed and passed over."""
+    position = {} if old is None else {name.decode(): i for i, name in enumerate(old["log_file"])}
+    rows = []
+    kept_names = set()
+    for key, name, log, digest in sorted(entries, key=lambda e: e[0]):
+        if log is None:
+            i = position[name]
+            rows.append({**{k: v[i:i + 1] for k, v in old.items() if _per_record(k, v, old)},
+                         "log_file": name, "sha256": digest, "stamp": old["stamp"][i].decode(), "key": key})
+            kept_names.add(name)
+            summary.kept += 1
+            continue
+        try:
+            data = read(log.path, robot)
+        except ValueError as err:  # MeasuredDataError and an adapter's refusals: the file and row named
+            if not skip_bad:
+                raise
+            summary.skipped.append((name, str(err).removeprefix(f"{log.path}: ")))
+            bar.update()
+            continue
+        rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,
+                     "key": key, "period": data.sample_period})
+        summary.imported.append(name)
+        bar.update()
+    if old is not None:  # records of files no longer in the folder: kept, in stamp order
+        for name, i in position.items():
+            if name not in kept_names and name not in {r["log_file"] for r in rows}:
+                rows.append({**{k: v[i:i + 1] for k, v in old.items() if _per_record(k, v, old)}, "log_file": name,
+                             "sha256": "", "stamp": old["stamp"][i].decode(), "key": float(old["stamp_key"][i])})
+                summary.kept += 1
+        rows.sort(key=lambda r: r["key"])
+    return rows
+
+
+def _per_record(name: str, value: np.ndarray, old: dict) -> bool:
+    """Whether an array of a previous run has one row per record (what a kept record carries over)."""
+    return name not in ("t", "q_ref", "cycles", "label", "stamp", "stamp_key", "log_file", "friction_multiplier") \
+        and np.ndim(value) >= 1 and len(value) == len(old["cycles"])
+
+
+def _write_unit(runs: h5py.Group, unit: str, rows: list[dict], robot: robots.Robot, events, command: str,
+                summary: ImportSummary, period: float) -> None:
+    """One unit's run group: its records, its labels, its attributes."""
+    n, n_axes = len(rows), robot.n_axes
+    keys = np.array([row["key"] for row in rows])
+    label = logfolder.labels(keys, events, n_axes)
+    summary.labels["worn"] = summary.labels.get("worn", 0) + int(np.any(label == logfolder.WORN, axis=1).sum())
+    summary.labels["healthy"] = summary.labels.get("healthy", 0) + int(np.all(label == logfolder.HEALTHY, axis=1).sum())
+    summary.labels["unknown"] = n + summary.labels.get("unknown", 0) - int(np.any(label == logfolder.WORN, axis=1).sum()) \
+        - int(np.all(label == logfolder.HEALTHY, axis=1).sum())
+    group = runs.create_group(unit)
+    arrays = {"t": np.zeros(0), "q_ref": np.zeros((0, n_axes)), "cycles": np.arange(1, n + 1),
+              "friction_multiplier": np.where(label == logfolder.WORN, WORN_MARK, 1.0), "label": label,
+              "stamp": np.array([row["stamp"] for row in rows], dtype=object), "stamp_key": keys,
+              "log_file": np.array([row["log_file"] for row in rows], dtype=object)}
+    names = [*(k for k in _feature_specs() if k != "friction_multiplier"), "log_cycles", "log_duration"]
+    names += [k for k in ("joint_temperature", "payload_mass") if all(k in row for row in rows)]
+    arrays.update({name: np.concatenate([row[name] for row in rows]) for name in names})
+    specs = {**{k: dataset.ARRAYS[k] for k in ("t", "q_ref", "cycles")}, **_feature_specs(), **dataset.MEASURED_ARRAYS}
+    for name, value in arrays.items():
+        units, axes, description = specs[name]
+        if value.dtype == object:
+            ds = group.create_dataset(name, data=value, dtype=h5py.string_dtype())
+        else:
+            ds = group.create_dataset(name, data=value, compression="gzip", compression_opts=4, shuffle=True)
+        ds.attrs.update({"units": units, "axes": axes, "description": description})
+    periods = [row["period"] for row in rows if "period" in row]
+    worn = sorted({k + 1 for k in np.flatnonzero(np.any(label == logfolder.WORN, axis=0))})
+    config = {"import": {"unit": unit, "stamps": rows and logfolder.parse_stamp(rows[0]["stamp"], unit)[1]}}
+    group.attrs.update({
+        "robot": robot.name, "task": MEASURED, "friction_model": MEASURED, "cycles": n,
+        "seed": int(hashlib.sha256(unit.encode()).hexdigest()[:7], 16), "worn_axes": np.array(worn, dtype=int),
+        "wear": json.dumps({}), "noise": json.dumps({}), "faultgen_version": __version__,
+        "model_sha256": dataset.model_hash(robot.path), "n_axes": n_axes,
+        "drivetrain": json.dumps(dataset.drivetrain(robot)),
+        "log_period": float(np.median(periods)) if periods else period,
+        "config": json.dumps(config, sort_keys=True), "command": command, "signals": False, "sample": "log",
+        "source": MEASURED, "unit": unit})

@@ -1,0 +1,269 @@
+"""A fleet's folder of measured logs: its layout, the stamps of its logs, its events and the labels
+they give each log (what :func:`faultgen.data.fleetlogs.import_logs` reads, docs/dataset.md
+"A fleet's logs")::
+
+    LOGS/
+      events.csv                 optional: unit, stamp, event, axis (one row per event)
+      <unit>/<stamp>.csv         one log: one or more cycles in the measured format
+      <unit>/<stamp>.csv.gz      (faultgen.data.measured), or the layout of an adapter
+      <unit>/<stamp>.h5          (faultgen.data.adapters)
+
+``<stamp>`` is an ISO date (``2026-03-01``), an ISO date and time (``2026-03-01T08:30:00``, also
+``2026-03-01T08-30-00`` or ``2026-03-01T0830``, as file names cannot hold ``:`` everywhere; naive
+times are read as UTC) or a sequence number (``17``); one unit's logs use one kind. The logs of
+a unit are taken in stamp order.
+
+Events (``event`` column) and the labels they give (per log and axis: worn, healthy, unknown;
+without events every log is unknown):
+
+==================  =========================================================================
+``onset``           the axis starts wearing at this stamp: its logs from here on are worn
+``failure``         the axis failed at this stamp (a gearbox failure, thesis ch. 5): its log at
+                    or just before the stamp is worn (from an earlier ``onset``: every log since),
+                    and so are its later logs, until a repair
+``repair``,         the axis was repaired or its gearbox replaced at this stamp: its last log
+``gearbox_change``  before it is worn (from an earlier ``onset`` or ``failure``: every log since),
+                    its logs from the stamp on healthy (a new part)
+``healthy``         the axis (empty ``axis``: every axis) was found healthy at this stamp (an
+                    inspection): its logs since its previous event, up to the stamp, are healthy
+==================  =========================================================================
+"""
+
+from __future__ import annotations
+
+import csv
+import re
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import axes
+
+#: The events of ``events.csv`` (module docstring).
+EVENTS = ("onset", "failure", "repair", "gearbox_change", "healthy")
+#: The columns of ``events.csv``, in order.
+EVENT_COLUMNS = ("unit", "stamp", "event", "axis")
+#: Per log and axis: the label codes of an imported dataset's ``label`` array.
+UNKNOWN, HEALTHY, WORN = -1, 0, 1
+#: Stamp kinds: a date or date-time (key: seconds since 1970-01-01 UTC) or a sequence number.
+TIME, SEQUENCE = "time", "sequence"
+
+_DATE_TIME = re.compile(r"(\d{4}-\d{2}-\d{2})(?:[T_ ](\d{2})[-:]?(\d{2})(?:[-:]?(\d{2}(?:\.\d+)?))?)?")
+
+
+@dataclass(frozen=True)
+class LogFile:
+    """One log of the folder.
+
+    Attributes
+    ----------
+    unit : str
+        The unit's folder name.
+    stamp : str
+        The stamp as written in the file name.
+    key : float
+        The stamp as a number that sorts them: seconds since 1970-01-01 UTC, or the sequence number.
+    kind : {"time", "sequence"}
+    path : Path
+    name : str
+        The path relative to the folder (``<unit>/<file>``), what the manifest records.
+    """
+
+    unit: str
+    stamp: str
+    key: float
+    kind: str
+    path: Path
+    name: str
+
+
+@dataclass(frozen=True)
+class Event:
+    """One row of ``events.csv``: ``axis`` 1..N, or 0 for every axis (a ``healthy`` event only)."""
+
+    unit: str
+    stamp: str
+    key: float
+    kind: str
+    event: str
+    axis: int
+    line: int
+
+
+def parse_stamp(text: str, where: str) -> tuple[float, str]:
+    """``(key, kind)`` of a stamp (module docstring).
+
+    Raises
+    ------
+    ValueError
+        If ``text`` is neither an ISO date or date-time nor a whole number; names ``where``.
+    """
+    if text.isdigit():
+        return float(int(text)), SEQUENCE
+    match = _DATE_TIME.fullmatch(text)
+    try:
+        if match is None:
+            moment = datetime.fromisoformat(text)
+        else:
+            day, hour, minute, second = match.groups()
+            moment = datetime.fromisoformat(day if hour is None else f"{day}T{hour}:{minute}:{second or '00'}")
+    except ValueError:
+        raise ValueError(f"{where}: stamp {text!r} is neither an ISO date (2026-03-01), an ISO date and time "
+                         "(2026-03-01T08:30:00 or 2026-03-01T08-30-00) nor a sequence number (17)") from None
+    if moment.tzinfo is None:
+        moment = moment.replace(tzinfo=timezone.utc)
+    return moment.timestamp(), TIME
+
+
+def stamp_of(name: str, suffixes: tuple[str, ...]) -> str | None:
+    """The stamp of a log's file name (its name without the first matching suffix), or None if it
+    has none of ``suffixes`` (lower-case, compared case-insensitively)."""
+    lower = name.lower()
+    for suffix in sorted(suffixes, key=len, reverse=True):
+        if lower.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)]
+    return None
+
+
+def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFile]], list[tuple[str, str]]]:
+    """The logs of ``folder``, per unit in stamp order, and the files that are not logs.
+
+    Hidden entries (``.name``) are passed over. A file in a unit folder whose name has none of
+    ``suffixes`` or whose stamp does not parse is returned in the second list as ``(name, reason)``.
+
+    Raises
+    ------
+    ValueError
+        If ``folder`` is not a folder or holds no unit folder; a file other than ``events.csv`` at
+        its top; two logs of one unit with the same stamp; one unit's stamps of both kinds.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"{folder}: no such folder; expected LOGS/<unit>/<stamp>.csv|.csv.gz|.h5")
+    units, bad = {}, []
+    for entry in sorted(folder.iterdir()):
+        if entry.name.startswith("."):
+            continue
+        if entry.is_file():
+            if entry.name != "events.csv":
+                raise ValueError(f"{entry}: a file at the top of the logs folder; expected one folder per unit "
+                                 "(LOGS/<unit>/<stamp>.csv) and optionally events.csv")
+            continue
+        logs = []
+        for path in sorted(entry.iterdir()):
+            if path.name.startswith("."):
+                continue
+            name = f"{entry.name}/{path.name}"
+            stamp = stamp_of(path.name, suffixes) if path.is_file() else None
+            if stamp is None:
+                bad.append((name, f"not a log: expected <stamp>{' or <stamp>'.join(suffixes)}"))
+                continue
+            try:
+                key, kind = parse_stamp(stamp, name)
+            except ValueError as err:
+                bad.append((name, str(err)))
+                continue
+            logs.append(LogFile(entry.name, stamp, key, kind, path, name))
+        kinds = {log.kind for log in logs}
+        if len(kinds) > 1:
+            raise ValueError(f"{entry}: the logs mix dates and sequence numbers as stamps "
+                             f"({next(g.name for g in logs if g.kind == TIME)}, "
+                             f"{next(g.name for g in logs if g.kind == SEQUENCE)}); use one kind per unit")
+        logs.sort(key=lambda g: g.key)
+        for a, b in zip(logs, logs[1:]):
+            if a.key == b.key:
+                raise ValueError(f"{a.name} and {b.name} have the same stamp; keep one log per stamp")
+        units[entry.name] = logs
+    if not units:
+        raise ValueError(f"{folder}: no unit folders; expected LOGS/<unit>/<stamp>.csv|.csv.gz|.h5")
+    return units, bad
+
+
+def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int) -> list[Event]:
+    """The rows of ``events.csv`` (module docstring), checked against the units' logs.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and line: a header other than :data:`EVENT_COLUMNS`, a unit without a folder,
+        a stamp that does not parse or is of another kind than the unit's logs, an unknown event,
+        an axis outside 1..N (empty only for ``healthy``).
+    """
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        raise ValueError(f"{path}: cannot read the events: {err}") from None
+    header = tuple(cell.strip() for cell in rows[0]) if rows else ()
+    if header != EVENT_COLUMNS:
+        raise ValueError(f"{path}: line 1 is {','.join(header) or '(empty)'}; expected the header "
+                         f"{','.join(EVENT_COLUMNS)}")
+    events = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(cell.strip() for cell in row):
+            continue
+        where = f"{path}: line {line}"
+        if len(row) != len(EVENT_COLUMNS):
+            raise ValueError(f"{where}: {len(row)} fields; expected {len(EVENT_COLUMNS)} ({','.join(EVENT_COLUMNS)})")
+        unit, stamp, event, axis = (cell.strip() for cell in row)
+        if unit not in units:
+            raise ValueError(f"{where}: unit {unit!r} has no folder of logs; units: {', '.join(sorted(units))}")
+        key, kind = parse_stamp(stamp, where)
+        logs = units[unit]
+        if logs and kind != logs[0].kind:
+            raise ValueError(f"{where}: stamp {stamp!r} is a {kind} stamp, but the logs of {unit} have {logs[0].kind} "
+                             "stamps")
+        if event not in EVENTS:
+            raise ValueError(f"{where}: event {event!r}; expected one of {', '.join(EVENTS)}")
+        if axis == "" and event == "healthy":
+            number = 0
+        else:
+            try:
+                number = axes.check(int(axis), n_axes)
+            except ValueError:
+                raise ValueError(f"{where}: axis {axis!r}; expected an axis 1..{n_axes}"
+                                 + (" (or empty: every axis)" if event == "healthy" else "")) from None
+        events.append(Event(unit, stamp, key, kind, event, number, line))
+    return events
+
+
+def labels(keys: np.ndarray, events: list[Event], n_axes: int) -> np.ndarray:
+    """Per log and axis, :data:`WORN`, :data:`HEALTHY` or :data:`UNKNOWN` from a unit's events
+    (module docstring), ndarray of int8 of shape (n_logs, N).
+
+    Parameters
+    ----------
+    keys : ndarray of shape (n_logs,)
+        The unit's log stamps (:attr:`LogFile.key`), increasing.
+    events : list of Event
+        The unit's events.
+    """
+    keys = np.asarray(keys, dtype=float)
+    out = np.full((len(keys), n_axes), UNKNOWN, dtype=np.int8)
+    for k in range(n_axes):
+        column = out[:, k]
+        mine = sorted((e for e in events if e.axis in (0, k + 1)), key=lambda e: (e.key, e.line))
+        previous, wearing = -np.inf, False  # the key of the axis's previous event; worn since an onset or failure
+        for event in mine:
+            before = np.flatnonzero(keys <= event.key)
+            if event.event == "onset":
+                column[keys >= event.key] = WORN
+                wearing = True
+            elif event.event == "failure":
+                if not wearing and before.size:
+                    column[before[-1]] = WORN
+                column[keys > event.key] = WORN
+                wearing = True
+            elif event.event in ("repair", "gearbox_change"):
+                earlier = np.flatnonzero(keys < event.key)
+                if not wearing and earlier.size:
+                    column[earlier[-1]] = WORN
+                column[keys >= event.key] = HEALTHY
+                wearing = False
+            else:  # healthy
+                column[(keys > previous) & (keys <= event.key)] = HEALTHY
+            previous = event.key
+    return out
