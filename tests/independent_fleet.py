@@ -63,8 +63,11 @@ VISCOUS_PER_K = 0.02
 #: Torque noise per sample, a share of each axis's torque RMS; angle noise, rad.
 NOISE = 0.005
 ANGLE_NOISE = 1e-5
-#: The parts are aluminium cubes hanging from the flange (their centre half an edge below it, along
-#: the flange's z axis): the load data a robot's program declares, which the monitor is told.
+#: The parts are aluminium cubes hanging from the flange (their centre half an edge from it, along
+#: the z axis of the URDF's ``tool0`` frame, as faultgen's payload condition places a part): the
+#: load data a robot's program declares, which the monitor is told. Their masses (5-35 kg) keep
+#: faultgen's twin of the motion within its drives' capacity (the KR210's axis 6: 366 N m at the arm,
+#: which the twin reached with a 60 kg part, Pinocchio's dynamics needing about 230 N m).
 PART_DENSITY = 2700.0
 #: Axes that may wear (the KR210's axis 6 motor is rated 3 N m: its friction is at the noise floor).
 WEARABLE = (1, 2, 3, 4, 5)
@@ -136,7 +139,7 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
             "onset": int(rng.integers(spec.onset[0], spec.onset[1] + 1)),
             "ambient": float(rng.uniform(17.0, 23.0)), "swing": float(rng.uniform(4.0, 8.0)),
             "rise": rng.uniform(5.0, 15.0, n_axes),
-            "parts": (float(rng.uniform(20.0, 60.0)), float(rng.uniform(80.0, 150.0)), float(rng.uniform(40.0, 180.0))),
+            "parts": (float(rng.uniform(5.0, 15.0)), float(rng.uniform(20.0, 35.0)), float(rng.uniform(10.0, 35.0))),
             "weeks": rng.integers(0, 2, spec.days // 7 + 1),
             "seed": int(rng.integers(2**31)),
             "new_part_day": int(rng.integers(spec.days * 5 // 12, spec.days * 2 // 3 + 1)),

@@ -17,9 +17,9 @@ import pytest
 from faultgen.monitor import loop
 from faultgen.monitor.scoring import Settings
 
-# three units, 30 days; unit 1 healthy, units 2 and 3 by the seed; wear from day 12-13 to 60 % on day 30
-SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=30, seed=5, onset=(12, 13))
-SETTINGS = Settings(train=10, persistence=3)
+# three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
+SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
+SETTINGS = Settings(train=14, persistence=3)
 
 
 @pytest.fixture(scope="module")
@@ -63,7 +63,7 @@ def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
 def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
     robot, logs, _ = fleet
     partial = tmp_path / "logs"
-    keep = 20
+    keep = 25
     for unit in logs.iterdir():
         (partial / unit.name).mkdir(parents=True)
         for log in sorted(unit.iterdir())[:keep]:
@@ -91,7 +91,7 @@ def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path)
     folder.mkdir(parents=True)
     units = sorted(logs.iterdir())
     files = sorted(units[0].iterdir())
-    for log in files[1:12]:
+    for log in files[1:16]:
         os.link(log, folder / log.name)
     loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
     os.link(files[0], folder / files[0].name)
@@ -103,7 +103,7 @@ def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitor
     robot, logs, _ = fleet
     out = tmp_path / "out"
     command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
-               "--no-calibrate", "--train", "10", "--persistence", "3"]
+               "--no-calibrate", "--train", "14", "--persistence", "3"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
     process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 120

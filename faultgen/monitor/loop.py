@@ -45,7 +45,6 @@ class _Unit:
     monitor: UnitMonitor
     model: str
     program: str
-    reference_payload: float
     settings_key: tuple
 
 
@@ -121,25 +120,25 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             first = unit_logs[0]
             model = _model(nominal, settings, calibrated, calibrate, first, cache, name, progress)
             program = _program(nominal, first.path, programs)
-            reference = fleet_logs.read(nominal, first).payload
-            state[name] = _Unit(UnitMonitor(name, settings, nominal.n_axes), model, program, reference, key)
+            state[name] = _Unit(UnitMonitor(name, settings, nominal.n_axes), model, program, key)
         unit = state[name]
         twin = None
         if settings.protocol == "twin":
-            twin_key = (unit.model, unit.program, unit.reference_payload)
+            twin_key = (unit.model, unit.program)
             if twin_key not in twins:
                 bar.set_postfix_str(f"twin of {name}")
-                twins[twin_key] = Twin(unit.model, Path(unit.program), cache / "cycles", unit.reference_payload)
+                twins[twin_key] = Twin(unit.model, Path(unit.program), cache / "cycles")
             twin = twins[twin_key]
             unit.monitor.signatures = twin.signatures
         bar.set_postfix_str(name)
         for log in unit_logs:
             reading = fleet_logs.read(nominal, log)
-            residual = reading.vector
+            residual, expected = reading.vector, None
             if twin is not None:
                 at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
-                residual = residual - twin.expected(at, reading.payload)
-            unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload)
+                expected = twin.expected(at, reading.payload)
+                residual = residual - expected
+            unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
             bar.update()
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]

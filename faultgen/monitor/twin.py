@@ -9,7 +9,7 @@ What the monitor asks of it (:class:`Twin`):
   aluminium cube of that mass hanging from the flange: the log gives the mass only);
 - :attr:`Twin.signatures`: how each axis's wear moves the features, per percent: one cycle with the
   axis's Coulomb and static friction at :data:`WEAR` % above nominal (thesis eq. 6.6's exp4 schedule
-  at its final value), minus the healthy cycle, at the reference conditions.
+  at its final value), minus the healthy cycle, at :data:`REFERENCE_TEMPERATURE` without a part.
 
 Every simulated cycle goes through the same feature code as a measured log
 (:func:`faultgen.monitor.logs.features_of` on the simulated angles and arm-side torque, the
@@ -63,7 +63,7 @@ class Twin:
     """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
     log whose motion is replayed, ``cache`` the folder of simulated cycles (created if needed)."""
 
-    def __init__(self, model: str | Path, program: Path, cache: Path, reference_payload: float = 0.0):
+    def __init__(self, model: str | Path, program: Path, cache: Path):
         self.model = str(model)
         self.robot = robots.load(model)
         self.program = Path(program)
@@ -71,10 +71,10 @@ class Twin:
         self.cache.mkdir(parents=True, exist_ok=True)
         self._files = _key(Path(self.robot.path).read_bytes(), self.program.read_bytes(), FRICTION)
         self._healthy: dict[float, np.ndarray] = {}
-        self.reference_payload = round(float(reference_payload), 1)
-        healthy = self.cycle(REFERENCE_TEMPERATURE, self.reference_payload)
-        #: (N, F): change of each feature per % wear of each axis.
-        self.signatures = np.stack([(self.cycle(REFERENCE_TEMPERATURE, self.reference_payload, axis) - healthy) / WEAR
+        healthy = self.cycle(REFERENCE_TEMPERATURE, 0.0)
+        #: (N, F): change of each feature per % wear of each axis (without a part: the signatures
+        #: are shared by every unit of the model and program).
+        self.signatures = np.stack([(self.cycle(REFERENCE_TEMPERATURE, 0.0, axis) - healthy) / WEAR
                                     for axis in range(1, self.robot.n_axes + 1)])
 
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
@@ -94,9 +94,13 @@ class Twin:
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=conditions.Conditions.from_dict(table), signals=True)
         result = sim.simulate(config, progress=False)
+        if result.saturated.size:
+            raise ValueError(f"the twin of {self.program} with a {payload:g} kg part (aluminium cube at the flange) "
+                             f"saturates the drive of axis {', '.join(map(str, result.saturated))}: the model cannot "
+                             "carry that part along this motion; check the log's payload column (kg) and the model")
         data = measured.from_arrays(result.t, result.q_a[0], result.tau_m[0] * self.robot.gear_ratio, self.robot,
                                     source=f"twin of {self.program.name}")
-        vector = fleet_logs.feature_vector(fleet_logs.features_of(self.robot, data))
+        vector = fleet_logs.features_of(self.robot, data)
         with atomic.atomic_path(path) as tmp:
             with open(tmp, "wb") as f:
                 np.save(f, vector)
