@@ -5,6 +5,7 @@ days, is ``benchmarks/monitor_loop.py`` (docs/analysis.md, "Monitor your own rob
 
 import filecmp
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -37,6 +38,14 @@ def monitored(fleet, tmp_path_factory):
     return out
 
 
+def with_cycles_of(monitored: Path, out: Path) -> Path:
+    """``out`` holding the twin's simulated cycles of ``monitored`` (content-addressed: the same
+    model, program and conditions give the same file), so that a test of the loop's bookkeeping
+    does not simulate them again."""
+    shutil.copytree(monitored / ".cache" / "cycles", out / ".cache" / "cycles")
+    return out
+
+
 def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_healthy_do_not(fleet, monitored):
     _, _, truth = fleet
     outcome = independent_fleet.evaluate(truth, monitored / "alarms.csv")
@@ -52,9 +61,16 @@ def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_hea
 
 
 def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
-    robot, _, _ = fleet
+    """The fleet again from the same seed: identical logs, and identical outputs from them (the
+    twin's cycles taken from the first run: faultgen's simulation repeats itself bit for bit,
+    tests/test_sim.py)."""
+    robot, first_logs, _ = fleet
     _, logs, _ = independent_fleet.write_fleet(tmp_path / "again", SPEC, robot=robot)
-    out = tmp_path / "out"
+    assert sorted(p.relative_to(logs) for p in logs.rglob("*.csv")) == \
+        sorted(p.relative_to(first_logs) for p in first_logs.rglob("*.csv"))
+    for path in logs.rglob("*.csv"):
+        assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
+    out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
     for name in ("alarms.csv", "scores.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
@@ -68,7 +84,7 @@ def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path)
         (partial / unit.name).mkdir(parents=True)
         for log in sorted(unit.iterdir())[:keep]:
             os.link(log, partial / unit.name / log.name)
-    out = tmp_path / "out"
+    out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
     first = (out / "scores.csv").read_text().splitlines()
     assert len(first) == 1 + SPEC.units * keep
@@ -86,34 +102,36 @@ def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path)
 
 def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path):
     robot, logs, _ = fleet
-    out = tmp_path / "out"
+    out = with_cycles_of(monitored, tmp_path / "out")
     folder = tmp_path / "logs" / "unit01"
     folder.mkdir(parents=True)
     units = sorted(logs.iterdir())
     files = sorted(units[0].iterdir())
-    for log in files[1:16]:
+    for log in [files[0], *files[2:16]]:
         os.link(log, folder / log.name)
     loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
-    os.link(files[0], folder / files[0].name)
-    with pytest.raises(ValueError, match=f"{files[0].name}.*older than the last scored log of unit01"):
+    os.link(files[1], folder / files[1].name)
+    with pytest.raises(ValueError, match=f"{files[1].name}.*older than the last scored log of unit01"):
         loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
 
 
 def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
     robot, logs, _ = fleet
-    out = tmp_path / "out"
+    out = with_cycles_of(monitored, tmp_path / "out")
     command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-calibrate", "--train", "14", "--persistence", "3"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
-    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    # killed once it is scoring: its progress bar has counted a log
     deadline = time.monotonic() + 120
-    while not (out / ".cache" / "cycles").is_dir() or not any((out / ".cache" / "cycles").iterdir()):
+    seen = ""
+    while "1/" not in seen and "2/" not in seen:
         assert process.poll() is None and time.monotonic() < deadline, "the monitor ended before it was killed"
-        time.sleep(0.05)
+        seen += process.stderr.read(1)
     process.send_signal(signal.SIGKILL)
     process.wait()
     assert not (out / "alarms.csv").exists() and not (out / "scores.csv").exists()
-    assert not list(out.glob("*.png"))
+    assert not list(out.glob("*.png")) and not (out / ".state").exists()
     result = subprocess.run(command, env=env, capture_output=True, text=True)
     assert result.returncode == 0, result.stderr[-2000:]
     assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
@@ -124,6 +142,6 @@ def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
     with pytest.raises(ValueError, match="protocol = 'magic'"):
         Settings(protocol="magic")
     (tmp_path / "logs").mkdir()
-    with pytest.raises(ValueError, match="no unit folder with a log"):
+    with pytest.raises(ValueError, match="no unit folders"):
         loop.monitor(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False)
     assert not (tmp_path / "out").exists()

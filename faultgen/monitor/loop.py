@@ -28,6 +28,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.data import atomic, measured
+from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import report
@@ -194,14 +195,14 @@ def _model(nominal, settings: Settings, calibrated, calibrate: bool, first, cach
 
 
 def _without_payload(path: Path) -> Path:
-    """The calibrated model without the payload its log carried (``payload*`` bodies, the
-    calibration's ``payload`` effect): the twin carries each log's declared part instead. Written
-    beside it (same assets and ``tasks.toml``) as ``<name>_twin.xml``."""
+    """The calibrated model without the part its log carried (the calibration's payload effect,
+    written again with no mass: :class:`faultgen.effects.payload.Payload` removes its bodies): the
+    twin carries each log's declared part instead. Written beside it (same assets and
+    ``tasks.toml``) as ``<name>_twin.xml``."""
     target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
     if not target.is_file():
         spec = mujoco.MjSpec.from_file(str(path))
-        for body in [b for b in spec.bodies if b.name.startswith("payload")]:
-            spec.delete(body)
+        Payload(mass=0.0).write(spec, robots.load(path))
         atomic.write_text(target, spec.to_xml())
     return target
 
