@@ -199,7 +199,7 @@ def test_a_changed_log_is_named_and_reimported_only_when_asked(logs, tmp_path, p
 
 
 def test_a_killed_import_leaves_no_complete_looking_file_and_the_rerun_finishes(tmp_path, puma):
-    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=2, days=20, suffix=".csv.gz")
+    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=2, days=12, suffix=".csv.gz")
     out = tmp_path / "f.h5"
     env = dict(os.environ, PYTHONPATH=str(Path(__file__).parents[1]))
     command = [sys.executable, "-m", "faultgen.cli", "logs", "import", str(logs), "--robot", "puma560", "-o", str(out)]
@@ -212,7 +212,7 @@ def test_a_killed_import_leaves_no_complete_looking_file_and_the_rerun_finishes(
     assert child.returncode == -signal.SIGKILL, "the import ended before it could be killed"
     assert not out.exists()
     summary = fleetlogs.import_logs(logs, out, robot="puma560", progress=False)
-    assert len(summary.imported) == 40 and dataset.validate(out) == []
+    assert len(summary.imported) == 24 and dataset.validate(out) == []
     assert not list(tmp_path.glob(".f.h5.*.part"))
 
 
@@ -315,3 +315,93 @@ def test_a_training_set_of_another_robot_is_refused(imported, tmp_path):
                                  "--no-progress", "-o", str(tmp_path / "d")])
     assert result.exit_code == 2, result.output
     assert "robots 'irb6700' and 'puma560'" in result.output and "differ in their joint range" in result.output
+
+
+def _signals_frame(puma, day=3):
+    t, q, qd, tau, cycle = fleetlog_folder.log_signals(puma, day, 0, np.zeros(6))
+    return t, q, qd, tau, cycle
+
+
+@pytest.mark.parametrize("layout", ["moment", "current"])
+def test_a_ur_rtde_recording_imports_as_the_same_signals_in_the_measured_format(tmp_path, puma, layout):
+    """The test writes the RTDE recorder's layout (space-separated; timestamp, actual_q_0..5,
+    actual_qd_0..5, target_moment_0..5 or actual_current_0..5, other columns beside) and the same
+    signals in the measured format: the two imports' records are equal."""
+    t, q, qd, tau, _ = _signals_frame(puma)
+    constants = np.array([2.0, 2.5, 3.0, 1.5, 1.0, 0.5])
+    columns = {"timestamp": t, **{f"actual_q_{k}": q[:, k] for k in range(6)},
+               **{f"actual_qd_{k}": qd[:, k] for k in range(6)}, "robot_mode": np.full(len(t), 7)}
+    if layout == "moment":
+        columns.update({f"target_moment_{k}": tau[:, k] for k in range(6)})
+    else:
+        columns.update({f"actual_current_{k}": tau[:, k] / constants[k] for k in range(6)})
+    (tmp_path / "UR" / "cell1").mkdir(parents=True)
+    pd.DataFrame(columns).to_csv(tmp_path / "UR" / "cell1" / "2026-03-01.csv", sep=" ", index=False)
+    (tmp_path / "M" / "cell1").mkdir(parents=True)
+    measured.write_csv(tmp_path / "M" / "cell1" / "2026-03-01.csv", t, q, tau, qd)
+    command = ["logs", "import", str(tmp_path / "UR"), "--robot", "puma560", "--format", "ur-rtde", "-o",
+               str(tmp_path / "ur.h5"), "--no-progress"]
+    if layout == "current":
+        result = runner.invoke(app, command)
+        assert result.exit_code == 2 and "no joint torque" in result.output and "--torque-constants" in result.output
+        command += ["--torque-constants", ",".join(map(str, constants))]
+    result = runner.invoke(app, command)
+    assert result.exit_code == 0, result.output
+    fleetlogs.import_logs(tmp_path / "M", tmp_path / "m.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "ur.h5") as ur, reader.open(tmp_path / "m.h5") as ref:
+        for name in FEATURES:
+            np.testing.assert_allclose(ur["cell1"].array(name), ref["cell1"].array(name), rtol=1e-12, atol=1e-12)
+
+
+def test_a_voraus_ad_parquet_imports_with_its_motor_torque_referred_to_the_arm(tmp_path, puma):
+    """The test writes the voraus-AD layout (time, sample, joint_position_1..6, joint_velocity_1..6,
+    motor_torque_1..6 at the motor, other columns beside) and the same signals in the measured format."""
+    t, q, qd, tau, cycle = _signals_frame(puma)
+    table = {"time": t, "sample": cycle, "anomaly": np.zeros(len(t), bool), "category": np.zeros(len(t), int),
+             **{f"joint_position_{k + 1}": q[:, k] for k in range(6)},
+             **{f"joint_velocity_{k + 1}": qd[:, k] for k in range(6)},
+             **{f"motor_torque_{k + 1}": tau[:, k] / puma.gear_ratio[k] for k in range(6)},
+             **{f"motor_position_{k + 1}": q[:, k] * puma.gear_ratio[k] for k in range(6)}}
+    (tmp_path / "V" / "run7").mkdir(parents=True)
+    pd.DataFrame(table).to_parquet(tmp_path / "V" / "run7" / "1.parquet")
+    (tmp_path / "M" / "run7").mkdir(parents=True)
+    fleetlog_folder.write_log(tmp_path / "M" / "run7" / "1.csv", puma, 3, 0, np.zeros(6))
+    result = runner.invoke(app, ["logs", "import", str(tmp_path / "V"), "--robot", "puma560", "--format", "voraus",
+                                 "-o", str(tmp_path / "v.h5"), "--no-progress"])
+    assert result.exit_code == 0, result.output
+    fleetlogs.import_logs(tmp_path / "M", tmp_path / "m.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "v.h5") as voraus, reader.open(tmp_path / "m.h5") as ref:
+        assert voraus["run7"].array("log_cycles")[0] == 2
+        for name in FEATURES:
+            np.testing.assert_allclose(voraus["run7"].array(name), ref["run7"].array(name), rtol=1e-9, atol=1e-12)
+    bad = pd.DataFrame(table).drop(columns=["motor_torque_4"])
+    bad.to_parquet(tmp_path / "V" / "run7" / "1.parquet")
+    result = runner.invoke(app, ["logs", "import", str(tmp_path / "V"), "--robot", "puma560", "--format", "voraus",
+                                 "-o", str(tmp_path / "v2.h5"), "--no-progress"])
+    assert result.exit_code == 2 and "missing column(s) motor_torque_4 of the voraus-AD layout" in result.output
+
+
+def test_stamps_sort_as_numbers_or_times_and_a_unit_mixing_them_is_refused(tmp_path, puma):
+    unit = tmp_path / "LOGS" / "press7"
+    unit.mkdir(parents=True)
+    for seq in (10, 2, 1):
+        fleetlog_folder.write_log(unit / f"{seq}.csv.gz", puma, seq, 0, np.zeros(6))
+    fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "f.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "f.h5") as data:
+        assert [s.decode() for s in data["press7"].array("stamp")] == ["1", "2", "10"]
+        np.testing.assert_array_equal(data["press7"].array("stamp_key"), [1.0, 2.0, 10.0])
+    timed = tmp_path / "T" / "cell"
+    timed.mkdir(parents=True)
+    for stamp in ("2026-03-01T14-00-00", "2026-03-01T08:30:00", "2026-03-01"):
+        fleetlog_folder.write_log(timed / f"{stamp}.h5", puma, 1, 0, np.zeros(6))
+    fleetlogs.import_logs(tmp_path / "T", tmp_path / "t.h5", robot="puma560", progress=False)
+    with reader.open(tmp_path / "t.h5") as data:
+        assert [s.decode() for s in data["cell"].array("stamp")] == ["2026-03-01", "2026-03-01T08:30:00",
+                                                                    "2026-03-01T14-00-00"]
+    fleetlog_folder.write_log(unit / "2026-03-01.csv", puma, 1, 0, np.zeros(6))
+    with pytest.raises(ValueError, match="mix dates and sequence numbers"):
+        fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "g.h5", robot="puma560", progress=False)
+    (unit / "2026-03-01.csv").unlink()
+    fleetlog_folder.write_log(unit / "2.h5", puma, 1, 0, np.zeros(6))
+    with pytest.raises(ValueError, match="have the same stamp"):
+        fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "g.h5", robot="puma560", progress=False)

@@ -267,7 +267,7 @@ def test_missing_file_unknown_suffix_and_unreadable_files(tmp_path, puma):
     ):
         measured.read(tmp_path / "data.txt", puma)
     (tmp_path / "folder.csv").mkdir()
-    with pytest.raises(MeasuredDataError, match=r"folder\.csv: not a file"):
+    with pytest.raises(MeasuredDataError, match=r"folder\.csv: not a regular file \(a folder\)"):
         measured.read(tmp_path / "folder.csv", puma)
     (tmp_path / "bad.csv").write_bytes(b"\x1f\x8b\x08 cut short")  # gzip magic, then garbage
     with pytest.raises(MeasuredDataError, match=r"bad\.csv: cannot read the file as CSV"):

@@ -38,7 +38,7 @@ from faultgen.calibrate import gearbox, plausibility, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.calibrate.plausibility import ImplausibleLogError
-from faultgen.data import atomic
+from faultgen.data import atomic, longlog
 from faultgen.data import measured as measured_io
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
@@ -214,12 +214,15 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`_calibrate`)."""
     nominal = robots.load(robot)
     if isinstance(measured, measured_io.MeasuredData):
-        data = measured
+        data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)
     else:
         if progress:
             print(f"reading {measured}", flush=True)
-        data = measured_io.read(measured, nominal)
-    _check_motion(data)
+        # a log longer than MAX_ROWS is averaged down while it is read: memory flat in its length
+        data, moves = longlog.read(measured, nominal, MAX_ROWS, search.REST_SPEED)
+        if progress and moves.rows > len(data):
+            print(data.notes[-1], flush=True)
+    _check_motion(data.source, moves)
     if len(data) > MAX_ROWS:
         data = decimate(data, MAX_ROWS)
         if progress:
@@ -249,9 +252,9 @@ def decimate(data: measured_io.MeasuredData, rows: int) -> measured_io.MeasuredD
     m = n // k
 
     def blocks(a: np.ndarray) -> np.ndarray:
-        return a[: m * k].reshape(m, k, *a.shape[1:]).mean(axis=1)
+        return longlog.block_mean(a, k, m)
 
-    note = f"decimated: {n} rows averaged over blocks of {k} to {m} (calibrate.MAX_ROWS = {MAX_ROWS})"
+    note = longlog.decimation_note(n, k, m, MAX_ROWS)
     return measured_io.MeasuredData(t=blocks(data.t), q=blocks(data.q), qd=blocks(data.qd), qdd=blocks(data.qdd),
                                     tau=blocks(data.tau), source=data.source,
                                     velocity_estimated=data.velocity_estimated, robot=data.robot,
@@ -262,16 +265,15 @@ def decimate(data: measured_io.MeasuredData, rows: int) -> measured_io.MeasuredD
 MIN_MOVING = 100
 
 
-def _check_motion(data: measured_io.MeasuredData) -> None:
+def _check_motion(source: Path, moves: longlog.Motion) -> None:
     """Refuse a log on which no joint moves: nothing can be identified (raises ImplausibleLogError
-    naming each joint's largest speed)."""
-    moving = np.sum(np.abs(data.qd) >= search.REST_SPEED, axis=0)
+    naming each joint's largest speed). ``moves``: the log's speeds at its full rate."""
+    moving, peak = moves.moving, moves.peak
     if np.all(moving < MIN_MOVING):
-        peak = np.max(np.abs(data.qd), axis=0) if len(data) else np.zeros(len(moving))
         joints = ", ".join(f"{a} (largest |qd| {v:.2g} rad/s)" for a, v in zip(axes.numbers(range(len(moving))), peak))
         raise ImplausibleLogError(
-            f"{data.source}: no joint moves: joints {joints} stay below {search.REST_SPEED:g} rad/s in all but "
-            f"{int(np.max(moving))} of {len(data)} samples (at least {MIN_MOVING} needed); give a log in which the "
+            f"{source}: no joint moves: joints {joints} stay below {search.REST_SPEED:g} rad/s in all but "
+            f"{int(np.max(moving))} of {moves.rows} samples (at least {MIN_MOVING} needed); give a log in which the "
             "robot moves (an excitation or a task program)")
 
 

@@ -399,4 +399,6 @@ def classify_command(
     stem.with_suffix(".md").write_text(text + "\n")
     benchmark.classification_heatmap(table, stem.with_suffix(".png"), estimate)
     typer.echo(text)
+    typer.echo(f"protocol: units of {file} itself (each pair of held-out runs scored by a model of the others; "
+               "--train OTHER.h5 learns from another dataset)")
     typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import shlex
 import sys
 from pathlib import Path
@@ -13,9 +14,21 @@ from faultgen.cli.base import Command, Group
 from faultgen.cli.main import app
 from faultgen.cli.options import Progress
 
-logs_app = typer.Typer(cls=Group, no_args_is_help=True, add_completion=False, rich_markup_mode=None,
-                       help="Your robots' measured logs: import a fleet's folder of logs into a dataset.")
+logs_app = typer.Typer(cls=Group, no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 app.add_typer(logs_app, name="logs")
+
+
+@logs_app.callback()
+def logs_group() -> None:
+    """Your robots' measured logs: import a fleet's folder of logs (LOGS/<unit>/<stamp>.csv) into a
+    dataset that every command reads (docs/dataset.md, "A fleet's logs").
+
+    Examples:
+
+    \b
+      faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5
+      faultgen detect fleet-logs.h5 --train nominal-fleet.h5
+    """
 
 
 @logs_app.command("import", cls=Command)
@@ -30,6 +43,13 @@ def import_command(
     reimport_changed: Annotated[bool, typer.Option(
         "--reimport-changed", help="Import again a log whose content changed since it was imported (without it, "
         "such a log is refused, named).")] = False,
+    log_format: Annotated[str, typer.Option(
+        "--format", help="The logs' layout: measured (t, q1..qN, tau1..tauN; docs/dataset.md), ur-rtde (Universal "
+        "Robots' RTDE recorder CSV) or voraus (the voraus-AD Parquet columns; CC BY-NC-SA data: use your own copy).")
+    ] = "measured",
+    torque_constants: Annotated[str | None, typer.Option(
+        metavar="K1,...,KN", help="With --format ur-rtde: N m/A at each joint, to read the torque from "
+        "actual_current_0.. when the file has no target_moment_0.. columns.")] = None,
     progress: Progress = True,
 ) -> None:
     """Import a fleet's measured logs as a dataset: one run per unit, one record per log, with the
@@ -47,10 +67,25 @@ def import_command(
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5 --skip-bad
       faultgen info fleet-logs.h5 && faultgen detect fleet-logs.h5
+      faultgen logs import UR-LOGS --robot ur5e-folder --format ur-rtde -o ur.h5
     """
-    from faultgen.data import fleetlogs
+    from faultgen.data import adapters, fleetlogs
+
+    read = {}
+    if log_format != "measured":
+        options = {}
+        if torque_constants is not None:
+            try:
+                options["torque_constants"] = tuple(float(k) for k in torque_constants.split(","))
+            except ValueError:
+                raise ValueError(f"--torque-constants {torque_constants!r}: expected numbers, comma-separated "
+                                 "(N m/A per joint)") from None
+        adapter = adapters.make(log_format, **options)
+        read = {"reader": functools.partial(adapter.read, accelerations=False), "suffixes": adapter.suffixes}
+    elif torque_constants is not None:
+        raise ValueError("--torque-constants reads UR's actual_current columns: give it with --format ur-rtde")
 
     command = "faultgen " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     summary = fleetlogs.import_logs(logs, out, robot=robot, skip_bad=skip_bad, progress=progress,
-                                    reimport_changed=reimport_changed, command=command)
+                                    reimport_changed=reimport_changed, command=command, **read)
     typer.echo(str(summary))

@@ -50,6 +50,8 @@ if TYPE_CHECKING:
 
 from faultgen import __version__
 from faultgen import axes as axis_numbers
+from faultgen import inputs
+from faultgen.data import structure
 from faultgen.data.atomic import atomic_path, hdf5_writer
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
@@ -147,6 +149,21 @@ MEASURED_OPTIONAL = ("joint_temperature", "payload_mass")
 SIMULATED_TRUTH = ("mean_friction_torque", "tracking_error")
 #: The ``source`` attribute of a run imported from measured logs (absent: simulated).
 MEASURED = "measured"
+#: The arrays that hold text (variable-length UTF-8 strings), not numbers.
+TEXT_ARRAYS = ("stamp", "log_file")
+
+
+def kinds(name: str) -> str:
+    """The NumPy type kinds an array of a run may hold (:func:`faultgen.inputs.bounded_dataset`):
+    text for :data:`TEXT_ARRAYS`, numbers (and booleans) for the others."""
+    return "SOU" if name in TEXT_ARRAYS else "fiub"
+
+#: name -> axes of every array a run may hold, and the lengths of the axes that are not cycles,
+#: samples or axes: the declared shapes :func:`faultgen.data.structure.check_runs` checks at opening.
+SHAPES = {name: spec[1] for table in (ARRAYS, COUNT_ARRAYS, DUTY_ARRAYS, CONDITION_ARRAYS, FAULT_ARRAYS,
+                                                        MEASURED_ARRAYS)
+          for name, spec in table.items()}
+BINS = {"bin": sensors.HISTOGRAM_BINS, "fine bin": sensors.TORQUE_COUNT_BINS}
 
 #: Attributes every run group carries.
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
@@ -351,6 +368,8 @@ def _open(path: str | Path):
     if writer is not None:
         raise DatasetError(f"{path} is in use: process {writer} is writing it (the finished file appears under "
                            "its own name when it is done)")
+    if Path(path).exists() and not Path(path).is_dir():
+        inputs.regular_file(path, "dataset")  # /dev/zero, a FIFO: refused before h5py waits on it
     try:
         f = h5py.File(path, "r")
     except FileNotFoundError:
@@ -363,6 +382,7 @@ def _open(path: str | Path):
                                "finish") from None
         raise DatasetError(f"{path}: cannot be opened as HDF5 (truncated or not HDF5): {err}") from None
     try:
+        inputs.check_hdf5_links(f, path)  # before anything is read through a link to another file
         if f.attrs.get("format") != FORMAT:
             raise DatasetError(f"{path} is not a faultgen file (format attribute {f.attrs.get('format')!r})")
         if not f.attrs.get("complete", False):
@@ -374,6 +394,7 @@ def _open(path: str | Path):
                                f"reads version {FORMAT_VERSION}")
         if len(f["runs"]) == 0:
             raise DatasetError(f"{path} has no runs (its /runs group is empty)")
+        structure.check_runs(f, path, SHAPES, BINS, kinds)
         yield f
     finally:
         f.close()
@@ -435,7 +456,7 @@ def read_run(path: str | Path, run_id: str | None = None,
         problems = _attribute_problems(group)
         if problems:
             raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every problem)")
-        arrays = {name: group[name][()] for name in wanted}
+        arrays = {name: inputs.bounded_dataset(group, name, path, kinds=kinds(name))[()] for name in wanted}
         for name, value in arrays.items():
             if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
                 raise DatasetError(f"{path}: run {run_id!r}: {name} holds non-finite values; the file is corrupted "
@@ -664,7 +685,7 @@ def _validate_run(group: h5py.Group) -> list[str]:
             problems.append(f"{name}: units/axes attributes {ds.attrs.get('units')!r}/{ds.attrs.get('axes')!r}, "
                             f"expected {units!r}/{axes!r}")
         try:
-            data[name] = ds[()]
+            data[name] = inputs.bounded_dataset(group, name, group.file.filename, kinds=kinds(name))[()]
         except (OSError, RuntimeError) as err:
             problems.append(f"{name}: cannot be read ({err}); the file is corrupted")
             return problems

@@ -31,6 +31,7 @@ was, and no file that looks complete.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 from collections.abc import Callable
@@ -251,7 +252,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     """
     logs_dir, out = Path(logs_dir), Path(out)
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
-    read = reader or measured.read
+    read = reader or functools.partial(measured.read, accelerations=False)
     speed_limit = programs.robot_limits(robot)[0]
     units, not_logs = logfolder.scan(logs_dir, suffixes)
     if not_logs and not skip_bad:
@@ -321,7 +322,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
                             "logs": str(logs_dir.resolve()), "events_sha256": events_sha,
                             "faultgen_version": __version__})
         f.attrs["complete"] = True
-    summary.units = len(plan)
+        summary.units = len(runs)
     return summary
 
 

@@ -32,6 +32,7 @@ without events every log is unknown):
 from __future__ import annotations
 
 import csv
+import io
 import re
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -39,12 +40,14 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen import axes
+from faultgen import axes, inputs
 
 #: The events of ``events.csv`` (module docstring).
 EVENTS = ("onset", "failure", "repair", "gearbox_change", "healthy")
 #: The columns of ``events.csv``, in order.
 EVENT_COLUMNS = ("unit", "stamp", "event", "axis")
+#: Largest events file read, bytes (a row is some 40 bytes: a million events).
+EVENTS_MAX_BYTES = 64 * 2**20
 #: Per log and axis: the label codes of an imported dataset's ``label`` array.
 UNKNOWN, HEALTHY, WORN = -1, 0, 1
 #: Stamp kinds: a date or date-time (key: seconds since 1970-01-01 UTC) or a sequence number.
@@ -192,10 +195,10 @@ def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int) -> lis
         an axis outside 1..N (empty only for ``healthy``).
     """
     path = Path(path)
+    text = inputs.read_text(path, "events file", EVENTS_MAX_BYTES).removeprefix("\ufeff")
     try:
-        with open(path, newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError, csv.Error) as err:
+        rows = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error as err:
         raise ValueError(f"{path}: cannot read the events: {err}") from None
     header = tuple(cell.strip() for cell in rows[0]) if rows else ()
     if header != EVENT_COLUMNS:

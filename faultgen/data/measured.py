@@ -62,9 +62,9 @@ taken from ``q``. Torque is used as it is.
 from __future__ import annotations
 
 import csv
-import gzip
 import math
 import zlib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -72,7 +72,7 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from faultgen import axes
+from faultgen import axes, inputs
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
@@ -117,7 +117,8 @@ UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
 
 #: File suffixes read by :func:`read`, lower case.
 CSV_SUFFIXES = (".csv", ".csv.gz")
-GZIP_MAGIC = b"\x1f\x8b"
+#: Most rows a log may have (a day at 1 kHz); a longer one, or an HDF5 log declaring more, is refused.
+MAX_ROWS = 100_000_000
 HDF5_SUFFIXES = (".h5", ".hdf5")
 
 #: Lowest accepted sample rate in Hz (applied to the median sample period).
@@ -156,7 +157,8 @@ class MeasuredData:
         Arm-side joint velocities in rad/s: the file's ``qd`` columns, or estimated from ``q``
         (see :attr:`velocity_estimated`).
     qdd : ndarray of shape (n, N)
-        Arm-side joint accelerations in rad/s^2, always estimated from ``q``.
+        Arm-side joint accelerations in rad/s^2, estimated from ``q`` (NaN when read with
+        ``accelerations=False``).
     tau : ndarray of shape (n, N)
         Arm-side joint torques in N m.
     source : Path
@@ -234,7 +236,7 @@ class MeasuredData:
 # Reading
 
 
-def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
+def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
     """Read, check and complete a measured-data file (format in the module docstring).
 
     Parameters
@@ -245,6 +247,9 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
         The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
         before the file is opened) or a loaded robot. Its joint range is used to recognise
         angles in degrees and angles out of range.
+    accelerations : bool, default True
+        Estimate ``qdd``; False leaves it NaN and saves its filter (a reader that needs no
+        accelerations: an imported fleet's features, :mod:`faultgen.data.fleetlogs`).
 
     Returns
     -------
@@ -277,16 +282,13 @@ def read(path: str | Path, robot: str | Path | robots.Robot) -> MeasuredData:
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     path = Path(path)
     kind = _kind(path)
-    if not path.exists():
-        raise MeasuredDataError(f"{path}: no such file")
-    if not path.is_file():
-        raise MeasuredDataError(f"{path}: not a file")
+    _regular(path)
     if kind == "csv":
         columns, extra, row_label = _read_csv(path, robot.n_axes)
     else:
         columns, extra, row_label = _read_hdf5(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
-    return _build(columns, robot, path, row_label, notes)
+    return _build(columns, robot, path, row_label, notes, accelerations)
 
 
 def from_arrays(
@@ -327,6 +329,39 @@ def from_arrays(
     return _build(columns, robot, where, _index_label, [])
 
 
+def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
+                 label=None, accelerations: bool = True) -> MeasuredData:
+    """Check and complete the columns of a log in another layout, mapped onto this format's names
+    (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
+    ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
+
+    Parameters
+    ----------
+    columns : dict of ndarray of shape (n,)
+    robot : str, Path or robots.Robot
+    source : str or Path
+        The file they came from, named in messages.
+    label : callable, optional
+        Data row index -> its description in messages (default: 1-based row and 0-based index).
+
+    Raises
+    ------
+    MeasuredDataError
+        As :func:`read`: a missing column, a non-finite value, times, rates, angles out of range.
+    """
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    where = Path(source)
+    label = label or _index_label
+    names = list(columns)
+    wanted, _ = _select_columns(where, names, robot.n_axes)
+    lengths = {len(np.asarray(columns[name])) for name in wanted}
+    if len(lengths) > 1:
+        raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
+    values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
+    _refuse_non_finite(where, values, wanted, label)
+    return _build(values, robot, where, label, [], accelerations)
+
+
 def _kind(path: Path) -> str:
     name = path.name.lower()
     if name.endswith(CSV_SUFFIXES):
@@ -337,6 +372,14 @@ def _kind(path: Path) -> str:
     raise MeasuredDataError(
         f"{path}: unknown file type {''.join(path.suffixes) or '(no suffix)'!r}; expected {accepted}"
     )
+
+
+def _regular(path: Path) -> None:
+    """Refuse a missing file, a folder, a device or a FIFO (faultgen.inputs), as MeasuredDataError."""
+    try:
+        inputs.regular_file(path, "measured log")
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
 
 
 def _csv_label(i: int) -> str:
@@ -352,26 +395,17 @@ def _compression(path: Path) -> str | None:
     return "gzip" if path.name.lower().endswith(".gz") else None
 
 
-def _stored_compression(path: Path) -> str | None:
-    """"gzip" if the file's content starts with gzip's magic bytes (RFC 1952), whatever its name."""
-    try:
-        with open(path, "rb") as fh:
-            return "gzip" if fh.read(2) == GZIP_MAGIC else None
-    except OSError as err:
-        raise MeasuredDataError(f"{path}: cannot read the file: {err}") from err
-
-
 def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
     """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
 
     A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
     reads like one named ``.csv.gz``.
     """
-    compression = _stored_compression(path)
-    opener = gzip.open if compression else open
     try:
-        with opener(path, "rt", newline="", encoding="utf-8-sig") as fh:
+        with inputs.open_text(path, "measured log") as fh:
             header = next(csv.reader(fh), None)
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
     except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
     if not header:
@@ -389,28 +423,37 @@ def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str]
     # All columns are parsed (extra ones as text) so that a row with too many or too few
     # fields is refused by the parser with its line number instead of being silently cut.
     read_kw = {
-        "compression": compression,
         "header": 0,
         "names": names,
         "index_col": False,
         "skip_blank_lines": False,
-        "encoding": "utf-8-sig",
     }
     try:
         try:
             # Fast path: numbers throughout. Anything else is diagnosed from the text below.
             dtypes = {name: (float if name in wanted else str) for name in names}
-            frame = pd.read_csv(path, dtype=dtypes, **read_kw)
-            clean = bool(np.isfinite(frame[wanted].to_numpy(dtype=float)).all())
+            with inputs.open_text(path, "measured log") as fh:
+                frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
+            # every column wanted (the common case): no reindexed copy of the frame
+            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
+            clean = bool(np.isfinite(values).all())
+        except inputs.InputError:
+            raise
         except (ValueError, TypeError):
             clean = False
         if not clean:
-            text = pd.read_csv(path, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
+            with inputs.open_text(path, "measured log") as fh:
+                text = pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
             text = _drop_trailing_blank_rows(text)
             frame = _numbers_from_text(path, text, wanted)
+    except inputs.InputError as err:
+        raise MeasuredDataError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-    columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+    if clean:  # the fast path's values, column by column
+        columns = {name: values[:, k] for k, name in enumerate(wanted)}
+    else:
+        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, _csv_label
 
 
@@ -484,23 +527,8 @@ def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str
 
 
 def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
-    try:
-        fh = h5py.File(path, "r")
-    except OSError as err:
-        raise MeasuredDataError(f"{path}: cannot read the file as HDF5: {err}") from err
-    with fh:
-        names = list(fh.keys())
-        datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
-        groups = [n for n in names if isinstance(fh[n], h5py.Group)]
-        try:
-            wanted, extra = _select_columns(path, datasets, n_axes)
-        except MeasuredDataError as err:
-            if groups:
-                raise MeasuredDataError(
-                    f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
-                ) from None
-            raise
-        extra = extra + [f"{g}/ (group)" for g in groups]
+    with _open_hdf5(path) as fh:
+        wanted, extra = hdf5_columns(fh, path, n_axes)
         columns = {}
         length = None
         for name in wanted:
@@ -518,6 +546,9 @@ def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str
                     raise MeasuredDataError(
                         f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}"
                     )
+            if ds.shape[0] > MAX_ROWS:
+                raise MeasuredDataError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
+                                        f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
             if length is None:
                 length = ds.shape[0]
             elif ds.shape[0] != length:
@@ -528,6 +559,39 @@ def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str
             columns[name] = np.asarray(ds[()], dtype=float)
     _refuse_non_finite(path, columns, wanted, _index_label)
     return columns, extra, _index_label
+
+
+def hdf5_columns(fh: h5py.File, path: Path, n_axes: int) -> tuple[list[str], list[str]]:
+    """The root datasets to read (required, plus all qd when present) and the extra ones (groups
+    among them, marked); refuse missing columns, naming the groups at the root that hold none."""
+    names = list(fh.keys())
+    datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
+    groups = [n for n in names if isinstance(fh[n], h5py.Group)]
+    try:
+        wanted, extra = _select_columns(path, datasets, n_axes)
+    except MeasuredDataError as err:
+        if groups:
+            raise MeasuredDataError(
+                f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
+            ) from None
+        raise
+    return wanted, extra + [f"{g}/ (group)" for g in groups]
+
+
+@contextmanager
+def _open_hdf5(path: Path):
+    """The HDF5 log, opened read-only after faultgen.inputs refused links and virtual datasets that
+    reach other files (MeasuredDataError naming the link)."""
+    try:
+        fh = h5py.File(path, "r")
+    except OSError as err:
+        raise MeasuredDataError(f"{path}: cannot read the file as HDF5: {err}") from err
+    with fh:
+        try:
+            inputs.check_hdf5_links(fh, path)
+        except inputs.InputError as err:
+            raise MeasuredDataError(str(err)) from None
+        yield fh
 
 
 def _unit_key(unit: str) -> str:
@@ -573,10 +637,10 @@ def _refuse_non_finite(where: Path, columns: dict[str, np.ndarray], order: list[
 # Checks and derivatives
 
 
-def _build(
-    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str]
-) -> MeasuredData:
-    t = columns[T_COLUMN]
+def check_time(t: np.ndarray, where: Path, label, notes: list[str]) -> tuple[np.ndarray, float]:
+    """Refuse sample times that do not increase, a median period above 1 / :data:`MIN_RATE`, a gap
+    above :data:`MAX_GAP` or a span below :data:`MIN_DURATION`; note long gaps in ``notes``. Returns
+    the intervals and the median period, s."""
     n = t.shape[0]
     if n < 2:
         raise MeasuredDataError(
@@ -614,6 +678,16 @@ def _build(
             f"{long_gaps.size} sampling interval(s) longer than twice the median period {period:.6g} s, "
             f"the longest {dt[gap]:.6g} s before {label(gap + 1)}"
         )
+    return dt, period
+
+
+def _build(
+    columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str],
+    accelerations: bool = True,
+) -> MeasuredData:
+    t = columns[T_COLUMN]
+    n = t.shape[0]
+    dt, period = check_time(t, where, label, notes)
 
     q_columns, qd_columns, tau_columns = column_names(robot.n_axes)
     q = np.column_stack([columns[c] for c in q_columns])
@@ -622,7 +696,12 @@ def _build(
 
     window = _savgol_window(period, n)
     uniform = _is_uniform(dt, period)
-    qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    if accelerations:
+        qd_est, qdd = _derivatives(t, q, period, window, uniform)
+    else:  # a reader that needs no qdd (an imported fleet's features) saves its filter
+        (qd_est,) = _derivatives(t, q, period, window, uniform, orders=(1,))
+        qdd = np.full_like(q, np.nan)
+        notes.append("qdd not estimated (accelerations=False): NaN")
     filt = f"Savitzky-Golay, order {SAVGOL_ORDER}, window {window} samples ({window * period:.4g} s)"
     if not uniform:
         notes.append(
@@ -701,17 +780,28 @@ def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> Non
         )
 
 
+def velocity_rows(n: int, window: int) -> slice:
+    """The rows over which given velocities are compared with the derivative of q (away from the ends)."""
+    return slice(window, n - window) if n > 4 * window else slice(None)
+
+
 def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: int) -> list[str]:
     """Refuse qd columns in deg/s; note columns that disagree with the derivative of q."""
+    inner = velocity_rows(qd.shape[0], window)
+    given, est = qd[inner], qd_est[inner]
+    return velocity_verdicts(where, np.einsum("ij,ij->j", est, est), np.einsum("ij,ij->j", est, given), len(est))
+
+
+def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: int) -> list[str]:
+    """:func:`_check_velocities` from the sums over its rows: per axis, ``power`` = sum of the
+    estimated speed squared, ``cross`` = sum of estimated times given speed, over ``size`` rows."""
     notes = []
-    inner = slice(window, qd.shape[0] - window) if qd.shape[0] > 4 * window else slice(None)
-    q_columns, qd_columns, _ = column_names(qd.shape[1])
+    q_columns, qd_columns, _ = column_names(len(power))
     for k, name in enumerate(qd_columns):
-        given, est = qd[inner, k], qd_est[inner, k]
-        power = float(np.dot(est, est))
-        if power / max(est.size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
+        power_k = float(power[k])
+        if power_k / max(size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
             continue
-        slope = float(np.dot(est, given) / power)
+        slope = float(cross[k] / power_k)
         if 40.0 <= slope <= 80.0:
             raise MeasuredDataError(
                 f"{where}: column {name} looks like deg/s (it is {slope:.4g} times the derivative of "

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from faultgen import inputs
 from faultgen.data import dataset
 
 if TYPE_CHECKING:
@@ -132,7 +133,7 @@ class Run:
                     why = ("; it was recorded without signals (features only): simulate it again with signals "
                            "(`faultgen sweep` without --features-only)")
                 raise dataset.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}{why}")
-            value = group[name][()]
+            value = inputs.bounded_dataset(group, name, self._source.path, kinds=dataset.kinds(name))[()]
             if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
                 raise dataset.DatasetError(f"{self._source.path}: run {self.id!r}: {name} holds non-finite values; the "
                                            f"file is corrupted (faultgen validate {self._source.path})")

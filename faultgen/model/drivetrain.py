@@ -16,10 +16,10 @@ in a robot folder stores them, one table per axis::
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+from faultgen import inputs
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 
@@ -166,9 +166,9 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise DrivetrainError(f"{path}: cannot read a TOML drivetrain table: {err}") from None
+        data = inputs.read_toml(path, "TOML drivetrain table")
+    except inputs.InputError as err:
+        raise DrivetrainError(str(err)) from None
     unknown = sorted(set(data) - {"axis"})
     if unknown:
         raise DrivetrainError(

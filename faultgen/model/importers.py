@@ -29,7 +29,6 @@ from __future__ import annotations
 import copy
 import math
 import re
-import tomllib
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -38,6 +37,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen import inputs
 from faultgen.axes import MAX_AXES, MIN_AXES
 from faultgen.model.builder import ArmError, ArmJoint, check_arm
 
@@ -472,9 +472,9 @@ def _number(path: Path, where: str, key: str, value, length: int | None = None) 
 
 def _read_dh(path: Path) -> Arm:
     try:
-        data = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
-        raise ArmError(f"{path}: not a TOML DH table: {err}") from None
+        data = inputs.read_toml(path, "TOML DH table")
+    except inputs.InputError as err:
+        raise ArmError(str(err)) from None
     unknown = sorted(set(data) - DH_TOP)
     if unknown:
         raise ArmError(f"{path}: unknown key {unknown[0]!r}; expected some of: {', '.join(sorted(DH_TOP))}")

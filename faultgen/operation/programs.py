@@ -45,12 +45,12 @@ from __future__ import annotations
 
 import hashlib
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from faultgen import inputs
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.model.robots import Robot
@@ -58,7 +58,7 @@ from faultgen.operation import ik as ik_module
 from faultgen.operation.ik import Arc, FlangeIK, Seam, ramp_arc_length, tool_rotation
 from faultgen.operation.tasks import (
     IK_STEP, LIMIT_TOLERANCE, PLAN_PERIOD, PROCESSES, SEAM_LIMIT_TOLERANCE, SEAM_TOLERANCE, TASKS, JointPath,
-    _Builder, _Table, ptp,
+    CycleTooLong, _Builder, _Table, ptp,
 )
 
 #: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
@@ -157,8 +157,8 @@ def record(task: str) -> dict | None:
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         text = data.decode()
         try:
-            out["name"] = str(tomllib.loads(text).get("name", label(task)))
-        except tomllib.TOMLDecodeError:
+            out["name"] = str(inputs.loads_toml(text, task, "program file").get("name", label(task)))
+        except inputs.InputError:
             out["name"] = label(task)
         out["text"] = text
     else:
@@ -302,7 +302,10 @@ class _Planner:
     def run(self) -> JointPath:
         for segment in self.p.segments:
             first = self.path.count - 1
-            getattr(self, f"_{segment.type}")(segment)
+            try:
+                getattr(self, f"_{segment.type}")(segment)
+            except CycleTooLong as err:  # a path longer than a cycle may be, refused before it is sampled
+                self.fail(segment, err.reason)
             self.spans.append((segment, first, self.path.count - 1))
         if self.gripped is not None:
             self.fail(None, f"the payload gripped in segment {self.gripped[2]} is still held at the end of the "
@@ -550,10 +553,11 @@ def read(path: str | Path, robot: Robot | str) -> Program:
         For a file that is missing or not TOML, or a key or value that is not understood (the
         message names the file, the segment and the key).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ProgramError(f"program file {path} does not exist")
-    return parse(path.read_text(), robot, path)
+    try:
+        text = inputs.read_text(path, "program file", inputs.TOML_MAX_BYTES)
+    except inputs.InputError as err:
+        raise ProgramError(str(err)) from None
+    return parse(text, robot, Path(path))
 
 
 def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
@@ -562,9 +566,9 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
         robot = robots.load(robot)
     where = str(source or "program")
     try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise ProgramError(f"{where}: {err}") from err
+        data = inputs.loads_toml(text, where, "program file")
+    except inputs.InputError as err:
+        raise ProgramError(str(err)) from None
     top = _Values(where, "", data, TOP_KEYS)
     name = top.text("name")
     limits = _limits(data, robot, where)
@@ -617,9 +621,9 @@ def _limits(data: dict, robot: Robot, where: str) -> tuple[np.ndarray, np.ndarra
             raise ProgramError(f"{where}: no [limits] table, and {folder_file} (where the robot's limits would be) "
                                "does not exist; add [limits] velocity, acceleration, jerk (deg/s, deg/s^2, deg/s^3)")
         try:
-            table = tomllib.loads(folder_file.read_text()).get("limits")
-        except tomllib.TOMLDecodeError as err:
-            raise ProgramError(f"{folder_file}: {err}") from err
+            table = inputs.read_toml(folder_file, "tasks file").get("limits")
+        except inputs.InputError as err:
+            raise ProgramError(str(err)) from None
         origin = str(folder_file)
     values = _Values(origin, "[limits] ", table if isinstance(table, dict) else {}, LIMIT_KEYS)
     n = len(robot.joint_names)
@@ -747,7 +751,7 @@ def export(robot: Robot | str, name: str) -> str:
         robot = robots.load(robot)
     tasks.load(robot, name)  # refuses an unknown task or a malformed file, with the file and the key
     source = robot.path.parent / "tasks.toml"
-    data = tomllib.loads(source.read_text())
+    data = inputs.read_toml(source, "tasks file")
     t, limits = data[name], data["limits"]
     header = (f"Thesis ch. 6.3.1 task {TASKS.index(name) + 1} ({PROCESSES[name]}) of {robot.name}, exported from "
               f"{source.name} by `faultgen tasks export`.")
@@ -851,7 +855,7 @@ def available(robot: Robot | str) -> list[tuple[str, str]]:
     out = []
     folder_file = robot.path.parent / "tasks.toml"
     if folder_file.is_file():
-        data = tomllib.loads(folder_file.read_text())
+        data = inputs.read_toml(folder_file, "tasks file")
         out += [(name, f"thesis task {TASKS.index(name) + 1}, {PROCESSES[name]} ({folder_file.name})")
                 for name in TASKS if name in data]
     folder = robot.path.parent / "programs"

@@ -27,21 +27,20 @@ joint range (by how much), and a motor torque above the drives' capacity.
 
 from __future__ import annotations
 
-import gzip
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pandas as pd
 from ruckig import ControlInterface, DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 from scipy.interpolate import CubicSpline
 
 from faultgen import derivatives as savgol
+from faultgen import inputs
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation.programs import ProgramError, _limits, check_torque, label
-from faultgen.operation.tasks import PLAN_PERIOD, JointPath
+from faultgen.operation.tasks import MAX_CYCLE_DURATION, MAX_CYCLE_SAMPLES, PLAN_PERIOD, JointPath
 
 #: Shortest log replayed, s (four filter windows) and fewest samples.
 MIN_DURATION = 0.2
@@ -210,17 +209,22 @@ def read(path: str | Path, robot: Robot | str) -> Replay:
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
     path = Path(path)
-    if not path.is_file():
-        raise ProgramError(f"joint log {path} does not exist")
+    try:
+        inputs.regular_file(path, "joint log")
+    except inputs.InputError as err:
+        raise ProgramError(str(err)) from None
     n_axes = len(robot.joint_names)
     wanted = ["t", *(f"q{i}" for i in range(1, n_axes + 1))]
     columns = _read_columns(path, wanted)
     t, q = columns[:, 0], columns[:, 1:]
+    if len(t) == 0:
+        raise ProgramError(f"{path}: the log has a header but no data rows; expected at least {MIN_SAMPLES} samples "
+                           f"over {MIN_DURATION} s")
     bad = np.argwhere(~np.isfinite(columns))
     if bad.size:
         row, col = bad[0]
         raise ProgramError(f"{path}: {wanted[col]} at data row {row + 1} is {columns[row, col]!r}; expected a number")
-    if len(t) < MIN_SAMPLES or t[-1] - t[0] < MIN_DURATION:
+    if len(t) < MIN_SAMPLES or t[-1] - t[0] < MIN_DURATION:  # a header-only log: 0 samples over 0 s
         raise ProgramError(f"{path}: the log is too short: {len(t)} samples over {t[-1] - t[0]:.4g} s; expected at "
                            f"least {MIN_SAMPLES} samples over {MIN_DURATION} s")
     dt = np.diff(t)
@@ -253,30 +257,74 @@ def read(path: str | Path, robot: Robot | str) -> Replay:
 
 
 def _read_columns(path: Path, wanted: list[str]) -> np.ndarray:
-    """The ``wanted`` columns of a CSV (gzip or not, by content) or HDF5 log, shape (n, len(wanted))."""
-    if path.name.lower().endswith((".h5", ".hdf5")):
+    """The ``wanted`` columns of a CSV (gzip or not, by content) or HDF5 log, shape (n, len(wanted)),
+    read in blocks of :data:`BLOCK_ROWS` and refused (the limit named) as soon as it runs longer than
+    a cycle may (:func:`faultgen.operation.tasks.check_cycle_length` at the finest step): memory is
+    bounded whatever the file's length. HDF5 links and virtual datasets that reach other files are
+    refused (:mod:`faultgen.inputs`)."""
+    try:
+        if path.name.lower().endswith((".h5", ".hdf5")):
+            return _read_hdf5(path, wanted)
+        return _read_csv(path, wanted)
+    except inputs.InputError as err:
+        raise ProgramError(str(err)) from None
+
+
+#: Rows read at a time, and most rows a replayed log may have (a cycle of at most an hour at 1 kHz...
+#: MAX_CYCLE_SAMPLES at the finest step).
+BLOCK_ROWS = 500_000
+
+
+def _check_length(path: Path, t: np.ndarray, rows: int) -> None:
+    if rows > MAX_CYCLE_SAMPLES:
+        raise ProgramError(f"{path}: more than {MAX_CYCLE_SAMPLES} rows; a replayed log is one cycle, of at most "
+                           f"{MAX_CYCLE_SAMPLES} samples (MAX_CYCLE_SAMPLES): replay a part of it")
+    if len(t) and np.all(np.isfinite(t[[0, -1]])) and t[-1] - t[0] > MAX_CYCLE_DURATION:
+        raise ProgramError(f"{path}: the log runs longer than {MAX_CYCLE_DURATION:g} s (t = {t[0]:.6g} .. beyond "
+                           f"{t[-1]:.6g} s); a replayed log is one cycle, of at most {MAX_CYCLE_DURATION:g} s "
+                           "(MAX_CYCLE_DURATION): replay a part of it")
+
+
+def _read_hdf5(path: Path, wanted: list[str]) -> np.ndarray:
+    with inputs.open_hdf5(path, "joint log") as f:
+        missing = [c for c in wanted if c not in f]
+        if missing:
+            raise ProgramError(f"{path}: no dataset {missing[0]!r} at the file root; a joint log needs "
+                               f"{', '.join(wanted)}")
+        columns = [inputs.bounded_dataset(f, c, path, (None,), kinds="fiu") for c in wanted]
+        lengths = {ds.shape[0] for ds in columns}
+        if len(lengths) > 1:
+            raise ProgramError(f"{path}: datasets {', '.join(wanted)} have different lengths "
+                               f"({', '.join(str(ds.shape[0]) for ds in columns)}); one row per sample is expected")
+        n = lengths.pop()
+        if n:
+            _check_length(path, np.array([columns[0][0], columns[0][n - 1]], dtype=float), n)
+        return np.column_stack([np.asarray(ds[()], dtype=float) for ds in columns]) if n else np.empty((0, len(wanted)))
+
+
+def _read_csv(path: Path, wanted: list[str]) -> np.ndarray:
+    blocks, rows = [], 0
+    with inputs.open_text(path, "joint log") as f:
         try:
-            with h5py.File(path, "r") as f:
-                missing = [c for c in wanted if c not in f]
+            reader = pd.read_csv(f, skipinitialspace=True, chunksize=BLOCK_ROWS)
+            for table in reader:
+                table.columns = [str(c).strip() for c in table.columns]
+                missing = [c for c in wanted if c not in table.columns]
                 if missing:
-                    raise ProgramError(f"{path}: no dataset {missing[0]!r} at the file root; a joint log needs "
-                                       f"{', '.join(wanted)}")
-                return np.column_stack([np.asarray(f[c][()], dtype=float) for c in wanted])
-        except OSError as err:
-            raise ProgramError(f"{path}: not an HDF5 file ({err})") from err
-    with open(path, "rb") as f:
-        compressed = f.read(2) == b"\x1f\x8b"
-    try:
-        with (gzip.open(path, "rt") if compressed else open(path)) as f:
-            table = pd.read_csv(f, skipinitialspace=True)
-    except (ValueError, OSError, pd.errors.ParserError) as err:
-        raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from err
-    table.columns = [str(c).strip() for c in table.columns]
-    missing = [c for c in wanted if c not in table.columns]
-    if missing:
-        raise ProgramError(f"{path}: no column {missing[0]!r}; a joint log needs {', '.join(wanted)} (rad), "
-                           f"got {', '.join(table.columns)}")
-    try:
-        return table[wanted].to_numpy(dtype=float)
-    except ValueError as err:
-        raise ProgramError(f"{path}: a value in columns {', '.join(wanted)} is not a number ({err})") from err
+                    raise ProgramError(f"{path}: no column {missing[0]!r}; a joint log needs {', '.join(wanted)} "
+                                       f"(rad), got {', '.join(table.columns)}")
+                try:
+                    block = table[wanted].to_numpy(dtype=float)
+                except ValueError as err:
+                    raise ProgramError(f"{path}: a value in columns {', '.join(wanted)} is not a number ({err})") \
+                        from None
+                if not len(block):
+                    continue
+                blocks.append(block)
+                rows += len(block)
+                _check_length(path, np.array([blocks[0][0, 0], block[-1, 0]]), rows)
+        except (ValueError, OSError, pd.errors.ParserError) as err:
+            if isinstance(err, (ProgramError, inputs.InputError)):
+                raise
+            raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from err
+    return np.concatenate(blocks) if blocks else np.empty((0, len(wanted)))

@@ -23,13 +23,13 @@ convergence").
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
+from faultgen import inputs
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation.ik import FlangeIK, Seam, ramp_arc_length, tool_rotation
@@ -40,6 +40,11 @@ IK_STEP = 0.01  # s: knot step of the seam IK; the spline interpolates in betwee
 #: s: every move, dwell and seam lasts a whole number of these (the thesis's 4 ms sampling period,
 #: ch. 6.3.2), so a path sampled at any step that divides it is the same path.
 PLAN_PERIOD = 0.004
+#: Longest cycle a task, program or replayed log may make, s, and most samples of its path: checked
+#: before a piece of path is allocated (a ``dwell time = 1e9`` asked for 87 TiB, a program of 10^4
+#: moves took 5.4 GB; issue 50). An hour is far beyond an industrial cycle (seconds to minutes).
+MAX_CYCLE_DURATION = 3600.0
+MAX_CYCLE_SAMPLES = 7_200_000  # an hour at the finest step, 0.5 ms
 SEAM_TOLERANCE = 5e-4  # m: largest allowed flange distance from the commanded seam point
 SEAM_LIMIT_TOLERANCE = 0.01  # relative excess over a velocity/acceleration limit allowed on the seam
 LIMIT_TOLERANCE = 1e-9  # relative (velocity, acceleration) and rad (position) elsewhere
@@ -365,12 +370,33 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
     trajectory = Trajectory(n)
     if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
         raise ValueError(f"{where}: ruckig found no move to {np.round(q_to, 4)}")
+    check_cycle_length(trajectory.duration, dt, where)
     steps = round(trajectory.duration / dt)
     samples = [trajectory.at_time(k * dt) for k in range(steps)]
     q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, n)
     qd = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
     qdd = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
     return q, qd, qdd
+
+
+class CycleTooLong(ValueError):
+    """A path would exceed :data:`MAX_CYCLE_DURATION` or :data:`MAX_CYCLE_SAMPLES`; ``reason`` says
+    by how much, without the place (``str`` adds it)."""
+
+    def __init__(self, where: str, reason: str) -> None:
+        super().__init__(f"{where}: {reason}")
+        self.reason = reason
+
+
+def check_cycle_length(duration: float, dt: float, where: str) -> None:
+    """Refuse (:class:`CycleTooLong`, naming ``where`` and the limit) a path of ``duration`` s at step
+    ``dt`` s beyond :data:`MAX_CYCLE_DURATION` or :data:`MAX_CYCLE_SAMPLES`, before it is sampled."""
+    if not duration <= MAX_CYCLE_DURATION:  # NaN too
+        raise CycleTooLong(where, f"the cycle would last {duration:.6g} s; a cycle lasts at most "
+                                  f"{MAX_CYCLE_DURATION:g} s (MAX_CYCLE_DURATION)")
+    if duration / dt > MAX_CYCLE_SAMPLES:
+        raise CycleTooLong(where, f"the cycle would take {duration / dt:.6g} samples at dt = {dt:g} s; a cycle "
+                                  f"has at most {MAX_CYCLE_SAMPLES} (MAX_CYCLE_SAMPLES)")
 
 
 class _Builder:
@@ -393,6 +419,7 @@ class _Builder:
         steps = len(q) - 1
         if steps == 0:
             return
+        check_cycle_length((self.count - 1 + steps) * self.dt, self.dt, label)
         if target is not None:
             self.target[-1][-1] = target[0]
         self.q.append(q[1:])
@@ -404,6 +431,7 @@ class _Builder:
         self.count += steps
 
     def hold(self, label: str, duration: float, target: np.ndarray | None = None) -> None:
+        check_cycle_length((self.count - 1) * self.dt + duration, self.dt, label)
         steps = round(duration / PLAN_PERIOD) * round(PLAN_PERIOD / self.dt)
         q = np.repeat(self.last[None], steps + 1, axis=0)
         zero = np.zeros_like(q)
@@ -471,10 +499,7 @@ def load(robot: Robot | str, name: str) -> Task:
     path = robot.path.parent / "tasks.toml"
     if not path.is_file():
         raise ValueError(f"{path}: no tasks file for robot {robot.name!r}")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"{path}: {err}") from err
+    data = inputs.read_toml(path, "tasks file")
     for key in data:
         if key not in ("limits", *TASKS):
             raise ValueError(f"{path}: unknown table [{key}]; expected [limits] and {', '.join(TASKS)}")

@@ -34,7 +34,6 @@ import socket
 import sys
 import threading
 import time
-import tomllib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, fields
@@ -45,6 +44,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen import axes as axis_numbers
+from faultgen import inputs
 from faultgen.data import atomic, dataset
 from faultgen.effects import friction
 from faultgen.model import robots
@@ -202,10 +202,7 @@ class Grid:
 
         A ``preset = "name"`` key starts from that preset. Unknown keys are refused.
         """
-        try:
-            data = tomllib.loads(Path(path).read_text())
-        except (OSError, tomllib.TOMLDecodeError) as err:
-            raise ValueError(f"cannot read grid file {path}: {err}") from None
+        data = inputs.read_toml(path, "grid file")
         known = {f.name for f in fields(cls)} | {"preset"}
         unknown = sorted(set(data) - known)
         if unknown:

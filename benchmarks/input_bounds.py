@@ -1,0 +1,195 @@
+"""Peak memory and time of faultgen on long logs and on hostile files (issue 50, item 4): a
+benchmark, not a test.
+
+Each case runs as its own process; its peak resident memory is the ``ru_maxrss`` that ``os.wait4``
+returns for that process alone (the interpreter and faultgen's imports included, about 0.2-0.3 GB).
+Prints one Markdown row per case with its verdict:
+
+* ``calibrate`` and a replay (``replay.read`` and the reference path at the robot's time step, the
+  part of ``faultgen simulate --task LOG`` that grows with the log) on CSV logs of 10^5, 10^6 and
+  10^7 rows at 1 kHz (100 s, 17 min, 2.8 h). Goal: the peak flat within 20 % of the 10^5-row one.
+  The logs: the PUMA 560 along :func:`faultgen.calibrate.synth.excitation` (sines of 0.1 and 0.23 Hz,
+  so 100 s is one period), its torque from our own inverse dynamics plus 1 % noise over one period,
+  tiled (so the motion is smooth across the joins); written once into FOLDER (1.7 GB for 10^7 rows)
+  and reused.
+* reading each bomb: TOML with a dotted key of 10^5 and of 2x10^4 parts and with 5x10^4 nested
+  brackets (as a drivetrain table, as a DH table, as a program), ``--drivetrain /dev/zero``, a
+  gzip-bomb log (3.9 MB inflating to 4 GB of valid-looking rows, through ``calibrate``), a
+  dataset declaring a (10^10, 6) array (``faultgen.open`` and ``validate``), a measured log
+  declaring 10^10 rows (``calibrate``). Goal: refused (exit 2 / ValueError) in under 5 s and
+  under 500 MB.
+
+    python benchmarks/input_bounds.py [FOLDER]          # default /tmp/faultgen-input-bounds
+    python benchmarks/input_bounds.py FOLDER --quick    # the bombs and the 10^5/10^6 logs only
+    python benchmarks/input_bounds.py FOLDER --no-bombs --sizes 100000 10000000
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+PERIOD = 0.001
+BASE_ROWS = 100_000  # one period of the excitation at 1 kHz
+SIZES = (100_000, 1_000_000, 10_000_000)
+FLAT = 0.20
+BOMB_MB, BOMB_S = 500, 5.0
+
+
+def make_log(folder: Path, rows: int) -> Path:
+    """The PUMA 560 excitation log of ``rows`` rows (module docstring), written once."""
+    path = folder / f"log-{rows}.csv"
+    if path.exists():
+        return path
+    from faultgen.calibrate import predict, synth
+    from faultgen.data import measured
+    from faultgen.model import robots
+
+    puma = robots.load("puma560")
+    t, q, qd, _ = synth.excitation([puma, robots.load("irb6700")], BASE_ROWS * PERIOD, PERIOD)
+    tau = np.empty_like(q)
+    for start in range(0, BASE_ROWS, 25_000):
+        part = slice(start, start + 25_000)
+        tau[part] = predict(puma, measured.from_arrays(t[part], q[part], np.zeros_like(q[part]), robot=puma,
+                                                       qd=qd[part]))
+    tau += np.random.default_rng(0).normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    rest = [",".join(row) for row in np.char.mod("%.9g", np.column_stack([q, tau]))]
+    header = "t," + ",".join([f"q{i}" for i in range(1, 7)] + [f"tau{i}" for i in range(1, 7)]) + "\n"
+    tmp = path.with_suffix(".part")
+    with open(tmp, "w") as fh:
+        fh.write(header)
+        for tile in range(-(-rows // BASE_ROWS)):
+            n = min(BASE_ROWS, rows - tile * BASE_ROWS)
+            times = np.char.mod("%.3f", (tile * BASE_ROWS + np.arange(n)) * PERIOD)
+            fh.write("\n".join(f"{a},{b}" for a, b in zip(times, rest[:n])) + "\n")
+    tmp.rename(path)
+    return path
+
+
+def make_bombs(folder: Path) -> dict[str, Path]:
+    import h5py
+
+    out = {}
+    for name, text in {"dotted-1e5.toml": "axis" + ".a" * 100_000 + " = 1\n",
+                       "dotted-2e4.toml": "axis" + ".a" * 20_000 + " = 1\n",
+                       "brackets-5e4.toml": "a = " + "[" * 50_000 + "]" * 50_000 + "\n"}.items():
+        out[name] = folder / name
+        out[name].write_text(text)
+    bomb = folder / "bomb.csv.gz"
+    if not bomb.exists():
+        header = b"t," + ",".join([f"q{i}" for i in range(1, 7)] + [f"tau{i}" for i in range(1, 7)]).encode() + b"\n"
+        with gzip.open(bomb, "wb", compresslevel=9) as g:
+            g.write(header)
+            row = b"0,0,0,0,0,0,0,0,0,0,0,0,0\n"
+            for _ in range(160):
+                g.write(row * 1_000_000)
+    out["bomb.csv.gz"] = bomb
+    log = folder / "declared-1e10.h5"
+    with h5py.File(log, "w") as f:
+        for name in ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]:
+            f.create_dataset(name, shape=(10**10,), dtype="f8", chunks=(4096,))
+    out["declared-1e10.h5"] = log
+    data = folder / "dataset-1e10.h5"
+    if not data.exists():
+        from faultgen.runs import sweep
+
+        base = folder / "dataset-base.h5"
+        if not base.exists():
+            sweep.run(sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], cycles=2), base, jobs=1,
+                      progress=False)
+        data.write_bytes(base.read_bytes())
+        with h5py.File(data, "r+") as f:
+            group = f["runs"][next(iter(f["runs"]))]
+            del group["tau_m"]
+            group.create_dataset("tau_m", shape=(10**10, 6), dtype="f8", chunks=(1024, 6))
+    out["dataset-1e10.h5"] = data
+    return out
+
+
+#: kind -> (imports, the case): only the case is timed (imports took 2-5 s on the loaded machine).
+CASES_CODE = {
+    "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
+    "replay": ("from faultgen.operation import replay\nfrom faultgen.model import robots",
+               "replay.read({log!r}, 'puma560').trajectory(robots.load('puma560').model.opt.timestep)"),
+    "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
+    "dh": ("from pathlib import Path\nfrom faultgen.model import importers", "importers._read_dh(Path({log!r}))"),
+    "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
+    "open": ("import faultgen", "faultgen.open({log!r}).features()"),
+    "validate": ("from faultgen.data import dataset", "dataset.validate({log!r})"),
+}
+
+
+def run_case(kind: str, log: Path, out: Path) -> dict:
+    """Run one case in a fresh interpreter; its peak resident memory from os.wait4, the case's own
+    time (after the imports), and whether it was refused (a ValueError: the CLI's exit 2) or completed."""
+    imports, call = CASES_CODE[kind]
+    code = (f"import json, time\n{imports}\nstart = time.perf_counter()\ntry:\n"
+            f"    {call.format(log=str(log), out=str(out))}\n"
+            "    result = {'outcome': 'completed'}\n"
+            "except ValueError as err:\n    result = {'outcome': 'refused', 'message': str(err)[:160]}\n"
+            "print(json.dumps({**result, 'seconds': time.perf_counter() - start}))\n")
+    shutil.rmtree(out, ignore_errors=True)
+    with tempfile.TemporaryFile("w+") as stdout, tempfile.TemporaryFile("w+") as stderr:
+        proc = subprocess.Popen([sys.executable, "-c", code], stdout=stdout, stderr=stderr, text=True)
+        _, status, usage = os.wait4(proc.pid, 0)  # this process's own peak, not the largest child's so far
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        stdout.seek(0)
+        stderr.seek(0)
+        lines, errors = stdout.read().strip().splitlines(), stderr.read().strip().splitlines()
+    result = json.loads(lines[-1]) if lines else {
+        "outcome": f"crashed (exit {proc.returncode}): {errors[-1][:160] if errors else ''}", "seconds": float("nan")}
+    return {**result, "peak_mb": usage.ru_maxrss / 1024}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("folder", nargs="?", default="/tmp/faultgen-input-bounds")
+    parser.add_argument("--quick", action="store_true", help="skip the 10^7-row log")
+    parser.add_argument("--sizes", type=int, nargs="+", help="log lengths (rows) to run; the first is the baseline")
+    parser.add_argument("--no-bombs", action="store_true", help="only the logs")
+    parser.add_argument("--no-logs", action="store_true", help="only the bombs")
+    args = parser.parse_args()
+    folder = Path(args.folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average "
+          f"{os.getloadavg()[0]:.1f}, {os.cpu_count()} cores\n")
+    print("| case | file | outcome | seconds | peak MB | verdict |\n| --- | --- | --- | --- | --- | --- |")
+    bombs = {} if args.no_bombs else make_bombs(folder)
+    for kind, name in [] if args.no_bombs else [("drivetrain", "dotted-1e5.toml"), ("drivetrain", "dotted-2e4.toml"),
+                       ("dh", "dotted-1e5.toml"), ("program", "brackets-5e4.toml"), ("drivetrain", "brackets-5e4.toml"),
+                       ("drivetrain", "/dev/zero"), ("calibrate", "bomb.csv.gz"), ("calibrate", "declared-1e10.h5"),
+                       ("replay", "declared-1e10.h5"), ("open", "dataset-1e10.h5"), ("validate", "dataset-1e10.h5")]:
+        path = bombs.get(name, Path(name))
+        r = run_case(kind, path, folder / "out-bomb")
+        ok = r["outcome"] == "refused" and r["seconds"] < BOMB_S and r["peak_mb"] < BOMB_MB
+        print(f"| {kind} | {name} ({path.stat().st_size / 1e6:.2f} MB) | {r['outcome']}: {r.get('message', '')[:90]} | "
+              f"{r['seconds']:.1f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused, < {BOMB_S:g} s, "
+              f"< {BOMB_MB} MB) |", flush=True)
+    sizes = [] if args.no_logs else args.sizes or (SIZES[:2] if args.quick else SIZES)
+    for kind in ("calibrate", "replay"):
+        base = None
+        for rows in sizes:
+            log = make_log(folder, rows)
+            out = folder / f"out-{kind}-{rows}"
+            r = run_case(kind, log, out)
+            base = base or r["peak_mb"]
+            ratio = r["peak_mb"] / base
+            verdict = (f"{'met' if ratio <= 1 + FLAT else 'NOT met'}: {ratio:.2f} x the {sizes[0]:.0e}-row peak (goal <= "
+                       f"{1 + FLAT:.2f})")
+            print(f"| {kind} | {rows:.0e} rows ({log.stat().st_size / 1e6:.0f} MB) | {r['outcome']}"
+                  f"{': ' + r['message'][:90] if 'message' in r else ''} | {r['seconds']:.0f} | {r['peak_mb']:.0f} | "
+                  f"{verdict} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,189 @@
+"""Adapters: logs in the layouts robots and datasets really have, read into the measured format.
+
+Each adapter maps a foreign file's columns onto the measured format's (``t``, ``q1..qN``,
+``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
+:func:`faultgen.data.measured.from_columns`, which checks them as it checks a measured log (the
+same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTERS`), chosen with
+``faultgen logs import --format NAME``; docs/dataset.md, "Adapters", gives each layout.
+
+- ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
+  ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s), and
+  the joint torque as ``target_moment_0..5`` (N m) or, with ``torque_constants`` given (N m/A at
+  the joint, one per axis), as ``actual_current_0..5`` (A) times them.
+- ``voraus``: the voraus-AD dataset's Parquet layout (Brockmann et al. 2023, CC BY-NC-SA 4.0: never
+  shipped with faultgen; read from your copy): ``time`` (s), ``joint_position_1..6`` (rad),
+  ``joint_velocity_1..6`` (rad/s) and ``motor_torque_1..6`` (N m at the motor, referred to the
+  arm by the robot's gear ratio), 100 Hz; its ``sample`` column (one recording) becomes the cycle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from faultgen import inputs
+from faultgen.data import measured
+from faultgen.model import robots
+
+#: name -> adapter class.
+ADAPTERS: dict[str, type[Adapter]] = {}
+#: Largest foreign log read, bytes on disk.
+MAX_BYTES = 4 * 2**30
+
+
+def register(name: str):
+    """Class decorator: register an :class:`Adapter` under ``name`` (its ``--format``)."""
+    def decorate(cls):
+        cls.name = name
+        ADAPTERS[name] = cls
+        return cls
+    return decorate
+
+
+@dataclass(frozen=True)
+class Adapter:
+    """Base: ``suffixes`` (lower case) of the files it reads, and :meth:`columns` (the foreign file's
+    columns as the measured format's, and the data-row labeller of its messages)."""
+
+    name = ""
+    suffixes: tuple[str, ...] = ()
+
+    def columns(self, path: Path, robot: robots.Robot) -> tuple[dict[str, np.ndarray], Callable[[int], str]]:
+        raise NotImplementedError
+
+    def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
+        """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
+        as :func:`faultgen.data.measured.read`)."""
+        columns, label = self.columns(Path(path), robot)
+        return measured.from_columns(columns, robot, path, label, accelerations)
+
+
+def make(name: str, **options) -> Adapter:
+    """The adapter ``name`` with its options.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (the message lists the known ones) or a bad option.
+    """
+    if name not in ADAPTERS:
+        raise ValueError(f"unknown log format {name!r}; expected measured (the default) or one of "
+                         f"{', '.join(ADAPTERS)}")
+    return ADAPTERS[name](**options)
+
+
+def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
+    missing = [c for c in wanted if c not in names]
+    if missing:
+        raise measured.MeasuredDataError(f"{path}: missing column(s) {', '.join(missing)} of the {what} layout; found "
+                                         f"{', '.join(names[:40]) or '(none)'}")
+
+
+def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[str, np.ndarray]:
+    """The ``wanted`` columns as floats, refused at the first cell that is not a finite number."""
+    out = {}
+    for name in wanted:
+        values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value "
+                                             f"{frame[name].iloc[bad[0]]!r}; expected a finite number")
+        out[name] = values
+    return out
+
+
+@register("ur-rtde")
+@dataclass(frozen=True)
+class URRTDE(Adapter):
+    """Universal Robots' RTDE recorder CSV (module docstring).
+
+    Parameters
+    ----------
+    torque_constants : tuple of float, optional
+        N m/A at the joint, per axis: read the torque as ``actual_current_i`` times them when the
+        file has no ``target_moment`` columns.
+    """
+
+    suffixes: tuple[str, ...] = (".csv", ".csv.gz")
+    torque_constants: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        if self.torque_constants is not None:
+            constants = np.asarray(self.torque_constants, dtype=float)
+            if constants.ndim != 1 or not np.all(np.isfinite(constants)) or np.any(constants <= 0):
+                raise ValueError(f"torque constants {self.torque_constants!r}: expected one positive number (N m/A) "
+                                 "per axis")
+
+    def columns(self, path: Path, robot: robots.Robot):
+        n_axes = robot.n_axes
+        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+            header = fh.readline()
+            separator = "," if "," in header else " "
+            frame = pd.read_csv(fh, sep=separator, header=None, names=header.strip().split(separator), dtype=str,
+                                keep_default_na=False, skipinitialspace=True)
+        names = list(frame.columns)
+        label = measured._csv_label
+        axes = range(n_axes)
+        q = [f"actual_q_{k}" for k in axes]
+        qd = [f"actual_qd_{k}" for k in axes]
+        moment = [f"target_moment_{k}" for k in axes]
+        current = [f"actual_current_{k}" for k in axes]
+        if all(c in names for c in moment):
+            torque, scale = moment, np.ones(n_axes)
+        elif self.torque_constants is not None and all(c in names for c in current):
+            if len(self.torque_constants) != n_axes:
+                raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
+            torque, scale = current, np.asarray(self.torque_constants, dtype=float)
+        else:
+            raise measured.MeasuredDataError(
+                f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
+                f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
+        wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else [])]
+        _require(path, names, wanted, "RTDE recorder")
+        values = _numbers(path, frame, wanted, label)
+        q_names, qd_names, tau_names = measured.column_names(n_axes)
+        out = {measured.T_COLUMN: values["timestamp"]}
+        out.update({q_names[k]: values[q[k]] for k in axes})
+        out.update({tau_names[k]: values[torque[k]] * scale[k] for k in axes})
+        if qd[0] in values:
+            out.update({qd_names[k]: values[qd[k]] for k in axes})
+        return out, label
+
+
+@register("voraus")
+@dataclass(frozen=True)
+class Voraus(Adapter):
+    """The voraus-AD dataset's Parquet layout (module docstring)."""
+
+    suffixes: tuple[str, ...] = (".parquet",)
+
+    def columns(self, path: Path, robot: robots.Robot):
+        import pyarrow.parquet as pq
+
+        n_axes = robot.n_axes
+        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
+        names = pq.read_schema(path).names
+        axes = range(1, n_axes + 1)
+        position = [f"joint_position_{k}" for k in axes]
+        velocity = [f"joint_velocity_{k}" for k in axes]
+        torque = [f"motor_torque_{k}" for k in axes]
+        wanted = ["time", *position, *torque, *(velocity if all(c in names for c in velocity) else [])]
+        _require(path, names, wanted, "voraus-AD")
+        sample = ["sample"] if "sample" in names else []
+        frame = pq.read_table(path, columns=wanted + sample).to_pandas()
+        label = measured._index_label
+        values = _numbers(path, frame, wanted + sample, label)
+        q_names, qd_names, tau_names = measured.column_names(n_axes)
+        out = {measured.T_COLUMN: values["time"]}
+        for k in range(n_axes):
+            out[q_names[k]] = values[position[k]]
+            out[tau_names[k]] = values[torque[k]] * robot.gear_ratio[k]  # motor side -> arm side
+            if velocity[k] in values:
+                out[qd_names[k]] = values[velocity[k]]
+        if sample:
+            out[measured.CYCLE_COLUMN] = values["sample"]
+        return out, label

@@ -1,0 +1,380 @@
+"""Readers' first line of defence: every file a stranger may hand faultgen (a DH table, a drivetrain
+or program file, a sweep config, a measured or replayed log, a dataset) is opened through here.
+
+What is refused, before any parser sees the content (docs/reliability.md, "Threat model: data
+files"):
+
+* anything but a regular file (a device such as ``/dev/zero``, a FIFO, a folder, a symlink to
+  one of these), and a file above the reader's size bound;
+* TOML nested deeper than :data:`TOML_MAX_DEPTH` brackets or with a dotted key of more than
+  :data:`TOML_MAX_KEY_PARTS` parts (``tomllib`` is quadratic in a dotted key's length and recurses
+  once per bracket: a 200 kB key of 10^5 parts took 19.6 GB, 5x10^4 brackets a RecursionError);
+* an HDF5 file holding an external link, a soft link that does not resolve inside the file, a
+  virtual dataset or a dataset whose raw data lives in an external file: each would make a
+  reader open a file it was not given;
+* an HDF5 dataset whose declared shape or element count is not the expected one (a 76 MB file
+  can declare (10^10, 6) float64: 447 GiB on read), or whose type is not numeric;
+* a gzip stream that inflates beyond :data:`GZIP_MAX_RATIO` times its compressed size (a bomb),
+  checked while it is read, so at most a few MiB are inflated before the refusal.
+
+Every refusal is an :class:`InputError` (a ``ValueError``: the command line prints it as one
+``error:`` line and exits 2) whose message starts with the file's path and names the key, link,
+dataset or row at fault and what was expected.
+
+This module imports no other faultgen layer, so every layer may use it.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import os
+import re
+import stat
+import tomllib
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+#: Size bound of a TOML file (DH table, drivetrain, program, sweep config, tasks file), bytes. The
+#: largest file the project writes (a program of a few hundred moves) is tens of kB.
+TOML_MAX_BYTES = 4 * 2**20
+#: Deepest bracket nesting (arrays and inline tables) a TOML file may have; the project's files use 2.
+TOML_MAX_DEPTH = 32
+#: Most parts of one dotted key (``a.b.c`` has 3) or table header; the project's files use at most 3.
+TOML_MAX_KEY_PARTS = 32
+#: A gzip stream inflating more than this many times its compressed size is refused as a bomb:
+#: a CSV log of sensor readings compresses 3-6 times (docs/reliability.md), a bomb 1000 times.
+GZIP_MAX_RATIO = 100
+#: Inflated bytes a gzip stream may produce before the ratio is checked (short files compress worse).
+GZIP_SLACK = 8 * 2**20
+#: Elements one HDF5 dataset may hold before a reader refuses it outright (8 GiB of float64).
+HDF5_MAX_ELEMENTS = 2**30
+
+
+class InputError(ValueError):
+    """A file refused before it was read or parsed: the message names the file, the offending item
+    (key, link, dataset, row) and what was expected."""
+
+
+def _kind(mode: int) -> str:
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "not a plain file"
+
+
+def regular_file(path: str | Path, what: str, max_bytes: int | None = None) -> Path:
+    """``path`` as a :class:`~pathlib.Path` after checking that it names a regular file (a symlink is
+    followed) of at most ``max_bytes`` bytes (no bound when None).
+
+    Raises
+    ------
+    InputError
+        "no such file", "not a regular file (a character device)" for ``/dev/zero`` or a symlink to
+        it, or the size and the bound; each message starts with ``path`` and names ``what``.
+    """
+    path = Path(path)
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        if path.is_symlink():
+            raise InputError(f"{path}: the {what} is a symlink to {os.readlink(path)}, which does not "
+                             "exist") from None
+        raise InputError(f"{path}: no such file (the {what})") from None
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the {what}: {err.strerror or err}") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = _kind(info.st_mode)
+        if path.is_symlink():
+            kind = f"a symlink to {os.readlink(path)}, {kind}"
+        raise InputError(f"{path}: not a regular file ({kind}); the {what} must be a regular file")
+    if max_bytes is not None and info.st_size > max_bytes:
+        raise InputError(f"{path}: {info.st_size} bytes; a {what} is read up to {max_bytes} bytes")
+    return path
+
+
+def read_bytes(path: str | Path, what: str, max_bytes: int) -> bytes:
+    """The content of the regular file ``path``, at most ``max_bytes`` bytes (checked on the size
+    and again while reading, for a file that grows or misreports its size)."""
+    path = regular_file(path, what, max_bytes)
+    with open(path, "rb") as fh:
+        data = fh.read(max_bytes + 1)
+    if len(data) > max_bytes:
+        raise InputError(f"{path}: more than {max_bytes} bytes; a {what} is read up to {max_bytes} bytes")
+    return data
+
+
+def read_text(path: str | Path, what: str, max_bytes: int) -> str:
+    """:func:`read_bytes` decoded as UTF-8; a file that is not UTF-8 is refused with the byte offset."""
+    data = read_bytes(path, what, max_bytes)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise InputError(f"{path}: byte {err.start} is not UTF-8 text; a {what} is a UTF-8 text file") from None
+
+
+# Strings and comments are skipped whole (a bracket or dot inside them is text); everything else the
+# scan needs is one structural character. Characters no alternative matches (bare keys, numbers)
+# are skipped by finditer.
+_TOML_TOKEN = re.compile(r'"""(?:[^"\\]|\\.|"(?!""))*"{3,5}|\'\'\'[\s\S]*?\'{3,5}|"(?:[^"\\\n]|\\.)*"'
+                         r"|'[^'\n]*'|#[^\n]*|[\[\]{},=.\n]")
+
+
+def check_toml_shape(text: str, source: str | Path, what: str) -> None:
+    """Refuse TOML text nested deeper than :data:`TOML_MAX_DEPTH` brackets or with a key (or table
+    header) of more than :data:`TOML_MAX_KEY_PARTS` dotted parts, before any parser sees it. A linear
+    scan: a malformed file passes here and is refused by the parser with its own message."""
+    stack: list[str] = []
+    in_key, header, parts, line = True, False, 1, 1
+    for match in _TOML_TOKEN.finditer(text):
+        token = match.group()
+        if token[0] in "\"'#":
+            line += token.count("\n")
+            continue
+        if token == "\n":
+            line += 1
+            if not stack:
+                in_key, header, parts = True, False, 1
+        elif token == "." and in_key:
+            parts += 1
+            if parts > TOML_MAX_KEY_PARTS:
+                raise InputError(f"{source}: line {line}: a dotted key of more than {TOML_MAX_KEY_PARTS} "
+                                 f"parts; a {what} nests at most {TOML_MAX_KEY_PARTS} levels")
+        elif token == "[" and in_key and not stack:
+            header = True  # a table header [a.b] or [[a.b]]: its dots count as a key's
+        elif token == "]" and header:
+            in_key, header = False, False
+        elif token == "=" and in_key and not header:
+            in_key, parts = False, 1
+        elif token in "[{":
+            stack.append(token)
+            in_key, parts = token == "{", 1
+            if len(stack) > TOML_MAX_DEPTH:
+                raise InputError(f"{source}: line {line}: brackets nested more than {TOML_MAX_DEPTH} "
+                                 f"deep; a {what} nests at most {TOML_MAX_DEPTH} levels")
+        elif token in "]}":
+            if stack:
+                stack.pop()
+            in_key = False
+        elif token == ",":
+            in_key, parts = bool(stack) and stack[-1] == "{", 1
+
+
+def loads_toml(text: str, source: str | Path, what: str) -> dict:
+    """TOML text (read from ``source``, named in errors) as a table, its size and nesting bounded
+    (:func:`check_toml_shape`) before it is parsed; a syntax error is an :class:`InputError` naming
+    ``source``."""
+    if len(text) > TOML_MAX_BYTES:
+        raise InputError(f"{source}: {len(text)} characters; a {what} is read up to {TOML_MAX_BYTES}")
+    check_toml_shape(text, source, what)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{source}: not a valid TOML {what}: {err}") from None
+    except RecursionError:  # not expected after the depth check; kept so no traceback escapes
+        raise InputError(f"{source}: nested too deeply to read as a {what}") from None
+
+
+def read_toml(path: str | Path, what: str, max_bytes: int = TOML_MAX_BYTES) -> dict:
+    """The table in the TOML file ``path``: a regular UTF-8 file of at most ``max_bytes`` bytes,
+    nesting bounded (:func:`check_toml_shape`), then parsed by ``tomllib``.
+
+    Raises
+    ------
+    InputError
+        Naming ``path`` and, for a nesting or syntax error, the line.
+    """
+    return loads_toml(read_text(path, what, max_bytes), path, what)
+
+
+# --------------------------------------------------------------------------------------------------
+# gzip
+
+
+class _BoundedInflate(io.RawIOBase):
+    """A raw reader over a gzip file that refuses to inflate beyond :data:`GZIP_MAX_RATIO` times the
+    compressed bytes consumed so far (plus :data:`GZIP_SLACK`)."""
+
+    def __init__(self, path: Path, what: str):
+        self._path, self._what = path, what
+        self._raw = open(path, "rb")
+        self._gz = gzip.GzipFile(fileobj=self._raw, mode="rb")
+        self._out = 0
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer) -> int:
+        try:
+            n = self._gz.readinto(buffer)
+        except (OSError, EOFError, gzip.BadGzipFile) as err:
+            raise InputError(f"{self._path}: not a readable gzip stream ({err}); a {self._what} "
+                             "compressed with gzip is expected") from None
+        self._out += n
+        if self._out > GZIP_SLACK and self._out > GZIP_MAX_RATIO * max(self._raw.tell(), 1):
+            raise InputError(f"{self._path}: inflates more than {GZIP_MAX_RATIO} times its compressed "
+                             f"size ({self._out} bytes from {self._raw.tell()}); refused as a gzip bomb "
+                             f"(a {self._what} compresses far less)")
+        return n
+
+    def close(self) -> None:
+        if not self.closed:
+            self._gz.close()
+            self._raw.close()
+        super().close()
+
+
+def is_gzip(path: str | Path) -> bool:
+    """Whether the file starts with gzip's magic bytes (RFC 1952), whatever its name."""
+    with open(path, "rb") as fh:
+        return fh.read(2) == b"\x1f\x8b"
+
+
+def open_bytes(path: str | Path, what: str, max_bytes: int | None = None) -> io.BufferedIOBase:
+    """A binary reader over the regular file ``path`` (of at most ``max_bytes`` bytes on disk),
+    inflating it when it is gzip-compressed (recognised by content) with the bomb check of
+    :class:`_BoundedInflate`. Close it (or use ``with``)."""
+    path = regular_file(path, what, max_bytes)
+    if is_gzip(path):
+        return io.BufferedReader(_BoundedInflate(path, what), 2**20)
+    return open(path, "rb")
+
+
+def open_text(path: str | Path, what: str, max_bytes: int | None = None) -> io.TextIOWrapper:
+    """:func:`open_bytes` as UTF-8 text (a byte-order mark skipped), newlines as in the file."""
+    return io.TextIOWrapper(open_bytes(path, what, max_bytes), encoding="utf-8-sig", newline="")
+
+
+def count_lines(path: str | Path, what: str) -> int:
+    """Lines of the (possibly gzip-compressed) text file ``path``, a last line without a newline
+    counted; read in blocks, so memory stays flat whatever the length (gzip bombs refused)."""
+    lines, last = 0, b"\n"
+    with open_bytes(path, what) as fh:
+        while block := fh.read(2**22):
+            lines += block.count(b"\n")
+            last = block[-1:]
+    return lines + (last != b"\n")
+
+
+# --------------------------------------------------------------------------------------------------
+# HDF5
+
+
+def _link_refusal(f, name: str, link) -> str | None:
+    """Why the link ``name`` (relative to the root of ``f``) is refused, or None."""
+    import h5py
+
+    if isinstance(link, h5py.ExternalLink):
+        return f"/{name} is an external link to {link.filename}:{link.path}"
+    if isinstance(link, h5py.SoftLink):
+        target = link.path if link.path.startswith("/") else f"{name.rpartition('/')[0]}/{link.path}"
+        try:
+            f[target]
+        except (KeyError, OSError, ValueError):
+            return f"/{name} is a soft link to {link.path}, which does not resolve inside the file"
+        return None
+    if not isinstance(link, h5py.HardLink):
+        return f"/{name} is a user-defined link"
+    return None
+
+
+def _dataset_refusal(f, name: str) -> str | None:
+    import h5py
+
+    obj = f.get(name)
+    if not isinstance(obj, h5py.Dataset):
+        return None
+    if obj.is_virtual:
+        sources = sorted({source.file_name for source in obj.virtual_sources()})
+        return f"/{name} is a virtual dataset reading {', '.join(sources)}"
+    if obj.external:
+        return f"/{name} keeps its data in external file(s) {', '.join(str(e[0]) for e in obj.external)}"
+    return None
+
+
+def check_hdf5_links(f, path: str | Path) -> None:
+    """Refuse an open HDF5 file in which any link is external, a soft link fails to resolve inside
+    the file, or a dataset is virtual or stored in external files: each would make a reader open a
+    file it was not given. Every link below the root is walked once (``H5Lvisit``), none followed
+    out of the file."""
+    import h5py
+
+    found: list[str] = []
+
+    def visit(name: str, link) -> int | None:
+        reason = _link_refusal(f, name, link)
+        if reason is None and isinstance(link, h5py.HardLink):
+            reason = _dataset_refusal(f, name)
+        if reason is not None:
+            found.append(reason)
+            return 1  # stop the walk: one refusal is enough to name
+        return None
+
+    f.visititems_links(visit)
+    if found:
+        raise InputError(f"{path}: {found[0]}; faultgen reads only the file it is given (links and "
+                         "virtual datasets that reach other files are refused)")
+
+
+@contextmanager
+def open_hdf5(path: str | Path, what: str = "HDF5 file") -> Iterator:
+    """``h5py.File(path, "r")`` after checking that ``path`` is a regular file, that it is HDF5 and
+    (:func:`check_hdf5_links`) that nothing in it reaches another file.
+
+    Raises
+    ------
+    InputError
+        Naming ``path``, and the link or dataset at fault.
+    """
+    import h5py
+
+    path = regular_file(path, what)
+    try:
+        f = h5py.File(path, "r")
+    except OSError as err:
+        raise InputError(f"{path}: not a readable HDF5 file ({err}); a {what} is expected") from None
+    try:
+        check_hdf5_links(f, path)
+        yield f
+    finally:
+        f.close()
+
+
+def bounded_dataset(f, name: str, path: str | Path, shape: tuple[int | None, ...] | None = None,
+                    kinds: str = "fiub", max_elements: int = HDF5_MAX_ELEMENTS):
+    """The dataset ``name`` of the open HDF5 file ``f`` (not read yet) after checking, from its
+    declared metadata only, that it is a dataset (not a group), that its type kind is one of
+    ``kinds`` (NumPy kinds: f float, i/u integer, b bool, S/O/U text), that its shape matches
+    ``shape`` (``None`` entries match any length; None skips the check) and that it holds at most
+    ``max_elements`` elements.
+
+    Raises
+    ------
+    InputError
+        Naming ``path``, the dataset, and the declared versus the expected shape or type.
+    """
+    import h5py
+
+    obj = f.get(name)
+    if obj is None:
+        raise InputError(f"{path}: no dataset {name}")
+    if not isinstance(obj, h5py.Dataset):
+        raise InputError(f"{path}: {obj.name} is a {type(obj).__name__.lower()}, not a dataset of numbers")
+    if obj.dtype.kind not in kinds:
+        raise InputError(f"{path}: {obj.name} holds {obj.dtype} values; numbers are expected")
+    declared = obj.shape
+    if declared is None:
+        raise InputError(f"{path}: {obj.name} is an empty (null) dataspace; an array is expected")
+    if shape is not None and (len(declared) != len(shape)
+                              or any(want is not None and have != want for have, want in zip(declared, shape))):
+        wanted = "(" + ", ".join("any" if n is None else str(n) for n in shape) + ("," if len(shape) == 1 else "") + ")"
+        raise InputError(f"{path}: {obj.name} has shape {declared}; {wanted} is expected")
+    if int(np.prod(declared, dtype=np.float64)) > max_elements:
+        raise InputError(f"{path}: {obj.name} declares {declared} = {int(np.prod(declared, dtype=np.float64)):.3g} "
+                         f"elements; at most {max_elements} are read")
+    return obj
