@@ -103,10 +103,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         if done is not None:
             stamps = [g.stamp for g in unit_logs]
             late = [g for g in unit_logs[: stamps.index(done)] if g.stamp not in seen] if done in stamps else []
-            if done not in stamps or late:
-                what = f"{late[0].path} is older than" if late else "the log of"
-                raise ValueError(f"{what} the last scored log of {name} ({done}); the monitor scores logs in stamp "
-                                 "order: score this folder into a new OUT")
+            if done not in stamps:
+                raise ValueError(f"{name}: its last scored log ({done}) is no longer in {logs_dir}; put it back or "
+                                 "score this folder into a new OUT")
+            if late:
+                raise ValueError(f"{late[0].path} is older than the last scored log of {name} ({done}); the monitor "
+                                 "scores logs in stamp order: score this folder into a new OUT")
             unit_logs = unit_logs[stamps.index(done) + 1:]
         pending[name] = unit_logs
     cache.mkdir(parents=True, exist_ok=True)
