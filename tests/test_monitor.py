@@ -13,10 +13,11 @@ import time
 from pathlib import Path
 
 import independent_fleet
+import numpy as np
 import pytest
 
 from faultgen.monitor import loop
-from faultgen.monitor.scoring import Settings
+from faultgen.monitor.scoring import Settings, UnitMonitor
 
 # three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
 SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
@@ -147,3 +148,41 @@ def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
     with pytest.raises(ValueError, match="no unit folders"):
         loop.monitor(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False)
     assert not (tmp_path / "out").exists()
+
+
+def _synthetic_unit(seed: int, wear: float, interval: bool) -> bool:
+    """A unit whose 12 features follow the joint temperature linearly (drawn slopes, unit noise);
+    it learns on 28 logs at 20-24 deg C and is then scored at 26-34 deg C (summer after a spring
+    start), from log 40 on with a wear growing along a drawn direction (``wear`` = 0: healthy).
+    Returns whether it raised a persistent alarm."""
+    rng = np.random.default_rng(seed)
+    slope, direction = rng.normal(0, 1, 12), np.abs(rng.normal(0, 1, 12))
+    unit = UnitMonitor("u", Settings(protocol="own"), n_axes=6)
+    if not interval:
+        unit.prediction_factor = lambda conditions: 1.0
+    for i in range(90):
+        temperature = rng.uniform(*((20, 24) if i < 28 else (26, 34)))
+        residual = slope * temperature + rng.normal(0, 1, 12) + wear * 0.2 * max(i - 40, 0) * direction
+        unit.add(f"{i:03d}", residual, temperature, 100.0)
+    return unit.first_alarm is not None
+
+
+def test_warmer_logs_than_the_learning_ones_do_not_alarm_a_healthy_unit_and_a_worn_one_still_alarms():
+    # the slope learned over 4 K and extrapolated 2-10 K beyond it is known only to its standard
+    # error: scored against the regression's prediction interval a healthy unit stays quiet, scored
+    # against the noise alone about half of them alarm (the fleet's warm-day false alarms)
+    seeds = range(20)
+    assert sum(_synthetic_unit(s, 0.0, interval=True) for s in seeds) <= 1
+    assert sum(_synthetic_unit(s, 0.0, interval=False) for s in seeds) >= 5
+    assert all(_synthetic_unit(s, 1.0, interval=True) for s in seeds)
+
+
+def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_outside():
+    rng = np.random.default_rng(0)
+    unit = UnitMonitor("u", Settings(protocol="own", train=10), n_axes=1)
+    temperatures = np.linspace(20.0, 24.0, 10)
+    for i, t in enumerate(temperatures):
+        unit.add(f"{i:02d}", rng.normal(0, 1, 3) + t, t, 100.0)
+    sxx = np.sum((temperatures - temperatures.mean()) ** 2)
+    assert unit.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
+    assert unit.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))

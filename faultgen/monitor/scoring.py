@@ -10,7 +10,15 @@ the unit's own normal operation. On them, per feature, the monitor learns
   and payload (least squares; linear extrapolation beyond them: the seasonal change of friction,
   which the first weeks see only a little of, and the part of a payload's effect the twin gets
   wrong, or without the twin all of it),
-- its noise (the standard deviation left, ``ddof`` = 1 + the slopes),
+- its noise (the standard deviation left, ``ddof`` = 1 + the slopes).
+
+A later log's residual is the regression's prediction error at its conditions, so it is
+standardised by the prediction interval's width, not by the noise alone: the noise times
+``sqrt(1 + 1/m + x0' (X'X)^-1 x0)`` (``m`` learning logs, ``x0`` the log's conditions and ``X``
+the learning logs', both centred on the learning mean: a least-squares regression's prediction
+interval for a new observation, Montgomery & Runger, thesis ref. [66], ch. 11-12). Inside the learned range the factor is close to
+1; a log 8 K warmer than learning logs that spanned 4 K is trusted to its slopes' standard error
+times that distance, which a narrow first month learns only roughly,
 
 and fits :class:`analysis.monitoring.PCAMonitor` (Hotelling's T2 and Q, thesis eq. 2.3-2.6; the
 Q limit out-of-fold, ``cv = 5``) on the standardised residuals. Every later log is standardised
@@ -102,6 +110,9 @@ class UnitMonitor:
         X = C[:, self.regressors_] - self.condition_mean_[self.regressors_]
         self.slope_ = np.linalg.lstsq(X, E - self.mean_, rcond=None)[0] if X.shape[1] else np.zeros((0, E.shape[1]))
         R = E - self.mean_ - X @ self.slope_
+        # (X'X)^-1 of the centred conditions: a later log's leverage (the prediction interval)
+        self.gram_inv_ = np.linalg.pinv(X.T @ X) if X.shape[1] else np.zeros((0, 0))
+        self.learned_ = len(E)
         scale = np.sqrt((R**2).sum(axis=0) / (len(R) - 1 - X.shape[1]))
         self.scale_ = np.where(scale > 0, scale, 1.0)
         Z = R / self.scale_
@@ -113,6 +124,12 @@ class UnitMonitor:
     def _standardise(self, e: np.ndarray, conditions: np.ndarray) -> np.ndarray:
         x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
         return (e - self.mean_ - x @ self.slope_) / self.scale_
+
+    def prediction_factor(self, conditions: np.ndarray) -> float:
+        """The prediction interval's width over the noise's for a log at ``conditions``
+        (temperature deg C, payload kg): ``sqrt(1 + 1/m + x0' (X'X)^-1 x0)`` (module docstring)."""
+        x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
+        return float(np.sqrt(1.0 + 1.0 / self.learned_ + x @ self.gram_inv_ @ x))
 
     # -- ranking --------------------------------------------------------------------------------
     def axis_scores(self, z: np.ndarray) -> np.ndarray:
@@ -137,7 +154,7 @@ class UnitMonitor:
             if len(self.training) == self.settings.train:
                 self._fit()
             return
-        z = self._standardise(np.asarray(residual, dtype=float), conditions)
+        z = self._standardise(np.asarray(residual, dtype=float), conditions) / self.prediction_factor(conditions)
         if expected is not None and self.learned_expectations:
             # the twin's prediction of a change from every condition learned from is trusted to
             # MODEL_UNCERTAINTY of its size: that much is added to the residual's noise
