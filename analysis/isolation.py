@@ -538,3 +538,39 @@ class PCAContributionIsolator(Isolator):
         Z = (X[self.n_reference :] - self.mean_) / self.scale_
         residual = Z - Z @ self.components_.T @ self.components_
         return (residual**2).mean(axis=0)
+
+
+def signature_scores(residual, signatures) -> np.ndarray:
+    """Match a residual against each axis's fault signature (directional residuals: Gertler,
+    *Fault Detection and Diagnosis in Engineering Systems*, 1998, ch. 8): axis i scores the
+    projection of the residual on its signature's unit vector, ``r . s_i / |s_i|``, so a fault of
+    axis i of any size scores highest on axis i when the signatures differ in direction. A fault
+    raising the signature's features scores positive, one lowering them negative.
+
+    Parameters
+    ----------
+    residual : array-like of shape (n_features,) or (n_samples, n_features)
+        Standardised residuals (the features minus their expectation, over their noise).
+    signatures : array-like of shape (n_axes, n_features)
+        How each axis's fault moves the features (same units as ``residual``, per unit of fault).
+
+    Returns
+    -------
+    ndarray of shape (n_axes,) or (n_samples, n_axes)
+
+    Raises
+    ------
+    ValueError
+        If the numbers of features differ, or a signature is zero or not finite (naming the axis).
+    """
+    r = np.asarray(residual, dtype=float)
+    s = np.asarray(signatures, dtype=float)
+    if s.ndim != 2 or r.shape[-1] != s.shape[1]:
+        raise ValueError(f"residual has {r.shape[-1]} features, signatures shape {s.shape}; expected (n_axes, "
+                         f"{r.shape[-1]})")
+    norm = np.linalg.norm(s, axis=1)
+    bad = np.flatnonzero(~np.isfinite(norm) | (norm == 0))
+    if bad.size:
+        raise ValueError(f"the signature of axis {int(bad[0]) + 1} is zero or not finite: the fault does not move "
+                         "the features, so it cannot be isolated from them")
+    return r @ (s / norm[:, None]).T

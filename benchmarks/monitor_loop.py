@@ -1,0 +1,147 @@
+"""`faultgen monitor` on a fleet made by a simulator that is not faultgen: detection, isolation,
+false alarms per protocol, and the loop's time against `faultgen fleet` (issue 46).
+
+    python benchmarks/monitor_loop.py [--units 12] [--worn 8] [--days 120] [--seed 0] [--work DIR]
+                                      [--protocols own,nominal,twin] [--skip-fleet] [--repeat]
+
+In one run of this script:
+
+- the fleet (tests/independent_fleet.py: Pinocchio RNEA on rtb-data's KR210 URDF, our own
+  motor-side friction, seasons, payloads, noise; ``--worn`` units wearing one axis each), its
+  truth in ``truth.csv``;
+- `faultgen monitor` on it per protocol: ``own`` (the features themselves against the unit's first
+  28 logs, no model), ``nominal`` (residuals against the twin built on the nominal model) and
+  ``twin`` (the default: each unit's model calibrated on its first log); each timed (wall, peak
+  RSS of the process tree);
+- `faultgen fleet` simulating the same number of units and days (the same robot folder, one
+  cycle a day, ``--jobs 1`` like the monitor), timed in the same run: the ratio monitor / fleet
+  (goal <= 1);
+- ``--repeat``: the fleet written again from the same seed and the twin monitor re-run: are the
+  logs and alarms.csv / scores.csv identical?
+
+Printed per protocol: worn units flagged with their wear at the first alarm in [10, 40) %
+(the issue's window), before 10 %, at 40 % or later, or never; detection delay (days from the
+wear reaching 10 % to the first alarm: median and range); isolation (worn axis named by the
+alarm); healthy units that ever alarm; false alarms per healthy unit-day (logs over a limit
+after the learning logs, of all such logs: the per-log rate the limits' alpha sets, 2 alpha for
+"T2 or Q" if the residuals were independent normal).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import hashlib
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import independent_fleet  # noqa: E402
+
+from benchmarks_common import PeakRSS  # noqa: E402  (sibling module)
+
+PROTOCOLS = {"own": ["--protocol", "own"], "nominal": ["--no-calibrate"], "twin": []}
+
+
+def run(command: list[str]) -> tuple[float, int, str]:
+    with PeakRSS() as memory:
+        started = time.perf_counter()
+        result = subprocess.run(command, capture_output=True, text=True)
+        wall = time.perf_counter() - started
+    if result.returncode:
+        raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
+    return wall, memory.peak, result.stdout
+
+
+def summary(truth: Path, out: Path) -> dict:
+    outcome = independent_fleet.evaluate(truth, out / "alarms.csv")
+    worn = {u: o for u, o in outcome.items() if o["axis"]}
+    healthy = [u for u, o in outcome.items() if not o["axis"]]
+    delays = [o["delay"] for o in worn.values() if o["in_window"]]
+    with open(out / "scores.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["unit"] in healthy and r["phase"] == "monitoring"]
+    return {
+        "in_window": sum(o["in_window"] for o in worn.values()),
+        "early": sum(o["wear"] is not None and o["wear"] < 10 for o in worn.values()),
+        "late": sum(o["wear"] is not None and o["wear"] >= 40 for o in worn.values()),
+        "missed": sum(o["wear"] is None for o in worn.values()),
+        "worn": len(worn),
+        "delay": (float(np.median(delays)), min(delays), max(delays)) if delays else None,
+        "isolated": sum(o["source"] == o["axis"] for o in worn.values() if o["alarm"]),
+        "alarmed": sum(bool(o["alarm"]) for o in worn.values()),
+        "healthy_alarm": sum(bool(outcome[u]["alarm"]) for u in healthy),
+        "healthy": len(healthy),
+        "false_rate": (sum(int(r["alarm"]) for r in rows), len(rows)),
+        "units": outcome,
+    }
+
+
+def digest(folder: Path, names) -> str:
+    h = hashlib.sha256()
+    for name in names:
+        for path in sorted(folder.glob(name)):
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--units", type=int, default=12)
+    parser.add_argument("--worn", type=int, default=8)
+    parser.add_argument("--days", type=int, default=120)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
+    parser.add_argument("--protocols", default="own,nominal,twin")
+    parser.add_argument("--skip-fleet", action="store_true", help="Do not time `faultgen fleet`.")
+    parser.add_argument("--repeat", action="store_true", help="Check the same seed gives identical outputs.")
+    args = parser.parse_args()
+    work = args.work or Path(tempfile.mkdtemp(prefix="monitor-loop-"))
+    spec = independent_fleet.FleetSpec(units=args.units, worn=args.worn, days=args.days, seed=args.seed)
+    started = time.perf_counter()
+    robot, logs, truth = independent_fleet.write_fleet(work / "fleet", spec)
+    print(f"fleet of {args.units} units x {args.days} days ({args.worn} worn) written by Pinocchio in "
+          f"{time.perf_counter() - started:.0f} s: {logs}")
+    faultgen = [sys.executable, "-m", "faultgen.cli"]
+    times = {}
+    for name in args.protocols.split(","):
+        out = work / f"monitor-{name}"
+        wall, peak, _ = run(faultgen + ["monitor", str(logs), "--robot", str(robot), "-o", str(out)] + PROTOCOLS[name])
+        times[name] = wall
+        s = summary(truth, out)
+        delay = "n/a" if s["delay"] is None else f"{s['delay'][0]:.0f} days (range {s['delay'][1]} to {s['delay'][2]})"
+        alarms, logs_ = s["false_rate"]
+        print(f"\n{name}: {wall:.0f} s, peak RSS {peak / 2**20:.0f} MiB")
+        print(f"  worn units flagged at 10-40 % wear: {s['in_window']} of {s['worn']} (before 10 %: {s['early']}, "
+              f"at >= 40 %: {s['late']}, never: {s['missed']}); delay from 10 % wear: {delay}")
+        print(f"  worn axis named by the alarm: {s['isolated']} of {s['alarmed']} alarmed worn units")
+        print(f"  healthy units that ever alarm: {s['healthy_alarm']} of {s['healthy']}; logs over a limit on "
+              f"healthy units: {alarms} of {logs_} unit-days ({alarms / max(logs_, 1):.3f}; 2 alpha = 0.02 if "
+              "independent normal)")
+        for unit, o in s["units"].items():
+            print(f"    {unit}: worn axis {o['axis'] or '-'}, alarm {o['alarm'] or '-'} (day {o['day'] or '-'}, "
+                  f"wear {'-' if o['wear'] is None else round(o['wear'], 1)} %, 10 % on day {o['day10'] or '-'}), "
+                  f"named axis {o['source'] or '-'}")
+    if not args.skip_fleet:
+        wall, peak, _ = run(faultgen + ["fleet", "--robots", str(args.units), "--failing", str(args.worn), "--days",
+                                        str(args.days), "--cycles-per-day", "1", "--robot", str(robot), "--jobs", "1",
+                                        "--no-progress", "-o", str(work / "faultgen-fleet.h5")])
+        print(f"\nfaultgen fleet, {args.units} units x {args.days} days, 1 cycle a day, 1 job: {wall:.0f} s, "
+              f"peak RSS {peak / 2**20:.0f} MiB")
+        for name, t in times.items():
+            print(f"  monitor ({name}) / fleet: {t / wall:.2f} (goal <= 1)")
+    if args.repeat:
+        _, logs2, _ = independent_fleet.write_fleet(work / "fleet-again", spec, robot=robot)
+        same_logs = digest(logs, ["*/*.csv"]) == digest(logs2, ["*/*.csv"])
+        out2 = work / "monitor-twin-again"
+        run(faultgen + ["monitor", str(logs2), "--robot", str(robot), "-o", str(out2)])
+        same = digest(work / "monitor-twin", ["alarms.csv", "scores.csv"]) == digest(out2, ["alarms.csv", "scores.csv"])
+        print(f"\nsame seed: logs identical {same_logs}; alarms.csv and scores.csv identical {same}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,72 @@
+"""The monitor's outputs: ``alarms.csv``, ``scores.csv`` and one control chart per unit."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence")
+SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
+
+
+def _fmt(value) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def write_alarms(path: Path, monitors) -> None:
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(ALARM_COLUMNS)
+        for m in monitors:
+            row = m.alarm_row()
+            writer.writerow([_fmt(row[c]) for c in ALARM_COLUMNS])
+
+
+def write_scores(path: Path, monitors, n_axes: int) -> None:
+    columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(columns)
+        for m in monitors:
+            for row in m.rows:
+                writer.writerow([_fmt(row[c]) for c in columns])
+
+
+def chart(path: Path, monitor, axis_note: str) -> None:
+    """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, and each
+    axis's isolation score."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = monitor.rows
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True, constrained_layout=True)
+    if rows:
+        x = np.arange(len(rows))
+        for name, style in (("Q", "-"), ("T2", "--")):
+            top.plot(x, [r[name] / r[f"{name}_limit"] for r in rows], style, lw=1, label=f"{name} / limit")
+        top.axhline(1.0, color="k", lw=0.8, label="limit (alpha {:g})".format(monitor.settings.alpha))
+        training = sum(r["phase"] == "training" for r in rows)
+        top.axvspan(-0.5, training - 0.5, color="0.9", label="learning (own first logs)")
+        stamps = [r["stamp"] for r in rows]
+        if monitor.first_alarm:
+            k = stamps.index(monitor.first_alarm)
+            for ax in (top, bottom):
+                ax.axvline(k, color="r", lw=1.2)
+            top.text(k, 1.0, f" alarm {monitor.first_alarm}, axis {monitor.source_axis}", color="r", va="bottom")
+        top.set_yscale("log")
+        scores = np.array([[r[f"score{i}"] for i in range(1, monitor.n_axes + 1)] for r in rows])
+        for i in range(monitor.n_axes):
+            bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
+        step = max(1, len(rows) // 8)
+        bottom.set_xticks(x[::step], stamps[::step], rotation=30, ha="right", fontsize=8)
+    top.set_ylabel("statistic / its limit")
+    top.legend(fontsize=7, loc="upper left")
+    top.set_title(f"{monitor.unit}: PCA monitor of the per-log features ({monitor.settings.protocol} protocol)")
+    bottom.set_ylabel(f"isolation score ({axis_note})")
+    bottom.legend(fontsize=7, loc="upper left", ncol=3)
+    fig.savefig(path, dpi=90, metadata={"Software": None})
+    plt.close(fig)

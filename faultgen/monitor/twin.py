@@ -1,0 +1,118 @@
+"""The twin of a unit: its model (calibrated or nominal) replaying the unit's own logged motion,
+healthy under the logged conditions and with each axis in turn worn.
+
+What the monitor asks of it (:class:`Twin`):
+
+- :meth:`Twin.expected`: the features a healthy unit shows at a joint temperature and payload:
+  the replayed cycle simulated at :data:`TEMPERATURES` (a quadratic through the three, so any
+  temperature in between and a little beyond) for every payload the unit's logs declare (an
+  aluminium cube of that mass hanging from the flange: the log gives the mass only);
+- :attr:`Twin.signatures`: how each axis's wear moves the features, per percent: one cycle with the
+  axis's Coulomb and static friction at :data:`WEAR` % above nominal (thesis eq. 6.6's exp4 schedule
+  at its final value), minus the healthy cycle, at :data:`REFERENCE_TEMPERATURE` without a part.
+
+Every simulated cycle goes through the same feature code as a measured log
+(:func:`faultgen.monitor.logs.features_of` on the simulated angles and arm-side torque, the
+velocity estimated from the angles as for a log without ``qd``), without sensor noise (the twin
+gives the expectation). Cycles are cached on disk by what determines them (model file, program
+file, temperature, payload, worn axis): units that share a model and a program share them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from faultgen.data import atomic, measured
+from faultgen.model import robots
+from faultgen.monitor import logs as fleet_logs
+from faultgen.operation import conditions, wear
+from faultgen.simulation import sensors
+from faultgen.simulation import stepping as sim
+
+#: Joint temperatures the healthy cycle is simulated at, deg C.
+TEMPERATURES = (0.0, 20.0, 40.0)
+#: Reference joint temperature of the wear signatures, deg C (faultgen's nominal friction holds at
+#: 35 C; the signatures are nearly linear in the friction level, so any in range would do).
+REFERENCE_TEMPERATURE = 20.0
+#: Wear of the signature cycles, % increase of Coulomb and static friction.
+WEAR = 40.0
+#: Friction model of the twin's simulation.
+FRICTION = "stribeck"
+#: Density of the declared part, kg/m^3 (aluminium), which sets its edge from its mass.
+PART_DENSITY = 2700.0
+
+
+def part_edge(mass: float) -> float:
+    """Edge of an aluminium cube of ``mass`` kg, m."""
+    return float((mass / PART_DENSITY) ** (1 / 3))
+
+
+def _key(*parts) -> str:
+    digest = hashlib.sha256()
+    for part in parts:
+        digest.update(part if isinstance(part, bytes) else json.dumps(part).encode())
+    return digest.hexdigest()[:24]
+
+
+class Twin:
+    """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
+    log whose motion is replayed, ``cache`` the folder of simulated cycles (created if needed)."""
+
+    def __init__(self, model: str | Path, program: Path, cache: Path):
+        self.model = str(model)
+        self.robot = robots.load(model)
+        self.program = Path(program)
+        self.cache = Path(cache)
+        self.cache.mkdir(parents=True, exist_ok=True)
+        self._files = _key(Path(self.robot.path).read_bytes(), self.program.read_bytes(), FRICTION)
+        self._healthy: dict[float, np.ndarray] = {}
+        healthy = self.cycle(REFERENCE_TEMPERATURE, 0.0)
+        #: (N, F): change of each feature per % wear of each axis (without a part: the signatures
+        #: are shared by every unit of the model and program).
+        self.signatures = np.stack([(self.cycle(REFERENCE_TEMPERATURE, 0.0, axis) - healthy) / WEAR
+                                    for axis in range(1, self.robot.n_axes + 1)])
+
+    def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
+        """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
+        nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
+        temperature = None if np.isnan(temperature) else round(float(temperature), 2)
+        path = self.cache / f"{_key(self._files, temperature, payload, worn_axis, WEAR)}.npy"
+        if path.is_file():
+            return np.load(path)
+        table: dict = {}
+        if temperature is not None:
+            table["thermal"] = {"ambient": temperature, "seasonal": 0.0, "daily": 0.0, "rise": 0.0}
+        if payload > 0:
+            table["payloads"] = {"masses": [payload], "sizes": [round(part_edge(payload), 4)]}
+        plan = wear.WearPlan.from_specs([f"{worn_axis}:exp4:{WEAR:g}"], last_cycle=1) if worn_axis else wear.WearPlan({})
+        config = sim.RunConfig(robot=self.model, task=str(self.program), friction=FRICTION, wear=plan, cycles=1,
+                               seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
+                               conditions=conditions.Conditions.from_dict(table), signals=True)
+        result = sim.simulate(config, progress=False)
+        if result.saturated.size:
+            raise ValueError(f"the twin of {self.program} with a {payload:g} kg part (aluminium cube at the flange) "
+                             f"saturates the drive of axis {', '.join(map(str, result.saturated))}: the model cannot "
+                             "carry that part along this motion; check the log's payload column (kg) and the model")
+        data = measured.from_arrays(result.t, result.q_a[0], result.tau_m[0] * self.robot.gear_ratio, self.robot,
+                                    source=f"twin of {self.program.name}")
+        vector = fleet_logs.features_of(self.robot, data)
+        with atomic.atomic_path(path) as tmp:
+            with open(tmp, "wb") as f:
+                np.save(f, vector)
+        return vector
+
+    def expected(self, temperature: float, payload: float) -> np.ndarray:
+        """Features of the healthy twin at ``temperature`` deg C (NaN: nominal) and ``payload`` kg."""
+        payload = round(float(payload), 1)
+        if np.isnan(temperature):
+            return self.cycle(float("nan"), payload)
+        if payload not in self._healthy:
+            points = np.stack([self.cycle(t, payload) for t in TEMPERATURES])
+            self._healthy[payload] = np.polyfit(np.asarray(TEMPERATURES), points, 2)
+        c = self._healthy[payload]
+        return c[0] * temperature**2 + c[1] * temperature + c[2]

@@ -1,0 +1,188 @@
+"""``faultgen monitor`` on a small fleet made by a simulator that is not faultgen
+(tests/independent_fleet.py: Pinocchio's dynamics of rtb-data's KR210 URDF, our own motor-side
+friction, seasons, payload changes, noise, wear on one unit). The full check, 12 units x 120
+days, is ``benchmarks/monitor_loop.py`` (docs/analysis.md, "Monitor your own robots")."""
+
+import filecmp
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import independent_fleet
+import numpy as np
+import pytest
+
+from faultgen.monitor import loop
+from faultgen.monitor.scoring import Settings, UnitMonitor
+
+# three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
+SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
+SETTINGS = Settings(train=14, persistence=3)
+
+
+@pytest.fixture(scope="module")
+def fleet(tmp_path_factory):
+    root = tmp_path_factory.mktemp("fleet")
+    robot, logs, truth = independent_fleet.write_fleet(root, SPEC)
+    return robot, logs, truth
+
+
+@pytest.fixture(scope="module")
+def monitored(fleet, tmp_path_factory):
+    robot, logs, truth = fleet
+    out = tmp_path_factory.mktemp("monitor") / "out"
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    return out
+
+
+def with_cycles_of(monitored: Path, out: Path) -> Path:
+    """``out`` holding the twin's simulated cycles of ``monitored`` (content-addressed: the same
+    model, program and conditions give the same file), so that a test of the loop's bookkeeping
+    does not simulate them again."""
+    shutil.copytree(monitored / ".cache" / "cycles", out / ".cache" / "cycles")
+    return out
+
+
+def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_healthy_do_not(fleet, monitored):
+    _, _, truth = fleet
+    outcome = independent_fleet.evaluate(truth, monitored / "alarms.csv")
+    worn = [u for u, o in outcome.items() if o["axis"]]
+    assert len(worn) == 1, outcome
+    for unit, o in outcome.items():
+        if o["axis"]:
+            assert o["in_window"], (unit, o)  # 10 % <= wear at the first alarm < 40 %
+            assert o["source"] == o["axis"], (unit, o)
+        else:
+            assert not o["alarm"], (unit, o)
+    assert {p.name for p in monitored.glob("*.png")} == {f"{u}.png" for u in outcome}
+
+
+def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
+    """The fleet again from the same seed: identical logs, and identical outputs from them (the
+    twin's cycles taken from the first run: faultgen's simulation repeats itself bit for bit,
+    tests/test_sim.py)."""
+    robot, first_logs, _ = fleet
+    _, logs, _ = independent_fleet.write_fleet(tmp_path / "again", SPEC, robot=robot)
+    assert sorted(p.relative_to(logs) for p in logs.rglob("*.csv")) == \
+        sorted(p.relative_to(first_logs) for p in first_logs.rglob("*.csv"))
+    for path in logs.rglob("*.csv"):
+        assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
+    out = with_cycles_of(monitored, tmp_path / "out")
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    for name in ("alarms.csv", "scores.csv"):
+        assert filecmp.cmp(out / name, monitored / name, shallow=False), name
+
+
+def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    partial = tmp_path / "logs"
+    keep = 25
+    for unit in logs.iterdir():
+        (partial / unit.name).mkdir(parents=True)
+        for log in sorted(unit.iterdir())[:keep]:
+            os.link(log, partial / unit.name / log.name)
+    out = with_cycles_of(monitored, tmp_path / "out")
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
+    first = (out / "scores.csv").read_text().splitlines()
+    assert len(first) == 1 + SPEC.units * keep
+    for unit in logs.iterdir():  # the rest of the month arrives
+        for log in sorted(unit.iterdir())[keep:]:
+            os.link(log, partial / unit.name / log.name)
+    before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
+    scored = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
+    assert all(len(m.rows) == SPEC.days for m in scored)
+    # the old rows are kept as they were, the new ones equal a run over the whole folder at once
+    assert (out / "scores.csv").read_text() == (monitored / "scores.csv").read_text()
+    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
+    assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
+
+
+def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    out = with_cycles_of(monitored, tmp_path / "out")
+    folder = tmp_path / "logs" / "unit01"
+    folder.mkdir(parents=True)
+    units = sorted(logs.iterdir())
+    files = sorted(units[0].iterdir())
+    for log in [files[0], *files[2:16]]:
+        os.link(log, folder / log.name)
+    loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    os.link(files[1], folder / files[1].name)
+    with pytest.raises(ValueError, match=f"{files[1].name}.*older than the last scored log of unit01"):
+        loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    out = with_cycles_of(monitored, tmp_path / "out")
+    cycles = out / ".cache" / "cycles"
+    for path in sorted(cycles.iterdir())[:2]:  # two of the twin's cycles to simulate again
+        path.unlink()
+    left = len(list(cycles.iterdir()))
+    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+               "--no-calibrate", "--train", "14", "--persistence", "3"]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).parents[1]), os.environ.get("PYTHONPATH", "")])}
+    process = subprocess.Popen(command, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while len(list(cycles.iterdir())) == left:  # killed once it has simulated one of them
+        assert process.poll() is None and time.monotonic() < deadline, "the monitor ended before it was killed"
+        time.sleep(0.02)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    assert not (out / "alarms.csv").exists() and not (out / "scores.csv").exists()
+    assert not list(out.glob("*.png")) and not (out / ".state").exists()
+    result = subprocess.run(command, env=env, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
+
+
+def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
+    robot, _, _ = fleet
+    with pytest.raises(ValueError, match="protocol = 'magic'"):
+        Settings(protocol="magic")
+    (tmp_path / "logs").mkdir()
+    with pytest.raises(ValueError, match="no unit folders"):
+        loop.monitor(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False)
+    assert not (tmp_path / "out").exists()
+
+
+def _synthetic_unit(seed: int, wear: float, interval: bool) -> bool:
+    """A unit whose 12 features follow the joint temperature linearly (drawn slopes, unit noise);
+    it learns on 28 logs at 20-24 deg C and is then scored at 26-34 deg C (summer after a spring
+    start), from log 40 on with a wear growing along a drawn direction (``wear`` = 0: healthy).
+    Returns whether it raised a persistent alarm."""
+    rng = np.random.default_rng(seed)
+    slope, direction = rng.normal(0, 1, 12), np.abs(rng.normal(0, 1, 12))
+    unit = UnitMonitor("u", Settings(protocol="own"), n_axes=6)
+    if not interval:
+        unit.prediction_factor = lambda conditions: 1.0
+    for i in range(90):
+        temperature = rng.uniform(*((20, 24) if i < 28 else (26, 34)))
+        residual = slope * temperature + rng.normal(0, 1, 12) + wear * 0.2 * max(i - 40, 0) * direction
+        unit.add(f"{i:03d}", residual, temperature, 100.0)
+    return unit.first_alarm is not None
+
+
+def test_warmer_logs_than_the_learning_ones_do_not_alarm_a_healthy_unit_and_a_worn_one_still_alarms():
+    # the slope learned over 4 K and extrapolated 2-10 K beyond it is known only to its standard
+    # error: scored against the regression's prediction interval a healthy unit stays quiet, scored
+    # against the noise alone about half of them alarm (the fleet's warm-day false alarms)
+    seeds = range(20)
+    assert sum(_synthetic_unit(s, 0.0, interval=True) for s in seeds) <= 1
+    assert sum(_synthetic_unit(s, 0.0, interval=False) for s in seeds) >= 5
+    assert all(_synthetic_unit(s, 1.0, interval=True) for s in seeds)
+
+
+def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_outside():
+    rng = np.random.default_rng(0)
+    unit = UnitMonitor("u", Settings(protocol="own", train=10), n_axes=1)
+    temperatures = np.linspace(20.0, 24.0, 10)
+    for i, t in enumerate(temperatures):
+        unit.add(f"{i:02d}", rng.normal(0, 1, 3) + t, t, 100.0)
+    sxx = np.sum((temperatures - temperatures.mean()) ** 2)
+    assert unit.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
+    assert unit.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
