@@ -41,7 +41,9 @@ def monitor_command(
     replays the unit's first log, healthy at every payload the logs declare and with each axis in
     turn worn (40 %, thesis eq. 6.6's schedule at its end); (c) on the first --train logs the monitor
     learns the residual's offset, temperature slope and noise and fits a PCA monitor (T2 and Q,
-    thesis eq. 2.3-2.6); (d) every later log is scored. A unit alarms from the first of
+    thesis eq. 2.3-2.6); (d) every later log is scored, its residual standardised by the
+    regression's prediction interval (wider the further its temperature and payload lie outside
+    those the learning logs saw). A unit alarms from the first of
     --persistence consecutive logs over a limit; its source axis is the one whose wear signature
     the residual follows most.
 
