@@ -36,6 +36,7 @@ BASE = {
     "detect": [f"{MISSING}/d.h5"],
     "training-source": [f"{MISSING}/d.h5"],
     "classify": [f"{MISSING}/d.h5"],
+    "monitor": [f"{MISSING}/LOGS", "--robot", "irb6700", "-o", f"{MISSING}/m"],
     "hidden-log": ["puma560", "--effect", "stribeck", "-o", f"{MISSING}/log.csv"],
 }
 #: Examples per option; with the options found, the total the docs give (test_the_fuzz_covers_...).

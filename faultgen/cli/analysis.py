@@ -110,8 +110,8 @@ def bench_isolators_command(
         training_input(train)
         isolators, stated = crossdata.trained_isolators(isolators, train, file, baseline=baseline)
         stated = "protocol: " + stated
-    typer.echo(stated)
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
+    typer.echo(stated)  # after the isolators ran: a plug-in refused in fit is the only line printed
     with atomic.output_set(written) as staged:  # all five outputs, or none
         benchmark.write_outputs(table, staged(stem), benchmark.isolation_markdown(table))
         benchmark.isolation_heatmap(table, staged(stem.with_suffix(".png")))
