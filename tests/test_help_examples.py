@@ -112,6 +112,17 @@ def mine_py(folder: Path) -> None:
     (folder / "mine.py").write_text(block)
 
 
+def logs_folder(folder: Path) -> None:
+    """A fleet's folder of logs in the documented layout (tests/fleetlog_folder.py): 3 units x 40
+    days of the IRB 6700's axes, axis 2 of u1 wearing from day 11, written in events.csv."""
+    import fleetlog_folder
+
+    from faultgen.model import robots
+
+    fleetlog_folder.write_fleet(folder / "LOGS", robots.load("irb6700"), units=3, days=40, worn={0: (2, 10, 2.0)})
+    (folder / "LOGS/events.csv").write_text("unit,stamp,event,axis\nu1,2026-03-11,onset,2\n")
+
+
 #: file -> the documented command that makes it (run with the small-data options) or a maker.
 MADE = {
     "quick.h5": "faultgen sweep --preset quick -o quick.h5",
@@ -127,6 +138,8 @@ MADE = {
     # docs/robots.md: "--drivetrain gives some or all drivetrain numbers (tables [axis.1] .. [axis.N])"
     "my_drives.toml": lambda folder: (folder / "my_drives.toml").write_text("[axis.1]\ngear_ratio = 100.0\n"),
     "mine.py": mine_py,
+    # docs/dataset.md's layout, "A fleet's logs": three units' daily logs, an onset on one in events.csv
+    "LOGS": logs_folder,
 }
 
 

@@ -84,7 +84,6 @@ def bench_isolators_command(
       faultgen sweep --preset j2 -o j2.h5 && faultgen bench-isolators j2.h5
       faultgen bench-isolators j2.h5 --speed-window 50,120 -o j2-window
       faultgen bench-isolators j2.h5 --isolator mine:LargestRise -o j2-mine
-      faultgen bench-isolators logs.h5 --train nominal.h5
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
@@ -190,7 +189,6 @@ def detect_command(
       faultgen fleet --robots 8 --days 20 -o fleet8.h5 && faultgen detect fleet8.h5
       faultgen sweep --preset quick --seed 0 --seed 1 -o quick-seeds.h5
       faultgen detect quick-seeds.h5 --protocol other-seeds -o quick-seeds-detection
-      faultgen detect logs.h5 --train nominal.h5 --first 10
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
@@ -263,7 +261,6 @@ def training_source_command(
 
     \b
       faultgen fleet -o fleet.h5 && faultgen training-source fleet.h5 -o fleet-ch4
-      faultgen training-source logs.h5 --train fleet.h5 --training-days 20 --test-days 10
     """
     from analysis import benchmark
     from analysis import training_source as ts
@@ -392,7 +389,6 @@ def classify_command(
       faultgen classify fleet.h5 --horizon 3 --pairs 0 --full -o fleet-full
       faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19 -o fleet-lr
       faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19 -o fleet-matched
-      faultgen classify logs.h5 --train fleet.h5 --classifier lr --classifier rf
     """
     import shlex
 

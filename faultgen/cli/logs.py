@@ -27,7 +27,6 @@ def logs_group() -> None:
 
     \b
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5
-      faultgen detect fleet-logs.h5 --train nominal-fleet.h5
     """
 
 
@@ -67,7 +66,6 @@ def import_command(
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5 --skip-bad
       faultgen info fleet-logs.h5 && faultgen detect fleet-logs.h5
-      faultgen logs import UR-LOGS --robot ur5e-folder --format ur-rtde -o ur.h5
     """
     from faultgen.data import adapters, fleetlogs
 

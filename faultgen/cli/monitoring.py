@@ -52,11 +52,13 @@ def monitor_command(
     OUT/<unit>.png (control chart, alarm, axis scores), all together; a rerun after new logs
     arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.
 
-    Example:
+    The twin is the default: `faultgen monitor LOGS --robot ROBOT -o OUT`, with LOGS the folder of
+    your robots' logs (`faultgen logs import --help`) and ROBOT the model they come from (its
+    calibration refuses logs the model cannot have made). Without a model, each unit against its
+    own first logs only:
 
     \b
-      faultgen monitor LOGS --robot ./kr210 -o monitor
-      faultgen monitor LOGS --robot ./kr210 -o monitor --protocol own
+      faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
     from faultgen.monitor import loop
     from faultgen.monitor.scoring import Settings

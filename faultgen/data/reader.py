@@ -335,7 +335,7 @@ class Dataset(Sequence):
     def unhashed(self) -> str:
         """A note when runs lack the program hash (files written before it): analyses then pair them
         by their ``task`` label alone, which two different programs may share; "" otherwise."""
-        old = [r for r in self.runs if r.program_sha256 is None]
+        old = [r for r in self.runs if r.program_sha256 is None and not r.measured]  # a log has no program
         if not old:
             return ""
         return (f"note: {len(old)} of {len(self.runs)} runs of {self.path.name} were written before runs recorded "

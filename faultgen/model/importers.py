@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import copy
 import math
-import re
 import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
