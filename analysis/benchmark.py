@@ -609,12 +609,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates), false_alarm_interval(*counts))
         false_alarm, n_normal, (low, high) = false_alarms[key]
         wear = fault_progress(run, axis) * 100.0 - 100.0
-        located = UNDECIDED
-        if onset is not None:
-            try:
-                located = int(isolation.make("cross_correlation").fit(worn[: onset + 1]).source_axis_)
-            except ValueError:  # too few samples up to the onset to cross-correlate: said, not undecided
-                located = TOO_FEW_CYCLES
+        located = locate_onset(worn, onset)
         rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
                          trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
@@ -641,6 +636,19 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
     table.attrs["fault_begins_sample"] = {r: c["begins"] for r, c in charts.items() if c["begins"] is not None}
     charts["_reasons"] = reasons
     return table, charts
+
+
+def locate_onset(features: np.ndarray, onset: int | None) -> int:
+    """The axis (1..N) the cross-correlation isolator (thesis ch. 3.4.2) names on ``features``
+    (n_samples, N) up to and including the ``onset`` sample, as ``faultgen detect`` locates (with
+    or without ``--train``); :data:`UNDECIDED` without an onset, :data:`TOO_FEW_CYCLES` when too
+    few samples precede it to cross-correlate (said, not undecided)."""
+    if onset is None:
+        return UNDECIDED
+    try:
+        return int(isolation.make("cross_correlation").fit(features[: onset + 1]).source_axis_)
+    except ValueError:
+        return TOO_FEW_CYCLES
 
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.

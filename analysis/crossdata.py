@@ -31,7 +31,7 @@ from sklearn.base import clone
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from analysis.benchmark import UNDECIDED, fault_progress, opened
+from analysis.benchmark import fault_progress, locate_onset, opened
 from analysis.features import kl_divergence
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen.data import reader
@@ -184,20 +184,6 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
         table = pd.DataFrame(rows)
         table.attrs["dataset_kind"] = data.kind
     return table, charts
-
-
-def locate_onset(features: np.ndarray, onset: int | None) -> int:
-    """The axis (1..N) the cross-correlation isolator (thesis ch. 3.4.2) names on ``features``
-    (n_records, N) up to and including the ``onset`` record, as ``faultgen detect`` locates;
-    :data:`analysis.benchmark.UNDECIDED` without an onset or with too few records before it.
-    (Kept beside :func:`analysis.benchmark.detection_table`'s own, which another change is editing;
-    one of the two should go when both have landed.)"""
-    if onset is None:
-        return UNDECIDED
-    try:
-        return int(isolation.make("cross_correlation").fit(features[: onset + 1]).source_axis_)
-    except ValueError:  # too few records before the onset to cross-correlate
-        return UNDECIDED
 
 
 class ReferencePCAContribution(isolation.PCAContributionIsolator):
