@@ -1,7 +1,7 @@
 """Faults: one effect's parameter growing over a run's cycles, friction wear among them.
 
 A :class:`Fault` names the effect (:mod:`faultgen.effects`), the axis, the parameter and how it
-grows, on the shape of a wear schedule (:class:`faultgen.operation.wear.Schedule`: ``linear`` by
+grows, on the shape of a wear schedule (:class:`faultgen.operation.schedules.Schedule`: ``linear`` by
 default; ``exp4``, ``logistic``, ``step``). It grows in one of two ways:
 
 ``absolute`` (``--fault``)
@@ -39,7 +39,7 @@ from faultgen import axes
 from faultgen.checks import is_whole
 from faultgen.effects.base import Effect
 from faultgen.effects.motor_friction import FrictionParameter, MotorFriction
-from faultgen.operation import wear
+from faultgen.operation import schedules
 
 #: How a fault's parameter grows (:attr:`Fault.growth`).
 GROWTHS = ("absolute", "relative")
@@ -83,7 +83,7 @@ class Fault:
     growth : str
         ``absolute`` (default) or ``relative`` (:data:`GROWTHS`; module docstring).
     options : dict
-        Further schedule parameters (:attr:`faultgen.operation.wear.Schedule.params`: logistic
+        Further schedule parameters (:attr:`faultgen.operation.schedules.Schedule.params`: logistic
         ``shape``, step ``step_cycle``), default none.
 
     Raises
@@ -176,13 +176,13 @@ class Fault:
         """The parameters the fault changes: :attr:`parameter`, or the members of its group."""
         return type(effects.get(self.effect)).groups.get(self.parameter, (self.parameter,))
 
-    def _schedule(self) -> wear.Schedule:
+    def _schedule(self) -> schedules.Schedule:
         """The growth's shape: a wear schedule of the relative increase, or of a unit rise."""
         params = {**({"onset": self.onset} if self.onset else {}), **self.options}
-        return wear.Schedule(self.kind, self.final if self.relative else 1.0, self.last_cycle, params)
+        return schedules.Schedule(self.kind, self.final if self.relative else 1.0, self.last_cycle, params)
 
     @property
-    def schedule(self) -> wear.Schedule:
+    def schedule(self) -> schedules.Schedule:
         """The schedule of a relative fault (its multiplier is the fault's value); ValueError for an absolute one."""
         if not self.relative:
             raise ValueError(f"the {self.effect} fault is absolute; only a relative fault has a multiplier schedule")
@@ -190,7 +190,7 @@ class Fault:
 
     def values(self, cycles) -> np.ndarray:
         """The parameter at ``cycles`` (ints >= 0, any shape): absolute, in its unit; relative,
-        the dimensionless multiplier of the robot's own value (:meth:`wear.Schedule.multiplier`,
+        the dimensionless multiplier of the robot's own value (:meth:`schedules.Schedule.multiplier`,
         thesis eq. 6.6 for ``exp4``)."""
         if self.relative:
             return self._schedule().multiplier(np.asarray(cycles))
