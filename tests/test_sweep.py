@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.model import robots
-from faultgen.runs import sweep
+from faultgen.runs import sweep, worker
 
 runner = CliRunner()
 
@@ -172,7 +172,7 @@ def test_a_ctrl_c_landing_in_a_weakref_callback_is_not_printed_but_stops_the_swe
     def callback(_) -> None:
         raise KeyboardInterrupt
 
-    with pytest.raises(KeyboardInterrupt), sweep._CtrlC():
+    with pytest.raises(KeyboardInterrupt), sweep.CtrlC():
         part = Part()
         ref = weakref.ref(part, callback)
         del part  # the callback runs here and its KeyboardInterrupt cannot propagate
@@ -188,11 +188,11 @@ def test_a_worker_does_not_print_an_interrupt_it_cannot_raise(monkeypatch, in_a_
     as the sweep's process stops the workers; other unraisable exceptions still reach the hook."""
     reached = []
     monkeypatch.setattr(sys, "unraisablehook", reached.append)  # stands for Python's printing hook
-    monkeypatch.setattr(sweep, "simulate_and_write", lambda *call: call)
+    monkeypatch.setattr(worker, "simulate_and_write", lambda *call: call)
     sweep_pid = os.getpid() + 1 if in_a_worker else os.getpid()
-    assert sweep._in_worker(sweep_pid, "run", "config") == ("run", "config")
+    assert worker.in_worker(sweep_pid, "run", "config") == ("run", "config")
     hook = sys.unraisablehook
-    sweep._in_worker(sweep_pid, "next run", "config")
+    worker.in_worker(sweep_pid, "next run", "config")
     assert sys.unraisablehook == hook  # a worker's next run does not wrap the hook again
 
     class Part:
@@ -212,7 +212,7 @@ def test_a_worker_does_not_print_an_interrupt_it_cannot_raise(monkeypatch, in_a_
 
 def test_once_the_sweep_stops_a_second_ctrl_c_is_not_raised_in_its_clean_up(ctrl_c_raises):
     try:
-        with sweep._CtrlC() as ctrl_c:
+        with sweep.CtrlC() as ctrl_c:
             with pytest.raises(KeyboardInterrupt):
                 signal.raise_signal(signal.SIGINT)
             try:

@@ -45,7 +45,8 @@ import numpy as np
 from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
-from faultgen.runs.sweep import RunStats, SweepError, SweepRefused, _release_memory, simulate_and_write
+from faultgen.runs.errors import SweepError, SweepRefused
+from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
 from faultgen.simulation import stepping as sim
 
 #: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
@@ -124,7 +125,7 @@ def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
     slim = for_transfer(result)
     simulated = result.tau_m.shape[0] * result.t[-1]
     del result
-    _release_memory()
+    release_memory()
     return Outcome(slim, get_worker().address, dataset.model_hash(robots.load(config.robot).path), __version__,
                    simulated, total, slim.stepping_time, _peak_memory())
 

@@ -13,18 +13,16 @@ same output refuses at once, naming the first. The kernel releases the lock of a
 the next one takes it over (and says so). The lock file is removed when the sweep ends.
 
 Whatever ends the sweep's own process (Ctrl-C, SIGTERM, SIGKILL), its local workers end too:
-each watches its parent and exits within a second of it (:func:`_watch_parent`); a SIGTERM is
+each watches its parent and exits within a second of it (:func:`faultgen.runs.worker.watch_parent`); a SIGTERM is
 handled as a Ctrl-C (the workers are stopped, the message says what is kept and how to resume).
 """
 
+
 from __future__ import annotations
 
-import ctypes
 import datetime
 import errno
 import fcntl
-import gc
-import itertools
 import json
 import logging
 import os
@@ -36,418 +34,27 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Self
 
-import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen import axes as axis_numbers
-from faultgen import inputs
 from faultgen.data import atomic, dataset
-from faultgen.effects import friction
-from faultgen.model import robots
-from faultgen.operation import faults, programs, tasks, wear
-from faultgen.operation.conditions import Conditions
-from faultgen.simulation import sensors
+from faultgen.runs import cluster, worker
+from faultgen.runs.errors import SweepError, SweepInterrupted, SweepRefused
+from faultgen.runs.grid import PRESETS, Grid
+from faultgen.runs.worker import RunStats, simulate_and_write
 from faultgen.simulation import stepping as sim
+
+__all__ = ["PRESETS", "Grid", "RunStats", "SweepError", "SweepInterrupted", "SweepRefused", "finished_runs",
+           "lock_path", "parts_folder", "run", "simulate_and_write"]
 
 log = logging.getLogger(__name__)
 
-#: Named grids. quick: a small grid for a first look (under a minute on 2 cores).
-#: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
-#: c2: thesis ch. 3 (PUMA 560, 3 tasks x 6 axes x {10, 20} % logistic over 120 hours of one-minute
-#: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled); features
-#: only unless ``signals=True`` (the signals would take 16 GB; detection gives the same table without).
-PRESETS = {
-    "quick": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
-                  schedules=["exp4"], cycles=100, record=list(range(10, 101, 10))),
-    "j2": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
-               schedules=["exp4"], cycles=100, record="all"),
-    "c2": dict(robots=["puma560"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[10.0, 20.0],
-               schedules=["logistic"], cycles=120 * 60, record={"period": 60, "first": 10}, signals=False),
-}
-
-
-class SweepError(RuntimeError):
-    """A sweep could not finish; the message says what to do. Finished runs are kept."""
-
-    #: The command line's exit code for it (faultgen.cli.base.Command): a run failed.
-    exit_code = 1
-
-
-class SweepRefused(SweepError):
-    """A sweep refused to start (its output exists, or another sweep is writing it); nothing ran."""
-
-    exit_code = 2
-
-
-class SweepInterrupted(SweepError):
-    """A sweep was interrupted (Ctrl-C); the message says how many runs are kept and how to resume."""
-
-    exit_code = 130  # as a shell reports a process ended by SIGINT (143 for SIGTERM)
-    message_prefix = ""  # a report of what was kept, not an error
-
-    def __init__(self, message: str, exit_code: int = 130) -> None:
-        super().__init__(message)
-        self.exit_code = exit_code
-
 
 class _Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where a Ctrl-C would be, so that a sweep stops the same way (:class:`_CtrlC`)."""
+    """SIGTERM, raised where a Ctrl-C would be, so that a sweep stops the same way (:class:`CtrlC`)."""
 
-
-@dataclass(frozen=True)
-class Grid:
-    """The runs of a sweep, as the product of its lists.
-
-    Attributes
-    ----------
-    robots, tasks : list of str
-    axes : list of int
-        Worn axes, 1..N of every robot of the grid; 0 means a run without wear (one per robot, task and seed).
-    increases : list of float
-        Final wear in percent (20 = Coulomb and static friction 20 % higher at the last cycle).
-    schedules : list of str
-        Wear schedules (:data:`faultgen.operation.wear.SCHEDULES`).
-    friction : str
-        Friction model (:data:`faultgen.effects.friction.MODELS`).
-    cycles : int
-        Cycles per run.
-    record : "all", list of int, or {"period": P, "first": F}
-        Cycles to simulate and record: all, the listed ones, or the first F of every P.
-    seeds : list of int
-    disturbance, encoder : float
-        Noise levels (:class:`faultgen.simulation.sensors.NoiseConfig`).
-    conditions : dict or None
-        Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
-        ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,
-        ``hours``); None: none, the runs differ from their references only by wear.
-    fault : str or None
-        A fault other than friction wear for the worn axes, ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]``
-        (:class:`faultgen.operation.faults.FaultSpec`, the one fault text of every command): with
-        AXIS ``each`` (``backlash:each:width:0.01``) each axis of ``axes`` but 0 gets it instead of friction
-        wear; with a number, ``axes`` may wear only that axis (and 0). ``increases`` and
-        ``schedules`` are then unused; ``kind=...`` shapes its growth.
-    signals : bool
-        Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
-        isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
-        window of ``bench-isolators`` needs the signals).
-
-    Raises
-    ------
-    ValueError
-        On construction, naming the first invalid value; nothing is simulated.
-    """
-
-    robots: list[str]
-    tasks: list[str]
-    axes: list[int]
-    increases: list[float] = field(default_factory=lambda: [20.0])
-    schedules: list[str] = field(default_factory=lambda: ["exp4"])
-    friction: str = "lugre"
-    cycles: int = 100
-    record: str | list[int] | dict = "all"
-    seeds: list[int] = field(default_factory=lambda: [0])
-    disturbance: float = 0.01
-    encoder: float = 1e-4
-    conditions: dict | None = None
-    fault: str | None = None
-    signals: bool = True
-
-    def __post_init__(self) -> None:
-        for name in ("robots", "tasks", "axes", "increases", "schedules", "seeds"):
-            value = getattr(self, name)
-            if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or not value:
-                raise ValueError(f"grid field {name!r} must be a non-empty list, got {value!r}")
-        for axis in self.axes:
-            if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
-                raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
-        friction.check_model(self.friction)
-        if self.fault is not None:
-            spec = faults.FaultSpec.parse(self.fault)
-            worn = sorted(set(self.axes) - {0})
-            if spec.axis is not None and worn != [spec.axis]:
-                raise ValueError(
-                    f"fault {self.fault!r} is on axis {spec.axis} but the grid wears axes "
-                    f"{', '.join(map(str, worn)) or 'none'}: give --axis 0 --axis {spec.axis}, or write "
-                    f"{str(replace(spec, axis=None))!r} "
-                    "to give each worn axis the fault in turn")
-        for kind in self.schedules:
-            if kind not in wear.SCHEDULES:
-                raise ValueError(f"unknown wear schedule {kind!r}; expected one of: {', '.join(wear.SCHEDULES)}")
-        for pct in self.increases:
-            if isinstance(pct, bool) or not isinstance(pct, (int, float)) or not np.isfinite(pct) or pct < 0:
-                raise ValueError(f"grid increases (--wear-pct): {pct!r} % must be a finite number >= 0")
-            if pct > 100 * wear.MAX_INCREASE:
-                raise ValueError(f"grid increases (--wear-pct): {pct:g} % is beyond the bound of "
-                                 f"{100 * wear.MAX_INCREASE:g} % (faultgen.operation.wear.MAX_INCREASE)")
-        for name in ("cycles",):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"grid {name} = {value!r} (--{name}): expected a whole number >= 1")
-        for seed in self.seeds:
-            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-                raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number >= 0")
-        if not isinstance(self.signals, bool):
-            raise ValueError(f"grid signals = {self.signals!r}: expected true or false (a TOML boolean, not a string)")
-        for name in ("disturbance", "encoder"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
-                raise ValueError(f"grid {name} = {value!r}: expected a finite number >= 0")
-        # builds and validates every run configuration, once: runs() returns these
-        object.__setattr__(self, "_runs", self._build_runs())
-
-    @classmethod
-    def from_preset(cls, name: str, **overrides) -> Grid:
-        """A named grid (:data:`PRESETS`), with fields replaced by ``overrides``."""
-        if name not in PRESETS:
-            raise ValueError(f"unknown preset {name!r}; expected one of: {', '.join(PRESETS)}")
-        return cls(**{**PRESETS[name], **overrides})
-
-    @classmethod
-    def from_toml(cls, path: str | Path) -> Grid:
-        """Read a grid from a TOML file whose top-level keys are the fields of :class:`Grid`.
-
-        A ``preset = "name"`` key starts from that preset. Unknown keys are refused.
-        """
-        data = inputs.read_toml(path, "grid file")
-        known = {f.name for f in fields(cls)} | {"preset"}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise ValueError(f"{path}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(known))}")
-        preset = data.pop("preset", None)
-        if not preset:
-            missing = [f.name for f in fields(cls) if f.name in ("robots", "tasks", "axes") and f.name not in data]
-            if missing:
-                raise ValueError(f"{path}: no key {missing[0]!r} (and no preset); a grid file needs robots, tasks "
-                                 "and axes, or preset = \"quick\" (or j2, c2)")
-        return cls.from_preset(preset, **data) if preset else cls(**data)
-
-    def recorded_cycles(self) -> tuple[int, ...] | None:
-        """The ``record`` field as cycle indices (None: all)."""
-        if self.record == "all":
-            return None
-        if isinstance(self.record, dict):
-            if set(self.record) != {"period", "first"}:
-                raise ValueError(f"record {self.record!r}: expected {{period = P, first = F}}")
-            period, first = int(self.record["period"]), int(self.record["first"])
-            if not 1 <= first <= period:
-                raise ValueError(f"record {self.record!r}: need 1 <= first <= period")
-            return tuple(k for k in range(1, self.cycles + 1) if (k - 1) % period < first)
-        if isinstance(self.record, (list, tuple)):
-            return tuple(int(c) for c in self.record)
-        raise ValueError(f"record {self.record!r}: expected \"all\", a list of cycles or {{period, first}}")
-
-    def runs(self) -> list[tuple[str, sim.RunConfig]]:
-        """Every run of the grid as ``(run id, RunConfig)``, in a stable order (built and validated
-        once, when the grid is made)."""
-        return list(self._runs)
-
-    def _build_runs(self) -> list[tuple[str, sim.RunConfig]]:
-        noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
-        record = self.recorded_cycles()
-        if self.conditions is not None and not isinstance(self.conditions, dict):
-            raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
-        conditions = Conditions.from_dict(self.conditions or {})
-        out: dict[str, sim.RunConfig] = {}
-        named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
-        for robot in self.robots:
-            first = named.setdefault(robots.load(robot).name, str(robot))
-            if first != str(robot) and robots.load(first).path != robots.load(robot).path:
-                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
-                                 "run ids need different names (rename one folder or MJCF file)")
-        self._check_programs()
-        for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
-            name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
-            if axis > n_axes:
-                raise ValueError(f"worn axis {axis} is out of range 0..{n_axes} of robot {name} (0 = no wear)")
-            # a run without wear is one run, whatever the wear levels and schedules of the grid
-            variants = [(None, 0.0)] if axis == 0 or self.fault else itertools.product(self.schedules, self.increases)
-            for kind, pct in variants:
-                plan, fault = wear.WearPlan({}), None
-                if axis == 0:
-                    label = "nowear"
-                elif self.fault:
-                    fault = faults.FaultSpec.parse(self.fault).fault(self.cycles, axis=axis)
-                    label = f"axis{axis}-{fault.effect}{fault.final:g}"
-                else:
-                    plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
-                    label = f"axis{axis}-{kind}{pct:g}"
-                run_id = f"{name}-{programs.label(task)}-{label}-seed{seed}"
-                if run_id in out and out[run_id].task != task:
-                    raise ValueError(f"tasks {out[run_id].task!r} and {task!r} would both make run {run_id!r}; "
-                                     "give the program files different file names")
-                out[run_id] = sim.RunConfig(
-                    robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault)
-        return list(out.items())
-
-    def _check_programs(self) -> None:
-        """Refuse two different programs under one label (a run's ``task``): analyses would take
-        one for the other (:func:`faultgen.operation.programs.identity` labels an edited export by
-        its file name; two files of one ``name`` still collide)."""
-        seen: dict[tuple[str, str], tuple[str, str]] = {}  # (robot, label) -> (task as given, program hash)
-        for robot, task in itertools.product(self.robots, self.tasks):
-            label, digest = programs.identity(robot, task)
-            first, first_digest = seen.setdefault((robots.load(robot).name, label), (task, digest))
-            if first_digest != digest:
-                raise ValueError(f"tasks {first!r} and {task!r} are different programs (sha256 {first_digest[:12]}... "
-                                 f"and {digest[:12]}...) under one label {label!r}: give the program file its own "
-                                 "`name` (or file name) so the dataset can tell them apart")
-
-    def to_json(self) -> str:
-        return json.dumps(asdict(self), sort_keys=True)
-
-
-@dataclass(frozen=True)
-class RunStats:
-    """What one worker did: simulated seconds and the wall time of each phase, s; on a Dask
-    cluster also where (``worker``, its address) and the worker process's peak resident set so far
-    (``memory``, bytes; 0 for local workers). A run sent back through Dask is written by the client:
-    ``writing`` is then the client's time."""
-
-    run_id: str
-    simulated: float
-    total: float
-    stepping: float
-    writing: float
-    worker: str = ""
-    memory: int = 0
-
-
-def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
-                       labelled: sim.RunConfig | None = None) -> RunStats:
-    """Worker task: simulate one run and write it to its part file (atomically), labelled with
-    ``labelled`` (the client's configuration when ``config`` names its robot or program by an
-    absolute path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`)."""
-    # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
-    # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
-    tqdm.set_lock(threading.RLock())
-    started = time.perf_counter()
-    result = sim.simulate(config, progress=False)
-    writing = time.perf_counter()
-    if labelled is not None:
-        result = replace(result, config=labelled)
-    dataset.write_run(part, result, run_id=run_id, command=command)
-    done = time.perf_counter()
-    stats = RunStats(run_id, result.tau_m.shape[0] * result.t[-1], done - started, result.stepping_time,
-                     done - writing)
-    del result
-    _release_memory()
-    return stats
-
-
-def _in_worker(sweep_pid: int, *call) -> RunStats:
-    """:func:`simulate_and_write` as a joblib worker runs it for the sweep of process ``sweep_pid``.
-
-    A Ctrl-C reaches the workers too (they are in the terminal's process group). One that lands
-    in a weakref callback or a ``__del__`` of a worker cannot be raised there, and Python would
-    print "Exception ignored ... KeyboardInterrupt" in the middle of the sweep's message; a worker
-    does not print it: the sweep's own process handles the Ctrl-C and stops the workers
-    (:class:`_CtrlC`). In the sweep's own process (joblib with one job) nothing changes.
-    """
-    if os.getpid() != sweep_pid:
-        _quiet_unraisable_interrupts()
-    return simulate_and_write(*call)
-
-
-def _start_worker(sweep_pid: int) -> None:
-    """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
-    whose sweep ended while it started (it has another parent already) ends at once. A SIGTERM
-    sent to the whole process group (``timeout``, a process manager, a closed terminal) is the
-    sweep's to handle: it stops its workers and says what is kept and how to resume; a worker that
-    ended on it first left loky's semaphores for Python to report as leaked, and the sweep no word."""
-    if os.getpid() == sweep_pid:
-        return
-    if os.getppid() != sweep_pid:
-        os._exit(1)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    _watch_parent(sweep_pid)
-
-
-def _start_resource_tracker() -> None:
-    """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
-    workers do (:func:`_start_worker`): a group-wide SIGTERM must not end it before the sweep has
-    stopped its workers and released their semaphores (it then reports them as leaked). It ends
-    when the sweep's process does."""
-    from joblib.externals.loky.backend import resource_tracker
-
-    if threading.current_thread() is not threading.main_thread():
-        return
-    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)  # inherited by the process started now
-    try:
-        resource_tracker.ensure_running()
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-_WATCHED: set[int] = set()
-
-
-def _watch_parent(sweep_pid: int, period: float = 0.5) -> None:
-    """End this worker process within ``period`` s once the sweep's process ``sweep_pid`` is gone.
-
-    A killed sweep (SIGKILL, or SIGTERM under a process manager) cannot stop its workers, and
-    loky's workers would go on simulating the rest of the grid, then idle for minutes (issue 42).
-    The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
-    Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
-    (another OS); either way the worker ends at once, its unfinished part left as a hidden
-    temporary file that the next sweep removes. Set once per worker process, from its start (the
-    loky initializer :func:`_start_worker`); a process whose parent is not the sweep's is left
-    alone.
-    """
-    if sweep_pid in _WATCHED or os.getppid() != sweep_pid:  # not a worker the sweep started: nothing to watch
-        return
-    _WATCHED.add(sweep_pid)
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):  # not Linux: the thread below does it
-        pass
-    if os.getppid() != sweep_pid:  # the sweep ended before the request was made
-        os._exit(1)
-
-    def watch() -> None:
-        while True:
-            time.sleep(period)
-            try:
-                os.kill(sweep_pid, 0)
-            except ProcessLookupError:
-                os._exit(1)
-            except PermissionError:
-                pass
-            if os.getppid() != sweep_pid:  # orphaned (reparented to init or a subreaper): the sweep is gone
-                os._exit(1)
-
-    threading.Thread(target=watch, name="faultgen-watch-sweep", daemon=True).start()
-
-
-def _quiet_unraisable_interrupts() -> None:
-    """From now on, a KeyboardInterrupt that cannot be raised is not printed (this process only;
-    every other unraisable exception still goes to the hook there was before)."""
-    previous = sys.unraisablehook
-    if getattr(previous, "quiet_interrupts", False):  # a worker runs many runs: set once
-        return
-
-    def hook(unraisable) -> None:
-        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
-            previous(unraisable)
-
-    hook.quiet_interrupts = True
-    sys.unraisablehook = hook
-
-
-def _release_memory() -> None:
-    """Give the run's freed memory back to the OS. glibc keeps freed heap memory, so a worker's
-    resident size would ratchet up run after run, and joblib's workers restart themselves (losing
-    their prepared models) once it grows 300 MB past its size after the first run."""
-    gc.collect()
-    try:
-        ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):  # not glibc: nothing to trim
-        pass
 
 
 def parts_folder(out: Path) -> Path:
@@ -533,7 +140,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                 _check_space(out, parts, plan, todo)
                 if on_start is not None:
                     on_start(len(plan), len(plan) - len(todo))
-                with _CtrlC() as ctrl_c:
+                with CtrlC() as ctrl_c:
                     try:
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
@@ -687,7 +294,7 @@ def _prepare(out: Path, parts: Path) -> None:
         stale.unlink()
 
 
-class _CtrlC:
+class CtrlC:
     """While a sweep runs, every Ctrl-C stops it once, wherever in this process it lands.
 
     Python raises a SIGINT as KeyboardInterrupt in whatever the main thread runs at that moment.
@@ -761,18 +368,16 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
     calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command) for run_id, config in todo]
     try:
         if scheduler:
-            from faultgen.runs import cluster
-
             yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
 
-            _start_resource_tracker()
-            # every worker watches the sweep from its start, idle or not (:func:`_watch_parent`)
-            backend = LokyBackend(initializer=_start_worker, initargs=(os.getpid(),))
+            worker.start_resource_tracker()
+            # every worker watches the sweep from its start, idle or not (:func:`faultgen.runs.worker.watch_parent`)
+            backend = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
             parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
-            yield from parallel(delayed(_in_worker)(os.getpid(), *call) for call in calls)
+            yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:
             _stop_local_workers()

@@ -1,0 +1,170 @@
+"""What a local worker process of a sweep does: simulate one run and write its part file
+(:func:`simulate_and_write`), and stay tied to the sweep that started it: it ends within a second
+of the sweep's process (:func:`watch_parent`), leaves a group-wide SIGTERM and Ctrl-C to the sweep,
+and gives its freed memory back to the OS after each run."""
+
+from __future__ import annotations
+
+import ctypes
+import gc
+import os
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from tqdm.auto import tqdm
+
+from faultgen.data import dataset
+from faultgen.simulation import stepping as sim
+
+
+@dataclass(frozen=True)
+class RunStats:
+    """What one worker did: simulated seconds and the wall time of each phase, s; on a Dask
+    cluster also where (``worker``, its address) and the worker process's peak resident set so far
+    (``memory``, bytes; 0 for local workers). A run sent back through Dask is written by the client:
+    ``writing`` is then the client's time."""
+
+    run_id: str
+    simulated: float
+    total: float
+    stepping: float
+    writing: float
+    worker: str = ""
+    memory: int = 0
+
+
+def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
+                       labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task: simulate one run and write it to its part file (atomically), labelled with
+    ``labelled`` (the client's configuration when ``config`` names its robot or program by an
+    absolute path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`)."""
+    # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
+    # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
+    tqdm.set_lock(threading.RLock())
+    started = time.perf_counter()
+    result = sim.simulate(config, progress=False)
+    writing = time.perf_counter()
+    if labelled is not None:
+        result = replace(result, config=labelled)
+    dataset.write_run(part, result, run_id=run_id, command=command)
+    done = time.perf_counter()
+    stats = RunStats(run_id, result.tau_m.shape[0] * result.t[-1], done - started, result.stepping_time,
+                     done - writing)
+    del result
+    release_memory()
+    return stats
+
+
+def in_worker(sweep_pid: int, *call) -> RunStats:
+    """:func:`simulate_and_write` as a joblib worker runs it for the sweep of process ``sweep_pid``.
+
+    A Ctrl-C reaches the workers too (they are in the terminal's process group). One that lands
+    in a weakref callback or a ``__del__`` of a worker cannot be raised there, and Python would
+    print "Exception ignored ... KeyboardInterrupt" in the middle of the sweep's message; a worker
+    does not print it: the sweep's own process handles the Ctrl-C and stops the workers
+    (:class:`faultgen.runs.sweep.CtrlC`). In the sweep's own process (joblib with one job) nothing changes.
+    """
+    if os.getpid() != sweep_pid:
+        quiet_unraisable_interrupts()
+    return simulate_and_write(*call)
+
+
+def start_worker(sweep_pid: int) -> None:
+    """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
+    whose sweep ended while it started (it has another parent already) ends at once. A SIGTERM
+    sent to the whole process group (``timeout``, a process manager, a closed terminal) is the
+    sweep's to handle: it stops its workers and says what is kept and how to resume; a worker that
+    ended on it first left loky's semaphores for Python to report as leaked, and the sweep no word."""
+    if os.getpid() == sweep_pid:
+        return
+    if os.getppid() != sweep_pid:
+        os._exit(1)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    watch_parent(sweep_pid)
+
+
+def start_resource_tracker() -> None:
+    """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
+    workers do (:func:`start_worker`): a group-wide SIGTERM must not end it before the sweep has
+    stopped its workers and released their semaphores (it then reports them as leaked). It ends
+    when the sweep's process does."""
+    from joblib.externals.loky.backend import resource_tracker
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)  # inherited by the process started now
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+_WATCHED: set[int] = set()
+
+
+def watch_parent(sweep_pid: int, period: float = 0.5) -> None:
+    """End this worker process within ``period`` s once the sweep's process ``sweep_pid`` is gone.
+
+    A killed sweep (SIGKILL, or SIGTERM under a process manager) cannot stop its workers, and
+    loky's workers would go on simulating the rest of the grid, then idle for minutes (issue 42).
+    The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
+    Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
+    (another OS); either way the worker ends at once, its unfinished part left as a hidden
+    temporary file that the next sweep removes. Set once per worker process, from its start (the
+    loky initializer :func:`start_worker`); a process whose parent is not the sweep's is left
+    alone.
+    """
+    if sweep_pid in _WATCHED or os.getppid() != sweep_pid:  # not a worker the sweep started: nothing to watch
+        return
+    _WATCHED.add(sweep_pid)
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the thread below does it
+        pass
+    if os.getppid() != sweep_pid:  # the sweep ended before the request was made
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(period)
+            try:
+                os.kill(sweep_pid, 0)
+            except ProcessLookupError:
+                os._exit(1)
+            except PermissionError:
+                pass
+            if os.getppid() != sweep_pid:  # orphaned (reparented to init or a subreaper): the sweep is gone
+                os._exit(1)
+
+    threading.Thread(target=watch, name="faultgen-watch-sweep", daemon=True).start()
+
+
+def quiet_unraisable_interrupts() -> None:
+    """From now on, a KeyboardInterrupt that cannot be raised is not printed (this process only;
+    every other unraisable exception still goes to the hook there was before)."""
+    previous = sys.unraisablehook
+    if getattr(previous, "quiet_interrupts", False):  # a worker runs many runs: set once
+        return
+
+    def hook(unraisable) -> None:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            previous(unraisable)
+
+    hook.quiet_interrupts = True
+    sys.unraisablehook = hook
+
+
+def release_memory() -> None:
+    """Give the run's freed memory back to the OS. glibc keeps freed heap memory, so a worker's
+    resident size would ratchet up run after run, and joblib's workers restart themselves (losing
+    their prepared models) once it grows 300 MB past its size after the first run."""
+    gc.collect()
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):  # not glibc: nothing to trim
+        pass
