@@ -159,3 +159,49 @@ def test_the_id_check_finds_an_id(tmp_path):
     source = tmp_path / "branch.py"
     source.write_text('def share(effect):\n    return 1.0 if effect.id == "cogging" else 0.0\n')
     assert (2, "cogging") in _string_constants(source)
+
+
+def _import_graph(root: Path) -> dict[str, set[str]]:
+    """Module -> the modules of the tree it imports (anywhere in it: a deferred import is an import)."""
+    modules = {".".join(path.relative_to(root).with_suffix("").parts).removesuffix(".__init__"): path
+               for tree in ("faultgen", "analysis") for path in (root / tree).rglob("*.py") if "_robots" not in path.parts}
+    graph = {}
+    for name, path in modules.items():
+        targets = set()
+        for imported in _imports(path):
+            parts = imported.split(".")
+            found = next((".".join(parts[:k]) for k in range(len(parts), 0, -1) if ".".join(parts[:k]) in modules), None)
+            if found is not None and found != name:
+                targets.add(found)
+        graph[name] = targets
+    return graph
+
+
+def _pairs(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
+    return {tuple(sorted((a, b))) for a, targets in graph.items() for b in targets if a in graph.get(b, ())}
+
+
+#: Pairs of modules that still import each other: two are other parts of issue 47 (the dataset
+#: split, the one log reader), to be dropped from here when those are merged; the calibration
+#: package's ``__init__`` and its ``refit`` (backfitting) are not in that issue's list.
+STILL_PAIRED = {("faultgen.data.dataset", "faultgen.data.reader"),
+                ("faultgen.operation.programs", "faultgen.operation.replay"),
+                ("faultgen.calibrate", "faultgen.calibrate.refit")}
+
+
+def test_no_pair_of_modules_imports_each_other():
+    """Data flows one way: no two modules import each other (issue 47: faults and wear, cluster and
+    sweep did), a deferred import inside a function included."""
+    pairs = _pairs(_import_graph(ROOT))
+    assert pairs <= STILL_PAIRED, f"modules importing each other: {sorted(pairs - STILL_PAIRED)}"
+
+
+def test_the_pair_check_finds_a_pair(tmp_path):
+    """The check above can fail: a deferred import back is a pair."""
+    package = tmp_path / "faultgen"
+    package.mkdir()
+    (tmp_path / "analysis").mkdir()
+    (package / "a.py").write_text("from faultgen.b import thing\n")
+    (package / "b.py").write_text("def thing():\n    from faultgen import a\n    return a\n")
+    (package / "c.py").write_text("from faultgen import a\n")
+    assert _pairs(_import_graph(tmp_path)) == {("faultgen.a", "faultgen.b")}

@@ -363,3 +363,33 @@ def test_cli_refuses_a_malformed_payload():
     result = CliRunner().invoke(app, ["simulate", "--robot", "puma560", "--payloads", "0.5:x", "-o", "never.h5"])
     assert result.exit_code == 2
     assert "--payloads part '0.5:x': expected MASS:SIZE in kg:m" in result.output
+
+
+def test_the_command_line_options_are_conditions_and_a_grid_keeps_their_short_table():
+    """The options of `simulate` and `sweep` become a Conditions at once (no table travels); a grid
+    holds it and stores the short table a grid file would hold, which reads back to the same."""
+    from faultgen.cli.options import conditions_from_options
+
+    made = conditions_from_options(True, "20:0.2,80:0.4", "blocks", True, 2, 40.0, task_mix="pick_place,spot_weld",
+                                   gear_loss=0.1, dry_share=0.5)
+    assert made == c.Conditions(thermal=c.Temperature(dry_share=0.5), payloads=c.Payloads((20.0, 80.0), (0.2, 0.4), "blocks"),
+                                spread=c.UnitSpread(gear_loss=0.1), task_mix=c.TaskMix(("pick_place", "spot_weld")),
+                                cycles_per_day=2, start_day=40.0)
+    assert conditions_from_options(False, None, "alternate", False, 1, 0.0) is None
+    with pytest.raises(ValueError, match=r"--payloads part '20': expected MASS:SIZE"):
+        conditions_from_options(False, "20", "alternate", False, 1, 0.0)
+    table = made.to_table()
+    assert table == {"thermal": {"dry_share": 0.5}, "payloads": {"masses": [20.0, 80.0], "sizes": [0.2, 0.4],
+                     "pattern": "blocks"}, "spread": {"gear_loss": 0.1},
+                     "task_mix": {"tasks": ["pick_place", "spot_weld"], "pattern": "alternate"},
+                     "cycles_per_day": 2, "start_day": 40.0}
+    assert c.Conditions.from_dict(table) == made
+    hours = c.Conditions(thermal=c.Temperature(ambient=25.0, shift=(8.0, 16.0)), cycles_per_day=2, hours=(9.0, 15.0))
+    assert c.Conditions.from_dict(json.loads(json.dumps(hours.to_table()))) == hours
+    grid = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], cycles=2, record=[2],
+                      conditions={"thermal": {}, "cycles_per_day": 1, "start_day": 0.0})
+    assert grid.conditions == c.Conditions(thermal=c.Temperature())
+    assert grid.runs()[0][1].conditions is grid.conditions  # passed down as it is
+    stored = json.loads(grid.to_json())
+    assert stored["conditions"] == {"thermal": {}, "cycles_per_day": 1, "start_day": 0.0}
+    assert sweep.Grid(**stored) == grid

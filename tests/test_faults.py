@@ -91,3 +91,33 @@ def test_a_fault_sweep_labels_every_cycle_and_isolates(tmp_path):
     table = benchmark.isolation_table(out, levels=(50, 100), progress=False)
     assert set(table["wear_pct"]) == {0.0, 50.0, 100.0}
     assert set(table.loc[table["worn_axis"] == 3, "cycles"]) == {2, 4}  # 50 % at cycle 4, the 2nd record
+
+
+def test_the_fault_text_is_parsed_once_into_what_grids_and_fleets_hold():
+    """One text for every command, read into a FaultSpec at the boundary: a sweep's grid and a
+    fleet hold that object (a text given to them is read once), build each run's Fault from it, and
+    store the text again; the text keeps every digit of its numbers."""
+    from faultgen.operation.faults import FaultSpec
+    from faultgen.operation.wear import Schedule, WearPlan
+    from faultgen.runs.fleet import Fleet
+
+    spec = FaultSpec.parse("backlash:each:width:0.01:kind=exp4")
+    assert spec == FaultSpec("backlash", None, "width", 0.01, "exp4") and str(spec) == "backlash:each:width:0.01:kind=exp4"
+    exact = FaultSpec.parse("cogging:3:amplitude:0.0123456789:poles=8")
+    assert FaultSpec.parse(str(exact)) == exact and str(exact) == "cogging:3:amplitude:0.0123456789:poles=8"
+    for bad, message in [("gearbox:2:width:0.01", r"unknown effect 'gearbox'; known effects: motor_friction"), ("backlash:9:width:0.01", r"fault axis 9: expected 1..7"),
+                         ("backlash:2:width:inf", r"FINAL = inf: expected a finite number"),
+                         ("backlash:width:0.01", r"write 'each' for the worn axis: 'backlash:each:width:0.01'")]:
+        with pytest.raises(ValueError, match=message):
+            FaultSpec.parse(bad)
+    grid = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0, 2, 3], cycles=4, record=[4],
+                      fault="backlash:each:width:0.01:kind=exp4")
+    assert grid.fault == spec and sweep.Grid(**{**json.loads(grid.to_json())}) == grid
+    assert json.loads(grid.to_json())["fault"] == str(spec)
+    assert [config.fault for _, config in grid.runs()] == [None, spec.fault(4, axis=2), spec.fault(4, axis=3)]
+    worn = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[2], cycles=4, record=[4], increases=[12.5])
+    assert worn.wear_schedules == (Schedule("exp4", 0.125, 4),)
+    assert worn.runs()[0][1].wear == WearPlan.from_specs(["2:exp4:12.5"], last_cycle=4)
+    fleet = Fleet(size=2, failing=1, days=6, cycles_per_day=1, models=("puma560",), fault="backlash:each:width:0.01")
+    assert fleet.fault == FaultSpec("backlash", None, "width", 0.01)
+    assert json.loads(fleet.to_json())["fleet"]["fault"] == "backlash:each:width:0.01"

@@ -1,13 +1,16 @@
 """Options that several commands share, declared once: the output, progress and parallelism
 options, and the operating conditions of `simulate`, `sweep` and `fleet`
-(faultgen.operation.conditions), with :func:`conditions_table` turning the latter into the
-library's conditions table."""
+(faultgen.operation.conditions), with :func:`conditions_from_options` turning the latter into the library's
+:class:`~faultgen.operation.conditions.Conditions`."""
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+if TYPE_CHECKING:
+    from faultgen.operation.conditions import Conditions
 
 #: Upper bounds of the command-line counts (each far above any use, each keeping the work and its
 #: memory finite): cycles of a run, days of a record, samples, Q-limit folds, held-out pairs and
@@ -85,17 +88,18 @@ CyclesPerDay = Annotated[int, typer.Option(
 StartDay = Annotated[float, typer.Option(help="Day of the year of cycle 1.", min=0.0, max=366.0)]
 
 
-def conditions_table(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
-                     start_day: float, task_mix: str | None = None, task_pattern: str = "alternate",
-                     gear_loss: float = 0.0, dry_share: float | None = None) -> dict | None:
-    """The conditions table (:meth:`Conditions.from_dict`) of the command-line options; None when
-    no condition is on. Raises ValueError naming a malformed ``--payloads`` part, a
-    ``--gear-loss`` without ``--unit-spread`` or a ``--dry-share`` without ``--temperature``."""
-    table: dict = {}
+def conditions_from_options(temperature: bool, payloads: str | None, pattern: str, spread: bool, cycles_per_day: int,
+                            start_day: float, task_mix: str | None = None, task_pattern: str = "alternate",
+                            gear_loss: float = 0.0, dry_share: float | None = None) -> Conditions | None:
+    """The :class:`~faultgen.operation.conditions.Conditions` of the command-line options, made
+    from them directly; None when no condition is on. Raises ValueError naming a malformed
+    ``--payloads`` part, a ``--gear-loss`` without ``--unit-spread``, a ``--dry-share`` without
+    ``--temperature``, or a value the conditions refuse."""
+    from faultgen.operation import conditions as c
+
     if dry_share is not None and not temperature:
         raise ValueError(f"--dry-share {dry_share:g} sets how friction follows the joint temperature: add --temperature")
-    if temperature:
-        table["thermal"] = {} if dry_share is None else {"dry_share": dry_share}
+    parts = None
     if payloads:
         masses, sizes = [], []
         for part in payloads.split(","):
@@ -105,13 +109,13 @@ def conditions_table(temperature: bool, payloads: str | None, pattern: str, spre
                 raise ValueError(f"--payloads part {part.strip()!r}: expected MASS:SIZE in kg:m, e.g. 20:0.2") from None
             masses.append(mass)
             sizes.append(size)
-        table["payloads"] = {"masses": masses, "sizes": sizes, "pattern": pattern}
+        parts = c.Payloads(tuple(masses), tuple(sizes), pattern)
     if gear_loss and not spread:
         raise ValueError(f"--gear-loss {gear_loss:g} is a part of the unit spread: add --unit-spread")
-    if spread:
-        table["spread"] = {"gear_loss": gear_loss} if gear_loss else {}
-    if task_mix:
-        table["task_mix"] = {"tasks": [t.strip() for t in task_mix.split(",")], "pattern": task_pattern}
-    if not table:
-        return None
-    return {**table, "cycles_per_day": cycles_per_day, "start_day": start_day}
+    made = c.Conditions(
+        thermal=(c.Temperature() if dry_share is None else c.Temperature(dry_share=dry_share)) if temperature else None,
+        payloads=parts,
+        spread=c.UnitSpread(gear_loss=gear_loss) if spread else None,
+        task_mix=c.TaskMix(tuple(t.strip() for t in task_mix.split(",")), task_pattern) if task_mix else None,
+        cycles_per_day=cycles_per_day, start_day=start_day)
+    return made if made.active else None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import shlex
 import sys
 from pathlib import Path
@@ -15,7 +16,7 @@ from faultgen.cli.base import Command, check_outputs, parse_cycles
 from faultgen.cli.main import app
 from faultgen.cli.options import (
     MAX_CYCLES, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress,
-    Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_table,
+    Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_from_options,
 )
 
 
@@ -91,9 +92,9 @@ def simulate_command(
         wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
         record=None if record is None else parse_cycles(record), seed=seed,
         noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
-        conditions=conditions_module.Conditions.from_dict(
-            conditions_table(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
-                             gear_loss=gear_loss, dry_share=dry_share) or {}),
+        conditions=conditions_from_options(temperature, payloads, payload_pattern, unit_spread, cycles_per_day,
+                                           start_day, gear_loss=gear_loss, dry_share=dry_share)
+        or conditions_module.Conditions(),
         fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
     )
     from faultgen.data import atomic
@@ -170,23 +171,22 @@ def sweep_command(
                "friction": friction_model, "cycles": cycles, "seeds": seeds,
                "record": record}
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
-    table = conditions_table(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
-                             task_mix, task_pattern, gear_loss, dry_share)
-    if table is not None:
-        options["conditions"] = table
+    made = conditions_from_options(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
+                                   task_mix, task_pattern, gear_loss, dry_share)
+    if made is not None:
+        options["conditions"] = made
     if features_only is not None:
         options["signals"] = not features_only
     if fault is not None:
-        options["fault"] = fault
-        on = faults.FaultSpec.parse(fault).axis
-        if on is not None and axes is None:  # a fault on a named axis: beside the run without wear
-            options["axes"] = [0, on]
+        options["fault"] = spec = faults.FaultSpec.parse(fault)  # parsed once, here
+        if spec.axis is not None and axes is None:  # a fault on a named axis: beside the run without wear
+            options["axes"] = [0, spec.axis]
     if record is not None:
         options["record"] = list(parse_cycles(record))
     if config is not None:
         grid = sweep.Grid.from_toml(config)
         if options:
-            grid = sweep.Grid(**{**{f: getattr(grid, f) for f in grid.__dataclass_fields__}, **options})
+            grid = dataclasses.replace(grid, **options)
     elif preset is not None:
         grid = sweep.Grid.from_preset(preset, **options)
     else:
@@ -244,8 +244,8 @@ def fleet_command(
     gear_loss: GearLoss = 0.0,
     fault: Annotated[str | None, typer.Option(
         help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
-        "from its onset day to FINAL on the failure day: EFFECT:PARAMETER:FINAL[:key=value,...], e.g. "
-        "backlash:each:width:0.01 (see `simulate --fault`); the same FINAL on every model (--robot picks them).")] = None,
+        "from its onset day to FINAL on the failure day: EFFECT:each:PARAMETER:FINAL[:key=value,...] (the "
+        "form of `simulate --fault`, AXIS 'each': the drawn axis), e.g. backlash:each:width:0.01; the same FINAL on every model (--robot picks them).")] = None,
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,

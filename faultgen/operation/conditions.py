@@ -45,7 +45,7 @@ plant record of joint temperatures or unit spread was at hand (docs/simulation.m
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from typing import ClassVar
 
 import numpy as np
@@ -466,6 +466,23 @@ class Conditions:
             del table["thermal"]["dry_share"]
         return table
 
+    def to_table(self) -> dict:
+        """The short table :meth:`from_dict` reads back into these conditions, as a grid file writes
+        it (and a sweep's dataset keeps its grid): each condition that is on, with its parts, tasks
+        and pattern and the settings not at their defaults; ``cycles_per_day`` and ``start_day``;
+        ``hours`` when set."""
+        table: dict = {}
+        for name in ("thermal", "payloads", "spread", "task_mix"):
+            value = getattr(self, name)
+            if value is not None:
+                table[name] = {f.name: _plain(getattr(value, f.name)) for f in fields(value)
+                               if f.name in ("masses", "sizes", "tasks", "pattern")
+                               or getattr(value, f.name) != f.default}
+        table.update(cycles_per_day=self.cycles_per_day, start_day=self.start_day)
+        if self.hours is not None:
+            table["hours"] = list(self.hours)
+        return table
+
     @classmethod
     def from_dict(cls, data: dict) -> Conditions:
         """Inverse of :meth:`to_dict`; unknown keys are refused with their name."""
@@ -489,3 +506,7 @@ class Conditions:
         rest = {k: tuple(data[k]) if isinstance(data[k], list) else data[k] for k in plain if data.get(k) is not None}
         return cls(**parts, **rest)
 
+
+def _plain(value):
+    """A setting as a table holds it: a tuple as a list."""
+    return list(value) if isinstance(value, tuple) else value

@@ -318,6 +318,14 @@ class FaultSpec:
     onset : int or None
     others : dict
         The effect's other parameters given.
+
+    Raises
+    ------
+    ValueError
+        On construction, for an unknown effect (listing the known ones), an axis outside 1..7 or a
+        FINAL that is not a finite number; the rest (the parameter, the values the effect admits,
+        the schedule) is checked when a :class:`Fault` is made (:meth:`fault`), where the run's
+        last cycle is known.
     """
 
     effect: str
@@ -328,6 +336,14 @@ class FaultSpec:
     start: float = 0.0
     onset: int | None = None
     others: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        effects.get(self.effect)  # ValueError lists the known ids
+        if self.axis is not None and (not is_whole(self.axis) or not 1 <= self.axis <= axes.MAX_AXES):
+            raise ValueError(f"fault axis {self.axis!r}: expected 1..{axes.MAX_AXES} (or {ANY_AXIS!r}: the worn axis "
+                             "of a sweep or a fleet)")
+        if isinstance(self.final, bool) or not isinstance(self.final, (int, float)) or not math.isfinite(self.final):
+            raise ValueError(f"fault FINAL = {self.final!r}: expected a finite number")
 
     @classmethod
     def parse(cls, spec: str) -> "FaultSpec":
@@ -369,7 +385,10 @@ class FaultSpec:
                     onset = int(number)
                 else:
                     others[key] = number
-        return cls(effect, axis, parameter, float(final_text), kind, start, onset, others)
+        try:
+            return cls(effect, axis, parameter, float(final_text), kind, start, onset, others)
+        except ValueError as err:
+            raise fail(str(err)) from None
 
     def fault(self, last_cycle: int, axis: int | None = None, **changes) -> Fault:
         """The :class:`Fault` on ``axis`` (a sweep's or fleet's worn axis; default the spec's own),
@@ -391,12 +410,19 @@ class FaultSpec:
             raise ValueError(f"bad fault spec {str(self)!r}: {err}; {_SPEC_FORM}") from None
 
     def __str__(self) -> str:
-        options = [*([f"kind={self.kind}"] if self.kind else []), *([f"start={self.start:g}"] if self.start else []),
+        options = [*([f"kind={self.kind}"] if self.kind else []), *([f"start={_text(self.start)}"] if self.start else []),
                    *([f"onset={self.onset}"] if self.onset is not None else []),
-                   *(f"{k}={v:g}" for k, v in self.others.items())]
+                   *(f"{k}={_text(v)}" for k, v in self.others.items())]
         axis = ANY_AXIS if self.axis is None else str(self.axis)
-        fields = [self.effect, axis, self.parameter, f"{self.final:g}"]
+        fields = [self.effect, axis, self.parameter, _text(self.final)]
         return ":".join([*fields, ",".join(options)] if options else fields)
+
+
+def _text(value: float) -> str:
+    """A number as a fault text writes it: short (``0.01``, ``20``), and exact (a value :g would
+    round, such as 0.0123456789, keeps every digit), so the text makes the same fault again."""
+    short = f"{value:g}"
+    return short if float(short) == value else repr(float(value))
 
 
 def _is_axis(text: str) -> bool:

@@ -148,11 +148,11 @@ class Fleet:
         Each robot runs a second task, drawn from the other two, in a random half of its cycles
         (:class:`faultgen.operation.conditions.TaskMix`); False: one task per robot. Off by default,
         so the fleet's draws and records are those of the fleets measured before it existed.
-    fault : str or None
-        Instead of friction wear, a failing robot's drawn axis gets this fault,
-        ``EFFECT:each:PARAMETER:FINAL[:key=value,...]`` (:class:`faultgen.operation.faults.FaultSpec`, the
-        one fault text of every command, AXIS ``each``: the drawn axis; e.g.
-        ``backlash:each:width:0.01``), growing on the exp4 schedule from its onset day to FINAL on the
+    fault : FaultSpec or None
+        Instead of friction wear, a failing robot's drawn axis gets this fault
+        (:class:`faultgen.operation.faults.FaultSpec`; its text, parsed once on construction, is the
+        one fault text of every command, ``EFFECT:each:PARAMETER:FINAL[:key=value,...]``, AXIS
+        ``each``: the drawn axis; e.g. ``backlash:each:width:0.01``), growing on the exp4 schedule from its onset day to FINAL on the
         failure day; FINAL is the same on both robot models. None (default): friction wear.
     gear_loss : float
         Each unit's gearboxes lose a share of the transmitted torque as Coulomb friction, drawn per
@@ -190,7 +190,7 @@ class Fleet:
     conditions: bool = True
     task_mix: bool = False
     gear_loss: float = 0.0
-    fault: str | None = None
+    fault: faults.FaultSpec | None = None
     dry_share: float = temperature_law.DRY_SHARE
     without: tuple[str, ...] = ()
     tasks: tuple[str, ...] = tasks.TASKS
@@ -231,10 +231,15 @@ class Fleet:
             except ValueError as err:
                 raise ValueError(f"fleet model {model!r}: its parts cannot be sized: {err}") from None
         object.__setattr__(self, "onset", (first, last))
-        if self.fault is not None:
-            spec = faults.FaultSpec.parse(self.fault)
+        if isinstance(self.fault, str):
+            object.__setattr__(self, "fault", faults.FaultSpec.parse(self.fault))
+        elif self.fault is not None and not isinstance(self.fault, faults.FaultSpec):
+            raise ValueError(f"fleet fault = {self.fault!r}: expected a fault text such as 'backlash:each:width:0.01' "
+                             "(or a FaultSpec)")
+        spec = self.fault
+        if spec is not None:
             if spec.axis is not None or spec.kind is not None or spec.onset is not None:
-                raise ValueError(f"fleet fault {self.fault!r}: the fleet sets the kind (exp4) and onset (the drawn "
+                raise ValueError(f"fleet fault {str(spec)!r}: the fleet sets the kind (exp4) and onset (the drawn "
                                  "onset day) and draws each failing robot's axis; give EFFECT:each:PARAMETER:FINAL"
                                  f"[:key=value,...] without them, e.g. "
                                  f"{str(replace(spec, axis=None, kind=None, onset=None))!r}")
@@ -335,14 +340,14 @@ class Fleet:
     def _fault(self, axis: int, onset_day: int) -> faults.Fault:
         """The fault of a robot failing on ``axis`` from ``onset_day``."""
         try:
-            return faults.FaultSpec.parse(self.fault).fault(
+            return self.fault.fault(
                 self.days * self.cycles_per_day, axis=axis, kind="exp4", onset=(onset_day - 1) * self.cycles_per_day)
         except ValueError as err:
-            raise ValueError(f"fleet fault {self.fault!r}: {err}") from None
+            raise ValueError(f"fleet fault {str(self.fault)!r}: {err}") from None
 
     def to_json(self) -> str:
         """The settings and every robot's draws, stored with the dataset."""
-        settings = asdict(self)
+        settings = {**asdict(self), "fault": None if self.fault is None else str(self.fault)}
         later = {"gear_loss": 0.0, "fault": None, "dry_share": temperature_law.DRY_SHARE, "without": (),
                  "tasks": tasks.TASKS}
         for name, default in later.items():  # at their defaults, the settings of fleets made before they existed

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import itertools
 import json
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -57,20 +57,26 @@ class Grid:
     seeds : list of int
     disturbance, encoder : float
         Noise levels (:class:`faultgen.simulation.sensors.NoiseConfig`).
-    conditions : dict or None
-        Operating conditions of every run (:meth:`faultgen.operation.conditions.Conditions.from_dict`:
-        ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables, ``cycles_per_day``, ``start_day``,
-        ``hours``); None: none, the runs differ from their references only by wear.
-    fault : str or None
-        A fault other than friction wear for the worn axes, ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]``
-        (:class:`faultgen.operation.faults.FaultSpec`, the one fault text of every command): with
-        AXIS ``each`` (``backlash:each:width:0.01``) each axis of ``axes`` but 0 gets it instead of friction
-        wear; with a number, ``axes`` may wear only that axis (and 0). ``increases`` and
-        ``schedules`` are then unused; ``kind=...`` shapes its growth.
+    conditions : Conditions or None
+        Operating conditions of every run (:class:`faultgen.operation.conditions.Conditions`); None:
+        none, the runs differ from their references only by wear. A table (a grid file's
+        ``[conditions]``: ``thermal``, ``payloads``, ``spread``, ``task_mix`` tables,
+        ``cycles_per_day``, ``start_day``, ``hours``) is read once into one
+        (:meth:`~faultgen.operation.conditions.Conditions.from_dict`).
+    fault : FaultSpec or None
+        A fault other than friction wear for the worn axes (:class:`faultgen.operation.faults.FaultSpec`);
+        its text, ``EFFECT:AXIS:PARAMETER:FINAL[:key=value,...]`` (the one fault text of every
+        command), is parsed once into one. With AXIS ``each`` (``backlash:each:width:0.01``) each
+        axis of ``axes`` but 0 gets it instead of friction wear; with a number, ``axes`` may wear
+        only that axis (and 0). ``increases`` and ``schedules`` are then unused; ``kind=...``
+        shapes its growth.
     signals : bool
         Keep the 250 Hz signals (False: features and truth only, a fraction of the size; the
         isolators and ``faultgen detect`` then work from the stored per-cycle features; the speed
         window of ``bench-isolators`` needs the signals).
+    wear_schedules : tuple of Schedule
+        Not a constructor argument: the wear schedule of a worn axis's runs, one per schedule and
+        increase (``schedules`` x ``increases``, in that order), built once on construction.
 
     Raises
     ------
@@ -89,9 +95,10 @@ class Grid:
     seeds: list[int] = field(default_factory=lambda: [0])
     disturbance: float = 0.01
     encoder: float = 1e-4
-    conditions: dict | None = None
-    fault: str | None = None
+    conditions: Conditions | None = None
+    fault: faults.FaultSpec | None = None
     signals: bool = True
+    wear_schedules: tuple[wear.Schedule, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in ("robots", "tasks", "axes", "increases", "schedules", "seeds"):
@@ -102,12 +109,13 @@ class Grid:
             if not isinstance(axis, int) or not 0 <= axis <= axis_numbers.MAX_AXES:
                 raise ValueError(f"worn axis {axis!r} is out of range 0..{axis_numbers.MAX_AXES} (0 = no wear)")
         friction.check_model(self.friction)
-        if self.fault is not None:
-            spec = faults.FaultSpec.parse(self.fault)
+        self._read_conditions_and_fault()
+        spec = self.fault
+        if spec is not None:
             worn = sorted(set(self.axes) - {0})
             if spec.axis is not None and worn != [spec.axis]:
                 raise ValueError(
-                    f"fault {self.fault!r} is on axis {spec.axis} but the grid wears axes "
+                    f"fault {str(spec)!r} is on axis {spec.axis} but the grid wears axes "
                     f"{', '.join(map(str, worn)) or 'none'}: give --axis 0 --axis {spec.axis}, or write "
                     f"{str(replace(spec, axis=None))!r} "
                     "to give each worn axis the fault in turn")
@@ -133,8 +141,24 @@ class Grid:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
                 raise ValueError(f"grid {name} = {value!r}: expected a finite number >= 0")
+        # the percent as the run id writes it (6 significant digits, :g), as the sweep always made it:
+        # the run id names the wear its run has
+        object.__setattr__(self, "wear_schedules", tuple(wear.Schedule(kind, float(f"{pct:g}") / 100.0, self.cycles)
+                                               for kind, pct in itertools.product(self.schedules, self.increases)))
         # builds and validates every run configuration, once: runs() returns these
         object.__setattr__(self, "_runs", self._build_runs())
+
+    def _read_conditions_and_fault(self) -> None:
+        """Hold the conditions and the fault as their types, reading a table or a fault text once."""
+        if isinstance(self.conditions, dict):
+            object.__setattr__(self, "conditions", Conditions.from_dict(self.conditions))
+        elif self.conditions is not None and not isinstance(self.conditions, Conditions):
+            raise ValueError(f"grid field 'conditions' must be a table (or a Conditions), got {self.conditions!r}")
+        if isinstance(self.fault, str):
+            object.__setattr__(self, "fault", faults.FaultSpec.parse(self.fault))
+        elif self.fault is not None and not isinstance(self.fault, faults.FaultSpec):
+            raise ValueError(f"grid field 'fault' must be a fault text such as 'backlash:each:width:0.01' (or a "
+                             f"FaultSpec), got {self.fault!r}")
 
     @classmethod
     def from_preset(cls, name: str, **overrides) -> Grid:
@@ -150,13 +174,13 @@ class Grid:
         A ``preset = "name"`` key starts from that preset. Unknown keys are refused.
         """
         data = inputs.read_toml(path, "grid file")
-        known = {f.name for f in fields(cls)} | {"preset"}
+        known = {f.name for f in fields(cls) if f.init} | {"preset"}
         unknown = sorted(set(data) - known)
         if unknown:
             raise ValueError(f"{path}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(known))}")
         preset = data.pop("preset", None)
         if not preset:
-            missing = [f.name for f in fields(cls) if f.name in ("robots", "tasks", "axes") and f.name not in data]
+            missing = [name for name in ("robots", "tasks", "axes") if name not in data]
             if missing:
                 raise ValueError(f"{path}: no key {missing[0]!r} (and no preset); a grid file needs robots, tasks "
                                  "and axes, or preset = \"quick\" (or j2, c2)")
@@ -185,9 +209,7 @@ class Grid:
     def _build_runs(self) -> list[tuple[str, sim.RunConfig]]:
         noise = sensors.NoiseConfig(disturbance=self.disturbance, encoder=self.encoder)
         record = self.recorded_cycles()
-        if self.conditions is not None and not isinstance(self.conditions, dict):
-            raise ValueError(f"grid field 'conditions' must be a table, got {self.conditions!r}")
-        conditions = Conditions.from_dict(self.conditions or {})
+        conditions = self.conditions or Conditions()
         out: dict[str, sim.RunConfig] = {}
         named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
         for robot in self.robots:
@@ -201,17 +223,17 @@ class Grid:
             if axis > n_axes:
                 raise ValueError(f"worn axis {axis} is out of range 0..{n_axes} of robot {name} (0 = no wear)")
             # a run without wear is one run, whatever the wear levels and schedules of the grid
-            variants = [(None, 0.0)] if axis == 0 or self.fault else itertools.product(self.schedules, self.increases)
-            for kind, pct in variants:
+            variants = [None] if axis == 0 or self.fault else self.wear_schedules
+            for schedule in variants:
                 plan, fault = wear.WearPlan({}), None
                 if axis == 0:
                     label = "nowear"
                 elif self.fault:
-                    fault = faults.FaultSpec.parse(self.fault).fault(self.cycles, axis=axis)
+                    fault = self.fault.fault(self.cycles, axis=axis)
                     label = f"axis{axis}-{fault.effect}{fault.final:g}"
                 else:
-                    plan = wear.WearPlan.from_specs([f"{axis}:{kind}:{pct:g}"], last_cycle=self.cycles)
-                    label = f"axis{axis}-{kind}{pct:g}"
+                    plan = wear.WearPlan({axis: schedule})
+                    label = f"axis{axis}-{schedule.kind}{100 * schedule.increase:g}"
                 run_id = f"{name}-{programs.label(task)}-{label}-seed{seed}"
                 if run_id in out and out[run_id].task != task:
                     raise ValueError(f"tasks {out[run_id].task!r} and {task!r} would both make run {run_id!r}; "
@@ -235,4 +257,10 @@ class Grid:
                                  "`name` (or file name) so the dataset can tell them apart")
 
     def to_json(self) -> str:
-        return json.dumps(asdict(self), sort_keys=True)
+        """The grid as its file would give it (the dataset keeps it): the fields, the conditions as
+        their short table (:meth:`~faultgen.operation.conditions.Conditions.to_table`), the fault as
+        its text."""
+        table = {f.name: getattr(self, f.name) for f in fields(self) if f.init}
+        table["conditions"] = None if self.conditions is None else self.conditions.to_table()
+        table["fault"] = None if self.fault is None else str(self.fault)
+        return json.dumps(table, sort_keys=True)
