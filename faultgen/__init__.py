@@ -42,7 +42,7 @@ PUBLIC = {
     "RunConfig": ("faultgen.simulation.config", "RunConfig"),
     "simulate": ("faultgen.simulation.stepping", "simulate"),
     "write_run": ("faultgen.data.dataset", "write_run"),
-    "Grid": ("faultgen.runs.sweep", "Grid"),
+    "Grid": ("faultgen.runs.grid", "Grid"),
     "run_sweep": ("faultgen.runs.sweep", "run"),
     "Fleet": ("faultgen.runs.fleet", "Fleet"),
     "robots": ("faultgen.model.robots", None),

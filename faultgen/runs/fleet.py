@@ -328,8 +328,10 @@ class Fleet:
             if robot["failing"] and self.fault is not None:
                 fault = self._fault(robot["axis"], robot["onset_day"])
             elif robot["failing"]:
-                spec = f"{robot['axis']}:exp4:{self.failure_wear:g}:onset={(robot['onset_day'] - 1) * self.cycles_per_day}"
-                plan = wear.WearPlan.from_specs([spec], last_cycle=cycles)
+                # the percent as the fleet has always written it (:g, 6 significant digits)
+                onset = (robot["onset_day"] - 1) * self.cycles_per_day
+                plan = wear.WearPlan({robot["axis"]: wear.Schedule("exp4", float(f"{self.failure_wear:g}") / 100.0,
+                                                                    cycles, {"onset": onset})})
             config = sim.RunConfig(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
                                    cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
                                    conditions=conditions.Conditions.from_dict(robot["conditions"]),
