@@ -137,7 +137,7 @@ class LoopRuns:
         self._each(mujoco.mj_forward)
 
     def set_const(self) -> None:
-        self._each(mujoco.mj_setConst)
+        self._each(_set_const)
 
     def rollout(self, nstep, control, control_spec, record, out):
         inputs, at = [], 0
@@ -160,6 +160,15 @@ class LoopRuns:
                     out[name][i, k] = getattr(data, name)
             self._get(i)
         return out
+
+
+def _set_const(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """``mj_setConst``, keeping the run's state (it poses ``data`` at ``qpos0`` to compute)."""
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    state = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, state, spec)
+    mujoco.mj_setConst(model, data)
+    mujoco.mj_setState(model, data, state, spec)
 
 
 #: The stepping backends by name.
