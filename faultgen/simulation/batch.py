@@ -16,7 +16,7 @@ from faultgen.operation.conditions import CycleConditions
 from faultgen.simulation import backends
 from faultgen.simulation.signals import TRUE_SIGNALS
 
-#: Logging periods handed to MuJoCo per ``Batch.rollout`` call (1 s of simulated time): long
+#: Logging periods handed to MuJoCo per ``rollout`` call of the backend (1 s of simulated time): long
 #: enough that the hand-over costs little, short enough that the per-step records stay small.
 CHUNK_PERIODS = 250
 

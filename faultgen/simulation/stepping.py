@@ -2,21 +2,21 @@
 
 Only the cycles that are recorded are simulated. Each starts from the task's start state (at
 rest, gearboxes deflected by the static load, drives on their set-points) with its own wear
-level, so cycles are independent: they are stepped together as the simulations of one
-``mujoco.batch.Batch``, one per cycle, with the wear as per-simulation model fields. A run
-without wear can instead step its cycles back to back in one simulation (``back_to_back``), each
-cycle starting from the state the previous one ended in, as a robot's own log runs on: the
-hidden-effect logs of the calibration do (:mod:`faultgen.calibrate.synth`).
+level, so cycles are independent: they are stepped together as the runs of one batch, one per
+cycle, with the wear as per-run model fields. A run without wear can instead step its cycles
+back to back in one simulation (``back_to_back``), each cycle starting from the state the
+previous one ended in, as a robot's own log runs on: the hidden-effect logs of the calibration do
+(:mod:`faultgen.calibrate.synth`).
 
-A stepping backend steps the cycles (:mod:`faultgen.simulation.backends`: ``mujoco.batch`` by
+A stepping backend steps the runs (:mod:`faultgen.simulation.backends`: ``mujoco.batch`` by
 default) with the friction model in the MuJoCo model (:mod:`faultgen.simulation.friction_models`:
-``lugre`` inside MuJoCo, ``stribeck`` set from Python before every step). This module runs a configuration; its parts are modules by job:
-:mod:`~faultgen.simulation.config` (:class:`RunConfig`), :mod:`~faultgen.simulation.model` (the
-compiled :class:`SimModel`), :mod:`~faultgen.simulation.prepare` (what runs of a robot and task share,
-cached), :mod:`~faultgen.simulation.batch` (cycles stepped together) and
-:mod:`~faultgen.simulation.results` (:class:`RunResult`, task mixes, daily records). Their public
-names are importable from here too.
-"""
+``lugre`` inside MuJoCo, ``stribeck`` set from Python before every step). This module runs a
+configuration; its parts are modules by job: :mod:`~faultgen.simulation.config`
+(:class:`RunConfig`), :mod:`~faultgen.simulation.model` (the compiled :class:`SimModel`),
+:mod:`~faultgen.simulation.prepare` (what runs of a robot and task share, cached),
+:mod:`~faultgen.simulation.batch` (cycles stepped together), :mod:`~faultgen.simulation.results`
+(:class:`RunResult`, task mixes, daily records) and :mod:`~faultgen.simulation.signals` (the
+signal set). Their public names are importable from here too."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ from faultgen.simulation.signals import SIGNALS, TRUE_SIGNALS, TRUTHS
 __all__ = ["BATCH_CYCLES", "CHUNK_PERIODS", "Prepared", "RunConfig", "RunResult", "SimModel", "SimulationDiverged",
            "applied_drive_torque", "build", "cycle_duration", "daily_record", "hold_end", "simulate", "start_state"]
 
-#: Most cycles stepped together in one ``Batch``: bounds the step buffers (about 1 MB per cycle
+#: Most cycles stepped together in one batch: bounds the step buffers (about 1 MB per cycle
 #: and second of chunk) when a run records many cycles (the c2 preset records 1200).
 BATCH_CYCLES = 100
 
