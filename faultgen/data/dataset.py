@@ -61,32 +61,10 @@ from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.operation.faults import Fault
 from faultgen.simulation import sensors
+from faultgen.simulation.signals import ARRAYS, SIGNAL_AXES  # the signal set, defined once (re-exported)
 
 FORMAT = "faultgen"
 FORMAT_VERSION = 1
-SIGNAL_AXES = "cycle, sample, axis"
-
-#: name -> (units, axes, description) of every array of a run group.
-ARRAYS = {
-    "t": ("s", "sample", "log time within a cycle (250 Hz)"),
-    "cycles": ("1", "cycle", "1-based index of each recorded cycle"),
-    "q_ref": ("rad", "sample, axis", "reference arm angle"),
-    "q_a": ("rad", SIGNAL_AXES, "arm angle from the encoder"),
-    "q_m": ("rad", SIGNAL_AXES, "motor angle from the encoder (motor side)"),
-    "qd_a": ("rad/s", SIGNAL_AXES, "arm speed, backward difference of q_a"),
-    "qd_m": ("rad/s", SIGNAL_AXES, "motor speed, backward difference of q_m (motor side)"),
-    "tau_m": ("N m", SIGNAL_AXES, "motor torque (drive output, motor side)"),
-    "tau_f": ("N m", SIGNAL_AXES, "true friction torque, motor side, positive opposing positive motion"),
-    "tau_dist": ("N m", SIGNAL_AXES, "true load disturbance on the arm joint (arm side)"),
-    "friction_multiplier": ("1", "cycle, axis", "true wear multiplier of Coulomb and static friction"),
-    "mean_friction_torque": ("N m", "cycle, axis", "mean absolute true friction torque per cycle (motor side)"),
-    "tracking_error": ("rad", "cycle, axis", "largest absolute error of the true arm angle against q_ref"),
-    "mean_abs_torque": ("N m", "cycle, axis", "mean absolute motor torque per cycle (motor side)"),
-    "rms_torque": ("N m", "cycle, axis", "RMS motor torque per cycle (motor side)"),
-    "angle_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of the joint range"),
-    "speed_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..max arm speed"),
-    "torque_hist": ("1", "cycle, axis, bin", "fraction of the cycle in each twelfth of 0..peak motor torque"),
-}
 
 #: name -> (units, axes, description) of the per-cycle sample counts of every run recorded per
 #: cycle (not daily records; files written before they existed lack them, and stay valid).

@@ -1,18 +1,22 @@
-"""Cycles stepped together as the simulations of one ``mujoco.batch.Batch``: their start state,
-how each cycle's robot differs from the nominal model (:class:`Plant`), what a stepper is handed
-(:class:`Work`) and returns (:class:`Raw`), and the divergence check."""
+"""Cycles stepped together as the simulations (runs) of one batch: their start state, how each
+cycle's robot differs from the nominal model (:class:`Plant`), what the stepping is handed
+(:class:`Work`) and returns (:class:`Raw`), the stepping loop (:func:`step`: a stepping backend,
+:mod:`faultgen.simulation.backends`, steps the runs; the friction model,
+:mod:`faultgen.simulation.friction_models`, says how friction enters them) and the divergence check."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, make_dataclass
 
+import mujoco
 import numpy as np
-from mujoco import batch as mjbatch
 
 from faultgen.model import robots
 from faultgen.operation.conditions import CycleConditions
+from faultgen.simulation import backends
+from faultgen.simulation.signals import TRUE_SIGNALS
 
-#: Logging periods handed to MuJoCo per ``Batch.rollout`` call (1 s of simulated time): long
+#: Logging periods handed to MuJoCo per ``rollout`` call of the backend (1 s of simulated time): long
 #: enough that the hand-over costs little, short enough that the per-step records stay small.
 CHUNK_PERIODS = 250
 
@@ -76,24 +80,24 @@ class Plant:
         return Plant(self.dry[rows], self.viscous[rows], self.link_mass,
                       None if self.fault is None else self.fault[rows], self.gear_loss)
 
-    def set_fault(self, batch, fault_fields: tuple, final: float) -> None:
+    def set_fault(self, runs, fault_fields: tuple, final: float) -> None:
         """Each simulation's fault parameter (:attr:`fault`, per cycle) into the fields it moves."""
         for name, index, at_final, slope in fault_fields:
-            values = batch.expand(name)
+            values = runs.expand(name)
             flat = values.reshape(values.shape[0], -1)
             flat[:, index] = at_final + (self.fault[:, None] - final) * slope
             values[...] = flat.reshape(values.shape)
 
-    def apply(self, sim, batch) -> None:
-        """The viscous and link-mass changes as per-simulation model fields of ``batch`` (the dry
-        friction is set by each stepper); nothing is expanded where nothing changes."""
+    def apply(self, sim, runs) -> None:
+        """The viscous and link-mass changes as per-simulation model fields of ``runs`` (the dry
+        friction is set by the friction model); nothing is expanded where nothing changes."""
         robot, model = sim.robot, sim.model
         if np.any(self.viscous != 1):
-            sim.stepping.scale_viscous(sim, batch, self.viscous)
+            sim.stepping.scale_viscous(sim, runs, self.viscous)
         if np.any(self.link_mass != 1):
             links = model.jnt_bodyid[[model.joint(n).id for n in robot.joint_names]]
-            batch.expand("body_mass")[:, links] *= self.link_mass
-            batch.expand("body_inertia")[:, links] *= self.link_mass[:, None]
+            runs.expand("body_mass")[:, links] *= self.link_mass
+            runs.expand("body_inertia")[:, links] *= self.link_mass[:, None]
 
 
 @dataclass(frozen=True)
@@ -102,7 +106,8 @@ class Work:
     and conditions), the start angles ``q0`` (N,), the drive ``inputs`` at every physics step
     (n_steps + 1, N, 3), the load disturbance ``dist`` per log period (n, n_log, N), physics steps
     per log period, MuJoCo threads, for a fault the fields it moves and its final value, and for a
-    program that grips a part the steps where its mass changes (:func:`apply_grips`)."""
+    program that grips a part the steps where its mass changes (:func:`apply_grips`), and the
+    stepping backend's name (:data:`faultgen.simulation.backends.BACKENDS`)."""
 
     cycles: np.ndarray
     plant: Plant
@@ -115,48 +120,119 @@ class Work:
     grips: tuple = ()
     qd0: np.ndarray | None = None
     qdd0: np.ndarray | None = None
+    backend: str = backends.DEFAULT
 
 
-@dataclass
-class Raw:
-    """True signals at the log times, each ``(n_cycles, n_log, N)``."""
-
-    q_a: np.ndarray
-    q_m: np.ndarray
-    qd_a: np.ndarray
-    qd_m: np.ndarray
-    tau_m: np.ndarray
-    tau_f: np.ndarray
+#: True signals at the log times (:data:`faultgen.simulation.signals.TRUE_SIGNALS`), each
+#: ``(n_cycles, n_log, N)``.
+Raw = make_dataclass("Raw", [(name, np.ndarray) for name in TRUE_SIGNALS])
+Raw.__doc__ = "True signals at the log times, each ``(n_cycles, n_log, N)``: " + ", ".join(TRUE_SIGNALS) + "."
 
 
-def new_batch(sim, work: Work) -> mjbatch.Batch:
-    """One simulation per recorded cycle, all at the task's start state."""
-    batch = mjbatch.Batch(sim.model, nsim=len(work.cycles), nthread=work.nthread)
-    batch.qpos, batch.qvel = start_state(sim.robot, work.q0, work.qd0, work.qdd0)
-    batch.act = 0.0
-    work.plant.apply(sim, batch)
+def new_runs(sim, work: Work) -> backends.Runs:
+    """One simulation per recorded cycle on the backend of ``work``, all at the task's start state,
+    with each cycle's plant, fault and dry friction."""
+    runs = backends.get(work.backend).new(sim.model, len(work.cycles), work.nthread)
+    runs.bind("qpos")[...], runs.bind("qvel")[...] = start_state(sim.robot, work.q0, work.qd0, work.qdd0)
+    runs.bind("act")[...] = 0.0
+    work.plant.apply(sim, runs)
     if work.fault is not None:
-        work.plant.set_fault(batch, *work.fault)
-    return batch
+        work.plant.set_fault(runs, *work.fault)
+    sim.stepping.scale_dry(sim, runs, work.plant.dry)
+    return runs
 
 
-def apply_grips(batch, grips: tuple, step: int) -> None:
+#: Inputs a step takes from Python: the drives' set-points (ctrl) and the load disturbance (qfrc_applied).
+CONTROL_SPEC = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+
+
+def step(sim, work: Work, bar) -> Raw:
+    """Step the cycles of ``work`` on ``sim`` and return the true signals at the log times.
+
+    The set-points and disturbances are handed over a chunk (:data:`CHUNK_PERIODS` log periods)
+    at a time, and chunks also break where a program grips or releases a payload. A friction model
+    that sets its level from Python (``per_step``) steps each chunk one step at a time; the others
+    hand it to the backend's ``rollout``. ``bar`` (tqdm) advances by the simulated seconds.
+    """
+    robot, model, friction = sim.robot, sim.model, sim.stepping
+    cycles, inputs, dist, per_log = work.cycles, work.inputs, work.dist, work.per_log
+    viscous = robot.friction.viscous * work.plant.viscous[:, None, :]
+    runs = new_runs(sim, work)
+    set_level = friction.before_step(sim, work, runs)
+    n_sim, n_steps = len(cycles), len(inputs) - 1
+    chunk = min(CHUNK_PERIODS * per_log, n_steps)
+    # buffers reused by every chunk: rollout inputs and per-substep records
+    control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
+    sizes = {"qpos": model.nq, "qvel": model.nv, "actuator_force": model.actuator_trnid.shape[0], "qfrc_constraint": model.nv}
+    records = {name: np.empty((n_sim, chunk, sizes[name])) for name in
+               dict.fromkeys(("qpos", "qvel", "actuator_force", friction.force_field))}
+    logs = {name: np.empty((n_sim, n_steps // per_log, robot.n_axes)) for name in TRUE_SIGNALS}
+    arm_dist = model.nu + robot.arm_dof
+    last_qvel = runs.bind("qvel").copy()
+    starts = sorted({*range(0, n_steps, chunk), *(at for at, _ in work.grips if 0 < at < n_steps)})
+    for start, stop in zip(starts, [*starts[1:], n_steps]):
+        size = stop - start
+        out = records if size == chunk else {k: np.empty((n_sim, size, v.shape[2])) for k, v in records.items()}
+        if set_level is None:
+            apply_grips(runs, work.grips, start)
+            control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
+            control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
+            runs.rollout(size, control=control_in[:, :size], control_spec=CONTROL_SPEC, record=tuple(out), out=out)
+        else:
+            _step_each(sim, work, runs, set_level, start, stop, out)
+        check_diverged(sim, runs, cycles, out["qvel"], start)
+        logged = slice(start // per_log, stop // per_log)
+        qpos, qvel, force = (out[k][:, per_log - 1 :: per_log] for k in ("qpos", "qvel", "actuator_force"))
+        v_m = qvel[:, :, robot.rotor_dof]
+        # rotor speeds one step before each logged one (the last of the previous chunk for a 4 ms step)
+        before = out["qvel"][:, per_log - 2 :: per_log] if per_log > 1 else np.concatenate(
+            [last_qvel[:, None], out["qvel"][:, :-1]], axis=1)
+        last_qvel = out["qvel"][:, -1].copy()
+        logs["q_a"][:, logged] = qpos[:, :, robot.arm_qpos]
+        logs["q_m"][:, logged] = qpos[:, :, robot.rotor_qpos]
+        logs["qd_a"][:, logged] = qvel[:, :, robot.arm_dof]
+        logs["qd_m"][:, logged] = v_m
+        logs["tau_m"][:, logged] = sim.applied_force(force, v_m, before[:, :, robot.rotor_dof])[:, :, sim.drive_ids]
+        logs["tau_f"][:, logged] = friction.friction_torque(sim, out[friction.force_field][:, per_log - 1 :: per_log],
+                                                            v_m, viscous)
+        bar.update(n_sim * size * model.opt.timestep)
+    return Raw(**logs)
+
+
+def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dict) -> None:
+    """Steps ``start`` to ``stop`` one at a time, the friction level set before each, recorded into
+    ``out`` (the friction level first, then a grip, the set-points and the disturbance)."""
+    robot, per_log = sim.robot, work.per_log
+    ctrl, applied = runs.bind("ctrl"), runs.bind("qfrc_applied")
+    bound = {name: runs.bind(name) for name in out}
+    for k, at in enumerate(range(start, stop)):
+        set_level(at)
+        if work.grips:
+            apply_grips(runs, work.grips, at)
+        ctrl[:, sim.drive_ctrl] = work.inputs[at]
+        applied[:, robot.arm_dof] = work.dist[:, at // per_log]
+        runs.step()
+        for name, values in bound.items():
+            out[name][:, k] = values
+
+
+def apply_grips(runs, grips: tuple, step: int) -> None:
     """Set the gripped body's mass and inertia at physics ``step`` where a program grips or releases
     (``grips``: ``(step, (body, mass, inertia, ipos, iquat))`` pairs); the same for every simulation."""
     for at, (body, mass, inertia, ipos, iquat) in grips:
         if at == step:
-            batch.expand("body_mass")[:, body] = mass
-            batch.expand("body_inertia")[:, body] = inertia
-            batch.expand("body_ipos")[:, body] = ipos
-            batch.expand("body_iquat")[:, body] = iquat
+            runs.expand("body_mass")[:, body] = mass
+            runs.expand("body_inertia")[:, body] = inertia
+            runs.expand("body_ipos")[:, body] = ipos
+            runs.expand("body_iquat")[:, body] = iquat
             # the constants MuJoCo derives from the masses (constraint weights, subtree masses) follow,
             # so an empty gripper is the same model whatever part the program grips
-            batch.set_const()
+            runs.set_const()
 
 
-def check_diverged(sim, batch, cycles: np.ndarray, velocities: np.ndarray, step: int) -> None:
+def check_diverged(sim, runs, cycles: np.ndarray, velocities: np.ndarray, step: int) -> None:
     """Raise SimulationDiverged naming the first bad cycle and axis."""
-    warned = np.asarray(batch.warning)
+    warned = np.asarray(runs.warning)
     bad = np.flatnonzero(~np.all(np.isfinite(velocities.reshape(len(cycles), -1)), axis=1)
                          | (warned.reshape(len(cycles), -1).sum(axis=1) > 0))
     if bad.size:

@@ -1,17 +1,16 @@
 """The friction models of a simulation as strategies: how each puts the robot's motor-side
-friction into the MuJoCo model and steps a batch of cycles with it (:data:`MODELS`, by the name
-``RunConfig.friction`` and the dataset's ``friction_model`` label give).
+friction into the MuJoCo model (:data:`MODELS`, by the name ``RunConfig.friction`` and the dataset's
+``friction_model`` label give). They do not step: a stepping backend does
+(:mod:`faultgen.simulation.backends`), driven by the loops of :mod:`faultgen.simulation.batch`.
 
 ``lugre``: everything that runs at the physics rate (the PID drives, LuGre friction, the
 gearboxes) runs inside MuJoCo, and Python only hands over pre-computed set-points and disturbance
-torques a chunk at a time (``Batch.rollout``). ``stribeck``: the static model needs its friction
-level set before every physics step from the rotor speed, so it steps from Python and is slower
-(docs/performance.md gives both figures).
+torques a chunk at a time (``rollout``). ``stribeck``: the static model needs its friction level set
+before every physics step from the rotor speed (:meth:`FrictionModel.before_step`), so it is stepped
+one step at a time from Python and is slower (docs/performance.md gives both figures).
 """
 
 from __future__ import annotations
-
-from dataclasses import fields
 
 import mujoco
 import numpy as np
@@ -20,7 +19,6 @@ from faultgen.effects import friction
 from faultgen.effects.base import Effect
 from faultgen.effects.load_dependent_friction import LoadDependentFriction
 from faultgen.model import robots
-from faultgen.simulation.batch import CHUNK_PERIODS, Raw, Work, apply_grips, check_diverged, new_batch
 
 
 def stepped_effects(robot: robots.Robot) -> list:
@@ -30,13 +28,16 @@ def stepped_effects(robot: robots.Robot) -> list:
 
 class FrictionModel:
     """A friction model of the simulation. Subclasses say how it enters the MJCF, which actuators
-    carry it, how a cycle's viscous friction is scaled and how a batch of cycles is stepped."""
+    carry it, how each run's dry and viscous friction are scaled, what sets its level before every
+    step (a model with :attr:`per_step`) and where the logged friction torque is read."""
 
     #: The model's name (:data:`faultgen.effects.friction.MODELS`).
     name: str
     #: Whether Python sets the friction level before every physics step (what friction growing
     #: with the load, the unit's gear loss, needs).
     per_step: bool
+    #: The MjData field the friction torque is read from after a step (:meth:`friction_torque`).
+    force_field: str
 
     def add(self, spec: mujoco.MjSpec, robot: robots.Robot, gains) -> None:
         """Put the robot's motor-side friction into ``spec`` (after the drives, ``gains``)."""
@@ -46,12 +47,22 @@ class FrictionModel:
         """Ids of the actuators that carry the friction, one per axis (empty: none)."""
         return np.array([], dtype=int)
 
-    def scale_viscous(self, sim, batch, factor: np.ndarray) -> None:
-        """Multiply each simulation's viscous friction by ``factor`` (n_sim, N)."""
+    def scale_viscous(self, sim, runs, factor: np.ndarray) -> None:
+        """Multiply each run's viscous friction by ``factor`` (n_sim, N)."""
         raise NotImplementedError
 
-    def step(self, sim, work: Work, bar) -> Raw:
-        """Step the cycles of ``work`` on ``sim``; the true signals at the log times."""
+    def scale_dry(self, sim, runs, dry: np.ndarray) -> None:
+        """Multiply each run's dry (Coulomb and static) friction by ``dry`` (n_sim, N), once before
+        stepping (a :attr:`per_step` model scales it in :meth:`before_step` instead)."""
+
+    def before_step(self, sim, work, runs):
+        """For a :attr:`per_step` model, ``set_level(step)``, called before every physics step
+        (``None``: the level stays what the model holds)."""
+
+    def friction_torque(self, sim, force: np.ndarray, v_m: np.ndarray, viscous: np.ndarray) -> np.ndarray:
+        """The motor-side friction torque, N m, positive opposing positive motion, ``(..., N)``,
+        from the :attr:`force_field` rows ``force`` ``(..., size)`` of a step, the rotor speeds
+        after it ``v_m`` (rad/s) and the viscous coefficients ``viscous`` (N m s/rad)."""
         raise NotImplementedError
 
     def __repr__(self) -> str:
@@ -63,6 +74,7 @@ class LuGre(FrictionModel):
 
     name = "lugre"
     per_step = False
+    force_field = "actuator_force"
 
     def add(self, spec, robot, gains):
         stepped = stepped_effects(robot)
@@ -77,55 +89,17 @@ class LuGre(FrictionModel):
     def actuator_ids(self, model, robot):
         return np.array([model.actuator(f"lugre{k + 1}").id for k in range(robot.n_axes)], dtype=int)
 
-    def scale_viscous(self, sim, batch, factor):
-        batch.expand("actuator_damping")[:, sim.lugre_ids] *= factor
+    def scale_viscous(self, sim, runs, factor):
+        runs.expand("actuator_damping")[:, sim.lugre_ids] *= factor
 
-    def step(self, sim, work, bar):
-        """All physics in MuJoCo: set-points and disturbances handed over one chunk at a time."""
-        robot, model = sim.robot, sim.model
-        cycles, dry, inputs, dist, per_log = work.cycles, work.plant.dry, work.inputs, work.dist, work.per_log
-        viscous = robot.friction.viscous * work.plant.viscous[:, None, :]
-        batch = new_batch(sim, work)
-        bias = batch.expand("actuator_biasprm")
+    def scale_dry(self, sim, runs, dry):
+        bias = runs.expand("actuator_biasprm")
         bias[:, sim.lugre_ids, 3] *= dry  # Coulomb level F_c
         bias[:, sim.lugre_ids, 4] *= dry  # breakaway level F_s
-        n_sim, n_steps = len(cycles), len(inputs) - 1
-        spec = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
-        chunk = min(CHUNK_PERIODS * per_log, n_steps)
-        # buffers reused by every chunk: rollout inputs and per-substep records
-        control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
-        records = {name: np.empty((n_sim, chunk, size)) for name, size in
-                   (("qpos", model.nq), ("qvel", model.nv), ("actuator_force", model.actuator_trnid.shape[0]))}
-        logs = {f.name: np.empty((n_sim, n_steps // per_log, robot.n_axes)) for f in fields(Raw)}
-        arm_dist = model.nu + robot.arm_dof
-        last_qvel = batch.qvel.copy()
-        # chunks also break where a program grips or releases a payload (whole log periods: segment boundaries)
-        starts = sorted({*range(0, n_steps, chunk), *(at for at, _ in work.grips if 0 < at < n_steps)})
-        for start, stop in zip(starts, [*starts[1:], n_steps]):
-            apply_grips(batch, work.grips, start)
-            size = stop - start
-            control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
-            control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
-            out = records if size == chunk else {k: np.empty((n_sim, size, v.shape[2])) for k, v in records.items()}
-            batch.rollout(size, control=control_in[:, :size], control_spec=spec, record=tuple(out), out=out)
-            check_diverged(sim, batch, cycles, out["qvel"], start)
-            logged = slice(start // per_log, stop // per_log)
-            qpos, qvel, force = (out[k][:, per_log - 1 :: per_log] for k in ("qpos", "qvel", "actuator_force"))
-            v_m = qvel[:, :, robot.rotor_dof]
-            # rotor speeds one step before each logged one (the last of the previous chunk for a 4 ms step)
-            before = out["qvel"][:, per_log - 2 :: per_log] if per_log > 1 else np.concatenate(
-                [last_qvel[:, None], out["qvel"][:, :-1]], axis=1)
-            last_qvel = out["qvel"][:, -1].copy()
-            applied = sim.applied_force(force, v_m, before[:, :, robot.rotor_dof])
-            logs["q_a"][:, logged] = qpos[:, :, robot.arm_qpos]
-            logs["q_m"][:, logged] = qpos[:, :, robot.rotor_qpos]
-            logs["qd_a"][:, logged] = qvel[:, :, robot.arm_dof]
-            logs["qd_m"][:, logged] = v_m
-            logs["tau_m"][:, logged] = applied[:, :, sim.drive_ids]
-            # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
-            logs["tau_f"][:, logged] = -force[:, :, sim.lugre_ids] + viscous * v_m
-            bar.update(n_sim * size * model.opt.timestep)
-        return Raw(**logs)
+
+    def friction_torque(self, sim, force, v_m, viscous):
+        # friction opposes motion: minus the LuGre actuator's force, plus the viscous term
+        return -force[..., sim.lugre_ids] + viscous * v_m
 
 
 class Stribeck(FrictionModel):
@@ -133,43 +107,35 @@ class Stribeck(FrictionModel):
 
     name = "stribeck"
     per_step = True
+    force_field = "qfrc_constraint"
 
     def add(self, spec, robot, gains):
         friction.add_stribeck(spec, robot)
 
-    def scale_viscous(self, sim, batch, factor):
-        batch.expand("dof_damping")[:, sim.robot.rotor_dof] *= factor
+    def scale_viscous(self, sim, runs, factor):
+        runs.expand("dof_damping")[:, sim.robot.rotor_dof] *= factor
 
-    def step(self, sim, work, bar):
-        """Static friction: the friction-loss level follows the rotor speed before every step."""
-        robot, model = sim.robot, sim.model
-        cycles, dry, inputs, dist, per_log = work.cycles, work.plant.dry, work.inputs, work.dist, work.per_log
-        viscous = robot.friction.viscous * work.plant.viscous
-        batch = new_batch(sim, work)
-        frictionloss = batch.expand("dof_frictionloss")
-        qvel, qpos = batch.bind("qvel"), batch.bind("qpos")
-        ctrl, applied = batch.bind("ctrl"), batch.bind("qfrc_applied")
-        force, constraint = batch.bind("actuator_force"), batch.bind("qfrc_constraint")
-        n_steps = len(inputs) - 1
-        n_log = n_steps // per_log
-        logs = {f.name: np.empty((len(cycles), n_log, robot.n_axes)) for f in fields(Raw)}
-        rotor, arm = robot.rotor_dof, robot.arm_dof
-        G = robot.gear_ratio
-        dt = model.opt.timestep
-        run_start = (cycles[:, None] - 1) * n_steps * dt  # a drift with time runs over the whole run
+    def before_step(self, sim, work, runs):
+        """The friction-loss level from the rotor speed (eq. 6.3), scaled by the stepped effects and
+        added to by those that grow with the load (the unit's gear loss among them)."""
+        robot, dt = sim.robot, sim.model.opt.timestep
+        dry, n_steps = work.plant.dry, len(work.inputs) - 1
+        frictionloss, qvel, qpos = runs.expand("dof_frictionloss"), runs.bind("qvel"), runs.bind("qpos")
+        rotor, G = robot.rotor_dof, robot.gear_ratio
+        run_start = (work.cycles[:, None] - 1) * n_steps * dt  # a drift with time runs over the whole run
         # the stepped effects that scale the dry friction and those that add to it, sorted once
         factors = [e for e in stepped_effects(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
         extras = [e for e in stepped_effects(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
         if np.any(work.plant.gear_loss):  # the unit's gearbox loss: the same effect, on top of the model's
             extras.append(LoadDependentFriction(coefficient=work.plant.gear_loss))
         if extras:  # the static load from the last step's kinematics, for those that ask for it
-            kinematics = [batch.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
-            batch.forward()  # the start state's, for the first step
+            kinematics = [runs.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
+            runs.forward()  # the start state's, for the first step
 
             def static_load() -> np.ndarray:
                 return robot.static_load_of(*kinematics, qpos)
 
-        for step in range(n_steps):
+        def set_level(step: int) -> None:
             level = dry
             for effect in factors:
                 level = level * effect.dry_friction_factor(run_start + step * dt)
@@ -178,27 +144,12 @@ class Stribeck(FrictionModel):
                 deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
                 for effect in extras:
                     frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
-            if work.grips:
-                apply_grips(batch, work.grips, step)
-            ctrl[:, sim.drive_ctrl] = inputs[step]
-            applied[:, arm] = dist[:, step // per_log]
-            logged = (step + 1) % per_log == 0
-            if logged:
-                v_before = qvel[:, rotor].copy()
-            batch.step()
-            if logged:
-                j = (step + 1) // per_log - 1
-                v_m = qvel[:, rotor]
-                logs["q_a"][:, j] = qpos[:, robot.arm_qpos]
-                logs["q_m"][:, j] = qpos[:, robot.rotor_qpos]
-                logs["qd_a"][:, j] = qvel[:, arm]
-                logs["qd_m"][:, j] = v_m
-                logs["tau_m"][:, j] = sim.applied_force(force, v_m, v_before)[:, sim.drive_ids]
-                logs["tau_f"][:, j] = -constraint[:, rotor] + viscous * v_m
-                bar.update(len(cycles) * per_log * model.opt.timestep)
-                if (j + 1) % CHUNK_PERIODS == 0 or j == n_log - 1:
-                    check_diverged(sim, batch, cycles, logs["qd_m"][:, : j + 1], step)
-        return Raw(**logs)
+
+        return set_level
+
+    def friction_torque(self, sim, force, v_m, viscous):
+        # the friction loss acts as a constraint force on the rotor, plus the viscous term
+        return -force[..., sim.robot.rotor_dof] + viscous * v_m
 
 
 #: The friction models by name.

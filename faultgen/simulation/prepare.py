@@ -26,7 +26,7 @@ class Prepared:
     Attributes
     ----------
     sim : SimModel
-        The compiled simulation model (``Batch`` works on copies of it).
+        The compiled simulation model (a stepping backend works on copies of it).
     task : faultgen.operation.tasks.Task
     path : faultgen.operation.tasks.JointPath
         The task's path sampled at every physics step.

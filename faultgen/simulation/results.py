@@ -12,6 +12,7 @@ from faultgen.simulation import sensors
 from faultgen.simulation.batch import Raw
 from faultgen.simulation.config import RunConfig
 from faultgen.simulation.prepare import prepared_for
+from faultgen.simulation.signals import SIGNALS
 
 
 @dataclass(frozen=True)
@@ -136,8 +137,8 @@ def merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunResu
                                                  if f.name not in CycleConditions.PER_UNIT})
     return RunResult(
         config=config, t=np.arange(1, n_log + 1) * sensors.LOG_PERIOD, cycles=joined(lambda r: r.cycles),
-        q_ref=own.q_ref[own.per_log::own.per_log], q_a=empty, q_m=empty, qd_a=empty, qd_m=empty, tau_m=empty,
-        tau_f=empty, tau_dist=empty, friction_multiplier=joined(lambda r: r.friction_multiplier),
+        q_ref=own.q_ref[own.per_log::own.per_log], **dict.fromkeys(SIGNALS, empty),
+        friction_multiplier=joined(lambda r: r.friction_multiplier),
         mean_friction_torque=joined(lambda r: r.mean_friction_torque),
         tracking_error=joined(lambda r: r.tracking_error),
         features={name: joined(lambda r, n=name: r.features[n]) for name in parts[0].features},
@@ -175,8 +176,8 @@ def daily_record(result: RunResult) -> RunResult:
                                 ("hour", "ambient_temperature", "joint_temperature", "dry_friction_factor",
                                  "viscous_factor")})
     empty = np.zeros((n_days, 0, result.friction_multiplier.shape[1]))
-    return replace(result, cycles=np.arange(1, n_days + 1), q_a=empty, q_m=empty, qd_a=empty, qd_m=empty,
-                   tau_m=empty, tau_f=empty, tau_dist=empty, friction_multiplier=days(result.friction_multiplier),
+    return replace(result, cycles=np.arange(1, n_days + 1), **dict.fromkeys(SIGNALS, empty),
+                   friction_multiplier=days(result.friction_multiplier),
                    mean_friction_torque=days(result.mean_friction_torque), tracking_error=days(result.tracking_error),
                    features=features, conditions=conditions,
                    fault_value=None if result.fault_value is None else result.fault_value[per_day - 1::per_day][:n_days])

@@ -2,20 +2,21 @@
 
 Only the cycles that are recorded are simulated. Each starts from the task's start state (at
 rest, gearboxes deflected by the static load, drives on their set-points) with its own wear
-level, so cycles are independent: they are stepped together as the simulations of one
-``mujoco.batch.Batch``, one per cycle, with the wear as per-simulation model fields. A run
-without wear can instead step its cycles back to back in one simulation (``back_to_back``), each
-cycle starting from the state the previous one ended in, as a robot's own log runs on: the
-hidden-effect logs of the calibration do (:mod:`faultgen.calibrate.synth`).
+level, so cycles are independent: they are stepped together as the runs of one batch, one per
+cycle, with the wear as per-run model fields. A run without wear can instead step its cycles
+back to back in one simulation (``back_to_back``), each cycle starting from the state the
+previous one ended in, as a robot's own log runs on: the hidden-effect logs of the calibration do
+(:mod:`faultgen.calibrate.synth`).
 
-The friction model steps the cycles (:mod:`faultgen.simulation.friction_models`: ``lugre`` inside
-MuJoCo, ``stribeck`` from Python). This module runs a configuration; its parts are modules by job:
-:mod:`~faultgen.simulation.config` (:class:`RunConfig`), :mod:`~faultgen.simulation.model` (the
-compiled :class:`SimModel`), :mod:`~faultgen.simulation.prepare` (what runs of a robot and task share,
-cached), :mod:`~faultgen.simulation.batch` (cycles stepped together) and
-:mod:`~faultgen.simulation.results` (:class:`RunResult`, task mixes, daily records). Their public
-names are importable from here too.
-"""
+A stepping backend steps the runs (:mod:`faultgen.simulation.backends`: ``mujoco.batch`` by
+default) with the friction model in the MuJoCo model (:mod:`faultgen.simulation.friction_models`:
+``lugre`` inside MuJoCo, ``stribeck`` set from Python before every step). This module runs a
+configuration; its parts are modules by job: :mod:`~faultgen.simulation.config`
+(:class:`RunConfig`), :mod:`~faultgen.simulation.model` (the compiled :class:`SimModel`),
+:mod:`~faultgen.simulation.prepare` (what runs of a robot and task share, cached),
+:mod:`~faultgen.simulation.batch` (cycles stepped together), :mod:`~faultgen.simulation.results`
+(:class:`RunResult`, task mixes, daily records) and :mod:`~faultgen.simulation.signals` (the
+signal set). Their public names are importable from here too."""
 
 from __future__ import annotations
 
@@ -28,17 +29,18 @@ from tqdm.auto import tqdm
 from faultgen.model import robots
 from faultgen.operation import faults
 from faultgen.operation.conditions import CycleConditions
-from faultgen.simulation import friction_models, sensors
+from faultgen.simulation import backends, batch, sensors
 from faultgen.simulation.batch import CHUNK_PERIODS, Plant, Raw, SimulationDiverged, Work, start_state
 from faultgen.simulation.config import RunConfig
 from faultgen.simulation.model import SimModel, applied_drive_torque, build
 from faultgen.simulation.prepare import Prepared, _prepare, _prepare_variant, cycle_duration, hold_end, prepared_for
 from faultgen.simulation.results import RunResult, daily_record, measure, merge_tasks, take
+from faultgen.simulation.signals import SIGNALS, TRUE_SIGNALS, TRUTHS
 
 __all__ = ["BATCH_CYCLES", "CHUNK_PERIODS", "Prepared", "RunConfig", "RunResult", "SimModel", "SimulationDiverged",
            "applied_drive_torque", "build", "cycle_duration", "daily_record", "hold_end", "simulate", "start_state"]
 
-#: Most cycles stepped together in one ``Batch``: bounds the step buffers (about 1 MB per cycle
+#: Most cycles stepped together in one batch: bounds the step buffers (about 1 MB per cycle
 #: and second of chunk) when a run records many cycles (the c2 preset records 1200).
 BATCH_CYCLES = 100
 
@@ -55,8 +57,12 @@ _prepared = prepared_for
 _ = _prepare, _prepare_variant
 
 
-def simulate(config: RunConfig, progress: bool = True) -> RunResult:
+def simulate(config: RunConfig, progress: bool = True, backend: str = backends.DEFAULT) -> RunResult:
     """Run ``config``: simulate its recorded cycles and return what the monitoring recorded.
+
+    ``backend`` names the stepping backend (:data:`faultgen.simulation.backends.BACKENDS`:
+    ``batch``, MuJoCo's threaded C stepping, or ``loop``, a plain Python loop of ``mj_step`` for
+    checking it); every backend gives the same results to float tolerance.
 
     With a task mix (:class:`faultgen.operation.conditions.TaskMix`) the cycles of each task are
     simulated together on that task's path, and the per-cycle results are put back in cycle order
@@ -66,31 +72,35 @@ def simulate(config: RunConfig, progress: bool = True) -> RunResult:
     ------
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
+    ValueError
+        For an unknown ``backend``.
     """
+    backends.get(backend)
     cycles = config.recorded_cycles
     n_axes = robots.load(config.robot).n_axes
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     if not config.daily:
-        return _simulate_cycles(config, cycles, conditions, progress)
+        return _simulate_cycles(config, cycles, conditions, progress, backend)
     # daily records: a block of whole days at a time, each reduced to its days before the next is
     # stepped, so that a run's memory does not grow with its days (cycles are independent: the
     # same arrays as all at once, tests/test_fleet.py)
     size = max(1, DAILY_BLOCK_CYCLES // config.conditions.cycles_per_day) * config.conditions.cycles_per_day
     blocks = [np.arange(i, min(i + size, len(cycles))) for i in range(0, len(cycles), size)]
     return _join_days([daily_record(_simulate_cycles(
-        config, cycles[rows], None if conditions is None else take(conditions, rows), progress)) for rows in blocks])
+        config, cycles[rows], None if conditions is None else take(conditions, rows), progress, backend))
+        for rows in blocks])
 
 
 def _simulate_cycles(config: RunConfig, cycles: np.ndarray, conditions: CycleConditions | None,
-                     progress: bool) -> RunResult:
+                     progress: bool, backend: str = backends.DEFAULT) -> RunResult:
     """The recorded ``cycles`` of ``config`` with their ``conditions``, every cycle kept."""
     mix = config.conditions.task_mix
     if mix is None:
-        return _simulate_task(config, config.task, cycles, conditions, progress)
+        return _simulate_task(config, config.task, cycles, conditions, progress, backend)
     task_of = conditions.tasks(mix)
     groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
     return merge_tasks(config, groups, [
-        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress) for g in groups])
+        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress, backend) for g in groups])
 
 
 def _join_days(blocks: list[RunResult]) -> RunResult:
@@ -106,9 +116,7 @@ def _join_days(blocks: list[RunResult]) -> RunResult:
     if conditions is not None:
         conditions = replace(conditions, **{f.name: joined(lambda b, n=f.name: getattr(b.conditions, n))
                                             for f in fields(CycleConditions) if f.name not in CycleConditions.PER_UNIT})
-    signals = {name: joined(lambda b, n=name: getattr(b, n)) for name in
-               ("q_a", "q_m", "qd_a", "qd_m", "tau_m", "tau_f", "tau_dist", "friction_multiplier",
-                "mean_friction_torque", "tracking_error")}
+    signals = {name: joined(lambda b, n=name: getattr(b, n)) for name in SIGNALS + TRUTHS}
     return replace(first, cycles=np.arange(1, sum(len(b.cycles) for b in blocks) + 1), **signals,
                    features={name: joined(lambda b, n=name: b.features[n]) for name in first.features},
                    conditions=conditions,
@@ -118,7 +126,7 @@ def _join_days(blocks: list[RunResult]) -> RunResult:
 
 
 def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, conditions: CycleConditions | None,
-                   progress: bool) -> RunResult:
+                   progress: bool, backend: str = backends.DEFAULT) -> RunResult:
     """The recorded ``cycles`` of ``config`` that run ``task_name``, with their ``conditions``:
     stepped, measured, their per-cycle features (and torque counts unless daily) computed."""
     prepared = prepared_for(config.robot, task_name, config.friction)
@@ -135,7 +143,6 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
     plant = Plant.of(multiplier, conditions, None if config.fault is None else config.fault.values(cycles))
 
-    stepper = friction_models.get(config.friction).step
     with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
               desc=f"{robot.name} {task_name}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
               "[{elapsed}<{remaining}]") as bar:
@@ -148,10 +155,10 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
             if not np.array_equal(path.q[0], path.q[-1]):
                 raise ValueError(f"{task_name} ends {np.max(np.abs(path.q[-1] - path.q[0])):.4g} rad away from where it "
                                  "starts; back_to_back runs need a cycle that returns to its start")
-            one = stepper(sim, Work(cycles[:1], plant.take([0]), path.q[0], chained,
+            one = batch.step(sim, Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread,
-                                     qd0=path.qd[0], qdd0=path.qdd[0]), bar)
-            raw = Raw(**{f.name: getattr(one, f.name).reshape(len(cycles), -1, robot.n_axes) for f in fields(Raw)})
+                                     qd0=path.qd[0], qdd0=path.qdd[0], backend=backend), bar)
+            raw = Raw(**{name: getattr(one, name).reshape(len(cycles), -1, robot.n_axes) for name in TRUE_SIGNALS})
         else:  # the cycles of each payload (its own model and feedforward) in batches of BATCH_CYCLES
             parts = conditions.payload_part if conditions is not None else np.full(len(cycles), -1)
             order, raws = [], []
@@ -163,12 +170,12 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                 for i in range(0, len(carrying), BATCH_CYCLES):
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
-                    raws.append(stepper(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
-                                                           dist[g], per_log, config.nthread, fault, variant.grips,
-                                                           path.qd[0], path.qdd[0]), bar))
+                    raws.append(batch.step(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
+                                                              dist[g], per_log, config.nthread, fault, variant.grips,
+                                                              path.qd[0], path.qdd[0], backend), bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
-            raw = Raw(**{f.name: np.concatenate([getattr(r, f.name) for r in raws])[back] for f in fields(Raw)})
+            raw = Raw(**{name: np.concatenate([getattr(r, name) for r in raws])[back] for name in TRUE_SIGNALS})
         stepping_time = time.perf_counter() - started
     result = measure(sim, config, cycles, multiplier, q_ref[per_log::per_log], dist, raw, stepping_time, conditions)
     if plant.fault is not None:
