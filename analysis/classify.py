@@ -446,13 +446,30 @@ def _check_inputs(X, y, groups, failed_groups, normal_groups):
     return X, y, groups, failed, normal
 
 
+#: Most held-out pairs one evaluation fits (each pair fits every classifier of every combination):
+#: "every pair" of a dataset with more is refused before any fit (``faultgen classify --pairs``).
+MAX_PAIRS = 100_000
+
+
 def select_pairs(failed_groups, normal_groups, n_pairs: int | None = None,
                  random_state: int | None = 0) -> list[tuple]:
     """(failed, normal) pairs of Procedure 1: all, failed-major, or ``n_pairs`` of them.
 
     A subset is drawn without replacement with ``numpy.random.default_rng(random_state)`` and
     kept in the same order as the full list, so equal arguments give equal pairs.
+
+    Raises
+    ------
+    ValueError
+        If ``n_pairs`` is below 1, or every pair is asked for (``None``, or at least as many as
+        there are) and there are more than :data:`MAX_PAIRS`.
     """
+    total = len(failed_groups) * len(normal_groups)
+    if (n_pairs is None or n_pairs >= total) and total > MAX_PAIRS:
+        raise ValueError(
+            f"every pair of {len(failed_groups)} worn x {len(normal_groups)} unworn runs is {total} held-out "
+            f"pairs, more than {MAX_PAIRS} (each fits every classifier); draw some with --pairs N (n_pairs)"
+        )
     pairs = list(product(failed_groups, normal_groups))
     if n_pairs is None or n_pairs >= len(pairs):
         return pairs

@@ -13,7 +13,10 @@ output is written, instead of a traceback or a table built on a wrong answer:
   in 0..N (0: undecided). A ``ValueError`` from ``fit`` keeps its meaning in the isolator contract
   (too few cycles for this isolator); any other exception is refused;
 - a detector's ``fit(X)`` and ``predict(X)`` must not raise, and ``predict(X)`` must give one
-  finite alarm per sample (shape (n_samples,)).
+  finite alarm per sample (shape (n_samples,)). A detector that also has control charts, a
+  ``score_samples(X)`` giving ``(t2, q)`` and fitted limits ``t2_limit_`` and ``q_limit_`` (as
+  :class:`analysis.monitoring.PCAMonitor`), has them drawn by ``detect`` like the PCA monitor's;
+  they too must be finite (T2 and Q one per sample, the limits positive).
 
 The current folder is searched first while the module is imported, and only then: ``sys.path``
 is left as it was, so a later import in faultgen never finds a file of the current folder.
@@ -31,6 +34,8 @@ from sklearn.base import BaseEstimator
 from faultgen.checks import is_whole
 
 ROLES = ("isolator", "detector")
+#: A detector's control limits, read with its ``score_samples`` (the charts of ``detect``).
+_LIMITS = ("t2_limit_", "q_limit_")
 
 
 class PluginError(Exception):
@@ -106,6 +111,9 @@ class Plugin(BaseEstimator):
         The user's estimator, fitted.
     source_axis_ : int
         An isolator's answer, 1..N, or 0 (undecided).
+    t2_limit_, q_limit_ : float
+        A detector's control limits, present only when its estimator has them and
+        ``score_samples`` (its charts are then drawn).
     """
 
     def __init__(self, spec: str = "", role: str = "isolator"):
@@ -149,7 +157,38 @@ class Plugin(BaseEstimator):
                 raise PluginError(f"plug-in {self.spec!r}: fit(X) set source_axis_ = {axis!r}; the isolator "
                                   f"contract is a whole number 1..{X.shape[1]} (the axis), or 0 when undecided")
             self.source_axis_ = int(axis)
+        if self.role == "detector" and all(hasattr(estimator, a) for a in ("score_samples", *_LIMITS)):
+            for name in _LIMITS:
+                value = getattr(estimator, name)
+                if not (isinstance(value, (int, float, np.number)) and np.isfinite(value) and value > 0):
+                    raise PluginError(f"plug-in {self.spec!r}: fit(X) set {name} = {value!r}; a control limit is a "
+                                      "finite number > 0")
+                setattr(self, name, float(value))
         return self
+
+    def score_samples(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """A detector's control-chart statistics ``(t2, q)`` for ``X`` (n_samples, n_features),
+        each of shape (n_samples,), when its estimator has them (``t2_limit_`` is then set).
+
+        Raises
+        ------
+        AttributeError
+            If the detector has no charts (no ``score_samples`` or limits).
+        PluginError
+            If ``score_samples`` raised, or did not give two finite arrays of shape (n_samples,).
+        """
+        if not hasattr(self, "t2_limit_"):
+            raise AttributeError(f"plug-in {self.spec!r} has no control charts (score_samples, t2_limit_, q_limit_)")
+        X = np.asarray(X)
+        try:
+            t2, q = (np.asarray(v, dtype=float) for v in self.estimator_.score_samples(X))
+        except Exception as err:
+            raise PluginError(f"plug-in {self.spec!r}: score_samples(X) of X {X.shape} failed: {_what(err)}") from None
+        for name, values in (("t2", t2), ("q", q)):
+            if values.shape != (len(X),) or not np.isfinite(values).all():
+                raise PluginError(f"plug-in {self.spec!r}: score_samples(X) gave {name} of {_describe(values)} for "
+                                  f"X {X.shape}; expected (t2, q), each finite, shape ({len(X)},)")
+        return t2, q
 
     def predict(self, X) -> np.ndarray:
         """A detector's alarms for ``X`` (n_samples, n_features): bool array of shape (n_samples,).

@@ -521,3 +521,17 @@ def test_classify_command_computes_the_short_table_unless_full(tmp_path, monkeyp
     assert seen == [True, False]
     assert "--full`." in outputs[0] and "--full`." not in outputs[1]
     assert "--full" in " ".join(runner.invoke(app, ["classify", "--help"]).output.split())
+
+
+def test_every_pair_is_bounded_before_any_fit():
+    # issue 50: --pairs 0 (every pair) had no upper bound; 400 x 300 runs would fit 120 000 pairs
+    from analysis.classify import MAX_PAIRS, select_pairs
+    from faultgen.cli.options import MAX_PAIRS as CLI_MAX_PAIRS
+
+    assert CLI_MAX_PAIRS == MAX_PAIRS
+    failed, normal = [f"w{i}" for i in range(400)], [f"h{i}" for i in range(300)]
+    for n_pairs in (None, 120_000):
+        with pytest.raises(ValueError, match="400 worn x 300 unworn runs is 120000 held-out pairs, more than 100000"):
+            select_pairs(failed, normal, n_pairs)
+    assert len(select_pairs(failed, normal, 20)) == 20
+    assert len(select_pairs(failed[:300], normal, None)) == 90_000

@@ -4,6 +4,7 @@ refused with one line naming it, exit 2, nothing written; ``sys.path`` is left a
 
 import sys
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -118,3 +119,52 @@ def test_loading_a_plug_in_leaves_sys_path_as_it_was(folder):
     plugin = plugins.load("bad_plugins:Isolator9", "isolator")
     assert sys.path == before  # the current folder was searched for this import only
     assert plugin.spec == "bad_plugins:Isolator9"
+
+
+def test_a_detectors_own_control_charts_are_passed_through(small):
+    # issue 50: a plug-in detector's Q/T2 charts were hidden by the guard. faultgen's own PCA
+    # monitor named as a plug-in now gives the charts the built-in monitor draws, to the bit
+    from analysis import benchmark
+
+    plugin = plugins.load("analysis.monitoring:PCAMonitor", "detector")
+    options = dict(protocol="same-run", progress=False, return_charts=True, variance=0.85, limit_folds=None)
+    _, charts = benchmark.detection_table(small, detector=plugin, **options)
+    _, builtin = benchmark.detection_table(small, **options)
+    worn = [key for key in charts if not key.startswith("_")]
+    assert worn and worn == [key for key in builtin if not key.startswith("_")]
+    for key in worn:
+        for name in ("t2", "q", "t2_limit", "q_limit"):  # (alarms: the built-in one judges Q alone)
+            np.testing.assert_array_equal(charts[key][name], builtin[key][name])
+
+
+def test_a_detector_with_lying_charts_is_refused(folder):
+    (folder / "chart_plugins.py").write_text(
+        "import numpy as np\nfrom analysis.monitoring import PCAMonitor\n\n"
+        "class NanCharts(PCAMonitor):\n"
+        "    def score_samples(self, X):\n"
+        "        t2, q = super().score_samples(X)\n"
+        "        return t2, q * np.nan\n\n"
+        "class AlarmsOnly(PCAMonitor):\n"
+        "    def score_samples(self, X):\n"
+        "        raise AssertionError('not called: this detector has no limits')\n"
+        "    def fit(self, X, y=None):\n"
+        "        super().fit(X)\n"
+        "        del self.t2_limit_\n"
+        "        return self\n"
+        "    def predict(self, X):\n"
+        "        return np.zeros(len(X), dtype=bool)\n\n"
+        "class BadLimit(PCAMonitor):\n"
+        "    def fit(self, X, y=None):\n"
+        "        super().fit(X)\n"
+        "        self.q_limit_ = -1.0\n"
+        "        return self\n")
+    X = np.random.default_rng(0).normal(size=(60, 6))
+    with pytest.raises(plugins.PluginError, match="score_samples\\(X\\) gave q of shape \\(60,\\), dtype float64, with NaN"):
+        plugins.load("chart_plugins:NanCharts", "detector").fit(X).score_samples(X)
+    with pytest.raises(plugins.PluginError, match="q_limit_ = -1.0; a control limit is a finite number > 0"):
+        plugins.load("chart_plugins:BadLimit", "detector").fit(X)
+    alarms_only = plugins.load("chart_plugins:AlarmsOnly", "detector").fit(X)
+    assert not hasattr(alarms_only, "q_limit_")  # drawn as alarms, as before
+    with pytest.raises(AttributeError, match="has no control charts"):
+        alarms_only.score_samples(X)
+    sys.modules.pop("chart_plugins", None)

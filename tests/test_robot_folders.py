@@ -1,119 +1,91 @@
-"""Every robot folder is complete, every element is named, and names pair up by axis."""
+"""Robot folders from strangers (issue 50, item 1): a folder given as `--robot DIR` gets the checks
+a description given to `robots add` gets (docs/reliability.md, threat model). Its MJCF may read
+only its own folder, may load no plugin, and its masses and drivetrain values are bounded; a
+refusal is one line `error: ...` naming the file and the construct, exit 2, nothing written.
+Before this change MuJoCo read such a folder's MJCF with none of these checks.
+"""
 
 import re
-import xml.etree.ElementTree as ET
+import shutil
+from pathlib import Path
 
-import mujoco
-import numpy as np
 import pytest
+from typer.testing import CliRunner
 
+from faultgen.cli import app
 from faultgen.model import robots
 
-ROBOTS = sorted(robots.available())
+SECRET = "s3cr3t-do-not-copy"
 
 
-def test_both_thesis_robots_are_available():
-    assert {"puma560", "irb6700"} <= set(ROBOTS)
+@pytest.fixture
+def folder(tmp_path):
+    """A copy of the shipped PUMA 560's folder (tmp_path/puma560) beside a file outside it."""
+    (tmp_path / "secret.xml").write_text(f"<mujoco><!-- {SECRET} --></mujoco>")
+    target = tmp_path / "puma560"
+    shutil.copytree(robots.load("puma560").path.parent, target)
+    return target
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_folder_has_model_scene_and_readme(name):
-    folder = robots.robots_dir() / name
-    assert (folder / f"{name}.xml").is_file()
-    assert (folder / "scene.xml").is_file()
-    readme = (folder / "README.md").read_text()
-    # The README gives the source of the numbers it lists, per topic.
-    for topic in ("gear ratio", "motor inertia", "stiffness", "friction", "mass"):
-        assert topic in readme.lower(), f"{name}/README.md does not cover {topic!r}"
+def edit(folder: Path, old: str, new: str, count: int = 1) -> None:
+    path = folder / "puma560.xml"
+    text = path.read_text()
+    assert old in text, old
+    path.write_text(text.replace(old, new, count))
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_scene_only_includes_the_robot(name):
-    folder = robots.robots_dir() / name
-    scene = ET.parse(folder / "scene.xml").getroot()
-    includes = [e.get("file") for e in scene.iter("include")]
-    assert includes == [f"{name}.xml"]
-    # Nothing that moves or acts is defined in the scene itself.
-    for tag in ("body", "joint", "actuator", "tendon", "keyframe"):
-        assert not list(scene.iter(tag)), f"scene.xml of {name} defines a <{tag}>"
-    robot = robots.load(name).model
-    scene_model = mujoco.MjModel.from_xml_path(str(folder / "scene.xml"))
-    assert (scene_model.nq, scene_model.nu, scene_model.ntendon, scene_model.nbody) == (
-        robot.nq,
-        robot.nu,
-        robot.ntendon,
-        robot.nbody,
-    )
+def refused(tmp_path, folder, *words):
+    """`faultgen simulate --robot FOLDER -o OUT`: exit 2, one line naming every one of ``words``,
+    no output written."""
+    out = tmp_path / "out.h5"
+    result = CliRunner().invoke(app, ["simulate", "--robot", str(folder), "--cycles", "2", "-o", str(out)])
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.output
+    for word in words:
+        assert word in lines[0], lines[0]
+    assert SECRET not in lines[0]
+    assert not out.exists() and not list(tmp_path.glob("*.partial*"))
+    return lines[0]
 
 
-NAMED_TYPES = {
-    "body": (mujoco.mjtObj.mjOBJ_BODY, "nbody"),
-    "joint": (mujoco.mjtObj.mjOBJ_JOINT, "njnt"),
-    "geom": (mujoco.mjtObj.mjOBJ_GEOM, "ngeom"),
-    "site": (mujoco.mjtObj.mjOBJ_SITE, "nsite"),
-    "tendon": (mujoco.mjtObj.mjOBJ_TENDON, "ntendon"),
-    "actuator": (mujoco.mjtObj.mjOBJ_ACTUATOR, "nu"),
-    "keyframe": (mujoco.mjtObj.mjOBJ_KEY, "nkey"),
-    "numeric": (mujoco.mjtObj.mjOBJ_NUMERIC, "nnumeric"),
-}
+def test_an_unchanged_copy_loads_as_the_shipped_robot(folder):
+    copy, shipped = robots.load(folder), robots.load("puma560")
+    assert copy.n_axes == shipped.n_axes
+    assert (copy.gear_ratio == shipped.gear_ratio).all()
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_every_element_is_named(name):
-    model = robots.load(name).model
-    for kind, (obj, count) in NAMED_TYPES.items():
-        first = 1 if kind == "body" else 0  # body 0 is the world
-        for i in range(first, getattr(model, count)):
-            assert mujoco.mj_id2name(model, obj, i), f"{name}: {kind} {i} has no name"
-    # frames are not compiled into the model, so check them in the source
-    source = ET.parse(robots.available()[name]).getroot()
-    assert all(f.get("name") for f in source.iter("frame")), f"{name}: unnamed <frame>"
+def test_an_include_outside_the_folder_is_refused(tmp_path, folder):
+    edit(folder, "<option", f'<include file="{tmp_path / "secret.xml"}"/>\n  <option')
+    refused(tmp_path, folder, "puma560.xml", "<include", "outside the folder")
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_joints_rotors_gearboxes_and_motors_pair_up(name):
-    robot = robots.load(name)
-    model = robot.model
-    # exactly the 6 arm joints and 6 rotors, nothing else moves
-    joint_names = {model.joint(i).name for i in range(model.njnt)}
-    assert joint_names == {f"joint{i}" for i in range(1, 7)} | {f"rotor{i}" for i in range(1, 7)}
-    assert model.nu == 6 and model.ntendon == 6
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    mujoco.mj_forward(model, data)
-    for i in range(1, 7):
-        joint, rotor = model.joint(f"joint{i}"), model.joint(f"rotor{i}")
-        actuator, tendon = model.actuator(f"motor{i}"), model.tendon(f"gearbox{i}")
-        assert actuator.trnid[0] == rotor.id
-        adr, num = model.tendon_adr[tendon.id], model.tendon_num[tendon.id]
-        assert num == 2
-        assert {int(model.wrap_objid[w]) for w in range(adr, adr + num)} == {joint.id, rotor.id}
-        # Coaxial: the rotor turns about the same world axis as its arm joint, on the link
-        # that carries the joint (the motor is mounted on the previous link).
-        np.testing.assert_allclose(data.xaxis[rotor.id], data.xaxis[joint.id], atol=1e-12)
-        np.testing.assert_allclose(data.xanchor[rotor.id], data.xanchor[joint.id], atol=1e-12)
-        assert model.body_parentid[rotor.bodyid[0]] == model.body_parentid[joint.bodyid[0]]
-        # the motor inertia is the rotor's armature, the rotor body itself is negligible
-        assert model.dof_armature[rotor.dofadr[0]] > 0
-        assert model.body_mass[rotor.bodyid[0]] < 1e-8
-        assert re.fullmatch(r"friction\d", model.numeric(f"friction{i}").name)
+def test_a_relative_include_out_of_the_folder_is_refused(tmp_path, folder):
+    edit(folder, "<option", '<include file="../secret.xml"/>\n  <option')
+    refused(tmp_path, folder, "<include", "outside the folder")
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_home_keyframe_is_within_limits_and_undeflected(name):
-    robot = robots.load(name)
-    model = robot.model
-    assert np.all(robot.home >= robot.joint_range[:, 0]) and np.all(robot.home <= robot.joint_range[:, 1])
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    mujoco.mj_forward(model, data)
-    np.testing.assert_allclose(data.ten_length, 0.0, atol=1e-12)
+def test_a_mesh_outside_the_folder_is_refused(tmp_path, folder):
+    edit(folder, "<option", '<asset><mesh name="m" file="/etc/hostname"/></asset>\n  <option')
+    refused(tmp_path, folder, "<mesh file=", "outside the folder")
 
 
-@pytest.mark.parametrize("name", ROBOTS)
-def test_friction_parameters_are_in_one_place_per_axis(name):
-    """A wear schedule edits friction{i} and nothing else: no friction elsewhere in the MJCF."""
-    model = robots.load(name).model
-    assert np.all(model.dof_frictionloss == 0)
-    assert np.all(model.dof_damping == 0)
-    assert np.all(model.actuator_biastype == mujoco.mjtBias.mjBIAS_NONE)
+def test_a_plugin_is_refused(tmp_path, folder):
+    edit(folder, "<option", '<extension><plugin plugin="mujoco.elasticity.cable"/></extension>\n  <option')
+    refused(tmp_path, folder, "<extension> refused", "plugins are code")
+
+
+def test_a_body_mass_out_of_bounds_is_refused(tmp_path, folder):
+    edit(folder, 'mass="0.001"', 'mass="1e12"')
+    refused(tmp_path, folder, "puma560.xml", "body 'link1'", "mass = 1000000000000.0", "expected a number in")
+
+
+def test_a_motor_inertia_out_of_bounds_is_refused(tmp_path, folder):
+    edit(folder, 'armature="0.0002"', 'armature="1e9"')
+    line = refused(tmp_path, folder, "puma560.xml", "axis 1", "motor_inertia")
+    assert re.search(r"1e\+?0?9|1000000000", line), line
+
+
+def test_a_description_too_large_is_refused(tmp_path, folder):
+    edit(folder, "<option", "<!-- " + "x" * (11 * 2**20) + " -->\n  <option")
+    refused(tmp_path, folder, "puma560.xml")

@@ -110,9 +110,10 @@ def test_a_diverging_run_names_cycle_and_axis(tmp_path, monkeypatch):
         (dict(cycles=0), r"cycles = 0; expected a whole number >= 1"),
         (dict(friction="coulomb"), "unknown friction model 'coulomb'; expected one of: lugre, stribeck"),
         (dict(record=(0, 5)), r"recorded cycle 0 is out of range 1..100"),
-        (dict(seed=-1), r"seed = -1; expected a whole number >= 0"),
-        ({"seed": True}, r"seed = True; expected a whole number >= 0"),
-        ({"seed": 2.0}, r"seed = 2.0; expected a whole number >= 0"),
+        (dict(seed=-1), r"seed = -1; expected a whole number in 0 \.\. 4294967295"),
+        ({"seed": True}, r"seed = True; expected a whole number in 0 \.\. 4294967295"),
+        ({"seed": 2.0}, r"seed = 2.0; expected a whole number in 0 \.\. 4294967295"),
+        ({"seed": 2**32}, r"seed = 4294967296; expected a whole number in 0 \.\. 4294967295"),
         (dict(robot="puma"), "unknown robot 'puma'"),
     ],
 )

@@ -370,3 +370,11 @@ def test_corrupted_truncated_and_unfinished_files_are_reported(reference, tmp_pa
 
     result = runner.invoke(app, ["validate", str(truncated)])
     assert result.exit_code == 1 and "truncated" in result.output
+
+
+def test_a_grid_files_seed_is_bounded(tmp_path):
+    # issue 50: a grid file's seeds reached the runs unbounded (the CLI bounds --seed only)
+    path = tmp_path / "grid.toml"
+    path.write_text('preset = "quick"\nseeds = [0, 4294967296]\n')
+    with pytest.raises(ValueError, match=r"grid seeds \(--seed\): 4294967296: expected a whole number in 0 \.\. 4294967295"):
+        sweep.Grid.from_toml(path)

@@ -319,7 +319,7 @@ def training_source_command(
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
     wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0, max=500.0)] = 10.0,
-    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all.", min=0, max=MAX_PAIRS)] = 20,
+    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all (refused when there are more than 100000).", min=0, max=MAX_PAIRS)] = 20,
     horizon: Annotated[int | None, typer.Option(
         help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
         "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "

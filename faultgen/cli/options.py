@@ -19,7 +19,7 @@ MAX_CYCLES = 1_000_000
 MAX_DAYS = 3650
 MAX_SAMPLES = 1_000_000
 MAX_FOLDS = 1000
-MAX_PAIRS = 100_000
+MAX_PAIRS = 100_000  # as analysis.classify.MAX_PAIRS (the bound on "every pair", --pairs 0)
 MAX_PERMUTATIONS = 10_000
 
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.

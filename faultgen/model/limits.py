@@ -110,9 +110,20 @@ def check_urdf(root: ET.Element, path: Path) -> None:
 def check_model(spec: mujoco.MjSpec, path: Path | str) -> None:
     """The compiled arm's masses, inertias, positions and joint ranges within the bounds (what a
     source of any kind gives; MJCF values reach MuJoCo unchecked otherwise)."""
-    for value in spec.option.gravity:
+    check_compiled(spec.copy().compile(), path)
+
+
+def check_compiled(model: mujoco.MjModel, path: Path | str) -> None:
+    """As :func:`check_model`, on an arm already compiled (a robot folder's MJCF, read by
+    :func:`faultgen.model.robots.load`).
+
+    Raises
+    ------
+    ArmError
+        Naming the file, the body or joint, the value and the bound.
+    """
+    for value in model.opt.gravity:
         number(path, "<option gravity>", "gravity", float(value), -MAX_GRAVITY, MAX_GRAVITY, "m/s^2")
-    model = spec.copy().compile()
     for body in range(1, model.nbody):
         name = model.body(body).name or f"#{body}"
         number(path, f"body {name!r}", "mass", float(model.body_mass[body]), 0.0, MAX_MASS, "kg")

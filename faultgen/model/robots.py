@@ -39,7 +39,8 @@ from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.motor_friction import MotorFriction
-from faultgen.model import drivetrain
+from faultgen.model import drivetrain, limits, mjcf, sources
+from faultgen.model.builder import ArmError
 
 
 class UnknownRobotError(ValueError):
@@ -583,11 +584,30 @@ def from_spec(spec: mujoco.MjSpec, path: str | Path) -> Robot:
 
 
 def _from_file(path: Path) -> Robot:
+    """Compile a robot MJCF after the checks a robot description from a stranger gets
+    (docs/reliability.md, threat model): a bounded regular file that names no file outside its own
+    folder and loads no plugin (:func:`faultgen.model.mjcf.check_files`), then, compiled, masses,
+    inertias, positions and ranges (:func:`faultgen.model.limits.check_compiled`) and its
+    drivetrain's values (:class:`faultgen.model.drivetrain.AxisDrive`) within their bounds."""
+    try:
+        text = sources.read_text(path, what="robot MJCF", error=ArmError)
+        mjcf.check_files(path, sources.parse_xml(text, path, ArmError), {})
+    except ArmError as err:
+        raise ModelError(str(err)) from err
     try:
         model = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as err:
         raise ModelError(f"{path}: {str(err).strip()}") from err
-    return _from_model(model, path)
+    try:
+        limits.check_compiled(model, path)
+    except ArmError as err:
+        raise ModelError(str(err)) from err
+    robot = _from_model(model, path)
+    try:
+        drivetrain_of(robot)
+    except drivetrain.DrivetrainError as err:
+        raise ModelError(f"{path}: {err}") from err
+    return robot
 
 
 def drivetrain_of(robot: Robot) -> drivetrain.Drivetrain:
@@ -601,7 +621,10 @@ def drivetrain_of(robot: Robot) -> drivetrain.Drivetrain:
                       gearbox_damping=float(robot.gearbox_damping[k]),
                       motor_torque_limit=float(robot.motor_torque_limit[k]))
         values.update({name: float(rows[k, j]) for j, name in enumerate(FRICTION_FIELDS)})
-        drives.append(drivetrain.AxisDrive(**values))
+        try:
+            drives.append(drivetrain.AxisDrive(**values))
+        except drivetrain.DrivetrainError as err:
+            raise drivetrain.DrivetrainError(f"axis {k + 1}: {err}") from err
     return drivetrain.Drivetrain(tuple(drives))
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from faultgen import axes as axis_numbers
 from faultgen import inputs
+from faultgen.checks import MAX_SEED
 from faultgen.effects import friction
 from faultgen.model import robots
 from faultgen.operation import faults, programs, tasks, wear
@@ -133,8 +134,8 @@ class Grid:
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"grid {name} = {value!r} (--{name}): expected a whole number >= 1")
         for seed in self.seeds:
-            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-                raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number >= 0")
+            if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+                raise ValueError(f"grid seeds (--seed): {seed!r}: expected a whole number in 0 .. {MAX_SEED}")
         if not isinstance(self.signals, bool):
             raise ValueError(f"grid signals = {self.signals!r}: expected true or false (a TOML boolean, not a string)")
         for name in ("disturbance", "encoder"):

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from faultgen.checks import is_whole
+from faultgen.checks import MAX_SEED, is_whole
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.operation.conditions import Conditions
@@ -102,8 +102,8 @@ class RunConfig:
             if bad:
                 raise ValueError(f"recorded cycle {bad[0]} is out of range 1..{self.cycles}")
             object.__setattr__(self, "record", tuple(sorted(set(record))))
-        if not is_whole(self.seed, 0):
-            raise ValueError(f"seed = {self.seed!r}; expected a whole number >= 0")
+        if not is_whole(self.seed, 0) or self.seed > MAX_SEED:
+            raise ValueError(f"seed = {self.seed!r}; expected a whole number in 0 .. {MAX_SEED}")
         if not isinstance(self.wear, WearPlan):
             raise TypeError(f"wear: expected a WearPlan, got {type(self.wear).__name__}")
         self.wear.check(n_axes)  # "axis 7 is out of range 1..6"
