@@ -186,3 +186,40 @@ def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_
     sxx = np.sum((temperatures - temperatures.mean()) ** 2)
     assert unit.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
     assert unit.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
+
+
+def test_the_wear_estimate_is_weighted_least_squares_along_each_signature():
+    # known values: a residual that is 7 % of axis 3's signature is estimated at exactly 7 % on
+    # axis 3, with standard error 1 / sqrt(sum(s^2 / variance)); scaling every variance by 4
+    # doubles the error and keeps the estimate
+    rng = np.random.default_rng(1)
+    signatures = rng.normal(0, 1, (6, 12))
+    unit = UnitMonitor("u", Settings(), n_axes=6, signatures=signatures)
+    variance = rng.uniform(0.5, 2.0, 12)
+    estimate, error = unit.wear_estimate(7.0 * signatures[2], variance)
+    assert estimate[2] == pytest.approx(7.0)
+    assert error[2] == pytest.approx(1.0 / np.sqrt(np.sum(signatures[2] ** 2 / variance)))
+    estimate4, error4 = unit.wear_estimate(7.0 * signatures[2], 4.0 * variance)
+    np.testing.assert_allclose(estimate4, estimate)
+    np.testing.assert_allclose(error4, 2.0 * error)
+    assert UnitMonitor("u", Settings(protocol="own"), n_axes=6).wear_estimate(signatures[2], variance) is None
+
+
+def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit():
+    # 40 learning logs of noise, then axis 2 wearing 0.5 % a log: the alarm comes once the lower
+    # 99 % bound has stayed at or above 5 % for 5 logs, on axis 2, and not before the estimate
+    # itself is above the limit
+    rng = np.random.default_rng(2)
+    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05  # feature units per %
+    unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
+    for i in range(200):
+        wear = max(i - 60, 0) * 0.5
+        unit.add(f"{i:03d}", rng.normal(0, 0.1, 12) + wear * signatures[1], 30.0, 100.0, np.zeros(12))
+    assert unit.first_alarm is not None and unit.source_axis == 2 and unit.statistic == "wear"
+    first = int(unit.first_alarm)
+    rows = {r["stamp"]: r for r in unit.rows}
+    assert all(max(rows[f"{k:03d}"][f"wear{a}_lower"] for a in range(1, 7)) >= 5.0 for k in range(first, first + 5))
+    assert max(rows[f"{first - 1:03d}"][f"wear{a}_lower"] for a in range(1, 7)) < 5.0  # else it began earlier
+    true_wear = (first - 60) * 0.5
+    assert 5.0 <= true_wear < 15.0, true_wear
+    assert "axis 2 wear estimate" in unit.alarm_row()["evidence"]

@@ -28,6 +28,9 @@ def monitor_command(
     train: Annotated[int, typer.Option(help="Logs of each unit's normal operation the monitor learns from.")] = 28,
     alpha: Annotated[float, typer.Option(help="Significance level of the T2 and Q limits.")] = 0.01,
     persistence: Annotated[int, typer.Option(help="Consecutive logs over a limit that make an alarm.")] = 5,
+    wear_limit: Annotated[float, typer.Option(
+        help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
+             "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -43,9 +46,11 @@ def monitor_command(
     learns the residual's offset, temperature slope and noise and fits a PCA monitor (T2 and Q,
     thesis eq. 2.3-2.6); (d) every later log is scored, its residual standardised by the
     regression's prediction interval (wider the further its temperature and payload lie outside
-    those the learning logs saw). A unit alarms from the first of
-    --persistence consecutive logs over a limit; its source axis is the one whose wear signature
-    the residual follows most.
+    those the learning logs saw), and each axis's wear estimated along its wear signature (weighted
+    least squares, with a standard error). With the twin a log alarms when the lower 1 - alpha
+    bound of the largest wear estimate reaches --wear-limit %; without it (--protocol own) when T2
+    or Q is over its limit. A unit alarms from the first of --persistence consecutive alarming
+    logs; its source axis is the one with the largest wear estimate (own: the largest share of Q).
 
     Writes OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores) and
@@ -63,7 +68,7 @@ def monitor_command(
     from faultgen.monitor import loop
     from faultgen.monitor.scoring import Settings
 
-    settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence)
+    settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
     monitors = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                             twin_temperature=twin_temperature, progress=True)
     alarmed = [m for m in monitors if m.first_alarm]
@@ -72,9 +77,12 @@ def monitor_command(
         what = f"alarm from {m.first_alarm}, axis {m.source_axis}" if m.first_alarm else row["evidence"]
         typer.echo(f"{m.unit}: {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
-    chance = min(1.0, logs_scored * (2 * alpha) ** persistence)
+    # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
+    # bounds over a limit the unworn estimate lies below (twin)
+    per_log = 2 * alpha if protocol == "own" else min(1.0, (monitors[0].n_axes if monitors else 1) * alpha)
+    chance = min(1.0, logs_scored * per_log**persistence)
     typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. Chance of a persistent alarm on a healthy unit over "
                f"{logs_scored} logs if its residuals were independent and normal: <= {chance:.2g} "
-               f"({persistence} in a row at <= {2 * alpha:g} per log); drift the first {train} logs did not show "
+               f"({persistence} in a row at <= {per_log:g} per log); drift the first {train} logs did not show "
                "raises it.")
     typer.echo(f"wrote {out / 'alarms.csv'}, {out / 'scores.csv'} and {len(monitors)} charts")

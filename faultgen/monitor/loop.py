@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import pickle
 import warnings
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from pathlib import Path
 
 import mujoco
@@ -50,7 +50,7 @@ class _Unit:
 
 
 def _settings_key(settings: Settings, model_source: str) -> tuple:
-    return (settings.protocol, settings.train, settings.alpha, settings.variance, settings.persistence, model_source)
+    return (*astuple(settings), model_source)
 
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,

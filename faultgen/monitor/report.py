@@ -25,17 +25,22 @@ def write_alarms(path: Path, monitors) -> None:
 
 
 def write_scores(path: Path, monitors, n_axes: int) -> None:
+    """Every scored log's row; with the twin also each axis's wear estimate, % (``wearI``), and its
+    lower ``1 - alpha`` bound (``wearI_lower``), what the alarm is judged on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
+    if any(m.signatures is not None for m in monitors):
+        columns += tuple(f"wear{i}" for i in range(1, n_axes + 1)) + tuple(f"wear{i}_lower" for i in range(1, n_axes + 1))
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(columns)
         for m in monitors:
             for row in m.rows:
-                writer.writerow([_fmt(row[c]) for c in columns])
+                writer.writerow([_fmt(row.get(c, "")) for c in columns])
 
 
 def chart(path: Path, monitor, axis_note: str) -> None:
-    """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, and each
+    """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, with the
+    twin each axis's wear estimate with the limit its lower bound is judged against, and each
     axis's isolation score."""
     import matplotlib
 
@@ -43,7 +48,10 @@ def chart(path: Path, monitor, axis_note: str) -> None:
     import matplotlib.pyplot as plt
 
     rows = monitor.rows
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), sharex=True, constrained_layout=True)
+    twin = bool(rows) and "wear1" in rows[0]
+    fig, panels = plt.subplots(3 if twin else 2, 1, figsize=(9, 8.5 if twin else 6), sharex=True,
+                               constrained_layout=True)
+    top, bottom = panels[0], panels[-1]
     if rows:
         x = np.arange(len(rows))
         for name, style in (("Q", "-"), ("T2", "--")):
@@ -54,10 +62,19 @@ def chart(path: Path, monitor, axis_note: str) -> None:
         stamps = [r["stamp"] for r in rows]
         if monitor.first_alarm:
             k = stamps.index(monitor.first_alarm)
-            for ax in (top, bottom):
+            for ax in panels:
                 ax.axvline(k, color="r", lw=1.2)
             top.text(k, 1.0, f" alarm {monitor.first_alarm}, axis {monitor.source_axis}", color="r", va="bottom")
         top.set_yscale("log")
+        if twin:
+            middle = panels[1]
+            for i in range(monitor.n_axes):
+                middle.plot(x, [r[f"wear{i + 1}"] for r in rows], lw=1, label=f"axis {i + 1}")
+            best = [max(r[f"wear{i + 1}_lower"] for i in range(monitor.n_axes)) for r in rows]
+            middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * (1 - monitor.settings.alpha):g} % bound")
+            middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
+            middle.set_ylabel("wear estimate, % (twin's scale)")
+            middle.legend(fontsize=7, loc="upper left", ncol=4)
         scores = np.array([[r[f"score{i}"] for i in range(1, monitor.n_axes + 1)] for r in rows])
         for i in range(monitor.n_axes):
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
