@@ -28,9 +28,15 @@ at rest back to it (or to wherever the last segment ends, at rest):
 ===============  ==================================================================================
 
 Every segment takes a ``label`` (what the dataset's path segments are called). Cartesian segments
-go through the same IK and spline as the thesis's seam (:class:`faultgen.operation.ik.FlangeIK`),
-sampled at the same knots, so the three thesis tasks written as programs (:func:`export`) give
-their paths bit for bit.
+go through flange IK every :data:`~faultgen.operation.tasks.IK_STEP` and a spline
+(:class:`faultgen.operation.ik.FlangeIK`); the segments are planned by
+:class:`faultgen.operation.planner.Planner`.
+
+The built-in tasks are programs too: each table of a robot folder's ``tasks.toml`` but ``[limits]``
+(the thesis tasks ``[pick_place]``, ``[spot_weld]``, ``[arc_weld]``) holds a program's keys less its
+name (the table's), robot (the folder's) and limits (the file's), and :func:`builtin` reads it
+through the same reader as a file; :func:`export` writes it as a program file. :func:`load` gives
+the :class:`~faultgen.operation.tasks.Task` a task name or file stands for.
 
 Before any simulation :meth:`Program.trajectory` refuses, naming the segment and the value: an
 unknown key, a Cartesian target out of reach (with the distance to the nearest reachable point), a
