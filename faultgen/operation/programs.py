@@ -62,7 +62,7 @@ from faultgen.operation.ik import tool_rotation
 
 # re-exported: the names callers (replay, the simulation's preparation) know programs by
 from faultgen.operation.planner import GRIP_BODY, TORQUE_CAPACITY, Planner, Segment, add_part, check_torque  # noqa: F401
-from faultgen.operation.tables import Table
+from faultgen.operation.tables import Table, toml_value
 from faultgen.operation.tasks import (  # noqa: F401
     PLAN_PERIOD,
     PROCESSES,
@@ -459,21 +459,6 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
 # -- export --------------------------------------------------------------------------------------
 
 
-def _toml(value) -> str:
-    """A TOML value: numbers as Python writes them (they read back to the same float), lists inline."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, list):
-        if value and isinstance(value[0], list):
-            return "[\n" + "".join(f"    {_toml(v)},\n" for v in value) + "]"
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
-    raise TypeError(f"cannot write {value!r} as TOML")
-
-
 #: Keys of a built-in task's table in ``tasks.toml``: a program's, less those its folder gives (its
 #: name is the table's, its robot the folder's, its limits the file's ``[limits]``).
 BUILTIN_KEYS = tuple(key for key in TOP_KEYS if key not in ("name", "robot", "limits"))
@@ -567,7 +552,7 @@ def dumps(program: dict, header: str = "", where: str = "program") -> str:
     for key in TOP_KEYS:
         if key in program and key not in ("limits", "tool", "segment"):
             unit = f"  # {_UNITS[key]}" if key in _UNITS else ""
-            lines.append(f"{key} = {_toml(program[key])}{unit}")
+            lines.append(f"{key} = {toml_value(program[key])}{unit}")
     for key, title in (("limits", "joint limits for planning, axes 1..N"),
                        ("tool", "flange orientation at Cartesian targets (world frame); offset: tool centre point, "
                                 "m, flange frame")):
@@ -575,9 +560,9 @@ def dumps(program: dict, header: str = "", where: str = "program") -> str:
             lines += ["", f"[{key}]  # {title}"]
             for name, value in program[key].items():
                 unit = f"  # {_UNITS[name]}" if key == "limits" and name in _UNITS else ""
-                lines.append(f"{name} = {_toml(value)}{unit}")
+                lines.append(f"{name} = {toml_value(value)}{unit}")
     for segment in program.get("segment", []):
-        lines += ["", "[[segment]]"] + [f"{key} = {_toml(value)}" for key, value in segment.items()]
+        lines += ["", "[[segment]]"] + [f"{key} = {toml_value(value)}" for key, value in segment.items()]
     return "\n".join(lines) + "\n"
 
 

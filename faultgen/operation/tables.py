@@ -2,7 +2,7 @@
 
 :class:`Table` reads numbers, arrays, fractions, joint angles and strings; every error is a
 :class:`~faultgen.operation.tasks.ProgramError` naming the file, the table and the key, and saying
-what was expected.
+what was expected. :func:`toml_value` writes a value back as TOML text.
 """
 
 from __future__ import annotations
@@ -25,6 +25,21 @@ def _numbers_only(value) -> bool:
     if isinstance(value, list):
         return all(_numbers_only(v) for v in value)
     return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def toml_value(value) -> str:
+    """A TOML value: numbers as Python writes them (they read back to the same float), lists inline."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list):
+        if value and isinstance(value[0], list):
+            return "[\n" + "".join(f"    {toml_value(v)},\n" for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    raise TypeError(f"cannot write {value!r} as TOML")
 
 
 class Table:
