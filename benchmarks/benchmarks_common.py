@@ -12,7 +12,7 @@ import numpy as np
 from mujoco import batch as mjbatch
 
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -54,7 +54,7 @@ class PeakRSS:
 def _prepared(config: sim.RunConfig):
     robot = robots.load(config.robot)
     model_sim = sim.build(robot, config.friction)
-    path = tasks.load(robot, config.task).trajectory(model_sim.model.opt.timestep)
+    path = programs.load(robot, config.task).trajectory(model_sim.model.opt.timestep)
     per_log = int(round(sensors.LOG_PERIOD / model_sim.model.opt.timestep))
     n_steps = -(-(len(path.t) - 1) // per_log) * per_log
     return robot, model_sim, path, n_steps

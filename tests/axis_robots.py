@@ -99,6 +99,8 @@ def make(folder: str | Path, n_axes: int) -> Path:
     (target / "tasks.toml").write_text(
         f"# Minimal tasks of the {n_axes}-axis test arm (tests/axis_robots.py)\n[limits]\n"
         f"velocity = {row(_VELOCITY)}\nacceleration = {row(_ACCELERATION)}\njerk = {row(_JERK)}\n\n"
-        f"[pick_place]\nstart = {row(_START)}\nwaypoints = [{row(_PICK)}, {row(_PLACE)}]\n"
-        "dwell = [0.5, 0.5]\nvelocity_scale = 1.0\nacceleration_scale = 1.0\n")
+        f'[pick_place]\nprocess = "point-to-point"\nstart = {row(_START)}\nvelocity_scale = 1.0\n'
+        f'acceleration_scale = 1.0\nsegment = [\n    {{type = "move", to = {row(_PICK)}}},\n'
+        f'    {{type = "dwell", time = 0.5}},\n    {{type = "move", to = {row(_PLACE)}}},\n'
+        f'    {{type = "dwell", time = 0.5}},\n    {{type = "move", to = {row(_START)}}},\n]\n')
     return path

@@ -47,7 +47,7 @@ import pinocchio as pin
 
 import pinocchio_log
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs
 
 #: Unit-to-unit spread of each friction parameter (log-normal sigma) and its day-to-day scatter,
 #: drawn per log and parameter and not logged (the state of the lubricant film, the warm-up the
@@ -104,7 +104,7 @@ def _motion(folder: str, rate: float):
     step = int(round(250.0 / rate))
     if step < 1 or abs(250.0 / step - rate) > 1e-9:
         raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
-    path = tasks.load(robots.load(folder), "pick_place").trajectory(pinocchio_log.RATE ** -1)
+    path = programs.load(robots.load(folder), "pick_place").trajectory(pinocchio_log.RATE ** -1)
     q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
     return np.arange(len(q)) / rate, q, qd, qdd
 

@@ -27,7 +27,7 @@ import rtbdata
 from faultgen.data import measured
 from faultgen.model import builder, importers, robots
 from faultgen.model.folder import add as add_robot
-from faultgen.operation import taskgen, tasks
+from faultgen.operation import programs, taskgen
 
 KR210_URDF = Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf"
 #: The flange frame of the URDF (ROS-Industrial's ``tool0``); the builder puts its ``flange`` site there.
@@ -79,7 +79,7 @@ def arm_torque(folder: Path, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,
 def motion(folder: Path, cycles: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``cycles`` back-to-back cycles of the folder's ``pick_place`` task at :data:`RATE`:
     ``t`` (n,) s and ``q``, ``qd``, ``qdd`` (n, N) in rad, rad/s, rad/s^2."""
-    path = tasks.load(robots.load(folder), "pick_place").trajectory(1.0 / RATE)
+    path = programs.load(robots.load(folder), "pick_place").trajectory(1.0 / RATE)
     # the last sample of a cycle is the first of the next (same angles, at rest)
     q, qd, qdd = (np.concatenate([x[:-1]] * cycles + [x[-1:]]) for x in (path.q, path.qd, path.qdd))
     return np.arange(len(q)) / RATE, q, qd, qdd

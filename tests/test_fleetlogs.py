@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset, fleetlogs, logfolder, measured, reader
 from faultgen.model import robots
-from faultgen.operation import programs, tasks
+from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -71,7 +71,7 @@ def test_the_records_are_the_shared_functions_features_of_each_log(logs, tmp_pat
                 for name in FEATURES:
                     np.testing.assert_array_equal(run.array(name)[i:i + 1], expected[name], err_msg=name)
     # the speed histogram's range is the one the robot's simulated thesis tasks use
-    np.testing.assert_array_equal(programs.robot_limits(puma)[0], tasks.load(puma, "pick_place").velocity_limit)
+    np.testing.assert_array_equal(programs.robot_limits(puma)[0], programs.load(puma, "pick_place").velocity_limit)
 
 
 def test_a_simulated_cycle_imported_as_a_log_has_the_simulated_features(tmp_path, puma):

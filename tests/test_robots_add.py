@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from faultgen.cli import app
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs, tasks
 
 UR5 = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 
@@ -42,7 +42,7 @@ def test_robot_added_from_a_dh_table_loads_plans_and_says_where_numbers_came_fro
     assert "sized: the source's effort limit 150 N m / G" in readme
     # the tasks plan, and stay within the motors' capacity
     for name in tasks.TASKS:
-        path = tasks.load(robot, name).trajectory(0.004)
+        path = programs.load(robot, name).trajectory(0.004)
         tau = robot.inverse_dynamics(path.q, path.qd, path.qdd)
         assert np.all(np.abs(tau) <= robot.motor_torque_limit * robot.gear_ratio)
     # the drivetrain.toml written is the model's, and rebuilding from it gives the same model

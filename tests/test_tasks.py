@@ -1,5 +1,6 @@
-"""Task cycles (thesis ch. 6.3.1, tasks 1-3): rest-to-rest cycles within the limits, weld stops
-at the weld points, a seam followed at constant speed with the configured weave.
+"""Task cycles (thesis ch. 6.3.1, tasks 1-3, the programs of each robot folder's tasks.toml):
+rest-to-rest cycles within the limits, weld stops at the weld points, a seam followed at constant
+speed with the configured weave; programs and replayed logs are one kind of task.
 
 Flange positions are measured independently of the planner: MuJoCo forward kinematics of the
 full robot model (rotors included) at ``robot.rigid_state(q)``.
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs, replay, tasks
 
 ROBOTS = ["puma560", "irb6700"]
 CASES = [(r, t) for r in ROBOTS for t in tasks.TASKS]
@@ -30,12 +31,29 @@ def loaded():
 
 @pytest.fixture(scope="module")
 def cycles(loaded):
-    """{(robot, task): (Task, JointPath)} at DT, planned once for the module."""
+    """{(robot, task): (Program, JointPath)} at DT, planned once for the module."""
     out = {}
     for robot, name in CASES:
-        task = tasks.load(loaded[robot], name)
+        task = programs.load(loaded[robot], name)
         out[robot, name] = task, task.trajectory(DT)
     return out
+
+
+def weld_points(task):
+    """The weld points (m, 3) of a spot weld program: the Cartesian poses it moves to."""
+    return np.array([s.values["pose"] for s in task.segments if s.type == "move" and "pose" in s.values])
+
+
+def weld_dwell(task):
+    """The stop at each weld point, s."""
+    (time,) = {s.values["time"] for s in task.segments if s.label == "weld"}
+    return time
+
+
+def seam(task):
+    """The values of an arc weld program's seam segment (vertices, corner_radius, speed, ...)."""
+    (segment,) = [s for s in task.segments if s.type == "seam"]
+    return segment.values
 
 
 def flange_positions(robot, q):
@@ -69,7 +87,7 @@ def straight_parts(task, positions, margin=0.01):
     seam plane; ``keep`` marks the positions beside the segment at least
     ``corner_radius + margin`` from its ends (clear of the rounded corners).
     """
-    vertices = task.seam
+    vertices = seam(task)["vertices"]
     normal = np.cross(vertices[1] - vertices[0], vertices[2] - vertices[1])
     normal /= np.linalg.norm(normal)
     parts = []
@@ -80,7 +98,8 @@ def straight_parts(task, positions, margin=0.01):
         along = (positions - a) @ direction
         across = (positions - a) @ lateral
         near = (np.abs(across) < 0.02) & (np.abs((positions - a) @ normal) < 0.02)
-        keep = near & (along > task.corner_radius + margin) & (along < length - task.corner_radius - margin)
+        radius = seam(task)["corner_radius"]
+        keep = near & (along > radius + margin) & (along < length - radius - margin)
         parts.append((keep, along, across))
     return parts
 
@@ -137,12 +156,13 @@ def test_pick_place_covers_a_large_part_of_every_range(cycles, loaded, robot):
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_spot_weld_stops_at_every_weld_point(cycles, loaded, robot):
     task, path = cycles[robot, "spot_weld"]
-    assert 8 <= len(task.points) <= 12
-    dwell_steps = round(task.dwell / DT)
+    points, dwell = weld_points(task), weld_dwell(task)
+    assert 8 <= len(points) <= 12
+    dwell_steps = round(dwell / DT)
     stops = [(a, b) for a, b in rest_runs(path) if b - a >= dwell_steps]
-    assert len(stops) == len(task.points)
-    for (first, last), point in zip(stops, task.points):
-        assert (last - first) * DT == pytest.approx(task.dwell, abs=DT / 2)
+    assert len(stops) == len(points)
+    for (first, last), point in zip(stops, points):
+        assert (last - first) * DT == pytest.approx(dwell, abs=DT / 2)
         flange = flange_positions(loaded[robot], path.q[[first, (first + last) // 2, last]])
         assert np.max(np.linalg.norm(flange - point, axis=1)) <= 0.5 * MM
         np.testing.assert_array_equal(path.target[first : last + 1], np.tile(point, (last - first + 1, 1)))
@@ -161,8 +181,8 @@ def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
     assert not np.any(np.isnan(target))
     assert np.max(np.linalg.norm(flange - target, axis=1)) <= 0.5 * MM
     # and the seam runs from the first to the last vertex (the weave starts and ends at zero)
-    np.testing.assert_allclose(flange[0], task.seam[0], atol=0.5 * MM)
-    np.testing.assert_allclose(flange[-1], task.seam[-1], atol=0.5 * MM)
+    np.testing.assert_allclose(flange[0], seam(task)["vertices"][0], atol=0.5 * MM)
+    np.testing.assert_allclose(flange[-1], seam(task)["vertices"][-1], atol=0.5 * MM)
     # the approach and retract are not on the seam
     assert np.all(np.isnan(path.target[:first])) and np.all(np.isnan(path.target[last + 1 :]))
 
@@ -170,40 +190,42 @@ def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_arc_weld_tool_speed_is_constant_along_the_seam(cycles, loaded, robot):
     task, path = cycles[robot, "arc_weld"]
+    v = seam(task)
     first, last = seam_segment(path)
     flange = flange_positions(loaded[robot], path.q[first : last + 1])
     velocity = np.gradient(flange, DT, axis=0)
     t = np.arange(len(flange)) * DT
-    cruise = (t > task.ramp_time + 0.05) & (t < t[-1] - task.ramp_time - 0.05)
+    cruise = (t > v["ramp_time"] + 0.05) & (t < t[-1] - v["ramp_time"] - 0.05)
     checked = 0
     for keep, along, _ in straight_parts(task, flange):
         sel = keep & cruise
         direction = np.gradient(along, DT)[sel]  # speed along the seam line
-        assert np.all(np.abs(direction / task.tool_speed - 1) < 0.03), (direction.min(), direction.max())
+        assert np.all(np.abs(direction / v["speed"] - 1) < 0.03), (direction.min(), direction.max())
         checked += sel.sum()
     assert checked > 0.5 * len(flange)
     # the weave adds its lateral speed, and on the outside of a corner arc the offset path is longer
-    weave_speed = 2 * np.pi * task.weave_frequency * task.weave_amplitude
-    bound = np.hypot(task.tool_speed, weave_speed) * (1 + task.weave_amplitude / task.corner_radius)
+    weave_speed = 2 * np.pi * v["weave_frequency"] * v["weave_amplitude"]
+    bound = np.hypot(v["speed"], weave_speed) * (1 + v["weave_amplitude"] / v["corner_radius"])
     assert np.max(np.linalg.norm(velocity, axis=1)) <= 1.02 * bound
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_arc_weld_weave_has_the_configured_amplitude_and_frequency(cycles, loaded, robot):
     task, path = cycles[robot, "arc_weld"]
+    v = seam(task)
     first, last = seam_segment(path)
     flange = flange_positions(loaded[robot], path.q[first : last + 1])
-    assert 1 * MM <= task.weave_amplitude <= 5 * MM and 1.0 <= task.weave_frequency <= 3.0
+    assert 1 * MM <= v["weave_amplitude"] <= 5 * MM and 1.0 <= v["weave_frequency"] <= 3.0
     for keep, _, across in straight_parts(task, flange):
         lateral = across[keep]
-        assert np.max(np.abs(lateral)) == pytest.approx(task.weave_amplitude, rel=0.03)
-        assert np.max(np.abs(lateral)) <= task.weave_amplitude + 0.5 * MM
+        assert np.max(np.abs(lateral)) == pytest.approx(v["weave_amplitude"], rel=0.03)
+        assert np.max(np.abs(lateral)) <= v["weave_amplitude"] + 0.5 * MM
     # frequency from the zero crossings of the lateral deviation on the longest straight part
     keep, _, across = max(straight_parts(task, flange), key=lambda part: part[0].sum())
     idx = np.flatnonzero(keep)
     crossings = np.sum(np.diff(np.sign(across[idx])) != 0)
     frequency = crossings / 2 / (len(idx) * DT)
-    assert frequency == pytest.approx(task.weave_frequency, rel=0.1)
+    assert frequency == pytest.approx(v["weave_frequency"], rel=0.1)
 
 
 @pytest.mark.parametrize("robot,name", CASES)
@@ -233,7 +255,7 @@ def test_a_finer_step_samples_the_same_path(cycles, robot, name):
 
 def test_unknown_task_lists_the_known_ones(loaded):
     with pytest.raises(ValueError) as err:
-        tasks.load(loaded["puma560"], "welding")
+        programs.load(loaded["puma560"], "welding")
     message = str(err.value)
     assert "'welding'" in message
     for name in tasks.TASKS:
@@ -260,22 +282,14 @@ def copy_robot_folder(tmp_path, name):
 @pytest.mark.parametrize(
     "old,new,task,key",
     [
-        (
-            "velocity = [100, 95, 100, 150, 130, 110]",
-            "velocity = [100, 95, 100, 150, 130]",
-            "pick_place",
-            "velocity",
-        ),
-        ("dwell = 0.4", "dwel = 0.4", "spot_weld", "dwell"),
-        ("tool_speed = 0.1 ", "tool_speed = -0.1 ", "arc_weld", "tool_speed"),
+        ("velocity = [100, 95, 100, 150, 130, 110]", "velocity = [100, 95, 100, 150, 130]", "pick_place", "velocity"),
+        ('{type = "dwell", time = 0.4, label = "weld"}', '{type = "dwell", tme = 0.4, label = "weld"}', "spot_weld",
+         "tme"),
+        ("speed = 0.1,", "speed = -0.1,", "arc_weld", "speed"),
         ("start = [0, 92, -122, 30, 0, 0]", "start = [0, 92, -122, 30, 120, 0]", "pick_place", "start"),
-        ("dwell = [0.5, 0.5]", "dwell = [0.5]", "pick_place", "dwell"),
-        (
-            "[0.65, -0.30, 0.30],\n    [0.65, 0.00",
-            "[0.65, -0.30, 0.31],\n    [0.65, 0.00",
-            "arc_weld",
-            "seam",
-        ),
+        ('{type = "dwell", time = 0.5}', '{type = "dwell", time = -0.5}', "pick_place", "time"),
+        ("[0.65, -0.30, 0.30], [0.65, 0.00", "[0.65, -0.30, 0.31], [0.65, 0.00", "arc_weld", "vertices"),
+        ("[pick_place]\n", "[pick_place]\nname = \"mine\"\n", "pick_place", "name"),
     ],
 )
 def test_malformed_tasks_file_names_the_file_and_the_key(tmp_path, old, new, task, key):
@@ -283,7 +297,7 @@ def test_malformed_tasks_file_names_the_file_and_the_key(tmp_path, old, new, tas
     assert old in text
     (tmp_path / "tasks.toml").write_text(text.replace(old, new, 1))
     with pytest.raises(ValueError) as err:
-        tasks.load(robots.load(mjcf), task)
+        programs.load(robots.load(mjcf), task).trajectory(DT)
     message = str(err.value)
     assert str(tmp_path / "tasks.toml") in message and key in message, message
 
@@ -292,15 +306,47 @@ def test_missing_or_unparsable_tasks_file_is_reported(tmp_path):
     mjcf, text = copy_robot_folder(tmp_path, "puma560")
     robot = robots.load(mjcf)
     with pytest.raises(ValueError, match="tasks.toml"):
-        tasks.load(robot, "pick_place")
-    (tmp_path / "tasks.toml").write_text(text.replace("[limits]", "[limits", 1))
+        programs.load(robot, "pick_place")
+    (tmp_path / "tasks.toml").write_text(text.replace("\n[limits]\n", "\n[limits\n", 1))
     with pytest.raises(ValueError, match="tasks.toml"):
-        tasks.load(robot, "pick_place")
+        programs.load(robot, "pick_place")
 
 
 def test_a_seam_too_fast_for_the_limits_names_the_axis_and_a_speed_that_fits(tmp_path):
     mjcf, text = copy_robot_folder(tmp_path, "irb6700")
-    (tmp_path / "tasks.toml").write_text(text.replace("tool_speed = 0.15 ", "tool_speed = 3.0 ", 1))
-    task = tasks.load(robots.load(mjcf), "arc_weld")
-    with pytest.raises(ValueError, match=r"axis \d.*tool_speed of about [0-9.]+ m/s would fit"):
+    (tmp_path / "tasks.toml").write_text(text.replace("speed = 0.15,", "speed = 1.5,", 1))
+    task = programs.load(robots.load(mjcf), "arc_weld")
+    with pytest.raises(ValueError, match=r"axis \d.*a speed of about [0-9.]+ m/s would fit"):
         task.trajectory(DT)
+
+
+def test_a_new_builtin_task_is_a_table_of_the_robot_folders_tasks_file(tmp_path):
+    """Adding a task to a robot takes its table in tasks.toml, nothing else: it loads, plans, exports."""
+    mjcf, text = copy_robot_folder(tmp_path, "puma560")
+    (tmp_path / "tasks.toml").write_text(text + (
+        '\n[wave]\nprocess = "handling"\nstart = [0, 92, -122, 30, 0, 0]\nsegment = [\n'
+        '    {type = "move", to = [20, 92, -122, 30, 0, 0]},\n    {type = "move", to = [0, 92, -122, 30, 0, 0]},\n]\n'))
+    robot = robots.load(mjcf)
+    task = programs.builtin(robot, "wave")
+    path = task.trajectory(DT)
+    assert task.name == "wave" and task.process == "handling" and [s[0] for s in path.segments] == ["move"] * 2
+    assert np.degrees(path.q[:, 0].max()) == pytest.approx(20.0)
+    assert "Task wave (handling) of puma560" in programs.export(robot, "wave")
+    with pytest.raises(ValueError, match=r"unknown task 'wav'; known tasks of puma560: pick_place, .*wave"):
+        programs.builtin(robot, "wav")
+
+
+def test_programs_and_replayed_logs_are_one_kind_of_task(cycles, tmp_path):
+    """The built-in tasks are programs, a joint log replays as a task: both satisfy tasks.Task, the
+    protocol the simulation reads (programs.load's return type)."""
+    task, path = cycles["puma560", "pick_place"]
+    log = tmp_path / "log.csv"
+    columns = np.column_stack([path.t, path.q])
+    np.savetxt(log, columns, delimiter=",", header="t," + ",".join(f"q{k + 1}" for k in range(6)), comments="",
+               fmt="%.17g")
+    logged = programs.load(task.robot, str(log))
+    assert isinstance(task, programs.Program) and isinstance(logged, replay.Replay)
+    for each in (task, logged):
+        assert isinstance(each, tasks.Task)
+        assert each.trajectory(DT).q.shape[1] == len(each.start) == len(each.velocity_limit) == 6
+    assert not isinstance(path, tasks.Task)  # a path is no task: the protocol checks what it names

@@ -15,7 +15,7 @@ condition number is large. Limits hold by construction: the velocity and acceler
 ``t = 0`` (``sum_l a_il = 0``, ``sum_l l b_il = 0``, so the trajectory starts and ends at rest and
 can be repeated), and each axis's series is scaled down until it stays within its share of the
 joint range and within the planning velocity and acceleration limits of the robot's
-``tasks.toml`` (:class:`faultgen.operation.tasks.Task`). The optimiser (:func:`design`) scores
+``tasks.toml`` (:func:`faultgen.operation.programs.robot_limits`). The optimiser (:func:`design`) scores
 :data:`STARTS` seeded random coefficient sets and runs scipy's L-BFGS-B on the logarithm of the
 condition number from the best, with the regressor columns and their grid values fixed (a
 criterion continuous in the coefficients) and a finite-difference step (:data:`STEP`) wide enough
@@ -32,12 +32,11 @@ import numpy as np
 from scipy.optimize import minimize
 
 from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
-from faultgen.calibrate.effects import REST_SPEED
-from faultgen.calibrate.effects import get
+from faultgen.calibrate.effects import REST_SPEED, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import atomic
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs, tasks
 
 #: Effects whose regressors the design separates, simplest first: every effect of the library
 #: that is :attr:`~faultgen.effects.Effect.designable` (left out: the warm-up, told apart by the
@@ -148,8 +147,8 @@ def _series(q0, a, b, period, t):
 def limits(robot: robots.Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Joint range (N, 2) rad, velocity (N,) rad/s and acceleration (N,) rad/s^2 limits: the
     model's joint ranges and the planning limits of its ``tasks.toml``."""
-    task = tasks.load(robot, tasks.TASKS[0])
-    return np.asarray(robot.joint_range, dtype=float), task.velocity_limit, task.acceleration_limit
+    velocity, acceleration, _ = programs.robot_limits(robot)
+    return np.asarray(robot.joint_range, dtype=float), velocity, acceleration
 
 
 def _at_rest(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -31,7 +31,7 @@ from faultgen.calibrate.effects import Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import measured
 from faultgen.model import robots
-from faultgen.operation import tasks
+from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
@@ -106,7 +106,7 @@ class Hidden:
 def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion, np.ndarray]:
     """The task's reference motion repeated ``cycles`` times at the log rate, and its nominal torque."""
     duration = sim.cycle_duration(str(robot.path), task)
-    path = tasks.load(robot, task).trajectory(sensors.LOG_PERIOD)
+    path = programs.load(robot, task).trajectory(sensors.LOG_PERIOD)
     n = round(duration / sensors.LOG_PERIOD)
     # the path held at its last sample to the cycle's end, as the simulator does
     q, qd, qdd = (np.tile(sim.hold_end(a, n - 1), (cycles, 1)) for a in (path.q, path.qd, path.qdd))

@@ -49,7 +49,7 @@ def card(path: str | Path) -> str:
         If ``path`` is not a finished faultgen dataset.
     """
     from faultgen.model import robots
-    from faultgen.operation import programs, tasks
+    from faultgen.operation import programs
 
     with reader.open(path) as data:
         runs = data.runs
@@ -120,7 +120,7 @@ def card(path: str | Path) -> str:
         rows.append([name, "", "torque_hist", "N m (motor)", "0..peak motor torque: " + "; ".join(
             f"0..{t:.3g}" for t in robot.motor_torque_limit)])
     for name, task in pairs:
-        limit = tasks.load(name, task).velocity_limit
+        limit = programs.load(name, task).velocity_limit
         rows.append([name, task, "speed_hist", "rad/s (arm)", "0..the task's speed limit: " + "; ".join(
             f"0..{v:.3g}" for v in limit)])
     for name in measured_robots:

@@ -28,9 +28,15 @@ at rest back to it (or to wherever the last segment ends, at rest):
 ===============  ==================================================================================
 
 Every segment takes a ``label`` (what the dataset's path segments are called). Cartesian segments
-go through the same IK and spline as the thesis's seam (:class:`faultgen.operation.ik.FlangeIK`),
-sampled at the same knots, so the three thesis tasks written as programs (:func:`export`) give
-their paths bit for bit.
+go through flange IK every :data:`~faultgen.operation.tasks.IK_STEP` and a spline
+(:class:`faultgen.operation.ik.FlangeIK`); the segments are planned by
+:class:`faultgen.operation.planner.Planner`.
+
+The built-in tasks are programs too: each table of a robot folder's ``tasks.toml`` but ``[limits]``
+(the thesis tasks ``[pick_place]``, ``[spot_weld]``, ``[arc_weld]``) holds a program's keys less its
+name (the table's), robot (the folder's) and limits (the file's), and :func:`builtin` reads it
+through the same reader as a file; :func:`export` writes it as a program file. :func:`load` gives
+the :class:`~faultgen.operation.tasks.Task` a task name or file stands for.
 
 Before any simulation :meth:`Program.trajectory` refuses, naming the segment and the value: an
 unknown key, a Cartesian target out of reach (with the distance to the nearest reachable point), a
@@ -44,21 +50,28 @@ Generic in the number of axes: N is the robot model's (``len(robot.joint_names)`
 from __future__ import annotations
 
 import hashlib
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from faultgen import inputs
-from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.model.robots import Robot
-from faultgen.operation import ik as ik_module
-from faultgen.operation.ik import Arc, FlangeIK, Seam, ramp_arc_length, tool_rotation
-from faultgen.operation.tasks import (
-    IK_STEP, LIMIT_TOLERANCE, PLAN_PERIOD, PROCESSES, SEAM_LIMIT_TOLERANCE, SEAM_TOLERANCE, TASKS, JointPath,
-    CycleTooLong, _Builder, _Table, ptp,
+from faultgen.operation.ik import tool_rotation
+
+# re-exported: the names callers (replay, the simulation's preparation) know programs by
+from faultgen.operation.planner import GRIP_BODY, TORQUE_CAPACITY, Planner, Segment, add_part, check_torque  # noqa: F401
+from faultgen.operation.tables import Table, toml_value
+from faultgen.operation.tasks import (  # noqa: F401
+    PLAN_PERIOD,
+    PROCESSES,
+    TASKS,
+    JointPath,
+    Load,
+    ProgramError,
+    Task,
+    check_step,
 )
 
 #: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
@@ -84,13 +97,6 @@ TOP_KEYS = ("name", "robot", "process", "description", "start", "velocity_scale"
             "tool", "segment")
 LIMIT_KEYS = ("velocity", "acceleration", "jerk")
 TOOL_KEYS = ("z", "x", "offset")
-#: Largest share of the drives' capacity (peak motor torque x gear ratio) a program may ask for.
-TORQUE_CAPACITY = 1.0
-
-
-class ProgramError(ValueError):
-    """A program (or replayed log) cannot run; the message names the file, the segment and the value."""
-
 
 def is_file_task(task: str) -> bool:
     """Whether ``task`` names a program or log file (by its suffix) rather than a thesis task."""
@@ -125,28 +131,28 @@ def label(task: str) -> str:
     return name
 
 
-def load(robot: Robot | str, task: str):
-    """The task ``task`` of ``robot``: a thesis task by name (:func:`faultgen.operation.tasks.load`), a
-    program file (``.toml``, :func:`read`) or a joint log to replay (``.csv``, ``.csv.gz``, ``.h5``;
-    :func:`faultgen.operation.replay.read`).
+def load(robot: Robot | str, task: str) -> Task:
+    """The task ``task`` of ``robot``: a thesis task by name (a program from the robot folder's
+    ``tasks.toml``, :func:`builtin`), a program file (``.toml``, :func:`read`) or a joint log to replay
+    (``.csv``, ``.csv.gz``, ``.h5``; :func:`faultgen.operation.replay.read`).
 
     Returns
     -------
-    Task, Program or Replay
-        Each has ``name``, ``start``, ``velocity_limit`` and ``trajectory(dt) -> JointPath``.
+    faultgen.operation.tasks.Task
+        A :class:`Program` or a :class:`~faultgen.operation.replay.Replay`.
 
     Raises
     ------
     ValueError
         For an unknown task or a file that cannot run on ``robot`` (:class:`ProgramError`).
     """
-    from faultgen.operation import replay, tasks
+    from faultgen.operation import replay
 
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
     check_name(task)
     if task in TASKS:
-        return tasks.load(robot, task)
+        return builtin(robot, task)
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         return read(task, robot)
     return replay.read(task, robot)
@@ -204,21 +210,6 @@ def identity(robot: Robot | str, task: str) -> tuple[str, str]:
 
 
 # -- the program ---------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Segment:
-    """One segment of a program: its 1-based ``number``, ``type`` (a key of :data:`SEGMENT_KEYS`),
-    ``label`` and its values (angles in rad, positions in m, times in s)."""
-
-    number: int
-    type: str
-    label: str
-    values: dict = field(default_factory=dict)
-
-    @property
-    def name(self) -> str:
-        return f"segment {self.number} ({self.type})"
 
 
 @dataclass(frozen=True, eq=False)
@@ -283,299 +274,15 @@ class Program:
         Returns
         -------
         JointPath
-            With ``loads``: the payload carried over sample ranges (:class:`Load`).
+            With ``loads``: the payload carried over sample ranges
+            (:class:`~faultgen.operation.tasks.Load`).
 
         Raises
         ------
         ProgramError
             Naming the segment and the value (module docstring).
         """
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {dt!r}")
-        if abs(PLAN_PERIOD / dt - round(PLAN_PERIOD / dt)) > 1e-9:
-            raise ValueError(f"dt = {dt!r} s does not divide the {PLAN_PERIOD * 1e3:g} ms planning period into whole "
-                             "steps; expected e.g. 0.004, 0.002, 0.001 or 0.0005")
-        return _Planner(self, float(dt)).run()
-
-
-@dataclass(frozen=True)
-class Load:
-    """A payload carried from sample ``first`` to sample ``last`` of a path (inclusive), with the
-    :class:`faultgen.effects.payload.Payload` parameters ``params``; ``segment`` names the grip."""
-
-    first: int
-    last: int
-    params: dict
-    segment: str
-
-
-class _Planner:
-    """Turns a program's segments into a :class:`JointPath`, checking as it goes."""
-
-    def __init__(self, program: Program, dt: float) -> None:
-        self.p = program
-        self.path = _Builder(program.start, dt)
-        self.ik = None
-        self.target = None  # last Cartesian target of the tool (m), None after a joint-space move
-        self.spans: list[tuple[Segment, int, int]] = []
-        self.loads: list[Load] = []
-        self.gripped: tuple[int, dict, str] | None = None
-
-    def fail(self, segment: Segment | None, problem: str):
-        where = f"{self.p.where}, {segment.name}" if segment is not None else self.p.where
-        raise ProgramError(f"{where}: {problem}")
-
-    def flange_ik(self) -> FlangeIK:
-        if self.ik is None:
-            self.ik = FlangeIK(self.p.robot, self.p.start)
-        return self.ik
-
-    def flange_target(self, point: np.ndarray) -> np.ndarray:
-        """The flange position that puts the tool centre point at ``point``."""
-        if np.any(self.p.tool_offset):
-            return point - self.p.tool_rotation @ self.p.tool_offset
-        return point
-
-    def run(self) -> JointPath:
-        for segment in self.p.segments:
-            first = self.path.count - 1
-            try:
-                getattr(self, f"_{segment.type}")(segment)
-            except CycleTooLong as err:  # a path longer than a cycle may be, refused before it is sampled
-                self.fail(segment, err.reason)
-            self.spans.append((segment, first, self.path.count - 1))
-        if self.gripped is not None:
-            self.fail(None, f"the payload gripped in segment {self.gripped[2]} is still held at the end of the "
-                      "cycle; add a release segment (every cycle starts with an empty gripper)")
-        result = self.path.build()
-        result = JointPath(result.t, result.q, result.qd, result.qdd, result.target, result.segments,
-                           loads=tuple(self.loads))
-        self.check_limits(result, np.concatenate(self.path.tolerance))
-        self.check_torque(result)
-        return result
-
-    # -- segments --
-
-    def _solve(self, segment: Segment, position: np.ndarray, q_init: np.ndarray) -> np.ndarray:
-        ik = self.flange_ik()
-        try:
-            return ik.solve(position, self.p.tool_rotation, q_init)
-        except ik_module.Unreachable as err:
-            distance = ik.nearest(position, q_init)
-            if distance > 1e-4:
-                self.fail(segment, f"Cartesian target {np.round(position, 4).tolist()} m (flange) is out of reach: "
-                          f"the nearest point the flange reaches within the joint ranges is {distance:.3f} m away")
-            self.fail(segment, f"Cartesian target {np.round(position, 4).tolist()} m (flange) is reachable, but not "
-                      f"in the tool orientation: {err.orientation_error:.3g} rad remain of it ({err})")
-
-    def _move(self, s: Segment) -> None:
-        v = s.values
-        if "to" in v:
-            q_to = v["to"]
-            self.target = None
-        else:
-            if self.p.tool_rotation is None:
-                self.fail(s, "a Cartesian move needs the tool orientation: [tool] z and x")
-            if "pose" in v:
-                point = v["pose"]
-                if "standoff" in v:
-                    point = point + -v["standoff"] * self.p.tool_rotation[:, 2]
-            elif "standoff" in v:
-                if self.target is None:
-                    self.fail(s, "standoff without pose backs off from the last Cartesian target, and there is none")
-                point = self.target + -v["standoff"] * self.p.tool_rotation[:, 2]
-            else:
-                self.fail(s, "expected one of: to (joint angles, deg), pose (m), standoff (m)")
-            q_to = self._solve(s, self.flange_target(point), self.path.last)
-            self.target = point
-        velocity = v.get("velocity_scale", self.p.velocity_scale) * self.p.velocity_limit
-        acceleration = v.get("acceleration_scale", self.p.acceleration_scale) * self.p.acceleration_limit
-        try:
-            q, qd, qdd = ptp(self.path.last, q_to, velocity, acceleration, self.p.jerk_limit, self.path.dt,
-                             f"{self.p.where}, {s.name}")
-        except ValueError as err:
-            raise ProgramError(str(err)) from err
-        self.path.add(s.label, q, qd, qdd)
-
-    def _dwell(self, s: Segment) -> None:
-        target = None if self.target is None else self.flange_target(self.target)
-        self.path.hold(s.label, s.values["time"], target=target)
-
-    def _grip(self, s: Segment) -> None:
-        if self.gripped is not None:
-            self.fail(s, f"the tool already holds the payload gripped in segment {self.gripped[2]}; release it first")
-        self.gripped = (self.path.count - 1, s.values["part"], str(s.number))
-
-    def _release(self, s: Segment) -> None:
-        if self.gripped is None:
-            self.fail(s, "nothing to release: no payload is gripped")
-        first, params, number = self.gripped
-        self.loads.append(Load(first, self.path.count - 1, params, f"segment {number}"))
-        self.gripped = None
-
-    def _start_point(self, s: Segment) -> np.ndarray:
-        if self.p.tool_rotation is None:
-            self.fail(s, "a Cartesian segment needs the tool orientation: [tool] z and x")
-        if self.target is not None:
-            return self.target
-        # the tool centre point where the last move left it
-        position, rotation = self.flange_ik().flange(self.path.last)
-        return position + rotation @ self.p.tool_offset
-
-    def _linear(self, s: Segment) -> None:
-        start = self._start_point(s)
-        try:
-            geometry = Seam(np.array([start, s.values["to"]]), 0.0, self.p.tool_rotation[:, 2])
-        except ValueError as err:
-            self.fail(s, str(err))
-        self._follow(s, geometry, 0.0, 0.0)
-
-    def _circular(self, s: Segment) -> None:
-        start = self._start_point(s)
-        try:
-            geometry = Arc(start, s.values["via"], s.values["to"])
-        except ValueError as err:
-            self.fail(s, str(err))
-        self._follow(s, geometry, 0.0, 0.0)
-
-    def _seam(self, s: Segment) -> None:
-        v = s.values
-        start = self._start_point(s)
-        gap = float(np.linalg.norm(v["vertices"][0] - start))
-        if gap > SEAM_TOLERANCE:
-            self.fail(s, f"the seam starts {gap * 1e3:.1f} mm from where the tool is "
-                      f"({np.round(start, 4).tolist()} m); add a move to its first vertex")
-        try:
-            geometry = Seam(v["vertices"], v["corner_radius"], self.p.tool_rotation[:, 2])
-        except ValueError as err:
-            self.fail(s, f"vertices: {err}")
-        self._follow(s, geometry, v.get("weave_amplitude", 0.0), v.get("weave_frequency", 0.0))
-
-    def _follow(self, s: Segment, geometry, weave_amplitude: float, weave_frequency: float) -> None:
-        """The tool along ``geometry`` at the segment's speed: IK every :data:`IK_STEP` from the path's
-        last angles, a clamped cubic spline through the solutions (thesis task 3's seam)."""
-        speed, ramp_time = s.values["speed"], s.values["ramp_time"]
-        length = geometry.length
-        if length / speed < ramp_time + PLAN_PERIOD:
-            self.fail(s, f"the path is {length:.4g} m long: at {speed} m/s it takes {length / speed:.3g} s, "
-                      f"not enough for a ramp_time of {ramp_time} s up and down; lower ramp_time or speed")
-        duration = math.ceil((length / speed + ramp_time) / PLAN_PERIOD - 1e-9) * PLAN_PERIOD
-        half_periods = max(1, round(2 * weave_frequency * length / speed))
-        rotation = self.p.tool_rotation
-
-        def tool_path(t: np.ndarray) -> np.ndarray:
-            ramp = duration - geometry.length / speed
-            arc = ramp_arc_length(t, speed, ramp, duration)
-            position, tangent = geometry.evaluate(arc)
-            weave = weave_amplitude * np.sin(np.pi * half_periods * arc / geometry.length)
-            return self.flange_target_rows(position + weave[:, None] * np.cross(geometry.normal, tangent))
-
-        ik, dt = self.flange_ik(), self.path.dt
-        knots = np.linspace(0.0, duration, math.ceil(duration / IK_STEP - 1e-9) + 1)
-        points = tool_path(knots)
-        t = np.arange(round(duration / dt) + 1) * dt
-        try:
-            q, qd, qdd = ik.follow(knots, points, rotation, self.path.last, t)
-        except ValueError as err:
-            self.fail(s, f"{err}")
-        target = tool_path(t)
-        deviation = ik.deviation(q, target)
-        k = int(np.argmax(deviation))
-        if deviation[k] > SEAM_TOLERANCE:
-            self.fail(s, f"IK leaves the flange {deviation[k] * 1e3:.3f} mm from the path at t = {k * dt:.3f} s "
-                      f"into the segment, more than the tolerance of {SEAM_TOLERANCE * 1e3} mm (a point near the "
-                      "edge of the workspace or a wrist singularity)")
-        self._check_speed(s, qd, qdd, speed)
-        self.path.add(s.label, q, qd, qdd, target=target, tolerance=SEAM_LIMIT_TOLERANCE)
-        # the last knot's point (not the last sample's): the next segment starts from it, as task 3's retract
-        self.target = points[-1] if not np.any(self.p.tool_offset) else points[-1] + rotation @ self.p.tool_offset
-
-    def flange_target_rows(self, points: np.ndarray) -> np.ndarray:
-        if np.any(self.p.tool_offset):
-            return points - (self.p.tool_rotation @ self.p.tool_offset)[None]
-        return points
-
-    def _check_speed(self, s: Segment, qd: np.ndarray, qdd: np.ndarray, speed: float) -> None:
-        """Refuse a Cartesian segment that needs more than a joint's speed or acceleration limit."""
-        ratio_v = np.max(np.abs(qd), axis=0) / self.p.velocity_limit
-        ratio_a = np.max(np.abs(qdd), axis=0) / self.p.acceleration_limit
-        axis = int(np.argmax(np.maximum(ratio_v, ratio_a)))
-        worst = max(ratio_v[axis], ratio_a[axis])
-        if worst > 1 + SEAM_LIMIT_TOLERANCE:
-            fit = speed / max(ratio_v[axis], np.sqrt(ratio_a[axis]))
-            kind = "velocity" if ratio_v[axis] >= ratio_a[axis] else "acceleration"
-            limit = (self.p.velocity_limit if kind == "velocity" else self.p.acceleration_limit)[axis]
-            unit = "deg/s" if kind == "velocity" else "deg/s^2"
-            self.fail(s, f"at speed = {speed} m/s axis {axis + 1} needs {worst * np.degrees(limit):.4g} {unit}, "
-                      f"{(worst - 1) * 100:.0f} % above its {kind} limit of {np.degrees(limit):.4g} {unit}; a speed "
-                      f"of about {fit:.3g} m/s would fit")
-
-    # -- checks over the whole cycle --
-
-    def segment_at(self, k: int) -> Segment | None:
-        for segment, first, last in self.spans:
-            if first < k <= last or (first == k == last):
-                return segment
-        return None
-
-    def check_limits(self, path: JointPath, tolerance: np.ndarray) -> None:
-        robot = self.p.robot
-        low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
-        bad = (path.q < low - LIMIT_TOLERANCE) | (path.q > high + LIMIT_TOLERANCE)
-        if np.any(bad):
-            k, axis = np.argwhere(bad)[0]
-            value = path.q[k, axis]
-            edge = low[axis] if value < low[axis] else high[axis]
-            self.fail(self.segment_at(k), f"axis {axis + 1} reaches {np.degrees(value):.2f} deg at t = {path.t[k]:.3f} "
-                      f"s, {abs(np.degrees(value - edge)):.2f} deg beyond its range {np.degrees(low[axis]):.1f}.."
-                      f"{np.degrees(high[axis]):.1f} deg")
-        for kind, values, limit, unit in (("velocity", path.qd, self.p.velocity_limit, "deg/s"),
-                                          ("acceleration", path.qdd, self.p.acceleration_limit, "deg/s^2")):
-            bad = np.abs(values) > limit * (1 + tolerance[:, None] + LIMIT_TOLERANCE)
-            if np.any(bad):
-                k, axis = np.argwhere(bad)[0]
-                value = abs(values[k, axis])
-                self.fail(self.segment_at(k), f"axis {axis + 1} reaches a {kind} of {np.degrees(value):.4g} {unit} at "
-                          f"t = {path.t[k]:.3f} s, {(value / limit[axis] - 1) * 100:.1f} % above its limit of "
-                          f"{np.degrees(limit[axis]):.4g} {unit}")
-
-    def check_torque(self, path: JointPath) -> None:
-        check_torque(self.p.robot, path, lambda k: self.segment_at(k), self.fail)
-
-
-#: The body a program's gripped part is, at the flange (not named ``payload*``: those are the robot's
-#: own payload effect and the payload condition's, which a grip adds to rather than replaces).
-GRIP_BODY = "gripped"
-
-
-def add_part(spec, robot: Robot, params: dict) -> None:
-    """Add a gripped part to an ``MjSpec`` of ``robot``: a body :data:`GRIP_BODY` at the flange with the
-    :class:`~faultgen.effects.payload.Payload` parameters ``params`` (the shared payload's body)."""
-    mass = params["mass"]
-    com = np.array([params[k] for k in ("com_x", "com_y", "com_z")])
-    inertia = np.array([params[k] for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")])
-    Payload._add_body(spec, robot, GRIP_BODY, max(mass, 1e-9), com, inertia)
-
-
-def check_torque(robot: Robot, path: JointPath, segment_at, fail) -> None:
-    """Refuse a path whose arm-side torque (:meth:`Robot.inverse_dynamics`, the payloads of
-    ``path.loads`` included) exceeds the drives' capacity, peak motor torque x gear ratio."""
-    stride = max(1, round(PLAN_PERIOD / (path.t[1] - path.t[0]))) if len(path.t) > 1 else 1
-    rows = np.arange(0, len(path.t), stride)  # every planning period is enough for a peak
-    tau = robot.inverse_dynamics(path.q[rows], path.qd[rows], path.qdd[rows])
-    for load in path.loads:
-        carrying = robot.edited(lambda spec, p=load.params: add_part(spec, robot, p))
-        sel = (rows >= load.first) & (rows <= load.last)
-        if np.any(sel):
-            tau[sel] = carrying.inverse_dynamics(path.q[rows[sel]], path.qd[rows[sel]], path.qdd[rows[sel]])
-    capacity = TORQUE_CAPACITY * robot.motor_torque_limit * robot.gear_ratio
-    ratio = np.abs(tau) / capacity
-    k, axis = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-    if ratio[k, axis] > 1:
-        fail(segment_at(rows[k]), f"axis {axis + 1} needs {abs(tau[k, axis]):.4g} N m (arm side) at t = "
-             f"{path.t[rows[k]]:.3f} s, {(ratio[k, axis] - 1) * 100:.1f} % above the drive's capacity of "
-             f"{capacity[axis]:.4g} N m (peak motor torque {robot.motor_torque_limit[axis]:.4g} N m x gear ratio "
-             f"{robot.gear_ratio[axis]:.4g}); lower the payload, the speed or the acceleration")
+        return Planner(self, check_step(dt)).run()
 
 
 # -- reading -------------------------------------------------------------------------------------
@@ -597,16 +304,17 @@ def read(path: str | Path, robot: Robot | str) -> Program:
     return parse(text, robot, Path(path))
 
 
-def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
-    """A :class:`Program` from TOML ``text`` (see :func:`read`)."""
+def parse(text: str, robot: Robot | str, source: Path | None = None, where: str | None = None) -> Program:
+    """A :class:`Program` from TOML ``text`` (see :func:`read`); ``where`` names it in messages (default
+    ``source``)."""
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
-    where = str(source or "program")
+    where = where or str(source or "program")
     try:
         data = inputs.loads_toml(text, where, "program file")
     except inputs.InputError as err:
         raise ProgramError(str(err)) from None
-    top = _Values(where, "", data, TOP_KEYS)
+    top = Table(where, "", data, TOP_KEYS)
     name = top.text("name")
     if "robot" in data:
         _check_robot(top, robot)
@@ -617,7 +325,7 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
             top.fail("process", f"{process!r} is not a process; expected one of {', '.join(PROGRAM_PROCESSES)}")
     limits = _limits(data, robot, where)
     start = top.angles("start", robot)
-    tool = _Values(where, "[tool] ", data.get("tool", {}), TOOL_KEYS)
+    tool = Table(where, "[tool] ", data.get("tool", {}), TOOL_KEYS)
     rotation, offset = None, np.zeros(3)
     if "z" in tool.data or "x" in tool.data:
         try:
@@ -642,7 +350,7 @@ def parse(text: str, robot: Robot | str, source: Path | None = None) -> Program:
     )
 
 
-def _check_robot(top: "_Values", robot: Robot) -> None:
+def _check_robot(top: Table, robot: Robot) -> None:
     """Refuse a program whose ``robot`` key names another robot than the one it runs on (its joint
     angles, poses and limits were written for that robot). A model ``faultgen calibrate`` wrote,
     ``<robot>_calibrated``, runs the programs of ``<robot>``."""
@@ -679,7 +387,7 @@ def _limits(data: dict, robot: Robot, where: str) -> tuple[np.ndarray, np.ndarra
         except inputs.InputError as err:
             raise ProgramError(str(err)) from None
         origin = str(folder_file)
-    values = _Values(origin, "[limits] ", table if isinstance(table, dict) else {}, LIMIT_KEYS)
+    values = Table(origin, "[limits] ", table if isinstance(table, dict) else {}, LIMIT_KEYS)
     n = len(robot.joint_names)
     return tuple(values.array(key, (n,), np.pi / 180, positive=True) for key in LIMIT_KEYS)
 
@@ -690,7 +398,7 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
     kind = table.get("type")
     if kind not in SEGMENT_KEYS:
         raise ProgramError(f"{where}: segment {number}: type = {kind!r}; expected one of {', '.join(SEGMENT_KEYS)}")
-    t = _Values(where, f"segment {number} ({kind}) ", table, ("type", "label", *SEGMENT_KEYS[kind]))
+    t = Table(where, f"segment {number} ({kind}) ", table, ("type", "label", *SEGMENT_KEYS[kind]))
     default_label = {"move": "move", "dwell": "dwell"}.get(kind, kind)
     values: dict = {}
     if kind == "move":
@@ -748,101 +456,66 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
     return Segment(number, kind, label_, values)
 
 
-class _Values(_Table):
-    """One table of a program file; every error names the file, the table and the key (the values
-    are read as a tasks.toml's are, :class:`faultgen.operation.tasks._Table`)."""
-
-    def __init__(self, where: str, prefix: str, data, keys: tuple[str, ...]) -> None:
-        if not isinstance(data, dict):
-            raise ProgramError(f"{where}: {prefix.strip() or 'file'}: expected a table, got {data!r}")
-        self.where, self.prefix = where, prefix
-        self._take(data, keys)
-
-    def fail(self, key: str, problem: str):
-        raise ProgramError(f"{self.where}: {self.prefix}{key}: {problem}")
-
-    def text(self, key: str) -> str:
-        value = self.get(key)
-        if not isinstance(value, str) or not value.strip():
-            self.fail(key, f"expected a non-empty string, got {value!r}")
-        return value
-
-    def angles(self, key: str, robot: Robot) -> np.ndarray:
-        """Joint angles given in deg, shape (N,), as rad within the joint ranges."""
-        return super().angles(key, robot)[0]
-
-
 # -- export --------------------------------------------------------------------------------------
 
 
-def _toml(value) -> str:
-    """A TOML value: numbers as Python writes them (they read back to the same float), lists inline."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, list):
-        if value and isinstance(value[0], list):
-            return "[\n" + "".join(f"    {_toml(v)},\n" for v in value) + "]"
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
-    raise TypeError(f"cannot write {value!r} as TOML")
+#: Keys of a built-in task's table in ``tasks.toml``: a program's, less those its folder gives (its
+#: name is the table's, its robot the folder's, its limits the file's ``[limits]``).
+BUILTIN_KEYS = tuple(key for key in TOP_KEYS if key not in ("name", "robot", "limits"))
 
 
-def export(robot: Robot | str, name: str) -> str:
-    """The thesis task ``name`` of ``robot`` (its ``tasks.toml`` section) as a program file's text:
-    the same path, bit for bit, when read back (numbers are copied as the file gives them).
+def builtin(robot: Robot | str, name: str) -> Program:
+    """The built-in task ``name`` of ``robot``: the table ``[name]`` of its folder's ``tasks.toml``
+    read as a program, with the file's ``[limits]`` (the thesis tasks of ch. 6.3.1 are the tables
+    :data:`~faultgen.operation.tasks.TASKS`). Its :attr:`Program.text` is what :func:`export` writes.
 
     Raises
     ------
-    ValueError
-        For an unknown task or a robot without a ``tasks.toml``.
+    ProgramError
+        For a robot without a ``tasks.toml``, a name that is no table of it (the message lists the
+        tables), or a table that does not read as a program (the file, the table, the segment and
+        the key named).
     """
-    from faultgen.operation import tasks
-
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
-    tasks.load(robot, name)  # refuses an unknown task or a malformed file, with the file and the key
     source = robot.path.parent / "tasks.toml"
-    data = inputs.read_toml(source, "tasks file")
-    t, limits = data[name], data["limits"]
-    header = (f"Thesis ch. 6.3.1 task {TASKS.index(name) + 1} ({PROCESSES[name]}) of {robot.name}, exported from "
-              f"{source.name} by `faultgen tasks export`.")
-    program = {"name": name, "robot": robot.name, "process": PROCESSES[name], "start": t["start"],
-               "velocity_scale": t["velocity_scale"], "acceleration_scale": t["acceleration_scale"],
-               "limits": {key: limits[key] for key in LIMIT_KEYS}}
-    if "tool_z" in t:
-        program["tool"] = {"z": t["tool_z"], "x": t["tool_x"]}
-    segments: list[dict] = []
-    if name == "pick_place":
-        for q, rest in zip(t["waypoints"], t["dwell"], strict=True):
-            segments += [{"type": "move", "to": q}, {"type": "dwell", "time": rest}]
-        segments.append({"type": "move", "to": t["start"]})
-    elif name == "spot_weld":
-        for point in t["points"]:
-            segments += [{"type": "move", "pose": point}, {"type": "dwell", "time": t["dwell"], "label": "weld"}]
-        segments.append({"type": "move", "to": t["start"]})
-    else:
-        seam = t["seam"]
-        segments += [
-            {"type": "move", "pose": seam[0], "standoff": t["standoff"], "label": "approach"},
-            {"type": "move", "pose": seam[0], "label": "approach"},
-            {"type": "seam", "vertices": seam, "corner_radius": t["corner_radius"], "speed": t["tool_speed"],
-             "ramp_time": t["ramp_time"], "weave_amplitude": t["weave_amplitude"],
-             "weave_frequency": t["weave_frequency"]},
-            {"type": "move", "standoff": t["standoff"], "label": "retract"},
-            {"type": "move", "to": t["start"], "label": "retract"},
-        ]
-    program["segment"] = segments
-    return dumps(program, header)
+    if not source.is_file():
+        raise ProgramError(f"{source}: no tasks file for robot {robot.name!r}")
+    try:
+        data = inputs.read_toml(source, "tasks file")
+    except inputs.InputError as err:
+        raise ProgramError(str(err)) from None
+    known = [key for key in data if key != "limits"]
+    if name not in known:
+        raise ProgramError(f"unknown task {name!r}; known tasks of {robot.name}: {', '.join(known)} ({source})")
+    where = f"{source} [{name}]"
+    table = Table(str(source), f"[{name}] ", data[name], BUILTIN_KEYS).data
+    limits = Table(str(source), "[limits] ", data.get("limits"), LIMIT_KEYS)
+    program = {"name": name, "robot": robot.name, **table, "limits": {key: limits.get(key) for key in LIMIT_KEYS}}
+    title = f"Thesis ch. 6.3.1 task {TASKS.index(name) + 1}" if name in TASKS else f"Task {name}"
+    header = (f"{title} ({table.get('process', 'program')}) of {robot.name}, exported from {source.name} by "
+              "`faultgen tasks export`.")
+    return parse(dumps(program, header, where), robot, source, where)
+
+
+def export(robot: Robot | str, name: str) -> str:
+    """The built-in task ``name`` of ``robot`` (a table of its ``tasks.toml``, :func:`builtin`) as a
+    program file's text to edit: the same program, so the same path bit for bit (numbers are written
+    as the file gives them).
+
+    Raises
+    ------
+    ProgramError
+        As :func:`builtin`.
+    """
+    return builtin(robot, name).text
 
 
 #: Comments :func:`dumps` writes beside the values it knows.
 _UNITS = {"start": "deg", "velocity": "deg/s", "acceleration": "deg/s^2", "jerk": "deg/s^3"}
 
 
-def dumps(program: dict, header: str = "") -> str:
+def dumps(program: dict, header: str = "", where: str = "program") -> str:
     """A program file's text from the table a program file reads as (``tomllib.loads`` of it): what
     a program generator (a robot builder writing thesis-like tasks) calls. Numbers are written as
     Python writes them, so they read back to the same floats.
@@ -856,6 +529,8 @@ def dumps(program: dict, header: str = "") -> str:
         ``x``, ``offset``); see the module docstring.
     header : str
         A comment for the file's top (one line or several).
+    where : str
+        Names the table in an error message.
 
     Raises
     ------
@@ -863,21 +538,21 @@ def dumps(program: dict, header: str = "") -> str:
         For a key :func:`parse` would not read (checked without a robot; :func:`parse` checks the
         values).
     """
-    _Values("program", "", program, TOP_KEYS)
+    Table(where, "", program, TOP_KEYS)
     for key in ("limits", "tool"):
-        _Values("program", f"[{key}] ", program.get(key, {}), LIMIT_KEYS if key == "limits" else TOOL_KEYS)
+        Table(where, f"[{key}] ", program.get(key, {}), LIMIT_KEYS if key == "limits" else TOOL_KEYS)
     for k, table in enumerate(program.get("segment", [])):
         kind = table.get("type") if isinstance(table, dict) else None
         if kind not in SEGMENT_KEYS:
-            raise ProgramError(f"program: segment {k + 1}: type = {kind!r}; expected one of {', '.join(SEGMENT_KEYS)}")
-        _Values("program", f"segment {k + 1} ({kind}) ", table, ("type", "label", *SEGMENT_KEYS[kind]))
+            raise ProgramError(f"{where}: segment {k + 1}: type = {kind!r}; expected one of {', '.join(SEGMENT_KEYS)}")
+        Table(where, f"segment {k + 1} ({kind}) ", table, ("type", "label", *SEGMENT_KEYS[kind]))
     lines = [f"# {line}" for line in header.splitlines()]
     if header:
         lines.append("# Units: joint angles in deg, positions in m (world frame), times in s, speeds in m/s.")
     for key in TOP_KEYS:
         if key in program and key not in ("limits", "tool", "segment"):
             unit = f"  # {_UNITS[key]}" if key in _UNITS else ""
-            lines.append(f"{key} = {_toml(program[key])}{unit}")
+            lines.append(f"{key} = {toml_value(program[key])}{unit}")
     for key, title in (("limits", "joint limits for planning, axes 1..N"),
                        ("tool", "flange orientation at Cartesian targets (world frame); offset: tool centre point, "
                                 "m, flange frame")):
@@ -885,9 +560,9 @@ def dumps(program: dict, header: str = "") -> str:
             lines += ["", f"[{key}]  # {title}"]
             for name, value in program[key].items():
                 unit = f"  # {_UNITS[name]}" if key == "limits" and name in _UNITS else ""
-                lines.append(f"{name} = {_toml(value)}{unit}")
+                lines.append(f"{name} = {toml_value(value)}{unit}")
     for segment in program.get("segment", []):
-        lines += ["", "[[segment]]"] + [f"{key} = {_toml(value)}" for key, value in segment.items()]
+        lines += ["", "[[segment]]"] + [f"{key} = {toml_value(value)}" for key, value in segment.items()]
     return "\n".join(lines) + "\n"
 
 
