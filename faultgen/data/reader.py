@@ -174,6 +174,24 @@ class Run:
             self._cache[name] = value
         return self._cache[name]
 
+    def units(self, name: str) -> str:
+        """The units the file stores for array ``name`` (its ``units`` attribute; "" if it has none).
+
+        Raises
+        ------
+        faultgen.data.schema.DatasetError
+            If the run has no such array, or the dataset was closed.
+        """
+        group = self._group()
+        if name not in group:
+            raise schema.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}")
+        return str(attr(group[name].attrs.get("units", "")))
+
+    def forget(self, *names: str) -> None:
+        """Drop the cached arrays ``names`` (read again if asked for): large signals not kept."""
+        for name in names:
+            self._cache.pop(name, None)
+
     def has(self, *names: str) -> bool:
         """Whether the run holds every array of ``names``."""
         group = self._group()
