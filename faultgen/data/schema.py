@@ -25,6 +25,7 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
         torque_counts          (n_cycles, N, 1200) samples per fine |tau_m| bin, what detection
                                bins from (COUNT_ARRAYS; runs recorded per cycle since it exists)
         day, hour, joint_temperature, ...      operating conditions per cycle, truth (only runs
+                                               with conditions: CONDITION_ARRAYS; attr conditions)
 
 Only tables and the small rules read from them live here (array names, units, axes and the
 dtypes and shapes they imply, run attributes, the format version, :class:`DatasetError`): the
@@ -154,10 +155,10 @@ PROGRAM_ATTRIBUTE = "program_sha256"
 
 #: Attributes of a run written since robots of 5 to 7 axes exist (files before them lack them and
 #: stay valid: their robots had six axes): ``n_axes`` (int) and ``drivetrain`` (JSON,
-#: :func:`drivetrain`).
+#: :func:`faultgen.data.writer.drivetrain`).
 ROBOT_ATTRIBUTES = ("n_axes", "drivetrain")
 
-#: The drivetrain numbers a run records (:func:`drivetrain`): Robot attribute -> SI unit.
+#: The drivetrain numbers a run records (:func:`faultgen.data.writer.drivetrain`): Robot attribute -> SI unit.
 DRIVETRAIN = {"gear_ratio": "1", "motor_inertia": "kg m^2", "gearbox_stiffness": "N m/rad",
               "gearbox_damping": "N m s/rad", "motor_torque_limit": "N m"}
 
@@ -167,7 +168,6 @@ class DatasetError(ValueError):
 
     #: The command line's exit code for it (faultgen.cli.base.Command): the file, not the input, is bad.
     exit_code = 1
-
 
 
 def condition_arrays(conditions: dict | None) -> list[str]:

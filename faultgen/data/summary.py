@@ -33,12 +33,13 @@ def features(path: str | Path) -> pd.DataFrame:
     (:data:`FEATURE_LABELS`), ``worn_axes`` (the run's worn axes as text, "2" or "2 5"; "" for
     none), ``cycle`` (1-based), ``axis`` (1..N), ``worn`` (this axis wears in this run),
     ``wear_pct`` (true wear of this axis at this cycle, ``(friction_multiplier - 1) * 100``),
-    then every array of :data:`ARRAYS` with axes "cycle, axis" and of :data:`DUTY_ARRAYS` (empty for
-    runs without) under its own name and every
-    histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` .. ``torque_hist_12``,
-    and, for runs with operating conditions, each of their :data:`CONDITION_ARRAYS` (a per-cycle
-    value on each of the cycle's rows, a per-axis one on each axis's; empty for runs without).
-    Values are the stored ones, in the units of :data:`ARRAYS`; ``DataFrame.attrs["units"]`` maps
+    then every array of :data:`~faultgen.data.schema.ARRAYS` with axes "cycle, axis" and of
+    :data:`~faultgen.data.schema.DUTY_ARRAYS` (empty for runs without) under its own name and
+    every histogram ("cycle, axis, bin") as one column per bin, ``torque_hist_1`` ..
+    ``torque_hist_12``, and, for runs with operating conditions, each of their
+    :data:`~faultgen.data.schema.CONDITION_ARRAYS` (a per-cycle value on each of the cycle's
+    rows, a per-axis one on each axis's; empty for runs without). Values are the stored ones, in
+    the units of :data:`~faultgen.data.schema.ARRAYS`; ``DataFrame.attrs["units"]`` maps
     each column to its unit.
 
     Raises
