@@ -134,7 +134,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
 
             for run in runs:
                 inside = speed_window_mean(run.signal("tau_m"), run.signal("qd_m"), *speed_window)
-                run._cache.pop("tau_m"), run._cache.pop("qd_m")  # large: not kept
+                run.forget("tau_m", "qd_m")  # large: not kept
                 windowed[run.id] = ~np.isnan(inside).any(axis=0)
                 values[run.id] = np.where(windowed[run.id], inside, values[run.id])
         worn = [r for r in runs if len(r.worn_axes) == 1]
@@ -902,7 +902,7 @@ def torque_record(run: reader.Run) -> np.ndarray | StoredHistograms:
         return run.array("torque_counts")
     if run.has_signals:
         tau_m = run.signal("tau_m")
-        run._cache.pop("tau_m")  # the largest array of a file: not kept
+        run.forget("tau_m")  # the largest array of a file: not kept
         return sensors.torque_counts(tau_m, robots.load(run.robot).motor_torque_limit)
     return StoredHistograms(run.array("torque_hist"))
 

@@ -88,7 +88,7 @@ def check_comparable(train: reader.Dataset, test: reader.Dataset) -> None:
             for run in data.runs:
                 if not run.has(name):
                     raise ValueError(f"{data.path}: run {run.id} has no {name}; both datasets need it")
-                units.setdefault(str(reader.dataset._attr(run._group()[name].attrs.get("units"))), data.path)
+                units.setdefault(run.units(name), data.path)
         if len(units) > 1:
             raise ValueError(f"{name} is in different units: " + ", ".join(f"{u!r} in {p}" for u, p in units.items()))
 

@@ -65,6 +65,19 @@ def test_signals_load_lazily_and_a_features_only_file_says_why_it_lacks_them(sma
         data.runs[0].signal("tau_m")
 
 
+def test_a_run_names_its_stored_units_and_forgets_a_large_array_it_read(small):
+    with faultgen.open(small) as data, h5py.File(small, "r") as f:
+        run = data.runs[1]
+        for name in ("tau_m", "friction_multiplier", "torque_hist", "t"):
+            assert run.units(name) == f["runs"][run.id][name].attrs["units"] == dataset.ARRAYS[name][0]
+        with pytest.raises(dataset.DatasetError, match="no array 'nothing'"):
+            run.units("nothing")
+        tau = run.signal("tau_m")
+        run.forget("tau_m", "qd_m")  # qd_m never read: nothing to forget
+        assert "tau_m" not in run._cache
+        np.testing.assert_array_equal(run.signal("tau_m"), tau)  # read again on asking
+
+
 def test_features_table_is_the_exported_table_and_carries_units(fleet):
     with faultgen.open(fleet) as data:
         table = data.features()

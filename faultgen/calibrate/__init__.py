@@ -34,11 +34,12 @@ import mujoco
 import numpy as np
 
 from faultgen import axes
-from faultgen.calibrate import gearbox, plausibility, search
+from faultgen.calibrate import plausibility, search
 from faultgen.calibrate.effects import EFFECTS, Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
-from faultgen.calibrate.plausibility import ImplausibleLogError
 from faultgen.calibrate.leftover import UNEXPLAINED_RATIO, unexplained, unexplained_line
+from faultgen.calibrate.plausibility import ImplausibleLogError
+from faultgen.calibrate.prediction import predict, predicted_motion
 from faultgen.data import atomic, longlog
 from faultgen.data import measured as measured_io
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
@@ -335,7 +336,7 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     current = nominal
-    predicted, motion = _predict(nominal, data)
+    predicted, motion = predicted_motion(nominal, data)
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
@@ -410,23 +411,6 @@ def _calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredDat
     return result
 
 
-def predict(robot: robots.Robot, data: measured_io.MeasuredData) -> np.ndarray:
-    """A model's drive torque along a measured motion, N m at the arm side, shape (n, 6).
-
-    :meth:`faultgen.model.robots.Robot.inverse_dynamics` (rigid body, motor inertia, friction and the
-    model's optional effects, time from the first sample) plus the torque of the flexible
-    gearboxes (:func:`faultgen.calibrate.gearbox.compliance_torque`).
-    """
-    return _predict(robot, data)[0]
-
-
-def _predict(robot: robots.Robot, data: measured_io.MeasuredData) -> tuple[np.ndarray, Motion]:
-    """:func:`predict` and the :class:`Motion` it evaluated (the search fits effects on it)."""
-    motion = motion_of(robot, data.t, data.q, data.qd, data.qdd)
-    rigid = robot.inverse_dynamics(data.q, data.qd, data.qdd, t=motion.t)
-    return rigid + gearbox.compliance_torque(robot, data.t, data.q, motion.load), motion
-
-
 def parameters(robot: robots.Robot) -> dict:
     """A robot's parameters as plain lists over axes 1..6, with their units (``parameters.json``):
     gear ratios, the motor-side friction (:data:`faultgen.effects.friction.FIELDS`) and every effect the
@@ -463,7 +447,7 @@ def _refit(spec: mujoco.MjSpec, current: robots.Robot, predicted: np.ndarray, st
         without = mujoco.MjSpec.from_string(spec.to_xml())
         befores[j].write(without, current, step.axes)
         reduced = robots.load(_write(without, path))
-        reduced_prediction, motion = _predict(reduced, data)
+        reduced_prediction, motion = predicted_motion(reduced, data)
         residual = tau - reduced_prediction
         kind = get(step.effect.id)
         if "completed" in step.evidence:  # fitted on its re-searched axes as the re-search did
@@ -513,7 +497,7 @@ def _extend(current: robots.Robot, predicted: np.ndarray, steps: list[Step], dat
         levelled = robots.load(_write(spec, path))  # the effect is written over the new levels
         kind.apply(spec, levelled, axis, found.params)
         trial = robots.load(_write(spec, path))
-        trial_prediction, trial_motion = _predict(trial, data)
+        trial_prediction, trial_motion = predicted_motion(trial, data)
         trial_gap = search.gap(tau, trial_prediction, split.held_out)
         if trial_gap["total_nrmse"] >= best_gap:
             path.write_text(kept)  # the model file keeps the model kept
@@ -572,7 +556,7 @@ def _sysid_stribeck(current: robots.Robot, predicted: np.ndarray, steps: list[St
         for axis, values in found.params.items():
             kind.apply(spec, current, axis, values)
         trial = robots.load(_write(spec, path))
-        trial_prediction, _ = _predict(trial, data)
+        trial_prediction, _ = predicted_motion(trial, data)
         after = search.gap(tau, trial_prediction, split.held_out)
         kept = after["total_nrmse"] < before["total_nrmse"]
 
@@ -610,7 +594,7 @@ def _with_effect(spec: mujoco.MjSpec, robot: robots.Robot, effect, axes, path: P
     trial_spec = mujoco.MjSpec.from_string(spec.to_xml())
     effect.write(trial_spec, robot, axes)
     trial = robots.load(_write(trial_spec, path))
-    prediction, motion = _predict(trial, data)
+    prediction, motion = predicted_motion(trial, data)
     return trial_spec, trial, prediction, motion, search.gap(tau, prediction, held_out)
 
 

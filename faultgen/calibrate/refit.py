@@ -127,7 +127,7 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     """
     from mujoco import sysid
 
-    from faultgen.calibrate import predict
+    from faultgen.calibrate.prediction import predict
 
     model_path = Path(result.model_out)
     base_xml = model_path.read_text()

@@ -353,6 +353,16 @@ def write_text(path: str | Path, text: str) -> None:
         tmp.write_text(text)
 
 
+def writer_of(path: str | Path) -> int | None:
+    """The pid of the running process writing ``path``, if ``path`` is the temporary file of an
+    atomic write (``.<name>.<pid>@<host>.<random>.part``, :func:`atomic_path`) of a process that
+    still runs on this host; else None."""
+    match = re.fullmatch(r"\.(.+)\.(\d+)@(.+)\.[^.]+\.part", Path(path).name)
+    if match is None or match[3] != _host() or not _running(int(match[2])):
+        return None
+    return int(match[2])
+
+
 def _host() -> str:
     return socket.gethostname().replace("/", "_")
 

@@ -2,7 +2,7 @@
 
 ``faultgen info FILE --card`` prints it. Built from the file (labels, the command, the version
 that wrote it), the robot models it names (friction, joint ranges, torque limits) and the
-schema tables of :mod:`faultgen.data.dataset`, so it cannot drift from what is stored.
+schema tables of :mod:`faultgen.data.schema`, so it cannot drift from what is stored.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import __version__
-from faultgen.data import dataset, reader
+from faultgen.data import reader, schema
 from faultgen.simulation import sensors
 
 #: The wear level the card explains in physical terms when the dataset has no friction wear; a
@@ -45,7 +45,7 @@ def card(path: str | Path) -> str:
 
     Raises
     ------
-    faultgen.data.dataset.DatasetError
+    faultgen.data.schema.DatasetError
         If ``path`` is not a finished faultgen dataset.
     """
     from faultgen.model import robots
@@ -125,7 +125,7 @@ def card(path: str | Path) -> str:
             f"0..{v:.3g}" for v in limit)])
     for name in measured_robots:
         limit = programs.robot_limits(name)[0]
-        rows.append([name, dataset.MEASURED, "speed_hist", "rad/s (arm)", "0..the robot's speed limit (tasks.toml "
+        rows.append([name, schema.MEASURED, "speed_hist", "rad/s (arm)", "0..the robot's speed limit (tasks.toml "
                      "[limits], as its thesis tasks): " + "; ".join(f"0..{v:.3g}" for v in limit)])
     lines += _table(["robot", "task", "histogram", "units", f"range per axis 1..N, split in {sensors.HISTOGRAM_BINS}"],
                     rows)
@@ -137,5 +137,5 @@ def card(path: str | Path) -> str:
               f"- Python {platform.python_version()}, MuJoCo {_version('mujoco')}, numpy {np.__version__}, "
               f"h5py {_version('h5py')}",
               f"- reading: `import faultgen; data = faultgen.open({str(path)!r})`; `data.runs`, `data.features()`",
-              f"- schema: format {dataset.FORMAT} version {dataset.FORMAT_VERSION}; docs/dataset.md"]
+              f"- schema: format {schema.FORMAT} version {schema.FORMAT_VERSION}; docs/dataset.md"]
     return "\n".join(lines)

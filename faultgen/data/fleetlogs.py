@@ -17,7 +17,7 @@ What an imported run holds beside the features (docs/dataset.md, "An imported fl
 ``label`` (per log and axis: 1 worn, 0 healthy, -1 unknown, from the events), ``stamp``,
 ``stamp_key``, ``log_cycles``, ``log_duration`` and, when every log of the unit has them,
 ``joint_temperature`` (mean over the log) and ``payload_mass`` (its largest value);
-:data:`faultgen.data.dataset.MEASURED_ARRAYS`. No truth is measured: ``friction_multiplier`` holds
+:data:`faultgen.data.schema.MEASURED_ARRAYS`. No truth is measured: ``friction_multiplier`` holds
 the labels as every analysis reads a wear (:data:`WORN_MARK` on worn logs, 1 elsewhere) and the
 simulated truths ``mean_friction_torque`` and ``tracking_error`` are absent.
 
@@ -43,8 +43,9 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen import __version__
-from faultgen.data import dataset, logfolder, measured
+from faultgen.data import logfolder, measured, schema, writer
 from faultgen.data.atomic import check_writable, hdf5_writer
+from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
@@ -53,7 +54,7 @@ from faultgen.simulation import sensors
 #: that reads it as a wear; healthy and unknown logs hold 1).
 WORN_MARK = 2.0
 #: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
-MEASURED = dataset.MEASURED
+MEASURED = schema.MEASURED
 #: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
 #: The group of the manifest in an imported dataset.
@@ -170,7 +171,7 @@ def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np
 def _feature_specs() -> dict[str, tuple[str, str, str]]:
     """The per-record arrays of a simulated fleet's run that an imported run holds too."""
     names = ("friction_multiplier", "mean_abs_torque", "rms_torque", "angle_hist", "speed_hist", "torque_hist")
-    return {**{name: dataset.ARRAYS[name] for name in names}, **dataset.DUTY_ARRAYS}
+    return {**{name: schema.ARRAYS[name] for name in names}, **schema.DUTY_ARRAYS}
 
 
 class _Previous:
@@ -183,25 +184,25 @@ class _Previous:
         self.path = out
         if not out.exists():
             return
-        with dataset._open(out) as f:
+        with open_file(out) as f:
             if MANIFEST not in f:
                 raise ValueError(f"{out} exists and is not an imported fleet (no /{MANIFEST} manifest); choose another "
                                  "-o, or remove it")
             manifest = f[MANIFEST]
-            name = dataset._attr(manifest.attrs.get("robot"))
-            if name != robot.name or dataset._attr(manifest.attrs.get("model_sha256")) != dataset.model_hash(robot.path):
+            name = attr(manifest.attrs.get("robot"))
+            if name != robot.name or attr(manifest.attrs.get("model_sha256")) != writer.model_hash(robot.path):
                 raise ValueError(f"{out} holds logs of robot {name!r} (model {str(manifest.attrs.get('model_sha256'))[:12]}); "
-                                 f"this import is for {robot.name!r} (model {dataset.model_hash(robot.path)[:12]}): "
+                                 f"this import is for {robot.name!r} (model {writer.model_hash(robot.path)[:12]}): "
                                  "give its robot, or another -o")
             self.files = dict(zip((n.decode() for n in manifest["file"][()]),
                                   (h.decode() for h in manifest["sha256"][()]), strict=True))
-            self.events_sha256 = dataset._attr(manifest.attrs.get("events_sha256", ""))
+            self.events_sha256 = attr(manifest.attrs.get("events_sha256", ""))
             self.runs = {unit: {"names": [n.decode() for n in group["log_file"][()]],
                                 "log_period": float(group.attrs["log_period"])} for unit, group in f["runs"].items()}
 
     def records(self, unit: str) -> dict[str, np.ndarray]:
         """Every array of a unit's previous run (features only: small), by name."""
-        with dataset._open(self.path) as f:
+        with open_file(self.path) as f:
             group = f["runs"][unit]
             return {name: group[name][()] for name in group}
 
@@ -297,7 +298,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
 
     manifest: dict[str, str] = {}
     with hdf5_writer(out) as f, tqdm(total=len(new), desc="import", unit="log", disable=not progress) as bar:
-        dataset._write_root(f, 0, command, "")
+        writer.write_root(f, 0, command, "")
         f.attrs["complete"] = False
         runs = f.create_group("runs")
         for unit in sorted(plan):
@@ -318,7 +319,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         group.create_dataset("file", data=np.array(names, dtype=object), dtype=h5py.string_dtype())
         group.create_dataset("sha256", data=np.array([manifest[n] for n in names], dtype=object),
                              dtype=h5py.string_dtype())
-        group.attrs.update({"robot": robot.name, "model_sha256": dataset.model_hash(robot.path),
+        group.attrs.update({"robot": robot.name, "model_sha256": writer.model_hash(robot.path),
                             "logs": str(logs_dir.resolve()), "events_sha256": events_sha,
                             "faultgen_version": __version__})
         f.attrs["complete"] = True
@@ -386,7 +387,7 @@ def _write_unit(runs: h5py.Group, unit: str, rows: list[dict], robot: robots.Rob
     names = [*(k for k in _feature_specs() if k != "friction_multiplier"), "log_cycles", "log_duration"]
     names += [k for k in ("joint_temperature", "payload_mass") if all(k in row for row in rows)]
     arrays.update({name: np.concatenate([row[name] for row in rows]) for name in names})
-    specs = {**{k: dataset.ARRAYS[k] for k in ("t", "q_ref", "cycles")}, **_feature_specs(), **dataset.MEASURED_ARRAYS}
+    specs = {**{k: schema.ARRAYS[k] for k in ("t", "q_ref", "cycles")}, **_feature_specs(), **schema.MEASURED_ARRAYS}
     for name, value in arrays.items():
         units, axes, description = specs[name]
         if value.dtype == object:
@@ -401,8 +402,8 @@ def _write_unit(runs: h5py.Group, unit: str, rows: list[dict], robot: robots.Rob
         "robot": robot.name, "task": MEASURED, "friction_model": MEASURED, "cycles": n,
         "seed": int(hashlib.sha256(unit.encode()).hexdigest()[:7], 16), "worn_axes": np.array(worn, dtype=int),
         "wear": json.dumps({}), "noise": json.dumps({}), "faultgen_version": __version__,
-        "model_sha256": dataset.model_hash(robot.path), "n_axes": n_axes,
-        "drivetrain": json.dumps(dataset.drivetrain(robot)),
+        "model_sha256": writer.model_hash(robot.path), "n_axes": n_axes,
+        "drivetrain": json.dumps(writer.drivetrain(robot)),
         "log_period": float(np.median(periods)) if periods else period,
         "config": json.dumps(config, sort_keys=True), "command": command, "signals": False, "sample": "log",
         "source": MEASURED, "unit": unit})

@@ -1,6 +1,6 @@
 """Typed reading of a faultgen dataset: :func:`open` gives a :class:`Dataset` of :class:`Run` records.
 
-The HDF5 layout (:mod:`faultgen.data.dataset`, docs/dataset.md) stays behind this module: a run's
+The HDF5 layout (:mod:`faultgen.data.schema`, docs/dataset.md) stays behind this module: a run's
 labels are typed fields (tuples of 1-based axes, parsed JSON, ints), its per-cycle truth and
 features are arrays read when first asked for, and the file is opened once for all reads::
 
@@ -11,7 +11,7 @@ features are arrays read when first asked for, and the file is opened once for a
             print(run.id, run.robot, run.task, run.worn_axes, run.wear.max())   # wear: (cycles, axes), %
         table = data.features()                                                 # tidy, one row per cycle and axis
 
-Arrays are named as in :data:`faultgen.data.dataset.ARRAYS` (and the duty, count, condition and
+Arrays are named as in :data:`faultgen.data.schema.ARRAYS` (and the duty, count, condition and
 fault tables beside it); :meth:`Run.array` reads any of them, :meth:`Run.signal` the 250 Hz
 signals (``tau_m``, ``q_a``, ...), and each read is cached on the run.
 """
@@ -19,7 +19,7 @@ signals (``tau_m``, ``q_a``, ...), and each read is cached on the run.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,21 +28,23 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from faultgen import inputs
-from faultgen.data import dataset
+from faultgen.data import schema
+from faultgen.data.opening import attr, open_file
+from faultgen.data.validator import attribute_problems
 
 if TYPE_CHECKING:
     import pandas as pd
 
 #: Every array a run group may hold -> (units, axes, description), from the tables of
-#: :mod:`faultgen.data.dataset`.
+#: :mod:`faultgen.data.schema`.
 SCHEMA: dict[str, tuple[str, str, str]] = {
-    **dataset.ARRAYS, **dataset.DUTY_ARRAYS, **dataset.COUNT_ARRAYS,
-    **{name: spec[:3] for name, spec in dataset.CONDITION_ARRAYS.items()}, **dataset.FAULT_ARRAYS,
+    **schema.ARRAYS, **schema.DUTY_ARRAYS, **schema.COUNT_ARRAYS,
+    **{name: spec[:3] for name, spec in schema.CONDITION_ARRAYS.items()}, **schema.FAULT_ARRAYS,
 }
 
 
 def _json(value) -> Any:
-    value = dataset._attr(value)
+    value = attr(value)
     return json.loads(value) if isinstance(value, str) and value else None
 
 
@@ -84,7 +86,7 @@ class Run:
         attribute, None for a thesis task.
     measured : bool
         True for a unit imported from measured logs (``faultgen logs import``): its records are
-        logs, its wear the labels of its events (:data:`faultgen.data.dataset.MEASURED_ARRAYS`).
+        logs, its wear the labels of its events (:data:`faultgen.data.schema.MEASURED_ARRAYS`).
     """
 
     id: str
@@ -145,7 +147,7 @@ class Run:
 
     def _group(self):
         if self._source is None:
-            raise dataset.DatasetError(f"run {self.id!r} is not attached to an open dataset")
+            raise schema.DatasetError(f"run {self.id!r} is not attached to an open dataset")
         return self._source._group(self.id)
 
     def array(self, name: str) -> np.ndarray:
@@ -153,7 +155,7 @@ class Run:
 
         Raises
         ------
-        faultgen.data.dataset.DatasetError
+        faultgen.data.schema.DatasetError
             If the run has no such array (the message says why, e.g. recorded without signals),
             or the dataset was closed.
         """
@@ -161,16 +163,34 @@ class Run:
             group = self._group()
             if name not in group:
                 why = ""
-                if not self.has_signals and SCHEMA.get(name, ("", ""))[1] == dataset.SIGNAL_AXES:
+                if not self.has_signals and SCHEMA.get(name, ("", ""))[1] == schema.SIGNAL_AXES:
                     why = ("; it was recorded without signals (features only): simulate it again with signals "
                            "(`faultgen sweep` without --features-only)")
-                raise dataset.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}{why}")
-            value = inputs.bounded_dataset(group, name, self._source.path, kinds=dataset.kinds(name))[()]
+                raise schema.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}{why}")
+            value = inputs.bounded_dataset(group, name, self._source.path, kinds=schema.kinds(name))[()]
             if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
-                raise dataset.DatasetError(f"{self._source.path}: run {self.id!r}: {name} holds non-finite values; the "
+                raise schema.DatasetError(f"{self._source.path}: run {self.id!r}: {name} holds non-finite values; the "
                                            f"file is corrupted (faultgen validate {self._source.path})")
             self._cache[name] = value
         return self._cache[name]
+
+    def units(self, name: str) -> str:
+        """The units the file stores for array ``name`` (its ``units`` attribute; "" if it has none).
+
+        Raises
+        ------
+        faultgen.data.schema.DatasetError
+            If the run has no such array, or the dataset was closed.
+        """
+        group = self._group()
+        if name not in group:
+            raise schema.DatasetError(f"{self._source.path}: run {self.id!r} has no array {name!r}")
+        return str(attr(group[name].attrs.get("units", "")))
+
+    def forget(self, *names: str) -> None:
+        """Drop the cached arrays ``names`` (read again if asked for): large signals not kept."""
+        for name in names:
+            self._cache.pop(name, None)
 
     def has(self, *names: str) -> bool:
         """Whether the run holds every array of ``names``."""
@@ -179,9 +199,9 @@ class Run:
 
     def signal(self, name: str = "tau_m") -> np.ndarray:
         """A 250 Hz signal, ndarray of shape (n_cycles, n_log, n_axes) in its units (:data:`SCHEMA`)."""
-        if SCHEMA.get(name, ("", ""))[1] != dataset.SIGNAL_AXES:
+        if SCHEMA.get(name, ("", ""))[1] != schema.SIGNAL_AXES:
             raise ValueError(f"{name!r} is not a 250 Hz signal; expected one of: "
-                             + ", ".join(n for n, s in SCHEMA.items() if s[1] == dataset.SIGNAL_AXES))
+                             + ", ".join(n for n, s in SCHEMA.items() if s[1] == schema.SIGNAL_AXES))
         return self.array(name)
 
     @property
@@ -247,9 +267,9 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
                     "log_period": float(attrs.get("log_period", np.nan)), "command": str(attrs.get("command", "")),
                     "config": config},
         # files written before the attribute: a program file's or log's runs kept its hash in `program`
-        program_sha256=str(attrs[dataset.PROGRAM_ATTRIBUTE]) if dataset.PROGRAM_ATTRIBUTE in attrs
+        program_sha256=str(attrs[schema.PROGRAM_ATTRIBUTE]) if schema.PROGRAM_ATTRIBUTE in attrs
         else (_json(attrs.get("program")) or {}).get("sha256"),
-        measured=attrs.get("source") == dataset.MEASURED, _source=source)
+        measured=attrs.get("source") == schema.MEASURED, _source=source)
 
 
 class Dataset(Sequence):
@@ -274,26 +294,26 @@ class Dataset(Sequence):
     def __init__(self, path: str | Path):
         self.path = Path(path)
         self._stack = ExitStack()
-        self._file = self._stack.enter_context(dataset._open(self.path))
+        self._file = self._stack.enter_context(open_file(self.path))
         attrs = self._file.attrs
-        self.command = str(dataset._attr(attrs.get("command", "")))
-        self.faultgen_version = str(dataset._attr(attrs.get("faultgen_version", "")))
+        self.command = str(attr(attrs.get("command", "")))
+        self.faultgen_version = str(attr(attrs.get("faultgen_version", "")))
         self.grid = _json(attrs.get("grid"))
         runs = []
         for run_id in self._file["runs"]:
             group = self._file["runs"][run_id]
-            problems = dataset._attribute_problems(group)  # labels that do not parse: named, not a crash
+            problems = attribute_problems(group)  # labels that do not parse: named, not a crash
             if problems:
                 self.close()
-                raise dataset.DatasetError(f"{self.path}: run {run_id!r}: {problems[0]} (faultgen validate {self.path} "
+                raise schema.DatasetError(f"{self.path}: run {run_id!r}: {problems[0]} (faultgen validate {self.path} "
                                            "lists every problem)")
-            runs.append(_run(run_id, {k: dataset._attr(v) for k, v in group.attrs.items()}, self))
+            runs.append(_run(run_id, {k: attr(v) for k, v in group.attrs.items()}, self))
         self.runs: tuple[Run, ...] = tuple(runs)
         self._by_id = {run.id: run for run in self.runs}
 
     def _group(self, run_id: str):
         if self._file is None:
-            raise dataset.DatasetError(f"{self.path} is closed; read runs inside `with faultgen.open(...)`")
+            raise schema.DatasetError(f"{self.path} is closed; read runs inside `with faultgen.open(...)`")
         return self._file["runs"][run_id]
 
     def close(self) -> None:
@@ -365,16 +385,16 @@ class Dataset(Sequence):
     def features(self) -> pd.DataFrame:
         """Every per-cycle quantity as one tidy table: one row per (run, recorded cycle, axis).
 
-        Columns: ``run``, the labels of :data:`faultgen.data.dataset.FEATURE_LABELS`, ``worn_axes``
+        Columns: ``run``, the labels of :data:`faultgen.data.summary.FEATURE_LABELS`, ``worn_axes``
         (text, "2" or "2 5"; "" for none), ``cycle`` (1-based), ``axis`` (1..N), ``worn``,
         ``wear_pct`` (true wear of the axis, %), every "cycle, axis" array of
-        :data:`faultgen.data.dataset.ARRAYS` and of the duty arrays (empty for runs without), each
+        :data:`faultgen.data.schema.ARRAYS` and of the duty arrays (empty for runs without), each
         histogram as one column per bin (``torque_hist_1`` ..), and the operating-condition arrays
         of runs that have them. ``DataFrame.attrs["units"]`` maps each column to its unit.
         """
         import pandas as pd
 
-        arrays = dataset.ARRAYS
+        arrays = schema.ARRAYS
         per_cycle = [name for name, (_, axes, _) in arrays.items() if axes == "cycle, axis"]
         histograms = [name for name, (_, axes, _) in arrays.items() if axes == "cycle, axis, bin"]
         frames = []
@@ -386,11 +406,11 @@ class Dataset(Sequence):
                        "cycle": np.repeat(run.recorded, n_axes), "axis": np.tile(np.arange(1, n_axes + 1), n_cycles),
                        "worn": np.tile([a in worn for a in range(1, n_axes + 1)], n_cycles),
                        "wear_pct": run.wear.ravel()}
-            duty = list(dataset.DUTY_ARRAYS) if run.has(*dataset.DUTY_ARRAYS) else []
+            duty = list(schema.DUTY_ARRAYS) if run.has(*schema.DUTY_ARRAYS) else []
             columns.update({name: run.array(name).ravel() if run.has(name) else np.full(n_cycles * n_axes, np.nan)
                             for name in (*per_cycle, *duty)})  # an imported run has no simulated truth: NaN
-            for name in dataset._condition_arrays(run.conditions):  # per cycle, per axis or per unit, to rows
-                values, axes = run.array(name), dataset.CONDITION_ARRAYS[name][1]
+            for name in schema.condition_arrays(run.conditions):  # per cycle, per axis or per unit, to rows
+                values, axes = run.array(name), schema.CONDITION_ARRAYS[name][1]
                 columns[name] = (values.ravel() if axes == "cycle, axis" else np.repeat(values, n_axes)
                                  if axes == "cycle" else np.tile(values, n_cycles))
             for name in histograms:
@@ -399,11 +419,74 @@ class Dataset(Sequence):
             frames.append(pd.DataFrame(columns))
         table = pd.concat(frames, ignore_index=True)
         table.attrs["units"] = {"wear_pct": "%", **{name: arrays[name][0] for name in per_cycle},
-                                **{name: spec[0] for name, spec in dataset.DUTY_ARRAYS.items() if name in table},
-                                **{name: spec[0] for name, spec in dataset.CONDITION_ARRAYS.items() if name in table},
+                                **{name: spec[0] for name, spec in schema.DUTY_ARRAYS.items() if name in table},
+                                **{name: spec[0] for name, spec in schema.CONDITION_ARRAYS.items() if name in table},
                                 **{c: arrays[c.rsplit("_", 1)[0]][0] for c in table.columns
                                    if c.rsplit("_", 1)[0] in histograms}}
         return table
+
+
+def list_runs(path: str | Path) -> list[str]:
+    """Run ids of a dataset, in file order."""
+    with open_file(path) as f:
+        return list(f["runs"])
+
+
+def runs_with(path: str | Path, names: Iterable[str]) -> list[str]:
+    """Run ids of a dataset, in file order, that hold every array of ``names`` (e.g. the
+    :data:`~faultgen.data.schema.DUTY_ARRAYS`, which runs simulated before they existed lack)."""
+    names = list(names)
+    with open_file(path) as f:
+        return [run_id for run_id in f["runs"] if all(name in f["runs"][run_id] for name in names)]
+
+
+def read_run(path: str | Path, run_id: str | None = None,
+             names: Iterable[str] | None = None) -> tuple[dict[str, np.ndarray], dict]:
+    """Read one run: its arrays by name and its attributes (labels and provenance).
+
+    ``run_id`` may be omitted for a file with one run; ``names`` limits the arrays read (default:
+    all, see :data:`faultgen.data.schema.ARRAYS`). Raises
+    :class:`~faultgen.data.schema.DatasetError` if the file is not a finished faultgen file, has
+    no such run, or the run has no such array.
+    """
+    with open_file(path) as f:
+        ids = list(f["runs"])
+        if run_id is None:
+            if len(ids) != 1:
+                raise schema.DatasetError(f"{path} has {len(ids)} runs; name one: {', '.join(ids[:10])}")
+            run_id = ids[0]
+        if run_id not in f["runs"]:
+            raise schema.DatasetError(f"{path} has no run {run_id!r}; runs: {', '.join(ids[:10])}")
+        group = f["runs"][run_id]
+        wanted = list(group) if names is None else list(names)
+        missing = [name for name in wanted if name not in group]
+        if missing:
+            why = ""
+            if not group.attrs.get("signals", True) and schema.ARRAYS.get(missing[0], ("", ""))[1] == schema.SIGNAL_AXES:
+                why = ("; it was recorded without signals (features only): simulate it again with signals "
+                       "(`faultgen sweep` without --features-only) to use this command")
+            raise schema.DatasetError(f"{path}: run {run_id!r} has no array {missing[0]!r}{why}")
+        problems = attribute_problems(group)
+        if problems:
+            raise schema.DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every problem)")
+        arrays = {name: inputs.bounded_dataset(group, name, path, kinds=schema.kinds(name))[()] for name in wanted}
+        for name, value in arrays.items():
+            if value.dtype.kind == "f" and not np.all(np.isfinite(value)):
+                raise schema.DatasetError(f"{path}: run {run_id!r}: {name} holds non-finite values; the file is corrupted "
+                                   f"(faultgen validate {path})")
+        attrs = {key: attr(group.attrs[key]) for key in group.attrs}
+    return arrays, attrs
+
+
+def labels(path: str | Path) -> list[dict]:
+    """The labels of every run, one dict per run (with its ``run`` id), in file order."""
+    with open_file(path) as f:
+        for run_id in f["runs"]:
+            problems = attribute_problems(f["runs"][run_id])
+            if problems:
+                raise schema.DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
+                                   "problem)")
+        return [{"run": run_id, **{k: attr(v) for k, v in f["runs"][run_id].attrs.items()}} for run_id in f["runs"]]
 
 
 def open(path: str | Path) -> Dataset:  # noqa: A001 (faultgen.open, as the builtin for files)
@@ -411,7 +494,7 @@ def open(path: str | Path) -> Dataset:  # noqa: A001 (faultgen.open, as the buil
 
     Raises
     ------
-    faultgen.data.dataset.DatasetError
+    faultgen.data.schema.DatasetError
         If ``path`` does not exist, is not HDF5, is not a faultgen file or is incomplete (its
         writer did not finish), or a run's labels do not parse; the message says which. Reading an
         array that holds non-finite values raises it too.

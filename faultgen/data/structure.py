@@ -3,7 +3,7 @@
 A stranger's file can declare an array of (10^10, 6) float64 in a 76 MB file (447 GiB on read),
 store text where numbers belong, put a group where an array belongs, leave a run group without its
 labels or claim ``cycles = 1e15``. :func:`check_runs` refuses each of these when the file is opened
-(:func:`faultgen.data.dataset._open`), from the declared shapes, types and attributes, so no
+(:func:`faultgen.data.opening.open_file`), from the declared shapes, types and attributes, so no
 command and no ``faultgen.open`` reads such an array or crashes on a missing label. The schema
 checks that need the values (units, finiteness, histograms summing to 1) stay with
 ``faultgen validate``.
