@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset, measured
 from faultgen.model import robots
-from faultgen.operation import programs, replay, tasks
+from faultgen.operation import programs, tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -204,12 +204,12 @@ def test_refuses_a_log_outside_the_joint_limits_or_too_short(tmp_path):
     q[200, 4] = 2.0  # axis 5 of the PUMA 560 reaches +-100 deg = 1.745 rad
     log_csv(tmp_path, path.t[:500], q)
     message = refused(tmp_path, (tmp_path / "log.csv").read_text(), robot="puma560", name="log.csv")
-    assert "q5 at data row 201" in message and "rad outside the joint range" in message
+    assert "q5 at data row 201" in message and "rad, outside the joint range" in message
     for f in tmp_path.iterdir():
         f.unlink()
     log_csv(tmp_path, path.t[:20], path.q[:20])
     message = refused(tmp_path, (tmp_path / "log.csv").read_text(), robot="puma560", name="log.csv")
-    assert "too short: 20 samples over 0.076 s" in message
+    assert "covers 0.076 s (20 data rows); expected at least 0.2 s" in message
 
 
 # -- replay ---------------------------------------------------------------------------------------
@@ -238,7 +238,7 @@ def test_a_replayed_log_that_starts_and_ends_moving_is_the_recorded_reference(tm
     assert np.abs(thesis.qd[300]).max() > 0.1 and np.abs(thesis.qd[3300]).max() > 0.1
     t = 100.0 + thesis.t[piece]
     log = log_csv(tmp_path, t, thesis.q[piece])
-    loaded = replay.read(log, "puma560")
+    loaded = programs.load("puma560", str(log))
     path = loaded.trajectory(robots.load("puma560").model.opt.timestep)
     assert [s[0] for s in path.segments] == ["replay", "run-out"]
     np.testing.assert_array_equal(path.qd[-1], 0.0)

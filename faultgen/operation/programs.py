@@ -149,7 +149,7 @@ def load(robot: Robot | str, task: str):
         return tasks.load(robot, task)
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         return read(task, robot)
-    return replay.read(task, robot)
+    return replay.read(task, robot, _limits({}, robot, task), check_torque)
 
 
 def record(task: str) -> dict | None:
