@@ -14,7 +14,8 @@ Two passes over the file, :data:`BLOCK_ROWS` rows at a time:
    on each side (the Savitzky-Golay filter is local: a uniformly sampled log gets the derivatives
    of the whole log, bit for bit; a log with a varying period is resampled block by block, which
    differs from the whole-log spline by far less than the filter's own error), each block averaged
-   over ``k`` consecutive rows (:func:`block_mean`) as it goes.
+   over ``k`` consecutive rows (:func:`block_mean`; the calibration) or every ``k``-th row kept (a
+   replay, whose reference must pass through the log's own samples) as it goes.
 """
 
 from __future__ import annotations
@@ -255,10 +256,12 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None) -> Scan:
     return Scan(t, np.array([kept[i] for i in order]), np.array(order), times)
 
 
-def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None) -> dict:
+def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None,
+             pick: bool = False) -> dict:
     """The second pass over ``src`` (module docstring): ``t``, ``q``, ``qd``, ``qdd`` (and ``tau``
-    when read) averaged over blocks of ``k`` rows, ``m`` rows each; ``qd`` is the file's when it has
-    ``qd`` columns. ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
+    when read) averaged over blocks of ``k`` rows, ``m`` rows each, or with ``pick`` every ``k``-th
+    row from the first (``m`` ignored: all of them); ``qd`` is the file's when it has ``qd`` columns.
+    ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
     index = {name: j for j, name in enumerate(src.wanted)}
     q_names, qd_names, tau_names = jointlog.column_names(n_axes)
     cols = {"t": [index[jointlog.T_COLUMN]], "q": [index[c] for c in q_names]}
@@ -279,12 +282,13 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
         if on_block is not None:
             on_block(start, block, qd_est, qd)
         whole = max(min(m * k - start, len(block)), 0) // k  # averaging blocks within this block
+        reduce = (lambda a, k, whole: a[::k]) if pick else block_mean
         # contiguous, as the whole-log reader's columns: the same sums in the same order, bit for bit
         values = {name: np.ascontiguousarray(block[:, c]) for name, c in cols.items()}
         values["t"] = values["t"][:, 0]
         values.update(qd=qd, qdd=qdd)
         for name, kept in out.items():
-            kept.append(block_mean(values[name], k, whole))
+            kept.append(reduce(values[name], k, whole))
 
     for start, block in src.blocks(size):
         if pending is not None:

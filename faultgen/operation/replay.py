@@ -31,8 +31,9 @@ The log is read by the measured-log reader (:mod:`faultgen.operation.jointlog`: 
 set of checks, one derivative estimator; the torque columns are not needed), in blocks
 (:mod:`faultgen.operation.logblocks`), so memory does not grow with the log's rows: a log of at
 most one row per physics step of the robot is read whole; a denser one has its derivatives
-estimated at its full rate block by block and is averaged over blocks of ``k`` rows down to one
-row per step (what the reference, sampled at that step, can use) as it is read.
+estimated at its full rate block by block and keeps every ``k``-th row from the first, at most
+one row per step (what the reference, sampled at that step, can use), as it is read: the
+reference still passes through the log's own samples, and time 0 is still its first.
 
 Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
@@ -239,12 +240,12 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
         found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
                                 tolerance=0.0)
         t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]
-    else:  # denser than the physics step: derivatives at the full rate, averaged down while read
+    else:  # denser than the physics step: derivatives at the full rate, every k-th row kept while read
         period, uniform = times.check(MIN_DURATION, 1 / MAX_GAP)
         q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
         jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
         k = -(-rows // most)
-        out = logblocks.averaged(src, n_axes, period, savgol.savgol_window(period, rows), uniform, k, rows // k)
+        out = logblocks.averaged(src, n_axes, period, savgol.savgol_window(period, rows), uniform, k, 0, pick=True)
         t, q, qd, qdd = (out[name] for name in ("t", "q", "qd", "qdd"))
     suffix = max((s for s in jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if path.name.lower().endswith(s)), key=len)
     velocity, acceleration, jerk = limits
