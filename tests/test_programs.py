@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset, measured
 from faultgen.model import robots
-from faultgen.operation import logblocks, programs, tasks
+from faultgen.operation import programs, replay, tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -284,7 +284,7 @@ def test_a_log_denser_than_the_physics_step_keeps_one_row_per_step_read_in_block
     sparse = programs.load("irb6700", str(log_csv(tmp_path, t[::10], q[::10], name="sparse.csv")))
     dense = log_csv(tmp_path, t, q, name="dense.csv")
     whole = programs.load("irb6700", str(dense))
-    monkeypatch.setattr(logblocks, "BLOCK_ROWS", 5000)
+    monkeypatch.setattr(replay, "BLOCK_ROWS", 5000)
     blocks = programs.load("irb6700", str(dense))
     assert len(sparse.t) == len(blocks.t) == 4001
     np.testing.assert_array_equal(blocks.t, sparse.t)

@@ -87,7 +87,7 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float) ->
     if not uniform:
         notes.append(f"sample period varies ({np.min(np.diff(t)):.6g}..{np.max(np.diff(t)):.6g} s): q resampled "
                      f"at the median period {period:.6g} s with a cubic spline for differentiation (block by block "
-                     "with a margin, faultgen.operation.logblocks), derivatives interpolated back")
+                     "with a margin, faultgen.data.longlog), derivatives interpolated back")
     k = -(-n // rows)
     m = n // k
     inner = measured.velocity_rows(n, window)

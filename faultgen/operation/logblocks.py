@@ -224,9 +224,10 @@ class Scan:
     times: TimeScan | None
 
 
-def scan(src, robot: robots.Robot, times: TimeScan | None = None) -> Scan:
-    """The first pass over ``src`` (module docstring): the whole times when ``times`` is None, else
-    checked as they stream by through it."""
+def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | None = None) -> Scan:
+    """The first pass over ``src`` (module docstring), in blocks of ``size`` rows (default
+    :data:`BLOCK_ROWS`): the whole times when ``times`` is None, else checked as they stream by
+    through it."""
     whole, kept = [], {}
     if not src.wanted:  # an empty file: the whole-file reader says what is missing
         return Scan(np.empty(0) if times is None else None, np.empty((0, 0)), np.empty(0, dtype=int), times)
@@ -236,7 +237,7 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None) -> Scan:
     t_col = index[jointlog.T_COLUMN]
     low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
     tol = jointlog.JOINT_RANGE_TOLERANCE
-    for start, block in src.blocks(BLOCK_ROWS):
+    for start, block in src.blocks(size or BLOCK_ROWS):
         if times is None:
             whole.append(block[:, t_col].copy())
         else:
@@ -248,7 +249,7 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None) -> Scan:
         outside = (q < low - tol) | (q > high + tol)
         rows.append(np.argmax(outside, axis=0)[outside.any(axis=0)])
         for i in np.unique(np.concatenate(rows)):
-            kept[start + int(i)] = block[i]
+            kept[start + int(i)] = block[i].copy()  # a copy: a view would keep the whole block
     order = sorted(kept)
     t = (np.concatenate(whole) if whole else np.empty(0)) if times is None else None
     if not order:
@@ -257,11 +258,12 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None) -> Scan:
 
 
 def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None,
-             pick: bool = False) -> dict:
+             pick: bool = False, size: int | None = None) -> dict:
     """The second pass over ``src`` (module docstring): ``t``, ``q``, ``qd``, ``qdd`` (and ``tau``
     when read) averaged over blocks of ``k`` rows, ``m`` rows each, or with ``pick`` every ``k``-th
     row from the first (``m`` ignored: all of them); ``qd`` is the file's when it has ``qd`` columns.
-    ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
+    ``on_block(start, block, qd_est, qd)`` sees each block at the full rate. Blocks of about ``size``
+    rows (default :data:`BLOCK_ROWS`; at least the filter's margin)."""
     index = {name: j for j, name in enumerate(src.wanted)}
     q_names, qd_names, tau_names = jointlog.column_names(n_axes)
     cols = {"t": [index[jointlog.T_COLUMN]], "q": [index[c] for c in q_names]}
@@ -270,7 +272,7 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
     qd_cols = [index[c] for c in qd_names] if qd_names[0] in index else None
     margin = window if uniform else max(window, 200)
     out = {name: [] for name in ("t", "q", "qd", "qdd", *(["tau"] if "tau" in cols else []))}
-    size = k * math.ceil(BLOCK_ROWS / k)  # blocks start on a whole averaging block
+    size = k * math.ceil(max(size or BLOCK_ROWS, 2 * margin) / k)  # blocks start on a whole averaging block
     left = np.empty((0, len(src.wanted)))
     pending = None
 
@@ -282,7 +284,7 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
         if on_block is not None:
             on_block(start, block, qd_est, qd)
         whole = max(min(m * k - start, len(block)), 0) // k  # averaging blocks within this block
-        reduce = (lambda a, k, whole: a[::k]) if pick else block_mean
+        reduce = (lambda a, k, whole: a[::k].copy()) if pick else block_mean  # copies: views keep the block
         # contiguous, as the whole-log reader's columns: the same sums in the same order, bit for bit
         values = {name: np.ascontiguousarray(block[:, c]) for name, c in cols.items()}
         values["t"] = values["t"][:, 0]

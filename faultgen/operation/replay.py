@@ -64,6 +64,9 @@ from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath
 #: Shortest log replayed, s (four filter windows); the longest interval between samples is the
 #: measured-log reader's :data:`faultgen.operation.jointlog.MAX_GAP` (the derivative filter's window).
 MIN_DURATION = 0.2
+#: Rows read at a time: a replay's peak memory is that of its reference at the physics step, so its
+#: blocks are smaller than the calibration's (:data:`faultgen.operation.logblocks.BLOCK_ROWS`).
+BLOCK_ROWS = 50_000
 #: A log end is at rest when every axis is below these, rad/s and rad/s^2.
 REST_SPEED = 1e-3
 REST_ACCELERATION = 1e-2
@@ -231,7 +234,7 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
     n_axes = robot.n_axes
     src = logblocks.source(path, n_axes, motion_only=True)
     times = logblocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
-    scan = logblocks.scan(src, robot, times)
+    scan = logblocks.scan(src, robot, times, BLOCK_ROWS)
     rows = times.rows
     step = robot.model.opt.timestep
     most = int((times.last - times.first) / step + 1e-6) + 1 if rows > 1 else rows  # a row per physics step
@@ -245,7 +248,8 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
         q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
         jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
         k = -(-rows // most)
-        out = logblocks.averaged(src, n_axes, period, savgol.savgol_window(period, rows), uniform, k, 0, pick=True)
+        out = logblocks.averaged(src, n_axes, period, savgol.savgol_window(period, rows), uniform, k, 0, pick=True,
+                                 size=BLOCK_ROWS)
         t, q, qd, qdd = (out[name] for name in ("t", "q", "qd", "qdd"))
     suffix = max((s for s in jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if path.name.lower().endswith(s)), key=len)
     velocity, acceleration, jerk = limits
