@@ -14,8 +14,9 @@ Two passes over the file, :data:`BLOCK_ROWS` rows at a time:
    on each side (the Savitzky-Golay filter is local: a uniformly sampled log gets the derivatives
    of the whole log, bit for bit; a log with a varying period is resampled block by block, which
    differs from the whole-log spline by far less than the filter's own error), each block averaged
-   over ``k`` consecutive rows (:func:`block_mean`; the calibration) or every ``k``-th row kept (a
-   replay, whose reference must pass through the log's own samples) as it goes.
+   over ``k`` consecutive rows (:func:`block_mean`) as it goes: the calibration; or
+2. :func:`thinned`: every ``k``-th row kept, the rest dropped as it goes: a replay, whose reference
+   is sampled at the physics step and must pass through the log's own samples.
 """
 
 from __future__ import annotations
@@ -257,13 +258,19 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | No
     return Scan(t, np.array([kept[i] for i in order]), np.array(order), times)
 
 
-def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None,
-             pick: bool = False, size: int | None = None) -> dict:
+def thinned(src, k: int, size: int | None = None) -> dict[str, np.ndarray]:
+    """Every ``k``-th row of ``src`` from the first, per column (its ``wanted``), read in blocks of
+    about ``size`` rows (default :data:`BLOCK_ROWS`)."""
+    size = k * math.ceil((size or BLOCK_ROWS) / k)  # blocks start on a kept row
+    parts = [block[::k].copy() for _, block in src.blocks(size)]  # copies: a view would keep the block
+    values = np.concatenate(parts) if parts else np.empty((0, len(src.wanted)))
+    return {name: np.ascontiguousarray(values[:, j]) for j, name in enumerate(src.wanted)}
+
+
+def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None) -> dict:
     """The second pass over ``src`` (module docstring): ``t``, ``q``, ``qd``, ``qdd`` (and ``tau``
-    when read) averaged over blocks of ``k`` rows, ``m`` rows each, or with ``pick`` every ``k``-th
-    row from the first (``m`` ignored: all of them); ``qd`` is the file's when it has ``qd`` columns.
-    ``on_block(start, block, qd_est, qd)`` sees each block at the full rate. Blocks of about ``size``
-    rows (default :data:`BLOCK_ROWS`; at least the filter's margin)."""
+    when read) averaged over blocks of ``k`` rows, ``m`` rows each; ``qd`` is the file's when it has
+    ``qd`` columns. ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
     index = {name: j for j, name in enumerate(src.wanted)}
     q_names, qd_names, tau_names = jointlog.column_names(n_axes)
     cols = {"t": [index[jointlog.T_COLUMN]], "q": [index[c] for c in q_names]}
@@ -272,7 +279,7 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
     qd_cols = [index[c] for c in qd_names] if qd_names[0] in index else None
     margin = window if uniform else max(window, 200)
     out = {name: [] for name in ("t", "q", "qd", "qdd", *(["tau"] if "tau" in cols else []))}
-    size = k * math.ceil(max(size or BLOCK_ROWS, 2 * margin) / k)  # blocks start on a whole averaging block
+    size = k * math.ceil(BLOCK_ROWS / k)  # blocks start on a whole averaging block
     left = np.empty((0, len(src.wanted)))
     pending = None
 
@@ -284,13 +291,12 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
         if on_block is not None:
             on_block(start, block, qd_est, qd)
         whole = max(min(m * k - start, len(block)), 0) // k  # averaging blocks within this block
-        reduce = (lambda a, k, whole: a[::k].copy()) if pick else block_mean  # copies: views keep the block
         # contiguous, as the whole-log reader's columns: the same sums in the same order, bit for bit
         values = {name: np.ascontiguousarray(block[:, c]) for name, c in cols.items()}
         values["t"] = values["t"][:, 0]
         values.update(qd=qd, qdd=qdd)
         for name, kept in out.items():
-            kept.append(reduce(values[name], k, whole))
+            kept.append(block_mean(values[name], k, whole))
 
     for start, block in src.blocks(size):
         if pending is not None:

@@ -30,10 +30,10 @@ recorded times by up to 0.8 rad.
 The log is read by the measured-log reader (:mod:`faultgen.operation.jointlog`: one parser, one
 set of checks, one derivative estimator; the torque columns are not needed), in blocks
 (:mod:`faultgen.operation.logblocks`), so memory does not grow with the log's rows: a log of at
-most one row per physics step of the robot is read whole; a denser one has its derivatives
-estimated at its full rate block by block and keeps every ``k``-th row from the first, at most
-one row per step (what the reference, sampled at that step, can use), as it is read: the
-reference still passes through the log's own samples, and time 0 is still its first.
+most one row per physics step of the robot is read whole; a denser one is checked row by row as
+it streams by and then replayed as every ``k``-th row from the first, at most one row per step
+(what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
+recorded at that rate (the reference passes through its own samples, time 0 is its first).
 
 Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
@@ -54,7 +54,6 @@ import numpy as np
 from ruckig import ControlInterface, DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 from scipy.interpolate import CubicSpline
 
-from faultgen import derivatives as savgol
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation import jointlog, logblocks
@@ -240,17 +239,15 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
     most = int((times.last - times.first) / step + 1e-6) + 1 if rows > 1 else rows  # a row per physics step
     if rows <= most:  # read whole, as the calibration reads a log
         columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
-        found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
-                                tolerance=0.0)
-        t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]
-    else:  # denser than the physics step: derivatives at the full rate, every k-th row kept while read
-        period, uniform = times.check(MIN_DURATION, 1 / MAX_GAP)
+    else:  # denser than the physics step: every k-th row kept while read, once every row is checked
+        times.check(MIN_DURATION, 1 / MAX_GAP)
         q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
         jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
         k = -(-rows // most)
-        out = logblocks.averaged(src, n_axes, period, savgol.savgol_window(period, rows), uniform, k, 0, pick=True,
-                                 size=BLOCK_ROWS)
-        t, q, qd, qdd = (out[name] for name in ("t", "q", "qd", "qdd"))
+        columns, label = logblocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
+    found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
+                            tolerance=0.0)
+    t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]
     suffix = max((s for s in jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if path.name.lower().endswith(s)), key=len)
     velocity, acceleration, jerk = limits
     return Replay(name=path.name[: -len(suffix)], robot_name=robot.name, process="replay", source=path, t=t - t[0],
