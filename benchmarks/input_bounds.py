@@ -153,8 +153,8 @@ CASES_CODE = {
     "replay": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
                "programs.load('puma560', {log!r}).trajectory(robots.load('puma560').model.opt.timestep)"),
     "simulate": ("from faultgen.simulation import stepping",
-                 "stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
-                 "progress=False)"),
+                 ("stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
+                  "progress=False)")),
     "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
     "dh": ("from pathlib import Path\nfrom faultgen.model import importers", "importers._read_dh(Path({log!r}))"),
     "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
