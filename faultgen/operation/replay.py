@@ -92,6 +92,8 @@ class Replay:
     start : ndarray of shape (N,)
         Where the cycle starts, rad: the log's first angles.
     robot : Robot
+    check_torque : callable
+        Refuses a reference above the drives' capacity (:func:`read`).
     """
 
     name: str
@@ -107,7 +109,7 @@ class Replay:
     jerk_limit: np.ndarray
     start: np.ndarray
     robot: Robot = field(repr=False)
-    check_torque: Callable = field(repr=False, default=None)
+    check_torque: Callable = field(repr=False)
 
     @property
     def duration(self) -> float:
