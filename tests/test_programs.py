@@ -275,7 +275,7 @@ def test_a_log_denser_than_the_physics_step_is_replayed_at_that_step_read_in_blo
     """A 2 s move of the IRB 6700 logged at 20 kHz (10 rows per 0.5 ms physics step), read in blocks
     of 5000 rows, replays as the same move logged at 2 kHz, bit for bit (issue 50: the memory of a
     replay does not grow with the log's rows); every row is checked: a repeated time at the first
-    row of a block is refused with its row."""
+    row of a block, or a gap across it, is refused with its row."""
     robot = robots.load("irb6700")
     t = np.arange(40001) / 20000
     s = t / t[-1]
@@ -294,6 +294,11 @@ def test_a_log_denser_than_the_physics_step_is_replayed_at_that_step_read_in_blo
     text = log_csv(tmp_path, t, q, name="back.csv").read_text()
     message = refused(tmp_path / "back", text, robot="irb6700", name="back.csv")
     assert "column t repeats at data row 30001 (line 30002)" in message
+    t[30000:] = np.arange(30000, 40001) / 20000 + 0.06  # a gap of 0.06 s across the same block edge
+    (tmp_path / "gap").mkdir()
+    text = log_csv(tmp_path, t, q, name="gap.csv").read_text()
+    message = refused(tmp_path / "gap", text, robot="irb6700", name="gap.csv")
+    assert "column t jumps by 0.06005 s from data row 30000 (line 30001) to data row 30001 (line 30002)" in message
 
 
 # -- payload grip and release ----------------------------------------------------------------------

@@ -31,7 +31,6 @@ import numpy as np
 import pandas as pd
 
 from faultgen import inputs
-from faultgen.derivatives import UNIFORM_TOLERANCE
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.model import robots
 from faultgen.operation import jointlog
@@ -160,8 +159,8 @@ class Hdf5:
 class TimeScan:
     """The sample times checked as they stream by, none of them kept: strictly increasing, no
     interval above :data:`faultgen.operation.jointlog.MAX_GAP`; ``limit(first, last, rows)`` may
-    refuse the log as soon as a block shows it too long. :attr:`period` is the median of the
-    blocks' median intervals (the exact median would need every interval at once)."""
+    refuse the log as soon as a block shows it too long. The sample rate checked is that of the
+    median of the blocks' median intervals (the exact median would need every interval at once)."""
 
     path: Path
     label: Callable[[int], str]
@@ -169,7 +168,6 @@ class TimeScan:
     rows: int = 0
     first: float = math.nan
     last: float = math.nan
-    low: float = math.inf
     high: float = 0.0
     gap_row: int = 0
     medians: list = field(default_factory=list)
@@ -190,12 +188,10 @@ class TimeScan:
             self.medians.append(float(np.median(dt)))
             if dt.max() > self.high:
                 self.high, self.gap_row = float(dt.max()), offset + int(np.argmax(dt))
-            self.low = min(self.low, float(dt.min()))
         self.limit(self.first, self.last, self.rows)
 
-    def check(self, min_duration: float, min_rate: float) -> tuple[float, bool]:
-        """The median period and whether the sampling is uniform, after refusing what
-        :func:`faultgen.operation.jointlog.check_time` refuses on the whole times."""
+    def check(self, min_duration: float, min_rate: float) -> None:
+        """Refuse what :func:`faultgen.operation.jointlog.check_time` refuses on the whole times."""
         if self.rows < 2:
             raise LogError(f"{self.path}: {self.rows} data row(s); expected at least {min_duration:g} s of data at "
                            f">= {min_rate:g} Hz")
@@ -210,7 +206,6 @@ class TimeScan:
         if self.last - self.first < min_duration:
             raise LogError(f"{self.path}: the data covers {self.last - self.first:.6g} s ({self.rows} data rows); "
                            f"expected at least {min_duration:g} s")
-        return period, max(abs(self.low - period), abs(self.high - period)) <= UNIFORM_TOLERANCE * period
 
 
 @dataclass
