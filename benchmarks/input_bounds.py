@@ -5,13 +5,17 @@ Each case runs as its own process; its peak resident memory is the ``ru_maxrss``
 returns for that process alone (the interpreter and faultgen's imports included, about 0.2-0.3 GB).
 Prints one Markdown row per case with its verdict:
 
-* ``calibrate`` and a replay (``replay.read`` and the reference path at the robot's time step, the
-  part of ``faultgen simulate --task LOG`` that grows with the log) on CSV logs of 10^5, 10^6 and
-  10^7 rows at 1 kHz (100 s, 17 min, 2.8 h). Goal: the peak flat within 20 % of the 10^5-row one.
-  The logs: the PUMA 560 along :func:`faultgen.calibrate.synth.excitation` (sines of 0.1 and 0.23 Hz,
-  so 100 s is one period), its torque from our own inverse dynamics plus 1 % noise over one period,
-  tiled (so the motion is smooth across the joins); written once into FOLDER (1.7 GB for 10^7 rows)
-  and reused.
+* ``calibrate`` on CSV logs of 10^5, 10^6 and 10^7 rows at 1 kHz (100 s, 17 min, 2.8 h). Goal: the
+  peak flat within 20 % of the 10^5-row one. The logs: the PUMA 560 along
+  :func:`faultgen.calibrate.synth.excitation` (sines of 0.1 and 0.23 Hz, so 100 s is one period), its
+  torque from our own inverse dynamics plus 1 % noise over one period, tiled (so the motion is smooth
+  across the joins); written once into FOLDER (1.7 GB for 10^7 rows) and reused.
+* a replay on CSV logs of 10^5, 10^6 and 10^7 rows over the same 50 s (2, 20 and 200 kHz; the
+  PUMA 560 moving on every axis, sines of 0.05-0.1 Hz): ``replay`` is the reading and the reference
+  path at the robot's time step (``programs.load(...).trajectory(dt)``), ``simulate`` one whole cycle
+  of ``faultgen simulate --task LOG`` in memory. A replayed cycle lasts at most an hour
+  (MAX_CYCLE_DURATION) and the simulation's cost follows its duration, so the duration is held and
+  the rows (the sampling rate) vary. Goal: the peak flat within 20 % of the 10^5-row one.
 * reading each bomb: TOML with a dotted key of 10^5 and of 2x10^4 parts and with 5x10^4 nested
   brackets (as a drivetrain table, as a DH table, as a program), ``--drivetrain /dev/zero``, a
   gzip-bomb log (3.9 MB inflating to 4 GB of valid-looking rows, through ``calibrate``), a
@@ -22,6 +26,7 @@ Prints one Markdown row per case with its verdict:
     python benchmarks/input_bounds.py [FOLDER]          # default /tmp/faultgen-input-bounds
     python benchmarks/input_bounds.py FOLDER --quick    # the bombs and the 10^5/10^6 logs only
     python benchmarks/input_bounds.py FOLDER --no-bombs --sizes 100000 10000000
+    python benchmarks/input_bounds.py FOLDER --no-bombs --kinds replay simulate
 """
 
 from __future__ import annotations
@@ -76,6 +81,32 @@ def make_log(folder: Path, rows: int) -> Path:
     return path
 
 
+REPLAY_SECONDS = 50.0
+
+
+def make_replay_log(folder: Path, rows: int) -> Path:
+    """``rows`` rows of the PUMA 560 moving over :data:`REPLAY_SECONDS` (module docstring), written
+    once, in pieces (times to 1e-11 s, angles to 12 digits)."""
+    path = folder / f"replay-{rows}.csv"
+    if path.exists():
+        return path
+    import pandas as pd
+
+    from faultgen.model import robots
+
+    home = robots.load("puma560").home
+    frequency = 0.05 * (1 + np.arange(6) / 5)
+    tmp = path.with_suffix(".part")
+    with open(tmp, "w") as fh:
+        fh.write("t," + ",".join(f"q{i}" for i in range(1, 7)) + "\n")
+        for start in range(0, rows, 1_000_000):
+            t = np.arange(start, min(start + 1_000_000, rows)) * (REPLAY_SECONDS / rows)
+            q = home + 0.3 * np.sin(2 * np.pi * frequency * t[:, None])
+            pd.DataFrame(np.column_stack([t, q])).to_csv(fh, header=False, index=False, float_format="%.12g")
+    tmp.rename(path)
+    return path
+
+
 def make_bombs(folder: Path) -> dict[str, Path]:
     import h5py
 
@@ -119,8 +150,11 @@ def make_bombs(folder: Path) -> dict[str, Path]:
 #: kind -> (imports, the case): only the case is timed (imports took 2-5 s on the loaded machine).
 CASES_CODE = {
     "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
-    "replay": ("from faultgen.operation import replay\nfrom faultgen.model import robots",
-               "replay.read({log!r}, 'puma560').trajectory(robots.load('puma560').model.opt.timestep)"),
+    "replay": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
+               "programs.load('puma560', {log!r}).trajectory(robots.load('puma560').model.opt.timestep)"),
+    "simulate": ("from faultgen.simulation import stepping",
+                 ("stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
+                  "progress=False)")),
     "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
     "dh": ("from pathlib import Path\nfrom faultgen.model import importers", "importers._read_dh(Path({log!r}))"),
     "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
@@ -158,7 +192,8 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", help="log lengths (rows) to run; the first is the baseline")
     parser.add_argument("--no-bombs", action="store_true", help="only the logs")
     parser.add_argument("--no-logs", action="store_true", help="only the bombs")
-    parser.add_argument("--kinds", nargs="+", default=["calibrate", "replay"], help="what to run on the logs")
+    parser.add_argument("--kinds", nargs="+", default=["calibrate", "replay", "simulate"],
+                        help="what to run on the logs")
     args = parser.parse_args()
     folder = Path(args.folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -180,7 +215,7 @@ def main() -> None:
     for kind in args.kinds:
         base = None
         for rows in sizes:
-            log = make_log(folder, rows)
+            log = make_log(folder, rows) if kind == "calibrate" else make_replay_log(folder, rows)
             out = folder / f"out-{kind}-{rows}"
             r = run_case(kind, log, out)
             base = base or r["peak_mb"]

@@ -47,15 +47,6 @@ def test_an_import_that_runs_back_up_breaks_the_contract(tmp_path, module, back_
     assert contract in result.stdout.replace("\n", " "), result.stdout
 
 
-#: Pairs of faultgen's modules that still import each other, each being broken on its own branch
-#: this session (issue 47): faults<->wear and cluster<->sweep on i47-seams, programs<->replay on
-#: i47-log. The coordinator empties this set at merge: a pair listed here that no longer imports
-#: each other fails the test as well, so the list cannot outlive its cycles.
-CYCLES_BEING_BROKEN = frozenset({
-    frozenset({"faultgen.operation.programs", "faultgen.operation.replay"}),
-})
-
-
 def _import_graph() -> dict[str, set[str]]:
     """faultgen's modules -> the faultgen modules each imports (at the top, inside functions or
     under TYPE_CHECKING alike: a lazy import is still a dependency), from grimp."""
@@ -98,12 +89,9 @@ def _cycles(imports: dict[str, set[str]], allowed: frozenset = frozenset()) -> l
 
 def test_no_modules_import_each_other():
     """No circle of imports between faultgen's modules, of two modules or more (a package's
-    ``__init__`` is a module too), but for the pairs being broken this session."""
+    ``__init__`` is a module too): none (issue 47)."""
     imports = _import_graph()
-    assert _cycles(imports, CYCLES_BEING_BROKEN) == [], "modules that import each other (docs/architecture.md)"
-    gone = [sorted(pair) for pair in CYCLES_BEING_BROKEN
-            if not _cycles({module: imports.get(module, set()) & pair for module in pair})]
-    assert gone == [], f"no longer a cycle: remove from CYCLES_BEING_BROKEN: {gone}"
+    assert _cycles(imports) == [], "modules that import each other (docs/architecture.md)"
 
 
 def test_the_cycle_check_finds_a_cycle():
@@ -114,7 +102,7 @@ def test_the_cycle_check_finds_a_cycle():
     imports = _import_graph()
     imports["faultgen.data.schema"].add("faultgen.data.reader")
     assert any({"faultgen.data.schema", "faultgen.data.reader"} <= set(group)
-               for group in _cycles(imports, CYCLES_BEING_BROKEN))
+               for group in _cycles(imports))
 
 
 def _imports(path: Path) -> list[str]:

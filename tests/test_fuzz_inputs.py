@@ -19,7 +19,7 @@ import faultgen
 from faultgen import inputs
 from faultgen.data import dataset, longlog, measured
 from faultgen.model import robots
-from faultgen.operation import replay
+from faultgen.operation import programs
 
 FUZZ = settings(deadline=None, suppress_health_check=list(HealthCheck), derandomize=True)
 COLUMNS = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]
@@ -91,7 +91,7 @@ def test_csv_log_readers(puma, data, name):
         path = Path(folder) / name
         path.write_bytes(data)
         _refuses_by_name(path, lambda: measured.read(path, puma))
-        _refuses_by_name(path, lambda: replay.read(path, puma))
+        _refuses_by_name(path, lambda: programs.load(puma, str(path)))
         _refuses_by_name(path, lambda: longlog.read(path, puma, 5, 1e-3))
 
 
@@ -149,7 +149,7 @@ def test_hdf5_log_readers(puma, kinds, n, bad_file):
                     if kind != "missing":
                         _column(f, name, kind, n)
         _refuses_by_name(path, lambda: measured.read(path, puma))
-        _refuses_by_name(path, lambda: replay.read(path, puma))
+        _refuses_by_name(path, lambda: programs.load(puma, str(path)))
         _refuses_by_name(path, lambda: longlog.read(path, puma, 5, 1e-3))
 
 

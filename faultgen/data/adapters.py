@@ -28,6 +28,7 @@ import pandas as pd
 from faultgen import inputs
 from faultgen.data import measured
 from faultgen.model import robots
+from faultgen.operation import jointlog
 
 #: name -> adapter class.
 ADAPTERS: dict[str, type[Adapter]] = {}
@@ -126,7 +127,7 @@ class URRTDE(Adapter):
             frame = pd.read_csv(fh, sep=separator, header=None, names=header.strip().split(separator), dtype=str,
                                 keep_default_na=False, skipinitialspace=True)
         names = list(frame.columns)
-        label = measured._csv_label
+        label = jointlog.csv_label
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
@@ -175,7 +176,7 @@ class Voraus(Adapter):
         _require(path, names, wanted, "voraus-AD")
         sample = ["sample"] if "sample" in names else []
         frame = pq.read_table(path, columns=wanted + sample).to_pandas()
-        label = measured._index_label
+        label = jointlog.index_label
         values = _numbers(path, frame, wanted + sample, label)
         q_names, qd_names, tau_names = measured.column_names(n_axes)
         out = {measured.T_COLUMN: values["time"]}

@@ -61,86 +61,45 @@ taken from ``q``. Torque is used as it is.
 
 from __future__ import annotations
 
-import csv
 import math
-import zlib
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pandas as pd
 
-from faultgen import axes, inputs
+from faultgen import axes
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
 from faultgen.derivatives import savgol_window as _savgol_window
-from faultgen.effects.payload import Payload
-from faultgen.effects.temperature import Temperature
 from faultgen.model import robots
+from faultgen.operation import jointlog
 
-#: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
-T_COLUMN = "t"
+# The format's names, read and checked by faultgen.operation.jointlog (shared with replayed logs):
+from faultgen.operation.jointlog import (  # noqa: F401 (re-exported)
+    CSV_SUFFIXES,
+    CYCLE_COLUMN,
+    FULL_TURN_MARGIN,
+    HDF5_SUFFIXES,
+    JOINT_RANGE_TOLERANCE,
+    MAX_GAP,
+    MAX_ROWS,
+    MIN_DURATION,
+    MIN_RATE,
+    PAYLOAD_COLUMN,
+    T_COLUMN,
+    TEMPERATURE_PREFIX,
+    UNITS,
+    check_time,
+    column_names,
+    hdf5_columns,
+    temperature_columns,
+)
 
-
-def column_names(n_axes: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
-    """The angle, velocity and torque columns of a robot of ``n_axes`` axes: ``q1..qN``,
-    ``qd1..qdN``, ``tau1..tauN``."""
-    numbers = range(1, n_axes + 1)
-    return tuple(f"q{i}" for i in numbers), tuple(f"qd{i}" for i in numbers), tuple(f"tau{i}" for i in numbers)
-
-
-def _required(n_axes: int) -> tuple[str, ...]:
-    q, _, tau = column_names(n_axes)
-    return (T_COLUMN, *q, *tau)
-
-
-#: Unit of each column of any robot (written as the ``unit`` attribute of HDF5 datasets).
-UNITS = {T_COLUMN: "s"}
-for _q, _qd, _tau in zip(*column_names(axes.MAX_AXES), strict=True):
-    UNITS.update({_q: "rad", _qd: "rad/s", _tau: "N m"})
-#: The optional columns of operating conditions are named as the effects that model them
-#: (:mod:`faultgen.effects`): ``temperature1..N`` (all N or none), the joint temperatures, and
-#: ``payload``, the payload mass; ``cycle`` is the cycle number of each sample.
-TEMPERATURE_PREFIX, PAYLOAD_COLUMN, CYCLE_COLUMN = Temperature.id, Payload.id, "cycle"
-
-
-def temperature_columns(n_axes: int) -> tuple[str, ...]:
-    """The joint-temperature columns of a robot of ``n_axes`` axes: ``temperature1..N``."""
-    return tuple(TEMPERATURE_PREFIX + str(i) for i in range(1, n_axes + 1))
-
-
-UNITS.update({name: "degC" for name in temperature_columns(axes.MAX_AXES)})
-UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
-
-#: File suffixes read by :func:`read`, lower case.
-CSV_SUFFIXES = (".csv", ".csv.gz")
-#: Most rows a log may have (a day at 1 kHz); a longer one, or an HDF5 log declaring more, is refused.
-MAX_ROWS = 100_000_000
-HDF5_SUFFIXES = (".h5", ".hdf5")
-
-#: Lowest accepted sample rate in Hz (applied to the median sample period).
-MIN_RATE = 100.0
-#: Longest accepted single interval between samples in s: the derivative filter window.
-MAX_GAP = 0.05
-#: Shortest accepted recording in s (last minus first sample time).
-MIN_DURATION = 2.0
-# SAVGOL_WINDOW, SAVGOL_ORDER, UNIFORM_TOLERANCE: the Savitzky-Golay estimator's settings, imported
-# from faultgen.derivatives (shared with replayed task logs, faultgen.operation.replay)
-#: Joint angles may exceed the robot's joint range by this much (rad) before being refused.
-JOINT_RANGE_TOLERANCE = 0.05
-#: Angles beyond a full turn plus this margin (rad) cannot be radians of a revolute arm joint.
-FULL_TURN_MARGIN = 0.1
-
-
-class MeasuredDataError(ValueError):
-    """Raised for a measured-data file that cannot be used.
-
-    The message starts with the file (or ``<arrays>``) and names the offending column and/or
-    data row (1-based, header not counted; see the module docstring) and what was expected.
-    """
+#: Raised for a measured-data file that cannot be used: the joint log's one error type
+#: (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming the file, column and data row).
+MeasuredDataError = jointlog.LogError
 
 
 @dataclass(frozen=True, eq=False)
@@ -281,12 +240,7 @@ def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool
     """
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     path = Path(path)
-    kind = _kind(path)
-    _regular(path)
-    if kind == "csv":
-        columns, extra, row_label = _read_csv(path, robot.n_axes)
-    else:
-        columns, extra, row_label = _read_hdf5(path, robot.n_axes)
+    columns, extra, row_label = jointlog.read_columns(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
     return _build(columns, robot, path, row_label, notes, accelerations)
 
@@ -326,7 +280,7 @@ def from_arrays(
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     where = Path(source) if source is not None else Path("<arrays>")
     columns = _columns_from_arrays(where, t, q, tau, qd, robot.n_axes)
-    return _build(columns, robot, where, _index_label, [])
+    return _build(columns, robot, where, jointlog.index_label, [])
 
 
 def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
@@ -351,251 +305,20 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
     """
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     where = Path(source)
-    label = label or _index_label
+    label = label or jointlog.index_label
     names = list(columns)
-    wanted, _ = _select_columns(where, names, robot.n_axes)
+    wanted, _ = jointlog.select_columns(where, names, robot.n_axes)
     lengths = {len(np.asarray(columns[name])) for name in wanted}
     if len(lengths) > 1:
         raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
     values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
-    _refuse_non_finite(where, values, wanted, label)
+    jointlog.refuse_non_finite(where, values, wanted, label)
     return _build(values, robot, where, label, [], accelerations)
-
-
-def _kind(path: Path) -> str:
-    name = path.name.lower()
-    if name.endswith(CSV_SUFFIXES):
-        return "csv"
-    if name.endswith(HDF5_SUFFIXES):
-        return "hdf5"
-    accepted = ", ".join(CSV_SUFFIXES + HDF5_SUFFIXES)
-    raise MeasuredDataError(
-        f"{path}: unknown file type {''.join(path.suffixes) or '(no suffix)'!r}; expected {accepted}"
-    )
-
-
-def _regular(path: Path) -> None:
-    """Refuse a missing file, a folder, a device or a FIFO (faultgen.inputs), as MeasuredDataError."""
-    try:
-        inputs.regular_file(path, "measured log")
-    except inputs.InputError as err:
-        raise MeasuredDataError(str(err)) from None
-
-
-def _csv_label(i: int) -> str:
-    return f"data row {i + 1} (line {i + 2})"
-
-
-def _index_label(i: int) -> str:
-    return f"data row {i + 1} (index {i})"
 
 
 def _compression(path: Path) -> str | None:
     """The compression a file written under this name gets: gzip for ``.gz``."""
     return "gzip" if path.name.lower().endswith(".gz") else None
-
-
-def _read_csv(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
-    """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
-
-    A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
-    reads like one named ``.csv.gz``.
-    """
-    try:
-        with inputs.open_text(path, "measured log") as fh:
-            header = next(csv.reader(fh), None)
-    except inputs.InputError as err:
-        raise MeasuredDataError(str(err)) from None
-    except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
-        raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-    if not header:
-        raise MeasuredDataError(
-            f"{path}: the file is empty; expected a header row with the columns t, q1..q{n_axes}, tau1..tau{n_axes}"
-        )
-    names = [h.strip() for h in header]
-    duplicated = sorted({n for n in names if names.count(n) > 1})
-    if duplicated:
-        raise MeasuredDataError(
-            f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header"
-        )
-    wanted, extra = _select_columns(path, names, n_axes)
-
-    # All columns are parsed (extra ones as text) so that a row with too many or too few
-    # fields is refused by the parser with its line number instead of being silently cut.
-    read_kw = {
-        "header": 0,
-        "names": names,
-        "index_col": False,
-        "skip_blank_lines": False,
-    }
-    try:
-        try:
-            # Fast path: numbers throughout. Anything else is diagnosed from the text below.
-            dtypes = {name: (float if name in wanted else str) for name in names}
-            with inputs.open_text(path, "measured log") as fh:
-                frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
-            # every column wanted (the common case): no reindexed copy of the frame
-            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
-            clean = bool(np.isfinite(values).all())
-        except inputs.InputError:
-            raise
-        except (ValueError, TypeError):
-            clean = False
-        if not clean:
-            with inputs.open_text(path, "measured log") as fh:
-                text = pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
-            text = _drop_trailing_blank_rows(text)
-            frame = _numbers_from_text(path, text, wanted)
-    except inputs.InputError as err:
-        raise MeasuredDataError(str(err)) from None
-    except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
-        raise MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-    if clean:  # the fast path's values, column by column
-        columns = {name: values[:, k] for k, name in enumerate(wanted)}
-    else:
-        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
-    return columns, extra, _csv_label
-
-
-def _drop_trailing_blank_rows(text: pd.DataFrame) -> pd.DataFrame:
-    blank = (text.apply(lambda col: col.str.strip()) == "").all(axis=1).to_numpy()
-    n = len(blank)
-    while n and blank[n - 1]:
-        n -= 1
-    return text.iloc[:n]
-
-
-def _numbers_from_text(path: Path, text: pd.DataFrame, wanted: list[str]) -> pd.DataFrame:
-    """Convert text columns to floats; refuse at the first empty / NaN / non-numeric cell."""
-    out = {}
-    first: tuple[int, int, str, str] | None = None  # (row, column order, column, raw text)
-    for order, name in enumerate(wanted):
-        raw = text[name].str.strip()
-        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size and (first is None or bad[0] < first[0]):
-            first = (int(bad[0]), order, name, str(raw.iloc[bad[0]]))
-        out[name] = values
-    if first is not None:
-        row, _, name, raw = first
-        raise MeasuredDataError(f"{path}: {_csv_label(row)}, column {name}: {_describe_bad_cell(raw)}")
-    return pd.DataFrame(out)
-
-
-def _describe_bad_cell(raw: str) -> str:
-    if raw == "":
-        return "empty cell; expected a number"
-    if raw.lower() in ("nan", "-nan", "+nan", "na", "n/a", "null", "none", "#n/a"):
-        return f"value {raw!r} (NaN); expected a number"
-    try:
-        value = float(raw)
-    except ValueError:
-        return f"value {raw!r} is not a number"
-    return f"value {raw!r} is not finite" if not math.isfinite(value) else f"value {raw!r} not understood"
-
-
-def _select_columns(path: Path, names: list[str], n_axes: int) -> tuple[list[str], list[str]]:
-    """Columns to read (required, plus all qd when present) and the extra ones; refuse missing."""
-    present = set(names)
-    n = n_axes
-    qd_columns = column_names(n)[1]
-    missing = [c for c in _required(n) if c not in present]
-    if missing:
-        shown = names if len(names) <= 40 else [*names[:40], f"... ({len(names)} in all)"]
-        hint = ""
-        if len(names) == 1 and ";" in names[0]:
-            hint = "; the header seems to use ';' as separator, expected ','"
-        elif len(names) == 1 and "\t" in names[0]:
-            hint = "; the header seems to use tabs as separator, expected ','"
-        raise MeasuredDataError(
-            f"{path}: missing column(s) {', '.join(missing)}; found columns: {', '.join(shown) or '(none)'}"
-            f"; required: t, q1..q{n}, tau1..tau{n} (qd1..qd{n} optional){hint}"
-        )
-    qd_present = [c for c in qd_columns if c in present]
-    if qd_present and len(qd_present) != n:
-        qd_missing = [c for c in qd_columns if c not in present]
-        raise MeasuredDataError(
-            f"{path}: velocity columns {', '.join(qd_present)} present but {', '.join(qd_missing)} missing; "
-            f"give all of qd1..qd{n} or none (then they are estimated from q)"
-        )
-    wanted = [*_required(n), *qd_present]
-    if all(c in present for c in temperature_columns(n)):  # some of them only: ignored, named as extra
-        wanted += temperature_columns(n)
-    wanted += [c for c in (PAYLOAD_COLUMN, CYCLE_COLUMN) if c in present]
-    extra = [n for n in names if n not in wanted]
-    return wanted, extra
-
-
-def _read_hdf5(path: Path, n_axes: int) -> tuple[dict[str, np.ndarray], list[str], object]:
-    with _open_hdf5(path) as fh:
-        wanted, extra = hdf5_columns(fh, path, n_axes)
-        columns = {}
-        length = None
-        for name in wanted:
-            ds = fh[name]
-            if ds.ndim != 1:
-                raise MeasuredDataError(
-                    f"{path}: dataset {name} has shape {ds.shape}; expected a 1-D dataset (n,)"
-                )
-            if ds.dtype.kind not in "fiu":
-                raise MeasuredDataError(f"{path}: dataset {name} has dtype {ds.dtype}; expected numbers")
-            unit = ds.attrs.get("unit", ds.attrs.get("units"))
-            if unit is not None:
-                unit = unit.decode() if isinstance(unit, bytes) else str(unit)
-                if _unit_key(unit) != _unit_key(UNITS[name]):
-                    raise MeasuredDataError(
-                        f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}"
-                    )
-            if ds.shape[0] > MAX_ROWS:
-                raise MeasuredDataError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
-                                        f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
-            if length is None:
-                length = ds.shape[0]
-            elif ds.shape[0] != length:
-                raise MeasuredDataError(
-                    f"{path}: dataset {name} has {ds.shape[0]} rows but {wanted[0]} has {length}; "
-                    "all columns must have the same length"
-                )
-            columns[name] = np.asarray(ds[()], dtype=float)
-    _refuse_non_finite(path, columns, wanted, _index_label)
-    return columns, extra, _index_label
-
-
-def hdf5_columns(fh: h5py.File, path: Path, n_axes: int) -> tuple[list[str], list[str]]:
-    """The root datasets to read (required, plus all qd when present) and the extra ones (groups
-    among them, marked); refuse missing columns, naming the groups at the root that hold none."""
-    names = list(fh.keys())
-    datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
-    groups = [n for n in names if isinstance(fh[n], h5py.Group)]
-    try:
-        wanted, extra = _select_columns(path, datasets, n_axes)
-    except MeasuredDataError as err:
-        if groups:
-            raise MeasuredDataError(
-                f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
-            ) from None
-        raise
-    return wanted, extra + [f"{g}/ (group)" for g in groups]
-
-
-@contextmanager
-def _open_hdf5(path: Path):
-    """The HDF5 log, opened read-only after faultgen.inputs refused links and virtual datasets that
-    reach other files (MeasuredDataError naming the link)."""
-    try:
-        fh = h5py.File(path, "r")
-    except OSError as err:
-        raise MeasuredDataError(f"{path}: cannot read the file as HDF5: {err}") from err
-    with fh:
-        try:
-            inputs.check_hdf5_links(fh, path)
-        except inputs.InputError as err:
-            raise MeasuredDataError(str(err)) from None
-        yield fh
-
-
-def _unit_key(unit: str) -> str:
-    return "".join(ch for ch in unit.lower() if ch not in " *.·")
 
 
 def _columns_from_arrays(where: Path, t, q, tau, qd, n_axes: int) -> dict[str, np.ndarray]:
@@ -614,93 +337,21 @@ def _columns_from_arrays(where: Path, t, q, tau, qd, n_axes: int) -> dict[str, n
                 f"{where}: {label} must have shape ({t.shape[0]}, {n_axes}), got {arr.shape}"
             )
         columns.update({name: arr[:, k] for k, name in enumerate(names)})
-    _refuse_non_finite(where, columns, list(columns), _index_label)
+    jointlog.refuse_non_finite(where, columns, list(columns), jointlog.index_label)
     return columns
-
-
-def _refuse_non_finite(where: Path, columns: dict[str, np.ndarray], order: list[str], label) -> None:
-    first = None
-    for name in order:
-        bad = np.flatnonzero(~np.isfinite(columns[name]))
-        if bad.size and (first is None or bad[0] < first[0]):
-            first = (int(bad[0]), name)
-    if first is not None:
-        row, name = first
-        value = columns[name][row]
-        what = "NaN" if np.isnan(value) else f"{value} (not finite)"
-        raise MeasuredDataError(
-            f"{where}: {label(row)}, column {name}: value {what}; expected a finite number"
-        )
-
-
-# --------------------------------------------------------------------------------------------
-# Checks and derivatives
-
-
-def check_time(t: np.ndarray, where: Path, label, notes: list[str]) -> tuple[np.ndarray, float]:
-    """Refuse sample times that do not increase, a median period above 1 / :data:`MIN_RATE`, a gap
-    above :data:`MAX_GAP` or a span below :data:`MIN_DURATION`; note long gaps in ``notes``. Returns
-    the intervals and the median period, s."""
-    n = t.shape[0]
-    if n < 2:
-        raise MeasuredDataError(
-            f"{where}: {n} data row(s); expected at least {MIN_DURATION:g} s of data at >= {MIN_RATE:g} Hz"
-        )
-    dt = np.diff(t)
-    back = np.flatnonzero(dt <= 0)
-    if back.size:
-        i = int(back[0]) + 1
-        how = "repeats" if dt[i - 1] == 0 else "goes back"
-        raise MeasuredDataError(
-            f"{where}: column t {how} at {label(i)}: t = {float(t[i])!r} s after t = {float(t[i - 1])!r} s at "
-            f"{label(i - 1)}; expected strictly increasing times"
-        )
-    period = float(np.median(dt))
-    if period > (1.0 / MIN_RATE) * (1 + 1e-9):
-        raise MeasuredDataError(
-            f"{where}: column t has a median sample period of {period:.6g} s ({1 / period:.4g} Hz); "
-            f"expected at most {1 / MIN_RATE:g} s (a sample rate of at least {MIN_RATE:g} Hz)"
-        )
-    gap = int(np.argmax(dt))
-    if dt[gap] > MAX_GAP * (1 + 1e-9):
-        raise MeasuredDataError(
-            f"{where}: column t jumps by {dt[gap]:.6g} s from {label(gap)} to {label(gap + 1)}; "
-            f"expected no interval longer than {MAX_GAP:g} s (the derivative filter window)"
-        )
-    duration = float(t[-1] - t[0])
-    if duration < MIN_DURATION:
-        raise MeasuredDataError(
-            f"{where}: the data covers {duration:.6g} s ({n} data rows); expected at least {MIN_DURATION:g} s"
-        )
-    long_gaps = np.flatnonzero(dt > 2 * period)
-    if long_gaps.size:
-        notes.append(
-            f"{long_gaps.size} sampling interval(s) longer than twice the median period {period:.6g} s, "
-            f"the longest {dt[gap]:.6g} s before {label(gap + 1)}"
-        )
-    return dt, period
 
 
 def _build(
     columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str],
     accelerations: bool = True,
 ) -> MeasuredData:
-    t = columns[T_COLUMN]
-    n = t.shape[0]
-    dt, period = check_time(t, where, label, notes)
-
-    q_columns, qd_columns, tau_columns = column_names(robot.n_axes)
-    q = np.column_stack([columns[c] for c in q_columns])
+    # a reader that needs no qdd (an imported fleet's features) saves its filter
+    motion = jointlog.motion(columns, robot, where, label, notes, orders=(1, 2) if accelerations else (1,))
+    t, q, dt, period, window, uniform = (motion[k] for k in ("t", "q", "dt", "period", "window", "uniform"))
+    qd_est, qdd = motion["derivatives"] if accelerations else (*motion["derivatives"], np.full_like(q, np.nan))
+    _, qd_columns, tau_columns = column_names(robot.n_axes)
     tau = np.column_stack([columns[c] for c in tau_columns])
-    _check_angles(where, q, robot, label)
-
-    window = _savgol_window(period, n)
-    uniform = _is_uniform(dt, period)
-    if accelerations:
-        qd_est, qdd = _derivatives(t, q, period, window, uniform)
-    else:  # a reader that needs no qdd (an imported fleet's features) saves its filter
-        (qd_est,) = _derivatives(t, q, period, window, uniform, orders=(1,))
-        qdd = np.full_like(q, np.nan)
+    if not accelerations:
         notes.append("qdd not estimated (accelerations=False): NaN")
     filt = f"Savitzky-Golay, order {SAVGOL_ORDER}, window {window} samples ({window * period:.4g} s)"
     if not uniform:
@@ -716,7 +367,7 @@ def _build(
         qd = np.column_stack([columns[c] for c in qd_columns])
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
         notes.extend(_check_velocities(where, qd, qd_est, window))
-    notes.extend(_torque_notes(tau, robot))
+    notes.extend(torque_notes(tau, robot))
     temperature = (np.column_stack([columns[c] for c in temperature_columns(robot.n_axes)])
                    if temperature_columns(robot.n_axes)[0] in columns else None)
     cycle = _cycles(where, columns[CYCLE_COLUMN], label) if CYCLE_COLUMN in columns else None
@@ -750,34 +401,6 @@ def _cycles(where: Path, values: np.ndarray, label) -> np.ndarray:
         raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN} goes back at {label(i)}: {values[i]:g} after "
                                 f"{values[i - 1]:g}; expected the samples of each cycle together, cycles in order")
     return values.astype(np.int64)
-
-
-def _check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label) -> None:
-    """Refuse angle columns in degrees or outside the joint range (plus tolerance)."""
-    tol = JOINT_RANGE_TOLERANCE
-    for k, name in enumerate(column_names(robot.n_axes)[0]):
-        lo, hi = robot.joint_range[k]
-        col = q[:, k]
-        outside = np.flatnonzero((col < lo - tol) | (col > hi + tol))
-        if not outside.size:
-            continue
-        as_rad = np.deg2rad(col)
-        fits_as_degrees = bool(np.all((as_rad >= lo - tol) & (as_rad <= hi + tol)))
-        peak = int(np.argmax(np.abs(col)))
-        beyond_turn = abs(col[peak]) > 2 * math.pi + FULL_TURN_MARGIN
-        too_wide = np.ptp(col) > (hi - lo) + 2 * tol
-        if fits_as_degrees and (beyond_turn or too_wide):
-            extreme = "max" if col[peak] >= 0 else "min"
-            raise MeasuredDataError(
-                f"{where}: column {name} looks like degrees ({extreme} {col[peak]:.6g} at {label(peak)}, "
-                f"span {np.ptp(col):.4g}); expected rad within the joint range [{lo:.4g}, {hi:.4g}] rad"
-            )
-        i = int(outside[0])
-        hint = " (if the column is in degrees, convert it to rad)" if fits_as_degrees else ""
-        raise MeasuredDataError(
-            f"{where}: column {name} at {label(i)} is {col[i]:.6g} rad, outside the joint range "
-            f"[{lo:.4g}, {hi:.4g}] rad of {robot.name} (tolerance {tol:g} rad){hint}"
-        )
 
 
 def velocity_rows(n: int, window: int) -> slice:
@@ -814,7 +437,7 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
     return notes
 
 
-def _torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
+def torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
     limit = robot.gear_ratio * robot.motor_torque_limit
     notes = []
     for k, name in enumerate(column_names(robot.n_axes)[2]):

@@ -155,7 +155,7 @@ def load(robot: Robot | str, task: str) -> Task:
         return builtin(robot, task)
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         return read(task, robot)
-    return replay.read(task, robot)
+    return replay.read(task, robot, _limits({}, robot, task), check_torque)
 
 
 def record(task: str) -> dict | None:

@@ -27,35 +27,45 @@ Before issue 51 a log that did not start at rest got a run-in, a ramp from rest 
 state, which shifted the whole log later in the run: the recorded reference was off the log at the
 recorded times by up to 0.8 rad.
 
-Refused before any simulation (:class:`faultgen.operation.programs.ProgramError`, naming the file,
-the row and the value): a missing column, a non-finite value, time not increasing, a log shorter than
-:data:`MIN_DURATION` or :data:`MIN_SAMPLES`, a gap longer than :data:`MAX_GAP`, an angle outside the
-joint range (by how much), and a motor torque above the drives' capacity.
+The log is read by the measured-log reader (:mod:`faultgen.operation.jointlog`: one parser, one
+set of checks, one derivative estimator; the torque columns are not needed), in blocks
+(:mod:`faultgen.operation.logblocks`), so memory does not grow with the log's rows: a log of at
+most one row per physics step of the robot is read whole; a denser one is checked row by row as
+it streams by and then replayed as every ``k``-th row from the first, at most one row per step
+(what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
+recorded at that rate (the reference passes through its own samples, time 0 is its first).
+
+Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
+the file, the row or column and the value): a missing column, a non-finite value, time not
+increasing, a log shorter than :data:`MIN_DURATION`, a gap longer than
+:data:`faultgen.operation.jointlog.MAX_GAP`, a log longer than
+:data:`faultgen.operation.tasks.MAX_CYCLE_DURATION` (as soon as a block shows it, before the rest
+is read), an angle outside the joint range (by how much), and a motor torque above the drives'
+capacity.
 """
 
 from __future__ import annotations
 
-import csv
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 from ruckig import ControlInterface, DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 from scipy.interpolate import CubicSpline
 
-from faultgen import derivatives as savgol
-from faultgen import inputs
 from faultgen.model import robots
 from faultgen.model.robots import Robot
-from faultgen.operation.programs import ProgramError, _limits, check_torque, label
-from faultgen.operation.tasks import MAX_CYCLE_DURATION, MAX_CYCLE_SAMPLES, PLAN_PERIOD, JointPath
+from faultgen.operation import jointlog, logblocks
+from faultgen.operation.jointlog import MAX_GAP, LogError
+from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath
 
-#: Shortest log replayed, s (four filter windows) and fewest samples.
+#: Shortest log replayed, s (four filter windows); the longest interval between samples is the
+#: measured-log reader's :data:`faultgen.operation.jointlog.MAX_GAP` (the derivative filter's window).
 MIN_DURATION = 0.2
-MIN_SAMPLES = 10
-#: Longest interval between samples, s (the derivative filter's window, as the measured-log reader).
-MAX_GAP = 0.05
+#: Rows read at a time: a replay's peak memory is that of its reference at the physics step, so its
+#: blocks are smaller than the calibration's (:data:`faultgen.operation.logblocks.BLOCK_ROWS`).
+BLOCK_ROWS = 50_000
 #: A log end is at rest when every axis is below these, rad/s and rad/s^2.
 REST_SPEED = 1e-3
 REST_ACCELERATION = 1e-2
@@ -82,6 +92,8 @@ class Replay:
     start : ndarray of shape (N,)
         Where the cycle starts, rad: the log's first angles.
     robot : Robot
+    check_torque : callable
+        Refuses a reference above the drives' capacity (:func:`read`).
     """
 
     name: str
@@ -97,6 +109,7 @@ class Replay:
     jerk_limit: np.ndarray
     start: np.ndarray
     robot: Robot = field(repr=False)
+    check_torque: Callable = field(repr=False)
 
     @property
     def duration(self) -> float:
@@ -109,7 +122,7 @@ class Replay:
 
         Raises
         ------
-        ProgramError
+        faultgen.operation.jointlog.LogError
             If the path leaves the joint ranges or needs more than the drives' torque.
         """
         steps = round(self.duration / dt)
@@ -136,7 +149,7 @@ class Replay:
         where = f"{self.source} (replay)"
 
         def fail(segment, problem):
-            raise ProgramError(f"{where}, {segment}: {problem}")
+            raise LogError(f"{where}, {segment}: {problem}")
 
         low, high = self.robot.joint_range[:, 0], self.robot.joint_range[:, 1]
         bad = (q < low) | (q > high)
@@ -146,7 +159,7 @@ class Replay:
             part = next(name for name, a, b in segments if a <= k <= b)
             fail(part, f"axis {axis + 1} reaches {q[k, axis]:.4f} rad at t = {k * dt:.3f} s, "
                  f"{abs(q[k, axis] - edge):.4f} rad beyond its range {low[axis]:.4f}..{high[axis]:.4f} rad")
-        check_torque(self.robot, path, lambda k: next(name for name, a, b in segments if a <= k <= b), fail)
+        self.check_torque(self.robot, path, lambda k: next(name for name, a, b in segments if a <= k <= b), fail)
         return path
 
 
@@ -176,12 +189,12 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
     over = np.abs(qdd) > replay.acceleration_limit
     if np.any(over):
         axis = int(np.argmax(over))
-        raise ProgramError(f"{replay.source} (replay): the log ends moving with an "
+        raise LogError(f"{replay.source} (replay): the log ends moving with an "
                            f"acceleration of {qdd[axis]:.4g} rad/s^2 on axis {axis + 1}, above the planning limit "
                            f"{replay.acceleration_limit[axis]:.4g} rad/s^2 the ramp out of "
                            "it may use")
     if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
-        raise ProgramError(f"{replay.source} (replay): ruckig found no ramp out of the "
+        raise LogError(f"{replay.source} (replay): ruckig found no ramp out of the "
                            "log's motion within the robot's planning limits")
     steps = round(trajectory.duration / dt)
     samples = [trajectory.at_time(k * dt) for k in range(steps)]
@@ -192,151 +205,61 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
     return pos, vel, acc
 
 
-def read(path: str | Path, robot: Robot | str) -> Replay:
-    """Read a joint log to replay on ``robot`` (module docstring).
+def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
+         check_torque: Callable) -> Replay:
+    """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
+    (:mod:`faultgen.operation.jointlog`, no torque columns), streamed (:mod:`faultgen.operation.logblocks`).
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` log with columns ``t`` (s) and ``q1..qN`` (rad).
+    robot : Robot or str
+    limits : tuple of three ndarray of shape (N,)
+        The robot's planning limits (velocity, acceleration, jerk; rad/s, rad/s^2, rad/s^3) of the
+        run-out: :func:`faultgen.operation.programs.robot_limits`.
+    check_torque : callable
+        ``check_torque(robot, path, segment_at, fail)`` refusing a reference above the drives'
+        capacity: :func:`faultgen.operation.programs.check_torque`.
 
     Raises
     ------
-    ProgramError
-        For a missing file or column, a non-finite value, time that does not increase, a log that is
-        too short or has a gap, or an angle outside the joint ranges; the message names the row.
+    faultgen.operation.jointlog.LogError
+        A ValueError naming the file and the row or column: a missing file or column, a non-finite
+        value, time that does not increase, a log that is too short, has a gap or runs longer than
+        :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
     """
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
     path = Path(path)
-    try:
-        inputs.regular_file(path, "joint log")
-    except inputs.InputError as err:
-        raise ProgramError(str(err)) from None
-    n_axes = len(robot.joint_names)
-    wanted = ["t", *(f"q{i}" for i in range(1, n_axes + 1))]
-    columns = _read_columns(path, wanted)
-    t, q = columns[:, 0], columns[:, 1:]
-    if len(t) == 0:
-        raise ProgramError(f"{path}: the log has a header but no data rows; expected at least {MIN_SAMPLES} samples "
-                           f"over {MIN_DURATION} s")
-    bad = np.argwhere(~np.isfinite(columns))
-    if bad.size:
-        row, col = bad[0]
-        raise ProgramError(f"{path}: {wanted[col]} at data row {row + 1} is {columns[row, col]!r}; expected a number")
-    if len(t) < MIN_SAMPLES or t[-1] - t[0] < MIN_DURATION:  # a header-only log: 0 samples over 0 s
-        raise ProgramError(f"{path}: the log is too short: {len(t)} samples over {t[-1] - t[0]:.4g} s; expected at "
-                           f"least {MIN_SAMPLES} samples over {MIN_DURATION} s")
-    dt = np.diff(t)
-    if np.any(dt <= 0):
-        row = int(np.argmax(dt <= 0)) + 1
-        raise ProgramError(f"{path}: t does not increase at data row {row + 1} (t = {t[row]!r} s after {t[row - 1]!r} "
-                           "s); expected strictly increasing times")
-    if dt.max() > MAX_GAP * (1 + 1e-9):
-        row = int(np.argmax(dt)) + 1
-        raise ProgramError(f"{path}: t jumps by {dt.max():.4g} s before data row {row + 1}; expected no interval "
-                           f"longer than {MAX_GAP} s")
-    low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
-    bad = np.argwhere((q < low) | (q > high))
-    if bad.size:
-        row, axis = bad[0]
-        edge = low[axis] if q[row, axis] < low[axis] else high[axis]
-        raise ProgramError(f"{path}: q{axis + 1} at data row {row + 1} (t = {t[row]:.4f} s) is {q[row, axis]:.4f} rad, "
-                           f"{abs(q[row, axis] - edge):.4f} rad outside the joint range {low[axis]:.4f}.."
-                           f"{high[axis]:.4f} rad of axis {axis + 1} of {robot.name}")
-    period = float(np.median(dt))
-    qd, qdd = savgol.derivatives(t, q, period, savgol.savgol_window(period, len(t)), savgol.is_uniform(dt, period))
-    velocity, acceleration, jerk = _limits({}, robot, str(path))
-    replay = Replay(name=label(str(path)), robot_name=robot.name, process="replay", source=path, t=t - t[0], q=q,
-                    qd=qd, qdd=qdd, velocity_limit=velocity, acceleration_limit=acceleration, jerk_limit=jerk,
-                    start=q[0], robot=robot)
-    return replay
+    n_axes = robot.n_axes
+    src = logblocks.source(path, n_axes, motion_only=True)
+    times = logblocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
+    scan = logblocks.scan(src, robot, times, BLOCK_ROWS)
+    rows = times.rows
+    step = robot.model.opt.timestep
+    most = int((times.last - times.first) / step + 1e-6) + 1 if rows > 1 else rows  # a row per physics step
+    if rows <= most:  # read whole, as the calibration reads a log
+        columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
+    else:  # denser than the physics step: every k-th row kept while read, once every row is checked
+        times.check(MIN_DURATION, 1 / MAX_GAP)
+        q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
+        jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
+        k = -(-rows // most)
+        columns, label = logblocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
+    found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
+                            tolerance=0.0)
+    t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]
+    suffix = max((s for s in jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if path.name.lower().endswith(s)), key=len)
+    velocity, acceleration, jerk = limits
+    return Replay(name=path.name[: -len(suffix)], robot_name=robot.name, process="replay", source=path, t=t - t[0],
+                  q=q, qd=qd, qdd=qdd, velocity_limit=velocity, acceleration_limit=acceleration, jerk_limit=jerk,
+                  start=q[0], robot=robot, check_torque=check_torque)
 
 
-def _read_columns(path: Path, wanted: list[str]) -> np.ndarray:
-    """The ``wanted`` columns of a CSV (gzip or not, by content) or HDF5 log, shape (n, len(wanted)),
-    read in blocks of :data:`BLOCK_ROWS` and refused (the limit named) as soon as it runs longer than
-    a cycle may (:func:`faultgen.operation.tasks.check_cycle_length` at the finest step): memory is
-    bounded whatever the file's length. HDF5 links and virtual datasets that reach other files are
-    refused (:mod:`faultgen.inputs`)."""
-    try:
-        if path.name.lower().endswith((".h5", ".hdf5")):
-            return _read_hdf5(path, wanted)
-        return _read_csv(path, wanted)
-    except inputs.InputError as err:
-        raise ProgramError(str(err)) from None
-
-
-#: Rows read at a time, and most rows a replayed log may have (a cycle of at most an hour at 1 kHz...
-#: MAX_CYCLE_SAMPLES at the finest step).
-BLOCK_ROWS = 500_000
-
-
-def _check_length(path: Path, t: np.ndarray, rows: int) -> None:
-    if rows > MAX_CYCLE_SAMPLES:
-        raise ProgramError(f"{path}: more than {MAX_CYCLE_SAMPLES} rows; a replayed log is one cycle, of at most "
-                           f"{MAX_CYCLE_SAMPLES} samples (MAX_CYCLE_SAMPLES): replay a part of it")
-    if len(t) and np.all(np.isfinite(t[[0, -1]])) and t[-1] - t[0] > MAX_CYCLE_DURATION:
-        raise ProgramError(f"{path}: the log runs longer than {MAX_CYCLE_DURATION:g} s (t = {t[0]:.6g} .. beyond "
-                           f"{t[-1]:.6g} s); a replayed log is one cycle, of at most {MAX_CYCLE_DURATION:g} s "
-                           "(MAX_CYCLE_DURATION): replay a part of it")
-
-
-def _read_hdf5(path: Path, wanted: list[str]) -> np.ndarray:
-    with inputs.open_hdf5(path, "joint log") as f:
-        missing = [c for c in wanted if c not in f]
-        if missing:
-            raise ProgramError(f"{path}: no dataset {missing[0]!r} at the file root; a joint log needs "
-                               f"{', '.join(wanted)}")
-        columns = [inputs.bounded_dataset(f, c, path, (None,), kinds="fiu") for c in wanted]
-        lengths = {ds.shape[0] for ds in columns}
-        if len(lengths) > 1:
-            raise ProgramError(f"{path}: datasets {', '.join(wanted)} have different lengths "
-                               f"({', '.join(str(ds.shape[0]) for ds in columns)}); one row per sample is expected")
-        n = lengths.pop()
-        if n:
-            _check_length(path, np.array([columns[0][0], columns[0][n - 1]], dtype=float), n)
-        return np.column_stack([np.asarray(ds[()], dtype=float) for ds in columns]) if n else np.empty((0, len(wanted)))
-
-
-def _read_csv(path: Path, wanted: list[str]) -> np.ndarray:
-    """Two passes: the first reads only ``t``, block by block, keeping nothing but its first value and
-    the row count, so a log longer than a cycle is refused before any of it is kept; the second
-    reads the wanted columns."""
-    first, rows = None, 0
-    for block in _csv_blocks(path, wanted, wanted[:1]):
-        first = block[0, 0] if first is None else first
-        rows += len(block)
-        _check_length(path, np.array([first, block[-1, 0]]), rows)
-    blocks = list(_csv_blocks(path, wanted, wanted))
-    return np.concatenate(blocks) if blocks else np.empty((0, len(wanted)))
-
-
-def _csv_blocks(path: Path, wanted: list[str], columns: list[str]):
-    """The ``columns`` of a CSV log as float blocks of :data:`BLOCK_ROWS` rows (empty ones skipped),
-    after checking that its header has every one of ``wanted``."""
-    _check_header(path, wanted)
-    with inputs.open_text(path, "joint log") as f:
-        try:
-            reader = pd.read_csv(f, skipinitialspace=True, chunksize=BLOCK_ROWS,
-                                 usecols=lambda name: str(name).strip() in columns)
-            for table in reader:
-                table.columns = [str(c).strip() for c in table.columns]
-                if not len(table):
-                    continue
-                try:
-                    yield table[columns].to_numpy(dtype=float)
-                except ValueError as err:
-                    raise ProgramError(f"{path}: a value in columns {', '.join(wanted)} is not a number ({err})") \
-                        from None
-        except (ValueError, OSError, pd.errors.ParserError) as err:
-            if isinstance(err, (ProgramError, inputs.InputError)):
-                raise
-            raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from err
-
-
-def _check_header(path: Path, wanted: list[str]) -> None:
-    try:
-        with inputs.open_text(path, "joint log") as f:
-            header = [name.strip() for name in next(csv.reader(f), [])]
-    except (UnicodeDecodeError, OSError, csv.Error) as err:
-        raise ProgramError(f"{path}: not a CSV file with a header row ({err})") from None
-    missing = [c for c in wanted if c not in header]
-    if missing:
-        raise ProgramError(f"{path}: no column {missing[0]!r}; a joint log needs {', '.join(wanted)} (rad), "
-                           f"got {', '.join(header)}")
+def _check_length(path: Path, first: float, last: float) -> None:
+    """Refuse a log longer than a cycle may be, as soon as a block shows it."""
+    if last - first > MAX_CYCLE_DURATION:
+        raise LogError(f"{path}: the log runs longer than {MAX_CYCLE_DURATION:g} s (t = {first:.6g} .. beyond "
+                       f"{last:.6g} s); a replayed log is one cycle, of at most {MAX_CYCLE_DURATION:g} s "
+                       "(MAX_CYCLE_DURATION): replay a part of it")

@@ -1,0 +1,472 @@
+"""A joint log: one implementation of reading, checking and differentiating the logs faultgen takes
+from a robot (the calibration's measured logs, :mod:`faultgen.data.measured`; a replayed log,
+:mod:`faultgen.operation.replay`, which needs no torque columns).
+
+The format (columns, units, CSV and HDF5 layouts, row numbers in messages) is documented in
+:mod:`faultgen.data.measured`. Every refusal is a :class:`LogError` (a ValueError) naming the file
+and the column and/or data row (1-based, header not counted).
+
+Derivatives: :func:`derivatives` (the Savitzky-Golay estimator of :mod:`faultgen.derivatives` at
+the median sample period), so a replayed log and the same log calibrated see one motion.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import zlib
+from contextlib import contextmanager
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+
+from faultgen import axes, inputs
+from faultgen.derivatives import derivatives as _savgol
+from faultgen.derivatives import is_uniform, savgol_window
+from faultgen.effects.payload import Payload
+from faultgen.effects.temperature import Temperature
+from faultgen.model import robots
+
+#: Column names of the format: ``t`` and, for a robot of N axes, :func:`column_names`.
+T_COLUMN = "t"
+
+
+def column_names(n_axes: int) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    """The angle, velocity and torque columns of a robot of ``n_axes`` axes: ``q1..qN``,
+    ``qd1..qdN``, ``tau1..tauN``."""
+    numbers = range(1, n_axes + 1)
+    return tuple(f"q{i}" for i in numbers), tuple(f"qd{i}" for i in numbers), tuple(f"tau{i}" for i in numbers)
+
+
+def required(n_axes: int) -> tuple[str, ...]:
+    q, _, tau = column_names(n_axes)
+    return (T_COLUMN, *q, *tau)
+
+
+#: Unit of each column of any robot (written as the ``unit`` attribute of HDF5 datasets).
+UNITS = {T_COLUMN: "s"}
+for _q, _qd, _tau in zip(*column_names(axes.MAX_AXES), strict=True):
+    UNITS.update({_q: "rad", _qd: "rad/s", _tau: "N m"})
+#: The optional columns of operating conditions are named as the effects that model them
+#: (:mod:`faultgen.effects`): ``temperature1..N`` (all N or none), the joint temperatures, and
+#: ``payload``, the payload mass; ``cycle`` is the cycle number of each sample.
+TEMPERATURE_PREFIX, PAYLOAD_COLUMN, CYCLE_COLUMN = Temperature.id, Payload.id, "cycle"
+
+
+def temperature_columns(n_axes: int) -> tuple[str, ...]:
+    """The joint-temperature columns of a robot of ``n_axes`` axes: ``temperature1..N``."""
+    return tuple(TEMPERATURE_PREFIX + str(i) for i in range(1, n_axes + 1))
+
+
+UNITS.update({name: "degC" for name in temperature_columns(axes.MAX_AXES)})
+UNITS.update({PAYLOAD_COLUMN: "kg", CYCLE_COLUMN: "1"})
+
+#: File suffixes read by :func:`read`, lower case.
+CSV_SUFFIXES = (".csv", ".csv.gz")
+#: Most rows a log may have (a day at 1 kHz); a longer one, or an HDF5 log declaring more, is refused.
+MAX_ROWS = 100_000_000
+HDF5_SUFFIXES = (".h5", ".hdf5")
+
+#: Lowest accepted sample rate in Hz (applied to the median sample period).
+MIN_RATE = 100.0
+#: Longest accepted single interval between samples in s: the derivative filter window.
+MAX_GAP = 0.05
+#: Shortest accepted recording in s (last minus first sample time).
+MIN_DURATION = 2.0
+# SAVGOL_WINDOW, SAVGOL_ORDER, UNIFORM_TOLERANCE: the Savitzky-Golay estimator's settings, imported
+# from faultgen.derivatives (shared with replayed task logs, faultgen.operation.replay)
+#: Joint angles may exceed the robot's joint range by this much (rad) before being refused.
+JOINT_RANGE_TOLERANCE = 0.05
+#: Angles beyond a full turn plus this margin (rad) cannot be radians of a revolute arm joint.
+FULL_TURN_MARGIN = 0.1
+
+
+class LogError(ValueError):
+    """Raised for a joint log that cannot be used.
+
+    The message starts with the file (or ``<arrays>``) and names the offending column and/or
+    data row (1-based, header not counted) and what was expected.
+    """
+
+
+def kind(path: Path) -> str:
+    name = path.name.lower()
+    if name.endswith(CSV_SUFFIXES):
+        return "csv"
+    if name.endswith(HDF5_SUFFIXES):
+        return "hdf5"
+    accepted = ", ".join(CSV_SUFFIXES + HDF5_SUFFIXES)
+    raise LogError(
+        f"{path}: unknown file type {''.join(path.suffixes) or '(no suffix)'!r}; expected {accepted}"
+    )
+
+
+def regular(path: Path) -> None:
+    """Refuse a missing file, a folder, a device or a FIFO (faultgen.inputs), as LogError."""
+    try:
+        inputs.regular_file(path, "joint log")
+    except inputs.InputError as err:
+        raise LogError(str(err)) from None
+
+
+def csv_label(i: int) -> str:
+    return f"data row {i + 1} (line {i + 2})"
+
+
+def index_label(i: int) -> str:
+    return f"data row {i + 1} (index {i})"
+
+
+def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
+    """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
+
+    A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
+    reads like one named ``.csv.gz``.
+    """
+    try:
+        with inputs.open_text(path, "joint log") as fh:
+            header = next(csv.reader(fh), None)
+    except inputs.InputError as err:
+        raise LogError(str(err)) from None
+    except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
+        raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
+    if not header:
+        raise LogError(
+            f"{path}: the file is empty; expected a header row with the columns t, q1..q{n_axes}, tau1..tau{n_axes}"
+        )
+    names = [h.strip() for h in header]
+    duplicated = sorted({n for n in names if names.count(n) > 1})
+    if duplicated:
+        raise LogError(
+            f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header"
+        )
+    wanted, extra = select_columns(path, names, n_axes, motion_only)
+
+    # All columns are parsed (extra ones as text) so that a row with too many or too few
+    # fields is refused by the parser with its line number instead of being silently cut.
+    read_kw = {
+        "header": 0,
+        "names": names,
+        "index_col": False,
+        "skip_blank_lines": False,
+    }
+    try:
+        try:
+            # Fast path: numbers throughout. Anything else is diagnosed from the text below.
+            dtypes = {name: (float if name in wanted else str) for name in names}
+            with inputs.open_text(path, "joint log") as fh:
+                frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
+            # every column wanted (the common case): no reindexed copy of the frame
+            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
+            clean = bool(np.isfinite(values).all())
+        except inputs.InputError:
+            raise
+        except (ValueError, TypeError):
+            clean = False
+        if not clean:
+            with inputs.open_text(path, "joint log") as fh:
+                text = pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
+            text = _drop_trailing_blank_rows(text)
+            frame = _numbers_from_text(path, text, wanted)
+    except inputs.InputError as err:
+        raise LogError(str(err)) from None
+    except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+        raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
+    if clean:  # the fast path's values, column by column
+        columns = {name: values[:, k] for k, name in enumerate(wanted)}
+    else:
+        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+    return columns, extra, csv_label
+
+
+def _drop_trailing_blank_rows(text: pd.DataFrame) -> pd.DataFrame:
+    blank = (text.apply(lambda col: col.str.strip()) == "").all(axis=1).to_numpy()
+    n = len(blank)
+    while n and blank[n - 1]:
+        n -= 1
+    return text.iloc[:n]
+
+
+def _numbers_from_text(path: Path, text: pd.DataFrame, wanted: list[str]) -> pd.DataFrame:
+    """Convert text columns to floats; refuse at the first empty / NaN / non-numeric cell."""
+    out = {}
+    first: tuple[int, int, str, str] | None = None  # (row, column order, column, raw text)
+    for order, name in enumerate(wanted):
+        raw = text[name].str.strip()
+        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size and (first is None or bad[0] < first[0]):
+            first = (int(bad[0]), order, name, str(raw.iloc[bad[0]]))
+        out[name] = values
+    if first is not None:
+        row, _, name, raw = first
+        raise LogError(f"{path}: {csv_label(row)}, column {name}: {describe_bad_cell(raw)}")
+    return pd.DataFrame(out)
+
+
+def describe_bad_cell(raw: str) -> str:
+    if raw == "":
+        return "empty cell; expected a number"
+    if raw.lower() in ("nan", "-nan", "+nan", "na", "n/a", "null", "none", "#n/a"):
+        return f"value {raw!r} (NaN); expected a number"
+    try:
+        value = float(raw)
+    except ValueError:
+        return f"value {raw!r} is not a number"
+    return f"value {raw!r} is not finite" if not math.isfinite(value) else f"value {raw!r} not understood"
+
+
+def select_columns(path: Path, names: list[str], n_axes: int, motion_only: bool = False) -> tuple[list[str], list[str]]:
+    """Columns to read (required, plus all qd when present) and the extra ones; refuse missing.
+    ``motion_only``: ``t`` and ``q1..qN`` alone (a replayed log: no torque), the rest extra."""
+    present = set(names)
+    n = n_axes
+    qd_columns = column_names(n)[1]
+    needed = required(n)[: n + 1] if motion_only else required(n)
+    missing = [c for c in needed if c not in present]
+    if missing:
+        shown = names if len(names) <= 40 else [*names[:40], f"... ({len(names)} in all)"]
+        hint = ""
+        if len(names) == 1 and ";" in names[0]:
+            hint = "; the header seems to use ';' as separator, expected ','"
+        elif len(names) == 1 and "\t" in names[0]:
+            hint = "; the header seems to use tabs as separator, expected ','"
+        raise LogError(
+            f"{path}: missing column(s) {', '.join(missing)}; found columns: {', '.join(shown) or '(none)'}"
+            + (f"; required: t, q1..q{n} (rad)" if motion_only else
+               f"; required: t, q1..q{n}, tau1..tau{n} (qd1..qd{n} optional)") + hint
+        )
+    if motion_only:
+        return list(needed), [c for c in names if c not in needed]
+    qd_present = [c for c in qd_columns if c in present]
+    if qd_present and len(qd_present) != n:
+        qd_missing = [c for c in qd_columns if c not in present]
+        raise LogError(
+            f"{path}: velocity columns {', '.join(qd_present)} present but {', '.join(qd_missing)} missing; "
+            f"give all of qd1..qd{n} or none (then they are estimated from q)"
+        )
+    wanted = [*required(n), *qd_present]
+    if all(c in present for c in temperature_columns(n)):  # some of them only: ignored, named as extra
+        wanted += temperature_columns(n)
+    wanted += [c for c in (PAYLOAD_COLUMN, CYCLE_COLUMN) if c in present]
+    extra = [n for n in names if n not in wanted]
+    return wanted, extra
+
+
+def read_hdf5(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
+    with open_hdf5(path) as fh:
+        wanted, extra = hdf5_columns(fh, path, n_axes, motion_only)
+        columns = {}
+        length = None
+        for name in wanted:
+            ds = fh[name]
+            if ds.ndim != 1:
+                raise LogError(
+                    f"{path}: dataset {name} has shape {ds.shape}; expected a 1-D dataset (n,)"
+                )
+            if ds.dtype.kind not in "fiu":
+                raise LogError(f"{path}: dataset {name} has dtype {ds.dtype}; expected numbers")
+            unit = ds.attrs.get("unit", ds.attrs.get("units"))
+            if unit is not None:
+                unit = unit.decode() if isinstance(unit, bytes) else str(unit)
+                if _unit_key(unit) != _unit_key(UNITS[name]):
+                    raise LogError(
+                        f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}"
+                    )
+            if ds.shape[0] > MAX_ROWS:
+                raise LogError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
+                                        f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
+            if length is None:
+                length = ds.shape[0]
+            elif ds.shape[0] != length:
+                raise LogError(
+                    f"{path}: dataset {name} has {ds.shape[0]} rows but {wanted[0]} has {length}; "
+                    "all columns must have the same length"
+                )
+            columns[name] = np.asarray(ds[()], dtype=float)
+    refuse_non_finite(path, columns, wanted, index_label)
+    return columns, extra, index_label
+
+
+def hdf5_columns(fh: h5py.File, path: Path, n_axes: int, motion_only: bool = False) -> tuple[list[str], list[str]]:
+    """The root datasets to read (required, plus all qd when present) and the extra ones (groups
+    among them, marked); refuse missing columns, naming the groups at the root that hold none."""
+    names = list(fh.keys())
+    datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
+    groups = [n for n in names if isinstance(fh[n], h5py.Group)]
+    try:
+        wanted, extra = select_columns(path, datasets, n_axes, motion_only)
+    except LogError as err:
+        if groups:
+            raise LogError(
+                f"{err}; groups at the root: {', '.join(groups)} (columns must be 1-D datasets at the file root)"
+            ) from None
+        raise
+    return wanted, extra + [f"{g}/ (group)" for g in groups]
+
+
+@contextmanager
+def open_hdf5(path: Path):
+    """The HDF5 log, opened read-only after faultgen.inputs refused links and virtual datasets that
+    reach other files (LogError naming the link)."""
+    try:
+        fh = h5py.File(path, "r")
+    except OSError as err:
+        raise LogError(f"{path}: cannot read the file as HDF5: {err}") from err
+    with fh:
+        try:
+            inputs.check_hdf5_links(fh, path)
+        except inputs.InputError as err:
+            raise LogError(str(err)) from None
+        yield fh
+
+
+def _unit_key(unit: str) -> str:
+    return "".join(ch for ch in unit.lower() if ch not in " *.·")
+
+
+
+def refuse_non_finite(where: Path, columns: dict[str, np.ndarray], order: list[str], label) -> None:
+    first = None
+    for name in order:
+        bad = np.flatnonzero(~np.isfinite(columns[name]))
+        if bad.size and (first is None or bad[0] < first[0]):
+            first = (int(bad[0]), name)
+    if first is not None:
+        row, name = first
+        value = columns[name][row]
+        what = "NaN" if np.isnan(value) else f"{value} (not finite)"
+        raise LogError(
+            f"{where}: {label(row)}, column {name}: value {what}; expected a finite number"
+        )
+
+
+
+# --------------------------------------------------------------------------------------------
+# Checks and derivatives
+
+
+def check_time(t: np.ndarray, where: Path, label, notes: list[str], min_duration: float = MIN_DURATION,
+               min_rate: float = MIN_RATE) -> tuple[np.ndarray, float]:
+    """Refuse sample times that do not increase, a median period above 1 / ``min_rate`` (default
+    :data:`MIN_RATE`), a gap above :data:`MAX_GAP` or a span below ``min_duration`` (default
+    :data:`MIN_DURATION`); note long gaps in ``notes``. Returns the intervals and the median period, s."""
+    n = t.shape[0]
+    if n < 2:
+        raise LogError(
+            f"{where}: {n} data row(s); expected at least {min_duration:g} s of data at >= {min_rate:g} Hz"
+        )
+    dt = np.diff(t)
+    back = np.flatnonzero(dt <= 0)
+    if back.size:
+        i = int(back[0]) + 1
+        how = "repeats" if dt[i - 1] == 0 else "goes back"
+        raise LogError(
+            f"{where}: column t {how} at {label(i)}: t = {float(t[i])!r} s after t = {float(t[i - 1])!r} s at "
+            f"{label(i - 1)}; expected strictly increasing times"
+        )
+    period = float(np.median(dt))
+    if period > (1.0 / min_rate) * (1 + 1e-9):
+        raise LogError(
+            f"{where}: column t has a median sample period of {period:.6g} s ({1 / period:.4g} Hz); "
+            f"expected at most {1 / min_rate:g} s (a sample rate of at least {min_rate:g} Hz)"
+        )
+    gap = int(np.argmax(dt))
+    if dt[gap] > MAX_GAP * (1 + 1e-9):
+        raise LogError(
+            f"{where}: column t jumps by {dt[gap]:.6g} s from {label(gap)} to {label(gap + 1)}; "
+            f"expected no interval longer than {MAX_GAP:g} s (the derivative filter window)"
+        )
+    duration = float(t[-1] - t[0])
+    if duration < min_duration:
+        raise LogError(
+            f"{where}: the data covers {duration:.6g} s ({n} data rows); expected at least {min_duration:g} s"
+        )
+    long_gaps = np.flatnonzero(dt > 2 * period)
+    if long_gaps.size:
+        notes.append(
+            f"{long_gaps.size} sampling interval(s) longer than twice the median period {period:.6g} s, "
+            f"the longest {dt[gap]:.6g} s before {label(gap + 1)}"
+        )
+    return dt, period
+
+
+def check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label,
+                 tolerance: float = JOINT_RANGE_TOLERANCE) -> None:
+    """Refuse angle columns in degrees or outside the joint range plus ``tolerance`` (rad)."""
+    tol = tolerance
+    for k, name in enumerate(column_names(robot.n_axes)[0]):
+        lo, hi = robot.joint_range[k]
+        col = q[:, k]
+        outside = np.flatnonzero((col < lo - tol) | (col > hi + tol))
+        if not outside.size:
+            continue
+        as_rad = np.deg2rad(col)
+        fits_as_degrees = bool(np.all((as_rad >= lo - tol) & (as_rad <= hi + tol)))
+        peak = int(np.argmax(np.abs(col)))
+        beyond_turn = abs(col[peak]) > 2 * math.pi + FULL_TURN_MARGIN
+        too_wide = np.ptp(col) > (hi - lo) + 2 * tol
+        if fits_as_degrees and (beyond_turn or too_wide):
+            extreme = "max" if col[peak] >= 0 else "min"
+            raise LogError(
+                f"{where}: column {name} looks like degrees ({extreme} {col[peak]:.6g} at {label(peak)}, "
+                f"span {np.ptp(col):.4g}); expected rad within the joint range [{lo:.4g}, {hi:.4g}] rad"
+            )
+        i = int(outside[0])
+        hint = " (if the column is in degrees, convert it to rad)" if fits_as_degrees else ""
+        raise LogError(
+            f"{where}: column {name} at {label(i)} is {col[i]:.6g} rad, outside the joint range "
+            f"[{lo:.4g}, {hi:.4g}] rad of {robot.name} (tolerance {tol:g} rad){hint}"
+        )
+
+
+def read_columns(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
+    """The columns of the log ``path`` (:func:`select_columns`), every cell a finite number, the
+    ignored extra column names and the row labeller (:func:`csv_label` or :func:`index_label`).
+
+    Raises
+    ------
+    LogError
+        For an unknown suffix, a file that is not a regular one or not readable as its type, a
+        missing column, a cell that is not a finite number (file, data row and column named).
+    """
+    path = Path(path)
+    reader = read_csv if kind(path) == "csv" else read_hdf5
+    regular(path)
+    return reader(path, n_axes, motion_only)
+
+
+def derivatives(t: np.ndarray, q: np.ndarray, dt: np.ndarray, period: float, orders=(1, 2)):
+    """The Savitzky-Golay window (samples), whether the sampling is uniform, and the derivatives of
+    ``q`` (n, N) of each order in ``orders`` at the times ``t`` (:mod:`faultgen.derivatives`), from
+    the intervals ``dt`` and median period ``period`` of :func:`check_time`."""
+    window = savgol_window(period, len(t))
+    uniform = is_uniform(dt, period)
+    return window, uniform, _savgol(t, q, period, window, uniform, orders=orders)
+
+
+def motion(columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, label, notes: list[str], *,
+           min_duration: float = MIN_DURATION, min_rate: float = MIN_RATE,
+           tolerance: float = JOINT_RANGE_TOLERANCE, orders=(1, 2)) -> dict:
+    """The checked motion of a log's ``columns`` (:func:`read_columns`): its times (:func:`check_time`),
+    angles (:func:`check_angles`) and their derivatives (:func:`derivatives`).
+
+    Returns
+    -------
+    dict
+        ``t`` (n,) s, ``q`` (n, N) rad, ``dt`` (n - 1,) s, ``period`` s, ``window`` samples,
+        ``uniform`` bool and ``derivatives``, a tuple of (n, N) arrays, one per order.
+
+    Raises
+    ------
+    LogError
+        As :func:`check_time` and :func:`check_angles`, naming the file, the column and the row.
+    """
+    t = columns[T_COLUMN]
+    dt, period = check_time(t, where, label, notes, min_duration, min_rate)
+    q = np.column_stack([columns[c] for c in column_names(robot.n_axes)[0]])
+    check_angles(where, q, robot, label, tolerance)
+    window, uniform, found = derivatives(t, q, dt, period, orders)
+    return {"t": t, "q": q, "dt": dt, "period": period, "window": window, "uniform": uniform, "derivatives": found}
