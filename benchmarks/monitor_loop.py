@@ -23,8 +23,9 @@ Printed per protocol: worn units flagged with their wear at the first alarm in [
 (the issue's window), before 10 %, at 40 % or later, or never; detection delay (days from the
 wear reaching 10 % to the first alarm: median and range); isolation (worn axis named by the
 alarm); healthy units that ever alarm; false alarms per healthy unit-day (logs over a limit
-after the learning logs, of all such logs: the per-log rate the limits' alpha sets, 2 alpha for
-"T2 or Q" if the residuals were independent normal).
+after the learning logs, of all such logs: what the log alarmed on, T2 or Q without a model, the
+wear estimate's lower bound with the twin; at most 2 alpha for "T2 or Q", and N alpha for "any of
+the N axes' bounds over the limit", if the residuals were independent normal).
 """
 
 from __future__ import annotations
@@ -120,7 +121,8 @@ def main() -> None:
               f"at >= 40 %: {s['late']}, never: {s['missed']}); delay from 10 % wear: {delay}")
         print(f"  worn axis named by the alarm: {s['isolated']} of {s['alarmed']} alarmed worn units")
         print(f"  healthy units that ever alarm: {s['healthy_alarm']} of {s['healthy']}; logs over a limit on "
-              f"healthy units: {alarms} of {logs_} unit-days ({alarms / max(logs_, 1):.3f}; 2 alpha = 0.02 if "
+              f"healthy units: {alarms} of {logs_} unit-days ({alarms / max(logs_, 1):.3f}; at most "
+              f"{'2 alpha = 0.02 (T2 or Q)' if name == 'own' else 'N alpha = 0.06 (any axis wear bound)'} if "
               "independent normal)")
         for unit, o in s["units"].items():
             print(f"    {unit}: worn axis {o['axis'] or '-'}, alarm {o['alarm'] or '-'} (day {o['day'] or '-'}, "
