@@ -169,7 +169,8 @@ def made(tmp_path_factory, worker_id):
 
 def test_every_help_page_has_examples_and_they_are_all_read():
     assert len(PAGES) >= 18 and sum(map(len, PAGES.values())) >= 45
-    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export"} <= set(PAGES)
+    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export",
+            "reproduce"} <= set(PAGES)
 
 
 @pytest.mark.parametrize("page", sorted(PAGES))
