@@ -51,7 +51,7 @@ def steps(scale: str = "full") -> list[Step]:
     pairs20 = ("--pairs", "2") if tiny else ()
     chance = ("--no-chance",) if tiny else ()  # tiny: the plumbing, not the verdicts
     c2_period = ("--period", "60")
-    jobs = ("--jobs", "1")  # one process per step: the runner runs steps side by side
+    jobs = ("--jobs", "1", "--no-progress")  # one process per step: the runner runs steps side by side
     data = [
         Step("sweep j2", ("sweep", *sweep, *jobs, "-o", "j2.h5"), ("j2.h5",), cost=6, makes_data=True),
         Step("sweep j2 seeds 1-2", ("sweep", *sweep, "--seed", "1", *(() if tiny else ("--seed", "2")), *jobs,
@@ -67,26 +67,26 @@ def steps(scale: str = "full") -> list[Step]:
     ]
     j2 = ("sweep j2",)
     analyses = [
-        Step("isolation j2", ("bench-isolators", "j2.h5", *levels, "-o", "j2-isolation"), _stem("j2-isolation"),
+        Step("isolation j2", ("bench-isolators", "j2.h5", *levels, "--no-progress", "-o", "j2-isolation"), _stem("j2-isolation"),
              j2, cost=0.3),
-        Step("isolation j2 window", ("bench-isolators", "j2.h5", "--speed-window", "50,120", "-o", "j2-window"),
+        Step("isolation j2 window", ("bench-isolators", "j2.h5", "--speed-window", "50,120", "--no-progress", "-o", "j2-window"),
              _stem("j2-window"), j2, cost=0.3),
         Step("isolation j2 bins", ("bench-isolators", "j2.h5", *(a for b in range(5, 21) for a in ("--bins", str(b))),
-                                   "-o", "j2-bins"), _stem("j2-bins"), j2, cost=0.5),
+                                   "--no-progress", "-o", "j2-bins"), _stem("j2-bins"), j2, cost=0.5),
         Step("table 6.1 j2", outputs=("j2-table-6-1.csv",), needs=j2, cost=0.2, call=_table_6_1),
-        Step("detect j2 same-run", ("detect", "j2.h5", "--protocol", "same-run", "-o", "j2-detection"),
+        Step("detect j2 same-run", ("detect", "j2.h5", "--protocol", "same-run", "--no-progress", "-o", "j2-detection"),
              _detect("j2-detection"), j2, cost=0.3),
-        *[Step(f"detect j2s3 {name}", ("detect", "j2s3.h5", *extra, "-o", f"j2s3-{name}"), _detect(f"j2s3-{name}"),
+        *[Step(f"detect j2s3 {name}", ("detect", "j2s3.h5", *extra, "--no-progress", "-o", f"j2s3-{name}"), _detect(f"j2s3-{name}"),
                ("combine j2s3",), cost=0.6)
           for name, extra in (("other-seeds", ()), ("other-seeds-ins", ("--limit-folds", "0")),
                               ("first", ("--protocol", "first-cycles")),
                               ("first-ins", ("--protocol", "first-cycles", "--limit-folds", "0")),
                               ("same-run", ("--protocol", "same-run")))],
-        Step("detect c2 same-run", ("detect", "c2.h5", *c2_period, "--protocol", "same-run", "-o", "c2-detection"),
+        Step("detect c2 same-run", ("detect", "c2.h5", *c2_period, "--protocol", "same-run", "--no-progress", "-o", "c2-detection"),
              _detect("c2-detection"), ("sweep c2",), cost=0.3),
-        Step("training-source fleet", ("training-source", "fleet.h5", *window, "-o", "fleet-ch4"), _ch4("fleet-ch4"),
+        Step("training-source fleet", ("training-source", "fleet.h5", *window, "--no-progress", "-o", "fleet-ch4"), _ch4("fleet-ch4"),
              ("fleet",), cost=0.3),
-        Step("training-source fleet-nc", ("training-source", "fleet-nc.h5", *window, "-o", "fleet-nc-ch4"),
+        Step("training-source fleet-nc", ("training-source", "fleet-nc.h5", *window, "--no-progress", "-o", "fleet-nc-ch4"),
              _ch4("fleet-nc-ch4"), ("fleet no conditions",), cost=0.3),
         Step("classify j2", ("classify", "j2.h5", *pairs12, *jobs, *chance, "-o", "j2-classification"),
              _classify("j2-classification"), j2, cost=4),

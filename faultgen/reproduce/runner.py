@@ -112,6 +112,14 @@ def execute(steps: Sequence[Step], folder: Path, jobs: int = 2,
             blocked = [s for s in pending if any(n in done and done[n].status == "failed" for n in s.needs)]
             for step in blocked:
                 pending.remove(step)
+            for step in [s for s in ready if _kept(s, folder)]:  # outputs there: no slot, reported at once
+                pending.remove(step)
+                ready.remove(step)
+                done[step.name] = Outcome(step, "kept", 0.0)
+                if report is not None:
+                    report(done[step.name], len(done), len(steps))
+            if any(_kept(s, folder) for s in pending if all(n in done for n in s.needs)):
+                continue  # a kept step made others ready
             for step in sorted(ready, key=lambda s: -s.cost)[: max(0, jobs - len(running))]:
                 pending.remove(step)
                 running[pool.submit(_run_step, step, folder)] = step
@@ -134,9 +142,12 @@ def execute(steps: Sequence[Step], folder: Path, jobs: int = 2,
     return list(done.values())
 
 
+def _kept(step: Step, folder: Path) -> bool:
+    """Whether every output of ``step`` is there (each is written atomically: there means whole)."""
+    return bool(step.outputs) and all((folder / o).exists() for o in step.outputs)
+
+
 def _run_step(step: Step, folder: Path) -> Outcome:
-    if step.outputs and all((folder / o).exists() for o in step.outputs):
-        return Outcome(step, "kept", 0.0)
     started = time.perf_counter()
     log = folder / "logs" / step.log_name
     if step.call is not None:
@@ -150,7 +161,7 @@ def _run_step(step: Step, folder: Path) -> Outcome:
     with log.open("w") as sink:
         sink.write(step.command() + "\n")
         sink.flush()
-        code = subprocess.call([sys.executable, "-m", "faultgen.cli", *step.args, "--no-progress"], cwd=folder,
+        code = subprocess.call([sys.executable, "-m", "faultgen.cli", *step.args], cwd=folder,
                                stdout=sink, stderr=subprocess.STDOUT)
     missing = [o for o in step.outputs if not (folder / o).exists()]
     status = "failed" if code != 0 or missing else "ran"
