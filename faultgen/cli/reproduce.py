@@ -45,6 +45,12 @@ def reproduce_command(
     parent = out.absolute().parent
     if not parent.is_dir():
         raise ValueError(f"cannot make {out}: folder {parent} does not exist")
+    import signal
+
+    def stop(signum, frame):  # SIGTERM as a Ctrl-C: the running commands stop and keep what they made
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, stop)
     say = typer.echo if progress else None
     summary = reproduce.run(out, scale="tiny" if tiny else "full", jobs=jobs, progress=say)
     typer.echo(f"wrote {summary} and {out / 'tables'}")

@@ -6,6 +6,7 @@ output goes to ``DIR/logs/NAME.log`` and its time to ``DIR/times.csv``.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import threading
@@ -62,6 +63,8 @@ class Step:
 #: written through a Python file object (faultgen.data.atomic) calls back into Python from inside
 #: HDF5, which another thread's h5py call must not interleave with.
 _IN_PROCESS = threading.Lock()
+#: The commands running now, stopped (Ctrl-C, as a user would) when the reproduction is stopped.
+_CHILDREN: set[subprocess.Popen] = set()
 
 
 class StepFailed(RuntimeError):
@@ -105,41 +108,52 @@ def execute(steps: Sequence[Step], folder: Path, jobs: int = 2,
     done: dict[str, Outcome] = {}
     running: dict[Future, Step] = {}
     failed: list[Outcome] = []
-    lock = threading.Lock()
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-        while pending or running:
-            ready = [s for s in pending if all(n in done and done[n].status != "failed" for n in s.needs)]
-            blocked = [s for s in pending if any(n in done and done[n].status == "failed" for n in s.needs)]
-            for step in blocked:
-                pending.remove(step)
-            for step in [s for s in ready if _kept(s, folder)]:  # outputs there: no slot, reported at once
-                pending.remove(step)
-                ready.remove(step)
-                done[step.name] = Outcome(step, "kept", 0.0)
-                if report is not None:
-                    report(done[step.name], len(done), len(steps))
-            if any(_kept(s, folder) for s in pending if all(n in done for n in s.needs)):
-                continue  # a kept step made others ready
-            for step in sorted(ready, key=lambda s: -s.cost)[: max(0, jobs - len(running))]:
-                pending.remove(step)
-                running[pool.submit(_run_step, step, folder)] = step
-            if not running:
-                break
-            finished, _ = wait(list(running), return_when=FIRST_COMPLETED)
-            for future in finished:
-                step = running.pop(future)
-                outcome = future.result()
-                with lock:
-                    done[step.name] = outcome
-                    if outcome.status == "failed":
-                        failed.append(outcome)
-                    if report is not None:
-                        report(outcome, len(done), len(steps))
+        try:
+            _schedule(pool, steps, folder, jobs, report, pending, done, running, failed)
+        except BaseException:  # Ctrl-C or SIGTERM: each command stops as on a Ctrl-C (a sweep keeps its runs)
+            for child in list(_CHILDREN):
+                child.send_signal(signal.SIGINT)
+            raise
     if failed:
         first = failed[0].step
         raise StepFailed(f"step {first.name!r} failed ({first.command()}); see {folder / 'logs' / first.log_name}; "
                          "run the same reproduce command again to resume (finished steps are kept)")
     return list(done.values())
+
+
+def _schedule(pool, steps, folder, jobs, report, pending, done, running, failed) -> None:
+    """Start ready steps as slots free up, until none is pending or running (:func:`execute`)."""
+    lock = threading.Lock()
+    while pending or running:
+        ready = [s for s in pending if all(n in done and done[n].status != "failed" for n in s.needs)]
+        blocked = [s for s in pending if any(n in done and done[n].status == "failed" for n in s.needs)]
+        for step in blocked:
+            pending.remove(step)
+        for step in [s for s in ready if _kept(s, folder)]:  # outputs there: no slot, reported at once
+            pending.remove(step)
+            ready.remove(step)
+            done[step.name] = Outcome(step, "kept", 0.0)
+            if report is not None:
+                report(done[step.name], len(done), len(steps))
+        if any(_kept(s, folder) for s in pending if all(n in done for n in s.needs)):
+            continue  # a kept step made others ready
+        # analyses first (short, and their tables appear early), then the costliest dataset
+        for step in sorted(ready, key=lambda s: (s.makes_data, -s.cost))[: max(0, jobs - len(running))]:
+            pending.remove(step)
+            running[pool.submit(_run_step, step, folder)] = step
+        if not running:
+            break
+        finished, _ = wait(list(running), return_when=FIRST_COMPLETED)
+        for future in finished:
+            step = running.pop(future)
+            outcome = future.result()
+            with lock:
+                done[step.name] = outcome
+                if outcome.status == "failed":
+                    failed.append(outcome)
+                if report is not None:
+                    report(outcome, len(done), len(steps))
 
 
 def _kept(step: Step, folder: Path) -> bool:
@@ -161,8 +175,13 @@ def _run_step(step: Step, folder: Path) -> Outcome:
     with log.open("w") as sink:
         sink.write(step.command() + "\n")
         sink.flush()
-        code = subprocess.call([sys.executable, "-m", "faultgen.cli", *step.args], cwd=folder,
-                               stdout=sink, stderr=subprocess.STDOUT)
+        child = subprocess.Popen([sys.executable, "-m", "faultgen.cli", *step.args], cwd=folder, stdout=sink,
+                                 stderr=subprocess.STDOUT)
+        _CHILDREN.add(child)
+        try:
+            code = child.wait()
+        finally:
+            _CHILDREN.discard(child)
     missing = [o for o in step.outputs if not (folder / o).exists()]
     status = "failed" if code != 0 or missing else "ran"
     return Outcome(step, status, time.perf_counter() - started)
