@@ -124,7 +124,6 @@ def execute(steps: Sequence[Step], folder: Path, jobs: int = 2,
 
 def _schedule(pool, steps, folder, jobs, report, pending, done, running, failed) -> None:
     """Start ready steps as slots free up, until none is pending or running (:func:`execute`)."""
-    lock = threading.Lock()
     while pending or running:
         ready = [s for s in pending if all(n in done and done[n].status != "failed" for n in s.needs)]
         blocked = [s for s in pending if any(n in done and done[n].status == "failed" for n in s.needs)]
@@ -148,12 +147,11 @@ def _schedule(pool, steps, folder, jobs, report, pending, done, running, failed)
         for future in finished:
             step = running.pop(future)
             outcome = future.result()
-            with lock:
-                done[step.name] = outcome
-                if outcome.status == "failed":
-                    failed.append(outcome)
-                if report is not None:
-                    report(outcome, len(done), len(steps))
+            done[step.name] = outcome
+            if outcome.status == "failed":
+                failed.append(outcome)
+            if report is not None:
+                report(outcome, len(done), len(steps))
 
 
 def _kept(step: Step, folder: Path) -> bool:

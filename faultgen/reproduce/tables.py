@@ -50,7 +50,7 @@ def _accuracy(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 def _range(values) -> str:
-    values = [v for v in values if v == v]
+    values = [v for v in values if pd.notna(v)]
     return f"{min(values):.3g}-{max(values):.3g}" if values else "-"
 
 
@@ -134,7 +134,7 @@ def speed_window(folder: Path) -> Part:
 
 
 def _slash(*values) -> str:
-    return " / ".join("-" if v is None or v != v else f"{v:.3g}" for v in values)
+    return " / ".join("-" if v is None or pd.isna(v) else f"{v:.3g}" for v in values)
 
 
 def bins(folder: Path) -> Part:
