@@ -33,10 +33,9 @@ def reproduce_command(
     full run takes about 30 min on 2 cores (docs/reproduction.md gives the measured time and what
     its reductions change: c2 records one cycle an hour, classify computes its seven default rows).
 
-    The full run is `faultgen reproduce -o repro`. A check of the command in about a minute:
-
-    \b
-      faultgen reproduce --tiny -o repro-tiny
+    Examples, in prose as each takes minutes: the full run is `faultgen reproduce -o repro`; a check
+    of the command and its outputs on grids of seconds is `faultgen reproduce --tiny -o repro-tiny`
+    (a few minutes on 2 cores: two dozen commands, each its own process).
     """
     from faultgen import reproduce
 

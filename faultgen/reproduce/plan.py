@@ -32,7 +32,7 @@ _TINY_SWEEP = ("--robot", "puma560", "--task", "pick_place", "--task", "spot_wel
                "--axis", "2", "--wear-pct", "20", "--schedule", "exp4", "--cycles", "12")
 _TINY_C2 = ('robots = ["puma560"]\ntasks = ["pick_place"]\naxes = [0, 1]\nincreases = [20.0]\n'
             'schedules = ["logistic"]\ncycles = 480\nrecord = {period = 60, first = 1}\nsignals = false\n')
-_TINY_FLEET = ("--robots", "8", "--failing", "4", "--days", "16", "--robot", "puma560")
+_TINY_FLEET = ("--robots", "8", "--failing", "4", "--days", "16", "--cycles-per-day", "1", "--robot", "puma560")
 _TINY_WINDOW = ("--training-days", "8", "--test-days", "5", "--gap-days", "2")
 
 
