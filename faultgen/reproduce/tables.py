@@ -246,7 +246,9 @@ def detection_c2(folder: Path) -> Part:
     worn = frame[frame["worn_axis"] > 0].copy()
     cells = {}
     for _, row in worn.iterrows():
-        level = int(round(row["final_wear_pct"]))
+        final = float(row["final_wear_pct"])  # the logistic reaches its level at the last hour, within rounding
+        level = min(thesis.TABLE_3_5, key=lambda lv: abs(lv - final))
+        level = level if abs(level - final) < 1 else round(final)
         mark = (f"✓ ({int(row['onset'])} h, {row['onset_wear_pct']:.1f} %)" if row["detected"] else "×")
         located = "" if not row["detected"] else (" located" if row["located"] else " not located")
         hours = thesis.TABLE_3_5.get(level, {}).get(int(row["worn_axis"]), (None,) * 3)
