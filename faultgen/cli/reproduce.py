@@ -29,9 +29,10 @@ def reproduce_command(
     thesis's numbers with a verdict (agrees, agrees in part, differs) and why they differ.
 
     Writes DIR/summary.md (every table with its verdict and time, and the tables of the page left
-    out, with why), DIR/tables/*.md, the analyses' own outputs, DIR/times.csv and DIR/logs/. The
-    full run takes about 30 min on 2 cores (docs/reproduction.md gives the measured time and what
-    its reductions change: c2 records one cycle an hour, classify computes its seven default rows).
+    out, with why), DIR/tables/*.md, the analyses' own outputs, DIR/times.csv and DIR/logs/. It
+    does less than the page's own commands, for time: c2 records one cycle an hour, classify
+    computes its seven default rows and the fleet's thesis protocol 40 pairs (docs/reproduction.md
+    says what each changes and what was measured).
 
     Examples, in prose as each takes minutes: the full run is `faultgen reproduce -o repro`; a check
     of the command and its outputs on grids of seconds is `faultgen reproduce --tiny -o repro-tiny`
