@@ -39,7 +39,11 @@ def run(out: str | Path, scale: str = "full", jobs: int = 2,
     folder.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
 
+    ended: list[Outcome] = []
+
     def said(outcome: Outcome, done: int, total: int) -> None:
+        ended.append(outcome)
+        report.write_times(folder, ended)
         if progress is not None:
             how = "kept (outputs there)" if outcome.status == "kept" else f"{outcome.status} in {_clock(outcome.seconds)}"
             progress(f"[{done}/{total}] {outcome.step.name}: {how}, {_clock(time.perf_counter() - started)} so far")
