@@ -143,3 +143,11 @@ def test_the_command_refuses_a_file_or_a_missing_folder_in_one_line(tmp_path):
         result = cli.invoke(app, ["reproduce", "--tiny", "-o", str(out)])
         assert result.exit_code == 2 and result.output.startswith("error: ") and message in result.output
         assert len(result.output.strip().splitlines()) == 1
+
+
+def test_the_plan_is_printed_without_running_anything(tmp_path):
+    result = cli.invoke(app, ["reproduce", "--plan", "-o", str(tmp_path / "repro")])
+    assert result.exit_code == 0, result.output
+    assert "sweep j2: faultgen sweep --preset j2" in result.output and "c2:" in result.output
+    assert "detect j2s3 other-seeds: faultgen detect j2s3.h5" in result.output and "[after: combine j2s3]" in result.output
+    assert not (tmp_path / "repro").exists()

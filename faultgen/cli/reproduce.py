@@ -21,6 +21,8 @@ def reproduce_command(
                                       min=1, max=64)] = 2,
     tiny: Annotated[bool, typer.Option("--tiny", help="Every step on grids of seconds: checks the command and "
                                        "its outputs; the numbers mean nothing.")] = False,
+    show_plan: Annotated[bool, typer.Option("--plan", help="Print the steps (each a faultgen command, with the "
+                                            "steps it needs) and stop: nothing is run or written.")] = False,
     progress: Progress = True,
 ) -> None:
     """Regenerate every table of docs/reproduction.md (thesis Tables 3.5, 4.1-4.4, 5.2, 6.1, 6.2 and
@@ -34,11 +36,19 @@ def reproduce_command(
     computes its seven default rows and the fleet's thesis protocol 40 pairs (docs/reproduction.md
     says what each changes and what was measured).
 
-    Examples, in prose as each takes minutes: the full run is `faultgen reproduce -o repro`; a check
-    of the command and its outputs on grids of seconds is `faultgen reproduce --tiny -o repro-tiny`
-    (a few minutes on 2 cores: two dozen commands, each its own process).
+    The runs take minutes, so they are given in prose: the full run is `faultgen reproduce -o repro`;
+    a check of the command and its outputs on grids of seconds is `faultgen reproduce --tiny -o
+    repro-tiny` (a few minutes on 2 cores: two dozen commands, each its own process). What the full
+    run will do, each step's command, without running it:
+
+    \b
+      faultgen reproduce --plan -o repro
     """
     from faultgen import reproduce
+
+    if show_plan:
+        typer.echo(reproduce.describe("tiny" if tiny else "full"))
+        return
 
     if out.exists() and not out.is_dir():
         raise ValueError(f"{out} is a file; --out expects a folder for the reproduction")

@@ -19,7 +19,21 @@ from pathlib import Path
 from faultgen.reproduce import plan, report, runner, tables
 from faultgen.reproduce.runner import Outcome, Step, StepFailed
 
-__all__ = ["Outcome", "Step", "StepFailed", "plan", "run"]
+__all__ = ["Outcome", "Step", "StepFailed", "describe", "plan", "run"]
+
+
+def describe(scale: str = "full") -> str:
+    """The steps of ``scale`` as text, one a line: its name, the command (run in the output
+    folder) and the steps it needs; then the reductions of the full scale. Raises ValueError for a
+    bad ``scale``."""
+    lines = [f"{len(plan.steps(scale))} steps ({scale} scale), each run in the output folder:"]
+    for step in plan.steps(scale):
+        needs = f"  [after: {', '.join(step.needs)}]" if step.needs else ""
+        lines.append(f"  {step.name}: {step.command()}{needs}")
+    if scale == "full":
+        lines.append("Less work than docs/reproduction.md's own commands:")
+        lines += [f"  {key}: {text}" for key, text in plan.REDUCTIONS.items()]
+    return "\n".join(lines)
 
 
 def run(out: str | Path, scale: str = "full", jobs: int = 2,
