@@ -63,7 +63,7 @@ class Step:
 #: written through a Python file object (faultgen.data.atomic) calls back into Python from inside
 #: HDF5, which another thread's h5py call must not interleave with.
 _IN_PROCESS = threading.Lock()
-#: The commands running now, stopped (Ctrl-C, as a user would) when the reproduction is stopped.
+#: The commands running now, stopped (SIGTERM) when the reproduction is stopped.
 _CHILDREN: set[subprocess.Popen] = set()
 
 
@@ -111,9 +111,11 @@ def execute(steps: Sequence[Step], folder: Path, jobs: int = 2,
     with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         try:
             _schedule(pool, steps, folder, jobs, report, pending, done, running, failed)
-        except BaseException:  # Ctrl-C or SIGTERM: each command stops as on a Ctrl-C (a sweep keeps its runs)
+        except BaseException:  # Ctrl-C or SIGTERM: each command gets a SIGTERM, which a sweep takes as a
+            # Ctrl-C (it keeps its finished runs); not SIGINT, which a process started in the background
+            # by a shell ignores
             for child in list(_CHILDREN):
-                child.send_signal(signal.SIGINT)
+                child.send_signal(signal.SIGTERM)
             raise
     if failed:
         first = failed[0].step
