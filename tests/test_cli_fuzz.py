@@ -38,6 +38,7 @@ BASE = {
     "classify": [f"{MISSING}/d.h5"],
     "monitor": [f"{MISSING}/LOGS", "--robot", "irb6700", "-o", f"{MISSING}/m"],
     "hidden-log": ["puma560", "--effect", "stribeck", "-o", f"{MISSING}/log.csv"],
+    "reproduce": ["--tiny", "-o", f"{MISSING}/repro"],
 }
 #: Examples per option; with the options found, the total the docs give (test_the_fuzz_covers_...).
 EXAMPLES = 50

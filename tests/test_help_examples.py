@@ -169,7 +169,10 @@ def made(tmp_path_factory, worker_id):
 
 def test_every_help_page_has_examples_and_they_are_all_read():
     assert len(PAGES) >= 18 and sum(map(len, PAGES.values())) >= 45
-    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export"} <= set(PAGES)
+    assert {"simulate", "sweep", "fleet", "detect", "classify", "calibrate", "hidden-log", "tasks export",
+            "reproduce"} <= set(PAGES)
+    # reproduce's runs take minutes each: prose, not example lines (its example line only prints the plan)
+    assert PAGES["reproduce"] == ["faultgen reproduce --plan -o repro"]
 
 
 @pytest.mark.parametrize("page", sorted(PAGES))
