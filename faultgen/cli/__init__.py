@@ -3,13 +3,13 @@
 One module per command group, each adding its commands to :data:`app` when imported: ``robots``
 (the robot models), ``programs`` (``tasks list|show|export``), ``runs`` (``simulate``, ``sweep``, ``fleet``), ``calibration``
 (``calibrate``), ``data`` (``info``, ``validate``, ``export``, ``plot``), ``logs`` (``logs import``),
-``monitoring`` (``monitor``) and ``analysis``
-(``bench-isolators``, ``detect``, ``training-source``, ``classify``); ``faultgen --help`` lists
+``monitoring`` (``monitor``), ``analysis``
+(``bench-isolators``, ``detect``, ``training-source``, ``classify``) and ``bench`` (``bench list|make|score``); ``faultgen --help`` lists
 them in that order. ``base`` holds the help layout and the one error handler every command
 shares; ``options`` the options several commands declare.
 """
 
 from faultgen.cli.main import app
-from faultgen.cli import robots, programs, runs, calibration, data, logs, monitoring, analysis
+from faultgen.cli import robots, programs, runs, calibration, data, logs, monitoring, analysis, bench
 
-__all__ = ["analysis", "app", "calibration", "data", "logs", "monitoring", "programs", "robots", "runs"]
+__all__ = ["analysis", "app", "bench", "calibration", "data", "logs", "monitoring", "programs", "robots", "runs"]
