@@ -60,7 +60,8 @@ def test_make_twice_gives_identical_manifests_and_a_changed_friction_fails_namin
     with pytest.raises(ValueError, match=r"track tiny version 1 \(small\).* at train\.h5:/units/train-000/") as err:
         make.make("tiny", tmp_path / "c", size="small", progress=False)
     assert "add version 2" in str(err.value)
-    assert not (tmp_path / "c").exists()  # nothing written
+    assert not (tmp_path / "c").exists() and not list(tmp_path.glob(".c*"))  # nothing written, nothing left
+    assert not list(tmp_path.glob(".a*")) and (tmp_path / "a/manifest.json").is_file()
 
 
 def test_tracks_have_disjoint_train_and_test_seeds_and_the_slot_says_what_it_needs():

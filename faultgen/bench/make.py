@@ -7,13 +7,17 @@ array (its dtype, shape and bytes) and of every unit's attributes, and of ``test
 the track version has a frozen manifest (``faultgen/bench/manifests/<track>-<version>-<size>.json``,
 shipped in the package), the new one must equal it; if not, nothing is written and the error names
 the track and the first differing array. The output folder appears complete or not at all
-(:func:`faultgen.data.atomic.atomic_folder`).
+(:func:`faultgen.data.atomic.atomic_folder`); the sweeps' runs are kept beside it
+(``.<out>.<track>-<version>-<size>.sweeps``) until it is written, so that a make stopped by Ctrl-C
+or a kill resumes from the runs it finished when run again, and are removed after a difference
+from the frozen manifest too.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 from importlib import resources
 from pathlib import Path
 
@@ -145,9 +149,11 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     if freeze and frozen_path.exists():
         raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
                          "a new recipe is a new version")
+    # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
+    # resumes from the runs it finished when run again (the sweep's own resume)
+    sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
+    sweeps.mkdir(exist_ok=True)
     with atomic.atomic_folder(out) as stage:
-        sweeps = stage / ".sweeps"
-        sweeps.mkdir()
         train = _split_units(recipe, "train", size, sweeps, jobs, progress, command)
         test = _split_units(recipe, "test", size, sweeps, jobs, progress, command)
         for k, unit in enumerate(train):
@@ -162,9 +168,6 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         for unit in test:  # the test file holds no label
             unit.fault_level = unit.worn_axis = unit.fault = None
         files.write(stage / "test.h5", test, {**attrs, "split": "test"})
-        for path in sorted(sweeps.iterdir()):
-            path.unlink()
-        sweeps.rmdir()
         arrays = hashes(stage)
         manifest = dict(track=track.name, version=recipe.number, size=size, faultgen_version=faultgen.__version__,
                         licence=track.licence, arrays=arrays)
@@ -173,6 +176,7 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
             differs = first_difference(arrays, frozen)
             if differs:
                 key, n = differs
+                shutil.rmtree(sweeps, ignore_errors=True)  # the same code would give the same runs again
                 raise ValueError(
                     f"track {track.name} version {recipe.number} ({size}): the data differs from the frozen manifest "
                     f"at {key} ({n} of {len(frozen)} arrays differ): this faultgen changes the track's data; add "
@@ -185,4 +189,5 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         else:
             manifest["status"] = "unfrozen"
         atomic.write_text(stage / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+    shutil.rmtree(sweeps, ignore_errors=True)
     return manifest
