@@ -8,11 +8,11 @@ import re
 import shutil
 from pathlib import Path
 
+import bench_plugins
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-import bench_plugins
 from analysis import plugins
 from faultgen.bench import baselines, files, make, score, tracks
 from faultgen.cli import app

@@ -15,7 +15,7 @@ random order (``test-000``, ...), so that neither the id nor the order tells the
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +62,6 @@ class Unit:
     fault_level: np.ndarray | None = None
     worn_axis: int | None = None
     fault: str | None = None
-    extra: dict = field(default_factory=dict)
 
     @property
     def n_axes(self) -> int:

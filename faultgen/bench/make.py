@@ -68,10 +68,11 @@ def first_difference(new: dict[str, str], frozen: dict[str, str]) -> tuple[str, 
     return (differing[0], len(differing)) if differing else None
 
 
-def _unit(run, uid: str, labelled: bool) -> files.Unit:
+def _unit(run) -> files.Unit:
+    """A run of a sweep as a labelled benchmark unit (its id is given later)."""
     arrays = {name: run.array(name) for name in files.OBSERVABLES if run.has(name)}
     fault = "none" if not run.failing else "friction_wear" if run.fault is None else str(run.fault["effect"])
-    unit = files.Unit(id=uid, robot=run.robot, task=run.task, sample=run.sample, arrays=arrays)
+    unit = files.Unit(id="", robot=run.robot, task=run.task, sample=run.sample, arrays=arrays)
     unit.fault_level = np.asarray(run.fault_level, dtype=float)
     unit.worn_axis = int(run.worn_axes[0]) if run.worn_axes else 0
     unit.fault = fault
@@ -80,6 +81,8 @@ def _unit(run, uid: str, labelled: bool) -> files.Unit:
 
 def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, jobs: int, progress: bool,
                  command: str) -> list[files.Unit]:
+    """Sweep every part of ``version`` for ``split`` into ``sweeps`` (resuming finished runs) and read
+    the runs as labelled units, in the parts' order and each sweep's run order."""
     runs = []
     for part, fields in version.grids(split, size):
         fields = dict(fields)
@@ -90,7 +93,7 @@ def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, j
     units = []
     for path in runs:
         with faultgen.open(path) as data:
-            units += [_unit(run, "", split == "train") for run in data]
+            units += [_unit(run) for run in data]
     return units
 
 
@@ -161,16 +164,16 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         test = [test[i] for i in _order(track.name, recipe.number, len(test))]
         for k, unit in enumerate(test):
             unit.id = f"test-{k:03d}"
-        attrs = dict(track=track.name, version=recipe.number, size=size, licence=track.licence,
-                     faultgen_version=faultgen.__version__, command=command)
+        attrs = {"track": track.name, "version": recipe.number, "size": size, "licence": track.licence,
+                     "faultgen_version": faultgen.__version__, "command": command}
         files.write(stage / "train.h5", train, {**attrs, "split": "train"})
         files.write_labels(stage / "test_labels.csv", test)
         for unit in test:  # the test file holds no label
             unit.fault_level = unit.worn_axis = unit.fault = None
         files.write(stage / "test.h5", test, {**attrs, "split": "test"})
         arrays = hashes(stage)
-        manifest = dict(track=track.name, version=recipe.number, size=size, faultgen_version=faultgen.__version__,
-                        licence=track.licence, arrays=arrays)
+        manifest = {"track": track.name, "version": recipe.number, "size": size, "faultgen_version": faultgen.__version__,
+                        "licence": track.licence, "arrays": arrays}
         if frozen_path.exists():
             frozen = json.loads(frozen_path.read_text())["arrays"]
             differs = first_difference(arrays, frozen)

@@ -85,7 +85,7 @@ def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
         if hasattr(estimator, method):
             try:
                 values = np.asarray(getattr(estimator, method)(X), dtype=float)
-            except Exception as err:
+            except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
                 raise ValueError(f"{name}: {method}(X) of X {X.shape} failed: {type(err).__name__}: {err}") from None
             if method == "predict_proba":
                 values = values[:, -1]
@@ -103,7 +103,7 @@ def _fit(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray):
     if is_classifier(template):
         try:
             inner = clone(template).fit(X, y)
-        except Exception as err:
+        except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
             raise ValueError(f"fit(X, y) of X {X.shape} failed: {type(err).__name__}: {err}") from None
         return inner, inner
     fitted = clone(method).fit(X[healthy])  # a plug-in: behind its contract guard (analysis.plugins)
@@ -125,8 +125,8 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
             scores = _scores(inner, X_unit, name)
             alarms = np.asarray(fitted.predict(X_unit)).astype(bool)
             level = unit.fault_level
-            judged.append(dict(unit=unit, scores=scores, alarms=alarms, positive=level >= WORN_PCT,
-                               mask=(level >= WORN_PCT) | (level <= 0)))
+            judged.append({"unit": unit, "scores": scores, "alarms": alarms, "positive": level >= WORN_PCT,
+                               "mask": (level >= WORN_PCT) | (level <= 0)})
     from analysis.monitoring import detect_onset
 
     delays = []
@@ -138,10 +138,10 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
         onset = detect_onset(row["alarms"], PERSISTENCE)
         starts = np.flatnonzero(unit.fault_level > 0)
         worn = np.flatnonzero(unit.fault_level >= WORN_PCT)
-        delays.append(dict(
-            unit=unit.id, detected=onset is not None,
-            after_start=np.nan if onset is None or not starts.size else float(cycles[onset] - cycles[starts[0]]),
-            after_10pct=np.nan if onset is None or not worn.size else float(cycles[onset] - cycles[worn[0]])))
+        delays.append({
+            "unit": unit.id, "detected": onset is not None,
+            "after_start": np.nan if onset is None or not starts.size else float(cycles[onset] - cycles[starts[0]]),
+            "after_10pct": np.nan if onset is None or not worn.size else float(cycles[onset] - cycles[worn[0]])})
     healthy = [r for r in judged if r["unit"].fault == "none"]
 
     def median(key):
@@ -167,7 +167,7 @@ def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
             axis = int(clone(method).fit(unit.arrays["mean_abs_torque"]).source_axis_)
         except ValueError:  # the isolator contract's "too few cycles": undecided
             axis = 0
-        answers.append(dict(unit=unit.id, worn_axis=unit.worn_axis, named=axis, n_axes=unit.n_axes))
+        answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes})
     failing = [a for a in answers if a["worn_axis"]]
     healthy = [a for a in answers if not a["worn_axis"]]
     n_axes = max((a["n_axes"] for a in answers), default=6)
