@@ -39,3 +39,12 @@ class Spy(ClassifierMixin, BaseEstimator):
     def predict(self, X):
         CALLS.append(("predict", np.array(X)))
         return np.zeros(len(X), dtype=bool)
+
+
+class AlwaysBacklash(BaseEstimator):
+    """An isolator naming axis 1 and backlash whatever it sees (scored against the chance level)."""
+
+    def fit(self, X, y=None):
+        self.source_axis_ = 1
+        self.fault_ = "backlash"
+        return self

@@ -152,3 +152,17 @@ def test_the_commands(thesis_small, tmp_path):
                           (["make", "thesis", "--version", "9", "-o", str(tmp_path / "x")], "no version 9")):
         result = runner.invoke(app, ["bench", *argv])
         assert result.exit_code == 2 and result.output.startswith("error: ") and message in result.output, result.output
+
+
+def test_the_fault_type_is_scored_where_a_track_has_several(tmp_path):
+    """A folder of three failing units (friction wear, backlash, cogging on axis 1) and an isolator
+    that always names axis 1 and backlash: axis top-1 1.0, fault type 1/3 at chance 1/3."""
+    cycles = np.arange(1, 6)
+    units = [files.Unit(id=f"test-{k:03d}", robot="irb6700", task="pick_place", sample="cycle",
+                        arrays={"cycles": cycles, "mean_abs_torque": np.ones((5, 6)) + k},
+                        fault_level=np.linspace(0, 100, 5), worn_axis=1, fault=fault)
+             for k, fault in enumerate(("friction_wear", "backlash", "cogging"))]
+    results = score.isolator_results(plugins.load("bench_plugins:AlwaysBacklash", "isolator"), "x", units)
+    assert results["top1_accuracy"]["value"] == 1.0
+    assert results["fault_type_accuracy"]["value"] == pytest.approx(1 / 3)
+    assert results["fault_type_accuracy"]["chance"] == pytest.approx(1 / 3)

@@ -23,7 +23,9 @@ larger: more likely faulty) and its alarms (``predict``).
 **Isolator** (``--isolator``, the contract of ``bench-isolators``): ``fit(X)`` on each failing test
 unit's per-cycle mean absolute motor torque (n_records, N) names a source axis (0: undecided). Its
 **top-1 accuracy** is the share naming the worn axis; chance 1/N. On the healthy units, the share
-left undecided is reported beside it.
+left undecided is reported beside it. An isolator that also sets ``fault_`` (a fault name of the
+labels: "friction_wear", "backlash", "cogging") is scored on it too on a track with several fault
+types (the faults track): ``fault_type_accuracy``, chance 1 / the number of fault types.
 
 Every figure has a 95 % percentile bootstrap interval over test units (:data:`RESAMPLES`
 resamples of the units with replacement, seed 0).
@@ -160,23 +162,30 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
 
 
 def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
-    """Each test unit's source axis from ``method`` fitted on its mean absolute motor torque."""
+    """Each test unit's source axis (and fault, if the isolator names one) from ``method`` fitted on
+    its mean absolute motor torque."""
     answers = []
     for unit in test:
         try:
-            axis = int(clone(method).fit(unit.arrays["mean_abs_torque"]).source_axis_)
+            fitted = clone(method).fit(unit.arrays["mean_abs_torque"])
+            axis, fault = int(fitted.source_axis_), getattr(getattr(fitted, "estimator_", fitted), "fault_", None)
         except ValueError:  # the isolator contract's "too few cycles": undecided
-            axis = 0
-        answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes})
+            axis, fault = 0, None
+        answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes,
+                        "fault": unit.fault, "named_fault": None if fault is None else str(fault)})
     failing = [a for a in answers if a["worn_axis"]]
     healthy = [a for a in answers if not a["worn_axis"]]
     n_axes = max((a["n_axes"] for a in answers), default=6)
-    return {
+    out = {
         "top1_accuracy": _figure(failing, lambda rows: float(np.mean([r["named"] == r["worn_axis"] for r in rows])),
                                  chance=1.0 / n_axes),
         "undecided_on_healthy": _figure(healthy, lambda rows: float(np.mean([r["named"] == 0 for r in rows]))),
-        "per_unit": answers,
     }
+    kinds = sorted({a["fault"] for a in failing})
+    if len(kinds) > 1 and any(a["named_fault"] is not None for a in answers):  # the faults track: which fault
+        out["fault_type_accuracy"] = _figure(
+            failing, lambda rows: float(np.mean([r["named_fault"] == r["fault"] for r in rows])), chance=1.0 / len(kinds))
+    return {**out, "per_unit": answers}
 
 
 def score(folder: str | Path, method, name: str, role: str, track: str | None = None) -> dict:
@@ -226,6 +235,9 @@ def markdown_row(results: dict, command: str) -> str:
                  _cell(delay, percent=False).replace(".000", ""), "-"]
     else:
         cells = ["-", "-", "-", "-", _cell(r["top1_accuracy"]) + f" (chance {100 * r['top1_accuracy']['chance']:.1f})"]
+        if "fault_type_accuracy" in r:
+            cells[-1] += (f"; fault type {_cell(r['fault_type_accuracy'])} "
+                          f"(chance {100 * r['fault_type_accuracy']['chance']:.1f})")
     return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
 
 
