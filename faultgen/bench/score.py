@@ -216,12 +216,11 @@ def score(folder: str | Path, method, name: str, role: str, track: str | None = 
             "date": datetime.date.today().isoformat(), "resamples": RESAMPLES, "results": results}
 
 
-def _cell(figure: dict, percent: bool = True) -> str:
-    scale = 100.0 if percent else 1.0
+def _cell(figure: dict, scale: float = 100.0, digits: int = 1) -> str:
+    """'value [low, high]' of a figure, times ``scale`` (100: a share in %), "-" when undefined."""
     value, (low, high) = figure["value"] * scale, (x * scale for x in figure["ci95"])
     if not np.isfinite(value):
         return "-"
-    digits = 1 if percent else 3
     return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
 
 
@@ -231,8 +230,8 @@ def markdown_row(results: dict, command: str) -> str:
     track = f"{results.get('track')} v{results.get('version')}" + (f" ({results['size']})" if results.get("size") != "full" else "")
     if results["role"] == "detector":
         delay = next(v for k, v in r.items() if k.startswith("delay_after_10pct"))
-        cells = [_cell(r["auroc"], percent=False), _cell(r["false_alarm_rate"]), _cell(r["detected_share"]),
-                 _cell(delay, percent=False).replace(".000", ""), "-"]
+        cells = [_cell(r["auroc"], scale=1.0, digits=3), _cell(r["false_alarm_rate"]), _cell(r["detected_share"]),
+                 _cell(delay, scale=1.0), "-"]
     else:
         cells = ["-", "-", "-", "-", _cell(r["top1_accuracy"]) + f" (chance {100 * r['top1_accuracy']['chance']:.1f})"]
         if "fault_type_accuracy" in r:
