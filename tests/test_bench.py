@@ -101,13 +101,18 @@ def test_the_test_file_holds_no_label(thesis_small):
 
 
 def test_random_scores_are_at_chance_and_the_pca_baseline_beats_them(thesis_small):
+    """A random scorer, through the plug-in loader and with four more seeds: its 95 % intervals hold
+    0.5 (at least 4 of 5: with 9 test units the percentile interval covered 0.5 for 18 of 20 random
+    scorers, docs/bench.md) and its AUROCs average near 0.5; the PCA baseline's interval lies above all."""
     folder, _ = thesis_small
-    bad = score.score(folder, plugins.load("bench_plugins:RandomScores", "detector"), "random", "detector")
-    low, high = bad["results"]["auroc"]["ci95"]
-    assert low <= 0.5 <= high
+    bad = [score.score(folder, plugins.load("bench_plugins:RandomScores", "detector"), "random", "detector")]
+    bad += [score.score(folder, bench_plugins.RandomScores(seed=k), "random", "detector") for k in range(1, 5)]
+    auroc = [b["results"]["auroc"] for b in bad]
+    assert sum(a["ci95"][0] <= 0.5 <= a["ci95"][1] for a in auroc) >= 4
+    assert abs(np.mean([a["value"] for a in auroc]) - 0.5) < 0.06
     role, pca = baselines.make("pca")
     good = score.score(folder, pca, "pca", role)
-    assert good["results"]["auroc"]["ci95"][0] > high
+    assert good["results"]["auroc"]["ci95"][0] > max(a["ci95"][1] for a in auroc)
     assert 0.0 <= good["results"]["false_alarm_rate"]["value"] <= 1.0
 
 
@@ -117,11 +122,13 @@ def test_the_method_sees_only_the_train_files_labels(thesis_small):
     score.score(folder, plugins.load("bench_plugins:Spy", "detector"), "spy", "detector")
     train = files.read(folder / "train.h5")
     test = files.read(folder / "test.h5")
-    fits = [c for c in bench_plugins.CALLS if c[0] == "fit" and c[2] is not None]
-    assert len(fits) == 1  # one robot and task in the small track
-    _, X, y = fits[0]
-    np.testing.assert_array_equal(X, np.concatenate([u.features() for u in train]))
-    np.testing.assert_array_equal(y, np.concatenate([u.fault_level >= 10 for u in train]).astype(int))
+    fits = [c for c in bench_plugins.CALLS if c[0] == "fit"]
+    setups = sorted({(u.robot, u.task) for u in test})
+    assert len(fits) == len(setups) == 2 and all(y is not None for *_, y in fits)  # irb6700 and puma560
+    for (_, X, y), setup in zip(fits, setups, strict=True):
+        own = [u for u in train if (u.robot, u.task) == setup]
+        np.testing.assert_array_equal(X, np.concatenate([u.features() for u in own]))
+        np.testing.assert_array_equal(y, np.concatenate([u.fault_level >= 10 for u in own]).astype(int))
     shown = [c[1] for c in bench_plugins.CALLS if c[0] in ("predict", "decision_function")]
     test_rows = {row.tobytes() for u in test for row in u.features()}
     assert shown and all(row.tobytes() in test_rows for X in shown for row in X)
@@ -131,7 +138,7 @@ def test_an_isolator_is_scored_against_its_chance(thesis_small):
     folder, _ = thesis_small
     role, trend = baselines.make("trend")
     results = score.score(folder, trend, "trend", role)["results"]["top1_accuracy"]
-    assert results["chance"] == pytest.approx(1 / 6) and results["units"] == 4
+    assert results["chance"] == pytest.approx(1 / 6) and results["units"] == 6  # 4 irb6700, 2 puma560
     assert results["ci95"][0] <= results["value"] <= results["ci95"][1]
 
 
