@@ -120,6 +120,11 @@ class Plugin(BaseEstimator):
         self.spec = spec
         self.role = role
 
+    def build(self) -> BaseEstimator:
+        """A new, unfitted ``Class()`` of the plug-in (``faultgen bench score`` fits a classifier
+        with labels through it); raises :class:`PluginError` as :func:`load` does."""
+        return self._build()
+
     def _build(self) -> BaseEstimator:
         cls = _estimator_class(self.spec)
         try:

@@ -39,6 +39,7 @@ BASE = {
     "monitor": [f"{MISSING}/LOGS", "--robot", "irb6700", "-o", f"{MISSING}/m"],
     "hidden-log": ["puma560", "--effect", "stribeck", "-o", f"{MISSING}/log.csv"],
     "reproduce": ["--tiny", "-o", f"{MISSING}/repro"],
+    "bench make": ["thesis", "-o", f"{MISSING}/bench"],
 }
 #: Examples per option; with the options found, the total the docs give (test_the_fuzz_covers_...).
 EXAMPLES = 50
@@ -52,11 +53,14 @@ def _numeric(annotation) -> bool:
 
 
 def numeric_options() -> list[tuple[str, str]]:
-    """(command, --option) of every int or float option of every command, from the signatures."""
+    """(command, --option) of every int or float option of every command and of every command of a
+    group ("bench make"), from the signatures."""
     found = []
-    for command in app.registered_commands:
+    commands = [(c.name, c) for c in app.registered_commands]
+    commands += [(f"{g.name} {c.name}", c) for g in app.registered_groups for c in g.typer_instance.registered_commands]
+    for name, command in commands:
         hints = typing.get_type_hints(command.callback, include_extras=True)
-        for name, hint in hints.items():
+        for option_name, hint in hints.items():
             if typing.get_origin(hint) is not typing.Annotated:
                 continue
             base, *extras = typing.get_args(hint)
@@ -66,7 +70,7 @@ def numeric_options() -> list[tuple[str, str]]:
             # in Annotated form typer keeps the first name given in ``default``
             names = [option.default, *(option.param_decls or ())]
             flags = [d for d in names if isinstance(d, str) and d.startswith("--")]
-            found.append((command.name, flags[0] if flags else "--" + name.replace("_", "-")))
+            found.append((name, flags[0] if flags else "--" + option_name.replace("_", "-")))
     return found
 
 
@@ -103,7 +107,7 @@ def test_every_command_with_a_numeric_option_is_fuzzed():
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(value=VALUES)
 def test_a_numeric_option_is_taken_or_refused_in_one_line(command, option, value):
-    result = runner.invoke(app, [command, *BASE[command], option, value])
+    result = runner.invoke(app, [*command.split(), *BASE[command], option, value])
     assert result.exception is None or isinstance(result.exception, SystemExit), (value, result.output)
     assert "Traceback" not in result.output, (value, result.output)
     assert result.exit_code == 2, (value, result.output)  # the value, or the rest of the line, is refused

@@ -71,6 +71,8 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     """``argv`` (after ``faultgen``) with the small-data options appended, the scheduler replaced;
     a sweep that does not choose its tasks or axes runs pick and place, without wear and on axis 2."""
     extra = list(SMALL.get(argv[0], []))
+    if argv[:2] == ["bench", "make"]:  # the test-sized version of the track (seconds)
+        extra = ["--size", "small"]
     if argv[0] == "fleet" and argv[argv.index("-o") + 1] in ANALYSED_FLEETS:
         extra = ANALYSED_FLEETS[argv[argv.index("-o") + 1]]
     if argv[0] == "sweep":

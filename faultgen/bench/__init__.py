@@ -1,0 +1,13 @@
+"""The benchmark: frozen tracks of seeded train and test files, and one score for any method.
+
+- :mod:`~faultgen.bench.tracks`: the tracks, one TOML recipe each (``tracks/<name>.toml``: robots,
+  programs, seeds, conditions; every version kept), read and turned into sweep grids;
+- :mod:`~faultgen.bench.files`: the train and test files (features only; the test labels apart);
+- :mod:`~faultgen.bench.make`: ``faultgen bench make``, the sweeps and the frozen manifest check;
+- :mod:`~faultgen.bench.score`: ``faultgen bench score``, AUROC, delay, false alarms, isolation,
+  each with a bootstrap interval over test units;
+- :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods and two pyod detectors).
+
+The layer sits above ``runs`` (it sweeps) and reads with the ``analysis`` package (it scores); only
+the command line sits above it (docs/bench.md).
+"""

@@ -1,0 +1,196 @@
+"""``faultgen bench make``: a track's train and test files, checked against its frozen manifest.
+
+The parts of a track version (:mod:`faultgen.bench.tracks`) are swept (:func:`faultgen.run_sweep`)
+with the train seeds and with the test seeds into a hidden folder beside the output, turned into
+the benchmark files (:mod:`faultgen.bench.files`), and hashed: the manifest is the SHA-256 of every
+array (its dtype, shape and bytes) and of every unit's attributes, and of ``test_labels.csv``. If
+the track version has a frozen manifest (``faultgen/bench/manifests/<track>-<version>-<size>.json``,
+shipped in the package), the new one must equal it; if not, nothing is written and the error names
+the track and the first differing array. The output folder appears complete or not at all
+(:func:`faultgen.data.atomic.atomic_folder`); the sweeps' runs are kept beside it
+(``.<out>.<track>-<version>-<size>.sweeps``) until it is written, so that a make stopped by Ctrl-C
+or a kill resumes from the runs it finished when run again, and are removed after a difference
+from the frozen manifest too.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+import faultgen
+from faultgen.bench import files, tracks
+from faultgen.data import atomic
+
+OUTPUTS = ("train.h5", "test.h5", "test_labels.csv", "manifest.json")
+
+
+def manifest_path(track: str, version: int, size: str) -> Path:
+    """Where the frozen manifest of a track version and size lives (in the package)."""
+    return Path(str(resources.files("faultgen.bench") / "manifests")) / f"{track}-{version}-{size}.json"
+
+
+def _array_hash(values: np.ndarray) -> str:
+    values = np.ascontiguousarray(values)
+    digest = hashlib.sha256(f"{values.dtype.str}{values.shape}".encode())
+    digest.update(values.tobytes())
+    return digest.hexdigest()
+
+
+def hashes(folder: Path) -> dict[str, str]:
+    """SHA-256 of every array and unit attribute set of ``train.h5`` and ``test.h5`` in ``folder``, and of
+    ``test_labels.csv``: ``{"train.h5:/units/train-000/cycles": hex, ...}`` in a stable order."""
+    import h5py
+
+    out = {}
+    for name in ("train.h5", "test.h5"):
+        with h5py.File(folder / name, "r") as f:
+            for uid in f["units"]:
+                g = f["units"][uid]
+                attrs = json.dumps({k: np.asarray(v).tolist() for k, v in sorted(g.attrs.items())}, sort_keys=True)
+                out[f"{name}:/units/{uid}@attrs"] = hashlib.sha256(attrs.encode()).hexdigest()
+                for array in sorted(g):
+                    out[f"{name}:/units/{uid}/{array}"] = _array_hash(g[array][()])
+    out["test_labels.csv"] = hashlib.sha256((folder / "test_labels.csv").read_bytes()).hexdigest()
+    return out
+
+
+def first_difference(new: dict[str, str], frozen: dict[str, str]) -> tuple[str, int] | None:
+    """The first array (in the frozen manifest's order, then the new one's) whose hash differs or that
+    is missing on one side, and how many differ; None if the two are equal."""
+    keys = list(frozen) + [k for k in new if k not in frozen]
+    differing = [k for k in keys if new.get(k) != frozen.get(k)]
+    return (differing[0], len(differing)) if differing else None
+
+
+def _unit(run) -> files.Unit:
+    """A run of a sweep as a labelled benchmark unit (its id is given later)."""
+    arrays = {name: run.array(name) for name in files.OBSERVABLES if run.has(name)}
+    fault = "none" if not run.failing else "friction_wear" if run.fault is None else str(run.fault["effect"])
+    unit = files.Unit(id="", robot=run.robot, task=run.task, sample=run.sample, arrays=arrays)
+    unit.fault_level = np.asarray(run.fault_level, dtype=float)
+    unit.worn_axis = int(run.worn_axes[0]) if run.worn_axes else 0
+    unit.fault = fault
+    return unit
+
+
+def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, jobs: int, progress: bool,
+                 command: str) -> list[files.Unit]:
+    """Sweep every part of ``version`` for ``split`` into ``sweeps`` (resuming finished runs) and read
+    the runs as labelled units, in the parts' order and each sweep's run order."""
+    runs = []
+    for part, fields in version.grids(split, size):
+        fields = dict(fields)
+        preset = fields.pop("preset", None)
+        grid = faultgen.Grid.from_preset(preset, **fields) if preset else faultgen.Grid(**fields)
+        out = faultgen.run_sweep(grid, sweeps / f"{split}-{part}.h5", jobs=jobs, progress=progress, command=command)
+        runs.append(out)
+    units = []
+    for path in runs:
+        with faultgen.open(path) as data:
+            units += [_unit(run) for run in data]
+    return units
+
+
+def _order(track: str, version: int, n: int) -> np.ndarray:
+    """The test units' seeded order: a permutation from the track's name and version."""
+    seed = int.from_bytes(hashlib.sha256(f"{track}-{version}".encode()).digest()[:8], "little")
+    return np.random.default_rng(seed).permutation(n)
+
+
+def make(track_name: str, out: str | Path, version: int | None = None, size: str = "full", jobs: int = 1,
+         progress: bool = True, command: str = "", freeze: bool = False) -> dict:
+    """Make the benchmark files of a track version in the folder ``out`` and check them.
+
+    Parameters
+    ----------
+    track_name : str
+        A track (:func:`faultgen.bench.tracks.names`).
+    out : path
+        The folder to write (``train.h5``, ``test.h5``, ``test_labels.csv``, ``manifest.json``); its
+        parent must exist. Files of those names in it are replaced.
+    version : int or None
+        The track version (None: the latest).
+    size : {"full", "small"}
+        ``small``: the test-sized version (seconds).
+    jobs : int
+        Worker processes of the sweeps.
+    freeze : bool
+        Write the manifest as the track version's frozen one (into the package) when it has none;
+        refused when it has one.
+
+    Returns
+    -------
+    dict
+        The manifest: track, version, size, faultgen_version, status ("checked" or "frozen" or
+        "unfrozen": no frozen manifest to check against), and ``arrays`` (name -> SHA-256).
+
+    Raises
+    ------
+    ValueError
+        For an unknown track, version or size, a slot, a folder that cannot be written, or data that
+        differs from the frozen manifest (naming the track and the first differing array; nothing is
+        written).
+    """
+    track = tracks.load(track_name)
+    recipe = track.version(version)
+    if size not in tracks.SIZES:
+        raise ValueError(f"--size {size!r}: expected one of {', '.join(tracks.SIZES)}")
+    out = Path(out)
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise ValueError(f"-o {out}: folder {out.parent} does not exist")
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"-o {out} is a file; give a folder")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"--jobs {jobs!r}: expected a whole number >= 1")
+    frozen_path = manifest_path(track.name, recipe.number, size)
+    if freeze and frozen_path.exists():
+        raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
+                         "a new recipe is a new version")
+    # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
+    # resumes from the runs it finished when run again (the sweep's own resume)
+    sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
+    sweeps.mkdir(exist_ok=True)
+    with atomic.atomic_folder(out) as stage:
+        train = _split_units(recipe, "train", size, sweeps, jobs, progress, command)
+        test = _split_units(recipe, "test", size, sweeps, jobs, progress, command)
+        for k, unit in enumerate(train):
+            unit.id = f"train-{k:03d}"
+        test = [test[i] for i in _order(track.name, recipe.number, len(test))]
+        for k, unit in enumerate(test):
+            unit.id = f"test-{k:03d}"
+        attrs = {"track": track.name, "version": recipe.number, "size": size, "licence": track.licence,
+                     "faultgen_version": faultgen.__version__, "command": command}
+        files.write(stage / "train.h5", train, {**attrs, "split": "train"})
+        files.write_labels(stage / "test_labels.csv", test)
+        for unit in test:  # the test file holds no label
+            unit.fault_level = unit.worn_axis = unit.fault = None
+        files.write(stage / "test.h5", test, {**attrs, "split": "test"})
+        arrays = hashes(stage)
+        manifest = {"track": track.name, "version": recipe.number, "size": size, "faultgen_version": faultgen.__version__,
+                        "licence": track.licence, "arrays": arrays}
+        if frozen_path.exists():
+            frozen = json.loads(frozen_path.read_text())["arrays"]
+            differs = first_difference(arrays, frozen)
+            if differs:
+                key, n = differs
+                shutil.rmtree(sweeps, ignore_errors=True)  # the same code would give the same runs again
+                raise ValueError(
+                    f"track {track.name} version {recipe.number} ({size}): the data differs from the frozen manifest "
+                    f"at {key} ({n} of {len(frozen)} arrays differ): this faultgen changes the track's data; add "
+                    f"version {max(track.versions) + 1} to faultgen/bench/tracks/{track.name}.toml and freeze it "
+                    f"(faultgen bench make {track.name} --version {max(track.versions) + 1} --freeze); nothing written")
+            manifest["status"] = "checked"
+        elif freeze:
+            atomic.write_text(frozen_path, json.dumps({**manifest, "status": "frozen"}, indent=1) + "\n")
+            manifest["status"] = "frozen"
+        else:
+            manifest["status"] = "unfrozen"
+        atomic.write_text(stage / "manifest.json", json.dumps(manifest, indent=1) + "\n")
+    shutil.rmtree(sweeps, ignore_errors=True)
+    return manifest

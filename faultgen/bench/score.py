@@ -1,0 +1,258 @@
+"""``faultgen bench score``: one score for anyone's detector or isolator on a track's test units.
+
+The method learns from ``train.h5`` only and is shown the records of ``test.h5`` (no labels);
+``test_labels.csv`` is read afterwards, by this module, to score its answers.
+
+**Detector** (``--detector mod:Class``, the contract of ``faultgen detect``, :mod:`analysis.plugins`,
+or a baseline): per robot and task of the test units, a new estimator learns the train units of
+that robot and task: a scikit-learn classifier (``sklearn.base.is_classifier``) ``fit(X, y)`` on
+all their records with ``y`` = 1 where the record's fault level is >= 10 % (Table 5.2's rule),
+any other estimator ``fit(X)`` on the records of the healthy ones. X holds, per record, the per-axis
+features of :data:`faultgen.bench.files.FEATURES` (shape (n_records, 4 N)). Then for each test
+unit, its score per record (``decision_function``, else ``predict_proba[:, 1]``, else the alarms;
+larger: more likely faulty) and its alarms (``predict``).
+
+- **AUROC** of the scores: positives the records whose fault level is >= 10 %, negatives those at
+  0 % (records in between are left out); chance 0.5.
+- **False-alarm rate**: the share of alarmed records of the healthy test units.
+- **Detection delay**: per failing unit, the onset (the first of 3 alarms in a row,
+  :func:`analysis.monitoring.detect_onset`, as ``faultgen detect``) minus the record where the fault
+  starts, and minus the record where it reaches 10 %, in cycles (days for daily records); the
+  median over the units detected, and the share detected.
+
+**Isolator** (``--isolator``, the contract of ``bench-isolators``): ``fit(X)`` on each failing test
+unit's per-cycle mean absolute motor torque (n_records, N) names a source axis (0: undecided). Its
+**top-1 accuracy** is the share naming the worn axis; chance 1/N. On the healthy units, the share
+left undecided is reported beside it. An isolator that also sets ``fault_`` (a fault name of the
+labels: "friction_wear", "backlash", "cogging") is scored on it too on a track with several fault
+types (the faults track): ``fault_type_accuracy``, chance 1 / the number of fault types.
+
+Every figure has a 95 % percentile bootstrap interval over test units (:data:`RESAMPLES`
+resamples of the units with replacement, seed 0).
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+from sklearn.base import clone, is_classifier
+from sklearn.metrics import roc_auc_score
+
+from faultgen.bench import files
+from faultgen.data import atomic
+
+RESAMPLES = 1000
+WORN_PCT = 10.0
+PERSISTENCE = 3
+
+
+def _interval(units: list, statistic, seed: int = 0) -> list[float]:
+    """95 % percentile bootstrap interval of ``statistic(units)`` over resampled units ([nan, nan]
+    when no resample gives a finite value)."""
+    rng = np.random.default_rng(seed)
+    values = []
+    for _ in range(RESAMPLES):
+        sample = [units[i] for i in rng.integers(len(units), size=len(units))]
+        value = statistic(sample)
+        if np.isfinite(value):
+            values.append(value)
+    if not values:
+        return [float("nan"), float("nan")]
+    return [float(np.percentile(values, 2.5)), float(np.percentile(values, 97.5))]
+
+
+def _figure(units: list, statistic, chance: float | None = None) -> dict:
+    value = statistic(units) if units else float("nan")
+    out = {"value": float(value), "ci95": _interval(units, statistic) if units else [float("nan")] * 2,
+           "units": len(units)}
+    if chance is not None:
+        out["chance"] = chance
+    return out
+
+
+def _auroc(units: list) -> float:
+    scores = np.concatenate([u["scores"][u["mask"]] for u in units])
+    labels = np.concatenate([u["positive"][u["mask"]] for u in units])
+    if labels.all() or not labels.any():
+        return float("nan")
+    return float(roc_auc_score(labels, scores))
+
+
+def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
+    for method in ("decision_function", "predict_proba"):
+        if hasattr(estimator, method):
+            try:
+                values = np.asarray(getattr(estimator, method)(X), dtype=float)
+            except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
+                raise ValueError(f"{name}: {method}(X) of X {X.shape} failed: {type(err).__name__}: {err}") from None
+            if method == "predict_proba":
+                values = values[:, -1]
+            if values.shape != (len(X),) or not np.isfinite(values).all():
+                raise ValueError(f"{name}: {method}(X) gave shape {values.shape} or non-finite values for X "
+                                 f"{X.shape}; expected one finite score per record")
+            return values
+    return np.asarray(estimator.predict(X), dtype=float)
+
+
+def _fit(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray):
+    """A new copy of ``method`` fitted on train records (the contract in the module's docstring);
+    returns (fitted object to predict with, the estimator to score with)."""
+    template = method.build() if hasattr(method, "build") else method  # a plug-in: the user's own class
+    if is_classifier(template):
+        try:
+            inner = clone(template).fit(X, y)
+        except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
+            raise ValueError(f"fit(X, y) of X {X.shape} failed: {type(err).__name__}: {err}") from None
+        return inner, inner
+    fitted = clone(method).fit(X[healthy])  # a plug-in: behind its contract guard (analysis.plugins)
+    return fitted, getattr(fitted, "estimator_", fitted)
+
+
+def detector_results(method, name: str, train: list[files.Unit], test: list[files.Unit]) -> dict:
+    """Fit ``method`` per robot and task on ``train`` (labelled units) and judge ``test`` (units whose
+    labels :func:`faultgen.bench.files.attach_labels` added; the method never sees them)."""
+    judged = []
+    for setup in sorted({(u.robot, u.task) for u in test}):
+        own = [u for u in train if (u.robot, u.task) == setup] or train
+        X = np.concatenate([u.features() for u in own])
+        y = np.concatenate([u.fault_level >= WORN_PCT for u in own]).astype(int)
+        healthy = np.concatenate([np.full(len(u.fault_level), u.fault == "none") for u in own])
+        fitted, inner = _fit(method, X, y, healthy)
+        for unit in (u for u in test if (u.robot, u.task) == setup):
+            X_unit = unit.features()
+            scores = _scores(inner, X_unit, name)
+            alarms = np.asarray(fitted.predict(X_unit)).astype(bool)
+            level = unit.fault_level
+            judged.append({"unit": unit, "scores": scores, "alarms": alarms, "positive": level >= WORN_PCT,
+                               "mask": (level >= WORN_PCT) | (level <= 0)})
+    from analysis.monitoring import detect_onset
+
+    delays = []
+    for row in judged:
+        unit = row["unit"]
+        if unit.fault == "none":
+            continue
+        cycles = unit.arrays["cycles"]
+        onset = detect_onset(row["alarms"], PERSISTENCE)
+        starts = np.flatnonzero(unit.fault_level > 0)
+        worn = np.flatnonzero(unit.fault_level >= WORN_PCT)
+        delays.append({
+            "unit": unit.id, "detected": onset is not None,
+            "after_start": np.nan if onset is None or not starts.size else float(cycles[onset] - cycles[starts[0]]),
+            "after_10pct": np.nan if onset is None or not worn.size else float(cycles[onset] - cycles[worn[0]])})
+    healthy = [r for r in judged if r["unit"].fault == "none"]
+
+    def median(key):
+        return lambda rows: float(np.nanmedian([r[key] for r in rows])) if any(
+            np.isfinite(r[key]) for r in rows) else float("nan")
+
+    sample = test[0].sample if test else "cycle"
+    return {
+        "auroc": _figure(judged, _auroc, chance=0.5),
+        "false_alarm_rate": _figure(healthy, lambda rows: float(np.mean(np.concatenate([r["alarms"] for r in rows])))),
+        "detected_share": _figure(delays, lambda rows: float(np.mean([r["detected"] for r in rows]))),
+        f"delay_after_start_{sample}s": _figure(delays, median("after_start")),
+        f"delay_after_10pct_{sample}s": _figure(delays, median("after_10pct")),
+        "per_unit": [{k: v for k, v in d.items()} for d in delays],
+    }
+
+
+def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
+    """Each test unit's source axis (and fault, if the isolator names one) from ``method`` fitted on
+    its mean absolute motor torque."""
+    answers = []
+    for unit in test:
+        try:
+            fitted = clone(method).fit(unit.arrays["mean_abs_torque"])
+            axis, fault = int(fitted.source_axis_), getattr(getattr(fitted, "estimator_", fitted), "fault_", None)
+        except ValueError:  # the isolator contract's "too few cycles": undecided
+            axis, fault = 0, None
+        answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes,
+                        "fault": unit.fault, "named_fault": None if fault is None else str(fault)})
+    failing = [a for a in answers if a["worn_axis"]]
+    healthy = [a for a in answers if not a["worn_axis"]]
+    n_axes = max((a["n_axes"] for a in answers), default=6)
+    out = {
+        "top1_accuracy": _figure(failing, lambda rows: float(np.mean([r["named"] == r["worn_axis"] for r in rows])),
+                                 chance=1.0 / n_axes),
+        "undecided_on_healthy": _figure(healthy, lambda rows: float(np.mean([r["named"] == 0 for r in rows]))),
+    }
+    kinds = sorted({a["fault"] for a in failing})
+    if len(kinds) > 1 and any(a["named_fault"] is not None for a in answers):  # the faults track: which fault
+        out["fault_type_accuracy"] = _figure(
+            failing, lambda rows: float(np.mean([r["named_fault"] == r["fault"] for r in rows])), chance=1.0 / len(kinds))
+    return {**out, "per_unit": answers}
+
+
+def score(folder: str | Path, method, name: str, role: str, track: str | None = None) -> dict:
+    """Score ``method`` (an unfitted estimator in ``role`` "detector" or "isolator") on the benchmark
+    files in ``folder``; returns the results (the JSON :func:`write` writes).
+
+    Raises
+    ------
+    ValueError
+        If the folder's files are missing or not benchmark files, or are of another track than ``track``.
+    """
+    import h5py
+
+    folder = Path(folder)
+    train, test = files.read(folder / "train.h5"), files.read(folder / "test.h5")
+    with h5py.File(folder / "test.h5", "r") as f:
+        made = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items() if k in ("track", "version", "size")}
+    if track is not None and made.get("track") != track:
+        raise ValueError(f"{folder} holds track {made.get('track')!r}, not {track!r}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # convergence and constant-feature warnings of baselines
+        if role == "detector":
+            labelled = files.attach_labels(test, folder / "test_labels.csv")
+            results = detector_results(method, name, train, labelled)
+        else:
+            results = isolator_results(method, name, files.attach_labels(test, folder / "test_labels.csv"))
+    return {"method": name, "role": role, **{k: str(v) for k, v in made.items()},
+            "date": datetime.date.today().isoformat(), "resamples": RESAMPLES, "results": results}
+
+
+def _cell(figure: dict, scale: float = 100.0, digits: int = 1) -> str:
+    """'value [low, high]' of a figure, times ``scale`` (100: a share in %), "-" when undefined."""
+    value, (low, high) = figure["value"] * scale, (x * scale for x in figure["ci95"])
+    if not np.isfinite(value):
+        return "-"
+    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
+
+
+def markdown_row(results: dict, command: str) -> str:
+    """One row of the leaderboard (docs/leaderboard.md) for ``results``."""
+    r = results["results"]
+    track = f"{results.get('track')} v{results.get('version')}" + (f" ({results['size']})" if results.get("size") != "full" else "")
+    if results["role"] == "detector":
+        delay = next(v for k, v in r.items() if k.startswith("delay_after_10pct"))
+        cells = [_cell(r["auroc"], scale=1.0, digits=3), _cell(r["false_alarm_rate"]), _cell(r["detected_share"]),
+                 _cell(delay, scale=1.0), "-"]
+    else:
+        cells = ["-", "-", "-", "-", _cell(r["top1_accuracy"]) + f" (chance {100 * r['top1_accuracy']['chance']:.1f})"]
+        if "fault_type_accuracy" in r:
+            cells[-1] += (f"; fault type {_cell(r['fault_type_accuracy'])} "
+                          f"(chance {100 * r['fault_type_accuracy']['chance']:.1f})")
+    return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
+
+
+def write(results: dict, out: str | Path, command: str) -> tuple[Path, Path]:
+    """``OUT.json`` (the results) and ``OUT.md`` (its leaderboard row), as one set."""
+    out = Path(out)
+    json_path, md_path = out.with_name(out.name + ".json"), out.with_name(out.name + ".md")
+    with atomic.output_set([json_path, md_path]) as staged:
+        staged(json_path).write_text(json.dumps({**results, "command": command}, indent=1, default=_plain) + "\n")
+        staged(md_path).write_text(markdown_row(results, command) + "\n")
+    return json_path, md_path
+
+
+def _plain(value):
+    if isinstance(value, (np.integer, np.bool_)):
+        return value.item()
+    if isinstance(value, np.floating):
+        return float(value)
+    raise TypeError(f"{type(value).__name__} is not JSON")

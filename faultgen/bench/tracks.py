@@ -1,0 +1,179 @@
+"""Benchmark tracks: versioned recipes (robots, programs, seeds, conditions) for seeded train and test sets.
+
+A track is one TOML file in ``faultgen/bench/tracks/`` holding every version ever released
+(``[[versions]]``): a version's recipe never changes once its manifest is frozen
+(``faultgen/bench/manifests/<track>-<version>-<size>.json``); a change of the recipe, or of
+faultgen, that alters the data is a new version. Each version is one or more *parts*, each a sweep
+grid (:class:`faultgen.Grid` fields, ``preset`` allowed) made twice: with the train seeds and with
+the test seeds, which must be disjoint (so are the units: a unit is a robot with its own seed, its
+own noise and, with ``spread``, its own friction). ``[versions.small]`` holds the overrides of the
+test-sized version (``--size small``), made in seconds for tests and examples.
+
+A track without ``versions`` is a slot: listed, with what it still needs (``needs``).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+SIZES = ("full", "small")
+SPLITS = ("train", "test")
+
+#: The keys of a track file and of a version (anything else is refused, named).
+_TRACK_KEYS = {"name", "summary", "licence", "card", "needs", "versions"}
+_VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small"}
+
+
+@dataclass(frozen=True)
+class Version:
+    """One frozen recipe of a track.
+
+    Attributes
+    ----------
+    number : int
+        1, 2, ...
+    parts : list of dict
+        Each a table of :class:`faultgen.Grid` fields (``name`` beside them names the part).
+    train_seeds, test_seeds : list of int
+        Disjoint unit seeds of the two splits (a part may give its own ``train_seeds`` / ``test_seeds``).
+    small : dict
+        Grid-field overrides of every part for ``--size small``.
+    notes : str
+    """
+
+    number: int
+    parts: list[dict]
+    train_seeds: list[int]
+    test_seeds: list[int]
+    small: dict = field(default_factory=dict)
+    notes: str = ""
+
+    def grids(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
+        """(part name, grid fields) of each part for ``split`` ("train" or "test") at ``size``."""
+        if split not in SPLITS:
+            raise ValueError(f"split {split!r}: expected one of {', '.join(SPLITS)}")
+        if size not in SIZES:
+            raise ValueError(f"size {size!r}: expected one of {', '.join(SIZES)}")
+        out = []
+        for k, part in enumerate(self.parts):
+            fields = {key: value for key, value in part.items() if key not in ("name", "train_seeds", "test_seeds")}
+            fields["seeds"] = list(part.get(f"{split}_seeds", getattr(self, f"{split}_seeds")))
+            if not fields["seeds"]:  # a part of one split only (the transfer track's nominal unit)
+                continue
+            fields["signals"] = False  # features only: the benchmark scores per-cycle features
+            if size == "small":
+                fields.update(self.small)
+            out.append((str(part.get("name", f"part{k + 1}")), fields))
+        return out
+
+
+@dataclass(frozen=True)
+class Track:
+    """A benchmark track: its name, what it asks, the licence of its data, and its versions.
+
+    Attributes
+    ----------
+    name, summary, licence : str
+    card : str
+        The dataset card's file in docs/bench/ (what the data is and is not).
+    needs : str
+        For a slot without versions: what it still needs.
+    versions : dict of int to Version
+    """
+
+    name: str
+    summary: str
+    licence: str
+    card: str = ""
+    needs: str = ""
+    versions: dict[int, Version] = field(default_factory=dict)
+
+    @property
+    def latest(self) -> int | None:
+        return max(self.versions) if self.versions else None
+
+    def version(self, number: int | None = None) -> Version:
+        """Version ``number`` (None: the latest).
+
+        Raises
+        ------
+        ValueError
+            For a slot (no version yet: the message says what it needs) or an unknown number.
+        """
+        if not self.versions:
+            raise ValueError(f"track {self.name!r} has no version yet: {self.needs}")
+        number = self.latest if number is None else number
+        if number not in self.versions:
+            raise ValueError(f"track {self.name!r} has no version {number}; versions: "
+                             f"{', '.join(map(str, sorted(self.versions)))}")
+        return self.versions[number]
+
+
+def _folder() -> Path:
+    return Path(str(resources.files("faultgen.bench") / "tracks"))
+
+
+def parse(data: dict, source: str) -> Track:
+    """A :class:`Track` from the table of a track file (``source`` names it in errors).
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the first unknown key, missing field, or train and test seeds that overlap.
+    """
+    unknown = sorted(set(data) - _TRACK_KEYS)
+    if unknown:
+        raise ValueError(f"{source}: unknown key {unknown[0]!r}; expected: {', '.join(sorted(_TRACK_KEYS))}")
+    for key in ("name", "summary", "licence"):
+        if not isinstance(data.get(key), str) or not data[key]:
+            raise ValueError(f"{source}: {key!r} must be a non-empty string")
+    versions = {}
+    for entry in data.get("versions", []):
+        bad = sorted(set(entry) - _VERSION_KEYS)
+        if bad:
+            raise ValueError(f"{source}: version {entry.get('version')}: unknown key {bad[0]!r}; expected: "
+                             f"{', '.join(sorted(_VERSION_KEYS))}")
+        number = entry.get("version")
+        if not isinstance(number, int) or isinstance(number, bool) or number < 1 or number in versions:
+            raise ValueError(f"{source}: version {number!r}: expected a new whole number >= 1")
+        version = Version(number=number, parts=list(entry.get("parts", [])), train_seeds=list(entry["train_seeds"]),
+                          test_seeds=list(entry["test_seeds"]), small=dict(entry.get("small", {})),
+                          notes=str(entry.get("notes", "")))
+        if not version.parts:
+            raise ValueError(f"{source}: version {number}: no [[versions.parts]]")
+        seeds = {split: {s for _, grid in version.grids(split) for s in grid["seeds"]} for split in SPLITS}
+        shared = sorted(seeds["train"] & seeds["test"])
+        if shared or not seeds["train"] or not seeds["test"]:
+            raise ValueError(f"{source}: version {number}: train seeds {sorted(seeds['train'])} and test seeds "
+                             f"{sorted(seeds['test'])}: each split needs seeds, and no seed (unit) may be in both")
+        versions[number] = version
+    return Track(name=data["name"], summary=data["summary"], licence=data["licence"], card=data.get("card", ""),
+                 needs=data.get("needs", ""), versions=versions)
+
+
+def load(name: str) -> Track:
+    """The track ``name`` (``faultgen bench list`` lists them).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name (the message lists the tracks), or a malformed track file.
+    """
+    path = _folder() / f"{name}.toml"
+    if not name.replace("-", "").replace("_", "").isalnum() or not path.is_file():
+        raise ValueError(f"unknown track {name!r}; expected one of: {', '.join(names())} (faultgen bench list)")
+    with path.open("rb") as f:
+        return parse(tomllib.load(f), str(path))
+
+
+#: The order tracks are listed in (any other track file follows, by name).
+ORDER = ("thesis", "faults", "conditions", "transfer", "sim-to-real")
+
+
+def names() -> list[str]:
+    """Every track's name, in :data:`ORDER`."""
+    found = sorted(p.stem for p in _folder().glob("*.toml"))
+    return [n for n in ORDER if n in found] + [n for n in found if n not in ORDER]

@@ -1,0 +1,55 @@
+"""Plug-ins for tests/test_bench.py: a deliberately bad detector (random scores) and a spy that
+records what it is given, to show that no test label reaches a method."""
+
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+
+#: Every call the spy saw: ("fit", X, y) or ("decision_function", X) or ("predict", X).
+CALLS: list[tuple] = []
+
+
+class RandomScores(BaseEstimator):
+    """Scores and alarms drawn at random, independent of the labels: each call's draws seeded by a
+    checksum of its X (the same records, the same draws; other records, other draws)."""
+
+    def __init__(self, seed: int = 0):
+        self.seed = seed
+
+    def fit(self, X, y=None):
+        return self
+
+    def decision_function(self, X):
+        return np.random.default_rng([self.seed, zlib.crc32(np.ascontiguousarray(X).tobytes())]).random(len(X))
+
+    def predict(self, X):
+        return self.decision_function(X) > 0.95
+
+
+class Spy(ClassifierMixin, BaseEstimator):
+    """A classifier that records its inputs (a classifier: the benchmark gives it the train labels)."""
+
+    def fit(self, X, y=None):
+        CALLS.append(("fit", np.array(X), None if y is None else np.array(y)))
+        self.classes_ = np.array([0, 1])
+        return self
+
+    def decision_function(self, X):
+        CALLS.append(("decision_function", np.array(X)))
+        return np.zeros(len(X))
+
+    def predict(self, X):
+        CALLS.append(("predict", np.array(X)))
+        return np.zeros(len(X), dtype=bool)
+
+
+class AlwaysBacklash(BaseEstimator):
+    """An isolator naming axis 1 and backlash whatever it sees (scored against the chance level)."""
+
+    def fit(self, X, y=None):
+        self.source_axis_ = 1
+        self.fault_ = "backlash"
+        return self
