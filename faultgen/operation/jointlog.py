@@ -158,9 +158,10 @@ def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[s
             dtypes = {name: (float if name in wanted else str) for name in names}
             with inputs.open_text(path, "joint log") as fh:
                 frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
-            # every column wanted (the common case): no reindexed copy of the frame
-            values = (frame if list(frame.columns) == wanted else frame[wanted]).to_numpy(dtype=float)
-            clean = bool(np.isfinite(values).all())
+            # column by column: no reindexed copy of the frame when it has columns not wanted
+            # (each column is a contiguous array either way, as the frame holds its floats)
+            columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+            clean = all(bool(np.isfinite(column).all()) for column in columns.values())
         except inputs.InputError:
             raise
         except (ValueError, TypeError):
@@ -174,9 +175,7 @@ def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[s
         raise LogError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
-    if clean:  # the fast path's values, column by column
-        columns = {name: values[:, k] for k, name in enumerate(wanted)}
-    else:
+    if not clean:
         columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, csv_label
 
