@@ -106,6 +106,38 @@ def test_compression_is_recognised_by_content_not_name(tmp_path, puma):
         np.testing.assert_array_equal(data.tau, tau)
 
 
+def test_arrow_and_pandas_readers_give_the_same_numbers_to_the_bit(tmp_path):
+    """A plain CSV log is parsed by pyarrow, a gzip-compressed one by pandas (jointlog.read_csv):
+    the same text gives the same doubles, in every way a logger may print them (17 significant
+    digits, fixed decimals, exponents, signs, spaces), and a bad cell is refused the same way."""
+    from faultgen.operation import jointlog
+
+    rng = np.random.default_rng(7)
+    values = rng.standard_normal((4000, 4)) * 10.0 ** rng.integers(-12, 12, (4000, 4))
+    cells = [lambda v: repr(float(v)), "{:.6f}".format, "{:.9e}".format, lambda v: f" {v:+.4g} "]
+    lines = ["t,q1,tau1,note"]
+    for i, row in enumerate(values):
+        fmt = cells[i % len(cells)]
+        lines.append(f"{i * 1e-3!r},{fmt(row[0])},{fmt(row[1])},x{row[2]:.3f}")
+    text = "\n".join(lines) + "\n"
+    (tmp_path / "plain.csv").write_text(text)
+    with gzip.open(tmp_path / "packed.csv.gz", "wt") as fh:
+        fh.write(text)
+    names = ["t", "q1", "tau1", "note"]
+    assert jointlog._arrow_columns(tmp_path / "packed.csv.gz", names, ["t"]) is None  # pandas's
+    assert jointlog._arrow_columns(tmp_path / "plain.csv", names, ["t"]) is not None  # pyarrow's
+    fast, extra, _ = jointlog.read_csv(tmp_path / "plain.csv", 1)
+    slow, _, _ = jointlog.read_csv(tmp_path / "packed.csv.gz", 1)
+    assert extra == ["note"] and set(fast) == {"t", "q1", "tau1"}
+    for name in fast:
+        assert fast[name].dtype == slow[name].dtype == np.float64
+        assert fast[name].tobytes() == slow[name].tobytes(), name
+    lines[3] = lines[3].replace(lines[3].split(",")[1], "1.2.3", 1)
+    (tmp_path / "bad.csv").write_text("\n".join(lines) + "\n")
+    with pytest.raises(jointlog.LogError, match=r"data row 3 \(line 4\), column q1: value '1.2.3' is not a number"):
+        jointlog.read_csv(tmp_path / "bad.csv", 1)
+
+
 def test_read_accepts_a_loaded_robot_and_reports_extra_columns(tmp_path, puma):
     frame = good_frame(puma)
     frame.insert(3, "temperature1", 40.0)

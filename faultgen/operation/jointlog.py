@@ -152,9 +152,13 @@ def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[s
         "index_col": False,
         "skip_blank_lines": False,
     }
+    fast = _arrow_columns(path, names, wanted)
+    if fast is not None:
+        return fast, extra, csv_label
     try:
         try:
-            # Fast path: numbers throughout. Anything else is diagnosed from the text below.
+            # Numbers throughout, by pandas (a gzip-compressed log, or one pyarrow refused).
+            # Anything else is diagnosed from the text below.
             dtypes = {name: (float if name in wanted else str) for name in names}
             with inputs.open_text(path, "joint log") as fh:
                 frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
@@ -178,6 +182,43 @@ def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[s
     if not clean:
         columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, csv_label
+
+
+def _arrow_columns(path: Path, names: list[str], wanted: list[str]) -> dict[str, np.ndarray] | None:
+    """The wanted columns of a clean, uncompressed CSV log as float arrays, parsed by pyarrow's
+    multi-threaded reader (the import's largest cost with pandas, issue 46); None for anything
+    else (a gzip-compressed file, a ragged row, a blank line, an empty, non-numeric or
+    non-finite cell, text that is not UTF-8), which :func:`read_csv` then reads or refuses
+    through pandas with the row named, as before. Same numbers as pandas's parser, bit for bit
+    (tests/test_measured.py)."""
+    import pyarrow as pa
+    from pyarrow import csv as pacsv
+
+    try:
+        if inputs.is_gzip(path):
+            return None
+        types = {name: (pa.float64() if name in wanted else pa.string()) for name in names}
+        with inputs.open_bytes(path, "joint log") as fh:
+            table = pacsv.read_csv(
+                fh,
+                read_options=pacsv.ReadOptions(column_names=names, skip_rows=1),
+                parse_options=pacsv.ParseOptions(ignore_empty_lines=False),
+                convert_options=pacsv.ConvertOptions(column_types=types, strings_can_be_null=False),
+            )
+    except inputs.InputError as err:
+        raise LogError(str(err)) from None
+    except (pa.ArrowException, OSError, ValueError):
+        return None
+    columns = {}
+    for name in wanted:
+        chunked = table.column(name)
+        if chunked.null_count:
+            return None
+        column = chunked.to_numpy()
+        if not np.isfinite(column).all():
+            return None
+        columns[name] = np.ascontiguousarray(column, dtype=float)
+    return columns if table.num_rows else None
 
 
 def _drop_trailing_blank_rows(text: pd.DataFrame) -> pd.DataFrame:
