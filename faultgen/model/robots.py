@@ -100,9 +100,11 @@ def load(name: str | Path) -> Robot:
 
 def source_of(robot: Robot) -> str:
     """The string that names ``robot`` for :func:`load` and in a dataset's provenance: its name when
-    it is that known robot's file, else its MJCF path."""
+    it is that known robot's file as read (:attr:`Robot.digest`), else its MJCF path (a robot
+    edited in memory is named by the file it was derived from)."""
     known = available().get(robot.name)
-    return robot.name if known is not None and known.resolve() == robot.path.resolve() else str(robot.path)
+    same = known is not None and robot.digest is not None and known.resolve() == robot.path.resolve()
+    return robot.name if same else str(robot.path)
 
 
 def _folder_model(folder: Path) -> Path:
