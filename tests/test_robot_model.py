@@ -81,3 +81,10 @@ def test_a_spec_handed_out_is_a_copy():
     spec = robot.new_spec()
     spec.option.timestep = 0.01
     assert robot.new_spec().option.timestep == robot.model.opt.timestep != 0.01
+
+
+def test_a_config_of_a_robot_edited_in_memory_takes_it_along_when_pickled():
+    robot = robots.load("puma560").edited(lambda spec: setattr(spec.option, "timestep", 0.0005))
+    config = sim.RunConfig(robot=robot, task="pick_place", cycles=2)
+    back = cloudpickle.loads(cloudpickle.dumps(config))
+    assert back.resolved is not None and back.model.model.opt.timestep == 0.0005

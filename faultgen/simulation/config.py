@@ -63,7 +63,8 @@ class RunConfig:
     resolved : Robot, optional (keyword only)
         The robot :attr:`robot` names, already resolved by the caller (a grid or fleet resolves
         each robot once for all its runs); resolved here (:func:`faultgen.model.robots.load`) when
-        omitted. Not compared, not pickled (a worker resolves :attr:`robot` again, once).
+        omitted. Not compared; not pickled when read from a file (a worker resolves :attr:`robot`
+        again, once), pickled when edited in memory (no file holds it).
 
     Raises
     ------
@@ -179,8 +180,9 @@ class RunConfig:
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
-        state["resolved"] = None  # a worker resolves the robot from its own files
-        return state
+        if self.resolved is not None and self.resolved.digest is not None:
+            state["resolved"] = None  # a worker resolves the robot from its own files, once
+        return state  # a robot edited in memory travels with the configuration (as its MJCF text)
 
     @property
     def faults(self) -> tuple[Fault, ...]:
