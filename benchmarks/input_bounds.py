@@ -156,7 +156,7 @@ CASES_CODE = {
                  ("stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
                   "progress=False)")),
     "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
-    "dh": ("from pathlib import Path\nfrom faultgen.model import importers", "importers._read_dh(Path({log!r}))"),
+    "dh": ("from pathlib import Path\nfrom faultgen.model import import_dh", "import_dh.read_dh(Path({log!r}))"),
     "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
     "open": ("import faultgen", "faultgen.open({log!r}).features()"),
     "validate": ("from faultgen.data import dataset", "dataset.validate({log!r})"),

@@ -9,13 +9,31 @@ The baseline, measured in the same run, is the same work with the robot cache of
 total set-up time cached over uncached.
 
     python benchmarks/setup_time.py --preset j2
+
+With ``--simulate --base OLD --new NEW`` it times instead what a default ``faultgen simulate
+--cycles 2`` does before its first physics step, with each checkout first on ``PYTHONPATH`` in a
+fresh interpreter, the two alternating (``--repeat`` each, medians shown): the imports up to the
+command line (``import``), then from the command's call to the first ``mujoco.batch.Batch``
+(``set-up``: validation, robot, task path, simulation model, set-points, output size estimate, the
+batch's start state), ``step`` or ``rollout``.
+The step itself is not run: the clock stops at its call. The last line, ``ratio``, is NEW's total
+over OLD's::
+
+    python benchmarks/setup_time.py --simulate --base /work/base --new .
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 from unittest import mock
 
 from faultgen.model import robots
@@ -28,10 +46,10 @@ def set_up(preset: str) -> tuple[float, float, int]:
     compiled = 0
     compile_file = robots._from_file
 
-    def counted(path):
+    def counted(path, *rest):
         nonlocal compiled
         compiled += 1
-        return compile_file(path)
+        return compile_file(path, *rest)
 
     sim._prepare.cache_clear()
     clear = getattr(getattr(robots, "_cached", None), "cache_clear", None)
@@ -48,11 +66,77 @@ def set_up(preset: str) -> tuple[float, float, int]:
     return validated - started, prepared - validated, compiled
 
 
+#: Runs in a fresh interpreter: the clock starts before faultgen is imported and stops at the first
+#: physics step (``mujoco.batch.Batch.step`` or ``rollout``), which raises to end the run there.
+FIRST_STEP = r"""
+import time
+started = time.perf_counter()
+import json, sys
+from mujoco import batch as mjbatch
+from faultgen.cli import app
+imported = time.perf_counter()
+
+class FirstStep(Exception):
+    pass
+
+def first_step(self, *args, **kwargs):
+    raise FirstStep(time.perf_counter())
+
+mjbatch.Batch.step = mjbatch.Batch.rollout = first_step  # static friction steps, LuGre rolls out
+called = time.perf_counter()
+try:
+    app(sys.argv[1:], standalone_mode=False)
+except FirstStep as reached:
+    stepped = reached.args[0]
+    print("TIMES " + json.dumps([imported - started, stepped - called]))
+"""
+
+
+def first_step_times(checkout: Path, out: Path) -> tuple[float, float]:
+    """(import s, set-up s) of one default ``faultgen simulate --cycles 2`` with ``checkout``."""
+    env = {**os.environ, "PYTHONPATH": str(checkout.resolve())}
+    done = subprocess.run([sys.executable, "-c", FIRST_STEP, "simulate", "--cycles", "2", "--no-progress",
+                           "--overwrite", "-o", str(out)], env=env, cwd=out.parent, capture_output=True,
+                          text=True, check=False)
+    line = [x for x in done.stdout.splitlines() if x.startswith("TIMES ")]
+    if not line:
+        raise RuntimeError(f"{checkout}: no first physics step reached\n{done.stdout}{done.stderr}")
+    imported, set_up = json.loads(line[-1].removeprefix("TIMES "))
+    return imported, set_up
+
+
+def compare_simulate(base: Path, new: Path, repeat: int) -> None:
+    """Print the medians of :func:`first_step_times` for ``base`` and ``new``, alternating."""
+    times: dict[str, list[tuple[float, float]]] = {"base": [], "new": []}
+    with tempfile.TemporaryDirectory() as folder:
+        for _ in range(repeat):
+            for label, checkout in (("base", base), ("new", new)):
+                times[label].append(first_step_times(checkout, Path(folder) / "run.h5"))
+    totals = {}
+    for label, checkout in (("base", base), ("new", new)):
+        imported = statistics.median(t[0] for t in times[label])
+        set_up = statistics.median(t[1] for t in times[label])
+        totals[label] = statistics.median(t[0] + t[1] for t in times[label])
+        print(f"{label:>5} {checkout}: import {imported:.3f} s, set-up to the first physics step {set_up:.3f} s, "
+              f"total {totals[label]:.3f} s (median of {repeat})")
+    print(f"ratio {totals['new'] / totals['base']:.3f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--preset", default="j2", choices=list(sweep.PRESETS))
     parser.add_argument("--repeat", type=int, default=5, help="set-ups timed per variant; the median is shown")
+    parser.add_argument("--simulate", action="store_true",
+                        help="time a default `faultgen simulate --cycles 2` up to its first physics step instead, "
+                             "--base against --new")
+    parser.add_argument("--base", type=Path, help="with --simulate: the checkout before the change")
+    parser.add_argument("--new", type=Path, help="with --simulate: the checkout after the change")
     args = parser.parse_args()
+    if args.simulate:
+        if args.base is None or args.new is None:
+            parser.error("--simulate needs --base and --new")
+        compare_simulate(args.base, args.new, args.repeat)
+        return
     n_runs = len(sweep.Grid.from_preset(args.preset).runs())
     results = {}
     cached = getattr(robots, "_cached", None)  # absent in versions without the cache

@@ -15,7 +15,7 @@ def test_a_robot_is_compiled_once_and_an_edited_file_again(tmp_path, monkeypatch
     path = folder / "puma560.xml"
     compiled = []
     original = robots._from_file
-    monkeypatch.setattr(robots, "_from_file", lambda p: compiled.append(p) or original(p))
+    monkeypatch.setattr(robots, "_from_file", lambda p, *rest: compiled.append(p) or original(p, *rest))
     first = robots.load(path)
     assert robots.load(path) is first and robots.load(str(path)) is first
     assert len(compiled) == 1

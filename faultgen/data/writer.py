@@ -34,7 +34,6 @@ from faultgen.data.schema import (
 )
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
-from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
 
@@ -79,7 +78,7 @@ def config_key(config) -> str:
 def run_attributes(result, command: str = "") -> dict:
     """Labels and provenance of a run, as HDF5 attributes (strings, numbers, JSON)."""
     config = result.config
-    robot = robots.load(config.robot)
+    robot = config.model
     program = programs.record(config.task)  # a program file or a replayed log: what makes it again
     label, digest = programs.identity(robot, config.task)
     return {
@@ -124,8 +123,8 @@ def estimated_size(config) -> int:
     n_cycles = len(config.recorded_cycles)
     per_cycle = 20_000
     if config.signals:
-        n_log = int(sim.cycle_duration(config.robot, config.task) / sensors.LOG_PERIOD) + 1
-        per_cycle += 7 * 4 * n_log * robots.load(config.robot).n_axes
+        n_log = int(sim.cycle_duration(config.model, config.task) / sensors.LOG_PERIOD) + 1
+        per_cycle += 7 * 4 * n_log * config.model.n_axes
     return n_cycles * per_cycle + 50_000
 
 

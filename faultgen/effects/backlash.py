@@ -51,6 +51,7 @@ class Backlash(Effect):
         "reversals of the transmitted torque (accelerations that change the gearbox load's sign)")
     summary = "gearbox backlash (dead band between motor and arm)"
     units: ClassVar[dict[str, str]] = {"width": "rad (arm side)"}
+    affine_mjcf: ClassVar[bool] = True
     absent = (0.0,)
     n_parameters = 0
     draw_limits: ClassVar[dict[str, float]] = {"width": 0.05}

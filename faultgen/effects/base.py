@@ -265,6 +265,11 @@ class Effect:
     #: linear in its parameter: (parameter, low, high, smallest size, smallest size on a robot
     #: where no axis reaches it); None: drawn by size.
     draw_range: ClassVar[tuple[str, float, float, float, float] | None] = None
+    #: Whether the simulation model's fields are affine in each parameter (its MJCF form and
+    #: :meth:`add_to_simulation` linear in it): a growing fault of it is then read from two compiled
+    #: models, not three (:func:`faultgen.simulation.prepare._affine_fields`); tests/test_compile_count.py
+    #: checks every effect that says so. False: checked at a third value on every run.
+    affine_mjcf: ClassVar[bool] = False
 
     def __init__(self, *, n_axes: int | None = None, **values) -> None:
         unknown = set(values) - set(self.units)

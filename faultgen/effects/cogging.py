@@ -29,6 +29,7 @@ class Cogging(Effect):
         "slow steady motion over several motor revolutions (the ripple repeats with the motor angle)")
     summary = "cogging torque (periodic in the motor angle)"
     units: ClassVar[dict[str, str]] = {"amplitude": "N m (motor side)", "poles": "1", "phase": "rad"}
+    affine_mjcf: ClassVar[bool] = True
     absent = (0.0, 0.0, 0.0)
     numeric = "cogging"
     n_parameters = 2

@@ -27,6 +27,7 @@ class TorqueOffset(Effect):
         "reverses)")
     summary = "a constant torque offset"
     units: ClassVar[dict[str, str]] = {"offset": "N m (arm side)"}
+    affine_mjcf: ClassVar[bool] = True
     absent = (0.0,)
     numeric = "torque_offset"
     signed = True

@@ -146,8 +146,6 @@ def load(robot: Robot | str, task: str) -> Task:
     ValueError
         For an unknown task or a file that cannot run on ``robot`` (:class:`ProgramError`).
     """
-    from faultgen.operation import replay
-
     if not isinstance(robot, Robot):
         robot = robots.load(robot)
     check_name(task)
@@ -155,6 +153,10 @@ def load(robot: Robot | str, task: str) -> Task:
         return builtin(robot, task)
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         return read(task, robot)
+    # only a replayed log needs the log reader (pandas, h5py, scipy.signal: about 1 s to import,
+    # which a thesis task or program would spend before its first physics step for nothing)
+    from faultgen.operation import replay
+
     return replay.read(task, robot, _limits({}, robot, task), check_torque)
 
 

@@ -126,7 +126,7 @@ def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
     simulated = result.tau_m.shape[0] * result.t[-1]
     del result
     release_memory()
-    return Outcome(slim, get_worker().address, dataset.model_hash(robots.load(config.robot).path), __version__,
+    return Outcome(slim, get_worker().address, dataset.model_hash(config.model.path), __version__,
                    simulated, total, slim.stepping_time, _peak_memory())
 
 
@@ -366,7 +366,7 @@ def _write(run_id: str, outcome: Outcome, part: Path, command: str) -> RunStats:
 
 def _mismatch(outcome: Outcome, config: sim.RunConfig) -> str:
     """Why a worker's run cannot be labelled as this process would label it ('' if it can)."""
-    ours = dataset.model_hash(robots.load(config.robot).path)
+    ours = dataset.model_hash(config.model.path)
     if outcome.model_sha256 != ours:
         return (f"worker {outcome.worker} simulated another {config.robot} model (MJCF SHA-256 "
                 f"{outcome.model_sha256[:12]}, here {ours[:12]}, faultgen {outcome.faultgen_version} there, "

@@ -273,6 +273,10 @@ class Fleet:
                              "friction follows the joint temperature")
         object.__setattr__(self, "without", tuple(name for name in CONDITIONS if name in without))
 
+    def _resolved(self) -> dict:
+        """Each of :attr:`models` resolved to its :class:`~faultgen.model.robot.Robot`, by name."""
+        return {model: robot_models.load(model) for model in self.models}
+
     def robots(self) -> list[dict]:
         """The draws of every robot, in order: ``run`` id, ``model``, ``task`` (its own; with a task
         mix the second is in the conditions table), ``failing``, ``axis`` (worn axis 1..N of its model, 0 for a
@@ -280,11 +284,12 @@ class Fleet:
         order = np.random.default_rng([self.seed, 0]).permutation(self.size)
         failing = set(order[: self.failing].tolist())
         out = []
+        resolved = self._resolved()
         for i in range(self.size):
             rng = np.random.default_rng([self.seed, i + 1])
             model = self.models[i % len(self.models)]
             task = str(rng.choice(self.tasks))
-            robot_model = robot_models.load(model)
+            robot_model = resolved[model]
             axis = int(rng.integers(1, robot_model.n_axes + 1))
             onset_day = int(rng.integers(self.onset[0], self.onset[1] + 1))
             (small_mass, small_size), (big_mass, big_size) = sized_parts(robot_model)
@@ -323,6 +328,7 @@ class Fleet:
         """``(run id, RunConfig)`` of every robot (:meth:`robots`), daily records without signals."""
         cycles = self.days * self.cycles_per_day
         out = []
+        resolved = self._resolved()
         for robot in self.robots():
             plan, fault = wear.WearPlan({}), None
             if robot["failing"] and self.fault is not None:
@@ -335,7 +341,7 @@ class Fleet:
             config = sim.RunConfig(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
                                    cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
                                    conditions=conditions.Conditions.from_dict(robot["conditions"]),
-                                   signals=False, daily=True, fault=fault)
+                                   signals=False, daily=True, fault=fault, resolved=resolved[robot["model"]])
             out.append((robot["run"], config))
         return out
 

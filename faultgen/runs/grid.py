@@ -213,14 +213,15 @@ class Grid:
         conditions = self.conditions or Conditions()
         out: dict[str, sim.RunConfig] = {}
         named: dict[str, str] = {}  # run ids carry the robot's name: two models of one name would share them
+        resolved = {str(robot): robots.load(robot) for robot in self.robots}  # once, for every run
         for robot in self.robots:
-            first = named.setdefault(robots.load(robot).name, str(robot))
-            if first != str(robot) and robots.load(first).path != robots.load(robot).path:
-                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {robots.load(robot).name!r}; "
+            first = named.setdefault(resolved[str(robot)].name, str(robot))
+            if first != str(robot) and resolved[first].path != resolved[str(robot)].path:
+                raise ValueError(f"robots {first!r} and {str(robot)!r} are both named {resolved[str(robot)].name!r}; "
                                  "run ids need different names (rename one folder or MJCF file)")
-        self._check_programs()
+        self._check_programs(resolved)
         for robot, task, axis, seed in itertools.product(self.robots, self.tasks, self.axes, self.seeds):
-            name, n_axes = robots.load(robot).name, robots.load(robot).n_axes
+            name, n_axes = resolved[str(robot)].name, resolved[str(robot)].n_axes
             if axis > n_axes:
                 raise ValueError(f"worn axis {axis} is out of range 0..{n_axes} of robot {name} (0 = no wear)")
             # a run without wear is one run, whatever the wear levels and schedules of the grid
@@ -241,17 +242,18 @@ class Grid:
                                      "give the program files different file names")
                 out[run_id] = sim.RunConfig(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault)
+                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault,
+                    resolved=resolved[str(robot)])
         return list(out.items())
 
-    def _check_programs(self) -> None:
+    def _check_programs(self, resolved: dict) -> None:
         """Refuse two different programs under one label (a run's ``task``): analyses would take
         one for the other (:func:`faultgen.operation.programs.identity` labels an edited export by
         its file name; two files of one ``name`` still collide)."""
         seen: dict[tuple[str, str], tuple[str, str]] = {}  # (robot, label) -> (task as given, program hash)
         for robot, task in itertools.product(self.robots, self.tasks):
-            label, digest = programs.identity(robot, task)
-            first, first_digest = seen.setdefault((robots.load(robot).name, label), (task, digest))
+            label, digest = programs.identity(resolved[str(robot)], task)
+            first, first_digest = seen.setdefault((resolved[str(robot)].name, label), (task, digest))
             if first_digest != digest:
                 raise ValueError(f"tasks {first!r} and {task!r} are different programs (sha256 {first_digest[:12]}... "
                                  f"and {digest[:12]}...) under one label {label!r}: give the program file its own "

@@ -274,7 +274,7 @@ def _describe_holder(parts: Path) -> str:
 def _expected_cost(item: tuple[str, sim.RunConfig]) -> float:
     """Simulated seconds of a run: recorded cycles times the task's cycle time."""
     config = item[1]
-    return len(config.recorded_cycles) * sim.cycle_duration(config.robot, config.task)
+    return len(config.recorded_cycles) * sim.cycle_duration(config.model, config.task)
 
 
 def _prepare(out: Path, parts: Path) -> None:

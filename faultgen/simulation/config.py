@@ -8,6 +8,7 @@ import numpy as np
 
 from faultgen.checks import MAX_SEED, is_whole
 from faultgen.model import robots
+from faultgen.model.robot import Robot
 from faultgen.operation import programs
 from faultgen.operation.conditions import Conditions
 from faultgen.operation.faults import Fault
@@ -22,7 +23,9 @@ class RunConfig:
     Attributes
     ----------
     robot : str
-        Robot name (``faultgen robots``) or MJCF path.
+        Robot name (``faultgen robots``), robot folder or MJCF path: what the dataset's provenance
+        and configuration key record. A :class:`~faultgen.model.robot.Robot` may be given instead;
+        it is then held as :attr:`model` and this becomes its name (a known robot) or MJCF path.
     task : str
         One of :data:`faultgen.operation.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
         (``.csv``, ``.h5``): :func:`faultgen.operation.programs.load`.
@@ -57,6 +60,11 @@ class RunConfig:
         Record one remote-monitoring sample per day of ``conditions.cycles_per_day`` cycles, the
         day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
         cycle is simulated, no signals are kept.
+    resolved : Robot, optional (keyword only)
+        The robot :attr:`robot` names, already resolved by the caller (a grid or fleet resolves
+        each robot once for all its runs); resolved here (:func:`faultgen.model.robots.load`) when
+        omitted. Not compared; not pickled when read from a file (a worker resolves :attr:`robot`
+        again, once), pickled when edited in memory (no file holds it).
 
     Raises
     ------
@@ -85,12 +93,21 @@ class RunConfig:
     signals: bool = True
     daily: bool = False
     fault: Fault | None = None
+    resolved: Robot | None = field(default=None, compare=False, repr=False, kw_only=True)
 
     def __post_init__(self) -> None:
-        n_axes = robots.load(self.robot).n_axes  # UnknownRobotError / ModelError (ValueErrors) name the problem
+        if isinstance(self.robot, Robot):
+            object.__setattr__(self, "resolved", self.robot)
+            object.__setattr__(self, "robot", robots.source_of(self.robot))
+        elif self.resolved is None:  # UnknownRobotError / ModelError (ValueErrors) name the problem
+            object.__setattr__(self, "resolved", robots.load(self.robot))
+        elif not isinstance(self.resolved, Robot):
+            raise TypeError(f"resolved: expected a Robot, got {type(self.resolved).__name__}")
+        robot = self.resolved
+        n_axes = robot.n_axes
         programs.check_name(self.task)  # a thesis task, or a program / joint log file
         if programs.is_file_task(self.task):  # checked before any simulation (segment and value named)
-            prepare.task_path(self.robot, self.task, *prepare.file_stamps(self.robot, self.task))
+            prepare.task_path(robot, self.task, *prepare.file_stamps(robot, self.task))
         stepping = friction_models.get(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
@@ -121,8 +138,7 @@ class RunConfig:
             self.fault.check(n_axes)
             if self.fault.last_cycle != self.cycles:
                 raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
-            if self.fault.effect in robots.load(self.robot).effects and np.any(
-                    robots.load(self.robot).effects[self.fault.effect].active()):
+            if self.fault.effect in robot.effects and np.any(robot.effects[self.fault.effect].active()):
                 raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
                                  "needs a robot without it")
             if self.back_to_back:
@@ -150,6 +166,23 @@ class RunConfig:
             if self.record is not None or self.signals or self.cycles % per_day:
                 raise ValueError(f"daily records need every cycle recorded, no signals and whole days: got record = "
                                  f"{self.record!r}, signals = {self.signals}, {self.cycles} cycles at {per_day} a day")
+
+    @property
+    def model(self) -> Robot:
+        """The resolved robot (:class:`~faultgen.model.robot.Robot`) the run simulates: the one
+        given or resolved on construction; after unpickling in another process, :attr:`robot`
+        resolved there once."""
+        robot = self.resolved
+        if robot is None:
+            robot = robots.load(self.robot)
+            object.__setattr__(self, "resolved", robot)
+        return robot
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        if self.resolved is not None and self.resolved.digest is not None:
+            state["resolved"] = None  # a worker resolves the robot from its own files, once
+        return state  # a robot edited in memory travels with the configuration (as its MJCF text)
 
     @property
     def faults(self) -> tuple[Fault, ...]:

@@ -120,8 +120,9 @@ def applied_drive_torque(force: np.ndarray, v: np.ndarray, v_before: np.ndarray,
 
 def build(robot: robots.Robot, friction_model: str = "lugre",
           edit: Callable[[mujoco.MjSpec], None] | None = None) -> SimModel:
-    """Compile ``robot`` with PID drives (:mod:`faultgen.simulation.control`) and a friction model;
-    ``edit(spec)``, when given, is applied to the MJCF first (as :meth:`Robot.edited` made ``robot``).
+    """Compile ``robot`` with PID drives (:mod:`faultgen.simulation.control`) and a friction model,
+    derived in memory from a copy of the robot's spec (:meth:`Robot.new_spec`: the file is not read
+    again); ``edit(spec)``, when given, is applied to that copy first (a growing fault's effect).
 
     Raises
     ------
@@ -129,7 +130,7 @@ def build(robot: robots.Robot, friction_model: str = "lugre",
         For an unknown friction model, or friction parameters the model cannot represent.
     """
     stepping = friction_models.get(friction_model)
-    spec = mujoco.MjSpec.from_file(str(robot.path))
+    spec = robot.new_spec()
     if edit is not None:
         edit(spec)
     gains = control.ServoGains.for_robot(robot)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import effects
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation import programs, tasks
@@ -56,11 +57,13 @@ class Prepared:
         return int(round(sensors.LOG_PERIOD / self.sim.model.opt.timestep))
 
 
-def prepared_for(robot: str, task: str, friction_model: str, payload: dict | None = None,
-              fault: Fault | None = None) -> Prepared:
-    """:func:`_prepare`, renewed when the robot's model or task file changes; ``payload``: the
+def prepared_for(robot: robots.Robot | str, task: str, friction_model: str, payload: dict | None = None,
+                 fault: Fault | None = None) -> Prepared:
+    """:func:`_prepare` of the resolved ``robot`` (a name or path is resolved here, once: the
+    boundary's job), renewed when its task file changes; ``payload``: the
     :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
     a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     stamps = file_stamps(robot, task)
     if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
@@ -69,80 +72,94 @@ def prepared_for(robot: str, task: str, friction_model: str, payload: dict | Non
                             key, *stamps)
 
 
-def file_stamps(robot: str, task: str) -> tuple[int, ...]:
-    """Modification times of the robot's model and task files (and of a program or log file, with
-    its size): what renews the cached preparations. Raises ValueError for a model file copied
-    without its ``tasks.toml``."""
-    model_file = robots.load(robot).path
+def file_stamps(robot: robots.Robot | str, task: str) -> tuple[int, ...]:
+    """Modification times of the robot's task file (and of a program or log file, with its size):
+    what renews the cached preparations (the robot's own model is the :class:`Robot` object they
+    are keyed by, one per file content). Raises ValueError for a model file copied without its
+    ``tasks.toml``."""
+    model_file = (robot if isinstance(robot, robots.Robot) else robots.load(robot)).path
     tasks_file = model_file.parent / "tasks.toml"
     if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
                          "with it (the model `faultgen calibrate` writes has one)")
-    stamps = (model_file.stat().st_mtime_ns, tasks_file.stat().st_mtime_ns)
+    stamps = (tasks_file.stat().st_mtime_ns,)
     if programs.is_file_task(task):
         stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
     return stamps
 
 
 @functools.lru_cache(maxsize=16)
-def task_path(robot_name: str, task_name: str, *file_stamps: int):
+def task_path(robot: robots.Robot, task_name: str, *file_stamps: int):
     """The task (thesis task, program or replayed log) and its checked path at the robot's physics
-    step, once per process (``file_stamps`` renew it on edits)."""
-    robot = robots.load(robot_name)
+    step, once per process and robot (``file_stamps`` renew it on edits of the task file)."""
     task = programs.load(robot, task_name)
     return task, task.trajectory(robot.model.opt.timestep)
 
 
 @functools.lru_cache(maxsize=16)
-def _prepare_variant(robot_name: str, task_name: str, friction_model: str, payload: tuple | None, fault: str | None,
-                     *file_stamps: int) -> Prepared:
+def _reference(robot: robots.Robot, task_name: str, *file_stamps: int) -> tuple:
+    """``(task, path, q_ref, qd_ref, qdd_ref)``: the task's path held to a whole number of log
+    periods at the robot's physics step, what every friction model and variant of the robot
+    shares (read-only; no simulation model is compiled for it)."""
+    task, path = task_path(robot, task_name, *file_stamps)
+    per_log = int(round(sensors.LOG_PERIOD / robot.model.opt.timestep))
+    n_steps = _padded_steps(len(path.t) - 1, per_log)
+    arrays = tuple(hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
+    for array in arrays:
+        array.setflags(write=False)
+    return (task, path, *arrays)
+
+
+@functools.lru_cache(maxsize=16)
+def _prepare_variant(robot: robots.Robot, task_name: str, friction_model: str, payload: tuple | None,
+                     fault: str | None, *file_stamps: int) -> Prepared:
     """The :class:`Prepared` of a robot carrying a payload (``(name, value)`` pairs of the
     :class:`~faultgen.effects.payload.Payload` parameters, written as a body at the flange) and/or
     with a growing fault (a :class:`Fault` as JSON): the nominal task path; a model with the payload
     and the fault's effect in it (at its final value; :attr:`Prepared.fault_fields` move it per
     simulation), and a feedforward with the payload only (the controller knows the load it carries,
-    not the fault)."""
-    nominal = _prepare(robot_name, task_name, friction_model, *file_stamps)
-    if nominal.grips:
+    not the fault). No nominal simulation model is compiled for it."""
+    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *file_stamps)
+    if getattr(path, "loads", ()):
         raise ValueError(f"{task_name} grips and releases a payload within the cycle; it runs without the payload "
                          "condition (--payloads) and without a growing fault")
-    robot = robots.load(robot_name)
     load = None if payload is None else Payload(**dict(payload))
-
-    def carry(spec):
-        if load is not None:
-            load.write(spec, robot)
-
-    controller = robot.edited(carry) if load is not None else robot
+    # the controller's robot: the nominal one carrying the payload, derived from its spec in memory
+    controller = robot.edited(lambda spec: load.write(spec, robot)) if load is not None else robot
     fields_ = ()
     if fault is None:
-        sim = build(controller, friction_model, edit=carry)
+        sim = build(controller, friction_model)
     else:
         grown = Fault(**json.loads(fault))
-
-        def model_at(value: float) -> SimModel:
-            def edit(mjspec):
-                carry(mjspec)
-                effect = grown.at(value, controller.n_axes)
-                effect.write(mjspec, controller, [grown.axis - 1])
-                effect.add_to_simulation(mjspec, controller)
-            return build(controller, friction_model, edit=edit)
-
+        model_at = fault_model(controller, friction_model, grown)
         sim = model_at(grown.final)
-        fields_ = _affine_fields(model_at, grown.start, grown.final, sim.model)
-    n_steps = len(nominal.inputs) - 1
-    path = nominal.path
-    inputs = sim.setpoints(nominal.q_ref, *(hold_end(a, n_steps) for a in (path.qd, path.qdd)))
+        fields_ = _affine_fields(model_at, grown.start, grown.final, sim.model,
+                                 checked=not type(effects.get(grown.effect)).affine_mjcf)
+    inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)
     inputs.setflags(write=False)
-    return Prepared(sim, nominal.task, path, nominal.q_ref, inputs, fields_)
+    return Prepared(sim, task, path, q_ref, inputs, fields_)
 
 
-def _affine_fields(model_at, start: float, final: float, model) -> tuple:
+def fault_model(robot: robots.Robot, friction_model: str, fault: Fault):
+    """``model_at(value)``: the simulation model of ``robot`` with ``fault``'s effect at ``value``
+    of its parameter, derived from the robot's spec (:func:`faultgen.simulation.model.build`)."""
+    def model_at(value: float) -> SimModel:
+        def edit(mjspec):
+            effect = fault.at(value, robot.n_axes)
+            effect.write(mjspec, robot, [fault.axis - 1])
+            effect.add_to_simulation(mjspec, robot)
+        return build(robot, friction_model, edit=edit)
+    return model_at
+
+
+def _affine_fields(model_at, start: float, final: float, model, checked: bool = True) -> tuple:
     """The model fields a fault's parameter moves, as ``(field, flat indices, values at final,
     change per unit)``: found by comparing ``model`` (compiled at ``final``) with the model
-    ``model_at(value)`` compiled half way from ``start``, and checked affine at a quarter (the
-    effect's MJCF form is linear in the parameter for every schedulable effect: a dead band's spring
-    lengths, a cogging amplitude, an offset's bias, a friction level).
+    ``model_at(value)`` compiled half way from ``start``, and, with ``checked``, checked affine at a
+    quarter (a third compile). The effect's MJCF form is linear in the parameter for every built-in
+    schedulable effect (a dead band's spring lengths, a cogging amplitude, an offset's bias); those
+    say so (:attr:`faultgen.effects.Effect.affine_mjcf`, proved by tests/test_compile_count.py) and
+    skip the check; an effect that does not (a plug-in's) is checked.
 
     Raises
     ------
@@ -150,13 +167,15 @@ def _affine_fields(model_at, start: float, final: float, model) -> tuple:
         If the models differ in structure or a field is not affine in the parameter.
     """
     value, other_value, check_value = final, start + 0.5 * (final - start), start + 0.25 * (final - start)
-    other, check = model_at(other_value).model, model_at(check_value).model
+    other = model_at(other_value).model
+    check = model_at(check_value).model if checked else None
     out = []
     for name in dir(model):
         a = getattr(model, name, None)
         if name.startswith("_") or not isinstance(a, np.ndarray) or a.dtype.kind != "f":
             continue
-        b, c = getattr(other, name), getattr(check, name)
+        b = getattr(other, name)
+        c = b if check is None else getattr(check, name)
         if a.shape != b.shape or a.shape != c.shape:
             raise ValueError(f"the fault changes the model's structure ({name}); it cannot grow per cycle")
         changed = np.flatnonzero((a != b).ravel())
@@ -164,26 +183,22 @@ def _affine_fields(model_at, start: float, final: float, model) -> tuple:
             continue
         slope = (a.ravel()[changed] - b.ravel()[changed]) / (value - other_value)
         expected = a.ravel()[changed] + slope * (check_value - value)
-        if not np.allclose(c.ravel()[changed], expected, rtol=1e-9, atol=1e-12):
+        if check is not None and not np.allclose(c.ravel()[changed], expected, rtol=1e-9, atol=1e-12):
             raise ValueError(f"the fault's parameter moves model field {name} non-linearly; it cannot grow per cycle")
         out.append((name, changed, a.ravel()[changed].copy(), slope))
     return tuple(out)
 
 
 @functools.lru_cache(maxsize=8)
-def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps: int) -> Prepared:
-    """The :class:`Prepared` of a robot, task and friction model, computed once per process
-    (``file_stamps``, the modification times of the model and task files, renew it on edits).
+def _prepare(robot: robots.Robot, task_name: str, friction_model: str, *file_stamps: int) -> Prepared:
+    """The :class:`Prepared` of a robot, task and friction model, computed once per process and
+    robot object (``file_stamps``, the modification times of the task files, renew it on edits).
     Arrays are made read-only so no run can change what the next one gets.
     """
-    robot = robots.load(robot_name)
-    task, path = task_path(robot_name, task_name, *file_stamps)
+    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *file_stamps)
     loads = getattr(path, "loads", ())
     sim = build(robot, friction_model,
                 edit=(lambda spec: programs.add_part(spec, robot, loads[0].params)) if loads else None)
-    per_log = int(round(sensors.LOG_PERIOD / sim.model.opt.timestep))
-    n_steps = _padded_steps(len(path.t) - 1, per_log)
-    q_ref, qd_ref, qdd_ref = (hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
     inputs = sim.setpoints(q_ref, qd_ref, qdd_ref)  # (n_steps + 1, N, 3)
     grips = ()
     if loads:  # the drives know the part they carry: its feedforward where the program grips it
@@ -197,15 +212,16 @@ def _prepare(robot_name: str, task_name: str, friction_model: str, *file_stamps:
             events[load.first] = (body, float(grip.mass[0]), grip.inertia.copy(), grip.ipos.copy(), grip.iquat.copy())
             events[load.last] = events[0]
         grips = tuple(sorted(events.items()))
-    for array in (q_ref, inputs):
-        array.setflags(write=False)
+    inputs.setflags(write=False)
     return Prepared(sim, task, path, q_ref, inputs, grips=grips)
 
 
-def cycle_duration(robot: str, task: str) -> float:
-    """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle)."""
-    prepared = prepared_for(robot, task, "stribeck")  # builds for any model file
-    return (len(prepared.inputs) - 1) * prepared.sim.model.opt.timestep
+def cycle_duration(robot: robots.Robot | str, task: str) -> float:
+    """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle): the
+    task's path held to whole log periods, no simulation model compiled for it."""
+    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    q_ref = _reference(robot, task, *file_stamps(robot, task))[2]
+    return (len(q_ref) - 1) * robot.model.opt.timestep
 
 
 def _padded_steps(n: int, per_log: int) -> int:

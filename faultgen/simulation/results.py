@@ -129,7 +129,7 @@ def merge_tasks(config: RunConfig, groups: list[np.ndarray], parts: list[RunResu
     def joined(get):
         return np.concatenate([get(r) for r in parts])[back]
 
-    own = prepared_for(config.robot, config.task, config.friction)
+    own = prepared_for(config.model, config.task, config.friction)
     n_log = (len(own.inputs) - 1) // own.per_log
     empty = np.zeros((len(back), 0, parts[0].friction_multiplier.shape[1]))
     conditions = replace(parts[0].conditions, **{f.name: joined(lambda r, n=f.name: getattr(r.conditions, n))

@@ -26,7 +26,6 @@ from dataclasses import fields, replace
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.model import robots
 from faultgen.operation import faults
 from faultgen.operation.conditions import CycleConditions
 from faultgen.simulation import backends, batch, sensors
@@ -77,7 +76,7 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
     """
     backends.get(backend)
     cycles = config.recorded_cycles
-    n_axes = robots.load(config.robot).n_axes
+    n_axes = config.model.n_axes
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     if not config.daily:
         return _simulate_cycles(config, cycles, conditions, progress, backend)
@@ -129,7 +128,11 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                    progress: bool, backend: str = backends.DEFAULT) -> RunResult:
     """The recorded ``cycles`` of ``config`` that run ``task_name``, with their ``conditions``:
     stepped, measured, their per-cycle features (and torque counts unless daily) computed."""
-    prepared = prepared_for(config.robot, task_name, config.friction)
+    payloads = conditions is not None and bool(np.any(conditions.payload_part >= 0))
+    # a fault run without payloads steps the faulted model only: no nominal model is compiled for it
+    # (its set-points, the disturbance's scale, are the nominal ones: the controller knows no fault)
+    prepared = prepared_for(config.model, task_name, config.friction,
+                            fault=config.fault if config.fault is not None and not payloads else None)
     sim, task, path, q_ref, inputs = prepared.sim, prepared.task, prepared.path, prepared.q_ref, prepared.inputs
     robot = sim.robot
     per_log = prepared.per_log
@@ -166,7 +169,7 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                 carrying = np.flatnonzero(parts == part)
                 payload = None if part < 0 else config.conditions.payloads.parameters(int(part))
                 variant = prepared if payload is None and config.fault is None else prepared_for(
-                    config.robot, task_name, config.friction, payload, config.fault)
+                    config.model, task_name, config.friction, payload, config.fault)
                 for i in range(0, len(carrying), BATCH_CYCLES):
                     g = carrying[i:i + BATCH_CYCLES]
                     fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
