@@ -29,6 +29,8 @@ class HeldRobot(robots.Robot):
     """A robot compiled from MJCF text held in memory, its ``path`` only a name (nothing is written
     there): :meth:`edited` starts from that text, not from the file (an effect's regressors compile
     edited copies, e.g. the payload's probe bodies, :class:`faultgen.effects.payload.Payload`).
+    :meth:`faultgen.model.robots.Robot.edited` reads the MJCF file at ``path``; once a robot holds
+    its own spec, this subclass can go.
 
     Attributes
     ----------
