@@ -225,7 +225,8 @@ def test_without_the_sysid_extra_the_stribeck_fit_stays_and_says_why(puma_motion
     from types import SimpleNamespace
 
     from faultgen import calibrate
-    from faultgen.calibrate import refit
+    from faultgen.calibrate import improve, refit
+    from faultgen.calibrate.trial import Model
 
     def missing():
         raise refit.SysidUnavailable(f"mujoco.sysid's optional dependencies are not installed; {refit.INSTALL}")
@@ -237,11 +238,12 @@ def test_without_the_sysid_extra_the_stribeck_fit_stays_and_says_why(puma_motion
     step = calibrate.Step(get("stribeck").current(robot), [5], {"separable": True}, {"total_nrmse": 0.1})
     steps = [step]
     split = search.Split.of(motion.t, motion.qd)
-    kept, predicted = calibrate._sysid_stribeck(robot, tau, steps, data, tau, split, True, True)
-    assert kept is robot and predicted is tau
+    model = Model.nominal(robot)
+    kept, predicted = improve.sysid_stribeck(model, tau, steps, data, tau, split, True, True)
+    assert kept is model and predicted is tau
     assert steps[0].effect is step.effect and steps[0].evidence["sysid"]["used"] is False
     assert "pip install" in steps[0].evidence["sysid"]["reason"]
     assert "not refined by mujoco.sysid" in capsys.readouterr().out
     off = [step]
-    calibrate._sysid_stribeck(robot, tau, off, data, tau, split, False, False)
+    improve.sysid_stribeck(model, tau, off, data, tau, split, False, False)
     assert "turned off" in off[0].evidence["sysid"]["reason"]

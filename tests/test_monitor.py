@@ -223,3 +223,23 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
     true_wear = (first - 60) * 0.5
     assert 5.0 <= true_wear < 15.0, true_wear
     assert "axis 2 wear estimate" in unit.alarm_row()["evidence"]
+
+
+@pytest.mark.parametrize(("temperature", "payload", "worn_axis"), [(None, 0.0, 0), (20.0, 0.0, 3), (0.0, 12.5, 0),
+                                                                    (40.0, 3.0, 6)])
+def test_a_twin_cycle_is_set_up_from_typed_objects_as_from_its_former_texts(temperature, payload, worn_axis):
+    """The twin's conditions and wear plan (issue 47, item 5): made as objects, equal to what the
+    table and the wear text it was built from before gave, so every twin cycle is the same."""
+    from faultgen.monitor import twin
+    from faultgen.operation import conditions, wear
+
+    held, plan = twin.setup(temperature, payload, worn_axis)
+    table: dict = {}
+    if temperature is not None:
+        table["thermal"] = {"ambient": temperature, "seasonal": 0.0, "daily": 0.0, "rise": 0.0}
+    if payload > 0:
+        table["payloads"] = {"masses": [payload], "sizes": [round(twin.part_edge(payload), 4)]}
+    assert held == conditions.Conditions.from_dict(table)
+    texts = [f"{worn_axis}:exp4:{twin.WEAR:g}"] if worn_axis else []
+    assert plan == wear.WearPlan.from_specs(texts, last_cycle=1)
+    assert plan.multipliers(1, 6).tolist() == wear.WearPlan.from_specs(texts, last_cycle=1).multipliers(1, 6).tolist()

@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 
 from faultgen import axes as axis_numbers
-from faultgen.calibrate import search
+from faultgen.calibrate import criterion, search
 from faultgen.calibrate.effects import get
 from faultgen.data import measured as measured_io
 from faultgen.model import robots
@@ -134,7 +134,7 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     robot = robots.load(model_path)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
-    scale = search._rms(tau, split.held_out)
+    scale = criterion.rms(tau, split.held_out)
     scale = np.where(scale > 0, scale, 1.0)
     rows = np.flatnonzero(split.fit.any(axis=1))[::STRIDE]
     mask = split.fit[rows]
@@ -273,7 +273,7 @@ def refine_stribeck(motion, residual: np.ndarray, tau: np.ndarray, split: search
     robot = motion.robot
     names = ("static", "stribeck_velocity", "stribeck_exponent")
     held = split.held_out
-    scale = search._rms(tau, held)
+    scale = criterion.rms(tau, held)
     scale = np.where(scale > 0, scale, 1.0)
     if start is None:
         start = {a: {name: float(kind.current(robot).values(a)[name]) for name in names} for a in axes}

@@ -51,6 +51,19 @@ def part_edge(mass: float) -> float:
     return float((mass / PART_DENSITY) ** (1 / 3))
 
 
+def setup(temperature: float | None, payload: float, worn_axis: int = 0) -> tuple[conditions.Conditions, wear.WearPlan]:
+    """The conditions and the wear plan of one twin cycle, built as typed objects: the joints held
+    at ``temperature`` deg C (None: the model's nominal friction, no thermal condition), a part of
+    ``payload`` kg (an aluminium cube, :func:`part_edge`, its edge rounded to 0.1 mm; 0: none), and
+    ``worn_axis`` (1..N; 0: none) at :data:`WEAR` % by thesis eq. 6.6's exp4 schedule reached at
+    the one cycle."""
+    thermal = (None if temperature is None
+               else conditions.Temperature(ambient=temperature, seasonal=0.0, daily=0.0, rise=0.0))
+    part = conditions.Payloads((payload,), (round(part_edge(payload), 4),)) if payload > 0 else None
+    plan = wear.WearPlan({worn_axis: wear.Schedule("exp4", WEAR / 100.0, 1)}) if worn_axis else wear.WearPlan({})
+    return conditions.Conditions(thermal=thermal, payloads=part), plan
+
+
 def _key(*parts) -> str:
     digest = hashlib.sha256()
     for part in parts:
@@ -83,15 +96,10 @@ class Twin:
         path = self.cache / f"{_key(self._files, temperature, payload, worn_axis, WEAR)}.npy"
         if path.is_file():
             return np.load(path)
-        table: dict = {}
-        if temperature is not None:
-            table["thermal"] = {"ambient": temperature, "seasonal": 0.0, "daily": 0.0, "rise": 0.0}
-        if payload > 0:
-            table["payloads"] = {"masses": [payload], "sizes": [round(part_edge(payload), 4)]}
-        plan = wear.WearPlan.from_specs([f"{worn_axis}:exp4:{WEAR:g}"], last_cycle=1) if worn_axis else wear.WearPlan({})
+        held, plan = setup(temperature, payload, worn_axis)
         config = sim.RunConfig(robot=self.model, task=str(self.program), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
-                               conditions=conditions.Conditions.from_dict(table), signals=True)
+                               conditions=held, signals=True)
         result = sim.simulate(config, progress=False)
         if result.saturated.size:
             raise ValueError(f"the twin of {self.program} with a {payload:g} kg part (aluminium cube at the flange) "

@@ -1,0 +1,175 @@
+"""The calibration loop (:func:`run`): the forward search that adds one effect per step, the
+passes after it (:mod:`faultgen.calibrate.improve`), and the outputs.
+
+Every model tried is held in memory (:mod:`faultgen.calibrate.trial`); the model kept is written
+once, at the end, with its parameter table, ``report.json`` and the figure.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import axes
+from faultgen.calibrate import plausibility, search
+from faultgen.calibrate.effects import Effect, get
+from faultgen.calibrate.improve import backfit, complete, extend, sysid_stribeck
+from faultgen.calibrate.prediction import predicted_motion
+from faultgen.calibrate.result import Calibration, Step, parameters
+from faultgen.calibrate.trial import Model, judge
+from faultgen.data import atomic
+from faultgen.data import measured as measured_io
+from faultgen.model import robots
+
+#: Most effects added in one calibration.
+MAX_STEPS = 6
+
+
+def run(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,
+        max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
+    """Run the calibration workflow and write its outputs into ``out``. Every model tried is
+    compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
+
+    Parameters
+    ----------
+    robot : str or Path
+        Robot name (``faultgen robots``) or MJCF file of the nominal model.
+    measured : str, Path or MeasuredData
+        The measured file (design document format) or data already read.
+    out : str or Path
+        Output folder, created if needed: ``model/<robot>_calibrated.xml`` (with the robot's
+        ``tasks.toml``, so ``faultgen simulate --model`` runs it), ``model/parameters.json``
+        (the augmented model's parameters per axis, SI units), ``report.json`` and
+        ``calibration.png``.
+    max_steps : int
+        Most effects to add.
+    progress : bool
+        Show a progress bar while the effects are fitted and print one line per step.
+    use_sysid : bool
+        Refine a Stribeck hump's parameters with ``mujoco.sysid`` when the ``mujoco[sysid]`` extra
+        is installed (:func:`faultgen.calibrate.improve.sysid_stribeck`); False: faultgen's own fit only.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    UnknownRobotError, ModelError
+        For an unknown robot or a broken model file.
+    MeasuredDataError
+        For a measured file the reader refuses (the message names the column or row).
+    ImplausibleLogError
+        For a log the nominal model cannot explain (another robot, motor-side torque, a column in
+        another unit or sign; :mod:`faultgen.calibrate.plausibility`); nothing is written.
+    ValueError
+        If ``max_steps`` < 0.
+    """
+    if max_steps < 0:
+        raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
+    nominal = robots.load(robot)
+    data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
+    split = search.Split.of(data.t, data.qd)
+    tau = np.asarray(data.tau)
+    model = Model.nominal(nominal)
+    predicted, motion = predicted_motion(nominal, data)
+    nominal_prediction = predicted
+    moving = np.abs(data.qd) >= search.REST_SPEED
+    plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+
+    out = Path(out)
+    model_dir = out / "model"
+    model_dir.mkdir(parents=True, exist_ok=True)
+    model_out = model_dir / f"{nominal.name}_calibrated.xml"  # every trial is named as the model written
+    tasks_file = nominal.path.parent / "tasks.toml"
+    if tasks_file.is_file():
+        shutil.copyfile(tasks_file, model_dir / "tasks.toml")
+    gap_before = search.gap(tau, predicted, split.held_out)
+    steps: list[Step] = []
+    befores: list[Effect] = []  # each step's effect as the model held it before the step
+    searches = 0
+    for k in range(max_steps):
+        residual = tau - predicted
+        searches += 1
+        ranked = search.rank(motion, residual, tau, split, progress=progress, label=f"step {k + 1}: fitting effects")
+        best = ranked[0]
+        if not best.axes:
+            break
+        trial = judge(model.with_effect(best.effect, best.axes, model_out), data, tau, split.held_out)
+        after = trial.gap
+        previous = steps[-1].gap_after if steps else gap_before
+        if after["total_nrmse"] >= previous["total_nrmse"]:
+            break  # the model with it does not do what the fit promised: stop, keep what works
+        errors = search.standard_errors(best.effect, motion, tau - predicted, tau, split, best.axes)
+        befores.append(best.effect.current(model.robot))
+        model, predicted, motion = trial.model, trial.prediction, trial.motion
+        steps.append(Step(best.effect, best.axes, evidence(best, ranked, residual, split), after, errors))
+        if progress:
+            print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
+                  f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
+        model, predicted, motion = complete(model, predicted, motion, steps, data, tau, split, model_out, progress)
+    if len(steps) > 1:
+        model, predicted = backfit(model, predicted, steps, befores, data, tau, split, model_out)
+        model, predicted = extend(model, predicted, steps, data, tau, split, model_out)
+    if any(s.effect.id == "stribeck" for s in steps):
+        model, predicted = sysid_stribeck(model, predicted, steps, data, tau, split, use_sysid, progress)
+    atomic.write_text(model_out, model.text)  # the one model file a calibration writes
+    atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
+
+    result = Calibration(
+        robot=nominal.name,
+        measured=str(data.source),
+        gap_before=gap_before,
+        steps=steps,
+        gap_after=search.gap(tau, predicted, split.held_out),
+        model_out=model_out,
+        time=np.asarray(data.t),
+        held_out=split.held_out,
+        moving=moving,
+        tau=tau,
+        nominal=nominal_prediction,
+        calibrated=predicted,
+        searches=searches,
+    )
+    atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
+    from faultgen.calibrate import figure
+
+    figure.save(result, out / "calibration.png")
+    return result
+
+
+def evidence(best: search.Candidate, ranked: list[search.Candidate], residual: np.ndarray,
+              split: search.Split) -> dict:
+    runner_up = next((c for c in ranked[1:] if c.axes), None)
+    compared = search.compare(ranked, residual, split)
+    candidates = [{"effect": c.effect.id, **compared[c.effect.id]} for c in ranked if c.effect.id in compared]
+    tied = [c for c in candidates if not c["separable"]]
+    ambiguous = len(tied) > 1
+    evidence = {
+        "rule": (f"held-out nrmse gain >= {search.MIN_GAIN} and >= {search.MIN_RELATIVE_GAIN:.0%} of the axis's "
+                 f"nrmse; fitted on the first {search.FIT_FRACTION:.0%} of the record"),
+        "score": best.score,
+        "heldout_gain_nrmse": [float(g) for g in best.gain],
+        "relative_gain": [float(g) for g in best.relative_gain],
+        "runner_up": None if runner_up is None else {"effect": runner_up.effect.id, "score": runner_up.score,
+                                                       "axes": axes.numbers(runner_up.axes)},
+        # how far ahead of the runner-up the chosen effect is, in held-out total nrmse
+        "margin": best.score - (runner_up.score if runner_up is not None else 0.0),
+        "scores": {c.effect.id: c.score for c in ranked},
+        # the selection (search.order): held-out AIC with effective sample sizes
+        "criterion": {"name": "held-out AIC, Gaussian per axis, effective sample size",
+                      "source": ("Akaike 1974; Burnham & Anderson 2002, Model Selection and Multimodel Inference, "
+                                 "sec. 2.6 (delta <= 2: both supported)"),
+                      "separable_above": search.SEPARABLE},
+        "candidates": candidates,
+        "separable": not ambiguous,
+    }
+    if ambiguous:
+        others = [c["effect"] for c in tied if c["effect"] != best.effect.id]
+        evidence["ambiguous_with"] = others
+        evidence["separate_by"] = {name: get(name).excited_by for name in [best.effect.id, *others]}
+    return evidence
+

@@ -1,0 +1,131 @@
+"""The models a calibration tries, held in memory: an MJCF text and the robot compiled from it.
+
+A trial (the model with one effect added, taken out or changed) is compiled from its MJCF text in
+memory (:func:`faultgen.model.robots.from_spec`); undoing a trial is keeping the model held before
+it. Nothing is written while the search runs: :func:`faultgen.calibrate.calibrate` writes the model
+kept, once, at the end. A trial is compiled from the very text the file will hold (the edited
+spec's ``to_xml``, parsed again), not from the edited spec, so the model the search judged is the
+model the written file loads.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from faultgen.calibrate import search
+from faultgen.calibrate.effects import Effect, Motion
+from faultgen.calibrate.prediction import predicted_motion
+from faultgen.data import measured as measured_io
+from faultgen.model import robots
+
+
+@dataclass(frozen=True, eq=False)
+class HeldRobot(robots.Robot):
+    """A robot compiled from MJCF text held in memory, its ``path`` only a name (nothing is written
+    there): :meth:`edited` starts from that text, not from the file (an effect's regressors compile
+    edited copies, e.g. the payload's probe bodies, :class:`faultgen.effects.payload.Payload`).
+    :meth:`faultgen.model.robots.Robot.edited` reads the MJCF file at ``path``; once a robot holds
+    its own spec, this subclass can go.
+
+    Attributes
+    ----------
+    text : str
+        The MJCF text the robot was compiled from.
+    """
+
+    text: str = ""
+
+    def edited(self, edit) -> robots.Robot:
+        """A copy with ``edit(spec)`` applied to an ``MjSpec`` of :attr:`text`, compiled in memory."""
+        spec = mujoco.MjSpec.from_string(self.text)
+        edit(spec)
+        return robots.from_spec(spec, self.path)
+
+
+@dataclass(frozen=True)
+class Model:
+    """One model of a calibration, in memory.
+
+    Attributes
+    ----------
+    text : str
+        The MJCF text the model file holds when this model is the one kept (the nominal file's own
+        text for the nominal model).
+    robot : Robot
+        The robot compiled from it; its ``path`` names the file it would be written to.
+    xml : str
+        The text an edit starts from (:meth:`spec`): MuJoCo's ``to_xml`` of the model, which is
+        ``text`` except for the nominal model, whose file may be laid out by hand.
+    """
+
+    text: str
+    robot: robots.Robot
+    xml: str
+
+    @classmethod
+    def nominal(cls, robot: robots.Robot) -> Model:
+        """The nominal model: ``robot`` as loaded (:func:`faultgen.model.robots.load`) and its file."""
+        return cls(Path(robot.path).read_text(), robot, mujoco.MjSpec.from_file(str(robot.path)).to_xml())
+
+    def spec(self) -> mujoco.MjSpec:
+        """A fresh ``MjSpec`` of the model, to edit."""
+        return mujoco.MjSpec.from_string(self.xml)
+
+    def edited(self, edit: Callable[[mujoco.MjSpec, robots.Robot], None], path: Path) -> Model:
+        """The model with ``edit(spec, robot)`` applied (``robot`` this model's), compiled in memory
+        and named ``path`` (:func:`compiled`)."""
+        spec = self.spec()
+        edit(spec, self.robot)
+        return compiled(spec, path)
+
+    def with_effect(self, effect: Effect, axes: list[int] | None, path: Path) -> Model:
+        """The model with ``effect`` written on ``axes`` (array indices; :meth:`Effect.write`)."""
+        return self.edited(lambda spec, robot: effect.write(spec, robot, axes), path)
+
+
+def compiled(spec: mujoco.MjSpec, path: Path) -> Model:
+    """The model an edited ``spec`` describes: its ``to_xml`` text and the robot compiled from that
+    text in memory, named ``path`` (nothing is written there).
+
+    Raises
+    ------
+    ModelError
+        If the text does not compile (:func:`faultgen.model.robots.from_spec`).
+    """
+    text = spec.to_xml()
+    robot = robots.from_spec(mujoco.MjSpec.from_string(text), path)
+    held = HeldRobot(**{f.name: getattr(robot, f.name) for f in fields(robot) if f.init}, text=text)
+    return Model(text, held, text)
+
+
+@dataclass(frozen=True)
+class Judged:
+    """A model with its prediction along the log and its held-out gap.
+
+    Attributes
+    ----------
+    model : Model
+    prediction : ndarray of shape (n, 6)
+        Its torque along the log, N m (:func:`faultgen.calibrate.prediction.predicted_motion`).
+    motion : Motion
+        The log's motion as its robot sees it (the effects' regressors).
+    gap : dict
+        Its held-out gap (:func:`faultgen.calibrate.search.gap`).
+    """
+
+    model: Model
+    prediction: np.ndarray
+    motion: Motion
+    gap: dict
+
+
+def judge(model: Model, data: measured_io.MeasuredData, tau: np.ndarray, held_out: np.ndarray) -> Judged:
+    """``model``'s prediction and motion along ``data`` and its held-out gap on ``held_out`` (n, 6)
+    against the measured ``tau`` (n, 6), N m."""
+    prediction, motion = predicted_motion(model.robot, data)
+    return Judged(model, prediction, motion, search.gap(tau, prediction, held_out))
