@@ -11,7 +11,7 @@ model the written file loads.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -22,29 +22,6 @@ from faultgen.calibrate.effects import Effect, Motion
 from faultgen.calibrate.prediction import predicted_motion
 from faultgen.data import measured as measured_io
 from faultgen.model import robots
-
-
-@dataclass(frozen=True, eq=False)
-class HeldRobot(robots.Robot):
-    """A robot compiled from MJCF text held in memory, its ``path`` only a name (nothing is written
-    there): :meth:`edited` starts from that text, not from the file (an effect's regressors compile
-    edited copies, e.g. the payload's probe bodies, :class:`faultgen.effects.payload.Payload`).
-    :meth:`faultgen.model.robots.Robot.edited` reads the MJCF file at ``path``; once a robot holds
-    its own spec, this subclass can go.
-
-    Attributes
-    ----------
-    text : str
-        The MJCF text the robot was compiled from.
-    """
-
-    text: str = ""
-
-    def edited(self, edit) -> robots.Robot:
-        """A copy with ``edit(spec)`` applied to an ``MjSpec`` of :attr:`text`, compiled in memory."""
-        spec = mujoco.MjSpec.from_string(self.text)
-        edit(spec)
-        return robots.from_spec(spec, self.path)
 
 
 @dataclass(frozen=True)
@@ -98,9 +75,9 @@ def compiled(spec: mujoco.MjSpec, path: Path) -> Model:
         If the text does not compile (:func:`faultgen.model.robots.from_spec`).
     """
     text = spec.to_xml()
-    robot = robots.from_spec(mujoco.MjSpec.from_string(text), path)
-    held = HeldRobot(**{f.name: getattr(robot, f.name) for f in fields(robot) if f.init}, text=text)
-    return Model(text, held, text)
+    # the robot keeps the spec parsed from the text, so its edits (an effect's regressors compile
+    # edited copies, e.g. the payload's probe bodies) start from that text too
+    return Model(text, robots.from_spec(mujoco.MjSpec.from_string(text), path), text)
 
 
 @dataclass(frozen=True)
