@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import csv
 import datetime
+import io
 import os
 from dataclasses import dataclass
 from functools import lru_cache
@@ -51,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.model import robots
-from faultgen.operation import programs
+from faultgen.operation import jointlog, programs
 
 #: Unit-to-unit spread of each friction parameter (log-normal sigma) and its day-to-day scatter,
 #: drawn per log and parameter and not logged (the state of the lubricant film, the warm-up the
@@ -237,8 +238,8 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     n = model.n_axes
     t, q, qd, qdd = _motion(str(folder), spec.rate)
     logs = root / "logs"
-    header = ["t", *(f"q{i}" for i in range(1, n + 1)), *(f"tau{i}" for i in range(1, n + 1)),
-              *(f"temperature{i}" for i in range(1, n + 1)), "payload"]
+    q_names, _, tau_names = jointlog.column_names(n)  # t, q1..qN, tau1..tauN, temperature1..N, payload
+    header = [jointlog.T_COLUMN, *q_names, *tau_names, *jointlog.temperature_columns(n), jointlog.PAYLOAD_COLUMN]
     days = stamps(spec)
     for unit in _units(spec, n):
         folder_of_unit = logs / unit["unit"]
@@ -268,12 +269,15 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
             angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)
             _write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2), round(mass, 1))
     truth = root / "truth.csv"
-    part = truth.with_name(truth.name + ".part")
-    with open(part, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(TRUTH_COLUMNS)
-        writer.writerows(truth_rows(spec, n))
-    os.replace(part, truth)
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(TRUTH_COLUMNS)
+    writer.writerows(truth_rows(spec, n))
+    content = text.getvalue().encode()
+    if not truth.is_file() or truth.read_bytes() != content:  # a resumed write leaves it be
+        part = truth.with_name(truth.name + ".part")
+        part.write_bytes(content)
+        os.replace(part, truth)
     return logs, truth
 
 

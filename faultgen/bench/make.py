@@ -144,7 +144,9 @@ def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, j
         if "robots" in fields:
             fields["robots"] = [str(added.get(r, r)) for r in fields["robots"]]
         grid = faultgen.Grid.from_preset(preset, **fields) if preset else faultgen.Grid(**fields)
-        out = faultgen.run_sweep(grid, sweeps / f"{split}-{part}.h5", jobs=jobs, progress=progress, command=command)
+        out = sweeps / f"{split}-{part}.h5"
+        if not out.is_file():  # a sweep's file appears only when it is complete: one made before a stop is kept
+            out = faultgen.run_sweep(grid, out, jobs=jobs, progress=progress, command=command)
         runs.append(out)
     units = []
     for path in runs:
