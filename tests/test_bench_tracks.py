@@ -84,3 +84,16 @@ def test_a_logs_part_must_name_an_added_robot_and_a_source_must_be_installed():
         tracks.source_path("no_such_data:robot.urdf")
     with pytest.raises(ValueError, match="nope.urdf does not exist in the installed 'rtbdata'"):
         tracks.source_path("rtbdata:nope.urdf")
+
+
+def test_transfer_v2_adds_the_urdf_robot_to_the_test_split_and_leaves_v1_as_frozen():
+    track = tracks.load("transfer")
+    v1, v2 = track.version(1), track.version(2)
+    assert track.latest == 2 and v1.robots == [] and [r["name"] for r in v2.robots] == ["kr210"]
+    assert v2.grids("train", "small") == v1.grids("train", "small")  # the same nominal unit to learn
+    tested = {(name, tuple(fields["robots"])) for name, fields in v2.grids("test", "small")}
+    assert tested == {("other_units", ("irb6700",)), ("urdf_robot", ("kr210",))}
+    for size in ("small", "full"):  # version 1's frozen manifests stay (faultgen bench make --version 1 checks them)
+        assert json.loads(make.manifest_path("transfer", 1, size).read_text())["version"] == 1
+    assert json.loads(make.manifest_path("transfer", 2, "small").read_text())["status"] == "frozen"
+    assert tracks.source_path(v2.robots[0]["from"]).name == "kr210l150.urdf"
