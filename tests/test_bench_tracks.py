@@ -97,3 +97,13 @@ def test_transfer_v2_adds_the_urdf_robot_to_the_test_split_and_leaves_v1_as_froz
         assert json.loads(make.manifest_path("transfer", 1, size).read_text())["version"] == 1
     assert json.loads(make.manifest_path("transfer", 2, "small").read_text())["status"] == "frozen"
     assert tracks.source_path(v2.robots[0]["from"]).name == "kr210l150.urdf"
+
+
+def test_without_pinocchio_the_track_is_refused_before_any_sweep_naming_the_extra(tmp_path, monkeypatch):
+    def missing():
+        raise ImportError("the independent simulator needs Pinocchio: pip install 'faultgen-robots[bench]'")
+
+    monkeypatch.setattr(independent, "pinocchio_module", missing)
+    with pytest.raises(ValueError, match=r"track sim-to-real version 1: .*faultgen-robots\[bench\]"):
+        make.make("sim-to-real", tmp_path / "out", size="small", progress=False)
+    assert list(tmp_path.iterdir()) == []

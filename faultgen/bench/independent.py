@@ -115,7 +115,8 @@ class FleetSpec:
         datetime.date.fromisoformat(self.start)
 
 
-def _pin():
+def pinocchio_module():
+    """The ``pinocchio`` module; ImportError naming the extra that installs it."""
     try:
         import pinocchio
     except ImportError:
@@ -128,7 +129,7 @@ def pinocchio_model(urdf: Path, mass: float = 0.0, com=(0.0, 0.0, 0.0), size=(0.
     """Pinocchio's model (``pin.Model``) of ``urdf``, with a solid box of ``mass`` kg, centre ``com``
     (m, flange frame) and edges ``size`` (m) added to the inertia of the body that carries the flange
     frame (:data:`FLANGE_FRAME`)."""
-    pin = _pin()
+    pin = pinocchio_module()
     model = pin.buildModelFromUrdf(str(urdf))
     if mass > 0:
         frame = model.frames[model.getFrameId(FLANGE_FRAME)]
@@ -162,7 +163,7 @@ def _motion(folder: str, rate: float):
 @lru_cache(maxsize=64)
 def _rigid(folder: str, rate: float, mass: float) -> np.ndarray:
     """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`)."""
-    pin = _pin()
+    pin = pinocchio_module()
     _, q, qd, qdd = _motion(folder, rate)
     edge = (mass / PART_DENSITY) ** (1 / 3)
     model = pinocchio_model(Path(folder) / "urdf_used.urdf", mass, (0.0, 0.0, edge / 2), (edge, edge, edge))

@@ -10,7 +10,10 @@ the track and the first differing array. The output folder appears complete or n
 (:func:`faultgen.data.atomic.atomic_folder`); the sweeps' runs are kept beside it
 (``.<out>.<track>-<version>-<size>.sweeps``) until it is written, so that a make stopped by Ctrl-C
 or a kill resumes from the runs it finished when run again, and are removed after a difference
-from the frozen manifest too.
+from the frozen manifest too. A version's third-party robots (``[[versions.robots]]``) are added into
+that folder first, and a part of kind ``logs`` is a fleet written there by the independent simulator
+(:mod:`faultgen.bench.independent`) and imported as ``faultgen logs import`` does, its labels from the
+simulator's truth.
 """
 
 from __future__ import annotations
@@ -210,6 +213,13 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     if freeze and frozen_path.exists():
         raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
                          "a new recipe is a new version")
+    if any(recipe.fleets(split, size) for split in tracks.SPLITS):
+        from faultgen.bench import independent
+
+        try:
+            independent.pinocchio_module()
+        except ImportError as err:  # before any sweep; the command line reports a ValueError in one line
+            raise ValueError(f"track {track.name} version {recipe.number}: {err}") from None
     # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
     # resumes from the runs it finished when run again (the sweep's own resume)
     sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
