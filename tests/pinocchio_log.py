@@ -24,14 +24,14 @@ import numpy as np
 import pinocchio as pin
 import rtbdata
 
+from faultgen.bench import independent
 from faultgen.data import measured
 from faultgen.model import builder, importers, robots
 from faultgen.model.folder import add as add_robot
 from faultgen.operation import programs, taskgen
 
 KR210_URDF = Path(rtbdata.__file__).parent / "xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf"
-#: The flange frame of the URDF (ROS-Industrial's ``tool0``); the builder puts its ``flange`` site there.
-FLANGE_FRAME = "tool0"
+FLANGE_FRAME = independent.FLANGE_FRAME
 #: Log rate, Hz (the thesis's 4 ms sampling period).
 RATE = 250.0
 
@@ -48,15 +48,10 @@ class HiddenPayload:
 
 def pinocchio_model(urdf: Path, payload: HiddenPayload | None) -> pin.Model:
     """Pinocchio's model of ``urdf``, with ``payload`` added to the inertia of the body that
-    carries the flange frame."""
-    model = pin.buildModelFromUrdf(str(urdf))
-    if payload is not None and payload.mass > 0:
-        frame = model.frames[model.getFrameId(FLANGE_FRAME)]
-        box = pin.Inertia.FromBox(payload.mass, *payload.size)
-        at_flange = pin.SE3(np.eye(3), np.asarray(payload.com, dtype=float)).act(box)
-        joint = frame.parentJoint
-        model.inertias[joint] = model.inertias[joint] + frame.placement.act(at_flange)
-    return model
+    carries the flange frame (:func:`faultgen.bench.independent.pinocchio_model`)."""
+    if payload is None:
+        return independent.pinocchio_model(urdf)
+    return independent.pinocchio_model(urdf, payload.mass, payload.com, payload.size)
 
 
 def arm_torque(folder: Path, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray,

@@ -7,6 +7,8 @@
 - :mod:`~faultgen.bench.score`: ``faultgen bench score``, AUROC, delay, false alarms, isolation,
   each with a bootstrap interval over test units;
 - :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods and two pyod detectors).
+- :mod:`~faultgen.bench.independent`: the sim-to-real track's test fleet, made by another simulator
+  (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use).
 
 The layer sits above ``runs`` (it sweeps) and reads with the ``analysis`` package (it scores); only
 the command line sits above it (docs/bench.md).

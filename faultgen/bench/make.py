@@ -10,7 +10,10 @@ the track and the first differing array. The output folder appears complete or n
 (:func:`faultgen.data.atomic.atomic_folder`); the sweeps' runs are kept beside it
 (``.<out>.<track>-<version>-<size>.sweeps``) until it is written, so that a make stopped by Ctrl-C
 or a kill resumes from the runs it finished when run again, and are removed after a difference
-from the frozen manifest too.
+from the frozen manifest too. A version's third-party robots (``[[versions.robots]]``) are added into
+that folder first, and a part of kind ``logs`` is a fleet written there by the independent simulator
+(:mod:`faultgen.bench.independent`) and imported as ``faultgen logs import`` does, its labels from the
+simulator's truth.
 """
 
 from __future__ import annotations
@@ -79,22 +82,80 @@ def _unit(run) -> files.Unit:
     return unit
 
 
+def add_robots(version: tracks.Version, folder: Path) -> dict[str, Path]:
+    """Add the version's third-party robots (``[[versions.robots]]``) under ``folder``, as ``faultgen
+    robots add NAME --from FILE --package PKG=DIR`` does (with its generated tasks); a robot already
+    there is kept (adding is atomic). Returns name -> robot folder."""
+    import warnings
+
+    from faultgen.model import importers
+    from faultgen.model.folder import add
+    from faultgen.operation import taskgen
+
+    out = {}
+    for robot in version.robots:
+        target = folder / robot["name"]
+        if not target.is_dir():
+            source = tracks.source_path(robot["from"])
+            packages = {name: tracks.source_path(spec) for name, spec in dict(robot.get("packages", {})).items()}
+            with warnings.catch_warnings():  # the meshes a robot leaves out (the command prints them)
+                warnings.simplefilter("ignore", importers.GeometryDropped)
+                add(robot["name"], source, target, tasks=taskgen.generate, packages=packages)
+        out[robot["name"]] = target
+    return out
+
+
+def _fleet_units(version: tracks.Version, split: str, size: str, sweeps: Path, added: dict[str, Path],
+                 progress: bool) -> list[files.Unit]:
+    """The units of the version's ``logs`` parts for ``split``: each fleet written by the independent
+    simulator into ``sweeps`` (resuming), imported as ``faultgen logs import`` does (only new logs),
+    and labelled from its truth.csv (wear %, worn axis)."""
+    from faultgen.bench import independent
+    from faultgen.data import fleetlogs
+
+    units = []
+    for part, fleet in version.fleets(split, size):
+        folder = added[fleet["robot"]]
+        spec = independent.FleetSpec(**{k: tuple(v) if isinstance(v, list) else v for k, v in fleet["spec"].items()})
+        logs, truth_path = independent.write_fleet(sweeps / f"{split}-{part}", spec, folder)
+        dataset = sweeps / f"{split}-{part}.h5"
+        fleetlogs.import_logs(logs, dataset, robot=str(folder), progress=progress)
+        truth = independent.read_truth(truth_path)
+        with faultgen.open(dataset) as data:
+            for run in data:
+                unit = _unit(run)
+                known = truth[run.id]  # an imported run's id is its unit's folder name
+                if [s.decode() if isinstance(s, bytes) else str(s) for s in run.array("stamp")] != known["stamps"]:
+                    raise ValueError(f"{dataset}: the logs of unit {run.id} differ from the stamps of its truth")
+                unit.task = fleet["task"]  # the program every log of the fleet ran (the import says "measured")
+                unit.fault_level = known["wear"].astype(float)
+                unit.worn_axis = known["axis"]
+                unit.fault = "friction_wear" if known["axis"] else "none"
+                units.append(unit)
+    return units
+
+
 def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, jobs: int, progress: bool,
-                 command: str) -> list[files.Unit]:
+                 command: str, added: dict[str, Path]) -> list[files.Unit]:
     """Sweep every part of ``version`` for ``split`` into ``sweeps`` (resuming finished runs) and read
-    the runs as labelled units, in the parts' order and each sweep's run order."""
+    the runs as labelled units, in the parts' order and each sweep's run order; then the units of its
+    ``logs`` parts (:func:`_fleet_units`). ``added``: the third-party robots' folders, by name."""
     runs = []
     for part, fields in version.grids(split, size):
         fields = dict(fields)
         preset = fields.pop("preset", None)
+        if "robots" in fields:
+            fields["robots"] = [str(added.get(r, r)) for r in fields["robots"]]
         grid = faultgen.Grid.from_preset(preset, **fields) if preset else faultgen.Grid(**fields)
-        out = faultgen.run_sweep(grid, sweeps / f"{split}-{part}.h5", jobs=jobs, progress=progress, command=command)
+        out = sweeps / f"{split}-{part}.h5"
+        if not out.is_file():  # a sweep's file appears only when it is complete: one made before a stop is kept
+            out = faultgen.run_sweep(grid, out, jobs=jobs, progress=progress, command=command)
         runs.append(out)
     units = []
     for path in runs:
         with faultgen.open(path) as data:
             units += [_unit(run) for run in data]
-    return units
+    return units + _fleet_units(version, split, size, sweeps, added, progress)
 
 
 def _order(track: str, version: int, n: int) -> np.ndarray:
@@ -152,13 +213,21 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     if freeze and frozen_path.exists():
         raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
                          "a new recipe is a new version")
+    if any(recipe.fleets(split, size) for split in tracks.SPLITS):
+        from faultgen.bench import independent
+
+        try:
+            independent.pinocchio_module()
+        except ImportError as err:  # before any sweep; the command line reports a ValueError in one line
+            raise ValueError(f"track {track.name} version {recipe.number}: {err}") from None
     # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
     # resumes from the runs it finished when run again (the sweep's own resume)
     sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
     sweeps.mkdir(exist_ok=True)
     with atomic.atomic_folder(out) as stage:
-        train = _split_units(recipe, "train", size, sweeps, jobs, progress, command)
-        test = _split_units(recipe, "test", size, sweeps, jobs, progress, command)
+        added = add_robots(recipe, sweeps / "robots")
+        train = _split_units(recipe, "train", size, sweeps, jobs, progress, command, added)
+        test = _split_units(recipe, "test", size, sweeps, jobs, progress, command, added)
         for k, unit in enumerate(train):
             unit.id = f"train-{k:03d}"
         test = [test[i] for i in _order(track.name, recipe.number, len(test))]

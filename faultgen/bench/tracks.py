@@ -7,7 +7,17 @@ faultgen, that alters the data is a new version. Each version is one or more *pa
 grid (:class:`faultgen.Grid` fields, ``preset`` allowed) made twice: with the train seeds and with
 the test seeds, which must be disjoint (so are the units: a unit is a robot with its own seed, its
 own noise and, with ``spread``, its own friction). ``[versions.small]`` holds the overrides of the
-test-sized version (``--size small``), made in seconds for tests and examples.
+test-sized version (``--size small``), made in seconds for tests and examples; a part's own ``small``
+table overrides it for that part.
+
+A part of kind ``logs`` (``kind = "logs"``) is not a sweep: it is a fleet's measured logs made by the
+independent simulator (:mod:`faultgen.bench.independent`, Pinocchio) for the robot ``robot`` doing
+``task``, one fleet per seed of its split (``fleet``: :class:`~faultgen.bench.independent.FleetSpec`
+fields), read with ``faultgen logs import`` (:func:`faultgen.data.fleetlogs.import_logs`); its
+``small`` overrides ``fleet``. A version's ``[[versions.robots]]`` are robots added from a
+third-party file as a user adds them (``faultgen robots add NAME --from FILE --package PKG=DIR``):
+``name``, ``from`` and ``packages``, each file given as ``python_package:path/inside`` (an installed
+data package such as rtb-data's ``rtbdata``); a part names them as any robot.
 
 A track without ``versions`` is a slot: listed, with what it still needs (``needs``).
 """
@@ -24,7 +34,11 @@ SPLITS = ("train", "test")
 
 #: The keys of a track file and of a version (anything else is refused, named).
 _TRACK_KEYS = {"name", "summary", "licence", "card", "needs", "versions"}
-_VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small"}
+_VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small", "robots"}
+_ROBOT_KEYS = {"name", "from", "packages"}
+_LOGS_KEYS = {"name", "kind", "robot", "task", "fleet", "small", "train_seeds", "test_seeds"}
+#: Keys of a part that are not :class:`faultgen.Grid` fields.
+_PART_KEYS = ("name", "kind", "small", "train_seeds", "test_seeds")
 
 
 @dataclass(frozen=True)
@@ -42,6 +56,8 @@ class Version:
     small : dict
         Grid-field overrides of every part for ``--size small``.
     notes : str
+    robots : list of dict
+        Robots added from a third-party file (``name``, ``from``, ``packages``; module docstring).
     """
 
     number: int
@@ -50,6 +66,10 @@ class Version:
     test_seeds: list[int]
     small: dict = field(default_factory=dict)
     notes: str = ""
+    robots: list[dict] = field(default_factory=list)
+
+    def _seeds(self, part: dict, split: str) -> list[int]:
+        return list(part.get(f"{split}_seeds", getattr(self, f"{split}_seeds")))
 
     def grids(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
         """(part name, grid fields) of each part for ``split`` ("train" or "test") at ``size``."""
@@ -59,14 +79,36 @@ class Version:
             raise ValueError(f"size {size!r}: expected one of {', '.join(SIZES)}")
         out = []
         for k, part in enumerate(self.parts):
-            fields = {key: value for key, value in part.items() if key not in ("name", "train_seeds", "test_seeds")}
-            fields["seeds"] = list(part.get(f"{split}_seeds", getattr(self, f"{split}_seeds")))
+            if part.get("kind", "grid") == "logs":
+                continue
+            fields = {key: value for key, value in part.items() if key not in _PART_KEYS}
+            fields["seeds"] = self._seeds(part, split)
             if not fields["seeds"]:  # a part of one split only (the transfer track's nominal unit)
                 continue
             fields["signals"] = False  # features only: the benchmark scores per-cycle features
             if size == "small":
                 fields.update(self.small)
+                fields.update(part.get("small", {}))
             out.append((str(part.get("name", f"part{k + 1}")), fields))
+        return out
+
+    def fleets(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
+        """(part name, fleet) of each part of kind ``logs`` for ``split`` at ``size``, one per seed:
+        ``{"robot", "task", "spec"}``, ``spec`` the :class:`~faultgen.bench.independent.FleetSpec`
+        fields with the seed."""
+        if split not in SPLITS or size not in SIZES:
+            raise ValueError(f"split {split!r}, size {size!r}: expected one of {', '.join(SPLITS)} and of "
+                             f"{', '.join(SIZES)}")
+        out = []
+        for k, part in enumerate(self.parts):
+            if part.get("kind", "grid") != "logs":
+                continue
+            spec = dict(part.get("fleet", {}))
+            if size == "small":
+                spec.update(part.get("small", {}))
+            for seed in self._seeds(part, split):
+                out.append((f"{part.get('name', f'part{k + 1}')}-{seed}",
+                            {"robot": part["robot"], "task": part["task"], "spec": {**spec, "seed": seed}}))
         return out
 
 
@@ -141,10 +183,12 @@ def parse(data: dict, source: str) -> Track:
             raise ValueError(f"{source}: version {number!r}: expected a new whole number >= 1")
         version = Version(number=number, parts=list(entry.get("parts", [])), train_seeds=list(entry["train_seeds"]),
                           test_seeds=list(entry["test_seeds"]), small=dict(entry.get("small", {})),
-                          notes=str(entry.get("notes", "")))
+                          notes=str(entry.get("notes", "")), robots=list(entry.get("robots", [])))
         if not version.parts:
             raise ValueError(f"{source}: version {number}: no [[versions.parts]]")
-        seeds = {split: {s for _, grid in version.grids(split) for s in grid["seeds"]} for split in SPLITS}
+        _check_robots_and_logs(version, f"{source}: version {number}")
+        seeds = {split: {s for _, grid in version.grids(split) for s in grid["seeds"]}
+                 | {fleet["spec"]["seed"] for _, fleet in version.fleets(split)} for split in SPLITS}
         shared = sorted(seeds["train"] & seeds["test"])
         if shared or not seeds["train"] or not seeds["test"]:
             raise ValueError(f"{source}: version {number}: train seeds {sorted(seeds['train'])} and test seeds "
@@ -152,6 +196,54 @@ def parse(data: dict, source: str) -> Track:
         versions[number] = version
     return Track(name=data["name"], summary=data["summary"], licence=data["licence"], card=data.get("card", ""),
                  needs=data.get("needs", ""), versions=versions)
+
+
+def _check_robots_and_logs(version: Version, where: str) -> None:
+    """Refuse a malformed ``[[versions.robots]]`` entry or part of kind ``logs`` (naming it)."""
+    added = set()
+    for robot in version.robots:
+        bad = sorted(set(robot) - _ROBOT_KEYS)
+        if bad or not isinstance(robot.get("name"), str) or not isinstance(robot.get("from"), str):
+            raise ValueError(f"{where}: robot {robot!r}: expected a table of name and from (and packages)")
+        for spec in (robot["from"], *dict(robot.get("packages", {})).values()):
+            if ":" not in spec:
+                raise ValueError(f"{where}: robot {robot['name']!r}: {spec!r}: expected python_package:path/inside")
+        added.add(robot["name"])
+    for part in version.parts:
+        kind = part.get("kind", "grid")
+        if kind not in ("grid", "logs"):
+            raise ValueError(f"{where}: part {part.get('name')!r}: kind {kind!r}: expected grid or logs")
+        if kind != "logs":
+            continue
+        bad = sorted(set(part) - _LOGS_KEYS)
+        if bad:
+            raise ValueError(f"{where}: logs part {part.get('name')!r}: unknown key {bad[0]!r}; expected: "
+                             f"{', '.join(sorted(_LOGS_KEYS))}")
+        if part.get("robot") not in added or not isinstance(part.get("task"), str):
+            raise ValueError(f"{where}: logs part {part.get('name')!r}: robot {part.get('robot')!r} must be one of "
+                             f"the version's [[versions.robots]] ({', '.join(sorted(added)) or 'none'}), and task a name")
+
+
+def source_path(spec: str) -> Path:
+    """The file or folder ``python_package:path/inside`` of an installed data package (rtb-data's
+    ``rtbdata:xacro/...``), found without importing the package.
+
+    Raises
+    ------
+    ValueError
+        If the package is not installed or has no such path (naming both, and the extra that installs it).
+    """
+    from importlib.util import find_spec
+
+    package, _, inside = spec.partition(":")
+    found = find_spec(package) if package.isidentifier() else None
+    if found is None or not found.submodule_search_locations:
+        raise ValueError(f"{spec}: the data package {package!r} is not installed; it comes with the bench extra: "
+                         "pip install 'faultgen-robots[bench]'")
+    path = Path(list(found.submodule_search_locations)[0]) / inside
+    if not path.exists():
+        raise ValueError(f"{spec}: {path} does not exist in the installed {package!r}")
+    return path
 
 
 def load(name: str) -> Track:
