@@ -22,10 +22,15 @@ from pathlib import Path
 from faultgen.bench import baselines, tracks
 
 
-def run(argv: list[str]) -> float:
+def run(argv: list[str]) -> tuple[float, str | None]:
+    """(wall s, None) of a command, or (wall s, its last error line) when it failed."""
     start = time.perf_counter()
-    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    done = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    error = None
+    if done.returncode != 0:
+        lines = [line for line in done.stderr.splitlines() if line.strip()]
+        error = f"exit {done.returncode}: {lines[-1] if lines else '(no message)'}"
+    return time.perf_counter() - start, error
 
 
 def main() -> None:
@@ -40,23 +45,30 @@ def main() -> None:
     made = dict(m.split("=", 1) for m in args.made)
     faultgen = [sys.executable, "-m", "faultgen.cli"]
     names = args.track or [n for n in tracks.names() if tracks.load(n).versions]
-    rows, total = [], 0.0
+    rows, total, failed = [], 0.0, []
     for name in names:
         folder = Path(made.get(name, args.out / name))
         if name not in made:
-            seconds = run([*faultgen, "bench", "make", name, "--size", args.size, "--jobs", str(args.jobs),
-                           "--no-progress", "-o", str(folder)])
+            seconds, error = run([*faultgen, "bench", "make", name, "--size", args.size, "--jobs", str(args.jobs),
+                                  "--no-progress", "-o", str(folder)])
             total += seconds
-            print(f"make {name} ({args.size}): {seconds:.1f} s", flush=True)
+            print(f"make {name} ({args.size}): {seconds:.1f} s" + (f"; FAILED, {error}" if error else ""), flush=True)
+            if error:  # its baselines cannot be scored; the other tracks still run
+                failed.append(f"make {name}")
+                continue
         for baseline in baselines.DETECTORS + baselines.ISOLATORS:
             stem = args.out / f"{name}-{baseline}"
-            seconds = run([*faultgen, "bench", "score", name, "--data", str(folder), "--baseline", baseline,
-                           "-o", str(stem)])
+            seconds, error = run([*faultgen, "bench", "score", name, "--data", str(folder), "--baseline", baseline,
+                                  "-o", str(stem)])
             total += seconds
-            print(f"score {name} {baseline}: {seconds:.1f} s", flush=True)
+            print(f"score {name} {baseline}: {seconds:.1f} s" + (f"; FAILED, {error}" if error else ""), flush=True)
+            if error:
+                failed.append(f"score {name} {baseline}")
+                continue
             rows.append(stem.with_name(stem.name + ".md").read_text().strip())
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    print(f"\ntotal {total / 60:.1f} min; largest process {peak:.0f} MB\n")
+    print(f"\ntotal {total / 60:.1f} min; largest process {peak:.0f} MB")
+    print(f"NOT the whole benchmark: {len(failed)} step(s) failed ({', '.join(failed)})\n" if failed else "")
     print("| track | method | AUROC [95 % CI] | false alarms % | detected % | delay after 10 % wear (cycles) | "
           "isolation top-1 % | command | date |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
