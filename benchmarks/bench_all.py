@@ -5,6 +5,7 @@ leaderboard rows (docs/leaderboard.md) as the commands wrote them.
     python benchmarks/bench_all.py --size small -o bench-all            # minutes
     python benchmarks/bench_all.py --jobs 2 -o bench-all                # the full tracks (issue 48: <= 60 min, <= 4 GB)
     python benchmarks/bench_all.py --size small --made thesis=DIR ...   # score folders made before
+    python benchmarks/bench_all.py --jobs 2 --freeze -o bench-all       # maintainers: freeze new versions
 
 The issue's target is a budget, not a ratio: the script prints the wall time of each command and
 their sum, and the largest resident set of any child process (``ru_maxrss`` of the children).
@@ -19,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from faultgen.bench import baselines, tracks
+from faultgen.bench import baselines, make, tracks
 
 
 def run(argv: list[str]) -> tuple[float, str | None]:
@@ -40,6 +41,9 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=1)
     parser.add_argument("--made", action="append", default=[], metavar="TRACK=DIR", help="a track's folder made before")
     parser.add_argument("--track", action="append", default=[], help="only these tracks (default: every one with a version)")
+    parser.add_argument("--freeze", action="store_true",
+                        help="maintainers: make a track version that has no frozen manifest at this size with "
+                             "`faultgen bench make --freeze` (its manifest becomes the version's reference)")
     args = parser.parse_args()
     args.out.mkdir(exist_ok=True)
     made = dict(m.split("=", 1) for m in args.made)
@@ -49,10 +53,12 @@ def main() -> None:
     for name in names:
         folder = Path(made.get(name, args.out / name))
         if name not in made:
+            freeze = args.freeze and not make.manifest_path(name, tracks.load(name).latest, args.size).exists()
             seconds, error = run([*faultgen, "bench", "make", name, "--size", args.size, "--jobs", str(args.jobs),
-                                  "--no-progress", "-o", str(folder)])
+                                  "--no-progress", "-o", str(folder), *(["--freeze"] if freeze else [])])
             total += seconds
-            print(f"make {name} ({args.size}): {seconds:.1f} s" + (f"; FAILED, {error}" if error else ""), flush=True)
+            print(f"make {name} ({args.size}{', frozen now' if freeze and not error else ''}): {seconds:.1f} s"
+                  + (f"; FAILED, {error}" if error else ""), flush=True)
             if error:  # its baselines cannot be scored; the other tracks still run
                 failed.append(f"make {name}")
                 continue

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -17,14 +19,19 @@ from faultgen.data import fleetlogs
 
 @pytest.fixture(scope="module")
 def sim_to_real(tmp_path_factory):
+    """The latest version at its test size, made by the command (in the version's numeric profile)."""
     folder = tmp_path_factory.mktemp("bench") / "s2r"
-    return folder, make.make("sim-to-real", folder, size="small", progress=False)
+    done = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "make", "sim-to-real", "--size", "small",
+                           "--no-progress", "-o", str(folder)],
+                          check=False, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    return folder, json.loads((folder / "manifest.json").read_text())
 
 
 def test_sim_to_real_is_made_against_its_frozen_manifest_with_the_fleet_as_the_test_split(sim_to_real):
     folder, manifest = sim_to_real
-    assert manifest["status"] == "checked"  # faultgen/bench/manifests/sim-to-real-1-small.json
-    frozen = json.loads(make.manifest_path("sim-to-real", 1, "small").read_text())["arrays"]
+    assert manifest["status"] == "checked"  # faultgen/bench/manifests/sim-to-real-2-small.json
+    frozen = json.loads(make.manifest_path("sim-to-real", 2, "small").read_text())["arrays"]
     assert manifest["arrays"] == frozen
     train, test = files.read(folder / "train.h5"), files.read(folder / "test.h5")
     # train: faultgen's simulation (cycles); test: the independent fleet's logs, one record a day
@@ -42,9 +49,13 @@ def test_sim_to_real_is_made_against_its_frozen_manifest_with_the_fleet_as_the_t
     assert sum(axis > 0 for axis, _ in truth.values()) == 2 and all(len(u.arrays["cycles"]) == 24 for u in test)
 
 
-def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path, monkeypatch, sim_to_real):
+def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path, monkeypatch):
     """Stopped (Ctrl-C) at the import of the fleet's logs: the train sweep and the fleet are done and kept
-    beside the output; the make run again makes neither again and gives the same manifest."""
+    beside the output; the make run again makes neither again and gives the manifest of a make never
+    stopped. In this process (to stop it), so version 1 (no numeric profile), checked against a make
+    of this process rather than the frozen manifest (made on one kind of processor)."""
+    monkeypatch.setattr(make, "manifest_path", lambda t, v, s: tmp_path / f"{t}-{v}-{s}.json")
+    unstopped = make.make("sim-to-real", tmp_path / "unstopped", version=1, size="small", progress=False)
     real_import = fleetlogs.import_logs
     seen = []
 
@@ -53,7 +64,7 @@ def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path
 
     monkeypatch.setattr(fleetlogs, "import_logs", stopped)
     with pytest.raises(KeyboardInterrupt):
-        make.make("sim-to-real", tmp_path / "out", size="small", progress=False)
+        make.make("sim-to-real", tmp_path / "out", version=1, size="small", progress=False)
     assert not (tmp_path / "out").exists()
     sweeps = tmp_path / ".out.sim-to-real-1-small.sweeps"
     done = sorted(p for p in sweeps.rglob("*") if p.is_file() and p.suffix in (".h5", ".csv", ".xml"))
@@ -65,9 +76,9 @@ def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path
         return real_import(*args, **kwargs)
 
     monkeypatch.setattr(fleetlogs, "import_logs", spy)
-    manifest = make.make("sim-to-real", tmp_path / "out", size="small", progress=False)
+    manifest = make.make("sim-to-real", tmp_path / "out", version=1, size="small", progress=False)
     assert len(seen) == 1 and [p.name for p in before if seen[0][p] != before[p]] == []
-    assert manifest["arrays"] == sim_to_real[1]["arrays"] and not sweeps.exists()
+    assert manifest["arrays"] == unstopped["arrays"] and not sweeps.exists()
 
 
 def test_a_logs_part_must_name_an_added_robot_and_a_source_must_be_installed():
@@ -89,7 +100,8 @@ def test_a_logs_part_must_name_an_added_robot_and_a_source_must_be_installed():
 def test_transfer_v2_adds_the_urdf_robot_to_the_test_split_and_leaves_v1_as_frozen():
     track = tracks.load("transfer")
     v1, v2 = track.version(1), track.version(2)
-    assert track.latest == 2 and v1.robots == [] and [r["name"] for r in v2.robots] == ["kr210"]
+    assert track.latest == 3 and v1.robots == [] and [r["name"] for r in v2.robots] == ["kr210"]
+    assert track.version(3).robots == v2.robots  # version 3: version 2 in the numeric profile
     assert v2.grids("train", "small") == v1.grids("train", "small")  # the same nominal unit to learn
     tested = {(name, tuple(fields["robots"])) for name, fields in v2.grids("test", "small")}
     assert tested == {("other_units", ("irb6700",)), ("urdf_robot", ("kr210",))}
@@ -105,5 +117,5 @@ def test_without_pinocchio_the_track_is_refused_before_any_sweep_naming_the_extr
 
     monkeypatch.setattr(independent, "pinocchio_module", missing)
     with pytest.raises(ValueError, match=r"track sim-to-real version 1: .*faultgen-robots\[bench\]"):
-        make.make("sim-to-real", tmp_path / "out", size="small", progress=False)
+        make.make("sim-to-real", tmp_path / "out", version=1, size="small", progress=False)
     assert list(tmp_path.iterdir()) == []

@@ -19,6 +19,7 @@ import re
 import shlex
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -99,10 +100,17 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
         if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
             shutil.copy(made_files[same[0]], same[0])
             continue
-        result = runner.invoke(app, small(words[1:], page, scheduler))
-        assert result.exit_code == 0, f"{line}\n{result.output}"
+        if words[1:3] == ["bench", "make"]:  # as a command: it starts itself again in the track's numeric profile
+            done = subprocess.run([sys.executable, "-m", "faultgen.cli", *small(words[1:], page, scheduler)],
+                                  check=False, capture_output=True, text=True, timeout=600)
+            assert done.returncode == 0, f"{line}\n{done.stdout}{done.stderr}"
+            output = done.stdout
+        else:
+            result = runner.invoke(app, small(words[1:], page, scheduler))
+            assert result.exit_code == 0, f"{line}\n{result.output}"
+            output = result.output
         if target:
-            Path(target).write_text(result.output)
+            Path(target).write_text(output)
 
 
 # -- what the docs tell a user to make before the examples ------------------------------------------

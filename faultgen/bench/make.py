@@ -13,7 +13,9 @@ or a kill resumes from the runs it finished when run again, and are removed afte
 from the frozen manifest too. A version's third-party robots (``[[versions.robots]]``) are added into
 that folder first, and a part of kind ``logs`` is a fleet written there by the independent simulator
 (:mod:`faultgen.bench.independent`) and imported as ``faultgen logs import`` does, its labels from the
-simulator's truth.
+simulator's truth. A version with a numeric ``profile`` is made in it (:mod:`faultgen.bench.profile`),
+and every manifest records the environment that made it (machine, BLAS kernels, NumPy's dispatch,
+package versions), which a failed check compares with its own.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 import faultgen
-from faultgen.bench import files, tracks
+from faultgen.bench import files, profile, tracks
 from faultgen.data import atomic
 
 OUTPUTS = ("train.h5", "test.h5", "test_labels.csv", "manifest.json")
@@ -158,6 +160,31 @@ def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, j
     return units + _fleet_units(version, split, size, sweeps, added, progress)
 
 
+def _why(track: tracks.Track, recipe: tracks.Version, numeric: str, frozen: dict | None, here: dict) -> str:
+    """What a difference from the frozen manifest says: the environments' differences where the frozen
+    one is recorded, the processor's kernels for a version made before profiles or on a processor
+    that cannot take its profile, else a faultgen change (a new version)."""
+    new = max(track.versions) + 1
+    change = (f"if this faultgen changed the track's data, add version {new} to faultgen/bench/tracks/{track.name}.toml "
+              f"and freeze it (faultgen bench make {track.name} --version {new} --freeze)")
+    if frozen:
+        moved = [f"{k} {frozen.get(k)!r} -> {here.get(k)!r}" for k in ("machine", "blas", "numpy_dispatch")
+                 if frozen.get(k) != here.get(k)]
+        moved += [f"{name} {frozen['packages'].get(name)} -> {here['packages'].get(name)}"
+                  for name in sorted(set(frozen.get("packages", {})) | set(here["packages"]))
+                  if frozen.get("packages", {}).get(name) != here["packages"].get(name)]
+        if moved:
+            change = f"the environment differs from the one that froze it ({'; '.join(moved)}); or {change}"
+    if recipe.profile is None:
+        pinned = [n for n in sorted(track.versions) if track.versions[n].profile]
+        change += (f"; version {recipe.number} was frozen before tracks pinned their numeric profile, so its bits also "
+                   "depend on the processor's BLAS and NumPy kernels"
+                   + (f": make version {pinned[-1]}" if pinned else ""))
+    elif numeric == "unsupported":
+        change += f"; this processor cannot take the version's numeric profile {recipe.profile} (faultgen.bench.profile)"
+    return change
+
+
 def _order(track: str, version: int, n: int) -> np.ndarray:
     """The test units' seeded order: a permutation from the track's name and version."""
     seed = int.from_bytes(hashlib.sha256(f"{track}-{version}".encode()).digest()[:8], "little")
@@ -188,15 +215,17 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     Returns
     -------
     dict
-        The manifest: track, version, size, faultgen_version, status ("checked" or "frozen" or
-        "unfrozen": no frozen manifest to check against), and ``arrays`` (name -> SHA-256).
+        The manifest: track, version, size, faultgen_version, licence, profile (the version's numeric
+        profile or None), environment (:func:`faultgen.bench.profile.describe`), status ("checked" or
+        "frozen" or "unfrozen": no frozen manifest to check against), and ``arrays`` (name -> SHA-256).
 
     Raises
     ------
     ValueError
-        For an unknown track, version or size, a slot, a folder that cannot be written, or data that
-        differs from the frozen manifest (naming the track and the first differing array; nothing is
-        written).
+        For an unknown track, version or size, a slot, a folder that cannot be written, a version with
+        a numeric profile in a process started without it (:func:`faultgen.bench.profile.check`), or
+        data that differs from the frozen manifest (naming the track, the first differing array and
+        what differs from the environment that froze it; nothing is written).
     """
     track = tracks.load(track_name)
     recipe = track.version(version)
@@ -209,6 +238,7 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         raise ValueError(f"-o {out} is a file; give a folder")
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"--jobs {jobs!r}: expected a whole number >= 1")
+    numeric = profile.check(recipe.profile)  # before any work: a process that cannot be pinned any more is refused
     frozen_path = manifest_path(track.name, recipe.number, size)
     if freeze and frozen_path.exists():
         raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
@@ -242,18 +272,19 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         files.write(stage / "test.h5", test, {**attrs, "split": "test"})
         arrays = hashes(stage)
         manifest = {"track": track.name, "version": recipe.number, "size": size, "faultgen_version": faultgen.__version__,
-                        "licence": track.licence, "arrays": arrays}
+                    "licence": track.licence, "profile": recipe.profile, "environment": profile.describe(),
+                    "arrays": arrays}
         if frozen_path.exists():
-            frozen = json.loads(frozen_path.read_text())["arrays"]
-            differs = first_difference(arrays, frozen)
+            frozen = json.loads(frozen_path.read_text())
+            differs = first_difference(arrays, frozen["arrays"])
             if differs:
                 key, n = differs
                 shutil.rmtree(sweeps, ignore_errors=True)  # the same code would give the same runs again
                 raise ValueError(
                     f"track {track.name} version {recipe.number} ({size}): the data differs from the frozen manifest "
-                    f"at {key} ({n} of {len(frozen)} arrays differ): this faultgen changes the track's data; add "
-                    f"version {max(track.versions) + 1} to faultgen/bench/tracks/{track.name}.toml and freeze it "
-                    f"(faultgen bench make {track.name} --version {max(track.versions) + 1} --freeze); nothing written")
+                    f"at {key} ({n} of {len(frozen['arrays'])} arrays differ): "
+                    f"{_why(track, recipe, numeric, frozen.get('environment'), manifest['environment'])}; "
+                    "nothing written")
             manifest["status"] = "checked"
         elif freeze:
             atomic.write_text(frozen_path, json.dumps({**manifest, "status": "frozen"}, indent=1) + "\n")

@@ -19,6 +19,10 @@ third-party file as a user adds them (``faultgen robots add NAME --from FILE --p
 ``name``, ``from`` and ``packages``, each file given as ``python_package:path/inside`` (an installed
 data package such as rtb-data's ``rtbdata``); a part names them as any robot.
 
+A version may name the numeric ``profile`` it is made in (:mod:`faultgen.bench.profile`: the same
+bits on two machines), and may be ``like`` an earlier version: its recipe (parts, seeds, small,
+robots) with the version's own keys over it.
+
 A track without ``versions`` is a slot: listed, with what it still needs (``needs``).
 """
 
@@ -29,12 +33,17 @@ from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
+from faultgen.bench import profile
+
 SIZES = ("full", "small")
 SPLITS = ("train", "test")
 
 #: The keys of a track file and of a version (anything else is refused, named).
 _TRACK_KEYS = {"name", "summary", "licence", "card", "needs", "versions"}
-_VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small", "robots"}
+_VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small", "robots", "profile",
+                 "like"}
+#: The keys a version takes from the version it is ``like``.
+_RECIPE_KEYS = ("parts", "train_seeds", "test_seeds", "small", "robots")
 _ROBOT_KEYS = {"name", "from", "packages"}
 _LOGS_KEYS = {"name", "kind", "robot", "task", "fleet", "small", "train_seeds", "test_seeds"}
 #: Keys of a part that are not :class:`faultgen.Grid` fields.
@@ -58,6 +67,9 @@ class Version:
     notes : str
     robots : list of dict
         Robots added from a third-party file (``name``, ``from``, ``packages``; module docstring).
+    profile : str or None
+        The numeric profile the version is made in (:mod:`faultgen.bench.profile`), None for the
+        versions frozen before profiles (their bits depend on the processor's kernels).
     """
 
     number: int
@@ -67,6 +79,7 @@ class Version:
     small: dict = field(default_factory=dict)
     notes: str = ""
     robots: list[dict] = field(default_factory=list)
+    profile: str | None = None
 
     def _seeds(self, part: dict, split: str) -> list[int]:
         return list(part.get(f"{split}_seeds", getattr(self, f"{split}_seeds")))
@@ -172,7 +185,7 @@ def parse(data: dict, source: str) -> Track:
     for key in ("name", "summary", "licence"):
         if not isinstance(data.get(key), str) or not data[key]:
             raise ValueError(f"{source}: {key!r} must be a non-empty string")
-    versions = {}
+    versions, raw = {}, {}
     for entry in data.get("versions", []):
         bad = sorted(set(entry) - _VERSION_KEYS)
         if bad:
@@ -181,9 +194,20 @@ def parse(data: dict, source: str) -> Track:
         number = entry.get("version")
         if not isinstance(number, int) or isinstance(number, bool) or number < 1 or number in versions:
             raise ValueError(f"{source}: version {number!r}: expected a new whole number >= 1")
+        if "like" in entry:  # the recipe of an earlier version, with this entry's own keys over it
+            if entry["like"] not in raw:
+                raise ValueError(f"{source}: version {number}: like = {entry['like']!r}: expected an earlier version "
+                                 f"of this file ({', '.join(map(str, raw)) or 'none'})")
+            entry = {**{k: v for k, v in raw[entry["like"]].items() if k in _RECIPE_KEYS}, **entry}
+        raw[number] = entry
+        try:
+            profile.unknown(entry.get("profile"))
+        except ValueError as err:
+            raise ValueError(f"{source}: version {number}: {err}") from None
         version = Version(number=number, parts=list(entry.get("parts", [])), train_seeds=list(entry["train_seeds"]),
                           test_seeds=list(entry["test_seeds"]), small=dict(entry.get("small", {})),
-                          notes=str(entry.get("notes", "")), robots=list(entry.get("robots", [])))
+                          notes=str(entry.get("notes", "")), robots=list(entry.get("robots", [])),
+                          profile=entry.get("profile"))
         if not version.parts:
             raise ValueError(f"{source}: version {number}: no [[versions.parts]]")
         _check_robots_and_logs(version, f"{source}: version {number}")

@@ -76,22 +76,33 @@ def make_command(
     the first differing array, and writes nothing. The test labels go to test_labels.csv, apart
     from test.h5: give a method train.h5 and test.h5 only.
 
-    `--size small` makes the test-sized version in seconds.
+    `--size small` makes the test-sized version in seconds. A version made in a numeric profile
+    (OpenBLAS's and NumPy's kernels pinned, so that any x86-64 machine with AVX2 gives the same
+    bits) is made in a process started again with it.
 
     Example:
 
     \b
       faultgen bench make thesis --jobs 2 -o bench-thesis
     """
-    from faultgen.bench import make
+    from faultgen.bench import make, profile, tracks
 
+    try:
+        wanted = tracks.load(track).version(version).profile
+    except ValueError:
+        wanted = None  # make() names the problem
+    if sys.argv[1:3] == ["bench", "make"]:  # run as a command (not inside a test's runner): pin the profile
+        profile.restart_pinned(wanted, sys.argv[1:])
     manifest = make.make(track, out, version=version, size=size, jobs=jobs, progress=progress,
                          command=shlex.join(["faultgen", *sys.argv[1:]]), freeze=freeze)
     verdict = {"checked": "identical to the frozen manifest",
                "frozen": "frozen now: this manifest is the version's reference",
                "unfrozen": "no frozen manifest for this version and size: not checked"}[manifest["status"]]
+    numeric = (f"numeric profile {wanted}" if wanted and profile.pinned(wanted) else
+               f"NOT in its numeric profile {wanted} (this processor cannot take it: other machines may differ)"
+               if wanted else "no numeric profile (a version frozen before profiles: its bits depend on the processor)")
     typer.echo(f"track {manifest['track']} version {manifest['version']} ({manifest['size']}): "
-               f"{len(manifest['arrays'])} arrays, {verdict}; data licence {manifest['licence']}")
+               f"{len(manifest['arrays'])} arrays, {verdict}; {numeric}; data licence {manifest['licence']}")
     typer.echo(f"wrote {out}/train.h5, {out}/test.h5, {out}/test_labels.csv, {out}/manifest.json")
 
 
