@@ -75,6 +75,49 @@ def test_a_growing_fault_at_a_cycle_is_the_model_compiled_at_its_value(robot_nam
     assert run.fault_value.tolist() == [pytest.approx(value)]
 
 
+def test_a_growing_load_dependent_friction_at_a_cycle_is_a_unit_gear_loss_of_that_value(monkeypatch):
+    """Load-dependent friction grows as a fault through the plant, its coefficient per simulation
+    beside the unit's gear loss: cycle 4 of a run growing it to 0.06 on axis 2 over 5 cycles has the
+    friction and motor torques of a run without the fault whose unit gear loss (the same physics,
+    the effect's transmitted-load form, unknown to the controller as a fault is) is that cycle's
+    value on axis 2, to 1e-9; the nominal run differs on axis 2 by over 2 % of the largest torque, its mean friction by 20 %. Not independent: both
+    are faultgen's gear-loss physics (tests of the effect itself: test_calibrate_effects)."""
+    from faultgen.simulation.batch import Plant
+
+    fault = parse_fault("load_dependent_friction:2:coefficient:0.06", last_cycle=5)
+    value = float(fault.values(np.array([4]))[0])
+    assert value == pytest.approx(0.048)
+    common = {"task": "pick_place", "friction": "stribeck", "record": (4,), "nthread": 1, "noise": QUIET}
+    run = sim.simulate(sim.RunConfig("irb6700", cycles=5, fault=fault, **common), progress=False)
+    nominal = sim.simulate(sim.RunConfig("irb6700", cycles=5, **common), progress=False)
+    plain = Plant.of
+
+    def with_gear_loss(*args, **kwargs):
+        plant = plain(*args, **kwargs)
+        return Plant(plant.dry, plant.viscous, plant.link_mass, plant.fault, np.array([0, value, 0, 0, 0, 0]))
+
+    monkeypatch.setattr(sim.Plant, "of", staticmethod(with_gear_loss))
+    unit = sim.simulate(sim.RunConfig("irb6700", cycles=5, **common), progress=False)
+    for name in ("tau_f", "tau_m"):
+        a, b, c = (getattr(r, name)[..., 1] for r in (run, unit, nominal))
+        assert np.max(np.abs(a - b)) < 1e-9 * np.max(np.abs(b))
+        assert np.max(np.abs(a - c)) > 0.02 * np.max(np.abs(c))
+    assert np.abs(run.tau_f[..., 1]).mean() > 1.2 * np.abs(nominal.tau_f[..., 1]).mean()
+    assert run.fault_value.tolist() == [pytest.approx(value)]
+
+
+def test_a_growing_load_dependent_friction_needs_the_static_model_and_its_transmitted_form():
+    fault = parse_fault("load_dependent_friction:2:coefficient:0.06", last_cycle=5)
+    assert fault.in_plant and not parse_fault("backlash:2:width:0.01", last_cycle=5).in_plant
+    with pytest.raises(ValueError, match=r"growing load_dependent_friction fault needs the static friction model "
+                                         r"\(friction='stribeck', --friction stribeck\)"):
+        sim.RunConfig("irb6700", "pick_place", cycles=5, fault=fault)
+    with pytest.raises(ValueError, match=r"transmitted-load form .*gravity_load = 0"):
+        parse_fault("load_dependent_friction:2:coefficient:0.06:gravity_load=1", last_cycle=5)
+    with pytest.raises(ValueError, match=r"transmitted-load form .*got parameter 'gravity_load'"):
+        parse_fault("load_dependent_friction:2:gravity_load:1", last_cycle=5)
+
+
 def test_a_fault_sweep_labels_every_cycle_and_isolates(tmp_path):
     from analysis import benchmark
 

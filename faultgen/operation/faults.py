@@ -17,9 +17,12 @@ default; ``exp4``, ``logistic``, ``step``). It grows in one of two ways:
     one per worn axis (:meth:`faultgen.operation.wear.WearPlan.faults` turns a wear spec into
     one); the simulation applies :func:`dry_multipliers` to the rotors' dry friction level.
 
-Effects that act through a per-step update of the friction level (``stepped``: load-dependent
-friction, warm-up) cannot be scheduled (their per-cycle counterparts are the operating conditions,
-:mod:`faultgen.operation.conditions`). The motor friction and the calibration's effects that change
+Effects that act through a per-step update of the friction level (``stepped``: warm-up) cannot be
+scheduled (their per-cycle counterparts are the operating conditions,
+:mod:`faultgen.operation.conditions`), with one exception, :data:`IN_PLANT`: load-dependent friction
+in its transmitted-load form, the physics of a unit's gear loss, whose growing coefficient the
+simulation carries per cycle in the plant (:class:`faultgen.simulation.batch.Plant`) rather than in
+the model; it needs the static friction model, as the gear loss does. The motor friction and the calibration's effects that change
 part of it (Coulomb, viscous, Stribeck) take no absolute fault: both friction models set the rotors'
 friction from the robot's nominal friction, so such a fault would move only the MJCF numeric and
 change nothing simulated (before issue 37 it was accepted and silently did that); friction wear is
@@ -43,6 +46,9 @@ from faultgen.operation import schedules
 
 #: How a fault's parameter grows (:attr:`Fault.growth`).
 GROWTHS = ("absolute", "relative")
+#: Stepped effects that can grow as a fault all the same: the simulation carries their value per cycle
+#: in the plant, not in the model (:attr:`Fault.in_plant`; module docstring).
+IN_PLANT = ("load_dependent_friction",)
 
 _SPEC_FORM = ("the form is EFFECT:AXIS:PARAMETER:FINAL[:key=value,...], e.g. 'backlash:2:width:0.01', "
               "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4' (AXIS 'each' in a sweep "
@@ -89,7 +95,8 @@ class Fault:
     Raises
     ------
     ValueError
-        For an unknown effect (listing them), a stepped or robot-wide effect, an absolute fault on
+        For an unknown effect (listing them), a stepped effect (but :data:`IN_PLANT`'s in its
+        transmitted-load form) or a robot-wide one, an absolute fault on
         the motor friction or an effect that changes part of it (friction wear is their fault), an
         axis outside 1..7, an unknown parameter or group, a non-finite value, a final value equal
         to the start, a bad schedule kind, onset or option, a relative fault that does not start
@@ -122,7 +129,7 @@ class Fault:
                 "the robot's nominal values: an absolute fault on it would change nothing simulated. Its fault is "
                 "friction wear, which grows the Coulomb and static friction: --wear AXIS:KIND:PERCENT (e.g. "
                 "--wear 2:exp4:20)")
-        if prototype.stepped:
+        if prototype.stepped and self.effect not in IN_PLANT:
             raise ValueError(f"fault effect {self.effect!r} acts through a per-step friction update and cannot grow "
                              "over cycles; use the operating conditions (--temperature) or the static friction model")
         if not prototype.per_axis:
@@ -136,6 +143,10 @@ class Fault:
                 raise ValueError(f"{self.effect} has no parameter {name!r}; it has: {', '.join(names)}")
         if self.parameter in self.others:
             raise ValueError(f"fault parameter {self.parameter!r} is also given as another parameter")
+        if self.in_plant and (self.parameter != "coefficient" or any(self.others.values())):
+            raise ValueError(f"a growing {self.effect} fault grows its coefficient in the transmitted-load form (the "
+                             f"gearbox's own loss, gravity_load = 0); got parameter {self.parameter!r}, others "
+                             f"{dict(self.others)!r}")
         for name, value in (("final", self.final), ("start", self.start), *self.others.items()):
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
                     or not math.isfinite(value):
@@ -170,6 +181,12 @@ class Fault:
     def relative(self) -> bool:
         """Whether the fault multiplies the robot's own value (friction wear) rather than setting one."""
         return self.growth == "relative"
+
+    @property
+    def in_plant(self) -> bool:
+        """Whether the simulation carries the fault's value per cycle in the plant, not in the model
+        (:data:`IN_PLANT`: a growing load-dependent friction adds to the unit's gear loss)."""
+        return self.effect in IN_PLANT
 
     @property
     def parameters(self) -> tuple[str, ...]:

@@ -6,7 +6,7 @@ cycle's robot differs from the nominal model (:class:`Plant`), what the stepping
 
 from __future__ import annotations
 
-from dataclasses import dataclass, make_dataclass
+from dataclasses import dataclass, make_dataclass, replace
 
 import mujoco
 import numpy as np
@@ -61,7 +61,8 @@ class Plant:
     """How each simulated cycle's robot differs from the nominal model: multipliers of the dry
     (Coulomb and static: wear, temperature, unit) and the viscous friction (n, N), of each link's
     mass and inertia (N,), a growing fault's parameter (n,) (None without one), and the unit's
-    gearbox loss growing with the load (N,), a load-dependent friction coefficient (zeros: none)."""
+    gearbox loss growing with the load, a load-dependent friction coefficient (zeros: none), (N,)
+    or per cycle (n, N) with a growing load-dependent friction fault (:meth:`with_fault_in_gear_loss`)."""
 
     dry: np.ndarray
     viscous: np.ndarray
@@ -78,7 +79,15 @@ class Plant:
 
     def take(self, rows) -> Plant:
         return Plant(self.dry[rows], self.viscous[rows], self.link_mass,
-                      None if self.fault is None else self.fault[rows], self.gear_loss)
+                      None if self.fault is None else self.fault[rows],
+                      self.gear_loss[rows] if np.ndim(self.gear_loss) == 2 else self.gear_loss)
+
+    def with_fault_in_gear_loss(self, axis: int) -> Plant:
+        """This plant with each cycle's fault value (:attr:`fault`, a load-dependent friction
+        coefficient) added to the gear loss of ``axis`` (0-based): gear loss (n, N)."""
+        loss = np.tile(self.gear_loss, (len(self.fault), 1))
+        loss[:, axis] += self.fault
+        return replace(self, gear_loss=loss)
 
     def set_fault(self, runs, fault_fields: tuple, final: float) -> None:
         """Each simulation's fault parameter (:attr:`fault`, per cycle) into the fields it moves."""

@@ -143,6 +143,10 @@ class RunConfig:
                                  "needs a robot without it")
             if self.back_to_back:
                 raise ValueError("a fault grows from cycle to cycle: run the cycles independently (no back_to_back)")
+            if self.fault.in_plant and not stepping.per_step:
+                raise ValueError(f"a growing {self.fault.effect} fault needs the static friction model "
+                                 "(friction='stribeck', --friction stribeck): friction growing with the load is "
+                                 "updated every step from Python, and the lugre model runs inside MuJoCo")
         if self.back_to_back and (self.wear.schedules or self.conditions.active
                                   or self.record not in (None, tuple(range(1, self.cycles + 1)))):
             raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "

@@ -26,6 +26,17 @@ def stepped_effects(robot: robots.Robot) -> list:
     return [e for e in robot.effects.values() if e.stepped and np.any(e.active())]
 
 
+class _PerSimulation:
+    """A stepped effect linear in its coefficient, with a coefficient per simulation (r, N): the
+    effect at coefficient 1 times it (a growing load-dependent friction fault in the gear loss)."""
+
+    def __init__(self, unit: Effect, coefficient: np.ndarray) -> None:
+        self.unit, self.coefficient = unit, coefficient
+
+    def dry_friction_extra(self, robot, deflection, static_load):
+        return self.coefficient * self.unit.dry_friction_extra(robot, deflection, static_load)
+
+
 class FrictionModel:
     """A friction model of the simulation. Subclasses say how it enters the MJCF, which actuators
     carry it, how each run's dry and viscous friction are scaled, what sets its level before every
@@ -126,8 +137,10 @@ class Stribeck(FrictionModel):
         # the stepped effects that scale the dry friction and those that add to it, sorted once
         factors = [e for e in stepped_effects(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
         extras = [e for e in stepped_effects(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
-        if np.any(work.plant.gear_loss):  # the unit's gearbox loss: the same effect, on top of the model's
-            extras.append(LoadDependentFriction(coefficient=work.plant.gear_loss))
+        gear_loss = work.plant.gear_loss
+        if np.any(gear_loss):  # the unit's gearbox loss: the same effect, on top of the model's
+            extras.append(LoadDependentFriction(coefficient=gear_loss) if np.ndim(gear_loss) == 1 else
+                          _PerSimulation(LoadDependentFriction(coefficient=np.ones(robot.n_axes)), gear_loss))
         if extras:  # the static load from the last step's kinematics, for those that ask for it
             kinematics = [runs.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
             runs.forward()  # the start state's, for the first step

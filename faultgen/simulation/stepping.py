@@ -131,8 +131,10 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     payloads = conditions is not None and bool(np.any(conditions.payload_part >= 0))
     # a fault run without payloads steps the faulted model only: no nominal model is compiled for it
     # (its set-points, the disturbance's scale, are the nominal ones: the controller knows no fault)
+    # a fault the plant carries (a growing load-dependent friction) is no model variant
+    in_model = config.fault if config.fault is not None and not config.fault.in_plant else None
     prepared = prepared_for(config.model, task_name, config.friction,
-                            fault=config.fault if config.fault is not None and not payloads else None)
+                            fault=in_model if in_model is not None and not payloads else None)
     sim, task, path, q_ref, inputs = prepared.sim, prepared.task, prepared.path, prepared.q_ref, prepared.inputs
     robot = sim.robot
     per_log = prepared.per_log
@@ -145,6 +147,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)
     dist = np.stack([sensors.disturbance(config.seed, int(c), n_log, sigma) for c in cycles])
     plant = Plant.of(multiplier, conditions, None if config.fault is None else config.fault.values(cycles))
+    if config.fault is not None and config.fault.in_plant:
+        plant = plant.with_fault_in_gear_loss(config.fault.axis - 1)
 
     with tqdm(total=len(cycles) * n_steps * sim.model.opt.timestep, unit="sim s", disable=not progress,
               desc=f"{robot.name} {task_name}", bar_format="{l_bar}{bar}| {n:.0f}/{total:.0f} sim s "
@@ -168,11 +172,11 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
             for part in np.unique(parts):
                 carrying = np.flatnonzero(parts == part)
                 payload = None if part < 0 else config.conditions.payloads.parameters(int(part))
-                variant = prepared if payload is None and config.fault is None else prepared_for(
-                    config.model, task_name, config.friction, payload, config.fault)
+                variant = prepared if payload is None and in_model is None else prepared_for(
+                    config.model, task_name, config.friction, payload, in_model)
                 for i in range(0, len(carrying), BATCH_CYCLES):
                     g = carrying[i:i + BATCH_CYCLES]
-                    fault = None if config.fault is None else (variant.fault_fields, config.fault.final)
+                    fault = None if in_model is None else (variant.fault_fields, in_model.final)
                     raws.append(batch.step(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
                                                               dist[g], per_log, config.nthread, fault, variant.grips,
                                                               path.qd[0], path.qdd[0], backend), bar))
