@@ -219,6 +219,10 @@ class Effect:
     stepped : bool
         True when the simulation realises the effect by a per-step update of the rotors' dry
         friction from Python, which only the static friction model (``--friction stribeck``) has.
+    plant_fault : bool
+        True for a stepped effect that can still grow as a fault: linear in one coefficient, the
+        simulation carries that coefficient per cycle in the plant (load-dependent friction, beside
+        the unit's gear loss; :attr:`faultgen.operation.faults.Fault.in_plant`).
     numeric, aliases : str
         Name ``<numeric>{i}`` of the effect's MJCF custom numeric on axis i (None when it is
         stored otherwise), and earlier names still read.
@@ -236,6 +240,7 @@ class Effect:
     n_parameters: ClassVar[int] = 1
     continuous: ClassVar[bool] = False
     stepped: ClassVar[bool] = False
+    plant_fault: ClassVar[bool] = False
     numeric: ClassVar[str | None] = None
     aliases: ClassVar[tuple[str, ...]] = ()
     #: Leading values a stored numeric must hold (the rest read as absent: a parameter added

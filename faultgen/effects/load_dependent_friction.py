@@ -46,6 +46,7 @@ class LoadDependentFriction(Effect):
     counts = ("gravity_load",)
     required = 1
     stepped = True
+    plant_fault = True  # grows as a fault in the plant, beside the unit's gear loss
     draw_limits: ClassVar[dict[str, float]] = {"coefficient": 0.8}
 
     @classmethod

@@ -19,7 +19,7 @@ default; ``exp4``, ``logistic``, ``step``). It grows in one of two ways:
 
 Effects that act through a per-step update of the friction level (``stepped``: warm-up) cannot be
 scheduled (their per-cycle counterparts are the operating conditions,
-:mod:`faultgen.operation.conditions`), with one exception, :data:`IN_PLANT`: load-dependent friction
+:mod:`faultgen.operation.conditions`), with one exception (``plant_fault``): load-dependent friction
 in its transmitted-load form, the physics of a unit's gear loss, whose growing coefficient the
 simulation carries per cycle in the plant (:class:`faultgen.simulation.batch.Plant`) rather than in
 the model; it needs the static friction model, as the gear loss does. The motor friction and the calibration's effects that change
@@ -46,9 +46,6 @@ from faultgen.operation import schedules
 
 #: How a fault's parameter grows (:attr:`Fault.growth`).
 GROWTHS = ("absolute", "relative")
-#: Stepped effects that can grow as a fault all the same: the simulation carries their value per cycle
-#: in the plant, not in the model (:attr:`Fault.in_plant`; module docstring).
-IN_PLANT = ("load_dependent_friction",)
 
 _SPEC_FORM = ("the form is EFFECT:AXIS:PARAMETER:FINAL[:key=value,...], e.g. 'backlash:2:width:0.01', "
               "'cogging:3:amplitude:0.05:poles=8' or 'torque_offset:1:offset:20:kind=exp4' (AXIS 'each' in a sweep "
@@ -95,7 +92,7 @@ class Fault:
     Raises
     ------
     ValueError
-        For an unknown effect (listing them), a stepped effect (but :data:`IN_PLANT`'s in its
+        For an unknown effect (listing them), a stepped effect (but a ``plant_fault`` one in its
         transmitted-load form) or a robot-wide one, an absolute fault on
         the motor friction or an effect that changes part of it (friction wear is their fault), an
         axis outside 1..7, an unknown parameter or group, a non-finite value, a final value equal
@@ -129,7 +126,7 @@ class Fault:
                 "the robot's nominal values: an absolute fault on it would change nothing simulated. Its fault is "
                 "friction wear, which grows the Coulomb and static friction: --wear AXIS:KIND:PERCENT (e.g. "
                 "--wear 2:exp4:20)")
-        if prototype.stepped and self.effect not in IN_PLANT:
+        if prototype.stepped and not prototype.plant_fault:
             raise ValueError(f"fault effect {self.effect!r} acts through a per-step friction update and cannot grow "
                              "over cycles; use the operating conditions (--temperature) or the static friction model")
         if not prototype.per_axis:
@@ -185,8 +182,8 @@ class Fault:
     @property
     def in_plant(self) -> bool:
         """Whether the simulation carries the fault's value per cycle in the plant, not in the model
-        (:data:`IN_PLANT`: a growing load-dependent friction adds to the unit's gear loss)."""
-        return self.effect in IN_PLANT
+        (the effect's ``plant_fault``: a growing load-dependent friction adds to the unit's gear loss)."""
+        return type(effects.get(self.effect)).plant_fault
 
     @property
     def parameters(self) -> tuple[str, ...]:
