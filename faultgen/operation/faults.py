@@ -22,8 +22,10 @@ scheduled (their per-cycle counterparts are the operating conditions,
 :mod:`faultgen.operation.conditions`), with one exception (``plant_fault``): load-dependent friction
 in its transmitted-load form, the physics of a unit's gear loss, whose growing coefficient the
 simulation carries per cycle in the plant (:class:`faultgen.simulation.batch.Plant`) rather than in
-the model; it needs the static friction model, as the gear loss does. The motor friction and the calibration's effects that change
-part of it (Coulomb, viscous, Stribeck) take no absolute fault: both friction models set the rotors'
+the model; it needs the static friction model, as the gear loss does.
+
+The motor friction and the calibration's effects that change part of it (Coulomb, viscous,
+Stribeck) take no absolute fault: both friction models set the rotors'
 friction from the robot's nominal friction, so such a fault would move only the MJCF numeric and
 change nothing simulated (before issue 37 it was accepted and silently did that); friction wear is
 their fault.
