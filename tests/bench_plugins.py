@@ -1,12 +1,27 @@
 """Plug-ins for tests/test_bench.py: a deliberately bad detector (random scores) and a spy that
-records what it is given, to show that no test label reaches a method."""
+records what it is given, to show that no test label reaches a method; and :func:`make_small`, a
+track made at its test size by the command, as the bench tests use it."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 import zlib
+from pathlib import Path
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
+
+
+def make_small(track: str, folder: Path) -> dict:
+    """The latest version of ``track`` at its test size made into ``folder`` by `faultgen bench make`
+    (a command: it starts itself again in the version's numeric profile); its manifest."""
+    done = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "make", track, "--size", "small",
+                           "--no-progress", "-o", str(folder)], check=False, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    return json.loads((folder / "manifest.json").read_text())
+
 
 #: Every call the spy saw: ("fit", X, y) or ("decision_function", X) or ("predict", X).
 CALLS: list[tuple] = []

@@ -6,8 +6,6 @@ from __future__ import annotations
 import json
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import bench_plugins
@@ -88,11 +86,7 @@ def thesis_small(tmp_path_factory):
     """The thesis track's latest version at its test size, made by the command (which starts itself
     again in the version's numeric profile, faultgen.bench.profile)."""
     folder = tmp_path_factory.mktemp("bench") / "thesis"
-    done = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "make", "thesis", "--size", "small",
-                           "--no-progress", "-o", str(folder)],
-                          check=False, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
-    return folder, json.loads((folder / "manifest.json").read_text())
+    return folder, bench_plugins.make_small("thesis", folder)
 
 
 def test_the_test_file_holds_no_label(thesis_small):

@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
-import sys
 
+import bench_plugins
 import numpy as np
 import pytest
 
@@ -21,11 +20,7 @@ from faultgen.data import fleetlogs
 def sim_to_real(tmp_path_factory):
     """The latest version at its test size, made by the command (in the version's numeric profile)."""
     folder = tmp_path_factory.mktemp("bench") / "s2r"
-    done = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "make", "sim-to-real", "--size", "small",
-                           "--no-progress", "-o", str(folder)],
-                          check=False, capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
-    return folder, json.loads((folder / "manifest.json").read_text())
+    return folder, bench_plugins.make_small("sim-to-real", folder)
 
 
 def test_sim_to_real_is_made_against_its_frozen_manifest_with_the_fleet_as_the_test_split(sim_to_real):

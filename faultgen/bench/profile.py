@@ -53,11 +53,16 @@ def _blas() -> str:
     return ", ".join(found) or "none found"
 
 
+def _numpy_dispatch() -> str:
+    """NumPy's dispatch targets this process runs, e.g. ``X86_V3 X86_V4`` (``baseline``: none)."""
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    return " ".join(f for f in __cpu_dispatch__ if __cpu_features__.get(f)) or "baseline"
+
+
 def describe() -> dict:
     """This process's numeric environment: ``{"machine", "python", "blas", "numpy_dispatch",
     "packages"}``, written into a track's manifest and named when a check fails."""
-    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-
     packages = {}
     for name in PACKAGES:
         try:
@@ -65,8 +70,7 @@ def describe() -> dict:
         except metadata.PackageNotFoundError:
             continue
     return {"machine": platform.machine(), "python": platform.python_version(), "blas": _blas(),
-            "numpy_dispatch": " ".join(f for f in __cpu_dispatch__ if __cpu_features__.get(f)) or "baseline",
-            "packages": packages}
+            "numpy_dispatch": _numpy_dispatch(), "packages": packages}
 
 
 def supported(name: str) -> bool:
@@ -82,7 +86,7 @@ def pinned(name: str) -> bool:
     wanted = PROFILES[name]
     if any(os.environ.get(k) != v for k, v in wanted.items()):
         return False
-    if any(target in describe()["numpy_dispatch"] for target in _ABOVE[name]):
+    if any(target in _numpy_dispatch() for target in _ABOVE[name]):
         return False
     blas = [kernels.strip().lower() for kernels in _blas().split(",")]
     return all(kernels == f"openblas {wanted['OPENBLAS_CORETYPE']}".lower() for kernels in blas)
