@@ -243,3 +243,105 @@ def test_a_twin_cycle_is_set_up_from_typed_objects_as_from_its_former_texts(temp
     texts = [f"{worn_axis}:exp4:{twin.WEAR:g}"] if worn_axis else []
     assert plan == wear.WearPlan.from_specs(texts, last_cycle=1)
     assert plan.multipliers(1, 6).tolist() == wear.WearPlan.from_specs(texts, last_cycle=1).multipliers(1, 6).tolist()
+
+
+# -- an output folder from someone else (issue 61, item 1) -------------------------------------------
+
+class _Planted:
+    """Unpickled, it makes the folder ``marker``: what a planted pickle would run."""
+
+    def __init__(self, marker: Path):
+        self.marker = marker
+
+    def __reduce__(self):
+        return os.mkdir, (str(self.marker),)
+
+
+def _copy_of(monitored: Path, out: Path) -> Path:
+    shutil.copytree(monitored, out)
+    return out
+
+
+def test_a_planted_pickle_in_the_state_is_refused_unread(fleet, monitored, tmp_path):
+    import pickle
+
+    robot, logs, _ = fleet
+    out = _copy_of(monitored, tmp_path / "out")
+    marker = tmp_path / "ran"
+    for path in (out / ".state").iterdir():
+        path.unlink()
+    (out / ".state" / "unit01.pkl").write_bytes(pickle.dumps(_Planted(marker)))
+    with pytest.raises(ValueError, match=r"unit01\.pkl.*pickle.*not read"):
+        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    assert not marker.exists()
+
+
+def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setting(fleet, monitored, tmp_path):
+    import json
+
+    robot, logs, _ = fleet
+    files = sorted((monitored / ".state").iterdir())
+    assert files and all(p.suffix == ".json" for p in files)
+    state = json.loads(files[0].read_text())
+    assert state["settings"]["train"] == SETTINGS.train and len(state["logs"]) == SPEC.days
+    assert all(len(log["sha256"]) == 64 for log in state["logs"])
+    out = _copy_of(monitored, tmp_path / "out")
+    with pytest.raises(ValueError, match=r"unit01\.json: holds a monitor run with other settings.*persistence 3 \(now 4\)"):
+        loop.monitor(robot, logs, out, calibrate=False, settings=Settings(train=14, persistence=4), progress=False)
+    state["logs"][3]["residual"] = state["logs"][3]["residual"][:-1]
+    (out / ".state" / files[0].name).write_text(json.dumps(state))
+    with pytest.raises(ValueError, match=r"unit01\.json: logs\[3\]\.residual is not a list of 12 numbers"):
+        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_scored_log_that_changed_since_is_refused(fleet, monitored, tmp_path):
+    robot, logs, _ = fleet
+    copied = tmp_path / "logs"
+    shutil.copytree(logs, copied)
+    out = _copy_of(monitored, tmp_path / "out")
+    log = sorted((copied / "unit02").iterdir())[5]
+    log.write_text(log.read_text().replace("\n1", "\n2", 1))
+    with pytest.raises(ValueError, match=f"{log.name} changed since it was scored"):
+        loop.monitor(robot, copied, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_cached_cycle_of_another_key_or_leading_outside_is_refused_and_never_echoed(fleet, monitored, tmp_path):
+    import json
+
+    robot, logs, _ = fleet
+    out = _copy_of(monitored, tmp_path / "out")
+    (out / ".state").rename(tmp_path / "state")  # a fresh run over the cached cycles
+    for name in ("alarms.csv", "scores.csv"):
+        (out / name).unlink()
+    cycles = sorted((out / ".cache" / "cycles").iterdir())
+    assert cycles and all(p.suffix == ".json" for p in cycles)
+    cycle = json.loads(cycles[0].read_text())
+    cycle["key"]["payload"] = 1.0 + cycle["key"]["payload"]
+    cycles[0].write_text(json.dumps(cycle))
+    with pytest.raises(ValueError, match=rf"{cycles[0].name}: not the cached twin cycle of"):
+        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    secret = tmp_path / "secret.json"
+    secret.write_text('{"format": "MARKER-4f1c", "key": {}}')
+    cycles[0].unlink()
+    cycles[0].symlink_to(secret)
+    with pytest.raises(ValueError, match="a link leading outside") as refused:
+        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    assert "MARKER" not in str(refused.value)
+
+
+def test_a_cached_calibration_is_checked_against_its_record(tmp_path):
+    from faultgen.inputs import InputError
+    from faultgen.monitor import state
+
+    model = tmp_path / "calibrated" / "m.xml"
+    model.parent.mkdir()
+    model.write_text("<mujoco/>")
+    key = {"robot": "a" * 64, "log": "b" * 64, "steps": 3}
+    record = tmp_path / "calibrated.json"
+    state.write_calibration(record, key, model)
+    state.read_calibration(record, tmp_path, key, model)
+    with pytest.raises(InputError, match="not the calibration of this robot and log"):
+        state.read_calibration(record, tmp_path, {**key, "log": "c" * 64}, model)
+    model.write_text("<mujoco><worldbody/></mujoco>")
+    with pytest.raises(InputError, match="m.xml: not the calibrated model its record"):
+        state.read_calibration(record, tmp_path, key, model)

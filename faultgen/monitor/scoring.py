@@ -43,8 +43,9 @@ closely the residual points along each axis's wear signature
 3.3-3.4). The source axis of a persistent alarm is the first of the ranking of the mean
 residual over the logs that made it persistent.
 
-State is small and bounded per log (a row of scores each); the object pickles, so a rerun on a
-grown folder continues where the last one stopped.
+State is small and bounded per log (a row of scores each); a rerun on a grown folder rebuilds the
+monitor by feeding it the stored inputs again (:mod:`faultgen.monitor.state`: JSON, no pickle) and
+continues where the last one stopped.
 """
 
 from __future__ import annotations

@@ -15,7 +15,9 @@ Every simulated cycle goes through the same feature code as a measured log
 (:func:`faultgen.monitor.logs.features_of` on the simulated angles and arm-side torque, the
 velocity estimated from the angles as for a log without ``qd``), without sensor noise (the twin
 gives the expectation). Cycles are cached on disk by what determines them (model file, program
-file, temperature, payload, worn axis): units that share a model and a program share them.
+file, temperature, payload, worn axis), each file holding its key beside the features
+(:func:`faultgen.monitor.state.read_cycle` refuses one whose key differs): units that share a model
+and a program share them.
 """
 
 from __future__ import annotations
@@ -26,9 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import atomic, measured
+from faultgen.data import measured
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import state as stored
 from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
@@ -64,24 +67,20 @@ def setup(temperature: float | None, payload: float, worn_axis: int = 0) -> tupl
     return conditions.Conditions(thermal=thermal, payloads=part), plan
 
 
-def _key(*parts) -> str:
-    digest = hashlib.sha256()
-    for part in parts:
-        digest.update(part if isinstance(part, bytes) else json.dumps(part).encode())
-    return digest.hexdigest()[:24]
-
-
 class Twin:
     """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
-    log whose motion is replayed, ``cache`` the folder of simulated cycles (created if needed)."""
+    log whose motion is replayed, ``cache`` the folder of simulated cycles (created if needed) inside
+    ``root`` (default ``cache``), out of which no cached cycle may lead."""
 
-    def __init__(self, model: str | Path, program: Path, cache: Path):
+    def __init__(self, model: str | Path, program: Path, cache: Path, root: Path | None = None):
         self.model = str(model)
         self.robot = robots.load(model)
         self.program = Path(program)
         self.cache = Path(cache)
+        self.root = self.cache if root is None else Path(root)
         self.cache.mkdir(parents=True, exist_ok=True)
-        self._files = _key(Path(self.robot.path).read_bytes(), self.program.read_bytes(), FRICTION)
+        self._files = {"model": stored.sha256_file(self.robot.path), "program": stored.sha256_file(self.program),
+                       "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES)}
         self._healthy: dict[float, np.ndarray] = {}
         healthy = self.cycle(REFERENCE_TEMPERATURE, 0.0)
         #: (N, F): change of each feature per % wear of each axis (without a part: the signatures
@@ -93,9 +92,12 @@ class Twin:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
         nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
         temperature = None if np.isnan(temperature) else round(float(temperature), 2)
-        path = self.cache / f"{_key(self._files, temperature, payload, worn_axis, WEAR)}.npy"
-        if path.is_file():
-            return np.load(path)
+        key = {**self._files, "temperature": temperature, "payload": float(payload), "worn_axis": int(worn_axis)}
+        name = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
+        path = self.cache / f"{name}.json"
+        n_features = len(fleet_logs.FEATURES) * self.robot.n_axes
+        if path.exists() or path.is_symlink():
+            return stored.read_cycle(path, self.root, key, n_features)
         held, plan = setup(temperature, payload, worn_axis)
         config = sim.RunConfig(robot=self.model, task=str(self.program), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
@@ -108,9 +110,7 @@ class Twin:
         data = measured.from_arrays(result.t, result.q_a[0], result.tau_m[0] * self.robot.gear_ratio, self.robot,
                                     source=f"twin of {self.program.name}")
         vector = fleet_logs.features_of(self.robot, data)
-        with atomic.atomic_path(path) as tmp:
-            with open(tmp, "wb") as f:
-                np.save(f, vector)
+        stored.write_cycle(path, key, vector)
         return vector
 
     def expected(self, temperature: float, payload: float) -> np.ndarray:

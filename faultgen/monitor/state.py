@@ -1,0 +1,245 @@
+"""What ``faultgen monitor`` keeps in ``OUT`` between runs, in formats that cannot run code.
+
+An output folder may come from someone else (docs/reliability.md, "Threat model: output folders"),
+so nothing in it is unpickled or imported, nothing it names is opened outside ``OUT`` and ``LOGS``,
+and every file is checked against the settings and inputs it belongs to before it is used:
+
+- ``OUT/.state/<unit>.json`` (:func:`write_unit`, :func:`read_unit`): the inputs the unit's monitor
+  was fed, one entry per scored log (stamp, the log's SHA-256, its residual, mean joint temperature,
+  payload and the twin's expectation), the twin's wear signatures, the log whose motion the twin
+  replays (by unit and stamp inside ``LOGS``, never a path) and the digest of the run's settings
+  (:func:`settings_digest`). A rerun replays these entries into a new
+  :class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same arithmetic in the same
+  order, so the continued monitor is bit for bit the one the earlier run ended with.
+- ``OUT/.cache/cycles/<digest>.json`` (:func:`write_cycle`, :func:`read_cycle`): one simulated
+  cycle's features beside the key that determined them (model and program SHA-256, friction model,
+  temperature, payload, worn axis); a file whose key is not the one asked for, or whose features
+  are not finite numbers of the expected length, is refused.
+- ``OUT/.cache/calibrated/<digest>/`` and ``<digest>.json`` (:func:`write_calibration`,
+  :func:`read_calibration`): a unit's calibration, under the digest of what it was made from, and
+  a record of the calibrated model's SHA-256; the model itself is loaded as any robot description
+  (:func:`faultgen.model.robots.load`: no file outside its folder, no plugin).
+
+Every refusal is a :class:`faultgen.inputs.InputError` naming the file and what did not match, and
+saying what to do (score into a new ``OUT``, or delete the named file).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from faultgen import inputs
+from faultgen.data import atomic
+from faultgen.monitor.scoring import Settings, UnitMonitor
+
+FORMAT = "faultgen-monitor-state/1"
+CYCLE_FORMAT = "faultgen-twin-cycle/1"
+CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
+#: Size bound of one unit's state file: about 0.6 kB per scored log, so 10^5 logs.
+STATE_MAX_BYTES = 64 * 2**20
+#: Size bound of one cached cycle (a few hundred bytes).
+CYCLE_MAX_BYTES = 2**20
+
+
+def sha256_file(path: str | Path) -> str:
+    """SHA-256 of a file's bytes, hex."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(2**20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def settings_digest(settings: Settings, model: str, twin_temperature: bool, robot_sha256: str) -> dict:
+    """What a state belongs to, as a JSON-able dict: the monitor's settings, the model source
+    ("nominal", "per-unit" or the SHA-256 of a given calibrated model), whether the twin predicts
+    the temperature's effect, and the SHA-256 of the robot's MJCF."""
+    return {**asdict(settings), "model": model, "twin_temperature": bool(twin_temperature), "robot": robot_sha256}
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One scored log as the monitor was fed it: ``stamp``, the log file's ``sha256``, its
+    ``residual`` (n_features,), mean joint ``temperature`` (deg C, NaN when not logged), ``payload``
+    (kg) and the twin's ``expected`` features (n_features,; None without a twin)."""
+
+    stamp: str
+    sha256: str
+    residual: np.ndarray
+    temperature: float
+    payload: float
+    expected: np.ndarray | None
+
+
+@dataclass
+class UnitState:
+    """A unit's state (module docstring): ``program`` the (unit, stamp) of the log its twin replays
+    (None without a twin), ``signatures`` (n_axes, n_features) or None, ``entries`` in stamp order."""
+
+    unit: str
+    settings: dict
+    program: tuple[str, str] | None
+    signatures: np.ndarray | None
+    entries: list[Entry]
+
+
+def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
+    """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
+    ``state`` ended with."""
+    monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
+    for e in state.entries:
+        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
+    return monitor
+
+
+def _floats(values) -> list[float]:
+    return [float(v) for v in np.ravel(values)]
+
+
+def write_unit(path: Path, state: UnitState) -> None:
+    """Write ``state`` as JSON (floats written exactly: ``repr`` round-trips; NaN as ``NaN``)."""
+    document = {
+        "format": FORMAT, "unit": state.unit, "settings": state.settings,
+        "program": list(state.program) if state.program else None,
+        "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
+        "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
+                  "temperature": float(e.temperature), "payload": float(e.payload),
+                  "expected": None if e.expected is None else _floats(e.expected)} for e in state.entries],
+    }
+    atomic.write_text(path, json.dumps(document, separators=(",", ":")))
+
+
+def inside(path: Path, root: Path) -> Path:
+    """``path`` after checking that it resolves inside ``root`` (a symbolic link out of the output
+    folder is refused, naming it: an output folder never makes faultgen read outside itself)."""
+    if not Path(path).resolve().is_relative_to(Path(root).resolve()):
+        raise inputs.InputError(f"{path}: a link leading outside {root}; faultgen never writes links into its output "
+                                "folders: delete it")
+    return Path(path)
+
+
+def _load_json(path: Path, what: str, max_bytes: int) -> dict:
+    text = inputs.read_text(path, what, max_bytes)
+    try:
+        document = json.loads(text)
+    except (ValueError, RecursionError) as err:
+        raise inputs.InputError(f"{path}: not a {what} ({type(err).__name__}: {str(err)[:80]})") from None
+    if not isinstance(document, dict):
+        raise inputs.InputError(f"{path}: not a {what} (expected a JSON object)")
+    return document
+
+
+def _vector(value, path: Path, name: str, length: int, finite: bool = True) -> np.ndarray:
+    if not (isinstance(value, list) and len(value) == length
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+        raise inputs.InputError(f"{path}: {name} is not a list of {length} numbers")
+    array = np.asarray(value, dtype=float)
+    if finite and not np.all(np.isfinite(array)):
+        raise inputs.InputError(f"{path}: {name} holds a value that is not a finite number")
+    return array
+
+
+def _number(value, path: Path, name: str) -> float:
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise inputs.InputError(f"{path}: {name} = {str(value)[:40]!r} is not a number")
+    return float(value)
+
+
+def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
+    """Read and check the state of ``unit`` written by :func:`write_unit`.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        The file is a link leading outside ``root`` or not a regular file, is above :data:`STATE_MAX_BYTES`, is not
+        such a state, belongs to another unit or to other settings (the differing settings named),
+        or holds an entry of the wrong type or length (named).
+    """
+    refuse = f"; score the logs into a new OUT (or delete {path.parent} to start this one again)"
+    d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
+    if d.get("format") != FORMAT:
+        raise inputs.InputError(f"{path}: format {str(d.get('format'))[:40]!r}, expected {FORMAT!r}{refuse}")
+    if d.get("unit") != unit:
+        raise inputs.InputError(f"{path}: the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}{refuse}")
+    if d.get("settings") != settings:
+        theirs = d.get("settings") if isinstance(d.get("settings"), dict) else {}
+        moved = [f"{k} {theirs.get(k)!r} (now {v!r})" for k, v in settings.items() if theirs.get(k) != v]
+        raise inputs.InputError(f"{path}: holds a monitor run with other settings or inputs: "
+                                f"{', '.join(moved) or 'unknown keys'}{refuse}")
+    program = d.get("program")
+    if program is not None and not (isinstance(program, list) and len(program) == 2
+                                    and all(isinstance(p, str) for p in program)):
+        raise inputs.InputError(f"{path}: program is not [unit, stamp]{refuse}")
+    signatures = d.get("signatures")
+    if signatures is not None:
+        if not (isinstance(signatures, list) and len(signatures) == n_axes):
+            raise inputs.InputError(f"{path}: signatures is not a list of {n_axes} rows{refuse}")
+        signatures = np.stack([_vector(row, path, f"signatures row {i + 1}", n_features)
+                               for i, row in enumerate(signatures)])
+    logs = d.get("logs")
+    if not isinstance(logs, list):
+        raise inputs.InputError(f"{path}: logs is not a list{refuse}")
+    entries = []
+    for i, log in enumerate(logs):
+        where = f"logs[{i}]"
+        if not (isinstance(log, dict) and isinstance(log.get("stamp"), str) and isinstance(log.get("sha256"), str)
+                and len(log["sha256"]) == 64):
+            raise inputs.InputError(f"{path}: {where} has no stamp or SHA-256{refuse}")
+        expected = log.get("expected")
+        entries.append(Entry(
+            log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
+            _number(log.get("temperature"), path, f"{where}.temperature"),
+            _number(log.get("payload"), path, f"{where}.payload"),
+            None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
+        if not math.isfinite(entries[-1].payload):
+            raise inputs.InputError(f"{path}: {where}.payload is not a finite number{refuse}")
+    return UnitState(unit, settings, tuple(program) if program else None, signatures, entries)
+
+
+def write_cycle(path: Path, key: dict, features: np.ndarray) -> None:
+    """Cache one simulated cycle's ``features`` beside the ``key`` that determined them."""
+    atomic.write_text(path, json.dumps({"format": CYCLE_FORMAT, "key": key, "features": _floats(features)}))
+
+
+def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray:
+    """The cached features of the cycle ``key``, checked (module docstring).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        The file is a link leading outside ``root``, is not a cached cycle of ``key`` or its features are not ``n_features`` finite numbers.
+    """
+    d = _load_json(inside(path, root), "cached twin cycle", CYCLE_MAX_BYTES)
+    if d.get("format") != CYCLE_FORMAT or d.get("key") != key:
+        raise inputs.InputError(f"{path}: not the cached twin cycle of {key} (another model, program or condition); "
+                                "delete it (the twin simulates it again)")
+    return _vector(d.get("features"), path, "features", n_features)
+
+
+def write_calibration(path: Path, key: dict, model: Path) -> None:
+    """Record that the calibration in ``model``'s folder was made from ``key`` (the nominal model's
+    and the log's SHA-256 and the search's length), with ``model``'s own SHA-256."""
+    atomic.write_text(path, json.dumps({"format": CALIBRATION_FORMAT, "key": key, "model": sha256_file(model)}))
+
+
+def read_calibration(path: Path, root: Path, key: dict, model: Path) -> None:
+    """Check a cached calibration's record against ``key`` and the model file it names.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        The record or the model is a link out of ``root``, the record belongs to another key, or
+        the model file is missing or is not the one the record was written for.
+    """
+    d = _load_json(inside(path, root), "cached calibration record", CYCLE_MAX_BYTES)
+    fix = f"; delete {path} and {path.with_suffix('')} (the unit is calibrated again)"
+    if d.get("format") != CALIBRATION_FORMAT or d.get("key") != key:
+        raise inputs.InputError(f"{path}: not the calibration of this robot and log{fix}")
+    if not Path(model).is_file() or sha256_file(inside(model, root)) != d.get("model"):
+        raise inputs.InputError(f"{model}: not the calibrated model its record {path.name} was written for{fix}")
