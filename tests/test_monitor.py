@@ -93,7 +93,7 @@ def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path)
         for log in sorted(unit.iterdir())[keep:]:
             os.link(log, partial / unit.name / log.name)
     before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
-    scored = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
+    scored = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False).monitors
     assert all(len(m.rows) == SPEC.days for m in scored)
     # the old rows are kept as they were, the new ones equal a run over the whole folder at once
     assert (out / "scores.csv").read_text() == (monitored / "scores.csv").read_text()

@@ -52,7 +52,14 @@ def monitor_command(
     or Q is over its limit. A unit alarms from the first of --persistence consecutive alarming
     logs; its source axis is the one with the largest wear estimate (own: the largest share of Q).
 
-    Writes OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence),
+    No unit stops the fleet: a unit whose twin cannot be built falls back (its calibrated model,
+    then the nominal model, then --protocol own), and a log that cannot be read or replayed is
+    skipped; OUT/units.csv gives every unit's status (monitored, learning, degraded, not
+    monitored), protocol, model and the reason. Exit status: 0 when every unit is monitored or
+    still learning, 3 when some unit is degraded or not monitored (every output still written),
+    2 when the run is refused before any work (bad option, robot, folder or OUT).
+
+    Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores) and
     OUT/<unit>.png (control chart, alarm, axis scores), all together; a rerun after new logs
     arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.
@@ -69,13 +76,17 @@ def monitor_command(
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
-    monitors = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                            twin_temperature=twin_temperature, progress=True)
+    outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
+                           twin_temperature=twin_temperature, progress=True)
+    monitors = outcome.monitors
     alarmed = [m for m in monitors if m.first_alarm]
-    for m in monitors:
-        row = m.alarm_row()
-        what = f"alarm from {m.first_alarm}, axis {m.source_axis}" if m.first_alarm else row["evidence"]
-        typer.echo(f"{m.unit}: {what}")
+    by_unit = {m.unit: m for m in monitors}
+    for status in outcome.statuses:
+        m = by_unit.get(status.unit)
+        what = f"alarm from {m.first_alarm}, axis {m.source_axis}" if m is not None and m.first_alarm else \
+            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
+        typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
+                   f"{', ' + status.model + ' model' if status.model else ''}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin)
@@ -85,4 +96,10 @@ def monitor_command(
                f"{logs_scored} logs if its residuals were independent and normal: <= {chance:.2g} "
                f"({persistence} in a row at <= {per_log:g} per log); drift the first {train} logs did not show "
                "raises it.")
-    typer.echo(f"wrote {out / 'alarms.csv'}, {out / 'scores.csv'} and {len(monitors)} charts")
+    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'} and {len(monitors)} charts")
+    short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
+    if short:
+        typer.echo(f"{len(short)} of {len(outcome.statuses)} units are degraded or not monitored "
+                   f"({', '.join(s.unit for s in short[:5])}{', ...' if len(short) > 5 else ''}): their reasons are "
+                   f"in {out / 'units.csv'}; exit status {loop.EXIT_SOME_UNITS_NOT_MONITORED}", err=True)
+        raise typer.Exit(loop.EXIT_SOME_UNITS_NOT_MONITORED)

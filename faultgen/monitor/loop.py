@@ -45,18 +45,63 @@ SAME_PROGRAM = 1e-3
 CALIBRATION_STEPS = 3
 
 
+#: Exit status of ``faultgen monitor`` when some unit is degraded or not monitored (every output is
+#: still written); 0 when every unit is monitored or still learning, 2 a refusal before any work.
+EXIT_SOME_UNITS_NOT_MONITORED = 3
+#: A unit's status in units.csv.
+STATUSES = ("monitored", "learning", "degraded", "not monitored")
+
+
 @dataclass
 class _Unit:
     monitor: UnitMonitor
-    model: str
+    model: str  # "given", "calibrated", "nominal" or "none" (protocol own)
     program: tuple[str, str] | None  # (unit, stamp) of the log the twin replays
+    first: tuple[str, str]  # (stamp, SHA-256) of the unit's first log, which its calibration is made from
     entries: list[stored.Entry] = field(default_factory=list)
+    skipped: list[stored.Skipped] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class UnitStatus:
+    """A unit's row of units.csv: its ``status`` (:data:`STATUSES`), the ``protocol`` and ``model``
+    its monitor uses, the ``reason`` (fallbacks taken, logs skipped, learning progress), the number
+    of logs scored (learning logs included) and the stamp of the last one."""
+
+    unit: str
+    status: str
+    protocol: str
+    model: str
+    reason: str
+    logs_scored: int
+    last_log: str
+
+
+@dataclass
+class Outcome:
+    """What :func:`monitor` did: each unit's ``monitors`` (:class:`UnitMonitor`) and ``statuses``
+    (:class:`UnitStatus`), in the fleet folder's order."""
+
+    monitors: list[UnitMonitor]
+    statuses: list[UnitStatus]
+
+    @property
+    def exit_status(self) -> int:
+        """0 when every unit is monitored or learning, :data:`EXIT_SOME_UNITS_NOT_MONITORED` else."""
+        bad = any(s.status in ("degraded", "not monitored") for s in self.statuses)
+        return EXIT_SOME_UNITS_NOT_MONITORED if bad else 0
 
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True) -> list[UnitMonitor]:
-    """Monitor every unit of ``logs_dir`` (module docstring); returns the units' monitors.
+            progress: bool = True) -> Outcome:
+    """Monitor every unit of ``logs_dir`` (module docstring).
+
+    No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
+    model, then the nominal model, then ``--protocol own``: the unit against its own first logs),
+    and a log that cannot be read or that the twin cannot replay is skipped; both are named in
+    ``units.csv`` (:class:`UnitStatus`) and the unit's state keeps them, so a rerun does not try again.
 
     Parameters
     ----------
@@ -77,12 +122,18 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         of the unit's learned slope alone.
     progress : bool
 
+    Returns
+    -------
+    Outcome
+        Each unit's monitor and status; :attr:`Outcome.exit_status` for the command line.
+
     Raises
     ------
     ValueError
-        A bad log (the file and row named), a log older than the last one scored, a scored log that
-        changed since, or ``out`` holding a run with other settings or a state or cache that does
-        not match them (:mod:`faultgen.monitor.state`, the file named).
+        Before any work, for the run as a whole: the robot, the fleet folder, a log older than the
+        last one scored, a scored log that changed since, or ``out`` holding a run with other
+        settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
+        file named).
     """
     nominal = robots.load(robot)
     units = fleet_logs.fleet(logs_dir)
@@ -94,73 +145,31 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path))
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
-    pending = {}
-    for name, unit_logs in units.items():
-        if name not in state:
-            pending[name] = unit_logs
-            continue
-        entries = state[name].entries
-        by_stamp = {g.stamp: g for g in unit_logs}
-        done = entries[-1].stamp
-        if done not in by_stamp:
-            raise ValueError(f"{name}: its last scored log ({done}) is no longer in {logs_dir}; put it back or "
-                             "score this folder into a new OUT")
-        for entry in entries:
-            log = by_stamp.get(entry.stamp)
-            if log is not None and stored.sha256_file(log.path) != entry.sha256:
-                raise ValueError(f"{log.path} changed since it was scored into {out} (SHA-256 {entry.sha256[:12]}..., "
-                                 "now another): score this folder into a new OUT")
-        seen = {e.stamp for e in entries}
-        stamps = [g.stamp for g in unit_logs]
-        late = [g for g in unit_logs[: stamps.index(done)] if g.stamp not in seen]
-        if late:
-            raise ValueError(f"{late[0].path} is older than the last scored log of {name} ({done}); the monitor "
-                             "scores logs in stamp order: score this folder into a new OUT")
-        pending[name] = unit_logs[stamps.index(done) + 1:]
+    pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
     cache.mkdir(parents=True, exist_ok=True)
-    total = sum(len(v) for v in pending.values())
-    bar = tqdm(total=total, desc="monitor", unit="log", disable=not progress)
+    bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
     twins: dict[tuple, Twin] = {}
     for name, unit_logs in pending.items():
         if not unit_logs:
             continue
-        first = units[name][0] if name not in state else _log(units, name, state[name].entries[0].stamp)
-        model = _model(nominal, settings, calibrated_model, calibrate, first, out, progress)
+        bar.set_postfix_str(f"twin of {name}")
         if name not in state:
-            program = _program(nominal, first, name, programs) if settings.protocol == "twin" else None
-            state[name] = _Unit(UnitMonitor(name, settings, nominal.n_axes), model, program)
+            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, out, programs, progress)
         unit = state[name]
-        twin = None
-        if settings.protocol == "twin":
-            twin_key = (model, unit.program)
-            if twin_key not in twins:
-                bar.set_postfix_str(f"twin of {name}")
-                twins[twin_key] = Twin(model, _log(units, *unit.program).path, cache / "cycles", root=out)
-            twin = twins[twin_key]
-            if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
-                raise ValueError(f"{out / '.state' / (name + '.json')}: its wear signatures are not those of the twin "
-                                 f"of {name} now (another model or program); score this folder into a new OUT")
-            unit.monitor.signatures = twin.signatures
+        twin = _twin(unit, units, nominal, calibrated_model, out, twins, progress)
         bar.set_postfix_str(name)
         for log in unit_logs:
-            sha256 = stored.sha256_file(log.path)
-            reading = fleet_logs.read(nominal, log)
-            residual, expected = reading.vector, None
-            if twin is not None:
-                at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
-                expected = twin.expected(at, reading.payload)
-                residual = residual - expected
-            unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
-            unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload,
-                                             expected))
+            _score_log(unit, log, nominal, twin, twin_temperature)
             bar.update()
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
+    statuses = [_status(name, state.get(name), settings) for name in units]
     note = "wear signature match" if settings.protocol == "twin" else "share of Q"
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
+        report.write_units(staging / "units.csv", statuses)
         for m in monitors:
             report.chart(staging / f"{m.unit}.png", m, note)
         (staging / ".state").mkdir()
@@ -168,8 +177,152 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             if name in state:
                 unit = state[name]
                 stored.write_unit(staging / ".state" / f"{name}.json",
-                                  stored.UnitState(name, key, unit.program, unit.monitor.signatures, unit.entries))
-    return monitors
+                                  stored.UnitState(name, key, unit.program, unit.monitor.signatures, unit.entries,
+                                                   unit.model, unit.first, unit.skipped, unit.notes))
+    return Outcome(monitors, statuses)
+
+
+def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir) -> list:
+    """The logs of ``name`` not yet scored (or skipped) by the run whose state is ``unit``.
+
+    Raises
+    ------
+    ValueError
+        The last log handled is gone, a handled log changed since (SHA-256), or a new log is older
+        than the last one handled (the monitor scores in stamp order).
+    """
+    if unit is None:
+        return unit_logs
+    handled = [(e.stamp, e.sha256) for e in unit.entries] + [(k.stamp, k.sha256) for k in unit.skipped]
+    by_stamp = {g.stamp: g for g in unit_logs}
+    stamps = [g.stamp for g in unit_logs]
+    done = max((s for s, _ in handled), key=lambda s: stamps.index(s) if s in by_stamp else -1)
+    if done not in by_stamp:
+        raise ValueError(f"{name}: its last scored log ({done}) is no longer in {logs_dir}; put it back or "
+                         "score this folder into a new OUT")
+    for stamp, sha256 in handled:
+        log = by_stamp.get(stamp)
+        if log is not None and stored.sha256_file(log.path) != sha256:
+            raise ValueError(f"{log.path} changed since it was scored into {out} (SHA-256 {sha256[:12]}..., "
+                             "now another): score this folder into a new OUT")
+    seen = {s for s, _ in handled}
+    late = [g for g in unit_logs[: stamps.index(done)] if g.stamp not in seen]
+    if late:
+        raise ValueError(f"{late[0].path} is older than the last scored log of {name} ({done}); the monitor "
+                         "scores logs in stamp order: score this folder into a new OUT")
+    return unit_logs[stamps.index(done) + 1:]
+
+
+def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, out: Path,
+              programs: list, progress: bool) -> _Unit:
+    """A unit seen for the first time: its program (the log its twin replays) and model, the
+    first that can be had of (given or calibrated, nominal); protocol ``own`` when none."""
+    monitor = UnitMonitor(name, settings, nominal.n_axes)
+    first = units[name][0]
+    first_key = (first.stamp, stored.sha256_file(first.path))
+    if settings.protocol != "twin":
+        return _Unit(monitor, "none", None, first_key)
+    try:
+        program = _program(nominal, first, name, programs)
+    except ValueError as err:
+        return _Unit(monitor, "none", None, first_key,
+                     notes=[f"its first log cannot be replayed ({_short(err)}): protocol own"])
+    kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
+    try:
+        _model(nominal, kind, calibrated_model, first_key, first.path, out, progress)
+    except stored.StateError:
+        raise
+    except ValueError as err:  # the calibration failed: the nominal model (never fails: a file)
+        return _Unit(monitor, "nominal", program, first_key,
+                     notes=[f"the {kind} model failed ({_short(err)}); nominal model used"])
+    return _Unit(monitor, kind, program, first_key)
+
+
+def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool) -> Twin | str | None:
+    """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
+    from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
+    a unit already scored against a twin that cannot be built again gets the reason (a str), and
+    its new logs are skipped with it. Each fallback is noted in the unit's reason."""
+    while unit.model != "none":
+        try:
+            first_path = _log(units, unit.monitor.unit, unit.first[0]).path if any(
+                g.stamp == unit.first[0] for g in units[unit.monitor.unit]) else None
+            model = _model(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress)
+            twin_key = (model, unit.program)
+            if twin_key not in twins:
+                twins[twin_key] = Twin(model, _log(units, *unit.program).path, out / ".cache" / "cycles", root=out)
+            twin = twins[twin_key]
+        except stored.StateError:
+            raise
+        except ValueError as err:
+            if unit.entries:
+                return f"the twin of the {unit.model} model cannot be built again ({_short(err)})"
+            fallback = "nominal" if unit.model in ("given", "calibrated") else "none"
+            unit.notes.append(f"the twin of the {unit.model} model failed ({_short(err)}); "
+                              f"{'nominal model' if fallback == 'nominal' else 'protocol own'} used")
+            unit.model = fallback
+            continue
+        if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
+            raise stored.StateError(f"{out / '.state' / (unit.monitor.unit + '.json')}: its wear signatures are not those of "
+                             f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
+                             "into a new OUT")
+        unit.monitor.signatures = twin.signatures
+        return twin
+    unit.program = None
+    return None
+
+
+def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool) -> None:
+    """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
+    cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
+    unit's state with its reason."""
+    sha256 = stored.sha256_file(log.path)
+    if isinstance(twin, str):
+        unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
+        return
+    try:
+        reading = fleet_logs.read(nominal, log)
+        residual, expected = reading.vector, None
+        if twin is not None:
+            at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
+            expected = twin.expected(at, reading.payload)
+            residual = residual - expected
+    except stored.StateError:
+        raise
+    except ValueError as err:
+        unit.skipped.append(stored.Skipped(log.stamp, sha256, _short(err)))
+        return
+    unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
+    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
+
+
+def _short(err: Exception, limit: int = 300) -> str:
+    text = " ".join(str(err).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _status(name: str, unit: _Unit | None, settings: Settings) -> UnitStatus:
+    """The unit's row of units.csv (:class:`UnitStatus`)."""
+    if unit is None:
+        return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
+    protocol = "own" if unit.model == "none" else "twin"
+    reasons = list(unit.notes)
+    if unit.skipped:
+        first = unit.skipped[0]
+        more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
+        reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
+    learning = unit.monitor.pca is None
+    if learning:
+        reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
+    if not unit.entries:
+        status = "not monitored"
+    elif unit.notes or unit.skipped:
+        status = "degraded"
+    else:
+        status = "learning" if learning else "monitored"
+    last = unit.entries[-1].stamp if unit.entries else ""
+    return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
+                      "; ".join(reasons), len(unit.entries), last)
 
 
 def _log(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fleet_logs.Log:
@@ -199,9 +352,10 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         if not (path.exists() or path.is_symlink()):
             continue
         kept = stored.read_unit(path, out, name, key, n_axes, n_features)
-        if not kept.entries:
+        if not (kept.entries or kept.skipped):
             continue
-        state[name] = _Unit(stored.replay(kept, settings, n_axes), "", kept.program, list(kept.entries))
+        state[name] = _Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
+                            list(kept.entries), list(kept.skipped), list(kept.notes))
     return state
 
 
@@ -217,17 +371,24 @@ def _given_model(calibrated: str | Path) -> Path:
     return path
 
 
-def _model(nominal, settings: Settings, calibrated: Path | None, calibrate: bool, first, out: Path,
+def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_path: Path | None, out: Path,
            progress: bool) -> str:
-    """The unit's model file: given, calibrated on its first log (cached in ``OUT/.cache/calibrated``
-    under the digest of the nominal model, the log and the search's length, beside a record of
-    the calibrated model's SHA-256 that a later run checks), or nominal."""
-    if settings.protocol != "twin" or (calibrated is None and not calibrate):
+    """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
+    the unit's first log (``first``: its stamp and SHA-256; ``first_path`` the file, needed only
+    when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
+    the nominal model, the log and the search's length, beside a record of the calibrated model's
+    SHA-256 that a later run checks.
+
+    Raises
+    ------
+    ValueError
+        The calibration fails, or its cache does not match its record.
+    """
+    if kind == "nominal":
         return str(nominal.path)
-    if calibrated is not None:
+    if kind == "given":
         return str(calibrated)
-    key = {"robot": stored.sha256_file(nominal.path), "log": stored.sha256_file(first.path),
-           "steps": CALIBRATION_STEPS}
+    key = {"robot": stored.sha256_file(nominal.path), "log": first[1], "steps": CALIBRATION_STEPS}
     digest = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
     root = out / ".cache" / "calibrated"
     folder, record = root / digest, root / f"{digest}.json"
@@ -235,6 +396,9 @@ def _model(nominal, settings: Settings, calibrated: Path | None, calibrate: bool
     if record.exists() or record.is_symlink():
         stored.read_calibration(record, out, key, model)
     else:
+        if first_path is None:
+            raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
+                             "in the fleet folder and its calibration is not cached")
         if folder.exists() or folder.is_symlink():  # a run killed before its record: ours to redo
             stored.inside(folder, out)
             shutil.rmtree(folder) if folder.is_dir() and not folder.is_symlink() else folder.unlink()
@@ -242,7 +406,7 @@ def _model(nominal, settings: Settings, calibrated: Path | None, calibrate: bool
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run_calibration(str(nominal.path), first.path, folder, max_steps=CALIBRATION_STEPS, progress=False)
+            run_calibration(str(nominal.path), first_path, folder, max_steps=CALIBRATION_STEPS, progress=False)
         stored.write_calibration(record, key, model)
     return str(_without_payload(model))
 

@@ -1,4 +1,8 @@
-"""The monitor's outputs: ``alarms.csv``, ``scores.csv`` and one control chart per unit."""
+"""The monitor's outputs: ``units.csv``, ``alarms.csv``, ``scores.csv`` and one control chart per unit.
+
+Text cells that a spreadsheet would take for a formula (starting with ``=``, ``+``, ``-``, ``@``, a
+tab or a carriage return: a unit folder named ``=HYPERLINK(...)``) are written with a leading
+``'`` (OWASP, "CSV Injection"); numbers are written as numbers."""
 
 from __future__ import annotations
 
@@ -11,8 +15,26 @@ ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "ev
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
 
 
+UNIT_COLUMNS = ("unit", "status", "protocol", "model", "reason", "logs_scored", "last_log")
+_FORMULA = ("=", "+", "-", "@", "\t", "\r")
+
+
 def _fmt(value) -> str:
-    return f"{value:.6g}" if isinstance(value, float) else str(value)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    text = str(value)
+    return "'" + text if isinstance(value, str) and text.startswith(_FORMULA) else text
+
+
+def write_units(path: Path, statuses) -> None:
+    """One row per unit of the fleet folder (:class:`faultgen.monitor.loop.UnitStatus`): its
+    status, the protocol and model its monitor uses, why (fallbacks, skipped logs, learning), the
+    logs scored and the last one."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(UNIT_COLUMNS)
+        for s in statuses:
+            writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS])
 
 
 def write_alarms(path: Path, monitors) -> None:

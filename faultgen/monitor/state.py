@@ -20,7 +20,7 @@ and every file is checked against the settings and inputs it belongs to before i
   a record of the calibrated model's SHA-256; the model itself is loaded as any robot description
   (:func:`faultgen.model.robots.load`: no file outside its folder, no plugin).
 
-Every refusal is a :class:`faultgen.inputs.InputError` naming the file and what did not match, and
+Every refusal is a :class:`StateError` (a :class:`faultgen.inputs.InputError`) naming the file and what did not match, and
 saying what to do (score into a new ``OUT``, or delete the named file).
 """
 
@@ -29,7 +29,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -45,6 +45,11 @@ CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
 STATE_MAX_BYTES = 64 * 2**20
 #: Size bound of one cached cycle (a few hundred bytes).
 CYCLE_MAX_BYTES = 2**20
+
+
+class StateError(inputs.InputError):
+    """A state or cache file in OUT refused (module docstring): it stops the run as a whole, before
+    any output is written, where a unit's own trouble (a log, a twin) only degrades that unit."""
 
 
 def sha256_file(path: str | Path) -> str:
@@ -77,16 +82,36 @@ class Entry:
     expected: np.ndarray | None
 
 
+@dataclass(frozen=True)
+class Skipped:
+    """A log the monitor could not score (unreadable, or its twin could not replay it): ``stamp``,
+    the file's ``sha256`` and the ``reason``."""
+
+    stamp: str
+    sha256: str
+    reason: str
+
+
+#: A unit's model kinds: a given calibrated model, its own calibration, the nominal model, none.
+MODELS = ("given", "calibrated", "nominal", "none")
+
+
 @dataclass
 class UnitState:
     """A unit's state (module docstring): ``program`` the (unit, stamp) of the log its twin replays
-    (None without a twin), ``signatures`` (n_axes, n_features) or None, ``entries`` in stamp order."""
+    (None without a twin), ``signatures`` (n_axes, n_features) or None, ``entries`` in stamp order,
+    ``model`` of :data:`MODELS` ("none": protocol own), ``first`` the (stamp, SHA-256) of the unit's
+    first log, the logs ``skipped`` and the ``notes`` on fallbacks taken."""
 
     unit: str
     settings: dict
     program: tuple[str, str] | None
     signatures: np.ndarray | None
     entries: list[Entry]
+    model: str = "nominal"
+    first: tuple[str, str] = ("", "")
+    skipped: list[Skipped] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
 
 def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
@@ -107,6 +132,8 @@ def write_unit(path: Path, state: UnitState) -> None:
     document = {
         "format": FORMAT, "unit": state.unit, "settings": state.settings,
         "program": list(state.program) if state.program else None,
+        "model": state.model, "first": list(state.first), "notes": list(state.notes),
+        "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature": float(e.temperature), "payload": float(e.payload),
@@ -119,35 +146,38 @@ def inside(path: Path, root: Path) -> Path:
     """``path`` after checking that it resolves inside ``root`` (a symbolic link out of the output
     folder is refused, naming it: an output folder never makes faultgen read outside itself)."""
     if not Path(path).resolve().is_relative_to(Path(root).resolve()):
-        raise inputs.InputError(f"{path}: a link leading outside {root}; faultgen never writes links into its output "
+        raise StateError(f"{path}: a link leading outside {root}; faultgen never writes links into its output "
                                 "folders: delete it")
     return Path(path)
 
 
 def _load_json(path: Path, what: str, max_bytes: int) -> dict:
-    text = inputs.read_text(path, what, max_bytes)
+    try:
+        text = inputs.read_text(path, what, max_bytes)
+    except inputs.InputError as err:
+        raise StateError(str(err)) from None
     try:
         document = json.loads(text)
     except (ValueError, RecursionError) as err:
-        raise inputs.InputError(f"{path}: not a {what} ({type(err).__name__}: {str(err)[:80]})") from None
+        raise StateError(f"{path}: not a {what} ({type(err).__name__}: {str(err)[:80]})") from None
     if not isinstance(document, dict):
-        raise inputs.InputError(f"{path}: not a {what} (expected a JSON object)")
+        raise StateError(f"{path}: not a {what} (expected a JSON object)")
     return document
 
 
 def _vector(value, path: Path, name: str, length: int, finite: bool = True) -> np.ndarray:
     if not (isinstance(value, list) and len(value) == length
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-        raise inputs.InputError(f"{path}: {name} is not a list of {length} numbers")
+        raise StateError(f"{path}: {name} is not a list of {length} numbers")
     array = np.asarray(value, dtype=float)
     if finite and not np.all(np.isfinite(array)):
-        raise inputs.InputError(f"{path}: {name} holds a value that is not a finite number")
+        raise StateError(f"{path}: {name} holds a value that is not a finite number")
     return array
 
 
 def _number(value, path: Path, name: str) -> float:
     if not isinstance(value, (int, float)) or isinstance(value, bool):
-        raise inputs.InputError(f"{path}: {name} = {str(value)[:40]!r} is not a number")
+        raise StateError(f"{path}: {name} = {str(value)[:40]!r} is not a number")
     return float(value)
 
 
@@ -156,7 +186,7 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
 
     Raises
     ------
-    faultgen.inputs.InputError
+    StateError
         The file is a link leading outside ``root`` or not a regular file, is above :data:`STATE_MAX_BYTES`, is not
         such a state, belongs to another unit or to other settings (the differing settings named),
         or holds an entry of the wrong type or length (named).
@@ -164,33 +194,46 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
     refuse = f"; score the logs into a new OUT (or delete {path.parent} to start this one again)"
     d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
     if d.get("format") != FORMAT:
-        raise inputs.InputError(f"{path}: format {str(d.get('format'))[:40]!r}, expected {FORMAT!r}{refuse}")
+        raise StateError(f"{path}: format {str(d.get('format'))[:40]!r}, expected {FORMAT!r}{refuse}")
     if d.get("unit") != unit:
-        raise inputs.InputError(f"{path}: the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}{refuse}")
+        raise StateError(f"{path}: the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}{refuse}")
     if d.get("settings") != settings:
         theirs = d.get("settings") if isinstance(d.get("settings"), dict) else {}
         moved = [f"{k} {theirs.get(k)!r} (now {v!r})" for k, v in settings.items() if theirs.get(k) != v]
-        raise inputs.InputError(f"{path}: holds a monitor run with other settings or inputs: "
+        raise StateError(f"{path}: holds a monitor run with other settings or inputs: "
                                 f"{', '.join(moved) or 'unknown keys'}{refuse}")
     program = d.get("program")
     if program is not None and not (isinstance(program, list) and len(program) == 2
                                     and all(isinstance(p, str) for p in program)):
-        raise inputs.InputError(f"{path}: program is not [unit, stamp]{refuse}")
+        raise StateError(f"{path}: program is not [unit, stamp]{refuse}")
     signatures = d.get("signatures")
     if signatures is not None:
         if not (isinstance(signatures, list) and len(signatures) == n_axes):
-            raise inputs.InputError(f"{path}: signatures is not a list of {n_axes} rows{refuse}")
+            raise StateError(f"{path}: signatures is not a list of {n_axes} rows{refuse}")
         signatures = np.stack([_vector(row, path, f"signatures row {i + 1}", n_features)
                                for i, row in enumerate(signatures)])
+    model, first, notes, skipped = d.get("model"), d.get("first"), d.get("notes"), d.get("skipped")
+    if model not in MODELS:
+        raise StateError(f"{path}: model {str(model)[:40]!r} is not one of {', '.join(MODELS)}{refuse}")
+    if not (isinstance(first, list) and len(first) == 2 and all(isinstance(p, str) for p in first)):
+        raise StateError(f"{path}: first is not [stamp, sha256]{refuse}")
+    if not (isinstance(notes, list) and all(isinstance(n, str) for n in notes)):
+        raise StateError(f"{path}: notes is not a list of texts{refuse}")
+    if not (isinstance(skipped, list) and all(
+            isinstance(k, dict) and all(isinstance(k.get(f), str) for f in ("stamp", "sha256", "reason"))
+            for k in skipped)):
+        raise StateError(f"{path}: skipped is not a list of {{stamp, sha256, reason}}{refuse}")
+    if (model == "none") != (program is None):
+        raise StateError(f"{path}: model {model!r} with program {program!r}{refuse}")
     logs = d.get("logs")
     if not isinstance(logs, list):
-        raise inputs.InputError(f"{path}: logs is not a list{refuse}")
+        raise StateError(f"{path}: logs is not a list{refuse}")
     entries = []
     for i, log in enumerate(logs):
         where = f"logs[{i}]"
         if not (isinstance(log, dict) and isinstance(log.get("stamp"), str) and isinstance(log.get("sha256"), str)
                 and len(log["sha256"]) == 64):
-            raise inputs.InputError(f"{path}: {where} has no stamp or SHA-256{refuse}")
+            raise StateError(f"{path}: {where} has no stamp or SHA-256{refuse}")
         expected = log.get("expected")
         entries.append(Entry(
             log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
@@ -198,8 +241,9 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             _number(log.get("payload"), path, f"{where}.payload"),
             None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
         if not math.isfinite(entries[-1].payload):
-            raise inputs.InputError(f"{path}: {where}.payload is not a finite number{refuse}")
-    return UnitState(unit, settings, tuple(program) if program else None, signatures, entries)
+            raise StateError(f"{path}: {where}.payload is not a finite number{refuse}")
+    return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
+                     [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes))
 
 
 def write_cycle(path: Path, key: dict, features: np.ndarray) -> None:
@@ -212,12 +256,12 @@ def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray
 
     Raises
     ------
-    faultgen.inputs.InputError
+    StateError
         The file is a link leading outside ``root``, is not a cached cycle of ``key`` or its features are not ``n_features`` finite numbers.
     """
     d = _load_json(inside(path, root), "cached twin cycle", CYCLE_MAX_BYTES)
     if d.get("format") != CYCLE_FORMAT or d.get("key") != key:
-        raise inputs.InputError(f"{path}: not the cached twin cycle of {key} (another model, program or condition); "
+        raise StateError(f"{path}: not the cached twin cycle of {key} (another model, program or condition); "
                                 "delete it (the twin simulates it again)")
     return _vector(d.get("features"), path, "features", n_features)
 
@@ -233,13 +277,13 @@ def read_calibration(path: Path, root: Path, key: dict, model: Path) -> None:
 
     Raises
     ------
-    faultgen.inputs.InputError
+    StateError
         The record or the model is a link out of ``root``, the record belongs to another key, or
         the model file is missing or is not the one the record was written for.
     """
     d = _load_json(inside(path, root), "cached calibration record", CYCLE_MAX_BYTES)
     fix = f"; delete {path} and {path.with_suffix('')} (the unit is calibrated again)"
     if d.get("format") != CALIBRATION_FORMAT or d.get("key") != key:
-        raise inputs.InputError(f"{path}: not the calibration of this robot and log{fix}")
+        raise StateError(f"{path}: not the calibration of this robot and log{fix}")
     if not Path(model).is_file() or sha256_file(inside(model, root)) != d.get("model"):
-        raise inputs.InputError(f"{model}: not the calibrated model its record {path.name} was written for{fix}")
+        raise StateError(f"{model}: not the calibrated model its record {path.name} was written for{fix}")

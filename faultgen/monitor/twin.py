@@ -4,8 +4,10 @@ healthy under the logged conditions and with each axis in turn worn.
 What the monitor asks of it (:class:`Twin`):
 
 - :meth:`Twin.expected`: the features a healthy unit shows at a joint temperature and payload:
-  the replayed cycle simulated at :data:`TEMPERATURES` (a quadratic through the three, so any
-  temperature in between and a little beyond) for every payload the unit's logs declare (an
+  the replayed cycle simulated at :data:`REFERENCE_TEMPERATURE` (the monitor's default, where the
+  unit's own learned slope carries the temperature), or, asked for another temperature
+  (``--twin-temperature``), at :data:`TEMPERATURES` (a quadratic through the three, so any
+  temperature in between and a little beyond), for every payload the unit's logs declare (an
   aluminium cube of that mass hanging from the flange: the log gives the mass only);
 - :attr:`Twin.signatures`: how each axis's wear moves the features, per percent: one cycle with the
   axis's Coulomb and static friction at :data:`WEAR` % above nominal (thesis eq. 6.6's exp4 schedule
@@ -116,8 +118,8 @@ class Twin:
     def expected(self, temperature: float, payload: float) -> np.ndarray:
         """Features of the healthy twin at ``temperature`` deg C (NaN: nominal) and ``payload`` kg."""
         payload = round(float(payload), 1)
-        if np.isnan(temperature):
-            return self.cycle(float("nan"), payload)
+        if np.isnan(temperature) or temperature == REFERENCE_TEMPERATURE:  # the monitor's default: one cycle
+            return self.cycle(float(temperature), payload)
         if payload not in self._healthy:
             points = np.stack([self.cycle(t, payload) for t in TEMPERATURES])
             self._healthy[payload] = np.polyfit(np.asarray(TEMPERATURES), points, 2)
