@@ -47,6 +47,7 @@ from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
 from analysis.features import Difference, WindowConcat
+from faultgen import children
 from faultgen.checks import is_whole
 
 #: Step types applied to each run on its own (they look at neighbouring rows; both are stateless).
@@ -615,7 +616,8 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
             aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
     else:
         jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
-        aucs = Parallel(n_jobs=n_jobs)(jobs)
+        with children.safe_path():  # loky's workers and trackers: no joblib.py of this folder (issue 61)
+            aucs = Parallel(n_jobs=n_jobs)(jobs)
     aucs = np.asarray(aucs, dtype=float)
     n_nan = int(np.isnan(aucs).sum())
     if n_nan:
@@ -899,7 +901,8 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
     # joblib's workers limit theirs alike
-    with threadpool_limits(limits=1):
+    # loky's workers and trackers start in this folder: no joblib.py of it on their path (issue 61)
+    with threadpool_limits(limits=1), children.safe_path():
         results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(tasks)
         per_job = np.array(list(tqdm(results, total=len(jobs), desc="classify", unit="pair", disable=not progress)))
     per_job = per_job.reshape(len(jobs), len(names) * len(models))

@@ -27,6 +27,8 @@ import platform
 import sys
 from importlib import metadata
 
+from faultgen import children
+
 #: Profiles by name: the environment variables that pin them (read by OpenBLAS and NumPy at load time).
 PROFILES = {
     "x86-64-v3": {
@@ -124,12 +126,14 @@ def check(name: str | None) -> str:
 def restart_pinned(name: str | None, argv: list[str]) -> None:
     """Start this command again in profile ``name`` (replacing this process) unless it runs in it
     already, no profile is asked, or the processor cannot take it. ``argv``: the command's arguments
-    after the program (``sys.argv[1:]``)."""
+    after the program (``sys.argv[1:]``). Started as ``python -P -m faultgen.cli`` with
+    ``PYTHONSAFEPATH=1`` (:mod:`faultgen.children`): ``python -m`` alone put the current folder first
+    on the path, and an ``h5py.py`` there ran in the make (issue 61)."""
     if name is None or not supported(name) or pinned(name):
         return
     if os.environ.get("_FAULTGEN_PROFILE_RESTART") == name:  # pinned variables that did not take: no loop
         return
-    env = {**os.environ, **PROFILES[name], "_FAULTGEN_PROFILE_RESTART": name}
+    env = children.environment({**PROFILES[name], "_FAULTGEN_PROFILE_RESTART": name})
     sys.stdout.flush()
     sys.stderr.flush()
-    os.execve(sys.executable, [sys.executable, "-m", "faultgen.cli", *argv], env)
+    os.execve(sys.executable, children.command("-m", "faultgen.cli", *argv), env)

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import signal
 import subprocess
-import sys
 import threading
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from faultgen import children
 
 
 @dataclass(frozen=True)
@@ -175,8 +176,10 @@ def _run_step(step: Step, folder: Path) -> Outcome:
     with log.open("w") as sink:
         sink.write(step.command() + "\n")
         sink.flush()
-        child = subprocess.Popen([sys.executable, "-m", "faultgen.cli", *step.args], cwd=folder, stdout=sink,
-                                 stderr=subprocess.STDOUT)
+        # -P and PYTHONSAFEPATH: `python -m` puts its current folder, the output folder here, first on
+        # the path, and an h5py.py or typer.py there would be imported (issue 61; faultgen.children)
+        child = subprocess.Popen(children.command("-m", "faultgen.cli", *step.args), cwd=folder,
+                                 env=children.environment(), stdout=sink, stderr=subprocess.STDOUT)
         _CHILDREN.add(child)
         try:
             code = child.wait()

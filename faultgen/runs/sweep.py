@@ -39,6 +39,7 @@ from typing import Self
 
 from tqdm.auto import tqdm
 
+from faultgen import children
 from faultgen.data import atomic, dataset
 from faultgen.runs import cluster, worker
 from faultgen.runs.errors import SweepError, SweepInterrupted, SweepRefused
@@ -373,11 +374,15 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
 
-            worker.start_resource_tracker()
-            # every worker watches the sweep from its start, idle or not (:func:`faultgen.runs.worker.watch_parent`)
-            backend = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
-            parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
-            yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
+            # loky starts its workers (`python -m`) and resource trackers (`python -c`) in this folder:
+            # without PYTHONSAFEPATH a joblib.py here ran in each of them (issue 61; faultgen.children)
+            with children.safe_path():
+                worker.start_resource_tracker()
+                # every worker watches the sweep from its start, idle or not
+                # (:func:`faultgen.runs.worker.watch_parent`)
+                backend = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
+                parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
+                yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:
             _stop_local_workers()
