@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import axes as axis_numbers
+from faultgen import inputs
 from faultgen.data import atomic
 
 #: name -> unit of every per-record array a method may read (faultgen's dataset schema): the
@@ -35,6 +37,18 @@ OBSERVABLES = {
 FEATURES = ("mean_abs_torque", "rms_torque", "average_speed", "average_load_torque")
 FORMAT = "faultgen-bench/1"
 LABEL_COLUMNS = ("unit", "cycle", "fault_level_pct", "worn_axis", "fault")
+#: The arrays every unit holds: its records' cycle numbers and the per-axis feature that sets the axes.
+REQUIRED = ("cycles", "mean_abs_torque")
+#: The text attributes of every unit and what each says.
+UNIT_TEXT = {"robot": "the robot's name", "task": "the task's name", "sample": "what a record is: cycle, day or log"}
+#: Most records one unit may hold (a record a cycle: a cycle a minute for 19 years).
+MAX_RECORDS = 10**7
+#: Most units one benchmark file may hold (the tracks have tens to hundreds).
+MAX_UNITS = 100_000
+#: Longest text attribute (robot, task, sample, fault) read, characters.
+MAX_TEXT_BYTES = 4096
+#: Size bound of ``test_labels.csv``, bytes (a row is under 80 bytes; a full track's file a few MB).
+LABELS_MAX_BYTES = 256 * 2**20
 
 
 @dataclass
@@ -92,37 +106,169 @@ def write(path: Path, units: list[Unit], attrs: dict) -> None:
                 g.attrs.update(worn_axis=int(unit.worn_axis), fault=str(unit.fault))
 
 
+def folder_file(path: str | Path, what: str, max_bytes: int | None = None) -> Path:
+    """``path`` after checking that it is a regular file (:func:`faultgen.inputs.regular_file`, of at
+    most ``max_bytes`` bytes) inside its benchmark folder (``path``'s parent): a symbolic link whose
+    target leaves the folder is refused, naming the link only (nothing of the target is read or shown).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Naming ``path`` and ``what``: missing (with the command that writes it), outside the folder,
+        not a regular file, or above the bound.
+    """
+    from faultgen.model.sources import inside
+
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not path.exists() and not path.is_symlink():
+        raise inputs.InputError(f"{path} does not exist (the {what}); `faultgen bench make TRACK -o {folder}` writes it")
+    if not inside(path, folder):
+        raise inputs.InputError(f"{path}: a symbolic link to a file outside the benchmark folder {folder}; the {what} "
+                                "must be a regular file inside the folder (nothing of the target was read)")
+    return inputs.regular_file(path, what, max_bytes)
+
+
+def _short(value, most: int = 60) -> str:
+    """``repr(value)`` cut to ``most`` characters (a name or cell of a file inside the folder, in an error)."""
+    text = repr(value)
+    return text if len(text) <= most else text[:most] + "...(cut)"
+
+
+def _attr(obj, name: str, where: str, expected: str, kinds: str, required: bool = True):
+    """The scalar attribute ``name`` of ``obj``, checked from its declared type and shape before it
+    is read: text (``kinds`` "SOU") is returned as str, a whole number ("iu") as int. None when it is
+    absent and not ``required``.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        ``where`` (the file and the unit) and the attribute: missing, not a scalar or of another type.
+    """
+    import h5py
+
+    if name not in obj.attrs:
+        if not required:
+            return None
+        raise inputs.InputError(f"{where}: no attribute {name!r}; {expected} is expected")
+    attr_id = h5py.h5a.open(obj.id, name.encode())
+    dtype = attr_id.dtype
+    if attr_id.shape != () or dtype.kind not in kinds or (dtype.kind in "SU" and dtype.itemsize > MAX_TEXT_BYTES) or (
+            dtype.kind == "O" and h5py.check_string_dtype(dtype) is None):  # O: text of any length, or a reference
+        raise inputs.InputError(f"{where}: attribute {name!r} is of type {attr_id.dtype} and shape {attr_id.shape}; "
+                                f"{expected} is expected")
+    value = obj.attrs[name]
+    if kinds == "iu":
+        return int(value)
+    text = value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
+    if len(text) > MAX_TEXT_BYTES:
+        raise inputs.InputError(f"{where}: attribute {name!r} is {len(text)} characters long; {expected} of at most "
+                                f"{MAX_TEXT_BYTES} is expected")
+    return text
+
+
+def _unit_arrays(path: Path, uid: str, g, labelled: bool) -> tuple[dict, int]:
+    """The datasets of the unit group ``g`` (not read yet), each checked from its declared shape and
+    type: ``cycles`` (the records, at most :data:`MAX_RECORDS`), ``mean_abs_torque`` (records x
+    axes), every other observable by its axes in faultgen's dataset schema, ``fault_level``
+    (records) when ``labelled``; and the number of axes."""
+    from faultgen.data.schema import BINS, SHAPES
+
+    where = f"{path}: unit {_short(uid)}"
+    for name in REQUIRED:
+        if name not in g:
+            raise inputs.InputError(f"{where}: no array {name!r}; every unit holds "
+                                    f"{' and '.join(REQUIRED)} (records{' x axes' if name != 'cycles' else ''})")
+    cycles = inputs.bounded_dataset(g, "cycles", path, (None,), kinds="iu")
+    n = cycles.shape[0]
+    if not 1 <= n <= MAX_RECORDS:
+        raise inputs.InputError(f"{where}: cycles declares {n} records; 1..{MAX_RECORDS} are expected")
+    torque = inputs.bounded_dataset(g, "mean_abs_torque", path, (n, None))
+    n_axes = torque.shape[1]
+    if not axis_numbers.MIN_AXES <= n_axes <= axis_numbers.MAX_AXES:
+        raise inputs.InputError(f"{where}: mean_abs_torque has {n_axes} axes; "
+                                f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES} are expected")
+    sizes = {"cycle": n, "axis": n_axes, **BINS}
+    arrays = {}
+    for name in OBSERVABLES:
+        if name in g:
+            shape = tuple(sizes[axis.strip()] for axis in SHAPES[name].split(","))
+            arrays[name] = inputs.bounded_dataset(g, name, path, shape, kinds="iu" if name == "cycles" else "fiub")
+    if labelled:
+        arrays["fault_level"] = inputs.bounded_dataset(g, "fault_level", path, (n,), kinds="fiu")
+    return arrays, n_axes
+
+
+def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list[Unit], dict]:
+    """The units of a benchmark file (as :func:`read`) and its file attributes ``attrs`` (each
+    required: text, or a whole number for ``version``).
+
+    The file is opened by :func:`faultgen.inputs.open_hdf5` (a file outside its folder, an external
+    or escaping soft link, a virtual dataset or external storage refused) and every unit's
+    attributes and arrays are checked from their declared types and shapes (:func:`_unit_arrays`,
+    at most :data:`MAX_UNITS` units and :data:`faultgen.inputs.HDF5_MAX_ELEMENTS` elements in all)
+    before any array is read.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        A ``ValueError`` naming the file, the unit and what is missing or wrong and what was expected.
+    """
+    import h5py
+
+    path = folder_file(path, "benchmark file")
+    with inputs.open_hdf5(path, "benchmark file of `faultgen bench make`") as f:
+        fmt = _attr(f, "format", str(path), f"the text {FORMAT!r}", "SOU", required=False)
+        if fmt != FORMAT:
+            raise inputs.InputError(f"{path} is not a benchmark file (format {_short(fmt)}, expected {FORMAT!r})")
+        made = {name: _attr(f, name, str(path), "a whole number" if name == "version" else "a text",
+                            "iu" if name == "version" else "SOU") for name in attrs}
+        group = f.get("units")
+        if not isinstance(group, h5py.Group):
+            found = "none" if group is None else f"a {type(group).__name__.lower()}"
+            raise inputs.InputError(f"{path}: no /units group (found {found}); a benchmark file holds its units "
+                                    "under /units")
+        if len(group) > MAX_UNITS:
+            raise inputs.InputError(f"{path}: {len(group)} units; at most {MAX_UNITS} are read")
+        checked, total = [], 0
+        for uid in group:  # every unit checked from its metadata before any array is read
+            g = group.get(uid)
+            where = f"{path}: unit {_short(uid)}"
+            if not isinstance(g, h5py.Group):
+                raise inputs.InputError(f"{where} is a {type(g).__name__.lower()}; each unit is a group")
+            labelled = "fault_level" in g
+            arrays, n_axes = _unit_arrays(path, uid, g, labelled)
+            total += sum(ds.size for ds in arrays.values())
+            if total > inputs.HDF5_MAX_ELEMENTS:
+                raise inputs.InputError(f"{path}: its units declare more than {inputs.HDF5_MAX_ELEMENTS} elements in "
+                                        f"all (at unit {_short(uid)}); a benchmark file is read up to that")
+            info = {name: _attr(g, name, where, f"a text ({meaning})", "SOU") for name, meaning in UNIT_TEXT.items()}
+            if labelled:
+                info["worn_axis"] = _attr(g, "worn_axis", where, f"a whole axis number 0..{n_axes}", "iu")
+                if not 0 <= info["worn_axis"] <= n_axes:
+                    raise inputs.InputError(f"{where}: attribute 'worn_axis' is {info['worn_axis']}; a whole axis "
+                                            f"number 0..{n_axes} (0: none) is expected")
+                info["fault"] = _attr(g, "fault", where, "a text (none, friction_wear or an effect id)", "SOU")
+            checked.append((uid, arrays, info))
+        units = []
+        for uid, arrays, info in checked:
+            values = {name: ds[()] for name, ds in arrays.items()}
+            fault_level = values.pop("fault_level", None)
+            units.append(Unit(id=uid, arrays=values, fault_level=fault_level, **info))
+    return units, made
+
+
 def read(path: str | Path) -> list[Unit]:
     """The units of a benchmark file, in file order (labels only in a train file).
 
     Raises
     ------
-    ValueError
-        If ``path`` does not exist or is not a benchmark file (naming it and what was expected).
+    faultgen.inputs.InputError
+        A ``ValueError``: if ``path`` does not exist, leaves its folder or is not a benchmark file,
+        or a unit lacks an attribute or array or declares a wrong type or shape (naming the file,
+        the unit and what was expected); see :func:`read_with_attrs`.
     """
-    import h5py
-
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path} does not exist; make it with `faultgen bench make TRACK -o {path.parent}`")
-    try:
-        f = h5py.File(path, "r")
-    except OSError:
-        raise ValueError(f"{path} is not an HDF5 file; expected a benchmark file of `faultgen bench make`") from None
-    with f:
-        if f.attrs.get("format") != FORMAT:
-            raise ValueError(f"{path} is not a benchmark file (format {f.attrs.get('format')!r}, expected {FORMAT!r})")
-        units = []
-        for uid in f["units"]:
-            g = f["units"][uid]
-            arrays = {name: g[name][()] for name in OBSERVABLES if name in g}
-            labelled = "fault_level" in g
-            units.append(Unit(id=uid, robot=str(g.attrs["robot"]), task=str(g.attrs["task"]),
-                              sample=str(g.attrs["sample"]), arrays=arrays,
-                              fault_level=g["fault_level"][()] if labelled else None,
-                              worn_axis=int(g.attrs["worn_axis"]) if labelled else None,
-                              fault=str(g.attrs["fault"]) if labelled else None))
-    return units
+    return read_with_attrs(path)[0]
 
 
 def write_labels(path: Path, units: list[Unit]) -> None:
@@ -137,30 +283,66 @@ def write_labels(path: Path, units: list[Unit]) -> None:
 def attach_labels(units: list[Unit], path: str | Path) -> list[Unit]:
     """``units`` of a test file with their labels from ``test_labels.csv`` (scoring only).
 
+    The file must be a regular file inside the benchmark folder (:func:`folder_file`: a symbolic
+    link leaving it is refused without reading the target) of at most :data:`LABELS_MAX_BYTES`
+    bytes, and hold no more rows than the units have records; an error names the file and the row,
+    and shows at most a short cut of the cell at fault (of this file only).
+
     Raises
     ------
-    ValueError
-        If the file is missing, a unit has no rows, or its cycles differ from the unit's (naming them).
+    faultgen.inputs.InputError
+        A ``ValueError``: if the file is missing or refused, its header or a row is wrong, a unit has
+        no rows, or its cycles differ from the unit's (naming them).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path} does not exist: the test labels are written by `faultgen bench make`")
+    path = folder_file(path, "test labels", LABELS_MAX_BYTES)
+    records = sum(len(unit.arrays["cycles"]) for unit in units)
     rows: dict[str, list] = {}
-    with path.open(newline="") as f:
-        reader = csv.DictReader(f)
-        if tuple(reader.fieldnames or ()) != LABEL_COLUMNS:
-            raise ValueError(f"{path}: columns {reader.fieldnames}, expected {', '.join(LABEL_COLUMNS)}")
-        for line, row in enumerate(reader, start=2):
-            try:
-                rows.setdefault(row["unit"], []).append((int(row["cycle"]), float(row["fault_level_pct"]),
-                                                         int(row["worn_axis"]), row["fault"]))
-            except ValueError:
-                raise ValueError(f"{path}, row {line}: {row}: expected a whole cycle, a number and a whole axis") from None
+    line = 1
+    try:
+        with inputs.open_text(path, "test labels", LABELS_MAX_BYTES) as fh:
+            reader = csv.reader(fh)
+            header = next(reader, None)
+            if tuple(header or ()) != LABEL_COLUMNS:
+                raise inputs.InputError(f"{path}, row 1: columns {_short(header, 120)}; expected "
+                                        f"{', '.join(LABEL_COLUMNS)}")
+            for line, fields in enumerate(reader, start=2):
+                if line - 1 > records:
+                    raise inputs.InputError(f"{path}, row {line}: more label rows than the {records} records of "
+                                            "the test file's units")
+                if len(fields) != len(LABEL_COLUMNS):
+                    raise inputs.InputError(f"{path}, row {line}: {len(fields)} fields; {len(LABEL_COLUMNS)} are "
+                                            f"expected ({', '.join(LABEL_COLUMNS)})")
+                unit, cycle, level, axis, fault = fields
+                parsed = []
+                for column, text, kind in (("cycle", cycle, int), ("fault_level_pct", level, float),
+                                           ("worn_axis", axis, int)):
+                    try:
+                        value = kind(text)
+                    except ValueError:
+                        value = None
+                    if value is None or (kind is float and not np.isfinite(value)) or (
+                            kind is int and not 0 <= value <= 10**12):
+                        raise inputs.InputError(
+                            f"{path}, row {line}: {column} {_short(text)}; expected "
+                            + ("a finite number (%)" if kind is float else "a whole number >= 0"))
+                    parsed.append(value)
+                rows.setdefault(unit, []).append((*parsed, fault))
+    except csv.Error as err:
+        raise inputs.InputError(f"{path}, row {line + 1}: not a CSV row ({err})") from None
+    except UnicodeDecodeError as err:
+        raise inputs.InputError(f"{path}, after row {line}: not UTF-8 text ({err.reason}); the test labels are a "
+                                "UTF-8 CSV file") from None
     out = []
     for unit in units:
         got = rows.get(unit.id)
         if not got or [c for c, *_ in got] != [int(c) for c in unit.arrays["cycles"]]:
-            raise ValueError(f"{path}: the labels of unit {unit.id} do not match its records in the test file")
+            raise inputs.InputError(f"{path}: the labels of unit {unit.id} do not match its records in the test file")
+        if len({(axis, fault) for _, _, axis, fault in got}) != 1:
+            raise inputs.InputError(f"{path}: the rows of unit {unit.id} disagree on worn_axis or fault; one worn "
+                                    "axis and fault per unit is expected")
+        if got[0][2] > unit.n_axes:
+            raise inputs.InputError(f"{path}: unit {unit.id} has worn_axis {got[0][2]}; its robot has "
+                                    f"{unit.n_axes} axes (0: none)")
         out.append(Unit(id=unit.id, robot=unit.robot, task=unit.task, sample=unit.sample, arrays=unit.arrays,
                         fault_level=np.array([level for _, level, *_ in got]), worn_axis=got[0][2], fault=got[0][3]))
     return out

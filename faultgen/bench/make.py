@@ -50,18 +50,21 @@ def _array_hash(values: np.ndarray) -> str:
 def hashes(folder: Path) -> dict[str, str]:
     """SHA-256 of every array and unit attribute set of ``train.h5`` and ``test.h5`` in ``folder``, and of
     ``test_labels.csv``: ``{"train.h5:/units/train-000/cycles": hex, ...}`` in a stable order."""
-    import h5py
+    from faultgen import inputs
 
     out = {}
     for name in ("train.h5", "test.h5"):
-        with h5py.File(folder / name, "r") as f:
+        path = files.folder_file(folder / name, "benchmark file")
+        with inputs.open_hdf5(path, "benchmark file of `faultgen bench make`") as f:  # nothing read from another file
             for uid in f["units"]:
                 g = f["units"][uid]
                 attrs = json.dumps({k: np.asarray(v).tolist() for k, v in sorted(g.attrs.items())}, sort_keys=True)
                 out[f"{name}:/units/{uid}@attrs"] = hashlib.sha256(attrs.encode()).hexdigest()
                 for array in sorted(g):
-                    out[f"{name}:/units/{uid}/{array}"] = _array_hash(g[array][()])
-    out["test_labels.csv"] = hashlib.sha256((folder / "test_labels.csv").read_bytes()).hexdigest()
+                    out[f"{name}:/units/{uid}/{array}"] = _array_hash(
+                        inputs.bounded_dataset(g, array, path)[()])
+    labels = files.folder_file(folder / "test_labels.csv", "test labels", files.LABELS_MAX_BYTES)
+    out["test_labels.csv"] = hashlib.sha256(inputs.read_bytes(labels, "test labels", files.LABELS_MAX_BYTES)).hexdigest()
     return out
 
 

@@ -195,14 +195,13 @@ def score(folder: str | Path, method, name: str, role: str, track: str | None = 
     Raises
     ------
     ValueError
-        If the folder's files are missing or not benchmark files, or are of another track than ``track``.
+        If the folder's files are missing, leave the folder or are not benchmark files (links to other
+        files, declared shapes, missing attributes: :func:`faultgen.bench.files.read_with_attrs`,
+        :func:`faultgen.bench.files.attach_labels`), or are of another track than ``track``.
     """
-    import h5py
-
     folder = Path(folder)
-    train, test = files.read(folder / "train.h5"), files.read(folder / "test.h5")
-    with h5py.File(folder / "test.h5", "r") as f:
-        made = {k: (v.item() if hasattr(v, "item") else v) for k, v in f.attrs.items() if k in ("track", "version", "size")}
+    train = files.read(folder / "train.h5")
+    test, made = files.read_with_attrs(folder / "test.h5", ("track", "version", "size"))
     if track is not None and made.get("track") != track:
         raise ValueError(f"{folder} holds track {made.get('track')!r}, not {track!r}")
     with warnings.catch_warnings():
