@@ -6,6 +6,8 @@ files"):
 
 * anything but a regular file (a device such as ``/dev/zero``, a FIFO, a folder, a symlink to
   one of these), and a file above the reader's size bound;
+* a path that leads, through a symbolic link, out of the folder it must stay in (:func:`within`:
+  a fleet's log folder; :func:`inside` for the folders a robot description may read);
 * TOML nested deeper than :data:`TOML_MAX_DEPTH` brackets or with a dotted key of more than
   :data:`TOML_MAX_KEY_PARTS` parts (``tomllib`` is quadratic in a dotted key's length and recurses
   once per bracket: a 200 kB key of 10^5 parts took 19.6 GB, 5x10^4 brackets a RecursionError);
@@ -66,6 +68,41 @@ def _kind(mode: int) -> str:
         if test(mode):
             return name
     return "not a plain file"
+
+
+def inside(path: str | Path, root: str | Path) -> bool:
+    """Whether ``path`` (resolved, symbolic links followed) lies in the folder ``root``; False for
+    a path that does not resolve (a loop of symbolic links)."""
+    try:
+        Path(path).resolve().relative_to(Path(root).resolve())
+    except (ValueError, RuntimeError, OSError):
+        return False
+    return True
+
+
+def resolved(path: str | Path) -> Path:
+    """``path`` with symbolic links followed, or as given when they loop."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError):
+        return Path(path)
+
+
+def within(path: str | Path, root: str | Path, what: str = "folder") -> Path:
+    """``path`` as a :class:`~pathlib.Path` after checking that it leads (symbolic links followed)
+    inside the folder ``root`` (:func:`inside`).
+
+    Raises
+    ------
+    InputError
+        ``PATH: a symbolic link out of the WHAT ROOT; links must stay inside the folder``: ``path``
+        as given (its place inside ``root``), never where the link leads nor anything read there.
+    """
+    path = Path(path)
+    if not inside(path, root):
+        raise InputError(f"{path}: a symbolic link out of the {what} {root} (or a loop of links); links must stay "
+                         "inside the folder")
+    return path
 
 
 def regular_file(path: str | Path, what: str, max_bytes: int | None = None) -> Path:

@@ -117,13 +117,11 @@ def folder_file(path: str | Path, what: str, max_bytes: int | None = None) -> Pa
         Naming ``path`` and ``what``: missing (with the command that writes it), outside the folder,
         not a regular file, or above the bound.
     """
-    from faultgen.model.sources import inside
-
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not path.exists() and not path.is_symlink():
         raise inputs.InputError(f"{path} does not exist (the {what}); `faultgen bench make TRACK -o {folder}` writes it")
-    if not inside(path, folder):
+    if not inputs.inside(path, folder):
         raise inputs.InputError(f"{path}: a symbolic link to a file outside the benchmark folder {folder}; the {what} "
                                 "must be a regular file inside the folder (nothing of the target was read)")
     return inputs.regular_file(path, what, max_bytes)

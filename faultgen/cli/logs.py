@@ -83,7 +83,10 @@ def import_command(
     elif torque_constants is not None:
         raise ValueError("--torque-constants reads UR's actual_current columns: give it with --format ur-rtde")
 
-    command = "faultgen " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    # the command as provenance, with LOGS given as an absolute path stored by its name: a dataset
+    # meant to be shared keeps no path of this machine (docs/reliability.md, "Log folders")
+    args = [logs.name if logs.is_absolute() and Path(a) == logs else a for a in sys.argv[1:]]
+    command = "faultgen " + " ".join(shlex.quote(a) for a in args)
     summary = fleetlogs.import_logs(logs, out, robot=robot, skip_bad=skip_bad, progress=progress,
                                     reimport_changed=reimport_changed, command=command, **read)
     typer.echo(str(summary))

@@ -21,7 +21,8 @@ What an imported run holds beside the features (docs/dataset.md, "An imported fl
 the labels as every analysis reads a wear (:data:`WORN_MARK` on worn logs, 1 elsewhere) and the
 simulated truths ``mean_friction_torque`` and ``tracking_error`` are absent.
 
-The dataset keeps a manifest (``/import``: each imported file's name and SHA-256): importing again
+The dataset keeps a manifest (``/import``: each imported file's name relative to the folder,
+``<unit>/<file>``, and its SHA-256; the folder's name only, never its path): importing again
 into the same output imports only the files that are new, keeps the records of the others (also
 of files no longer in the folder), and refuses a file whose content changed since it was imported
 (naming it), unless ``reimport_changed``. Every write is atomic
@@ -260,7 +261,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         name, reason = not_logs[0]
         raise ValueError(f"{logs_dir / name}: {reason} (--skip-bad passes over bad files and lists them)")
     events_path = logs_dir / "events.csv"
-    events = logfolder.read_events(events_path, units, robot.n_axes) if events_path.is_file() else []
+    events = logfolder.read_events(events_path, units, robot.n_axes, logs_dir) if events_path.is_file() else []
     events_sha = sha256(events_path) if events_path.is_file() else ""
     previous = _Previous(out, robot)
     summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
@@ -320,7 +321,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         group.create_dataset("sha256", data=np.array([manifest[n] for n in names], dtype=object),
                              dtype=h5py.string_dtype())
         group.attrs.update({"robot": robot.name, "model_sha256": writer.model_hash(robot.path),
-                            "logs": str(logs_dir.resolve()), "events_sha256": events_sha,
+                            "logs": logs_dir.resolve().name, "events_sha256": events_sha,
                             "faultgen_version": __version__})
         f.attrs["complete"] = True
         summary.units = len(runs)

@@ -8,6 +8,10 @@ they give each log (what :func:`faultgen.data.fleetlogs.import_logs` reads, docs
       <unit>/<stamp>.csv.gz      (faultgen.data.measured), or the layout of an adapter
       <unit>/<stamp>.h5          (faultgen.data.adapters)
 
+Symbolic links may stay inside ``LOGS`` (a unit folder or a log linked to another place in it);
+a unit folder, a log or ``events.csv`` whose link leads out of ``LOGS`` is refused, named by its
+place in ``LOGS`` (:func:`faultgen.inputs.within`), before anything behind it is listed or read.
+
 ``<stamp>`` is an ISO date (``2026-03-01``), an ISO date and time (``2026-03-01T08:30:00``, also
 ``2026-03-01T08-30-00`` or ``2026-03-01T0830``, as file names cannot hold ``:`` everywhere; naive
 times are read as UTC) or a sequence number (``17``); one unit's logs use one kind. The logs of
@@ -50,6 +54,11 @@ EVENT_COLUMNS = ("unit", "stamp", "event", "axis")
 EVENTS_MAX_BYTES = 64 * 2**20
 #: Per log and axis: the label codes of an imported dataset's ``label`` array.
 UNKNOWN, HEALTHY, WORN = -1, 0, 1
+#: What a link out of the folder is called in its refusal (:func:`faultgen.inputs.within`).
+FOLDER = "logs folder"
+#: The reason a log whose link leads out of the folder is not a log (listed with the files that are not).
+LINK_OUT = "a symbolic link out of the logs folder; links must stay inside the folder"
+
 #: Stamp kinds: a date or date-time (key: seconds since 1970-01-01 UTC) or a sequence number.
 TIME, SEQUENCE = "time", "sequence"
 
@@ -134,13 +143,16 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     """The logs of ``folder``, per unit in stamp order, and the files that are not logs.
 
     Hidden entries (``.name``) are passed over. A file in a unit folder whose name has none of
-    ``suffixes`` or whose stamp does not parse is returned in the second list as ``(name, reason)``.
+    ``suffixes``, whose stamp does not parse or whose link leads out of ``folder`` (:data:`LINK_OUT`:
+    not read) is returned in the second list as ``(name, reason)``.
 
     Raises
     ------
     ValueError
-        If ``folder`` is not a folder or holds no unit folder; a file other than ``events.csv`` at
-        its top; two logs of one unit with the same stamp; one unit's stamps of both kinds.
+        If ``folder`` is not a folder or holds no unit folder; a unit folder or ``events.csv`` whose
+        link leads out of ``folder`` (:class:`faultgen.inputs.InputError`, nothing behind it listed);
+        a file other than ``events.csv`` at its top; an entry that is neither a file nor a folder (a
+        broken link); two logs of one unit with the same stamp; one unit's stamps of both kinds.
     """
     folder = Path(folder)
     if not folder.is_dir():
@@ -149,16 +161,23 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     for entry in sorted(folder.iterdir()):
         if entry.name.startswith("."):
             continue
+        inputs.within(entry, folder, FOLDER)
         if entry.is_file():
             if entry.name != "events.csv":
                 raise ValueError(f"{entry}: a file at the top of the logs folder; expected one folder per unit "
                                  "(LOGS/<unit>/<stamp>.csv) and optionally events.csv")
             continue
+        if not entry.is_dir():
+            raise ValueError(f"{entry}: neither a unit folder nor events.csv (a broken symbolic link?); expected "
+                             "one folder per unit (LOGS/<unit>/<stamp>.csv) and optionally events.csv")
         logs = []
         for path in sorted(entry.iterdir()):
             if path.name.startswith("."):
                 continue
             name = f"{entry.name}/{path.name}"
+            if not inputs.inside(path, folder):
+                bad.append((name, LINK_OUT))
+                continue
             stamp = stamp_of(path.name, suffixes) if path.is_file() else None
             if stamp is None:
                 bad.append((name, f"not a log: expected <stamp>{' or <stamp>'.join(suffixes)}"))
@@ -184,17 +203,24 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     return units, bad
 
 
-def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int) -> list[Event]:
+def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,
+                folder: Path | None = None) -> list[Event]:
     """The rows of ``events.csv`` (module docstring), checked against the units' logs.
+
+    Parameters
+    ----------
+    folder : Path, optional
+        The logs folder the file must lie in (links followed); default the file's own folder.
 
     Raises
     ------
     ValueError
         Naming the file and line: a header other than :data:`EVENT_COLUMNS`, a unit without a folder,
         a stamp that does not parse or is of another kind than the unit's logs, an unknown event,
-        an axis outside 1..N (empty only for ``healthy``).
+        an axis outside 1..N (empty only for ``healthy``); a file whose link leads out of ``folder``
+        (before it is read: nothing of it is quoted).
     """
-    path = Path(path)
+    path = inputs.within(path, Path(path).parent if folder is None else folder, FOLDER)
     text = inputs.read_text(path, "events file", EVENTS_MAX_BYTES).removeprefix("\ufeff")
     try:
         rows = list(csv.reader(io.StringIO(text, newline="")))

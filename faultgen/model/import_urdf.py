@@ -13,6 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen import inputs
 from faultgen.axes import MAX_AXES, MIN_AXES
 from faultgen.model import limits, mjcf, sources
 from faultgen.model.builder import ArmError, check_arm, one_line
@@ -40,7 +41,7 @@ def _resolve_mesh(filename: str, path: Path, packages: dict[str, Path]) -> Path 
         name = filename[len("file://") :] if filename.startswith("file://") else filename
         candidates = [Path(name) if Path(name).is_absolute() else base / name]
     for candidate in candidates:
-        if not any(sources.inside(candidate, root) for root in allowed):
+        if not any(inputs.inside(candidate, root) for root in allowed):
             raise ArmError(
                 f'{path}: <mesh filename="{filename}"> is outside the folder {base.resolve()} and the '
                 "--package folders; a robot description may read only those"

@@ -11,8 +11,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from faultgen.inputs import inside, resolved
 from faultgen.model.builder import ArmError
-from faultgen.model.sources import inside, parse_xml, read_text, resolved, roots
+from faultgen.model.sources import parse_xml, read_text, roots
 
 #: Most bodies (links) an arm description may have: a 7-axis arm with its tool and sensor frames
 #: has tens; a description with more is refused before MuJoCo compiles it.

@@ -1,9 +1,9 @@
 """What a robot description may read: its own folder and the package folders the user names.
 
 A URDF, xacro or MJCF from a stranger names other files (includes, meshes, textures); the readers
-check each against :func:`allowed` before anything reads it, and read only regular files of a
-bounded size (:func:`read_bytes`), so a description cannot pull in ``/etc/passwd``, ``~/.ssh`` or
-``/dev/zero``.
+check each against :func:`roots` (:func:`faultgen.inputs.inside`, links followed) before anything
+reads it, and read only regular files of a bounded size (:func:`read_bytes`), so a description
+cannot pull in ``/etc/passwd``, ``~/.ssh`` or ``/dev/zero``.
 """
 
 from __future__ import annotations
@@ -19,24 +19,6 @@ from faultgen import inputs
 MAX_XML_DEPTH = 200
 #: Largest robot description (URDF, xacro, MJCF file) read, bytes (rtb-data's largest URDF has 8 kB).
 MAX_DESCRIPTION_BYTES = 10_000_000
-
-
-def inside(path: Path, root: Path) -> bool:
-    """Whether ``path`` (resolved, symbolic links followed) lies in the folder ``root``; False for
-    a path that does not resolve (a loop of symbolic links)."""
-    try:
-        Path(path).resolve().relative_to(Path(root).resolve())
-    except (ValueError, RuntimeError, OSError):
-        return False
-    return True
-
-
-def resolved(path: Path) -> Path:
-    """``path`` with symbolic links followed, or as given when they loop."""
-    try:
-        return Path(path).resolve()
-    except (RuntimeError, OSError):
-        return Path(path)
 
 
 def roots(source: Path, packages: dict[str, Path] | None) -> list[Path]:

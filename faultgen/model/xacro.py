@@ -33,9 +33,10 @@ import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+from faultgen.inputs import inside
+from faultgen.inputs import resolved as resolve
 from faultgen.model.builder import ArmError
-from faultgen.model.sources import hint, inside, parse_xml, read_bytes
-from faultgen.model.sources import resolved as resolve
+from faultgen.model.sources import hint, parse_xml, read_bytes
 
 MAX_FILE_BYTES = 10_000_000
 MAX_INCLUDE_DEPTH = 20

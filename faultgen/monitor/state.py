@@ -145,7 +145,7 @@ def write_unit(path: Path, state: UnitState) -> None:
 def inside(path: Path, root: Path) -> Path:
     """``path`` after checking that it resolves inside ``root`` (a symbolic link out of the output
     folder is refused, naming it: an output folder never makes faultgen read outside itself)."""
-    if not Path(path).resolve().is_relative_to(Path(root).resolve()):
+    if not inputs.inside(path, root):
         raise StateError(f"{path}: a link leading outside {root}; faultgen never writes links into its output "
                                 "folders: delete it")
     return Path(path)
