@@ -102,10 +102,14 @@ def chart(path: Path, monitor, axis_note: str) -> None:
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
         step = max(1, len(rows) // 8)
         bottom.set_xticks(x[::step], stamps[::step], rotation=30, ha="right", fontsize=8)
+    else:
+        top.text(0.5, 0.5, "no log scored: see units.csv", ha="center", va="center", transform=top.transAxes)
     top.set_ylabel("statistic / its limit")
-    top.legend(fontsize=7, loc="upper left")
-    top.set_title(f"{monitor.unit}: PCA monitor of the per-log features ({monitor.settings.protocol} protocol)")
-    bottom.set_ylabel(f"isolation score ({axis_note})")
-    bottom.legend(fontsize=7, loc="upper left", ncol=3)
+    protocol = "twin" if monitor.signatures is not None else "own"
+    top.set_title(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)")
+    bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'share of Q'})")
+    if rows:
+        top.legend(fontsize=7, loc="upper left")
+        bottom.legend(fontsize=7, loc="upper left", ncol=3)
     fig.savefig(path, dpi=90, metadata={"Software": None})
     plt.close(fig)

@@ -136,7 +136,7 @@ def write_unit(path: Path, state: UnitState) -> None:
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
-                  "temperature": float(e.temperature), "payload": float(e.payload),
+                  "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
                   "expected": None if e.expected is None else _floats(e.expected)} for e in state.entries],
     }
     atomic.write_text(path, json.dumps(document, separators=(",", ":")))
@@ -237,11 +237,11 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         expected = log.get("expected")
         entries.append(Entry(
             log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
-            _number(log.get("temperature"), path, f"{where}.temperature"),
-            _number(log.get("payload"), path, f"{where}.payload"),
+            _number(log.get("temperature_C"), path, f"{where}.temperature_C"),
+            _number(log.get("payload_kg"), path, f"{where}.payload_kg"),
             None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
         if not math.isfinite(entries[-1].payload):
-            raise StateError(f"{path}: {where}.payload is not a finite number{refuse}")
+            raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
                      [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes))
 

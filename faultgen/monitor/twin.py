@@ -84,6 +84,7 @@ class Twin:
         self._files = {"model": stored.sha256_file(self.robot.path), "program": stored.sha256_file(self.program),
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES)}
         self._healthy: dict[float, np.ndarray] = {}
+        self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         healthy = self.cycle(REFERENCE_TEMPERATURE, 0.0)
         #: (N, F): change of each feature per % wear of each axis (without a part: the signatures
         #: are shared by every unit of the model and program).
@@ -94,21 +95,28 @@ class Twin:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
         nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
         temperature = None if np.isnan(temperature) else round(float(temperature), 2)
-        key = {**self._files, "temperature": temperature, "payload": float(payload), "worn_axis": int(worn_axis)}
+        key = {**self._files, "temperature_C": temperature, "payload_kg": float(payload), "worn_axis": int(worn_axis)}
         name = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
         path = self.cache / f"{name}.json"
         n_features = len(fleet_logs.FEATURES) * self.robot.n_axes
         if path.exists() or path.is_symlink():
             return stored.read_cycle(path, self.root, key, n_features)
+        if (temperature, payload, worn_axis) in self._refused:  # a part it cannot carry: said once, not simulated again
+            raise ValueError(self._refused[temperature, payload, worn_axis])
         held, plan = setup(temperature, payload, worn_axis)
         config = sim.RunConfig(robot=self.model, task=str(self.program), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=held, signals=True)
         result = sim.simulate(config, progress=False)
         if result.saturated.size:
-            raise ValueError(f"the twin of {self.program} with a {payload:g} kg part (aluminium cube at the flange) "
-                             f"saturates the drive of axis {', '.join(map(str, result.saturated))}: the model cannot "
-                             "carry that part along this motion; check the log's payload column (kg) and the model")
+            rated = self.robot.rated_payload
+            sized = (f"its drives were sized for a rated payload of {rated:g} kg (`faultgen robots add ... --payload KG` "
+                     "sizes an added robot for the one you know)" if np.isfinite(rated) else "")
+            self._refused[temperature, payload, worn_axis] = (
+                f"the twin of {self.program.name} with a {payload:g} kg part (aluminium cube at the flange) saturates "
+                f"the drive of axis {', '.join(map(str, result.saturated))}: the model cannot carry that part along "
+                f"this motion; {sized + '; ' if sized else ''}check the log's payload column (kg) and the model")
+            raise ValueError(self._refused[temperature, payload, worn_axis])
         data = measured.from_arrays(result.t, result.q_a[0], result.tau_m[0] * self.robot.gear_ratio, self.robot,
                                     source=f"twin of {self.program.name}")
         vector = fleet_logs.features_of(self.robot, data)
