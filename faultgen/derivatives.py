@@ -54,3 +54,13 @@ def derivatives(
         CubicSpline(grid, savgol_filter(q_grid, window, SAVGOL_ORDER, deriv=d, delta=period, axis=0, mode="interp"),
                     axis=0)(s)
         for d in orders)
+
+
+def smoothed(t: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``q`` (n, k) sampled at ``t`` (n,) s through the same Savitzky-Golay filter as its derivatives
+    (order 0: the angles the velocity and acceleration are the derivatives of), shape (n, k). On
+    a smooth motion it changes the angles by far less than an encoder's noise; on a noisy log it
+    removes what a drive tracking the log as its reference would amplify."""
+    dt = np.diff(t)
+    period = float(np.median(dt))
+    return derivatives(t, q, period, savgol_window(period, len(t)), is_uniform(dt, period), orders=(0,))[0]

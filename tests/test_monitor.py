@@ -426,3 +426,40 @@ def test_a_unit_whose_twin_cannot_be_built_falls_back_to_its_own_protocol(fleet,
     assert status["unit99"].logs_scored == SPEC.days
     assert outcome.exit_status == loop.EXIT_SOME_UNITS_NOT_MONITORED
     assert all(s.status == "monitored" for u, s in status.items() if u != "unit99")
+
+
+def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tmp_path):
+    """An irb6700 pick and place logged with faultgen's default encoder noise (1e-4 rad) replayed
+    as it is saturates the drive of axis 2 (`simulate --task log.csv` says so); the twin replays the
+    log's angles through the derivative filter and carries it, its drives below 0.8 of their limit
+    as on the noise-free log (issue 60)."""
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+    from faultgen.model import robots
+    from faultgen.monitor.twin import Twin
+    from faultgen.operation import wear
+    from faultgen.simulation import sensors
+    from faultgen.simulation import stepping as sim
+
+    robot = robots.load("irb6700")
+    run = sim.simulate(sim.RunConfig(robot="irb6700", task="pick_place", friction="stribeck", wear=wear.WearPlan({}),
+                                     cycles=1, seed=1, noise=sensors.NoiseConfig(encoder=1e-4), nthread=1,
+                                     signals=True), progress=False)
+    assert run.saturated.size == 0
+    log = tmp_path / "noisy.csv"
+    names = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]
+    np.savetxt(log, np.column_stack([run.t, run.q_a[0], run.tau_m[0] * robot.gear_ratio]), delimiter=",",
+               header=",".join(names), comments="", fmt="%.9g")
+    result = CliRunner().invoke(app, ["simulate", "--robot", "irb6700", "--task", str(log), "--friction", "stribeck",
+                                      "--encoder-noise", "0", "--disturbance", "0", "-o", str(tmp_path / "r.h5")])
+    assert result.exit_code == 0, result.output
+    assert "warning: the drive of axis 2 reached its torque limit" in result.output
+    twin = Twin("irb6700", log, tmp_path / "cache")
+    replayed = sim.simulate(sim.RunConfig(robot="irb6700", task=str(twin._reference), friction="stribeck",
+                                          wear=wear.WearPlan({}), cycles=1, seed=0,
+                                          noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
+                                          signals=True), progress=False)
+    peak = np.max(np.abs(replayed.tau_m[0]), axis=0) / robot.motor_torque_limit
+    assert replayed.saturated.size == 0 and peak.max() < 0.8, peak
+    assert np.all(np.isfinite(twin.expected(20.0, 0.0)))

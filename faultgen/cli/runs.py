@@ -104,6 +104,21 @@ def simulate_command(
     command = shlex.join(["faultgen", *sys.argv[1:]])
     dataset.write_run(out, result, command=command)
     typer.echo(summary(result, out))
+    if result.saturated.size:
+        typer.echo(saturation_warning(result.saturated, task), err=True)
+
+
+def saturation_warning(saturated, task: str) -> str:
+    """The warning of a run whose drives reached their torque limit (the dataset's ``saturated``
+    label): which axes, what it means, and for a replayed log the likely causes."""
+    axes = ", ".join(str(int(a)) for a in saturated)
+    text = (f"warning: the drive of axis {axes} reached its torque limit (saturated): the run does not follow its "
+            "task there, and its torques are the drive's limit, not the task's")
+    if Path(task).suffix.lower() in (".csv", ".gz", ".h5", ".hdf5"):
+        text += ("; a replayed log is tracked as the drive's reference, so an encoder's noise in its angles, a part "
+                 "heavier than the model was sized for or a motion faster than the model's drives can carry "
+                 "saturate it (`faultgen monitor` replays a log's angles through the derivative filter)")
+    return text
 
 
 @app.command("sweep", cls=Command)

@@ -13,6 +13,11 @@ What the monitor asks of it (:class:`Twin`):
   axis's Coulomb and static friction at :data:`WEAR` % above nominal (thesis eq. 6.6's exp4 schedule
   at its final value), minus the healthy cycle, at :data:`REFERENCE_TEMPERATURE` without a part.
 
+The replayed motion is the program log's angles through the derivative filter
+(:func:`faultgen.derivatives.smoothed`, the Savitzky-Golay filter its velocities and accelerations
+come from): a drive tracking an encoder's noise as its reference saturates where the real one did
+not (issue 60).
+
 Every simulated cycle goes through the same feature code as a measured log
 (:func:`faultgen.monitor.logs.features_of` on the simulated angles and arm-side torque, the
 velocity estimated from the angles as for a log without ``qd``), without sensor noise (the twin
@@ -30,7 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import measured
+from faultgen import derivatives
+from faultgen.data import atomic, measured
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
@@ -81,8 +87,11 @@ class Twin:
         self.cache = Path(cache)
         self.root = self.cache if root is None else Path(root)
         self.cache.mkdir(parents=True, exist_ok=True)
-        self._files = {"model": stored.sha256_file(self.robot.path), "program": stored.sha256_file(self.program),
-                       "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES)}
+        program_sha256 = stored.sha256_file(self.program)
+        self._files = {"model": stored.sha256_file(self.robot.path), "program": program_sha256,
+                       "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
+                       "reference": f"savgol {derivatives.SAVGOL_WINDOW:g} s"}
+        self._reference = self._smoothed_program(program_sha256)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         healthy = self.cycle(REFERENCE_TEMPERATURE, 0.0)
@@ -90,6 +99,23 @@ class Twin:
         #: are shared by every unit of the model and program).
         self.signatures = np.stack([(self.cycle(REFERENCE_TEMPERATURE, 0.0, axis) - healthy) / WEAR
                                     for axis in range(1, self.robot.n_axes + 1)])
+
+    def _smoothed_program(self, sha256: str) -> Path:
+        """The program log's motion as the twin replays it: its angles through the derivative filter
+        (:func:`faultgen.derivatives.smoothed`), written (again, every time: nothing read back) as
+        ``t, q1..qN`` in the folder ``programs`` beside ``cache``. A logged cycle was executed by the real drive, so the
+        twin must not saturate on the encoder's noise, which the replay tracks as its reference
+        (faultgen's default 1e-4 rad saturated the irb6700's axis 2 on its own pick and place)."""
+        data = measured.read(self.program, self.robot, accelerations=False)
+        t = np.asarray(data.t, dtype=float)
+        q = derivatives.smoothed(t, np.asarray(data.q, dtype=float))
+        folder = self.cache.parent / "programs"  # beside the cycles: the cycle folder holds cycles only
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / f"{sha256[:24]}.csv"
+        header = ",".join(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))])
+        with atomic.atomic_path(path) as tmp:
+            np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.17g")
+        return path
 
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
@@ -104,7 +130,7 @@ class Twin:
         if (temperature, payload, worn_axis) in self._refused:  # a part it cannot carry: said once, not simulated again
             raise ValueError(self._refused[temperature, payload, worn_axis])
         held, plan = setup(temperature, payload, worn_axis)
-        config = sim.RunConfig(robot=self.model, task=str(self.program), friction=FRICTION, wear=plan, cycles=1,
+        config = sim.RunConfig(robot=self.model, task=str(self._reference), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=held, signals=True)
         result = sim.simulate(config, progress=False)
