@@ -22,11 +22,16 @@ Prints one Markdown row per case with its verdict:
   dataset declaring a (10^10, 6) array (``faultgen.open`` and ``validate``), a measured log
   declaring 10^10 rows (``calibrate``). Goal: refused (exit 2 / ValueError) in under 5 s and
   under 500 MB.
+* reading three hostile xacros as ``robots add`` does (``importers.read``: expanded, parsed,
+  compiled; :func:`xacro_bombs`; issue 61, item 5): a 2.4 kB macro fan-out of 16^10 calls, a 103 kB
+  file expanding to a 600 MB URDF, an expression of 50 000 minus signs. Each runs with its address
+  space capped at 2 GB and is killed after 60 s. Goal: refused or completed within both.
 
     python benchmarks/input_bounds.py [FOLDER]          # default /tmp/faultgen-input-bounds
     python benchmarks/input_bounds.py FOLDER --quick    # the bombs and the 10^5/10^6 logs only
     python benchmarks/input_bounds.py FOLDER --no-bombs --sizes 100000 10000000
     python benchmarks/input_bounds.py FOLDER --no-bombs --kinds replay simulate
+    python benchmarks/input_bounds.py FOLDER --xacro    # the xacro bombs only
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ BASE_ROWS = 100_000  # one period of the excitation at 1 kHz
 SIZES = (100_000, 1_000_000, 10_000_000)
 FLAT = 0.20
 BOMB_MB, BOMB_S = 500, 5.0
+XACRO_MB, XACRO_S = 2048, 60.0
 
 
 def make_log(folder: Path, rows: int) -> Path:
@@ -147,6 +153,51 @@ def make_bombs(folder: Path) -> dict[str, Path]:
     return out
 
 
+XACRO_NS = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+
+
+def six_axis_urdf() -> str:
+    """The links and joints of a valid six-axis arm (what `robots add` takes), for the xacro bombs."""
+    parts = ['<link name="base"/>']
+    axes = ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"]  # a six-axis industrial arm's
+    offsets = ["0 0 0.4", "0.1 0 0.2", "0 0 0.6", "0.3 0 0.1", "0.3 0 0", "0.1 0 0"]
+    for k in range(6):
+        parts.append(f'<link name="l{k}"><inertial><mass value="{10 - k}"/><origin xyz="0.05 0 0.05"/>'
+                     '<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+                     f'<joint name="j{k}" type="revolute"><parent link="{"base" if k == 0 else f"l{k - 1}"}"/>'
+                     f'<child link="l{k}"/><origin xyz="{offsets[k]}"/><axis xyz="{axes[k]}"/>'
+                     '<limit lower="-3" upper="3" effort="0" velocity="2"/></joint>')
+    return "".join(parts)
+
+
+def xacro_bombs(folder: Path) -> dict[str, Path]:
+    """Three hostile xacros (issue 61, item 5):
+
+    * ``fanout.xacro`` (2.4 kB): ten macros, each calling the one below 16 times: 16^10 (10^12)
+      macro calls producing nothing (so no element bound is reached);
+    * ``wide.xacro`` (103 kB): a property of 10^5 characters written out, in one attribute of
+      6000 ``<gazebo>`` elements from three macros of ten calls each, beside a valid six-axis arm: a
+      600 MB URDF;
+    * ``unary.xacro`` (50 kB): ``${-----...-1}`` with 50 000 minus signs.
+    """
+    texts = {
+        "fanout.xacro": '<xacro:macro name="m0" params=""/>\n' + "".join(
+            f'<xacro:macro name="m{k}" params="">{f"<xacro:m{k - 1}/>" * 16}</xacro:macro>\n' for k in range(1, 11))
+        + "<xacro:m10/>",
+        "wide.xacro": f'<xacro:property name="w" value="{"x" * 100_000}"/>\n'
+        '<xacro:macro name="g1" params="">' + '<gazebo reference="${w}"/>' * 10 + "</xacro:macro>\n"
+        '<xacro:macro name="g2" params="">' + "<xacro:g1/>" * 10 + "</xacro:macro>\n"
+        '<xacro:macro name="g3" params="">' + "<xacro:g2/>" * 10 + "</xacro:macro>\n" + "<xacro:g3/>" * 6,
+        "unary.xacro": '<link name="${' + "-" * 50_000 + '1}"/>',
+    }
+    out = {}
+    for name, body in texts.items():
+        out[name] = folder / name
+        arm = six_axis_urdf() + "\n" if name == "wide.xacro" else ""
+        out[name].write_text(f'<robot name="{name.split(".")[0]}" {XACRO_NS}>\n{arm}{body}\n</robot>\n')
+    return out
+
+
 #: kind -> (imports, the case): only the case is timed (imports took 2-5 s on the loaded machine).
 CASES_CODE = {
     "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
@@ -160,28 +211,50 @@ CASES_CODE = {
     "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
     "open": ("import faultgen", "faultgen.open({log!r}).features()"),
     "validate": ("from faultgen.data import dataset", "dataset.validate({log!r})"),
+    # what `robots add` reads (expanded, parsed, compiled by MuJoCo); the URDF it would write, its size
+    "xacro": ("from faultgen.model import importers",
+              "print(len(importers.read({log!r}).urdf), 'characters of urdf_used.urdf', file=sys.stderr)"),
 }
 
 
-def run_case(kind: str, log: Path, out: Path) -> dict:
+def run_case(kind: str, log: Path, out: Path, cap_mb: int | None = None, timeout: float | None = None) -> dict:
     """Run one case in a fresh interpreter; its peak resident memory from os.wait4, the case's own
-    time (after the imports), and whether it was refused (a ValueError: the CLI's exit 2) or completed."""
+    time (after the imports), and whether it was refused (a ValueError: the CLI's exit 2) or completed.
+    ``cap_mb``: its address space is capped (RLIMIT_AS: past it, a MemoryError); ``timeout``: it is
+    killed after that many seconds. The time of a killed or crashed case is the process's, imports
+    included."""
     imports, call = CASES_CODE[kind]
-    code = (f"import json, time\n{imports}\nstart = time.perf_counter()\ntry:\n"
+    cap = f"import resource\nresource.setrlimit(resource.RLIMIT_AS, ({cap_mb << 20}, {cap_mb << 20}))\n" if cap_mb else ""
+    code = (f"{cap}import json, sys, time\n{imports}\nstart = time.perf_counter()\ntry:\n"
             f"    {call.format(log=str(log), out=str(out))}\n"
             "    result = {'outcome': 'completed'}\n"
             "except ValueError as err:\n    result = {'outcome': 'refused', 'message': str(err)[:160]}\n"
             "print(json.dumps({**result, 'seconds': time.perf_counter() - start}))\n")
     shutil.rmtree(out, ignore_errors=True)
+    killed = False
     with tempfile.TemporaryFile("w+") as stdout, tempfile.TemporaryFile("w+") as stderr:
+        start = time.monotonic()
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=stdout, stderr=stderr, text=True)
-        _, status, usage = os.wait4(proc.pid, 0)  # this process's own peak, not the largest child's so far
+        while True:  # os.wait4: this process's own peak, not the largest child's so far
+            pid, status, usage = os.wait4(proc.pid, os.WNOHANG if timeout else 0)
+            if pid:
+                break
+            if not killed and time.monotonic() - start > timeout:
+                proc.kill()
+                killed = True
+            time.sleep(0.05)
+        seconds = time.monotonic() - start
         proc.returncode = os.waitstatus_to_exitcode(status)
         stdout.seek(0)
         stderr.seek(0)
         lines, errors = stdout.read().strip().splitlines(), stderr.read().strip().splitlines()
+    if killed:
+        return {"outcome": f"killed after {timeout:g} s (still running)", "seconds": seconds,
+                "peak_mb": usage.ru_maxrss / 1024}
     result = json.loads(lines[-1]) if lines else {
-        "outcome": f"crashed (exit {proc.returncode}): {errors[-1][:160] if errors else ''}", "seconds": float("nan")}
+        "outcome": f"crashed (exit {proc.returncode}): {errors[-1][:160] if errors else ''}", "seconds": seconds}
+    if result["outcome"] == "completed" and errors:
+        result["message"] = errors[-1][:160]  # what the case printed of its result (the xacro's URDF size)
     return {**result, "peak_mb": usage.ru_maxrss / 1024}
 
 
@@ -192,6 +265,7 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", help="log lengths (rows) to run; the first is the baseline")
     parser.add_argument("--no-bombs", action="store_true", help="only the logs")
     parser.add_argument("--no-logs", action="store_true", help="only the bombs")
+    parser.add_argument("--xacro", action="store_true", help="only the xacro bombs")
     parser.add_argument("--kinds", nargs="+", default=["calibrate", "replay", "simulate"],
                         help="what to run on the logs")
     args = parser.parse_args()
@@ -200,6 +274,14 @@ def main() -> None:
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average "
           f"{os.getloadavg()[0]:.1f}, {os.cpu_count()} cores\n")
     print("| case | file | outcome | seconds | peak MB | verdict |\n| --- | --- | --- | --- | --- | --- |")
+    for name, path in ({} if args.no_bombs else xacro_bombs(folder)).items():
+        r = run_case("xacro", path, folder / "out-bomb", cap_mb=XACRO_MB, timeout=XACRO_S)
+        ok = r["outcome"] in ("refused", "completed") and r["seconds"] < XACRO_S and r["peak_mb"] < XACRO_MB
+        print(f"| xacro | {name} ({path.stat().st_size / 1e3:.1f} kB) | {r['outcome']}: {r.get('message', '')[:200]} | "
+              f"{r['seconds']:.2f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused or completed, "
+              f"< {XACRO_S:g} s, < {XACRO_MB} MB, address space capped there) |", flush=True)
+    if args.xacro:
+        return
     bombs = {} if args.no_bombs else make_bombs(folder)
     for kind, name in [] if args.no_bombs else [("drivetrain", "dotted-1e5.toml"), ("drivetrain", "dotted-2e4.toml"),
                        ("dh", "dotted-1e5.toml"), ("program", "brackets-5e4.toml"), ("drivetrain", "brackets-5e4.toml"),

@@ -6,6 +6,7 @@ import re
 import xml.etree.ElementTree as ET
 
 import pytest
+from robot_sources import refused
 
 from faultgen.model import xacro
 from faultgen.model.builder import ArmError
@@ -70,8 +71,9 @@ def test_what_it_does_not_take_is_refused_naming_the_construct(tmp_path, body, m
 
 
 def test_a_file_that_expands_exponentially_is_refused(tmp_path):
-    # 2^40 links from 40 macros each calling the one below twice
-    macros = '<xacro:macro name="m0" params=""><link name="x"/></xacro:macro>' + "".join(
+    # 100 x 2^40 links from 40 macros each calling the one below twice (the elements' bound is passed
+    # at the 500th call of m0, before the macro calls' bound, xacro.MAX_STEPS)
+    macros = '<xacro:macro name="m0" params="">' + '<link name="x"/>' * 100 + "</xacro:macro>" + "".join(
         f'<xacro:macro name="m{k}" params=""><xacro:m{k - 1}/><xacro:m{k - 1}/></xacro:macro>' for k in range(1, 41)
     )
     with pytest.raises(ArmError, match=f"more than {xacro.MAX_ELEMENTS} elements"):
@@ -90,7 +92,7 @@ def test_a_file_that_includes_itself_is_refused(tmp_path):
         ('<xacro:property name="p0" value="ab"/>'
          + "".join(f'<xacro:property name="p{k}" value="${{p{k - 1} + p{k - 1}}}"/>' for k in range(1, 41))
          + '<link name="${p40}"/>', "a string of more than"),
-        ('<link name="${' + "+".join(["1"] * 100_000) + '}"/>', "nested too deeply"),
+        ('<link name="${' + "+".join(["1"] * 100_000) + '}"/>', f"longer than {xacro.MAX_EXPRESSION} characters"),
         ("".join(f'<xacro:property name="q{k}" value="${{q{k - 1}}}"/>' for k in range(1, 20_000))
          + '<xacro:property name="q0" value="1"/><link name="${q19999}"/>', "nested too deeply"),
         ('<link name="${' + "*".join(["99999999999"] * 40) + '}"/>', ""),
@@ -103,3 +105,104 @@ def test_expressions_that_would_grow_without_bound_are_refused_or_kept_small(tmp
     else:  # a product of large integers becomes a float, refused as out of range past 1e308
         with pytest.raises(ArmError, match="out of range"):
             expand(tmp_path, body)
+
+
+# Bounded work, not only bounded nesting (issue 61, item 5). Each input below is expanded without an
+# error by the code before these bounds (d97cfd5), or fails there with a MemoryError traceback; the
+# inputs the issue measured (a 16^10 macro fan-out running for months, a 600 MB URDF written at
+# 3.6 GB) are measured by benchmarks/input_bounds.py --xacro (docs/reliability.md).
+
+
+def fan_out(levels, calls):
+    """Macros m1..m<levels>, each calling the one below ``calls`` times, m0 empty: calls^levels calls
+    producing nothing (so no element bound is reached), and the call of the top one."""
+    return '<xacro:macro name="m0" params=""/>' + "".join(
+        f'<xacro:macro name="m{k}" params="">{f"<xacro:m{k - 1}/>" * calls}</xacro:macro>'
+        for k in range(1, levels + 1)
+    ) + f"<xacro:m{levels}/>"
+
+
+def test_a_macro_fan_out_is_refused_after_a_bounded_number_of_calls(tmp_path):
+    # 4^8 = 65 536 calls (a second without the bound, and 16^10 would take months): refused at the
+    # 10 001st, naming the file, the macro and the bound
+    with pytest.raises(ArmError, match=rf"top\.xacro: xacro <xacro:m\d+> refused: the file needs more than "
+                       rf"{xacro.MAX_STEPS} macro calls, block insertions and includes"):
+        expand(tmp_path, fan_out(8, 4))
+
+
+BIG = 2_100_000  # characters: ten copies pass xacro.MAX_COPIED
+
+
+@pytest.mark.parametrize(
+    "body, files, construct",
+    [
+        # a macro whose body is a 2.1 MB property, called ten times
+        (f'<xacro:macro name="big" params=""><xacro:property name="p" value="{"x" * BIG}"/></xacro:macro>'
+         + "<xacro:big/>" * 10, {}, "<xacro:big>"),
+        # a block of 2.1 MB inserted ten times
+        (f'<xacro:property name="blk"><xacro:property name="p" value="{"x" * BIG}"/></xacro:property>'
+         + '<xacro:insert_block name="blk"/>' * 10, {}, '<xacro:insert_block name="blk">'),
+        # a 2.1 MB file included ten times
+        ('<xacro:include filename="big.xacro"/>' * 10,
+         {"big.xacro": f'<robot {NS}><xacro:property name="p" value="{"x" * BIG}"/></robot>'}, "include of"),
+    ],
+)
+def test_macro_calls_blocks_and_includes_copying_too_much_are_refused(tmp_path, body, files, construct):
+    assert 10 * BIG > xacro.MAX_COPIED >= 9 * (BIG + 100)
+    with pytest.raises(ArmError, match=rf"top\.xacro: xacro {re.escape(construct)}.* refused: the file's macro "
+                       rf"calls, block insertions and includes copy more than {xacro.MAX_COPIED} characters"):
+        expand(tmp_path, body, **files)
+
+
+WIDE = 100_000  # characters of one attribute
+
+
+@pytest.mark.parametrize(
+    "value, copies, construct",
+    [
+        ("x" * WIDE, 101, "<gazebo>"),  # 101 attributes of 10^5 characters: 10.1 million, counted as expanded
+        ("&amp;" * WIDE, 21, "document"),  # 2.1 million &, written as &amp;: 10.5 million, counted as written
+    ],
+)
+def test_an_expansion_writing_more_than_the_output_bound_is_refused(tmp_path, value, copies, construct):
+    body = f'<xacro:property name="w" value="{value}"/>' + '<gazebo reference="${w}"/>' * copies
+    with pytest.raises(ArmError, match=rf"top\.xacro: xacro {construct} refused: the expanded document holds more "
+                       rf"than {xacro.MAX_OUTPUT} characters"):
+        expand(tmp_path, body)
+
+
+def test_the_bounds_leave_room_for_a_large_description(tmp_path):
+    # 400 links of 12 500 characters each (5 MB) from a macro called 400 times
+    root = expand(tmp_path, '<xacro:property name="w" value="' + "x" * 12_400 + '"/>'
+                  '<xacro:macro name="l" params="i"><link name="l${i}" doc="${w}"/></xacro:macro>'
+                  + "".join(f'<xacro:l i="{i}"/>' for i in range(400)))
+    assert len(names(root)) == 400
+
+
+@pytest.mark.parametrize(
+    "expression, message",
+    [
+        ("-" * 50_000 + "1", f"longer than {xacro.MAX_EXPRESSION} characters"),  # a MemoryError in Python's parser
+        ("not " * 20_000 + "1", f"longer than {xacro.MAX_EXPRESSION} characters"),
+        ("-" * (xacro.MAX_EXPRESSION - 1) + "1", "nested too deeply"),  # within the length: the evaluator's bound
+    ],
+)
+def test_an_expression_too_long_for_the_parser_is_refused_before_it(tmp_path, expression, message):
+    with pytest.raises(ArmError, match=rf"top\.xacro: xacro \$\{{.*refused: {message}"):
+        expand(tmp_path, f'<link name="${{{expression}}}"/>')
+
+
+@pytest.mark.parametrize(
+    "body, words",
+    [
+        (fan_out(8, 4), [f"more than {xacro.MAX_STEPS} macro calls"]),
+        ('<xacro:property name="w" value="' + "x" * WIDE + '"/>' + '<gazebo reference="${w}"/>' * 101,
+         [f"more than {xacro.MAX_OUTPUT} characters"]),
+        ('<link name="${' + "-" * 50_000 + '1}"/>', [f"longer than {xacro.MAX_EXPRESSION} characters"]),
+    ],
+    ids=["fan-out", "wide", "unary"],
+)
+def test_robots_add_refuses_a_xacro_past_a_bound_in_one_line(tmp_path, body, words):
+    source = tmp_path / "arm.xacro"
+    source.write_text(f'<robot name="arm" {NS}>{body}</robot>')
+    refused(tmp_path, source, str(source), *words)

@@ -20,7 +20,12 @@ refuses the rest, naming the construct and the file (:class:`~faultgen.model.bui
 
 Bounds: :data:`MAX_FILE_BYTES` per file, :data:`MAX_INCLUDE_DEPTH` nested includes,
 :data:`MAX_ELEMENTS` elements in the expanded document, :data:`MAX_CALL_DEPTH` nested macro calls,
-:data:`MAX_TEXT` characters in one evaluated string.
+:data:`MAX_TEXT` characters in one evaluated string, :data:`MAX_EXPRESSION` characters in one
+``${...}`` (checked before Python's parser sees it). The work in all: :data:`MAX_STEPS` macro calls,
+block insertions and includes, which copy or read at most :data:`MAX_COPIED` characters of xacro
+(a macro's body once per call, a block once per insertion, a file once per include); and the
+expanded document holds at most :data:`MAX_OUTPUT` characters. A file over a bound is refused
+as it is reached, naming the file, the macro, block, include, element or expression, and the bound.
 """
 
 from __future__ import annotations
@@ -43,6 +48,13 @@ MAX_INCLUDE_DEPTH = 20
 MAX_ELEMENTS = 50_000  # a 7-axis URDF has a few hundred; the link bound (mjcf.MAX_LINKS) is 500
 MAX_CALL_DEPTH = 50
 MAX_TEXT = 100_000
+# rtb-data's 58 xacros (ABB, KUKA, Franka, Trossen, Clearpath, PUMA; 55 of which expand) need at most
+# 13 macro calls + 6 block insertions + 4 includes (each at most 13, 6, 4), 36 000 characters copied
+# or read, a 25 000-character URDF and 46 characters in one ${...} (2026-11-25)
+MAX_STEPS = 10_000  # macro calls, block insertions and includes in all
+MAX_COPIED = 20_000_000  # characters those copy or read: twice an included file's MAX_FILE_BYTES
+MAX_OUTPUT = 10_000_000  # characters of the expanded URDF: a URDF file's own bound (sources.MAX_DESCRIPTION_BYTES)
+MAX_EXPRESSION = 1_000  # characters in one ${...}: within what Python's parser nests without a MemoryError
 
 #: Functions a ``${...}`` expression may call (``math.NAME`` alike).
 FUNCTIONS = {
@@ -167,9 +179,12 @@ class _Expander:
         self.packages = {name: Path(p).resolve() for name, p in packages.items()}
         self.files: list[Path] = []
         self.args: dict[str, str] = {}
-        self.macros: dict[str, tuple[list, ET.Element]] = {}
+        self.macros: dict[str, tuple[list, ET.Element, int]] = {}  # params, body, the body's _size
         self.elements = 0
         self.calls = 0
+        self.steps = 0
+        self.copied = 0
+        self.output = 0
 
     @property
     def where(self) -> str:
@@ -181,13 +196,50 @@ class _Expander:
             'without running code; docs/robots.md, "xacro", lists what it takes)'
         )
 
+    def over(self, construct: str, why: str) -> ArmError:
+        """A bound on the work or the output passed (no construct missing): the file, the construct
+        where it was passed and the bound."""
+        return ArmError(
+            f"{self.where}: xacro {construct} refused: {why} (a bound of faultgen's xacro expander; "
+            'docs/reliability.md, "Threat model: robot descriptions")'
+        )
+
     # ---------------------------------------------------------------------- files --
     def parse(self, path: Path) -> ET.Element:
         if len(self.files) >= MAX_INCLUDE_DEPTH:
             raise self.refuse(f"include of {path}", f"more than {MAX_INCLUDE_DEPTH} nested includes")
         if path in self.files:
             raise self.refuse(f"include of {path}", "it includes itself")
-        return parse_xml(read_bytes(path, MAX_FILE_BYTES, "xacro file", ArmError), path, ArmError)
+        if self.files:  # an include: a step of the work, its bytes copied (the top file is read once)
+            self.step(f"include of {path}")
+        data = read_bytes(path, MAX_FILE_BYTES, "xacro file", ArmError)
+        if self.files:
+            self.copy(f"include of {path}", len(data))
+        return parse_xml(data, path, ArmError)
+
+    def step(self, construct: str) -> None:
+        """One more macro call, block insertion or include (:data:`MAX_STEPS` in all)."""
+        self.steps += 1
+        if self.steps > MAX_STEPS:
+            raise self.over(
+                construct, f"the file needs more than {MAX_STEPS} macro calls, block insertions and includes in all"
+            )
+
+    def copy(self, construct: str, chars: int) -> None:
+        """``chars`` more characters of xacro copied or read (:data:`MAX_COPIED` in all)."""
+        self.copied += chars
+        if self.copied > MAX_COPIED:
+            raise self.over(
+                construct,
+                f"the file's macro calls, block insertions and includes copy more than {MAX_COPIED} characters "
+                "of xacro in all",
+            )
+
+    def emit(self, node: ET.Element) -> None:
+        """``node`` (expanded) is in the output: its characters count (:data:`MAX_OUTPUT` in all)."""
+        self.output += _size(node, deep=False)
+        if self.output > MAX_OUTPUT:
+            raise self.over(f"<{_local(node.tag)}>", f"the expanded document holds more than {MAX_OUTPUT} characters")
 
     def resolve_include(self, name: str) -> Path:
         base = self.files[-1].parent
@@ -263,10 +315,14 @@ class _Expander:
         raise self.refuse(f"$({inner})", f"$({command}) is not supported")
 
     def expression(self, source: str, scope: _Scope):
+        if len(source) > MAX_EXPRESSION:  # its nesting with it: Python's parser fails past a few thousand
+            raise self.over(f"${{{_short(source)}}}", f"longer than {MAX_EXPRESSION} characters")
         try:
             tree = ast.parse(source.strip(), mode="eval")
         except SyntaxError:
             raise self.refuse(f"${{{_short(source)}}}", "not an expression") from None
+        except (MemoryError, RecursionError):  # the parser's stack: shorter than the bound when deep already
+            raise self.refuse(f"${{{_short(source)}}}", "nested too deeply") from None
         try:
             return self.value(tree.body, scope, _short(source))
         except ArmError:
@@ -372,6 +428,7 @@ class _Expander:
                 node.set(key, _text_of(self.text(value, scope)))
             if node.text and node.text.strip():
                 node.text = _text_of(self.text(node.text, scope))
+            self.emit(node)
             self.children(node, scope)
             return [node]
         tag = _local(node.tag)
@@ -429,7 +486,7 @@ class _Expander:
             if param.startswith("**"):
                 kind = "blocks"
             params.append((param.lstrip("*"), kind, default if ":=" in word else None))
-        self.macros[name] = (params, node)
+        self.macros[name] = (params, node, _size(node))
         return []
 
     def _condition(self, node: ET.Element, scope: _Scope, negate: bool) -> list[ET.Element]:
@@ -454,6 +511,8 @@ class _Expander:
             raise self.refuse(f'<xacro:insert_block name="{name}">', "no block of that name") from None
         if not isinstance(block, list):
             raise self.refuse(f'<xacro:insert_block name="{name}">', "it names a property, not a block")
+        self.step(f'<xacro:insert_block name="{name}">')
+        self.copy(f'<xacro:insert_block name="{name}">', sum(_size(b) for b in block))
         holder = ET.Element("holder")
         holder.extend(copy.deepcopy(block))
         return self.children(holder, scope)
@@ -463,7 +522,9 @@ class _Expander:
         if self.calls > MAX_CALL_DEPTH:
             raise self.refuse(f"<xacro:{name}>", f"more than {MAX_CALL_DEPTH} nested macro calls")
         try:
-            params, body = self.macros[name]
+            params, body, size = self.macros[name]
+            self.step(f"<xacro:{name}>")
+            self.copy(f"<xacro:{name}>", size)
             inner = _Scope(scope)
             given = dict(node.attrib)
             blocks = [c for c in node if isinstance(c.tag, str)]
@@ -494,6 +555,16 @@ class _Expander:
             return self.children(holder, inner)
         finally:
             self.calls -= 1
+
+
+def _size(node: ET.Element, deep: bool = True) -> int:
+    """Characters of ``node`` as written, without markup and escapes: tag, attribute names and values,
+    text and tail; with its descendants' if ``deep``."""
+    total = 0
+    for e in node.iter() if deep else (node,):
+        total += len(e.tag) if isinstance(e.tag, str) else 0
+        total += sum(len(k) + len(v) for k, v in e.attrib.items()) + len(e.text or "") + len(e.tail or "")
+    return total
 
 
 def _short(text: str, n: int = 60) -> str:
@@ -537,4 +608,6 @@ def expand(path: str | Path, packages: dict[str, str | Path] | None = None) -> s
     for key in [k for k in root.attrib if is_xacro_namespace(k)]:
         del root.attrib[key]
     text = ET.tostring(root, encoding="unicode")
+    if len(text) > MAX_OUTPUT:  # the count above is before escapes (& -> &amp;: one character up to six)
+        raise expander.over("document", f"the expanded document holds more than {MAX_OUTPUT} characters")
     return re.sub(r'\s+xmlns:\w+="[^"]*xacro[^"]*"', "", text)
