@@ -463,3 +463,26 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
     peak = np.max(np.abs(replayed.tau_m[0]), axis=0) / robot.motor_torque_limit
     assert replayed.saturated.size == 0 and peak.max() < 0.8, peak
     assert np.all(np.isfinite(twin.expected(20.0, 0.0)))
+
+
+def test_an_implausible_calibration_does_not_become_the_twin():
+    """A calibration that put the Stribeck hump at 216 rad/s (nominal 10; issue 60's KR210) or a dry
+    friction above half the drive's torque is named, so the monitor falls back to the nominal model."""
+    from types import SimpleNamespace
+
+    from faultgen.calibrate import plausibility
+    from faultgen.model import robots
+
+    nominal = robots.load("irb6700")
+    assert plausibility.implausible_parameters(nominal, nominal) == []
+    v = np.array(nominal.friction.stribeck_velocity, dtype=float)
+    static = np.array(nominal.friction.static, dtype=float)
+    v[0] = 21.6 * v[0]
+    static[3] = 0.6 * nominal.motor_torque_limit[3]
+    friction = SimpleNamespace(**{name: np.array(getattr(nominal.friction, name), dtype=float)
+                                  for name in ("coulomb_pos", "coulomb_neg")}, stribeck_velocity=v, static=static)
+    edited = SimpleNamespace(friction=friction, motor_torque_limit=nominal.motor_torque_limit, n_axes=nominal.n_axes)
+    found = plausibility.implausible_parameters(nominal, edited)
+    assert len(found) == 2, found
+    assert found[0].startswith("axis 1: Stribeck velocity") and "21.6 x its nominal" in found[0]
+    assert found[1].startswith("axis 4: dry friction") and "0.6 of the motor's torque limit" in found[1]

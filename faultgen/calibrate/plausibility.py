@@ -96,3 +96,33 @@ def check(robot, tau: np.ndarray, predicted: np.ndarray, moving: np.ndarray) -> 
         f"the model predicts (accepted {low:g}-{high:g} x; every judged axis: {found}). Check that the log is "
         f"from a {robot.name} (--robot; `faultgen robots` lists the models), that tau is in N m and at the arm "
         f"side (motor torque times gear ratio)")
+
+
+#: A calibrated Stribeck velocity more than this many times the nominal one (or less than its
+#: inverse) is not a friction the drive has: a hump fitted to something else (a KR210 calibrated on
+#: a log whose only differences from nominal were unit spread and temperature got 216 rad/s,
+#: nominal 10, and its twin saturated two axes; issue 60).
+STRIBECK_RATIO = 10.0
+#: A calibrated dry friction (Coulomb or static, motor side) above this share of the motor's
+#: torque limit leaves the drive too little to move the arm: not a friction a working robot has.
+FRICTION_SHARE = 0.5
+
+
+def implausible_parameters(nominal, calibrated) -> list[str]:
+    """What makes a calibrated robot's friction implausible against its nominal model, one text per
+    finding (empty when none): a Stribeck velocity beyond :data:`STRIBECK_RATIO` times the nominal
+    one, a Coulomb or static friction above :data:`FRICTION_SHARE` of the motor's torque limit.
+    ``nominal`` and ``calibrated`` are :class:`faultgen.model.robots.Robot` of the same axes."""
+    found = []
+    f0, f1 = nominal.friction, calibrated.friction
+    for i in range(nominal.n_axes):
+        v0, v1 = float(f0.stribeck_velocity[i]), float(f1.stribeck_velocity[i])
+        if v0 > 0 and not (1 / STRIBECK_RATIO <= v1 / v0 <= STRIBECK_RATIO):
+            found.append(f"axis {i + 1}: Stribeck velocity {v1:.3g} rad/s, {v1 / v0:.3g} x its nominal {v0:.3g} "
+                         f"(accepted: {1 / STRIBECK_RATIO:g}-{STRIBECK_RATIO:g} x)")
+        dry = max(abs(float(f1.coulomb_pos[i])), abs(float(f1.coulomb_neg[i])), abs(float(f1.static[i])))
+        limit = float(calibrated.motor_torque_limit[i])
+        if dry > FRICTION_SHARE * limit:
+            found.append(f"axis {i + 1}: dry friction {dry:.3g} N m at the motor, {dry / limit:.2g} of the motor's "
+                         f"torque limit {limit:.3g} N m (accepted: <= {FRICTION_SHARE:g})")
+    return found

@@ -30,6 +30,7 @@ import mujoco
 import numpy as np
 from tqdm.auto import tqdm
 
+from faultgen.calibrate import plausibility
 from faultgen.data import atomic, measured
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
@@ -408,6 +409,9 @@ def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], 
             warnings.simplefilter("ignore")
             run_calibration(str(nominal.path), first_path, folder, max_steps=CALIBRATION_STEPS, progress=False)
         stored.write_calibration(record, key, model)
+    implausible = plausibility.implausible_parameters(nominal, robots.load(model))
+    if implausible:
+        raise ValueError(f"its calibration on the first log is implausible: {'; '.join(implausible)}")
     return str(_without_payload(model))
 
 
