@@ -486,3 +486,49 @@ def test_an_implausible_calibration_does_not_become_the_twin():
     assert len(found) == 2, found
     assert found[0].startswith("axis 1: Stribeck velocity") and "21.6 x its nominal" in found[0]
     assert found[1].startswith("axis 4: dry friction") and "0.6 of the motor's torque limit" in found[1]
+
+
+def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(fleet, monitored, tmp_path):
+    """The worn unit's logs until three days after its alarm, then a gearbox change on the worn
+    axis and a healthy unit's logs (a new part, and another unit's spread): the alarm stays in
+    alarms.csv, closed by the change; the unit learns its offset again and stays quiet; a rerun
+    replays the event from the state (issue 60, part 4)."""
+    import csv
+
+    robot, logs, truth = fleet
+    outcome = independent_fleet.evaluate(truth, monitored / "alarms.csv")
+    worn = next(u for u, o in outcome.items() if o["axis"])
+    healthy = next(u for u, o in outcome.items() if not o["axis"])
+    change = outcome[worn]["day"] + 3
+    copy = tmp_path / "logs"
+    (copy / worn).mkdir(parents=True)
+    before = sorted((logs / worn).iterdir())[:change]
+    after = sorted((logs / healthy).iterdir())[change:]
+    for log in [*before, *after]:
+        os.link(log, copy / worn / log.name)
+    (copy / "events.csv").write_text(f"unit,stamp,event,axis\n{worn},{after[0].stem},gearbox_change,"
+                                     f"{outcome[worn]['axis']}\n")
+    out = with_cycles_of(monitored, tmp_path / "out")
+    loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+    with open(out / "alarms.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 2, rows
+    assert rows[0]["first_alarm"] == outcome[worn]["alarm"] and rows[0]["closed"] == after[0].stem
+    assert rows[0]["closed_by"] == f"gearbox_change of axis {outcome[worn]['axis']}"
+    assert rows[1]["first_alarm"] == "" and "no persistent alarm" in rows[1]["evidence"], rows[1]
+    with open(out / "scores.csv", newline="") as f:
+        phases = [row["phase"] for row in csv.DictReader(f)]
+    assert phases.count("relearning") == max(5, SETTINGS.train // 4)
+    # the same outputs when the logs arrive in two runs, the event between them
+    split = tmp_path / "split"
+    (split / worn).mkdir(parents=True)
+    for log in before:
+        os.link(log, split / worn / log.name)
+    shutil.copy(copy / "events.csv", split / "events.csv")
+    again = with_cycles_of(monitored, tmp_path / "again")
+    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    for log in after:
+        os.link(log, split / worn / log.name)
+    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    for name in ("alarms.csv", "scores.csv"):
+        assert (again / name).read_text() == (out / name).read_text(), name

@@ -59,7 +59,11 @@ def monitor_command(
     still learning, 3 when some unit is degraded or not monitored (every output still written),
     2 when the run is refused before any work (bad option, robot, folder or OUT).
 
-    Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence),
+    A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
+    with closed and closed_by) and the unit learns its offset again from the next logs.
+
+    Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
+    closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores) and
     OUT/<unit>.png (control chart, alarm, axis scores), all together; a rerun after new logs
     arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.

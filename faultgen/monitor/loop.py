@@ -31,7 +31,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.calibrate import plausibility
-from faultgen.data import atomic, measured
+from faultgen.data import atomic, logfolder, measured
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
@@ -49,6 +49,8 @@ CALIBRATION_STEPS = 3
 #: Exit status of ``faultgen monitor`` when some unit is degraded or not monitored (every output is
 #: still written); 0 when every unit is monitored or still learning, 2 a refusal before any work.
 EXIT_SOME_UNITS_NOT_MONITORED = 3
+#: Events of ``events.csv`` after which a unit's offset is learned again and its open alarm closed.
+MAINTENANCE = ("repair", "gearbox_change")
 #: A unit's status in units.csv.
 STATUSES = ("monitored", "learning", "degraded", "not monitored")
 
@@ -62,6 +64,7 @@ class _Unit:
     entries: list[stored.Entry] = field(default_factory=list)
     skipped: list[stored.Skipped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    maintenance: list[stored.Maintenance] = field(default_factory=list)
 
 
 @dataclass(frozen=True)
@@ -147,6 +150,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
+    maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     cache.mkdir(parents=True, exist_ok=True)
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
@@ -161,6 +165,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         twin = _twin(unit, units, nominal, calibrated_model, out, twins, progress)
         bar.set_postfix_str(name)
         for log in unit_logs:
+            for event in maintenance.get(name, ()):
+                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
+                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
+                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
+                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
+                                                               len(unit.entries)))
             _score_log(unit, log, nominal, twin, twin_temperature)
             bar.update()
     bar.close()
@@ -179,7 +189,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 unit = state[name]
                 stored.write_unit(staging / ".state" / f"{name}.json",
                                   stored.UnitState(name, key, unit.program, unit.monitor.signatures, unit.entries,
-                                                   unit.model, unit.first, unit.skipped, unit.notes))
+                                                   unit.model, unit.first, unit.skipped, unit.notes,
+                                                   unit.maintenance))
     return Outcome(monitors, statuses)
 
 
@@ -326,6 +337,19 @@ def _status(name: str, unit: _Unit | None, settings: Settings) -> UnitStatus:
                       "; ".join(reasons), len(unit.entries), last)
 
 
+def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, list]:
+    """Each unit's repairs and gearbox changes of ``LOGS/events.csv`` (none without the file), in
+    stamp order (:func:`faultgen.data.logfolder.read_events`; a bad file stops the run, named)."""
+    path = logs_dir / "events.csv"
+    if not path.exists():
+        return {}
+    found: dict[str, list] = {}
+    for event in logfolder.read_events(path, units, n_axes, folder=logs_dir):
+        if event.event in MAINTENANCE:
+            found.setdefault(event.unit, []).append(event)
+    return {unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()}
+
+
 def _log(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fleet_logs.Log:
     """The log ``stamp`` of ``unit`` in the fleet folder (a state names logs, never paths)."""
     for log in units.get(unit, ()):
@@ -356,7 +380,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         if not (kept.entries or kept.skipped):
             continue
         state[name] = _Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
-                            list(kept.entries), list(kept.skipped), list(kept.notes))
+                            list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance))
     return state
 
 

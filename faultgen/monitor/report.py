@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence")
+ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
 
 
@@ -42,8 +42,8 @@ def write_alarms(path: Path, monitors) -> None:
         writer = csv.writer(f)
         writer.writerow(ALARM_COLUMNS)
         for m in monitors:
-            row = m.alarm_row()
-            writer.writerow([_fmt(row[c]) for c in ALARM_COLUMNS])
+            for row in m.alarm_rows():
+                writer.writerow([_fmt(row[c]) for c in ALARM_COLUMNS])
 
 
 def write_scores(path: Path, monitors, n_axes: int) -> None:

@@ -123,6 +123,35 @@ class UnitMonitor:
         self.rows: list[dict] = []
         self.last_stamp: str | None = None
         self.learned_expectations: list[np.ndarray] = []
+        #: Alarms closed by a maintenance event, oldest first (rows of alarms.csv).
+        self.closed: list[dict] = []
+        #: After a maintenance event: the offsets of the logs since, until :attr:`relearn_logs` (None otherwise).
+        self.relearning: list[np.ndarray] | None = None
+
+    @property
+    def relearn_logs(self) -> int:
+        """Logs after a repair or gearbox change from which the unit's offset is learned again:
+        a quarter of ``train``, at least 5."""
+        return max(5, self.settings.train // 4)
+
+    # -- maintenance ----------------------------------------------------------------------------
+    def maintenance(self, stamp: str, event: str, axis: int) -> None:
+        """A repair or gearbox change (``event``) on ``axis`` (1..N) logged at ``stamp``, before the
+        next log: the open alarm, if any, is closed by it (kept in :attr:`closed`), and the unit's
+        offset (the residual's mean, every feature's) is learned again from the next
+        :attr:`relearn_logs` logs, which are scored but do not alarm; its slopes, noise and PCA
+        model stay. The wear estimate of every axis, the changed one's first, restarts from the new
+        offset. During the first learning the learning restarts."""
+        if self.pca is None:
+            self.training, self.learned_expectations = [], []
+            return
+        if self.first_alarm is not None:
+            self.closed.append({**self._open_alarm(), "closed": stamp, "closed_by": f"{event} of axis {axis}"})
+            self.first_alarm, self.source_axis, self.statistic = None, None, ""
+            self.limit, self.evidence = float("nan"), ""
+        self.run = 0
+        self.window.clear()
+        self.relearning = []
 
     # -- learning -------------------------------------------------------------------------------
     def _fit(self) -> None:
@@ -192,6 +221,13 @@ class UnitMonitor:
                 self._fit()
             return
         e = np.asarray(residual, dtype=float)
+        relearned = self.relearning is not None
+        if relearned:
+            x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
+            self.relearning.append(e - x @ self.slope_)
+            if len(self.relearning) == self.relearn_logs:
+                self.mean_ = np.mean(self.relearning, axis=0)
+                self.relearning = None
         factor = self.prediction_factor(conditions)
         z = self._standardise(e, conditions) / factor
         variance = (self.scale_ * factor) ** 2
@@ -203,7 +239,7 @@ class UnitMonitor:
             variance = variance + (MODEL_UNCERTAINTY * change) ** 2
         x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
         wear = self.wear_estimate(e - self.mean_ - x @ self.slope_, variance)
-        self._score(stamp, z, phase="monitoring", wear=wear)
+        self._score(stamp, z, phase="relearning" if relearned else "monitoring", wear=wear)
 
     @property
     def bound_quantile(self) -> float:
@@ -260,11 +296,24 @@ class UnitMonitor:
                          f"{self.settings.alpha:g}; axis {self.source_axis} first by share of Q "
                          f"({scores[order[0]]:.3g}; next axis {order[1] + 1}: {scores[order[1]]:.3g})")
 
-    def alarm_row(self) -> dict:
-        """The unit's row of alarms.csv."""
+    def _open_alarm(self) -> dict:
         return {"unit": self.unit, "first_alarm": self.first_alarm or "",
                 "source_axis": "" if self.source_axis is None else self.source_axis,
                 "statistic": self.statistic, "limit": "" if np.isnan(self.limit) else f"{self.limit:.6g}",
-                "evidence": self.evidence if self.first_alarm else
-                (f"no persistent alarm in {len(self.rows)} logs" if self.pca is not None else
-                 f"still learning: {len(self.training)} of {self.settings.train} logs")}
+                "evidence": self.evidence}
+
+    def alarm_row(self) -> dict:
+        """The unit's current row of alarms.csv: its open alarm, or why there is none."""
+        row = {**self._open_alarm(), "closed": "", "closed_by": ""}
+        if not self.first_alarm:
+            row["evidence"] = (f"no persistent alarm in {len(self.rows)} logs" if self.pca is not None else
+                               f"still learning: {len(self.training)} of {self.settings.train} logs")
+            if self.relearning is not None:
+                row["evidence"] += (f"; learning its offset again after maintenance: {len(self.relearning)} of "
+                                    f"{self.relearn_logs} logs")
+        return row
+
+    def alarm_rows(self) -> list[dict]:
+        """The unit's rows of alarms.csv: every alarm closed by maintenance (``closed``,
+        ``closed_by``), then its current row (:meth:`alarm_row`)."""
+        return [*self.closed, self.alarm_row()]

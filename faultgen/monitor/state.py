@@ -92,6 +92,21 @@ class Skipped:
     reason: str
 
 
+@dataclass(frozen=True)
+class Maintenance:
+    """A repair or gearbox change (``event``) of ``axis`` at ``stamp``, given to the unit's monitor
+    before its entry number ``at`` (:meth:`faultgen.monitor.scoring.UnitMonitor.maintenance`)."""
+
+    stamp: str
+    event: str
+    axis: int
+    at: int
+
+    def same(self, other: "Maintenance") -> bool:
+        """The same event of ``events.csv`` (wherever it was given)."""
+        return (self.stamp, self.event, self.axis) == (other.stamp, other.event, other.axis)
+
+
 #: A unit's model kinds: a given calibrated model, its own calibration, the nominal model, none.
 MODELS = ("given", "calibrated", "nominal", "none")
 
@@ -101,7 +116,8 @@ class UnitState:
     """A unit's state (module docstring): ``program`` the (unit, stamp) of the log its twin replays
     (None without a twin), ``signatures`` (n_axes, n_features) or None, ``entries`` in stamp order,
     ``model`` of :data:`MODELS` ("none": protocol own), ``first`` the (stamp, SHA-256) of the unit's
-    first log, the logs ``skipped`` and the ``notes`` on fallbacks taken."""
+    first log, the logs ``skipped``, the ``notes`` on fallbacks taken and the ``maintenance``
+    events given to its monitor."""
 
     unit: str
     settings: dict
@@ -112,14 +128,21 @@ class UnitState:
     first: tuple[str, str] = ("", "")
     skipped: list[Skipped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    maintenance: list[Maintenance] = field(default_factory=list)
 
 
 def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
     """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
     ``state`` ended with."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
-    for e in state.entries:
+    for i, e in enumerate(state.entries):
+        for m in state.maintenance:
+            if m.at == i:
+                monitor.maintenance(m.stamp, m.event, m.axis)
         monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
+    for m in state.maintenance:
+        if m.at == len(state.entries):
+            monitor.maintenance(m.stamp, m.event, m.axis)
     return monitor
 
 
@@ -134,6 +157,7 @@ def write_unit(path: Path, state: UnitState) -> None:
         "program": list(state.program) if state.program else None,
         "model": state.model, "first": list(state.first), "notes": list(state.notes),
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
+        "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
@@ -223,6 +247,12 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             isinstance(k, dict) and all(isinstance(k.get(f), str) for f in ("stamp", "sha256", "reason"))
             for k in skipped)):
         raise StateError(f"{path}: skipped is not a list of {{stamp, sha256, reason}}{refuse}")
+    maintenance = d.get("maintenance")
+    if not (isinstance(maintenance, list) and all(
+            isinstance(m, dict) and isinstance(m.get("stamp"), str) and isinstance(m.get("event"), str)
+            and all(isinstance(m.get(f), int) and not isinstance(m.get(f), bool) and m.get(f) >= 0 for f in ("axis", "at"))
+            for m in maintenance)):
+        raise StateError(f"{path}: maintenance is not a list of {{stamp, event, axis, at}}{refuse}")
     if (model == "none") != (program is None):
         raise StateError(f"{path}: model {model!r} with program {program!r}{refuse}")
     logs = d.get("logs")
@@ -243,7 +273,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         if not math.isfinite(entries[-1].payload):
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
-                     [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes))
+                     [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes),
+                     [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance])
 
 
 def write_cycle(path: Path, key: dict, features: np.ndarray) -> None:
