@@ -52,6 +52,9 @@ EXIT_SOME_UNITS_NOT_MONITORED = 3
 #: Events of ``events.csv`` after which a unit's offset is learned again and its open alarm closed.
 MAINTENANCE = ("repair", "gearbox_change")
 #: A unit's status in units.csv.
+#: ``degraded``: under protocol own where the twin was asked for, or with logs skipped; a unit whose
+#: twin uses the nominal model because its calibration failed or was implausible is ``monitored``,
+#: the model column and the reason say so.
 STATUSES = ("monitored", "learning", "degraded", "not monitored")
 
 
@@ -328,7 +331,7 @@ def _status(name: str, unit: _Unit | None, settings: Settings) -> UnitStatus:
         reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
     if not unit.entries:
         status = "not monitored"
-    elif unit.notes or unit.skipped:
+    elif unit.skipped or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
         status = "learning" if learning else "monitored"
