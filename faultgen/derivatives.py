@@ -56,11 +56,13 @@ def derivatives(
         for d in orders)
 
 
-def smoothed(t: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """``q`` (n, k) sampled at ``t`` (n,) s through the same Savitzky-Golay filter as its derivatives
-    (order 0: the angles the velocity and acceleration are the derivatives of), shape (n, k). On
-    a smooth motion it changes the angles by far less than an encoder's noise; on a noisy log it
-    removes what a drive tracking the log as its reference would amplify."""
+def smoothed(t: np.ndarray, q: np.ndarray, window: float = SAVGOL_WINDOW) -> np.ndarray:
+    """``q`` (n, k) sampled at ``t`` (n,) s through the Savitzky-Golay filter of its derivatives
+    (cubic, order 0) over ``window`` s, shape (n, k). On a smooth motion it changes the angles by
+    far less than an encoder's noise; on a noisy log it removes what a drive tracking the log as its
+    reference would amplify."""
     dt = np.diff(t)
     period = float(np.median(dt))
-    return derivatives(t, q, period, savgol_window(period, len(t)), is_uniform(dt, period), orders=(0,))[0]
+    samples = max(SAVGOL_ORDER + 2, 2 * round(window / (2 * period)) + 1)
+    samples = min(samples, len(t) if len(t) % 2 else len(t) - 1)
+    return derivatives(t, q, period, samples, is_uniform(dt, period), orders=(0,))[0]

@@ -102,7 +102,7 @@ class Maintenance:
     axis: int
     at: int
 
-    def same(self, other: "Maintenance") -> bool:
+    def same(self, other: Maintenance) -> bool:
         """The same event of ``events.csv`` (wherever it was given)."""
         return (self.stamp, self.event, self.axis) == (other.stamp, other.event, other.axis)
 
