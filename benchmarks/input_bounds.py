@@ -26,6 +26,16 @@ Prints one Markdown row per case with its verdict:
   compiled; :func:`xacro_bombs`; issue 61, item 5): a 2.4 kB macro fan-out of 16^10 calls, a 103 kB
   file expanding to a 600 MB URDF, an expression of 50 000 minus signs. Each runs with its address
   space capped at 2 GB and is killed after 60 s. Goal: refused or completed within both.
+* bounded work (issue 61, item 5): a CSV log whose header has 32 000 extra columns (``calibrate``), an
+  HDF5 log declaring 10^8 rows (``calibrate``, and ``logs import``'s reader, ``measured.read``, the
+  monitor's too), a voraus-AD Parquet table of 10^8 rows (a few MB: constant columns), an RTDE
+  recorder log of one-character cells (the ``ur-rtde`` adapter), ``events.csv`` at the old 64 MiB
+  bound and at the new bound (minimal rows), a program of 10^4 moves (``programs.read`` and its
+  path). Goal: refused or completed within 2 GB and 60 s.
+
+Every case runs under a cap (``--cap-mb``, default 4000 MB resident, and ``--cap-s``, 120 s): a
+process above it is killed and reported as such, so a case that blows up on old code is measured
+without taking the machine down.
 
     python benchmarks/input_bounds.py [FOLDER]          # default /tmp/faultgen-input-bounds
     python benchmarks/input_bounds.py FOLDER --quick    # the bombs and the 10^5/10^6 logs only
@@ -55,6 +65,8 @@ SIZES = (100_000, 1_000_000, 10_000_000)
 FLAT = 0.20
 BOMB_MB, BOMB_S = 500, 5.0
 XACRO_MB, XACRO_S = 2048, 60.0
+WORK_MB, WORK_S = 2000, 60.0
+CAP_MB, CAP_S = 4000, 120.0
 
 
 def make_log(folder: Path, rows: int) -> Path:
@@ -198,6 +210,67 @@ def xacro_bombs(folder: Path) -> dict[str, Path]:
     return out
 
 
+PUMA_COLUMNS = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]
+
+
+def make_work_bombs(folder: Path) -> dict[str, Path]:
+    """The hostile files of bounded work (module docstring), written once each."""
+    import h5py
+
+    out = {}
+    wide = out["wide-32000.csv"] = folder / "wide-32000.csv"
+    if not wide.exists():
+        names = PUMA_COLUMNS + [f"x{i}" for i in range(32_000)]
+        rows = [",".join([f"{k * 0.001:.3f}"] + ["0"] * (len(names) - 1)) for k in range(3)]
+        wide.write_text(",".join(names) + "\n" + "\n".join(rows) + "\n")
+    declared = out["declared-1e8.h5"] = folder / "logs-1e8" / "unit1" / "1.h5"
+    if not declared.exists():
+        declared.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(declared, "w") as f:
+            for name in PUMA_COLUMNS:
+                f.create_dataset(name, shape=(10**8,), dtype="f8", chunks=(4096,))
+    out["logs-1e8"] = folder / "logs-1e8"
+    voraus = out["voraus-1e8.parquet"] = folder / "voraus-1e8.parquet"
+    if not voraus.exists():
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        names = ["time", *(f"{c}_{k}" for c in ("joint_position", "joint_velocity", "motor_torque")
+                           for k in range(1, 7)), "sample"]
+        zeros = pa.array(np.zeros(10**6))
+        table = pa.table({name: zeros for name in names})
+        tmp = voraus.with_suffix(".part")
+        with pq.ParquetWriter(tmp, table.schema) as writer:
+            for _ in range(100):
+                writer.write_table(table, row_group_size=10**6)
+        tmp.rename(voraus)
+    rtde = out["rtde-bomb.csv"] = folder / "rtde-bomb.csv"
+    if not rtde.exists():  # 1.5x10^6 rows of 100 one-character cells (and the time): 300 MB
+        names = ["timestamp", *(f"{c}_{k}" for c in ("actual_q", "actual_qd", "target_moment", "actual_current")
+                                for k in range(6))]
+        names += [f"output_{i}" for i in range(100 - len(names) + 1)]
+        tail = " 0" * (len(names) - 1) + "\n"
+        tmp = rtde.with_suffix(".part")
+        with open(tmp, "w") as fh:
+            fh.write(" ".join(names) + "\n")
+            for start in range(0, 1_500_000, 100_000):
+                fh.write("".join(f"{k * 0.002:.3f}{tail}" for k in range(start, start + 100_000)))
+        tmp.rename(rtde)
+    for name, size in (("events-64MiB.csv", 64 * 2**20), ("events-16MiB.csv", 16 * 2**20)):
+        events = out[name] = folder / name.removesuffix(".csv") / "events.csv"
+        if not events.exists():
+            events.parent.mkdir(exist_ok=True)
+            (events.parent / "u").mkdir(exist_ok=True)
+            (events.parent / "u" / "1.csv").write_text("")
+            header, row = b"unit,stamp,event,axis\n", b"u,1,onset,1\n"
+            events.write_bytes(header + row * ((size - len(header)) // len(row)))
+    program = out["program-1e4.toml"] = folder / "program-1e4.toml"
+    moves = ["[[segment]]\ntype = \"move\"\nto = [" + ("10, 80, -110, 20, 10, 10" if k % 2 else "0, 92, -122, 30, 0, 0")
+             + "]\n" for k in range(10_000)]
+    program.write_text('name = "many"\nstart = [0, 92, -122, 30, 0, 0]\n\n' + "\n".join(moves))
+    return out
+
+
 #: kind -> (imports, the case): only the case is timed (imports took 2-5 s on the loaded machine).
 CASES_CODE = {
     "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
@@ -214,6 +287,18 @@ CASES_CODE = {
     # what `robots add` reads (expanded, parsed, compiled by MuJoCo); the URDF it would write, its size
     "xacro": ("from faultgen.model import importers",
               "print(len(importers.read({log!r}).urdf), 'characters of urdf_used.urdf', file=sys.stderr)"),
+    "measured": ("from faultgen.data import measured", "measured.read({log!r}, 'puma560', accelerations=False)"),
+    "logs-import": ("from faultgen.data import fleetlogs",
+                    "fleetlogs.import_logs({log!r}, {out!r} + '.h5', robot='puma560', progress=False)"),
+    "voraus": ("from faultgen.data import adapters\nfrom faultgen.model import robots",
+               "adapters.make('voraus').read({log!r}, robots.load('puma560'), accelerations=False)"),
+    "ur-rtde": ("from faultgen.data import adapters\nfrom faultgen.model import robots",
+                "adapters.make('ur-rtde').read({log!r}, robots.load('puma560'), accelerations=False)"),
+    "events": ("from pathlib import Path\nfrom faultgen.data import logfolder",
+               "logfolder.read_events(Path({log!r}), {{'u': [logfolder.LogFile('u', '1', 1.0, 'sequence', "
+               "Path({log!r}).parent / 'u' / '1.csv', 'u/1.csv')]}}, 6)"),
+    "program-path": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
+                     "programs.read({log!r}, 'puma560').trajectory(robots.load('puma560').model.opt.timestep)"),
 }
 
 
@@ -231,31 +316,50 @@ def run_case(kind: str, log: Path, out: Path, cap_mb: int | None = None, timeout
             "except ValueError as err:\n    result = {'outcome': 'refused', 'message': str(err)[:160]}\n"
             "print(json.dumps({**result, 'seconds': time.perf_counter() - start}))\n")
     shutil.rmtree(out, ignore_errors=True)
-    killed = False
+    Path(str(out) + ".h5").unlink(missing_ok=True)
+    killed = None
     with tempfile.TemporaryFile("w+") as stdout, tempfile.TemporaryFile("w+") as stderr:
         start = time.monotonic()
         proc = subprocess.Popen([sys.executable, "-c", code], stdout=stdout, stderr=stderr, text=True)
-        while True:  # os.wait4: this process's own peak, not the largest child's so far
-            pid, status, usage = os.wait4(proc.pid, os.WNOHANG if timeout else 0)
+        limit = timeout if timeout else CAP[1]
+        while True:  # the cap: resident memory and time polled, the process killed above either
+            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
             if pid:
                 break
-            if not killed and time.monotonic() - start > timeout:
+            rss = _rss_mb(proc.pid)
+            if killed is None and (rss > CAP[0] or time.monotonic() - start > limit):
+                killed = (f"killed at the cap ({rss:.0f} MB resident after {time.monotonic() - start:.0f} s; cap "
+                          f"{CAP[0]:g} MB, {limit:g} s)")
                 proc.kill()
-                killed = True
-            time.sleep(0.05)
+            time.sleep(0.02)
         seconds = time.monotonic() - start
         proc.returncode = os.waitstatus_to_exitcode(status)
         stdout.seek(0)
         stderr.seek(0)
         lines, errors = stdout.read().strip().splitlines(), stderr.read().strip().splitlines()
     if killed:
-        return {"outcome": f"killed after {timeout:g} s (still running)", "seconds": seconds,
-                "peak_mb": usage.ru_maxrss / 1024}
-    result = json.loads(lines[-1]) if lines else {
-        "outcome": f"crashed (exit {proc.returncode}): {errors[-1][:160] if errors else ''}", "seconds": seconds}
-    if result["outcome"] == "completed" and errors:
-        result["message"] = errors[-1][:160]  # what the case printed of its result (the xacro's URDF size)
+        result = {"outcome": killed, "seconds": seconds}
+    else:
+        result = json.loads(lines[-1]) if lines else {
+            "outcome": f"crashed (exit {proc.returncode}): {errors[-1][:160] if errors else ''}", "seconds": seconds}
+        if result["outcome"] == "completed" and errors:
+            result["message"] = errors[-1][:160]  # what the case printed of its result (the xacro's URDF size)
     return {**result, "peak_mb": usage.ru_maxrss / 1024}
+
+
+#: The cap every case runs under: resident MB, seconds (set by --cap-mb, --cap-s).
+CAP = [CAP_MB, CAP_S]
+
+
+def _rss_mb(pid: int) -> float:
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return 0.0
 
 
 def main() -> None:
@@ -268,7 +372,14 @@ def main() -> None:
     parser.add_argument("--xacro", action="store_true", help="only the xacro bombs")
     parser.add_argument("--kinds", nargs="+", default=["calibrate", "replay", "simulate"],
                         help="what to run on the logs")
+    parser.add_argument("--no-work", action="store_true", help="skip the bounded-work cases (issue 61, item 5)")
+    parser.add_argument("--only-work", action="store_true", help="only the bounded-work cases")
+    parser.add_argument("--cap-mb", type=float, default=CAP_MB, help="kill a case above this resident memory, MB")
+    parser.add_argument("--cap-s", type=float, default=CAP_S, help="kill a case running longer, s")
     args = parser.parse_args()
+    CAP[:] = [args.cap_mb, args.cap_s]
+    if args.only_work:
+        args.no_bombs = args.no_logs = True
     folder = Path(args.folder)
     folder.mkdir(parents=True, exist_ok=True)
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average "
@@ -293,6 +404,19 @@ def main() -> None:
         print(f"| {kind} | {name} ({path.stat().st_size / 1e6:.2f} MB) | {r['outcome']}: {r.get('message', '')[:90]} | "
               f"{r['seconds']:.1f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused, < {BOMB_S:g} s, "
               f"< {BOMB_MB} MB) |", flush=True)
+    work = {} if args.no_work else make_work_bombs(folder)
+    for kind, name in [] if args.no_work else [
+            ("calibrate", "wide-32000.csv"), ("calibrate", "declared-1e8.h5"), ("measured", "declared-1e8.h5"),
+            ("logs-import", "logs-1e8"), ("voraus", "voraus-1e8.parquet"), ("ur-rtde", "rtde-bomb.csv"),
+            ("events", "events-64MiB.csv"), ("events", "events-16MiB.csv"), ("program", "program-1e4.toml"),
+            ("program-path", "program-1e4.toml")]:
+        path = work[name]
+        r = run_case(kind, path, folder / "out-work")
+        ok = r["outcome"] in ("refused", "completed") and r["seconds"] < WORK_S and r["peak_mb"] < WORK_MB
+        size = sum(p.stat().st_size for p in path.rglob("*") if p.is_file()) if path.is_dir() else path.stat().st_size
+        print(f"| {kind} | {name} ({size / 1e6:.2f} MB) | {r['outcome']}{': ' + r['message'][:110] if 'message' in r else ''}"
+              f" | {r['seconds']:.1f} | {r['peak_mb']:.0f} | {'met' if ok else 'NOT met'} (goal: refused or completed, "
+              f"< {WORK_S:g} s, < {WORK_MB} MB) |", flush=True)
     sizes = [] if args.no_logs else args.sizes or (SIZES[:2] if args.quick else SIZES)
     for kind in args.kinds:
         base = None

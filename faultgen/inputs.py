@@ -17,7 +17,10 @@ files"):
 * an HDF5 dataset whose declared shape or element count is not the expected one (a 76 MB file
   can declare (10^10, 6) float64: 447 GiB on read), or whose type is not numeric;
 * a gzip stream that inflates beyond :data:`GZIP_MAX_RATIO` times its compressed size (a bomb),
-  checked while it is read, so at most a few MiB are inflated before the refusal.
+  checked while it is read, so at most a few MiB are inflated before the refusal;
+* a CSV header line longer than :data:`CSV_HEADER_MAX_BYTES` or naming more than
+  :data:`CSV_MAX_COLUMNS` columns (:func:`csv_header`), before the rows are parsed: a header of
+  32 000 extra columns (477 kB) cost the whole-log reader 2.6 GB and ``std::bad_alloc``.
 
 Every refusal is an :class:`InputError` (a ``ValueError``: the command line prints it as one
 ``error:`` line and exits 2) whose message starts with the file's path and names the key, link,
@@ -54,6 +57,13 @@ GZIP_MAX_RATIO = 100
 GZIP_SLACK = 8 * 2**20
 #: Elements one HDF5 dataset may hold before a reader refuses it outright (8 GiB of float64).
 HDF5_MAX_ELEMENTS = 2**30
+
+
+#: Most columns a CSV log's header may name: a log in the measured format has at most 31 of its own,
+#: a Universal Robots RTDE recording with every output a few hundred.
+CSV_MAX_COLUMNS = 1024
+#: Longest header line of a CSV log, bytes (1024 names of 60 characters and their separators).
+CSV_HEADER_MAX_BYTES = 64 * 2**10
 
 
 class InputError(ValueError):
@@ -296,6 +306,41 @@ def count_lines(path: str | Path, what: str) -> int:
             lines += block.count(b"\n")
             last = block[-1:]
     return lines + (last != b"\n")
+
+
+def csv_header(path: str | Path, what: str, separator: str | None = ",", max_columns: int = CSV_MAX_COLUMNS,
+               max_bytes: int = CSV_HEADER_MAX_BYTES) -> tuple[list[str], str]:
+    """The column names of the (possibly gzip-compressed) CSV file ``path``'s first line and the
+    separator, reading at most ``max_bytes`` of it and refusing more than ``max_columns`` names,
+    before any row is parsed. ``separator`` None: ``,`` when the line holds one, else a space (an
+    RTDE recording); ``,`` is parsed as CSV (quotes), a space split. An empty file: no names.
+
+    Raises
+    ------
+    InputError
+        ``PATH: the header line is longer than N bytes ...`` or ``PATH: the header names N columns;
+        a WHAT has at most M (CSV_MAX_COLUMNS)``; as :func:`open_bytes` (not a regular file, a bomb).
+    UnicodeDecodeError
+        For a header that is not UTF-8 (the callers name the file).
+    """
+    import csv
+
+    with open_bytes(path, what) as fh:
+        raw = fh.readline(max_bytes + 1)
+    if len(raw) > max_bytes:
+        raise InputError(f"{path}: the header line is longer than {max_bytes} bytes (no line end within them); a "
+                         f"{what}'s header is read up to {max_bytes} bytes (CSV_HEADER_MAX_BYTES)")
+    line = raw.decode("utf-8-sig")
+    if separator is None:
+        separator = "," if "," in line else " "
+    if separator == ",":
+        names = next(csv.reader([line]), [])
+    else:
+        names = line.strip().split(separator) if line.strip() else []
+    if len(names) > max_columns:
+        raise InputError(f"{path}: the header names {len(names)} columns; a {what} has at most {max_columns} "
+                         "(CSV_MAX_COLUMNS): export the columns faultgen reads")
+    return names, separator
 
 
 # --------------------------------------------------------------------------------------------------

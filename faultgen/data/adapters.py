@@ -121,12 +121,13 @@ class URRTDE(Adapter):
 
     def columns(self, path: Path, robot: robots.Robot):
         n_axes = robot.n_axes
-        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
-            header = fh.readline()
-            separator = "," if "," in header else " "
-            frame = pd.read_csv(fh, sep=separator, header=None, names=header.strip().split(separator), dtype=str,
-                                keep_default_na=False, skipinitialspace=True)
-        names = list(frame.columns)
+        inputs.regular_file(path, "RTDE log", MAX_BYTES)
+        try:
+            names, separator = inputs.csv_header(path, "RTDE log", separator=None)
+        except inputs.InputError as err:
+            raise jointlog.LogBoundError(str(err)) from None
+        except (OSError, UnicodeDecodeError, EOFError) as err:
+            raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
         label = jointlog.csv_label
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
@@ -145,7 +146,8 @@ class URRTDE(Adapter):
                 f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
         wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else [])]
         _require(path, names, wanted, "RTDE recorder")
-        values = _numbers(path, frame, wanted, label)
+        jointlog.csv_rows(path, len(wanted), "an RTDE log", "RTDE log")
+        values = _rtde_numbers(path, names, separator, wanted, label)
         q_names, qd_names, tau_names = measured.column_names(n_axes)
         out = {measured.T_COLUMN: values["timestamp"]}
         out.update({q_names[k]: values[q[k]] for k in axes})
@@ -153,6 +155,34 @@ class URRTDE(Adapter):
         if qd[0] in values:
             out.update({qd_names[k]: values[qd[k]] for k in axes})
         return out, label
+
+
+def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str], label) -> dict[str, np.ndarray]:
+    """The ``wanted`` columns of an RTDE log parsed as numbers (only they converted and kept: memory
+    in proportion to the numbers, where reading every cell as text took 7 times the file), refused
+    at the first cell that is not a finite number, found from the text in chunks of rows."""
+    kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
+          "skiprows": 1, "chunksize": max(1_000, jointlog.CHUNK_CELLS // len(wanted))}
+    parts = {name: [] for name in wanted}
+    try:
+        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+            for frame in pd.read_csv(fh, dtype=float, **kw):
+                for name in wanted:
+                    parts[name].append(frame[name].to_numpy(dtype=float))
+        out = {name: jointlog.joined(parts[name]) for name in wanted}
+        if all(bool(np.isfinite(column).all()) for column in out.values()):
+            return out
+    except inputs.InputError:
+        raise
+    except (ValueError, TypeError):  # a cell that is not a number: found from the text below
+        pass
+    del parts
+    start = 0
+    with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+        for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
+            _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
+            start += len(frame)
+    raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
 
 @register("voraus")
@@ -175,6 +205,9 @@ class Voraus(Adapter):
         wanted = ["time", *position, *torque, *(velocity if all(c in names for c in velocity) else [])]
         _require(path, names, wanted, "voraus-AD")
         sample = ["sample"] if "sample" in names else []
+        # the rows from the file's metadata, before any is read: a few MB of constant columns may hold 10^8
+        rows = pq.ParquetFile(path).metadata.num_rows
+        jointlog.check_whole_rows(path, rows, len(wanted + sample), what="a voraus-AD log")
         frame = pq.read_table(path, columns=wanted + sample).to_pandas()
         label = jointlog.index_label
         values = _numbers(path, frame, wanted + sample, label)

@@ -50,8 +50,10 @@ from faultgen import axes, inputs
 EVENTS = ("onset", "failure", "repair", "gearbox_change", "healthy")
 #: The columns of ``events.csv``, in order.
 EVENT_COLUMNS = ("unit", "stamp", "event", "axis")
-#: Largest events file read, bytes (a row is some 40 bytes: a million events).
-EVENTS_MAX_BYTES = 64 * 2**20
+#: Largest events file read, bytes (a row is some 40 bytes: 400 000 events, a fleet's decades of
+#: maintenance). Read row by row, each event kept as a small object whose unit, event and kind are
+#: shared strings: at most about 15 times the file (64 MiB of minimal rows took 1.9 GB, 30 times).
+EVENTS_MAX_BYTES = 16 * 2**20
 #: Per log and axis: the label codes of an imported dataset's ``label`` array.
 UNKNOWN, HEALTHY, WORN = -1, 0, 1
 #: What a link out of the folder is called in its refusal (:func:`faultgen.inputs.within`).
@@ -91,7 +93,7 @@ class LogFile:
     name: str
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Event:
     """One row of ``events.csv``: ``axis`` 1..N, or 0 for every axis (a ``healthy`` event only)."""
 
@@ -221,17 +223,28 @@ def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,
         (before it is read: nothing of it is quoted).
     """
     path = inputs.within(path, Path(path).parent if folder is None else folder, FOLDER)
-    text = inputs.read_text(path, "events file", EVENTS_MAX_BYTES).removeprefix("\ufeff")
+    inputs.regular_file(path, "events file", EVENTS_MAX_BYTES)
     try:
-        rows = list(csv.reader(io.StringIO(text, newline="")))
+        with inputs.open_bytes(path, "events file", EVENTS_MAX_BYTES) as fh:
+            return _events(path, fh, units, n_axes)
+    except UnicodeDecodeError:
+        inputs.read_text(path, "events file", EVENTS_MAX_BYTES)  # refuses it naming the byte offset in the file
+        raise
     except csv.Error as err:
         raise ValueError(f"{path}: cannot read the events: {err}") from None
-    header = tuple(cell.strip() for cell in rows[0]) if rows else ()
+
+
+def _events(path: Path, fh, units: dict[str, list[LogFile]], n_axes: int) -> list[Event]:
+    """The events of the open ``events.csv`` (:func:`read_events`), read row by row (no list of rows)."""
+    reader = csv.reader(io.TextIOWrapper(fh, encoding="utf-8-sig", newline=""))
+    first = next(reader, None)
+    header = tuple(cell.strip() for cell in first) if first is not None else ()
     if header != EVENT_COLUMNS:
         raise ValueError(f"{path}: line 1 is {','.join(header) or '(empty)'}; expected the header "
                          f"{','.join(EVENT_COLUMNS)}")
+    shared = {name: name for name in (*units, *EVENTS)}  # one string per unit and event, not one per row
     events = []
-    for line, row in enumerate(rows[1:], start=2):
+    for line, row in enumerate(reader, start=2):
         if not any(cell.strip() for cell in row):
             continue
         where = f"{path}: line {line}"
@@ -255,7 +268,7 @@ def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,
             except ValueError:
                 raise ValueError(f"{where}: axis {axis!r}; expected an axis 1..{n_axes}"
                                  + (" (or empty: every axis)" if event == "healthy" else "")) from None
-        events.append(Event(unit, stamp, key, kind, event, number, line))
+        events.append(Event(shared[unit], stamp, key, kind, shared[event], number, line))
     return events
 
 

@@ -12,9 +12,9 @@ the median sample period), so a replayed log and the same log calibrated see one
 
 from __future__ import annotations
 
-import csv
 import math
 import zlib
+from collections import Counter
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -68,6 +68,17 @@ CSV_SUFFIXES = (".csv", ".csv.gz")
 #: Most rows a log may have (a day at 1 kHz); a longer one, or an HDF5 log declaring more, is refused.
 MAX_ROWS = 100_000_000
 HDF5_SUFFIXES = (".h5", ".hdf5")
+#: Memory a log read whole (:func:`read_columns`: a log the calibration does not average down, an
+#: imported fleet's log, the monitor's, an adapter's) may give the columns it reads, bytes (each
+#: column as float64): its rows are bounded by this divided by 8 bytes times the columns read
+#: (:func:`whole_rows`; 5.2 million rows of a 6-axis log's 13, 86 min at 1 kHz), checked before any
+#: row is read, so a small file declaring or holding more (an 8 kB HDF5 log declaring 10^8 rows was
+#: a MemoryError in ``logs import``) is refused. The checks and derivatives of a log read whole take
+#: about three times its columns more (docs/reliability.md); a longer log is for the calibration's
+#: streaming reader (:mod:`faultgen.data.longlog`) or a replay's (:mod:`faultgen.operation.replay`).
+WHOLE_MAX_BYTES = 512 * 2**20
+#: Cells of a CSV log parsed at a time when pandas reads it (a compressed log, or one pyarrow refused).
+CHUNK_CELLS = 4_000_000
 
 #: Lowest accepted sample rate in Hz (applied to the median sample period).
 MIN_RATE = 100.0
@@ -89,6 +100,55 @@ class LogError(ValueError):
     The message starts with the file (or ``<arrays>``) and names the offending column and/or
     data row (1-based, header not counted) and what was expected.
     """
+
+
+class LogBoundError(LogError, inputs.InputError):
+    """A log refused before its rows are read, by a bound on the work or memory its reading would
+    take (:data:`WHOLE_MAX_BYTES`, :data:`faultgen.inputs.CSV_MAX_COLUMNS`): both a :class:`LogError`
+    and a :class:`faultgen.inputs.InputError`; the message names the file, the count and the bound."""
+
+
+def whole_rows(n_columns: int, bytes_per_cell: int = 8) -> int:
+    """Most rows a log read whole may have when ``n_columns`` columns of ``bytes_per_cell`` bytes are
+    kept (:data:`WHOLE_MAX_BYTES`)."""
+    return WHOLE_MAX_BYTES // (max(bytes_per_cell, 8) * max(n_columns, 1))
+
+
+def check_whole_rows(path: Path, rows: int, n_columns: int, bytes_per_cell: int = 8, what: str = "a log") -> None:
+    """Refuse ``rows`` rows of ``n_columns`` columns read whole above :func:`whole_rows`."""
+    most = whole_rows(n_columns, bytes_per_cell)
+    if rows > most:
+        raise LogBoundError(f"{path}: {rows} rows of {n_columns} columns; {what} read whole has at most {most} "
+                            f"({WHOLE_MAX_BYTES // 2**20} MiB of {max(bytes_per_cell, 8)}-byte cells, WHOLE_MAX_BYTES)")
+
+
+def csv_rows(path: Path, n_columns: int, what: str = "a log", label: str = "joint log") -> None:
+    """Refuse a CSV log (plain or gzip-compressed) of more data rows than :func:`whole_rows` allows for
+    ``n_columns`` columns, counted before it is parsed: from its size when that already bounds them
+    (a row takes at least a byte), else by a streaming line count (:func:`faultgen.inputs.count_lines`)."""
+    try:
+        if not inputs.is_gzip(path) and path.stat().st_size <= whole_rows(n_columns):
+            return
+        lines = inputs.count_lines(path, label)
+    except inputs.InputError as err:
+        raise LogError(str(err)) from None
+    check_whole_rows(path, max(lines - 1, 0), n_columns, what=what)
+
+
+def header(path: Path, what: str = "joint log") -> list[str]:
+    """The names in the CSV log's header, bounded (:func:`faultgen.inputs.csv_header`), stripped;
+    refuse a name given twice."""
+    try:
+        raw, _ = inputs.csv_header(path, what)
+    except inputs.InputError as err:
+        raise LogBoundError(str(err)) from None
+    except (OSError, UnicodeDecodeError, EOFError, zlib.error) as err:
+        raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
+    names = [h.strip() for h in raw]
+    duplicated = sorted(n for n, count in Counter(names).items() if count > 1)
+    if duplicated:
+        raise LogError(f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header")
+    return names
 
 
 def kind(path: Path) -> str:
@@ -123,65 +183,58 @@ def read_csv(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[s
     """Columns of a CSV file as float arrays, the ignored extra column names, the row labeller.
 
     A gzip-compressed file is recognised by its content, so a compressed log named ``.csv``
-    reads like one named ``.csv.gz``.
+    reads like one named ``.csv.gz``. The header is bounded (:func:`header`) and the rows
+    (:func:`csv_rows`) before a row is parsed; only the wanted columns are converted and kept.
     """
-    try:
-        with inputs.open_text(path, "joint log") as fh:
-            header = next(csv.reader(fh), None)
-    except inputs.InputError as err:
-        raise LogError(str(err)) from None
-    except (OSError, UnicodeDecodeError, EOFError, zlib.error, csv.Error) as err:
-        raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
-    if not header:
+    names = header(path)
+    if not names:
         raise LogError(
             f"{path}: the file is empty; expected a header row with the columns t, q1..q{n_axes}, tau1..tau{n_axes}"
         )
-    names = [h.strip() for h in header]
-    duplicated = sorted({n for n in names if names.count(n) > 1})
-    if duplicated:
-        raise LogError(
-            f"{path}: column(s) {', '.join(duplicated)} appear more than once in the header"
-        )
     wanted, extra = select_columns(path, names, n_axes, motion_only)
-
-    # All columns are parsed (extra ones as text) so that a row with too many or too few
-    # fields is refused by the parser with its line number instead of being silently cut.
+    csv_rows(path, len(wanted))
+    fast = _arrow_columns(path, names, wanted)
+    if fast is not None:
+        return fast, extra, csv_label
+    # pandas (a gzip-compressed log, or one pyarrow refused), in chunks of rows: every column is
+    # tokenized, so a row with too many or too few fields is refused by the parser with its line
+    # number instead of being silently cut, but only a chunk's extra cells are held at a time.
     read_kw = {
         "header": 0,
         "names": names,
         "index_col": False,
         "skip_blank_lines": False,
+        "chunksize": max(1_000, CHUNK_CELLS // len(names)),
     }
-    fast = _arrow_columns(path, names, wanted)
-    if fast is not None:
-        return fast, extra, csv_label
     try:
         try:
-            # Numbers throughout, by pandas (a gzip-compressed log, or one pyarrow refused).
-            # Anything else is diagnosed from the text below.
+            # Numbers throughout. Anything else is diagnosed from the text below.
             dtypes = {name: (float if name in wanted else str) for name in names}
+            parts = {name: [] for name in wanted}
             with inputs.open_text(path, "joint log") as fh:
-                frame = pd.read_csv(fh, dtype=dtypes, **read_kw)
-            # column by column: no reindexed copy of the frame when it has columns not wanted
-            # (each column is a contiguous array either way, as the frame holds its floats)
-            columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+                for frame in pd.read_csv(fh, dtype=dtypes, **read_kw):
+                    for name in wanted:
+                        parts[name].append(frame[name].to_numpy(dtype=float))
+            columns = {name: joined(parts[name]) for name in wanted}
             clean = all(bool(np.isfinite(column).all()) for column in columns.values())
         except inputs.InputError:
             raise
         except (ValueError, TypeError):
             clean = False
         if not clean:
-            with inputs.open_text(path, "joint log") as fh:
-                text = pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw)
-            text = _drop_trailing_blank_rows(text)
-            frame = _numbers_from_text(path, text, wanted)
+            columns = _numbers_from_text(path, read_kw, wanted)
     except inputs.InputError as err:
         raise LogError(str(err)) from None
     except (OSError, EOFError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as err:
         raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
-    if not clean:
-        columns = {name: frame[name].to_numpy(dtype=float) for name in wanted}
     return columns, extra, csv_label
+
+
+def joined(parts: list[np.ndarray]) -> np.ndarray:
+    """One contiguous float column from its chunks (the one chunk itself: no copy)."""
+    if len(parts) == 1:
+        return np.ascontiguousarray(parts[0], dtype=float)
+    return np.ascontiguousarray(np.concatenate(parts) if parts else np.empty(0), dtype=float)
 
 
 def _arrow_columns(path: Path, names: list[str], wanted: list[str]) -> dict[str, np.ndarray] | None:
@@ -197,13 +250,15 @@ def _arrow_columns(path: Path, names: list[str], wanted: list[str]) -> dict[str,
     try:
         if inputs.is_gzip(path):
             return None
-        types = {name: (pa.float64() if name in wanted else pa.string()) for name in names}
+        types = {name: pa.float64() for name in wanted}
         with inputs.open_bytes(path, "joint log") as fh:
+            # only the wanted columns converted and kept; every row's fields still counted by the parser
             table = pacsv.read_csv(
                 fh,
                 read_options=pacsv.ReadOptions(column_names=names, skip_rows=1),
                 parse_options=pacsv.ParseOptions(ignore_empty_lines=False),
-                convert_options=pacsv.ConvertOptions(column_types=types, strings_can_be_null=False),
+                convert_options=pacsv.ConvertOptions(column_types=types, strings_can_be_null=False,
+                                                     include_columns=wanted),
             )
     except inputs.InputError as err:
         raise LogError(str(err)) from None
@@ -221,29 +276,32 @@ def _arrow_columns(path: Path, names: list[str], wanted: list[str]) -> dict[str,
     return columns if table.num_rows else None
 
 
-def _drop_trailing_blank_rows(text: pd.DataFrame) -> pd.DataFrame:
-    blank = (text.apply(lambda col: col.str.strip()) == "").all(axis=1).to_numpy()
-    n = len(blank)
-    while n and blank[n - 1]:
-        n -= 1
-    return text.iloc[:n]
-
-
-def _numbers_from_text(path: Path, text: pd.DataFrame, wanted: list[str]) -> pd.DataFrame:
-    """Convert text columns to floats; refuse at the first empty / NaN / non-numeric cell."""
-    out = {}
+def _numbers_from_text(path: Path, read_kw: dict, wanted: list[str]) -> dict[str, np.ndarray]:
+    """The wanted columns from the text, chunk by chunk: trailing blank rows dropped, refused at the
+    first empty / NaN / non-numeric cell before them (the first data row, then the first wanted
+    column). A bad cell in a blank row counts only when a row that is not blank follows it."""
+    parts = {name: [] for name in wanted}
     first: tuple[int, int, str, str] | None = None  # (row, column order, column, raw text)
-    for order, name in enumerate(wanted):
-        raw = text[name].str.strip()
-        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size and (first is None or bad[0] < first[0]):
-            first = (int(bad[0]), order, name, str(raw.iloc[bad[0]]))
-        out[name] = values
-    if first is not None:
+    last_filled, start = -1, 0
+    with inputs.open_text(path, "joint log") as fh:
+        for text in pd.read_csv(fh, dtype=str, keep_default_na=False, na_filter=False, **read_kw):
+            blank = (text.apply(lambda col: col.str.strip()) == "").all(axis=1).to_numpy()
+            filled = np.flatnonzero(~blank)
+            if filled.size:
+                last_filled = start + int(filled[-1])
+            for order, name in enumerate(wanted):
+                raw = text[name].str.strip()
+                values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=float)
+                bad = np.flatnonzero(~np.isfinite(values))
+                if first is None or first[0] >= start:  # the earliest bad cell: earlier chunks win
+                    if bad.size and (first is None or start + bad[0] < first[0]):
+                        first = (start + int(bad[0]), order, name, str(raw.iloc[bad[0]]))
+                parts[name].append(values)
+            start += len(text)
+    if first is not None and first[0] <= last_filled:
         row, _, name, raw = first
         raise LogError(f"{path}: {csv_label(row)}, column {name}: {describe_bad_cell(raw)}")
-    return pd.DataFrame(out)
+    return {name: joined(parts[name])[: last_filled + 1] for name in wanted}
 
 
 def describe_bad_cell(raw: str) -> str:
@@ -325,7 +383,11 @@ def read_hdf5(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[
                     f"{path}: dataset {name} has {ds.shape[0]} rows but {wanted[0]} has {length}; "
                     "all columns must have the same length"
                 )
-            columns[name] = np.asarray(ds[()], dtype=float)
+        # from the declared shapes and element sizes, before any row is read
+        cell = max(fh[name].dtype.itemsize for name in wanted) if wanted else 8
+        check_whole_rows(path, length or 0, len(wanted), cell)
+        for name in wanted:
+            columns[name] = np.asarray(fh[name][()], dtype=float)
     refuse_non_finite(path, columns, wanted, index_label)
     return columns, extra, index_label
 

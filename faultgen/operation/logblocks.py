@@ -21,7 +21,6 @@ Two passes over the file, :data:`BLOCK_ROWS` rows at a time:
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -61,15 +60,14 @@ class Csv:
 
     def __init__(self, path: Path, n_axes: int, motion_only: bool = False):
         self.path = path
+        header = jointlog.header(path)  # bounded: CSV_MAX_COLUMNS, CSV_HEADER_MAX_BYTES
         try:
-            with inputs.open_text(path, "joint log") as fh:
-                header = next(csv.reader(fh), None)
             lines = inputs.count_lines(path, "joint log")
         except inputs.InputError as err:
             raise LogError(str(err)) from None
-        except (OSError, UnicodeDecodeError, EOFError, csv.Error) as err:
+        except (OSError, UnicodeDecodeError, EOFError) as err:
             raise LogError(f"{path}: cannot read the file as CSV: {err}") from err
-        self.names = [h.strip() for h in header or []]
+        self.names = header
         self.wanted, self.extra = (jointlog.select_columns(path, self.names, n_axes, motion_only) if header
                                    else ([], []))
         self.rows = max(lines - 1, 0) if self.wanted else 0  # an upper bound: blank lines count here
@@ -224,7 +222,7 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | No
     """The first pass over ``src`` (module docstring), in blocks of ``size`` rows (default
     :data:`BLOCK_ROWS`): the whole times when ``times`` is None, else checked as they stream by
     through it."""
-    whole, kept = [], {}
+    kept = {}
     if not src.wanted:  # an empty file: the whole-file reader says what is missing
         return Scan(np.empty(0) if times is None else None, np.empty((0, 0)), np.empty(0, dtype=int), times)
     index = {name: j for j, name in enumerate(src.wanted)}
@@ -233,11 +231,19 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | No
     t_col = index[jointlog.T_COLUMN]
     low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
     tol = jointlog.JOINT_RANGE_TOLERANCE
+    # the whole times in one array of the declared rows (no list of blocks joined: half the memory),
+    # checked as they stream by too, so a log whose times repeat or go back (an HDF5 file declaring
+    # 10^8 rows it does not hold reads as zeros) is refused at its first block, not after all of it
+    whole = np.empty(src.rows) if times is None else None
+    early = TimeScan(src.path, src.label) if times is None else times
+    end = 0
     for start, block in src.blocks(size or BLOCK_ROWS):
         if times is None:
-            whole.append(block[:, t_col].copy())
-        else:
-            times.add(start, block[:, t_col])
+            if start + len(block) > len(whole):  # more rows than counted (cannot happen): grow
+                whole = np.concatenate([whole, np.empty(start + len(block) - len(whole))])
+            whole[start:start + len(block)] = block[:, t_col]
+            end = start + len(block)
+        early.add(start, block[:, t_col])
         q = block[:, q_cols]
         rows = [np.argmin(q, axis=0), np.argmax(q, axis=0), np.argmax(np.abs(q), axis=0)]
         if tau_cols:
@@ -247,7 +253,7 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | No
         for i in np.unique(np.concatenate(rows)):
             kept[start + int(i)] = block[i].copy()  # a copy: a view would keep the whole block
     order = sorted(kept)
-    t = (np.concatenate(whole) if whole else np.empty(0)) if times is None else None
+    t = whole[:end] if times is None else None
     if not order:
         return Scan(t, np.empty((0, len(src.wanted))), np.empty(0, dtype=int), times)
     return Scan(t, np.array([kept[i] for i in order]), np.array(order), times)

@@ -93,6 +93,18 @@ SEGMENT_KEYS = {
 PROGRAM_PROCESSES = (*PROCESSES.values(), "program", "handling", "pick and place", "palletizing", "packaging",
                      "machine tending", "assembly", "spot welding", "arc welding", "laser welding", "cutting",
                      "painting", "dispensing", "gluing", "grinding", "polishing", "deburring", "inspection")
+#: Most ``[[segment]]`` tables a program may have, counted before any is checked, planned or sampled
+#: (a program of 10^4 moves was refused by the cycle's duration bound only after 46 s and 1.4 GB,
+#: its moves planned one by one). The thesis tasks have 5 to 20; the largest program the project
+#: writes a few hundred.
+MAX_SEGMENTS = 1000
+
+
+class ProgramBoundError(ProgramError, inputs.InputError):
+    """A program refused before it is checked or planned, by a bound on its size (:data:`MAX_SEGMENTS`):
+    a :class:`ProgramError` and a :class:`faultgen.inputs.InputError`."""
+
+
 TOP_KEYS = ("name", "robot", "process", "description", "start", "velocity_scale", "acceleration_scale", "limits",
             "tool", "segment")
 LIMIT_KEYS = ("velocity", "acceleration", "jerk")
@@ -316,6 +328,10 @@ def parse(text: str, robot: Robot | str, source: Path | None = None, where: str 
         data = inputs.loads_toml(text, where, "program file")
     except inputs.InputError as err:
         raise ProgramError(str(err)) from None
+    raw = data.get("segment", [])
+    if isinstance(raw, list) and len(raw) > MAX_SEGMENTS:
+        raise ProgramBoundError(f"{where}: {len(raw)} [[segment]] tables; a program has at most {MAX_SEGMENTS} "
+                                "(MAX_SEGMENTS): split it into several programs")
     top = Table(where, "", data, TOP_KEYS)
     name = top.text("name")
     if "robot" in data:
