@@ -417,3 +417,36 @@ def test_training_source_with_another_dataset_as_the_one_to_many_source(imported
     otm = cases[cases["source"] == "OTM"]
     assert set(otm["reference"]) == {"other.h5:u1", "other.h5:u3", "other.h5:u5"}
     assert len(otm) == 3 * 6 * 3 and (cases[cases["source"] == "OTO"]["reference"] == cases[cases["source"] == "OTO"]["robot"]).all()
+
+
+def test_a_log_replaced_mid_import_is_stored_under_the_digest_of_the_content_parsed(logs, tmp_path, puma):
+    """The log is read once: its digest is that of the bytes parsed, even when the file is replaced
+    between the hash and the parse (two reads stored the new content under the old one's digest)."""
+    import hashlib
+
+    victim = logs / "u1" / "2026-03-03.csv"
+    parsed: dict[str, bytes] = {}
+
+    def replaced_meanwhile(path, robot):
+        if Path(path).name == victim.name and not parsed:
+            fleetlog_folder.write_log(victim, puma, 2, 1, np.full(puma.n_axes, 0.5))  # another log, same name
+            parsed[victim.name] = Path(path).read_bytes()
+        return measured.read(path, robot, accelerations=False)
+
+    out = tmp_path / "f.h5"
+    fleetlogs.import_logs(logs, out, robot=puma, progress=False, reader=replaced_meanwhile)
+    with h5py.File(out, "r") as f:
+        manifest = dict(zip((n.decode() for n in f["import"]["file"][()]), (h.decode() for h in f["import"]["sha256"][()])))
+    assert manifest["u1/2026-03-03.csv"] == hashlib.sha256(parsed[victim.name]).hexdigest()
+    # what was parsed is what was there when the import began: the file now holds another content
+    assert fleetlogs.sha256(victim) != manifest["u1/2026-03-03.csv"]
+    result = runner.invoke(app, ["logs", "import", str(logs), "--robot", "puma560", "-o", str(out), "--no-progress"])
+    assert result.exit_code == 2 and f"{victim} changed since it was imported" in result.output, result.output
+
+
+def test_a_refusal_of_a_log_names_the_log(logs, tmp_path):
+    bad = logs / "u2" / "2026-03-02.csv"
+    bad.write_text("t,q1\n0,1\n")
+    with pytest.raises(ValueError) as err:
+        fleetlogs.import_logs(logs, tmp_path / "f.h5", robot="puma560", progress=False)
+    assert str(err.value).startswith(f"{bad}: ") and "faultgen-log-" not in str(err.value)

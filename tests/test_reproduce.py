@@ -68,6 +68,76 @@ def test_a_command_step_runs_faultgen_in_the_folder(tmp_path):
     assert (tmp_path / "logs" / "tasks.log").read_text().startswith("faultgen tasks export irb6700 pick_place")
 
 
+def test_a_full_run_after_a_tiny_one_makes_each_step_again_at_its_scale(tmp_path):
+    """A step's outputs are kept only when its record (DIR/.steps) says they were made with the same
+    settings: a full run after an interrupted tiny one made the full tables on the tiny grids."""
+    tiny, full = ([s for s in plan.steps(scale) if s.name == "c2 grid"] for scale in ("tiny", "full"))
+    (outcome,) = runner.execute(tiny, tmp_path, jobs=1)
+    assert outcome.status == "ran" and "cycles = 480" in (tmp_path / "c2.toml").read_text()
+    (outcome,) = runner.execute(full, tmp_path, jobs=1)
+    assert outcome.status == "ran" and (tmp_path / "c2.toml").read_text() == plan.C2_CONFIG
+    (outcome,) = runner.execute(full, tmp_path, jobs=1)
+    assert outcome.status == "kept"
+    assert all(runner.records(plan.steps("tiny"))[s.name] != runner.records(plan.steps("full"))[s.name]
+               for s in plan.steps("full"))
+
+
+def test_a_step_whose_need_was_made_again_is_made_again(tmp_path):
+    log: list[str] = []
+
+    def steps(settings: str) -> list[Step]:
+        return [Step("a", outputs=("a.txt",), call=_writes("a", log), settings=settings),
+                Step("b", outputs=("b.txt",), needs=("a",), call=_writes("b", log))]
+
+    runner.execute(steps("one"), tmp_path, jobs=1)
+    outcomes = runner.execute(steps("two"), tmp_path, jobs=1)  # b's own settings are the same: its need's are not
+    assert {o.step.name: o.status for o in outcomes} == {"a": "ran", "b": "ran"} and log == ["a", "b", "a", "b"]
+    (tmp_path / ".steps" / "b.json").write_text((tmp_path / ".steps" / "b.json").read_text().replace('"done"', '"running"'))
+    outcomes = runner.execute(steps("two"), tmp_path, jobs=1)  # killed after its record said it started: again
+    assert {o.step.name: o.status for o in outcomes} == {"a": "kept", "b": "ran"}
+
+
+def test_a_resumed_run_makes_the_steps_a_kept_step_made_ready(tmp_path):
+    log: list[str] = []
+    steps = [Step("a", outputs=("a.txt",), call=_writes("a", log)),
+             Step("b", outputs=("b.txt",), needs=("a",), call=_writes("b", log))]
+    runner.execute(steps, tmp_path, jobs=1)
+    (tmp_path / "b.txt").unlink()  # killed before b wrote it
+    outcomes = runner.execute(steps, tmp_path, jobs=1)
+    assert {o.step.name: o.status for o in outcomes} == {"a": "kept", "b": "ran"} and (tmp_path / "b.txt").exists()
+
+
+def test_an_output_no_run_made_is_refused_before_anything_runs(tmp_path):
+    log: list[str] = []
+    (tmp_path / "b.txt").write_text("the user's own\n")
+    steps = [Step("a", outputs=("a.txt",), call=_writes("a", log)), Step("b", outputs=("b.txt",), call=_writes("b", log))]
+    with pytest.raises(ValueError, match=r"b\.txt is there, and no record .* says a reproduction made it \(step 'b'"):
+        runner.execute(steps, tmp_path, jobs=1)
+    assert log == [] and (tmp_path / "b.txt").read_text() == "the user's own\n"
+
+
+def test_a_command_step_made_again_replaces_its_output(tmp_path):
+    old = Step("tasks", ("tasks", "export", "irb6700", "pick_place", "-o", "t.toml"), outputs=("t.toml",), settings="x")
+    runner.execute([old], tmp_path, jobs=1)
+    new = Step("tasks", ("tasks", "export", "irb6700", "spot_weld", "-o", "t.toml"), outputs=("t.toml",), settings="x")
+    (outcome,) = runner.execute([new], tmp_path, jobs=1)
+    assert outcome.status == "ran" and "spot_weld" in (tmp_path / "t.toml").read_text()
+    assert "--overwrite" in (tmp_path / "logs" / "tasks.log").read_text()
+
+
+def test_every_command_step_can_replace_its_outputs():
+    import typer.main
+
+    command = typer.main.get_command(app)
+    for scale in plan.SCALES:
+        for step in plan.steps(scale):
+            if not step.args:
+                continue
+            sub = command.commands[step.args[0]]
+            options = {o for p in sub.params for o in getattr(p, "opts", [])}
+            assert "--overwrite" in options, step.name
+
+
 def test_every_plan_is_valid_and_shares_its_datasets():
     for scale in plan.SCALES:
         steps = plan.steps(scale)

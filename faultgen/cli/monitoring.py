@@ -10,13 +10,17 @@ import typer
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
 
+#: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations.
+CACHE_ENTRIES = ("cycles", "calibrated")
+
 
 @app.command("monitor", cls=Command)
 def monitor_command(
     logs: Annotated[Path, typer.Argument(help="Fleet folder: LOGS/<unit>/<stamp>.csv (or .csv.gz, .h5).")],
     robot: Annotated[str, typer.Option(help="Robot the logs were recorded on: name, robot folder or MJCF file.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder: alarms.csv, scores.csv, <unit>.png. "
-                                      "An earlier run's folder is continued: only new logs are scored.")],
+                                      "An earlier run's folder is continued: only new logs are scored. Another "
+                                      "folder that holds files is refused unless --overwrite.")],
     calibrated: Annotated[Path | None, typer.Option(
         help="A `faultgen calibrate` output folder whose model every unit's twin uses (default: each unit's "
              "model calibrated on its first log).")] = None,
@@ -34,6 +38,9 @@ def monitor_command(
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
+    overwrite: Annotated[bool, typer.Option(
+        "--overwrite", help="Write into a folder that holds files but is not an earlier monitor run's output, "
+        "replacing its files of the outputs' names; without it such a folder is refused.")] = False,
 ) -> None:
     """Monitor your own robots: learn each unit's normal operation from its first logs against its
     twin, score every later log, and name the worn axis.
@@ -57,7 +64,8 @@ def monitor_command(
     skipped; OUT/units.csv gives every unit's status (monitored, learning, degraded, not
     monitored), protocol, model and the reason. Exit status: 0 when every unit is monitored or
     still learning, 3 when some unit is degraded or not monitored (every output still written),
-    2 when the run is refused before any work (bad option, robot, folder or OUT).
+    2 when the run is refused before any work (bad option, robot, folder or OUT). OUT must lie apart
+    from LOGS (neither inside it nor holding it); a run that fails leaves no OUT it made.
 
     A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
     with closed and closed_by) and the unit learns its offset again from the next logs.
@@ -80,8 +88,14 @@ def monitor_command(
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
-    outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                           twin_temperature=twin_temperature, progress=True)
+    check_monitor_out(out, logs, overwrite)
+    made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
+    try:
+        outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
+                               twin_temperature=twin_temperature, progress=True)
+    except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
+        remove_made(made)
+        raise
     monitors = outcome.monitors
     alarmed = [m for m in monitors if m.first_alarm]
     by_unit = {m.unit: m for m in monitors}
@@ -107,3 +121,56 @@ def monitor_command(
                    f"({', '.join(s.unit for s in short[:5])}{', ...' if len(short) > 5 else ''}): their reasons are "
                    f"in {out / 'units.csv'}; exit status {loop.EXIT_SOME_UNITS_NOT_MONITORED}", err=True)
         raise typer.Exit(loop.EXIT_SOME_UNITS_NOT_MONITORED)
+
+
+def is_monitor_output(folder: Path) -> bool:
+    """Whether ``folder`` is an earlier monitor run's output: it holds the monitors' state
+    (``.state``), or the cache a run killed before its first outputs leaves (``.cache`` holding
+    nothing but :data:`CACHE_ENTRIES`)."""
+    state, cache = folder / ".state", folder / ".cache"
+    if state.is_dir() and not state.is_symlink():
+        return True
+    if not cache.is_dir() or cache.is_symlink():
+        return False
+    return all(entry.name in CACHE_ENTRIES for entry in cache.iterdir())
+
+
+def check_monitor_out(out: Path, logs: Path, overwrite: bool) -> None:
+    """Refuse, before any work, an OUT that is LOGS, lies inside it or holds it
+    (:func:`faultgen.data.atomic.check_apart`), is a file, or is a folder holding files that is
+    not an earlier monitor run's output (:func:`is_monitor_output`: continued) unless ``overwrite``.
+
+    Raises
+    ------
+    ValueError
+        Naming OUT (and LOGS) and what to do.
+    """
+    from faultgen.data import atomic
+
+    atomic.check_apart(out, logs)
+    if (out.exists() or out.is_symlink()) and not out.is_dir():
+        raise ValueError(f"{out} is a file; --out expects a folder to write the results into")
+    if out.is_dir() and any(out.iterdir()) and not is_monitor_output(out) and not overwrite:
+        raise ValueError(f"{out} holds files and is not an earlier monitor run's output (no {out / '.state'}); pass "
+                         "--overwrite to write into it (replacing its files of the outputs' names) or choose another "
+                         "--out")
+
+
+def first_missing(path: Path) -> Path | None:
+    """The outermost folder of ``path`` (``path`` itself or a folder above it) that does not exist
+    now: the one a run that creates ``path`` (with its parents) makes; None when ``path`` exists."""
+    path = path.absolute()
+    if path.exists() or path.is_symlink():
+        return None
+    while not (path.parent.exists() or path.parent.is_symlink()) and path.parent != path:
+        path = path.parent
+    return path
+
+
+def remove_made(made: Path | None) -> None:
+    """Remove ``made`` (:func:`first_missing` before the run): a folder this run created, with all
+    it holds. Nothing that existed before the run is touched."""
+    import shutil
+
+    if made is not None and made.is_dir() and not made.is_symlink():
+        shutil.rmtree(made, ignore_errors=True)

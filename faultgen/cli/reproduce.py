@@ -16,7 +16,8 @@ from faultgen.cli.options import Progress
 def reproduce_command(
     out: Annotated[Path, typer.Option("--out", "-o", help="Folder for the datasets, the tables and the summary; "
                                       "created if missing. A folder of an earlier run is resumed: steps whose "
-                                      "outputs are there are kept.")],
+                                      "outputs are there, made at the same scale (DIR/.steps), are kept; made at "
+                                      "another, made again. A file of an output's name no run made is refused.")],
     jobs: Annotated[int, typer.Option(help="Steps run side by side, each a process (one per core is best).",
                                       min=1, max=64)] = 2,
     tiny: Annotated[bool, typer.Option("--tiny", help="Every step on grids of seconds: checks the command and "

@@ -382,3 +382,27 @@ def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def check_apart(out: str | Path, folder: str | Path, what: str = "the logs folder") -> None:
+    """Refuse, before any work, an output ``out`` that is the input ``folder`` itself, lies inside
+    it or contains it (both resolved: symbolic links followed, ``..`` removed). An output inside a
+    folder that a later run reads as a whole (a fleet's LOGS) is read back as one of its entries
+    and breaks that run; an output that is or holds the folder would replace entries of it.
+
+    Raises
+    ------
+    ValueError
+        Naming ``out`` and ``folder`` as given, and what to do.
+    """
+    from faultgen import inputs
+
+    here, there = inputs.resolved(Path(out).absolute()), inputs.resolved(Path(folder).absolute())
+    if here == there:
+        raise ValueError(f"{out} is {what} {folder} itself; write the results into a folder outside {folder}")
+    if there in here.parents:
+        raise ValueError(f"{out} lies inside {what} {folder}: a later run would read it as part of the folder; "
+                         f"write it outside {folder}")
+    if here in there.parents:
+        raise ValueError(f"{out} contains {what} {folder}, whose entries its outputs could replace; write the "
+                         f"results into a folder outside {folder}")

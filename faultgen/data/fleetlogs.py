@@ -45,7 +45,7 @@ from tqdm.auto import tqdm
 
 from faultgen import __version__
 from faultgen.data import logfolder, measured, schema, writer
-from faultgen.data.atomic import check_writable, hdf5_writer
+from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
 from faultgen.operation import programs
@@ -127,6 +127,39 @@ def sha256(path: Path) -> str:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+def read_once(read: Reader, path: Path, robot: robots.Robot) -> tuple[measured.MeasuredData, str]:
+    """``read(path, robot)`` on the bytes of ``path`` read once, and their SHA-256: the file is
+    copied into a private temporary folder while it is hashed, and the copy is parsed, so the
+    digest is that of exactly the content parsed, even when the log is replaced meanwhile (read
+    twice, a log replaced between the hash and the parse was stored under the old content's
+    digest). A refusal names ``path``, never the copy.
+
+    Raises
+    ------
+    ValueError
+        The reader's refusal (:class:`faultgen.data.measured.MeasuredDataError`, an adapter's), or
+        :class:`faultgen.inputs.InputError` for a path that is not a regular file.
+    """
+    import tempfile
+
+    from faultgen import inputs
+
+    path = Path(path)
+    digest = hashlib.sha256()
+    with tempfile.TemporaryDirectory(prefix="faultgen-log-") as folder:
+        copy = Path(folder) / path.name  # the same name: readers go by its suffix
+        with open(inputs.regular_file(path, "log"), "rb") as source, open(copy, "wb") as sink:
+            for block in iter(lambda: source.read(1 << 20), b""):
+                digest.update(block)
+                sink.write(block)
+        try:
+            data = read(copy, robot)
+        except ValueError as err:  # name the log, not its copy
+            err.args = tuple(a.replace(str(copy), str(path)) if isinstance(a, str) else a for a in err.args) or err.args
+            raise
+    return data, digest.hexdigest()
 
 
 def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np.ndarray) -> dict[str, np.ndarray]:
@@ -253,6 +286,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         If ``out`` cannot be written (nothing is left at ``out`` but what was there).
     """
     logs_dir, out = Path(logs_dir), Path(out)
+    check_apart(out, logs_dir)  # a dataset inside LOGS would be read back as a file of the folder
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
     read = reader or functools.partial(measured.read, accelerations=False)
     speed_limit = programs.robot_limits(robot)[0]
@@ -343,7 +377,7 @@ def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) 
             summary.kept += 1
             continue
         try:
-            data = read(log.path, robot)
+            data, digest = read_once(read, log.path, robot)
         except ValueError as err:  # MeasuredDataError and an adapter's refusals: the file and row named
             if not skip_bad:
                 raise

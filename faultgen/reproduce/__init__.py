@@ -39,12 +39,14 @@ def describe(scale: str = "full") -> str:
 def run(out: str | Path, scale: str = "full", jobs: int = 2,
         progress: Callable[[str], None] | None = None) -> Path:
     """Make every step of ``scale`` (:data:`.plan.SCALES`) in folder ``out`` (created; steps whose
-    outputs are there are kept, so a killed run resumes) with ``jobs`` steps at a time, build the
+    outputs are there, recorded as made with the same settings, are kept, so a killed run resumes;
+    outputs of another scale are made again) with ``jobs`` steps at a time, build the
     tables and write the summary; return the summary's path.
 
     ``progress(line)`` receives one line as each step ends (``[done/total] name: ran in 3m02s``)
     and one per table written. Raises :class:`StepFailed` naming the first failed step and its
-    log, ValueError for a bad ``scale`` or ``jobs`` < 1.
+    log, ValueError for a bad ``scale`` or ``jobs`` < 1, or a file of an output's name that no
+    earlier run's record claims (:func:`.runner.check_outputs`), before anything runs.
     """
     if jobs < 1:
         raise ValueError(f"jobs {jobs}: expected at least 1")

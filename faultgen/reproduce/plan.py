@@ -8,6 +8,7 @@ steps on grids of seconds (the test of the command's plumbing; its numbers mean 
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from faultgen.reproduce.runner import Step
@@ -104,7 +105,8 @@ def steps(scale: str = "full") -> list[Step]:
                                            "-o", "fleet-nc-matched"),
              _classify("fleet-nc-matched"), ("fleet no conditions",), cost=3),
     ]
-    return data + analyses
+    # the scale decides every output (the grids, and what the analyses read): recorded with them
+    return [dataclasses.replace(step, settings=scale) for step in data + analyses]
 
 
 def _stem(stem: str) -> tuple[str, ...]:
