@@ -137,11 +137,13 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     Raises
     ------
     ValueError
-        Before any work, for the run as a whole: the robot, the fleet folder, a log older than the
+        Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
+        (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, a log older than the
         last one scored, a scored log that changed since, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
         file named).
     """
+    atomic.check_apart(out, logs_dir)
     nominal = robots.load(robot)
     units = fleet_logs.fleet(logs_dir)
     out = Path(out)
