@@ -1372,6 +1372,8 @@ def write_outputs(table: pd.DataFrame, stem: Path, text: str | None = None) -> l
     """Write ``table`` as ``<stem>.csv`` and ``text`` (default: the table) as ``<stem>.md``."""
     stem = Path(stem)
     csv, md = stem.with_suffix(".csv"), stem.with_suffix(".md")
-    table.to_csv(csv, index=not isinstance(table.index, pd.RangeIndex))
+    from faultgen.data import cells
+
+    cells.escaped(table).to_csv(csv, index=not isinstance(table.index, pd.RangeIndex))
     md.write_text((text or markdown(table)) + "\n")
     return [csv, md]

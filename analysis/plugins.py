@@ -203,17 +203,25 @@ class Plugin(BaseEstimator):
         PluginError
             If ``predict`` raised, or its answer is not one finite number (or bool) per sample.
         """
-        X = np.asarray(X)
-        try:
-            alarms = self.estimator_.predict(X)
-            alarms = np.asarray(alarms)
-        except Exception as err:
-            raise PluginError(f"plug-in {self.spec!r}: predict(X) of X {X.shape} failed: {_what(err)}") from None
-        finite = alarms.dtype.kind in "biuf" and (alarms.dtype.kind != "f" or bool(np.isfinite(alarms).all()))
-        if alarms.shape != (len(X),) or not finite:
-            raise PluginError(f"plug-in {self.spec!r}: predict(X) gave {_describe(alarms)} for X {X.shape}; the "
-                              f"detector contract is one finite alarm (bool or 0/1) per sample, shape ({len(X)},)")
-        return alarms.astype(bool)
+        return alarms(self.spec, self.estimator_, X)
+
+
+def alarms(spec: str, estimator, X) -> np.ndarray:
+    """``estimator.predict(X)`` held to the detector contract (:meth:`Plugin.predict`): bool array
+    of shape (n_samples,), or :class:`PluginError` naming ``spec`` (``faultgen bench score`` calls
+    a plug-in's classifier, which it fits with labels outside a :class:`Plugin`, through it too)."""
+    X = np.asarray(X)
+    try:
+        found = np.asarray(estimator.predict(X))
+    except PluginError:  # a Plugin's own predict: already held to the contract
+        raise
+    except Exception as err:
+        raise PluginError(f"plug-in {spec!r}: predict(X) of X {X.shape} failed: {_what(err)}") from None
+    finite = found.dtype.kind in "biuf" and (found.dtype.kind != "f" or bool(np.isfinite(found).all()))
+    if found.shape != (len(X),) or not finite:
+        raise PluginError(f"plug-in {spec!r}: predict(X) gave {_describe(found)} for X {X.shape}; the "
+                          f"detector contract is one finite alarm (bool or 0/1) per sample, shape ({len(X)},)")
+    return found.astype(bool)
 
 
 def _describe(values: np.ndarray) -> str:

@@ -68,3 +68,42 @@ class AlwaysBacklash(BaseEstimator):
         self.source_axis_ = 1
         self.fault_ = "backlash"
         return self
+
+
+class AlarmsOnlyRaising(BaseEstimator):
+    """A detector with no decision_function whose predict raises: its score is its alarms, and the
+    raise is named on one line as `detect` names it (issue 61, item 7)."""
+
+    def fit(self, X, y=None):
+        return self
+
+    def predict(self, X):
+        raise KeyError("no alarms today")
+
+
+class ClassifierTooFewAlarms(ClassifierMixin, BaseEstimator):
+    """A classifier (fitted with labels, outside the plug-in guard) answering two alarms for any X."""
+
+    def fit(self, X, y=None):
+        self.classes_ = np.array([0, 1])
+        return self
+
+    def decision_function(self, X):
+        return np.zeros(len(X))
+
+    def predict(self, X):
+        return np.zeros(2, dtype=bool)
+
+
+class ClassifierFlatProbabilities(ClassifierMixin, BaseEstimator):
+    """A classifier whose predict_proba gives one column-less value per record (1-D)."""
+
+    def fit(self, X, y=None):
+        self.classes_ = np.array([0, 1])
+        return self
+
+    def predict_proba(self, X):
+        return np.zeros(len(X))
+
+    def predict(self, X):
+        return np.zeros(len(X), dtype=bool)

@@ -11,6 +11,7 @@ The folders are built in a few milliseconds with :func:`faultgen.bench.files.wri
 from __future__ import annotations
 
 import json
+import re
 
 import bench_plugins
 import h5py
@@ -208,3 +209,19 @@ def test_label_rows_with_bad_values_name_the_file_and_row(tmp_path):
         labels.write_text("\n".join(row) + "\n")
         with pytest.raises(InputError, match=r"test_labels\.csv, " + message):
             files.attach_labels(test, labels)
+
+
+@pytest.mark.parametrize("plugin, message", [
+    ("AlarmsOnlyRaising", r"plug-in 'bench_plugins:AlarmsOnlyRaising': predict\(X\) of X \(8, 24\) failed: KeyError"),
+    ("ClassifierTooFewAlarms", r"predict\(X\) gave shape \(2,\), dtype bool for X \(8, 24\); the detector contract"),
+    ("ClassifierFlatProbabilities", r"predict_proba\(X\) gave shape \(0,\) or non-finite values for X \(8, 24\)"),
+])
+def test_a_detector_plug_in_breaking_the_detect_contract_is_refused_on_one_line(tmp_path, plugin, message):
+    """Issue 61, item 7: `bench score --detector` holds a plug-in to the contract `detect` holds it to
+    (analysis.plugins): one without decision_function whose predict raises, a classifier answering
+    too few alarms, a 1-D predict_proba (before: a KeyError or IndexError traceback, exit 1)."""
+    folder = _folder(tmp_path)
+    result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(folder), "--detector",
+                                 f"bench_plugins:{plugin}", "-o", str(tmp_path / "s")])
+    line = _refused(result, tmp_path / "s")
+    assert re.search(message, line), line

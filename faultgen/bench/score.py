@@ -83,6 +83,11 @@ def _auroc(units: list) -> float:
 
 
 def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
+    """A detector's score per record: ``decision_function``, else ``predict_proba[:, -1]``, else its
+    alarms (:func:`analysis.plugins.alarms`: the contract ``detect`` holds a plug-in to), each
+    refused with one line naming ``name`` when it raises or is not one finite number per record."""
+    from analysis import plugins
+
     for method in ("decision_function", "predict_proba"):
         if hasattr(estimator, method):
             try:
@@ -90,12 +95,12 @@ def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
             except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
                 raise ValueError(f"{name}: {method}(X) of X {X.shape} failed: {type(err).__name__}: {err}") from None
             if method == "predict_proba":
-                values = values[:, -1]
+                values = values[:, -1] if values.ndim == 2 and values.shape[1] else np.full(0, np.nan)
             if values.shape != (len(X),) or not np.isfinite(values).all():
                 raise ValueError(f"{name}: {method}(X) gave shape {values.shape} or non-finite values for X "
                                  f"{X.shape}; expected one finite score per record")
             return values
-    return np.asarray(estimator.predict(X), dtype=float)
+    return plugins.alarms(name, estimator, X).astype(float)
 
 
 def _fit(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray):
@@ -115,6 +120,8 @@ def _fit(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray):
 def detector_results(method, name: str, train: list[files.Unit], test: list[files.Unit]) -> dict:
     """Fit ``method`` per robot and task on ``train`` (labelled units) and judge ``test`` (units whose
     labels :func:`faultgen.bench.files.attach_labels` added; the method never sees them)."""
+    from analysis import plugins
+
     judged = []
     for setup in sorted({(u.robot, u.task) for u in test}):
         own = [u for u in train if (u.robot, u.task) == setup] or train
@@ -125,7 +132,7 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
         for unit in (u for u in test if (u.robot, u.task) == setup):
             X_unit = unit.features()
             scores = _scores(inner, X_unit, name)
-            alarms = np.asarray(fitted.predict(X_unit)).astype(bool)
+            alarms = plugins.alarms(name, fitted, X_unit)
             level = unit.fault_level
             judged.append({"unit": unit, "scores": scores, "alarms": alarms, "positive": level >= WORN_PCT,
                                "mask": (level >= WORN_PCT) | (level <= 0)})

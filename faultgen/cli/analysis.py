@@ -12,6 +12,7 @@ from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
 from faultgen.data import atomic
+from faultgen.data import cells as csv_cells
 from faultgen.cli.options import (
     MAX_CYCLES, MAX_DAYS, MAX_FOLDS, MAX_PAIRS, MAX_PERMUTATIONS, MAX_SAMPLES, Overwrite, Progress, QAlpha,
 )
@@ -115,7 +116,7 @@ def bench_isolators_command(
         benchmark.write_outputs(table, staged(stem), benchmark.isolation_markdown(table))
         benchmark.isolation_heatmap(table, staged(stem.with_suffix(".png")))
         confusion = benchmark.isolation_confusion(table)
-        confusion.to_csv(staged(confusion_stem.with_suffix(".csv")))
+        csv_cells.escaped(confusion).to_csv(staged(confusion_stem.with_suffix(".csv")))
         benchmark.confusion_figure(confusion, staged(confusion_stem.with_suffix(".png")))
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
@@ -217,7 +218,7 @@ def detect_command(
     summary = benchmark.detection_summary(table)
     with atomic.output_set(written) as staged:  # all four outputs, or none
         benchmark.write_outputs(table, staged(stem))
-        summary.to_csv(staged(summary_csv))
+        csv_cells.escaped(summary).to_csv(staged(summary_csv))
         benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(table, digits=4))
     typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
@@ -306,9 +307,9 @@ def training_source_command(
     text = "\n\n".join(parts)
     with atomic.output_set(paths.values()) as staged:  # all outputs, or none
         if tukey is not None:
-            anova.to_csv(staged(paths["anova"]), index=False)
-            tukey.to_csv(staged(paths["tukey"]), index=False)
-        cases.to_csv(staged(paths["cases"]), index=False)
+            csv_cells.escaped(anova).to_csv(staged(paths["anova"]), index=False)
+            csv_cells.escaped(tukey).to_csv(staged(paths["tukey"]), index=False)
+        csv_cells.escaped(cases).to_csv(staged(paths["cases"]), index=False)
         staged(paths["md"]).write_text(text + "\n")
         ts.figure(cases, staged(paths["png"]), marked=tukey)
     typer.echo(text)
@@ -412,7 +413,7 @@ def classify_command(
         text = (benchmark.markdown(table, digits=3) + f"\n\nprotocol: {table.attrs['protocol']}. auc: the samples of "
                 f"{file} ranked by a model fitted on {train}; null: its mean over label sets with the tested runs' roles "
                 "exchanged (the chance level on these robots); p: the permutation p-value.")
-        table.to_csv(stem.with_suffix(".csv"))
+        csv_cells.escaped(table).to_csv(stem.with_suffix(".csv"))
         stem.with_suffix(".md").write_text(text + "\n")
         typer.echo(text)
         typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md")))
@@ -432,7 +433,7 @@ def classify_command(
     text = (benchmark.markdown(benchmark.classification_printed(table), digits=3) + "\n\n" + caption + "\n\n"
             + benchmark.classification_verdict(table, command))
     with atomic.output_set([stem.with_suffix(s) for s in (".csv", ".md", ".png")]) as staged:  # all, or none
-        benchmark.classification_tidy(table).to_csv(staged(stem.with_suffix(".csv")), index=False)
+        csv_cells.escaped(benchmark.classification_tidy(table)).to_csv(staged(stem.with_suffix(".csv")), index=False)
         staged(stem.with_suffix(".md")).write_text(text + "\n")
         benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")))
     typer.echo(text)

@@ -68,20 +68,27 @@ def import_command(
       faultgen info fleet-logs.h5 && faultgen detect fleet-logs.h5
     """
     from faultgen.data import adapters, fleetlogs
+    from faultgen.model import robots
 
     read = {}
+    if torque_constants is not None and log_format != "ur-rtde":
+        raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
+                         f"--format {log_format}")
     if log_format != "measured":
         options = {}
         if torque_constants is not None:
             try:
-                options["torque_constants"] = tuple(float(k) for k in torque_constants.split(","))
+                constants = tuple(float(k) for k in torque_constants.split(","))
             except ValueError:
-                raise ValueError(f"--torque-constants {torque_constants!r}: expected numbers, comma-separated "
-                                 "(N m/A per joint)") from None
+                constants = ()
+            lo, hi = adapters.MIN_TORQUE_CONSTANT, adapters.MAX_TORQUE_CONSTANT
+            n_axes = robots.load(robot).n_axes
+            if len(constants) != n_axes or not all(lo <= k <= hi for k in constants):
+                raise ValueError(f"--torque-constants {torque_constants[:200]!r}: expected {n_axes} numbers (the axes "
+                                 f"of {robot}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
+            options["torque_constants"] = constants
         adapter = adapters.make(log_format, **options)
         read = {"reader": functools.partial(adapter.read, accelerations=False), "suffixes": adapter.suffixes}
-    elif torque_constants is not None:
-        raise ValueError("--torque-constants reads UR's actual_current columns: give it with --format ur-rtde")
 
     # the command as provenance, with LOGS given as an absolute path stored by its name: a dataset
     # meant to be shared keeps no path of this machine (docs/reliability.md, "Log folders")

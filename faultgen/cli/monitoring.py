@@ -13,14 +13,28 @@ from faultgen.cli.main import app
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations.
 CACHE_ENTRIES = ("cycles", "calibrated")
 
+#: The fewest logs the monitor learns a unit from (faultgen.monitor.scoring.Settings), and the most
+#: logs --train and --persistence may name (years of a log an hour: beyond any fleet's record).
+MIN_TRAIN, MAX_LOGS = 10, 100_000
+
+
+def _output_folder(value: Path) -> Path:
+    """``--out``: a folder, or a path where one can be made; an existing file is refused before
+    any log is read (typer callback)."""
+    if value is not None and (value.exists() or value.is_symlink()) and not value.is_dir():
+        raise typer.BadParameter(f"{value} exists and is not a folder; OUT is the monitor's output folder "
+                                 "(give a new or an earlier run's folder)")
+    return value
+
 
 @app.command("monitor", cls=Command)
 def monitor_command(
     logs: Annotated[Path, typer.Argument(help="Fleet folder: LOGS/<unit>/<stamp>.csv (or .csv.gz, .h5).")],
     robot: Annotated[str, typer.Option(help="Robot the logs were recorded on: name, robot folder or MJCF file.")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder: alarms.csv, scores.csv, <unit>.png. "
-                                      "An earlier run's folder is continued: only new logs are scored. Another "
-                                      "folder that holds files is refused unless --overwrite.")],
+    out: Annotated[Path, typer.Option("--out", "-o", callback=_output_folder, help="Output folder: units.csv, "
+                                      "alarms.csv, scores.csv, <unit>.png. An earlier run's folder is continued: only "
+                                      "new logs are scored. Another folder that holds files is refused unless "
+                                      "--overwrite.")],
     calibrated: Annotated[Path | None, typer.Option(
         help="A `faultgen calibrate` output folder whose model every unit's twin uses (default: each unit's "
              "model calibrated on its first log).")] = None,
@@ -29,9 +43,12 @@ def monitor_command(
     protocol: Annotated[str, typer.Option(
         help="twin: residuals against the unit's twin, isolation by wear signatures; own: the features "
              "themselves, isolation by each axis's share of Q (no model).")] = "twin",
-    train: Annotated[int, typer.Option(help="Logs of each unit's normal operation the monitor learns from.")] = 28,
-    alpha: Annotated[float, typer.Option(help="Significance level of the T2 and Q limits.")] = 0.01,
-    persistence: Annotated[int, typer.Option(help="Consecutive logs over a limit that make an alarm.")] = 5,
+    train: Annotated[int, typer.Option(help="Logs of each unit's normal operation the monitor learns from.",
+                                       min=MIN_TRAIN, max=MAX_LOGS)] = 28,
+    alpha: Annotated[float, typer.Option(help="Significance level of the T2 and Q limits, below 0.5.",
+                                         min=1e-9, max=0.499)] = 0.01,
+    persistence: Annotated[int, typer.Option(help="Consecutive logs over a limit that make an alarm.",
+                                             min=1, max=MAX_LOGS)] = 5,
     wear_limit: Annotated[float, typer.Option(
         help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
              "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,

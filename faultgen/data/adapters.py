@@ -18,7 +18,9 @@ same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTE
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,6 +36,9 @@ from faultgen.operation import jointlog
 ADAPTERS: dict[str, type[Adapter]] = {}
 #: Largest foreign log read, bytes on disk.
 MAX_BYTES = 4 * 2**30
+#: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
+#: about 10: the motor's 0.1 times the gear ratio 101).
+MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
 
 
 def register(name: str):
@@ -74,7 +79,13 @@ def make(name: str, **options) -> Adapter:
     if name not in ADAPTERS:
         raise ValueError(f"unknown log format {name!r}; expected measured (the default) or one of "
                          f"{', '.join(ADAPTERS)}")
-    return ADAPTERS[name](**options)
+    cls = ADAPTERS[name]
+    known = [f.name for f in dataclasses.fields(cls) if f.name != "suffixes"]
+    unknown = [key for key in options if key not in known]
+    if unknown:
+        raise ValueError(f"log format {name} takes no option {', '.join(unknown)}"
+                         + (f"; its options: {', '.join(known)}" if known else ""))
+    return cls(**options)
 
 
 def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
@@ -114,10 +125,14 @@ class URRTDE(Adapter):
 
     def __post_init__(self) -> None:
         if self.torque_constants is not None:
-            constants = np.asarray(self.torque_constants, dtype=float)
-            if constants.ndim != 1 or not np.all(np.isfinite(constants)) or np.any(constants <= 0):
-                raise ValueError(f"torque constants {self.torque_constants!r}: expected one positive number (N m/A) "
-                                 "per axis")
+            try:
+                constants = np.asarray(self.torque_constants, dtype=float)
+            except (TypeError, ValueError):
+                constants = np.full(0, np.nan)
+            if constants.ndim != 1 or not constants.size or not np.all(
+                    (constants >= MIN_TORQUE_CONSTANT) & (constants <= MAX_TORQUE_CONSTANT)):
+                raise ValueError(f"torque constants {self.torque_constants!r}: expected one number in "
+                                 f"{MIN_TORQUE_CONSTANT:g} .. {MAX_TORQUE_CONSTANT:g} N m/A per axis")
 
     def columns(self, path: Path, robot: robots.Robot):
         n_axes = robot.n_axes
@@ -128,6 +143,10 @@ class URRTDE(Adapter):
             raise jointlog.LogBoundError(str(err)) from None
         except (OSError, UnicodeDecodeError, EOFError) as err:
             raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
+        twice = sorted(name for name, count in Counter(names).items() if count > 1)
+        if twice:
+            raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
+                                             "header")
         label = jointlog.csv_label
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]

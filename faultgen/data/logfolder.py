@@ -37,7 +37,9 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import re
+import stat
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
@@ -63,6 +65,8 @@ LINK_OUT = "a symbolic link out of the logs folder; links must stay inside the f
 
 #: Stamp kinds: a date or date-time (key: seconds since 1970-01-01 UTC) or a sequence number.
 TIME, SEQUENCE = "time", "sequence"
+#: Most digits of a sequence number (below 2^53: every one a distinct float key).
+MAX_SEQUENCE_DIGITS = 15
 
 _DATE_TIME = re.compile(r"(\d{4}-\d{2}-\d{2})(?:[T_ ](\d{2})[-:]?(\d{2})(?:[-:]?(\d{2}(?:\.\d+)?))?)?")
 
@@ -112,9 +116,14 @@ def parse_stamp(text: str, where: str) -> tuple[float, str]:
     Raises
     ------
     ValueError
-        If ``text`` is neither an ISO date or date-time nor a whole number; names ``where``.
+        If ``text`` is neither an ISO date or date-time nor a whole number of at most
+        :data:`MAX_SEQUENCE_DIGITS` ASCII digits; names ``where``.
     """
-    if text.isdigit():
+    if text.isdigit():  # ASCII digits only: "²" and "٣" are digits to str.isdigit, not to a sequence
+        if not (text.isascii() and len(text) <= MAX_SEQUENCE_DIGITS):
+            raise ValueError(f"{where}: stamp {_shown(text)}: expected a sequence number of at most "
+                             f"{MAX_SEQUENCE_DIGITS} digits 0-9 (17), an ISO date (2026-03-01) or an ISO date and time "
+                             "(2026-03-01T08:30:00)")
         return float(int(text)), SEQUENCE
     match = _DATE_TIME.fullmatch(text)
     try:
@@ -123,12 +132,16 @@ def parse_stamp(text: str, where: str) -> tuple[float, str]:
         else:
             day, hour, minute, second = match.groups()
             moment = datetime.fromisoformat(day if hour is None else f"{day}T{hour}:{minute}:{second or '00'}")
-    except ValueError:
-        raise ValueError(f"{where}: stamp {text!r} is neither an ISO date (2026-03-01), an ISO date and time "
+        key = (moment if moment.tzinfo is not None else moment.replace(tzinfo=timezone.utc)).timestamp()
+    except (ValueError, OverflowError):
+        raise ValueError(f"{where}: stamp {_shown(text)} is neither an ISO date (2026-03-01), an ISO date and time "
                          "(2026-03-01T08:30:00 or 2026-03-01T08-30-00) nor a sequence number (17)") from None
-    if moment.tzinfo is None:
-        moment = moment.replace(tzinfo=timezone.utc)
-    return moment.timestamp(), TIME
+    return key, TIME
+
+
+def _shown(text: str) -> str:
+    """A stamp for a message: quoted, cut to 40 characters (a 5000-digit stamp is not echoed)."""
+    return repr(text) if len(text) <= 40 else f"{text[:40]!r}... ({len(text)} characters)"
 
 
 def stamp_of(name: str, suffixes: tuple[str, ...]) -> str | None:
@@ -153,8 +166,9 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     ValueError
         If ``folder`` is not a folder or holds no unit folder; a unit folder or ``events.csv`` whose
         link leads out of ``folder`` (:class:`faultgen.inputs.InputError`, nothing behind it listed);
-        a file other than ``events.csv`` at its top; an entry that is neither a file nor a folder (a
-        broken link); two logs of one unit with the same stamp; one unit's stamps of both kinds.
+        a file other than ``events.csv`` at its top; an ``events.csv`` that is not a regular file; an
+        entry that is neither a file nor a folder (a FIFO, a broken link); a unit folder or log whose
+        name is not UTF-8; two logs of one unit with the same stamp; one unit's stamps of both kinds.
     """
     folder = Path(folder)
     if not folder.is_dir():
@@ -163,19 +177,24 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     for entry in sorted(folder.iterdir()):
         if entry.name.startswith("."):
             continue
+        _utf8(entry)
         inputs.within(entry, folder, FOLDER)
-        if entry.is_file():
-            if entry.name != "events.csv":
-                raise ValueError(f"{entry}: a file at the top of the logs folder; expected one folder per unit "
-                                 "(LOGS/<unit>/<stamp>.csv) and optionally events.csv")
+        if entry.name == "events.csv":
+            if not entry.is_file():
+                raise ValueError(f"{entry}: {_kind(entry)}; the events file must be a regular file (unit, stamp, "
+                                 "event, axis)")
             continue
+        if entry.is_file():
+            raise ValueError(f"{entry}: a file at the top of the logs folder; expected one folder per unit "
+                             "(LOGS/<unit>/<stamp>.csv) and optionally events.csv")
         if not entry.is_dir():
-            raise ValueError(f"{entry}: neither a unit folder nor events.csv (a broken symbolic link?); expected "
+            raise ValueError(f"{entry}: neither a unit folder nor events.csv ({_kind(entry)}); expected "
                              "one folder per unit (LOGS/<unit>/<stamp>.csv) and optionally events.csv")
         logs = []
         for path in sorted(entry.iterdir()):
             if path.name.startswith("."):
                 continue
+            _utf8(path)
             name = f"{entry.name}/{path.name}"
             if not inputs.inside(path, folder):
                 bad.append((name, LINK_OUT))
@@ -203,6 +222,26 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     if not units:
         raise ValueError(f"{folder}: no unit folders; expected LOGS/<unit>/<stamp>.csv|.csv.gz|.h5")
     return units, bad
+
+
+def _utf8(path: Path) -> None:
+    """Refuse a name that is not UTF-8 (a unit's name is stored as text in the dataset and the
+    monitor's tables), shown with its undecodable bytes escaped."""
+    try:
+        path.name.encode("utf-8")
+    except UnicodeEncodeError:
+        shown = os.fsencode(path).decode("utf-8", "backslashreplace")
+        raise ValueError(f"{shown}: the name is not UTF-8 text; rename it (unit folders and logs are named in "
+                         "UTF-8)") from None
+
+
+def _kind(path: Path) -> str:
+    """What ``path`` is, for a message: a folder, a FIFO, a broken symbolic link, ..."""
+    try:
+        info = path.stat()
+    except OSError:
+        return "a broken symbolic link" if path.is_symlink() else "not readable"
+    return "a regular file" if stat.S_ISREG(info.st_mode) else inputs._kind(info.st_mode)  # its wording of file kinds
 
 
 def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,

@@ -370,7 +370,7 @@ def _build(
     notes.extend(torque_notes(tau, robot))
     temperature = (np.column_stack([columns[c] for c in temperature_columns(robot.n_axes)])
                    if temperature_columns(robot.n_axes)[0] in columns else None)
-    cycle = _cycles(where, columns[CYCLE_COLUMN], label) if CYCLE_COLUMN in columns else None
+    cycle = _cycles(where, columns[CYCLE_COLUMN], label, t) if CYCLE_COLUMN in columns else None
 
     return MeasuredData(
         t=t,
@@ -388,18 +388,28 @@ def _build(
     )
 
 
-def _cycles(where: Path, values: np.ndarray, label) -> np.ndarray:
-    """The ``cycle`` column as whole numbers that never decrease, or refused at the first row that is not."""
-    fractional = np.flatnonzero(values != np.round(values))
+def _cycles(where: Path, values: np.ndarray, label, t: np.ndarray) -> np.ndarray:
+    """The ``cycle`` column as whole numbers 0..:data:`~faultgen.operation.jointlog.MAX_CYCLE` that
+    never decrease, each cycle but the log's first and last spanning at least
+    :data:`~faultgen.operation.jointlog.MIN_CYCLE_TIME` s, or refused at the first row that is not."""
+    fractional = np.flatnonzero((values != np.round(values)) | (values < 0) | (values > jointlog.MAX_CYCLE))
     if fractional.size:
         i = int(fractional[0])
-        raise MeasuredDataError(f"{where}: {label(i)}, column {CYCLE_COLUMN}: value {values[i]!r}; expected a whole "
-                                "cycle number")
+        raise MeasuredDataError(f"{where}: {label(i)}, column {CYCLE_COLUMN}: value {values[i]:.6g}; expected a whole "
+                                f"cycle number 0 .. {jointlog.MAX_CYCLE:g}")
     back = np.flatnonzero(np.diff(values) < 0)
     if back.size:
         i = int(back[0]) + 1
         raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN} goes back at {label(i)}: {values[i]:g} after "
                                 f"{values[i - 1]:g}; expected the samples of each cycle together, cycles in order")
+    starts = np.flatnonzero(np.diff(values)) + 1  # the first row of each cycle but the first
+    spans = t[starts[1:] - 1] - t[starts[:-1]]  # first to last sample of each cycle between the first and last
+    short = np.flatnonzero(spans < jointlog.MIN_CYCLE_TIME)
+    if short.size:
+        i = int(starts[short[0]])
+        raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN}: cycle {values[i]:g} from {label(i)} spans "
+                                f"{spans[short[0]]:.6g} s; expected cycles of at least {jointlog.MIN_CYCLE_TIME:g} s "
+                                "(but the log's first and last)")
     return values.astype(np.int64)
 
 

@@ -9,7 +9,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from faultgen.data import reader
+from faultgen.data import cells, reader
 from faultgen.data.atomic import atomic_path
 from faultgen.data.opening import attr, open_file
 from faultgen.data.schema import MEASURED, DatasetError
@@ -70,7 +70,7 @@ def export_features(path: str | Path, out: str | Path) -> Path:
         if out.name.lower().endswith(".parquet"):
             table.to_parquet(tmp, index=False)
         else:
-            table.to_csv(tmp, index=False, compression="gzip" if out.name.lower().endswith(".gz") else None)
+            cells.escaped(table).to_csv(tmp, index=False, compression="gzip" if out.name.lower().endswith(".gz") else None)
     return out
 
 

@@ -131,6 +131,9 @@ def attribute_problems(group: h5py.Group) -> list[str]:
                 value = attrs[key]
                 shown = value.tolist() if isinstance(value, (np.ndarray, np.generic)) else value
                 problems.append(f"attribute {key!r} is {shown!r}, expected {expected}")
+    if "n_axes" in attrs and not _axis_count(attrs["n_axes"]):  # every reader sizes its arrays with it
+        problems.append(f"n_axes attribute {attrs['n_axes']}, expected a whole number "
+                        f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}")
     for key in ("wear", "noise", "config", "conditions", "fault"):
         if key in attrs:
             try:
@@ -141,6 +144,12 @@ def attribute_problems(group: h5py.Group) -> list[str]:
             if not isinstance(table, dict):
                 problems.append(f"attribute {key!r} is {str(attrs[key])[:40]!r}, expected a JSON table")
     return problems
+
+
+def _axis_count(value) -> bool:
+    """Whether an ``n_axes`` attribute is a whole number of axes MIN_AXES..MAX_AXES."""
+    return bool(np.ndim(value) == 0 and np.issubdtype(np.asarray(value).dtype, np.integer)
+                and axis_numbers.MIN_AXES <= int(value) <= axis_numbers.MAX_AXES)
 
 
 def _program_problems(attrs) -> list[str]:
@@ -252,8 +261,7 @@ def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
     problems = []
     if "n_axes" in group.attrs:
         n_axes = group.attrs["n_axes"]
-        if not (np.ndim(n_axes) == 0 and np.issubdtype(np.asarray(n_axes).dtype, np.integer)
-                and axis_numbers.MIN_AXES <= int(n_axes) <= axis_numbers.MAX_AXES):
+        if not _axis_count(n_axes):
             return 0, [f"n_axes attribute {n_axes}, expected a whole number "
                        f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}"]
         n_axes = int(n_axes)

@@ -2,7 +2,8 @@
 
 Text cells that a spreadsheet would take for a formula (starting with ``=``, ``+``, ``-``, ``@``, a
 tab or a carriage return: a unit folder named ``=HYPERLINK(...)``) are written with a leading
-``'`` (OWASP, "CSV Injection"); numbers are written as numbers."""
+``'`` (OWASP, "CSV Injection", :mod:`faultgen.data.cells`, as every CSV faultgen writes); numbers
+are written as numbers."""
 
 from __future__ import annotations
 
@@ -11,19 +12,19 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen.data import cells
+
 ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
 
 
 UNIT_COLUMNS = ("unit", "status", "protocol", "model", "reason", "logs_scored", "last_log")
-_FORMULA = ("=", "+", "-", "@", "\t", "\r")
 
 
 def _fmt(value) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
-    text = str(value)
-    return "'" + text if isinstance(value, str) and text.startswith(_FORMULA) else text
+    return cells.text(value) if isinstance(value, str) else str(value)
 
 
 def write_units(path: Path, statuses) -> None:

@@ -92,6 +92,22 @@ MIN_DURATION = 2.0
 JOINT_RANGE_TOLERANCE = 0.05
 #: Angles beyond a full turn plus this margin (rad) cannot be radians of a revolute arm joint.
 FULL_TURN_MARGIN = 0.1
+#: The values a log may hold, per column (prefix) -> (low, high, unit, what it is likely to be when
+#: outside): no robot comes near them, and past them the features and fits overflow (a torque of
+#: 1e300 squared) instead of naming the row. Angles are bounded by the robot's joint range
+#: (:func:`check_angles`), cycle numbers by :data:`MAX_CYCLE`.
+VALUE_BOUNDS = {
+    T_COLUMN: (-1e10, 1e10, "s", "seconds since 1970 reach 2e9"),
+    "qd": (-1e5, 1e5, "rad/s", "the fastest wrists turn 20 rad/s"),
+    "tau": (-1e7, 1e7, "N m", "the largest arms' axes carry 1e5 N m"),
+    TEMPERATURE_PREFIX: (-60.0, 250.0, "degC", "in deg C, not K or deg F"),
+    PAYLOAD_COLUMN: (0.0, 1e4, "kg", "the largest arms carry 2.3 t"),
+}
+#: Largest cycle number of a log (a cycle a second for 30 years); cycle numbers are >= 0.
+MAX_CYCLE = 10**9
+#: Shortest cycle, s, but a log's first and last (which its ends may cut): a ``cycle`` column that
+#: starts a new cycle every few samples is refused (each cycle's features are computed apart).
+MIN_CYCLE_TIME = 0.1
 
 
 class LogError(ValueError):
@@ -430,6 +446,26 @@ def _unit_key(unit: str) -> str:
 
 
 
+def check_values(where: Path, columns: dict[str, np.ndarray], label) -> None:
+    """Refuse the first row whose value lies outside :data:`VALUE_BOUNDS` (naming the file, the
+    column, the data row, the value and the bound)."""
+    first = None
+    for name, values in columns.items():
+        stem = name.rstrip("0123456789")
+        key = name if name in (T_COLUMN, PAYLOAD_COLUMN) else stem if stem != name else None
+        if key not in VALUE_BOUNDS:
+            continue
+        low, high, _, _ = VALUE_BOUNDS[key]
+        bad = np.flatnonzero((values < low) | (values > high))
+        if bad.size and (first is None or bad[0] < first[0]):
+            first = (int(bad[0]), name, key)
+    if first is not None:
+        row, name, key = first
+        low, high, unit, hint = VALUE_BOUNDS[key]
+        raise LogError(f"{where}: {label(row)}, column {name}: value {float(columns[name][row]):.6g} {unit}; expected "
+                       f"{low:g} .. {high:g} {unit} ({hint})")
+
+
 def refuse_non_finite(where: Path, columns: dict[str, np.ndarray], order: list[str], label) -> None:
     first = None
     for name in order:
@@ -564,8 +600,10 @@ def motion(columns: dict[str, np.ndarray], robot: robots.Robot, where: Path, lab
     Raises
     ------
     LogError
-        As :func:`check_time` and :func:`check_angles`, naming the file, the column and the row.
+        As :func:`check_values`, :func:`check_time` and :func:`check_angles`, naming the file, the
+        column and the row.
     """
+    check_values(where, columns, label)
     t = columns[T_COLUMN]
     dt, period = check_time(t, where, label, notes, min_duration, min_rate)
     q = np.column_stack([columns[c] for c in column_names(robot.n_axes)[0]])

@@ -108,6 +108,12 @@ class ProgramBoundError(ProgramError, inputs.InputError):
 TOP_KEYS = ("name", "robot", "process", "description", "start", "velocity_scale", "acceleration_scale", "limits",
             "tool", "segment")
 LIMIT_KEYS = ("velocity", "acceleration", "jerk")
+#: The bounds of each of a robot's [limits], deg/s, deg/s^2, deg/s^3: around those a robot
+#: description may give (faultgen.model.limits: speeds of 1e-3 .. 100 rad/s, 0.057 .. 5730 deg/s)
+#: and those faultgen.operation.taskgen derives from them; the thesis robots' are 95-210, 250-700
+#: and 1250-6000.
+LIMIT_BOUNDS = {"velocity": (0.05, 6000.0, "deg/s"), "acceleration": (0.05, 1e6, "deg/s^2"),
+                "jerk": (0.05, 1e8, "deg/s^3")}
 TOOL_KEYS = ("z", "x", "offset")
 
 def is_file_task(task: str) -> bool:
@@ -407,7 +413,16 @@ def _limits(data: dict, robot: Robot, where: str) -> tuple[np.ndarray, np.ndarra
         origin = str(folder_file)
     values = Table(origin, "[limits] ", table if isinstance(table, dict) else {}, LIMIT_KEYS)
     n = len(robot.joint_names)
-    return tuple(values.array(key, (n,), np.pi / 180, positive=True) for key in LIMIT_KEYS)
+    limits = []
+    for key in LIMIT_KEYS:
+        given = values.array(key, (n,), 1.0, positive=True)
+        low, high, unit = LIMIT_BOUNDS[key]
+        outside = np.flatnonzero((given < low) | (given > high))
+        if outside.size:
+            values.fail(key, f"axis {outside[0] + 1}: {given[outside[0]]:g} {unit}; expected {low:g} .. {high:g} {unit} "
+                             "on every axis")
+        limits.append(given * (np.pi / 180))  # as Table.array scales: the same floats, the same plans
+    return tuple(limits)
 
 
 def _segment(where: str, number: int, table, robot: Robot) -> Segment:

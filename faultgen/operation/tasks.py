@@ -197,8 +197,14 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
     inp.max_jerk = jerk
     inp.duration_discretization = DurationDiscretization.Discrete
     trajectory = Trajectory(n)
-    if otg.calculate(inp, trajectory) not in (Result.Working, Result.Finished):
-        raise ValueError(f"{where}: ruckig found no move to {np.round(q_to, 4)}")
+    try:
+        result = otg.calculate(inp, trajectory)
+    except ValueError:  # a code its Python enum lacks, e.g. -101: the duration beyond ruckig's numbers
+        result = None
+    if result not in (Result.Working, Result.Finished):
+        raise ValueError(f"{where}: ruckig found no move to {np.round(q_to, 4)} within the limits (velocity "
+                         f"{np.round(np.rad2deg(velocity), 4)} deg/s, acceleration {np.round(np.rad2deg(acceleration), 4)} "
+                         f"deg/s^2, jerk {np.round(np.rad2deg(jerk), 4)} deg/s^3)")
     check_cycle_length(trajectory.duration, dt, where)
     steps = round(trajectory.duration / dt)
     samples = [trajectory.at_time(k * dt) for k in range(steps)]
