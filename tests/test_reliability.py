@@ -258,7 +258,6 @@ def test_an_interrupted_calibrate_leaves_nothing_that_blocks_a_rerun(moving_log,
     os.close(read)
     message = b"".join(stderr).lstrip(b"\0").decode(errors="replace")
     assert proc.returncode == 130, stdout + message  # interrupted (SIGINT), not failed
-    assert "fitting effects" not in message, message  # its first write to stderr, the bar, was never made
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # OUT absent: a rerun is not refused
 
 
