@@ -268,10 +268,12 @@ def test_a_sweep_in_the_background_terminated_with_its_group_says_how_to_resume(
         wait_for(lambda: (parts / "sweep.json").exists() and len(workers(mark)) >= 2, "two workers")
         os.killpg(proc.pid, signal.SIGTERM)  # the sweep, its workers and loky's resource tracker
         stdout, stderr = proc.communicate(timeout=120)
-        wait_for(lambda: not marked(mark), "every process of the sweep to end", seconds=10)
+        wait_for(lambda: not marked(mark), "every process of the sweep to end")  # a deadline, not a delay
     finally:
         for p in marked(mark):
             p.kill()
+    # counted once nothing of the sweep runs: equal to the message's count, counted after it stopped its
+    # workers, only if no worker went on to finish a run (no fixed wait for them)
     kept = len(list(parts.glob("*.h5")))
     assert proc.returncode == 143, stdout + stderr
     assert stderr.strip() == (f"terminated (SIGTERM): {kept} of 4 runs kept in {parts}; run the same command to "

@@ -24,8 +24,9 @@ from faultgen.runs import sweep
 
 runner = CliRunner()
 CLI = [sys.executable, "-m", "faultgen.cli"]
-# 4 runs of 40 cycles: each keeps a worker busy for longer than the 10 s the test gives the workers
-# to end once the sweep is killed (they end at once; before issue 42 they finished their runs)
+# 4 runs of 40 cycles (each keeps a worker busy for over 10 s): a sweep killed once its two workers
+# have started has runs under way. Its workers end at once and write nothing more (before issue 42
+# they finished their runs): the tests check the runs kept once every process has ended, not a clock
 GRID_ARGS = ["--robot", "irb6700", "--task", "pick_place", "--task", "spot_weld", "--axis", "0", "--axis", "2",
              "--cycles", "40", "--no-progress"]
 
@@ -77,11 +78,15 @@ def test_a_killed_sweep_leaves_no_worker_running(tmp_path, how):
         wait_for(lambda: (parts / "sweep.json").exists() and len(workers(mark)) >= 2, "two workers")
         proc.send_signal(how)  # the sweep's own process only, as `kill PID` does
         stdout, stderr = proc.communicate(timeout=120)
+        # its workers stopped (SIGTERM: before the sweep ends) or were sent SIGKILL as it ended
+        # (PR_SET_PDEATHSIG): what is kept now is all there will be
+        at_the_end = sorted(parts.glob("*.h5"))
         # every process the sweep started (workers, resource trackers) ends: none is left orphaned
-        wait_for(lambda: not marked(mark), "every process of the sweep to end", seconds=10)
+        wait_for(lambda: not marked(mark), "every process of the sweep to end")
     finally:
         for p in marked(mark):
             p.kill()
+    assert sorted(parts.glob("*.h5")) == at_the_end  # no worker went on to finish its run
     assert not out.exists()
     if how == signal.SIGTERM:
         kept = len(list(parts.glob("*.h5")))
@@ -198,15 +203,61 @@ def test_calibrate_refuses_a_log_without_motion_naming_the_joints_and_writes_not
     assert "ZeroDivisionError" not in result.output and sorted(p.name for p in tmp_path.iterdir()) == ["still.csv"]
 
 
+def full_pipe() -> tuple[int, int]:
+    """A pipe (read end, write end) whose buffer is already full: a child given the write end blocks
+    in its first write to it, there and nowhere else, until the test reads the read end. The
+    writer is halted at a known point whatever the machine's load."""
+    read, write = os.pipe()
+    os.set_blocking(write, False)
+    for size in (65536, 1):  # then byte by byte: the last page too
+        try:
+            while True:
+                os.write(write, b"\0" * size)
+        except BlockingIOError:
+            pass
+    os.set_blocking(write, True)  # the child's writes wait
+    return read, write
+
+
+def as_a_terminal_starts_it() -> None:
+    """``preexec_fn``: SIGINT at its default action, as a shell starts a foreground command. A test
+    process started in the background by a non-interactive shell has SIGINT ignored, and an ignored
+    signal stays ignored across exec: the child would not stop on it (tests/test_sweep.py)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def test_an_interrupted_calibrate_leaves_nothing_that_blocks_a_rerun(moving_log, tmp_path):
+    """Interrupted inside the staging folder, at a known point: calibrate's first write to stderr
+    is its progress bar, after the staging folder holds model/tasks.toml (the point at which main
+    left OUT/model/tasks.toml); with stderr a full pipe it waits there, so it cannot finish before
+    the interrupt, however loaded the machine (on this log the search takes about a second)."""
+    import threading
+
     out = tmp_path / "out"
+    read, write = full_pipe()
     proc = subprocess.Popen([*CLI, "calibrate", "--robot", "puma560", "--measured", str(moving_log), "--out", str(out)],
-                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    # the staging folder holds the model's tasks.toml: the point at which main left OUT/model/tasks.toml
-    wait_for(lambda: any(tmp_path.glob(".out.*.part/model/tasks.toml")) or proc.poll() is not None, "calibrate to write")
-    proc.send_signal(signal.SIGINT)
-    proc.communicate(timeout=120)
-    assert proc.returncode != 0
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=write, text=True,
+                            env={k: v for k, v in os.environ.items() if not k.startswith("TQDM_")},  # the bar shown
+                            preexec_fn=as_a_terminal_starts_it)  # noqa: PLW1509 (no threads of ours here)
+    os.close(write)
+    stderr: list[bytes] = []
+    try:
+        wait_for(lambda: any(tmp_path.glob(".out.*.part/model/tasks.toml")) or proc.poll() is not None,
+                 "calibrate to write model/tasks.toml into its staging folder")
+        assert proc.poll() is None, "calibrate ended before it wrote model/tasks.toml"
+        proc.send_signal(signal.SIGINT)
+        drain = threading.Thread(target=lambda: stderr.extend(iter(lambda: os.read(read, 65536), b"")), daemon=True)
+        drain.start()  # what it writes as it stops, then end of file
+        stdout, _ = proc.communicate(timeout=120)
+        drain.join(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    os.close(read)
+    message = b"".join(stderr).lstrip(b"\0").decode(errors="replace")
+    assert proc.returncode == 130, stdout + message  # interrupted (SIGINT), not failed
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # OUT absent: a rerun is not refused
 
 
