@@ -56,7 +56,7 @@ def test_a_folder_of_other_files_is_refused_unless_overwrite_and_an_earlier_outp
     assert _monitor(fleet, killed).exit_code == 0 and (killed / "alarms.csv").is_file()
     (tmp_path / "file").write_text("x")
     result = _monitor(fleet, tmp_path / "file")
-    assert result.exit_code == 2 and "is a file" in result.output and (tmp_path / "file").read_text() == "x"
+    assert result.exit_code == 2 and "is not a folder" in result.output and (tmp_path / "file").read_text() == "x"
 
 
 @pytest.mark.parametrize("where", ["LOGS", "LOGS/mon", "LOGS/u1", "LOGS/../LOGS/mon", ".", "link"])

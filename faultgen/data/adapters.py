@@ -197,10 +197,16 @@ def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str
         pass
     del parts
     start = 0
-    with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
-        for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
-            _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
-            start += len(frame)
+    try:
+        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+            for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
+                _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
+                start += len(frame)
+    except (inputs.InputError, measured.MeasuredDataError):
+        raise
+    except (ValueError, OSError, EOFError) as err:  # pandas's ParserError (an unbalanced quote) is a ValueError
+        raise measured.MeasuredDataError(f"{path}: cannot read the file as an RTDE recorder CSV: "
+                                         f"{' '.join(str(err).split())}") from None
     raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
 
