@@ -532,3 +532,49 @@ def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(
     loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
     for name in ("alarms.csv", "scores.csv"):
         assert (again / name).read_text() == (out / name).read_text(), name
+
+
+def test_ur_rtde_recordings_are_monitored_with_their_joint_temperatures(fleet, tmp_path):
+    """The fleet's logs written as Universal Robots' RTDE recordings (space-separated,
+    ``timestamp, actual_q_i, target_moment_i, joint_temperatures_i``) and as measured logs with the
+    same numbers: `monitor --format ur-rtde` scores them as the measured ones, the temperature
+    included (the state's temperatures are the logged ones), and says which torque it took
+    (issue 60, part 5: the adapter dropped the temperatures, and monitor had no --format)."""
+    import csv
+    import json
+
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+
+    robot, logs, _ = fleet
+    rtde, plain = tmp_path / "rtde", tmp_path / "plain"
+    for log in sorted(logs.rglob("*.csv"))[::2]:  # every other day: 20 logs a unit
+        header, *rows = log.read_text().splitlines()
+        names = header.split(",")
+        table = np.array([[float(c) for c in row.split(",")] for row in rows])
+        keep = [names.index(n) for n in names if n != "payload"]
+        for folder in (rtde, plain):
+            (folder / log.parent.name).mkdir(parents=True, exist_ok=True)
+        np.savetxt(plain / log.parent.name / log.name, table[:, keep], delimiter=",",
+                   header=",".join(names[k] for k in keep), comments="", fmt="%.17g")
+        order = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7)),
+                 *(f"temperature{i}" for i in range(1, 7))]
+        ur = ["timestamp", *(f"actual_q_{i}" for i in range(6)), *(f"target_moment_{i}" for i in range(6)),
+              *(f"joint_temperatures_{i}" for i in range(6))]
+        np.savetxt(rtde / log.parent.name / log.name, table[:, [names.index(n) for n in order]], delimiter=" ",
+                   header=" ".join(ur), comments="", fmt="%.17g")
+    common = ["--robot", str(robot), "--protocol", "own", "--train", "10", "--persistence", "3"]
+    runs = {}
+    for name, folder, extra in (("plain", plain, []), ("rtde", rtde, ["--format", "ur-rtde"])):
+        result = CliRunner().invoke(app, ["monitor", str(folder), "-o", str(tmp_path / f"out-{name}"), *common, *extra])
+        assert result.exit_code == 0, result.output
+        runs[name] = tmp_path / f"out-{name}"
+    for name in ("alarms.csv", "scores.csv"):
+        assert (runs["rtde"] / name).read_text() == (runs["plain"] / name).read_text(), name
+    state = json.loads((runs["rtde"] / ".state" / "unit01.json").read_text())
+    first = np.loadtxt(sorted((rtde / "unit01").iterdir())[0], skiprows=1)
+    assert state["logs"][0]["temperature_C"] == pytest.approx(first[:, 13:19].mean(), rel=1e-12)
+    with open(runs["rtde"] / "units.csv", newline="") as f:
+        reasons = {row["unit"]: row["reason"] for row in csv.DictReader(f)}
+    assert all("torque from target_moment_i (the controller's commanded moment" in r for r in reasons.values())

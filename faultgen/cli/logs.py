@@ -12,7 +12,7 @@ import typer
 
 from faultgen.cli.base import Command, Group
 from faultgen.cli.main import app
-from faultgen.cli.options import Progress
+from faultgen.cli.options import LogFormat, Progress, TorqueConstants, log_adapter
 
 logs_app = typer.Typer(cls=Group, no_args_is_help=True, add_completion=False, rich_markup_mode=None)
 app.add_typer(logs_app, name="logs")
@@ -42,13 +42,8 @@ def import_command(
     reimport_changed: Annotated[bool, typer.Option(
         "--reimport-changed", help="Import again a log whose content changed since it was imported (without it, "
         "such a log is refused, named).")] = False,
-    log_format: Annotated[str, typer.Option(
-        "--format", help="The logs' layout: measured (t, q1..qN, tau1..tauN; docs/dataset.md), ur-rtde (Universal "
-        "Robots' RTDE recorder CSV) or voraus (the voraus-AD Parquet columns; CC BY-NC-SA data: use your own copy).")
-    ] = "measured",
-    torque_constants: Annotated[str | None, typer.Option(
-        metavar="K1,...,KN", help="With --format ur-rtde: N m/A at each joint, to read the torque from "
-        "actual_current_0.. when the file has no target_moment_0.. columns.")] = None,
+    log_format: LogFormat = "measured",
+    torque_constants: TorqueConstants = None,
     progress: Progress = True,
 ) -> None:
     """Import a fleet's measured logs as a dataset: one run per unit, one record per log, with the
@@ -67,28 +62,11 @@ def import_command(
       faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5 --skip-bad
       faultgen info fleet-logs.h5 && faultgen detect fleet-logs.h5
     """
-    from faultgen.data import adapters, fleetlogs
-    from faultgen.model import robots
+    from faultgen.data import fleetlogs
 
-    read = {}
-    if torque_constants is not None and log_format != "ur-rtde":
-        raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
-                         f"--format {log_format}")
-    if log_format != "measured":
-        options = {}
-        if torque_constants is not None:
-            try:
-                constants = tuple(float(k) for k in torque_constants.split(","))
-            except ValueError:
-                constants = ()
-            lo, hi = adapters.MIN_TORQUE_CONSTANT, adapters.MAX_TORQUE_CONSTANT
-            n_axes = robots.load(robot).n_axes
-            if len(constants) != n_axes or not all(lo <= k <= hi for k in constants):
-                raise ValueError(f"--torque-constants {torque_constants[:200]!r}: expected {n_axes} numbers (the axes "
-                                 f"of {robot}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
-            options["torque_constants"] = constants
-        adapter = adapters.make(log_format, **options)
-        read = {"reader": functools.partial(adapter.read, accelerations=False), "suffixes": adapter.suffixes}
+    adapter = log_adapter(log_format, torque_constants, robot)
+    read = {} if adapter is None else {"reader": functools.partial(adapter.read, accelerations=False),
+                                       "suffixes": adapter.suffixes}
 
     # the command as provenance, with LOGS given as an absolute path stored by its name: a dataset
     # meant to be shared keeps no path of this machine (docs/reliability.md, "Log folders")

@@ -9,6 +9,7 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
+from faultgen.cli.options import LogFormat, TorqueConstants, log_adapter
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations.
 CACHE_ENTRIES = ("cycles", "calibrated")
@@ -52,6 +53,8 @@ def monitor_command(
     wear_limit: Annotated[float, typer.Option(
         help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
              "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
+    log_format: LogFormat = "measured",
+    torque_constants: TorqueConstants = None,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -84,6 +87,10 @@ def monitor_command(
     2 when the run is refused before any work (bad option, robot, folder or OUT). OUT must lie apart
     from LOGS (neither inside it nor holding it); a run that fails leaves no OUT it made.
 
+    Logs in another layout: --format ur-rtde (Universal Robots' RTDE recorder; joint temperatures
+    kept; the torque is the measured actual current times --torque-constants, or else the commanded
+    target moment, which units.csv says) or --format voraus, as `faultgen logs import` reads them.
+
     A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
     with closed and closed_by) and the unit learns its offset again from the next logs.
 
@@ -105,11 +112,12 @@ def monitor_command(
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
+    adapter = log_adapter(log_format, torque_constants, robot)
     check_monitor_out(out, logs, overwrite)
     made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                               twin_temperature=twin_temperature, progress=True)
+                               twin_temperature=twin_temperature, progress=True, log_format=adapter)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise

@@ -25,6 +25,12 @@ MAX_PERMUTATIONS = 10_000
 #: The ``--overwrite`` flag of every command that writes: without it an existing output is refused.
 Overwrite = Annotated[bool, typer.Option("--overwrite", help="Replace existing outputs; without it they are refused.")]
 Progress = Annotated[bool, typer.Option(help="Show a progress bar.")]
+LogFormat = Annotated[str, typer.Option(
+    "--format", help="The logs' layout: measured (t, q1..qN, tau1..tauN; docs/dataset.md), ur-rtde (Universal "
+    "Robots' RTDE recorder CSV) or voraus (the voraus-AD Parquet columns; CC BY-NC-SA data: use your own copy).")]
+TorqueConstants = Annotated[str | None, typer.Option(
+    metavar="K1,...,KN", help="With --format ur-rtde: N m/A at each joint, to read the torque as the measured "
+    "actual_current_0.. times them (without it: the commanded target_moment_0..).")]
 Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run is started; more than the CPU cores only slows each down).", min=1, max=1024)]
 
 
@@ -119,3 +125,36 @@ def conditions_from_options(temperature: bool, payloads: str | None, pattern: st
         task_mix=c.TaskMix(tuple(t.strip() for t in task_mix.split(",")), task_pattern) if task_mix else None,
         cycles_per_day=cycles_per_day, start_day=start_day)
     return made if made.active else None
+
+
+def log_adapter(log_format: str, torque_constants: str | None, robot: str):
+    """The :class:`faultgen.data.adapters.Adapter` of ``--format`` (None for the measured format)
+    with ``--torque-constants`` parsed and checked against ``robot``'s axes.
+
+    Raises
+    ------
+    ValueError
+        An unknown format; torque constants with another format than ur-rtde, not numbers, not one
+        per axis or outside their bounds (named).
+    """
+    from faultgen.data import adapters
+    from faultgen.model import robots
+
+    if torque_constants is not None and log_format != "ur-rtde":
+        raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
+                         f"--format {log_format}")
+    if log_format == "measured":
+        return None
+    options = {}
+    if torque_constants is not None:
+        try:
+            constants = tuple(float(k) for k in torque_constants.split(","))
+        except ValueError:
+            constants = ()
+        lo, hi = adapters.MIN_TORQUE_CONSTANT, adapters.MAX_TORQUE_CONSTANT
+        n_axes = robots.load(robot).n_axes
+        if len(constants) != n_axes or not all(lo <= k <= hi for k in constants):
+            raise ValueError(f"--torque-constants {torque_constants[:200]!r}: expected {n_axes} numbers (the axes "
+                             f"of {robot}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
+        options["torque_constants"] = constants
+    return adapters.make(log_format, **options)

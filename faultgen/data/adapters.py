@@ -7,9 +7,10 @@ same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTE
 ``faultgen logs import --format NAME``; docs/dataset.md, "Adapters", gives each layout.
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
-  ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s), and
-  the joint torque as ``target_moment_0..5`` (N m) or, with ``torque_constants`` given (N m/A at
-  the joint, one per axis), as ``actual_current_0..5`` (A) times them.
+  ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
+  ``joint_temperatures_0..5`` (deg C, all or none), and the joint torque: with ``torque_constants``
+  given (N m/A at the joint, one per axis), the measured ``actual_current_0..5`` (A) times them;
+  without, the commanded ``target_moment_0..5`` (N m). Which one was taken is the log's note.
 - ``voraus``: the voraus-AD dataset's Parquet layout (Brockmann et al. 2023, CC BY-NC-SA 4.0: never
   shipped with faultgen; read from your copy): ``time`` (s), ``joint_position_1..6`` (rad),
   ``joint_velocity_1..6`` (rad/s) and ``motor_torque_1..6`` (N m at the motor, referred to the
@@ -18,9 +19,8 @@ same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTE
 
 from __future__ import annotations
 
-from collections import Counter
-from collections.abc import Callable
 import dataclasses
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -58,14 +58,17 @@ class Adapter:
     name = ""
     suffixes: tuple[str, ...] = ()
 
-    def columns(self, path: Path, robot: robots.Robot) -> tuple[dict[str, np.ndarray], Callable[[int], str]]:
+    def columns(self, path: Path, robot: robots.Robot) -> tuple:
+        """``(columns, label)`` or ``(columns, label, notes)``: the file's columns under the
+        measured format's names, the data-row labeller of messages, and what the reading chose
+        (which torque source, say), kept in :attr:`faultgen.data.measured.MeasuredData.notes`."""
         raise NotImplementedError
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
         as :func:`faultgen.data.measured.read`)."""
-        columns, label = self.columns(Path(path), robot)
-        return measured.from_columns(columns, robot, path, label, accelerations)
+        columns, label, *notes = self.columns(Path(path), robot)
+        return measured.from_columns(columns, robot, path, label, accelerations, notes=notes[0] if notes else ())
 
 
 def make(name: str, **options) -> Adapter:
@@ -153,17 +156,24 @@ class URRTDE(Adapter):
         qd = [f"actual_qd_{k}" for k in axes]
         moment = [f"target_moment_{k}" for k in axes]
         current = [f"actual_current_{k}" for k in axes]
-        if all(c in names for c in moment):
-            torque, scale = moment, np.ones(n_axes)
-        elif self.torque_constants is not None and all(c in names for c in current):
+        temperature = [f"joint_temperatures_{k}" for k in axes]
+        if self.torque_constants is not None and all(c in names for c in current):
             if len(self.torque_constants) != n_axes:
                 raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
             torque, scale = current, np.asarray(self.torque_constants, dtype=float)
+            source = "torque from actual_current_i x the torque constants given (measured)"
+        elif all(c in names for c in moment):
+            torque, scale = moment, np.ones(n_axes)
+            source = ("torque from target_moment_i (the controller's commanded moment, not a measurement; "
+                      "--torque-constants K1,...,KN reads the measured actual_current_i instead)"
+                      + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
         else:
             raise measured.MeasuredDataError(
                 f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
                 f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
-        wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else [])]
+        with_temperature = all(c in names for c in temperature)
+        wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else []),
+                  *(temperature if with_temperature else [])]
         _require(path, names, wanted, "RTDE recorder")
         jointlog.csv_rows(path, len(wanted), "an RTDE log", "RTDE log")
         values = _rtde_numbers(path, names, separator, wanted, label)
@@ -173,7 +183,9 @@ class URRTDE(Adapter):
         out.update({tau_names[k]: values[torque[k]] * scale[k] for k in axes})
         if qd[0] in values:
             out.update({qd_names[k]: values[qd[k]] for k in axes})
-        return out, label
+        if with_temperature:
+            out.update({name: values[temperature[k]] for k, name in enumerate(jointlog.temperature_columns(n_axes))})
+        return out, label, (source,)
 
 
 def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str], label) -> dict[str, np.ndarray]:

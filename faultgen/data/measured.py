@@ -284,7 +284,7 @@ def from_arrays(
 
 
 def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
-                 label=None, accelerations: bool = True) -> MeasuredData:
+                 label=None, accelerations: bool = True, notes: tuple[str, ...] = ()) -> MeasuredData:
     """Check and complete the columns of a log in another layout, mapped onto this format's names
     (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
     ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
@@ -297,6 +297,8 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
         The file they came from, named in messages.
     label : callable, optional
         Data row index -> its description in messages (default: 1-based row and 0-based index).
+    notes : tuple of str
+        What the adapter chose (its torque source), first in :attr:`MeasuredData.notes`.
 
     Raises
     ------
@@ -313,7 +315,7 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
         raise MeasuredDataError(f"{where}: columns of different lengths {sorted(lengths)}")
     values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
     jointlog.refuse_non_finite(where, values, wanted, label)
-    return _build(values, robot, where, label, [], accelerations)
+    return _build(values, robot, where, label, list(notes), accelerations)
 
 
 def _compression(path: Path) -> str | None:

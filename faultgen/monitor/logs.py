@@ -6,6 +6,7 @@ records) and its logged conditions (joint temperature, payload; :mod:`faultgen.d
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -26,8 +27,23 @@ FEATURES = ("rms_torque", "average_load_torque")
 Log = logfolder.LogFile
 
 
-def fleet(logs_dir: str | Path) -> dict[str, list[Log]]:
-    """The units of a fleet folder and each unit's logs in stamp order.
+#: A log reader: (path, robot) -> the checked log (:func:`faultgen.data.measured.read`, or an
+#: adapter's, :mod:`faultgen.data.adapters`).
+Reader = Callable[[Path, Robot], measured.MeasuredData]
+
+
+def reader_of(adapter=None) -> tuple[Reader, tuple[str, ...]]:
+    """The reader and the file suffixes of a log format: the measured format's without ``adapter``,
+    else the adapter's (:class:`faultgen.data.adapters.Adapter`, accelerations not estimated: the
+    import's reading of the same files)."""
+    if adapter is None:
+        return measured.read, fleetlogs.SUFFIXES
+    return (lambda path, robot: adapter.read(path, robot, accelerations=False)), adapter.suffixes
+
+
+def fleet(logs_dir: str | Path, suffixes: tuple[str, ...] = fleetlogs.SUFFIXES) -> dict[str, list[Log]]:
+    """The units of a fleet folder and each unit's logs (files ending in one of ``suffixes``) in
+    stamp order.
 
     Raises
     ------
@@ -35,7 +51,7 @@ def fleet(logs_dir: str | Path) -> dict[str, list[Log]]:
         As :func:`faultgen.data.logfolder.scan`, or for a file in a unit folder that is not a log
         (named, with what was expected).
     """
-    units, bad = logfolder.scan(Path(logs_dir), fleetlogs.SUFFIXES)
+    units, bad = logfolder.scan(Path(logs_dir), suffixes)
     if bad:
         name, reason = bad[0]
         more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
@@ -46,11 +62,12 @@ def fleet(logs_dir: str | Path) -> dict[str, list[Log]]:
 @dataclass(frozen=True)
 class Reading:
     """A log's features (``vector``, :data:`FEATURES` by name then axis), mean joint temperature
-    (deg C, NaN when not logged) and payload (kg, 0 when not logged)."""
+    (deg C, NaN when not logged), payload (kg, 0 when not logged) and the reader's ``notes``."""
 
     vector: np.ndarray
     temperature: float
     payload: float
+    notes: tuple[str, ...] = ()
 
 
 def feature_vector(record: dict[str, np.ndarray]) -> np.ndarray:
@@ -68,9 +85,10 @@ def features_of(robot: Robot, data: measured.MeasuredData) -> np.ndarray:
     return feature_vector(fleetlogs.log_record(data, robot, _speed_limit(robot)))
 
 
-def read(robot: Robot, log: Log) -> Reading:
-    """Read and check one log (:func:`faultgen.data.measured.read`, errors name the file and row)."""
-    data = measured.read(log.path, robot)
+def read(robot: Robot, log: Log, reader: Reader = measured.read) -> Reading:
+    """Read and check one log (``reader``: :func:`faultgen.data.measured.read` by default; errors
+    name the file and row)."""
+    data = reader(log.path, robot)
     temperature = float(np.mean(data.joint_temperature)) if data.joint_temperature is not None else float("nan")
     payload = float(np.max(data.payload_mass)) if data.payload_mass is not None else 0.0
-    return Reading(features_of(robot, data), temperature, payload)
+    return Reading(features_of(robot, data), temperature, payload, tuple(data.notes))

@@ -31,7 +31,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.calibrate import plausibility
-from faultgen.data import atomic, logfolder, measured
+from faultgen.data import atomic, logfolder
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
@@ -102,7 +102,7 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True) -> Outcome:
+            progress: bool = True, log_format=None) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
@@ -128,6 +128,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         The twin also predicts the temperature's effect (the model's own temperature law) instead
         of the unit's learned slope alone.
     progress : bool
+    log_format : faultgen.data.adapters.Adapter, optional
+        The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
 
     Returns
     -------
@@ -145,13 +147,15 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     """
     atomic.check_apart(out, logs_dir)
     nominal = robots.load(robot)
-    units = fleet_logs.fleet(logs_dir)
+    read_with, suffixes = fleet_logs.reader_of(log_format)
+    units = fleet_logs.fleet(logs_dir, suffixes)
     out = Path(out)
     cache = out / ".cache"
     calibrated_model = _given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
-    key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path))
+    key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
+                                 "measured" if log_format is None else repr(log_format))
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
@@ -165,9 +169,10 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             continue
         bar.set_postfix_str(f"twin of {name}")
         if name not in state:
-            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, out, programs, progress)
+            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, out, programs, progress,
+                                    read_with)
         unit = state[name]
-        twin = _twin(unit, units, nominal, calibrated_model, out, twins, progress)
+        twin = _twin(unit, units, nominal, calibrated_model, out, twins, progress, read_with)
         bar.set_postfix_str(name)
         for log in unit_logs:
             for event in maintenance.get(name, ()):
@@ -176,7 +181,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                     unit.monitor.maintenance(event.stamp, event.event, event.axis)
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
-            _score_log(unit, log, nominal, twin, twin_temperature)
+            _score_log(unit, log, nominal, twin, twin_temperature, read_with)
             bar.update()
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
@@ -231,7 +236,7 @@ def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir
 
 
 def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, out: Path,
-              programs: list, progress: bool) -> _Unit:
+              programs: list, progress: bool, read_with: fleet_logs.Reader) -> _Unit:
     """A unit seen for the first time: its program (the log its twin replays) and model, the
     first that can be had of (given or calibrated, nominal); protocol ``own`` when none."""
     monitor = UnitMonitor(name, settings, nominal.n_axes)
@@ -240,13 +245,13 @@ def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibr
     if settings.protocol != "twin":
         return _Unit(monitor, "none", None, first_key)
     try:
-        program = _program(nominal, first, name, programs)
+        program = _program(nominal, first, name, programs, read_with)
     except ValueError as err:
         return _Unit(monitor, "none", None, first_key,
                      notes=[f"its first log cannot be replayed ({_short(err)}): protocol own"])
     kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
     try:
-        _model(nominal, kind, calibrated_model, first_key, first.path, out, progress)
+        _model(nominal, kind, calibrated_model, first_key, first.path, out, progress, read_with)
     except stored.StateError:
         raise
     except ValueError as err:  # the calibration failed: the nominal model (never fails: a file)
@@ -255,7 +260,8 @@ def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibr
     return _Unit(monitor, kind, program, first_key)
 
 
-def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool) -> Twin | str | None:
+def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
+          read_with: fleet_logs.Reader) -> Twin | str | None:
     """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
     from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
@@ -264,10 +270,11 @@ def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict,
         try:
             first_path = _log(units, unit.monitor.unit, unit.first[0]).path if any(
                 g.stamp == unit.first[0] for g in units[unit.monitor.unit]) else None
-            model = _model(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress)
+            model = _model(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress, read_with)
             twin_key = (model, unit.program)
             if twin_key not in twins:
-                twins[twin_key] = Twin(model, _log(units, *unit.program).path, out / ".cache" / "cycles", root=out)
+                twins[twin_key] = Twin(model, _log(units, *unit.program).path, out / ".cache" / "cycles", root=out,
+                                       reader=read_with)
             twin = twins[twin_key]
         except stored.StateError:
             raise
@@ -289,7 +296,8 @@ def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict,
     return None
 
 
-def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool) -> None:
+def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
+               read_with: fleet_logs.Reader) -> None:
     """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
     cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
     unit's state with its reason."""
@@ -298,7 +306,7 @@ def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperat
         unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
         return
     try:
-        reading = fleet_logs.read(nominal, log)
+        reading = fleet_logs.read(nominal, log, read_with)
         residual, expected = reading.vector, None
         if twin is not None:
             at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
@@ -309,6 +317,8 @@ def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperat
     except ValueError as err:
         unit.skipped.append(stored.Skipped(log.stamp, sha256, _short(err)))
         return
+    if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
+        unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
     unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
 
@@ -402,7 +412,7 @@ def _given_model(calibrated: str | Path) -> Path:
 
 
 def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_path: Path | None, out: Path,
-           progress: bool) -> str:
+           progress: bool, read_with: fleet_logs.Reader) -> str:
     """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
     the unit's first log (``first``: its stamp and SHA-256; ``first_path`` the file, needed only
     when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
@@ -436,7 +446,8 @@ def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], 
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run_calibration(str(nominal.path), first_path, folder, max_steps=CALIBRATION_STEPS, progress=False)
+            run_calibration(str(nominal.path), read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
+                            progress=False)
         stored.write_calibration(record, key, model)
     implausible = plausibility.implausible_parameters(nominal, robots.load(model))
     if implausible:
@@ -459,10 +470,10 @@ def _without_payload(path: Path) -> Path:
     return target
 
 
-def _program(nominal, first: fleet_logs.Log, unit: str, programs: list) -> tuple[str, str]:
+def _program(nominal, first: fleet_logs.Log, unit: str, programs: list, read_with: fleet_logs.Reader) -> tuple[str, str]:
     """The log (unit, stamp) to replay for ``unit`` whose first log is ``first``: an earlier unit's
     when the motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles."""
-    q = np.asarray(measured.read(first.path, nominal).q)
+    q = np.asarray(read_with(first.path, nominal).q)
     for other, other_program in programs:
         if other.shape == q.shape and np.max(np.abs(other - q)) < SAME_PROGRAM:
             return other_program

@@ -61,11 +61,14 @@ def sha256_file(path: str | Path) -> str:
     return digest.hexdigest()
 
 
-def settings_digest(settings: Settings, model: str, twin_temperature: bool, robot_sha256: str) -> dict:
+def settings_digest(settings: Settings, model: str, twin_temperature: bool, robot_sha256: str,
+                    log_format: str = "measured") -> dict:
     """What a state belongs to, as a JSON-able dict: the monitor's settings, the model source
     ("nominal", "per-unit" or the SHA-256 of a given calibrated model), whether the twin predicts
-    the temperature's effect, and the SHA-256 of the robot's MJCF."""
-    return {**asdict(settings), "model": model, "twin_temperature": bool(twin_temperature), "robot": robot_sha256}
+    the temperature's effect, the SHA-256 of the robot's MJCF and the logs' format (with its
+    options)."""
+    return {**asdict(settings), "model": model, "twin_temperature": bool(twin_temperature), "robot": robot_sha256,
+            "format": log_format}
 
 
 @dataclass(frozen=True)

@@ -85,15 +85,18 @@ def setup(temperature: float | None, payload: float, worn_axis: int = 0) -> tupl
 
 class Twin:
     """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
-    log whose motion is replayed, ``cache`` the folder of simulated cycles (created if needed) inside
-    ``root`` (default ``cache``), out of which no cached cycle may lead."""
+    log whose motion is replayed (read by ``reader``, :data:`faultgen.monitor.logs.Reader`; the
+    measured format's by default), ``cache`` the folder of simulated cycles (created if needed)
+    inside ``root`` (default ``cache``), out of which no cached cycle may lead."""
 
-    def __init__(self, model: str | Path, program: Path, cache: Path, root: Path | None = None):
+    def __init__(self, model: str | Path, program: Path, cache: Path, root: Path | None = None,
+                 reader: fleet_logs.Reader | None = None):
         self.model = str(model)
         self.robot = robots.load(model)
         self.program = Path(program)
         self.cache = Path(cache)
         self.root = self.cache if root is None else Path(root)
+        self.reader = reader or (lambda path, robot: measured.read(path, robot, accelerations=False))
         self.cache.mkdir(parents=True, exist_ok=True)
         program_sha256 = stored.sha256_file(self.program)
         self._files = {"model": stored.sha256_file(self.robot.path), "program": program_sha256,
@@ -115,7 +118,7 @@ class Twin:
         ``cache``. A logged cycle was executed by the real drive, so the twin must not saturate on
         the encoder's noise, which the replay tracks as its reference (faultgen's default 1e-4 rad
         saturated the irb6700's axis 2 on its own pick and place)."""
-        data = measured.read(self.program, self.robot, accelerations=False)
+        data = self.reader(self.program, self.robot)
         t = np.asarray(data.t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(data.q, dtype=float), REFERENCE_WINDOW)
         folder = self.cache.parent / "programs"  # beside the cycles: the cycle folder holds cycles only
