@@ -412,10 +412,10 @@ def test_a_unit_whose_twin_cannot_be_built_falls_back_to_its_own_protocol(fleet,
         log.write_text("\n".join([header, *rows]) + "\n")
 
     class Refusing(loop.Twin):
-        def __init__(self, model, program, cache, root=None):
+        def __init__(self, model, program, cache, root=None, reader=None):
             if Path(program).parent.name == "unit99":
                 raise ValueError("the twin saturates the drive of axis 2 (planted)")
-            super().__init__(model, program, cache, root)
+            super().__init__(model, program, cache, root, reader)
 
     monkeypatch.setattr(loop, "Twin", Refusing)
     out = with_cycles_of(monitored, tmp_path / "out")
@@ -578,3 +578,23 @@ def test_ur_rtde_recordings_are_monitored_with_their_joint_temperatures(fleet, t
     with open(runs["rtde"] / "units.csv", newline="") as f:
         reasons = {row["unit"]: row["reason"] for row in csv.DictReader(f)}
     assert all("torque from target_moment_i (the controller's commanded moment" in r for r in reasons.values())
+
+
+def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
+    """`--jobs 2` scores groups of units in two processes; the outputs are those of one job, bit
+    for bit, and a rerun after more logs arrived scores only those (issue 60, part 6)."""
+    robot, logs, _ = fleet
+    partial = tmp_path / "logs"
+    for unit in logs.iterdir():
+        (partial / unit.name).mkdir(parents=True)
+        for log in sorted(unit.iterdir())[:30]:
+            os.link(log, partial / unit.name / log.name)
+    out = with_cycles_of(monitored, tmp_path / "out")
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    for unit in logs.iterdir():
+        for log in sorted(unit.iterdir())[30:]:
+            os.link(log, partial / unit.name / log.name)
+    outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
+    for name in ("alarms.csv", "scores.csv", "units.csv"):
+        assert (out / name).read_bytes() == (monitored / name).read_bytes(), name

@@ -9,10 +9,11 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.cli.options import LogFormat, TorqueConstants, log_adapter
+from faultgen.cli.options import Jobs, LogFormat, TorqueConstants, log_adapter
 
-#: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations.
-CACHE_ENTRIES = ("cycles", "calibrated")
+#: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
+#: the twins' filtered program logs (faultgen.monitor.twin).
+CACHE_ENTRIES = ("cycles", "calibrated", "programs")
 
 #: The fewest logs the monitor learns a unit from (faultgen.monitor.scoring.Settings), and the most
 #: logs --train and --persistence may name (years of a log an hour: beyond any fleet's record).
@@ -55,6 +56,7 @@ def monitor_command(
              "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
+    jobs: Jobs = 1,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -117,7 +119,7 @@ def monitor_command(
     made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                               twin_temperature=twin_temperature, progress=True, log_format=adapter)
+                               twin_temperature=twin_temperature, progress=True, log_format=adapter, jobs=jobs)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise

@@ -102,7 +102,7 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None) -> Outcome:
+            progress: bool = True, log_format=None, jobs: int = 1) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
@@ -130,6 +130,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     progress : bool
     log_format : faultgen.data.adapters.Adapter, optional
         The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
+    jobs : int
+        Local processes scoring units in parallel (groups of units sharing a twin); the outputs are
+        those of one job, bit for bit.
 
     Returns
     -------
@@ -161,28 +164,17 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     cache.mkdir(parents=True, exist_ok=True)
-    bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
-    twins: dict[tuple, Twin] = {}
-    for name, unit_logs in pending.items():
-        if not unit_logs:
-            continue
-        bar.set_postfix_str(f"twin of {name}")
-        if name not in state:
-            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, out, programs, progress,
-                                    read_with)
-        unit = state[name]
-        twin = _twin(unit, units, nominal, calibrated_model, out, twins, progress, read_with)
-        bar.set_postfix_str(name)
-        for log in unit_logs:
-            for event in maintenance.get(name, ()):
-                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
-                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
-                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
-                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
-                                                               len(unit.entries)))
-            _score_log(unit, log, nominal, twin, twin_temperature, read_with)
-            bar.update()
+    for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
+        if unit_logs and name not in state:
+            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, read_with)
+    context = _Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance)
+    groups = _groups({name: (state[name], logs) for name, logs in pending.items() if logs})
+    bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
+    for done in _map(context, groups, jobs):
+        for name, unit in done:
+            state[name] = unit
+            bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
     statuses = [_status(name, state.get(name), settings) for name in units]
@@ -202,6 +194,86 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                    unit.model, unit.first, unit.skipped, unit.notes,
                                                    unit.maintenance))
     return Outcome(monitors, statuses)
+
+
+@dataclass(frozen=True)
+class _Context:
+    """What scoring a group of units needs (sent to a worker process as it is)."""
+
+    robot: Path
+    settings: Settings
+    calibrated: Path | None
+    out: Path
+    twin_temperature: bool
+    log_format: object
+    units: dict
+    maintenance: dict
+
+
+def _groups(pending: dict[str, tuple[_Unit, list]]) -> list[list[tuple[str, _Unit, list]]]:
+    """The units to score, one group each, in the folder's order (a twin's simulated cycles are
+    shared through the disk cache: :func:`_prepare_twins` simulates them once before)."""
+    return [[(name, unit, logs)] for name, (unit, logs) in pending.items()]
+
+
+def _prepare_twins(context: _Context, groups: list) -> None:
+    """Simulate, once and in this process, the cycles of every twin that several units share (the
+    nominal or a given model on one program), so that parallel workers read them from the cache
+    instead of simulating them side by side. A twin that cannot be built is left to each unit's
+    own fallback (:func:`_twin`)."""
+    nominal = robots.load(context.robot)
+    read_with, _ = fleet_logs.reader_of(context.log_format)
+    seen = set()
+    for (name, unit, _), in groups:
+        key = (unit.model, unit.program)
+        if unit.model not in ("given", "nominal") or unit.program is None or key in seen:
+            continue
+        seen.add(key)
+        model = str(context.calibrated) if unit.model == "given" else str(nominal.path)
+        try:
+            Twin(model, _log(context.units, *unit.program).path, context.out / ".cache" / "cycles", root=context.out,
+                 reader=read_with)
+        except stored.StateError:
+            raise
+        except ValueError:
+            continue
+
+
+def _map(context: _Context, groups: list, jobs: int):
+    """Each group scored (:func:`_score_group`), in order; in ``jobs`` local processes (joblib's
+    loky, started without the user's folders on their path: :func:`faultgen.children.safe_path`)
+    when ``jobs`` > 1. Every group's arithmetic is the same wherever it runs, so the outputs are
+    those of one job, bit for bit."""
+    if jobs <= 1 or len(groups) <= 1:
+        yield from (_score_group(context, group) for group in groups)
+        return
+    _prepare_twins(context, groups)
+    from joblib import Parallel, delayed
+
+    from faultgen import children
+
+    with children.safe_path():
+        yield from Parallel(n_jobs=min(jobs, len(groups)), return_as="generator")(
+            delayed(_score_group)(context, group) for group in groups)
+
+
+def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> list[tuple[str, _Unit]]:
+    """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
+    events given before the first log at or after them; returns the units."""
+    nominal = robots.load(context.robot)
+    read_with, _ = fleet_logs.reader_of(context.log_format)
+    twins: dict[tuple, Twin] = {}
+    for name, unit, unit_logs in group:
+        twin = _twin(unit, context.units, nominal, context.calibrated, context.out, twins, False, read_with)
+        for log in unit_logs:
+            for event in context.maintenance.get(name, ()):
+                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
+                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
+                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
+                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
+                                                               len(unit.entries)))
+            _score_log(unit, log, nominal, twin, context.twin_temperature, read_with)
+    return [(name, unit) for name, unit, _ in group]
 
 
 def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir) -> list:
@@ -235,10 +307,12 @@ def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir
     return unit_logs[stamps.index(done) + 1:]
 
 
-def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, out: Path,
-              programs: list, progress: bool, read_with: fleet_logs.Reader) -> _Unit:
-    """A unit seen for the first time: its program (the log its twin replays) and model, the
-    first that can be had of (given or calibrated, nominal); protocol ``own`` when none."""
+def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
+              read_with: fleet_logs.Reader) -> _Unit:
+    """A unit seen for the first time: its program (the log its twin replays) and the kind of model
+    asked for (given, calibrated on its first log, nominal); protocol ``own`` without a twin or
+    when its first log cannot be read. The model itself is made with the twin (:func:`_twin`),
+    which falls back when it cannot be."""
     monitor = UnitMonitor(name, settings, nominal.n_axes)
     first = units[name][0]
     first_key = (first.stamp, stored.sha256_file(first.path))
@@ -250,13 +324,6 @@ def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibr
         return _Unit(monitor, "none", None, first_key,
                      notes=[f"its first log cannot be replayed ({_short(err)}): protocol own"])
     kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
-    try:
-        _model(nominal, kind, calibrated_model, first_key, first.path, out, progress, read_with)
-    except stored.StateError:
-        raise
-    except ValueError as err:  # the calibration failed: the nominal model (never fails: a file)
-        return _Unit(monitor, "nominal", program, first_key,
-                     notes=[f"the {kind} model failed ({_short(err)}); nominal model used"])
     return _Unit(monitor, kind, program, first_key)
 
 
