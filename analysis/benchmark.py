@@ -1150,7 +1150,7 @@ MEASURED_NEXT = ("label more logs in the logs folder's events.csv (`onset` or `f
 STACKING_WORN_RUNS = 2
 
 
-def _without_stacking(path, inputs: "ClassificationInputs", kwargs: dict) -> str:
+def _without_stacking(path, inputs: ClassificationInputs, kwargs: dict) -> str:
     """Drop the stacking classifier from ``kwargs["classifiers"]`` (default: every classifier)
     when a leave-pair-out training set holds failed samples of fewer than
     :data:`STACKING_WORN_RUNS` runs (its inner folds by run would train on one class: scikit-learn's

@@ -49,7 +49,6 @@ def card(path: str | Path) -> str:
         If ``path`` is not a finished faultgen dataset.
     """
     from faultgen.model import robots
-    from faultgen.operation import programs
 
     with reader.open(path) as data:
         runs = data.runs
