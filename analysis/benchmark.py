@@ -94,6 +94,11 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     task saw at that level; it is right only when the isolator names no axis (undecided): naming
     one is a false isolation. Runs wearing several axes are skipped.
 
+    A dataset imported from logs (``faultgen logs import``) has no measured wear, only logs
+    labelled worn by its events: each worn unit is one case, its logs up to and including the
+    first labelled worn (``levels`` do not apply; ``wear_pct`` holds :data:`LABELLED_WORN`, a
+    mark), and ``attrs["imported"]`` is True.
+
     With ``speed_window`` (low, high) in rad/s of motor speed, the per-cycle signal is the mean
     |motor torque| over the samples whose motor speed lies in the window (thesis ch. 6.3.2,
     :func:`analysis.features.speed_window_mean`); an axis of a run with a cycle that has no such
@@ -140,6 +145,9 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         worn = [r for r in runs if len(r.worn_axes) == 1]
         if not worn:
             raise ValueError(f"{data.path} has no run with exactly one worn axis to isolate")
+        imported = all(r.measured for r in data.runs)
+        if imported:  # no wear is measured: one case per unit, up to its first log labelled worn
+            levels = [LABELLED_WORN]
         # cycles seen per (setup, level): what the worn runs saw, shown to the healthy runs of the same
         # robot, program, friction and conditions (reader.Run.setup) too
         seen: dict[tuple, int] = {}
@@ -169,7 +177,36 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                              answer=axis_label(predicted), correct=predicted == axis,
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
                              n_axes=X.shape[1], needed=np.nan if needed[name] is None else needed[name]))
-    return pd.DataFrame(rows)
+    table = pd.DataFrame(rows)
+    table.attrs["imported"] = imported
+    return table
+
+
+#: The ``wear_pct`` of an imported dataset's cases in :func:`isolation_table`: a mark for "up to the
+#: first log labelled worn" (a worn log's friction multiplier, :data:`faultgen.data.fleetlogs.WORN_MARK`,
+#: read as a wear), not a measured wear.
+LABELLED_WORN = 100.0
+
+
+def isolation_levels(table: pd.DataFrame, frame: pd.DataFrame) -> pd.DataFrame:
+    """``frame`` (indexed by task and ``wear_pct``, as :func:`isolation_accuracy`) with its levels
+    as ``faultgen bench-isolators`` prints them: 0 "no fault"; on an imported dataset the index
+    level is ``logs`` and its cases "to first worn" (up to the first log labelled worn)."""
+    frame = frame.rename(index={0.0: "no fault"}, level="wear_pct")
+    if table.attrs.get("imported"):
+        frame = frame.rename(index={LABELLED_WORN: "to first worn"}, level="wear_pct")
+        frame.index = frame.index.set_names("logs", level="wear_pct")
+    return frame
+
+
+def isolation_csv(table: pd.DataFrame) -> pd.DataFrame:
+    """An :func:`isolation_table` as its CSV holds it: on an imported dataset ``wear_pct`` becomes
+    ``logs``, "no fault" or "to first worn" (no wear is measured)."""
+    if not table.attrs.get("imported"):
+        return table
+    logs = np.where(table["wear_pct"] == 0, "no fault", "to first worn")
+    return table.drop(columns="wear_pct").assign(logs=logs)[
+        [*(c if c != "wear_pct" else "logs" for c in table.columns)]]
 
 
 def motor_speed_coverage(path, speed_window: tuple[float, float]) -> pd.DataFrame:
@@ -317,7 +354,8 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
     marked = marked or ("te10" if "te10" in isolators else isolators[0])
     accuracy = isolation_accuracy_text(table)
     n_axes = _table_axes(table)
-    head = (["task", "wear %"] + [f"axis {a}" for a in range(1, n_axes + 1)]
+    imported = bool(table.attrs.get("imported"))
+    head = (["task", "logs" if imported else "wear %"] + [f"axis {a}" for a in range(1, n_axes + 1)]
             + [f"accuracy {name} (%)" for name in isolators])
     lines = ["| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
     for (task, level), group in table[table["isolator"] == marked].groupby(["task", "wear_pct"]):
@@ -326,9 +364,11 @@ def isolation_markdown(table: pd.DataFrame, marked: str | None = None) -> str:
             row = group[group["worn_axis"] == axis]
             marks.append("-" if row.empty else ("✓" if bool(row["correct"].iloc[0]) else "✗"))
         acc = [accuracy.loc[(task, level), name] for name in isolators]
-        lines.append("| " + " | ".join([task, _level_label(level), *marks, *acc]) + " |")
-    decided = isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct")
-    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). {ACCURACY_RULE}\n\n"
+        lines.append("| " + " | ".join([task, _level_label(level, imported), *marks, *acc]) + " |")
+    decided = isolation_levels(table, isolation_decided(table))
+    cases = (" Units imported from logs: each worn unit is one case, its logs up to the first labelled worn by "
+             "events.csv (\"to first worn\"); no wear is measured." if imported else "")
+    return (f"Marks: {marked} (✓ source axis isolated, ✗ not, - no run). {ACCURACY_RULE}{cases}\n\n"
             + "\n".join(lines)
             + "\n\nCases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
             "cycles):\n\n"
@@ -342,8 +382,8 @@ ACCURACY_RULE = ("Accuracy: the share of cases an isolator ran on in which it na
                  "are not scored: \"not applicable: N cycles < M needed\".")
 
 
-def _level_label(level: float) -> str:
-    return "no fault" if level == 0 else f"{level:g}"
+def _level_label(level: float, imported: bool = False) -> str:
+    return "no fault" if level == 0 else "to first worn" if imported else f"{level:g}"
 
 
 def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
@@ -355,7 +395,8 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     ax = fig.subplots()
     image = ax.imshow(accuracy.to_numpy(dtype=float), vmin=0, vmax=100, cmap="viridis", aspect="auto")
     ax.set_yticks(range(accuracy.shape[0]), accuracy.index)
-    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {_level_label(w)}" + (" %" if w else "")
+    imported = bool(table.attrs.get("imported"))
+    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {_level_label(w, imported)}" + (" %" if w and not imported else "")
                                              for t, w in accuracy.columns], fontsize=8, rotation=35, ha="right")
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
@@ -363,7 +404,8 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
             ax.text(j, i, "n/a" if np.isnan(value) else f"{value:.0f}", ha="center", va="center",
                     color="white" if np.isnan(value) or value < 60 else "black")
     fig.colorbar(image, ax=ax, label="source axis isolated (%)")
-    ax.set_title("isolation accuracy per task and wear level (n/a: too few cycles for the isolator)")
+    ax.set_title("isolation accuracy per task and " + ("case (logs up to the first labelled worn)" if imported
+                                                     else "wear level") + " (n/a: too few cycles for the isolator)")
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     return out
@@ -472,7 +514,8 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
                                    limit_folds)
         table.attrs.update(dataset_kind=data.kind, command=data.command, first=first, limit_folds=limit_folds,
-                           alpha=alpha, protocol_reasons=charts.pop("_reasons"))
+                           alpha=alpha, protocol_reasons=charts.pop("_reasons"),
+                           imported=bool(data.runs) and all(run.measured for run in data.runs))
     return (table, charts) if return_charts else table
 
 
@@ -520,6 +563,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         return []
 
     monitors: dict[tuple, tuple] = {}
+    far: dict[str, tuple] = {}  # runs whose Q limit lies FAR_LIMIT times above every Q they were tested on
     false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy runs
     rows, charts, reasons = [], {}, {}
     for run in tqdm(runs, desc="detection", unit="run", disable=not progress):
@@ -535,6 +579,9 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         used_protocol, n_first = protocol, fitted_first(first, n_samples)
         if protocol == "auto":  # a fleet's robots are units of their own: each learns its first days (thesis ch. 4)
             used_protocol, reason = _auto_protocol(data.kind, others, own, n_samples, first)
+            if run.measured and used_protocol == "first-cycles":
+                reason = (f"units imported from logs: each unit learns its first {fitted_first(first, n_samples)} logs "
+                          "(thesis ch. 4, one-to-one)")
             reasons[used_protocol] = reason
         if used_protocol == "other-seeds":
             if not others:
@@ -623,17 +670,23 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                          onset_cycle=np.nan if onset is None else int(run.recorded[groups == onset][0]),
                          onset_wear_pct=np.nan if onset is None else round(float(wear[groups == onset].max()), 2),
                          located_axis=located, located=located == axis))
+        if run.measured:  # no wear is measured: a worn log's friction_multiplier is a mark, not a percentage
+            del rows[-1]["final_wear_pct"], rows[-1]["onset_wear_pct"]
         chart = {"sample": np.arange(len(alarms)),
                  "cycle": np.array([run.recorded[groups == g][0] for g in range(len(alarms))]),
                  "wear_pct": np.array([wear[groups == g].max() for g in range(len(alarms))]), "alarm": alarms}
         if hasattr(monitor, "score_samples") and hasattr(monitor, "q_limit_"):
             t2, q = monitor.score_samples(worn[:, used])
             chart.update(t2=t2, q=q, t2_limit=monitor.t2_limit_, q_limit=monitor.q_limit_)
+            tested = q[skip:] if skip < len(q) else q
+            if tested.size and monitor.q_limit_ >= FAR_LIMIT * max(float(tested.max()), 1e-300):
+                far[run.id] = (float(monitor.q_limit_), float(tested.min()), float(tested.max()), trained_on)
         charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
                               protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
     table = pd.DataFrame(rows)
     # what detection_advice needs: the sample each fault begins at (what --first must stay below)
     table.attrs["fault_begins_sample"] = {r: c["begins"] for r, c in charts.items() if c["begins"] is not None}
+    table.attrs["q_limit_far"] = far
     charts["_reasons"] = reasons
     return table, charts
 
@@ -651,6 +704,11 @@ def locate_onset(features: np.ndarray, onset: int | None) -> int:
         return TOO_FEW_CYCLES
 
 
+#: A Q limit this many times the largest Q of the samples a run is tested on (two decades) is said
+#: by :func:`detection_advice`: Q cannot alarm there, and the usual cause is a learning sample unlike
+#: the others (an outlying day or log), whose out-of-fold residual sets the limit.
+FAR_LIMIT = 100.0
+
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
 DETECTION_COLUMNS = {
     "onset": "the first sample (0-based) of the first run of PERSISTENCE alarms at or after the fault begins",
@@ -661,6 +719,26 @@ DETECTION_COLUMNS = {
     "trained_on_fault": "the fault began inside the samples the monitor learned from (first-cycles): it learned "
                         "faulty data as normal",
 }
+
+
+#: :data:`DETECTION_COLUMNS` as they read on a dataset imported from logs (``faultgen logs import``).
+MEASURED_DETECTION_COLUMNS = {
+    **DETECTION_COLUMNS,
+    "onset": "the first sample (0-based) of the first run of PERSISTENCE alarms at or after the first log labelled "
+             "worn",
+    "onset_cycle": "the 1-based log (in stamp order) of that sample",
+    "fault_begins_cycle": "the first log labelled worn by events.csv (an onset or failure event); an alarm before it "
+                          "is counted as a false alarm (alarms_before_fault_pct), never a detection",
+    "false_alarm_pct": "share of alarm samples on units without a log labelled worn (false_alarm_runs of them; "
+                       "unknown logs among them); see the protocol",
+    "trained_on_fault": "the first log labelled worn lies inside the logs the monitor learned from: it learned worn "
+                        "logs as normal",
+}
+
+
+def detection_columns(table: pd.DataFrame) -> dict[str, str]:
+    """What the columns of a :func:`detection_table` mean, for its dataset (simulated or imported)."""
+    return MEASURED_DETECTION_COLUMNS if table.attrs.get("imported") else DETECTION_COLUMNS
 
 
 def false_alarm_meaning(protocols: Iterable[str]) -> str:
@@ -684,6 +762,15 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
     notes = []
     kind = table.attrs.get("dataset_kind", "sweep")
     command = table.attrs.get("command", "")
+    imported = bool(table.attrs.get("imported"))
+    for run, (limit, low, high, learned_from) in table.attrs.get("q_limit_far", {}).items():
+        notes.append(f"note: the Q limit of {run} ({limit:.3g}, learned from {learned_from}) lies "
+                     f"{np.log10(limit / max(high, 1e-300)):.1f} decades above every Q it was tested on "
+                     f"({low:.3g}-{high:.3g}), so Q cannot alarm there: a learning "
+                     + ("log" if imported else "sample") + " unlike the others (one outlying "
+                     + ("log" if imported else "day or cycle") + ") sets the out-of-fold limit. Look at those "
+                     + ("logs" if imported else "samples") + " (the grey span of the figure) and learn from others "
+                     "(--first), or take the in-sample limit (--limit-folds 0)")
     seeds = (f"sweep this dataset's grid again with several seeds: `{_with_seeds(command)}`"
              if command.startswith("faultgen sweep") else "sweep its grid with several seeds (--seed 0 --seed 1 --seed 2)")
     held_in = table[table["protocol"] != "other-seeds"]
@@ -691,7 +778,10 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
         notes.append(f"note: this dataset lacks runs without wear of other seeds, so {len(held_in)} of {len(table)} "
                      f"runs were judged by a monitor that learned from {', '.join(sorted(set(held_in['protocol'])))}. "
                      f"For false alarms on healthy runs of other units, {seeds}")
-    if kind == "fleet" and (table["protocol"] == "first-cycles").any():
+    if imported and (table["protocol"] == "first-cycles").any():
+        notes.append("note: each imported unit learns its own first logs (first-cycles, thesis ch. 4 OTO); "
+                     "false_alarm_pct is that protocol on the units without a log labelled worn")
+    elif kind == "fleet" and (table["protocol"] == "first-cycles").any():
         notes.append("note: a fleet's robots each learn their own first days (first-cycles, thesis ch. 4 OTO); "
                      "false_alarm_pct is that protocol on the fleet's healthy robots. For monitors learnt from other "
                      "robots, compared with their own, run `faultgen training-source` on a 60-day fleet")
@@ -705,11 +795,17 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
                  if np.isfinite(earliest) else f"at cycle {int(learned['fault_begins_cycle'].min())}")
         if np.isfinite(earliest) and earliest - 1 >= fewest:
             remedy = f"A --first of {int(earliest) - 1} (or fewer, at least {fewest}) keeps training before it"
+        elif imported:
+            remedy = (f"No --first avoids it (the monitor needs at least {fewest} learning logs"
+                      f"{f' with --limit-folds {folds}' if folds else ''}): learn normal operation from units without "
+                      "a log labelled worn or from another dataset (--train OTHER.h5), or, where a unit's events.csv "
+                      f"onset comes too early, {MEASURED_NEXT}")
         else:
             remedy = (f"No --first avoids it (the monitor needs at least {fewest} training samples"
                       f"{f' with --limit-folds {folds}' if folds else ''}); learn from runs without wear instead: "
                       f"{seeds} for --protocol other-seeds, or record cycles before the wear begins")
-        notes.append(f"note: {len(learned)} of {len(table)} runs are left out of the summary: the fault began inside "
+        began = "the first log labelled worn lies" if imported else "the fault began"
+        notes.append(f"note: {len(learned)} of {len(table)} runs are left out of the summary: {began} inside "
                      f"the samples their monitor learned as normal (trained_on_fault; earliest {where}), so their "
                      f"detections say nothing. {remedy}")
     alpha = 100.0 * table.attrs.get("alpha", 0.05)
@@ -740,12 +836,14 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
         wrong = len(detected) - len(short) - len(undecided)
         if wrong:
             why.append(f"in {wrong} it named another axis than the worn one")
+        more = ("more logs before the onset (longer records of the units; the first log labelled worn comes from "
+                "events.csv)" if imported else "more samples before the onset: record more cycles (--record all)")
         notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): {'; '.join(why)}. Location needs "
-                     "more samples before the onset: record more cycles (--record all)")
+                     + more)
     noisy = table[table["alarms_before_fault_pct"] >= 50]
     if len(noisy):
-        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the fault "
-                     "begins (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
+        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the "
+                     + ("first log labelled worn" if imported else "fault begins") + " (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
                      "detections say little")
     return "\n".join(notes)
 
@@ -815,6 +913,8 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
     aggregate = dict(runs=("run", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
                      detected_pct=("detected", percent), median_onset_cycle=("onset_cycle", "median"),
                      median_onset_wear_pct=("onset_wear_pct", "median"), located_pct=("located", percent))
+    if "onset_wear_pct" not in table:  # units imported from logs: no wear is measured
+        del aggregate["median_onset_wear_pct"]
     parts = []
     for key, label in (("task", "task"), ("worn_axis", "worn axis"), (None, "all")):
         by = table[key].astype(str) if key else pd.Series("all", index=table.index)
@@ -1017,6 +1117,7 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     from analysis.classify import ESTIMATED, SHORT_TABLE, evaluate, select_pairs
 
     inputs = classification_inputs(path, wear_threshold, horizon)
+    dropped = _without_stacking(path, inputs, kwargs)
     if short and kwargs.get("preprocessing") is None:
         kwargs["preprocessing"] = [n for n in SHORT_TABLE
                                    if inputs.estimated is not None or not n.startswith(ESTIMATED)]
@@ -1034,8 +1135,58 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         source = judged
     table = with_verdict(table, null_values)
     table.attrs.update(pairs=len(select_pairs(inputs.failed, inputs.normal, n_pairs, random_state)),
-                       chance_source=source)
+                       chance_source=source, imported=inputs.imported, notes=[dropped] if dropped else [])
     return table
+
+
+#: What a dataset imported from logs (``faultgen logs import``) can do next, in an analysis's advice.
+MEASURED_NEXT = ("label more logs in the logs folder's events.csv (`onset` or `failure` rows for worn axes, `healthy` "
+                 "rows for units inspected healthy) and import again, or run `faultgen monitor LOGS --robot ROBOT -o "
+                 "OUT` on the folder, which needs no labels (each unit judged against its calibrated twin)")
+
+#: Fewest worn runs (with failed samples) a training set of the stacking classifier needs: its
+#: inner cross-validation splits the training runs into folds by run (:func:`analysis.classify.run_folds`),
+#: and the base classifiers of a fold need failed samples in the runs outside it.
+STACKING_WORN_RUNS = 2
+
+
+def _without_stacking(path, inputs: ClassificationInputs, kwargs: dict) -> str:
+    """Drop the stacking classifier from ``kwargs["classifiers"]`` (default: every classifier)
+    when a leave-pair-out training set holds failed samples of fewer than
+    :data:`STACKING_WORN_RUNS` runs (its inner folds by run would train on one class: scikit-learn's
+    "needs samples of at least 2 classes"); returns the note saying so, "" when kept. Asked for by
+    name (``--classifier stacking``) it is refused instead.
+
+    Raises
+    ------
+    ValueError
+        If stacking was asked for by name and cannot be fitted, or it was the only classifier.
+    """
+    from analysis.classify import CLASSIFIERS
+
+    named = kwargs.get("classifiers")
+    classifiers = list(named) if named is not None else list(CLASSIFIERS)
+    if "stacking" not in classifiers:
+        return ""
+    carriers = sorted({g for g, label in zip(inputs.groups, inputs.y, strict=True) if label and g in inputs.failed},
+                      key=str)
+    if len(carriers) - 1 >= STACKING_WORN_RUNS:  # one worn run is held out with each pair
+        return ""
+    needs = STACKING_WORN_RUNS + 1
+    if inputs.imported:
+        what = (f"failed samples (logs labelled worn) in {len(carriers)} unit(s) ({', '.join(map(str, carriers))}); with "
+                f"one held out, its inner folds by unit need worn logs of at least {STACKING_WORN_RUNS} other units: "
+                f"events.csv needs an `onset` or `failure` row for the worn axis of at least {needs} units in all")
+    else:
+        what = (f"failed samples in {len(carriers)} worn run(s); with one held out, its inner folds by run need failed "
+                f"samples of at least {STACKING_WORN_RUNS} other runs ({needs} worn runs in all)")
+    others = [c for c in classifiers if c != "stacking"]
+    if named is not None and "stacking" in named or not others:
+        raise ValueError(f"{path}: the stacking classifier cannot be fitted here: the dataset has {what}"
+                         + (f" ({inputs.imported})" if inputs.imported else "")
+                         + "; leave it out (--classifier lr --classifier svm --classifier rf)")
+    kwargs["classifiers"] = others
+    return f"note: stacking left out: the dataset has {what}."
 
 
 @dataclass(frozen=True, eq=False)
@@ -1050,6 +1201,31 @@ class ClassificationInputs:
     groups: np.ndarray
     failed: list
     normal: list
+    imported: str = ""
+
+
+def imported_labels(runs) -> str:
+    """The labels of a dataset's units imported from logs (``faultgen logs import``), in words:
+    logs worn (and in which units), healthy and unknown, from their events (``label``); "" when no
+    run is imported."""
+    from faultgen.data import logfolder
+
+    measured = [run for run in runs if run.measured]
+    if not measured:
+        return ""
+    worn = healthy = unknown = 0
+    worn_units = []
+    for run in measured:
+        label = run.array("label")
+        is_worn = np.any(label == logfolder.WORN, axis=1)
+        is_healthy = np.all(label == logfolder.HEALTHY, axis=1)
+        worn, healthy = worn + int(is_worn.sum()), healthy + int(is_healthy.sum())
+        unknown += int(len(label) - is_worn.sum() - is_healthy.sum())
+        if is_worn.any():
+            worn_units.append(run.id)
+    return (f"labels from events.csv: {worn} logs worn in {len(worn_units)} unit(s)"
+            + (f" ({', '.join(worn_units[:6])}{', ...' if len(worn_units) > 6 else ''})" if worn_units else "")
+            + f", {healthy} healthy, {unknown} unknown (counted as not worn)")
 
 
 def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | None = None) -> ClassificationInputs:
@@ -1068,6 +1244,7 @@ def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | Non
         names = (*levels, "angle_hist", "speed_hist", "torque_hist", "friction_multiplier")
         records = [(run, {name: run.array(name) for name in names}) for run in data.runs]
         path = data.path
+        imported = imported_labels(data.runs)
         fault_levels = {run.id: run.fault_level for run, _ in records if run.fault is not None}
     X, estimated, y, groups, failed, normal = [], [], [], [], [], []
     for run, arrays in records:
@@ -1099,12 +1276,17 @@ def classification_inputs(path, wear_threshold: float = 10.0, horizon: int | Non
                          "classifier, whose features are per axis; classify each robot model's runs apart (e.g. a "
                          "fleet of one --robot)")
     if not failed or not normal:
+        if imported:
+            raise ValueError(f"{path}: classification needs units with and without logs labelled worn (has "
+                             f"{len(failed)} with, {len(normal)} without; {imported}): events.csv needs `onset` or "
+                             "`failure` rows for worn units and `healthy` rows for inspected ones")
         raise ValueError(f"{path}: classification needs runs with and without wear (has {len(failed)} worn, "
                          f"{len(normal)} unworn)")
-    _check_training_sets(path, y, groups, failed, normal, f"true wear >= {wear_threshold:g} %" if horizon is None
-                         else f"worn runs' last {THESIS_WINDOW + 1} before the horizon")
+    _check_training_sets(path, y, groups, failed, normal,
+                         ("labelled worn by events.csv" if imported else f"true wear >= {wear_threshold:g} %")
+                         if horizon is None else f"worn runs' last {THESIS_WINDOW + 1} before the horizon", imported)
     return ClassificationInputs(np.vstack(X), np.vstack(estimated) if duty else None, np.concatenate(y),
-                                np.concatenate(groups), failed, normal)
+                                np.concatenate(groups), failed, normal, imported)
 
 
 #: Label exchanges of the chance level ``faultgen classify`` measures per row by default: with 19
@@ -1196,9 +1378,10 @@ def classification_verdict(table: pd.DataFrame, command: str = "faultgen classif
     return (f"verdict: no judged cell is above chance at the {100 * CHANCE_ALPHA:g} % level{reason}: the AUCs of "
             f"{', '.join(judged)} ({np.nanmin(means.to_numpy()):.2f}-{np.nanmax(means.to_numpy()):.2f}) are what it reaches "
             f"with the runs' labels exchanged (chance {np.nanmin(null.to_numpy()):.2f}-{np.nanmax(null.to_numpy()):.2f}), "
-            "so they do not show that worn samples are told from healthy ones. More data would help: more worn and "
-            "unworn runs (several seeds: --seed 0 --seed 1 --seed 2, or more robots in a fleet) and more recorded "
-            f"cycles per run (--record all, more --cycles or --days){others}")
+            "so they do not show that worn samples are told from healthy ones. More data would help: "
+            + (f"more labelled logs: {MEASURED_NEXT}" if table.attrs.get("imported") else
+               "more worn and unworn runs (several seeds: --seed 0 --seed 1 --seed 2, or more robots in a fleet) and "
+               "more recorded cycles per run (--record all, more --cycles or --days)") + others)
 
 
 def classification_printed(table: pd.DataFrame) -> pd.DataFrame:
@@ -1249,7 +1432,9 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
     is judged against it (per cell, per row on lr, or not measured with the command that measures
     it), why two orders of the same steps are two rows (when both are), and with ``short`` (the
     default rows of ``faultgen classify``) how to get every row."""
+    imported = table.attrs.get("imported", "")
     labels = (f"the thesis's window (T-{horizon + 10} to T-{horizon}) labelled by the robot's state" if horizon is not None
+              else f"every log labelled worn by events.csv is a failed sample ({imported})" if imported
               else f"every sample labelled failed when its true wear reaches {wear_threshold:g} %")
     pairs = table.attrs.get("pairs", "every" if n_pairs is None else n_pairs)
     parts = [f"Leave-pair-out ROC AUC (mean and std over {pairs} held-out "
@@ -1279,6 +1464,7 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
     if short:
         parts.append("Rows: each step alone and the fullest combinations; every row of Table 5.2: "
                      f"`{command} --full`.")
+    parts += [note.removeprefix("note: ").capitalize() for note in table.attrs.get("notes", [])]
     return " ".join(parts)
 
 
@@ -1304,8 +1490,9 @@ def classification_heatmap(table: pd.DataFrame, out: Path) -> Path:
             text = f"{means.iat[i, j]:.2f}"
             if measured:
                 column = means.columns[j]
-                if table[(column, "above")].iat[i] is not None:
-                    text += f"\np {table[(column, 'p')].iat[i]:.2f}" + (" *" if table[(column, "above")].iat[i] else "")
+                above, p = table[(column, "above")].iat[i], table[(column, "p")].iat[i]
+                if pd.notna(above) and pd.notna(p):  # not judged: None or NaN (NaN is truthy), no p, no star
+                    text += f"\np {p:.2f}" + (" *" if bool(above) else "")
             ax.text(j, i, text, ha="center", va="center", fontsize=7)
     fig.colorbar(image, ax=ax, label=f"AUC (white: {centre:.2f}, {what})")
     title = "leave-pair-out AUC per preprocessing and classifier"
@@ -1339,13 +1526,22 @@ AXIS_COLUMNS = {"predicted", "located_axis"}
 MIN_CLASS_SAMPLES = 5
 
 
-def _check_training_sets(path, y: list, groups: list, failed: list, normal: list, failed_means: str) -> None:
+def _check_training_sets(path, y: list, groups: list, failed: list, normal: list, failed_means: str,
+                         imported: str = "") -> None:
     """Refuse a dataset whose leave-pair-out training sets lack a class, saying what it lacks
-    (``failed_means``: what makes a sample failed, for the message)."""
+    (``failed_means``: what makes a sample failed, for the message; ``imported``: the labels of an
+    imported dataset, :func:`imported_labels`, named with what events.csv needs)."""
     per_run = {g[0]: (int(labels.sum()), int(len(labels) - labels.sum())) for labels, g in zip(y, groups, strict=True)}
     totals = np.sum(list(per_run.values()), axis=0)
     fewest = min((totals[0] - per_run[f][0] - per_run[n][0], totals[1] - per_run[f][1] - per_run[n][1])
                  for f in failed for n in normal)
+    if min(fewest) < MIN_CLASS_SAMPLES and imported:
+        raise ValueError(
+            f"{path}: its labels are too few for leave-pair-out classification: with one unit with worn logs and one "
+            f"without held out, the smallest training set has {fewest[0]} failed samples ({failed_means}) and "
+            f"{fewest[1]} normal ones, and the classifiers need at least {MIN_CLASS_SAMPLES} of each ({imported}). "
+            "events.csv needs `onset` or `failure` rows for the worn axes of more units (at least 2 with worn logs) "
+            "and `healthy` rows for units inspected healthy")
     if min(fewest) < MIN_CLASS_SAMPLES:
         raise ValueError(
             f"{path}: this dataset lacks runs for leave-pair-out classification: with one worn and one unworn run "

@@ -122,6 +122,8 @@ def _draw_fleet(data, out: Path) -> Path:
     from matplotlib.figure import Figure
 
     runs = data.runs
+    imported = all(run.measured for run in runs)  # logs: labels from events.csv, no wear measured
+    parts = False
     cols = min(4, len(runs))
     rows = -(-len(runs) // cols)
     fig = Figure(figsize=(4.2 * cols, 2.6 * rows + 1.2), layout="constrained")
@@ -141,19 +143,32 @@ def _draw_fleet(data, out: Path) -> Path:
         for j in worn:
             ax.plot(days, change[:, j], ".", ms=3, color="tab:blue", alpha=0.5)
             ax.plot(days, trend[:, j], "-", lw=1.6, color="tab:blue", label=f"axis {j + 1}")
+        if run.measured:  # each log's label from events.csv, ticked along the top
+            label = run.array("label")
+            for flags, color in ((np.any(label == 1, axis=1), WEAR_COLOR), (np.all(label == 0, axis=1), "0.2")):
+                ax.plot(days[flags], np.full(int(flags.sum()), 0.97), "|", ms=6, color=color,
+                        transform=ax.get_xaxis_transform())
         if run.has("payload_mass"):  # the part of each day's record: the lighter one ticked
             mass = run.array("payload_mass")
             light = mass < mass.max()
+            parts |= bool(light.any())
             ax.plot(days[light], np.zeros(int(light.sum())), "|", ms=6, color="tab:green",
                     transform=ax.get_xaxis_transform(), label="lighter part")
         ax.axhline(0.0, color="0.4", lw=0.6)
         ax.set_ylabel(CHANGE_LABEL.replace("change of ", "").replace(" [%]", "\nchange [%]"), fontsize=7)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
-        state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
-        ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
-                     color=WEAR_COLOR if run.failing else "black")
-        if run.failing:
+        if run.measured:
+            label = run.array("label")
+            n_worn, n_healthy = int(np.any(label == 1, axis=1).sum()), int(np.all(label == 0, axis=1).sum())
+            state = (f"logs {n_worn} worn" + (f" (axis {', '.join(str(a) for a in run.worn_axes)})" if n_worn else "")
+                     + f", {n_healthy} healthy, {len(label) - n_worn - n_healthy} unknown")
+            ax.set_title(f"{run.id}\n{run.robot}: {state}", fontsize=8, color=WEAR_COLOR if n_worn else "black")
+        else:
+            state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
+            ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
+                         color=WEAR_COLOR if run.failing else "black")
+        if run.failing and not run.measured:
             twin = ax.twinx()
             twin.plot(days, run.fault_level, "-", color=WEAR_COLOR, lw=1.2)
             twin.set_ylim(bottom=0.0)
@@ -162,11 +177,21 @@ def _draw_fleet(data, out: Path) -> Path:
     for ax in panels[len(runs):]:
         ax.set_visible(False)
     for ax in panels[max(0, len(runs) - cols):len(runs)]:
-        ax.set_xlabel("day of the record", fontsize=8)
-    fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
-                 f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running median "
-                 f"over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; grey: the "
-                 "other axes); red: the worn axis's true wear; green ticks: days with the lighter part", fontsize=10)
+        ax.set_xlabel("log of the record (stamp order)" if imported else "day of the record", fontsize=8)
+    if imported:
+        worn_units = sum(bool(run.worn_axes) for run in runs)
+        fig.suptitle(f"{data.path.name}: {len(runs)} units imported from logs ({worn_units} with logs labelled worn "
+                     f"by events.csv), one panel each\nchange of each axis's mean |motor torque| per log from its "
+                     f"first {BASELINE_DAYS} logs, running median over {TREND_DAYS} logs where the window is whole\n"
+                     "(grey: axes without a log labelled worn; blue: the axis with worn logs, its logs as dots)\n"
+                     "ticks along the top: logs labelled worn (red) and healthy (black), none: unknown"
+                     + ("; green ticks: logs with the lighter part" if parts else ""), fontsize=10)
+    else:
+        fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
+                     f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running "
+                     f"median over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; "
+                     "grey: the other axes); red: the worn axis's true wear; green ticks: days with the lighter part",
+                     fontsize=10)
     from faultgen.data.atomic import atomic_path
 
     with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG

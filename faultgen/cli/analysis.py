@@ -36,8 +36,14 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
     check_outputs(outputs, overwrite)
     with reader.open(file) as data:
         failing, unhashed = data.failing, data.unhashed
+        imported = all(run.measured for run in data.runs)
     if unhashed:  # old files: runs are paired by their task label alone
         typer.echo(unhashed)
+    if not failing and imported:
+        from analysis import benchmark
+
+        raise ValueError(f"{file} has no log labelled worn (its logs' events.csv has no `onset` or `failure` row): the "
+                         f"analyses compare worn logs with healthy ones; {benchmark.MEASURED_NEXT}")
     if not failing:
         raise ValueError(f"{file} has no worn run (every run is without wear or fault): the analyses compare worn "
                          "runs with runs without wear; sweep with --axis 1..6 too")
@@ -113,7 +119,7 @@ def bench_isolators_command(
     table = benchmark.isolation_table(file, isolators, wear_levels, progress=progress, speed_window=window)
     typer.echo(stated)  # after the isolators ran: a plug-in refused in fit is the only line printed
     with atomic.output_set(written) as staged:  # all five outputs, or none
-        benchmark.write_outputs(table, staged(stem), benchmark.isolation_markdown(table))
+        benchmark.write_outputs(benchmark.isolation_csv(table), staged(stem), benchmark.isolation_markdown(table))
         benchmark.isolation_heatmap(table, staged(stem.with_suffix(".png")))
         confusion = benchmark.isolation_confusion(table)
         csv_cells.escaped(confusion).to_csv(staged(confusion_stem.with_suffix(".csv")))
@@ -121,15 +127,23 @@ def bench_isolators_command(
     if window is not None:
         typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
         typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
-    accuracy = benchmark.isolation_accuracy_text(table).rename(index={0.0: "no fault"}, level="wear_pct")
+    imported = bool(table.attrs.get("imported"))
+    if imported:
+        typer.echo("units imported from logs: no wear is measured; each worn unit is one case, its logs up to the "
+                   "first labelled worn by events.csv (\"to first worn\"; --levels does not apply)")
+    accuracy = benchmark.isolation_levels(table, benchmark.isolation_accuracy_text(table))
     typer.echo(benchmark.markdown(accuracy, digits=4))
     typer.echo(benchmark.ACCURACY_RULE + " In the CSV, predicted 0 is undecided and -1 too few cycles (column answer "
                "spells it; needed: the isolator's fewest cycles).")
     typer.echo("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few cycles):")
-    typer.echo(benchmark.markdown(benchmark.isolation_decided(table).rename(index={0.0: "no fault"}, level="wear_pct"),
-                                  digits=4))
+    typer.echo(benchmark.markdown(benchmark.isolation_levels(table, benchmark.isolation_decided(table)), digits=4))
     starved = benchmark.starved_isolators(table)
-    if starved:
+    if starved and imported:
+        typer.echo(f"note: this dataset lacks logs: with at most {int(table['cycles'].max())} logs per unit up to its "
+                   f"first labelled worn, {', '.join(starved)} named no axis (undecided, or too few logs to run) in "
+                   "most worn cases. These isolators need tens of records (thesis Table 6.2: up to 86) before the "
+                   f"first worn one: longer records of the units; {benchmark.MEASURED_NEXT}")
+    elif starved:
         typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
                    f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
                    "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
@@ -221,7 +235,7 @@ def detect_command(
         csv_cells.escaped(summary).to_csv(staged(summary_csv))
         benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
     typer.echo(benchmark.markdown(table, digits=4))
-    typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.DETECTION_COLUMNS.items()))
+    typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.detection_columns(table).items()))
     left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
     rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
              if left_out else "")

@@ -49,7 +49,6 @@ def card(path: str | Path) -> str:
         If ``path`` is not a finished faultgen dataset.
     """
     from faultgen.model import robots
-    from faultgen.operation import programs
 
     with reader.open(path) as data:
         runs = data.runs
@@ -57,17 +56,26 @@ def card(path: str | Path) -> str:
         kind, command, written_by = data.kind, data.command, data.faultgen_version
         shas = {run.robot: run.provenance["model_sha256"] for run in runs}
         largest = max((float(run.wear.max()) for run in runs), default=0.0)
+        labels = {run.id: run.array("label") for run in runs if run.measured}
     wear_pct = round(largest, 1) if largest > 0.05 else EXAMPLE_WEAR
     robot_names = sorted({r.robot for r in runs})
     pairs = sorted({(r.robot, r.task) for r in runs if not r.measured})
     measured_robots = sorted({r.robot for r in runs if r.measured})
+    imported = all(r.measured for r in runs)  # only logs: no wear is measured, labels come from events
     lines = [f"# Dataset card: {Path(path).name}", "",
-             f"A faultgen {kind}: {len(runs)} run(s) ({sum(r.failing for r in runs)} with wear or a fault), robots "
+             f"A faultgen {kind}: {len(runs)} run(s) ({sum(r.failing for r in runs)} "
+             + ("with a log labelled worn" if imported else "with wear or a fault") + "), robots "
              f"{', '.join(robot_names)}, tasks {', '.join(sorted({r.task for r in runs}))}; a sample is "
              + ("a log's record (the largest of its cycles' features, as a simulated day's)"
                 if any(r.sample == "log" for r in runs)
                 else "a day's record (the day's maximum of its cycles)" if any(r.sample == "day" for r in runs)
                 else "one recorded cycle") + ".", ""]
+
+    if imported:
+        lines += _imported_labels(runs, labels)
+        lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported)
+        lines += _provenance(path, command, written_by, shas)
+        return "\n".join(lines)
 
     lines += [f"## What {wear_pct:g} % wear means", "",
               (f"{wear_pct:g} % is the largest wear in this dataset. " if largest > 0.05 else
@@ -104,8 +112,58 @@ def card(path: str | Path) -> str:
                  "`friction_multiplier` holds it as a wear (2 on worn logs, 1 elsewhere)."] if measured_robots else []),
               ""]
 
-    lines += ["## Arrays and units", ""]
-    rows = [[name, *reader.SCHEMA[name]] for name in names if name in reader.SCHEMA]
+    lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported)
+    lines += _provenance(path, command, written_by, shas)
+    return "\n".join(lines)
+
+
+#: What an imported dataset's arrays hold where the schema speaks of a simulation.
+IMPORTED_ARRAYS = {
+    "friction_multiplier": ("1", "cycle, axis", "the log's label as a number (2 labelled worn by events.csv, 1 "
+                                                "healthy or unknown): a mark, not a measured friction"),
+    "t": ("s", "sample", "empty: the logs' signals are not stored"),
+    "q_ref": ("rad", "sample, axis", "empty: the logs' signals are not stored"),
+    "cycles": ("1", "cycle", "1-based index of each log record, in stamp order"),
+}
+
+
+def _imported_labels(runs, labels: dict) -> list[str]:
+    """The card's label section of a dataset imported from logs: what its labels are (``labels``:
+    each run's ``label`` array) and how many."""
+    from faultgen.data import logfolder
+
+    worn = healthy = unknown = 0
+    for label in labels.values():
+        is_worn, is_healthy = np.any(label == logfolder.WORN, axis=1), np.all(label == logfolder.HEALTHY, axis=1)
+        worn, healthy = worn + int(is_worn.sum()), healthy + int(is_healthy.sum())
+        unknown += int(len(label) - is_worn.sum() - is_healthy.sum())
+    units = [r.id for r in runs if r.worn_axes]
+    return ["## Labels", "",
+            "Units imported from measured logs (`faultgen logs import`, task `measured`): one run per unit, one "
+            "record per log in stamp order. Nothing here is simulated and no wear is measured: what a log is, worn, "
+            "healthy or unknown, comes from the events of the logs folder's `events.csv` (`onset`, `failure`, "
+            "`repair`, `gearbox_change`, `healthy`; docs/dataset.md, \"A fleet's logs\").", "",
+            f"- logs: {worn} worn (in {len(units)} unit(s){': ' + ', '.join(units[:8]) if units else ''}"
+            f"{', ...' if len(units) > 8 else ''}), {healthy} healthy, {unknown} unknown (no event covers them).",
+            "- `label`: per log and axis, 1 worn, 0 healthy, -1 unknown.",
+            "- `worn_axes`: the axes with a log labelled worn; none: no log of the unit is labelled worn (healthy "
+            "or unknown).",
+            "- `friction_multiplier`: the label as a number the analyses read (2 on worn logs, 1 elsewhere), not a "
+            "measured friction.",
+            "- `stamp`, `log_file`, `log_cycles`, `log_duration`: each record's log, its cycles and duration.",
+            "- `seed`: a number derived from the unit's name (the analyses' unit key).",
+            "- next: label more logs in `events.csv` and import again, or run `faultgen monitor` on the logs "
+            "folder, which needs no labels.", ""]
+
+
+def _arrays_and_edges(names, robot_names, pairs, measured_robots, imported) -> list[str]:
+    """The card's arrays with their units, and the histograms' bin edges."""
+    from faultgen.model import robots
+    from faultgen.operation import programs
+
+    lines = ["## Arrays and units", ""]
+    rows = [[name, *(IMPORTED_ARRAYS.get(name) if imported and name in IMPORTED_ARRAYS else reader.SCHEMA[name])]
+            for name in names if name in reader.SCHEMA]
     lines += _table(["array", "units", "axes", "description"], rows)
 
     lines += ["", "## Histogram bin edges", "",
@@ -129,8 +187,12 @@ def card(path: str | Path) -> str:
                      "[limits], as its thesis tasks): " + "; ".join(f"0..{v:.3g}" for v in limit)])
     lines += _table(["robot", "task", "histogram", "units", f"range per axis 1..N, split in {sensors.HISTOGRAM_BINS}"],
                     rows)
+    return lines
 
-    lines += ["", "## Provenance and versions", "",
+
+def _provenance(path, command, written_by, shas) -> list[str]:
+    """The card's provenance and versions."""
+    return ["", "## Provenance and versions", "",
               f"- command: `{command or '(not stored)'}`",
               f"- written by faultgen {written_by}; this card by faultgen {__version__}",
               "- robot models (SHA-256 of the MJCF): " + "; ".join(f"{k} {v[:12]}" for k, v in sorted(shas.items())),
@@ -138,4 +200,3 @@ def card(path: str | Path) -> str:
               f"h5py {_version('h5py')}",
               f"- reading: `import faultgen; data = faultgen.open({str(path)!r})`; `data.runs`, `data.features()`",
               f"- schema: format {schema.FORMAT} version {schema.FORMAT_VERSION}; docs/dataset.md"]
-    return "\n".join(lines)

@@ -104,6 +104,8 @@ def summary(path: str | Path) -> str:
         f"  {what}:{' ' * (14 - len(what))}{min(n_cycles)}-{max(n_cycles)} "
         f"{record} per run, {sum(n_cycles)} in all; "
         + (f"{min(n_log)}-{max(n_log)} samples per cycle at {1 / sensors.LOG_PERIOD:.0f} Hz" if signals
+           else "each log's features and its labels from events.csv (the logs' signals are not stored)"
+           if all(row.get("source") == MEASURED for row in rows)
            else "features and truth only (no 250 Hz signals)"),
     ]
     if any("conditions" in row for row in rows):
@@ -124,7 +126,7 @@ def summary(path: str | Path) -> str:
     measured = [row for row in rows if row.get("source") == MEASURED]
     if measured:
         lines.append(f"  measured:      {len(measured)} unit(s) imported from logs (`faultgen logs import`): labels from "
-                     "their events, no simulated truth")
+                     "their events, nothing simulated")
     if command:
         lines.append(f"  command:       {command}")
     return "\n".join(lines)
