@@ -290,7 +290,8 @@ def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir
     handled = [(e.stamp, e.sha256) for e in unit.entries] + [(k.stamp, k.sha256) for k in unit.skipped]
     by_stamp = {g.stamp: g for g in unit_logs}
     stamps = [g.stamp for g in unit_logs]
-    done = max((s for s, _ in handled), key=lambda s: stamps.index(s) if s in by_stamp else -1)
+    position = {stamp: i for i, stamp in enumerate(stamps)}
+    done = max((s for s, _ in handled), key=lambda s: position.get(s, -1))
     if done not in by_stamp:
         raise ValueError(f"{name}: its last scored log ({done}) is no longer in {logs_dir}; put it back or "
                          "score this folder into a new OUT")
@@ -300,11 +301,11 @@ def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir
             raise ValueError(f"{log.path} changed since it was scored into {out} (SHA-256 {sha256[:12]}..., "
                              "now another): score this folder into a new OUT")
     seen = {s for s, _ in handled}
-    late = [g for g in unit_logs[: stamps.index(done)] if g.stamp not in seen]
+    late = [g for g in unit_logs[: position[done]] if g.stamp not in seen]
     if late:
         raise ValueError(f"{late[0].path} is older than the last scored log of {name} ({done}); the monitor "
                          "scores logs in stamp order: score this folder into a new OUT")
-    return unit_logs[stamps.index(done) + 1:]
+    return unit_logs[position[done] + 1:]
 
 
 def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
