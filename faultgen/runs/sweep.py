@@ -395,6 +395,15 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
 def _stop_local_workers() -> None:
     """Shut joblib's worker processes down and wait for them, so that nothing they hold (loky's
     semaphores) is left for Python's resource tracker to report as leaked at exit."""
+    import time
+
     from joblib.externals.loky import get_reusable_executor
 
-    get_reusable_executor().shutdown(wait=True, kill_workers=True)
+    executor = get_reusable_executor()
+    for _ in range(200):  # an interrupt while loky is still starting its manager thread: it starts within moments
+        try:
+            executor.shutdown(wait=True, kill_workers=True)
+            return
+        except RuntimeError:  # "cannot join thread before it is started" (seen under load, issue 61)
+            time.sleep(0.05)
+    executor.shutdown(wait=True, kill_workers=True)
