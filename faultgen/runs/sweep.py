@@ -406,4 +406,7 @@ def _stop_local_workers() -> None:
             return
         except RuntimeError:  # "cannot join thread before it is started" (seen under load, issue 61)
             time.sleep(0.05)
-    executor.shutdown(wait=True, kill_workers=True)
+    for process in list((getattr(executor, "_processes", None) or {}).values()):  # the thread never started
+        process.kill()
+        process.join()
+    executor.shutdown(wait=False, kill_workers=True)
