@@ -25,7 +25,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model import builder, importers, limits, robots, sizing
+from faultgen.model import builder, importers, limits, plausibility, robots, sizing
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
@@ -33,12 +33,17 @@ NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
 
 @dataclass(frozen=True)
 class Added:
-    """What :func:`add` wrote: the folder, the loaded robot, the arm as read, the payload used."""
+    """What :func:`add` wrote: the folder, the loaded robot, the arm as read, the payload used, where
+    that payload came from, and the plausibility report (:mod:`faultgen.model.plausibility`: a
+    summary line and the findings, each with what to do)."""
 
     folder: Path
     robot: robots.Robot
     arm: importers.Arm
     payload: float
+    payload_origin: str = ""
+    plausibility: str = ""
+    findings: tuple[str, ...] = ()
 
 
 SCENE = """<mujoco model="{name} scene">
@@ -117,14 +122,16 @@ def add(
     arm = importers.read(source, packages)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
+    guessed = payload is None and math.isnan(arm.payload)
     payload_origin = (
         "given with --payload"
         if payload is not None
         else "from the source"
-        if not math.isnan(arm.payload)
-        else f"sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass"
+        if not guessed
+        else f"GUESSED: {sizing.PAYLOAD_SHARE * 100:g} % of the moving mass; give --payload KG"
     )
-    drive, origin, payload = sizing.size(arm, given, payload)
+    result = sizing.sized(arm, given, payload)
+    drive, origin, payload = result.drivetrain, result.origin, result.payload
     dropped = _skeleton(arm.spec, str(source))
     if dropped:
         arm.notes.append(
@@ -145,6 +152,9 @@ def add(
         (stage / f"{name}.xml").write_text(text)
         robot = robots.load(stage / f"{name}.xml")
         size = reach(robot)
+        summary, findings = plausibility.report(arm, payload, guessed, result.moving_mass,
+                                                plausibility.radial_reach(robot), result.loads,
+                                                sizing.PAYLOAD_SHARE)
         (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
         header = (
             f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
@@ -161,7 +171,8 @@ def add(
         if tasks is not None:
             (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
         (stage / "README.md").write_text(
-            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin)
+            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin, (summary, findings),
+                   result.loads)
         )
         if out.exists():
             out.rmdir()
@@ -169,7 +180,7 @@ def add(
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    return Added(out, robots.load(out / f"{name}.xml"), arm, payload)
+    return Added(out, robots.load(out / f"{name}.xml"), arm, payload, payload_origin, summary, tuple(findings))
 
 
 def remove_stale(out: Path) -> list[Path]:
@@ -263,6 +274,8 @@ def readme(
     drivetrain,
     robot,
     payload_origin: str = "",
+    checked: tuple[str, list[str]] | None = None,
+    loads: sizing.Loads | None = None,
 ) -> str:
     """README.md of an added robot: where the arm came from, and per axis where every drivetrain
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
@@ -291,7 +304,14 @@ def readme(
         "",
         f"Kinematics, joint limits, link masses, centres of mass and inertias are the {arm.kind} file's "
         f"`{arm.source.name}`, as MuJoCo's compiler reads it. Rated payload: {payload:.4g} kg "
-        f"({payload_origin}).",
+        f"({payload_origin})"
+        + (
+            f"; the drives are sized to hold and accelerate it with its centre of mass {loads.offset:.3g} m "
+            "out along the flange's z axis (sizing.rated_load)"
+            if loads is not None
+            else ""
+        )
+        + ".",
         "",
         "| axis | joint | source joint | range (rad) | speed limit (rad/s) | effort limit (N m) |",
         "| --- | --- | --- | --- | --- | --- |",
@@ -303,6 +323,11 @@ def readme(
         )
     if arm.notes:
         lines += ["", "Changes made while reading:", ""] + [f"- {note}" for note in arm.notes]
+    if checked is not None:
+        summary, findings = checked
+        lines += ["", "## Plausibility", "", f"{summary}: "
+                  + (f"{len(findings)} finding(s)." if findings else "nothing implausible found."), ""]
+        lines += [f"- {finding}" for finding in findings]
     lines += [
         "",
         "## Drivetrain (gear ratio, motor inertia, gearbox stiffness and damping, motor torque limit, "
