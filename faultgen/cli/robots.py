@@ -90,8 +90,8 @@ def robots_command(
             typer.echo(f"warning: {warning.message}", err=True)
         robot = added.robot
         typer.echo(f"{robot.name}: {robot.n_axes} axes from {added.arm.kind} {source} -> {added.folder} "
-                   f"(rated payload {added.payload:.4g} kg, {added.payload_origin}; provenance in "
-                   f"{added.folder / 'README.md'})")
+                   f"(rated payload {added.payload:.4g} kg, {added.payload_origin}; sizing rule {added.rule}; "
+                   f"provenance in {added.folder / 'README.md'})")
         typer.echo(f"plausibility: {added.plausibility}: "
                    + (f"{len(added.findings)} finding(s)" if added.findings else "nothing implausible found"))
         for finding in added.findings:

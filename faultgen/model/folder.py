@@ -29,6 +29,9 @@ from faultgen.model import builder, importers, limits, plausibility, robots, siz
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
+#: How ``drivetrain.toml`` and README.md record the sizing rule (:func:`sizing_rule` reads it back).
+RULE_LINE = "Sized where not given by sizing rule {rule} (faultgen.model.sizing.RULE_VERSIONS)"
+RULE_RECORD = re.compile(r"by sizing rule (\d+) \(faultgen\.model\.sizing\.RULE_VERSIONS\)")
 
 
 @dataclass(frozen=True)
@@ -44,6 +47,7 @@ class Added:
     payload_origin: str = ""
     plausibility: str = ""
     findings: tuple[str, ...] = ()
+    rule: int = sizing.RULE
 
 
 SCENE = """<mujoco model="{name} scene">
@@ -79,6 +83,7 @@ def add(
     payload: float | None = None,
     tasks: Callable[[robots.Robot, importers.Arm, float], str] | None = None,
     packages: dict[str, str | Path] | None = None,
+    rule: int = sizing.RULE,
 ) -> Added:
     """Write the robot folder ``out`` for the arm in ``source``.
 
@@ -99,6 +104,10 @@ def add(
     packages : dict of str to path, optional
         ROS package name -> folder, for ``package://`` meshes and xacro's ``$(find NAME)``; the
         source may read only its own folder and these (:func:`faultgen.model.importers.read`).
+    rule : int
+        The sizing rule (:data:`faultgen.model.sizing.RULE_VERSIONS`; default the latest): the
+        benchmark's frozen track versions add their robots with the rule they were frozen with.
+        ``drivetrain.toml`` and README.md record it (:func:`sizing_rule`).
 
     Returns
     -------
@@ -114,6 +123,7 @@ def add(
         raise ValueError(f"robot name {name!r}; expected a letter, then letters, digits, '_' or '-'")
     if payload is not None and not (math.isfinite(payload) and 0 <= payload <= limits.MAX_PAYLOAD):
         raise ValueError(f"payload = {payload!r} kg; expected a number in 0 .. {limits.MAX_PAYLOAD:g} kg")
+    sizing.check_rule(rule)
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
@@ -130,7 +140,7 @@ def add(
         if not guessed
         else f"GUESSED: {sizing.PAYLOAD_SHARE * 100:g} % of the moving mass; give --payload KG"
     )
-    result = sizing.sized(arm, given, payload)
+    result = sizing.sized(arm, given, payload, rule)
     drive, origin, payload = result.drivetrain, result.origin, result.payload
     dropped = _skeleton(arm.spec, str(source))
     if dropped:
@@ -158,6 +168,7 @@ def add(
         (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
         header = (
             f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
+            f"{RULE_LINE.format(rule=rule)}\n"
             f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
             f"--drivetrain drivetrain.toml -o NEW_FOLDER"
         )
@@ -172,7 +183,7 @@ def add(
             (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
         (stage / "README.md").write_text(
             readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin, (summary, findings),
-                   result.loads)
+                   result.loads, rule)
         )
         if out.exists():
             out.rmdir()
@@ -180,7 +191,24 @@ def add(
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    return Added(out, robots.load(out / f"{name}.xml"), arm, payload, payload_origin, summary, tuple(findings))
+    return Added(out, robots.load(out / f"{name}.xml"), arm, payload, payload_origin, summary, tuple(findings),
+                 rule)
+
+
+def sizing_rule(folder: str | Path) -> int | None:
+    """The sizing rule that sized the robot folder ``folder`` (:data:`faultgen.model.sizing.
+    RULE_VERSIONS`), as its ``drivetrain.toml`` records it; None for a folder that records none (a
+    shipped robot, or one added before the rules were versioned)."""
+    path = Path(folder) / "drivetrain.toml"
+    if not path.is_file():
+        return None
+    for line in path.read_text().splitlines():
+        if not line.startswith("#"):
+            break
+        match = RULE_RECORD.search(line)
+        if match:
+            return int(match[1])
+    return None
 
 
 def remove_stale(out: Path) -> list[Path]:
@@ -276,6 +304,7 @@ def readme(
     payload_origin: str = "",
     checked: tuple[str, list[str]] | None = None,
     loads: sizing.Loads | None = None,
+    rule: int | None = None,
 ) -> str:
     """README.md of an added robot: where the arm came from, and per axis where every drivetrain
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
@@ -337,7 +366,8 @@ def readme(
         "rule "
         '(docs/robots.md, "Your own robot", gives each rule\'s numbers and sources). Units: '
         + "; ".join(f"{k}: {u}" for k, u in UNITS.items())
-        + ".",
+        + "."
+        + (f" {RULE_LINE.format(rule=rule)}: {sizing.RULE_VERSIONS[rule]}." if rule is not None else ""),
         "",
         "| quantity | " + " | ".join(f"axis {i}" for i in range(1, n + 1)) + " |",
         "| --- |" + " --- |" * n,

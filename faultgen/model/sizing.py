@@ -23,6 +23,17 @@ inertia law fitted through the PUMA 560's measured motors:
 - Coulomb friction 3 % of the motor torque limit in both directions, static excess 30 % of it,
   Stribeck velocity 10 rad/s, exponent 2, viscous ``Coulomb / 400 rad/s``, bristle stiffness
   ``Coulomb / 0.1 rad``, bristle damping 0.
+
+These are sizing rule 2 (:data:`RULE`, the default). The rules are versioned (:data:`RULE_VERSIONS`),
+so that a robot folder made with an earlier rule can be made again bit for bit (the benchmark's
+frozen track versions add their third-party robots with the rule they were frozen with,
+:mod:`faultgen.bench.tracks`): rule 1, faultgen's rule before the rated load sized the drives, differs
+only in the arm-side peak torque where the source gives no effort limit:
+``1.5 max_q |g_i(q)| + max_q M_ii(q) qd_max / 0.5 s`` (gravity with the rated payload as a solid
+sphere of 1000 kg/m^3 one radius out along the last joint's axis from its origin, over 256 poses,
+plus reaching top speed in half a second; :func:`arm_loads_rule1`), and motor torque limit
+``tau_peak / G``, at least 0.27 N m. The robot folder records the rule that sized it
+(``drivetrain.toml``'s header and README.md: :func:`faultgen.model.folder.sizing_rule`).
 """
 
 from __future__ import annotations
@@ -72,6 +83,18 @@ VISCOUS_SPEED, PRESLIDING = 400.0, 0.1
 #: Payload share of the moving mass when the rated payload is unknown (a guess, said as one).
 PAYLOAD_SHARE = 0.15
 
+#: The sizing rules by number, as a robot folder records them; :data:`RULE` is the default.
+RULE_VERSIONS = {
+    1: "the peak-torque rule before issue 60 (1.5 x max gravity torque with the rated payload as a sphere at the "
+    "last joint + max M_ii x speed limit / 0.5 s)",
+    2: "the rated load held and accelerated along the planning limits (load diagram's offset, rotor inertia and "
+    "motor friction included)",
+}
+RULE = 2
+#: Rule 1's gravity margin and time to reach top speed, s (its peak-torque rule), and the density of
+#: its rated payload, kg/m^3 (a solid sphere one radius out along the last axis).
+GRAVITY_MARGIN, RAMP_TIME, PAYLOAD_DENSITY = 1.5, 0.5, 1000.0
+
 #: The rule of each key, as the robot's README names it.
 RULES = {
     "gear_ratio": f"G = {MOTOR_SPEED:g} rad/s / joint speed limit",
@@ -89,6 +112,12 @@ RULES = {
     FRICTION_FIELDS[5]: f"Coulomb / {VISCOUS_SPEED:g} rad/s",  # viscous (a name the effects own)
     "bristle_stiffness": f"Coulomb / {PRESLIDING:g} rad presliding deflection",
     "bristle_damping": "0 (docs/simulation.md, 'Numerical convergence')",
+}
+#: Rule 1's rules, as its robots' READMEs name them (its motor torque limit's differs).
+RULES_1 = {
+    **RULES,
+    "motor_torque_limit": f"arm-side peak torque / G; peak = effort limit, else {GRAVITY_MARGIN:g} x max "
+    f"gravity torque (rated payload) + max M_ii x speed limit / {RAMP_TIME:g} s",
 }
 
 
@@ -139,6 +168,42 @@ class Loads:
     acceleration: np.ndarray
     payload: float
     offset: float
+
+
+def arm_loads_rule1(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rule 1's loads: largest gravity torque (rated payload at the last link's origin) and largest
+    diagonal of the joint-space inertia over :data:`POSES` poses within the limits, N m and kg m^2,
+    shape (N,). Kept as faultgen computed them before rule 2 (bit for bit)."""
+    spec = spec.copy()
+    last = spec.body(joints[-1].body)
+    model = spec.copy().compile()
+    if payload > 0:
+        # a solid sphere of water's density, its centre one radius out along the last axis
+        radius = (3 * payload / (4 * math.pi * PAYLOAD_DENSITY)) ** (1 / 3)
+        axis = model.jnt_axis[model.joint(joints[-1].name).id]
+        load = last.add_body(
+            name="__payload", pos=(model.jnt_pos[model.joint(joints[-1].name).id] + radius * axis).tolist()
+        )
+        load.explicitinertial = True
+        load.mass, load.inertia = payload, [0.4 * payload * radius**2] * 3
+    model = spec.compile()
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(SEED)
+    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
+    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
+    low, high = np.array([j.range for j in joints]).T
+    gravity, inertia = np.zeros(len(joints)), np.zeros(len(joints))
+    full = np.zeros((model.nv, model.nv))
+    for _ in range(POSES):
+        data.qpos[:] = 0
+        data.qpos[qadr] = rng.uniform(low, high)
+        data.qvel[:], data.qacc[:] = 0, 0
+        mujoco.mj_inverse(model, data)
+        gravity = np.maximum(gravity, np.abs(data.qfrc_inverse[dofs]))
+        mujoco.mj_fullM(model, data, full)
+        inertia = np.maximum(inertia, np.diag(full)[dofs])
+    return gravity, inertia
 
 
 def with_rated_load(spec: mujoco.MjSpec, joints: list, payload: float) -> mujoco.MjSpec:
@@ -219,29 +284,46 @@ def moving_mass(spec: mujoco.MjSpec, joints: list) -> float:
 
 
 def size(
-    arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None
+    arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None, rule: int = RULE
 ) -> tuple[Drivetrain, dict[int, dict[str, str]], float]:
     """:func:`sized`'s drivetrain, provenance and rated payload (kg)."""
-    out = sized(arm, given, payload)
+    out = sized(arm, given, payload, rule)
     return out.drivetrain, out.origin, out.payload
 
 
 @dataclass(frozen=True)
 class Sized:
     """What :func:`sized` gives: the drivetrain, ``origin[axis][key]`` (``"given"`` or ``"sized:
-    <rule>"``), the rated payload used (kg), the :class:`Loads` the rules used and the arm's moving
-    mass (kg)."""
+    <rule>"``), the rated payload used (kg), the :class:`Loads` the rules used (None under rule 1,
+    which sizes from gravity and inertia alone), the arm's moving mass (kg) and the sizing rule
+    (:data:`RULE_VERSIONS`)."""
 
     drivetrain: Drivetrain
     origin: dict
     payload: float
-    loads: Loads
+    loads: Loads | None
     moving_mass: float
+    rule: int = RULE
 
 
-def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None) -> Sized:
+def check_rule(rule) -> int:
+    """``rule`` if it is a sizing rule's number (:data:`RULE_VERSIONS`).
+
+    Raises
+    ------
+    ValueError
+        Naming the rules there are.
+    """
+    if isinstance(rule, bool) or not isinstance(rule, int) or rule not in RULE_VERSIONS:
+        raise ValueError(f"sizing rule {rule!r}: expected one of {', '.join(map(str, RULE_VERSIONS))}")
+    return rule
+
+
+def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float | None = None,
+          rule: int = RULE) -> Sized:
     """A full drivetrain for ``arm`` (:class:`faultgen.model.importers.Arm`): the values ``given``
-    (``{axis: {key: value}}``, e.g. a partial ``--drivetrain``) and the rest sized by :data:`RULES`.
+    (``{axis: {key: value}}``, e.g. a partial ``--drivetrain``) and the rest sized by :data:`RULES`
+    (``rule`` 2) or :data:`RULES_1` (``rule`` 1: module docstring).
 
     Parameters
     ----------
@@ -250,11 +332,15 @@ def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float 
         Values to keep, by axis number (1..N) and key.
     payload : float, optional
         Rated payload in kg; by default the source's, else :data:`PAYLOAD_SHARE` of the moving mass.
+    rule : int
+        The sizing rule (:data:`RULE_VERSIONS`; default :data:`RULE`).
 
     Returns
     -------
     Sized
     """
+    if check_rule(rule) == 1:
+        return _sized_rule1(arm, given, payload)
     given = given or {}
     n = len(arm.joints)
     mass = moving_mass(arm.spec, arm.joints)
@@ -317,7 +403,74 @@ def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float 
         table[axis] = {key: mine[key] for key in KEYS}
         origin[axis] = notes
     source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
-    return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), loads, mass)
+    return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), loads, mass, 2)
+
+
+def _sized_rule1(arm, given: dict[int, dict[str, float]] | None, payload: float | None) -> Sized:
+    """:func:`sized` under rule 1: faultgen's sizing before rule 2, kept as it was (bit for bit)."""
+    given = given or {}
+    n = len(arm.joints)
+    model = arm.spec.copy().compile()
+    first = model.joint(arm.joints[0].name).id
+    moving_mass = float(model.body_subtreemass[model.jnt_bodyid[first]])
+    if payload is None:
+        payload = arm.payload if not math.isnan(arm.payload) else PAYLOAD_SHARE * moving_mass
+    gravity, inertia = arm_loads_rule1(arm.spec, arm.joints, payload)
+    main = main_axes(n)
+    table, origin = {}, {}
+    for k in range(n):
+        axis = k + 1
+        wrist = k >= main
+        mine = dict(given.get(axis, {}))
+        notes = {key: "given" for key in mine}
+
+        def put(key: str, value: float, mine=mine, notes=notes) -> float:
+            if key not in mine:
+                mine[key] = float(value)
+                notes[key] = "sized: " + RULES_1[key]
+            return mine[key]
+
+        known_speed = not math.isnan(arm.speed_limit[k])
+        speed = arm.speed_limit[k] if known_speed else DEFAULT_SPEED[wrist]
+        G = put("gear_ratio", MOTOR_SPEED / speed)
+        if "gear_ratio" not in given.get(axis, {}):
+            notes["gear_ratio"] += (
+                f" ({speed:.4g} rad/s from the source)"
+                if known_speed
+                else f" (no speed limit in the source: {speed:g} rad/s assumed)"
+            )
+        effort = arm.effort_limit[k]
+        peak = (
+            effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
+        )
+        torque = put(
+            "motor_torque_limit", peak / G if not math.isnan(effort) else max(peak / G, MIN_MOTOR_TORQUE)
+        )
+        if "motor_torque_limit" not in given.get(axis, {}):
+            notes["motor_torque_limit"] = (
+                f"sized: the source's effort limit {effort:.4g} N m / G"
+                if not math.isnan(effort)
+                else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
+                f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
+                f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
+                f"{MIN_MOTOR_TORQUE:g} N m"
+            )
+        jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
+        f = RESONANCE[wrist]
+        stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
+        put("gearbox_damping", 2 * DAMPING_RATIO * math.sqrt(stiffness * G**2 * jm))
+        coulomb = put("coulomb_pos", COULOMB_SHARE * torque)
+        put("coulomb_neg", COULOMB_SHARE * torque)
+        put("static", STATIC_SHARE * coulomb)
+        put("stribeck_velocity", STRIBECK_VELOCITY)
+        put("stribeck_exponent", STRIBECK_EXPONENT)
+        put(FRICTION_FIELDS[5], coulomb / VISCOUS_SPEED)
+        put("bristle_stiffness", coulomb / PRESLIDING)
+        put("bristle_damping", 0.0)
+        table[axis] = {key: mine[key] for key in KEYS}
+        origin[axis] = notes
+    source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
+    return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), None, moving_mass, 1)
 
 
 #: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3
