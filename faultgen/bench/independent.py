@@ -7,7 +7,9 @@ What is independent and what is ours:
 - **Rigid-body dynamics: Pinocchio's** recursive Newton-Euler (``pin.rnea``) on the robot folder's
   ``urdf_used.urdf`` (the URDF as faultgen compiled it, read by Pinocchio's own URDF parser): for the
   benchmark, rtb-data's KR210 L150 URDF (ROS-Industrial's ``kuka_kr210_support``), the robot added to
-  faultgen as a user would (``faultgen robots add kr210 --from kr210l150.urdf``); the payload a box at
+  faultgen as a user would (``faultgen robots add kr210 --from kr210l150.urdf``; the bench adds it
+  with the track version's sizing rule, :func:`faultgen.bench.make.add_robots`: its drives, and so
+  this simulator's friction and motor inertia, are the folder's); the payload a box at
   the flange (the URDF's ``tool0`` frame) placed by Pinocchio (:func:`pinocchio_model`).
 - **Motor-side friction: ours, written here, in a form faultgen does not use**: at motor speed
   ``w = G qd`` (rad/s), ``f(w) = (Fc + Fs / (1 + (w / ws)^2)) (2 / pi) atan(w / we) + Fv(T) w``

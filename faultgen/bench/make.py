@@ -89,8 +89,10 @@ def _unit(run) -> files.Unit:
 
 def add_robots(version: tracks.Version, folder: Path) -> dict[str, Path]:
     """Add the version's third-party robots (``[[versions.robots]]``) under ``folder``, as ``faultgen
-    robots add NAME --from FILE --package PKG=DIR`` does (with its generated tasks); a robot already
-    there is kept (adding is atomic). Returns name -> robot folder."""
+    robots add NAME --from FILE --package PKG=DIR`` does (with its generated tasks), with the version's
+    sizing rule (``sizing``: rule 1 for the versions that name none); a robot already there is kept
+    (adding is atomic; :func:`make` starts a sweeps folder afresh whose robots another rule sized).
+    Returns name -> robot folder."""
     import warnings
 
     from faultgen.model import importers
@@ -105,9 +107,19 @@ def add_robots(version: tracks.Version, folder: Path) -> dict[str, Path]:
             packages = {name: tracks.source_path(spec) for name, spec in dict(robot.get("packages", {})).items()}
             with warnings.catch_warnings():  # the meshes a robot leaves out (the command prints them)
                 warnings.simplefilter("ignore", importers.GeometryDropped)
-                add(robot["name"], source, target, tasks=taskgen.generate, packages=packages)
+                add(robot["name"], source, target, tasks=taskgen.generate, packages=packages, rule=version.sizing)
         out[robot["name"]] = target
     return out
+
+
+def _other_sizing(version: tracks.Version, folder: Path) -> list[str]:
+    """The version's robots in ``folder`` (a sweeps folder's, left by an earlier make) that do not
+    record the version's sizing rule: sized by another rule, or by a faultgen before the rules were
+    recorded."""
+    from faultgen.model.folder import sizing_rule
+
+    return [robot["name"] for robot in version.robots
+            if (folder / robot["name"]).is_dir() and sizing_rule(folder / robot["name"]) != version.sizing]
 
 
 def _fleet_units(version: tracks.Version, split: str, size: str, sweeps: Path, added: dict[str, Path],
@@ -256,6 +268,8 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
     # resumes from the runs it finished when run again (the sweep's own resume)
     sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
+    if _other_sizing(recipe, sweeps / "robots"):  # runs of robots another sizing rule made are not resumed
+        shutil.rmtree(sweeps)
     sweeps.mkdir(exist_ok=True)
     with atomic.atomic_folder(out) as stage:
         added = add_robots(recipe, sweeps / "robots")

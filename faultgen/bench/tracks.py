@@ -21,7 +21,10 @@ data package such as rtb-data's ``rtbdata``); a part names them as any robot.
 
 A version may name the numeric ``profile`` it is made in (:mod:`faultgen.bench.profile`: the same
 bits on two machines), and may be ``like`` an earlier version: its recipe (parts, seeds, small,
-robots) with the version's own keys over it.
+robots, sizing) with the version's own keys over it. A version's ``sizing`` is the drivetrain sizing
+rule its third-party robots are added with (:data:`faultgen.model.sizing.RULE_VERSIONS`); a version
+that names none uses rule 1, the rule of every version frozen before the rules were versioned (rule 2,
+``robots add``'s default since, changes their robots' drives and so their data).
 
 A track without ``versions`` is a slot: listed, with what it still needs (``needs``).
 """
@@ -41,9 +44,15 @@ SPLITS = ("train", "test")
 #: The keys of a track file and of a version (anything else is refused, named).
 _TRACK_KEYS = {"name", "summary", "licence", "card", "needs", "versions"}
 _VERSION_KEYS = {"version", "released", "notes", "parts", "train_seeds", "test_seeds", "small", "robots", "profile",
-                 "like"}
+                 "like", "sizing"}
 #: The keys a version takes from the version it is ``like``.
-_RECIPE_KEYS = ("parts", "train_seeds", "test_seeds", "small", "robots")
+_RECIPE_KEYS = ("parts", "train_seeds", "test_seeds", "small", "robots", "sizing")
+#: The sizing rule of a version that names none: the rule every version frozen before ``sizing`` was
+#: a key was made with (module docstring).
+DEFAULT_SIZING = 1
+#: The sizing rules' numbers: those of :data:`faultgen.model.sizing.RULE_VERSIONS` (not imported here:
+#: it loads NumPy, which a profiled make must load only after its profile is set).
+SIZING_RULES = (1, 2)
 _ROBOT_KEYS = {"name", "from", "packages"}
 _LOGS_KEYS = {"name", "kind", "robot", "task", "fleet", "small", "train_seeds", "test_seeds"}
 #: Keys of a part that are not :class:`faultgen.Grid` fields.
@@ -70,6 +79,9 @@ class Version:
     profile : str or None
         The numeric profile the version is made in (:mod:`faultgen.bench.profile`), None for the
         versions frozen before profiles (their bits depend on the processor's kernels).
+    sizing : int
+        The drivetrain sizing rule its ``robots`` are added with
+        (:data:`faultgen.model.sizing.RULE_VERSIONS`; :data:`DEFAULT_SIZING` when the version names none).
     """
 
     number: int
@@ -80,6 +92,7 @@ class Version:
     notes: str = ""
     robots: list[dict] = field(default_factory=list)
     profile: str | None = None
+    sizing: int = DEFAULT_SIZING
 
     def _seeds(self, part: dict, split: str) -> list[int]:
         return list(part.get(f"{split}_seeds", getattr(self, f"{split}_seeds")))
@@ -204,10 +217,14 @@ def parse(data: dict, source: str) -> Track:
             profile.unknown(entry.get("profile"))
         except ValueError as err:
             raise ValueError(f"{source}: version {number}: {err}") from None
+        rule = entry.get("sizing", DEFAULT_SIZING)
+        if isinstance(rule, bool) or not isinstance(rule, int) or rule not in SIZING_RULES:
+            raise ValueError(f"{source}: version {number}: sizing = {rule!r}: expected one of "
+                             f"{', '.join(map(str, SIZING_RULES))} (faultgen.model.sizing.RULE_VERSIONS)")
         version = Version(number=number, parts=list(entry.get("parts", [])), train_seeds=list(entry["train_seeds"]),
                           test_seeds=list(entry["test_seeds"]), small=dict(entry.get("small", {})),
                           notes=str(entry.get("notes", "")), robots=list(entry.get("robots", [])),
-                          profile=entry.get("profile"))
+                          profile=entry.get("profile"), sizing=rule)
         if not version.parts:
             raise ValueError(f"{source}: version {number}: no [[versions.parts]]")
         _check_robots_and_logs(version, f"{source}: version {number}")

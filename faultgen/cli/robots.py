@@ -39,8 +39,10 @@ def robots_command(
     ] = None,
     payload: Annotated[
         float | None,
-        typer.Option(help="With `add`: rated payload in kg, 0..10000 (the largest industrial arms carry about 2300; "
-                          "default: the source's, else sized).", min=0.0, max=MAX_PAYLOAD),
+        typer.Option(help="With `add`: rated payload in kg, 0..10000 (the datasheet's; the largest industrial arms "
+                          "carry about 2300). The drives are sized to hold and accelerate it; default: the "
+                          "source's, else guessed as 15 % of the moving mass (said as a guess).",
+                     min=0.0, max=MAX_PAYLOAD),
     ] = None,
     out: Annotated[
         Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
@@ -88,7 +90,12 @@ def robots_command(
             typer.echo(f"warning: {warning.message}", err=True)
         robot = added.robot
         typer.echo(f"{robot.name}: {robot.n_axes} axes from {added.arm.kind} {source} -> {added.folder} "
-                   f"(rated payload {added.payload:.4g} kg; provenance in {added.folder / 'README.md'})")
+                   f"(rated payload {added.payload:.4g} kg, {added.payload_origin}; sizing rule {added.rule}; "
+                   f"provenance in {added.folder / 'README.md'})")
+        typer.echo(f"plausibility: {added.plausibility}: "
+                   + (f"{len(added.findings)} finding(s)" if added.findings else "nothing implausible found"))
+        for finding in added.findings:
+            typer.echo(f"warning: {finding}", err=True)
         return
     if any(value is not None for value in (new_name, source, drivetrain, payload, out)) or package:
         raise ValueError("NAME, --from, --drivetrain, --payload, --package and -o go with `faultgen robots add`")

@@ -47,6 +47,10 @@ class Arm:
     urdf : str
         For a URDF or xacro: the URDF as compiled (meshes left out, inertials filled in), the
         input of an independent check (tests/test_robot_import.py runs Pinocchio on it).
+    mesh_inertials : list of str
+        Links whose mass and inertia were computed from their meshes (no ``<inertial>`` in the
+        source: uniform solids of 1000 kg/m^3), for the plausibility report
+        (:mod:`faultgen.model.plausibility`).
     """
 
     spec: mujoco.MjSpec
@@ -59,3 +63,4 @@ class Arm:
     description: str = ""
     notes: list[str] = field(default_factory=list)
     urdf: str = ""
+    mesh_inertials: list[str] = field(default_factory=list)

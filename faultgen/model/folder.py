@@ -25,20 +25,29 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model import builder, importers, limits, robots, sizing
+from faultgen.model import builder, importers, limits, plausibility, robots, sizing
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
+#: How ``drivetrain.toml`` and README.md record the sizing rule (:func:`sizing_rule` reads it back).
+RULE_LINE = "Sized where not given by sizing rule {rule} (faultgen.model.sizing.RULE_VERSIONS)"
+RULE_RECORD = re.compile(r"by sizing rule (\d+) \(faultgen\.model\.sizing\.RULE_VERSIONS\)")
 
 
 @dataclass(frozen=True)
 class Added:
-    """What :func:`add` wrote: the folder, the loaded robot, the arm as read, the payload used."""
+    """What :func:`add` wrote: the folder, the loaded robot, the arm as read, the payload used, where
+    that payload came from, and the plausibility report (:mod:`faultgen.model.plausibility`: a
+    summary line and the findings, each with what to do)."""
 
     folder: Path
     robot: robots.Robot
     arm: importers.Arm
     payload: float
+    payload_origin: str = ""
+    plausibility: str = ""
+    findings: tuple[str, ...] = ()
+    rule: int = sizing.RULE
 
 
 SCENE = """<mujoco model="{name} scene">
@@ -74,6 +83,7 @@ def add(
     payload: float | None = None,
     tasks: Callable[[robots.Robot, importers.Arm, float], str] | None = None,
     packages: dict[str, str | Path] | None = None,
+    rule: int = sizing.RULE,
 ) -> Added:
     """Write the robot folder ``out`` for the arm in ``source``.
 
@@ -94,6 +104,10 @@ def add(
     packages : dict of str to path, optional
         ROS package name -> folder, for ``package://`` meshes and xacro's ``$(find NAME)``; the
         source may read only its own folder and these (:func:`faultgen.model.importers.read`).
+    rule : int
+        The sizing rule (:data:`faultgen.model.sizing.RULE_VERSIONS`; default the latest): the
+        benchmark's frozen track versions add their robots with the rule they were frozen with.
+        ``drivetrain.toml`` and README.md record it (:func:`sizing_rule`).
 
     Returns
     -------
@@ -109,6 +123,7 @@ def add(
         raise ValueError(f"robot name {name!r}; expected a letter, then letters, digits, '_' or '-'")
     if payload is not None and not (math.isfinite(payload) and 0 <= payload <= limits.MAX_PAYLOAD):
         raise ValueError(f"payload = {payload!r} kg; expected a number in 0 .. {limits.MAX_PAYLOAD:g} kg")
+    sizing.check_rule(rule)
     out = Path(out)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
@@ -117,14 +132,16 @@ def add(
     arm = importers.read(source, packages)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
+    guessed = payload is None and math.isnan(arm.payload)
     payload_origin = (
         "given with --payload"
         if payload is not None
         else "from the source"
-        if not math.isnan(arm.payload)
-        else f"sized: {sizing.PAYLOAD_SHARE:.0%} of the moving mass"
+        if not guessed
+        else f"GUESSED: {sizing.PAYLOAD_SHARE * 100:g} % of the moving mass; give --payload KG"
     )
-    drive, origin, payload = sizing.size(arm, given, payload)
+    result = sizing.sized(arm, given, payload, rule)
+    drive, origin, payload = result.drivetrain, result.origin, result.payload
     dropped = _skeleton(arm.spec, str(source))
     if dropped:
         arm.notes.append(
@@ -145,9 +162,13 @@ def add(
         (stage / f"{name}.xml").write_text(text)
         robot = robots.load(stage / f"{name}.xml")
         size = reach(robot)
+        summary, findings = plausibility.report(arm, payload, guessed, result.moving_mass,
+                                                plausibility.radial_reach(robot), result.loads,
+                                                sizing.PAYLOAD_SHARE)
         (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
         header = (
             f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
+            f"{RULE_LINE.format(rule=rule)}\n"
             f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
             f"--drivetrain drivetrain.toml -o NEW_FOLDER"
         )
@@ -161,7 +182,8 @@ def add(
         if tasks is not None:
             (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
         (stage / "README.md").write_text(
-            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin)
+            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin, (summary, findings),
+                   result.loads, rule)
         )
         if out.exists():
             out.rmdir()
@@ -169,7 +191,24 @@ def add(
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    return Added(out, robots.load(out / f"{name}.xml"), arm, payload)
+    return Added(out, robots.load(out / f"{name}.xml"), arm, payload, payload_origin, summary, tuple(findings),
+                 rule)
+
+
+def sizing_rule(folder: str | Path) -> int | None:
+    """The sizing rule that sized the robot folder ``folder`` (:data:`faultgen.model.sizing.
+    RULE_VERSIONS`), as its ``drivetrain.toml`` records it; None for a folder that records none (a
+    shipped robot, or one added before the rules were versioned)."""
+    path = Path(folder) / "drivetrain.toml"
+    if not path.is_file():
+        return None
+    for line in path.read_text().splitlines():
+        if not line.startswith("#"):
+            break
+        match = RULE_RECORD.search(line)
+        if match:
+            return int(match[1])
+    return None
 
 
 def remove_stale(out: Path) -> list[Path]:
@@ -263,6 +302,9 @@ def readme(
     drivetrain,
     robot,
     payload_origin: str = "",
+    checked: tuple[str, list[str]] | None = None,
+    loads: sizing.Loads | None = None,
+    rule: int | None = None,
 ) -> str:
     """README.md of an added robot: where the arm came from, and per axis where every drivetrain
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
@@ -291,7 +333,14 @@ def readme(
         "",
         f"Kinematics, joint limits, link masses, centres of mass and inertias are the {arm.kind} file's "
         f"`{arm.source.name}`, as MuJoCo's compiler reads it. Rated payload: {payload:.4g} kg "
-        f"({payload_origin}).",
+        f"({payload_origin})"
+        + (
+            f"; the drives are sized to hold and accelerate it with its centre of mass {loads.offset:.3g} m "
+            "out along the flange's z axis (sizing.rated_load)"
+            if loads is not None
+            else ""
+        )
+        + ".",
         "",
         "| axis | joint | source joint | range (rad) | speed limit (rad/s) | effort limit (N m) |",
         "| --- | --- | --- | --- | --- | --- |",
@@ -303,6 +352,11 @@ def readme(
         )
     if arm.notes:
         lines += ["", "Changes made while reading:", ""] + [f"- {note}" for note in arm.notes]
+    if checked is not None:
+        summary, findings = checked
+        lines += ["", "## Plausibility", "", f"{summary}: "
+                  + (f"{len(findings)} finding(s)." if findings else "nothing implausible found."), ""]
+        lines += [f"- {finding}" for finding in findings]
     lines += [
         "",
         "## Drivetrain (gear ratio, motor inertia, gearbox stiffness and damping, motor torque limit, "
@@ -312,7 +366,8 @@ def readme(
         "rule "
         '(docs/robots.md, "Your own robot", gives each rule\'s numbers and sources). Units: '
         + "; ".join(f"{k}: {u}" for k, u in UNITS.items())
-        + ".",
+        + "."
+        + (f" {RULE_LINE.format(rule=rule)}: {sizing.RULE_VERSIONS[rule]}." if rule is not None else ""),
         "",
         "| quantity | " + " | ".join(f"axis {i}" for i in range(1, n + 1)) + " |",
         "| --- |" + " --- |" * n,

@@ -199,6 +199,7 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
         description=limits.text(path, "robot name", f"{root.get('name', path.stem)} from {kind} {path.name}"),
         notes=notes,
         urdf=urdf,
+        mesh_inertials=filled,
     )
 
 
