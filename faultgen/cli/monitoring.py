@@ -9,7 +9,7 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.cli.options import Jobs, LogFormat, TorqueConstants, log_adapter
+from faultgen.cli.options import Jobs, LogFormat, Progress, TorqueConstants, log_adapter
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).
@@ -33,10 +33,10 @@ def _output_folder(value: Path) -> Path:
 def monitor_command(
     logs: Annotated[Path, typer.Argument(help="Fleet folder: LOGS/<unit>/<stamp>.csv (or .csv.gz, .h5).")],
     robot: Annotated[str, typer.Option(help="Robot the logs were recorded on: name, robot folder or MJCF file.")],
-    out: Annotated[Path, typer.Option("--out", "-o", callback=_output_folder, help="Output folder: units.csv, "
-                                      "alarms.csv, scores.csv, <unit>.png. An earlier run's folder is continued: only "
-                                      "new logs are scored. Another folder that holds files is refused unless "
-                                      "--overwrite.")],
+    out: Annotated[Path, typer.Option("--out", "-o", callback=_output_folder, help="Output folder: report.html, "
+                                      "units.csv, alarms.csv, scores.csv, <unit>.png. An earlier run's folder is "
+                                      "continued: only new logs are scored. Another folder that holds files is "
+                                      "refused unless --overwrite.")],
     calibrated: Annotated[Path | None, typer.Option(
         help="A `faultgen calibrate` output folder whose model every unit's twin uses (default: each unit's "
              "model calibrated on its first log).")] = None,
@@ -63,6 +63,7 @@ def monitor_command(
     overwrite: Annotated[bool, typer.Option(
         "--overwrite", help="Write into a folder that holds files but is not an earlier monitor run's output, "
         "replacing its files of the outputs' names; without it such a folder is refused.")] = False,
+    progress: Progress = True,
 ) -> None:
     """Monitor your own robots: learn each unit's normal operation from its first logs against its
     twin, score every later log, and name the worn axis.
@@ -99,8 +100,10 @@ def monitor_command(
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores) and
-    OUT/<unit>.png (control chart, alarm, axis scores), all together; a rerun after new logs
-    arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.
+    OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html (the fleet report: a
+    page for a browser, offline, with every unit's status, alarm, evidence and chart; its settings
+    in OUT/settings.json; `faultgen report OUT` writes it again), all together; a rerun after new
+    logs arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.
 
     The twin is the default: `faultgen monitor LOGS --robot ROBOT -o OUT`, with LOGS the folder of
     your robots' logs (`faultgen logs import --help`) and ROBOT the model they come from (its
@@ -110,7 +113,7 @@ def monitor_command(
     \b
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
-    from faultgen.monitor import loop
+    from faultgen.monitor import loop, page
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
@@ -119,7 +122,8 @@ def monitor_command(
     made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                               twin_temperature=twin_temperature, progress=True, log_format=adapter, jobs=jobs)
+                               twin_temperature=twin_temperature, progress=progress, log_format=adapter,
+                               jobs=jobs)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise
@@ -134,14 +138,11 @@ def monitor_command(
                    f"{', ' + status.model + ' model' if status.model else ''}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
-    # bounds over a limit the unworn estimate lies below (twin)
-    per_log = 2 * alpha if protocol == "own" else min(1.0, (monitors[0].n_axes if monitors else 1) * alpha)
-    chance = min(1.0, logs_scored * per_log**persistence)
-    typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. Chance of a persistent alarm on a healthy unit over "
-               f"{logs_scored} logs if its residuals were independent and normal: <= {chance:.2g} "
-               f"({persistence} in a row at <= {per_log:g} per log); drift the first {train} logs did not show "
-               "raises it.")
-    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'} and {len(monitors)} charts")
+    # bounds over a limit the unworn estimate lies below (twin); the report page says the same
+    typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. " + page.false_alarm_statement(
+        protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored))
+    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {len(monitors)} charts and "
+               f"the fleet report {out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
     if short:
         typer.echo(f"{len(short)} of {len(outcome.statuses)} units are degraded or not monitored "

@@ -35,7 +35,7 @@ from faultgen.data import atomic, logfolder
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import report
+from faultgen.monitor import page, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
@@ -183,6 +183,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
         report.write_units(staging / "units.csv", statuses)
+        page.write(staging, settings, robot=str(robot), logs=str(logs_dir), model=model_source,
+                   twin_temperature=twin_temperature)
         for m in monitors:
             report.chart(staging / f"{m.unit}.png", m, note)
         (staging / ".state").mkdir()

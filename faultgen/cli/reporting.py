@@ -1,0 +1,45 @@
+"""``faultgen report``: the fleet report page of a ``faultgen monitor`` output folder, written again
+(faultgen.monitor.page)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from faultgen.cli.base import Command
+from faultgen.cli.main import app
+
+
+@app.command("report", cls=Command)
+def report_command(
+    out: Annotated[Path, typer.Argument(help="A `faultgen monitor` output folder (units.csv, alarms.csv, "
+                                        "scores.csv; settings.json when the monitor wrote it).")],
+) -> None:
+    """Write the fleet report page OUT/report.html again from a monitor's output folder: one file
+    that opens in a browser offline (plotly.js inside it, no server, nothing fetched).
+
+    The page is built from OUT/units.csv, OUT/alarms.csv and OUT/scores.csv alone, with the run's
+    settings of OUT/settings.json (from an output of an earlier faultgen without it, those of the
+    monitors' state, OUT/.state). It shows the fleet table, the units that need attention first
+    (an open alarm, the surest wear first, then degraded, not monitored, learning, quiet units:
+    status, alarm, axis, since when, the alarm axis's wear estimate and its lower bound, the last
+    log, the alarms maintenance closed), a panel per unit (click it in the table: the alarm's
+    evidence in words, closed alarms and the maintenance that closed them, and a chart of each
+    axis's wear with its lower-bound band and the wear limit, T2 and Q over their limits, the
+    learning logs shaded, relearning after maintenance marked) and the run's settings with the
+    false-alarm statement `faultgen monitor` prints. `faultgen monitor` writes the page itself;
+    this command writes it again, e.g. after copying the CSVs of a run elsewhere.
+
+    \b
+      faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own --no-progress
+      faultgen report monitor-own
+    """
+    from faultgen.monitor import page
+
+    if not out.is_dir():
+        raise ValueError(f"{out} is not a folder; give a `faultgen monitor` output folder (its units.csv, alarms.csv "
+                         "and scores.csv)")
+    written = page.write(out, page.read_settings(out))
+    typer.echo(f"wrote {written}")

@@ -1,0 +1,551 @@
+"""The monitor's fleet report: ``OUT/report.html``, one page a service engineer opens in a browser
+(issue 58).
+
+The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
+``scores.csv`` (:mod:`faultgen.monitor.report`), and the run's settings (a small dict, kept beside
+it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
+(:func:`write`, :func:`read_settings`). It holds:
+
+- the fleet table, the units that need attention first: an open alarm (the surest wear first),
+  then degraded, not monitored, learning and quiet units; per unit its status, open alarm, axis,
+  since when, the current wear estimate of that axis (with the twin) and its lower ``1 - alpha``
+  bound, the last log and the alarms maintenance closed;
+- a panel per unit (a ``<details>``, opened by clicking the unit in the table): the alarm's
+  evidence in words, closed alarms and the maintenance that closed them, and a chart: each axis's
+  wear estimate with its lower-bound band and the wear limit, T2 and Q over their limits, the
+  learning logs shaded, the relearning after maintenance marked;
+- the run's settings and the false-alarm statement the command line prints
+  (:func:`false_alarm_statement`).
+
+It is one self-contained file that works offline: plotly.js is embedded once (no CDN, no server),
+each unit's chart is kept as JSON in the page and drawn when its panel is first opened (a page of
+hundreds of units opens at once). Every text taken from the data (unit names are a stranger's
+folder names, stamps file names) is HTML-escaped (:func:`html.escape`), in the page and in the
+charts, whose labels plotly reads as HTML too; no data text becomes an element id.
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import json
+import math
+from dataclasses import asdict, dataclass, field, is_dataclass
+from pathlib import Path
+
+from faultgen import inputs
+from faultgen.data import atomic, cells
+from faultgen.monitor import report
+
+#: The page's file name in OUT.
+PAGE = "report.html"
+#: The run's settings beside it (what ``faultgen report`` builds the page again with).
+SETTINGS = "settings.json"
+#: Size bound of a settings file read back (a few hundred bytes written).
+SETTINGS_MAX_BYTES = 64 * 2**10
+#: Settings shown on the page, in this order, with their meaning.
+SETTING_NAMES = {
+    "robot": "robot the logs were recorded on",
+    "logs": "fleet folder",
+    "protocol": "protocol (twin: residuals against each unit's twin; own: the unit's own first logs)",
+    "model": "model of the twins (per-unit: calibrated on each unit's first log; nominal; or a given model's SHA-256)",
+    "train": "logs of normal operation each unit learns from",
+    "alpha": "significance level",
+    "variance": "PCA variance kept",
+    "persistence": "consecutive alarming logs that make an alarm",
+    "wear_limit": "wear limit, % (twin's scale): the lower bound a log's wear estimate must reach to alarm",
+    "twin_temperature": "the twin's temperature law predicts the seasonal change",
+}
+#: Order of the fleet table: what needs attention first (an open alarm before any status).
+ATTENTION = ("degraded", "not monitored", "learning", "monitored")
+#: Line colours of the axes (plotly's default sequence).
+COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
+           "#17becf")
+
+
+def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: int, n_axes: int,
+                          logs_scored: int) -> str:
+    """The chance that a healthy unit raises a persistent alarm over ``logs_scored`` logs if its
+    residuals were independent and normal, in words: a log alarms with chance <= 2 alpha without a
+    twin (T2 or Q) and <= N alpha with it (any of the ``n_axes`` axes' lower bounds over a limit
+    the unworn estimate lies below), and an alarm needs ``persistence`` in a row."""
+    per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * alpha)
+    chance = min(1.0, logs_scored * per_log**persistence)
+    return (f"Chance of a persistent alarm on a healthy unit over {logs_scored} logs if its residuals were "
+            f"independent and normal: <= {chance:.2g} ({persistence} in a row at <= {per_log:g} per log); drift "
+            f"the first {train} logs did not show raises it.")
+
+
+# -- reading the outputs ----------------------------------------------------------------------------
+
+def _text(cell: str) -> str:
+    """A text cell as it was before the CSV writer's formula escape (:mod:`faultgen.data.cells`)."""
+    return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
+
+
+def _read_csv(folder: Path, name: str, required: tuple[str, ...]) -> tuple[list[str], list[dict]]:
+    """The header and rows of ``folder/name``, text cells unescaped; refused (ValueError, named)
+    when missing, a link out of ``folder``, or without one of the ``required`` columns."""
+    path = folder / name
+    if not (path.exists() or path.is_symlink()):
+        raise ValueError(f"{folder}: no {name}; give a `faultgen monitor` output folder")
+    if not inputs.inside(path, folder) or not path.is_file():
+        raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.DictReader(f)
+        columns = list(reader.fieldnames or ())
+        missing = [c for c in required if c not in columns]
+        if missing:
+            raise ValueError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
+        rows = [{k: _text(v or "") for k, v in row.items() if k is not None} for row in reader]
+        return columns, rows
+
+
+def _number(cell) -> float:
+    try:
+        return float(cell)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+@dataclass
+class Unit:
+    """One unit as the outputs give it: its row of units.csv, its current row of alarms.csv (None
+    for a unit never scored), the alarms maintenance closed and its rows of scores.csv."""
+
+    row: dict
+    current: dict | None = None
+    closed: list[dict] = field(default_factory=list)
+    scores: list[dict] = field(default_factory=list)
+
+    @property
+    def name(self) -> str:
+        return self.row["unit"]
+
+    @property
+    def open_alarm(self) -> bool:
+        return bool(self.current and self.current.get("first_alarm"))
+
+    def axis_wear(self) -> tuple[int, float, float] | None:
+        """The axis whose wear the table shows and its last log's wear estimate and lower bound, %:
+        the alarm's axis, else the axis with the largest lower bound; None without the twin."""
+        if not self.scores or not self.scores[-1].get("wear1"):
+            return None
+        last = self.scores[-1]
+        axis = _number(self.current["source_axis"]) if self.open_alarm else math.nan
+        axis = int(axis) if math.isfinite(axis) and axis == int(axis) else None
+        if axis is None or f"wear{axis}" not in last:
+            lowers = {i: _number(last[k]) for i in range(1, 1000) if (k := f"wear{i}_lower") in last}
+            if not lowers:
+                return None
+            axis = max(lowers, key=lambda i: -math.inf if math.isnan(lowers[i]) else lowers[i])
+        return axis, _number(last[f"wear{axis}"]), _number(last[f"wear{axis}_lower"])
+
+    def attention(self) -> tuple:
+        """Sort key of the fleet table (:data:`ATTENTION`): an open alarm first, the surest wear first."""
+        if self.open_alarm:
+            wear = self.axis_wear()
+            lower = wear[2] if wear is not None and not math.isnan(wear[2]) else -math.inf
+            return (0, -lower, self.current["first_alarm"])
+        status = self.row.get("status", "")
+        return (1 + (ATTENTION.index(status) if status in ATTENTION else len(ATTENTION)), 0.0, "")
+
+
+@dataclass
+class Fleet:
+    """The outputs of one monitor run: its units in the table's order, the axes' count."""
+
+    units: list[Unit]
+    n_axes: int
+    twin: bool
+
+
+def read(folder: str | Path) -> Fleet:
+    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``).
+
+    Raises
+    ------
+    ValueError
+        A file is missing, or a link out of the folder.
+    """
+    folder = Path(folder)
+    _, unit_rows = _read_csv(folder, "units.csv", report.UNIT_COLUMNS)
+    _, alarm_rows = _read_csv(folder, "alarms.csv", report.ALARM_COLUMNS)
+    columns, score_rows = _read_csv(folder, "scores.csv", report.SCORE_COLUMNS)
+    units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
+    for r in alarm_rows:
+        unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
+        if r.get("closed"):
+            unit.closed.append(r)
+        else:
+            unit.current = r
+    for r in score_rows:
+        if r["unit"] in units:
+            units[r["unit"]].scores.append(r)
+    n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
+    ordered = sorted(units.values(), key=Unit.attention)
+    return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
+
+
+# -- settings ---------------------------------------------------------------------------------------
+
+def _settings_dict(settings, extra: dict) -> dict:
+    base = asdict(settings) if is_dataclass(settings) else dict(settings or {})
+    kept = {**base, **extra}
+    return {k: v for k, v in kept.items() if isinstance(v, (str, int, float, bool)) or v is None}
+
+
+def read_settings(folder: str | Path) -> dict:
+    """The run's settings kept in ``OUT/settings.json`` (by :func:`write`); for a folder written
+    before it, those of the monitors' state (``OUT/.state/<unit>.json``, their ``settings``); an
+    empty dict when neither is there: the page then leaves them and the false-alarm statement out.
+
+    Raises
+    ------
+    ValueError
+        A settings file that is not a JSON object, is too large, or a link out of the folder.
+    """
+    folder = Path(folder)
+    path = folder / SETTINGS
+    max_bytes = SETTINGS_MAX_BYTES
+    key = None
+    if not (path.exists() or path.is_symlink()):
+        states = sorted((folder / ".state").glob("*.json")) if (folder / ".state").is_dir() else []
+        if not states:
+            return {}
+        from faultgen.monitor.state import STATE_MAX_BYTES
+
+        path, max_bytes, key = states[0], STATE_MAX_BYTES, "settings"
+    if not inputs.inside(path, folder):
+        raise ValueError(f"{path}: a link leading outside {folder}; it is not read")
+    try:
+        document = json.loads(inputs.read_text(path, "monitor settings", max_bytes))
+    except (ValueError, RecursionError) as err:
+        raise ValueError(f"{path}: not a monitor's settings ({str(err)[:80]})") from None
+    if key is not None and isinstance(document, dict):
+        document = document.get(key)
+    if isinstance(document, dict):
+        return _settings_dict(document, {})
+    raise ValueError(f"{path}: not a monitor's settings (expected a JSON object)")
+
+
+# -- the page ---------------------------------------------------------------------------------------
+
+def _e(value) -> str:
+    return html.escape("" if value is None else str(value), quote=True)
+
+
+def _pct(value: float) -> str:
+    return "–" if math.isnan(value) else f"{value:.3g} %"
+
+
+def _short(value: float) -> float | None:
+    """A chart's number: 4 significant digits (the page stays small), None for NaN (JSON null)."""
+    if value is None or math.isnan(value) or math.isinf(value):
+        return None
+    return float(f"{value:.4g}")
+
+
+def _rgba(colour: str, alpha: float) -> str:
+    r, g, b = (int(colour[i:i + 2], 16) for i in (1, 3, 5))
+    return f"rgba({r},{g},{b},{alpha})"
+
+
+def _spans(phases: list[str], phase: str) -> list[tuple[int, int]]:
+    """The runs (first, last index) of consecutive rows in ``phase``."""
+    spans, start = [], None
+    for i, p in enumerate([*phases, ""]):
+        if p == phase and start is None:
+            start = i
+        elif p != phase and start is not None:
+            spans.append((start, i - 1))
+            start = None
+    return spans
+
+
+def figure(unit: Unit, settings: dict) -> dict:
+    """The unit's chart as a plotly figure (a JSON-able dict, every text HTML-escaped): with the
+    twin each axis's wear estimate, its lower-bound band and the wear limit above T2 and Q over
+    their limits; the learning logs shaded, each relearning after maintenance shaded and named,
+    the open alarm and every closed one marked."""
+    rows = unit.scores
+    x = list(range(len(rows)))
+    stamps = [_e(r["stamp"]) for r in rows]
+    twin = bool(rows) and bool(rows[0].get("wear1"))
+    data, shapes, annotations = [], [], []
+    stat_axis = "y2" if twin else "y"
+    n_axes = sum(1 for k in rows[0] if k.startswith("score") and k[5:].isdigit()) if rows else 0
+    if twin:
+        for i in range(1, n_axes + 1):
+            colour = COLOURS[(i - 1) % len(COLOURS)]
+            lower = [_short(_number(r.get(f"wear{i}_lower"))) for r in rows]
+            wear = [_short(_number(r.get(f"wear{i}"))) for r in rows]
+            data.append({"type": "scatter", "mode": "lines", "x": x, "y": lower, "line": {"width": 0, "color": colour},
+                         "legendgroup": f"axis{i}", "showlegend": False, "name": f"axis {i} lower bound",
+                         "customdata": stamps, "hovertemplate": "%{customdata}: lower bound %{y:.3g} %<extra></extra>"})
+            data.append({"type": "scatter", "mode": "lines", "x": x, "y": wear, "line": {"width": 1.5, "color": colour},
+                         "fill": "tonexty", "fillcolor": _rgba(colour, 0.15), "legendgroup": f"axis{i}",
+                         "name": f"axis {i} wear", "customdata": stamps,
+                         "hovertemplate": "%{customdata}: axis " + str(i) + " wear %{y:.3g} %<extra></extra>"})
+        limit = _number(settings.get("wear_limit"))
+        if not math.isnan(limit):
+            data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [limit, limit],
+                         "line": {"color": "black", "dash": "dash", "width": 1}, "name": f"wear limit {limit:g} %",
+                         "hoverinfo": "skip"})
+    for name, dash, colour in (("Q", "solid", "#1f3a93"), ("T2", "dot", "#9467bd")):
+        ratio = [_short(_number(r[name]) / _number(r[f"{name}_limit"])) if _number(r[f"{name}_limit"]) else None
+                 for r in rows]
+        data.append({"type": "scatter", "mode": "lines", "x": x, "y": ratio, "yaxis": stat_axis,
+                     "line": {"width": 1.2, "dash": dash, "color": colour}, "name": f"{name} / its limit", "customdata": stamps,
+                     "hovertemplate": "%{customdata}: " + name + " / limit %{y:.3g}<extra></extra>"})
+    if rows:
+        alpha = settings.get("alpha")
+        data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [1, 1], "yaxis": stat_axis,
+                     "line": {"color": "black", "width": 1}, "hoverinfo": "skip",
+                     "name": "limit" + (f" (alpha {alpha:g})" if isinstance(alpha, (int, float)) else "")})
+    phases = [r["phase"] for r in rows]
+
+    def band(first: int, last: int, colour: str, text: str) -> None:
+        shapes.append({"type": "rect", "xref": "x", "yref": "paper", "x0": first - 0.5, "x1": last + 0.5, "y0": 0,
+                       "y1": 1, "fillcolor": colour, "opacity": 0.35, "line": {"width": 0}, "layer": "below"})
+        annotations.append({"x": first - 0.5, "xref": "x", "xanchor": "left", "y": 1, "yref": "paper",
+                            "yanchor": "bottom", "text": text, "showarrow": False, "font": {"size": 10}})
+
+    def line(at: int, colour: str, dash: str, text: str, y: float) -> None:
+        shapes.append({"type": "line", "xref": "x", "yref": "paper", "x0": at, "x1": at, "y0": 0, "y1": 1,
+                       "line": {"color": colour, "width": 1.5, "dash": dash}})
+        annotations.append({"x": at, "xref": "x", "xanchor": "left", "y": y, "yref": "paper", "text": text,
+                            "showarrow": False, "font": {"size": 10, "color": colour}, "bgcolor": "rgba(255,255,255,0.7)"})
+
+    for first, last in _spans(phases, "training"):
+        band(first, last, "#bbbbbb", "learning")
+    for first, last in _spans(phases, "relearning"):
+        band(first, last, "#f5c27a", "maintenance: offset learned again")
+    raw = [r["stamp"] for r in rows]
+    for k, alarm in enumerate(unit.closed):
+        if alarm["first_alarm"] in raw:
+            line(raw.index(alarm["first_alarm"]), "#7f7f7f", "dash",
+                 _e(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
+                 0.9 - 0.08 * (k % 3))
+    if unit.open_alarm and unit.current["first_alarm"] in raw:
+        line(raw.index(unit.current["first_alarm"]), "#d62728", "solid",
+             _e(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
+    step = max(1, len(rows) // 8)
+    layout = {
+        "height": 560 if twin else 340, "margin": {"l": 60, "r": 20, "t": 30, "b": 90},
+        "hovermode": "closest", "showlegend": True,
+        "legend": {"orientation": "h", "y": -0.2 if twin else -0.35, "font": {"size": 10}},
+        "xaxis": {"tickvals": x[::step], "ticktext": stamps[::step], "tickangle": -30,
+                  "range": [-0.5, max(len(rows), 1) - 0.5], "anchor": stat_axis, "zeroline": False},
+        "shapes": shapes, "annotations": annotations,
+    }
+    if twin:
+        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": "wear estimate, % (twin's scale)"}}
+        layout["yaxis2"] = {"domain": [0.0, 0.38], "type": "log", "title": {"text": "statistic / its limit"}}
+    else:
+        layout["yaxis"] = {"type": "log", "title": {"text": "statistic / its limit"}}
+    return {"data": data, "layout": layout}
+
+
+def _script_json(value) -> str:
+    """``value`` as JSON safe inside a ``<script>`` element (no ``<``: no ``</script>``, no comment)."""
+    return json.dumps(value, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c").replace(
+        "\u2028", "\\u2028").replace("\u2029", "\\u2029")
+
+
+STYLE = """
+body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.2em 2em;color:#222;font-size:14px}
+h1{font-size:1.5em;margin-bottom:.2em} h2{font-size:1.2em;margin-top:1.6em}
+table{border-collapse:collapse;margin:.5em 0} th,td{border-bottom:1px solid #ddd;padding:.3em .6em;text-align:left;
+vertical-align:top} th{background:#f3f3f3}
+#fleet tbody tr:hover{background:#f8f8ff} td[data-column="since"],td[data-column="last log"]{white-space:nowrap}
+.status{padding:.1em .4em;border-radius:.3em;font-size:.9em;white-space:nowrap}
+.s-alarm{background:#d62728;color:#fff} .s-degraded{background:#ff9f40} .s-not-monitored{background:#bbb}
+.s-learning{background:#cfe3ff} .s-monitored{background:#d9f2d9}
+.muted{color:#777} .evidence{background:#fff4f4;border-left:3px solid #d62728;padding:.4em .7em}
+details.unit{border:1px solid #ddd;border-radius:.3em;margin:.4em 0;padding:.3em .7em}
+details.unit summary{cursor:pointer;font-weight:600} .chart{width:100%;min-height:300px}
+.statement{background:#f6f6f6;padding:.5em .8em}
+"""
+
+SCRIPT = """
+(function(){
+  var config={responsive:true,displaylogo:false,typesetMath:false};
+  function render(d){
+    if(!d.open)return;
+    var div=d.querySelector('.chart');
+    if(!div||div.getAttribute('data-drawn'))return;
+    var fig=JSON.parse(document.getElementById('figure-'+d.getAttribute('data-index')).textContent);
+    Plotly.newPlot(div,fig.data,fig.layout,config);
+    div.setAttribute('data-drawn','1');
+  }
+  function show(id){
+    var d=document.getElementById(id);
+    if(d&&d.tagName==='DETAILS'){d.open=true;render(d);d.scrollIntoView();}
+  }
+  document.querySelectorAll('details.unit').forEach(function(d){
+    d.addEventListener('toggle',function(){render(d);});
+  });
+  document.querySelectorAll('a.unit-link').forEach(function(a){
+    a.addEventListener('click',function(){show(a.getAttribute('href').slice(1));});
+  });
+  document.getElementById('open-all').addEventListener('click',function(){
+    document.querySelectorAll('details.unit').forEach(function(d){d.open=true;render(d);});
+  });
+  document.getElementById('close-all').addEventListener('click',function(){
+    document.querySelectorAll('details.unit').forEach(function(d){d.open=false;});
+  });
+  window.addEventListener('hashchange',function(){show(location.hash.slice(1));});
+  if(location.hash)show(location.hash.slice(1));
+})();
+"""
+
+#: The fleet table's columns.
+COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)", "last log",
+           "logs", "closed alarms")
+
+
+def _status_badge(unit: Unit) -> str:
+    status = unit.row.get("status", "")
+    reason = unit.row.get("reason", "")
+    css = "s-" + "-".join(status.split()) if status in ATTENTION else ""
+    return f'<span class="status {css}" title="{_e(reason)}">{_e(status)}</span>'
+
+
+def _closed_text(alarm: dict) -> str:
+    return (f"alarm from {alarm['first_alarm']}, axis {alarm['source_axis']}, closed {alarm['closed']} by "
+            f"{alarm['closed_by']}")
+
+
+def _table_row(index: int, unit: Unit) -> str:
+    wear = unit.axis_wear()
+    alarm = unit.current if unit.open_alarm else None
+    if wear is None:
+        wear_cell = '<span class="muted">–</span>'
+    else:
+        axis, estimate, lower = wear
+        text = f"{_pct(estimate)} (≥ {_pct(lower)})"
+        wear_cell = text if alarm else f'<span class="muted">axis {axis}: {text}</span>'
+    opened = (f'<span class="status s-alarm">{_e(alarm["statistic"])} alarm</span>' if alarm else "")
+    closed = "<br>".join(_e(_closed_text(a)) for a in unit.closed)
+    cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
+              _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
+              _e(unit.row.get("last_log", "")), _e(unit.row.get("logs_scored", "")), closed]
+    return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
+
+
+def _panel(index: int, unit: Unit, settings: dict) -> str:
+    row = unit.row
+    model = f", {row['model']} model" if row.get("model") else ""
+    head = (f"{_e(unit.name)} — {_e(row.get('status', ''))}"
+            + (f" — alarm from {_e(unit.current['first_alarm'])}, axis {_e(unit.current['source_axis'])}"
+               if unit.open_alarm else ""))
+    parts = [f'<details class="unit" id="unit-{index}" data-index="{index}"><summary>{head}</summary>',
+             f"<p>{_e(row.get('status', ''))} ({_e(row.get('protocol', ''))}{_e(model)}); "
+             f"{_e(row.get('logs_scored', ''))} logs scored, the last {_e(row.get('last_log', '') or '–')}."
+             + (f" {_e(row['reason'])}." if row.get("reason") else "") + "</p>"]
+    if unit.open_alarm:
+        parts.append(f'<p class="evidence"><b>Open alarm</b> from {_e(unit.current["first_alarm"])} on axis '
+                     f'{_e(unit.current["source_axis"])} ({_e(unit.current["statistic"])}): '
+                     f'{_e(unit.current["evidence"])}</p>')
+    elif unit.current is not None:
+        parts.append(f"<p>No open alarm: {_e(unit.current['evidence'])}.</p>")
+    if unit.closed:
+        items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
+        parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
+    if unit.scores:
+        parts.append(f'<div class="chart" id="chart-{index}"></div>')
+        parts.append(f'<script type="application/json" id="figure-{index}">'
+                     f"{_script_json(figure(unit, settings))}</script>")
+    else:
+        parts.append('<p class="muted">No log scored: no chart.</p>')
+    parts.append("</details>")
+    return "\n".join(parts)
+
+
+def build(fleet: Fleet, settings: dict) -> str:
+    """The page's HTML (module docstring)."""
+    from plotly.offline import get_plotlyjs
+
+    units = fleet.units
+    counts = {s: sum(u.row.get("status") == s for u in units) for s in ATTENTION}
+    alarmed = sum(u.open_alarm for u in units)
+    monitors = [u for u in units if u.current is not None]
+    summary = (f"{len(units)} units: {alarmed} with an open alarm, "
+               + ", ".join(f"{n} {s}" for s, n in counts.items() if n) + ".")
+    statement = ""
+    if all(isinstance(settings.get(k), (int, float)) for k in ("alpha", "persistence", "train")):
+        logs_scored = max((sum(r["phase"] == "monitoring" for r in u.scores) for u in monitors), default=0)
+        statement = (f"{alarmed} of {len(monitors)} units alarm. " + false_alarm_statement(
+            str(settings.get("protocol", "twin")), float(settings["alpha"]), int(settings["persistence"]),
+            int(settings["train"]), fleet.n_axes, logs_scored))
+    setting_rows = "".join(f"<tr><th>{_e(k)}</th><td>{_e(settings[k])}</td><td class='muted'>{_e(v)}</td></tr>"
+                           for k, v in SETTING_NAMES.items() if k in settings)
+    setting_rows += "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td><td></td></tr>"
+                            for k, v in settings.items() if k not in SETTING_NAMES)
+    run = (f'<p class="statement" id="statement">{_e(statement)}</p>' if statement else
+           '<p class="muted">The run&#x27;s settings were not found (no settings.json): the false-alarm statement '
+           'is left out.</p>')
+    table = "\n".join(_table_row(i, u) for i, u in enumerate(units))
+    panels = "\n".join(_panel(i, u, settings) for i, u in enumerate(units))
+    header = "".join(f"<th>{_e(c)}</th>" for c in COLUMNS)
+    wear_note = (" The wear column gives the current (last log's) wear estimate of the alarm's axis, % increase of "
+                 "its dry friction in the twin's scale, and its lower bound; without an alarm, of the axis whose "
+                 "lower bound is largest (grey)." if fleet.twin else "")
+    return f"""<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>faultgen fleet report</title>
+<style>{STYLE}</style>
+<script type="text/javascript">{get_plotlyjs()}</script>
+</head>
+<body>
+<h1>Fleet report</h1>
+<p>{_e(summary)} Units that need attention come first: an open alarm (the surest wear first), then degraded, not
+monitored, learning and quiet units. Click a unit for its panel: the alarm's evidence, the maintenance that closed
+earlier alarms, and its chart.{_e(wear_note)}</p>
+<table id="fleet">
+<thead><tr>{header}</tr></thead>
+<tbody>
+{table}
+</tbody>
+</table>
+<h2>Units</h2>
+<p><button id="open-all" type="button">open all</button> <button id="close-all" type="button">close all</button></p>
+{panels}
+<h2>The run</h2>
+{run}
+<table id="settings">{setting_rows}</table>
+<p class="muted">Written by faultgen from units.csv, alarms.csv and scores.csv of this folder; <code>faultgen report
+FOLDER</code> writes it again. Each unit's control chart is also FOLDER/&lt;unit&gt;.png.</p>
+<script type="text/javascript">{SCRIPT}</script>
+</body>
+</html>
+"""
+
+
+def _write(path: Path, text: str) -> None:
+    with atomic.atomic_path(path) as tmp:
+        tmp.write_bytes(text.encode("utf-8"))
+
+
+def write(folder: str | Path, settings=None, **extra) -> Path:
+    """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
+    ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
+    robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
+    Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
+
+    Returns
+    -------
+    Path
+        The page.
+    """
+    folder = Path(folder)
+    settings = _settings_dict(settings, extra)
+    page = folder / PAGE
+    _write(page, build(read(folder), settings))
+    if settings:
+        _write(folder / SETTINGS, json.dumps(settings, indent=1, sort_keys=True) + "\n")
+    return page

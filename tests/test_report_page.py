@@ -1,0 +1,236 @@
+"""The monitor's fleet report (``OUT/report.html``, faultgen.monitor.page; issue 58) opened in a
+real browser: Debian's headless Chromium driven by Selenium (chromedriver), both from the
+package registry (`.ci/run` installs them with apt-get; Selenium is pointed at them, so it never
+downloads a browser or a driver of its own). The page comes from a small monitor output made
+directly: :class:`~faultgen.monitor.scoring.UnitMonitor` objects fed synthetic residuals (a worn
+unit, a healthy one, one whose alarm a repair closed, one still learning, one never scored, and
+one named like an HTML injection), written by the monitor's own CSV writers.
+
+With ``FAULTGEN_SCREENSHOT=1`` the test also saves its screenshot of the page as
+docs/report-page.png (docs/analysis.md shows it)."""
+
+from __future__ import annotations
+
+import csv
+import html
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+from faultgen.monitor import page, report
+from faultgen.monitor.loop import UnitStatus
+from faultgen.monitor.scoring import Settings, UnitMonitor
+
+ROOT = Path(__file__).resolve().parents[1]
+CHROMIUM, CHROMEDRIVER = Path("/usr/bin/chromium"), Path("/usr/bin/chromedriver")
+SETTINGS = Settings(train=10, persistence=3, alpha=0.01, wear_limit=5.0)
+N_AXES, N_FEATURES = 3, 9
+HOSTILE = "press<img src=x onerror=alert(1)>"  # a folder name a stranger's LOGS may hold
+UNITS = ("weld-07", "weld-02", "paint-11", HOSTILE, "=new-cell", "spare-01")
+
+
+def _feed(monitor: UnitMonitor, days: int, wear, seed: int, repair: int | None = None) -> None:
+    """``days`` daily logs: noise (1 per feature) plus ``wear(day)`` % along axis 2's signature;
+    a repair of axis 2 before day ``repair``."""
+    rng = np.random.default_rng(seed)
+    for day in range(days):
+        if day == repair:
+            monitor.maintenance(f"2026-03-{day + 1:02d} 06:00", "repair", 2)
+        residual = rng.standard_normal(N_FEATURES) + wear(day) * monitor.signatures[1]
+        monitor.add(f"2026-03-{day + 1:02d}", residual, float("nan"), 0.0)
+
+
+def make_output(out: Path) -> Path:
+    """A monitor output folder (units.csv, alarms.csv, scores.csv) of :data:`UNITS`."""
+    signatures = np.random.default_rng(0).standard_normal((N_AXES, N_FEATURES))
+    monitors = [UnitMonitor(name, SETTINGS, N_AXES, signatures) for name in UNITS[:5]]
+    _feed(monitors[0], 30, lambda d: max(0.0, d - 14) * 1.5, seed=1)  # wears from day 15
+    _feed(monitors[1], 30, lambda d: 0.0, seed=2)
+    _feed(monitors[2], 30, lambda d: 0.0 if d < 12 or d >= 20 else 25.0, seed=3, repair=20)  # repaired
+    _feed(monitors[3], 30, lambda d: 0.0, seed=4)
+    _feed(monitors[4], 6, lambda d: 0.0, seed=5)  # still learning
+    assert monitors[0].first_alarm and monitors[2].closed and not monitors[2].first_alarm
+    statuses = [UnitStatus(m.unit, "monitored" if m.pca is not None else "learning", "twin", "calibrated",
+                           "" if m.pca is not None else f"learning: {len(m.training)} of 10 logs", len(m.rows) or
+                           len(m.training), m.last_stamp) for m in monitors]
+    statuses.append(UnitStatus(UNITS[5], "not monitored", "twin", "", "no log", 0, ""))
+    out.mkdir(parents=True, exist_ok=True)
+    report.write_alarms(out / "alarms.csv", monitors)
+    report.write_scores(out / "scores.csv", monitors, N_AXES)
+    report.write_units(out / "units.csv", statuses)
+    return out
+
+
+def _csv(path: Path) -> list[dict]:
+    with open(path, newline="") as f:
+        return [{k: page._text(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory) -> Path:
+    out = make_output(tmp_path_factory.mktemp("report") / "OUT")
+    page.write(out, SETTINGS, robot="irb6700", logs="/data/LOGS", model="per-unit", twin_temperature=False)
+    return out
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Headless Chromium with its console and network logs, or a skip off CI when it is missing
+    (in CI, `.ci/run` installs it: a missing browser fails there)."""
+    if not (CHROMIUM.is_file() and CHROMEDRIVER.is_file()):
+        message = f"{CHROMIUM} or {CHROMEDRIVER} missing: apt-get install chromium chromium-driver (.ci/run does)"
+        if os.environ.get("CI"):
+            pytest.fail(message)
+        pytest.skip(message)
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    profile = Path(os.environ.get("TMPDIR", "/tmp")) / f"faultgen-chromium-{os.getpid()}"
+    options = webdriver.ChromeOptions()
+    options.binary_location = str(CHROMIUM)
+    for flag in ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 "--disable-dev-shm-usage", "--window-size=1200,800", f"--user-data-dir={profile}"):
+        options.add_argument(flag)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL", "performance": "ALL"})
+    driver = webdriver.Chrome(service=Service(executable_path=str(CHROMEDRIVER)), options=options)
+    try:
+        driver.set_window_size(1200, 800)
+        yield driver
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def test_the_page_in_a_real_browser(written, browser, tmp_path):
+    import json
+
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    url = (written / page.PAGE).resolve().as_uri()
+    browser.get_log("performance")  # what the browser did before: its own new-tab page
+    browser.get(url)
+    WebDriverWait(browser, 20).until(lambda d: d.execute_script("return window.Plotly !== undefined"))
+    browser.save_screenshot(str(tmp_path / "report-page.png"))
+    if os.environ.get("FAULTGEN_SCREENSHOT"):
+        shutil.copy(tmp_path / "report-page.png", ROOT / "docs" / "report-page.png")
+
+    # the fleet table holds units.csv's and alarms.csv's rows, the open alarm first
+    units = {r["unit"]: r for r in _csv(written / "units.csv")}
+    alarms = _csv(written / "alarms.csv")
+    current = {r["unit"]: r for r in alarms if not r["closed"]}
+    closed = {u: [r for r in alarms if r["unit"] == u and r["closed"]] for u in units}
+    header = [th.text for th in browser.find_elements(By.CSS_SELECTOR, "#fleet thead th")]
+    rows = [dict(zip(header, (td.text for td in tr.find_elements(By.TAG_NAME, "td"))))
+            for tr in browser.find_elements(By.CSS_SELECTOR, "#fleet tbody tr")]
+    assert sorted(r["unit"] for r in rows) == sorted(units) and len(rows) == len(units)
+    assert rows[0]["unit"] == "weld-07" and rows[0]["open alarm"] == "wear alarm"
+    assert [r["unit"] for r in rows] == ["weld-07", "spare-01", "=new-cell", "weld-02", "paint-11", HOSTILE]
+    for row in rows:
+        unit, alarm = units[row["unit"]], current.get(row["unit"])
+        assert (row["status"], row["last log"], row["logs"]) == (unit["status"], unit["last_log"], unit["logs_scored"])
+        assert row["since"] == (alarm["first_alarm"] if alarm else "")
+        assert row["axis"] == (alarm["source_axis"] if alarm and alarm["first_alarm"] else "")
+        assert row["closed alarms"].count("closed") == len(closed[row["unit"]])
+    assert current["weld-07"]["source_axis"] == "2" and rows[0]["wear of the axis, last log (lower bound)"].endswith(")")
+    assert "closed 2026-03-21 06:00 by repair of axis 2" in next(r for r in rows if r["unit"] == "paint-11")["closed alarms"]
+    # the stranger's unit name is text, not markup; nothing on the page points outside it
+    assert browser.execute_script("return document.images.length") == 0
+    links = browser.execute_script(
+        "return Array.from(document.querySelectorAll('[src],[href]')).map(e => e.getAttribute('src') || "
+        "e.getAttribute('href'))")
+    assert all(link.startswith("#") for link in links), links
+    assert "Chance of a persistent alarm on a healthy unit" in browser.find_element(By.ID, "statement").text
+
+    # clicking a unit opens its panel and draws its chart
+    panels = browser.find_elements(By.CSS_SELECTOR, "details.unit")
+    assert len(panels) == len(units) and not any(p.get_attribute("open") for p in panels)
+    for name in ("weld-07", HOSTILE):
+        link = next(a for a in browser.find_elements(By.CSS_SELECTOR, "a.unit-link") if a.text == name)
+        link.click()
+        target = browser.find_element(By.ID, link.get_attribute("href").split("#")[1])
+        WebDriverWait(browser, 20).until(lambda d, t=target: t.find_elements(By.CSS_SELECTOR, ".chart svg.main-svg"))
+        assert target.get_attribute("open") is not None
+        svg = target.find_element(By.CSS_SELECTOR, ".chart svg.main-svg")
+        assert svg.is_displayed() and svg.size["width"] > 300 and svg.size["height"] > 200
+        assert len(target.find_elements(By.CSS_SELECTOR, ".chart .scatterlayer .trace")) >= 2 * N_AXES + 3
+        assert target.find_element(By.TAG_NAME, "summary").text.startswith(name)
+    if os.environ.get("FAULTGEN_SCREENSHOT"):  # the worn unit's panel, scrolled to
+        browser.execute_script("document.getElementById(arguments[0]).scrollIntoView()", "unit-0")
+        browser.save_screenshot(str(ROOT / "docs" / "report-unit.png"))
+    worn = browser.find_element(By.CSS_SELECTOR, "details.unit[open]")
+    assert "wear estimate" in worn.find_element(By.CSS_SELECTOR, ".evidence").text
+    browser.find_element(By.ID, "open-all").click()
+    scored = {r["unit"] for r in _csv(written / "scores.csv")}  # a unit still learning has no row yet
+    assert len(scored) == 4
+    WebDriverWait(browser, 20).until(lambda d: len(d.find_elements(By.CSS_SELECTOR, ".chart.js-plotly-plot")) == len(scored))
+    assert browser.execute_script("return document.images.length") == 0
+
+    # no console error, no request but the page itself
+    console = browser.get_log("browser")
+    assert not [e for e in console if e["level"] in ("SEVERE", "WARNING")], console
+    events = [json.loads(e["message"])["message"] for e in browser.get_log("performance")]
+    requests = [m["params"] for m in events if m["method"] == "Network.requestWillBeSent"]
+    assert {r["request"]["url"] for r in requests if r.get("documentURL") == url} == {url}, requests
+    assert not [r for r in requests if r["request"]["url"].split(":")[0] in ("http", "https", "ws", "wss")], requests
+
+
+def test_report_builds_the_page_again_from_an_output_folder(written, tmp_path):
+    out = shutil.copytree(written, tmp_path / "OUT")
+    (out / page.PAGE).unlink()
+    result = CliRunner().invoke(app, ["report", str(out)])
+    assert result.exit_code == 0, result.output
+    assert (out / page.PAGE).read_bytes() == (written / page.PAGE).read_bytes()
+    assert str(out / page.PAGE) in result.output
+    text = (out / page.PAGE).read_text()
+    assert HOSTILE not in text and "press&lt;img src=x onerror=alert(1)&gt;" in text
+    assert text.count("plotly.js v") == 1 and "<script src" not in text and "<link" not in text
+    (out / page.SETTINGS).unlink()  # a folder without the settings: the page without them, said so
+    result = CliRunner().invoke(app, ["report", str(out)])
+    assert result.exit_code == 0 and "settings were not found" in (out / page.PAGE).read_text()
+    result = CliRunner().invoke(app, ["report", str(tmp_path / "nothing")])
+    assert result.exit_code == 2 and "units.csv" in result.output
+
+
+def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):
+    import plotly.graph_objects as go
+
+    fleet = page.read(written)
+    assert [u.name for u in fleet.units][:1] == ["weld-07"] and fleet.n_axes == N_AXES and fleet.twin
+    settings = page.read_settings(written)
+    assert settings["wear_limit"] == 5.0 and settings["robot"] == "irb6700"
+    for unit in fleet.units:
+        if unit.scores:
+            figure = page.figure(unit, settings)
+            go.Figure(figure)  # every property one plotly knows
+            texts = [a["text"] for a in figure["layout"]["annotations"]]
+            assert all("<" not in t for t in texts)
+    repaired = next(u for u in fleet.units if u.name == "paint-11")
+    texts = [a["text"] for a in page.figure(repaired, settings)["layout"]["annotations"]]
+    assert "maintenance: offset learned again" in texts and any("closed by repair of axis 2" in t for t in texts)
+
+
+def test_monitor_writes_the_page(tmp_path):
+    """The monitor itself writes report.html and settings.json with its outputs (protocol own, a
+    small synthetic fleet: `faultgen monitor ... --no-progress`)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    import fleetlog_folder
+
+    from faultgen.model import robots
+
+    logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", robots.load("puma560"), units=2, days=12)
+    out = tmp_path / "OUT"
+    result = CliRunner().invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(out), "--protocol",
+                                      "own", "--train", "10", "--no-progress"])
+    assert result.exit_code == 0, result.output
+    assert str(out / page.PAGE) in result.output
+    assert page.read_settings(out)["protocol"] == "own"
+    statement = next(line for line in result.output.splitlines() if "Chance of a persistent alarm" in line)
+    assert html.escape(statement) in (out / page.PAGE).read_text()
