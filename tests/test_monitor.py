@@ -3,6 +3,7 @@
 friction, seasons, payload changes, noise, wear on one unit). The full check, 12 units x 120
 days, is ``benchmarks/monitor_loop.py`` (docs/analysis.md, "Monitor your own robots")."""
 
+import csv
 import filecmp
 import os
 import shutil
@@ -73,8 +74,29 @@ def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
         assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
     out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
-    for name in ("alarms.csv", "scores.csv"):
+    for name in ("alarms.csv", "scores.csv", "rul.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
+
+
+def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(fleet, monitored):
+    """rul.csv: every unit and axis at its last log; the worn axis (wear 60 % on the last day, its
+    estimate some 0.5-0.7 of it, still growing) a remaining life with its interval, the healthy
+    units no end of life within the horizon (faultgen.monitor.prognosis; tests/test_prognosis.py)."""
+    from faultgen.monitor import prognosis
+
+    _, _, truth_path = fleet
+    truth = independent_fleet.read_truth(truth_path)
+    with open(monitored / "rul.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert {(r["unit"], int(r["axis"])) for r in rows} == {(u, a) for u in truth for a in range(1, 7)}
+    for r in rows:
+        t = truth[r["unit"]]
+        assert r["stamp"] == t["stamps"][-1] and r["time_unit"] == "days", r
+        if t["axis"] and int(r["axis"]) == t["axis"]:
+            assert r["model"] in prognosis.MODELS and r["logs_fitted"] != "", r
+            assert 0 <= float(r["rul_5"]) <= float(r["rul"]) <= float(r["rul_95"]) < prognosis.HORIZON, r
+        elif not t["axis"]:
+            assert r["rul"] == "" and "no end of life within the horizon (365 days)" in r["verdict"], r
 
 
 def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
@@ -581,5 +603,5 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
             os.link(log, partial / unit.name / log.name)
     outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
-    for name in ("alarms.csv", "scores.csv", "units.csv"):
+    for name in ("alarms.csv", "scores.csv", "units.csv", "rul.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name

@@ -54,6 +54,9 @@ def monitor_command(
     wear_limit: Annotated[float, typer.Option(
         help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
              "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
+    failure_wear: Annotated[float, typer.Option(
+        help="With the twin: the wear estimate (%, in the twin's scale) that ends an axis's life; OUT/rul.csv gives "
+             "each axis's remaining life until it, with a 5-95 % interval.", min=1.0, max=500.0)] = 40.0,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
@@ -99,11 +102,14 @@ def monitor_command(
 
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),
-    OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores) and
-    OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html (the fleet report: a
-    page for a browser, offline, with every unit's status, alarm, evidence and chart; its settings
-    in OUT/settings.json; `faultgen report OUT` writes it again), all together; a rerun after new
-    logs arrived scores only those. Method and its check on an independent fleet: docs/analysis.md.
+    OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
+    OUT/rul.csv (per unit and axis, with the twin: the remaining life until the wear estimate reaches
+    --failure-wear, in days or logs, with a 5-95 % interval and the trend model, or "no end of life
+    within the horizon"), OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html
+    (the fleet report: a page for a browser, offline, with every unit's status, alarm, evidence and
+    chart; its settings in OUT/settings.json; `faultgen report OUT` writes it again), all together;
+    a rerun after new logs arrived scores only those. Method and its check on an independent fleet:
+    docs/analysis.md.
 
     The twin is the default: `faultgen monitor LOGS --robot ROBOT -o OUT`, with LOGS the folder of
     your robots' logs (`faultgen logs import --help`) and ROBOT the model they come from (its
@@ -123,7 +129,7 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs)
+                               jobs=jobs, failure_wear=failure_wear)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise
@@ -141,8 +147,8 @@ def monitor_command(
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
     typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. " + page.false_alarm_statement(
         protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored))
-    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {len(monitors)} charts and "
-               f"the fleet report {out / page.PAGE}")
+    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'rul.csv'}, "
+               f"{len(monitors)} charts and the fleet report {out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
     if short:
         typer.echo(f"{len(short)} of {len(outcome.statuses)} units are degraded or not monitored "

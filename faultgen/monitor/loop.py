@@ -35,7 +35,7 @@ from faultgen.data import atomic, logfolder
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import page, report
+from faultgen.monitor import page, prognosis, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
@@ -102,7 +102,8 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None, jobs: int = 1) -> Outcome:
+            progress: bool = True, log_format=None, jobs: int = 1,
+            failure_wear: float = prognosis.FAILURE_WEAR) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
@@ -133,6 +134,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     jobs : int
         Local processes scoring units in parallel (groups of units sharing a twin); the outputs are
         those of one job, bit for bit.
+    failure_wear : float
+        The wear estimate, % in the twin's scale, that ends an axis's life: ``rul.csv`` gives each
+        axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
 
     Returns
     -------
@@ -149,6 +153,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         file named).
     """
     atomic.check_apart(out, logs_dir)
+    prognosis.check_failure_wear(failure_wear)
     nominal = robots.load(robot)
     read_with, suffixes = fleet_logs.reader_of(log_format)
     units = fleet_logs.fleet(logs_dir, suffixes)
@@ -183,6 +188,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
         report.write_units(staging / "units.csv", statuses)
+        prognosis.write(staging / "rul.csv", monitors, failure_wear)
         page.write(staging, settings, robot=str(robot), logs=str(logs_dir), model=model_source,
                    twin_temperature=twin_temperature)
         for m in monitors:

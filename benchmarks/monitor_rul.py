@@ -1,0 +1,223 @@
+"""`faultgen monitor`'s remaining useful life (faultgen.monitor.prognosis, issue 59) scored against
+the truth of a fleet made by a simulator that is not faultgen, with NASA ProgPy's metrics.
+
+    python benchmarks/monitor_rul.py [--units 6] [--worn 4] [--days 120] [--seed 0] [--final-wear 60]
+                                     [--failure-wear 40] [--work DIR]
+
+In one run of this script:
+
+- the fleet (tests/independent_fleet.py: Pinocchio RNEA on rtb-data's KR210 URDF, our own
+  motor-side friction, seasons, payloads, noise; ``--worn`` units wearing one axis each, linearly
+  from a day drawn in 20-50 to ``--final-wear`` % on the last day), its truth in ``truth.csv``;
+- `faultgen monitor LOGS --no-calibrate --failure-wear F` (the twin on the nominal model), timed;
+- for each worn unit whose alarm names its worn axis: the remaining life of that axis computed as
+  the monitor computes it (:func:`faultgen.monitor.prognosis.remaining_life` on the unit's rows of
+  ``scores.csv`` up to each log, from the log that made the alarm persistent to the last), a
+  profile of ProgPy time-of-event distributions (``ToEPredictionProfile``), scored against two
+  end-of-life times:
+
+  (A) **the true wear reaches F** (truth.csv only: independent of the monitor). The estimate is in
+      the twin's scale, which grows 0.5-0.7 % per % of true wear on this fleet, so a remaining life
+      to an *estimate* of F is expected to be late by a factor 1.4-2 against this truth: its bias is
+      reported, not hidden;
+  (B) **the estimate's trend reaches F**: the day the unit's true wear, times its twin's scale (a
+      straight line of the worn axis's estimate on the true wear, fitted in hindsight over the logs
+      past 5 % true wear), reaches F; the true wear grows linearly, so this day is defined beyond
+      the record too. Not independent (the scale is fitted on the estimates themselves): it says
+      how well the trend is extrapolated, apart from the twin's scale.
+
+Metrics (``progpy.metrics``, Saxena et al. 2010): alpha-lambda with alpha 0.2 and beta 0.5 (at least
+half the distribution within +-20 % of the true remaining life) at lambda 0.5 (the first prediction
+half-way from the persistent alarm to the end of life); the relative accuracy there and cumulated
+over the predictions before the end of life; the prognostic horizon (the end-of-life time minus the
+first prediction meeting the alpha criterion with beta 0.5); the median bias of the estimate (days,
+predicted minus true remaining life). A sample beyond the prediction's horizon (365 days) enters the
+metrics at the horizon (ProgPy drops a None sample from a mean).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import independent_fleet
+
+from faultgen.monitor import prognosis
+
+ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
+#: The monitor's defaults the benchmark replays (faultgen.monitor.scoring.Settings).
+MONITOR_ALPHA, PERSISTENCE = 0.01, 5
+
+
+def _floats(row: dict) -> dict:
+    return {k: (float(v) if k.startswith("wear") and v != "" else v) for k, v in row.items()}
+
+
+def _absolute(toe, t_prediction: float, horizon: float):
+    """ProgPy's time-to-event samples (from the prediction) as times of event (days), a sample beyond
+    the horizon at the horizon."""
+    from progpy.uncertain_data import UnweightedSamples
+
+    return UnweightedSamples([{"failure": t_prediction + (horizon if v is None else v)} for v in toe.key("failure")])
+
+
+def score(profile, eol: float, start: float, record_end: float) -> dict:
+    """ProgPy's metrics of ``profile`` (times of prediction, day) against the end of life ``eol``
+    (day); ``start`` the persistent alarm's day."""
+    from progpy.metrics import alpha_lambda, prognostic_horizon
+    from progpy.predictors import ToEPredictionProfile
+
+    before = ToEPredictionProfile()
+    for t, toe in profile.items():
+        if t < eol:
+            before.add_prediction(t, toe)
+    truth = {"failure": eol}
+    lam = start + LAMBDA * (eol - start)
+    out = {"eol": eol, "lambda": lam, "predictions": len(before)}
+    if not len(before):
+        return out
+    if lam <= max(before.keys()):
+        out["alpha_lambda"] = bool(alpha_lambda(before, truth, lam, ALPHA, BETA)["failure"])
+        at = min(t for t in before if t >= lam)
+        out["ra_lambda"] = (before[at] - at).relative_accuracy({"failure": eol - at})["failure"]
+    else:
+        out["alpha_lambda"] = None  # the record ends before lambda
+
+    def criterion(tte, tte_truth):
+        bounds = {k: (v - ALPHA * v, v + ALPHA * v) for k, v in tte_truth.items()}
+        return {k: p >= BETA for k, p in tte.percentage_in_bounds(bounds).items()}
+
+    out["ph"] = prognostic_horizon(before, criterion, truth)["failure"]
+    # Saxena's cumulative relative accuracy on the remaining life: ProgPy's relative accuracy of each
+    # prediction's remaining-life distribution against the true remaining life then (its
+    # cumulative_relative_accuracy takes one ground truth for every prediction: a time of event, not
+    # a remaining life), averaged
+    out["cra"] = float(np.mean([(toe - t).relative_accuracy({"failure": eol - t})["failure"]
+                                for t, toe in before.items()]))
+    out["bias"] = float(np.median([np.median(toe.key("failure")) - eol for toe in before.values()]))
+    out["end_of_record"] = record_end
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--units", type=int, default=6)
+    parser.add_argument("--worn", type=int, default=4)
+    parser.add_argument("--days", type=int, default=120)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--final-wear", type=float, default=60.0)
+    parser.add_argument("--failure-wear", type=float, default=prognosis.FAILURE_WEAR)
+    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
+    args = parser.parse_args()
+    work = args.work or Path(tempfile.mkdtemp(prefix="monitor-rul-"))
+    spec = independent_fleet.FleetSpec(units=args.units, worn=args.worn, days=args.days, seed=args.seed,
+                                       final_wear=args.final_wear)
+    started = time.perf_counter()
+    kept = work / "fleet" / "kr210"  # a rerun in the same --work keeps the robot folder (and resumes the fleet)
+    robot, logs, truth_path = independent_fleet.write_fleet(work / "fleet", spec, robot=kept if kept.is_dir() else None)
+    print(f"fleet of {args.units} units x {args.days} days ({args.worn} worn to {args.final_wear:g} %) written by "
+          f"Pinocchio in {time.perf_counter() - started:.0f} s: {logs}")
+    out = work / "monitor"
+    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+               "--no-calibrate", "--failure-wear", f"{args.failure_wear:g}"]
+    started = time.perf_counter()
+    result = subprocess.run(command, check=False, capture_output=True, text=True)
+    if result.returncode:
+        raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
+    print(f"faultgen monitor --no-calibrate --failure-wear {args.failure_wear:g}: {time.perf_counter() - started:.0f} s")
+
+    truth = independent_fleet.read_truth(truth_path)
+    with open(out / "scores.csv", newline="") as f:
+        scores = [_floats(r) for r in csv.DictReader(f)]
+    with open(out / "alarms.csv", newline="") as f:
+        alarms = {r["unit"]: r for r in csv.DictReader(f)}
+    with open(out / "rul.csv", newline="") as f:
+        rul = list(csv.DictReader(f))
+    F, H = args.failure_wear, prognosis.HORIZON
+    print(f"\nrul.csv at the last log ({len(rul)} rows):")
+    for r in rul:
+        t = truth[r["unit"]]
+        if t["axis"] and int(r["axis"]) == t["axis"] or r["rul"]:
+            print(f"  {r['unit']} axis {r['axis']} ({'worn' if int(r['axis']) == t['axis'] else 'not worn'}): "
+                  f"{r['verdict']}")
+    quiet = sum(not r["rul"] for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
+    others = sum(1 for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
+    print(f"  axes not worn with no end of life within the horizon: {quiet} of {others}")
+
+    results = {"A": [], "B": []}
+    started = time.perf_counter()
+    for unit, t in truth.items():
+        if not t["axis"]:
+            continue
+        alarm = alarms[unit]
+        axis = t["axis"]
+        if not alarm["first_alarm"] or int(alarm["source_axis"]) != axis:
+            print(f"\n{unit}: worn axis {axis}, alarm {alarm['first_alarm'] or 'none'} on axis "
+                  f"{alarm['source_axis'] or '-'}: not scored")
+            continue
+        rows = [r for r in scores if r["unit"] == unit]
+        stamps = [r["stamp"] for r in rows]
+        day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
+        wear = t["wear"]
+        rate = wear[-1] - wear[-2]
+        onset = args.days - wear[-1] / rate  # the true wear is rate * (day - onset) from its onset on
+        true_eol = onset + F / rate  # (A)
+        monitoring = [r for r in rows if r["phase"] == "monitoring"]
+        past = [(wear[day[r["stamp"]] - 1], r[f"wear{axis}"]) for r in monitoring if wear[day[r["stamp"]] - 1] >= 5]
+        scale, offset = np.polyfit(*zip(*past), 1)
+        estimate_eol = onset + (F - offset) / scale / rate  # (B)
+        first = stamps.index(alarm["first_alarm"])
+        start = day[stamps[first + PERSISTENCE - 1]]
+        from progpy.predictors import ToEPredictionProfile
+
+        profile = ToEPredictionProfile()
+        medians = []
+        for j in range(first + PERSISTENCE - 1, len(rows)):
+            (row,) = prognosis.remaining_life(unit, rows[: j + 1], 6, alpha=MONITOR_ALPHA, failure_wear=F,
+                                              since=alarm["first_alarm"], source_axis=axis, axes=[axis])
+            now = day[rows[j]["stamp"]]
+            if row.distribution is not None:
+                profile.add_prediction(now, _absolute(row.distribution, now, H))
+            medians.append((now, row.rul))
+        print(f"\n{unit}: worn axis {axis}, true wear {F:g} % on day {true_eol:.1f}; estimate {scale:.2f} x true wear "
+              f"{offset:+.1f} %, so {F:g} % estimated on day {estimate_eol:.1f}; alarm persistent on day {start}; "
+              f"{len(profile)} of {len(medians)} predictions with an end of life within {H:g} days")
+        shown = medians[:: max(1, len(medians) // 6)]
+        print("  day: predicted remaining life (median), true (A), estimate's (B): " + "; ".join(
+            f"{d}: {'-' if m is None else f'{m:.0f}'}, {true_eol - d:.0f}, {estimate_eol - d:.0f}" for d, m in shown))
+        for name, eol in (("A", true_eol), ("B", estimate_eol)):
+            s = score(profile, eol, start, args.days)
+            s["unit"] = unit
+            results[name].append(s)
+            al = {None: f"n/a (lambda day {s['lambda']:.0f} after the record)", True: "met", False: "not met"}[
+                s.get("alpha_lambda")]  # a bool or None
+            ph = "none" if s.get("ph") is None else f"{s['ph']:.0f} days"
+            print(f"  ({name}) end of life day {eol:.1f}, lambda day {s['lambda']:.1f}: alpha-lambda {al}; "
+                  f"RA at lambda {s.get('ra_lambda', float('nan')):.2f}; cumulative RA {s.get('cra', float('nan')):.2f} "
+                  f"over {s['predictions']} predictions; prognostic horizon "
+                  f"{ph}; median bias "
+                  f"{s.get('bias', float('nan')):+.1f} days")
+    print(f"\nprofiles computed in {time.perf_counter() - started:.0f} s")
+    for name, label in (("A", "true wear reaches F (independent)"), ("B", "estimate's trend reaches F (hindsight)")):
+        rs = results[name]
+        met = sum(r.get("alpha_lambda") is True for r in rs)
+        evaluable = sum(r.get("alpha_lambda") is not None for r in rs)
+        phs = [r["ph"] for r in rs if r.get("ph") is not None]
+        print(f"({name}) {label}: alpha-lambda (alpha {ALPHA}, beta {BETA}, lambda {LAMBDA}) met on {met} of "
+              f"{evaluable} evaluable units ({len(rs)} scored); median RA at lambda "
+              f"{np.median([r['ra_lambda'] for r in rs if 'ra_lambda' in r]) if evaluable else float('nan'):.2f}; "
+              f"median cumulative RA {np.median([r['cra'] for r in rs if 'cra' in r]):.2f}; prognostic horizon "
+              f"{len(phs)} of {len(rs)} units ({', '.join(f'{p:.0f}' for p in phs) or '-'} days); median bias "
+              f"{np.median([r['bias'] for r in rs if 'bias' in r]):+.1f} days")
+
+
+if __name__ == "__main__":
+    main()

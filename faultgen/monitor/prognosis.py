@@ -1,0 +1,387 @@
+"""Remaining useful life per unit and axis (issue 59): the time until an axis's wear estimate
+reaches a failure wear, as a distribution, from a degradation trend fitted on the unit's wear
+estimates (:mod:`faultgen.monitor.scoring`: per log and axis ``wearI`` %, in the twin's scale, and
+its lower ``1 - alpha`` bound ``wearI_lower``; the estimate's standard error is ``(wearI -
+wearI_lower) / z``, ``z`` the standard normal's ``1 - alpha`` quantile). Recomputed from the
+unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`write_rul`).
+
+Per axis:
+
+1. **The logs fitted**: the unit's monitoring logs since its last maintenance (the rows of phase
+   ``monitoring`` after the last ``relearning`` one: a new part starts a new trend); for the source
+   axis of the unit's open alarm, only those from its first alarm on (the alarm marks where the
+   wear left the noise: the flat stretch before it would bend a straight line). At least
+   :data:`MIN_LOGS`; time in days since the last of them (stamps that are dates or date-times,
+   :func:`faultgen.data.logfolder.parse_stamp`), or in logs (sequence-number stamps).
+2. **Two degradation models**, each fitted by weighted least squares (``scipy.optimize.curve_fit``,
+   weights one over each estimate's variance), written with their parameters as the state now
+   (``t`` <= 0 the logs' times, 0 the last log): linear ``w(t) = w0 + b t`` and exponential
+   ``w(t) = w0 + b (exp(k t) - 1) / k`` (``a + c exp(k t)``, the exponential degradation model of
+   Gebraeel et al. 2005 with an offset, by its wear ``w0`` and slope ``b`` now and its growth rate
+   ``k``; ``k`` -> 0 is the line). **Criterion**: the smaller AICc (Akaike's criterion with the small
+   sample correction, ``statsmodels.tools.eval_measures.aicc``; Burnham & Anderson 2002) of the
+   Gaussian likelihood with the variances' common scale fitted, so the exponential's third parameter
+   must pay for itself (with 5 logs it cannot: its AICc is infinite). A fit that does not converge or
+   whose covariance is not finite is not a candidate.
+3. **Parameter uncertainty**: the fit's covariance, scaled by the residuals' reduced chi-square when
+   it is above one (the stated standard errors are a floor: the log-to-log scatter of a real unit
+   may exceed them, never fall below), sampled (:data:`SAMPLES` draws, multivariate normal, seeded)
+   into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the model's state now.
+4. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each sample of the state
+   through :class:`WearTrend` (a :class:`progpy.PrognosticsModel` whose ``next_state`` is the exact
+   solution of either model, so no step error) up to :data:`HORIZON` days (logs), its event
+   ``failure`` met at wear >= the failure wear; the step ends on the crossing when it falls inside
+   it, so a sample's time of event is exact. A sample that does not cross within the horizon has
+   no time of event (ProgPy's None).
+5. **The row**: the median time of event (the estimate), its 5 and 95 % quantiles
+   (``numpy.quantile``, ``inverted_cdf``: a sample's own value, with the samples beyond the horizon
+   counted as later than it), and the probability of failure within the horizon (one minus
+   ProgPy's :func:`progpy.metrics.prob_success` at the horizon). When that probability is below
+   one half (the median lies beyond the horizon: a flat or falling trend, or one too slow), the
+   axis has **no end of life within the horizon**, said with the horizon, and no number is given.
+
+Why the fit is not ProgPy's own: ProgPy fits a model's parameters to run-to-failure data by
+minimising an error (``PrognosticsModel.estimate_params``), without the parameters' covariance, and
+its state estimators (Kalman and particle filters) track a model's state given its parameters; a
+trend fitted to a short noisy health-indicator series with the uncertainty of its parameters is a
+regression, so scipy's least squares with its covariance does that part and ProgPy the prediction,
+its uncertainty types and metrics (``benchmarks/monitor_rul.py``).
+
+The wear is in the twin's scale (:mod:`faultgen.monitor.scoring`): on the independent fleet the
+estimate grows some 0.5-0.7 % per % of true wear, so the remaining life to a 40 % *estimate* is
+longer than to 40 % true wear (docs/analysis.md, "Remaining useful life").
+"""
+
+from __future__ import annotations
+
+import csv
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from statistics import NormalDist
+
+import numpy as np
+
+from faultgen.data import cells, logfolder
+
+#: Default failure wear, % (in the twin's scale): the end of life the remaining life counts to.
+FAILURE_WEAR = 40.0
+#: Largest failure wear taken, %.
+MAX_FAILURE_WEAR = 1000.0
+#: How far ahead an end of life is looked for: days (date stamps) or logs (sequence numbers).
+HORIZON = 365.0
+#: Fewest logs a trend is fitted on (the monitor's default persistence: an alarm's own logs).
+MIN_LOGS = 5
+#: Draws of the fitted parameters propagated to a time of event.
+SAMPLES = 1000
+#: The interval given: 5 and 95 % quantiles of the time of event.
+INTERVAL = (0.05, 0.95)
+#: Models, the simpler first.
+MODELS = ("linear", "exponential")
+#: How much smaller the exponential's AICc must be for it to be taken over the line (Burnham &
+#: Anderson 2002, ch. 2.6: models within 2 of the best have substantial support; the simpler is kept).
+AICC_MARGIN = 2.0
+
+COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model", "rul", "rul_5", "rul_95",
+           "p_within_horizon", "horizon", "logs_fitted", "fitted_from", "verdict")
+
+
+@dataclass
+class Remaining:
+    """One row of ``rul.csv``: ``unit``, ``axis`` (1..N; None when the unit has no wear estimate),
+    computed at ``stamp`` (the last log fitted), in ``time_unit`` ("days" or "logs"); ``wear`` the
+    model's wear now, %, ``model`` ("linear" or "exponential"), ``rul`` the median time to
+    ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
+    ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, and ``verdict`` in
+    words. ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
+    key ``failure``), for scoring; None without a fit."""
+
+    unit: str
+    axis: int | None
+    stamp: str
+    time_unit: str
+    verdict: str
+    failure_wear: float = FAILURE_WEAR
+    horizon: float = HORIZON
+    wear: float | None = None
+    model: str = ""
+    rul: float | None = None
+    rul_5: float | None = None
+    rul_95: float | None = None
+    p_within_horizon: float | None = None
+    logs_fitted: int = 0
+    fitted_from: str = ""
+    distribution: object = field(default=None, repr=False)
+
+    @property
+    def end_of_life(self) -> bool:
+        """Whether an end of life lies within the horizon (:attr:`rul` is a number)."""
+        return self.rul is not None
+
+
+def _wear_trend_model(failure_wear: float):
+    """The ProgPy model of both trends (module docstring, 4), its event at ``failure_wear``."""
+    from progpy import PrognosticsModel
+
+    class WearTrend(PrognosticsModel):
+        """``dw/dt = s``, ``ds/dt = k s``: a line (``k`` = 0) or ``w0 + b (exp(k t) - 1) / k``,
+        stepped by its exact solution."""
+
+        # ProgPy reads a model's names and defaults from these class attributes
+        inputs = []  # noqa: RUF012
+        states = ["wear", "slope", "growth"]  # noqa: RUF012
+        outputs = ["wear"]  # noqa: RUF012
+        events = ["failure"]  # noqa: RUF012
+        default_parameters = {"failure_wear": failure_wear, "process_noise": 0.0,  # noqa: RUF012
+                              "measurement_noise": 0.0, "x0": {"wear": 0.0, "slope": 0.0, "growth": 0.0}}
+
+        def next_state(self, x, u, dt):
+            k, s = x["growth"], x["slope"]
+            return self.StateContainer({"wear": x["wear"] + s * _expm1_over(k, dt), "slope": s * np.exp(k * dt),
+                                        "growth": k})
+
+        def output(self, x):
+            return self.OutputContainer({"wear": x["wear"]})
+
+        def event_state(self, x):
+            return {"failure": max(0.0, 1.0 - float(x["wear"]) / self.parameters["failure_wear"])}
+
+        def threshold_met(self, x):
+            return {"failure": bool(x["wear"] >= self.parameters["failure_wear"])}
+
+    return WearTrend()
+
+
+def _expm1_over(k, t):
+    """``(exp(k t) - 1) / k``, ``t`` where ``k t`` is too small for the quotient."""
+    k, t = np.asarray(k, dtype=float), np.asarray(t, dtype=float)
+    small = np.abs(k * t) < 1e-8
+    return np.where(small, t * (1.0 + 0.5 * k * t), np.expm1(k * t) / np.where(small, 1.0, k))
+
+
+def _linear(t, w0, b):
+    return w0 + b * t
+
+
+def _exponential(t, w0, b, k):
+    return w0 + b * _expm1_over(k, t)
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k]), their covariance
+    ``cov`` (scaled: module docstring, 3) and its ``aicc``."""
+
+    model: str
+    params: np.ndarray
+    cov: np.ndarray
+    aicc: float
+
+
+def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
+    """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
+    standard errors ``error``; the one of smaller AICc (module docstring, 2-3), None when neither fits."""
+    from scipy import stats
+    from scipy.optimize import curve_fit
+    from statsmodels.tools.eval_measures import aicc
+
+    t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
+    fits = []
+    linear = None
+    for name, f in (("linear", _linear), ("exponential", _exponential)):
+        n_params = 2 if name == "linear" else 3
+        if len(t) < n_params + 1:
+            continue
+        if name == "linear":
+            p0 = [wear[-1], 0.0]
+        else:
+            if linear is None:
+                continue
+            span = max(float(-t[0]), 1e-9)
+            p0 = [linear.params[0], linear.params[1], 0.1 / span]
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                params, cov = curve_fit(f, t, wear, p0=p0, sigma=error, absolute_sigma=True, maxfev=5000)
+        except (RuntimeError, ValueError, np.linalg.LinAlgError):
+            continue
+        residual = wear - f(t, *params)
+        dof = len(t) - n_params
+        chi2 = float(np.sum((residual / error) ** 2))
+        if dof > 0:
+            cov = cov * max(1.0, chi2 / dof)
+        if not (np.all(np.isfinite(params)) and np.all(np.isfinite(cov))):
+            continue
+        # Gaussian likelihood, the variances' common scale at its maximum (one parameter more)
+        scale = np.sqrt(chi2 / len(t)) if chi2 > 0 else 1e-12
+        llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
+        found = Fit(name, params, cov, float(aicc(llf, len(t), n_params + 1)))
+        if name == "linear":
+            linear = found
+        fits.append(found)
+    if not fits:
+        return None
+    if len(fits) == 2 and fits[1].aicc < fits[0].aicc - AICC_MARGIN:
+        return fits[1]
+    return fits[0]
+
+
+def _state_samples(fit: Fit, samples: int, seed: int):
+    """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now."""
+    from progpy.uncertain_data import UnweightedSamples
+
+    rng = np.random.default_rng(seed)
+    drawn = rng.multivariate_normal(fit.params, fit.cov, size=samples, method="eigh")
+    growth = drawn[:, 2] if drawn.shape[1] > 2 else np.zeros(samples)
+    return UnweightedSamples([{"wear": float(w), "slope": float(s), "growth": float(k)}
+                              for w, s, k in zip(drawn[:, 0], drawn[:, 1], growth)])
+
+
+def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0):
+    """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
+    under ``fit`` (module docstring, 4): ``UnweightedSamples`` with key ``failure`` (None beyond
+    ``horizon``)."""
+    from progpy.predictors import MonteCarlo
+
+    model = _wear_trend_model(failure_wear)
+
+    def step(t, x):  # up to the horizon, ending on the crossing when it falls inside the step
+        wear, slope, growth = float(x["wear"]), float(x["slope"]), float(x["growth"])
+        gap, left = failure_wear - wear, max(horizon - t, 1e-9)
+        if gap <= 0:
+            return 1e-9
+        reach = np.inf
+        if slope > 0:
+            ratio = growth * gap / slope
+            if abs(growth) < 1e-12:
+                reach = gap / slope
+            elif ratio > -1:
+                reach = float(np.log1p(ratio) / growth)
+        return float(min(left, max(reach * (1.0 + 1e-12), 1e-9)))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = MonteCarlo(model).predict(_state_samples(fit, samples, seed), dt=step, horizon=horizon,
+                                           save_freq=horizon, events=["failure"])
+    return result.time_of_event
+
+
+def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, failure_wear: float = FAILURE_WEAR,
+                   keys: dict[str, float] | None = None, kind: str | None = None, since: str | None = None,
+                   source_axis: int | None = None, horizon: float = HORIZON, samples: int = SAMPLES,
+                   seed: int = 0, axes: list[int] | None = None) -> list[Remaining]:
+    """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
+    rows (``UnitMonitor.rows``: ``stamp``, ``phase``, ``wearI``, ``wearI_lower``) with the monitor's
+    ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
+    (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
+    first alarm of the open alarm, whose ``source_axis`` is fitted from it on (module docstring);
+    ``axes`` (1..N) the axes wanted, all when None. A unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
+    check_failure_wear(failure_wear)
+    stamp = rows[-1]["stamp"] if rows else ""
+    if not rows or "wear1" not in rows[0]:
+        why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
+        return [Remaining(unit, None, stamp, "", why, failure_wear, horizon)]
+    block = []
+    for row in reversed(rows):  # the monitoring logs since the last maintenance
+        if row["phase"] != "monitoring":
+            break
+        block.append(row)
+    block.reverse()
+    if keys is None:
+        parsed = [logfolder.parse_stamp(r["stamp"], f"{unit}/{r['stamp']}") for r in block]
+        keys = {r["stamp"]: key for r, (key, _) in zip(block, parsed)}
+        kind = parsed[0][1] if parsed else kind
+    time_unit = "logs" if kind == logfolder.SEQUENCE else "days"
+    per = 1.0 if kind == logfolder.SEQUENCE else 86400.0
+    z = NormalDist().inv_cdf(1.0 - alpha)
+    out = []
+    for axis in range(1, n_axes + 1) if axes is None else axes:
+        fitted = block
+        if since is not None and axis == source_axis:
+            stamps = [r["stamp"] for r in block]
+            fitted = block[stamps.index(since):] if since in stamps else block
+        base = Remaining(unit, axis, stamp, time_unit, "", failure_wear, horizon, logs_fitted=len(fitted),
+                         fitted_from=fitted[0]["stamp"] if fitted else "")
+        if len(fitted) < MIN_LOGS:
+            base.verdict = (f"too few logs for a trend: {len(fitted)} of {MIN_LOGS} since the "
+                            f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
+            out.append(base)
+            continue
+        wear = np.array([r[f"wear{axis}"] for r in fitted], dtype=float)
+        error = (wear - np.array([r[f"wear{axis}_lower"] for r in fitted], dtype=float)) / z
+        t = np.array([keys[r["stamp"]] for r in fitted], dtype=float)
+        t = (t - t[-1]) / per
+        fit = fit_trend(t, wear, np.maximum(error, 1e-9))
+        if fit is None:
+            base.verdict = "no trend could be fitted"
+            out.append(base)
+            continue
+        slope, slope_error = float(fit.params[1]), float(np.sqrt(fit.cov[1, 1]))
+        if slope - z * slope_error <= 0:
+            base.model, base.wear = fit.model, float(fit.params[0])
+            base.verdict = (f"no wear trend (slope now {slope:.2g} +- {slope_error:.2g} % per {time_unit[:-1]}, not above "
+                            f"0 at alpha {alpha:g}): no end of life within the horizon ({horizon:g} {time_unit})")
+            out.append(base)
+            continue
+        toe = time_of_event(fit, failure_wear, horizon, samples, seed)
+        out.append(_summarise(base, fit, toe, horizon))
+    return out
+
+
+def _summarise(row: Remaining, fit: Fit, toe, horizon: float) -> Remaining:
+    from progpy.metrics import prob_success
+
+    values = np.array([np.inf if v is None else float(v) for v in toe.key("failure")])
+    values[values < 1e-6] = 0.0  # crossed already: the first step's length
+    low, mid, high = np.quantile(values, [INTERVAL[0], 0.5, INTERVAL[1]], method="inverted_cdf")
+    row.model, row.wear, row.distribution = fit.model, float(fit.params[0]), toe
+    row.p_within_horizon = 1.0 - float(prob_success(toe, horizon)["failure"])
+    unit = row.time_unit
+    h = f"{horizon:g} {unit}"
+    if row.p_within_horizon < 0.5:
+        row.verdict = f"no end of life within the horizon ({h}): probability {row.p_within_horizon:.2f} within it"
+        return row
+    row.rul, row.rul_5 = float(mid), float(low)
+    row.rul_95 = float(high) if np.isfinite(high) else None
+    upper = f"{high:.3g} {unit}" if np.isfinite(high) else f"beyond the {h} horizon"
+    now = " (at or past it now)" if row.wear >= row.failure_wear else ""
+    row.verdict = (f"end of life (wear {row.failure_wear:g} %){now} in {mid:.3g} {unit}, 5-95 %: {low:.3g} {unit} "
+                   f"to {upper} ({fit.model} trend of {row.logs_fitted} logs)")
+    return row
+
+
+def check_failure_wear(failure_wear: float) -> None:
+    if not 0 < failure_wear <= MAX_FAILURE_WEAR:
+        raise ValueError(f"failure_wear = {failure_wear!r} %; expected a number in (0, {MAX_FAILURE_WEAR:g}] (the wear "
+                         "estimate, in the twin's scale, counted as the end of an axis's life)")
+
+
+def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, **options) -> list[Remaining]:
+    """:func:`remaining_life` of a :class:`faultgen.monitor.scoring.UnitMonitor`: its rows, alpha
+    and open alarm."""
+    return remaining_life(monitor.unit, monitor.rows, monitor.n_axes, alpha=monitor.settings.alpha,
+                          failure_wear=failure_wear, since=monitor.first_alarm, source_axis=monitor.source_axis,
+                          **options)
+
+
+def _cell(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return cells.text(value) if isinstance(value, str) else str(value)
+
+
+def write_rul(path: Path, rows: list[Remaining]) -> None:
+    """``rul.csv``: one row per unit and axis (:data:`COLUMNS`; empty cells where there is no
+    number: no fit, or beyond the horizon)."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(COLUMNS)
+        for row in rows:
+            writer.writerow([_cell(getattr(row, c)) for c in COLUMNS])
+
+
+def write(path: Path, monitors, failure_wear: float = FAILURE_WEAR) -> None:
+    """``rul.csv`` of every unit's monitor (:func:`of_monitor`, :func:`write_rul`)."""
+    write_rul(path, [row for m in monitors for row in of_monitor(m, failure_wear)])

@@ -1,0 +1,132 @@
+"""Remaining useful life (faultgen.monitor.prognosis) on synthetic wear series whose crossing of
+the failure wear is known: linear and exponential growth plus noise, a flat series, and rul.csv.
+The check against an independent fleet's truth is benchmarks/monitor_rul.py (docs/analysis.md)."""
+
+import csv
+import datetime
+from statistics import NormalDist
+
+import numpy as np
+import pytest
+
+from faultgen.monitor import prognosis
+
+ALPHA = 0.01
+Z = NormalDist().inv_cdf(1 - ALPHA)
+NOISE = 2.0  # % : the wear estimate's standard error, as the monitor states it
+DRAWS = 50
+SAMPLES = 200  # draws of the fit per prediction (the monitor takes prognosis.SAMPLES)
+
+
+def _rows(wear: np.ndarray, start: str = "2026-01-05", sequence: bool = False) -> list[dict]:
+    day = datetime.date.fromisoformat(start)
+    return [{"stamp": str(100 + i) if sequence else (day + datetime.timedelta(days=i)).isoformat(),
+             "phase": "monitoring", "wear1": float(w), "wear1_lower": float(w - Z * NOISE)}
+            for i, w in enumerate(wear)]
+
+
+def _one(rows: list[dict], **options) -> prognosis.Remaining:
+    (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, **options)
+    return row
+
+
+def _covered(row: prognosis.Remaining, truth: float) -> bool:
+    high = np.inf if row.rul_95 is None else row.rul_95
+    return row.rul is not None and row.rul_5 <= truth <= high
+
+
+def test_a_linear_wear_is_called_linear_and_its_interval_covers_the_true_crossing():
+    covered, linear, errors = 0, 0, []
+    for seed in range(DRAWS):
+        rng = np.random.default_rng(seed)
+        rate, days = rng.uniform(0.3, 0.8), 40
+        t = np.arange(days)
+        row = _one(_rows(rate * t + rng.normal(0, NOISE, days)))
+        truth = (prognosis.FAILURE_WEAR - rate * (days - 1)) / rate  # days after the last log
+        covered += _covered(row, truth)
+        linear += row.model == "linear"
+        errors.append(np.inf if row.rul is None else row.rul - truth)
+        assert row.time_unit == "days" and row.stamp == "2026-02-13" and row.logs_fitted == days
+    assert covered >= 0.8 * DRAWS, covered  # a 90 % interval: 45 of 50 expected
+    assert linear >= 0.8 * DRAWS, linear
+    assert abs(np.median(errors)) < 3.0, np.median(errors)
+
+
+def test_an_exponential_wear_is_called_exponential_and_its_interval_covers_the_true_crossing():
+    covered, exponential = 0, 0
+    for seed in range(DRAWS):
+        rng = np.random.default_rng(1000 + seed)
+        growth, days = rng.uniform(0.04, 0.05), 50  # 12-21 % at the last log, 40 % 12-27 days later
+        t = np.arange(days)
+        wear = 2.0 * np.expm1(growth * t)
+        row = _one(_rows(wear + rng.normal(0, NOISE, days)))
+        truth = np.log1p(prognosis.FAILURE_WEAR / 2.0) / growth - (days - 1)
+        covered += _covered(row, truth)
+        exponential += row.model == "exponential"
+    assert exponential >= 0.8 * DRAWS, exponential
+    assert covered >= 0.8 * DRAWS, covered
+
+
+def test_a_flat_series_has_no_end_of_life_within_the_horizon():
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        row = _one(_rows(rng.normal(0, NOISE, 60)))
+        assert row.rul is None and row.rul_5 is None and row.rul_95 is None, row
+        assert not row.end_of_life
+        assert "no end of life within the horizon (365 days)" in row.verdict, row.verdict
+
+
+def test_sequence_stamps_count_logs_and_the_open_alarm_fits_its_axis_from_the_alarm_on():
+    rng = np.random.default_rng(3)
+    wear = np.r_[np.zeros(30), 0.5 * np.arange(1, 31)] + rng.normal(0, NOISE, 60)
+    rows = _rows(wear, sequence=True)
+    whole = _one(rows)
+    alarmed = _one(rows, since=rows[30]["stamp"], source_axis=1)
+    assert whole.time_unit == alarmed.time_unit == "logs"
+    assert whole.logs_fitted == 60 and alarmed.logs_fitted == 30 and alarmed.fitted_from == "130"
+    truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5
+    assert _covered(alarmed, truth), alarmed
+    assert not _covered(whole, truth), whole  # the flat stretch before the alarm bends the trend
+
+
+def test_maintenance_restarts_the_trend_and_too_few_logs_say_so():
+    rows = _rows(np.linspace(0, 35, 40))
+    rows[20]["phase"] = "relearning"
+    row = _one(rows)
+    assert row.logs_fitted == 19 and row.fitted_from == rows[21]["stamp"]
+    row = _one(rows[:24])
+    assert row.rul is None and row.verdict.startswith("too few logs for a trend: 3 of 5"), row.verdict
+    (unit,) = prognosis.remaining_life("u", [], 6, alpha=ALPHA)
+    assert unit.axis is None and "learning" in unit.verdict
+    own = [{"stamp": "2026-01-05", "phase": "monitoring", "Q": 1.0}]
+    (unit,) = prognosis.remaining_life("u", own, 6, alpha=ALPHA)
+    assert unit.axis is None and "protocol own" in unit.verdict
+    with pytest.raises(ValueError, match="failure_wear"):
+        prognosis.remaining_life("u", rows, 1, alpha=ALPHA, failure_wear=0.0)
+
+
+def test_the_same_rows_give_the_same_distribution():
+    rng = np.random.default_rng(7)
+    rows = _rows(0.6 * np.arange(30) + rng.normal(0, NOISE, 30))
+    a, b = _one(rows), _one(rows)
+    assert a.distribution.key("failure") == b.distribution.key("failure")
+    assert (a.rul, a.rul_5, a.rul_95) == (b.rul, b.rul_5, b.rul_95)
+
+
+def test_rul_csv_has_a_row_per_unit_and_axis_with_empty_cells_where_there_is_no_number(tmp_path):
+    rng = np.random.default_rng(11)
+    worn = _one(_rows(0.7 * np.arange(40) + rng.normal(0, NOISE, 40)))
+    flat = _one(_rows(rng.normal(0, NOISE, 40)))
+    flat.unit = "=cmd"  # a unit folder a spreadsheet would take for a formula
+    path = tmp_path / "rul.csv"
+    prognosis.write_rul(path, [worn, flat])
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        assert tuple(reader.fieldnames) == prognosis.COLUMNS
+        rows = list(reader)
+    assert [r["unit"] for r in rows] == ["u", "'=cmd"]
+    assert float(rows[0]["rul_5"]) <= float(rows[0]["rul"]) <= float(rows[0]["rul_95"])
+    assert rows[0]["model"] in prognosis.MODELS and rows[0]["time_unit"] == "days"
+    assert rows[0]["stamp"] == "2026-02-13" and float(rows[0]["failure_wear"]) == 40.0
+    assert rows[1]["rul"] == rows[1]["rul_5"] == rows[1]["rul_95"] == ""
+    assert "no end of life within the horizon" in rows[1]["verdict"]
