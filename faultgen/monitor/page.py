@@ -117,6 +117,7 @@ class Unit:
     current: dict | None = None
     closed: list[dict] = field(default_factory=list)
     scores: list[dict] = field(default_factory=list)
+    remaining: dict[int, dict] = field(default_factory=dict)  # axis -> its row of rul.csv
 
     @property
     def name(self) -> str:
@@ -182,6 +183,11 @@ def read(folder: str | Path) -> Fleet:
     for r in score_rows:
         if r["unit"] in units:
             units[r["unit"]].scores.append(r)
+    if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
+        for r in _read_csv(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"))[1]:
+            axis = _number(r["axis"])
+            if r["unit"] in units and math.isfinite(axis):
+                units[r["unit"]].remaining[int(axis)] = r
     n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
     ordered = sorted(units.values(), key=Unit.attention)
     return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
@@ -401,8 +407,19 @@ SCRIPT = """
 """
 
 #: The fleet table's columns.
-COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)", "last log",
-           "logs", "closed alarms")
+COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)",
+           "remaining life (5-95 %)", "last log", "logs", "closed alarms")
+
+
+def _remaining(row: dict | None) -> str:
+    """A row of rul.csv in words: the median remaining life and its 5-95 % interval, or its verdict."""
+    if not row:
+        return ""
+    rul = _number(row.get("rul"))
+    if not math.isfinite(rul):
+        return row.get("verdict", "")
+    unit = row.get("time_unit", "")
+    return f"{rul:.0f} {unit} ({_number(row.get('rul_5')):.0f}-{_number(row.get('rul_95')):.0f})"
 
 
 def _status_badge(unit: Unit) -> str:
@@ -428,9 +445,10 @@ def _table_row(index: int, unit: Unit) -> str:
         wear_cell = text if alarm else f'<span class="muted">axis {axis}: {text}</span>'
     opened = (f'<span class="status s-alarm">{_e(alarm["statistic"])} alarm</span>' if alarm else "")
     closed = "<br>".join(_e(_closed_text(a)) for a in unit.closed)
+    remaining = _e(_remaining(unit.remaining.get(wear[0]))) if wear is not None else ""
     cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
               _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
-              _e(unit.row.get("last_log", "")), _e(unit.row.get("logs_scored", "")), closed]
+              remaining, _e(unit.row.get("last_log", "")), _e(unit.row.get("logs_scored", "")), closed]
     return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
 
 
@@ -450,6 +468,11 @@ def _panel(index: int, unit: Unit, settings: dict) -> str:
                      f'{_e(unit.current["evidence"])}</p>')
     elif unit.current is not None:
         parts.append(f"<p>No open alarm: {_e(unit.current['evidence'])}.</p>")
+    if unit.remaining:
+        items = "".join(f"<li>axis {axis}: {_e(_remaining(r))}"
+                        + (f" ({_e(r['model'])} trend of {_e(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
+                        + "</li>" for axis, r in sorted(unit.remaining.items()))
+        parts.append(f"<p>Remaining life until the wear estimate reaches the failure wear (rul.csv):</p><ul>{items}</ul>")
     if unit.closed:
         items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
