@@ -603,5 +603,7 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
             os.link(log, partial / unit.name / log.name)
     outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
-    for name in ("alarms.csv", "scores.csv", "units.csv", "rul.csv"):
+    charts = tuple(p.name for p in monitored.glob("*.png"))
+    assert charts
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name

@@ -20,6 +20,7 @@ share their simulated cycles.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import shutil
 import warnings
@@ -173,26 +174,29 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
         if unit_logs and name not in state:
             state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, read_with)
-    context = _Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance)
+    context = _Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
+                       failure_wear)
     groups = _groups({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
+    made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
     for done in _map(context, groups, jobs):
-        for name, unit in done:
-            state[name] = unit
+        for name, unit, outputs in done:
+            state[name], made[name] = unit, outputs
             bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
+    for m in monitors:  # the units with no new log
+        made.setdefault(m.unit, _unit_outputs(m, failure_wear))
     statuses = [_status(name, state.get(name), settings) for name in units]
-    note = "wear signature match" if settings.protocol == "twin" else "share of Q"
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
         report.write_units(staging / "units.csv", statuses)
-        prognosis.write(staging / "rul.csv", monitors, failure_wear)
+        prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
         page.write(staging, settings, robot=str(robot), logs=str(logs_dir), model=model_source,
                    twin_temperature=twin_temperature)
         for m in monitors:
-            report.chart(staging / f"{m.unit}.png", m, note)
+            (staging / f"{m.unit}.png").write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()
         for name in units:
             if name in state:
@@ -216,6 +220,7 @@ class _Context:
     log_format: object
     units: dict
     maintenance: dict
+    failure_wear: float
 
 
 def _groups(pending: dict[str, tuple[_Unit, list]]) -> list[list[tuple[str, _Unit, list]]]:
@@ -265,9 +270,20 @@ def _map(context: _Context, groups: list, jobs: int):
             delayed(_score_group)(context, group) for group in groups)
 
 
-def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> list[tuple[str, _Unit]]:
+def _unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
+    """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
+    rul.csv (:func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
+    they are made in parallel too."""
+    note = "wear signature match" if monitor.signatures is not None else "share of Q"
+    buffer = io.BytesIO()
+    report.chart(buffer, monitor, note)
+    return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)
+
+
+def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> list[tuple[str, _Unit, tuple]]:
     """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
-    events given before the first log at or after them; returns the units."""
+    events given before the first log at or after them; returns the units with their chart and
+    remaining life (:func:`_unit_outputs`)."""
     nominal = robots.load(context.robot)
     read_with, _ = fleet_logs.reader_of(context.log_format)
     twins: dict[tuple, Twin] = {}
@@ -281,7 +297,7 @@ def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> lis
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
             _score_log(unit, log, nominal, twin, context.twin_temperature, read_with)
-    return [(name, unit) for name, unit, _ in group]
+    return [(name, unit, _unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
 
 
 def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir) -> list:

@@ -61,7 +61,7 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
                 writer.writerow([_fmt(row.get(c, "")) for c in columns])
 
 
-def chart(path: Path, monitor, axis_note: str) -> None:
+def chart(path, monitor, axis_note: str) -> None:
     """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, with the
     twin each axis's wear estimate with the limit its lower bound is judged against, and each
     axis's isolation score."""
@@ -70,6 +70,11 @@ def chart(path: Path, monitor, axis_note: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    with plt.style.context("default"):  # whatever another library set globally (ProgPy sets fonts on import)
+        _draw(path, monitor, axis_note, plt)
+
+
+def _draw(path, monitor, axis_note: str, plt) -> None:
     rows = monitor.rows
     twin = bool(rows) and "wear1" in rows[0]
     fig, panels = plt.subplots(3 if twin else 2, 1, figsize=(9, 8.5 if twin else 6), sharex=True,
@@ -112,5 +117,5 @@ def chart(path: Path, monitor, axis_note: str) -> None:
     if rows:
         top.legend(fontsize=7, loc="upper left")
         bottom.legend(fontsize=7, loc="upper left", ncol=3)
-    fig.savefig(path, dpi=90, metadata={"Software": None})
+    fig.savefig(path, format="png", dpi=90, metadata={"Software": None})
     plt.close(fig)
