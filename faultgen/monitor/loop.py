@@ -185,8 +185,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
-    for m in monitors:  # the units with no new log
-        made.setdefault(m.unit, _unit_outputs(m, failure_wear))
+    for m in monitors:
+        if m.unit not in made:  # a unit with no new log
+            made[m.unit] = _unit_outputs(m, failure_wear)
     statuses = [_status(name, state.get(name), settings) for name in units]
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
