@@ -230,6 +230,8 @@ def test_monitor_writes_the_page(tmp_path):
     assert result.exit_code == 0, result.output
     assert str(out / page.PAGE) in result.output
     assert page.read_settings(out)["protocol"] == "own"
+    for name in (page.PAGE, page.SETTINGS):  # LOGS by its name: a page meant to be shared holds no path of ours
+        assert str(tmp_path) not in (out / name).read_text(), name
     statement = next(line for line in result.output.splitlines() if "Chance of a persistent alarm" in line)
     assert html.escape(statement) in (out / page.PAGE).read_text()
 
