@@ -607,3 +607,51 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     assert charts
     for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
+
+
+def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(fleet, monitored, tmp_path):
+    """From day 21 a healthy unit runs its program turned 0.3 rad about the base (axis 1, whose
+    dynamics do not depend on its angle): nobody logged it. The monitor finds the motion left the
+    twin's program, rebuilds the twin on that day's log and learns the unit again (units.csv says
+    so; no wear alarm); a run in two parts around the change gives the same outputs (issue 60,
+    part 4)."""
+    import csv
+
+    robot, logs, truth = fleet
+    outcome = independent_fleet.evaluate(truth, monitored / "alarms.csv")
+    healthy = next(u for u, o in outcome.items() if not o["axis"])
+    copy = tmp_path / "logs"
+    (copy / healthy).mkdir(parents=True)
+    files = sorted((logs / healthy).iterdir())
+    for day, log in enumerate(files, start=1):
+        if day <= 20:
+            os.link(log, copy / healthy / log.name)
+            continue
+        header, *rows = log.read_text().splitlines()
+        k = header.split(",").index("q1")
+        turned = []
+        for row in rows:
+            cells = row.split(",")
+            cells[k] = repr(float(cells[k]) + 0.3)
+            turned.append(",".join(cells))
+        (copy / healthy / log.name).write_text("\n".join([header, *turned]) + "\n")
+    out = with_cycles_of(monitored, tmp_path / "out")
+    loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+    with open(out / "units.csv", newline="") as f:
+        row = next(csv.DictReader(f))
+    assert row["status"] == "monitored" and f"program changed at {files[20].stem}" in row["reason"], row
+    with open(out / "scores.csv", newline="") as f:
+        phases = [(r["stamp"], r["phase"]) for r in csv.DictReader(f)]
+    assert [p for s, p in phases if s >= files[20].stem][:SETTINGS.train] == ["training"] * SETTINGS.train
+    assert "no persistent alarm" in (out / "alarms.csv").read_text()
+    split = tmp_path / "split"
+    (split / healthy).mkdir(parents=True)
+    for log in sorted((copy / healthy).iterdir())[:25]:
+        os.link(log, split / healthy / log.name)
+    again = with_cycles_of(monitored, tmp_path / "again")
+    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    for log in sorted((copy / healthy).iterdir())[25:]:
+        os.link(log, split / healthy / log.name)
+    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    for name in ("alarms.csv", "scores.csv", "units.csv"):
+        assert (again / name).read_text() == (out / name).read_text(), name

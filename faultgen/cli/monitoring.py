@@ -98,7 +98,9 @@ def monitor_command(
     target moment, which units.csv says) or --format voraus, as `faultgen logs import` reads them.
 
     A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
-    with closed and closed_by) and the unit learns its offset again from the next logs.
+    with closed and closed_by) and the unit learns its offset again from the next logs; a log whose
+    motion left the twin's program (a program change nobody logged) rebuilds the twin on it and the
+    unit learns again, said in units.csv.
 
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),

@@ -68,6 +68,7 @@ class Reading:
     temperature: float
     payload: float
     notes: tuple[str, ...] = ()
+    q: np.ndarray | None = None  # (n, N) rad: the log's angles, which tell a program change
 
 
 def feature_vector(record: dict[str, np.ndarray]) -> np.ndarray:
@@ -91,4 +92,4 @@ def read(robot: Robot, log: Log, reader: Reader = measured.read) -> Reading:
     data = reader(log.path, robot)
     temperature = float(np.mean(data.joint_temperature)) if data.joint_temperature is not None else float("nan")
     payload = float(np.max(data.payload_mass)) if data.payload_mass is not None else 0.0
-    return Reading(features_of(robot, data), temperature, payload, tuple(data.notes))
+    return Reading(features_of(robot, data), temperature, payload, tuple(data.notes), np.asarray(data.q))

@@ -43,6 +43,9 @@ from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 
 #: Two units run the same program when their first logs have the same samples and angles within this, rad.
 SAME_PROGRAM = 1e-3
+#: A log whose angles lie more than this off its twin's program, rad, or whose length differs by more
+#: than PROGRAM_LENGTH of it, runs another program (noise and tracking: about 1e-3 rad).
+PROGRAM_CHANGE, PROGRAM_LENGTH = 0.05, 0.05
 #: Effects searched when a unit's model is calibrated on its first log (faultgen.calibrate).
 CALIBRATION_STEPS = 3
 
@@ -69,6 +72,9 @@ class _Unit:
     skipped: list[stored.Skipped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     maintenance: list[stored.Maintenance] = field(default_factory=list)
+    program_changes: list[stored.ProgramChange] = field(default_factory=list)
+    program_q: np.ndarray | None = None  # the program log's angles (read when needed; not kept in the state)
+    initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
 
 
 @dataclass(frozen=True)
@@ -204,9 +210,11 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             if name in state:
                 unit = state[name]
                 stored.write_unit(staging / ".state" / f"{name}.json",
-                                  stored.UnitState(name, key, unit.program, unit.monitor.signatures, unit.entries,
+                                  stored.UnitState(name, key, unit.program,
+                                                   unit.monitor.signatures if unit.initial_signatures is None
+                                                   else unit.initial_signatures, unit.entries,
                                                    unit.model, unit.first, unit.skipped, unit.notes,
-                                                   unit.maintenance))
+                                                   unit.maintenance, unit.program_changes))
     return Outcome(monitors, statuses)
 
 
@@ -298,7 +306,7 @@ def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> lis
                     unit.monitor.maintenance(event.stamp, event.event, event.axis)
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
-            _score_log(unit, log, nominal, twin, context.twin_temperature, read_with)
+            twin = _score_log(unit, log, nominal, twin, context.twin_temperature, read_with, context)
     return [(name, unit, _unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
 
 
@@ -385,22 +393,59 @@ def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict,
                              f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
                              "into a new OUT")
         unit.monitor.signatures = twin.signatures
+        if unit.initial_signatures is None and not unit.program_changes:
+            unit.initial_signatures = twin.signatures
         return twin
     unit.program = None
     return None
 
 
+def _program_changed(q: np.ndarray, program: np.ndarray) -> bool:
+    """Whether a log's angles ``q`` (n, N) trace another motion than the program's (m, N): a length
+    more than :data:`PROGRAM_LENGTH` apart, or an angle more than :data:`PROGRAM_CHANGE` rad off
+    over their common samples (noise and tracking stay far below it)."""
+    n = min(len(q), len(program))
+    if abs(len(q) - len(program)) > PROGRAM_LENGTH * max(len(q), len(program)):
+        return True
+    return bool(np.max(np.abs(q[:n] - program[:n])) > PROGRAM_CHANGE)
+
+
+def _new_program(unit: _Unit, log, reading, twin: Twin, context) -> Twin:
+    """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
+    restarts its learning against it, its open alarm closed by the change; noted in its reason.
+
+    Raises
+    ------
+    ValueError
+        The new program's twin cannot be built (the log is then skipped, named).
+    """
+    new = Twin(twin.model, log.path, context.out / ".cache" / "cycles", root=context.out, reader=twin.reader)
+    unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
+    unit.monitor.signatures = new.signatures
+    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), reading.q
+    unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
+    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
+                      "replays that log, and the unit learns its normal operation again")
+    return new
+
+
 def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
-               read_with: fleet_logs.Reader) -> None:
+               read_with: fleet_logs.Reader, context=None) -> Twin | str | None:
     """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
     cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
-    unit's state with its reason."""
+    unit's state with its reason. A log whose motion left the twin's program starts a new one
+    (:func:`_new_program`). Returns the twin for the next log."""
     sha256 = stored.sha256_file(log.path)
     if isinstance(twin, str):
         unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
-        return
+        return twin
     try:
         reading = fleet_logs.read(nominal, log, read_with)
+        if twin is not None and context is not None and unit.program is not None:
+            if unit.program_q is None:
+                unit.program_q = np.asarray(read_with(_log(context.units, *unit.program).path, nominal).q)
+            if _program_changed(reading.q, unit.program_q):
+                twin = _new_program(unit, log, reading, twin, context)
         residual, expected = reading.vector, None
         if twin is not None:
             at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
@@ -410,11 +455,12 @@ def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperat
         raise
     except ValueError as err:
         unit.skipped.append(stored.Skipped(log.stamp, sha256, _short(err)))
-        return
+        return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
     unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
+    return twin
 
 
 def _short(err: Exception, limit: int = 300) -> str:
@@ -489,7 +535,8 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         if not (kept.entries or kept.skipped):
             continue
         state[name] = _Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
-                            list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance))
+                            list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
+                            list(kept.program_changes), initial_signatures=kept.signatures)
     return state
 
 

@@ -134,6 +134,19 @@ class UnitMonitor:
         a quarter of ``train``, at least 5."""
         return max(5, self.settings.train // 4)
 
+    # -- a new program ---------------------------------------------------------------------------
+    def restart(self, stamp: str, reason: str) -> None:
+        """The unit runs another program from the log ``stamp`` on (``reason`` says how it was
+        found): its open alarm, if any, is closed by it, and the unit learns its normal operation
+        again from this log on (``train`` logs), against the twin of the new program."""
+        if self.first_alarm is not None:
+            self.closed.append({**self._open_alarm(), "closed": stamp, "closed_by": reason})
+            self.first_alarm, self.source_axis, self.statistic = None, None, ""
+            self.limit, self.evidence = float("nan"), ""
+        self.training, self.learned_expectations = [], []
+        self.pca, self.relearning, self.run = None, None, 0
+        self.window.clear()
+
     # -- maintenance ----------------------------------------------------------------------------
     def maintenance(self, stamp: str, event: str, axis: int) -> None:
         """A repair or gearbox change (``event``) on ``axis`` (1..N) logged at ``stamp``, before the

@@ -41,6 +41,8 @@ from faultgen.monitor.scoring import Settings, UnitMonitor
 FORMAT = "faultgen-monitor-state/1"
 CYCLE_FORMAT = "faultgen-twin-cycle/1"
 CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
+#: How a program change that nobody logged closes an open alarm (alarms.csv ``closed_by``).
+PROGRAM_CHANGED = "program change (not logged: the motion left the twin's program)"
 #: Size bound of one unit's state file: about 0.6 kB per scored log, so 10^5 logs.
 STATE_MAX_BYTES = 64 * 2**20
 #: Size bound of one cached cycle (a few hundred bytes).
@@ -110,6 +112,18 @@ class Maintenance:
         return (self.stamp, self.event, self.axis) == (other.stamp, other.event, other.axis)
 
 
+@dataclass(frozen=True)
+class ProgramChange:
+    """The unit ran another program from log ``stamp`` on (not logged: its motion left the twin's
+    program); its monitor restarted before its entry number ``at`` with the twin of ``program``
+    (unit, stamp) and that twin's ``signatures`` (n_axes, n_features)."""
+
+    stamp: str
+    program: tuple[str, str]
+    at: int
+    signatures: np.ndarray
+
+
 #: A unit's model kinds: a given calibrated model, its own calibration, the nominal model, none.
 MODELS = ("given", "calibrated", "nominal", "none")
 
@@ -117,7 +131,8 @@ MODELS = ("given", "calibrated", "nominal", "none")
 @dataclass
 class UnitState:
     """A unit's state (module docstring): ``program`` the (unit, stamp) of the log its twin replays
-    (None without a twin), ``signatures`` (n_axes, n_features) or None, ``entries`` in stamp order,
+    (None without a twin), ``signatures`` (n_axes, n_features) of its first program's twin (those of
+    each later program are in ``program_changes``) or None, ``entries`` in stamp order,
     ``model`` of :data:`MODELS` ("none": protocol own), ``first`` the (stamp, SHA-256) of the unit's
     first log, the logs ``skipped``, the ``notes`` on fallbacks taken and the ``maintenance``
     events given to its monitor."""
@@ -132,6 +147,7 @@ class UnitState:
     skipped: list[Skipped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     maintenance: list[Maintenance] = field(default_factory=list)
+    program_changes: list[ProgramChange] = field(default_factory=list)
 
 
 def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
@@ -142,6 +158,10 @@ def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
         for m in state.maintenance:
             if m.at == i:
                 monitor.maintenance(m.stamp, m.event, m.axis)
+        for c in state.program_changes:
+            if c.at == i:
+                monitor.restart(c.stamp, PROGRAM_CHANGED)
+                monitor.signatures = c.signatures
         monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
     for m in state.maintenance:
         if m.at == len(state.entries):
@@ -161,6 +181,8 @@ def write_unit(path: Path, state: UnitState) -> None:
         "model": state.model, "first": list(state.first), "notes": list(state.notes),
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
+        "program_changes": [{"stamp": c.stamp, "program": list(c.program), "at": c.at,
+                             "signatures": [_floats(row) for row in c.signatures]} for c in state.program_changes],
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
@@ -256,6 +278,19 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             and all(isinstance(m.get(f), int) and not isinstance(m.get(f), bool) and m.get(f) >= 0 for f in ("axis", "at"))
             for m in maintenance)):
         raise StateError(f"{path}: maintenance is not a list of {{stamp, event, axis, at}}{refuse}")
+    changes = d.get("program_changes", [])
+    if not isinstance(changes, list):
+        raise StateError(f"{path}: program_changes is not a list{refuse}")
+    program_changes = []
+    for i, c in enumerate(changes):
+        if not (isinstance(c, dict) and isinstance(c.get("stamp"), str) and isinstance(c.get("at"), int)
+                and not isinstance(c.get("at"), bool) and c["at"] >= 0 and isinstance(c.get("program"), list)
+                and len(c["program"]) == 2 and all(isinstance(p, str) for p in c["program"])
+                and isinstance(c.get("signatures"), list) and len(c["signatures"]) == n_axes):
+            raise StateError(f"{path}: program_changes[{i}] is not {{stamp, program, at, signatures}}{refuse}")
+        rows = np.stack([_vector(r, path, f"program_changes[{i}].signatures row {k + 1}", n_features)
+                         for k, r in enumerate(c["signatures"])])
+        program_changes.append(ProgramChange(c["stamp"], tuple(c["program"]), c["at"], rows))
     if (model == "none") != (program is None):
         raise StateError(f"{path}: model {model!r} with program {program!r}{refuse}")
     logs = d.get("logs")
@@ -277,7 +312,7 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
                      [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes),
-                     [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance])
+                     [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance], program_changes)
 
 
 def write_cycle(path: Path, key: dict, features: np.ndarray) -> None:
