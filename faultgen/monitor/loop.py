@@ -1,20 +1,28 @@
-"""``faultgen monitor``: a fleet's measured logs in, alarms and the worn axis out (issue 46).
+"""``faultgen monitor``: a fleet's measured logs in, alarms and the worn axis out (issues 46, 60).
 
-For each unit (a folder of ``LOGS``, its logs in stamp order, :mod:`faultgen.monitor.logs`):
+For each unit (a folder of ``LOGS``, its logs in stamp order, :mod:`faultgen.monitor.logs`, in
+the measured format or an adapter's):
 
-(a) the model: calibrated on the unit's first log (:func:`faultgen.calibrate.calibrate`, cached),
-    or a calibrated model given for every unit, or the nominal model;
+(a) the model: calibrated on the unit's first log (:func:`faultgen.calibrate.calibrate`, cached,
+    refused when implausible), or a calibrated model given for every unit, or the nominal model;
 (b) the twin (:class:`faultgen.monitor.twin.Twin`): the model replaying the unit's own first log,
-    at each payload the logs declare, healthy and with each axis in turn worn;
+    at each payload the logs declare, healthy and with each axis in turn worn; a unit whose twin
+    cannot be built falls back to the nominal model, then to protocol own (:func:`_twin`);
 (c)-(d) the unit's monitor (:class:`faultgen.monitor.scoring.UnitMonitor`): learned on the first
-    logs, then every later log scored in stamp order.
+    logs, then every later log scored in stamp order; a log that cannot be read or replayed is
+    skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
+    offset is learned again, and a log whose motion left the twin's program starts a new program
+    (:func:`_new_program`).
 
-Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``alarms.csv``,
-``scores.csv``, ``<unit>.png`` and the monitors' state in ``.state`` (a rerun on a grown folder
-scores only the new logs; JSON, never a pickle: :mod:`faultgen.monitor.state`). Simulated cycles
-and calibrations are cached in ``OUT/.cache``, each checked against what it was made from; units
-whose first logs trace the same motion (angles within :data:`SAME_PROGRAM` rad) and share a model
-share their simulated cycles.
+Units are scored one after another, or in ``jobs`` processes (:func:`_map`), with the same outputs.
+Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``units.csv`` (each
+unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`),
+``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` and the monitors' state in
+``.state`` (a rerun on a grown folder scores only the new logs; JSON, never a pickle:
+:mod:`faultgen.monitor.state`). Simulated cycles, calibrations and the twins' filtered program
+logs are cached in ``OUT/.cache``, each checked against what it was made from; units whose first
+logs trace the same motion (angles within :data:`SAME_PROGRAM` rad) and share a model share their
+simulated cycles.
 """
 
 from __future__ import annotations
