@@ -388,22 +388,29 @@ def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float 
                 f"{loads.offset:.3g} m out along the flange's z axis, acceleration = speed "
                 f"limit / {RAMP[0]:g} s (main) or {RAMP[1]:g} s (wrist); gravity alone {loads.gravity[k]:.4g} N m"
             )
-        jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
-        f = RESONANCE[wrist]
-        stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
-        put("gearbox_damping", 2 * DAMPING_RATIO * math.sqrt(stiffness * G**2 * jm))
-        coulomb = put("coulomb_pos", COULOMB_SHARE * torque)
-        put("coulomb_neg", COULOMB_SHARE * torque)
-        put("static", STATIC_SHARE * coulomb)
-        put("stribeck_velocity", STRIBECK_VELOCITY)
-        put("stribeck_exponent", STRIBECK_EXPONENT)
-        put(FRICTION_FIELDS[5], coulomb / VISCOUS_SPEED)
-        put("bristle_stiffness", coulomb / PRESLIDING)
-        put("bristle_damping", 0.0)
+        _put_from_torque(put, torque, G, wrist)
         table[axis] = {key: mine[key] for key in KEYS}
         origin[axis] = notes
     source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
     return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), loads, mass, 2)
+
+
+def _put_from_torque(put, torque: float, G: float, wrist: int) -> None:
+    """The rules of one axis that follow from its motor torque limit ``torque`` (N m) and gear ratio
+    ``G``, the same under every sizing rule: motor inertia, gearbox stiffness and damping, motor
+    friction (module docstring); ``put(key, value)`` keeps a value the user gave over the rule's."""
+    jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
+    f = RESONANCE[wrist]
+    stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
+    put("gearbox_damping", 2 * DAMPING_RATIO * math.sqrt(stiffness * G**2 * jm))
+    coulomb = put("coulomb_pos", COULOMB_SHARE * torque)
+    put("coulomb_neg", COULOMB_SHARE * torque)
+    put("static", STATIC_SHARE * coulomb)
+    put("stribeck_velocity", STRIBECK_VELOCITY)
+    put("stribeck_exponent", STRIBECK_EXPONENT)
+    put(FRICTION_FIELDS[5], coulomb / VISCOUS_SPEED)
+    put("bristle_stiffness", coulomb / PRESLIDING)
+    put("bristle_damping", 0.0)
 
 
 def _sized_rule1(arm, given: dict[int, dict[str, float]] | None, payload: float | None) -> Sized:
@@ -455,18 +462,7 @@ def _sized_rule1(arm, given: dict[int, dict[str, float]] | None, payload: float 
                 f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
                 f"{MIN_MOTOR_TORQUE:g} N m"
             )
-        jm = put("motor_inertia", JM_SCALE * torque**JM_EXPONENT)
-        f = RESONANCE[wrist]
-        stiffness = put("gearbox_stiffness", (2 * math.pi * f) ** 2 * G**2 * jm)
-        put("gearbox_damping", 2 * DAMPING_RATIO * math.sqrt(stiffness * G**2 * jm))
-        coulomb = put("coulomb_pos", COULOMB_SHARE * torque)
-        put("coulomb_neg", COULOMB_SHARE * torque)
-        put("static", STATIC_SHARE * coulomb)
-        put("stribeck_velocity", STRIBECK_VELOCITY)
-        put("stribeck_exponent", STRIBECK_EXPONENT)
-        put(FRICTION_FIELDS[5], coulomb / VISCOUS_SPEED)
-        put("bristle_stiffness", coulomb / PRESLIDING)
-        put("bristle_damping", 0.0)
+        _put_from_torque(put, torque, G, wrist)
         table[axis] = {key: mine[key] for key in KEYS}
         origin[axis] = notes
     source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"

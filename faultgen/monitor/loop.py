@@ -27,9 +27,7 @@ simulated cycles.
 
 from __future__ import annotations
 
-import hashlib
 import io
-import json
 import shutil
 import warnings
 from dataclasses import dataclass, field
@@ -578,7 +576,7 @@ def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], 
     if kind == "given":
         return str(calibrated)
     key = {"robot": stored.sha256_file(nominal.path), "log": first[1], "steps": CALIBRATION_STEPS}
-    digest = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
+    digest = stored.key_name(key)
     root = out / ".cache" / "calibrated"
     folder, record = root / digest, root / f"{digest}.json"
     model = folder / "model" / f"{nominal.name}_calibrated.xml"

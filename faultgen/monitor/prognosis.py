@@ -130,7 +130,7 @@ def _import_progpy() -> None:
     import matplotlib
 
     with matplotlib.rc_context():
-        import progpy  # noqa: F401
+        import progpy
         import progpy.visualize  # noqa: F401
 
 

@@ -63,6 +63,12 @@ def sha256_file(path: str | Path) -> str:
     return digest.hexdigest()
 
 
+def key_name(key: dict) -> str:
+    """The file name of a cache entry made from ``key`` (a JSON-able dict): the first 24 hex digits
+    of the SHA-256 of its canonical JSON."""
+    return hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
+
+
 def settings_digest(settings: Settings, model: str, twin_temperature: bool, robot_sha256: str,
                     log_format: str = "measured") -> dict:
     """What a state belongs to, as a JSON-able dict: the monitor's settings, the model source

@@ -31,8 +31,6 @@ and a program share them.
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 
 import numpy as np
@@ -134,7 +132,7 @@ class Twin:
         nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
         temperature = None if np.isnan(temperature) else round(float(temperature), 2)
         key = {**self._files, "temperature_C": temperature, "payload_kg": float(payload), "worn_axis": int(worn_axis)}
-        name = hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24]
+        name = stored.key_name(key)
         path = self.cache / f"{name}.json"
         n_features = len(fleet_logs.FEATURES) * self.robot.n_axes
         if path.exists() or path.is_symlink():
