@@ -22,12 +22,22 @@ What is independent and what is ours:
   ``Jm``.
 - **Conditions: ours**: a seasonal hall temperature (each unit its own mean and swing, on the
   calendar of its stamps: January cold) plus the joints' warm-up; a product change every week
-  between two parts per unit (drawn masses; aluminium cubes hanging from the flange, as declared
-  in the robot's load data), and from a drawn day between 5/12 and 2/3 of the record a third part
+  between two parts per unit (drawn masses up to :attr:`FleetSpec.max_part`; aluminium cubes
+  hanging from the flange, as declared in the robot's load data), and from a drawn day between 5/12 and 2/3 of the record a third part
   (a new product) among them; Gaussian torque noise (:data:`NOISE` of each axis's
   torque RMS) and angle noise.
-- **Wear: ours**: on a worn unit, one axis's Coulomb and Stribeck friction grow linearly from an
-  onset day to :attr:`FleetSpec.final_wear` percent on the last day.
+- **Wear: ours**: on a worn unit, one axis (of :attr:`FleetSpec.wearable`) has its Coulomb and
+  Stribeck friction grow linearly from an onset day to :attr:`FleetSpec.final_wear` percent on the
+  last day.
+- **Maintenance and program changes: ours** (issue 60; none by default): on
+  :attr:`FleetSpec.gearbox_changes` worn units the worn axis's gearbox is changed
+  :data:`CHANGE_DELAY` days after the wear passed :data:`CHANGE_WEAR` %: from that day the axis's
+  friction is the folder's nominal one (a new gearbox: no wear, no unit spread), logged in
+  ``logs/events.csv`` (``unit, stamp, event, axis``, the layout ``faultgen monitor`` reads); on
+  :attr:`FleetSpec.program_changes` healthy units the program changes on a drawn day nobody logs
+  (the pick and place targets :data:`PROGRAM_SHRINK` of the way from the start pose: other target
+  poses, another motion). Both in ``ROOT/changes.csv`` (``unit, stamp, change, axis``), the truth,
+  never read by the monitor.
 - The motion: the robot folder's generated ``pick_place`` cycle (faultgen's planner; the motion is
   logged, so any would do), one cycle per log.
 
@@ -44,6 +54,7 @@ Needs Pinocchio (``pin``, the ``bench`` extra: ``pip install 'faultgen-robots[be
 from __future__ import annotations
 
 import csv
+import dataclasses
 import datetime
 import io
 import os
@@ -76,8 +87,17 @@ ANGLE_NOISE = 1e-5
 #: faultgen's twin of the motion within its drives' capacity (the KR210's axis 6: 366 N m at the arm,
 #: which the twin reached with a 60 kg part, Pinocchio's dynamics needing about 230 N m).
 PART_DENSITY = 2700.0
-#: Axes that may wear (the KR210's axis 6 motor is rated 3 N m: its friction is at the noise floor).
+#: Axes that may wear by default (the KR210's axis 6 motor sized by rule 1 is rated 3 N m: its
+#: friction is at the noise floor).
 WEARABLE = (1, 2, 3, 4, 5)
+#: The heaviest part by default, kg (the parts' draws are scaled to :attr:`FleetSpec.max_part`).
+MAX_PART = 35.0
+#: A gearbox change comes this many days after the worn axis's wear passed CHANGE_WEAR percent.
+CHANGE_WEAR, CHANGE_DELAY = 20.0, 10
+#: A changed program's pick and place targets lie this share of the way from its start pose to the old ones.
+PROGRAM_SHRINK = 0.7
+#: The columns of changes.csv (the truth of the gearbox and program changes).
+CHANGE_COLUMNS = ("unit", "stamp", "change", "axis")
 #: The flange frame of the URDF (ROS-Industrial's ``tool0``); faultgen's builder puts its ``flange`` site there.
 FLANGE_FRAME = "tool0"
 #: The rate the motion is planned at, Hz (the planner's 4 ms, the thesis's sampling period).
@@ -90,7 +110,10 @@ TRUTH_COLUMNS = ("unit", "stamp", "worn_axis", "wear_percent")
 class FleetSpec:
     """The fleet: ``units`` robots (``worn`` of them wearing), one log a day for ``days`` days from
     ``start``; logs at ``rate`` Hz; a worn unit's wear starts on a day drawn in ``onset`` (1-based)
-    and reaches ``final_wear`` % on the last day. Every draw comes from ``seed``."""
+    and reaches ``final_wear`` % on the last day, on one of the axes ``wearable`` (1-based); parts
+    up to ``max_part`` kg; ``gearbox_changes`` worn units get a new gearbox on the worn axis and
+    ``program_changes`` healthy units an unlogged program change (module docstring). Every draw comes
+    from ``seed``; the defaults draw what the fleet drew before these options existed."""
 
     units: int = 12
     worn: int = 8
@@ -100,9 +123,14 @@ class FleetSpec:
     start: str = "2026-01-05"
     onset: tuple[int, int] = (20, 50)
     final_wear: float = 60.0
+    wearable: tuple[int, ...] = WEARABLE
+    max_part: float = MAX_PART
+    gearbox_changes: int = 0
+    program_changes: int = 0
 
     def __post_init__(self) -> None:
-        for name, low in (("units", 1), ("worn", 0), ("days", 2), ("seed", 0)):
+        for name, low in (("units", 1), ("worn", 0), ("days", 2), ("seed", 0), ("gearbox_changes", 0),
+                          ("program_changes", 0)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"fleet {name} = {value!r}: expected a whole number >= {low}")
@@ -115,6 +143,17 @@ class FleetSpec:
         if not 0.0 < float(self.final_wear) <= 1000.0:
             raise ValueError(f"fleet final_wear = {self.final_wear!r}: expected a percent in (0, 1000]")
         datetime.date.fromisoformat(self.start)
+        wearable = tuple(self.wearable)
+        if not wearable or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 1 for a in wearable):
+            raise ValueError(f"fleet wearable = {self.wearable!r}: expected axes as whole numbers >= 1")
+        object.__setattr__(self, "wearable", wearable)
+        if isinstance(self.max_part, bool) or not 0.0 < float(self.max_part) <= 10000.0:
+            raise ValueError(f"fleet max_part = {self.max_part!r} kg: expected a mass in (0, 10000]")
+        if self.gearbox_changes > self.worn:
+            raise ValueError(f"fleet gearbox_changes = {self.gearbox_changes}: more than its {self.worn} worn units")
+        if self.program_changes > self.units - self.worn:
+            raise ValueError(f"fleet program_changes = {self.program_changes}: more than its "
+                             f"{self.units - self.worn} healthy units")
 
 
 def pinocchio_module():
@@ -151,22 +190,34 @@ def stamps(spec: FleetSpec) -> list[str]:
     return [(first + datetime.timedelta(days=d)).isoformat() for d in range(spec.days)]
 
 
+def changed_program(program, shrink: float = PROGRAM_SHRINK):
+    """``program`` (a :class:`faultgen.operation.programs.Program`) with every joint-space target
+    ``to`` moved to ``start + shrink (to - start)``: the same cycle between other poses."""
+    start = np.asarray(program.start, dtype=float)
+    segments = tuple(
+        dataclasses.replace(s, values={**s.values, "to": start + shrink * (np.asarray(s.values["to"]) - start)})
+        if s.type == "move" and "to" in s.values else s for s in program.segments)
+    return dataclasses.replace(program, segments=segments)
+
+
 @lru_cache(maxsize=4)
-def _motion(folder: str, rate: float):
-    """The pick-and-place cycle planned at 250 Hz (the planner's 4 ms), taken at ``rate`` Hz."""
+def _motion(folder: str, rate: float, changed: bool = False):
+    """The pick-and-place cycle (``changed``: :func:`changed_program`'s) planned at 250 Hz (the
+    planner's 4 ms), taken at ``rate`` Hz."""
     step = int(round(PLAN_RATE / rate))
     if step < 1 or abs(PLAN_RATE / step - rate) > 1e-9:
         raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
-    path = programs.load(robots.load(folder), "pick_place").trajectory(PLAN_RATE ** -1)
+    program = programs.load(robots.load(folder), "pick_place")
+    path = (changed_program(program) if changed else program).trajectory(PLAN_RATE ** -1)
     q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
     return np.arange(len(q)) / rate, q, qd, qdd
 
 
-@lru_cache(maxsize=64)
-def _rigid(folder: str, rate: float, mass: float) -> np.ndarray:
+@lru_cache(maxsize=128)
+def _rigid(folder: str, rate: float, mass: float, changed: bool = False) -> np.ndarray:
     """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`)."""
     pin = pinocchio_module()
-    _, q, qd, qdd = _motion(folder, rate)
+    _, q, qd, qdd = _motion(folder, rate, changed)
     edge = (mass / PART_DENSITY) ** (1 / 3)
     model = pinocchio_model(Path(folder) / "urdf_used.urdf", mass, (0.0, 0.0, edge / 2), (edge, edge, edge))
     data = model.createData()
@@ -180,24 +231,41 @@ def motor_friction(w: np.ndarray, coulomb, static, viscous) -> np.ndarray:
 
 
 def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
+    if max(spec.wearable) > n_axes:
+        raise ValueError(f"fleet wearable = {spec.wearable!r}: the robot has axes 1..{n_axes}")
     names = unit_names(spec)
     worn = set(np.random.default_rng([spec.seed, 0]).permutation(spec.units)[: spec.worn].tolist())
+    scale = float(spec.max_part) / MAX_PART
     out = []
     for i, name in enumerate(names):
         rng = np.random.default_rng([spec.seed, i + 1])
         spread = np.exp(rng.normal(0.0, SPREAD, (3, n_axes)))
         out.append({
             "unit": name, "spread": spread,
-            "axis": int(rng.choice(WEARABLE)) if i in worn else 0,
+            "axis": int(rng.choice(spec.wearable)) if i in worn else 0,
             "onset": int(rng.integers(spec.onset[0], spec.onset[1] + 1)),
             "ambient": float(rng.uniform(17.0, 23.0)), "swing": float(rng.uniform(4.0, 8.0)),
             "rise": rng.uniform(5.0, 15.0, n_axes),
-            "parts": (float(rng.uniform(5.0, 15.0)), float(rng.uniform(20.0, 35.0)), float(rng.uniform(10.0, 35.0))),
+            "parts": tuple(scale * float(rng.uniform(low, high)) for low, high in ((5.0, 15.0), (20.0, 35.0),
+                                                                                    (10.0, 35.0))),
             "weeks": rng.integers(0, 2, spec.days // 7 + 1),
             "seed": int(rng.integers(2**31)),
             "new_part_day": int(rng.integers(spec.days * 5 // 12, spec.days * 2 // 3 + 1)),
             "new_weeks": rng.integers(0, 3, spec.days // 7 + 1),
+            "gearbox_day": 0, "program_day": 0,
         })
+    # the changes from a stream of their own: without them, the draws above are the fleet's before
+    changes = np.random.default_rng([spec.seed, 0, 1])
+    worn_units = [u for u in out if u["axis"]]
+    for u in [worn_units[k] for k in sorted(changes.permutation(len(worn_units))[: spec.gearbox_changes])]:
+        passed = next((d for d in range(1, spec.days + 1) if wear_percent(spec, u["onset"], d) >= CHANGE_WEAR), None)
+        if passed is None or passed + CHANGE_DELAY > spec.days:
+            raise ValueError(f"fleet gearbox_changes: {u['unit']}'s wear passes {CHANGE_WEAR:g} % on day {passed}, "
+                             f"less than {CHANGE_DELAY} days before the last ({spec.days}); expected more days")
+        u["gearbox_day"] = passed + CHANGE_DELAY
+    healthy = [u for u in out if not u["axis"]]
+    for k in sorted(changes.permutation(len(healthy))[: spec.program_changes]):
+        healthy[k]["program_day"] = int(changes.integers(spec.days * 2 // 5, spec.days * 3 // 5 + 1))
     return out
 
 
@@ -208,12 +276,19 @@ def wear_percent(spec: FleetSpec, onset: int, day: int) -> float:
     return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
 
 
+def _wear(spec: FleetSpec, unit: dict, day: int) -> float:
+    """A unit's true wear on ``day``: 0 on a healthy unit and from its gearbox change on."""
+    if not unit["axis"] or (unit["gearbox_day"] and day >= unit["gearbox_day"]):
+        return 0.0
+    return wear_percent(spec, unit["onset"], day)
+
+
 def truth_rows(spec: FleetSpec, n_axes: int = 6) -> list[list]:
     """The rows of truth.csv (:data:`TRUTH_COLUMNS`), unit by unit and day by day, without writing a log."""
     rows = []
     for unit in _units(spec, n_axes):
         for d, stamp in enumerate(stamps(spec), start=1):
-            wear = wear_percent(spec, unit["onset"], d) if unit["axis"] else 0.0
+            wear = _wear(spec, unit, d)
             rows.append([unit["unit"], stamp, unit["axis"], f"{wear:.4f}"])
     return rows
 
@@ -239,12 +314,12 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     G, jm, nominal = model.gear_ratio, model.motor_inertia, model.friction
     fc0, fs0, fv0 = (np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
     n = model.n_axes
-    t, q, qd, qdd = _motion(str(folder), spec.rate)
     logs = root / "logs"
     q_names, _, tau_names = jointlog.column_names(n)  # t, q1..qN, tau1..tauN, temperature1..N, payload
     header = [jointlog.T_COLUMN, *q_names, *tau_names, *jointlog.temperature_columns(n), jointlog.PAYLOAD_COLUMN]
     days = stamps(spec)
-    for unit in _units(spec, n):
+    units = _units(spec, n)
+    for unit in units:
         folder_of_unit = logs / unit["unit"]
         if all((folder_of_unit / f"{stamp}.csv").is_file() for stamp in days):
             continue  # drawn in one go from its own seed: complete, and as the same seed draws it
@@ -258,30 +333,59 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
             week = (d - 1) // 7
             new_product = d >= unit["new_part_day"]
             mass = unit["parts"][int((unit["new_weeks"] if new_product else unit["weeks"])[week])]
-            wear = wear_percent(spec, unit["onset"], d) if unit["axis"] else 0.0
+            wear = _wear(spec, unit, d)
             grow = np.ones(n)
             if unit["axis"]:
                 grow[unit["axis"] - 1] += wear / 100.0
+            spread = unit["spread"]
+            if unit["gearbox_day"] and d >= unit["gearbox_day"]:  # a new gearbox: the nominal friction
+                spread = spread.copy()
+                spread[:, unit["axis"] - 1] = 1.0
             jitter = np.exp(rng.normal(0.0, JITTER, (3, n)))
-            fc = fc0 * unit["spread"][0] * grow * jitter[0]
-            fs = fs0 * unit["spread"][1] * grow * jitter[1]
-            fv = fv0 * unit["spread"][2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
-            tau = (_rigid(str(folder), spec.rate, round(mass, 1)) + G**2 * jm * qdd
+            fc = fc0 * spread[0] * grow * jitter[0]
+            fs = fs0 * spread[1] * grow * jitter[1]
+            fv = fv0 * spread[2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
+            changed = bool(unit["program_day"]) and d >= unit["program_day"]
+            t, q, qd, qdd = _motion(str(folder), spec.rate, changed)
+            tau = (_rigid(str(folder), spec.rate, round(mass, 1), changed) + G**2 * jm * qdd
                    + G * motor_friction(G * qd, fc, fs, fv))
             tau = tau + rng.normal(0.0, 1.0, tau.shape) * NOISE * np.sqrt(np.mean(tau**2, axis=0))
             angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)
             _write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2), round(mass, 1))
     truth = root / "truth.csv"
+    _write_table(truth, TRUTH_COLUMNS, truth_rows(spec, n))
+    events = [[u["unit"], days[u["gearbox_day"] - 1], "gearbox_change", u["axis"]] for u in units if u["gearbox_day"]]
+    if events:  # the logged maintenance, which the monitor reads
+        _write_table(logs / "events.csv", ("unit", "stamp", "event", "axis"), events)
+    programs_ = [[u["unit"], days[u["program_day"] - 1], "program_change", ""] for u in units if u["program_day"]]
+    if events or programs_:
+        _write_table(root / "changes.csv", CHANGE_COLUMNS, sorted(events + programs_))
+    return logs, truth
+
+
+def _write_table(path: Path, columns, rows) -> None:
+    """``path`` as CSV, written atomically and only when its content changes (a resumed write leaves it be)."""
     text = io.StringIO(newline="")
     writer = csv.writer(text)
-    writer.writerow(TRUTH_COLUMNS)
-    writer.writerows(truth_rows(spec, n))
+    writer.writerow(columns)
+    writer.writerows(rows)
     content = text.getvalue().encode()
-    if not truth.is_file() or truth.read_bytes() != content:  # a resumed write leaves it be
-        part = truth.with_name(truth.name + ".part")
+    if not path.is_file() or path.read_bytes() != content:
+        part = path.with_name(path.name + ".part")
         part.write_bytes(content)
-        os.replace(part, truth)
-    return logs, truth
+        os.replace(part, path)
+
+
+def read_changes(root: Path) -> dict[str, list[dict]]:
+    """``{unit: [{"stamp", "change", "axis"}, ...]}`` from ``root/changes.csv`` (empty without one)."""
+    path = Path(root) / "changes.csv"
+    out: dict[str, list[dict]] = {}
+    if path.is_file():
+        with open(path, newline="") as f:
+            for row in csv.DictReader(f):
+                out.setdefault(row["unit"], []).append(
+                    {"stamp": row["stamp"], "change": row["change"], "axis": int(row["axis"]) if row["axis"] else 0})
+    return out
 
 
 def _write_csv(path: Path, header, t, q, tau, temperature, mass) -> None:
