@@ -20,7 +20,8 @@ from faultgen.monitor.scoring import Settings
 # two units, 40 days: unit01 or unit02 worn from day 11 (20 % passed on day 14, gearbox change on
 # day 24, 83 % wear the day before), the other healthy with a program change drawn in days 16-24
 SPEC = independent_fleet.FleetSpec(units=2, worn=1, days=40, seed=3, onset=(11, 11), final_wear=200.0,
-                                   wearable=(1, 2, 3, 4, 5, 6, 7), max_part=14.0, gearbox_changes=1,
+                                   wearable=(1, 2, 3, 4, 5, 6, 7), max_part=14.0, rated_part=True,
+                                   gearbox_changes=1,
                                    program_changes=1)
 SETTINGS = Settings(train=10, persistence=3)
 
@@ -79,7 +80,18 @@ def test_the_generator_writes_the_gearbox_change_and_the_program_change(fleet):
     n = min(len(after), len(first))
     assert np.max(np.abs(after[:n] - first[:n])) > loop.PROGRAM_CHANGE
     parts = {float(angles_and_payload(p)[1][0]) for u in truth for p in (logs / u).glob("*.csv")}
-    assert 0.0 < min(parts) and max(parts) <= 14.0, parts
+    assert 0.0 < min(parts) and max(parts) == 14.0, parts  # the rated payload carried, nothing heavier
+
+
+def test_same_seed_gives_identical_files_with_the_changes(fleet, tmp_path):
+    robot, logs, _, _ = fleet
+    _, again, _ = independent_fleet.write_fleet(tmp_path, SPEC, robot=robot)
+    names = sorted(p.relative_to(logs).as_posix() for p in logs.rglob("*.csv"))
+    assert names == sorted(p.relative_to(again).as_posix() for p in again.rglob("*.csv")) and "events.csv" in names
+    for name in names:
+        assert (logs / name).read_bytes() == (again / name).read_bytes(), name
+    for name in ("truth.csv", "changes.csv"):
+        assert (logs.parent / name).read_bytes() == (again.parent / name).read_bytes(), name
 
 
 def test_the_gearbox_change_closes_the_alarm_and_the_program_change_is_not_raised_as_wear(fleet, monitored):
@@ -112,6 +124,7 @@ def test_the_gearbox_change_closes_the_alarm_and_the_program_change_is_not_raise
 @pytest.mark.parametrize(("field", "value", "message"), [
     ("wearable", (0, 1), "fleet wearable = (0, 1): expected axes as whole numbers >= 1"),
     ("max_part", -1.0, "fleet max_part = -1.0 kg: expected a mass in (0, 10000]"),
+    ("max_part", True, "fleet max_part = True kg: expected a mass in (0, 10000]"),
     ("gearbox_changes", 2, "fleet gearbox_changes = 2: more than its 1 worn units"),
     ("program_changes", 2, "fleet program_changes = 2: more than its 1 healthy units"),
 ])
@@ -119,3 +132,12 @@ def test_a_fleet_spec_out_of_range_is_refused_by_name(field, value, message):
     with pytest.raises(ValueError) as err:
         independent_fleet.FleetSpec(**{"units": 2, "worn": 1, field: value})
     assert str(err.value) == message
+
+
+def test_rated_part_must_be_a_bool_and_an_axis_beyond_the_robot_is_refused(fleet, tmp_path):
+    with pytest.raises(TypeError, match=r"^fleet rated_part = 1: expected True or False$"):
+        independent_fleet.FleetSpec(rated_part=1)
+    robot = fleet[0]
+    with pytest.raises(ValueError, match=r"^fleet wearable = \(1, 8\): the robot has axes 1\.\.7$"):
+        independent_fleet.write_fleet(tmp_path, independent_fleet.FleetSpec(units=1, worn=1, wearable=(1, 8)),
+                                      robot=robot)

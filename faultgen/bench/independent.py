@@ -111,7 +111,8 @@ class FleetSpec:
     """The fleet: ``units`` robots (``worn`` of them wearing), one log a day for ``days`` days from
     ``start``; logs at ``rate`` Hz; a worn unit's wear starts on a day drawn in ``onset`` (1-based)
     and reaches ``final_wear`` % on the last day, on one of the axes ``wearable`` (1-based); parts
-    up to ``max_part`` kg; ``gearbox_changes`` worn units get a new gearbox on the worn axis and
+    up to ``max_part`` kg (``rated_part``: the fleet's heaviest part drawn is made ``max_part``
+    itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
     ``program_changes`` healthy units an unlogged program change (module docstring). Every draw comes
     from ``seed``; the defaults draw what the fleet drew before these options existed."""
 
@@ -125,6 +126,7 @@ class FleetSpec:
     final_wear: float = 60.0
     wearable: tuple[int, ...] = WEARABLE
     max_part: float = MAX_PART
+    rated_part: bool = False
     gearbox_changes: int = 0
     program_changes: int = 0
 
@@ -147,6 +149,8 @@ class FleetSpec:
         if not wearable or not all(isinstance(a, int) and not isinstance(a, bool) and a >= 1 for a in wearable):
             raise ValueError(f"fleet wearable = {self.wearable!r}: expected axes as whole numbers >= 1")
         object.__setattr__(self, "wearable", wearable)
+        if not isinstance(self.rated_part, bool):
+            raise TypeError(f"fleet rated_part = {self.rated_part!r}: expected True or False")
         if isinstance(self.max_part, bool) or not 0.0 < float(self.max_part) <= 10000.0:
             raise ValueError(f"fleet max_part = {self.max_part!r} kg: expected a mass in (0, 10000]")
         if self.gearbox_changes > self.worn:
@@ -254,6 +258,9 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
             "new_weeks": rng.integers(0, 3, spec.days // 7 + 1),
             "gearbox_day": 0, "program_day": 0,
         })
+    if spec.rated_part:  # the heaviest part drawn becomes the heaviest allowed
+        unit, k = max(((u, k) for u in out for k in range(3)), key=lambda uk: uk[0]["parts"][uk[1]])
+        unit["parts"] = tuple(float(spec.max_part) if j == k else m for j, m in enumerate(unit["parts"]))
     # the changes from a stream of their own: without them, the draws above are the fleet's before
     changes = np.random.default_rng([spec.seed, 0, 1])
     worn_units = [u for u in out if u["axis"]]
