@@ -52,10 +52,12 @@ def monitor_command(
     persistence: Annotated[int, typer.Option(help="Consecutive logs over a limit that make an alarm.",
                                              min=1, max=MAX_LOGS)] = 5,
     wear_limit: Annotated[float, typer.Option(
-        help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
-             "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
+        help="With the twin: the wear (% increase of an axis's dry friction, in % of the unit's own: its "
+             "calibrated or nominal model's) the lower 1 - alpha bound of a log's wear estimate must reach for "
+             "the log to alarm. OUT/wear.csv gives each estimate with its 90 % interval.", min=0.001,
+        max=1000.0)] = 10.0,
     failure_wear: Annotated[float, typer.Option(
-        help="With the twin: the wear estimate (%, in the twin's scale) that ends an axis's life; OUT/rul.csv gives "
+        help="With the twin: the wear estimate (% of the axis's own dry friction) that ends an axis's life; OUT/rul.csv gives "
              "each axis's remaining life until it, with a 5-95 % interval.", min=1.0, max=500.0)] = 40.0,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
