@@ -5,10 +5,10 @@ interval that carries the twin's model uncertainty beside its noise, and ``wear.
 import csv
 
 import numpy as np
+import pinocchio_log
 import pytest
 from scipy.stats import norm
 
-import pinocchio_log
 from faultgen.bench import independent
 from faultgen.data import measured
 from faultgen.model import robots
@@ -101,7 +101,7 @@ def test_wear_csv_holds_each_log_and_axis_estimate_with_its_interval_as_scores_c
         assert float(r["wear"]) == pytest.approx(float(s[f"wear{r['axis']}"]), rel=1e-5)
         assert float(r["wear_lower"]) == pytest.approx(float(s[f"wear{r['axis']}_lower"]), rel=1e-5, abs=1e-9)
         assert float(r["wear_5"]) < float(r["wear"]) < float(r["wear_95"])
-    last = [r for r in rows if r["stamp"] == "039" and r["axis"] == "2"][0]
+    last = next(r for r in rows if r["stamp"] == "039" and r["axis"] == "2")
     assert float(last["wear_5"]) <= 14.0 <= float(last["wear_95"])  # the planted 14 % on axis 2
 
 

@@ -12,8 +12,8 @@ What the monitor asks of it (:class:`Twin`):
 - :attr:`Twin.signatures`: how each axis's wear moves the features, per percent of the model's own
   dry friction: one cycle with the axis's Coulomb and static friction at :data:`WEAR` % above the
   model's (thesis eq. 6.6's exp4 schedule at its final value), minus the healthy cycle, both at the
-  model's own friction (no temperature law: the features' change per % grows with the rest of the friction) without a
-  part.
+  model's own friction (no temperature law on top: the features' change per % grows with the rest
+  of the friction) without a part.
 
 The replayed motion is the program log's angles through a cubic Savitzky-Golay filter of
 :data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's
