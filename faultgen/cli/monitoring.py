@@ -107,6 +107,8 @@ def monitor_command(
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
+    OUT/wear.csv (per unit, log and axis, with the twin: the wear estimate, % of the axis's own dry
+    friction, with its 90 % interval that carries the twin's model uncertainty),
     OUT/rul.csv (per unit and axis, with the twin: the remaining life until the wear estimate reaches
     --failure-wear, in days or logs, with a 5-95 % interval and the trend model, or "no end of life
     within the horizon"), OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html
@@ -151,7 +153,8 @@ def monitor_command(
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
     typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. " + page.false_alarm_statement(
         protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored))
-    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'rul.csv'}, "
+    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
+               f"{out / 'rul.csv'}, "
                f"{len(monitors)} charts and the fleet report {out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
     if short:
