@@ -17,9 +17,9 @@ In one run of this script:
   end-of-life times:
 
   (A) **the true wear reaches F** (truth.csv only: independent of the monitor). The estimate is in
-      the twin's scale, which grows 0.5-0.7 % per % of true wear on this fleet, so a remaining life
-      to an *estimate* of F is expected to be late by a factor 1.4-2 against this truth: its bias is
-      reported, not hidden;
+      % of the axis's own dry friction (0.82-1.23 % per % of true wear on this fleet; in the twin's
+      scale before issue 59 part 1, 0.4-0.7, and the remaining life was late by a factor 1.4-2): its
+      bias is reported, not hidden;
   (B) **the estimate's trend reaches F**: the day the unit's true wear, times its twin's scale (a
       straight line of the worn axis's estimate on the true wear, fitted in hindsight over the logs
       past 5 % true wear), reaches F; the true wear grows linearly, so this day is defined beyond

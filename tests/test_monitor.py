@@ -74,13 +74,13 @@ def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
         assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
     out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
-    for name in ("alarms.csv", "scores.csv", "rul.csv"):
+    for name in ("alarms.csv", "scores.csv", "rul.csv", "wear.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
 
 
 def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(fleet, monitored):
-    """rul.csv: every unit and axis at its last log; the worn axis (wear 60 % on the last day, its
-    estimate some 0.5-0.7 of it, still growing) a remaining life with its interval, the healthy
+    """rul.csv: every unit and axis at its last log; the worn axis (wear 60 % on the last day, still
+    growing) a remaining life with its interval, the healthy
     units no end of life within the horizon (faultgen.monitor.prognosis; tests/test_prognosis.py)."""
     from faultgen.monitor import prognosis
 
@@ -229,8 +229,8 @@ def test_the_wear_estimate_is_weighted_least_squares_along_each_signature():
 
 def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit():
     # 40 learning logs of noise, then axis 2 wearing 0.5 % a log: the alarm comes once the lower
-    # 99 % bound has stayed at or above 5 % for 5 logs, on axis 2, and not before the estimate
-    # itself is above the limit
+    # 99 % bound has stayed at or above the limit (10 %) for 5 logs, on axis 2, and not before the
+    # estimate itself is above the limit
     rng = np.random.default_rng(2)
     signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05  # feature units per %
     unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
@@ -240,10 +240,12 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
     assert unit.first_alarm is not None and unit.source_axis == 2 and unit.statistic == "wear"
     first = int(unit.first_alarm)
     rows = {r["stamp"]: r for r in unit.rows}
-    assert all(max(rows[f"{k:03d}"][f"wear{a}_lower"] for a in range(1, 7)) >= 5.0 for k in range(first, first + 5))
-    assert max(rows[f"{first - 1:03d}"][f"wear{a}_lower"] for a in range(1, 7)) < 5.0  # else it began earlier
+    limit = unit.settings.wear_limit
+    assert limit == 10.0
+    assert all(max(rows[f"{k:03d}"][f"wear{a}_lower"] for a in range(1, 7)) >= limit for k in range(first, first + 5))
+    assert max(rows[f"{first - 1:03d}"][f"wear{a}_lower"] for a in range(1, 7)) < limit  # else it began earlier
     true_wear = (first - 60) * 0.5
-    assert 5.0 <= true_wear < 15.0, true_wear
+    assert limit <= true_wear < limit + 10.0, true_wear
     assert "axis 2 wear estimate" in unit.alarm_row()["evidence"]
 
 
@@ -605,7 +607,7 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
     charts = tuple(p.name for p in monitored.glob("*.png"))
     assert charts
-    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv"):
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
 

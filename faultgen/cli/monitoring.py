@@ -52,10 +52,12 @@ def monitor_command(
     persistence: Annotated[int, typer.Option(help="Consecutive logs over a limit that make an alarm.",
                                              min=1, max=MAX_LOGS)] = 5,
     wear_limit: Annotated[float, typer.Option(
-        help="With the twin: the wear (% increase of an axis's dry friction, in the twin's scale) the lower "
-             "1 - alpha bound of a log's wear estimate must reach for the log to alarm.", min=0.001, max=1000.0)] = 5.0,
+        help="With the twin: the wear (% increase of an axis's dry friction, in % of the unit's own: its "
+             "calibrated or nominal model's) the lower 1 - alpha bound of a log's wear estimate must reach for "
+             "the log to alarm. OUT/wear.csv gives each estimate with its 90 % interval.", min=0.001,
+        max=1000.0)] = 10.0,
     failure_wear: Annotated[float, typer.Option(
-        help="With the twin: the wear estimate (%, in the twin's scale) that ends an axis's life; OUT/rul.csv gives "
+        help="With the twin: the wear estimate (% of the axis's own dry friction) that ends an axis's life; OUT/rul.csv gives "
              "each axis's remaining life until it, with a 5-95 % interval.", min=1.0, max=500.0)] = 40.0,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
@@ -105,6 +107,8 @@ def monitor_command(
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
+    OUT/wear.csv (per unit, log and axis, with the twin: the wear estimate, % of the axis's own dry
+    friction, with its 90 % interval that carries the twin's model uncertainty),
     OUT/rul.csv (per unit and axis, with the twin: the remaining life until the wear estimate reaches
     --failure-wear, in days or logs, with a 5-95 % interval and the trend model, or "no end of life
     within the horizon"), OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html
@@ -149,7 +153,8 @@ def monitor_command(
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
     typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. " + page.false_alarm_statement(
         protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored))
-    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'rul.csv'}, "
+    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
+               f"{out / 'rul.csv'}, "
                f"{len(monitors)} charts and the fleet report {out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
     if short:

@@ -148,7 +148,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         Local processes scoring units in parallel (groups of units sharing a twin); the outputs are
         those of one job, bit for bit.
     failure_wear : float
-        The wear estimate, % in the twin's scale, that ends an axis's life: ``rul.csv`` gives each
+        The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
         axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
 
     Returns
@@ -204,6 +204,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
+        report.write_wear(staging / "wear.csv", monitors)
         report.write_units(staging / "units.csv", statuses)
         prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
         # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)

@@ -53,7 +53,7 @@ SETTING_NAMES = {
     "alpha": "significance level",
     "variance": "PCA variance kept",
     "persistence": "consecutive alarming logs that make an alarm",
-    "wear_limit": "wear limit, % (twin's scale): the lower bound a log's wear estimate must reach to alarm",
+    "wear_limit": "wear limit, % of the axis's own dry friction: the lower bound a log's wear estimate must reach to alarm",
     "twin_temperature": "the twin's temperature law predicts the seasonal change",
 }
 #: Order of the fleet table: what needs attention first (an open alarm before any status).
@@ -346,7 +346,7 @@ def figure(unit: Unit, settings: dict) -> dict:
         "shapes": shapes, "annotations": annotations,
     }
     if twin:
-        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": "wear estimate, % (twin's scale)"}}
+        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": "wear estimate, % of own dry friction"}}
         layout["yaxis2"] = {"domain": [0.0, 0.38], "type": "log", "title": {"text": "statistic / its limit"}}
     else:
         layout["yaxis"] = {"type": "log", "title": {"text": "statistic / its limit"}}
@@ -513,7 +513,7 @@ def build(fleet: Fleet, settings: dict) -> str:
     panels = "\n".join(_panel(i, u, settings) for i, u in enumerate(units))
     header = "".join(f"<th>{_e(c)}</th>" for c in COLUMNS)
     wear_note = (" The wear column gives the current (last log's) wear estimate of the alarm's axis, % increase of "
-                 "its dry friction in the twin's scale, and its lower bound; without an alarm, of the axis whose "
+                 "its dry friction in % of the unit's own (wear.csv: with its 90 % interval), and its lower bound; without an alarm, of the axis whose "
                  "lower bound is largest (grey)." if fleet.twin else "")
     return f"""<!DOCTYPE html>
 <html lang="en">

@@ -1,6 +1,6 @@
 """Remaining useful life per unit and axis (issue 59): the time until an axis's wear estimate
 reaches a failure wear, as a distribution, from a degradation trend fitted on the unit's wear
-estimates (:mod:`faultgen.monitor.scoring`: per log and axis ``wearI`` %, in the twin's scale, and
+estimates (:mod:`faultgen.monitor.scoring`: per log and axis ``wearI`` %, of the axis's own dry friction, and
 its lower ``1 - alpha`` bound ``wearI_lower``; the estimate's standard error is ``(wearI -
 wearI_lower) / z``, ``z`` the standard normal's ``1 - alpha`` quantile). Recomputed from the
 unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`write_rul`).
@@ -47,9 +47,10 @@ trend fitted to a short noisy health-indicator series with the uncertainty of it
 regression, so scipy's least squares with its covariance does that part and ProgPy the prediction,
 its uncertainty types and metrics (``benchmarks/monitor_rul.py``).
 
-The wear is in the twin's scale (:mod:`faultgen.monitor.scoring`): on the independent fleet the
-estimate grows some 0.5-0.7 % per % of true wear, so the remaining life to a 40 % *estimate* is
-longer than to 40 % true wear (docs/analysis.md, "Remaining useful life").
+The wear is in % of the axis's own dry friction (:mod:`faultgen.monitor.scoring`; before issue 59
+part 1 it was in the twin's scale, 0.5-0.7 % per % of true wear on the independent fleet, and the
+remaining life to a 40 % estimate was late against the true wear: docs/analysis.md, "Remaining
+useful life").
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 
-#: Default failure wear, % (in the twin's scale): the end of life the remaining life counts to.
+#: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
 #: Largest failure wear taken, %.
 MAX_FAILURE_WEAR = 1000.0
@@ -372,7 +373,7 @@ def _summarise(row: Remaining, fit: Fit, toe, horizon: float) -> Remaining:
 def check_failure_wear(failure_wear: float) -> None:
     if not 0 < failure_wear <= MAX_FAILURE_WEAR:
         raise ValueError(f"failure_wear = {failure_wear!r} %; expected a number in (0, {MAX_FAILURE_WEAR:g}] (the wear "
-                         "estimate, in the twin's scale, counted as the end of an axis's life)")
+                         "estimate, % of the axis's own dry friction, counted as the end of an axis's life)")
 
 
 def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, **options) -> list[Remaining]:

@@ -61,6 +61,27 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
                 writer.writerow([_fmt(row.get(c, "")) for c in columns])
 
 
+WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower")
+
+
+def write_wear(path: Path, monitors) -> None:
+    """``wear.csv``: per unit, scored log and axis (1..N), the wear estimate, % increase of the
+    axis's dry friction in % of the unit's own (``wear``), its 90 % interval with the twin's model
+    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`)
+    and the lower ``1 - alpha`` bound of its noise the alarm is judged on (``wear_lower``, as
+    ``wearI_lower`` of scores.csv). Only units with a twin have rows."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(WEAR_COLUMNS)
+        for m in monitors:
+            for row in m.rows:
+                if "wear1" not in row:
+                    continue
+                for axis in range(1, m.n_axes + 1):
+                    writer.writerow([_fmt(row["unit"]), _fmt(row["stamp"]), row["phase"], axis,
+                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower"))])
+
+
 def chart(path, monitor, axis_note: str) -> None:
     """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, with the
     twin each axis's wear estimate with the limit its lower bound is judged against, and each
@@ -101,7 +122,7 @@ def _draw(path, monitor, axis_note: str, plt) -> None:
             best = [max(r[f"wear{i + 1}_lower"] for i in range(monitor.n_axes)) for r in rows]
             middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * (1 - monitor.settings.alpha):g} % bound")
             middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
-            middle.set_ylabel("wear estimate, % (twin's scale)")
+            middle.set_ylabel("wear estimate, % of own dry friction")
             middle.legend(fontsize=7, loc="upper left", ncol=4)
         scores = np.array([[r[f"score{i}"] for i in range(1, monitor.n_axes + 1)] for r in rows])
         for i in range(monitor.n_axes):

@@ -1,0 +1,148 @@
+"""The wear in the robot's own scale (issue 59, part 1): the twin's wear signatures at the model's
+own friction answer like a unit of an independent simulator, each log's estimate has a 90 %
+interval that carries the twin's model uncertainty beside its noise, and ``wear.csv`` holds them."""
+
+import csv
+
+import numpy as np
+import pinocchio_log
+import pytest
+from scipy.stats import norm
+
+from faultgen.bench import independent
+from faultgen.data import measured
+from faultgen.model import robots
+from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import report
+from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_INTERVAL, Settings, UnitMonitor
+from faultgen.monitor.twin import WEAR, Twin
+
+
+def test_the_interval_is_the_estimate_with_its_noise_and_the_scale_uncertainty():
+    estimate, error = np.array([20.0, 0.0, -4.0]), np.array([2.0, 3.0, 1.0])
+    low, high = UnitMonitor.wear_interval(estimate, error)
+    half = norm.ppf(0.5 + WEAR_INTERVAL / 2) * np.sqrt(error**2 + (SCALE_UNCERTAINTY * estimate) ** 2)
+    np.testing.assert_allclose(low, estimate - half)
+    np.testing.assert_allclose(high, estimate + half)
+    assert WEAR_INTERVAL == 0.90 and high[0] - low[0] > 2 * norm.ppf(0.95) * error[0]  # wider than the noise's
+
+
+def test_the_interval_covers_nine_in_ten_when_the_scale_is_off_by_its_stated_uncertainty():
+    # a unit whose features answer its wear k times the twin's (k normal about 1, sd the stated
+    # scale uncertainty) plus noise: the 90 % interval covers the truth on 86-94 % of 4000 draws;
+    # the noise's interval alone covers far fewer at these wears
+    rng = np.random.default_rng(0)
+    truth = rng.uniform(10.0, 40.0, 4000)
+    error = rng.uniform(0.5, 3.0, truth.size)
+    estimate = truth * rng.normal(1.0, SCALE_UNCERTAINTY, truth.size) + rng.normal(0.0, 1.0, truth.size) * error
+    low, high = UnitMonitor.wear_interval(estimate, error)
+    covered = np.mean((low <= truth) & (truth <= high))
+    assert 0.86 <= covered <= 0.94, covered
+    noise_only = np.mean(np.abs(estimate - truth) <= norm.ppf(0.95) * error)
+    assert noise_only < 0.75, noise_only  # 0.62: far from the 0.9 it claims
+
+
+def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool = True) -> tuple[UnitMonitor, np.ndarray]:
+    """A twin unit whose every log scatters ``scatter`` % of wear along ``axis``'s signature (a
+    log's friction scatter) beside independent noise; 40 learning logs, 200 healthy logs after.
+    Returns the monitor and the later logs' wear estimates over their errors on that axis."""
+    rng = np.random.default_rng(seed)
+    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
+    z = []
+    for i in range(240):
+        residual = rng.normal(0, 0.05, 12) + rng.normal(0, scatter) * signatures[axis - 1]
+        unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(12))
+        if i == 39 and not correct:
+            unit.dispersion_ = np.ones(6)
+        if i >= 40:
+            row = unit.rows[-1]
+            error = (row[f"wear{axis}"] - row[f"wear{axis}_lower"]) / unit.bound_quantile
+            z.append(row[f"wear{axis}"] / error)
+    return unit, np.array(z)
+
+
+def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_show():
+    # the features' noise is not independent: a log's friction scatter moves an axis's features
+    # together; measured on the learning logs, it widens the errors so that the later healthy logs'
+    # estimates scatter by about one error (0.85-1.25, the mean over 4 units of 200 logs each), where
+    # the error of independent noise alone understates it (> 2); without the scatter it stays 1-1.3
+    spreads, uncorrected = [], []
+    for seed in range(4):
+        unit, z = _unit_with_scatter_along(3, 3.0, seed=seed)
+        assert unit.dispersion_[2] > 1.5, unit.dispersion_
+        spreads.append(np.std(z))
+        uncorrected.append(np.std(_unit_with_scatter_along(3, 3.0, seed=seed, correct=False)[1]))
+        quiet, _ = _unit_with_scatter_along(3, 0.0, seed=seed)
+        assert np.all(quiet.dispersion_ <= 1.3), quiet.dispersion_
+    assert 0.85 <= np.mean(spreads) <= 1.25, spreads
+    assert np.mean(uncorrected) > 2.0, uncorrected
+
+
+def test_wear_csv_holds_each_log_and_axis_estimate_with_its_interval_as_scores_csv(tmp_path):
+    rng = np.random.default_rng(5)
+    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    unit = UnitMonitor("unit01", Settings(train=20), n_axes=6, signatures=signatures)
+    own = UnitMonitor("unit02", Settings(protocol="own", train=20), n_axes=6)
+    for i in range(40):
+        unit.add(f"{i:03d}", rng.normal(0, 0.05, 12) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(12))
+        own.add(f"{i:03d}", rng.normal(0, 0.05, 12), 30.0, 0.0)
+    report.write_wear(tmp_path / "wear.csv", [unit, own])
+    report.write_scores(tmp_path / "scores.csv", [unit, own], 6)
+    with open(tmp_path / "wear.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    with open(tmp_path / "scores.csv", newline="") as f:
+        scores = {r["stamp"]: r for r in csv.DictReader(f) if r["unit"] == "unit01"}
+    assert tuple(rows[0]) == report.WEAR_COLUMNS
+    assert len(rows) == 40 * 6 and {r["unit"] for r in rows} == {"unit01"}  # the unit without a twin has none
+    for r in rows:
+        s = scores[r["stamp"]]
+        assert r["phase"] == s["phase"]
+        assert float(r["wear"]) == pytest.approx(float(s[f"wear{r['axis']}"]), rel=1e-5)
+        assert float(r["wear_lower"]) == pytest.approx(float(s[f"wear{r['axis']}_lower"]), rel=1e-5, abs=1e-9)
+        assert float(r["wear_5"]) < float(r["wear"]) < float(r["wear_95"])
+    last = next(r for r in rows if r["stamp"] == "039" and r["axis"] == "2")
+    assert float(last["wear_5"]) <= 14.0 <= float(last["wear_95"])  # the planted 14 % on axis 2
+
+
+@pytest.fixture(scope="module")
+def kr210(tmp_path_factory):
+    return pinocchio_log.add_kr210(tmp_path_factory.mktemp("kr210") / "kr210")
+
+
+def test_the_twins_signatures_answer_like_an_independent_unit_per_percent_of_its_own_dry_friction(kr210, tmp_path):
+    """The independent simulator (Pinocchio's dynamics, its own Lorentzian friction law with a
+    viscous friction falling 2 %/K, faultgen.bench.independent) with the folder's nominal friction,
+    noise-free, its joints at 20 and 40 deg C, no part and 25 kg: the change of its features per %
+    of its dry friction (Coulomb and Stribeck) grown on one axis, projected on the twin's signature
+    of that axis (least squares), is 0.85-1.15 of it on axes 1-5. At 20 deg C under faultgen's
+    temperature law (1.30 times the dry and 2.86 times the viscous friction), as before issue 59,
+    the twin's signatures were 1.6-2.1 times larger: those ratios stay below 0.7."""
+    robot = robots.load(kr210)
+    gear, jm, friction = robot.gear_ratio, robot.motor_inertia, robot.friction
+    fc, fs, fv = (np.asarray(x, dtype=float) for x in (friction.coulomb_pos, friction.static, friction.viscous))
+    t, q, qd, qdd = independent._motion(str(kr210), 125.0)
+
+    def features(temperature, mass, axis=0, wear=0.0):
+        grow = np.ones(robot.n_axes)
+        if axis:
+            grow[axis - 1] += wear / 100.0
+        viscous = fv * np.exp(-independent.VISCOUS_PER_K * (temperature - 20.0))
+        tau = (independent._rigid(str(kr210), 125.0, mass) + gear**2 * jm * qdd
+               + gear * independent.motor_friction(gear * qd, fc * grow, fs * grow, viscous))
+        return fleet_logs.features_of(robot, measured.from_arrays(t, q, tau, robot))
+
+    program = measured.write_csv(tmp_path / "program.csv", t, q, independent._rigid(str(kr210), 125.0, 0.0))
+    twin = Twin(kr210, program, tmp_path / "cache" / "cycles")
+    healthy20 = twin.cycle(20.0, 0.0)
+    at20 = np.stack([(twin.cycle(20.0, 0.0, a) - healthy20) / WEAR for a in range(1, 6)])
+    for temperature in (20.0, 40.0):
+        for mass in (0.0, 25.0):
+            base = features(temperature, mass)
+            for a in range(1, 6):
+                change = (features(temperature, mass, a, WEAR) - base) / WEAR
+                s = twin.signatures[a - 1]
+                ratio = float(s @ change / (s @ s))
+                assert 0.85 <= ratio <= 1.15, (temperature, mass, a, ratio)
+                before = float(at20[a - 1] @ change / (at20[a - 1] @ at20[a - 1]))
+                assert before < 0.7, (temperature, mass, a, before)
