@@ -150,34 +150,126 @@ def _auto_protocol(kind: str, others: list, own, n_samples: int, first: int | No
                      "or sweep with --axis 0 and several seeds")
 
 
-def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
-               limit_folds) -> tuple[pd.DataFrame, dict]:
-    path = data.path
-    runs = data.runs
-    healthy = data.healthy
-    torque: dict[str, np.ndarray | StoredHistograms] = {}
+class _Work:
+    """What one detection table shares across its worn runs: the dataset's healthy runs and the
+    settings, each run's torque record read once (:func:`torque_record`), one monitor per training
+    set (``monitors``) and that monitor's false-alarm rate on the healthy runs it did not learn from
+    (``false_alarms``)."""
 
-    def torque_of(run: reader.Run) -> np.ndarray | StoredHistograms:
+    def __init__(self, data: reader.Dataset, variance, alpha, period, detector, limit_folds):
+        self.path, self.healthy = data.path, data.healthy
+        self.variance, self.alpha, self.period = variance, alpha, period
+        self.detector, self.limit_folds = detector, limit_folds
+        self.torque: dict[str, np.ndarray | StoredHistograms] = {}
+        self.monitors: dict[tuple, tuple] = {}
+        self.false_alarms: dict[tuple, tuple] = {}
+
+    def torque_of(self, run: reader.Run) -> np.ndarray | StoredHistograms:
         """A run's per-cycle |motor torque| counts (:func:`torque_record`), read once."""
-        if run.id not in torque:
-            torque[run.id] = torque_record(run)
-        return torque[run.id]
+        if run.id not in self.torque:
+            self.torque[run.id] = torque_record(run)
+        return self.torque[run.id]
 
-    def similar(run: reader.Run) -> list[reader.Run]:
+    def similar(self, run: reader.Run) -> list[reader.Run]:
         """Healthy runs to measure false alarms on under first-cycles: of the same kind (robot,
         task, friction), else of the same robot model (a fleet's robots each have their own task),
         else all."""
         for match in (lambda r: _same_unit_kind(r, run), lambda r: r.robot == run.robot, lambda r: True):
-            chosen = [r for r in healthy if match(r)]
+            chosen = [r for r in self.healthy if match(r)]
             if chosen:
                 return chosen
         return []
 
-    monitors: dict[tuple, tuple] = {}
+    def fit(self, training: list, held_out: bool) -> tuple:
+        """:func:`_fit_monitor` on ``training`` with the table's settings; a monitor of a held-out
+        protocol judges against the training data's mean histogram and, with ``limit_folds``, an
+        out-of-sample Q limit."""
+        return _fit_monitor(training, self.period, self.variance, self.alpha, self.detector,
+                            fixed_reference=held_out, folds=self.limit_folds if held_out else None)
+
+    def plan(self, run: reader.Run, protocol: str, own, others: list, sample_of: np.ndarray,
+             samples: np.ndarray, n_first: int) -> tuple:
+        """What the monitor of worn ``run`` learns from under ``protocol`` (``own``: the healthy run of
+        its seed or None, ``others``: those of other seeds): the training (run id, torque record,
+        cycles) list, the key of its monitor, what it was trained on (words), the healthy runs its
+        false alarms are measured on, and the samples of ``run`` it learned from (``skip``).
+
+        Raises
+        ------
+        ValueError
+            If the dataset lacks the healthy data the protocol needs (naming what and the remedy).
+        """
+        if protocol == "other-seeds":
+            if not others:
+                raise ValueError(f"{self.path}: protocol other-seeds needs runs without wear of {run.robot} "
+                                 f"{run.task} with another seed than {run.seed}; this dataset has none"
+                                 f"{_unlike(run, self.healthy)}. Sweep "
+                                 "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
+            training = [(r.id, self.torque_of(r), r.recorded) for r in others]
+            key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
+                [own] if own else [], 0
+            if own is None and len(others) > 1:  # no healthy run of the tested seed: each other one in turn
+                heldout = [("leave-one-out", r, [o for o in others if o is not r]) for r in others]
+        elif protocol == "first-cycles":
+            if len(samples) <= n_first:
+                raise ValueError(f"{self.path}: protocol first-cycles learns from the first {n_first} samples of a "
+                                 f"run and needs more; {run.id} has {len(samples)}. Give a smaller --first, record more "
+                                 "cycles, or sweep several seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
+            keep = np.isin(sample_of, samples[:n_first])
+            training = [(run.id, self.torque_of(run)[keep], run.recorded[keep])]
+            key, trained_on = (run.id, n_first), f"samples 1-{n_first} of the run"
+            heldout, skip = self.similar(run), n_first
+        else:  # same-run
+            if own is None:
+                raise ValueError(f"{self.path}: protocol same-run needs the run without wear of {run.robot} "
+                                 f"{run.task} seed {run.seed}; this dataset has none{_unlike(run, self.healthy)}: "
+                                 "use --protocol first-cycles (or auto)")
+            training = [(own.id, self.torque_of(own), own.recorded)]
+            key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
+        return training, key, trained_on, heldout, skip
+
+    def false_alarm(self, run: reader.Run, protocol: str, heldout: list, fitted: tuple, skip: int,
+                    n_first: int) -> tuple:
+        """The false-alarm rate (%) of the monitor ``fitted`` (scale, reference, features used,
+        monitor) for worn ``run`` on the healthy runs ``heldout`` it did not learn from, each judged
+        as ``protocol`` says: (mean rate or NaN, runs judged, its Clopper-Pearson interval)."""
+        scale, reference, used, monitor = fitted
+        rates, counts = [], [0, 0]  # and alarms, samples over the healthy runs: the interval
+        for normal_run in heldout:
+            if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
+                _, normal_run, rest = normal_run
+                n_scale, n_reference, n_used, n_monitor = self.fit(
+                    [(r.id, self.torque_of(r), r.recorded) for r in rest], True)
+                normal, _ = kl_features(self.torque_of(normal_run), normal_run.recorded, n_scale, self.period,
+                                        n_reference)
+                flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)
+            elif protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
+                normal_of = group_cycles(normal_run.recorded, self.period)
+                if len(np.unique(normal_of)) <= n_first:
+                    continue
+                own_keep = np.isin(normal_of, np.unique(normal_of)[:n_first])
+                n_scale, n_reference, n_used, n_monitor = self.fit(
+                    [(normal_run.id, self.torque_of(normal_run)[own_keep], normal_run.recorded[own_keep])], True)
+                normal, _ = kl_features(self.torque_of(normal_run), normal_run.recorded, n_scale, self.period,
+                                        n_reference)
+                flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)[n_first:]
+            else:
+                normal, _ = kl_features(self.torque_of(normal_run), normal_run.recorded, scale, self.period,
+                                        reference)
+                flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
+            rates.append(100.0 * float(np.mean(flags)))
+            counts[0] += int(np.sum(flags))
+            counts[1] += int(flags.size)
+        return float(np.mean(rates)) if rates else np.nan, len(rates), false_alarm_interval(*counts)
+
+
+def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
+               limit_folds) -> tuple[pd.DataFrame, dict]:
+    work = _Work(data, variance, alpha, period, detector, limit_folds)
+    healthy = work.healthy
     far: dict[str, tuple] = {}  # runs whose Q limit lies FAR_LIMIT times above every Q they were tested on
-    false_alarms: dict[tuple, float] = {}  # per monitor: its rate on the held-out healthy runs
     rows, charts, reasons = [], {}, {}
-    for run in tqdm(runs, desc="detection", unit="run", disable=not progress):
+    for run in tqdm(data.runs, desc="detection", unit="run", disable=not progress):
         if len(run.worn_axes) != 1:
             continue
         axis = run.worn_axes[0]
@@ -194,41 +286,15 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                 reason = (f"units imported from logs: each unit learns its first {fitted_first(first, n_samples)} logs "
                           "(thesis ch. 4, one-to-one)")
             reasons[used_protocol] = reason
-        if used_protocol == "other-seeds":
-            if not others:
-                raise ValueError(f"{path}: protocol other-seeds needs runs without wear of {run.robot} "
-                                 f"{run.task} with another seed than {run.seed}; this dataset has none"
-                                 f"{_unlike(run, healthy)}. Sweep "
-                                 "several seeds (--seed 0 --seed 1 --seed 2) or use --protocol first-cycles")
-            training = [(r.id, torque_of(r), r.recorded) for r in others]
-            key, trained_on, heldout, skip = tuple(r.id for r in others), " ".join(r.id for r in others), \
-                [own] if own else [], 0
-            if own is None and len(others) > 1:  # no healthy run of the tested seed: each other one in turn
-                heldout = [("leave-one-out", r, [o for o in others if o is not r]) for r in others]
-        elif used_protocol == "first-cycles":
-            if n_samples <= n_first:
-                raise ValueError(f"{path}: protocol first-cycles learns from the first {n_first} samples of a run and "
-                                 f"needs more; {run.id} has {n_samples}. Give a smaller --first, record more cycles, "
-                                 "or sweep several seeds (--seed 0 --seed 1 --seed 2) for --protocol other-seeds")
-            keep = np.isin(sample_of, samples[:n_first])
-            training = [(run.id, torque_of(run)[keep], run.recorded[keep])]
-            key, trained_on, heldout, skip = (run.id, n_first), f"samples 1-{n_first} of the run", similar(run), n_first
-        else:  # same-run
-            if own is None:
-                raise ValueError(f"{path}: protocol same-run needs the run without wear of {run.robot} "
-                                 f"{run.task} seed {run.seed}; this dataset has none{_unlike(run, healthy)}: use "
-                                 "--protocol first-cycles (or auto)")
-            training = [(own.id, torque_of(own), own.recorded)]
-            key, trained_on, heldout, skip = (own.id,), own.id, [own], 0
-        held_out = used_protocol != "same-run"
-        if key not in monitors:  # one monitor serves every worn run that learns from the same data
-            monitors[key] = _fit_monitor(training, period, variance, alpha, detector, fixed_reference=held_out,
-                                         folds=limit_folds if held_out else None)
+        training, key, trained_on, heldout, skip = work.plan(run, used_protocol, own, others, sample_of, samples,
+                                                             n_first)
+        if key not in work.monitors:  # one monitor serves every worn run that learns from the same data
+            work.monitors[key] = work.fit(training, used_protocol != "same-run")
 
         if used_protocol == "same-run":
             used_protocol = "same-run (in-sample)"
-        scale, reference, used, monitor = monitors[key]
-        worn, groups = kl_features(torque_of(run), run.recorded, scale, period, reference)
+        scale, reference, used, monitor = work.monitors[key]
+        worn, groups = kl_features(work.torque_of(run), run.recorded, scale, period, reference)
         alarms = np.asarray(monitor.predict(worn[:, used]), dtype=bool)
         # the fault's first sample: an alarm before it is a false alarm, never a detection
         begins = run.fault_begins
@@ -237,35 +303,10 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         onset = detect_onset(alarms[first_tested:], persistence=persistence)
         onset = None if onset is None else onset + first_tested
         before = alarms[skip:start]
-        if key not in false_alarms:
-            rates, counts = [], [0, 0]  # and alarms, samples over the healthy runs: the interval
-            for normal_run in heldout:
-                if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
-                    _, normal_run, rest = normal_run
-                    n_scale, n_reference, n_used, n_monitor = _fit_monitor(
-                        [(r.id, torque_of(r), r.recorded) for r in rest], period, variance, alpha, detector,
-                        fixed_reference=True, folds=limit_folds)
-                    normal, _ = kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
-                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)
-                elif used_protocol == "first-cycles" and normal_run is not run:  # the protocol on a healthy robot
-                    normal_of = group_cycles(normal_run.recorded, period)
-                    if len(np.unique(normal_of)) <= n_first:
-                        continue
-                    own_keep = np.isin(normal_of, np.unique(normal_of)[:n_first])
-                    fitted = _fit_monitor([(normal_run.id, torque_of(normal_run)[own_keep],
-                                            normal_run.recorded[own_keep])], period, variance, alpha, detector,
-                                          fixed_reference=True, folds=limit_folds)
-                    n_scale, n_reference, n_used, n_monitor = fitted
-                    normal, _ = kl_features(torque_of(normal_run), normal_run.recorded, n_scale, period, n_reference)
-                    flags = np.asarray(n_monitor.predict(normal[:, n_used]), dtype=bool)[n_first:]
-                else:
-                    normal, _ = kl_features(torque_of(normal_run), normal_run.recorded, scale, period, reference)
-                    flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
-                rates.append(100.0 * float(np.mean(flags)))
-                counts[0] += int(np.sum(flags))
-                counts[1] += int(flags.size)
-            false_alarms[key] = (float(np.mean(rates)) if rates else np.nan, len(rates), false_alarm_interval(*counts))
-        false_alarm, n_normal, (low, high) = false_alarms[key]
+        if key not in work.false_alarms:
+            work.false_alarms[key] = work.false_alarm(run, used_protocol, heldout, work.monitors[key], skip,
+                                                      n_first)
+        false_alarm, n_normal, (low, high) = work.false_alarms[key]
         wear = fault_progress(run, axis) * 100.0 - 100.0
         located = locate_onset(worn, onset)
         rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
