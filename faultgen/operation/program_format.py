@@ -1,7 +1,8 @@
 """What a program file holds, as data: the keys of its top table, its ``[limits]``, ``[tool]`` and
 each segment type, the bounds of its limits, the processes it may name, its most segments; and its
-text written from the table it reads as (:func:`dumps`). Read by :mod:`faultgen.operation.programs`
-(which names these too) and written by robot builders (:mod:`faultgen.operation.taskgen`)."""
+text written from the table it reads as (:func:`dumps`: what a program generator calls, also known
+as ``programs.dumps``). :mod:`faultgen.operation.programs` reads a program by these tables and names
+them too."""
 
 from __future__ import annotations
 
