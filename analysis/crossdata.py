@@ -31,7 +31,8 @@ from sklearn.base import clone
 from tqdm.auto import tqdm
 
 from analysis import isolation
-from analysis.benchmark import fault_progress, locate_onset, opened
+from analysis.benchmark.detection import locate_onset
+from analysis.benchmark.truth import fault_progress, opened
 from analysis.features import kl_divergence
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen.data import reader
@@ -252,7 +253,7 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
     """
     from sklearn.metrics import roc_auc_score
 
-    from analysis.benchmark import classification_inputs
+    from analysis.benchmark.classification_features import classification_inputs
     from analysis.classify import (ESTIMATED, SHORT_TABLE, fit_by_run, make_pipeline, null_p_value, permuted_roles,
                                    score_by_run)
 

@@ -365,6 +365,7 @@ def test_classify_command_hands_the_time_control_to_the_library(small, tmp_path,
 
 def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypatch):
     from analysis import classify
+    from analysis.benchmark import classification_features
     from faultgen.data import dataset
 
     # one unworn run: held out, it leaves no healthy robot to train on
@@ -373,7 +374,7 @@ def test_the_thesis_window_keeps_t13_to_t3_labelled_by_the_robot(small, monkeypa
     seen = []
     monkeypatch.setattr(classify, "evaluate", lambda X, y, groups, *a, estimated=None, **kw: seen.append((X, y, groups))
                         or pd.DataFrame())
-    monkeypatch.setattr(benchmark, "_check_training_sets", lambda *args: None)
+    monkeypatch.setattr(classification_features, "_check_training_sets", lambda *args: None)
     benchmark.classification_table(small, progress=False)
     benchmark.classification_table(small, progress=False, horizon=3)
     (X, _, groups), (Xw, yw, groups_w) = seen

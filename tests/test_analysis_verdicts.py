@@ -9,6 +9,7 @@ from sklearn.base import BaseEstimator
 from typer.testing import CliRunner
 
 from analysis import benchmark, isolation
+from analysis.benchmark import detection_report
 from faultgen.cli import app
 
 runner = CliRunner()
@@ -54,7 +55,7 @@ def test_detect_says_what_its_summary_rests_on(small, tmp_path):
 
 
 def test_the_advice_suggests_the_datasets_own_sweep_with_seeds():
-    assert benchmark._with_seeds("faultgen sweep --preset j2 -o j2.h5 --no-progress") == \
+    assert detection_report._with_seeds("faultgen sweep --preset j2 -o j2.h5 --no-progress") == \
         "faultgen sweep --preset j2 --seed 0 --seed 1 --seed 2 -o j2-seeds.h5"
 
 

@@ -32,8 +32,6 @@ from __future__ import annotations
 
 import ast
 import copy
-import math
-import operator
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -42,6 +40,7 @@ from faultgen.inputs import inside
 from faultgen.inputs import resolved as resolve
 from faultgen.model.builder import ArmError
 from faultgen.model.sources import hint, parse_xml, read_bytes
+from faultgen.model.xacro_expressions import Undefined, evaluate, short
 
 MAX_FILE_BYTES = 10_000_000
 MAX_INCLUDE_DEPTH = 20
@@ -56,53 +55,12 @@ MAX_COPIED = 20_000_000  # characters those copy or read: twice an included file
 MAX_OUTPUT = 10_000_000  # characters of the expanded URDF: a URDF file's own bound (sources.MAX_DESCRIPTION_BYTES)
 MAX_EXPRESSION = 1_000  # characters in one ${...}: within what Python's parser nests without a MemoryError
 
-#: Functions a ``${...}`` expression may call (``math.NAME`` alike).
-FUNCTIONS = {
-    **{
-        name: getattr(math, name)
-        for name in (
-            "sin cos tan asin acos atan atan2 sinh cosh tanh sqrt exp log log10 radians degrees "
-            "fabs floor ceil hypot copysign"
-        ).split()
-    },
-    "abs": abs,
-    "min": min,
-    "max": max,
-    "round": round,
-    "int": int,
-    "float": float,
-}
-CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False}
-
-_BINARY = {
-    ast.Add: operator.add,
-    ast.Sub: operator.sub,
-    ast.Mult: operator.mul,
-    ast.Div: operator.truediv,
-    ast.FloorDiv: operator.floordiv,
-    ast.Mod: operator.mod,
-    ast.Pow: operator.pow,
-}
-_COMPARE = {
-    ast.Eq: operator.eq,
-    ast.NotEq: operator.ne,
-    ast.Lt: operator.lt,
-    ast.LtE: operator.le,
-    ast.Gt: operator.gt,
-    ast.GtE: operator.ge,
-}
-
-
 def is_xacro_namespace(tag: str) -> bool:
     return tag.startswith("{") and tag[1 : tag.index("}")].rstrip("/#").endswith("xacro")
 
 
 def _local(tag: str) -> str:
     return tag.split("}", 1)[1] if tag.startswith("{") else tag
-
-
-class _Undefined(Exception):
-    pass
 
 
 class _Scope:
@@ -139,7 +97,7 @@ class _Scope:
             self.done[name] = value
             return value
         if self.parent is None:
-            raise _Undefined(name)
+            raise Undefined(name)
         return self.parent.get(name, expander)
 
 
@@ -316,92 +274,23 @@ class _Expander:
 
     def expression(self, source: str, scope: _Scope):
         if len(source) > MAX_EXPRESSION:  # its nesting with it: Python's parser fails past a few thousand
-            raise self.over(f"${{{_short(source)}}}", f"longer than {MAX_EXPRESSION} characters")
+            raise self.over(f"${{{short(source)}}}", f"longer than {MAX_EXPRESSION} characters")
         try:
             tree = ast.parse(source.strip(), mode="eval")
         except SyntaxError:
-            raise self.refuse(f"${{{_short(source)}}}", "not an expression") from None
+            raise self.refuse(f"${{{short(source)}}}", "not an expression") from None
         except (MemoryError, RecursionError):  # the parser's stack: shorter than the bound when deep already
-            raise self.refuse(f"${{{_short(source)}}}", "nested too deeply") from None
+            raise self.refuse(f"${{{short(source)}}}", "nested too deeply") from None
         try:
-            return self.value(tree.body, scope, _short(source))
+            return evaluate(tree.body, scope, short(source), self, MAX_TEXT)
         except ArmError:
             raise
         except RecursionError:
-            raise self.refuse(f"${{{_short(source)}}}", "nested too deeply") from None
-        except _Undefined as err:
-            raise ArmError(f"{self.where}: ${{{_short(source)}}}: no property {err.args[0]!r}") from None
+            raise self.refuse(f"${{{short(source)}}}", "nested too deeply") from None
+        except Undefined as err:
+            raise ArmError(f"{self.where}: ${{{short(source)}}}: no property {err.args[0]!r}") from None
         except (ArithmeticError, TypeError, ValueError) as err:
-            raise ArmError(f"{self.where}: ${{{_short(source)}}}: {err}") from None
-
-    def value(self, node: ast.AST, scope: _Scope, source: str):
-        if isinstance(node, ast.Constant) and isinstance(node.value, (int, float, str, bool)):
-            return node.value
-        if isinstance(node, ast.Name):
-            if "__" in node.id:
-                raise self.refuse(f"${{{source}}}", f"name {node.id!r}")
-            if scope.has(node.id):
-                return scope.get(node.id, self)
-            if node.id in CONSTANTS:
-                return CONSTANTS[node.id]
-            raise _Undefined(node.id)
-        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            left, right = self.value(node.left, scope, source), self.value(node.right, scope, source)
-            if isinstance(node.op, ast.Add) and isinstance(left, str) and isinstance(right, str):
-                if len(left) + len(right) > MAX_TEXT:
-                    raise self.refuse(f"${{{source}}}", f"a string of more than {MAX_TEXT} characters")
-                return left + right
-            if not all(isinstance(v, (int, float)) for v in (left, right)):
-                raise self.refuse(f"${{{source}}}", f"{type(node.op).__name__} of {left!r} and {right!r}")
-            if isinstance(node.op, ast.Pow):
-                left, right = float(left), float(right)  # no integer powers of unbounded size
-            result = _BINARY[type(node.op)](left, right)
-            # no integers of unbounded size (their arithmetic slows down with their length)
-            result = float(result) if isinstance(result, int) and abs(result) > 2**63 else result
-            if isinstance(result, float) and not math.isfinite(result):
-                raise ArmError(f"{self.where}: ${{{source}}}: {result} (out of range)")
-            return result
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd, ast.Not)):
-            operand = self.value(node.operand, scope, source)
-            if isinstance(node.op, ast.Not):
-                return not operand
-            if not isinstance(operand, (int, float)):
-                raise self.refuse(f"${{{source}}}", f"sign of {operand!r}")
-            return -operand if isinstance(node.op, ast.USub) else +operand
-        if isinstance(node, ast.BoolOp):
-            result = None
-            for operand in node.values:
-                result = self.value(operand, scope, source)
-                if isinstance(node.op, ast.And) != bool(result):
-                    return result
-            return result
-        if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
-            left = self.value(node.left, scope, source)
-            for op, right_node in zip(node.ops, node.comparators):
-                right = self.value(right_node, scope, source)
-                if not _COMPARE[type(op)](left, right):
-                    return False
-                left = right
-            return True
-        if isinstance(node, ast.IfExp):
-            test = self.value(node.test, scope, source)
-            return self.value(node.body if test else node.orelse, scope, source)
-        if isinstance(node, ast.Call) and not node.keywords:
-            name = _function_name(node.func)
-            if name not in FUNCTIONS:
-                what = _short(ast.unparse(node.func))
-                raise self.refuse(f"${{{source}}}", f"function {what}() (allowed: {', '.join(sorted(FUNCTIONS))})")
-            args = [self.value(a, scope, source) for a in node.args]
-            if not all(isinstance(a, (int, float)) for a in args):
-                raise self.refuse(f"${{{source}}}", f"{name}() of {args!r}")
-            return FUNCTIONS[name](*args)
-        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id == "math":
-            if node.attr in ("pi", "e"):
-                return CONSTANTS[node.attr]
-        kind = {ast.Attribute: "attribute access", ast.Subscript: "subscript", ast.Call: "call"}.get(
-            type(node), type(node).__name__
-        )
-        raise self.refuse(f"${{{source}}}", f"{kind} {_short(ast.unparse(node))!r}")
+            raise ArmError(f"{self.where}: ${{{short(source)}}}: {err}") from None
 
     # ---------------------------------------------------------------------- elements --
     def count(self, n: int = 1) -> None:
@@ -507,7 +396,7 @@ class _Expander:
         name = node.get("name", "")
         try:
             block = scope.get(name, self)
-        except _Undefined:
+        except Undefined:
             raise self.refuse(f'<xacro:insert_block name="{name}">', "no block of that name") from None
         if not isinstance(block, list):
             raise self.refuse(f'<xacro:insert_block name="{name}">', "it names a property, not a block")
@@ -565,18 +454,6 @@ def _size(node: ET.Element, deep: bool = True) -> int:
         total += len(e.tag) if isinstance(e.tag, str) else 0
         total += sum(len(k) + len(v) for k, v in e.attrib.items()) + len(e.text or "") + len(e.tail or "")
     return total
-
-
-def _short(text: str, n: int = 60) -> str:
-    return text if len(text) <= n else text[: n - 3] + "..."
-
-
-def _function_name(func: ast.AST) -> str | None:
-    if isinstance(func, ast.Name):
-        return func.id
-    if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name) and func.value.id == "math":
-        return func.attr
-    return None
 
 
 def expand(path: str | Path, packages: dict[str, str | Path] | None = None) -> str:

@@ -39,12 +39,12 @@ from types import MappingProxyType
 
 import numpy as np
 
-from faultgen import effects
-from faultgen import axes
+from faultgen import axes, effects
 from faultgen.checks import is_whole
 from faultgen.effects.base import Effect
 from faultgen.effects.motor_friction import FrictionParameter, MotorFriction
 from faultgen.operation import schedules
+from faultgen.operation.spec_options import key_values
 
 #: How a fault's parameter grows (:attr:`Fault.growth`).
 GROWTHS = ("absolute", "relative")
@@ -383,10 +383,7 @@ class FaultSpec:
         axis = None if axis_text == ANY_AXIS else int(axis_text)
         kind, start, onset, others = None, 0.0, None, {}
         if len(parts) == 5:
-            for option in parts[4].split(","):
-                key, sep, value = (s.strip() for s in option.partition("="))
-                if not sep or not key or not value:
-                    raise fail(f"option {option!r} is not key=value")
+            for key, value in key_values(parts[4], fail):
                 if key == "kind":
                     kind = value
                     continue

@@ -23,6 +23,7 @@ from faultgen import axes
 from faultgen.effects.motor_friction import MotorFriction
 from faultgen.operation.faults import Fault, dry_multipliers
 from faultgen.operation.schedules import INT_PARAMS, MAX_INCREASE, SCHEDULES, Schedule, check_cycles
+from faultgen.operation.spec_options import key_values
 
 __all__ = ["DRY", "MAX_INCREASE", "SCHEDULES", "Schedule", "WearPlan", "parse_wear"]
 
@@ -180,10 +181,7 @@ def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
         raise fail(f"PERCENT {percent_text} is not a finite number >= 0 (20 means +20 % friction)")
     params: dict[str, float | int] = {}
     if len(parts) == 4:
-        for option in parts[3].split(","):
-            key, sep, value = (s.strip() for s in option.partition("="))
-            if not sep or not key or not value:
-                raise fail(f"option {option!r} is not key=value")
+        for key, value in key_values(parts[3], fail):
             try:
                 params[key] = int(value) if key in INT_PARAMS else float(value)
             except ValueError:

@@ -1,0 +1,116 @@
+"""Fitting and scoring a pipeline on the rows of several runs: the sequence steps (differences,
+windows) applied to each run on its own, every other step to all rows; stacking's inner folds split
+by run."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from sklearn.ensemble import StackingClassifier
+from sklearn.pipeline import Pipeline
+
+from analysis.features import Difference, WindowConcat
+
+#: Step types applied to each run on its own (they look at neighbouring rows; both are stateless).
+SEQUENCE_STEPS = (Difference, WindowConcat)
+
+
+def _steps(estimator) -> list:
+    if isinstance(estimator, Pipeline):
+        return [s for _, s in estimator.steps if s is not None and s != "passthrough"]
+    return [estimator]
+
+
+def _per_run(step, X: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """``step.fit_transform`` on each run's rows on its own, rows back in their places."""
+    out = None
+    for g in pd.unique(groups):
+        idx = np.flatnonzero(groups == g)
+        part = np.asarray(step.fit_transform(X[idx]))
+        if out is None:
+            out = np.empty((X.shape[0], *part.shape[1:]), dtype=part.dtype)
+        out[idx] = part
+    return out
+
+
+def _transform(estimator, X, groups, y=None, fit: bool = False) -> tuple[np.ndarray, object]:
+    steps = _steps(estimator)
+    return run_steps(steps[:-1], X, groups, y, fit), steps[-1]
+
+
+def fit_by_run(estimator, X, y, groups):
+    """Fit ``estimator`` (a Pipeline or a classifier) in place on rows of several runs.
+
+    Steps of :data:`SEQUENCE_STEPS` are applied to each run's rows separately (rows of one
+    run in time order); every other step is fitted on all rows, in pipeline order.
+
+    Parameters
+    ----------
+    estimator : Pipeline or classifier
+        Unfitted; fitted in place.
+    X : ndarray of shape (n_samples, n_features)
+    y : ndarray of shape (n_samples,)
+    groups : ndarray of shape (n_samples,)
+        Run of each row.
+
+    Returns
+    -------
+    The fitted ``estimator``.
+    """
+    groups = np.asarray(groups)
+    Xt, final = _transform(estimator, np.asarray(X), groups, y, fit=True)
+    if isinstance(final, StackingClassifier) and isinstance(final.cv, int | None):
+        final.set_params(cv=run_folds(y, groups, 5 if final.cv is None else final.cv))
+    final.fit(Xt, y)
+    return estimator
+
+
+def run_folds(y, groups, n_splits: int = 5) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Cross-validation folds that split by run, not by sample: every run's samples in one fold
+    (``StratifiedGroupKFold``, classes balanced across folds as far as whole runs allow).
+
+    :func:`fit_by_run` gives these to a stacking classifier's inner cross-validation: split by
+    sample, its base classifiers learn other days of the very runs whose out-of-fold outputs
+    train the meta-classifier, which then learns how the base outputs look on known robots
+    (docs/analysis.md, "stacking"). Fewer runs than ``n_splits``: one fold per run.
+
+    Returns
+    -------
+    list of (train indices, test indices)
+    """
+    from sklearn.model_selection import StratifiedGroupKFold
+
+    y, groups = np.asarray(y), np.asarray(groups)
+    n_runs = len(pd.unique(groups))
+    folds = StratifiedGroupKFold(n_splits=max(2, min(n_splits, n_runs)))
+    return list(folds.split(np.zeros((len(y), 1)), y, groups))
+
+
+def score_by_run(estimator, X, groups) -> np.ndarray:
+    """Score of the positive class (label 1) per row, from an estimator fitted by :func:`fit_by_run`.
+
+    The probability of class 1 where the final step has ``predict_proba``, otherwise its
+    ``decision_function`` (SVM): either ranks the rows, which is all ROC AUC needs.
+
+    Returns
+    -------
+    ndarray of shape (n_samples,)
+    """
+    Xt, final = _transform(estimator, np.asarray(X), np.asarray(groups))
+    classes = list(final.classes_)
+    if hasattr(final, "predict_proba"):
+        return final.predict_proba(Xt)[:, classes.index(1)]
+    return final.decision_function(Xt)  # binary: positive means classes_[1] = 1
+
+
+def run_steps(steps: list, X: np.ndarray, groups: np.ndarray, y=None, fit: bool = False) -> np.ndarray:
+    """Apply preprocessing ``steps`` (fitted in place with ``fit``) as :func:`fit_by_run` does."""
+    Xt = X
+    for step in steps:
+        if isinstance(step, SEQUENCE_STEPS):
+            Xt = _per_run(step, Xt, groups)
+        elif fit:
+            Xt = step.fit_transform(Xt, y)
+        else:
+            Xt = step.transform(Xt)
+    return Xt

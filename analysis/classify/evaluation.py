@@ -1,0 +1,146 @@
+"""Every classifier with every preprocessing combination on the same held-out pairs, Table 5.2's
+layout, with the chance level of every cell on request."""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from threadpoolctl import threadpool_limits
+from tqdm.auto import tqdm
+
+from analysis.classify.chance import null_p_value, permuted_roles
+from analysis.classify.classifiers import CLASSIFIERS
+from analysis.classify.labels import make_labels
+from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, pair_cells, select_pairs
+from analysis.classify.preprocessing import ESTIMATED, PREPROCESSING, preprocessing_steps
+from faultgen import children
+from faultgen.checks import is_whole
+
+
+def evaluate(X, y, groups, failed_groups, normal_groups,
+             classifiers: Iterable[str] | Mapping[str, object] = tuple(CLASSIFIERS),
+             preprocessing: Iterable[str] | None = None, *, estimated=None, n_pairs: int | None = None,
+             random_state: int | None = 0, label_rule=None, matched: bool = False, n_jobs: int | None = None,
+             permutations: int = 0, return_aucs: bool = False, progress: bool = False):
+    """Mean and standard deviation of leave-pair-out AUC per combination and classifier, Table 5.2.
+
+    Every combination and classifier is scored by :func:`leave_pair_out_auc` on the same pairs.
+
+    Parameters
+    ----------
+    X, y, groups, failed_groups, normal_groups
+        As in :func:`leave_pair_out_auc`.
+    classifiers : iterable of str or mapping of str to estimator, default=all of CLASSIFIERS
+        Names in :data:`CLASSIFIERS`, or column name -> estimator (cloned per pair).
+    preprocessing : iterable of str or None, default=None
+        Combination names (:func:`preprocessing_steps`). None: every key of
+        :data:`PREPROCESSING`, without the ``+estM`` ones when ``estimated`` is None.
+    estimated : array-like of shape (n_samples, n_estimated) or None, default=None
+        Estimated quantities (thesis ch. 5.3.2: torque and speed estimated from the indicators),
+        appended as columns to ``X`` for the combinations starting with ``+estM``; required by
+        them. faultgen has no such block of its own; pass e.g. model-based estimates.
+    n_pairs, random_state, label_rule, matched, n_jobs
+        As in :func:`leave_pair_out_auc`; ``random_state`` also seeds the classifiers and the
+        permutations.
+    permutations : int, default=0
+        With ``K >= 1``, also the chance level of every cell: the mean AUC on each of ``K`` label
+        sets with the runs' roles exchanged (:func:`permuted_roles`, the same sets for every
+        cell), reported as their mean (column ``"null"``) and the permutation p-value of the
+        observed mean (``"p"``, :func:`null_p_value`). Costs ``K`` times the table.
+    return_aucs : bool, default=False
+        Also return ``{(classifier, preprocessing): ndarray of AUCs}``, the input of
+        :func:`compare_preprocessing`.
+    progress : bool, default=False
+        Show a progress bar over the (preprocessing, classifier) cells.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        Index ``preprocessing`` (in the order given), columns a MultiIndex ``(classifier,
+        "mean" | "std")``: mean and sample standard deviation (ddof 1) of the AUCs, NaN pairs
+        left out; with ``permutations`` also ``"null"`` and ``"p"`` per classifier, and
+        ``attrs["null_values"]``: ``"<classifier> <preprocessing>"`` -> the K exchanged mean AUCs.
+    aucs : dict
+        Only with ``return_aucs=True``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`leave_pair_out_auc`; for an unknown classifier or combination; for ``+estM``
+        without ``estimated``, or ``estimated`` with other rows than ``X``; for ``permutations``
+        not an integer >= 0.
+    """
+    X, y, groups, failed, normal = check_inputs(X, y, groups, failed_groups, normal_groups)
+    if not is_whole(permutations, 0):
+        raise ValueError(f"permutations = {permutations!r}; expected an integer >= 0 (0: no chance level)")
+    if estimated is not None:
+        estimated = np.asarray(estimated, dtype=float)
+        if estimated.ndim == 1:
+            estimated = estimated[:, None]
+        if estimated.ndim != 2 or estimated.shape[0] != X.shape[0]:
+            raise ValueError(f"estimated must have shape ({X.shape[0]}, n_estimated), got {estimated.shape}")
+    if preprocessing is None:
+        names = [n for n in PREPROCESSING if estimated is not None or not n.startswith(ESTIMATED)]
+    else:
+        names = list(preprocessing)
+    for name in names:
+        preprocessing_steps(name)  # unknown tokens fail before any fitting
+        if name.startswith(ESTIMATED) and estimated is None:
+            raise ValueError(f"preprocessing {name!r} needs the estimated quantities (estimated=...)")
+    if isinstance(classifiers, Mapping):
+        models = dict(classifiers)
+    else:
+        models = {}
+        for c in classifiers:
+            if c not in CLASSIFIERS:
+                raise ValueError(f"unknown classifier {c!r}; expected one of: {', '.join(CLASSIFIERS)}")
+            models[c] = c
+    labels = make_labels(y, groups, failed, label_rule)
+    X_est = np.hstack([X, estimated]) if estimated is not None else None
+    roles = permuted_roles(labels, groups, failed, normal, permutations, random_state) if permutations else []
+
+    # one job per (label set, held-out pair): every cell of the pair, each preprocessing computed once
+    label_sets = [(labels, failed, normal), *roles]
+    jobs = [(k, pair) for k, (_, f, n) in enumerate(label_sets) for pair in select_pairs(f, n, n_pairs, random_state)]
+    run = delayed(pair_cells)
+    tasks = (run(X, X_est, label_sets[k][0], groups, pair, names, models, random_state, matched) for k, pair in jobs)
+    # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
+    # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
+    # joblib's workers limit theirs alike
+    # loky's workers and trackers start in this folder: no joblib.py of it on their path (issue 61)
+    with threadpool_limits(limits=1), children.safe_path():
+        results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(tasks)
+        per_job = np.array(list(tqdm(results, total=len(jobs), desc="classify", unit="pair", disable=not progress)))
+    per_job = per_job.reshape(len(jobs), len(names) * len(models))
+    set_of = np.array([k for k, _ in jobs])
+    cells = [(name, column) for name in names for column in models]
+    aucs: dict[tuple[str, str], np.ndarray] = {}
+    null: dict[tuple[str, str], np.ndarray] = {}
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
+        for c, (name, column) in enumerate(cells):
+            aucs[column, name] = per_job[set_of == 0, c]
+            null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, len(label_sets))])
+    n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
+    if n_nan - {0}:
+        warnings.warn(f"up to {max(n_nan)} held-out pairs per cell have no AUC (one class only); they are "
+                      "left out of mean and std", UndefinedAUCWarning, stacklevel=2)
+
+    statistics = ["mean", "std", "null", "p"] if permutations else ["mean", "std"]
+    columns = pd.MultiIndex.from_product([list(models), statistics], names=["classifier", "statistic"])
+    table = pd.DataFrame(index=pd.Index(names, name="preprocessing"), columns=columns, dtype=float)
+    for (column, name), a in aucs.items():
+        valid = a[~np.isnan(a)]
+        table.loc[name, (column, "mean")] = valid.mean() if valid.size else np.nan
+        table.loc[name, (column, "std")] = valid.std(ddof=1) if valid.size > 1 else np.nan
+        if permutations:
+            table.loc[name, (column, "null")] = np.nanmean(null[column, name])
+            table.loc[name, (column, "p")] = null_p_value(table.loc[name, (column, "mean")], null[column, name])
+    if permutations:  # each cell's mean AUC per exchanged label set: what its p-value counts against
+        table.attrs["null_values"] = {f"{column} {name}": [float(v) for v in values]
+                                      for (column, name), values in null.items()}
+    return (table, aucs) if return_aucs else table

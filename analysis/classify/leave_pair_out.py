@@ -1,0 +1,220 @@
+"""Thesis Procedure 1: ROC AUC with one failed and one normal run held out, over all pairs or a seeded
+subset, optionally time-matched; one pair's AUCs for every (preprocessing, classifier) cell at once."""
+
+from __future__ import annotations
+
+import warnings
+from itertools import product
+
+import numpy as np
+import pandas as pd
+from joblib import Parallel, delayed
+from sklearn.base import BaseEstimator, clone
+from sklearn.metrics import roc_auc_score
+from threadpoolctl import threadpool_limits
+
+from analysis.classify.by_run import fit_by_run, run_steps, score_by_run
+from analysis.classify.labels import make_labels
+from analysis.classify.preprocessing import ESTIMATED, make_pipeline, preprocessing_steps
+from faultgen import children
+
+
+class UndefinedAUCWarning(UserWarning):
+    """Some held-out pairs had no AUC (one class only in the pair or in its training set)."""
+
+
+def check_inputs(X, y, groups, failed_groups, normal_groups):
+    """``X`` (n_samples, n_features) as floats, ``y`` and ``groups`` (n_samples,) as arrays, and the
+    failed and normal runs as lists, checked for :func:`leave_pair_out_auc` and
+    :func:`analysis.classify.evaluate`.
+
+    Raises
+    ------
+    ValueError
+        On shapes that do not match (named with the shape expected), no failed or no normal run,
+        a run in both lists, or a run without samples in ``groups`` (the run named).
+    """
+    X, y, groups = np.asarray(X, dtype=float), np.asarray(y), np.asarray(groups)
+    if X.ndim != 2:
+        raise ValueError(f"X must have shape (n_samples, n_features), got shape {X.shape}")
+    for name, a in (("y", y), ("groups", groups)):
+        if a.shape != (X.shape[0],):
+            raise ValueError(f"{name} must have shape ({X.shape[0]},) like X's rows, got {a.shape}")
+    failed, normal = list(failed_groups), list(normal_groups)
+    if not failed or not normal:
+        raise ValueError(f"need at least one failed and one normal run, got {len(failed)} failed and "
+                         f"{len(normal)} normal")
+    both = set(failed) & set(normal)
+    if both:
+        raise ValueError(f"run {min(both, key=str)!r} is both failed and normal")
+    present = set(pd.unique(groups).tolist())
+    for g in failed + normal:
+        if g not in present:
+            raise ValueError(f"run {g!r} has no samples in groups")
+    return X, y, groups, failed, normal
+
+
+#: Most held-out pairs one evaluation fits (each pair fits every classifier of every combination):
+#: "every pair" of a dataset with more is refused before any fit (``faultgen classify --pairs``).
+MAX_PAIRS = 100_000
+
+
+def select_pairs(failed_groups, normal_groups, n_pairs: int | None = None,
+                 random_state: int | None = 0) -> list[tuple]:
+    """(failed, normal) pairs of Procedure 1: all, failed-major, or ``n_pairs`` of them.
+
+    A subset is drawn without replacement with ``numpy.random.default_rng(random_state)`` and
+    kept in the same order as the full list, so equal arguments give equal pairs.
+
+    Raises
+    ------
+    ValueError
+        If ``n_pairs`` is below 1, or every pair is asked for (``None``, or at least as many as
+        there are) and there are more than :data:`MAX_PAIRS`.
+    """
+    total = len(failed_groups) * len(normal_groups)
+    if (n_pairs is None or n_pairs >= total) and total > MAX_PAIRS:
+        raise ValueError(
+            f"every pair of {len(failed_groups)} worn x {len(normal_groups)} unworn runs is {total} held-out "
+            f"pairs, more than {MAX_PAIRS} (each fits every classifier); draw some with --pairs N (n_pairs)"
+        )
+    pairs = list(product(failed_groups, normal_groups))
+    if n_pairs is None or n_pairs >= len(pairs):
+        return pairs
+    if n_pairs < 1:
+        raise ValueError(f"n_pairs = {n_pairs!r}; expected None or an integer >= 1")
+    chosen = np.sort(np.random.default_rng(random_state).choice(len(pairs), size=n_pairs, replace=False))
+    return [pairs[i] for i in chosen]
+
+
+def matched_rows(labels, groups, pair) -> np.ndarray:
+    """Rows a time-matched AUC compares: the failed samples of ``pair``'s failed run and the
+    samples of its normal run at the same positions in its record (k-th sample against k-th
+    sample, counted from the start; positions the normal run does not reach are left out).
+
+    Returns
+    -------
+    ndarray of bool of shape (n_samples,)
+    """
+    failed, normal = pair
+    failed_rows, normal_rows = np.flatnonzero(groups == failed), np.flatnonzero(groups == normal)
+    positions = np.flatnonzero(labels[failed_rows] == 1)
+    positions = positions[positions < normal_rows.size]
+    rows = np.zeros(len(groups), dtype=bool)
+    rows[failed_rows[positions]] = rows[normal_rows[positions]] = True
+    return rows
+
+
+def _pair_auc(factory, X, labels, groups, pair, matched: bool = False) -> float:
+    held = np.isin(groups, list(pair))
+    train = ~held
+    # the held-out runs are scored whole (differencing needs each sample's predecessor); a
+    # time-matched AUC then ranks only the failed samples against the same days of the normal run
+    test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
+    truth = labels[held][test]
+    if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
+        return np.nan
+    model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else clone(factory)
+    fit_by_run(model, X[train], labels[train], groups[train])
+    return float(roc_auc_score(truth, score_by_run(model, X[held], groups[held])[test]))
+
+
+def pair_cells(X, X_est, labels, groups, pair, names, models, random_state, matched) -> np.ndarray:
+    """AUCs of one held-out pair for every (preprocessing, classifier) cell, in ``product(names,
+    models)`` order: each preprocessing fitted once on the training runs, then every classifier on
+    its output. The same numbers as :func:`_pair_auc` on each cell's whole pipeline."""
+    held = np.isin(groups, list(pair))
+    train = ~held
+    test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
+    truth = labels[held][test]
+    out = np.full(len(names) * len(models), np.nan)
+    if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
+        return out
+    k = 0
+    for name in names:
+        data = X_est if name.startswith(ESTIMATED) else X
+        steps = [step for _, step in preprocessing_steps(name)]
+        X_train = run_steps(steps, data[train], groups[train], labels[train], fit=True)
+        X_test = run_steps(steps, data[held], groups[held])
+        for model in models.values():
+            clf = make_pipeline(model, "control", random_state=random_state)
+            fit_by_run(clf, X_train, labels[train], groups[train])
+            out[k] = roc_auc_score(truth, score_by_run(clf, X_test, groups[held])[test])
+            k += 1
+    return out
+
+
+def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_groups, *,
+                       n_pairs: int | None = None, random_state: int | None = 0, label_rule=None,
+                       matched: bool = False, n_jobs: int | None = None, return_pairs: bool = False):
+    """ROC AUC with one failed and one normal run held out, thesis Procedure 1.
+
+    For each pair (failed run ``i``, normal run ``j``): fit a new model on the samples of all
+    other runs (:func:`fit_by_run`), score the samples of ``i`` and ``j`` (:func:`score_by_run`)
+    and compute ``sklearn.metrics.roc_auc_score`` against their labels.
+
+    Parameters
+    ----------
+    pipeline_factory : callable or estimator
+        ``pipeline_factory()`` returns a new, unfitted model (e.g.
+        ``lambda: make_pipeline("lr", "+diff")``); an estimator is cloned instead.
+    X : array-like of shape (n_samples, n_features)
+        Samples of all runs; each run's rows in time order.
+    y : array-like of shape (n_samples,)
+        Labels or what ``label_rule`` reads; see :func:`make_labels`.
+    groups : array-like of shape (n_samples,)
+        Run of each sample.
+    failed_groups, normal_groups : sequence
+        Runs with and without wear; runs in neither are always in the training set.
+    n_pairs : int or None, default=None
+        None: every pair (``len(failed) * len(normal)``). An int: that many pairs, drawn with
+        ``random_state`` (:func:`select_pairs`).
+    random_state : int or None, default=0
+        Seed of the pair subset.
+    label_rule : None, float or callable, default=None
+        See :func:`make_labels`; None means ``y`` holds 0/1 labels.
+    matched : bool, default=False
+        A time control: rank the failed samples of ``i`` only against the samples of ``j`` at the
+        same positions in its record (:func:`matched_rows`), not against ``i``'s own earlier
+        samples and ``j``'s other days. When a failed run's failed samples are its last ones
+        (labels by wear), anything that changes along a record (season, a life-average indicator
+        settling) tells late from early samples without any fault; matched, it cannot. Changes
+        nothing where every sample of ``i`` is failed and the runs are as long (the thesis's
+        window, ``analysis.benchmark.classification_table(horizon=...)``).
+    n_jobs : int or None, default=None
+        Pairs in parallel with joblib (None: one at a time).
+    return_pairs : bool, default=False
+        Also return the pairs.
+
+    Returns
+    -------
+    aucs : ndarray of shape (n_pairs,)
+        One AUC per pair, in the order of :func:`select_pairs`. NaN where it is undefined: the
+        held-out pair has one class only (e.g. the failed run never reaches the wear threshold,
+        so all its samples are 0 like the normal run's), or the training runs do. An
+        :class:`UndefinedAUCWarning` says how many; aggregate with ``np.nanmean``.
+    pairs : list of (failed, normal)
+        Only with ``return_pairs=True``.
+
+    Raises
+    ------
+    ValueError
+        On shapes that do not match, a run missing from ``groups`` or in both lists, or labels
+        that are not 0/1 (see :func:`make_labels`).
+    """
+    X, y, groups, failed, normal = check_inputs(X, y, groups, failed_groups, normal_groups)
+    labels = make_labels(y, groups, failed, label_rule)
+    pairs = select_pairs(failed, normal, n_pairs, random_state)
+    if n_jobs is None:
+        with threadpool_limits(limits=1):  # small fits: see evaluate
+            aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
+    else:
+        jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
+        with children.safe_path():  # loky's workers and trackers: no joblib.py of this folder (issue 61)
+            aucs = Parallel(n_jobs=n_jobs)(jobs)
+    aucs = np.asarray(aucs, dtype=float)
+    n_nan = int(np.isnan(aucs).sum())
+    if n_nan:
+        warnings.warn(f"{n_nan} of {len(pairs)} held-out pairs have no AUC (one class only in the pair "
+                      "or in its training runs); they are NaN", UndefinedAUCWarning, stacklevel=2)
+    return (aucs, pairs) if return_pairs else aucs
