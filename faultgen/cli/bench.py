@@ -138,6 +138,7 @@ def score_command(
       faultgen bench score thesis --data bench-small --baseline pca
       faultgen bench score thesis --data bench-small --isolator mine:LargestRise
       faultgen bench score thesis --data bench-small --detector mine:ZScore
+      faultgen bench make prognostics --size small -o bench-prognostics
       faultgen bench score prognostics --data bench-prognostics --baseline linear
     """
     if track == "prognostics" or prognoser:  # remaining useful life: its own contract and metrics
