@@ -152,7 +152,8 @@ def _figure(values: list[float], statistic) -> dict:
     return {"value": value, "ci95": [low, high], "units": int(values.size)}
 
 
-def _summary(rows: list[dict]) -> dict:
+def summary(rows: list[dict]) -> dict:
+    """The figures over units (module docstring) of per-unit metric rows (:func:`unit_metrics`)."""
     rows = [r for r in rows if r["alpha_lambda"] is not None]
     return {"alpha_lambda_share": _figure([float(r["alpha_lambda"]) for r in rows], np.mean),
             "ra_lambda": _figure([r["ra_lambda"] for r in rows], np.mean),
@@ -217,7 +218,7 @@ def score(folder: str | Path, prognoser, name: str) -> dict:
     return {"method": name, "role": "prognoser", **{k: str(v) for k, v in made.items()},
             "date": datetime.date.today().isoformat(), "failure_wear": failure, "alpha": ALPHA, "beta": BETA,
             "lambda": LAMBDA, "resamples": RESAMPLES, "unscored_units": len(labelled) - len(method_rows),
-            "results": _summary(method_rows), "naive": _summary(naive_rows), "ra_lambda_minus_naive": diff,
+            "results": summary(method_rows), "naive": summary(naive_rows), "ra_lambda_minus_naive": diff,
             "verdict": words, "per_unit": method_rows, "naive_per_unit": naive_rows}
 
 

@@ -33,9 +33,10 @@ def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | N
     json_path, md_path = prognostics.write(results, stem, command)
     typer.echo(prognostics.HEADER)
     typer.echo(prognostics.markdown_row(results, command))
+    diff = results["ra_lambda_minus_naive"]
     typer.echo(f"verdict: {results['verdict']}; relative accuracy at lambda minus the naive prognoser's (mean life "
-               f"of the train split): {results['ra_lambda_minus_naive']['value']:.2f} "
-               f"{results['ra_lambda_minus_naive']['ci95']}; alpha {prognostics.ALPHA}, beta {prognostics.BETA}, "
+               f"of the train split): {diff['value']:.2f} [{diff['ci95'][0]:.2f}, {diff['ci95'][1]:.2f}]; "
+               f"alpha {prognostics.ALPHA}, beta {prognostics.BETA}, "
                f"lambda {prognostics.LAMBDA}; intervals: bootstrap over {results['results']['ra_lambda']['units']} "
                f"test units (docs/bench/prognostics.md)")
     typer.echo(f"wrote {json_path}, {md_path}")
