@@ -86,6 +86,11 @@ class NaN:
         return np.array([np.nan])
 
 
+class Raising(NaN):
+    def predict(self, unit):
+        raise KeyError("torque")
+
+
 def test_an_exact_prognoser_meets_every_metric_and_is_judged_above_the_naive_one(small):
     folder, _ = small
     test = files.attach_labels(files.read(folder / "test.h5"), folder / "test_labels.csv")
@@ -98,6 +103,8 @@ def test_an_exact_prognoser_meets_every_metric_and_is_judged_above_the_naive_one
     assert results["verdict"].startswith("above the naive prognoser")
     with pytest.raises(ValueError, match="nan: predict\\(\\) at time .* NaN"):
         prognostics.score(folder, NaN(), "nan")
+    with pytest.raises(ValueError, match="raising: predict\\(\\) on unit test-00\\d at time .* failed: KeyError"):
+        prognostics.score(folder, Raising(), "raising")
 
 
 def test_the_command_writes_the_row_and_the_verdict(small, tmp_path):
