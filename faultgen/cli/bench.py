@@ -117,7 +117,11 @@ def score_command(
         metavar="MODULE:CLASS", help="Your isolator (the contract of `faultgen bench-isolators --isolator`).")] = None,
     baseline: Annotated[str | None, typer.Option(
         help="A baseline: pca, lr, svm, rf, stacking, iforest, ecod (detectors; pyod's need the bench extra), "
-             "transfer_entropy, cross_correlation, granger, trend, pca_contribution (isolators).")] = None,
+             "transfer_entropy, cross_correlation, granger, trend, pca_contribution (isolators); on the "
+             "prognostics track linear, exponential, mean_life (prognosers).")] = None,
+    prognoser: Annotated[str | None, typer.Option(
+        metavar="MODULE:CLASS", help="Your prognoser, on the prognostics track (the contract of "
+        "faultgen.bench.prognosers).")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem: OUT.json and OUT.md (default: "
                                                                   "DATA/score-NAME).")] = None,
 ) -> None:
@@ -134,7 +138,13 @@ def score_command(
       faultgen bench score thesis --data bench-small --baseline pca
       faultgen bench score thesis --data bench-small --isolator mine:LargestRise
       faultgen bench score thesis --data bench-small --detector mine:ZScore
+      faultgen bench make prognostics --size small -o bench-prognostics
+      faultgen bench score prognostics --data bench-prognostics --baseline linear
     """
+    if track == "prognostics" or prognoser:  # remaining useful life: its own contract and metrics
+        from faultgen.cli import bench_prognostics
+
+        return bench_prognostics.score(data, prognoser, baseline, out)
     from analysis import plugins
     from faultgen.bench import baselines, score
 

@@ -1,0 +1,117 @@
+"""The twin's remaining useful life (`faultgen monitor`, faultgen.monitor.prognosis) on the
+prognostics track's test fleet, scored as `faultgen bench score prognostics` scores a prognoser.
+
+    python benchmarks/prognostics_twin.py --data prognostics-full [--size full] [--work DIR]
+
+The twin reads a fleet's raw logs, which a track's ``test.h5`` (features) no longer holds, so this
+script writes the track version's test fleet again with its recipe (the independent simulator,
+faultgen/bench/independent.py, the same spec and seed as the track's ``fleet`` part; the robot added
+with the version's sizing rule), runs ``faultgen monitor LOGS --no-calibrate --failure-wear 40`` on
+it, and replays the monitor's remaining life (:func:`faultgen.monitor.prognosis.remaining_life`) on
+each unit's rows up to every day from the wear's onset to the day before its end of life: from the
+day the unit's alarm became persistent, the distribution of the time until the alarm's source axis
+reaches 40 % *estimated* wear (the twin's scale); before it, or for another axis, no prediction (every
+sample beyond the horizon). The source axis is the one ``alarms.csv`` names at the end of the run.
+The end of life and onset are the fleet's ``truth.csv`` (the same as the track's test labels); the
+naive prognoser (the train split's lives, from ``--data``'s ``train.h5``) is scored on the same
+days. Metrics, intervals and verdict: :mod:`faultgen.bench.prognostics`. Prints the leaderboard row.
+Not in the track's numeric profile: the fleet's last bits may differ from the track's test split.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import datetime
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from faultgen.bench import files, independent, make, prognosers, prognostics, tracks
+from faultgen.model import robots
+from faultgen.monitor import prognosis
+
+#: The monitor's defaults the replay uses (faultgen.monitor.scoring.Settings).
+MONITOR_ALPHA, PERSISTENCE = 0.01, 5
+
+
+def _floats(row: dict) -> dict:
+    return {k: (float(v) if k.startswith("wear") and v != "" else v) for k, v in row.items()}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", type=Path, required=True, help="The track's folder of `faultgen bench make`.")
+    parser.add_argument("--size", default="full", choices=tracks.SIZES)
+    parser.add_argument("--work", type=Path, default=None)
+    args = parser.parse_args()
+    work = args.work or Path(tempfile.mkdtemp(prefix="prognostics-twin-"))
+    recipe = tracks.load("prognostics").version(1)
+    failure = prognostics.FAILURE_WEAR[1]
+    started = time.perf_counter()
+    robot = make.add_robots(recipe, work / "robots")["kr210"]
+    (_, fleet), = recipe.fleets("test", args.size)
+    spec = independent.FleetSpec(**{k: tuple(v) if isinstance(v, list) else v for k, v in fleet["spec"].items()})
+    logs, truth_path = independent.write_fleet(work / "fleet", spec, robot)
+    n_axes = robots.load(robot).n_axes
+    print(f"fleet {spec} written in {time.perf_counter() - started:.0f} s")
+    out = work / "monitor"
+    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+               "--no-calibrate", "--failure-wear", f"{failure:g}"]
+    started = time.perf_counter()
+    done = subprocess.run(command, check=False, capture_output=True, text=True)
+    if done.returncode not in (0, 3):  # 3: some unit degraded or not monitored, every output written
+        raise SystemExit(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr[-3000:]}")
+    print(f"faultgen monitor --no-calibrate --failure-wear {failure:g}: {time.perf_counter() - started:.0f} s")
+    truth = independent.read_truth(truth_path)
+    with open(out / "scores.csv", newline="") as f:
+        scores = [_floats(r) for r in csv.DictReader(f)]
+    with open(out / "alarms.csv", newline="") as f:
+        alarms = {r["unit"]: r for r in csv.DictReader(f)}
+    naive = prognosers.MeanLife().fit(files.read(args.data / "train.h5"), failure)
+    twin_rows, naive_rows = [], []
+    started = time.perf_counter()
+    for unit, t in truth.items():
+        days = np.arange(1, len(t["stamps"]) + 1, dtype=float)
+        eol = float(days[np.flatnonzero(t["wear"] >= failure)[0]])
+        onset = float(days[np.flatnonzero(t["wear"] > 0)[0]])
+        rows = [r for r in scores if r["unit"] == unit]
+        day = {r["stamp"]: i + 1 for i, r in enumerate(rows)}
+        alarm = alarms.get(unit, {})
+        first, axis = alarm.get("first_alarm") or None, int(alarm.get("source_axis") or 0)
+        persistent = (day[first] + PERSISTENCE - 1) if first in day else np.inf
+        twin, mean_life = {}, {}
+        for now in days[(days >= onset) & (days < eol)]:
+            record = files.Unit(id=unit, robot="kr210", task="pick_place", sample="log",
+                                arrays={"cycles": days[: int(now)]})
+            mean_life[now] = naive.predict(record)
+            samples = np.array([np.inf])
+            if axis and now >= persistent:
+                (row,) = prognosis.remaining_life(unit, rows[: int(now)], n_axes, alpha=MONITOR_ALPHA,
+                                                  failure_wear=failure, since=first, source_axis=axis, axes=[axis])
+                if row.distribution is not None:
+                    samples = np.array([np.inf if v is None else now + float(v) for v in row.distribution.key("failure")])
+            twin[now] = samples
+        extra = {"unit": unit, "worn_axis": t["axis"], "alarm_axis": axis, "alarm_persistent_day": persistent}
+        twin_rows.append({**extra, **prognostics.unit_metrics(twin, eol, onset)})
+        naive_rows.append({**extra, **prognostics.unit_metrics(mean_life, eol, onset)})
+    print(f"{sum(len(r) for r in twin_rows)} unit rows replayed in {time.perf_counter() - started:.0f} s")
+    words, diff = prognostics.verdict(twin_rows, naive_rows)
+    results = {"method": "twin (faultgen monitor)", "track": "prognostics", "version": "1", "size": args.size,
+               "date": datetime.date.today().isoformat(), "results": prognostics.summary(twin_rows),
+               "naive": prognostics.summary(naive_rows), "verdict": words}
+    for row in twin_rows:
+        print({k: row[k] for k in ("unit", "worn_axis", "alarm_axis", "alarm_persistent_day", "eol", "alpha_lambda",
+                                   "ra_lambda", "ph")})
+    print(f"verdict: {words}; relative accuracy at lambda minus the naive's: {diff['value']:.2f} "
+          f"[{diff['ci95'][0]:.2f}, {diff['ci95'][1]:.2f}]")
+    print(prognostics.HEADER)
+    print(prognostics.markdown_row(results, "python benchmarks/prognostics_twin.py " + " ".join(sys.argv[1:])))
+
+
+if __name__ == "__main__":
+    main()

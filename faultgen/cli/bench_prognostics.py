@@ -1,0 +1,42 @@
+"""``faultgen bench score prognostics``: parse the prognoser, call :mod:`faultgen.bench.prognostics`,
+print its leaderboard row and verdict (the ``score`` command of :mod:`faultgen.cli.bench` hands the
+prognostics track here)."""
+
+from __future__ import annotations
+
+import shlex
+import sys
+from pathlib import Path
+
+import typer
+
+
+def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | None) -> None:
+    """Score ``--prognoser MODULE:CLASS`` or ``--baseline NAME`` on the prognostics track's files in
+    ``data``; writes OUT.json and OUT.md and prints the row with the naive prognoser's figures.
+
+    Raises
+    ------
+    ValueError
+        Unless exactly one of the two is given, for an unknown baseline, or what scoring raises.
+    """
+    from faultgen.bench import prognosers, prognostics
+
+    if (prognoser is None) == (baseline is None):
+        raise ValueError("the prognostics track takes one of --prognoser MODULE:CLASS or --baseline "
+                         f"{'|'.join(prognostics.BASELINES)}")
+    name = prognoser or baseline
+    method = prognosers.load(prognoser) if prognoser else prognostics.baseline(baseline)
+    stem = out or data / f"score-{name.replace(':', '.')}"
+    results = prognostics.score(data, method, name)
+    command = shlex.join(["faultgen", *sys.argv[1:]])
+    json_path, md_path = prognostics.write(results, stem, command)
+    typer.echo(prognostics.HEADER)
+    typer.echo(prognostics.markdown_row(results, command))
+    diff = results["ra_lambda_minus_naive"]
+    typer.echo(f"verdict: {results['verdict']}; relative accuracy at lambda minus the naive prognoser's (mean life "
+               f"of the train split): {diff['value']:.2f} [{diff['ci95'][0]:.2f}, {diff['ci95'][1]:.2f}]; "
+               f"alpha {prognostics.ALPHA}, beta {prognostics.BETA}, "
+               f"lambda {prognostics.LAMBDA}; intervals: bootstrap over {results['results']['ra_lambda']['units']} "
+               f"test units (docs/bench/prognostics.md)")
+    typer.echo(f"wrote {json_path}, {md_path}")
