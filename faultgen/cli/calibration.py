@@ -10,7 +10,7 @@ import typer
 from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_output_folder
 from faultgen.cli.main import app
-from faultgen.cli.options import Overwrite
+from faultgen.cli.options import LogFormat, Overwrite, TorqueConstants, log_adapter
 
 
 @app.command("calibrate", cls=Command)
@@ -18,12 +18,15 @@ def calibrate_command(
     robot: Annotated[str, typer.Option(help="Robot name (see `faultgen robots`), robot folder or MJCF file of the nominal model.")],
     measured: Annotated[Path, typer.Option(
         help="Measured torque log: CSV (.csv, .csv.gz) or HDF5 with columns t, q1..q6 (rad), tau1..tau6 (N m, arm "
-             "side) and optionally qd1..qd6 (rad/s); at least 2 s at >= 100 Hz.")],
+             "side) and optionally qd1..qd6 (rad/s); at least 2 s at >= 100 Hz; or a log in another layout "
+             "with --format.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="Output folder (created): model/, report.json, calibration.png.")],
     max_steps: Annotated[int, typer.Option(help="Most effects to add.", min=0, max=20)] = 6,
     sysid: Annotated[bool, typer.Option(
         help="Refine a Stribeck hump's level, velocity and exponent with mujoco.sysid when the mujoco[sysid] "
              "extra is installed (kept when it lowers the held-out gap).")] = True,
+    log_format: LogFormat = "measured",
+    torque_constants: TorqueConstants = None,
     overwrite: Overwrite = False,
 ) -> None:
     """Find what the model misses in a measured torque log, add it, and show the gap shrink.
@@ -48,6 +51,10 @@ def calibrate_command(
     parameters and evidence) and calibration.png (measured vs model torque and the residual
     before and after, per axis). Method and accuracy: docs/calibration.md.
 
+    A log in another layout is read by the adapter `faultgen logs import` and `faultgen monitor`
+    use: --format ur-rtde (Universal Robots' RTDE recorder; --torque-constants for the measured
+    current) or --format voraus, whole, with the measured format's checks (docs/dataset.md).
+
     Example (on a log with a hidden effect, `faultgen hidden-log`):
 
     \b
@@ -57,7 +64,13 @@ def calibrate_command(
     from faultgen import calibrate
 
     check_output_folder(out, overwrite)
-    result = calibrate.calibrate(robot, measured, out, max_steps=max_steps, progress=True, use_sysid=sysid)
+    adapter = log_adapter(log_format, torque_constants, robot)
+    log = measured
+    if adapter is not None:  # read once, whole, by the format's adapter; calibrate takes the checked data
+        from faultgen.model import robots
+
+        log = adapter.read(measured, robots.load(robot))
+    result = calibrate.calibrate(robot, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
