@@ -5,6 +5,7 @@ stored them still read, their robot loaded by its label."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import sys
 from pathlib import Path
@@ -15,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 import faultgen
+from analysis import crossdata
 from faultgen.cli import app
 from faultgen.data import dataset, fleetlogs
 from faultgen.model import robots
@@ -170,3 +172,23 @@ def test_a_bad_limits_attribute_is_named_by_validate_and_the_reader(tmp_path):
         f["runs"]["u1"].attrs["limits"] = "not json"
     with pytest.raises(dataset.DatasetError, match="attribute 'limits' is not JSON"):
         faultgen.open(path)
+
+
+def test_two_versions_of_one_robot_are_compared_by_what_each_stored(tmp_path):
+    puma = robots.load("puma560")
+    start = fleetlog_folder.date(2026, 3, 1)
+    test = imported_fleet(tmp_path / "test", puma, {0: (2, 4, 0.2)}, units=2, days=10, start=start)
+    train = shutil.copy(test, tmp_path / "train.h5")
+    with h5py.File(train, "a") as f:  # another version of puma560: its joint ranges 10 % narrower
+        for group in f["runs"].values():
+            table = json.loads(group.attrs["limits"])
+            table["joint_range"] = (0.9 * np.array(table["joint_range"])).tolist()
+            group.attrs.update({"limits": json.dumps(table), "model_sha256": "f" * 64})
+    assert dataset.validate(train) == []
+    result = runner.invoke(app, ["detect", str(test), "--train", str(train), "--first", "4", "--no-progress",
+                                 "-o", str(tmp_path / "d")])
+    assert result.exit_code == 2, result.output
+    assert f"robots 'puma560' and 'puma560' (models ffffffffffff and {dataset.model_hash(puma.path)[:12]})" in \
+        result.output and "differ in their joint range" in result.output
+    with faultgen.open(test) as a, faultgen.open(test) as b:  # the same version: comparable
+        crossdata.check_comparable(a, b)
