@@ -257,7 +257,8 @@ def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
 
     N is the ``n_axes`` attribute (5..7); a run written before it existed has the axes of its
     ``friction_multiplier`` (six, the only robots then). ``drivetrain``, when present, must be JSON
-    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers.
+    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers; ``limits``,
+    when present, the limits of N axes (:func:`limits_problems`).
     """
     problems = []
     if "n_axes" in group.attrs:
