@@ -66,7 +66,8 @@ def check_comparable(train: reader.Dataset, test: reader.Dataset) -> None:
     ------
     ValueError
         Naming the robots and what differs (axes, joint range, speed limit, peak motor torque), or
-        the array and its units in each file.
+        the array and its units in each file; or a file written before its runs stored their limits
+        whose robot cannot be loaded on this machine.
     """
     ranges = {}  # (robot, model digest) -> what its first run in train, else in test, stored of it
     for data in (train, test):

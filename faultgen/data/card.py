@@ -49,6 +49,9 @@ def card(path: str | Path) -> str:
     ------
     faultgen.data.schema.DatasetError
         If ``path`` is not a finished faultgen dataset.
+    ValueError
+        For a file written before its runs stored their drivetrain or limits whose robot cannot be
+        loaded on this machine (:attr:`faultgen.data.reader.Run.limits`).
     """
     with reader.open(path) as data:
         runs = data.runs
