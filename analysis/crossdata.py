@@ -14,7 +14,9 @@ protocol (:data:`OWN`, :data:`OTHER`, :data:`TWIN`):
 **Comparable features.** Both datasets must hold the features the method reads, in the same units
 (the stored ``units`` attributes), for robots with the same axes, joint ranges, speed limits
 (``tasks.toml`` ``[limits]``) and peak motor torques: the design ranges of the 12-bin histograms
-(:func:`check_comparable`). A simulated dataset and an import of the same robot's logs are.
+(:func:`check_comparable`), as each run stored them (:attr:`faultgen.data.reader.Run.limits` and
+:attr:`~faultgen.data.reader.Run.drivetrain`: no robot's files are read). A simulated dataset and an
+import of the same robot's logs are.
 
 **Per-unit normalisation** (ch. 4: one robot's raw signal says more about its task than about
 its condition; the thesis differenced it, here each unit is referred to its own start): every
@@ -36,8 +38,6 @@ from analysis.benchmark.truth import fault_progress, opened
 from analysis.features import kl_divergence
 from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
 from faultgen.data import reader
-from faultgen.model import robots
-from faultgen.operation import programs
 
 OWN, OTHER, TWIN = "own history", "another dataset", "the twin"
 #: The stored per-record arrays the methods read, whose units both datasets must share.
@@ -52,9 +52,11 @@ def protocol(train: reader.Dataset, baseline: int) -> str:
             "records")
 
 
-def _robot_ranges(name: str) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    robot = robots.load(name)
-    return robot.n_axes, robot.joint_range, programs.robot_limits(robot)[0], robot.motor_torque_limit
+def _robot_ranges(run: reader.Run) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """The axes, joint range (N, 2) rad, speed limit (N,) rad/s and peak motor torque (N,) N m a run
+    stored of its robot."""
+    drive, limits = run.drivetrain, run.limits
+    return drive.n_axes, limits.joint_range, limits.velocity, drive.motor_torque_limit
 
 
 def check_comparable(train: reader.Dataset, test: reader.Dataset) -> None:
@@ -64,23 +66,29 @@ def check_comparable(train: reader.Dataset, test: reader.Dataset) -> None:
     ------
     ValueError
         Naming the robots and what differs (axes, joint range, speed limit, peak motor torque), or
-        the array and its units in each file.
+        the array and its units in each file; or a file written before its runs stored their limits
+        whose robot cannot be loaded on this machine.
     """
-    ranges = {}
+    ranges = {}  # (robot, model digest) -> what its first run in train, else in test, stored of it
     for data in (train, test):
-        for name in sorted({run.robot for run in data.runs}):
-            if name not in ranges:
+        first = {}
+        for run in data.runs:
+            first.setdefault((run.robot, run.model_sha256), run)
+        for key in sorted(first):
+            if key not in ranges:
                 try:
-                    ranges[name] = _robot_ranges(name)
+                    ranges[key] = _robot_ranges(first[key])
                 except ValueError as err:
-                    raise ValueError(f"{data.path}: robot {name!r} of its runs cannot be loaded to check that its "
+                    raise ValueError(f"{data.path}: robot {key[0]!r} of its runs cannot be loaded to check that its "
                                      f"features compare: {err}") from None
     first = next(iter(ranges))
     what = ("axes", "joint range", "speed limit (tasks.toml [limits])", "peak motor torque")
-    for name, values in ranges.items():
+    for key, values in ranges.items():
         for label, a, b in zip(what, ranges[first], values, strict=True):
             if not np.allclose(a, b, rtol=1e-9, atol=0):
-                raise ValueError(f"robots {first!r} and {name!r} of {train.path} and {test.path} differ in their {label} "
+                models = "" if key[0] != first[0] else f" (models {first[1][:12]} and {key[1][:12]})"
+                raise ValueError(f"robots {first[0]!r} and {key[0]!r}{models} of {train.path} and {test.path} differ in "
+                                 f"their {label} "
                                  f"({np.round(a, 4).tolist()} against {np.round(b, 4).tolist()}): their histograms "
                                  "do not share bins, so a model of one does not judge the other")
     for name in FEATURES:

@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from faultgen.data import reader
-from faultgen.model import robots
 from faultgen.simulation import sensors
 
 
@@ -23,8 +22,9 @@ def torque_record(run: reader.Run) -> np.ndarray | StoredHistograms:
     """What detection bins a run's |motor torque| from: its per-cycle counts in fine bins of
     0 .. peak motor torque (``torque_counts``, (n_cycles, 6, 1200),
     :func:`faultgen.simulation.sensors.torque_counts`), read as stored, or computed from the
-    stored signals for a file written before the counts existed; the two are equal bit for bit
-    for the same run. A run that has neither (a daily record, or an old file without signals)
+    stored signals for a file written before the counts existed, over the peak motor torque the run
+    stored (:attr:`faultgen.data.reader.Run.drivetrain`); the two are equal bit for bit for the same
+    run. A run that has neither (a daily record, or an old file without signals)
     gives its 12-bin ``torque_hist`` (:class:`StoredHistograms`).
 
     Raises
@@ -38,7 +38,7 @@ def torque_record(run: reader.Run) -> np.ndarray | StoredHistograms:
     if run.has_signals:
         tau_m = run.signal("tau_m")
         run.forget("tau_m")  # the largest array of a file: not kept
-        return sensors.torque_counts(tau_m, robots.load(run.robot).motor_torque_limit)
+        return sensors.torque_counts(tau_m, run.drivetrain.motor_torque_limit)
     return StoredHistograms(run.array("torque_hist"))
 
 

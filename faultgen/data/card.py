@@ -1,8 +1,10 @@
 """A dataset card: what a faultgen dataset holds and what its numbers mean, as Markdown.
 
 ``faultgen info FILE --card`` prints it. Built from the file (labels, the command, the version
-that wrote it), the robot models it names (friction, joint ranges, torque limits) and the
-schema tables of :mod:`faultgen.data.schema`, so it cannot drift from what is stored.
+that wrote it, what each run stored of its robot: friction, gear ratios, torque limits, joint ranges
+and speed limits, :mod:`faultgen.data.robot_record`) and the schema tables of
+:mod:`faultgen.data.schema`, so it cannot drift from what is stored, and needs no robot's files
+(a file written before runs stored them: :attr:`faultgen.data.reader.Run.limits`).
 """
 
 from __future__ import annotations
@@ -47,9 +49,10 @@ def card(path: str | Path) -> str:
     ------
     faultgen.data.schema.DatasetError
         If ``path`` is not a finished faultgen dataset.
+    ValueError
+        For a file written before its runs stored their drivetrain or limits whose robot cannot be
+        loaded on this machine (:attr:`faultgen.data.reader.Run.limits`).
     """
-    from faultgen.model import robots
-
     with reader.open(path) as data:
         runs = data.runs
         names = sorted({name for run in runs for name in run.names})
@@ -59,6 +62,11 @@ def card(path: str | Path) -> str:
         labels = {run.id: run.array("label") for run in runs if run.measured}
     wear_pct = round(largest, 1) if largest > 0.05 else EXAMPLE_WEAR
     robot_names = sorted({r.robot for r in runs})
+    first = {}  # each robot's and each (robot, task)'s first run: what it stored of the robot
+    for run in runs:
+        first.setdefault(run.robot, run)
+        if not run.measured:
+            first.setdefault((run.robot, run.task), run)
     pairs = sorted({(r.robot, r.task) for r in runs if not r.measured})
     measured_robots = sorted({r.robot for r in runs if r.measured})
     imported = all(r.measured for r in runs)  # only logs: no wear is measured, labels come from events
@@ -73,7 +81,7 @@ def card(path: str | Path) -> str:
 
     if imported:
         lines += _imported_labels(runs, labels)
-        lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported)
+        lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported, first)
         lines += _provenance(path, command, written_by, shas)
         return "\n".join(lines)
 
@@ -88,13 +96,13 @@ def card(path: str | Path) -> str:
               "`dry_friction_factor` scales each unit's):", ""]
     rows = []
     for name in robot_names:
-        robot = robots.load(name)
-        for a in range(len(robot.gear_ratio)):
-            coulomb = float(robot.friction.coulomb_pos[a])
+        drive = first[name].drivetrain
+        for a in range(len(drive.gear_ratio)):
+            coulomb = float(drive.friction["coulomb_pos"][a])
             rise = coulomb * wear_pct / 100
-            rows.append([name, a + 1, f"{coulomb:.3g}", f"+{rise:.3g}", f"{robot.gear_ratio[a]:.4g}",
-                         f"+{rise * robot.gear_ratio[a]:.3g}",
-                         f"{100 * rise / float(robot.motor_torque_limit[a]):.2g}"])
+            rows.append([name, a + 1, f"{coulomb:.3g}", f"+{rise:.3g}", f"{drive.gear_ratio[a]:.4g}",
+                         f"+{rise * drive.gear_ratio[a]:.3g}",
+                         f"{100 * rise / float(drive.motor_torque_limit[a]):.2g}"])
     lines += _table(["robot", "axis", "Coulomb new, N m (motor)", f"+{wear_pct:g} %, N m (motor)", "gear ratio",
                      f"+{wear_pct:g} %, N m (arm)", "% of peak motor torque"], rows)
 
@@ -112,7 +120,7 @@ def card(path: str | Path) -> str:
                  "`friction_multiplier` holds it as a wear (2 on worn logs, 1 elsewhere)."] if measured_robots else []),
               ""]
 
-    lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported)
+    lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported, first)
     lines += _provenance(path, command, written_by, shas)
     return "\n".join(lines)
 
@@ -156,11 +164,9 @@ def _imported_labels(runs, labels: dict) -> list[str]:
             "folder, which needs no labels.", ""]
 
 
-def _arrays_and_edges(names, robot_names, pairs, measured_robots, imported) -> list[str]:
-    """The card's arrays with their units, and the histograms' bin edges."""
-    from faultgen.model import robots
-    from faultgen.operation import programs
-
+def _arrays_and_edges(names, robot_names, pairs, measured_robots, imported, first) -> list[str]:
+    """The card's arrays with their units, and the histograms' bin edges (``first``: a robot name, or
+    a (robot, task) pair, -> its first run, whose stored limits and drivetrain give the edges)."""
     lines = ["## Arrays and units", ""]
     rows = [[name, *(IMPORTED_ARRAYS.get(name) if imported and name in IMPORTED_ARRAYS else reader.SCHEMA[name])]
             for name in names if name in reader.SCHEMA]
@@ -171,18 +177,17 @@ def _arrays_and_edges(names, robot_names, pairs, measured_robots, imported) -> l
               "cycle (a day's record: of its maximum cycle). Edges per axis, lowest to highest:", ""]
     rows = []
     for name in robot_names:
-        robot = robots.load(name)
-        low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
+        low, high = first[name].limits.joint_range[:, 0], first[name].limits.joint_range[:, 1]
         rows.append([name, "", "angle_hist", "rad", "joint range: " + "; ".join(
             f"{lo:.3g}..{hi:.3g}" for lo, hi in zip(low, high, strict=True))])
         rows.append([name, "", "torque_hist", "N m (motor)", "0..peak motor torque: " + "; ".join(
-            f"0..{t:.3g}" for t in robot.motor_torque_limit)])
+            f"0..{t:.3g}" for t in first[name].drivetrain.motor_torque_limit)])
     for name, task in pairs:
-        limit = programs.load(name, task).velocity_limit
+        limit = first[name, task].limits.task_velocity
         rows.append([name, task, "speed_hist", "rad/s (arm)", "0..the task's speed limit: " + "; ".join(
             f"0..{v:.3g}" for v in limit)])
     for name in measured_robots:
-        limit = programs.robot_limits(name)[0]
+        limit = first[name].limits.velocity
         rows.append([name, schema.MEASURED, "speed_hist", "rad/s (arm)", "0..the robot's speed limit (tasks.toml "
                      "[limits], as its thesis tasks): " + "; ".join(f"0..{v:.3g}" for v in limit)])
     lines += _table(["robot", "task", "histogram", "units", f"range per axis 1..N, split in {sensors.HISTOGRAM_BINS}"],

@@ -9,6 +9,7 @@ flows one way between them (docs/architecture.md)::
     opening     the one gate every read passes (a finished faultgen file, or DatasetError)
     writer      labels and provenance of a run, atomic write of a run, merge of part files
     validator   every value checked against the schema (`faultgen validate`)
+    robot_record  what a run stored of its robot (drivetrain, limits), read by the typed runs
     reader      typed reading (`faultgen.open`) and plain reads (read_run, labels, list_runs)
     summary     `faultgen info`'s text and the tidy features table (`faultgen export`)
 
@@ -29,6 +30,7 @@ from faultgen.data.schema import (
     FAULT_ARRAYS,
     FORMAT,
     FORMAT_VERSION,
+    LIMITS,
     MEASURED,
     MEASURED_ARRAYS,
     MEASURED_OPTIONAL,
@@ -48,6 +50,7 @@ from faultgen.data.writer import (
     config_key,
     drivetrain,
     estimated_size,
+    limits,
     merge,
     model_hash,
     run_attributes,
@@ -56,9 +59,9 @@ from faultgen.data.writer import (
 
 __all__ = [
     "ARRAYS", "BINS", "CONDITION_ARRAYS", "COUNT_ARRAYS", "COUNT_AXES", "DRIVETRAIN", "DUTY_ARRAYS",
-    "EXPORT_SUFFIXES", "FAULT_ARRAYS", "FEATURE_LABELS", "FORMAT", "FORMAT_VERSION", "MEASURED", "MEASURED_ARRAYS",
+    "EXPORT_SUFFIXES", "FAULT_ARRAYS", "FEATURE_LABELS", "FORMAT", "FORMAT_VERSION", "LIMITS", "MEASURED", "MEASURED_ARRAYS",
     "MEASURED_OPTIONAL", "PROGRAM_ATTRIBUTE", "ROBOT_ATTRIBUTES", "RUN_ATTRIBUTES", "SHAPES", "SIGNAL_AXES",
     "SIMULATED_TRUTH", "TEXT_ARRAYS", "DatasetError", "config_key", "drivetrain", "estimated_size",
-    "export_features", "features", "kinds", "labels", "list_runs", "merge", "model_hash", "read_run",
+    "export_features", "features", "kinds", "labels", "limits", "list_runs", "merge", "model_hash", "read_run",
     "run_attributes", "runs_with", "saturation_warnings", "summary", "validate", "write_run",
 ]

@@ -438,7 +438,7 @@ def _write_unit(runs: h5py.Group, unit: str, rows: list[dict], robot: robots.Rob
         "seed": int(hashlib.sha256(unit.encode()).hexdigest()[:7], 16), "worn_axes": np.array(worn, dtype=int),
         "wear": json.dumps({}), "noise": json.dumps({}), "faultgen_version": __version__,
         "model_sha256": writer.model_hash(robot.path), "n_axes": n_axes,
-        "drivetrain": json.dumps(writer.drivetrain(robot)),
+        "drivetrain": json.dumps(writer.drivetrain(robot)), "limits": json.dumps(writer.limits(robot)),
         "log_period": float(np.median(periods)) if periods else period,
         "config": json.dumps(config, sort_keys=True), "command": command, "signals": False, "sample": "log",
         "source": MEASURED, "unit": unit})

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from faultgen import inputs
-from faultgen.data import schema
+from faultgen.data import robot_record, schema
 from faultgen.data.opening import attr, open_file
 from faultgen.data.validator import attribute_problems
 
@@ -87,6 +87,9 @@ class Run:
     measured : bool
         True for a unit imported from measured logs (``faultgen logs import``): its records are
         logs, its wear the labels of its events (:data:`faultgen.data.schema.MEASURED_ARRAYS`).
+
+    What the run stored of its robot, which the analyses read instead of the robot's files:
+    :attr:`drivetrain`, :attr:`limits` and :attr:`model_sha256`.
     """
 
     id: str
@@ -105,6 +108,7 @@ class Run:
     provenance: dict = field(repr=False)
     program_sha256: str | None = field(default=None, repr=False)
     measured: bool = False
+    _stored: dict = field(default_factory=dict, repr=False, compare=False)
     _source: Dataset | None = field(default=None, repr=False, compare=False)
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -112,6 +116,54 @@ class Run:
     def failing(self) -> bool:
         """Whether the run wears or carries a fault (a failing robot of a fleet)."""
         return bool(self.worn_axes) or self.fault is not None
+
+    @property
+    def model_sha256(self) -> str:
+        """SHA-256 (hex) of the robot's MJCF file the run was simulated with (or its logs imported for,
+        ``faultgen logs import``): which version of the robot its :attr:`drivetrain` is."""
+        return self.provenance.get("model_sha256", "")
+
+    @property
+    def drivetrain(self) -> robot_record.Drivetrain:
+        """The drivetrain the run stored (gear ratios, motor inertias, gearbox stiffness and damping,
+        peak motor torques, nominal motor friction; per axis, SI units:
+        :class:`faultgen.data.robot_record.Drivetrain`), read on first use. A file written before runs
+        stored it (before robots of 5-7 axes) gives the robot's, loaded from its files by :attr:`robot`
+        (``from_files``).
+
+        Raises
+        ------
+        faultgen.data.schema.DatasetError
+            If the stored attribute does not read.
+        ValueError
+            For such an older file whose robot cannot be loaded on this machine.
+        """
+        if "drivetrain" not in self._stored:
+            attrs = self._stored.get("attrs", {})
+            self._stored["drivetrain"] = robot_record.drivetrain(attrs, self.robot, self._where)
+        return self._stored["drivetrain"]
+
+    @property
+    def limits(self) -> robot_record.Limits:
+        """The limits the run's histograms were binned over (joint range, the robot's and the task's
+        speed limit: :class:`faultgen.data.robot_record.Limits`), read on first use. A file written
+        before runs stored them gives the robot's, loaded from its files by :attr:`robot` (``from_files``).
+
+        Raises
+        ------
+        faultgen.data.schema.DatasetError
+            If the stored attribute does not read.
+        ValueError
+            For such an older file whose robot cannot be loaded on this machine.
+        """
+        if "limits" not in self._stored:
+            attrs = self._stored.get("attrs", {})
+            self._stored["limits"] = robot_record.limits(attrs, self.robot, self.task, self._where)
+        return self._stored["limits"]
+
+    @property
+    def _where(self) -> str:
+        return f"{self._source.path if self._source is not None else '(no file)'}: run {self.id!r}"
 
     @property
     def program(self) -> str:
@@ -269,7 +321,8 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
         # files written before the attribute: a program file's or log's runs kept its hash in `program`
         program_sha256=str(attrs[schema.PROGRAM_ATTRIBUTE]) if schema.PROGRAM_ATTRIBUTE in attrs
         else (_json(attrs.get("program")) or {}).get("sha256"),
-        measured=attrs.get("source") == schema.MEASURED, _source=source)
+        measured=attrs.get("source") == schema.MEASURED, _source=source,
+        _stored={"attrs": {key: attrs[key] for key in ("drivetrain", "limits", "source") if key in attrs}})
 
 
 class Dataset(Sequence):

@@ -12,7 +12,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      a program file's or log's program: name, file, sha256, program_text;
                                      wear JSON, noise JSON) and provenance (faultgen_version,
                                      model_sha256, log_period, config JSON, command; since robots
-                                     of 5-7 axes: n_axes, drivetrain JSON)
+                                     of 5-7 axes: n_axes, drivetrain JSON; since issue 57:
+                                     limits JSON, LIMITS)
         t, cycles, q_ref                       time base, recorded cycles, reference
         q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, N) logged signals, 250 Hz, N the
                                                robot's axes (attr n_axes; 6 in files before it)
@@ -139,6 +140,15 @@ ROBOT_ATTRIBUTES = ("n_axes", "drivetrain")
 #: The drivetrain numbers a run records (:func:`faultgen.data.writer.drivetrain`): Robot attribute -> SI unit.
 DRIVETRAIN = {"gear_ratio": "1", "motor_inertia": "kg m^2", "gearbox_stiffness": "N m/rad",
               "gearbox_damping": "N m s/rad", "motor_torque_limit": "N m"}
+
+#: The robot's limits a run records (attribute ``limits``, JSON, :func:`faultgen.data.writer.limits`):
+#: entry -> SI unit. ``joint_range`` (N, 2), the angle histogram's range; ``velocity`` (N,), the
+#: robot's speed limit (its folder's ``tasks.toml`` ``[limits]``); ``task_velocity`` (N,), the run's
+#: own task's speed limit, the speed histogram's range (the torque histogram's is the drivetrain's
+#: ``motor_torque_limit``). With ``drivetrain`` and ``model_sha256`` it is what an analysis needs of
+#: the robot, so a dataset is analysed without the robot's files (:mod:`faultgen.data.robot_record`).
+#: Files written before it lack it and stay valid: readers then load the robot by its label.
+LIMITS = {"joint_range": "rad", "velocity": "rad/s", "task_velocity": "rad/s"}
 
 
 class DatasetError(ValueError):

@@ -27,6 +27,7 @@ from faultgen.data.schema import (
     DUTY_ARRAYS,
     FAULT_ARRAYS,
     FORMAT_VERSION,
+    LIMITS,
     MEASURED,
     MEASURED_ARRAYS,
     MEASURED_OPTIONAL,
@@ -134,7 +135,7 @@ def attribute_problems(group: h5py.Group) -> list[str]:
     if "n_axes" in attrs and not _axis_count(attrs["n_axes"]):  # every reader sizes its arrays with it
         problems.append(f"n_axes attribute {attrs['n_axes']}, expected a whole number "
                         f"{axis_numbers.MIN_AXES}..{axis_numbers.MAX_AXES}")
-    for key in ("wear", "noise", "config", "conditions", "fault"):
+    for key in ("wear", "noise", "config", "conditions", "fault", "limits"):
         if key in attrs:
             try:
                 table = json.loads(attrs[key])
@@ -256,7 +257,8 @@ def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
 
     N is the ``n_axes`` attribute (5..7); a run written before it existed has the axes of its
     ``friction_multiplier`` (six, the only robots then). ``drivetrain``, when present, must be JSON
-    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers.
+    with every :data:`DRIVETRAIN` entry and friction parameter a list of N finite numbers; ``limits``,
+    when present, the limits of N axes (:func:`limits_problems`).
     """
     problems = []
     if "n_axes" in group.attrs:
@@ -287,7 +289,32 @@ def _robot_attributes(group: h5py.Group, data: dict) -> tuple[int, list[str]]:
                 break
     elif "n_axes" in group.attrs:
         problems.append("has the n_axes attribute but not drivetrain")
+    if "limits" in group.attrs:
+        problems += limits_problems(attr(group.attrs["limits"]), n_axes)
     return n_axes, problems
+
+
+def limits_problems(text, n_axes: int) -> list[str]:
+    """What is wrong with a run's ``limits`` attribute (:data:`LIMITS`, JSON) for a robot of
+    ``n_axes`` axes: ``joint_range`` must be N pairs of finite numbers, low below high, ``velocity``
+    and ``task_velocity`` N finite positive numbers (rad, rad/s); [] when it is right."""
+    try:
+        table = json.loads(text)
+        entries = {name: table[name] for name in LIMITS}
+    except (ValueError, KeyError, TypeError) as err:
+        return [f"limits attribute is not the limits JSON (missing or bad {err})"]
+
+    def numbers(values, size) -> bool:
+        return isinstance(values, list) and len(values) == size and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) and np.isfinite(x) for x in values)
+
+    pairs = entries["joint_range"]
+    if not (isinstance(pairs, list) and len(pairs) == n_axes and all(numbers(p, 2) and p[0] < p[1] for p in pairs)):
+        return [f"limits joint_range: expected {n_axes} pairs of finite numbers, low below high, got {pairs!r}"]
+    for name in ("velocity", "task_velocity"):
+        if not (numbers(entries[name], n_axes) and all(v > 0 for v in entries[name])):
+            return [f"limits {name}: expected {n_axes} finite positive numbers, got {entries[name]!r}"]
+    return []
 
 
 def _counts_fit(totals: np.ndarray, n_log: int, data: dict, conditions: dict | None, task: str) -> bool:

@@ -29,6 +29,7 @@ from faultgen.data.schema import (
     FAULT_ARRAYS,
     FORMAT,
     FORMAT_VERSION,
+    LIMITS,
     SIGNAL_AXES,
     condition_arrays,
 )
@@ -52,6 +53,31 @@ def drivetrain(robot) -> dict:
     table["friction"] = {name: [float(x) for x in getattr(robot.friction, name)] for name in FRICTION_FIELDS}
     table["units"] = {**DRIVETRAIN, **{f"friction.{name}": FRICTION_UNITS[name] for name in FRICTION_FIELDS}}
     return table
+
+
+def limits(robot, task: str | None = None) -> dict | None:
+    """The robot's limits a run's histograms were binned over (:data:`LIMITS`), as plain lists:
+    ``joint_range`` (N, 2) rad, ``velocity`` (N,) rad/s (the robot folder's ``tasks.toml``
+    ``[limits]``, :func:`faultgen.operation.programs.robot_limits`) and ``task_velocity`` (N,) rad/s,
+    the speed limit of ``task`` (a thesis task or a program file, as the simulation loads it,
+    :func:`faultgen.operation.programs.load`; a replayed log and ``None``, a measured log, run to the
+    robot's), with ``units``. None for a robot whose folder has no ``[limits]`` (an MJCF file alone,
+    running a program file with its own): the run then does not store them, as files before them.
+
+    Raises
+    ------
+    ValueError
+        For a task that does not load (:class:`faultgen.operation.programs.ProgramError`).
+    """
+    try:
+        velocity = programs.robot_limits(robot)[0]
+    except programs.ProgramError:
+        return None
+    own = task is not None and (task in programs.TASKS or str(task).lower().endswith(programs.PROGRAM_SUFFIXES))
+    task_velocity = programs.load(robot, task).velocity_limit if own else velocity
+    return {"joint_range": [[float(lo), float(hi)] for lo, hi in robot.joint_range],
+            "velocity": [float(v) for v in velocity], "task_velocity": [float(v) for v in task_velocity],
+            "units": dict(LIMITS)}
 
 
 def config_key(config) -> str:
@@ -99,6 +125,7 @@ def run_attributes(result, command: str = "") -> dict:
         "model_sha256": model_hash(robot.path),
         "n_axes": int(robot.n_axes),
         "drivetrain": json.dumps(drivetrain(robot)),
+        **({} if (stored := limits(robot, config.task)) is None else {"limits": json.dumps(stored)}),
         "log_period": sensors.LOG_PERIOD,
         "config": config_key(config),
         "command": command,
