@@ -34,35 +34,34 @@ def _linked(source: Path, target: Path, days: slice) -> None:
 
 
 def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tmp_path, monkeypatch):
-    client = tmp_path / "client"
+    """The local run on every log against two runs on the cluster, the second after the rest of the
+    logs arrived (it scores only those): every output but the cache the same bytes, the state
+    included; the cluster's workers simulated the parts' twin cycles and sent them back."""
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", SPEC)
-    _linked(logs, client / "logs", slice(None))
-    # a planted unit whose every log the reader refuses: its reason names the log's path as the client has it
-    (client / "logs" / "unit98").mkdir()
+    # a planted unit whose every log the reader refuses, naming the log's path as the client has it
+    (logs / "unit98").mkdir()
     for log in sorted((logs / "unit01").iterdir()):
         header, *rows = log.read_text().splitlines()
-        (client / "logs" / "unit98" / log.name).write_text(
-            "\n".join([header, *(row.rsplit(",", 1)[0] + ",8000" for row in rows)]) + "\n")
-    partial = client / "grown"  # the folder the cluster scores twice: 16 days, then all of them
-    _linked(client / "logs", partial, slice(0, 16))
+        rows[5] = ",".join([rows[3].split(",")[0], *rows[5].split(",")[1:]])  # time goes back
+        (logs / "unit98" / log.name).write_text("\n".join([header, *rows]) + "\n")
+    client, remote = tmp_path / "client", tmp_path / "remote"  # each a working directory with its own logs/
+    _linked(logs, client / "logs", slice(None))
+    _linked(logs, remote / "logs", slice(0, 16))  # the cluster's: 16 days, then all of them
     (tmp_path / "cluster").mkdir()
     monkeypatch.chdir(client)
     robot = str(robot)  # an added robot's folder: the workers see it at the same path (the same machine)
     local = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "local", *COMMON])
     assert local.exit_code == 3, local.output  # unit98 is not monitored
+    monkeypatch.chdir(remote)
     cluster = Cluster(tmp_path / "cluster")
     try:
         for name in ("w1", "w2"):
             cluster.start_worker(name)
-        result = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "remote", *COMMON,
-                                          "--scheduler", cluster.address])
-        assert result.exit_code == 3, result.output
-        first = CliRunner().invoke(app, ["monitor", "grown", "--robot", robot, "-o", "grown-out", *COMMON,
-                                         "--scheduler", cluster.address])
+        on_cluster = ["--robot", robot, "-o", "remote", *COMMON, "--scheduler", cluster.address]
+        first = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
         assert first.exit_code == 3, first.output
-        _linked(client / "logs", partial, slice(16, None))
-        again = CliRunner().invoke(app, ["monitor", "grown", "--robot", robot, "-o", "grown-out", *COMMON,
-                                         "--scheduler", cluster.address])
+        _linked(logs, remote / "logs", slice(16, None))
+        again = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
         assert again.exit_code == 3, again.output
         both = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "other", *COMMON,
                                         "--scheduler", cluster.address, "--jobs", "2"])
@@ -70,20 +69,17 @@ def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tm
         cluster.close()
     expected = _outputs(client / "local")
     assert {"units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "report.html", "unit01.png",
-            ".state/unit01.json"} <= set(expected)
-    assert _outputs(client / "remote") == expected
-    units = (client / "remote" / "units.csv").read_text()
-    assert f"{Path('logs') / 'unit98' / sorted((logs / 'unit01').iterdir())[0].name}" in units, units
-    # the grown folder's second run scored only the new logs: the outputs of the one run on all of
-    # them (the report page names LOGS by its folder's name, "grown" there)
-    grown = _outputs(client / "grown-out")
-    assert {k: v for k, v in grown.items() if k != "report.html"} == \
-        {k: v for k, v in expected.items() if k != "report.html"}
-    assert sorted(p.name for p in (client / "remote" / ".cache" / "cycles").iterdir()) == \
+            ".state/unit01.json", ".state/unit98.json"} <= set(expected)
+    assert _outputs(remote / "remote") == expected
+    units = (client / "local" / "units.csv").read_text()
+    assert f"{Path('logs') / 'unit98' / sorted((logs / 'unit01').iterdir())[0].name}: column t goes back" in units
+    # the same cycles cached: those of the parts were simulated by the workers and sent back (this process
+    # simulates only the shared twin without a part before the map)
+    assert sorted(p.name for p in (remote / "remote" / ".cache" / "cycles").iterdir()) == \
         sorted(p.name for p in (client / "local" / ".cache" / "cycles").iterdir())
     # --jobs with --scheduler is refused before any work
     assert both.exit_code == 2 and "--jobs 2 with --scheduler" in both.output, both.output
-    assert not (client / "other").exists()
+    assert not (remote / "other").exists()
 
 
 @pytest.mark.parametrize("address", ["foo", "tcp://127.0.0.1:99999"])
