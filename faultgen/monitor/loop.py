@@ -41,7 +41,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import page, prognosis, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, unit_outputs
-from faultgen.monitor.parallel import Workers, groups_of, map_groups
+from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
 
@@ -174,8 +174,6 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
-    n_groups = sum(1 for logs in pending.values() if logs)
-    workers = Workers(min(jobs, n_groups)) if scheduler is None and n_groups > 1 else None
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     cache.mkdir(parents=True, exist_ok=True)
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
@@ -187,7 +185,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
-    for done in map_groups(context, groups, jobs, scheduler, robot, workers):
+    for done in map_groups(context, groups, jobs, scheduler, robot):
         for name, unit, outputs in done:
             state[name], made[name] = unit, outputs
             bar.update(len(pending[name]))

@@ -1,11 +1,20 @@
-"""The units of ``faultgen monitor`` scored in parallel (:func:`mapgroups_of`): one after another in
-this process, in local processes (joblib's loky), or on a Dask cluster that shares no file system
-with this process (:mod:`faultgen.monitor.remote`); every group's arithmetic is the same wherever
-it runs, so the outputs are those of one job, bit for bit.
+"""The units of ``faultgen monitor`` scored in parallel (:func:`map_groups`): one after another in
+this process, in local processes (on Linux forked from this one, which has made the imports and the
+shared twins; elsewhere joblib's loky), or on a Dask cluster that shares no file system with this
+process (:mod:`faultgen.monitor.remote`); every group's arithmetic is the same wherever it runs, so
+the outputs are those of one job, bit for bit.
+
+Why forked processes and not joblib's loky on Linux: a loky worker is a fresh interpreter that
+imports the scoring code again (faultgen, MuJoCo, SciPy, matplotlib, ProgPy), 2-3 s per worker on
+an idle core and about 13 s at a load average of 8, which was most of ``--jobs 2``'s loss on a
+small fleet (docs/performance.md); joblib's fork-based backend (``multiprocessing``) yields no
+results before the last, so the standard library's ``ProcessPoolExecutor`` with the fork context
+is used, its tasks a group's index into what the workers inherit.
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from faultgen.model import robots
@@ -45,49 +54,38 @@ def prepare_twins(context: Context, groups: list) -> None:
             continue
 
 
-class Workers:
-    """``jobs`` local worker processes (joblib's loky) started at once in a background thread, each
-    importing the scoring code, while this process goes on with its serial part (reading the fleet
-    folder, each new unit's first log, the shared twins): on 2 cores the workers' start (about as
-    long as this process's own imports) then no longer adds to the run's wall time.
-    :func:`map_groups` waits for them and joblib reuses them (the same ``n_jobs``: loky's reusable
-    executor). With ``jobs`` <= 1 nothing is started."""
-
-    def __init__(self, jobs: int):
-        self.jobs = jobs
-        self._thread = None
-        if jobs > 1:
-            import threading
-
-            self._thread = threading.Thread(target=self._start, daemon=True)
-            self._thread.start()
-
-    def _start(self) -> None:
-        from joblib import Parallel, delayed
-
-        from faultgen import children
-
-        with children.safe_path():
-            Parallel(n_jobs=self.jobs)(delayed(_import_scoring)() for _ in range(self.jobs))
-
-    def wait(self) -> None:
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
+#: What the forked workers read instead of receiving it with every task: the run's context and its
+#: groups, set in this process before the workers are forked (:func:`map_groups`).
+_SHARED: dict = {}
 
 
-def _import_scoring() -> None:
-    import faultgen.monitor.feed  # noqa: F401  (what a group's scoring imports: faultgen, MuJoCo, SciPy, ...)
+def _score_shared(index: int) -> list:
+    return score_group(_SHARED["context"], _SHARED["groups"][index])
+
+
+def preload() -> None:
+    """Import, in this process, what scoring a group imports on first use (matplotlib for the
+    charts, ProgPy for the remaining life, as :mod:`faultgen.monitor.report` and
+    :mod:`faultgen.monitor.prognosis` import them), so that forked workers start with it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot
+
+    from faultgen.monitor import prognosis
+
+    prognosis._import_progpy()
 
 
 def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
-               robot: str | Path | None = None, workers: Workers | None = None):
+               robot: str | Path | None = None):
     """Each group scored (:func:`score_group`), yielded in order: in this process; in ``jobs``
-    local processes (joblib's loky, started without the user's folders on their path:
-    :func:`faultgen.children.safe_path`) when ``jobs`` > 1; or on the Dask cluster of
+    local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared twins are
+    simulated: :func:`prepare_twins`, and the scoring's imports made: :func:`preload`; elsewhere
+    joblib's loky, started without the user's folders on their path:
+    :func:`faultgen.children.safe_path`); or on the Dask cluster of
     ``scheduler`` (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every
-    group's arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit.
-    ``workers``: the local processes started ahead (:class:`Workers`, of ``min(jobs, len(groups))``)."""
+    group's arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit."""
     if scheduler is not None:
         prepare_twins(context, groups)
         from faultgen.monitor import remote
@@ -98,12 +96,26 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
         yield from (score_group(context, group) for group in groups)
         return
     prepare_twins(context, groups)
-    if workers is not None:
-        workers.wait()
+    n_jobs = min(jobs, len(groups))
+    if sys.platform.startswith("linux"):
+        # Forked workers start with this process's imports and state (faultgen, MuJoCo, SciPy,
+        # matplotlib, ProgPy: 2-3 s of a fresh interpreter's start on an idle core, 13 s at a load
+        # average of 8), and read the context and groups from it: a task is a group's index.
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        preload()
+        _SHARED.update(context=context, groups=groups)
+        try:
+            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+                yield from pool.map(_score_shared, range(len(groups)))
+        finally:
+            _SHARED.clear()
+        return
     from joblib import Parallel, delayed
 
     from faultgen import children
 
-    with children.safe_path():
-        yield from Parallel(n_jobs=min(jobs, len(groups)), return_as="generator")(
+    with children.safe_path():  # elsewhere (no fork): loky's fresh workers, without the user's folders on their path
+        yield from Parallel(n_jobs=n_jobs, return_as="generator")(
             delayed(score_group)(context, group) for group in groups)
