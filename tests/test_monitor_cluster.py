@@ -36,7 +36,8 @@ def _linked(source: Path, target: Path, days: slice) -> None:
 def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tmp_path, monkeypatch):
     """The local run on every log against two runs on the cluster, the second after the rest of the
     logs arrived (it scores only those): every output but the cache the same bytes, the state
-    included; the cluster's workers simulated the parts' twin cycles and sent them back."""
+    included; the cluster's workers simulated the parts' twin cycles and sent them back. A third
+    run with no new log makes every chart again on the workers, the same bytes."""
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", SPEC)
     # a planted unit whose every log the reader refuses, naming the log's path as the client has it
     (logs / "unit98").mkdir()
@@ -63,6 +64,11 @@ def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tm
         _linked(logs, remote / "logs", slice(16, None))
         again = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
         assert again.exit_code == 3, again.output
+        grown = _outputs(remote / "remote")
+        for chart in (remote / "remote").glob("*.png"):
+            chart.unlink()
+        idle = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])  # no new log: the charts made again there
+        assert idle.exit_code == 3, idle.output
         both = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "other", *COMMON,
                                         "--scheduler", cluster.address, "--jobs", "2"])
     finally:
@@ -70,9 +76,10 @@ def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tm
     expected = _outputs(client / "local")
     assert {"units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "report.html", "unit01.png",
             ".state/unit01.json", ".state/unit98.json"} <= set(expected)
+    assert grown == expected
     assert _outputs(remote / "remote") == expected
     units = (client / "local" / "units.csv").read_text()
-    assert f"{Path('logs') / 'unit98' / sorted((logs / 'unit01').iterdir())[0].name}: column t goes back" in units
+    assert f"{Path('logs') / 'unit98' / min((logs / 'unit01').iterdir()).name}: column t goes back" in units
     # the same cycles cached: those of the parts were simulated by the workers and sent back (this process
     # simulates only the shared twin without a part before the map)
     assert sorted(p.name for p in (remote / "remote" / ".cache" / "cycles").iterdir()) == \

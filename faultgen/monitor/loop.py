@@ -40,7 +40,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, unit_outputs
+from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
@@ -185,15 +185,15 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
-    for done in map_groups(context, groups, jobs, scheduler, robot):
+    idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
+    for done in map_groups(context, groups, jobs, scheduler, robot, idle):
         for name, unit, outputs in done:
-            state[name], made[name] = unit, outputs
-            bar.update(len(pending[name]))
+            made[name] = outputs
+            if unit is not None:
+                state[name] = unit
+                bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
-    for m in monitors:
-        if m.unit not in made:  # a unit with no new log
-            made[m.unit] = unit_outputs(m, failure_wear)
     statuses = [_status(name, state.get(name), settings) for name in units]
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)

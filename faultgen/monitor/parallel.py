@@ -20,7 +20,7 @@ from pathlib import Path
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import Context, score_group
+from faultgen.monitor.feed import Context, score_group, unit_outputs
 from faultgen.monitor.twin import Twin
 from faultgen.monitor.unit import Unit, log_of
 
@@ -60,7 +60,16 @@ _SHARED: dict = {}
 
 
 def _score_shared(index: int) -> list:
-    return score_group(_SHARED["context"], _SHARED["groups"][index])
+    groups = _SHARED["groups"]
+    if index < len(groups):
+        return score_group(_SHARED["context"], groups[index])
+    return idle_outputs(_SHARED["idle"][index - len(groups)], _SHARED["context"].failure_wear)
+
+
+def idle_outputs(monitor, failure_wear: float) -> list:
+    """The chart and rows of rul.csv of a unit with no new log (:func:`unit_outputs`), as
+    :func:`score_group` returns a unit's: ``[(unit, None, outputs)]`` (None: its state unchanged)."""
+    return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
 
 
 def preload() -> None:
@@ -78,37 +87,42 @@ def preload() -> None:
 
 
 def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
-               robot: str | Path | None = None):
-    """Each group scored (:func:`score_group`), yielded in order: in this process; in ``jobs``
-    local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared twins are
-    simulated: :func:`prepare_twins`, and the scoring's imports made: :func:`preload`; elsewhere
-    joblib's loky, started without the user's folders on their path:
-    :func:`faultgen.children.safe_path`); or on the Dask cluster of
-    ``scheduler`` (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every
-    group's arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit."""
+               robot: str | Path | None = None, idle: list | tuple = ()):
+    """Each group scored (:func:`score_group`), then each ``idle`` monitor's (a unit with no new log)
+    chart and remaining life made (:func:`idle_outputs`), yielded in that order: in this process;
+    in ``jobs`` local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared
+    twins are simulated: :func:`prepare_twins`, and the scoring's imports made: :func:`preload`;
+    elsewhere joblib's loky, started without the user's folders on their path:
+    :func:`faultgen.children.safe_path`); or on the Dask cluster of ``scheduler``
+    (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every group's
+    arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit."""
+    idle = list(idle)
     if scheduler is not None:
-        prepare_twins(context, groups)
+        if groups:
+            prepare_twins(context, groups)
         from faultgen.monitor import remote
 
-        yield from remote.execute(context, groups, scheduler, context.robot if robot is None else robot)
+        yield from remote.execute(context, groups, scheduler, context.robot if robot is None else robot, idle)
         return
-    if jobs <= 1 or len(groups) <= 1:
+    if jobs <= 1 or len(groups) + len(idle) <= 1:
         yield from (score_group(context, group) for group in groups)
+        yield from (idle_outputs(m, context.failure_wear) for m in idle)
         return
-    prepare_twins(context, groups)
-    n_jobs = min(jobs, len(groups))
+    if groups:
+        prepare_twins(context, groups)
+    n_jobs = min(jobs, len(groups) + len(idle))
     if sys.platform.startswith("linux"):
         # Forked workers start with this process's imports and state (faultgen, MuJoCo, SciPy,
         # matplotlib, ProgPy: 2-3 s of a fresh interpreter's start on an idle core, 13 s at a load
-        # average of 8), and read the context and groups from it: a task is a group's index.
+        # average of 8), and read the context and groups from it: a task is an index.
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         preload()
-        _SHARED.update(context=context, groups=groups)
+        _SHARED.update(context=context, groups=groups, idle=idle)
         try:
             with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
-                yield from pool.map(_score_shared, range(len(groups)))
+                yield from pool.map(_score_shared, range(len(groups) + len(idle)))
         finally:
             _SHARED.clear()
         return
@@ -116,6 +130,7 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
 
     from faultgen import children
 
+    tasks = [delayed(score_group)(context, group) for group in groups]
+    tasks += [delayed(idle_outputs)(m, context.failure_wear) for m in idle]
     with children.safe_path():  # elsewhere (no fork): loky's fresh workers, without the user's folders on their path
-        yield from Parallel(n_jobs=n_jobs, return_as="generator")(
-            delayed(score_group)(context, group) for group in groups)
+        yield from Parallel(n_jobs=n_jobs, return_as="generator")(tasks)

@@ -23,6 +23,7 @@ a later task: two units of one model and program may simulate the same part's cy
 
 from __future__ import annotations
 
+import itertools
 import json
 import shutil
 import tempfile
@@ -35,6 +36,7 @@ from faultgen.data import atomic
 from faultgen.model import robots
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, score_group
+from faultgen.monitor.parallel import idle_outputs
 from faultgen.monitor.unit import CALIBRATION_STEPS, Unit
 
 #: The cache entries a task may read or make (OUT/.cache/<entry>).
@@ -197,9 +199,11 @@ class Cache:
                 self._add(name, made[name])
 
 
-def execute(context: Context, groups: list, scheduler: str, robot: str | Path) -> Iterator[list]:
-    """Score ``groups`` on the Dask cluster of ``scheduler`` (module docstring); yield each
-    group's result as :func:`score_group` returns it, in order, once its cache files are written.
+def execute(context: Context, groups: list, scheduler: str, robot: str | Path, idle: list = ()) -> Iterator[list]:
+    """Score ``groups`` on the Dask cluster of ``scheduler`` (module docstring), then make the
+    charts and remaining life of the ``idle`` monitors (units with no new log,
+    :func:`faultgen.monitor.parallel.idle_outputs`, which reads no file); yield each result as
+    :func:`score_group` returns it, in order, a group's once its cache files are written.
     ``robot`` is the robot as the user named it (:func:`robot_for_workers`). At most
     :data:`IN_FLIGHT` tasks per worker thread are sent ahead, so this process holds the bytes of
     only so many groups' logs at a time.
@@ -234,11 +238,14 @@ def execute(context: Context, groups: list, scheduler: str, robot: str | Path) -
         threads = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
         window = max(IN_FLIGHT * threads, 2)
         futures: deque = deque()
-        todo = iter(groups)
+        tasks = itertools.chain(
+            ((score_remote, (_context_of(context, group), sent_robot, group), group) for group in groups),
+            ((idle_outputs, (monitor, context.failure_wear), None) for monitor in idle))
         while True:
-            for group in todo:
-                futures.append(client.submit(score_remote, _context_of(context, group), sent_robot, group,
-                                             _shipment(context, cache, group, ours), pure=False))
+            for function, args, group in tasks:
+                if group is not None:  # its logs and cache read only now: so many groups' bytes at a time
+                    args = (*args, _shipment(context, cache, group, ours))
+                futures.append(client.submit(function, *args, pure=False))
                 if len(futures) >= window:
                     break
             if not futures:
@@ -251,6 +258,9 @@ def execute(context: Context, groups: list, scheduler: str, robot: str | Path) -
                                  "is written: run the same command again") from None
             finally:
                 future.release()
+            if not isinstance(returned, Returned):  # an idle unit's outputs
+                yield returned
+                continue
             if returned.robot_sha256 != ours:
                 raise SweepError(f"worker {returned.worker} loaded another {context.robot.name} (MJCF SHA-256 "
                                  f"{returned.robot_sha256[:12]}, here {ours[:12]}): install the same faultgen and "
