@@ -53,6 +53,12 @@ def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list
     return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)
 
 
+def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:
+    """The chart and rows of rul.csv of a unit with no new log (:func:`unit_outputs`), as
+    :func:`score_group` returns a unit's: ``[(unit, None, outputs)]`` (None: its state unchanged)."""
+    return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
+
+
 def score_group(context: Context, group: list[tuple[str, Unit, list]]) -> list[tuple[str, Unit, tuple]]:
     """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
     events given before the first log at or after them; returns the units with their chart and

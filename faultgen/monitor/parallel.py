@@ -20,7 +20,7 @@ from pathlib import Path
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import Context, score_group, unit_outputs
+from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.twin import Twin
 from faultgen.monitor.unit import Unit, log_of
 
@@ -64,12 +64,6 @@ def _score_shared(index: int) -> list:
     if index < len(groups):
         return score_group(_SHARED["context"], groups[index])
     return idle_outputs(_SHARED["idle"][index - len(groups)], _SHARED["context"].failure_wear)
-
-
-def idle_outputs(monitor, failure_wear: float) -> list:
-    """The chart and rows of rul.csv of a unit with no new log (:func:`unit_outputs`), as
-    :func:`score_group` returns a unit's: ``[(unit, None, outputs)]`` (None: its state unchanged)."""
-    return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
 
 
 def preload() -> None:

@@ -35,8 +35,7 @@ from pathlib import Path
 from faultgen.data import atomic
 from faultgen.model import robots
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import Context, score_group
-from faultgen.monitor.parallel import idle_outputs
+from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.unit import CALIBRATION_STEPS, Unit
 
 #: The cache entries a task may read or make (OUT/.cache/<entry>).
@@ -202,7 +201,7 @@ class Cache:
 def execute(context: Context, groups: list, scheduler: str, robot: str | Path, idle: list = ()) -> Iterator[list]:
     """Score ``groups`` on the Dask cluster of ``scheduler`` (module docstring), then make the
     charts and remaining life of the ``idle`` monitors (units with no new log,
-    :func:`faultgen.monitor.parallel.idle_outputs`, which reads no file); yield each result as
+    :func:`faultgen.monitor.feed.idle_outputs`, which reads no file); yield each result as
     :func:`score_group` returns it, in order, a group's once its cache files are written.
     ``robot`` is the robot as the user named it (:func:`robot_for_workers`). At most
     :data:`IN_FLIGHT` tasks per worker thread are sent ahead, so this process holds the bytes of
