@@ -24,7 +24,8 @@ efficiency 2 idle cores would give from the CPU times (``--jobs 1``'s CPU time a
 process's own plus half its workers'), whether the outputs of every run are identical
 to the first ``--jobs 1`` run's (every file of OUT but its cache: the CSVs, charts, report.html, the
 state; byte for byte), and the per-unit-log cost with which a fleet of
-1000 units x 365 logs is planned (from the CPU time of ``--jobs 1`` less a rerun's with nothing new).
+1000 units x 365 logs is planned (the workers' CPU per unit-log, and a rerun's with nothing new per
+unit: each unit's chart and remaining life are made again on every run).
 """
 
 from __future__ import annotations
@@ -164,14 +165,20 @@ def main() -> None:
           f"= {estimate:.2f} (an estimate, not a measured wall time)")
     print(f"outputs of --jobs 2 identical to --jobs 1 (every file of OUT but its cache): "
           f"{'yes' if identical else 'NO'}")
-    fixed = run(logs, robot, work / "out-1", 1)  # nothing new to score: start, state, report
-    per_log = (ideal1 - fixed.cpu) / (args.units * args.days)
-    plan = 1000 * 365 * per_log
-    print(f"fixed part (a rerun of --jobs 1 with no new log: start, imports, the state read again, the report): "
-          f"{fixed.wall:.1f} s wall, {fixed.cpu:.1f} s CPU; per unit-log (--jobs 1, twin cached, CPU) "
-          f"{per_log * 1e3:.0f} ms ((CPU(1) - fixed) / {args.units * args.days}); a fleet of 1000 units x 365 logs: "
-          f"{plan / 3600:.1f} h of scoring on one core, {plan / 3600 / 8:.2f} h on 8 (plus each distinct model and "
-          "program's twin, and a calibration per unit with the default twin)")
+    best = min(runs[2], key=lambda r: r.cpu - r.main_cpu)
+    workers_cpu = best.cpu - best.main_cpu
+    rerun = run(logs, robot, work / "out-1", 1)  # nothing new: each state replayed, chart and remaining life again
+    per_unit = max(rerun.cpu - best.main_cpu, 0.0) / args.units
+    per_log = max(workers_cpu - args.units * per_unit, 0.0) / (args.units * args.days)
+    plan = 1000 * (365 * per_log + per_unit)
+    daily = 1000 * (per_unit + per_log)
+    print(f"a rerun with no new log (--jobs 1): {rerun.wall:.1f} s wall, {rerun.cpu:.1f} s CPU, so {per_unit:.2f} s "
+          f"per unit and run beyond the main process's {best.main_cpu:.1f} s (its state replayed, its chart and "
+          f"remaining life made again); per unit-log beyond that: {per_log * 1e3:.1f} ms (the workers' "
+          f"{workers_cpu:.1f} s of CPU in --jobs 2, twin cached). A fleet of 1000 units x 365 logs scored at once: "
+          f"{plan / 3600:.2f} h of CPU ({plan / 60 / 8:.0f} min on 8 worker cores); a daily run of 1000 new logs: "
+          f"{daily / 60:.0f} min of CPU ({daily / 60 / 8:.1f} min on 8); plus the main process's part, each distinct "
+          "model and program's twin, and with the default twin a calibration per new unit")
 
 if __name__ == "__main__":
     main()
