@@ -21,7 +21,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
-from faultgen.monitor.twin import Twin
+from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.monitor.unit import Unit, log_of
 
 
@@ -31,11 +31,12 @@ def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Uni
     return [[(name, unit, logs)] for name, (unit, logs) in pending.items()]
 
 
-def prepare_twins(context: Context, groups: list) -> None:
-    """Simulate, once and in this process, the cycles of every twin that several units share (the
-    nominal or a given model on one program), so that parallel workers read them from the cache
-    instead of simulating them side by side. A twin that cannot be built is left to each unit's
-    own fallback (:func:`twin_of`)."""
+def prepare_twins(context: Context, groups: list, pool=None) -> None:
+    """Simulate, once, the cycles of every twin that several units share (the nominal or a given
+    model on one program), so that parallel workers read them from the cache instead of simulating
+    them side by side: each of its :func:`faultgen.monitor.twin.base_cycles` as a task of ``pool``
+    (a ``concurrent.futures`` executor) when given, then the twin made here from the cache. A twin
+    that cannot be built is left to each unit's own fallback (:func:`twin_of`)."""
     nominal = robots.load(context.robot)
     read_with, _ = fleet_logs.reader_of(context.log_format)
     seen = set()
@@ -45,13 +46,31 @@ def prepare_twins(context: Context, groups: list) -> None:
             continue
         seen.add(key)
         model = str(context.calibrated) if unit.model == "given" else str(nominal.path)
+        program = log_of(context.units, *unit.program).path
+        cache = context.out / ".cache" / "cycles"
         try:
-            Twin(model, log_of(context.units, *unit.program).path, context.out / ".cache" / "cycles", root=context.out,
-                 reader=read_with)
+            twin = Twin(model, program, cache, root=context.out, reader=read_with, cycles=False)
+            missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
+            if pool is not None and len(missing) > 1:
+                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.log_format, *c)
+                                                 for c in missing], strict=True)))
+            twin.complete()
         except stored.StateError:
             raise
         except ValueError:
             continue
+
+
+def _twin_cycle(model: str, program: Path, cache: Path, root: Path, log_format, temperature: float, payload: float,
+                worn_axis: int) -> None:
+    """Worker task: one cycle of a shared twin into the cache (:meth:`faultgen.monitor.twin.Twin.cycle`).
+    A cycle that cannot be simulated (or a cache file refused) is left to the twin made after all
+    of them, which says why."""
+    read_with, _ = fleet_logs.reader_of(log_format)
+    try:
+        Twin(model, program, cache, root=root, reader=read_with, cycles=False).cycle(temperature, payload, worn_axis)
+    except ValueError:
+        return
 
 
 #: What the forked workers read instead of receiving it with every task: the run's context and its
@@ -102,24 +121,27 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
         yield from (score_group(context, group) for group in groups)
         yield from (idle_outputs(m, context.failure_wear) for m in idle)
         return
-    if groups:
-        prepare_twins(context, groups)
     n_jobs = min(jobs, len(groups) + len(idle))
     if sys.platform.startswith("linux"):
         # Forked workers start with this process's imports and state (faultgen, MuJoCo, SciPy,
         # matplotlib, ProgPy: 2-3 s of a fresh interpreter's start on an idle core, 13 s at a load
-        # average of 8), and read the context and groups from it: a task is an index.
+        # average of 8), and read the context and groups from it: a task is an index. They
+        # simulate the shared twins' cycles first (in ``jobs`` processes, not one after another).
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
         preload()
         _SHARED.update(context=context, groups=groups, idle=idle)
         try:
-            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+            with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+                if groups:
+                    prepare_twins(context, groups, pool)
                 yield from pool.map(_score_shared, range(len(groups) + len(idle)))
         finally:
             _SHARED.clear()
         return
+    if groups:
+        prepare_twins(context, groups)
     from joblib import Parallel, delayed
 
     from faultgen import children
