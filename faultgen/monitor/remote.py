@@ -110,8 +110,12 @@ def score_remote(context: Context, robot: str, group: list, shipment: Shipment) 
         shipped_cache = set(shipment.cache)
         try:
             scored = score_group(here, local)
-        except ValueError as err:
-            raise type(err)(_put_back(str(err), paths)) from None
+        except ValueError as err:  # a refusal of the run (a state or cache file), in the client's paths
+            try:
+                again = type(err)(_put_back(str(err), paths))
+            except TypeError:  # an error that is not made from its message alone: as it was
+                raise err from None
+            raise again from None
         made = {}
         for path in sorted((out / ".cache").rglob("*")):
             name = path.relative_to(out / ".cache").as_posix()
