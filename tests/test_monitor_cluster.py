@@ -17,7 +17,8 @@ from faultgen.cli import app
 
 # three units, 24 days, one of them worn from day 10-11; parts on some days (cycles the workers simulate)
 SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=24, seed=5, onset=(10, 11))
-COMMON = ["--no-calibrate", "--train", "10", "--persistence", "3", "--no-progress"]
+# the default twin: each unit's model calibrated on its first log (on the workers, sent back with the cache)
+COMMON = ["--train", "10", "--persistence", "3", "--no-progress"]
 
 
 def _outputs(out: Path) -> dict[str, bytes]:
@@ -80,10 +81,12 @@ def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tm
     assert _outputs(remote / "remote") == expected
     units = (client / "local" / "units.csv").read_text()
     assert f"{Path('logs') / 'unit98' / min((logs / 'unit01').iterdir()).name}: column t goes back" in units
-    # the same cycles cached: those of the parts were simulated by the workers and sent back (this process
-    # simulates only the shared twin without a part before the map)
-    assert sorted(p.name for p in (remote / "remote" / ".cache" / "cycles").iterdir()) == \
-        sorted(p.name for p in (client / "local" / ".cache" / "cycles").iterdir())
+    # the same cycles and calibrations cached: the workers calibrated each unit and simulated its twin,
+    # and sent them back
+    for entry in ("cycles", "calibrated"):
+        assert sorted(p.name for p in (remote / "remote" / ".cache" / entry).iterdir()) == \
+            sorted(p.name for p in (client / "local" / ".cache" / entry).iterdir()), entry
+    assert "calibrated" in (remote / "remote" / "units.csv").read_text()
     # --jobs with --scheduler is refused before any work
     assert both.exit_code == 2 and "--jobs 2 with --scheduler" in both.output, both.output
     assert not (remote / "other").exists()
