@@ -609,6 +609,26 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     assert charts
     for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
+    # a rerun with no new log: every unit's chart and remaining life made again in the workers, the same bytes
+    for name in charts:
+        (out / name).unlink()
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
+        assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
+
+
+def test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_the_outputs_of_one(fleet, monitored,
+                                                                                                    tmp_path):
+    """With no cached cycle, `--jobs 2` simulates the shared twin's cycles in its two worker processes
+    (faultgen.monitor.parallel.prepare_twins), not one after another: the same cycle files, byte for
+    byte, and the same outputs as the one-job run."""
+    robot, logs, _ = fleet
+    out = tmp_path / "out"
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    cycles = {p.name: p.read_bytes() for p in (out / ".cache" / "cycles").iterdir()}
+    assert cycles == {p.name: p.read_bytes() for p in (monitored / ".cache" / "cycles").iterdir()}
+    for name in ("alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "unit01.png"):
+        assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
 
 def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(fleet, monitored, tmp_path):

@@ -9,7 +9,7 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.cli.options import Jobs, LogFormat, Progress, TorqueConstants, log_adapter
+from faultgen.cli.options import Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).
@@ -62,6 +62,7 @@ def monitor_command(
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
+    scheduler: MonitorScheduler = None,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -104,6 +105,11 @@ def monitor_command(
     motion left the twin's program (a program change nobody logged) rebuilds the twin on it and the
     unit learns again, said in units.csv.
 
+    Units in parallel: --jobs N local processes, or --scheduler tcp://HOST:PORT, a Dask cluster whose
+    workers share no folder with this machine (the units' logs and cached twins are sent, their
+    results come back and are written here); either way the outputs are those of --jobs 1, bit for
+    bit.
+
     Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
     closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
@@ -135,7 +141,7 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs, failure_wear=failure_wear)
+                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise

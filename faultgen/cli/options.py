@@ -53,6 +53,15 @@ Scheduler = Annotated[str | None, typer.Option(
     "to this process, which writes it (docs/dataset.md, \"Running on a cluster\"). Dask sends tasks and results "
     "as pickles, which run code when read: name only a scheduler you trust, on a network you trust, or use TLS "
     "(docs/reliability.md, \"Threat model\"). An address where no Dask scheduler answers is refused in seconds.")]
+MonitorScheduler = Annotated[str | None, typer.Option(
+    "--scheduler", callback=_scheduler_address,
+    help="Score the units on the Dask cluster of this scheduler (tcp://HOST:PORT, or tls://HOST:PORT with Dask's TLS "
+    "configuration) instead of local processes: its workers need faultgen and the robot (a known robot's name, or "
+    "an added robot's folder at the same path), not LOGS or OUT; each unit's logs and cached twin go to a worker "
+    "and its results come back to this process, which writes OUT, the same bytes as --jobs 1 (docs/performance.md, "
+    "\"Monitoring a fleet on a cluster\"). Not with --jobs. Dask sends tasks and results as pickles, which run code "
+    "when read: name only a scheduler you trust, on a network you trust, or use TLS. An address where no Dask "
+    "scheduler answers is refused in seconds.")]
 SharedFolder = Annotated[bool, typer.Option(
     "--shared-folder", help="With --scheduler: the workers write their runs into OUT's folder themselves, which "
     "they must all see at the same absolute path (a shared file system; checked first): the client then only merges "

@@ -7,14 +7,16 @@ the measured format or an adapter's):
     refused when implausible), or a calibrated model given for every unit, or the nominal model;
 (b) the twin (:class:`faultgen.monitor.twin.Twin`): the model replaying the unit's own first log,
     at each payload the logs declare, healthy and with each axis in turn worn; a unit whose twin
-    cannot be built falls back to the nominal model, then to protocol own (:func:`_twin`);
+    cannot be built falls back to the nominal model, then to protocol own
+    (:func:`faultgen.monitor.unit.twin_of`);
 (c)-(d) the unit's monitor (:class:`faultgen.monitor.scoring.UnitMonitor`): learned on the first
     logs, then every later log scored in stamp order; a log that cannot be read or replayed is
     skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
     offset is learned again, and a log whose motion left the twin's program starts a new program
-    (:func:`_new_program`).
+    (:func:`faultgen.monitor.feed.new_program`).
 
-Units are scored one after another, or in ``jobs`` processes (:func:`_map`), with the same outputs.
+Units are scored one after another, in ``jobs`` local processes or on a Dask cluster
+(:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
 Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``units.csv`` (each
 unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`),
 ``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` and the monitors' state in
@@ -27,33 +29,25 @@ simulated cycles.
 
 from __future__ import annotations
 
-import io
-import shutil
-import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
-import mujoco
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.calibrate import plausibility
 from faultgen.data import atomic, logfolder
-from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import page, prognosis, report
 from faultgen.monitor import state as stored
+from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
+from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
-from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
+from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
 
-#: Two units run the same program when their first logs have the same samples and angles within this, rad.
-SAME_PROGRAM = 1e-3
-#: A log whose angles lie more than this off its twin's program, rad, or whose length differs by more
-#: than PROGRAM_LENGTH of it, runs another program (noise and tracking: about 1e-3 rad).
-PROGRAM_CHANGE, PROGRAM_LENGTH = 0.05, 0.05
-#: Effects searched when a unit's model is calibrated on its first log (faultgen.calibrate).
-CALIBRATION_STEPS = 3
+__all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "PROGRAM_LENGTH",
+           "SAME_PROGRAM", "STATUSES", "Outcome", "UnitStatus", "monitor"]
+
 
 
 #: Exit status of ``faultgen monitor`` when some unit is degraded or not monitored (every output is
@@ -66,21 +60,6 @@ MAINTENANCE = ("repair", "gearbox_change")
 #: twin uses the nominal model because its calibration failed or was implausible is ``monitored``,
 #: the model column and the reason say so.
 STATUSES = ("monitored", "learning", "degraded", "not monitored")
-
-
-@dataclass
-class _Unit:
-    monitor: UnitMonitor
-    model: str  # "given", "calibrated", "nominal" or "none" (protocol own)
-    program: tuple[str, str] | None  # (unit, stamp) of the log the twin replays
-    first: tuple[str, str]  # (stamp, SHA-256) of the unit's first log, which its calibration is made from
-    entries: list[stored.Entry] = field(default_factory=list)
-    skipped: list[stored.Skipped] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    maintenance: list[stored.Maintenance] = field(default_factory=list)
-    program_changes: list[stored.ProgramChange] = field(default_factory=list)
-    program_q: np.ndarray | None = None  # the program log's angles (read when needed; not kept in the state)
-    initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
 
 
 @dataclass(frozen=True)
@@ -115,7 +94,7 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None, jobs: int = 1,
+            progress: bool = True, log_format=None, jobs: int = 1, scheduler: str | None = None,
             failure_wear: float = prognosis.FAILURE_WEAR) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
@@ -147,6 +126,10 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     jobs : int
         Local processes scoring units in parallel (groups of units sharing a twin); the outputs are
         those of one job, bit for bit.
+    scheduler : str, optional
+        ``tcp://HOST:PORT`` (or ``tls://``) of a Dask scheduler whose workers score the units
+        instead (:mod:`faultgen.monitor.remote`): they need faultgen and the robot, not LOGS or
+        OUT; the outputs are those of one local job, bit for bit. Not with ``jobs`` > 1.
     failure_wear : float
         The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
         axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
@@ -163,8 +146,19 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, a log older than the
         last one scored, a scored log that changed since, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named).
+        file named), or ``jobs`` > 1 with a ``scheduler``.
+    faultgen.runs.errors.SweepRefused
+        ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
+    faultgen.runs.errors.SweepError
+        The scheduler was lost, or a worker has another robot model (nothing is written).
     """
+    if scheduler is not None and jobs > 1:
+        raise ValueError(f"--jobs {jobs} with --scheduler {scheduler}: the cluster's workers score the units in "
+                         "parallel; drop --jobs (or --scheduler to score them in local processes)")
+    if scheduler is not None:  # a Dask scheduler must answer there, before any work
+        from faultgen.runs import cluster
+
+        cluster.probe(scheduler)
     atomic.check_apart(out, logs_dir)
     prognosis.check_failure_wear(failure_wear)
     nominal = robots.load(robot)
@@ -172,7 +166,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     units = fleet_logs.fleet(logs_dir, suffixes)
     out = Path(out)
     cache = out / ".cache"
-    calibrated_model = _given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
+    calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
     key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
@@ -185,21 +179,21 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
     for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
         if unit_logs and name not in state:
-            state[name] = _new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, read_with)
-    context = _Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
+            state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, read_with)
+    context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                        failure_wear)
-    groups = _groups({name: (state[name], logs) for name, logs in pending.items() if logs})
+    groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
-    for done in _map(context, groups, jobs):
+    idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
+    for done in map_groups(context, groups, jobs, scheduler, robot, idle):
         for name, unit, outputs in done:
-            state[name], made[name] = unit, outputs
-            bar.update(len(pending[name]))
+            made[name] = outputs
+            if unit is not None:
+                state[name] = unit
+                bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
-    for m in monitors:
-        if m.unit not in made:  # a unit with no new log
-            made[m.unit] = _unit_outputs(m, failure_wear)
     statuses = [_status(name, state.get(name), settings) for name in units]
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
@@ -225,99 +219,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     return Outcome(monitors, statuses)
 
 
-@dataclass(frozen=True)
-class _Context:
-    """What scoring a group of units needs (sent to a worker process as it is)."""
 
-    robot: Path
-    settings: Settings
-    calibrated: Path | None
-    out: Path
-    twin_temperature: bool
-    log_format: object
-    units: dict
-    maintenance: dict
-    failure_wear: float
-
-
-def _groups(pending: dict[str, tuple[_Unit, list]]) -> list[list[tuple[str, _Unit, list]]]:
-    """The units to score, one group each, in the folder's order (a twin's simulated cycles are
-    shared through the disk cache: :func:`_prepare_twins` simulates them once before)."""
-    return [[(name, unit, logs)] for name, (unit, logs) in pending.items()]
-
-
-def _prepare_twins(context: _Context, groups: list) -> None:
-    """Simulate, once and in this process, the cycles of every twin that several units share (the
-    nominal or a given model on one program), so that parallel workers read them from the cache
-    instead of simulating them side by side. A twin that cannot be built is left to each unit's
-    own fallback (:func:`_twin`)."""
-    nominal = robots.load(context.robot)
-    read_with, _ = fleet_logs.reader_of(context.log_format)
-    seen = set()
-    for (name, unit, _), in groups:
-        key = (unit.model, unit.program)
-        if unit.model not in ("given", "nominal") or unit.program is None or key in seen:
-            continue
-        seen.add(key)
-        model = str(context.calibrated) if unit.model == "given" else str(nominal.path)
-        try:
-            Twin(model, _log(context.units, *unit.program).path, context.out / ".cache" / "cycles", root=context.out,
-                 reader=read_with)
-        except stored.StateError:
-            raise
-        except ValueError:
-            continue
-
-
-def _map(context: _Context, groups: list, jobs: int):
-    """Each group scored (:func:`_score_group`), in order; in ``jobs`` local processes (joblib's
-    loky, started without the user's folders on their path: :func:`faultgen.children.safe_path`)
-    when ``jobs`` > 1. Every group's arithmetic is the same wherever it runs, so the outputs are
-    those of one job, bit for bit."""
-    if jobs <= 1 or len(groups) <= 1:
-        yield from (_score_group(context, group) for group in groups)
-        return
-    _prepare_twins(context, groups)
-    from joblib import Parallel, delayed
-
-    from faultgen import children
-
-    with children.safe_path():
-        yield from Parallel(n_jobs=min(jobs, len(groups)), return_as="generator")(
-            delayed(_score_group)(context, group) for group in groups)
-
-
-def _unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
-    """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
-    rul.csv (:func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
-    they are made in parallel too."""
-    note = "wear signature match" if monitor.signatures is not None else "share of Q"
-    buffer = io.BytesIO()
-    report.chart(buffer, monitor, note)
-    return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)
-
-
-def _score_group(context: _Context, group: list[tuple[str, _Unit, list]]) -> list[tuple[str, _Unit, tuple]]:
-    """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
-    events given before the first log at or after them; returns the units with their chart and
-    remaining life (:func:`_unit_outputs`)."""
-    nominal = robots.load(context.robot)
-    read_with, _ = fleet_logs.reader_of(context.log_format)
-    twins: dict[tuple, Twin] = {}
-    for name, unit, unit_logs in group:
-        twin = _twin(unit, context.units, nominal, context.calibrated, context.out, twins, False, read_with)
-        for log in unit_logs:
-            for event in context.maintenance.get(name, ()):
-                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
-                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
-                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
-                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
-                                                               len(unit.entries)))
-            twin = _score_log(unit, log, nominal, twin, context.twin_temperature, read_with, context)
-    return [(name, unit, _unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
-
-
-def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir) -> list:
+def _pending(name: str, unit_logs: list, unit: Unit | None, out: Path, logs_dir) -> list:
     """The logs of ``name`` not yet scored (or skipped) by the run whose state is ``unit``.
 
     Raises
@@ -349,133 +252,8 @@ def _pending(name: str, unit_logs: list, unit: _Unit | None, out: Path, logs_dir
     return unit_logs[position[done] + 1:]
 
 
-def _new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
-              read_with: fleet_logs.Reader) -> _Unit:
-    """A unit seen for the first time: its program (the log its twin replays) and the kind of model
-    asked for (given, calibrated on its first log, nominal); protocol ``own`` without a twin or
-    when its first log cannot be read. The model itself is made with the twin (:func:`_twin`),
-    which falls back when it cannot be."""
-    monitor = UnitMonitor(name, settings, nominal.n_axes)
-    first = units[name][0]
-    first_key = (first.stamp, stored.sha256_file(first.path))
-    if settings.protocol != "twin":
-        return _Unit(monitor, "none", None, first_key)
-    try:
-        program = _program(nominal, first, name, programs, read_with)
-    except ValueError as err:
-        return _Unit(monitor, "none", None, first_key,
-                     notes=[f"its first log cannot be replayed ({_short(err)}): protocol own"])
-    kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
-    return _Unit(monitor, kind, program, first_key)
 
-
-def _twin(unit: _Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
-          read_with: fleet_logs.Reader) -> Twin | str | None:
-    """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
-    from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
-    a unit already scored against a twin that cannot be built again gets the reason (a str), and
-    its new logs are skipped with it. Each fallback is noted in the unit's reason."""
-    while unit.model != "none":
-        try:
-            first_path = _log(units, unit.monitor.unit, unit.first[0]).path if any(
-                g.stamp == unit.first[0] for g in units[unit.monitor.unit]) else None
-            model = _model(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress, read_with)
-            twin_key = (model, unit.program)
-            if twin_key not in twins:
-                twins[twin_key] = Twin(model, _log(units, *unit.program).path, out / ".cache" / "cycles", root=out,
-                                       reader=read_with)
-            twin = twins[twin_key]
-        except stored.StateError:
-            raise
-        except ValueError as err:
-            if unit.entries:
-                return f"the twin of the {unit.model} model cannot be built again ({_short(err)})"
-            fallback = "nominal" if unit.model in ("given", "calibrated") else "none"
-            unit.notes.append(f"the twin of the {unit.model} model failed ({_short(err)}); "
-                              f"{'nominal model' if fallback == 'nominal' else 'protocol own'} used")
-            unit.model = fallback
-            continue
-        if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
-            raise stored.StateError(f"{out / '.state' / (unit.monitor.unit + '.json')}: its wear signatures are not those of "
-                             f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
-                             "into a new OUT")
-        unit.monitor.signatures = twin.signatures
-        if unit.initial_signatures is None and not unit.program_changes:
-            unit.initial_signatures = twin.signatures
-        return twin
-    unit.program = None
-    return None
-
-
-def _program_changed(q: np.ndarray, program: np.ndarray) -> bool:
-    """Whether a log's angles ``q`` (n, N) trace another motion than the program's (m, N): a length
-    more than :data:`PROGRAM_LENGTH` apart, or an angle more than :data:`PROGRAM_CHANGE` rad off
-    over their common samples (noise and tracking stay far below it)."""
-    n = min(len(q), len(program))
-    if abs(len(q) - len(program)) > PROGRAM_LENGTH * max(len(q), len(program)):
-        return True
-    return bool(np.max(np.abs(q[:n] - program[:n])) > PROGRAM_CHANGE)
-
-
-def _new_program(unit: _Unit, log, reading, twin: Twin, context) -> Twin:
-    """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
-    restarts its learning against it, its open alarm closed by the change; noted in its reason.
-
-    Raises
-    ------
-    ValueError
-        The new program's twin cannot be built (the log is then skipped, named).
-    """
-    new = Twin(twin.model, log.path, context.out / ".cache" / "cycles", root=context.out, reader=twin.reader)
-    unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
-    unit.monitor.signatures = new.signatures
-    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), reading.q
-    unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
-    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
-                      "replays that log, and the unit learns its normal operation again")
-    return new
-
-
-def _score_log(unit: _Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
-               read_with: fleet_logs.Reader, context=None) -> Twin | str | None:
-    """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
-    cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
-    unit's state with its reason. A log whose motion left the twin's program starts a new one
-    (:func:`_new_program`). Returns the twin for the next log."""
-    sha256 = stored.sha256_file(log.path)
-    if isinstance(twin, str):
-        unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
-        return twin
-    try:
-        reading = fleet_logs.read(nominal, log, read_with)
-        if twin is not None and context is not None and unit.program is not None:
-            if unit.program_q is None:
-                unit.program_q = np.asarray(read_with(_log(context.units, *unit.program).path, nominal).q)
-            if _program_changed(reading.q, unit.program_q):
-                twin = _new_program(unit, log, reading, twin, context)
-        residual, expected = reading.vector, None
-        if twin is not None:
-            at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
-            expected = twin.expected(at, reading.payload)
-            residual = residual - expected
-    except stored.StateError:
-        raise
-    except ValueError as err:
-        unit.skipped.append(stored.Skipped(log.stamp, sha256, _short(err)))
-        return twin
-    if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
-        unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
-    unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
-    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
-    return twin
-
-
-def _short(err: Exception, limit: int = 300) -> str:
-    text = " ".join(str(err).split())
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _status(name: str, unit: _Unit | None, settings: Settings) -> UnitStatus:
+def _status(name: str, unit: Unit | None, settings: Settings) -> UnitStatus:
     """The unit's row of units.csv (:class:`UnitStatus`)."""
     if unit is None:
         return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
@@ -512,16 +290,8 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, l
     return {unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()}
 
 
-def _log(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fleet_logs.Log:
-    """The log ``stamp`` of ``unit`` in the fleet folder (a state names logs, never paths)."""
-    for log in units.get(unit, ()):
-        if log.stamp == stamp:
-            return log
-    raise ValueError(f"the log {unit}/{stamp} that an earlier run scored or replays is no longer in the fleet folder; "
-                     "put it back or score this folder into a new OUT")
 
-
-def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int) -> dict[str, _Unit]:
+def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int) -> dict[str, Unit]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
     looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code."""
@@ -541,89 +311,8 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         kept = stored.read_unit(path, out, name, key, n_axes, n_features)
         if not (kept.entries or kept.skipped):
             continue
-        state[name] = _Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
+        state[name] = Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
                             list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
                             list(kept.program_changes), initial_signatures=kept.signatures)
     return state
 
-
-def _given_model(calibrated: str | Path) -> Path:
-    """The model file of a ``faultgen calibrate`` output folder (or the file itself)."""
-    path = Path(calibrated)
-    if path.is_dir():
-        found = sorted((path / "model").glob("*_calibrated.xml")) or sorted(path.glob("*_calibrated.xml"))
-        if not found:
-            raise ValueError(f"{path}: no model/<robot>_calibrated.xml; give a `faultgen calibrate` output "
-                             "folder or its model file")
-        path = found[0]
-    return path
-
-
-def _model(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_path: Path | None, out: Path,
-           progress: bool, read_with: fleet_logs.Reader) -> str:
-    """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
-    the unit's first log (``first``: its stamp and SHA-256; ``first_path`` the file, needed only
-    when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
-    the nominal model, the log and the search's length, beside a record of the calibrated model's
-    SHA-256 that a later run checks.
-
-    Raises
-    ------
-    ValueError
-        The calibration fails, or its cache does not match its record.
-    """
-    if kind == "nominal":
-        return str(nominal.path)
-    if kind == "given":
-        return str(calibrated)
-    key = {"robot": stored.sha256_file(nominal.path), "log": first[1], "steps": CALIBRATION_STEPS}
-    digest = stored.key_name(key)
-    root = out / ".cache" / "calibrated"
-    folder, record = root / digest, root / f"{digest}.json"
-    model = folder / "model" / f"{nominal.name}_calibrated.xml"
-    if record.exists() or record.is_symlink():
-        stored.read_calibration(record, out, key, model)
-    else:
-        if first_path is None:
-            raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
-                             "in the fleet folder and its calibration is not cached")
-        if folder.exists() or folder.is_symlink():  # a run killed before its record: ours to redo
-            stored.inside(folder, out)
-            shutil.rmtree(folder) if folder.is_dir() and not folder.is_symlink() else folder.unlink()
-        from faultgen.calibrate import calibrate as run_calibration
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            run_calibration(str(nominal.path), read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
-                            progress=False)
-        stored.write_calibration(record, key, model)
-    implausible = plausibility.implausible_parameters(nominal, robots.load(model))
-    if implausible:
-        raise ValueError(f"its calibration on the first log is implausible: {'; '.join(implausible)}")
-    return str(_without_payload(model))
-
-
-def _without_payload(path: Path) -> Path:
-    """The calibrated model without the part its log carried (the calibration's payload effect,
-    written again with no mass: :class:`faultgen.effects.payload.Payload` removes its bodies): the
-    twin carries each log's declared part instead. Written beside it (same assets and
-    ``tasks.toml``) as ``<name>_twin.xml``, from the model checked as any robot description
-    (:func:`faultgen.model.robots.load`: no file outside its folder) before MuJoCo parses it."""
-    target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
-    if not target.is_file():
-        robot = robots.load(path)
-        spec = mujoco.MjSpec.from_file(str(path))
-        Payload(mass=0.0).write(spec, robot)
-        atomic.write_text(target, spec.to_xml())
-    return target
-
-
-def _program(nominal, first: fleet_logs.Log, unit: str, programs: list, read_with: fleet_logs.Reader) -> tuple[str, str]:
-    """The log (unit, stamp) to replay for ``unit`` whose first log is ``first``: an earlier unit's
-    when the motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles."""
-    q = np.asarray(read_with(first.path, nominal).q)
-    for other, other_program in programs:
-        if other.shape == q.shape and np.max(np.abs(other - q)) < SAME_PROGRAM:
-            return other_program
-    programs.append((q, (unit, first.stamp)))
-    return (unit, first.stamp)

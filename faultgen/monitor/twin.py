@@ -83,6 +83,14 @@ def setup(temperature: float | None, payload: float, worn_axis: int = 0) -> tupl
     return conditions.Conditions(thermal=thermal, payloads=part), plan
 
 
+def base_cycles(n_axes: int) -> list[tuple[float, float, int]]:
+    """The (temperature deg C or NaN, payload kg, worn axis) of the cycles every :class:`Twin` of a
+    robot of ``n_axes`` axes simulates when it is made: the healthy expectation without a part, the
+    healthy cycle at the model's own friction and one per worn axis (its :attr:`Twin.signatures`)."""
+    return [(REFERENCE_TEMPERATURE, 0.0, 0), (float("nan"), 0.0, 0),
+            *((float("nan"), 0.0, axis) for axis in range(1, n_axes + 1))]
+
+
 class Twin:
     """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
     log whose motion is replayed (read by ``reader``, :data:`faultgen.monitor.logs.Reader`; the
@@ -90,7 +98,7 @@ class Twin:
     inside ``root`` (default ``cache``), out of which no cached cycle may lead."""
 
     def __init__(self, model: str | Path, program: Path, cache: Path, root: Path | None = None,
-                 reader: fleet_logs.Reader | None = None):
+                 reader: fleet_logs.Reader | None = None, cycles: bool = True):
         self.model = str(model)
         self.robot = robots.load(model)
         self.program = Path(program)
@@ -105,6 +113,13 @@ class Twin:
         self._reference = self._smoothed_program(program_sha256)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
+        if cycles:
+            self.complete()
+
+    def complete(self) -> None:
+        """Simulate (or read from the cache) the :func:`base_cycles` and set :attr:`signatures`: done
+        when the twin is made, unless it was made with ``cycles=False`` (to know which base cycles
+        are cached, :meth:`cached`, and simulate the others in parallel first)."""
         self.cycle(REFERENCE_TEMPERATURE, 0.0)  # the monitor's healthy expectation without a part
         # The signatures at the model's own friction (a calibrated model's, as identified on the
         # unit's first log, or the nominal one's), with no temperature law on top: the features are
@@ -138,13 +153,21 @@ class Twin:
             np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.17g")
         return path
 
+    def _key(self, temperature: float, payload: float, worn_axis: int) -> tuple[dict, Path]:
+        temperature = None if np.isnan(temperature) else round(float(temperature), 2)
+        key = {**self._files, "temperature_C": temperature, "payload_kg": float(payload), "worn_axis": int(worn_axis)}
+        return key, self.cache / f"{stored.key_name(key)}.json"
+
+    def cached(self, temperature: float, payload: float, worn_axis: int = 0) -> bool:
+        """Whether the cycle :meth:`cycle` would return is in the cache (as a file; read and checked by it)."""
+        path = self._key(temperature, payload, worn_axis)[1]
+        return path.exists() or path.is_symlink()
+
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
         nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
-        temperature = None if np.isnan(temperature) else round(float(temperature), 2)
-        key = {**self._files, "temperature_C": temperature, "payload_kg": float(payload), "worn_axis": int(worn_axis)}
-        name = stored.key_name(key)
-        path = self.cache / f"{name}.json"
+        key, path = self._key(temperature, payload, worn_axis)
+        temperature = key["temperature_C"]
         n_features = len(fleet_logs.FEATURES) * self.robot.n_axes
         if path.exists() or path.is_symlink():
             return stored.read_cycle(path, self.root, key, n_features)

@@ -1,0 +1,144 @@
+"""A group of units' new logs scored in stamp order (:func:`score_group`): each log read and fed to
+the unit's monitor against its twin (:func:`score_log`), a repair or gearbox change given before the
+first log at or after it, a log that cannot be read or replayed skipped and named, a program change
+nobody logged starting a new twin (:func:`new_program`); and each unit's chart and remaining life
+(:func:`unit_outputs`). Runs wherever the group is scored (this process, a local worker, a Dask
+worker: :mod:`faultgen.monitor.parallel`), with the same arithmetic.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from faultgen.model import robots
+from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import prognosis, report
+from faultgen.monitor import state as stored
+from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
+from faultgen.monitor.unit import Unit, log_of, short, twin_of
+
+#: A log whose angles lie more than this off its twin's program, rad, or whose length differs by more
+#: than PROGRAM_LENGTH of it, runs another program (noise and tracking: about 1e-3 rad).
+PROGRAM_CHANGE, PROGRAM_LENGTH = 0.05, 0.05
+
+
+@dataclass(frozen=True)
+class Context:
+    """What scoring a group of units needs (sent to a worker process as it is)."""
+
+    robot: Path
+    settings: Settings
+    calibrated: Path | None
+    out: Path
+    twin_temperature: bool
+    log_format: object
+    units: dict
+    maintenance: dict
+    failure_wear: float
+
+
+
+def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
+    """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
+    rul.csv (:func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
+    they are made in parallel too."""
+    note = "wear signature match" if monitor.signatures is not None else "share of Q"
+    buffer = io.BytesIO()
+    report.chart(buffer, monitor, note)
+    return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)
+
+
+def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:
+    """The chart and rows of rul.csv of a unit with no new log (:func:`unit_outputs`), as
+    :func:`score_group` returns a unit's: ``[(unit, None, outputs)]`` (None: its state unchanged)."""
+    return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
+
+
+def score_group(context: Context, group: list[tuple[str, Unit, list]]) -> list[tuple[str, Unit, tuple]]:
+    """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
+    events given before the first log at or after them; returns the units with their chart and
+    remaining life (:func:`unit_outputs`)."""
+    nominal = robots.load(context.robot)
+    read_with, _ = fleet_logs.reader_of(context.log_format)
+    twins: dict[tuple, Twin] = {}
+    for name, unit, unit_logs in group:
+        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, read_with)
+        for log in unit_logs:
+            for event in context.maintenance.get(name, ()):
+                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
+                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
+                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
+                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
+                                                               len(unit.entries)))
+            twin = score_log(unit, log, nominal, twin, context.twin_temperature, read_with, context)
+    return [(name, unit, unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
+
+
+
+def program_changed(q: np.ndarray, program: np.ndarray) -> bool:
+    """Whether a log's angles ``q`` (n, N) trace another motion than the program's (m, N): a length
+    more than :data:`PROGRAM_LENGTH` apart, or an angle more than :data:`PROGRAM_CHANGE` rad off
+    over their common samples (noise and tracking stay far below it)."""
+    n = min(len(q), len(program))
+    if abs(len(q) - len(program)) > PROGRAM_LENGTH * max(len(q), len(program)):
+        return True
+    return bool(np.max(np.abs(q[:n] - program[:n])) > PROGRAM_CHANGE)
+
+
+def new_program(unit: Unit, log, reading, twin: Twin, context) -> Twin:
+    """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
+    restarts its learning against it, its open alarm closed by the change; noted in its reason.
+
+    Raises
+    ------
+    ValueError
+        The new program's twin cannot be built (the log is then skipped, named).
+    """
+    new = Twin(twin.model, log.path, context.out / ".cache" / "cycles", root=context.out, reader=twin.reader)
+    unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
+    unit.monitor.signatures = new.signatures
+    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), reading.q
+    unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
+    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
+                      "replays that log, and the unit learns its normal operation again")
+    return new
+
+
+def score_log(unit: Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
+               read_with: fleet_logs.Reader, context=None) -> Twin | str | None:
+    """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
+    cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
+    unit's state with its reason. A log whose motion left the twin's program starts a new one
+    (:func:`new_program`). Returns the twin for the next log."""
+    sha256 = stored.sha256_file(log.path)
+    if isinstance(twin, str):
+        unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
+        return twin
+    try:
+        reading = fleet_logs.read(nominal, log, read_with)
+        if twin is not None and context is not None and unit.program is not None:
+            if unit.program_q is None:
+                unit.program_q = np.asarray(read_with(log_of(context.units, *unit.program).path, nominal).q)
+            if program_changed(reading.q, unit.program_q):
+                twin = new_program(unit, log, reading, twin, context)
+        residual, expected = reading.vector, None
+        if twin is not None:
+            at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
+            expected = twin.expected(at, reading.payload)
+            residual = residual - expected
+    except stored.StateError:
+        raise
+    except ValueError as err:
+        unit.skipped.append(stored.Skipped(log.stamp, sha256, short(err)))
+        return twin
+    if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
+        unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
+    unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
+    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
+    return twin
+

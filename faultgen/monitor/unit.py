@@ -1,0 +1,206 @@
+"""A unit of ``faultgen monitor`` (:func:`faultgen.monitor.loop.monitor`): what is kept of it between
+logs and runs (:class:`Unit`), its program (the log its twin replays, shared with an earlier unit
+that runs the same motion: :func:`program_of`), its model (given, calibrated on its first log and
+cached, or nominal: :func:`model_of`) and its twin with the fallbacks (calibrated or given model ->
+nominal model -> protocol own: :func:`twin_of`).
+"""
+
+from __future__ import annotations
+
+import shutil
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from faultgen.calibrate import plausibility
+from faultgen.data import atomic
+from faultgen.effects.payload import Payload
+from faultgen.model import robots
+from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import state as stored
+from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.twin import Twin
+
+#: Two units run the same program when their first logs have the same samples and angles within this, rad.
+SAME_PROGRAM = 1e-3
+#: Effects searched when a unit's model is calibrated on its first log (faultgen.calibrate).
+CALIBRATION_STEPS = 3
+
+
+@dataclass
+class Unit:
+    """What the monitor keeps of a unit: its monitor, the kind of model its twin uses, its program, its
+    first log, the logs scored and skipped, its reason's notes, maintenance and program changes."""
+
+    monitor: UnitMonitor
+    model: str  # "given", "calibrated", "nominal" or "none" (protocol own)
+    program: tuple[str, str] | None  # (unit, stamp) of the log the twin replays
+    first: tuple[str, str]  # (stamp, SHA-256) of the unit's first log, which its calibration is made from
+    entries: list[stored.Entry] = field(default_factory=list)
+    skipped: list[stored.Skipped] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    maintenance: list[stored.Maintenance] = field(default_factory=list)
+    program_changes: list[stored.ProgramChange] = field(default_factory=list)
+    program_q: np.ndarray | None = None  # the program log's angles (read when needed; not kept in the state)
+    initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
+
+
+
+def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
+              read_with: fleet_logs.Reader) -> Unit:
+    """A unit seen for the first time: its program (the log its twin replays) and the kind of model
+    asked for (given, calibrated on its first log, nominal); protocol ``own`` without a twin or
+    when its first log cannot be read. The model itself is made with the twin (:func:`twin_of`),
+    which falls back when it cannot be."""
+    monitor = UnitMonitor(name, settings, nominal.n_axes)
+    first = units[name][0]
+    first_key = (first.stamp, stored.sha256_file(first.path))
+    if settings.protocol != "twin":
+        return Unit(monitor, "none", None, first_key)
+    try:
+        program = program_of(nominal, first, name, programs, read_with)
+    except ValueError as err:
+        return Unit(monitor, "none", None, first_key,
+                     notes=[f"its first log cannot be replayed ({short(err)}): protocol own"])
+    kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
+    return Unit(monitor, kind, program, first_key)
+
+
+def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
+          read_with: fleet_logs.Reader) -> Twin | str | None:
+    """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
+    from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
+    a unit already scored against a twin that cannot be built again gets the reason (a str), and
+    its new logs are skipped with it. Each fallback is noted in the unit's reason."""
+    while unit.model != "none":
+        try:
+            first_path = log_of(units, unit.monitor.unit, unit.first[0]).path if any(
+                g.stamp == unit.first[0] for g in units[unit.monitor.unit]) else None
+            model = model_of(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress, read_with)
+            twin_key = (model, unit.program)
+            if twin_key not in twins:
+                twins[twin_key] = Twin(model, log_of(units, *unit.program).path, out / ".cache" / "cycles", root=out,
+                                       reader=read_with)
+            twin = twins[twin_key]
+        except stored.StateError:
+            raise
+        except ValueError as err:
+            if unit.entries:
+                return f"the twin of the {unit.model} model cannot be built again ({short(err)})"
+            fallback = "nominal" if unit.model in ("given", "calibrated") else "none"
+            unit.notes.append(f"the twin of the {unit.model} model failed ({short(err)}); "
+                              f"{'nominal model' if fallback == 'nominal' else 'protocol own'} used")
+            unit.model = fallback
+            continue
+        if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
+            raise stored.StateError(f"{out / '.state' / (unit.monitor.unit + '.json')}: its wear signatures are not those of "
+                             f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
+                             "into a new OUT")
+        unit.monitor.signatures = twin.signatures
+        if unit.initial_signatures is None and not unit.program_changes:
+            unit.initial_signatures = twin.signatures
+        return twin
+    unit.program = None
+    return None
+
+
+
+def short(err: Exception, limit: int = 300) -> str:
+    text = " ".join(str(err).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+
+def log_of(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fleet_logs.Log:
+    """The log ``stamp`` of ``unit`` in the fleet folder (a state names logs, never paths)."""
+    for log in units.get(unit, ()):
+        if log.stamp == stamp:
+            return log
+    raise ValueError(f"the log {unit}/{stamp} that an earlier run scored or replays is no longer in the fleet folder; "
+                     "put it back or score this folder into a new OUT")
+
+
+
+def given_model(calibrated: str | Path) -> Path:
+    """The model file of a ``faultgen calibrate`` output folder (or the file itself)."""
+    path = Path(calibrated)
+    if path.is_dir():
+        found = sorted((path / "model").glob("*_calibrated.xml")) or sorted(path.glob("*_calibrated.xml"))
+        if not found:
+            raise ValueError(f"{path}: no model/<robot>_calibrated.xml; give a `faultgen calibrate` output "
+                             "folder or its model file")
+        path = found[0]
+    return path
+
+
+def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_path: Path | None, out: Path,
+           progress: bool, read_with: fleet_logs.Reader) -> str:
+    """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
+    the unit's first log (``first``: its stamp and SHA-256; ``first_path`` the file, needed only
+    when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
+    the nominal model, the log and the search's length, beside a record of the calibrated model's
+    SHA-256 that a later run checks.
+
+    Raises
+    ------
+    ValueError
+        The calibration fails, or its cache does not match its record.
+    """
+    if kind == "nominal":
+        return str(nominal.path)
+    if kind == "given":
+        return str(calibrated)
+    key = {"robot": stored.sha256_file(nominal.path), "log": first[1], "steps": CALIBRATION_STEPS}
+    digest = stored.key_name(key)
+    root = out / ".cache" / "calibrated"
+    folder, record = root / digest, root / f"{digest}.json"
+    model = folder / "model" / f"{nominal.name}_calibrated.xml"
+    if record.exists() or record.is_symlink():
+        stored.read_calibration(record, out, key, model)
+    else:
+        if first_path is None:
+            raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
+                             "in the fleet folder and its calibration is not cached")
+        if folder.exists() or folder.is_symlink():  # a run killed before its record: ours to redo
+            stored.inside(folder, out)
+            shutil.rmtree(folder) if folder.is_dir() and not folder.is_symlink() else folder.unlink()
+        from faultgen.calibrate import calibrate as run_calibration
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            run_calibration(str(nominal.path), read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
+                            progress=False)
+        stored.write_calibration(record, key, model)
+    implausible = plausibility.implausible_parameters(nominal, robots.load(model))
+    if implausible:
+        raise ValueError(f"its calibration on the first log is implausible: {'; '.join(implausible)}")
+    return str(without_payload(model))
+
+
+def without_payload(path: Path) -> Path:
+    """The calibrated model without the part its log carried (the calibration's payload effect,
+    written again with no mass: :class:`faultgen.effects.payload.Payload` removes its bodies): the
+    twin carries each log's declared part instead. Written beside it (same assets and
+    ``tasks.toml``) as ``<name>_twin.xml``, from the model checked as any robot description
+    (:func:`faultgen.model.robots.load`: no file outside its folder) before MuJoCo parses it."""
+    target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
+    if not target.is_file():
+        robot = robots.load(path)
+        spec = mujoco.MjSpec.from_file(str(path))
+        Payload(mass=0.0).write(spec, robot)
+        atomic.write_text(target, spec.to_xml())
+    return target
+
+
+def program_of(nominal, first: fleet_logs.Log, unit: str, programs: list, read_with: fleet_logs.Reader) -> tuple[str, str]:
+    """The log (unit, stamp) to replay for ``unit`` whose first log is ``first``: an earlier unit's
+    when the motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles."""
+    q = np.asarray(read_with(first.path, nominal).q)
+    for other, other_program in programs:
+        if other.shape == q.shape and np.max(np.abs(other - q)) < SAME_PROGRAM:
+            return other_program
+    programs.append((q, (unit, first.stamp)))
+    return (unit, first.stamp)
