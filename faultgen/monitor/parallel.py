@@ -96,7 +96,7 @@ def preload() -> None:
 
     from faultgen.monitor import prognosis
 
-    prognosis._import_progpy()
+    prognosis.import_progpy()
 
 
 def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
@@ -133,7 +133,7 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
         preload()
         _SHARED.update(context=context, groups=groups, idle=idle)
         try:
-            with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
                 if groups:
                     prepare_twins(context, groups, pool)
                 yield from pool.map(_score_shared, range(len(groups) + len(idle)))

@@ -120,7 +120,7 @@ class Remaining:
         return self.rul is not None
 
 
-def _import_progpy() -> None:
+def import_progpy() -> None:
     """Import ProgPy with matplotlib's settings kept: ``progpy.visualize`` sets global rcParams
     (font size 14, line width 3, ...) when imported, which changed every chart drawn after it in
     the process (the monitor's charts of later units, 2026-11-25)."""
@@ -137,7 +137,7 @@ def _import_progpy() -> None:
 
 def _wear_trend_model(failure_wear: float):
     """The ProgPy model of both trends (module docstring, 4), its event at ``failure_wear``."""
-    _import_progpy()
+    import_progpy()
     from progpy import PrognosticsModel
 
     class WearTrend(PrognosticsModel):
@@ -245,7 +245,7 @@ def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
 
 def _state_samples(fit: Fit, samples: int, seed: int):
     """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now."""
-    _import_progpy()
+    import_progpy()
     from progpy.uncertain_data import UnweightedSamples
 
     rng = np.random.default_rng(seed)
@@ -259,7 +259,7 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
     """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
     under ``fit`` (module docstring, 4): ``UnweightedSamples`` with key ``failure`` (None beyond
     ``horizon``)."""
-    _import_progpy()
+    import_progpy()
     from progpy.predictors import MonteCarlo
 
     model = _wear_trend_model(failure_wear)
@@ -348,7 +348,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
 
 
 def _summarise(row: Remaining, fit: Fit, toe, horizon: float) -> Remaining:
-    _import_progpy()
+    import_progpy()
     from progpy.metrics import prob_success
 
     values = np.array([np.inf if v is None else float(v) for v in toe.key("failure")])
