@@ -101,26 +101,26 @@ def test_a_detector_that_separates_is_above_chance(thesis_small):
 
 def test_transfer_entropy_on_a_short_track_is_warned_about(thesis_small, tmp_path):
     """12 records a unit with 10 bins: transfer entropy leaves most worn units undecided and its
-    figure is flagged in the console and OUT.md; on units of 30 records no warning."""
+    figure is flagged in the console and OUT.md; on units of 40 records no warning, on 30 one."""
     out = tmp_path / "te"
     result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(thesis_small), "--baseline",
                                  "transfer_entropy", "-o", str(out)])
     assert result.exit_code == 0, result.output
-    warning = "WARNING: the track's units have 12 records; transfer_entropy needs at least 21"
+    warning = "WARNING: the track's units have 12 records; transfer_entropy needs at least 31"
     assert warning in result.output and warning in out.with_name("te.md").read_text()
     assert "no verdict: the track is too short for the method" in out.with_name("te.md").read_text()
     r = json.loads(out.with_name("te.json").read_text())["results"]
     assert sum(u["named"] == 0 for u in r["per_unit"] if u["worn_axis"]) >= 4  # ties: undecided
-    assert verdicts.records_needed(TransferEntropyIsolator(bins=5, history=2))[0] == 2 * 25 + 2
+    assert verdicts.records_needed(TransferEntropyIsolator(bins=5, history=2))[0] == 3 * 25 + 2
     assert verdicts.records_needed(baselines.make("trend")[1]) is None
     rng = np.random.default_rng(0)
     units = [files.Unit(id=f"test-{k:03d}", robot="irb6700", task="pick_place", sample="cycle",
-                        arrays={"cycles": np.arange(1, 31), "mean_abs_torque": rng.random((30, 6))},
-                        fault_level=np.linspace(0, 20, 30), worn_axis=2, fault="friction_wear") for k in range(3)]
+                        arrays={"cycles": np.arange(1, 41), "mean_abs_torque": rng.random((40, 6))},
+                        fault_level=np.linspace(0, 20, 40), worn_axis=2, fault="friction_wear") for k in range(3)]
     long = score.isolator_results(TransferEntropyIsolator(), "transfer_entropy", units)
     assert "warnings" not in long
-    short = [dataclasses.replace(u, arrays={k: v[:20] for k, v in u.arrays.items()}) for u in units]
-    assert "20 records; transfer_entropy needs at least 21" in score.isolator_results(
+    short = [dataclasses.replace(u, arrays={k: v[:30] for k, v in u.arrays.items()}) for u in units]
+    assert "30 records; transfer_entropy needs at least 31" in score.isolator_results(
         TransferEntropyIsolator(), "transfer_entropy", short)["warnings"][0]
 
 
