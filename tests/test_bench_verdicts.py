@@ -62,6 +62,8 @@ def test_the_chance_of_an_onset_is_the_share_of_alarm_sequences_that_hold_one():
                     for s in itertools.product((0, 1), repeat=n) if detect_onset(np.array(s), persistence) is not None)
         assert verdicts.chance_detected(n, rate, persistence) == pytest.approx(exact, abs=1e-12)
     assert verdicts.chance_detected(12, 1.0, 3) == 1.0 and verdicts.chance_detected(12, 0.0, 3) == 0.0
+    np.testing.assert_array_equal(verdicts.chance_detected([8, 2, 8], 0.7, 3), [verdicts.chance_detected(8, 0.7, 3),
+                                                                                0.0, verdicts.chance_detected(8, 0.7, 3)])
     with pytest.raises(ValueError, match="probability"):
         verdicts.chance_detected(12, 1.5, 3)
 

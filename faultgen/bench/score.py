@@ -130,7 +130,7 @@ def _chance_share(units: list, parts: bool = False):
     if not healthy or not failing:
         return (float("nan"),) * 3 if parts else float("nan")
     rate = float(np.mean(np.concatenate([u["alarms"] for u in healthy])))
-    random = float(np.mean([verdicts.chance_detected(len(u["alarms"]), rate, PERSISTENCE) for u in failing]))
+    random = float(np.mean(verdicts.chance_detected([len(u["alarms"]) for u in failing], rate, PERSISTENCE)))
     own = float(np.mean([u["detected"] for u in healthy]))
     return (max(random, own), random, own) if parts else max(random, own)
 

@@ -41,31 +41,48 @@ def word(low: float, high: float, chance: float) -> str:
     return "at chance"
 
 
-def chance_detected(n_records: int, rate: float, persistence: int) -> float:
+def chance_detected(n_records, rate: float, persistence: int):
     """Probability that a detector alarming on each of ``n_records`` records independently with
     probability ``rate`` raises ``persistence`` alarms in a row somewhere (the onset rule of
     :func:`analysis.monitoring.detect_onset`): the share of failing units it "detects".
 
-    Exact, by the Markov chain of the current run length (0 .. persistence - 1, and "run seen").
+    Exact, by the Markov chain of the current run length (0 .. persistence - 1, and "run seen"),
+    stepped once up to the largest ``n_records``.
+
+    Parameters
+    ----------
+    n_records : int or array-like of int, shape (n_units,)
+        Records of a unit (each >= 0).
+    rate : float
+        Probability of an alarm per record, in [0, 1].
+    persistence : int
+        Alarms in a row that make an onset, >= 1.
+
+    Returns
+    -------
+    float, or ndarray of shape (n_units,) for an array ``n_records``
 
     Raises
     ------
     ValueError
-        If ``n_records`` is not an integer >= 0, ``persistence`` not one >= 1, or ``rate`` not in [0, 1].
+        If a record count is not an integer >= 0, ``persistence`` not one >= 1, or ``rate`` not in [0, 1].
     """
-    if not is_whole(n_records, 0) or not is_whole(persistence, 1):
+    counts = np.asarray(n_records)
+    if not np.issubdtype(counts.dtype, np.integer) or (counts < 0).any() or not is_whole(persistence, 1):
         raise ValueError(f"n_records = {n_records!r}, persistence = {persistence!r}: expected integers >= 0 and >= 1")
     if not 0.0 <= rate <= 1.0:
         raise ValueError(f"rate = {rate!r}: expected a probability in [0, 1]")
     state = np.zeros(persistence + 1)
     state[0] = 1.0
-    for _ in range(int(n_records)):
+    seen = np.zeros(int(counts.max(initial=0)) + 1)  # seen[n]: a run within the first n records
+    for n in range(1, seen.size):
         step = np.zeros_like(state)
         step[0] = state[:persistence].sum() * (1.0 - rate)
         step[1:persistence + 1] = state[:persistence] * rate
         step[persistence] += state[persistence]
         state = step
-    return float(state[persistence])
+        seen[n] = state[persistence]
+    return seen[counts] if counts.ndim else float(seen[counts])
 
 
 def records_needed(method) -> tuple[int, str] | None:
