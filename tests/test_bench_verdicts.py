@@ -144,3 +144,23 @@ def test_out_md_is_a_markdown_table_with_a_verdict_line_per_figure(thesis_small,
     figures = 4 if role == "detector" else 1
     assert len(verdict_lines) == figures and all(
         re.search(r": (above|at|below) chance|no verdict", line) for line in verdict_lines)
+
+
+def test_without_healthy_test_units_the_detection_figures_have_no_verdict():
+    """Two failing test units and no healthy one: no false-alarm rate, so the detected share and the
+    detection at 5 % false alarms get "no verdict", never a chance level made up."""
+    rng = np.random.default_rng(0)
+
+    def unit(k, fault, axis):
+        return files.Unit(id=f"u{k}", robot="irb6700", task="pick_place", sample="cycle",
+                          arrays={"cycles": np.arange(1, 21), **{f: rng.random((20, 6)) for f in files.FEATURES}},
+                          fault_level=np.linspace(0, 20, 20) if axis else np.zeros(20), worn_axis=axis, fault=fault)
+
+    r = score.detector_results(baselines.PCADetector(), "pca", [unit(0, "none", 0), unit(1, "friction_wear", 2)],
+                               [unit(2, "friction_wear", 2), unit(3, "friction_wear", 3)])
+    assert np.isnan(r["detected_share"]["chance"]) and np.isnan(r["detection_at_5pct_far"]["value"])
+    lines = verdicts.detector_lines(r)
+    assert lines[1].startswith("detection at 5 % false alarms: no verdict")
+    assert "no verdict (no healthy test unit" in lines[2] and lines[3].startswith("delay: no verdict")
+    assert verdicts.summary({"role": "detector", "results": r}).endswith("at 5 % false alarms no verdict; "
+                                                                         "detected no verdict")

@@ -113,6 +113,8 @@ def records_needed(method) -> tuple[int, str] | None:
 
 def _figure_line(name: str, figure: dict, scale: float, unit: str, against: str, short: bool = False) -> str:
     value, (low, high) = figure["value"] * scale, (x * scale for x in figure["ci95"])
+    if not np.isfinite(value):
+        return f"{name}: no verdict (undefined on these test units; {against})"
     verdict = ("no verdict, the track is too short for the method" if short
                else word(figure["ci95"][0], figure["ci95"][1], figure["chance"]))
     return f"{name} {value:.{3 if scale == 1 else 1}f}{unit} [{low:.{3 if scale == 1 else 1}f}, " \
@@ -130,7 +132,10 @@ def detector_lines(r: dict) -> list[str]:
                             "their records alarm; a detector that does not separate alarms on 5 % of worn records"))
     det, diff, far = r["detected_share"], r["detected_minus_chance"], r["false_alarm_rate"]
     verdict = word(diff["ci95"][0], diff["ci95"][1], 0.0)
-    if np.isfinite(det["value"]):
+    if np.isfinite(det["value"]) and not np.isfinite(det["chance"]):
+        out.append(f"detected {100 * det['value']:.1f} % of failing units: no verdict (no healthy test unit to "
+                   "measure the false-alarm rate its chance depends on)")
+    elif np.isfinite(det["value"]):
         out.append(f"detected {100 * det['value']:.1f} % of failing units: {verdict} (chance "
                    f"{100 * det['chance']:.1f} %, the larger of: alarms at random on {100 * far['value']:.1f} % of "
                    f"records, the healthy units' false-alarm rate, detect {100 * det['chance_random_alarms']:.1f} %; "
@@ -138,7 +143,7 @@ def detector_lines(r: dict) -> list[str]:
                    f"healthy units; difference {100 * diff['value']:+.1f} points "
                    f"[{100 * diff['ci95'][0]:+.1f}, {100 * diff['ci95'][1]:+.1f}])")
     else:
-        out.append("detected: no verdict (no failing unit, or no healthy unit to set the false-alarm rate)")
+        out.append("detected: no verdict (no failing test unit)")
     delay = next(v for k, v in r.items() if k.startswith("delay_after_10pct"))
     early = sum(1 for u in r["per_unit"] if u["detected"] and u["after_start"] < 0)
     detected = sum(1 for u in r["per_unit"] if u["detected"])
@@ -147,8 +152,9 @@ def detector_lines(r: dict) -> list[str]:
                    f"a detection delay (detection above chance); the onset came before the fault started on "
                    f"{early} of {detected} units detected")
     else:
-        out.append(f"delay: no verdict (detection {verdict}: a delay means something only where detection beats "
-                   f"chance; the onset came before the fault started on {early} of {detected} units detected)")
+        share = "has no verdict" if verdict == "no verdict" else f"is {verdict}"
+        out.append(f"delay: no verdict (the detected share {share}: a delay means something only where detection "
+                   f"beats chance; the onset came before the fault started on {early} of {detected} units detected)")
     return out
 
 
