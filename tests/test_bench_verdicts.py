@@ -164,3 +164,16 @@ def test_without_healthy_test_units_the_detection_figures_have_no_verdict():
     assert "no verdict (no healthy test unit" in lines[2] and lines[3].startswith("delay: no verdict")
     assert verdicts.summary({"role": "detector", "results": r}).endswith("at 5 % false alarms no verdict; "
                                                                          "detected no verdict")
+
+
+def test_no_unit_detected_is_below_chance_only_where_chance_would_detect_some():
+    """0 of 18 failing units detected where chance detects each with 4.7 %: 0 is what chance gives on
+    18 units 42 % of the time (binomial), so at chance, though the bootstrap interval of the difference
+    lies below 0; on 200 units chance detects at least 4 (2.5 % quantile), so 0 is below chance."""
+    difference = {"value": -0.047, "ci95": [-0.1, -0.03]}
+    for units, expected in ((18, "at chance"), (200, "below chance")):
+        detected = {"value": 0.0, "chance": 0.047, "chance_range95": verdicts.chance_range(units, 0.047)}
+        assert verdicts.detected_word(detected, difference) == expected
+    assert verdicts.chance_range(200, 0.047)[0] * 200 >= 4
+    assert verdicts.detected_word({"value": 0.6, "chance_range95": verdicts.chance_range(6, 0.0)},
+                                  {"ci95": [0.3, 0.9]}) == "above chance"

@@ -26,7 +26,9 @@ larger: more likely faulty) and its alarms (``predict``).
   is the larger of the share a detector alarming at random at the false-alarm rate detects
   (:func:`faultgen.bench.verdicts.chance_detected`, per unit by its records) and the share of
   healthy units where the method's own alarms make an onset; ``detected_minus_chance`` is the
-  difference, bootstrapped with the false-alarm rate.
+  difference, bootstrapped with the false-alarm rate, and ``chance_range95`` the central 95 % of
+  the share a detector detecting each unit with that chance gets on this many units
+  (:func:`faultgen.bench.verdicts.chance_range`).
 
 **Isolator** (``--isolator``, the contract of ``bench-isolators``): ``fit(X)`` on each failing test
 unit's per-cycle mean absolute motor torque (n_records, N) names a source axis (0: undecided). Its
@@ -216,6 +218,7 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
     detected = _figure(delays, lambda rows: float(np.mean([r["detected"] for r in rows])))
     detected["chance"], detected["chance_random_alarms"], detected["healthy_units_detected"] = _chance_share(
         judged, parts=True)
+    detected["chance_range95"] = verdicts.chance_range(len(delays), detected["chance"])
     return {
         "auroc": _figure(judged, _auroc, chance=0.5),
         "false_alarm_rate": far,

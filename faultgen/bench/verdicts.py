@@ -10,7 +10,8 @@ not look at the data gets, by its 95 % bootstrap interval over test units:
   records a detector that does not separate them alarms on at that rate); the share of failing
   units detected against the share a detector alarming at random at the observed false-alarm rate
   detects (:func:`chance_detected`) or, if larger, the share of healthy units on which the method's
-  own alarms make an onset, by the interval of the difference; isolation top-1 and fault
+  own alarms make an onset, by the interval of the difference and the range chance alone gives on
+  as many units (:func:`detected_word`); isolation top-1 and fault
   type accuracy against 1 / the number of axes or fault types;
 - the detection delay gets no verdict of its own: it is a delay only where detection is above chance.
 
@@ -85,6 +86,34 @@ def chance_detected(n_records, rate: float, persistence: int):
     return seen[counts] if counts.ndim else float(seen[counts])
 
 
+def chance_range(n_units: int, chance: float) -> list[float]:
+    """Central 95 % range [2.5 %, 97.5 % quantile] of the share of ``n_units`` units a detector
+    detects when it detects each one with probability ``chance`` (binomial, ``scipy.stats.binom``);
+    [nan, nan] when ``chance`` is not finite or there is no unit. A detected share inside it is
+    what chance gives on so few units, whatever the bootstrap interval says (a share of 0 or 1 has
+    a bootstrap interval of one point)."""
+    from scipy.stats import binom
+
+    if not n_units or not np.isfinite(chance):
+        return [float("nan"), float("nan")]
+    return [float(binom.ppf(q, n_units, chance)) / n_units for q in (0.025, 0.975)]
+
+
+def detected_word(detected: dict, difference: dict) -> str:
+    """The detected share's verdict: above (below) chance when the bootstrap interval of its
+    difference from chance lies above (below) 0 and the share lies above (below) the range chance
+    gives on as many units (:func:`chance_range`); else at chance ("no verdict" when undefined)."""
+    word_ = word(difference["ci95"][0], difference["ci95"][1], 0.0)
+    low, high = detected.get("chance_range95", [float("nan")] * 2)
+    if word_ == "no verdict" or not np.isfinite(low):
+        return "no verdict"
+    if word_ == "above chance" and detected["value"] > high + TOLERANCE:
+        return word_
+    if word_ == "below chance" and detected["value"] < low - TOLERANCE:
+        return word_
+    return "at chance"
+
+
 def records_needed(method) -> tuple[int, str] | None:
     """(records per unit, why) below which ``method``'s isolation figure says nothing, or None when
     the benchmark knows no such limit for it (any isolator but transfer entropy's).
@@ -131,7 +160,7 @@ def detector_lines(r: dict) -> list[str]:
                             "chance 5.0 %: the threshold set on the healthy test units' scores so that 5 % of "
                             "their records alarm; a detector that does not separate alarms on 5 % of worn records"))
     det, diff, far = r["detected_share"], r["detected_minus_chance"], r["false_alarm_rate"]
-    verdict = word(diff["ci95"][0], diff["ci95"][1], 0.0)
+    verdict = detected_word(det, diff)
     if np.isfinite(det["value"]) and not np.isfinite(det["chance"]):
         out.append(f"detected {100 * det['value']:.1f} % of failing units: no verdict (no healthy test unit to "
                    "measure the false-alarm rate its chance depends on)")
@@ -141,7 +170,9 @@ def detector_lines(r: dict) -> list[str]:
                    f"records, the healthy units' false-alarm rate, detect {100 * det['chance_random_alarms']:.1f} %; "
                    f"the method's own alarms make an onset on {100 * det['healthy_units_detected']:.1f} % of the "
                    f"healthy units; difference {100 * diff['value']:+.1f} points "
-                   f"[{100 * diff['ci95'][0]:+.1f}, {100 * diff['ci95'][1]:+.1f}])")
+                   f"[{100 * diff['ci95'][0]:+.1f}, {100 * diff['ci95'][1]:+.1f}]; chance alone detects "
+                   f"{100 * det['chance_range95'][0]:.1f}-{100 * det['chance_range95'][1]:.1f} % of "
+                   f"{det['units']} units)")
     else:
         out.append("detected: no verdict (no failing test unit)")
     delay = next(v for k, v in r.items() if k.startswith("delay_after_10pct"))
@@ -181,9 +212,9 @@ def summary(results: dict) -> str:
     """The verdict cell of the leaderboard row: each figure's word, short."""
     r = results["results"]
     if results["role"] == "detector":
-        diff = r["detected_minus_chance"]["ci95"]
+        detected = detected_word(r["detected_share"], r["detected_minus_chance"])
         return (f"AUROC {word(*r['auroc']['ci95'], 0.5)}; at 5 % false alarms "
-                f"{word(*r['detection_at_5pct_far']['ci95'], 0.05)}; detected {word(*diff, 0.0)}")
+                f"{word(*r['detection_at_5pct_far']['ci95'], 0.05)}; detected {detected}")
     top1 = r["top1_accuracy"]
     if r.get("warnings"):
         return "no verdict: the track is too short for the method (its figure says nothing)"
