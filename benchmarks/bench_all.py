@@ -20,7 +20,7 @@ import sys
 import time
 from pathlib import Path
 
-from faultgen.bench import baselines, make, tracks
+from faultgen.bench import baselines, make, score, tracks
 
 
 def run(argv: list[str]) -> tuple[float, str | None]:
@@ -71,13 +71,12 @@ def main() -> None:
             if error:
                 failed.append(f"score {name} {baseline}")
                 continue
-            rows.append(stem.with_name(stem.name + ".md").read_text().strip())
+            rows.append(stem.with_name(stem.name + ".md").read_text().splitlines()[2])  # header, separator, row
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
     print(f"\ntotal {total / 60:.1f} min; largest process {peak:.0f} MB")
     print(f"NOT the whole benchmark: {len(failed)} step(s) failed ({', '.join(failed)})\n" if failed else "")
-    print("| track | method | AUROC [95 % CI] | false alarms % | detected % | delay after 10 % wear (cycles) | "
-          "isolation top-1 % | command | date |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print(score.HEADER)
+    print(score.SEPARATOR)
     print("\n".join(rows))
 
 

@@ -154,7 +154,7 @@ def test_the_commands(thesis_small, tmp_path):
     result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(folder), "--baseline", "pca", "-o", str(out)])
     assert result.exit_code == 0, result.output
     assert json.loads(out.with_suffix(".json").read_text())["results"]["auroc"]["chance"] == 0.5
-    assert re.match(r"\| thesis v2 \(small\) \| pca \| [01]\.\d{3} \[", out.with_suffix(".md").read_text())
+    assert re.search(r"^\| thesis v2 \(small\) \| pca \| [01]\.\d{3} \[", out.with_suffix(".md").read_text(), re.M)
     for argv, message in ((["score", "thesis", "--data", str(folder)], "give one of"),
                           (["score", "faults", "--data", str(folder), "--baseline", "pca"], "holds track 'thesis'"),
                           (["score", "thesis", "--data", str(folder), "--baseline", "nope"], "unknown baseline"),

@@ -6,6 +6,8 @@
 - :mod:`~faultgen.bench.make`: ``faultgen bench make``, the sweeps and the frozen manifest check;
 - :mod:`~faultgen.bench.score`: ``faultgen bench score``, AUROC, delay, false alarms, isolation,
   each with a bootstrap interval over test units;
+- :mod:`~faultgen.bench.verdicts`: every score's verdict against chance (above, at, below), and the
+  records per unit a method needs;
 - :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods and two pyod detectors).
 - :mod:`~faultgen.bench.independent`: the sim-to-real track's test fleet, made by another simulator
   (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use).

@@ -15,10 +15,20 @@ larger: more likely faulty) and its alarms (``predict``).
 - **AUROC** of the scores: positives the records whose fault level is >= 10 %, negatives those at
   0 % (records in between are left out); chance 0.5.
 - **False-alarm rate**: the share of alarmed records of the healthy test units.
+- **Detection at 5 % false alarms**: the share of worn records (>= 10 %) whose score exceeds the
+  threshold that 5 % of the healthy test units' records exceed (the ROC curve of worn records
+  against the healthy units' records at a false-positive rate of :data:`FAR`, interpolated between
+  its points: a random threshold between two scores); chance 5 %.
 - **Detection delay**: per failing unit, the onset (the first of 3 alarms in a row,
   :func:`analysis.monitoring.detect_onset`, as ``faultgen detect``) minus the record where the fault
   starts, and minus the record where it reaches 10 %, in cycles (days for daily records); the
-  median over the units detected, and the share detected.
+  median over the units detected, and the share detected. The share's chance (:func:`_chance_share`)
+  is the larger of the share a detector alarming at random at the false-alarm rate detects
+  (:func:`faultgen.bench.verdicts.chance_detected`, per unit by its records) and the share of
+  healthy units where the method's own alarms make an onset; ``detected_minus_chance`` is the
+  difference, bootstrapped with the false-alarm rate, and ``chance_range95`` the central 95 % of
+  the share a detector detecting each unit with that chance gets on this many units
+  (:func:`faultgen.bench.verdicts.chance_range`).
 
 **Isolator** (``--isolator``, the contract of ``bench-isolators``): ``fit(X)`` on each failing test
 unit's per-cycle mean absolute motor torque (n_records, N) names a source axis (0: undecided). Its
@@ -28,7 +38,10 @@ labels: "friction_wear", "backlash", "cogging") is scored on it too on a track w
 types (the faults track): ``fault_type_accuracy``, chance 1 / the number of fault types.
 
 Every figure has a 95 % percentile bootstrap interval over test units (:data:`RESAMPLES`
-resamples of the units with replacement, seed 0).
+resamples of the units with replacement, seed 0), and its verdict against its chance level
+(:mod:`faultgen.bench.verdicts`): above, at or below chance. An isolator whose need of records
+(:func:`faultgen.bench.verdicts.records_needed`) the track's units do not meet gets a warning in
+``results["warnings"]``.
 """
 
 from __future__ import annotations
@@ -40,14 +53,16 @@ from pathlib import Path
 
 import numpy as np
 from sklearn.base import clone, is_classifier
-from sklearn.metrics import roc_auc_score
+from sklearn.metrics import roc_auc_score, roc_curve
 
-from faultgen.bench import files
+from faultgen.bench import files, verdicts
 from faultgen.data import atomic
 
 RESAMPLES = 1000
 WORN_PCT = 10.0
 PERSISTENCE = 3
+#: The false-alarm rate at which the detection rate is read (a share of the healthy units' records).
+FAR = 0.05
 
 
 def _interval(units: list, statistic, seed: int = 0) -> list[float]:
@@ -80,6 +95,46 @@ def _auroc(units: list) -> float:
     if labels.all() or not labels.any():
         return float("nan")
     return float(roc_auc_score(labels, scores))
+
+
+def _detection_at_far(units: list) -> float:
+    """Share of worn records (>= 10 %) of the failing units alarmed at the threshold that a share
+    :data:`FAR` of the healthy units' records exceed (the ROC curve at that false-positive rate,
+    linear between its points: ties broken at random); NaN without both kinds of record."""
+    healthy = [u["scores"] for u in units if u["unit"].fault == "none"]
+    worn = [u["scores"][u["positive"]] for u in units if u["unit"].fault != "none"]
+    negatives = np.concatenate(healthy) if healthy else np.zeros(0)
+    positives = np.concatenate(worn) if worn else np.zeros(0)
+    if not negatives.size or not positives.size:
+        return float("nan")
+    fpr, tpr, _ = roc_curve(np.r_[np.zeros(negatives.size), np.ones(positives.size)], np.r_[negatives, positives],
+                            drop_intermediate=False)
+    last = np.r_[np.diff(fpr) > 0, True]  # per false-positive rate its highest true-positive rate
+    return float(np.interp(FAR, fpr[last], tpr[last]))
+
+
+def _detected_minus_chance(units: list) -> float:
+    """Share of failing units detected minus its chance, :func:`_chance_share` (NaN without both
+    healthy and failing units)."""
+    failing = [u for u in units if u["unit"].fault != "none"]
+    chance = _chance_share(units)
+    return float(np.mean([u["detected"] for u in failing]) - chance) if np.isfinite(chance) else float("nan")
+
+
+def _chance_share(units: list, parts: bool = False):
+    """The share of failing units a detector "detects" by chance: the larger of (a) the share a
+    detector alarming on each record independently at the healthy units' false-alarm rate detects
+    (:func:`faultgen.bench.verdicts.chance_detected`, per failing unit by its records) and (b) the
+    share of healthy units in which the detector's own alarms make an onset (its false alarms come
+    in runs). With ``parts``: (chance, a, b). NaN without both healthy and failing units."""
+    healthy = [u for u in units if u["unit"].fault == "none"]
+    failing = [u for u in units if u["unit"].fault != "none"]
+    if not healthy or not failing:
+        return (float("nan"),) * 3 if parts else float("nan")
+    rate = float(np.mean(np.concatenate([u["alarms"] for u in healthy])))
+    random = float(np.mean(verdicts.chance_detected([len(u["alarms"]) for u in failing], rate, PERSISTENCE)))
+    own = float(np.mean([u["detected"] for u in healthy]))
+    return (max(random, own), random, own) if parts else max(random, own)
 
 
 def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
@@ -141,10 +196,11 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
     delays = []
     for row in judged:
         unit = row["unit"]
+        onset = detect_onset(row["alarms"], PERSISTENCE)
+        row["detected"] = onset is not None
         if unit.fault == "none":
             continue
         cycles = unit.arrays["cycles"]
-        onset = detect_onset(row["alarms"], PERSISTENCE)
         starts = np.flatnonzero(unit.fault_level > 0)
         worn = np.flatnonzero(unit.fault_level >= WORN_PCT)
         delays.append({
@@ -158,10 +214,17 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
             np.isfinite(r[key]) for r in rows) else float("nan")
 
     sample = test[0].sample if test else "cycle"
+    far = _figure(healthy, lambda rows: float(np.mean(np.concatenate([r["alarms"] for r in rows]))))
+    detected = _figure(delays, lambda rows: float(np.mean([r["detected"] for r in rows])))
+    detected["chance"], detected["chance_random_alarms"], detected["healthy_units_detected"] = _chance_share(
+        judged, parts=True)
+    detected["chance_range95"] = verdicts.chance_range(len(delays), detected["chance"])
     return {
         "auroc": _figure(judged, _auroc, chance=0.5),
-        "false_alarm_rate": _figure(healthy, lambda rows: float(np.mean(np.concatenate([r["alarms"] for r in rows])))),
-        "detected_share": _figure(delays, lambda rows: float(np.mean([r["detected"] for r in rows]))),
+        "false_alarm_rate": far,
+        "detection_at_5pct_far": _figure(judged, _detection_at_far, chance=FAR),
+        "detected_share": detected,
+        "detected_minus_chance": _figure(judged, _detected_minus_chance, chance=0.0),
         f"delay_after_start_{sample}s": _figure(delays, median("after_start")),
         f"delay_after_10pct_{sample}s": _figure(delays, median("after_10pct")),
         "per_unit": [{k: v for k, v in d.items()} for d in delays],
@@ -188,6 +251,12 @@ def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
                                  chance=1.0 / n_axes),
         "undecided_on_healthy": _figure(healthy, lambda rows: float(np.mean([r["named"] == 0 for r in rows]))),
     }
+    need = verdicts.records_needed(method)
+    records = sorted(len(unit.arrays["mean_abs_torque"]) for unit in test)
+    if need is not None and records and records[0] < need[0]:
+        span = f"{records[0]}" if records[0] == records[-1] else f"{records[0]}-{records[-1]}"
+        out["warnings"] = [f"the track's units have {span} records; {name} needs at least {need[0]} ({need[1]}): "
+                           "its figure here says nothing"]
     kinds = sorted({a["fault"] for a in failing})
     if len(kinds) > 1 and any(a["named_fault"] is not None for a in answers):  # the faults track: which fault
         out["fault_type_accuracy"] = _figure(
@@ -230,29 +299,53 @@ def _cell(figure: dict, scale: float = 100.0, digits: int = 1) -> str:
     return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
 
 
+#: The columns of a leaderboard row (docs/leaderboard.md), header and separator.
+HEADER = ("| track | method | AUROC [95 % CI] | false alarms % | detection % at 5 % false alarms (chance 5) | "
+          "detected % (chance at the false-alarm rate) | delay after 10 % wear | isolation top-1 % | verdict | "
+          "command | date |")
+SEPARATOR = "|" + " --- |" * HEADER.count(" | ") + " --- |"
+
+
+def _escaped(cell: str) -> str:
+    """A table cell's text with its pipes escaped (a pipe, even in a code span, ends a cell)."""
+    return cell.replace("|", "\\|")
+
+
 def markdown_row(results: dict, command: str) -> str:
-    """One row of the leaderboard (docs/leaderboard.md) for ``results``."""
+    """One row of the leaderboard (docs/leaderboard.md) for ``results``: the cells of :data:`HEADER`."""
     r = results["results"]
     track = f"{results.get('track')} v{results.get('version')}" + (f" ({results['size']})" if results.get("size") != "full" else "")
     if results["role"] == "detector":
         delay = next(v for k, v in r.items() if k.startswith("delay_after_10pct"))
-        cells = [_cell(r["auroc"], scale=1.0, digits=3), _cell(r["false_alarm_rate"]), _cell(r["detected_share"]),
-                 _cell(delay, scale=1.0), "-"]
+        detected = _cell(r["detected_share"])
+        if detected != "-" and np.isfinite(r["detected_share"]["chance"]):
+            detected += f" (chance {100 * r['detected_share']['chance']:.1f})"
+        cells = [_cell(r["auroc"], scale=1.0, digits=3), _cell(r["false_alarm_rate"]),
+                 _cell(r["detection_at_5pct_far"]), detected, _cell(delay, scale=1.0), "-"]
     else:
-        cells = ["-", "-", "-", "-", _cell(r["top1_accuracy"]) + f" (chance {100 * r['top1_accuracy']['chance']:.1f})"]
+        cells = ["-"] * 5 + [_cell(r["top1_accuracy"]) + f" (chance {100 * r['top1_accuracy']['chance']:.1f})"]
         if "fault_type_accuracy" in r:
             cells[-1] += (f"; fault type {_cell(r['fault_type_accuracy'])} "
                           f"(chance {100 * r['fault_type_accuracy']['chance']:.1f})")
-    return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
+    cells = [track, results["method"], *cells, verdicts.summary(results), f"`{command}`", results["date"]]
+    return "| " + " | ".join(_escaped(c) for c in cells) + " |"
+
+
+def markdown(results: dict, command: str) -> str:
+    """``OUT.md``: a Markdown table (:data:`HEADER`, :data:`SEPARATOR`, the row) and below it one
+    line per figure with its verdict (:func:`faultgen.bench.verdicts.lines`), warnings first."""
+    lines = "\n".join(f"- {line}" for line in verdicts.lines(results))
+    return f"{HEADER}\n{SEPARATOR}\n{markdown_row(results, command)}\n\n{lines}\n"
 
 
 def write(results: dict, out: str | Path, command: str) -> tuple[Path, Path]:
-    """``OUT.json`` (the results) and ``OUT.md`` (its leaderboard row), as one set."""
+    """``OUT.json`` (the results and the verdict lines) and ``OUT.md`` (:func:`markdown`), as one set."""
     out = Path(out)
     json_path, md_path = out.with_name(out.name + ".json"), out.with_name(out.name + ".md")
     with atomic.output_set([json_path, md_path]) as staged:
-        staged(json_path).write_text(json.dumps({**results, "command": command}, indent=1, default=_plain) + "\n")
-        staged(md_path).write_text(markdown_row(results, command) + "\n")
+        staged(json_path).write_text(json.dumps({**results, "verdicts": verdicts.lines(results), "command": command},
+                                                indent=1, default=_plain) + "\n")
+        staged(md_path).write_text(markdown(results, command))
     return json_path, md_path
 
 

@@ -126,10 +126,12 @@ def score_command(
                                                                   "DATA/score-NAME).")] = None,
 ) -> None:
     """Score a detector or an isolator on a track's test units: AUROC, false-alarm rate on healthy
-    units, detection delay after the fault's start and after 10 % wear, isolation top-1 accuracy,
-    each with a 95 % bootstrap interval over test units and its chance level. The method learns
-    from train.h5 only; test_labels.csv is read after it answered. Writes OUT.json and OUT.md (a
-    row of docs/leaderboard.md).
+    units, detection rate at 5 % false alarms, the share of failing units detected beside what
+    random alarms at the same false-alarm rate detect, detection delay after the fault's start and
+    after 10 % wear, isolation top-1 accuracy, each with a 95 % bootstrap interval over test units
+    and its verdict against chance (above, at or below), and a warning when the track's units are
+    too short for the method. The method learns from train.h5 only; test_labels.csv is read after
+    it answered. Writes OUT.json and OUT.md (a row of docs/leaderboard.md and the verdict lines).
 
     Example:
 
@@ -161,8 +163,6 @@ def score_command(
     results = score.score(data, method, name, role, track=track)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     json_path, md_path = score.write(results, stem, command)
-    typer.echo("| track | method | AUROC [95 % CI] | false alarms % | detected % | delay after 10 % wear | "
-               "isolation top-1 % | command | date |")
-    typer.echo(score.markdown_row(results, command))
-    typer.echo("AUROC chance 0.5; intervals: bootstrap over test units (docs/bench.md)")
+    typer.echo(score.markdown(results, command), nl=False)
+    typer.echo("intervals: 95 % bootstrap over test units; verdicts against chance (docs/bench.md)")
     typer.echo(f"wrote {json_path}, {md_path}")
