@@ -84,7 +84,13 @@ def main() -> None:
     with open(work / "monitor" / "units.csv", newline="") as f:
         statuses = collections.Counter(r["status"] + " (" + r["model"] + ")" for r in csv.DictReader(f))
     print("monitor units: " + ", ".join(f"{n} {s}" for s, n in sorted(statuses.items())))
-    scores, alarms, named = twin.answers(work / "monitor", written, {u.id: len(u.arrays["cycles"]) for u in test})
+    scores, alarms, named, answered = twin.answers(work / "monitor", written,
+                                                   {u.id: len(u.arrays["cycles"]) for u in test})
+    silent = sum(int((~a).sum()) for a in answered.values())
+    if silent:
+        print(f"warning: the monitor gave no row for {silent} of {sum(len(a) for a in answered.values())} records "
+              f"(a unit still learning its {train} logs when its logs ended): scored below every answer, no alarm; "
+              "the track is too short for the twin there")
     stem = args.out or args.data / "score-twin"
     rows = []
     for role, method in (("detector", recorded.RecordedDetector(recorded.detector_answers(test, scores, alarms))),

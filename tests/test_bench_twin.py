@@ -85,7 +85,8 @@ def injected(tmp_path):
 
 def test_an_injected_outcome_gives_the_expected_figures_through_the_scorer(injected):
     data, out, written, units = injected
-    scores, alarms, named = twin.answers(out, written, {u.id: 20 for u in units})
+    scores, alarms, named, answered = twin.answers(out, written, {u.id: 20 for u in units})
+    assert answered["test-000"].all() and answered["test-002"].tolist() == [False] * 3 + [True] * 17
     # the score is the largest bound of a log; a log without a row gets one below every score of the run
     assert scores["test-000"][13] == pytest.approx(12.0) and scores["test-001"][0] == pytest.approx(-4.99)
     assert np.all(scores["test-002"][:3] == pytest.approx(-5.0 + 0.04 - 1.0 - 0.03))  # the run's lowest (-4.96) - 1
@@ -110,7 +111,7 @@ def test_an_injected_outcome_gives_the_expected_figures_through_the_scorer(injec
 
 def test_a_unit_without_answers_is_refused_not_left_undecided(injected):
     data, out, written, units = injected
-    scores, alarms, named = twin.answers(out, written, {u.id: 20 for u in units})
+    scores, alarms, named, _ = twin.answers(out, written, {u.id: 20 for u in units})
     with pytest.raises(ValueError, match="no recorded answer for test unit test-001"):
         recorded.detector_answers(units, {k: v for k, v in scores.items() if k != "test-001"}, alarms)
     partial = recorded.RecordedIsolator(recorded.isolator_answers(units[:2], named))

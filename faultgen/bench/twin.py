@@ -45,8 +45,8 @@ def _read(path: Path) -> list[dict]:
         return list(csv.DictReader(f))
 
 
-def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dict, dict, dict]:
-    """(scores, alarms, axis named) per test unit from the monitor's output folder ``out``.
+def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dict, dict, dict, dict]:
+    """(scores, alarms, axis named, answered) per test unit from the monitor's output folder ``out``.
 
     Parameters
     ----------
@@ -62,6 +62,8 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
     scores : dict of unit id -> ndarray of shape (n_records,), float
     alarms : dict of unit id -> ndarray of shape (n_records,), bool
     named : dict of unit id -> int (1..N, 0 undecided)
+    answered : dict of unit id -> ndarray of shape (n_records,), bool
+        The records the monitor gave a row (the others scored at the floor).
 
     Raises
     ------
@@ -83,10 +85,10 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
             raised.setdefault(row["unit"], []).append(row)
     values = [max(float(r[c]) for c in lower) for r in rows]
     floor = (min(values) if values else 0.0) - UNSCORED
-    scores, alarms, named = {}, {}, {}
+    scores, alarms, named, answered = {}, {}, {}, {}
     for uid, monitored in written.records.items():
         n = n_records[uid]
-        score, alarm = np.full(n, floor), np.zeros(n, dtype=bool)
+        score, alarm, seen = np.full(n, floor), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
         first = []  # (record of the alarm's first log, axis)
         for name, records in monitored.items():
             stamps = _stamps(written.logs / name)
@@ -98,7 +100,8 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
                     raise ValueError(f"{out}/scores.csv: unit {name} has no log {stamp}")
                 score[at[stamp]] = max(float(row[c]) for c in lower)
                 alarm[at[stamp]] = row["alarm"] == "1"
+                seen[at[stamp]] = True
             first += [(at[r["first_alarm"]], int(r["source_axis"] or 0)) for r in raised.get(name, [])]
-        scores[uid], alarms[uid] = score, alarm
+        scores[uid], alarms[uid], answered[uid] = score, alarm, seen
         named[uid] = min(first)[1] if first else 0
-    return scores, alarms, named
+    return scores, alarms, named, answered
