@@ -11,8 +11,9 @@ twin reads raw logs, which test.h5 (features) does not hold, so the script
    (faultgen.bench.rawlogs: the sim-to-real track's fleet by the independent simulator; the conditions
    track's runs simulated again with their signals, each program's cycles a monitor unit of their own)
    and ties each regenerated unit to its test unit by its features (never by the labels);
-2. runs `faultgen monitor LOGS --robot ROBOT -o WORK/monitor --train N` (calibrated twins by default,
-   `--no-calibrate` the nominal model; N 28 at full size, 10 at small);
+2. runs `faultgen monitor LOGS --robot ROBOT -o WORK/monitor-trainN[-nominal] --train N` (calibrated twins
+   by default, `--no-calibrate` the nominal model; N 28 at full size, 10 at small); a rerun with the same
+   WORK reads the logs the first wrote (WORK/records.json);
 3. reads each test unit's answers from the monitor's scores.csv and alarms.csv (faultgen.bench.twin:
    score per record the largest lower bound of the wear estimates, alarm per record the log's alarm,
    the axis its first persistent alarm names) and scores them with faultgen.bench.score.score, the
@@ -29,11 +30,14 @@ from __future__ import annotations
 import argparse
 import collections
 import csv
+import json
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 from faultgen.bench import files, rawlogs, recorded, score, twin
 
@@ -74,17 +78,26 @@ def main() -> None:
     work.mkdir(parents=True, exist_ok=True)
     train = args.train or TRAIN[size]
     started = time.perf_counter()
-    written = rawlogs.write(args.track, version, size, test, work)
+    kept = work / "records.json"
+    if kept.is_file():  # the logs an earlier run wrote into WORK (for another --train or --no-calibrate)
+        held = json.loads(kept.read_text())
+        written = rawlogs.Written(work / held["logs"], held["robot"], {
+            uid: {name: np.array(rows, dtype=int) for name, rows in units.items()} for uid, units in held["records"].items()})
+    else:
+        written = rawlogs.write(args.track, version, size, test, work)
+        kept.write_text(json.dumps({"logs": str(written.logs.relative_to(work)), "robot": written.robot, "records": {
+            uid: {name: rows.tolist() for name, rows in units.items()} for uid, units in written.records.items()}}))
     n_logs = sum(len(r) for units in written.records.values() for r in units.values())
     print(f"{args.track} v{version} ({size}): {len(test)} test units, {n_logs} logs in "
           f"{sum(len(u) for u in written.records.values())} monitor units written in {time.perf_counter() - started:.0f} s")
     started = time.perf_counter()
-    command = monitor(written, work / "monitor", train, not args.no_calibrate, args.jobs)
+    out = work / f"monitor-train{train}{'-nominal' if args.no_calibrate else ''}"
+    command = monitor(written, out, train, not args.no_calibrate, args.jobs)
     print(f"{' '.join(command[2:])}: {time.perf_counter() - started:.0f} s")
-    with open(work / "monitor" / "units.csv", newline="") as f:
+    with open(out / "units.csv", newline="") as f:
         statuses = collections.Counter(r["status"] + " (" + r["model"] + ")" for r in csv.DictReader(f))
     print("monitor units: " + ", ".join(f"{n} {s}" for s, n in sorted(statuses.items())))
-    scores, alarms, named, answered = twin.answers(work / "monitor", written,
+    scores, alarms, named, answered = twin.answers(out, written,
                                                    {u.id: len(u.arrays["cycles"]) for u in test})
     silent = sum(int((~a).sum()) for a in answered.values())
     if silent:
