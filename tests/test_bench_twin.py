@@ -133,7 +133,7 @@ def test_a_task_mix_run_simulated_task_by_task_gives_the_tracks_cycles():
     assert {k: v["rows"].tolist() for k, v in parts.items()} == {"pick_place": [0, 2], "spot_weld": [1]}
     for task, part in parts.items():
         assert part["q"].shape[0] == len(part["rows"]) and part["tau"].shape == part["q"].shape
-        np.testing.assert_array_equal(part["payload"], mixed.conditions.payload_mass[part["rows"]])
+        np.testing.assert_array_equal(part["payload_mass"], mixed.conditions.payload_mass[part["rows"]])
         for name in files.FEATURES:
             np.testing.assert_allclose(part["features"][name], mixed.features[name][part["rows"]], rtol=1e-9, atol=1e-9)
 

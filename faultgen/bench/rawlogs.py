@@ -170,10 +170,10 @@ def _sweeps(parts: list[tuple[str, dict]], test: list[files.Unit], work: Path) -
 
 
 def _simulate(config, stepping) -> dict[str, dict]:
-    """``{task: {"rows", "cycles", "t", "q", "tau", "temperature", "payload", "features"}}`` of one run:
-    each task's cycles simulated with their signals (module docstring); ``rows`` index the run's
-    recorded cycles (its records in ``test.h5``). Shapes: ``t`` (n_log,) s; ``q`` and ``tau`` (n,
-    n_log, N) rad and N m at the arm side; ``temperature`` (n, N) deg C or None; ``payload`` (n,) kg."""
+    """Per task of one run, its cycles simulated with their signals (module docstring): ``rows``
+    (the run's recorded cycles, its records in ``test.h5``, that the task ran), ``cycles``, ``t``
+    (n_log,) s, ``q`` and ``tau`` (n, n_log, N) rad and N m at the arm side, ``joint_temperature``
+    (n, N) deg C or None, ``payload_mass`` (n,) kg and ``features`` (name -> (n, N))."""
     cycles = config.recorded_cycles
     conditions = config.conditions
     mix = conditions.task_mix
@@ -192,8 +192,9 @@ def _simulate(config, stepping) -> dict[str, dict]:
         out[str(task)] = {
             "rows": rows, "cycles": result.cycles, "t": result.t, "q": result.q_a,
             "tau": result.tau_m * config.model.gear_ratio,  # arm side: the motor torque through the gear ratio
-            "temperature": None if held is None or np.isnan(held.joint_temperature).all() else held.joint_temperature,
-            "payload": np.zeros(len(rows)) if held is None else held.payload_mass,
+            "joint_temperature": None if held is None or np.isnan(held.joint_temperature).all()
+            else held.joint_temperature,
+            "payload_mass": np.zeros(len(rows)) if held is None else held.payload_mass,
             "features": {n: result.features[n] for n in files.FEATURES}}
     return out
 
@@ -206,7 +207,7 @@ def _write_logs(folder: Path, part: dict) -> None:
     q_names, _, tau_names = jointlog.column_names(n)
     header = [jointlog.T_COLUMN, *q_names, *tau_names]
     formats = ["%.4f"] + ["%.8f"] * n + ["%.5f"] * n
-    has_temperature = part["temperature"] is not None
+    has_temperature = part["joint_temperature"] is not None
     if has_temperature:
         header += list(jointlog.temperature_columns(n))
         formats += ["%.3f"] * n
@@ -216,8 +217,8 @@ def _write_logs(folder: Path, part: dict) -> None:
     for i, cycle in enumerate(part["cycles"]):
         columns = [t[:, None], part["q"][i], part["tau"][i]]
         if has_temperature:
-            columns.append(np.broadcast_to(part["temperature"][i], (len(t), n)))
-        columns.append(np.full((len(t), 1), part["payload"][i]))
+            columns.append(np.broadcast_to(part["joint_temperature"][i], (len(t), n)))
+        columns.append(np.full((len(t), 1), part["payload_mass"][i]))
         path = folder / f"{int(cycle):04d}.csv"
         partial = path.with_name(path.name + ".part")
         np.savetxt(partial, np.hstack(columns), fmt=formats, delimiter=",", header=",".join(header), comments="")
