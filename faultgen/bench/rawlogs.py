@@ -140,19 +140,28 @@ def _sweeps(parts: list[tuple[str, dict]], test: list[files.Unit], work: Path) -
         runs += grid.runs()
     regenerated, rows = {}, {}
     staged = work / "runs"
+    staged.mkdir(parents=True, exist_ok=True)
     for run_id, config in runs:
         if robot not in (None, config.robot):
             raise ValueError(f"the test split runs robots {robot} and {config.robot}; the monitor takes one")
         if config.daily:
             raise ValueError(f"run {run_id} records one sample a day: its records are no logs")
         robot = config.robot
-        features, rows[run_id] = [], {}
-        for task, part in _simulate(config, stepping).items():  # written at once: a run's signals, not all
-            _write_logs(staged / f"{run_id}-{task}", part)
-            features.append((part["rows"], np.concatenate([part["features"][n] for n in files.FEATURES], axis=1)))
-            rows[run_id][task] = part["rows"]
-        order = np.concatenate([r for r, _ in features])
-        regenerated[run_id] = np.concatenate([f for _, f in features])[np.argsort(order)]
+        done = staged / f"{run_id}.npz"  # a run whose logs are all written: kept (a stopped write resumes)
+        if not done.is_file():
+            features, tasks = [], {}
+            for task, part in _simulate(config, stepping).items():  # written at once: a run's signals, not all
+                _write_logs(staged / f"{run_id}-{task}", part)
+                features.append((part["rows"], np.concatenate([part["features"][n] for n in files.FEATURES], axis=1)))
+                tasks[task] = part["rows"]
+            order = np.concatenate([r for r, _ in features])
+            partial = staged / f"{run_id}.part.npz"
+            np.savez(partial, features=np.concatenate([f for _, f in features])[np.argsort(order)],
+                     **{f"rows_{task}": r for task, r in tasks.items()})
+            os.replace(partial, done)
+        with np.load(done) as held:
+            regenerated[run_id] = held["features"]
+            rows[run_id] = {name[5:]: held[name] for name in held.files if name.startswith("rows_")}
     tied = match(regenerated, test)
     logs = work / "logs"
     logs.mkdir(parents=True, exist_ok=True)
