@@ -104,11 +104,13 @@ def main() -> None:
         print(f"warning: the monitor gave no row for {silent} of {sum(len(a) for a in answered.values())} records "
               f"(a unit still learning its {train} logs when its logs ended): scored below every answer, no alarm; "
               "the track is too short for the twin there")
+    name = NAME + (", nominal model" if args.no_calibrate else "") + (
+        f", {train} learning logs" if train != TRAIN[size] else "")
     stem = args.out or args.data / "score-twin"
     rows = []
     for role, method in (("detector", recorded.RecordedDetector(recorded.detector_answers(test, scores, alarms))),
                          ("isolator", recorded.RecordedIsolator(recorded.isolator_answers(test, named)))):
-        results = score.score(args.data, method, NAME, role, track=args.track)
+        results = score.score(args.data, method, name, role, track=args.track)
         json_path, _ = score.write(results, stem.with_name(f"{stem.name}-{role}"), command_line)
         rows.append(score.markdown_row(results, command_line))
         print(f"wrote {json_path}")
