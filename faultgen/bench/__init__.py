@@ -11,6 +11,9 @@
 - :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods and two pyod detectors).
 - :mod:`~faultgen.bench.independent`: the sim-to-real track's test fleet, made by another simulator
   (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use).
+- :mod:`~faultgen.bench.rawlogs`, :mod:`~faultgen.bench.twin`, :mod:`~faultgen.bench.recorded`:
+  ``faultgen monitor``'s twin as a baseline: a track's test split written again as raw logs, the
+  monitor's outputs read as per-unit answers, and answers made elsewhere scored by :mod:`score`.
 
 The layer sits above ``runs`` (it sweeps) and reads with the ``analysis`` package (it scores); only
 the command line sits above it (docs/bench.md).
