@@ -120,8 +120,8 @@ def main() -> None:
         else:
             for unit in results["results"]["per_unit"]:
                 print(f"  {unit['unit']}: detected {unit['detected']}, after 10 % {unit['after_10pct']}")
-    print("| track | method | AUROC [95 % CI] | false alarms % | detected % | delay after 10 % wear | "
-          "isolation top-1 % | command | date |")
+    print(score.HEADER)
+    print(score.SEPARATOR)
     print("\n".join(rows))
 
 

@@ -106,7 +106,7 @@ def test_an_injected_outcome_gives_the_expected_figures_through_the_scorer(injec
     assert isolator["results"]["top1_accuracy"]["value"] == 0.5  # axis 2 right, axis 5 for 4 wrong
     assert isolator["results"]["undecided_on_healthy"]["value"] == 1.0
     row = score.markdown_row(isolator, "python benchmarks/twin_baseline.py --track sim-to-real --data d")
-    assert row.startswith("| sim-to-real v2 (small) | twin | - | - | - | - | 50.0 [")
+    assert row.startswith("| sim-to-real v2 (small) | twin | - | - | - | - | - | 50.0 [")
 
 
 def test_a_unit_without_answers_is_refused_not_left_undecided(injected):
@@ -163,7 +163,7 @@ def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_ro
                           capture_output=True, text=True, timeout=600, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     rows = [line for line in done.stdout.splitlines() if line.startswith("| sim-to-real v2 (small) | twin")]
-    assert len(rows) == 2 and rows[0].split(" | ")[2] != "-" and rows[1].split(" | ")[6].endswith("(chance 16.7)")
+    assert len(rows) == 2 and rows[0].split(" | ")[2] != "-" and rows[1].split(" | ")[7].endswith("(chance 16.7)")
     detector = json.loads((data / "score-twin-detector.json").read_text())["results"]
     isolator = json.loads((data / "score-twin-isolator.json").read_text())["results"]
     assert sorted(u["unit"] for u in detector["per_unit"]) == sorted(k for k, v in truth.items() if v)
