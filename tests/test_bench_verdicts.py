@@ -14,7 +14,6 @@ import pytest
 from markdown_it import MarkdownIt
 from typer.testing import CliRunner
 
-from analysis import plugins
 from analysis.isolation import TransferEntropyIsolator
 from analysis.monitoring import detect_onset
 from faultgen.bench import baselines, files, score, verdicts

@@ -90,7 +90,7 @@ class Limits:
     from_files: bool = False
 
     @property
-    def task_velocity(self) -> np.ndarray:  # noqa: D102 (documented above)
+    def task_velocity(self) -> np.ndarray:
         given = self._task_velocity
         return np.asarray(given() if callable(given) else given, dtype=float)
 
