@@ -70,6 +70,13 @@ class AlwaysBacklash(BaseEstimator):
         return self
 
 
+class NeverNames(BaseEstimator):
+    """An isolator that names no axis on any unit (the contract's "too few cycles" refusal)."""
+
+    def fit(self, X, y=None):
+        raise ValueError("too few cycles to name an axis")
+
+
 class AlarmsOnlyRaising(BaseEstimator):
     """A detector with no decision_function whose predict raises: its score is its alarms, and the
     raise is named on one line as `detect` names it (issue 61, item 7)."""

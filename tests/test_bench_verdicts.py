@@ -125,6 +125,24 @@ def test_transfer_entropy_on_a_short_track_is_warned_about(thesis_small, tmp_pat
         TransferEntropyIsolator(), "transfer_entropy", short)["warnings"][0]
 
 
+def test_an_isolator_naming_no_axis_has_no_verdict_not_below_chance(thesis_small, tmp_path):
+    """An isolator that leaves every worn unit undecided scores top-1 0 %: an abstention, said as no
+    verdict (the twin on the small conditions track read "below chance" from an empty answer set)."""
+    out = tmp_path / "never"
+    result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(thesis_small),
+                                 "--isolator", "bench_plugins:NeverNames", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.with_name("never.md").read_text()
+    assert "no verdict (the method named no axis on any of the 6 worn units" in text
+    assert "no verdict: the method named no axis on any worn unit" in text  # the row's verdict cell
+    assert "below chance" not in text and "below chance" not in result.output
+    r = json.loads(out.with_name("never.json").read_text())["results"]
+    assert r["top1_accuracy"]["value"] == 0.0 and verdicts.named_none(r)
+    # one worn unit named (wrongly) is an answer again, judged against chance
+    r["per_unit"][next(i for i, u in enumerate(r["per_unit"]) if u["worn_axis"])]["named"] = 1
+    assert not verdicts.named_none(r)
+
+
 @pytest.mark.parametrize("method", ["pca", "trend"])
 def test_out_md_is_a_markdown_table_with_a_verdict_line_per_figure(thesis_small, tmp_path, method):
     role, estimator = baselines.make(method)

@@ -189,12 +189,24 @@ def detector_lines(r: dict) -> list[str]:
     return out
 
 
+def named_none(r: dict) -> bool:
+    """True when an isolator left every worn test unit undecided (named no axis: its top-1 of 0 is
+    an abstention, not a wrong answer, and says nothing either way)."""
+    worn = [u for u in r.get("per_unit", []) if u.get("worn_axis")]
+    return bool(worn) and all(u["named"] == 0 for u in worn)
+
+
 def isolator_lines(r: dict) -> list[str]:
     """The verdict lines of an isolator's results, the too-short warning first."""
     out = [f"WARNING: {w}" for w in r.get("warnings", [])]
     top1 = r["top1_accuracy"]
-    out.append(_figure_line("isolation top-1", top1, 100.0, " %", f"chance {100 * top1['chance']:.1f} %: one "
-                            f"axis of {round(1 / top1['chance'])} named at random", short=bool(r.get("warnings"))))
+    against = f"chance {100 * top1['chance']:.1f} %: one axis of {round(1 / top1['chance'])} named at random"
+    if named_none(r) and not r.get("warnings"):
+        worn = sum(1 for u in r["per_unit"] if u["worn_axis"])
+        out.append(f"isolation top-1 0.0 %: no verdict (the method named no axis on any of the {worn} worn units: "
+                   f"it says nothing; {against})")
+    else:
+        out.append(_figure_line("isolation top-1", top1, 100.0, " %", against, short=bool(r.get("warnings"))))
     if "fault_type_accuracy" in r:
         kind = r["fault_type_accuracy"]
         out.append(_figure_line("fault type", kind, 100.0, " %", f"chance {100 * kind['chance']:.1f} %: one of "
@@ -218,6 +230,8 @@ def summary(results: dict) -> str:
     top1 = r["top1_accuracy"]
     if r.get("warnings"):
         return "no verdict: the track is too short for the method (its figure says nothing)"
+    if named_none(r):
+        return "no verdict: the method named no axis on any worn unit"
     cell = f"top-1 {word(*top1['ci95'], top1['chance'])}"
     if "fault_type_accuracy" in r:
         kind = r["fault_type_accuracy"]
