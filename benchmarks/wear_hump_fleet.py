@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import datetime
 import io
 import os
 import sys
@@ -80,13 +79,7 @@ def write_fleet(root: Path, spec: ind.FleetSpec, robot: Path) -> tuple[Path, Pat
         rng = np.random.default_rng(unit["seed"])
         a = unit["axis"] - 1
         for d, stamp in enumerate(days, start=1):
-            date = datetime.date.fromisoformat(stamp)
-            season = np.cos(2 * np.pi * (date.timetuple().tm_yday - 200) / 365.25)
-            ambient = unit["ambient"] + unit["swing"] * season + rng.normal(0.0, 1.0)
-            temperature = ambient + unit["rise"]
-            week = (d - 1) // 7
-            new_product = d >= unit["new_part_day"]
-            mass = unit["parts"][int((unit["new_weeks"] if new_product else unit["weeks"])[week])]
+            temperature, mass = ind.day_conditions(unit, d, stamp, rng)
             wear = ind.wear_percent(spec, unit["onset"], d) if unit["axis"] else 0.0
             jitter = np.exp(rng.normal(0.0, ind.JITTER, (3, n)))
             fc = fc0 * unit["spread"][0] * jitter[0]

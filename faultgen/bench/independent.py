@@ -300,6 +300,20 @@ def truth_rows(spec: FleetSpec, n_axes: int = 6) -> list[list]:
     return rows
 
 
+def day_conditions(unit: dict, day: int, stamp: str, rng: np.random.Generator) -> tuple[float, float]:
+    """A unit's joint temperature (deg C: the season's ambient, one draw of ``rng`` for the day's
+    weather, plus the unit's rise) and part mass (kg: the week's part, of the new product from its
+    day) on ``day`` (1-based) dated ``stamp``; ``unit`` one of :func:`_units`."""
+    date = datetime.date.fromisoformat(stamp)
+    season = np.cos(2 * np.pi * (date.timetuple().tm_yday - 200) / 365.25)
+    ambient = unit["ambient"] + unit["swing"] * season + rng.normal(0.0, 1.0)
+    temperature = ambient + unit["rise"]
+    week = (day - 1) // 7
+    new_product = day >= unit["new_part_day"]
+    mass = unit["parts"][int((unit["new_weeks"] if new_product else unit["weeks"])[week])]
+    return temperature, mass
+
+
 def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     """Write the fleet of the robot folder ``robot`` under ``root``: ``root/logs/<unit>/<stamp>.csv``
     and ``root/truth.csv``; returns (logs, truth).
@@ -333,13 +347,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
         rng = np.random.default_rng(unit["seed"])
         folder_of_unit.mkdir(parents=True, exist_ok=True)
         for d, stamp in enumerate(days, start=1):
-            date = datetime.date.fromisoformat(stamp)
-            season = np.cos(2 * np.pi * (date.timetuple().tm_yday - 200) / 365.25)
-            ambient = unit["ambient"] + unit["swing"] * season + rng.normal(0.0, 1.0)
-            temperature = ambient + unit["rise"]
-            week = (d - 1) // 7
-            new_product = d >= unit["new_part_day"]
-            mass = unit["parts"][int((unit["new_weeks"] if new_product else unit["weeks"])[week])]
+            temperature, mass = day_conditions(unit, d, stamp, rng)
             wear = _wear(spec, unit, d)
             grow = np.ones(n)
             if unit["axis"]:
