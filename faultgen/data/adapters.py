@@ -191,9 +191,10 @@ class URRTDE(Adapter):
 def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str], label) -> dict[str, np.ndarray]:
     """The ``wanted`` columns of an RTDE log parsed as numbers (only they converted and kept: memory
     in proportion to the numbers, where reading every cell as text took 7 times the file), refused
-    at the first cell that is not a finite number, found from the text in chunks of rows."""
+    at the first cell that is not a finite number, found from the text in chunks of rows (every
+    column of a row is tokenized, kept or not: a chunk's rows are bounded by all the columns)."""
     kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": max(1_000, jointlog.CHUNK_CELLS // len(wanted))}
+          "skiprows": 1, "chunksize": max(1_000, jointlog.CHUNK_CELLS // len(names))}
     parts = {name: [] for name in wanted}
     try:
         with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
