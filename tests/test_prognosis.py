@@ -21,7 +21,7 @@ SAMPLES = 200  # draws of the fit per prediction (the monitor takes prognosis.SA
 def _rows(wear: np.ndarray, start: str = "2026-01-05", sequence: bool = False) -> list[dict]:
     day = datetime.date.fromisoformat(start)
     return [{"stamp": str(100 + i) if sequence else (day + datetime.timedelta(days=i)).isoformat(),
-             "phase": "monitoring", "wear1": float(w), "wear1_lower": float(w - Z * NOISE)}
+             "phase": "monitoring", "wear1_log": float(w), "wear1_log_lower": float(w - Z * NOISE)}
             for i, w in enumerate(wear)]
 
 

@@ -57,8 +57,8 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
             unit.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
-            error = (row[f"wear{axis}"] - row[f"wear{axis}_lower"]) / unit.bound_quantile
-            z.append(row[f"wear{axis}"] / error)
+            error = (row[f"wear{axis}_log"] - row[f"wear{axis}_log_lower"]) / unit.bound_quantile
+            z.append(row[f"wear{axis}_log"] / error)
     return unit, np.array(z)
 
 

@@ -5,8 +5,9 @@ The monitor runs on the test split's raw logs (:mod:`faultgen.bench.rawlogs`) an
 ``scores.csv`` (per monitor unit and log) and ``alarms.csv`` (per unit, its persistent alarms and the
 axis each names). Read back per test unit (:func:`answers`):
 
-- **score** of a record: the largest over the axes of the lower ``1 - alpha`` bound of the log's wear
-  estimate (``wearI_lower``, % of the axis's own dry friction): the statistic the monitor alarms on
+- **score** of a record: the largest over the axes of the lower ``1 - alpha`` bound of the wear at the
+  log (``wearI_lower``, % of the axis's own dry friction, filtered over the unit's logs up to that
+  one, :class:`faultgen.monitor.scoring.WearTrend`): the statistic the monitor alarms on
   with the twin (a log alarms when it reaches ``--wear-limit``). The monitor gives it for the logs it
   learned from too (``phase`` training, estimated with what it learned from them); a log it gave no
   row (a unit still learning when its logs ended, a log skipped) gets :data:`UNSCORED` below every
@@ -24,6 +25,7 @@ The bench layer does not import the monitor (they are sibling layers): it reads 
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import numpy as np
@@ -72,7 +74,7 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
         log that is not among the unit's logs.
     """
     rows = _read(Path(out) / "scores.csv")
-    lower = sorted((c for c in (rows[0] if rows else {}) if c.startswith("wear") and c.endswith("_lower")),
+    lower = sorted((c for c in (rows[0] if rows else {}) if re.fullmatch(r"wear\d+_lower", c)),
                    key=lambda c: int(c[4:-6]))
     if rows and not lower:
         raise ValueError(f"{out}/scores.csv has no wear estimates (wearI_lower): the monitor ran without the twin")

@@ -1,8 +1,9 @@
 """Remaining useful life per unit and axis (issue 59): the time until an axis's wear estimate
 reaches a failure wear, as a distribution, from a degradation trend fitted on the unit's wear
-estimates (:mod:`faultgen.monitor.scoring`: per log and axis ``wearI`` %, of the axis's own dry friction, and
-its lower ``1 - alpha`` bound ``wearI_lower``; the estimate's standard error is ``(wearI -
-wearI_lower) / z``, ``z`` the standard normal's ``1 - alpha`` quantile). Recomputed from the
+estimates (:mod:`faultgen.monitor.scoring`: per log and axis its own estimate ``wearI_log`` %, of the
+axis's own dry friction, and its lower ``1 - alpha`` bound ``wearI_log_lower``; the estimate's
+standard error is ``(wearI_log - wearI_log_lower) / z``, ``z`` the standard normal's ``1 - alpha``
+quantile; not the wear filtered over the logs, ``wearI``, whose errors are not independent). Recomputed from the
 unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`write_rul`).
 
 Per axis:
@@ -290,14 +291,16 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                    source_axis: int | None = None, horizon: float = HORIZON, samples: int = SAMPLES,
                    seed: int = 0, axes: list[int] | None = None) -> list[Remaining]:
     """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
-    rows (``UnitMonitor.rows``: ``stamp``, ``phase``, ``wearI``, ``wearI_lower``) with the monitor's
+    rows (``UnitMonitor.rows``: ``stamp``, ``phase``, each log's own wear estimate ``wearI_log`` and its
+    lower bound ``wearI_log_lower``, not the filtered ``wearI``, whose errors are not independent from
+    log to log as the trend's fit assumes) with the monitor's
     ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
     first alarm of the open alarm, whose ``source_axis`` is fitted from it on (module docstring);
     ``axes`` (1..N) the axes wanted, all when None. A unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
     check_failure_wear(failure_wear)
     stamp = rows[-1]["stamp"] if rows else ""
-    if not rows or "wear1" not in rows[0]:
+    if not rows or "wear1_log" not in rows[0]:
         why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
         return [Remaining(unit, None, stamp, "", why, failure_wear, horizon)]
     block = []
@@ -326,8 +329,8 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                             f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
             out.append(base)
             continue
-        wear = np.array([r[f"wear{axis}"] for r in fitted], dtype=float)
-        error = (wear - np.array([r[f"wear{axis}_lower"] for r in fitted], dtype=float)) / z
+        wear = np.array([r[f"wear{axis}_log"] for r in fitted], dtype=float)
+        error = (wear - np.array([r[f"wear{axis}_log_lower"] for r in fitted], dtype=float)) / z
         t = np.array([keys[r["stamp"]] for r in fitted], dtype=float)
         t = (t - t[-1]) / per
         fit = fit_trend(t, wear, np.maximum(error, 1e-9))

@@ -48,11 +48,13 @@ def write_alarms(path: Path, monitors) -> None:
 
 
 def write_scores(path: Path, monitors, n_axes: int) -> None:
-    """Every scored log's row; with the twin also each axis's wear estimate, % (``wearI``), and its
-    lower ``1 - alpha`` bound (``wearI_lower``), what the alarm is judged on."""
+    """Every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
+    logs, :class:`faultgen.monitor.scoring.WearTrend`), its lower ``1 - alpha`` bound
+    (``wearI_lower``), what the alarm is judged on, and the log's own estimate and bound
+    (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
     if any(m.signatures is not None for m in monitors):
-        columns += tuple(f"wear{i}" for i in range(1, n_axes + 1)) + tuple(f"wear{i}_lower" for i in range(1, n_axes + 1))
+        columns += tuple(f"wear{i}{end}" for end in ("", "_lower", "_log", "_log_lower") for i in range(1, n_axes + 1))
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(columns)
@@ -61,15 +63,17 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
                 writer.writerow([_fmt(row.get(c, "")) for c in columns])
 
 
-WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower")
+WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
 
 
 def write_wear(path: Path, monitors) -> None:
-    """``wear.csv``: per unit, scored log and axis (1..N), the wear estimate, % increase of the
-    axis's dry friction in % of the unit's own (``wear``), its 90 % interval with the twin's model
-    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`)
-    and the lower ``1 - alpha`` bound of its noise the alarm is judged on (``wear_lower``, as
-    ``wearI_lower`` of scores.csv). Only units with a twin have rows."""
+    """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
+    friction in % of the unit's own (``wear``: filtered over the logs so far,
+    :class:`faultgen.monitor.scoring.WearTrend`), its 90 % interval with the twin's model
+    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
+    the lower ``1 - alpha`` bound of its noise the alarm is judged on (``wear_lower``, as
+    ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin
+    have rows."""
     with open(path, "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(WEAR_COLUMNS)
@@ -79,7 +83,7 @@ def write_wear(path: Path, monitors) -> None:
                     continue
                 for axis in range(1, m.n_axes + 1):
                     writer.writerow([_fmt(row["unit"]), _fmt(row["stamp"]), row["phase"], axis,
-                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower"))])
+                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower", "_log"))])
 
 
 def chart(path, monitor, axis_note: str) -> None:

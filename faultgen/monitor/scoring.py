@@ -31,8 +31,10 @@ along that axis's wear signature (the twin's change of the features per % wear; 
 over each feature's variance: its noise times the prediction factor, squared, plus the twin's own
 uncertainty of :data:`MODEL_UNCERTAINTY` of its predicted change; the estimate's standard error is
 one over the root of the summed weights: the fault-magnitude estimate of a known fault direction,
-Gertler 1998 ch. 8; Basseville & Nikiforov 1993 ch. 7), and the log alarms when the lower
-``1 - alpha`` one-sided bound of the largest estimate reaches ``wear_limit`` % (:class:`Settings`).
+Gertler 1998 ch. 8; Basseville & Nikiforov 1993 ch. 7), each axis's estimates are filtered over
+the logs through a local linear trend (:class:`WearTrend`: a log's estimate scatters by 3-4 % of
+wear, the filtered wear by about half that), and the log alarms when the lower ``1 - alpha``
+one-sided bound of the largest filtered wear reaches ``wear_limit`` % (:class:`Settings`).
 T2 and Q alarm on any change the first logs did not show (drift of the season the unit's slopes
 extrapolate, a new part); the wear estimate only on a change along a wear signature, and its bound
 says how much wear, so a slow wear is called at a level and not when it first leaves the noise.
@@ -79,10 +81,60 @@ MODEL_UNCERTAINTY = 0.25
 SCALE_UNCERTAINTY = 0.10
 #: The two-sided interval of each wear estimate in ``wear.csv``.
 WEAR_INTERVAL = 0.90
+#: % of wear per log, per log: the standard deviation of the change of an axis's wear rate from one
+#: log to the next in the local linear trend through which each log's wear estimate is filtered
+#: (:class:`WearTrend`). The independent fleet's worn axes grow 0.5-1 % per log (60 % over 60-100
+#: daily logs); 0.1 lets the filter follow a rate that doubles within about ten logs. Chosen on
+#: seeds 0 and 1 of the independent fleet's first law (0.05-0.2 gave median errors within 0.2 point
+#: of each other), checked on a held-out seed and the second law (docs/analysis.md, "Wear in the
+#: robot's own scale").
+WEAR_RATE_CHANGE = 0.1
 
 
 #: Largest ``wear_limit`` taken, % (a friction ten times its nominal is no longer wear to monitor).
 MAX_WEAR_LIMIT = 1000.0
+
+
+class WearTrend:
+    """Each axis's wear filtered over the logs: a Kalman filter of a local linear trend (the wear
+    and its rate per log; the rate a random walk of :data:`WEAR_RATE_CHANGE`, the wear none beyond
+    it; Harvey 1989, ch. 2-3; Durbin & Koopman 2012, ch. 3), whose measurement is a log's wear
+    estimate with its standard error. A log's estimate scatters by 3-4 % of wear (a log's friction
+    scatter lies along the wear signature); the filtered wear by about half that, without the lag of
+    a mean over the last logs, since the rate is part of the state.
+
+    Parameters
+    ----------
+    n_axes : int
+    """
+
+    def __init__(self, n_axes: int):
+        self.n_axes = n_axes
+        self.state: np.ndarray | None = None  # (n_axes, 2): wear %, rate % per log
+        self.covariance: np.ndarray | None = None  # (n_axes, 2, 2)
+
+    def reset(self) -> None:
+        """Forget the trend (a new learning, a repair, a gearbox change): the next log starts it."""
+        self.state = self.covariance = None
+
+    def update(self, estimate: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Take a log's wear ``estimate`` % and its standard ``error`` % (both (n_axes,)); return the
+        filtered wear % and its standard error % (both (n_axes,)). The first log after a reset
+        starts the trend at its estimate, the rate at 0 -+ 1 % per log."""
+        estimate, variance = np.asarray(estimate, dtype=float), np.asarray(error, dtype=float) ** 2
+        if self.state is None:
+            self.state = np.stack([estimate, np.zeros(self.n_axes)], axis=1)
+            self.covariance = np.zeros((self.n_axes, 2, 2))
+            self.covariance[:, 0, 0], self.covariance[:, 1, 1] = variance, 1.0
+        else:
+            step = np.array([[1.0, 1.0], [0.0, 1.0]])
+            self.state = self.state @ step.T
+            self.covariance = step @ self.covariance @ step.T
+            self.covariance[:, 1, 1] += WEAR_RATE_CHANGE**2
+            gain = self.covariance[:, :, 0] / (self.covariance[:, 0, 0] + variance)[:, None]  # (n_axes, 2)
+            self.state = self.state + gain * (estimate - self.state[:, 0])[:, None]
+            self.covariance = self.covariance - gain[:, :, None] * self.covariance[:, None, 0, :]
+        return self.state[:, 0].copy(), np.sqrt(self.covariance[:, 0, 0])
 
 
 @dataclass(frozen=True)
@@ -91,7 +143,7 @@ class Settings:
     ``variance``, ``persistence`` (consecutive alarming logs) and, with the twin, ``wear_limit``:
     the wear, % increase of an axis's dry friction (Coulomb and Stribeck, thesis eq. 6.6) in % of
     the unit's own (its model's: calibrated on its first log, or nominal), that the lower ``1 -
-    alpha`` bound of a log's wear estimate (its noise) must reach for the log to alarm.
+    alpha`` bound of the wear filtered up to a log (its noise) must reach for the log to alarm.
 
     The default 10 % is the issue's (issue 59); its alarms on two independent fleets are in
     docs/analysis.md, "Wear in the robot's own scale"."""
@@ -144,6 +196,8 @@ class UnitMonitor:
         #: (n_axes,) each axis's wear estimate's scatter on the learning logs over its stated
         #: standard error, at least 1 (:meth:`_fit`; 1 before it).
         self.dispersion_ = np.ones(n_axes)
+        #: Each axis's wear filtered over the logs (the wear reported and alarmed on).
+        self.trend = WearTrend(n_axes)
 
     @property
     def relearn_logs(self) -> int:
@@ -182,6 +236,7 @@ class UnitMonitor:
         self.run = 0
         self.window.clear()
         self.relearning = []
+        self.trend.reset()
 
     # -- learning -------------------------------------------------------------------------------
     def _fit(self) -> None:
@@ -204,6 +259,7 @@ class UnitMonitor:
         Z = R / self.scale_
         self.pca = PCAMonitor(variance=self.settings.variance, alpha=self.settings.alpha, cv=5).fit(Z)
         self.training = []
+        self.trend.reset()
         if self.signatures is not None:
             # the learning logs are unworn: their wear estimates' scatter over the stated standard
             # error (a feature's noise is not independent of the others': a log's friction scatter
@@ -277,6 +333,7 @@ class UnitMonitor:
             if len(self.relearning) == self.relearn_logs:
                 self.mean_ = np.mean(self.relearning, axis=0)
                 self.relearning = None
+                self.trend.reset()  # the wear restarts from the new offset
         factor = self.prediction_factor(conditions)
         z = self._standardise(e, conditions) / factor
         variance = (self.scale_ * factor) ** 2
@@ -301,14 +358,18 @@ class UnitMonitor:
         alarm = q > self.pca.q_limit_ or t2 > self.pca.t2_limit_
         wear_row = {}
         if wear is not None:
-            estimate, error = wear
+            log_estimate, log_error = wear
+            wear = estimate, error = self.trend.update(log_estimate, log_error)
             bound = estimate - self.bound_quantile * error
             alarm = bool(bound.max() >= self.settings.wear_limit)
             low, high = self.wear_interval(estimate, error)
             wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
                         **{f"wear{i + 1}_lower": float(v) for i, v in enumerate(bound)},
                         **{f"wear{i + 1}_5": float(v) for i, v in enumerate(low)},
-                        **{f"wear{i + 1}_95": float(v) for i, v in enumerate(high)}}
+                        **{f"wear{i + 1}_95": float(v) for i, v in enumerate(high)},
+                        **{f"wear{i + 1}_log": float(v) for i, v in enumerate(log_estimate)},
+                        **{f"wear{i + 1}_log_lower": float(v)
+                           for i, v in enumerate(log_estimate - self.bound_quantile * log_error)}}
         scores = self.axis_scores(z)
         ranking = np.argsort(-scores, kind="stable") + 1
         if phase == "monitoring":

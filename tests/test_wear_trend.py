@@ -1,0 +1,93 @@
+"""The wear filtered over the logs (issue 59, part 1: :class:`faultgen.monitor.scoring.WearTrend`): a
+Kalman filter of a local linear trend, checked against statsmodels' state-space Kalman filter (an
+independent implementation) and on simulated wear ramps against their truth."""
+
+import numpy as np
+import pytest
+from statsmodels.tsa.statespace.mlemodel import MLEModel
+
+from faultgen.monitor.scoring import WEAR_RATE_CHANGE, Settings, UnitMonitor, WearTrend
+
+
+def _statsmodels_filter(y: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """statsmodels' filtered wear and its standard error for the same local linear trend: the first
+    log is the prior (the wear at its estimate and variance, the rate 0 -+ 1 % per log), not
+    counted again as a measurement."""
+    model = MLEModel(np.r_[np.nan, y[1:]], k_states=2)
+    model.ssm["design"] = np.array([[1.0, 0.0]])
+    model.ssm["transition"] = np.array([[1.0, 1.0], [0.0, 1.0]])
+    model.ssm["selection"] = np.eye(2)
+    model.ssm["state_cov"] = np.diag([0.0, WEAR_RATE_CHANGE**2])
+    model.ssm["obs_cov"] = (error**2)[None, None, :]
+    model.ssm.initialize_known(np.array([y[0], 0.0]), np.diag([error[0] ** 2, 1.0]))
+    result = model.ssm.filter()
+    return result.filtered_state[0], np.sqrt(result.filtered_state_cov[0, 0])
+
+
+def test_the_trend_is_statsmodels_kalman_filter_of_a_local_linear_trend():
+    rng = np.random.default_rng(3)
+    n = 80
+    truth = np.maximum(np.arange(n) - 30, 0) * 0.8
+    error = rng.uniform(1.0, 4.0, (n, 3))
+    y = truth[:, None] + rng.normal(size=(n, 3)) * error
+    trend = WearTrend(3)
+    ours = np.array([trend.update(y[k], error[k]) for k in range(n)])  # (n, 2, 3)
+    for axis in range(3):
+        wear, sd = _statsmodels_filter(y[:, axis], error[:, axis])
+        np.testing.assert_allclose(ours[:, 0, axis], wear, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(ours[:, 1, axis], sd, rtol=1e-9, atol=1e-9)
+
+
+def test_on_wear_ramps_the_filter_halves_the_error_and_states_it():
+    """300 axes worn from a log in 30-60 at 0.5-1 % per log (the independent fleet's rates), each
+    log's estimate off by its error of 3-4 %: between 10 and 40 % true wear the filtered wear is off
+    by less than half as much (RMS 1.48 against 3.54 measured, 2026-11-25), without a lag (mean
+    error within 0.3 point), and its stated error is what it shows (the error over it scatters by
+    0.92; 1 when exact)."""
+    rng = np.random.default_rng(0)
+    filtered, raw, z = [], [], []
+    for _ in range(300):
+        n, onset, rate = 120, rng.integers(30, 60), rng.uniform(0.5, 1.0)
+        truth = np.maximum(np.arange(n) - onset, 0) * rate
+        error = rng.uniform(3.0, 4.0, n)
+        y = truth + rng.normal(size=n) * error
+        trend = WearTrend(1)
+        for k in range(n):
+            wear, sd = trend.update(y[k:k + 1], error[k:k + 1])
+            if 10 <= truth[k] <= 40:
+                filtered.append(wear[0] - truth[k])
+                raw.append(y[k] - truth[k])
+                z.append((wear[0] - truth[k]) / sd[0])
+    rms = np.sqrt(np.mean(np.square(filtered)))
+    assert rms < 0.5 * np.sqrt(np.mean(np.square(raw))), rms
+    assert abs(np.mean(filtered)) < 0.3
+    assert 0.8 <= np.std(z) <= 1.15, np.std(z)
+
+
+def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate():
+    rng = np.random.default_rng(5)
+    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    for i in range(60):
+        unit.add(f"{i:03d}", rng.normal(0, 0.05, 12) + max(i - 30, 0) * 0.8 * signatures[1], 30.0, 0.0,
+                 np.zeros(12))
+    rows = unit.rows
+    log = np.array([[r[f"wear{a}_log"] for a in range(1, 7)] for r in rows])
+    error = np.array([[r[f"wear{a}_log"] - r[f"wear{a}_log_lower"] for a in range(1, 7)] for r in rows])
+    trend = WearTrend(6)
+    expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile)[0] for k in range(len(rows))])
+    np.testing.assert_allclose([[r[f"wear{a}"] for a in range(1, 7)] for r in rows], expected, rtol=1e-12)
+    assert rows[-1]["wear2"] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
+
+
+def test_maintenance_restarts_the_trend():
+    rng = np.random.default_rng(6)
+    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    for i in range(50):
+        unit.add(f"{i:03d}", rng.normal(0, 0.05, 12) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(12))
+    unit.maintenance("050", "gearbox change", 2)
+    assert unit.trend.state is None
+    residual = rng.normal(0, 0.05, 12)
+    unit.add("051", residual, 30.0, 0.0, np.zeros(12))
+    assert unit.rows[-1]["wear2"] == pytest.approx(unit.rows[-1]["wear2_log"])  # a new trend starts at the log
