@@ -362,7 +362,11 @@ class UnitMonitor:
             wear = estimate, error = self.trend.update(log_estimate, log_error)
             bound = estimate - self.bound_quantile * error
             alarm = bool(bound.max() >= self.settings.wear_limit)
-            low, high = self.wear_interval(estimate, error)
+            # the interval keeps the log's own error: the filter averages out the scatter from log
+            # to log, not the errors that stay for weeks (an offset learned on logs with early wear,
+            # a season's drift extrapolated, the calibration's friction), which the learning logs
+            # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
+            low, high = self.wear_interval(estimate, log_error)
             wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
                         **{f"wear{i + 1}_lower": float(v) for i, v in enumerate(bound)},
                         **{f"wear{i + 1}_5": float(v) for i, v in enumerate(low)},
