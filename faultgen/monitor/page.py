@@ -53,7 +53,7 @@ SETTING_NAMES = {
     "alpha": "significance level",
     "variance": "PCA variance kept",
     "persistence": "consecutive alarming logs that make an alarm",
-    "wear_limit": "wear limit, % of the axis's own dry friction: the lower bound a log's wear estimate must reach to alarm",
+    "wear_limit": "wear limit, % of the axis's own dry friction: the lower bound of the wear, filtered over the logs, must reach to alarm",
     "twin_temperature": "the twin's temperature law predicts the seasonal change",
 }
 #: Order of the fleet table: what needs attention first (an open alarm before any status).
