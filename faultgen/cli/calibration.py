@@ -101,10 +101,11 @@ def excitation_command(
     """
     from faultgen.calibrate import excitation
     from faultgen.cli.base import check_outputs
+    from faultgen.model import robots
 
     check_outputs([out], overwrite)
-    designed = excitation.design(robot, harmonics=harmonics, period=period, seed=seed, iterations=iterations,
-                                 starts=starts)
+    designed = excitation.design(robots.load(robot), harmonics=harmonics, period=period, seed=seed,
+                                 iterations=iterations, starts=starts)
     designed.write(out)
     typer.echo(f"wrote {out}: {designed.period:g} s period, {len(designed.a)} harmonics, regressor condition "
                f"number {designed.condition_number:.1f} (first random start {designed.start_condition_number:.1f}, "
