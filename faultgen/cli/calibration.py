@@ -62,15 +62,15 @@ def calibrate_command(
       faultgen calibrate --robot puma560 --measured log.csv --out calib
     """
     from faultgen import calibrate
+    from faultgen.model import robots
 
     check_output_folder(out, overwrite)
-    adapter = log_adapter(log_format, torque_constants, robot)
+    nominal = robots.load(robot)  # once, for the log's reader and the calibration
+    adapter = log_adapter(log_format, torque_constants, nominal)
     log = measured
     if adapter is not None:  # read once, whole, by the format's adapter; calibrate takes the checked data
-        from faultgen.model import robots
-
-        log = adapter.read(measured, robots.load(robot))
-    result = calibrate.calibrate(robot, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
+        log = adapter.read(measured, nominal)
+    result = calibrate.calibrate(nominal, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
