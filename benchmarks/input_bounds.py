@@ -275,13 +275,14 @@ def make_work_bombs(folder: Path) -> dict[str, Path]:
 CASES_CODE = {
     "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
     "replay": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
-               "programs.load('puma560', {log!r}).trajectory(robots.load('puma560').model.opt.timestep)"),
+               "programs.load(robots.load('puma560'), {log!r}).trajectory(robots.load('puma560').model.opt.timestep)"),
     "simulate": ("from faultgen.simulation import stepping",
                  ("stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
                   "progress=False)")),
     "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
     "dh": ("from pathlib import Path\nfrom faultgen.model import import_dh", "import_dh.read_dh(Path({log!r}))"),
-    "program": ("from faultgen.operation import programs", "programs.read({log!r}, 'puma560')"),
+    "program": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
+                "programs.read({log!r}, robots.load('puma560'))"),
     "open": ("import faultgen", "faultgen.open({log!r}).features()"),
     "validate": ("from faultgen.data import dataset", "dataset.validate({log!r})"),
     # what `robots add` reads (expanded, parsed, compiled by MuJoCo); the URDF it would write, its size
@@ -298,7 +299,7 @@ CASES_CODE = {
                "logfolder.read_events(Path({log!r}), {{'u': [logfolder.LogFile('u', '1', 1.0, 'sequence', "
                "Path({log!r}).parent / 'u' / '1.csv', 'u/1.csv')]}}, 6)"),
     "program-path": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
-                     "programs.read({log!r}, 'puma560').trajectory(robots.load('puma560').model.opt.timestep)"),
+                     "programs.read({log!r}, robots.load('puma560')).trajectory(robots.load('puma560').model.opt.timestep)"),
 }
 
 

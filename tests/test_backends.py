@@ -25,7 +25,7 @@ PERIODS = 12  # log periods stepped (48 ms): a few seconds for the whole file
 
 def short_work(name, model_name, backend):
     """Two runs of the first ``PERIODS`` log periods of pick_place, each with its own plant."""
-    prepared = prepare.prepared_for(name, "pick_place", model_name)
+    prepared = prepare.prepared_for(robots.load(name), "pick_place", model_name)
     model, robot, per_log = prepared.sim.model, prepared.sim.robot, prepared.per_log
     n_steps = PERIODS * per_log
     n = robot.n_axes
@@ -65,7 +65,7 @@ def test_backend_steps_as_the_plain_loop(name, model_name, backend):
 
 
 def test_backends_are_different_steppers():
-    model = prepare.prepared_for("puma560", "pick_place", "lugre").sim.model
+    model = prepare.prepared_for(robots.load("puma560"), "pick_place", "lugre").sim.model
     assert isinstance(backends.get("loop").new(model, 2, 1), backends.LoopRuns)
     assert not isinstance(backends.get("batch").new(model, 2, 1), backends.LoopRuns)
 

@@ -13,10 +13,16 @@ from analysis import benchmark
 from faultgen import plot as plotting
 from faultgen.cli import app
 from faultgen.data import dataset, reader
+from faultgen.model import robots
 from faultgen.operation import programs
 from test_plot import _subset  # a valid dataset of some runs of another
 
 runner = CliRunner()
+
+
+def _irb():
+    """The robot these programs run on (resolved once per process: robots.load caches it)."""
+    return robots.load("irb6700")
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +34,7 @@ def sweep_file(shared_sweep):
 
 def _edited(folder, name=None):
     """The spot weld exported and edited (slower, first pose moved), as ``folder/mine2.toml``."""
-    text = programs.export("irb6700", "spot_weld")
+    text = programs.export(_irb(), "spot_weld")
     assert "velocity_scale = 1.0" in text and "pose = [1.55, -0.25, 0.8]" in text
     text = text.replace("velocity_scale = 1.0", "velocity_scale = 0.6", 1)
     text = text.replace("pose = [1.55, -0.25, 0.8]", "pose = [1.57, -0.25, 0.8]", 1)
@@ -40,22 +46,22 @@ def _edited(folder, name=None):
 
 
 def test_an_edited_export_is_labelled_by_its_file_and_an_unedited_one_is_the_task(tmp_path):
-    builtin = programs.identity("irb6700", "spot_weld")
-    assert builtin == ("spot_weld", hashlib.sha256(programs.export("irb6700", "spot_weld").encode()).hexdigest())
+    builtin = programs.identity(_irb(), "spot_weld")
+    assert builtin == ("spot_weld", hashlib.sha256(programs.export(_irb(), "spot_weld").encode()).hexdigest())
     same = tmp_path / "mine.toml"
-    same.write_text(programs.export("irb6700", "spot_weld"))
-    assert programs.identity("irb6700", str(same)) == builtin  # the same program, bit for bit
+    same.write_text(programs.export(_irb(), "spot_weld"))
+    assert programs.identity(_irb(), str(same)) == builtin  # the same program, bit for bit
     edited = _edited(tmp_path)
-    label, digest = programs.identity("irb6700", str(edited))
+    label, digest = programs.identity(_irb(), str(edited))
     assert label == "mine2" and digest == hashlib.sha256(edited.read_bytes()).hexdigest() != builtin[1]
     renamed = _edited(tmp_path, name="slow_weld")  # a name of its own is kept
-    assert programs.identity("irb6700", str(renamed))[0] == "slow_weld"
+    assert programs.identity(_irb(), str(renamed))[0] == "slow_weld"
 
 
 def test_a_sweep_refuses_two_programs_under_one_label_and_writes_nothing(tmp_path):
     a = _edited(tmp_path, name="myweld").rename(tmp_path / "a.toml")
     b = tmp_path / "b.toml"
-    b.write_text(programs.export("irb6700", "spot_weld").replace('name = "spot_weld"', 'name = "myweld"'))
+    b.write_text(programs.export(_irb(), "spot_weld").replace('name = "spot_weld"', 'name = "myweld"'))
     out = tmp_path / "bad.h5"
     result = runner.invoke(app, ["sweep", "--task", str(a), "--task", str(b), "--axis", "0", "--cycles", "2",
                                  "-o", str(out), "--no-progress"])
@@ -67,7 +73,7 @@ def test_a_sweep_refuses_two_programs_under_one_label_and_writes_nothing(tmp_pat
 def test_every_run_records_its_programs_hash_and_the_validator_checks_it(sweep_file, tmp_path):
     with reader.open(sweep_file) as data:
         for run in data.runs:
-            assert run.program_sha256 == programs.identity("irb6700", run.task)[1]
+            assert run.program_sha256 == programs.identity(_irb(), run.task)[1]
             assert run.program == run.program_sha256
         assert data.unhashed == ""
     bad = tmp_path / "bad.h5"

@@ -14,7 +14,7 @@ runner = CliRunner()
 
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory):
-    return programs.export("irb6700", "pick_place")
+    return programs.export(robots.load("irb6700"), "pick_place")
 
 
 def _edited(text: str, key: str, value: str) -> str:
@@ -45,7 +45,7 @@ def test_a_program_value_out_of_range_is_refused_naming_file_and_key(exported, t
 
 
 def test_the_programs_the_project_ships_still_read(exported):
-    program = programs.parse(exported, "irb6700")
+    program = programs.parse(exported, robots.load("irb6700"))
     assert program.process == "point-to-point" and program.robot_name == "irb6700"
     robot = robots.load("irb6700")
     shipped = programs.read(robot.path.parent / "programs" / "palletize.toml", robot)

@@ -77,8 +77,8 @@ def test_dataset_records_the_program_and_validates(tmp_path):
         assert record["sha256"] in attrs["config"]
     # the stored text is the program: written back, it runs the same path
     again = write(tmp_path, "again.toml", attrs["program_text"])
-    a = programs.read(program, "puma560").trajectory(0.004)
-    b = programs.read(again, "puma560").trajectory(0.004)
+    a = programs.read(program, robots.load("puma560")).trajectory(0.004)
+    b = programs.read(again, robots.load("puma560")).trajectory(0.004)
     np.testing.assert_array_equal(a.q, b.q)
     with h5py.File(out, "r+") as f:  # a tampered text is caught
         f["runs/run"].attrs["program_text"] = attrs["program_text"].replace("0.4", "0.5")
@@ -203,7 +203,7 @@ def log_csv(tmp_path, t, q, name="log.csv"):
 
 
 def test_refuses_a_log_outside_the_joint_limits_or_too_short(tmp_path):
-    path = programs.load("puma560", "pick_place").trajectory(0.004)
+    path = programs.load(robots.load("puma560"), "pick_place").trajectory(0.004)
     q = path.q[:500].copy()
     q[200, 4] = 2.0  # axis 5 of the PUMA 560 reaches +-100 deg = 1.745 rad
     log_csv(tmp_path, path.t[:500], q)
@@ -237,12 +237,12 @@ def test_a_replayed_log_that_starts_and_ends_moving_is_the_recorded_reference(tm
     """A 3 s piece of the PUMA 560's pick and place, cut mid-motion at both ends, logged at 1 kHz with
     an offset clock: the run starts in the log's first state (moving), and the reference recorded in
     the dataset is the log at the recorded times within 1e-6 rad (issue 51: 0.81 rad before)."""
-    thesis = programs.load("puma560", "pick_place").trajectory(0.001)
+    thesis = programs.load(robots.load("puma560"), "pick_place").trajectory(0.001)
     piece = slice(300, 3301)  # moving at both ends
     assert np.abs(thesis.qd[300]).max() > 0.1 and np.abs(thesis.qd[3300]).max() > 0.1
     t = 100.0 + thesis.t[piece]
     log = log_csv(tmp_path, t, thesis.q[piece])
-    loaded = programs.load("puma560", str(log))
+    loaded = programs.load(robots.load("puma560"), str(log))
     path = loaded.trajectory(robots.load("puma560").model.opt.timestep)
     assert [s[0] for s in path.segments] == ["replay", "run-out"]
     np.testing.assert_array_equal(path.qd[-1], 0.0)
@@ -284,10 +284,10 @@ def test_a_log_denser_than_the_physics_step_is_replayed_at_that_step_read_in_blo
     t = np.arange(40001) / 20000
     s = t / t[-1]
     q = robot.home + (10 * s**3 - 15 * s**4 + 6 * s**5)[:, None] * np.array([1.0, 0.4, -0.5, 1.2, 0.8, 1.5])
-    sparse = programs.load("irb6700", str(log_csv(tmp_path, t[::10], q[::10], name="sparse.csv")))
+    sparse = programs.load(robots.load("irb6700"), str(log_csv(tmp_path, t[::10], q[::10], name="sparse.csv")))
     dense = log_csv(tmp_path, t, q, name="dense.csv")
     monkeypatch.setattr(replay, "BLOCK_ROWS", 5000)
-    blocks = programs.load("irb6700", str(dense))
+    blocks = programs.load(robots.load("irb6700"), str(dense))
     assert len(sparse.t) == len(blocks.t) == 4001
     for name in ("t", "q", "qd", "qdd"):
         np.testing.assert_array_equal(getattr(blocks, name), getattr(sparse, name))
@@ -412,7 +412,7 @@ def test_the_task_mix_and_the_fleet_take_program_files(tmp_path):
     from faultgen.operation.conditions import TaskMix
     from faultgen.runs.fleet import Fleet
 
-    program = write(tmp_path, "mine.toml", programs.export("irb6700", "spot_weld"))
+    program = write(tmp_path, "mine.toml", programs.export(robots.load("irb6700"), "spot_weld"))
     assert TaskMix((str(program), "pick_place")).tasks == (str(program), "pick_place")
     with pytest.raises(ValueError, match="task mix: task file .*missing.toml.* does not exist"):
         TaskMix((str(tmp_path / "missing.toml"),))

@@ -257,7 +257,7 @@ def test_a_program_of_1e4_moves_is_refused_before_any_move_is_checked(tmp_path):
     path.write_text('name = "many"\nstart = [0, 92, -122, 30, 0, 0]\n\n' + "\n".join(moves))
     start = time.perf_counter()
     with pytest.raises(inputs.InputError) as err:  # 46 s and 1.4 GB before, refused by the cycle's duration
-        programs.read(path, "puma560")
+        programs.read(path, robots.load("puma560"))
     assert time.perf_counter() - start < 5.0
     assert str(err.value).startswith(f"{path}: 10000 [[segment]] tables; a program has at most "
                                      f"{programs.MAX_SEGMENTS}")

@@ -195,7 +195,7 @@ def test_two_versions_of_one_robot_are_compared_by_what_each_stored(tmp_path):
 
 
 def test_a_program_files_own_speed_limits_are_stored_and_carded(tmp_path):
-    text = programs.export("puma560", "pick_place").replace('name = "pick_place"', 'name = "slow_pp"')
+    text = programs.export(robots.load("puma560"), "pick_place").replace('name = "pick_place"', 'name = "slow_pp"')
     assert "velocity = [100, 95, 100, 150, 130, 110]" in text
     program = tmp_path / "slow.toml"
     program.write_text(text.replace("velocity = [100, 95, 100, 150, 130, 110]", "velocity = [80, 80, 80, 120, 100, 90]"))
@@ -205,7 +205,7 @@ def test_a_program_files_own_speed_limits_are_stored_and_carded(tmp_path):
     with faultgen.open(out) as data:
         limits = data.runs[0].limits
     np.testing.assert_allclose(np.degrees(limits.task_velocity), [80, 80, 80, 120, 100, 90], rtol=1e-12)
-    np.testing.assert_array_equal(limits.velocity, programs.robot_limits("puma560")[0])
+    np.testing.assert_array_equal(limits.velocity, programs.robot_limits(robots.load("puma560"))[0])
     card = runner.invoke(app, ["info", str(out), "--card"])
     assert card.exit_code == 0, card.output  # before the runs stored it: "unknown task 'slow_pp'"
     assert "| puma560 | slow_pp | speed_hist | rad/s (arm) | 0..the task's speed limit: 0..1.4; 0..1.4; 0..1.4; 0..2.09; " \

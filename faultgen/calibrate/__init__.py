@@ -61,7 +61,7 @@ __all__ = ["EFFECTS", "UNEXPLAINED_RATIO", "Calibration", "Effect", "Implausible
 MAX_ROWS = 25_000
 
 
-def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,
+def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
@@ -69,8 +69,10 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     log longer than :data:`MAX_ROWS` rows is first averaged down to that many (:func:`decimate`),
     so memory stays bounded whatever the log's length. A log on which no joint moves is refused
     (:class:`ImplausibleLogError`, naming the joints and how little they move). ``use_sysid``: a
-    Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`faultgen.calibrate.loop.run`)."""
-    nominal = robots.load(robot)
+    Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`faultgen.calibrate.loop.run`).
+    ``robot``: the nominal model, a :class:`~faultgen.model.robot.Robot` or a name, robot folder or MJCF
+    file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError)."""
+    nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
         data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)
     else:
@@ -88,7 +90,7 @@ def calibrate(robot: str | Path, measured: str | Path | measured_io.MeasuredData
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     with atomic.atomic_folder(out) as staging:
-        result = _calibrate(robot, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid)
+        result = _calibrate(nominal, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))
         atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
     return result

@@ -259,9 +259,9 @@ def condition_number(robot: robots.Robot, t: np.ndarray, q: np.ndarray, qd: np.n
     return float(np.sqrt(eigen[-1] / eigen[0])) if eigen[0] > 0 else float("inf")
 
 
-def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float = PERIOD, seed: int = 0,
+def design(robot: robots.Robot, harmonics: int = HARMONICS, period: float = PERIOD, seed: int = 0,
            iterations: int = ITERATIONS, effects: tuple[str, ...] = EFFECTS, starts: int = STARTS) -> Excitation:
-    """An excitation for ``robot`` (name, MJCF path or loaded model) optimised for a small
+    """An excitation for the resolved ``robot`` (:func:`faultgen.model.robots.load`) optimised for a small
     regressor condition number (module docstring): ``starts`` seeded random coefficient sets are
     scored, and the best :data:`LOCAL` of them optimised by L-BFGS-B on the logarithm of the
     condition number (finite-difference gradients), the columns and grid values fixed at those of
@@ -283,13 +283,15 @@ def design(robot: str | robots.Robot, harmonics: int = HARMONICS, period: float 
 
     Raises
     ------
+    TypeError
+        If ``robot`` is not a :class:`~faultgen.model.robot.Robot` (a name is resolved once, at the boundary).
     ValueError
         For ``harmonics`` < 1, ``period`` <= 0, ``iterations`` < 0 or ``starts`` < 1.
     """
     if harmonics < 1 or not period > 0 or iterations < 0 or starts < 1:
         raise ValueError(f"harmonics = {harmonics}, period = {period} s, iterations = {iterations}, starts = "
                          f"{starts}; expected harmonics >= 1, period > 0, iterations >= 0 and starts >= 1")
-    model = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    model = robots.require(robot, "excitation.design")
     bounds = limits(model)
     n_axes = len(model.gear_ratio)
     t = np.linspace(0.0, period, SAMPLES, endpoint=False)

@@ -28,15 +28,15 @@ from faultgen.model import robots
 MAX_STEPS = 6
 
 
-def run(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out: str | Path,
+def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
         max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
     Parameters
     ----------
-    robot : str or Path
-        Robot name (``faultgen robots``) or MJCF file of the nominal model.
+    robot : Robot
+        The nominal model, resolved by the caller (:func:`faultgen.calibrate.calibrate`).
     measured : str, Path or MeasuredData
         The measured file (design document format) or data already read.
     out : str or Path
@@ -58,8 +58,8 @@ def run(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out:
 
     Raises
     ------
-    UnknownRobotError, ModelError
-        For an unknown robot or a broken model file.
+    TypeError
+        If ``robot`` is not a :class:`~faultgen.model.robot.Robot` (a name is resolved once, at the boundary).
     MeasuredDataError
         For a measured file the reader refuses (the message names the column or row).
     ImplausibleLogError
@@ -70,7 +70,7 @@ def run(robot: str | Path, measured: str | Path | measured_io.MeasuredData, out:
     """
     if max_steps < 0:
         raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
-    nominal = robots.load(robot)
+    nominal = robots.require(robot, "calibrate.loop.run")
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)

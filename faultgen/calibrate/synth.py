@@ -105,7 +105,7 @@ class Hidden:
 
 def nominal_motion(robot: robots.Robot, task: str, cycles: int) -> tuple[Motion, np.ndarray]:
     """The task's reference motion repeated ``cycles`` times at the log rate, and its nominal torque."""
-    duration = sim.cycle_duration(str(robot.path), task)
+    duration = sim.cycle_duration(robot, task)
     path = programs.load(robot, task).trajectory(sensors.LOG_PERIOD)
     n = round(duration / sensors.LOG_PERIOD)
     # the path held at its last sample to the cycle's end, as the simulator does
@@ -231,7 +231,7 @@ def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path
     return path
 
 
-def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str = "pick_place",
+def record(robot: robots.Robot, hidden: Hidden, out: str | Path, task: str = "pick_place",
            cycles: int = 4, seed: int = 0, progress: bool = False) -> Path:
     """Simulate ``cycles`` cycles of ``task`` on the robot with ``hidden`` switched on and write
     the log in the measured-data format (CSV, the design document's columns) to ``out``; the
@@ -242,15 +242,21 @@ def record(robot: str | robots.Robot, hidden: Hidden, out: str | Path, task: str
     -------
     Path
         ``out``.
+
+    Raises
+    ------
+    TypeError
+        If ``robot`` is not a :class:`~faultgen.model.robot.Robot` (resolve a name once:
+        :func:`faultgen.model.robots.load`).
     """
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    robots.require(robot, "synth.record")
     out = Path(out)
     model = write_model(robot, hidden, out.parent / f"{out.stem}_model")
     config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed,
                            back_to_back=True)
     run = sim.simulate(config, progress=progress)
     G = robot.gear_ratio
-    duration = sim.cycle_duration(str(model), task)
+    duration = sim.cycle_duration(config.model, task)
     t = np.concatenate([(c - 1) * duration + run.t for c in run.cycles])
     t = t - t[0]
     # MuJoCo computes a step's drive torque from the state at the step's start, and the log

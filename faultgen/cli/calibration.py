@@ -62,15 +62,15 @@ def calibrate_command(
       faultgen calibrate --robot puma560 --measured log.csv --out calib
     """
     from faultgen import calibrate
+    from faultgen.model import robots
 
     check_output_folder(out, overwrite)
-    adapter = log_adapter(log_format, torque_constants, robot)
+    nominal = robots.load(robot)  # once, for the log's reader and the calibration
+    adapter = log_adapter(log_format, torque_constants, nominal)
     log = measured
     if adapter is not None:  # read once, whole, by the format's adapter; calibrate takes the checked data
-        from faultgen.model import robots
-
-        log = adapter.read(measured, robots.load(robot))
-    result = calibrate.calibrate(robot, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
+        log = adapter.read(measured, nominal)
+    result = calibrate.calibrate(nominal, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
@@ -101,10 +101,11 @@ def excitation_command(
     """
     from faultgen.calibrate import excitation
     from faultgen.cli.base import check_outputs
+    from faultgen.model import robots
 
     check_outputs([out], overwrite)
-    designed = excitation.design(robot, harmonics=harmonics, period=period, seed=seed, iterations=iterations,
-                                 starts=starts)
+    designed = excitation.design(robots.load(robot), harmonics=harmonics, period=period, seed=seed,
+                                 iterations=iterations, starts=starts)
     designed.write(out)
     typer.echo(f"wrote {out}: {designed.period:g} s period, {len(designed.a)} harmonics, regressor condition "
                f"number {designed.condition_number:.1f} (first random start {designed.start_condition_number:.1f}, "

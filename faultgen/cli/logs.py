@@ -63,8 +63,10 @@ def import_command(
       faultgen info fleet-logs.h5 && faultgen detect fleet-logs.h5
     """
     from faultgen.data import fleetlogs
+    from faultgen.model import robots
 
-    adapter = log_adapter(log_format, torque_constants, robot)
+    resolved = robots.load(robot)  # once, for the log reader and the import
+    adapter = log_adapter(log_format, torque_constants, resolved)
     read = {} if adapter is None else {"reader": functools.partial(adapter.read, accelerations=False),
                                        "suffixes": adapter.suffixes}
 
@@ -72,6 +74,6 @@ def import_command(
     # meant to be shared keeps no path of this machine (docs/reliability.md, "Log folders")
     args = [logs.name if logs.is_absolute() and Path(a) == logs else a for a in sys.argv[1:]]
     command = "faultgen " + " ".join(shlex.quote(a) for a in args)
-    summary = fleetlogs.import_logs(logs, out, robot=robot, skip_bad=skip_bad, progress=progress,
+    summary = fleetlogs.import_logs(logs, out, robot=resolved, skip_bad=skip_bad, progress=progress,
                                     reimport_changed=reimport_changed, command=command, **read)
     typer.echo(str(summary))

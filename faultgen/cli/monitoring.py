@@ -132,11 +132,13 @@ def monitor_command(
     \b
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
+    from faultgen.model import robots
     from faultgen.monitor import loop, page
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
-    adapter = log_adapter(log_format, torque_constants, robot)
+    # the monitor resolves its robot itself (faultgen.monitor.loop); here only to check --torque-constants
+    adapter = log_adapter(log_format, torque_constants, robots.load(robot) if torque_constants is not None else None)
     check_monitor_out(out, logs, overwrite)
     made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
     try:

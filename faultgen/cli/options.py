@@ -136,9 +136,10 @@ def conditions_from_options(temperature: bool, payloads: str | None, pattern: st
     return made if made.active else None
 
 
-def log_adapter(log_format: str, torque_constants: str | None, robot: str):
+def log_adapter(log_format: str, torque_constants: str | None, robot):
     """The :class:`faultgen.data.adapters.Adapter` of ``--format`` (None for the measured format)
-    with ``--torque-constants`` parsed and checked against ``robot``'s axes.
+    with ``--torque-constants`` parsed and checked against the axes of ``robot``, the command's
+    resolved :class:`~faultgen.model.robot.Robot` (None when no torque constants are given).
 
     Raises
     ------
@@ -147,7 +148,6 @@ def log_adapter(log_format: str, torque_constants: str | None, robot: str):
         per axis or outside their bounds (named).
     """
     from faultgen.data import adapters
-    from faultgen.model import robots
 
     if torque_constants is not None and log_format != "ur-rtde":
         raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
@@ -161,9 +161,9 @@ def log_adapter(log_format: str, torque_constants: str | None, robot: str):
         except ValueError:
             constants = ()
         lo, hi = adapters.MIN_TORQUE_CONSTANT, adapters.MAX_TORQUE_CONSTANT
-        n_axes = robots.load(robot).n_axes
+        n_axes = robot.n_axes
         if len(constants) != n_axes or not all(lo <= k <= hi for k in constants):
             raise ValueError(f"--torque-constants {torque_constants[:200]!r}: expected {n_axes} numbers (the axes "
-                             f"of {robot}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
+                             f"of {robot.name}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
         options["torque_constants"] = constants
     return adapters.make(log_format, **options)

@@ -41,9 +41,10 @@ def list_command(robot: Annotated[str, typer.Argument(help="Robot name or MJCF f
     \b
       faultgen tasks list irb6700
     """
+    from faultgen.model import robots
     from faultgen.operation import programs
 
-    rows = programs.available(robot)
+    rows = programs.available(robots.load(robot))  # the robot resolved here, once
     if not rows:
         typer.echo(f"{robot}: no tasks (no tasks.toml, no programs/ folder)")
         return
@@ -69,9 +70,9 @@ def show_command(
     from faultgen.model import robots
     from faultgen.operation import programs
 
-    typer.echo(programs.show(robot, task), nl=False)
+    loaded = robots.load(robot)  # once, for the text and the check
+    typer.echo(programs.show(loaded, task), nl=False)
     if check:
-        loaded = robots.load(robot)
         path = programs.load(loaded, task).trajectory(loaded.model.opt.timestep)
         typer.echo(f"# checked: {path.duration:.3f} s cycle, {len(path.segments)} path segments, "
                    f"{len(path.loads)} payload(s) carried", err=True)
@@ -93,9 +94,10 @@ def export_command(
       faultgen simulate --robot irb6700 --task sw.toml --wear 2:exp4:20 -o sw.h5
     """
     from faultgen.data.atomic import atomic_path
+    from faultgen.model import robots
     from faultgen.operation import programs
 
-    text = programs.export(robot, task)
+    text = programs.export(robots.load(robot), task)
     if out is None:
         typer.echo(text, nl=False)
         return

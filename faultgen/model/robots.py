@@ -34,7 +34,7 @@ class UnknownRobotError(ValueError):
 
 
 __all__ = ["RATED_PAYLOAD", "ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_of", "from_spec", "load",
-           "robots_dir", "source_of", "with_timestep"]
+           "require", "robots_dir", "source_of", "with_timestep"]
 
 
 def robots_dir() -> Path:
@@ -96,6 +96,21 @@ def load(name: str | Path) -> Robot:
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
     path = path.resolve()
     return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+
+
+def require(robot: Robot, where: str) -> Robot:
+    """``robot`` if it is a :class:`Robot`; below the boundary a name is never resolved again.
+
+    Raises
+    ------
+    TypeError
+        For anything else (a name, a path), naming ``where`` and saying to resolve it once with
+        :func:`load`.
+    """
+    if not isinstance(robot, Robot):
+        raise TypeError(f"{where}: expected a Robot, got {type(robot).__name__} {robot!r}; resolve a robot "
+                        "name, folder or MJCF file once with faultgen.model.robots.load and pass the Robot")
+    return robot
 
 
 def source_of(robot: Robot) -> str:

@@ -171,7 +171,7 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run_calibration(str(nominal.path), read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
+            run_calibration(nominal, read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
                             progress=False)
         stored.write_calibration(record, key, model)
     implausible = plausibility.implausible_parameters(nominal, robots.load(model))

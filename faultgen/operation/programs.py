@@ -128,7 +128,7 @@ def label(task: str) -> str:
     return name
 
 
-def load(robot: Robot | str, task: str) -> Task:
+def load(robot: Robot, task: str) -> Task:
     """The task ``task`` of ``robot``: a thesis task by name (a program from the robot folder's
     ``tasks.toml``, :func:`builtin`), a program file (``.toml``, :func:`read`) or a joint log to replay
     (``.csv``, ``.csv.gz``, ``.h5``; :func:`faultgen.operation.replay.read`).
@@ -140,11 +140,13 @@ def load(robot: Robot | str, task: str) -> Task:
 
     Raises
     ------
+    TypeError
+        If ``robot`` is not a :class:`Robot` (a name is resolved once, at the boundary:
+        :func:`faultgen.model.robots.load`).
     ValueError
         For an unknown task or a file that cannot run on ``robot`` (:class:`ProgramError`).
     """
-    if not isinstance(robot, Robot):
-        robot = robots.load(robot)
+    robots.require(robot, "programs.load")
     check_name(task)
     if task in TASKS:
         return builtin(robot, task)
@@ -177,7 +179,7 @@ def record(task: str) -> dict | None:
     return out
 
 
-def identity(robot: Robot | str, task: str) -> tuple[str, str]:
+def identity(robot: Robot, task: str) -> tuple[str, str]:
     """What a run's program is: ``(label, sha256)``.
 
     ``sha256`` is the hex digest of the program's text: a program file's or log's bytes, and for a
@@ -287,7 +289,7 @@ class Program:
 # -- reading -------------------------------------------------------------------------------------
 
 
-def read(path: str | Path, robot: Robot | str) -> Program:
+def read(path: str | Path, robot: Robot) -> Program:
     """Read a program file for ``robot``.
 
     Raises
@@ -303,11 +305,11 @@ def read(path: str | Path, robot: Robot | str) -> Program:
     return parse(text, robot, Path(path))
 
 
-def parse(text: str, robot: Robot | str, source: Path | None = None, where: str | None = None) -> Program:
+def parse(text: str, robot: Robot, source: Path | None = None, where: str | None = None) -> Program:
     """A :class:`Program` from TOML ``text`` (see :func:`read`); ``where`` names it in messages (default
-    ``source``)."""
-    if not isinstance(robot, Robot):
-        robot = robots.load(robot)
+    ``source``). TypeError if ``robot`` is not a :class:`Robot` (:func:`faultgen.model.robots.load`
+    resolves a name)."""
+    robots.require(robot, "programs.parse")
     where = where or str(source or "program")
     try:
         data = inputs.loads_toml(text, where, "program file")
@@ -363,17 +365,19 @@ def _check_robot(top: Table, robot: Robot) -> None:
                           f"that robot's); run it with --robot {named}, or write {robot.name!r} there")
 
 
-def robot_limits(robot: Robot | str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def robot_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The joint velocity, acceleration and jerk limits of a robot folder (its ``tasks.toml``
     ``[limits]``), rad/s, rad/s^2, rad/s^3, each of shape (N,): the limits the thesis tasks are
     planned to, and the speed histogram's design maximum of their per-cycle features.
 
     Raises
     ------
+    TypeError
+        If ``robot`` is not a :class:`Robot` (:func:`faultgen.model.robots.load` resolves a name).
     ProgramError
         If the folder has no ``tasks.toml`` or its ``[limits]`` are missing or malformed.
     """
-    robot = robot if isinstance(robot, Robot) else robots.load(robot)
+    robots.require(robot, "programs.robot_limits")
     return _limits({}, robot, f"{robot.name} limits")
 
 
@@ -471,20 +475,21 @@ def _segment(where: str, number: int, table, robot: Robot) -> Segment:
 # -- export --------------------------------------------------------------------------------------
 
 
-def builtin(robot: Robot | str, name: str) -> Program:
+def builtin(robot: Robot, name: str) -> Program:
     """The built-in task ``name`` of ``robot``: the table ``[name]`` of its folder's ``tasks.toml``
     read as a program, with the file's ``[limits]`` (the thesis tasks of ch. 6.3.1 are the tables
     :data:`~faultgen.operation.tasks.TASKS`). Its :attr:`Program.text` is what :func:`export` writes.
 
     Raises
     ------
+    TypeError
+        If ``robot`` is not a :class:`Robot` (:func:`faultgen.model.robots.load` resolves a name).
     ProgramError
         For a robot without a ``tasks.toml``, a name that is no table of it (the message lists the
         tables), or a table that does not read as a program (the file, the table, the segment and
         the key named).
     """
-    if not isinstance(robot, Robot):
-        robot = robots.load(robot)
+    robots.require(robot, "programs.builtin")
     source = robot.path.parent / "tasks.toml"
     if not source.is_file():
         raise ProgramError(f"{source}: no tasks file for robot {robot.name!r}")
@@ -505,7 +510,7 @@ def builtin(robot: Robot | str, name: str) -> Program:
     return parse(dumps(program, header, where), robot, source, where)
 
 
-def export(robot: Robot | str, name: str) -> str:
+def export(robot: Robot, name: str) -> str:
     """The built-in task ``name`` of ``robot`` (a table of its ``tasks.toml``, :func:`builtin`) as a
     program file's text to edit: the same program, so the same path bit for bit (numbers are written
     as the file gives them).
@@ -518,7 +523,7 @@ def export(robot: Robot | str, name: str) -> str:
     return builtin(robot, name).text
 
 
-def show(robot: Robot | str, task: str) -> str:
+def show(robot: Robot, task: str) -> str:
     """The text of a task: a thesis task exported (:func:`export`), or a program file's own text."""
     if task in TASKS:
         return export(robot, task)
@@ -528,11 +533,10 @@ def show(robot: Robot | str, task: str) -> str:
     return Path(task).read_text()
 
 
-def available(robot: Robot | str) -> list[tuple[str, str]]:
+def available(robot: Robot) -> list[tuple[str, str]]:
     """The programs of ``robot``: ``(name, what)`` for each thesis task in its ``tasks.toml`` and each
-    program file in its folder's ``programs/``."""
-    if not isinstance(robot, Robot):
-        robot = robots.load(robot)
+    program file in its folder's ``programs/``. TypeError if ``robot`` is not a :class:`Robot`."""
+    robots.require(robot, "programs.available")
     out = []
     folder_file = robot.path.parent / "tasks.toml"
     if folder_file.is_file():

@@ -54,7 +54,6 @@ import numpy as np
 from ruckig import ControlInterface, DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 from scipy.interpolate import CubicSpline
 
-from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation import jointlog, logblocks
 from faultgen.operation.jointlog import MAX_GAP, LogError
@@ -205,7 +204,7 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
     return pos, vel, acc
 
 
-def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
+def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
          check_torque: Callable) -> Replay:
     """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
     (:mod:`faultgen.operation.jointlog`, no torque columns), streamed (:mod:`faultgen.operation.logblocks`).
@@ -214,7 +213,8 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
     ----------
     path : str or Path
         A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` log with columns ``t`` (s) and ``q1..qN`` (rad).
-    robot : Robot or str
+    robot : Robot
+        Resolved by the caller (:func:`faultgen.operation.programs.load`).
     limits : tuple of three ndarray of shape (N,)
         The robot's planning limits (velocity, acceleration, jerk; rad/s, rad/s^2, rad/s^3) of the
         run-out: :func:`faultgen.operation.programs.robot_limits`.
@@ -229,8 +229,6 @@ def read(path: str | Path, robot: Robot | str, limits: tuple[np.ndarray, np.ndar
         value, time that does not increase, a log that is too short, has a gap or runs longer than
         :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
     """
-    if not isinstance(robot, Robot):
-        robot = robots.load(robot)
     path = Path(path)
     n_axes = robot.n_axes
     src = logblocks.source(path, n_axes, motion_only=True)

@@ -57,13 +57,14 @@ class Prepared:
         return int(round(sensors.LOG_PERIOD / self.sim.model.opt.timestep))
 
 
-def prepared_for(robot: robots.Robot | str, task: str, friction_model: str, payload: dict | None = None,
+def prepared_for(robot: robots.Robot, task: str, friction_model: str, payload: dict | None = None,
                  fault: Fault | None = None) -> Prepared:
-    """:func:`_prepare` of the resolved ``robot`` (a name or path is resolved here, once: the
-    boundary's job), renewed when its task file changes; ``payload``: the
-    :class:`faultgen.effects.payload.Payload` parameters of a part the robot carries; ``fault``:
-    a growing fault to build into the simulated robot (:func:`_prepare_variant`)."""
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    """:func:`_prepare` of the resolved ``robot`` (a name is resolved once, at the boundary:
+    :func:`faultgen.model.robots.load`; TypeError for anything but a :class:`Robot`), renewed when
+    its task file changes; ``payload``: the :class:`faultgen.effects.payload.Payload` parameters of a
+    part the robot carries; ``fault``: a growing fault to build into the simulated robot
+    (:func:`_prepare_variant`)."""
+    robots.require(robot, "prepared_for")
     stamps = file_stamps(robot, task)
     if payload is None and fault is None:
         return _prepare(robot, task, friction_model, *stamps)
@@ -72,12 +73,12 @@ def prepared_for(robot: robots.Robot | str, task: str, friction_model: str, payl
                             key, *stamps)
 
 
-def file_stamps(robot: robots.Robot | str, task: str) -> tuple[int, ...]:
+def file_stamps(robot: robots.Robot, task: str) -> tuple[int, ...]:
     """Modification times of the robot's task file (and of a program or log file, with its size):
     what renews the cached preparations (the robot's own model is the :class:`Robot` object they
     are keyed by, one per file content). Raises ValueError for a model file copied without its
     ``tasks.toml``."""
-    model_file = (robot if isinstance(robot, robots.Robot) else robots.load(robot)).path
+    model_file = robot.path
     tasks_file = model_file.parent / "tasks.toml"
     if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
@@ -216,10 +217,11 @@ def _prepare(robot: robots.Robot, task_name: str, friction_model: str, *file_sta
     return Prepared(sim, task, path, q_ref, inputs, grips=grips)
 
 
-def cycle_duration(robot: robots.Robot | str, task: str) -> float:
-    """Simulated time of one cycle of ``task`` on ``robot``, s (what a run steps per cycle): the
-    task's path held to whole log periods, no simulation model compiled for it."""
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+def cycle_duration(robot: robots.Robot, task: str) -> float:
+    """Simulated time of one cycle of ``task`` on the resolved ``robot``, s (what a run steps per
+    cycle): the task's path held to whole log periods, no simulation model compiled for it.
+    TypeError for anything but a :class:`~faultgen.model.robot.Robot`."""
+    robots.require(robot, "cycle_duration")
     q_ref = _reference(robot, task, *file_stamps(robot, task))[2]
     return (len(q_ref) - 1) * robot.model.opt.timestep
 
