@@ -26,10 +26,11 @@ import fleetlog_folder
 import independent_fleet
 import numpy as np
 import open_counter
+import pandas as pd
 import pytest
 
 from faultgen import inputs
-from faultgen.data import measured
+from faultgen.data import adapters, measured
 from faultgen.model import robots
 from faultgen.monitor import loop
 from faultgen.monitor import logs as fleet_logs
@@ -77,3 +78,29 @@ def test_a_held_log_is_refused_with_the_message_of_its_file(tmp_path):
     with pytest.raises(measured.MeasuredDataError):
         parsed.checked()
     assert Path(str(inputs.hold(path, "log", 100))) == path
+
+
+@pytest.mark.parametrize("name", ["ur-rtde", "voraus"])
+def test_the_built_in_adapters_parse_a_held_log_as_their_file_and_open_it_once(tmp_path, name):
+    """ur-rtde (space-separated RTDE recorder CSV) and voraus (Parquet) read the held bytes
+    (``reads_held``): the monitor's :class:`faultgen.monitor.logs.Source` opens their logs once."""
+    puma = robots.load("puma560")
+    t, q, qd, tau, cycle = fleetlog_folder.log_signals(puma, 3, 0, np.zeros(6))
+    if name == "ur-rtde":
+        path = tmp_path / "2026-03-01.csv"
+        columns = {"timestamp": t, **{f"actual_q_{k}": q[:, k] for k in range(6)},
+                   **{f"target_moment_{k}": tau[:, k] for k in range(6)}}
+        pd.DataFrame(columns).to_csv(path, sep=" ", index=False)
+    else:
+        path = tmp_path / "1.parquet"
+        table = {"time": t, "sample": cycle, **{f"joint_position_{k + 1}": q[:, k] for k in range(6)},
+                 **{f"motor_torque_{k + 1}": tau[:, k] / puma.gear_ratio[k] for k in range(6)}}
+        pd.DataFrame(table).to_parquet(path)
+    adapter = adapters.make(name)
+    with open_counter.opens_under(tmp_path) as counts:
+        parsed = fleet_logs.Source(puma, adapter).get(fleet_logs.Log("u1", path.stem, 0.0, "sequence", path, path.name))
+    assert dict(counts) == {path.name: 1}
+    by_path = adapter.read(path, puma, accelerations=False)
+    assert parsed.data.source == path and parsed.data.notes == by_path.notes
+    for field in ("t", "q", "qd", "tau"):
+        assert np.array_equal(getattr(parsed.data, field), getattr(by_path, field))
