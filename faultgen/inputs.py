@@ -337,7 +337,8 @@ class _BoundedInflate(io.RawIOBase):
 
 
 def is_gzip(path: str | Path | Held) -> bool:
-    """Whether the file (or :class:`Held` bytes) starts with gzip's magic bytes (RFC 1952), whatever its name."""
+    """Whether the file (or :class:`Held` bytes) starts with gzip's magic bytes (RFC 1952), whatever
+    its name."""
     if isinstance(path, Held):
         return path.data[:2] == b"\x1f\x8b"
     with open(path, "rb") as fh:

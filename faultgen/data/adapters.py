@@ -247,7 +247,7 @@ class Voraus(Adapter):
 
         n_axes = robot.n_axes
         inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path  # held: not opened again
+        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path  # held: not reopened
         names = pq.read_schema(source).names
         axes = range(1, n_axes + 1)
         position = [f"joint_position_{k}" for k in axes]

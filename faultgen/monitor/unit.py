@@ -140,9 +140,9 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
            out: Path, progress: bool, source: fleet_logs.Source) -> str:
     """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
     the unit's first log (``first``: its stamp and SHA-256; ``first_log`` the log, parsed by
-    ``source`` and needed only when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
-    the nominal model, the log and the search's length, beside a record of the calibrated model's
-    SHA-256 that a later run checks.
+    ``source`` and needed only when the calibration is not cached), cached in
+    ``OUT/.cache/calibrated`` under the digest of the nominal model, the log and the search's
+    length, beside a record of the calibrated model's SHA-256 that a later run checks.
 
     Raises
     ------

@@ -104,8 +104,9 @@ def kind(path: Path) -> str:
     if name.endswith(HDF5_SUFFIXES):
         return "hdf5"
     accepted = ", ".join(CSV_SUFFIXES + HDF5_SUFFIXES)
+    suffixes = "".join(inputs.path_of(path).suffixes)
     raise LogError(
-        f"{path}: unknown file type {''.join(inputs.path_of(path).suffixes) or '(no suffix)'!r}; expected {accepted}"
+        f"{path}: unknown file type {suffixes or '(no suffix)'!r}; expected {accepted}"
     )
 
 
