@@ -26,12 +26,18 @@ Every refusal is an :class:`InputError` (a ``ValueError``: the command line prin
 ``error:`` line and exits 2) whose message starts with the file's path and names the key, link,
 dataset or row at fault and what was expected.
 
+A file read once and handed on as its bytes (:class:`Held`, :func:`hold`: ``faultgen monitor``
+reads each log once) is taken by :func:`regular_file`, :func:`is_gzip`, :func:`open_bytes` and
+what is built on them (:func:`open_text`, :func:`count_lines`, :func:`csv_header`) as its file,
+with the same checks and messages, without opening the file again.
+
 This module imports no other faultgen layer, so every layer may use it.
 """
 
 from __future__ import annotations
 
 import gzip
+import hashlib
 import io
 import os
 import re
@@ -39,6 +45,7 @@ import stat
 import tomllib
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -115,9 +122,58 @@ def within(path: str | Path, root: str | Path, what: str = "folder") -> Path:
     return path
 
 
-def regular_file(path: str | Path, what: str, max_bytes: int | None = None) -> Path:
+@dataclass(frozen=True, eq=False)
+class Held:
+    """A file's bytes as one read of it found them (:func:`hold`): ``path`` (named in messages: its
+    ``str`` is the path's) and ``data``. The readers of this module take it for the file itself."""
+
+    path: Path
+    data: bytes
+
+    def __str__(self) -> str:
+        return str(self.path)
+
+    @property
+    def name(self) -> str:
+        return self.path.name
+
+    @property
+    def size(self) -> int:
+        """Bytes held (the file's size when it was read)."""
+        return len(self.data)
+
+    @property
+    def sha256(self) -> str:
+        """SHA-256 of the bytes, hex (the file's at the read)."""
+        return hashlib.sha256(self.data).hexdigest()
+
+
+def hold(path: str | Path, what: str, max_bytes: int) -> Held:
+    """The regular file ``path`` read once into memory (:func:`read_bytes`: at most ``max_bytes``
+    bytes), to be parsed and hashed from what was read.
+
+    Raises
+    ------
+    InputError
+        As :func:`read_bytes` (not a regular file, above ``max_bytes``).
+    """
+    return Held(Path(path), read_bytes(path, what, max_bytes))
+
+
+def path_of(source: str | Path | Held) -> Path:
+    """The path of a file given by name or held (:class:`Held`)."""
+    return source.path if isinstance(source, Held) else Path(source)
+
+
+def size_of(source: str | Path | Held) -> int:
+    """Bytes of a file given by name (its size on disk: a stat) or held (:class:`Held`)."""
+    return source.size if isinstance(source, Held) else Path(source).stat().st_size
+
+
+def regular_file(path: str | Path | Held, what: str, max_bytes: int | None = None) -> Path | Held:
     """``path`` as a :class:`~pathlib.Path` after checking that it names a regular file (a symlink is
-    followed) of at most ``max_bytes`` bytes (no bound when None).
+    followed) of at most ``max_bytes`` bytes (no bound when None); a :class:`Held` file checked on
+    its bytes' count and returned as it is.
 
     Raises
     ------
@@ -125,6 +181,10 @@ def regular_file(path: str | Path, what: str, max_bytes: int | None = None) -> P
         "no such file", "not a regular file (a character device)" for ``/dev/zero`` or a symlink to
         it, or the size and the bound; each message starts with ``path`` and names ``what``.
     """
+    if isinstance(path, Held):
+        if max_bytes is not None and path.size > max_bytes:
+            raise InputError(f"{path}: {path.size} bytes; a {what} is read up to {max_bytes} bytes")
+        return path
     path = Path(path)
     try:
         info = path.stat()
@@ -245,11 +305,11 @@ def read_toml(path: str | Path, what: str, max_bytes: int = TOML_MAX_BYTES) -> d
 
 class _BoundedInflate(io.RawIOBase):
     """A raw reader over a gzip file that refuses to inflate beyond :data:`GZIP_MAX_RATIO` times the
-    compressed bytes consumed so far (plus :data:`GZIP_SLACK`)."""
+    compressed bytes consumed so far (plus :data:`GZIP_SLACK`); ``path`` a file's name or :class:`Held`."""
 
-    def __init__(self, path: Path, what: str):
+    def __init__(self, path: Path | Held, what: str):
         self._path, self._what = path, what
-        self._raw = open(path, "rb")
+        self._raw = io.BytesIO(path.data) if isinstance(path, Held) else open(path, "rb")
         self._gz = gzip.GzipFile(fileobj=self._raw, mode="rb")
         self._out = 0
 
@@ -276,20 +336,23 @@ class _BoundedInflate(io.RawIOBase):
         super().close()
 
 
-def is_gzip(path: str | Path) -> bool:
-    """Whether the file starts with gzip's magic bytes (RFC 1952), whatever its name."""
+def is_gzip(path: str | Path | Held) -> bool:
+    """Whether the file (or :class:`Held` bytes) starts with gzip's magic bytes (RFC 1952), whatever
+    its name."""
+    if isinstance(path, Held):
+        return path.data[:2] == b"\x1f\x8b"
     with open(path, "rb") as fh:
         return fh.read(2) == b"\x1f\x8b"
 
 
-def open_bytes(path: str | Path, what: str, max_bytes: int | None = None) -> io.BufferedIOBase:
-    """A binary reader over the regular file ``path`` (of at most ``max_bytes`` bytes on disk),
-    inflating it when it is gzip-compressed (recognised by content) with the bomb check of
-    :class:`_BoundedInflate`. Close it (or use ``with``)."""
+def open_bytes(path: str | Path | Held, what: str, max_bytes: int | None = None) -> io.BufferedIOBase:
+    """A binary reader over the regular file ``path`` (of at most ``max_bytes`` bytes on disk; or
+    over :class:`Held` bytes, the file not opened again), inflating it when it is gzip-compressed
+    (recognised by content) with the bomb check of :class:`_BoundedInflate`. Close it (or use ``with``)."""
     path = regular_file(path, what, max_bytes)
     if is_gzip(path):
         return io.BufferedReader(_BoundedInflate(path, what), 2**20)
-    return open(path, "rb")
+    return io.BytesIO(path.data) if isinstance(path, Held) else open(path, "rb")
 
 
 def open_text(path: str | Path, what: str, max_bytes: int | None = None) -> io.TextIOWrapper:
@@ -437,7 +500,7 @@ def open_hdf5(path: str | Path, what: str = "HDF5 file") -> Iterator:
 
     path = regular_file(path, what)
     try:
-        f = h5py.File(path, "r")
+        f = h5py.File(io.BytesIO(path.data) if isinstance(path, Held) else path, "r")
     except OSError as err:
         raise InputError(f"{path}: not a readable HDF5 file ({err}); a {what} is expected") from None
     try:

@@ -53,9 +53,16 @@ def register(name: str):
 @dataclass(frozen=True)
 class Adapter:
     """Base: ``suffixes`` (lower case) of the files it reads, and :meth:`columns` (the foreign file's
-    columns as the measured format's, and the data-row labeller of its messages)."""
+    columns as the measured format's, and the data-row labeller of its messages).
+
+    ``reads_held``: :meth:`columns` takes the file's bytes read once (:class:`faultgen.inputs.Held`)
+    for its path, reading through :mod:`faultgen.inputs` (``open_bytes``, ``open_text``,
+    ``csv_header``) or from ``held.data``, so ``faultgen monitor`` opens each log once. False (the
+    default, a plug-in written against a path): :meth:`read` hands it the held file's path, which
+    it then opens again."""
 
     name = ""
+    reads_held = False
     suffixes: tuple[str, ...] = ()
 
     def columns(self, path: Path, robot: robots.Robot) -> tuple:
@@ -66,9 +73,11 @@ class Adapter:
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
-        as :func:`faultgen.data.measured.read`)."""
-        columns, label, *notes = self.columns(Path(path), robot)
-        return measured.from_columns(columns, robot, path, label, accelerations, notes=notes[0] if notes else ())
+        as :func:`faultgen.data.measured.read`); ``path`` may be held (:attr:`reads_held`)."""
+        given = path if self.reads_held and isinstance(path, inputs.Held) else inputs.path_of(path)
+        columns, label, *notes = self.columns(given, robot)
+        return measured.from_columns(columns, robot, inputs.path_of(path), label, accelerations,
+                                     notes=notes[0] if notes else ())
 
 
 def make(name: str, **options) -> Adapter:
@@ -123,6 +132,7 @@ class URRTDE(Adapter):
         file has no ``target_moment`` columns.
     """
 
+    reads_held = True
     suffixes: tuple[str, ...] = (".csv", ".csv.gz")
     torque_constants: tuple[float, ...] | None = None
 
@@ -228,14 +238,17 @@ def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str
 class Voraus(Adapter):
     """The voraus-AD dataset's Parquet layout (module docstring)."""
 
+    reads_held = True
     suffixes: tuple[str, ...] = (".parquet",)
 
-    def columns(self, path: Path, robot: robots.Robot):
+    def columns(self, path: Path | inputs.Held, robot: robots.Robot):
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
         n_axes = robot.n_axes
         inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        names = pq.read_schema(path).names
+        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path  # held: not reopened
+        names = pq.read_schema(source).names
         axes = range(1, n_axes + 1)
         position = [f"joint_position_{k}" for k in axes]
         velocity = [f"joint_velocity_{k}" for k in axes]
@@ -244,9 +257,9 @@ class Voraus(Adapter):
         _require(path, names, wanted, "voraus-AD")
         sample = ["sample"] if "sample" in names else []
         # the rows from the file's metadata, before any is read: a few MB of constant columns may hold 10^8
-        rows = pq.ParquetFile(path).metadata.num_rows
+        rows = pq.ParquetFile(source).metadata.num_rows
         jointlog.check_whole_rows(path, rows, len(wanted + sample), what="a voraus-AD log")
-        frame = pq.read_table(path, columns=wanted + sample).to_pandas()
+        frame = pq.read_table(source, columns=wanted + sample).to_pandas()
         label = jointlog.index_label
         values = _numbers(path, frame, wanted + sample, label)
         q_names, qd_names, tau_names = measured.column_names(n_axes)

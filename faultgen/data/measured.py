@@ -68,7 +68,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from faultgen import axes
+from faultgen import axes, inputs
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
@@ -195,13 +195,14 @@ class MeasuredData:
 # Reading
 
 
-def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
+def read(path: str | Path | inputs.Held, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
     """Read, check and complete a measured-data file (format in the module docstring).
 
     Parameters
     ----------
-    path : str or Path
-        A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` file (suffix case-insensitive).
+    path : str, Path or faultgen.inputs.Held
+        A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` file (suffix case-insensitive), or its bytes
+        read once (:func:`faultgen.inputs.hold`: parsed from them, :attr:`MeasuredData.source` its path).
     robot : str, Path or robots.Robot
         The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
         before the file is opened) or a loaded robot. Its joint range is used to recognise
@@ -239,10 +240,9 @@ def read(path: str | Path, robot: str | Path | robots.Robot, accelerations: bool
     a hint to convert when the values would fit as degrees.
     """
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
-    path = Path(path)
     columns, extra, row_label = jointlog.read_columns(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
-    return _build(columns, robot, path, row_label, notes, accelerations)
+    return _build(columns, robot, inputs.path_of(path), row_label, notes, accelerations)
 
 
 def from_arrays(

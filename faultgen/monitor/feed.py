@@ -3,7 +3,8 @@ the unit's monitor against its twin (:func:`score_log`), a repair or gearbox cha
 first log at or after it, a log that cannot be read or replayed skipped and named, a program change
 nobody logged starting a new twin (:func:`new_program`); and each unit's chart and remaining life
 (:func:`unit_outputs`). Runs wherever the group is scored (this process, a local worker, a Dask
-worker: :mod:`faultgen.monitor.parallel`), with the same arithmetic.
+worker: :mod:`faultgen.monitor.parallel`), with the same arithmetic. Each log is read once, by
+the process's :class:`faultgen.monitor.logs.Source` (the run's, where it was made).
 """
 
 from __future__ import annotations
@@ -59,15 +60,17 @@ def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:
     return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
 
 
-def score_group(context: Context, group: list[tuple[str, Unit, list]]) -> list[tuple[str, Unit, tuple]]:
+def score_group(context: Context, group: list[tuple[str, Unit, list]],
+                source: fleet_logs.Source | None = None) -> list[tuple[str, Unit, tuple]]:
     """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
     events given before the first log at or after them; returns the units with their chart and
-    remaining life (:func:`unit_outputs`)."""
+    remaining life (:func:`unit_outputs`). ``source``: the run's logs as read so far (this
+    process's; a new one when None, as in a worker that did not inherit it)."""
     nominal = robots.load(context.robot)
-    read_with, _ = fleet_logs.reader_of(context.log_format)
+    source = source if source is not None else fleet_logs.Source(nominal, context.log_format)
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, read_with)
+        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, source)
         for log in unit_logs:
             for event in context.maintenance.get(name, ()):
                 done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
@@ -75,7 +78,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]]) -> list[t
                     unit.monitor.maintenance(event.stamp, event.event, event.axis)
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
-            twin = score_log(unit, log, nominal, twin, context.twin_temperature, read_with, context)
+            twin = score_log(unit, log, nominal, twin, context.twin_temperature, source, context)
     return [(name, unit, unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
 
 
@@ -90,7 +93,7 @@ def program_changed(q: np.ndarray, program: np.ndarray) -> bool:
     return bool(np.max(np.abs(q[:n] - program[:n])) > PROGRAM_CHANGE)
 
 
-def new_program(unit: Unit, log, reading, twin: Twin, context) -> Twin:
+def new_program(unit: Unit, log, reading, twin: Twin, context, source: fleet_logs.Source) -> Twin:
     """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
     restarts its learning against it, its open alarm closed by the change; noted in its reason.
 
@@ -99,7 +102,8 @@ def new_program(unit: Unit, log, reading, twin: Twin, context) -> Twin:
     ValueError
         The new program's twin cannot be built (the log is then skipped, named).
     """
-    new = Twin(twin.model, log.path, context.out / ".cache" / "cycles", root=context.out, reader=twin.reader)
+    new = Twin(twin.model, source.get(log), context.out / ".cache" / "cycles", root=context.out)
+    source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
     unit.monitor.signatures = new.signatures
     unit.program, unit.program_q = (unit.monitor.unit, log.stamp), reading.q
@@ -110,22 +114,30 @@ def new_program(unit: Unit, log, reading, twin: Twin, context) -> Twin:
 
 
 def score_log(unit: Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
-               read_with: fleet_logs.Reader, context=None) -> Twin | str | None:
-    """Read one log and feed it to the unit's monitor; a log that cannot be read, or that the twin
-    cannot replay (``twin`` a str: the reason no twin can be had), is skipped and kept in the
-    unit's state with its reason. A log whose motion left the twin's program starts a new one
-    (:func:`new_program`). Returns the twin for the next log."""
-    sha256 = stored.sha256_file(log.path)
+               source: fleet_logs.Source, context=None) -> Twin | str | None:
+    """Feed one log (read once by ``source``, then forgotten unless a program keeps it) to the
+    unit's monitor; a log that cannot be read, or that the twin cannot replay (``twin`` a str: the
+    reason no twin can be had), is skipped and kept in the unit's state with its reason. A log
+    whose motion left the twin's program starts a new one (:func:`new_program`). Returns the twin
+    for the next log."""
+    try:
+        return _score(unit, log, source.get(log), nominal, twin, twin_temperature, source, context)
+    finally:
+        source.done(log)
+
+
+def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_temperature: bool, source, context):
+    sha256 = parsed.sha256
     if isinstance(twin, str):
         unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
         return twin
     try:
-        reading = fleet_logs.read(nominal, log, read_with)
+        reading = fleet_logs.reading_of(nominal, parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
             if unit.program_q is None:
-                unit.program_q = np.asarray(read_with(log_of(context.units, *unit.program).path, nominal).q)
+                unit.program_q = np.asarray(source.get(log_of(context.units, *unit.program)).checked().q)
             if program_changed(reading.q, unit.program_q):
-                twin = new_program(unit, log, reading, twin, context)
+                twin = new_program(unit, log, reading, twin, context, source)
         residual, expected = reading.vector, None
         if twin is not None:
             at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE

@@ -2,6 +2,11 @@
 (:func:`faultgen.data.logfolder.scan`), each log's record by the import's code
 (:func:`faultgen.data.fleetlogs.log_record`: the per-cycle features of a simulated fleet's daily
 records) and its logged conditions (joint temperature, payload; :mod:`faultgen.data.measured`).
+
+Each log is read once in a run (:class:`Source`): its bytes held (:func:`faultgen.inputs.hold`),
+hashed (the SHA-256 the state and the caches key on) and parsed from them by the log format's
+reader, and that :class:`Parsed` log handed to the program's identification, the calibration, the
+twin and the scoring.
 """
 
 from __future__ import annotations
@@ -13,9 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import inputs
 from faultgen.data import fleetlogs, logfolder, measured
 from faultgen.model.robots import Robot
-from faultgen.operation import programs
+from faultgen.monitor import state as stored
+from faultgen.operation import jointlog, programs
 
 #: The features the monitor watches, per axis (of :func:`faultgen.simulation.sensors.cycle_features`):
 #: the two that follow friction on an axis whose load keeps one sign (gravity), where the mean
@@ -89,7 +96,92 @@ def features_of(robot: Robot, data: measured.MeasuredData) -> np.ndarray:
 def read(robot: Robot, log: Log, reader: Reader = measured.read) -> Reading:
     """Read and check one log (``reader``: :func:`faultgen.data.measured.read` by default; errors
     name the file and row)."""
-    data = reader(log.path, robot)
+    return reading_of(robot, reader(log.path, robot))
+
+
+def reading_of(robot: Robot, data: measured.MeasuredData) -> Reading:
+    """The :class:`Reading` of a checked log: its features, mean joint temperature, payload, notes, angles."""
     temperature = float(np.mean(data.joint_temperature)) if data.joint_temperature is not None else float("nan")
     payload = float(np.max(data.payload_mass)) if data.payload_mass is not None else 0.0
     return Reading(features_of(robot, data), temperature, payload, tuple(data.notes), np.asarray(data.q))
+
+
+#: Largest log held in memory to be read once, bytes on disk: the bound a log read whole puts on its
+#: kept cells (:data:`faultgen.operation.jointlog.WHOLE_MAX_BYTES`), so holding its bytes at most
+#: doubles what reading it takes. A larger log is parsed from its path (its header, size and rows
+#: each opening it) and hashed by another read.
+HOLD_MAX_BYTES = jointlog.WHOLE_MAX_BYTES
+
+
+@dataclass(frozen=True, eq=False)
+class Parsed:
+    """A log as one read of it found it: ``path``, ``sha256`` (hex, of its bytes) and the checked
+    ``data`` (:class:`faultgen.data.measured.MeasuredData`), or ``error`` (the ``ValueError`` its
+    reading raised, naming the file and row), which :meth:`checked` raises."""
+
+    path: Path
+    sha256: str
+    data: measured.MeasuredData | None
+    error: ValueError | None = None
+
+    def checked(self) -> measured.MeasuredData:
+        """:attr:`data`; raises :attr:`error` for a log that cannot be read."""
+        if self.error is not None:
+            raise self.error
+        return self.data
+
+
+def parse(path: Path, robot: Robot, reader: Reader = measured.read, held: bool = True) -> Parsed:
+    """Read the log ``path`` once (:class:`Parsed`): its bytes held (``held`` and at most
+    :data:`HOLD_MAX_BYTES`), hashed and parsed by ``reader`` (which then takes a
+    :class:`faultgen.inputs.Held` for the path); otherwise parsed from the path and hashed apart.
+
+    Raises
+    ------
+    OSError
+        The file cannot be read at all (a ``ValueError`` of the reader is kept in :attr:`Parsed.error`).
+    """
+    path = Path(path)
+    source = path
+    if held and path.stat().st_size <= HOLD_MAX_BYTES:
+        try:
+            source = inputs.hold(path, "joint log", HOLD_MAX_BYTES)
+        except inputs.InputError:
+            source = path  # grown past the bound since its size was read: read from the path
+    sha256 = source.sha256 if isinstance(source, inputs.Held) else stored.sha256_file(path)
+    try:
+        return Parsed(path, sha256, reader(source, robot))
+    except ValueError as err:
+        return Parsed(path, sha256, None, err)
+
+
+class Source:
+    """The logs of one ``faultgen monitor`` run, each read once (:func:`parse`) by the format's
+    reader (``log_format`` an adapter, the measured format when None; held unless the adapter reads
+    only paths: :attr:`faultgen.data.adapters.Adapter.reads_held`) and kept until :meth:`done` (a
+    program, :meth:`keep`, for the run), so a unit's first log serves its program, calibration,
+    twin and score from one read. It holds the parsed first log of each unit not yet scored, and
+    each program."""
+
+    def __init__(self, robot: Robot, log_format=None):
+        self.robot = robot
+        self.reader, _ = reader_of(log_format)
+        self.held = log_format is None or bool(getattr(log_format, "reads_held", False))
+        self._parsed: dict[Path, Parsed] = {}
+        self._kept: set[Path] = set()
+
+    def get(self, log: Log) -> Parsed:
+        """The log ``log`` parsed (read now if not yet in this run)."""
+        path = Path(log.path)
+        if path not in self._parsed:
+            self._parsed[path] = parse(path, self.robot, self.reader, self.held)
+        return self._parsed[path]
+
+    def keep(self, log: Log) -> None:
+        """Keep ``log`` parsed for the run: a program, which twins replay and later logs are compared with."""
+        self._kept.add(Path(log.path))
+
+    def done(self, log: Log) -> None:
+        """Forget ``log`` (scored), unless it is kept (:meth:`keep`)."""
+        if Path(log.path) not in self._kept:
+            self._parsed.pop(Path(log.path), None)

@@ -24,7 +24,9 @@ unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`fault
 :mod:`faultgen.monitor.state`). Simulated cycles, calibrations and the twins' filtered program
 logs are cached in ``OUT/.cache``, each checked against what it was made from; units whose first
 logs trace the same motion (angles within :data:`SAME_PROGRAM` rad) and share a model share their
-simulated cycles.
+simulated cycles. Each log is read once (:class:`faultgen.monitor.logs.Source`: hashed and
+parsed in one pass, the parsed log passed on; a rerun also hashes the logs scored before, to refuse
+one that changed).
 """
 
 from __future__ import annotations
@@ -162,7 +164,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     atomic.check_apart(out, logs_dir)
     prognosis.check_failure_wear(failure_wear)
     nominal = robots.load(robot)
-    read_with, suffixes = fleet_logs.reader_of(log_format)
+    _, suffixes = fleet_logs.reader_of(log_format)
+    source = fleet_logs.Source(nominal, log_format)  # each log read once, parsed data passed on
     units = fleet_logs.fleet(logs_dir, suffixes)
     out = Path(out)
     cache = out / ".cache"
@@ -179,14 +182,14 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
     for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
         if unit_logs and name not in state:
-            state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, read_with)
+            state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                        failure_wear)
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
     idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
-    for done in map_groups(context, groups, jobs, scheduler, robot, idle):
+    for done in map_groups(context, groups, jobs, scheduler, robot, idle, source):
         for name, unit, outputs in done:
             made[name] = outputs
             if unit is not None:

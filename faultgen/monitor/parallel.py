@@ -31,14 +31,15 @@ def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Uni
     return [[(name, unit, logs)] for name, (unit, logs) in pending.items()]
 
 
-def prepare_twins(context: Context, groups: list, pool=None) -> None:
+def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.Source | None = None) -> None:
     """Simulate, once, the cycles of every twin that several units share (the nominal or a given
     model on one program), so that parallel workers read them from the cache instead of simulating
     them side by side: each of its :func:`faultgen.monitor.twin.base_cycles` as a task of ``pool``
     (a ``concurrent.futures`` executor) when given, then the twin made here from the cache. A twin
-    that cannot be built is left to each unit's own fallback (:func:`twin_of`)."""
+    that cannot be built is left to each unit's own fallback (:func:`twin_of`). The programs come
+    parsed from ``source`` (the run's; a new one when None) and go to the tasks as they are."""
     nominal = robots.load(context.robot)
-    read_with, _ = fleet_logs.reader_of(context.log_format)
+    source = source if source is not None else fleet_logs.Source(nominal, context.log_format)
     seen = set()
     for (name, unit, _), in groups:
         key = (unit.model, unit.program)
@@ -46,13 +47,13 @@ def prepare_twins(context: Context, groups: list, pool=None) -> None:
             continue
         seen.add(key)
         model = str(context.calibrated) if unit.model == "given" else str(nominal.path)
-        program = log_of(context.units, *unit.program).path
         cache = context.out / ".cache" / "cycles"
         try:
-            twin = Twin(model, program, cache, root=context.out, reader=read_with, cycles=False)
+            program = source.get(log_of(context.units, *unit.program))
+            twin = Twin(model, program, cache, root=context.out, cycles=False)
             missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
             if pool is not None and len(missing) > 1:
-                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.log_format, *c)
+                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, *c)
                                                  for c in missing], strict=True)))
             twin.complete()
         except stored.StateError:
@@ -61,14 +62,13 @@ def prepare_twins(context: Context, groups: list, pool=None) -> None:
             continue
 
 
-def _twin_cycle(model: str, program: Path, cache: Path, root: Path, log_format, temperature: float, payload: float,
+def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, temperature: float, payload: float,
                 worn_axis: int) -> None:
-    """Worker task: one cycle of a shared twin into the cache (:meth:`faultgen.monitor.twin.Twin.cycle`).
-    A cycle that cannot be simulated (or a cache file refused) is left to the twin made after all
-    of them, which says why."""
-    read_with, _ = fleet_logs.reader_of(log_format)
+    """Worker task: one cycle of a shared twin (its program as this run parsed it) into the cache
+    (:meth:`faultgen.monitor.twin.Twin.cycle`). A cycle that cannot be simulated (or a cache file
+    refused) is left to the twin made after all of them, which says why."""
     try:
-        Twin(model, program, cache, root=root, reader=read_with, cycles=False).cycle(temperature, payload, worn_axis)
+        Twin(model, program, cache, root=root, cycles=False).cycle(temperature, payload, worn_axis)
     except ValueError:
         return
 
@@ -81,7 +81,7 @@ _SHARED: dict = {}
 def _score_shared(index: int) -> list:
     groups = _SHARED["groups"]
     if index < len(groups):
-        return score_group(_SHARED["context"], groups[index])
+        return score_group(_SHARED["context"], groups[index], _SHARED["source"])
     return idle_outputs(_SHARED["idle"][index - len(groups)], _SHARED["context"].failure_wear)
 
 
@@ -100,7 +100,7 @@ def preload() -> None:
 
 
 def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
-               robot: str | Path | None = None, idle: list | tuple = ()):
+               robot: str | Path | None = None, idle: list | tuple = (), source: fleet_logs.Source | None = None):
     """Each group scored (:func:`score_group`), then each ``idle`` monitor's (a unit with no new log)
     chart and remaining life made (:func:`idle_outputs`), yielded in that order: in this process;
     in ``jobs`` local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared
@@ -108,17 +108,20 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
     elsewhere joblib's loky, started without the user's folders on their path:
     :func:`faultgen.children.safe_path`); or on the Dask cluster of ``scheduler``
     (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every group's
-    arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit."""
+    arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit.
+    ``source``: the run's logs as read so far (:class:`faultgen.monitor.logs.Source`), which this
+    process and forked workers read from; loky's and Dask's workers read the logs they score."""
     idle = list(idle)
+    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
     if scheduler is not None:
         if groups:
-            prepare_twins(context, groups)
+            prepare_twins(context, groups, source=source)
         from faultgen.monitor import remote
 
         yield from remote.execute(context, groups, scheduler, context.robot if robot is None else robot, idle)
         return
     if jobs <= 1 or len(groups) + len(idle) <= 1:
-        yield from (score_group(context, group) for group in groups)
+        yield from (score_group(context, group, source) for group in groups)
         yield from (idle_outputs(m, context.failure_wear) for m in idle)
         return
     n_jobs = min(jobs, len(groups) + len(idle))
@@ -131,17 +134,17 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
         from concurrent.futures import ProcessPoolExecutor
 
         preload()
-        _SHARED.update(context=context, groups=groups, idle=idle)
+        _SHARED.update(context=context, groups=groups, idle=idle, source=source)
         try:
             with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
                 if groups:
-                    prepare_twins(context, groups, pool)
+                    prepare_twins(context, groups, pool, source)
                 yield from pool.map(_score_shared, range(len(groups) + len(idle)))
         finally:
             _SHARED.clear()
         return
     if groups:
-        prepare_twins(context, groups)
+        prepare_twins(context, groups, source=source)
     from joblib import Parallel, delayed
 
     from faultgen import children

@@ -93,24 +93,36 @@ def base_cycles(n_axes: int) -> list[tuple[float, float, int]]:
 
 class Twin:
     """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
-    log whose motion is replayed (read by ``reader``, :data:`faultgen.monitor.logs.Reader`; the
-    measured format's by default), ``cache`` the folder of simulated cycles (created if needed)
-    inside ``root`` (default ``cache``), out of which no cached cycle may lead."""
+    log whose motion is replayed, as the run parsed it (:class:`faultgen.monitor.logs.Parsed`: its
+    SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
+    error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
+    format's by default), ``cache`` the folder of simulated cycles (created if needed) inside
+    ``root`` (default ``cache``), out of which no cached cycle may lead.
 
-    def __init__(self, model: str | Path, program: Path, cache: Path, root: Path | None = None,
+    Raises
+    ------
+    ValueError
+        The program cannot be read (file and row named), or a base cycle cannot be simulated.
+    """
+
+    def __init__(self, model: str | Path, program: Path | fleet_logs.Parsed, cache: Path, root: Path | None = None,
                  reader: fleet_logs.Reader | None = None, cycles: bool = True):
         self.model = str(model)
         self.robot = robots.load(model)
-        self.program = Path(program)
         self.cache = Path(cache)
         self.root = self.cache if root is None else Path(root)
-        self.reader = reader or (lambda path, robot: measured.read(path, robot, accelerations=False))
         self.cache.mkdir(parents=True, exist_ok=True)
-        program_sha256 = stored.sha256_file(self.program)
-        self._files = {"model": stored.sha256_file(self.robot.path), "program": program_sha256,
+        if not isinstance(program, fleet_logs.Parsed):
+            reader = reader or (lambda path, robot: measured.read(path, robot, accelerations=False))
+            program = fleet_logs.Parsed(Path(program), stored.sha256_file(program), None)
+            data = reader(program.path, self.robot)
+        else:
+            data = program.checked()
+        self.program = program.path
+        self._files = {"model": stored.sha256_file(self.robot.path), "program": program.sha256,
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
                        "reference": f"savgol {REFERENCE_WINDOW:g} s"}
-        self._reference = self._smoothed_program(program_sha256)
+        self._reference = self._smoothed_program(program.sha256, data)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         if cycles:
@@ -135,14 +147,13 @@ class Twin:
         self.signatures = np.stack([(self.cycle(at_own, 0.0, axis) - healthy) / WEAR
                                     for axis in range(1, self.robot.n_axes + 1)])
 
-    def _smoothed_program(self, sha256: str) -> Path:
+    def _smoothed_program(self, sha256: str, data: measured.MeasuredData) -> Path:
         """The program log's motion as the twin replays it: its angles through the Savitzky-Golay
         filter of :data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`), written (again,
         every time: nothing is read back) as ``t, q1..qN`` in the folder ``programs`` beside
         ``cache``. A logged cycle was executed by the real drive, so the twin must not saturate on
         the encoder's noise, which the replay tracks as its reference (faultgen's default 1e-4 rad
         saturated the irb6700's axis 2 on its own pick and place)."""
-        data = self.reader(self.program, self.robot)
         t = np.asarray(data.t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(data.q, dtype=float), REFERENCE_WINDOW)
         folder = self.cache.parent / "programs"  # beside the cycles: the cycle folder holds cycles only

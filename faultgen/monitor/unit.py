@@ -2,7 +2,8 @@
 logs and runs (:class:`Unit`), its program (the log its twin replays, shared with an earlier unit
 that runs the same motion: :func:`program_of`), its model (given, calibrated on its first log and
 cached, or nominal: :func:`model_of`) and its twin with the fallbacks (calibrated or given model ->
-nominal model -> protocol own: :func:`twin_of`).
+nominal model -> protocol own: :func:`twin_of`). Logs come parsed from the run's
+:class:`faultgen.monitor.logs.Source`, which reads each once.
 """
 
 from __future__ import annotations
@@ -50,18 +51,18 @@ class Unit:
 
 
 def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
-              read_with: fleet_logs.Reader) -> Unit:
+              source: fleet_logs.Source) -> Unit:
     """A unit seen for the first time: its program (the log its twin replays) and the kind of model
     asked for (given, calibrated on its first log, nominal); protocol ``own`` without a twin or
     when its first log cannot be read. The model itself is made with the twin (:func:`twin_of`),
-    which falls back when it cannot be."""
+    which falls back when it cannot be. The first log is read here, once (``source``)."""
     monitor = UnitMonitor(name, settings, nominal.n_axes)
     first = units[name][0]
-    first_key = (first.stamp, stored.sha256_file(first.path))
+    first_key = (first.stamp, source.get(first).sha256)
     if settings.protocol != "twin":
         return Unit(monitor, "none", None, first_key)
     try:
-        program = program_of(nominal, first, name, programs, read_with)
+        program = program_of(first, name, programs, source)
     except ValueError as err:
         return Unit(monitor, "none", None, first_key,
                      notes=[f"its first log cannot be replayed ({short(err)}): protocol own"])
@@ -70,20 +71,19 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
 
 
 def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
-          read_with: fleet_logs.Reader) -> Twin | str | None:
+          source: fleet_logs.Source) -> Twin | str | None:
     """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
     from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
     its new logs are skipped with it. Each fallback is noted in the unit's reason."""
     while unit.model != "none":
         try:
-            first_path = log_of(units, unit.monitor.unit, unit.first[0]).path if any(
-                g.stamp == unit.first[0] for g in units[unit.monitor.unit]) else None
-            model = model_of(nominal, unit.model, calibrated_model, unit.first, first_path, out, progress, read_with)
+            first_log = next((g for g in units[unit.monitor.unit] if g.stamp == unit.first[0]), None)
+            model = model_of(nominal, unit.model, calibrated_model, unit.first, first_log, out, progress, source)
             twin_key = (model, unit.program)
             if twin_key not in twins:
-                twins[twin_key] = Twin(model, log_of(units, *unit.program).path, out / ".cache" / "cycles", root=out,
-                                       reader=read_with)
+                twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
+                                       root=out)
             twin = twins[twin_key]
         except stored.StateError:
             raise
@@ -136,13 +136,13 @@ def given_model(calibrated: str | Path) -> Path:
     return path
 
 
-def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_path: Path | None, out: Path,
-           progress: bool, read_with: fleet_logs.Reader) -> str:
+def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_log: fleet_logs.Log | None,
+           out: Path, progress: bool, source: fleet_logs.Source) -> str:
     """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
-    the unit's first log (``first``: its stamp and SHA-256; ``first_path`` the file, needed only
-    when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under the digest of
-    the nominal model, the log and the search's length, beside a record of the calibrated model's
-    SHA-256 that a later run checks.
+    the unit's first log (``first``: its stamp and SHA-256; ``first_log`` the log, parsed by
+    ``source`` and needed only when the calibration is not cached), cached in
+    ``OUT/.cache/calibrated`` under the digest of the nominal model, the log and the search's
+    length, beside a record of the calibrated model's SHA-256 that a later run checks.
 
     Raises
     ------
@@ -161,7 +161,7 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
     if record.exists() or record.is_symlink():
         stored.read_calibration(record, out, key, model)
     else:
-        if first_path is None:
+        if first_log is None:
             raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
                              "in the fleet folder and its calibration is not cached")
         if folder.exists() or folder.is_symlink():  # a run killed before its record: ours to redo
@@ -171,7 +171,7 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run_calibration(nominal, read_with(first_path, nominal), folder, max_steps=CALIBRATION_STEPS,
+            run_calibration(nominal, source.get(first_log).checked(), folder, max_steps=CALIBRATION_STEPS,
                             progress=False)
         stored.write_calibration(record, key, model)
     implausible = plausibility.implausible_parameters(nominal, robots.load(model))
@@ -195,12 +195,20 @@ def without_payload(path: Path) -> Path:
     return target
 
 
-def program_of(nominal, first: fleet_logs.Log, unit: str, programs: list, read_with: fleet_logs.Reader) -> tuple[str, str]:
-    """The log (unit, stamp) to replay for ``unit`` whose first log is ``first``: an earlier unit's
-    when the motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles."""
-    q = np.asarray(read_with(first.path, nominal).q)
+def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_logs.Source) -> tuple[str, str]:
+    """The log (unit, stamp) to replay for ``unit`` whose first log is ``first`` (parsed by
+    ``source``, which keeps a program for the twins that replay it): an earlier unit's when the
+    motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles.
+
+    Raises
+    ------
+    ValueError
+        The first log cannot be read (file and row named).
+    """
+    q = np.asarray(source.get(first).checked().q)
     for other, other_program in programs:
         if other.shape == q.shape and np.max(np.abs(other - q)) < SAME_PROGRAM:
             return other_program
+    source.keep(first)
     programs.append((q, (unit, first.stamp)))
     return (unit, first.stamp)

@@ -12,6 +12,7 @@ the median sample period), so a replayed log and the same log calibrated see one
 
 from __future__ import annotations
 
+import io
 import math
 import zlib
 from collections import Counter
@@ -72,7 +73,7 @@ def csv_rows(path: Path, n_columns: int, what: str = "a log", label: str = "join
     ``n_columns`` columns, counted before it is parsed: from its size when that already bounds them
     (a row takes at least a byte), else by a streaming line count (:func:`faultgen.inputs.count_lines`)."""
     try:
-        if not inputs.is_gzip(path) and path.stat().st_size <= whole_rows(n_columns):
+        if not inputs.is_gzip(path) and inputs.size_of(path) <= whole_rows(n_columns):
             return
         lines = inputs.count_lines(path, label)
     except inputs.InputError as err:
@@ -103,8 +104,9 @@ def kind(path: Path) -> str:
     if name.endswith(HDF5_SUFFIXES):
         return "hdf5"
     accepted = ", ".join(CSV_SUFFIXES + HDF5_SUFFIXES)
+    suffixes = "".join(inputs.path_of(path).suffixes)
     raise LogError(
-        f"{path}: unknown file type {''.join(path.suffixes) or '(no suffix)'!r}; expected {accepted}"
+        f"{path}: unknown file type {suffixes or '(no suffix)'!r}; expected {accepted}"
     )
 
 
@@ -359,7 +361,7 @@ def open_hdf5(path: Path):
     """The HDF5 log, opened read-only after faultgen.inputs refused links and virtual datasets that
     reach other files (LogError naming the link)."""
     try:
-        fh = h5py.File(path, "r")
+        fh = h5py.File(io.BytesIO(path.data) if isinstance(path, inputs.Held) else path, "r")
     except OSError as err:
         raise LogError(f"{path}: cannot read the file as HDF5: {err}") from err
     with fh:
@@ -489,9 +491,12 @@ def check_angles(where: Path, q: np.ndarray, robot: robots.Robot, label,
         )
 
 
-def read_columns(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
+def read_columns(path: Path | inputs.Held, n_axes: int, motion_only: bool = False
+                 ) -> tuple[dict[str, np.ndarray], list[str], object]:
     """The columns of the log ``path`` (:func:`select_columns`), every cell a finite number, the
     ignored extra column names and the row labeller (:func:`csv_label` or :func:`index_label`).
+    ``path`` may be the log's bytes read once (:class:`faultgen.inputs.Held`): parsed from them,
+    the file not opened again.
 
     Raises
     ------
@@ -499,7 +504,7 @@ def read_columns(path: Path, n_axes: int, motion_only: bool = False) -> tuple[di
         For an unknown suffix, a file that is not a regular one or not readable as its type, a
         missing column, a cell that is not a finite number (file, data row and column named).
     """
-    path = Path(path)
+    path = path if isinstance(path, inputs.Held) else Path(path)
     reader = read_csv if kind(path) == "csv" else read_hdf5
     regular(path)
     return reader(path, n_axes, motion_only)
