@@ -2,8 +2,9 @@
 export with time in milliseconds, angles in degrees and torques in N m, tab-separated, ``.tsv``.
 
 Importing this module registers it (:func:`faultgen.data.adapters.register`); from then on
-``--format deg-ms`` reads it in ``faultgen logs import``, ``faultgen calibrate`` and ``faultgen
-monitor``, with the measured format's checks (:func:`faultgen.data.measured.from_columns`). A format
+``--format deg-ms`` reads it in ``faultgen logs import``, ``faultgen calibrate``, ``faultgen
+monitor`` and ``faultgen simulate --task LOG`` (the replay), with the measured format's checks
+(:func:`faultgen.data.measured.from_columns`; the replay's, :func:`faultgen.operation.replay.from_columns`). A format
 shipped with faultgen is the same class in ``faultgen/data/adapters.py``. tests/test_log_formats.py
 uses it.
 """

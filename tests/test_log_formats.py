@@ -1,4 +1,5 @@
-"""A log format added in one file reaches `logs import`, `calibrate` and `monitor` (issue 57, item 2).
+"""A log format added in one file reaches `logs import`, `calibrate`, `monitor` and the replay of
+`simulate --task LOG` (issue 57, item 2).
 
 tests/log_format_example.py registers ``deg-ms`` (milliseconds, degrees, tab-separated) and nothing
 else: each command given ``--format deg-ms`` reads the logs through it and gives the outputs it
@@ -17,6 +18,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import adapters
 from faultgen.model import robots
+from faultgen.operation import jointlog, programs
 
 runner = CliRunner()
 
@@ -110,3 +112,76 @@ def test_calibrate_refuses_an_unknown_format_and_torque_constants_of_another(tmp
                                  "-o", str(tmp_path / "c"), "--format", "voraus", "--torque-constants", "1,1,1,1,1,1"])
     assert result.exit_code == 2 and "--torque-constants" in result.output
     assert not (tmp_path / "c").exists()
+
+
+def motion_log(path, robot, t, q):
+    """A measured-format log of the motion ``t`` (s), ``q`` (rad) with no torque (a replay reads none)."""
+    names = ["t", *(f"q{k}" for k in range(1, 7)), *(f"tau{k}" for k in range(1, 7))]
+    np.savetxt(path, np.column_stack([t, q, np.zeros_like(q)]), delimiter=",", header=",".join(names), comments="",
+               fmt="%.17g")
+    return path
+
+
+def test_simulate_replays_the_format(tmp_path, puma):
+    """A 2 s piece of the PUMA 560's pick and place (ending mid-move) at 250 Hz, as a ``deg-ms``
+    log: ``simulate --task LOG --format deg-ms`` gives the dataset of the same numbers in the measured
+    format, array for array; the dataset says which format the log was read by."""
+    thesis = programs.load(puma, "pick_place").trajectory(0.004)
+    piece = slice(200, 701)
+    source = motion_log(tmp_path / "source.csv", puma, 3.0 + thesis.t[piece], thesis.q[piece])
+    tsv = log_format_example.write(source, tmp_path / "piece.tsv")
+    plain = log_format_example.measured_copy(tsv, puma, tmp_path / "plain.csv")
+    stores = {}
+    for name, log, extra in (("example", tsv, ["--format", "deg-ms"]), ("plain", plain, [])):
+        out = tmp_path / f"{name}.h5"
+        result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(log), "--cycles", "1",
+                                     "--no-progress", "-o", str(out), *extra])
+        assert result.exit_code == 0, result.output
+        stores[name] = out
+    with h5py.File(stores["example"]) as a, h5py.File(stores["plain"]) as b:
+        run_a, run_b = a["runs/run"], b["runs/run"]
+        arrays = sorted(k for k, v in run_b.items() if isinstance(v, h5py.Dataset))
+        assert sorted(k for k, v in run_a.items() if isinstance(v, h5py.Dataset)) == arrays
+        assert {"q_ref", "q_m", "tau_m", "mean_abs_torque"} <= set(arrays)
+        for k in arrays:
+            np.testing.assert_array_equal(run_a[k][()], run_b[k][()], err_msg=k)
+        assert run_a.attrs["task"] == "piece" and run_b.attrs["task"] == "plain"
+        assert json.loads(run_a.attrs["program"])["format"] == {"name": "deg-ms"}
+        assert "format" not in json.loads(run_b.attrs["program"])
+        assert json.loads(run_a.attrs["config"])["log_format"] == {"name": "deg-ms"}
+
+
+def test_a_dense_log_in_the_format_replays_as_in_the_measured_format_and_is_refused_alike(tmp_path, puma):
+    """A 1 s piece at 4 kHz (two rows per physics step of the PUMA 560): read through the adapter, the
+    replay keeps every second row as the measured reader does, bit for bit; a gap in the log is
+    refused with the measured format's message."""
+    thesis = programs.load(puma, "pick_place").trajectory(0.00025)
+    piece = slice(1200, 5201)
+    source = motion_log(tmp_path / "source.csv", puma, thesis.t[piece], thesis.q[piece])
+    tsv = log_format_example.write(source, tmp_path / "dense.tsv")
+    plain = log_format_example.measured_copy(tsv, puma, tmp_path / "plain.csv")
+    example = programs.load(puma, programs.log_task(str(tsv), adapters.make("deg-ms")))
+    measured = programs.load(puma, str(plain))
+    assert example.name == "dense" and len(example.t) == len(measured.t) == 2001
+    for name in ("t", "q", "qd", "qdd"):
+        np.testing.assert_array_equal(getattr(example, name), getattr(measured, name), err_msg=name)
+    t = thesis.t[piece].copy()
+    t[3000:] += 0.06  # a gap longer than the derivative filter's window
+    gap = log_format_example.write(motion_log(tmp_path / "gap.csv", puma, t, thesis.q[piece]), tmp_path / "gap.tsv")
+    with pytest.raises(jointlog.LogError, match=r"gap.tsv: column t jumps by 0.06025 s from data row 3000 \(index "
+                                                 r"2999\) to data row 3001 \(index 3000\); expected no interval"):
+        programs.load(puma, programs.log_task(str(gap), adapters.make("deg-ms")))
+
+
+def test_simulate_refuses_a_format_for_a_task_that_is_no_log_and_torque_constants_of_another(tmp_path):
+    for task in ("pick_place", str(tmp_path / "mine.toml")):
+        result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", task, "--format", "deg-ms",
+                                     "-o", str(tmp_path / "x.h5")])
+        assert result.exit_code == 2 and "log format deg-ms reads a joint log" in result.output, result.output
+    result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(tmp_path / "x.tsv"), "--format",
+                                 "no-such-format", "-o", str(tmp_path / "x.h5")])
+    assert result.exit_code == 2 and "no-such-format" in result.output and "deg-ms" in result.output
+    result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(tmp_path / "x.tsv"), "--format",
+                                 "deg-ms", "--torque-constants", "1,1,1,1,1,1", "-o", str(tmp_path / "x.h5")])
+    assert result.exit_code == 2 and "--torque-constants" in result.output
+    assert not (tmp_path / "x.h5").exists()

@@ -15,8 +15,9 @@ from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_cycles
 from faultgen.cli.main import app
 from faultgen.cli.options import (
-    MAX_CYCLES, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, Overwrite, PayloadParts, PayloadPattern, Progress,
-    Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, UnitSpreadFlag, conditions_from_options,
+    MAX_CYCLES, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, LogFormat, Overwrite, PayloadParts, PayloadPattern,
+    Progress, Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, TorqueConstants,
+    UnitSpreadFlag, conditions_from_options, log_adapter,
 )
 
 
@@ -26,7 +27,9 @@ def simulate_command(
         "--robot", "--model",
         help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
         "model `faultgen calibrate` wrote.")] = "irb6700",
-    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3), a program file (.toml, `faultgen tasks`) or a joint log to replay (.csv with t, q1..qN in rad).")] = "pick_place",
+    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3), a program file (.toml, `faultgen tasks`) or a joint log to replay (.csv with t, q1..qN in rad, or a log in another --format).")] = "pick_place",
+    log_format: LogFormat = "measured",
+    torque_constants: TorqueConstants = None,
     friction_model: Friction = "lugre",
     wear: Annotated[
         list[str] | None,
@@ -78,8 +81,10 @@ def simulate_command(
       faultgen simulate --friction stribeck --wear 2:exp4:20 --unit-spread --gear-loss 0.1 -o lossy.h5
     """
     from faultgen.data import dataset
+    from faultgen.model import robots
     from faultgen.operation import conditions as conditions_module
     from faultgen.operation import faults as faults_module
+    from faultgen.operation import programs
     from faultgen.operation import wear as wear_module
     from faultgen.simulation import sensors
     from faultgen.simulation import stepping as sim
@@ -87,8 +92,10 @@ def simulate_command(
     check_outputs([out], overwrite)
     if cycles < 1:
         raise ValueError(f"--cycles {cycles}: expected a whole number >= 1")
+    loaded = robots.load(robot) if torque_constants is not None else None  # to check --torque-constants only
+    adapter = log_adapter(log_format, torque_constants, loaded)  # None: the measured format, read as before
     config = sim.RunConfig(
-        robot=robot, task=task, friction=friction_model,
+        robot=robot, task=programs.log_task(task, adapter), friction=friction_model,
         wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
         record=None if record is None else parse_cycles(record), seed=seed,
         noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
@@ -96,6 +103,7 @@ def simulate_command(
                                            start_day, gear_loss=gear_loss, dry_share=dry_share)
         or conditions_module.Conditions(),
         fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
+        resolved=loaded,
     )
     from faultgen.data import atomic
 
@@ -105,16 +113,17 @@ def simulate_command(
     dataset.write_run(out, result, command=command)
     typer.echo(summary(result, out))
     if result.saturated.size:
-        typer.echo(saturation_warning(result.saturated, task), err=True)
+        typer.echo(saturation_warning(result.saturated, task, replayed=adapter is not None), err=True)
 
 
-def saturation_warning(saturated, task: str) -> str:
+def saturation_warning(saturated, task: str, replayed: bool = False) -> str:
     """The warning of a run whose drives reached their torque limit (the dataset's ``saturated``
-    label): which axes, what it means, and for a replayed log the likely causes."""
+    label): which axes, what it means, and for a replayed log (by its suffix, or ``replayed``: a log
+    in another format) the likely causes."""
     axes = ", ".join(str(int(a)) for a in saturated)
     text = (f"warning: the drive of axis {axes} reached its torque limit (saturated): the run does not follow its "
             "task there, and its torques are the drive's limit, not the task's")
-    if Path(task).suffix.lower() in (".csv", ".gz", ".h5", ".hdf5"):
+    if replayed or Path(task).suffix.lower() in (".csv", ".gz", ".h5", ".hdf5"):
         text += ("; a replayed log is tracked as the drive's reference, so an encoder's noise in its angles, a part "
                  "heavier than the model was sized for or a motion faster than the model's drives can carry "
                  "saturate it (`faultgen monitor` replays a log's angles through the derivative filter)")

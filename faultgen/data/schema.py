@@ -9,7 +9,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
     /runs/<run id>/           attrs: labels (robot, task, friction_model, cycles, seed, worn_axes,
                                      program_sha256: what the program is (PROGRAM_ATTRIBUTE;
                                      older files lack it),
-                                     a program file's or log's program: name, file, sha256, program_text;
+                                     a program file's or log's program: name, file, sha256, program_text,
+                                     a log's format (not the measured one);
                                      wear JSON, noise JSON) and provenance (faultgen_version,
                                      model_sha256, log_period, config JSON, command; since robots
                                      of 5-7 axes: n_axes, drivetrain JSON; since issue 57:

@@ -83,13 +83,15 @@ def limits(robot, task: str | None = None) -> dict | None:
 def config_key(config) -> str:
     """The run configuration as canonical JSON: equal keys mean the same simulation."""
     key = {
-        "robot": config.robot, "task": config.task, "friction": config.friction,
+        "robot": config.robot, "task": str(config.task), "friction": config.friction,
         **({"program_sha256": program["sha256"]} if (program := programs.record(config.task)) else {}),
         "wear": config.wear.to_dict(), "cycles": int(config.cycles),
         "record": [int(c) for c in config.recorded_cycles], "seed": int(config.seed),
         "noise": asdict(config.noise),
     }
     # a run keeps the key it had before these options existed when it does not use them
+    if program and "format" in program:  # a log read through another format than measured
+        key["log_format"] = program["format"]
     if config.conditions.active:
         key["conditions"] = config.conditions.to_dict()
     if not config.signals:

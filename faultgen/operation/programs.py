@@ -80,6 +80,7 @@ from faultgen.operation.tasks import (  # noqa: F401
     TASKS,
     JointPath,
     Load,
+    LogTask,
     ProgramError,
     Task,
     check_step,
@@ -95,15 +96,34 @@ class ProgramBoundError(ProgramError, inputs.InputError):
     a :class:`ProgramError` and a :class:`faultgen.inputs.InputError`."""
 
 
-def is_file_task(task: str) -> bool:
-    """Whether ``task`` names a program or log file (by its suffix) rather than a thesis task."""
+def is_file_task(task: str | LogTask) -> bool:
+    """Whether ``task`` names a program or log file (by its suffix, or a :class:`LogTask`) rather
+    than a thesis task."""
     name = str(task).lower()
-    return name.endswith(PROGRAM_SUFFIXES + REPLAY_SUFFIXES)
+    return isinstance(task, LogTask) or name.endswith(PROGRAM_SUFFIXES + REPLAY_SUFFIXES)
+
+
+def log_task(task: str, adapter=None) -> str | LogTask:
+    """The task ``task`` with its log read through the log format ``adapter`` (a
+    :class:`faultgen.data.adapters.Adapter`): a :class:`LogTask`; ``task`` itself when ``adapter``
+    is None (the measured format, or no log). ValueError when ``adapter`` is given with a thesis
+    task or a program file (a format reads a joint log)."""
+    if adapter is None:
+        return task
+    if task in TASKS or str(task).lower().endswith(PROGRAM_SUFFIXES):
+        what = "a thesis task" if task in TASKS else "a program file"
+        raise ValueError(f"log format {adapter.name} reads a joint log to replay; task {str(task)!r} is {what} "
+                         "(a format other than measured is for a log only)")
+    return LogTask(str(task), adapter)
 
 
 def check_name(task: str) -> str:
     """``task`` if it is a thesis task name or an existing program / log file, else ValueError naming
     it and what is expected."""
+    if isinstance(task, LogTask):
+        if not Path(task.path).is_file():
+            raise ValueError(f"task file {task.path!r} does not exist")
+        return task
     if not isinstance(task, str) or not task:
         raise ValueError(f"task {task!r}: expected a task name ({', '.join(TASKS)}) or a program file (.toml) "
                          "or joint log (.csv, .h5)")
@@ -121,6 +141,8 @@ def label(task: str) -> str:
     """A short name for ``task`` in run ids and progress bars: the thesis name, or the file's stem."""
     if task in TASKS or not is_file_task(task):
         return task
+    if isinstance(task, LogTask):
+        return task.stem
     name = Path(task).name
     for suffix in sorted(PROGRAM_SUFFIXES + REPLAY_SUFFIXES, key=len, reverse=True):
         if name.lower().endswith(suffix):
@@ -131,7 +153,8 @@ def label(task: str) -> str:
 def load(robot: Robot, task: str) -> Task:
     """The task ``task`` of ``robot``: a thesis task by name (a program from the robot folder's
     ``tasks.toml``, :func:`builtin`), a program file (``.toml``, :func:`read`) or a joint log to replay
-    (``.csv``, ``.csv.gz``, ``.h5``; :func:`faultgen.operation.replay.read`).
+    (``.csv``, ``.csv.gz``, ``.h5``, or a :class:`LogTask` in another format;
+    :func:`faultgen.operation.replay.read`).
 
     Returns
     -------
@@ -156,13 +179,14 @@ def load(robot: Robot, task: str) -> Task:
     # which a thesis task or program would spend before its first physics step for nothing)
     from faultgen.operation import replay
 
-    return replay.read(task, robot, _limits({}, robot, task), check_torque)
+    adapter = task.adapter if isinstance(task, LogTask) else None
+    return replay.read(str(task), robot, _limits({}, robot, str(task)), check_torque, adapter=adapter)
 
 
 def record(task: str) -> dict | None:
     """What a dataset keeps of a file task so the run can be made again: ``name`` (the program's, or
-    the log's stem), ``file`` (as given), ``sha256`` of the file's bytes and, for a program, its
-    ``text``; None for a thesis task."""
+    the log's stem), ``file`` (as given), ``sha256`` of the file's bytes, for a program its ``text``
+    and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); None for a thesis task."""
     if task in TASKS or not is_file_task(task):
         return None
     data = Path(task).read_bytes()
@@ -176,6 +200,8 @@ def record(task: str) -> dict | None:
         out["text"] = text
     else:
         out["name"] = label(task)
+    if isinstance(task, LogTask):
+        out["format"] = task.log_format()
     return out
 
 

@@ -34,6 +34,9 @@ most one row per physics step of the robot is read whole; a denser one is checke
 it streams by and then replayed as every ``k``-th row from the first, at most one row per step
 (what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
 recorded at that rate (the reference passes through its own samples, time 0 is its first).
+A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``; issue 57) is
+parsed by its adapter, whole, and its columns replayed by :func:`from_columns` with the same checks
+and messages.
 
 Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
@@ -205,14 +208,16 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
 
 
 def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
-         check_torque: Callable) -> Replay:
+         check_torque: Callable, adapter=None) -> Replay:
     """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
-    (:mod:`faultgen.operation.jointlog`, no torque columns), streamed (:mod:`faultgen.operation.logblocks`).
+    (:mod:`faultgen.operation.jointlog`, no torque columns), streamed (:mod:`faultgen.operation.logblocks`),
+    or, with ``adapter``, by that log format's reader (:func:`from_columns`).
 
     Parameters
     ----------
     path : str or Path
-        A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` log with columns ``t`` (s) and ``q1..qN`` (rad).
+        A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` log with columns ``t`` (s) and ``q1..qN`` (rad);
+        with ``adapter``, a log in that format.
     robot : Robot
         Resolved by the caller (:func:`faultgen.operation.programs.load`).
     limits : tuple of three ndarray of shape (N,)
@@ -221,6 +226,9 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
     check_torque : callable
         ``check_torque(robot, path, segment_at, fail)`` refusing a reference above the drives'
         capacity: :func:`faultgen.operation.programs.check_torque`.
+    adapter : faultgen.data.adapters.Adapter, optional
+        The log's format other than the measured one: its ``columns(path, robot)`` parses the file
+        into the measured format's columns (``t``, ``q1..qN`` used), which :func:`from_columns` checks.
 
     Raises
     ------
@@ -228,15 +236,18 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         A ValueError naming the file and the row or column: a missing file or column, a non-finite
         value, time that does not increase, a log that is too short, has a gap or runs longer than
         :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
+        With ``adapter``, what its reader refuses too (a ValueError naming the file).
     """
     path = Path(path)
+    if adapter is not None:
+        columns, label = adapter.columns(path, robot)[:2]
+        return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
     n_axes = robot.n_axes
     src = logblocks.source(path, n_axes, motion_only=True)
     times = logblocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
     scan = logblocks.scan(src, robot, times, BLOCK_ROWS)
     rows = times.rows
-    step = robot.model.opt.timestep
-    most = int((times.last - times.first) / step + 1e-6) + 1 if rows > 1 else rows  # a row per physics step
+    most = _most_rows(times, robot)  # a row per physics step
     if rows <= most:  # read whole, as the calibration reads a log
         columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
     else:  # denser than the physics step: every k-th row kept while read, once every row is checked
@@ -245,12 +256,71 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
         k = -(-rows // most)
         columns, label = logblocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
+    return _replay(columns, label, path, robot, limits, check_torque, jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES)
+
+
+def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], path: str | Path, robot: Robot,
+                 limits: tuple[np.ndarray, np.ndarray, np.ndarray], check_torque: Callable,
+                 suffixes: tuple[str, ...] = ()) -> Replay:
+    """A log already parsed into the measured format's columns (a log format's adapter,
+    :meth:`faultgen.data.adapters.Adapter.columns`), replayed on ``robot`` with the checks and
+    messages :func:`read` gives a measured log read whole: a missing column, a non-finite value,
+    time not increasing, too short, a gap, too long, an angle outside the joint range; a log denser
+    than one row per physics step is replayed as every ``k``-th row, as :func:`read` does.
+
+    Parameters
+    ----------
+    columns : dict of str to ndarray of shape (n,)
+        ``t`` (s) and ``q1..qN`` (rad) used; other columns ignored.
+    label : callable
+        Data row index (0-based) -> its name in messages (:func:`faultgen.operation.jointlog.index_label`).
+    path : str or Path
+        The file, named in messages; its name less the longest of ``suffixes`` it ends with is the
+        replay's :attr:`Replay.name` (less its last suffix when none).
+    robot, limits, check_torque
+        As :func:`read`.
+
+    Raises
+    ------
+    faultgen.operation.jointlog.LogError
+        As :func:`read`.
+    """
+    path = Path(path)
+    wanted, _ = jointlog.select_columns(path, list(columns), robot.n_axes, motion_only=True)
+    motion = {name: np.asarray(columns[name], dtype=float) for name in wanted}
+    jointlog.refuse_non_finite(path, motion, wanted, label)
+    times = logblocks.TimeScan(path, label, lambda first, last, rows: _check_length(path, first, last))
+    if len(motion[jointlog.T_COLUMN]):  # none: refused by the whole-log checks below, as read() refuses it
+        times.add(0, motion[jointlog.T_COLUMN])
+    most = _most_rows(times, robot)
+    if times.rows > most:  # denser than the physics step: every k-th row, as read() keeps of a measured log
+        times.check(MIN_DURATION, 1 / MAX_GAP)
+        q = np.column_stack([motion[c] for c in jointlog.column_names(robot.n_axes)[0]])
+        jointlog.check_angles(path, q, robot, label, 0.0)
+        k = -(-times.rows // most)
+        kept = {name: np.ascontiguousarray(values[::k]) for name, values in motion.items()}
+        motion, label = kept, lambda i, whole=label: whole(i * k)
+    return _replay(motion, label, path, robot, limits, check_torque, suffixes)
+
+
+def _most_rows(times: logblocks.TimeScan, robot: Robot) -> int:
+    """The rows a log of these ``times`` is replayed with at most: one per physics step."""
+    step = robot.model.opt.timestep
+    rows = times.rows
+    return int((times.last - times.first) / step + 1e-6) + 1 if rows > 1 else rows
+
+
+def _replay(columns: dict[str, np.ndarray], label: Callable[[int], str], path: Path, robot: Robot, limits: tuple,
+            check_torque: Callable, suffixes: tuple[str, ...]) -> Replay:
+    """The :class:`Replay` of a log's ``t`` and ``q`` ``columns`` (at most a row per physics step),
+    checked and differentiated (:func:`faultgen.operation.jointlog.motion`)."""
     found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
                             tolerance=0.0)
     t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]
-    suffix = max((s for s in jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if path.name.lower().endswith(s)), key=len)
+    ends = [s for s in suffixes if path.name.lower().endswith(s)]
+    name = path.name[: -len(max(ends, key=len))] if ends else path.stem
     velocity, acceleration, jerk = limits
-    return Replay(name=path.name[: -len(suffix)], robot_name=robot.name, process="replay", source=path, t=t - t[0],
+    return Replay(name=name, robot_name=robot.name, process="replay", source=path, t=t - t[0],
                   q=q, qd=qd, qdd=qdd, velocity_limit=velocity, acceleration_limit=acceleration, jerk_limit=jerk,
                   start=q[0], robot=robot, check_torque=check_torque)
 

@@ -26,6 +26,7 @@ convergence").
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -147,6 +148,49 @@ class Task(Protocol):
     robot: Robot
 
     def trajectory(self, dt: float) -> JointPath: ...
+
+
+@dataclass(frozen=True)
+class LogTask:
+    """A joint log to replay that is read through a registered log format
+    (:mod:`faultgen.data.adapters`; ``faultgen simulate --task LOG --format NAME``) instead of the
+    measured format, whose log stays a plain path. It stands where a task name does
+    (:func:`faultgen.operation.programs.load` replays it): ``str()`` and ``os.fspath()`` give the
+    path as given; hashable, so the task's cached preparations are keyed by path and format.
+
+    Attributes
+    ----------
+    path : str
+        The log file, as given.
+    adapter : object
+        The format's adapter (a :class:`faultgen.data.adapters.Adapter`; this layer only calls its
+        ``columns(path, robot)``, reads its ``name``, ``suffixes`` and dataclass fields).
+    """
+
+    path: str
+    adapter: object
+
+    def __str__(self) -> str:
+        return self.path
+
+    def __fspath__(self) -> str:
+        return self.path
+
+    @property
+    def stem(self) -> str:
+        """The file's name less the format's longest suffix it ends with (less its last suffix when
+        it ends with none)."""
+        name = Path(self.path).name
+        ends = [s for s in self.adapter.suffixes if name.lower().endswith(s)]
+        return name[: -len(max(ends, key=len))] if ends else Path(name).stem
+
+    def log_format(self) -> dict:
+        """The format as a dataset records it: ``name`` and the adapter's options (its dataclass
+        fields but ``suffixes``; tuples as lists)."""
+        fields = dataclasses.fields(self.adapter) if dataclasses.is_dataclass(self.adapter) else ()
+        options = {f.name: getattr(self.adapter, f.name) for f in fields if f.name != "suffixes"}
+        return {"name": self.adapter.name,
+                **{k: list(v) if isinstance(v, tuple) else v for k, v in options.items()}}
 
 
 def check_step(dt) -> float:

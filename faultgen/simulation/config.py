@@ -26,9 +26,10 @@ class RunConfig:
         Robot name (``faultgen robots``), robot folder or MJCF path: what the dataset's provenance
         and configuration key record. A :class:`~faultgen.model.robot.Robot` may be given instead;
         it is then held as :attr:`model` and this becomes its name (a known robot) or MJCF path.
-    task : str
+    task : str or faultgen.operation.tasks.LogTask
         One of :data:`faultgen.operation.tasks.TASKS`, or a program file (``.toml``) or joint log to replay
-        (``.csv``, ``.h5``): :func:`faultgen.operation.programs.load`.
+        (``.csv``, ``.h5``; a :class:`~faultgen.operation.tasks.LogTask` for a log in another format,
+        :func:`faultgen.operation.programs.log_task`): :func:`faultgen.operation.programs.load`.
     friction : str
         Friction model, one of :data:`faultgen.effects.friction.MODELS`.
     wear : WearPlan
@@ -80,7 +81,7 @@ class RunConfig:
     """
 
     robot: str
-    task: str
+    task: str | programs.LogTask
     friction: str = "lugre"
     wear: WearPlan = field(default_factory=lambda: WearPlan({}))
     cycles: int = 100
