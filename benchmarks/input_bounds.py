@@ -288,7 +288,7 @@ CASES_CODE = {
     # what `robots add` reads (expanded, parsed, compiled by MuJoCo); the URDF it would write, its size
     "xacro": ("from faultgen.model import importers",
               "print(len(importers.read({log!r}).urdf), 'characters of urdf_used.urdf', file=sys.stderr)"),
-    "measured": ("from faultgen.data import measured", "measured.read({log!r}, 'puma560', accelerations=False)"),
+    "measured": ("from faultgen.data import measured\nfrom faultgen.model import robots", "measured.read({log!r}, robots.load('puma560'), accelerations=False)"),
     "logs-import": ("from faultgen.data import fleetlogs",
                     "fleetlogs.import_logs({log!r}, {out!r} + '.h5', robot='puma560', progress=False)"),
     "voraus": ("from faultgen.data import adapters\nfrom faultgen.model import robots",

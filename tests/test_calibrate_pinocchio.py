@@ -16,6 +16,7 @@ import pytest
 
 from faultgen.calibrate import calibrate, gearbox
 from faultgen.data import measured
+from faultgen.model import robots
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +47,7 @@ def test_payload_comes_back_exactly_from_exact_derivatives_on_a_rigid_model(kr21
     hidden = pinocchio_log.HiddenPayload(mass=120.0)
     t, q, qd, qdd = pinocchio_log.motion(kr210, cycles=1)
     tau = pinocchio_log.arm_torque(kr210, q, qd, qdd, hidden)
-    data = dataclasses.replace(measured.from_arrays(t, q, tau, str(kr210), qd=qd), qdd=qdd)
+    data = dataclasses.replace(measured.from_arrays(t, q, tau, robots.load(kr210), qd=qd), qdd=qdd)
     result = calibrate(str(kr210), data, tmp_path / "calib", max_steps=1)
     assert [s.effect.id for s in result.steps] == ["payload"]
     assert result.gap_after["total_nrmse"] < 1e-4 * result.gap_before["total_nrmse"]

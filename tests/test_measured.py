@@ -72,7 +72,7 @@ def test_round_trip(tmp_path, puma, name, with_qd):
         with gzip.open(path, "rt") as fh:
             assert fh.readline().startswith("t,q1,q2")
 
-    data = measured.read(path, "puma560")
+    data = measured.read(path, robots.load("puma560"))
 
     np.testing.assert_array_equal(data.t, t)
     np.testing.assert_array_equal(data.q, q)
@@ -205,7 +205,7 @@ def test_estimated_derivatives_match_analytic_ones(tmp_path, puma, rate, window,
     q, qd, qdd = sinusoids(puma, t)
     path = measured.write_csv(tmp_path / "m.csv", t, q + NOISE * rng.standard_normal(q.shape), torques(t))
 
-    data = measured.read(path, "puma560")
+    data = measured.read(path, robots.load("puma560"))
 
     assert data.velocity_estimated
     assert f"window {window} samples" in data.notes[-1]
@@ -284,10 +284,14 @@ def test_given_velocity_is_used_and_checked(tmp_path, puma):
 # Refusals
 
 
-def test_unknown_robot_is_refused_listing_known_robots(tmp_path):
-    # Checked before the file is opened: the missing file is not what is reported.
-    with pytest.raises(robots.UnknownRobotError, match=r"unknown robot 'kuka_kr16'; known robots: .*puma560"):
-        measured.read(tmp_path / "absent.csv", "kuka_kr16")
+def test_a_robot_name_is_refused_below_the_boundary(tmp_path):
+    # Resolved once by the caller (issue 57): a name here is a TypeError saying so, before the file
+    # is opened (the missing file is not what is reported).
+    for call in (lambda: measured.read(tmp_path / "absent.csv", "puma560"),
+                 lambda: measured.from_arrays(np.zeros(3), np.zeros((3, 6)), np.zeros((3, 6)), "puma560"),
+                 lambda: measured.from_columns({}, "puma560", "x.csv")):
+        with pytest.raises(TypeError, match=r"measured\.\w+: expected a Robot, got str 'puma560'; resolve"):
+            call()
 
 
 def test_missing_file_unknown_suffix_and_unreadable_files(tmp_path, puma):

@@ -71,7 +71,7 @@ def test_a_held_log_is_refused_with_the_message_of_its_file(tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text("t,q1\n0,1\n")
     with pytest.raises(measured.MeasuredDataError) as from_file:
-        measured.read(path, "puma560")
+        measured.read(path, robots.load("puma560"))
     parsed = fleet_logs.parse(path, robots.load("puma560"))
     assert isinstance(parsed.error, measured.MeasuredDataError)
     assert str(parsed.error) == str(from_file.value)

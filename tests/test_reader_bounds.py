@@ -47,7 +47,7 @@ def test_a_csv_header_of_thousands_of_columns_is_refused_before_its_rows_are_par
     log = _wide_log(tmp_path / "wide.csv", 2000)  # 32 000 took 25 s and 0.6-2.6 GB before
     start = time.perf_counter()
     with pytest.raises(inputs.InputError) as err:
-        measured.read(log, "puma560")
+        measured.read(log, robots.load("puma560"))
     assert time.perf_counter() - start < 5.0
     assert str(err.value).startswith(f"{log}: the header names 2013 columns; a joint log has at most "
                                      f"{inputs.CSV_MAX_COLUMNS}")
@@ -61,7 +61,7 @@ def test_a_csv_header_line_longer_than_the_bound_is_refused(tmp_path):
     log.write_text(",".join(COLUMNS) + ",x" + "y" * inputs.CSV_HEADER_MAX_BYTES + "\n0" + ",0" * 13 + "\n")
     with pytest.raises(inputs.InputError, match=rf"^{re.escape(str(log))}: the header line is longer than "
                                                  rf"{inputs.CSV_HEADER_MAX_BYTES} bytes"):
-        measured.read(log, "puma560")
+        measured.read(log, robots.load("puma560"))
 
 
 def test_a_log_with_extra_columns_reads_only_the_wanted_ones_the_same(tmp_path):
@@ -110,7 +110,7 @@ def test_an_hdf5_log_declaring_1e8_rows_is_refused_by_memory_before_a_whole_read
     most = jointlog.WHOLE_MAX_BYTES // (8 * 13)
     start = time.perf_counter()
     with pytest.raises(inputs.InputError) as err:
-        measured.read(log, "puma560")
+        measured.read(log, robots.load("puma560"))
     assert time.perf_counter() - start < 5.0
     assert str(err.value).startswith(f"{log}: 100000000 rows of 13 columns; a log read whole has at most {most}")
     _refused_by_cli(["logs", "import", str(tmp_path / "logs"), "--robot", "puma560", "-o", str(tmp_path / "f.h5"),

@@ -264,8 +264,9 @@ def test_an_interrupted_calibrate_leaves_nothing_that_blocks_a_rerun(moving_log,
 def test_a_long_log_is_averaged_down_and_keeps_the_relation_between_its_columns(moving_log):
     from faultgen import calibrate
     from faultgen.data import measured
+    from faultgen.model import robots
 
-    data = measured.read(moving_log, "puma560")
+    data = measured.read(moving_log, robots.load("puma560"))
     short = calibrate.decimate(data, 1000)
     k = -(-len(data) // 1000)
     assert len(short) == len(data) // k <= 1000

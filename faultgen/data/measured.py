@@ -195,7 +195,7 @@ class MeasuredData:
 # Reading
 
 
-def read(path: str | Path | inputs.Held, robot: str | Path | robots.Robot, accelerations: bool = True) -> MeasuredData:
+def read(path: str | Path | inputs.Held, robot: robots.Robot, accelerations: bool = True) -> MeasuredData:
     """Read, check and complete a measured-data file (format in the module docstring).
 
     Parameters
@@ -203,9 +203,9 @@ def read(path: str | Path | inputs.Held, robot: str | Path | robots.Robot, accel
     path : str, Path or faultgen.inputs.Held
         A ``.csv``, ``.csv.gz``, ``.h5`` or ``.hdf5`` file (suffix case-insensitive), or its bytes
         read once (:func:`faultgen.inputs.hold`: parsed from them, :attr:`MeasuredData.source` its path).
-    robot : str, Path or robots.Robot
-        The robot the data was recorded on: a name for :func:`faultgen.model.robots.load` (checked
-        before the file is opened) or a loaded robot. Its joint range is used to recognise
+    robot : robots.Robot
+        The robot the data was recorded on, resolved once by the caller
+        (:func:`faultgen.model.robots.load`). Its joint range is used to recognise
         angles in degrees and angles out of range.
     accelerations : bool, default True
         Estimate ``qdd``; False leaves it NaN and saves its filter (a reader that needs no
@@ -218,8 +218,8 @@ def read(path: str | Path | inputs.Held, robot: str | Path | robots.Robot, accel
 
     Raises
     ------
-    robots.UnknownRobotError
-        For an unknown robot name; the message lists the known robots.
+    TypeError
+        For a robot that is not a :class:`~faultgen.model.robots.Robot` (a name: resolve it once).
     MeasuredDataError
         When the file is missing, unreadable or has an unknown suffix; a column is missing
         (the message lists the missing and the present columns) or only some ``qd`` columns
@@ -239,7 +239,7 @@ def read(path: str | Path | inputs.Held, robot: str | Path | robots.Robot, accel
     units and is accepted. Smaller excursions out of range are refused as out of range, with
     a hint to convert when the values would fit as degrees.
     """
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    robot = robots.require(robot, "measured.read")
     columns, extra, row_label = jointlog.read_columns(path, robot.n_axes)
     notes = [f"ignored extra columns: {', '.join(extra)}"] if extra else []
     return _build(columns, robot, inputs.path_of(path), row_label, notes, accelerations)
@@ -249,7 +249,7 @@ def from_arrays(
     t: np.ndarray,
     q: np.ndarray,
     tau: np.ndarray,
-    robot: str | Path | robots.Robot,
+    robot: robots.Robot,
     qd: np.ndarray | None = None,
     source: str | Path | None = None,
 ) -> MeasuredData:
@@ -261,7 +261,7 @@ def from_arrays(
         Sample times in s.
     q, tau : array_like of shape (n, N)
         Arm-side joint angles (rad) and torques (N m), N the robot's axes.
-    robot : str, Path or robots.Robot
+    robot : robots.Robot
         As for :func:`read`.
     qd : array_like of shape (n, N), optional
         Arm-side joint velocities in rad/s; estimated from ``q`` when omitted.
@@ -277,13 +277,13 @@ def from_arrays(
     robots.UnknownRobotError, MeasuredDataError
         As for :func:`read`; rows are 1-based data rows with the 0-based index added.
     """
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    robot = robots.require(robot, "measured.from_arrays")
     where = Path(source) if source is not None else Path("<arrays>")
     columns = _columns_from_arrays(where, t, q, tau, qd, robot.n_axes)
     return _build(columns, robot, where, jointlog.index_label, [])
 
 
-def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robot, source: str | Path,
+def from_columns(columns: dict[str, np.ndarray], robot: robots.Robot, source: str | Path,
                  label=None, accelerations: bool = True, notes: tuple[str, ...] = ()) -> MeasuredData:
     """Check and complete the columns of a log in another layout, mapped onto this format's names
     (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
@@ -292,7 +292,7 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
     Parameters
     ----------
     columns : dict of ndarray of shape (n,)
-    robot : str, Path or robots.Robot
+    robot : robots.Robot
     source : str or Path
         The file they came from, named in messages.
     label : callable, optional
@@ -305,7 +305,7 @@ def from_columns(columns: dict[str, np.ndarray], robot: str | Path | robots.Robo
     MeasuredDataError
         As :func:`read`: a missing column, a non-finite value, times, rates, angles out of range.
     """
-    robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
+    robot = robots.require(robot, "measured.from_columns")
     where = Path(source)
     label = label or jointlog.index_label
     names = list(columns)
