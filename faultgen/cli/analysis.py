@@ -214,12 +214,12 @@ def detect_command(
     from analysis import benchmark
     from analysis import plugins as plugins_
 
+    if plugin and baseline:
+        raise ValueError("give one of --detector MODULE:CLASS or --baseline NAME")
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
     written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv]
     analysis_input(file, written, overwrite)
-    if plugin and baseline:
-        raise ValueError("give one of --detector MODULE:CLASS or --baseline NAME")
     detector = (plugins_.load(plugin, "detector") if plugin else
                 baselines.healthy_detector(baseline) if baseline else None)
     if train is not None:  # another dataset learns normal operation (analysis.crossdata)
