@@ -8,6 +8,7 @@ from typing import Annotated
 
 import typer
 
+from faultgen.bench import baselines
 from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_window
 from faultgen.cli.main import app
@@ -181,6 +182,10 @@ def detect_command(
              "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
              "current folder). The module is imported and so runs as code: name only modules you trust "
              "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
+    baseline: Annotated[str | None, typer.Option(
+        help=f"A named detector instead of the PCA monitor: {', '.join(baselines.healthy_detectors())} (`faultgen "
+             "bench baselines`; the classifiers learn labels, so only `bench score` takes them). --variance and "
+             "--alpha are then unused.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -204,15 +209,19 @@ def detect_command(
       faultgen fleet --robots 8 --days 20 -o fleet8.h5 && faultgen detect fleet8.h5
       faultgen sweep --preset quick --seed 0 --seed 1 -o quick-seeds.h5
       faultgen detect quick-seeds.h5 --protocol other-seeds -o quick-seeds-detection
+      faultgen detect quick.h5 --baseline iforest -o quick-iforest
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
 
+    if plugin and baseline:
+        raise ValueError("give one of --detector MODULE:CLASS or --baseline NAME")
     stem = out or file.with_name(file.stem + "-detection")
     summary_csv = stem.with_name(stem.name + "-summary.csv")
     written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"), summary_csv]
     analysis_input(file, written, overwrite)
-    detector = plugins_.load(plugin, "detector") if plugin else None
+    detector = (plugins_.load(plugin, "detector") if plugin else
+                baselines.healthy_detector(baseline) if baseline else None)
     if train is not None:  # another dataset learns normal operation (analysis.crossdata)
         from analysis import crossdata
 

@@ -9,6 +9,7 @@ from typing import Annotated
 
 import typer
 
+from faultgen.bench import baselines
 from faultgen.cli.base import Command, Group
 from faultgen.cli.main import app
 from faultgen.cli.options import Jobs, Progress
@@ -55,6 +56,23 @@ def list_command() -> None:
                   for n in sorted(track.versions)]
         typer.echo(f"{name}: {track.summary}\n  versions (frozen sizes): {'; '.join(frozen)}; data licence "
                    f"{track.licence}; card {track.card}")
+
+
+@bench_app.command("baselines", cls=Command)
+def baselines_command() -> None:
+    """List the named baselines of `bench score --baseline` and `detect --baseline`: role, what
+    each is, and the extra it needs.
+
+    Example:
+
+    \b
+      faultgen bench baselines
+    """
+    for name in baselines.names():
+        entry = baselines.REGISTRY[name]
+        needs = f" (needs {entry.needs}: the {entry.extra} extra)" if entry.needs else ""
+        learns = ", a classifier (it learns labels: bench score only)" if entry.labels else ""
+        typer.echo(f"{name}: {entry.role}{learns}; {entry.summary}{needs}")
 
 
 @bench_app.command("make", cls=Command)
@@ -116,9 +134,9 @@ def score_command(
     isolator: Annotated[str | None, typer.Option(
         metavar="MODULE:CLASS", help="Your isolator (the contract of `faultgen bench-isolators --isolator`).")] = None,
     baseline: Annotated[str | None, typer.Option(
-        help="A baseline: pca, lr, svm, rf, stacking, iforest, ecod (detectors; pyod's need the bench extra), "
-             "transfer_entropy, cross_correlation, granger, trend, pca_contribution (isolators); on the "
-             "prognostics track linear, exponential, mean_life (prognosers).")] = None,
+        help=f"A baseline (`faultgen bench baselines`): {baselines.describe('detector')}, "
+             f"{baselines.describe('isolator')}; on the prognostics track linear, exponential, mean_life "
+             "(prognosers).")] = None,
     prognoser: Annotated[str | None, typer.Option(
         metavar="MODULE:CLASS", help="Your prognoser, on the prognostics track (the contract of "
         "faultgen.bench.prognosers).")] = None,
@@ -148,7 +166,7 @@ def score_command(
 
         return bench_prognostics.score(data, prognoser, baseline, out)
     from analysis import plugins
-    from faultgen.bench import baselines, score
+    from faultgen.bench import score
 
     given = [(role, value) for role, value in (("detector", detector), ("isolator", isolator), ("baseline", baseline))
              if value]
