@@ -9,7 +9,9 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.cli.options import Backend, Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter
+from faultgen.cli.options import (
+    Backend, Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter,
+)
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).

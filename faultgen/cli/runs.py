@@ -353,8 +353,8 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
         tqdm.write(f"{stats.run_id}: {stats.worker}, {stats.total:.1f} s, worker peak {stats.memory / 1e6:.0f} MB")
 
     sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
-              command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared, backend=backend,
-              on_run=where if scheduler else None)
+              command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared,
+              on_run=where if scheduler else None, backend=backend)
 
 
 def summary(result, out: Path) -> str:

@@ -62,14 +62,15 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
             continue
 
 
-def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str, temperature: float,
-                payload: float, worn_axis: int) -> None:
+def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str,
+                temperature: float, payload: float, worn_axis: int) -> None:
     """Worker task: one cycle of a shared twin (its program as this run parsed it) into the cache
     (:meth:`faultgen.monitor.twin.Twin.cycle`), simulated on the stepping ``backend``. A cycle that
     cannot be simulated (or a cache file refused) is left to the twin made after all of them, which
     says why."""
     try:
-        Twin(model, program, cache, root=root, cycles=False, backend=backend).cycle(temperature, payload, worn_axis)
+        twin = Twin(model, program, cache, root=root, cycles=False, backend=backend)
+        twin.cycle(temperature, payload, worn_axis)
     except ValueError:
         return
 

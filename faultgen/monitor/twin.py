@@ -109,7 +109,8 @@ class Twin:
     """
 
     def __init__(self, model: str | Path, program: Path | fleet_logs.Parsed, cache: Path, root: Path | None = None,
-                 reader: fleet_logs.Reader | None = None, cycles: bool = True, backend: str = backends.DEFAULT):
+                 reader: fleet_logs.Reader | None = None, cycles: bool = True,
+                 backend: str = backends.DEFAULT):
         backends.get(backend)
         self.backend = backend
         self.model = str(model)

@@ -377,10 +377,12 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, backend) for run_id, config in todo]
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, backend)
+             for run_id, config in todo]
     try:
         if scheduler:
-            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar, backend=backend)
+            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar,
+                                       backend=backend)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
