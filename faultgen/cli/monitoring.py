@@ -9,7 +9,9 @@ import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.cli.options import Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter
+from faultgen.cli.options import (
+    Backend, Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter,
+)
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).
@@ -63,6 +65,7 @@ def monitor_command(
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
     scheduler: MonitorScheduler = None,
+    backend: Backend = None,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -144,7 +147,7 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear)
+                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
         remove_made(made)
         raise

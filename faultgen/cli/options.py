@@ -62,6 +62,26 @@ MonitorScheduler = Annotated[str | None, typer.Option(
     "\"Monitoring a fleet on a cluster\"). Not with --jobs. Dask sends tasks and results as pickles, which run code "
     "when read: name only a scheduler you trust, on a network you trust, or use TLS. An address where no Dask "
     "scheduler answers is refused in seconds.")]
+
+
+def _backend(value: str | None) -> str:
+    """The ``--backend`` name, checked before any work (typer callback): the default's when not given."""
+    from faultgen.simulation import backends
+
+    if value is None:
+        return backends.DEFAULT
+    try:
+        backends.get(value)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+    return value
+
+
+Backend = Annotated[str | None, typer.Option(
+    "--backend", callback=_backend, show_default=False, help="The stepping backend the simulations run on: "
+    "batch (mujoco.batch, threaded C; the default) or loop (a plain mj_step loop, slow: the tests' reference); "
+    "every backend gives the same outputs to float tolerance (docs/architecture.md, \"Stepping backends\").")]
+
 SharedFolder = Annotated[bool, typer.Option(
     "--shared-folder", help="With --scheduler: the workers write their runs into OUT's folder themselves, which "
     "they must all see at the same absolute path (a shared file system; checked first): the client then only merges "

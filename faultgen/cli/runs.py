@@ -15,9 +15,9 @@ from faultgen.checks import MAX_SEED
 from faultgen.cli.base import Command, check_outputs, parse_cycles
 from faultgen.cli.main import app
 from faultgen.cli.options import (
-    MAX_CYCLES, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, LogFormat, Overwrite, PayloadParts, PayloadPattern,
-    Progress, Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature, TorqueConstants,
-    UnitSpreadFlag, conditions_from_options, log_adapter,
+    MAX_CYCLES, Backend, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, LogFormat, Overwrite, PayloadParts,
+    PayloadPattern, Progress, Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature,
+    TorqueConstants, UnitSpreadFlag, conditions_from_options, log_adapter,
 )
 
 
@@ -170,6 +170,7 @@ def sweep_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
+    backend: Backend = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -228,7 +229,7 @@ def sweep_command(
                        "they are")
 
     run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder)
+              shared=shared_folder, backend=backend)
     typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
@@ -273,6 +274,7 @@ def fleet_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
+    backend: Backend = None,
     out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -318,14 +320,15 @@ def fleet_command(
                    + (f"; resuming, {done} robots already finished" if done else ""))
 
     run_sweep(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder)
+              shared=shared_folder, backend=backend)
     typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
                f"  faultgen detect {out}")
 
 
 def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
-              announce, shared: bool = False) -> None:
-    """:func:`faultgen.runs.sweep.run` for a command, recording the command line in the dataset.
+              announce, backend: str, shared: bool = False) -> None:
+    """:func:`faultgen.runs.sweep.run` for a command (on the stepping ``backend``), recording the
+    command line in the dataset.
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
     before anything ran, 130 interrupted with the finished runs kept, 1 a run failed. On a
     cluster, each run's worker is printed as the run is kept."""
@@ -351,7 +354,7 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
 
     sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
               command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared,
-              on_run=where if scheduler else None)
+              on_run=where if scheduler else None, backend=backend)
 
 
 def summary(result, out: Path) -> str:

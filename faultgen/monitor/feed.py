@@ -22,6 +22,7 @@ from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 from faultgen.monitor.unit import Unit, log_of, short, twin_of
+from faultgen.simulation import backends
 
 #: A log whose angles lie more than this off its twin's program, rad, or whose length differs by more
 #: than PROGRAM_LENGTH of it, runs another program (noise and tracking: about 1e-3 rad).
@@ -30,7 +31,9 @@ PROGRAM_CHANGE, PROGRAM_LENGTH = 0.05, 0.05
 
 @dataclass(frozen=True)
 class Context:
-    """What scoring a group of units needs (sent to a worker process as it is)."""
+    """What scoring a group of units needs (sent to a worker process as it is); ``backend``: the
+    stepping backend of the twins' cycles (:data:`faultgen.simulation.backends.BACKENDS`; ValueError
+    on construction for one this process does not know)."""
 
     robot: Path
     settings: Settings
@@ -41,7 +44,10 @@ class Context:
     units: dict
     maintenance: dict
     failure_wear: float
+    backend: str = backends.DEFAULT
 
+    def __post_init__(self) -> None:
+        backends.get(self.backend)
 
 
 def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
@@ -70,7 +76,8 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     source = source if source is not None else fleet_logs.Source(nominal, context.log_format)
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, source)
+        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, source,
+                       context.backend)
         for log in unit_logs:
             for event in context.maintenance.get(name, ()):
                 done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
@@ -102,7 +109,8 @@ def new_program(unit: Unit, log, reading, twin: Twin, context, source: fleet_log
     ValueError
         The new program's twin cannot be built (the log is then skipped, named).
     """
-    new = Twin(twin.model, source.get(log), context.out / ".cache" / "cycles", root=context.out)
+    new = Twin(twin.model, source.get(log), context.out / ".cache" / "cycles", root=context.out,
+               backend=twin.backend)
     source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
     unit.monitor.signatures = new.signatures

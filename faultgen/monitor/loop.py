@@ -46,6 +46,7 @@ from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
+from faultgen.simulation import backends
 
 __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "PROGRAM_LENGTH",
            "SAME_PROGRAM", "STATUSES", "Outcome", "UnitStatus", "monitor"]
@@ -97,7 +98,7 @@ class Outcome:
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
             progress: bool = True, log_format=None, jobs: int = 1, scheduler: str | None = None,
-            failure_wear: float = prognosis.FAILURE_WEAR) -> Outcome:
+            failure_wear: float = prognosis.FAILURE_WEAR, backend: str = backends.DEFAULT) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
@@ -135,6 +136,10 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     failure_wear : float
         The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
         axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
+    backend : str
+        The stepping backend the twins' cycles are simulated on
+        (:data:`faultgen.simulation.backends.BACKENDS`; with ``jobs`` or ``scheduler``, the workers
+        must know it too). Every backend gives the same outputs to float tolerance.
 
     Returns
     -------
@@ -148,7 +153,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, a log older than the
         last one scored, a scored log that changed since, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named), or ``jobs`` > 1 with a ``scheduler``.
+        file named), ``jobs`` > 1 with a ``scheduler``, or an unknown ``backend``.
     faultgen.runs.errors.SweepRefused
         ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
@@ -163,6 +168,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         cluster.probe(scheduler)
     atomic.check_apart(out, logs_dir)
     prognosis.check_failure_wear(failure_wear)
+    backends.get(backend)
     nominal = robots.load(robot)
     _, suffixes = fleet_logs.reader_of(log_format)
     source = fleet_logs.Source(nominal, log_format)  # each log read once, parsed data passed on
@@ -184,7 +190,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         if unit_logs and name not in state:
             state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                       failure_wear)
+                       failure_wear, backend)
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored

@@ -50,10 +50,10 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
         cache = context.out / ".cache" / "cycles"
         try:
             program = source.get(log_of(context.units, *unit.program))
-            twin = Twin(model, program, cache, root=context.out, cycles=False)
+            twin = Twin(model, program, cache, root=context.out, cycles=False, backend=context.backend)
             missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
             if pool is not None and len(missing) > 1:
-                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, *c)
+                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.backend, *c)
                                                  for c in missing], strict=True)))
             twin.complete()
         except stored.StateError:
@@ -62,13 +62,15 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
             continue
 
 
-def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, temperature: float, payload: float,
-                worn_axis: int) -> None:
+def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str,
+                temperature: float, payload: float, worn_axis: int) -> None:
     """Worker task: one cycle of a shared twin (its program as this run parsed it) into the cache
-    (:meth:`faultgen.monitor.twin.Twin.cycle`). A cycle that cannot be simulated (or a cache file
-    refused) is left to the twin made after all of them, which says why."""
+    (:meth:`faultgen.monitor.twin.Twin.cycle`), simulated on the stepping ``backend``. A cycle that
+    cannot be simulated (or a cache file refused) is left to the twin made after all of them, which
+    says why."""
     try:
-        Twin(model, program, cache, root=root, cycles=False).cycle(temperature, payload, worn_axis)
+        twin = Twin(model, program, cache, root=root, cycles=False, backend=backend)
+        twin.cycle(temperature, payload, worn_axis)
     except ValueError:
         return
 

@@ -28,7 +28,8 @@ velocity estimated from the angles as for a log without ``qd``), without sensor 
 gives the expectation). Cycles are cached on disk by what determines them (model file, program
 file, temperature, payload, worn axis), each file holding its key beside the features
 (:func:`faultgen.monitor.state.read_cycle` refuses one whose key differs): units that share a model
-and a program share them.
+and a program share them. The stepping backend (:mod:`faultgen.simulation.backends`) is not in the
+key: every backend gives the same cycle to float tolerance.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.operation import conditions, wear
-from faultgen.simulation import sensors
+from faultgen.simulation import backends, sensors
 from faultgen.simulation import stepping as sim
 
 #: Joint temperatures the healthy cycle is simulated at, deg C.
@@ -97,16 +98,21 @@ class Twin:
     SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
     format's by default), ``cache`` the folder of simulated cycles (created if needed) inside
-    ``root`` (default ``cache``), out of which no cached cycle may lead.
+    ``root`` (default ``cache``), out of which no cached cycle may lead, ``backend`` the stepping
+    backend its cycles are simulated on (:data:`faultgen.simulation.backends.BACKENDS`).
 
     Raises
     ------
     ValueError
-        The program cannot be read (file and row named), or a base cycle cannot be simulated.
+        An unknown ``backend`` (the known ones named), the program cannot be read (file and row
+        named), or a base cycle cannot be simulated.
     """
 
     def __init__(self, model: str | Path, program: Path | fleet_logs.Parsed, cache: Path, root: Path | None = None,
-                 reader: fleet_logs.Reader | None = None, cycles: bool = True):
+                 reader: fleet_logs.Reader | None = None, cycles: bool = True,
+                 backend: str = backends.DEFAULT):
+        backends.get(backend)
+        self.backend = backend
         self.model = str(model)
         self.robot = robots.load(model)
         self.cache = Path(cache)
@@ -188,7 +194,7 @@ class Twin:
         config = sim.RunConfig(robot=self.model, task=str(self._reference), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=held, signals=True)
-        result = sim.simulate(config, progress=False)
+        result = sim.simulate(config, progress=False, backend=self.backend)
         if result.saturated.size:
             rated = self.robot.rated_payload
             sized = (f"its drives were sized for a rated payload of {rated:g} kg (`faultgen robots add ... --payload KG` "

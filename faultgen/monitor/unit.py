@@ -24,6 +24,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import Twin
+from faultgen.simulation import backends
 
 #: Two units run the same program when their first logs have the same samples and angles within this, rad.
 SAME_PROGRAM = 1e-3
@@ -71,8 +72,9 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
 
 
 def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
-          source: fleet_logs.Source) -> Twin | str | None:
-    """The unit's twin, or None for a unit under protocol ``own``. A unit not yet scored falls back
+          source: fleet_logs.Source, backend: str = backends.DEFAULT) -> Twin | str | None:
+    """The unit's twin (its cycles simulated on the stepping ``backend``, a known name), or None
+    for a unit under protocol ``own``. A unit not yet scored falls back
     from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
     its new logs are skipped with it. Each fallback is noted in the unit's reason."""
@@ -83,7 +85,7 @@ def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict
             twin_key = (model, unit.program)
             if twin_key not in twins:
                 twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
-                                       root=out)
+                                       root=out, backend=backend)
             twin = twins[twin_key]
         except stored.StateError:
             raise

@@ -47,6 +47,7 @@ from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
+from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
 
 #: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
@@ -111,8 +112,9 @@ def _missing_on_worker(config: sim.RunConfig) -> str:
     return ""
 
 
-def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
-    """Worker task: simulate one run and return it (:class:`Outcome`); writes nothing."""
+def simulate_remote(run_id: str, config: sim.RunConfig, backend: str = backends.DEFAULT) -> Outcome:
+    """Worker task: simulate one run on the stepping ``backend`` (ValueError if the worker does not
+    know it) and return it (:class:`Outcome`); writes nothing."""
     from distributed import get_worker
 
     missing = _missing_on_worker(config)
@@ -120,7 +122,7 @@ def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker, or run the sweep there")
     started = time.perf_counter()
-    result = sim.simulate(config, progress=False)
+    result = sim.simulate(config, progress=False, backend=backend)
     total = time.perf_counter() - started
     slim = for_transfer(result)
     simulated = result.tau_m.shape[0] * result.t[-1]
@@ -131,16 +133,16 @@ def simulate_remote(run_id: str, config: sim.RunConfig) -> Outcome:
 
 
 def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str,
-                 labelled: sim.RunConfig | None = None) -> RunStats:
-    """Worker task with a shared file system: simulate one run and write its part file there,
-    labelled with ``labelled`` (the client's configuration)."""
+                 labelled: sim.RunConfig | None = None, backend: str = backends.DEFAULT) -> RunStats:
+    """Worker task with a shared file system: simulate one run on the stepping ``backend`` and
+    write its part file there, labelled with ``labelled`` (the client's configuration)."""
     from distributed import get_worker
 
     missing = _missing_on_worker(config)
     if missing:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker")
-    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled)
+    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled, backend=backend)
     return replace(stats, worker=get_worker().address, memory=_peak_memory())
 
 
@@ -148,10 +150,12 @@ def _peak_memory() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
 
 
-def task_key(run_id: str, config: sim.RunConfig) -> str:
-    """The Dask key of a run: its id and a digest of its configuration, so that the dashboard
-    names the run, and two sweeps on one cluster share a task only when it is the same simulation."""
-    digest = hashlib.sha256(dataset.config_key(config).encode()).hexdigest()[:16]
+def task_key(run_id: str, config: sim.RunConfig, backend: str = backends.DEFAULT) -> str:
+    """The Dask key of a run: its id and a digest of its configuration (and of its stepping backend
+    when not the default), so that the dashboard names the run, and two sweeps on one cluster share
+    a task only when it is the same simulation on the same backend."""
+    text = dataset.config_key(config) + ("" if backend == backends.DEFAULT else f"\nbackend={backend}")
+    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     return f"faultgen-{run_id}-{digest}"
 
 
@@ -261,7 +265,7 @@ def _is_handshake(message: bytes) -> bool:
 
 
 def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, command: str = "",
-            shared: bool = False, bar=None) -> Iterator[RunStats]:
+            shared: bool = False, bar=None, backend: str = backends.DEFAULT) -> Iterator[RunStats]:
     """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
     the worker's address) once its part file is written, in completion order.
 
@@ -279,6 +283,9 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
         The workers write the part files themselves (they must see ``parts`` at its absolute path).
     bar : tqdm, optional
         A progress bar whose postfix shows the workers the scheduler has after each run.
+    backend : str
+        The stepping backend the workers simulate on (a name they must know:
+        :data:`faultgen.simulation.backends.BACKENDS` in their processes).
 
     Raises
     ------
@@ -305,14 +312,14 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
         run_of = {}
         futures = []
         for run_id, config in todo:
-            key = task_key(run_id, config)
+            key = task_key(run_id, config, backend)
             run_of[key] = run_id
             sent = for_workers(config)
             if shared:
                 futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
-                                             None if sent is config else config, key=key))
+                                             None if sent is config else config, backend, key=key))
             else:
-                futures.append(client.submit(simulate_remote, run_id, sent, key=key))
+                futures.append(client.submit(simulate_remote, run_id, sent, backend, key=key))
         configs = dict(todo)
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)

@@ -45,6 +45,7 @@ from faultgen.runs import cluster, worker
 from faultgen.runs.errors import SweepError, SweepInterrupted, SweepRefused
 from faultgen.runs.grid import PRESETS, Grid
 from faultgen.runs.worker import RunStats, simulate_and_write
+from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
 
 __all__ = ["PRESETS", "Grid", "RunStats", "SweepError", "SweepInterrupted", "SweepRefused", "finished_runs",
@@ -80,7 +81,8 @@ def finished_runs(grid: Grid, out: str | Path) -> list[str]:
 def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
         command: str = "", on_run: Callable[[RunStats], None] | None = None,
         timings: dict | None = None, overwrite: bool = False,
-        on_start: Callable[[int, int], None] | None = None, shared: bool = False) -> Path:
+        on_start: Callable[[int, int], None] | None = None, shared: bool = False,
+        backend: str = backends.DEFAULT) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
@@ -108,6 +110,10 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     shared : bool
         With ``scheduler``: the workers write the part files themselves, in the folder of ``out``,
         which they must all see at its absolute path (a shared file system; checked first).
+    backend : str
+        The stepping backend every run is simulated on (:data:`faultgen.simulation.backends.BACKENDS`;
+        the workers must know it: a backend registered outside faultgen, in their processes too).
+        Every backend gives the same dataset to float tolerance; the name is not stored.
 
     Returns
     -------
@@ -117,7 +123,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     ------
     SweepRefused
         Before anything runs, if ``out`` exists (and not ``overwrite``) or another sweep is
-        writing it (the message names that sweep: pid, host, start time, command).
+        writing it (the message names that sweep: pid, host, start time, command), or for an
+        unknown ``backend`` (the known ones named).
     SweepInterrupted
         On Ctrl-C (KeyboardInterrupt): the workers are stopped, and the message says how many
         runs are kept and how to resume.
@@ -130,6 +137,10 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     parts = parts_folder(out)
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SweepRefused(f"jobs {jobs!r}: expected a whole number >= 1")
+    try:
+        backends.get(backend)
+    except ValueError as err:
+        raise SweepRefused(str(err)) from None
     with _lock(out, parts):
         if out.exists() and not overwrite:
             raise SweepRefused(f"{out} exists; pass --overwrite to replace it or choose another output")
@@ -146,7 +157,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
                             for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command,
-                                                  shared, bar):
+                                                  shared, bar, backend):
                                 bar.update(1)
                                 if on_run is not None:
                                     on_run(stats)
@@ -361,15 +372,17 @@ class CtrlC:
 
 
 def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, shared: bool = False,
-             bar=None) -> Iterator[RunStats]:
-    """Run the missing runs; yield the stats of each as it finishes, in completion order."""
+             bar=None, backend: str = backends.DEFAULT) -> Iterator[RunStats]:
+    """Run the missing runs on ``backend``; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command) for run_id, config in todo]
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, backend)
+             for run_id, config in todo]
     try:
         if scheduler:
-            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar)
+            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar,
+                                       backend=backend)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend

@@ -18,6 +18,7 @@ from pathlib import Path
 from tqdm.auto import tqdm
 
 from faultgen.data import dataset
+from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
 
 
@@ -38,15 +39,17 @@ class RunStats:
 
 
 def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
-                       labelled: sim.RunConfig | None = None) -> RunStats:
-    """Worker task: simulate one run and write it to its part file (atomically), labelled with
-    ``labelled`` (the client's configuration when ``config`` names its robot or program by an
-    absolute path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`)."""
+                       labelled: sim.RunConfig | None = None, backend: str = backends.DEFAULT) -> RunStats:
+    """Worker task: simulate one run on the stepping ``backend`` (a name of
+    :data:`faultgen.simulation.backends.BACKENDS`; ValueError if this process does not know it) and
+    write it to its part file (atomically), labelled with ``labelled`` (the client's configuration
+    when ``config`` names its robot or program by an absolute path for a cluster's workers:
+    :func:`faultgen.runs.cluster.for_workers`)."""
     # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
     # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
     tqdm.set_lock(threading.RLock())
     started = time.perf_counter()
-    result = sim.simulate(config, progress=False)
+    result = sim.simulate(config, progress=False, backend=backend)
     writing = time.perf_counter()
     if labelled is not None:
         result = replace(result, config=labelled)

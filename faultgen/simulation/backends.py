@@ -15,10 +15,10 @@ use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s inte
 - ``forward()``, ``set_const()``: ``mj_forward`` / ``mj_setConst`` of every run;
 - ``warning``: each run's warning counters, ``(n, mjNWARNING, 2)``.
 
-:data:`BACKENDS` by name: ``batch`` (``mujoco.batch.Batch``: C threads, the default) and ``loop``
-(a Python loop of ``mujoco.mj_step`` over one ``MjData`` and one ``MjModel`` copy per run,
-deliberately plain: the reference the tests hold ``batch`` to; docs/architecture.md, "Stepping
-backends", says what a GPU backend implements).
+:data:`BACKENDS` by name (:func:`register` adds one): ``batch`` (``mujoco.batch.Batch``: C threads,
+the default) and ``loop`` (a Python loop of ``mujoco.mj_step`` over one ``MjData`` and one
+``MjModel`` copy per run, deliberately plain: the reference the tests hold ``batch`` to;
+docs/architecture.md, "Stepping backends", says what a GPU backend implements).
 """
 
 from __future__ import annotations
@@ -171,8 +171,35 @@ def _set_const(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     mujoco.mj_setState(model, data, state, spec)
 
 
-#: The stepping backends by name.
-BACKENDS = {backend.name: backend for backend in (BatchBackend(), LoopBackend())}
+#: The stepping backends by name (:func:`register` adds one).
+BACKENDS: dict[str, Backend] = {}
+
+
+def register(backend: Backend) -> Backend:
+    """Add ``backend`` (an instance of a :class:`Backend` subclass) to :data:`BACKENDS` under its
+    ``name`` and return it: from then on sweeps, fleets, the cluster's workers and the monitor's twin
+    reach it by that name (a process that has not registered it, a fresh worker process or a Dask
+    worker, does not know it). Registering the same instance again changes nothing.
+
+    Raises
+    ------
+    ValueError
+        If ``backend`` is not a :class:`Backend`, its ``name`` is not a non-empty string, or the
+        name is registered to another backend.
+    """
+    if not isinstance(backend, Backend):
+        raise ValueError(f"{backend!r} is not a stepping backend (an instance of a Backend subclass)")
+    name = getattr(backend, "name", None)
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"stepping backend {backend!r} has no name (a class attribute name = '...')")
+    if BACKENDS.get(name, backend) is not backend:
+        raise ValueError(f"stepping backend {name!r} is already registered to {BACKENDS[name]!r}")
+    BACKENDS[name] = backend
+    return backend
+
+
+register(BatchBackend())
+register(LoopBackend())
 
 #: The backend runs use unless told otherwise.
 DEFAULT = "batch"
