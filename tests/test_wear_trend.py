@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from statsmodels.tsa.statespace.mlemodel import MLEModel
 
-from faultgen.monitor.scoring import WEAR_RATE_CHANGE, Settings, UnitMonitor, WearTrend
+from faultgen.monitor.scoring import OUTLIER_GATE, OUTLIER_RUN, WEAR_RATE_CHANGE, Settings, UnitMonitor, WearTrend
 
 
 def _statsmodels_filter(y: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -91,3 +91,26 @@ def test_maintenance_restarts_the_trend():
     residual = rng.normal(0, 0.05, 12)
     unit.add("051", residual, 30.0, 0.0, np.zeros(12))
     assert unit.rows[-1]["wear2"] == pytest.approx(unit.rows[-1]["wear2_log"])  # a new trend starts at the log
+
+
+def test_a_single_outlying_log_does_not_move_the_trend_and_three_in_a_row_restart_it():
+    """Innovation gating (OUTLIER_GATE, OUTLIER_RUN): on faultgen's shipped IRB 6700 fleet one log of
+    a healthy unit answered 262 % on axis 1 and, filtered, alarmed for a week. A log beyond the gate
+    leaves the trend as predicted; three in a row are a step, and the trend starts again at the last."""
+    rng = np.random.default_rng(9)
+    error = np.full(2, 3.0)
+    trend = WearTrend(2)
+    for _ in range(20):
+        trend.update(rng.normal(0.0, 3.0, 2), error)
+    before = trend.state.copy()
+    wear, _ = trend.update(np.array([260.0, 1.0]), error)
+    assert abs(wear[0] - before[0, 0] - before[0, 1]) < 1e-12  # axis 1: the prediction, the log ignored
+    assert trend.gated.tolist() == [1, 0]
+    trend.update(np.zeros(2), error)  # a log the trend describes: the count starts again
+    assert trend.gated.tolist() == [0, 0]
+    for k in range(3):  # a step of 60 %: gated twice, then the trend restarts at the third log
+        wear, sd = trend.update(np.array([60.0 + k, 0.0]), error)
+        assert trend.gated[0] == (k + 1) % 3
+    assert wear[0] == 62.0 and sd[0] == 3.0  # started at that log, with its error
+    assert abs(wear[1]) < 3.0  # the other axis went on as before
+    assert OUTLIER_GATE == 5.0 and OUTLIER_RUN == 3
