@@ -91,3 +91,57 @@ def test_below_the_boundary_a_name_is_a_type_error(loads, call):
     with pytest.raises(TypeError, match="expected a Robot, got str 'puma560'; resolve .* once"):
         call()
     assert loads == []  # refused, not resolved
+
+
+def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
+    """``faultgen monitor`` on the nominal model: the robot folder is resolved once, by the command
+    (`monitor.loop`), and the twins and their cycles take that Robot. Before: once by the command,
+    once per unit's twin and once per simulated cycle's ``RunConfig`` (24 in all on the IRB 6700
+    fleet of tests/test_monitor_shipped.py, 3 units, --no-calibrate; measured 2026-11-25)."""
+    import independent_fleet
+
+    robot, logs, _ = independent_fleet.write_fleet(
+        tmp_path / "fleet", independent_fleet.FleetSpec(units=3, worn=1, days=14, seed=5, onset=(12, 13)))
+    loads.clear()  # what building the fleet loaded (robots add checks the folder it writes)
+    result = runner.invoke(app, ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"),
+                                 "--no-calibrate", "--train", "10", "--persistence", "3", "--no-progress"])
+    assert result.exit_code == 0, result.output
+    assert loads == [str(robot)]
+
+
+#: The modules that call ``robots.load`` (besides the command line, ``faultgen/cli/``), how many
+#: times, and why each may: a boundary (the public API or a worker resolving what it was sent as a
+#: name), a model file the code itself just wrote or calibrated, or a name stored in a record.
+#: A new caller fails this test: resolve at the boundary and pass the Robot instead, or add it
+#: here with its reason.
+ALLOWED = {
+    "faultgen/calibrate/__init__.py": (1, "public calibrate(): a name or a Robot, resolved once"),
+    "faultgen/data/fleetlogs.py": (1, "public import_logs(): a name or a Robot, resolved once"),
+    "faultgen/runs/grid.py": (1, "public Grid: each robot once for every run"),
+    "faultgen/simulation/config.py": (2, "public RunConfig: a name once on construction, or after unpickling"),
+    "faultgen/monitor/loop.py": (1, "monitor(): the library entry, once per run"),
+    "faultgen/monitor/feed.py": (1, "a worker without the run's source (loky, Dask): once"),
+    "faultgen/monitor/parallel.py": (2, "a worker without the run's source: once"),
+    "faultgen/monitor/remote.py": (1, "a Dask worker: once"),
+    "faultgen/monitor/twin.py": (1, "a twin of a model file (the calibrated model, a given one)"),
+    "faultgen/monitor/unit.py": (2, "the calibrated model the monitor just wrote"),
+    "faultgen/calibrate/loop.py": (1, "the calibrated model just written (its parameters.json)"),
+    "faultgen/calibrate/refit.py": (2, "the calibrated model written; the nominal by the name its result stores"),
+    "faultgen/model/folder.py": (2, "robots add: the folder just written, checked by loading it"),
+    "faultgen/data/robot_record.py": (1, "a dataset written before drivetrains were stored: its robot label"),
+    "faultgen/bench/independent.py": (2, "the independent simulator's own entry: a robot folder"),
+}
+
+
+def test_robots_load_is_called_only_where_it_may_be():
+    counts = {}
+    for path in sorted((ROOT / "faultgen").rglob("*.py")) + sorted((ROOT / "analysis").rglob("*.py")):
+        where = path.relative_to(ROOT).as_posix()
+        if where.startswith("faultgen/cli/") or where == "faultgen/model/robots.py":
+            continue
+        calls = [node for node in ast.walk(ast.parse(path.read_text(), where)) if isinstance(node, ast.Call)
+                 and isinstance(node.func, ast.Attribute) and node.func.attr == "load"
+                 and isinstance(node.func.value, ast.Name) and node.func.value.id == "robots"]
+        if calls:
+            counts[where] = len(calls)
+    assert counts == {where: n for where, (n, _) in ALLOWED.items()}

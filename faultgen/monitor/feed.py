@@ -72,8 +72,9 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     events given before the first log at or after them; returns the units with their chart and
     remaining life (:func:`unit_outputs`). ``source``: the run's logs as read so far (this
     process's; a new one when None, as in a worker that did not inherit it)."""
-    nominal = robots.load(context.robot)
-    source = source if source is not None else fleet_logs.Source(nominal, context.log_format)
+    # the run's source holds the robot resolved once; a worker without one resolves it here
+    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
+    nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
         twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, source,

@@ -38,8 +38,9 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
     (a ``concurrent.futures`` executor) when given, then the twin made here from the cache. A twin
     that cannot be built is left to each unit's own fallback (:func:`twin_of`). The programs come
     parsed from ``source`` (the run's; a new one when None) and go to the tasks as they are."""
-    nominal = robots.load(context.robot)
-    source = source if source is not None else fleet_logs.Source(nominal, context.log_format)
+    # the run's source holds the robot resolved once; a worker without one resolves it here
+    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
+    nominal = source.robot
     seen = set()
     for (name, unit, _), in groups:
         key = (unit.model, unit.program)
@@ -50,7 +51,8 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
         cache = context.out / ".cache" / "cycles"
         try:
             program = source.get(log_of(context.units, *unit.program))
-            twin = Twin(model, program, cache, root=context.out, cycles=False, backend=context.backend)
+            twin = Twin(nominal if unit.model == "nominal" else model, program, cache, root=context.out, cycles=False,
+                        backend=context.backend)
             missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
             if pool is not None and len(missing) > 1:
                 list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.backend, *c)

@@ -93,7 +93,8 @@ def base_cycles(n_axes: int) -> list[tuple[float, float, int]]:
 
 
 class Twin:
-    """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, ``program`` the
+    """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, or the robot
+    resolved from it (a :class:`~faultgen.model.robot.Robot`, not loaded again), ``program`` the
     log whose motion is replayed, as the run parsed it (:class:`faultgen.monitor.logs.Parsed`: its
     SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
@@ -108,13 +109,15 @@ class Twin:
         named), or a base cycle cannot be simulated.
     """
 
-    def __init__(self, model: str | Path, program: Path | fleet_logs.Parsed, cache: Path, root: Path | None = None,
+    def __init__(self, model: str | Path | robots.Robot, program: Path | fleet_logs.Parsed, cache: Path,
+                 root: Path | None = None,
                  reader: fleet_logs.Reader | None = None, cycles: bool = True,
                  backend: str = backends.DEFAULT):
         backends.get(backend)
         self.backend = backend
-        self.model = str(model)
-        self.robot = robots.load(model)
+        resolved = isinstance(model, robots.Robot)
+        self.model = str(model.path) if resolved else str(model)
+        self.robot = model if resolved else robots.load(model)
         self.cache = Path(cache)
         self.root = self.cache if root is None else Path(root)
         self.cache.mkdir(parents=True, exist_ok=True)
@@ -191,7 +194,7 @@ class Twin:
         if (temperature, payload, worn_axis) in self._refused:  # a part it cannot carry: said once, not simulated again
             raise ValueError(self._refused[temperature, payload, worn_axis])
         held, plan = setup(temperature, payload, worn_axis)
-        config = sim.RunConfig(robot=self.model, task=str(self._reference), friction=FRICTION, wear=plan, cycles=1,
+        config = sim.RunConfig(robot=self.robot, task=str(self._reference), friction=FRICTION, wear=plan, cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=held, signals=True)
         result = sim.simulate(config, progress=False, backend=self.backend)

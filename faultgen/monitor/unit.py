@@ -84,7 +84,8 @@ def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict
             model = model_of(nominal, unit.model, calibrated_model, unit.first, first_log, out, progress, source)
             twin_key = (model, unit.program)
             if twin_key not in twins:
-                twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
+                twins[twin_key] = Twin(nominal if model == str(nominal.path) else model,  # resolved once
+                                       source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
                                        root=out, backend=backend)
             twin = twins[twin_key]
         except stored.StateError:
