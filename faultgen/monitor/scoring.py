@@ -391,8 +391,8 @@ class UnitMonitor:
             bound = estimate - self.bound_quantile * error
             alarm = bool(bound.max() >= self.settings.wear_limit)
             # the interval keeps the log's own error: the filter averages out the scatter from log
-            # to log, not the errors that stay for weeks (an offset learned on logs with early wear,
-            # a season's drift extrapolated, the calibration's friction), which the learning logs
+            # to log, not the errors that stay for weeks (the learned temperature slopes
+            # extrapolated over a season, the calibration's friction), which the learning logs
             # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
             low, high = self.wear_interval(estimate, log_error)
             wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
@@ -427,7 +427,8 @@ class UnitMonitor:
             self.evidence = (f"axis {self.source_axis} wear estimate {estimate[order[0]]:.3g} %, its lower "
                              f"{100 * (1 - self.settings.alpha):g} % bound {bound[order[0]]:.3g} % ({span}) >= limit "
                              f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares along each "
-                             f"axis's wear signature); next axis {order[1] + 1}: {estimate[order[1]]:.3g} %")
+                             f"axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
+                             f"{estimate[order[1]]:.3g} %")
             return
         mean = np.mean(Z, axis=0)
         scores = self.axis_scores(mean)
