@@ -253,7 +253,7 @@ def test_a_replayed_log_that_starts_and_ends_moving_is_the_recorded_reference(tm
     expected = np.column_stack([np.interp(times[inside], t - t[0], thesis.q[piece][:, k]) for k in range(6)])
     np.testing.assert_allclose(q_ref[inside], expected, rtol=0, atol=1e-6)
     # velocity and acceleration by the calibration's estimator on the log
-    data = measured.from_arrays(t, thesis.q[piece], np.zeros_like(thesis.q[piece]), robot="puma560")
+    data = measured.from_arrays(t, thesis.q[piece], np.zeros_like(thesis.q[piece]), robot=robots.load("puma560"))
     np.testing.assert_array_equal(loaded.qd, data.qd)
     np.testing.assert_array_equal(loaded.qdd, data.qdd)
 

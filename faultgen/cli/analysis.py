@@ -209,7 +209,7 @@ def detect_command(
       faultgen fleet --robots 8 --days 20 -o fleet8.h5 && faultgen detect fleet8.h5
       faultgen sweep --preset quick --seed 0 --seed 1 -o quick-seeds.h5
       faultgen detect quick-seeds.h5 --protocol other-seeds -o quick-seeds-detection
-      faultgen detect quick.h5 --baseline iforest -o quick-iforest
+      faultgen detect quick.h5 --baseline pca -o quick-pca     # iforest, ecod: the bench extra (pyod)
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
