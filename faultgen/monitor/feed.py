@@ -49,6 +49,11 @@ class Context:
     def __post_init__(self) -> None:
         backends.get(self.backend)
 
+    def new_source(self) -> fleet_logs.Source:
+        """A log source of this run's robot, resolved here: for a worker that did not inherit the
+        run's (the run's own holds the robot its command resolved)."""
+        return fleet_logs.Source(robots.load(self.robot), self.log_format)
+
 
 def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
     """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
@@ -72,8 +77,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     events given before the first log at or after them; returns the units with their chart and
     remaining life (:func:`unit_outputs`). ``source``: the run's logs as read so far (this
     process's; a new one when None, as in a worker that did not inherit it)."""
-    # the run's source holds the robot resolved once; a worker without one resolves it here
-    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
+    source = source if source is not None else context.new_source()
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:

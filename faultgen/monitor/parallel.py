@@ -17,7 +17,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
@@ -38,8 +37,7 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
     (a ``concurrent.futures`` executor) when given, then the twin made here from the cache. A twin
     that cannot be built is left to each unit's own fallback (:func:`twin_of`). The programs come
     parsed from ``source`` (the run's; a new one when None) and go to the tasks as they are."""
-    # the run's source holds the robot resolved once; a worker without one resolves it here
-    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
+    source = source if source is not None else context.new_source()
     nominal = source.robot
     seen = set()
     for (name, unit, _), in groups:
@@ -116,7 +114,7 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
     ``source``: the run's logs as read so far (:class:`faultgen.monitor.logs.Source`), which this
     process and forked workers read from; loky's and Dask's workers read the logs they score."""
     idle = list(idle)
-    source = source if source is not None else fleet_logs.Source(robots.load(context.robot), context.log_format)
+    source = source if source is not None else context.new_source()
     if scheduler is not None:
         if groups:
             prepare_twins(context, groups, source=source)
