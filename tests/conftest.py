@@ -62,3 +62,18 @@ def shared_fleet(tmp_path_factory, worker_id):
         return out
 
     return build
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures plot() draws, kept for inspection when it saves them."""
+    from matplotlib.figure import Figure
+
+    drawn, save = [], Figure.savefig
+
+    def spy(self, *args, **kwargs):
+        drawn.append(self)
+        return save(self, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", spy)
+    return drawn

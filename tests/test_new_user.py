@@ -15,7 +15,6 @@ from faultgen.cli import app
 from faultgen.operation import faults
 from faultgen.runs import sweep
 from faultgen.runs.fleet import Fleet
-from test_plot import figures  # noqa: F401 - the fixture: the figures a command saves
 
 ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()

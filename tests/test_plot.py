@@ -19,21 +19,6 @@ def sweep_file(shared_sweep):
                         cycles=20, record=[1, 10, 20])
 
 
-@pytest.fixture
-def figures(monkeypatch):
-    """The figures plot() draws, kept for inspection when it saves them."""
-    from matplotlib.figure import Figure
-
-    drawn, save = [], Figure.savefig
-
-    def spy(self, *args, **kwargs):
-        drawn.append(self)
-        return save(self, *args, **kwargs)
-
-    monkeypatch.setattr(Figure, "savefig", spy)
-    return drawn
-
-
 def _subset(source, path, runs: dict):
     """A valid dataset at ``path`` holding some runs of ``source`` ({new id: run id})."""
     with h5py.File(source, "r") as src, h5py.File(path, "w") as dst:

@@ -38,7 +38,8 @@ the validator, the reader and the summary all read them, and this module imports
 from __future__ import annotations
 
 from faultgen.simulation import sensors
-from faultgen.simulation.signals import ARRAYS, SIGNAL_AXES  # the signal set, defined once (re-exported)
+from faultgen.simulation.signals import ARRAYS  # the signal set, defined once
+from faultgen.simulation.signals import SIGNAL_AXES as SIGNAL_AXES  # re-exported for the readers
 
 FORMAT = "faultgen"
 FORMAT_VERSION = 1
