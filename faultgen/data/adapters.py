@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,7 +31,7 @@ import pandas as pd
 from faultgen import inputs
 from faultgen.data import measured
 from faultgen.model import robots
-from faultgen.operation import jointlog
+from faultgen.operation import jointlog, logblocks
 
 #: name -> adapter class.
 ADAPTERS: dict[str, type[Adapter]] = {}
@@ -39,6 +40,11 @@ MAX_BYTES = 4 * 2**30
 #: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
 #: about 10: the motor's 0.1 times the gear ratio 101).
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
+
+
+#: Data rows of the first block read to learn a log's columns before its blocks are read
+#: (:class:`Blocks`).
+PEEK_ROWS = 16
 
 
 def register(name: str):
@@ -52,8 +58,16 @@ def register(name: str):
 
 @dataclass(frozen=True)
 class Adapter:
-    """Base: ``suffixes`` (lower case) of the files it reads, and :meth:`columns` (the foreign file's
-    columns as the measured format's, and the data-row labeller of its messages).
+    """Base of a log format: ``suffixes`` (lower case) of the files it reads, and its two readers
+    with the same checks and messages: whole (:meth:`columns`, :meth:`read`) and in blocks of rows
+    (:meth:`blocks`, :meth:`source`) for a log too long to read whole (the calibration's
+    :mod:`faultgen.data.longlog`, the replay's streaming, :mod:`faultgen.operation.logblocks`).
+
+    A column-mapping format defines :meth:`convert` alone (one block of the file, its cells as
+    floats, mapped onto the measured format's names and units) and :attr:`separator`: the base
+    reads the file as delimited text, whole or in chunks (:meth:`frames`), so it gets both readers.
+    A format with a reader of its own overrides :meth:`columns` and, to read in blocks with bounded
+    memory, :meth:`blocks` and :meth:`rows` (else its blocks are its whole read, sliced).
 
     ``reads_held``: :meth:`columns` takes the file's bytes read once (:class:`faultgen.inputs.Held`)
     for its path, reading through :mod:`faultgen.inputs` (``open_bytes``, ``open_text``,
@@ -64,12 +78,122 @@ class Adapter:
     name = ""
     reads_held = False
     suffixes: tuple[str, ...] = ()
+    #: The column separator of a delimited-text format read by :meth:`frames`.
+    separator = ","
+    #: Data row index (0-based, from the file's first data row) -> its name in messages.
+    label = staticmethod(jointlog.index_label)
+
+    def convert(self, frame: pd.DataFrame, robot: robots.Robot):
+        """One block of the file (``frame``: its columns by the file's names, every cell a finite
+        float) as the measured format's columns: a dict of name (``t`` s, ``q1..qN`` rad,
+        ``tau1..tauN`` N m at the arm, optional ``qd1..qdN`` rad/s, ``temperature1..N``,
+        ``cycle``) to ndarray of shape (rows,), or ``(columns, notes)``. Defined by a
+        column-mapping format (class docstring); a column it names that the file lacks is refused
+        with the file's columns (:meth:`frames`)."""
+        raise NotImplementedError
+
+    def _maps(self) -> bool:
+        return type(self).convert is not Adapter.convert
+
+    def frames(self, path: Path | inputs.Held, size: int | None) -> Iterator[tuple[int, pd.DataFrame]]:
+        """The delimited-text file ``path`` (:attr:`separator`, a header row; plain or gzip) as
+        ``(start, frame)``: its first data row's index and ``size`` rows of it (the whole file when
+        None), every cell a finite float.
+
+        Raises
+        ------
+        faultgen.data.measured.MeasuredDataError
+            Not a regular file, unreadable as such text, a column named twice in the header, a
+            cell that is not a finite number (the data row, column and value named).
+        """
+        what = f"{self.name} log"
+        inputs.regular_file(path, what, MAX_BYTES)
+        try:
+            names, _ = inputs.csv_header(path, what, separator=self.separator)
+        except inputs.InputError as err:
+            raise jointlog.LogBoundError(str(err)) from None
+        except (OSError, UnicodeDecodeError, EOFError) as err:
+            raise measured.MeasuredDataError(f"{path}: cannot read the file as {what}: {err}") from err
+        twice = sorted(name for name, count in Counter(names).items() if count > 1)
+        if twice:
+            raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
+                                             "header")
+        if size is None:
+            jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
+        kw = {"sep": self.separator, "dtype": str, "keep_default_na": False, "na_filter": False,
+              "chunksize": size or max(jointlog.whole_rows(len(names)), 1)}
+        start = 0
+        try:
+            with inputs.open_text(path, what, MAX_BYTES) as fh:
+                for frame in pd.read_csv(fh, **kw):
+                    values = _numbers(path, frame, list(frame.columns), lambda i, s=start: self.label(s + i))
+                    yield start, pd.DataFrame(values, index=frame.index)
+                    start += len(frame)
+        except (inputs.InputError, measured.MeasuredDataError):
+            raise
+        except (ValueError, OSError, EOFError) as err:  # pandas's ParserError is a ValueError
+            raise measured.MeasuredDataError(f"{path}: cannot read the file as {what}: "
+                                             f"{' '.join(str(err).split())}") from None
+
+    def _converted(self, path, frame: pd.DataFrame, robot: robots.Robot) -> tuple[dict, tuple[str, ...]]:
+        try:
+            out = self.convert(frame, robot)
+        except KeyError as err:
+            raise measured.MeasuredDataError(
+                f"{inputs.path_of(path)}: missing column {err} of the {self.name} layout; found "
+                f"{', '.join(map(str, frame.columns[:40])) or '(none)'}") from None
+        columns, notes = out if isinstance(out, tuple) else (out, ())
+        return columns, tuple(notes)
 
     def columns(self, path: Path, robot: robots.Robot) -> tuple:
         """``(columns, label)`` or ``(columns, label, notes)``: the file's columns under the
-        measured format's names, the data-row labeller of messages, and what the reading chose
-        (which torque source, say), kept in :attr:`faultgen.data.measured.MeasuredData.notes`."""
-        raise NotImplementedError
+        measured format's names (dict of ndarray of shape (n,)), the data-row labeller of messages,
+        and what the reading chose (which torque source, say), kept in
+        :attr:`faultgen.data.measured.MeasuredData.notes`. The base: :meth:`convert` of the
+        whole file (:meth:`frames`)."""
+        if not self._maps():
+            raise NotImplementedError(f"log format {self.name}: define convert() or columns()")
+        frames = list(self.frames(path, None))
+        frame = frames[0][1] if frames else pd.DataFrame()
+        columns, notes = self._converted(path, frame, robot)
+        return columns, self.label, notes
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        """The log in blocks of ``size`` data rows (the last one shorter), each as :meth:`columns`
+        gives the whole file: ``(columns, label, notes)``, the label naming rows from the file's
+        first data row. The base: :meth:`convert` of each chunk of :meth:`frames`; for a format
+        without :meth:`convert`, its whole read sliced (memory that of the whole read).
+
+        Raises
+        ------
+        faultgen.data.measured.MeasuredDataError
+            What :meth:`columns` refuses, with the same message.
+        """
+        if self._maps():
+            for _, frame in self.frames(path, size):
+                columns, notes = self._converted(path, frame, robot)
+                yield columns, self.label, notes
+            return
+        columns, label, *notes = self.columns(path, robot)
+        n = len(next(iter(columns.values()), ()))
+        for start in range(0, n, size):
+            yield {k: np.asarray(v)[start:start + size] for k, v in columns.items()}, label, tuple(*notes)
+
+    def rows(self, path: Path) -> int:
+        """An upper bound of the log's data rows, found before they are parsed. The base: the lines
+        of the delimited-text file but its header (:func:`faultgen.inputs.count_lines`)."""
+        try:
+            return max(inputs.count_lines(path, f"{self.name} log") - 1, 0)
+        except inputs.InputError as err:
+            raise jointlog.LogBoundError(str(err)) from None
+        except (OSError, UnicodeDecodeError, EOFError) as err:
+            raise measured.MeasuredDataError(f"{path}: cannot read the file: {err}") from err
+
+    def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
+        """The log ``path`` as blocks of the measured format's columns (:class:`Blocks`: the block
+        source :mod:`faultgen.operation.logblocks` reads), ``motion_only`` as there (``t`` and
+        ``q1..qN``: a replay)."""
+        return Blocks(self, Path(path), robot, motion_only)
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
@@ -98,6 +222,93 @@ def make(name: str, **options) -> Adapter:
         raise ValueError(f"log format {name} takes no option {', '.join(unknown)}"
                          + (f"; its options: {', '.join(known)}" if known else ""))
     return cls(**options)
+
+
+class Blocks:
+    """A log read through its format's :meth:`Adapter.blocks` as the block source
+    :mod:`faultgen.operation.logblocks` reads: ``path``, ``wanted`` (the measured format's columns
+    read, in the order of a block's columns: :func:`faultgen.operation.jointlog.select_columns`),
+    ``extra`` (none: the adapter chose its columns), ``notes`` (what the reading chose), ``rows``
+    (an upper bound of the data rows, :meth:`Adapter.rows`), ``label`` and :meth:`blocks`. Its first
+    :data:`PEEK_ROWS` rows are read here, to learn the columns.
+
+    Raises
+    ------
+    faultgen.data.measured.MeasuredDataError
+        A missing column (as :func:`faultgen.data.measured.from_columns` names it), a log of more
+        rows than :data:`faultgen.operation.jointlog.MAX_ROWS`, or what the adapter refuses.
+    """
+
+    def __init__(self, adapter: Adapter, path: Path, robot: robots.Robot, motion_only: bool = False):
+        self.adapter, self.path, self.robot, self.extra = adapter, path, robot, []
+        peek = iter(adapter.blocks(path, robot, PEEK_ROWS))
+        try:
+            first = next(peek, None)
+        finally:
+            getattr(peek, "close", lambda: None)()  # a generator's file closed now
+        if first is None:  # no data row: the whole read says what is wrong
+            self.wanted, self.notes, self.rows, self.label = [], (), 0, adapter.label
+            return
+        columns, self.label, *notes = first
+        self.notes = tuple(notes[0]) if notes else ()
+        self.wanted, _ = jointlog.select_columns(path, list(columns), robot.n_axes, motion_only)
+        self.rows = adapter.rows(path)
+        if self.rows > jointlog.MAX_ROWS:
+            raise measured.MeasuredDataError(f"{path}: {self.rows} data rows; a log has at most {jointlog.MAX_ROWS} "
+                                             "(MAX_ROWS: a day at 1 kHz)")
+
+    def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
+        """``(start, block)``: the index of the block's first data row and its ``wanted`` columns
+        (ndarray of shape (size, len(wanted)), floats; the last block shorter), every cell refused
+        unless finite, as :func:`faultgen.data.measured.from_columns` refuses it."""
+        start, held, count = 0, [], 0  # held: rows read, not yet yielded (``count`` of them)
+        for columns, *_ in self.adapter.blocks(self.path, self.robot, size):
+            values = {name: np.asarray(columns[name], dtype=float) for name in self.wanted}
+            lengths = {len(v) for v in values.values()}
+            if len(lengths) > 1:
+                raise measured.MeasuredDataError(f"{self.path}: columns of different lengths {sorted(lengths)}")
+            first = start + count
+            jointlog.refuse_non_finite(self.path, values, self.wanted, lambda i, s=first: self.label(s + i))
+            held.append(np.column_stack([values[name] for name in self.wanted]))
+            count += len(held[-1])
+            while count >= size:  # blocks of exactly ``size`` rows, whatever the adapter's
+                rows = np.concatenate(held) if len(held) > 1 else held[0]
+                yield start, rows[:size]
+                start, count = start + size, count - size
+                held = [rows[size:]] if count else []
+        if count:
+            yield start, np.concatenate(held)
+
+
+@dataclass(frozen=True)
+class Measured(Adapter):
+    """The measured format (:mod:`faultgen.data.measured`; ``--format measured``, the default) as an
+    adapter: read whole by :func:`faultgen.data.measured.read`, in blocks by its own block reader
+    (:func:`faultgen.operation.logblocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
+
+    name = "measured"
+    reads_held = True
+    suffixes: tuple[str, ...] = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES
+
+    def columns(self, path, robot: robots.Robot) -> tuple:
+        columns, extra, label = jointlog.read_columns(path, robot.n_axes)
+        return columns, label, tuple([f"ignored extra columns: {', '.join(extra)}"] if extra else [])
+
+    def read(self, path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
+        return measured.read(path, robot, accelerations)
+
+    def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
+        return logblocks.source(Path(path), robot.n_axes, motion_only)
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        src = self.source(path, robot)
+        notes = (f"ignored extra columns: {', '.join(src.extra)}",) if src.extra else ()
+        for _, block in src.blocks(size):
+            yield {name: block[:, j] for j, name in enumerate(src.wanted)}, src.label, notes
+
+
+#: The measured format, the default (not in :data:`ADAPTERS`: ``--format measured`` gives no adapter).
+MEASURED = Measured()
 
 
 def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
