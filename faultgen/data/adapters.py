@@ -325,8 +325,10 @@ def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[
         values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value "
-                                             f"{frame[name].iloc[bad[0]]!r}; expected a finite number")
+            raw = frame[name].iloc[bad[0]]
+            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else repr(raw)  # inf, not np.float64(inf)
+            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value {shown}; expected "
+                                             "a finite number")
         out[name] = values
     return out
 
@@ -358,7 +360,12 @@ class URRTDE(Adapter):
                 raise ValueError(f"torque constants {self.torque_constants!r}: expected one number in "
                                  f"{MIN_TORQUE_CONSTANT:g} .. {MAX_TORQUE_CONSTANT:g} N m/A per axis")
 
-    def columns(self, path: Path, robot: robots.Robot):
+    label = staticmethod(jointlog.csv_label)
+
+    def _plan(self, path: Path | inputs.Held, robot: robots.Robot) -> dict:
+        """What to read of the RTDE log ``path`` from its header: ``names``, ``separator``,
+        ``wanted`` (its columns read), ``map`` (measured name -> (its column, factor)) and ``note``
+        (the torque source), or refused (a missing column, a name twice)."""
         n_axes = robot.n_axes
         inputs.regular_file(path, "RTDE log", MAX_BYTES)
         try:
@@ -371,7 +378,6 @@ class URRTDE(Adapter):
         if twice:
             raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
                                              "header")
-        label = jointlog.csv_label
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
@@ -381,10 +387,10 @@ class URRTDE(Adapter):
         if self.torque_constants is not None and all(c in names for c in current):
             if len(self.torque_constants) != n_axes:
                 raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
-            torque, scale = current, np.asarray(self.torque_constants, dtype=float)
+            torque, scale = current, [float(k) for k in self.torque_constants]
             source = "torque from actual_current_i x the torque constants given (measured)"
         elif all(c in names for c in moment):
-            torque, scale = moment, np.ones(n_axes)
+            torque, scale = moment, [1.0] * n_axes
             source = ("torque from target_moment_i (the controller's commanded moment, not a measurement; "
                       "--torque-constants K1,...,KN reads the measured actual_current_i instead)"
                       + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
@@ -392,45 +398,64 @@ class URRTDE(Adapter):
             raise measured.MeasuredDataError(
                 f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
                 f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
-        with_temperature = all(c in names for c in temperature)
-        wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else []),
-                  *(temperature if with_temperature else [])]
+        with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
+        wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
         _require(path, names, wanted, "RTDE recorder")
-        jointlog.csv_rows(path, len(wanted), "an RTDE log", "RTDE log")
-        values = _rtde_numbers(path, names, separator, wanted, label)
         q_names, qd_names, tau_names = measured.column_names(n_axes)
-        out = {measured.T_COLUMN: values["timestamp"]}
-        out.update({q_names[k]: values[q[k]] for k in axes})
-        out.update({tau_names[k]: values[torque[k]] * scale[k] for k in axes})
-        if qd[0] in values:
-            out.update({qd_names[k]: values[qd[k]] for k in axes})
+        mapping = {measured.T_COLUMN: ("timestamp", None)}
+        mapping.update({q_names[k]: (q[k], None) for k in axes})
+        mapping.update({tau_names[k]: (torque[k], scale[k]) for k in axes})
+        if with_qd:
+            mapping.update({qd_names[k]: (qd[k], None) for k in axes})
         if with_temperature:
-            out.update({name: values[temperature[k]] for k, name in enumerate(jointlog.temperature_columns(n_axes))})
-        return out, label, (source,)
+            mapping.update({name: (temperature[k], None) for k, name in enumerate(jointlog.temperature_columns(n_axes))})
+        return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
+
+    @staticmethod
+    def _mapped(plan: dict, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {name: values[column] if factor is None else values[column] * factor
+                for name, (column, factor) in plan["map"].items()}
+
+    def columns(self, path: Path, robot: robots.Robot):
+        plan = self._plan(path, robot)
+        jointlog.csv_rows(path, len(plan["wanted"]), "an RTDE log", "RTDE log")
+        parts = {name: [] for name in plan["wanted"]}
+        for values in _rtde_chunks(path, plan["names"], plan["separator"], plan["wanted"], self.label):
+            for name in plan["wanted"]:
+                parts[name].append(values[name])
+        values = {name: jointlog.joined(chunks) for name, chunks in parts.items()}
+        return self._mapped(plan, values), self.label, (plan["note"],)
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        plan = self._plan(path, robot)
+        for values in _rtde_chunks(path, plan["names"], plan["separator"], plan["wanted"], self.label, size):
+            yield self._mapped(plan, values), self.label, (plan["note"],)
 
 
-def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str], label) -> dict[str, np.ndarray]:
-    """The ``wanted`` columns of an RTDE log parsed as numbers (only they converted and kept: memory
-    in proportion to the numbers, where reading every cell as text took 7 times the file), refused
-    at the first cell that is not a finite number, found from the text in chunks of rows (every
-    column of a row is tokenized, kept or not: a chunk's rows are bounded by all the columns)."""
+def _rtde_chunks(path: Path, names: list[str], separator: str, wanted: list[str], label,
+                 size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+    """The ``wanted`` columns of an RTDE log parsed as numbers, ``size`` rows at a time (default:
+    rows bounded by all the columns, as every column of a row is tokenized, kept or not; only the
+    wanted converted and kept: memory in proportion to the numbers, where reading every cell as
+    text took 7 times the file), refused at the first cell that is not a finite number, found from
+    the text (:func:`_numbers`: the data row, column and value named)."""
     kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": max(1_000, jointlog.CHUNK_CELLS // len(names))}
-    parts = {name: [] for name in wanted}
+          "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
     try:
         with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=float, **kw):
-                for name in wanted:
-                    parts[name].append(frame[name].to_numpy(dtype=float))
-        out = {name: jointlog.joined(parts[name]) for name in wanted}
-        if all(bool(np.isfinite(column).all()) for column in out.values()):
-            return out
+                values = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+                if not all(bool(np.isfinite(column).all()) for column in values.values()):
+                    break
+                yield values
+            else:
+                return
     except inputs.InputError:
         raise
     except (ValueError, TypeError):  # a cell that is not a number: found from the text below
         pass
-    del parts
     start = 0
+    kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
     try:
         with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
@@ -452,34 +477,58 @@ class Voraus(Adapter):
     reads_held = True
     suffixes: tuple[str, ...] = (".parquet",)
 
-    def columns(self, path: Path | inputs.Held, robot: robots.Robot):
+    @staticmethod
+    def _plan(path: Path | inputs.Held, robot: robots.Robot) -> tuple:
+        """The file as pyarrow reads it (``path`` or the held bytes: not reopened), its columns
+        read (refused when missing) and its rows, from the metadata before any is read (a few MB
+        of constant columns may hold 10^8)."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        n_axes = robot.n_axes
         inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path  # held: not reopened
+        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path
         names = pq.read_schema(source).names
-        axes = range(1, n_axes + 1)
-        position = [f"joint_position_{k}" for k in axes]
+        axes = range(1, robot.n_axes + 1)
         velocity = [f"joint_velocity_{k}" for k in axes]
-        torque = [f"motor_torque_{k}" for k in axes]
-        wanted = ["time", *position, *torque, *(velocity if all(c in names for c in velocity) else [])]
+        wanted = ["time", *(f"joint_position_{k}" for k in axes), *(f"motor_torque_{k}" for k in axes),
+                  *(velocity if all(c in names for c in velocity) else [])]
         _require(path, names, wanted, "voraus-AD")
-        sample = ["sample"] if "sample" in names else []
-        # the rows from the file's metadata, before any is read: a few MB of constant columns may hold 10^8
-        rows = pq.ParquetFile(source).metadata.num_rows
-        jointlog.check_whole_rows(path, rows, len(wanted + sample), what="a voraus-AD log")
-        frame = pq.read_table(source, columns=wanted + sample).to_pandas()
-        label = jointlog.index_label
-        values = _numbers(path, frame, wanted + sample, label)
-        q_names, qd_names, tau_names = measured.column_names(n_axes)
+        wanted += ["sample"] if "sample" in names else []
+        return source, wanted, pq.ParquetFile(source).metadata.num_rows
+
+    @staticmethod
+    def _mapped(values: dict[str, np.ndarray], robot: robots.Robot) -> dict[str, np.ndarray]:
+        q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
         out = {measured.T_COLUMN: values["time"]}
-        for k in range(n_axes):
-            out[q_names[k]] = values[position[k]]
-            out[tau_names[k]] = values[torque[k]] * robot.gear_ratio[k]  # motor side -> arm side
-            if velocity[k] in values:
-                out[qd_names[k]] = values[velocity[k]]
-        if sample:
+        for k in range(robot.n_axes):
+            out[q_names[k]] = values[f"joint_position_{k + 1}"]
+            out[tau_names[k]] = values[f"motor_torque_{k + 1}"] * robot.gear_ratio[k]  # motor side -> arm side
+            if f"joint_velocity_{k + 1}" in values:
+                out[qd_names[k]] = values[f"joint_velocity_{k + 1}"]
+        if "sample" in values:
             out[measured.CYCLE_COLUMN] = values["sample"]
-        return out, label
+        return out
+
+    def columns(self, path: Path | inputs.Held, robot: robots.Robot):
+        import pyarrow.parquet as pq
+
+        source, wanted, rows = self._plan(path, robot)
+        jointlog.check_whole_rows(path, rows, len(wanted), what="a voraus-AD log")
+        frame = pq.read_table(source, columns=wanted).to_pandas()
+        return self._mapped(_numbers(path, frame, wanted, self.label), robot), self.label
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        import pyarrow.parquet as pq
+
+        source, wanted, _ = self._plan(path, robot)
+        start = 0
+        for batch in pq.ParquetFile(source).iter_batches(batch_size=size, columns=wanted):
+            values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
+            yield self._mapped(values, robot), self.label, ()
+            start += batch.num_rows
+
+    def rows(self, path: Path) -> int:
+        import pyarrow.parquet as pq
+
+        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
+        return pq.ParquetFile(path).metadata.num_rows
