@@ -4,7 +4,12 @@ Each adapter maps a foreign file's columns onto the measured format's (``t``, ``
 ``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
 :func:`faultgen.data.measured.from_columns`, which checks them as it checks a measured log (the
 same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTERS`), chosen with
-``faultgen logs import --format NAME``; docs/dataset.md, "Adapters", gives each layout.
+``--format NAME`` (``logs import``, ``calibrate``, ``monitor``, ``simulate --task LOG``);
+docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`Adapter.columns`)
+or in blocks of rows (:meth:`Adapter.blocks`, :meth:`Adapter.source`: a log too long to read whole,
+calibrated by :mod:`faultgen.data.longlog` or replayed streamed by
+:mod:`faultgen.operation.replay`) with the same checks and messages; :data:`MEASURED` is the
+measured format's own readers as an adapter (docs/architecture.md, "Log formats").
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
   ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
