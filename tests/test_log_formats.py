@@ -101,18 +101,24 @@ def test_monitor_reads_the_format(fleets, tmp_path):
 def test_calibrate_reads_the_format(tmp_path, hidden):
     """A log with a hidden Coulomb friction on some axes, in the example layout: the calibration
     finds what it finds on the same numbers in the measured format, step for step."""
-    tsv, plain = hidden
+    reports = _calibrated(tmp_path, *hidden)
+    assert reports["example"] == reports["plain"]
+    assert [step["effect"] for step in reports["example"]["steps"]] == ["coulomb"]
+
+
+def _calibrated(tmp_path, tsv, plain, printed=""):
+    """The reports of ``calibrate --format deg-ms`` on ``tsv`` and of ``calibrate`` on ``plain``
+    (the log's file and model path left out), each run printing ``printed``."""
     reports = {}
     for name, log, extra in (("example", tsv, ["--format", "deg-ms"]), ("plain", plain, [])):
         out = tmp_path / f"calib-{name}"
         result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(out),
                                      "--max-steps", "1", "--no-sysid", *extra])
-        assert result.exit_code == 0, result.output
+        assert result.exit_code == 0 and printed in result.output, result.output
         reports[name] = json.loads((out / "report.json").read_text())
     for report in reports.values():
         report.pop("measured"), report.pop("model_out")
-    assert reports["example"] == reports["plain"]
-    assert [step["effect"] for step in reports["example"]["steps"]] == ["coulomb"]
+    return reports
 
 
 def _no_whole_read(monkeypatch):
@@ -139,16 +145,7 @@ def test_calibrate_reads_a_long_log_of_the_format_in_blocks(tmp_path, puma, hidd
     assert example.notes == measured.notes
     for name in ("moving", "peak", "rows"):
         np.testing.assert_array_equal(getattr(moves, name), getattr(plain_moves, name), err_msg=name)
-    reports = {}
-    for name, log, extra in (("example", tsv, ["--format", "deg-ms"]), ("plain", plain, [])):
-        out = tmp_path / f"calib-{name}"
-        result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(out),
-                                     "--max-steps", "1", "--no-sysid", *extra])
-        assert result.exit_code == 0, result.output
-        assert "decimated: 1964 rows averaged over blocks of 3 to 654" in result.output
-        reports[name] = json.loads((out / "report.json").read_text())
-    for report in reports.values():
-        report.pop("measured"), report.pop("model_out")
+    reports = _calibrated(tmp_path, tsv, plain, "decimated: 1964 rows averaged over blocks of 3 to 654")
     assert reports["example"] == reports["plain"]
 
 

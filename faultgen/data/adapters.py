@@ -112,17 +112,7 @@ class Adapter:
             cell that is not a finite number (the data row, column and value named).
         """
         what = f"{self.name} log"
-        inputs.regular_file(path, what, MAX_BYTES)
-        try:
-            names, _ = inputs.csv_header(path, what, separator=self.separator)
-        except inputs.InputError as err:
-            raise jointlog.LogBoundError(str(err)) from None
-        except (OSError, UnicodeDecodeError, EOFError) as err:
-            raise measured.MeasuredDataError(f"{path}: cannot read the file as {what}: {err}") from err
-        twice = sorted(name for name, count in Counter(names).items() if count > 1)
-        if twice:
-            raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
-                                             "header")
+        names, _ = _header(path, what, self.separator, what)
         if size is None:
             jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
         kw = {"sep": self.separator, "dtype": str, "keep_default_na": False, "na_filter": False,
@@ -316,6 +306,24 @@ class Measured(Adapter):
 MEASURED = Measured()
 
 
+def _header(path: Path | inputs.Held, what: str, separator: str | None, as_what: str) -> tuple[list[str], str]:
+    """The names in the header of the delimited-text log ``path`` and its separator (``None``:
+    found), the file a regular one (bounded: :data:`MAX_BYTES`, :func:`faultgen.inputs.csv_header`);
+    refused unreadable (as ``as_what``) or with a name twice."""
+    inputs.regular_file(path, what, MAX_BYTES)
+    try:
+        names, separator = inputs.csv_header(path, what, separator=separator)
+    except inputs.InputError as err:
+        raise jointlog.LogBoundError(str(err)) from None
+    except (OSError, UnicodeDecodeError, EOFError) as err:
+        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: {err}") from err
+    twice = sorted(name for name, count in Counter(names).items() if count > 1)
+    if twice:
+        raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
+                                         "header")
+    return names, separator
+
+
 def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
     missing = [c for c in wanted if c not in names]
     if missing:
@@ -372,17 +380,7 @@ class URRTDE(Adapter):
         ``wanted`` (its columns read), ``map`` (measured name -> (its column, factor)) and ``note``
         (the torque source), or refused (a missing column, a name twice)."""
         n_axes = robot.n_axes
-        inputs.regular_file(path, "RTDE log", MAX_BYTES)
-        try:
-            names, separator = inputs.csv_header(path, "RTDE log", separator=None)
-        except inputs.InputError as err:
-            raise jointlog.LogBoundError(str(err)) from None
-        except (OSError, UnicodeDecodeError, EOFError) as err:
-            raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-        twice = sorted(name for name, count in Counter(names).items() if count > 1)
-        if twice:
-            raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
-                                             "header")
+        names, separator = _header(path, "RTDE log", None, "CSV")
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
