@@ -13,6 +13,7 @@ import fleetlog_folder
 import h5py
 import log_format_example
 import numpy as np
+import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
@@ -278,3 +279,16 @@ def test_simulate_refuses_a_format_for_a_task_that_is_no_log_and_torque_constant
                                  "deg-ms", "--torque-constants", "1,1,1,1,1,1", "-o", str(tmp_path / "x.h5")])
     assert result.exit_code == 2 and "--torque-constants" in result.output
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_a_log_of_the_format_missing_a_column_is_refused_naming_it_whole_and_in_blocks(tmp_path, puma, hidden):
+    """The base class's reading of a column-mapping format: a column ``convert`` names that the file
+    lacks is refused with the file's columns, by the whole read, the calibration's and the replay's."""
+    frame = pd.read_csv(hidden[0], sep="\t").drop(columns=["angle_deg_3"])
+    frame.to_csv(tmp_path / "missing.tsv", sep="\t", index=False)
+    adapter, log = adapters.make("deg-ms"), tmp_path / "missing.tsv"
+    message = r"missing\.tsv: missing column 'angle_deg_3' of the deg-ms layout; found time_ms, angle_deg_1, angle_deg_2, "
+    for read in (lambda: adapter.read(log, puma), lambda: longlog.read(log, puma, 700, search.REST_SPEED, adapter),
+                 lambda: programs.load(puma, programs.log_task(str(log), adapter))):
+        with pytest.raises(jointlog.LogError, match=message):
+            read()

@@ -115,20 +115,13 @@ class Adapter:
         names, _ = _header(path, what, self.separator, what)
         if size is None:
             jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
-        kw = {"sep": self.separator, "dtype": str, "keep_default_na": False, "na_filter": False,
-              "chunksize": size or max(jointlog.whole_rows(len(names)), 1)}
         start = 0
-        try:
-            with inputs.open_text(path, what, MAX_BYTES) as fh:
-                for frame in pd.read_csv(fh, **kw):
-                    values = _numbers(path, frame, list(frame.columns), lambda i, s=start: self.label(s + i))
-                    yield start, pd.DataFrame(values, index=frame.index)
-                    start += len(frame)
-        except (inputs.InputError, measured.MeasuredDataError):
-            raise
-        except (ValueError, OSError, EOFError) as err:  # pandas's ParserError is a ValueError
-            raise measured.MeasuredDataError(f"{path}: cannot read the file as {what}: "
-                                             f"{' '.join(str(err).split())}") from None
+        for values in _text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
+            frame = pd.DataFrame(values, columns=names)
+            yield start, frame
+            start += len(frame)
+        if not start:  # no data row: the header's columns, empty
+            yield 0, pd.DataFrame({name: np.empty(0) for name in names}, columns=names)
 
     def _converted(self, path, frame: pd.DataFrame, robot: robots.Robot) -> tuple[dict, tuple[str, ...]]:
         try:
@@ -148,10 +141,12 @@ class Adapter:
         whole file (:meth:`frames`)."""
         if not self._maps():
             raise NotImplementedError(f"log format {self.name}: define convert() or columns()")
-        frames = list(self.frames(path, None))
-        frame = frames[0][1] if frames else pd.DataFrame()
-        columns, notes = self._converted(path, frame, robot)
-        return columns, self.label, notes
+        parts, notes = {}, ()
+        for _, frame in self.frames(path, None):  # converted chunk by chunk, as the blocks are
+            columns, notes = self._converted(path, frame, robot)
+            for name, values in columns.items():
+                parts.setdefault(name, []).append(values)
+        return {name: jointlog.joined(chunks) for name, chunks in parts.items()}, self.label, notes
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         """The log in blocks of ``size`` data rows (the last one shorter), each as :meth:`columns`
@@ -415,6 +410,11 @@ class URRTDE(Adapter):
         return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
 
     @staticmethod
+    def _chunks(path, plan: dict, size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+        return _text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
+                            plan["wanted"], URRTDE.label, size)
+
+    @staticmethod
     def _mapped(plan: dict, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         return {name: values[column] if factor is None else values[column] * factor
                 for name, (column, factor) in plan["map"].items()}
@@ -423,7 +423,7 @@ class URRTDE(Adapter):
         plan = self._plan(path, robot)
         jointlog.csv_rows(path, len(plan["wanted"]), "an RTDE log", "RTDE log")
         parts = {name: [] for name in plan["wanted"]}
-        for values in _rtde_chunks(path, plan["names"], plan["separator"], plan["wanted"], self.label):
+        for values in self._chunks(path, plan):
             for name in plan["wanted"]:
                 parts[name].append(values[name])
         values = {name: jointlog.joined(chunks) for name, chunks in parts.items()}
@@ -431,21 +431,22 @@ class URRTDE(Adapter):
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         plan = self._plan(path, robot)
-        for values in _rtde_chunks(path, plan["names"], plan["separator"], plan["wanted"], self.label, size):
+        for values in self._chunks(path, plan, size):
             yield self._mapped(plan, values), self.label, (plan["note"],)
 
 
-def _rtde_chunks(path: Path, names: list[str], separator: str, wanted: list[str], label,
+def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separator: str, wanted: list[str], label,
                  size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
-    """The ``wanted`` columns of an RTDE log parsed as numbers, ``size`` rows at a time (default:
-    rows bounded by all the columns, as every column of a row is tokenized, kept or not; only the
-    wanted converted and kept: memory in proportion to the numbers, where reading every cell as
-    text took 7 times the file), refused at the first cell that is not a finite number, found from
-    the text (:func:`_numbers`: the data row, column and value named)."""
+    """The ``wanted`` columns of a delimited-text log (a header row of ``names``) parsed as numbers,
+    ``size`` rows at a time (default: rows bounded by all the columns, as every column of a row is
+    tokenized, kept or not; only the wanted converted and kept: memory in proportion to the
+    numbers, where reading every cell as text took 7 times the file), refused at the first cell
+    that is not a finite number, found from the text (:func:`_numbers`: the data row, column and
+    value named), or when the text is not such a table (named ``as_what``)."""
     kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
           "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
     try:
-        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+        with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=float, **kw):
                 values = {name: frame[name].to_numpy(dtype=float) for name in wanted}
                 if not all(bool(np.isfinite(column).all()) for column in values.values()):
@@ -460,14 +461,14 @@ def _rtde_chunks(path: Path, names: list[str], separator: str, wanted: list[str]
     start = 0
     kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
     try:
-        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+        with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
                 _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
                 start += len(frame)
     except (inputs.InputError, measured.MeasuredDataError):
         raise
     except (ValueError, OSError, EOFError) as err:  # pandas's ParserError (an unbalanced quote) is a ValueError
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as an RTDE recorder CSV: "
+        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: "
                                          f"{' '.join(str(err).split())}") from None
     raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
