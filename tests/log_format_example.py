@@ -18,25 +18,27 @@ import numpy as np
 import pandas as pd
 
 from faultgen.data import adapters, measured
-from faultgen.operation import jointlog
 
 
 @adapters.register("deg-ms")
 @dataclass(frozen=True)
 class DegreesMilliseconds(adapters.Adapter):
-    """``time_ms`` (ms), ``angle_deg_1..N`` (deg), ``torque_Nm_1..N`` (N m at the arm), tab-separated."""
+    """``time_ms`` (ms), ``angle_deg_1..N`` (deg), ``torque_Nm_1..N`` (N m at the arm), tab-separated.
+
+    The column mapping and units alone (:meth:`convert` of one block of the file, read as
+    tab-separated text by the base class): the base reads the file whole or in blocks with it."""
 
     suffixes: tuple[str, ...] = (".tsv",)
+    separator = "\t"
 
-    def columns(self, path: Path, robot):
-        frame = pd.read_csv(path, sep="\t")
+    def convert(self, frame, robot):
         n_axes = robot.n_axes
         q_names, _, tau_names = measured.column_names(n_axes)
         out = {measured.T_COLUMN: frame["time_ms"].to_numpy(float) / 1000.0}
         for k in range(n_axes):
             out[q_names[k]] = np.radians(frame[f"angle_deg_{k + 1}"].to_numpy(float))
             out[tau_names[k]] = frame[f"torque_Nm_{k + 1}"].to_numpy(float)
-        return out, jointlog.index_label
+        return out
 
 
 def write(source: Path, path: Path) -> Path:
@@ -57,6 +59,6 @@ def measured_copy(path: Path, robot, out: Path) -> Path:
     """The numbers this adapter reads from ``path``, written at ``out`` in the measured format
     (``t, q1..qN, tau1..tauN``, 17 digits: read back bit for bit), for comparing a command's
     outputs on both."""
-    columns, _ = DegreesMilliseconds().columns(path, robot)
+    columns = DegreesMilliseconds().columns(path, robot)[0]
     pd.DataFrame(columns).to_csv(out, index=False, float_format="%.17g")
     return out

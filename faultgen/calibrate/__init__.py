@@ -62,7 +62,8 @@ MAX_ROWS = 25_000
 
 
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
-              max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
+              max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
+              log_format=None) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
@@ -71,7 +72,10 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     (:class:`ImplausibleLogError`, naming the joints and how little they move). ``use_sysid``: a
     Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`faultgen.calibrate.loop.run`).
     ``robot``: the nominal model, a :class:`~faultgen.model.robot.Robot` or a name, robot folder or MJCF
-    file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError)."""
+    file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError).
+    ``log_format``: the log's format when not the measured one (a
+    :class:`faultgen.data.adapters.Adapter`, ``--format NAME``): read through it, whole or, longer
+    than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`)."""
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
         data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)
@@ -79,7 +83,7 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
         if progress:
             print(f"reading {measured}", flush=True)
         # a log longer than MAX_ROWS is averaged down while it is read: memory flat in its length
-        data, moves = longlog.read(measured, nominal, MAX_ROWS, search.REST_SPEED)
+        data, moves = longlog.read(measured, nominal, MAX_ROWS, search.REST_SPEED, log_format)
         if progress and moves.rows > len(data):
             print(data.notes[-1], flush=True)
     _check_motion(data.source, moves)

@@ -53,7 +53,8 @@ def calibrate_command(
 
     A log in another layout is read by the adapter `faultgen logs import` and `faultgen monitor`
     use: --format ur-rtde (Universal Robots' RTDE recorder; --torque-constants for the measured
-    current) or --format voraus, whole, with the measured format's checks (docs/dataset.md).
+    current) or --format voraus, whole or, when long, in blocks, with the measured format's checks
+    (docs/dataset.md).
 
     Example (on a log with a hidden effect, `faultgen hidden-log`):
 
@@ -66,11 +67,9 @@ def calibrate_command(
 
     check_output_folder(out, overwrite)
     nominal = robots.load(robot)  # once, for the log's reader and the calibration
-    adapter = log_adapter(log_format, torque_constants, nominal)
-    log = measured
-    if adapter is not None:  # read once, whole, by the format's adapter; calibrate takes the checked data
-        log = adapter.read(measured, nominal)
-    result = calibrate.calibrate(nominal, log, out, max_steps=max_steps, progress=True, use_sysid=sysid)
+    adapter = log_adapter(log_format, torque_constants, nominal)  # None: the measured format
+    result = calibrate.calibrate(nominal, measured, out, max_steps=max_steps, progress=True, use_sysid=sysid,
+                                 log_format=adapter)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 

@@ -4,7 +4,12 @@ Each adapter maps a foreign file's columns onto the measured format's (``t``, ``
 ``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
 :func:`faultgen.data.measured.from_columns`, which checks them as it checks a measured log (the
 same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTERS`), chosen with
-``faultgen logs import --format NAME``; docs/dataset.md, "Adapters", gives each layout.
+``--format NAME`` (``logs import``, ``calibrate``, ``monitor``, ``simulate --task LOG``);
+docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`Adapter.columns`)
+or in blocks of rows (:meth:`Adapter.blocks`, :meth:`Adapter.source`: a log too long to read whole,
+calibrated by :mod:`faultgen.data.longlog` or replayed streamed by
+:mod:`faultgen.operation.replay`) with the same checks and messages; :data:`MEASURED` is the
+measured format's own readers as an adapter (docs/architecture.md, "Log formats").
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
   ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
@@ -21,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import Counter
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,7 +36,7 @@ import pandas as pd
 from faultgen import inputs
 from faultgen.data import measured
 from faultgen.model import robots
-from faultgen.operation import jointlog
+from faultgen.operation import jointlog, logblocks
 
 #: name -> adapter class.
 ADAPTERS: dict[str, type[Adapter]] = {}
@@ -39,6 +45,11 @@ MAX_BYTES = 4 * 2**30
 #: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
 #: about 10: the motor's 0.1 times the gear ratio 101).
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
+
+
+#: Data rows of the first block read to learn a log's columns before its blocks are read
+#: (:class:`Blocks`).
+PEEK_ROWS = 16
 
 
 def register(name: str):
@@ -52,8 +63,16 @@ def register(name: str):
 
 @dataclass(frozen=True)
 class Adapter:
-    """Base: ``suffixes`` (lower case) of the files it reads, and :meth:`columns` (the foreign file's
-    columns as the measured format's, and the data-row labeller of its messages).
+    """Base of a log format: ``suffixes`` (lower case) of the files it reads, and its two readers
+    with the same checks and messages: whole (:meth:`columns`, :meth:`read`) and in blocks of rows
+    (:meth:`blocks`, :meth:`source`) for a log too long to read whole (the calibration's
+    :mod:`faultgen.data.longlog`, the replay's streaming, :mod:`faultgen.operation.logblocks`).
+
+    A column-mapping format defines :meth:`convert` alone (one block of the file, its cells as
+    floats, mapped onto the measured format's names and units) and :attr:`separator`: the base
+    reads the file as delimited text, whole or in chunks (:meth:`frames`), so it gets both readers.
+    A format with a reader of its own overrides :meth:`columns` and, to read in blocks with bounded
+    memory, :meth:`blocks` and :meth:`rows` (else its blocks are its whole read, sliced).
 
     ``reads_held``: :meth:`columns` takes the file's bytes read once (:class:`faultgen.inputs.Held`)
     for its path, reading through :mod:`faultgen.inputs` (``open_bytes``, ``open_text``,
@@ -64,12 +83,107 @@ class Adapter:
     name = ""
     reads_held = False
     suffixes: tuple[str, ...] = ()
+    #: The column separator of a delimited-text format read by :meth:`frames`.
+    separator = ","
+    #: Data row index (0-based, from the file's first data row) -> its name in messages.
+    label = staticmethod(jointlog.index_label)
+
+    def convert(self, frame: pd.DataFrame, robot: robots.Robot):
+        """One block of the file (``frame``: its columns by the file's names, every cell a finite
+        float) as the measured format's columns: a dict of name (``t`` s, ``q1..qN`` rad,
+        ``tau1..tauN`` N m at the arm, optional ``qd1..qdN`` rad/s, ``temperature1..N``,
+        ``cycle``) to ndarray of shape (rows,), or ``(columns, notes)``. Defined by a
+        column-mapping format (class docstring); a column it names that the file lacks is refused
+        with the file's columns (:meth:`frames`)."""
+        raise NotImplementedError
+
+    def _maps(self) -> bool:
+        return type(self).convert is not Adapter.convert
+
+    def frames(self, path: Path | inputs.Held, size: int | None) -> Iterator[tuple[int, pd.DataFrame]]:
+        """The delimited-text file ``path`` (:attr:`separator`, a header row; plain or gzip) as
+        ``(start, frame)``: its first data row's index and ``size`` rows of it (the whole file when
+        None), every cell a finite float.
+
+        Raises
+        ------
+        faultgen.data.measured.MeasuredDataError
+            Not a regular file, unreadable as such text, a column named twice in the header, a
+            cell that is not a finite number (the data row, column and value named).
+        """
+        what = f"{self.name} log"
+        names, _ = _header(path, what, self.separator, what)
+        if size is None:
+            jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
+        start = 0
+        for values in _text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
+            frame = pd.DataFrame(values, columns=names)
+            yield start, frame
+            start += len(frame)
+        if not start:  # no data row: the header's columns, empty
+            yield 0, pd.DataFrame({name: np.empty(0) for name in names}, columns=names)
+
+    def _converted(self, path, frame: pd.DataFrame, robot: robots.Robot) -> tuple[dict, tuple[str, ...]]:
+        try:
+            out = self.convert(frame, robot)
+        except KeyError as err:
+            raise measured.MeasuredDataError(
+                f"{inputs.path_of(path)}: missing column {err} of the {self.name} layout; found "
+                f"{', '.join(map(str, frame.columns[:40])) or '(none)'}") from None
+        columns, notes = out if isinstance(out, tuple) else (out, ())
+        return columns, tuple(notes)
 
     def columns(self, path: Path, robot: robots.Robot) -> tuple:
         """``(columns, label)`` or ``(columns, label, notes)``: the file's columns under the
-        measured format's names, the data-row labeller of messages, and what the reading chose
-        (which torque source, say), kept in :attr:`faultgen.data.measured.MeasuredData.notes`."""
-        raise NotImplementedError
+        measured format's names (dict of ndarray of shape (n,)), the data-row labeller of messages,
+        and what the reading chose (which torque source, say), kept in
+        :attr:`faultgen.data.measured.MeasuredData.notes`. The base: :meth:`convert` of the
+        whole file (:meth:`frames`)."""
+        if not self._maps():
+            raise NotImplementedError(f"log format {self.name}: define convert() or columns()")
+        parts, notes = {}, ()
+        for _, frame in self.frames(path, None):  # converted chunk by chunk, as the blocks are
+            columns, notes = self._converted(path, frame, robot)
+            for name, values in columns.items():
+                parts.setdefault(name, []).append(values)
+        return {name: jointlog.joined(chunks) for name, chunks in parts.items()}, self.label, notes
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        """The log in blocks of ``size`` data rows (the last one shorter), each as :meth:`columns`
+        gives the whole file: ``(columns, label, notes)``, the label naming rows from the file's
+        first data row. The base: :meth:`convert` of each chunk of :meth:`frames`; for a format
+        without :meth:`convert`, its whole read sliced (memory that of the whole read).
+
+        Raises
+        ------
+        faultgen.data.measured.MeasuredDataError
+            What :meth:`columns` refuses, with the same message.
+        """
+        if self._maps():
+            for _, frame in self.frames(path, size):
+                columns, notes = self._converted(path, frame, robot)
+                yield columns, self.label, notes
+            return
+        columns, label, *notes = self.columns(path, robot)
+        n = len(next(iter(columns.values()), ()))
+        for start in range(0, n, size):
+            yield {k: np.asarray(v)[start:start + size] for k, v in columns.items()}, label, tuple(*notes)
+
+    def rows(self, path: Path) -> int:
+        """An upper bound of the log's data rows, found before they are parsed. The base: the lines
+        of the delimited-text file but its header (:func:`faultgen.inputs.count_lines`)."""
+        try:
+            return max(inputs.count_lines(path, f"{self.name} log") - 1, 0)
+        except inputs.InputError as err:
+            raise jointlog.LogBoundError(str(err)) from None
+        except (OSError, UnicodeDecodeError, EOFError) as err:
+            raise measured.MeasuredDataError(f"{path}: cannot read the file: {err}") from err
+
+    def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
+        """The log ``path`` as blocks of the measured format's columns (:class:`Blocks`: the block
+        source :mod:`faultgen.operation.logblocks` reads), ``motion_only`` as there (``t`` and
+        ``q1..qN``: a replay)."""
+        return Blocks(self, Path(path), robot, motion_only)
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
@@ -100,6 +214,111 @@ def make(name: str, **options) -> Adapter:
     return cls(**options)
 
 
+class Blocks:
+    """A log read through its format's :meth:`Adapter.blocks` as the block source
+    :mod:`faultgen.operation.logblocks` reads: ``path``, ``wanted`` (the measured format's columns
+    read, in the order of a block's columns: :func:`faultgen.operation.jointlog.select_columns`),
+    ``extra`` (none: the adapter chose its columns), ``notes`` (what the reading chose), ``rows``
+    (an upper bound of the data rows, :meth:`Adapter.rows`), ``label`` and :meth:`blocks`. Its first
+    :data:`PEEK_ROWS` rows are read here, to learn the columns.
+
+    Raises
+    ------
+    faultgen.data.measured.MeasuredDataError
+        A missing column (as :func:`faultgen.data.measured.from_columns` names it), a log of more
+        rows than :data:`faultgen.operation.jointlog.MAX_ROWS`, or what the adapter refuses.
+    """
+
+    def __init__(self, adapter: Adapter, path: Path, robot: robots.Robot, motion_only: bool = False):
+        self.adapter, self.path, self.robot, self.extra = adapter, path, robot, []
+        peek = iter(adapter.blocks(path, robot, PEEK_ROWS))
+        try:
+            first = next(peek, None)
+        finally:
+            getattr(peek, "close", lambda: None)()  # a generator's file closed now
+        if first is None:  # no data row: the whole read says what is wrong
+            self.wanted, self.notes, self.rows, self.label = [], (), 0, adapter.label
+            return
+        columns, self.label, *notes = first
+        self.notes = tuple(notes[0]) if notes else ()
+        self.wanted, _ = jointlog.select_columns(path, list(columns), robot.n_axes, motion_only)
+        self.rows = adapter.rows(path)
+        if self.rows > jointlog.MAX_ROWS:
+            raise measured.MeasuredDataError(f"{path}: {self.rows} data rows; a log has at most {jointlog.MAX_ROWS} "
+                                             "(MAX_ROWS: a day at 1 kHz)")
+
+    def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
+        """``(start, block)``: the index of the block's first data row and its ``wanted`` columns
+        (ndarray of shape (size, len(wanted)), floats; the last block shorter), every cell refused
+        unless finite, as :func:`faultgen.data.measured.from_columns` refuses it."""
+        start, held, count = 0, [], 0  # held: rows read, not yet yielded (``count`` of them)
+        for columns, *_ in self.adapter.blocks(self.path, self.robot, size):
+            values = {name: np.asarray(columns[name], dtype=float) for name in self.wanted}
+            lengths = {len(v) for v in values.values()}
+            if len(lengths) > 1:
+                raise measured.MeasuredDataError(f"{self.path}: columns of different lengths {sorted(lengths)}")
+            first = start + count
+            jointlog.refuse_non_finite(self.path, values, self.wanted, lambda i, s=first: self.label(s + i))
+            held.append(np.column_stack([values[name] for name in self.wanted]))
+            count += len(held[-1])
+            while count >= size:  # blocks of exactly ``size`` rows, whatever the adapter's
+                rows = np.concatenate(held) if len(held) > 1 else held[0]
+                yield start, rows[:size]
+                start, count = start + size, count - size
+                held = [rows[size:]] if count else []
+        if count:
+            yield start, np.concatenate(held)
+
+
+@dataclass(frozen=True)
+class Measured(Adapter):
+    """The measured format (:mod:`faultgen.data.measured`; ``--format measured``, the default) as an
+    adapter: read whole by :func:`faultgen.data.measured.read`, in blocks by its own block reader
+    (:func:`faultgen.operation.logblocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
+
+    name = "measured"
+    reads_held = True
+    suffixes: tuple[str, ...] = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES
+
+    def columns(self, path, robot: robots.Robot) -> tuple:
+        columns, extra, label = jointlog.read_columns(path, robot.n_axes)
+        return columns, label, tuple([f"ignored extra columns: {', '.join(extra)}"] if extra else [])
+
+    def read(self, path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
+        return measured.read(path, robot, accelerations)
+
+    def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
+        return logblocks.source(Path(path), robot.n_axes, motion_only)
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        src = self.source(path, robot)
+        notes = (f"ignored extra columns: {', '.join(src.extra)}",) if src.extra else ()
+        for _, block in src.blocks(size):
+            yield {name: block[:, j] for j, name in enumerate(src.wanted)}, src.label, notes
+
+
+#: The measured format, the default (not in :data:`ADAPTERS`: ``--format measured`` gives no adapter).
+MEASURED = Measured()
+
+
+def _header(path: Path | inputs.Held, what: str, separator: str | None, as_what: str) -> tuple[list[str], str]:
+    """The names in the header of the delimited-text log ``path`` and its separator (``None``:
+    found), the file a regular one (bounded: :data:`MAX_BYTES`, :func:`faultgen.inputs.csv_header`);
+    refused unreadable (as ``as_what``) or with a name twice."""
+    inputs.regular_file(path, what, MAX_BYTES)
+    try:
+        names, separator = inputs.csv_header(path, what, separator=separator)
+    except inputs.InputError as err:
+        raise jointlog.LogBoundError(str(err)) from None
+    except (OSError, UnicodeDecodeError, EOFError) as err:
+        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: {err}") from err
+    twice = sorted(name for name, count in Counter(names).items() if count > 1)
+    if twice:
+        raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
+                                         "header")
+    return names, separator
+
+
 def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
     missing = [c for c in wanted if c not in names]
     if missing:
@@ -114,8 +333,10 @@ def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[
         values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
-            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value "
-                                             f"{frame[name].iloc[bad[0]]!r}; expected a finite number")
+            raw = frame[name].iloc[bad[0]]
+            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else repr(raw)  # inf, not np.float64(inf)
+            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value {shown}; expected "
+                                             "a finite number")
         out[name] = values
     return out
 
@@ -147,20 +368,14 @@ class URRTDE(Adapter):
                 raise ValueError(f"torque constants {self.torque_constants!r}: expected one number in "
                                  f"{MIN_TORQUE_CONSTANT:g} .. {MAX_TORQUE_CONSTANT:g} N m/A per axis")
 
-    def columns(self, path: Path, robot: robots.Robot):
+    label = staticmethod(jointlog.csv_label)
+
+    def _plan(self, path: Path | inputs.Held, robot: robots.Robot) -> dict:
+        """What to read of the RTDE log ``path`` from its header: ``names``, ``separator``,
+        ``wanted`` (its columns read), ``map`` (measured name -> (its column, factor)) and ``note``
+        (the torque source), or refused (a missing column, a name twice)."""
         n_axes = robot.n_axes
-        inputs.regular_file(path, "RTDE log", MAX_BYTES)
-        try:
-            names, separator = inputs.csv_header(path, "RTDE log", separator=None)
-        except inputs.InputError as err:
-            raise jointlog.LogBoundError(str(err)) from None
-        except (OSError, UnicodeDecodeError, EOFError) as err:
-            raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: {err}") from err
-        twice = sorted(name for name, count in Counter(names).items() if count > 1)
-        if twice:
-            raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
-                                             "header")
-        label = jointlog.csv_label
+        names, separator = _header(path, "RTDE log", None, "CSV")
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
@@ -170,10 +385,10 @@ class URRTDE(Adapter):
         if self.torque_constants is not None and all(c in names for c in current):
             if len(self.torque_constants) != n_axes:
                 raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
-            torque, scale = current, np.asarray(self.torque_constants, dtype=float)
+            torque, scale = current, [float(k) for k in self.torque_constants]
             source = "torque from actual_current_i x the torque constants given (measured)"
         elif all(c in names for c in moment):
-            torque, scale = moment, np.ones(n_axes)
+            torque, scale = moment, [1.0] * n_axes
             source = ("torque from target_moment_i (the controller's commanded moment, not a measurement; "
                       "--torque-constants K1,...,KN reads the measured actual_current_i instead)"
                       + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
@@ -181,54 +396,79 @@ class URRTDE(Adapter):
             raise measured.MeasuredDataError(
                 f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
                 f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
-        with_temperature = all(c in names for c in temperature)
-        wanted = ["timestamp", *q, *torque, *([c for c in qd] if all(c in names for c in qd) else []),
-                  *(temperature if with_temperature else [])]
+        with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
+        wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
         _require(path, names, wanted, "RTDE recorder")
-        jointlog.csv_rows(path, len(wanted), "an RTDE log", "RTDE log")
-        values = _rtde_numbers(path, names, separator, wanted, label)
         q_names, qd_names, tau_names = measured.column_names(n_axes)
-        out = {measured.T_COLUMN: values["timestamp"]}
-        out.update({q_names[k]: values[q[k]] for k in axes})
-        out.update({tau_names[k]: values[torque[k]] * scale[k] for k in axes})
-        if qd[0] in values:
-            out.update({qd_names[k]: values[qd[k]] for k in axes})
+        mapping = {measured.T_COLUMN: ("timestamp", None)}
+        mapping.update({q_names[k]: (q[k], None) for k in axes})
+        mapping.update({tau_names[k]: (torque[k], scale[k]) for k in axes})
+        if with_qd:
+            mapping.update({qd_names[k]: (qd[k], None) for k in axes})
         if with_temperature:
-            out.update({name: values[temperature[k]] for k, name in enumerate(jointlog.temperature_columns(n_axes))})
-        return out, label, (source,)
+            mapping.update({name: (temperature[k], None) for k, name in enumerate(jointlog.temperature_columns(n_axes))})
+        return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
+
+    @staticmethod
+    def _chunks(path, plan: dict, size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+        return _text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
+                            plan["wanted"], URRTDE.label, size)
+
+    @staticmethod
+    def _mapped(plan: dict, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {name: values[column] if factor is None else values[column] * factor
+                for name, (column, factor) in plan["map"].items()}
+
+    def columns(self, path: Path, robot: robots.Robot):
+        plan = self._plan(path, robot)
+        jointlog.csv_rows(path, len(plan["wanted"]), "an RTDE log", "RTDE log")
+        parts = {name: [] for name in plan["wanted"]}
+        for values in self._chunks(path, plan):
+            for name in plan["wanted"]:
+                parts[name].append(values[name])
+        values = {name: jointlog.joined(chunks) for name, chunks in parts.items()}
+        return self._mapped(plan, values), self.label, (plan["note"],)
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        plan = self._plan(path, robot)
+        for values in self._chunks(path, plan, size):
+            yield self._mapped(plan, values), self.label, (plan["note"],)
 
 
-def _rtde_numbers(path: Path, names: list[str], separator: str, wanted: list[str], label) -> dict[str, np.ndarray]:
-    """The ``wanted`` columns of an RTDE log parsed as numbers (only they converted and kept: memory
-    in proportion to the numbers, where reading every cell as text took 7 times the file), refused
-    at the first cell that is not a finite number, found from the text in chunks of rows (every
-    column of a row is tokenized, kept or not: a chunk's rows are bounded by all the columns)."""
+def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separator: str, wanted: list[str], label,
+                 size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
+    """The ``wanted`` columns of a delimited-text log (a header row of ``names``) parsed as numbers,
+    ``size`` rows at a time (default: rows bounded by all the columns, as every column of a row is
+    tokenized, kept or not; only the wanted converted and kept: memory in proportion to the
+    numbers, where reading every cell as text took 7 times the file), refused at the first cell
+    that is not a finite number, found from the text (:func:`_numbers`: the data row, column and
+    value named), or when the text is not such a table (named ``as_what``)."""
     kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": max(1_000, jointlog.CHUNK_CELLS // len(names))}
-    parts = {name: [] for name in wanted}
+          "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
     try:
-        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+        with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=float, **kw):
-                for name in wanted:
-                    parts[name].append(frame[name].to_numpy(dtype=float))
-        out = {name: jointlog.joined(parts[name]) for name in wanted}
-        if all(bool(np.isfinite(column).all()) for column in out.values()):
-            return out
+                values = {name: frame[name].to_numpy(dtype=float) for name in wanted}
+                if not all(bool(np.isfinite(column).all()) for column in values.values()):
+                    break
+                yield values
+            else:
+                return
     except inputs.InputError:
         raise
     except (ValueError, TypeError):  # a cell that is not a number: found from the text below
         pass
-    del parts
     start = 0
+    kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
     try:
-        with inputs.open_text(path, "RTDE log", MAX_BYTES) as fh:
+        with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
                 _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
                 start += len(frame)
     except (inputs.InputError, measured.MeasuredDataError):
         raise
     except (ValueError, OSError, EOFError) as err:  # pandas's ParserError (an unbalanced quote) is a ValueError
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as an RTDE recorder CSV: "
+        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: "
                                          f"{' '.join(str(err).split())}") from None
     raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
@@ -241,34 +481,58 @@ class Voraus(Adapter):
     reads_held = True
     suffixes: tuple[str, ...] = (".parquet",)
 
-    def columns(self, path: Path | inputs.Held, robot: robots.Robot):
+    @staticmethod
+    def _plan(path: Path | inputs.Held, robot: robots.Robot) -> tuple:
+        """The file as pyarrow reads it (``path`` or the held bytes: not reopened), its columns
+        read (refused when missing) and its rows, from the metadata before any is read (a few MB
+        of constant columns may hold 10^8)."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        n_axes = robot.n_axes
         inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path  # held: not reopened
+        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path
         names = pq.read_schema(source).names
-        axes = range(1, n_axes + 1)
-        position = [f"joint_position_{k}" for k in axes]
+        axes = range(1, robot.n_axes + 1)
         velocity = [f"joint_velocity_{k}" for k in axes]
-        torque = [f"motor_torque_{k}" for k in axes]
-        wanted = ["time", *position, *torque, *(velocity if all(c in names for c in velocity) else [])]
+        wanted = ["time", *(f"joint_position_{k}" for k in axes), *(f"motor_torque_{k}" for k in axes),
+                  *(velocity if all(c in names for c in velocity) else [])]
         _require(path, names, wanted, "voraus-AD")
-        sample = ["sample"] if "sample" in names else []
-        # the rows from the file's metadata, before any is read: a few MB of constant columns may hold 10^8
-        rows = pq.ParquetFile(source).metadata.num_rows
-        jointlog.check_whole_rows(path, rows, len(wanted + sample), what="a voraus-AD log")
-        frame = pq.read_table(source, columns=wanted + sample).to_pandas()
-        label = jointlog.index_label
-        values = _numbers(path, frame, wanted + sample, label)
-        q_names, qd_names, tau_names = measured.column_names(n_axes)
+        wanted += ["sample"] if "sample" in names else []
+        return source, wanted, pq.ParquetFile(source).metadata.num_rows
+
+    @staticmethod
+    def _mapped(values: dict[str, np.ndarray], robot: robots.Robot) -> dict[str, np.ndarray]:
+        q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
         out = {measured.T_COLUMN: values["time"]}
-        for k in range(n_axes):
-            out[q_names[k]] = values[position[k]]
-            out[tau_names[k]] = values[torque[k]] * robot.gear_ratio[k]  # motor side -> arm side
-            if velocity[k] in values:
-                out[qd_names[k]] = values[velocity[k]]
-        if sample:
+        for k in range(robot.n_axes):
+            out[q_names[k]] = values[f"joint_position_{k + 1}"]
+            out[tau_names[k]] = values[f"motor_torque_{k + 1}"] * robot.gear_ratio[k]  # motor side -> arm side
+            if f"joint_velocity_{k + 1}" in values:
+                out[qd_names[k]] = values[f"joint_velocity_{k + 1}"]
+        if "sample" in values:
             out[measured.CYCLE_COLUMN] = values["sample"]
-        return out, label
+        return out
+
+    def columns(self, path: Path | inputs.Held, robot: robots.Robot):
+        import pyarrow.parquet as pq
+
+        source, wanted, rows = self._plan(path, robot)
+        jointlog.check_whole_rows(path, rows, len(wanted), what="a voraus-AD log")
+        frame = pq.read_table(source, columns=wanted).to_pandas()
+        return self._mapped(_numbers(path, frame, wanted, self.label), robot), self.label
+
+    def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
+        import pyarrow.parquet as pq
+
+        source, wanted, _ = self._plan(path, robot)
+        start = 0
+        for batch in pq.ParquetFile(source).iter_batches(batch_size=size, columns=wanted):
+            values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
+            yield self._mapped(values, robot), self.label, ()
+            start += batch.num_rows
+
+    def rows(self, path: Path) -> int:
+        import pyarrow.parquet as pq
+
+        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
+        return pq.ParquetFile(path).metadata.num_rows

@@ -1,5 +1,8 @@
 """A long measured log read in blocks and averaged down while it is read, so that reading it takes
 memory that does not grow with its length (docs/reliability.md, docs/calibration.md "Long logs").
+A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``) is read the
+same way through its adapter's block reader (:meth:`faultgen.data.adapters.Adapter.source`), with
+the same checks and messages.
 
 ``faultgen calibrate`` works on at most ``rows`` rows: a longer log is averaged over blocks of
 ``k = ceil(n / rows)`` samples (:func:`block_mean`). Reading the whole log first and averaging it
@@ -17,7 +20,8 @@ the file, :data:`BLOCK_ROWS` rows at a time:
    the whole-log spline by far less than the filter's own error), the speed checks summed, and
    each block averaged down as it goes.
 
-A log of at most ``rows`` rows is read whole by :func:`faultgen.data.measured.read`.
+A log of at most ``rows`` rows is read whole by :func:`faultgen.data.measured.read` (an adapter's log
+by :meth:`faultgen.data.adapters.Adapter.read`).
 """
 
 from __future__ import annotations
@@ -27,11 +31,15 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import measured
+from faultgen.data import adapters, measured
 from faultgen.derivatives import SAVGOL_ORDER, is_uniform, savgol_window
 from faultgen.model import robots
 from faultgen.operation import jointlog, logblocks
-from faultgen.operation.logblocks import BLOCK_ROWS, block_mean  # noqa: F401 (re-exported)
+from faultgen.operation.logblocks import block_mean  # noqa: F401 (re-exported)
+
+#: Rows read at a time (:data:`faultgen.operation.logblocks.BLOCK_ROWS`; rounded up to a whole
+#: number of averaging blocks).
+BLOCK_ROWS = logblocks.BLOCK_ROWS
 
 
 @dataclass(frozen=True)
@@ -54,28 +62,39 @@ def motion(qd: np.ndarray, rest_speed: float) -> Motion:
     return Motion(np.sum(np.abs(qd) >= rest_speed, axis=0), peak, len(qd))
 
 
-def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float) -> tuple[measured.MeasuredData, Motion]:
-    """The measured log ``path`` (:func:`faultgen.data.measured.read`'s format and checks), averaged
-    down to at most ``rows`` rows when longer, and its :class:`Motion` at the full rate.
+def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
+         adapter: adapters.Adapter | None = None) -> tuple[measured.MeasuredData, Motion]:
+    """The log ``path`` in the measured format (:func:`faultgen.data.measured.read`'s format and
+    checks) or, with ``adapter``, in that format, averaged down to at most ``rows`` rows when
+    longer (read in blocks of :data:`BLOCK_ROWS` rows: :meth:`faultgen.data.adapters.Adapter.source`),
+    and its :class:`Motion` at the full rate.
+
+    Returns
+    -------
+    (MeasuredData, Motion)
+        ``t`` (m,) s, ``q``, ``qd``, ``qdd``, ``tau`` (m, N) in rad, rad/s, rad/s^2, N m, m <= ``rows``.
 
     Raises
     ------
     faultgen.data.measured.MeasuredDataError
-        As :func:`faultgen.data.measured.read`, naming the file, the column and the data row.
+        As :func:`faultgen.data.measured.read` (an adapter's log: as its
+        :meth:`~faultgen.data.adapters.Adapter.read`), naming the file, the column and the data row.
     """
     path = Path(path)
-    src = logblocks.source(path, robot.n_axes)
+    fmt = adapters.MEASURED if adapter is None else adapter
+    src = fmt.source(path, robot)
     if src.rows <= rows:
-        data = measured.read(path, robot)
+        data = fmt.read(path, robot)
         return data, motion(data.qd, rest_speed)
-    first = logblocks.scan(src, robot)
+    first = logblocks.scan(src, robot, size=BLOCK_ROWS)
     t, kept, kept_rows = first.t, first.kept, first.kept_rows
     n = len(t)
     if n <= rows:  # fewer rows than lines (blank lines): read whole, as a short log
-        data = measured.read(path, robot)
+        data = fmt.read(path, robot)
         return data, motion(data.qd, rest_speed)
     label = src.label
     notes = [f"ignored extra columns: {', '.join(src.extra)}"] if src.extra else []
+    notes.extend(src.notes)  # what an adapter chose: first, as its whole read has them
     dt, period = measured.check_time(t, path, label, notes)
     index = {name: j for j, name in enumerate(src.wanted)}
     q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
@@ -92,7 +111,7 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float) ->
     m = n // k
     inner = measured.velocity_rows(n, window)
     sums = _Sums(robot.n_axes, rest_speed, inner.start or 0, inner.stop if inner.stop is not None else n)
-    out = logblocks.averaged(src, robot.n_axes, period, window, uniform, k, m, sums.add)
+    out = logblocks.averaged(src, robot.n_axes, period, window, uniform, k, m, sums.add, BLOCK_ROWS)
     estimated = qd_names[0] not in index
     if estimated:
         notes.append(f"qd and qdd estimated from q: {filt}")

@@ -17,6 +17,15 @@ Two passes over the file, :data:`BLOCK_ROWS` rows at a time:
    over ``k`` consecutive rows (:func:`block_mean`) as it goes: the calibration; or
 2. :func:`thinned`: every ``k``-th row kept, the rest dropped as it goes: a replay, whose reference
    is sampled at the physics step and must pass through the log's own samples.
+
+The passes read a *block source*: ``path``; ``wanted``, the measured format's columns read (the
+order of a block's columns); ``extra``, the file's columns ignored; ``notes``, what the reading
+chose; ``rows``, an upper bound of the data rows, known before they are parsed; ``label``, data
+row index -> its name in messages; and ``blocks(size)``, yielding ``(start, block)``: the index of
+the block's first data row and a float array of shape (size, len(wanted)) (the last block shorter),
+every cell refused unless finite (a :class:`~faultgen.operation.jointlog.LogError` naming the file,
+the data row and the column). :func:`source` gives the measured format's (:class:`Csv`,
+:class:`Hdf5`); every log format has one (:meth:`faultgen.data.adapters.Adapter.source`).
 """
 
 from __future__ import annotations
@@ -57,6 +66,7 @@ class Csv:
     ``rows`` an upper bound of its data rows (blank lines count)."""
 
     label = staticmethod(jointlog.csv_label)
+    notes: tuple[str, ...] = ()
 
     def __init__(self, path: Path, n_axes: int, motion_only: bool = False):
         self.path = path
@@ -128,6 +138,7 @@ class Hdf5:
     whole-file reader then names the dataset at fault)."""
 
     label = staticmethod(jointlog.index_label)
+    notes: tuple[str, ...] = ()
 
     def __init__(self, path: Path, n_axes: int, motion_only: bool = False):
         self.path = path
@@ -268,10 +279,12 @@ def thinned(src, k: int, size: int | None = None) -> dict[str, np.ndarray]:
     return {name: np.ascontiguousarray(values[:, j]) for j, name in enumerate(src.wanted)}
 
 
-def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None) -> dict:
-    """The second pass over ``src`` (module docstring): ``t``, ``q``, ``qd``, ``qdd`` (and ``tau``
-    when read) averaged over blocks of ``k`` rows, ``m`` rows each; ``qd`` is the file's when it has
-    ``qd`` columns. ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
+def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int, m: int, on_block=None,
+             size: int | None = None) -> dict:
+    """The second pass over ``src`` (module docstring) in blocks of about ``size`` rows (default
+    :data:`BLOCK_ROWS`): ``t``, ``q``, ``qd``, ``qdd`` (and ``tau`` when read) averaged over blocks
+    of ``k`` rows, ``m`` rows each; ``qd`` is the file's when it has ``qd`` columns.
+    ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
     index = {name: j for j, name in enumerate(src.wanted)}
     q_names, qd_names, tau_names = jointlog.column_names(n_axes)
     cols = {"t": [index[jointlog.T_COLUMN]], "q": [index[c] for c in q_names]}
@@ -280,7 +293,7 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
     qd_cols = [index[c] for c in qd_names] if qd_names[0] in index else None
     margin = window if uniform else max(window, 200)
     out = {name: [] for name in ("t", "q", "qd", "qdd", *(["tau"] if "tau" in cols else []))}
-    size = k * math.ceil(BLOCK_ROWS / k)  # blocks start on a whole averaging block
+    size = k * math.ceil((size or BLOCK_ROWS) / k)  # blocks start on a whole averaging block
     left = np.empty((0, len(src.wanted)))
     pending = None
 

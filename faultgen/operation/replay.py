@@ -35,8 +35,8 @@ it streams by and then replayed as every ``k``-th row from the first, at most on
 (what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
 recorded at that rate (the reference passes through its own samples, time 0 is its first).
 A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``; issue 57) is
-parsed by its adapter, whole, and its columns replayed by :func:`from_columns` with the same checks
-and messages.
+streamed the same way through its adapter's block reader; read whole (at most a row per physics
+step), its columns are replayed by :func:`from_columns` with the same checks and messages.
 
 Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
@@ -210,8 +210,10 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
 def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
          check_torque: Callable, adapter=None) -> Replay:
     """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
-    (:mod:`faultgen.operation.jointlog`, no torque columns), streamed (:mod:`faultgen.operation.logblocks`),
-    or, with ``adapter``, by that log format's reader (:func:`from_columns`).
+    (:mod:`faultgen.operation.jointlog`, no torque columns) or, with ``adapter``, by that log
+    format's readers, streamed (:mod:`faultgen.operation.logblocks`) through the format's block
+    source either way; a log of at most a row per physics step then read whole (an adapter's by
+    its ``columns``, checked by :func:`from_columns`).
 
     Parameters
     ----------
@@ -227,8 +229,10 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         ``check_torque(robot, path, segment_at, fail)`` refusing a reference above the drives'
         capacity: :func:`faultgen.operation.programs.check_torque`.
     adapter : faultgen.data.adapters.Adapter, optional
-        The log's format other than the measured one: its ``columns(path, robot)`` parses the file
-        into the measured format's columns (``t``, ``q1..qN`` used), which :func:`from_columns` checks.
+        The log's format other than the measured one: ``source(path, robot, motion_only=True)``
+        gives its blocks of the measured format's columns (``t``, ``q1..qN`` used; the block source
+        of :mod:`faultgen.operation.logblocks`), ``columns(path, robot)`` the whole file's, which
+        :func:`from_columns` checks.
 
     Raises
     ------
@@ -239,15 +243,16 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         With ``adapter``, what its reader refuses too (a ValueError naming the file).
     """
     path = Path(path)
-    if adapter is not None:
-        columns, label = adapter.columns(path, robot)[:2]
-        return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
     n_axes = robot.n_axes
-    src = logblocks.source(path, n_axes, motion_only=True)
+    src = (logblocks.source(path, n_axes, motion_only=True) if adapter is None
+           else adapter.source(path, robot, motion_only=True))
     times = logblocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
     scan = logblocks.scan(src, robot, times, BLOCK_ROWS)
     rows = times.rows
     most = _most_rows(times, robot)  # a row per physics step
+    if rows <= most and adapter is not None:  # read whole by the format's reader, as the calibration reads it
+        columns, label = adapter.columns(path, robot)[:2]
+        return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
     if rows <= most:  # read whole, as the calibration reads a log
         columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
     else:  # denser than the physics step: every k-th row kept while read, once every row is checked
@@ -256,7 +261,8 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
         k = -(-rows // most)
         columns, label = logblocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
-    return _replay(columns, label, path, robot, limits, check_torque, jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES)
+    suffixes = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if adapter is None else adapter.suffixes
+    return _replay(columns, label, path, robot, limits, check_torque, suffixes)
 
 
 def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], path: str | Path, robot: Robot,
