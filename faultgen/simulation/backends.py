@@ -5,7 +5,8 @@ A backend makes the ``runs`` of a batch (:meth:`Backend.new`); the stepping loop
 use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s interface faultgen needs:
 
 - ``bind(name)``: an MjData field of every run, ``(n, ...)``; state fields (``qpos``, ``qvel``,
-  ``act``, ``ctrl``, ``qfrc_applied``) are written through, the others are read after a call;
+  ``act``, ``ctrl``, ``qfrc_applied``) are written through, the others are read after a call
+  (``mujoco.batch`` fills the fields bound before the call);
 - ``expand(name)``: a model field given per-run values, ``(n, ...)``, written through;
 - ``step()``: one physics step (``mj_step``) of every run;
 - ``rollout(nstep, control, control_spec, record, out)``: ``nstep`` steps, setting the state

@@ -13,7 +13,7 @@ import numpy as np
 
 from faultgen.model import robots
 from faultgen.operation.conditions import CycleConditions
-from faultgen.simulation import backends
+from faultgen.simulation import backends, friction_update
 from faultgen.simulation.signals import TRUE_SIGNALS
 
 #: Logging periods handed to MuJoCo per ``rollout`` call of the backend (1 s of simulated time): long
@@ -172,6 +172,8 @@ def step(sim, work: Work, bar) -> Raw:
     runs = new_runs(sim, work)
     schedule = friction.schedule(sim, work)
     if schedule is not None and schedule.reads_start_state:
+        for name in friction_update.KINEMATICS:  # bound before the call that fills them
+            runs.bind(name)
         runs.forward()  # the start state's kinematics, for the first step's load-dependent friction
     applies = backends.get(work.backend).applies_friction_update
     in_rollout = schedule is None or (schedule.in_arrays and applies)
