@@ -164,13 +164,19 @@ class Schedule:
             terms.append((np.broadcast_to(inner, (nsim, n)), np.broadcast_to(outer, (nsim, n)),
                           np.zeros(n, bool)))
         f = robot.friction
+
+        def stacked(i: int) -> np.ndarray:  # part i of every term, (nsim, T, N)
+            return np.stack([t[i] for t in terms], axis=1) if terms else np.zeros((nsim, 0, n))
+
+        #: The update's arrays but the chunk's ``level``.
         self.base = FrictionUpdate(
-            robot.rotor_dof, robot.rotor_qpos, robot.arm_qpos, f.coulomb_pos, f.coulomb_neg, f.static,
-            f.stribeck_velocity, f.stribeck_exponent, np.broadcast_to(self.dry[:, None], (nsim, 0, n)),
-            robot.gear_ratio, robot.gearbox_stiffness,
-            np.stack([t[0] for t in terms], axis=1) if terms else np.zeros((nsim, 0, n)),
-            np.stack([t[1] for t in terms], axis=1) if terms else np.zeros((nsim, 0, n)),
-            np.array([t[2] for t in terms], dtype=bool).reshape(len(terms), n), robot.static_terms)
+            rotor_dof=robot.rotor_dof, rotor_qpos=robot.rotor_qpos, arm_qpos=robot.arm_qpos,
+            coulomb_pos=f.coulomb_pos, coulomb_neg=f.coulomb_neg, static_friction=f.static,
+            stribeck_velocity=f.stribeck_velocity, stribeck_exponent=f.stribeck_exponent,
+            level=np.zeros((nsim, 0, n)), gear_ratio=robot.gear_ratio, stiffness=robot.gearbox_stiffness,
+            load_inner=stacked(0), load_outer=stacked(1),
+            load_static=np.array([t[2] for t in terms], dtype=bool).reshape(len(terms), n),
+            static_terms=robot.static_terms)
 
     @property
     def in_arrays(self) -> bool:
