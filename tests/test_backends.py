@@ -21,9 +21,8 @@ from tqdm.auto import tqdm
 from faultgen.data import dataset
 from faultgen.effects import friction
 from faultgen.model import robots
-from faultgen.simulation import friction_models
 from faultgen.operation.wear import WearPlan
-from faultgen.simulation import backends, batch, prepare, results, signals
+from faultgen.simulation import backends, batch, friction_models, prepare, results, signals
 from faultgen.simulation import stepping as sim
 
 PERIODS = 12  # log periods stepped (48 ms): a few seconds for the whole file
