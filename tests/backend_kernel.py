@@ -38,7 +38,9 @@ def friction_loss(u, k: int, qvel: np.ndarray, qpos: np.ndarray, subtree_com, xa
 
 
 class KernelRuns:
-    """``mujoco.batch.Batch``'s runs with a ``rollout`` that takes a friction ``update``."""
+    """``mujoco.batch.Batch``'s runs with a ``rollout`` that takes a friction ``update`` (stepping
+    every run one step at a time from Python: a run whose warnings rise is not stopped, as the
+    tests' runs do not diverge)."""
 
     def __init__(self, model, nsim: int, nthread: int) -> None:
         self.batch = mjbatch.Batch(model, nsim=nsim, nthread=nthread)
