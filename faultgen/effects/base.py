@@ -447,6 +447,14 @@ class Effect:
         called), N m, shape (r, N); None: none. Only for a :attr:`stepped` effect."""
         return None
 
+    def dry_friction_load_terms(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """:meth:`dry_friction_extra` as arrays a stepping backend can hold, for an extra of the form
+        ``coefficient * |load| / G``: per axis the ``coefficient`` (N,) and whether the load is the
+        static one (True) or the transmitted one ``K deflection`` (False), (N,) bool. None (the
+        default): not of that form, so a run with the effect sets the rotors' friction level from
+        Python before every step (docs/architecture.md, "Stepping backends")."""
+        return None
+
     # -- identification ------------------------------------------------------------------
 
     def grid(self, motion: Motion, axis: int) -> list:

@@ -66,6 +66,9 @@ class LoadDependentFriction(Effect):
             load = np.where(self.gravity_load == 1, static_load(), load)
         return self.coefficient * np.abs(load) / robot.gear_ratio
 
+    def dry_friction_load_terms(self):
+        return self.coefficient, self.gravity_load == 1
+
     def grid(self, motion, axis):
         return list(FORMS)
 

@@ -341,14 +341,10 @@ class Robot:
         xanchor, xaxis : ndarray of shape (r, njnt, 3)
         qpos : ndarray of shape (r, nq)
         """
-        joints, bodies, mass, gravity, stiffness, rest = self._static_terms
-        lever = subtree_com[:, bodies] - xanchor[:, joints]  # (r, N, 3), m
-        # -a . ((c - p) x m g) = m a^T [g]x (c - p), [g]x v = g x v: a product, not a cross product
-        moment = np.sum((xaxis[:, joints] @ gravity) * lever, axis=-1)
-        return mass * moment + stiffness * (qpos[:, self.arm_qpos] - rest)
+        return static_load_from(self.static_terms, subtree_com, xanchor, xaxis, qpos[:, self.arm_qpos])
 
     @cached_property
-    def _static_terms(self) -> tuple:
+    def static_terms(self) -> tuple:
         """Arm joint ids, the bodies they carry, those subtrees' masses (kg), the gravity's cross-
         product matrix ``[g]x`` (3, 3), the joints' spring stiffness and rest angles."""
         model = self.model
@@ -584,3 +580,13 @@ def _gear_ratio(model: mujoco.MjModel, path: Path, tendon: int, joint: int, roto
         )
     return 1.0 / wraps[rotor]
 
+
+def static_load_from(terms: tuple, subtree_com: np.ndarray, xanchor: np.ndarray, xaxis: np.ndarray,
+                     arm_angles: np.ndarray) -> np.ndarray:
+    """:meth:`Robot.static_load_of` from its constant ``terms`` (:attr:`Robot.static_terms`, arrays a
+    stepping backend can hold) and the arm angles ``arm_angles`` (r, N) rad, N m, (r, N)."""
+    joints, bodies, mass, gravity, stiffness, rest = terms
+    lever = subtree_com[:, bodies] - xanchor[:, joints]  # (r, N, 3), m
+    # -a . ((c - p) x m g) = m a^T [g]x (c - p), [g]x v = g x v: a product, not a cross product
+    moment = np.sum((xaxis[:, joints] @ gravity) * lever, axis=-1)
+    return mass * moment + stiffness * (arm_angles - rest)

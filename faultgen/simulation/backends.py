@@ -5,14 +5,20 @@ A backend makes the ``runs`` of a batch (:meth:`Backend.new`); the stepping loop
 use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s interface faultgen needs:
 
 - ``bind(name)``: an MjData field of every run, ``(n, ...)``; state fields (``qpos``, ``qvel``,
-  ``act``, ``ctrl``, ``qfrc_applied``) are written through, the others are read after a call;
+  ``act``, ``ctrl``, ``qfrc_applied``) are written through, the others are read after a call
+  (``mujoco.batch`` fills the fields bound before the call);
 - ``expand(name)``: a model field given per-run values, ``(n, ...)``, written through;
 - ``step()``: one physics step (``mj_step``) of every run;
 - ``rollout(nstep, control, control_spec, record, out)``: ``nstep`` steps, setting the state
   components of ``control_spec`` from ``control`` ``(n, nstep, size)`` before each and recording
   the MjData fields ``record`` after each into ``out[name]`` ``(n, nstep, ...)``; a run whose
-  warning counters rise stops stepping and repeats its last records;
-- ``forward()``, ``set_const()``: ``mj_forward`` / ``mj_setConst`` of every run;
+  warning counters rise stops stepping and repeats its last records. A backend with
+  :attr:`Backend.applies_friction_update` also takes ``update``, a
+  :class:`faultgen.simulation.friction_update.FrictionUpdate` of the ``nstep`` steps, and writes its
+  friction loss (:func:`faultgen.simulation.friction_update.apply`) before each step, before the
+  controls;
+- ``forward()``: ``mj_forward`` of every run; ``set_const()``: ``mj_setConst`` of every run, keeping
+  its MjData (its state and the last step's kinematics);
 - ``warning``: each run's warning counters, ``(n, mjNWARNING, 2)``.
 
 :data:`BACKENDS` by name (:func:`register` adds one): ``batch`` (``mujoco.batch.Batch``: C threads,
@@ -29,6 +35,8 @@ from typing import Protocol
 import mujoco
 import numpy as np
 from mujoco import batch as mjbatch
+
+from faultgen.simulation import friction_update
 
 #: MjData fields a caller writes (inputs and state); the others are outputs of a call.
 STATE_FIELDS = ("qpos", "qvel", "act", "ctrl", "qfrc_applied", "qacc_warmstart")
@@ -52,7 +60,7 @@ class Runs(Protocol):
     def set_const(self) -> None: ...
 
     def rollout(self, nstep: int, control: np.ndarray, control_spec: int, record: tuple,
-                out: dict) -> dict: ...
+                out: dict, update=None) -> dict: ...
 
 
 class Backend:
@@ -60,6 +68,10 @@ class Backend:
 
     #: The backend's name (:data:`BACKENDS`).
     name: str
+    #: Whether its runs' ``rollout`` takes a friction ``update`` and applies it before every step
+    #: (the static friction model's level); False: the stepping loop steps such a run one step at a
+    #: time, applying the update from Python before each (:func:`faultgen.simulation.batch.step`).
+    applies_friction_update: bool = False
 
     def new(self, model: mujoco.MjModel, nsim: int, nthread: int) -> Runs:
         """``nsim`` simulations of ``model`` at its default state, on ``nthread`` threads where
@@ -84,6 +96,7 @@ class LoopBackend(Backend):
     thread, slow: for checking the other backends, not for runs)."""
 
     name = "loop"
+    applies_friction_update = True
 
     def new(self, model, nsim, nthread):
         return LoopRuns(model, nsim)
@@ -139,19 +152,26 @@ class LoopRuns:
     def set_const(self) -> None:
         self._each(_set_const)
 
-    def rollout(self, nstep, control, control_spec, record, out):
+    def rollout(self, nstep, control, control_spec, record, out, update=None):
         inputs, at = [], 0
         for bit, name in _CONTROL_ORDER:
             if control_spec & bit:
                 size = getattr(self.datas[0], name).size
                 inputs.append((name, at, size))
                 at += size
+        if update is not None:
+            frictionloss = self.expand("dof_frictionloss")
         for i, (model, data) in enumerate(zip(self.models, self.datas)):
             self._put(i)
             warned = sum(w.number for w in data.warning)
             stopped = False
+            world = None if update is None else update.take([i])
             for k in range(nstep):
                 if not stopped:
+                    if world is not None:  # the friction loss from the run's state, before the controls
+                        kinematics = tuple(getattr(data, f)[None] for f in friction_update.KINEMATICS)
+                        model.dof_frictionloss[world.rotor_dof] = friction_update.apply(
+                            world, k, data.qvel[None], data.qpos[None], kinematics)[0]
                     for name, start, size in inputs:
                         getattr(data, name)[:] = control[i, k, start:start + size]
                     mujoco.mj_step(model, data)
@@ -159,16 +179,18 @@ class LoopRuns:
                 for name in record:
                     out[name][i, k] = getattr(data, name)
             self._get(i)
+            if update is not None:
+                frictionloss[i] = model.dof_frictionloss
         return out
 
 
 def _set_const(model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """``mj_setConst``, keeping the run's state (it poses ``data`` at ``qpos0`` to compute)."""
-    spec = mujoco.mjtState.mjSTATE_INTEGRATION
-    state = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state, spec)
+    """``mj_setConst``, keeping the run's data (it poses ``data`` at ``qpos0`` to compute): its
+    state and the last step's kinematics, as ``mujoco.batch.Batch.set_const`` does."""
+    kept = mujoco.MjData(model)
+    mujoco.mj_copyData(kept, model, data)
     mujoco.mj_setConst(model, data)
-    mujoco.mj_setState(model, data, state, spec)
+    mujoco.mj_copyData(data, model, kept)
 
 
 #: The stepping backends by name (:func:`register` adds one).

@@ -13,7 +13,7 @@ import numpy as np
 
 from faultgen.model import robots
 from faultgen.operation.conditions import CycleConditions
-from faultgen.simulation import backends
+from faultgen.simulation import backends, friction_update
 from faultgen.simulation.signals import TRUE_SIGNALS
 
 #: Logging periods handed to MuJoCo per ``rollout`` call of the backend (1 s of simulated time): long
@@ -159,15 +159,24 @@ def step(sim, work: Work, bar) -> Raw:
     """Step the cycles of ``work`` on ``sim`` and return the true signals at the log times.
 
     The set-points and disturbances are handed over a chunk (:data:`CHUNK_PERIODS` log periods)
-    at a time, and chunks also break where a program grips or releases a payload. A friction model
-    that sets its level from Python (``per_step``) steps each chunk one step at a time; the others
-    hand it to the backend's ``rollout``. ``bar`` (tqdm) advances by the simulated seconds.
+    at a time to the backend's ``rollout``, and chunks also break where a program grips or releases
+    a payload. A friction model whose level is set before every step (``per_step``) hands its update
+    for the chunk (:class:`faultgen.simulation.friction_update.FrictionUpdate`) to ``rollout`` too
+    when the backend applies it (``applies_friction_update``); otherwise (and for a plug-in effect
+    whose extra friction is not in the update's arrays) each chunk is stepped one step at a time with
+    the update applied from Python before each. ``bar`` (tqdm) advances by the simulated seconds.
     """
     robot, model, friction = sim.robot, sim.model, sim.stepping
     cycles, inputs, dist, per_log = work.cycles, work.inputs, work.dist, work.per_log
     viscous = robot.friction.viscous * work.plant.viscous[:, None, :]
     runs = new_runs(sim, work)
-    set_level = friction.before_step(sim, work, runs)
+    schedule = friction.schedule(sim, work)
+    if schedule is not None and schedule.reads_start_state:
+        for name in friction_update.KINEMATICS:  # bound before the call that fills them
+            runs.bind(name)
+        runs.forward()  # the start state's kinematics, for the first step's load-dependent friction
+    applies = backends.get(work.backend).applies_friction_update
+    in_rollout = schedule is None or (schedule.in_arrays and applies)
     n_sim, n_steps = len(cycles), len(inputs) - 1
     chunk = min(CHUNK_PERIODS * per_log, n_steps)
     # buffers reused by every chunk: rollout inputs and per-substep records
@@ -182,13 +191,15 @@ def step(sim, work: Work, bar) -> Raw:
     for start, stop in zip(starts, [*starts[1:], n_steps]):
         size = stop - start
         out = records if size == chunk else {k: np.empty((n_sim, size, v.shape[2])) for k, v in records.items()}
-        if set_level is None:
+        update = None if schedule is None else schedule.chunk(start, stop)
+        if in_rollout:
             apply_grips(runs, work.grips, start)
             control_in[:, :size, : model.nu][:, :, sim.drive_ctrl] = inputs[start:stop]
             control_in[:, :size, arm_dist] = np.repeat(dist[:, start // per_log : stop // per_log], per_log, axis=1)
-            runs.rollout(size, control=control_in[:, :size], control_spec=CONTROL_SPEC, record=tuple(out), out=out)
+            runs.rollout(size, control=control_in[:, :size], control_spec=CONTROL_SPEC, record=tuple(out), out=out,
+                         **({} if update is None else {"update": update}))
         else:
-            _step_each(sim, work, runs, set_level, start, stop, out)
+            _step_each(sim, work, runs, schedule.setter(runs, update), start, stop, out)
         check_diverged(sim, runs, cycles, out["qvel"], start)
         logged = slice(start // per_log, stop // per_log)
         qpos, qvel, force = (out[k][:, per_log - 1 :: per_log] for k in ("qpos", "qvel", "actuator_force"))
@@ -209,13 +220,14 @@ def step(sim, work: Work, bar) -> Raw:
 
 
 def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dict) -> None:
-    """Steps ``start`` to ``stop`` one at a time, the friction level set before each, recorded into
-    ``out`` (the friction level first, then a grip, the set-points and the disturbance)."""
+    """Steps ``start`` to ``stop`` one at a time, the friction level set before each (``set_level(k)``,
+    ``k`` from 0 at ``start``), recorded into ``out`` (the friction level first, then a grip, the
+    set-points and the disturbance)."""
     robot, per_log = sim.robot, work.per_log
     ctrl, applied = runs.bind("ctrl"), runs.bind("qfrc_applied")
     bound = {name: runs.bind(name) for name in out}
     for k, at in enumerate(range(start, stop)):
-        set_level(at)
+        set_level(k)
         if work.grips:
             apply_grips(runs, work.grips, at)
         ctrl[:, sim.drive_ctrl] = work.inputs[at]

@@ -5,9 +5,12 @@ friction into the MuJoCo model (:data:`MODELS`, by the name ``RunConfig.friction
 
 ``lugre``: everything that runs at the physics rate (the PID drives, LuGre friction, the
 gearboxes) runs inside MuJoCo, and Python only hands over pre-computed set-points and disturbance
-torques a chunk at a time (``rollout``). ``stribeck``: the static model needs its friction level set
-before every physics step from the rotor speed (:meth:`FrictionModel.before_step`), so it is stepped
-one step at a time from Python and is slower (docs/performance.md gives both figures).
+torques a chunk at a time (``rollout``). ``stribeck``: the static model's friction level is set
+before every physics step from the rotor speed; that update is data
+(:class:`faultgen.simulation.friction_update.FrictionUpdate`, made chunk by chunk by
+:meth:`FrictionModel.schedule`), handed over a chunk at a time like the set-points to a backend
+that applies it itself, and applied one step at a time from Python on the others
+(docs/performance.md gives both models' speed).
 """
 
 from __future__ import annotations
@@ -16,9 +19,8 @@ import mujoco
 import numpy as np
 
 from faultgen.effects import friction
-from faultgen.effects.base import Effect
-from faultgen.effects.load_dependent_friction import LoadDependentFriction
 from faultgen.model import robots
+from faultgen.simulation.friction_update import Schedule
 
 
 def stepped_effects(robot: robots.Robot) -> list:
@@ -26,26 +28,16 @@ def stepped_effects(robot: robots.Robot) -> list:
     return [e for e in robot.effects.values() if e.stepped and np.any(e.active())]
 
 
-class _PerSimulation:
-    """A stepped effect linear in its coefficient, with a coefficient per simulation (r, N): the
-    effect at coefficient 1 times it (a growing load-dependent friction fault in the gear loss)."""
-
-    def __init__(self, unit: Effect, coefficient: np.ndarray) -> None:
-        self.unit, self.coefficient = unit, coefficient
-
-    def dry_friction_extra(self, robot, deflection, static_load):
-        return self.coefficient * self.unit.dry_friction_extra(robot, deflection, static_load)
-
-
 class FrictionModel:
     """A friction model of the simulation. Subclasses say how it enters the MJCF, which actuators
     carry it, how each run's dry and viscous friction are scaled, what sets its level before every
-    step (a model with :attr:`per_step`) and where the logged friction torque is read."""
+    step (a model with :attr:`per_step`: its :meth:`schedule`) and where the logged friction torque
+    is read."""
 
     #: The model's name (:data:`faultgen.effects.friction.MODELS`).
     name: str
-    #: Whether Python sets the friction level before every physics step (what friction growing
-    #: with the load, the unit's gear loss, needs).
+    #: Whether the friction level is set before every physics step (what friction growing with
+    #: the load, the unit's gear loss, needs): by the update :meth:`schedule` makes.
     per_step: bool
     #: The MjData field the friction torque is read from after a step (:meth:`friction_torque`).
     force_field: str
@@ -64,11 +56,12 @@ class FrictionModel:
 
     def scale_dry(self, sim, runs, dry: np.ndarray) -> None:
         """Multiply each run's dry (Coulomb and static) friction by ``dry`` (n_sim, N), once before
-        stepping (a :attr:`per_step` model scales it in :meth:`before_step` instead)."""
+        stepping (a :attr:`per_step` model scales it in its :meth:`schedule` instead)."""
 
-    def before_step(self, sim, work, runs):
-        """For a :attr:`per_step` model, ``set_level(step)``, called before every physics step
-        (``None``: the level stays what the model holds)."""
+    def schedule(self, sim, work) -> Schedule | None:
+        """For a :attr:`per_step` model, the friction updates of the batch ``work``
+        (:class:`faultgen.simulation.batch.Work`) chunk by chunk; None: the level stays what the
+        model holds."""
 
     def friction_torque(self, sim, force: np.ndarray, v_m: np.ndarray, viscous: np.ndarray) -> np.ndarray:
         """The motor-side friction torque, N m, positive opposing positive motion, ``(..., N)``,
@@ -114,7 +107,7 @@ class LuGre(FrictionModel):
 
 
 class Stribeck(FrictionModel):
-    """Static friction (thesis eq. 6.3) as the rotors' friction loss, set from Python every step."""
+    """Static friction (thesis eq. 6.3) as the rotors' friction loss, set before every step."""
 
     name = "stribeck"
     per_step = True
@@ -126,39 +119,10 @@ class Stribeck(FrictionModel):
     def scale_viscous(self, sim, runs, factor):
         runs.expand("dof_damping")[:, sim.robot.rotor_dof] *= factor
 
-    def before_step(self, sim, work, runs):
+    def schedule(self, sim, work):
         """The friction-loss level from the rotor speed (eq. 6.3), scaled by the stepped effects and
         added to by those that grow with the load (the unit's gear loss among them)."""
-        robot, dt = sim.robot, sim.model.opt.timestep
-        dry, n_steps = work.plant.dry, len(work.inputs) - 1
-        frictionloss, qvel, qpos = runs.expand("dof_frictionloss"), runs.bind("qvel"), runs.bind("qpos")
-        rotor, G = robot.rotor_dof, robot.gear_ratio
-        run_start = (work.cycles[:, None] - 1) * n_steps * dt  # a drift with time runs over the whole run
-        # the stepped effects that scale the dry friction and those that add to it, sorted once
-        factors = [e for e in stepped_effects(robot) if type(e).dry_friction_factor is not Effect.dry_friction_factor]
-        extras = [e for e in stepped_effects(robot) if type(e).dry_friction_extra is not Effect.dry_friction_extra]
-        gear_loss = work.plant.gear_loss
-        if np.any(gear_loss):  # the unit's gearbox loss: the same effect, on top of the model's
-            extras.append(LoadDependentFriction(coefficient=gear_loss) if np.ndim(gear_loss) == 1 else
-                          _PerSimulation(LoadDependentFriction(coefficient=np.ones(robot.n_axes)), gear_loss))
-        if extras:  # the static load from the last step's kinematics, for those that ask for it
-            kinematics = [runs.bind(name) for name in ("subtree_com", "xanchor", "xaxis")]
-            runs.forward()  # the start state's, for the first step
-
-            def static_load() -> np.ndarray:
-                return robot.static_load_of(*kinematics, qpos)
-
-        def set_level(step: int) -> None:
-            level = dry
-            for effect in factors:
-                level = level * effect.dry_friction_factor(run_start + step * dt)
-            frictionloss[:, rotor] = robot.friction.stribeck_level(qvel[:, rotor], level)
-            if extras:  # the gearbox deflection (eq. 6.2a) carries the load
-                deflection = qpos[:, robot.rotor_qpos] / G - qpos[:, robot.arm_qpos]
-                for effect in extras:
-                    frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
-
-        return set_level
+        return Schedule(sim, work, stepped_effects(sim.robot))
 
     def friction_torque(self, sim, force, v_m, viscous):
         # the friction loss acts as a constraint force on the rotor, plus the viscous term
