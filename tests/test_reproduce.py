@@ -13,8 +13,8 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
+from faultgen.data.dataset import combine
 from faultgen.reproduce import plan, report, runner, tables, thesis
-from faultgen.reproduce.datasets import combine
 from faultgen.reproduce.runner import Step, StepFailed
 
 cli = CliRunner()

@@ -1,51 +1,14 @@
-"""Data shared between tables: two sweeps of the same grid with other seeds combined into one
-dataset (so that j2's seed-0 runs serve both Table 6.2 and the three-seed detection study), and
-thesis Table 6.1 read off j2's last cycle instead of simulated again."""
+"""Data shared between tables: thesis Table 6.1 read off j2's last cycle instead of simulated again.
+(Two sweeps of one grid with other seeds are combined into one dataset by
+:func:`faultgen.data.dataset.combine`, so that j2's seed-0 runs serve both Table 6.2 and the
+three-seed detection study.)"""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-
-
-def combine(files: Sequence[str | Path], out: str | Path) -> Path:
-    """Copy the runs of ``files`` (faultgen datasets) into one new dataset ``out``, atomically.
-
-    The root attributes are those of the first file, with ``n_runs`` and ``command`` updated; run
-    groups are copied as stored. Raises ValueError if a run id appears in two files or a file is
-    not a complete faultgen dataset (validation names the problem).
-    """
-    import h5py
-
-    from faultgen.data import atomic, dataset
-
-    files = [Path(f) for f in files]
-    for path in files:
-        problems = dataset.validate(path)
-        if problems:
-            raise ValueError(f"{path} fails validation (run `faultgen validate {path}`): {problems[0]}")
-    seen: dict[str, Path] = {}
-    for path in files:
-        for run_id in dataset.list_runs(path):
-            if run_id in seen:
-                raise ValueError(f"run {run_id!r} is in both {seen[run_id]} and {path}; combine datasets of other seeds")
-            seen[run_id] = path
-    out = Path(out)
-    with atomic.hdf5_writer(out) as dst:
-        with h5py.File(files[0], "r") as first:
-            for key, value in first.attrs.items():
-                dst.attrs[key] = value
-        dst.attrs["n_runs"] = len(seen)
-        dst.attrs["command"] = "combined by faultgen reproduce from " + ", ".join(f.name for f in files)
-        runs = dst.create_group("runs")
-        for path in files:
-            with h5py.File(path, "r") as src:
-                for run_id in src["runs"]:
-                    src.copy(src["runs"][run_id], runs, name=run_id)
-    return out
 
 
 def last_cycle_torque(path: str | Path) -> pd.DataFrame:

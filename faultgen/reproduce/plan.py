@@ -132,9 +132,10 @@ def _write(path: Path, text: str) -> None:
 
 
 def _combine_j2s3(folder: Path) -> None:
-    from faultgen.reproduce.datasets import combine
+    from faultgen.data.dataset import combine
 
-    combine([folder / "j2.h5", folder / "j2s12.h5"], folder / "j2s3.h5")
+    combine([folder / "j2.h5", folder / "j2s12.h5"], folder / "j2s3.h5",
+            command="combined by faultgen reproduce from j2.h5, j2s12.h5")
 
 
 def _table_6_1(folder: Path) -> None:
