@@ -127,8 +127,9 @@ ALLOWED = {
     "faultgen/simulation/config.py": (2, ("public API: RunConfig(robot=name), once on construction; "
                                           "a worker: a RunConfig unpickled (its robot sent as the name)")),
     "faultgen/monitor/loop.py": (1, "public API: monitor(), the library entry, once per run"),
-    "faultgen/monitor/feed.py": (2, ("a worker (loky, Dask) without the run's source: the robot and the "
-                                     "--calibrated model sent as paths (Context.new_source), once each")),
+    "faultgen/monitor/feed.py": (2, ("Context.new_source, the monitor's boundary in each process: for "
+                                     "monitor() (the library entry) the --calibrated model; for a worker "
+                                     "(loky, Dask) sent the run as paths, the robot and that model; once each")),
     "faultgen/monitor/remote.py": (1, "a Dask worker: the robot sent as a name, once (its error says what to install)"),
     "faultgen/monitor/unit.py": (1, ("state of an earlier run: a calibrated or twin model it cached in OUT/.cache "
                                      "(checked against its record), read once (cached_model)")),
