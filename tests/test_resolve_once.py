@@ -109,34 +109,39 @@ def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
     assert loads == [str(robot)]
 
 
+#: The boundaries a robot may be resolved at below the command line: the public API (a library
+#: entry documented to take a robot's name, folder or file), a worker (a process sent the robot as
+#: a name: a RunConfig unpickled, loky, Dask), or an earlier run's state (a dataset or a cache file
+#: it wrote, naming a robot).
+BOUNDARIES = ("public API", "worker", "an earlier run's state")
+
 #: The modules that call ``robots.load`` (besides the command line, ``faultgen/cli/``), how many
-#: times, and which boundary each is: the public API (a library entry documented to take a robot's
-#: name, folder or file), a worker (a process that was sent the robot as a name: unpickled, loky,
-#: Dask), or state from outside this process (a dataset or cache file an earlier run wrote, naming
-#: a robot). A model file faultgen writes is not loaded again by its path: its writer returns the
-#: Robot (``robots.write``; a folder staged and renamed into place: ``robots.moved``). A new caller
-#: fails this test: resolve at the boundary and pass the Robot instead, or add it here with the
-#: boundary it is. Before issue 57's last part (2026-11-26) the list also held calibrate/loop.py (1,
-#: the calibrated model just written), calibrate/refit.py (2, the calibrated model written and the
-#: nominal by its stored name), monitor/twin.py (1, a twin of a model file), model/folder.py (2,
-#: robots add loading the folder it wrote) and one more in monitor/unit.py and bench/independent.py.
+#: times, the boundary each is (:data:`BOUNDARIES`) and why. A model file faultgen writes is not
+#: loaded again by its path: its writer returns the Robot (``robots.write``; a folder staged and
+#: renamed into place: ``robots.moved``). A new caller fails this test: resolve at the boundary and
+#: pass the Robot instead, or add it here with its boundary and why. Before issue 57's last part
+#: (2026-11-26) the list also held calibrate/loop.py (1, the calibrated model just written),
+#: calibrate/refit.py (2, the calibrated model written; the nominal by the name its result stores),
+#: monitor/twin.py (1, a twin of a model file), model/folder.py (2, robots add loading the folder it
+#: wrote), and one more call each in monitor/unit.py and bench/independent.py.
 ALLOWED = {
-    "faultgen/calibrate/__init__.py": (1, "public API: calibrate() takes a name or a Robot, resolved once"),
-    "faultgen/data/fleetlogs.py": (1, "public API: import_logs() takes a name or a Robot, resolved once"),
-    "faultgen/runs/grid.py": (1, "public API: a Grid (sweep) names its robots; each resolved once for every run"),
-    "faultgen/simulation/config.py": (2, ("public API: RunConfig(robot=name), once on construction; "
-                                          "a worker: a RunConfig unpickled (its robot sent as the name)")),
-    "faultgen/monitor/loop.py": (1, "public API: monitor(), the library entry, once per run"),
-    "faultgen/monitor/feed.py": (2, ("Context.new_source, the monitor's boundary in each process: for "
-                                     "monitor() (the library entry) the --calibrated model; for a worker "
-                                     "(loky, Dask) sent the run as paths, the robot and that model; once each")),
-    "faultgen/monitor/remote.py": (1, "a Dask worker: the robot sent as a name, once (its error says what to install)"),
-    "faultgen/monitor/unit.py": (1, ("state of an earlier run: a calibrated or twin model it cached in OUT/.cache "
-                                     "(checked against its record), read once (cached_model)")),
-    "faultgen/data/robot_record.py": (1, ("state of an earlier run: a dataset written before drivetrains were "
-                                          "stored names its robot by its label only")),
-    "faultgen/bench/independent.py": (1, ("public API of the bench: write_fleet(), the independent simulator's "
-                                          "entry, takes a robot folder; once per fleet")),
+    "faultgen/calibrate/__init__.py": (1, "public API", "calibrate() takes a name or a Robot, resolved once"),
+    "faultgen/data/fleetlogs.py": (1, "public API", "import_logs() takes a name or a Robot, resolved once"),
+    "faultgen/runs/grid.py": (1, "public API", "a Grid (sweep) names its robots; each resolved once for every run"),
+    "faultgen/simulation/config.py": (2, "public API", ("RunConfig(robot=name), once on construction; and as a "
+                                                        "worker: a RunConfig unpickled (its robot sent as the name)")),
+    "faultgen/monitor/loop.py": (1, "public API", "monitor(), the library entry: the robot, once per run"),
+    "faultgen/monitor/feed.py": (2, "worker", ("Context.new_source, where each process's robots are resolved: for "
+                                               "monitor() the --calibrated model; for a worker (loky, Dask) sent the "
+                                               "run as paths, the robot and that model; once each")),
+    "faultgen/monitor/remote.py": (1, "worker", "a Dask worker: the robot sent as a name, once (saying what to install)"),
+    "faultgen/monitor/unit.py": (1, "an earlier run's state", ("a calibrated or twin model the monitor cached in "
+                                                               "OUT/.cache (checked against its record), read once "
+                                                               "(cached_model)")),
+    "faultgen/data/robot_record.py": (1, "an earlier run's state", ("a dataset written before drivetrains were "
+                                                                    "stored names its robot by its label only")),
+    "faultgen/bench/independent.py": (1, "public API", ("write_fleet(), the bench's independent simulator's entry, "
+                                                        "takes a robot folder; once per fleet")),
 }
 
 
@@ -151,7 +156,8 @@ def test_robots_load_is_called_only_where_it_may_be():
                  and isinstance(node.func.value, ast.Name) and node.func.value.id == "robots"]
         if calls:
             counts[where] = len(calls)
-    assert counts == {where: n for where, (n, _) in ALLOWED.items()}
+    assert counts == {where: n for where, (n, _, _) in ALLOWED.items()}
+    assert {kind for _, kind, _ in ALLOWED.values()} <= set(BOUNDARIES)
 
 
 # -- a model file faultgen writes: its writer returns the Robot (issue 57, item 1) ----------------
