@@ -55,13 +55,14 @@ def run(name: str) -> list[dict]:
         path, hidden = independent_set.make(case, folder)
         started = time.perf_counter()
         # both fits on the same rows: a long log averaged down as calibrate does (MAX_ROWS)
-        data = measured_io.read(path, robots.load(case.robot))
+        nominal = robots.load(case.robot)  # resolved once, for the calibration and the refit
+        data = measured_io.read(path, nominal)
         if len(data) > MAX_ROWS:
             data = decimate(data, MAX_ROWS)
         # faultgen's own fit on every effect: calibrate's sysid refinement of a Stribeck hump off
-        result = calibrate(case.robot, data, Path(folder) / "out", use_sysid=False)
+        result = calibrate(nominal, data, Path(folder) / "out", use_sysid=False)
         own = time.perf_counter() - started
-        refits, elapsed, gap = refit(result, data)
+        refits, elapsed, gap = refit(result, data, nominal)
     rows = []
     for r in refits:
         truth = _truth(hidden, r.effect, r.name, r.axis)

@@ -67,7 +67,7 @@ def write_fleet(root: Path, spec: ind.FleetSpec, robot: Path) -> tuple[Path, Pat
     G, jm, nominal = model.gear_ratio, model.motor_inertia, model.friction
     fc0, fs0, fv0 = (np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
     n = model.n_axes
-    t, q, qd, qdd = ind._motion(str(folder), spec.rate)
+    t, q, qd, qdd = ind._motion(model, spec.rate)
     logs = root / "logs"
     q_names, _, tau_names = columns.column_names(n)
     header = [columns.T_COLUMN, *q_names, *tau_names, *columns.temperature_columns(n), columns.PAYLOAD_COLUMN]
@@ -92,7 +92,7 @@ def write_fleet(root: Path, spec: ind.FleetSpec, robot: Path) -> tuple[Path, Pat
             fv = fv0 * unit["spread"][2] * jitter[2] * np.exp(-ind.VISCOUS_PER_K * (temperature - 20.0))
             w = G * qd
             friction = dry_friction(w, fc, fs, speed) + fv * w
-            tau = ind._rigid(str(folder), spec.rate, round(mass, 1)) + G**2 * jm * qdd + G * friction
+            tau = ind._rigid(model, spec.rate, round(mass, 1)) + G**2 * jm * qdd + G * friction
             tau = tau + rng.normal(0.0, 1.0, tau.shape) * ind.NOISE * np.sqrt(np.mean(tau**2, axis=0))
             angles = q + rng.normal(0.0, ind.ANGLE_NOISE, q.shape)
             ind._write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2),

@@ -10,6 +10,7 @@ import pytest
 
 import backend_example
 import independent_fleet
+from faultgen.model import robots
 from faultgen.monitor import loop
 from faultgen.monitor.scoring import Settings
 from faultgen.monitor.twin import Twin, base_cycles
@@ -97,9 +98,10 @@ def test_the_monitors_twins_step_on_the_backend_it_is_given_with_the_default_bac
     assert runs == len(list(cycles.glob("*.json"))) > len(base_cycles(6))  # every twin cycle, payloads' too
     # the cycles the monitor keeps (the first unit's twin replays its first log) against the default backend's
     program = sorted((logs / "unit01").iterdir())[0]
-    kept = Twin(robot, program, cycles, root=out, cycles=False)
+    model = robots.load(robot)  # a Twin takes the robot, resolved once
+    kept = Twin(model, program, cycles, root=out, cycles=False)
     assert all(kept.cached(*c) for c in base_cycles(6))
-    default = Twin(robot, program, tmp_path / "default" / "cycles", cycles=False)
+    default = Twin(model, program, tmp_path / "default" / "cycles", cycles=False)
     for c in base_cycles(6)[:3]:  # the healthy expectation, the healthy cycle at the model's friction, axis 1 worn
         np.testing.assert_allclose(kept.cycle(*c), default.cycle(*c), rtol=1e-9, atol=1e-9, err_msg=str(c))
 

@@ -109,26 +109,39 @@ def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
     assert loads == [str(robot)]
 
 
+#: The boundaries a robot may be resolved at below the command line: the public API (a library
+#: entry documented to take a robot's name, folder or file), a worker (a process sent the robot as
+#: a name: a RunConfig unpickled, loky, Dask), or an earlier run's state (a dataset or a cache file
+#: it wrote, naming a robot).
+BOUNDARIES = ("public API", "worker", "an earlier run's state")
+
 #: The modules that call ``robots.load`` (besides the command line, ``faultgen/cli/``), how many
-#: times, and why each may: a boundary (the public API or a worker resolving what it was sent as a
-#: name), a model file the code itself just wrote or calibrated, or a name stored in a record.
-#: A new caller fails this test: resolve at the boundary and pass the Robot instead, or add it
-#: here with its reason.
+#: times, the boundary each is (:data:`BOUNDARIES`) and why. A model file faultgen writes is not
+#: loaded again by its path: its writer returns the Robot (``robots.write``; a folder staged and
+#: renamed into place: ``robots.moved``). A new caller fails this test: resolve at the boundary and
+#: pass the Robot instead, or add it here with its boundary and why. Before issue 57's last part
+#: (2026-11-26) the list also held calibrate/loop.py (1, the calibrated model just written),
+#: calibrate/refit.py (2, the calibrated model written; the nominal by the name its result stores),
+#: monitor/twin.py (1, a twin of a model file), model/folder.py (2, robots add loading the folder it
+#: wrote), and one more call each in monitor/unit.py and bench/independent.py.
 ALLOWED = {
-    "faultgen/calibrate/__init__.py": (1, "public calibrate(): a name or a Robot, resolved once"),
-    "faultgen/data/fleetlogs.py": (1, "public import_logs(): a name or a Robot, resolved once"),
-    "faultgen/runs/grid.py": (1, "public Grid: each robot once for every run"),
-    "faultgen/simulation/config.py": (2, "public RunConfig: a name once on construction, or after unpickling"),
-    "faultgen/monitor/loop.py": (1, "monitor(): the library entry, once per run"),
-    "faultgen/monitor/feed.py": (1, "Context.new_source: a worker without the run's source (loky, Dask), once"),
-    "faultgen/monitor/remote.py": (1, "a Dask worker: once"),
-    "faultgen/monitor/twin.py": (1, "a twin of a model file (the calibrated model, a given one)"),
-    "faultgen/monitor/unit.py": (2, "the calibrated model the monitor just wrote"),
-    "faultgen/calibrate/loop.py": (1, "the calibrated model just written (its parameters.json)"),
-    "faultgen/calibrate/refit.py": (2, "the calibrated model written; the nominal by the name its result stores"),
-    "faultgen/model/folder.py": (2, "robots add: the folder just written, checked by loading it"),
-    "faultgen/data/robot_record.py": (1, "a dataset written before drivetrains were stored: its robot label"),
-    "faultgen/bench/independent.py": (2, "the independent simulator's own entry: a robot folder"),
+    "faultgen/calibrate/__init__.py": (1, "public API", "calibrate() takes a name or a Robot, resolved once"),
+    "faultgen/data/fleetlogs.py": (1, "public API", "import_logs() takes a name or a Robot, resolved once"),
+    "faultgen/runs/grid.py": (1, "public API", "a Grid (sweep) names its robots; each resolved once for every run"),
+    "faultgen/simulation/config.py": (2, "public API", ("RunConfig(robot=name), once on construction; and as a "
+                                                        "worker: a RunConfig unpickled (its robot sent as the name)")),
+    "faultgen/monitor/loop.py": (1, "public API", "monitor(), the library entry: the robot, once per run"),
+    "faultgen/monitor/feed.py": (2, "worker", ("Context.new_source, where each process's robots are resolved: for "
+                                               "monitor() the --calibrated model; for a worker (loky, Dask) sent the "
+                                               "run as paths, the robot and that model; once each")),
+    "faultgen/monitor/remote.py": (1, "worker", "a Dask worker: the robot sent as a name, once (saying what to install)"),
+    "faultgen/monitor/unit.py": (1, "an earlier run's state", ("a calibrated or twin model the monitor cached in "
+                                                               "OUT/.cache (checked against its record), read once "
+                                                               "(cached_model)")),
+    "faultgen/data/robot_record.py": (1, "an earlier run's state", ("a dataset written before drivetrains were "
+                                                                    "stored names its robot by its label only")),
+    "faultgen/bench/independent.py": (1, "public API", ("write_fleet(), the bench's independent simulator's entry, "
+                                                        "takes a robot folder; once per fleet")),
 }
 
 
@@ -143,4 +156,134 @@ def test_robots_load_is_called_only_where_it_may_be():
                  and isinstance(node.func.value, ast.Name) and node.func.value.id == "robots"]
         if calls:
             counts[where] = len(calls)
-    assert counts == {where: n for where, (n, _) in ALLOWED.items()}
+    assert counts == {where: n for where, (n, _, _) in ALLOWED.items()}
+    assert {kind for _, kind, _ in ALLOWED.values()} <= set(BOUNDARIES)
+
+
+# -- a model file faultgen writes: its writer returns the Robot (issue 57, item 1) ----------------
+
+
+def test_a_written_model_is_the_robot_a_reload_gives_and_a_moved_one_too(tmp_path, loads):
+    import mujoco
+
+    from faultgen.calibrate import parameters
+
+    text = robots.load("puma560").path.read_text()
+    loads.clear()
+    (tmp_path / "staged").mkdir()
+    written = robots.write(tmp_path / "staged" / "arm.xml", text)
+    assert loads == []  # read back by its writer, not resolved by name
+    assert written is robots.load(tmp_path / "staged" / "arm.xml")  # the same object: what any reload gives
+    (tmp_path / "staged").rename(tmp_path / "final")
+    moved = robots.moved(written, tmp_path / "final" / "arm.xml")
+    again = robots.load(tmp_path / "final" / "arm.xml")
+    assert (moved.name, moved.path, moved.digest) == (again.name, again.path, again.digest)
+    assert moved.model is written.model  # not compiled again
+    assert parameters(moved) == parameters(again)
+    assert moved.new_spec().modelfiledir == str(again.path.parent)
+    assert mujoco.MjSpec.to_xml(moved.new_spec()) == mujoco.MjSpec.to_xml(again.new_spec())
+    (tmp_path / "final" / "arm.xml").write_text(text.replace("puma", "Puma", 1))
+    with pytest.raises(robots.ModelError, match="not the file the robot 'arm' was read from"):
+        robots.moved(written, tmp_path / "final" / "arm.xml")
+
+
+@pytest.fixture(scope="module")
+def coulomb_log():
+    """Three pick-and-place cycles of the PUMA 560 with a Coulomb level raised on axis 3 (as
+    tests/test_calibrate_in_memory.py): the calibration adds one effect."""
+    import numpy as np
+
+    from faultgen import effects
+    from faultgen.calibrate import synth
+    from faultgen.data import measured
+
+    robot = robots.load("puma560")
+    motion, tau = synth.nominal_motion(robot, "pick_place", 3)
+    phi, _ = effects.get("coulomb").columns(motion, 2, None)
+    rng = np.random.default_rng(3)
+    tau = tau + rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
+    tau[:, 2] += phi[:, 0] * 0.07
+    return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
+
+
+def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, tmp_path, loads):
+    """``calibrate`` resolves the nominal robot once (the public entry) and returns the calibrated
+    robot it wrote (``Calibration.model``): before, ``calibrate.loop`` loaded the model file it had
+    just written to make parameters.json, and ``refit`` loaded it again with the nominal by name."""
+    import json
+
+    from faultgen.calibrate import calibrate, parameters, predict
+
+    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    assert loads == ["puma560"]
+    assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
+    reloaded = robots.load(result.model_out)
+    assert result.model.path == reloaded.path == result.model_out.resolve()
+    assert result.model.digest == reloaded.digest and result.nominal_digest == robots.load("puma560").digest
+    assert parameters(result.model) == parameters(reloaded)
+    assert json.loads((tmp_path / "out" / "model" / "parameters.json").read_text()) == json.loads(
+        json.dumps(parameters(reloaded)))
+    assert (predict(result.model, coulomb_log) == result.calibrated).all()
+
+
+def test_refit_takes_the_nominal_robot_and_checks_it_is_the_calibrations(coulomb_log, tmp_path):
+    from dataclasses import replace
+
+    from faultgen.calibrate import calibrate
+    from faultgen.calibrate.refit import calibrated_from, refit
+
+    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    puma = robots.load("puma560")
+    assert calibrated_from(result, puma) is puma
+    with pytest.raises(TypeError, match="expected a Robot, got str 'puma560'"):
+        refit(result, coulomb_log, "puma560")
+    with pytest.raises(ValueError, match="the nominal robot given .irb6700.* is not the one the calibration started "
+                                         "from .puma560"):
+        calibrated_from(result, robots.load("irb6700"))
+    (tmp_path / "puma560").mkdir()
+    (tmp_path / "puma560" / "puma560.xml").write_text(puma.path.read_text().replace("puma", "Puma", 1))
+    with pytest.raises(ValueError, match="its MJCF's SHA-1"):  # same name, another file
+        calibrated_from(result, robots.load(tmp_path / "puma560"))
+    with pytest.raises(ValueError, match="holds no calibrated robot"):
+        calibrated_from(replace(result, model=None), puma)
+
+
+def test_robots_add_loads_nothing_by_name(tmp_path, loads):
+    """``robots add`` checks the folder it writes by reading its model back once, from its writer
+    (``robots.write``), and names it by the folder it renames into place (``robots.moved``): before,
+    it loaded the staged file and then the folder again."""
+    from faultgen.model import folder
+
+    source = robots.robots_dir() / "irb6700"
+    loads.clear()
+    added = folder.add("irb_copy", source / "arm.xml", tmp_path / "irb_copy", drivetrain=source / "drivetrain.toml",
+                       payload=200.0)
+    assert loads == []
+    again = robots.load(tmp_path / "irb_copy")
+    assert (added.robot.path, added.robot.digest, added.robot.name) == (again.path, again.digest, again.name)
+
+
+def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
+    """``faultgen monitor`` calibrating each unit's model on its first log: the robot is resolved once
+    (the command), each unit's calibrated and twin models come from their writers; the second run
+    on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once."""
+    import shutil
+
+    import independent_fleet
+
+    robot, logs, _ = independent_fleet.write_fleet(
+        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
+    loads.clear()
+    args = ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"), "--train", "10",
+            "--persistence", "3", "--no-progress"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert loads == [str(robot)]
+    assert (tmp_path / "out" / "units.csv").read_text().count("calibrated") == 2
+    cached = sorted((tmp_path / "out" / ".cache" / "calibrated").glob("*/model/*.xml"))
+    assert len(cached) == 4  # each unit's calibrated model and its twin model
+    shutil.rmtree(tmp_path / "out" / ".state")  # the units scored again, from the cached calibrations
+    loads.clear()
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert loads[0] == str(robot) and sorted(loads[1:]) == [str(path) for path in cached]

@@ -121,19 +121,19 @@ def test_the_twins_signatures_answer_like_an_independent_unit_per_percent_of_its
     robot = robots.load(kr210)
     gear, jm, friction = robot.gear_ratio, robot.motor_inertia, robot.friction
     fc, fs, fv = (np.asarray(x, dtype=float) for x in (friction.coulomb_pos, friction.static, friction.viscous))
-    t, q, qd, qdd = independent._motion(str(kr210), 125.0)
+    t, q, qd, qdd = independent._motion(robot, 125.0)
 
     def features(temperature, mass, axis=0, wear=0.0):
         grow = np.ones(robot.n_axes)
         if axis:
             grow[axis - 1] += wear / 100.0
         viscous = fv * np.exp(-independent.VISCOUS_PER_K * (temperature - 20.0))
-        tau = (independent._rigid(str(kr210), 125.0, mass) + gear**2 * jm * qdd
+        tau = (independent._rigid(robot, 125.0, mass) + gear**2 * jm * qdd
                + gear * independent.motor_friction(gear * qd, fc * grow, fs * grow, viscous))
         return fleet_logs.features_of(robot, measured.from_arrays(t, q, tau, robot))
 
-    program = measured.write_csv(tmp_path / "program.csv", t, q, independent._rigid(str(kr210), 125.0, 0.0))
-    twin = Twin(kr210, program, tmp_path / "cache" / "cycles")
+    program = measured.write_csv(tmp_path / "program.csv", t, q, independent._rigid(robot, 125.0, 0.0))
+    twin = Twin(robot, program, tmp_path / "cache" / "cycles")
     healthy20 = twin.cycle(20.0, 0.0)
     at20 = np.stack([(twin.cycle(20.0, 0.0, a) - healthy20) / WEAR for a in range(1, 6)])
     for temperature in (20.0, 40.0):

@@ -205,25 +205,26 @@ def changed_program(program, shrink: float = PROGRAM_SHRINK):
 
 
 @lru_cache(maxsize=4)
-def _motion(folder: str, rate: float, changed: bool = False):
-    """The pick-and-place cycle (``changed``: :func:`changed_program`'s) planned at 250 Hz (the
-    planner's 4 ms), taken at ``rate`` Hz."""
+def _motion(robot: robots.Robot, rate: float, changed: bool = False):
+    """The pick-and-place cycle of ``robot`` (as :func:`write_fleet` resolved its folder;
+    ``changed``: :func:`changed_program`'s) planned at 250 Hz (the planner's 4 ms), taken at ``rate`` Hz."""
     step = int(round(PLAN_RATE / rate))
     if step < 1 or abs(PLAN_RATE / step - rate) > 1e-9:
         raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
-    program = programs.load(robots.load(folder), "pick_place")
+    program = programs.load(robot, "pick_place")
     path = (changed_program(program) if changed else program).trajectory(PLAN_RATE ** -1)
     q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
     return np.arange(len(q)) / rate, q, qd, qdd
 
 
 @lru_cache(maxsize=128)
-def _rigid(folder: str, rate: float, mass: float, changed: bool = False) -> np.ndarray:
-    """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`)."""
+def _rigid(robot: robots.Robot, rate: float, mass: float, changed: bool = False) -> np.ndarray:
+    """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`), from
+    the URDF in the robot's folder."""
     pin = pinocchio_module()
-    _, q, qd, qdd = _motion(folder, rate, changed)
+    _, q, qd, qdd = _motion(robot, rate, changed)
     edge = (mass / PART_DENSITY) ** (1 / 3)
-    model = pinocchio_model(Path(folder) / "urdf_used.urdf", mass, (0.0, 0.0, edge / 2), (edge, edge, edge))
+    model = pinocchio_model(robot.path.parent / "urdf_used.urdf", mass, (0.0, 0.0, edge / 2), (edge, edge, edge))
     data = model.createData()
     return np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
 
@@ -330,8 +331,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
         Without Pinocchio.
     """
     root = Path(root)
-    folder = Path(robot)
-    model = robots.load(folder)
+    model = robots.load(Path(robot))  # the independent simulator's entry: its robot folder, resolved once
     G, jm, nominal = model.gear_ratio, model.motor_inertia, model.friction
     fc0, fs0, fv0 = (np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
     n = model.n_axes
@@ -361,8 +361,8 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
             fs = fs0 * spread[1] * grow * jitter[1]
             fv = fv0 * spread[2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
             changed = bool(unit["program_day"]) and d >= unit["program_day"]
-            t, q, qd, qdd = _motion(str(folder), spec.rate, changed)
-            tau = (_rigid(str(folder), spec.rate, round(mass, 1), changed) + G**2 * jm * qdd
+            t, q, qd, qdd = _motion(model, spec.rate, changed)
+            tau = (_rigid(model, spec.rate, round(mass, 1), changed) + G**2 * jm * qdd
                    + G * motor_friction(G * qd, fc, fs, fv))
             tau = tau + rng.normal(0.0, 1.0, tau.shape) * NOISE * np.sqrt(np.mean(tau**2, axis=0))
             angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)

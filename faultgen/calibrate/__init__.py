@@ -75,7 +75,8 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError).
     ``log_format``: the log's format when not the measured one (a
     :class:`faultgen.data.adapters.Adapter`, ``--format NAME``): read through it, whole or, longer
-    than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`)."""
+    than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`).
+    The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
         data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)
@@ -97,7 +98,7 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
         result = _calibrate(nominal, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))
         atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
-    return result
+    return replace(result, model=robots.moved(result.model, result.model_out))  # the folder renamed into place
 
 
 def decimate(data: measured_io.MeasuredData, rows: int) -> measured_io.MeasuredData:

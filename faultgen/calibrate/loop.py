@@ -55,6 +55,7 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     Returns
     -------
     Calibration
+        With the calibrated robot as written (:attr:`Calibration.model`).
 
     Raises
     ------
@@ -116,8 +117,9 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         model, predicted = extend(model, predicted, steps, data, tau, split, model_out)
     if any(s.effect.id == "stribeck" for s in steps):
         model, predicted = sysid_stribeck(model, predicted, steps, data, tau, split, use_sysid, progress)
-    atomic.write_text(model_out, model.text)  # the one model file a calibration writes
-    atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(robots.load(model_out)), indent=2) + "\n")
+    # the one model file a calibration writes, and the robot it is (read back once, by its writer)
+    calibrated = robots.write(model_out, model.text, atomic.write_text)
+    atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
 
     result = Calibration(
         robot=nominal.name,
@@ -133,6 +135,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         nominal=nominal_prediction,
         calibrated=predicted,
         searches=searches,
+        model=calibrated,
+        nominal_digest=nominal.digest,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     from faultgen.calibrate import figure

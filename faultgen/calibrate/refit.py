@@ -107,12 +107,14 @@ def _optimize(sysid, residual_of, starts, low, high, max_iters: int):
     return x, half, seconds
 
 
-def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[list[Refit], float, float]:
+def refit(result, data: measured_io.MeasuredData, nominal: robots.Robot,
+          max_iters: int = 30) -> tuple[list[Refit], float, float]:
     """Fit the continuous parameters of ``result``'s steps (a :class:`faultgen.calibrate.Calibration`)
-    again with ``mujoco.sysid`` on the calibrated model, starting from the nominal model's values
-    (the effect absent; 20 % off faultgen's values when the model cannot be compiled there, an
-    absent payload having no positive-definite inertia), on the measured ``data`` the calibration
-    used.
+    again with ``mujoco.sysid`` on the calibrated model (the robot the calibration wrote,
+    :attr:`~faultgen.calibrate.Calibration.model`), starting from the values of ``nominal``, the
+    robot the calibration started from, as its caller resolved it (the effect absent; 20 % off
+    faultgen's values when the model cannot be compiled there, an absent payload having no
+    positive-definite inertia), on the measured ``data`` the calibration used.
 
     Returns
     -------
@@ -124,14 +126,20 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     ------
     ImportError
         When ``mujoco.sysid`` is not installed (``pip install mujoco[sysid]``).
+    TypeError
+        If ``nominal`` is not a :class:`~faultgen.model.robot.Robot` (a name is resolved once, by the caller).
+    ValueError
+        If ``nominal`` is not the robot ``result`` was calibrated from (its name, or its file's
+        SHA-1 where the calibration recorded one), or ``result`` holds no calibrated robot.
     """
     from mujoco import sysid
 
     from faultgen.calibrate.prediction import predict
 
-    model_path = Path(result.model_out)
+    nominal = calibrated_from(result, nominal)
+    robot = result.model
+    model_path = Path(robot.path)
     base_xml = model_path.read_text()
-    robot = robots.load(model_path)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     scale = criterion.rms(tau, split.held_out)
@@ -175,7 +183,6 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
 
     # sysid starts where the nominal model is (the effect absent), not at faultgen's answer; its
     # bounds reach five times past faultgen's change
-    nominal = robots.load(result.robot)
     starts = np.array([float(get(step.effect.id).current(nominal).values(axis)[name])
                        for step, axis, name, _, _ in entries])
     try:
@@ -190,6 +197,30 @@ def refit(result, data: measured_io.MeasuredData, max_iters: int = 30) -> tuple[
     gap = search.gap(tau, predict(robots.from_spec(spec_with(x), model_path), data), split.held_out)["total_nrmse"]
     return refits, elapsed, gap
 
+
+def calibrated_from(result, nominal: robots.Robot) -> robots.Robot:
+    """``nominal`` once checked to be the robot ``result`` (a :class:`faultgen.calibrate.Calibration`)
+    was calibrated from, and ``result`` to hold the calibrated robot: the names match, and the
+    files' SHA-1 where both are known (:attr:`Robot.digest`).
+
+    Raises
+    ------
+    TypeError
+        ``nominal`` is not a Robot (:func:`faultgen.model.robots.require`).
+    ValueError
+        Another robot, or a result without its calibrated robot (:attr:`Calibration.model`).
+    """
+    nominal = robots.require(nominal, "calibrate.refit.refit")
+    if result.model is None:
+        raise ValueError(f"the calibration into {result.model_out} holds no calibrated robot (Calibration.model); "
+                         "refit the result faultgen.calibrate.calibrate returned")
+    recorded = getattr(result, "nominal_digest", None)
+    if nominal.name != result.robot or (recorded is not None and nominal.digest is not None
+                                         and nominal.digest != recorded):
+        raise ValueError(f"the nominal robot given ({nominal.name}, {nominal.path}) is not the one the calibration "
+                         f"started from ({result.robot}" + (f", its MJCF's SHA-1 {recorded}" if recorded else "")
+                         + "); pass the robot it was calibrated from")
+    return nominal
 
 
 # -- inside the calibration: the Stribeck hump refined by sysid (issue 39, item 4) ------------------

@@ -80,6 +80,13 @@ class Calibration:
     searches : int or None
         How many times every effect was fitted to the residual (the steps, and the search that
         found nothing more when there was one).
+    model : Robot or None
+        The augmented model as written to ``model_out``, read from it once by its writer
+        (:func:`faultgen.model.robots.write`): who needs the calibrated robot takes it from here
+        rather than loading ``model_out`` again.
+    nominal_digest : str or None
+        SHA-1 of the nominal model's MJCF (:attr:`Robot.digest`; None for one edited in memory),
+        which :func:`faultgen.calibrate.refit.refit` checks the nominal robot it is handed against.
     """
 
     robot: str
@@ -95,6 +102,8 @@ class Calibration:
     nominal: np.ndarray
     calibrated: np.ndarray
     searches: int | None = None
+    model: robots.Robot | None = None
+    nominal_digest: str | None = None
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""

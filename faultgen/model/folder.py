@@ -159,8 +159,7 @@ def add(
     prefix = f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-"  # remove_stale's pattern
     stage = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
     try:
-        (stage / f"{name}.xml").write_text(text)
-        robot = robots.load(stage / f"{name}.xml")
+        robot = robots.write(stage / f"{name}.xml", text)  # the robot as written: it loads, or nothing is added
         size = reach(robot)
         summary, findings = plausibility.report(arm, payload, guessed, result.moving_mass,
                                                 plausibility.radial_reach(robot), result.loads,
@@ -191,8 +190,9 @@ def add(
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    return Added(out, robots.load(out / f"{name}.xml"), arm, payload, payload_origin, summary, tuple(findings),
-                 rule)
+    # the robot read from the staged file, named by the folder it was renamed to (not read again)
+    return Added(out, robots.moved(robot, out / f"{name}.xml"), arm, payload, payload_origin, summary,
+                 tuple(findings), rule)
 
 
 def sizing_rule(folder: str | Path) -> int | None:

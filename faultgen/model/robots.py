@@ -15,10 +15,12 @@ too.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import re
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import mujoco
@@ -34,7 +36,7 @@ class UnknownRobotError(ValueError):
 
 
 __all__ = ["RATED_PAYLOAD", "ModelError", "Robot", "UnknownRobotError", "available", "drivetrain_of", "from_spec", "load",
-           "require", "robots_dir", "source_of", "with_timestep"]
+           "moved", "require", "robots_dir", "source_of", "with_timestep", "write"]
 
 
 def robots_dir() -> Path:
@@ -96,6 +98,49 @@ def load(name: str | Path) -> Robot:
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
     path = path.resolve()
     return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+
+
+def write(path: str | Path, text: str, writer: Callable[[Path, str], object] | None = None) -> Robot:
+    """Write the robot MJCF ``text`` to ``path`` and return the :class:`Robot` it is: the writer of a
+    model file (a calibration, the monitor's twin model, ``robots add``) hands on the robot it
+    wrote, so nobody loads that file again by its path (docs/architecture.md, "One robot model,
+    resolved once").
+
+    The robot is read back from the file as written, once, with :func:`load`'s checks and cache
+    (its bytes' SHA-1): it is what any later ``load(path)`` gives, the same object while the file
+    is unchanged. ``writer(path, text)`` writes the file (an atomic writer such as
+    :func:`faultgen.data.atomic.write_text`; default :meth:`pathlib.Path.write_text`).
+
+    Raises
+    ------
+    ModelError
+        If the file written does not load as a robot (as :func:`load`).
+    """
+    path = Path(path)
+    (writer or Path.write_text)(path, text)
+    path = path.resolve()
+    return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+
+
+def moved(robot: Robot, path: str | Path) -> Robot:
+    """``robot``, read from a file that has since been moved to ``path`` unchanged (a folder staged
+    hidden and renamed into place once complete: :func:`faultgen.calibrate.calibrate`,
+    ``robots add``): the same compiled model, named by its new path (its spec now resolving files
+    beside it), without reading it again. Equal to what :func:`load` of ``path`` gives (tests/test_resolve_once.py).
+
+    Raises
+    ------
+    ModelError
+        If ``robot`` was not read from a file or ``path`` does not hold that file's bytes (its SHA-1).
+    """
+    path = Path(path).resolve()
+    digest = hashlib.sha1(path.read_bytes()).hexdigest() if path.is_file() else None
+    if robot.digest is None or digest != robot.digest:
+        raise ModelError(f"{path}: not the file the robot {robot.name!r} was read from ({robot.path}), unchanged; "
+                         "load it with faultgen.model.robots.load")
+    spec = robot.new_spec()
+    spec.modelfiledir = str(path.parent)
+    return dataclasses.replace(robot, name=path.stem, path=path, _spec=spec)
 
 
 def require(robot: Robot, where: str) -> Robot:

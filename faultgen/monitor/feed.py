@@ -49,10 +49,20 @@ class Context:
     def __post_init__(self) -> None:
         backends.get(self.backend)
 
-    def new_source(self) -> fleet_logs.Source:
-        """A log source of this run's robot, resolved here: for a worker that did not inherit the
-        run's (the run's own holds the robot its command resolved)."""
-        return fleet_logs.Source(robots.load(self.robot), self.log_format)
+    def new_source(self, nominal: robots.Robot | None = None) -> fleet_logs.Source:
+        """A log source of this run holding its robots: ``nominal`` (the robot the run's command or
+        library call resolved), else :attr:`robot` resolved here, for a worker that did not inherit
+        the run's source (loky, Dask); and the model given for every unit (:attr:`calibrated`),
+        resolved here once, or the ValueError its loading raised, which each unit's twin falls back
+        from (:func:`faultgen.monitor.unit.twin_of`)."""
+        nominal = robots.load(self.robot) if nominal is None else nominal
+        given = None
+        if self.calibrated is not None:
+            try:
+                given = robots.load(self.calibrated)
+            except ValueError as err:  # UnknownRobotError, ModelError: the units fall back to the nominal model
+                given = err
+        return fleet_logs.Source(nominal, self.log_format, given)
 
 
 def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
@@ -81,8 +91,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        twin = twin_of(unit, context.units, nominal, context.calibrated, context.out, twins, False, source,
-                       context.backend)
+        twin = twin_of(unit, context.units, context.out, twins, False, source, context.backend)
         for log in unit_logs:
             for event in context.maintenance.get(name, ()):
                 done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
@@ -114,7 +123,7 @@ def new_program(unit: Unit, log, reading, twin: Twin, context, source: fleet_log
     ValueError
         The new program's twin cannot be built (the log is then skipped, named).
     """
-    new = Twin(twin.model, source.get(log), context.out / ".cache" / "cycles", root=context.out,
+    new = Twin(twin.robot, source.get(log), context.out / ".cache" / "cycles", root=context.out,
                backend=twin.backend)
     source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)

@@ -161,10 +161,15 @@ class Source:
     only paths: :attr:`faultgen.data.adapters.Adapter.reads_held`) and kept until :meth:`done` (a
     program, :meth:`keep`, for the run), so a unit's first log serves its program, calibration,
     twin and score from one read. It holds the parsed first log of each unit not yet scored, and
-    each program."""
+    each program. ``robot`` is the run's nominal robot and ``given`` the model given for every unit
+    (``--calibrated``), each resolved once where this process's source was made (the run's command
+    or library call, or a worker: :meth:`faultgen.monitor.feed.Context.new_source`); ``given`` is
+    None without one, or the ValueError its loading raised (each unit then falls back, saying why:
+    :func:`faultgen.monitor.unit.twin_of`)."""
 
-    def __init__(self, robot: Robot, log_format=None):
+    def __init__(self, robot: Robot, log_format=None, given: Robot | ValueError | None = None):
         self.robot = robot
+        self.given = given
         self.reader, _ = reader_of(log_format)
         self.held = log_format is None or bool(getattr(log_format, "reads_held", False))
         self._parsed: dict[Path, Parsed] = {}

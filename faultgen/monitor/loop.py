@@ -171,7 +171,6 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     backends.get(backend)
     nominal = robots.load(robot)
     _, suffixes = fleet_logs.reader_of(log_format)
-    source = fleet_logs.Source(nominal, log_format)  # each log read once, parsed data passed on
     units = fleet_logs.fleet(logs_dir, suffixes)
     out = Path(out)
     cache = out / ".cache"
@@ -185,12 +184,13 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     cache.mkdir(parents=True, exist_ok=True)
+    context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
+                       failure_wear, backend)
+    source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
     programs: list[tuple[np.ndarray, tuple[str, str]]] = []
     for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
         if unit_logs and name not in state:
             state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
-    context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                       failure_wear, backend)
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored

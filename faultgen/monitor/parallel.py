@@ -17,11 +17,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from faultgen.model.robot import Robot
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.twin import Twin, base_cycles
-from faultgen.monitor.unit import Unit, log_of
+from faultgen.monitor.unit import Unit, log_of, model_of
 
 
 def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Unit, list]]]:
@@ -38,19 +39,17 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
     that cannot be built is left to each unit's own fallback (:func:`twin_of`). The programs come
     parsed from ``source`` (the run's; a new one when None) and go to the tasks as they are."""
     source = source if source is not None else context.new_source()
-    nominal = source.robot
     seen = set()
     for (name, unit, _), in groups:
         key = (unit.model, unit.program)
         if unit.model not in ("given", "nominal") or unit.program is None or key in seen:
             continue
         seen.add(key)
-        model = str(context.calibrated) if unit.model == "given" else str(nominal.path)
         cache = context.out / ".cache" / "cycles"
         try:
+            model = model_of(source, unit.model, unit.first, None, context.out, False)  # as twin_of has it
             program = source.get(log_of(context.units, *unit.program))
-            twin = Twin(nominal if unit.model == "nominal" else model, program, cache, root=context.out, cycles=False,
-                        backend=context.backend)
+            twin = Twin(model, program, cache, root=context.out, cycles=False, backend=context.backend)
             missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
             if pool is not None and len(missing) > 1:
                 list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.backend, *c)
@@ -62,9 +61,10 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
             continue
 
 
-def _twin_cycle(model: str, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str,
+def _twin_cycle(model: Robot, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str,
                 temperature: float, payload: float, worn_axis: int) -> None:
-    """Worker task: one cycle of a shared twin (its program as this run parsed it) into the cache
+    """Worker task: one cycle of a shared twin (its robot and its program as this run resolved and
+    parsed them, pickled: a robot read from a file is parsed again from it on arrival) into the cache
     (:meth:`faultgen.monitor.twin.Twin.cycle`), simulated on the stepping ``backend``. A cycle that
     cannot be simulated (or a cache file refused) is left to the twin made after all of them, which
     says why."""

@@ -109,7 +109,7 @@ def score_remote(context: Context, robot: str, group: list, shipment: Shipment) 
                  for name, unit, unit_logs in group]
         shipped_cache = set(shipment.cache)
         try:
-            scored = score_group(here, local)
+            scored = score_group(here, local, here.new_source(nominal))  # the robot resolved above, once
         except ValueError as err:  # a refusal of the run (a state or cache file), in the client's paths
             try:
                 again = type(err)(_put_back(str(err), paths))

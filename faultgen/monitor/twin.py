@@ -93,8 +93,9 @@ def base_cycles(n_axes: int) -> list[tuple[float, float, int]]:
 
 
 class Twin:
-    """A unit's twin (module docstring): ``model`` an MJCF file or robot folder, or the robot
-    resolved from it (a :class:`~faultgen.model.robot.Robot`, not loaded again), ``program`` the
+    """A unit's twin (module docstring): ``model`` the robot it simulates (a
+    :class:`~faultgen.model.robot.Robot`: the nominal, a given or a calibrated one, as the monitor
+    resolved or wrote it; :func:`faultgen.monitor.unit.model_of`), ``program`` the
     log whose motion is replayed, as the run parsed it (:class:`faultgen.monitor.logs.Parsed`: its
     SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
@@ -107,17 +108,19 @@ class Twin:
     ValueError
         An unknown ``backend`` (the known ones named), the program cannot be read (file and row
         named), or a base cycle cannot be simulated.
+    TypeError
+        ``model`` is not a Robot (a name or path: resolve it once with
+        :func:`faultgen.model.robots.load`).
     """
 
-    def __init__(self, model: str | Path | robots.Robot, program: Path | fleet_logs.Parsed, cache: Path,
+    def __init__(self, model: robots.Robot, program: Path | fleet_logs.Parsed, cache: Path,
                  root: Path | None = None,
                  reader: fleet_logs.Reader | None = None, cycles: bool = True,
                  backend: str = backends.DEFAULT):
         backends.get(backend)
         self.backend = backend
-        resolved = isinstance(model, robots.Robot)
-        self.model = str(model.path) if resolved else str(model)
-        self.robot = model if resolved else robots.load(model)
+        self.robot = robots.require(model, "monitor.twin.Twin")
+        self.model = str(self.robot.path)
         self.cache = Path(cache)
         self.root = self.cache if root is None else Path(root)
         self.cache.mkdir(parents=True, exist_ok=True)

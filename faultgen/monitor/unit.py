@@ -71,21 +71,21 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
     return Unit(monitor, kind, program, first_key)
 
 
-def twin_of(unit: Unit, units, nominal, calibrated_model, out: Path, twins: dict, progress: bool,
-          source: fleet_logs.Source, backend: str = backends.DEFAULT) -> Twin | str | None:
+def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: fleet_logs.Source,
+            backend: str = backends.DEFAULT) -> Twin | str | None:
     """The unit's twin (its cycles simulated on the stepping ``backend``, a known name), or None
-    for a unit under protocol ``own``. A unit not yet scored falls back
+    for a unit under protocol ``own``; its model comes from :func:`model_of` (the robots of
+    ``source``, or the unit's calibration). A unit not yet scored falls back
     from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
     its new logs are skipped with it. Each fallback is noted in the unit's reason."""
     while unit.model != "none":
         try:
             first_log = next((g for g in units[unit.monitor.unit] if g.stamp == unit.first[0]), None)
-            model = model_of(nominal, unit.model, calibrated_model, unit.first, first_log, out, progress, source)
-            twin_key = (model, unit.program)
+            model = model_of(source, unit.model, unit.first, first_log, out, progress)
+            twin_key = (str(model.path), unit.program)
             if twin_key not in twins:
-                twins[twin_key] = Twin(nominal if model == str(nominal.path) else model,  # resolved once
-                                       source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
+                twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
                                        root=out, backend=backend)
             twin = twins[twin_key]
         except stored.StateError:
@@ -139,23 +139,30 @@ def given_model(calibrated: str | Path) -> Path:
     return path
 
 
-def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str], first_log: fleet_logs.Log | None,
-           out: Path, progress: bool, source: fleet_logs.Source) -> str:
-    """The unit's model file of ``kind``: "given" (``calibrated``), "nominal", or "calibrated" on
-    the unit's first log (``first``: its stamp and SHA-256; ``first_log`` the log, parsed by
-    ``source`` and needed only when the calibration is not cached), cached in
-    ``OUT/.cache/calibrated`` under the digest of the nominal model, the log and the search's
-    length, beside a record of the calibrated model's SHA-256 that a later run checks.
+def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first_log: fleet_logs.Log | None,
+             out: Path, progress: bool) -> robots.Robot:
+    """The robot a unit's twin simulates, of ``kind``: "nominal" and "given" (``--calibrated``) are
+    the robots ``source`` holds, resolved once where it was made; "calibrated": calibrated on the
+    unit's first log (``first``: its stamp and SHA-256; ``first_log`` the log, parsed by ``source``
+    and needed only when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under
+    the digest of the nominal model, the log and the search's length, beside a record of the
+    calibrated model's SHA-256 that a later run checks; the robot is that model without its log's
+    part (:func:`without_payload`), as its writer returned it (or, cached, as an earlier run wrote
+    it: :func:`cached_model`).
 
     Raises
     ------
     ValueError
-        The calibration fails, or its cache does not match its record.
+        The given model did not load, the calibration fails or is implausible, or its cache does
+        not match its record.
     """
+    nominal = source.robot
     if kind == "nominal":
-        return str(nominal.path)
+        return nominal
     if kind == "given":
-        return str(calibrated)
+        if not isinstance(source.given, robots.Robot):
+            raise ValueError(str(source.given) if source.given is not None else "no --calibrated model given")
+        return source.given
     key = {"robot": stored.sha256_file(nominal.path), "log": first[1], "steps": CALIBRATION_STEPS}
     digest = stored.key_name(key)
     root = out / ".cache" / "calibrated"
@@ -163,6 +170,7 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
     model = folder / "model" / f"{nominal.name}_calibrated.xml"
     if record.exists() or record.is_symlink():
         stored.read_calibration(record, out, key, model)
+        calibrated = cached_model(model)
     else:
         if first_log is None:
             raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
@@ -174,28 +182,37 @@ def model_of(nominal, kind: str, calibrated: Path | None, first: tuple[str, str]
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            run_calibration(nominal, source.get(first_log).checked(), folder, max_steps=CALIBRATION_STEPS,
-                            progress=False)
+            calibrated = run_calibration(nominal, source.get(first_log).checked(), folder,
+                                         max_steps=CALIBRATION_STEPS, progress=False).model
         stored.write_calibration(record, key, model)
-    implausible = plausibility.implausible_parameters(nominal, robots.load(model))
+    implausible = plausibility.implausible_parameters(nominal, calibrated)
     if implausible:
         raise ValueError(f"its calibration on the first log is implausible: {'; '.join(implausible)}")
-    return str(without_payload(model))
+    return without_payload(calibrated)
 
 
-def without_payload(path: Path) -> Path:
+def cached_model(path: Path) -> robots.Robot:
+    """A model file that an earlier run of the monitor wrote into ``OUT/.cache/calibrated`` (the
+    calibrated model, checked against its record first, or its twin model): state this process did
+    not make, read once here with :func:`faultgen.model.robots.load`'s checks."""
+    return robots.load(path)
+
+
+def without_payload(calibrated: robots.Robot) -> robots.Robot:
     """The calibrated model without the part its log carried (the calibration's payload effect,
     written again with no mass: :class:`faultgen.effects.payload.Payload` removes its bodies): the
     twin carries each log's declared part instead. Written beside it (same assets and
-    ``tasks.toml``) as ``<name>_twin.xml``, from the model checked as any robot description
-    (:func:`faultgen.model.robots.load`: no file outside its folder) before MuJoCo parses it."""
+    ``tasks.toml``) as ``<name>_twin.xml`` (:func:`faultgen.model.robots.write`, which returns the
+    robot written), from the calibrated model's file (checked as any robot description when it
+    was read: no file outside its folder) parsed again by MuJoCo; one an earlier run wrote is
+    read (:func:`cached_model`)."""
+    path = calibrated.path
     target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
-    if not target.is_file():
-        robot = robots.load(path)
-        spec = mujoco.MjSpec.from_file(str(path))
-        Payload(mass=0.0).write(spec, robot)
-        atomic.write_text(target, spec.to_xml())
-    return target
+    if target.is_file():
+        return cached_model(target)
+    spec = mujoco.MjSpec.from_file(str(path))
+    Payload(mass=0.0).write(spec, calibrated)
+    return robots.write(target, spec.to_xml(), atomic.write_text)
 
 
 def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_logs.Source) -> tuple[str, str]:
