@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 from statsmodels.tsa.statespace.mlemodel import MLEModel
 
-from faultgen.monitor.scoring import OUTLIER_GATE, OUTLIER_RUN, WEAR_RATE_CHANGE, Settings, UnitMonitor, WearTrend
+from faultgen.monitor.scoring import (
+    OUTLIER_GATE,
+    OUTLIER_RUN,
+    WEAR_ALARM_CONFIDENCE,
+    WEAR_RATE_CHANGE,
+    Settings,
+    UnitMonitor,
+    WearTrend,
+)
 
 
 def _statsmodels_filter(y: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -75,9 +83,17 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
     log = np.array([[r[f"wear{a}_log"] for a in range(1, 7)] for r in rows])
     error = np.array([[r[f"wear{a}_log"] - r[f"wear{a}_log_lower"] for a in range(1, 7)] for r in rows])
     trend = WearTrend(6)
-    expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile)[0] for k in range(len(rows))])
-    np.testing.assert_allclose([[r[f"wear{a}"] for a in range(1, 7)] for r in rows], expected, rtol=1e-12)
+    expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile) for k in range(len(rows))])
+    np.testing.assert_allclose([[r[f"wear{a}"] for a in range(1, 7)] for r in rows], expected[:, 0], rtol=1e-12)
     assert rows[-1]["wear2"] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
+    # the alarm is judged on the filtered wear's lower one-sided 90 % bound (WEAR_ALARM_CONFIDENCE),
+    # each log's own bound stays 1 - alpha
+    assert unit.alarm_quantile == pytest.approx(1.2816, abs=1e-4) and WEAR_ALARM_CONFIDENCE == 0.90
+    lower = np.array([[r[f"wear{a}_lower"] for a in range(1, 7)] for r in rows])
+    np.testing.assert_allclose(lower, expected[:, 0] - unit.alarm_quantile * expected[:, 1], rtol=1e-9, atol=1e-9)
+    monitoring = [k for k, r in enumerate(rows) if r["phase"] == "monitoring"]
+    assert [rows[k]["alarm"] for k in monitoring] == [int(lower[k].max() >= 10.0) for k in monitoring]
+    assert any(rows[k]["alarm"] for k in monitoring) and unit.first_alarm is not None
 
 
 def test_maintenance_restarts_the_trend():
