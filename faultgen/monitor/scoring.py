@@ -133,7 +133,10 @@ class WearTrend:
     as wear; it starts at 0 with the slopes' own covariance (:meth:`set_prior`) and is learned from
     every later log's condition that departs from the trend (a day's weather, a part), and it is
     kept across a restart of the wear (:meth:`reset`). Without a prior it stays 0 with no
-    uncertainty: the local linear trend alone.
+    uncertainty: the local linear trend alone. What it costs: it is learned on while an axis wears,
+    and where a wear begins as the season warms (a kink the trend follows only over some logs) part
+    of the wear is taken for a slope error (docs/analysis.md, "Wear in the robot's own scale": on
+    the second friction law the median error rose by 0.7 point).
 
     A log whose estimate lies more than :data:`OUTLIER_GATE` standard errors of the innovation from
     the trend's prediction does not move the trend (innovation gating, Bar-Shalom et al. 2001, ch.
