@@ -55,8 +55,8 @@ def monitor_command(
                                              min=1, max=MAX_LOGS)] = 5,
     wear_limit: Annotated[float, typer.Option(
         help="With the twin: the wear (% increase of an axis's dry friction, in % of the unit's own: its "
-             "calibrated or nominal model's) the lower 1 - alpha bound of the wear filtered up to a log must reach "
-             "for the log to alarm. OUT/wear.csv gives it with its 90 % interval and each log's own estimate.", min=0.001,
+             "calibrated or nominal model's) the lower one-sided 90 % bound of the wear filtered up to a log must "
+             "reach for the log to alarm. OUT/wear.csv gives it with its 90 % interval and each log's own estimate.", min=0.001,
         max=1000.0)] = 10.0,
     failure_wear: Annotated[float, typer.Option(
         help="With the twin: the wear estimate (% of the axis's own dry friction) that ends an axis's life; OUT/rul.csv gives "
@@ -87,7 +87,7 @@ def monitor_command(
     regression's prediction interval (wider the further its temperature and payload lie outside
     those the learning logs saw), and each axis's wear estimated along its wear signature (weighted
     least squares, with a standard error) and filtered over the logs (a local linear trend). With
-    the twin a log alarms when the lower 1 - alpha bound of the largest filtered wear reaches
+    the twin a log alarms when the lower 90 % bound of the largest filtered wear reaches
     --wear-limit %; without it (--protocol own) when T2
     or Q is over its limit. A unit alarms from the first of --persistence consecutive alarming
     logs; its source axis is the one with the largest wear estimate (own: the largest share of Q).

@@ -8,8 +8,8 @@ it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an
 
 - the fleet table, the units that need attention first: an open alarm (the surest wear first),
   then degraded, not monitored, learning and quiet units; per unit its status, open alarm, axis,
-  since when, the current wear estimate of that axis (with the twin) and its lower ``1 - alpha``
-  bound, the last log and the alarms maintenance closed;
+  since when, the current wear estimate of that axis (with the twin) and its lower one-sided 90 %
+  bound (the alarm's), the last log and the alarms maintenance closed;
 - a panel per unit (a ``<details>``, opened by clicking the unit in the table): the alarm's
   evidence in words, closed alarms and the maintenance that closed them, and a chart: each axis's
   wear estimate with its lower-bound band and the wear limit, T2 and Q over their limits, the
@@ -35,7 +35,7 @@ from pathlib import Path
 
 from faultgen import inputs
 from faultgen.data import atomic, cells
-from faultgen.monitor import report
+from faultgen.monitor import report, scoring
 
 #: The page's file name in OUT.
 PAGE = "report.html"
@@ -67,9 +67,11 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
                           logs_scored: int) -> str:
     """The chance that a healthy unit raises a persistent alarm over ``logs_scored`` logs if its
     residuals were independent and normal, in words: a log alarms with chance <= 2 alpha without a
-    twin (T2 or Q) and <= N alpha with it (any of the ``n_axes`` axes' lower bounds over a limit
-    the unworn estimate lies below), and an alarm needs ``persistence`` in a row."""
-    per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * alpha)
+    twin (T2 or Q) and <= N (1 - c) with it (any of the ``n_axes`` axes' lower one-sided ``c`` bounds
+    over a limit the unworn wear lies below, ``c`` =
+    :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), and an alarm needs ``persistence`` in a
+    row."""
+    per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * (1.0 - scoring.WEAR_ALARM_CONFIDENCE))
     chance = min(1.0, logs_scored * per_log**persistence)
     return (f"Chance of a persistent alarm on a healthy unit over {logs_scored} logs if its residuals were "
             f"independent and normal: <= {chance:.2g} ({persistence} in a row at <= {per_log:g} per log); drift "

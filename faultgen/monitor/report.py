@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.data import cells
+from faultgen.monitor import scoring
 
 ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
@@ -49,8 +50,9 @@ def write_alarms(path: Path, monitors) -> None:
 
 def write_scores(path: Path, monitors, n_axes: int) -> None:
     """Every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
-    logs, :class:`faultgen.monitor.scoring.WearTrend`), its lower ``1 - alpha`` bound
-    (``wearI_lower``), what the alarm is judged on, and the log's own estimate and bound
+    logs, :class:`faultgen.monitor.scoring.WearTrend`), its lower one-sided 90 % bound
+    (``wearI_lower``, :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), what the alarm is judged
+    on, and the log's own estimate and its lower ``1 - alpha`` bound
     (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
     if any(m.signatures is not None for m in monitors):
@@ -71,7 +73,7 @@ def write_wear(path: Path, monitors) -> None:
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.scoring.WearTrend`), its 90 % interval with the twin's model
     uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
-    the lower ``1 - alpha`` bound of its noise the alarm is judged on (``wear_lower``, as
+    the lower one-sided 90 % bound of its noise the alarm is judged on (``wear_lower``, as
     ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin
     have rows."""
     with open(path, "w", newline="") as f:
@@ -124,7 +126,7 @@ def _draw(path, monitor, axis_note: str, plt) -> None:
             for i in range(monitor.n_axes):
                 middle.plot(x, [r[f"wear{i + 1}"] for r in rows], lw=1, label=f"axis {i + 1}")
             best = [max(r[f"wear{i + 1}_lower"] for i in range(monitor.n_axes)) for r in rows]
-            middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * (1 - monitor.settings.alpha):g} % bound")
+            middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * scoring.WEAR_ALARM_CONFIDENCE:g} % bound")
             middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
             middle.set_ylabel("wear estimate, % of own dry friction")
             middle.legend(fontsize=7, loc="upper left", ncol=4)
