@@ -1,12 +1,15 @@
-"""The named baselines, one registry: each detector and isolator declared once, by :func:`register`
-on a function that returns a new unfitted estimator. What reaches them by name:
+"""The named baselines, one registry: each detector, isolator and prognoser declared once, by
+:func:`register` on a function that returns a new unfitted estimator. What reaches them by name:
 
 - ``faultgen bench score --baseline NAME`` (scored like a ``--detector`` or ``--isolator`` plug-in,
   :mod:`faultgen.bench.score`), its help and its errors;
 - ``faultgen detect --baseline NAME``, a detector that learns healthy samples (not one that learns
   labels: a classifier);
+- ``faultgen bench-isolators``: every registered isolator (:func:`isolators`);
+- ``faultgen bench score prognostics --baseline NAME`` or ``--prognoser NAME``: a prognoser
+  (:func:`prognoser`, the contract of :mod:`faultgen.bench.prognosers`);
 - ``faultgen bench baselines`` (the list) and ``benchmarks/bench_all.py`` (the leaderboard's rows,
-  docs/leaderboard.md), through :func:`names`.
+  docs/leaderboard.md), through :func:`names` and :func:`scorable`.
 
 Adding a baseline is one decorated function here (or in a module of one's own imported before
 the command runs: tests/baseline_example.py). The built-ins:
@@ -25,6 +28,14 @@ Detectors:
 Isolators (scored like an ``--isolator`` plug-in): ``transfer_entropy``, ``cross_correlation``,
 ``granger``, ``trend``, ``pca_contribution`` (:data:`analysis.isolation.ISOLATORS`, thesis ch. 3.3 and 6.3).
 
+Prognosers (the prognostics track): ``linear``, ``exponential`` (:mod:`faultgen.bench.degradation`)
+and ``mean_life``, the naive one (:class:`faultgen.bench.prognosers.MeanLife`).
+
+The twin (``twin``): ``faultgen monitor``'s twin as a detector and isolator. It runs on a context a
+track's files do not hold (the test split written as raw logs, the monitor run on them:
+``benchmarks/twin_baseline.py``), so it has no factory: :meth:`Baseline.make` refuses it naming that
+context, and ``bench score --baseline``, ``detect --baseline`` and ``bench_all`` leave it out.
+
 This module imports nothing heavy (each factory imports its estimator), so the command line's help
 lists the registry without loading scikit-learn.
 """
@@ -38,7 +49,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from sklearn.base import BaseEstimator
 
-ROLES = ("detector", "isolator")
+#: The roles, in the order :func:`names` lists them.
+ROLES = ("detector", "isolator", "prognoser")
 
 
 @dataclass(frozen=True)
@@ -49,9 +61,11 @@ class Baseline:
     ----------
     name : str
         What ``--baseline`` takes; the method's name in the score files and the leaderboard.
-    role : {"detector", "isolator"}
-    factory : callable () -> estimator
-        A new, unfitted scikit-learn estimator on every call.
+    role : {"detector", "isolator", "prognoser"}
+    factory : callable (**params) -> estimator, or None
+        A new, unfitted estimator on every call (a scikit-learn one for a detector or an isolator;
+        for a prognoser, the contract of :mod:`faultgen.bench.prognosers`); keyword parameters, when
+        the estimator takes any, go to it. None for an entry that runs only in its ``context``.
     summary : str
         One line: what it is and where it comes from.
     needs : str or None
@@ -61,26 +75,37 @@ class Baseline:
     labels : bool
         It learns from labelled records (a classifier, ``fit(X, y)``); ``faultgen detect``, which
         learns healthy samples only, refuses it.
+    context : str or None
+        What it runs on besides a track's train and test files (the twin: the monitor run on raw
+        logs); None for an estimator any command builds. Commands that take only a track's files
+        or a dataset refuse an entry with a context, naming it.
+    isolates : bool
+        A detector that also names the worn axis (the twin).
     """
 
     name: str
     role: str
-    factory: Callable[[], BaseEstimator]
+    factory: Callable[..., BaseEstimator] | None
     summary: str
     needs: str | None = None
     extra: str = "bench"
     labels: bool = False
+    context: str | None = None
+    isolates: bool = False
 
-    def make(self) -> BaseEstimator:
-        """A new unfitted estimator.
+    def make(self, **params) -> BaseEstimator:
+        """A new unfitted estimator, ``params`` passed to its factory.
 
         Raises
         ------
         ValueError
-            If the optional module it needs is not installed (saying how to install it).
+            If the entry runs only in its context (naming it), or the optional module it needs is
+            not installed (saying how to install it).
         """
+        if self.factory is None or self.context is not None:
+            raise ValueError(f"baseline {self.name!r} runs on {self.context}; this command cannot run it")
         try:
-            return self.factory()
+            return self.factory(**params)
         except ImportError as err:
             if self.needs is None or (err.name or "").partition(".")[0] != self.needs:
                 raise
@@ -93,9 +118,11 @@ REGISTRY: dict[str, Baseline] = {}
 
 
 def register(name: str, role: str, summary: str, *, needs: str | None = None, extra: str = "bench",
-             labels: bool = False) -> Callable:
-    """Decorator: register the decorated factory (no arguments -> a new unfitted estimator) as the
-    baseline ``name`` (the fields of :class:`Baseline`); returns the factory unchanged.
+             labels: bool = False, context: str | None = None, isolates: bool = False) -> Callable:
+    """Decorator: register the decorated factory (keyword parameters or none -> a new unfitted
+    estimator) as the baseline ``name`` (the fields of :class:`Baseline`); returns the factory
+    unchanged. An entry with a ``context`` may decorate a function that stands for it: it is never
+    called.
 
     Raises
     ------
@@ -112,7 +139,8 @@ def register(name: str, role: str, summary: str, *, needs: str | None = None, ex
         known = REGISTRY.get(name)
         if known is not None and known.factory is not factory:
             raise ValueError(f"baseline {name!r} is already registered ({known.summary})")
-        REGISTRY[name] = Baseline(name, role, factory, summary, needs, extra, labels)
+        REGISTRY[name] = Baseline(name, role, None if context else factory, summary, needs, extra, labels,
+                                  context, isolates)
         return factory
 
     return add
@@ -137,21 +165,83 @@ def get(name: str) -> Baseline:
     return REGISTRY[name]
 
 
-def make(name: str) -> tuple[str, BaseEstimator]:
-    """(role, a new unfitted estimator) of the baseline ``name``.
+def make(name: str, **params) -> tuple[str, BaseEstimator]:
+    """(role, a new unfitted estimator) of the baseline ``name``, ``params`` given to it (e.g.
+    ``make("transfer_entropy", bins=5)``).
 
     Raises
     ------
     ValueError
-        For an unknown name (listing them), or a pyod baseline without pyod installed (saying how).
+        For an unknown name (listing them), an entry that runs only in its context (the twin), or a
+        pyod baseline without pyod installed (saying how).
     """
     baseline = get(name)
-    return baseline.role, baseline.make()
+    return baseline.role, baseline.make(**params)
+
+
+def scorable() -> tuple[str, ...]:
+    """The detectors and isolators ``faultgen bench score --baseline`` runs on a track's files alone
+    (not an entry with a context): the leaderboard's list (``benchmarks/bench_all.py``)."""
+    return tuple(n for n in names() if REGISTRY[n].role in ("detector", "isolator") and REGISTRY[n].context is None)
+
+
+def for_track(name: str) -> tuple[str, BaseEstimator]:
+    """(role, a new estimator) of the baseline ``name`` for ``faultgen bench score`` on a detection
+    and isolation track.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, a prognoser (the prognostics track's), or an entry with a context (each
+        listing what the command takes), or as :func:`make`.
+    """
+    baseline = get(name)
+    if baseline.role not in ("detector", "isolator") or baseline.context is not None:
+        what = (f"is a prognoser (`bench score prognostics --baseline {name}`)" if baseline.role == "prognoser" else
+                f"runs on {baseline.context}")
+        raise ValueError(f"baseline {name!r} {what}; bench score on this track takes: {', '.join(scorable())}")
+    return make(name)
+
+
+def isolators(bins=(5, 10)) -> dict[str, BaseEstimator]:
+    """Every registered isolator (not one with a context) -> a new estimator with its defaults, in
+    the order registered; ``transfer_entropy`` once per bin count of ``bins`` (``te5``, ``te10``:
+    thesis ch. 6): the isolators of ``faultgen bench-isolators``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`make` (a bin count the isolator refuses, a missing optional module).
+    """
+    chosen = {}
+    for name in names("isolator"):
+        if REGISTRY[name].context is not None:
+            continue
+        if name == "transfer_entropy":
+            chosen.update({f"te{b}": make(name, bins=b)[1] for b in bins})
+        else:
+            chosen[name] = make(name)[1]
+    return chosen
+
+
+def prognoser(name: str):
+    """A new prognoser of the registered name ``name`` (the contract of
+    :mod:`faultgen.bench.prognosers`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name or another role, listing the registered prognosers.
+    """
+    if name not in REGISTRY or REGISTRY[name].role != "prognoser":
+        raise ValueError(f"unknown prognostics baseline {name!r}; expected one of: {', '.join(names('prognoser'))} "
+                         "(or MODULE:CLASS with --prognoser)")
+    return make(name)[1]
 
 
 def healthy_detectors() -> tuple[str, ...]:
     """The detectors that learn healthy samples (not labels): the baselines ``faultgen detect`` takes."""
-    return tuple(n for n in names("detector") if not REGISTRY[n].labels)
+    return tuple(n for n in names("detector") if not REGISTRY[n].labels and REGISTRY[n].context is None)
 
 
 def healthy_detector(name: str) -> BaseEstimator:
@@ -166,30 +256,34 @@ def healthy_detector(name: str) -> BaseEstimator:
         baselines ``detect`` takes, or a missing optional module (as :func:`make`).
     """
     baseline = get(name)
-    if baseline.role != "detector" or baseline.labels:
+    if baseline.role != "detector" or baseline.labels or baseline.context is not None:
         takes = ", ".join(healthy_detectors())
-        what = ("an isolator (`faultgen bench-isolators`, `bench score`)" if baseline.role != "detector" else
-                "a classifier: it learns labelled records, and detect learns healthy samples only (`bench score`)")
-        raise ValueError(f"baseline {name!r} is {what}; detect takes a detector that learns healthy samples: {takes}")
+        what = {"isolator": "is an isolator (`faultgen bench-isolators`, `bench score`)",
+                "prognoser": "is a prognoser (`bench score prognostics`)"}.get(
+            baseline.role, f"runs on {baseline.context}" if baseline.context else
+            "is a classifier: it learns labelled records, and detect learns healthy samples only (`bench score`)")
+        raise ValueError(f"baseline {name!r} {what}; detect takes a detector that learns healthy samples: {takes}")
     return baseline.make()
 
 
 def describe(role: str) -> str:
-    """``role``'s names for a command's help: "pca, lr, ..., ecod (detectors; pyod's need the bench
-    extra)"."""
-    listed = names(role)
+    """``role``'s names a command builds (not one with a context) for its help: "pca, lr, ..., ecod
+    (detectors; pyod's need the bench extra)"."""
+    listed = [n for n in names(role) if REGISTRY[n].context is None]
     needs = {b.needs: b.extra for b in REGISTRY.values() if b.role == role and b.needs}
     notes = "".join(f"; {module}'s need the {extra} extra" for module, extra in needs.items())
     return f"{', '.join(listed)} ({role}s{notes})"
 
 
 def __getattr__(attribute: str):
-    """``DETECTORS`` and ``ISOLATORS``, the names of each role as registered now (a baseline
-    registered later is in them); ``PCADetector``, imported on first use."""
+    """``DETECTORS``, ``ISOLATORS`` and ``PROGNOSERS``, the names of each role as registered now (a
+    baseline registered later is in them); ``PCADetector``, imported on first use."""
     if attribute == "DETECTORS":
         return names("detector")
     if attribute == "ISOLATORS":
         return names("isolator")
+    if attribute == "PROGNOSERS":
+        return names("prognoser")
     if attribute == "PCADetector":
         from faultgen.bench.pca_detector import PCADetector
 
@@ -252,32 +346,67 @@ def _ecod():
 # Isolators: the analysis package's (analysis.isolation.ISOLATORS), with their defaults.
 
 
-def _isolator(name: str):
+def _isolator(name: str, **params):
     from analysis import isolation
 
-    return isolation.make(name)
+    return isolation.make(name, **params)
 
 
 @register("transfer_entropy", "isolator", "largest summed net transfer entropy (thesis eq. 6.4-6.5)")
-def _transfer_entropy():
-    return _isolator("transfer_entropy")
+def _transfer_entropy(**params):
+    return _isolator("transfer_entropy", **params)
 
 
 @register("cross_correlation", "isolator", "the axis leading every other in cross-correlation (ch. 3.4.2)")
-def _cross_correlation():
-    return _isolator("cross_correlation")
+def _cross_correlation(**params):
+    return _isolator("cross_correlation", **params)
 
 
 @register("granger", "isolator", "largest summed net pairwise Granger F statistic (Granger 1969)")
-def _granger():
-    return _isolator("granger")
+def _granger(**params):
+    return _isolator("granger", **params)
 
 
 @register("trend", "isolator", "the axis whose signal drifts most against its own noise")
-def _trend():
-    return _isolator("trend")
+def _trend(**params):
+    return _isolator("trend", **params)
 
 
 @register("pca_contribution", "isolator", "largest contribution to the PCA residual Q (thesis eq. 3.3-3.4)")
-def _pca_contribution():
-    return _isolator("pca_contribution")
+def _pca_contribution(**params):
+    return _isolator("pca_contribution", **params)
+
+
+
+# Prognosers: the prognostics track's (faultgen.bench.prognosers' contract).
+
+
+@register("linear", "prognoser", "linear trend of the torque rise, extrapolated to the train split's end-of-life level")
+def _linear(**params):
+    from faultgen.bench.degradation import LinearDegradation
+
+    return LinearDegradation(**params)
+
+
+@register("exponential", "prognoser", "exponential trend of the torque rise (Gebraeel et al. 2005), extrapolated")
+def _exponential(**params):
+    from faultgen.bench.degradation import ExponentialDegradation
+
+    return ExponentialDegradation(**params)
+
+
+@register("mean_life", "prognoser", "the naive prognoser: the train split's lives, whatever the unit's records")
+def _mean_life():
+    from faultgen.bench.prognosers import MeanLife
+
+    return MeanLife()
+
+
+# The twin: the monitor's, run on raw logs outside any command that takes a track's files.
+
+
+@register("twin", "detector", "faultgen monitor's twin: wear estimate's lower bound, the axis of its first alarm",
+          context="the test split as raw logs, faultgen monitor run on them (benchmarks/twin_baseline.py)",
+          isolates=True)
+def _twin():  # never called: the entry has a context
+    raise NotImplementedError
