@@ -7,14 +7,17 @@ thesis track, `faultgen detect --baseline zmean` runs it on a dataset as the sam
 plug-in does, and benchmarks/bench_all.py lists it; `faultgen bench-isolators` runs ``rise`` beside
 the built-in isolators, whose rows stay those of analysis.benchmark.default_isolators; `faultgen
 bench score prognostics --prognoser doubling` scores ``doubling`` as the class itself is scored.
-Every built-in name still makes the estimator the if-chain of faultgen/bench/baselines.py made
-before the registry (type and parameters), the registry lists every role (the twin with the context
+The monitor model ``pca_monitor`` (analysis.registry, the same registry) is what the monitor,
+detect's default, training-source and the pca baseline make. Every built-in name still makes the
+estimator the if-chain of faultgen/bench/baselines.py made before the registry (type and
+parameters), the registry lists every role (the twin with the context
 it runs on, refused by the commands that cannot run it), and an unknown name's error lists the
 registered names.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.util
 import json
 import re
@@ -84,7 +87,8 @@ def test_every_builtin_name_makes_the_estimator_it_made_before(name):
 def test_the_example_is_one_registered_entry_and_an_unknown_name_lists_them():
     entry = baselines.REGISTRY["zmean"]
     assert entry.factory is baseline_example.zmean and entry.role == "detector"
-    assert baselines.names() == (*BUILTIN[:7], "twin", "zmean", *BUILTIN[7:], "rise", *PROGNOSERS, "doubling")
+    assert baselines.names() == (*BUILTIN[:7], "twin", "zmean", *BUILTIN[7:], "rise", *PROGNOSERS, "doubling",
+                                 "pca_monitor")
     assert "zmean" in baselines.DETECTORS and "zmean" not in baselines.ISOLATORS
     assert "zmean" in baselines.healthy_detectors() and "lr" not in baselines.healthy_detectors()
     expected = "unknown baseline 'nope'; expected one of: " + ", ".join(baselines.names())
@@ -92,8 +96,8 @@ def test_the_example_is_one_registered_entry_and_an_unknown_name_lists_them():
         baselines.make("nope")
     with pytest.raises(ValueError, match="already registered"):
         baselines.register("zmean", "detector", "another")(lambda: None)
-    with pytest.raises(ValueError, match="expected one of: detector, isolator, prognoser"):
-        baselines.register("x", "monitor", "no such role")
+    with pytest.raises(ValueError, match="expected one of: detector, isolator, prognoser, monitor"):
+        baselines.register("x", "nope", "no such role")
     result = runner.invoke(app, ["bench", "baselines"])
     assert result.exit_code == 0 and "zmean: detector; z-score of the mean" in result.output
 
@@ -154,7 +158,8 @@ def test_detect_takes_the_pca_baseline_as_its_plug_in_and_refuses_what_learns_la
         outputs[name] = (tmp_path / f"{name}.csv").read_bytes()
     assert outputs["baseline"] == outputs["plugin"]
     for name, message in (("lr", "is a classifier"), ("trend", "is an isolator"), ("nope", "unknown baseline"),
-                          ("linear", "is a prognoser"), ("twin", "runs on the test split as raw logs")):
+                          ("linear", "is a prognoser"), ("twin", "runs on the test split as raw logs"),
+                          ("pca_monitor", "is a monitor model")):
         result = runner.invoke(app, ["detect", str(small), "--no-progress", "--baseline", name,
                                      "-o", str(tmp_path / name)])
         assert result.exit_code == 2 and message in result.output, result.output
@@ -238,3 +243,39 @@ def test_bench_score_prognostics_takes_a_registered_prognoser_by_name(prognostic
     assert "linear, exponential, mean_life, doubling (prognosers)" in " ".join(help_text.split())
     result = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(prognostics_small), "--prognoser", "pca"])
     assert result.exit_code == 2 and "expected one of: linear, exponential, mean_life, doubling" in result.output
+
+
+def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_uses_it(small, tmp_path,
+                                                                                         monkeypatch):
+    """``pca_monitor`` (analysis.registry, whose REGISTRY faultgen.bench.baselines re-exports) is the
+    PCAMonitor the monitor, detect's default Q monitor, training-source's and the pca baseline fit:
+    each asks the registry for it (a spy on its factory sees every call); bench score, detect
+    --baseline and bench_all leave it out (a monitor model is not a detector)."""
+    from analysis import registry, training_source
+    from analysis.monitoring import PCAMonitor
+    from faultgen.bench.pca_detector import PCADetector
+    from faultgen.monitor import scoring
+
+    assert baselines.REGISTRY is registry.REGISTRY and baselines.make is registry.make
+    role, made = baselines.make("pca_monitor", variance=0.8, alpha=0.01, cv=5)
+    assert role == "monitor" and type(made) is PCAMonitor
+    assert made.get_params() == PCAMonitor(variance=0.8, alpha=0.01, cv=5).get_params()
+    assert "pca_monitor" not in baselines.scorable() and "pca_monitor" not in _bench_all().methods()
+    calls = []
+    entry = registry.REGISTRY["pca_monitor"]
+    spy = dataclasses.replace(entry, factory=lambda **params: calls.append(params) or entry.factory(**params))
+    monkeypatch.setitem(registry.REGISTRY, "pca_monitor", spy)
+    rng = np.random.default_rng(0)
+    PCADetector().fit(rng.normal(size=(60, 5)))
+    assert calls[-1] == {"variance": 0.75, "alpha": 0.05}
+    unit = scoring.UnitMonitor("u", scoring.Settings(protocol="own", train=10), n_axes=1)
+    for i in range(10):
+        unit.add(f"{i:02d}", rng.normal() * np.ones(4) + 0.1 * rng.normal(size=4), 20.0 + i % 3, 100.0)
+    assert calls[-1] == {"variance": unit.settings.variance, "alpha": unit.settings.alpha, "cv": 5}
+    assert isinstance(unit.pca, PCAMonitor)
+    training_source._fit(rng.normal(size=(40, 4)), 0.85, 0.05, None)
+    assert calls[-1] == {"variance": 0.85, "alpha": 0.05, "statistic": "q", "cv": None}
+    n = len(calls)
+    result = runner.invoke(app, ["detect", str(small), "--no-progress", "-o", str(tmp_path / "det")])
+    assert result.exit_code == 0, result.output
+    assert len(calls) > n and all(c["statistic"] == "q" for c in calls[n:])  # detect's default Q monitor

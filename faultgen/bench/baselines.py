@@ -1,5 +1,7 @@
-"""The named baselines, one registry: each detector, isolator and prognoser declared once, by
-:func:`register` on a function that returns a new unfitted estimator. What reaches them by name:
+"""The named baselines, one registry (:mod:`analysis.registry`, re-exported here): each detector,
+isolator and prognoser declared once, by :func:`register` on a function that returns a new unfitted
+estimator; the monitor model ``pca_monitor`` is declared in :mod:`analysis.registry` itself, where
+the monitor layer reaches it. What reaches them by name:
 
 - ``faultgen bench score --baseline NAME`` (scored like a ``--detector`` or ``--isolator`` plug-in,
   :mod:`faultgen.bench.score`), its help and its errors;
@@ -42,141 +44,19 @@ lists the registry without loading scikit-learn.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+# the registry itself (one for every layer: the monitor's model is in it too), re-exported here
+from analysis.registry import REGISTRY, ROLES, Baseline, get, make, names, register
 
 if TYPE_CHECKING:
     from sklearn.base import BaseEstimator
 
-#: The roles, in the order :func:`names` lists them.
-ROLES = ("detector", "isolator", "prognoser")
+__all__ = ["REGISTRY", "ROLES", "Baseline", "describe", "for_track", "get", "healthy_detector", "healthy_detectors",
+           "isolators", "make", "names", "prognoser", "register", "scorable"]
 
-
-@dataclass(frozen=True)
-class Baseline:
-    """One named baseline.
-
-    Attributes
-    ----------
-    name : str
-        What ``--baseline`` takes; the method's name in the score files and the leaderboard.
-    role : {"detector", "isolator", "prognoser"}
-    factory : callable (**params) -> estimator, or None
-        A new, unfitted estimator on every call (a scikit-learn one for a detector or an isolator;
-        for a prognoser, the contract of :mod:`faultgen.bench.prognosers`); keyword parameters, when
-        the estimator takes any, go to it. None for an entry that runs only in its ``context``.
-    summary : str
-        One line: what it is and where it comes from.
-    needs : str or None
-        The optional module it imports (e.g. ``"pyod"``), None when the base install has it.
-    extra : str
-        The package extra that installs ``needs``.
-    labels : bool
-        It learns from labelled records (a classifier, ``fit(X, y)``); ``faultgen detect``, which
-        learns healthy samples only, refuses it.
-    context : str or None
-        What it runs on besides a track's train and test files (the twin: the monitor run on raw
-        logs); None for an estimator any command builds. Commands that take only a track's files
-        or a dataset refuse an entry with a context, naming it.
-    isolates : bool
-        A detector that also names the worn axis (the twin).
-    """
-
-    name: str
-    role: str
-    factory: Callable[..., BaseEstimator] | None
-    summary: str
-    needs: str | None = None
-    extra: str = "bench"
-    labels: bool = False
-    context: str | None = None
-    isolates: bool = False
-
-    def make(self, **params) -> BaseEstimator:
-        """A new unfitted estimator, ``params`` passed to its factory.
-
-        Raises
-        ------
-        ValueError
-            If the entry runs only in its context (naming it), or the optional module it needs is
-            not installed (saying how to install it).
-        """
-        if self.factory is None or self.context is not None:
-            raise ValueError(f"baseline {self.name!r} runs on {self.context}; this command cannot run it")
-        try:
-            return self.factory(**params)
-        except ImportError as err:
-            if self.needs is None or (err.name or "").partition(".")[0] != self.needs:
-                raise
-            raise ValueError(f"baseline {self.name!r} needs {self.needs}: pip install "
-                             f"'faultgen-robots[{self.extra}]' (or {self.needs})") from None
-
-
-#: Every registered baseline by name, in the order registered.
-REGISTRY: dict[str, Baseline] = {}
-
-
-def register(name: str, role: str, summary: str, *, needs: str | None = None, extra: str = "bench",
-             labels: bool = False, context: str | None = None, isolates: bool = False) -> Callable:
-    """Decorator: register the decorated factory (keyword parameters or none -> a new unfitted
-    estimator) as the baseline ``name`` (the fields of :class:`Baseline`); returns the factory
-    unchanged. An entry with a ``context`` may decorate a function that stands for it: it is never
-    called.
-
-    Raises
-    ------
-    ValueError
-        If ``role`` is not one of :data:`ROLES`, ``name`` is empty or holds a ``:`` (the mark of a
-        ``MODULE:CLASS`` plug-in), or ``name`` is registered to another factory.
-    """
-    if role not in ROLES:
-        raise ValueError(f"baseline {name!r}: role {role!r}; expected one of: {', '.join(ROLES)}")
-    if not name or ":" in name:
-        raise ValueError(f"baseline name {name!r}: expected a plain name (MODULE:CLASS names a plug-in)")
-
-    def add(factory: Callable[[], BaseEstimator]) -> Callable[[], BaseEstimator]:
-        known = REGISTRY.get(name)
-        if known is not None and known.factory is not factory:
-            raise ValueError(f"baseline {name!r} is already registered ({known.summary})")
-        REGISTRY[name] = Baseline(name, role, None if context else factory, summary, needs, extra, labels,
-                                  context, isolates)
-        return factory
-
-    return add
-
-
-def names(role: str | None = None) -> tuple[str, ...]:
-    """The registered names, detectors first, each role in the order registered; only ``role``'s
-    when given."""
-    return tuple(b.name for r in ROLES if role in (None, r) for b in REGISTRY.values() if b.role == r)
-
-
-def get(name: str) -> Baseline:
-    """The baseline ``name``.
-
-    Raises
-    ------
-    ValueError
-        For an unknown name, listing the registered ones.
-    """
-    if name not in REGISTRY:
-        raise ValueError(f"unknown baseline {name!r}; expected one of: {', '.join(names())}")
-    return REGISTRY[name]
-
-
-def make(name: str, **params) -> tuple[str, BaseEstimator]:
-    """(role, a new unfitted estimator) of the baseline ``name``, ``params`` given to it (e.g.
-    ``make("transfer_entropy", bins=5)``).
-
-    Raises
-    ------
-    ValueError
-        For an unknown name (listing them), an entry that runs only in its context (the twin), or a
-        pyod baseline without pyod installed (saying how).
-    """
-    baseline = get(name)
-    return baseline.role, baseline.make(**params)
+#: Why a command that takes a detector refuses a monitor model.
+MONITOR = "is a monitor model (T2, Q and their limits: faultgen monitor's, detect's default's), not a detector"
 
 
 def scorable() -> tuple[str, ...]:
@@ -197,8 +77,8 @@ def for_track(name: str) -> tuple[str, BaseEstimator]:
     """
     baseline = get(name)
     if baseline.role not in ("detector", "isolator") or baseline.context is not None:
-        what = (f"is a prognoser (`bench score prognostics --baseline {name}`)" if baseline.role == "prognoser" else
-                f"runs on {baseline.context}")
+        what = {"prognoser": f"is a prognoser (`bench score prognostics --baseline {name}`)",
+                "monitor": MONITOR}.get(baseline.role, f"runs on {baseline.context}")
         raise ValueError(f"baseline {name!r} {what}; bench score on this track takes: {', '.join(scorable())}")
     return make(name)
 
@@ -259,7 +139,7 @@ def healthy_detector(name: str) -> BaseEstimator:
     if baseline.role != "detector" or baseline.labels or baseline.context is not None:
         takes = ", ".join(healthy_detectors())
         what = {"isolator": "is an isolator (`faultgen bench-isolators`, `bench score`)",
-                "prognoser": "is a prognoser (`bench score prognostics`)"}.get(
+                "prognoser": "is a prognoser (`bench score prognostics`)", "monitor": MONITOR}.get(
             baseline.role, f"runs on {baseline.context}" if baseline.context else
             "is a classifier: it learns labelled records, and detect learns healthy samples only (`bench score`)")
         raise ValueError(f"baseline {name!r} {what}; detect takes a detector that learns healthy samples: {takes}")

@@ -24,11 +24,13 @@ class PCADetector(BaseEstimator):
         self.alpha = alpha
 
     def fit(self, X, y=None) -> PCADetector:
-        from analysis.monitoring import PCAMonitor, varying_columns
+        from analysis import registry
+        from analysis.monitoring import varying_columns
 
         X = np.asarray(X, dtype=float)
         self.columns_ = varying_columns(X)
-        self.monitor_ = PCAMonitor(variance=self.variance, alpha=self.alpha).fit(X[:, self.columns_])
+        made = registry.make("pca_monitor", variance=self.variance, alpha=self.alpha)[1]  # the monitor model
+        self.monitor_ = made.fit(X[:, self.columns_])
         return self
 
     def decision_function(self, X) -> np.ndarray:
