@@ -2,13 +2,16 @@
 once, by :func:`register`, and made by name with :func:`make` (``make(NAME, **params)``).
 
 It sits in the ``analysis`` package, below both of its users that may not import each other (the
-``bench`` and ``monitor`` layers of faultgen, pyproject's import-linter contract): the benchmark's
-baselines are declared in :mod:`faultgen.bench.baselines` (its face: ``faultgen bench baselines``,
-``bench score --baseline``, ``detect --baseline``, ``bench-isolators``), and the monitor model of
-thesis ch. 2.3 here (``pca_monitor``, role ``monitor``: :class:`analysis.monitoring.PCAMonitor`,
-Hotelling's T2 and Q with their limits), which ``faultgen monitor`` (:mod:`faultgen.monitor.scoring`),
-``faultgen detect``'s default Q monitor, ``faultgen training-source`` and the ``pca`` baseline build
-through :func:`make` (and so ``faultgen reproduce``, which runs those commands).
+``bench`` and ``monitor`` layers of faultgen, pyproject's import-linter contract). Declared here:
+the analysis package's methods, ``pca`` (:class:`analysis.pca_detector.PCADetector`), the
+classifiers ``lr``, ``svm``, ``rf``, ``stacking`` (thesis ch. 5.2, which ``faultgen classify``
+makes through :func:`make`), and the monitor model of thesis ch. 2.3 (``pca_monitor``, role
+``monitor``: :class:`analysis.monitoring.PCAMonitor`, Hotelling's T2 and Q with their limits),
+which ``faultgen monitor`` (:mod:`faultgen.monitor.scoring`), ``faultgen detect``'s default Q
+monitor and ``faultgen training-source`` make through :func:`make` (and so ``faultgen reproduce``,
+which runs those commands). The benchmark's other baselines are declared in
+:mod:`faultgen.bench.baselines` (its face: ``faultgen bench baselines``, ``bench score
+--baseline``, ``detect --baseline``, ``bench-isolators``).
 
 A **monitor** (role ``monitor``) is a scikit-learn estimator with ``fit(X)`` (X of shape (n_samples,
 n_features), healthy samples), ``score_samples(X)`` -> (T2, Q), each of shape (n_samples,),
@@ -154,6 +157,45 @@ def make(name: str, **params) -> tuple[str, BaseEstimator]:
     """
     baseline = get(name)
     return baseline.role, baseline.make(**params)
+
+
+# The analysis package's detectors, declared here so that its own commands (classify) reach them:
+# the PCA baseline and the classifiers of thesis ch. 5.2 (seed 0 unless given).
+
+
+@register("pca", "detector", "PCA monitor, T2 or Q above its 95 % limit (thesis ch. 2.3, 75 % of variance)")
+def _pca(**params):
+    from analysis.pca_detector import PCADetector
+
+    return PCADetector(**params)
+
+
+def _classifier(name: str, **params):
+    from analysis.classify.classifiers import CLASSIFIERS
+
+    return CLASSIFIERS[name](**{"random_state": 0, **params})
+
+
+@register("lr", "detector", "logistic regression on labelled records (thesis ch. 5.2)", labels=True)
+def _lr(**params):
+    return _classifier("lr", **params)
+
+
+@register("svm", "detector", "support vector machine on labelled records (thesis ch. 5.2)", labels=True)
+def _svm(**params):
+    return _classifier("svm", **params)
+
+
+@register("rf", "detector", "random forest on labelled records (thesis ch. 5.2)", labels=True)
+def _rf(**params):
+    return _classifier("rf", **params)
+
+
+@register("stacking", "detector", "LR and SVM stacked under LR, on labelled records (thesis Fig. 5-3)",
+          labels=True)
+def _stacking(**params):
+    # by sample: bench score's fit sees records, not units (classify asks for inner_cv="run")
+    return _classifier("stacking", **{"inner_cv": "sample", **params})
 
 
 # The monitor model, declared here so that the monitor layer reaches it without the bench layer.

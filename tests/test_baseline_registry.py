@@ -8,7 +8,7 @@ plug-in does, and benchmarks/bench_all.py lists it; `faultgen bench-isolators` r
 the built-in isolators, whose rows stay those of analysis.benchmark.default_isolators; `faultgen
 bench score prognostics --prognoser doubling` scores ``doubling`` as the class itself is scored.
 The monitor model ``pca_monitor`` (analysis.registry, the same registry) is what the monitor,
-detect's default, training-source and the pca baseline make. Every built-in name still makes the
+detect's default and training-source make, and classify makes its classifiers by the registry. Every built-in name still makes the
 estimator the if-chain of faultgen/bench/baselines.py made before the registry (type and
 parameters), the registry lists every role (the twin with the context
 it runs on, refused by the commands that cannot run it), and an unknown name's error lists the
@@ -248,9 +248,9 @@ def test_bench_score_prognostics_takes_a_registered_prognoser_by_name(prognostic
 def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_uses_it(small, tmp_path,
                                                                                          monkeypatch):
     """``pca_monitor`` (analysis.registry, whose REGISTRY faultgen.bench.baselines re-exports) is the
-    PCAMonitor the monitor, detect's default Q monitor, training-source's and the pca baseline fit:
-    each asks the registry for it (a spy on its factory sees every call); bench score, detect
-    --baseline and bench_all leave it out (a monitor model is not a detector)."""
+    PCAMonitor the monitor, detect's default Q monitor and training-source fit: each asks the
+    registry for it (a spy on its factory sees every call); the pca baseline fits the same one;
+    bench score, detect --baseline and bench_all leave it out (a monitor model is not a detector)."""
     from analysis import registry, training_source
     from analysis.monitoring import PCAMonitor
     from faultgen.bench.pca_detector import PCADetector
@@ -266,8 +266,10 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     spy = dataclasses.replace(entry, factory=lambda **params: calls.append(params) or entry.factory(**params))
     monkeypatch.setitem(registry.REGISTRY, "pca_monitor", spy)
     rng = np.random.default_rng(0)
-    PCADetector().fit(rng.normal(size=(60, 5)))
-    assert calls[-1] == {"variance": 0.75, "alpha": 0.05}
+    # the pca baseline is itself an entry: it fits the same PCAMonitor (the registry imports it, so it
+    # does not ask the registry back)
+    fitted = PCADetector().fit(rng.normal(size=(60, 5))).monitor_
+    assert fitted.get_params() == entry.factory(variance=0.75, alpha=0.05).get_params() and not calls
     unit = scoring.UnitMonitor("u", scoring.Settings(protocol="own", train=10), n_axes=1)
     for i in range(10):
         unit.add(f"{i:02d}", rng.normal() * np.ones(4) + 0.1 * rng.normal(size=4), 20.0 + i % 3, 100.0)
@@ -279,3 +281,26 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     result = runner.invoke(app, ["detect", str(small), "--no-progress", "-o", str(tmp_path / "det")])
     assert result.exit_code == 0, result.output
     assert len(calls) > n and all(c["statistic"] == "q" for c in calls[n:])  # detect's default Q monitor
+
+
+def test_classify_makes_its_classifiers_through_the_registry(monkeypatch):
+    """`faultgen classify` (thesis Table 5.2, which `reproduce` runs) builds each classifier by
+    ``analysis.registry.make`` with its seed, stacking with inner folds by run: the estimator the
+    classifier's own factory makes (``CLASSIFIERS[name](random_state=...)``), whereas `bench score
+    --baseline stacking` keeps its folds by sample."""
+    from analysis import registry
+    from analysis.classify import CLASSIFIERS
+    from analysis.classify.preprocessing import make_pipeline
+
+    asked = []
+    make = registry.make
+    monkeypatch.setattr(registry, "make", lambda name, **params: asked.append((name, params)) or make(name, **params))
+    for name in CLASSIFIERS:
+        made = make_pipeline(name, "control", random_state=7)
+        direct = CLASSIFIERS[name](random_state=7)
+        tail = [est for _, est in made.steps[-len(direct.steps):]] if hasattr(direct, "steps") else [made.steps[-1][1]]
+        expected = [est for _, est in direct.steps] if hasattr(direct, "steps") else [direct]
+        assert [_params(a) for a in tail] == [_params(b) for b in expected]
+    assert asked == [("lr", {"random_state": 7}), ("svm", {"random_state": 7}), ("rf", {"random_state": 7}),
+                     ("stacking", {"random_state": 7, "inner_cv": "run"})]
+    assert baselines.make("stacking")[1].get_params()["stacking__cv"].__class__.__name__ == "StratifiedKFold"

@@ -1,7 +1,8 @@
 """The named baselines, one registry (:mod:`analysis.registry`, re-exported here): each detector,
 isolator and prognoser declared once, by :func:`register` on a function that returns a new unfitted
-estimator; the monitor model ``pca_monitor`` is declared in :mod:`analysis.registry` itself, where
-the monitor layer reaches it. What reaches them by name:
+estimator; ``pca``, the classifiers and the monitor model ``pca_monitor`` are declared in
+:mod:`analysis.registry` itself, where ``faultgen classify`` and the monitor layer reach them, the
+others here. What reaches them by name:
 
 - ``faultgen bench score --baseline NAME`` (scored like a ``--detector`` or ``--isolator`` plug-in,
   :mod:`faultgen.bench.score`), its help and its errors;
@@ -165,47 +166,14 @@ def __getattr__(attribute: str):
     if attribute == "PROGNOSERS":
         return names("prognoser")
     if attribute == "PCADetector":
-        from faultgen.bench.pca_detector import PCADetector
+        from analysis.pca_detector import PCADetector
 
         return PCADetector
     raise AttributeError(f"module {__name__!r} has no attribute {attribute!r}")
 
 
-# The built-ins. Detectors:
-
-
-@register("pca", "detector", "PCA monitor, T2 or Q above its 95 % limit (thesis ch. 2.3, 75 % of variance)")
-def _pca():
-    from faultgen.bench.pca_detector import PCADetector
-
-    return PCADetector()
-
-
-def _classifier(name: str, **params):
-    from analysis.classify import CLASSIFIERS
-
-    return CLASSIFIERS[name](random_state=0, **params)
-
-
-@register("lr", "detector", "logistic regression on labelled records (thesis ch. 5.2)", labels=True)
-def _lr():
-    return _classifier("lr")
-
-
-@register("svm", "detector", "support vector machine on labelled records (thesis ch. 5.2)", labels=True)
-def _svm():
-    return _classifier("svm")
-
-
-@register("rf", "detector", "random forest on labelled records (thesis ch. 5.2)", labels=True)
-def _rf():
-    return _classifier("rf")
-
-
-@register("stacking", "detector", "LR and SVM stacked under LR, on labelled records (thesis Fig. 5-3)",
-          labels=True)
-def _stacking():
-    return _classifier("stacking", inner_cv="sample")  # by sample: the fit sees records, not units
+# The built-ins (pca and the classifiers are declared in analysis.registry, where classify reaches them).
+# Detectors:
 
 
 @register("iforest", "detector", "pyod's isolation forest (Liu, Ting & Zhou 2008), outside the thesis",
