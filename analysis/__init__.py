@@ -9,4 +9,6 @@
 - :mod:`analysis.isolation`: isolators with one interface (transfer entropy, eqs. 6.4-6.5;
   cross-correlation, ch. 3.4.2; Granger; trend; PCA contribution) and a registry for your own.
 - :mod:`analysis.benchmark`: all of them over a dataset, in the layouts of Tables 6.2, 3.5, 5.2.
+- :mod:`analysis.registry`: the one registry of named methods (detectors, isolators, prognosers,
+  the monitor model ``pca_monitor``) that faultgen's benchmark and monitor both make by name.
 """

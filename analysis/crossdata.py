@@ -32,7 +32,7 @@ import pandas as pd
 from sklearn.base import clone
 from tqdm.auto import tqdm
 
-from analysis import isolation
+from analysis import isolation, registry
 from analysis.benchmark.detection import locate_onset
 from analysis.benchmark.truth import fault_progress, opened
 from analysis.features import kl_divergence
@@ -152,7 +152,8 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
         normal = np.vstack([unit_detection_features(run, first) for run in learnt])
         used = varying_columns(normal)
         monitor = (clone(detector).fit(normal[:, used]) if detector is not None
-                   else fit_q_monitor(normal[:, used], variance, alpha, cv=limit_folds))
+                   else fit_q_monitor(normal[:, used], registry.make("pca_monitor", variance=variance, alpha=alpha,
+                                                                     statistic="q", cv=limit_folds)[1]))
         judged = [run for run in data.healthy if len(run.recorded) > first]
         rates = [100.0 * float(np.mean(np.asarray(monitor.predict(unit_detection_features(run, first)[first:, used]),
                                                   dtype=bool))) for run in judged]

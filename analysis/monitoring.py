@@ -233,12 +233,18 @@ class PCAMonitor(BaseEstimator):
         return (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
 
 
-def fit_q_monitor(X, variance: float, alpha: float, cv: int | None = None) -> PCAMonitor:
-    """A :class:`PCAMonitor` alarming on Q, fitted on ``X`` (m, n_features). Where ``variance``
-    would need every component (no residual space for Q, as with a few weakly correlated
-    features), it keeps ``min(n_features - 1, m - 3)`` components instead: one feature's worth of
-    residual, and room for a fold of ``cv`` to fit them."""
-    monitor = PCAMonitor(variance=variance, alpha=alpha, statistic="q", cv=cv)
+def fit_q_monitor(X, monitor: PCAMonitor) -> PCAMonitor:
+    """``monitor``, an unfitted :class:`PCAMonitor` alarming on Q (the registry's: ``analysis.registry
+    .make("pca_monitor", variance=..., alpha=..., statistic="q", cv=...)``), fitted on ``X`` (m,
+    n_features). Where its ``variance`` would need every component (no residual space for Q, as
+    with a few weakly correlated features), it keeps ``min(n_features - 1, m - 3)`` components
+    instead: one feature's worth of residual, and room for a fold of ``cv`` to fit them.
+
+    Raises
+    ------
+    ValueError
+        If it cannot be fitted with that many components either (too few samples).
+    """
     try:
         return monitor.fit(X)
     except ValueError:

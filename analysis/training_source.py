@@ -34,6 +34,7 @@ import pandas as pd
 from scipy import signal as scipy_signal
 from tqdm.auto import tqdm
 
+from analysis import registry
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
@@ -154,7 +155,9 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
     """The features used and the Q monitor fitted on detrended training signals ``X``."""
     X = _detrend(X)
     used = varying_columns(X)
-    return used, fit_q_monitor(X[:, used], variance, alpha, cv=None if folds is None else min(folds, len(X)))
+    made = registry.make("pca_monitor", variance=variance, alpha=alpha, statistic="q",
+                         cv=None if folds is None else min(folds, len(X)))[1]
+    return used, fit_q_monitor(X[:, used], made)
 
 
 def _robots(path, window: Window) -> list[tuple]:

@@ -36,11 +36,13 @@ def run(argv: list[str]) -> tuple[float, str | None]:
 
 def methods() -> tuple[str, ...]:
     """The baselines each track is scored with: every registered detector, then every isolator
-    (:func:`faultgen.bench.baselines.names`, at the time of the call). Each is scored by a ``faultgen``
-    process, which knows the baselines declared in faultgen/bench/baselines.py: a baseline registered
-    by a module of one's own (tests/baseline_example.py) is listed, but its score fails as unknown
-    unless it is declared there."""
-    return baselines.names()
+    (:func:`faultgen.bench.baselines.scorable`, at the time of the call; not the twin, which runs on
+    the monitor's outputs: benchmarks/twin_baseline.py, nor the prognosers). Each is scored by a
+    ``faultgen`` process, which knows the baselines declared in analysis/registry.py and
+    faultgen/bench/baselines.py: a baseline registered by a module of one's own
+    (tests/baseline_example.py) is listed, but its score fails as unknown unless it is declared
+    there."""
+    return baselines.scorable()
 
 
 def main() -> None:

@@ -14,7 +14,7 @@ import bench_plugins
 import numpy as np
 import pytest
 
-from faultgen.bench import degradation, files, independent, make, prognosers, prognostics
+from faultgen.bench import baselines, files, independent, make, prognosers, prognostics
 
 
 @pytest.fixture(scope="module")
@@ -146,14 +146,14 @@ def test_a_degradation_baseline_finds_the_end_of_life_of_its_own_law(name, law):
     train = [_unit(f"train-{k}", law(s), 120, 2, rng) for k, s in enumerate((0.5, 0.8))]
     test = _unit("test", law(0.6), 120, 2, rng)
     eol = prognosers.end_of_life(test, 40.0)
-    prognoser = degradation.BASELINES[name]().fit(train, 40.0)
+    prognoser = baselines.make(name)[1].fit(train, 40.0)
     # 0.8 N m at 40 % wear over the level of 20 N m with no part
     assert prognoser.levels_[2] == pytest.approx(0.04, rel=0.05)
     now = int(eol // 2)
     predicted = prognoser.predict(prognosers.prefix(test, now))
     assert prognoser._axis(prognosers.prefix(test, now))[0] == 1
     assert np.median(predicted) == pytest.approx(eol, rel=0.05)
-    again = degradation.BASELINES[name]().fit(train, 40.0).predict(prognosers.prefix(test, now))
+    again = baselines.make(name)[1].fit(train, 40.0).predict(prognosers.prefix(test, now))
     assert np.array_equal(predicted, again)  # same records, same draws
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from analysis import isolation
+from analysis import isolation, registry
 from analysis.benchmark.detection_features import (
     StoredHistograms,
     detection_scale,
@@ -412,7 +412,8 @@ def _fit_monitor(training: list, period: int | None, variance: float, alpha: flo
     if folds is not None:
         folds = min(folds, len(normal))  # at most one fold per training sample
     try:
-        return scale, reference, used, fit_q_monitor(normal[:, used], variance, alpha, cv=folds)
+        made = registry.make("pca_monitor", variance=variance, alpha=alpha, statistic="q", cv=folds)[1]
+        return scale, reference, used, fit_q_monitor(normal[:, used], made)
     except ValueError as err:
         if folds is None:
             raise

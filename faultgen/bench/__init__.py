@@ -8,9 +8,10 @@
   each with a bootstrap interval over test units;
 - :mod:`~faultgen.bench.verdicts`: every score's verdict against chance (above, at, below), and the
   records per unit a method needs;
-- :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods and two pyod detectors),
-  one registry that ``bench score``, ``detect`` and ``bench baselines`` read (the PCA one's class in
-  :mod:`~faultgen.bench.pca_detector`).
+- :mod:`~faultgen.bench.baselines`: the named baselines (the thesis's methods, two pyod detectors, the
+  prognostics track's prognosers, the twin), declared in the one registry (:mod:`analysis.registry`)
+  that ``bench score``, ``detect``, ``bench-isolators`` and ``bench baselines`` read (the PCA one's
+  class in :mod:`~faultgen.bench.pca_detector`).
 - :mod:`~faultgen.bench.independent`: the sim-to-real track's test fleet, made by another simulator
   (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use).
 - :mod:`~faultgen.bench.rawlogs`, :mod:`~faultgen.bench.twin`, :mod:`~faultgen.bench.recorded`:

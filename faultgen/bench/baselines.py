@@ -1,12 +1,18 @@
-"""The named baselines, one registry: each detector and isolator declared once, by :func:`register`
-on a function that returns a new unfitted estimator. What reaches them by name:
+"""The named baselines, one registry (:mod:`analysis.registry`, re-exported here): each detector,
+isolator and prognoser declared once, by :func:`register` on a function that returns a new unfitted
+estimator; ``pca``, the classifiers and the monitor model ``pca_monitor`` are declared in
+:mod:`analysis.registry` itself, where ``faultgen classify`` and the monitor layer reach them, the
+others here. What reaches them by name:
 
 - ``faultgen bench score --baseline NAME`` (scored like a ``--detector`` or ``--isolator`` plug-in,
   :mod:`faultgen.bench.score`), its help and its errors;
 - ``faultgen detect --baseline NAME``, a detector that learns healthy samples (not one that learns
   labels: a classifier);
+- ``faultgen bench-isolators``: every registered isolator (:func:`isolators`);
+- ``faultgen bench score prognostics --baseline NAME`` or ``--prognoser NAME``: a prognoser
+  (:func:`prognoser`, the contract of :mod:`faultgen.bench.prognosers`);
 - ``faultgen bench baselines`` (the list) and ``benchmarks/bench_all.py`` (the leaderboard's rows,
-  docs/leaderboard.md), through :func:`names`.
+  docs/leaderboard.md), through :func:`names` and :func:`scorable`.
 
 Adding a baseline is one decorated function here (or in a module of one's own imported before
 the command runs: tests/baseline_example.py). The built-ins:
@@ -25,133 +31,98 @@ Detectors:
 Isolators (scored like an ``--isolator`` plug-in): ``transfer_entropy``, ``cross_correlation``,
 ``granger``, ``trend``, ``pca_contribution`` (:data:`analysis.isolation.ISOLATORS`, thesis ch. 3.3 and 6.3).
 
+Prognosers (the prognostics track): ``linear``, ``exponential`` (:mod:`faultgen.bench.degradation`)
+and ``mean_life``, the naive one (:class:`faultgen.bench.prognosers.MeanLife`).
+
+The twin (``twin``): ``faultgen monitor``'s twin as a detector and isolator. It runs on a context a
+track's files do not hold (the test split written as raw logs, the monitor run on them:
+``benchmarks/twin_baseline.py``), so it has no factory: :meth:`Baseline.make` refuses it naming that
+context, and ``bench score --baseline``, ``detect --baseline`` and ``bench_all`` leave it out.
+
 This module imports nothing heavy (each factory imports its estimator), so the command line's help
 lists the registry without loading scikit-learn.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+# the registry itself (one for every layer: the monitor's model is in it too), re-exported here
+from analysis.registry import REGISTRY, ROLES, Baseline, get, make, names, register
 
 if TYPE_CHECKING:
     from sklearn.base import BaseEstimator
 
-ROLES = ("detector", "isolator")
+__all__ = ["REGISTRY", "ROLES", "Baseline", "describe", "for_track", "get", "healthy_detector", "healthy_detectors",
+           "isolators", "make", "names", "prognoser", "register", "scorable"]
+
+#: Why a command that takes a detector refuses a monitor model.
+MONITOR = "is a monitor model (T2, Q and their limits: faultgen monitor's, detect's default's), not a detector"
 
 
-@dataclass(frozen=True)
-class Baseline:
-    """One named baseline.
-
-    Attributes
-    ----------
-    name : str
-        What ``--baseline`` takes; the method's name in the score files and the leaderboard.
-    role : {"detector", "isolator"}
-    factory : callable () -> estimator
-        A new, unfitted scikit-learn estimator on every call.
-    summary : str
-        One line: what it is and where it comes from.
-    needs : str or None
-        The optional module it imports (e.g. ``"pyod"``), None when the base install has it.
-    extra : str
-        The package extra that installs ``needs``.
-    labels : bool
-        It learns from labelled records (a classifier, ``fit(X, y)``); ``faultgen detect``, which
-        learns healthy samples only, refuses it.
-    """
-
-    name: str
-    role: str
-    factory: Callable[[], BaseEstimator]
-    summary: str
-    needs: str | None = None
-    extra: str = "bench"
-    labels: bool = False
-
-    def make(self) -> BaseEstimator:
-        """A new unfitted estimator.
-
-        Raises
-        ------
-        ValueError
-            If the optional module it needs is not installed (saying how to install it).
-        """
-        try:
-            return self.factory()
-        except ImportError as err:
-            if self.needs is None or (err.name or "").partition(".")[0] != self.needs:
-                raise
-            raise ValueError(f"baseline {self.name!r} needs {self.needs}: pip install "
-                             f"'faultgen-robots[{self.extra}]' (or {self.needs})") from None
+def scorable() -> tuple[str, ...]:
+    """The detectors and isolators ``faultgen bench score --baseline`` runs on a track's files alone
+    (not an entry with a context): the leaderboard's list (``benchmarks/bench_all.py``)."""
+    return tuple(n for n in names() if REGISTRY[n].role in ("detector", "isolator") and REGISTRY[n].context is None)
 
 
-#: Every registered baseline by name, in the order registered.
-REGISTRY: dict[str, Baseline] = {}
-
-
-def register(name: str, role: str, summary: str, *, needs: str | None = None, extra: str = "bench",
-             labels: bool = False) -> Callable:
-    """Decorator: register the decorated factory (no arguments -> a new unfitted estimator) as the
-    baseline ``name`` (the fields of :class:`Baseline`); returns the factory unchanged.
+def for_track(name: str) -> tuple[str, BaseEstimator]:
+    """(role, a new estimator) of the baseline ``name`` for ``faultgen bench score`` on a detection
+    and isolation track.
 
     Raises
     ------
     ValueError
-        If ``role`` is not one of :data:`ROLES`, ``name`` is empty or holds a ``:`` (the mark of a
-        ``MODULE:CLASS`` plug-in), or ``name`` is registered to another factory.
-    """
-    if role not in ROLES:
-        raise ValueError(f"baseline {name!r}: role {role!r}; expected one of: {', '.join(ROLES)}")
-    if not name or ":" in name:
-        raise ValueError(f"baseline name {name!r}: expected a plain name (MODULE:CLASS names a plug-in)")
-
-    def add(factory: Callable[[], BaseEstimator]) -> Callable[[], BaseEstimator]:
-        known = REGISTRY.get(name)
-        if known is not None and known.factory is not factory:
-            raise ValueError(f"baseline {name!r} is already registered ({known.summary})")
-        REGISTRY[name] = Baseline(name, role, factory, summary, needs, extra, labels)
-        return factory
-
-    return add
-
-
-def names(role: str | None = None) -> tuple[str, ...]:
-    """The registered names, detectors first, each role in the order registered; only ``role``'s
-    when given."""
-    return tuple(b.name for r in ROLES if role in (None, r) for b in REGISTRY.values() if b.role == r)
-
-
-def get(name: str) -> Baseline:
-    """The baseline ``name``.
-
-    Raises
-    ------
-    ValueError
-        For an unknown name, listing the registered ones.
-    """
-    if name not in REGISTRY:
-        raise ValueError(f"unknown baseline {name!r}; expected one of: {', '.join(names())}")
-    return REGISTRY[name]
-
-
-def make(name: str) -> tuple[str, BaseEstimator]:
-    """(role, a new unfitted estimator) of the baseline ``name``.
-
-    Raises
-    ------
-    ValueError
-        For an unknown name (listing them), or a pyod baseline without pyod installed (saying how).
+        For an unknown name, a prognoser (the prognostics track's), or an entry with a context (each
+        listing what the command takes), or as :func:`make`.
     """
     baseline = get(name)
-    return baseline.role, baseline.make()
+    if baseline.role not in ("detector", "isolator") or baseline.context is not None:
+        what = {"prognoser": f"is a prognoser (`bench score prognostics --baseline {name}`)",
+                "monitor": MONITOR}.get(baseline.role, f"runs on {baseline.context}")
+        raise ValueError(f"baseline {name!r} {what}; bench score on this track takes: {', '.join(scorable())}")
+    return make(name)
+
+
+def isolators(bins=(5, 10)) -> dict[str, BaseEstimator]:
+    """Every registered isolator (not one with a context) -> a new estimator with its defaults, in
+    the order registered; ``transfer_entropy`` once per bin count of ``bins`` (``te5``, ``te10``:
+    thesis ch. 6): the isolators of ``faultgen bench-isolators``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`make` (a bin count the isolator refuses, a missing optional module).
+    """
+    chosen = {}
+    for name in names("isolator"):
+        if REGISTRY[name].context is not None:
+            continue
+        if name == "transfer_entropy":
+            chosen.update({f"te{b}": make(name, bins=b)[1] for b in bins})
+        else:
+            chosen[name] = make(name)[1]
+    return chosen
+
+
+def prognoser(name: str):
+    """A new prognoser of the registered name ``name`` (the contract of
+    :mod:`faultgen.bench.prognosers`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name or another role, listing the registered prognosers.
+    """
+    if name not in REGISTRY or REGISTRY[name].role != "prognoser":
+        raise ValueError(f"unknown prognostics baseline {name!r}; expected one of: {', '.join(names('prognoser'))} "
+                         "(or MODULE:CLASS with --prognoser)")
+    return make(name)[1]
 
 
 def healthy_detectors() -> tuple[str, ...]:
     """The detectors that learn healthy samples (not labels): the baselines ``faultgen detect`` takes."""
-    return tuple(n for n in names("detector") if not REGISTRY[n].labels)
+    return tuple(n for n in names("detector") if not REGISTRY[n].labels and REGISTRY[n].context is None)
 
 
 def healthy_detector(name: str) -> BaseEstimator:
@@ -166,72 +137,43 @@ def healthy_detector(name: str) -> BaseEstimator:
         baselines ``detect`` takes, or a missing optional module (as :func:`make`).
     """
     baseline = get(name)
-    if baseline.role != "detector" or baseline.labels:
+    if baseline.role != "detector" or baseline.labels or baseline.context is not None:
         takes = ", ".join(healthy_detectors())
-        what = ("an isolator (`faultgen bench-isolators`, `bench score`)" if baseline.role != "detector" else
-                "a classifier: it learns labelled records, and detect learns healthy samples only (`bench score`)")
-        raise ValueError(f"baseline {name!r} is {what}; detect takes a detector that learns healthy samples: {takes}")
+        what = {"isolator": "is an isolator (`faultgen bench-isolators`, `bench score`)",
+                "prognoser": "is a prognoser (`bench score prognostics`)", "monitor": MONITOR}.get(
+            baseline.role, f"runs on {baseline.context}" if baseline.context else
+            "is a classifier: it learns labelled records, and detect learns healthy samples only (`bench score`)")
+        raise ValueError(f"baseline {name!r} {what}; detect takes a detector that learns healthy samples: {takes}")
     return baseline.make()
 
 
 def describe(role: str) -> str:
-    """``role``'s names for a command's help: "pca, lr, ..., ecod (detectors; pyod's need the bench
-    extra)"."""
-    listed = names(role)
+    """``role``'s names a command builds (not one with a context) for its help: "pca, lr, ..., ecod
+    (detectors; pyod's need the bench extra)"."""
+    listed = [n for n in names(role) if REGISTRY[n].context is None]
     needs = {b.needs: b.extra for b in REGISTRY.values() if b.role == role and b.needs}
     notes = "".join(f"; {module}'s need the {extra} extra" for module, extra in needs.items())
     return f"{', '.join(listed)} ({role}s{notes})"
 
 
 def __getattr__(attribute: str):
-    """``DETECTORS`` and ``ISOLATORS``, the names of each role as registered now (a baseline
-    registered later is in them); ``PCADetector``, imported on first use."""
+    """``DETECTORS``, ``ISOLATORS`` and ``PROGNOSERS``, the names of each role as registered now (a
+    baseline registered later is in them); ``PCADetector``, imported on first use."""
     if attribute == "DETECTORS":
         return names("detector")
     if attribute == "ISOLATORS":
         return names("isolator")
+    if attribute == "PROGNOSERS":
+        return names("prognoser")
     if attribute == "PCADetector":
-        from faultgen.bench.pca_detector import PCADetector
+        from analysis.pca_detector import PCADetector
 
         return PCADetector
     raise AttributeError(f"module {__name__!r} has no attribute {attribute!r}")
 
 
-# The built-ins. Detectors:
-
-
-@register("pca", "detector", "PCA monitor, T2 or Q above its 95 % limit (thesis ch. 2.3, 75 % of variance)")
-def _pca():
-    from faultgen.bench.pca_detector import PCADetector
-
-    return PCADetector()
-
-
-def _classifier(name: str, **params):
-    from analysis.classify import CLASSIFIERS
-
-    return CLASSIFIERS[name](random_state=0, **params)
-
-
-@register("lr", "detector", "logistic regression on labelled records (thesis ch. 5.2)", labels=True)
-def _lr():
-    return _classifier("lr")
-
-
-@register("svm", "detector", "support vector machine on labelled records (thesis ch. 5.2)", labels=True)
-def _svm():
-    return _classifier("svm")
-
-
-@register("rf", "detector", "random forest on labelled records (thesis ch. 5.2)", labels=True)
-def _rf():
-    return _classifier("rf")
-
-
-@register("stacking", "detector", "LR and SVM stacked under LR, on labelled records (thesis Fig. 5-3)",
-          labels=True)
-def _stacking():
-    return _classifier("stacking", inner_cv="sample")  # by sample: the fit sees records, not units
+# The built-ins (pca and the classifiers are declared in analysis.registry, where classify reaches them).
+# Detectors:
 
 
 @register("iforest", "detector", "pyod's isolation forest (Liu, Ting & Zhou 2008), outside the thesis",
@@ -252,32 +194,67 @@ def _ecod():
 # Isolators: the analysis package's (analysis.isolation.ISOLATORS), with their defaults.
 
 
-def _isolator(name: str):
+def _isolator(name: str, **params):
     from analysis import isolation
 
-    return isolation.make(name)
+    return isolation.make(name, **params)
 
 
 @register("transfer_entropy", "isolator", "largest summed net transfer entropy (thesis eq. 6.4-6.5)")
-def _transfer_entropy():
-    return _isolator("transfer_entropy")
+def _transfer_entropy(**params):
+    return _isolator("transfer_entropy", **params)
 
 
 @register("cross_correlation", "isolator", "the axis leading every other in cross-correlation (ch. 3.4.2)")
-def _cross_correlation():
-    return _isolator("cross_correlation")
+def _cross_correlation(**params):
+    return _isolator("cross_correlation", **params)
 
 
 @register("granger", "isolator", "largest summed net pairwise Granger F statistic (Granger 1969)")
-def _granger():
-    return _isolator("granger")
+def _granger(**params):
+    return _isolator("granger", **params)
 
 
 @register("trend", "isolator", "the axis whose signal drifts most against its own noise")
-def _trend():
-    return _isolator("trend")
+def _trend(**params):
+    return _isolator("trend", **params)
 
 
 @register("pca_contribution", "isolator", "largest contribution to the PCA residual Q (thesis eq. 3.3-3.4)")
-def _pca_contribution():
-    return _isolator("pca_contribution")
+def _pca_contribution(**params):
+    return _isolator("pca_contribution", **params)
+
+
+
+# Prognosers: the prognostics track's (faultgen.bench.prognosers' contract).
+
+
+@register("linear", "prognoser", "linear trend of the torque rise, extrapolated to the train split's end-of-life level")
+def _linear(**params):
+    from faultgen.bench.degradation import LinearDegradation
+
+    return LinearDegradation(**params)
+
+
+@register("exponential", "prognoser", "exponential trend of the torque rise (Gebraeel et al. 2005), extrapolated")
+def _exponential(**params):
+    from faultgen.bench.degradation import ExponentialDegradation
+
+    return ExponentialDegradation(**params)
+
+
+@register("mean_life", "prognoser", "the naive prognoser: the train split's lives, whatever the unit's records")
+def _mean_life():
+    from faultgen.bench.prognosers import MeanLife
+
+    return MeanLife()
+
+
+# The twin: the monitor's, run on raw logs outside any command that takes a track's files.
+
+
+@register("twin", "detector", "faultgen monitor's twin: wear estimate's lower bound, the axis of its first alarm",
+          context="the test split as raw logs, faultgen monitor run on them (benchmarks/twin_baseline.py)",
+          isolates=True)
+def _twin():  # never called: the entry has a context
+    raise NotImplementedError

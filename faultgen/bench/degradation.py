@@ -225,5 +225,3 @@ class ExponentialDegradation(_Degradation):
         out[ok] = t0 + s[ok]
         return out
 
-
-BASELINES = {"linear": LinearDegradation, "exponential": ExponentialDegradation}

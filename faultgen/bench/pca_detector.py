@@ -1,39 +1,7 @@
-"""The PCA T2/Q monitor of thesis ch. 2.3 as a benchmark detector (the ``pca`` baseline of
-:mod:`faultgen.bench.baselines`), apart from the registry so that listing the baselines imports no
-scikit-learn."""
+"""The ``pca`` baseline's class, :class:`analysis.pca_detector.PCADetector`, under its earlier name
+(``faultgen.bench.pca_detector:PCADetector`` and ``faultgen.bench.baselines:PCADetector`` still name
+it as a plug-in)."""
 
-from __future__ import annotations
+from analysis.pca_detector import PCADetector
 
-import numpy as np
-from sklearn.base import BaseEstimator
-
-
-class PCADetector(BaseEstimator):
-    """The PCA T2/Q monitor as a benchmark detector: ``decision_function`` is ``max(T2 / T2_limit,
-    Q / Q_limit)`` (> 1: an alarm), features that do not vary in training left out.
-
-    Parameters
-    ----------
-    variance : float, default=0.75
-        Share of the variance kept (thesis ch. 3.2.2).
-    alpha : float, default=0.05
-    """
-
-    def __init__(self, variance: float = 0.75, alpha: float = 0.05):
-        self.variance = variance
-        self.alpha = alpha
-
-    def fit(self, X, y=None) -> PCADetector:
-        from analysis.monitoring import PCAMonitor, varying_columns
-
-        X = np.asarray(X, dtype=float)
-        self.columns_ = varying_columns(X)
-        self.monitor_ = PCAMonitor(variance=self.variance, alpha=self.alpha).fit(X[:, self.columns_])
-        return self
-
-    def decision_function(self, X) -> np.ndarray:
-        t2, q = self.monitor_.score_samples(np.asarray(X, dtype=float)[:, self.columns_])
-        return np.maximum(t2 / self.monitor_.t2_limit_, q / self.monitor_.q_limit_)
-
-    def predict(self, X) -> np.ndarray:
-        return self.decision_function(X) > 1.0
+__all__ = ["PCADetector"]

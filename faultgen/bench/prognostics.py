@@ -2,8 +2,9 @@
 prognostics track's test units, scored with NASA ProgPy's metrics and judged against a naive
 prognoser.
 
-The prognoser (:mod:`faultgen.bench.prognosers`: ``--prognoser MODULE:CLASS``, or a baseline
-``--baseline linear|exponential|mean_life``) learns from ``train.h5`` (run-to-failure units with
+The prognoser (:mod:`faultgen.bench.prognosers`: ``--prognoser MODULE:CLASS``, or a registered
+prognoser of :mod:`faultgen.bench.baselines`, ``--baseline NAME`` or ``--prognoser NAME``:
+``linear``, ``exponential``, ``mean_life``) learns from ``train.h5`` (run-to-failure units with
 their labels) and the track's failure wear (:data:`FAILURE_WEAR`). ``test_labels.csv`` gives each
 test unit's end of life (the first record whose true wear reaches the failure wear) and its onset
 (the first record with wear); the prognoser is then shown each test unit's records up to every
@@ -39,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.bench import files, prognosers
+from faultgen.bench import baselines, files, prognosers
 from faultgen.data import atomic
 
 #: The failure wear of each version of the track, % (the end of life: docs/bench/prognostics.md).
@@ -48,27 +49,20 @@ ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
 #: Where a sample with no end of life enters the metrics: this many records after the prediction.
 HORIZON = 365.0
 RESAMPLES = 1000
-#: The baselines of ``--baseline`` on the prognostics track.
-BASELINES = ("linear", "exponential", "mean_life")
 TRACK = "prognostics"
 
 
 def baseline(name: str):
-    """A new baseline prognoser: ``linear``, ``exponential`` (:mod:`faultgen.bench.degradation`) or
-    ``mean_life`` (the naive one).
+    """A new registered prognoser (:func:`faultgen.bench.baselines.prognoser`): ``linear``,
+    ``exponential`` (:mod:`faultgen.bench.degradation`), ``mean_life`` (the naive one), or one
+    registered by a module of one's own.
 
     Raises
     ------
     ValueError
-        For another name (listing them).
+        For another name (listing the registered prognosers).
     """
-    from faultgen.bench import degradation
-
-    if name in degradation.BASELINES:
-        return degradation.BASELINES[name]()
-    if name == "mean_life":
-        return prognosers.MeanLife()
-    raise ValueError(f"unknown prognostics baseline {name!r}; expected one of: {', '.join(BASELINES)}")
+    return baselines.prognoser(name)
 
 
 def _progpy():

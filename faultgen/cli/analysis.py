@@ -82,8 +82,8 @@ def bench_isolators_command(
     baseline: Annotated[int, typer.Option(help="With --train: the first cycles of each unit its signal is centred "
                                                "and scaled by (pca_contribution's reference cycles).", min=2)] = 20,
 ) -> None:
-    """Accuracy of every isolator (transfer entropy, cross-correlation, Granger, ...) at finding the
-    worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
+    """Accuracy of every registered isolator (`faultgen bench baselines`: transfer entropy,
+    cross-correlation, Granger, ...) at finding the worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
 
     Examples (the thesis's Table 6.2 on its grid; then averaging only over the motor speeds of
     thesis ch. 6.3.2; then with your own isolator, mine.py of docs/analysis.md):
@@ -108,7 +108,7 @@ def bench_isolators_command(
                confusion_stem.with_suffix(".csv"), confusion_stem.with_suffix(".png")]
     analysis_input(file, written, overwrite)
     window = parse_window(speed_window) if speed_window is not None else None
-    isolators = benchmark.default_isolators(bins or (5, 10))
+    isolators = baselines.isolators(bins or (5, 10))  # every registered isolator (faultgen.bench.baselines)
     isolators.update({spec.rpartition(":")[2]: plugins_.load(spec, "isolator") for spec in plugins or []})
     stated = "protocol: own history (each isolator reads the tested run's own cycles)"
     if train is not None:

@@ -60,8 +60,8 @@ def list_command() -> None:
 
 @bench_app.command("baselines", cls=Command)
 def baselines_command() -> None:
-    """List the named baselines of `bench score --baseline` and `detect --baseline`: role, what
-    each is, and the extra it needs.
+    """List the named baselines of `bench score --baseline`, `detect --baseline`, `bench-isolators`
+    and `bench score prognostics --prognoser`: role, what each is, and the extra or context it needs.
 
     Example:
 
@@ -72,7 +72,9 @@ def baselines_command() -> None:
         entry = baselines.REGISTRY[name]
         needs = f" (needs {entry.needs}: the {entry.extra} extra)" if entry.needs else ""
         learns = ", a classifier (it learns labels: bench score only)" if entry.labels else ""
-        typer.echo(f"{name}: {entry.role}{learns}; {entry.summary}{needs}")
+        role = f"{entry.role} and isolator" if entry.isolates else entry.role
+        context = f"; runs on {entry.context}, no command builds it" if entry.context else ""
+        typer.echo(f"{name}: {role}{learns}; {entry.summary}{needs}{context}")
 
 
 @bench_app.command("make", cls=Command)
@@ -135,11 +137,10 @@ def score_command(
         metavar="MODULE:CLASS", help="Your isolator (the contract of `faultgen bench-isolators --isolator`).")] = None,
     baseline: Annotated[str | None, typer.Option(
         help=f"A baseline (`faultgen bench baselines`): {baselines.describe('detector')}, "
-             f"{baselines.describe('isolator')}; on the prognostics track linear, exponential, mean_life "
-             "(prognosers).")] = None,
+             f"{baselines.describe('isolator')}; on the prognostics track {baselines.describe('prognoser')}.")] = None,
     prognoser: Annotated[str | None, typer.Option(
-        metavar="MODULE:CLASS", help="Your prognoser, on the prognostics track (the contract of "
-        "faultgen.bench.prognosers).")] = None,
+        metavar="NAME|MODULE:CLASS", help="Your prognoser, on the prognostics track (the contract of "
+        f"faultgen.bench.prognosers), or a registered one: {baselines.describe('prognoser')}.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem: OUT.json and OUT.md (default: "
                                                                   "DATA/score-NAME).")] = None,
 ) -> None:
@@ -174,7 +175,7 @@ def score_command(
         raise ValueError("give one of --detector MODULE:CLASS, --isolator MODULE:CLASS or --baseline NAME")
     role, name = given[0]
     if role == "baseline":
-        role, method = baselines.make(name)
+        role, method = baselines.for_track(name)
     else:
         method = plugins.load(name, role)
     stem = out or data / f"score-{name.replace(':', '.')}"

@@ -12,21 +12,23 @@ import typer
 
 
 def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | None) -> None:
-    """Score ``--prognoser MODULE:CLASS`` or ``--baseline NAME`` on the prognostics track's files in
-    ``data``; writes OUT.json and OUT.md and prints the row with the naive prognoser's figures.
+    """Score ``--prognoser MODULE:CLASS``, ``--prognoser NAME`` or ``--baseline NAME`` (a prognoser
+    registered in :mod:`faultgen.bench.baselines`) on the prognostics track's files in ``data``;
+    writes OUT.json and OUT.md and prints the row with the naive prognoser's figures.
 
     Raises
     ------
     ValueError
-        Unless exactly one of the two is given, for an unknown baseline, or what scoring raises.
+        Unless exactly one of the two is given, for a name not registered as a prognoser (listing
+        them), or what loading or scoring raises.
     """
-    from faultgen.bench import prognosers, prognostics
+    from faultgen.bench import baselines, prognosers, prognostics
 
     if (prognoser is None) == (baseline is None):
-        raise ValueError("the prognostics track takes one of --prognoser MODULE:CLASS or --baseline "
-                         f"{'|'.join(prognostics.BASELINES)}")
+        raise ValueError("the prognostics track takes one of --prognoser MODULE:CLASS or --prognoser/--baseline "
+                         f"{'|'.join(baselines.names('prognoser'))}")
     name = prognoser or baseline
-    method = prognosers.load(prognoser) if prognoser else prognostics.baseline(baseline)
+    method = prognosers.load(name) if ":" in name else prognostics.baseline(name)
     stem = out or data / f"score-{name.replace(':', '.')}"
     results = prognostics.score(data, method, name)
     command = shlex.join(["faultgen", *sys.argv[1:]])

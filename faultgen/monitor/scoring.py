@@ -20,7 +20,8 @@ interval for a new observation, Montgomery & Runger, thesis ref. [66], ch. 11-12
 1; a log 8 K warmer than learning logs that spanned 4 K is trusted to its slopes' standard error
 times that distance, which a narrow first month learns only roughly,
 
-and fits :class:`analysis.monitoring.PCAMonitor` (Hotelling's T2 and Q, thesis eq. 2.3-2.6; the
+and fits :class:`analysis.monitoring.PCAMonitor`, made by the registry (``pca_monitor`` of
+:mod:`analysis.registry`) (Hotelling's T2 and Q, thesis eq. 2.3-2.6; the
 Q limit out-of-fold, ``cv = 5``) on the standardised residuals. Every later log is standardised
 the same way (with the twin, a feature's noise is widened by :data:`MODEL_UNCERTAINTY` of the
 change the twin predicts from the nearest condition learned from: a new part is predicted, not
@@ -61,6 +62,7 @@ from statistics import NormalDist
 
 import numpy as np
 
+from analysis import registry
 from analysis.isolation import signature_scores
 from analysis.monitoring import PCAMonitor
 
@@ -349,7 +351,8 @@ class UnitMonitor:
         scale = np.sqrt((R**2).sum(axis=0) / (len(R) - 1 - X.shape[1]))
         self.scale_ = np.where(scale > 0, scale, 1.0)
         Z = R / self.scale_
-        self.pca = PCAMonitor(variance=self.settings.variance, alpha=self.settings.alpha, cv=5).fit(Z)
+        # the registry's monitor model (analysis.registry: the one detect and training-source build)
+        self.pca = registry.make("pca_monitor", variance=self.settings.variance, alpha=self.settings.alpha, cv=5)[1].fit(Z)
         self.training = []
         self.trend = WearTrend(self.n_axes, X.shape[1])
         if self.signatures is not None:
