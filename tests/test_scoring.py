@@ -6,6 +6,7 @@ cases, and a spy on the module under each command."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,7 +150,7 @@ def test_detect_scores_through_the_module_under_its_rules(two_seeds, spied, tmp_
     rules = scoring.DETECT_RULES.with_persistence(2)
     assert _rules(spied, "onset") == _rules(spied, "false_alarm_rate") == {rules}
     assert {"before_fault", "isolation_right", "detected_share"} <= {name for name, _ in spied}
-    assert "scoring.onset" in open(detection.__file__).read()  # no second onset rule beside it
+    assert "scoring.onset" in Path(detection.__file__).read_text()  # no second onset rule beside it
 
 
 def test_detect_train_scores_through_the_module_under_detects_rules(two_seeds, spied, tmp_path):
@@ -163,4 +164,4 @@ def test_bench_isolators_scores_through_the_module(two_seeds, spied, tmp_path):
     assert result.exit_code == 0, result.output
     assert _rules(spied, "top1_accuracy") == {scoring.ISOLATION_TABLE_RULES}
     assert "isolation_right" in {name for name, _ in spied}  # each case's "correct"
-    assert "scoring.top1_accuracy" in open(isolation_scores.__file__).read()
+    assert "scoring.top1_accuracy" in Path(isolation_scores.__file__).read_text()
