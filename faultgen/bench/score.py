@@ -203,14 +203,15 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
     delays = []
     for row in judged:
         unit = row["unit"]
-        onset = scoring.onset(row["alarms"], RULES)  # from the first record: the method never sees the labels
+        start = scoring.fault_start(unit.fault_level)  # the onset is looked for from the first record (RULES)
+        onset = scoring.onset(row["alarms"], RULES, fault_start=start)
         row["detected"] = onset is not None
         if unit.fault == "none":
             continue
         cycles = unit.arrays["cycles"]
         delays.append({
             "unit": unit.id, "detected": onset is not None,
-            "after_start": scoring.delay(onset, cycles, scoring.fault_start(unit.fault_level)),
+            "after_start": scoring.delay(onset, cycles, start),
             "after_10pct": scoring.delay(onset, cycles, scoring.first_reaching(unit.fault_level, WORN_PCT))})
     healthy = [r for r in judged if r["unit"].fault == "none"]
 
