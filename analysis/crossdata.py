@@ -32,11 +32,11 @@ import pandas as pd
 from sklearn.base import clone
 from tqdm.auto import tqdm
 
-from analysis import isolation, registry
+from analysis import isolation, registry, scoring
 from analysis.benchmark.detection import locate_onset
 from analysis.benchmark.truth import fault_progress, opened
 from analysis.features import kl_divergence
-from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
+from analysis.monitoring import fit_q_monitor, varying_columns
 from faultgen.data import reader
 
 OWN, OTHER, TWIN = "own history", "another dataset", "the twin"
@@ -154,10 +154,11 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
         monitor = (clone(detector).fit(normal[:, used]) if detector is not None
                    else fit_q_monitor(normal[:, used], registry.make("pca_monitor", variance=variance, alpha=alpha,
                                                                      statistic="q", cv=limit_folds)[1]))
+        rules = scoring.DETECT_RULES.with_persistence(persistence)  # as detect's: from the fault's first sample
         judged = [run for run in data.healthy if len(run.recorded) > first]
-        rates = [100.0 * float(np.mean(np.asarray(monitor.predict(unit_detection_features(run, first)[first:, used]),
-                                                  dtype=bool))) for run in judged]
-        false_alarm = float(np.mean(rates)) if rates else np.nan
+        flags = [np.asarray(monitor.predict(unit_detection_features(run, first)[first:, used]), dtype=bool)
+                 for run in judged]
+        false_alarm = scoring.false_alarm_rate(flags, rules, scale=100.0)  # the mean of each run's rate
         rows, charts = [], {}
         for run in tqdm([r for r in data.runs if len(r.worn_axes) == 1], desc="detection", unit="run",
                         disable=not progress):
@@ -166,17 +167,14 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
             features = unit_detection_features(run, first)[:, used]
             alarms = np.asarray(monitor.predict(features), dtype=bool)
             begins = run.fault_begins
-            start = len(alarms) if begins is None else begins
-            tested = max(first, start)
-            onset = detect_onset(alarms[tested:], persistence=persistence)
-            onset = None if onset is None else onset + tested
-            before = alarms[first:start]
+            onset = scoring.onset(alarms, rules, fault_start=begins, skip=first)
+            before = scoring.before_fault(alarms, begins, first)
             wear = fault_progress(run, axis) * 100.0 - 100.0
             located = locate_onset(features, onset)
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed, worn_axis=axis,
                              final_wear_pct=round(float(wear[-1]), 2), protocol=label,
                              trained_on=f"{len(learnt)} runs without wear of {source.path.name}",
-                             false_alarm_pct=round(false_alarm, 2), false_alarm_runs=len(rates),
+                             false_alarm_pct=round(false_alarm, 2), false_alarm_runs=len(flags),
                              fault_begins_cycle=np.nan if begins is None else int(run.recorded[begins]),
                              trained_on_fault=begins is not None and begins < first,
                              alarms_before_fault_pct=round(100.0 * float(before.mean()), 2) if before.size else np.nan,
@@ -184,7 +182,7 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
                              onset=np.nan if onset is None else int(onset),
                              onset_cycle=np.nan if onset is None else int(run.recorded[onset]),
                              onset_wear_pct=np.nan if onset is None else round(float(wear[onset]), 2),
-                             located_axis=located, located=located == axis))
+                             located_axis=located, located=bool(scoring.isolation_right(located, axis))))
             chart = {"sample": np.arange(len(alarms)), "cycle": run.recorded, "wear_pct": wear, "alarm": alarms}
             if hasattr(monitor, "score_samples") and hasattr(monitor, "q_limit_"):
                 t2, q = monitor.score_samples(features)

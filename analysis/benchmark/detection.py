@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from analysis import isolation, registry
+from analysis import isolation, registry, scoring
 from analysis.benchmark.detection_features import (
     StoredHistograms,
     detection_scale,
@@ -21,7 +21,7 @@ from analysis.benchmark.detection_features import (
 )
 from analysis.benchmark.tables import TOO_FEW_CYCLES, UNDECIDED
 from analysis.benchmark.truth import fault_progress, opened
-from analysis.monitoring import detect_onset, fit_q_monitor, varying_columns
+from analysis.monitoring import fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
 from faultgen.data import reader
 
@@ -79,7 +79,8 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     sample with true wear or fault above 0: ``fault_begins_cycle``) whose Q statistic exceeds its
     ``1 - alpha`` limit for ``persistence`` samples in a row; alarms before the fault begins are
     false alarms (``alarms_before_fault_pct``), never a detection (a fleet's failing robots wear
-    from a drawn onset day). Under the held-out protocols the Q
+    from a drawn onset day): :data:`analysis.scoring.DETECT_RULES`, computed by :mod:`analysis.scoring`
+    as every command's figures are. Under the held-out protocols the Q
     limit is estimated out of sample over ``limit_folds`` folds of the training samples, at most
     one fold per training sample (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample,
     eq. 2.6 as in the thesis):
@@ -87,11 +88,11 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     same-run always uses the in-sample limit; its location is the axis the
     cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
 
-    The false-alarm rate is the share of alarm samples on runs without wear that the monitor did
-    not learn from (:func:`false_alarm_meaning`): under other-seeds the run of the tested seed;
-    under first-cycles every healthy run of the same robot, task and friction model (else of the
-    same robot model: a fleet's healthy robots), each judged by the protocol itself, a monitor
-    learnt from its own first ``first`` samples, after them. Under same-run it is measured on the
+    The false-alarm rate is the mean of each one's share of alarm samples (``"per_run_mean"``) over
+    the runs without wear that the monitor did not learn from (:func:`false_alarm_meaning`): under
+    other-seeds the run of the tested seed; under first-cycles every healthy run of the same robot,
+    task and friction model (else of the same robot model: a fleet's healthy robots), each judged by
+    the protocol itself, a monitor learnt from its own first ``first`` samples, after them. Under same-run it is measured on the
     training run itself (in-sample, said in the ``protocol`` column).
 
     ``detector``, a scikit-learn estimator whose ``fit(X)`` learns healthy samples and whose
@@ -156,9 +157,9 @@ class _Work:
     set (``monitors``) and that monitor's false-alarm rate on the healthy runs it did not learn from
     (``false_alarms``)."""
 
-    def __init__(self, data: reader.Dataset, variance, alpha, period, detector, limit_folds):
+    def __init__(self, data: reader.Dataset, variance, alpha, period, detector, limit_folds, rules):
         self.path, self.healthy = data.path, data.healthy
-        self.variance, self.alpha, self.period = variance, alpha, period
+        self.variance, self.alpha, self.period, self.rules = variance, alpha, period, rules
         self.detector, self.limit_folds = detector, limit_folds
         self.torque: dict[str, np.ndarray | StoredHistograms] = {}
         self.monitors: dict[tuple, tuple] = {}
@@ -232,9 +233,10 @@ class _Work:
                     n_first: int) -> tuple:
         """The false-alarm rate (%) of the monitor ``fitted`` (scale, reference, features used,
         monitor) for worn ``run`` on the healthy runs ``heldout`` it did not learn from, each judged
-        as ``protocol`` says: (mean rate or NaN, runs judged, its Clopper-Pearson interval)."""
+        as ``protocol`` says: (the rate of :func:`analysis.scoring.false_alarm_rate` under the table's
+        rules, % or NaN, runs judged, its Clopper-Pearson interval)."""
         scale, reference, used, monitor = fitted
-        rates, counts = [], [0, 0]  # and alarms, samples over the healthy runs: the interval
+        judged = []  # each healthy run's alarms after what its monitor learned from
         for normal_run in heldout:
             if isinstance(normal_run, tuple):  # other-seeds: a monitor of the other healthy runs judges it
                 _, normal_run, rest = normal_run
@@ -257,15 +259,15 @@ class _Work:
                 normal, _ = kl_features(self.torque_of(normal_run), normal_run.recorded, scale, self.period,
                                         reference)
                 flags = np.asarray(monitor.predict(normal[:, used]), dtype=bool)[skip:]
-            rates.append(100.0 * float(np.mean(flags)))
-            counts[0] += int(np.sum(flags))
-            counts[1] += int(flags.size)
-        return float(np.mean(rates)) if rates else np.nan, len(rates), false_alarm_interval(*counts)
+            judged.append(flags)
+        return (scoring.false_alarm_rate(judged, self.rules, scale=100.0), len(judged),
+                false_alarm_interval(*scoring.alarm_counts(judged)))
 
 
 def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
                limit_folds) -> tuple[pd.DataFrame, dict]:
-    work = _Work(data, variance, alpha, period, detector, limit_folds)
+    rules = scoring.DETECT_RULES.with_persistence(persistence)  # the onset from the fault's first sample
+    work = _Work(data, variance, alpha, period, detector, limit_folds, rules)
     healthy = work.healthy
     far: dict[str, tuple] = {}  # runs whose Q limit lies FAR_LIMIT times above every Q they were tested on
     rows, charts, reasons = [], {}, {}
@@ -296,13 +298,11 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
         scale, reference, used, monitor = work.monitors[key]
         worn, groups = kl_features(work.torque_of(run), run.recorded, scale, period, reference)
         alarms = np.asarray(monitor.predict(worn[:, used]), dtype=bool)
-        # the fault's first sample: an alarm before it is a false alarm, never a detection
+        # the fault's first sample: an alarm before it is a false alarm, never a detection (rules)
         begins = run.fault_begins
-        start = len(alarms) if begins is None else int(groups[begins])
-        first_tested = max(skip, start)
-        onset = detect_onset(alarms[first_tested:], persistence=persistence)
-        onset = None if onset is None else onset + first_tested
-        before = alarms[skip:start]
+        start = None if begins is None else int(groups[begins])
+        onset = scoring.onset(alarms, rules, fault_start=start, skip=skip)
+        before = scoring.before_fault(alarms, start, skip)
         if key not in work.false_alarms:
             work.false_alarms[key] = work.false_alarm(run, used_protocol, heldout, work.monitors[key], skip,
                                                       n_first)
@@ -321,7 +321,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                          onset=np.nan if onset is None else int(onset),
                          onset_cycle=np.nan if onset is None else int(run.recorded[groups == onset][0]),
                          onset_wear_pct=np.nan if onset is None else round(float(wear[groups == onset].max()), 2),
-                         located_axis=located, located=located == axis))
+                         located_axis=located, located=bool(scoring.isolation_right(located, axis))))
         if run.measured:  # no wear is measured: a worn log's friction_multiplier is a mark, not a percentage
             del rows[-1]["final_wear_pct"], rows[-1]["onset_wear_pct"]
         chart = {"sample": np.arange(len(alarms)),

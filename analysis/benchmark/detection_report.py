@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from analysis import isolation
+from analysis import isolation, scoring
 from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
@@ -175,9 +175,12 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
     def percent(flags):
         return 100.0 * flags.mean() if len(flags) else np.nan
 
+    def detected(flags):  # the share of worn runs with an onset (analysis.scoring)
+        return 100.0 * scoring.detected_share(flags)
+
     learned = table["trained_on_fault"].astype(bool) if "trained_on_fault" in table else pd.Series(False, table.index)
     aggregate = dict(runs=("run", "size"), false_alarm_pct=("false_alarm_pct", "mean"),
-                     detected_pct=("detected", percent), median_onset_cycle=("onset_cycle", "median"),
+                     detected_pct=("detected", detected), median_onset_cycle=("onset_cycle", "median"),
                      median_onset_wear_pct=("onset_wear_pct", "median"), located_pct=("located", percent))
     if "onset_wear_pct" not in table:  # units imported from logs: no wear is measured
         del aggregate["median_onset_wear_pct"]

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
-from analysis import isolation
+from analysis import isolation, scoring
 from analysis.benchmark.tables import TOO_FEW_CYCLES, axis_label
 from analysis.benchmark.truth import NO_FAULT, fault_progress, level_cycle, opened
 from faultgen import axes
@@ -128,7 +128,7 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
                 predicted = TOO_FEW_CYCLES
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
-                             answer=axis_label(predicted), correct=predicted == axis,
+                             answer=axis_label(predicted), correct=bool(scoring.isolation_right(predicted, axis)),
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
                              n_axes=X.shape[1], needed=np.nan if needed[name] is None else needed[name]))
     table = pd.DataFrame(rows)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from analysis import scoring
 from analysis.benchmark.isolation_answers import LABELLED_WORN
 from analysis.benchmark.tables import TOO_FEW_CYCLES, UNDECIDED, axis_label, markdown
 from analysis.benchmark.truth import NO_FAULT
@@ -84,9 +85,13 @@ def isolation_accuracy(table: pd.DataFrame) -> pd.DataFrame:
     run without wear, when it names none (undecided); so an isolator that runs and never decides
     scores 100 % on "no fault" and 0 % elsewhere. A case it could not run on (fewer cycles than it
     needs: predicted -1) is not applicable and left out; a cell with no applicable case is NaN,
-    which :func:`isolation_accuracy_text` spells "not applicable: N cycles < M needed"."""
-    applicable = table[table["predicted"] != TOO_FEW_CYCLES]
-    accuracy = (applicable.groupby(["task", "wear_pct", "isolator"])["correct"].mean().mul(100)
+    which :func:`isolation_accuracy_text` spells "not applicable: N cycles < M needed". Each cell is
+    :func:`analysis.scoring.top1_accuracy` under :data:`analysis.scoring.ISOLATION_TABLE_RULES`, the
+    figure ``bench score``'s top-1 accuracy is (there a unit too short is undecided)."""
+    groups = table.groupby(["task", "wear_pct", "isolator"])[["predicted", "worn_axis"]]
+    rules = scoring.ISOLATION_TABLE_RULES
+    cells = groups.apply(lambda g: scoring.top1_accuracy(g["predicted"], g["worn_axis"], rules))
+    accuracy = (cells.dropna().mul(100)
                 .reindex(pd.MultiIndex.from_frame(table[["task", "wear_pct", "isolator"]].drop_duplicates()))
                 .unstack("isolator"))
     return accuracy.sort_index().astype(float).round(1)

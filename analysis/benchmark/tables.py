@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pandas as pd
 
-#: What an isolator's answer means where it is not an axis number 1..6.
-UNDECIDED, TOO_FEW_CYCLES = 0, -1
+#: What an isolator's answer means where it is not an axis number 1..N (defined with the rules that
+#: score it, :mod:`analysis.scoring`).
+from analysis.scoring import TOO_FEW_CYCLES, UNDECIDED
 
 
 def axis_label(value: int) -> str:

@@ -20,7 +20,8 @@ larger: more likely faulty) and its alarms (``predict``).
   against the healthy units' records at a false-positive rate of :data:`FAR`, interpolated between
   its points: a random threshold between two scores); chance 5 %.
 - **Detection delay**: per failing unit, the onset (the first of 3 alarms in a row,
-  :func:`analysis.monitoring.detect_onset`, as ``faultgen detect``) minus the record where the fault
+  :func:`analysis.monitoring.detect_onset`, as ``faultgen detect``, but looked for from the first
+  record: :data:`RULES`) minus the record where the fault
   starts, and minus the record where it reaches 10 %, in cycles (days for daily records); the
   median over the units detected, and the share detected. The share's chance (:func:`_chance_share`)
   is the larger of the share a detector alarming at random at the false-alarm rate detects
@@ -36,6 +37,11 @@ unit's per-cycle mean absolute motor torque (n_records, N) names a source axis (
 left undecided is reported beside it. An isolator that also sets ``fault_`` (a fault name of the
 labels: "friction_wear", "backlash", "cogging") is scored on it too on a track with several fault
 types (the faults track): ``fault_type_accuracy``, chance 1 / the number of fault types.
+
+The onset, false-alarm rate, share detected, delays and top-1 accuracy are computed by
+:mod:`analysis.scoring`, the one scoring path ``faultgen detect`` and ``bench-isolators`` use too,
+under :data:`RULES` (:data:`analysis.scoring.BENCH_RULES`; why they differ from ``detect``'s: that
+module's docstring).
 
 Every figure has a 95 % percentile bootstrap interval over test units (:data:`RESAMPLES`
 resamples of the units with replacement, seed 0), and its verdict against its chance level
@@ -55,12 +61,15 @@ import numpy as np
 from sklearn.base import clone, is_classifier
 from sklearn.metrics import roc_auc_score, roc_curve
 
+from analysis import scoring
 from faultgen.bench import files, verdicts
 from faultgen.data import atomic
 
 RESAMPLES = 1000
 WORN_PCT = 10.0
-PERSISTENCE = 3
+#: The rules every figure is scored by (:data:`analysis.scoring.BENCH_RULES`: the onset from the first
+#: record, the healthy units' records pooled, 3 alarms in a row, "too few cycles" undecided).
+RULES = scoring.BENCH_RULES
 #: The false-alarm rate at which the detection rate is read (a share of the healthy units' records).
 FAR = 0.05
 
@@ -118,7 +127,7 @@ def _detected_minus_chance(units: list) -> float:
     healthy and failing units)."""
     failing = [u for u in units if u["unit"].fault != "none"]
     chance = _chance_share(units)
-    return float(np.mean([u["detected"] for u in failing]) - chance) if np.isfinite(chance) else float("nan")
+    return scoring.detected_share([u["detected"] for u in failing]) - chance if np.isfinite(chance) else float("nan")
 
 
 def _chance_share(units: list, parts: bool = False):
@@ -131,9 +140,9 @@ def _chance_share(units: list, parts: bool = False):
     failing = [u for u in units if u["unit"].fault != "none"]
     if not healthy or not failing:
         return (float("nan"),) * 3 if parts else float("nan")
-    rate = float(np.mean(np.concatenate([u["alarms"] for u in healthy])))
-    random = float(np.mean(verdicts.chance_detected([len(u["alarms"]) for u in failing], rate, PERSISTENCE)))
-    own = float(np.mean([u["detected"] for u in healthy]))
+    rate = scoring.false_alarm_rate([u["alarms"] for u in healthy], RULES)
+    random = float(np.mean(verdicts.chance_detected([len(u["alarms"]) for u in failing], rate, RULES.persistence)))
+    own = scoring.detected_share([u["detected"] for u in healthy])
     return (max(random, own), random, own) if parts else max(random, own)
 
 
@@ -191,22 +200,19 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
             level = unit.fault_level
             judged.append({"unit": unit, "scores": scores, "alarms": alarms, "positive": level >= WORN_PCT,
                                "mask": (level >= WORN_PCT) | (level <= 0)})
-    from analysis.monitoring import detect_onset
-
     delays = []
     for row in judged:
         unit = row["unit"]
-        onset = detect_onset(row["alarms"], PERSISTENCE)
+        start = scoring.fault_start(unit.fault_level)  # the onset is looked for from the first record (RULES)
+        onset = scoring.onset(row["alarms"], RULES, fault_start=start)
         row["detected"] = onset is not None
         if unit.fault == "none":
             continue
         cycles = unit.arrays["cycles"]
-        starts = np.flatnonzero(unit.fault_level > 0)
-        worn = np.flatnonzero(unit.fault_level >= WORN_PCT)
         delays.append({
             "unit": unit.id, "detected": onset is not None,
-            "after_start": np.nan if onset is None or not starts.size else float(cycles[onset] - cycles[starts[0]]),
-            "after_10pct": np.nan if onset is None or not worn.size else float(cycles[onset] - cycles[worn[0]])})
+            "after_start": scoring.delay(onset, cycles, start),
+            "after_10pct": scoring.delay(onset, cycles, scoring.first_reaching(unit.fault_level, WORN_PCT))})
     healthy = [r for r in judged if r["unit"].fault == "none"]
 
     def median(key):
@@ -214,8 +220,8 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
             np.isfinite(r[key]) for r in rows) else float("nan")
 
     sample = test[0].sample if test else "cycle"
-    far = _figure(healthy, lambda rows: float(np.mean(np.concatenate([r["alarms"] for r in rows]))))
-    detected = _figure(delays, lambda rows: float(np.mean([r["detected"] for r in rows])))
+    far = _figure(healthy, lambda rows: scoring.false_alarm_rate([r["alarms"] for r in rows], RULES))
+    detected = _figure(delays, lambda rows: scoring.detected_share([r["detected"] for r in rows]))
     detected["chance"], detected["chance_random_alarms"], detected["healthy_units_detected"] = _chance_share(
         judged, parts=True)
     detected["chance_range95"] = verdicts.chance_range(len(delays), detected["chance"])
@@ -239,17 +245,19 @@ def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
         try:
             fitted = clone(method).fit(unit.arrays["mean_abs_torque"])
             axis, fault = int(fitted.source_axis_), getattr(getattr(fitted, "estimator_", fitted), "fault_", None)
-        except ValueError:  # the isolator contract's "too few cycles": undecided
-            axis, fault = 0, None
+        except ValueError:  # the isolator contract's "too few cycles": undecided (RULES)
+            axis, fault = scoring.too_few_answer(RULES), None
         answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes,
                         "fault": unit.fault, "named_fault": None if fault is None else str(fault)})
     failing = [a for a in answers if a["worn_axis"]]
     healthy = [a for a in answers if not a["worn_axis"]]
     n_axes = max((a["n_axes"] for a in answers), default=6)
     out = {
-        "top1_accuracy": _figure(failing, lambda rows: float(np.mean([r["named"] == r["worn_axis"] for r in rows])),
-                                 chance=1.0 / n_axes),
-        "undecided_on_healthy": _figure(healthy, lambda rows: float(np.mean([r["named"] == 0 for r in rows]))),
+        "top1_accuracy": _figure(failing, lambda rows: scoring.top1_accuracy(
+            [r["named"] for r in rows], [r["worn_axis"] for r in rows], RULES), chance=1.0 / n_axes),
+        # a healthy unit's true axis is none: its top-1 accuracy is the share left undecided
+        "undecided_on_healthy": _figure(healthy, lambda rows: scoring.top1_accuracy(
+            [r["named"] for r in rows], [scoring.UNDECIDED] * len(rows), RULES)),
     }
     need = verdicts.records_needed(method)
     records = sorted(len(unit.arrays["mean_abs_torque"]) for unit in test)
