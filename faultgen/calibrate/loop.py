@@ -29,7 +29,8 @@ MAX_STEPS = 6
 
 
 def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
-        max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
+        max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
+        friction_every_axis: bool = False) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
@@ -51,6 +52,11 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     use_sysid : bool
         Refine a Stribeck hump's parameters with ``mujoco.sysid`` when the ``mujoco[sysid]`` extra
         is installed (:func:`faultgen.calibrate.improve.sysid_stribeck`); False: faultgen's own fit only.
+    friction_every_axis : bool
+        After the search, fit the Coulomb (dry) friction level of every moving axis to what the
+        model leaves, always, not by model selection (:func:`own_friction`): each axis's friction
+        is then the unit's own, where the search would leave an axis at nominal (``faultgen
+        monitor`` reads wear in % of it).
 
     Returns
     -------
@@ -117,6 +123,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         model, predicted = extend(model, predicted, steps, data, tau, split, model_out)
     if any(s.effect.id == "stribeck" for s in steps):
         model, predicted = sysid_stribeck(model, predicted, steps, data, tau, split, use_sysid, progress)
+    if friction_every_axis:
+        model, predicted, motion = own_friction(model, predicted, motion, steps, data, tau, split, model_out, progress)
     # the one model file a calibration writes, and the robot it is (read back once, by its writer)
     calibrated = robots.write(model_out, model.text, atomic.write_text)
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
@@ -143,6 +151,39 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
     figure.save(result, out / "calibration.png")
     return result
+
+
+#: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`
+#: to fit its Coulomb level.
+OWN_FRICTION_SAMPLES = 200
+
+
+def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step], data: measured_io.MeasuredData,
+                 tau: np.ndarray, split: search.Split, path: Path, progress: bool = False):
+    """The Coulomb (dry) friction level of every axis that moves (at least
+    :data:`OWN_FRICTION_SAMPLES` samples above the rest speed) fitted to the residual the model
+    leaves, on the whole moving record (fitting and held-out parts: no selection is made, so none is
+    held out), and written whatever the held-out gap does: the unit's own dry friction on every
+    axis, the scale ``faultgen monitor`` reads wear in (issue 59, item 1). Appended to ``steps``
+    as a step whose evidence says so (``"every_axis": true``). Returns the model, its prediction
+    and motion."""
+    effect = get("coulomb")
+    whole = search.Split(split.fit | split.held_out, split.held_out)
+    fit = search.fit_effect(effect, motion, tau - predicted, tau, whole)
+    moving = whole.fit.sum(axis=0) >= OWN_FRICTION_SAMPLES
+    chosen = [int(a) for a in np.flatnonzero(moving & fit.physical)]
+    if not chosen:
+        return model, predicted, motion
+    errors = search.standard_errors(effect, motion, tau - predicted, tau, whole, chosen)
+    trial = judge(model.with_effect(fit.effect, chosen, path), data, tau, split.held_out)
+    steps.append(Step(fit.effect, chosen, {
+        "rule": "fitted on every moving axis, always (friction_every_axis; not by model selection), on the whole "
+                "moving record", "every_axis": True, "separable": True,
+        "heldout_gain_nrmse": [float(g) for g in fit.gain]}, trial.gap, errors))
+    if progress:
+        print(f"own friction: coulomb on axes {axes.numbers(chosen)}, held-out total nrmse "
+              f"{trial.gap['total_nrmse']:.4f}", flush=True)
+    return trial.model, trial.prediction, trial.motion
 
 
 def evidence(best: search.Candidate, ranked: list[search.Candidate], residual: np.ndarray,
