@@ -1,5 +1,5 @@
 """The calibration's own-friction option (issue 59, item 1): with ``friction_every_axis`` the
-Coulomb level of every moving axis is fitted, always, so an axis whose friction differs from the
+Coulomb (dry) and viscous levels of every moving axis are fitted, always, so an axis whose friction differs from the
 nominal one by less than the model selection adds still gets its own level (``faultgen monitor``
 reads wear in % of it)."""
 
@@ -51,7 +51,11 @@ def test_every_moving_axis_gets_its_own_coulomb_level(log, tmp_path):
     assert np.all(np.abs(fitted[moving] - RATIO[moving]) <= TOLERANCE), fitted
     left = ratio(plain.model)
     assert np.any(np.abs(left[moving] - RATIO[moving]) > TOLERANCE), left
-    step = own.steps[-1]
-    assert step.effect.id == "coulomb" and step.evidence["every_axis"]
+    assert [(s.effect.id, s.evidence.get("every_axis")) for s in own.steps[-2:]] == [("coulomb", True),
+                                                                                      ("viscous", True)]
+    # no viscous change in the log: the viscous level fitted beside the dry one stays near nominal
+    nominal = robot.friction.viscous
+    assert np.all(np.abs(own.model.friction.viscous[moving] - nominal[moving]) <= 0.05 * nominal[moving] + 1e-9), (
+        own.model.friction.viscous, nominal)
     report = json.loads((tmp_path / "own" / "report.json").read_text())
-    assert report["steps"][-1]["evidence"]["every_axis"] is True
+    assert report["steps"][-2]["evidence"]["every_axis"] is True

@@ -53,8 +53,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         Refine a Stribeck hump's parameters with ``mujoco.sysid`` when the ``mujoco[sysid]`` extra
         is installed (:func:`faultgen.calibrate.improve.sysid_stribeck`); False: faultgen's own fit only.
     friction_every_axis : bool
-        After the search, fit the Coulomb (dry) friction level of every moving axis to what the
-        model leaves, always, not by model selection (:func:`own_friction`): each axis's friction
+        After the search, fit the Coulomb (dry) and viscous friction levels of every moving axis to
+        what the model leaves, always, not by model selection (:func:`own_friction`): each axis's friction
         is then the unit's own, where the search would leave an axis at nominal (``faultgen
         monitor`` reads wear in % of it).
 
@@ -160,30 +160,52 @@ OWN_FRICTION_SAMPLES = 200
 
 def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step], data: measured_io.MeasuredData,
                  tau: np.ndarray, split: search.Split, path: Path, progress: bool = False):
-    """The Coulomb (dry) friction level of every axis that moves (at least
-    :data:`OWN_FRICTION_SAMPLES` samples above the rest speed) fitted to the residual the model
-    leaves, on the whole moving record (fitting and held-out parts: no selection is made, so none is
-    held out), and written whatever the held-out gap does: the unit's own dry friction on every
-    axis, the scale ``faultgen monitor`` reads wear in (issue 59, item 1). Appended to ``steps``
-    as a step whose evidence says so (``"every_axis": true``). Returns the model, its prediction
-    and motion."""
-    effect = get("coulomb")
-    whole = search.Split(split.fit | split.held_out, split.held_out)
-    fit = search.fit_effect(effect, motion, tau - predicted, tau, whole)
-    moving = whole.fit.sum(axis=0) >= OWN_FRICTION_SAMPLES
-    chosen = [int(a) for a in np.flatnonzero(moving & fit.physical)]
-    if not chosen:
+    """The dry (Coulomb, one change of both directions) and viscous friction levels of every axis
+    that moves (at least :data:`OWN_FRICTION_SAMPLES` samples above the rest speed), fitted
+    together by least squares to the residual the model leaves, on the whole moving record
+    (fitting and held-out parts: no selection is made, so none is held out), and written whatever
+    the held-out gap does: the unit's own friction on every axis, the scale ``faultgen monitor``
+    reads wear in (issue 59, item 1). Fitted together because on a motion of few steady speeds a
+    lower dry level and a higher viscous one give nearly the same torque: a dry level fitted alone
+    takes up the viscous one's change. An axis whose joint fit is not admissible (a level below
+    zero) gets its Coulomb level alone. Appended to ``steps`` as one step per effect whose
+    evidence says so (``"every_axis": true``). Returns the model, its prediction and motion."""
+    coulomb, viscous = get("coulomb"), get("viscous")
+    rows = (split.fit | split.held_out) & ((split.fit | split.held_out).sum(axis=0) >= OWN_FRICTION_SAMPLES)
+    residual = tau - predicted
+    dry, wet = {}, {}
+    for a in np.flatnonzero(rows.any(axis=0)):
+        a = int(a)
+        phi_c = coulomb.columns(motion, a, None)[0][:, :1]
+        phi_v = viscous.columns(motion, a, None)[0]
+        r, keep = residual[:, a], rows[:, a]
+        theta = np.linalg.lstsq(np.column_stack([phi_c, phi_v])[keep], r[keep], rcond=None)[0]
+        c = coulomb.params(motion, a, np.array([theta[0], 0.0]), None)
+        v = viscous.params(motion, a, theta[1:], None)
+        if not (coulomb.admissible(motion, a, c) and viscous.admissible(motion, a, v)):
+            theta = np.linalg.lstsq(phi_c[keep], r[keep], rcond=None)[0]
+            c, v = coulomb.params(motion, a, np.array([theta[0], 0.0]), None), None
+        if not coulomb.admissible(motion, a, c):
+            continue
+        dry[a] = c
+        if v is not None:
+            wet[a] = v
+    if not dry:
         return model, predicted, motion
-    errors = search.standard_errors(effect, motion, tau - predicted, tau, whole, chosen)
-    trial = judge(model.with_effect(fit.effect, chosen, path), data, tau, split.held_out)
-    steps.append(Step(fit.effect, chosen, {
-        "rule": "fitted on every moving axis, always (friction_every_axis; not by model selection), on the whole "
-                "moving record", "every_axis": True, "separable": True,
-        "heldout_gain_nrmse": [float(g) for g in fit.gain]}, trial.gap, errors))
-    if progress:
-        print(f"own friction: coulomb on axes {axes.numbers(chosen)}, held-out total nrmse "
-              f"{trial.gap['total_nrmse']:.4f}", flush=True)
-    return trial.model, trial.prediction, trial.motion
+    rule = ("fitted on every moving axis, always (friction_every_axis; not by model selection), dry and viscous "
+            "together on the whole moving record")
+    for effect, params in ((coulomb, dry), (viscous, wet)):
+        if not params:
+            continue
+        fitted = effect.fitted(model.robot, params)
+        chosen = sorted(params)
+        trial = judge(model.with_effect(fitted, chosen, path), data, tau, split.held_out)
+        steps.append(Step(fitted, chosen, {"rule": rule, "every_axis": True, "separable": True}, trial.gap, {}))
+        model, predicted, motion = trial.model, trial.prediction, trial.motion
+        if progress:
+            print(f"own friction: {effect.id} on axes {axes.numbers(chosen)}, held-out total nrmse "
+                  f"{trial.gap['total_nrmse']:.4f}", flush=True)
+    return model, predicted, motion
 
 
 def evidence(best: search.Candidate, ranked: list[search.Candidate], residual: np.ndarray,
