@@ -49,6 +49,10 @@ def test_every_moving_axis_gets_its_own_coulomb_level(log, tmp_path):
     # every moving axis at its true level; without the option axis 1 (1 % off, under the selection's
     # thresholds) stays at nominal
     assert np.all(np.abs(fitted[moving] - RATIO[moving]) <= TOLERANCE), fitted
+    # one level both ways: the two directions' difference stays the nominal model's
+    f, g = own.model.friction, robot.friction
+    np.testing.assert_allclose((f.coulomb_pos - f.coulomb_neg)[moving], (g.coulomb_pos - g.coulomb_neg)[moving],
+                               atol=1e-5)  # the model file holds 6 digits
     left = ratio(plain.model)
     assert np.any(np.abs(left[moving] - RATIO[moving]) > TOLERANCE), left
     assert [(s.effect.id, s.evidence.get("every_axis")) for s in own.steps[-2:]] == [("coulomb", True),

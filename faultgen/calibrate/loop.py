@@ -124,7 +124,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     if any(s.effect.id == "stribeck" for s in steps):
         model, predicted = sysid_stribeck(model, predicted, steps, data, tau, split, use_sysid, progress)
     if friction_every_axis:
-        model, predicted, motion = own_friction(model, predicted, motion, steps, data, tau, split, model_out, progress)
+        model, predicted, motion = own_friction(model, predicted, motion, steps, data, tau, split, model_out, nominal,
+                                               progress)
     # the one model file a calibration writes, and the robot it is (read back once, by its writer)
     calibrated = robots.write(model_out, model.text, atomic.write_text)
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
@@ -159,8 +160,9 @@ OWN_FRICTION_SAMPLES = 200
 
 
 def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step], data: measured_io.MeasuredData,
-                 tau: np.ndarray, split: search.Split, path: Path, progress: bool = False):
-    """The dry (Coulomb, one change of both directions) and viscous friction levels of every axis
+                 tau: np.ndarray, split: search.Split, path: Path, nominal: robots.Robot, progress: bool = False):
+    """The dry (Coulomb: one level both ways, the difference of the two directions set back to the
+    ``nominal`` model's) and viscous friction levels of every axis
     that moves (at least :data:`OWN_FRICTION_SAMPLES` samples above the rest speed), fitted
     together by least squares to the residual the model leaves, on the whole moving record
     (fitting and held-out parts: no selection is made, so none is held out), and written whatever
@@ -178,13 +180,17 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
         a = int(a)
         phi_c = coulomb.columns(motion, a, None)[0][:, :1]
         phi_v = viscous.columns(motion, a, None)[0]
-        r, keep = residual[:, a], rows[:, a]
+        # the two directions' difference set back to the nominal model's: the search's per-direction fit
+        # read out of one log is not kept (docs/analysis.md, "Every axis's own friction")
+        f, g = motion.robot.friction, nominal.friction
+        skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
+        r, keep = residual[:, a] - coulomb.columns(motion, a, None)[0][:, 1] * skew, rows[:, a]
         theta = np.linalg.lstsq(np.column_stack([phi_c, phi_v])[keep], r[keep], rcond=None)[0]
-        c = coulomb.params(motion, a, np.array([theta[0], 0.0]), None)
+        c = coulomb.params(motion, a, np.array([theta[0], skew]), None)
         v = viscous.params(motion, a, theta[1:], None)
         if not (coulomb.admissible(motion, a, c) and viscous.admissible(motion, a, v)):
             theta = np.linalg.lstsq(phi_c[keep], r[keep], rcond=None)[0]
-            c, v = coulomb.params(motion, a, np.array([theta[0], 0.0]), None), None
+            c, v = coulomb.params(motion, a, np.array([theta[0], skew]), None), None
         if not coulomb.admissible(motion, a, c):
             continue
         dry[a] = c

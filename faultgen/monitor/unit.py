@@ -43,7 +43,7 @@ def calibration_key(nominal_sha256: str, first_sha256: str) -> dict:
     search's length and, when on, :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
     key = {"robot": nominal_sha256, "log": first_sha256, "steps": CALIBRATION_STEPS}
     if OWN_FRICTION:
-        key["friction"] = "every axis: dry and viscous"
+        key["friction"] = "every axis: one dry level and viscous"
     return key
 
 
