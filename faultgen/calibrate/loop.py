@@ -29,7 +29,8 @@ MAX_STEPS = 6
 
 
 def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
-        max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True) -> Calibration:
+        max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
+        friction_every_axis: bool = False) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
@@ -51,6 +52,11 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     use_sysid : bool
         Refine a Stribeck hump's parameters with ``mujoco.sysid`` when the ``mujoco[sysid]`` extra
         is installed (:func:`faultgen.calibrate.improve.sysid_stribeck`); False: faultgen's own fit only.
+    friction_every_axis : bool
+        After the search, fit the Coulomb (dry) and viscous friction levels of every moving axis to
+        what the model leaves, always, not by model selection (:func:`own_friction`): each axis's friction
+        is then the unit's own, where the search would leave an axis at nominal (``faultgen
+        monitor`` reads wear in % of it).
 
     Returns
     -------
@@ -117,6 +123,9 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         model, predicted = extend(model, predicted, steps, data, tau, split, model_out)
     if any(s.effect.id == "stribeck" for s in steps):
         model, predicted = sysid_stribeck(model, predicted, steps, data, tau, split, use_sysid, progress)
+    if friction_every_axis:
+        model, predicted, motion = own_friction(model, predicted, motion, steps, data, tau, split, model_out, nominal,
+                                               progress)
     # the one model file a calibration writes, and the robot it is (read back once, by its writer)
     calibrated = robots.write(model_out, model.text, atomic.write_text)
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
@@ -143,6 +152,66 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
     figure.save(result, out / "calibration.png")
     return result
+
+
+#: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`
+#: to fit its Coulomb level.
+OWN_FRICTION_SAMPLES = 200
+
+
+def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step], data: measured_io.MeasuredData,
+                 tau: np.ndarray, split: search.Split, path: Path, nominal: robots.Robot, progress: bool = False):
+    """The dry (Coulomb: one level both ways, the difference of the two directions set back to the
+    ``nominal`` model's) and viscous friction levels of every axis
+    that moves (at least :data:`OWN_FRICTION_SAMPLES` samples above the rest speed), fitted
+    together by least squares to the residual the model leaves, on the whole moving record
+    (fitting and held-out parts: no selection is made, so none is held out), and written whatever
+    the held-out gap does: the unit's own friction on every axis, the scale ``faultgen monitor``
+    reads wear in (issue 59, item 1). Fitted together because on a motion of few steady speeds a
+    lower dry level and a higher viscous one give nearly the same torque: a dry level fitted alone
+    takes up the viscous one's change. An axis whose joint fit is not admissible (a level below
+    zero) gets its Coulomb level alone. Appended to ``steps`` as one step per effect whose
+    evidence says so (``"every_axis": true``). Returns the model, its prediction and motion."""
+    coulomb, viscous = get("coulomb"), get("viscous")
+    rows = (split.fit | split.held_out) & ((split.fit | split.held_out).sum(axis=0) >= OWN_FRICTION_SAMPLES)
+    residual = tau - predicted
+    dry, wet = {}, {}
+    for a in np.flatnonzero(rows.any(axis=0)):
+        a = int(a)
+        phi_c = coulomb.columns(motion, a, None)[0][:, :1]
+        phi_v = viscous.columns(motion, a, None)[0]
+        # the two directions' difference set back to the nominal model's: the search's per-direction fit
+        # read out of one log is not kept (docs/analysis.md, "Every axis's own friction")
+        f, g = motion.robot.friction, nominal.friction
+        skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
+        r, keep = residual[:, a] - coulomb.columns(motion, a, None)[0][:, 1] * skew, rows[:, a]
+        theta = np.linalg.lstsq(np.column_stack([phi_c, phi_v])[keep], r[keep], rcond=None)[0]
+        c = coulomb.params(motion, a, np.array([theta[0], skew]), None)
+        v = viscous.params(motion, a, theta[1:], None)
+        if not (coulomb.admissible(motion, a, c) and viscous.admissible(motion, a, v)):
+            theta = np.linalg.lstsq(phi_c[keep], r[keep], rcond=None)[0]
+            c, v = coulomb.params(motion, a, np.array([theta[0], skew]), None), None
+        if not coulomb.admissible(motion, a, c):
+            continue
+        dry[a] = c
+        if v is not None:
+            wet[a] = v
+    if not dry:
+        return model, predicted, motion
+    rule = ("fitted on every moving axis, always (friction_every_axis; not by model selection), dry and viscous "
+            "together on the whole moving record")
+    for effect, params in ((coulomb, dry), (viscous, wet)):
+        if not params:
+            continue
+        fitted = effect.fitted(model.robot, params)
+        chosen = sorted(params)
+        trial = judge(model.with_effect(fitted, chosen, path), data, tau, split.held_out)
+        steps.append(Step(fitted, chosen, {"rule": rule, "every_axis": True, "separable": True}, trial.gap, {}))
+        model, predicted, motion = trial.model, trial.prediction, trial.motion
+        if progress:
+            print(f"own friction: {effect.id} on axes {axes.numbers(chosen)}, held-out total nrmse "
+                  f"{trial.gap['total_nrmse']:.4f}", flush=True)
+    return model, predicted, motion
 
 
 def evidence(best: search.Candidate, ranked: list[search.Candidate], residual: np.ndarray,

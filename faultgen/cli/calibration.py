@@ -25,6 +25,10 @@ def calibrate_command(
     sysid: Annotated[bool, typer.Option(
         help="Refine a Stribeck hump's level, velocity and exponent with mujoco.sysid when the mujoco[sysid] "
              "extra is installed (kept when it lowers the held-out gap).")] = True,
+    fit_friction_all: Annotated[bool, typer.Option(
+        "--fit-friction-all",
+        help="After the search, fit the Coulomb (dry) friction level of every moving axis, always (not by model "
+             "selection): each axis's friction is the unit's own (what `faultgen monitor` reads wear in).")] = False,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     overwrite: Overwrite = False,
@@ -69,7 +73,7 @@ def calibrate_command(
     nominal = robots.load(robot)  # once, for the log's reader and the calibration
     adapter = log_adapter(log_format, torque_constants, nominal)  # None: the measured format
     result = calibrate.calibrate(nominal, measured, out, max_steps=max_steps, progress=True, use_sysid=sysid,
-                                 log_format=adapter)
+                                 log_format=adapter, friction_every_axis=fit_friction_all)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
