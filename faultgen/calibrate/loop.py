@@ -22,6 +22,8 @@ from faultgen.calibrate.result import Calibration, Step, parameters
 from faultgen.calibrate.trial import Model, judge
 from faultgen.data import atomic
 from faultgen.data import measured as measured_io
+from faultgen.effects.coulomb import Coulomb
+from faultgen.effects.viscous import Viscous
 from faultgen.model import robots
 
 #: Most effects added in one calibration.
@@ -172,7 +174,7 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
     takes up the viscous one's change. An axis whose joint fit is not admissible (a level below
     zero) gets its Coulomb level alone. Appended to ``steps`` as one step per effect whose
     evidence says so (``"every_axis": true``). Returns the model, its prediction and motion."""
-    coulomb, viscous = get("coulomb"), get("viscous")
+    coulomb, viscous = get(Coulomb.id), get(Viscous.id)
     rows = (split.fit | split.held_out) & ((split.fit | split.held_out).sum(axis=0) >= OWN_FRICTION_SAMPLES)
     residual = tau - predicted
     dry, wet = {}, {}
