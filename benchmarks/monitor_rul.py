@@ -3,13 +3,20 @@ the truth of a fleet made by a simulator that is not faultgen, with NASA ProgPy'
 
     python benchmarks/monitor_rul.py [--units 6] [--worn 4] [--days 120] [--seed 0] [--final-wear 60]
                                      [--failure-wear 40] [--work DIR]
+    python benchmarks/monitor_rul.py --fleet WORK [--out monitor] [--failure-wear 40]
+
+The second form scores a run of ``benchmarks/monitor_wear_scale.py`` (its ``WORK``: the issue's two
+independent fleets, first law and Stribeck-hump law, 12 units with 8 worn, with the calibrated
+twin, the monitor's default) instead of writing a fleet and running the monitor: the remaining
+life is recomputed from that run's ``scores.csv`` (which does not depend on ``--failure-wear``).
 
 In one run of this script:
 
 - the fleet (tests/independent_fleet.py: Pinocchio RNEA on rtb-data's KR210 URDF, our own
   motor-side friction, seasons, payloads, noise; ``--worn`` units wearing one axis each, linearly
   from a day drawn in 20-50 to ``--final-wear`` % on the last day), its truth in ``truth.csv``;
-- `faultgen monitor LOGS --no-calibrate --failure-wear F` (the twin on the nominal model), timed;
+- `faultgen monitor LOGS --no-calibrate --failure-wear F` (the twin on the nominal model), timed
+  (not with ``--fleet``);
 - for each worn unit whose alarm names its worn axis: the remaining life of that axis computed as
   the monitor computes it (:func:`faultgen.monitor.prognosis.remaining_life` on the unit's rows of
   ``scores.csv`` up to each log, from the log that made the alarm persistent to the last), a
@@ -28,7 +35,9 @@ In one run of this script:
 
 Metrics (``progpy.metrics``, Saxena et al. 2010): alpha-lambda with alpha 0.2 and beta 0.5 (at least
 half the distribution within +-20 % of the true remaining life) at lambda 0.5 (the first prediction
-half-way from the persistent alarm to the end of life); the relative accuracy there and cumulated
+half-way from the persistent alarm to the end of life), with the share of the distribution that
+lies within those bounds there and the distribution's 5-95 % width over the true remaining life
+(to tell a late or early median from a wide distribution); the relative accuracy there and cumulated
 over the predictions before the end of life; the prognostic horizon (the end-of-life time minus the
 first prediction meeting the alpha criterion with beta 0.5); the median bias of the estimate (days,
 predicted minus true remaining life). A sample beyond the prediction's horizon (365 days) enters the
@@ -88,6 +97,13 @@ def score(profile, eol: float, start: float, record_end: float) -> dict:
         out["alpha_lambda"] = bool(alpha_lambda(before, truth, lam, ALPHA, BETA)["failure"])
         at = min(t for t in before if t >= lam)
         out["ra_lambda"] = (before[at] - at).relative_accuracy({"failure": eol - at})["failure"]
+        # what alpha-lambda judges there: the share of the distribution within +-alpha of the true
+        # remaining life (met at >= beta), and the distribution's 5-95 % width over the true remaining life
+        rul = eol - at
+        out["mass_lambda"] = float((before[at] - at).percentage_in_bounds(
+            {"failure": (rul * (1 - ALPHA), rul * (1 + ALPHA))})["failure"])
+        samples = np.asarray((before[at] - at).key("failure"), dtype=float)
+        out["width_lambda"] = float(np.subtract(*np.percentile(samples, [95, 5])) / rul)
     else:
         out["alpha_lambda"] = None  # the record ends before lambda
 
@@ -107,16 +123,20 @@ def score(profile, eol: float, start: float, record_end: float) -> dict:
     return out
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--units", type=int, default=6)
-    parser.add_argument("--worn", type=int, default=4)
-    parser.add_argument("--days", type=int, default=120)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--final-wear", type=float, default=60.0)
-    parser.add_argument("--failure-wear", type=float, default=prognosis.FAILURE_WEAR)
-    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
-    args = parser.parse_args()
+def day_of(wear: np.ndarray, level: float) -> float:
+    """The day (day 1 = the first log) the true wear series ``wear`` (one value a day, %) first
+    reaches ``level`` %, linearly interpolated between days; beyond the record, extended along
+    the last day's rate."""
+    above = np.flatnonzero(wear >= level)
+    if above.size and above[0] > 0:
+        i = int(above[0])
+        return i + (level - wear[i - 1]) / (wear[i] - wear[i - 1])  # between day i and day i + 1
+    rate = wear[-1] - wear[-2]
+    return len(wear) + (level - wear[-1]) / rate
+
+
+def run_fleet(args) -> tuple[Path, Path]:
+    """Write the fleet (or resume it in ``--work``) and run the monitor on it; returns (truth.csv, OUT)."""
     work = args.work or Path(tempfile.mkdtemp(prefix="monitor-rul-"))
     spec = independent_fleet.FleetSpec(units=args.units, worn=args.worn, days=args.days, seed=args.seed,
                                        final_wear=args.final_wear)
@@ -133,7 +153,35 @@ def main() -> None:
     if result.returncode:
         raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
     print(f"faultgen monitor --no-calibrate --failure-wear {args.failure_wear:g}: {time.perf_counter() - started:.0f} s")
+    return truth_path, out
 
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--units", type=int, default=6)
+    parser.add_argument("--worn", type=int, default=4)
+    parser.add_argument("--days", type=int, default=120)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--final-wear", type=float, default=60.0)
+    parser.add_argument("--failure-wear", type=float, default=prognosis.FAILURE_WEAR)
+    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
+    parser.add_argument("--fleet", type=Path, default=None,
+                        help="Score an existing run of benchmarks/monitor_wear_scale.py instead (its WORK: truth.csv "
+                             "and the monitor's OUT, --out): the remaining life is recomputed from its scores.csv "
+                             "with --failure-wear; no fleet is written and no monitor run.")
+    parser.add_argument("--out", default="monitor", help="With --fleet: the monitor's OUT inside it.")
+    args = parser.parse_args()
+    if args.fleet is not None:
+        truth_path, out = args.fleet / "truth.csv", args.fleet / args.out  # scores.csv does not depend on F
+        print(f"scoring the existing run {out} against {truth_path}")
+    else:
+        truth_path, out = run_fleet(args)
+    evaluate(truth_path, out, args.failure_wear)
+
+
+def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list[dict]]:
+    """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
+    docstring); prints a block per unit and the fleet's lines; returns the scores of (A) and (B)."""
     truth = independent_fleet.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
         scores = [_floats(r) for r in csv.DictReader(f)]
@@ -141,7 +189,7 @@ def main() -> None:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
     with open(out / "rul.csv", newline="") as f:
         rul = list(csv.DictReader(f))
-    F, H = args.failure_wear, prognosis.HORIZON
+    F, H = failure_wear, prognosis.HORIZON
     print(f"\nrul.csv at the last log ({len(rul)} rows):")
     for r in rul:
         t = truth[r["unit"]]
@@ -151,6 +199,12 @@ def main() -> None:
     quiet = sum(not r["rul"] for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
     others = sum(1 for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
     print(f"  axes not worn with no end of life within the horizon: {quiet} of {others}")
+    span = max(len(t["wear"]) for t in truth.values())  # days of the fleet
+    healthy = [r for r in rul if not truth[r["unit"]]["axis"]]
+    within = [r for r in healthy if r["rul"] and float(r["rul"]) <= span]
+    print(f"  healthy units: {len(within)} of {len(healthy)} axes with an end of life within the fleet's span of "
+          f"{span} days ({'met' if not within else 'NOT met'}: the issue asks for none)"
+          + "".join(f"; {r['unit']} axis {r['axis']} in {float(r['rul']):.0f} days" for r in within))
 
     results = {"A": [], "B": []}
     started = time.perf_counter()
@@ -167,13 +221,11 @@ def main() -> None:
         stamps = [r["stamp"] for r in rows]
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
         wear = t["wear"]
-        rate = wear[-1] - wear[-2]
-        onset = args.days - wear[-1] / rate  # the true wear is rate * (day - onset) from its onset on
-        true_eol = onset + F / rate  # (A)
+        true_eol = day_of(wear, F)  # (A)
         monitoring = [r for r in rows if r["phase"] == "monitoring"]
         past = [(wear[day[r["stamp"]] - 1], r[f"wear{axis}"]) for r in monitoring if wear[day[r["stamp"]] - 1] >= 5]
         scale, offset = np.polyfit(*zip(*past), 1)
-        estimate_eol = onset + (F - offset) / scale / rate  # (B)
+        estimate_eol = day_of(wear, (F - offset) / scale)  # (B)
         first = stamps.index(alarm["first_alarm"])
         start = day[stamps[first + PERSISTENCE - 1]]
         from progpy.predictors import ToEPredictionProfile
@@ -194,14 +246,16 @@ def main() -> None:
         print("  day: predicted remaining life (median), true (A), estimate's (B): " + "; ".join(
             f"{d}: {'-' if m is None else f'{m:.0f}'}, {true_eol - d:.0f}, {estimate_eol - d:.0f}" for d, m in shown))
         for name, eol in (("A", true_eol), ("B", estimate_eol)):
-            s = score(profile, eol, start, args.days)
+            s = score(profile, eol, start, len(wear))
             s["unit"] = unit
             results[name].append(s)
             al = {None: f"n/a (lambda day {s['lambda']:.0f} after the record)", True: "met", False: "not met"}[
                 s.get("alpha_lambda")]  # a bool or None
             ph = "none" if s.get("ph") is None else f"{s['ph']:.0f} days"
             print(f"  ({name}) end of life day {eol:.1f}, lambda day {s['lambda']:.1f}: alpha-lambda {al}; "
-                  f"RA at lambda {s.get('ra_lambda', float('nan')):.2f}; cumulative RA {s.get('cra', float('nan')):.2f} "
+                  f"RA at lambda {s.get('ra_lambda', float('nan')):.2f} (share within +-{ALPHA:g}: "
+                  f"{s.get('mass_lambda', float('nan')):.2f}, 5-95 % width {s.get('width_lambda', float('nan')):.2f} x "
+                  f"the true remaining life); cumulative RA {s.get('cra', float('nan')):.2f} "
                   f"over {s['predictions']} predictions; prognostic horizon "
                   f"{ph}; median bias "
                   f"{s.get('bias', float('nan')):+.1f} days")
@@ -217,6 +271,7 @@ def main() -> None:
               f"median cumulative RA {np.median([r['cra'] for r in rs if 'cra' in r]):.2f}; prognostic horizon "
               f"{len(phs)} of {len(rs)} units ({', '.join(f'{p:.0f}' for p in phs) or '-'} days); median bias "
               f"{np.median([r['bias'] for r in rs if 'bias' in r]):+.1f} days")
+    return results
 
 
 if __name__ == "__main__":
