@@ -400,26 +400,61 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
         if not scheduler:
             _stop_local_workers()
         raise
+    except RuntimeError as err:
+        # an interrupt while loky was starting its manager thread: joblib's abort could not join it
+        # ("cannot join thread before it is started") and raised that instead, the interrupt as its context
+        if scheduler or not isinstance(err.__context__, KeyboardInterrupt):
+            raise
+        try:
+            raise err.__context__ from None
+        except KeyboardInterrupt:  # handled as such: a further one is not raised while the workers stop
+            _stop_local_workers()
+            raise
     except OSError as err:
         raise SweepError(f"a run could not be written: {err}. Finished runs are kept in {parts}; free space "
                          "or fix permissions and run the same command again") from err
 
 
 def _stop_local_workers() -> None:
-    """Shut joblib's worker processes down and wait for them, so that nothing they hold (loky's
-    semaphores) is left for Python's resource tracker to report as leaked at exit."""
-    import time
+    """Stop joblib's worker processes and wait until nothing of loky's runs in this process any more,
+    so that every semaphore loky made is released here, before the exit: none is left for its
+    resource tracker to report as leaked under the sweep's message.
 
-    from joblib.externals.loky import get_reusable_executor
+    - The executor joblib ran (loky's reusable one), never a new one: ``get_reusable_executor()``
+      replaced the executor joblib's own abort had shut down with a new one, six semaphores more. The
+      abort fails if the interrupt came while loky was starting its manager thread ("cannot join
+      thread before it is started", :func:`_execute`): that thread starts within moments.
+    - The feeder thread of its call queue: a daemon thread, which loky does not join in the process
+      that made the queue. It holds the queue's three semaphores and releases them when it ends, each
+      release a message to the resource tracker; a release still under way when the interpreter
+      finalizes is cut off (a daemon thread does not run again), and the tracker reported "1 leaked
+      semlock objects" (CI, under load).
+    - A garbage collection: a semaphore in a reference cycle is released by whichever thread collects
+      it, possibly one of those.
+    """
+    import gc
 
-    executor = get_reusable_executor()
-    for _ in range(200):  # an interrupt while loky is still starting its manager thread: it starts within moments
-        try:
-            executor.shutdown(wait=True, kill_workers=True)
-            return
-        except RuntimeError:  # "cannot join thread before it is started" (seen under load, issue 61)
-            time.sleep(0.05)
-    for process in list((getattr(executor, "_processes", None) or {}).values()):  # the thread never started
-        process.kill()
-        process.join()
-    executor.shutdown(wait=False, kill_workers=True)
+    from joblib.externals.loky import reusable_executor
+
+    executor = reusable_executor._executor  # the one joblib ran, or None
+    if executor is not None:
+        stop = getattr(executor, "terminate", executor.shutdown)  # joblib's also removes its temporary folders
+        for _ in range(200):
+            try:
+                stop(kill_workers=True)
+                break
+            except RuntimeError:  # "cannot join thread before it is started" (seen under load, issue 61)
+                time.sleep(0.05)
+        else:
+            for process in list((getattr(executor, "_processes", None) or {}).values()):  # it never started
+                try:
+                    os.kill(process.pid, signal.SIGKILL)  # loky's process has no kill(); SIGTERM is ignored
+                except ProcessLookupError:
+                    pass
+                process.join()
+            executor.shutdown(wait=False, kill_workers=True)
+    deadline = time.monotonic() + 5  # a closed queue's feeder ends within moments; never hang the exit on one
+    for thread in threading.enumerate():
+        if thread.daemon and thread.name == "QueueFeederThread":
+            thread.join(max(0.0, deadline - time.monotonic()))
+    gc.collect()
