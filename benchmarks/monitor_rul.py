@@ -104,6 +104,8 @@ def score(profile, eol: float, start: float, record_end: float) -> dict:
             {"failure": (rul * (1 - ALPHA), rul * (1 + ALPHA))})["failure"])
         samples = np.asarray((before[at] - at).key("failure"), dtype=float)
         out["width_lambda"] = float(np.subtract(*np.percentile(samples, [95, 5])) / rul)
+        low, high = np.percentile(samples, [5, 95])
+        out["covers_lambda"] = bool(low <= rul <= high)
     else:
         out["alpha_lambda"] = None  # the record ends before lambda
 
@@ -255,7 +257,8 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list
             print(f"  ({name}) end of life day {eol:.1f}, lambda day {s['lambda']:.1f}: alpha-lambda {al}; "
                   f"RA at lambda {s.get('ra_lambda', float('nan')):.2f} (share within +-{ALPHA:g}: "
                   f"{s.get('mass_lambda', float('nan')):.2f}, 5-95 % width {s.get('width_lambda', float('nan')):.2f} x "
-                  f"the true remaining life); cumulative RA {s.get('cra', float('nan')):.2f} "
+                  f"the true remaining life, {'covering' if s.get('covers_lambda') else 'not covering'} it); "
+                  f"cumulative RA {s.get('cra', float('nan')):.2f} "
                   f"over {s['predictions']} predictions; prognostic horizon "
                   f"{ph}; median bias "
                   f"{s.get('bias', float('nan')):+.1f} days")
@@ -270,7 +273,10 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list
               f"{np.median([r['ra_lambda'] for r in rs if 'ra_lambda' in r]) if evaluable else float('nan'):.2f}; "
               f"median cumulative RA {np.median([r['cra'] for r in rs if 'cra' in r]):.2f}; prognostic horizon "
               f"{len(phs)} of {len(rs)} units ({', '.join(f'{p:.0f}' for p in phs) or '-'} days); median bias "
-              f"{np.median([r['bias'] for r in rs if 'bias' in r]):+.1f} days")
+              f"{np.median([r['bias'] for r in rs if 'bias' in r]):+.1f} days; at lambda the 5-95 % interval "
+              f"covers the true remaining life on {sum(bool(r.get('covers_lambda')) for r in rs)} of {evaluable} "
+              f"units, median width {np.median([r['width_lambda'] for r in rs if 'width_lambda' in r]) if evaluable else float('nan'):.2f} "
+              f"x the true remaining life")
     return results
 
 
