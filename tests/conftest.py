@@ -64,6 +64,31 @@ def shared_fleet(tmp_path_factory, worker_id):
     return build
 
 
+@pytest.fixture(scope="session")
+def shared_bench(tmp_path_factory, worker_id):
+    """``shared_bench(track)``: the folder of a bench track's latest version at its test size, made by
+    the command (tests/bench_plugins.py's ``make_small``) once per test session, as
+    :func:`shared_sweep` builds sweeps (the thesis track's was made by three test files, each on
+    every worker that ran one of its tests). Tests read its files; `bench score` without ``-o``
+    adds its ``score-NAME`` outputs beside them, which no test reads from another."""
+    import bench_plugins
+
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / "shared-bench"
+    folder.mkdir(exist_ok=True)
+
+    def build(track: str) -> Path:
+        out = folder / track
+        with FileLock(folder / f"{track}.build-lock"):
+            if not (out / "manifest.json").exists():
+                bench_plugins.make_small(track, out)
+        return out
+
+    return build
+
+
 @pytest.fixture
 def figures(monkeypatch):
     """The figures plot() draws, kept for inspection when it saves them."""

@@ -24,7 +24,6 @@ import re
 from pathlib import Path
 
 import baseline_example
-import bench_plugins
 import numpy as np
 import pandas as pd
 import pytest
@@ -110,10 +109,8 @@ def _bench_all():
 
 
 @pytest.fixture(scope="module")
-def thesis_small(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("registry") / "thesis"
-    bench_plugins.make_small("thesis", folder)
-    return folder
+def thesis_small(shared_bench):
+    return shared_bench("thesis")
 
 
 def test_bench_score_and_the_leaderboard_reach_the_example(thesis_small, tmp_path):
@@ -213,10 +210,8 @@ def test_bench_isolators_runs_a_registered_isolator_beside_the_built_in_ones(sma
 
 
 @pytest.fixture(scope="module")
-def prognostics_small(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("registry") / "prognostics"
-    bench_plugins.make_small("prognostics", folder)
-    return folder
+def prognostics_small(shared_bench):
+    return shared_bench("prognostics")
 
 
 def test_bench_score_prognostics_takes_a_registered_prognoser_by_name(prognostics_small, tmp_path):

@@ -82,11 +82,11 @@ def test_tracks_have_disjoint_train_and_test_seeds_and_the_slot_says_what_it_nee
 
 
 @pytest.fixture(scope="module")
-def thesis_small(tmp_path_factory):
+def thesis_small(shared_bench):
     """The thesis track's latest version at its test size, made by the command (which starts itself
-    again in the version's numeric profile, faultgen.bench.profile)."""
-    folder = tmp_path_factory.mktemp("bench") / "thesis"
-    return folder, bench_plugins.make_small("thesis", folder)
+    again in the version's numeric profile, faultgen.bench.profile), once a session (conftest.py)."""
+    folder = shared_bench("thesis")
+    return folder, json.loads((folder / "manifest.json").read_text())
 
 
 def test_the_test_file_holds_no_label(thesis_small):

@@ -10,7 +10,6 @@ import subprocess
 import sys
 from typing import ClassVar
 
-import bench_plugins
 import numpy as np
 import pytest
 
@@ -18,10 +17,11 @@ from faultgen.bench import baselines, files, independent, make, prognosers, prog
 
 
 @pytest.fixture(scope="module")
-def small(tmp_path_factory):
-    """Version 1 at its test size, made by the command (in its numeric profile)."""
-    folder = tmp_path_factory.mktemp("bench") / "prog"
-    return folder, bench_plugins.make_small("prognostics", folder)
+def small(shared_bench):
+    """Version 1 at its test size, made by the command (in its numeric profile) once a session
+    (conftest.py)."""
+    folder = shared_bench("prognostics")
+    return folder, json.loads((folder / "manifest.json").read_text())
 
 
 def test_the_track_is_made_again_identical_to_its_frozen_manifest_with_run_to_failure_units(small):

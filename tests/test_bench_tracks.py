@@ -8,7 +8,6 @@ from __future__ import annotations
 import json
 import os
 
-import bench_plugins
 import numpy as np
 import pytest
 
@@ -17,10 +16,11 @@ from faultgen.data import fleetlogs
 
 
 @pytest.fixture(scope="module")
-def sim_to_real(tmp_path_factory):
-    """The latest version at its test size, made by the command (in the version's numeric profile)."""
-    folder = tmp_path_factory.mktemp("bench") / "s2r"
-    return folder, bench_plugins.make_small("sim-to-real", folder)
+def sim_to_real(shared_bench):
+    """The latest version at its test size, made by the command (in the version's numeric profile)
+    once a session (conftest.py)."""
+    folder = shared_bench("sim-to-real")
+    return folder, json.loads((folder / "manifest.json").read_text())
 
 
 def test_sim_to_real_is_made_against_its_frozen_manifest_with_the_fleet_as_the_test_split(sim_to_real):

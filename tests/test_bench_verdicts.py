@@ -8,7 +8,6 @@ import itertools
 import json
 import re
 
-import bench_plugins
 import numpy as np
 import pytest
 from markdown_it import MarkdownIt
@@ -23,12 +22,10 @@ runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def thesis_small(tmp_path_factory):
+def thesis_small(shared_bench):
     """The thesis track's latest version at its test size (12 records a unit; 6 failing, 3 healthy
-    test units), made by the command."""
-    folder = tmp_path_factory.mktemp("verdicts") / "thesis"
-    bench_plugins.make_small("thesis", folder)
-    return folder
+    test units), made by the command once a session (conftest.py)."""
+    return shared_bench("thesis")
 
 
 def _cells(line: str) -> list[str]:

@@ -83,8 +83,10 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     return [*argv, *extra]
 
 
-def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path]) -> None:
-    """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments."""
+def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path], bench=None) -> None:
+    """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments.
+    ``bench``: conftest.py's ``shared_bench``, whose folders are made by the command a ``bench make``
+    line becomes here when it gives no other option (``bench make TRACK --size small -o OUT``)."""
     for part in line.split("&&"):
         words = shlex.split(part, comments=True)
         target = None
@@ -99,6 +101,13 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
         same = [name for name in outputs if name in made_files and shlex.split(MADE[name]) == words]
         if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
             shutil.copy(made_files[same[0]], same[0])
+            continue
+        argv = small(words[1:], page, scheduler)
+        options = dict(zip(argv[3::2], argv[4::2], strict=True)) if argv[:2] == ["bench", "make"] and len(argv) % 2 else {}
+        if bench is not None and set(options) == {"--size", "-o"} and options["--size"] == "small":
+            # the command conftest.py's shared_bench ran (tests/bench_plugins.py's make_small, the same
+            # options and --no-progress): its folder, without the score-NAME outputs other tests added
+            shutil.copytree(bench(argv[2]), options["-o"], ignore=shutil.ignore_patterns("score-*", ".*"))
             continue
         if words[1:3] == ["bench", "make"]:  # as a command: it starts itself again in the track's numeric profile
             done = subprocess.run([sys.executable, "-m", "faultgen.cli", *small(words[1:], page, scheduler)],
@@ -186,7 +195,7 @@ def test_every_help_page_has_examples_and_they_are_all_read():
 
 
 @pytest.mark.parametrize("page", sorted(PAGES))
-def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
+def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, monkeypatch):
     lines = PAGES[page]
     needed = {word for line in lines for word in re.split(r"[\s:/=]+", line) if word in MADE}
     needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
@@ -204,7 +213,7 @@ def test_the_examples_of_a_help_page_run(page, made, tmp_path, monkeypatch):
         scheduler = cluster.scheduler_address
     try:
         for line in lines:
-            run_line(line, page, scheduler, made_files)
+            run_line(line, page, scheduler, made_files, shared_bench)
     finally:
         if scheduler:
             cluster.close()
