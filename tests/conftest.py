@@ -20,17 +20,25 @@ if os.environ.get("PYTEST_XDIST_WORKER"):
     threadpool_limits(1)
 
 
+def shared_folder(tmp_path_factory, worker_id: str, name: str) -> Path:
+    """The folder ``name`` that every pytest-xdist worker of this session sees (the xdist recipe: the
+    parent of the workers' temporary folders), created if needed; what is built in it is built once,
+    under a file lock in it."""
+    root = tmp_path_factory.getbasetemp()
+    if worker_id != "master":
+        root = root.parent
+    folder = root / name
+    folder.mkdir(exist_ok=True)
+    return folder
+
+
 @pytest.fixture(scope="session")
 def shared_sweep(tmp_path_factory, worker_id):
     """``shared_sweep(name, **grid)``: the path of a sweep dataset built once per test session and
     read by every pytest-xdist worker (module fixtures would be built once per worker: the 40-cycle
     analysis dataset took 20 s on each). The xdist recipe: a file lock in the folder the workers'
     temporary folders share. Tests only read these files; one that edits a dataset copies it."""
-    root = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        root = root.parent
-    folder = root / "shared-sweeps"
-    folder.mkdir(exist_ok=True)
+    folder = shared_folder(tmp_path_factory, worker_id, "shared-sweeps")
 
     def build(name: str, **grid) -> Path:
         out = folder / f"{name}.h5"
@@ -48,11 +56,7 @@ def shared_fleet(tmp_path_factory, worker_id):
     built once per test session, as :func:`shared_sweep` builds sweeps."""
     from faultgen.runs.fleet import Fleet
 
-    root = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        root = root.parent
-    folder = root / "shared-sweeps"
-    folder.mkdir(exist_ok=True)
+    folder = shared_folder(tmp_path_factory, worker_id, "shared-sweeps")
 
     def build(name: str, **settings) -> Path:
         out = folder / f"{name}.h5"
@@ -73,11 +77,7 @@ def shared_bench(tmp_path_factory, worker_id):
     adds its ``score-NAME`` outputs beside them, which no test reads from another."""
     import bench_plugins
 
-    root = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        root = root.parent
-    folder = root / "shared-bench"
-    folder.mkdir(exist_ok=True)
+    folder = shared_folder(tmp_path_factory, worker_id, "shared-bench")
 
     def build(track: str) -> Path:
         out = folder / track
