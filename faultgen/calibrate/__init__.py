@@ -76,8 +76,8 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     ``log_format``: the log's format when not the measured one (a
     :class:`faultgen.data.adapters.Adapter`, ``--format NAME``): read through it, whole or, longer
     than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`).
-    ``friction_every_axis``: the Coulomb friction level of every moving axis fitted after the search,
-    always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
+    ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
+    after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
     The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):

@@ -157,7 +157,7 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
 
 #: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`
-#: to fit its Coulomb level.
+#: to fit its dry (Coulomb) and viscous levels.
 OWN_FRICTION_SAMPLES = 200
 
 
@@ -175,18 +175,19 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
     zero) gets its Coulomb level alone. Appended to ``steps`` as one step per effect whose
     evidence says so (``"every_axis": true``). Returns the model, its prediction and motion."""
     coulomb, viscous = get(Coulomb.id), get(Viscous.id)
-    rows = (split.fit | split.held_out) & ((split.fit | split.held_out).sum(axis=0) >= OWN_FRICTION_SAMPLES)
+    moving = split.fit | split.held_out
+    rows = moving & (moving.sum(axis=0) >= OWN_FRICTION_SAMPLES)
     residual = tau - predicted
     dry, wet = {}, {}
     for a in np.flatnonzero(rows.any(axis=0)):
         a = int(a)
-        phi_c = coulomb.columns(motion, a, None)[0][:, :1]
-        phi_v = viscous.columns(motion, a, None)[0]
+        columns_c = coulomb.columns(motion, a, None)[0]  # (n, 2): both directions, the positive one's excess
+        phi_c, phi_v = columns_c[:, :1], viscous.columns(motion, a, None)[0]
         # the two directions' difference set back to the nominal model's: the search's per-direction fit
         # read out of one log is not kept (docs/analysis.md, "Every axis's own friction")
         f, g = motion.robot.friction, nominal.friction
         skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
-        r, keep = residual[:, a] - coulomb.columns(motion, a, None)[0][:, 1] * skew, rows[:, a]
+        r, keep = residual[:, a] - columns_c[:, 1] * skew, rows[:, a]
         theta = np.linalg.lstsq(np.column_stack([phi_c, phi_v])[keep], r[keep], rcond=None)[0]
         c = coulomb.params(motion, a, np.array([theta[0], skew]), None)
         v = viscous.params(motion, a, theta[1:], None)

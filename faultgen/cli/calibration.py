@@ -27,8 +27,8 @@ def calibrate_command(
              "extra is installed (kept when it lowers the held-out gap).")] = True,
     fit_friction_all: Annotated[bool, typer.Option(
         "--fit-friction-all",
-        help="After the search, fit the Coulomb (dry) friction level of every moving axis, always (not by model "
-             "selection): each axis's friction is the unit's own (what `faultgen monitor` reads wear in).")] = False,
+        help="After the search, fit the dry (Coulomb) and viscous friction levels of every moving axis, always (not "
+             "by model selection): each axis's friction is the unit's own (what `faultgen monitor` reads wear in).")] = False,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     overwrite: Overwrite = False,

@@ -30,7 +30,7 @@ from faultgen.simulation import backends
 SAME_PROGRAM = 1e-3
 #: Effects searched when a unit's model is calibrated on its first log (faultgen.calibrate).
 CALIBRATION_STEPS = 3
-#: Whether the unit's calibration fits the Coulomb friction of every moving axis, always
+#: Whether the unit's calibration fits the dry and viscous friction of every moving axis, always
 #: (:func:`faultgen.calibrate.loop.own_friction`), so each axis's wear is read in % of its own
 #: fitted dry friction rather than the nominal one where the search leaves an axis (issue 59, item 1).
 #: Off: on the four fleets of docs/analysis.md ("Every axis's own friction", 2026-11-26) the

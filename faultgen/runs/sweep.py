@@ -405,11 +405,8 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
         # ("cannot join thread before it is started") and raised that instead, the interrupt as its context
         if scheduler or not isinstance(err.__context__, KeyboardInterrupt):
             raise
-        try:
-            raise err.__context__ from None
-        except KeyboardInterrupt:  # handled as such: a further one is not raised while the workers stop
-            _stop_local_workers()
-            raise
+        _stop_local_workers()
+        raise err.__context__ from None
     except OSError as err:
         raise SweepError(f"a run could not be written: {err}. Finished runs are kept in {parts}; free space "
                          "or fix permissions and run the same command again") from err
