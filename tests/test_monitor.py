@@ -17,6 +17,7 @@ import independent_fleet
 import numpy as np
 import pytest
 
+from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import loop
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
@@ -314,7 +315,8 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
         loop.monitor(robot, logs, out, calibrate=False, settings=Settings(train=14, persistence=4), progress=False)
     state["logs"][3]["residual"] = state["logs"][3]["residual"][:-1]
     (out / ".state" / files[0].name).write_text(json.dumps(state))
-    with pytest.raises(ValueError, match=r"unit01\.json: logs\[3\]\.residual is not a list of 12 numbers"):
+    n_features = len(fleet_logs.FEATURES) * 6  # per axis of the KR210
+    with pytest.raises(ValueError, match=rf"unit01\.json: logs\[3\]\.residual is not a list of {n_features} numbers"):
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
 
 
@@ -446,7 +448,7 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
 
     from faultgen.cli import app
     from faultgen.model import robots
-    from faultgen.monitor.twin import Twin
+    from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
     from faultgen.operation import wear
     from faultgen.simulation import sensors
     from faultgen.simulation import stepping as sim
@@ -471,7 +473,7 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
                                           signals=True), progress=False)
     peak = np.max(np.abs(replayed.tau_m[0]), axis=0) / robot.motor_torque_limit
     assert replayed.saturated.size == 0 and peak.max() < 0.8, peak
-    assert np.all(np.isfinite(twin.expected(20.0, 0.0)))
+    assert np.all(np.isfinite(twin.expected(REFERENCE_TEMPERATURE, 0.0)))  # the monitor's healthy expectation
 
 
 def test_an_implausible_calibration_does_not_become_the_twin():

