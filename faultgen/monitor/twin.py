@@ -140,6 +140,7 @@ class Twin:
         self.program = program.path
         self._files = {"model": stored.sha256_file(self.robot.path), "program": program.sha256,
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
+                       "moving_speed": fleet_logs.MOVING_SPEED,  # friction_torque's standstill threshold
                        "reference": f"savgol {REFERENCE_WINDOW:g} s"}
         self._reference = self._smoothed_program(program.sha256, data)
         self._healthy: dict[float, np.ndarray] = {}
