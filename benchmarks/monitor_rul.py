@@ -103,8 +103,8 @@ def score(profile, eol: float, start: float, record_end: float) -> dict:
         out["mass_lambda"] = float((before[at] - at).percentage_in_bounds(
             {"failure": (rul * (1 - ALPHA), rul * (1 + ALPHA))})["failure"])
         samples = np.asarray((before[at] - at).key("failure"), dtype=float)
-        out["width_lambda"] = float(np.subtract(*np.percentile(samples, [95, 5])) / rul)
         low, high = np.percentile(samples, [5, 95])
+        out["width_lambda"] = float((high - low) / rul)
         out["covers_lambda"] = bool(low <= rul <= high)
     else:
         out["alpha_lambda"] = None  # the record ends before lambda

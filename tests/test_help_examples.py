@@ -24,6 +24,7 @@ from pathlib import Path
 
 import pytest
 import rtbdata
+from conftest import shared_folder
 from filelock import FileLock
 from typer.main import get_command
 from typer.testing import CliRunner
@@ -110,12 +111,12 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             shutil.copytree(bench(argv[2]), options["-o"], ignore=shutil.ignore_patterns("score-*", ".*"))
             continue
         if words[1:3] == ["bench", "make"]:  # as a command: it starts itself again in the track's numeric profile
-            done = subprocess.run([sys.executable, "-m", "faultgen.cli", *small(words[1:], page, scheduler)],
+            done = subprocess.run([sys.executable, "-m", "faultgen.cli", *argv],
                                   check=False, capture_output=True, text=True, timeout=600)
             assert done.returncode == 0, f"{line}\n{done.stdout}{done.stderr}"
             output = done.stdout
         else:
-            result = runner.invoke(app, small(words[1:], page, scheduler))
+            result = runner.invoke(app, argv)
             assert result.exit_code == 0, f"{line}\n{result.output}"
             output = result.output
         if target:
@@ -165,11 +166,7 @@ MADE = {
 @pytest.fixture(scope="session")
 def made(tmp_path_factory, worker_id):
     """``made(name)``: the path of a file of :data:`MADE`, made once per session."""
-    root = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        root = root.parent
-    folder = root / "help-examples-made"
-    folder.mkdir(exist_ok=True)
+    folder = shared_folder(tmp_path_factory, worker_id, "help-examples-made")
 
     def make(name: str) -> Path:
         with FileLock(folder / f"{name}.lock"):
