@@ -318,6 +318,13 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
     n_features = len(fleet_logs.FEATURES) * 6  # per axis of the KR210
     with pytest.raises(ValueError, match=rf"unit01\.json: logs\[3\]\.residual is not a list of {n_features} numbers"):
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    # a state an earlier faultgen wrote (format 1: two features per axis) is refused, saying what to do
+    state["format"] = "faultgen-monitor-state/1"
+    (out / ".state" / files[0].name).write_text(json.dumps(state))
+    with pytest.raises(ValueError, match=r"unit01\.json: format 'faultgen-monitor-state/1', expected "
+                                         r"'faultgen-monitor-state/2' \(a state written by another version of "
+                                         r"faultgen.*score the logs into a new OUT"):
+        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
 
 
 def test_a_scored_log_that_changed_since_is_refused(fleet, monitored, tmp_path):
