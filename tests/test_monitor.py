@@ -484,8 +484,9 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
 
 
 def test_an_implausible_calibration_does_not_become_the_twin():
-    """A calibration that put the Stribeck hump at 216 rad/s (nominal 10; issue 60's KR210) or a dry
-    friction above half the drive's torque is named, so the monitor falls back to the nominal model."""
+    """A calibration that put the Stribeck hump at 216 rad/s (nominal 10; issue 60's KR210), a dry
+    friction above half the drive's torque or a Coulomb level beyond 3 x nominal either way is
+    named, so the monitor falls back (faultgen.monitor.unit.FALLBACK)."""
     from types import SimpleNamespace
 
     from faultgen.calibrate import plausibility
@@ -504,6 +505,16 @@ def test_an_implausible_calibration_does_not_become_the_twin():
     assert len(found) == 2, found
     assert found[0].startswith("axis 1: Stribeck velocity") and "21.6 x its nominal" in found[0]
     assert found[1].startswith("axis 4: dry friction") and "0.6 of the motor's torque limit" in found[1]
+    # a Coulomb level traded for a viscous one (a KR210 L150's own friction on its nominal model: 0.16 x)
+    for factor, refused in ((0.16, True), (0.61, False), (1.59, False), (3.2, True)):
+        friction.coulomb_pos = np.array(nominal.friction.coulomb_pos, dtype=float)
+        friction.coulomb_neg = np.array(nominal.friction.coulomb_neg, dtype=float)
+        friction.coulomb_pos[1] *= factor
+        friction.coulomb_neg[1] *= factor
+        found = [f for f in plausibility.implausible_parameters(nominal, edited) if f.startswith("axis 2")]
+        assert bool(found) == refused, (factor, found)
+        if refused:
+            assert found[0].startswith("axis 2: Coulomb friction") and f"{factor:.3g} x its nominal" in found[0], found
 
 
 def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(fleet, monitored, tmp_path):
