@@ -484,8 +484,9 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
 
 
 def test_an_implausible_calibration_does_not_become_the_twin():
-    """A calibration that put the Stribeck hump at 216 rad/s (nominal 10; issue 60's KR210) or a dry
-    friction above half the drive's torque is named, so the monitor falls back to the nominal model."""
+    """A calibration that put the Stribeck hump at 216 rad/s (nominal 10; issue 60's KR210), a dry
+    friction above half the drive's torque or a Coulomb level beyond 3 x nominal either way is
+    named, so the monitor falls back (faultgen.monitor.unit.FALLBACK)."""
     from types import SimpleNamespace
 
     from faultgen.calibrate import plausibility
@@ -504,6 +505,16 @@ def test_an_implausible_calibration_does_not_become_the_twin():
     assert len(found) == 2, found
     assert found[0].startswith("axis 1: Stribeck velocity") and "21.6 x its nominal" in found[0]
     assert found[1].startswith("axis 4: dry friction") and "0.6 of the motor's torque limit" in found[1]
+    # a Coulomb level traded for a viscous one (a KR210 L150's own friction on its nominal model: 0.16 x)
+    for factor, refused in ((0.16, True), (0.61, False), (1.59, False), (3.2, True)):
+        friction.coulomb_pos = np.array(nominal.friction.coulomb_pos, dtype=float)
+        friction.coulomb_neg = np.array(nominal.friction.coulomb_neg, dtype=float)
+        friction.coulomb_pos[1] *= factor
+        friction.coulomb_neg[1] *= factor
+        found = [f for f in plausibility.implausible_parameters(nominal, edited) if f.startswith("axis 2")]
+        assert bool(found) == refused, (factor, found)
+        if refused:
+            assert found[0].startswith("axis 2: Coulomb friction") and f"{factor:.3g} x its nominal" in found[0], found
 
 
 def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(fleet, monitored, tmp_path):
@@ -686,3 +697,63 @@ def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(
     loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
     for name in ("alarms.csv", "scores.csv", "units.csv"):
         assert (again / name).read_text() == (out / name).read_text(), name
+
+
+def test_a_unit_whose_twin_cannot_be_built_falls_back_through_its_own_friction_then_nominal_then_own(
+        fleet, tmp_path, monkeypatch):
+    """The fallback chain of a calibrated unit (faultgen.monitor.unit.FALLBACK): each kind's failure
+    is noted and the next is tried, the unit's own friction on the nominal model before the nominal
+    model (issue 59: a calibration refused as implausible kept none of the unit's own friction)."""
+    from faultgen.model import robots
+    from faultgen.monitor import unit as units_module
+
+    robot, logs, _ = fleet
+    nominal = robots.load(robot)
+    units = fleet_logs.fleet(logs)
+    source = fleet_logs.Source(nominal)
+    tried = []
+
+    def failing(source, kind, *args):
+        tried.append(kind)
+        raise ValueError(f"the {kind} twin refused for this test")
+
+    monkeypatch.setattr(units_module, "model_of", failing)
+    name = sorted(units)[0]
+    unit = units_module.new_unit(name, units, nominal, SETTINGS, None, True, [], source)
+    assert unit.model == "calibrated"
+    assert units_module.twin_of(unit, units, tmp_path, {}, False, source) is None
+    assert tried == ["calibrated", "friction", "nominal"] and unit.model == "none"
+    assert unit.notes == [
+        "the twin of the calibrated model failed (the calibrated twin refused for this test); nominal model with "
+        "the unit's own friction used",
+        "the twin of the nominal model with the unit's own friction failed (the friction twin refused for this "
+        "test); nominal model used",
+        "the twin of the nominal model failed (the nominal twin refused for this test); protocol own used"]
+
+
+def test_the_own_friction_fallback_fits_every_moving_axis_dry_and_viscous_level_on_the_nominal_model(fleet, tmp_path):
+    """Kind "friction": no search, the nominal model's Stribeck hump and direction skew kept, every
+    moving axis's dry (Coulomb) and viscous level fitted to the unit's first log (the fleet's units
+    spread 15 % about the nominal friction), cached under its own key and read back the same."""
+    from faultgen.model import robots
+    from faultgen.monitor import state as stored
+    from faultgen.monitor import unit as units_module
+
+    robot, logs, _ = fleet
+    nominal = robots.load(robot)
+    units = fleet_logs.fleet(logs)
+    source = fleet_logs.Source(nominal)
+    first = units[sorted(units)[0]][0]
+    key = (first.stamp, source.get(first).sha256)
+    made = units_module.model_of(source, "friction", key, first, tmp_path, False)
+    f, g = made.friction, nominal.friction
+    np.testing.assert_array_equal(f.stribeck_velocity, g.stribeck_velocity)
+    np.testing.assert_allclose(np.subtract(f.coulomb_neg, f.coulomb_pos), np.subtract(g.coulomb_neg, g.coulomb_pos),
+                               atol=1e-9)
+    ratio = np.asarray(f.coulomb_pos) / np.asarray(g.coulomb_pos)
+    assert np.all(np.abs(ratio - 1.0) > 1e-3) and np.all((ratio > 0.5) & (ratio < 1.5)), ratio
+    digest = stored.key_name(units_module.calibration_key(stored.sha256_file(nominal.path), key[1], 0))
+    assert (tmp_path / ".cache" / "calibrated" / f"{digest}.json").is_file()
+    again = units_module.model_of(source, "friction", key, None, tmp_path, False)  # the cache, not the log
+    assert again.path == made.path
+    np.testing.assert_array_equal(again.friction.coulomb_pos, f.coulomb_pos)

@@ -132,8 +132,9 @@ class ProgramChange:
     signatures: np.ndarray
 
 
-#: A unit's model kinds: a given calibrated model, its own calibration, the nominal model, none.
-MODELS = ("given", "calibrated", "nominal", "none")
+#: A unit's model kinds: a given calibrated model, its own calibration, its own friction on the
+#: nominal model (:data:`faultgen.monitor.unit.FALLBACK`), the nominal model, none.
+MODELS = ("given", "calibrated", "friction", "nominal", "none")
 
 
 @dataclass

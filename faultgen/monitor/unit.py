@@ -43,10 +43,20 @@ CALIBRATION_STEPS = 3
 OWN_FRICTION = True
 
 
-def calibration_key(nominal_sha256: str, first_sha256: str) -> dict:
+#: The kinds of model a unit's twin falls back through, each to the next when its twin cannot be
+#: built (:func:`twin_of`): "given" and "calibrated" to "friction", "friction" to "nominal",
+#: "nominal" to "none" (protocol own).
+FALLBACK = {"given": "nominal", "calibrated": "friction", "friction": "nominal", "nominal": "none"}
+#: What each kind is called in a unit's reason.
+KIND_NAMES = {"given": "given model", "calibrated": "calibrated model", "nominal": "nominal model",
+              "friction": "nominal model with the unit's own friction", "none": "protocol own"}
+
+
+def calibration_key(nominal_sha256: str, first_sha256: str, steps: int = CALIBRATION_STEPS) -> dict:
     """The key of a unit's cached calibration: the nominal model's and the first log's SHA-256, the
-    search's length and, when on, :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
-    key = {"robot": nominal_sha256, "log": first_sha256, "steps": CALIBRATION_STEPS}
+    search's length ``steps`` (0: own friction on the nominal model, kind "friction") and, when on,
+    :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
+    key = {"robot": nominal_sha256, "log": first_sha256, "steps": steps}
     if OWN_FRICTION:
         key["friction"] = "every axis: one dry level and viscous"
     return key
@@ -96,7 +106,8 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
     """The unit's twin (its cycles simulated on the stepping ``backend``, a known name), or None
     for a unit under protocol ``own``; its model comes from :func:`model_of` (the robots of
     ``source``, or the unit's calibration). A unit not yet scored falls back
-    from its model to the nominal one and then to protocol ``own`` when its twin cannot be built;
+    through :data:`FALLBACK` when its twin cannot be built (its calibration refused as implausible,
+    say: to its own friction on the nominal model, then to the nominal model, then to protocol ``own``);
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
     its new logs are skipped with it. Each fallback is noted in the unit's reason."""
     while unit.model != "none":
@@ -113,9 +124,11 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
         except ValueError as err:
             if unit.entries:
                 return f"the twin of the {unit.model} model cannot be built again ({short(err)})"
-            fallback = "nominal" if unit.model in ("given", "calibrated") else "none"
-            unit.notes.append(f"the twin of the {unit.model} model failed ({short(err)}); "
-                              f"{'nominal model' if fallback == 'nominal' else 'protocol own'} used")
+            fallback = FALLBACK[unit.model]
+            if fallback == "friction" and not OWN_FRICTION:
+                fallback = "nominal"
+            unit.notes.append(f"the twin of the {KIND_NAMES[unit.model]} failed ({short(err)}); "
+                              f"{KIND_NAMES[fallback]} used")
             unit.model = fallback
             continue
         if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
@@ -164,7 +177,11 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
     """The robot a unit's twin simulates, of ``kind``: "nominal" and "given" (``--calibrated``) are
     the robots ``source`` holds, resolved once where it was made; "calibrated": calibrated on the
     unit's first log (``first``: its stamp and SHA-256; ``first_log`` the log, parsed by ``source``
-    and needed only when the calibration is not cached), cached in ``OUT/.cache/calibrated`` under
+    and needed only when the calibration is not cached); "friction": the same with no search, only
+    every moving axis's own dry and viscous friction fitted on the nominal model
+    (:func:`faultgen.calibrate.loop.own_friction`), the fallback of a calibration whose search fitted
+    something implausible (a Stribeck velocity 20 x nominal: docs/analysis.md, "A calibration refused
+    as implausible"). Both are cached in ``OUT/.cache/calibrated`` under
     the digest of the nominal model, the log and the search's length, beside a record of the
     calibrated model's SHA-256 that a later run checks; the robot is that model without its log's
     part (:func:`without_payload`), as its writer returned it (or, cached, as an earlier run wrote
@@ -183,7 +200,8 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         if not isinstance(source.given, robots.Robot):
             raise ValueError(str(source.given) if source.given is not None else "no --calibrated model given")
         return source.given
-    key = calibration_key(stored.sha256_file(nominal.path), first[1])
+    steps = 0 if kind == "friction" else CALIBRATION_STEPS
+    key = calibration_key(stored.sha256_file(nominal.path), first[1], steps)
     digest = stored.key_name(key)
     root = out / ".cache" / "calibrated"
     folder, record = root / digest, root / f"{digest}.json"
@@ -203,8 +221,8 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             calibrated = run_calibration(nominal, source.get(first_log).checked(), folder,
-                                         max_steps=CALIBRATION_STEPS, progress=False,
-                                         friction_every_axis=OWN_FRICTION).model
+                                         max_steps=steps, progress=False,
+                                         friction_every_axis=OWN_FRICTION or kind == "friction").model
         stored.write_calibration(record, key, model)
     implausible = plausibility.implausible_parameters(nominal, calibrated)
     if implausible:
