@@ -172,16 +172,20 @@ def main() -> None:
                              "and the monitor's OUT, --out): the remaining life is recomputed from its scores.csv "
                              "with --failure-wear; no fleet is written and no monitor run.")
     parser.add_argument("--out", default="monitor", help="With --fleet: the monitor's OUT inside it.")
+    parser.add_argument("--hinge", choices=prognosis.HINGE_COVARIANCES, default=None,
+                        help="Fit the alarm's source axis with the changepoint trend over the whole block, its "
+                             "uncertainty so (faultgen.monitor.prognosis.fit_hinge); the monitor's from-alarm fit "
+                             "when not given.")
     args = parser.parse_args()
     if args.fleet is not None:
         truth_path, out = args.fleet / "truth.csv", args.fleet / args.out  # scores.csv does not depend on F
         print(f"scoring the existing run {out} against {truth_path}")
     else:
         truth_path, out = run_fleet(args)
-    evaluate(truth_path, out, args.failure_wear)
+    evaluate(truth_path, out, args.failure_wear, args.hinge)
 
 
-def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list[dict]]:
+def evaluate(truth_path: Path, out: Path, failure_wear: float, hinge: str | None = None) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
     docstring); prints a block per unit and the fleet's lines; returns the scores of (A) and (B)."""
     truth = independent_fleet.read_truth(truth_path)
@@ -236,7 +240,8 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list
         medians = []
         for j in range(first + PERSISTENCE - 1, len(rows)):
             (row,) = prognosis.remaining_life(unit, rows[: j + 1], 6, alpha=MONITOR_ALPHA, failure_wear=F,
-                                              since=alarm["first_alarm"], source_axis=axis, axes=[axis])
+                                              since=alarm["first_alarm"], source_axis=axis, axes=[axis],
+                                              hinge=hinge)
             now = day[rows[j]["stamp"]]
             if row.distribution is not None:
                 profile.add_prediction(now, _absolute(row.distribution, now, H))

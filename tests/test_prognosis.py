@@ -1,5 +1,6 @@
 """Remaining useful life (faultgen.monitor.prognosis) on synthetic wear series whose crossing of
-the failure wear is known: linear and exponential growth plus noise, a flat series, and rul.csv.
+the failure wear is known: linear and exponential growth plus noise, flat then rising (the changepoint
+trend), a flat series, and rul.csv.
 The check against an independent fleet's truth is benchmarks/monitor_rul.py (docs/analysis.md)."""
 
 import csv
@@ -87,6 +88,44 @@ def test_sequence_stamps_count_logs_and_the_open_alarm_fits_its_axis_from_the_al
     truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5
     assert _covered(alarmed, truth), alarmed
     assert not _covered(whole, truth), whole  # the flat stretch before the alarm bends the trend
+
+
+def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_narrower_than_from_the_alarm():
+    # flat for 40 logs, then 0.5 % a log for 30; the alarm 10 logs into the rise, so the fit from the
+    # alarm on has 20 logs of the rise and the changepoint trend all 30 (and the flat stretch)
+    truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5  # logs after the last
+    draws = 20
+    covered = {c: 0 for c in prognosis.HINGE_COVARIANCES}
+    widths = {c: [] for c in (*prognosis.HINGE_COVARIANCES, "from the alarm")}
+    for seed in range(draws):
+        rng = np.random.default_rng(500 + seed)
+        wear = np.r_[np.zeros(40), 0.5 * np.arange(1, 31)] + rng.normal(0, NOISE, 70)
+        rows = _rows(wear, sequence=True)
+        alarmed = _one(rows, since=rows[50]["stamp"], source_axis=1)
+        assert alarmed.model != "hinge" and alarmed.logs_fitted == 20 and alarmed.fitted_from == "150"
+        widths["from the alarm"].append(np.inf if alarmed.rul is None else (alarmed.rul_95 or np.inf) - alarmed.rul_5)
+        for covariance in prognosis.HINGE_COVARIANCES:
+            row = _one(rows, since=rows[50]["stamp"], source_axis=1, hinge=covariance)
+            assert row.model == "hinge" and row.logs_fitted == 70 and row.fitted_from == "100", row
+            covered[covariance] += _covered(row, truth)
+            widths[covariance].append(np.inf if row.rul is None else (row.rul_95 or np.inf) - row.rul_5)
+        t = np.arange(70.0) - 69.0
+        fit = prognosis.fit_hinge(t, wear, np.full(70, NOISE))
+        assert abs(fit.changepoint - (-30.0)) < 6.0 and abs(fit.params[1] - 0.5) < 0.15, fit
+    for covariance in prognosis.HINGE_COVARIANCES:
+        assert covered[covariance] >= 0.8 * draws, (covariance, covered)  # a 90 % interval
+        assert np.median(widths[covariance]) < 0.75 * np.median(widths["from the alarm"]), widths
+
+
+def test_a_hinge_that_does_not_rise_falls_back_to_the_fit_from_the_alarm():
+    rng = np.random.default_rng(5)
+    wear = np.r_[np.full(30, 20.0), 20.0 - 0.5 * np.arange(1, 21)] + rng.normal(0, NOISE, 50)
+    rows = _rows(wear, sequence=True)
+    row = _one(rows, since=rows[40]["stamp"], source_axis=1, hinge="jacobian")
+    assert prognosis.fit_hinge(np.arange(50.0) - 49.0, wear, np.full(50, NOISE)).params[1] < 0
+    assert row.model != "hinge" and row.logs_fitted == 10 and row.fitted_from == "140", row
+    with pytest.raises(ValueError, match="covariance"):
+        prognosis.fit_hinge(np.arange(50.0) - 49.0, wear, np.full(50, NOISE), covariance="bayes")
 
 
 def test_maintenance_restarts_the_trend_and_too_few_logs_say_so():
