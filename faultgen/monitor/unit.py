@@ -123,7 +123,7 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
             raise
         except ValueError as err:
             if unit.entries:
-                return f"the twin of the {unit.model} model cannot be built again ({short(err)})"
+                return f"the twin of the {KIND_NAMES[unit.model]} cannot be built again ({short(err)})"
             fallback = FALLBACK[unit.model]
             if fallback == "friction" and not OWN_FRICTION:
                 fallback = "nominal"
