@@ -41,7 +41,10 @@ lies within those bounds there and the distribution's 5-95 % width over the true
 over the predictions before the end of life; the prognostic horizon (the end-of-life time minus the
 first prediction meeting the alpha criterion with beta 0.5); the median bias of the estimate (days,
 predicted minus true remaining life). A sample beyond the prediction's horizon (365 days) enters the
-metrics at the horizon (ProgPy drops a None sample from a mean).
+metrics at the horizon (ProgPy drops a None sample from a mean). **Reachable**: per unit, how far
+from the true remaining life at (A)'s lambda an exact prediction of the day the estimate reaches F
+(B's end of life) would be, ``(B - A) / (A - lambda)``; beyond alpha no trend fitted to that estimate
+can meet (A)'s alpha-lambda, however sharp: the count bounds (A)'s criterion by the wear estimate.
 """
 
 from __future__ import annotations
@@ -255,6 +258,8 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, hinge: str | None
         for name, eol in (("A", true_eol), ("B", estimate_eol)):
             s = score(profile, eol, start, len(wear))
             s["unit"] = unit
+            if name == "A":  # a prediction of the estimate's own crossing, exact, judged against the truth
+                s["perfect_error"] = (estimate_eol - true_eol) / (true_eol - s["lambda"])
             results[name].append(s)
             al = {None: f"n/a (lambda day {s['lambda']:.0f} after the record)", True: "met", False: "not met"}[
                 s.get("alpha_lambda")]  # a bool or None
@@ -267,6 +272,11 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, hinge: str | None
                   f"over {s['predictions']} predictions; prognostic horizon "
                   f"{ph}; median bias "
                   f"{s.get('bias', float('nan')):+.1f} days")
+            if name == "A":
+                r = s["perfect_error"]
+                print(f"      a prediction of the day the estimate reaches {F:g} %, exact, would be off by {r:+.2f} of "
+                      f"the true remaining life at lambda: alpha-lambda {'reachable' if abs(r) <= ALPHA else 'out of reach'}"
+                      f" for any trend of this estimate")
     print(f"\nprofiles computed in {time.perf_counter() - started:.0f} s")
     for name, label in (("A", "true wear reaches F (independent)"), ("B", "estimate's trend reaches F (hindsight)")):
         rs = results[name]
@@ -282,6 +292,10 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, hinge: str | None
               f"covers the true remaining life on {sum(bool(r.get('covers_lambda')) for r in rs)} of {evaluable} "
               f"units, median width {np.median([r['width_lambda'] for r in rs if 'width_lambda' in r]) if evaluable else float('nan'):.2f} "
               f"x the true remaining life")
+    reachable = sum(abs(r["perfect_error"]) <= ALPHA for r in results["A"])
+    print(f"(A) reachable: a prediction of the day each estimate reaches F, exact, would be within +-{ALPHA:g} of the "
+          f"true remaining life at lambda on {reachable} of {len(results['A'])} units (the wear estimate's own scale and "
+          "offset bound alpha-lambda against the true wear, whatever the trend)")
     return results
 
 
