@@ -3,7 +3,8 @@ the truth of a fleet made by a simulator that is not faultgen, with NASA ProgPy'
 
     python benchmarks/monitor_rul.py [--units 6] [--worn 4] [--days 120] [--seed 0] [--final-wear 60]
                                      [--failure-wear 40] [--work DIR]
-    python benchmarks/monitor_rul.py --fleet WORK [--out monitor] [--failure-wear 40]
+    python benchmarks/monitor_rul.py --fleet WORK [--out monitor] [--failure-wear 40] [--from-alarm]
+                                     [--scale-uncertainty 0.1]
 
 The second form scores a run of ``benchmarks/monitor_wear_scale.py`` (its ``WORK``: the issue's two
 independent fleets, first law and Stribeck-hump law, 12 units with 8 worn, with the calibrated
@@ -175,16 +176,23 @@ def main() -> None:
                              "and the monitor's OUT, --out): the remaining life is recomputed from its scores.csv "
                              "with --failure-wear; no fleet is written and no monitor run.")
     parser.add_argument("--out", default="monitor", help="With --fleet: the monitor's OUT inside it.")
+    parser.add_argument("--from-alarm", action="store_true",
+                        help="Fit the alarm's source axis from its alarm on, not with the changepoint trend over its "
+                             "whole block (the monitor's rule before 2026-11-26).")
+    parser.add_argument("--scale-uncertainty", type=float, default=prognosis.SCALE_UNCERTAINTY,
+                        help="Relative standard uncertainty of the wear estimate's scale carried into the time of "
+                             "event (the monitor's, 0.10; 0 as before 2026-11-26).")
     args = parser.parse_args()
     if args.fleet is not None:
         truth_path, out = args.fleet / "truth.csv", args.fleet / args.out  # scores.csv does not depend on F
         print(f"scoring the existing run {out} against {truth_path}")
     else:
         truth_path, out = run_fleet(args)
-    evaluate(truth_path, out, args.failure_wear)
+    evaluate(truth_path, out, args.failure_wear, not args.from_alarm, args.scale_uncertainty)
 
 
-def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list[dict]]:
+def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool = True,
+             scale_uncertainty: float = prognosis.SCALE_UNCERTAINTY) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
     docstring); prints a block per unit and the fleet's lines; returns the scores of (A) and (B)."""
     truth = independent_fleet.read_truth(truth_path)
@@ -239,7 +247,8 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float) -> dict[str, list
         medians = []
         for j in range(first + PERSISTENCE - 1, len(rows)):
             (row,) = prognosis.remaining_life(unit, rows[: j + 1], 6, alpha=MONITOR_ALPHA, failure_wear=F,
-                                              since=alarm["first_alarm"], source_axis=axis, axes=[axis])
+                                              since=alarm["first_alarm"], source_axis=axis, axes=[axis],
+                                              changepoint=changepoint, scale_uncertainty=scale_uncertainty)
             now = day[rows[j]["stamp"]]
             if row.distribution is not None:
                 profile.add_prediction(now, _absolute(row.distribution, now, H))

@@ -1,5 +1,6 @@
 """Remaining useful life (faultgen.monitor.prognosis) on synthetic wear series whose crossing of
-the failure wear is known: linear and exponential growth plus noise, a flat series, and rul.csv.
+the failure wear is known: linear and exponential growth plus noise, flat then rising (the changepoint
+trend), a flat series, and rul.csv.
 The check against an independent fleet's truth is benchmarks/monitor_rul.py (docs/analysis.md)."""
 
 import csv
@@ -76,17 +77,88 @@ def test_a_flat_series_has_no_end_of_life_within_the_horizon():
         assert "no end of life within the horizon (365 days)" in row.verdict, row.verdict
 
 
-def test_sequence_stamps_count_logs_and_the_open_alarm_fits_its_axis_from_the_alarm_on():
+def test_sequence_stamps_count_logs_and_the_open_alarm_fits_its_axis_over_the_block_or_from_the_alarm_on():
     rng = np.random.default_rng(3)
     wear = np.r_[np.zeros(30), 0.5 * np.arange(1, 31)] + rng.normal(0, NOISE, 60)
     rows = _rows(wear, sequence=True)
     whole = _one(rows)
-    alarmed = _one(rows, since=rows[30]["stamp"], source_axis=1)
-    assert whole.time_unit == alarmed.time_unit == "logs"
-    assert whole.logs_fitted == 60 and alarmed.logs_fitted == 30 and alarmed.fitted_from == "130"
+    hinge = _one(rows, since=rows[30]["stamp"], source_axis=1)
+    alarmed = _one(rows, since=rows[30]["stamp"], source_axis=1, changepoint=False)
+    assert whole.time_unit == alarmed.time_unit == hinge.time_unit == "logs"
+    assert whole.logs_fitted == 60 and whole.model != "changepoint"
+    assert hinge.logs_fitted == 60 and hinge.model == "changepoint" and hinge.fitted_from == "100", hinge
+    assert alarmed.logs_fitted == 30 and alarmed.fitted_from == "130"
     truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5
     assert _covered(alarmed, truth), alarmed
-    assert not _covered(whole, truth), whole  # the flat stretch before the alarm bends the trend
+    assert _covered(hinge, truth), hinge
+    assert not _covered(whole, truth), whole  # a line through the flat stretch before the alarm is bent
+
+
+def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_narrower_than_from_the_alarm():
+    # flat for 40 logs, then 0.5 % a log for 30; the alarm 10 logs into the rise, so the fit from the
+    # alarm on has 20 logs of the rise and the changepoint trend all 30 (and the flat stretch); the
+    # estimate's scale exact here, so the trend alone is compared (no scale uncertainty)
+    truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5  # logs after the last
+    draws = 20
+    covered, widths = 0, {"hinge": [], "from the alarm": []}
+    for seed in range(draws):
+        rng = np.random.default_rng(500 + seed)
+        wear = np.r_[np.zeros(40), 0.5 * np.arange(1, 31)] + rng.normal(0, NOISE, 70)
+        rows = _rows(wear, sequence=True)
+        alarmed = _one(rows, since=rows[50]["stamp"], source_axis=1, changepoint=False, scale_uncertainty=0.0)
+        assert alarmed.model != "changepoint" and alarmed.logs_fitted == 20 and alarmed.fitted_from == "150"
+        widths["from the alarm"].append(np.inf if alarmed.rul is None else (alarmed.rul_95 or np.inf) - alarmed.rul_5)
+        row = _one(rows, since=rows[50]["stamp"], source_axis=1, scale_uncertainty=0.0)
+        assert row.model == "changepoint" and row.logs_fitted == 70 and row.fitted_from == "100", row
+        covered += _covered(row, truth)
+        widths["hinge"].append(np.inf if row.rul is None else (row.rul_95 or np.inf) - row.rul_5)
+        t = np.arange(70.0) - 69.0
+        fit = prognosis.fit_hinge(t, wear, np.full(70, NOISE))
+        assert abs(fit.changepoint - (-30.0)) < 6.0 and abs(fit.params[1] - 0.5) < 0.15, fit
+    assert covered >= 0.8 * draws, covered  # a 90 % interval
+    assert np.median(widths["hinge"]) < 0.75 * np.median(widths["from the alarm"]), widths
+
+
+def test_a_hinge_that_does_not_rise_falls_back_to_the_fit_from_the_alarm():
+    rng = np.random.default_rng(5)
+    wear = np.r_[np.full(30, 20.0), 20.0 - 0.5 * np.arange(1, 21)] + rng.normal(0, NOISE, 50)
+    rows = _rows(wear, sequence=True)
+    row = _one(rows, since=rows[40]["stamp"], source_axis=1)
+    assert prognosis.fit_hinge(np.arange(50.0) - 49.0, wear, np.full(50, NOISE)).params[1] < 0
+    assert row.model != "changepoint" and row.logs_fitted == 10 and row.fitted_from == "140", row
+
+
+def test_the_scale_uncertainty_spreads_the_time_of_event_as_its_closed_form():
+    """A line known exactly (w0, b; no covariance) and a scale k ~ N(1, u): the crossing of F k is at
+    (F k - w0) / b, normal with mean (F - w0) / b and standard deviation F u / b."""
+    w0, b, u = 10.0, 0.5, 0.1
+    fit = prognosis.Fit("linear", np.array([w0, b]), np.zeros((2, 2)), 0.0)
+    toe = prognosis.time_of_event(fit, prognosis.FAILURE_WEAR, samples=4000, seed=1, scale_uncertainty=u)
+    times = np.array([t for t in toe.key("failure")], dtype=float)
+    mean, sd = (prognosis.FAILURE_WEAR - w0) / b, prognosis.FAILURE_WEAR * u / b
+    assert abs(np.median(times) - mean) < 0.05 * sd * 4, np.median(times)
+    for q in (0.05, 0.95):
+        expected = mean + NormalDist().inv_cdf(q) * sd
+        assert abs(np.quantile(times, q) - expected) < 0.1 * sd, (q, np.quantile(times, q), expected)
+    exact = prognosis.time_of_event(fit, prognosis.FAILURE_WEAR, samples=50, seed=1, scale_uncertainty=0.0)
+    np.testing.assert_allclose([t for t in exact.key("failure")], mean, rtol=1e-9)
+
+
+def test_with_the_scale_uncertainty_the_interval_covers_the_true_wears_crossing_when_the_estimate_is_scaled():
+    """Estimates of a linear wear read at a scale k ~ N(1, 0.1) the logs cannot tell (as the twin's
+    model uncertainty, faultgen.monitor.scoring.SCALE_UNCERTAINTY): the interval carrying it covers the
+    day the true wear reaches the failure wear on at least 80 % of the draws; the trend's alone does not."""
+    covered = {True: 0, False: 0}
+    for seed in range(DRAWS):
+        rng = np.random.default_rng(2000 + seed)
+        rate, days, k = rng.uniform(0.3, 0.5), 60, 1.0 + 0.1 * rng.standard_normal()
+        truth = prognosis.FAILURE_WEAR / rate - (days - 1)
+        rows = _rows(k * rate * np.arange(days) + rng.normal(0, 1.0, days))
+        for scaled in covered:
+            row = _one(rows, scale_uncertainty=prognosis.SCALE_UNCERTAINTY if scaled else 0.0)
+            covered[scaled] += _covered(row, truth)
+    assert covered[True] >= 0.8 * DRAWS, covered
+    assert covered[False] <= 0.6 * DRAWS, covered
 
 
 def test_maintenance_restarts_the_trend_and_too_few_logs_say_so():

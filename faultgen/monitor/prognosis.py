@@ -9,14 +9,22 @@ unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`w
 Per axis:
 
 1. **The logs fitted**: the unit's monitoring logs since its last maintenance (the rows of phase
-   ``monitoring`` after the last ``relearning`` one: a new part starts a new trend); for the source
-   axis of the unit's open alarm, only those from its first alarm on (the alarm marks where the
-   wear left the noise: the flat stretch before it would bend a straight line). At least
+   ``monitoring`` after the last ``relearning`` one: a new part starts a new trend). At least
    :data:`MIN_LOGS`; time in days since the last of them (stamps that are dates or date-times,
    :func:`faultgen.data.logfolder.parse_stamp`), or in logs (sequence-number stamps).
-2. **Two degradation models**, each fitted by weighted least squares (``scipy.optimize.curve_fit``,
-   weights one over each estimate's variance), written with their parameters as the state now
-   (``t`` <= 0 the logs' times, 0 the last log): linear ``w(t) = w0 + b t`` and exponential
+2. **The source axis of the unit's open alarm: a changepoint trend** over all of them, the
+   two-phase degradation model of prognostics, flat until a changepoint ``tc`` and a line after it,
+   ``w(t) = w_now + b max(t, tc)`` (:func:`fit_hinge`; ``t`` <= 0 the logs' times, 0 the last log):
+   weighted least squares of (``w_now``, ``b``) at each candidate ``tc`` (each log's time from the
+   3rd log to the 5th from the last, :data:`HINGE_MARGINS`), the least chi-square's ``tc`` refined
+   between its neighbours, and the covariance of (``w_now``, ``b``) the Gauss-Newton one of all
+   three parameters there (``tc`` included), marginalised. From now on it is the line. When it
+   cannot be fitted or its slope is not positive: the two models of 3 on the logs from the first
+   alarm on (the alarm marks where the wear left the noise; the flat stretch before it would bend
+   a straight line), the rule before 2026-11-26.
+3. **Every other axis: two degradation models**, each fitted by weighted least squares (``scipy.optimize.curve_fit``,
+   weights one over each estimate's variance), written with their parameters as the state now:
+   linear ``w(t) = w0 + b t`` and exponential
    ``w(t) = w0 + b (exp(k t) - 1) / k`` (``a + c exp(k t)``, the exponential degradation model of
    Gebraeel et al. 2005 with an offset, by its wear ``w0`` and slope ``b`` now and its growth rate
    ``k``; ``k`` -> 0 is the line). **Criterion**: the smaller AICc (Akaike's criterion with the small
@@ -24,22 +32,36 @@ Per axis:
    Gaussian likelihood with the variances' common scale fitted, so the exponential's third parameter
    must pay for itself (with 5 logs it cannot: its AICc is infinite). A fit that does not converge or
    whose covariance is not finite is not a candidate.
-3. **Parameter uncertainty**: the fit's covariance, scaled by the residuals' reduced chi-square when
+4. **Uncertainty**: the fit's covariance, scaled by the residuals' reduced chi-square when
    it is above one (the stated standard errors are a floor: the log-to-log scatter of a real unit
    may exceed them, never fall below), sampled (:data:`SAMPLES` draws, multivariate normal, seeded)
-   into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the model's state now.
-4. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each sample of the state
+   into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the model's state now, each
+   sample with a **scale** of the wear estimate drawn from a normal of mean 1 and standard deviation
+   :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY` (0.10), the twin's model uncertainty that
+   ``wear.csv``'s 90 % interval carries: the estimate is the wear times a scale the unit's logs
+   cannot tell, so the wear reaches the failure wear when the estimate reaches the failure wear
+   times that scale. The trend's own covariance comes from the log-to-log scatter, which more logs
+   average away; the scale error does not average away.
+5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each sample of the state
    through :class:`WearTrend` (a :class:`progpy.PrognosticsModel` whose ``next_state`` is the exact
    solution of either model, so no step error) up to :data:`HORIZON` days (logs), its event
-   ``failure`` met at wear >= the failure wear; the step ends on the crossing when it falls inside
-   it, so a sample's time of event is exact. A sample that does not cross within the horizon has
-   no time of event (ProgPy's None).
-5. **The row**: the median time of event (the estimate), its 5 and 95 % quantiles
+   ``failure`` met at wear >= the failure wear times the sample's scale; the step ends on the
+   crossing when it falls inside it, so a sample's time of event is exact. A sample that does not
+   cross within the horizon has no time of event (ProgPy's None).
+6. **The row**: the median time of event (the estimate), its 5 and 95 % quantiles
    (``numpy.quantile``, ``inverted_cdf``: a sample's own value, with the samples beyond the horizon
    counted as later than it), and the probability of failure within the horizon (one minus
    ProgPy's :func:`progpy.metrics.prob_success` at the horizon). When that probability is below
    one half (the median lies beyond the horizon: a flat or falling trend, or one too slow), the
    axis has **no end of life within the horizon**, said with the horizon, and no number is given.
+
+Why the changepoint and the scale (2026-11-26; docs/analysis.md, "Remaining useful life"): on the
+four independent fleets of issue 59 (32 worn units; ``benchmarks/monitor_rul.py --fleet W``), the
+fit from the alarm on, without the scale, had a prognostic horizon on 4 units and its 5-95 %
+interval covered the true remaining life at lambda on 23; the changepoint alone on 22 and 13 (sharper
+than its error, which is mostly each unit's scale); both together on 15 and 28. Alpha-lambda (0.2
+at lambda 0.5) was met on 1, 8 and 0 of 32: the estimate's own scale and offset put it out of reach
+of any trend on most units (the benchmark's "reachable" count).
 
 Why the fit is not ProgPy's own: ProgPy fits a model's parameters to run-to-failure data by
 minimising an error (``PrognosticsModel.estimate_params``), without the parameters' covariance, and
@@ -65,6 +87,7 @@ from statistics import NormalDist
 import numpy as np
 
 from faultgen.data import cells, logfolder
+from faultgen.monitor.scoring import SCALE_UNCERTAINTY
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
@@ -78,8 +101,12 @@ MIN_LOGS = 5
 SAMPLES = 1000
 #: The interval given: 5 and 95 % quantiles of the time of event.
 INTERVAL = (0.05, 0.95)
-#: Models, the simpler first.
-MODELS = ("linear", "exponential")
+#: Models, the simpler first; "changepoint" (the hinge: flat, then a line) only for the open alarm's source axis
+#: (module docstring, 2).
+MODELS = ("linear", "exponential", "changepoint")
+#: The hinge's changepoint is looked for between the logs this far from either end of the block
+#: (the 3rd log and the 5th from the last: a flat stretch and a rise of at least a few logs each).
+HINGE_MARGINS = (2, 4)
 #: How much smaller the exponential's AICc must be for it to be taken over the line (Burnham &
 #: Anderson 2002, ch. 2.6: models within 2 of the best have substantial support; the simpler is kept).
 AICC_MARGIN = 2.0
@@ -137,35 +164,37 @@ def import_progpy() -> None:
 
 
 def _wear_trend_model(failure_wear: float):
-    """The ProgPy model of both trends (module docstring, 4), its event at ``failure_wear``."""
+    """The ProgPy model of both trends (module docstring, 5), its event at ``failure_wear``."""
     import_progpy()
     from progpy import PrognosticsModel
 
     class WearTrend(PrognosticsModel):
         """``dw/dt = s``, ``ds/dt = k s``: a line (``k`` = 0) or ``w0 + b (exp(k t) - 1) / k``,
-        stepped by its exact solution."""
+        stepped by its exact solution; the estimate's ``scale`` constant, the event at ``w`` >=
+        the failure wear times it."""
 
         # ProgPy reads a model's names and defaults from these class attributes
         inputs = []  # noqa: RUF012
-        states = ["wear", "slope", "growth"]  # noqa: RUF012
+        states = ["wear", "slope", "growth", "scale"]  # noqa: RUF012
         outputs = ["wear"]  # noqa: RUF012
         events = ["failure"]  # noqa: RUF012
         default_parameters = {"failure_wear": failure_wear, "process_noise": 0.0,  # noqa: RUF012
-                              "measurement_noise": 0.0, "x0": {"wear": 0.0, "slope": 0.0, "growth": 0.0}}
+                              "measurement_noise": 0.0,
+                              "x0": {"wear": 0.0, "slope": 0.0, "growth": 0.0, "scale": 1.0}}
 
         def next_state(self, x, u, dt):
             k, s = x["growth"], x["slope"]
             return self.StateContainer({"wear": x["wear"] + s * _expm1_over(k, dt), "slope": s * np.exp(k * dt),
-                                        "growth": k})
+                                        "growth": k, "scale": x["scale"]})
 
         def output(self, x):
             return self.OutputContainer({"wear": x["wear"]})
 
         def event_state(self, x):
-            return {"failure": max(0.0, 1.0 - float(x["wear"]) / self.parameters["failure_wear"])}
+            return {"failure": max(0.0, 1.0 - float(x["wear"]) / (self.parameters["failure_wear"] * x["scale"]))}
 
         def threshold_met(self, x):
-            return {"failure": bool(x["wear"] >= self.parameters["failure_wear"])}
+            return {"failure": bool(x["wear"] >= self.parameters["failure_wear"] * x["scale"])}
 
     return WearTrend()
 
@@ -188,17 +217,100 @@ def _exponential(t, w0, b, k):
 @dataclass(frozen=True)
 class Fit:
     """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k]), their covariance
-    ``cov`` (scaled: module docstring, 3) and its ``aicc``."""
+    ``cov`` (scaled: module docstring, 4) and its ``aicc``; ``changepoint`` the hinge's ``tc``
+    (None for the other models)."""
 
     model: str
     params: np.ndarray
     cov: np.ndarray
     aicc: float
+    changepoint: float | None = None
+
+
+def _hinge_design(t: np.ndarray, tc) -> np.ndarray:
+    """The hinge's design matrices at changepoints ``tc`` (shape (m,)): (m, n, 2), columns 1 and ``max(t, tc)``."""
+    tc = np.atleast_1d(np.asarray(tc, dtype=float))
+    x = np.maximum(t[None, :], tc[:, None])
+    return np.stack([np.ones_like(x), x], axis=-1)
+
+
+def _hinge_wls(t, wear, weight, tc):
+    """Weighted least squares of the hinge's (w_now, b) at each changepoint ``tc``: parameters (m, 2)
+    and chi-square (m,); NaN where the design is singular."""
+    x = _hinge_design(t, tc)
+    a = np.einsum("mni,n,mnj->mij", x, weight, x)
+    rhs = np.einsum("mni,n,n->mi", x, weight, wear)
+    det = a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] ** 2
+    ok = det > 1e-12 * np.maximum(a[:, 0, 0] * a[:, 1, 1], 1e-300)
+    inverse = np.full_like(a, np.nan)
+    inverse[ok, 0, 0], inverse[ok, 1, 1] = a[ok, 1, 1] / det[ok], a[ok, 0, 0] / det[ok]
+    inverse[ok, 0, 1] = inverse[ok, 1, 0] = -a[ok, 0, 1] / det[ok]
+    params = np.einsum("mij,mj->mi", inverse, rhs)
+    residual = wear[None, :] - np.einsum("mni,mi->mn", x, params)
+    return params, np.einsum("mn,n->m", residual**2, weight)
+
+
+def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
+    """The two-phase (changepoint) trend fitted to the wear estimates ``wear`` (%) at times ``t``
+    (<= 0, the last 0) with standard errors ``error``: flat until ``tc``, then a line,
+    ``w(t) = w_now + b max(t, tc)`` (module docstring, 2): weighted least squares of
+    (``w_now``, ``b``) at each candidate ``tc`` (the logs' times, :data:`HINGE_MARGINS` from either
+    end), the least chi-square's ``tc`` refined between its neighbours (``scipy.optimize.minimize_scalar``);
+    the covariance of (``w_now``, ``b``) the Gauss-Newton one of the three parameters there (as
+    ``curve_fit`` with ``absolute_sigma`` gives it), marginalised, scaled by the reduced
+    chi-square when above one. :class:`Fit` with ``params`` (w_now, b) and ``changepoint`` ``tc``;
+    None when it cannot be fitted (fewer than ``sum(HINGE_MARGINS) + 1`` logs, a singular design or a
+    covariance that is not finite)."""
+    from scipy import stats
+    from scipy.optimize import minimize_scalar
+    from statsmodels.tools.eval_measures import aicc
+
+    t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
+    n = len(t)
+    first, last = HINGE_MARGINS[0], n - 1 - HINGE_MARGINS[1]
+    if last < first:
+        return None
+    weight = 1.0 / error**2
+    grid = t[first: last + 1]
+    chi2 = _hinge_wls(t, wear, weight, grid)[1]
+    if not np.any(np.isfinite(chi2)):
+        return None
+    best = int(np.nanargmin(chi2))
+    # the profile's minimum between the grid's neighbours of its best log (chi2 is smooth between logs)
+    low, high = grid[max(best - 1, 0)], grid[min(best + 1, len(grid) - 1)]
+    tc = float(grid[best])
+    if high > low:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            found = minimize_scalar(lambda c: float(_hinge_wls(t, wear, weight, c)[1][0]), bounds=(low, high),
+                                    method="bounded", options={"xatol": 1e-6 * max(high - low, 1e-9)})
+        if np.isfinite(found.fun) and found.fun < chi2[best]:
+            tc = float(found.x)
+    params, chi2_tc = _hinge_wls(t, wear, weight, tc)
+    (w_now, b), chi2_tc = params[0], float(chi2_tc[0])
+    if not np.all(np.isfinite(params)):
+        return None
+    # covariance of (w_now, b, tc): the Gauss-Newton one at the optimum, the model's derivative in tc
+    # being b before tc and 0 after it
+    jacobian = np.column_stack([np.ones(n), np.maximum(t, tc), np.where(t < tc, b, 0.0)])
+    try:
+        cov = np.linalg.inv(jacobian.T @ (jacobian * weight[:, None]))
+    except np.linalg.LinAlgError:
+        return None
+    dof = n - 3
+    if dof > 0:
+        cov = cov * max(1.0, chi2_tc / dof)
+    if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
+        return None
+    residual = wear - (w_now + b * np.maximum(t, tc))
+    scale = np.sqrt(chi2_tc / n) if chi2_tc > 0 else 1e-12
+    llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
+    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], float(aicc(llf, n, 4)), changepoint=tc)
 
 
 def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
-    standard errors ``error``; the one of smaller AICc (module docstring, 2-3), None when neither fits."""
+    standard errors ``error``; the one of smaller AICc (module docstring, 3-4), None when neither fits."""
     from scipy import stats
     from scipy.optimize import curve_fit
     from statsmodels.tools.eval_measures import aicc
@@ -244,22 +356,27 @@ def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     return fits[0]
 
 
-def _state_samples(fit: Fit, samples: int, seed: int):
-    """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now."""
+def _state_samples(fit: Fit, samples: int, seed: int, scale_uncertainty: float = 0.0):
+    """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now,
+    each with a scale of the wear estimate drawn from a normal of mean 1 and standard deviation
+    ``scale_uncertainty`` (at least 0.05)."""
     import_progpy()
     from progpy.uncertain_data import UnweightedSamples
 
     rng = np.random.default_rng(seed)
     drawn = rng.multivariate_normal(fit.params, fit.cov, size=samples, method="eigh")
     growth = drawn[:, 2] if drawn.shape[1] > 2 else np.zeros(samples)
-    return UnweightedSamples([{"wear": float(w), "slope": float(s), "growth": float(k)}
-                              for w, s, k in zip(drawn[:, 0], drawn[:, 1], growth)])
+    scale = np.maximum(1.0 + scale_uncertainty * rng.standard_normal(samples), 0.05) if scale_uncertainty else \
+        np.ones(samples)
+    return UnweightedSamples([{"wear": float(w), "slope": float(s), "growth": float(k), "scale": float(c)}
+                              for w, s, k, c in zip(drawn[:, 0], drawn[:, 1], growth, scale)])
 
 
-def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0):
+def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0,
+                  scale_uncertainty: float = SCALE_UNCERTAINTY):
     """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
-    under ``fit`` (module docstring, 4): ``UnweightedSamples`` with key ``failure`` (None beyond
-    ``horizon``)."""
+    under ``fit``, the estimate's scale uncertain by ``scale_uncertainty`` (module docstring, 4-5):
+    ``UnweightedSamples`` with key ``failure`` (None beyond ``horizon``)."""
     import_progpy()
     from progpy.predictors import MonteCarlo
 
@@ -267,7 +384,7 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
 
     def step(t, x):  # up to the horizon, ending on the crossing when it falls inside the step
         wear, slope, growth = float(x["wear"]), float(x["slope"]), float(x["growth"])
-        gap, left = failure_wear - wear, max(horizon - t, 1e-9)
+        gap, left = failure_wear * float(x["scale"]) - wear, max(horizon - t, 1e-9)
         if gap <= 0:
             return 1e-9
         reach = np.inf
@@ -281,7 +398,8 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = MonteCarlo(model).predict(_state_samples(fit, samples, seed), dt=step, horizon=horizon,
+        result = MonteCarlo(model).predict(_state_samples(fit, samples, seed, scale_uncertainty), dt=step,
+                                           horizon=horizon,
                                            save_freq=horizon, events=["failure"])
     return result.time_of_event
 
@@ -289,15 +407,20 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
 def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, failure_wear: float = FAILURE_WEAR,
                    keys: dict[str, float] | None = None, kind: str | None = None, since: str | None = None,
                    source_axis: int | None = None, horizon: float = HORIZON, samples: int = SAMPLES,
-                   seed: int = 0, axes: list[int] | None = None) -> list[Remaining]:
+                   seed: int = 0, axes: list[int] | None = None, changepoint: bool = True,
+                   scale_uncertainty: float = SCALE_UNCERTAINTY) -> list[Remaining]:
     """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
     rows (``UnitMonitor.rows``: ``stamp``, ``phase``, each log's own wear estimate ``wearI_log`` and its
     lower bound ``wearI_log_lower``, not the filtered ``wearI``, whose errors are not independent from
     log to log as the trend's fit assumes) with the monitor's
     ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
-    first alarm of the open alarm, whose ``source_axis`` is fitted from it on (module docstring);
-    ``axes`` (1..N) the axes wanted, all when None. A unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
+    first alarm of the open alarm, whose ``source_axis`` gets the changepoint trend over the whole
+    block (:func:`fit_hinge`; ``changepoint`` False: the trends of the logs from the alarm on, the rule
+    before 2026-11-26) and is fitted from the alarm on when that fails (module docstring, 2);
+    ``scale_uncertainty`` the relative standard uncertainty of the estimate's scale carried into the
+    time of event (module docstring, 4; 0: none); ``axes`` (1..N) the axes wanted, all when None. A
+    unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
     check_failure_wear(failure_wear)
     stamp = rows[-1]["stamp"] if rows else ""
     if not rows or "wear1_log" not in rows[0]:
@@ -317,11 +440,24 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     per = 1.0 if kind == logfolder.SEQUENCE else 86400.0
     z = NormalDist().inv_cdf(1.0 - alpha)
     out = []
+
+    def series(logs, axis):
+        wear = np.array([r[f"wear{axis}_log"] for r in logs], dtype=float)
+        error = (wear - np.array([r[f"wear{axis}_log_lower"] for r in logs], dtype=float)) / z
+        t = np.array([keys[r["stamp"]] for r in logs], dtype=float)
+        return (t - t[-1]) / per, wear, np.maximum(error, 1e-9)
+
     for axis in range(1, n_axes + 1) if axes is None else axes:
         fitted = block
+        hinge = None
         if since is not None and axis == source_axis:
             stamps = [r["stamp"] for r in block]
-            fitted = block[stamps.index(since):] if since in stamps else block
+            if changepoint and since in stamps:  # the whole block, flat then rising
+                hinge = fit_hinge(*series(block, axis))
+                if hinge is not None and not hinge.params[1] > 0:
+                    hinge = None
+            if hinge is None:  # the logs from the alarm on
+                fitted = block[stamps.index(since):] if since in stamps else block
         base = Remaining(unit, axis, stamp, time_unit, "", failure_wear, horizon, logs_fitted=len(fitted),
                          fitted_from=fitted[0]["stamp"] if fitted else "")
         if len(fitted) < MIN_LOGS:
@@ -329,11 +465,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                             f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
             out.append(base)
             continue
-        wear = np.array([r[f"wear{axis}_log"] for r in fitted], dtype=float)
-        error = (wear - np.array([r[f"wear{axis}_log_lower"] for r in fitted], dtype=float)) / z
-        t = np.array([keys[r["stamp"]] for r in fitted], dtype=float)
-        t = (t - t[-1]) / per
-        fit = fit_trend(t, wear, np.maximum(error, 1e-9))
+        fit = hinge if hinge is not None else fit_trend(*series(fitted, axis))
         if fit is None:
             base.verdict = "no trend could be fitted"
             out.append(base)
@@ -345,7 +477,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                             f"0 at alpha {alpha:g}): no end of life within the horizon ({horizon:g} {time_unit})")
             out.append(base)
             continue
-        toe = time_of_event(fit, failure_wear, horizon, samples, seed)
+        toe = time_of_event(fit, failure_wear, horizon, samples, seed, scale_uncertainty)
         out.append(_summarise(base, fit, toe, horizon))
     return out
 
@@ -368,8 +500,9 @@ def _summarise(row: Remaining, fit: Fit, toe, horizon: float) -> Remaining:
     row.rul_95 = float(high) if np.isfinite(high) else None
     upper = f"{high:.3g} {unit}" if np.isfinite(high) else f"beyond the {h} horizon"
     now = " (at or past it now)" if row.wear >= row.failure_wear else ""
+    rising = "" if fit.changepoint is None else f", rising for the last {-fit.changepoint:.3g} {unit}"
     row.verdict = (f"end of life (wear {row.failure_wear:g} %){now} in {mid:.3g} {unit}, 5-95 %: {low:.3g} {unit} "
-                   f"to {upper} ({fit.model} trend of {row.logs_fitted} logs)")
+                   f"to {upper} ({fit.model} trend of {row.logs_fitted} logs{rising})")
     return row
 
 
