@@ -93,9 +93,9 @@ def monitor_command(
     logs; its source axis is the one with the largest wear estimate (own: the largest share of Q).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (its calibrated model,
-    then its own friction on the nominal model, then the nominal model, then --protocol own), and a log that cannot be read or replayed is
-    skipped; OUT/units.csv gives every unit's status (monitored, learning, degraded, not
-    monitored), protocol, model and the reason. Exit status: 0 when every unit is monitored or
+    then its own friction on the nominal model, then the nominal model, then --protocol own), and
+    a log that cannot be read or replayed is skipped; OUT/units.csv gives every unit's status
+    (monitored, learning, degraded, not monitored), protocol, model and the reason. Exit status: 0 when every unit is monitored or
     still learning, 3 when some unit is degraded or not monitored (every output still written),
     2 when the run is refused before any work (bad option, robot, folder or OUT). OUT must lie apart
     from LOGS (neither inside it nor holding it); a run that fails leaves no OUT it made.
