@@ -83,7 +83,7 @@ def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(f
     """rul.csv: every unit and axis at its last log; the worn axis (wear 60 % on the last day, still
     growing) a remaining life with its interval, the healthy
     units no end of life within the horizon (faultgen.monitor.prognosis; tests/test_prognosis.py)."""
-    from faultgen.monitor import prognosis
+    from faultgen.monitor import prognosis, trends
 
     _, _, truth_path = fleet
     truth = independent_fleet.read_truth(truth_path)
@@ -94,7 +94,7 @@ def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(f
         t = truth[r["unit"]]
         assert r["stamp"] == t["stamps"][-1] and r["time_unit"] == "days", r
         if t["axis"] and int(r["axis"]) == t["axis"]:
-            assert r["model"] in prognosis.MODELS and r["logs_fitted"] != "", r
+            assert r["model"] in trends.MODELS and r["logs_fitted"] != "", r
             assert 0 <= float(r["rul_5"]) <= float(r["rul"]) <= float(r["rul_95"]) < prognosis.HORIZON, r
         elif not t["axis"]:
             assert r["rul"] == "" and "no end of life within the horizon (365 days)" in r["verdict"], r

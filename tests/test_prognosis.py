@@ -10,7 +10,7 @@ from statistics import NormalDist
 import numpy as np
 import pytest
 
-from faultgen.monitor import prognosis
+from faultgen.monitor import prognosis, trends
 
 ALPHA = 0.01
 Z = NormalDist().inv_cdf(1 - ALPHA)
@@ -113,7 +113,7 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
         covered += _covered(row, truth)
         widths["hinge"].append(np.inf if row.rul is None else (row.rul_95 or np.inf) - row.rul_5)
         t = np.arange(70.0) - 69.0
-        fit = prognosis.fit_hinge(t, wear, np.full(70, NOISE))
+        fit = trends.fit_hinge(t, wear, np.full(70, NOISE))
         assert abs(fit.changepoint - (-30.0)) < 6.0 and abs(fit.params[1] - 0.5) < 0.15, fit
     assert covered >= 0.8 * draws, covered  # a 90 % interval
     assert np.median(widths["hinge"]) < 0.75 * np.median(widths["from the alarm"]), widths
@@ -124,7 +124,7 @@ def test_a_hinge_that_does_not_rise_falls_back_to_the_fit_from_the_alarm():
     wear = np.r_[np.full(30, 20.0), 20.0 - 0.5 * np.arange(1, 21)] + rng.normal(0, NOISE, 50)
     rows = _rows(wear, sequence=True)
     row = _one(rows, since=rows[40]["stamp"], source_axis=1)
-    assert prognosis.fit_hinge(np.arange(50.0) - 49.0, wear, np.full(50, NOISE)).params[1] < 0
+    assert trends.fit_hinge(np.arange(50.0) - 49.0, wear, np.full(50, NOISE)).params[1] < 0
     assert row.model != "changepoint" and row.logs_fitted == 10 and row.fitted_from == "140", row
 
 
@@ -132,7 +132,7 @@ def test_the_scale_uncertainty_spreads_the_time_of_event_as_its_closed_form():
     """A line known exactly (w0, b; no covariance) and a scale k ~ N(1, u): the crossing of F k is at
     (F k - w0) / b, normal with mean (F - w0) / b and standard deviation F u / b."""
     w0, b, u = 10.0, 0.5, 0.1
-    fit = prognosis.Fit("linear", np.array([w0, b]), np.zeros((2, 2)), 0.0)
+    fit = trends.Fit("linear", np.array([w0, b]), np.zeros((2, 2)), 0.0)
     toe = prognosis.time_of_event(fit, prognosis.FAILURE_WEAR, samples=4000, seed=1, scale_uncertainty=u)
     times = np.array([t for t in toe.key("failure")], dtype=float)
     mean, sd = (prognosis.FAILURE_WEAR - w0) / b, prognosis.FAILURE_WEAR * u / b
@@ -198,7 +198,7 @@ def test_rul_csv_has_a_row_per_unit_and_axis_with_empty_cells_where_there_is_no_
         rows = list(reader)
     assert [r["unit"] for r in rows] == ["u", "'=cmd"]
     assert float(rows[0]["rul_5"]) <= float(rows[0]["rul"]) <= float(rows[0]["rul_95"])
-    assert rows[0]["model"] in prognosis.MODELS and rows[0]["time_unit"] == "days"
+    assert rows[0]["model"] in trends.MODELS and rows[0]["time_unit"] == "days"
     assert rows[0]["stamp"] == "2026-02-13" and float(rows[0]["failure_wear"]) == 40.0
     assert rows[1]["rul"] == rows[1]["rul_5"] == rows[1]["rul_95"] == ""
     assert "no end of life within the horizon" in rows[1]["verdict"]

@@ -14,16 +14,18 @@ Per axis:
    :func:`faultgen.data.logfolder.parse_stamp`), or in logs (sequence-number stamps).
 2. **The source axis of the unit's open alarm: a changepoint trend** over all of them, the
    two-phase degradation model of prognostics, flat until a changepoint ``tc`` and a line after it,
-   ``w(t) = w_now + b max(t, tc)`` (:func:`fit_hinge`; ``t`` <= 0 the logs' times, 0 the last log):
-   weighted least squares of (``w_now``, ``b``) at each candidate ``tc`` (each log's time from the
-   3rd log to the 5th from the last, :data:`HINGE_MARGINS`), the least chi-square's ``tc`` refined
+   ``w(t) = w_now + b max(t, tc)`` (:func:`faultgen.monitor.trends.fit_hinge`; ``t`` <= 0 the logs'
+   times, 0 the last log): weighted least squares of (``w_now``, ``b``) at each candidate ``tc``
+   (each log's time from the 3rd log to the 5th from the last,
+   :data:`faultgen.monitor.trends.HINGE_MARGINS`), the least chi-square's ``tc`` refined
    between its neighbours, and the covariance of (``w_now``, ``b``) the Gauss-Newton one of all
    three parameters there (``tc`` included), marginalised. From now on it is the line. When it
    cannot be fitted or its slope is not positive: the two models of 3 on the logs from the first
    alarm on (the alarm marks where the wear left the noise; the flat stretch before it would bend
    a straight line), the rule before 2026-11-26.
-3. **Every other axis: two degradation models**, each fitted by weighted least squares (``scipy.optimize.curve_fit``,
-   weights one over each estimate's variance), written with their parameters as the state now:
+3. **Every other axis: two degradation models** (:func:`faultgen.monitor.trends.fit_trend`), each
+   fitted by weighted least squares (``scipy.optimize.curve_fit``, weights one over each estimate's
+   variance), written with their parameters as the state now:
    linear ``w(t) = w0 + b t`` and exponential
    ``w(t) = w0 + b (exp(k t) - 1) / k`` (``a + c exp(k t)``, the exponential degradation model of
    Gebraeel et al. 2005 with an offset, by its wear ``w0`` and slope ``b`` now and its growth rate
@@ -88,6 +90,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 from faultgen.monitor.scoring import SCALE_UNCERTAINTY
+from faultgen.monitor.trends import Fit, expm1_over, fit_hinge, fit_trend
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
@@ -101,16 +104,6 @@ MIN_LOGS = 5
 SAMPLES = 1000
 #: The interval given: 5 and 95 % quantiles of the time of event.
 INTERVAL = (0.05, 0.95)
-#: Models, the simpler first; "changepoint" (the hinge: flat, then a line) only for the open alarm's source axis
-#: (module docstring, 2).
-MODELS = ("linear", "exponential", "changepoint")
-#: The hinge's changepoint is looked for between the logs this far from either end of the block
-#: (the 3rd log and the 5th from the last: a flat stretch and a rise of at least a few logs each).
-HINGE_MARGINS = (2, 4)
-#: How much smaller the exponential's AICc must be for it to be taken over the line (Burnham &
-#: Anderson 2002, ch. 2.6: models within 2 of the best have substantial support; the simpler is kept).
-AICC_MARGIN = 2.0
-
 COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model", "rul", "rul_5", "rul_95",
            "p_within_horizon", "horizon", "logs_fitted", "fitted_from", "verdict")
 
@@ -184,7 +177,7 @@ def _wear_trend_model(failure_wear: float):
 
         def next_state(self, x, u, dt):
             k, s = x["growth"], x["slope"]
-            return self.StateContainer({"wear": x["wear"] + s * _expm1_over(k, dt), "slope": s * np.exp(k * dt),
+            return self.StateContainer({"wear": x["wear"] + s * expm1_over(k, dt), "slope": s * np.exp(k * dt),
                                         "growth": k, "scale": x["scale"]})
 
         def output(self, x):
@@ -197,163 +190,6 @@ def _wear_trend_model(failure_wear: float):
             return {"failure": bool(x["wear"] >= self.parameters["failure_wear"] * x["scale"])}
 
     return WearTrend()
-
-
-def _expm1_over(k, t):
-    """``(exp(k t) - 1) / k``, ``t`` where ``k t`` is too small for the quotient."""
-    k, t = np.asarray(k, dtype=float), np.asarray(t, dtype=float)
-    small = np.abs(k * t) < 1e-8
-    return np.where(small, t * (1.0 + 0.5 * k * t), np.expm1(k * t) / np.where(small, 1.0, k))
-
-
-def _linear(t, w0, b):
-    return w0 + b * t
-
-
-def _exponential(t, w0, b, k):
-    return w0 + b * _expm1_over(k, t)
-
-
-@dataclass(frozen=True)
-class Fit:
-    """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k]), their covariance
-    ``cov`` (scaled: module docstring, 4) and its ``aicc``; ``changepoint`` the hinge's ``tc``
-    (None for the other models)."""
-
-    model: str
-    params: np.ndarray
-    cov: np.ndarray
-    aicc: float
-    changepoint: float | None = None
-
-
-def _hinge_design(t: np.ndarray, tc) -> np.ndarray:
-    """The hinge's design matrices at changepoints ``tc`` (shape (m,)): (m, n, 2), columns 1 and ``max(t, tc)``."""
-    tc = np.atleast_1d(np.asarray(tc, dtype=float))
-    x = np.maximum(t[None, :], tc[:, None])
-    return np.stack([np.ones_like(x), x], axis=-1)
-
-
-def _hinge_wls(t, wear, weight, tc):
-    """Weighted least squares of the hinge's (w_now, b) at each changepoint ``tc``: parameters (m, 2)
-    and chi-square (m,); NaN where the design is singular."""
-    x = _hinge_design(t, tc)
-    a = np.einsum("mni,n,mnj->mij", x, weight, x)
-    rhs = np.einsum("mni,n,n->mi", x, weight, wear)
-    det = a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] ** 2
-    ok = det > 1e-12 * np.maximum(a[:, 0, 0] * a[:, 1, 1], 1e-300)
-    inverse = np.full_like(a, np.nan)
-    inverse[ok, 0, 0], inverse[ok, 1, 1] = a[ok, 1, 1] / det[ok], a[ok, 0, 0] / det[ok]
-    inverse[ok, 0, 1] = inverse[ok, 1, 0] = -a[ok, 0, 1] / det[ok]
-    params = np.einsum("mij,mj->mi", inverse, rhs)
-    residual = wear[None, :] - np.einsum("mni,mi->mn", x, params)
-    return params, np.einsum("mn,n->m", residual**2, weight)
-
-
-def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
-    """The two-phase (changepoint) trend fitted to the wear estimates ``wear`` (%) at times ``t``
-    (<= 0, the last 0) with standard errors ``error``: flat until ``tc``, then a line,
-    ``w(t) = w_now + b max(t, tc)`` (module docstring, 2): weighted least squares of
-    (``w_now``, ``b``) at each candidate ``tc`` (the logs' times, :data:`HINGE_MARGINS` from either
-    end), the least chi-square's ``tc`` refined between its neighbours (``scipy.optimize.minimize_scalar``);
-    the covariance of (``w_now``, ``b``) the Gauss-Newton one of the three parameters there (as
-    ``curve_fit`` with ``absolute_sigma`` gives it), marginalised, scaled by the reduced
-    chi-square when above one. :class:`Fit` with ``params`` (w_now, b) and ``changepoint`` ``tc``;
-    None when it cannot be fitted (fewer than ``sum(HINGE_MARGINS) + 1`` logs, a singular design or a
-    covariance that is not finite)."""
-    from scipy import stats
-    from scipy.optimize import minimize_scalar
-    from statsmodels.tools.eval_measures import aicc
-
-    t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
-    n = len(t)
-    first, last = HINGE_MARGINS[0], n - 1 - HINGE_MARGINS[1]
-    if last < first:
-        return None
-    weight = 1.0 / error**2
-    grid = t[first: last + 1]
-    chi2 = _hinge_wls(t, wear, weight, grid)[1]
-    if not np.any(np.isfinite(chi2)):
-        return None
-    best = int(np.nanargmin(chi2))
-    # the profile's minimum between the grid's neighbours of its best log (chi2 is smooth between logs)
-    low, high = grid[max(best - 1, 0)], grid[min(best + 1, len(grid) - 1)]
-    tc = float(grid[best])
-    if high > low:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            found = minimize_scalar(lambda c: float(_hinge_wls(t, wear, weight, c)[1][0]), bounds=(low, high),
-                                    method="bounded", options={"xatol": 1e-6 * max(high - low, 1e-9)})
-        if np.isfinite(found.fun) and found.fun < chi2[best]:
-            tc = float(found.x)
-    params, chi2_tc = _hinge_wls(t, wear, weight, tc)
-    (w_now, b), chi2_tc = params[0], float(chi2_tc[0])
-    if not np.all(np.isfinite(params)):
-        return None
-    # covariance of (w_now, b, tc): the Gauss-Newton one at the optimum, the model's derivative in tc
-    # being b before tc and 0 after it
-    jacobian = np.column_stack([np.ones(n), np.maximum(t, tc), np.where(t < tc, b, 0.0)])
-    try:
-        cov = np.linalg.inv(jacobian.T @ (jacobian * weight[:, None]))
-    except np.linalg.LinAlgError:
-        return None
-    dof = n - 3
-    if dof > 0:
-        cov = cov * max(1.0, chi2_tc / dof)
-    if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
-        return None
-    residual = wear - (w_now + b * np.maximum(t, tc))
-    scale = np.sqrt(chi2_tc / n) if chi2_tc > 0 else 1e-12
-    llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
-    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], float(aicc(llf, n, 4)), changepoint=tc)
-
-
-def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
-    """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
-    standard errors ``error``; the one of smaller AICc (module docstring, 3-4), None when neither fits."""
-    from scipy import stats
-    from scipy.optimize import curve_fit
-    from statsmodels.tools.eval_measures import aicc
-
-    t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
-    fits = []
-    linear = None
-    for name, f in (("linear", _linear), ("exponential", _exponential)):
-        n_params = 2 if name == "linear" else 3
-        if len(t) < n_params + 1:
-            continue
-        if name == "linear":
-            p0 = [wear[-1], 0.0]
-        else:
-            if linear is None:
-                continue
-            span = max(float(-t[0]), 1e-9)
-            p0 = [linear.params[0], linear.params[1], 0.1 / span]
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                params, cov = curve_fit(f, t, wear, p0=p0, sigma=error, absolute_sigma=True, maxfev=5000)
-        except (RuntimeError, ValueError, np.linalg.LinAlgError):
-            continue
-        residual = wear - f(t, *params)
-        dof = len(t) - n_params
-        chi2 = float(np.sum((residual / error) ** 2))
-        if dof > 0:
-            cov = cov * max(1.0, chi2 / dof)
-        if not (np.all(np.isfinite(params)) and np.all(np.isfinite(cov))):
-            continue
-        # Gaussian likelihood, the variances' common scale at its maximum (one parameter more)
-        scale = np.sqrt(chi2 / len(t)) if chi2 > 0 else 1e-12
-        llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
-        found = Fit(name, params, cov, float(aicc(llf, len(t), n_params + 1)))
-        if name == "linear":
-            linear = found
-        fits.append(found)
-    if not fits:
-        return None
-    if len(fits) == 2 and fits[1].aicc < fits[0].aicc - AICC_MARGIN:
-        return fits[1]
-    return fits[0]
 
 
 def _state_samples(fit: Fit, samples: int, seed: int, scale_uncertainty: float = 0.0):
@@ -416,8 +252,9 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
     first alarm of the open alarm, whose ``source_axis`` gets the changepoint trend over the whole
-    block (:func:`fit_hinge`; ``changepoint`` False: the trends of the logs from the alarm on, the rule
-    before 2026-11-26) and is fitted from the alarm on when that fails (module docstring, 2);
+    block (:func:`faultgen.monitor.trends.fit_hinge`; ``changepoint`` False: the trends of the logs
+    from the alarm on, the rule before 2026-11-26) and is fitted from the alarm on when that fails
+    (module docstring, 2);
     ``scale_uncertainty`` the relative standard uncertainty of the estimate's scale carried into the
     time of event (module docstring, 4; 0: none); ``axes`` (1..N) the axes wanted, all when None. A
     unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
