@@ -752,7 +752,7 @@ def test_the_own_friction_fallback_fits_every_moving_axis_dry_and_viscous_level_
                                atol=1e-9)
     ratio = np.asarray(f.coulomb_pos) / np.asarray(g.coulomb_pos)
     assert np.all(np.abs(ratio - 1.0) > 1e-3) and np.all((ratio > 0.5) & (ratio < 1.5)), ratio
-    digest = stored.key_name(units_module.calibration_key(stored.sha256_file(nominal.path), key[1], 0))
+    digest = stored.key_name(units_module.calibration_key(stored.sha256_file(nominal.path), key[1], "friction"))
     assert (tmp_path / ".cache" / "calibrated" / f"{digest}.json").is_file()
     again = units_module.model_of(source, "friction", key, None, tmp_path, False)  # the cache, not the log
     assert again.path == made.path

@@ -192,7 +192,7 @@ def _wear_trend_model(failure_wear: float):
     return WearTrend()
 
 
-def _state_samples(fit: Fit, samples: int, seed: int, scale_uncertainty: float = 0.0):
+def _state_samples(fit: Fit, samples: int, seed: int, scale_uncertainty: float):
     """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now,
     each with a scale of the wear estimate drawn from a normal of mean 1 and standard deviation
     ``scale_uncertainty`` (at least 0.05)."""

@@ -36,7 +36,7 @@ from faultgen.data import atomic
 from faultgen.model import robots
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
-from faultgen.monitor.unit import CALIBRATION_STEPS, Unit, calibration_key
+from faultgen.monitor.unit import Unit, calibration_key
 
 #: The cache entries a task may read or make (OUT/.cache/<entry>).
 CACHE = ("cycles", "calibrated", "programs")
@@ -167,7 +167,7 @@ class Cache:
         files: dict[str, bytes] = {}
         models = set(self.base)
         if unit.model in ("calibrated", "friction"):
-            key = calibration_key(nominal_sha256, first_sha256, 0 if unit.model == "friction" else CALIBRATION_STEPS)
+            key = calibration_key(nominal_sha256, first_sha256, unit.model)
             digest = stored.key_name(key)
             record, folder = self.root / "calibrated" / f"{digest}.json", self.root / "calibrated" / digest
             if record.is_file() and folder.is_dir():

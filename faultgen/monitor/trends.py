@@ -42,13 +42,15 @@ def _exponential(t, w0, b, k):
 @dataclass(frozen=True)
 class Fit:
     """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k]), their covariance
-    ``cov`` (scaled by the reduced chi-square when above one: :mod:`faultgen.monitor.prognosis`, 4)
-    and its ``aicc``; ``changepoint`` the hinge's ``tc`` (None for the other models)."""
+    ``cov`` (scaled by the reduced chi-square when above one: :mod:`faultgen.monitor.prognosis`, 4),
+    its ``aicc`` (the line's and the exponential's, which :func:`fit_trend` compares by it; NaN for
+    the changepoint trend, compared with nothing) and ``changepoint`` the hinge's ``tc`` (None for
+    the other models)."""
 
     model: str
     params: np.ndarray
     cov: np.ndarray
-    aicc: float
+    aicc: float = float("nan")
     changepoint: float | None = None
 
 
@@ -65,12 +67,10 @@ def _hinge_wls(t, wear, weight, tc):
     x = _hinge_design(t, tc)
     a = np.einsum("mni,n,mnj->mij", x, weight, x)
     rhs = np.einsum("mni,n,n->mi", x, weight, wear)
-    det = a[:, 0, 0] * a[:, 1, 1] - a[:, 0, 1] ** 2
+    det = np.linalg.det(a)
     ok = det > 1e-12 * np.maximum(a[:, 0, 0] * a[:, 1, 1], 1e-300)
-    inverse = np.full_like(a, np.nan)
-    inverse[ok, 0, 0], inverse[ok, 1, 1] = a[ok, 1, 1] / det[ok], a[ok, 0, 0] / det[ok]
-    inverse[ok, 0, 1] = inverse[ok, 1, 0] = -a[ok, 0, 1] / det[ok]
-    params = np.einsum("mij,mj->mi", inverse, rhs)
+    params = np.full(rhs.shape, np.nan)
+    params[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0]
     residual = wear[None, :] - np.einsum("mni,mi->mn", x, params)
     return params, np.einsum("mn,n->m", residual**2, weight)
 
@@ -86,9 +86,7 @@ def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     chi-square when above one. :class:`Fit` with ``params`` (w_now, b) and ``changepoint`` ``tc``;
     None when it cannot be fitted (fewer than ``sum(HINGE_MARGINS) + 1`` logs, a singular design or a
     covariance that is not finite)."""
-    from scipy import stats
     from scipy.optimize import minimize_scalar
-    from statsmodels.tools.eval_measures import aicc
 
     t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
     n = len(t)
@@ -127,10 +125,7 @@ def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         cov = cov * max(1.0, chi2_tc / dof)
     if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
         return None
-    residual = wear - (w_now + b * np.maximum(t, tc))
-    scale = np.sqrt(chi2_tc / n) if chi2_tc > 0 else 1e-12
-    llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
-    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], float(aicc(llf, n, 4)), changepoint=tc)
+    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], changepoint=tc)
 
 
 def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:

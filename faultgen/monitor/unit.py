@@ -52,11 +52,17 @@ KIND_NAMES = {"given": "given model", "calibrated": "calibrated model", "nominal
               "friction": "nominal model with the unit's own friction", "none": "protocol own"}
 
 
-def calibration_key(nominal_sha256: str, first_sha256: str, steps: int = CALIBRATION_STEPS) -> dict:
-    """The key of a unit's cached calibration: the nominal model's and the first log's SHA-256, the
-    search's length ``steps`` (0: own friction on the nominal model, kind "friction") and, when on,
-    :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
-    key = {"robot": nominal_sha256, "log": first_sha256, "steps": steps}
+def calibration_steps(kind: str) -> int:
+    """The search's length of a unit's calibration of ``kind``: :data:`CALIBRATION_STEPS` for
+    "calibrated", none for "friction" (its own friction on the nominal model only)."""
+    return 0 if kind == "friction" else CALIBRATION_STEPS
+
+
+def calibration_key(nominal_sha256: str, first_sha256: str, kind: str = "calibrated") -> dict:
+    """The key of a unit's cached calibration of ``kind`` ("calibrated" or "friction"): the nominal
+    model's and the first log's SHA-256, the search's length (:func:`calibration_steps`) and, when
+    on, :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
+    key = {"robot": nominal_sha256, "log": first_sha256, "steps": calibration_steps(kind)}
     if OWN_FRICTION:
         key["friction"] = "every axis: one dry level and viscous"
     return key
@@ -200,8 +206,7 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         if not isinstance(source.given, robots.Robot):
             raise ValueError(str(source.given) if source.given is not None else "no --calibrated model given")
         return source.given
-    steps = 0 if kind == "friction" else CALIBRATION_STEPS
-    key = calibration_key(stored.sha256_file(nominal.path), first[1], steps)
+    key = calibration_key(stored.sha256_file(nominal.path), first[1], kind)
     digest = stored.key_name(key)
     root = out / ".cache" / "calibrated"
     folder, record = root / digest, root / f"{digest}.json"
@@ -221,7 +226,7 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             calibrated = run_calibration(nominal, source.get(first_log).checked(), folder,
-                                         max_steps=steps, progress=False,
+                                         max_steps=calibration_steps(kind), progress=False,
                                          friction_every_axis=OWN_FRICTION or kind == "friction").model
         stored.write_calibration(record, key, model)
     implausible = plausibility.implausible_parameters(nominal, calibrated)
