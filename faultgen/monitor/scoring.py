@@ -562,8 +562,8 @@ class UnitMonitor:
             self.statistic, self.limit = "wear", float(self.settings.wear_limit)
             self.evidence = (f"axis {self.source_axis} wear estimate {estimate[order[0]]:.3g} %, its lower "
                              f"{100 * WEAR_ALARM_CONFIDENCE:g} % bound {bound[order[0]]:.3g} % ({span}) >= limit "
-                             f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares along each "
-                             f"axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
+                             f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares of the friction "
+                             f"torques along each axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
                              f"{estimate[order[1]]:.3g} %")
             return
         mean = np.mean(Z, axis=0)
