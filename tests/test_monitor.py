@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import loop
+from faultgen.monitor import loop, scoring
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
 # three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
@@ -211,21 +211,28 @@ def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_
     assert unit.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
 
 
-def test_the_wear_estimate_is_weighted_least_squares_along_each_signature():
+def test_the_wear_estimate_is_weighted_least_squares_of_the_friction_torques_along_each_signature():
     # known values: a residual that is 7 % of axis 3's signature is estimated at exactly 7 % on
-    # axis 3, with standard error 1 / sqrt(sum(s^2 / variance)); scaling every variance by 4
-    # doubles the error and keeps the estimate
+    # axis 3, with standard error 1 / sqrt(sum(s^2 / variance)) over the friction torques (the
+    # last 6 of the 18 features, scoring.WEAR_FEATURES); scaling every variance by 4 doubles the
+    # error and keeps the estimate; the RMS and average load torques do not move it
+    assert scoring.FEATURES[2] == "friction_torque" and scoring.WEAR_FEATURES == ("friction_torque",)
     rng = np.random.default_rng(1)
-    signatures = rng.normal(0, 1, (6, 12))
+    signatures = rng.normal(0, 1, (6, 18))
     unit = UnitMonitor("u", Settings(), n_axes=6, signatures=signatures)
-    variance = rng.uniform(0.5, 2.0, 12)
+    np.testing.assert_array_equal(unit.wear_columns(), np.arange(12, 18))
+    variance = rng.uniform(0.5, 2.0, 18)
     estimate, error = unit.wear_estimate(7.0 * signatures[2], variance)
     assert estimate[2] == pytest.approx(7.0)
-    assert error[2] == pytest.approx(1.0 / np.sqrt(np.sum(signatures[2] ** 2 / variance)))
+    assert error[2] == pytest.approx(1.0 / np.sqrt(np.sum(signatures[2, 12:] ** 2 / variance[12:])))
     estimate4, error4 = unit.wear_estimate(7.0 * signatures[2], 4.0 * variance)
     np.testing.assert_allclose(estimate4, estimate)
     np.testing.assert_allclose(error4, 2.0 * error)
+    other = np.where(np.arange(18) < 12, rng.normal(0, 1, 18), 0.0)  # only the RMS and load torques change
+    np.testing.assert_allclose(unit.wear_estimate(7.0 * signatures[2] + other, variance)[0], estimate, rtol=1e-12)
     assert UnitMonitor("u", Settings(protocol="own"), n_axes=6).wear_estimate(signatures[2], variance) is None
+    with pytest.raises(ValueError, match=r"wear signatures of shape \(6, 12\); expected \(6, 18\)"):
+        UnitMonitor("u", Settings(), n_axes=6, signatures=signatures[:, :12]).wear_estimate(np.zeros(12), np.ones(12))
 
 
 def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit():
@@ -233,11 +240,11 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
     # 99 % bound has stayed at or above the limit (10 %) for 5 logs, on axis 2, and not before the
     # estimate itself is above the limit
     rng = np.random.default_rng(2)
-    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05  # feature units per %
+    signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05  # feature units per %
     unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
     for i in range(200):
         wear = max(i - 60, 0) * 0.5
-        unit.add(f"{i:03d}", rng.normal(0, 0.1, 12) + wear * signatures[1], 30.0, 100.0, np.zeros(12))
+        unit.add(f"{i:03d}", rng.normal(0, 0.1, 18) + wear * signatures[1], 30.0, 100.0, np.zeros(18))
     assert unit.first_alarm is not None and unit.source_axis == 2 and unit.statistic == "wear"
     first = int(unit.first_alarm)
     rows = {r["stamp"]: r for r in unit.rows}

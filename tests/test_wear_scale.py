@@ -47,12 +47,12 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
     log's friction scatter) beside independent noise; 40 learning logs, 200 healthy logs after.
     Returns the monitor and the later logs' wear estimates over their errors on that axis."""
     rng = np.random.default_rng(seed)
-    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
     unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
     z = []
     for i in range(240):
-        residual = rng.normal(0, 0.05, 12) + rng.normal(0, scatter) * signatures[axis - 1]
-        unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(12))
+        residual = rng.normal(0, 0.05, 18) + rng.normal(0, scatter) * signatures[axis - 1]
+        unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(18))
         if i == 39 and not correct:
             unit.dispersion_ = np.ones(6)
         if i >= 40:
@@ -81,12 +81,12 @@ def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_sho
 
 def test_wear_csv_holds_each_log_and_axis_estimate_with_its_interval_as_scores_csv(tmp_path):
     rng = np.random.default_rng(5)
-    signatures = np.abs(rng.normal(0, 1, (6, 12))) * 0.05
+    signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
     unit = UnitMonitor("unit01", Settings(train=20), n_axes=6, signatures=signatures)
     own = UnitMonitor("unit02", Settings(protocol="own", train=20), n_axes=6)
     for i in range(40):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 12) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(12))
-        own.add(f"{i:03d}", rng.normal(0, 0.05, 12), 30.0, 0.0)
+        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
+        own.add(f"{i:03d}", rng.normal(0, 0.05, 18), 30.0, 0.0)
     report.write_wear(tmp_path / "wear.csv", [unit, own])
     report.write_scores(tmp_path / "scores.csv", [unit, own], 6)
     with open(tmp_path / "wear.csv", newline="") as f:

@@ -21,20 +21,12 @@ import numpy as np
 from faultgen import inputs
 from faultgen.data import fleetlogs, logfolder, measured
 from faultgen.model.robots import Robot
+from faultgen.monitor import scoring
 from faultgen.monitor import state as stored
 from faultgen.operation import jointlog, programs
 
-#: The features the monitor watches, per axis (of :func:`faultgen.simulation.sensors.cycle_features`):
-#: the two that follow friction on an axis whose load keeps one sign (gravity), where the mean
-#: absolute torque does not (friction adds on the way up what it takes on the way down: KR210 axis
-#: 2 at 40 % wear, +0.01 % mean |torque|, +2 % RMS, +4.5 % average load torque). The histograms are
-#: left out: a friction change of a few percent moves a 12-bin histogram by less than one bin.
-#: ``friction_torque`` (:func:`friction_torque`, the monitor's own, not an imported fleet's) moves by
-#: the mean |dry friction| over the motion, what the wear is stated in, whatever the friction's
-#: shape: with it the second independent fleet's (a growing Stribeck hump) median error fell from
-#: 4.37 to 3.90 points and the first law's three fleets' from 2.17, 1.90, 2.89 to 1.92, 1.84, 2.41
-#: (docs/analysis.md, "Wear in the robot's own scale", 2026-11-26).
-FEATURES = ("rms_torque", "average_load_torque", "friction_torque")
+#: The features the monitor watches per axis (:data:`faultgen.monitor.scoring.FEATURES`, which says why).
+FEATURES = scoring.FEATURES
 
 #: Share of an axis's speed limit below which a sample counts as standing still in
 #: ``friction_torque`` (:func:`friction_torque`).

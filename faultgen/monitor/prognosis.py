@@ -1,7 +1,9 @@
 """Remaining useful life per unit and axis (issue 59): the time until an axis's wear estimate
 reaches a failure wear, as a distribution, from a degradation trend fitted on the unit's wear
 estimates (:mod:`faultgen.monitor.scoring`: per log and axis its own estimate ``wearI_log`` %, of the
-axis's own dry friction, and its lower ``1 - alpha`` bound ``wearI_log_lower``; the estimate's
+axis's own dry friction, less the part of the learned condition slopes' error at the log's
+conditions as the trend had learned it by then (the season the slopes extrapolate, which a trend
+would take for wear), and its lower ``1 - alpha`` bound ``wearI_log_lower``; the estimate's
 standard error is ``(wearI_log - wearI_log_lower) / z``, ``z`` the standard normal's ``1 - alpha``
 quantile; not the wear filtered over the logs, ``wearI``, whose errors are not independent). Recomputed from the
 unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`write_rul`).

@@ -52,7 +52,8 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
     """Every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
     logs, :class:`faultgen.monitor.scoring.WearTrend`), its lower one-sided 90 % bound
     (``wearI_lower``, :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), what the alarm is judged
-    on, and the log's own estimate and its lower ``1 - alpha`` bound
+    on, and the log's own estimate (less the learned slope errors' part at its conditions,
+    :meth:`faultgen.monitor.scoring.WearTrend.condition_part`) and its lower ``1 - alpha`` bound
     (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
     if any(m.signatures is not None for m in monitors):

@@ -27,8 +27,9 @@ the same way (with the twin, a feature's noise is widened by :data:`MODEL_UNCERT
 change the twin predicts from the nearest condition learned from: a new part is predicted, not
 known) and scored. Without a twin (protocol ``own``) a log alarms when T2 or Q is above its
 ``1 - alpha`` limit. With the twin, T2 and Q are scored and charted the same way, but a log alarms
-on the wear itself: each axis's wear is estimated from the residual by weighted least squares
-along that axis's wear signature (the twin's change of the features per % wear; the weights one
+on the wear itself: each axis's wear is estimated from the residual's friction torques
+(:data:`WEAR_FEATURES`) by weighted least squares along that axis's wear signature (the twin's
+change of those features per % wear; the weights one
 over each feature's variance: its noise times the prediction factor, squared, plus the twin's own
 uncertainty of :data:`MODEL_UNCERTAINTY` of its predicted change; the estimate's standard error is
 one over the root of the summed weights: the fault-magnitude estimate of a known fault direction,
@@ -67,6 +68,28 @@ from analysis.isolation import signature_scores
 from analysis.monitoring import PCAMonitor
 
 PROTOCOLS = ("twin", "own")
+#: The features the monitor watches per axis, in the order of a log's feature vector (by name, then
+#: axis), which :mod:`faultgen.monitor.logs` computes (its module gives why these). The two that
+#: follow friction on an axis whose load keeps one sign (gravity), where the mean absolute torque
+#: does not (friction adds on the way up what it takes on the way down: KR210 axis 2 at 40 % wear,
+#: +0.01 % mean |torque|, +2 % RMS, +4.5 % average load torque); the histograms are left out (a
+#: friction change of a few percent moves a 12-bin histogram by less than one bin).
+#: ``friction_torque`` (:func:`faultgen.monitor.logs.friction_torque`, the monitor's own, not an
+#: imported fleet's) moves by the mean |dry friction| over the motion, what the wear is stated in,
+#: whatever the friction's shape: with it the second independent fleet's (a growing Stribeck hump)
+#: median error fell from 4.37 to 3.90 points and the first law's three fleets' from 2.17, 1.90,
+#: 2.89 to 1.92, 1.84, 2.41 (docs/analysis.md, "Wear in the robot's own scale", 2026-11-26).
+FEATURES = ("rms_torque", "average_load_torque", "friction_torque")
+#: The features each axis's wear (its magnitude, wear.csv) is read on; T2, Q and the ranking of the
+#: axes use all :data:`FEATURES`. The friction torque alone: its change per % of an axis's dry
+#: friction is the mean |dry friction| over the motion whatever the log's load, where the RMS and
+#: the average load torque weigh friction by the torque it adds to, so the twin's signature
+#: (simulated without a part, at the model's friction) misreads them on a log of another load or
+#: friction (their response 0.64-1.08 of the signature's on the independent fleets' worn axes). Read
+#: on it alone, the median error on the independent fleets fell from 1.98, 1.67, 2.39, 2.77, 2.10,
+#: 2.85 to 2.40, 1.33, 1.65, 2.22, 1.96, 1.69 points (first law seeds 0, 1, 3, the second law, the
+#: KR210 L150 and iiwa 14 fleets; docs/analysis.md, "The wear read on the friction torque").
+WEAR_FEATURES = ("friction_torque",)
 #: Share of the twin's predicted change of a feature, from the nearest condition the unit's
 #: learning logs saw, that counts as the twin's own uncertainty. Measured on the independent fleet
 #: (an earlier draw of it, parts of 125 and 27 kg): the twin's change of the KR210's mean |torque|
@@ -212,6 +235,13 @@ class WearTrend:
             self.gated[restart] = 0
         self.state, self.covariance = state, covariance
         return self.state[:, 0].copy(), np.sqrt(self.covariance[:, 0, 0])
+
+    def condition_part(self, conditions: np.ndarray | None) -> np.ndarray:
+        """The slope errors' part (n_axes,) % of a log's estimate at its centred ``conditions``
+        (k,; None: none), as the state now holds them; zeros without a trend or slope errors."""
+        if self.state is None or not self.n_regressors or conditions is None:
+            return np.zeros(self.n_axes)
+        return self.state[:, 2:] @ np.asarray(conditions, dtype=float)
 
     def _start(self, estimate: np.ndarray, variance: np.ndarray, x: np.ndarray, slope_mean: np.ndarray,
                slope_covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -381,17 +411,31 @@ class UnitMonitor:
         x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
         return float(np.sqrt(1.0 + 1.0 / self.learned_ + x @ self.gram_inv_ @ x))
 
+    def wear_columns(self) -> np.ndarray:
+        """The positions of :data:`WEAR_FEATURES` in a feature vector of :data:`FEATURES` by name,
+        then axis (``len(WEAR_FEATURES) * n_axes`` indices)."""
+        n = self.n_axes
+        return np.concatenate([FEATURES.index(name) * n + np.arange(n) for name in WEAR_FEATURES])
+
     def wear_estimate(self, residual: np.ndarray, variance: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """Each axis's wear, % of its own dry friction (n_axes,), and its standard error from the
         noise (n_axes,), from ``residual`` (n_features,: the features minus the twin's expectation,
         the unit's offset and its condition slopes) whose features have ``variance``
-        (n_features,): weighted least squares along each axis's wear signature (module docstring),
-        the error times :attr:`dispersion_`. None without a twin."""
+        (n_features,): weighted least squares of the :data:`WEAR_FEATURES` along each axis's wear
+        signature (module docstring), the error times :attr:`dispersion_`. None without a twin.
+
+        Raises ``ValueError`` when the signatures are not (n_axes, ``len(FEATURES) * n_axes``)."""
         if self.signatures is None:
             return None
-        information = (self.signatures**2 / variance).sum(axis=1)
+        expected = (self.n_axes, len(FEATURES) * self.n_axes)
+        if self.signatures.shape != expected:
+            raise ValueError(f"wear signatures of shape {self.signatures.shape}; expected {expected} "
+                             f"(each axis's change of {', '.join(FEATURES)} of every axis per %)")
+        columns = self.wear_columns()
+        signatures, residual, variance = self.signatures[:, columns], residual[columns], variance[columns]
+        information = (signatures**2 / variance).sum(axis=1)
         error = self.dispersion_ / np.sqrt(information)
-        return (self.signatures * residual / variance).sum(axis=1) / information, error
+        return (signatures * residual / variance).sum(axis=1) / information, error
 
     @staticmethod
     def wear_interval(estimate: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -475,6 +519,11 @@ class UnitMonitor:
         if wear is not None:
             log_estimate, log_error, trend_error, x = wear
             wear = estimate, error = self.trend.update(log_estimate, trend_error, x)
+            # the log's own estimate less the slope errors' part at its conditions, as learned up
+            # to it: the season the learned slopes extrapolate, which the remaining life's trend
+            # would otherwise take for wear (docs/analysis.md, "The log's own estimate without
+            # the season")
+            log_estimate = log_estimate - self.trend.condition_part(x)
             bound = estimate - self.alarm_quantile * error
             alarm = bool(bound.max() >= self.settings.wear_limit)
             # the interval keeps the log's own error: the filter averages out the scatter from log
@@ -513,8 +562,8 @@ class UnitMonitor:
             self.statistic, self.limit = "wear", float(self.settings.wear_limit)
             self.evidence = (f"axis {self.source_axis} wear estimate {estimate[order[0]]:.3g} %, its lower "
                              f"{100 * WEAR_ALARM_CONFIDENCE:g} % bound {bound[order[0]]:.3g} % ({span}) >= limit "
-                             f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares along each "
-                             f"axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
+                             f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares of the friction "
+                             f"torques along each axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
                              f"{estimate[order[1]]:.3g} %")
             return
         mean = np.mean(Z, axis=0)
