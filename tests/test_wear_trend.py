@@ -1,4 +1,4 @@
-"""The wear filtered over the logs (issue 59, part 1: :class:`faultgen.monitor.scoring.WearTrend`): a
+"""The wear filtered over the logs (issue 59, part 1: :class:`faultgen.monitor.wear_trend.WearTrend`): a
 Kalman filter of a local linear trend, checked against statsmodels' state-space Kalman filter (an
 independent implementation) and on simulated wear ramps against their truth."""
 
@@ -6,15 +6,8 @@ import numpy as np
 import pytest
 from statsmodels.tsa.statespace.mlemodel import MLEModel
 
-from faultgen.monitor.scoring import (
-    OUTLIER_GATE,
-    OUTLIER_RUN,
-    WEAR_ALARM_CONFIDENCE,
-    WEAR_RATE_CHANGE,
-    Settings,
-    UnitMonitor,
-    WearTrend,
-)
+from faultgen.monitor.scoring import WEAR_ALARM_CONFIDENCE, Settings, UnitMonitor
+from faultgen.monitor.wear_trend import OUTLIER_GATE, OUTLIER_RUN, WEAR_RATE_CHANGE, WearTrend
 
 
 def _statsmodels_filter(y: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

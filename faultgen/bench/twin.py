@@ -7,7 +7,7 @@ axis each names). Read back per test unit (:func:`answers`):
 
 - **score** of a record: the largest over the axes of the lower ``1 - alpha`` bound of the wear at the
   log (``wearI_lower``, % of the axis's own dry friction, filtered over the unit's logs up to that
-  one, :class:`faultgen.monitor.scoring.WearTrend`): the statistic the monitor alarms on
+  one, :class:`faultgen.monitor.wear_trend.WearTrend`): the statistic the monitor alarms on
   with the twin (a log alarms when it reaches ``--wear-limit``). The monitor gives it for the logs it
   learned from too (``phase`` training, estimated with what it learned from them); a log it gave no
   row (a unit still learning when its logs ended, a log skipped) gets :data:`UNSCORED` below every

@@ -50,10 +50,10 @@ def write_alarms(path: Path, monitors) -> None:
 
 def write_scores(path: Path, monitors, n_axes: int) -> None:
     """Every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
-    logs, :class:`faultgen.monitor.scoring.WearTrend`), its lower one-sided 90 % bound
+    logs, :class:`faultgen.monitor.wear_trend.WearTrend`), its lower one-sided 90 % bound
     (``wearI_lower``, :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), what the alarm is judged
     on, and the log's own estimate (less the learned slope errors' part at its conditions,
-    :meth:`faultgen.monitor.scoring.WearTrend.condition_part`) and its lower ``1 - alpha`` bound
+    :meth:`faultgen.monitor.wear_trend.WearTrend.condition_part`) and its lower ``1 - alpha`` bound
     (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
     if any(m.signatures is not None for m in monitors):
@@ -72,7 +72,7 @@ WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "
 def write_wear(path: Path, monitors) -> None:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
-    :class:`faultgen.monitor.scoring.WearTrend`), its 90 % interval with the twin's model
+    :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
     uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
     the lower one-sided 90 % bound of its noise the alarm is judged on (``wear_lower``, as
     ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin

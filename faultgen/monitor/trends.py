@@ -54,6 +54,13 @@ class Fit:
     changepoint: float | None = None
 
 
+def _widened(cov: np.ndarray, chi2: float, dof: int) -> np.ndarray:
+    """``cov`` scaled by the reduced chi-square ``chi2 / dof`` when it is above one (the scatter
+    about the trend larger than the stated errors; :mod:`faultgen.monitor.prognosis`, 4); as given
+    without degrees of freedom."""
+    return cov * max(1.0, chi2 / dof) if dof > 0 else cov
+
+
 def _hinge_design(t: np.ndarray, tc) -> np.ndarray:
     """The hinge's design matrices at changepoints ``tc`` (shape (m,)): (m, n, 2), columns 1 and ``max(t, tc)``."""
     tc = np.atleast_1d(np.asarray(tc, dtype=float))
@@ -120,9 +127,7 @@ def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         cov = np.linalg.inv(jacobian.T @ (jacobian * weight[:, None]))
     except np.linalg.LinAlgError:
         return None
-    dof = n - 3
-    if dof > 0:
-        cov = cov * max(1.0, chi2_tc / dof)
+    cov = _widened(cov, chi2_tc, n - 3)
     if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
         return None
     return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], changepoint=tc)
@@ -157,10 +162,8 @@ def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         except (RuntimeError, ValueError, np.linalg.LinAlgError):
             continue
         residual = wear - f(t, *params)
-        dof = len(t) - n_params
         chi2 = float(np.sum((residual / error) ** 2))
-        if dof > 0:
-            cov = cov * max(1.0, chi2 / dof)
+        cov = _widened(cov, chi2, len(t) - n_params)
         if not (np.all(np.isfinite(params)) and np.all(np.isfinite(cov))):
             continue
         # Gaussian likelihood, the variances' common scale at its maximum (one parameter more)
