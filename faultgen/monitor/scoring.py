@@ -70,7 +70,7 @@ from faultgen.monitor.wear_trend import WearTrend
 
 PROTOCOLS = ("twin", "own")
 #: The features the monitor watches per axis, in the order of a log's feature vector (by name, then
-#: axis), which :mod:`faultgen.monitor.logs` computes (its module gives why these). The two that
+#: axis), which :mod:`faultgen.monitor.logs` computes. The RMS and average load torques: the two that
 #: follow friction on an axis whose load keeps one sign (gravity), where the mean absolute torque
 #: does not (friction adds on the way up what it takes on the way down: KR210 axis 2 at 40 % wear,
 #: +0.01 % mean |torque|, +2 % RMS, +4.5 % average load torque); the histograms are left out (a
