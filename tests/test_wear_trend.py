@@ -167,6 +167,19 @@ def test_the_slope_errors_in_the_state_are_statsmodels_regression_effects():
         np.testing.assert_allclose(ours[:, 1, axis], sd, rtol=1e-9, atol=1e-9)
 
 
+def _unworn_axis_over_a_season(rng, learn: int, n: int, noise: float):
+    """An unworn axis over a season: the centred joint temperature ``x`` of ``learn`` January logs
+    (the day's weather, 1 K) and ``n`` later ones warming by 5-10 K, ``(X'X)^-1`` of the learning
+    logs', and the later logs' wear estimates ``y`` (noise ``noise``) carrying a slope error drawn as
+    a least squares on the learning logs leaves it."""
+    season = np.linspace(0.0, 1.0, learn + n) ** 1.5 * rng.uniform(5.0, 10.0)
+    temperature = season + rng.normal(0.0, 1.0, learn + n)
+    x = temperature - temperature[:learn].mean()
+    gram_inv = 1.0 / np.sum(x[:learn] ** 2)
+    slope_error = rng.normal(0.0, noise * np.sqrt(gram_inv))
+    return x, gram_inv, slope_error * x[learn:] + rng.normal(0.0, noise, n)
+
+
 def test_a_slope_learned_on_a_narrow_range_is_not_extrapolated_over_the_season_as_wear():
     """The independent fleet's case (docs/analysis.md, "Wear in the robot's own scale"): the slopes
     are learned on 28 logs of January (the joint temperature within a few kelvin: the day's weather,
@@ -178,17 +191,10 @@ def test_a_slope_learned_on_a_narrow_range_is_not_extrapolated_over_the_season_a
     trend alone is off by 3.99 (largest 14.5; measured 2026-11-26), and its stated error is honest
     (the error over it scatters by 0.95), where the trend alone states a third of its error (2.79)."""
     rng = np.random.default_rng(1)
-    learn, n = 28, 90
+    learn, n, noise = 28, 90, 3.0
     with_state, without, z, z_without = [], [], [], []
     for _ in range(300):
-        season = np.linspace(0.0, 1.0, learn + n) ** 1.5 * rng.uniform(5.0, 10.0)
-        temperature = season + rng.normal(0.0, 1.0, learn + n)
-        x = temperature - temperature[:learn].mean()
-        noise = 3.0
-        # the slope's error along the signature: as a least squares on the learning logs leaves it
-        gram_inv = 1.0 / np.sum(x[:learn] ** 2)
-        slope_error = rng.normal(0.0, noise * np.sqrt(gram_inv))
-        y = slope_error * x[learn:] + rng.normal(0.0, noise, n)
+        x, gram_inv, y = _unworn_axis_over_a_season(rng, learn, n, noise)
         plain, regression = WearTrend(1), WearTrend(1, 1)
         regression.set_prior(np.full((1, 1, 1), noise**2 * gram_inv))
         for i in range(n):
@@ -241,11 +247,7 @@ def test_the_logs_own_estimate_less_the_learned_slope_errors_drifts_less_with_th
     late = {"raw": [], "corrected": []}
     t = np.arange(n) - (n - 1.0)
     for _ in range(200):
-        season = np.linspace(0.0, 1.0, learn + n) ** 1.5 * rng.uniform(5.0, 10.0)
-        x = season + rng.normal(0.0, 1.0, learn + n)
-        x = x - x[:learn].mean()
-        gram_inv = 1.0 / np.sum(x[:learn] ** 2)
-        y = rng.normal(0.0, noise * np.sqrt(gram_inv)) * x[learn:] + rng.normal(0.0, noise, n)
+        x, gram_inv, y = _unworn_axis_over_a_season(rng, learn, n, noise)
         trend = WearTrend(1, 1)
         trend.set_prior(np.full((1, 1, 1), noise**2 * gram_inv))
         corrected = []
