@@ -141,3 +141,38 @@ def test_rated_part_must_be_a_bool_and_an_axis_beyond_the_robot_is_refused(fleet
     with pytest.raises(ValueError, match=r"^fleet wearable = \(1, 8\): the robot has axes 1\.\.7$"):
         independent_fleet.write_fleet(tmp_path, independent_fleet.FleetSpec(units=1, worn=1, wearable=(1, 8)),
                                       robot=robot)
+
+
+def test_own_friction_is_each_units_dry_friction_as_the_generator_applies_it(fleet, tmp_path, monkeypatch):
+    """``independent.own_friction`` (the truth a unit's wear is a percentage of, for
+    benchmarks/wear_scale_sources.py) against the levels the generator hands its friction law on
+    every log of two healthy units: the Coulomb and static levels are it times each log's jitter
+    (log-normal, sd JITTER: within 4 sd), and a draw of another component or unit would not be."""
+    from faultgen.bench import independent
+    from faultgen.model import robots
+
+    robot = fleet[0]
+    spec = independent_fleet.FleetSpec(units=2, worn=0, days=2, seed=5, onset=(1, 2), max_part=14.0,
+                                       wearable=SPEC.wearable)
+    handed = []
+    law = independent.motor_friction
+
+    def recorded(w, coulomb, static, viscous):
+        handed.append(np.array([coulomb, static]))
+        return law(w, coulomb, static, viscous)
+
+    monkeypatch.setattr(independent, "motor_friction", recorded)
+    independent.write_fleet(tmp_path, spec, robot)
+    own = independent.own_friction(spec, robots.load(robot))
+    assert sorted(own) == ["unit01", "unit02"] and own["unit01"].shape == (3, 7)
+    levels = {"unit01": np.array(handed[:2]), "unit02": np.array(handed[2:])}  # units in order, a log a day
+    assert len(handed) == 4
+    bound = 4 * independent.JITTER
+    for unit, logged in levels.items():
+        assert np.all(np.abs(np.log(logged / own[unit][:2])) < bound), unit
+    # the bound tells the draws apart: the other unit's levels, or this unit's viscous draw applied to
+    # its Coulomb level, are off by more
+    assert np.any(np.abs(np.log(levels["unit01"] / own["unit02"][:2])) > bound)
+    nominal = robots.load(robot).friction
+    viscous_draw = own["unit01"][2] / np.asarray(nominal.viscous)
+    assert np.any(np.abs(np.log(levels["unit01"][:, 0] / (np.asarray(nominal.coulomb_pos) * viscous_draw))) > bound)

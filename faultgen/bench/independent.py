@@ -301,6 +301,17 @@ def truth_rows(spec: FleetSpec, n_axes: int = 6) -> list[list]:
     return rows
 
 
+def own_friction(spec: FleetSpec, robot: robots.Robot) -> dict[str, np.ndarray]:
+    """Each unit's own friction levels as the generator draws them, the truth apart (what a unit's
+    wear is a percentage of): ``{unit: ndarray of shape (3, N)}``, the Coulomb, static (Stribeck
+    hump) and viscous levels at 20 deg C, N m and N m s/rad at the motor, the ``robot`` folder's
+    nominal ones times the unit's draw (:data:`SPREAD`), before each log's :data:`JITTER` and any
+    wear. Read by ``benchmarks/wear_scale_sources.py``; never by the monitor."""
+    f = robot.friction
+    nominal = np.array([f.coulomb_pos, f.static, f.viscous], dtype=float)
+    return {u["unit"]: nominal * u["spread"] for u in _units(spec, robot.n_axes)}
+
+
 def day_conditions(unit: dict, day: int, stamp: str, rng: np.random.Generator) -> tuple[float, float]:
     """A unit's joint temperature (deg C: the season's ambient, one draw of ``rng`` for the day's
     weather, plus the unit's rise) and part mass (kg: the week's part, of the new product from its
