@@ -761,6 +761,9 @@ def test_the_own_friction_fallback_fits_every_moving_axis_dry_and_viscous_level_
     assert np.all(np.abs(ratio - 1.0) > 1e-3) and np.all((ratio > 0.5) & (ratio < 1.5)), ratio
     digest = stored.key_name(units_module.calibration_key(stored.sha256_file(nominal.path), key[1], "friction"))
     assert (tmp_path / ".cache" / "calibrated" / f"{digest}.json").is_file()
+    cached = tmp_path / ".cache" / "calibrated" / digest
+    # the model and its report, not the calibration's figure (nothing reads it there; 1.6 s a unit)
+    assert (cached / "report.json").is_file() and not (cached / "calibration.png").exists()
     again = units_module.model_of(source, "friction", key, None, tmp_path, False)  # the cache, not the log
     assert again.path == made.path
     np.testing.assert_array_equal(again.friction.coulomb_pos, f.coulomb_pos)

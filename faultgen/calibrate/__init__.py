@@ -63,7 +63,7 @@ MAX_ROWS = 25_000
 
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-              log_format=None, friction_every_axis: bool = False) -> Calibration:
+              log_format=None, friction_every_axis: bool = False, figure: bool = True) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
@@ -78,6 +78,7 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`).
     ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
     after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
+    ``figure``: draw ``calibration.png`` (False: the other outputs only, as ``faultgen monitor`` caches them).
     The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
@@ -98,7 +99,7 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     out.parent.mkdir(parents=True, exist_ok=True)
     with atomic.atomic_folder(out) as staging:
         result = _calibrate(nominal, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid,
-                             friction_every_axis=friction_every_axis)
+                             friction_every_axis=friction_every_axis, figure=figure)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))
         atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
     return replace(result, model=robots.moved(result.model, result.model_out))  # the folder renamed into place

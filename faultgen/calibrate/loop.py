@@ -32,7 +32,7 @@ MAX_STEPS = 6
 
 def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
         max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-        friction_every_axis: bool = False) -> Calibration:
+        friction_every_axis: bool = False, figure: bool = True) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
@@ -45,8 +45,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     out : str or Path
         Output folder, created if needed: ``model/<robot>_calibrated.xml`` (with the robot's
         ``tasks.toml``, so ``faultgen simulate --model`` runs it), ``model/parameters.json``
-        (the augmented model's parameters per axis, SI units), ``report.json`` and
-        ``calibration.png``.
+        (the augmented model's parameters per axis, SI units), ``report.json`` and, with
+        ``figure``, ``calibration.png``.
     max_steps : int
         Most effects to add.
     progress : bool
@@ -59,6 +59,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         what the model leaves, always, not by model selection (:func:`own_friction`): each axis's friction
         is then the unit's own, where the search would leave an axis at nominal (``faultgen
         monitor`` reads wear in % of it).
+    figure : bool
+        Draw ``calibration.png`` (measured against model torque per axis, about 1.6 s for a day's
+        log of six axes); ``faultgen monitor`` caches its units' calibrations without it (nothing
+        reads it there).
 
     Returns
     -------
@@ -150,9 +154,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         nominal_digest=nominal.digest,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
-    from faultgen.calibrate import figure
+    if figure:
+        from faultgen.calibrate import figure as figures
 
-    figure.save(result, out / "calibration.png")
+        figures.save(result, out / "calibration.png")
     return result
 
 
