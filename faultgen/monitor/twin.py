@@ -29,7 +29,11 @@ gives the expectation). Cycles are cached on disk by what determines them (model
 file, temperature, payload, worn axis), each file holding its key beside the features
 (:func:`faultgen.monitor.state.read_cycle` refuses one whose key differs): units that share a model
 and a program share them. The stepping backend (:mod:`faultgen.simulation.backends`) is not in the
-key: every backend gives the same cycle to float tolerance.
+key: every backend gives the same cycle to float tolerance. The signature cycles a twin has not
+cached yet (healthy at the model's own friction and one per worn axis) are stepped together as the
+runs of one batch, which costs little more than one of them (the static friction's update before
+each step is Python, the same for one run or seven): the same bits as one by one
+(tests/test_twin_batch.py).
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
-from faultgen.operation import conditions, wear
+from faultgen.operation import conditions, faults, wear
 from faultgen.simulation import backends, sensors
 from faultgen.simulation import stepping as sim
 
@@ -161,6 +165,7 @@ class Twin:
         # times those at its own friction, and the independent fleet's units answered 0.49-0.66 % per %
         # of their own dry friction's wear (0.85-1.15 now: tests/test_wear_scale.py).
         at_own = float("nan")
+        self._simulate_together([(at_own, 0.0, axis) for axis in range(self.robot.n_axes + 1)])
         healthy = self.cycle(at_own, 0.0)
         #: (N, F): change of each feature per % wear of each axis, % of the model's own dry friction
         #: (without a part: the signatures are shared by every unit of the model and program).
@@ -194,6 +199,42 @@ class Twin:
         path = self._key(temperature, payload, worn_axis)[1]
         return path.exists() or path.is_symlink()
 
+    def _config(self, temperature: float | None, payload: float, plan: wear.WearPlan, cycles: int = 1) -> sim.RunConfig:
+        """The run of ``cycles`` replayed cycles at ``temperature`` (rounded; None: the model's own
+        friction) with a ``payload`` kg part and wear ``plan``, without noise."""
+        held, _ = setup(temperature, payload)
+        return sim.RunConfig(robot=self.robot, task=str(self._reference), friction=FRICTION, wear=plan, cycles=cycles,
+                             seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
+                             conditions=held, signals=True)
+
+    def _features(self, result: sim.RunResult, index: int = 0) -> np.ndarray:
+        """The feature vector of simulated cycle ``index`` of ``result``, as a measured log's."""
+        data = measured.from_arrays(result.t, result.q_a[index], result.tau_m[index] * self.robot.gear_ratio,
+                                    self.robot, source=f"twin of {self.program.name}")
+        return fleet_logs.features_of(self.robot, data)
+
+    def _simulate_together(self, cycles: list[tuple[float, float, int]]) -> None:
+        """Simulate the ``cycles`` (temperature, payload, worn axis) that are not cached, all at one
+        temperature and payload and differing only in their worn axis, as one batch
+        (:func:`faultgen.simulation.stepping.simulate`'s ``dry_multipliers``, each row the one-cycle
+        run's wear plan gives: the same bits as simulating them one by one, in a third to a half of
+        the time; docs/performance.md) and cache them. Where a drive saturates nothing is cached:
+        :meth:`cycle` simulates them one by one, naming the one that saturates."""
+        missing = [c for c in cycles if not self.cached(*c)]
+        if len(missing) < 2 or len({(str(t), p) for t, p, _ in missing}) > 1:
+            return
+        temperature, payload = self._key(*missing[0])[0]["temperature_C"], missing[0][1]
+        n = self.robot.n_axes
+        rows = np.stack([faults.dry_multipliers(setup(temperature, payload, axis)[1].faults(), np.array([1]), n)[0]
+                         for _, _, axis in missing])
+        config = self._config(temperature, payload, wear.WearPlan({}), cycles=len(missing))
+        result = sim.simulate(config, progress=False, backend=self.backend, dry_multipliers=rows)
+        if result.saturated.size:
+            return
+        for index, c in enumerate(missing):
+            key, path = self._key(*c)
+            stored.write_cycle(path, key, self._features(result, index))
+
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
         nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
@@ -204,10 +245,7 @@ class Twin:
             return stored.read_cycle(path, self.root, key, n_features)
         if (temperature, payload, worn_axis) in self._refused:  # a part it cannot carry: said once, not simulated again
             raise ValueError(self._refused[temperature, payload, worn_axis])
-        held, plan = setup(temperature, payload, worn_axis)
-        config = sim.RunConfig(robot=self.robot, task=str(self._reference), friction=FRICTION, wear=plan, cycles=1,
-                               seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
-                               conditions=held, signals=True)
+        config = self._config(temperature, payload, setup(temperature, payload, worn_axis)[1])
         result = sim.simulate(config, progress=False, backend=self.backend)
         if result.saturated.size:
             rated = self.robot.rated_payload
@@ -218,9 +256,7 @@ class Twin:
                 f"the drive of axis {', '.join(map(str, result.saturated))}: the model cannot carry that part along "
                 f"this motion; {sized + '; ' if sized else ''}check the log's payload column (kg) and the model")
             raise ValueError(self._refused[temperature, payload, worn_axis])
-        data = measured.from_arrays(result.t, result.q_a[0], result.tau_m[0] * self.robot.gear_ratio, self.robot,
-                                    source=f"twin of {self.program.name}")
-        vector = fleet_logs.features_of(self.robot, data)
+        vector = self._features(result)
         stored.write_cycle(path, key, vector)
         return vector
 

@@ -56,12 +56,20 @@ _prepared = prepared_for
 _ = _prepare, _prepare_variant
 
 
-def simulate(config: RunConfig, progress: bool = True, backend: str = backends.DEFAULT) -> RunResult:
+def simulate(config: RunConfig, progress: bool = True, backend: str = backends.DEFAULT,
+             dry_multipliers: np.ndarray | None = None) -> RunResult:
     """Run ``config``: simulate its recorded cycles and return what the monitoring recorded.
 
     ``backend`` names the stepping backend (:data:`faultgen.simulation.backends.BACKENDS`:
     ``batch``, MuJoCo's threaded C stepping, or ``loop``, a plain Python loop of ``mj_step`` for
     checking it); every backend gives the same results to float tolerance.
+
+    ``dry_multipliers``: ndarray of shape (n_recorded, N), each recorded cycle's multiplier of
+    every axis's dry (Coulomb and static) friction, given instead of a wear plan (``config.wear``
+    empty): cycles that no wear schedule relates, such as one healthy and one per worn axis
+    (:class:`faultgen.monitor.twin.Twin`'s signatures), stepped together as one batch. A cycle's
+    result is the same, bit for bit, as the one-cycle run whose wear plan gives that row
+    (tests/test_twin_batch.py).
 
     With a task mix (:class:`faultgen.operation.conditions.TaskMix`) the cycles of each task are
     simulated together on that task's path, and the per-cycle results are put back in cycle order
@@ -72,14 +80,17 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     ValueError
-        For an unknown ``backend``.
+        For an unknown ``backend``; ``dry_multipliers`` not of that shape, not finite and positive,
+        beside a wear plan or with daily records.
     """
     backends.get(backend)
     cycles = config.recorded_cycles
     n_axes = config.model.n_axes
+    if dry_multipliers is not None:
+        dry_multipliers = _checked_multipliers(config, dry_multipliers, len(cycles), n_axes)
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     if not config.daily:
-        return _simulate_cycles(config, cycles, conditions, progress, backend)
+        return _simulate_cycles(config, cycles, conditions, progress, backend, dry_multipliers)
     # daily records: a block of whole days at a time, each reduced to its days before the next is
     # stepped, so that a run's memory does not grow with its days (cycles are independent: the
     # same arrays as all at once, tests/test_fleet.py)
@@ -90,16 +101,31 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
         for rows in blocks])
 
 
+def _checked_multipliers(config: RunConfig, values, n_cycles: int, n_axes: int) -> np.ndarray:
+    """:func:`simulate`'s ``dry_multipliers``, checked (its Raises)."""
+    values = np.asarray(values, dtype=float)
+    if values.shape != (n_cycles, n_axes) or not np.all(np.isfinite(values) & (values > 0)):
+        raise ValueError(f"dry_multipliers of shape {values.shape}: expected finite numbers > 0 of shape "
+                         f"({n_cycles}, {n_axes}), one row per recorded cycle and a column per axis")
+    if config.wear.schedules or config.daily:
+        raise ValueError("dry_multipliers are given instead of a wear plan and without daily records; this run "
+                         f"has {'a wear plan' if config.wear.schedules else 'daily records'}")
+    return values
+
+
 def _simulate_cycles(config: RunConfig, cycles: np.ndarray, conditions: CycleConditions | None,
-                     progress: bool, backend: str = backends.DEFAULT) -> RunResult:
-    """The recorded ``cycles`` of ``config`` with their ``conditions``, every cycle kept."""
+                     progress: bool, backend: str = backends.DEFAULT,
+                     dry_multipliers: np.ndarray | None = None) -> RunResult:
+    """The recorded ``cycles`` of ``config`` with their ``conditions``, every cycle kept (``dry_multipliers``:
+    :func:`simulate`'s, checked)."""
     mix = config.conditions.task_mix
     if mix is None:
-        return _simulate_task(config, config.task, cycles, conditions, progress, backend)
+        return _simulate_task(config, config.task, cycles, conditions, progress, backend, dry_multipliers)
     task_of = conditions.tasks(mix)
     groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
     return merge_tasks(config, groups, [
-        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress, backend) for g in groups])
+        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress, backend,
+                       None if dry_multipliers is None else dry_multipliers[g]) for g in groups])
 
 
 def _join_days(blocks: list[RunResult]) -> RunResult:
@@ -125,9 +151,11 @@ def _join_days(blocks: list[RunResult]) -> RunResult:
 
 
 def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, conditions: CycleConditions | None,
-                   progress: bool, backend: str = backends.DEFAULT) -> RunResult:
+                   progress: bool, backend: str = backends.DEFAULT,
+                   dry_multipliers: np.ndarray | None = None) -> RunResult:
     """The recorded ``cycles`` of ``config`` that run ``task_name``, with their ``conditions``:
-    stepped, measured, their per-cycle features (and torque counts unless daily) computed."""
+    stepped, measured, their per-cycle features (and torque counts unless daily) computed; each
+    cycle's dry friction multipliers ``dry_multipliers`` when given, else the wear plan's."""
     payloads = conditions is not None and bool(np.any(conditions.payload_part >= 0))
     # a fault run without payloads steps the faulted model only: no nominal model is compiled for it
     # (its set-points, the disturbance's scale, are the nominal ones: the controller knows no fault)
@@ -141,7 +169,8 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
     n_steps = len(inputs) - 1
 
     # friction wear is a fault: the relative faults on the motor friction scale each cycle's dry friction
-    multiplier = faults.dry_multipliers(config.faults, cycles, robot.n_axes)
+    multiplier = (faults.dry_multipliers(config.faults, cycles, robot.n_axes) if dry_multipliers is None
+                  else dry_multipliers)
     n_log = n_steps // per_log
     feedforward_arm = inputs[:, :, 2] * robot.gear_ratio
     sigma = config.noise.disturbance * np.mean(np.abs(feedforward_arm), axis=0)

@@ -1,0 +1,54 @@
+"""A twin's signature cycles (the healthy cycle at the model's own friction and one per worn axis)
+simulated together as one batch (``stepping.simulate``'s ``dry_multipliers``) are the bits of the
+same cycles simulated one by one, as the twin did before (and still does for a cycle asked alone);
+``dry_multipliers`` refuses what it cannot mean, by name."""
+
+import numpy as np
+import pytest
+
+from faultgen.calibrate import synth
+from faultgen.model import robots
+from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
+from faultgen.operation.wear import Schedule, WearPlan
+from faultgen.simulation import stepping as sim
+
+
+@pytest.fixture(scope="module")
+def program(tmp_path_factory):
+    robot = robots.load("puma560")
+    log = synth.record(robot, synth.Hidden(None), tmp_path_factory.mktemp("program") / "log.csv", cycles=1, seed=1)
+    return robot, log
+
+
+def test_the_signature_cycles_of_one_batch_are_the_bits_of_one_by_one(program, tmp_path):
+    robot, log = program
+    together = Twin(robot, log, tmp_path / "together")  # made: its signature cycles in one batch
+    apart = Twin(robot, log, tmp_path / "apart", cycles=False)
+    own = float("nan")
+    healthy = apart.cycle(own, 0.0)  # one at a time: nothing cached, each its own simulation
+    worn = [apart.cycle(own, 0.0, axis) for axis in range(1, robot.n_axes + 1)]
+    apart.cycle(REFERENCE_TEMPERATURE, 0.0)  # the healthy expectation, simulated alone in both
+    np.testing.assert_array_equal(together.cycle(own, 0.0), healthy)
+    for axis, vector in enumerate(worn, start=1):
+        np.testing.assert_array_equal(together.cycle(own, 0.0, axis), vector)
+    np.testing.assert_array_equal(together.signatures, np.stack([(v - healthy) / 40.0 for v in worn]))
+    assert np.all(np.abs(together.signatures).max(axis=1) > 0)  # every axis's wear moves some feature
+    cached = sorted(p.name for p in (tmp_path / "together").glob("*.json"))
+    assert cached == sorted(p.name for p in (tmp_path / "apart").glob("*.json"))
+    for name in cached:  # the cache files too: key and features
+        assert (tmp_path / "together" / name).read_bytes() == (tmp_path / "apart" / name).read_bytes()
+
+
+def test_dry_multipliers_are_refused_with_a_wear_plan_or_the_wrong_shape(program):
+    robot, _ = program
+    config = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0)
+    with pytest.raises(ValueError, match=r"^dry_multipliers of shape \(2, 5\): expected finite numbers > 0 of "
+                                         r"shape \(2, 6\), one row per recorded cycle and a column per axis$"):
+        sim.simulate(config, progress=False, dry_multipliers=np.ones((2, 5)))
+    with pytest.raises(ValueError, match=r"^dry_multipliers of shape \(2, 6\): expected finite numbers > 0"):
+        sim.simulate(config, progress=False, dry_multipliers=np.zeros((2, 6)))
+    worn = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0,
+                         wear=WearPlan({2: Schedule("exp4", 0.2, 2)}))
+    with pytest.raises(ValueError, match=r"^dry_multipliers are given instead of a wear plan and without daily "
+                                         r"records; this run has a wear plan$"):
+        sim.simulate(worn, progress=False, dry_multipliers=np.ones((2, 6)))
