@@ -52,7 +52,7 @@ def test_dry_multipliers_are_refused_with_a_wear_plan_or_the_wrong_shape(program
     worn = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0,
                          wear=WearPlan({2: Schedule("exp4", 0.2, 2)}))
     with pytest.raises(ValueError, match=r"^dry_multipliers are given instead of a wear plan and without daily "
-                                         r"records; this run has a wear plan$"):
+                                         r"records; this run has friction wear \(a wear plan or a fault\)$"):
         sim.simulate(worn, progress=False, dry_multipliers=np.ones((2, 6)))
 
 
