@@ -8,7 +8,7 @@ import pytest
 
 from faultgen.calibrate import synth
 from faultgen.model import robots
-from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
+from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin, setup
 from faultgen.operation.wear import Schedule, WearPlan
 from faultgen.simulation import stepping as sim
 
@@ -27,13 +27,15 @@ def test_the_signature_cycles_of_one_batch_are_the_bits_of_one_by_one(program, t
     own = float("nan")
     healthy = apart.cycle(own, 0.0)  # one at a time: nothing cached, each its own simulation
     worn = [apart.cycle(own, 0.0, axis) for axis in range(1, robot.n_axes + 1)]
-    apart.cycle(REFERENCE_TEMPERATURE, 0.0)  # the healthy expectation, simulated alone in both
+    # the healthy expectation at the reference temperature is the cycle at the model's own friction
+    np.testing.assert_array_equal(apart.cycle(REFERENCE_TEMPERATURE, 0.0), healthy)
     np.testing.assert_array_equal(together.cycle(own, 0.0), healthy)
     for axis, vector in enumerate(worn, start=1):
         np.testing.assert_array_equal(together.cycle(own, 0.0, axis), vector)
     np.testing.assert_array_equal(together.signatures, np.stack([(v - healthy) / 40.0 for v in worn]))
     assert np.all(np.abs(together.signatures).max(axis=1) > 0)  # every axis's wear moves some feature
     cached = sorted(p.name for p in (tmp_path / "together").glob("*.json"))
+    assert len(cached) == robot.n_axes + 1  # the base cycles: healthy and one per worn axis, once each
     assert cached == sorted(p.name for p in (tmp_path / "apart").glob("*.json"))
     for name in cached:  # the cache files too: key and features
         assert (tmp_path / "together" / name).read_bytes() == (tmp_path / "apart" / name).read_bytes()
@@ -50,5 +52,17 @@ def test_dry_multipliers_are_refused_with_a_wear_plan_or_the_wrong_shape(program
     worn = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0,
                          wear=WearPlan({2: Schedule("exp4", 0.2, 2)}))
     with pytest.raises(ValueError, match=r"^dry_multipliers are given instead of a wear plan and without daily "
-                                         r"records; this run has a wear plan$"):
+                                         r"records; this run has friction wear \(a wear plan or a fault\)$"):
         sim.simulate(worn, progress=False, dry_multipliers=np.ones((2, 6)))
+
+
+def test_the_reference_temperature_leaves_the_models_friction_as_it_is(program, tmp_path):
+    """Why the twin reads its healthy expectation at REFERENCE_TEMPERATURE from the cycle at the
+    model's own friction: simulated with the joints held at that temperature (the thermal condition
+    and faultgen's temperature law on), the cycle is the same (bits here; 1e-12 asked)."""
+    robot, log = program
+    twin = Twin(robot, log, tmp_path / "cycles", cycles=False)
+    held, plan = setup(REFERENCE_TEMPERATURE, 0.0)
+    assert held.thermal is not None
+    warm = sim.simulate(twin._config(REFERENCE_TEMPERATURE, 0.0, plan), progress=False)
+    np.testing.assert_allclose(twin._features(warm), twin.cycle(float("nan"), 0.0), rtol=1e-12, atol=0)

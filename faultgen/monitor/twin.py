@@ -5,7 +5,9 @@ What the monitor asks of it (:class:`Twin`):
 
 - :meth:`Twin.expected`: the features a healthy unit shows at a joint temperature and payload:
   the replayed cycle simulated at :data:`REFERENCE_TEMPERATURE` (the monitor's default, where the
-  unit's own learned slope carries the temperature), or, asked for another temperature
+  unit's own learned slope carries the temperature; faultgen's temperature law leaves the model's
+  friction as it is there, so that cycle is the one at the model's own friction, simulated and
+  cached once under that key), or, asked for another temperature
   (``--twin-temperature``), at :data:`TEMPERATURES` (a quadratic through the three, so any
   temperature in between and a little beyond), for every payload the unit's logs declare (an
   aluminium cube of that mass hanging from the flange: the log gives the mass only);
@@ -97,10 +99,10 @@ def setup(temperature: float | None, payload: float, worn_axis: int = 0) -> tupl
 
 def base_cycles(n_axes: int) -> list[tuple[float, float, int]]:
     """The (temperature deg C or NaN, payload kg, worn axis) of the cycles every :class:`Twin` of a
-    robot of ``n_axes`` axes simulates when it is made: the healthy expectation without a part, the
-    healthy cycle at the model's own friction and one per worn axis (its :attr:`Twin.signatures`)."""
-    return [(REFERENCE_TEMPERATURE, 0.0, 0), (float("nan"), 0.0, 0),
-            *((float("nan"), 0.0, axis) for axis in range(1, n_axes + 1))]
+    robot of ``n_axes`` axes simulates when it is made: the healthy cycle at the model's own friction
+    (also the healthy expectation without a part at :data:`REFERENCE_TEMPERATURE`) and one per worn
+    axis (its :attr:`Twin.signatures`)."""
+    return [(float("nan"), 0.0, axis) for axis in range(n_axes + 1)]
 
 
 class Twin:
@@ -156,7 +158,6 @@ class Twin:
         """Simulate (or read from the cache) the :func:`base_cycles` and set :attr:`signatures`: done
         when the twin is made, unless it was made with ``cycles=False`` (to know which base cycles
         are cached, :meth:`cached`, and simulate the others in parallel first)."""
-        self.cycle(REFERENCE_TEMPERATURE, 0.0)  # the monitor's healthy expectation without a part
         # The signatures at the model's own friction (a calibrated model's, as identified on the
         # unit's first log, or the nominal one's), with no temperature law on top: the features are
         # not linear in friction (an RMS and a 10/3-norm of the torque), so their change per % of dry
@@ -165,8 +166,8 @@ class Twin:
         # times those at its own friction, and the independent fleet's units answered 0.49-0.66 % per %
         # of their own dry friction's wear (0.85-1.15 now: tests/test_wear_scale.py).
         at_own = float("nan")
-        self._simulate_together([(at_own, 0.0, axis) for axis in range(self.robot.n_axes + 1)])
-        healthy = self.cycle(at_own, 0.0)
+        self._simulate_together(base_cycles(self.robot.n_axes))
+        healthy = self.cycle(at_own, 0.0)  # also the monitor's healthy expectation without a part
         #: (N, F): change of each feature per % wear of each axis, % of the model's own dry friction
         #: (without a part: the signatures are shared by every unit of the model and program).
         self.signatures = np.stack([(self.cycle(at_own, 0.0, axis) - healthy) / WEAR
@@ -190,7 +191,10 @@ class Twin:
         return path
 
     def _key(self, temperature: float, payload: float, worn_axis: int) -> tuple[dict, Path]:
-        temperature = None if np.isnan(temperature) else round(float(temperature), 2)
+        """A cycle's cache key and file; :data:`REFERENCE_TEMPERATURE` is the model's own friction
+        (NaN): faultgen's temperature law's factors are 1 there (one over itself)."""
+        own = np.isnan(temperature) or float(temperature) == REFERENCE_TEMPERATURE
+        temperature = None if own else round(float(temperature), 2)
         key = {**self._files, "temperature_C": temperature, "payload_kg": float(payload), "worn_axis": int(worn_axis)}
         return key, self.cache / f"{stored.key_name(key)}.json"
 
@@ -221,7 +225,7 @@ class Twin:
         the time; docs/performance.md) and cache them. Where a drive saturates nothing is cached:
         :meth:`cycle` simulates them one by one, naming the one that saturates."""
         missing = [c for c in cycles if not self.cached(*c)]
-        if len(missing) < 2 or len({(str(t), p) for t, p, _ in missing}) > 1:
+        if len(missing) < 2 or len({(self._key(*c)[0]["temperature_C"], c[1]) for c in missing}) > 1:
             return
         temperature, payload = self._key(*missing[0])[0]["temperature_C"], missing[0][1]
         n = self.robot.n_axes

@@ -65,8 +65,8 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
     checking it); every backend gives the same results to float tolerance.
 
     ``dry_multipliers``: ndarray of shape (n_recorded, N), each recorded cycle's multiplier of
-    every axis's dry (Coulomb and static) friction, given instead of a wear plan (``config.wear``
-    empty): cycles that no wear schedule relates, such as one healthy and one per worn axis
+    every axis's dry (Coulomb and static) friction, given instead of friction wear (no wear plan,
+    no fault on the dry friction): cycles that no wear schedule relates, such as one healthy and one per worn axis
     (:class:`faultgen.monitor.twin.Twin`'s signatures), stepped together as one batch. A cycle's
     result is the same, bit for bit, as the one-cycle run whose wear plan gives that row
     (tests/test_twin_batch.py).
@@ -81,7 +81,7 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     ValueError
         For an unknown ``backend``; ``dry_multipliers`` not of that shape, not finite and positive,
-        beside a wear plan or with daily records.
+        beside friction wear or with daily records.
     """
     backends.get(backend)
     cycles = config.recorded_cycles
@@ -107,9 +107,10 @@ def _checked_multipliers(config: RunConfig, values, n_cycles: int, n_axes: int) 
     if values.shape != (n_cycles, n_axes) or not np.all(np.isfinite(values) & (values > 0)):
         raise ValueError(f"dry_multipliers of shape {values.shape}: expected finite numbers > 0 of shape "
                          f"({n_cycles}, {n_axes}), one row per recorded cycle and a column per axis")
-    if config.wear.schedules or config.daily:
+    worn = bool(np.any(faults.dry_multipliers(config.faults, config.recorded_cycles, n_axes) != 1.0))
+    if worn or config.daily:
         raise ValueError("dry_multipliers are given instead of a wear plan and without daily records; this run "
-                         f"has {'a wear plan' if config.wear.schedules else 'daily records'}")
+                         f"has {'friction wear (a wear plan or a fault)' if worn else 'daily records'}")
     return values
 
 
