@@ -221,8 +221,8 @@ class Twin:
         """Simulate the ``cycles`` (temperature, payload, worn axis) that are not cached, all at one
         temperature and payload and differing only in their worn axis, as one batch
         (:func:`faultgen.simulation.stepping.simulate`'s ``dry_multipliers``, each row the one-cycle
-        run's wear plan gives: the same bits as simulating them one by one, in a third to a half of
-        the time; docs/performance.md) and cache them. Where a drive saturates nothing is cached:
+        run's wear plan gives: the same bits as simulating them one by one, in about half the time;
+        docs/performance.md) and cache them. Where a drive saturates nothing is cached:
         :meth:`cycle` simulates them one by one, naming the one that saturates."""
         missing = [c for c in cycles if not self.cached(*c)]
         if len(missing) < 2 or len({(self._key(*c)[0]["temperature_C"], c[1]) for c in missing}) > 1:
