@@ -41,7 +41,7 @@ def test_one_calibration_writes_the_model_file_once(coulomb_log, tmp_path, monke
         return write_text(self, data, *args, **kwargs)
 
     monkeypatch.setattr(pathlib.Path, "write_text", counted)
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False, figure=False)
     assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
     assert len(writes) == 1, [str(p) for p in writes]
     # the file written is the model the search judged: loaded back, it predicts what the search kept

@@ -26,7 +26,7 @@ FAST = ["puma560-01-none", "irb6700-03-payload", "puma560-07-stribeck_exponent",
 def test_toolbox_log_is_named_and_the_gap_halves(tmp_path, name):
     case = next(c for c in CASES if c.name == name)
     path, hidden = make(case, tmp_path)
-    result = calibrate(case.robot, path, tmp_path / "out")
+    result = calibrate(case.robot, path, tmp_path / "out", figure=False)
     verdict = judge(hidden, result)
     assert verdict["named"], f"hidden {verdict['hidden']}\n{result.summary()}"
     if hidden.forms:

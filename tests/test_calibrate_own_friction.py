@@ -38,8 +38,8 @@ def log():
 
 def test_every_moving_axis_gets_its_own_coulomb_level(log, tmp_path):
     robot, data = log
-    plain = calibrate(robot, data, tmp_path / "plain", max_steps=3)
-    own = calibrate(robot, data, tmp_path / "own", max_steps=3, friction_every_axis=True)
+    plain = calibrate(robot, data, tmp_path / "plain", max_steps=3, figure=False)
+    own = calibrate(robot, data, tmp_path / "own", max_steps=3, friction_every_axis=True, figure=False)
     def ratio(model):  # each axis's negative-direction change in units of the nominal positive level, plus one
         return 1 + (model.friction.coulomb_neg - robot.friction.coulomb_neg) / robot.friction.coulomb_pos
 

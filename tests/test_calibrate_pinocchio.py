@@ -28,7 +28,7 @@ def test_payload_hidden_in_a_pinocchio_log_is_named_and_the_gap_halved(kr210, tm
     hidden = pinocchio_log.HiddenPayload(mass=90.0)
     # one pick-and-place cycle, 7.24 s at 250 Hz
     log = pinocchio_log.write_log(kr210, tmp_path / "log.csv", cycles=1, payload=hidden, seed=3)
-    calibrate(str(kr210), log, tmp_path / "calib", max_steps=2)
+    calibrate(str(kr210), log, tmp_path / "calib", max_steps=2, figure=False)
     report = json.loads((tmp_path / "calib" / "report.json").read_text())
     steps = report["steps"]
     assert steps and steps[0]["effect"] == "payload", [s["effect"] for s in steps]
@@ -48,7 +48,7 @@ def test_payload_comes_back_exactly_from_exact_derivatives_on_a_rigid_model(kr21
     t, q, qd, qdd = pinocchio_log.motion(kr210, cycles=1)
     tau = pinocchio_log.arm_torque(kr210, q, qd, qdd, hidden)
     data = dataclasses.replace(measured.from_arrays(t, q, tau, robots.load(kr210), qd=qd), qdd=qdd)
-    result = calibrate(str(kr210), data, tmp_path / "calib", max_steps=1)
+    result = calibrate(str(kr210), data, tmp_path / "calib", max_steps=1, figure=False)
     assert [s.effect.id for s in result.steps] == ["payload"]
     assert result.gap_after["total_nrmse"] < 1e-4 * result.gap_before["total_nrmse"]
     fitted = result.steps[0].record()["params"]["robot"]

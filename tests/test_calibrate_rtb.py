@@ -55,7 +55,7 @@ def toolbox_log(tmp_path, robot, motion, hidden):
 def test_effect_added_to_toolbox_data_is_named(tmp_path, path, effect):
     robot, motion = path
     hidden = synth.draw(robot, effect, np.random.default_rng(SEED))
-    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, hidden), tmp_path / "out")
+    result = calibrate("puma560", toolbox_log(tmp_path, robot, motion, hidden), tmp_path / "out", figure=False)
     assert result.steps, f"nothing found; hidden {hidden}"
     first = result.steps[0]
     assert (first.effect.id, first.axes) == (effect, hidden.axes), result.summary()
@@ -75,7 +75,7 @@ def test_coulomb_change_in_one_direction_is_fitted_per_direction(tmp_path, path)
     rng = np.random.default_rng(SEED)
     tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     log = measured.write_csv(tmp_path / "toolbox.csv", motion.t, motion.q + rng.normal(size=motion.q.shape) * 1e-5, tau)
-    result = calibrate("puma560", log, tmp_path / "out")
+    result = calibrate("puma560", log, tmp_path / "out", figure=False)
     first = result.steps[0]
     assert (first.effect.id, first.axes) == ("coulomb", [k]), result.summary()
     found = first.effect.values(k)
