@@ -141,6 +141,25 @@ def day_of(wear: np.ndarray, level: float) -> float:
     return len(wear) + (level - wear[-1]) / rate
 
 
+def estimate_line(wear: np.ndarray, day: dict[str, int], rows: list[dict], axis: int) -> tuple[float, float]:
+    """The scale and offset of ``axis``'s wear estimate on the true wear: the least-squares line of
+    its monitoring ``rows``' ``wear<axis>`` (scores.csv) on the true ``wear`` (one value a day, %;
+    ``day``: stamp -> day, 1-based) where the true wear is past 5 %."""
+    past = [(wear[day[r["stamp"]] - 1], float(r[f"wear{axis}"])) for r in rows
+            if r["phase"] == "monitoring" and wear[day[r["stamp"]] - 1] >= 5]
+    scale, offset = np.polyfit(*zip(*past), 1)
+    return float(scale), float(offset)
+
+
+def exact_crossing_error(wear: np.ndarray, scale: float, offset: float, start: int, failure: float) -> float:
+    """(the day the estimate, ``scale`` x the true ``wear`` + ``offset``, reaches ``failure`` - the true
+    end of life) over the true remaining life at lambda, ``start`` the persistent alarm's day: what
+    an exact prediction of the estimate's own crossing would be off by ("reachable" within +-ALPHA)."""
+    eol = day_of(wear, failure)
+    lam = start + LAMBDA * (eol - start)
+    return (day_of(wear, (failure - offset) / scale) - eol) / (eol - lam)
+
+
 def run_fleet(args) -> tuple[Path, Path]:
     """Write the fleet (or resume it in ``--work``) and run the monitor on it; returns (truth.csv, OUT)."""
     work = args.work or Path(tempfile.mkdtemp(prefix="monitor-rul-"))
@@ -235,9 +254,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
         wear = t["wear"]
         true_eol = day_of(wear, F)  # (A)
-        monitoring = [r for r in rows if r["phase"] == "monitoring"]
-        past = [(wear[day[r["stamp"]] - 1], r[f"wear{axis}"]) for r in monitoring if wear[day[r["stamp"]] - 1] >= 5]
-        scale, offset = np.polyfit(*zip(*past), 1)
+        scale, offset = estimate_line(wear, day, rows, axis)
         estimate_eol = day_of(wear, (F - offset) / scale)  # (B)
         first = stamps.index(alarm["first_alarm"])
         start = day[stamps[first + PERSISTENCE - 1]]
@@ -263,7 +280,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
             s = score(profile, eol, start, len(wear))
             s["unit"] = unit
             if name == "A":  # a prediction of the estimate's own crossing, exact, judged against the truth
-                s["perfect_error"] = (estimate_eol - true_eol) / (true_eol - s["lambda"])
+                s["perfect_error"] = exact_crossing_error(wear, scale, offset, start, F)
             results[name].append(s)
             al = {None: f"n/a (lambda day {s['lambda']:.0f} after the record)", True: "met", False: "not met"}[
                 s.get("alpha_lambda")]  # a bool or None

@@ -80,14 +80,6 @@ def per_log_coulomb(nominal: robots.Robot, logs: list[Path]) -> np.ndarray:
     return np.array(levels)
 
 
-def exact_crossing_error(wear: np.ndarray, scale: float, offset: float, start: int, failure: float) -> float:
-    """(day the estimate ``scale`` x true + ``offset`` reaches ``failure`` - true end of life) over the true
-    remaining life at lambda (``monitor_rul.py``'s "reachable")."""
-    eol = monitor_rul.day_of(wear, failure)
-    lam = start + monitor_rul.LAMBDA * (eol - start)
-    return (monitor_rul.day_of(wear, (failure - offset) / scale) - eol) / (eol - lam)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, required=True, help="The fleet's seed (monitor_wear_scale.py --seed).")
@@ -119,17 +111,15 @@ def main() -> None:
             continue
         a = axis - 1
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}
-        pairs = [(t["wear"][day[r["stamp"]] - 1], float(r[f"wear{axis}"])) for r in scores
-                 if r["unit"] == unit and t["wear"][day[r["stamp"]] - 1] >= 5]
-        scale, offset = np.polyfit(*zip(*pairs), 1)
+        scale, offset = monitor_rul.estimate_line(t["wear"], day, [r for r in scores if r["unit"] == unit], axis)
         logs = sorted((work / "logs" / unit).glob("*.csv"))
         fitted = fitted_friction(cached[state.sha256_file(logs[0])])
         coulomb = fitted["coulomb"][a] / own[unit][0, a]
         dry = (fitted["coulomb"][a] + fitted["static"][a]) / (own[unit][0, a] + own[unit][1, a])
         stamps = [r["stamp"] for r in scores if r["unit"] == unit]
         start = day[stamps[stamps.index(alarm["first_alarm"]) + monitor_rul.PERSISTENCE - 1]]
-        now = exact_crossing_error(t["wear"], scale, offset, start, F)
-        exact = exact_crossing_error(t["wear"], scale * dry, offset * dry, start, F)
+        now = monitor_rul.exact_crossing_error(t["wear"], scale, offset, start, F)
+        exact = monitor_rul.exact_crossing_error(t["wear"], scale * dry, offset * dry, start, F)
         row = {"scale": scale, "dry": dry, "now": now, "exact": exact}
         cells = [f"{unit} ({axis})", f"{scale:.2f}, {offset:+.1f}", f"{coulomb:.3f}", f"{dry:.3f}"]
         if args.per_log:

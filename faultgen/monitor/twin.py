@@ -224,19 +224,20 @@ class Twin:
         run's wear plan gives: the same bits as simulating them one by one, in about half the time;
         docs/performance.md) and cache them. Where a drive saturates nothing is cached:
         :meth:`cycle` simulates them one by one, naming the one that saturates."""
-        missing = [c for c in cycles if not self.cached(*c)]
-        if len(missing) < 2 or len({(self._key(*c)[0]["temperature_C"], c[1]) for c in missing}) > 1:
+        missing = [(key, path) for key, path in (self._key(*c) for c in cycles)
+                   if not (path.exists() or path.is_symlink())]  # not cached
+        held = {(key["temperature_C"], key["payload_kg"]) for key, _ in missing}
+        if len(missing) < 2 or len(held) > 1:
             return
-        temperature, payload = self._key(*missing[0])[0]["temperature_C"], missing[0][1]
+        ((temperature, payload),) = held
         n = self.robot.n_axes
-        rows = np.stack([faults.dry_multipliers(setup(temperature, payload, axis)[1].faults(), np.array([1]), n)[0]
-                         for _, _, axis in missing])
+        rows = np.stack([faults.dry_multipliers(setup(temperature, payload, key["worn_axis"])[1].faults(),
+                                                np.array([1]), n)[0] for key, _ in missing])
         config = self._config(temperature, payload, wear.WearPlan({}), cycles=len(missing))
         result = sim.simulate(config, progress=False, backend=self.backend, dry_multipliers=rows)
         if result.saturated.size:
             return
-        for index, c in enumerate(missing):
-            key, path = self._key(*c)
+        for index, (key, path) in enumerate(missing):
             stored.write_cycle(path, key, self._features(result, index))
 
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:

@@ -87,7 +87,7 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
     cycles = config.recorded_cycles
     n_axes = config.model.n_axes
     if dry_multipliers is not None:
-        dry_multipliers = _checked_multipliers(config, dry_multipliers, len(cycles), n_axes)
+        dry_multipliers = _checked_multipliers(config, dry_multipliers, cycles, n_axes)
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     if not config.daily:
         return _simulate_cycles(config, cycles, conditions, progress, backend, dry_multipliers)
@@ -101,13 +101,13 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
         for rows in blocks])
 
 
-def _checked_multipliers(config: RunConfig, values, n_cycles: int, n_axes: int) -> np.ndarray:
-    """:func:`simulate`'s ``dry_multipliers``, checked (its Raises)."""
+def _checked_multipliers(config: RunConfig, values, cycles: np.ndarray, n_axes: int) -> np.ndarray:
+    """:func:`simulate`'s ``dry_multipliers`` for the recorded ``cycles``, checked (its Raises)."""
     values = np.asarray(values, dtype=float)
-    if values.shape != (n_cycles, n_axes) or not np.all(np.isfinite(values) & (values > 0)):
+    if values.shape != (len(cycles), n_axes) or not np.all(np.isfinite(values) & (values > 0)):
         raise ValueError(f"dry_multipliers of shape {values.shape}: expected finite numbers > 0 of shape "
-                         f"({n_cycles}, {n_axes}), one row per recorded cycle and a column per axis")
-    worn = bool(np.any(faults.dry_multipliers(config.faults, config.recorded_cycles, n_axes) != 1.0))
+                         f"({len(cycles)}, {n_axes}), one row per recorded cycle and a column per axis")
+    worn = bool(np.any(faults.dry_multipliers(config.faults, cycles, n_axes) != 1.0))
     if worn or config.daily:
         raise ValueError("dry_multipliers are given instead of a wear plan and without daily records; this run "
                          f"has {'friction wear (a wear plan or a fault)' if worn else 'daily records'}")
