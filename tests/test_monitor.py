@@ -378,7 +378,7 @@ def test_a_cached_calibration_is_checked_against_its_record(tmp_path):
     model.write_text("<mujoco/>")
     key = {"robot": "a" * 64, "log": "b" * 64, "steps": 3}
     record = tmp_path / "calibrated.json"
-    state.write_calibration(record, key, model)
+    state.write_calibration(record, tmp_path, key, model)
     state.read_calibration(record, tmp_path, key, model)
     with pytest.raises(InputError, match="not the calibration of this robot and log"):
         state.read_calibration(record, tmp_path, {**key, "log": "c" * 64}, model)

@@ -15,7 +15,6 @@ from faultgen.cli.options import (
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).
-CACHE_ENTRIES = ("cycles", "calibrated", "programs")
 
 #: The fewest logs the monitor learns a unit from (faultgen.monitor.scoring.Settings), and the most
 #: logs --train and --persistence may name (years of a log an hour: beyond any fleet's record).
@@ -179,13 +178,15 @@ def monitor_command(
 def is_monitor_output(folder: Path) -> bool:
     """Whether ``folder`` is an earlier monitor run's output: it holds the monitors' state
     (``.state``), or the cache a run killed before its first outputs leaves (``.cache`` holding
-    nothing but :data:`CACHE_ENTRIES`)."""
+    nothing but :data:`faultgen.monitor.state.CACHE`)."""
+    from faultgen.monitor import state as stored
+
     state, cache = folder / ".state", folder / ".cache"
     if state.is_dir() and not state.is_symlink():
         return True
     if not cache.is_dir() or cache.is_symlink():
         return False
-    return all(entry.name in CACHE_ENTRIES for entry in cache.iterdir())
+    return all(entry.name in stored.CACHE for entry in cache.iterdir())
 
 
 def check_monitor_out(out: Path, logs: Path, overwrite: bool) -> None:

@@ -180,10 +180,11 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
                                  "measured" if log_format is None else repr(log_format))
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
+    confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
     pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
-    cache.mkdir(parents=True, exist_ok=True)
+    confined.mkdir(cache)
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                        failure_wear, backend)
     source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on

@@ -32,14 +32,15 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from faultgen.data import atomic
+from faultgen.data.confined import Confined
 from faultgen.model import robots
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.unit import Unit, calibration_key
 
-#: The cache entries a task may read or make (OUT/.cache/<entry>).
-CACHE = ("cycles", "calibrated", "programs")
+#: Size bound of one file of a cached calibration's folder (its model, report and the robot's
+#: assets: meshes of an added robot are a few MB).
+CALIBRATION_FILE_MAX_BYTES = 256 * 2**20
 #: Tasks sent ahead per worker thread (the rest wait in this process, their logs not yet read).
 IN_FLIGHT = 2
 
@@ -84,10 +85,9 @@ def score_remote(context: Context, robot: str, group: list, shipment: Shipment) 
     try:
         logs, out = root / "logs", root / "out"
         for files, base in ((shipment.logs, logs), (shipment.cache, out / ".cache")):
+            laid = Confined(base, "worker's folder")  # a name leading out of it (``..``) is refused
             for name, data in files.items():
-                path = base / name
-                path.parent.mkdir(parents=True, exist_ok=True)
-                path.write_bytes(data)
+                laid.write_bytes(base / name, data)
         try:
             nominal = robots.load(robot)
         except (OSError, ValueError) as err:
@@ -146,13 +146,14 @@ class Cache:
 
     def __init__(self, out: Path, nominal_sha256: str, calibrated: Path | None):
         self.root = out / ".cache"
+        self.out = stored.checked_out(out)  # every read and write below stays inside OUT
         self.base = {nominal_sha256} | ({stored.sha256_file(calibrated)} if calibrated is not None else set())
         self.nominal_sha256 = nominal_sha256
         self.by_model: dict[str, dict[str, bytes]] = {}
         folder = self.root / "cycles"
         if folder.is_dir():
-            for path in sorted(folder.glob("*.json")):
-                self._add(f"cycles/{path.name}", stored.inside(path, out).read_bytes())
+            for path in sorted(folder.glob("*.json")):  # each bounded as the local reader bounds it
+                self._add(f"cycles/{path.name}", self.out.read_bytes(path, "cached twin cycle", stored.CYCLE_MAX_BYTES))
 
     def _add(self, name: str, data: bytes) -> None:
         try:
@@ -171,11 +172,12 @@ class Cache:
             digest = stored.key_name(key)
             record, folder = self.root / "calibrated" / f"{digest}.json", self.root / "calibrated" / digest
             if record.is_file() and folder.is_dir():
-                files[f"calibrated/{digest}.json"] = record.read_bytes()
-                for path in sorted(folder.rglob("*")):
+                files[f"calibrated/{digest}.json"] = self.out.read_bytes(record, "cached calibration record",
+                                                                         stored.CYCLE_MAX_BYTES)
+                for path in sorted(self.out.path(folder).rglob("*")):
                     if path.is_file():
-                        stored.inside(path, self.root)
-                        files[path.relative_to(self.root).as_posix()] = path.read_bytes()
+                        files[path.relative_to(self.root).as_posix()] = self.out.read_bytes(
+                            path, "file of a cached calibration", CALIBRATION_FILE_MAX_BYTES)
                         if path.name.endswith("_twin.xml"):
                             models.add(stored.sha256_file(path))
         for model in sorted(models):
@@ -188,16 +190,14 @@ class Cache:
         calibration's record last, after its folder."""
         records = [name for name in made if name.startswith("calibrated/") and name.count("/") == 1]
         for name in sorted(set(made) - set(records)) + sorted(records):
-            if name.split("/")[0] not in CACHE:
+            if name.split("/")[0] not in stored.CACHE:
                 raise ValueError(f"a worker sent back {name!r}, which is not a monitor cache file")
             if Path(name).is_absolute() or ".." in Path(name).parts:
                 raise ValueError(f"a worker sent back {name!r}, which is not a path inside the monitor's cache")
-            path = self.root / name
+            path = self.out.path(self.root / name)
             if path.exists() and not name.startswith("programs/"):
                 continue
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with atomic.atomic_path(path) as tmp:
-                Path(tmp).write_bytes(made[name])
+            self.out.write_bytes(path, made[name])
             if name.startswith("cycles/"):
                 self._add(name, made[name])
 

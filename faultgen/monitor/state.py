@@ -36,6 +36,7 @@ import numpy as np
 
 from faultgen import inputs
 from faultgen.data import atomic
+from faultgen.data.confined import Confined
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
 #: The state files' format: 2 since the monitor's features per axis are three (``friction_torque``,
@@ -47,6 +48,8 @@ CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
 PROGRAM_CHANGED = "program change (not logged: the motion left the twin's program)"
 #: Size bound of one unit's state file: about 0.6 kB per scored log, so 10^5 logs.
 STATE_MAX_BYTES = 64 * 2**20
+#: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read).
+CACHE = ("cycles", "calibrated", "programs")
 #: Size bound of one cached cycle (a few hundred bytes).
 CYCLE_MAX_BYTES = 2**20
 
@@ -200,13 +203,31 @@ def write_unit(path: Path, state: UnitState) -> None:
     atomic.write_text(path, json.dumps(document, separators=(",", ":")))
 
 
+def out_folder(out: str | Path) -> Confined:
+    """``OUT`` as the monitor reads and writes it (:class:`faultgen.data.confined.Confined`): a path
+    that leads, through a link, outside it is refused as a :class:`StateError` naming it (an output
+    folder never makes faultgen read or write outside itself)."""
+    return Confined(out, "monitor output folder", StateError)
+
+
+def checked_out(out: str | Path) -> Confined:
+    """:func:`out_folder` after checking, before a run reads or writes anything there, that OUT's
+    ``.state``, ``.cache`` and each :data:`CACHE` entry, where they exist, lead inside OUT.
+
+    Raises
+    ------
+    StateError
+        One of them is a link leading outside OUT (named).
+    """
+    confined = out_folder(out)
+    for entry in (".state", ".cache", *(f".cache/{name}" for name in CACHE)):
+        confined.path(Path(out) / entry)
+    return confined
+
+
 def inside(path: Path, root: Path) -> Path:
-    """``path`` after checking that it resolves inside ``root`` (a symbolic link out of the output
-    folder is refused, naming it: an output folder never makes faultgen read outside itself)."""
-    if not inputs.inside(path, root):
-        raise StateError(f"{path}: a link leading outside {root}; faultgen never writes links into its output "
-                                "folders: delete it")
-    return Path(path)
+    """``path`` after checking that it leads inside ``root`` (:func:`out_folder`)."""
+    return out_folder(root).path(path)
 
 
 def _load_json(path: Path, what: str, max_bytes: int) -> dict:
@@ -325,9 +346,10 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
                      [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance], program_changes)
 
 
-def write_cycle(path: Path, key: dict, features: np.ndarray) -> None:
-    """Cache one simulated cycle's ``features`` beside the ``key`` that determined them."""
-    atomic.write_text(path, json.dumps({"format": CYCLE_FORMAT, "key": key, "features": _floats(features)}))
+def write_cycle(path: Path, root: Path, key: dict, features: np.ndarray) -> None:
+    """Cache one simulated cycle's ``features`` beside the ``key`` that determined them, at ``path``
+    inside ``root`` (:func:`out_folder`: a link leading out is refused, nothing written)."""
+    out_folder(root).write_text(path, json.dumps({"format": CYCLE_FORMAT, "key": key, "features": _floats(features)}))
 
 
 def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray:
@@ -345,10 +367,13 @@ def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray
     return _vector(d.get("features"), path, "features", n_features)
 
 
-def write_calibration(path: Path, key: dict, model: Path) -> None:
+def write_calibration(path: Path, root: Path, key: dict, model: Path) -> None:
     """Record that the calibration in ``model``'s folder was made from ``key`` (the nominal model's
-    and the log's SHA-256 and the search's length), with ``model``'s own SHA-256."""
-    atomic.write_text(path, json.dumps({"format": CALIBRATION_FORMAT, "key": key, "model": sha256_file(model)}))
+    and the log's SHA-256 and the search's length), with ``model``'s own SHA-256, at ``path``
+    inside ``root`` (:func:`out_folder`)."""
+    folder = out_folder(root)
+    folder.write_text(path, json.dumps({"format": CALIBRATION_FORMAT, "key": key,
+                                        "model": sha256_file(folder.path(model))}))
 
 
 def read_calibration(path: Path, root: Path, key: dict, model: Path) -> None:

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import derivatives
-from faultgen.data import atomic, measured
+from faultgen.data import measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
@@ -113,7 +113,8 @@ class Twin:
     SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
     format's by default), ``cache`` the folder of simulated cycles (created if needed) inside
-    ``root`` (default ``cache``), out of which no cached cycle may lead, ``backend`` the stepping
+    ``root`` (default: the folder holding ``cache``, where the replayed motion goes too,
+    ``programs``), out of which no cached file may lead (read or written), ``backend`` the stepping
     backend its cycles are simulated on (:data:`faultgen.simulation.backends.BACKENDS`).
 
     Raises
@@ -135,8 +136,9 @@ class Twin:
         self.robot = robots.require(model, "monitor.twin.Twin")
         self.model = str(self.robot.path)
         self.cache = Path(cache)
-        self.root = self.cache if root is None else Path(root)
-        self.cache.mkdir(parents=True, exist_ok=True)
+        self.root = self.cache.parent if root is None else Path(root)
+        self.folder = stored.out_folder(self.root)  # every cache path checked: no link leading out of root
+        self.folder.mkdir(self.cache)
         if not isinstance(program, fleet_logs.Parsed):
             reader = reader or (lambda path, robot: measured.read(path, robot, accelerations=False))
             program = fleet_logs.Parsed(Path(program), stored.sha256_file(program), None)
@@ -182,11 +184,9 @@ class Twin:
         saturated the irb6700's axis 2 on its own pick and place)."""
         t = np.asarray(data.t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(data.q, dtype=float), REFERENCE_WINDOW)
-        folder = self.cache.parent / "programs"  # beside the cycles: the cycle folder holds cycles only
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{sha256[:24]}.csv"
+        path = self.cache.parent / "programs" / f"{sha256[:24]}.csv"  # beside the cycles: they hold cycles only
         header = ",".join(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))])
-        with atomic.atomic_path(path) as tmp:
+        with self.folder.writing(path) as tmp:
             np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.17g")
         return path
 
@@ -238,7 +238,7 @@ class Twin:
         if result.saturated.size:
             return
         for index, (key, path) in enumerate(missing):
-            stored.write_cycle(path, key, self._features(result, index))
+            stored.write_cycle(path, self.root, key, self._features(result, index))
 
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
@@ -262,7 +262,7 @@ class Twin:
                 f"this motion; {sized + '; ' if sized else ''}check the log's payload column (kg) and the model")
             raise ValueError(self._refused[temperature, payload, worn_axis])
         vector = self._features(result)
-        stored.write_cycle(path, key, vector)
+        stored.write_cycle(path, self.root, key, vector)
         return vector
 
     def expected(self, temperature: float, payload: float) -> np.ndarray:

@@ -8,7 +8,6 @@ nominal model -> protocol own: :func:`twin_of`). Logs come parsed from the run's
 
 from __future__ import annotations
 
-import shutil
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +16,6 @@ import mujoco
 import numpy as np
 
 from faultgen.calibrate import plausibility
-from faultgen.data import atomic
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
@@ -209,19 +207,19 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         return source.given
     key = calibration_key(stored.sha256_file(nominal.path), first[1], kind)
     digest = stored.key_name(key)
+    confined = stored.out_folder(out)
     root = out / ".cache" / "calibrated"
     folder, record = root / digest, root / f"{digest}.json"
     model = folder / "model" / f"{nominal.name}_calibrated.xml"
     if record.exists() or record.is_symlink():
         stored.read_calibration(record, out, key, model)
-        calibrated = cached_model(model)
+        calibrated = cached_model(confined.path(model))
     else:
         if first_log is None:
             raise ValueError(f"the first log of the unit ({first[0]}), which its model was calibrated on, is no longer "
                              "in the fleet folder and its calibration is not cached")
-        if folder.exists() or folder.is_symlink():  # a run killed before its record: ours to redo
-            stored.inside(folder, out)
-            shutil.rmtree(folder) if folder.is_dir() and not folder.is_symlink() else folder.unlink()
+        confined.remove(folder)  # a run killed before its record: ours to redo
+        confined.mkdir(root)
         from faultgen.calibrate import calibrate as run_calibration
 
         with warnings.catch_warnings():
@@ -229,11 +227,11 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
             calibrated = run_calibration(nominal, source.get(first_log).checked(), folder,
                                          max_steps=calibration_steps(kind), progress=False,
                                          friction_every_axis=OWN_FRICTION or kind == "friction", figure=False).model
-        stored.write_calibration(record, key, model)
+        stored.write_calibration(record, out, key, model)
     implausible = plausibility.implausible_parameters(nominal, calibrated)
     if implausible:
         raise ValueError(f"its calibration on the first log is implausible: {'; '.join(implausible)}")
-    return without_payload(calibrated)
+    return without_payload(calibrated, out)
 
 
 def cached_model(path: Path) -> robots.Robot:
@@ -243,21 +241,23 @@ def cached_model(path: Path) -> robots.Robot:
     return robots.load(path)
 
 
-def without_payload(calibrated: robots.Robot) -> robots.Robot:
+def without_payload(calibrated: robots.Robot, out: Path) -> robots.Robot:
     """The calibrated model without the part its log carried (the calibration's payload effect,
     written again with no mass: :class:`faultgen.effects.payload.Payload` removes its bodies): the
     twin carries each log's declared part instead. Written beside it (same assets and
     ``tasks.toml``) as ``<name>_twin.xml`` (:func:`faultgen.model.robots.write`, which returns the
     robot written), from the calibrated model's file (checked as any robot description when it
     was read: no file outside its folder) parsed again by MuJoCo; one an earlier run wrote is
-    read (:func:`cached_model`)."""
+    read (:func:`cached_model`). Both stay inside ``out`` (:func:`faultgen.monitor.state.out_folder`:
+    a ``_twin.xml`` linked out of it is refused, never parsed)."""
     path = calibrated.path
-    target = path.with_name(path.name.replace("_calibrated.xml", "_twin.xml"))
+    confined = stored.out_folder(out)
+    target = confined.path(path.with_name(path.name.replace("_calibrated.xml", "_twin.xml")))
     if target.is_file():
         return cached_model(target)
-    spec = mujoco.MjSpec.from_file(str(path))
+    spec = mujoco.MjSpec.from_file(str(confined.path(path)))
     Payload(mass=0.0).write(spec, calibrated)
-    return robots.write(target, spec.to_xml(), atomic.write_text)
+    return robots.write(target, spec.to_xml(), confined.write_text)
 
 
 def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_logs.Source) -> tuple[str, str]:
