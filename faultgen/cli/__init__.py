@@ -8,11 +8,23 @@ One module per command group, each adding its commands to :data:`app` when impor
 and ``reproduce`` (every table of docs/reproduction.md); ``faultgen --help`` lists
 them in that order. ``base`` holds the help layout and the one error handler every command
 shares; ``options`` the options several commands declare.
+
+Importing it sets ``PYTHONSAFEPATH=1`` in this process's environment (:data:`faultgen.children.SAFE_PATH`)
+before any library is imported: every Python a library starts from the command, however it starts
+it (MuJoCo's import of ``glfw`` runs ``python -c`` to check its library's version; loky, Dask,
+multiprocessing), then leaves the current folder off its path, as the children faultgen starts
+itself with ``-P`` do (:mod:`faultgen.children`).
 """
 
-from faultgen.cli.main import app
-from faultgen.cli import (robots, programs, runs, calibration, data, logs, monitoring, reporting, analysis, bench,
-                          reproduce)
+import os
+
+from faultgen import children
+
+os.environ.update(children.SAFE_PATH)
+
+from faultgen.cli.main import app  # noqa: E402  (after the environment is safe for the libraries' children)
+from faultgen.cli import (robots, programs, runs, calibration, data, logs, monitoring, reporting,  # noqa: E402
+                          analysis, bench, reproduce)
 
 __all__ = ["analysis", "app", "bench", "calibration", "data", "logs", "monitoring", "programs", "reporting",
            "reproduce", "robots", "runs"]
