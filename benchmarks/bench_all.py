@@ -16,17 +16,17 @@ from __future__ import annotations
 import argparse
 import resource
 import subprocess
-import sys
 import time
 from pathlib import Path
 
+from faultgen import children
 from faultgen.bench import baselines, make, score, tracks
 
 
 def run(argv: list[str]) -> tuple[float, str | None]:
     """(wall s, None) of a command, or (wall s, its last error line) when it failed."""
     start = time.perf_counter()
-    done = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    done = subprocess.run(argv, env=children.environment(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     error = None
     if done.returncode != 0:
         lines = [line for line in done.stderr.splitlines() if line.strip()]
@@ -58,7 +58,7 @@ def main() -> None:
     args = parser.parse_args()
     args.out.mkdir(exist_ok=True)
     made = dict(m.split("=", 1) for m in args.made)
-    faultgen = [sys.executable, "-m", "faultgen.cli"]
+    faultgen = children.command("-m", "faultgen.cli")
     names = args.track or [n for n in tracks.names() if tracks.load(n).versions]
     rows, total, failed = [], 0.0, []
     for name in names:

@@ -32,7 +32,6 @@ import argparse
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 import warnings
@@ -41,6 +40,8 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from faultgen import children
+
 
 def timed(command: list[str]) -> tuple[float, float]:
     """Wall time and CPU time (user + system, the command and the workers it waited for), s."""
@@ -48,14 +49,15 @@ def timed(command: list[str]) -> tuple[float, float]:
 
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
-    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(command, env=children.environment(), check=True, stdout=subprocess.DEVNULL)
     wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def faultgen() -> str:
-    return str(Path(sys.executable).with_name("faultgen"))
+def faultgen() -> list[str]:
+    """The faultgen command line, started without the current folder on its path (faultgen.children)."""
+    return children.command("-m", "faultgen.cli")
 
 
 def ratio_line(what: str, t: tuple[float, float], reference: tuple[float, float], name: str) -> str:
@@ -102,15 +104,15 @@ def main() -> None:
         sweep = None
         if path is None and steps & {1, 2}:
             path = folder / "quick.h5"
-            command = [faultgen(), "sweep", "--preset", "quick", "-o", str(path), "--no-progress"]
+            command = [*faultgen(), "sweep", "--preset", "quick", "-o", str(path), "--no-progress"]
             if 1 in steps:
                 sweep = timed(command)
                 print(f"faultgen sweep --preset quick:   {sweep[0]:7.1f} s wall, {sweep[1]:7.1f} s CPU   ({load()})")
             else:
-                subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+                subprocess.run(command, env=children.environment(), check=True, stdout=subprocess.DEVNULL)
         if 1 in steps:
             for flag in ([], ["--full"]):
-                t = timed([faultgen(), "classify", str(path), *flag, "-o", str(folder / "cls"), "--no-progress",
+                t = timed([*faultgen(), "classify", str(path), *flag, "-o", str(folder / "cls"), "--no-progress",
                            "--overwrite"])
                 what = f"faultgen classify {' '.join(flag) or '(defaults)'}"
                 print(f"{what:33s} {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")
@@ -152,12 +154,12 @@ def main() -> None:
         if args.fleet is not None:
             made = None
             if args.make_fleet:
-                made = timed([faultgen(), "fleet", "-o", str(args.fleet), "--no-progress", "--overwrite"])
+                made = timed([*faultgen(), "fleet", "-o", str(args.fleet), "--no-progress", "--overwrite"])
                 print(f"faultgen fleet (default, 26 robots): {made[0]:7.1f} s wall, {made[1]:7.1f} s CPU   ({load()})")
             if 3 in steps:
                 stacking_check(args.fleet)
             for flag in ([], ["--full"]) if 4 in steps else ():
-                t = timed([faultgen(), "classify", str(args.fleet), "--horizon", "3", "--pairs", "0", *flag,
+                t = timed([*faultgen(), "classify", str(args.fleet), "--horizon", "3", "--pairs", "0", *flag,
                            "-o", str(folder / "fleet-cls"), "--no-progress", "--overwrite"])
                 what = f"classify {args.fleet.name} --horizon 3 --pairs 0 {' '.join(flag)}"
                 print(f"{what}: {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")

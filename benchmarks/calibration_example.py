@@ -14,9 +14,9 @@ from __future__ import annotations
 import argparse
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
+from faultgen import children
 from faultgen.calibrate import synth
 from faultgen.model import robots
 
@@ -37,8 +37,8 @@ def main() -> None:
     with_both = robots.load(synth.write_model(robot, payload, args.out / "hidden_model"))
     log = synth.record(with_both, coulomb, args.out / "measured.csv", seed=3, cycles=args.cycles)
     print(f"hidden: {payload}, {coulomb}\nmeasured log: {log}", flush=True)
-    subprocess.run([sys.executable, "-m", "faultgen.cli", "calibrate", "--robot", "puma560", "--measured", str(log),
-                    "--out", str(args.out / "calibration")], check=True)
+    subprocess.run([*children.command("-m", "faultgen.cli"), "calibrate", "--robot", "puma560", "--measured", str(log),
+                    "--out", str(args.out / "calibration")], env=children.environment(), check=True)
     figure = args.out / "calibration" / "calibration.png"
     if args.figure is not None:
         args.figure.parent.mkdir(parents=True, exist_ok=True)

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
 from faultgen.calibrate import MAX_ROWS, predict, synth
 from faultgen.data import measured
 from faultgen.model import robots
@@ -50,8 +51,9 @@ def make_log(path: Path, rows: int) -> None:
 
 
 def calibrate(log: Path, out: Path) -> dict:
-    run = subprocess.run(["/usr/bin/time", "-v", sys.executable, "-m", "faultgen.cli", "calibrate", "--robot",
-                          "puma560", "--measured", str(log), "--out", str(out)], capture_output=True, text=True)
+    run = subprocess.run(["/usr/bin/time", "-v", *children.command("-m", "faultgen.cli"), "calibrate", "--robot",
+                          "puma560", "--measured", str(log), "--out", str(out)], env=children.environment(),
+                         capture_output=True, text=True)
     if run.returncode != 0:
         raise SystemExit(run.stdout + run.stderr)
     peak = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", run.stderr)[1]) * 1e3

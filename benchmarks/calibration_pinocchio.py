@@ -35,16 +35,18 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import pinocchio_log  # noqa: E402
 
-FAULTGEN = [sys.executable, "-m", "faultgen.cli"]
+FAULTGEN = children.command("-m", "faultgen.cli")
 
 
 def faultgen(*args: str) -> str:
     """Run a faultgen command; its output, or the command and its output on failure."""
-    done = subprocess.run([*FAULTGEN, *args], capture_output=True, text=True)
+    done = subprocess.run([*FAULTGEN, *args], env=children.environment(), capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"faultgen {' '.join(args)} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
     return done.stdout

@@ -18,13 +18,14 @@ Exit status 0 when every dataset is identical, 1 otherwise (the differing arrays
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
+
+from faultgen import children
 
 #: The runs: output name and ``faultgen`` arguments.
 RUNS = {
@@ -50,13 +51,13 @@ RUNS = {
 def generate(checkout: Path, out: Path) -> None:
     """Write every run of :data:`RUNS` into ``out`` with the faultgen of ``checkout``."""
     out.mkdir(parents=True, exist_ok=True)
-    env = {**os.environ, "PYTHONPATH": str(checkout.resolve())}
+    env = children.environment({"PYTHONPATH": str(checkout.resolve())})
     for name, args in RUNS.items():
         target = out / name
         if target.exists():
             continue
-        command = [sys.executable, "-m", "faultgen.cli", *args, "-o", str(target)]
-        print(" ".join(command[2:]), flush=True)
+        command = [*children.command("-m", "faultgen.cli"), *args, "-o", str(target)]
+        print(" ".join(command[3:]), flush=True)
         subprocess.run(command, env=env, check=True, stdout=subprocess.DEVNULL)
 
 

@@ -16,11 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import subprocess
-import sys
 import tarfile
 import tempfile
 from io import BytesIO
 from pathlib import Path
+
+from faultgen import children
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("faultgen", "analysis")
@@ -61,8 +62,8 @@ print(json.dumps({"modules": modules, "edges": edges, "circles": circles, "lines
 
 def measure(root: Path) -> dict:
     """The graph of the tree at ``root`` (a child process whose import path starts there)."""
-    done = subprocess.run([sys.executable, "-c", _MEASURE, str(root), ",".join(PACKAGES)], cwd=root,
-                          env={"PYTHONPATH": str(root), "PATH": "/usr/bin:/bin"}, capture_output=True, text=True,
+    done = subprocess.run(children.command("-c", _MEASURE, str(root), ",".join(PACKAGES)), cwd=root,
+                          env={**children.SAFE_PATH, "PYTHONPATH": str(root), "PATH": "/usr/bin:/bin"}, capture_output=True, text=True,
                           check=False)
     if done.returncode:
         raise SystemExit(f"measuring {root} failed:\n{done.stderr}")

@@ -52,12 +52,13 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+from faultgen import children
 
 PERIOD = 0.001
 BASE_ROWS = 100_000  # one period of the excitation at 1 kHz
@@ -321,7 +322,8 @@ def run_case(kind: str, log: Path, out: Path, cap_mb: int | None = None, timeout
     killed = None
     with tempfile.TemporaryFile("w+") as stdout, tempfile.TemporaryFile("w+") as stderr:
         start = time.monotonic()
-        proc = subprocess.Popen([sys.executable, "-c", code], stdout=stdout, stderr=stderr, text=True)
+        proc = subprocess.Popen(children.command("-c", code), env=children.environment(), stdout=stdout,
+                                stderr=stderr, text=True)
         limit = timeout if timeout else CAP[1]
         while True:  # the cap: resident memory and time polled, the process killed above either
             pid, status, usage = os.wait4(proc.pid, os.WNOHANG)

@@ -24,6 +24,7 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
 
 import fleetlog_folder  # noqa: E402
 
+from faultgen import children
 from faultgen.model import robots  # noqa: E402
 
 #: Logs per fleet: units x days.
@@ -44,7 +45,7 @@ def write(folder: Path, units: int, days: int) -> Path:
 
 def measured_command(command: list[str]) -> tuple[float, float]:
     """(wall s, peak resident GB) of a command under /usr/bin/time -v."""
-    run = subprocess.run(["/usr/bin/time", "-v", *command], capture_output=True, text=True)
+    run = subprocess.run(["/usr/bin/time", "-v", *command], env=children.environment(), capture_output=True, text=True)
     if run.returncode != 0:
         raise SystemExit(run.stdout + run.stderr)
     peak = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", run.stderr)[1]) * 1e3
@@ -92,7 +93,7 @@ def main() -> None:
         out = folder / f"import-{n}.h5"
         read_s, import_s, rows = timings(logs, out)
         out.unlink()
-        _, peak = measured_command([sys.executable, "-c", IMPORT, str(logs), str(out)])
+        _, peak = measured_command(children.command("-c", IMPORT, str(logs), str(out)))
         ratio = import_s / read_s
         print(f"| {n} | {rows} | {read_s:.2f} | {import_s:.2f} | {ratio:.2f} | {peak:.3f} |")
     print(f"ratio {ratio:.3f}")

@@ -57,6 +57,8 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet  # noqa: E402
 
@@ -69,7 +71,7 @@ def run(command: list[str]) -> tuple[float, int, str, int]:
     """Wall time (s), peak RSS of the process tree (bytes), stdout and exit status of ``command``."""
     with PeakRSS() as memory:
         started = time.perf_counter()
-        result = subprocess.run(command, capture_output=True, text=True)
+        result = subprocess.run(command, env=children.environment(), capture_output=True, text=True)
         wall = time.perf_counter() - started
     if result.returncode not in (0, 3):  # 3: some unit degraded or not monitored, every output written
         raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
@@ -197,7 +199,7 @@ def main() -> None:
     robot, logs, truth = independent_fleet.write_fleet(work / "fleet", spec, robot=folder)
     print(f"fleet of {args.units} units x {args.days} days ({args.worn} worn) of {robot.name} written by Pinocchio in "
           f"{time.perf_counter() - started:.0f} s: {logs}")
-    faultgen = [sys.executable, "-m", "faultgen.cli"]
+    faultgen = children.command("-m", "faultgen.cli")
     times = {}
     for name in args.protocols.split(","):
         out = work / f"monitor-{name}"

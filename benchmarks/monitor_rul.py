@@ -63,6 +63,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet
 
+from faultgen import children
 from faultgen.monitor import prognosis
 
 ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
@@ -171,10 +172,10 @@ def run_fleet(args) -> tuple[Path, Path]:
     print(f"fleet of {args.units} units x {args.days} days ({args.worn} worn to {args.final_wear:g} %) written by "
           f"Pinocchio in {time.perf_counter() - started:.0f} s: {logs}")
     out = work / "monitor"
-    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+    command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-calibrate", "--failure-wear", f"{args.failure_wear:g}"]
     started = time.perf_counter()
-    result = subprocess.run(command, check=False, capture_output=True, text=True)
+    result = subprocess.run(command, env=children.environment(), check=False, capture_output=True, text=True)
     if result.returncode:
         raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
     print(f"faultgen monitor --no-calibrate --failure-wear {args.failure_wear:g}: {time.perf_counter() - started:.0f} s")

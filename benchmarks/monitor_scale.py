@@ -46,6 +46,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from faultgen import children
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import independent_fleet
@@ -72,12 +74,13 @@ class Timed:
 def run(logs: Path, robot: Path, out: Path, jobs: int, scheduler: str | None = None) -> Timed:
     import psutil
 
-    command = [sys.executable, "-P", "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+    command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-calibrate", "--no-progress",
                *(["--scheduler", scheduler] if scheduler else ["--jobs", str(jobs)])]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    process = psutil.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = psutil.Popen(command, env=children.environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True)
     main_cpu = 0.0
     while process.poll() is None:  # the monitor's own CPU time, sampled until it exits
         try:

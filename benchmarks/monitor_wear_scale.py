@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import independent_fleet
@@ -96,10 +98,10 @@ def main() -> None:
     else:
         logs, truth = wear_hump_fleet.write_fleet(work, spec, robot)
     out = work / args.out
-    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+    command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-progress"] + (["--no-calibrate"] if args.no_calibrate else [])
     started = time.perf_counter()
-    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    result = subprocess.run(command, env=children.environment(), capture_output=True, text=True, check=False)
     if result.returncode not in (0, 3):
         raise SystemExit(f"{' '.join(command)} failed:\n{result.stderr[-3000:]}")
     print(f"{args.law} law, seed {args.seed}: faultgen monitor {'--no-calibrate ' if args.no_calibrate else ''}"

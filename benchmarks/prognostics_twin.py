@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
 from faultgen.bench import files, independent, make, prognosers, prognostics, tracks
 from faultgen.model import robots
 from faultgen.monitor import prognosis
@@ -60,10 +61,10 @@ def main() -> None:
     n_axes = robots.load(robot).n_axes
     print(f"fleet {spec} written in {time.perf_counter() - started:.0f} s")
     out = work / "monitor"
-    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
+    command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-calibrate", "--failure-wear", f"{failure:g}"]
     started = time.perf_counter()
-    done = subprocess.run(command, check=False, capture_output=True, text=True)
+    done = subprocess.run(command, env=children.environment(), check=False, capture_output=True, text=True)
     if done.returncode not in (0, 3):  # 3: some unit degraded or not monitored, every output written
         raise SystemExit(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr[-3000:]}")
     print(f"faultgen monitor --no-calibrate --failure-wear {failure:g}: {time.perf_counter() - started:.0f} s")

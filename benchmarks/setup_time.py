@@ -27,15 +27,14 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import os
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 from unittest import mock
 
+from faultgen import children
 from faultgen.model import robots
 from faultgen.runs import sweep
 from faultgen.simulation import stepping as sim
@@ -94,9 +93,9 @@ except FirstStep as reached:
 
 def first_step_times(checkout: Path, out: Path) -> tuple[float, float]:
     """(import s, set-up s) of one default ``faultgen simulate --cycles 2`` with ``checkout``."""
-    env = {**os.environ, "PYTHONPATH": str(checkout.resolve())}
-    done = subprocess.run([sys.executable, "-c", FIRST_STEP, "simulate", "--cycles", "2", "--no-progress",
-                           "--overwrite", "-o", str(out)], env=env, cwd=out.parent, capture_output=True,
+    env = children.environment({"PYTHONPATH": str(checkout.resolve())})
+    done = subprocess.run(children.command("-c", FIRST_STEP, "simulate", "--cycles", "2", "--no-progress",
+                                           "--overwrite", "-o", str(out)), env=env, cwd=out.parent, capture_output=True,
                           text=True, check=False)
     line = [x for x in done.stdout.splitlines() if x.startswith("TIMES ")]
     if not line:

@@ -18,10 +18,11 @@ Exit status 0 when every array is identical, 1 otherwise.
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 from pathlib import Path
+
+from faultgen import children
 
 import numpy as np
 
@@ -112,16 +113,15 @@ def main() -> int:
     if args.simulate:
         simulate(args.simulate, args.out)
         return 0
-    children = {}
-    for label, checkout in (("new", args.new), ("base", args.base)):
-        children[label] = {**os.environ, "PYTHONPATH": str(checkout.resolve())}
+    environments = {label: children.environment({"PYTHONPATH": str(checkout.resolve())})
+                    for label, checkout in (("new", args.new), ("base", args.base))}
     robot = args.out / "robot" / "puma560_stepped.xml"
     if not robot.exists():
-        subprocess.run([sys.executable, __file__, "--write-robot", "-o", str(robot.parent)],
-                       env=children["new"], check=True)
-    for label, env in children.items():
+        subprocess.run(children.command(__file__, "--write-robot", "-o", str(robot.parent)),
+                       env=environments["new"], check=True)
+    for label, env in environments.items():
         if not (args.out / label).exists():
-            subprocess.run([sys.executable, __file__, "--simulate", str(robot), "-o", str(args.out / label)],
+            subprocess.run(children.command(__file__, "--simulate", str(robot), "-o", str(args.out / label)),
                            env=env, check=True)
     bad = 0
     pairs = [(f"{name}: base vs new", args.out / "base" / f"{name}.npz", args.out / "new" / f"{name}.npz")

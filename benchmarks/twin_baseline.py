@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen import children
 from faultgen.bench import files, rawlogs, recorded, score, twin
 
 NAME = "twin (faultgen monitor)"
@@ -47,11 +48,11 @@ TRAIN = {"full": 28, "small": 10}
 
 def monitor(written: rawlogs.Written, out: Path, train: int, calibrate: bool, jobs: int) -> list[str]:
     """Run `faultgen monitor` on the written logs; returns the command (SystemExit when it fails)."""
-    command = [sys.executable, "-m", "faultgen.cli", "monitor", str(written.logs), "--robot", written.robot,
+    command = [*children.command("-m", "faultgen.cli"), "monitor", str(written.logs), "--robot", written.robot,
                "-o", str(out), "--train", str(train), "--jobs", str(jobs), "--no-progress"]
     if not calibrate:
         command.append("--no-calibrate")
-    done = subprocess.run(command, check=False, capture_output=True, text=True)
+    done = subprocess.run(command, env=children.environment(), check=False, capture_output=True, text=True)
     if done.returncode not in (0, 3):  # 3: some unit degraded or not monitored, every output written
         raise SystemExit(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr[-3000:]}")
     return command

@@ -136,4 +136,5 @@ def restart_pinned(name: str | None, argv: list[str]) -> None:
     env = children.environment({**PROFILES[name], "_FAULTGEN_PROFILE_RESTART": name})
     sys.stdout.flush()
     sys.stderr.flush()
-    os.execve(sys.executable, children.command("-m", "faultgen.cli", *argv), env)
+    command = children.command("-m", "faultgen.cli", *argv)
+    os.execve(command[0], command, env)

@@ -10,7 +10,7 @@ import typer
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
 from faultgen.cli.options import (
-    Backend, Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter,
+    Backend, Jobs, LogFormat, MonitorScheduler, Progress, TorqueConstants, log_adapter, warn_jobs,
 )
 
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
@@ -108,7 +108,8 @@ def monitor_command(
     motion left the twin's program (a program change nobody logged) rebuilds the twin on it and the
     unit learns again, said in units.csv.
 
-    Units in parallel: --jobs N local processes, or --scheduler tcp://HOST:PORT, a Dask cluster whose
+    Units in parallel: --jobs N local processes (at most one per unit; a warning above the CPU
+    cores), or --scheduler tcp://HOST:PORT, a Dask cluster whose
     workers share no folder with this machine (the units' logs and cached twins are sent, their
     results come back and are written here); either way the outputs are those of --jobs 1, bit for
     bit.
@@ -142,13 +143,15 @@ def monitor_command(
     # the monitor resolves its robot itself (faultgen.monitor.loop); here only to check --torque-constants
     adapter = log_adapter(log_format, torque_constants, robots.load(robot) if torque_constants is not None else None)
     check_monitor_out(out, logs, overwrite)
-    made = first_missing(out / ".cache")  # what the run creates first: OUT/.cache, and OUT when it is new
+    if scheduler is None:  # at most one worker per unit is started (faultgen.monitor.parallel.map_groups)
+        warn_jobs(jobs, "the units", "400-600 MB")
+    made = missing_folders(out / ".cache")  # what the run creates first: OUT/.cache, OUT and folders above it when new
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
                                jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend)
-    except Exception:  # a refusal or a failure: nothing this run made is left (OUT, folders above it, OUT/.cache)
-        remove_made(made)
+    except Exception:  # a refusal or a failure: nothing this run made is left (OUT, OUT/.cache, empty folders above)
+        remove_made(made, out)
         raise
     monitors = outcome.monitors
     alarmed = [m for m in monitors if m.first_alarm]
@@ -210,21 +213,32 @@ def check_monitor_out(out: Path, logs: Path, overwrite: bool) -> None:
                          "--out")
 
 
-def first_missing(path: Path) -> Path | None:
-    """The outermost folder of ``path`` (``path`` itself or a folder above it) that does not exist
-    now: the one a run that creates ``path`` (with its parents) makes; None when ``path`` exists."""
+def missing_folders(path: Path) -> list[Path]:
+    """``path`` and the folders above it that do not exist now, innermost first (absolute): those a
+    run that creates ``path`` with its parents makes; empty when ``path`` exists."""
     path = path.absolute()
-    if path.exists() or path.is_symlink():
-        return None
-    while not (path.parent.exists() or path.parent.is_symlink()) and path.parent != path:
+    missing = []
+    while not (path.exists() or path.is_symlink()) and path.parent != path:
+        missing.append(path)
         path = path.parent
-    return path
+    return missing
 
 
-def remove_made(made: Path | None) -> None:
-    """Remove ``made`` (:func:`first_missing` before the run): a folder this run created, with all
-    it holds. Nothing that existed before the run is touched."""
+def remove_made(made: list[Path], out: Path) -> None:
+    """Remove what a failed run made (:func:`missing_folders` before the run): OUT with all it holds
+    when the run made it, else the OUT/.cache it made; then each new folder above OUT, innermost
+    first, only while it is empty. A folder above OUT may hold another run's output by now (two
+    runs into new folders under one new parent): it is kept, and so is everything in it. Nothing
+    that existed before the run is touched."""
     import shutil
 
-    if made is not None and made.is_dir() and not made.is_symlink():
-        shutil.rmtree(made, ignore_errors=True)
+    out = out.absolute()
+    for folder in made:
+        if folder == out or out in folder.parents:  # the run's own: OUT/.cache, OUT
+            if folder.is_dir() and not folder.is_symlink():
+                shutil.rmtree(folder, ignore_errors=True)
+            continue
+        try:
+            folder.rmdir()  # fails on a folder that holds anything
+        except OSError:
+            return

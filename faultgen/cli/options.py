@@ -31,7 +31,20 @@ LogFormat = Annotated[str, typer.Option(
 TorqueConstants = Annotated[str | None, typer.Option(
     metavar="K1,...,KN", help="With --format ur-rtde: N m/A at each joint, to read the torque as the measured "
     "actual_current_0.. times them (without it: the commanded target_moment_0..).")]
-Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run is started; more than the CPU cores only slows each down).", min=1, max=1024)]
+Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run, or per unit of a monitor, is started; more than the CPU cores only slows each down).", min=1, max=1024)]
+
+
+def warn_jobs(jobs: int, what: str, memory: str) -> None:
+    """Warn (stderr) when ``jobs`` local workers are more than this machine's CPU cores: ``what``
+    (the runs, the units) share the cores and each takes longer, and each worker takes ``memory``
+    (its figure in words, "about 150 MB"). The commands start at most one worker per run or unit;
+    the warning is the same for each."""
+    import os
+
+    cores = os.cpu_count() or 1
+    if jobs > cores:
+        typer.echo(f"warning: --jobs {jobs} is more than the {cores} CPU cores: {what} share them and each takes "
+                   f"longer (and memory: {memory} per worker); --jobs {cores} is as fast", err=True)
 
 
 def _scheduler_address(value: str | None) -> str | None:

@@ -17,7 +17,7 @@ from faultgen.cli.main import app
 from faultgen.cli.options import (
     MAX_CYCLES, Backend, CyclesPerDay, DryShare, Friction, GearLoss, Jobs, LogFormat, Overwrite, PayloadParts,
     PayloadPattern, Progress, Scheduler, SharedFolder, StartDay, TaskMixPattern, TaskMixTasks, Temperature,
-    TorqueConstants, UnitSpreadFlag, conditions_from_options, log_adapter,
+    TorqueConstants, UnitSpreadFlag, conditions_from_options, log_adapter, warn_jobs,
 )
 
 
@@ -332,16 +332,12 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
     before anything ran, 130 interrupted with the finished runs kept, 1 a run failed. On a
     cluster, each run's worker is printed as the run is kept."""
-    import os
-
     from tqdm.auto import tqdm
 
     from faultgen.runs import sweep
 
-    cores = os.cpu_count() or 1
-    if scheduler is None and jobs > cores:
-        typer.echo(f"warning: --jobs {jobs} is more than the {cores} CPU cores: the runs share them and each takes "
-                   f"longer (and memory: about 150 MB per worker); --jobs {cores} is as fast", err=True)
+    if scheduler is None:
+        warn_jobs(jobs, "the runs", "about 150 MB")
     if shared and not scheduler:
         raise ValueError("--shared-folder is for the workers of a Dask cluster: add --scheduler ADDRESS, or drop it")
     if scheduler:  # a Dask scheduler must answer there, before any work

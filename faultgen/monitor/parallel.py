@@ -14,6 +14,7 @@ is used, its tasks a group's index into what the workers inherit.
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -23,6 +24,7 @@ from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.monitor.unit import Unit, log_of, model_of
+from faultgen.runs import worker
 
 
 def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Unit, list]]]:
@@ -108,7 +110,8 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
     in ``jobs`` local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared
     twins are simulated: :func:`prepare_twins`, and the scoring's imports made: :func:`preload`;
     elsewhere joblib's loky, started without the user's folders on their path:
-    :func:`faultgen.children.safe_path`); or on the Dask cluster of ``scheduler``
+    :func:`faultgen.children.safe_path`; either way each worker ends within a second of this process,
+    as a sweep's do: :func:`faultgen.runs.worker.watch_parent`); or on the Dask cluster of ``scheduler``
     (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every group's
     arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit.
     ``source``: the run's logs as read so far (:class:`faultgen.monitor.logs.Source`), which this
@@ -138,7 +141,10 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
         preload()
         _SHARED.update(context=context, groups=groups, idle=idle, source=source)
         try:
-            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+            # each worker ends within a second of this process, whatever ended it (SIGKILL, SIGTERM),
+            # as the sweep's do: forked workers waiting on the task queue would otherwise run on for good
+            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork"),
+                                     initializer=worker.watch_parent, initargs=(os.getpid(),)) as pool:
                 if groups:
                     prepare_twins(context, groups, pool, source)
                 yield from pool.map(_score_shared, range(len(groups) + len(idle)))
@@ -148,10 +154,12 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
     if groups:
         prepare_twins(context, groups, source=source)
     from joblib import Parallel, delayed
+    from joblib._parallel_backends import LokyBackend
 
     from faultgen import children
 
     tasks = [delayed(score_group)(context, group) for group in groups]
     tasks += [delayed(idle_outputs)(m, context.failure_wear) for m in idle]
     with children.safe_path():  # elsewhere (no fork): loky's fresh workers, without the user's folders on their path
-        yield from Parallel(n_jobs=n_jobs, return_as="generator")(tasks)
+        backend = LokyBackend(initializer=worker.watch_parent, initargs=(os.getpid(),))
+        yield from Parallel(n_jobs=n_jobs, return_as="generator", backend=backend)(tasks)
