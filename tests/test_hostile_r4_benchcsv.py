@@ -25,6 +25,7 @@ from typer.testing import CliRunner
 
 from faultgen.bench import files, make, prognosers, prognostics
 from faultgen.cli import app
+from faultgen.data import cells
 from faultgen.inputs import InputError
 
 runner = CliRunner()
@@ -190,3 +191,120 @@ def test_a_prognoser_answering_minus_infinity_is_refused_not_read_as_no_end_of_l
         with pytest.raises(ValueError, match="NaN, -inf or outside"):
             prognosers.samples(np.array(bad), "m", 3.0)
     assert prognosers.samples(np.array([4.0, np.inf]), "m", 3.0).tolist() == [4.0, np.inf]
+
+
+# -- every CSV faultgen writes: one cell function (faultgen.data.cells) -------------------------------
+
+EVIL = ("=1+1\r\nevil", "x\r=1+1")
+
+
+def _checked_csv(path) -> list[list[str]]:
+    """The rows of a CSV file faultgen wrote, after checking that no row spans lines (for a reader that
+    splits at any line break, str.splitlines) and that no text cell starts with a formula character."""
+    import io
+
+    content = path.read_text()
+    rows = list(csv.reader(io.StringIO(content, newline="")))
+    assert len(content.splitlines()) == len(rows), f"{path.name}: a row split across lines"
+    for row in rows:
+        for value in row:
+            assert not value.lstrip(" ").startswith(cells.FORMULA) or cells._NUMBER.fullmatch(value.strip()), \
+                (path.name, value)
+    return rows
+
+
+@pytest.fixture(scope="module")
+def evil_fleet(tmp_path_factory):
+    """Two units of 11 daily logs named with a line break and a formula, beside a plain one."""
+    import fleetlog_folder
+
+    from faultgen.model import robots
+
+    logs = fleetlog_folder.write_fleet(tmp_path_factory.mktemp("evil") / "LOGS", robots.load("puma560"), units=3,
+                                       days=11)
+    for k, name in enumerate(EVIL, start=1):
+        (logs / f"u{k}").rename(logs / name)
+    return logs
+
+
+def test_a_unit_named_with_a_line_break_and_a_formula_keeps_each_export_row_whole(evil_fleet, tmp_path):
+    data, out = tmp_path / "d.h5", tmp_path / "e.csv"
+    result = runner.invoke(app, ["logs", "import", str(evil_fleet), "--robot", "puma560", "-o", str(data),
+                                 "--no-progress"])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(app, ["export", str(data), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    rows = _checked_csv(out)
+    per_run = {}
+    for row in rows[1:]:
+        per_run[row[0]] = per_run.get(row[0], 0) + 1
+    assert sorted(per_run) == ["'=1+1  evil", "u3", "x =1+1"]
+    assert len(set(per_run.values())) == 1  # as many rows for each unit: none split
+
+
+def test_the_monitors_csv_files_keep_a_unit_named_with_a_line_break_on_one_row(evil_fleet, tmp_path):
+    result = runner.invoke(app, ["monitor", str(evil_fleet), "--robot", "puma560", "-o", str(tmp_path / "OUT"),
+                                 "--protocol", "own", "--train", "10", "--no-progress"])
+    assert result.exit_code == 0, result.output
+    written = {name: _checked_csv(tmp_path / "OUT" / name)
+               for name in ("units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv")}
+    assert sorted(row[0] for row in written["units.csv"][1:]) == ["'=1+1  evil", "u3", "x =1+1"]
+    per_unit = {}
+    for row in written["scores.csv"][1:]:
+        per_unit[row[0]] = per_unit.get(row[0], 0) + 1
+    assert sorted(per_unit) == ["'=1+1  evil", "u3", "x =1+1"] and len(set(per_unit.values())) == 1  # 11 logs each
+
+
+def test_a_cell_is_neutralised_only_where_it_is_text():
+    assert cells.text("=1+1\r\nevil") == "'=1+1  evil" and cells.text("x\r=1+1") == "x =1+1"
+    assert cells.text("\u2028@SUM(A1)") == "' @SUM(A1)" and cells.text("\t-x") == "'\t-x"
+    for number in ("-1.5", "+3e-2", "-inf", "12"):
+        assert cells.text(number) == number
+    assert cells.line(["a,b", "=1", -2.5, "x\ny"]) == "\"a,b\",'=1,-2.5,x y"
+
+
+#: CSV writes that do not go through faultgen.data.cells: none. Each entry: (file, line's text) of a
+#: call the walk below finds that writes no CSV.
+NOT_CSV = {
+    ("faultgen/operation/faults.py", 'return ":".join([*fields, ",".join(options)] if options else fields)'),
+    ("faultgen/calibrate/excitation.py", "atomic.write_text(path, self.to_csv(dt, periods))"),
+}
+
+
+def test_every_csv_faultgen_writes_goes_through_the_one_cell_function():
+    """A walk of faultgen's and the analysis package's source: csv.writer and csv.DictWriter only in
+    faultgen/data/cells.py; every DataFrame.to_csv on ``cells.escaped(...)``; every numpy.savetxt with
+    ``header=cells.line(...)``; no comma-joined line (``",".join``, but in an f-string's message) but the
+    ones of :data:`NOT_CSV`."""
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    found = []
+    for path in sorted([*root.glob("faultgen/**/*.py"), *root.glob("analysis/**/*.py")]):
+        name = str(path.relative_to(root))
+        source = path.read_text()
+        lines = source.splitlines()
+        tree = ast.parse(source)
+        in_text = {id(n) for f in ast.walk(tree) if isinstance(f, ast.JoinedStr) for n in ast.walk(f)}  # messages
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Call) or not isinstance(node.func, ast.Attribute) or id(node) in in_text:
+                continue
+            func, where = node.func, (name, lines[node.lineno - 1].strip())
+            if where in NOT_CSV:
+                continue
+            if func.attr in ("writer", "DictWriter") and isinstance(func.value, ast.Name) and func.value.id == "csv":
+                ok = name == "faultgen/data/cells.py"
+            elif func.attr == "to_csv":
+                receiver = func.value
+                ok = isinstance(receiver, ast.Call) and getattr(receiver.func, "attr", None) == "escaped"
+            elif func.attr == "savetxt":
+                header = next((k.value for k in node.keywords if k.arg == "header"), None)
+                ok = isinstance(header, ast.Call) and getattr(header.func, "attr", None) == "line"
+            elif func.attr == "join" and isinstance(func.value, ast.Constant) and func.value.value == ",":
+                ok = False
+            else:
+                continue
+            if not ok:
+                found.append(f"{name}:{node.lineno}: {where[1]}")
+    assert not found, "CSV writes not through faultgen.data.cells:\n" + "\n".join(found)

@@ -22,7 +22,7 @@ import numpy as np
 
 from faultgen import axes as axis_numbers
 from faultgen import inputs
-from faultgen.data import atomic
+from faultgen.data import atomic, cells
 from faultgen.operation.logformat import MAX_CYCLE, PAYLOAD_COLUMN, TEMPERATURE_PREFIX, VALUE_BOUNDS
 
 #: name -> unit of every per-record array a method may read (faultgen's dataset schema): the
@@ -306,10 +306,10 @@ def read(path: str | Path) -> list[Unit]:
 
 def write_labels(path: Path, units: list[Unit]) -> None:
     """``test_labels.csv``: one row per unit and record (:data:`LABEL_COLUMNS`), atomically."""
-    rows = [",".join(LABEL_COLUMNS)]
+    rows = [cells.line(LABEL_COLUMNS)]
     for unit in units:
         for cycle, level in zip(unit.arrays["cycles"], unit.fault_level):
-            rows.append(f"{unit.id},{int(cycle)},{float(level)!r},{unit.worn_axis},{unit.fault}")
+            rows.append(cells.line([unit.id, int(cycle), float(level), int(unit.worn_axis), str(unit.fault)]))
     atomic.write_text(path, "\n".join(rows) + "\n")
 
 
