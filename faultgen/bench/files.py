@@ -225,9 +225,9 @@ def _check_range(values: np.ndarray, name: str, where: str) -> None:
     if bad.any():
         index = np.unravel_index(int(np.argmax(bad)), values.shape)
         unit = OBSERVABLES.get(name, "%")
-        raise inputs.InputError(f"{where}: {name} holds {values[index].item()!r} at record {index[0] + 1}; finite values "
-                                f"within {low:g}..{high:g}{'' if unit == '1' else ' ' + unit} are expected (what a run "
-                                "writes)")
+        raise inputs.InputError(f"{where}: {name} holds {values[index].item()!r} at record {index[0] + 1}; finite "
+                                f"values within {low:g}..{high:g}{'' if unit == '1' else ' ' + unit} are expected "
+                                "(what a run writes)")
 
 
 def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list[Unit], dict]:

@@ -118,9 +118,7 @@ def compare(folder: str | Path, made: dict, allow_modified: bool = False) -> dic
     else:
         frozen = json.loads(frozen_path.read_text())["arrays"]
         new = hashes(folder)
-        keys = list(frozen) + [k for k in new if k not in frozen]
-        lines = [f"{_described(k, folder, new, frozen)} the frozen manifest of {what}"
-                 for k in keys if new.get(k) != frozen.get(k)]
+        lines = [f"{_described(k, folder, new, frozen)} the frozen manifest of {what}" for k in _differing(new, frozen)]
         if len(lines) > 1:
             lines[0] += f" ({len(lines)} of {len(frozen)} arrays differ)"
     if not lines:
@@ -131,11 +129,17 @@ def compare(folder: str | Path, made: dict, allow_modified: bool = False) -> dic
     return {"comparable": False, "modified": lines[:20], "modified_count": len(lines)}
 
 
+def _differing(new: dict[str, str], frozen: dict[str, str]) -> list[str]:
+    """The arrays (in the frozen manifest's order, then the new one's) whose hash differs or that are
+    missing on one side."""
+    keys = list(frozen) + [k for k in new if k not in frozen]
+    return [k for k in keys if new.get(k) != frozen.get(k)]
+
+
 def first_difference(new: dict[str, str], frozen: dict[str, str]) -> tuple[str, int] | None:
     """The first array (in the frozen manifest's order, then the new one's) whose hash differs or that
     is missing on one side, and how many differ; None if the two are equal."""
-    keys = list(frozen) + [k for k in new if k not in frozen]
-    differing = [k for k in keys if new.get(k) != frozen.get(k)]
+    differing = _differing(new, frozen)
     return (differing[0], len(differing)) if differing else None
 
 

@@ -224,9 +224,9 @@ def modified_lines(results: dict) -> list[str]:
     named; none for a folder equal to it."""
     if results.get("comparable", True):
         return []
-    more = results.get("modified_count", 0) - len(results.get("modified", []))
-    return ([f"WARNING: {NOT_COMPARABLE} ({results.get('modified_count')} differ)"]
-            + [f"WARNING: {line}" for line in results.get("modified", [])] + ([f"WARNING: and {more} more"] if more > 0 else []))
+    named, count = results.get("modified", []), results.get("modified_count", 0)
+    more = [f"WARNING: and {count - len(named)} more"] if count > len(named) else []
+    return [f"WARNING: {NOT_COMPARABLE} ({count} differ)", *(f"WARNING: {line}" for line in named), *more]
 
 
 def lines(results: dict) -> list[str]:
