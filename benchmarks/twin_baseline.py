@@ -68,6 +68,8 @@ def main() -> None:
                         "10 at small size).")
     parser.add_argument("--no-calibrate", action="store_true", help="The twin on the nominal model.")
     parser.add_argument("--jobs", type=int, default=1)
+    parser.add_argument("--allow-modified", action="store_true", help="Score a folder that differs from the track's "
+                        "frozen manifest anyway, marked not comparable (`faultgen bench score --allow-modified`).")
     parser.add_argument("-o", "--out", type=Path, default=None)
     args = parser.parse_args()
     command_line = "python benchmarks/twin_baseline.py " + " ".join(sys.argv[1:])
@@ -111,7 +113,7 @@ def main() -> None:
     rows = []
     for role, method in (("detector", recorded.RecordedDetector(recorded.detector_answers(test, scores, alarms))),
                          ("isolator", recorded.RecordedIsolator(recorded.isolator_answers(test, named)))):
-        results = score.score(args.data, method, name, role, track=args.track)
+        results = score.score(args.data, method, name, role, track=args.track, allow_modified=args.allow_modified)
         json_path, _ = score.write(results, stem.with_name(f"{stem.name}-{role}"), command_line)
         rows.append(score.markdown_row(results, command_line))
         print(f"wrote {json_path}")

@@ -73,7 +73,7 @@ def _outside(root):
 
 def _cli_score(folder, out):
     return runner.invoke(app, ["bench", "score", "thesis", "--data", str(folder), "--isolator",
-                               "bench_plugins:AlwaysBacklash", "-o", str(out)])
+                               "bench_plugins:AlwaysBacklash", "--allow-modified", "-o", str(out)])
 
 
 def _refused(result, out, *absent):
@@ -222,6 +222,6 @@ def test_a_detector_plug_in_breaking_the_detect_contract_is_refused_on_one_line(
     too few alarms, a 1-D predict_proba (before: a KeyError or IndexError traceback, exit 1)."""
     folder = _folder(tmp_path)
     result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(folder), "--detector",
-                                 f"bench_plugins:{plugin}", "-o", str(tmp_path / "s")])
+                                 f"bench_plugins:{plugin}", "--allow-modified", "-o", str(tmp_path / "s")])
     line = _refused(result, tmp_path / "s")
     assert re.search(message, line), line

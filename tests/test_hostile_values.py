@@ -232,7 +232,7 @@ def test_a_unit_named_as_a_formula_is_escaped_in_the_exported_csv(imported, tmp_
     assert result.exit_code == 0, result.output
     lines = (tmp_path / "x.csv").read_text().splitlines()
     assert all(line.startswith("'=HYPERLINK(1),") for line in lines[1:]), lines[:2]
-    assert cells.text("-2") == "'-2" and cells.text("ok") == "ok"
+    assert cells.text("-2") == "-2" and cells.text("-x") == "'-x" and cells.text("ok") == "ok"  # numbers stay numbers
     assert pd.read_csv(tmp_path / "x.csv")["run"].iloc[0] == "'=HYPERLINK(1)"
 
 

@@ -22,7 +22,8 @@ import numpy as np
 
 from faultgen import axes as axis_numbers
 from faultgen import inputs
-from faultgen.data import atomic
+from faultgen.data import atomic, cells
+from faultgen.operation.logformat import MAX_CYCLE, PAYLOAD_COLUMN, TEMPERATURE_PREFIX, VALUE_BOUNDS
 
 #: name -> unit of every per-record array a method may read (faultgen's dataset schema): the
 #: per-axis features ("record, axis"), the histograms ("record, axis, bin") and, for a run with
@@ -49,6 +50,19 @@ MAX_UNITS = 100_000
 MAX_TEXT_BYTES = 4096
 #: Size bound of ``test_labels.csv``, bytes (a row is under 80 bytes; a full track's file a few MB).
 LABELS_MAX_BYTES = 256 * 2**20
+#: The largest fault level a run writes, % (``faultgen run --wear-pct`` takes 0..500).
+MAX_FAULT_LEVEL = 500.0
+_TAU, _QD = VALUE_BOUNDS["tau"][:2], VALUE_BOUNDS["qd"][:2]
+#: array -> (low, high) of the values a run or an import writes (the joint logs' bounds,
+#: :data:`faultgen.operation.logformat.VALUE_BOUNDS`; the histograms are shares of a record's
+#: samples): every value read is finite and within them, so that no metric overflows or turns NaN.
+VALUE_RANGES = {
+    "cycles": (0, MAX_CYCLE), "mean_abs_torque": _TAU, "rms_torque": _TAU, "average_load_torque": _TAU,
+    "average_speed": _QD, "angle_hist": (0.0, 1.0), "speed_hist": (0.0, 1.0), "torque_hist": (0.0, 1.0),
+    "day": (0.0, MAX_CYCLE), "hour": (0.0, 24.0), "ambient_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2],
+    "joint_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2], "payload_mass": VALUE_BOUNDS[PAYLOAD_COLUMN][:2],
+    "task_index": (0, MAX_CYCLE), "fault_level": (0.0, MAX_FAULT_LEVEL),
+}
 
 
 @dataclass
@@ -197,6 +211,25 @@ def _unit_arrays(path: Path, uid: str, g, labelled: bool) -> tuple[dict, int]:
     return arrays, n_axes
 
 
+def _check_range(values: np.ndarray, name: str, where: str) -> None:
+    """Refuse the first value of the array ``name`` that is not finite or lies outside its
+    :data:`VALUE_RANGES`, naming ``where`` (the file and unit), the array, the record and the range.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+    """
+    low, high = VALUE_RANGES[name]
+    bad = ~np.isfinite(values) | (values < low) | (values > high) if values.dtype.kind == "f" else (
+        (values < low) | (values > high))
+    if bad.any():
+        index = np.unravel_index(int(np.argmax(bad)), values.shape)
+        unit = OBSERVABLES.get(name, "%")
+        raise inputs.InputError(f"{where}: {name} holds {values[index].item()!r} at record {index[0] + 1}; finite "
+                                f"values within {low:g}..{high:g}{'' if unit == '1' else ' ' + unit} are expected "
+                                "(what a run writes)")
+
+
 def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list[Unit], dict]:
     """The units of a benchmark file (as :func:`read`) and its file attributes ``attrs`` (each
     required: text, or a whole number for ``version``).
@@ -251,6 +284,8 @@ def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list
         units = []
         for uid, arrays, info in checked:
             values = {name: ds[()] for name, ds in arrays.items()}
+            for name, array in values.items():
+                _check_range(array, name, f"{path}: unit {_short(uid)}")
             fault_level = values.pop("fault_level", None)
             units.append(Unit(id=uid, arrays=values, fault_level=fault_level, **info))
     return units, made
@@ -271,10 +306,10 @@ def read(path: str | Path) -> list[Unit]:
 
 def write_labels(path: Path, units: list[Unit]) -> None:
     """``test_labels.csv``: one row per unit and record (:data:`LABEL_COLUMNS`), atomically."""
-    rows = [",".join(LABEL_COLUMNS)]
+    rows = [cells.line(LABEL_COLUMNS)]
     for unit in units:
         for cycle, level in zip(unit.arrays["cycles"], unit.fault_level):
-            rows.append(f"{unit.id},{int(cycle)},{float(level)!r},{unit.worn_axis},{unit.fault}")
+            rows.append(cells.line([unit.id, int(cycle), float(level), int(unit.worn_axis), str(unit.fault)]))
     atomic.write_text(path, "\n".join(rows) + "\n")
 
 
@@ -318,11 +353,12 @@ def attach_labels(units: list[Unit], path: str | Path) -> list[Unit]:
                         value = kind(text)
                     except ValueError:
                         value = None
-                    if value is None or (kind is float and not np.isfinite(value)) or (
-                            kind is int and not 0 <= value <= 10**12):
+                    if value is None or (kind is float and not (np.isfinite(value) and 0 <= value <= MAX_FAULT_LEVEL)) \
+                            or (kind is int and not 0 <= value <= MAX_CYCLE):
                         raise inputs.InputError(
                             f"{path}, row {line}: {column} {_short(text)}; expected "
-                            + ("a finite number (%)" if kind is float else "a whole number >= 0"))
+                            + (f"a finite number within 0..{MAX_FAULT_LEVEL:g} (%)" if kind is float
+                               else f"a whole number within 0..{MAX_CYCLE}"))
                     parsed.append(value)
                 rows.setdefault(unit, []).append((*parsed, fault))
     except csv.Error as err:

@@ -64,6 +64,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen.data import cells
 from faultgen.model import robots
 from faultgen.operation import jointlog, programs
 
@@ -392,7 +393,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
 def _write_table(path: Path, columns, rows) -> None:
     """``path`` as CSV, written atomically and only when its content changes (a resumed write leaves it be)."""
     text = io.StringIO(newline="")
-    writer = csv.writer(text)
+    writer = cells.writer(text)
     writer.writerow(columns)
     writer.writerows(rows)
     content = text.getvalue().encode()
@@ -420,7 +421,7 @@ def _write_csv(path: Path, header, t, q, tau, temperature, mass) -> None:
                        np.full((rows, 1), mass)])
     formats = ["%.4f"] + ["%.6f"] * q.shape[1] + ["%.4f"] * tau.shape[1] + ["%.2f"] * len(temperature) + ["%.1f"]
     part = path.with_name(path.name + ".part")  # no reader lists it (a log ends in .csv)
-    np.savetxt(part, table, fmt=formats, delimiter=",", header=",".join(header), comments="")
+    np.savetxt(part, table, fmt=formats, delimiter=",", header=cells.line(header), comments="")
     os.replace(part, path)
 
 

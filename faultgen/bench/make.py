@@ -33,6 +33,8 @@ from faultgen.bench import files, profile, tracks
 from faultgen.data import atomic
 
 OUTPUTS = ("train.h5", "test.h5", "test_labels.csv", "manifest.json")
+#: The most bytes an attribute of a unit may declare before :func:`hashes` reads it.
+ATTRS_MAX_BYTES = 64 * 2**10
 
 
 def manifest_path(track: str, version: int, size: str) -> Path:
@@ -50,6 +52,8 @@ def _array_hash(values: np.ndarray) -> str:
 def hashes(folder: Path) -> dict[str, str]:
     """SHA-256 of every array and unit attribute set of ``train.h5`` and ``test.h5`` in ``folder``, and of
     ``test_labels.csv``: ``{"train.h5:/units/train-000/cycles": hex, ...}`` in a stable order."""
+    import h5py
+
     from faultgen import inputs
 
     out = {}
@@ -58,6 +62,10 @@ def hashes(folder: Path) -> dict[str, str]:
         with inputs.open_hdf5(path, "benchmark file of `faultgen bench make`") as f:  # nothing read from another file
             for uid in f["units"]:
                 g = f["units"][uid]
+                for key in g.attrs:  # declared sizes first: a unit's attributes are a few short texts and numbers
+                    if h5py.h5a.open(g.id, key.encode()).get_storage_size() > ATTRS_MAX_BYTES:
+                        raise inputs.InputError(f"{path}: unit {uid[:60]!r} attribute {key[:60]!r} declares more than "
+                                                f"{ATTRS_MAX_BYTES} bytes; a unit's attributes are short")
                 attrs = json.dumps({k: np.asarray(v).tolist() for k, v in sorted(g.attrs.items())}, sort_keys=True)
                 out[f"{name}:/units/{uid}@attrs"] = hashlib.sha256(attrs.encode()).hexdigest()
                 for array in sorted(g):
@@ -68,11 +76,70 @@ def hashes(folder: Path) -> dict[str, str]:
     return out
 
 
+def _described(key: str, folder: Path, new: dict[str, str], frozen: dict[str, str]) -> str:
+    """A manifest key as a file of ``folder`` and an array in it, and how it differs: "FOLDER/test.h5:
+    array /units/test-003/cycles differs from", "... is missing against" or "... is not in"."""
+    name, _, array = key.partition(":")
+    where = f"{folder / name}" + (f": array {array}" if array else "")
+    how = "is missing against" if key not in new else "is not in" if key not in frozen else "differs from"
+    return f"{where} {how}"
+
+
+def compare(folder: str | Path, made: dict, allow_modified: bool = False) -> dict:
+    """Check a benchmark folder to be scored against its track version's frozen manifest (shipped in
+    the package, never the folder's own ``manifest.json``): the SHA-256 of every array and unit
+    attribute set of ``train.h5`` and ``test.h5`` and of ``test_labels.csv`` (:func:`hashes`).
+
+    ``made``: the test file's attributes track, version and size (as
+    :func:`faultgen.bench.files.read_with_attrs` read them, after the files were checked).
+
+    Returns
+    -------
+    dict
+        ``{"comparable": True}`` when every digest equals the frozen one; with ``allow_modified``,
+        ``{"comparable": False, "modified": [up to 20 "FILE: array A differs from ..." lines],
+        "modified_count": n}`` otherwise (no frozen manifest counts as one difference).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Without ``allow_modified``, when the track version and size have no frozen manifest or a
+        digest differs: one line naming the file, the first differing array and how many differ.
+    """
+    from faultgen import inputs
+
+    folder = Path(folder)
+    track, version, size = made.get("track"), made.get("version"), made.get("size")
+    known = track in tracks.names() and size in tracks.SIZES and isinstance(version, int)
+    frozen_path = manifest_path(track, version, size) if known else None
+    what = f"track {track!s:.60} version {version} ({size!s:.20})"
+    if frozen_path is None or not frozen_path.is_file():
+        lines = [f"{folder / 'test.h5'}: {what} has no frozen manifest in this faultgen"]
+    else:
+        frozen = json.loads(frozen_path.read_text())["arrays"]
+        new = hashes(folder)
+        lines = [f"{_described(k, folder, new, frozen)} the frozen manifest of {what}" for k in _differing(new, frozen)]
+        if len(lines) > 1:
+            lines[0] += f" ({len(lines)} of {len(frozen)} arrays differ)"
+    if not lines:
+        return {"comparable": True}
+    if not allow_modified:
+        raise inputs.InputError(f"{lines[0]}; its score would not be comparable with the track's (give "
+                                "--allow-modified to score it anyway, marked not comparable)")
+    return {"comparable": False, "modified": lines[:20], "modified_count": len(lines)}
+
+
+def _differing(new: dict[str, str], frozen: dict[str, str]) -> list[str]:
+    """The arrays (in the frozen manifest's order, then the new one's) whose hash differs or that are
+    missing on one side."""
+    keys = list(frozen) + [k for k in new if k not in frozen]
+    return [k for k in keys if new.get(k) != frozen.get(k)]
+
+
 def first_difference(new: dict[str, str], frozen: dict[str, str]) -> tuple[str, int] | None:
     """The first array (in the frozen manifest's order, then the new one's) whose hash differs or that
     is missing on one side, and how many differ; None if the two are equal."""
-    keys = list(frozen) + [k for k in new if k not in frozen]
-    differing = [k for k in keys if new.get(k) != frozen.get(k)]
+    differing = _differing(new, frozen)
     return (differing[0], len(differing)) if differing else None
 
 

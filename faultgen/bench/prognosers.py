@@ -31,6 +31,9 @@ from faultgen.bench import files
 
 #: Most samples a prediction may hold.
 MAX_SAMPLES = 100_000
+#: The latest time of end of life a sample may give (the largest cycle number a record may hold,
+#: :data:`faultgen.bench.files.VALUE_RANGES`); ``inf``: none within the horizon.
+MAX_TIME = float(files.VALUE_RANGES["cycles"][1])
 
 
 def end_of_life(unit: files.Unit, failure_wear: float) -> float | None:
@@ -106,7 +109,8 @@ def samples(values, name: str, now: float) -> np.ndarray:
     Raises
     ------
     ValueError
-        Naming ``name``: not a 1-D array of 1..:data:`MAX_SAMPLES` numbers, or a NaN.
+        Naming ``name``: not a 1-D array of 1..:data:`MAX_SAMPLES` numbers, or a sample that is
+        neither ``inf`` nor a time within 0..:data:`MAX_TIME` (NaN, -inf, a negative time).
     """
     if values is None:
         return np.array([np.inf])
@@ -115,7 +119,12 @@ def samples(values, name: str, now: float) -> np.ndarray:
     except (TypeError, ValueError):
         raise ValueError(f"{name}: predict() gave {type(values).__name__}; expected a 1-D array of times of end "
                          "of life") from None
-    if out.ndim != 1 or not 1 <= out.size <= MAX_SAMPLES or np.isnan(out).any():
-        raise ValueError(f"{name}: predict() at time {now:g} gave shape {out.shape} with "
-                         f"{int(np.isnan(out).sum())} NaN; expected 1..{MAX_SAMPLES} samples, numbers or inf")
+    if out.ndim != 1 or not 1 <= out.size <= MAX_SAMPLES:
+        raise ValueError(f"{name}: predict() at time {now:g} gave shape {out.shape}; expected 1..{MAX_SAMPLES} "
+                         f"samples, times within 0..{MAX_TIME:g} or inf")
+    bad = ~((out >= 0) & (out <= MAX_TIME) | (out == np.inf))  # NaN and -inf too
+    if bad.any():
+        raise ValueError(f"{name}: predict() at time {now:g} gave {int(bad.sum())} samples that are NaN, -inf or "
+                         f"outside 0..{MAX_TIME:g} (the first {float(out[bad][0])!r}); expected times within "
+                         f"0..{MAX_TIME:g} or inf (no end of life)")
     return out

@@ -173,17 +173,23 @@ def verdict(method: list[dict], naive: list[dict]) -> tuple[str, dict]:
     return words, diff
 
 
-def score(folder: str | Path, prognoser, name: str) -> dict:
+def score(folder: str | Path, prognoser, name: str, allow_modified: bool = False) -> dict:
     """Score ``prognoser`` (unfitted: :mod:`faultgen.bench.prognosers`) on the prognostics track's files
-    in ``folder``, with the naive prognoser beside it; returns the results (the JSON :func:`write` writes).
+    in ``folder``, with the naive prognoser beside it; returns the results (the JSON :func:`write` writes),
+    with ``comparable`` as :func:`faultgen.bench.score.score` (``allow_modified`` alike: the verdict
+    of a folder that differs from the frozen manifest starts with
+    :data:`faultgen.bench.verdicts.NOT_COMPARABLE`).
 
     Raises
     ------
     ValueError
         If the folder's files are missing or not benchmark files (:func:`faultgen.bench.files.read_with_attrs`),
-        hold another track or a version without a failure wear, or the prognoser's fit or predict
-        fails or answers outside the contract (naming it).
+        hold another track or a version without a failure wear, differ from the frozen manifest
+        without ``allow_modified`` (:func:`faultgen.bench.make.compare`), or the prognoser's fit or
+        predict fails or answers outside the contract (naming it).
     """
+    from faultgen.bench import make, verdicts
+
     folder = Path(folder)
     train = files.read(folder / "train.h5")
     test, made = files.read_with_attrs(folder / "test.h5", ("track", "version", "size"))
@@ -194,6 +200,7 @@ def score(folder: str | Path, prognoser, name: str) -> dict:
                          f"{', '.join(map(str, FAILURE_WEAR))}")
     failure = FAILURE_WEAR[made["version"]]
     labelled = files.attach_labels(test, folder / "test_labels.csv")
+    checked = make.compare(folder, made, allow_modified)
     per_method = {}
     for label, method in ((name, prognoser), ("mean_life", prognosers.MeanLife())):
         try:
@@ -209,7 +216,9 @@ def score(folder: str | Path, prognoser, name: str) -> dict:
         per_method[label] = rows
     method_rows, naive_rows = per_method[name], per_method["mean_life"]
     words, diff = verdict(method_rows, naive_rows)
-    return {"method": name, "role": "prognoser", **{k: str(v) for k, v in made.items()},
+    if not checked["comparable"]:
+        words = f"{verdicts.NOT_COMPARABLE}; {words}"
+    return {"method": name, "role": "prognoser", **{k: str(v) for k, v in made.items()}, **checked,
             "date": datetime.date.today().isoformat(), "failure_wear": failure, "alpha": ALPHA, "beta": BETA,
             "lambda": LAMBDA, "resamples": RESAMPLES, "unscored_units": len(labelled) - len(method_rows),
             "results": summary(method_rows), "naive": summary(naive_rows), "ra_lambda_minus_naive": diff,

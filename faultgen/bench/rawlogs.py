@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.bench import files, tracks
+from faultgen.data import cells
 from faultgen.operation import jointlog
 
 #: Largest relative difference (to the feature's scale) between a regenerated unit's features and
@@ -230,5 +231,5 @@ def _write_logs(folder: Path, part: dict) -> None:
         columns.append(np.full((len(t), 1), part["payload_mass"][i]))
         path = folder / f"{int(cycle):04d}.csv"
         partial = path.with_name(path.name + ".part")
-        np.savetxt(partial, np.hstack(columns), fmt=formats, delimiter=",", header=",".join(header), comments="")
+        np.savetxt(partial, np.hstack(columns), fmt=formats, delimiter=",", header=cells.line(header), comments="")
         os.replace(partial, path)

@@ -272,22 +272,32 @@ def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
     return {**out, "per_unit": answers}
 
 
-def score(folder: str | Path, method, name: str, role: str, track: str | None = None) -> dict:
+def score(folder: str | Path, method, name: str, role: str, track: str | None = None,
+          allow_modified: bool = False) -> dict:
     """Score ``method`` (an unfitted estimator in ``role`` "detector" or "isolator") on the benchmark
-    files in ``folder``; returns the results (the JSON :func:`write` writes).
+    files in ``folder``; returns the results (the JSON :func:`write` writes), with ``comparable``:
+    whether the folder equals its track version's frozen manifest (:func:`faultgen.bench.make.compare`).
+
+    ``allow_modified``: score a folder that differs from the frozen manifest anyway, its results
+    marked not comparable (``comparable`` False, ``modified``: the differing files and arrays, named
+    in the verdict lines).
 
     Raises
     ------
     ValueError
         If the folder's files are missing, leave the folder or are not benchmark files (links to other
         files, declared shapes, missing attributes: :func:`faultgen.bench.files.read_with_attrs`,
-        :func:`faultgen.bench.files.attach_labels`), or are of another track than ``track``.
+        :func:`faultgen.bench.files.attach_labels`), are of another track than ``track``, or, without
+        ``allow_modified``, differ from the track version's frozen manifest (naming the file and array).
     """
+    from faultgen.bench import make
+
     folder = Path(folder)
     train = files.read(folder / "train.h5")
     test, made = files.read_with_attrs(folder / "test.h5", ("track", "version", "size"))
     if track is not None and made.get("track") != track:
         raise ValueError(f"{folder} holds track {made.get('track')!r}, not {track!r}")
+    checked = make.compare(folder, made, allow_modified)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # convergence and constant-feature warnings of baselines
         if role == "detector":
@@ -295,7 +305,7 @@ def score(folder: str | Path, method, name: str, role: str, track: str | None = 
             results = detector_results(method, name, train, labelled)
         else:
             results = isolator_results(method, name, files.attach_labels(test, folder / "test_labels.csv"))
-    return {"method": name, "role": role, **{k: str(v) for k, v in made.items()},
+    return {"method": name, "role": role, **{k: str(v) for k, v in made.items()}, **checked,
             "date": datetime.date.today().isoformat(), "resamples": RESAMPLES, "results": results}
 
 

@@ -214,14 +214,35 @@ def isolator_lines(r: dict) -> list[str]:
     return out
 
 
+#: The verdict's mark on the results of a folder that differs from its track's frozen manifest.
+NOT_COMPARABLE = "NOT COMPARABLE: the data differ from the track's frozen manifest"
+
+
+def modified_lines(results: dict) -> list[str]:
+    """The warning lines of results scored with ``allow_modified`` on a folder that differs from its
+    frozen manifest (:func:`faultgen.bench.make.compare`): the mark and each differing file and array
+    named; none for a folder equal to it."""
+    if results.get("comparable", True):
+        return []
+    named, count = results.get("modified", []), results.get("modified_count", 0)
+    more = [f"WARNING: and {count - len(named)} more"] if count > len(named) else []
+    return [f"WARNING: {NOT_COMPARABLE} ({count} differ)", *(f"WARNING: {line}" for line in named), *more]
+
+
 def lines(results: dict) -> list[str]:
     """Every verdict line of ``results`` (:func:`faultgen.bench.score.score`), as printed and written."""
     r = results["results"]
-    return detector_lines(r) if results["role"] == "detector" else isolator_lines(r)
+    return modified_lines(results) + (detector_lines(r) if results["role"] == "detector" else isolator_lines(r))
 
 
 def summary(results: dict) -> str:
-    """The verdict cell of the leaderboard row: each figure's word, short."""
+    """The verdict cell of the leaderboard row: each figure's word, short (after :data:`NOT_COMPARABLE`
+    for a folder that differs from its frozen manifest)."""
+    cell = _summary(results)
+    return cell if results.get("comparable", True) else f"{NOT_COMPARABLE}; {cell}"
+
+
+def _summary(results: dict) -> str:
     r = results["results"]
     if results["role"] == "detector":
         detected = detected_word(r["detected_share"], r["detected_minus_chance"])

@@ -34,7 +34,7 @@ from scipy.optimize import minimize
 from faultgen.calibrate.effects import EFFECTS as ALL_EFFECTS
 from faultgen.calibrate.effects import REST_SPEED, get
 from faultgen.calibrate.effects import motion as motion_of
-from faultgen.data import atomic
+from faultgen.data import atomic, cells
 from faultgen.model import robots
 from faultgen.operation import programs, tasks
 
@@ -121,8 +121,8 @@ class Excitation:
         t = np.arange(steps + 1) * dt
         q = self.sample(t)[0]
         buffer = io.StringIO()
-        header = ",".join(["t", *[f"q{i + 1}" for i in range(q.shape[1])]])
-        np.savetxt(buffer, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.9g")
+        np.savetxt(buffer, np.column_stack([t, q]), delimiter=",", comments="", fmt="%.9g",
+                   header=cells.line(["t", *[f"q{i + 1}" for i in range(q.shape[1])]]))
         return buffer.getvalue()
 
     def write(self, path: str | Path, dt: float = tasks.PLAN_PERIOD, periods: int = 1) -> Path:

@@ -143,6 +143,9 @@ def score_command(
         f"faultgen.bench.prognosers), or a registered one: {baselines.describe('prognoser')}.")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem: OUT.json and OUT.md (default: "
                                                                   "DATA/score-NAME).")] = None,
+    allow_modified: Annotated[bool, typer.Option(
+        "--allow-modified", help="Score a folder that differs from the track version's frozen manifest anyway: "
+        "warned, each differing file and array named, and the verdict marked NOT COMPARABLE.")] = False,
 ) -> None:
     """Score a detector or an isolator on a track's test units: AUROC, false-alarm rate on healthy
     units, detection rate at 5 % false alarms, the share of failing units detected beside what
@@ -151,6 +154,10 @@ def score_command(
     and its verdict against chance (above, at or below), and a warning when the track's units are
     too short for the method. The method learns from train.h5 only; test_labels.csv is read after
     it answered. Writes OUT.json and OUT.md (a row of docs/leaderboard.md and the verdict lines).
+
+    The folder is first compared with the track version's frozen manifest (SHA-256 of every array
+    and of test_labels.csv): a folder that differs is refused, naming the file and array, unless
+    --allow-modified is given.
 
     Example:
 
@@ -165,7 +172,7 @@ def score_command(
     if track == "prognostics" or prognoser:  # remaining useful life: its own contract and metrics
         from faultgen.cli import bench_prognostics
 
-        return bench_prognostics.score(data, prognoser, baseline, out)
+        return bench_prognostics.score(data, prognoser, baseline, out, allow_modified)
     from analysis import plugins
     from faultgen.bench import score
 
@@ -179,7 +186,7 @@ def score_command(
     else:
         method = plugins.load(name, role)
     stem = out or data / f"score-{name.replace(':', '.')}"
-    results = score.score(data, method, name, role, track=track)
+    results = score.score(data, method, name, role, track=track, allow_modified=allow_modified)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     json_path, md_path = score.write(results, stem, command)
     typer.echo(score.markdown(results, command), nl=False)

@@ -11,10 +11,12 @@ from pathlib import Path
 import typer
 
 
-def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | None) -> None:
+def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | None,
+          allow_modified: bool = False) -> None:
     """Score ``--prognoser MODULE:CLASS``, ``--prognoser NAME`` or ``--baseline NAME`` (a prognoser
     registered in :mod:`faultgen.bench.baselines`) on the prognostics track's files in ``data``;
     writes OUT.json and OUT.md and prints the row with the naive prognoser's figures.
+    ``allow_modified``: as :func:`faultgen.bench.prognostics.score` (the differences printed first).
 
     Raises
     ------
@@ -22,7 +24,7 @@ def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | N
         Unless exactly one of the two is given, for a name not registered as a prognoser (listing
         them), or what loading or scoring raises.
     """
-    from faultgen.bench import baselines, prognosers, prognostics
+    from faultgen.bench import baselines, prognosers, prognostics, verdicts
 
     if (prognoser is None) == (baseline is None):
         raise ValueError("the prognostics track takes one of --prognoser MODULE:CLASS or --prognoser/--baseline "
@@ -30,9 +32,11 @@ def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | N
     name = prognoser or baseline
     method = prognosers.load(name) if ":" in name else prognostics.baseline(name)
     stem = out or data / f"score-{name.replace(':', '.')}"
-    results = prognostics.score(data, method, name)
+    results = prognostics.score(data, method, name, allow_modified)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     json_path, md_path = prognostics.write(results, stem, command)
+    for line in verdicts.modified_lines(results):
+        typer.echo(line)
     typer.echo(prognostics.HEADER)
     typer.echo(prognostics.markdown_row(results, command))
     diff = results["ra_lambda_minus_naive"]

@@ -69,6 +69,7 @@ import numpy as np
 import pandas as pd
 
 from faultgen import axes, inputs
+from faultgen.data import cells
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
@@ -550,7 +551,7 @@ def write_csv(
     # gzip level 6 (zlib's default) writes about as small as 9 in half the time; mtime 0 keeps
     # the file byte-identical for identical data.
     compression = {"method": "gzip", "compresslevel": 6, "mtime": 0} if _compression(path) else None
-    frame.to_csv(path, index=False, compression=compression)
+    cells.escaped(frame).to_csv(path, index=False, compression=compression)
     return path
 
 

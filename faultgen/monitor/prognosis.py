@@ -82,7 +82,6 @@ useful life").
 
 from __future__ import annotations
 
-import csv
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -364,14 +363,14 @@ def _cell(value) -> str:
         return ""
     if isinstance(value, float):
         return f"{value:.6g}"
-    return cells.text(value) if isinstance(value, str) else str(value)
+    return value if isinstance(value, str) else str(value)
 
 
 def write_rul(path: Path, rows: list[Remaining]) -> None:
     """``rul.csv``: one row per unit and axis (:data:`COLUMNS`; empty cells where there is no
     number: no fit, or beyond the horizon)."""
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(COLUMNS)
         for row in rows:
             writer.writerow([_cell(getattr(row, c)) for c in COLUMNS])

@@ -7,7 +7,6 @@ are written as numbers."""
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +24,7 @@ UNIT_COLUMNS = ("unit", "status", "protocol", "model", "reason", "logs_scored", 
 def _fmt(value) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
-    return cells.text(value) if isinstance(value, str) else str(value)
+    return value if isinstance(value, str) else str(value)
 
 
 def write_units(path: Path, statuses) -> None:
@@ -33,7 +32,7 @@ def write_units(path: Path, statuses) -> None:
     status, the protocol and model its monitor uses, why (fallbacks, skipped logs, learning), the
     logs scored and the last one."""
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(UNIT_COLUMNS)
         for s in statuses:
             writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS])
@@ -41,7 +40,7 @@ def write_units(path: Path, statuses) -> None:
 
 def write_alarms(path: Path, monitors) -> None:
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(ALARM_COLUMNS)
         for m in monitors:
             for row in m.alarm_rows():
@@ -59,7 +58,7 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
     if any(m.signatures is not None for m in monitors):
         columns += tuple(f"wear{i}{end}" for end in ("", "_lower", "_log", "_log_lower") for i in range(1, n_axes + 1))
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(columns)
         for m in monitors:
             for row in m.rows:
@@ -78,7 +77,7 @@ def write_wear(path: Path, monitors) -> None:
     ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin
     have rows."""
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(WEAR_COLUMNS)
         for m in monitors:
             for row in m.rows:

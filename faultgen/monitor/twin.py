@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import derivatives
-from faultgen.data import measured
+from faultgen.data import cells, measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
@@ -185,9 +185,9 @@ class Twin:
         t = np.asarray(data.t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(data.q, dtype=float), REFERENCE_WINDOW)
         path = self.cache.parent / "programs" / f"{sha256[:24]}.csv"  # beside the cycles: they hold cycles only
-        header = ",".join(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))])
         with self.folder.writing(path) as tmp:
-            np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", header=header, comments="", fmt="%.17g")
+            np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", comments="", fmt="%.17g",
+                       header=cells.line(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))]))
         return path
 
     def _key(self, temperature: float, payload: float, worn_axis: int) -> tuple[dict, Path]:

@@ -139,9 +139,9 @@ def _combine_j2s3(folder: Path) -> None:
 
 
 def _table_6_1(folder: Path) -> None:
-    from faultgen.data import atomic
+    from faultgen.data import atomic, cells
     from faultgen.reproduce.datasets import last_cycle_torque
 
     table = last_cycle_torque(folder / "j2.h5")
     with atomic.atomic_path(folder / "j2-table-6-1.csv") as tmp:
-        table.to_csv(tmp, index=False)
+        cells.escaped(table).to_csv(tmp, index=False)

@@ -63,13 +63,13 @@ def write(folder: Path, parts: Sequence[Part], outcomes: Sequence[Outcome], scal
 def write_times(folder: Path, outcomes: Sequence[Outcome]) -> Path:
     """``DIR/times.csv``: one row per step ended so far (step, status, seconds, makes_data,
     command), rewritten as each step ends so that a stopped run keeps the times it measured."""
-    from faultgen.data import atomic
+    from faultgen.data import atomic, cells
 
     times = pd.DataFrame([{"step": o.step.name, "status": o.status, "seconds": round(o.seconds, 1),
                            "makes_data": o.step.makes_data, "command": o.step.command()} for o in outcomes],
                          columns=["step", "status", "seconds", "makes_data", "command"])
     with atomic.atomic_path(folder / "times.csv") as tmp:
-        times.to_csv(tmp, index=False)
+        cells.escaped(times).to_csv(tmp, index=False)
     return folder / "times.csv"
 
 
