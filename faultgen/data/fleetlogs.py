@@ -331,6 +331,9 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         return summary
     check_writable(out)
 
+    by_unit: dict[str, list] = {}
+    for event in events:
+        by_unit.setdefault(event.unit, []).append(event)
     manifest: dict[str, str] = {}
     with hdf5_writer(out) as f, tqdm(total=len(new), desc="import", unit="log", disable=not progress) as bar:
         writer.write_root(f, 0, command, "")
@@ -341,9 +344,8 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
             rows = _rows(unit, plan[unit], old, read, robot, speed_limit, skip_bad, summary, bar)
             if not rows:
                 continue
-            unit_events = [e for e in events if e.unit == unit]
             period = previous.runs.get(unit, {}).get("log_period", sensors.LOG_PERIOD)
-            _write_unit(runs, unit, rows, robot, unit_events, command, summary, period)
+            _write_unit(runs, unit, rows, robot, by_unit.get(unit, []), command, summary, period)
             manifest.update({row["log_file"]: row["sha256"] for row in rows})
         if not len(runs):
             raise ValueError(f"{logs_dir}: no log could be imported ({len(summary.skipped)} bad file(s): "

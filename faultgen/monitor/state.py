@@ -115,9 +115,10 @@ class Maintenance:
     axis: int
     at: int
 
-    def same(self, other: Maintenance) -> bool:
-        """The same event of ``events.csv`` (wherever it was given)."""
-        return (self.stamp, self.event, self.axis) == (other.stamp, other.event, other.axis)
+    @property
+    def identity(self) -> tuple[str, str, int]:
+        """``(stamp, event, axis)``: the same for the same event of ``events.csv`` (wherever it was given)."""
+        return self.stamp, self.event, self.axis
 
 
 @dataclass(frozen=True)
@@ -163,18 +164,21 @@ def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
     """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
     ``state`` ended with."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
+    maintenance: dict[int, list[Maintenance]] = {}
+    for m in state.maintenance:  # grouped by entry, in their order: each looked at once
+        maintenance.setdefault(m.at, []).append(m)
+    changes: dict[int, list[ProgramChange]] = {}
+    for c in state.program_changes:
+        changes.setdefault(c.at, []).append(c)
     for i, e in enumerate(state.entries):
-        for m in state.maintenance:
-            if m.at == i:
-                monitor.maintenance(m.stamp, m.event, m.axis)
-        for c in state.program_changes:
-            if c.at == i:
-                monitor.restart(c.stamp, PROGRAM_CHANGED)
-                monitor.signatures = c.signatures
-        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
-    for m in state.maintenance:
-        if m.at == len(state.entries):
+        for m in maintenance.get(i, ()):
             monitor.maintenance(m.stamp, m.event, m.axis)
+        for c in changes.get(i, ()):
+            monitor.restart(c.stamp, PROGRAM_CHANGED)
+            monitor.signatures = c.signatures
+        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
+    for m in maintenance.get(len(state.entries), ()):
+        monitor.maintenance(m.stamp, m.event, m.axis)
     return monitor
 
 
