@@ -12,6 +12,7 @@ import time
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -59,3 +60,46 @@ def test_many_repairs_in_events_csv_cost_time_linear_in_their_number(tmp_path, p
     # 16 times the rows: a cost linear in them (and the run's fixed cost) well within 20 times; one
     # growing with their square 256 times
     assert seconds[16000] < 20 * seconds[1000], seconds
+
+
+def _gzip(path: Path) -> Path:
+    """``path`` replaced by ``path.gz`` of the same content (``gzip FILE``)."""
+    import gzip
+
+    packed = path.with_name(path.name + ".gz")
+    packed.write_bytes(gzip.compress(path.read_bytes()))
+    path.unlink()
+    return packed
+
+
+def _stamps(dataset: Path, unit: str) -> list[str]:
+    import h5py
+
+    with h5py.File(dataset) as f:
+        return [s.decode() for s in f["runs"][unit]["stamp"][()]]
+
+
+def test_a_log_gzipped_after_its_import_is_the_same_log_not_a_second_record(tmp_path, puma):
+    logs = _fleet(tmp_path, puma, days=3)
+    out = tmp_path / "f.h5"
+    assert runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress"]).exit_code == 0
+    packed = _gzip(logs / "u1" / "2026-03-02.csv")
+    again = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress"])
+    assert again.exit_code == 0 and "nothing new" in again.output, again.output
+    assert _stamps(out, "u1") == ["2026-03-01", "2026-03-02", "2026-03-03"]
+    assert runner.invoke(app, ["validate", str(out)]).exit_code == 0
+    # another content under the gzipped name: changed, named with the name it was imported as
+    fleetlog_folder.write_log(packed, puma, 1, 0, np.full(puma.n_axes, 0.5))
+    changed = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress"])
+    assert changed.exit_code == 2 and f"{packed} changed since it was imported as u1/2026-03-02.csv" in changed.output, \
+        changed.output
+    redone = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress",
+                                 "--reimport-changed"])
+    assert redone.exit_code == 0, redone.output
+    assert _stamps(out, "u1") == ["2026-03-01", "2026-03-02", "2026-03-03"]
+    assert runner.invoke(app, ["validate", str(out)]).exit_code == 0
+    # the plain log back beside the gzipped one: two files of one stamp, refused by name
+    fleetlog_folder.write_log(logs / "u1" / "2026-03-02.csv", puma, 1, 0, np.zeros(puma.n_axes))
+    both = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress"])
+    assert both.exit_code == 2 and "u1/2026-03-02.csv and u1/2026-03-02.csv.gz have the same stamp" in both.output, \
+        both.output

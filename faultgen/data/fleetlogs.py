@@ -23,9 +23,12 @@ simulated truths ``mean_friction_torque`` and ``tracking_error`` are absent.
 
 The dataset keeps a manifest (``/import``: each imported file's name relative to the folder,
 ``<unit>/<file>``, and its SHA-256; the folder's name only, never its path): importing again
-into the same output imports only the files that are new, keeps the records of the others (also
-of files no longer in the folder), and refuses a file whose content changed since it was imported
-(naming it), unless ``reimport_changed``. Every write is atomic
+into the same output imports only the logs that are new, keeps the records of the others (also
+of files no longer in the folder), and refuses a log whose content changed since it was imported
+(naming it), unless ``reimport_changed``. A log is keyed by its unit and stamp, not its file name:
+``u1/2026-03-01.csv`` gzipped to ``u1/2026-03-01.csv.gz`` is the log imported before (its inflated
+content the one imported: kept; another: changed), never a second record of that day; two files of
+one stamp in a unit folder are refused by name (:func:`faultgen.data.logfolder.scan`). Every write is atomic
 (:func:`faultgen.data.atomic.hdf5_writer`): a failure or a kill leaves the previous dataset as it
 was, and no file that looks complete.
 """
@@ -129,6 +132,22 @@ def sha256(path: Path) -> str:
     return digest.hexdigest()
 
 
+def content_sha256(path: Path) -> str | None:
+    """SHA-256 of a log's content: its bytes, inflated when it is gzip-compressed (with the bomb
+    check of :func:`faultgen.inputs.open_bytes`), so a log gzipped after its import has the digest
+    it was imported under; None for a file that cannot be read so."""
+    from faultgen import inputs
+
+    digest = hashlib.sha256()
+    try:
+        with inputs.open_bytes(path, "log") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(block)
+    except (OSError, ValueError, EOFError):
+        return None
+    return digest.hexdigest()
+
+
 def read_once(read: Reader, path: Path, robot: robots.Robot) -> tuple[measured.MeasuredData, str]:
     """``read(path, robot)`` on the bytes of ``path`` read once, and their SHA-256: the file is
     copied into a private temporary folder while it is hashed, and the copy is parsed, so the
@@ -215,6 +234,7 @@ class _Previous:
         self.files: dict[str, str] = {}
         self.events_sha256 = ""
         self.runs: dict[str, dict] = {}
+        self.by_stamp: dict[tuple[str, float], str] = {}
         self.path = out
         if not out.exists():
             return
@@ -232,7 +252,16 @@ class _Previous:
                                   (h.decode() for h in manifest["sha256"][()]), strict=True))
             self.events_sha256 = attr(manifest.attrs.get("events_sha256", ""))
             self.runs = {unit: {"names": [n.decode() for n in group["log_file"][()]],
+                                "keys": [float(k) for k in group["stamp_key"][()]],
                                 "log_period": float(group.attrs["log_period"])} for unit, group in f["runs"].items()}
+        # each record's file by its unit and stamp: a log is the same log under another name
+        # (2026-03-01.csv gzipped to 2026-03-01.csv.gz)
+        self.by_stamp = {(unit, key): name for unit, run in self.runs.items()
+                         for name, key in zip(run["names"], run["keys"], strict=True)}
+
+    def name_of(self, log: logfolder.LogFile) -> str | None:
+        """The file name under which ``log``'s unit and stamp were imported, or None."""
+        return log.name if log.name in self.files else self.by_stamp.get((log.unit, log.key))
 
     def records(self, unit: str) -> dict[str, np.ndarray]:
         """Every array of a unit's previous run (features only: small), by name."""
@@ -300,24 +329,27 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     previous = _Previous(out, robot)
     summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
 
-    # what each unit's records will be, in stamp order: kept from the previous import, or read now
-    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str]]] = {}
+    # what each unit's records will be, in stamp order: kept from the previous import, or read now;
+    # a log is keyed by its unit and stamp, so a file renamed (gzipped) is the record imported before
+    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str, str | None]]] = {}
     for unit, logs in units.items():
         entries = []
         for log in logs:
             digest = sha256(log.path)
-            before = previous.files.get(log.name)
-            if before is None or before == digest:
-                entries.append((log.key, log.name, None if before else log, digest))
+            was = previous.name_of(log)
+            before = previous.files.get(was) if was is not None else None
+            if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
+                entries.append((log.key, log.name, None if before else log, digest, was))
                 continue
             if not reimport_changed:
-                raise ValueError(f"{log.path} changed since it was imported into {out} (SHA-256 {before[:12]}... then, "
-                                 f"{digest[:12]}... now); put the imported content back, or give --reimport-changed "
-                                 "to import it again")
+                then = "" if was == log.name else f" as {was}"
+                raise ValueError(f"{log.path} changed since it was imported{then} into {out} (SHA-256 {before[:12]}... "
+                                 f"then, {digest[:12]}... now); put the imported content back, or give "
+                                 "--reimport-changed to import it again")
             summary.reimported.append(log.name)
-            entries.append((log.key, log.name, log, digest))
+            entries.append((log.key, log.name, log, digest, was))
         plan[unit] = entries
-    present = {log.name for logs in units.values() for log in logs}
+    present = {name for entries in plan.values() for entry in entries for name in (entry[1], entry[4]) if name}
     for unit, run in previous.runs.items():  # records whose files left the folder: kept
         gone = [name for name in run["names"] if name not in present]
         summary.gone += gone
@@ -365,17 +397,20 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
 
 
 def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) -> list[dict]:
-    """A unit's records in stamp order: kept ones from ``old`` (the previous run's arrays), new ones
-    read (one log at a time); bad logs refused, or with ``skip_bad`` listed and passed over."""
+    """A unit's records in stamp order: kept ones from ``old`` (the previous run's arrays; a record
+    kept under its file's new name when the file was renamed), new ones read (one log at a time;
+    one re-imported replaces its old record); bad logs refused, or with ``skip_bad`` listed and
+    passed over."""
     position = {} if old is None else {name.decode(): i for i, name in enumerate(old["log_file"])}
     rows = []
     kept_names = set()
-    for key, name, log, digest in sorted(entries, key=lambda e: e[0]):
+    for key, name, log, digest, was in sorted(entries, key=lambda e: e[0]):
+        if was is not None:
+            kept_names.add(was)  # never kept again as a record of a file gone from the folder
         if log is None:
-            i = position[name]
+            i = position[was if was is not None else name]
             rows.append({**{k: v[i:i + 1] for k, v in old.items() if _per_record(k, v, old)},
                          "log_file": name, "sha256": digest, "stamp": old["stamp"][i].decode(), "key": key})
-            kept_names.add(name)
             summary.kept += 1
             continue
         try:
