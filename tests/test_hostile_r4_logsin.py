@@ -103,3 +103,55 @@ def test_a_log_gzipped_after_its_import_is_the_same_log_not_a_second_record(tmp_
     both = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(out), "--no-progress"])
     assert both.exit_code == 2 and "u1/2026-03-02.csv and u1/2026-03-02.csv.gz have the same stamp" in both.output, \
         both.output
+
+
+def _units_csv(out: Path) -> dict[str, dict]:
+    import csv
+
+    with open(out / "units.csv", newline="") as fh:
+        return {row["unit"]: row for row in csv.DictReader(fh)}
+
+
+def test_a_scored_log_gzipped_changed_or_gone_and_a_late_log_are_named_never_fatal(tmp_path, puma):
+    logs = _fleet(tmp_path, puma, units=2, days=3)
+    out = tmp_path / "OUT"
+    assert _monitor(logs, out).exit_code == 0
+    _gzip(logs / "u1" / "2026-03-02.csv")  # the same content: the same log
+    fleetlog_folder.write_log(logs / "u1" / "2026-03-04.csv", puma, 3, 0, np.zeros(puma.n_axes))
+    done = _monitor(logs, out)
+    assert done.exit_code == 0, done.output
+    assert _units_csv(out)["u1"]["logs_scored"] == "4" and "changed" not in _units_csv(out)["u1"]["reason"]
+    # a scored log rewritten (caught mid-write), the last one gone, a late one: named, the rest scored
+    fleetlog_folder.write_log(logs / "u1" / "2026-03-01.csv", puma, 0, 9, np.full(puma.n_axes, 0.5))
+    (logs / "u1" / "2026-03-04.csv").unlink()
+    fleetlog_folder.write_log(logs / "u1" / "2026-02-27.csv", puma, 0, 0, np.zeros(puma.n_axes))
+    fleetlog_folder.write_log(logs / "u1" / "2026-03-05.csv", puma, 4, 0, np.zeros(puma.n_axes))
+    fleetlog_folder.write_log(logs / "u2" / "2026-03-04.csv", puma, 3, 1, np.zeros(puma.n_axes))
+    done = _monitor(logs, out)
+    assert done.exit_code == 3 and "Traceback" not in done.output, done.output
+    units = _units_csv(out)
+    reason = units["u1"]["reason"]
+    assert units["u1"]["status"] == "degraded" and units["u1"]["logs_scored"] == "5", units
+    assert "changed since an earlier run scored or skipped them (its results kept): u1/2026-03-01.csv" in reason
+    assert "now gone from the logs folder (its results kept): 2026-03-04" in reason
+    assert "older than the last log scored, not scored (logs are scored in stamp order): u1/2026-02-27.csv" in reason
+    assert units["u2"]["logs_scored"] == "4" and units["u2"]["status"] == "learning", units
+
+
+def test_a_log_deleted_during_the_run_is_skipped_and_named_and_the_fleet_finishes(tmp_path, puma, monkeypatch):
+    from faultgen.monitor import loop
+
+    logs = _fleet(tmp_path, puma, units=2, days=3)
+    listed = loop.fleet_logs.fleet
+
+    def listed_then_deleted(*args, **kwargs):
+        units = listed(*args, **kwargs)
+        (logs / "u2" / "2026-03-02.csv").unlink()  # gone after the folder was listed
+        return units
+
+    monkeypatch.setattr(loop.fleet_logs, "fleet", listed_then_deleted)
+    done = _monitor(logs, tmp_path / "OUT")
+    assert done.exit_code == 3 and isinstance(done.exception, (SystemExit, type(None))), done.output
+    units = _units_csv(tmp_path / "OUT")
+    assert units["u1"]["logs_scored"] == "3" and units["u2"]["logs_scored"] == "2", units
+    assert "1 logs skipped: 2026-03-02:" in units["u2"]["reason"] and "cannot be read" in units["u2"]["reason"], units
