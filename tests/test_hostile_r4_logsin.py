@@ -155,3 +155,21 @@ def test_a_log_deleted_during_the_run_is_skipped_and_named_and_the_fleet_finishe
     units = _units_csv(tmp_path / "OUT")
     assert units["u1"]["logs_scored"] == "3" and units["u2"]["logs_scored"] == "2", units
     assert "1 logs skipped: 2026-03-02:" in units["u2"]["reason"] and "cannot be read" in units["u2"]["reason"], units
+
+
+def test_a_unit_named_to_the_longest_file_name_is_monitored_under_a_bounded_name(tmp_path, puma):
+    from faultgen.monitor import state
+
+    logs = _fleet(tmp_path, puma, units=2, days=3)
+    long = "w" * 251  # the folder may be named so (255 bytes at most); "<name>.json" may not
+    (logs / "u2").rename(logs / long)
+    out = tmp_path / "OUT"
+    done = _monitor(logs, out)
+    assert done.exit_code == 0 and "Traceback" not in done.output, done.output
+    assert _units_csv(out)[long]["logs_scored"] == "3"
+    name = state.unit_file(long, ".json")
+    assert len(name.encode()) <= state.UNIT_FILE_MAX_BYTES + 32 and (out / ".state" / name).is_file()
+    assert (out / state.unit_file(long, ".png")).is_file()
+    fleetlog_folder.write_log(logs / long / "2026-03-04.csv", puma, 3, 1, np.zeros(puma.n_axes))
+    again = _monitor(logs, out)  # the state found again under the same name
+    assert again.exit_code == 0 and _units_csv(out)[long]["logs_scored"] == "4", again.output

@@ -19,7 +19,9 @@ Units are scored one after another, in ``jobs`` local processes or on a Dask clu
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
 Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``units.csv`` (each
 unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`),
-``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` and the monitors' state in
+``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` (a unit name longer than
+:data:`faultgen.monitor.state.UNIT_FILE_MAX_BYTES` cut and its digest added:
+:func:`faultgen.monitor.state.unit_file`) and the monitors' state in
 ``.state`` (a rerun on a grown folder scores only the new logs; JSON, never a pickle:
 :mod:`faultgen.monitor.state`). Simulated cycles, calibrations and the twins' filtered program
 logs are cached in ``OUT/.cache``, each checked against what it was made from; units whose first
@@ -217,12 +219,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         page.write(staging, settings, robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,
                    model=model_source, twin_temperature=twin_temperature)
         for m in monitors:
-            (staging / f"{m.unit}.png").write_bytes(made[m.unit][0])
+            (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()
         for name in units:
             if name in state:
                 unit = state[name]
-                stored.write_unit(staging / ".state" / f"{name}.json",
+                stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
                                   stored.UnitState(name, key, unit.program,
                                                    unit.monitor.signatures if unit.initial_signatures is None
                                                    else unit.initial_signatures, unit.entries,
@@ -323,7 +325,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
                          "code when read, so it is not read); score the logs into a new OUT")
     state = {}
     for name in units:
-        path = folder / f"{name}.json"
+        path = folder / stored.unit_file(name, ".json")
         if not (path.exists() or path.is_symlink()):
             continue
         kept = stored.read_unit(path, out, name, key, n_axes, n_features)

@@ -65,6 +65,22 @@ def sha256_file(path: str | Path) -> str:
     return digest.hexdigest()
 
 
+#: Longest unit name kept as it is in a file name of OUT (``<unit>.png``, ``.state/<unit>.json``),
+#: UTF-8 bytes: with its suffix and an atomic write's temporary name (``.<name>.<pid>@<host>.XXXXXXXX.part``,
+#: up to 87 bytes more) it stays within the 255 bytes a file name may have.
+UNIT_FILE_MAX_BYTES = 128
+
+
+def unit_file(unit: str, suffix: str) -> str:
+    """The file name of ``unit``'s chart or state in OUT: ``<unit><suffix>``, or for a name longer
+    than :data:`UNIT_FILE_MAX_BYTES` bytes its first 100 bytes (whole characters), ``-`` and 16 hex
+    digits of the SHA-256 of the whole name (units.csv and the state itself keep the whole name)."""
+    raw = unit.encode("utf-8")
+    if len(raw) <= UNIT_FILE_MAX_BYTES:
+        return unit + suffix
+    return f"{raw[:100].decode('utf-8', 'ignore')}-{hashlib.sha256(raw).hexdigest()[:16]}{suffix}"
+
+
 def key_name(key: dict) -> str:
     """The file name of a cache entry made from ``key`` (a JSON-able dict): the first 24 hex digits
     of the SHA-256 of its canonical JSON."""
