@@ -173,3 +173,49 @@ def test_a_unit_named_to_the_longest_file_name_is_monitored_under_a_bounded_name
     fleetlog_folder.write_log(logs / long / "2026-03-04.csv", puma, 3, 1, np.zeros(puma.n_axes))
     again = _monitor(logs, out)  # the state found again under the same name
     assert again.exit_code == 0 and _units_csv(out)[long]["logs_scored"] == "4", again.output
+
+
+@pytest.fixture(scope="module")
+def monitored(tmp_path_factory, puma) -> Path:
+    """A protocol-own monitor OUT of a small fleet (two units, three logs), for its files to be planted."""
+    root = tmp_path_factory.mktemp("monitored")
+    logs = _fleet(root, puma, units=2, days=3)
+    assert _monitor(logs, root / "OUT").exit_code == 0
+    return root / "OUT"
+
+
+def _copy(out: Path, tmp_path: Path) -> Path:
+    import shutil
+
+    return Path(shutil.copytree(out, tmp_path / "OUT"))
+
+
+@pytest.mark.parametrize(("key", "value", "said"), [
+    ("train", -5, "train = -5; expected a whole number of logs 10..100000"),
+    ("alpha", 1e999, "alpha = Infinity; expected a significance level in (0, 0.5)"),
+    ("persistence", 10**30, "persistence = 1000000000000000000000000000000; expected a whole number of logs"),
+    ("persistence", 5.5, "persistence = 5.5; expected a whole number"),
+    ("wear_limit", 0, "wear_limit = 0; expected a wear in (0, 1000] %"),
+    ("protocol", "=HYPERLINK(1)", 'protocol = "=HYPERLINK(1)"; expected one of twin, own'),
+    ("twin_temperature", 1, "twin_temperature = 1; expected true or false"),
+    ("verbose", True, "key 'verbose' is not a monitor setting"),
+])
+def test_a_planted_settings_value_is_refused_naming_the_file_and_key(monitored, tmp_path, key, value, said):
+    import json
+
+    out = _copy(monitored, tmp_path)
+    settings = json.loads((out / "settings.json").read_text())
+    settings[key] = value
+    (out / "settings.json").write_text(json.dumps(settings))
+    done = runner.invoke(app, ["report", str(out)])
+    assert done.exit_code == 2 and f"settings.json: {said}" in done.output, done.output
+    assert not isinstance(done.exception, (OverflowError, TypeError)), done.exception
+
+
+def test_a_planted_settings_value_is_a_one_line_refusal_under_the_cap(monitored, tmp_path):
+    import capped
+
+    out = _copy(monitored, tmp_path)
+    (out / "settings.json").write_text((out / "settings.json").read_text().replace('"persistence": 5',
+                                                                                   '"persistence": 1e999'))
+    capped.one_line_refusal(capped.run("report", out, cwd=tmp_path), "settings.json", "persistence")
