@@ -219,3 +219,54 @@ def test_a_planted_settings_value_is_a_one_line_refusal_under_the_cap(monitored,
     (out / "settings.json").write_text((out / "settings.json").read_text().replace('"persistence": 5',
                                                                                    '"persistence": 1e999'))
     capped.one_line_refusal(capped.run("report", out, cwd=tmp_path), "settings.json", "persistence")
+
+
+def _plant(state: dict, where: str, value) -> None:
+    """Set ``state``'s value at ``where`` (``logs.1.temperature_C``: keys and list positions)."""
+    *path, last = where.split(".")
+    node = state
+    for part in path:
+        node = node[int(part)] if isinstance(node, list) else node[part]
+    node[int(last) if isinstance(node, list) else last] = value
+
+
+@pytest.mark.parametrize(("where", "value", "said"), [
+    ("logs.1.temperature_C", float("inf"), "logs[1].temperature_C is infinite; expected a finite number, or NaN"),
+    ("maintenance", [{"stamp": "2026-03-02", "event": "repair", "axis": 10**18, "at": 1}],
+     "maintenance[0].axis = 1000000000000000000; expected an axis 1..6"),
+    ("maintenance", [{"stamp": "2026-03-02", "event": '=HYPERLINK("http://x")', "axis": 1, "at": 1}],
+     "maintenance[0].event = '=HYPERLINK(\"http://x\")'; expected one of repair, gearbox_change"),
+    ("maintenance", [{"stamp": "2026-03-02", "event": "repair", "axis": 1, "at": 99}],
+     "maintenance[0].at = 99, after the 3 logs scored"),
+    ("maintenance", [{"stamp": "yesterday", "event": "repair", "axis": 1, "at": 1}],
+     "maintenance[0].stamp: stamp 'yesterday' is neither"),
+    ("logs.1.stamp", "2026-02-30", "logs[1].stamp: stamp '2026-02-30' is neither"),
+    ("logs.1.stamp", "2026-02-28", "logs[1].stamp '2026-02-28' is not after logs[0]'s"),
+    ("logs.1.stamp", "2026-03-01", "logs[1] has the stamp of logs[0]"),
+    ("logs.0.sha256", "=" * 64, "logs[0].sha256 is not a SHA-256"),
+    ("skipped", [{"stamp": "2026-03-02", "sha256": "0" * 64, "reason": "planted"}],
+     "logs[1] has the stamp of skipped[0]"),
+    ("first.0", "=cmd|' /C calc'!A0", "first[0]: stamp"),
+])
+def test_a_planted_state_value_no_run_writes_is_refused_naming_the_file_and_value(monitored, tmp_path, where, value,
+                                                                                   said):
+    import json
+
+    out = _copy(monitored, tmp_path)
+    path = out / ".state" / "u1.json"
+    state = json.loads(path.read_text())
+    _plant(state, where, value)
+    path.write_text(json.dumps(state))
+    done = _monitor(monitored.parent / "LOGS", out)
+    assert done.exit_code == 2 and f"u1.json: {said}" in done.output, done.output
+
+
+def test_an_infinite_temperature_in_a_state_is_a_one_line_refusal_under_the_cap(monitored, tmp_path):
+    import capped
+
+    out = _copy(monitored, tmp_path)
+    path = out / ".state" / "u2.json"
+    path.write_text(path.read_text().replace('"temperature_C":NaN', '"temperature_C":Infinity', 1))
+    done = capped.run("monitor", monitored.parent / "LOGS", "--robot", ROBOT, "-o", out, "--protocol", "own",
+                      cwd=tmp_path)
+    capped.one_line_refusal(done, "u2.json", "temperature_C")

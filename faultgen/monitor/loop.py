@@ -61,7 +61,7 @@ __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", 
 #: still written); 0 when every unit is monitored or still learning, 2 a refusal before any work.
 EXIT_SOME_UNITS_NOT_MONITORED = 3
 #: Events of ``events.csv`` after which a unit's offset is learned again and its open alarm closed.
-MAINTENANCE = ("repair", "gearbox_change")
+MAINTENANCE = stored.MAINTENANCE
 #: A unit's status in units.csv.
 #: ``degraded``: under protocol own where the twin was asked for, or with logs skipped; a unit whose
 #: twin uses the nominal model because its calibration failed or was implausible is ``monitored``,
