@@ -270,3 +270,32 @@ def test_an_infinite_temperature_in_a_state_is_a_one_line_refusal_under_the_cap(
     done = capped.run("monitor", monitored.parent / "LOGS", "--robot", ROBOT, "-o", out, "--protocol", "own",
                       cwd=tmp_path)
     capped.one_line_refusal(done, "u2.json", "temperature_C")
+
+
+def test_a_log_deleted_during_an_import_is_skipped_and_named(tmp_path, puma, monkeypatch):
+    from faultgen.data import fleetlogs
+
+    logs = _fleet(tmp_path, puma, units=2, days=3)
+    listed = fleetlogs.logfolder.scan
+    hashed = fleetlogs.sha256
+
+    def listed_then_deleted(*args, **kwargs):
+        units = listed(*args, **kwargs)
+        (logs / "u1" / "2026-03-02.csv").unlink()  # gone after the folder was listed
+        return units
+
+    def hashed_then_deleted(path):
+        digest = hashed(path)
+        if path.name == "2026-03-03.csv" and path.parent.name == "u2":
+            path.unlink()  # gone after it was hashed, before it was read
+        return digest
+
+    monkeypatch.setattr(fleetlogs.logfolder, "scan", listed_then_deleted)
+    monkeypatch.setattr(fleetlogs, "sha256", hashed_then_deleted)
+    done = runner.invoke(app, ["logs", "import", str(logs), "--robot", ROBOT, "-o", str(tmp_path / "f.h5"),
+                               "--no-progress"])
+    assert done.exit_code == 0, done.output
+    assert "u1/2026-03-02.csv: removed from the folder while it was imported" in done.output
+    assert "u2/2026-03-03.csv: removed from the folder while it was imported" in done.output
+    assert _stamps(tmp_path / "f.h5", "u1") == ["2026-03-01", "2026-03-03"]
+    assert _stamps(tmp_path / "f.h5", "u2") == ["2026-03-01", "2026-03-02"]

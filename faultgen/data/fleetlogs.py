@@ -61,6 +61,8 @@ WORN_MARK = 2.0
 MEASURED = schema.MEASURED
 #: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
+#: Why a log listed in the folder was not imported when it vanished before it was read (skipped, named).
+VANISHED = "removed from the folder while it was imported"
 #: The group of the manifest in an imported dataset.
 MANIFEST = "import"
 
@@ -287,7 +289,8 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         The robot of every unit (a name, a robot folder, or a loaded robot).
     skip_bad : bool
         Pass over bad files (not a log, a stamp that does not parse, a log the reader refuses),
-        listing them in the summary; without it the first one is refused.
+        listing them in the summary; without it the first one is refused. A log removed from the
+        folder while it is imported is passed over and listed either way (:data:`VANISHED`).
     progress : bool
         A progress bar over the logs read.
     reimport_changed : bool
@@ -335,7 +338,11 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     for unit, logs in units.items():
         entries = []
         for log in logs:
-            digest = sha256(log.path)
+            try:
+                digest = sha256(log.path)
+            except OSError as err:  # removed since the folder was listed: skipped, named
+                summary.skipped.append((log.name, f"{VANISHED} ({err.strerror or err})"))
+                continue
             was = previous.name_of(log)
             before = previous.files.get(was) if was is not None else None
             if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
@@ -416,9 +423,10 @@ def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) 
         try:
             data, digest = read_once(read, log.path, robot)
         except ValueError as err:  # MeasuredDataError and an adapter's refusals: the file and row named
-            if not skip_bad:
+            gone = not (log.path.exists() or log.path.is_symlink())
+            if not (skip_bad or gone):
                 raise
-            summary.skipped.append((name, str(err).removeprefix(f"{log.path}: ")))
+            summary.skipped.append((name, VANISHED if gone else str(err).removeprefix(f"{log.path}: ")))
             bar.update()
             continue
         rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,
