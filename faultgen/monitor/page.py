@@ -261,7 +261,8 @@ def _setting_text(v) -> bool:
 #: before it) and the values a run writes there: a check, and what is expected (what a refusal says).
 SETTING_VALUES = {
     "protocol": (lambda v: v in scoring.PROTOCOLS, f"one of {', '.join(scoring.PROTOCOLS)}"),
-    "train": (_setting_count(scoring.MIN_TRAIN, scoring.MAX_LOGS), f"a whole number of logs {scoring.MIN_TRAIN}..{scoring.MAX_LOGS}"),
+    "train": (_setting_count(scoring.MIN_TRAIN, scoring.MAX_LOGS),
+              f"a whole number of logs {scoring.MIN_TRAIN}..{scoring.MAX_LOGS}"),
     "alpha": (_setting_number(0.0, 0.5, False), "a significance level in (0, 0.5)"),
     "variance": (_setting_number(0.0, 1.0, True), "a share of the PCA variance in (0, 1]"),
     "persistence": (_setting_count(1, scoring.MAX_LOGS), f"a whole number of logs 1..{scoring.MAX_LOGS}"),
