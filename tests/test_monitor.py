@@ -124,7 +124,7 @@ def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path)
     assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
 
 
-def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path):
+def test_a_log_older_than_the_last_scored_is_named_and_not_scored(fleet, monitored, tmp_path):
     robot, logs, _ = fleet
     out = with_cycles_of(monitored, tmp_path / "out")
     folder = tmp_path / "logs" / "unit01"
@@ -135,8 +135,9 @@ def test_a_log_older_than_the_last_scored_is_refused(fleet, monitored, tmp_path)
         os.link(log, folder / log.name)
     loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
     os.link(files[1], folder / files[1].name)
-    with pytest.raises(ValueError, match=f"{files[1].name}.*older than the last scored log of unit01"):
-        loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    again = loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    assert f"not scored (logs are scored in stamp order): unit01/{files[1].name}" in again.statuses[0].reason
+    assert again.statuses[0].logs_scored == 15 and again.statuses[0].status == "degraded"
 
 
 def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
@@ -334,15 +335,18 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
 
 
-def test_a_scored_log_that_changed_since_is_refused(fleet, monitored, tmp_path):
+def test_a_scored_log_that_changed_since_is_named_and_its_score_kept(fleet, monitored, tmp_path):
     robot, logs, _ = fleet
     copied = tmp_path / "logs"
     shutil.copytree(logs, copied)
     out = _copy_of(monitored, tmp_path / "out")
     log = sorted((copied / "unit02").iterdir())[5]
     log.write_text(log.read_text().replace("\n1", "\n2", 1))
-    with pytest.raises(ValueError, match=f"{log.name} changed since it was scored"):
-        loop.monitor(robot, copied, out, calibrate=False, settings=SETTINGS, progress=False)
+    again = loop.monitor(robot, copied, out, calibrate=False, settings=SETTINGS, progress=False)
+    status = next(s for s in again.statuses if s.unit == "unit02")
+    assert f"1 logs changed since an earlier run scored or skipped them (its results kept): unit02/{log.name}" \
+        in status.reason and status.status == "degraded"
+    assert (out / "scores.csv").read_text() == (monitored / "scores.csv").read_text()
 
 
 def test_a_cached_cycle_of_another_key_or_leading_outside_is_refused_and_never_echoed(fleet, monitored, tmp_path):

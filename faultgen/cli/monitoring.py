@@ -16,8 +16,9 @@ from faultgen.cli.options import (
 #: What a monitor's output folder holds in its cache (OUT/.cache): simulated cycles, calibrations,
 #: the twins' filtered program logs (faultgen.monitor.twin).
 
-#: The fewest logs the monitor learns a unit from (faultgen.monitor.scoring.Settings), and the most
-#: logs --train and --persistence may name (years of a log an hour: beyond any fleet's record).
+#: The fewest logs the monitor learns a unit from, and the most logs --train and --persistence may
+#: name: faultgen.monitor.scoring's MIN_TRAIN and MAX_LOGS (which a settings file read back is
+#: checked against), repeated so that the command line's options load without the monitor.
 MIN_TRAIN, MAX_LOGS = 10, 100_000
 
 

@@ -23,9 +23,12 @@ simulated truths ``mean_friction_torque`` and ``tracking_error`` are absent.
 
 The dataset keeps a manifest (``/import``: each imported file's name relative to the folder,
 ``<unit>/<file>``, and its SHA-256; the folder's name only, never its path): importing again
-into the same output imports only the files that are new, keeps the records of the others (also
-of files no longer in the folder), and refuses a file whose content changed since it was imported
-(naming it), unless ``reimport_changed``. Every write is atomic
+into the same output imports only the logs that are new, keeps the records of the others (also
+of files no longer in the folder), and refuses a log whose content changed since it was imported
+(naming it), unless ``reimport_changed``. A log is keyed by its unit and stamp, not its file name:
+``u1/2026-03-01.csv`` gzipped to ``u1/2026-03-01.csv.gz`` is the log imported before (its inflated
+content the one imported: kept; another: changed), never a second record of that day; two files of
+one stamp in a unit folder are refused by name (:func:`faultgen.data.logfolder.scan`). Every write is atomic
 (:func:`faultgen.data.atomic.hdf5_writer`): a failure or a kill leaves the previous dataset as it
 was, and no file that looks complete.
 """
@@ -58,6 +61,8 @@ WORN_MARK = 2.0
 MEASURED = schema.MEASURED
 #: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
+#: Why a log listed in the folder was not imported when it vanished before it was read (skipped, named).
+VANISHED = "removed from the folder while it was imported"
 #: The group of the manifest in an imported dataset.
 MANIFEST = "import"
 
@@ -126,6 +131,22 @@ def sha256(path: Path) -> str:
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
+    return digest.hexdigest()
+
+
+def content_sha256(path: Path) -> str | None:
+    """SHA-256 of a log's content: its bytes, inflated when it is gzip-compressed (with the bomb
+    check of :func:`faultgen.inputs.open_bytes`), so a log gzipped after its import has the digest
+    it was imported under; None for a file that cannot be read so."""
+    from faultgen import inputs
+
+    digest = hashlib.sha256()
+    try:
+        with inputs.open_bytes(path, "log") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(block)
+    except (OSError, ValueError, EOFError):
+        return None
     return digest.hexdigest()
 
 
@@ -215,6 +236,7 @@ class _Previous:
         self.files: dict[str, str] = {}
         self.events_sha256 = ""
         self.runs: dict[str, dict] = {}
+        self.by_stamp: dict[tuple[str, float], str] = {}
         self.path = out
         if not out.exists():
             return
@@ -232,7 +254,16 @@ class _Previous:
                                   (h.decode() for h in manifest["sha256"][()]), strict=True))
             self.events_sha256 = attr(manifest.attrs.get("events_sha256", ""))
             self.runs = {unit: {"names": [n.decode() for n in group["log_file"][()]],
+                                "keys": [float(k) for k in group["stamp_key"][()]],
                                 "log_period": float(group.attrs["log_period"])} for unit, group in f["runs"].items()}
+        # each record's file by its unit and stamp: a log is the same log under another name
+        # (2026-03-01.csv gzipped to 2026-03-01.csv.gz)
+        self.by_stamp = {(unit, key): name for unit, run in self.runs.items()
+                         for name, key in zip(run["names"], run["keys"], strict=True)}
+
+    def name_of(self, log: logfolder.LogFile) -> str | None:
+        """The file name under which ``log``'s unit and stamp were imported, or None."""
+        return log.name if log.name in self.files else self.by_stamp.get((log.unit, log.key))
 
     def records(self, unit: str) -> dict[str, np.ndarray]:
         """Every array of a unit's previous run (features only: small), by name."""
@@ -258,7 +289,8 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         The robot of every unit (a name, a robot folder, or a loaded robot).
     skip_bad : bool
         Pass over bad files (not a log, a stamp that does not parse, a log the reader refuses),
-        listing them in the summary; without it the first one is refused.
+        listing them in the summary; without it the first one is refused. A log removed from the
+        folder while it is imported is passed over and listed either way (:data:`VANISHED`).
     progress : bool
         A progress bar over the logs read.
     reimport_changed : bool
@@ -300,24 +332,31 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     previous = _Previous(out, robot)
     summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
 
-    # what each unit's records will be, in stamp order: kept from the previous import, or read now
-    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str]]] = {}
+    # what each unit's records will be, in stamp order: kept from the previous import, or read now;
+    # a log is keyed by its unit and stamp, so a file renamed (gzipped) is the record imported before
+    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str, str | None]]] = {}
     for unit, logs in units.items():
         entries = []
         for log in logs:
-            digest = sha256(log.path)
-            before = previous.files.get(log.name)
-            if before is None or before == digest:
-                entries.append((log.key, log.name, None if before else log, digest))
+            try:
+                digest = sha256(log.path)
+            except OSError as err:  # removed since the folder was listed: skipped, named
+                summary.skipped.append((log.name, f"{VANISHED} ({err.strerror or err})"))
+                continue
+            was = previous.name_of(log)
+            before = previous.files.get(was) if was is not None else None
+            if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
+                entries.append((log.key, log.name, None if before else log, digest, was))
                 continue
             if not reimport_changed:
-                raise ValueError(f"{log.path} changed since it was imported into {out} (SHA-256 {before[:12]}... then, "
-                                 f"{digest[:12]}... now); put the imported content back, or give --reimport-changed "
-                                 "to import it again")
+                then = "" if was == log.name else f" as {was}"
+                raise ValueError(f"{log.path} changed since it was imported{then} into {out} (SHA-256 {before[:12]}... "
+                                 f"then, {digest[:12]}... now); put the imported content back, or give "
+                                 "--reimport-changed to import it again")
             summary.reimported.append(log.name)
-            entries.append((log.key, log.name, log, digest))
+            entries.append((log.key, log.name, log, digest, was))
         plan[unit] = entries
-    present = {log.name for logs in units.values() for log in logs}
+    present = {name for entries in plan.values() for entry in entries for name in (entry[1], entry[4]) if name}
     for unit, run in previous.runs.items():  # records whose files left the folder: kept
         gone = [name for name in run["names"] if name not in present]
         summary.gone += gone
@@ -331,6 +370,9 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
         return summary
     check_writable(out)
 
+    by_unit: dict[str, list] = {}
+    for event in events:
+        by_unit.setdefault(event.unit, []).append(event)
     manifest: dict[str, str] = {}
     with hdf5_writer(out) as f, tqdm(total=len(new), desc="import", unit="log", disable=not progress) as bar:
         writer.write_root(f, 0, command, "")
@@ -341,9 +383,8 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
             rows = _rows(unit, plan[unit], old, read, robot, speed_limit, skip_bad, summary, bar)
             if not rows:
                 continue
-            unit_events = [e for e in events if e.unit == unit]
             period = previous.runs.get(unit, {}).get("log_period", sensors.LOG_PERIOD)
-            _write_unit(runs, unit, rows, robot, unit_events, command, summary, period)
+            _write_unit(runs, unit, rows, robot, by_unit.get(unit, []), command, summary, period)
             manifest.update({row["log_file"]: row["sha256"] for row in rows})
         if not len(runs):
             raise ValueError(f"{logs_dir}: no log could be imported ({len(summary.skipped)} bad file(s): "
@@ -363,25 +404,29 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
 
 
 def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) -> list[dict]:
-    """A unit's records in stamp order: kept ones from ``old`` (the previous run's arrays), new ones
-    read (one log at a time); bad logs refused, or with ``skip_bad`` listed and passed over."""
+    """A unit's records in stamp order: kept ones from ``old`` (the previous run's arrays; a record
+    kept under its file's new name when the file was renamed), new ones read (one log at a time;
+    one re-imported replaces its old record); bad logs refused, or with ``skip_bad`` listed and
+    passed over."""
     position = {} if old is None else {name.decode(): i for i, name in enumerate(old["log_file"])}
     rows = []
     kept_names = set()
-    for key, name, log, digest in sorted(entries, key=lambda e: e[0]):
+    for key, name, log, digest, was in sorted(entries, key=lambda e: e[0]):
+        if was is not None:
+            kept_names.add(was)  # never kept again as a record of a file gone from the folder
         if log is None:
-            i = position[name]
+            i = position[was if was is not None else name]
             rows.append({**{k: v[i:i + 1] for k, v in old.items() if _per_record(k, v, old)},
                          "log_file": name, "sha256": digest, "stamp": old["stamp"][i].decode(), "key": key})
-            kept_names.add(name)
             summary.kept += 1
             continue
         try:
             data, digest = read_once(read, log.path, robot)
         except ValueError as err:  # MeasuredDataError and an adapter's refusals: the file and row named
-            if not skip_bad:
+            gone = not (log.path.exists() or log.path.is_symlink())
+            if not (skip_bad or gone):
                 raise
-            summary.skipped.append((name, str(err).removeprefix(f"{log.path}: ")))
+            summary.skipped.append((name, VANISHED if gone else str(err).removeprefix(f"{log.path}: ")))
             bar.update()
             continue
         rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,

@@ -92,10 +92,15 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
         twin = twin_of(unit, context.units, context.out, twins, False, source, context.backend)
+        events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
+        given = {m.identity for m in unit.maintenance}
+        i = 0
         for log in unit_logs:
-            for event in context.maintenance.get(name, ()):
-                done = stored.Maintenance(event.stamp, event.event, event.axis, 0)
-                if event.key <= log.key and not any(m.same(done) for m in unit.maintenance):
+            while i < len(events) and events[i].key <= log.key:
+                event = events[i]
+                i += 1
+                if (event.stamp, event.event, event.axis) not in given:
+                    given.add((event.stamp, event.event, event.axis))
                     unit.monitor.maintenance(event.stamp, event.event, event.axis)
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))

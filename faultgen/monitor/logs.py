@@ -155,23 +155,29 @@ def parse(path: Path, robot: Robot, reader: Reader = measured.read, held: bool =
     :data:`HOLD_MAX_BYTES`), hashed and parsed by ``reader`` (which then takes a
     :class:`faultgen.inputs.Held` for the path); otherwise parsed from the path and hashed apart.
 
-    Raises
-    ------
-    OSError
-        The file cannot be read at all (a ``ValueError`` of the reader is kept in :attr:`Parsed.error`).
+    A ``ValueError`` of the reader is kept in :attr:`Parsed.error`, and so is a file that cannot be
+    read at all (deleted since the folder was listed: an :class:`faultgen.inputs.InputError` naming
+    it, :attr:`Parsed.sha256` empty), so that the log is skipped, never the run stopped.
     """
     path = Path(path)
     source = path
-    if held and path.stat().st_size <= HOLD_MAX_BYTES:
-        try:
-            source = inputs.hold(path, "joint log", HOLD_MAX_BYTES)
-        except inputs.InputError:
-            source = path  # grown past the bound since its size was read: read from the path
-    sha256 = source.sha256 if isinstance(source, inputs.Held) else stored.sha256_file(path)
+    try:
+        if held and path.stat().st_size <= HOLD_MAX_BYTES:
+            try:
+                source = inputs.hold(path, "joint log", HOLD_MAX_BYTES)
+            except inputs.InputError:
+                source = path  # grown past the bound since its size was read: read from the path
+        sha256 = source.sha256 if isinstance(source, inputs.Held) else stored.sha256_file(path)
+    except OSError as err:
+        return Parsed(path, "", None, inputs.InputError(f"{path}: cannot be read ({err.strerror or err}); it was "
+                                                        "removed or replaced since the logs folder was listed"))
     try:
         return Parsed(path, sha256, reader(source, robot))
     except ValueError as err:
         return Parsed(path, sha256, None, err)
+    except OSError as err:  # removed while the reader opened it again (a log read from its path)
+        return Parsed(path, sha256, None, inputs.InputError(f"{path}: cannot be read ({err.strerror or err}); it "
+                                                            "was removed or replaced while it was read"))
 
 
 class Source:

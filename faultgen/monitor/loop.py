@@ -19,14 +19,18 @@ Units are scored one after another, in ``jobs`` local processes or on a Dask clu
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
 Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``units.csv`` (each
 unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`),
-``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` and the monitors' state in
+``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` (a unit name longer than
+:data:`faultgen.monitor.state.UNIT_FILE_MAX_BYTES` cut and its digest added:
+:func:`faultgen.monitor.state.unit_file`) and the monitors' state in
 ``.state`` (a rerun on a grown folder scores only the new logs; JSON, never a pickle:
 :mod:`faultgen.monitor.state`). Simulated cycles, calibrations and the twins' filtered program
 logs are cached in ``OUT/.cache``, each checked against what it was made from; units whose first
 logs trace the same motion (angles within :data:`SAME_PROGRAM` rad) and share a model share their
 simulated cycles. Each log is read once (:class:`faultgen.monitor.logs.Source`: hashed and
-parsed in one pass, the parsed log passed on; a rerun also hashes the logs scored before, to refuse
-one that changed).
+parsed in one pass, the parsed log passed on; a rerun also hashes the logs scored before, to name
+one that changed). A log that changed, vanished or came late (stamped before the last one scored)
+after an earlier run is named in its unit's reason and not scored; one that vanishes during the
+run is skipped, named: neither stops the fleet.
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.data import atomic, logfolder
+from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import page, prognosis, report
@@ -57,7 +61,7 @@ __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", 
 #: still written); 0 when every unit is monitored or still learning, 2 a refusal before any work.
 EXIT_SOME_UNITS_NOT_MONITORED = 3
 #: Events of ``events.csv`` after which a unit's offset is learned again and its open alarm closed.
-MAINTENANCE = ("repair", "gearbox_change")
+MAINTENANCE = stored.MAINTENANCE
 #: A unit's status in units.csv.
 #: ``degraded``: under protocol own where the twin was asked for, or with logs skipped; a unit whose
 #: twin uses the nominal model because its calibration failed or was implausible is ``monitored``,
@@ -150,8 +154,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     ------
     ValueError
         Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
-        (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, a log older than the
-        last one scored, a scored log that changed since, or ``out`` holding a run with other
+        (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
         file named), ``jobs`` > 1 with a ``scheduler``, or an unknown ``backend``.
     faultgen.runs.errors.SweepRefused
@@ -182,7 +185,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
-    pending = {name: _pending(name, unit_logs, state.get(name), out, logs_dir) for name, unit_logs in units.items()}
+    pending, stale = {}, {}
+    for name, unit_logs in units.items():
+        pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     confined.mkdir(cache)
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
@@ -204,7 +209,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
-    statuses = [_status(name, state.get(name), settings) for name in units]
+    statuses = [_status(name, state.get(name), settings, stale[name]) for name in units]
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
@@ -215,12 +220,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         page.write(staging, settings, robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,
                    model=model_source, twin_temperature=twin_temperature)
         for m in monitors:
-            (staging / f"{m.unit}.png").write_bytes(made[m.unit][0])
+            (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()
         for name in units:
             if name in state:
                 unit = state[name]
-                stored.write_unit(staging / ".state" / f"{name}.json",
+                stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
                                   stored.UnitState(name, key, unit.program,
                                                    unit.monitor.signatures if unit.initial_signatures is None
                                                    else unit.initial_signatures, unit.entries,
@@ -230,45 +235,51 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
 
 
 
-def _pending(name: str, unit_logs: list, unit: Unit | None, out: Path, logs_dir) -> list:
-    """The logs of ``name`` not yet scored (or skipped) by the run whose state is ``unit``.
-
-    Raises
-    ------
-    ValueError
-        The last log handled is gone, a handled log changed since (SHA-256), or a new log is older
-        than the last one handled (the monitor scores in stamp order).
-    """
+def _pending(name: str, unit_logs: list, unit: Unit | None) -> tuple[list, list[str]]:
+    """The logs of ``name`` not yet scored (or skipped) by the run whose state is ``unit``: those
+    stamped after the last log it handled; and notes naming the logs it handled that changed or
+    left the folder since (their earlier scores kept: a log gzipped since, the same content, is not
+    changed) and the new logs stamped before its last one (not scored: the monitor scores in stamp
+    order). None of these stops the run: the unit's reason in units.csv names them."""
     if unit is None:
-        return unit_logs
-    handled = [(e.stamp, e.sha256) for e in unit.entries] + [(k.stamp, k.sha256) for k in unit.skipped]
-    by_stamp = {g.stamp: g for g in unit_logs}
-    stamps = [g.stamp for g in unit_logs]
-    position = {stamp: i for i, stamp in enumerate(stamps)}
-    done = max((s for s, _ in handled), key=lambda s: position.get(s, -1))
-    if done not in by_stamp:
-        raise ValueError(f"{name}: its last scored log ({done}) is no longer in {logs_dir}; put it back or "
-                         "score this folder into a new OUT")
-    for stamp, sha256 in handled:
-        log = by_stamp.get(stamp)
-        if log is not None and stored.sha256_file(log.path) != sha256:
-            raise ValueError(f"{log.path} changed since it was scored into {out} (SHA-256 {sha256[:12]}..., "
-                             "now another): score this folder into a new OUT")
-    seen = {s for s, _ in handled}
-    late = [g for g in unit_logs[: position[done]] if g.stamp not in seen]
-    if late:
-        raise ValueError(f"{late[0].path} is older than the last scored log of {name} ({done}); the monitor "
-                         "scores logs in stamp order: score this folder into a new OUT")
-    return unit_logs[position[done] + 1:]
+        return unit_logs, []
+    handled = {logfolder.parse_stamp(k.stamp, name)[0]: (k.stamp, k.sha256) for k in unit.skipped}
+    handled |= {logfolder.parse_stamp(e.stamp, name)[0]: (e.stamp, e.sha256) for e in unit.entries}
+    last = max(handled)
+    by_key = {g.key: g for g in unit_logs}
+    gone = [stamp for key, (stamp, _) in handled.items() if key not in by_key]
+    changed = [by_key[key].name for key, (_, digest) in handled.items()
+               if key in by_key and not _same_log(by_key[key].path, digest)]
+    late = [g.name for g in unit_logs if g.key < last and g.key not in handled]
+    notes = []
+    for found, what in ((changed, "changed since an earlier run scored or skipped them (its results kept)"),
+                        (gone, "scored or skipped by an earlier run, now gone from the logs folder (its results kept)"),
+                        (late, "older than the last log scored, not scored (logs are scored in stamp order)")):
+        if found:
+            more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
+            notes.append(f"{len(found)} logs {what}: {found[0]}{more}")
+    return [g for g in unit_logs if g.key > last], notes
+
+
+def _same_log(path: Path, sha256: str) -> bool:
+    """Whether the log at ``path`` is the one scored with SHA-256 ``sha256``: the same bytes, or
+    the same content gzipped (:func:`faultgen.data.fleetlogs.content_sha256`); False for a file
+    that cannot be read."""
+    try:
+        return stored.sha256_file(path) == sha256 or fleetlogs.content_sha256(path) == sha256
+    except OSError:
+        return False
 
 
 
-def _status(name: str, unit: Unit | None, settings: Settings) -> UnitStatus:
-    """The unit's row of units.csv (:class:`UnitStatus`)."""
+def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = ()) -> UnitStatus:
+    """The unit's row of units.csv (:class:`UnitStatus`); ``stale``: notes on logs handled by an
+    earlier run that changed or left the folder, or new logs older than them (:func:`_pending`),
+    which make it degraded."""
     if unit is None:
         return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
     protocol = "own" if unit.model == "none" else "twin"
-    reasons = list(unit.notes)
+    reasons = [*unit.notes, *stale]
     if unit.skipped:
         first = unit.skipped[0]
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
@@ -278,7 +289,7 @@ def _status(name: str, unit: Unit | None, settings: Settings) -> UnitStatus:
         reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
     if not unit.entries:
         status = "not monitored"
-    elif unit.skipped or protocol != settings.protocol:  # another model (said in the reason) is not degraded
+    elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
         status = "learning" if learning else "monitored"
@@ -315,7 +326,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
                          "code when read, so it is not read); score the logs into a new OUT")
     state = {}
     for name in units:
-        path = folder / f"{name}.json"
+        path = folder / stored.unit_file(name, ".json")
         if not (path.exists() or path.is_symlink()):
             continue
         kept = stored.read_unit(path, out, name, key, n_axes, n_features)

@@ -211,7 +211,8 @@ def read_settings(folder: str | Path) -> dict:
     Raises
     ------
     ValueError
-        A settings file that is not a JSON object, is too large, or a link out of the folder.
+        A settings file that is not a JSON object, is too large, or a link out of the folder; a
+        key or value no run writes (:func:`check_settings`).
     """
     folder = Path(folder)
     path = folder / SETTINGS
@@ -233,8 +234,63 @@ def read_settings(folder: str | Path) -> dict:
     if key is not None and isinstance(document, dict):
         document = document.get(key)
     if isinstance(document, dict):
-        return _settings_dict(document, {})
+        return check_settings(document, path)
     raise ValueError(f"{path}: not a monitor's settings (expected a JSON object)")
+
+
+def _setting_count(low: int, high: int):
+    return lambda v: isinstance(v, int) and not isinstance(v, bool) and low <= v <= high
+
+
+def _setting_number(low: float, high: float, top: bool):
+    return lambda v: (isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                      and low < v and (v <= high if top else v < high))
+
+
+def _setting_shown(value) -> str:
+    """A JSON value for a message, cut to 40 characters."""
+    text = json.dumps(value)
+    return text if len(text) <= 40 else f"{text[:40]}... ({len(text)} characters)"
+
+
+def _setting_text(v) -> bool:
+    return isinstance(v, str) and len(v) <= 4096
+
+
+#: Each key of a settings file (a run's ``settings.json``, or the ``settings`` of a state written
+#: before it) and the values a run writes there: a check, and what is expected (what a refusal says).
+SETTING_VALUES = {
+    "protocol": (lambda v: v in scoring.PROTOCOLS, f"one of {', '.join(scoring.PROTOCOLS)}"),
+    "train": (_setting_count(scoring.MIN_TRAIN, scoring.MAX_LOGS),
+              f"a whole number of logs {scoring.MIN_TRAIN}..{scoring.MAX_LOGS}"),
+    "alpha": (_setting_number(0.0, 0.5, False), "a significance level in (0, 0.5)"),
+    "variance": (_setting_number(0.0, 1.0, True), "a share of the PCA variance in (0, 1]"),
+    "persistence": (_setting_count(1, scoring.MAX_LOGS), f"a whole number of logs 1..{scoring.MAX_LOGS}"),
+    "wear_limit": (_setting_number(0.0, scoring.MAX_WEAR_LIMIT, True), f"a wear in (0, {scoring.MAX_WEAR_LIMIT:g}] %"),
+    "twin_temperature": (lambda v: isinstance(v, bool), "true or false"),
+    **{name: (_setting_text, "a text of at most 4096 characters") for name in ("robot", "logs", "model", "format")},
+}
+
+
+def check_settings(document: dict, path: str | Path) -> dict:
+    """``document``, a settings file's object, after checking each key is one a run writes and its
+    value in the range a run writes (:data:`SETTING_VALUES`; a key may be absent).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Naming ``path``, the key and what was expected: an unknown key, a value of another type or
+        out of range (a negative ``train``, an infinite ``alpha``, ``persistence`` of 10^400).
+    """
+    for key, value in document.items():
+        if key not in SETTING_VALUES:
+            raise inputs.InputError(f"{path}: key {str(key)[:40]!r} is not a monitor setting (expected only "
+                                    f"{', '.join(SETTING_VALUES)}); write the file again with `faultgen monitor`")
+        valid, expected = SETTING_VALUES[key]
+        if not valid(value):
+            raise inputs.InputError(f"{path}: {key} = {_setting_shown(value)}; expected {expected} (as a monitor run "
+                                    "writes it)")
+    return dict(document)
 
 
 # -- the page ---------------------------------------------------------------------------------------

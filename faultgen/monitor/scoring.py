@@ -124,6 +124,9 @@ WEAR_ALARM_CONFIDENCE = 0.90
 
 #: Largest ``wear_limit`` taken, % (a friction ten times its nominal is no longer wear to monitor).
 MAX_WEAR_LIMIT = 1000.0
+#: The fewest logs a unit is learned from (``train``), and the most logs ``train`` and ``persistence``
+#: may name (years of a log an hour: beyond any fleet's record).
+MIN_TRAIN, MAX_LOGS = 10, 100_000
 
 
 @dataclass(frozen=True)
@@ -149,7 +152,7 @@ class Settings:
     def __post_init__(self) -> None:
         if self.protocol not in PROTOCOLS:
             raise ValueError(f"protocol = {self.protocol!r}; expected one of {', '.join(PROTOCOLS)}")
-        if not (isinstance(self.train, int) and self.train >= 10):
+        if not (isinstance(self.train, int) and self.train >= MIN_TRAIN):
             raise ValueError(f"train = {self.train!r} logs; expected a whole number >= 10 (the unit's normal "
                              "operation, from which its offset, temperature slope and noise are learned)")
         if not 0 < self.alpha < 0.5:

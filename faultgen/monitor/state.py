@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import inputs
-from faultgen.data import atomic
+from faultgen.data import atomic, logfolder
 from faultgen.data.confined import Confined
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
@@ -50,6 +50,9 @@ PROGRAM_CHANGED = "program change (not logged: the motion left the twin's progra
 STATE_MAX_BYTES = 64 * 2**20
 #: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read).
 CACHE = ("cycles", "calibrated", "programs")
+#: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
+#: offset is learned again and its open alarm closed.
+MAINTENANCE = ("repair", "gearbox_change")
 #: Size bound of one cached cycle (a few hundred bytes).
 CYCLE_MAX_BYTES = 2**20
 
@@ -66,6 +69,22 @@ def sha256_file(path: str | Path) -> str:
         for block in iter(lambda: f.read(2**20), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+#: Longest unit name kept as it is in a file name of OUT (``<unit>.png``, ``.state/<unit>.json``),
+#: UTF-8 bytes: with its suffix and an atomic write's temporary name (``.<name>.<pid>@<host>.XXXXXXXX.part``,
+#: up to 87 bytes more) it stays within the 255 bytes a file name may have.
+UNIT_FILE_MAX_BYTES = 128
+
+
+def unit_file(unit: str, suffix: str) -> str:
+    """The file name of ``unit``'s chart or state in OUT: ``<unit><suffix>``, or for a name longer
+    than :data:`UNIT_FILE_MAX_BYTES` bytes its first 100 bytes (whole characters), ``-`` and 16 hex
+    digits of the SHA-256 of the whole name (units.csv and the state itself keep the whole name)."""
+    raw = unit.encode("utf-8")
+    if len(raw) <= UNIT_FILE_MAX_BYTES:
+        return unit + suffix
+    return f"{raw[:100].decode('utf-8', 'ignore')}-{hashlib.sha256(raw).hexdigest()[:16]}{suffix}"
 
 
 def key_name(key: dict) -> str:
@@ -118,9 +137,10 @@ class Maintenance:
     axis: int
     at: int
 
-    def same(self, other: Maintenance) -> bool:
-        """The same event of ``events.csv`` (wherever it was given)."""
-        return (self.stamp, self.event, self.axis) == (other.stamp, other.event, other.axis)
+    @property
+    def identity(self) -> tuple[str, str, int]:
+        """``(stamp, event, axis)``: the same for the same event of ``events.csv`` (wherever it was given)."""
+        return self.stamp, self.event, self.axis
 
 
 @dataclass(frozen=True)
@@ -166,18 +186,21 @@ def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
     """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
     ``state`` ended with."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
+    maintenance: dict[int, list[Maintenance]] = {}
+    for m in state.maintenance:  # grouped by entry, in their order: each looked at once
+        maintenance.setdefault(m.at, []).append(m)
+    changes: dict[int, list[ProgramChange]] = {}
+    for c in state.program_changes:
+        changes.setdefault(c.at, []).append(c)
     for i, e in enumerate(state.entries):
-        for m in state.maintenance:
-            if m.at == i:
-                monitor.maintenance(m.stamp, m.event, m.axis)
-        for c in state.program_changes:
-            if c.at == i:
-                monitor.restart(c.stamp, PROGRAM_CHANGED)
-                monitor.signatures = c.signatures
-        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
-    for m in state.maintenance:
-        if m.at == len(state.entries):
+        for m in maintenance.get(i, ()):
             monitor.maintenance(m.stamp, m.event, m.axis)
+        for c in changes.get(i, ()):
+            monitor.restart(c.stamp, PROGRAM_CHANGED)
+            monitor.signatures = c.signatures
+        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
+    for m in maintenance.get(len(state.entries), ()):
+        monitor.maintenance(m.stamp, m.event, m.axis)
     return monitor
 
 
@@ -260,15 +283,38 @@ def _number(value, path: Path, name: str) -> float:
     return float(value)
 
 
+def _stamp(value, path: Path, name: str, refuse: str) -> float:
+    """The key of a stamp read from a state (:func:`faultgen.data.logfolder.parse_stamp`)."""
+    if not isinstance(value, str):
+        raise StateError(f"{path}: {name} is not a stamp{refuse}")
+    try:
+        return logfolder.parse_stamp(value, f"{path}: {name}")[0]
+    except ValueError as err:
+        raise StateError(f"{err}{refuse}") from None
+
+
+def _digest(value, path: Path, name: str, refuse: str, empty: bool = False) -> str:
+    """A SHA-256 read from a state: 64 lower-case hex digits (or, with ``empty``, "": a log that
+    could not be read at all)."""
+    if not (isinstance(value, str) and ((empty and value == "") or (len(value) == 64 and all(
+            c in "0123456789abcdef" for c in value)))):
+        raise StateError(f"{path}: {name} is not a SHA-256 (64 hex digits){refuse}")
+    return value
+
+
 def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
-    """Read and check the state of ``unit`` written by :func:`write_unit`.
+    """Read and check the state of ``unit`` written by :func:`write_unit`: every value one a run
+    writes (stamps that parse, the logs' in increasing order and each stamp handled once, SHA-256s
+    of 64 hex digits, finite numbers where a run writes them: a temperature finite or NaN (not
+    logged), a maintenance event of :data:`MAINTENANCE` on an axis 1..``n_axes``, given before an
+    entry that exists).
 
     Raises
     ------
     StateError
         The file is a link leading outside ``root`` or not a regular file, is above :data:`STATE_MAX_BYTES`, is not
         such a state, belongs to another unit or to other settings (the differing settings named),
-        or holds an entry of the wrong type or length (named).
+        or holds a value of the wrong type, length or range (named).
     """
     refuse = f"; score the logs into a new OUT (or delete {path.parent} to start this one again)"
     d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
@@ -286,6 +332,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
     if program is not None and not (isinstance(program, list) and len(program) == 2
                                     and all(isinstance(p, str) for p in program)):
         raise StateError(f"{path}: program is not [unit, stamp]{refuse}")
+    if program is not None:
+        _stamp(program[1], path, "program[1]", refuse)
     signatures = d.get("signatures")
     if signatures is not None:
         if not (isinstance(signatures, list) and len(signatures) == n_axes):
@@ -297,18 +345,35 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         raise StateError(f"{path}: model {str(model)[:40]!r} is not one of {', '.join(MODELS)}{refuse}")
     if not (isinstance(first, list) and len(first) == 2 and all(isinstance(p, str) for p in first)):
         raise StateError(f"{path}: first is not [stamp, sha256]{refuse}")
+    _stamp(first[0], path, "first[0]", refuse)
+    _digest(first[1], path, "first[1]", refuse, empty=True)
     if not (isinstance(notes, list) and all(isinstance(n, str) for n in notes)):
         raise StateError(f"{path}: notes is not a list of texts{refuse}")
     if not (isinstance(skipped, list) and all(
             isinstance(k, dict) and all(isinstance(k.get(f), str) for f in ("stamp", "sha256", "reason"))
             for k in skipped)):
         raise StateError(f"{path}: skipped is not a list of {{stamp, sha256, reason}}{refuse}")
+    handled = {}  # stamp key -> where: each log is scored or skipped once
+    for i, k in enumerate(skipped):
+        key = _stamp(k["stamp"], path, f"skipped[{i}].stamp", refuse)
+        _digest(k["sha256"], path, f"skipped[{i}].sha256", refuse, empty=True)
+        if handled.setdefault(key, f"skipped[{i}]") != f"skipped[{i}]":
+            raise StateError(f"{path}: skipped[{i}] has the stamp of {handled[key]}{refuse}")
     maintenance = d.get("maintenance")
     if not (isinstance(maintenance, list) and all(
             isinstance(m, dict) and isinstance(m.get("stamp"), str) and isinstance(m.get("event"), str)
             and all(isinstance(m.get(f), int) and not isinstance(m.get(f), bool) and m.get(f) >= 0 for f in ("axis", "at"))
             for m in maintenance)):
         raise StateError(f"{path}: maintenance is not a list of {{stamp, event, axis, at}}{refuse}")
+    for i, m in enumerate(maintenance):
+        _stamp(m["stamp"], path, f"maintenance[{i}].stamp", refuse)
+        if m["event"] not in MAINTENANCE:
+            raise StateError(f"{path}: maintenance[{i}].event = {m['event'][:40]!r}; expected one of "
+                             f"{', '.join(MAINTENANCE)}{refuse}")
+        if not 1 <= m["axis"] <= n_axes:
+            raise StateError(f"{path}: maintenance[{i}].axis = {m['axis']}; expected an axis 1..{n_axes}{refuse}")
+        if i and m["at"] < maintenance[i - 1]["at"]:
+            raise StateError(f"{path}: maintenance[{i}].at is before maintenance[{i - 1}].at{refuse}")
     changes = d.get("program_changes", [])
     if not isinstance(changes, list):
         raise StateError(f"{path}: program_changes is not a list{refuse}")
@@ -321,18 +386,27 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             raise StateError(f"{path}: program_changes[{i}] is not {{stamp, program, at, signatures}}{refuse}")
         rows = np.stack([_vector(r, path, f"program_changes[{i}].signatures row {k + 1}", n_features)
                          for k, r in enumerate(c["signatures"])])
+        _stamp(c["stamp"], path, f"program_changes[{i}].stamp", refuse)
+        _stamp(c["program"][1], path, f"program_changes[{i}].program[1]", refuse)
         program_changes.append(ProgramChange(c["stamp"], tuple(c["program"]), c["at"], rows))
     if (model == "none") != (program is None):
         raise StateError(f"{path}: model {model!r} with program {program!r}{refuse}")
     logs = d.get("logs")
     if not isinstance(logs, list):
         raise StateError(f"{path}: logs is not a list{refuse}")
-    entries = []
+    entries, last = [], -math.inf
     for i, log in enumerate(logs):
         where = f"logs[{i}]"
-        if not (isinstance(log, dict) and isinstance(log.get("stamp"), str) and isinstance(log.get("sha256"), str)
-                and len(log["sha256"]) == 64):
+        if not (isinstance(log, dict) and isinstance(log.get("stamp"), str) and isinstance(log.get("sha256"), str)):
             raise StateError(f"{path}: {where} has no stamp or SHA-256{refuse}")
+        key = _stamp(log["stamp"], path, f"{where}.stamp", refuse)
+        _digest(log["sha256"], path, f"{where}.sha256", refuse)
+        if handled.setdefault(key, where) != where:
+            raise StateError(f"{path}: {where} has the stamp of {handled[key]}{refuse}")
+        if entries and key <= last:
+            raise StateError(f"{path}: {where}.stamp {log['stamp']!r} is not after logs[{i - 1}]'s; a run scores logs "
+                             f"in stamp order{refuse}")
+        last = key
         expected = log.get("expected")
         entries.append(Entry(
             log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
@@ -341,6 +415,14 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
         if not math.isfinite(entries[-1].payload):
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
+        if math.isinf(entries[-1].temperature):  # NaN: not logged
+            raise StateError(f"{path}: {where}.temperature_C is infinite; expected a finite number, or NaN when the log "
+                             f"has no temperature{refuse}")
+    for name, items in (("maintenance", maintenance), ("program_changes", changes)):
+        late = next((i for i, m in enumerate(items) if m["at"] > len(entries)), None)
+        if late is not None:
+            raise StateError(f"{path}: {name}[{late}].at = {items[late]['at']}, after the {len(entries)} logs "
+                             f"scored{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
                      [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes),
                      [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance], program_changes)
