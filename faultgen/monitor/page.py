@@ -28,12 +28,14 @@ from __future__ import annotations
 
 import csv
 import html
+import io
 import json
 import math
 from dataclasses import asdict, dataclass, field, is_dataclass
 from pathlib import Path
 
 from faultgen import inputs
+from faultgen.axes import MAX_AXES
 from faultgen.data import atomic, cells
 from faultgen.monitor import report, scoring
 
@@ -41,6 +43,18 @@ from faultgen.monitor import report, scoring
 PAGE = "report.html"
 #: The run's settings beside it (what ``faultgen report`` builds the page again with).
 SETTINGS = "settings.json"
+#: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv),
+#: bytes, checked before it is read: scores.csv has a row of about 0.4 kB per scored log (six axes,
+#: the twin's wear columns), so 80 000 logs; the page of so many is already too large for a browser.
+CSV_MAX_BYTES = 32 * 2**20
+#: Longest text cell read, characters: what the monitor writes (:data:`faultgen.monitor.report.CELL_MAX_CHARS`)
+#: and the ``'`` of a formula escape.
+CELL_MAX_CHARS = report.CELL_MAX_CHARS + 1
+#: Columns holding a unit's or a log's name (a folder's or a file's: at most 255 bytes), and their
+#: longest cell read, characters (with a formula escape): the page repeats a log's stamp in each trace
+#: of its unit's chart.
+NAME_COLUMNS = ("unit", "stamp", "first_alarm", "last_log")
+NAME_MAX_CHARS = 256
 #: Size bound of a settings file read back (a few hundred bytes written).
 SETTINGS_MAX_BYTES = 64 * 2**10
 #: Settings shown on the page, in this order, with their meaning.
@@ -86,21 +100,49 @@ def _text(cell: str) -> str:
 
 
 def _read_csv(folder: Path, name: str, required: tuple[str, ...]) -> tuple[list[str], list[dict]]:
-    """The header and rows of ``folder/name``, text cells unescaped; refused (ValueError, named)
-    when missing, a link out of ``folder``, or without one of the ``required`` columns."""
+    """The header and rows of ``folder/name``, text cells unescaped, read whole after checking its
+    size (:data:`CSV_MAX_BYTES`), then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
+    :data:`NAME_MAX_CHARS` for :data:`NAME_COLUMNS`) and at most :data:`faultgen.axes.MAX_AXES`
+    ``scoreI`` columns.
+
+    Raises
+    ------
+    ValueError
+        (:class:`faultgen.inputs.InputError` for the content) Naming the file, and the row or
+        column at fault: missing, a link out of ``folder``, above its size bound, not UTF-8, a
+        malformed row or a cell too long, too many axes, or without one of the ``required`` columns.
+    """
     path = folder / name
     if not (path.exists() or path.is_symlink()):
         raise ValueError(f"{folder}: no {name}; give a `faultgen monitor` output folder")
     if not inputs.inside(path, folder) or not path.is_file():
         raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
-    with open(path, newline="", encoding="utf-8") as f:
-        reader = csv.DictReader(f)
-        columns = list(reader.fieldnames or ())
+    what = "monitor output table"
+    reader = csv.reader(io.StringIO(inputs.read_text(path, what, CSV_MAX_BYTES), newline=""))
+    try:
+        columns = next(reader, [])
         missing = [c for c in required if c not in columns]
         if missing:
-            raise ValueError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
-        rows = [{k: _text(v or "") for k, v in row.items() if k is not None} for row in reader]
-        return columns, rows
+            raise inputs.InputError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
+        if len(columns) > inputs.CSV_MAX_COLUMNS:
+            raise inputs.InputError(f"{path}: the header names {len(columns)} columns; the monitor writes at most "
+                                    f"{inputs.CSV_MAX_COLUMNS}")
+        axes_ = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
+        if axes_ > MAX_AXES:
+            raise inputs.InputError(f"{path}: {axes_} score columns; a robot has at most {MAX_AXES} axes")
+        limits = [NAME_MAX_CHARS if c in NAME_COLUMNS else CELL_MAX_CHARS for c in columns]
+        rows = []
+        for cells_ in reader:
+            if not cells_:
+                continue  # a blank line
+            for cell, limit, column in zip(cells_, limits, columns):
+                if len(cell) > limit:
+                    raise inputs.InputError(f"{path}: row {reader.line_num}, column {column}: a cell of {len(cell)} "
+                                            f"characters; the monitor writes at most {limit}")
+            rows.append({k: _text(v) for k, v in zip(columns, cells_)} | dict.fromkeys(columns[len(cells_):], ""))
+    except csv.Error as err:
+        raise inputs.InputError(f"{path}: row {reader.line_num}: not a CSV row the monitor writes ({err})") from None
+    return columns, rows
 
 
 def _number(cell) -> float:

@@ -1,0 +1,77 @@
+"""Hostile inputs, round 4: memory and size bounds on every reader. Each reader's memory is bounded
+from the file's declared sizes before it reads; a file beyond a bound is refused with exit 2 and one
+``error:`` line naming the file (and the row, column or value at fault), no traceback, under the 4 GB
+address-space cap the findings were judged by (:mod:`capped`) where the finding is about memory."""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from faultgen.cli import app
+from faultgen.monitor import page, report
+from faultgen.monitor.loop import UnitStatus
+
+sys.path.insert(0, str(Path(__file__).parent))
+import capped  # noqa: E402
+
+runner = CliRunner()
+
+
+def _refused(result, *names: str) -> str:
+    """The error line of a refused in-process run: exit 2, one line, no traceback, naming ``names``."""
+    text = result.output
+    assert result.exit_code == 2, text
+    assert "Traceback" not in text and len(text.strip().splitlines()) == 1, text
+    for name in names:
+        assert str(name) in text, (name, text)
+    return text
+
+
+# -- the fleet report reads its tables through one bounded reader ----------------------------------
+
+def _monitor_output(out: Path, reason: str = "", n_axes: int = 6) -> Path:
+    """A small monitor output folder (one unit, three scored logs), written by the monitor's writers
+    except scores.csv, whose ``n_axes`` score columns are written directly."""
+    out.mkdir(parents=True, exist_ok=True)
+    report.write_units(out / "units.csv", [UnitStatus("weld-01", "monitored", "own", "", reason, 3, "2026-03-03")])
+    report.write_alarms(out / "alarms.csv", [])
+    with open(out / "scores.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([*report.SCORE_COLUMNS, *(f"score{i}" for i in range(1, n_axes + 1))])
+        for day in (1, 2, 3):
+            writer.writerow(["weld-01", f"2026-03-0{day}", "monitoring", 1.0, 2.0, 1.5, 3.0, 0, 1] + [0.1] * n_axes)
+    return out
+
+
+def test_the_report_reads_a_monitor_output_it_wrote_with_a_reason_longer_than_a_csv_field(tmp_path):
+    """A unit's reason gathers a note per program change: one over 131 072 characters stopped the
+    page at the end of ``monitor`` with ``_csv.Error``. The writer cuts it, saying so; the page reads it."""
+    out = _monitor_output(tmp_path / "out", reason="program changed at 2026-03-01; " * 6000)
+    fleet = page.read(out)
+    reason = fleet.units[0].row["reason"]
+    assert len(reason) <= report.CELL_MAX_CHARS and reason.endswith("more characters)"), reason[-80:]
+    assert runner.invoke(app, ["report", str(out)]).exit_code == 0
+
+
+@pytest.mark.parametrize("plant", ["long cell", "not utf-8", "too large", "eight axes"])
+def test_a_planted_table_is_refused_by_the_report_naming_the_file(tmp_path, plant):
+    """Every table the report reads goes through one bounded, checked reader: a cell over the CSV
+    module's 131 072 characters (was ``_csv.Error``), a units.csv that is not UTF-8 (was
+    ``UnicodeDecodeError``), a table over its size bound or with more
+    score columns than a robot has axes (was read: 9 MB built a 299 MB page in 1.7 GB) is refused."""
+    out = _monitor_output(tmp_path / "out", n_axes=8 if plant == "eight axes" else 6)
+    name = "scores.csv" if plant in ("too large", "eight axes") else "units.csv"
+    path = out / name
+    if plant == "long cell":
+        path.write_text(path.read_text() + "weld-02,monitored,own,," + "x" * 140_000 + ",3,2026-03-03\n")
+    elif plant == "not utf-8":
+        path.write_bytes(path.read_bytes().replace(b"weld-01", b"weld-\xff1"))
+    elif plant == "too large":
+        with open(path, "ab") as f:  # sparse: no time spent writing it
+            f.truncate(page.CSV_MAX_BYTES + 1)
+    _refused(runner.invoke(app, ["report", str(out)]), path)
