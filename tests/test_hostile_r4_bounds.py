@@ -95,3 +95,35 @@ def test_a_state_file_above_what_a_run_writes_is_refused_before_it_is_parsed(tmp
     with pytest.raises(state.StateError, match=r"weld-01\.json: the state of weld-01 would be \d+ bytes"):
         state.write_unit(tmp_path / ".state" / "weld-01.json", big)
     assert path.stat().st_size > state.STATE_MAX_BYTES  # the file there was left as it was
+
+
+# -- planning: a cycle longer than MAX_CYCLE_DURATION refused before it is sampled -----------------
+
+SLOW_PROGRAM = """name = "slow"
+start = [0, 20, 15, 0, 80, 0]
+[limits]
+velocity = [0.05, 0.05, 0.05, 0.05, 0.05, 0.05]
+acceleration = [100, 100, 100, 100, 100, 100]
+jerk = [1000, 1000, 1000, 1000, 1000, 1000]
+[[segment]]
+type = "move"
+to = [-10, 20, 15, 0, 80, 0]
+[[segment]]
+type = "move"
+to = [169, 20, 15, 0, 80, 0]
+"""
+
+
+def test_moves_adding_up_past_an_hour_are_refused_before_the_move_is_sampled(tmp_path):
+    """Each move was checked on its own duration: at the documented minimum velocity (0.05 deg/s) a
+    move of 200 s and one of 3580 s sampled the second (a list of ruckig's samples: 3.8 GB, then
+    ``MemoryError`` under the cap, 44 s). The cycle so far and the move's planned duration are now
+    checked together before it is sampled (0.3 GB, 3 s)."""
+    program = tmp_path / "slow.toml"
+    program.write_text(SLOW_PROGRAM)
+    done = capped.run("simulate", "--robot", "irb6700", "--task", program, "--cycles", "1", "--no-progress",
+                      "-o", tmp_path / "run.h5", cwd=tmp_path)
+    text = capped.one_line_refusal(done, program, "segment 2 (move)", "the cycle would last 3780.03 s",
+                                   "MAX_CYCLE_DURATION")
+    assert len(text.strip().splitlines()) == 1, text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.toml"]
