@@ -6,6 +6,7 @@ address-space cap the findings were judged by (:mod:`capped`) where the finding 
 from __future__ import annotations
 
 import csv
+import os
 import sys
 from pathlib import Path
 
@@ -20,6 +21,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 import capped  # noqa: E402
 
 runner = CliRunner()
+#: A child's environment in which this folder's helper modules (the bench plug-ins) import.
+WITH_TESTS = {"PYTHONPATH": os.pathsep.join(filter(None, (os.environ.get("PYTHONPATH"), str(Path(__file__).parent))))}
 
 
 def _refused(result, *names: str) -> str:
@@ -127,3 +130,31 @@ def test_moves_adding_up_past_an_hour_are_refused_before_the_move_is_sampled(tmp
                                    "MAX_CYCLE_DURATION")
     assert len(text.strip().splitlines()) == 1, text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.toml"]
+
+
+# -- bench score: a benchmark file's arrays bounded in bytes from their declared shapes --------------
+
+def test_a_small_test_file_declaring_gigabytes_in_unwritten_chunks_is_refused_before_any_read(tmp_path):
+    """A test.h5 of some kB within every former bound (10^7 records, below 2^30 elements) declaring
+    cycles, four features and the angle histogram in chunks never written: 7.8 GB asked for on read
+    (``MemoryError`` under the cap). The declared bytes of all units are now bounded
+    (:data:`faultgen.bench.files.MAX_BYTES`, 512 MiB as float64) before any array is read."""
+    import h5py
+    from test_bench_hostile import AXES, _folder
+
+    from faultgen.bench import files
+
+    folder, n = _folder(tmp_path), 10**7
+    with h5py.File(folder / "test.h5", "r+") as f:
+        group = f["units/test-000"]
+        for name in list(group):
+            del group[name]
+        group.create_dataset("cycles", shape=(n,), chunks=(2**16,), dtype="i8")
+        for name in files.FEATURES:
+            group.create_dataset(name, shape=(n, AXES), chunks=(2**14, AXES), dtype="f8")
+        group.create_dataset("angle_hist", shape=(n, AXES, 12), chunks=(2**10, AXES, 12), dtype="f8")
+    assert (folder / "test.h5").stat().st_size < 2**20
+    done = capped.run("bench", "score", "thesis", "--data", folder, "--isolator", "bench_plugins:AlwaysBacklash",
+                      "-o", tmp_path / "out", cwd=tmp_path, env=WITH_TESTS)
+    capped.one_line_refusal(done, folder / "test.h5", "unit 'test-000'", f"more than {files.MAX_BYTES} bytes")
+    assert not list(tmp_path.glob("out*"))
