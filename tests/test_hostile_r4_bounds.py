@@ -26,13 +26,15 @@ WITH_TESTS = {"PYTHONPATH": os.pathsep.join(filter(None, (os.environ.get("PYTHON
 
 
 def _refused(result, *names: str) -> str:
-    """The error line of a refused in-process run: exit 2, one line, no traceback, naming ``names``."""
+    """The error line of a refused in-process run: exit 2, no traceback, one ``error:`` line (the
+    last: a command may say what it reads first) naming ``names``."""
     text = result.output
     assert result.exit_code == 2, text
-    assert "Traceback" not in text and len(text.strip().splitlines()) == 1, text
+    line = text.strip().splitlines()[-1]
+    assert "Traceback" not in text and text.count("error: ") == 1 and line.startswith("error: "), text
     for name in names:
-        assert str(name) in text, (name, text)
-    return text
+        assert str(name) in line, (name, text)
+    return line
 
 
 # -- the fleet report reads its tables through one bounded reader ----------------------------------
@@ -158,3 +160,76 @@ def test_a_small_test_file_declaring_gigabytes_in_unwritten_chunks_is_refused_be
                       "-o", tmp_path / "out", cwd=tmp_path, env=WITH_TESTS)
     capped.one_line_refusal(done, folder / "test.h5", "unit 'test-000'", f"more than {files.MAX_BYTES} bytes")
     assert not list(tmp_path.glob("out*"))
+
+
+# -- voraus Parquet and HDF5 logs: one bounded reader for every command ----------------------------
+
+VORAUS = ["time", *(f"{c}_{k}" for c in ("joint_position", "joint_velocity", "motor_torque") for k in range(1, 7)),
+          "sample"]
+
+
+def _voraus_rows(path: Path, rows: int) -> Path:
+    """A voraus-AD Parquet table of ``rows`` rows (times in ms, everything else zero), written a
+    million rows a row group: a few MB."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    chunk = 10**6
+    zeros = pa.array(np.zeros(chunk))
+    with pq.ParquetWriter(path, pa.schema([(name, pa.float64()) for name in VORAUS])) as writer:
+        for start in range(0, rows, chunk):
+            n = min(chunk, rows - start)
+            columns = {name: zeros.slice(0, n) for name in VORAUS}
+            columns["time"] = pa.array(np.arange(start, start + n) * 1e-3)
+            writer.write_table(pa.table(columns), row_group_size=chunk)
+    return path
+
+
+def test_calibrate_refuses_a_voraus_table_above_the_whole_read_bound_from_its_metadata(tmp_path):
+    """``logs import`` refused a voraus table of more rows than a log read whole may have from the
+    Parquet metadata; ``calibrate`` streamed it (pyarrow decodes a row group whole: a 14.5 MB file
+    took 3.6 GB). Every path that reads a voraus log now checks it in one place."""
+    from faultgen.operation import jointlog
+
+    most = jointlog.whole_rows(len(VORAUS))
+    log = _voraus_rows(tmp_path / "long.parquet", most + 1)
+    done = capped.run("calibrate", "--robot", "puma560", "--measured", log, "--format", "voraus",
+                      "-o", tmp_path / "cal", cwd=tmp_path)
+    capped.one_line_refusal(done, f"{log}: {most + 1} rows of 20 columns", f"at most {most}", "WHOLE_MAX_BYTES")
+    assert not (tmp_path / "cal").exists()
+
+
+@pytest.mark.parametrize("command", ["calibrate", "import"])
+def test_a_truncated_voraus_table_is_refused_naming_the_file(tmp_path, command):
+    """A voraus Parquet cut short (no footer): pyarrow's error named no file."""
+    folder = tmp_path / "logs" / "u1"
+    folder.mkdir(parents=True)
+    log = _voraus_rows(folder / "2026-03-01.parquet", 1000)
+    log.write_bytes(log.read_bytes()[: log.stat().st_size // 2])
+    args = (["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]
+            if command == "calibrate" else
+            ["logs", "import", str(tmp_path / "logs"), "--robot", "puma560", "-o", str(tmp_path / "f.h5"), "--no-progress"])
+    line = _refused(runner.invoke(app, [*args, "--format", "voraus"]), log, "not a readable Parquet file")
+    assert "voraus-AD" in line
+    assert not (tmp_path / "cal").exists() and not (tmp_path / "f.h5").exists()
+
+
+def test_an_hdf5_log_whose_time_is_text_is_refused_naming_the_file_by_calibrate(tmp_path):
+    """The calibration's block reader (a log longer than calibrate.MAX_ROWS) converted the datasets to
+    float as it read them: a ``t`` of text gave ``could not convert string to float`` without the
+    file's name (and text that reads as numbers was taken). Its datasets are now
+    checked from their metadata as the whole read's are (one function)."""
+    import h5py
+    import numpy as np
+
+    log = tmp_path / "log.h5"
+    columns = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]
+    rows = 30_000  # above calibrate.MAX_ROWS: the log is streamed in blocks
+    with h5py.File(log, "w") as f:
+        for name in columns[1:]:
+            f[name] = np.zeros(rows)
+        f["t"] = np.array([f"t={k}ms" for k in range(rows)], dtype="S10")
+    _refused(runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]),
+             log, "dataset t has dtype |S10; expected numbers")
+    assert not (tmp_path / "cal").exists()
