@@ -233,3 +233,38 @@ def test_an_hdf5_log_whose_time_is_text_is_refused_naming_the_file_by_calibrate(
     _refused(runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]),
              log, "dataset t has dtype |S10; expected numbers")
     assert not (tmp_path / "cal").exists()
+
+
+# -- holding a log's bytes reserves what the file holds, not the bound -----------------------------
+
+_ADDRESS_SPACE_GROWTH = """
+import sys
+from faultgen import inputs
+
+def peak():
+    with open("/proc/self/status") as fh:
+        return next(int(line.split()[1]) * 1024 for line in fh if line.startswith("VmPeak"))
+
+before = peak()
+held = inputs.hold(sys.argv[1], "joint log", int(sys.argv[2]))
+assert held.data.startswith(b"t,q1"), held.data[:20]
+print(peak() - before)
+"""
+
+
+def test_holding_a_small_log_reserves_its_size_not_the_bound(tmp_path):
+    """Every log the monitor reads is held once (``inputs.hold``, bounded at
+    :data:`faultgen.monitor.logs.HOLD_MAX_BYTES`, 512 MiB); ``read(bound + 1)`` allocated the bound
+    before the file was read, so each read of a 0.1 MB log reserved 512 MiB of address space (an
+    8-unit run 4.9 GB: ``MemoryError`` under a 4 GB cap). The peak address space a read adds is now
+    about the file's size."""
+    import subprocess
+
+    from faultgen import children
+    from faultgen.monitor import logs
+
+    log = tmp_path / "2026-03-01.csv"
+    log.write_text("t,q1\n" + "0.001,0.5\n" * 10_000)
+    done = subprocess.run(children.command("-c", _ADDRESS_SPACE_GROWTH, str(log), str(logs.HOLD_MAX_BYTES)), env=children.environment(),
+                          capture_output=True, text=True, timeout=120, check=True)
+    assert int(done.stdout) < 16 * 2**20, done.stdout  # was 512 MiB
