@@ -22,7 +22,8 @@ import capped  # noqa: E402
 
 runner = CliRunner()
 #: A child's environment in which this folder's helper modules (the bench plug-ins) import.
-WITH_TESTS = {"PYTHONPATH": os.pathsep.join(filter(None, (os.environ.get("PYTHONPATH"), str(Path(__file__).parent))))}
+WITH_TESTS = {"PYTHONPATH": os.pathsep.join(filter(None, (os.environ.get("PYTHONPATH"),
+                                                          str(Path(__file__).parent))))}
 
 
 def _refused(result, *names: str) -> str:
@@ -61,6 +62,10 @@ def test_the_report_reads_a_monitor_output_it_wrote_with_a_reason_longer_than_a_
     reason = fleet.units[0].row["reason"]
     assert len(reason) <= report.CELL_MAX_CHARS and reason.endswith("more characters)"), reason[-80:]
     assert runner.invoke(app, ["report", str(out)]).exit_code == 0
+    # the tables a monitor run has just written are read whatever their size (it holds their rows)
+    with pytest.raises(ValueError, match=r"units\.csv: \d+ bytes; a monitor output table is read up to 200 bytes"):
+        page.write(out, table_max_bytes=200)
+    assert page.write(out, table_max_bytes=None).is_file()
 
 
 @pytest.mark.parametrize("plant", ["long cell", "not utf-8", "too large", "eight axes"])
@@ -94,7 +99,8 @@ def test_a_state_file_above_what_a_run_writes_is_refused_before_it_is_parsed(tmp
     path.parent.mkdir()
     path.write_text('{"logs":[' + "[]," * (6 * 2**20) + "[]]}")  # 18 MiB
     monkeypatch.setattr(state.json, "loads", lambda text: pytest.fail("the state was parsed"))
-    with pytest.raises(state.StateError, match=rf"{path}: \d+ bytes; a monitor state is read up to {state.STATE_MAX_BYTES}"):
+    bound = state.STATE_MAX_BYTES
+    with pytest.raises(state.StateError, match=rf"{path}: \d+ bytes; a monitor state is read up to {bound}"):
         state.read_unit(path, tmp_path, "weld-01", {}, 6, 18)
     big = state.UnitState("weld-01", {}, None, None, [], notes=["x" * state.STATE_MAX_BYTES])
     with pytest.raises(state.StateError, match=r"weld-01\.json: the state of weld-01 would be \d+ bytes"):
@@ -209,7 +215,8 @@ def test_a_truncated_voraus_table_is_refused_naming_the_file(tmp_path, command):
     log.write_bytes(log.read_bytes()[: log.stat().st_size // 2])
     args = (["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]
             if command == "calibrate" else
-            ["logs", "import", str(tmp_path / "logs"), "--robot", "puma560", "-o", str(tmp_path / "f.h5"), "--no-progress"])
+            ["logs", "import", str(tmp_path / "logs"), "--robot", "puma560", "-o", str(tmp_path / "f.h5"),
+             "--no-progress"])
     line = _refused(runner.invoke(app, [*args, "--format", "voraus"]), log, "not a readable Parquet file")
     assert "voraus-AD" in line
     assert not (tmp_path / "cal").exists() and not (tmp_path / "f.h5").exists()
@@ -230,8 +237,8 @@ def test_an_hdf5_log_whose_time_is_text_is_refused_naming_the_file_by_calibrate(
         for name in columns[1:]:
             f[name] = np.zeros(rows)
         f["t"] = np.array([f"t={k}ms" for k in range(rows)], dtype="S10")
-    _refused(runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]),
-             log, "dataset t has dtype |S10; expected numbers")
+    args = ["calibrate", "--robot", "puma560", "--measured", str(log), "-o", str(tmp_path / "cal")]
+    _refused(runner.invoke(app, args), log, "dataset t has dtype |S10; expected numbers")
     assert not (tmp_path / "cal").exists()
 
 
@@ -265,6 +272,6 @@ def test_holding_a_small_log_reserves_its_size_not_the_bound(tmp_path):
 
     log = tmp_path / "2026-03-01.csv"
     log.write_text("t,q1\n" + "0.001,0.5\n" * 10_000)
-    done = subprocess.run(children.command("-c", _ADDRESS_SPACE_GROWTH, str(log), str(logs.HOLD_MAX_BYTES)), env=children.environment(),
-                          capture_output=True, text=True, timeout=120, check=True)
+    done = subprocess.run(children.command("-c", _ADDRESS_SPACE_GROWTH, str(log), str(logs.HOLD_MAX_BYTES)),
+                          env=children.environment(), capture_output=True, text=True, timeout=120, check=True)
     assert int(done.stdout) < 16 * 2**20, done.stdout  # was 512 MiB

@@ -99,9 +99,11 @@ def _text(cell: str) -> str:
     return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
 
 
-def _read_csv(folder: Path, name: str, required: tuple[str, ...]) -> tuple[list[str], list[dict]]:
+def _read_csv(folder: Path, name: str, required: tuple[str, ...],
+              max_bytes: int | None = CSV_MAX_BYTES) -> tuple[list[str], list[dict]]:
     """The header and rows of ``folder/name``, text cells unescaped, read whole after checking its
-    size (:data:`CSV_MAX_BYTES`), then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
+    size (``max_bytes``; None: the tables a monitor run just wrote, whose rows it holds already),
+    then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
     :data:`NAME_MAX_CHARS` for :data:`NAME_COLUMNS`) and at most :data:`faultgen.axes.MAX_AXES`
     ``scoreI`` columns.
 
@@ -118,7 +120,8 @@ def _read_csv(folder: Path, name: str, required: tuple[str, ...]) -> tuple[list[
     if not inputs.inside(path, folder) or not path.is_file():
         raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
     what = "monitor output table"
-    reader = csv.reader(io.StringIO(inputs.read_text(path, what, CSV_MAX_BYTES), newline=""))
+    bound = path.stat().st_size if max_bytes is None else max_bytes
+    reader = csv.reader(io.StringIO(inputs.read_text(path, what, bound), newline=""))
     try:
         columns = next(reader, [])
         missing = [c for c in required if c not in columns]
@@ -205,8 +208,9 @@ class Fleet:
     twin: bool
 
 
-def read(folder: str | Path) -> Fleet:
-    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``).
+def read(folder: str | Path, max_bytes: int | None = CSV_MAX_BYTES) -> Fleet:
+    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``), each
+    table read by :func:`_read_csv` (``max_bytes`` as there).
 
     Raises
     ------
@@ -214,9 +218,9 @@ def read(folder: str | Path) -> Fleet:
         A file is missing, or a link out of the folder.
     """
     folder = Path(folder)
-    _, unit_rows = _read_csv(folder, "units.csv", report.UNIT_COLUMNS)
-    _, alarm_rows = _read_csv(folder, "alarms.csv", report.ALARM_COLUMNS)
-    columns, score_rows = _read_csv(folder, "scores.csv", report.SCORE_COLUMNS)
+    _, unit_rows = _read_csv(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
+    _, alarm_rows = _read_csv(folder, "alarms.csv", report.ALARM_COLUMNS, max_bytes)
+    columns, score_rows = _read_csv(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
         unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
@@ -228,7 +232,8 @@ def read(folder: str | Path) -> Fleet:
         if r["unit"] in units:
             units[r["unit"]].scores.append(r)
     if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
-        for r in _read_csv(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"))[1]:
+        for r in _read_csv(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
+                           max_bytes)[1]:
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
@@ -598,11 +603,18 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, **extra) -> Path:
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = CSV_MAX_BYTES, **extra) -> Path:
     """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
     robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
+    ``table_max_bytes``: each table's size bound (:data:`CSV_MAX_BYTES`; None for the tables a monitor
+    run has just written: their rows are in its memory already, and a large fleet's page is written).
+
+    Raises
+    ------
+    ValueError
+        A table refused by :func:`_read_csv` (named, with the row or column at fault).
 
     Returns
     -------
@@ -612,7 +624,7 @@ def write(folder: str | Path, settings=None, **extra) -> Path:
     folder = Path(folder)
     settings = _settings_dict(settings, extra)
     page = folder / PAGE
-    _write(page, build(read(folder), settings))
+    _write(page, build(read(folder, table_max_bytes), settings))
     if settings:
         _write(folder / SETTINGS, json.dumps(settings, indent=1, sort_keys=True) + "\n")
     return page
