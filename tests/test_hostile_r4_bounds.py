@@ -14,7 +14,7 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.monitor import page, report
+from faultgen.monitor import page, report, tables
 from faultgen.monitor.loop import UnitStatus
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -83,7 +83,7 @@ def test_a_planted_table_is_refused_by_the_report_naming_the_file(tmp_path, plan
         path.write_bytes(path.read_bytes().replace(b"weld-01", b"weld-\xff1"))
     elif plant == "too large":
         with open(path, "ab") as f:  # sparse: no time spent writing it
-            f.truncate(page.CSV_MAX_BYTES + 1)
+            f.truncate(tables.CSV_MAX_BYTES + 1)
     _refused(runner.invoke(app, ["report", str(out)]), path)
 
 

@@ -26,35 +26,20 @@ charts, whose labels plotly reads as HTML too; no data text becomes an element i
 
 from __future__ import annotations
 
-import csv
 import html
-import io
 import json
 import math
 from dataclasses import asdict, dataclass, field, is_dataclass
 from pathlib import Path
 
 from faultgen import inputs
-from faultgen.axes import MAX_AXES
-from faultgen.data import atomic, cells
-from faultgen.monitor import report, scoring
+from faultgen.data import atomic
+from faultgen.monitor import report, scoring, tables
 
 #: The page's file name in OUT.
 PAGE = "report.html"
 #: The run's settings beside it (what ``faultgen report`` builds the page again with).
 SETTINGS = "settings.json"
-#: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv),
-#: bytes, checked before it is read: scores.csv has a row of about 0.4 kB per scored log (six axes,
-#: the twin's wear columns), so 80 000 logs; the page of so many is already too large for a browser.
-CSV_MAX_BYTES = 32 * 2**20
-#: Longest text cell read, characters: what the monitor writes (:data:`faultgen.monitor.report.CELL_MAX_CHARS`)
-#: and the ``'`` of a formula escape.
-CELL_MAX_CHARS = report.CELL_MAX_CHARS + 1
-#: Columns holding a unit's or a log's name (a folder's or a file's: at most 255 bytes), and their
-#: longest cell read, characters (with a formula escape): the page repeats a log's stamp in each trace
-#: of its unit's chart.
-NAME_COLUMNS = ("unit", "stamp", "first_alarm", "last_log")
-NAME_MAX_CHARS = 256
 #: Size bound of a settings file read back (a few hundred bytes written).
 SETTINGS_MAX_BYTES = 64 * 2**10
 #: Settings shown on the page, in this order, with their meaning.
@@ -93,60 +78,6 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
 
 
 # -- reading the outputs ----------------------------------------------------------------------------
-
-def _text(cell: str) -> str:
-    """A text cell as it was before the CSV writer's formula escape (:mod:`faultgen.data.cells`)."""
-    return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
-
-
-def _read_csv(folder: Path, name: str, required: tuple[str, ...],
-              max_bytes: int | None = CSV_MAX_BYTES) -> tuple[list[str], list[dict]]:
-    """The header and rows of ``folder/name``, text cells unescaped, read whole after checking its
-    size (``max_bytes``; None: the tables a monitor run just wrote, whose rows it holds already),
-    then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
-    :data:`NAME_MAX_CHARS` for :data:`NAME_COLUMNS`) and at most :data:`faultgen.axes.MAX_AXES`
-    ``scoreI`` columns.
-
-    Raises
-    ------
-    ValueError
-        (:class:`faultgen.inputs.InputError` for the content) Naming the file, and the row or
-        column at fault: missing, a link out of ``folder``, above its size bound, not UTF-8, a
-        malformed row or a cell too long, too many axes, or without one of the ``required`` columns.
-    """
-    path = folder / name
-    if not (path.exists() or path.is_symlink()):
-        raise ValueError(f"{folder}: no {name}; give a `faultgen monitor` output folder")
-    if not inputs.inside(path, folder) or not path.is_file():
-        raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
-    what = "monitor output table"
-    bound = path.stat().st_size if max_bytes is None else max_bytes
-    reader = csv.reader(io.StringIO(inputs.read_text(path, what, bound), newline=""))
-    try:
-        columns = next(reader, [])
-        missing = [c for c in required if c not in columns]
-        if missing:
-            raise inputs.InputError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
-        if len(columns) > inputs.CSV_MAX_COLUMNS:
-            raise inputs.InputError(f"{path}: the header names {len(columns)} columns; the monitor writes at most "
-                                    f"{inputs.CSV_MAX_COLUMNS}")
-        axes_ = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
-        if axes_ > MAX_AXES:
-            raise inputs.InputError(f"{path}: {axes_} score columns; a robot has at most {MAX_AXES} axes")
-        limits = [NAME_MAX_CHARS if c in NAME_COLUMNS else CELL_MAX_CHARS for c in columns]
-        rows = []
-        for cells_ in reader:
-            if not cells_:
-                continue  # a blank line
-            for cell, limit, column in zip(cells_, limits, columns):
-                if len(cell) > limit:
-                    raise inputs.InputError(f"{path}: row {reader.line_num}, column {column}: a cell of {len(cell)} "
-                                            f"characters; the monitor writes at most {limit}")
-            rows.append({k: _text(v) for k, v in zip(columns, cells_)} | dict.fromkeys(columns[len(cells_):], ""))
-    except csv.Error as err:
-        raise inputs.InputError(f"{path}: row {reader.line_num}: not a CSV row the monitor writes ({err})") from None
-    return columns, rows
-
 
 def _number(cell) -> float:
     try:
@@ -208,9 +139,9 @@ class Fleet:
     twin: bool
 
 
-def read(folder: str | Path, max_bytes: int | None = CSV_MAX_BYTES) -> Fleet:
+def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
     """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``), each
-    table read by :func:`_read_csv` (``max_bytes`` as there).
+    table read by :func:`faultgen.monitor.tables.read` (``max_bytes`` as there).
 
     Raises
     ------
@@ -218,9 +149,9 @@ def read(folder: str | Path, max_bytes: int | None = CSV_MAX_BYTES) -> Fleet:
         A file is missing, or a link out of the folder.
     """
     folder = Path(folder)
-    _, unit_rows = _read_csv(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
-    _, alarm_rows = _read_csv(folder, "alarms.csv", report.ALARM_COLUMNS, max_bytes)
-    columns, score_rows = _read_csv(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
+    _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
+    _, alarm_rows = tables.read(folder, "alarms.csv", report.ALARM_COLUMNS, max_bytes)
+    columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
         unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
@@ -232,7 +163,7 @@ def read(folder: str | Path, max_bytes: int | None = CSV_MAX_BYTES) -> Fleet:
         if r["unit"] in units:
             units[r["unit"]].scores.append(r)
     if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
-        for r in _read_csv(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
+        for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
                            max_bytes)[1]:
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
@@ -603,18 +534,18 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = CSV_MAX_BYTES, **extra) -> Path:
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES, **extra) -> Path:
     """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
     robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
-    ``table_max_bytes``: each table's size bound (:data:`CSV_MAX_BYTES`; None for the tables a monitor
+    ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`; None for the tables a monitor
     run has just written: their rows are in its memory already, and a large fleet's page is written).
 
     Raises
     ------
     ValueError
-        A table refused by :func:`_read_csv` (named, with the row or column at fault).
+        A table refused by :func:`faultgen.monitor.tables.read` (named, with the row or column at fault).
 
     Returns
     -------

@@ -21,7 +21,7 @@ SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "al
 
 UNIT_COLUMNS = ("unit", "status", "protocol", "model", "reason", "logs_scored", "last_log")
 #: Longest text cell the monitor writes, characters (the fleet report reads none longer,
-#: :data:`faultgen.monitor.page.CELL_MAX_CHARS`): a longer text (a unit's reason gathers a note per
+#: :data:`faultgen.monitor.tables.CELL_MAX_CHARS`): a longer text (a unit's reason gathers a note per
 #: program change) is cut there, saying how many characters were left out.
 CELL_MAX_CHARS = 4096
 
