@@ -146,7 +146,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     Raises
     ------
     ValueError
-        A file is missing, or a link out of the folder.
+        A file is missing, a link out of the folder, or a table refused by that reader (named).
     """
     folder = Path(folder)
     _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
@@ -534,13 +534,15 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES, **extra) -> Path:
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES,
+          **extra) -> Path:
     """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
     robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
-    ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`; None for the tables a monitor
-    run has just written: their rows are in its memory already, and a large fleet's page is written).
+    ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`;
+    None for the tables a monitor run has just written: their rows are in its memory already, and a
+    large fleet's page is written).
 
     Raises
     ------
