@@ -307,14 +307,16 @@ def figure(unit: Unit, settings: dict) -> dict:
         band(first, last, "#bbbbbb", "learning")
     for first, last in _spans(phases, "relearning"):
         band(first, last, "#f5c27a", "maintenance: offset learned again")
-    raw = [r["stamp"] for r in rows]
+    raw: dict[str, int] = {}  # a stamp's first row: one look-up per alarm (a list's index was rows x alarms)
+    for k, r in enumerate(rows):
+        raw.setdefault(r["stamp"], k)
     for k, alarm in enumerate(unit.closed):
         if alarm["first_alarm"] in raw:
-            line(raw.index(alarm["first_alarm"]), "#7f7f7f", "dash",
+            line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
                  _e(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
                  0.9 - 0.08 * (k % 3))
     if unit.open_alarm and unit.current["first_alarm"] in raw:
-        line(raw.index(unit.current["first_alarm"]), "#d62728", "solid",
+        line(raw[unit.current["first_alarm"]], "#d62728", "solid",
              _e(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
     step = max(1, len(rows) // 8)
     layout = {
