@@ -302,7 +302,7 @@ ramp_time = 0.1
         programs.parse(text, robots.load("irb6700")).trajectory(0.004)
 
 
-def test_a_unit_of_many_logs_and_closed_alarms_is_charted_in_linear_time(tmp_path):
+def test_a_unit_of_many_logs_and_closed_alarms_is_charted_in_linear_time():
     """Within the tables' bounds, a planted alarms.csv can close an alarm at every log of a unit: each
     closed alarm's log was looked up in a list of the unit's stamps (rows x alarms: 40 000 of each,
     11 s, a 32 MiB pair of tables hours). One look-up table per chart (0.5 s)."""
