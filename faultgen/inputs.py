@@ -207,10 +207,15 @@ def regular_file(path: str | Path | Held, what: str, max_bytes: int | None = Non
 
 def read_bytes(path: str | Path, what: str, max_bytes: int) -> bytes:
     """The content of the regular file ``path``, at most ``max_bytes`` bytes (checked on the size
-    and again while reading, for a file that grows or misreports its size)."""
+    and again while reading, for a file that grows or misreports its size). The buffer is sized from
+    the file's size, not the bound: ``read(max_bytes + 1)`` reserved ``max_bytes`` of address space
+    for every file (512 MiB a log; a monitor's threads reading at once passed a 4 GB cap)."""
     path = regular_file(path, what, max_bytes)
     with open(path, "rb") as fh:
-        data = fh.read(max_bytes + 1)
+        size = os.fstat(fh.fileno()).st_size
+        data = fh.read(min(size, max_bytes) + 1)
+        if len(data) > size:  # it grew since: read on, up to the bound
+            data += fh.read(max_bytes + 1 - len(data))
     if len(data) > max_bytes:
         raise InputError(f"{path}: more than {max_bytes} bytes; a {what} is read up to {max_bytes} bytes")
     return data

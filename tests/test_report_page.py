@@ -23,7 +23,7 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.monitor import page, report
+from faultgen.monitor import page, report, tables
 from faultgen.monitor.loop import UnitStatus
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
@@ -69,7 +69,7 @@ def make_output(out: Path) -> Path:
 
 def _csv(path: Path) -> list[dict]:
     with open(path, newline="") as f:
-        return [{k: page._text(v) for k, v in row.items()} for row in csv.DictReader(f)]
+        return [{k: tables.unescaped(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
 @pytest.fixture(scope="module")

@@ -48,6 +48,11 @@ MAX_RECORDS = 10**7
 MAX_UNITS = 100_000
 #: Longest text attribute (robot, task, sample, fault) read, characters.
 MAX_TEXT_BYTES = 4096
+#: Most bytes a benchmark file's arrays may declare, all units together, counted as float64 (8 bytes an
+#: element, as the features are scored) from the declared shapes before any array is read: 2^26
+#: elements, some 9.5 million records of cycles and mean_abs_torque on six axes, 140 000 with every
+#: observable. A thesis track's file is a few MB.
+MAX_BYTES = 512 * 2**20
 #: Size bound of ``test_labels.csv``, bytes (a row is under 80 bytes; a full track's file a few MB).
 LABELS_MAX_BYTES = 256 * 2**20
 #: The largest fault level a run writes, % (``faultgen run --wear-pct`` takes 0..500).
@@ -237,8 +242,7 @@ def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list
     The file is opened by :func:`faultgen.inputs.open_hdf5` (a file outside its folder, an external
     or escaping soft link, a virtual dataset or external storage refused) and every unit's
     attributes and arrays are checked from their declared types and shapes (:func:`_unit_arrays`,
-    at most :data:`MAX_UNITS` units and :data:`faultgen.inputs.HDF5_MAX_ELEMENTS` elements in all)
-    before any array is read.
+    at most :data:`MAX_UNITS` units and :data:`MAX_BYTES` in all, as float64) before any array is read.
 
     Raises
     ------
@@ -269,10 +273,10 @@ def read_with_attrs(path: str | Path, attrs: tuple[str, ...] = ()) -> tuple[list
                 raise inputs.InputError(f"{where} is a {type(g).__name__.lower()}; each unit is a group")
             labelled = "fault_level" in g
             arrays, n_axes = _unit_arrays(path, uid, g, labelled)
-            total += sum(ds.size for ds in arrays.values())
-            if total > inputs.HDF5_MAX_ELEMENTS:
-                raise inputs.InputError(f"{path}: its units declare more than {inputs.HDF5_MAX_ELEMENTS} elements in "
-                                        f"all (at unit {_short(uid)}); a benchmark file is read up to that")
+            total += 8 * sum(ds.size for ds in arrays.values())
+            if total > MAX_BYTES:
+                raise inputs.InputError(f"{path}: its units declare more than {MAX_BYTES} bytes of arrays (as float64) "
+                                        f"in all, at unit {_short(uid)}; a benchmark file is read up to that (MAX_BYTES)")
             info = {name: _attr(g, name, where, f"a text ({meaning})", "SOU") for name, meaning in UNIT_TEXT.items()}
             if labelled:
                 info["worn_axis"] = _attr(g, "worn_axis", where, f"a whole axis number 0..{n_axes}", "iu")

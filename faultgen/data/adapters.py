@@ -27,6 +27,7 @@ from __future__ import annotations
 import dataclasses
 from collections import Counter
 from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -473,6 +474,19 @@ def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separato
     raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
 
+@contextmanager
+def _named(path: Path | inputs.Held) -> Iterator[None]:
+    """Turn pyarrow's errors reading the Parquet file ``path`` (a truncated or corrupt file) into a
+    :class:`~faultgen.data.measured.MeasuredDataError` that names it."""
+    import pyarrow as pa
+
+    try:
+        yield
+    except (pa.ArrowException, OSError) as err:
+        raise measured.MeasuredDataError(f"{inputs.path_of(path)}: not a readable Parquet file ({str(err)[:200]}); "
+                                         "a voraus-AD log is a Parquet table") from None
+
+
 @register("voraus")
 @dataclass(frozen=True)
 class Voraus(Adapter):
@@ -482,23 +496,41 @@ class Voraus(Adapter):
     suffixes: tuple[str, ...] = (".parquet",)
 
     @staticmethod
-    def _plan(path: Path | inputs.Held, robot: robots.Robot) -> tuple:
-        """The file as pyarrow reads it (``path`` or the held bytes: not reopened), its columns
-        read (refused when missing) and its rows, from the metadata before any is read (a few MB
-        of constant columns may hold 10^8)."""
+    def _parquet(path: Path | inputs.Held):
+        """The file as pyarrow reads it (:class:`pyarrow.parquet.ParquetFile` of ``path`` or the held
+        bytes: not reopened), its footer read, no row yet.
+
+        Raises
+        ------
+        faultgen.data.measured.MeasuredDataError
+            Naming the file: not a regular file of at most :data:`MAX_BYTES`, or not a Parquet file
+            pyarrow reads (truncated: no footer; another format).
+        """
         import pyarrow as pa
         import pyarrow.parquet as pq
 
         inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        source = pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path
-        names = pq.read_schema(source).names
+        with _named(path):
+            return pq.ParquetFile(pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path)
+
+    @classmethod
+    def _plan(cls, path: Path | inputs.Held, robot: robots.Robot) -> tuple:
+        """The file (:meth:`_parquet`), its columns read (refused when missing) and its rows, checked
+        from the metadata before any is read against the bound of a log read whole
+        (:func:`faultgen.operation.jointlog.check_whole_rows`; a few MB of constant columns may hold
+        10^8 rows, and pyarrow decodes a row group whole even when it is read in batches): every
+        path that reads a voraus log (``logs import``, the monitor, ``calibrate``) goes through here."""
+        parquet = cls._parquet(path)
+        names = parquet.schema_arrow.names
         axes = range(1, robot.n_axes + 1)
         velocity = [f"joint_velocity_{k}" for k in axes]
         wanted = ["time", *(f"joint_position_{k}" for k in axes), *(f"motor_torque_{k}" for k in axes),
                   *(velocity if all(c in names for c in velocity) else [])]
         _require(path, names, wanted, "voraus-AD")
         wanted += ["sample"] if "sample" in names else []
-        return source, wanted, pq.ParquetFile(source).metadata.num_rows
+        rows = parquet.metadata.num_rows
+        jointlog.check_whole_rows(inputs.path_of(path), rows, len(wanted), what="a voraus-AD log")
+        return parquet, wanted, rows
 
     @staticmethod
     def _mapped(values: dict[str, np.ndarray], robot: robots.Robot) -> dict[str, np.ndarray]:
@@ -514,25 +546,20 @@ class Voraus(Adapter):
         return out
 
     def columns(self, path: Path | inputs.Held, robot: robots.Robot):
-        import pyarrow.parquet as pq
-
-        source, wanted, rows = self._plan(path, robot)
-        jointlog.check_whole_rows(path, rows, len(wanted), what="a voraus-AD log")
-        frame = pq.read_table(source, columns=wanted).to_pandas()
+        parquet, wanted, _ = self._plan(path, robot)
+        with _named(path):
+            frame = parquet.read(columns=wanted).to_pandas()
         return self._mapped(_numbers(path, frame, wanted, self.label), robot), self.label
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
-        import pyarrow.parquet as pq
-
-        source, wanted, _ = self._plan(path, robot)
+        parquet, wanted, _ = self._plan(path, robot)
         start = 0
-        for batch in pq.ParquetFile(source).iter_batches(batch_size=size, columns=wanted):
-            values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
-            yield self._mapped(values, robot), self.label, ()
-            start += batch.num_rows
+        with _named(path):
+            batches = parquet.iter_batches(batch_size=size, columns=wanted)
+            for batch in batches:
+                values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
+                yield self._mapped(values, robot), self.label, ()
+                start += batch.num_rows
 
     def rows(self, path: Path) -> int:
-        import pyarrow.parquet as pq
-
-        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
-        return pq.ParquetFile(path).metadata.num_rows
+        return self._parquet(path).metadata.num_rows

@@ -217,8 +217,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         report.write_units(staging / "units.csv", statuses)
         prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
         # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-        page.write(staging, settings, robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,
-                   model=model_source, twin_temperature=twin_temperature)
+        page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
+                   logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
         for m in monitors:
             (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()

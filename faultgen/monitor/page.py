@@ -26,7 +26,6 @@ charts, whose labels plotly reads as HTML too; no data text becomes an element i
 
 from __future__ import annotations
 
-import csv
 import html
 import json
 import math
@@ -34,8 +33,8 @@ from dataclasses import asdict, dataclass, field, is_dataclass
 from pathlib import Path
 
 from faultgen import inputs
-from faultgen.data import atomic, cells
-from faultgen.monitor import report, scoring
+from faultgen.data import atomic
+from faultgen.monitor import report, scoring, tables
 
 #: The page's file name in OUT.
 PAGE = "report.html"
@@ -79,29 +78,6 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
 
 
 # -- reading the outputs ----------------------------------------------------------------------------
-
-def _text(cell: str) -> str:
-    """A text cell as it was before the CSV writer's formula escape (:mod:`faultgen.data.cells`)."""
-    return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
-
-
-def _read_csv(folder: Path, name: str, required: tuple[str, ...]) -> tuple[list[str], list[dict]]:
-    """The header and rows of ``folder/name``, text cells unescaped; refused (ValueError, named)
-    when missing, a link out of ``folder``, or without one of the ``required`` columns."""
-    path = folder / name
-    if not (path.exists() or path.is_symlink()):
-        raise ValueError(f"{folder}: no {name}; give a `faultgen monitor` output folder")
-    if not inputs.inside(path, folder) or not path.is_file():
-        raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
-    with open(path, newline="", encoding="utf-8") as f:
-        reader = csv.DictReader(f)
-        columns = list(reader.fieldnames or ())
-        missing = [c for c in required if c not in columns]
-        if missing:
-            raise ValueError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
-        rows = [{k: _text(v or "") for k, v in row.items() if k is not None} for row in reader]
-        return columns, rows
-
 
 def _number(cell) -> float:
     try:
@@ -163,18 +139,19 @@ class Fleet:
     twin: bool
 
 
-def read(folder: str | Path) -> Fleet:
-    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``).
+def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
+    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``), each
+    table read by :func:`faultgen.monitor.tables.read` (``max_bytes`` as there).
 
     Raises
     ------
     ValueError
-        A file is missing, or a link out of the folder.
+        A file is missing, a link out of the folder, or a table refused by that reader (named).
     """
     folder = Path(folder)
-    _, unit_rows = _read_csv(folder, "units.csv", report.UNIT_COLUMNS)
-    _, alarm_rows = _read_csv(folder, "alarms.csv", report.ALARM_COLUMNS)
-    columns, score_rows = _read_csv(folder, "scores.csv", report.SCORE_COLUMNS)
+    _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
+    _, alarm_rows = tables.read(folder, "alarms.csv", report.ALARM_COLUMNS, max_bytes)
+    columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
         unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
@@ -186,7 +163,8 @@ def read(folder: str | Path) -> Fleet:
         if r["unit"] in units:
             units[r["unit"]].scores.append(r)
     if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
-        for r in _read_csv(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"))[1]:
+        for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
+                           max_bytes)[1]:
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
@@ -385,14 +363,16 @@ def figure(unit: Unit, settings: dict) -> dict:
         band(first, last, "#bbbbbb", "learning")
     for first, last in _spans(phases, "relearning"):
         band(first, last, "#f5c27a", "maintenance: offset learned again")
-    raw = [r["stamp"] for r in rows]
+    raw: dict[str, int] = {}  # a stamp's first row: one look-up per alarm (a list's index was rows x alarms)
+    for k, r in enumerate(rows):
+        raw.setdefault(r["stamp"], k)
     for k, alarm in enumerate(unit.closed):
         if alarm["first_alarm"] in raw:
-            line(raw.index(alarm["first_alarm"]), "#7f7f7f", "dash",
+            line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
                  _e(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
                  0.9 - 0.08 * (k % 3))
     if unit.open_alarm and unit.current["first_alarm"] in raw:
-        line(raw.index(unit.current["first_alarm"]), "#d62728", "solid",
+        line(raw[unit.current["first_alarm"]], "#d62728", "solid",
              _e(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
     step = max(1, len(rows) // 8)
     layout = {
@@ -612,11 +592,20 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, **extra) -> Path:
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES,
+          **extra) -> Path:
     """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
     robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
+    ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`;
+    None for the tables a monitor run has just written: their rows are in its memory already, and a
+    large fleet's page is written).
+
+    Raises
+    ------
+    ValueError
+        A table refused by :func:`faultgen.monitor.tables.read` (named, with the row or column at fault).
 
     Returns
     -------
@@ -626,7 +615,7 @@ def write(folder: str | Path, settings=None, **extra) -> Path:
     folder = Path(folder)
     settings = _settings_dict(settings, extra)
     page = folder / PAGE
-    _write(page, build(read(folder), settings))
+    _write(page, build(read(folder, table_max_bytes), settings))
     if settings:
         _write(folder / SETTINGS, json.dumps(settings, indent=1, sort_keys=True) + "\n")
     return page

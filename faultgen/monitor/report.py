@@ -19,12 +19,21 @@ SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "al
 
 
 UNIT_COLUMNS = ("unit", "status", "protocol", "model", "reason", "logs_scored", "last_log")
+#: Longest text cell the monitor writes, characters (the fleet report reads none longer,
+#: :data:`faultgen.monitor.tables.CELL_MAX_CHARS`): a longer text (a unit's reason gathers a note per
+#: program change) is cut there, saying how many characters were left out.
+CELL_MAX_CHARS = 4096
 
 
 def _fmt(value) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
-    return value if isinstance(value, str) else str(value)
+    if not isinstance(value, str):
+        return str(value)
+    if len(value) > CELL_MAX_CHARS:
+        cut = CELL_MAX_CHARS - 40
+        value = f"{value[:cut]} ... ({len(value) - cut} more characters)"
+    return value  # neutralised by cells.writer
 
 
 def write_units(path: Path, statuses) -> None:

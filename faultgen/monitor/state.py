@@ -46,8 +46,10 @@ CYCLE_FORMAT = "faultgen-twin-cycle/1"
 CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
 #: How a program change that nobody logged closes an open alarm (alarms.csv ``closed_by``).
 PROGRAM_CHANGED = "program change (not logged: the motion left the twin's program)"
-#: Size bound of one unit's state file: about 0.6 kB per scored log, so 10^5 logs.
-STATE_MAX_BYTES = 64 * 2**20
+#: Size bound of one unit's state file, written (:func:`write_unit` refuses a larger one) and read back
+#: (checked before it is parsed): about 0.6 kB per scored log, so some 28 000 logs (a log an hour for
+#: three years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
+STATE_MAX_BYTES = 16 * 2**20
 #: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read).
 CACHE = ("cycles", "calibrated", "programs")
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
@@ -209,7 +211,14 @@ def _floats(values) -> list[float]:
 
 
 def write_unit(path: Path, state: UnitState) -> None:
-    """Write ``state`` as JSON (floats written exactly: ``repr`` round-trips; NaN as ``NaN``)."""
+    """Write ``state`` as JSON (floats written exactly: ``repr`` round-trips; NaN as ``NaN``).
+
+    Raises
+    ------
+    StateError
+        The state would be larger than :data:`STATE_MAX_BYTES` (a later run could not read it back);
+        nothing is written.
+    """
     document = {
         "format": FORMAT, "unit": state.unit, "settings": state.settings,
         "program": list(state.program) if state.program else None,
@@ -223,7 +232,11 @@ def write_unit(path: Path, state: UnitState) -> None:
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
                   "expected": None if e.expected is None else _floats(e.expected)} for e in state.entries],
     }
-    atomic.write_text(path, json.dumps(document, separators=(",", ":")))
+    text = json.dumps(document, separators=(",", ":"))
+    if len(text) > STATE_MAX_BYTES:
+        raise StateError(f"{path}: the state of {state.unit} would be {len(text)} bytes ({len(state.entries)} logs); "
+                         f"a state is kept up to {STATE_MAX_BYTES} bytes: score the later logs into a new OUT")
+    atomic.write_text(path, text)
 
 
 def out_folder(out: str | Path) -> Confined:

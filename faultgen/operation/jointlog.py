@@ -300,39 +300,48 @@ def select_columns(path: Path, names: list[str], n_axes: int, motion_only: bool 
     return wanted, extra
 
 
+def hdf5_rows(fh: h5py.File, path: Path, wanted: list[str]) -> int:
+    """The rows of the HDF5 log's columns ``wanted``, from their declared metadata only, after checking
+    each: a 1-D dataset of numbers (text or a compound refused, never converted), of its column's
+    unit when it names one, of at most :data:`MAX_ROWS` rows, all of one length. What the whole read
+    (:func:`read_hdf5`) and the block reader (:class:`faultgen.operation.logblocks`) both check.
+
+    Raises
+    ------
+    LogError
+        Naming the file, the dataset and what was expected.
+    """
+    length = None
+    for name in wanted:
+        ds = fh[name]
+        if ds.ndim != 1:
+            raise LogError(f"{path}: dataset {name} has shape {ds.shape}; expected a 1-D dataset (n,)")
+        if ds.dtype.kind not in "fiu":
+            raise LogError(f"{path}: dataset {name} has dtype {ds.dtype}; expected numbers")
+        unit = ds.attrs.get("unit", ds.attrs.get("units"))
+        if unit is not None:
+            unit = unit.decode() if isinstance(unit, bytes) else str(unit)
+            if _unit_key(unit) != _unit_key(UNITS[name]):
+                raise LogError(f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}")
+        if ds.shape[0] > MAX_ROWS:
+            raise LogError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
+                           f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
+        if length is None:
+            length = ds.shape[0]
+        elif ds.shape[0] != length:
+            raise LogError(f"{path}: dataset {name} has {ds.shape[0]} rows but {wanted[0]} has {length}; "
+                           "all columns must have the same length")
+    return length or 0
+
+
 def read_hdf5(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
     with open_hdf5(path) as fh:
         wanted, extra = hdf5_columns(fh, path, n_axes, motion_only)
         columns = {}
-        length = None
-        for name in wanted:
-            ds = fh[name]
-            if ds.ndim != 1:
-                raise LogError(
-                    f"{path}: dataset {name} has shape {ds.shape}; expected a 1-D dataset (n,)"
-                )
-            if ds.dtype.kind not in "fiu":
-                raise LogError(f"{path}: dataset {name} has dtype {ds.dtype}; expected numbers")
-            unit = ds.attrs.get("unit", ds.attrs.get("units"))
-            if unit is not None:
-                unit = unit.decode() if isinstance(unit, bytes) else str(unit)
-                if _unit_key(unit) != _unit_key(UNITS[name]):
-                    raise LogError(
-                        f"{path}: dataset {name} has unit {unit!r}; expected {UNITS[name]!r}"
-                    )
-            if ds.shape[0] > MAX_ROWS:
-                raise LogError(f"{path}: dataset {name} declares {ds.shape[0]} rows; a log has at most "
-                                        f"{MAX_ROWS} (MAX_ROWS: a day at 1 kHz)")
-            if length is None:
-                length = ds.shape[0]
-            elif ds.shape[0] != length:
-                raise LogError(
-                    f"{path}: dataset {name} has {ds.shape[0]} rows but {wanted[0]} has {length}; "
-                    "all columns must have the same length"
-                )
+        length = hdf5_rows(fh, path, wanted)
         # from the declared shapes and element sizes, before any row is read
         cell = max(fh[name].dtype.itemsize for name in wanted) if wanted else 8
-        check_whole_rows(path, length or 0, len(wanted), cell)
+        check_whole_rows(path, length, len(wanted), cell)
         for name in wanted:
             columns[name] = np.asarray(fh[name][()], dtype=float)
     refuse_non_finite(path, columns, wanted, index_label)

@@ -134,8 +134,9 @@ class Csv:
 
 
 class Hdf5:
-    """An HDF5 log's wanted root datasets in blocks of rows; ``rows`` 0 when their shapes differ (the
-    whole-file reader then names the dataset at fault)."""
+    """An HDF5 log's wanted root datasets in blocks of rows, each checked from its metadata first
+    (:func:`faultgen.operation.jointlog.hdf5_rows`: a dataset not 1-D, of text, of another length or
+    above MAX_ROWS refused, named)."""
 
     label = staticmethod(jointlog.index_label)
     notes: tuple[str, ...] = ()
@@ -144,15 +145,7 @@ class Hdf5:
         self.path = path
         with jointlog.open_hdf5(path) as fh:
             self.wanted, self.extra = jointlog.hdf5_columns(fh, path, n_axes, motion_only)
-            lengths = {name: fh[name].shape for name in self.wanted}
-        shapes = set(lengths.values())
-        if len(shapes) != 1 or len(next(iter(shapes))) != 1:
-            self.rows = 0
-            return
-        self.rows = next(iter(shapes))[0]
-        if self.rows > jointlog.MAX_ROWS:
-            raise LogError(f"{path}: {self.rows} rows; a log has at most {jointlog.MAX_ROWS} "
-                           "(MAX_ROWS: a day at 1 kHz)")
+            self.rows = jointlog.hdf5_rows(fh, path, self.wanted)
 
     def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
         with jointlog.open_hdf5(self.path) as fh:

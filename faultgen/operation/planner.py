@@ -30,6 +30,7 @@ from faultgen.operation.tasks import (
     Load,
     PathBuilder,
     ProgramError,
+    check_cycle_length,
     ptp,
 )
 
@@ -138,7 +139,9 @@ class Planner:
         acceleration = v.get("acceleration_scale", self.p.acceleration_scale) * self.p.acceleration_limit
         try:
             q, qd, qdd = ptp(self.path.last, q_to, velocity, acceleration, self.p.jerk_limit, self.path.dt,
-                             f"{self.p.where}, {s.name}")
+                             f"{self.p.where}, {s.name}", elapsed=(self.path.count - 1) * self.path.dt)
+        except CycleTooLong:
+            raise  # run() names the segment
         except ValueError as err:
             raise ProgramError(str(err)) from err
         self.path.add(s.label, q, qd, qdd)
@@ -217,6 +220,7 @@ class Planner:
             return self.flange_target_rows(position + weave[:, None] * np.cross(geometry.normal, tangent))
 
         ik, dt = self.flange_ik(), self.path.dt
+        check_cycle_length((self.path.count - 1) * dt + duration, dt, s.label)  # before any array of it
         knots = np.linspace(0.0, duration, math.ceil(duration / IK_STEP - 1e-9) + 1)
         points = tool_path(knots)
         t = np.arange(round(duration / dt) + 1) * dt

@@ -205,7 +205,7 @@ def check_step(dt) -> float:
 
 
 def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray,
-        dt: float, where: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        dt: float, where: str, elapsed: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A ruckig rest-to-rest joint move (jerk-limited, time-optimal, all axes finishing together,
     lasting whole :data:`PLAN_PERIOD`), sampled every ``dt`` s.
 
@@ -219,6 +219,10 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
         Sample step, s.
     where : str
         Names the move in an error message.
+    elapsed : float
+        Duration of the path before the move, s: the cycle, this move included, is checked against
+        :data:`MAX_CYCLE_DURATION` and :data:`MAX_CYCLE_SAMPLES` (:func:`check_cycle_length`) from the
+        move's planned duration, before it is sampled.
 
     Returns
     -------
@@ -228,7 +232,7 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
     Raises
     ------
     ValueError
-        If ruckig finds no move.
+        If ruckig finds no move; :class:`CycleTooLong` if the cycle would be too long with it.
     """
     n = len(q_from)
     otg = Ruckig(n, PLAN_PERIOD)
@@ -249,12 +253,12 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
         raise ValueError(f"{where}: ruckig found no move to {np.round(q_to, 4)} within the limits (velocity "
                          f"{np.round(np.rad2deg(velocity), 4)} deg/s, acceleration {np.round(np.rad2deg(acceleration), 4)} "
                          f"deg/s^2, jerk {np.round(np.rad2deg(jerk), 4)} deg/s^3)")
-    check_cycle_length(trajectory.duration, dt, where)
+    check_cycle_length(elapsed + trajectory.duration, dt, where)
     steps = round(trajectory.duration / dt)
-    samples = [trajectory.at_time(k * dt) for k in range(steps)]
-    q = np.array([s[0] for s in samples] + [q_to]).reshape(-1, n)
-    qd = np.array([s[1] for s in samples] + [np.zeros(n)]).reshape(-1, n)
-    qdd = np.array([s[2] for s in samples] + [np.zeros(n)]).reshape(-1, n)
+    q, qd, qdd = np.empty((steps + 1, n)), np.zeros((steps + 1, n)), np.zeros((steps + 1, n))
+    for k in range(steps):  # into the arrays: a list of ruckig's samples took 15 times their memory
+        q[k], qd[k], qdd[k] = trajectory.at_time(k * dt)
+    q[steps] = q_to
     return q, qd, qdd
 
 

@@ -1,0 +1,83 @@
+"""The monitor's tables read back (``units.csv``, ``alarms.csv``, ``scores.csv``, ``rul.csv`` of a
+monitor output folder, :mod:`faultgen.monitor.report` writes them): by one bounded, checked reader
+(:func:`read`), for the fleet report (:mod:`faultgen.monitor.page`). A table is a stranger's file
+when ``faultgen report`` is given a folder: its size is checked before it is read, every cell's
+length and the number of axes as it is parsed; each refusal names the file and the row or column."""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+from faultgen import inputs
+from faultgen.axes import MAX_AXES
+from faultgen.data import cells
+from faultgen.monitor import report
+
+#: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv),
+#: bytes, checked before it is read: scores.csv has a row of about 0.4 kB per scored log (six axes,
+#: the twin's wear columns), so 80 000 logs; the page of so many is already too large for a browser.
+CSV_MAX_BYTES = 32 * 2**20
+#: Longest text cell read, characters: what the monitor writes (:data:`faultgen.monitor.report.CELL_MAX_CHARS`)
+#: and the ``'`` of a formula escape.
+CELL_MAX_CHARS = report.CELL_MAX_CHARS + 1
+#: Columns holding a unit's or a log's name (a folder's or a file's: at most 255 bytes), and their
+#: longest cell read, characters (with a formula escape): the page repeats a log's stamp in each trace
+#: of its unit's chart.
+NAME_COLUMNS = ("unit", "stamp", "first_alarm", "last_log")
+NAME_MAX_CHARS = 256
+
+
+def unescaped(cell: str) -> str:
+    """A text cell as it was before the CSV writer's formula escape (:mod:`faultgen.data.cells`)."""
+    return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
+
+
+def read(folder: Path, name: str, required: tuple[str, ...],
+         max_bytes: int | None = CSV_MAX_BYTES) -> tuple[list[str], list[dict]]:
+    """The header and rows of ``folder/name``, text cells unescaped, read whole after checking its
+    size (``max_bytes``; None: the tables a monitor run just wrote, whose rows it holds already),
+    then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
+    :data:`NAME_MAX_CHARS` for :data:`NAME_COLUMNS`) and at most :data:`faultgen.axes.MAX_AXES`
+    ``scoreI`` columns.
+
+    Raises
+    ------
+    ValueError
+        (:class:`faultgen.inputs.InputError` for the content) Naming the file, and the row or
+        column at fault: missing, a link out of ``folder``, above its size bound, not UTF-8, a
+        malformed row or a cell too long, too many axes, or without one of the ``required`` columns.
+    """
+    path = folder / name
+    if not (path.exists() or path.is_symlink()):
+        raise ValueError(f"{folder}: no {name}; give a `faultgen monitor` output folder")
+    if not inputs.inside(path, folder) or not path.is_file():
+        raise ValueError(f"{path}: not a file inside {folder} (a link out of the folder is not read)")
+    what = "monitor output table"
+    bound = path.stat().st_size if max_bytes is None else max_bytes
+    reader = csv.reader(io.StringIO(inputs.read_text(path, what, bound), newline=""))
+    try:
+        columns = next(reader, [])
+        missing = [c for c in required if c not in columns]
+        if missing:
+            raise inputs.InputError(f"{path}: no column {missing[0]}; is it a `faultgen monitor` output?")
+        if len(columns) > inputs.CSV_MAX_COLUMNS:
+            raise inputs.InputError(f"{path}: the header names {len(columns)} columns; the monitor writes at most "
+                                    f"{inputs.CSV_MAX_COLUMNS}")
+        axes_ = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
+        if axes_ > MAX_AXES:
+            raise inputs.InputError(f"{path}: {axes_} score columns; a robot has at most {MAX_AXES} axes")
+        limits = [NAME_MAX_CHARS if c in NAME_COLUMNS else CELL_MAX_CHARS for c in columns]
+        rows = []
+        for cells_ in reader:
+            if not cells_:
+                continue  # a blank line
+            for cell, limit, column in zip(cells_, limits, columns):
+                if len(cell) > limit:
+                    raise inputs.InputError(f"{path}: row {reader.line_num}, column {column}: a cell of {len(cell)} "
+                                            f"characters; the monitor writes at most {limit}")
+            rows.append({k: unescaped(v) for k, v in zip(columns, cells_)} | dict.fromkeys(columns[len(cells_):], ""))
+    except csv.Error as err:
+        raise inputs.InputError(f"{path}: row {reader.line_num}: not a CSV row the monitor writes ({err})") from None
+    return columns, rows
