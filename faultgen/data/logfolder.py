@@ -52,10 +52,12 @@ from faultgen import axes, inputs
 EVENTS = ("onset", "failure", "repair", "gearbox_change", "healthy")
 #: The columns of ``events.csv``, in order.
 EVENT_COLUMNS = ("unit", "stamp", "event", "axis")
-#: Largest events file read, bytes (a row is some 40 bytes: 400 000 events, a fleet's decades of
-#: maintenance). Read row by row, each event kept as a small object whose unit, event and kind are
-#: shared strings: at most about 15 times the file (64 MiB of minimal rows took 1.9 GB, 30 times).
-EVENTS_MAX_BYTES = 16 * 2**20
+#: Largest events file read, bytes (a row is some 40 bytes: 50 000 events, a hundred units' two
+#: decades of maintenance; at most 160 000 rows of the shortest form). Read row by row, each event
+#: kept as a small object whose unit, event and kind are shared strings: at most about 15 times the
+#: file. Bounded so that a unit's repairs, kept in its state (some 65 bytes each), stay well inside
+#: :data:`faultgen.monitor.state.STATE_MAX_BYTES` (16 MiB): at most 10 MB of them.
+EVENTS_MAX_BYTES = 2 * 2**20
 #: Per log and axis: the label codes of an imported dataset's ``label`` array.
 UNKNOWN, HEALTHY, WORN = -1, 0, 1
 #: What a link out of the folder is called in its refusal (:func:`faultgen.inputs.within`).
