@@ -29,6 +29,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import signal
 
 from faultgen.data.measured import MeasuredData
 from faultgen.model.robots import Robot
@@ -39,9 +40,12 @@ MIN_SPEEDS, MIN_STEADY = 3, 0.5
 SPEED_FLOOR = 1e-3
 #: The moving axis's speed is at least this many times every other axis's.
 DOMINANCE = 10.0
-#: Steady: within this share of the plateau speed (or 3 SPEED_FLOOR/10, whichever is larger).
-SPEED_TOLERANCE = 0.03
-#: Time dropped at each end of a steady stretch, s (the velocity filter's reach and the controller's settling).
+#: Steady: within this share of the plateau speed (a drive at a slow speed wavers by 10 % and more as
+#: friction grips and slips), or NOISE_SIGMAS times the averaged speed's noise.
+SPEED_TOLERANCE, NOISE_SIGMAS = 0.15, 4.0
+#: Speeds are averaged over this time, s (the segments found on them: encoder noise on a slow speed).
+SMOOTH = 0.25
+#: Time dropped at each end of a steady stretch besides SMOOTH / 2, s (the controller's settling).
 TRIM = 0.05
 #: Two segments' speeds are one speed when they agree within this share.
 SAME_SPEED = 0.05
@@ -83,31 +87,50 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(edges[::2], edges[1::2]))
 
 
+def smoothed_speed(log: MeasuredData) -> tuple[np.ndarray, np.ndarray]:
+    """Each axis's speed averaged over :data:`SMOOTH` s (the angle's central difference across it),
+    rad/s, shape (n, N); and the noise of that average per axis, rad/s, shape (N,): ``sqrt(2) s_q / SMOOTH``,
+    ``s_q`` the angle noise (1.4826 times the median absolute deviation of ``q`` from a Savitzky-Golay fit
+    over :data:`SMOOTH` / 2 s)."""
+    t, q = np.asarray(log.t), np.asarray(log.q)
+    dt = float(np.median(np.diff(t)))
+    h = max(1, int(round(SMOOTH / 2 / dt)))
+    ahead, behind = np.minimum(np.arange(len(t)) + h, len(t) - 1), np.maximum(np.arange(len(t)) - h, 0)
+    speed = (q[ahead] - q[behind]) / (t[ahead] - t[behind])[:, None]
+    window = min(2 * (h // 2) + 1, len(t) - (1 - len(t) % 2))
+    residual = q - signal.savgol_filter(q, max(window, 5), 3, axis=0)
+    noise = 1.4826 * np.median(np.abs(residual - np.median(residual, axis=0)), axis=0)
+    return speed, np.sqrt(2) * noise / SMOOTH
+
+
 def segments(log: MeasuredData) -> list[Segment]:
     """The constant-speed segments of ``log`` (module docstring), in time order."""
-    qd, t = np.asarray(log.qd), np.asarray(log.t)
+    t, q = np.asarray(log.t), np.asarray(log.q)
+    qd, noise = smoothed_speed(log)
+    floor = np.maximum(SPEED_FLOOR, NOISE_SIGMAS * noise)
     found = []
     for k in range(qd.shape[1]):
         speed = np.abs(qd[:, k])
-        others = np.delete(np.abs(qd), k, axis=1).max(axis=1) if qd.shape[1] > 1 else np.zeros(len(t))
-        moving = (speed > SPEED_FLOOR) & (speed >= DOMINANCE * others)
+        others = np.delete(np.abs(qd) - floor, k, axis=1).max(axis=1) if qd.shape[1] > 1 else np.zeros(len(t))
+        moving = (speed > floor[k]) & (speed >= DOMINANCE * others)
         for sign in (1.0, -1.0):
             for a, b in _runs(moving & (np.sign(qd[:, k]) == sign)):
                 v = speed[a:b]
                 top = np.percentile(v, 99)
                 plateau = np.median(v[v >= 0.95 * top])
-                steady = np.abs(v - plateau) <= max(SPEED_TOLERANCE * plateau, 0.3 * SPEED_FLOOR)
+                steady = np.abs(v - plateau) <= max(SPEED_TOLERANCE * plateau, NOISE_SIGMAS * noise[k])
                 stretches = _runs(steady)
                 if not stretches:
                     continue
                 s0, s1 = max(stretches, key=lambda r: t[a + r[1] - 1] - t[a + r[0]])
-                i0 = int(np.searchsorted(t, t[a + s0] + TRIM))
-                i1 = int(np.searchsorted(t, t[a + s1 - 1] - TRIM, side="right"))
+                i0 = int(np.searchsorted(t, t[a + s0] + SMOOTH / 2 + TRIM))
+                i1 = int(np.searchsorted(t, t[a + s1 - 1] - SMOOTH / 2 - TRIM, side="right"))
                 if i1 - i0 < 3 or t[i1 - 1] - t[i0] < MIN_STEADY:
                     continue
                 temperature = (float(np.mean(log.joint_temperature[i0:i1, k]))
                                if log.joint_temperature is not None else float("nan"))
-                found.append(Segment(k, float(np.mean(qd[i0:i1, k])), i0, i1, float(t[i1 - 1] - t[i0]), temperature))
+                mean = (q[i1 - 1, k] - q[i0, k]) / (t[i1 - 1] - t[i0])
+                found.append(Segment(k, float(mean), i0, i1, float(t[i1 - 1] - t[i0]), temperature))
     return sorted(found, key=lambda s: s.start)
 
 

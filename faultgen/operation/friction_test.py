@@ -20,7 +20,7 @@ The motion, per axis ``k`` (1..N in turn):
   velocity`` of the robot's tasks.toml; lower where the stroke cannot give :data:`STEADY` s of it).
 - **Each speed**: a move to one end of its stroke, a dwell of :data:`DWELL` s, the stroke at that
   speed (ruckig, jerk-limited ramps at the robot's acceleration limit), a dwell, the stroke back, a
-  dwell. Each stroke is as long as :data:`STEADY` s at speed plus both ramps needs (at most
+  dwell; the moves between strokes at a tenth of the acceleration limit (no constant speed). Each stroke is as long as :data:`STEADY` s at speed plus both ramps needs (at most
   :data:`STROKE_SHARE` of the range).
 
 Generic in the number of axes.
@@ -49,8 +49,9 @@ TOP_SHARE = 0.8
 LOW_SHARE = 0.5
 #: Longest stroke as a share of the joint range, and its clearance from each limit, rad.
 STROKE_SHARE, MARGIN = 0.6, math.radians(3.0)
-#: Dwell at each end of a stroke, s; speed scale of the moves between strokes.
-DWELL, REPOSITION = 0.4, 0.5
+#: Dwell at each end of a stroke, s; acceleration scale of the moves between strokes (slow
+#: ramps, so that they never hold a constant speed a reader could take for a test speed).
+DWELL, REPOSITION = 0.4, 0.1
 #: Postures searched per axis, their seed, and the flange's least height above the floor (share of the reach).
 CANDIDATES, SEED, FLOOR_SHARE = 300, 0, 0.2
 
@@ -148,14 +149,14 @@ def program(robot: Robot, axes: list[int] | None = None, count: int = SPEEDS) ->
             scale = round(float(speed / velocity[k]), 6)
             label = f"axis {axis} at {speed:.4g} rad/s"
             segments += [
-                {"type": "move", "to": _deg(a), "velocity_scale": REPOSITION},
+                {"type": "move", "to": _deg(a), "acceleration_scale": REPOSITION},
                 {"type": "dwell", "time": DWELL},
                 {"type": "move", "to": _deg(b), "velocity_scale": scale, "label": f"{label}, +"},
                 {"type": "dwell", "time": DWELL},
                 {"type": "move", "to": _deg(a), "velocity_scale": scale, "label": f"{label}, -"},
                 {"type": "dwell", "time": DWELL},
             ]
-    segments.append({"type": "move", "to": _deg(start), "velocity_scale": REPOSITION})
+    segments.append({"type": "move", "to": _deg(start), "acceleration_scale": REPOSITION})
     return {"name": "friction_test", "robot": robot.name, "process": "friction test",
             "description": f"constant-speed friction test, axes {', '.join(map(str, axes))}, {count} speeds each way",
             "start": _deg(start), "segment": segments}
