@@ -182,10 +182,10 @@ def friction_test_command(
     Example:
 
     \b
-      faultgen tasks friction-test puma560 --axes 1 --speeds 3 -o short.toml
-      faultgen simulate --robot puma560 --task short.toml --cycles 1 -o short.h5
+      faultgen tasks friction-test puma560 --axes 2 --speeds 4 -o short.toml
+      faultgen hidden-log puma560 --effect coulomb --task short.toml --cycles 1 -o log.csv
       faultgen friction-test log.csv --robot puma560 -o curve
-      faultgen friction-test later.csv --robot puma560 -o later --reference curve
+      faultgen friction-test log.csv --robot puma560 -o again --reference curve
     """
     from faultgen.calibrate import friction_report
     from faultgen.data import measured
@@ -199,8 +199,10 @@ def friction_test_command(
     for note in reading.notes:
         typer.echo(f"note: {note}")
     for _, row in reading.fits.iterrows():
+        temperature = "no temperature logged" if row["temperature_degC"] != row["temperature_degC"] else (
+            f"{row['temperature_degC']:.1f} degC")
         typer.echo(f"axis {int(row['axis'])} ({int(row['speeds'])} speeds, {row['model']}, "
-                   f"{row['temperature_degC']:.1f} degC): dry {row['coulomb_Nm']:.4g} N m "
+                   f"{temperature}): dry {row['coulomb_Nm']:.4g} N m "
                    f"[{row['coulomb_Nm_low']:.4g}, {row['coulomb_Nm_high']:.4g}], viscous {row['viscous_Nms_rad']:.4g} "
                    f"N m s/rad [{row['viscous_Nms_rad_low']:.4g}, {row['viscous_Nms_rad_high']:.4g}] (95 %, arm side)")
     typer.echo(f"wrote {len(written.files)} files into {out}")

@@ -127,7 +127,7 @@ def friction_test_command(
     \b
       faultgen tasks friction-test puma560 -o test.toml
       faultgen tasks friction-test puma560 --axes 1 --speeds 3 -o short.toml
-      faultgen simulate --robot puma560 --task test.toml --cycles 1 -o test.h5
+      faultgen simulate --robot puma560 --task short.toml --cycles 1 -o short.h5
     """
     from faultgen.data.atomic import atomic_path
     from faultgen.model import robots

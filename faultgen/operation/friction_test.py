@@ -157,7 +157,8 @@ def program(robot: Robot, axes: list[int] | None = None, count: int = SPEEDS) ->
                 {"type": "dwell", "time": DWELL},
             ]
     segments.append({"type": "move", "to": _deg(start), "acceleration_scale": REPOSITION})
-    return {"name": "friction_test", "robot": robot.name, "process": "friction test",
+    # no ``robot`` key: the test runs on the robot's calibrated or hidden-effect copies too
+    return {"name": f"friction_test_{robot.name}", "process": "friction test",
             "description": f"constant-speed friction test, axes {', '.join(map(str, axes))}, {count} speeds each way",
             "start": _deg(start), "segment": segments}
 
