@@ -184,8 +184,8 @@ def friction_test_command(
     \b
       faultgen tasks friction-test puma560 --axes 2 --speeds 4 -o short.toml
       faultgen hidden-log puma560 --effect coulomb --task short.toml --cycles 1 -o log.csv
-      faultgen friction-test log.csv --robot puma560 -o curve
-      faultgen friction-test log.csv --robot puma560 -o again --reference curve
+      faultgen friction-test log.csv --robot puma560 -o friction
+      faultgen friction-test log.csv --robot puma560 -o friction-again --reference friction
     """
     from faultgen.calibrate import friction_report
     from faultgen.data import measured
