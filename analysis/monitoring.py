@@ -320,7 +320,8 @@ def reconstruction_contributions(Z, M, groups=None) -> np.ndarray:
     out = np.empty((Z.shape[0], len(groups)))
     for column, g in enumerate(_check_groups(groups, n)):
         A = MZ[:, g]  # Xi^T M z per sample
-        out[:, column] = np.einsum("si,ij,sj->s", A, np.linalg.pinv(M[np.ix_(g, g)], rcond=1e-12, hermitian=True), A)
+        inverse = np.linalg.pinv(M[np.ix_(g, g)], rcond=1e-12, hermitian=True)  # (Xi^T M Xi)^+
+        out[:, column] = np.einsum("si,ij,sj->s", A, inverse, A)
     return np.clip(out, 0.0, None)
 
 
@@ -330,7 +331,8 @@ def _check_groups(groups, n: int) -> list[np.ndarray]:
     for k, g in enumerate(groups):
         g = np.asarray(g)
         if g.ndim != 1 or g.size == 0 or not np.issubdtype(g.dtype, np.integer) or g.min() < 0 or g.max() >= n:
-            raise ValueError(f"group {k} = {g.tolist()!r}; expected a non-empty list of feature indices in 0..{n - 1}")
+            raise ValueError(f"group {k} = {g.tolist()!r}; expected a non-empty list of feature indices "
+                             f"in 0..{n - 1}")
         checked.append(g)
     return checked
 

@@ -321,7 +321,8 @@ class UnitMonitor:
         """Each axis's isolation score for standardised residual(s) ``z`` (larger: more likely)."""
         if self.signatures is not None:
             return signature_scores(z, self.signatures / self.scale_)
-        axes = [np.arange(len(FEATURES)) * self.n_axes + a for a in range(self.n_axes)]
+        # each axis's features (by feature, then axis) reconstructed together
+        axes = np.arange(self.pca.n_features_in_).reshape(-1, self.n_axes).T
         return self.pca.contributions(np.atleast_2d(z), "q", method="rbc", groups=axes).mean(axis=0)
 
     # -- scoring --------------------------------------------------------------------------------
