@@ -498,7 +498,8 @@ class PCAContributionIsolator(Isolator):
     a residual remains). For the later cycles, E = Z (I - P_m P_m^T) and ``scores_[i] = mean over
     cycles of E[:, i]**2 / (1 - sum_j P[j, i]**2)``: how much Q falls when axis i is
     reconstructed (:func:`analysis.monitoring.reconstruction_contributions`). Axis i's share of Q,
-    ``E[:, i]**2`` alone, smears a fault over the axes correlated with it.
+    ``E[:, i]**2`` alone, smears a fault over the axes correlated with it. With one residual
+    direction (m = n_axes - 1) every axis's score is the whole Q: a tie, source axis 0.
 
     Parameters
     ----------
