@@ -36,7 +36,7 @@ from analysis import isolation, registry, scoring
 from analysis.benchmark.detection import locate_onset
 from analysis.benchmark.truth import fault_progress, opened
 from analysis.features import kl_divergence
-from analysis.monitoring import fit_q_monitor, varying_columns
+from analysis.monitoring import fit_q_monitor, reconstruction_contributions, varying_columns
 from faultgen.data import reader
 
 OWN, OTHER, TWIN = "own history", "another dataset", "the twin"
@@ -199,7 +199,7 @@ class ReferencePCAContribution(isolation.PCAContributionIsolator):
     another dataset: ``reference`` (m, N), the training units' per-cycle signal, each unit
     already :func:`unit_normalised`. The tested run is standardised by its own first
     ``n_reference`` cycles (its baseline) and its residual off the reference's components scored
-    per axis (thesis eq. 3.3-3.4)."""
+    per axis by reconstruction-based contribution to Q (thesis eq. 3.3-3.4; Alcala and Qin 2009)."""
 
     def __init__(self, reference=None, n_reference=20, variance=0.9):
         super().__init__(n_reference=n_reference, variance=variance)
@@ -216,8 +216,8 @@ class ReferencePCAContribution(isolation.PCAContributionIsolator):
         self.n_components_ = min(int(np.searchsorted(explained, self.variance - 1e-12) + 1), X.shape[1] - 1)
         self.components_ = vt[: self.n_components_]
         Z = (X[self.n_reference:] - self.mean_) / self.scale_
-        residual = Z - Z @ self.components_.T @ self.components_
-        return (residual**2).mean(axis=0)
+        residual_projector = np.eye(X.shape[1]) - self.components_.T @ self.components_
+        return reconstruction_contributions(Z, residual_projector).mean(axis=0)
 
 
 def trained_isolators(isolators: dict, train, test, baseline: int = 20,

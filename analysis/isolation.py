@@ -17,6 +17,7 @@ from sklearn.base import BaseEstimator
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_array
 
+from analysis.monitoring import reconstruction_contributions
 from faultgen import axes
 from faultgen.checks import is_whole
 
@@ -488,13 +489,17 @@ class TrendIsolator(Isolator):
 
 @register("pca_contribution")
 class PCAContributionIsolator(Isolator):
-    """Source axis = largest contribution to the PCA residual Q (thesis eq. 3.3-3.4).
+    """Source axis = largest reconstruction-based contribution to the PCA residual Q (thesis eq.
+    3.3-3.4; Alcala and Qin, Automatica 45 (2009) 1593-1600).
 
     The first ``n_reference`` cycles (normal operation) are standardised (their mean and
     standard deviation; a constant column is scaled by 1) and decomposed by SVD; the first m
     components explaining >= ``variance`` of their variance are kept (m at most n_axes - 1, so
-    a residual remains). For the later cycles, E = Z (I - P_m P_m^T) and
-    ``scores_[i] = mean over cycles of E[:, i]**2``, axis i's part of Q.
+    a residual remains). For the later cycles, E = Z (I - P_m P_m^T) and ``scores_[i] = mean over
+    cycles of E[:, i]**2 / (1 - sum_j P[j, i]**2)``: how much Q falls when axis i is
+    reconstructed (:func:`analysis.monitoring.reconstruction_contributions`). Axis i's share of Q,
+    ``E[:, i]**2`` alone, smears a fault over the axes correlated with it. With one residual
+    direction (m = n_axes - 1) every axis's score is the whole Q: a tie, source axis 0.
 
     Parameters
     ----------
@@ -511,7 +516,7 @@ class PCAContributionIsolator(Isolator):
         Principal directions P_m^T.
     n_components_ : int
     scores_ : ndarray of shape (n_axes,)
-        Mean squared standardised residual per axis over cycles n_reference+1 .. n.
+        Mean reconstruction-based contribution to Q per axis over cycles n_reference+1 .. n.
     source_axis_ : int
     """
 
@@ -536,8 +541,8 @@ class PCAContributionIsolator(Isolator):
         self.n_components_ = min(m, X.shape[1] - 1)
         self.components_ = vt[: self.n_components_]
         Z = (X[self.n_reference :] - self.mean_) / self.scale_
-        residual = Z - Z @ self.components_.T @ self.components_
-        return (residual**2).mean(axis=0)
+        residual_projector = np.eye(X.shape[1]) - self.components_.T @ self.components_
+        return reconstruction_contributions(Z, residual_projector).mean(axis=0)
 
 
 def signature_scores(residual, signatures) -> np.ndarray:

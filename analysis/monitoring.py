@@ -202,35 +202,139 @@ class PCAMonitor(BaseEstimator):
         alarm = {"q": q > self.q_limit_, "t2": t2 > self.t2_limit_}
         return alarm[self.statistic] if self.statistic in alarm else alarm["q"] | alarm["t2"]
 
-    def contributions(self, X, statistic: str = "q") -> np.ndarray:
-        """Contribution of each feature to Q or T2, for isolating the feature behind an alarm.
+    def index_matrix(self, statistic: str = "q") -> np.ndarray:
+        """The matrix ``M`` of the statistic as a quadratic form of the standardised sample ``z``,
+        ``index = z M z^T``, ndarray of shape (n_features, n_features): for ``"q"`` the residual
+        projector ``C~ = I - P_k P_k^T`` (eq. 2.5), for ``"t2"`` ``D = P_k Lambda_k^-1 P_k^T``
+        (eq. 2.3); Alcala and Qin, Automatica 45 (2009) 1593-1600.
 
-        ``"q"``: squared residuals ``e_j^2`` of the standardised sample, which sum to Q (the
-        thesis's Q contribution plots show the residuals ``e_j`` with their sign).
-        ``"t2"``: ``z P_k Lambda_k^(-1/2) P_k^T``, thesis eq. 8 (ch. 2.3.3.2), signed; the sum of
-        their squares is T2. Eq. 8 is printed with ``lambda^(1/2)``; the inverse square root is
-        the form whose squares add up to T2 (PLS_Toolbox ``tcon``, Wise & Gallagher 1996).
+        Raises ``ValueError`` for another ``statistic``."""
+        check_is_fitted(self, "q_limit_")
+        if statistic not in ("q", "t2"):
+            raise ValueError(f"statistic = {statistic!r}; expected 'q' or 't2'")
+        P = self.components_.T
+        if statistic == "q":
+            return np.eye(P.shape[0]) - P @ P.T
+        return (P / self.eigenvalues_[: self.n_components_]) @ P.T
+
+    def contributions(self, X, statistic: str = "q", method: str = "complete", groups=None) -> np.ndarray:
+        """Contribution of each feature (or group of features) to Q or T2, for isolating the feature
+        behind an alarm.
+
+        ``method="complete"`` (complete decomposition, the thesis's): ``"q"`` the squared residuals
+        ``e_j^2`` of the standardised sample, which sum to Q (the thesis's Q contribution plots show
+        the residuals ``e_j`` with their sign); ``"t2"`` ``z P_k Lambda_k^(-1/2) P_k^T``, thesis eq.
+        8 (ch. 2.3.3.2), signed; the sum of their squares is T2. Eq. 8 is printed with
+        ``lambda^(1/2)``; the inverse square root is the form whose squares add up to T2
+        (PLS_Toolbox ``tcon``, Wise & Gallagher 1996). A fault along one feature spreads into the
+        residuals of the features correlated with it, so the largest complete contribution can be
+        another feature's ("smearing").
+
+        ``method="rbc"``: reconstruction-based contributions (Alcala and Qin, Automatica 45 (2009)
+        1593-1600): the amount by which the statistic falls when the sample is
+        reconstructed along feature ``i``, ``RBC_i = (xi_i^T M z)^2 / (xi_i^T M xi_i)`` with ``M``
+        of :meth:`index_matrix` and ``xi_i`` the i-th unit vector; a fault of large enough size
+        along one feature has its largest RBC on that feature. Non-negative; they do not sum to the
+        statistic. A feature whose direction the statistic cannot see (``xi_i^T M xi_i`` below
+        1e-12 of the largest diagonal entry) has RBC 0.
 
         Parameters
         ----------
         X : array-like of shape (n_samples, n_features)
         statistic : {"q", "t2"}, default="q"
+        method : {"complete", "rbc"}, default="complete"
+        groups : sequence of n_groups index sequences, or None
+            Contributions of sets of features (e.g. one robot axis's features) instead of single
+            ones. With ``"rbc"`` a group is reconstructed along all its features at once,
+            ``z M Xi (Xi^T M Xi)^+ Xi^T M z^T`` (Alcala and Qin 2009, multidimensional
+            faults; ``^+`` the pseudo-inverse); with ``"complete"`` the group's squared
+            contributions are summed (``"t2"`` then also unsigned).
 
         Returns
         -------
-        ndarray of shape (n_samples, n_features)
+        ndarray of shape (n_samples, n_features), or (n_samples, n_groups) with ``groups``
 
         Raises
         ------
         ValueError
-            For another ``statistic``, or a number of features other than in fit.
+            For another ``statistic`` or ``method``, a group that is empty or names a feature out of
+            range, or a number of features other than in fit.
         """
         if statistic not in ("q", "t2"):
             raise ValueError(f"statistic = {statistic!r}; expected 'q' or 't2'")
-        _, T, E = self._project(X)
+        if method not in ("complete", "rbc"):
+            raise ValueError(f"method = {method!r}; expected 'complete' or 'rbc'")
+        Z, T, E = self._project(X)
+        groups = None if groups is None else _check_groups(groups, Z.shape[1])
+        if method == "rbc":
+            return reconstruction_contributions(Z, self.index_matrix(statistic), groups)
         if statistic == "q":
-            return E**2
-        return (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
+            complete = E**2
+        else:
+            complete = (T / np.sqrt(self.eigenvalues_[: self.n_components_])) @ self.components_
+        if groups is None:
+            return complete
+        squared = complete if statistic == "q" else complete**2
+        return np.stack([squared[:, g].sum(axis=1) for g in groups], axis=1)
+
+
+def reconstruction_contributions(Z, M, groups=None) -> np.ndarray:
+    """Reconstruction-based contributions (RBC) of each variable, or group of variables, to the
+    fault detection index ``z M z^T`` (Alcala and Qin, Automatica 45 (2009) 1593-1600):
+    ``RBC_i = (xi_i^T M z)^2 / (xi_i^T M xi_i)`` for variable ``i``, and ``z M Xi (Xi^T M
+    Xi)^+ Xi^T M z^T`` for a group whose unit vectors are the columns of ``Xi``: the largest fall of
+    the index along that direction (its minimum over ``f`` of ``(z - Xi f) M (z - Xi f)^T`` taken
+    from the index). A direction the index cannot see (``xi_i^T M xi_i`` below 1e-12 of the
+    largest diagonal entry of ``M``) contributes 0.
+
+    Parameters
+    ----------
+    Z : array-like of shape (n_samples, n_variables)
+        Samples in the variables of ``M`` (for :class:`PCAMonitor`, standardised).
+    M : array-like of shape (n_variables, n_variables)
+        Symmetric positive semi-definite matrix of the index (:meth:`PCAMonitor.index_matrix`).
+    groups : sequence of index sequences, or None
+        Sets of variables reconstructed together; None: each variable alone.
+
+    Returns
+    -------
+    ndarray of shape (n_samples, n_variables), or (n_samples, n_groups) with ``groups``
+
+    Raises
+    ------
+    ValueError
+        If ``M`` is not square with the samples' number of variables, or a group is empty or out
+        of range.
+    """
+    Z = np.atleast_2d(np.asarray(Z, dtype=float))
+    M = np.asarray(M, dtype=float)
+    n = Z.shape[1]
+    if M.shape != (n, n):
+        raise ValueError(f"M has shape {M.shape}; expected ({n}, {n}) for samples of {n} variables")
+    MZ = Z @ M  # row j: (M z_j)^T, M symmetric
+    tol = 1e-12 * max(float(np.abs(np.diag(M)).max()), np.finfo(float).tiny)
+    if groups is None:
+        diagonal = np.diag(M)
+        seen = diagonal > tol
+        return np.where(seen, MZ**2 / np.where(seen, diagonal, 1.0), 0.0)
+    out = np.empty((Z.shape[0], len(groups)))
+    for column, g in enumerate(_check_groups(groups, n)):
+        A = MZ[:, g]  # Xi^T M z per sample
+        inverse = np.linalg.pinv(M[np.ix_(g, g)], rcond=1e-12, hermitian=True)  # (Xi^T M Xi)^+
+        out[:, column] = np.einsum("si,ij,sj->s", A, inverse, A)
+    return np.clip(out, 0.0, None)
+
+
+def _check_groups(groups, n: int) -> list[np.ndarray]:
+    """``groups`` as integer index arrays, each non-empty and within ``0..n-1``."""
+    checked = []
+    for k, g in enumerate(groups):
+        g = np.asarray(g)
+        if g.ndim != 1 or g.size == 0 or not np.issubdtype(g.dtype, np.integer) or g.min() < 0 or g.max() >= n:
+            raise ValueError(f"group {k} = {g.tolist()!r}; expected a non-empty list of feature indices "
+                             f"in 0..{n - 1}")
+        checked.append(g)
+    return checked
 
 
 def fit_q_monitor(X, monitor: PCAMonitor) -> PCAMonitor:

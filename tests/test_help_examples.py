@@ -215,9 +215,9 @@ def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, mon
         if scheduler:
             cluster.close()
     # run in the checkout, the examples would leave `git status` clean: all they write is ignored
-    # (but your own sources: a robot folder of `robots add`, a program of `tasks export`)
+    # (but your own sources: a robot folder of `robots add`, a program of `tasks export` or `tasks friction-test`)
     sources = {w[w.index("-o") + 1] for line in lines for part in line.split("&&")
-               if (w := shlex.split(part, comments=True))[1:3] in (["robots", "add"], ["tasks", "export"])}
+               if (w := shlex.split(part, comments=True))[1:3] in (["robots", "add"], ["tasks", "export"], ["tasks", "friction-test"])}
     written = sorted(p.name + ("/" if p.is_dir() else "") for p in tmp_path.iterdir()
                      if p.name not in needed | sources and p.name != "__pycache__")
     if written:

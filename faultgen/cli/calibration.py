@@ -155,3 +155,54 @@ def hidden_log_command(
     synth.record(model, hidden, out, task=task, cycles=cycles, seed=seed, progress=True)
     typer.echo(f"wrote {out}: {model.name} {task}, {cycles} cycle(s), hidden {hidden}\n"
                f"calibrate it: faultgen calibrate --robot {robot} --measured {out} --out calib")
+
+
+@app.command("friction-test", cls=Command)
+def friction_test_command(
+    log: Annotated[Path, typer.Argument(help="Log of a friction test: t, q1..qN (rad), tau1..tauN (N m, arm side), "
+                                             "optionally qd1..qdN and temperature1..N; CSV or HDF5.")],
+    robot: Annotated[str, typer.Option(help="Robot name (see `faultgen robots`), robot folder or MJCF file.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Output folder (created): friction_curve.csv, "
+                                                           "friction_fit.csv, friction_axis<k>.png.")],
+    reference: Annotated[Path | None, typer.Option(
+        help="A reference test (an earlier output folder of this command, or its log): its curve in each figure.")] = None,
+    overwrite: Overwrite = False,
+) -> None:
+    """Read a friction test: each axis's friction against speed, by direction differencing, fitted.
+
+    The constant-speed segments are found without being told where they are (per axis at least 3
+    speeds each way, each steady at least 0.5 s with only that axis moving: faultgen's test,
+    `faultgen tasks friction-test`, or a maker's own routine). At each speed the friction is half the
+    difference of the two directions' torques at the same angles (gravity and inertia cancel: the
+    read does not rest on the model; where a direction is missing the model's rigid-body torque is
+    subtracted instead, and the output says so). Each axis's curve F = Fc + Fs exp(-(v/vs)^2) + Fv v
+    is fitted with 95 % intervals, at the logged temperature. Torques arm side (motor side: over the
+    gear ratio). Method: docs/friction-test.md.
+
+    Example:
+
+    \b
+      faultgen tasks friction-test puma560 --axes 2 --speeds 4 -o short.toml
+      faultgen hidden-log puma560 --effect coulomb --task short.toml --cycles 1 -o log.csv
+      faultgen friction-test log.csv --robot puma560 -o friction
+      faultgen friction-test log.csv --robot puma560 -o friction-again --reference friction
+    """
+    from faultgen.calibrate import friction_report
+    from faultgen.data import measured
+    from faultgen.model import robots
+
+    check_output_folder(out, overwrite)
+    loaded = robots.load(robot)
+    reading = friction_report.read(measured.read(log, loaded, accelerations=False), loaded)
+    ref = friction_report.reference_fits(reference, loaded) if reference is not None else None
+    written = friction_report.write(reading, out, ref)
+    for note in reading.notes:
+        typer.echo(f"note: {note}")
+    for _, row in reading.fits.iterrows():
+        temperature = "no temperature logged" if row["temperature_degC"] != row["temperature_degC"] else (
+            f"{row['temperature_degC']:.1f} degC")
+        typer.echo(f"axis {int(row['axis'])} ({int(row['speeds'])} speeds, {row['model']}, "
+                   f"{temperature}): dry {row['coulomb_Nm']:.4g} N m "
+                   f"[{row['coulomb_Nm_low']:.4g}, {row['coulomb_Nm_high']:.4g}], viscous {row['viscous_Nms_rad']:.4g} "
+                   f"N m s/rad [{row['viscous_Nms_rad_low']:.4g}, {row['viscous_Nms_rad_high']:.4g}] (95 %, arm side)")
+    typer.echo(f"wrote {len(written.files)} files into {out}")

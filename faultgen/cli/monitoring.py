@@ -46,7 +46,7 @@ def monitor_command(
         help="Calibrate each unit's model on its first log; --no-calibrate: the nominal model.")] = True,
     protocol: Annotated[str, typer.Option(
         help="twin: residuals against the unit's twin, isolation by wear signatures; own: the features "
-             "themselves, isolation by each axis's share of Q (no model).")] = "twin",
+             "themselves, isolation by each axis's reconstruction-based contribution to Q (no model).")] = "twin",
     train: Annotated[int, typer.Option(help="Logs of each unit's normal operation the monitor learns from.",
                                        min=MIN_TRAIN, max=MAX_LOGS)] = 28,
     alpha: Annotated[float, typer.Option(help="Significance level of the T2 and Q limits, below 0.5.",
@@ -90,7 +90,8 @@ def monitor_command(
     the twin a log alarms when the lower 90 % bound of the largest filtered wear reaches
     --wear-limit %; without it (--protocol own) when T2
     or Q is over its limit. A unit alarms from the first of --persistence consecutive alarming
-    logs; its source axis is the one with the largest wear estimate (own: the largest share of Q).
+    logs; its source axis is the one with the largest wear estimate (own: the largest
+    reconstruction-based contribution to Q, Alcala and Qin 2009).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (its calibrated model,
     then its own friction on the nominal model, then the nominal model, then --protocol own), and

@@ -105,3 +105,49 @@ def export_command(
     with atomic_path(out) as tmp:
         Path(tmp).write_text(text)
     typer.echo(f"wrote {out}: {task} of {robot} as a program file")
+
+
+@tasks_app.command("friction-test", cls=Command)
+def friction_test_command(
+    robot: Annotated[str, typer.Argument(help="Robot name or MJCF file.")],
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="Program file to write (default: print).")] = None,
+    axes: Annotated[str | None, typer.Option(help="Axes to test, comma-separated, e.g. 1,2 (default: all).")] = None,
+    speeds: Annotated[int, typer.Option(help="Constant speeds per axis and direction (at least 3).")] = 7,
+    overwrite: Overwrite = False,
+) -> None:
+    """Write a friction test as a program file: each axis in turn at constant speeds, both ways.
+
+    Per axis: speeds spaced in log from inside the Stribeck region to 80 % of the speed limit, each
+    over a stroke inside the joint limits (1.5 s steady, jerk-limited ramps, dwells), from a posture
+    where gravity on that axis changes least. Its duration is printed. Run it like any task
+    (`simulate --task`, sweeps) and read its log with `faultgen friction-test` (docs/friction-test.md).
+
+    Examples:
+
+    \b
+      faultgen tasks friction-test puma560 -o test.toml
+      faultgen tasks friction-test puma560 --axes 1 --speeds 3 -o short.toml
+      faultgen simulate --robot puma560 --task short.toml --cycles 1 -o short.h5
+    """
+    from faultgen.data.atomic import atomic_path
+    from faultgen.model import robots
+    from faultgen.operation import friction_test, programs
+
+    chosen = None
+    if axes is not None:
+        try:
+            chosen = [int(a) for a in axes.split(",")]
+        except ValueError:
+            raise ValueError(f"--axes {axes!r}: expected axis numbers separated by commas, e.g. 1,2") from None
+    if out is not None:
+        check_outputs([out], overwrite)
+    loaded = robots.load(robot)
+    text = friction_test.text(loaded, chosen, speeds)
+    duration = programs.parse(text, loaded, where="friction test").trajectory(loaded.model.opt.timestep).duration
+    if out is None:
+        typer.echo(text, nl=False)
+        typer.echo(f"# friction test of {robot}: {duration:.1f} s", err=True)
+        return
+    with atomic_path(out) as tmp:
+        Path(tmp).write_text(text)
+    typer.echo(f"wrote {out}: friction test of {robot}, {duration:.1f} s ({duration / 60:.1f} min)")

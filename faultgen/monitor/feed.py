@@ -69,7 +69,7 @@ def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list
     """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
     rul.csv (:func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
     they are made in parallel too."""
-    note = "wear signature match" if monitor.signatures is not None else "share of Q"
+    note = "wear signature match" if monitor.signatures is not None else "RBC of Q"
     buffer = io.BytesIO()
     report.chart(buffer, monitor, note)
     return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)

@@ -149,7 +149,7 @@ def _draw(path, monitor, axis_note: str, plt) -> None:
     top.set_ylabel("statistic / its limit")
     protocol = "twin" if monitor.signatures is not None else "own"
     top.set_title(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)")
-    bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'share of Q'})")
+    bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'RBC of Q'})")
     if rows:
         top.legend(fontsize=7, loc="upper left")
         bottom.legend(fontsize=7, loc="upper left", ncol=3)

@@ -46,9 +46,11 @@ says how much wear, so a slow wear is called at a level and not when it first le
 Either way, a unit's alarm is persistent from the first of ``persistence`` consecutive alarming
 logs (thesis ch. 3.4.1, :func:`analysis.monitoring.detect_onset`). Each log's axes are ranked: with the twin by how
 closely the residual points along each axis's wear signature
-(:func:`analysis.isolation.signature_scores`), without it by each axis's share of Q (thesis eq.
-3.3-3.4). The source axis of a persistent alarm is the first of the ranking of the mean
-residual over the logs that made it persistent.
+(:func:`analysis.isolation.signature_scores`), without it by each axis's reconstruction-based
+contribution to Q (Alcala and Qin, Automatica 45 (2009) 1593-1600: how much Q falls when the log is
+reconstructed along that axis's features; each axis's share of Q, thesis eq. 3.3-3.4, smears a fault
+over the axes whose features are correlated with it). The source axis of a persistent alarm is the
+first of the ranking of the mean residual over the logs that made it persistent.
 
 State is small and bounded per log (a row of scores each); a rerun on a grown folder rebuilds the
 monitor by feeding it the stored inputs again (:mod:`faultgen.monitor.state`: JSON, no pickle) and
@@ -322,8 +324,9 @@ class UnitMonitor:
         """Each axis's isolation score for standardised residual(s) ``z`` (larger: more likely)."""
         if self.signatures is not None:
             return signature_scores(z, self.signatures / self.scale_)
-        contributions = self.pca.contributions(np.atleast_2d(z), "q").mean(axis=0)
-        return contributions.reshape(-1, self.n_axes).sum(axis=0)
+        # each axis's features (by feature, then axis) reconstructed together
+        axes = np.arange(self.pca.n_features_in_).reshape(-1, self.n_axes).T
+        return self.pca.contributions(np.atleast_2d(z), "q", method="rbc", groups=axes).mean(axis=0)
 
     # -- scoring --------------------------------------------------------------------------------
     def add(self, stamp: str, residual: np.ndarray, temperature: float, payload: float,
@@ -445,7 +448,8 @@ class UnitMonitor:
         value = float(np.mean(q) if self.statistic == "Q" else np.mean(t2))
         self.limit = float(self.pca.q_limit_ if self.statistic == "Q" else self.pca.t2_limit_)
         self.evidence = (f"{self.statistic} {value:.3g} ({span}) > limit {self.limit:.3g} at alpha "
-                         f"{self.settings.alpha:g}; axis {self.source_axis} first by share of Q "
+                         f"{self.settings.alpha:g}; axis {self.source_axis} first by reconstruction-based "
+                         "contribution to Q "
                          f"({scores[order[0]]:.3g}; next axis {order[1] + 1}: {scores[order[1]]:.3g})")
 
     def _open_alarm(self) -> dict:

@@ -26,7 +26,8 @@ SEGMENT_KEYS = {
 #: default. A closed list, so that a typo or a stray value is refused, naming the key.
 PROGRAM_PROCESSES = (*PROCESSES.values(), "program", "handling", "pick and place", "palletizing", "packaging",
                      "machine tending", "assembly", "spot welding", "arc welding", "laser welding", "cutting",
-                     "painting", "dispensing", "gluing", "grinding", "polishing", "deburring", "inspection")
+                     "painting", "dispensing", "gluing", "grinding", "polishing", "deburring", "inspection",
+                     "friction test")
 
 
 #: Most ``[[segment]]`` tables a program may have, counted before any is checked, planned or sampled
