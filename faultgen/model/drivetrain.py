@@ -185,7 +185,9 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
     ------
     DrivetrainError
         If the file is not TOML, has a key other than ``axis`` at the top or an unknown key in an
-        axis table, names an axis outside 1..N, gives a value that is not a finite number or is
+        axis table (the gearbox rating's keys, :data:`faultgen.model.rating.KEYS`, are checked and
+        left out of the table: :func:`faultgen.model.rating.given` reads them), names an axis
+        outside 1..N, gives a value that is not a finite number or is
         negative (or zero where :data:`POSITIVE` needs > 0), or (``partial=False``) lacks an axis
         or a key. The message names the file, the axis and the key.
     """
@@ -212,13 +214,17 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
             raise DrivetrainError(f"{path}: [axis.{label}] is not an axis of this arm (1..{n_axes})")
         if not isinstance(values, dict):
             raise DrivetrainError(f"{path}: axis.{label} must be a table")
-        bad = sorted(set(values) - set(KEYS))
+        from faultgen.model import rating  # the gearbox rating's keys, read by faultgen.model.rating
+
+        bad = sorted(set(values) - set(KEYS) - set(rating.KEYS))
         if bad:
             raise DrivetrainError(
-                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}"
+                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS + rating.KEYS)}"
             )
         try:
-            table[axis] = {k: check_value(k, v) for k, v in values.items()}
+            for k in set(values) & set(rating.KEYS):
+                rating.check(k, values[k])
+            table[axis] = {k: check_value(k, v) for k, v in values.items() if k not in rating.KEYS}
         except DrivetrainError as err:
             raise DrivetrainError(f"{path}: axis {axis}: {err}") from None
     if not partial:
