@@ -88,7 +88,9 @@ def settings_digest(settings: Settings, model: str, twin_temperature: bool, robo
 class Entry:
     """One scored log as the monitor was fed it: ``stamp``, the log file's ``sha256``, its
     ``residual`` (n_features,), mean joint ``temperature`` (deg C, NaN when not logged), ``payload``
-    (kg) and the twin's ``expected`` features (n_features,; None without a twin)."""
+    (kg), the twin's ``expected`` features (n_features,; None without a twin), the share of each
+    axis's rated life the log consumed, ``life`` (n_axes,; :func:`faultgen.monitor.life.consumption`;
+    None in a state written before it) and the log's ``duration`` (s)."""
 
     stamp: str
     sha256: str
@@ -96,6 +98,8 @@ class Entry:
     temperature: float
     payload: float
     expected: np.ndarray | None
+    life: np.ndarray | None = None
+    duration: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -198,7 +202,9 @@ def write_unit(path: Path, state: UnitState) -> None:
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
-                  "expected": None if e.expected is None else _floats(e.expected)} for e in state.entries],
+                  "expected": None if e.expected is None else _floats(e.expected),
+                  **({} if e.life is None else {"life": _floats(e.life), "duration_s": float(e.duration)})}
+                 for e in state.entries],
     }
     atomic.write_text(path, json.dumps(document, separators=(",", ":")))
 
@@ -258,6 +264,18 @@ def _number(value, path: Path, name: str) -> float:
     if not isinstance(value, (int, float)) or isinstance(value, bool):
         raise StateError(f"{path}: {name} = {str(value)[:40]!r} is not a number")
     return float(value)
+
+
+def _load(log: dict, path: Path, where: str, n_axes: int) -> tuple[np.ndarray | None, float]:
+    """An entry's ``life`` and ``duration_s`` (:class:`Entry`): both or neither; each axis's share
+    >= 0, the duration > 0."""
+    if "life" not in log and "duration_s" not in log:
+        return None, math.nan
+    life = _vector(log.get("life"), path, f"{where}.life", n_axes)
+    duration = _number(log.get("duration_s"), path, f"{where}.duration_s")
+    if np.any(life < 0) or not (math.isfinite(duration) and duration > 0):
+        raise StateError(f"{path}: {where}: life below 0 or duration_s not a finite number > 0")
+    return life, duration
 
 
 def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
@@ -338,7 +356,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
             _number(log.get("temperature_C"), path, f"{where}.temperature_C"),
             _number(log.get("payload_kg"), path, f"{where}.payload_kg"),
-            None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
+            None if expected is None else _vector(expected, path, f"{where}.expected", n_features),
+            *_load(log, path, where, n_axes)))
         if not math.isfinite(entries[-1].payload):
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
