@@ -91,9 +91,9 @@ def test_consumption_accumulates_between_logs_at_the_operating_hours_and_a_gearb
 def test_service_by_is_the_earlier_of_the_load_and_the_condition_based_life():
     life_rows = [{"axis": "1", "days_left": "40"}, {"axis": "2", "days_left": ""}]
     rul_rows = [{"axis": "2", "rul": "12.4", "time_unit": "days"}]
-    assert life.service_by("2026-03-01", life_rows, rul_rows) == ("2026-03-13", "wear of axis 2 (condition)")
-    assert life.service_by("2026-03-01", life_rows, []) == ("2026-04-10", "rated life of axis 1 (load)")
-    assert life.service_by("17", life_rows, []) == ("in 40 days", "rated life of axis 1 (load)")
+    assert life.service_by("2026-03-01", life_rows, rul_rows) == ("2026-03-13", "condition: axis 2's wear")
+    assert life.service_by("2026-03-01", life_rows, []) == ("2026-04-10", "load: axis 1's rated life")
+    assert life.service_by("17", life_rows, []) == ("in 40 days", "load: axis 1's rated life")
     assert life.service_by("2026-03-01", [], []) == ("", "")
 
 
@@ -123,7 +123,8 @@ def test_drivetrain_toml_gives_the_rating_and_a_bad_one_is_refused_naming_axis_a
     for bad, match in (('gearbox_type = "planetary"', "axis 2: gearbox_type = 'planetary'; expected one of"),
                        ("rated_torque = -1.0", r"axis 2: rated_torque = -1.0; expected a finite number > 0"),
                        ("rated_life = nan", r"axis 2: rated_life = nan; expected a finite number"),
-                       ('rated_speed = "fast"', r"axis 2: rated_speed = 'fast'; expected")):
+                       ('rated_speed = "fast"', r"axis 2: rated_speed = 'fast'; expected"),
+                       ('gearbox_type = ["cycloid"]', r"axis 2: gearbox_type = \"\['cycloid'\]\"; expected one of")):
         path.write_text(text.replace("[axis.2]\n", f"[axis.2]\n{bad}\n"))
         for read in (lambda: drivetrain.read_table(path, n), lambda: rating.given(path, n)):
             with pytest.raises(drivetrain.DrivetrainError, match=match):

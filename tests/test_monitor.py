@@ -75,7 +75,7 @@ def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
         assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
     out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
-    for name in ("alarms.csv", "scores.csv", "rul.csv", "wear.csv"):
+    for name in ("alarms.csv", "scores.csv", "rul.csv", "wear.csv", "life.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
 
 
@@ -98,6 +98,44 @@ def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(f
             assert 0 <= float(r["rul_5"]) <= float(r["rul"]) <= float(r["rul_95"]) < prognosis.HORIZON, r
         elif not t["axis"]:
             assert r["rul"] == "" and "no end of life within the horizon (365 days)" in r["verdict"], r
+
+
+def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_it(fleet, monitored):
+    """life.csv (faultgen.monitor.life): a row per unit and axis; one log's consumption in the state
+    is that log's by the formula (test_life.py checks the formula by hand), the consumed % the sum
+    of each log's % per day times the days since the log before it, and the page shows each unit's."""
+    import csv
+    import json
+    from datetime import datetime
+
+    from faultgen.data import measured
+    from faultgen.model import robots
+    from faultgen.monitor import life
+
+    robot, logs, _ = fleet
+    nominal = robots.load(robot)
+    with open(monitored / "life.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    units = sorted(p.name for p in logs.iterdir() if p.is_dir())
+    assert [(r["unit"], int(r["axis"])) for r in rows] == [(u, a) for u in units for a in range(1, nominal.n_axes + 1)]
+    page = (monitored / "report.html").read_text()
+    assert "Rated life consumed by load (life.csv)" in page and "service by" in page
+    for unit in units:
+        entries = json.loads((monitored / ".state" / f"{unit}.json").read_text())["logs"]
+        first = sorted((logs / unit).iterdir())[0]
+        data = measured.read(first, nominal)
+        assert entries[0]["life"] == list(life.consumption(data.t, data.qd, data.tau, life.ratings_of(nominal)))
+        assert entries[0]["duration_s"] == data.t[-1] - data.t[0]
+        mine = [r for r in rows if r["unit"] == unit]
+        for r in mine:
+            k = int(r["axis"]) - 1
+            per_day = [e["life"][k] / e["duration_s"] * 16 * 3600 * 100 for e in entries]  # % per day, 16 h a day
+            stamps = [datetime.fromisoformat(e["stamp"]) for e in entries]
+            days = [(b - a).total_seconds() / 86400 for a, b in zip(stamps, stamps[1:])]
+            assert float(r["consumed_pct"]) == pytest.approx(sum(p * d for p, d in zip(per_day[1:], days)), rel=1e-5)
+            assert float(r["duty_pct_per_day"]) == pytest.approx(np.mean(per_day[-life.WINDOW:]), rel=1e-5)
+            assert float(r["consumed_pct"]) > 0 and r["since"] == entries[0]["stamp"] and r["stamp"] == entries[-1]["stamp"]
+        assert life.table_cell(mine).split(":")[0] in page
 
 
 def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
@@ -634,13 +672,13 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
     charts = tuple(p.name for p in monitored.glob("*.png"))
     assert charts
-    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
     # a rerun with no new log: every unit's chart and remaining life made again in the workers, the same bytes
     for name in charts:
         (out / name).unlink()
     loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
-    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
 

@@ -36,23 +36,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from faultgen import inputs
-from faultgen.model.drivetrain import AxisDrive, Drivetrain, DrivetrainError
+from faultgen.model.drivetrain import (GEARBOX_EXPONENTS, RATING_BOUNDS, RATING_KEYS, RATING_UNITS, AxisDrive,
+                                       Drivetrain, DrivetrainError, check_rating)
 from faultgen.model.sizing import main_axes
 
-#: Gearbox types and the life exponent p of each (Harmonic Drive: 3; Nabtesco RV and ISO 281's
-#: roller bearings: 10/3).
-EXPONENTS = {"strain-wave": 3.0, "cycloid": 10.0 / 3.0}
-#: Unit and meaning of each rating key, in file order.
-UNITS = {
-    "gearbox_type": f"one of {', '.join(EXPONENTS)}",
-    "rated_torque": "N m, arm side (gear output), at the rated speed",
-    "rated_speed": "rad/s, arm side (gear output)",
-    "rated_life": "h at rated torque and speed, L10",
-}
-KEYS = tuple(UNITS)
-#: Bounds of the numbers, (low, high), exclusive of 0: far outside any robot gear (rated torques
-#: 1 .. 10^5 N m, output speeds 0.1 .. 10 rad/s, lives 10^3 .. 10^5 h).
-BOUNDS = {"rated_torque": (0.0, 1e7), "rated_speed": (0.0, 1e4), "rated_life": (0.0, 1e7)}
+#: Gearbox types and their life exponent p, the rating keys' units, bounds and check (kept in
+#: :mod:`faultgen.model.drivetrain`, whose reader checks them in ``drivetrain.toml``).
+EXPONENTS, UNITS, KEYS, BOUNDS = GEARBOX_EXPONENTS, RATING_UNITS, RATING_KEYS, RATING_BOUNDS
+check = check_rating
 
 #: Arm-side peak torque / rated torque of the default (module docstring).
 PEAK_TO_RATED = 2.5
@@ -68,25 +59,6 @@ RULES = {
     "rated_speed": "cycloid 15 rpm (Nabtesco RV-E); strain-wave 2000 rpm / G (Harmonic Drive's rated input speed)",
     "rated_life": "cycloid 6000 h (Nabtesco RV-E, L10); strain-wave 7000 h (Harmonic Drive L50 35000 h / 5)",
 }
-
-
-def check(key: str, value) -> str | float:
-    """``value`` of rating key ``key``, checked: a known type, or a finite number > 0 within :data:`BOUNDS`.
-
-    Raises
-    ------
-    DrivetrainError
-        Naming the key, the value and what was expected.
-    """
-    if key == "gearbox_type":
-        if value not in EXPONENTS:
-            raise DrivetrainError(f"gearbox_type = {value!r}; expected one of {', '.join(map(repr, EXPONENTS))}")
-        return value
-    low, high = BOUNDS[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not low < value <= high:
-        raise DrivetrainError(f"{key} = {value!r}; expected a finite number > {low:g} and <= {high:g} ({UNITS[key]})")
-    return float(value)
 
 
 @dataclass(frozen=True)

@@ -187,8 +187,8 @@ def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOU
 def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     r = row.rating
     default = ", default" if "rated_life" in r.defaults or "rated_torque" in r.defaults else ""
-    origin = "the gearbox change" if changed else "the unit's first log (what ran before it is not known)"
-    text = (f"{row.consumed:.3g} % of the rated life ({r.rated_life:g} h L10 at {r.rated_torque:.4g} N m, "
+    origin = "the gearbox change" if changed else "the unit's first log: what ran before it is not known"
+    text = (f"{row.consumed:.3g} % of the rated life ({r.rated_life:g} h L10 at {r.rated_torque:.5g} N m, "
             f"{r.gearbox_type}{default}) consumed since {row.since} ({origin})")
     if not row.logs:
         return text + ": no log with a load record since"
@@ -198,7 +198,7 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
         text += f"; past the rated life (100 %), at {row.duty:.3g} % per day"
     else:
         text += (f"; at {row.duty:.3g} % per day (last {min(row.logs, window)} logs, {row.hours_per_day:g} h of "
-                 f"operation a day) 100 % in {row.days_left:.4g} days")
+                 f"operation a day) 100 % in {row.days_left:.0f} days")
     return text + (f" ({missing} logs without a load record left out)" if missing else "")
 
 
@@ -229,11 +229,11 @@ def service_by(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> 
     for r in life_rows:
         days = _float(r.get("days_left"))
         if math.isfinite(days):
-            found.append((max(days, 0.0), f"rated life of axis {r.get('axis')} (load)"))
+            found.append((max(days, 0.0), f"load: axis {r.get('axis')}'s rated life"))
     for r in rul_rows:
         days = _float(r.get("rul"))
         if math.isfinite(days) and r.get("time_unit") == "days":
-            found.append((days, f"wear of axis {r.get('axis')} (condition)"))
+            found.append((days, f"condition: axis {r.get('axis')}'s wear"))
     if not found:
         return "", ""
     days, why = min(found, key=lambda f: f[0])
@@ -254,3 +254,16 @@ def _float(cell) -> float:
         return float(cell)
     except (TypeError, ValueError):
         return math.nan
+
+
+def table_cell(rows: list[dict]) -> str:
+    """The fleet table's cell of a unit's rows of life.csv (as read): the axis that consumed most,
+    its % and the days left at the recent duty."""
+    found = [(r, _float(r.get("consumed_pct"))) for r in rows]
+    found = [(r, c) for r, c in found if math.isfinite(c)]
+    if not found:
+        return ""
+    r, consumed = max(found, key=lambda f: f[1])
+    days = _float(r.get("days_left"))
+    left = f"{days:.0f} days left" if math.isfinite(days) else "no load"
+    return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"

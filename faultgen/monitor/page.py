@@ -35,7 +35,7 @@ from pathlib import Path
 
 from faultgen import inputs
 from faultgen.data import atomic, cells
-from faultgen.monitor import report, scoring
+from faultgen.monitor import life, report, scoring
 
 #: The page's file name in OUT.
 PAGE = "report.html"
@@ -120,6 +120,7 @@ class Unit:
     closed: list[dict] = field(default_factory=list)
     scores: list[dict] = field(default_factory=list)
     remaining: dict[int, dict] = field(default_factory=dict)  # axis -> its row of rul.csv
+    life: list[dict] = field(default_factory=list)  # its rows of life.csv
 
     @property
     def name(self) -> str:
@@ -190,6 +191,10 @@ def read(folder: str | Path) -> Fleet:
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
+    if (folder / "life.csv").exists():  # the rated life consumed by load (issue 75; optional)
+        for r in _read_csv(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"))[1]:
+            if r["unit"] in units:
+                units[r["unit"]].life.append(r)
     n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
     ordered = sorted(units.values(), key=Unit.attention)
     return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
@@ -410,7 +415,7 @@ SCRIPT = """
 
 #: The fleet table's columns.
 COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)",
-           "remaining life (5-95 %)", "last log", "logs", "closed alarms")
+           "remaining life (5-95 %)", "life consumed by load", "service by", "last log", "logs", "closed alarms")
 
 
 def _remaining(row: dict | None) -> str:
@@ -450,8 +455,14 @@ def _table_row(index: int, unit: Unit) -> str:
     remaining = _e(_remaining(unit.remaining.get(wear[0]))) if wear is not None else ""
     cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
               _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
-              remaining, _e(unit.row.get("last_log", "")), _e(unit.row.get("logs_scored", "")), closed]
+              remaining, _e(life.table_cell(unit.life)), _service_by(unit), _e(unit.row.get("last_log", "")),
+              _e(unit.row.get("logs_scored", "")), closed]
     return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
+
+
+def _service_by(unit: Unit) -> str:
+    date, why = life.service_by(unit.row.get("last_log", ""), unit.life, list(unit.remaining.values()))
+    return f"{_e(date)} ({_e(why)})" if date else ""
 
 
 def _panel(index: int, unit: Unit, settings: dict) -> str:
@@ -475,6 +486,9 @@ def _panel(index: int, unit: Unit, settings: dict) -> str:
                         + (f" ({_e(r['model'])} trend of {_e(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
                         + "</li>" for axis, r in sorted(unit.remaining.items()))
         parts.append(f"<p>Remaining life until the wear estimate reaches the failure wear (rul.csv):</p><ul>{items}</ul>")
+    if unit.life:
+        items = "".join(f"<li>axis {_e(r['axis'])}: {_e(r['verdict'])}</li>" for r in unit.life)
+        parts.append(f"<p>Rated life consumed by load (life.csv); service by {_service_by(unit) or '–'}:</p><ul>{items}</ul>")
     if unit.closed:
         items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
