@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,8 @@ from typer.testing import CliRunner
 from faultgen.cli.main import app
 from faultgen.model import drivetrain, rating, robots
 from faultgen.monitor import life
+
+UR5_DH = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 
 # one log of four samples, 1 s apart: axis 1 a strain-wave gear, axis 2 a cycloid at its rated point
 T = np.array([0.0, 1.0, 2.0, 3.0])
@@ -136,3 +139,15 @@ def test_robots_name_prints_the_rating_with_its_defaults_marked():
     assert result.exit_code == 0, result.output
     assert "rated torque [N m] (default)" in result.output
     assert "(default, or * where others are given) rated_life: cycloid 6000 h (Nabtesco RV-E, L10)" in result.output
+
+
+def test_a_rating_given_to_robots_add_is_kept_in_the_folder_and_the_rest_defaults(tmp_path):
+    drive = tmp_path / "drives.toml"
+    drive.write_text('[axis.5]\ngearbox_type = "cycloid"\nrated_life = 9000.0\n')
+    result = CliRunner().invoke(app, ["robots", "add", "ur5", "--from", str(UR5_DH), "--drivetrain", str(drive),
+                                      "-o", str(tmp_path / "ur5")])
+    assert result.exit_code == 0, result.output
+    ratings = rating.of_robot(robots.load(tmp_path / "ur5"))
+    assert (ratings[4].gearbox_type, ratings[4].rated_life, ratings[4].defaults) == \
+        ("cycloid", 9000.0, ("rated_torque", "rated_speed"))
+    assert ratings[3].gearbox_type == "strain-wave" and ratings[3].defaults == rating.KEYS

@@ -194,9 +194,11 @@ class Drivetrain:
                 raise DrivetrainError(f"{source}: axis {axis}: {err}") from None
         return cls(tuple(axes))
 
-    def to_toml(self, notes: dict[int, dict[str, str]] | None = None, header: str = "") -> str:
+    def to_toml(self, notes: dict[int, dict[str, str]] | None = None, header: str = "",
+                ratings: dict[int, dict] | None = None) -> str:
         """The drivetrain as ``drivetrain.toml`` text, every number at full precision (``repr``);
-        ``notes[axis][key]`` is written as a comment after the value (its source)."""
+        ``notes[axis][key]`` is written as a comment after the value (its source); ``ratings[axis]``
+        the gearbox rating keys given (:data:`RATING_KEYS`), written after the axis's numbers."""
         lines = [f"# {line}" if line else "#" for line in header.splitlines()]
         lines += ["# Units: " + "; ".join(f"{k}: {u}" for k, u in UNITS.items()), ""]
         for axis, drive in enumerate(self.axes, start=1):
@@ -204,6 +206,8 @@ class Drivetrain:
             for key, value in asdict(drive).items():
                 note = (notes or {}).get(axis, {}).get(key)
                 lines.append(f"{key} = {value!r}" + (f"  # {note}" if note else ""))
+            given = (ratings or {}).get(axis, {})
+            lines += [f"{key} = {given[key]!r}  # given in --drivetrain" for key in RATING_KEYS if key in given]
             lines.append("")
         return "\n".join(lines)
 
