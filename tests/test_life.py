@@ -49,6 +49,8 @@ def test_the_catalogues_averaged_form_gives_the_same_consumption():
 def test_a_log_of_the_wrong_shape_or_times_is_refused_naming_them():
     with pytest.raises(ValueError, match=r"qd \(4, 1\).*expected"):
         life.consumption(T, QD[:, :1], TAU, RATINGS)
+    with pytest.raises(ValueError, match="2 ratings for 1 axes"):
+        life.consumption(T, QD[:, :1], TAU[:, :1], RATINGS)
     with pytest.raises(ValueError, match="strictly increasing"):
         life.consumption(T[::-1], QD, TAU, RATINGS)
 
@@ -56,7 +58,7 @@ def test_a_log_of_the_wrong_shape_or_times_is_refused_naming_them():
 @dataclass
 class _Entry:
     stamp: str
-    life: np.ndarray | None
+    load: np.ndarray | None
     duration: float
 
 
@@ -69,9 +71,12 @@ class _Event:
 
 
 def test_consumption_accumulates_between_logs_at_the_operating_hours_and_a_gearbox_change_resets_it():
-    # each log: 60 s consuming 1e-6 of axis 1's and 2e-6 of axis 2's rated life -> per hour of
-    # operation 6e-5 and 1.2e-4; 16 h a day: 0.096 % and 0.192 % per day
-    entries = [_Entry(f"2026-03-{d:02d}", np.array([1e-6, 2e-6]), 60.0) for d in (1, 2, 4, 5)]
+    # each log: 60 s consuming 1e-6 of axis 1's and 2e-6 of axis 2's rated life (integral |qd| |tau|^p dt
+    # = the share x n_N T_N^p L_n) -> per hour of operation 6e-5 and 1.2e-4; 16 h a day: 0.096 % and 0.192 %
+    load = np.zeros((2, 2))
+    load[0, 0] = 1e-6 * 2.0 * 10.0 ** 3 * 1000 * 3600  # strain-wave, p = 3: the first row
+    load[1, 1] = 2e-6 * 1.0 * 100.0 ** (10 / 3) * 6000 * 3600  # cycloid, p = 10/3: the second
+    entries = [_Entry(f"2026-03-{d:02d}", load, 60.0) for d in (1, 2, 4, 5)]
     rows = life.of_unit("u", entries, [], RATINGS, hours_per_day=16.0)
     # days counted between logs from the first: 1 + 2 + 1 = 4 days
     assert rows[0].consumed == pytest.approx(4 * 0.096) and rows[1].consumed == pytest.approx(4 * 0.192)

@@ -101,8 +101,8 @@ def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(f
 
 
 def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_it(fleet, monitored):
-    """life.csv (faultgen.monitor.life): a row per unit and axis; one log's consumption in the state
-    is that log's by the formula (test_life.py checks the formula by hand), the consumed % the sum
+    """life.csv (faultgen.monitor.life): a row per unit and axis; one log's load in the state gives
+    that log's consumption by the formula (test_life.py checks the formula by hand), the consumed % the sum
     of each log's % per day times the days since the log before it, and the page shows each unit's."""
     import csv
     import json
@@ -124,12 +124,18 @@ def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_
         entries = json.loads((monitored / ".state" / f"{unit}.json").read_text())["logs"]
         first = sorted((logs / unit).iterdir())[0]
         data = measured.read(first, nominal)
-        assert entries[0]["life"] == list(life.consumption(data.t, data.qd, data.tau, life.ratings_of(nominal)))
+        ratings = life.ratings_of(nominal)
+        shares = life.consumed(np.reshape(entries[0]["load"], (2, -1)), ratings)
+        assert shares == pytest.approx(life.consumption(data.t, data.qd, data.tau, ratings), rel=1e-12)
         assert entries[0]["duration_s"] == data.t[-1] - data.t[0]
         mine = [r for r in rows if r["unit"] == unit]
         for r in mine:
             k = int(r["axis"]) - 1
-            per_day = [e["life"][k] / e["duration_s"] * 16 * 3600 * 100 for e in entries]  # % per day, 16 h a day
+            g = ratings[k]
+            p = 0 if g.gearbox_type == "strain-wave" else 1  # the row of that exponent's integral
+            shares = [e["load"][p * nominal.n_axes + k] / (g.rated_speed * g.rated_torque ** g.exponent * g.rated_life
+                                                           * 3600) for e in entries]
+            per_day = [share / e["duration_s"] * 16 * 3600 * 100 for share, e in zip(shares, entries)]  # 16 h a day
             stamps = [datetime.fromisoformat(e["stamp"]) for e in entries]
             days = [(b - a).total_seconds() / 86400 for a, b in zip(stamps, stamps[1:])]
             assert float(r["consumed_pct"]) == pytest.approx(sum(p * d for p, d in zip(per_day[1:], days)), rel=1e-5)
@@ -370,6 +376,34 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
                                          r"'faultgen-monitor-state/2' \(a state written by another version of "
                                          r"faultgen.*score the logs into a new OUT"):
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_states_log_load_is_checked_and_a_state_written_without_loads_still_loads(fleet, monitored, tmp_path):
+    """Each log's load in the state (faultgen.monitor.life.load_integrals) is refused when it is not
+    2 x N numbers >= 0; a state whose logs have none (written before life.csv) is continued, its
+    logs left out of life.csv and counted in the verdict."""
+    import json
+
+    robot, logs, _ = fleet
+    out = _copy_of(monitored, tmp_path / "out")
+    path = out / ".state" / "unit01.json"
+    state = json.loads(path.read_text())
+    for load, match in (([1.0], r"logs\[2\]\.load is not a list of 12 numbers"),
+                        ([-1.0] * 12, r"logs\[2\]: load below 0")):
+        bad = json.loads(json.dumps(state))
+        bad["logs"][2]["load"] = load
+        path.write_text(json.dumps(bad))
+        with pytest.raises(ValueError, match=rf"unit01\.json: {match}"):
+            loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    for log in state["logs"]:
+        del log["load"], log["duration_s"]
+    path.write_text(json.dumps(state))
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    with open(out / "life.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["unit"] == "unit01"]
+    assert len(rows) == 6 and all(float(r["consumed_pct"]) == 0 and r["days_left"] == "" for r in rows)
+    assert f"{SPEC.days} logs without a load record left out" in rows[0]["verdict"]
+    assert (out / "alarms.csv").read_bytes() == (monitored / "alarms.csv").read_bytes()
 
 
 def test_a_scored_log_that_changed_since_is_refused(fleet, monitored, tmp_path):

@@ -155,7 +155,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return twin
     try:
         reading = fleet_logs.reading_of(nominal, parsed.checked())
-        load = _load(parsed.checked(), nominal)
+        load = _load(parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
             if unit.program_q is None:
                 unit.program_q = np.asarray(source.get(log_of(context.units, *unit.program)).checked().q)
@@ -180,11 +180,10 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
 
 
 
-def _load(data, nominal) -> tuple[np.ndarray | None, float]:
-    """The share of each axis's rated life the log consumed and its duration, s
-    (:func:`faultgen.monitor.life.consumption`); (None, NaN) for a log it cannot take (one sample):
-    the log is still scored."""
+def _load(data) -> tuple[np.ndarray | None, float]:
+    """The log's load (:func:`faultgen.monitor.life.load_integrals`) and its duration, s; (None,
+    NaN) for a log it cannot take (one sample): the log is still scored."""
     try:
-        return life.consumption(data.t, data.qd, data.tau, life.ratings_of(nominal)), float(data.t[-1] - data.t[0])
+        return life.load_integrals(data.t, data.qd, data.tau), float(data.t[-1] - data.t[0])
     except ValueError:
         return None, float("nan")

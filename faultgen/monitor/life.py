@@ -17,7 +17,9 @@ integrals over a log's samples (trapezoidal, ``numpy.trapezoid``),
     consumed = integral (|qd| / n_N) (|tau| / T_N)^p dt / L_n        (:func:`consumption`)
 
 with ``qd`` (rad/s) and ``tau`` (N m) the log's arm-side speed and torque, the gear's output. A
-standing axis consumes nothing (the bearings turn with the output).
+standing axis consumes nothing (the bearings turn with the output). A unit's state keeps each scored
+log's ``integral |qd| |tau|^p dt`` for both exponents (:func:`load_integrals`), not its share, so
+each run judges the whole history against the ratings the robot's ``drivetrain.toml`` gives now.
 
 A log records minutes of a unit's operation, not all of it, so the monitor counts each log as the
 unit's duty from the log before it up to it: the log's consumption per second of operation times
@@ -49,6 +51,8 @@ from faultgen.model import rating
 HOURS_PER_DAY = 16.0
 #: Logs whose mean consumption per day is the unit's recent duty.
 WINDOW = 10
+#: The life exponents a log's load is integrated with (:func:`load_integrals`): strain-wave, cycloid.
+EXPONENTS = tuple(rating.EXPONENTS.values())
 #: Events that fit a new gearbox (its consumption starts again at 0).
 RESETS = ("gearbox_change",)
 COLUMNS = ("unit", "axis", "gearbox_type", "exponent", "rated_torque_Nm", "rated_speed_rad_s", "rated_life_h",
@@ -62,11 +66,10 @@ def ratings_of(robot) -> tuple[rating.GearboxRating, ...]:
     return rating.of_robot(robot)
 
 
-def _checked(t, qd, tau, ratings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _checked(t, qd, tau) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     t, qd, tau = (np.asarray(a, dtype=float) for a in (t, qd, tau))
-    if t.ndim != 1 or len(t) < 2 or qd.shape != (len(t), len(ratings)) or tau.shape != qd.shape:
-        raise ValueError(f"t {t.shape}, qd {qd.shape}, tau {tau.shape}; expected (n,), (n, {len(ratings)}) and "
-                         f"(n, {len(ratings)}) with n >= 2 (one rating per axis)")
+    if t.ndim != 1 or len(t) < 2 or qd.ndim != 2 or len(qd) != len(t) or tau.shape != qd.shape:
+        raise ValueError(f"t {t.shape}, qd {qd.shape}, tau {tau.shape}; expected (n,), (n, N) and (n, N) with n >= 2")
     if not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
         raise ValueError("t: expected finite sample times in s, strictly increasing")
     return t, qd, tau
@@ -93,19 +96,44 @@ def consumption(t, qd, tau, ratings) -> np.ndarray:
     ValueError
         Shapes that do not match, or times not strictly increasing.
     """
-    t, qd, tau = _checked(t, qd, tau, ratings)
-    out = np.empty(len(ratings))
-    for k, r in enumerate(ratings):
-        load = (np.abs(qd[:, k]) / r.rated_speed) * (np.abs(tau[:, k]) / r.rated_torque) ** r.exponent
-        out[k] = np.trapezoid(load, t) / (r.rated_life * 3600.0)
-    return out
+    t, qd, tau = _checked(t, qd, tau)
+    if len(ratings) != qd.shape[1]:
+        raise ValueError(f"{len(ratings)} ratings for {qd.shape[1]} axes; expected one per axis")
+    return consumed(load_integrals(t, qd, tau), ratings)
+
+
+def load_integrals(t, qd, tau) -> np.ndarray:
+    """``integral |qd| |tau|^p dt`` over a log for each exponent p of :data:`EXPONENTS` (rows) and
+    each axis (columns), rad (N m)^p: what the rated life consumed needs of the log, whatever the
+    rating (:func:`consumed`); each scored log's is kept in the unit's state.
+
+    Returns
+    -------
+    ndarray of shape (len(EXPONENTS), N)
+
+    Raises
+    ------
+    ValueError
+        As :func:`consumption`.
+    """
+    t, qd, tau = _checked(t, qd, tau)
+    speed, torque = np.abs(qd), np.abs(tau)
+    return np.stack([np.trapezoid(speed * torque ** p, t, axis=0) for p in EXPONENTS])
+
+
+def consumed(integrals: np.ndarray, ratings) -> np.ndarray:
+    """The share of each axis's rated life of :func:`load_integrals` ``integrals`` (len(EXPONENTS),
+    N): ``integral / (n_N T_N^p L_n)`` with each axis's rating's p, shape (N,)."""
+    return np.array([integrals[EXPONENTS.index(r.exponent), k]
+                     / (r.rated_speed * r.rated_torque ** r.exponent * r.rated_life * 3600.0)
+                     for k, r in enumerate(ratings)])
 
 
 def average_load(t, qd, tau, ratings) -> tuple[np.ndarray, np.ndarray]:
     """The catalogue's average output speed ``n_av`` (rad/s) and torque ``T_av`` (N m) of each axis
     over a log (module docstring; each shape (N,)): ``duration / L`` with ``L`` from them is
     :func:`consumption`."""
-    t, qd, tau = _checked(t, qd, tau, ratings)
+    t, qd, tau = _checked(t, qd, tau)
     speed = np.abs(qd)
     turned = np.trapezoid(speed, t, axis=0)
     p = np.array([r.exponent for r in ratings])
@@ -153,7 +181,7 @@ def check_hours(hours_per_day: float) -> None:
 def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOURS_PER_DAY,
             window: int = WINDOW) -> list[LifeRow]:
     """Each axis's row of ``life.csv`` from a unit's scored logs (``entries``: each with ``stamp``,
-    ``life`` (N,) of :func:`consumption` or None, ``duration`` s) and its ``maintenance``
+    ``load`` of :func:`load_integrals` or None, ``duration`` s) and its ``maintenance``
     (``stamp``, ``event``, ``axis``, ``at``: the index of the first entry after it); module
     docstring. An entry without a load record (a state written before it) is left out, counted in
     the verdict."""
@@ -164,21 +192,22 @@ def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOU
         start = changes[-1].at if changes else 0
         since = changes[-1].stamp if changes else (entries[0].stamp if entries else "")
         previous = _key(since, unit)[0] if changes else None
-        consumed, rates, missing = 0.0, [], 0
+        total, rates, missing = 0.0, [], 0
         for e in entries[start:]:
             key, kind = _key(e.stamp, unit)
             day = 86400.0 if kind == logfolder.TIME else 1.0
             days = 0.0 if previous is None else max(key - previous, 0.0) / day
             previous = key
-            if e.life is None:
+            if e.load is None:
                 missing += 1
                 continue
-            per_day = float(e.life[axis - 1]) / e.duration * hours_per_day * 3600.0 * 100.0  # % per day
-            consumed += per_day * days
+            share = float(consumed(e.load[:, axis - 1:axis], (r,))[0])
+            per_day = share / e.duration * hours_per_day * 3600.0 * 100.0  # % per day
+            total += per_day * days
             rates.append(per_day)
         duty = float(np.mean(rates[-window:])) if rates else 0.0
-        left = (100.0 - consumed) / duty if duty > 0 else None
-        rows.append(LifeRow(unit, axis, r, since, consumed, duty, left, hours_per_day, len(rates),
+        left = (100.0 - total) / duty if duty > 0 else None
+        rows.append(LifeRow(unit, axis, r, since, total, duty, left, hours_per_day, len(rates),
                             entries[-1].stamp if entries else "", ""))
         rows[-1].verdict = _verdict(rows[-1], bool(changes), missing, window)
     return rows
@@ -190,8 +219,9 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     origin = "the gearbox change" if changed else "the unit's first log: what ran before it is not known"
     text = (f"{row.consumed:.3g} % of the rated life ({r.rated_life:g} h L10 at {r.rated_torque:.5g} N m, "
             f"{r.gearbox_type}{default}) consumed since {row.since} ({origin})")
+    left_out = f" ({missing} logs without a load record left out: a state written before it)" if missing else ""
     if not row.logs:
-        return text + ": no log with a load record since"
+        return text + ": no log with a load record since" + left_out
     if row.days_left is None:
         text += "; no load in the last logs: no end of the rated life at this duty"
     elif row.days_left <= 0:
@@ -199,7 +229,7 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     else:
         text += (f"; at {row.duty:.3g} % per day (last {min(row.logs, window)} logs, {row.hours_per_day:g} h of "
                  f"operation a day) 100 % in {row.days_left:.0f} days")
-    return text + (f" ({missing} logs without a load record left out)" if missing else "")
+    return text + left_out
 
 
 def _cell(value) -> str:

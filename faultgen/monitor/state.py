@@ -88,9 +88,9 @@ def settings_digest(settings: Settings, model: str, twin_temperature: bool, robo
 class Entry:
     """One scored log as the monitor was fed it: ``stamp``, the log file's ``sha256``, its
     ``residual`` (n_features,), mean joint ``temperature`` (deg C, NaN when not logged), ``payload``
-    (kg), the twin's ``expected`` features (n_features,; None without a twin), the share of each
-    axis's rated life the log consumed, ``life`` (n_axes,; :func:`faultgen.monitor.life.consumption`;
-    None in a state written before it) and the log's ``duration`` (s)."""
+    (kg), the twin's ``expected`` features (n_features,; None without a twin), the log's ``load``
+    (:func:`faultgen.monitor.life.load_integrals`, (2, n_axes): what the rated life it consumed is
+    computed from; None in a state written before it) and its ``duration`` (s)."""
 
     stamp: str
     sha256: str
@@ -98,7 +98,7 @@ class Entry:
     temperature: float
     payload: float
     expected: np.ndarray | None
-    life: np.ndarray | None = None
+    load: np.ndarray | None = None
     duration: float = math.nan
 
 
@@ -203,7 +203,7 @@ def write_unit(path: Path, state: UnitState) -> None:
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
                   "expected": None if e.expected is None else _floats(e.expected),
-                  **({} if e.life is None else {"life": _floats(e.life), "duration_s": float(e.duration)})}
+                  **({} if e.load is None else {"load": _floats(e.load), "duration_s": float(e.duration)})}
                  for e in state.entries],
     }
     atomic.write_text(path, json.dumps(document, separators=(",", ":")))
@@ -267,15 +267,15 @@ def _number(value, path: Path, name: str) -> float:
 
 
 def _load(log: dict, path: Path, where: str, n_axes: int) -> tuple[np.ndarray | None, float]:
-    """An entry's ``life`` and ``duration_s`` (:class:`Entry`): both or neither; each axis's share
+    """An entry's ``load`` and ``duration_s`` (:class:`Entry`): both or neither; the load's values
     >= 0, the duration > 0."""
-    if "life" not in log and "duration_s" not in log:
+    if "load" not in log and "duration_s" not in log:
         return None, math.nan
-    life = _vector(log.get("life"), path, f"{where}.life", n_axes)
+    load = _vector(log.get("load"), path, f"{where}.load", 2 * n_axes).reshape(2, n_axes)
     duration = _number(log.get("duration_s"), path, f"{where}.duration_s")
-    if np.any(life < 0) or not (math.isfinite(duration) and duration > 0):
-        raise StateError(f"{path}: {where}: life below 0 or duration_s not a finite number > 0")
-    return life, duration
+    if np.any(load < 0) or not (math.isfinite(duration) and duration > 0):
+        raise StateError(f"{path}: {where}: load below 0 or duration_s not a finite number > 0")
+    return load, duration
 
 
 def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
