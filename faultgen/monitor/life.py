@@ -1,4 +1,4 @@
-"""The life each axis's gearbox has consumed by its load: ``OUT/life.csv`` (issue 75, item 5).
+"""The life each axis's gearbox has consumed by its load: ``OUT/life.csv``.
 
 The gearbox makers' rated life, for a gear run at output speed ``n`` and output torque ``T``::
 
@@ -36,6 +36,7 @@ earlier of that and the condition-based remaining life (``rul.csv``).
 from __future__ import annotations
 
 import csv
+import html
 import math
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -297,3 +298,15 @@ def table_cell(rows: list[dict]) -> str:
     days = _float(r.get("days_left"))
     left = f"{days:.0f} days left" if math.isfinite(days) else "no load"
     return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
+
+
+def service_by_html(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> str:
+    """:func:`service_by` for the page: ``date (what sets it)``, HTML-escaped; "" without one."""
+    date, why = service_by(last_stamp, life_rows, rul_rows)
+    return f"{html.escape(date)} ({html.escape(why)})" if date else ""
+
+
+def panel_html(life_rows: list[dict], service: str) -> str:
+    """A unit's panel paragraph: every axis's verdict of life.csv and the ``service`` by (HTML)."""
+    items = "".join(f"<li>axis {html.escape(r['axis'])}: {html.escape(r['verdict'])}</li>" for r in life_rows)
+    return f"<p>Rated life consumed by load (life.csv); service by {service or '–'}:</p><ul>{items}</ul>"

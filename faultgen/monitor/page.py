@@ -126,6 +126,10 @@ class Unit:
     def name(self) -> str:
         return self.row["unit"]
 
+    def service_by(self) -> str:
+        """The earlier of the load- and the condition-based life, a date (:func:`faultgen.monitor.life.service_by`)."""
+        return life.service_by_html(self.row.get("last_log", ""), self.life, list(self.remaining.values()))
+
     @property
     def open_alarm(self) -> bool:
         return bool(self.current and self.current.get("first_alarm"))
@@ -191,7 +195,7 @@ def read(folder: str | Path) -> Fleet:
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
-    if (folder / "life.csv").exists():  # the rated life consumed by load (issue 75; optional)
+    if (folder / "life.csv").exists():  # the rated life consumed by load (optional: a run before it has none)
         for r in _read_csv(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"))[1]:
             if r["unit"] in units:
                 units[r["unit"]].life.append(r)
@@ -455,14 +459,9 @@ def _table_row(index: int, unit: Unit) -> str:
     remaining = _e(_remaining(unit.remaining.get(wear[0]))) if wear is not None else ""
     cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
               _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
-              remaining, _e(life.table_cell(unit.life)), _service_by(unit), _e(unit.row.get("last_log", "")),
+              remaining, _e(life.table_cell(unit.life)), unit.service_by(), _e(unit.row.get("last_log", "")),
               _e(unit.row.get("logs_scored", "")), closed]
     return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
-
-
-def _service_by(unit: Unit) -> str:
-    date, why = life.service_by(unit.row.get("last_log", ""), unit.life, list(unit.remaining.values()))
-    return f"{_e(date)} ({_e(why)})" if date else ""
 
 
 def _panel(index: int, unit: Unit, settings: dict) -> str:
@@ -487,8 +486,7 @@ def _panel(index: int, unit: Unit, settings: dict) -> str:
                         + "</li>" for axis, r in sorted(unit.remaining.items()))
         parts.append(f"<p>Remaining life until the wear estimate reaches the failure wear (rul.csv):</p><ul>{items}</ul>")
     if unit.life:
-        items = "".join(f"<li>axis {_e(r['axis'])}: {_e(r['verdict'])}</li>" for r in unit.life)
-        parts.append(f"<p>Rated life consumed by load (life.csv); service by {_service_by(unit) or '–'}:</p><ul>{items}</ul>")
+        parts.append(life.panel_html(unit.life, unit.service_by()))
     if unit.closed:
         items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
