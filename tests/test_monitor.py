@@ -75,7 +75,7 @@ def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
         assert filecmp.cmp(path, first_logs / path.relative_to(logs), shallow=False), path
     out = with_cycles_of(monitored, tmp_path / "out")
     loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
-    for name in ("alarms.csv", "scores.csv", "rul.csv", "wear.csv"):
+    for name in ("alarms.csv", "scores.csv", "rul.csv", "wear.csv", "life.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
 
 
@@ -98,6 +98,50 @@ def test_rul_csv_gives_the_worn_axis_an_end_of_life_and_the_healthy_units_none(f
             assert 0 <= float(r["rul_5"]) <= float(r["rul"]) <= float(r["rul_95"]) < prognosis.HORIZON, r
         elif not t["axis"]:
             assert r["rul"] == "" and "no end of life within the horizon (365 days)" in r["verdict"], r
+
+
+def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_it(fleet, monitored):
+    """life.csv (faultgen.monitor.life): a row per unit and axis; one log's load in the state gives
+    that log's consumption by the formula (test_life.py checks the formula by hand), the consumed % the sum
+    of each log's % per day times the days since the log before it, and the page shows each unit's."""
+    import csv
+    import json
+    from datetime import datetime
+
+    from faultgen.data import measured
+    from faultgen.model import robots
+    from faultgen.monitor import life
+
+    robot, logs, _ = fleet
+    nominal = robots.load(robot)
+    with open(monitored / "life.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    units = sorted(p.name for p in logs.iterdir() if p.is_dir())
+    assert [(r["unit"], int(r["axis"])) for r in rows] == [(u, a) for u in units for a in range(1, nominal.n_axes + 1)]
+    page = (monitored / "report.html").read_text()
+    assert "Rated life consumed by load (life.csv)" in page and "service by" in page
+    for unit in units:
+        entries = json.loads((monitored / ".state" / f"{unit}.json").read_text())["logs"]
+        first = sorted((logs / unit).iterdir())[0]
+        data = measured.read(first, nominal)
+        ratings = life.ratings_of(nominal)
+        shares = life.consumed(np.reshape(entries[0]["load"], (2, -1)), ratings)
+        assert shares == pytest.approx(life.consumption(data.t, data.qd, data.tau, ratings), rel=1e-12)
+        assert entries[0]["duration_s"] == data.t[-1] - data.t[0]
+        mine = [r for r in rows if r["unit"] == unit]
+        for r in mine:
+            k = int(r["axis"]) - 1
+            g = ratings[k]
+            p = 0 if g.gearbox_type == "strain-wave" else 1  # the row of that exponent's integral
+            shares = [e["load"][p * nominal.n_axes + k] / (g.rated_speed * g.rated_torque ** g.exponent * g.rated_life
+                                                           * 3600) for e in entries]
+            per_day = [share / e["duration_s"] * 16 * 3600 * 100 for share, e in zip(shares, entries)]  # 16 h a day
+            stamps = [datetime.fromisoformat(e["stamp"]) for e in entries]
+            days = [(b - a).total_seconds() / 86400 for a, b in zip(stamps, stamps[1:])]
+            assert float(r["consumed_pct"]) == pytest.approx(sum(p * d for p, d in zip(per_day[1:], days)), rel=1e-5)
+            assert float(r["duty_pct_per_day"]) == pytest.approx(np.mean(per_day[-life.WINDOW:]), rel=1e-5)
+            assert float(r["consumed_pct"]) > 0 and r["since"] == entries[0]["stamp"] and r["stamp"] == entries[-1]["stamp"]
+        assert life.table_cell(mine).split(":")[0] in page
 
 
 def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
@@ -333,6 +377,34 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
                                          r"'faultgen-monitor-state/2' \(a state written by another version of "
                                          r"faultgen.*score the logs into a new OUT"):
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+
+
+def test_a_states_log_load_is_checked_and_a_state_written_without_loads_still_loads(fleet, monitored, tmp_path):
+    """Each log's load in the state (faultgen.monitor.life.load_integrals) is refused when it is not
+    2 x N numbers >= 0; a state whose logs have none (written before life.csv) is continued, its
+    logs left out of life.csv and counted in the verdict."""
+    import json
+
+    robot, logs, _ = fleet
+    out = _copy_of(monitored, tmp_path / "out")
+    path = out / ".state" / "unit01.json"
+    state = json.loads(path.read_text())
+    for load, match in (([1.0], r"logs\[2\]\.load is not a list of 12 numbers"),
+                        ([-1.0] * 12, r"logs\[2\]: load below 0")):
+        bad = json.loads(json.dumps(state))
+        bad["logs"][2]["load"] = load
+        path.write_text(json.dumps(bad))
+        with pytest.raises(ValueError, match=rf"unit01\.json: {match}"):
+            loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    for log in state["logs"]:
+        del log["load"], log["duration_s"]
+    path.write_text(json.dumps(state))
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    with open(out / "life.csv", newline="") as f:
+        rows = [r for r in csv.DictReader(f) if r["unit"] == "unit01"]
+    assert len(rows) == 6 and all(float(r["consumed_pct"]) == 0 and r["days_left"] == "" for r in rows)
+    assert f"{SPEC.days} logs without a load record left out" in rows[0]["verdict"]
+    assert (out / "alarms.csv").read_bytes() == (monitored / "alarms.csv").read_bytes()
 
 
 def test_a_scored_log_that_changed_since_is_named_and_its_score_kept(fleet, monitored, tmp_path):
@@ -638,13 +710,13 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
     charts = tuple(p.name for p in monitored.glob("*.png"))
     assert charts
-    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
     # a rerun with no new log: every unit's chart and remaining life made again in the workers, the same bytes
     for name in charts:
         (out / name).unlink()
     loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
-    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv"):
+    for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
 

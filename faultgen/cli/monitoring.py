@@ -61,6 +61,9 @@ def monitor_command(
     failure_wear: Annotated[float, typer.Option(
         help="With the twin: the wear estimate (% of the axis's own dry friction) that ends an axis's life; OUT/rul.csv gives "
              "each axis's remaining life until it, with a 5-95 % interval.", min=1.0, max=500.0)] = 40.0,
+    hours_per_day: Annotated[float, typer.Option(
+        help="Operating hours per calendar day between a unit's logs (a log records minutes of its work): "
+             "OUT/life.csv's rated-life consumption between logs.", min=0.1, max=24.0)] = 16.0,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
@@ -123,7 +126,10 @@ def monitor_command(
     friction, with its 90 % interval that carries the twin's model uncertainty),
     OUT/rul.csv (per unit and axis, with the twin: the remaining life until the wear estimate reaches
     --failure-wear, in days or logs, with a 5-95 % interval and the trend model, or "no end of life
-    within the horizon"), OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html
+    within the horizon"), OUT/life.csv (per unit and axis: the % of its gearbox's rated life the
+    load consumed since the last gearbox_change, from each log's arm-side torque and speed with
+    the makers' rated-life formula and the robot's gearbox ratings, `faultgen robots ROBOT`; the
+    duty in % per day and the days left to 100 %), OUT/<unit>.png (control chart, alarm, axis scores) and OUT/report.html
     (the fleet report: a page for a browser, offline, with every unit's status, alarm, evidence and
     chart; its settings in OUT/settings.json; `faultgen report OUT` writes it again), all together;
     a rerun after new logs arrived scores only those. Method and its check on an independent fleet:
@@ -151,7 +157,8 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend)
+                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend,
+                               hours_per_day=hours_per_day)
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, OUT/.cache, empty folders above)
         remove_made(made, out)
         raise

@@ -13,7 +13,7 @@ from faultgen.cli.base import Command
 from faultgen.cli.main import app
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
-from faultgen.model import folder, importers, robots
+from faultgen.model import folder, importers, rating, robots
 from faultgen.operation import taskgen
 
 #: The largest rated payload `robots add --payload` takes, kg.
@@ -131,4 +131,20 @@ def describe(robot: robots.Robot) -> str:
     for title, unit, values in rows:
         cells = "".join(f"{v:>12.5g}" for v in np.asarray(values))
         lines.append(f"{title + ' [' + unit + ']':<{label}}{cells}")
-    return head + "\n".join(lines)
+    return head + "\n".join(lines + gearbox_lines(robot, label))
+
+
+def gearbox_lines(robot: robots.Robot, label: int) -> list[str]:
+    """The gearbox rating rows (:mod:`faultgen.model.rating`): a row of defaults labelled
+    ``(default)``, a default among given values marked ``*``; each default's rule below."""
+    ratings = rating.of_robot(robot)
+    lines, used = [], []
+    for key, title in (("gearbox_type", "gearbox type"), ("rated_torque", "rated torque [N m]"),
+                       ("rated_speed", "rated speed [rad/s]"), ("rated_life", "rated life L10 [h]")):
+        marks = ["*" if key in r.defaults else "" for r in ratings]
+        every = all(marks)
+        used += [key] if any(marks) else []
+        cells = "".join(f"{(v if isinstance(v, str) else f'{v:.5g}') + ('' if every else m):>12}"
+                        for v, m in zip((getattr(r, key) for r in ratings), marks))
+        lines.append(f"{title + (' (default)' if every else ''):<{label}}{cells}")
+    return lines + [f"(default, or * where others are given) {key}: {rating.RULES[key]}" for key in used]

@@ -60,8 +60,48 @@ BOUNDS = {
     "bristle_stiffness": (0.0, 1e10),
     "bristle_damping": (0.0, 1e8),
 }
+
+
 class DrivetrainError(ValueError):
     """A drivetrain table that cannot be used: the message names the file, axis and key."""
+
+
+#: The gearbox rating (:mod:`faultgen.model.rating`), whose keys :func:`read_table` checks.
+#: Gearbox types and the life exponent p of each (Harmonic Drive: 3; Nabtesco RV and ISO 281's
+#: roller bearings: 10/3).
+GEARBOX_EXPONENTS = {"strain-wave": 3.0, "cycloid": 10.0 / 3.0}
+#: Unit and meaning of each rating key, in file order.
+RATING_UNITS = {
+    "gearbox_type": f"one of {', '.join(GEARBOX_EXPONENTS)}",
+    "rated_torque": "N m, arm side (gear output), at the rated speed",
+    "rated_speed": "rad/s, arm side (gear output)",
+    "rated_life": "h at rated torque and speed, L10",
+}
+RATING_KEYS = tuple(RATING_UNITS)
+#: Bounds of the numbers, (low, high), exclusive of 0: far outside any robot gear (rated torques
+#: 1 .. 10^5 N m, output speeds 0.1 .. 10 rad/s, lives 10^3 .. 10^5 h).
+RATING_BOUNDS = {"rated_torque": (0.0, 1e7), "rated_speed": (0.0, 1e4), "rated_life": (0.0, 1e7)}
+
+
+def check_rating(key: str, value) -> str | float:
+    """``value`` of rating key ``key`` checked: a type of :data:`GEARBOX_EXPONENTS`, or a finite
+    number > 0 within :data:`RATING_BOUNDS`.
+
+    Raises
+    ------
+    DrivetrainError
+        Naming the key, the value and what was expected.
+    """
+    if key == "gearbox_type":
+        if not isinstance(value, str) or value not in GEARBOX_EXPONENTS:
+            raise DrivetrainError(f"gearbox_type = {str(value)[:40]!r}; expected one of {', '.join(map(repr, GEARBOX_EXPONENTS))}")
+        return value
+    low, high = RATING_BOUNDS[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+            or not low < value <= high:
+        raise DrivetrainError(f"{key} = {str(value)[:40] if isinstance(value, str) else value!r}; expected a finite "
+                              f"number > {low:g} and <= {high:g} ({RATING_UNITS[key]})")
+    return float(value)
 
 
 def check_value(key: str, value) -> float:
@@ -154,9 +194,11 @@ class Drivetrain:
                 raise DrivetrainError(f"{source}: axis {axis}: {err}") from None
         return cls(tuple(axes))
 
-    def to_toml(self, notes: dict[int, dict[str, str]] | None = None, header: str = "") -> str:
+    def to_toml(self, notes: dict[int, dict[str, str]] | None = None, header: str = "",
+                ratings: dict[int, dict] | None = None) -> str:
         """The drivetrain as ``drivetrain.toml`` text, every number at full precision (``repr``);
-        ``notes[axis][key]`` is written as a comment after the value (its source)."""
+        ``notes[axis][key]`` is written as a comment after the value (its source); ``ratings[axis]``
+        the gearbox rating keys given (:data:`RATING_KEYS`), written after the axis's numbers."""
         lines = [f"# {line}" if line else "#" for line in header.splitlines()]
         lines += ["# Units: " + "; ".join(f"{k}: {u}" for k, u in UNITS.items()), ""]
         for axis, drive in enumerate(self.axes, start=1):
@@ -164,6 +206,8 @@ class Drivetrain:
             for key, value in asdict(drive).items():
                 note = (notes or {}).get(axis, {}).get(key)
                 lines.append(f"{key} = {value!r}" + (f"  # {note}" if note else ""))
+            given = (ratings or {}).get(axis, {})
+            lines += [f"{key} = {given[key]!r}  # given in --drivetrain" for key in RATING_KEYS if key in given]
             lines.append("")
         return "\n".join(lines)
 
@@ -185,7 +229,9 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
     ------
     DrivetrainError
         If the file is not TOML, has a key other than ``axis`` at the top or an unknown key in an
-        axis table, names an axis outside 1..N, gives a value that is not a finite number or is
+        axis table (the gearbox rating's keys, :data:`RATING_KEYS`, are checked and
+        left out of the table: :func:`faultgen.model.rating.given` reads them), names an axis
+        outside 1..N, gives a value that is not a finite number or is
         negative (or zero where :data:`POSITIVE` needs > 0), or (``partial=False``) lacks an axis
         or a key. The message names the file, the axis and the key.
     """
@@ -212,13 +258,15 @@ def read_table(path: str | Path, n_axes: int, partial: bool = False) -> dict[int
             raise DrivetrainError(f"{path}: [axis.{label}] is not an axis of this arm (1..{n_axes})")
         if not isinstance(values, dict):
             raise DrivetrainError(f"{path}: axis.{label} must be a table")
-        bad = sorted(set(values) - set(KEYS))
+        bad = sorted(set(values) - set(KEYS) - set(RATING_KEYS))
         if bad:
             raise DrivetrainError(
-                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS)}"
+                f"{path}: axis {axis}: unknown key {bad[0]!r}; expected some of: {', '.join(KEYS + RATING_KEYS)}"
             )
         try:
-            table[axis] = {k: check_value(k, v) for k, v in values.items()}
+            for k in sorted(set(values) & set(RATING_KEYS)):
+                check_rating(k, values[k])
+            table[axis] = {k: check_value(k, v) for k, v in values.items() if k not in RATING_KEYS}
         except DrivetrainError as err:
             raise DrivetrainError(f"{path}: axis {axis}: {err}") from None
     if not partial:

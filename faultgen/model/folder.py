@@ -25,7 +25,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from faultgen.model import builder, importers, limits, plausibility, robots, sizing
+from faultgen.model import builder, importers, limits, plausibility, rating, robots, sizing
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,63}$")
@@ -175,7 +175,8 @@ def add(
             axis: {k: ("given in --drivetrain" if v == "given" else v) for k, v in keys.items()}
             for axis, keys in origin.items()
         }
-        (stage / "drivetrain.toml").write_text(drive.to_toml(notes=notes, header=header))
+        rated = rating.given(drivetrain, n) if drivetrain is not None else {}  # the gearbox ratings given, kept
+        (stage / "drivetrain.toml").write_text(drive.to_toml(notes=notes, header=header, ratings=rated))
         if arm.urdf:
             (stage / "urdf_used.urdf").write_text(arm.urdf)
         if tasks is not None:

@@ -17,7 +17,7 @@ import numpy as np
 
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import prognosis, report
+from faultgen.monitor import life, prognosis, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
@@ -160,6 +160,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return twin
     try:
         reading = fleet_logs.reading_of(nominal, parsed.checked())
+        load = _load(parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
             if unit.program_q is None:
                 unit.program_q = np.asarray(source.get(log_of(context.units, *unit.program)).checked().q)
@@ -178,6 +179,16 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
     unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
-    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected))
+    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
+                                     *load))
     return twin
 
+
+
+def _load(data) -> tuple[np.ndarray | None, float]:
+    """The log's load (:func:`faultgen.monitor.life.load_integrals`) and its duration, s; (None,
+    NaN) for a log it cannot take (one sample): the log is still scored."""
+    try:
+        return life.load_integrals(data.t, data.qd, data.tau), float(data.t[-1] - data.t[0])
+    except ValueError:
+        return None, float("nan")

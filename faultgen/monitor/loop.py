@@ -18,7 +18,8 @@ the measured format or an adapter's):
 Units are scored one after another, in ``jobs`` local processes or on a Dask cluster
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
 Outputs in OUT, written together (:func:`faultgen.data.atomic.atomic_folder`): ``units.csv`` (each
-unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`),
+unit's status and why), ``alarms.csv``, ``scores.csv``, ``rul.csv`` (:mod:`faultgen.monitor.prognosis`), ``life.csv``
+(:mod:`faultgen.monitor.life`: the gearboxes' rated life consumed by their load),
 ``report.html`` (:mod:`faultgen.monitor.page`), ``<unit>.png`` (a unit name longer than
 :data:`faultgen.monitor.state.UNIT_FILE_MAX_BYTES` cut and its digest added:
 :func:`faultgen.monitor.state.unit_file`) and the monitors' state in
@@ -44,7 +45,7 @@ from tqdm.auto import tqdm
 from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import page, prognosis, report
+from faultgen.monitor import life, page, prognosis, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
@@ -102,7 +103,8 @@ class Outcome:
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
             progress: bool = True, log_format=None, jobs: int = 1, scheduler: str | None = None,
-            failure_wear: float = prognosis.FAILURE_WEAR, backend: str = backends.DEFAULT) -> Outcome:
+            failure_wear: float = prognosis.FAILURE_WEAR, backend: str = backends.DEFAULT,
+            hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
@@ -144,6 +146,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         The stepping backend the twins' cycles are simulated on
         (:data:`faultgen.simulation.backends.BACKENDS`; with ``jobs`` or ``scheduler``, the workers
         must know it too). Every backend gives the same outputs to float tolerance.
+    hours_per_day : float
+        Operating hours per calendar day between logs, in (0, 24]: ``life.csv``'s consumption
+        between logs (:mod:`faultgen.monitor.life`).
 
     Returns
     -------
@@ -156,7 +161,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
         (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named), ``jobs`` > 1 with a ``scheduler``, or an unknown ``backend``.
+        file named), ``jobs`` > 1 with a ``scheduler``, an unknown ``backend``, ``hours_per_day``
+        outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
+        (:mod:`faultgen.model.rating`).
     faultgen.runs.errors.SweepRefused
         ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
@@ -173,6 +180,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     prognosis.check_failure_wear(failure_wear)
     backends.get(backend)
     nominal = robots.load(robot)
+    ratings = life.ratings_of(nominal)  # a bad rating refused before any work
+    life.check_hours(hours_per_day)
     _, suffixes = fleet_logs.reader_of(log_format)
     units = fleet_logs.fleet(logs_dir, suffixes)
     out = Path(out)
@@ -216,6 +225,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         report.write_wear(staging / "wear.csv", monitors)
         report.write_units(staging / "units.csv", statuses)
         prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
+        life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
+            name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
         # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
         page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
                    logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from faultgen.data import atomic
-from faultgen.monitor import report, scoring, tables
+from faultgen.monitor import life, report, scoring, tables
 from faultgen.monitor.run_settings import SETTINGS, check_settings, read_settings, settings_dict  # noqa: F401
 
 #: The page's file name in OUT.
@@ -92,10 +92,15 @@ class Unit:
     closed: list[dict] = field(default_factory=list)
     scores: list[dict] = field(default_factory=list)
     remaining: dict[int, dict] = field(default_factory=dict)  # axis -> its row of rul.csv
+    life: list[dict] = field(default_factory=list)  # its rows of life.csv
 
     @property
     def name(self) -> str:
         return self.row["unit"]
+
+    def service_by(self) -> str:
+        """The earlier of the load- and the condition-based life, a date (:func:`faultgen.monitor.life.service_by`)."""
+        return life.service_by_html(self.row.get("last_log", ""), self.life, list(self.remaining.values()))
 
     @property
     def open_alarm(self) -> bool:
@@ -164,6 +169,10 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
             axis = _number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
+    if (folder / "life.csv").exists():  # the rated life consumed by load (optional: a run before it has none)
+        for r in _read_csv(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"))[1]:
+            if r["unit"] in units:
+                units[r["unit"]].life.append(r)
     n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
     ordered = sorted(units.values(), key=Unit.attention)
     return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
@@ -344,7 +353,7 @@ SCRIPT = """
 
 #: The fleet table's columns.
 COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)",
-           "remaining life (5-95 %)", "last log", "logs", "closed alarms")
+           "remaining life (5-95 %)", "life consumed by load", "service by", "last log", "logs", "closed alarms")
 
 
 def _remaining(row: dict | None) -> str:
@@ -384,7 +393,8 @@ def _table_row(index: int, unit: Unit) -> str:
     remaining = _e(_remaining(unit.remaining.get(wear[0]))) if wear is not None else ""
     cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
               _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
-              remaining, _e(unit.row.get("last_log", "")), _e(unit.row.get("logs_scored", "")), closed]
+              remaining, _e(life.table_cell(unit.life)), unit.service_by(), _e(unit.row.get("last_log", "")),
+              _e(unit.row.get("logs_scored", "")), closed]
     return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
 
 
@@ -409,6 +419,8 @@ def _panel(index: int, unit: Unit, settings: dict) -> str:
                         + (f" ({_e(r['model'])} trend of {_e(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
                         + "</li>" for axis, r in sorted(unit.remaining.items()))
         parts.append(f"<p>Remaining life until the wear estimate reaches the failure wear (rul.csv):</p><ul>{items}</ul>")
+    if unit.life:
+        parts.append(life.panel_html(unit.life, unit.service_by()))
     if unit.closed:
         items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")

@@ -109,7 +109,9 @@ def settings_digest(settings: Settings, model: str, twin_temperature: bool, robo
 class Entry:
     """One scored log as the monitor was fed it: ``stamp``, the log file's ``sha256``, its
     ``residual`` (n_features,), mean joint ``temperature`` (deg C, NaN when not logged), ``payload``
-    (kg) and the twin's ``expected`` features (n_features,; None without a twin)."""
+    (kg), the twin's ``expected`` features (n_features,; None without a twin), the log's ``load``
+    (:func:`faultgen.monitor.life.load_integrals`, (2, n_axes): what the rated life it consumed is
+    computed from; None in a state written before it) and its ``duration`` (s)."""
 
     stamp: str
     sha256: str
@@ -117,6 +119,8 @@ class Entry:
     temperature: float
     payload: float
     expected: np.ndarray | None
+    load: np.ndarray | None = None
+    duration: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -230,7 +234,9 @@ def write_unit(path: Path, state: UnitState) -> None:
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
-                  "expected": None if e.expected is None else _floats(e.expected)} for e in state.entries],
+                  "expected": None if e.expected is None else _floats(e.expected),
+                  **({} if e.load is None else {"load": _floats(e.load), "duration_s": float(e.duration)})}
+                 for e in state.entries],
     }
     text = json.dumps(document, separators=(",", ":"))
     if len(text) > STATE_MAX_BYTES:
@@ -313,6 +319,18 @@ def _digest(value, path: Path, name: str, refuse: str, empty: bool = False) -> s
             c in "0123456789abcdef" for c in value)))):
         raise StateError(f"{path}: {name} is not a SHA-256 (64 hex digits){refuse}")
     return value
+
+
+def _load(log: dict, path: Path, where: str, n_axes: int) -> tuple[np.ndarray | None, float]:
+    """An entry's ``load`` and ``duration_s`` (:class:`Entry`): both or neither; the load's values
+    >= 0, the duration > 0."""
+    if "load" not in log and "duration_s" not in log:
+        return None, math.nan
+    load = _vector(log.get("load"), path, f"{where}.load", 2 * n_axes).reshape(2, n_axes)
+    duration = _number(log.get("duration_s"), path, f"{where}.duration_s")
+    if np.any(load < 0) or not (math.isfinite(duration) and duration > 0):
+        raise StateError(f"{path}: {where}: load below 0 or duration_s not a finite number > 0")
+    return load, duration
 
 
 def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
@@ -425,7 +443,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
             _number(log.get("temperature_C"), path, f"{where}.temperature_C"),
             _number(log.get("payload_kg"), path, f"{where}.payload_kg"),
-            None if expected is None else _vector(expected, path, f"{where}.expected", n_features)))
+            None if expected is None else _vector(expected, path, f"{where}.expected", n_features),
+            *_load(log, path, where, n_axes)))
         if not math.isfinite(entries[-1].payload):
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
         if math.isinf(entries[-1].temperature):  # NaN: not logged

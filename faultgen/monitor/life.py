@@ -1,0 +1,312 @@
+"""The life each axis's gearbox has consumed by its load: ``OUT/life.csv``.
+
+The gearbox makers' rated life, for a gear run at output speed ``n`` and output torque ``T``::
+
+    L = L_n (n_N / n_av) (T_N / T_av)^p
+
+(Harmonic Drive engineering data, "Life of the wave generator bearing": ``L50 = Ln (nN / n_av)
+(TN / T_av)^3``; Nabtesco's RV catalogue, "Service life": the same form with ``p = 10/3``, as ISO 281
+for roller bearings), ``L_n``, ``n_N``, ``T_N`` the rated life, speed and torque
+(:mod:`faultgen.model.rating`), the averages over the duty
+
+    n_av = sum |n_i| t_i / sum t_i,    T_av = (sum |n_i| t_i |T_i|^p / sum |n_i| t_i)^(1/p).
+
+A duty of duration ``t`` consumes ``t / L`` of the rated life, which is, the sums written as
+integrals over a log's samples (trapezoidal, ``numpy.trapezoid``),
+
+    consumed = integral (|qd| / n_N) (|tau| / T_N)^p dt / L_n        (:func:`consumption`)
+
+with ``qd`` (rad/s) and ``tau`` (N m) the log's arm-side speed and torque, the gear's output. A
+standing axis consumes nothing (the bearings turn with the output). A unit's state keeps each scored
+log's ``integral |qd| |tau|^p dt`` for both exponents (:func:`load_integrals`), not its share, so
+each run judges the whole history against the ratings the robot's ``drivetrain.toml`` gives now.
+
+A log records minutes of a unit's operation, not all of it, so the monitor counts each log as the
+unit's duty from the log before it up to it: the log's consumption per second of operation times
+the operating seconds in between, ``hours_per_day`` (default :data:`HOURS_PER_DAY`, two shifts: an
+assumption, written in every row) per calendar day of the stamps; sequence-number stamps count one
+step as one day. Summed from the axis's last gearbox change in ``events.csv`` (``gearbox_change``
+of that axis or of every axis: a ``repair`` leaves the gearbox's bearings, and their life, as they
+were), else from the unit's first log (what ran before it is not known: the row says so). The
+**duty** is the mean consumption per day over the last :data:`WINDOW` logs since then, and the
+**days left** the time to 100 % at that duty. :func:`service_by` sets a unit's "service by" as the
+earlier of that and the condition-based remaining life (``rul.csv``).
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import math
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from faultgen.data import cells, logfolder
+from faultgen.model import rating
+
+#: Operating hours per calendar day the consumption between logs assumes (two 8 h shifts).
+HOURS_PER_DAY = 16.0
+#: Logs whose mean consumption per day is the unit's recent duty.
+WINDOW = 10
+#: The life exponents a log's load is integrated with (:func:`load_integrals`): strain-wave, cycloid.
+EXPONENTS = tuple(rating.EXPONENTS.values())
+#: Events that fit a new gearbox (its consumption starts again at 0).
+RESETS = ("gearbox_change",)
+COLUMNS = ("unit", "axis", "gearbox_type", "exponent", "rated_torque_Nm", "rated_speed_rad_s", "rated_life_h",
+           "defaults", "since", "consumed_pct", "duty_pct_per_day", "days_left", "hours_per_day", "logs", "stamp",
+           "verdict")
+
+
+@lru_cache(maxsize=4)
+def ratings_of(robot) -> tuple[rating.GearboxRating, ...]:
+    """:func:`faultgen.model.rating.of_robot`, once per robot and process."""
+    return rating.of_robot(robot)
+
+
+def _checked(t, qd, tau) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    t, qd, tau = (np.asarray(a, dtype=float) for a in (t, qd, tau))
+    if t.ndim != 1 or len(t) < 2 or qd.ndim != 2 or len(qd) != len(t) or tau.shape != qd.shape:
+        raise ValueError(f"t {t.shape}, qd {qd.shape}, tau {tau.shape}; expected (n,), (n, N) and (n, N) with n >= 2")
+    if not (np.all(np.isfinite(t)) and np.all(np.diff(t) > 0)):
+        raise ValueError("t: expected finite sample times in s, strictly increasing")
+    return t, qd, tau
+
+
+def consumption(t, qd, tau, ratings) -> np.ndarray:
+    """The share of each axis's rated life a log consumed (module docstring).
+
+    Parameters
+    ----------
+    t : array of shape (n,)
+        Sample times, s, strictly increasing (n >= 2).
+    qd, tau : arrays of shape (n, N)
+        Arm-side speed (rad/s) and torque (N m) of each axis.
+    ratings : sequence of N :class:`faultgen.model.rating.GearboxRating`
+
+    Returns
+    -------
+    ndarray of shape (N,)
+        Fractions of the rated life (1 = all of it).
+
+    Raises
+    ------
+    ValueError
+        Shapes that do not match, or times not strictly increasing.
+    """
+    t, qd, tau = _checked(t, qd, tau)
+    if len(ratings) != qd.shape[1]:
+        raise ValueError(f"{len(ratings)} ratings for {qd.shape[1]} axes; expected one per axis")
+    return consumed(load_integrals(t, qd, tau), ratings)
+
+
+def load_integrals(t, qd, tau) -> np.ndarray:
+    """``integral |qd| |tau|^p dt`` over a log for each exponent p of :data:`EXPONENTS` (rows) and
+    each axis (columns), rad (N m)^p: what the rated life consumed needs of the log, whatever the
+    rating (:func:`consumed`); each scored log's is kept in the unit's state.
+
+    Returns
+    -------
+    ndarray of shape (len(EXPONENTS), N)
+
+    Raises
+    ------
+    ValueError
+        As :func:`consumption`.
+    """
+    t, qd, tau = _checked(t, qd, tau)
+    speed, torque = np.abs(qd), np.abs(tau)
+    return np.stack([np.trapezoid(speed * torque ** p, t, axis=0) for p in EXPONENTS])
+
+
+def consumed(integrals: np.ndarray, ratings) -> np.ndarray:
+    """The share of each axis's rated life of :func:`load_integrals` ``integrals`` (len(EXPONENTS),
+    N): ``integral / (n_N T_N^p L_n)`` with each axis's rating's p, shape (N,)."""
+    return np.array([integrals[EXPONENTS.index(r.exponent), k]
+                     / (r.rated_speed * r.rated_torque ** r.exponent * r.rated_life * 3600.0)
+                     for k, r in enumerate(ratings)])
+
+
+def average_load(t, qd, tau, ratings) -> tuple[np.ndarray, np.ndarray]:
+    """The catalogue's average output speed ``n_av`` (rad/s) and torque ``T_av`` (N m) of each axis
+    over a log (module docstring; each shape (N,)): ``duration / L`` with ``L`` from them is
+    :func:`consumption`."""
+    t, qd, tau = _checked(t, qd, tau)
+    speed = np.abs(qd)
+    turned = np.trapezoid(speed, t, axis=0)
+    p = np.array([r.exponent for r in ratings])
+    n_av = turned / (t[-1] - t[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t_av = (np.trapezoid(speed * np.abs(tau) ** p, t, axis=0) / turned) ** (1 / p)
+    return n_av, np.where(turned > 0, t_av, 0.0)
+
+
+@dataclass
+class LifeRow:
+    """One unit's axis in ``life.csv`` (:data:`COLUMNS`): the rating, ``since`` (stamp of the
+    gearbox change, or of the unit's first log), ``consumed`` %, ``duty`` % per day, ``days_left``
+    (None without load) and the ``verdict`` in words."""
+
+    unit: str
+    axis: int
+    rating: rating.GearboxRating
+    since: str
+    consumed: float
+    duty: float
+    days_left: float | None
+    hours_per_day: float
+    logs: int
+    stamp: str
+    verdict: str
+
+    def cells(self) -> list:
+        r = self.rating
+        return [self.unit, self.axis, r.gearbox_type, r.exponent, r.rated_torque, r.rated_speed, r.rated_life,
+                " ".join(r.defaults), self.since, self.consumed, self.duty, self.days_left, self.hours_per_day,
+                self.logs, self.stamp, self.verdict]
+
+
+def _key(stamp: str, unit: str) -> tuple[float, str]:
+    return logfolder.parse_stamp(stamp, f"{unit}/{stamp}")
+
+
+def check_hours(hours_per_day: float) -> None:
+    """Raises ValueError unless ``hours_per_day`` is in (0, 24]."""
+    if not (isinstance(hours_per_day, (int, float)) and math.isfinite(hours_per_day) and 0 < hours_per_day <= 24):
+        raise ValueError(f"hours_per_day = {hours_per_day!r}; expected operating hours per calendar day in (0, 24]")
+
+
+def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOURS_PER_DAY,
+            window: int = WINDOW) -> list[LifeRow]:
+    """Each axis's row of ``life.csv`` from a unit's scored logs (``entries``: each with ``stamp``,
+    ``load`` of :func:`load_integrals` or None, ``duration`` s) and its ``maintenance``
+    (``stamp``, ``event``, ``axis``, ``at``: the index of the first entry after it); module
+    docstring. An entry without a load record (a state written before it) is left out, counted in
+    the verdict."""
+    check_hours(hours_per_day)
+    rows = []
+    for axis, r in enumerate(ratings, start=1):
+        changes = [m for m in maintenance if m.event in RESETS and m.axis in (axis, 0)]
+        start = changes[-1].at if changes else 0
+        since = changes[-1].stamp if changes else (entries[0].stamp if entries else "")
+        previous = _key(since, unit)[0] if changes else None
+        total, rates, missing = 0.0, [], 0
+        for e in entries[start:]:
+            key, kind = _key(e.stamp, unit)
+            day = 86400.0 if kind == logfolder.TIME else 1.0
+            days = 0.0 if previous is None else max(key - previous, 0.0) / day
+            previous = key
+            if e.load is None:
+                missing += 1
+                continue
+            share = float(consumed(e.load[:, axis - 1:axis], (r,))[0])
+            per_day = share / e.duration * hours_per_day * 3600.0 * 100.0  # % per day
+            total += per_day * days
+            rates.append(per_day)
+        duty = float(np.mean(rates[-window:])) if rates else 0.0
+        left = (100.0 - total) / duty if duty > 0 else None
+        rows.append(LifeRow(unit, axis, r, since, total, duty, left, hours_per_day, len(rates),
+                            entries[-1].stamp if entries else "", ""))
+        rows[-1].verdict = _verdict(rows[-1], bool(changes), missing, window)
+    return rows
+
+
+def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
+    r = row.rating
+    default = ", default" if "rated_life" in r.defaults or "rated_torque" in r.defaults else ""
+    origin = "the gearbox change" if changed else "the unit's first log: what ran before it is not known"
+    text = (f"{row.consumed:.3g} % of the rated life ({r.rated_life:g} h L10 at {r.rated_torque:.5g} N m, "
+            f"{r.gearbox_type}{default}) consumed since {row.since} ({origin})")
+    left_out = f" ({missing} logs without a load record left out: a state written before it)" if missing else ""
+    if not row.logs:
+        return text + ": no log with a load record since" + left_out
+    if row.days_left is None:
+        text += "; no load in the last logs: no end of the rated life at this duty"
+    elif row.days_left <= 0:
+        text += f"; past the rated life (100 %), at {row.duty:.3g} % per day"
+    else:
+        text += (f"; at {row.duty:.3g} % per day (last {min(row.logs, window)} logs, {row.hours_per_day:g} h of "
+                 f"operation a day) 100 % in {row.days_left:.0f} days")
+    return text + left_out
+
+
+def _cell(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return cells.text(value) if isinstance(value, str) else str(value)
+
+
+def write_life(path: Path, rows: list[LifeRow]) -> None:
+    """``life.csv``: one row per unit and axis (:data:`COLUMNS`; ``days_left`` empty without load;
+    ``defaults`` the rating keys that are defaults, space separated)."""
+    with open(path, "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(COLUMNS)
+        for row in rows:
+            writer.writerow([_cell(v) for v in row.cells()])
+
+
+def service_by(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> tuple[str, str]:
+    """A unit's "service by" and what sets it: the earlier of the load-based days left (rows of
+    life.csv, as read: text cells) and the condition-based remaining life (rows of rul.csv in days),
+    counted from ``last_stamp``; a date for date stamps, else "in N days". ``("", "")`` when neither
+    gives a number."""
+    found = []
+    for r in life_rows:
+        days = _float(r.get("days_left"))
+        if math.isfinite(days):
+            found.append((max(days, 0.0), f"load: axis {r.get('axis')}'s rated life"))
+    for r in rul_rows:
+        days = _float(r.get("rul"))
+        if math.isfinite(days) and r.get("time_unit") == "days":
+            found.append((days, f"condition: axis {r.get('axis')}'s wear"))
+    if not found:
+        return "", ""
+    days, why = min(found, key=lambda f: f[0])
+    try:
+        key, kind = _key(last_stamp, "unit")
+    except ValueError:
+        kind = None
+    if kind == logfolder.TIME:
+        try:
+            return (datetime.fromtimestamp(key, timezone.utc) + timedelta(days=days)).date().isoformat(), why
+        except (OverflowError, ValueError):  # beyond the calendar's year 9999
+            pass
+    return f"in {days:.0f} days", why
+
+
+def _float(cell) -> float:
+    try:
+        return float(cell)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def table_cell(rows: list[dict]) -> str:
+    """The fleet table's cell of a unit's rows of life.csv (as read): the axis that consumed most,
+    its % and the days left at the recent duty."""
+    found = [(r, _float(r.get("consumed_pct"))) for r in rows]
+    found = [(r, c) for r, c in found if math.isfinite(c)]
+    if not found:
+        return ""
+    r, consumed = max(found, key=lambda f: f[1])
+    days = _float(r.get("days_left"))
+    left = f"{days:.0f} days left" if math.isfinite(days) else "no load"
+    return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
+
+
+def service_by_html(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> str:
+    """:func:`service_by` for the page: ``date (what sets it)``, HTML-escaped; "" without one."""
+    date, why = service_by(last_stamp, life_rows, rul_rows)
+    return f"{html.escape(date)} ({html.escape(why)})" if date else ""
+
+
+def panel_html(life_rows: list[dict], service: str) -> str:
+    """A unit's panel paragraph: every axis's verdict of life.csv and the ``service`` by (HTML)."""
+    items = "".join(f"<li>axis {html.escape(r['axis'])}: {html.escape(r['verdict'])}</li>" for r in life_rows)
+    return f"<p>Rated life consumed by load (life.csv); service by {service or '–'}:</p><ul>{items}</ul>"
