@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import argparse
 import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from analysis import isolation
+from faultgen import children
 
 
 def main() -> None:
@@ -25,9 +25,10 @@ def main() -> None:
     args = parser.parse_args()
     if not args.out.exists():
         axes = [a for k in range(1, 7) for a in ("--axis", str(k))]
-        subprocess.run([sys.executable, "-m", "faultgen.cli", "sweep", "--robot", "irb6700", "--task", "pick_place",
+        subprocess.run(children.command("-m", "faultgen.cli", "sweep", "--robot", "irb6700", "--task", "pick_place",
                         *axes, "--wear-pct", "20", "--schedule", "exp4", "--cycles", "100", "--seed", "1",
-                        "--features-only", "--jobs", "1", "--no-progress", "-o", str(args.out)], check=True)
+                        "--features-only", "--jobs", "1", "--no-progress", "-o", str(args.out)),
+                       env=children.environment(), check=True)
     with h5py.File(args.out) as f:
         runs = sorted(f["runs"])
         data = [f["runs"][r]["mean_abs_torque"][()] for r in runs]

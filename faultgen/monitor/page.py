@@ -170,7 +170,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
     if (folder / "life.csv").exists():  # the rated life consumed by load (optional: a run before it has none)
-        for r in _read_csv(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"))[1]:
+        for r in tables.read(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"), max_bytes)[1]:
             if r["unit"] in units:
                 units[r["unit"]].life.append(r)
     n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
