@@ -91,21 +91,20 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
     nominal = robots.require(robot, "calibrate.loop.run")
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
-    data, channel_delay = check_delay(nominal, data, delay)
+    data, channel_delay, (predicted, motion) = check_delay(nominal, data, delay)
     if progress:
         print(channel_delay.get("line", channel_delay.get("reason")), flush=True)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     model = Model.nominal(nominal)
-    predicted, motion = predicted_motion(nominal, data)
 
     def tested(prediction: np.ndarray) -> list[dict]:
         return residual_tests.run(data.t, tau - prediction, split.held_out, tau, data.q, data.qd, data.qdd)
 
-    after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+    after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
 
     out = Path(out)
     model_dir = out / "model"
@@ -182,18 +181,19 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     return result
 
 
-def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData,
-                delay: str | float | None) -> tuple[measured_io.MeasuredData, dict]:
+def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: str | float | None):
     """The channel delay check of :func:`run`: the delay of the torque behind the motion estimated
     on the log as given (:func:`faultgen.calibrate.delay.estimate`, the nominal model's torque),
     then the correction ``delay`` asks for (None: none; "auto": the estimate; a number, s) and,
-    after a correction, the delay left. Returns the log to calibrate and the ``report.json``
+    after a correction, the delay left. Returns the log to calibrate, the ``report.json``
     record (``estimate``, ``applied_s``, ``after_correction``, ``line``; ``reason`` instead when
-    the log is too short to estimate it)."""
+    the log is too short to estimate it) and the nominal model's prediction and motion on the
+    log returned (:func:`faultgen.calibrate.prediction.predicted_motion`)."""
     if delay is not None and delay != "auto" and (isinstance(delay, bool) or not isinstance(delay, (int, float))):
         raise ValueError(f"--delay {delay!r}: expected auto or a delay in seconds, e.g. 0.012")
+    given = predicted_motion(nominal, data)
     try:
-        found = delays.estimate(data.t, data.tau, predicted_motion(nominal, data)[0])
+        found = delays.estimate(data.t, data.tau, given[0])
     except ValueError as err:
         if delay == "auto":
             raise ValueError(f"--delay auto: {err}") from None
@@ -204,18 +204,19 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData,
     else:
         record.update(estimate=found.record(), line=found.line())
     if delay is None:
-        return data, record
+        return data, record, given
     seconds = found.seconds if delay == "auto" else float(delay)
     data = delays.shift(data, seconds)
     record["applied_s"] = seconds
     record["line"] = f"{record.get('line', record.get('reason'))}; torque moved {1e3 * seconds:+.1f} ms (--delay {delay})"
+    corrected = predicted_motion(nominal, data)
     try:
-        left = delays.estimate(data.t, data.tau, predicted_motion(nominal, data)[0])
+        left = delays.estimate(data.t, data.tau, corrected[0])
     except ValueError:
-        return data, record
+        return data, record, corrected
     record["after_correction"] = left.record()
     record["line"] += "; left: " + left.line()
-    return data, record
+    return data, record, corrected
 
 
 #: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`
