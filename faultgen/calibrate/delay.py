@@ -4,7 +4,10 @@ every log before the effect search, and the log with its torque columns moved by
 
 A controller that samples the torque (or the motor current) later than the encoders logs
 ``tau_logged(t) = tau(t - d)``. The model's torque along the logged motion is ``tau(t)``, so the
-cross-correlation of the measured torque with the model's peaks at the lag ``d``. The lag is taken
+cross-correlation of the measured torque's rate of change with the model's peaks at the lag ``d``
+(the rates, not the torques: a torque held against gravity says nothing about when it was
+sampled, and it would flatten the peak; on pick-and-place logs with long rests the torques' own
+interval reached 40 ms where the rates' is 3 ms wide). The lag is taken
 to a fraction of a sample by a parabola through the peak and its two neighbours (Jacovitti &
 Scarano 1993, "Discrete time techniques for time delay estimation", IEEE Trans. Signal Process.
 41(2), eq. 19), its interval by a block bootstrap of the time axis (Carlstein 1986, non-overlapping
@@ -31,9 +34,8 @@ SEED = 0
 BLOCK = 2.0
 MIN_BLOCKS = 10
 #: What the interval is widened by on both sides, in sample periods: the bias the bootstrap does not
-#: see. The parabola's own (up to 0.08 sample on roboticstoolbox logs shifted by a known delay) and
-#: the effects not yet in the model (a payload or a Stribeck hump moved the peak by up to 0.1
-#: sample on unshifted roboticstoolbox logs); docs/calibration.md, "Channel delay".
+#: see, the parabola's own (up to 0.08 sample on roboticstoolbox logs shifted by a known delay) and
+#: that of effects not yet in the model; docs/calibration.md, "Channel delay".
 ALLOWANCE = 0.15
 
 
@@ -65,8 +67,8 @@ class Delay:
         """For ``report.json``: the estimate and interval in s, the level and the method."""
         return {"seconds": self.seconds, "interval_s": [self.low, self.high], "level": LEVEL,
                 "sample_period_s": self.period, "covers_zero": self.covers_zero,
-                "method": ("peak of the cross-correlation of the measured with the model's torque (all axes, each "
-                           "standardised), parabolic sub-sample interpolation (Jacovitti & Scarano 1993); interval: "
+                "method": ("peak of the cross-correlation of the measured with the model's torque rate (all axes, "
+                           "each standardised), parabolic sub-sample interpolation (Jacovitti & Scarano 1993); interval: "
                            f"percentile, block bootstrap ({REPLICATES} replicates, blocks of up to {BLOCK:g} s, "
                            f"Carlstein 1986), widened by {ALLOWANCE:g} sample period either side")}
 
@@ -112,7 +114,8 @@ def estimate(t: np.ndarray, tau: np.ndarray, predicted: np.ndarray, max_delay: f
     if n < 2 * k * MIN_BLOCKS:
         raise ValueError(f"a log of {n} samples is too short to estimate a delay of up to {max_delay:g} s; "
                          f"expected at least {2 * k * MIN_BLOCKS} samples")
-    products = _products(_standardised(tau), _standardised(predicted), k)  # (n - 2k, 2k + 1)
+    rate, model_rate = np.gradient(tau, t, axis=0), np.gradient(predicted, t, axis=0)
+    products = _products(_standardised(rate), _standardised(model_rate), k)  # (n - 2k, 2k + 1)
     rows = products.shape[0]
     size = max(1, min(int(round(BLOCK / period)), rows // MIN_BLOCKS))
     blocks = rows // size
