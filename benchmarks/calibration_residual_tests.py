@@ -77,6 +77,7 @@ def run(case: independent_set.Case | tuple, late: bool) -> dict:
             row["log"] += "-late12ms"
         result = calibrate(case.robot, path, Path(folder) / "out", figure=False)
         found = result.delay["estimate"]
+        row["duration_s"] = float(result.time[-1] - result.time[0])
         row.update(steps=" ".join(s.effect.id for s in result.steps), gap=result.gap_after["total_nrmse"],
                    unexplained=" ".join(str(u["axis"]) for u in result.unexplained()),
                    smallest_p_adjusted=smallest_p(result), delay_ms=1e3 * found["seconds"],

@@ -43,6 +43,7 @@ from statsmodels.stats.multitest import multipletests
 
 from faultgen import axes as axis_numbers
 from faultgen.calibrate.criterion import noise_floor
+from faultgen.calibrate.search import ABOVE_FLOOR
 from faultgen.derivatives import savgol_window
 
 #: Family-wise level of the tests over all axes (MATLAB ``resid``'s 99 % confidence region).
@@ -53,9 +54,6 @@ LAGS = 25
 WHITENESS_LAGS = 10
 #: Fewest thinned held-out samples an axis needs to be tested.
 MIN_SAMPLES = 40
-#: Held-out nrmse over the noise floor above which a failed test calls an axis unexplained (the
-#: search's :data:`faultgen.calibrate.search.ABOVE_FLOOR`).
-ABOVE_FLOOR = 1.2
 #: The motion variables each axis's residual is tested against, per axis.
 MOTION = ("q", "qd", "qdd")
 
@@ -109,7 +107,7 @@ def run(t: np.ndarray, residual: np.ndarray, held: np.ndarray, tau: np.ndarray, 
         records.append(record)
         if not record["tested"]:
             continue
-        q_stat, p_white = _ljung_box(x[mask])
+        q_stat, p_white = _ljung_box(x[mask])  # the held-out samples end to end, across an axis's rests
         record["whiteness"] = {"statistic": q_stat, "lags": WHITENESS_LAGS, "p": p_white}
         own = {f"tau{axis_numbers.number(a)}": np.asarray(tau, dtype=float)[rows, a]}
         record["independence"] = {name: _cross(x, y) for name, y in {**own, **variables}.items()}
