@@ -35,7 +35,7 @@ def save(result, path: str | Path) -> Path:
         + f"; fitted {a['fitted']}" for a in result.ambiguous())
     left_over = {u["axis"]: u for u in result.unexplained()}
     unexplained = "".join(f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} (noise floor {u['noise_floor']:.3f}); "
-                          f"failed: {', '.join(u['failed'])}" + _follows(u) + f"; added: {', '.join(u['added']) or 'none'}"
+                          f"failed: {_failed(u['failed'])}" + _follows(u) + f"; added: {', '.join(u['added']) or 'none'}"
                           for a, u in left_over.items())
     delay = "" if result.delay is None or "estimate" not in result.delay else (
         f"\nchannel delay {1e3 * result.delay['estimate']['seconds']:+.1f} ms "
@@ -77,3 +77,8 @@ def _follows(found: dict) -> str:
     """What an unexplained axis's residual follows, for the title (nothing when only whiteness failed)."""
     follows = found["follows"]
     return "" if follows is None else f"; follows {follows['variable']} at {1e3 * follows['lag_s']:+.0f} ms"
+
+
+def _failed(names: list[str], most: int = 4) -> str:
+    """The failed tests for the title, the first ``most`` and how many more."""
+    return ", ".join(names[:most]) + (f" and {len(names) - most} more" if len(names) > most else "")

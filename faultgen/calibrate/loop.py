@@ -215,7 +215,7 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
     except ValueError:
         return data, record, corrected
     record["after_correction"] = left.record()
-    record["line"] += "; left: " + left.line()
+    record["line"] += "; left: " + left.line().removeprefix("channel delay: ")
     return data, record, corrected
 
 
