@@ -96,7 +96,8 @@ def test_the_summary_report_and_figure_name_the_axis(tmp_path, log, monkeypatch)
     monkeypatch.setattr(pyplot, "close", lambda fig: drawn.append(fig))
     figure.save(result, tmp_path / "c.png")
     (fig,) = drawn
-    assert "axis 3: LEFT UNEXPLAINED" in fig._suptitle.get_text() and "follows qd5 at +104 ms" in fig._suptitle.get_text()
+    title = fig._suptitle.get_text()
+    assert "axis 3: LEFT UNEXPLAINED" in title and "follows qd5 at +104 ms" in title
     assert "UNEXPLAINED" in fig.axes[4].get_ylabel() and "UNEXPLAINED" not in fig.axes[0].get_ylabel()
     clean = Calibration(**{**result.__dict__, "residual_tests": residual_tests.run(t, noise, held, tau, q, qd, qdd)})
     assert "UNEXPLAINED" not in clean.summary() and clean.report()["unexplained"] == []

@@ -67,8 +67,9 @@ class Delay:
         """For ``report.json``: the estimate and interval in s, the level and the method."""
         return {"seconds": self.seconds, "interval_s": [self.low, self.high], "level": LEVEL,
                 "sample_period_s": self.period, "covers_zero": self.covers_zero,
-                "method": ("peak of the cross-correlation of the measured with the model's torque rate (all axes, "
-                           "each standardised), parabolic sub-sample interpolation (Jacovitti & Scarano 1993); interval: "
+                "method": ("peak of the cross-correlation of the measured with the model's torque rate (all "
+                           "axes, each standardised), parabolic sub-sample interpolation (Jacovitti & Scarano "
+                           "1993); interval: "
                            f"percentile, block bootstrap ({REPLICATES} replicates, blocks of up to {BLOCK:g} s, "
                            f"Carlstein 1986), widened by {ALLOWANCE:g} sample period either side")}
 

@@ -34,13 +34,13 @@ def save(result, path: str | Path) -> Path:
         + " / ".join(f"{c['effect']} (dAIC {c['delta_aic']:.1f})" for c in a["candidates"])
         + f"; fitted {a['fitted']}" for a in result.ambiguous())
     left_over = {u["axis"]: u for u in result.unexplained()}
-    unexplained = "".join(f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} (noise floor {u['noise_floor']:.3f}); "
-                          f"failed: {_failed(u['failed'])}" + _follows(u) + f"; added: {', '.join(u['added']) or 'none'}"
-                          for a, u in left_over.items())
-    delay = "" if result.delay is None or "estimate" not in result.delay else (
-        f"\nchannel delay {1e3 * result.delay['estimate']['seconds']:+.1f} ms "
-        f"({1e3 * result.delay['estimate']['interval_s'][0]:+.1f} .. {1e3 * result.delay['estimate']['interval_s'][1]:+.1f}"
-        f" ms), torque moved {1e3 * result.delay['applied_s']:+.1f} ms")
+    unexplained = "".join(
+        f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} (noise floor {u['noise_floor']:.3f}); failed: "
+        f"{_failed(u['failed'])}{_follows(u)}; added: {', '.join(u['added']) or 'none'}" for a, u in left_over.items())
+    found = (result.delay or {}).get("estimate")
+    delay = "" if found is None else (
+        f"\nchannel delay {1e3 * found['seconds']:+.1f} ms ({1e3 * found['interval_s'][0]:+.1f} .. "
+        f"{1e3 * found['interval_s'][1]:+.1f} ms), torque moved {1e3 * result.delay['applied_s']:+.1f} ms")
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
                  f"{result.gap_after['total_nrmse']:.3f}{delay}{ambiguous}{unexplained}", fontsize=11,

@@ -208,7 +208,8 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
     seconds = found.seconds if delay == "auto" else float(delay)
     data = delays.shift(data, seconds)
     record["applied_s"] = seconds
-    record["line"] = f"{record.get('line', record.get('reason'))}; torque moved {1e3 * seconds:+.1f} ms (--delay {delay})"
+    record["line"] = (f"{record.get('line', record.get('reason'))}; torque moved {1e3 * seconds:+.1f} ms "
+                      f"(--delay {delay})")
     corrected = predicted_motion(nominal, data)
     try:
         left = delays.estimate(data.t, data.tau, corrected[0])

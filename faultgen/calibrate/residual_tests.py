@@ -102,8 +102,8 @@ def run(t: np.ndarray, residual: np.ndarray, held: np.ndarray, tau: np.ndarray, 
     for a in range(n_axes):
         mask = held[rows, a]
         x = np.where(mask, residual[rows, a], np.nan)
-        record = {"axis": axis_numbers.number(a), "tested": bool(mask.sum() >= MIN_SAMPLES), "samples": int(mask.sum()),
-                  "stride": step, "failed": [], "follows": None}
+        record = {"axis": axis_numbers.number(a), "tested": bool(mask.sum() >= MIN_SAMPLES),
+                  "samples": int(mask.sum()), "stride": step, "failed": [], "follows": None}
         records.append(record)
         if not record["tested"]:
             continue
@@ -169,7 +169,8 @@ def line(found: dict) -> str:
     tests = []
     if "whiteness" in found["failed"]:
         w = found["whiteness"]
-        tests.append(f"not white (Ljung-Box Q = {w['statistic']:.1f} over {w['lags']} lags, p = {w['p_adjusted']:.2g})")
+        tests.append(f"not white (Ljung-Box Q = {w['statistic']:.1f} over {w['lags']} lags, "
+                     f"p = {w['p_adjusted']:.2g})")
     follows = found["follows"]
     if follows is not None:
         v = found["independence"][follows["variable"]]
