@@ -41,7 +41,7 @@ import numpy as np
 from faultgen import axes
 from faultgen.calibrate import search
 from faultgen.calibrate.effects import EFFECTS, Effect, get
-from faultgen.calibrate.leftover import UNEXPLAINED_RATIO, unexplained
+from faultgen.calibrate.residual_tests import LEVEL as RESIDUAL_TEST_LEVEL
 from faultgen.calibrate.loop import MAX_STEPS
 from faultgen.calibrate.loop import run as _calibrate
 from faultgen.calibrate.plausibility import ImplausibleLogError
@@ -51,8 +51,8 @@ from faultgen.data import atomic, longlog
 from faultgen.data import measured as measured_io
 from faultgen.model import robots
 
-__all__ = ["EFFECTS", "UNEXPLAINED_RATIO", "Calibration", "Effect", "ImplausibleLogError", "Step", "calibrate", "get",
-           "parameters", "predict", "unexplained"]
+__all__ = ["EFFECTS", "RESIDUAL_TEST_LEVEL", "Calibration", "Effect", "ImplausibleLogError", "Step", "calibrate", "get",
+           "parameters", "predict"]
 
 
 #: Most rows the search works on. A longer log is averaged down to this many (:func:`decimate`):
@@ -63,7 +63,8 @@ MAX_ROWS = 25_000
 
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-              log_format=None, friction_every_axis: bool = False, figure: bool = True) -> Calibration:
+              log_format=None, friction_every_axis: bool = False, figure: bool = True,
+              delay: str | float | None = None) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
@@ -79,6 +80,8 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
     after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
     ``figure``: draw ``calibration.png`` (False: the other outputs only, as ``faultgen monitor`` caches them).
+    ``delay``: the channel delay's correction (None: reported only; "auto": the estimate; a number
+    of seconds; :func:`faultgen.calibrate.loop.check_delay`).
     The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
@@ -99,7 +102,7 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     out.parent.mkdir(parents=True, exist_ok=True)
     with atomic.atomic_folder(out) as staging:
         result = _calibrate(nominal, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid,
-                             friction_every_axis=friction_every_axis, figure=figure)
+                             friction_every_axis=friction_every_axis, figure=figure, delay=delay)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))
         atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
     return replace(result, model=robots.moved(result.model, result.model_out))  # the folder renamed into place

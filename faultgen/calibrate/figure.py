@@ -34,12 +34,16 @@ def save(result, path: str | Path) -> Path:
         + " / ".join(f"{c['effect']} (dAIC {c['delta_aic']:.1f})" for c in a["candidates"])
         + f"; fitted {a['fitted']}" for a in result.ambiguous())
     left_over = {u["axis"]: u for u in result.unexplained()}
-    unexplained = "".join(f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} = {u['ratio']:.1f}x the median "
-                          f"axis's; every effect tried on it, added: {', '.join(u['added']) or 'none'}"
-                          for a, u in left_over.items())
+    unexplained = "".join(
+        f"\naxis {a}: LEFT UNEXPLAINED, nrmse {u['nrmse']:.3f} (noise floor {u['noise_floor']:.3f}); failed: "
+        f"{_failed(u['failed'])}{_follows(u)}; added: {', '.join(u['added']) or 'none'}" for a, u in left_over.items())
+    found = (result.delay or {}).get("estimate")
+    delay = "" if found is None else (
+        f"\nchannel delay {1e3 * found['seconds']:+.1f} ms ({1e3 * found['interval_s'][0]:+.1f} .. "
+        f"{1e3 * found['interval_s'][1]:+.1f} ms), torque moved {1e3 * result.delay['applied_s']:+.1f} ms")
     fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
                  f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
-                 f"{result.gap_after['total_nrmse']:.3f}{ambiguous}{unexplained}", fontsize=11,
+                 f"{result.gap_after['total_nrmse']:.3f}{delay}{ambiguous}{unexplained}", fontsize=11,
                  color="tab:red" if left_over else "black")
     for axis in range(n_axes):
         left, right = axes[axis]
@@ -67,3 +71,14 @@ def save(result, path: str | Path) -> Path:
     fig.savefig(path, dpi=90)
     plt.close(fig)
     return path
+
+
+def _follows(found: dict) -> str:
+    """What an unexplained axis's residual follows, for the title (nothing when only whiteness failed)."""
+    follows = found["follows"]
+    return "" if follows is None else f"; follows {follows['variable']} at {1e3 * follows['lag_s']:+.0f} ms"
+
+
+def _failed(names: list[str], most: int = 4) -> str:
+    """The failed tests for the title, the first ``most`` and how many more."""
+    return ", ".join(names[:most]) + (f" and {len(names) - most} more" if len(names) > most else "")

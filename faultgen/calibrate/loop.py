@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import axes
-from faultgen.calibrate import plausibility, search
+from faultgen.calibrate import delay as delays
+from faultgen.calibrate import plausibility, residual_tests, search
 from faultgen.calibrate.effects import Effect, get
 from faultgen.calibrate.improve import backfit, complete, extend, sysid_stribeck
 from faultgen.calibrate.prediction import predicted_motion
@@ -32,7 +33,7 @@ MAX_STEPS = 6
 
 def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
         max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-        friction_every_axis: bool = False, figure: bool = True) -> Calibration:
+        friction_every_axis: bool = False, figure: bool = True, delay: str | float | None = None) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
@@ -63,6 +64,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         Draw ``calibration.png`` (measured against model torque per axis, about 1.6 s for a day's
         log of six axes); ``faultgen monitor`` caches its units' calibrations without it (nothing
         reads it there).
+    delay : None, "auto" or float
+        The channel delay check (:mod:`faultgen.calibrate.delay`), made on every log before the
+        search and reported: None reports it only; ``"auto"`` moves the torque columns by the
+        estimate; a number by that many seconds (positive: the torque was logged late).
 
     Returns
     -------
@@ -79,19 +84,27 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         For a log the nominal model cannot explain (another robot, motor-side torque, a column in
         another unit or sign; :mod:`faultgen.calibrate.plausibility`); nothing is written.
     ValueError
-        If ``max_steps`` < 0.
+        If ``max_steps`` < 0, ``delay`` is neither None, "auto" nor a number of at most half the
+        log's length, or is "auto" on a log too short to estimate it.
     """
     if max_steps < 0:
         raise ValueError(f"max_steps (--max-steps) = {max_steps}; expected a whole number >= 0")
     nominal = robots.require(robot, "calibrate.loop.run")
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
+    data, channel_delay, (predicted, motion) = check_delay(nominal, data, delay)
+    if progress:
+        print(channel_delay.get("line", channel_delay.get("reason")), flush=True)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     model = Model.nominal(nominal)
-    predicted, motion = predicted_motion(nominal, data)
+
+    def tested(prediction: np.ndarray) -> list[dict]:
+        return residual_tests.run(data.t, tau - prediction, split.held_out, tau, data.q, data.qd, data.qdd)
+
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+    after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
 
     out = Path(out)
     model_dir = out / "model"
@@ -120,6 +133,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         befores.append(best.effect.current(model.robot))
         model, predicted, motion = trial.model, trial.prediction, trial.motion
         steps.append(Step(best.effect, best.axes, evidence(best, ranked, residual, split), after, errors))
+        after_steps.append({"after": f"step {k + 1}: {best.effect.id}",
+                            "axes": residual_tests.summary(tested(predicted))})
         if progress:
             print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
                   f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
@@ -136,6 +151,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     calibrated = robots.write(model_out, model.text, atomic.write_text)
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
 
+    final_tests = tested(predicted)
+    after_steps.append({"after": "calibrated model", "axes": residual_tests.summary(final_tests)})
     result = Calibration(
         robot=nominal.name,
         measured=str(data.source),
@@ -152,6 +169,9 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         searches=searches,
         model=calibrated,
         nominal_digest=nominal.digest,
+        residual_tests=final_tests,
+        tests_after_steps=after_steps,
+        delay=channel_delay,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     if figure:
@@ -159,6 +179,45 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
         figures.save(result, out / "calibration.png")
     return result
+
+
+def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: str | float | None):
+    """The channel delay check of :func:`run`: the delay of the torque behind the motion estimated
+    on the log as given (:func:`faultgen.calibrate.delay.estimate`, the nominal model's torque),
+    then the correction ``delay`` asks for (None: none; "auto": the estimate; a number, s) and,
+    after a correction, the delay left. Returns the log to calibrate, the ``report.json``
+    record (``estimate``, ``applied_s``, ``after_correction``, ``line``; ``reason`` instead when
+    the log is too short to estimate it) and the nominal model's prediction and motion on the
+    log returned (:func:`faultgen.calibrate.prediction.predicted_motion`)."""
+    if delay is not None and delay != "auto" and (isinstance(delay, bool) or not isinstance(delay, (int, float))):
+        raise ValueError(f"--delay {delay!r}: expected auto or a delay in seconds, e.g. 0.012")
+    given = predicted_motion(nominal, data)
+    try:
+        found = delays.estimate(data.t, data.tau, given[0])
+    except ValueError as err:
+        if delay == "auto":
+            raise ValueError(f"--delay auto: {err}") from None
+        found = None
+    record = {"mode": "report only" if delay is None else str(delay), "applied_s": 0.0}
+    if found is None:
+        record["reason"] = "channel delay: not estimated, the log is too short"
+    else:
+        record.update(estimate=found.record(), line=found.line())
+    if delay is None:
+        return data, record, given
+    seconds = found.seconds if delay == "auto" else float(delay)
+    data = delays.shift(data, seconds)
+    record["applied_s"] = seconds
+    record["line"] = (f"{record.get('line', record.get('reason'))}; torque moved {1e3 * seconds:+.1f} ms "
+                      f"(--delay {delay})")
+    corrected = predicted_motion(nominal, data)
+    try:
+        left = delays.estimate(data.t, data.tau, corrected[0])
+    except ValueError:
+        return data, record, corrected
+    record["after_correction"] = left.record()
+    record["line"] += "; left: " + left.line().removeprefix("channel delay: ")
+    return data, record, corrected
 
 
 #: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`

@@ -11,7 +11,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate.effects import Effect
-from faultgen.calibrate.leftover import unexplained, unexplained_line
+from faultgen.calibrate import residual_tests
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -87,6 +87,14 @@ class Calibration:
     nominal_digest : str or None
         SHA-1 of the nominal model's MJCF (:attr:`Robot.digest`; None for one edited in memory),
         which :func:`faultgen.calibrate.refit.refit` checks the nominal robot it is handed against.
+    residual_tests : list of dict or None
+        The residual tests of the calibrated model, per axis (:func:`faultgen.calibrate.residual_tests.run`);
+        None: not made (nothing is then called unexplained).
+    tests_after_steps : list of dict
+        The tests' short record (:func:`faultgen.calibrate.residual_tests.summary`) of the nominal
+        model, after each step of the search and of the calibrated model: ``after`` and ``axes``.
+    delay : dict or None
+        The channel delay check (:func:`faultgen.calibrate.loop.check_delay`).
     """
 
     robot: str
@@ -104,6 +112,9 @@ class Calibration:
     searches: int | None = None
     model: robots.Robot | None = None
     nominal_digest: str | None = None
+    residual_tests: list[dict] | None = None
+    tests_after_steps: list[dict] = field(default_factory=list)
+    delay: dict | None = None
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""
@@ -116,11 +127,19 @@ class Calibration:
             "model_out": str(self.model_out),
             "ambiguous": self.ambiguous(),
             "unexplained": self.unexplained(),
+            "residual_tests": self.tests_after_steps,
+            "channel_delay": self.delay,
         }
 
     def unexplained(self) -> list[dict]:
-        """The axes left unexplained after the search (:func:`unexplained`)."""
-        return unexplained(self.gap_before, self.gap_after, self.steps, self.searches)
+        """The axes the calibrated model leaves unexplained: a residual test failed and the axis
+        is above its noise floor (:func:`faultgen.calibrate.residual_tests.unexplained`); each with
+        its tests' statistics and p-values and the effects added on it (with their step)."""
+        if self.residual_tests is None:
+            return []
+        found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after)
+        return [{**u, "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(self.steps, start=1)
+                                if u["axis"] - 1 in s.axes]} for u in found]
 
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
@@ -140,6 +159,8 @@ class Calibration:
     def summary(self) -> str:
         """A few lines for a terminal: each effect, its axes and parameters, the gap before -> after."""
         lines = [f"{self.robot}: held-out total nrmse {self.gap_before['total_nrmse']:.4f} (nominal model)"]
+        if self.delay is not None:
+            lines.append(self.delay.get("line", self.delay.get("reason", "")))
         if not self.steps:
             lines.append("no significant missing effect found")
         for k, step in enumerate(self.steps, start=1):
@@ -170,7 +191,7 @@ class Calibration:
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
         for u in self.unexplained():
-            lines.append(unexplained_line(u, self.robot))
+            lines.append(residual_tests.line(u))
         # the static model: for a per-step friction update, or a Stribeck curve MuJoCo's LuGre
         # (Gaussian only) cannot represent
         static_only = any(s.effect.stepped for s in self.steps) or any(

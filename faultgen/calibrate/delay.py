@@ -1,0 +1,182 @@
+"""The delay between a log's motion channels and its torque channels (:func:`estimate`), checked on
+every log before the effect search, and the log with its torque columns moved by a delay
+(:func:`shift`, ``faultgen calibrate --delay auto|SECONDS``).
+
+A controller that samples the torque (or the motor current) later than the encoders logs
+``tau_logged(t) = tau(t - d)``. The model's torque along the logged motion is ``tau(t)``, so the
+cross-correlation of the measured torque's rate of change with the model's peaks at the lag ``d``
+(the rates, not the torques: a torque held against gravity says nothing about when it was
+sampled, and it would flatten the peak; on pick-and-place logs with long rests the torques' own
+interval reached 40 ms where the rates' is 3 ms wide). The lag is taken
+to a fraction of a sample by a parabola through the peak and its two neighbours (Jacovitti &
+Scarano 1993, "Discrete time techniques for time delay estimation", IEEE Trans. Signal Process.
+41(2), eq. 19), its interval by a block bootstrap of the time axis (Carlstein 1986, non-overlapping
+blocks; Efron & Tibshirani 1993, ch. 13, the percentile interval). Nothing the effect search adds
+moves the peak: a missing friction or payload changes the torque's size, not when it happens.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from faultgen.data import measured as measured_io
+
+#: Largest delay searched, s, either way (a controller's channels are a few cycles apart).
+MAX_DELAY = 0.1
+#: Level of the delay's interval.
+LEVEL = 0.95
+#: Bootstrap replicates; fixed seed, so the same log gives the same interval.
+REPLICATES = 1000
+SEED = 0
+#: Length of a bootstrap block, s, and the fewest blocks (a short log gets shorter blocks).
+BLOCK = 2.0
+MIN_BLOCKS = 10
+#: What the interval is widened by on both sides, in sample periods: the bias the bootstrap does not
+#: see, the parabola's own (up to 0.08 sample on roboticstoolbox logs shifted by a known delay) and
+#: that of effects not yet in the model; docs/calibration.md, "Channel delay".
+ALLOWANCE = 0.15
+
+
+@dataclass(frozen=True)
+class Delay:
+    """A delay of the torque channels behind the motion channels, s (positive: the torque logged
+    late), with its interval.
+
+    Attributes
+    ----------
+    seconds : float
+        The estimate: the cross-correlation's peak, parabolic sub-sample interpolation.
+    low, high : float
+        The :data:`LEVEL` percentile interval of the block bootstrap, s.
+    period : float
+        The log's median sample period, s.
+    """
+
+    seconds: float
+    low: float
+    high: float
+    period: float
+
+    @property
+    def covers_zero(self) -> bool:
+        return bool(self.low <= 0.0 <= self.high)
+
+    def record(self) -> dict:
+        """For ``report.json``: the estimate and interval in s, the level and the method."""
+        return {"seconds": self.seconds, "interval_s": [self.low, self.high], "level": LEVEL,
+                "sample_period_s": self.period, "covers_zero": self.covers_zero,
+                "method": ("peak of the cross-correlation of the measured with the model's torque rate (all "
+                           "axes, each standardised), parabolic sub-sample interpolation (Jacovitti & Scarano "
+                           "1993); interval: "
+                           f"percentile, block bootstrap ({REPLICATES} replicates, blocks of up to {BLOCK:g} s, "
+                           f"Carlstein 1986), widened by {ALLOWANCE:g} sample period either side")}
+
+    def line(self) -> str:
+        """One console line: the estimate, its interval and whether it differs from zero."""
+        verdict = ("its interval covers 0: no delay shown" if self.covers_zero else
+                   "the torque is logged off the motion: `faultgen calibrate --delay auto` corrects it")
+        return (f"channel delay: torque behind motion {1e3 * self.seconds:+.1f} ms ({LEVEL:.0%} interval "
+                f"{1e3 * self.low:+.1f} .. {1e3 * self.high:+.1f} ms, sample period {1e3 * self.period:.1f} ms); "
+                f"{verdict}")
+
+
+def estimate(t: np.ndarray, tau: np.ndarray, predicted: np.ndarray, max_delay: float = MAX_DELAY) -> Delay:
+    """The delay of the measured torque behind the model's torque along the same logged motion.
+
+    Parameters
+    ----------
+    t : ndarray of shape (n,)
+        Sample times, s (about uniform: the median period is the lag unit).
+    tau, predicted : ndarray of shape (n, N)
+        Measured torque and the model's torque along the logged motion, N m.
+    max_delay : float
+        Largest delay searched either way, s.
+
+    Returns
+    -------
+    Delay
+        Estimate and :data:`LEVEL` interval, s.
+
+    Raises
+    ------
+    ValueError
+        If the log is shorter than :data:`MIN_BLOCKS` times twice the lags searched, or the shapes
+        differ.
+    """
+    t = np.asarray(t, dtype=float)
+    tau, predicted = np.asarray(tau, dtype=float), np.asarray(predicted, dtype=float)
+    if tau.shape != predicted.shape or tau.shape[0] != t.shape[0]:
+        raise ValueError(f"tau {tau.shape} and predicted {predicted.shape} must both have shape ({t.shape[0]}, N)")
+    period = float(np.median(np.diff(t)))
+    k = max(1, int(np.ceil(max_delay / period)))
+    n = t.shape[0]
+    if n < 2 * k * MIN_BLOCKS:
+        raise ValueError(f"a log of {n} samples is too short to estimate a delay of up to {max_delay:g} s; "
+                         f"expected at least {2 * k * MIN_BLOCKS} samples")
+    rate, model_rate = np.gradient(tau, t, axis=0), np.gradient(predicted, t, axis=0)
+    products = _products(_standardised(rate), _standardised(model_rate), k)  # (n - 2k, 2k + 1)
+    rows = products.shape[0]
+    size = max(1, min(int(round(BLOCK / period)), rows // MIN_BLOCKS))
+    blocks = rows // size
+    sums = products[: blocks * size].reshape(blocks, size, -1).sum(axis=1)  # (blocks, 2k + 1)
+    rng = np.random.default_rng(SEED)
+    counts = rng.multinomial(blocks, np.full(blocks, 1.0 / blocks), size=REPLICATES)
+    boot = np.array([_peak(c) for c in counts @ sums]) * period
+    low, high = np.quantile(boot, [(1 - LEVEL) / 2, (1 + LEVEL) / 2]) + np.array([-1, 1]) * ALLOWANCE * period
+    return Delay(seconds=float(_peak(sums.sum(axis=0)) * period), low=float(low), high=float(high), period=period)
+
+
+def shift(data: measured_io.MeasuredData, seconds: float) -> measured_io.MeasuredData:
+    """``data`` with its torque columns moved ``seconds`` earlier (``tau(t) <- tau_logged(t + seconds)``,
+    linear interpolation: the correction of a torque logged ``seconds`` after the motion; negative:
+    moved later). The rows whose corrected torque would lie outside the log are dropped; the
+    motion, its derivatives and the other columns are kept as they are on the rows kept.
+
+    Raises
+    ------
+    ValueError
+        If ``seconds`` is not finite or leaves fewer than half of the log's rows.
+    """
+    seconds = float(seconds)
+    t = np.asarray(data.t)
+    span = float(t[-1] - t[0])
+    if not np.isfinite(seconds) or abs(seconds) > span / 2:
+        raise ValueError(f"--delay {seconds!r} s: expected a finite delay of at most half the log's {span:.3g} s")
+    keep = (t + seconds >= t[0]) & (t + seconds <= t[-1])
+    tau = np.column_stack([np.interp(t[keep] + seconds, t, data.tau[:, a]) for a in range(data.tau.shape[1])])
+
+    def rows(a):
+        return None if a is None else np.asarray(a)[keep]
+
+    note = f"torque columns moved {1e3 * seconds:+.1f} ms (--delay); {int((~keep).sum())} rows at the end dropped"
+    return replace(data, t=t[keep], q=rows(data.q), qd=rows(data.qd), qdd=rows(data.qdd), tau=tau,
+                   joint_temperature=rows(data.joint_temperature), payload_mass=rows(data.payload_mass),
+                   cycle=rows(data.cycle), notes=(*data.notes, note))
+
+
+def _standardised(x: np.ndarray) -> np.ndarray:
+    """Each column less its mean, over its standard deviation (a still column: zero)."""
+    x = x - x.mean(axis=0)
+    scale = x.std(axis=0)
+    return np.where(scale > 0, x / np.where(scale > 0, scale, 1.0), 0.0)
+
+
+def _products(a: np.ndarray, b: np.ndarray, k: int) -> np.ndarray:
+    """Row ``i`` (times ``k .. n - k``), column ``j`` (lag ``j - k``): ``sum_axes a[i] b[i - lag]``."""
+    n = a.shape[0]
+    return np.column_stack([np.einsum("ij,ij->i", a[k:n - k], b[k - lag:n - k - lag]) for lag in range(-k, k + 1)])
+
+
+def _peak(c: np.ndarray) -> float:
+    """The lag (samples, from ``-k``) of the largest of ``c`` (2k + 1,), to a fraction of a sample
+    by the parabola through it and its neighbours (an end of the range: that end)."""
+    k = (c.size - 1) // 2
+    j = int(np.argmax(c))
+    if 0 < j < c.size - 1:
+        below, top, above = c[j - 1], c[j], c[j + 1]
+        curvature = below - 2 * top + above
+        if curvature < 0:
+            return j - k + 0.5 * (below - above) / curvature
+    return float(j - k)
