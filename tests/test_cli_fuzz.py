@@ -40,6 +40,7 @@ BASE = {
     "hidden-log": ["puma560", "--effect", "stribeck", "-o", f"{MISSING}/log.csv"],
     "reproduce": ["--tiny", "-o", f"{MISSING}/repro"],
     "bench make": ["thesis", "-o", f"{MISSING}/bench"],
+    "tasks friction-test": ["puma560", "-o", f"{MISSING}/test.toml"],
 }
 #: Examples per option; with the options found, the total the docs give (test_the_fuzz_covers_...).
 EXAMPLES = 50

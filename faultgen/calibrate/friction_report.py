@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from faultgen.calibrate import friction_fit, friction_test
-from faultgen.data import measured
+from faultgen.data import cells, measured
 from faultgen.data.atomic import output_set
 from faultgen.model.robots import Robot
 
@@ -95,8 +95,8 @@ def write(reading: Reading, out: Path, reference: pd.DataFrame | None = None) ->
     axes = [int(a) for a in reading.fits["axis"]]
     targets = [out / "friction_curve.csv", out / "friction_fit.csv", *(out / f"friction_axis{a}.png" for a in axes)]
     with output_set(targets) as staged:
-        reading.points.to_csv(staged(targets[0]), index=False)
-        reading.fits.to_csv(staged(targets[1]), index=False)
+        cells.escaped(reading.points).to_csv(staged(targets[0]), index=False)
+        cells.escaped(reading.fits).to_csv(staged(targets[1]), index=False)
         for a, target in zip(axes, targets[2:]):
             ref = None
             if reference is not None and (reference["axis"] == a).any():

@@ -35,7 +35,6 @@ earlier of that and the condition-based remaining life (``rul.csv``).
 
 from __future__ import annotations
 
-import csv
 import html
 import math
 from dataclasses import dataclass
@@ -238,14 +237,14 @@ def _cell(value) -> str:
         return ""
     if isinstance(value, float):
         return f"{value:.6g}"
-    return cells.text(value) if isinstance(value, str) else str(value)
+    return value if isinstance(value, str) else str(value)  # text neutralised by cells.writer
 
 
 def write_life(path: Path, rows: list[LifeRow]) -> None:
     """``life.csv``: one row per unit and axis (:data:`COLUMNS`; ``days_left`` empty without load;
     ``defaults`` the rating keys that are defaults, space separated)."""
     with open(path, "w", newline="") as f:
-        writer = csv.writer(f)
+        writer = cells.writer(f)
         writer.writerow(COLUMNS)
         for row in rows:
             writer.writerow([_cell(v) for v in row.cells()])
