@@ -47,8 +47,8 @@ CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
 #: How a program change that nobody logged closes an open alarm (alarms.csv ``closed_by``).
 PROGRAM_CHANGED = "program change (not logged: the motion left the twin's program)"
 #: Size bound of one unit's state file, written (:func:`write_unit` refuses a larger one) and read back
-#: (checked before it is parsed): about 0.6 kB per scored log, so some 28 000 logs (a log an hour for
-#: three years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
+#: (checked before it is parsed): about 0.85 kB per scored log with its load record, so some 20 000 logs (a log an hour for
+#: two years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
 STATE_MAX_BYTES = 16 * 2**20
 #: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read).
 CACHE = ("cycles", "calibrated", "programs")
