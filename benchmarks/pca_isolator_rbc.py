@@ -9,30 +9,20 @@ the axis each names from the per-cycle mean absolute motor torque (0: undecided,
 from __future__ import annotations
 
 import argparse
-import subprocess
+import sys
 from pathlib import Path
 
-import h5py
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from analysis import isolation
-from faultgen import children
+import te_records  # noqa: E402  (the same sweep, made and read once)
+from analysis import isolation  # noqa: E402
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-o", "--out", type=Path, required=True, help="the sweep file (made when missing)")
     args = parser.parse_args()
-    if not args.out.exists():
-        axes = [a for k in range(1, 7) for a in ("--axis", str(k))]
-        subprocess.run(children.command("-m", "faultgen.cli", "sweep", "--robot", "irb6700", "--task", "pick_place",
-                        *axes, "--wear-pct", "20", "--schedule", "exp4", "--cycles", "100", "--seed", "1",
-                        "--features-only", "--jobs", "1", "--no-progress", "-o", str(args.out)),
-                       env=children.environment(), check=True)
-    with h5py.File(args.out) as f:
-        runs = sorted(f["runs"])
-        data = [f["runs"][r]["mean_abs_torque"][()] for r in runs]
-        worn = [int(f["runs"][r].attrs["worn_axes"][0]) for r in runs]
+    data, worn = te_records.worn_runs(args.out)
     print("| variance | components | worn axis | RBC names | share of Q names |\n| --- | --- | --- | --- | --- |")
     right = {}
     for variance in (0.9, 0.75, 0.5):

@@ -22,20 +22,26 @@ from analysis import isolation
 from faultgen import children
 
 
+def worn_runs(out: Path) -> tuple[list[np.ndarray], list[int]]:
+    """The six runs' per-cycle mean absolute motor torque (100, 6) and worn axis, from the sweep
+    file ``out`` (made by `faultgen sweep` when missing)."""
+    if not out.exists():
+        axes = [a for k in range(1, 7) for a in ("--axis", str(k))]
+        subprocess.run([*children.command("-m", "faultgen.cli"), "sweep", "--robot", "irb6700", "--task", "pick_place",
+                        *axes, "--wear-pct", "20", "--schedule", "exp4", "--cycles", "100", "--seed", "1",
+                        "--features-only", "--jobs", "1", "--no-progress", "-o", str(out)],
+                       env=children.environment(), check=True)
+    with h5py.File(out) as f:
+        runs = sorted(f["runs"])
+        return ([f["runs"][r]["mean_abs_torque"][()] for r in runs],
+                [int(f["runs"][r].attrs["worn_axes"][0]) for r in runs])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-o", "--out", type=Path, required=True, help="the sweep file (made when missing)")
     args = parser.parse_args()
-    if not args.out.exists():
-        axes = [a for k in range(1, 7) for a in ("--axis", str(k))]
-        subprocess.run([*children.command("-m", "faultgen.cli"), "sweep", "--robot", "irb6700", "--task", "pick_place",
-                        *axes, "--wear-pct", "20", "--schedule", "exp4", "--cycles", "100", "--seed", "1",
-                        "--features-only", "--jobs", "1", "--no-progress", "-o", str(args.out)],
-                       env=children.environment(), check=True)
-    with h5py.File(args.out) as f:
-        runs = sorted(f["runs"])
-        data = [f["runs"][r]["mean_abs_torque"][()] for r in runs]
-        worn = [int(f["runs"][r].attrs["worn_axes"][0]) for r in runs]
+    data, worn = worn_runs(args.out)
     rng = np.random.default_rng(0)
     print("| bins | records | worn axis named % | undecided % |\n| --- | --- | --- | --- |")
     for bins in (10, 5):

@@ -32,25 +32,26 @@ MARKER_LINE = "SECRET-MARKER-7f3a9c-outside-the-benchmark-folder"
 RECORDS, AXES = 8, 6
 
 
-def _unit(uid: str, k: int, worn_axis: int) -> files.Unit:
+def _unit(uid: str, k: int, worn_axis: int, top: float = 40.0) -> files.Unit:
     rng = np.random.default_rng(k)
     arrays = {"cycles": np.arange(1, RECORDS + 1)}
     for name in files.FEATURES:
         arrays[name] = 1.0 + rng.random((RECORDS, AXES))
     if worn_axis:
         arrays["mean_abs_torque"][:, worn_axis - 1] += np.linspace(0, 2, RECORDS)
-    level = np.linspace(0, 40, RECORDS) if worn_axis else np.zeros(RECORDS)
+    level = np.linspace(0, top, RECORDS) if worn_axis else np.zeros(RECORDS)
     return files.Unit(id=uid, robot="irb6700", task="pick_place", sample="cycle", arrays=arrays,
                       fault_level=level, worn_axis=worn_axis, fault="friction_wear" if worn_axis else "none")
 
 
-def _folder(root):
-    """A benchmark folder of two train and three test units (test labels apart), as `bench make` writes it."""
+def _folder(root, track="thesis", version=2, axes=((0, 2), (0, 3, 5)), top=40.0):
+    """A benchmark folder as `bench make` writes it: train units worn on ``axes[0]`` and test units on
+    ``axes[1]`` (0: healthy) up to ``top`` %, the test labels apart."""
     folder = root / "bench"
     folder.mkdir()
-    attrs = {"track": "thesis", "version": 2, "size": "small", "licence": "CC0-1.0"}
-    train = [_unit(f"train-{k:03d}", k, axis) for k, axis in enumerate((0, 2))]
-    test = [_unit(f"test-{k:03d}", 10 + k, axis) for k, axis in enumerate((0, 3, 5))]
+    attrs = {"track": track, "version": version, "size": "small", "licence": "CC0-1.0"}
+    train = [_unit(f"train-{k:03d}", k, axis, top) for k, axis in enumerate(axes[0])]
+    test = [_unit(f"test-{k:03d}", 10 + k, axis, top) for k, axis in enumerate(axes[1])]
     files.write(folder / "train.h5", train, {**attrs, "split": "train"})
     files.write_labels(folder / "test_labels.csv", test)
     for unit in test:

@@ -7,7 +7,7 @@
 - every value a benchmark reader reads is checked against the range a run writes (finite; wear
   0..500 %; a prognoser's times of end of life 0..1e9 or inf).
 
-The folders are built in milliseconds with faultgen.bench.files (as tests/test_bench_hostile.py);
+The folders are built in milliseconds by tests/test_bench_hostile.py's `_folder` (faultgen.bench.files);
 their "frozen" manifest is their own hashes, through a patched ``make.manifest_path``, except in the
 one test that reproduces the finding on the thesis track made once a session (conftest.py).
 """
@@ -23,40 +23,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from faultgen.bench import files, make, prognosers, prognostics
+from faultgen.bench import make, prognosers, prognostics
 from faultgen.cli import app
 from faultgen.data import cells
 from faultgen.inputs import InputError
+from test_bench_hostile import _folder  # the same hand-built folder
 
 runner = CliRunner()
-RECORDS, AXES = 8, 6
-
-
-def _unit(uid: str, k: int, worn_axis: int, top: float = 40.0) -> files.Unit:
-    rng = np.random.default_rng(k)
-    arrays = {"cycles": np.arange(1, RECORDS + 1)}
-    for name in files.FEATURES:
-        arrays[name] = 1.0 + rng.random((RECORDS, AXES))
-    if worn_axis:
-        arrays["mean_abs_torque"][:, worn_axis - 1] += np.linspace(0, 2, RECORDS)
-    level = np.linspace(0, top, RECORDS) if worn_axis else np.zeros(RECORDS)
-    return files.Unit(id=uid, robot="irb6700", task="pick_place", sample="cycle", arrays=arrays,
-                      fault_level=level, worn_axis=worn_axis, fault="friction_wear" if worn_axis else "none")
-
-
-def _folder(root, track="thesis", version=2, axes=((0, 2), (0, 3, 5)), top=40.0):
-    """A benchmark folder as `bench make` writes it: train units, test units, their labels apart."""
-    folder = root / "bench"
-    folder.mkdir()
-    attrs = {"track": track, "version": version, "size": "small", "licence": "CC0-1.0"}
-    train = [_unit(f"train-{k:03d}", k, axis, top) for k, axis in enumerate(axes[0])]
-    test = [_unit(f"test-{k:03d}", 10 + k, axis, top) for k, axis in enumerate(axes[1])]
-    files.write(folder / "train.h5", train, {**attrs, "split": "train"})
-    files.write_labels(folder / "test_labels.csv", test)
-    for unit in test:
-        unit.fault_level = unit.worn_axis = unit.fault = None
-    files.write(folder / "test.h5", test, {**attrs, "split": "test"})
-    return folder
 
 
 @pytest.fixture

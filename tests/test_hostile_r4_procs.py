@@ -19,6 +19,7 @@ import pytest
 from typer.testing import CliRunner
 
 import fleetlog_folder
+from test_reliability import marked  # every process carrying the test's environment mark
 from faultgen import children
 from faultgen.cli import app
 from faultgen.model import robots
@@ -118,19 +119,6 @@ def test_the_twin_baselines_monitor_in_a_folder_with_a_planted_h5py_runs_none_of
 def small_fleet(tmp_path_factory) -> Path:
     """3 units x 12 daily logs of irb6700 (synthetic, tests/fleetlog_folder.py)."""
     return fleetlog_folder.write_fleet(tmp_path_factory.mktemp("fleet") / "logs", robots.load("irb6700"))
-
-
-def marked(mark: str) -> list[psutil.Process]:
-    """Every running process whose environment carries ``FAULTGEN_TEST_MARK=mark``: the monitor the
-    test started and every process forked from it, whoever their parent is now."""
-    found = []
-    for p in psutil.process_iter():
-        try:
-            if p.environ().get("FAULTGEN_TEST_MARK") == mark and p.status() != psutil.STATUS_ZOMBIE:
-                found.append(p)
-        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess):
-            pass
-    return found
 
 
 def wait_for(condition, what: str, seconds: float) -> float:

@@ -23,7 +23,7 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.monitor import page, report, tables
+from faultgen.monitor import page, report, run_settings, tables
 from faultgen.monitor.loop import UnitStatus
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
@@ -202,7 +202,7 @@ def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):
 
     fleet = page.read(written)
     assert [u.name for u in fleet.units][:1] == ["weld-07"] and fleet.n_axes == N_AXES and fleet.twin
-    settings = page.read_settings(written)
+    settings = run_settings.read_settings(written)
     assert settings["wear_limit"] == 5.0 and settings["robot"] == "irb6700"
     for unit in fleet.units:
         if unit.scores:
@@ -229,7 +229,7 @@ def test_monitor_writes_the_page(tmp_path):
                                       "own", "--train", "10", "--no-progress"])
     assert result.exit_code == 0, result.output
     assert str(out / page.PAGE) in result.output
-    assert page.read_settings(out)["protocol"] == "own"
+    assert run_settings.read_settings(out)["protocol"] == "own"
     for name in (page.PAGE, page.SETTINGS):  # LOGS by its name: a page meant to be shared holds no path of ours
         assert str(tmp_path) not in (out / name).read_text(), name
     statement = next(line for line in result.output.splitlines() if "Chance of a persistent alarm" in line)

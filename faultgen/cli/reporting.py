@@ -36,10 +36,10 @@ def report_command(
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own --no-progress
       faultgen report monitor-own
     """
-    from faultgen.monitor import page
+    from faultgen.monitor import page, run_settings
 
     if not out.is_dir():
         raise ValueError(f"{out} is not a folder; give a `faultgen monitor` output folder (its units.csv, alarms.csv "
                          "and scores.csv)")
-    written = page.write(out, page.read_settings(out))
+    written = page.write(out, run_settings.read_settings(out))
     typer.echo(f"wrote {written}")

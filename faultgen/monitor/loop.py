@@ -326,11 +326,11 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, l
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int) -> dict[str, Unit]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
     looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
-    A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code."""
+    A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
+    itself was checked to lead inside ``out`` by the caller (:func:`faultgen.monitor.state.checked_out`)."""
     folder = out / ".state"
     if not folder.is_dir():
         return {}
-    stored.inside(folder, out)
     pickles = sorted(p.name for p in folder.glob("*.pkl"))
     if pickles:
         raise ValueError(f"{folder}: holds {pickles[0]}, a monitor state of an earlier faultgen (a pickle, which can run "

@@ -4,7 +4,7 @@
 The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
 ``scores.csv`` (:mod:`faultgen.monitor.report`), and the run's settings (a small dict, kept beside
 it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
-(:func:`write`, :func:`read_settings`). It holds:
+(:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`). It holds:
 
 - the fleet table, the units that need attention first: an open alarm (the surest wear first),
   then degraded, not monitored, learning and quiet units; per unit its status, open alarm, axis,
@@ -34,7 +34,7 @@ from pathlib import Path
 
 from faultgen.data import atomic
 from faultgen.monitor import life, report, scoring, tables
-from faultgen.monitor.run_settings import SETTINGS, check_settings, read_settings, settings_dict  # noqa: F401
+from faultgen.monitor.run_settings import SETTINGS, settings_dict
 
 #: The page's file name in OUT.
 PAGE = "report.html"
