@@ -7,6 +7,8 @@ they give each log (what :func:`faultgen.data.fleetlogs.import_logs` reads, docs
       <unit>/<stamp>.csv         one log: one or more cycles in the measured format
       <unit>/<stamp>.csv.gz      (faultgen.data.measured), or the layout of an adapter
       <unit>/<stamp>.h5          (faultgen.data.adapters)
+      <unit>/friction-test/<stamp>.csv   optional: the unit's friction tests (the same suffixes and
+                                 stamps as its logs; never taken as logs: :func:`scan_tests`)
 
 Symbolic links may stay inside ``LOGS`` (a unit folder or a log linked to another place in it);
 a unit folder, a log or ``events.csv`` whose link leads out of ``LOGS`` is refused, named by its
@@ -65,6 +67,9 @@ FOLDER = "logs folder"
 #: The reason a log whose link leads out of the folder is not a log (listed with the files that are not).
 LINK_OUT = "a symbolic link out of the logs folder; links must stay inside the folder"
 
+#: A unit's folder of friction tests (``LOGS/<unit>/friction-test/<stamp>.csv``, :func:`scan_tests`):
+#: passed over by :func:`scan`, whose logs are a unit's production logs.
+TESTS = "friction-test"
 #: Stamp kinds: a date or date-time (key: seconds since 1970-01-01 UTC) or a sequence number.
 TIME, SEQUENCE = "time", "sequence"
 #: Most digits of a sequence number (below 2^53: every one a distinct float key).
@@ -192,38 +197,74 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
         if not entry.is_dir():
             raise ValueError(f"{entry}: neither a unit folder nor events.csv ({_kind(entry)}); expected "
                              "one folder per unit (LOGS/<unit>/<stamp>.csv) and optionally events.csv")
-        logs = []
-        for path in sorted(entry.iterdir()):
-            if path.name.startswith("."):
-                continue
-            _utf8(path)
-            name = f"{entry.name}/{path.name}"
-            if not inputs.inside(path, folder):
-                bad.append((name, LINK_OUT))
-                continue
-            stamp = stamp_of(path.name, suffixes) if path.is_file() else None
-            if stamp is None:
-                bad.append((name, f"not a log: expected <stamp>{' or <stamp>'.join(suffixes)}"))
-                continue
-            try:
-                key, kind = parse_stamp(stamp, name)
-            except ValueError as err:
-                bad.append((name, str(err)))
-                continue
-            logs.append(LogFile(entry.name, stamp, key, kind, path, name))
-        kinds = {log.kind for log in logs}
-        if len(kinds) > 1:
-            raise ValueError(f"{entry}: the logs mix dates and sequence numbers as stamps "
-                             f"({next(g.name for g in logs if g.kind == TIME)}, "
-                             f"{next(g.name for g in logs if g.kind == SEQUENCE)}); use one kind per unit")
-        logs.sort(key=lambda g: g.key)
-        for a, b in zip(logs, logs[1:]):
-            if a.key == b.key:
-                raise ValueError(f"{a.name} and {b.name} have the same stamp; keep one log per stamp")
-        units[entry.name] = logs
+        units[entry.name] = _listing(entry, folder, suffixes, entry.name, bad)
     if not units:
         raise ValueError(f"{folder}: no unit folders; expected LOGS/<unit>/<stamp>.csv|.csv.gz|.h5")
     return units, bad
+
+
+def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, bad: list) -> list[LogFile]:
+    """The logs of the folder ``where`` (a unit's, or its :data:`TESTS` folder) in stamp order, the
+    files that are not logs added to ``bad`` (:func:`scan`'s rules); a unit's :data:`TESTS` folder
+    is passed over (its tests are no logs: :func:`scan_tests`)."""
+    logs = []
+    for path in sorted(where.iterdir()):
+        if path.name.startswith("."):
+            continue
+        _utf8(path)
+        name = f"{where.relative_to(folder).as_posix()}/{path.name}"
+        if not inputs.inside(path, folder):
+            bad.append((name, LINK_OUT))
+            continue
+        if path.name == TESTS and where.name == unit and path.is_dir():
+            continue
+        stamp = stamp_of(path.name, suffixes) if path.is_file() else None
+        if stamp is None:
+            bad.append((name, f"not a log: expected <stamp>{' or <stamp>'.join(suffixes)}"))
+            continue
+        try:
+            key, kind = parse_stamp(stamp, name)
+        except ValueError as err:
+            bad.append((name, str(err)))
+            continue
+        logs.append(LogFile(unit, stamp, key, kind, path, name))
+    kinds = {log.kind for log in logs}
+    if len(kinds) > 1:
+        raise ValueError(f"{where}: the logs mix dates and sequence numbers as stamps "
+                         f"({next(g.name for g in logs if g.kind == TIME)}, "
+                         f"{next(g.name for g in logs if g.kind == SEQUENCE)}); use one kind per unit")
+    logs.sort(key=lambda g: g.key)
+    for a, b in zip(logs, logs[1:]):
+        if a.key == b.key:
+            raise ValueError(f"{a.name} and {b.name} have the same stamp; keep one log per stamp")
+    return logs
+
+
+def scan_tests(folder: Path, units, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFile]], list[tuple[str, str]]]:
+    """Each unit's friction tests, ``LOGS/<unit>/friction-test/<stamp><suffix>`` (:data:`TESTS`), in
+    stamp order (units without the folder left out), and the files there that are not tests, as
+    :func:`scan` lists a unit's logs: the same suffixes, stamps, names and links (a test folder whose
+    link leads out of ``folder`` is refused, :class:`faultgen.inputs.InputError`; a test's link out is
+    listed as not a test, never read).
+
+    Raises
+    ------
+    ValueError
+        As :func:`scan` for a unit's logs: a name not UTF-8, two tests of one stamp, stamps of both kinds;
+        a ``friction-test`` entry that is not a folder.
+    """
+    folder = Path(folder)
+    found, bad = {}, []
+    for unit in units:
+        where = folder / unit / TESTS
+        if not (where.exists() or where.is_symlink()):
+            continue
+        inputs.within(where, folder, FOLDER)
+        if not where.is_dir():
+            raise ValueError(f"{where}: {_kind(where)}; expected a folder of the unit's friction tests "
+                             f"(LOGS/<unit>/{TESTS}/<stamp>.csv)")
+        found[unit] = _listing(where, folder, suffixes, unit, bad)
+    return found, bad
 
 
 def _utf8(path: Path) -> None:

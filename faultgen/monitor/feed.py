@@ -17,7 +17,7 @@ import numpy as np
 
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import life, prognosis, report
+from faultgen.monitor import friction_tests, life, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
@@ -67,12 +67,13 @@ class Context:
 
 def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
     """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
-    rul.csv (:func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
+    rul.csv (:func:`faultgen.monitor.friction_tests.remaining_life`: on the unit's friction tests'
+    scale when it has tests, else :func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
     they are made in parallel too."""
     note = "wear signature match" if monitor.signatures is not None else "RBC of Q"
     buffer = io.BytesIO()
     report.chart(buffer, monitor, note)
-    return buffer.getvalue(), prognosis.of_monitor(monitor, failure_wear)
+    return buffer.getvalue(), friction_tests.remaining_life(monitor, failure_wear)
 
 
 def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:

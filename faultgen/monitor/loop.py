@@ -45,7 +45,7 @@ from tqdm.auto import tqdm
 from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import life, page, prognosis, report
+from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
@@ -184,6 +184,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     life.check_hours(hours_per_day)
     _, suffixes = fleet_logs.reader_of(log_format)
     units = fleet_logs.fleet(logs_dir, suffixes)
+    found = friction_tests.find(logs_dir, units, suffixes)  # a bad test refused before any work
     out = Path(out)
     cache = out / ".cache"
     calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
@@ -193,11 +194,17 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                  "measured" if log_format is None else repr(log_format))
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
-    state = _load_state(out, units, key, settings, nominal.n_axes, n_features)
+    maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
+    tests = friction_tests.read_tests(found, nominal, out, log_format)  # each test read once, cached
+    wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ())) for name, read in tests.items()}
+
+    def scale_of(name: str):
+        return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
+
+    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
     pending, stale = {}, {}
     for name, unit_logs in units.items():
         pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
-    maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     confined.mkdir(cache)
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                        failure_wear, backend)
@@ -206,6 +213,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
         if unit_logs and name not in state:
             state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
+            state[name].monitor.tests = scale_of(name)
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
@@ -218,12 +226,15 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
-    statuses = [_status(name, state.get(name), settings, stale[name]) for name in units]
+    statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
     with atomic.atomic_folder(out) as staging:
         report.write_alarms(staging / "alarms.csv", monitors)
         report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
-        report.write_wear(staging / "wear.csv", monitors)
-        report.write_units(staging / "units.csv", statuses)
+        report.write_wear(staging / "wear.csv", monitors, scales=bool(found))
+        report.write_units(staging / "units.csv", statuses, scales={
+            m.unit: _scale_of(m) for m in monitors} if found else None)
+        if found:
+            friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
         prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
         life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
             name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
@@ -283,14 +294,26 @@ def _same_log(path: Path, sha256: str) -> bool:
 
 
 
-def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = ()) -> UnitStatus:
+def _scale_of(monitor) -> str:
+    """units.csv's ``wear_scale`` of a unit: ``friction test`` when its last log's wear of some axis
+    is on its tests' scale (:mod:`faultgen.monitor.friction_tests`), ``twin`` otherwise."""
+    last = monitor.rows[-1] if monitor.rows else {}
+    on_tests = any(last.get(f"wear{k}_scale") == friction_tests.TESTS_SCALE for k in range(1, monitor.n_axes + 1))
+    return friction_tests.TESTS_SCALE if on_tests else friction_tests.TWIN_SCALE
+
+
+def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=()) -> UnitStatus:
     """The unit's row of units.csv (:class:`UnitStatus`); ``stale``: notes on logs handled by an
     earlier run that changed or left the folder, or new logs older than them (:func:`_pending`),
-    which make it degraded."""
+    which make it degraded; ``tests``: its friction tests read (those that could not be read named)."""
     if unit is None:
         return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
     protocol = "own" if unit.model == "none" else "twin"
     reasons = [*unit.notes, *stale]
+    unread = [t for t in tests if t.error]
+    if unread:
+        more = f" (and {len(unread) - 1} more)" if len(unread) > 1 else ""
+        reasons.append(f"{len(unread)} friction tests not read: {unread[0].stamp}: {unread[0].error}{more}")
     if unit.skipped:
         first = unit.skipped[0]
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
@@ -323,7 +346,8 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, l
 
 
 
-def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int) -> dict[str, Unit]:
+def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
+                scale_of=lambda name: None) -> dict[str, Unit]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
     looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
@@ -343,7 +367,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         kept = stored.read_unit(path, out, name, key, n_axes, n_features)
         if not (kept.entries or kept.skipped):
             continue
-        state[name] = Unit(stored.replay(kept, settings, n_axes), kept.model, kept.program, kept.first,
+        state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,
                             list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
                             list(kept.program_changes), initial_signatures=kept.signatures)
     return state

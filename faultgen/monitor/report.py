@@ -36,15 +36,17 @@ def _fmt(value) -> str:
     return value  # neutralised by cells.writer
 
 
-def write_units(path: Path, statuses) -> None:
+def write_units(path: Path, statuses, scales: dict[str, str] | None = None) -> None:
     """One row per unit of the fleet folder (:class:`faultgen.monitor.loop.UnitStatus`): its
     status, the protocol and model its monitor uses, why (fallbacks, skipped logs, learning), the
-    logs scored and the last one."""
+    logs scored and the last one; with ``scales`` (a fleet with friction tests) also the scale of its
+    wear, ``wear_scale`` (a unit not in it: ``twin``; :mod:`faultgen.monitor.friction_tests`)."""
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)
-        writer.writerow(UNIT_COLUMNS)
+        writer.writerow(UNIT_COLUMNS + (("wear_scale",) if scales is not None else ()))
         for s in statuses:
-            writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS])
+            extra = [scales.get(s.unit, "twin")] if scales is not None else []
+            writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS] + extra)
 
 
 def write_alarms(path: Path, monitors) -> None:
@@ -77,24 +79,27 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
 
 
-def write_wear(path: Path, monitors) -> None:
+def write_wear(path: Path, monitors, scales: bool = False) -> None:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
     uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
     the lower one-sided 90 % bound of its noise the alarm is judged on (``wear_lower``, as
     ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin
-    have rows."""
+    have rows. With ``scales`` (a fleet with friction tests) also each row's ``wear_scale``:
+    ``friction test`` or ``twin`` (:mod:`faultgen.monitor.friction_tests`)."""
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)
-        writer.writerow(WEAR_COLUMNS)
+        writer.writerow(WEAR_COLUMNS + (("wear_scale",) if scales else ()))
         for m in monitors:
             for row in m.rows:
                 if "wear1" not in row:
                     continue
                 for axis in range(1, m.n_axes + 1):
+                    extra = [row.get(f"wear{axis}_scale", "twin")] if scales else []
                     writer.writerow([_fmt(row["unit"]), _fmt(row["stamp"]), row["phase"], axis,
-                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower", "_log"))])
+                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower", "_log")),
+                                     *extra])
 
 
 def chart(path, monitor, axis_note: str) -> None:

@@ -194,6 +194,9 @@ class UnitMonitor:
         self.dispersion_ = np.ones(n_axes)
         #: Each axis's wear filtered over the logs (the wear reported and alarmed on).
         self.trend = WearTrend(n_axes)
+        #: The unit's friction tests' scale (:class:`faultgen.monitor.friction_tests.Rescale`), or
+        #: None: the wear in the twin's scale.
+        self.tests = None
 
     @property
     def relearn_logs(self) -> int:
@@ -213,6 +216,8 @@ class UnitMonitor:
         self.training, self.learned_expectations = [], []
         self.pca, self.relearning, self.run = None, None, 0
         self.window.clear()
+        if self.tests is not None:
+            self.tests.reset()
 
     # -- maintenance ----------------------------------------------------------------------------
     def maintenance(self, stamp: str, event: str, axis: int) -> None:
@@ -222,6 +227,8 @@ class UnitMonitor:
         :attr:`relearn_logs` logs, which are scored but do not alarm; its slopes, noise and PCA
         model stay. The wear estimate of every axis, the changed one's first, restarts from the new
         offset. During the first learning the learning restarts."""
+        if self.tests is not None:
+            self.tests.reset()
         if self.pca is None:
             self.training, self.learned_expectations = [], []
             return
@@ -319,6 +326,23 @@ class UnitMonitor:
         half = z * np.sqrt(np.asarray(error) ** 2 + (SCALE_UNCERTAINTY * np.asarray(estimate)) ** 2)
         return estimate - half, estimate + half
 
+    def _on_tests(self, stamp, estimate, error, log_estimate, log_error):
+        """The filtered wear (with its error), its interval, alarm bound and the log's own estimate
+        (with its error) on the unit's friction tests' scale (:mod:`faultgen.monitor.friction_tests`),
+        and the row's twin-scale values, factors and scales."""
+        factor, factor_error, names = self.tests.at(stamp, estimate, error)
+        z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
+        half = z * np.sqrt((factor * log_error) ** 2 + (factor_error * estimate) ** 2)
+        lower = log_estimate - self.bound_quantile * log_error
+        row = {**{f"wear{i + 1}_twin_log": float(v) for i, v in enumerate(log_estimate)},
+               **{f"wear{i + 1}_twin_log_lower": float(v) for i, v in enumerate(lower)},
+               **{f"wear{i + 1}_factor": float(v) for i, v in enumerate(factor)},
+               **{f"wear{i + 1}_factor_error": float(v) for i, v in enumerate(factor_error)},
+               **{f"wear{i + 1}_scale": v for i, v in enumerate(names)}}
+        rescaled = (factor * estimate, factor * error)
+        return (rescaled, rescaled[0] - half, rescaled[0] + half, rescaled[0] - self.alarm_quantile * rescaled[1],
+                factor * log_estimate, factor * log_error, row)
+
     # -- ranking --------------------------------------------------------------------------------
     def axis_scores(self, z: np.ndarray) -> np.ndarray:
         """Each axis's isolation score for standardised residual(s) ``z`` (larger: more likely)."""
@@ -352,6 +376,8 @@ class UnitMonitor:
                 self.mean_ = np.mean(self.relearning, axis=0)
                 self.relearning = None
                 self.trend.reset()  # the wear restarts from the new offset
+                if self.tests is not None:
+                    self.tests.reset()
         factor = self.prediction_factor(conditions)
         z = self._standardise(e, conditions) / factor
         variance = (self.scale_ * factor) ** 2
@@ -404,13 +430,19 @@ class UnitMonitor:
             # extrapolated over a season, the calibration's friction), which the learning logs
             # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
             low, high = self.wear_interval(estimate, log_error)
+            tested = {}
+            if self.tests is not None:  # on the unit's friction tests' scale
+                wear, low, high, bound, log_estimate, log_error, tested = self._on_tests(
+                    stamp, estimate, error, log_estimate, log_error)
+                estimate = wear[0]
+                alarm = bool(bound.max() >= self.settings.wear_limit)
             wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
                         **{f"wear{i + 1}_lower": float(v) for i, v in enumerate(bound)},
                         **{f"wear{i + 1}_5": float(v) for i, v in enumerate(low)},
                         **{f"wear{i + 1}_95": float(v) for i, v in enumerate(high)},
                         **{f"wear{i + 1}_log": float(v) for i, v in enumerate(log_estimate)},
                         **{f"wear{i + 1}_log_lower": float(v)
-                           for i, v in enumerate(log_estimate - self.bound_quantile * log_error)}}
+                           for i, v in enumerate(log_estimate - self.bound_quantile * log_error)}, **tested}
         scores = self.axis_scores(z)
         ranking = np.argsort(-scores, kind="stable") + 1
         if phase == "monitoring":

@@ -50,8 +50,9 @@ PROGRAM_CHANGED = "program change (not logged: the motion left the twin's progra
 #: (checked before it is parsed): about 0.85 kB per scored log with its load record, so some 20 000 logs (a log an hour for
 #: two years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
 STATE_MAX_BYTES = 16 * 2**20
-#: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read).
-CACHE = ("cycles", "calibrated", "programs")
+#: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read;
+#: ``friction-tests``: the tests' readings, :mod:`faultgen.monitor.friction_tests`).
+CACHE = ("cycles", "calibrated", "programs", "friction-tests")
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
 #: offset is learned again and its open alarm closed.
 MAINTENANCE = ("repair", "gearbox_change")
@@ -188,10 +189,12 @@ class UnitState:
     program_changes: list[ProgramChange] = field(default_factory=list)
 
 
-def replay(state: UnitState, settings: Settings, n_axes: int) -> UnitMonitor:
+def replay(state: UnitState, settings: Settings, n_axes: int, tests=None) -> UnitMonitor:
     """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
-    ``state`` ended with."""
+    ``state`` ended with (``tests``: its friction tests' scale, :attr:`UnitMonitor.tests`, given
+    before the entries)."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
+    monitor.tests = tests
     maintenance: dict[int, list[Maintenance]] = {}
     for m in state.maintenance:  # grouped by entry, in their order: each looked at once
         maintenance.setdefault(m.at, []).append(m)

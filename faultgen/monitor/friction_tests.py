@@ -1,0 +1,417 @@
+"""A unit's friction tests in ``faultgen monitor`` (issue 75, item 3): each axis's wear read
+directly, and the production logs' wear put on the tests' scale.
+
+**The folder.** ``LOGS/<unit>/friction-test/<stamp><suffix>`` (:data:`faultgen.data.logfolder.TESTS`):
+the suffixes, ``--format`` and stamps of the unit's logs, listed and checked as they are
+(:func:`faultgen.data.logfolder.scan_tests`: names, links, stamps; read by the logs' reader and
+within its bounds, :func:`faultgen.monitor.logs.parse`); never taken as a production log. A test's
+stamps must be of the kind of its unit's logs (dates, or sequence numbers), so that a test falls
+between two logs.
+
+**A test read** (:func:`read_tests`): :func:`faultgen.calibrate.friction_report.read` (segments
+found, direction differencing, each axis's curve fitted with 95 % intervals; docs/friction-test.md),
+once: the fit is cached in ``OUT/.cache/friction-tests`` under the test's SHA-256, the robot's and
+the log format (a continued run reads no test twice). A test that cannot be read is named in its
+unit's reason and left out.
+
+**Each test's wear** (:func:`tests_wear`), per axis ``k`` read, from the tests since the axis's last
+repair or gearbox change (``events.csv``), the first of them the reference ``0``: the dry level
+``c`` (``coulomb_Nm``) at the test's logged temperature ``T`` (``temperature_degC``), corrected to
+the reference's temperature ``T0`` by the unit's own **temperature law** ``ln c = a_k + beta T``
+(a relative change per kelvin common to the unit's axes, each axis its own level ``a_k``)::
+
+    wear = 100 (exp(ln c - ln c0 - beta (T - T0)) - 1)  %
+
+``beta`` is learned from the unit's own tests: the median over its axes of each axis's least-squares
+slope of ``ln c`` on ``T`` (``scipy.stats.linregress``; axes with at least :data:`LAW_TESTS` tests
+spanning at least :data:`LAW_SPAN_K` K), the median so that the worn axis, whose slope carries its
+wear (the season and the wear both grow), does not move it; its standard error ``s_beta`` the
+median of the slopes' own standard errors and the axes' scatter about the median (1.4826 times
+the median absolute deviation), together. Without such axes ``beta`` is 0 with ``s_beta`` =
+:data:`BETA_PRIOR` (a stated assumption: dry friction moves by some 0.5 %/K, Bittencourt 2014);
+without logged temperatures no correction is made. The **90 % interval** (:data:`INTERVAL`) is that
+of ``ln c - ln c0 - beta (T - T0)`` with the variance ``v + v0 + s_beta^2 (T - T0)^2``, ``v`` the
+larger of the fit's own (``(coulomb_Nm_high - coulomb_Nm_low) / (2 1.96 c)``, squared) and the
+unit's test-to-test repeatability (the median over its axes of the scatter of ``ln c`` about each
+axis's temperature law, when at least :data:`LAW_AXES` axes give it: what a test's day adds, the
+lubricant film, that no fit of one test sees).
+
+**The logs on the tests' scale** (:class:`Rescale`): per axis, the tests' wear ``y_j`` against the
+monitor's own wear in the twin's scale ``x_j`` at the test's day (the filtered wear of the last log
+at or before it, :class:`faultgen.monitor.wear_trend.WearTrend`) is the line ``y = b + f x``, fitted
+by weighted least squares (``statsmodels`` WLS, weights one over ``var y_j + var x_j``) with the
+priors of mixed estimation (Theil & Goldberger 1961: one pseudo-observation each) ``f ~ N(1,``
+:data:`SCALE_PRIOR` ``^2)`` and ``b ~ N(0, v0)`` (``b`` the reference test's own error, which every
+test's wear shares); its covariance scaled by the reduced chi-square of the tests when above one.
+A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
+knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
+``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``: the factor's own error ``s_f`` in place of the twin's
+:data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`. The remaining life
+(:func:`remaining_life`) gets each axis's series rescaled by its latest ``f`` and ``s_f / f`` as
+the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
+in the twin's scale (``wear_scale`` ``twin``).
+
+``OUT/tests.csv`` (:func:`write_tests`, :data:`COLUMNS`): one row per unit, test and axis read.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from statistics import NormalDist
+
+import numpy as np
+
+from faultgen.calibrate import friction_fit, friction_report
+from faultgen.data import cells, logfolder
+from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import state as stored
+
+#: ``wear_scale`` of a unit's wear (units.csv, wear.csv): on its friction tests' scale, or its twin's.
+TESTS_SCALE, TWIN_SCALE = "friction test", "twin"
+#: The columns of ``OUT/tests.csv`` (the friction_fit.csv columns of ``faultgen friction-test``, arm side).
+FIT_COLUMNS = ("temperature_degC", "coulomb_Nm", "coulomb_Nm_low", "coulomb_Nm_high", "static_excess_Nm",
+               "stribeck_velocity_rad_s", "viscous_Nms_rad", "viscous_Nms_rad_low", "viscous_Nms_rad_high")
+COLUMNS = ("unit", "stamp", "axis", *FIT_COLUMNS, "wear", "wear_lower", "wear_upper", "verdict")
+#: The two-sided interval of a test's wear and of the logs' wear on the tests' scale.
+INTERVAL = 0.90
+#: The temperature law: tests per axis (since its last repair) and their temperature span, K, an
+#: axis needs for its slope; axes whose scatter about their law gives the repeatability.
+LAW_TESTS, LAW_SPAN_K, LAW_AXES = 3, 1.0, 3
+#: Standard error of the temperature law's slope, 1/K, when the unit's tests cannot tell it.
+BETA_PRIOR = 0.005
+#: Standard deviation of the prior of the scale factor ``f`` (mean 1: the twin's scale): the twin's
+#: scale was 0.7-1.4 of the truth's on the independent fleets (issue 75).
+SCALE_PRIOR = 0.5
+#: Smallest scale factor used (a factor fitted below it on an axis whose tests contradict its logs).
+SCALE_MIN = 0.2
+#: The cache of the tests' readings in OUT, its entries' format and largest size, bytes.
+CACHE, CACHE_FORMAT, CACHE_MAX_BYTES = "friction-tests", "faultgen-friction-test-reading/1", 2**20
+#: The fit's interval (friction_fit's 95 %) as a standard error: its half width over this.
+FIT_Z = float(NormalDist().inv_cdf(0.5 + friction_fit.LEVEL / 2))
+
+
+@dataclass(frozen=True)
+class FrictionTest:
+    """One friction test of a unit as read: ``stamp``, ``key`` (its stamp's sort key), the file's
+    ``sha256``, ``fits`` (one dict per axis read: ``axis`` 1..N and :data:`FIT_COLUMNS`) and
+    ``error`` (why it could not be read; "" when read)."""
+
+    stamp: str
+    key: float
+    sha256: str
+    fits: tuple[dict, ...] = ()
+    error: str = ""
+
+
+def find(logs_dir: Path, units: dict[str, list], suffixes: tuple[str, ...]) -> dict[str, list]:
+    """Each unit's tests (:func:`faultgen.data.logfolder.scan_tests`), units without a test folder
+    left out. ValueError, before any work, for a file there that is not a test (named, as a unit's
+    logs are: :func:`faultgen.monitor.logs.fleet`) or stamps of another kind than the unit's logs."""
+    found, bad = logfolder.scan_tests(Path(logs_dir), list(units), suffixes)
+    if bad:
+        name, reason = bad[0]
+        more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+        raise ValueError(f"{Path(logs_dir) / name}: {reason.replace('not a log', 'not a friction test')}{more}")
+    for unit, tests in found.items():
+        logs = units[unit]
+        if tests and logs and tests[0].kind != logs[0].kind:
+            raise ValueError(f"{tests[0].path}: a friction test stamped by {tests[0].kind} where the unit's logs are "
+                             f"stamped by {logs[0].kind} ({logs[0].name}); use one kind per unit")
+    return found
+
+
+def _cache_key(robot_sha256: str, sha256: str, log_format: str) -> dict:
+    return {"robot": robot_sha256, "test": sha256, "format": log_format, "reader": CACHE_FORMAT}
+
+
+def read_tests(found: dict[str, list], robot, out: Path, log_format=None) -> dict[str, list[FrictionTest]]:
+    """Each unit's tests read (module docstring), in stamp order: from ``OUT/.cache/friction-tests``
+    when an earlier run read the same bytes (checked against its key), else parsed by the logs'
+    reader (``log_format``, :func:`faultgen.monitor.logs.reader_of`) and fitted, and cached."""
+    reader, _ = fleet_logs.reader_of(log_format)
+    held = log_format is None or bool(getattr(log_format, "reads_held", False))
+    robot_sha256 = stored.sha256_file(robot.path)
+    fmt = "measured" if log_format is None else repr(log_format)
+    confined = stored.out_folder(out)
+    root = Path(out) / ".cache" / CACHE
+    read: dict[str, list[FrictionTest]] = {}
+    for unit, tests in found.items():
+        read[unit] = []
+        for log in tests:
+            try:
+                digest = stored.sha256_file(log.path)
+            except OSError as err:
+                read[unit].append(FrictionTest(log.stamp, log.key, "", error=f"cannot be read ({err.strerror or err})"))
+                continue
+            key = _cache_key(robot_sha256, digest, fmt)
+            path = root / f"{stored.key_name(key)}.json"
+            if path.exists() or path.is_symlink():
+                read[unit].append(_cached(path, out, key, log))
+                continue
+            parsed = fleet_logs.parse(log.path, robot, reader, held)
+            test = _reading(parsed, robot, log)
+            confined.mkdir(root)
+            key = _cache_key(robot_sha256, parsed.sha256 or digest, fmt)
+            confined.write_text(root / f"{stored.key_name(key)}.json",
+                                json.dumps({"format": CACHE_FORMAT, "key": key, "fits": list(test.fits),
+                                            "error": test.error}))
+            read[unit].append(test)
+    return read
+
+
+def _reading(parsed: fleet_logs.Parsed, robot, log) -> FrictionTest:
+    """A parsed test fitted (:func:`faultgen.calibrate.friction_report.read`), or why not."""
+    try:
+        fits = friction_report.read(parsed.checked(), robot).fits
+    except ValueError as err:
+        text = " ".join(str(err).split())
+        return FrictionTest(log.stamp, log.key, parsed.sha256, error=text[:300])
+    rows = tuple({"axis": int(r["axis"]), **{c: float(r[c]) for c in FIT_COLUMNS}} for _, r in fits.iterrows())
+    return FrictionTest(log.stamp, log.key, parsed.sha256, rows)
+
+
+def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
+    """A cached reading, checked (a :class:`faultgen.monitor.state.StateError` naming the file otherwise)."""
+    d = stored._load_json(stored.inside(path, out), "cached friction test reading", CACHE_MAX_BYTES)
+    fits, error = d.get("fits"), d.get("error")
+    ok = d.get("format") == CACHE_FORMAT and d.get("key") == key and isinstance(error, str) and isinstance(fits, list)
+    ok = ok and all(isinstance(f, dict) and isinstance(f.get("axis"), int) and not isinstance(f.get("axis"), bool)
+                    and all(isinstance(f.get(c), (int, float)) and not isinstance(f.get(c), bool) for c in FIT_COLUMNS)
+                    for f in fits)
+    if not ok:
+        raise stored.StateError(f"{path}: not the cached reading of the friction test {log.name}; delete it (the test "
+                                "is read again)")
+    return FrictionTest(log.stamp, log.key, key["test"], tuple({c: (int(f[c]) if c == "axis" else float(f[c]))
+                                                       for c in ("axis", *FIT_COLUMNS)} for f in fits), error)
+
+
+@dataclass
+class Law:
+    """A unit's temperature law (module docstring): ``beta`` 1/K, its standard error ``error`` 1/K,
+    the test-to-test ``repeatability`` (relative standard deviation; NaN when not known) and how it
+    was learned (``source``, in words)."""
+
+    beta: float
+    error: float
+    repeatability: float
+    source: str
+
+
+def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
+    """The temperature law of a unit from each axis's tests ``{axis: (T degC, ln c)}`` since its
+    last repair (module docstring)."""
+    from scipy import stats
+
+    slopes, errors, scatter = [], [], []
+    for t, y in series.values():
+        ok = np.isfinite(t) & np.isfinite(y)
+        t, y = t[ok], y[ok]
+        if len(t) < LAW_TESTS or np.ptp(t) < LAW_SPAN_K:
+            continue
+        fit = stats.linregress(t, y)
+        slopes.append(fit.slope)
+        errors.append(fit.stderr)
+        if len(t) > 2:
+            scatter.append(float(np.sqrt(np.sum((y - fit.intercept - fit.slope * t) ** 2) / (len(t) - 2))))
+    repeatability = float(np.median(scatter)) if len(scatter) >= LAW_AXES else math.nan
+    if not slopes:
+        return Law(0.0, BETA_PRIOR, repeatability, f"no axis with {LAW_TESTS} tests over {LAW_SPAN_K:g} K: "
+                                                     f"not corrected (+-{100 * BETA_PRIOR:g} %/K)")
+    beta = float(np.median(slopes))
+    spread = 1.4826 * float(np.median(np.abs(np.array(slopes) - beta))) if len(slopes) > 2 else 0.0
+    error = float(np.hypot(np.median(errors), spread))
+    return Law(beta, error, repeatability, f"{100 * beta:+.2f} +- {100 * error:.2f} %/K (median of {len(slopes)} axes)")
+
+
+@dataclass
+class AxisWear:
+    """One test's wear of one axis (module docstring): ``wear`` % and its 90 % interval, its
+    standard error in ``ln`` (``log_error``), the reference's own (``reference_error``), the verdict."""
+
+    stamp: str
+    key: float
+    axis: int
+    fit: dict
+    wear: float
+    lower: float
+    upper: float
+    log_error: float
+    reference_error: float
+    verdict: str
+    reference: bool = False
+
+
+def _relative_error(fit: dict) -> float:
+    c, low, high = fit["coulomb_Nm"], fit["coulomb_Nm_low"], fit["coulomb_Nm_high"]
+    if not (np.isfinite(low) and np.isfinite(high)) or c <= 0:
+        return math.nan
+    return (high - low) / (2 * FIT_Z * c)
+
+
+def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[list[AxisWear], Law | None]:
+    """Each read axis's wear at each test (module docstring), and the unit's temperature law; the
+    ``maintenance`` events (repairs, gearbox changes: ``key`` and ``axis``) start an axis's tests again."""
+    per_axis: dict[int, list[tuple[Test, dict]]] = {}
+    for test in tests:
+        if test.error:
+            continue
+        for fit in test.fits:
+            k = fit["axis"]
+            if not 1 <= k <= n_axes:
+                continue
+            events = [m.key for m in maintenance if m.axis in (k, 0) and m.key <= test.key]
+            reset = max(events) if events else -math.inf
+            per_axis.setdefault(k, [])
+            per_axis[k] = [(t, f) for t, f in per_axis[k] if t.key >= reset] + [(test, fit)]
+    series = {}
+    for k, items in per_axis.items():
+        good = [(t, f) for t, f in items if f["coulomb_Nm"] > 0]
+        series[k] = (np.array([f["temperature_degC"] for _, f in good]), np.log([f["coulomb_Nm"] for _, f in good]))
+    if not per_axis:
+        return [], None
+    law = learn_law(series)
+    z = NormalDist().inv_cdf(0.5 + INTERVAL / 2)
+    rows = []
+    for k, items in sorted(per_axis.items()):
+        reference = next(((t, f) for t, f in items if f["coulomb_Nm"] > 0), None)
+        for test, fit in items:
+            if reference is None or fit["coulomb_Nm"] <= 0:
+                rows.append(AxisWear(test.stamp, test.key, k, fit, math.nan, math.nan, math.nan, math.nan, math.nan,
+                                     "no positive dry level read: no wear"))
+                continue
+            t0, f0 = reference
+            error0 = _spread(f0, law)
+            dt = fit["temperature_degC"] - f0["temperature_degC"]
+            corrected = np.isfinite(dt)
+            d = math.log(fit["coulomb_Nm"] / f0["coulomb_Nm"]) - (law.beta * dt if corrected else 0.0)
+            if test is t0:
+                sd = error0
+                verdict = f"reference: the first test since the axis's last repair (temperature law {law.source})"
+                d = 0.0
+            else:
+                sd = math.sqrt(_spread(fit, law) ** 2 + error0**2 + ((law.error * dt) ** 2 if corrected else 0.0))
+                verdict = (f"dry level {100 * (math.exp(d) - 1):+.1f} % over {t0.stamp}'s"
+                           + (f", corrected from {fit['temperature_degC']:.1f} to {f0['temperature_degC']:.1f} degC"
+                              if corrected else ", no temperature logged: not corrected"))
+            sd = sd if np.isfinite(sd) else math.nan
+            rows.append(AxisWear(test.stamp, test.key, k, fit, 100 * (math.exp(d) - 1), 100 * (math.exp(d - z * sd) - 1),
+                                 100 * (math.exp(d + z * sd) - 1), sd, error0, verdict, test is t0))
+    rows.sort(key=lambda r: (r.key, r.axis))
+    return rows, law
+
+
+def _spread(fit: dict, law: Law) -> float:
+    """A test's relative standard error of its dry level: the fit's, or the unit's repeatability when larger."""
+    own = _relative_error(fit)
+    values = [v for v in (own, law.repeatability) if np.isfinite(v)]
+    return max(values) if values else math.nan
+
+
+@dataclass
+class Rescale:
+    """The factors that put a unit's wear on its tests' scale (module docstring), fed the monitor's
+    wear in the twin's scale log by log (:meth:`at`): ``wears`` the tests' :class:`AxisWear` in
+    stamp order, ``kind`` the stamps' kind (:func:`faultgen.data.logfolder.parse_stamp`)."""
+
+    unit: str
+    n_axes: int
+    wears: list[AxisWear]
+    pairs: dict[int, list[tuple[float, float, float, float]]] = field(default_factory=dict)  # axis -> (y, sy, x, sx)
+    last: tuple[float, np.ndarray, np.ndarray] | None = None  # key, twin-scale wear and error of the last log
+    done: int = 0  # wears paired so far
+
+    def reset(self, axis: int = 0) -> None:
+        """Forget the pairs of ``axis`` (0: every axis): a repair, a new program."""
+        for k in list(self.pairs):
+            if axis in (0, k):
+                self.pairs[k] = []
+
+    def at(self, stamp: str, wear: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
+        """The factor ``f`` (n_axes,) and its standard error for the log ``stamp`` whose filtered wear
+        in the twin's scale is ``wear`` % -+ ``error`` % (each (n_axes,)), and each axis's scale's
+        name; the tests up to the log paired with the last log at or before each."""
+        key = logfolder.parse_stamp(stamp, f"{self.unit}/{stamp}")[0]
+        while self.done < len(self.wears) and self.wears[self.done].key <= key:
+            w = self.wears[self.done]
+            self.done += 1
+            source = (wear, error) if w.key == key or self.last is None else self.last[1:]
+            if self.last is None and w.key < key:
+                source = None  # a test before the first log scored: nothing to pair it with
+            if w.log_error != w.log_error or source is None:
+                continue
+            if w.reference:
+                self.pairs[w.axis] = []
+            sy = 100 * (1 + w.wear / 100) * w.log_error
+            self.pairs.setdefault(w.axis, []).append((w.wear, sy, float(source[0][w.axis - 1]),
+                                                      float(source[1][w.axis - 1])))
+        self.last = (key, np.asarray(wear, dtype=float), np.asarray(error, dtype=float))
+        factor, factor_error = np.ones(self.n_axes), np.zeros(self.n_axes)
+        names = [TWIN_SCALE] * self.n_axes
+        for k, pairs in self.pairs.items():
+            if pairs:
+                factor[k - 1], factor_error[k - 1] = self.fit(k)
+                names[k - 1] = TESTS_SCALE
+        return factor, factor_error, names
+
+    def fit(self, axis: int) -> tuple[float, float]:
+        """The factor of ``axis`` and its standard error from its pairs (module docstring)."""
+        import statsmodels.api as sm
+
+        pairs = np.array(self.pairs[axis], dtype=float)
+        y, sy, x, sx = pairs.T
+        reference = next((w.reference_error for w in reversed(self.wears[: self.done]) if w.axis == axis), math.nan)
+        sb = 100 * reference if np.isfinite(reference) and reference > 0 else 5.0
+        design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
+        target = np.r_[y, 1.0, 0.0]
+        weights = np.r_[1.0 / np.maximum(sy**2 + sx**2, 1e-6), 1.0 / SCALE_PRIOR**2, 1.0 / sb**2]
+        result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
+        cov = np.asarray(result.cov_params())
+        if len(y) > 2:
+            chi2 = float(np.sum(weights[: len(y)] * (y - design[: len(y)] @ result.params) ** 2) / (len(y) - 2))
+            cov = cov * max(1.0, chi2)
+        return max(float(result.params[1]), SCALE_MIN), float(np.sqrt(cov[1, 1]))
+
+
+def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
+    """``OUT/tests.csv`` (:data:`COLUMNS`): per unit, test and axis read, in stamp order; empty cells
+    where there is no number."""
+
+    def cell(value) -> str:
+        if value is None or (isinstance(value, float) and not math.isfinite(value)):
+            return ""
+        return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+    with open(path, "w", newline="") as f:
+        writer = cells.writer(f)
+        writer.writerow(COLUMNS)
+        for unit, rows in wears.items():
+            for r in rows:
+                writer.writerow([unit, r.stamp, r.axis, *(cell(r.fit[c]) for c in FIT_COLUMNS),
+                                 cell(r.wear), cell(r.lower), cell(r.upper), r.verdict])
+
+
+def remaining_life(monitor, failure_wear: float) -> list:
+    """:func:`faultgen.monitor.prognosis.of_monitor` of a monitor on its tests' scale: each axis's
+    own estimates rescaled by its latest factor, the factor's relative error as the scale's
+    uncertainty (an axis in the twin's scale keeps the default); axis by axis."""
+    from faultgen.monitor import prognosis
+
+    rows = monitor.rows
+    if not rows or "wear1_twin_log" not in rows[-1]:
+        return prognosis.of_monitor(monitor, failure_wear)
+    last = rows[-1]
+    out = []
+    for k in range(1, monitor.n_axes + 1):
+        factor = last[f"wear{k}_factor"]
+        rescaled = [{**r, f"wear{k}_log": factor * r[f"wear{k}_twin_log"],
+                     f"wear{k}_log_lower": factor * r[f"wear{k}_twin_log_lower"]} if f"wear{k}_twin_log" in r else r
+                    for r in rows]
+        uncertainty = (last[f"wear{k}_factor_error"] / factor if last[f"wear{k}_scale"] == TESTS_SCALE
+                       else prognosis.SCALE_UNCERTAINTY)
+        out += prognosis.remaining_life(monitor.unit, rescaled, monitor.n_axes, alpha=monitor.settings.alpha,
+                                        failure_wear=failure_wear, since=monitor.first_alarm,
+                                        source_axis=monitor.source_axis, axes=[k], scale_uncertainty=uncertainty)
+    return out
