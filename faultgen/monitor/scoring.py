@@ -332,7 +332,7 @@ class UnitMonitor:
         and the row's twin-scale values, factors and scales."""
         factor, factor_error, names = self.tests.at(stamp, estimate, error)
         z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
-        half = z * np.sqrt((factor * log_error) ** 2 + (factor_error * estimate) ** 2)
+        half = z * np.sqrt((factor * error) ** 2 + (factor_error * estimate) ** 2)
         lower = log_estimate - self.bound_quantile * log_error
         row = {**{f"wear{i + 1}_twin_log": float(v) for i, v in enumerate(log_estimate)},
                **{f"wear{i + 1}_twin_log_lower": float(v) for i, v in enumerate(lower)},
