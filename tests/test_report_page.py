@@ -193,8 +193,11 @@ def test_report_builds_the_page_again_from_an_output_folder(written, tmp_path):
     (out / page.SETTINGS).unlink()  # a folder without the settings: the page without them, said so
     result = CliRunner().invoke(app, ["report", str(out)])
     assert result.exit_code == 0 and "settings were not found" in (out / page.PAGE).read_text()
-    result = CliRunner().invoke(app, ["report", str(tmp_path / "nothing")])
-    assert result.exit_code == 2 and "units.csv" in result.output
+    missing = CliRunner().invoke(app, ["report", str(tmp_path / "nothing")])
+    assert missing.exit_code == 2 and "units.csv" in missing.output
+    # this folder has no rul.csv and no life.csv: each named, not dropped silently
+    assert f"note: {out / 'rul.csv'} is missing: the page shows no remaining life" in result.output
+    assert f"note: {out / 'life.csv'} is missing: the page shows no life consumed by load" in result.output
 
 
 def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):

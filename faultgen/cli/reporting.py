@@ -15,14 +15,16 @@ from faultgen.cli.main import app
 @app.command("report", cls=Command)
 def report_command(
     out: Annotated[Path, typer.Argument(help="A `faultgen monitor` output folder (units.csv, alarms.csv, "
-                                        "scores.csv; settings.json when the monitor wrote it).")],
+                                        "scores.csv; rul.csv, life.csv and settings.json when the monitor "
+                                        "wrote them).")],
 ) -> None:
     """Write the fleet report page OUT/report.html again from a monitor's output folder: one file
     that opens in a browser offline (plotly.js inside it, no server, nothing fetched).
 
-    The page is built from OUT/units.csv, OUT/alarms.csv and OUT/scores.csv alone, with the run's
-    settings of OUT/settings.json (from an output of an earlier faultgen without it, those of the
-    monitors' state, OUT/.state). It shows the fleet table, the units that need attention first
+    The page is built from OUT/units.csv, OUT/alarms.csv and OUT/scores.csv, the remaining life of
+    OUT/rul.csv and the life consumed by load of OUT/life.csv (each named when it is missing: the page
+    then has no such column), with the run's settings of OUT/settings.json (from an output of an
+    earlier faultgen without it, those of the monitors' state, OUT/.state). It shows the fleet table, the units that need attention first
     (an open alarm, the surest wear first, then degraded, not monitored, learning, quiet units:
     status, alarm, axis, since when, the alarm axis's wear estimate and its lower bound, the last
     log, the alarms maintenance closed), a panel per unit (click it in the table: the alarm's
@@ -42,4 +44,12 @@ def report_command(
         raise ValueError(f"{out} is not a folder; give a `faultgen monitor` output folder (its units.csv, alarms.csv "
                          "and scores.csv)")
     written = page.write(out, run_settings.read_settings(out))
+    for name, what in OPTIONAL.items():
+        if not (out / name).is_file():
+            typer.echo(f"note: {out / name} is missing: the page shows no {what}", err=True)
     typer.echo(f"wrote {written}")
+
+
+#: The tables of a monitor's output the page shows when they are there (a copy of the CSVs may leave them out).
+OPTIONAL = {"rul.csv": "remaining life (the condition-based service date)",
+            "life.csv": "life consumed by load (the load-based service date)"}
