@@ -70,7 +70,9 @@ CSS = """
 .l-stale{background:#6c757d;color:#fff} .l-unknown{background:#e2e2e2;color:#222} .l-ok{background:#2ca02c;color:#fff}
 #fleet td[data-column="unit"]{overflow-wrap:anywhere} small.muted{display:block}
 @media (max-width:700px){
- body{margin:.5em .6em} td,th{overflow-wrap:anywhere}
+ body{margin:.5em .6em} #fleet td{overflow-wrap:anywhere}
+ #settings,#settings tbody,#settings tr,#settings th,#settings td{display:block;border:none;overflow-wrap:anywhere}
+ #settings tr{border-bottom:1px solid #ddd;padding:.2em 0} #settings th{background:none;padding-bottom:0}
  #fleet thead{display:none} #fleet,#fleet tbody,#fleet tr,#fleet td{display:block}
  #fleet tr{border:1px solid #ddd;border-radius:.3em;margin:.4em 0;padding:.2em 0}
  #fleet td{border:none;padding:.1em .5em} #fleet td:empty{display:none}

@@ -1,21 +1,29 @@
 """The monitor's fleet report: ``OUT/report.html``, one page a service engineer opens in a browser
-(issue 58).
+(issues 58 and 75).
 
 The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
-``scores.csv`` (:mod:`faultgen.monitor.report`), and the run's settings (a small dict, kept beside
-it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
+``scores.csv`` (:mod:`faultgen.monitor.report`), where present ``wear.csv``, ``rul.csv``,
+``life.csv`` and ``tests.csv`` (the friction tests), and the run's settings (a small dict, kept
+beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
 (:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`). It holds:
 
-- the fleet table, the units that need attention first: an open alarm (the surest wear first),
-  then degraded, not monitored, learning and quiet units; per unit its status, open alarm, axis,
-  since when, the current wear estimate of that axis (with the twin) and its lower one-sided 90 %
-  bound (the alarm's), the last log and the alarms maintenance closed;
-- a panel per unit (a ``<details>``, opened by clicking the unit in the table): the alarm's
-  evidence in words, closed alarms and the maintenance that closed them, and a chart: each axis's
-  wear estimate with its lower-bound band and the wear limit, T2 and Q over their limits, the
-  learning logs shaded, the relearning after maintenance marked;
+- the fleet table (:mod:`faultgen.monitor.lights`, where its rules are stated): one line per unit,
+  a state light (service due, watch, stale, unknown, ok: colour and word), the "service by" date
+  with its 5-95 % interval, the axis, its wear with its 90 % interval, the life consumed by load
+  and the last log; the earliest service first, then the units without a date by their light;
+- a panel per unit (a ``<details>``, opened by clicking the unit in the table): the rules its light
+  met, each axis's wear and the scale it is in, the status, the alarm's evidence in words, the
+  long verdicts (each axis's remaining life, rul.csv, and life consumed, life.csv), closed alarms
+  and the maintenance that closed them, a chart (:mod:`faultgen.monitor.unit_chart`: each axis's
+  wear with its interval and the wear limit, T2 and Q over their limits, the learning logs shaded,
+  the relearning after maintenance marked, the friction-test days) and, with friction tests, each
+  alarming axis's friction curve, the reference test against the latest
+  (:mod:`faultgen.monitor.friction_panel`);
 - the run's settings and the false-alarm statement the command line prints
   (:func:`false_alarm_statement`).
+
+At 400 px wide (a phone) the table's lines become cards, each cell under its column's name: no
+column leaves the screen (tests/test_r6_page.py checks it in headless Chromium).
 
 It is one self-contained file that works offline: plotly.js is embedded once (no CDN, no server),
 each unit's chart is kept as JSON in the page and drawn when its panel is first opened (a page of
@@ -34,8 +42,8 @@ from pathlib import Path
 
 from faultgen.data import atomic
 from faultgen.monitor import friction_panel, life, lights, report, scoring, tables
-from faultgen.monitor.unit_chart import figure
 from faultgen.monitor.run_settings import SETTINGS, settings_dict
+from faultgen.monitor.unit_chart import figure
 
 #: The page's file name in OUT.
 PAGE = "report.html"
@@ -174,8 +182,10 @@ class Fleet:
 
 
 def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
-    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``), each
-    table read by :func:`faultgen.monitor.tables.read` (``max_bytes`` as there).
+    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``; and
+    ``rul.csv``, ``life.csv``, ``wear.csv``, ``tests.csv`` where present), each table read by
+    :func:`faultgen.monitor.tables.read` (``max_bytes`` as there), in the order of
+    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`).
 
     Raises
     ------
@@ -237,10 +247,7 @@ body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.2
 h1{font-size:1.5em;margin-bottom:.2em} h2{font-size:1.2em;margin-top:1.6em}
 table{border-collapse:collapse;margin:.5em 0} th,td{border-bottom:1px solid #ddd;padding:.3em .6em;text-align:left;
 vertical-align:top} th{background:#f3f3f3}
-#fleet tbody tr:hover{background:#f8f8ff} td[data-column="since"],td[data-column="last log"]{white-space:nowrap}
-.status{padding:.1em .4em;border-radius:.3em;font-size:.9em;white-space:nowrap}
-.s-alarm{background:#d62728;color:#fff} .s-degraded{background:#ff9f40} .s-not-monitored{background:#bbb}
-.s-learning{background:#cfe3ff} .s-monitored{background:#d9f2d9}
+#fleet tbody tr:hover{background:#f8f8ff} td[data-column="last log"]{white-space:nowrap}
 .muted{color:#777} .evidence{background:#fff4f4;border-left:3px solid #d62728;padding:.4em .7em}
 details.unit{border:1px solid #ddd;border-radius:.3em;margin:.4em 0;padding:.3em .7em}
 details.unit summary{cursor:pointer;font-weight:600} .chart{width:100%;min-height:300px}

@@ -136,7 +136,8 @@ def figure(unit, settings: dict) -> dict:
     def line(at: int, colour: str, dash: str, text: str, y: float) -> None:
         shapes.append({"type": "line", "xref": "x", "yref": "paper", "x0": at, "x1": at, "y0": 0, "y1": 1,
                        "line": {"color": colour, "width": 1.5, "dash": dash}})
-        annotations.append({"x": at, "xref": "x", "xanchor": "left", "y": y, "yref": "paper", "text": text,
+        side = "right" if at > len(rows) / 2 else "left"  # the label inside the chart, on the side with room
+        annotations.append({"x": at, "xref": "x", "xanchor": side, "y": y, "yref": "paper", "text": text,
                             "showarrow": False, "font": {"size": 10, "color": colour}, "bgcolor": "rgba(255,255,255,0.7)"})
 
     for first, last in _spans(phases, "training"):
