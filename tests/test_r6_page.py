@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 import re
 import shutil
 from dataclasses import dataclass, field
@@ -23,6 +24,7 @@ from test_report_page import browser  # noqa: F401  (the headless Chromium fixtu
 
 from faultgen.monitor import friction_panel, life, lights, page, prognosis, report
 
+ROOT = Path(__file__).resolve().parents[1]
 DAY0 = date(2026, 6, 1)
 N_AXES = 3
 SETTINGS = {"protocol": "twin", "alpha": 0.01, "persistence": 3, "train": 10, "wear_limit": 5.0}
@@ -99,7 +101,8 @@ def make_out(out: Path, specs=FLEET, tests: bool = True, scales: bool = True) ->
             left = s.days_left[a]
             lives.append([s.name, a + 1, "strain-wave", 3, 100.0, 2.0, 7000.0, "", day(days[0]) if days else "", 5.0,
                           0.25, "" if left is None else left, 16, len(days), day(s.last),
-                          f"LIFE-VERDICT {s.name} axis {a + 1}: 5 % of the rated life consumed"])
+                          f"5 % of the rated life (7000 h L10 at 100 N m, strain-wave) consumed since "
+                          f"{day(days[0]) if days else '-'}" + ("" if left is None else f"; 100 % in {left:g} days")])
         for a, (rul, low, high, verdict) in s.rul.items():
             ruls.append([s.name, a, day(s.last), "days", s.wear[a - 1], prognosis.FAILURE_WEAR, "exponential" if rul else "",
                          rul, low, high, "", 365, 10, day(days[0]), verdict])
@@ -197,10 +200,13 @@ def test_each_rule_at_its_stated_bound(tmp_path, spec, state):
 def test_the_long_verdicts_are_in_the_panel_not_the_table(out):
     text = (out / page.PAGE).read_text()
     table = _table(text)
-    for verdict in (NO_TREND, "end of life in 30 days", "LIFE-VERDICT"):
+    for verdict in (NO_TREND, "end of life in 30 days", "of the rated life (7000 h L10"):
         assert verdict not in table
-    assert NO_TREND in _panel(text, "due-alarm")
-    assert "LIFE-VERDICT watch-date axis 2: 5 % of the rated life consumed" in _panel(text, "watch-date")
+    assert NO_TREND in _panel(text, "due-alarm") and "end of life in 30 days" in _panel(text, "watch-date")
+    assert "axis 2: 5 % of the rated life (7000 h L10 at 100 N m, strain-wave) consumed since 2026-06-21; 100 % in 45 " \
+           "days" in _panel(text, "watch-date")
+    assert life.table_cell([{"axis": "2", "consumed_pct": "905", "days_left": "-10"}]) == \
+        "axis 2: 905 % (past the rated life)"
     assert "remaining life (5-95 %)" not in table.lower()
 
 
@@ -287,5 +293,18 @@ def test_the_page_reads_at_400_px_and_draws_the_friction_curve(out, browser):  #
                 assert svg.size["width"] <= width
         console = browser.get_log("browser")
         assert not [e for e in console if e["level"] in ("SEVERE", "WARNING")], console
+        if os.environ.get("FAULTGEN_SCREENSHOT"):  # docs/_r6_page.md shows them
+            browser.execute_script("window.scrollTo(0, 0)")
+            browser.save_screenshot(str(ROOT / "docs" / "report-page-400.png"))
+            browser.set_window_size(1200, 900)
+            browser.get((out / page.PAGE).resolve().as_uri())
+            WebDriverWait(browser, 20).until(lambda d: d.execute_script("return window.Plotly !== undefined"))
+            browser.save_screenshot(str(ROOT / "docs" / "report-lights.png"))
+            link = next(a for a in browser.find_elements(By.CSS_SELECTOR, "a.unit-link") if a.text == "watch-alarm")
+            link.click()
+            target = browser.find_element(By.ID, link.get_attribute("href").split("#")[1])
+            WebDriverWait(browser, 20).until(lambda d: len(target.find_elements(By.CSS_SELECTOR, ".chart svg.main-svg")) >= 2)
+            browser.execute_script("arguments[0].scrollIntoView()", target.find_elements(By.CSS_SELECTOR, ".chart")[0])
+            browser.save_screenshot(str(ROOT / "docs" / "report-lights-unit.png"))
     finally:
         browser.set_window_size(1200, 800)

@@ -190,10 +190,10 @@ def curve_figure(rows: list[dict], axis: int) -> dict | None:
                      "hovertemplate": "%{x:.3g} rad/s: %{y:.4g} N m<extra>" + name + "</extra>"})
     note = "" if last is not first else " (one test: nothing to compare yet)"
     return {"data": data, "layout": {
-        "height": 340, "margin": {"l": 60, "r": 20, "t": 40, "b": 90}, "showlegend": True,
+        "height": 360, "margin": {"l": 60, "r": 20, "t": 40, "b": 110}, "showlegend": True,
         "title": {"text": _e(f"axis {axis}: friction torque, arm side{note}"), "font": {"size": 13}, "x": 0.01,
                   "xanchor": "left"},
-        "legend": {"orientation": "h", "y": -0.3, "font": {"size": 10}},
+        "legend": {"orientation": "h", "y": -0.45, "font": {"size": 10}},
         "xaxis": {"title": {"text": "speed, rad/s"}, "rangemode": "tozero"},
         "yaxis": {"title": {"text": "friction, N m"}, "rangemode": "tozero"}}}
 

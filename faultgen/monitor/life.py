@@ -327,14 +327,15 @@ def _float(cell) -> float:
 
 def table_cell(rows: list[dict]) -> str:
     """The fleet table's cell of a unit's rows of life.csv (as read): the axis that consumed most,
-    its % and the days left at the recent duty."""
+    its % and the days left at the recent duty ("past the rated life" at 0 or fewer, "no load"
+    without a number)."""
     found = [(r, _float(r.get("consumed_pct"))) for r in rows]
     found = [(r, c) for r, c in found if math.isfinite(c)]
     if not found:
         return ""
     r, consumed = max(found, key=lambda f: f[1])
     days = _float(r.get("days_left"))
-    left = f"{days:.0f} days left" if math.isfinite(days) else "no load"
+    left = ("no load" if not math.isfinite(days) else "past the rated life" if days <= 0 else f"{days:.0f} days left")
     return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
 
 
