@@ -308,3 +308,16 @@ def test_the_page_reads_at_400_px_and_draws_the_friction_curve(out, browser):  #
             browser.save_screenshot(str(ROOT / "docs" / "report-lights-unit.png"))
     finally:
         browser.set_window_size(1200, 800)
+
+
+def test_one_test_is_drawn_alone_and_a_tests_csv_without_a_needed_column_is_refused(tmp_path):
+    row = dict(zip(TEST_COLUMNS, ["u", day(3), "2", "30", "1.5", "", "", "", "", "0.2", "", "", "0", "", "", ""]))
+    figure = friction_panel.curve_figure([row], 2)
+    named = [t for t in figure["data"] if t.get("name")]
+    assert len(named) == 1 and "one test: nothing to compare yet" in figure["layout"]["title"]["text"]
+    assert named[0]["y"] == pytest.approx([1.5 + 0.2 * v for v in named[0]["x"]], rel=1e-3)  # no hump fitted
+    assert friction_panel.curve_figure([row | {"coulomb_Nm": ""}], 2) is None
+    folder = make_out(tmp_path / "OUT", (Spec("a"),))
+    _write(folder / "tests.csv", [c for c in TEST_COLUMNS if c != "coulomb_Nm"], [])
+    with pytest.raises(ValueError, match=r"tests\.csv: no column coulomb_Nm"):
+        page.read(folder)
