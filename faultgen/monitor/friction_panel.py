@@ -177,7 +177,8 @@ def curve_figure(rows: list[dict], axis: int) -> dict | None:
         temperature = _number(r.get("temperature_degC"))
         name = _e(f"{what} {r['stamp']}" + (f", {temperature:.3g} °C" if math.isfinite(temperature) else "")
                   + (f", wear {_number(r.get('wear')):.3g} %" if math.isfinite(_number(r.get("wear"))) else ""))
-        low, high = curve(v, *_params(r, "_low")), curve(v, *_params(r, "_high"))
+        with np.errstate(over="ignore", invalid="ignore"):  # a planted number: inf or NaN, drawn as a gap (None)
+            low, high, mid = curve(v, *_params(r, "_low")), curve(v, *_params(r, "_high")), curve(v, *_params(r))
         fill = _rgba(colour)
         data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in low],
                      "line": {"width": 0, "color": colour}, "showlegend": False, "hoverinfo": "skip",
@@ -185,7 +186,7 @@ def curve_figure(rows: list[dict], axis: int) -> dict | None:
         data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in high],
                      "line": {"width": 0, "color": colour}, "fill": "tonexty", "fillcolor": fill, "showlegend": False,
                      "hoverinfo": "skip", "legendgroup": name})
-        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in curve(v, *_params(r))],
+        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in mid],
                      "line": {"width": 2, "color": colour}, "name": name, "legendgroup": name,
                      "hovertemplate": "%{x:.3g} rad/s: %{y:.4g} N m<extra>" + name + "</extra>"})
     note = "" if last is not first else " (one test: nothing to compare yet)"
