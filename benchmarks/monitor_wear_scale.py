@@ -1,15 +1,21 @@
 """The wear in the robot's own scale (issue 59, part 1) against the truth of two independent fleets.
 
-    python benchmarks/monitor_wear_scale.py --law first|hump [--seed 0] [--work DIR] [--robot DIR]
-                                            [--out monitor] [--no-calibrate]
+    python benchmarks/monitor_wear_scale.py --law first|hump|hump-lorentzian [--seed 0] [--work DIR] [--robot DIR]
+                                            [--out monitor] [--no-calibrate] [--friction-test-every DAYS]
 
 In one run of this script:
 
 - the fleet, 12 units x 120 days, 8 worn (linearly from a day drawn in 20-50 to 60 % on day 120),
   in ``WORK/logs`` with its truth in ``WORK/truth.csv``: ``--law first`` the generator of
   :mod:`faultgen.bench.independent` (wear grows Coulomb and Stribeck friction alike), ``--law
-  hump`` the same draws with a growing, widening Stribeck hump (``benchmarks/wear_hump_fleet.py``);
-  the truth is the increase of the worn axis's dry friction in % of the unit's own. A fleet already
+  hump`` the same draws with a friction law of its own (an exponential hump, a tanh sign, dry and
+  viscous friction falling with temperature) whose wear grows the hump faster than the Coulomb
+  level, widens it and grows the viscous coefficient as the Coulomb level (``benchmarks/wear_hump_fleet.py``;
+  ``--law hump-lorentzian``: issue 59's second fleet, the first law's friction with the growing hump);
+  the truth is the increase of the worn axis's dry friction in % of the unit's own. With
+  ``--friction-test-every DAYS`` each unit also runs faultgen's friction test every DAYS days
+  through the fleet's own dynamics and friction law (``LOGS/<unit>/friction-test/<stamp>.csv``, their
+  truth in ``WORK/truth_tests.csv``; :mod:`faultgen.bench.independent`). A fleet already
   there is kept (its units are drawn from the seed: the same files);
 - ``faultgen monitor LOGS --robot KR210 -o WORK/OUT`` (the calibrated twin, the default; an OUT of
   an earlier run is continued, so a rerun only rewrites the outputs), timed;
@@ -81,22 +87,26 @@ def evaluate(truth_path: Path, out: Path) -> tuple[list[dict], list[str]]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--law", choices=("first", "hump"), default="first")
+    parser.add_argument("--law", choices=("first", "hump", "hump-lorentzian"), default="first")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--work", type=Path, default=None)
     parser.add_argument("--robot", type=Path, default=None, help="The KR210 folder (made in WORK/kr210 if not given).")
     parser.add_argument("--out", default="monitor", help="The monitor's OUT, inside WORK.")
     parser.add_argument("--no-calibrate", action="store_true")
+    parser.add_argument("--friction-test-every", type=int, default=0, metavar="DAYS",
+                        help="Each unit also runs a friction test every DAYS days (0: none, the default).")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="wear-scale-"))
     robot = args.robot or pinocchio_log.add_kr210(work / "kr210")
-    spec = independent_fleet.FleetSpec(units=12, worn=8, days=120, seed=args.seed)
+    spec = independent_fleet.FleetSpec(units=12, worn=8, days=120, seed=args.seed,
+                                       friction_test_every=args.friction_test_every)
     if args.law == "first":
         _, logs, truth = independent_fleet.write_fleet(work, spec, robot=robot)
-    elif (work / "truth.csv").is_file():
+    elif (work / "truth.csv").is_file() and (not spec.friction_test_every or (work / "truth_tests.csv").is_file()):
         logs, truth = work / "logs", work / "truth.csv"
     else:
-        logs, truth = wear_hump_fleet.write_fleet(work, spec, robot)
+        law = "lorentzian" if args.law == "hump-lorentzian" else "exponential"
+        logs, truth = wear_hump_fleet.write_fleet(work, spec, robot, law)
     out = work / args.out
     command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-progress"] + (["--no-calibrate"] if args.no_calibrate else [])

@@ -41,6 +41,20 @@ What is independent and what is ours:
 - The motion: the robot folder's generated ``pick_place`` cycle (faultgen's planner; the motion is
   logged, so any would do), one cycle per log.
 
+- **Friction tests: the motion faultgen's, the plant ours** (issue 75; none by default): with
+  :attr:`FleetSpec.friction_test_every` ``= D`` every unit runs a friction test on days 1, 1 + D,
+  1 + 2 D, ...: the motion of ``faultgen tasks friction-test`` for the robot folder
+  (:func:`faultgen.operation.friction_test.program`: each axis in turn at constant speeds both ways)
+  driven through this module's dynamics and friction law (Pinocchio's RNEA, no part, the reflected
+  motor inertia, :func:`motor_friction` with the day's levels, wear and gearbox), so that the test's
+  friction is the plant's; run warm (the day's joint temperature) or cold (before the warm-up: the
+  hall's temperature that day), drawn per test (:data:`COLD_SHARE`) and logged, with its own per-log
+  scatter and the same noise model. Drawn from a stream of their own (the unit's seed and the
+  day): the daily logs are the same with or without tests. Written as
+  ``logs/<unit>/friction-test/<stamp>.csv`` (the daily logs' columns, payload 0; the stamp the day's
+  date), their truth apart in ``ROOT/truth_tests.csv`` (:data:`TEST_TRUTH_COLUMNS`: per test and axis
+  the Coulomb level and viscous coefficient the plant had, arm side, at the test's temperature).
+
 Output (:func:`write_fleet`), the layout ``faultgen logs import`` reads: ``ROOT/logs/<unit>/<stamp>.csv``
 with ``t, q1..qN, tau1..tauN, temperature1..N, payload`` (s, rad, N m arm side, deg C, kg), the
 stamps ISO dates, one log a day; and the truth apart, ``ROOT/truth.csv``: ``unit, stamp,
@@ -105,6 +119,13 @@ FLANGE_FRAME = "tool0"
 PLAN_RATE = 250.0
 #: The columns of truth.csv.
 TRUTH_COLUMNS = ("unit", "stamp", "worn_axis", "wear_percent")
+#: A unit's friction tests are in this folder of its log folder.
+TEST_FOLDER = "friction-test"
+#: The columns of truth_tests.csv: per test and axis (1-based) the plant's Coulomb level (N m) and
+#: viscous coefficient (N m s/rad), arm side, at the test's joint temperature (deg C, as logged).
+TEST_TRUTH_COLUMNS = ("unit", "stamp", "axis", "coulomb_Nm", "viscous_Nms_rad", "temperature_degC")
+#: The share of friction tests run cold (before the warm-up: the joints at the hall's temperature).
+COLD_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -114,8 +135,9 @@ class FleetSpec:
     and reaches ``final_wear`` % on the last day, on one of the axes ``wearable`` (1-based); parts
     up to ``max_part`` kg (``rated_part``: the fleet's heaviest part drawn is made ``max_part``
     itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
-    ``program_changes`` healthy units an unlogged program change (module docstring). Every draw comes
-    from ``seed``; the defaults draw what the fleet drew before these options existed."""
+    ``program_changes`` healthy units an unlogged program change; every ``friction_test_every`` days
+    (0: never) each unit runs a friction test (module docstring). Every draw comes from ``seed``; the
+    defaults draw what the fleet drew before these options existed."""
 
     units: int = 12
     worn: int = 8
@@ -130,10 +152,11 @@ class FleetSpec:
     rated_part: bool = False
     gearbox_changes: int = 0
     program_changes: int = 0
+    friction_test_every: int = 0
 
     def __post_init__(self) -> None:
         for name, low in (("units", 1), ("worn", 0), ("days", 2), ("seed", 0), ("gearbox_changes", 0),
-                          ("program_changes", 0)):
+                          ("program_changes", 0), ("friction_test_every", 0)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"fleet {name} = {value!r}: expected a whole number >= {low}")
@@ -327,13 +350,113 @@ def day_conditions(unit: dict, day: int, stamp: str, rng: np.random.Generator) -
     return temperature, mass
 
 
+def friction_test_days(spec: FleetSpec) -> list[int]:
+    """The days (1-based) of each unit's friction tests: 1, 1 + D, 1 + 2 D, ... up to ``spec.days``
+    for ``D = spec.friction_test_every``; none for 0."""
+    every = spec.friction_test_every
+    return list(range(1, spec.days + 1, every)) if every else []
+
+
+@lru_cache(maxsize=4)
+def friction_test_motion(robot: robots.Robot, rate: float):
+    """The friction test of ``robot`` (:func:`faultgen.operation.friction_test.program`, as ``faultgen
+    tasks friction-test`` writes it) planned at 250 Hz and taken at ``rate`` Hz: ``t`` (n,) s, ``q``,
+    ``qd``, ``qdd`` (n, N) rad, rad/s, rad/s^2, and Pinocchio's RNEA torque of it without a part
+    (n, N) N m, from the URDF in the robot's folder. ValueError for a rate as :func:`_motion`'s."""
+    from faultgen.operation import friction_test
+
+    step = int(round(PLAN_RATE / rate))
+    if step < 1 or abs(PLAN_RATE / step - rate) > 1e-9:
+        raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
+    program = programs.parse(friction_test.text(robot), robot, where=f"friction test of {robot.name}")
+    path = program.trajectory(PLAN_RATE ** -1)
+    q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
+    pin = pinocchio_module()
+    model = pinocchio_model(robot.path.parent / "urdf_used.urdf")
+    data = model.createData()
+    rigid = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
+    return np.arange(len(q)) / rate, q, qd, qdd, rigid
+
+
+def _levels(spec: FleetSpec, unit: dict, day: int, nominal, jitter: np.ndarray, temperature) -> tuple:
+    """A unit's motor-side Coulomb, static and viscous levels on ``day`` (1-based), each (N,): the
+    ``nominal`` ones times the unit's spread (the nominal on a changed gearbox's axis), the wear on
+    the worn axis's dry friction, the log's ``jitter`` (3, N), the viscous law at ``temperature`` deg C."""
+    fc0, fs0, fv0 = nominal
+    wear = _wear(spec, unit, day)
+    grow = np.ones(len(fc0))
+    if unit["axis"]:
+        grow[unit["axis"] - 1] += wear / 100.0
+    spread = unit["spread"]
+    if unit["gearbox_day"] and day >= unit["gearbox_day"]:  # a new gearbox: the nominal friction
+        spread = spread.copy()
+        spread[:, unit["axis"] - 1] = 1.0
+    fc = fc0 * spread[0] * grow * jitter[0]
+    fs = fs0 * spread[1] * grow * jitter[1]
+    fv = fv0 * spread[2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
+    return fc, fs, fv
+
+
+def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
+    """A unit's daily draws in the order the writer makes them, one tuple a day: ``(day, stamp,
+    temperature, mass, jitter, changed, noise, angle noise)`` (the last two shaped as the day's motion)."""
+    rng = np.random.default_rng(unit["seed"])
+    n = model.n_axes
+    for d, stamp in enumerate(stamps(spec), start=1):
+        temperature, mass = day_conditions(unit, d, stamp, rng)
+        jitter = np.exp(rng.normal(0.0, JITTER, (3, n)))
+        changed = bool(unit["program_day"]) and d >= unit["program_day"]
+        shape = _motion(model, spec.rate, changed)[1].shape
+        noise = rng.normal(0.0, 1.0, shape)
+        yield d, stamp, temperature, mass, jitter, changed, noise, rng.normal(0.0, ANGLE_NOISE, shape)
+
+
+def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int) -> tuple:
+    """A friction test's draws on ``day`` (1-based), from the stream of the unit's seed and the day:
+    its joint temperature, deg C (N,: the day's ``temperature`` warm, the hall's, without the unit's
+    warm-up rise, cold; :data:`COLD_SHARE`), its per-log ``jitter`` (3, N) and the generator of its noise."""
+    rng = np.random.default_rng([unit["seed"], 1, day])
+    cold = rng.random() < COLD_SHARE
+    jitter = np.exp(rng.normal(0.0, JITTER, (3, n_axes)))
+    return (temperature - unit["rise"] if cold else np.asarray(temperature, dtype=float)), jitter, rng
+
+
+def write_friction_test(path: Path, header, model: robots.Robot, rate: float, friction, temperature: np.ndarray,
+               rng: np.random.Generator) -> None:
+    """Write one friction test log (:func:`friction_test_motion` at ``rate`` Hz) at ``path``: the arm-side torque
+    Pinocchio's RNEA plus the reflected motor inertia plus ``G friction(G qd)`` (``friction``: the
+    plant's motor-side law at motor speeds (n, N), N m), the noise model of the daily logs drawn from
+    ``rng``, ``temperature`` (N,) deg C logged (rounded to 0.01) and payload 0."""
+    G, jm = model.gear_ratio, model.motor_inertia
+    t, q, qd, qdd, rigid = friction_test_motion(model, rate)
+    tau = rigid + G**2 * jm * qdd + G * friction(G * qd)
+    tau = tau + rng.normal(0.0, 1.0, tau.shape) * NOISE * np.sqrt(np.mean(tau**2, axis=0))
+    angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _write_csv(path, header, t, angles, tau, np.round(temperature, 2), 0.0)
+
+
+def friction_test_truth(unit: str, stamp: str, gear_ratio: np.ndarray, coulomb, viscous, temperature) -> list[list]:
+    """truth_tests.csv's rows (:data:`TEST_TRUTH_COLUMNS`) of one test: motor-side ``coulomb`` (N m) and
+    ``viscous`` (N m s/rad) levels (N,) referred to the arm (``G`` and ``G^2``), ``temperature`` as logged."""
+    return [[unit, stamp, k + 1, f"{gear_ratio[k] * coulomb[k]:.6g}", f"{gear_ratio[k] ** 2 * viscous[k]:.6g}",
+             f"{round(float(temperature[k]), 2):.2f}"] for k in range(len(gear_ratio))]
+
+
+def log_header(n: int) -> list[str]:
+    """The columns of a log of ``n`` axes: t, q1..qN, tau1..tauN, temperature1..N, payload."""
+    q_names, _, tau_names = jointlog.column_names(n)
+    return [jointlog.T_COLUMN, *q_names, *tau_names, *jointlog.temperature_columns(n), jointlog.PAYLOAD_COLUMN]
+
+
 def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     """Write the fleet of the robot folder ``robot`` under ``root``: ``root/logs/<unit>/<stamp>.csv``
-    and ``root/truth.csv``; returns (logs, truth).
+    and ``root/truth.csv``; with friction tests also ``root/logs/<unit>/friction-test/<stamp>.csv`` and
+    ``root/truth_tests.csv``; returns (logs, truth).
 
-    A unit whose folder holds every log (each written atomically) is kept as it is: a write stopped
-    part-way resumes at the first unit not complete and gives the same files. Same ``spec``, identical
-    files.
+    A unit whose folder holds every log and test (each written atomically) is kept as it is (its
+    tests' truth drawn again): a write stopped part-way resumes at the first unit not complete and
+    gives the same files. Same ``spec``, identical files.
 
     Raises
     ------
@@ -345,42 +468,40 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     root = Path(root)
     model = robots.load(Path(robot))  # the independent simulator's entry: its robot folder, resolved once
     G, jm, nominal = model.gear_ratio, model.motor_inertia, model.friction
-    fc0, fs0, fv0 = (np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
+    nominal = tuple(np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
     n = model.n_axes
     logs = root / "logs"
-    q_names, _, tau_names = jointlog.column_names(n)  # t, q1..qN, tau1..tauN, temperature1..N, payload
-    header = [jointlog.T_COLUMN, *q_names, *tau_names, *jointlog.temperature_columns(n), jointlog.PAYLOAD_COLUMN]
+    header = log_header(n)
     days = stamps(spec)
+    tested = set(friction_test_days(spec))
     units = _units(spec, n)
+    test_rows = []
     for unit in units:
         folder_of_unit = logs / unit["unit"]
-        if all((folder_of_unit / f"{stamp}.csv").is_file() for stamp in days):
-            continue  # drawn in one go from its own seed: complete, and as the same seed draws it
-        rng = np.random.default_rng(unit["seed"])
+        kept = all((folder_of_unit / f"{stamp}.csv").is_file() for stamp in days) and all(
+            (folder_of_unit / TEST_FOLDER / f"{days[d - 1]}.csv").is_file() for d in tested)
         folder_of_unit.mkdir(parents=True, exist_ok=True)
-        for d, stamp in enumerate(days, start=1):
-            temperature, mass = day_conditions(unit, d, stamp, rng)
-            wear = _wear(spec, unit, d)
-            grow = np.ones(n)
-            if unit["axis"]:
-                grow[unit["axis"] - 1] += wear / 100.0
-            spread = unit["spread"]
-            if unit["gearbox_day"] and d >= unit["gearbox_day"]:  # a new gearbox: the nominal friction
-                spread = spread.copy()
-                spread[:, unit["axis"] - 1] = 1.0
-            jitter = np.exp(rng.normal(0.0, JITTER, (3, n)))
-            fc = fc0 * spread[0] * grow * jitter[0]
-            fs = fs0 * spread[1] * grow * jitter[1]
-            fv = fv0 * spread[2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
-            changed = bool(unit["program_day"]) and d >= unit["program_day"]
+        for d, stamp, temperature, mass, jitter, changed, noise, angle_noise in _days(spec, unit, model):
+            if d in tested:
+                warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n)
+                fc, fs, fv = _levels(spec, unit, d, nominal, test_jitter, warmth)
+                test_rows += friction_test_truth(unit["unit"], stamp, G, fc, fv, warmth)
+                if not kept:
+                    write_friction_test(folder_of_unit / TEST_FOLDER / f"{stamp}.csv", header, model, spec.rate,
+                               lambda w, fc=fc, fs=fs, fv=fv: motor_friction(w, fc, fs, fv), warmth, rng)
+            if kept:
+                continue  # drawn in one go from its own seed: complete, and as the same seed draws it
+            fc, fs, fv = _levels(spec, unit, d, nominal, jitter, temperature)
             t, q, qd, qdd = _motion(model, spec.rate, changed)
             tau = (_rigid(model, spec.rate, round(mass, 1), changed) + G**2 * jm * qdd
                    + G * motor_friction(G * qd, fc, fs, fv))
-            tau = tau + rng.normal(0.0, 1.0, tau.shape) * NOISE * np.sqrt(np.mean(tau**2, axis=0))
-            angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)
+            tau = tau + noise * NOISE * np.sqrt(np.mean(tau**2, axis=0))
+            angles = q + angle_noise
             _write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2), round(mass, 1))
     truth = root / "truth.csv"
     _write_table(truth, TRUTH_COLUMNS, truth_rows(spec, n))
+    if tested:
+        _write_table(root / "truth_tests.csv", TEST_TRUTH_COLUMNS, test_rows)
     events = [[u["unit"], days[u["gearbox_day"] - 1], "gearbox_change", u["axis"]] for u in units if u["gearbox_day"]]
     if events:  # the logged maintenance, which the monitor reads
         _write_table(logs / "events.csv", ("unit", "stamp", "event", "axis"), events)
