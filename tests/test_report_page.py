@@ -120,7 +120,9 @@ def test_the_page_in_a_real_browser(written, browser, tmp_path):
     if os.environ.get("FAULTGEN_SCREENSHOT"):
         shutil.copy(tmp_path / "report-page.png", ROOT / "docs" / "report-page.png")
 
-    # the fleet table holds units.csv's and alarms.csv's rows, the open alarm first
+    # the fleet table holds units.csv's and alarms.csv's rows, the open alarm first; since issue 75 (item 6)
+    # a line per unit (state light, service by, axis, wear, life consumed, last log): the status, the alarm's
+    # start, the logs scored and the closed alarms are in the unit's panel (faultgen.monitor.lights)
     units = {r["unit"]: r for r in _csv(written / "units.csv")}
     alarms = _csv(written / "alarms.csv")
     current = {r["unit"]: r for r in alarms if not r["closed"]}
@@ -129,16 +131,25 @@ def test_the_page_in_a_real_browser(written, browser, tmp_path):
     rows = [dict(zip(header, (td.text for td in tr.find_elements(By.TAG_NAME, "td"))))
             for tr in browser.find_elements(By.CSS_SELECTOR, "#fleet tbody tr")]
     assert sorted(r["unit"] for r in rows) == sorted(units) and len(rows) == len(units)
-    assert rows[0]["unit"] == "weld-07" and rows[0]["open alarm"] == "wear alarm"
-    assert [r["unit"] for r in rows] == ["weld-07", "spare-01", "=new-cell", "weld-02", "paint-11", HOSTILE]
+    assert rows[0]["unit"] == "weld-07" and rows[0]["state"] == "watch"
+    # =new-cell's last log is 24 days before the fleet's latest: stale, before the unknown spare-01
+    assert [r["unit"] for r in rows] == ["weld-07", "=new-cell", "spare-01", "weld-02", "paint-11", HOSTILE]
+    assert [r["state"] for r in rows] == ["watch", "stale", "unknown", "ok", "ok", "ok"]
+    fleet = {u.name: u for u in page.read(written).units}
     for row in rows:
         unit, alarm = units[row["unit"]], current.get(row["unit"])
-        assert (row["status"], row["last log"], row["logs"]) == (unit["status"], unit["last_log"], unit["logs_scored"])
-        assert row["since"] == (alarm["first_alarm"] if alarm else "")
-        assert row["axis"] == (alarm["source_axis"] if alarm and alarm["first_alarm"] else "")
-        assert row["closed alarms"].count("closed") == len(closed[row["unit"]])
-    assert current["weld-07"]["source_axis"] == "2" and rows[0]["wear of the axis, last log (lower bound)"].endswith(")")
-    assert "closed 2026-03-21 06:00 by repair of axis 2" in next(r for r in rows if r["unit"] == "paint-11")["closed alarms"]
+        assert row["last log"] == unit["last_log"]
+        wear = fleet[row["unit"]].axis_wear()
+        assert row["axis"] == (alarm["source_axis"] if alarm and alarm["first_alarm"] else str(wear[0]) if wear else "")
+        link = next(a for a in browser.find_elements(By.CSS_SELECTOR, "a.unit-link") if a.text == row["unit"])
+        panel = browser.find_element(By.ID, link.get_attribute("href").split("#")[1]).get_attribute("textContent")
+        assert f"{unit['status']} (" in panel and f"{unit['logs_scored']} logs scored" in panel
+        opened = bool(alarm and alarm["first_alarm"])
+        assert ("Open alarm from" in panel) == opened and (not opened or f"from {alarm['first_alarm']}" in panel)
+        assert panel.count(", closed ") == len(closed[row["unit"]])
+        if row["unit"] == "paint-11":
+            assert "closed 2026-03-21 06:00 by repair of axis 2" in panel
+    assert current["weld-07"]["source_axis"] == "2" and rows[0]["wear, % (90 %)"].endswith(")")
     # the stranger's unit name is text, not markup; nothing on the page points outside it
     assert browser.execute_script("return document.images.length") == 0
     links = browser.execute_script(
@@ -193,8 +204,11 @@ def test_report_builds_the_page_again_from_an_output_folder(written, tmp_path):
     (out / page.SETTINGS).unlink()  # a folder without the settings: the page without them, said so
     result = CliRunner().invoke(app, ["report", str(out)])
     assert result.exit_code == 0 and "settings were not found" in (out / page.PAGE).read_text()
-    result = CliRunner().invoke(app, ["report", str(tmp_path / "nothing")])
-    assert result.exit_code == 2 and "units.csv" in result.output
+    missing = CliRunner().invoke(app, ["report", str(tmp_path / "nothing")])
+    assert missing.exit_code == 2 and "units.csv" in missing.output
+    # this folder has no rul.csv and no life.csv: each named, not dropped silently
+    assert f"note: {out / 'rul.csv'} is missing: the page shows no remaining life" in result.output
+    assert f"note: {out / 'life.csv'} is missing: the page shows no life consumed by load" in result.output
 
 
 def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):
@@ -254,6 +268,6 @@ def test_the_remaining_life_is_in_the_table_and_the_units_panel(written, tmp_pat
         writer.writeheader()
         writer.writerows(rows)
     text = page.write(out, SETTINGS).read_text()
-    assert "remaining life (5-95 %)" in text
+    assert "Remaining life (5-95 %)" in text  # in the panel since issue 75 (item 6): the table has "service by"
     assert "12 days (8-20)" in text and "(linear trend of 9 logs)" in text
     assert "no end of life within the horizon (365 days)" in text

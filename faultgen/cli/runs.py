@@ -271,6 +271,11 @@ def fleet_command(
         help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
         "from its onset day to FINAL on the failure day: EFFECT:each:PARAMETER:FINAL[:key=value,...] (the "
         "form of `simulate --fault`, AXIS 'each': the drawn axis), e.g. backlash:each:width:0.01; the same FINAL on every model (--robot picks them).")] = None,
+    friction_test_every: Annotated[int, typer.Option(
+        "--friction-test-every", metavar="DAYS", help="Each robot also runs its model's friction test "
+        "(`faultgen tasks friction-test`) every DAYS days from day 1: one more run per robot, "
+        "<run>-friction-test, its tests' signals labelled record=friction_test (docs/friction-test.md); "
+        "0: none.", min=0, max=3650)] = 0,
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
@@ -295,6 +300,7 @@ def fleet_command(
       faultgen fleet --fault backlash:each:width:0.01 -o fleet-backlash.h5
       faultgen fleet --robot irb6700 --fault cogging:each:amplitude:0.5:poles=8 -o fleet-cogging.h5
       faultgen fleet --without payloads -o fleet-no-parts.h5
+      faultgen fleet --friction-test-every 14 -o fleet-tested.h5
       faultgen fleet --robots 500 --days 365 --scheduler tcp://10.0.0.5:8786 -o fleet-500.h5
     """
     from faultgen.runs import fleet
@@ -308,7 +314,8 @@ def fleet_command(
         chosen["tasks"] = tuple(task_pool)
     plan = fleet.Fleet(size=size, failing=failing, days=days, cycles_per_day=cycles_per_day, **chosen,
                        failure_wear=failure_wear, seed=seed, conditions=conditions, task_mix=task_mix,
-                       friction=friction_model, gear_loss=gear_loss, fault=fault)
+                       friction=friction_model, gear_loss=gear_loss, fault=fault,
+                       friction_test_every=friction_test_every)
     if jobs < 1:
         raise ValueError(f"--jobs {jobs}: expected >= 1")
     check_outputs([out], overwrite)
@@ -316,8 +323,9 @@ def fleet_command(
     where = f" on {scheduler}" if scheduler else f" with {jobs} job(s)"
 
     def announce(n_runs: int, done: int) -> None:
-        typer.echo(f"{n_runs} robots x {days} days -> {out}{where}"
-                   + (f"; resuming, {done} robots already finished" if done else ""))
+        robots_ = f"{n_runs // 2} robots (and their friction-test runs)" if friction_test_every else f"{n_runs} robots"
+        typer.echo(f"{robots_} x {days} days -> {out}{where}"
+                   + (f"; resuming, {done} {'runs' if friction_test_every else 'robots'} already finished" if done else ""))
 
     run_sweep(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
               shared=shared_folder, backend=backend)

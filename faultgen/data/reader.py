@@ -87,6 +87,10 @@ class Run:
     measured : bool
         True for a unit imported from measured logs (``faultgen logs import``): its records are
         logs, its wear the labels of its events (:data:`faultgen.data.schema.MEASURED_ARRAYS`).
+    friction_test : bool
+        True for a run whose records are friction tests (attribute ``record = "friction_test"``,
+        :data:`faultgen.data.schema.RECORD_ATTRIBUTE`): in a fleet, a robot's tests
+        (:attr:`Dataset.friction_tests`); :mod:`faultgen.data.friction_records` reads one as a log.
 
     What the run stored of its robot, which the analyses read instead of the robot's files:
     :attr:`drivetrain`, :attr:`limits` and :attr:`model_sha256`.
@@ -108,6 +112,7 @@ class Run:
     provenance: dict = field(repr=False)
     program_sha256: str | None = field(default=None, repr=False)
     measured: bool = False
+    friction_test: bool = False
     _stored: dict = field(default_factory=dict, repr=False, compare=False)
     _source: Dataset | None = field(default=None, repr=False, compare=False)
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
@@ -322,6 +327,7 @@ def _run(run_id: str, attrs: dict, source: Dataset) -> Run:
         program_sha256=str(attrs[schema.PROGRAM_ATTRIBUTE]) if schema.PROGRAM_ATTRIBUTE in attrs
         else (_json(attrs.get("program")) or {}).get("sha256"),
         measured=attrs.get("source") == schema.MEASURED, _source=source,
+        friction_test=attrs.get(schema.RECORD_ATTRIBUTE) == schema.FRICTION_TEST,
         _stored={"attrs": {key: attrs[key] for key in ("drivetrain", "limits", "source") if key in attrs}})
 
 
@@ -335,7 +341,10 @@ class Dataset(Sequence):
     ----------
     path : pathlib.Path
     runs : tuple of Run
-        In file order.
+        In file order; in a fleet (``faultgen fleet``), its robots' runs without their friction tests.
+    friction_tests : tuple of Run
+        The runs labelled friction tests (:attr:`Run.friction_test`), in file order: in a fleet, a
+        robot's is ``<run id>-friction-test``, beside :attr:`runs`; elsewhere also among them.
     command : str
         The command that wrote the file.
     faultgen_version : str
@@ -361,8 +370,10 @@ class Dataset(Sequence):
                 raise schema.DatasetError(f"{self.path}: run {run_id!r}: {problems[0]} (faultgen validate {self.path} "
                                            "lists every problem)")
             runs.append(_run(run_id, {k: attr(v) for k, v in group.attrs.items()}, self))
-        self.runs: tuple[Run, ...] = tuple(runs)
-        self._by_id = {run.id: run for run in self.runs}
+        fleet = isinstance(self.grid, dict) and "fleet" in self.grid
+        self.friction_tests: tuple[Run, ...] = tuple(r for r in runs if r.friction_test)
+        self.runs: tuple[Run, ...] = tuple(r for r in runs if not (fleet and r.friction_test))
+        self._by_id = {run.id: run for run in runs}
 
     def _group(self, run_id: str):
         if self._file is None:
@@ -384,7 +395,7 @@ class Dataset(Sequence):
         return len(self.runs)
 
     def __getitem__(self, key):
-        """A run by position (int, slice) or by id (str); raises KeyError naming the runs."""
+        """A run by position (int, slice) or by id (str, a friction test's too); raises KeyError naming the runs."""
         if isinstance(key, str):
             if key not in self._by_id:
                 raise KeyError(f"{self.path} has no run {key!r}; runs: {', '.join(list(self._by_id)[:10])}")

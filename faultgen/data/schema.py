@@ -14,7 +14,8 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      wear JSON, noise JSON) and provenance (faultgen_version,
                                      model_sha256, log_period, config JSON, command; since robots
                                      of 5-7 axes: n_axes, drivetrain JSON; since issue 57:
-                                     limits JSON, LIMITS)
+                                     limits JSON, LIMITS; since issue 75, a friction test's
+                                     run: record = "friction_test", RECORD_ATTRIBUTE)
         t, cycles, q_ref                       time base, recorded cycles, reference
         q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, N) logged signals, 250 Hz, N the
                                                robot's axes (attr n_axes; 6 in files before it)
@@ -128,6 +129,17 @@ BINS = {"bin": sensors.HISTOGRAM_BINS, "fine bin": sensors.TORQUE_COUNT_BINS}
 RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axes", "wear", "noise",
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
 
+
+#: The attribute that labels a run's records as friction tests (issue 75): ``record = "friction_test"``
+#: (:data:`FRICTION_TEST`) on a run whose program is a friction test (its ``process`` is ``"friction
+#: test"``: ``faultgen tasks friction-test``, :mod:`faultgen.operation.friction_test`); absent on every
+#: other run (production records, as in files written before it). A fleet's tests
+#: (``faultgen fleet --friction-test-every``) are such runs beside its robots' runs; a reader filters
+#: on it (the typed reader keeps a fleet's tests apart: ``Dataset.friction_tests``).
+RECORD_ATTRIBUTE = "record"
+FRICTION_TEST = "friction_test"
+#: The program ``process`` that makes a run a friction test.
+FRICTION_TEST_PROCESS = "friction test"
 
 #: The attribute that says what a run's program is (:func:`faultgen.operation.programs.identity`):
 #: the SHA-256 of its text, hex. Runs written before it lack it; readers then fall back to the

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from faultgen.data import cells, reader
 from faultgen.data.atomic import atomic_path
 from faultgen.data.opening import attr, open_file
-from faultgen.data.schema import MEASURED, DatasetError
+from faultgen.data.schema import FRICTION_TEST, MEASURED, RECORD_ATTRIBUTE, DatasetError
 from faultgen.data.validator import attribute_problems
 from faultgen.operation.faults import Fault
 from faultgen.simulation import sensors
@@ -85,9 +85,12 @@ def summary(path: str | Path) -> str:
             if problems:
                 raise DatasetError(f"{path}: run {run_id!r}: {problems[0]} (faultgen validate {path} lists every "
                                    "problem)")
-        rows = [{k: attr(v) for k, v in runs[r].attrs.items()} for r in runs]
-        n_cycles = [runs[r]["cycles"].shape[0] for r in runs]
-        n_log = [runs[r]["t"].shape[0] for r in runs]
+        tests = [r for r in runs if attr(runs[r].attrs.get(RECORD_ATTRIBUTE)) == FRICTION_TEST]
+        kept = [r for r in runs if r not in tests] or tests  # a fleet's tests on a line of their own
+        rows = [{k: attr(v) for k, v in runs[r].attrs.items()} for r in kept]
+        n_cycles = [runs[r]["cycles"].shape[0] for r in kept]
+        n_log = [runs[r]["t"].shape[0] for r in kept]
+        n_tests = sum(runs[r]["cycles"].shape[0] for r in tests) if len(kept) < len(runs) else 0
         version, command = attr(f.attrs.get("faultgen_version")), attr(f.attrs.get("command", ""))
     worn = sorted({tuple(int(a) for a in row["worn_axes"]) for row in rows})
     daily = any(row.get("sample") in ("day", "log") for row in rows)
@@ -95,7 +98,7 @@ def summary(path: str | Path) -> str:
     what, record = ("logs", "log records") if logs else ("days", "daily records") if daily else ("cycles", "recorded")
     signals = all(row.get("signals", True) for row in rows)
     lines = [
-        f"{path}: {len(rows)} run(s), {Path(path).stat().st_size / 1e6:.1f} MB, written by faultgen {version}",
+        f"{path}: {len(rows)} run(s){f' and {len(tests)} friction-test run(s)' if n_tests else ''}, {Path(path).stat().st_size / 1e6:.1f} MB, written by faultgen {version}",
         f"  robots:        {', '.join(sorted({r['robot'] for r in rows}))}",
         f"  tasks:         {', '.join(sorted({r['task'] for r in rows}))}",
         f"  friction:      {', '.join(sorted({r['friction_model'] for r in rows}))}",
@@ -108,6 +111,9 @@ def summary(path: str | Path) -> str:
            if all(row.get("source") == MEASURED for row in rows)
            else "features and truth only (no 250 Hz signals)"),
     ]
+    if n_tests:
+        lines.append(f"  friction tests: {len(tests)} run(s) labelled {RECORD_ATTRIBUTE}={FRICTION_TEST}, "
+                     f"{n_tests} tests in all, with their signals (not counted above; docs/friction-test.md)")
     if any("conditions" in row for row in rows):
         tables = [json.loads(row["conditions"]) for row in rows if "conditions" in row]
         kinds = sorted({key for table in tables for key, value in table.items()

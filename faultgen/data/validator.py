@@ -27,11 +27,13 @@ from faultgen.data.schema import (
     DUTY_ARRAYS,
     FAULT_ARRAYS,
     FORMAT_VERSION,
+    FRICTION_TEST,
     LIMITS,
     MEASURED,
     MEASURED_ARRAYS,
     MEASURED_OPTIONAL,
     PROGRAM_ATTRIBUTE,
+    RECORD_ATTRIBUTE,
     RUN_ATTRIBUTES,
     SIGNAL_AXES,
     SIMULATED_TRUTH,
@@ -119,6 +121,7 @@ def attribute_problems(group: h5py.Group) -> list[str]:
         PROGRAM_ATTRIBUTE: (lambda v: isinstance(v, str) and len(v) == 64
                             and all(c in "0123456789abcdef" for c in v), "64 hex digits (a SHA-256)"),
         "source": (lambda v: v == MEASURED, f"{MEASURED!r} (absent for a simulated run)"),
+        RECORD_ATTRIBUTE: (lambda v: v == FRICTION_TEST, f"{FRICTION_TEST!r} (absent for production records)"),
         "saturated": (lambda v: isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iu",
                       "a list of axes"),
     }

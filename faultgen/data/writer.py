@@ -29,7 +29,10 @@ from faultgen.data.schema import (
     FAULT_ARRAYS,
     FORMAT,
     FORMAT_VERSION,
+    FRICTION_TEST,
+    FRICTION_TEST_PROCESS,
     LIMITS,
+    RECORD_ATTRIBUTE,
     SIGNAL_AXES,
     condition_arrays,
 )
@@ -103,6 +106,19 @@ def config_key(config) -> str:
     return json.dumps(key, sort_keys=True)
 
 
+def is_friction_test(program: dict | None) -> bool:
+    """Whether a run's program (:func:`faultgen.operation.programs.record`'s dict; None for a thesis
+    task) is a friction test: a program file whose ``process`` is :data:`FRICTION_TEST_PROCESS`."""
+    if program is None or "text" not in program:
+        return False
+    import tomllib
+
+    try:
+        return tomllib.loads(program["text"]).get("process") == FRICTION_TEST_PROCESS
+    except tomllib.TOMLDecodeError:
+        return False
+
+
 def run_attributes(result, command: str = "") -> dict:
     """Labels and provenance of a run, as HDF5 attributes (strings, numbers, JSON)."""
     config = result.config
@@ -135,6 +151,8 @@ def run_attributes(result, command: str = "") -> dict:
         "signals": bool(config.signals),
         "sample": "day" if config.daily else "cycle",
         **({"fault": json.dumps(config.fault.to_dict())} if config.fault is not None else {}),
+        # a friction test's records, labelled so (absent on every other run, as in files before it)
+        **({RECORD_ATTRIBUTE: FRICTION_TEST} if is_friction_test(program) else {}),
         # axes whose motor saturated (a wear or fault too large for the drive): validate reports them
         **({"saturated": np.asarray(result.saturated, dtype=int)} if len(getattr(result, "saturated", ())) else {}),
     }

@@ -250,33 +250,72 @@ def write_life(path: Path, rows: list[LifeRow]) -> None:
             writer.writerow([_cell(v) for v in row.cells()])
 
 
-def service_by(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> tuple[str, str]:
-    """A unit's "service by" and what sets it: the earlier of the load-based days left (rows of
-    life.csv, as read: text cells) and the condition-based remaining life (rows of rul.csv in days),
-    counted from ``last_stamp``; a date for date stamps, else "in N days". ``("", "")`` when neither
-    gives a number."""
+@dataclass(frozen=True)
+class Service:
+    """A unit's "service by" in days from its last log (:func:`service_window`): ``days`` the
+    earliest source, ``low`` and ``high`` the earliest of the sources' 5 % and 95 % ends (a
+    load-based life is one number, its own ends; ``math.inf`` beyond the horizon), ``why`` the
+    source that sets ``days`` in words, ``axis`` its axis."""
+
+    days: float
+    low: float
+    high: float
+    why: str
+    axis: int | None
+
+
+def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | None:
+    """The earlier of the load-based days left (rows of life.csv, as read: text cells) and the
+    condition-based remaining life (rows of rul.csv in days), with its interval: each end the
+    earliest of the sources' ends (the rated-life formula gives one number, so a load-based source
+    is its own ends; a condition-based one its ``rul_5``, ``rul_95``, an empty ``rul_95`` beyond the
+    horizon). The upper end so holds with at least the sources' 95 %: the minimum of the times is
+    below it whenever the source that gives it is. None when no source gives a number."""
     found = []
     for r in life_rows:
         days = _float(r.get("days_left"))
         if math.isfinite(days):
-            found.append((max(days, 0.0), f"load: axis {r.get('axis')}'s rated life"))
+            days = max(days, 0.0)
+            found.append((days, days, days, f"load: axis {r.get('axis')}'s rated life", r.get("axis")))
     for r in rul_rows:
         days = _float(r.get("rul"))
         if math.isfinite(days) and r.get("time_unit") == "days":
-            found.append((days, f"condition: axis {r.get('axis')}'s wear"))
+            low, high = _float(r.get("rul_5")), _float(r.get("rul_95"))
+            found.append((days, min(days, low) if math.isfinite(low) else days,
+                          max(days, high) if math.isfinite(high) else math.inf,
+                          f"condition: axis {r.get('axis')}'s wear", r.get("axis")))
     if not found:
-        return "", ""
-    days, why = min(found, key=lambda f: f[0])
+        return None
+    days, _, _, why, axis = min(found, key=lambda f: f[0])
+    axis = _float(axis)
+    return Service(days, min(f[1] for f in found), min(f[2] for f in found), why,
+                   int(axis) if math.isfinite(axis) and axis == int(axis) else None)
+
+
+def date_after(last_stamp: str, days: float) -> str:
+    """The day ``days`` after ``last_stamp``: an ISO date for date stamps, else "in N days" (a
+    sequence step counts as a day)."""
     try:
         key, kind = _key(last_stamp, "unit")
     except ValueError:
         kind = None
-    if kind == logfolder.TIME:
+    if kind == logfolder.TIME and math.isfinite(days):
         try:
-            return (datetime.fromtimestamp(key, timezone.utc) + timedelta(days=days)).date().isoformat(), why
+            return (datetime.fromtimestamp(key, timezone.utc) + timedelta(days=days)).date().isoformat()
         except (OverflowError, ValueError):  # beyond the calendar's year 9999
             pass
-    return f"in {days:.0f} days", why
+    return f"in {days:.0f} days"
+
+
+def service_by(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> tuple[str, str]:
+    """A unit's "service by" and what sets it: the earlier of the load-based days left (rows of
+    life.csv, as read: text cells) and the condition-based remaining life (rows of rul.csv in days),
+    counted from ``last_stamp``; a date for date stamps, else "in N days". ``("", "")`` when neither
+    gives a number (:func:`service_window`)."""
+    service = service_window(life_rows, rul_rows)
+    if service is None:
+        return "", ""
+    return date_after(last_stamp, service.days), service.why
 
 
 def _float(cell) -> float:
@@ -288,14 +327,15 @@ def _float(cell) -> float:
 
 def table_cell(rows: list[dict]) -> str:
     """The fleet table's cell of a unit's rows of life.csv (as read): the axis that consumed most,
-    its % and the days left at the recent duty."""
+    its % and the days left at the recent duty ("past the rated life" at 0 or fewer, "no load"
+    without a number)."""
     found = [(r, _float(r.get("consumed_pct"))) for r in rows]
     found = [(r, c) for r, c in found if math.isfinite(c)]
     if not found:
         return ""
     r, consumed = max(found, key=lambda f: f[1])
     days = _float(r.get("days_left"))
-    left = f"{days:.0f} days left" if math.isfinite(days) else "no load"
+    left = ("no load" if not math.isfinite(days) else "past the rated life" if days <= 0 else f"{days:.0f} days left")
     return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
 
 

@@ -36,6 +36,7 @@ run is skipped, named: neither stops the fleet.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,6 +52,8 @@ from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
+from faultgen.runs.errors import SweepInterrupted
+from faultgen.runs.sweep import CtrlC, Terminated
 from faultgen.simulation import backends
 
 __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "PROGRAM_LENGTH",
@@ -168,6 +171,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
         The scheduler was lost, or a worker has another robot model (nothing is written).
+    MonitorInterrupted
+        Ctrl-C or SIGTERM while the units were scored (exit code 130 or 143): the workers are
+        stopped and the message says what ``out`` keeps (:func:`interrupted`).
     """
     if scheduler is not None and jobs > 1:
         raise ValueError(f"--jobs {jobs} with --scheduler {scheduler}: the cluster's workers score the units in "
@@ -186,7 +192,6 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     units = fleet_logs.fleet(logs_dir, suffixes)
     found = friction_tests.find(logs_dir, units, suffixes)  # a bad test refused before any work
     out = Path(out)
-    cache = out / ".cache"
     calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
@@ -202,10 +207,28 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
+    kept = len(state), max((u.entries[-1].stamp for u in state.values() if u.entries), default="")
+    with CtrlC() as ctrl_c:
+        try:
+            return _run(state, units, out, confined, key, settings, nominal, ratings, logs_dir, calibrated_model,
+                        calibrate, model_source, twin_temperature, log_format, failure_wear, backend, progress, jobs,
+                        scheduler, robot, hours_per_day, (maintenance, found, tests, wears, scale_of))
+        except KeyboardInterrupt as interrupt:
+            ctrl_c.stopping = True
+            raise interrupted(out, *kept, isinstance(interrupt, Terminated)) from None
+
+
+def _run(state, units, out, confined, key, settings, nominal, ratings, logs_dir, calibrated_model, calibrate,
+         model_source, twin_temperature, log_format, failure_wear, backend, progress, jobs, scheduler, robot,
+         hours_per_day, read) -> Outcome:
+    """The work of :func:`monitor` once its inputs are checked and the earlier run's ``state`` read:
+    score the new logs, then write every output at once. ``read``: the units' maintenance events, the
+    friction tests found and read, their wear and each unit's scale (:mod:`faultgen.monitor.friction_tests`)."""
+    maintenance, found, tests, wears, scale_of = read
     pending, stale = {}, {}
     for name, unit_logs in units.items():
         pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
-    confined.mkdir(cache)
+    confined.mkdir(out / ".cache")
     context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                        failure_wear, backend)
     source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
@@ -218,12 +241,14 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
     made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
     idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
-    for done in map_groups(context, groups, jobs, scheduler, robot, idle, source):
-        for name, unit, outputs in done:
-            made[name] = outputs
-            if unit is not None:
-                state[name] = unit
-                bar.update(len(pending[name]))
+    # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
+    with contextlib.closing(map_groups(context, groups, jobs, scheduler, robot, idle, source)) as results:
+        for done in results:
+            for name, unit, outputs in done:
+                made[name] = outputs
+                if unit is not None:
+                    state[name] = unit
+                    bar.update(len(pending[name]))
     bar.close()
     monitors = [state[name].monitor for name in units if name in state]
     statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
@@ -255,6 +280,27 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                    unit.maintenance, unit.program_changes))
     return Outcome(monitors, statuses)
 
+
+
+class MonitorInterrupted(SweepInterrupted):
+    """``faultgen monitor`` stopped by Ctrl-C (exit code 130) or SIGTERM (143) while it scored the
+    units: its workers are stopped, and the message says what ``out`` keeps."""
+
+
+def interrupted(out: Path, units: int, last: str, terminated: bool) -> MonitorInterrupted:
+    """What an interrupted run tells: ``out`` is written only once every unit is scored
+    (:func:`faultgen.data.atomic.atomic_folder`), so it keeps the earlier run's outputs and state as
+    they were (its ``units`` units, scored up to the logs of ``last``), or, on a first run (``units``
+    0), no output; either way ``OUT/.cache`` keeps the twins' cycles and calibrations made so far,
+    and the same command again continues."""
+    what, code = ("terminated (SIGTERM)", 143) if terminated else ("interrupted", 130)
+    if not units:
+        return MonitorInterrupted(f"{what} before every unit was scored: no output is written ({out} gets its outputs "
+                                  f"once every unit is scored); {out / '.cache'} keeps the twins made so far; run the "
+                                  "same command to continue", code)
+    upto = f", scored up to the logs of {last}" if last else ""
+    return MonitorInterrupted(f"{what}: {out} is kept as the earlier run left it ({units} units{upto}); "
+                              "this run's new logs are not scored; run the same command to score them", code)
 
 
 def _pending(name: str, unit_logs: list, unit: Unit | None) -> tuple[list, list[str]]:

@@ -1,21 +1,29 @@
 """The monitor's fleet report: ``OUT/report.html``, one page a service engineer opens in a browser
-(issue 58).
+(issues 58 and 75).
 
 The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
-``scores.csv`` (:mod:`faultgen.monitor.report`), and the run's settings (a small dict, kept beside
-it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
+``scores.csv`` (:mod:`faultgen.monitor.report`), where present ``wear.csv``, ``rul.csv``,
+``life.csv`` and ``tests.csv`` (the friction tests), and the run's settings (a small dict, kept
+beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
 (:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`). It holds:
 
-- the fleet table, the units that need attention first: an open alarm (the surest wear first),
-  then degraded, not monitored, learning and quiet units; per unit its status, open alarm, axis,
-  since when, the current wear estimate of that axis (with the twin) and its lower one-sided 90 %
-  bound (the alarm's), the last log and the alarms maintenance closed;
-- a panel per unit (a ``<details>``, opened by clicking the unit in the table): the alarm's
-  evidence in words, closed alarms and the maintenance that closed them, and a chart: each axis's
-  wear estimate with its lower-bound band and the wear limit, T2 and Q over their limits, the
-  learning logs shaded, the relearning after maintenance marked;
+- the fleet table (:mod:`faultgen.monitor.lights`, where its rules are stated): one line per unit,
+  a state light (service due, watch, stale, unknown, ok: colour and word), the "service by" date
+  with its 5-95 % interval, the axis, its wear with its 90 % interval, the life consumed by load
+  and the last log; the earliest service first, then the units without a date by their light;
+- a panel per unit (a ``<details>``, opened by clicking the unit in the table): the rules its light
+  met, each axis's wear and the scale it is in, the status, the alarm's evidence in words, the
+  long verdicts (each axis's remaining life, rul.csv, and life consumed, life.csv), closed alarms
+  and the maintenance that closed them, a chart (:mod:`faultgen.monitor.unit_chart`: each axis's
+  wear with its interval and the wear limit, T2 and Q over their limits, the learning logs shaded,
+  the relearning after maintenance marked, the friction-test days) and, with friction tests, each
+  alarming axis's friction curve, the reference test against the latest
+  (:mod:`faultgen.monitor.friction_panel`);
 - the run's settings and the false-alarm statement the command line prints
   (:func:`false_alarm_statement`).
+
+At 400 px wide (a phone) the table's lines become cards, each cell under its column's name: no
+column leaves the screen (tests/test_r6_page.py checks it in headless Chromium).
 
 It is one self-contained file that works offline: plotly.js is embedded once (no CDN, no server),
 each unit's chart is kept as JSON in the page and drawn when its panel is first opened (a page of
@@ -33,8 +41,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from faultgen.data import atomic
-from faultgen.monitor import life, report, scoring, tables
+from faultgen.monitor import friction_panel, life, lights, report, scoring, tables
 from faultgen.monitor.run_settings import SETTINGS, settings_dict
+from faultgen.monitor.unit_chart import figure
 
 #: The page's file name in OUT.
 PAGE = "report.html"
@@ -53,9 +62,6 @@ SETTING_NAMES = {
 }
 #: Order of the fleet table: what needs attention first (an open alarm before any status).
 ATTENTION = ("degraded", "not monitored", "learning", "monitored")
-#: Line colours of the axes (plotly's default sequence).
-COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
-           "#17becf")
 
 
 def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: int, n_axes: int,
@@ -82,6 +88,19 @@ def _number(cell) -> float:
         return math.nan
 
 
+@dataclass(frozen=True)
+class WearNow:
+    """An axis's wear at a unit's last log, %: the ``estimate``, its 90 % interval (``low``,
+    ``high``; ``interval`` False: ``low`` the lower one-sided 90 % bound and no ``high``) and the
+    ``scale`` it is in (:data:`faultgen.monitor.lights.SCALES`)."""
+
+    estimate: float
+    low: float
+    high: float
+    interval: bool
+    scale: str
+
+
 @dataclass
 class Unit:
     """One unit as the outputs give it: its row of units.csv, its current row of alarms.csv (None
@@ -93,6 +112,8 @@ class Unit:
     scores: list[dict] = field(default_factory=list)
     remaining: dict[int, dict] = field(default_factory=dict)  # axis -> its row of rul.csv
     life: list[dict] = field(default_factory=list)  # its rows of life.csv
+    wear: dict[int, list[dict]] = field(default_factory=dict)  # axis -> its rows of wear.csv, in order
+    tests: list[dict] = field(default_factory=list)  # its rows of tests.csv (friction tests)
 
     @property
     def name(self) -> str:
@@ -121,6 +142,26 @@ class Unit:
             axis = max(lowers, key=lambda i: -math.inf if math.isnan(lowers[i]) else lowers[i])
         return axis, _number(last[f"wear{axis}"]), _number(last[f"wear{axis}_lower"])
 
+    def axes(self) -> list[int]:
+        """The unit's axes (1..N of scores.csv's ``scoreI`` columns, else of wear.csv)."""
+        if self.scores:
+            return [i for i in range(1, 1000) if f"score{i}" in self.scores[-1]] or sorted(self.wear)
+        return sorted(self.wear)
+
+    def wear_now(self, axis: int) -> WearNow | None:
+        """An axis's wear at the unit's last log: wear.csv's last row (its 90 % interval and
+        ``wear_scale``) where there is one, else scores.csv's estimate and lower bound; the scale
+        wear.csv's, else units.csv's ``wear_scale``, else ``twin``. None without either."""
+        scale = self.row.get("wear_scale") or "twin"
+        if self.wear.get(axis):
+            r = self.wear[axis][-1]
+            return WearNow(_number(r.get("wear")), _number(r.get("wear_5")), _number(r.get("wear_95")), True,
+                           r.get("wear_scale") or scale)
+        if self.scores and self.scores[-1].get(f"wear{axis}"):
+            last = self.scores[-1]
+            return WearNow(_number(last[f"wear{axis}"]), _number(last.get(f"wear{axis}_lower")), math.nan, False, scale)
+        return None
+
     def attention(self) -> tuple:
         """Sort key of the fleet table (:data:`ATTENTION`): an open alarm first, the surest wear first."""
         if self.open_alarm:
@@ -141,8 +182,10 @@ class Fleet:
 
 
 def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
-    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``), each
-    table read by :func:`faultgen.monitor.tables.read` (``max_bytes`` as there).
+    """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``; and
+    ``rul.csv``, ``life.csv``, ``wear.csv``, ``tests.csv`` where present), each table read by
+    :func:`faultgen.monitor.tables.read` (``max_bytes`` as there), in the order of
+    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`).
 
     Raises
     ------
@@ -173,6 +216,15 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
         for r in tables.read(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"), max_bytes)[1]:
             if r["unit"] in units:
                 units[r["unit"]].life.append(r)
+    if (folder / "wear.csv").exists():  # the wear's 90 % interval and scale (optional: a run before it has none)
+        for r in tables.read(folder, "wear.csv", report.WEAR_COLUMNS, max_bytes)[1]:
+            axis = _number(r["axis"])
+            if r["unit"] in units and math.isfinite(axis) and axis == int(axis):
+                units[r["unit"]].wear.setdefault(int(axis), []).append(r)
+    if (folder / "tests.csv").exists():  # friction tests (optional, issue 75: absent, no test data)
+        for r in tables.read(folder, "tests.csv", friction_panel.REQUIRED, max_bytes)[1]:
+            if r["unit"] in units:
+                units[r["unit"]].tests.append(r)
     n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
     ordered = sorted(units.values(), key=Unit.attention)
     return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
@@ -182,120 +234,6 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
 
 def _e(value) -> str:
     return html.escape("" if value is None else str(value), quote=True)
-
-
-def _pct(value: float) -> str:
-    return "–" if math.isnan(value) else f"{value:.3g} %"
-
-
-def _short(value: float) -> float | None:
-    """A chart's number: 4 significant digits (the page stays small), None for NaN (JSON null)."""
-    if value is None or math.isnan(value) or math.isinf(value):
-        return None
-    return float(f"{value:.4g}")
-
-
-def _rgba(colour: str, alpha: float) -> str:
-    r, g, b = (int(colour[i:i + 2], 16) for i in (1, 3, 5))
-    return f"rgba({r},{g},{b},{alpha})"
-
-
-def _spans(phases: list[str], phase: str) -> list[tuple[int, int]]:
-    """The runs (first, last index) of consecutive rows in ``phase``."""
-    spans, start = [], None
-    for i, p in enumerate([*phases, ""]):
-        if p == phase and start is None:
-            start = i
-        elif p != phase and start is not None:
-            spans.append((start, i - 1))
-            start = None
-    return spans
-
-
-def figure(unit: Unit, settings: dict) -> dict:
-    """The unit's chart as a plotly figure (a JSON-able dict, every text HTML-escaped): with the
-    twin each axis's wear estimate, its lower-bound band and the wear limit above T2 and Q over
-    their limits; the learning logs shaded, each relearning after maintenance shaded and named,
-    the open alarm and every closed one marked."""
-    rows = unit.scores
-    x = list(range(len(rows)))
-    stamps = [_e(r["stamp"]) for r in rows]
-    twin = bool(rows) and bool(rows[0].get("wear1"))
-    data, shapes, annotations = [], [], []
-    stat_axis = "y2" if twin else "y"
-    n_axes = sum(1 for k in rows[0] if k.startswith("score") and k[5:].isdigit()) if rows else 0
-    if twin:
-        for i in range(1, n_axes + 1):
-            colour = COLOURS[(i - 1) % len(COLOURS)]
-            lower = [_short(_number(r.get(f"wear{i}_lower"))) for r in rows]
-            wear = [_short(_number(r.get(f"wear{i}"))) for r in rows]
-            data.append({"type": "scatter", "mode": "lines", "x": x, "y": lower, "line": {"width": 0, "color": colour},
-                         "legendgroup": f"axis{i}", "showlegend": False, "name": f"axis {i} lower bound",
-                         "customdata": stamps, "hovertemplate": "%{customdata}: lower bound %{y:.3g} %<extra></extra>"})
-            data.append({"type": "scatter", "mode": "lines", "x": x, "y": wear, "line": {"width": 1.5, "color": colour},
-                         "fill": "tonexty", "fillcolor": _rgba(colour, 0.15), "legendgroup": f"axis{i}",
-                         "name": f"axis {i} wear", "customdata": stamps,
-                         "hovertemplate": "%{customdata}: axis " + str(i) + " wear %{y:.3g} %<extra></extra>"})
-        limit = _number(settings.get("wear_limit"))
-        if not math.isnan(limit):
-            data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [limit, limit],
-                         "line": {"color": "black", "dash": "dash", "width": 1}, "name": f"wear limit {limit:g} %",
-                         "hoverinfo": "skip"})
-    for name, dash, colour in (("Q", "solid", "#1f3a93"), ("T2", "dot", "#9467bd")):
-        ratio = [_short(_number(r[name]) / _number(r[f"{name}_limit"])) if _number(r[f"{name}_limit"]) else None
-                 for r in rows]
-        data.append({"type": "scatter", "mode": "lines", "x": x, "y": ratio, "yaxis": stat_axis,
-                     "line": {"width": 1.2, "dash": dash, "color": colour}, "name": f"{name} / its limit", "customdata": stamps,
-                     "hovertemplate": "%{customdata}: " + name + " / limit %{y:.3g}<extra></extra>"})
-    if rows:
-        alpha = settings.get("alpha")
-        data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [1, 1], "yaxis": stat_axis,
-                     "line": {"color": "black", "width": 1}, "hoverinfo": "skip",
-                     "name": "limit" + (f" (alpha {alpha:g})" if isinstance(alpha, (int, float)) else "")})
-    phases = [r["phase"] for r in rows]
-
-    def band(first: int, last: int, colour: str, text: str) -> None:
-        shapes.append({"type": "rect", "xref": "x", "yref": "paper", "x0": first - 0.5, "x1": last + 0.5, "y0": 0,
-                       "y1": 1, "fillcolor": colour, "opacity": 0.35, "line": {"width": 0}, "layer": "below"})
-        annotations.append({"x": first - 0.5, "xref": "x", "xanchor": "left", "y": 1, "yref": "paper",
-                            "yanchor": "bottom", "text": text, "showarrow": False, "font": {"size": 10}})
-
-    def line(at: int, colour: str, dash: str, text: str, y: float) -> None:
-        shapes.append({"type": "line", "xref": "x", "yref": "paper", "x0": at, "x1": at, "y0": 0, "y1": 1,
-                       "line": {"color": colour, "width": 1.5, "dash": dash}})
-        annotations.append({"x": at, "xref": "x", "xanchor": "left", "y": y, "yref": "paper", "text": text,
-                            "showarrow": False, "font": {"size": 10, "color": colour}, "bgcolor": "rgba(255,255,255,0.7)"})
-
-    for first, last in _spans(phases, "training"):
-        band(first, last, "#bbbbbb", "learning")
-    for first, last in _spans(phases, "relearning"):
-        band(first, last, "#f5c27a", "maintenance: offset learned again")
-    raw: dict[str, int] = {}  # a stamp's first row: one look-up per alarm (a list's index was rows x alarms)
-    for k, r in enumerate(rows):
-        raw.setdefault(r["stamp"], k)
-    for k, alarm in enumerate(unit.closed):
-        if alarm["first_alarm"] in raw:
-            line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
-                 _e(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
-                 0.9 - 0.08 * (k % 3))
-    if unit.open_alarm and unit.current["first_alarm"] in raw:
-        line(raw[unit.current["first_alarm"]], "#d62728", "solid",
-             _e(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
-    step = max(1, len(rows) // 8)
-    layout = {
-        "height": 560 if twin else 340, "margin": {"l": 60, "r": 20, "t": 30, "b": 90},
-        "hovermode": "closest", "showlegend": True,
-        "legend": {"orientation": "h", "y": -0.2 if twin else -0.35, "font": {"size": 10}},
-        "xaxis": {"tickvals": x[::step], "ticktext": stamps[::step], "tickangle": -30,
-                  "range": [-0.5, max(len(rows), 1) - 0.5], "anchor": stat_axis, "zeroline": False},
-        "shapes": shapes, "annotations": annotations,
-    }
-    if twin:
-        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": "wear estimate, % of own dry friction"}}
-        layout["yaxis2"] = {"domain": [0.0, 0.38], "type": "log", "title": {"text": "statistic / its limit"}}
-    else:
-        layout["yaxis"] = {"type": "log", "title": {"text": "statistic / its limit"}}
-    return {"data": data, "layout": layout}
 
 
 def _script_json(value) -> str:
@@ -309,10 +247,7 @@ body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:1.2
 h1{font-size:1.5em;margin-bottom:.2em} h2{font-size:1.2em;margin-top:1.6em}
 table{border-collapse:collapse;margin:.5em 0} th,td{border-bottom:1px solid #ddd;padding:.3em .6em;text-align:left;
 vertical-align:top} th{background:#f3f3f3}
-#fleet tbody tr:hover{background:#f8f8ff} td[data-column="since"],td[data-column="last log"]{white-space:nowrap}
-.status{padding:.1em .4em;border-radius:.3em;font-size:.9em;white-space:nowrap}
-.s-alarm{background:#d62728;color:#fff} .s-degraded{background:#ff9f40} .s-not-monitored{background:#bbb}
-.s-learning{background:#cfe3ff} .s-monitored{background:#d9f2d9}
+#fleet tbody tr:hover{background:#f8f8ff} td[data-column="last log"]{white-space:nowrap}
 .muted{color:#777} .evidence{background:#fff4f4;border-left:3px solid #d62728;padding:.4em .7em}
 details.unit{border:1px solid #ddd;border-radius:.3em;margin:.4em 0;padding:.3em .7em}
 details.unit summary{cursor:pointer;font-weight:600} .chart{width:100%;min-height:300px}
@@ -324,11 +259,12 @@ SCRIPT = """
   var config={responsive:true,displaylogo:false,typesetMath:false};
   function render(d){
     if(!d.open)return;
-    var div=d.querySelector('.chart');
-    if(!div||div.getAttribute('data-drawn'))return;
-    var fig=JSON.parse(document.getElementById('figure-'+d.getAttribute('data-index')).textContent);
-    Plotly.newPlot(div,fig.data,fig.layout,config);
-    div.setAttribute('data-drawn','1');
+    d.querySelectorAll('.chart').forEach(function(div){
+      if(div.getAttribute('data-drawn'))return;
+      var fig=JSON.parse(document.getElementById(div.getAttribute('data-figure')).textContent);
+      Plotly.newPlot(div,fig.data,fig.layout,config);
+      div.setAttribute('data-drawn','1');
+    });
   }
   function show(id){
     var d=document.getElementById(id);
@@ -351,9 +287,19 @@ SCRIPT = """
 })();
 """
 
-#: The fleet table's columns.
-COLUMNS = ("unit", "status", "open alarm", "axis", "since", "wear of the axis, last log (lower bound)",
-           "remaining life (5-95 %)", "life consumed by load", "service by", "last log", "logs", "closed alarms")
+#: The fleet table's columns (:mod:`faultgen.monitor.lights`).
+COLUMNS = lights.COLUMNS
+#: The page's reading guide above the table (the rules of :mod:`faultgen.monitor.lights`).
+LEGEND = (f"Each line: the state (service due: service by within {lights.DUE_DAYS:g} days of the fleet's latest log, "
+          "or an open alarm past the failure wear; watch: an open alarm, or service by within "
+          f"{lights.WATCH_DAYS:g} days; stale: no log for {lights.STALE_DAYS:g} days or more before the fleet's "
+          "latest; unknown: learning, not monitored or no wear estimate; ok: none; hover for the rules met), the "
+          "service-by date, the earlier of the condition-based remaining life (rul.csv) and the load-based life "
+          "(life.csv), with its 5-95 % interval, the axis (the open alarm's, else the one setting service by, else the "
+          "largest lower wear bound), its wear at the last log, % increase of its dry friction, with its 90 % "
+          "interval, the life its gearbox consumed by load, the last log. Earliest service first (an open alarm past "
+          "the failure wear: now), then units without a date by state. Click a unit for its panel: the rules met, every axis's wear, remaining life and life "
+          "verdicts, the alarm's evidence, the maintenance, its chart and its friction tests.")
 
 
 def _remaining(row: dict | None) -> str:
@@ -367,44 +313,25 @@ def _remaining(row: dict | None) -> str:
     return f"{rul:.0f} {unit} ({_number(row.get('rul_5')):.0f}-{_number(row.get('rul_95')):.0f})"
 
 
-def _status_badge(unit: Unit) -> str:
-    status = unit.row.get("status", "")
-    reason = unit.row.get("reason", "")
-    css = "s-" + "-".join(status.split()) if status in ATTENTION else ""
-    return f'<span class="status {css}" title="{_e(reason)}">{_e(status)}</span>'
-
-
 def _closed_text(alarm: dict) -> str:
     return (f"alarm from {alarm['first_alarm']}, axis {alarm['source_axis']}, closed {alarm['closed']} by "
             f"{alarm['closed_by']}")
 
 
-def _table_row(index: int, unit: Unit) -> str:
-    wear = unit.axis_wear()
-    alarm = unit.current if unit.open_alarm else None
-    if wear is None:
-        wear_cell = '<span class="muted">–</span>'
-    else:
-        axis, estimate, lower = wear
-        text = f"{_pct(estimate)} (≥ {_pct(lower)})"
-        wear_cell = text if alarm else f'<span class="muted">axis {axis}: {text}</span>'
-    opened = (f'<span class="status s-alarm">{_e(alarm["statistic"])} alarm</span>' if alarm else "")
-    closed = "<br>".join(_e(_closed_text(a)) for a in unit.closed)
-    remaining = _e(_remaining(unit.remaining.get(wear[0]))) if wear is not None else ""
-    cells_ = [f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>', _status_badge(unit), opened,
-              _e(alarm["source_axis"]) if alarm else "", _e(alarm["first_alarm"]) if alarm else "", wear_cell,
-              remaining, _e(life.table_cell(unit.life)), unit.service_by(), _e(unit.row.get("last_log", "")),
-              _e(unit.row.get("logs_scored", "")), closed]
-    return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells_)) + "</tr>"
+def _chart(name: str, fig: dict) -> str:
+    """A chart drawn when its panel opens: its div and its figure as JSON (``name`` no data text)."""
+    return (f'<div class="chart" id="chart-{name}" data-figure="figure-{name}"></div>\n'
+            f'<script type="application/json" id="figure-{name}">{_script_json(fig)}</script>')
 
 
-def _panel(index: int, unit: Unit, settings: dict) -> str:
+def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
     row = unit.row
     model = f", {row['model']} model" if row.get("model") else ""
-    head = (f"{_e(unit.name)} — {_e(row.get('status', ''))}"
+    head = (f"{_e(unit.name)} — {_e(lit.state)} — {_e(row.get('status', ''))}"
             + (f" — alarm from {_e(unit.current['first_alarm'])}, axis {_e(unit.current['source_axis'])}"
                if unit.open_alarm else ""))
     parts = [f'<details class="unit" id="unit-{index}" data-index="{index}"><summary>{head}</summary>',
+             lights.panel_html(unit, lit),
              f"<p>{_e(row.get('status', ''))} ({_e(row.get('protocol', ''))}{_e(model)}); "
              f"{_e(row.get('logs_scored', ''))} logs scored, the last {_e(row.get('last_log', '') or '–')}."
              + (f" {_e(row['reason'])}." if row.get("reason") else "") + "</p>"]
@@ -414,36 +341,50 @@ def _panel(index: int, unit: Unit, settings: dict) -> str:
                      f'{_e(unit.current["evidence"])}</p>')
     elif unit.current is not None:
         parts.append(f"<p>No open alarm: {_e(unit.current['evidence'])}.</p>")
+    if lit.service is not None:
+        parts.append(f"<p>Service by {lights.service_cell(unit, lit)} ({_e(lit.service.why)}).</p>")
     if unit.remaining:
         items = "".join(f"<li>axis {axis}: {_e(_remaining(r))}"
                         + (f" ({_e(r['model'])} trend of {_e(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
+                        + (f"; {_e(r['verdict'])}" if r.get("verdict") and _remaining(r) != r["verdict"] else "")
                         + "</li>" for axis, r in sorted(unit.remaining.items()))
-        parts.append(f"<p>Remaining life until the wear estimate reaches the failure wear (rul.csv):</p><ul>{items}</ul>")
+        parts.append("<p>Remaining life (5-95 %) until the wear estimate reaches the failure wear (rul.csv):</p>"
+                     f"<ul>{items}</ul>")
     if unit.life:
         parts.append(life.panel_html(unit.life, unit.service_by()))
     if unit.closed:
         items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
     if unit.scores:
-        parts.append(f'<div class="chart" id="chart-{index}"></div>')
-        parts.append(f'<script type="application/json" id="figure-{index}">'
-                     f"{_script_json(figure(unit, settings))}</script>")
+        parts.append(_chart(str(index), figure(unit, settings)))
     else:
         parts.append('<p class="muted">No log scored: no chart.</p>')
+    tests = friction_panel.by_axis(unit.tests)
+    if tests:
+        limit = settings.get("wear_limit")
+        drawn = [(a, f) for a in friction_panel.alarming_axes(unit, float(limit) if isinstance(limit, (int, float))
+                                                              else math.nan)
+                 if (f := friction_panel.curve_figure(tests.get(a, []), a)) is not None]
+        parts.append(friction_panel.panel_text(tests, [a for a, _ in drawn]))
+        parts += [_chart(f"{index}-axis{a}", f) for a, f in drawn]
     parts.append("</details>")
     return "\n".join(parts)
 
 
 def build(fleet: Fleet, settings: dict) -> str:
-    """The page's HTML (module docstring)."""
+    """The page's HTML (module docstring): the units in the order of :meth:`faultgen.monitor.lights.Light.order`."""
     from plotly.offline import get_plotlyjs
 
-    units = fleet.units
-    counts = {s: sum(u.row.get("status") == s for u in units) for s in ATTENTION}
+    now = lights.latest(fleet.units)
+    protocol = str(settings.get("protocol", "") or "")
+    lit = [(u, lights.light(u, now, protocol)) for u in fleet.units]
+    lit.sort(key=lambda ul: ul[1].order(ul[0].attention()))
+    units = [u for u, _ in lit]
+    counts = {s: sum(l_.state == s for _, l_ in lit) for s in lights.STATES}
     alarmed = sum(u.open_alarm for u in units)
     monitors = [u for u in units if u.current is not None]
-    summary = (f"{len(units)} units: {alarmed} with an open alarm, "
-               + ", ".join(f"{n} {s}" for s, n in counts.items() if n) + ".")
+    summary = (f"{len(units)} units: " + ", ".join(f"{n} {s}" for s, n in counts.items() if n)
+               + f"; {alarmed} with an open alarm.")
     statement = ""
     if all(isinstance(settings.get(k), (int, float)) for k in ("alpha", "persistence", "train")):
         logs_scored = max((sum(r["phase"] == "monitoring" for r in u.scores) for u in monitors), default=0)
@@ -457,40 +398,37 @@ def build(fleet: Fleet, settings: dict) -> str:
     run = (f'<p class="statement" id="statement">{_e(statement)}</p>' if statement else
            '<p class="muted">The run&#x27;s settings were not found (no settings.json): the false-alarm statement '
            'is left out.</p>')
-    table = "\n".join(_table_row(i, u) for i, u in enumerate(units))
-    panels = "\n".join(_panel(i, u, settings) for i, u in enumerate(units))
+    table = "\n".join(lights.row(i, u, l_) for i, (u, l_) in enumerate(lit))
+    panels = "\n".join(_panel(i, u, settings, l_) for i, (u, l_) in enumerate(lit))
     header = "".join(f"<th>{_e(c)}</th>" for c in COLUMNS)
-    wear_note = (" The wear column gives the current (last log's) wear estimate of the alarm's axis, % increase of "
-                 "its dry friction in % of the unit's own (wear.csv: with its 90 % interval), and its lower bound; without an alarm, of the axis whose "
-                 "lower bound is largest (grey)." if fleet.twin else "")
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
 <title>faultgen fleet report</title>
-<style>{STYLE}</style>
+<style>{STYLE}{lights.CSS}</style>
 <script type="text/javascript">{get_plotlyjs()}</script>
 </head>
 <body>
 <h1>Fleet report</h1>
-<p>{_e(summary)} Units that need attention come first: an open alarm (the surest wear first), then degraded, not
-monitored, learning and quiet units. Click a unit for its panel: the alarm's evidence, the maintenance that closed
-earlier alarms, and its chart.{_e(wear_note)}</p>
+<p>{_e(summary)} Service due and the earliest service first; click a unit for its panel.</p>
 <table id="fleet">
 <thead><tr>{header}</tr></thead>
 <tbody>
 {table}
 </tbody>
 </table>
+<p class="muted" id="legend">{_e(LEGEND)}</p>
 <h2>Units</h2>
 <p><button id="open-all" type="button">open all</button> <button id="close-all" type="button">close all</button></p>
 {panels}
 <h2>The run</h2>
 {run}
 <table id="settings">{setting_rows}</table>
-<p class="muted">Written by faultgen from units.csv, alarms.csv and scores.csv of this folder; <code>faultgen report
-FOLDER</code> writes it again. Each unit's control chart is also FOLDER/&lt;unit&gt;.png.</p>
+<p class="muted">Written by faultgen from units.csv, alarms.csv and scores.csv of this folder (and wear.csv, rul.csv,
+life.csv, tests.csv where present); <code>faultgen report FOLDER</code> writes it again. Each unit's control chart is
+also FOLDER/&lt;unit&gt;.png.</p>
 <script type="text/javascript">{SCRIPT}</script>
 </body>
 </html>

@@ -103,6 +103,18 @@ def preload() -> None:
     prognosis.import_progpy()
 
 
+def stop(pool) -> None:
+    """Stop a forked pool at once: its queued tasks cancelled and its workers (this process's
+    ``multiprocessing`` children) killed, not waited for: a unit being scored would otherwise hold a
+    Ctrl-C for as long as its scoring takes. Nothing they made is kept (the monitor writes its
+    outputs only once every unit is scored)."""
+    import multiprocessing
+
+    pool.shutdown(wait=False, cancel_futures=True)
+    for child in multiprocessing.active_children():
+        child.kill()  # reaped by the pool's own thread
+
+
 def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
                robot: str | Path | None = None, idle: list | tuple = (), source: fleet_logs.Source | None = None):
     """Each group scored (:func:`score_group`), then each ``idle`` monitor's (a unit with no new log)
@@ -140,15 +152,23 @@ def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | N
 
         preload()
         _SHARED.update(context=context, groups=groups, idle=idle, source=source)
+        # each worker ends within a second of this process, whatever ended it (SIGKILL, SIGTERM), as the
+        # sweep's do (forked workers waiting on the task queue would otherwise run on for good), and
+        # leaves a Ctrl-C or SIGTERM of the process group to this process (faultgen.runs.worker.start_worker)
+        pool = ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=worker.start_worker, initargs=(os.getpid(),))
+        stopped = False
         try:
-            # each worker ends within a second of this process, whatever ended it (SIGKILL, SIGTERM),
-            # as the sweep's do: forked workers waiting on the task queue would otherwise run on for good
-            with ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork"),
-                                     initializer=worker.watch_parent, initargs=(os.getpid(),)) as pool:
-                if groups:
-                    prepare_twins(context, groups, pool, source)
-                yield from pool.map(_score_shared, range(len(groups) + len(idle)))
+            if groups:
+                prepare_twins(context, groups, pool, source)
+            yield from pool.map(_score_shared, range(len(groups) + len(idle)))
+        except BaseException:  # Ctrl-C, SIGTERM, a failure, or the caller closing this generator
+            stopped = True
+            stop(pool)
+            raise
         finally:
+            if not stopped:
+                pool.shutdown()
             _SHARED.clear()
         return
     if groups:

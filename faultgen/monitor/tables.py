@@ -1,5 +1,5 @@
-"""The monitor's tables read back (``units.csv``, ``alarms.csv``, ``scores.csv``, ``rul.csv`` of a
-monitor output folder, :mod:`faultgen.monitor.report` writes them): by one bounded, checked reader
+"""The monitor's tables read back (``units.csv``, ``alarms.csv``, ``scores.csv``, ``rul.csv``,
+``life.csv``, ``wear.csv``, ``tests.csv`` of a monitor output folder): by one bounded, checked reader
 (:func:`read`), for the fleet report (:mod:`faultgen.monitor.page`). A table is a stranger's file
 when ``faultgen report`` is given a folder: its size is checked before it is read, every cell's
 length and the number of axes as it is parsed; each refusal names the file and the row or column."""
@@ -15,9 +15,10 @@ from faultgen.axes import MAX_AXES
 from faultgen.data import cells
 from faultgen.monitor import report
 
-#: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv),
-#: bytes, checked before it is read: scores.csv has a row of about 0.4 kB per scored log (six axes,
-#: the twin's wear columns), so 80 000 logs; the page of so many is already too large for a browser.
+#: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv,
+#: life.csv, wear.csv, tests.csv), bytes, checked before it is read: scores.csv has a row of about
+#: 0.4 kB per scored log (six axes, the twin's wear columns), so 80 000 logs, wear.csv six rows of
+#: about 80 B, so 70 000; the page of so many is already too large for a browser.
 CSV_MAX_BYTES = 32 * 2**20
 #: Longest text cell read, characters: what the monitor writes (:data:`faultgen.monitor.report.CELL_MAX_CHARS`)
 #: and the ``'`` of a formula escape.

@@ -21,6 +21,16 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   duty (average speed and load torque, from which ``analysis.features.duty_indicators`` makes the
   speed and torque indicators); no 250 Hz signals are kept.
 
+- with ``friction_test_every`` ``= D`` (issue 75; 0, none, by default) each robot also runs the
+  friction test of its model (:func:`faultgen.operation.friction_test.program`, as ``faultgen tasks
+  friction-test`` writes it) on days 1, 1 + D, 1 + 2 D, ...: one more run per robot,
+  ``<run id>-friction-test``, whose recorded cycles are the first cycle of each test day (its wear,
+  fault, hall climate, warm-up and unit spread those of the robot's records at that cycle; no part
+  carried), with its 250 Hz signals, labelled a test (run attribute ``record = "friction_test"``,
+  :data:`faultgen.data.schema.RECORD_ATTRIBUTE`); the typed reader keeps a fleet's tests beside its
+  runs (``Dataset.friction_tests``), not among them. The program is written once per model and
+  content into :func:`friction_test_program`'s folder.
+
 Labels: a run's ``worn_axes`` (empty: healthy), its wear schedule (``last_cycle`` /
 ``cycles_per_day`` is the failure day) and the true wear per day (``friction_multiplier``); the
 draws of every robot are in the dataset's grid JSON (:meth:`Fleet.to_json`).
@@ -28,8 +38,11 @@ draws of every robot are in the dataset's grid JSON (:meth:`Fleet.to_json`).
 
 from __future__ import annotations
 
+import hashlib
 import json
+import os
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -104,6 +117,34 @@ def sized_parts(robot) -> tuple:
 #: The conditions a fleet's robot has, as :class:`faultgen.operation.conditions.Conditions` names
 #: them: hall climate and warm-up, parts, unit spread (``Fleet.without`` leaves some out).
 CONDITIONS = ("thermal", "payloads", "spread")
+#: A robot's friction tests are the run of this id suffix (``<run id>-friction-test``).
+TEST_SUFFIX = "-friction-test"
+
+
+def friction_test_program(robot) -> Path:
+    """The friction test of ``robot`` (a :class:`~faultgen.model.robot.Robot`) as a program file, written
+    once (atomically) and named by the robot and its text's SHA-256: ``<folder>/<robot>-<sha 12>.toml``,
+    the folder ``$FAULTGEN_CACHE/friction-tests`` (default ``$XDG_CACHE_HOME/faultgen`` or
+    ``~/.cache/faultgen``). The same robot gives the same file, so a resumed fleet finds its runs
+    finished; the dataset keeps the program's text. A cluster's workers must see the folder.
+
+    Raises
+    ------
+    ValueError
+        As :func:`faultgen.operation.friction_test.program` (an axis whose stroke leaves no speed).
+    OSError
+        When the folder cannot be written.
+    """
+    from faultgen.data import atomic
+    from faultgen.operation import friction_test
+
+    text = friction_test.text(robot)
+    root = os.environ.get("FAULTGEN_CACHE") or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "faultgen"
+    path = Path(root) / "friction-tests" / f"{robot.name}-{hashlib.sha256(text.encode()).hexdigest()[:12]}.toml"
+    if not path.is_file() or path.read_text() != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic.write_text(path, text)
+    return path
 
 
 @dataclass(frozen=True)
@@ -165,6 +206,10 @@ class Fleet:
         default :data:`faultgen.effects.temperature.DRY_SHARE`, chosen, not measured); needs the
         conditions. At the default the fleet's draws, records and stored settings are those of the
         fleets measured before it could be set.
+    friction_test_every : int
+        Days between a robot's friction tests (module docstring), the first on day 1; 0 (default):
+        none, and the fleet's runs, records and stored settings are those of the fleets made
+        before tests existed.
 
     Raises
     ------
@@ -194,6 +239,7 @@ class Fleet:
     dry_share: float = temperature_law.DRY_SHARE
     without: tuple[str, ...] = ()
     tasks: tuple[str, ...] = tasks.TASKS
+    friction_test_every: int = 0
 
     def __post_init__(self) -> None:
         check_number("fleet size", self.size, 2, 10000, whole=True)
@@ -205,6 +251,8 @@ class Fleet:
         check_number("fleet cycles_per_day (--cycles-per-day)", self.cycles_per_day, 1, 24, whole=True)
         check_number("fleet failure_wear (--failure-wear)", self.failure_wear, 0, 100 * wear.MAX_INCREASE)
         check_number("fleet seed", self.seed, 0, 2**31, whole=True)
+        check_number("fleet friction_test_every (--friction-test-every)", self.friction_test_every, 0, self.days,
+                     whole=True)
         friction_models.check_model(self.friction)
         check_number("fleet gear_loss", self.gear_loss, 0, 0.5)
         if self.gear_loss and (self.friction != "stribeck" or not self.conditions):
@@ -325,7 +373,8 @@ class Fleet:
         return [start + step * (k + 0.5) for k in range(self.cycles_per_day)]
 
     def runs(self) -> list[tuple[str, sim.RunConfig]]:
-        """``(run id, RunConfig)`` of every robot (:meth:`robots`), daily records without signals."""
+        """``(run id, RunConfig)`` of every robot (:meth:`robots`), daily records without signals; with
+        :attr:`friction_test_every`, each robot's friction-test run right after it (:meth:`_tests`)."""
         cycles = self.days * self.cycles_per_day
         out = []
         resolved = self._resolved()
@@ -343,7 +392,26 @@ class Fleet:
                                    conditions=conditions.Conditions.from_dict(robot["conditions"]),
                                    signals=False, daily=True, fault=fault, resolved=resolved[robot["model"]])
             out.append((robot["run"], config))
+            if self.friction_test_every:
+                out.append(self._tests(robot, config))
         return out
+
+    def test_days(self) -> list[int]:
+        """The days (1-based) of each robot's friction tests: 1, 1 + D, ... for D = :attr:`friction_test_every`."""
+        return list(range(1, self.days + 1, self.friction_test_every)) if self.friction_test_every else []
+
+    def _tests(self, robot: dict, daily: sim.RunConfig) -> tuple[str, sim.RunConfig]:
+        """The friction-test run of ``robot`` (:meth:`robots`' entry) beside its ``daily`` run: the
+        model's test program, the same cycles, wear, fault, seed and conditions (its climate and unit
+        spread, no part, no task mix), the first cycle of each test day recorded with its signals."""
+        table = {k: v for k, v in robot["conditions"].items() if k not in ("payloads", "task_mix")}
+        test = friction_test_program(daily.model)
+        record = tuple((day - 1) * self.cycles_per_day + 1 for day in self.test_days())
+        config = sim.RunConfig(robot=daily.robot, task=str(test), friction=self.friction, wear=daily.wear,
+                               cycles=daily.cycles, record=record, seed=daily.seed, noise=daily.noise, nthread=1,
+                               conditions=conditions.Conditions.from_dict(table), signals=True, fault=daily.fault,
+                               resolved=daily.model)
+        return robot["run"] + TEST_SUFFIX, config
 
     def _fault(self, axis: int, onset_day: int) -> faults.Fault:
         """The fault of a robot failing on ``axis`` from ``onset_day``."""
@@ -357,7 +425,7 @@ class Fleet:
         """The settings and every robot's draws, stored with the dataset."""
         settings = {**asdict(self), "fault": None if self.fault is None else str(self.fault)}
         later = {"gear_loss": 0.0, "fault": None, "dry_share": temperature_law.DRY_SHARE, "without": (),
-                 "tasks": tasks.TASKS}
+                 "tasks": tasks.TASKS, "friction_test_every": 0}
         for name, default in later.items():  # at their defaults, the settings of fleets made before they existed
             if settings[name] == default:
                 del settings[name]

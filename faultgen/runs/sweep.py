@@ -54,7 +54,7 @@ __all__ = ["PRESETS", "Grid", "RunStats", "SweepError", "SweepInterrupted", "Swe
 log = logging.getLogger(__name__)
 
 
-class _Terminated(KeyboardInterrupt):
+class Terminated(KeyboardInterrupt):
     """SIGTERM, raised where a Ctrl-C would be, so that a sweep stops the same way (:class:`CtrlC`)."""
 
 
@@ -164,7 +164,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                     except KeyboardInterrupt as interrupt:
                         ctrl_c.stopping = True
                         kept = len(finished_runs(grid, out))
-                        what, code = (("terminated (SIGTERM)", 143) if isinstance(interrupt, _Terminated)
+                        what, code = (("terminated (SIGTERM)", 143) if isinstance(interrupt, Terminated)
                                       else ("interrupted", 130))
                         if not kept:  # the part folder goes too: nothing to point at
                             raise SweepInterrupted(f"{what}: none of the {len(plan)} runs had finished; run the "
@@ -313,7 +313,7 @@ class CtrlC:
     If that is a weakref callback or a ``__del__`` (joblib and loky free locks and queues through
     such callbacks while the workers' results are collected), the exception cannot propagate:
     Python prints "Exception ignored in ... KeyboardInterrupt" and goes on as if no key had been
-    pressed. A SIGTERM is raised as :class:`_Terminated`, a KeyboardInterrupt, and stops the sweep
+    pressed. A SIGTERM is raised as :class:`Terminated`, a KeyboardInterrupt, and stops the sweep
     the same way. Within this block such an interrupt is not printed but sent again as SIGINT 0.1 s
     later, once the callback is over, so it reaches the sweep. And once the sweep stops (a
     KeyboardInterrupt is being handled, or :attr:`stopping` is set), a further SIGINT (a second
@@ -358,13 +358,13 @@ class CtrlC:
     def _on_sigterm(self, signum, frame) -> None:
         if self.stopping or isinstance(sys.exc_info()[1], KeyboardInterrupt):
             return
-        raise _Terminated
+        raise Terminated
 
     def _unraisable(self, unraisable) -> None:
         if not isinstance(unraisable.exc_value, KeyboardInterrupt):
             self._previous_hook(unraisable)
         elif not self.stopping:
-            again = signal.SIGTERM if isinstance(unraisable.exc_value, _Terminated) else signal.SIGINT
+            again = signal.SIGTERM if isinstance(unraisable.exc_value, Terminated) else signal.SIGINT
             resend = threading.Timer(self.RESEND_AFTER, os.kill, (os.getpid(), again))
             resend.daemon = True
             resend.start()
