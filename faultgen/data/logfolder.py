@@ -240,7 +240,8 @@ def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, ba
     return logs
 
 
-def scan_tests(folder: Path, units, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFile]], list[tuple[str, str]]]:
+def scan_tests(folder: Path, units,
+               suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFile]], list[tuple[str, str]]]:
     """Each unit's friction tests, ``LOGS/<unit>/friction-test/<stamp><suffix>`` (:data:`TESTS`), in
     stamp order (units without the folder left out), and the files there that are not tests, as
     :func:`scan` lists a unit's logs: the same suffixes, stamps, names and links (a test folder whose

@@ -45,14 +45,17 @@ priors of mixed estimation (Theil & Goldberger 1961: one pseudo-observation each
 :data:`SCALE_PRIOR` ``^2)`` and ``b ~ N(0,`` :data:`OFFSET_PRIOR` ``^2)`` (``b``: the reference test's
 own error, which every test's wear shares, and the monitor's learned offset's; the tests before the
 wear fix it), each test weighed by its own error (the reference's apart) and by :data:`FORGET`
-per later test (the twin's scale may change with the wear); its covariance scaled by the reduced chi-square of the tests when above one.
+per later test (the twin's scale may change with the wear); its covariance scaled by the reduced
+chi-square of the tests when above one.
 A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
 ``s_f`` in place of the twin's :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`, and the filter's
 error in place of the log's own (which the twin's scale keeps for the errors that stay for weeks:
 the tests' scale takes them, the slow ones, as the factor's; with the log's own the interval
-covered 99.7 % of the first independent fleet's logs, with the filter's 97.7 %). The remaining life
+covered 99.7 % of the first independent fleet's logs, with the filter's 97.7 %, at a prior of
+0.15). The tests' wear (and so each factor) uses the temperature law as all of the unit's tests
+read so far give it: a later test may move an earlier log's wear a little. The remaining life
 (:func:`remaining_life`) gets each axis's series rescaled by its latest ``f`` and ``s_f / f`` as
 the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
 in the twin's scale (``wear_scale`` ``twin``).
@@ -125,7 +128,8 @@ class FrictionTest:
 
 def find(logs_dir: Path, units: dict[str, list], suffixes: tuple[str, ...]) -> dict[str, list]:
     """Each unit's tests (:func:`faultgen.data.logfolder.scan_tests`), units without a test folder
-    or with an empty one left out (a fleet without tests is monitored as before them). ValueError, before any work, for a file there that is not a test (named, as a unit's
+    or with an empty one left out (a fleet without tests is monitored as before them). ValueError,
+    before any work, for a file there that is not a test (named, as a unit's
     logs are: :func:`faultgen.monitor.logs.fleet`) or stamps of another kind than the unit's logs."""
     found, bad = logfolder.scan_tests(Path(logs_dir), list(units), suffixes)
     if bad:
@@ -320,8 +324,9 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
                            + (f", corrected from {fit['temperature_degC']:.1f} to {f0['temperature_degC']:.1f} degC"
                               if corrected else ", no temperature logged: not corrected"))
             sd = sd if np.isfinite(sd) else math.nan
-            rows.append(AxisWear(test.stamp, test.key, k, fit, 100 * (math.exp(d) - 1), 100 * (math.exp(d - z * sd) - 1),
-                                 100 * (math.exp(d + z * sd) - 1), sd, error0, verdict, test is t0, own))
+            rows.append(AxisWear(test.stamp, test.key, k, fit, 100 * (math.exp(d) - 1),
+                                 100 * (math.exp(d - z * sd) - 1), 100 * (math.exp(d + z * sd) - 1), sd, error0,
+                                 verdict, test is t0, own))
     rows.sort(key=lambda r: (r.key, r.axis))
     return rows, law
 

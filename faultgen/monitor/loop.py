@@ -201,7 +201,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
     tests = friction_tests.read_tests(found, nominal, out, log_format)  # each test read once, cached
-    wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ())) for name, read in tests.items()}
+    wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ()))
+             for name, read in tests.items()}
 
     def scale_of(name: str):
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
