@@ -393,12 +393,12 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             out.append(base)
             continue
         weights = akaike_weights(fits)
+        named = named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
-        slopes = np.array(drawn.key("slope"), dtype=float)
-        base.model, base.wear = named_model(fits).model, float(np.median(drawn.key("wear")))
+        base.model, base.wear = named.model, float(np.median(drawn.key("wear")))
         base.models = ", ".join(f"{f.model} {w:.2f}" for f, w in zip(fits, weights))
-        if np.quantile(slopes, alpha) <= 0:
-            slope, slope_error = float(np.median(slopes)), float(np.std(slopes))
+        slope, slope_error = float(named.params[1]), float(np.sqrt(named.cov[1, 1]))
+        if slope - z * slope_error <= 0:  # the named model's slope now, as before the model average
             base.verdict = (f"no wear trend (slope now {slope:.2g} +- {slope_error:.2g} % per {time_unit[:-1]}, not above "
                             f"0 at alpha {alpha:g}): no end of life within the horizon ({horizon:g} {time_unit})")
             out.append(base)
@@ -427,14 +427,14 @@ def unpredictable(fits, weights, labels, values: np.ndarray, low: float, mid: fl
                   logs_since_rise: int | None) -> str:
     """Why the trend cannot yet tell the remaining life (module docstring, 7), or "" when it can:
     fewer than :data:`MIN_RISE_LOGS` logs since the rise (``logs_since_rise``; None: no rise
-    fitted), a 5-95 % interval (``low``, ``high``) wider than :data:`WIDTH_LIMIT` times the median
-    ``mid`` (or ending beyond the horizon), or two models of weight >= :data:`MIN_MODEL_WEIGHT`
+    fitted), a 5-95 % interval (``low``, ``high``) ending beyond the horizon or, its 5 % end above 0,
+    wider than :data:`WIDTH_LIMIT` times the median ``mid``, or two models of weight >= :data:`MIN_MODEL_WEIGHT`
     whose own 5-95 % intervals (of their draws ``values[labels == i]``) do not overlap."""
     if logs_since_rise is not None and logs_since_rise < MIN_RISE_LOGS:
         return f"{logs_since_rise} logs since the rise began, {MIN_RISE_LOGS} needed"
     if not np.isfinite(high):
         return "the 95 % end of its interval beyond the horizon"
-    if high - low > WIDTH_LIMIT * max(mid, 1e-9):
+    if low > 0 and high - low > WIDTH_LIMIT * mid:  # a 5 % end at 0: the failure wear may be reached now
         return f"its 5-95 % interval ({low:.3g}-{high:.3g}) wider than {WIDTH_LIMIT:g} times its median ({mid:.3g})"
     ranges = {i: _quantiles(values[labels == i]) for i, w in enumerate(weights)
               if w >= MIN_MODEL_WEIGHT and np.sum(labels == i) >= 20}
