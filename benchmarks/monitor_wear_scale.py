@@ -87,10 +87,12 @@ def main() -> None:
     parser.add_argument("--robot", type=Path, default=None, help="The KR210 folder (made in WORK/kr210 if not given).")
     parser.add_argument("--out", default="monitor", help="The monitor's OUT, inside WORK.")
     parser.add_argument("--no-calibrate", action="store_true")
+    parser.add_argument("--wear-growth", type=float, default=1.0,
+                        help="The wear's exponent from its onset (faultgen.bench.independent.wear_percent; 1 linear).")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="wear-scale-"))
     robot = args.robot or pinocchio_log.add_kr210(work / "kr210")
-    spec = independent_fleet.FleetSpec(units=12, worn=8, days=120, seed=args.seed)
+    spec = independent_fleet.FleetSpec(units=12, worn=8, days=120, seed=args.seed, wear_growth=args.wear_growth)
     if args.law == "first":
         _, logs, truth = independent_fleet.write_fleet(work, spec, robot=robot)
     elif (work / "truth.csv").is_file():

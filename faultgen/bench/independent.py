@@ -114,7 +114,8 @@ class FleetSpec:
     and reaches ``final_wear`` % on the last day, on one of the axes ``wearable`` (1-based); parts
     up to ``max_part`` kg (``rated_part``: the fleet's heaviest part drawn is made ``max_part``
     itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
-    ``program_changes`` healthy units an unlogged program change (module docstring). Every draw comes
+    ``program_changes`` healthy units an unlogged program change (module docstring); ``wear_growth``
+    the exponent of the wear's rise (:func:`wear_percent`; 1, linear, by default). Every draw comes
     from ``seed``; the defaults draw what the fleet drew before these options existed."""
 
     units: int = 12
@@ -130,8 +131,12 @@ class FleetSpec:
     rated_part: bool = False
     gearbox_changes: int = 0
     program_changes: int = 0
+    wear_growth: float = 1.0
 
     def __post_init__(self) -> None:
+        if isinstance(self.wear_growth, bool) or not 1.0 <= float(self.wear_growth) <= 4.0:
+            raise ValueError(f"fleet wear_growth = {self.wear_growth!r}: expected the wear's exponent in [1, 4] "
+                             "(1: linear from the onset)")
         for name, low in (("units", 1), ("worn", 0), ("days", 2), ("seed", 0), ("gearbox_changes", 0),
                           ("program_changes", 0)):
             value = getattr(self, name)
@@ -279,10 +284,14 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
 
 
 def wear_percent(spec: FleetSpec, onset: int, day: int) -> float:
-    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based)."""
+    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): from the
+    onset to ``final_wear`` on the last day, as the power ``wear_growth`` of the time since the onset
+    (1: linear; 2: its rate growing in proportion to that time)."""
     if day < onset:
         return 0.0
-    return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
+    if spec.wear_growth == 1.0:
+        return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
+    return spec.final_wear * ((day - onset) / max(spec.days - onset, 1)) ** spec.wear_growth
 
 
 def _wear(spec: FleetSpec, unit: dict, day: int) -> float:

@@ -14,58 +14,56 @@ Per axis:
    ``monitoring`` after the last ``relearning`` one: a new part starts a new trend). At least
    :data:`MIN_LOGS`; time in days since the last of them (stamps that are dates or date-times,
    :func:`faultgen.data.logfolder.parse_stamp`), or in logs (sequence-number stamps).
-2. **The source axis of the unit's open alarm: a changepoint trend** over all of them, the
-   two-phase degradation model of prognostics, flat until a changepoint ``tc`` and a line after it,
-   ``w(t) = w_now + b max(t, tc)`` (:func:`faultgen.monitor.trends.fit_hinge`; ``t`` <= 0 the logs'
-   times, 0 the last log): weighted least squares of (``w_now``, ``b``) at each candidate ``tc``
-   (each log's time from the 3rd log to the 5th from the last,
-   :data:`faultgen.monitor.trends.HINGE_MARGINS`), the least chi-square's ``tc`` refined
-   between its neighbours, and the covariance of (``w_now``, ``b``) the Gauss-Newton one of all
-   three parameters there (``tc`` included), marginalised. From now on it is the line. When it
-   cannot be fitted or its slope is not positive: the two models of 3 on the logs from the first
-   alarm on (the alarm marks where the wear left the noise; the flat stretch before it would bend
-   a straight line), the rule before 2026-11-26.
-3. **Every other axis: two degradation models** (:func:`faultgen.monitor.trends.fit_trend`), each
-   fitted by weighted least squares (``scipy.optimize.curve_fit``, weights one over each estimate's
-   variance), written with their parameters as the state now:
-   linear ``w(t) = w0 + b t`` and exponential
-   ``w(t) = w0 + b (exp(k t) - 1) / k`` (``a + c exp(k t)``, the exponential degradation model of
-   Gebraeel et al. 2005 with an offset, by its wear ``w0`` and slope ``b`` now and its growth rate
-   ``k``; ``k`` -> 0 is the line). **Criterion**: the smaller AICc (Akaike's criterion with the small
-   sample correction, ``statsmodels.tools.eval_measures.aicc``; Burnham & Anderson 2002) of the
-   Gaussian likelihood with the variances' common scale fitted, so the exponential's third parameter
-   must pay for itself (with 5 logs it cannot: its AICc is infinite). A fit that does not converge or
-   whose covariance is not finite is not a candidate.
-4. **Uncertainty**: the fit's covariance, scaled by the residuals' reduced chi-square when
-   it is above one (the stated standard errors are a floor: the log-to-log scatter of a real unit
-   may exceed them, never fall below), sampled (:data:`SAMPLES` draws, multivariate normal, seeded)
-   into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the model's state now, each
-   sample with a **scale** of the wear estimate drawn from a normal of mean 1 and standard deviation
-   :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY` (0.10), the twin's model uncertainty that
-   ``wear.csv``'s 90 % interval carries: the estimate is the wear times a scale the unit's logs
-   cannot tell, so the wear reaches the failure wear when the estimate reaches the failure wear
-   times that scale. The trend's own covariance comes from the log-to-log scatter, which more logs
-   average away; the scale error does not average away.
-5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each sample of the state
-   through :class:`WearTrend` (a :class:`progpy.PrognosticsModel` whose ``next_state`` is the exact
-   solution of either model, so no step error) up to :data:`HORIZON` days (logs), its event
-   ``failure`` met at wear >= the failure wear times the sample's scale; the step ends on the
-   crossing when it falls inside it, so a sample's time of event is exact. A sample that does not
-   cross within the horizon has no time of event (ProgPy's None).
-6. **The row**: the median time of event (the estimate), its 5 and 95 % quantiles
-   (``numpy.quantile``, ``inverted_cdf``: a sample's own value, with the samples beyond the horizon
-   counted as later than it), and the probability of failure within the horizon (one minus
-   ProgPy's :func:`progpy.metrics.prob_success` at the horizon). When that probability is below
-   one half (the median lies beyond the horizon: a flat or falling trend, or one too slow), the
-   axis has **no end of life within the horizon**, said with the horizon, and no number is given.
-
-Why the changepoint and the scale (2026-11-26; docs/analysis.md, "Remaining useful life"): on the
-four independent fleets of issue 59 (32 worn units; ``benchmarks/monitor_rul.py --fleet W``), the
-fit from the alarm on, without the scale, had a prognostic horizon on 4 units and its 5-95 %
-interval covered the true remaining life at lambda on 23; the changepoint alone on 22 and 13 (sharper
-than its error, which is mostly each unit's scale); both together on 15 and 28. Alpha-lambda (0.2
-at lambda 0.5) was met on 1, 8 and 0 of 32: the estimate's own scale and offset put it out of reach
-of any trend on most units (the benchmark's "reachable" count).
+2. **The source axis of the unit's open alarm: four models over all of them** (the logs since
+   the last maintenance, flat and then rising): the line, the exponential (3), the changepoint
+   trend, flat until ``tc`` and a line after it, ``w(t) = w_now + b max(t, tc)``
+   (:func:`faultgen.monitor.trends.fit_hinge`; ``tc`` among the logs from the 3rd to the 5th from
+   the last, :data:`faultgen.monitor.trends.HINGE_MARGINS`, refined between its neighbours, its
+   uncertainty in the covariance), and the **power-law rise**, flat and then ``c (t - t0)^p``, ``p``
+   in [1, 4] (:func:`faultgen.monitor.trends.fit_power`: a rise that accelerates; ``p`` = 1 is the
+   changepoint trend). When neither the changepoint trend nor the power law rises: the line and
+   the exponential of the logs from the first alarm on (the rule before 2026-11-26).
+3. **Every other axis: the line and the exponential** (:func:`faultgen.monitor.trends.fit_models`),
+   each by weighted least squares (``scipy``, weights one over each estimate's variance), written
+   with the state now: ``w(t) = w0 + b t`` and ``w(t) = w0 + b (exp(k t) - 1) / k`` (Gebraeel et al.
+   2005 with an offset; ``k`` >= 0, an accelerating wear; ``k`` -> 0 is the line).
+   **The model average** (issue 75, 2026-11-26): each model's **Akaike weight** (AICc,
+   ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the variances' common
+   scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham & Anderson 2002, ch.
+   2.9), and each model's parameters drawn in proportion to it (:func:`sample_counts`), so that the
+   distribution carries the model uncertainty: where the logs cannot tell a line from an
+   accelerating rise, part of the draws accelerate and the interval reaches earlier. ``model``
+   in rul.csv names the simplest model within 2 of the least AICc (the rule before the average),
+   ``models`` gives every weight. An axis whose named model's slope now is not above 0 at alpha has
+   **no wear trend** (no number).
+4. **Uncertainty**: each fit's covariance, scaled by the residuals' reduced chi-square when
+   it is above one (the stated standard errors are a floor), sampled (:data:`SAMPLES` draws in all,
+   multivariate normal, seeded; the exponential's ``k`` and the power law's ``p`` and ``t0`` kept in
+   their bounds) into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the state now,
+   each draw with a **scale** of the wear estimate from a normal of mean 1 and standard deviation
+   ``scale_uncertainty`` (the monitor's :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`, 0.10,
+   without friction tests; per axis where a test gives it): the estimate is the wear times a scale
+   the unit's logs cannot tell, so the wear reaches the failure wear when the estimate reaches
+   the failure wear times that scale. More logs average the trend's scatter away, not the scale.
+5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each draw through
+   :class:`WearTrend` (a :class:`progpy.PrognosticsModel` stepped by the exact solution of its
+   model) up to :data:`HORIZON` days (logs), its event ``failure`` met at wear >= the failure wear
+   times the draw's scale, the step ending on the crossing, so a time of event is exact.
+6. **The row**: the median time of event, its 5 and 95 % quantiles (``numpy.quantile``,
+   ``inverted_cdf``; a draw beyond the horizon later than any), and the probability of failure
+   within the horizon (one minus ProgPy's :func:`progpy.metrics.prob_success`). Below one half:
+   **no end of life within the horizon**, without a number.
+7. **Not yet predictable** (issue 75; :func:`unpredictable`): the trend cannot yet tell the
+   remaining life, and rul.csv says so in ``verdict`` with its cells empty (the draws' median and
+   interval in the words), when (a) fewer than :data:`MIN_RISE_LOGS` (5) logs lie after the
+   changepoint trend's changepoint, where the models that date a rise carry at least half the
+   weight (a slope from 4 logs is the noise's: the monitor's persistence is 5 logs); (b) the 95 %
+   end lies beyond the horizon; (c) the 5 % end is above 0 and the interval is wider than
+   :data:`WIDTH_LIMIT` (3) times its median (a plan on the median could be off by a factor
+   four; with the 5 % end at 0 the failure wear may be reached now, which is said with a number);
+   or (d) two models of weight >= :data:`MIN_MODEL_WEIGHT` (0.1) have 5-95 % intervals of their
+   own that do not overlap (the models disagree by more than their intervals). Measured on the
+   independent fleets: docs/analysis.md, "A remaining life that does not run late".
 
 Why the fit is not ProgPy's own: ProgPy fits a model's parameters to run-to-failure data by
 minimising an error (``PrognosticsModel.estimate_params``), without the parameters' covariance, and
