@@ -199,3 +199,17 @@ def test_sample_counts_follow_the_weights():
     np.testing.assert_allclose(trends.akaike_weights(
         [trends.Fit("linear", np.zeros(2), np.eye(2), aicc=a) for a in (10.0, 12.0, np.inf)]),
         [1 / (1 + math.exp(-1)), math.exp(-1) / (1 + math.exp(-1)), 0.0])
+
+
+def test_the_fleets_wear_growth_is_linear_by_default_and_a_power_of_the_time_since_the_onset():
+    from faultgen.bench import independent
+
+    spec = independent.FleetSpec(units=3, worn=2, days=30, seed=4, onset=(5, 10))
+    assert independent.truth_rows(spec) == independent.truth_rows(independent.FleetSpec(
+        units=3, worn=2, days=30, seed=4, onset=(5, 10), wear_growth=1.0))
+    grown = independent.FleetSpec(units=3, worn=2, days=30, seed=4, onset=(5, 10), wear_growth=2.0)
+    for linear, square in zip(independent.truth_rows(spec), independent.truth_rows(grown)):
+        assert linear[:3] == square[:3]
+        assert math.isclose(float(square[3]), float(linear[3]) ** 2 / spec.final_wear, abs_tol=2e-4)
+    with pytest.raises(ValueError, match="wear_growth = 0.5"):
+        independent.FleetSpec(wear_growth=0.5)
