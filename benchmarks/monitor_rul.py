@@ -317,6 +317,23 @@ def summarise(results: dict[str, list[dict]]) -> None:
     """The fleet's lines: each figure of issue 75 beside its criterion and verdict (module docstring)."""
     rs = results["A"]
     n = len(rs)
+    print("\n| unit (axis) | at lambda: day, true RUL | median (5-95 %), days | covers | late > 20 % | PHM 2008 | "
+          "RA at lambda | alpha-lambda | PH, days | models (weights) |\n| --- | --- | --- | --- | --- | --- | --- | --- | "
+          "--- | --- |")
+    for r in rs:
+        a = r["at_lambda"]
+        if a.get("at") is None:
+            cells = ["-", "no prediction at lambda", "-", "-", "-"]
+        elif not a["predictable"]:
+            cells = [f"{a['at']}, {a['true']:.1f}", "not yet predictable: " + a["verdict"].split(": ", 1)[1].split(" (")[0],
+                     "no", "no", "-"]
+        else:
+            high = "beyond" if a["high"] is None else f"{a['high']:.1f}"
+            cells = [f"{a['at']}, {a['true']:.1f}", f"{a['median']:.1f} ({a['low']:.1f}-{high})",
+                     "yes" if a["covers"] else "**no**", "**LATE**" if a["late"] else "no", f"{a['phm08']:.2f}"]
+        al = {None: "n/a", True: "met", False: "not met"}[r.get("alpha_lambda")]
+        print(f"| {r['unit']} ({r['axis']}) | " + " | ".join(cells) + f" | {r.get('ra_lambda', float('nan')):.2f} | {al} | "
+              f"{'-' if r.get('ph') is None else format(r['ph'], '.0f')} | {a.get('models') or '-'} |")
     at = [r["at_lambda"] for r in rs]
     numbers = [a for a in at if a.get("predictable")]
     covered = sum(bool(a.get("covers")) for a in at)
