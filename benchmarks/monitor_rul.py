@@ -231,6 +231,32 @@ def _at_lambda(predictions: list[tuple[int, prognosis.Remaining]], eol: float, s
     return out
 
 
+def quiet_axes(truth: dict, scores: list[dict], alarms: dict, failure_wear: float, changepoint: bool,
+               scale_uncertainty) -> None:
+    """Every unit's remaining life at its last log as the monitor writes it in rul.csv: the axes that
+    do not wear with an end of life within the horizon, the healthy units' within the fleet's span."""
+    span = max(len(t["wear"]) for t in truth.values())
+    within, healthy, others = [], 0, 0
+    for unit, t in truth.items():
+        rows = [r for r in scores if r["unit"] == unit]
+        alarm = alarms[unit]
+        source = int(alarm["source_axis"]) if alarm["source_axis"] else None
+        for row in prognosis.remaining_life(unit, rows, 6, alpha=MONITOR_ALPHA, failure_wear=failure_wear,
+                                            since=alarm["first_alarm"] or None, source_axis=source,
+                                            changepoint=changepoint, scale_uncertainty=scale_uncertainty):
+            if row.axis == t["axis"]:
+                continue
+            others += 1
+            healthy += not t["axis"]
+            if row.rul is not None:
+                within.append((unit, row.axis, row.rul, bool(t["axis"])))
+    early = [w for w in within if not w[3] and w[2] <= span]
+    print(f"axes that do not wear, at the last log: {others - len(within)} of {others} with no end of life within "
+          f"the horizon ({', '.join(f'{u} axis {a} in {r:.0f} days' for u, a, r, _ in within) or 'none has one'}); "
+          f"healthy units: {len(early)} of {healthy} axes with an end of life within the fleet's {span} days "
+          f"(none: {verdict(not early)})")
+
+
 def verdict(ok: bool) -> str:
     return "met" if ok else "NOT met"
 
@@ -246,6 +272,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
     with open(out / "alarms.csv", newline="") as f:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
     F, H = failure_wear, prognosis.HORIZON
+    quiet_axes(truth, scores, alarms, F, changepoint, scale_uncertainty)
     results = {"A": [], "B": []}
     started = time.perf_counter()
     from progpy.predictors import ToEPredictionProfile
