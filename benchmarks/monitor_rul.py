@@ -42,7 +42,15 @@ lies within those bounds there and the distribution's 5-95 % width over the true
 over the predictions before the end of life; the prognostic horizon (the end-of-life time minus the
 first prediction meeting the alpha criterion with beta 0.5); the median bias of the estimate (days,
 predicted minus true remaining life). A sample beyond the prediction's horizon (365 days) enters the
-metrics at the horizon (ProgPy drops a None sample from a mean). **Reachable**: per unit, how far
+metrics at the horizon (ProgPy drops a None sample from a mean). **Issue 75's figures** (:mod:`faultgen.bench.rul_scores`), at the first
+prediction at or after (A)'s lambda, whatever its verdict: whether the 5-95 % interval covers the
+true remaining life (criterion without friction tests: on at least 80 % of the worn units), whether
+the median is late by more than alpha (20 %) of it (at most 20 % of the units without tests, none
+with them), the PHM 2008 score of the median (Saxena et al. 2008); a "not yet predictable" there
+counts as neither covering nor late, and its units are counted. A table per unit (markdown) and the
+fleet's lines, each figure beside its criterion and verdict (met / NOT met). Before them, every
+unit's remaining life at its last log as rul.csv gives it: the axes that do not wear with an end of
+life within the horizon, the healthy units' within the fleet's span. **Reachable**: per unit, how far
 from the true remaining life at (A)'s lambda an exact prediction of the day the estimate reaches F
 (B's end of life) would be, ``(B - A) / (A - lambda)``; beyond alpha no trend fitted to that estimate
 can meet (A)'s alpha-lambda, however sharp: the count bounds (A)'s criterion by the wear estimate.
