@@ -360,7 +360,7 @@ def summarise(results: dict[str, list[dict]]) -> None:
         if a.get("at") is None:
             cells = ["-", "no prediction at lambda", "-", "-", "-"]
         elif not a["predictable"]:
-            cells = [f"{a['at']}, {a['true']:.1f}", "not yet predictable: " + a["verdict"].split(": ", 1)[1].split(" (")[0],
+            cells = [f"{a['at']}, {a['true']:.1f}", "not yet predictable: " + a["verdict"].split(": ", 1)[1].split(" (median ")[0],
                      "no", "no", "-"]
         else:
             high = "beyond" if a["high"] is None else f"{a['high']:.1f}"
