@@ -118,10 +118,11 @@ COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model"
 class Remaining:
     """One row of ``rul.csv``: ``unit``, ``axis`` (1..N; None when the unit has no wear estimate),
     computed at ``stamp`` (the last log fitted), in ``time_unit`` ("days" or "logs"); ``wear`` the
-    model's wear now, %, ``model`` ("linear" or "exponential"), ``rul`` the median time to
+    model's wear now, %, ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
     ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
-    ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, and ``verdict`` in
-    words. ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
+    ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, ``verdict`` in
+    words, ``models`` every model's weight in the average, and ``predictable`` False for "not yet
+    predictable" (no number; module docstring, 7). ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
     key ``failure``), for scoring; None without a fit."""
 
     unit: str
