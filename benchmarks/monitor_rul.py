@@ -42,7 +42,15 @@ lies within those bounds there and the distribution's 5-95 % width over the true
 over the predictions before the end of life; the prognostic horizon (the end-of-life time minus the
 first prediction meeting the alpha criterion with beta 0.5); the median bias of the estimate (days,
 predicted minus true remaining life). A sample beyond the prediction's horizon (365 days) enters the
-metrics at the horizon (ProgPy drops a None sample from a mean). **Reachable**: per unit, how far
+metrics at the horizon (ProgPy drops a None sample from a mean). **Issue 75's figures** (:mod:`faultgen.bench.rul_scores`), at the first
+prediction at or after (A)'s lambda, whatever its verdict: whether the 5-95 % interval covers the
+true remaining life (criterion without friction tests: on at least 80 % of the worn units), whether
+the median is late by more than alpha (20 %) of it (at most 20 % of the units without tests, none
+with them), the PHM 2008 score of the median (Saxena et al. 2008); a "not yet predictable" there
+counts as neither covering nor late, and its units are counted. A table per unit (markdown) and the
+fleet's lines, each figure beside its criterion and verdict (met / NOT met). Before them, every
+unit's remaining life at its last log as rul.csv gives it: the axes that do not wear with an end of
+life within the horizon, the healthy units' within the fleet's span. **Reachable**: per unit, how far
 from the true remaining life at (A)'s lambda an exact prediction of the day the estimate reaches F
 (B's end of life) would be, ``(B - A) / (A - lambda)``; beyond alpha no trend fitted to that estimate
 can meet (A)'s alpha-lambda, however sharp: the count bounds (A)'s criterion by the wear estimate.
@@ -64,6 +72,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet
 
 from faultgen import children
+from faultgen.bench import rul_scores
 from faultgen.monitor import prognosis
 
 ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
@@ -211,41 +220,75 @@ def main() -> None:
     evaluate(truth_path, out, args.failure_wear, not args.from_alarm, args.scale_uncertainty)
 
 
+def _at_lambda(predictions: list[tuple[int, prognosis.Remaining]], eol: float, start: float) -> dict:
+    """The issue-75 figures of the first prediction at or after lambda (``start`` + LAMBDA (``eol`` -
+    ``start``)), whatever its verdict: its median and 5-95 % interval, the true remaining life, and
+    whether it is a number, covers the truth, is late by more than ALPHA, its PHM 2008 score."""
+    lam = start + LAMBDA * (eol - start)
+    after = [(d, r) for d, r in predictions if d >= lam and d < eol]
+    if not after:
+        return {"lambda": lam, "at": None}
+    day, row = after[0]
+    true = eol - day
+    out = {"lambda": lam, "at": day, "true": true, "predictable": row.rul is not None, "verdict": row.verdict,
+           "models": getattr(row, "models", "")}
+    if row.rul is not None:
+        out.update(median=row.rul, low=row.rul_5, high=row.rul_95,
+                   covers=rul_scores.covers(row.rul_5, row.rul_95, true), late=rul_scores.late(row.rul, true),
+                   phm08=float(rul_scores.phm08_score(row.rul, true)))
+    return out
+
+
+def quiet_axes(truth: dict, scores: list[dict], alarms: dict, failure_wear: float, changepoint: bool,
+               scale_uncertainty) -> None:
+    """Every unit's remaining life at its last log as the monitor writes it in rul.csv: the axes that
+    do not wear with an end of life within the horizon, the healthy units' within the fleet's span."""
+    span = max(len(t["wear"]) for t in truth.values())
+    within, healthy, others = [], 0, 0
+    for unit, t in truth.items():
+        rows = [r for r in scores if r["unit"] == unit]
+        alarm = alarms[unit]
+        source = int(alarm["source_axis"]) if alarm["source_axis"] else None
+        for row in prognosis.remaining_life(unit, rows, 6, alpha=MONITOR_ALPHA, failure_wear=failure_wear,
+                                            since=alarm["first_alarm"] or None, source_axis=source,
+                                            changepoint=changepoint, scale_uncertainty=scale_uncertainty):
+            if row.axis == t["axis"]:
+                continue
+            others += 1
+            healthy += not t["axis"]
+            if row.rul is not None:
+                within.append((unit, row.axis, row.rul, bool(t["axis"])))
+    early = [w for w in within if not w[3] and w[2] <= span]
+    print(f"axes that do not wear, at the last log: {others - len(within)} of {others} with no end of life within "
+          f"the horizon ({', '.join(f'{u} axis {a} in {r:.0f} days' for u, a, r, _ in within) or 'none has one'}); "
+          f"healthy units: {len(early)} of {healthy} axes with an end of life within the fleet's {span} days "
+          f"(none: {verdict(not early)})")
+
+
+def verdict(ok: bool) -> str:
+    return "met" if ok else "NOT met"
+
+
 def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool = True,
              scale_uncertainty: float = prognosis.SCALE_UNCERTAINTY) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
-    docstring); prints a block per unit and the fleet's lines; returns the scores of (A) and (B)."""
+    docstring); prints a block per unit and the fleet's lines, each figure beside the criterion of
+    issue 75 and its verdict; returns the scores of (A) and (B) (each with ``at_lambda``)."""
     truth = independent_fleet.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
         scores = [_floats(r) for r in csv.DictReader(f)]
     with open(out / "alarms.csv", newline="") as f:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
-    with open(out / "rul.csv", newline="") as f:
-        rul = list(csv.DictReader(f))
     F, H = failure_wear, prognosis.HORIZON
-    print(f"\nrul.csv at the last log ({len(rul)} rows):")
-    for r in rul:
-        t = truth[r["unit"]]
-        if t["axis"] and int(r["axis"]) == t["axis"] or r["rul"]:
-            print(f"  {r['unit']} axis {r['axis']} ({'worn' if int(r['axis']) == t['axis'] else 'not worn'}): "
-                  f"{r['verdict']}")
-    quiet = sum(not r["rul"] for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
-    others = sum(1 for r in rul if not truth[r["unit"]]["axis"] or int(r["axis"]) != truth[r["unit"]]["axis"])
-    print(f"  axes not worn with no end of life within the horizon: {quiet} of {others}")
-    span = max(len(t["wear"]) for t in truth.values())  # days of the fleet
-    healthy = [r for r in rul if not truth[r["unit"]]["axis"]]
-    within = [r for r in healthy if r["rul"] and float(r["rul"]) <= span]
-    print(f"  healthy units: {len(within)} of {len(healthy)} axes with an end of life within the fleet's span of "
-          f"{span} days ({'met' if not within else 'NOT met'}: the issue asks for none)"
-          + "".join(f"; {r['unit']} axis {r['axis']} in {float(r['rul']):.0f} days" for r in within))
-
+    quiet_axes(truth, scores, alarms, F, changepoint, scale_uncertainty)
     results = {"A": [], "B": []}
     started = time.perf_counter()
+    from progpy.predictors import ToEPredictionProfile
+
     for unit, t in truth.items():
         if not t["axis"]:
             continue
-        alarm = alarms[unit]
-        axis = t["axis"]
+        alarm, axis = alarms[unit], t["axis"]
         if not alarm["first_alarm"] or int(alarm["source_axis"]) != axis:
             print(f"\n{unit}: worn axis {axis}, alarm {alarm['first_alarm'] or 'none'} on axis "
                   f"{alarm['source_axis'] or '-'}: not scored")
@@ -259,66 +302,101 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
         estimate_eol = day_of(wear, (F - offset) / scale)  # (B)
         first = stamps.index(alarm["first_alarm"])
         start = day[stamps[first + PERSISTENCE - 1]]
-        from progpy.predictors import ToEPredictionProfile
-
-        profile = ToEPredictionProfile()
-        medians = []
+        profile, predictions = ToEPredictionProfile(), []
         for j in range(first + PERSISTENCE - 1, len(rows)):
+            now = day[rows[j]["stamp"]]
+            if now >= max(true_eol, estimate_eol):  # the metrics take the predictions before the end of life
+                break
             (row,) = prognosis.remaining_life(unit, rows[: j + 1], 6, alpha=MONITOR_ALPHA, failure_wear=F,
                                               since=alarm["first_alarm"], source_axis=axis, axes=[axis],
                                               changepoint=changepoint, scale_uncertainty=scale_uncertainty)
-            now = day[rows[j]["stamp"]]
-            if row.distribution is not None:
+            if row.rul is not None:  # a "not yet predictable" or no end of life gives no number
                 profile.add_prediction(now, _absolute(row.distribution, now, H))
-            medians.append((now, row.rul))
+            predictions.append((now, row))
         print(f"\n{unit}: worn axis {axis}, true wear {F:g} % on day {true_eol:.1f}; estimate {scale:.2f} x true wear "
               f"{offset:+.1f} %, so {F:g} % estimated on day {estimate_eol:.1f}; alarm persistent on day {start}; "
-              f"{len(profile)} of {len(medians)} predictions with an end of life within {H:g} days")
-        shown = medians[:: max(1, len(medians) // 6)]
-        print("  day: predicted remaining life (median), true (A), estimate's (B): " + "; ".join(
-            f"{d}: {'-' if m is None else f'{m:.0f}'}, {true_eol - d:.0f}, {estimate_eol - d:.0f}" for d, m in shown))
+              f"{len(profile)} of {len(predictions)} predictions before the end of life with a number")
+        shown = predictions[:: max(1, len(predictions) // 6)]
+        print("  day: predicted remaining life (median; '?' not yet predictable), true (A): " + "; ".join(
+            f"{d}: {'?' if r.rul is None else f'{r.rul:.0f}'}, {true_eol - d:.0f}" for d, r in shown))
         for name, eol in (("A", true_eol), ("B", estimate_eol)):
             s = score(profile, eol, start, len(wear))
-            s["unit"] = unit
+            s["unit"], s["axis"] = unit, axis
+            s["at_lambda"] = _at_lambda(predictions, eol, start)
             if name == "A":  # a prediction of the estimate's own crossing, exact, judged against the truth
                 s["perfect_error"] = exact_crossing_error(wear, scale, offset, start, F)
             results[name].append(s)
-            al = {None: f"n/a (lambda day {s['lambda']:.0f} after the record)", True: "met", False: "not met"}[
-                s.get("alpha_lambda")]  # a bool or None
+            if name == "B":
+                continue
+            a = s["at_lambda"]
+            al = {None: "n/a", True: "met", False: "not met"}[s.get("alpha_lambda")]
             ph = "none" if s.get("ph") is None else f"{s['ph']:.0f} days"
-            print(f"  ({name}) end of life day {eol:.1f}, lambda day {s['lambda']:.1f}: alpha-lambda {al}; "
-                  f"RA at lambda {s.get('ra_lambda', float('nan')):.2f} (share within +-{ALPHA:g}: "
-                  f"{s.get('mass_lambda', float('nan')):.2f}, 5-95 % width {s.get('width_lambda', float('nan')):.2f} x "
-                  f"the true remaining life, {'covering' if s.get('covers_lambda') else 'not covering'} it); "
-                  f"cumulative RA {s.get('cra', float('nan')):.2f} "
-                  f"over {s['predictions']} predictions; prognostic horizon "
-                  f"{ph}; median bias "
-                  f"{s.get('bias', float('nan')):+.1f} days")
-            if name == "A":
-                r = s["perfect_error"]
-                print(f"      a prediction of the day the estimate reaches {F:g} %, exact, would be off by {r:+.2f} of "
-                      f"the true remaining life at lambda: alpha-lambda {'reachable' if abs(r) <= ALPHA else 'out of reach'}"
-                      f" for any trend of this estimate")
+            if a["at"] is None:
+                print(f"  (A) end of life day {eol:.1f}: no prediction at lambda (day {a['lambda']:.1f})")
+            elif not a["predictable"]:
+                print(f"  (A) at lambda (day {a['at']}, true remaining life {a['true']:.1f} days): {a['verdict']}")
+            else:
+                print(f"  (A) at lambda (day {a['at']}): median {a['median']:.1f} days, 5-95 % {a['low']:.1f}-"
+                      f"{'beyond' if a['high'] is None else format(a['high'], '.1f')}, true {a['true']:.1f}: "
+                      f"{'covers' if a['covers'] else 'does NOT cover'}, {'LATE' if a['late'] else 'not late'} "
+                      f"(> {ALPHA:g}), PHM 2008 score {a['phm08']:.2f}; models {a['models']}")
+            print(f"      alpha-lambda {al}; RA at lambda {s.get('ra_lambda', float('nan')):.2f}; prognostic horizon "
+                  f"{ph}; median bias {s.get('bias', float('nan')):+.1f} days; exact crossing of the estimate off by "
+                  f"{s['perfect_error']:+.2f} ({'reachable' if abs(s['perfect_error']) <= ALPHA else 'out of reach'})")
     print(f"\nprofiles computed in {time.perf_counter() - started:.0f} s")
-    for name, label in (("A", "true wear reaches F (independent)"), ("B", "estimate's trend reaches F (hindsight)")):
-        rs = results[name]
-        met = sum(r.get("alpha_lambda") is True for r in rs)
-        evaluable = sum(r.get("alpha_lambda") is not None for r in rs)
-        phs = [r["ph"] for r in rs if r.get("ph") is not None]
-        print(f"({name}) {label}: alpha-lambda (alpha {ALPHA}, beta {BETA}, lambda {LAMBDA}) met on {met} of "
-              f"{evaluable} evaluable units ({len(rs)} scored); median RA at lambda "
-              f"{np.median([r['ra_lambda'] for r in rs if 'ra_lambda' in r]) if evaluable else float('nan'):.2f}; "
-              f"median cumulative RA {np.median([r['cra'] for r in rs if 'cra' in r]):.2f}; prognostic horizon "
-              f"{len(phs)} of {len(rs)} units ({', '.join(f'{p:.0f}' for p in phs) or '-'} days); median bias "
-              f"{np.median([r['bias'] for r in rs if 'bias' in r]):+.1f} days; at lambda the 5-95 % interval "
-              f"covers the true remaining life on {sum(bool(r.get('covers_lambda')) for r in rs)} of {evaluable} "
-              f"units, median width {np.median([r['width_lambda'] for r in rs if 'width_lambda' in r]) if evaluable else float('nan'):.2f} "
-              f"x the true remaining life")
-    reachable = sum(abs(r["perfect_error"]) <= ALPHA for r in results["A"])
-    print(f"(A) reachable: a prediction of the day each estimate reaches F, exact, would be within +-{ALPHA:g} of the "
-          f"true remaining life at lambda on {reachable} of {len(results['A'])} units (the wear estimate's own scale and "
-          "offset bound alpha-lambda against the true wear, whatever the trend)")
+    summarise(results)
     return results
+
+
+def summarise(results: dict[str, list[dict]]) -> None:
+    """The fleet's lines: each figure of issue 75 beside its criterion and verdict (module docstring)."""
+    rs = results["A"]
+    n = len(rs)
+    print("\n| unit (axis) | at lambda: day, true RUL | median (5-95 %), days | covers | late > 20 % | PHM 2008 | "
+          "RA at lambda | alpha-lambda | PH, days | models (weights) |\n| --- | --- | --- | --- | --- | --- | --- | --- | "
+          "--- | --- |")
+    for r in rs:
+        a = r["at_lambda"]
+        if a.get("at") is None:
+            cells = ["-", "no prediction at lambda", "-", "-", "-"]
+        elif not a["predictable"]:
+            cells = [f"{a['at']}, {a['true']:.1f}", "not yet predictable: " + a["verdict"].split(": ", 1)[1].split(" (median ")[0],
+                     "no", "no", "-"]
+        else:
+            high = "beyond" if a["high"] is None else f"{a['high']:.1f}"
+            cells = [f"{a['at']}, {a['true']:.1f}", f"{a['median']:.1f} ({a['low']:.1f}-{high})",
+                     "yes" if a["covers"] else "**no**", "**LATE**" if a["late"] else "no", f"{a['phm08']:.2f}"]
+        al = {None: "n/a", True: "met", False: "not met"}[r.get("alpha_lambda")]
+        print(f"| {r['unit']} ({r['axis']}) | " + " | ".join(cells) + f" | {r.get('ra_lambda', float('nan')):.2f} | {al} | "
+              f"{'-' if r.get('ph') is None else format(r['ph'], '.0f')} | {a.get('models') or '-'} |")
+    at = [r["at_lambda"] for r in rs]
+    numbers = [a for a in at if a.get("predictable")]
+    covered = sum(bool(a.get("covers")) for a in at)
+    late = sum(bool(a.get("late")) for a in at)
+    unknown = sum(a.get("at") is not None and not a.get("predictable") for a in at)
+    met = sum(r.get("alpha_lambda") is True for r in rs)
+    phs = [r["ph"] for r in rs if r.get("ph") is not None]
+    phm = [a["phm08"] for a in numbers]
+    ra = [r["ra_lambda"] for r in rs if "ra_lambda" in r]
+    print(f"(A) true wear reaches F, {n} worn units scored; at lambda {unknown} 'not yet predictable' "
+          "(counted as not covering and not late):")
+    print(f"  5-95 % interval covers the true remaining life at lambda: {covered} of {n} (>= 80 %: "
+          f"{verdict(n and covered >= 0.8 * n)})")
+    print(f"  median late by more than {ALPHA:.0%} of the true remaining life at lambda: {late} of {n} (<= 20 % "
+          f"without friction tests: {verdict(late <= 0.2 * n)}; none with them: {verdict(late == 0)})")
+    print(f"  alpha-lambda (alpha {ALPHA}, beta {BETA}, lambda {LAMBDA}): {met} of {n} (>= 80 % with friction tests: "
+          f"{verdict(n and met >= 0.8 * n)})")
+    print(f"  relative accuracy at lambda: median {np.median(ra) if ra else float('nan'):.2f} "
+          f"({', '.join(f'{v:.2f}' for v in ra)}); prognostic horizon on {len(phs)} of {n} units "
+          f"({', '.join(f'{p:.0f}' for p in phs) or '-'} days); PHM 2008 score at lambda: sum {sum(phm):.2f} over "
+          f"{len(phm)} units with a number ({', '.join(f'{v:.2f}' for v in phm)})")
+    b = results["B"]
+    print(f"(B) the estimate's own crossing (hindsight): alpha-lambda {sum(r.get('alpha_lambda') is True for r in b)} "
+          f"of {len(b)}; covers at lambda {sum(bool(r['at_lambda'].get('covers')) for r in b)}; late "
+          f"{sum(bool(r['at_lambda'].get('late')) for r in b)}")
+    reachable = sum(abs(r["perfect_error"]) <= ALPHA for r in rs)
+    print(f"(A) reachable: an exact prediction of each estimate's crossing within +-{ALPHA:g} of the true remaining "
+          f"life at lambda on {reachable} of {n} units")
 
 
 if __name__ == "__main__":

@@ -100,7 +100,7 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
     # estimate's scale exact here, so the trend alone is compared (no scale uncertainty)
     truth = (prognosis.FAILURE_WEAR - 15.0) / 0.5  # logs after the last
     draws = 20
-    covered, widths = 0, {"hinge": [], "from the alarm": []}
+    covered, named, widths = 0, 0, {"hinge": [], "from the alarm": []}
     for seed in range(draws):
         rng = np.random.default_rng(500 + seed)
         wear = np.r_[np.zeros(40), 0.5 * np.arange(1, 31)] + rng.normal(0, NOISE, 70)
@@ -109,13 +109,17 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
         assert alarmed.model != "changepoint" and alarmed.logs_fitted == 20 and alarmed.fitted_from == "150"
         widths["from the alarm"].append(np.inf if alarmed.rul is None else (alarmed.rul_95 or np.inf) - alarmed.rul_5)
         row = _one(rows, since=rows[50]["stamp"], source_axis=1, scale_uncertainty=0.0)
-        assert row.model == "changepoint" and row.logs_fitted == 70 and row.fitted_from == "100", row
+        # since the model average (2026-11-26, issue 75) the row names the simplest model near the least
+        # AICc among the line, the exponential, the changepoint trend and the power law
+        named += row.model == "changepoint"
+        assert row.logs_fitted == 70 and row.fitted_from == "100", row
         covered += _covered(row, truth)
         widths["hinge"].append(np.inf if row.rul is None else (row.rul_95 or np.inf) - row.rul_5)
         t = np.arange(70.0) - 69.0
         fit = trends.fit_hinge(t, wear, np.full(70, NOISE))
         assert abs(fit.changepoint - (-30.0)) < 6.0 and abs(fit.params[1] - 0.5) < 0.15, fit
     assert covered >= 0.8 * draws, covered  # a 90 % interval
+    assert named >= 0.8 * draws, named
     assert np.median(widths["hinge"]) < 0.75 * np.median(widths["from the alarm"]), widths
 
 

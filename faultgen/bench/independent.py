@@ -136,7 +136,8 @@ class FleetSpec:
     up to ``max_part`` kg (``rated_part``: the fleet's heaviest part drawn is made ``max_part``
     itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
     ``program_changes`` healthy units an unlogged program change; every ``friction_test_every`` days
-    (0: never) each unit runs a friction test (module docstring). Every draw comes from ``seed``; the
+    (0: never) each unit runs a friction test (module docstring); ``wear_growth`` the exponent of the
+    wear's rise (:func:`wear_percent`; 1, linear, by default). Every draw comes from ``seed``; the
     defaults draw what the fleet drew before these options existed."""
 
     units: int = 12
@@ -153,8 +154,12 @@ class FleetSpec:
     gearbox_changes: int = 0
     program_changes: int = 0
     friction_test_every: int = 0
+    wear_growth: float = 1.0
 
     def __post_init__(self) -> None:
+        if isinstance(self.wear_growth, bool) or not 1.0 <= float(self.wear_growth) <= 4.0:
+            raise ValueError(f"fleet wear_growth = {self.wear_growth!r}: expected the wear's exponent in [1, 4] "
+                             "(1: linear from the onset)")
         for name, low in (("units", 1), ("worn", 0), ("days", 2), ("seed", 0), ("gearbox_changes", 0),
                           ("program_changes", 0), ("friction_test_every", 0)):
             value = getattr(self, name)
@@ -302,10 +307,14 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
 
 
 def wear_percent(spec: FleetSpec, onset: int, day: int) -> float:
-    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based)."""
+    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): from the
+    onset to ``final_wear`` on the last day, as the power ``wear_growth`` of the time since the onset
+    (1: linear; 2: its rate growing in proportion to that time)."""
     if day < onset:
         return 0.0
-    return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
+    if spec.wear_growth == 1.0:
+        return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
+    return spec.final_wear * ((day - onset) / max(spec.days - onset, 1)) ** spec.wear_growth
 
 
 def _wear(spec: FleetSpec, unit: dict, day: int) -> float:

@@ -21,7 +21,11 @@ performance"):
 - **relative accuracy** there (``1 - |true RUL - mean predicted RUL| / true RUL``; 1 is exact, it
   falls below 0 when the error exceeds the true RUL), and averaged over every prediction (cumulative);
 - **prognostic horizon**: the end of life minus the first prediction meeting the alpha criterion
-  (``progpy.metrics.prognostic_horizon``), 0 when none does, in records (days on the track).
+  (``progpy.metrics.prognostic_horizon``), 0 when none does, in records (days on the track);
+- at lambda (issue 75, :mod:`faultgen.bench.rul_scores`; in the JSON, not yet the leaderboard's
+  row): whether the median is late by more than ALPHA of the true remaining life, whether the 5-95 %
+  interval covers it, and the PHM 2008 score of the median (summarised as the late share, the
+  covering share and the mean score).
 
 Over the units: the share meeting alpha-lambda, the mean relative accuracy at lambda and the median
 prognostic horizon, each with a 95 % percentile bootstrap interval over test units
@@ -40,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.bench import baselines, files, prognosers
+from faultgen.bench import baselines, files, prognosers, rul_scores
 from faultgen.data import atomic
 
 #: The failure wear of each version of the track, % (the end of life: docs/bench/prognostics.md).
@@ -102,19 +106,28 @@ def predictions(prognoser, name: str, unit: files.Unit, failure_wear: float) -> 
 def unit_metrics(profile: dict, eol: float, onset: float) -> dict:
     """ProgPy's metrics (module docstring) of ``{time: samples}`` against the end of life ``eol``."""
     alpha_lambda, prognostic_horizon, Profile, Samples = _progpy()
-    before = Profile()
+    before, finite = Profile(), {}
     for t, values in profile.items():
         values = np.where(np.isfinite(values), values, t + HORIZON)
+        finite[t] = values
         before.add_prediction(t, Samples([{"failure": float(v)} for v in values]))
     truth = {"failure": eol}
     lam = onset + LAMBDA * (eol - onset)
     out = {"eol": eol, "onset": onset, "lambda": lam, "predictions": len(before)}
     if not len(before) or lam > max(before.keys()):
-        return {**out, "alpha_lambda": None, "ra_lambda": None, "cra": None, "ph": None}
+        return {**out, "alpha_lambda": None, "ra_lambda": None, "cra": None, "ph": None, "late_lambda": None,
+                "covers_lambda": None, "phm08_lambda": None}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out["alpha_lambda"] = bool(alpha_lambda(before, truth, lam, ALPHA, BETA)["failure"])
         at = min(t for t in before if t >= lam)
+        # issue 75 (faultgen.bench.rul_scores): the median late by more than ALPHA, the 5-95 % interval
+        # covering the true remaining life, the PHM 2008 score of the median
+        low, median, high = np.quantile(finite[at] - at, [0.05, 0.5, 0.95])
+        true_rul = max(eol - at, 1e-9)
+        out.update(late_lambda=rul_scores.late(median, true_rul, ALPHA),
+                   covers_lambda=rul_scores.covers(low, high, eol - at),
+                   phm08_lambda=float(rul_scores.phm08_score(median, eol - at)))
         out["ra_lambda"] = float((before[at] - at).relative_accuracy({"failure": eol - at})["failure"])
 
         def criterion(tte, tte_truth):
@@ -152,7 +165,11 @@ def summary(rows: list[dict]) -> dict:
     return {"alpha_lambda_share": _figure([float(r["alpha_lambda"]) for r in rows], np.mean),
             "ra_lambda": _figure([r["ra_lambda"] for r in rows], np.mean),
             "cumulative_ra": _figure([r["cra"] for r in rows], np.mean),
-            "prognostic_horizon": _figure([r["ph"] for r in rows], np.median)}
+            "prognostic_horizon": _figure([r["ph"] for r in rows], np.median),
+            "late_share": _figure([float(r["late_lambda"]) for r in rows if r.get("late_lambda") is not None], np.mean),
+            "covers_share": _figure([float(r["covers_lambda"]) for r in rows if r.get("covers_lambda") is not None],
+                                    np.mean),
+            "phm08_lambda": _figure([r["phm08_lambda"] for r in rows if r.get("phm08_lambda") is not None], np.mean)}
 
 
 def verdict(method: list[dict], naive: list[dict]) -> tuple[str, dict]:

@@ -14,58 +14,58 @@ Per axis:
    ``monitoring`` after the last ``relearning`` one: a new part starts a new trend). At least
    :data:`MIN_LOGS`; time in days since the last of them (stamps that are dates or date-times,
    :func:`faultgen.data.logfolder.parse_stamp`), or in logs (sequence-number stamps).
-2. **The source axis of the unit's open alarm: a changepoint trend** over all of them, the
-   two-phase degradation model of prognostics, flat until a changepoint ``tc`` and a line after it,
-   ``w(t) = w_now + b max(t, tc)`` (:func:`faultgen.monitor.trends.fit_hinge`; ``t`` <= 0 the logs'
-   times, 0 the last log): weighted least squares of (``w_now``, ``b``) at each candidate ``tc``
-   (each log's time from the 3rd log to the 5th from the last,
-   :data:`faultgen.monitor.trends.HINGE_MARGINS`), the least chi-square's ``tc`` refined
-   between its neighbours, and the covariance of (``w_now``, ``b``) the Gauss-Newton one of all
-   three parameters there (``tc`` included), marginalised. From now on it is the line. When it
-   cannot be fitted or its slope is not positive: the two models of 3 on the logs from the first
-   alarm on (the alarm marks where the wear left the noise; the flat stretch before it would bend
-   a straight line), the rule before 2026-11-26.
-3. **Every other axis: two degradation models** (:func:`faultgen.monitor.trends.fit_trend`), each
-   fitted by weighted least squares (``scipy.optimize.curve_fit``, weights one over each estimate's
-   variance), written with their parameters as the state now:
-   linear ``w(t) = w0 + b t`` and exponential
-   ``w(t) = w0 + b (exp(k t) - 1) / k`` (``a + c exp(k t)``, the exponential degradation model of
-   Gebraeel et al. 2005 with an offset, by its wear ``w0`` and slope ``b`` now and its growth rate
-   ``k``; ``k`` -> 0 is the line). **Criterion**: the smaller AICc (Akaike's criterion with the small
-   sample correction, ``statsmodels.tools.eval_measures.aicc``; Burnham & Anderson 2002) of the
-   Gaussian likelihood with the variances' common scale fitted, so the exponential's third parameter
-   must pay for itself (with 5 logs it cannot: its AICc is infinite). A fit that does not converge or
-   whose covariance is not finite is not a candidate.
-4. **Uncertainty**: the fit's covariance, scaled by the residuals' reduced chi-square when
-   it is above one (the stated standard errors are a floor: the log-to-log scatter of a real unit
-   may exceed them, never fall below), sampled (:data:`SAMPLES` draws, multivariate normal, seeded)
-   into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the model's state now, each
-   sample with a **scale** of the wear estimate drawn from a normal of mean 1 and standard deviation
-   :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY` (0.10), the twin's model uncertainty that
-   ``wear.csv``'s 90 % interval carries: the estimate is the wear times a scale the unit's logs
-   cannot tell, so the wear reaches the failure wear when the estimate reaches the failure wear
-   times that scale. The trend's own covariance comes from the log-to-log scatter, which more logs
-   average away; the scale error does not average away.
-5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each sample of the state
-   through :class:`WearTrend` (a :class:`progpy.PrognosticsModel` whose ``next_state`` is the exact
-   solution of either model, so no step error) up to :data:`HORIZON` days (logs), its event
-   ``failure`` met at wear >= the failure wear times the sample's scale; the step ends on the
-   crossing when it falls inside it, so a sample's time of event is exact. A sample that does not
-   cross within the horizon has no time of event (ProgPy's None).
-6. **The row**: the median time of event (the estimate), its 5 and 95 % quantiles
-   (``numpy.quantile``, ``inverted_cdf``: a sample's own value, with the samples beyond the horizon
-   counted as later than it), and the probability of failure within the horizon (one minus
-   ProgPy's :func:`progpy.metrics.prob_success` at the horizon). When that probability is below
-   one half (the median lies beyond the horizon: a flat or falling trend, or one too slow), the
-   axis has **no end of life within the horizon**, said with the horizon, and no number is given.
-
-Why the changepoint and the scale (2026-11-26; docs/analysis.md, "Remaining useful life"): on the
-four independent fleets of issue 59 (32 worn units; ``benchmarks/monitor_rul.py --fleet W``), the
-fit from the alarm on, without the scale, had a prognostic horizon on 4 units and its 5-95 %
-interval covered the true remaining life at lambda on 23; the changepoint alone on 22 and 13 (sharper
-than its error, which is mostly each unit's scale); both together on 15 and 28. Alpha-lambda (0.2
-at lambda 0.5) was met on 1, 8 and 0 of 32: the estimate's own scale and offset put it out of reach
-of any trend on most units (the benchmark's "reachable" count).
+2. **The source axis of the unit's open alarm: four models over all of them** (the logs since
+   the last maintenance, flat and then rising): the line, the exponential (3), the changepoint
+   trend, flat until ``tc`` and a line after it, ``w(t) = w_now + b max(t, tc)``
+   (:func:`faultgen.monitor.trends.fit_hinge`; ``tc`` among the logs from the 3rd to the 5th from
+   the last, :data:`faultgen.monitor.trends.HINGE_MARGINS`, refined between its neighbours, its
+   uncertainty in the covariance), and the **power-law rise**, flat and then ``c (t - t0)^p``, ``p``
+   in [1, 4] (:func:`faultgen.monitor.trends.fit_power`: a rise that accelerates; ``p`` = 1 is the
+   changepoint trend). When neither the changepoint trend nor the power law rises: the line and
+   the exponential of the logs from the first alarm on (the rule before 2026-11-26).
+3. **Every other axis: the line and the exponential** (:func:`faultgen.monitor.trends.fit_models`),
+   each by weighted least squares (``scipy``, weights one over each estimate's variance), written
+   with the state now: ``w(t) = w0 + b t`` and ``w(t) = w0 + b (exp(k t) - 1) / k`` (Gebraeel et al.
+   2005 with an offset; ``k`` >= 0, an accelerating wear; ``k`` -> 0 is the line).
+   **The model average** (issue 75, 2026-11-26): each model's **Akaike weight** (AICc,
+   ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the variances' common
+   scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham & Anderson 2002, ch.
+   2.9), and each model's parameters drawn in proportion to it (:func:`sample_counts`), so that the
+   distribution carries the model uncertainty: where the logs cannot tell a line from an
+   accelerating rise, part of the draws accelerate and the interval reaches earlier. ``model``
+   in rul.csv names the simplest model within 2 of the least AICc (the rule before the average),
+   ``models`` gives every weight. An axis whose named model's slope now is not above 0 at alpha has
+   **no wear trend** (no number).
+4. **Uncertainty**: each fit's covariance, scaled by the residuals' reduced chi-square when
+   it is above one (the stated standard errors are a floor), sampled (:data:`SAMPLES` draws in all,
+   multivariate normal, seeded; the exponential's ``k`` and the power law's ``p`` and ``t0`` kept in
+   their bounds) into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the state now,
+   each draw with a **scale** of the wear estimate from a normal of mean 1 and standard deviation
+   ``scale_uncertainty`` (the monitor's :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`, 0.10,
+   without friction tests; per axis where a test gives it): the estimate is the wear times a scale
+   the unit's logs cannot tell, so the wear reaches the failure wear when the estimate reaches
+   the failure wear times that scale. More logs average the trend's scatter away, not the scale.
+5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each draw through
+   :class:`WearTrend` (a :class:`progpy.PrognosticsModel` stepped by the exact solution of its
+   model) up to :data:`HORIZON` days (logs), its event ``failure`` met at wear >= the failure wear
+   times the draw's scale, the step ending on the crossing, so a time of event is exact.
+6. **The row**: the median time of event, its 5 and 95 % quantiles (``numpy.quantile``,
+   ``inverted_cdf``; a draw beyond the horizon later than any), and the probability of failure
+   within the horizon (one minus ProgPy's :func:`progpy.metrics.prob_success`). Below one half:
+   **no end of life within the horizon**, without a number.
+7. **Not yet predictable** (issue 75; :func:`unpredictable`): the trend cannot yet tell the
+   remaining life, and rul.csv says so in ``verdict`` with its cells empty (the draws' median and
+   interval in the words), when (a) fewer than :data:`MIN_RISE_LOGS` (5) logs lie after the
+   changepoint trend's changepoint, where the models that date a rise carry at least half the
+   weight (a slope from 4 logs is the noise's: the monitor's persistence is 5 logs); (b) the 95 %
+   end lies beyond the horizon (the trend cannot bound the life); or (c) two models of weight >=
+   :data:`MIN_MODEL_WEIGHT` (0.1) have 5-95 % intervals of their own that do not overlap (the
+   models disagree by more than their intervals). A wide interval alone is not "not yet
+   predictable": without a friction test the estimate's scale is uncertain by 10 %, and a life
+   that does not know its scale says so by its width (issue 75); a first version that withheld
+   intervals wider than 3 times their median withheld 4 covering, early answers at lambda on the
+   accelerating fleets. Measured on the independent fleets: docs/analysis.md, "A remaining life
+   that does not run late".
 
 Why the fit is not ProgPy's own: ProgPy fits a model's parameters to run-to-failure data by
 minimising an error (``PrognosticsModel.estimate_params``), without the parameters' covariance, and
@@ -83,6 +83,7 @@ useful life").
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from statistics import NormalDist
@@ -91,7 +92,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 from faultgen.monitor.scoring import SCALE_UNCERTAINTY
-from faultgen.monitor.trends import Fit, expm1_over, fit_hinge, fit_trend
+from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, akaike_weights, expm1_over, fit_models
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
@@ -105,18 +106,23 @@ MIN_LOGS = 5
 SAMPLES = 1000
 #: The interval given: 5 and 95 % quantiles of the time of event.
 INTERVAL = (0.05, 0.95)
+#: "Not yet predictable" (module docstring, 7): fewer logs than this since the rise began ...
+MIN_RISE_LOGS = 5
+#: ... or two models of at least this weight whose own 5-95 % intervals do not overlap.
+MIN_MODEL_WEIGHT = 0.1
 COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model", "rul", "rul_5", "rul_95",
-           "p_within_horizon", "horizon", "logs_fitted", "fitted_from", "verdict")
+           "p_within_horizon", "horizon", "logs_fitted", "fitted_from", "verdict", "models")
 
 
 @dataclass
 class Remaining:
     """One row of ``rul.csv``: ``unit``, ``axis`` (1..N; None when the unit has no wear estimate),
     computed at ``stamp`` (the last log fitted), in ``time_unit`` ("days" or "logs"); ``wear`` the
-    model's wear now, %, ``model`` ("linear" or "exponential"), ``rul`` the median time to
+    model's wear now, %, ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
     ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
-    ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, and ``verdict`` in
-    words. ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
+    ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, ``verdict`` in
+    words, ``models`` every model's weight in the average, and ``predictable`` False for "not yet
+    predictable" (no number; module docstring, 7). ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
     key ``failure``), for scoring; None without a fit."""
 
     unit: str
@@ -134,6 +140,8 @@ class Remaining:
     p_within_horizon: float | None = None
     logs_fitted: int = 0
     fitted_from: str = ""
+    models: str = ""
+    predictable: bool = True
     distribution: object = field(default=None, repr=False)
 
     @property
@@ -158,28 +166,36 @@ def import_progpy() -> None:
 
 
 def _wear_trend_model(failure_wear: float):
-    """The ProgPy model of both trends (module docstring, 5), its event at ``failure_wear``."""
+    """The ProgPy model of every trend (module docstring, 5), its event at ``failure_wear``."""
     import_progpy()
     from progpy import PrognosticsModel
 
     class WearTrend(PrognosticsModel):
-        """``dw/dt = s``, ``ds/dt = k s``: a line (``k`` = 0) or ``w0 + b (exp(k t) - 1) / k``,
-        stepped by its exact solution; the estimate's ``scale`` constant, the event at ``w`` >=
-        the failure wear times it."""
+        """``dw/dt = s``: with ``power`` 1, ``ds/dt = k s`` (a line, ``k`` = 0, or ``w0 + b (exp(k t)
+        - 1) / k``); with ``power`` p > 1 (and ``k`` 0), the power-law rise ``c (age)^p`` above its
+        flat level, ``s = c p age^(p-1)`` (:func:`faultgen.monitor.trends.power_curve`); stepped by
+        the exact solution; the estimate's ``scale`` constant, the event at ``w`` >= the failure
+        wear times it."""
 
         # ProgPy reads a model's names and defaults from these class attributes
         inputs = []  # noqa: RUF012
-        states = ["wear", "slope", "growth", "scale"]  # noqa: RUF012
+        states = ["wear", "slope", "growth", "age", "power", "scale"]  # noqa: RUF012
         outputs = ["wear"]  # noqa: RUF012
         events = ["failure"]  # noqa: RUF012
         default_parameters = {"failure_wear": failure_wear, "process_noise": 0.0,  # noqa: RUF012
                               "measurement_noise": 0.0,
-                              "x0": {"wear": 0.0, "slope": 0.0, "growth": 0.0, "scale": 1.0}}
+                              "x0": {"wear": 0.0, "slope": 0.0, "growth": 0.0, "age": 1.0, "power": 1.0,
+                                     "scale": 1.0}}
 
         def next_state(self, x, u, dt):
-            k, s = x["growth"], x["slope"]
-            return self.StateContainer({"wear": x["wear"] + s * expm1_over(k, dt), "slope": s * np.exp(k * dt),
-                                        "growth": k, "scale": x["scale"]})
+            k, s, age, p = x["growth"], x["slope"], x["age"], x["power"]
+            if p > 1.0:
+                wear = x["wear"] + s * ((age + dt) ** p - age**p) / (p * age ** (p - 1.0))
+                slope = s * ((age + dt) / age) ** (p - 1.0)
+            else:
+                wear, slope = x["wear"] + s * expm1_over(k, dt), s * np.exp(k * dt)
+            return self.StateContainer({"wear": wear, "slope": slope, "growth": k, "age": age + dt, "power": p,
+                                        "scale": x["scale"]})
 
         def output(self, x):
             return self.OutputContainer({"wear": x["wear"]})
@@ -193,27 +209,64 @@ def _wear_trend_model(failure_wear: float):
     return WearTrend()
 
 
-def _state_samples(fit: Fit, samples: int, seed: int, scale_uncertainty: float):
-    """The fit's parameters drawn ``samples`` times as ProgPy's ``UnweightedSamples`` of the state now,
-    each with a scale of the wear estimate drawn from a normal of mean 1 and standard deviation
-    ``scale_uncertainty`` (at least 0.05)."""
+def sample_counts(weights, samples: int) -> np.ndarray:
+    """Each model's number of draws, in proportion to its ``weights`` (summing to 1), ``samples`` in
+    all (the largest remainders rounded up, ties to the first model). Shape (len(weights),)."""
+    weights = np.asarray(weights, dtype=float)
+    exact = weights / weights.sum() * samples
+    counts = np.floor(exact).astype(int)
+    order = np.argsort(-(exact - counts), kind="stable")
+    counts[order[: samples - counts.sum()]] += 1
+    return counts
+
+
+def _states(fit: Fit, drawn: np.ndarray) -> np.ndarray:
+    """A fit's drawn parameters (m, len(params)) as states (m, 5): wear, slope, growth, age, power;
+    the power law's age and exponent kept within the bounds it was fitted in."""
+    m = len(drawn)
+    states = np.column_stack([drawn[:, 0], drawn[:, 1], np.zeros(m), np.ones(m), np.ones(m)])
+    if fit.model == "exponential":  # accelerating (fitted with k >= 0)
+        states[:, 2] = np.maximum(drawn[:, 2], 0.0)
+    elif fit.model == "power":
+        low, high = fit.limits
+        states[:, 3] = np.clip(drawn[:, 2], low[0], high[0])
+        states[:, 4] = np.clip(drawn[:, 3], 1.0, POWER_MAX)
+    return states
+
+
+def _state_samples(fits, weights, samples: int, seed: int, scale_uncertainty: float):
+    """The model average's draws (module docstring, 4): each fit's parameters drawn in proportion to
+    its weight (:func:`sample_counts`), with a scale of the wear estimate drawn from a normal of mean
+    1 and standard deviation ``scale_uncertainty`` (at least 0.05), as ProgPy's ``UnweightedSamples``
+    of the state now; and each draw's model index (shape (samples,))."""
     import_progpy()
     from progpy.uncertain_data import UnweightedSamples
 
     rng = np.random.default_rng(seed)
-    drawn = rng.multivariate_normal(fit.params, fit.cov, size=samples, method="eigh")
-    growth = drawn[:, 2] if drawn.shape[1] > 2 else np.zeros(samples)
+    counts = sample_counts(weights, samples)
+    states = np.concatenate([_states(f, rng.multivariate_normal(f.params, f.cov, size=c, method="eigh"))
+                             for f, c in zip(fits, counts)])
+    labels = np.repeat(np.arange(len(fits)), counts)
     scale = np.maximum(1.0 + scale_uncertainty * rng.standard_normal(samples), 0.05) if scale_uncertainty else \
         np.ones(samples)
-    return UnweightedSamples([{"wear": float(w), "slope": float(s), "growth": float(k), "scale": float(c)}
-                              for w, s, k, c in zip(drawn[:, 0], drawn[:, 1], growth, scale)])
+    names = ("wear", "slope", "growth", "age", "power")
+    return UnweightedSamples([{**dict(zip(names, map(float, x))), "scale": float(c)}
+                              for x, c in zip(states, scale)]), labels
 
 
-def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0,
-                  scale_uncertainty: float = SCALE_UNCERTAINTY):
+def time_of_event(fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0,
+                  scale_uncertainty: float = SCALE_UNCERTAINTY, weights=None):
     """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
-    under ``fit``, the estimate's scale uncertain by ``scale_uncertainty`` (module docstring, 4-5):
-    ``UnweightedSamples`` with key ``failure`` (None beyond ``horizon``)."""
+    under ``fit`` (a :class:`~faultgen.monitor.trends.Fit`, or a list of them drawn in proportion to
+    ``weights``, the model average), the estimate's scale uncertain by ``scale_uncertainty`` (module
+    docstring, 4-5): ``UnweightedSamples`` with key ``failure`` (None beyond ``horizon``)."""
+    fits = [fit] if isinstance(fit, Fit) else list(fit)
+    drawn, _ = _state_samples(fits, [1.0] * len(fits) if weights is None else weights, samples, seed,
+                              scale_uncertainty)
+    return _propagate(drawn, failure_wear, horizon)
+
+
+def _propagate(drawn, failure_wear: float, horizon: float):
     import_progpy()
     from progpy.predictors import MonteCarlo
 
@@ -221,13 +274,16 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
 
     def step(t, x):  # up to the horizon, ending on the crossing when it falls inside the step
         wear, slope, growth = float(x["wear"]), float(x["slope"]), float(x["growth"])
+        age, power = float(x["age"]), float(x["power"])
         gap, left = failure_wear * float(x["scale"]) - wear, max(horizon - t, 1e-9)
         if gap <= 0:
             return 1e-9
         reach = np.inf
         if slope > 0:
             ratio = growth * gap / slope
-            if abs(growth) < 1e-12:
+            if power > 1.0:  # (age + T)^p = age^p + gap / c, c = slope / (p age^(p-1))
+                reach = float((age**power + gap * power * age ** (power - 1.0) / slope) ** (1.0 / power) - age)
+            elif abs(growth) < 1e-12:
                 reach = gap / slope
             elif ratio > -1:
                 reach = float(np.log1p(ratio) / growth)
@@ -235,31 +291,58 @@ def time_of_event(fit: Fit, failure_wear: float, horizon: float = HORIZON, sampl
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        result = MonteCarlo(model).predict(_state_samples(fit, samples, seed, scale_uncertainty), dt=step,
-                                           horizon=horizon,
-                                           save_freq=horizon, events=["failure"])
+        result = MonteCarlo(model).predict(drawn, dt=step, horizon=horizon, save_freq=horizon, events=["failure"])
     return result.time_of_event
+
+
+def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float:
+    """The relative standard uncertainty of ``axis``'s (1..``n_axes``) wear scale from
+    ``scale_uncertainty``: one number for every axis, a mapping axis -> number (an axis not in it
+    gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers.
+    ValueError naming the value when a number is not in [0, 1) or the sequence's length is not
+    ``n_axes``."""
+    if isinstance(scale_uncertainty, Mapping):
+        for key in scale_uncertainty:
+            if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 1 <= key <= n_axes:
+                raise ValueError(f"scale_uncertainty axis {key!r}: expected an axis 1..{n_axes}")
+        value = scale_uncertainty.get(axis, SCALE_UNCERTAINTY)
+    elif isinstance(scale_uncertainty, (list, tuple, np.ndarray)):
+        if len(scale_uncertainty) != n_axes:
+            raise ValueError(f"scale_uncertainty = {list(scale_uncertainty)!r}: expected {n_axes} numbers, one per "
+                             "axis")
+        value = scale_uncertainty[axis - 1]
+    else:
+        value = scale_uncertainty
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) or \
+            not 0.0 <= float(value) < 1.0:
+        raise ValueError(f"scale_uncertainty of axis {axis} = {value!r}: expected the relative standard "
+                         "uncertainty of the wear estimate's scale, a number in [0, 1)")
+    return float(value)
 
 
 def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, failure_wear: float = FAILURE_WEAR,
                    keys: dict[str, float] | None = None, kind: str | None = None, since: str | None = None,
                    source_axis: int | None = None, horizon: float = HORIZON, samples: int = SAMPLES,
                    seed: int = 0, axes: list[int] | None = None, changepoint: bool = True,
-                   scale_uncertainty: float = SCALE_UNCERTAINTY) -> list[Remaining]:
+                   scale_uncertainty=SCALE_UNCERTAINTY) -> list[Remaining]:
     """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
     rows (``UnitMonitor.rows``: ``stamp``, ``phase``, each log's own wear estimate ``wearI_log`` and its
     lower bound ``wearI_log_lower``, not the filtered ``wearI``, whose errors are not independent from
     log to log as the trend's fit assumes) with the monitor's
     ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
-    first alarm of the open alarm, whose ``source_axis`` gets the changepoint trend over the whole
-    block (:func:`faultgen.monitor.trends.fit_hinge`; ``changepoint`` False: the trends of the logs
-    from the alarm on, the rule before 2026-11-26) and is fitted from the alarm on when that fails
-    (module docstring, 2);
+    first alarm of the open alarm, whose ``source_axis`` gets the model average with the changepoint
+    trend and the power-law rise over the whole block (module docstring, 2; ``changepoint`` False:
+    the line and the exponential of the logs from the alarm on, the rule before 2026-11-26) and is
+    fitted from the alarm on when neither rises;
     ``scale_uncertainty`` the relative standard uncertainty of the estimate's scale carried into the
-    time of event (module docstring, 4; 0: none); ``axes`` (1..N) the axes wanted, all when None. A
+    time of event (module docstring, 4; 0: none): one number for every axis, a mapping axis (1..N)
+    -> number (an axis not in it: :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`) or a sequence
+    of ``n_axes`` numbers (:func:`scale_of_axis`); ``axes`` (1..N) the axes wanted, all when None. A
     unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
     check_failure_wear(failure_wear)
+    wanted = list(range(1, n_axes + 1)) if axes is None else list(axes)
+    uncertainty = {axis: scale_of_axis(scale_uncertainty, axis, n_axes) for axis in wanted}
     stamp = rows[-1]["stamp"] if rows else ""
     if not rows or "wear1_log" not in rows[0]:
         why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
@@ -285,16 +368,15 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         t = np.array([keys[r["stamp"]] for r in logs], dtype=float)
         return (t - t[-1]) / per, wear, np.maximum(error, 1e-9)
 
-    for axis in range(1, n_axes + 1) if axes is None else axes:
-        fitted = block
-        hinge = None
+    for axis in wanted:
+        fitted, fits = block, []
         if since is not None and axis == source_axis:
             stamps = [r["stamp"] for r in block]
-            if changepoint and since in stamps:  # the whole block, flat then rising
-                hinge = fit_hinge(*series(block, axis))
-                if hinge is not None and not hinge.params[1] > 0:
-                    hinge = None
-            if hinge is None:  # the logs from the alarm on
+            if changepoint and since in stamps and len(block) >= MIN_LOGS:  # the whole block, flat then rising
+                fits = fit_models(*series(block, axis), changepoint=True)
+                if not any(f.changepoint is not None for f in fits):
+                    fits = []
+            if not fits:  # the logs from the alarm on
                 fitted = block[stamps.index(since):] if since in stamps else block
         base = Remaining(unit, axis, stamp, time_unit, "", failure_wear, horizon, logs_fitted=len(fitted),
                          fitted_from=fitted[0]["stamp"] if fitted else "")
@@ -303,44 +385,101 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                             f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
             out.append(base)
             continue
-        fit = hinge if hinge is not None else fit_trend(*series(fitted, axis))
-        if fit is None:
+        if not fits:
+            fits = fit_models(*series(fitted, axis))
+        if not fits:
             base.verdict = "no trend could be fitted"
             out.append(base)
             continue
-        slope, slope_error = float(fit.params[1]), float(np.sqrt(fit.cov[1, 1]))
-        if slope - z * slope_error <= 0:
-            base.model, base.wear = fit.model, float(fit.params[0])
+        weights = akaike_weights(fits)
+        named = named_model(fits)
+        drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
+        base.model, base.wear = named.model, float(np.median(drawn.key("wear")))
+        base.models = ", ".join(f"{f.model} {w:.2f}" for f, w in zip(fits, weights))
+        slope, slope_error = float(named.params[1]), float(np.sqrt(named.cov[1, 1]))
+        if slope - z * slope_error <= 0:  # the named model's slope now, as before the model average
             base.verdict = (f"no wear trend (slope now {slope:.2g} +- {slope_error:.2g} % per {time_unit[:-1]}, not above "
                             f"0 at alpha {alpha:g}): no end of life within the horizon ({horizon:g} {time_unit})")
             out.append(base)
             continue
-        toe = time_of_event(fit, failure_wear, horizon, samples, seed, scale_uncertainty)
-        out.append(_summarise(base, fit, toe, horizon))
+        toe = _propagate(drawn, failure_wear, horizon)
+        out.append(_summarise(base, fits, weights, labels, toe, horizon, series(fitted, axis)[0]))
     return out
 
 
-def _summarise(row: Remaining, fit: Fit, toe, horizon: float) -> Remaining:
+def named_model(fits) -> Fit:
+    """The model ``rul.csv`` names (column ``model``; the draws come from every model, column
+    ``models``): the simplest (fewest parameters, in the order of
+    :data:`faultgen.monitor.trends.MODELS`) whose AICc is within
+    :data:`faultgen.monitor.trends.AICC_MARGIN` of the least, as the rule before the average chose."""
+    least = min(f.aicc for f in fits)
+    near = [f for f in fits if f.aicc <= least + AICC_MARGIN] or fits
+    return min(near, key=lambda f: (len(f.params) + (f.changepoint is not None), MODELS.index(f.model)))
+
+
+def _quantiles(values: np.ndarray) -> np.ndarray:
+    """The 5 %, median and 95 % of times of event (``inf`` beyond the horizon; module docstring, 6)."""
+    return np.quantile(values, [INTERVAL[0], 0.5, INTERVAL[1]], method="inverted_cdf")
+
+
+def unpredictable(fits, weights, labels, values: np.ndarray, low: float, mid: float, high: float,
+                  logs_since_rise: int | None) -> str:
+    """Why the trend cannot yet tell the remaining life (module docstring, 7), or "" when it can:
+    fewer than :data:`MIN_RISE_LOGS` logs since the rise (``logs_since_rise``; None: no rise
+    fitted), a 5-95 % interval (``low``, ``mid`` its median, ``high``) ending beyond the horizon, or two
+    models of weight >= :data:`MIN_MODEL_WEIGHT` whose own 5-95 % intervals (of their draws
+    ``values[labels == i]``) do not overlap."""
+    if logs_since_rise is not None and logs_since_rise < MIN_RISE_LOGS:
+        return f"{logs_since_rise} logs since the rise began, {MIN_RISE_LOGS} needed"
+    if not np.isfinite(high):
+        return "the 95 % end of its interval beyond the horizon"
+    ranges = {i: _quantiles(values[labels == i]) for i, w in enumerate(weights)
+              if w >= MIN_MODEL_WEIGHT and np.sum(labels == i) >= 20}
+    for i in ranges:
+        for j in ranges:
+            if i < j and (ranges[i][2] < ranges[j][0] or ranges[j][2] < ranges[i][0]):
+                return (f"the {fits[i].model} ({ranges[i][0]:.3g}-{ranges[i][2]:.3g}) and {fits[j].model} "
+                        f"({ranges[j][0]:.3g}-{ranges[j][2]:.3g}) trends' 5-95 % intervals do not overlap")
+    return ""
+
+
+def _summarise(row: Remaining, fits, weights, labels, toe, horizon: float, times: np.ndarray) -> Remaining:
+    """The row of a propagated model average (module docstring, 6-7); ``times`` the fitted logs' times."""
     import_progpy()
     from progpy.metrics import prob_success
 
     values = np.array([np.inf if v is None else float(v) for v in toe.key("failure")])
     values[values < 1e-6] = 0.0  # crossed already: the first step's length
-    low, mid, high = np.quantile(values, [INTERVAL[0], 0.5, INTERVAL[1]], method="inverted_cdf")
-    row.model, row.wear, row.distribution = fit.model, float(fit.params[0]), toe
+    low, mid, high = _quantiles(values)
+    row.distribution = toe
     row.p_within_horizon = 1.0 - float(prob_success(toe, horizon)["failure"])
     unit = row.time_unit
     h = f"{horizon:g} {unit}"
     if row.p_within_horizon < 0.5:
         row.verdict = f"no end of life within the horizon ({h}): probability {row.p_within_horizon:.2f} within it"
         return row
-    row.rul, row.rul_5 = float(mid), float(low)
-    row.rul_95 = float(high) if np.isfinite(high) else None
+    # the rise's start: the changepoint trend's changepoint (the power law's start is ill-determined
+    # when its exponent is large: a steep late rise reads as a slow early one), where the models that
+    # date a rise carry at least half the weight
+    dated = [f for f in fits if f.changepoint is not None]
+    since_rise = None
+    if dated and sum(w for f, w in zip(fits, weights) if f.changepoint is not None) >= 0.5:
+        hinge = next((f for f in dated if f.model == "changepoint"), dated[0])
+        since_rise = int(np.sum(times > hinge.changepoint))
     upper = f"{high:.3g} {unit}" if np.isfinite(high) else f"beyond the {h} horizon"
     now = " (at or past it now)" if row.wear >= row.failure_wear else ""
-    rising = "" if fit.changepoint is None else f", rising for the last {-fit.changepoint:.3g} {unit}"
+    models = f"models: {row.models}"
+    why = unpredictable(fits, weights, labels, values, low, mid, high, since_rise)
+    if why:
+        row.predictable = False
+        row.verdict = (f"not yet predictable: {why} (median {mid:.3g} {unit}, 5-95 %: {low:.3g} {unit} to {upper}; "
+                       f"{row.logs_fitted} logs; {models})")
+        return row
+    row.rul, row.rul_5 = float(mid), float(low)
+    row.rul_95 = float(high)
+    rising = "" if since_rise is None else f", rising for the last {since_rise} logs"
     row.verdict = (f"end of life (wear {row.failure_wear:g} %){now} in {mid:.3g} {unit}, 5-95 %: {low:.3g} {unit} "
-                   f"to {upper} ({fit.model} trend of {row.logs_fitted} logs{rising})")
+                   f"to {upper} (model average of {row.logs_fitted} logs{rising}; {models})")
     return row
 
 

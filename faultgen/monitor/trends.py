@@ -1,9 +1,11 @@
-"""The degradation trends :mod:`faultgen.monitor.prognosis` fits to an axis's wear estimates (issue
-59), each by weighted least squares with its parameters' covariance, written with the state now
-(``t`` <= 0 the logs' times, 0 the last log): a line, an exponential (:func:`fit_trend`, chosen by
-AICc) and the changepoint trend, flat and then a line (:func:`fit_hinge`). The remaining life
-propagates them with ProgPy (:mod:`faultgen.monitor.prognosis`, whose module docstring gives the
-rules and what they rest on).
+"""The degradation trends :mod:`faultgen.monitor.prognosis` fits to an axis's wear estimates (issues
+59 and 75), each by weighted least squares with its parameters' covariance, written with the state now
+(``t`` <= 0 the logs' times, 0 the last log; ``params[0]`` the wear now, %, ``params[1]`` its slope
+now, % per day or log): a line, an exponential, the changepoint trend, flat and then a line
+(:func:`fit_hinge`), and the power-law rise, flat and then a power of the time since the rise
+(:func:`fit_power`); each with its AICc, from which :func:`akaike_weights` gives the model average's
+weights (:func:`fit_models`). The remaining life propagates them with ProgPy
+(:mod:`faultgen.monitor.prognosis`, whose module docstring gives the rules and what they rest on).
 """
 
 from __future__ import annotations
@@ -13,9 +15,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Models, the simpler first; "changepoint" (the hinge: flat, then a line) only for the open
-#: alarm's source axis (faultgen.monitor.prognosis, module docstring, 2).
-MODELS = ("linear", "exponential", "changepoint")
+#: Models, the simpler first; "changepoint" (the hinge: flat, then a line) and "power" (flat, then
+#: a power >= 1 of the time since the rise) only for the open alarm's source axis
+#: (faultgen.monitor.prognosis, module docstring, 2).
+MODELS = ("linear", "exponential", "changepoint", "power")
+#: The power law's exponent is looked for in [1, POWER_MAX] (1: the changepoint trend; 2: a wear
+#: rate growing in proportion to the time since the rise; above 4 the rise is a step the logs would
+#: show as such).
+POWER_MAX = 4.0
+#: The exponents of the power law's starting grid (refined by least squares).
+POWER_GRID = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0)
 #: The hinge's changepoint is looked for between the logs this far from either end of the block
 #: (the 3rd log and the 5th from the last: a flat stretch and a rise of at least a few logs each).
 HINGE_MARGINS = (2, 4)
@@ -41,17 +50,19 @@ def _exponential(t, w0, b, k):
 
 @dataclass(frozen=True)
 class Fit:
-    """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k]), their covariance
-    ``cov`` (scaled by the reduced chi-square when above one: :mod:`faultgen.monitor.prognosis`, 4),
-    its ``aicc`` (the line's and the exponential's, which :func:`fit_trend` compares by it; NaN for
-    the changepoint trend, compared with nothing) and ``changepoint`` the hinge's ``tc`` (None for
-    the other models)."""
+    """A fitted trend: ``model`` name, parameters ``params`` (w0, b[, k] for the line and the
+    exponential, w_now, b for the changepoint trend, w_now, b, age, p for the power law: the wear
+    now, %, and its slope now first), their covariance ``cov`` (scaled by the reduced chi-square when
+    above one: :mod:`faultgen.monitor.prognosis`, 4), its ``aicc`` (:func:`information_criterion`,
+    on the logs it was fitted on) and ``changepoint`` the time the rise began (the hinge's ``tc``,
+    the power law's -age; None for the other models)."""
 
     model: str
     params: np.ndarray
     cov: np.ndarray
     aicc: float = float("nan")
     changepoint: float | None = None
+    limits: tuple | None = None
 
 
 def _widened(cov: np.ndarray, chi2: float, dof: int) -> np.ndarray:
@@ -71,15 +82,7 @@ def _hinge_design(t: np.ndarray, tc) -> np.ndarray:
 def _hinge_wls(t, wear, weight, tc):
     """Weighted least squares of the hinge's (w_now, b) at each changepoint ``tc``: parameters (m, 2)
     and chi-square (m,); NaN where the design is singular."""
-    x = _hinge_design(t, tc)
-    a = np.einsum("mni,n,mnj->mij", x, weight, x)
-    rhs = np.einsum("mni,n,n->mi", x, weight, wear)
-    det = np.linalg.det(a)
-    ok = det > 1e-12 * np.maximum(a[:, 0, 0] * a[:, 1, 1], 1e-300)
-    params = np.full(rhs.shape, np.nan)
-    params[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0]
-    residual = wear[None, :] - np.einsum("mni,mi->mn", x, params)
-    return params, np.einsum("mn,n->m", residual**2, weight)
+    return _wls(_hinge_design(t, tc), wear, weight)
 
 
 def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
@@ -130,19 +133,136 @@ def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     cov = _widened(cov, chi2_tc, n - 3)
     if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
         return None
-    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], changepoint=tc)
+    residual = wear - (w_now + b * np.maximum(t, tc))
+    return Fit("changepoint", np.array([w_now, b]), cov[:2, :2], information_criterion(residual, error, 3),
+               changepoint=tc)
 
 
-def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
-    """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
-    standard errors ``error``; the one of smaller AICc (:mod:`faultgen.monitor.prognosis`, 3-4), None
-    when neither fits."""
+def information_criterion(residual: np.ndarray, error: np.ndarray, n_params: int) -> float:
+    """AICc (``statsmodels.tools.eval_measures.aicc``; Burnham & Anderson 2002) of a trend with
+    ``n_params`` parameters whose ``residual`` (%, shape (n,)) have the stated standard errors
+    ``error`` (%): the Gaussian likelihood with the variances' common scale at its maximum (one
+    parameter more); infinite where the sample is too small for the correction."""
     from scipy import stats
-    from scipy.optimize import curve_fit
     from statsmodels.tools.eval_measures import aicc
 
+    n = len(residual)
+    if n - n_params - 2 <= 0:
+        return float("inf")
+    chi2 = float(np.sum((residual / error) ** 2))
+    scale = np.sqrt(chi2 / n) if chi2 > 0 else 1e-12
+    llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
+    return float(aicc(llf, n, n_params + 1))
+
+
+def power_curve(t, w_now, b, age, p):
+    """The power-law rise at times ``t`` (<= 0): ``w_now + b ((age + t)_+^p - age^p) / (p age^(p-1))``,
+    flat until ``-age`` and then ``c (t + age)^p`` above that level, ``c = b / (p age^(p-1))``: the wear
+    ``w_now`` and slope ``b`` now, ``age`` (> 0) the time since the rise began, ``p`` >= 1 (1: the
+    changepoint trend)."""
+    t = np.asarray(t, dtype=float)
+    return w_now + b * (np.maximum(age + t, 0.0) ** p - age**p) / (p * age ** (p - 1.0))
+
+
+def fit_power(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
+    """The power-law rise (:func:`power_curve`; ``w = a + c (t - t0)_+^p``, ``p`` in [1,
+    :data:`POWER_MAX`], the rise's start ``t0`` = -age among the logs the changepoint trend looks at,
+    :data:`HINGE_MARGINS`) fitted to ``wear`` (%) at times ``t`` (<= 0, the last 0) with standard
+    errors ``error``: weighted least squares of (``w_now``, ``b``) on a grid of the logs' ages and
+    :data:`POWER_GRID`, the best refined over all four parameters within those bounds
+    (``scipy.optimize.least_squares``), the covariance the Gauss-Newton one there, scaled by the
+    reduced chi-square when above one. :class:`Fit` ``power`` with ``params`` (w_now, b, age, p)
+    and ``changepoint`` -age; None when it cannot be fitted."""
+    from scipy.optimize import least_squares
+
     t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
-    fits = []
+    n = len(t)
+    first, last = HINGE_MARGINS[0], n - 1 - HINGE_MARGINS[1]
+    if last < first or n < 7:
+        return None
+    ages = -t[first: last + 1]
+    ages = ages[ages > 0]
+    if not ages.size:
+        return None
+    weight = 1.0 / error**2
+    grid = [(a, p) for a in ages for p in POWER_GRID]
+    basis = np.stack([(np.maximum(a + t, 0.0) ** p - a**p) / (p * a ** (p - 1.0)) for a, p in grid])
+    x = np.stack([np.ones_like(basis), basis], axis=-1)
+    params, chi2 = _wls(x, wear, weight)
+    if not np.any(np.isfinite(chi2)):
+        return None
+    best = int(np.nanargmin(chi2))
+    start = np.array([*params[best], *grid[best]])
+    low = np.array([-np.inf, -np.inf, float(ages.min()), 1.0])
+    high = np.array([np.inf, np.inf, float(ages.max()), POWER_MAX])
+    if not high[2] > low[2]:
+        high[2] = low[2] * (1 + 1e-9) + 1e-12
+    start = np.clip(start, low, high)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            found = least_squares(lambda q: (power_curve(t, *q) - wear) / error, start, bounds=(low, high),
+                                  x_scale="jac", method="trf")
+        jacobian = found.jac
+        cov = np.linalg.inv(jacobian.T @ jacobian)
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    chi2_found = float(np.sum(found.fun**2))
+    cov = _widened(cov, chi2_found, n - 4)
+    if not (np.all(np.isfinite(found.x)) and np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
+        return None
+    residual = wear - power_curve(t, *found.x)
+    return Fit("power", found.x, cov, information_criterion(residual, error, 4), changepoint=-float(found.x[2]),
+               limits=(low[2:], high[2:]))
+
+
+def _wls(x: np.ndarray, wear: np.ndarray, weight: np.ndarray):
+    """Weighted least squares of ``wear`` (n,) on each design ``x`` (m, n, 2): parameters (m, 2) and
+    chi-square (m,); NaN where the design is singular."""
+    a = np.einsum("mni,n,mnj->mij", x, weight, x)
+    rhs = np.einsum("mni,n,n->mi", x, weight, wear)
+    det = np.linalg.det(a)
+    ok = det > 1e-12 * np.maximum(a[:, 0, 0] * a[:, 1, 1], 1e-300)
+    params = np.full(rhs.shape, np.nan)
+    params[ok] = np.linalg.solve(a[ok], rhs[ok][..., None])[..., 0]
+    residual = wear[None, :] - np.einsum("mni,mi->mn", x, params)
+    return params, np.einsum("mn,n->m", residual**2, weight)
+
+
+def akaike_weights(fits: list[Fit]) -> np.ndarray:
+    """The Akaike weights of ``fits`` (Burnham & Anderson 2002, ch. 2.9): ``exp(-dAICc / 2)``
+    normalised (``scipy.special.softmax``), a fit of infinite AICc weight 0; all equal when none is
+    finite. Shape (len(fits),)."""
+    from scipy.special import softmax
+
+    aicc = np.array([f.aicc for f in fits], dtype=float)
+    finite = np.isfinite(aicc)
+    if not finite.any():
+        return np.full(len(fits), 1.0 / len(fits))
+    weights = np.zeros(len(fits))
+    weights[finite] = softmax(-0.5 * (aicc[finite] - aicc[finite].min()))
+    return weights
+
+
+def fit_models(t: np.ndarray, wear: np.ndarray, error: np.ndarray, changepoint: bool = False) -> list[Fit]:
+    """Every model that fits (:data:`MODELS`; the changepoint trend and the power-law rise only with
+    ``changepoint``): the line, the exponential, and with ``changepoint`` the hinge and the power
+    law, each with its AICc on the same logs (the model average's weights, :func:`akaike_weights`).
+    A hinge or power law whose slope now is not positive is left out (a trend that has stopped
+    rising is the line's or the exponential's)."""
+    fits = list(_fit_line_and_exponential(t, wear, error))
+    if changepoint:
+        for fit in (fit_hinge(t, wear, error), fit_power(t, wear, error)):
+            if fit is not None and fit.params[1] > 0:
+                fits.append(fit)
+    return fits
+
+
+def _fit_line_and_exponential(t, wear, error):
+    """The line and the exponential fitted to ``wear`` (:func:`fit_trend`), each with its AICc."""
+    from scipy.optimize import curve_fit
+
+    t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
     linear = None
     for name, f in (("linear", _linear), ("exponential", _exponential)):
         n_params = 2 if name == "linear" else 3
@@ -158,7 +278,10 @@ def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                params, cov = curve_fit(f, t, wear, p0=p0, sigma=error, absolute_sigma=True, maxfev=5000)
+                bounds = ([-np.inf, -np.inf], [np.inf, np.inf]) if name == "linear" else \
+                    ([-np.inf, -np.inf, 0.0], [np.inf, np.inf, np.inf])  # an accelerating exponential
+                params, cov = curve_fit(f, t, wear, p0=p0, sigma=error, absolute_sigma=True, bounds=bounds,
+                                        **({"maxfev": 5000} if name == "linear" else {"max_nfev": 5000}))
         except (RuntimeError, ValueError, np.linalg.LinAlgError):
             continue
         residual = wear - f(t, *params)
@@ -166,13 +289,17 @@ def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         cov = _widened(cov, chi2, len(t) - n_params)
         if not (np.all(np.isfinite(params)) and np.all(np.isfinite(cov))):
             continue
-        # Gaussian likelihood, the variances' common scale at its maximum (one parameter more)
-        scale = np.sqrt(chi2 / len(t)) if chi2 > 0 else 1e-12
-        llf = float(np.sum(stats.norm.logpdf(residual, scale=error * scale)))
-        found = Fit(name, params, cov, float(aicc(llf, len(t), n_params + 1)))
+        found = Fit(name, params, cov, information_criterion(residual, error, n_params))
         if name == "linear":
             linear = found
-        fits.append(found)
+        yield found
+
+
+def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
+    """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
+    standard errors ``error``; the one of smaller AICc by :data:`AICC_MARGIN` (the rule before the
+    model average of 2026-11-26), None when neither fits."""
+    fits = list(_fit_line_and_exponential(t, wear, error))
     if not fits:
         return None
     if len(fits) == 2 and fits[1].aicc < fits[0].aicc - AICC_MARGIN:
