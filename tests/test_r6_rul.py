@@ -157,7 +157,7 @@ def test_the_scale_uncertainty_per_axis():
     default = rows_of({1: 0.0})[1]  # an axis not named: the monitor's SCALE_UNCERTAINTY
     same = rows_of(prognosis.SCALE_UNCERTAINTY)[1]
     assert (default.rul, default.rul_5, default.rul_95) == (same.rul, same.rul_5, same.rul_95)
-    for bad, match in (({3: 0.1}, "axis 3"), ([0.1], "expected 2 numbers"), (1.5, "1.5"), (-0.1, "-0.1"),
+    for bad, match in (({3: 0.1}, "axis 3"), ([0.1], "expected 2 numbers"), (10.5, "10.5"), (float("nan"), "nan"), (-0.1, "-0.1"),
                        ({1: "x"}, "'x'")):
         with pytest.raises(ValueError, match=match):
             rows_of(bad)

@@ -102,6 +102,8 @@ MAX_FAILURE_WEAR = 1000.0
 HORIZON = 365.0
 #: Fewest logs a trend is fitted on (the monitor's default persistence: an alarm's own logs).
 MIN_LOGS = 5
+#: Largest relative standard uncertainty of a wear scale taken (:func:`scale_of_axis`).
+MAX_SCALE_UNCERTAINTY = 10.0
 #: Draws of the fitted parameters propagated to a time of event.
 SAMPLES = 1000
 #: The interval given: 5 and 95 % quantiles of the time of event.
@@ -299,8 +301,10 @@ def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float:
     """The relative standard uncertainty of ``axis``'s (1..``n_axes``) wear scale from
     ``scale_uncertainty``: one number for every axis, a mapping axis -> number (an axis not in it
     gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers.
-    ValueError naming the value when a number is not in [0, 1) or the sequence's length is not
-    ``n_axes``."""
+    ValueError naming the value when a number is not in [0, :data:`MAX_SCALE_UNCERTAINTY`] or the
+    sequence's length is not ``n_axes``. Above 1 is allowed: a scale read from one or two friction
+    tests may be that uncertain (:mod:`faultgen.monitor.friction_tests`); each draw's scale is kept
+    at 0.05 or more."""
     if isinstance(scale_uncertainty, Mapping):
         for key in scale_uncertainty:
             if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 1 <= key <= n_axes:
@@ -314,9 +318,9 @@ def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float:
     else:
         value = scale_uncertainty
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) or \
-            not 0.0 <= float(value) < 1.0:
+            not 0.0 <= float(value) <= MAX_SCALE_UNCERTAINTY:
         raise ValueError(f"scale_uncertainty of axis {axis} = {value!r}: expected the relative standard "
-                         "uncertainty of the wear estimate's scale, a number in [0, 1)")
+                         f"uncertainty of the wear estimate's scale, a number in [0, {MAX_SCALE_UNCERTAINTY:g}]")
     return float(value)
 
 
