@@ -53,7 +53,7 @@ VISIBLE = 0.02
 @dataclass(frozen=True)
 class Case:
     name: str
-    kind: str  # an outside kind of FORMS, "library", "mixed" or "null"
+    kind: str  # an outside kind of FORMS, "library", "mixed" or "none" (a null log)
     rate: float
     duration: float
     seed: int
@@ -82,8 +82,8 @@ CASES = [
     Case("ow-15-load_total", "library", 400, 40, 3015, forms=("load_total",)),
     Case("ow-16-stribeck+ripple-ax5", "mixed", 500, 40, 3016, axis=4, size=0.06, order=3,
          forms=("stribeck_exponent",)),
-    Case("ow-17-null", "null", 400, 40, 3017),
-    Case("ow-18-null", "null", 800, 30, 3018, velocities=False),
+    Case("ow-17-null", "none", 400, 40, 3017),
+    Case("ow-18-null", "none", 800, 30, 3018, velocities=False),
 ]
 
 
@@ -139,7 +139,7 @@ def make(case: Case, folder: Path) -> tuple[Path, dict]:
         frame = frame.iloc[rows:].reset_index(drop=True)
         before = before[rows:]  # the same times as the rows kept
     change = np.sqrt(np.mean((frame[taus].to_numpy() - before) ** 2, axis=0)) / rms
-    truth = {"axes": [int(k) for k in np.flatnonzero(change >= VISIBLE)] if kind not in ("library", "null") else [],
+    truth = {"axes": [int(k) for k in np.flatnonzero(change >= VISIBLE)] if kind not in ("library", "none") else [],
              "form": FORMS.get("ripple" if kind == "mixed" else kind), "delay_s": case.size if kind == "delay" else None,
              "hidden": hidden, "change": change}
     if not case.velocities:
@@ -184,7 +184,7 @@ def run(case: Case) -> dict:
         row["library_named"] = (verdict["named"] if verdict is not None else
                                 all(any(e == effect and set(on) <= set(axes) for e, axes in steps) for effect, on in named))
         row["hidden_library"] = " | ".join(f"{e} {[a + 1 for a in on]}" for e, on in named)
-    if case.kind in ("null", "library"):
+    if case.kind in ("none", "library"):
         row["clean"] = not left
     row["seconds"] = time.perf_counter() - started
     return row
@@ -193,11 +193,12 @@ def run(case: Case) -> dict:
 def summary(frame: pd.DataFrame) -> str:
     outside = frame[frame["kind"].isin(list(FORMS) + ["mixed"])]
     library = frame[frame["kind"] == "library"]
-    null = frame[frame["kind"] == "null"]
+    null = frame[frame["kind"] == "none"]
+    periodic = outside[outside.kind.isin(["ripple", "mixed", "position_friction"])]
     lines = [f"outside effects reported unexplained on their axes: {int(outside.reported.sum())} of {len(outside)}",
              f"right form named first: {int(outside.form_named.sum())} of {len(outside)} "
-             f"({outside.form_named.mean():.0%}; period resolved on {int((outside.order_resolved == True).sum())} of "  # noqa: E712
-             f"{int(outside.kind.isin(['ripple', 'mixed', 'position_friction']).sum())} periodic)",
+             f"({outside.form_named.mean():.0%}; the period resolved on {int((periodic.order_resolved == True).sum())} "  # noqa: E712
+             f"of {len(periodic)} periodic)",
              f"a library effect written on an outside effect's axes: {int(outside.forced.sum())} of {len(outside)}"]
     if len(library):
         lines.append(f"in-library effects named as today: {int(library.library_named.sum())} of {len(library)}; "
