@@ -19,6 +19,7 @@ import numpy as np
 
 from faultgen import axes as axis_numbers
 from faultgen.calibrate import remainder, residual_tests, search
+from faultgen.calibrate.criterion import rms
 
 #: How many times the effect's held-out nrmse drop a single generic group's must reach to win.
 MORE = 1.1
@@ -52,7 +53,7 @@ def check(candidate: search.Candidate, on: list[int], trial, before: np.ndarray,
     suspects = [a for a in on if a in failing]
     if not suspects:
         return list(on), []
-    scale = search._rms(tau, split.held_out)
+    scale = rms(tau, split.held_out)
     declined = []
     for a in suspects:
         record = decline(candidate, a, data, tau, before, split, float(scale[a]) or 1.0, gear_ratio)
