@@ -162,10 +162,10 @@ def run(case: Case) -> dict:
            "qd": case.velocities, "truth_axes": " ".join(str(a + 1) for a in truth["axes"]),
            "unexplained": " ".join(str(a + 1) for a in sorted(left)),
            "steps": " | ".join(f"{e} {[a + 1 for a in on]}" for e, on in steps) or "-",
-           "not_written": " | ".join(f"{d['effect']} [{d['axis']}]" for d in result.declined) or "-",
+           "not_written": " | ".join(f"{d['effect']} [{d['axis']}]" for d in getattr(result, "declined", [])) or "-",
            "gap_before": result.gap_before["total_nrmse"], "gap_after": result.gap_after["total_nrmse"],
            "delay_check_ms": 1e3 * result.delay["estimate"]["seconds"] if result.delay.get("estimate") else np.nan}
-    first = {a: (u["terms"][0] if u["terms"] else None) for a, u in left.items()}
+    first = {a: (u["terms"][0] if u.get("terms") else None) for a, u in left.items()}  # (before issue 73: none)
     row["first_terms"] = " || ".join(f"axis {a + 1}: {t['words']} ({100 * t['share']:.0f} %)" if t else
                                      f"axis {a + 1}: -" for a, t in sorted(first.items()))
     if truth["axes"]:
