@@ -206,6 +206,8 @@ def choose(ranked: list[search.Candidate], model: Model, predicted: np.ndarray, 
         allowed, refusals = guard.check(candidate, on, trial, predicted, data, tau, split, gear_ratio)
         declined += refusals
         refused |= {(d["effect"], d["axis"] - 1) for d in refusals}
+        if not allowed and not candidate.effect.per_axis:  # a robot-wide effect is declined whole
+            refused |= {(candidate.effect.id, a) for a in on}
         if allowed == on:
             return candidate, on, trial
         if not allowed:
