@@ -199,3 +199,18 @@ def test_the_example_ripple_is_named_and_the_gap_shrinks(tmp_path):
     assert mine.gap_after["nrmse"][1] < 0.6 * plain.gap_after["nrmse"][1]
     assert all(u["axis"] != 2 for u in mine.unexplained())
     assert "arm_ripple" not in REGISTRY
+
+
+def test_no_forced_fit_an_offset_beside_another_structure_is_written(log):
+    """An offset of 2 N m beside a smaller structure (another axis's acceleration) that the offset
+    leaves, failing the tests: the generic term alone explains the structure only, less than the
+    offset does, so the offset is written (an intercept in the generic fit would take the offset's
+    share and refuse it)."""
+    t, q, qd, qdd, model, fit, held, noise = log
+    structure = 0.5 * qdd[:, 4] / np.std(qdd[:, 4])
+    before, after = noise.copy(), noise.copy()
+    before[:, 1] += 2.0 + structure
+    after[:, 1] += structure
+    scale = np.sqrt(np.mean((model + before)[held[:, 1], 1] ** 2))
+    gain = (np.sqrt(np.mean(before[held[:, 1], 1] ** 2)) - np.sqrt(np.mean(after[held[:, 1], 1] ** 2))) / scale
+    assert _guarded(log, before, after, gain) == ([1], [])

@@ -7,7 +7,7 @@ axis is reported unexplained with that term (``report.json``: the unexplained ax
 
 "Explains more" compares held-out nrmse drops on the remainder before the step: the effect's on
 that axis (:attr:`faultgen.calibrate.search.Candidate.gain`) against the best single generic group's,
-fitted alone with an intercept on the fitting part (:func:`faultgen.calibrate.remainder.best_single`);
+fitted alone, without an intercept, on the fitting part (:func:`faultgen.calibrate.remainder.best_single`);
 the generic group wins when its drop is at least :data:`MORE` times the effect's. One form against
 one form: an effect in the library that is the plant's explains its own remainder at least as
 well as any other single form does.
@@ -79,7 +79,7 @@ def decline(candidate: search.Candidate, axis: int, data, tau: np.ndarray, befor
     effect_gain = float(candidate.gain[axis])
     if best is None or gain < MORE * max(effect_gain, 0.0):
         return None
-    value, unit = remainder.size(best, theta[:-1])
+    value, unit = remainder.size(best, theta)
     return {"effect": candidate.effect.id, "axis": axis_numbers.number(axis), "effect_gain_nrmse": effect_gain,
             "generic": best.key, "generic_form": best.form, "generic_gain_nrmse": float(gain),
             "generic_words": remainder.words(best, axis, value, None, unit),

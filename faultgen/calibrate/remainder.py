@@ -155,16 +155,18 @@ def _predict(design: np.ndarray, theta: np.ndarray) -> np.ndarray:
 
 def best_single(candidates: list[Group], y: np.ndarray, fit: np.ndarray, held: np.ndarray, scale: float
                 ) -> tuple[Group | None, float, np.ndarray | None]:
-    """The generic group that alone (with an intercept, fitted on ``fit``) lowers the held-out nrmse
-    of the remainder ``y`` (n,) most, that drop (nrmse: RMS over ``scale``, the axis's measured
-    torque RMS, N m) and its coefficients (the intercept last). (None, 0.0, None) when no group lowers it."""
+    """The generic group that alone (no intercept: a constant is the library's torque offset, and
+    an intercept in every generic fit would let any group take an offset's share too; fitted on
+    ``fit``) lowers the held-out nrmse of the remainder ``y`` (n,) most, that drop (nrmse: RMS over
+    ``scale``, the axis's measured torque RMS, N m) and its coefficients. (None, 0.0, None) when no
+    group lowers it."""
     if not held.any() or not fit.any():
         return None, 0.0, None
     before = float(np.sqrt(np.mean(y[held] ** 2)))
     best, best_gain, best_theta = None, 0.0, None
     for g in candidates:
-        theta = _ols(g.columns, y, fit)
-        after = float(np.sqrt(np.mean((y[held] - _predict(g.columns[held], theta)) ** 2)))
+        theta = np.linalg.lstsq(g.columns[fit], y[fit], rcond=None)[0]
+        after = float(np.sqrt(np.mean((y[held] - g.columns[held] @ theta) ** 2)))
         gain = (before - after) / scale
         if gain > best_gain:
             best, best_gain, best_theta = g, gain, theta
