@@ -92,9 +92,9 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     out = tmp_path / "out"
     report = json.loads((out / "report.json").read_text())
     # the contract's keys (design notes), and later additions: the steps not separable on this log, the residual
-    # tests after every step and the channel delay check
+    # tests after every step, the channel delay check and the library effects not written (issue 73)
     assert set(report) == {"robot", "measured", "gap_before", "steps", "gap_after", "model_out", "ambiguous",
-                           "unexplained", "residual_tests", "channel_delay"}
+                           "unexplained", "residual_tests", "channel_delay", "not_written"}
     assert report["steps"][0]["units"]["mass"] == "kg" and report["steps"][0]["units"]["com_x"] == "m (flange frame)"
     assert report["robot"] == "puma560" and report["measured"].endswith("measured.csv")
     for gap in (report["gap_before"], report["gap_after"], report["steps"][0]["gap_after"]):

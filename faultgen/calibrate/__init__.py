@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import axes
-from faultgen.calibrate import search
+from faultgen.calibrate import search, user_effects
 from faultgen.calibrate.effects import EFFECTS, Effect, get
 from faultgen.calibrate.residual_tests import LEVEL as RESIDUAL_TEST_LEVEL
 from faultgen.calibrate.loop import MAX_STEPS
@@ -64,7 +64,7 @@ MAX_ROWS = 25_000
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
               log_format=None, friction_every_axis: bool = False, figure: bool = True,
-              delay: str | float | None = None) -> Calibration:
+              delay: str | float | None = None, effects: list[str] | None = None) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
@@ -82,7 +82,17 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     ``figure``: draw ``calibration.png`` (False: the other outputs only, as ``faultgen monitor`` caches them).
     ``delay``: the channel delay's correction (None: reported only; "auto": the estimate; a number
     of seconds; :func:`faultgen.calibrate.loop.check_delay`).
+    ``effects``: a user's own effect classes, ``module:Class`` or ``path/file.py:Class`` each
+    (``--effects``; :mod:`faultgen.calibrate.user_effects`), fitted beside the library's for this
+    calibration (UserEffectError, a ValueError, naming the module and class when one is not usable).
     The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
+    with user_effects.loaded(effects):  # the library as it was afterwards
+        return _calibrate_with(robot, measured, out, max_steps, progress, use_sysid, log_format,
+                               friction_every_axis, figure, delay)
+
+
+def _calibrate_with(robot, measured, out, max_steps, progress, use_sysid, log_format, friction_every_axis, figure,
+                    delay) -> Calibration:
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
         data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)

@@ -74,7 +74,12 @@ def save(result, path: str | Path) -> Path:
 
 
 def _follows(found: dict) -> str:
-    """What an unexplained axis's residual follows, for the title (nothing when only whiteness failed)."""
+    """What an unexplained axis's residual follows, for the title: the first generic term named
+    (:mod:`faultgen.calibrate.remainder`), else the variable of the tests' largest correlation
+    (nothing when only whiteness failed)."""
+    terms = found.get("terms") or []
+    if terms:
+        return f"; follows: {terms[0]['words']} ({100 * terms[0]['share']:.0f} % of the gap left)"
     follows = found["follows"]
     return "" if follows is None else f"; follows {follows['variable']} at {1e3 * follows['lag_s']:+.0f} ms"
 

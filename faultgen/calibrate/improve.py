@@ -33,8 +33,8 @@ REFIT_ROUNDS = 2
 
 
 def complete(model: Model, predicted: np.ndarray, motion: Motion, steps: list[Step], data: measured_io.MeasuredData,
-             tau: np.ndarray, split: search.Split, path: Path, progress: bool = False
-             ) -> tuple[Model, np.ndarray, Motion]:
+             tau: np.ndarray, split: search.Split, path: Path, progress: bool = False,
+             declined: set[tuple[str, int]] = frozenset()) -> tuple[Model, np.ndarray, Motion]:
     """Per-axis completeness: every axis whose held-out nrmse is still above
     :data:`search.ABOVE_FLOOR` times its noise floor (:func:`search.noise_floor`) is searched again
     for each per-axis effect the model already holds on other axes, judged by its held-out evidence
@@ -43,13 +43,14 @@ def complete(model: Model, predicted: np.ndarray, motion: Motion, steps: list[St
     effect took most of the torque (a payload) is then found on the rest. ``steps`` is updated in
     place (axes, the effect as the model holds it, standard errors on the new axes and a
     ``completed`` record in the evidence); trials are named ``path``. Returns the model kept, its
-    prediction and motion."""
+    prediction and motion. ``declined``: (effect id, axis) pairs not to be written (no forced fit,
+    :mod:`faultgen.calibrate.guard`)."""
     floor = search.noise_floor(tau, split.held_out)
     for j, step in enumerate(steps):
         kind = get(step.effect.id)
         now = search.gap(tau, predicted, split.held_out)
         open_axes = [a for a in range(len(floor)) if now["nrmse"][a] > search.ABOVE_FLOOR * floor[a]
-                     and a not in step.axes]
+                     and a not in step.axes and (step.effect.id, a) not in declined]
         if not kind.per_axis or not open_axes:
             continue
         residual = tau - predicted

@@ -15,7 +15,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate import delay as delays
-from faultgen.calibrate import plausibility, residual_tests, search
+from faultgen.calibrate import guard, plausibility, remainder, residual_tests, search
 from faultgen.calibrate.effects import Effect, get
 from faultgen.calibrate.improve import backfit, complete, extend, sysid_stribeck
 from faultgen.calibrate.prediction import predicted_motion
@@ -117,28 +117,28 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     steps: list[Step] = []
     befores: list[Effect] = []  # each step's effect as the model held it before the step
     searches = 0
+    declined: list[dict] = []  # (no forced fit) library effects not written on an axis, guard.check
     for k in range(max_steps):
         residual = tau - predicted
         searches += 1
         ranked = search.rank(motion, residual, tau, split, progress=progress, label=f"step {k + 1}: fitting effects")
-        best = ranked[0]
-        if not best.axes:
-            break
-        trial = judge(model.with_effect(best.effect, best.axes, model_out), data, tau, split.held_out)
-        after = trial.gap
         previous = steps[-1].gap_after if steps else gap_before
-        if after["total_nrmse"] >= previous["total_nrmse"]:
-            break  # the model with it does not do what the fit promised: stop, keep what works
-        errors = search.standard_errors(best.effect, motion, tau - predicted, tau, split, best.axes)
+        chosen = choose(ranked, model, predicted, data, tau, split, model_out, previous, declined, nominal.gear_ratio)
+        if chosen is None:
+            break  # nothing left, or the model with it does not do what the fit promised: keep what works
+        best, on, trial = chosen
+        after = trial.gap
+        errors = search.standard_errors(best.effect, motion, tau - predicted, tau, split, on)
         befores.append(best.effect.current(model.robot))
         model, predicted, motion = trial.model, trial.prediction, trial.motion
-        steps.append(Step(best.effect, best.axes, evidence(best, ranked, residual, split), after, errors))
+        steps.append(Step(best.effect, on, evidence(best, ranked, residual, split), after, errors))
         after_steps.append({"after": f"step {k + 1}: {best.effect.id}",
                             "axes": residual_tests.summary(tested(predicted))})
         if progress:
-            print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(best.axes)}, held-out total nrmse "
+            print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(on)}, held-out total nrmse "
                   f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
-        model, predicted, motion = complete(model, predicted, motion, steps, data, tau, split, model_out, progress)
+        model, predicted, motion = complete(model, predicted, motion, steps, data, tau, split, model_out, progress,
+                                           {(d["effect"], d["axis"] - 1) for d in declined})
     if len(steps) > 1:
         model, predicted = backfit(model, predicted, steps, befores, data, tau, split, model_out)
         model, predicted = extend(model, predicted, steps, data, tau, split, model_out)
@@ -153,6 +153,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
     final_tests = tested(predicted)
     after_steps.append({"after": "calibrated model", "axes": residual_tests.summary(final_tests)})
+    # what each unexplained axis's remainder follows (the generic library's terms, in words)
+    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out))
+    follows = {u["axis"]: remainder.explain(data.t, data.q, data.qd, data.qdd, tau, predicted, nominal.gear_ratio,
+                                            split.fit, split.held_out, u["axis"] - 1) for u in left}
     result = Calibration(
         robot=nominal.name,
         measured=str(data.source),
@@ -172,6 +176,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         residual_tests=final_tests,
         tests_after_steps=after_steps,
         delay=channel_delay,
+        follows=follows,
+        declined=declined,
     )
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     if figure:
@@ -179,6 +185,37 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
 
         figures.save(result, out / "calibration.png")
     return result
+
+
+def choose(ranked: list[search.Candidate], model: Model, predicted: np.ndarray, data: measured_io.MeasuredData,
+           tau: np.ndarray, split: search.Split, path: Path, previous: dict, declined: list[dict],
+           gear_ratio: np.ndarray):
+    """The step to take: the first candidate of ``ranked`` with axes left where it may be written
+    (no forced fit, :func:`faultgen.calibrate.guard.check`; ``declined``, updated in place, holds
+    the (effect, axis) pairs already refused), as ``(candidate, axes, trial)``; None when there is
+    none, or when the first whose axes are all allowed does not lower the held-out gap (as before
+    the guard: stop and keep what works)."""
+    refused = {(d["effect"], d["axis"] - 1) for d in declined}
+    for candidate in (c for c in ranked if c.axes):
+        on = [a for a in candidate.axes if (candidate.effect.id, a) not in refused]
+        if not on:
+            continue
+        trial = judge(model.with_effect(candidate.effect, on, path), data, tau, split.held_out)
+        if trial.gap["total_nrmse"] >= previous["total_nrmse"]:
+            return None
+        allowed, refusals = guard.check(candidate, on, trial, predicted, data, tau, split, gear_ratio)
+        declined += refusals
+        refused |= {(d["effect"], d["axis"] - 1) for d in refusals}
+        if not allowed and not candidate.effect.per_axis:  # a robot-wide effect is declined whole
+            refused |= {(candidate.effect.id, a) for a in on}
+        if allowed == on:
+            return candidate, on, trial
+        if not allowed:
+            continue
+        trial = judge(model.with_effect(candidate.effect, allowed, path), data, tau, split.held_out)
+        if trial.gap["total_nrmse"] < previous["total_nrmse"]:
+            return candidate, allowed, trial
+    return None
 
 
 def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: str | float | None):

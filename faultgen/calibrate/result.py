@@ -11,7 +11,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate.effects import Effect
-from faultgen.calibrate import residual_tests
+from faultgen.calibrate import remainder, residual_tests
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -95,6 +95,12 @@ class Calibration:
         model, after each step of the search and of the calibrated model: ``after`` and ``axes``.
     delay : dict or None
         The channel delay check (:func:`faultgen.calibrate.loop.check_delay`).
+    follows : dict
+        Per unexplained axis (numbered 1..N), what its remainder follows
+        (:func:`faultgen.calibrate.remainder.explain`): the generic terms in words, their shares.
+    declined : list of dict
+        Library effects not written on an axis because a generic term explains more of its
+        remainder (no forced fit, :func:`faultgen.calibrate.guard.check`).
     """
 
     robot: str
@@ -115,6 +121,8 @@ class Calibration:
     residual_tests: list[dict] | None = None
     tests_after_steps: list[dict] = field(default_factory=list)
     delay: dict | None = None
+    follows: dict = field(default_factory=dict)
+    declined: list[dict] = field(default_factory=list)
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""
@@ -129,6 +137,7 @@ class Calibration:
             "unexplained": self.unexplained(),
             "residual_tests": self.tests_after_steps,
             "channel_delay": self.delay,
+            "not_written": self.declined,
         }
 
     def unexplained(self) -> list[dict]:
@@ -138,8 +147,11 @@ class Calibration:
         if self.residual_tests is None:
             return []
         found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after)
+        empty = {"terms": [], "explained_share": 0.0, "explained_interval": [0.0, 0.0]}
         return [{**u, "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(self.steps, start=1)
-                                if u["axis"] - 1 in s.axes]} for u in found]
+                                if u["axis"] - 1 in s.axes],
+                 **{k: v for k, v in self.follows.get(u["axis"], empty).items() if k != "axis"},
+                 "not_written": [d for d in self.declined if d["axis"] == u["axis"]]} for u in found]
 
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
@@ -192,6 +204,9 @@ class Calibration:
                      f"model: {self.model_out}")
         for u in self.unexplained():
             lines.append(residual_tests.line(u))
+            lines.append(remainder.line(u))
+            lines += [f"   not written on axis {d['axis']}: {d['effect']} (held-out nrmse drop {d['effect_gain_nrmse']:.4f}; "
+                      f"{d['generic_words']} alone: {d['generic_gain_nrmse']:.4f})" for d in u["not_written"]]
         # the static model: for a per-step friction update, or a Stribeck curve MuJoCo's LuGre
         # (Gaussian only) cannot represent
         static_only = any(s.effect.stepped for s in self.steps) or any(

@@ -33,6 +33,11 @@ def calibrate_command(
         metavar="auto|SECONDS",
         help="Correct the delay of the torque columns behind the angles: auto (by the estimate the check reports) or "
              "a number of seconds (positive: the torque was logged late). Default: reported only.")] = None,
+    effects: Annotated[list[str] | None, typer.Option(
+        "--effects", metavar="MODULE:CLASS",
+        help="Your own effect class, fitted beside the library's: module:Class (the module on PYTHONPATH) or "
+             "path/to/file.py:Class, a subclass of faultgen.effects.Effect (example: "
+             "docs/examples/arm_ripple.py:ArmRipple). Repeat for several.")] = None,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     overwrite: Overwrite = False,
@@ -58,7 +63,11 @@ def calibrate_command(
     interval and reported (--delay corrects it). After every step, the residual of each axis is
     tested on the held-out part for whiteness (Ljung-Box) and for independence from the motion and
     the torque (cross-correlation over lags -25..25), Holm-adjusted at 1 %: an axis that fails, above
-    its noise floor, is printed as LEFT UNEXPLAINED with the variable and lag its residual follows.
+    its noise floor, is printed as LEFT UNEXPLAINED with the variable and lag its residual follows,
+    and with what its remainder follows in words (a sparse regression on generic terms: periodic in
+    the arm angle, the torque lagging the motion, a gain, the speed squared, cross-axis terms), with
+    each term's share of the remaining gap. A library effect is not written on an axis where a
+    generic term explains more of it and the axis still fails the tests (no forced fit).
 
     Writes into OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`)
     and model/parameters.json, report.json (gap before/after per axis, each effect with its axes,
@@ -80,12 +89,17 @@ def calibrate_command(
     from faultgen import calibrate
     from faultgen.model import robots
 
+    from faultgen.calibrate import user_effects
+
     shift = _delay(delay)
+    for spec in effects or ():
+        user_effects.load(spec)  # a bad --effects is refused before anything is read or written
     check_output_folder(out, overwrite)
     nominal = robots.load(robot)  # once, for the log's reader and the calibration
     adapter = log_adapter(log_format, torque_constants, nominal)  # None: the measured format
     result = calibrate.calibrate(nominal, measured, out, max_steps=max_steps, progress=True, use_sysid=sysid,
-                                 log_format=adapter, friction_every_axis=fit_friction_all, delay=shift)
+                                 log_format=adapter, friction_every_axis=fit_friction_all, delay=shift,
+                                 effects=effects)
     typer.echo(result.summary())
     typer.echo(f"wrote {out / 'report.json'} and {out / 'calibration.png'}")
 
