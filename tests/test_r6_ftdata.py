@@ -49,9 +49,10 @@ def test_a_fleet_without_tests_is_todays_and_with_tests_adds_one_labelled_test_r
         assert test.conditions.payloads is None and test.conditions.thermal == daily.conditions.thermal
         assert writer.is_friction_test(programs.record(test.task)) and not writer.is_friction_test(
             programs.record(daily.task))
-    with pytest.raises(ValueError, match=r"^fleet friction_test_every \(--friction-test-every\) = 7: expected a "
-                                         r"whole number within 0\.\.6$"):
-        fleet.Fleet(**SMALL, friction_test_every=7)
+    with pytest.raises(ValueError, match=r"^fleet friction_test_every \(--friction-test-every\) = 3651: expected a "
+                                         r"whole number within 0\.\.3650$"):
+        fleet.Fleet(**SMALL, friction_test_every=3651)
+    assert fleet.Fleet(**SMALL, friction_test_every=30).test_days() == [1]  # longer than the fleet: day 1 only
 
 
 def test_a_fleet_test_record_reads_back_as_the_robots_dry_level_at_its_wear(tested, tmp_path):

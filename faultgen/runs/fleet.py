@@ -251,7 +251,7 @@ class Fleet:
         check_number("fleet cycles_per_day (--cycles-per-day)", self.cycles_per_day, 1, 24, whole=True)
         check_number("fleet failure_wear (--failure-wear)", self.failure_wear, 0, 100 * wear.MAX_INCREASE)
         check_number("fleet seed", self.seed, 0, 2**31, whole=True)
-        check_number("fleet friction_test_every (--friction-test-every)", self.friction_test_every, 0, self.days,
+        check_number("fleet friction_test_every (--friction-test-every)", self.friction_test_every, 0, 3650,
                      whole=True)
         friction_models.check_model(self.friction)
         check_number("fleet gear_loss", self.gear_loss, 0, 0.5)
