@@ -27,7 +27,6 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.runs import sweep
-from faultgen.runs.fleet import Fleet
 
 REPO = Path(__file__).resolve().parents[1]
 FLEET = dict(size=2, failing=1, days=6, cycles_per_day=1)
@@ -102,8 +101,8 @@ def reference(shared_sweep) -> Path:
     return shared_sweep("sweep-reference", **SMALL)
 
 
-def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(reference, tmp_path, monkeypatch,
-                                                                                subtests):
+def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(reference, shared_fleet, tmp_path,
+                                                                                monkeypatch, subtests):
     """One test on one cluster (pytest-xdist would start a cluster in each of its workers that
     got one of several tests), each case a subtest: a sweep and a fleet equal the local ones, a
     shared folder, a worker killed mid-run, the client killed mid-run."""
@@ -120,7 +119,10 @@ def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(re
                      a_killed_client_resumes_to_the_same_dataset,
                      a_relative_robot_folder_and_program_run_on_the_workers):
             with subtests.test(case.__name__.replace("_", " ")):
-                case(cluster, reference, client_folder)
+                # the local fleet on one job, built once a session (tests/test_fleet.py compares with it too)
+                local = {"local_fleet": shared_fleet("fleet-small", **FLEET)} \
+                    if case is sweep_and_fleet_equal_the_local_ones else {}
+                case(cluster, reference, client_folder, **local)
     finally:
         cluster.close()
 
@@ -182,7 +184,7 @@ def where_runs_went(output: str) -> dict[str, str]:
     return dict(re.findall(r"^(\S+): (tcp://[^,]+), ", output, flags=re.MULTILINE))
 
 
-def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder):
+def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder, local_fleet):
     runner = CliRunner()
     result = runner.invoke(app, ["sweep", *SMALL_ARGS, "--scheduler", cluster.address, "--no-progress",
                                  "-o", "out/s.h5"])
@@ -198,9 +200,8 @@ def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder):
                                  "-o", "out/f.h5"])
     assert result.exit_code == 0, result.output
     assert len(where_runs_went(result.output)) == 2
-    local = sweep.run(Fleet(**FLEET), client_folder / "local-fleet.h5", jobs=1, progress=False)
     assert dataset.validate("out/f.h5") == []
-    assert_same_files(local, Path("out/f.h5"))
+    assert_same_files(local_fleet, Path("out/f.h5"))
     for name in ("w1", "w2"):  # the workers wrote nothing where OUT would be, seen from their folders
         assert not (cluster.root / name / "out").exists()
 

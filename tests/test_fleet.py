@@ -109,15 +109,14 @@ def test_a_daily_record_is_the_days_maximum():
                                pairs(cycles.conditions.joint_temperature).mean(axis=1))
 
 
-def test_a_small_fleet_runs_validates_and_repeats_bit_for_bit(tmp_path):
-    runner = CliRunner()
-    files = []
-    for name in ("a.h5", "b.h5"):
-        out = tmp_path / name
-        result = runner.invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
-                                     "--jobs", "1", "--no-progress", "-o", str(out)])
-        assert result.exit_code == 0, result.output
-        files.append(out)
+def test_a_small_fleet_runs_validates_and_repeats_bit_for_bit(tmp_path, shared_fleet):
+    """The command's fleet, and the same fleet made again (by the library, once a session: conftest.py's
+    shared_fleet, which tests/test_cluster.py compares its cluster's fleet with) hold the same bits."""
+    out = tmp_path / "a.h5"
+    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day",
+                                      "1", "--jobs", "1", "--no-progress", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    files = [out, shared_fleet("fleet-small", size=2, failing=1, days=6, cycles_per_day=1)]
     assert dataset.validate(files[0]) == []
     labels = dataset.labels(files[0])
     assert sorted(len(row["worn_axes"]) for row in labels) == [0, 1]

@@ -8,8 +8,9 @@ example that is that same command gets the file made so: same seed, the same fil
 kept small (:data:`SMALL`, appended: click takes an option's last value): a ``simulate`` or
 ``sweep`` records fewer cycles, a sweep that does not choose them one task and two axes, a
 ``fleet`` has fewer robots, days and cycles a day; ``classify``, ``training-source``,
-``excitation`` and ``hidden-log`` do less work. The rest of each command line is the example's
-own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+``excitation`` and ``hidden-log`` do less work; a ``sweep``, ``fleet`` or ``classify`` that does not
+choose ``--jobs`` runs in the test's process. The rest of each command line is the example's own.
+A ``--scheduler`` address is replaced by the address of a local Dask cluster.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from pathlib import Path
 
 import pytest
 import rtbdata
+import typer.testing
 from conftest import shared_folder
 from filelock import FileLock
 from typer.main import get_command
@@ -51,6 +53,7 @@ ANALYSED_FLEETS = {"fleet.h5": ["--robots", "8", "--days", "16", "--cycles-per-d
 def pages() -> dict[str, list[str]]:
     """Command path -> the example lines of its ``--help``."""
     out = {}
+    built = get_command(app)
 
     def walk(command, path):
         if hasattr(command, "commands"):
@@ -62,7 +65,9 @@ def pages() -> dict[str, list[str]]:
             if lines:
                 out[" ".join(path)] = lines
 
-    walk(get_command(app), [])
+    with pytest.MonkeyPatch.context() as patch:  # the click command built once, not once a page (2 s)
+        patch.setattr(typer.testing, "_get_command", lambda _: built)
+        walk(built, [])
     return out
 
 
@@ -80,6 +85,10 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     if argv[0] == "sweep":
         extra += [] if "--task" in argv else ["--task", "pick_place"]
         extra += [] if "--axis" in argv else ["--axis", "0", "--axis", "2"]
+    if argv[0] in ("sweep", "fleet", "classify") and not {"--jobs", "--scheduler"} & set(argv):
+        # in this test process (2 to 5 s of CPU less than the default's worker processes, on a machine
+        # whose cores pytest-xdist's workers fill); an example that chooses --jobs keeps its own
+        extra += ["--jobs", "1"]
     argv = [scheduler if a.startswith("tcp://") and scheduler else a for a in argv]
     return [*argv, *extra]
 

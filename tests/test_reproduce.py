@@ -153,7 +153,7 @@ def test_every_plan_is_valid_and_shares_its_datasets():
 def _tiny_sweep(folder: Path, seed: int) -> Path:
     out = folder / f"s{seed}.h5"
     result = cli.invoke(app, ["sweep", "--robot", "puma560", "--task", "pick_place", "--axis", "0", "--axis", "1",
-                              "--cycles", "2", "--seed", str(seed), "--no-progress", "-o", str(out)])
+                              "--cycles", "2", "--seed", str(seed), "--no-progress", "--jobs", "1", "-o", str(out)])
     assert result.exit_code == 0, result.output
     return out
 
