@@ -27,12 +27,12 @@ interval; empty cells where there is no number). Without the file the page shows
 
 from __future__ import annotations
 
-import html
 import math
 
 import numpy as np
 
 from faultgen.monitor import lights
+from faultgen.monitor.html_cells import escaped, number, short
 
 #: The columns of tests.csv the page needs (the others are read when present).
 REQUIRED = ("unit", "stamp", "axis", "coulomb_Nm", "viscous_Nms_rad", "wear")
@@ -40,19 +40,7 @@ REQUIRED = ("unit", "stamp", "axis", "coulomb_Nm", "viscous_Nms_rad", "wear")
 CURVE_POINTS = 60
 
 
-def _e(value) -> str:
-    return html.escape("" if value is None else str(value), quote=True)
 
-
-def _number(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def _short(value: float) -> float | None:
-    return None if value is None or not math.isfinite(value) else float(f"{value:.4g}")
 
 
 def by_axis(rows: list[dict]) -> dict[int, list[dict]]:
@@ -60,7 +48,7 @@ def by_axis(rows: list[dict]) -> dict[int, list[dict]]:
     left out)."""
     found: dict[int, list[tuple[float, dict]]] = {}
     for r in rows:
-        axis, key = _number(r.get("axis")), lights.stamp_key(r.get("stamp", ""))
+        axis, key = number(r.get("axis")), lights.stamp_key(r.get("stamp", ""))
         if key is not None and math.isfinite(axis) and axis == int(axis) and axis >= 1:
             found.setdefault(int(axis), []).append((key[0], r))
     return {a: [r for _, r in sorted(v, key=lambda kv: kv[0])] for a, v in sorted(found.items())}
@@ -112,17 +100,17 @@ def markers(tests: dict[int, list[dict]], log_stamps: list[str], colours, wear_p
         kept = [r for r in rows if places.get(r["stamp"]) is not None]
         if not kept:
             continue
-        wear = [_number(r.get("wear")) for r in kept]
-        low = [_number(r.get("wear_lower")) for r in kept]
-        high = [_number(r.get("wear_upper")) for r in kept]
+        wear = [number(r.get("wear")) for r in kept]
+        low = [number(r.get("wear_lower")) for r in kept]
+        high = [number(r.get("wear_upper")) for r in kept]
         data.append({"type": "scatter", "mode": "markers", "x": [places[r["stamp"]] for r in kept],
-                     "y": [_short(w) for w in wear], "legendgroup": f"axis{axis}",
+                     "y": [short(w) for w in wear], "legendgroup": f"axis{axis}",
                      "marker": {"symbol": "diamond", "size": 8, "color": colours[(axis - 1) % len(colours)],
                                 "line": {"color": "black", "width": 0.5}},
                      "error_y": {"type": "data", "symmetric": False,
-                                 "array": [_short(h - w) for h, w in zip(high, wear)],
-                                 "arrayminus": [_short(w - lo) for lo, w in zip(low, wear)], "width": 3},
-                     "name": f"axis {axis} friction test", "customdata": [_e(r["stamp"]) for r in kept],
+                                 "array": [short(h - w) for h, w in zip(high, wear)],
+                                 "arrayminus": [short(w - lo) for lo, w in zip(low, wear)], "width": 3},
+                     "name": f"axis {axis} friction test", "customdata": [escaped(r["stamp"]) for r in kept],
                      "hovertemplate": "%{customdata}: friction test, axis " + str(axis)
                                       + " wear %{y:.3g} %<extra></extra>"})
     return data, shapes, annotations
@@ -132,31 +120,31 @@ def alarming_axes(unit, wear_limit: float) -> list[int]:
     """The axes whose friction curve the panel draws (module docstring)."""
     axes = set()
     if unit.open_alarm:
-        axis = _number(unit.current.get("source_axis"))
+        axis = number(unit.current.get("source_axis"))
         if math.isfinite(axis) and axis == int(axis):
             axes.add(int(axis))
     if unit.scores and math.isfinite(wear_limit):
         last = unit.scores[-1]
         for axis in unit.axes():
-            if _number(last.get(f"wear{axis}_lower")) >= wear_limit:
+            if number(last.get(f"wear{axis}_lower")) >= wear_limit:
                 axes.add(axis)
     return sorted(axes)
 
 
 def reference(rows: list[dict]) -> dict:
     """The test the latest is compared with (module docstring); ``rows`` in stamp order."""
-    zero = [r for r in rows if _number(r.get("wear")) == 0.0]
+    zero = [r for r in rows if number(r.get("wear")) == 0.0]
     return zero[-1] if zero else rows[0]
 
 
 def _params(row: dict, end: str = "") -> tuple[float, float, float, float]:
-    static, stribeck = _number(row.get("static_excess_Nm")), _number(row.get("stribeck_velocity_rad_s"))
+    static, stribeck = number(row.get("static_excess_Nm")), number(row.get("stribeck_velocity_rad_s"))
     if not (math.isfinite(static) and math.isfinite(stribeck) and stribeck > 0):
         static, stribeck = 0.0, 1.0  # no hump fitted
-    coulomb = _number(row.get(f"coulomb_Nm{end}")) if end else math.nan
-    viscous = _number(row.get(f"viscous_Nms_rad{end}")) if end else math.nan
-    return (coulomb if math.isfinite(coulomb) else _number(row.get("coulomb_Nm")), static, stribeck,
-            viscous if math.isfinite(viscous) else _number(row.get("viscous_Nms_rad")))
+    coulomb = number(row.get(f"coulomb_Nm{end}")) if end else math.nan
+    viscous = number(row.get(f"viscous_Nms_rad{end}")) if end else math.nan
+    return (coulomb if math.isfinite(coulomb) else number(row.get("coulomb_Nm")), static, stribeck,
+            viscous if math.isfinite(viscous) else number(row.get("viscous_Nms_rad")))
 
 
 def curve_figure(rows: list[dict], axis: int) -> dict | None:
@@ -164,35 +152,35 @@ def curve_figure(rows: list[dict], axis: int) -> dict | None:
     text HTML-escaped); None when no test of the axis has a dry level and a viscous coefficient."""
     from faultgen.calibrate.friction_fit import curve
 
-    rows = [r for r in rows if math.isfinite(_number(r.get("coulomb_Nm"))) and math.isfinite(_number(r.get("viscous_Nms_rad")))]
+    rows = [r for r in rows if math.isfinite(number(r.get("coulomb_Nm"))) and math.isfinite(number(r.get("viscous_Nms_rad")))]
     if not rows:
         return None
     first, last = reference(rows), rows[-1]
     shown = [(first, "#1f77b4", "reference test")] + ([(last, "#d62728", "latest test")] if last is not first else [])
-    top = max([1.0] + [4 * _params(r)[2] for r, _, _ in shown if _number(r.get("static_excess_Nm")) > 0])
+    top = max([1.0] + [4 * _params(r)[2] for r, _, _ in shown if number(r.get("static_excess_Nm")) > 0])
     v = np.linspace(0.0, top, CURVE_POINTS)
-    speeds = [_short(s) for s in v]
+    speeds = [short(s) for s in v]
     data = []
     for r, colour, what in shown:
-        temperature = _number(r.get("temperature_degC"))
-        name = _e(f"{what} {r['stamp']}" + (f", {temperature:.3g} °C" if math.isfinite(temperature) else "")
-                  + (f", wear {_number(r.get('wear')):.3g} %" if math.isfinite(_number(r.get("wear"))) else ""))
+        temperature = number(r.get("temperature_degC"))
+        name = escaped(f"{what} {r['stamp']}" + (f", {temperature:.3g} °C" if math.isfinite(temperature) else "")
+                  + (f", wear {number(r.get('wear')):.3g} %" if math.isfinite(number(r.get("wear"))) else ""))
         with np.errstate(over="ignore", invalid="ignore"):  # a planted number: inf or NaN, drawn as a gap (None)
             low, high, mid = curve(v, *_params(r, "_low")), curve(v, *_params(r, "_high")), curve(v, *_params(r))
         fill = _rgba(colour)
-        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in low],
+        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [short(f) for f in low],
                      "line": {"width": 0, "color": colour}, "showlegend": False, "hoverinfo": "skip",
                      "legendgroup": name})
-        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in high],
+        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [short(f) for f in high],
                      "line": {"width": 0, "color": colour}, "fill": "tonexty", "fillcolor": fill, "showlegend": False,
                      "hoverinfo": "skip", "legendgroup": name})
-        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [_short(f) for f in mid],
+        data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [short(f) for f in mid],
                      "line": {"width": 2, "color": colour}, "name": name, "legendgroup": name,
                      "hovertemplate": "%{x:.3g} rad/s: %{y:.4g} N m<extra>" + name + "</extra>"})
     note = "" if last is not first else " (one test: nothing to compare yet)"
     return {"data": data, "layout": {
         "height": 360, "margin": {"l": 60, "r": 20, "t": 40, "b": 110}, "showlegend": True,
-        "title": {"text": _e(f"axis {axis}: friction torque, arm side{note}"), "font": {"size": 13}, "x": 0.01,
+        "title": {"text": escaped(f"axis {axis}: friction torque, arm side{note}"), "font": {"size": 13}, "x": 0.01,
                   "xanchor": "left"},
         "legend": {"orientation": "h", "y": -0.45, "font": {"size": 10}},
         "xaxis": {"title": {"text": "speed, rad/s"}, "rangemode": "tozero"},
@@ -214,4 +202,4 @@ def panel_text(tests: dict[int, list[dict]], drawn: list[int]) -> str:
     shown = ", ".join(stamps[:3] + (["..."] if len(stamps) > 4 else []) + stamps[3:][-1:])
     curves = (f" Friction curves of the alarming axes, reference test against the latest: axis "
               f"{', '.join(str(a) for a in drawn)}." if drawn else " No alarming axis: no friction curve drawn.")
-    return f"<p>{len(stamps)} friction tests (tests.csv): {_e(shown)}; dotted green lines on the chart.{_e(curves)}</p>"
+    return f"<p>{len(stamps)} friction tests (tests.csv): {escaped(shown)}; dotted green lines on the chart.{escaped(curves)}</p>"

@@ -40,12 +40,12 @@ monitored, learning and quiet units).
 
 from __future__ import annotations
 
-import html
 import math
 from dataclasses import dataclass, field
 
 from faultgen.data import logfolder
 from faultgen.monitor import life, prognosis
+from faultgen.monitor.html_cells import escaped, number
 
 #: The lights, in the order the rules are tried and the undated units are listed.
 STATES = ("service due", "watch", "stale", "unknown", "ok")
@@ -84,15 +84,6 @@ CSS = """
 """
 
 
-def _e(value) -> str:
-    return html.escape("" if value is None else str(value), quote=True)
-
-
-def _number(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def stamp_key(stamp: str) -> tuple[float, str] | None:
@@ -141,14 +132,14 @@ class Light:
 
 def _failure_wear(unit, axis: int) -> float:
     row = unit.remaining.get(axis) or {}
-    value = _number(row.get("failure_wear"))
+    value = number(row.get("failure_wear"))
     return value if math.isfinite(value) else prognosis.FAILURE_WEAR
 
 
 def shown_axis(unit, service: life.Service | None) -> int | None:
     """The axis of the table's line (module docstring)."""
     if unit.open_alarm:
-        axis = _number(unit.current.get("source_axis"))
+        axis = number(unit.current.get("source_axis"))
         if math.isfinite(axis) and axis == int(axis):
             return int(axis)
     if service is not None and service.axis is not None:
@@ -206,7 +197,7 @@ def light(unit, now: dict[str, tuple[float, str]], protocol: str = "") -> Light:
 
 def badge(state: str, title: str = "") -> str:
     """The light as HTML: a coloured pill with the word."""
-    return f'<span class="light l-{"-".join(state.split())}" title="{_e(title)}">{_e(state)}</span>'
+    return f'<span class="light l-{"-".join(state.split())}" title="{escaped(title)}">{escaped(state)}</span>'
 
 
 def _short_date(text: str, like: str) -> str:
@@ -230,7 +221,7 @@ def service_cell(unit, lit: Light) -> str:
         high = _short_date(life.date_after(last, service.high), date) if math.isfinite(service.high) else "later"
         interval = f"{low} – {high}"
     source = "wear" if service.why.startswith("condition") else "load"
-    return f'{_e(date)} <small class="muted">{_e(interval)}; by {source}, axis {_e(service.axis)}</small>'
+    return f'{escaped(date)} <small class="muted">{escaped(interval)}; by {source}, axis {escaped(service.axis)}</small>'
 
 
 def wear_cell(unit, axis: int | None) -> str:
@@ -242,22 +233,22 @@ def wear_cell(unit, axis: int | None) -> str:
         text = f"{wear.estimate:.3g} ({wear.low:.3g} – {wear.high:.3g})"
     else:
         text = f"{wear.estimate:.3g} (≥ {wear.low:.3g})"
-    return f'<span title="{_e(SCALES.get(wear.scale, wear.scale))}">{_e(text)}</span>'
+    return f'<span title="{escaped(SCALES.get(wear.scale, wear.scale))}">{escaped(text)}</span>'
 
 
 def row(index: int, unit, lit: Light) -> str:
     """The unit's line of the fleet table (:data:`COLUMNS`), every data text HTML-escaped."""
     cells = [badge(lit.state, "; ".join(lit.reasons)),
-             f'<a class="unit-link" href="#unit-{index}">{_e(unit.name)}</a>',
-             service_cell(unit, lit), _e(lit.axis if lit.axis is not None else ""), wear_cell(unit, lit.axis),
-             _e(life.table_cell(unit.life)), _e(unit.row.get("last_log", ""))]
+             f'<a class="unit-link" href="#unit-{index}">{escaped(unit.name)}</a>',
+             service_cell(unit, lit), escaped(lit.axis if lit.axis is not None else ""), wear_cell(unit, lit.axis),
+             escaped(life.table_cell(unit.life)), escaped(unit.row.get("last_log", ""))]
     return "<tr>" + "".join(f'<td data-column="{c}">{v}</td>' for c, v in zip(COLUMNS, cells)) + "</tr>"
 
 
 def panel_html(unit, lit: Light) -> str:
     """The light's paragraph of a unit's panel: the state and every rule met, and each axis's wear
     at the last log with its interval and the scale it is in (HTML)."""
-    reasons = "".join(f"<li>{_e(r)}</li>" for r in lit.reasons)
+    reasons = "".join(f"<li>{escaped(r)}</li>" for r in lit.reasons)
     parts = [f"<p>{badge(lit.state)} the rules met:</p><ul>{reasons}</ul>"]
     found = [(axis, w) for axis in unit.axes() if (w := unit.wear_now(axis)) is not None and math.isfinite(w.estimate)]
     scales = {w.scale for _, w in found}
@@ -266,9 +257,9 @@ def panel_html(unit, lit: Light) -> str:
         bound = (f"90 % interval {wear.low:.3g} – {wear.high:.3g} %" if wear.interval
                  else f"lower 90 % bound {wear.low:.3g} %")
         scale = f", {wear.scale} scale" if len(scales) > 1 else ""
-        items.append(f"<li>axis {axis}: {wear.estimate:.3g} % ({_e(bound)}){_e(scale)}</li>")
+        items.append(f"<li>axis {axis}: {wear.estimate:.3g} % ({escaped(bound)}){escaped(scale)}</li>")
     if items:
         source = "wear.csv" if unit.wear else "scores.csv"
         what = "; ".join(SCALES.get(s, s) for s in sorted(scales))
-        parts.append(f"<p>Wear at the last log ({source}), {_e(what)}:</p><ul>{''.join(items)}</ul>")
+        parts.append(f"<p>Wear at the last log ({source}), {escaped(what)}:</p><ul>{''.join(items)}</ul>")
     return "\n".join(parts)

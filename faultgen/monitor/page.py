@@ -34,7 +34,6 @@ charts, whose labels plotly reads as HTML too; no data text becomes an element i
 
 from __future__ import annotations
 
-import html
 import json
 import math
 from dataclasses import dataclass, field
@@ -42,6 +41,7 @@ from pathlib import Path
 
 from faultgen.data import atomic
 from faultgen.monitor import friction_panel, life, lights, report, scoring, tables
+from faultgen.monitor.html_cells import escaped, number
 from faultgen.monitor.run_settings import SETTINGS, settings_dict
 from faultgen.monitor.unit_chart import figure
 
@@ -80,12 +80,6 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
 
 
 # -- reading the outputs ----------------------------------------------------------------------------
-
-def _number(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 @dataclass(frozen=True)
@@ -133,14 +127,14 @@ class Unit:
         if not self.scores or not self.scores[-1].get("wear1"):
             return None
         last = self.scores[-1]
-        axis = _number(self.current["source_axis"]) if self.open_alarm else math.nan
+        axis = number(self.current["source_axis"]) if self.open_alarm else math.nan
         axis = int(axis) if math.isfinite(axis) and axis == int(axis) else None
         if axis is None or f"wear{axis}" not in last:
-            lowers = {i: _number(last[k]) for i in range(1, 1000) if (k := f"wear{i}_lower") in last}
+            lowers = {i: number(last[k]) for i in range(1, 1000) if (k := f"wear{i}_lower") in last}
             if not lowers:
                 return None
             axis = max(lowers, key=lambda i: -math.inf if math.isnan(lowers[i]) else lowers[i])
-        return axis, _number(last[f"wear{axis}"]), _number(last[f"wear{axis}_lower"])
+        return axis, number(last[f"wear{axis}"]), number(last[f"wear{axis}_lower"])
 
     def axes(self) -> list[int]:
         """The unit's axes (1..N of scores.csv's ``scoreI`` columns, else of wear.csv)."""
@@ -155,11 +149,11 @@ class Unit:
         scale = self.row.get("wear_scale") or "twin"
         if self.wear.get(axis):
             r = self.wear[axis][-1]
-            return WearNow(_number(r.get("wear")), _number(r.get("wear_5")), _number(r.get("wear_95")), True,
+            return WearNow(number(r.get("wear")), number(r.get("wear_5")), number(r.get("wear_95")), True,
                            r.get("wear_scale") or scale)
         if self.scores and self.scores[-1].get(f"wear{axis}"):
             last = self.scores[-1]
-            return WearNow(_number(last[f"wear{axis}"]), _number(last.get(f"wear{axis}_lower")), math.nan, False, scale)
+            return WearNow(number(last[f"wear{axis}"]), number(last.get(f"wear{axis}_lower")), math.nan, False, scale)
         return None
 
     def attention(self) -> tuple:
@@ -209,7 +203,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
         for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
                            max_bytes)[1]:
-            axis = _number(r["axis"])
+            axis = number(r["axis"])
             if r["unit"] in units and math.isfinite(axis):
                 units[r["unit"]].remaining[int(axis)] = r
     if (folder / "life.csv").exists():  # the rated life consumed by load (optional: a run before it has none)
@@ -218,7 +212,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
                 units[r["unit"]].life.append(r)
     if (folder / "wear.csv").exists():  # the wear's 90 % interval and scale (optional: a run before it has none)
         for r in tables.read(folder, "wear.csv", report.WEAR_COLUMNS, max_bytes)[1]:
-            axis = _number(r["axis"])
+            axis = number(r["axis"])
             if r["unit"] in units and math.isfinite(axis) and axis == int(axis):
                 units[r["unit"]].wear.setdefault(int(axis), []).append(r)
     if (folder / "tests.csv").exists():  # friction tests (optional, issue 75: absent, no test data)
@@ -231,9 +225,6 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
 
 
 # -- the page ---------------------------------------------------------------------------------------
-
-def _e(value) -> str:
-    return html.escape("" if value is None else str(value), quote=True)
 
 
 def _script_json(value) -> str:
@@ -306,11 +297,11 @@ def _remaining(row: dict | None) -> str:
     """A row of rul.csv in words: the median remaining life and its 5-95 % interval, or its verdict."""
     if not row:
         return ""
-    rul = _number(row.get("rul"))
+    rul = number(row.get("rul"))
     if not math.isfinite(rul):
         return row.get("verdict", "")
     unit = row.get("time_unit", "")
-    return f"{rul:.0f} {unit} ({_number(row.get('rul_5')):.0f}-{_number(row.get('rul_95')):.0f})"
+    return f"{rul:.0f} {unit} ({number(row.get('rul_5')):.0f}-{number(row.get('rul_95')):.0f})"
 
 
 def _closed_text(alarm: dict) -> str:
@@ -327,33 +318,33 @@ def _chart(name: str, fig: dict) -> str:
 def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
     row = unit.row
     model = f", {row['model']} model" if row.get("model") else ""
-    head = (f"{_e(unit.name)} — {_e(lit.state)} — {_e(row.get('status', ''))}"
-            + (f" — alarm from {_e(unit.current['first_alarm'])}, axis {_e(unit.current['source_axis'])}"
+    head = (f"{escaped(unit.name)} — {escaped(lit.state)} — {escaped(row.get('status', ''))}"
+            + (f" — alarm from {escaped(unit.current['first_alarm'])}, axis {escaped(unit.current['source_axis'])}"
                if unit.open_alarm else ""))
     parts = [f'<details class="unit" id="unit-{index}" data-index="{index}"><summary>{head}</summary>',
              lights.panel_html(unit, lit),
-             f"<p>{_e(row.get('status', ''))} ({_e(row.get('protocol', ''))}{_e(model)}); "
-             f"{_e(row.get('logs_scored', ''))} logs scored, the last {_e(row.get('last_log', '') or '–')}."
-             + (f" {_e(row['reason'])}." if row.get("reason") else "") + "</p>"]
+             f"<p>{escaped(row.get('status', ''))} ({escaped(row.get('protocol', ''))}{escaped(model)}); "
+             f"{escaped(row.get('logs_scored', ''))} logs scored, the last {escaped(row.get('last_log', '') or '–')}."
+             + (f" {escaped(row['reason'])}." if row.get("reason") else "") + "</p>"]
     if unit.open_alarm:
-        parts.append(f'<p class="evidence"><b>Open alarm</b> from {_e(unit.current["first_alarm"])} on axis '
-                     f'{_e(unit.current["source_axis"])} ({_e(unit.current["statistic"])}): '
-                     f'{_e(unit.current["evidence"])}</p>')
+        parts.append(f'<p class="evidence"><b>Open alarm</b> from {escaped(unit.current["first_alarm"])} on axis '
+                     f'{escaped(unit.current["source_axis"])} ({escaped(unit.current["statistic"])}): '
+                     f'{escaped(unit.current["evidence"])}</p>')
     elif unit.current is not None:
-        parts.append(f"<p>No open alarm: {_e(unit.current['evidence'])}.</p>")
+        parts.append(f"<p>No open alarm: {escaped(unit.current['evidence'])}.</p>")
     if lit.service is not None:
-        parts.append(f"<p>Service by {lights.service_cell(unit, lit)} ({_e(lit.service.why)}).</p>")
+        parts.append(f"<p>Service by {lights.service_cell(unit, lit)} ({escaped(lit.service.why)}).</p>")
     if unit.remaining:
-        items = "".join(f"<li>axis {axis}: {_e(_remaining(r))}"
-                        + (f" ({_e(r['model'])} trend of {_e(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
-                        + (f"; {_e(r['verdict'])}" if r.get("verdict") and _remaining(r) != r["verdict"] else "")
+        items = "".join(f"<li>axis {axis}: {escaped(_remaining(r))}"
+                        + (f" ({escaped(r['model'])} trend of {escaped(r.get('logs_fitted', ''))} logs)" if r.get("model") else "")
+                        + (f"; {escaped(r['verdict'])}" if r.get("verdict") and _remaining(r) != r["verdict"] else "")
                         + "</li>" for axis, r in sorted(unit.remaining.items()))
         parts.append("<p>Remaining life (5-95 %) until the wear estimate reaches the failure wear (rul.csv):</p>"
                      f"<ul>{items}</ul>")
     if unit.life:
         parts.append(life.panel_html(unit.life, unit.service_by()))
     if unit.closed:
-        items = "".join(f"<li>{_e(_closed_text(a))}: {_e(a['evidence'])}</li>" for a in unit.closed)
+        items = "".join(f"<li>{escaped(_closed_text(a))}: {escaped(a['evidence'])}</li>" for a in unit.closed)
         parts.append(f"<p>Alarms closed by maintenance (the unit's offset learned again after each):</p><ul>{items}</ul>")
     if unit.scores:
         parts.append(_chart(str(index), figure(unit, settings)))
@@ -391,16 +382,16 @@ def build(fleet: Fleet, settings: dict) -> str:
         statement = (f"{alarmed} of {len(monitors)} units alarm. " + false_alarm_statement(
             str(settings.get("protocol", "twin")), float(settings["alpha"]), int(settings["persistence"]),
             int(settings["train"]), fleet.n_axes, logs_scored))
-    setting_rows = "".join(f"<tr><th>{_e(k)}</th><td>{_e(settings[k])}</td><td class='muted'>{_e(v)}</td></tr>"
+    setting_rows = "".join(f"<tr><th>{escaped(k)}</th><td>{escaped(settings[k])}</td><td class='muted'>{escaped(v)}</td></tr>"
                            for k, v in SETTING_NAMES.items() if k in settings)
-    setting_rows += "".join(f"<tr><th>{_e(k)}</th><td>{_e(v)}</td><td></td></tr>"
+    setting_rows += "".join(f"<tr><th>{escaped(k)}</th><td>{escaped(v)}</td><td></td></tr>"
                             for k, v in settings.items() if k not in SETTING_NAMES)
-    run = (f'<p class="statement" id="statement">{_e(statement)}</p>' if statement else
+    run = (f'<p class="statement" id="statement">{escaped(statement)}</p>' if statement else
            '<p class="muted">The run&#x27;s settings were not found (no settings.json): the false-alarm statement '
            'is left out.</p>')
     table = "\n".join(lights.row(i, u, l_) for i, (u, l_) in enumerate(lit))
     panels = "\n".join(_panel(i, u, settings, l_) for i, (u, l_) in enumerate(lit))
-    header = "".join(f"<th>{_e(c)}</th>" for c in COLUMNS)
+    header = "".join(f"<th>{escaped(c)}</th>" for c in COLUMNS)
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
@@ -412,14 +403,14 @@ def build(fleet: Fleet, settings: dict) -> str:
 </head>
 <body>
 <h1>Fleet report</h1>
-<p>{_e(summary)} Service due and the earliest service first; click a unit for its panel.</p>
+<p>{escaped(summary)} Service due and the earliest service first; click a unit for its panel.</p>
 <table id="fleet">
 <thead><tr>{header}</tr></thead>
 <tbody>
 {table}
 </tbody>
 </table>
-<p class="muted" id="legend">{_e(LEGEND)}</p>
+<p class="muted" id="legend">{escaped(LEGEND)}</p>
 <h2>Units</h2>
 <p><button id="open-all" type="button">open all</button> <button id="close-all" type="button">close all</button></p>
 {panels}

@@ -12,32 +12,17 @@ its interval). The wear axis names the scale (units.csv's and wear.csv's ``wear_
 
 from __future__ import annotations
 
-import html
 import math
 
 from faultgen.monitor import friction_panel
+from faultgen.monitor.html_cells import escaped, number, short
 
 #: Line colours of the axes (plotly's default sequence).
 COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
            "#17becf")
 
 
-def _e(value) -> str:
-    return html.escape("" if value is None else str(value), quote=True)
 
-
-def _number(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def _short(value: float) -> float | None:
-    """A chart's number: 4 significant digits (the page stays small), None for NaN (JSON null)."""
-    if value is None or math.isnan(value) or math.isinf(value):
-        return None
-    return float(f"{value:.4g}")
 
 
 def _rgba(colour: str, alpha: float) -> str:
@@ -71,8 +56,8 @@ def _interval(unit, axis: int, rows: list[dict]) -> tuple[list, list] | None:
         k = seen[r["stamp"]] = seen.get(r["stamp"], -1) + 1
         match = found.get(r["stamp"], [])
         w = match[min(k, len(match) - 1)] if match else {}
-        low.append(_short(_number(w.get("wear_5"))))
-        high.append(_short(_number(w.get("wear_95"))))
+        low.append(short(number(w.get("wear_5"))))
+        high.append(short(number(w.get("wear_95"))))
     return low, high
 
 
@@ -82,7 +67,7 @@ def figure(unit, settings: dict) -> dict:
     ``wear_limit``, ``alpha``)."""
     rows = unit.scores
     x = list(range(len(rows)))
-    stamps = [_e(r["stamp"]) for r in rows]
+    stamps = [escaped(r["stamp"]) for r in rows]
     twin = bool(rows) and bool(rows[0].get("wear1"))
     data, shapes, annotations = [], [], []
     stat_axis = "y2" if twin else "y"
@@ -90,10 +75,10 @@ def figure(unit, settings: dict) -> dict:
     if twin:
         for i in range(1, n_axes + 1):
             colour = COLOURS[(i - 1) % len(COLOURS)]
-            wear = [_short(_number(r.get(f"wear{i}"))) for r in rows]
+            wear = [short(number(r.get(f"wear{i}"))) for r in rows]
             interval = _interval(unit, i, rows)
             if interval is None:  # no wear.csv: the lower one-sided bound of scores.csv
-                lower = [_short(_number(r.get(f"wear{i}_lower"))) for r in rows]
+                lower = [short(number(r.get(f"wear{i}_lower"))) for r in rows]
                 data.append({"type": "scatter", "mode": "lines", "x": x, "y": lower, "line": {"width": 0, "color": colour},
                              "legendgroup": f"axis{i}", "showlegend": False, "name": f"axis {i} lower bound",
                              "customdata": stamps, "hovertemplate": "%{customdata}: lower bound %{y:.3g} %<extra></extra>"})
@@ -109,13 +94,13 @@ def figure(unit, settings: dict) -> dict:
                          "legendgroup": f"axis{i}",
                          "name": f"axis {i} wear", "customdata": stamps,
                          "hovertemplate": "%{customdata}: axis " + str(i) + " wear %{y:.3g} %<extra></extra>"})
-        limit = _number(settings.get("wear_limit"))
+        limit = number(settings.get("wear_limit"))
         if not math.isnan(limit):
             data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [limit, limit],
                          "line": {"color": "black", "dash": "dash", "width": 1}, "name": f"wear limit {limit:g} %",
                          "hoverinfo": "skip"})
     for name, dash, colour in (("Q", "solid", "#1f3a93"), ("T2", "dot", "#9467bd")):
-        ratio = [_short(_number(r[name]) / _number(r[f"{name}_limit"])) if _number(r[f"{name}_limit"]) else None
+        ratio = [short(number(r[name]) / number(r[f"{name}_limit"])) if number(r[f"{name}_limit"]) else None
                  for r in rows]
         data.append({"type": "scatter", "mode": "lines", "x": x, "y": ratio, "yaxis": stat_axis,
                      "line": {"width": 1.2, "dash": dash, "color": colour}, "name": f"{name} / its limit", "customdata": stamps,
@@ -150,11 +135,11 @@ def figure(unit, settings: dict) -> dict:
     for k, alarm in enumerate(unit.closed):
         if alarm["first_alarm"] in raw:
             line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
-                 _e(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
+                 escaped(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
                  0.9 - 0.08 * (k % 3))
     if unit.open_alarm and unit.current["first_alarm"] in raw:
         line(raw[unit.current["first_alarm"]], "#d62728", "solid",
-             _e(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
+             escaped(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
     if unit.tests:
         traces, lines, notes = friction_panel.markers(friction_panel.by_axis(unit.tests), [r["stamp"] for r in rows],
                                                       COLOURS, twin)
