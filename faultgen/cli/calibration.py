@@ -44,40 +44,33 @@ def calibrate_command(
 ) -> None:
     """Find what the model misses in a measured torque log, add it, and show the gap shrink.
 
-    The nominal model predicts the measured torque along the measured motion; every effect of
-    the library is fitted to the residual on the first 70 % of the record and judged on the last
-    30 % (held out); the effect that cuts the held-out error most, on the axes where the cut is
-    significant, is written into the model, and the search repeats until nothing significant is
-    left. When the log cannot tell two effects apart (held-out AIC within 2), the simpler is fitted
-    and the summary, report.json and the figure say so, with the motion that would separate them. A log the robot cannot explain (another robot, motor-side torque, a column in another
-    unit or with the other sign) is refused before anything is written, naming what to check.
+    The nominal model predicts the measured torque along the measured motion; every effect of the library is
+    fitted to the residual on the first 70 % of the record and judged on the last 30 % (held out); the effect
+    that cuts the held-out error most, on the axes where the cut is significant, is written into the model,
+    and the search repeats until nothing significant is left. When the log cannot tell two effects apart
+    (held-out AIC within 2), the simpler is fitted and the summary, report.json and the figure say so, with
+    the motion that would separate them. A log the robot cannot explain (another robot, motor-side torque, a
+    column in another unit or sign) is refused before anything is written, naming what to check.
 
-    Effects: torque_offset (constant offset), coulomb (Coulomb friction level), viscous (viscous
-    friction), stribeck (low-speed friction hump), load_dependent_friction (friction growing with
-    the gearbox load: the transmitted torque or the gravity load), temperature (friction drifting
-    with time, warm-up), payload (mass, centre of mass and inertia at the flange), cogging (torque
-    periodic in the motor angle), backlash (gearbox dead band in the flexible-gearbox equation). Every fitted parameter is reported with
-    its standard error.
+    Effects (faultgen.effects; docs/calibration.md): torque_offset, coulomb, viscous, stribeck,
+    load_dependent_friction, temperature, payload, cogging, backlash; each parameter with its standard error.
 
-    Before the search, the delay of the torque channels behind the motion is estimated with a 95 %
-    interval and reported (--delay corrects it). After every step, the residual of each axis is
-    tested on the held-out part for whiteness (Ljung-Box) and for independence from the motion and
-    the torque (cross-correlation over lags -25..25), Holm-adjusted at 1 %: an axis that fails, above
-    its noise floor, is printed as LEFT UNEXPLAINED with the variable and lag its residual follows,
-    and with what its remainder follows in words (a sparse regression on generic terms: periodic in
-    the arm angle, the torque lagging the motion, a gain, the speed squared, cross-axis terms), with
-    each term's share of the remaining gap. A library effect is not written on an axis where a
-    generic term explains more of it and the axis still fails the tests (no forced fit).
+    Before the search, the delay of the torque channels behind the motion is estimated with a 95 % interval
+    and reported (--delay corrects it). After every step, the residual of each axis is tested on the held-out
+    part for whiteness (Ljung-Box) and for independence from the motion and the torque (cross-correlation over
+    lags -25..25), Holm-adjusted at 1 %: an axis that fails, above its noise floor, is printed as LEFT
+    UNEXPLAINED with the variable and lag its residual follows, and with what its remainder follows in words
+    (a sparse regression on generic terms: periodic in the arm angle, the torque lagging the motion, a gain,
+    the speed squared, cross-axis terms), with each term's share of the remaining gap. A library effect is not
+    written on an axis where a generic term explains more and the axis still fails the tests (no forced fit).
 
-    Writes into OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`)
-    and model/parameters.json, report.json (gap before/after per axis, each effect with its axes,
-    parameters and evidence) and calibration.png (measured vs model torque and the residual
-    before and after, per axis). Method and accuracy: docs/calibration.md.
+    Writes into OUT: model/<robot>_calibrated.xml (run it with `faultgen simulate --model ...`) and
+    model/parameters.json, report.json (gap before/after per axis, each effect with its axes, parameters and
+    evidence) and calibration.png (measured vs model torque and the residual before and after, per axis).
+    Method and accuracy: docs/calibration.md.
 
-    A log in another layout is read by the adapter `faultgen logs import` and `faultgen monitor`
-    use: --format ur-rtde (Universal Robots' RTDE recorder; --torque-constants for the measured
-    current) or --format voraus, whole or, when long, in blocks, with the measured format's checks
-    (docs/dataset.md).
+    A log in another layout: --format ur-rtde (--torque-constants for the measured current) or voraus, read
+    as `faultgen logs import` and `faultgen monitor` read it (docs/dataset.md).
 
     Example (on a log with a hidden effect, `faultgen hidden-log`):
 
@@ -87,9 +80,8 @@ def calibrate_command(
       faultgen calibrate --robot puma560 --measured log.csv --out calib2 --delay auto
     """
     from faultgen import calibrate
-    from faultgen.model import robots
-
     from faultgen.calibrate import user_effects
+    from faultgen.model import robots
 
     shift = _delay(delay)
     for spec in effects or ():

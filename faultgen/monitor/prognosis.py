@@ -351,16 +351,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     if not rows or "wear1_log" not in rows[0]:
         why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
         return [Remaining(unit, None, stamp, "", why, failure_wear, horizon)]
-    block = []
-    for row in reversed(rows):  # the monitoring logs since the last maintenance
-        if row["phase"] != "monitoring":
-            break
-        block.append(row)
-    block.reverse()
-    if keys is None:
-        parsed = [logfolder.parse_stamp(r["stamp"], f"{unit}/{r['stamp']}") for r in block]
-        keys = {r["stamp"]: key for r, (key, _) in zip(block, parsed)}
-        kind = parsed[0][1] if parsed else kind
+    block, keys, kind = monitoring_block(unit, rows, keys, kind)
     time_unit = "logs" if kind == logfolder.SEQUENCE else "days"
     per = 1.0 if kind == logfolder.SEQUENCE else 86400.0
     z = NormalDist().inv_cdf(1.0 - alpha)
@@ -409,6 +400,23 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         toe = _propagate(drawn, failure_wear, horizon)
         out.append(_summarise(base, fits, weights, labels, toe, horizon, series(fitted, axis)[0]))
     return out
+
+
+def monitoring_block(unit: str, rows: list[dict], keys: dict[str, float] | None, kind: str | None):
+    """The unit's monitoring rows since its last maintenance (the rows after the last that is not
+    of phase ``monitoring``), their stamps' time ``keys`` and ``kind``
+    (:func:`faultgen.data.logfolder.parse_stamp`; parsed when ``keys`` is None)."""
+    block = []
+    for row in reversed(rows):
+        if row["phase"] != "monitoring":
+            break
+        block.append(row)
+    block.reverse()
+    if keys is None:
+        parsed = [logfolder.parse_stamp(r["stamp"], f"{unit}/{r['stamp']}") for r in block]
+        keys = {r["stamp"]: key for r, (key, _) in zip(block, parsed)}
+        kind = parsed[0][1] if parsed else kind
+    return block, keys, kind
 
 
 def named_model(fits) -> Fit:
