@@ -208,77 +208,60 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
-    kept = len(state), max((u.entries[-1].stamp for u in state.values() if u.entries), default="")
-    with CtrlC() as ctrl_c:
-        try:
-            return _run(state, units, out, confined, key, settings, nominal, ratings, logs_dir, calibrated_model,
-                        calibrate, model_source, twin_temperature, log_format, failure_wear, backend, progress, jobs,
-                        scheduler, robot, hours_per_day, (maintenance, found, tests, wears, scale_of))
-        except KeyboardInterrupt as interrupt:
-            ctrl_c.stopping = True
-            raise interrupted(out, *kept, isinstance(interrupt, Terminated)) from None
-
-
-def _run(state, units, out, confined, key, settings, nominal, ratings, logs_dir, calibrated_model, calibrate,
-         model_source, twin_temperature, log_format, failure_wear, backend, progress, jobs, scheduler, robot,
-         hours_per_day, read) -> Outcome:
-    """The work of :func:`monitor` once its inputs are checked and the earlier run's ``state`` read:
-    score the new logs, then write every output at once. ``read``: the units' maintenance events, the
-    friction tests found and read, their wear and each unit's scale (:mod:`faultgen.monitor.friction_tests`)."""
-    maintenance, found, tests, wears, scale_of = read
-    pending, stale = {}, {}
-    for name, unit_logs in units.items():
-        pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
-    confined.mkdir(out / ".cache")
-    context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                       failure_wear, backend)
-    source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
-    programs: list[tuple[np.ndarray, tuple[str, str]]] = []
-    for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
-        if unit_logs and name not in state:
-            state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
-            state[name].monitor.tests = scale_of(name)
-    groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
-    bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
-    made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
-    idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
-    # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
-    with contextlib.closing(map_groups(context, groups, jobs, scheduler, robot, idle, source)) as results:
-        for done in results:
-            for name, unit, outputs in done:
-                made[name] = outputs
-                if unit is not None:
-                    state[name] = unit
-                    bar.update(len(pending[name]))
-    bar.close()
-    monitors = [state[name].monitor for name in units if name in state]
-    statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
-    with atomic.atomic_folder(out) as staging:
-        report.write_alarms(staging / "alarms.csv", monitors)
-        report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
-        report.write_wear(staging / "wear.csv", monitors, scales=bool(found))
-        report.write_units(staging / "units.csv", statuses, scales={
-            m.unit: _scale_of(m) for m in monitors} if found else None)
-        if found:
-            friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
-        prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
-        life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
-            name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
-        # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-        page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
-                   logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
-        for m in monitors:
-            (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
-        (staging / ".state").mkdir()
-        for name in units:
-            if name in state:
-                unit = state[name]
-                stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
-                                  stored.UnitState(name, key, unit.program,
-                                                   unit.monitor.signatures if unit.initial_signatures is None
-                                                   else unit.initial_signatures, unit.entries,
-                                                   unit.model, unit.first, unit.skipped, unit.notes,
-                                                   unit.maintenance, unit.program_changes))
+    with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
+        pending, stale = {}, {}
+        for name, unit_logs in units.items():
+            pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
+        confined.mkdir(out / ".cache")
+        context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
+                           failure_wear, backend)
+        source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
+        programs: list[tuple[np.ndarray, tuple[str, str]]] = []
+        for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
+            if unit_logs and name not in state:
+                state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
+                state[name].monitor.tests = scale_of(name)
+        groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
+        bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
+        made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
+        idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
+        # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
+        with contextlib.closing(map_groups(context, groups, jobs, scheduler, robot, idle, source)) as results:
+            for done in results:
+                for name, unit, outputs in done:
+                    made[name] = outputs
+                    if unit is not None:
+                        state[name] = unit
+                        bar.update(len(pending[name]))
+        bar.close()
+        monitors = [state[name].monitor for name in units if name in state]
+        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
+        with atomic.atomic_folder(out) as staging:
+            report.write_alarms(staging / "alarms.csv", monitors)
+            report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
+            report.write_wear(staging / "wear.csv", monitors, scales=bool(found))
+            report.write_units(staging / "units.csv", statuses, scales={
+                m.unit: _scale_of(m) for m in monitors} if found else None)
+            if found:
+                friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
+            prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
+            life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
+                name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
+            # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
+            page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
+                       logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
+            for m in monitors:
+                (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
+            (staging / ".state").mkdir()
+            for name in units:
+                if name in state:
+                    unit = state[name]
+                    stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
+                                      stored.UnitState(name, key, unit.program,
+                                                       unit.monitor.signatures if unit.initial_signatures is None
+                                                       else unit.initial_signatures, unit.entries,
+                                                       unit.model, unit.first, unit.skipped, unit.notes,
+                                                       unit.maintenance, unit.program_changes))
     return Outcome(monitors, statuses)
 
 
@@ -286,6 +269,20 @@ def _run(state, units, out, confined, key, settings, nominal, ratings, logs_dir,
 class MonitorInterrupted(SweepInterrupted):
     """``faultgen monitor`` stopped by Ctrl-C (exit code 130) or SIGTERM (143) while it scored the
     units: its workers are stopped, and the message says what ``out`` keeps."""
+
+
+@contextlib.contextmanager
+def told_on_interrupt(out: Path, state: dict[str, Unit]):
+    """Within it, Ctrl-C or SIGTERM (:class:`faultgen.runs.sweep.CtrlC`) raises
+    :class:`MonitorInterrupted`, which says what ``out`` keeps (:func:`interrupted`) from the
+    earlier run's ``state`` as it is on entry."""
+    kept = len(state), max((u.entries[-1].stamp for u in state.values() if u.entries), default="")
+    with CtrlC() as ctrl_c:
+        try:
+            yield
+        except KeyboardInterrupt as interrupt:
+            ctrl_c.stopping = True
+            raise interrupted(out, *kept, isinstance(interrupt, Terminated)) from None
 
 
 def interrupted(out: Path, units: int, last: str, terminated: bool) -> MonitorInterrupted:
