@@ -42,6 +42,16 @@ def cell(value):
     return text(value) if isinstance(value, str) else value
 
 
+def figure(value) -> str:
+    """A table's cell of a number or a word: a float to 6 significant digits, None empty, anything
+    else as text (which :func:`writer` then neutralises)."""
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return value if isinstance(value, str) else str(value)
+
+
 class _Writer:
     """:func:`csv.writer`'s ``writerow`` and ``writerows``, every cell through :func:`cell`."""
 

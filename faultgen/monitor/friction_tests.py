@@ -407,10 +407,8 @@ def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
     """``OUT/tests.csv`` (:data:`COLUMNS`): per unit, test and axis read, in stamp order; empty cells
     where there is no number."""
 
-    def cell(value) -> str:
-        if value is None or (isinstance(value, float) and not math.isfinite(value)):
-            return ""
-        return f"{value:.6g}" if isinstance(value, float) else str(value)
+    def cell(value) -> str:  # no number: empty, NaN included
+        return cells.figure(None if isinstance(value, float) and not math.isfinite(value) else value)
 
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)
@@ -424,22 +422,17 @@ def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
 def remaining_life(monitor, failure_wear: float) -> list:
     """:func:`faultgen.monitor.prognosis.of_monitor` of a monitor on its tests' scale: each axis's
     own estimates rescaled by its latest factor, the factor's relative error as the scale's
-    uncertainty (an axis in the twin's scale keeps the default); axis by axis."""
+    uncertainty (an axis in the twin's scale keeps the default)."""
     from faultgen.monitor import prognosis
 
     rows = monitor.rows
     if not rows or "wear1_twin_log" not in rows[-1]:
         return prognosis.of_monitor(monitor, failure_wear)
-    last = rows[-1]
-    out = []
-    for k in range(1, monitor.n_axes + 1):
-        factor = last[f"wear{k}_factor"]
-        rescaled = [{**r, f"wear{k}_log": factor * r[f"wear{k}_twin_log"],
-                     f"wear{k}_log_lower": factor * r[f"wear{k}_twin_log_lower"]}
-                    if f"wear{k}_twin_log" in r else r for r in rows]
-        uncertainty = (last[f"wear{k}_factor_error"] / factor if last[f"wear{k}_scale"] == TESTS_SCALE
-                       else prognosis.SCALE_UNCERTAINTY)
-        out += prognosis.remaining_life(monitor.unit, rescaled, monitor.n_axes, alpha=monitor.settings.alpha,
-                                        failure_wear=failure_wear, since=monitor.first_alarm,
-                                        source_axis=monitor.source_axis, axes=[k], scale_uncertainty=uncertainty)
-    return out
+    last, axes = rows[-1], range(1, monitor.n_axes + 1)
+    factor = {k: last[f"wear{k}_factor"] for k in axes}
+    rescaled = [{**r, **{f"wear{k}{end}": factor[k] * r[f"wear{k}_twin{end}"]
+                         for k in axes for end in ("_log", "_log_lower")}} if "wear1_twin_log" in r else r
+                for r in rows]
+    uncertainty = {k: last[f"wear{k}_factor_error"] / factor[k] if last[f"wear{k}_scale"] == TESTS_SCALE
+                   else prognosis.SCALE_UNCERTAINTY for k in axes}
+    return prognosis.of_monitor(monitor, failure_wear, rows=rescaled, scale_uncertainty=uncertainty)

@@ -232,14 +232,6 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     return text + left_out
 
 
-def _cell(value) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return value if isinstance(value, str) else str(value)  # text neutralised by cells.writer
-
-
 def write_life(path: Path, rows: list[LifeRow]) -> None:
     """``life.csv``: one row per unit and axis (:data:`COLUMNS`; ``days_left`` empty without load;
     ``defaults`` the rating keys that are defaults, space separated)."""
@@ -247,7 +239,7 @@ def write_life(path: Path, rows: list[LifeRow]) -> None:
         writer = cells.writer(f)
         writer.writerow(COLUMNS)
         for row in rows:
-            writer.writerow([_cell(v) for v in row.cells()])
+            writer.writerow([cells.figure(v) for v in row.cells()])
 
 
 @dataclass(frozen=True)

@@ -501,20 +501,14 @@ def check_failure_wear(failure_wear: float) -> None:
                          "estimate, % of the axis's own dry friction, counted as the end of an axis's life)")
 
 
-def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, **options) -> list[Remaining]:
-    """:func:`remaining_life` of a :class:`faultgen.monitor.scoring.UnitMonitor`: its rows, alpha
-    and open alarm."""
-    return remaining_life(monitor.unit, monitor.rows, monitor.n_axes, alpha=monitor.settings.alpha,
+def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, rows: list[dict] | None = None,
+               **options) -> list[Remaining]:
+    """:func:`remaining_life` of a :class:`faultgen.monitor.scoring.UnitMonitor`: its rows (or
+    ``rows``, the same put on another scale), alpha and open alarm."""
+    return remaining_life(monitor.unit, monitor.rows if rows is None else rows, monitor.n_axes,
+                          alpha=monitor.settings.alpha,
                           failure_wear=failure_wear, since=monitor.first_alarm, source_axis=monitor.source_axis,
                           **options)
-
-
-def _cell(value) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return f"{value:.6g}"
-    return value if isinstance(value, str) else str(value)
 
 
 def write_rul(path: Path, rows: list[Remaining]) -> None:
@@ -524,7 +518,7 @@ def write_rul(path: Path, rows: list[Remaining]) -> None:
         writer = cells.writer(f)
         writer.writerow(COLUMNS)
         for row in rows:
-            writer.writerow([_cell(getattr(row, c)) for c in COLUMNS])
+            writer.writerow([cells.figure(getattr(row, c)) for c in COLUMNS])
 
 
 def write(path: Path, monitors, failure_wear: float = FAILURE_WEAR) -> None:
