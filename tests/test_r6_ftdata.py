@@ -87,6 +87,9 @@ def test_a_fleet_test_record_reads_back_as_the_robots_dry_level_at_its_wear(test
         viscous = record.array("viscous_factor")[0]
         assert wear.max() == pytest.approx(1.5)
         fits = friction_report.read(friction_records.log(record, 0, robot), robot).fits
+        written = measured.read(friction_records.write(record, 0, tmp_path / "test.csv"), robot)
+        as_log = friction_records.log(record, 0, robot)  # the file holds the log, to the CSV's digits
+        assert np.allclose(written.tau, as_log.tau, rtol=1e-6) and np.allclose(written.q, as_log.q, rtol=1e-9)
     f, G = robot.friction, robot.gear_ratio
     axes = fits["axis"].to_numpy() - 1
     assert axes.tolist() == sorted({0, worn - 1}) and int(np.argmax(wear)) == worn - 1

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import cells, measured
+from faultgen.data import atomic, cells, measured
 from faultgen.data.reader import Run
 from faultgen.operation import jointlog
 
@@ -53,9 +53,10 @@ def log(run: Run, index: int, robot) -> measured.MeasuredData:
 
 def write(run: Run, index: int, path: str | Path) -> Path:
     """Test ``index`` of ``run`` written as a measured-format CSV (``t, q1..qN, tau1..tauN[,
-    temperature1..N]``) at ``path``, the file ``faultgen friction-test`` reads; raises as :func:`log`."""
+    temperature1..N]``) at ``path``, atomically (a killed write leaves no partial file), the file
+    ``faultgen friction-test`` reads; raises as :func:`log`."""
     import pandas as pd
 
     path = Path(path)
-    cells.escaped(pd.DataFrame(_columns(run, index))).to_csv(path, index=False)
+    atomic.write_text(path, cells.escaped(pd.DataFrame(_columns(run, index))).to_csv(index=False))
     return path
