@@ -46,6 +46,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 from faultgen.model import rating
+from faultgen.monitor.html_cells import number
 
 #: Operating hours per calendar day the consumption between logs assumes (two 8 h shifts).
 HOURS_PER_DAY = 16.0
@@ -265,21 +266,21 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
     below it whenever the source that gives it is. None when no source gives a number."""
     found = []
     for r in life_rows:
-        days = _float(r.get("days_left"))
+        days = number(r.get("days_left"))
         if math.isfinite(days):
             days = max(days, 0.0)
             found.append((days, days, days, f"load: axis {r.get('axis')}'s rated life", r.get("axis")))
     for r in rul_rows:
-        days = _float(r.get("rul"))
+        days = number(r.get("rul"))
         if math.isfinite(days) and r.get("time_unit") == "days":
-            low, high = _float(r.get("rul_5")), _float(r.get("rul_95"))
+            low, high = number(r.get("rul_5")), number(r.get("rul_95"))
             found.append((days, min(days, low) if math.isfinite(low) else days,
                           max(days, high) if math.isfinite(high) else math.inf,
                           f"condition: axis {r.get('axis')}'s wear", r.get("axis")))
     if not found:
         return None
     days, _, _, why, axis = min(found, key=lambda f: f[0])
-    axis = _float(axis)
+    axis = number(axis)
     return Service(days, min(f[1] for f in found), min(f[2] for f in found), why,
                    int(axis) if math.isfinite(axis) and axis == int(axis) else None)
 
@@ -310,23 +311,16 @@ def service_by(last_stamp: str, life_rows: list[dict], rul_rows: list[dict]) -> 
     return date_after(last_stamp, service.days), service.why
 
 
-def _float(cell) -> float:
-    try:
-        return float(cell)
-    except (TypeError, ValueError):
-        return math.nan
-
-
 def table_cell(rows: list[dict]) -> str:
     """The fleet table's cell of a unit's rows of life.csv (as read): the axis that consumed most,
     its % and the days left at the recent duty ("past the rated life" at 0 or fewer, "no load"
     without a number)."""
-    found = [(r, _float(r.get("consumed_pct"))) for r in rows]
+    found = [(r, number(r.get("consumed_pct"))) for r in rows]
     found = [(r, c) for r, c in found if math.isfinite(c)]
     if not found:
         return ""
     r, consumed = max(found, key=lambda f: f[1])
-    days = _float(r.get("days_left"))
+    days = number(r.get("days_left"))
     left = ("no load" if not math.isfinite(days) else "past the rated life" if days <= 0 else f"{days:.0f} days left")
     return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
 
