@@ -123,9 +123,9 @@ def estimate(t: np.ndarray, tau: np.ndarray, predicted: np.ndarray, max_delay: f
     sums = products[: blocks * size].reshape(blocks, size, -1).sum(axis=1)  # (blocks, 2k + 1)
     rng = np.random.default_rng(SEED)
     counts = rng.multinomial(blocks, np.full(blocks, 1.0 / blocks), size=REPLICATES)
-    boot = np.array([_peak(c) for c in counts @ sums]) * period
+    boot = np.array([peak(c) for c in counts @ sums]) * period
     low, high = np.quantile(boot, [(1 - LEVEL) / 2, (1 + LEVEL) / 2]) + np.array([-1, 1]) * ALLOWANCE * period
-    return Delay(seconds=float(_peak(sums.sum(axis=0)) * period), low=float(low), high=float(high), period=period)
+    return Delay(seconds=float(peak(sums.sum(axis=0)) * period), low=float(low), high=float(high), period=period)
 
 
 def shift(data: measured_io.MeasuredData, seconds: float) -> measured_io.MeasuredData:
@@ -169,7 +169,7 @@ def _products(a: np.ndarray, b: np.ndarray, k: int) -> np.ndarray:
     return np.column_stack([np.einsum("ij,ij->i", a[k:n - k], b[k - lag:n - k - lag]) for lag in range(-k, k + 1)])
 
 
-def _peak(c: np.ndarray) -> float:
+def peak(c: np.ndarray) -> float:
     """The lag (samples, from ``-k``) of the largest of ``c`` (2k + 1,), to a fraction of a sample
     by the parabola through it and its neighbours (an end of the range: that end)."""
     k = (c.size - 1) // 2

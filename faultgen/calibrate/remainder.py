@@ -50,6 +50,7 @@ from sklearn.linear_model import LassoCV
 from sklearn.model_selection import KFold
 
 from faultgen import axes as axis_numbers
+from faultgen.calibrate.delay import peak
 
 #: Harmonics per arm revolution tried (``arm_periodic``, ``position_friction`` up to 2).
 ARM_HARMONICS = 6
@@ -121,7 +122,7 @@ def delay(t: np.ndarray, model: np.ndarray, y: np.ndarray, rows: np.ndarray) -> 
     """The shift ``d`` (s, within :data:`MAX_DELAY`) for which ``model(t - d) - model(t)`` (with an
     intercept, at unit gain: a free gain trades against the shift where the first-order term holds)
     fits ``y`` best on ``rows``: whole samples, then a parabola through the best and its neighbours
-    (Jacovitti & Scarano 1993)."""
+    (Jacovitti & Scarano 1993; :func:`faultgen.calibrate.delay.peak`)."""
     dt = float(np.median(np.diff(t)))
     most = max(1, min(int(round(MAX_DELAY / dt)), int(rows.sum()) // 4))
     index = np.flatnonzero(rows)
@@ -133,14 +134,7 @@ def delay(t: np.ndarray, model: np.ndarray, y: np.ndarray, rows: np.ndarray) -> 
     for k in range(-most, most + 1):
         c = model[index - k] - model[index]
         sse.append(float(np.sum((target - (c - c.mean())) ** 2)))
-    sse = np.array(sse)
-    j = int(np.argmin(sse))
-    shift = float(j - most)
-    if 0 < j < len(sse) - 1:
-        curve = sse[j - 1] - 2 * sse[j] + sse[j + 1]
-        if curve > 0:
-            shift += 0.5 * (sse[j - 1] - sse[j + 1]) / curve
-    return shift * dt
+    return peak(-np.array(sse)) * dt  # the least squared error, between samples
 
 
 def _ols(design: np.ndarray, y: np.ndarray, rows: np.ndarray) -> np.ndarray:
