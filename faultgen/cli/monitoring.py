@@ -146,7 +146,7 @@ def monitor_command(
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
     from faultgen.model import robots
-    from faultgen.monitor import loop, page
+    from faultgen.monitor import lights, loop, page
     from faultgen.monitor.scoring import Settings
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
@@ -176,15 +176,15 @@ def monitor_command(
     by_unit = {m.unit: m for m in monitors}
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
-        what = f"alarm from {m.first_alarm}, axis {m.source_axis}" if m is not None and m.first_alarm else \
+        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if m is not None and m.first_alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
         typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
                    f"{', ' + status.model + ' model' if status.model else ''}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
-    typer.echo(f"{len(alarmed)} of {len(monitors)} units alarm. " + page.false_alarm_statement(
-        protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored))
+    typer.echo(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", page.false_alarm_statement(
+        protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored)))))
     typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
                f"{out / 'rul.csv'}, "
                f"{len(monitors)} charts and the fleet report {out / page.PAGE}")

@@ -130,6 +130,14 @@ class Light:
         return (1, 0.0, rank, *attention)
 
 
+def alarm_dates(alarm: dict) -> str:
+    """When an alarm (a row of alarms.csv) became known and the log it started from, in words:
+    "known K (from F)"; "from F" for a folder written before ``known`` (issue 72), or when they are
+    the same log."""
+    known, first = alarm.get("known") or "", alarm.get("first_alarm") or ""
+    return f"known {known} (from {first})" if known and known != first else f"from {first}"
+
+
 def _failure_wear(unit, axis: int) -> float:
     row = unit.remaining.get(axis) or {}
     value = number(row.get("failure_wear"))
@@ -169,7 +177,7 @@ def light(unit, now: dict[str, tuple[float, str]], protocol: str = "") -> Light:
             met["watch"].append(f"{when}: within {WATCH_DAYS:g} days")
     if unit.open_alarm:
         axis = out.axis
-        alarm = f"open alarm from {unit.current.get('first_alarm', '')} on axis {unit.current.get('source_axis', '')}"
+        alarm = f"open alarm {alarm_dates(unit.current)} on axis {unit.current.get('source_axis', '')}"
         wear = unit.wear_now(axis) if axis is not None else None
         failure = _failure_wear(unit, axis) if axis is not None else math.nan
         if wear is not None and math.isfinite(wear.estimate) and wear.estimate >= failure:

@@ -364,7 +364,11 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
     learning = unit.monitor.pca is None
     if learning:
-        reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
+        again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
+                 if unit.monitor.program_changed else "")
+        reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
+    elif unit.monitor.not_observable_note():
+        reasons.append(unit.monitor.not_observable_note())
     if not unit.entries:
         status = "not monitored"
     elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded

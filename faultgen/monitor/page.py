@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import json
 import math
+from statistics import NormalDist
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -56,7 +57,7 @@ SETTING_NAMES = {
     "train": "logs of normal operation each unit learns from",
     "alpha": "significance level",
     "variance": "PCA variance kept",
-    "persistence": "consecutive alarming logs that make an alarm",
+    "persistence": "consecutive alarming logs that make an alarm (with the twin, one log whose lower bound passes the limit by its own width alarms at once)",
     "wear_limit": "wear limit, % of the axis's own dry friction: the lower bound of the wear, filtered over the logs, must reach to alarm",
     "twin_temperature": "the twin's temperature law predicts the seasonal change",
 }
@@ -71,12 +72,18 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
     twin (T2 or Q) and <= N (1 - c) with it (any of the ``n_axes`` axes' lower one-sided ``c`` bounds
     over a limit the unworn wear lies below, ``c`` =
     :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), and an alarm needs ``persistence`` in a
-    row."""
+    row, or, with the twin, one log whose bound passes the limit by its own width (<= N (1 - Phi(2
+    z_c)) per log). "" where the bound is 1 or more: it says nothing (issue 72)."""
     per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * (1.0 - scoring.WEAR_ALARM_CONFIDENCE))
-    chance = min(1.0, logs_scored * per_log**persistence)
+    z = NormalDist().inv_cdf(scoring.WEAR_ALARM_CONFIDENCE)
+    at_once = 0.0 if protocol == "own" else n_axes * (1.0 - NormalDist().cdf(2 * z))
+    chance = logs_scored * (per_log**persistence + at_once)
+    if chance >= 1.0:
+        return ""
+    once = f" or one far past the limit at <= {at_once:.2g}" if at_once else ""
     return (f"Chance of a persistent alarm on a healthy unit over {logs_scored} logs if its residuals were "
-            f"independent and normal: <= {chance:.2g} ({persistence} in a row at <= {per_log:g} per log); drift "
-            f"the first {train} logs did not show raises it.")
+            f"independent and normal: <= {chance:.2g} ({persistence} in a row at <= {per_log:g} per log{once}); "
+            f"drift the first {train} logs did not show raises it.")
 
 
 # -- reading the outputs ----------------------------------------------------------------------------
@@ -188,7 +195,8 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     """
     folder = Path(folder)
     _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
-    _, alarm_rows = tables.read(folder, "alarms.csv", report.ALARM_COLUMNS, max_bytes)
+    # ``known`` is new (issue 72): a folder written before it is still read
+    _, alarm_rows = tables.read(folder, "alarms.csv", tuple(c for c in report.ALARM_COLUMNS if c != "known"), max_bytes)
     columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
@@ -305,7 +313,7 @@ def _remaining(row: dict | None) -> str:
 
 
 def _closed_text(alarm: dict) -> str:
-    return (f"alarm from {alarm['first_alarm']}, axis {alarm['source_axis']}, closed {alarm['closed']} by "
+    return (f"alarm {lights.alarm_dates(alarm)}, axis {alarm['source_axis']}, closed {alarm['closed']} by "
             f"{alarm['closed_by']}")
 
 
@@ -319,7 +327,7 @@ def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
     row = unit.row
     model = f", {row['model']} model" if row.get("model") else ""
     head = (f"{escaped(unit.name)} — {escaped(lit.state)} — {escaped(row.get('status', ''))}"
-            + (f" — alarm from {escaped(unit.current['first_alarm'])}, axis {escaped(unit.current['source_axis'])}"
+            + (f" — alarm {escaped(lights.alarm_dates(unit.current))}, axis {escaped(unit.current['source_axis'])}"
                if unit.open_alarm else ""))
     parts = [f'<details class="unit" id="unit-{index}" data-index="{index}"><summary>{head}</summary>',
              lights.panel_html(unit, lit),
@@ -327,7 +335,7 @@ def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
              f"{escaped(row.get('logs_scored', ''))} logs scored, the last {escaped(row.get('last_log', '') or '–')}."
              + (f" {escaped(row['reason'])}." if row.get("reason") else "") + "</p>"]
     if unit.open_alarm:
-        parts.append(f'<p class="evidence"><b>Open alarm</b> from {escaped(unit.current["first_alarm"])} on axis '
+        parts.append(f'<p class="evidence"><b>Open alarm</b> {escaped(lights.alarm_dates(unit.current))} on axis '
                      f'{escaped(unit.current["source_axis"])} ({escaped(unit.current["statistic"])}): '
                      f'{escaped(unit.current["evidence"])}</p>')
     elif unit.current is not None:
@@ -379,9 +387,9 @@ def build(fleet: Fleet, settings: dict) -> str:
     statement = ""
     if all(isinstance(settings.get(k), (int, float)) for k in ("alpha", "persistence", "train")):
         logs_scored = max((sum(r["phase"] == "monitoring" for r in u.scores) for u in monitors), default=0)
-        statement = (f"{alarmed} of {len(monitors)} units alarm. " + false_alarm_statement(
+        statement = " ".join(filter(None, (f"{alarmed} of {len(monitors)} units alarm.", false_alarm_statement(
             str(settings.get("protocol", "twin")), float(settings["alpha"]), int(settings["persistence"]),
-            int(settings["train"]), fleet.n_axes, logs_scored))
+            int(settings["train"]), fleet.n_axes, logs_scored))))
     setting_rows = "".join(f"<tr><th>{escaped(k)}</th><td>{escaped(settings[k])}</td><td class='muted'>{escaped(v)}</td></tr>"
                            for k, v in SETTING_NAMES.items() if k in settings)
     setting_rows += "".join(f"<tr><th>{escaped(k)}</th><td>{escaped(v)}</td><td></td></tr>"

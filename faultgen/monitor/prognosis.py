@@ -91,7 +91,7 @@ from statistics import NormalDist
 import numpy as np
 
 from faultgen.data import cells, logfolder
-from faultgen.monitor.scoring import SCALE_UNCERTAINTY
+from faultgen.monitor.scoring import NOT_OBSERVABLE, SCALE_UNCERTAINTY
 from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, akaike_weights, expm1_over, fit_models
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
@@ -120,7 +120,8 @@ COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model"
 class Remaining:
     """One row of ``rul.csv``: ``unit``, ``axis`` (1..N; None when the unit has no wear estimate),
     computed at ``stamp`` (the last log fitted), in ``time_unit`` ("days" or "logs"); ``wear`` the
-    model's wear now, %, ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
+    axis's wear at the last log, %, as wear.csv gives it (the filtered wear; the trend's wear now for
+    rows without it; issue 72), ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
     ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
     ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, ``verdict`` in
     words, ``models`` every model's weight in the average, and ``predictable`` False for "not yet
@@ -365,6 +366,12 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
 
     for axis in wanted:
         fitted, fits = block, []
+        now = rows[-1].get(f"wear{axis}")  # wear.csv's of the last log (issue 72: not the trend's)
+        if isinstance(now, float) and np.isnan(now):  # faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS
+            out.append(Remaining(unit, axis, stamp, time_unit, f"{NOT_OBSERVABLE}: no wear, trend or remaining life "
+                                 "(one log's 90 % interval of its wear is wider than the rule of "
+                                 "faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS; units.csv)", failure_wear, horizon))
+            continue
         if since is not None and axis == source_axis:
             stamps = [r["stamp"] for r in block]
             if changepoint and since in stamps and len(block) >= MIN_LOGS:  # the whole block, flat then rising
@@ -374,7 +381,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             if not fits:  # the logs from the alarm on
                 fitted = block[stamps.index(since):] if since in stamps else block
         base = Remaining(unit, axis, stamp, time_unit, "", failure_wear, horizon, logs_fitted=len(fitted),
-                         fitted_from=fitted[0]["stamp"] if fitted else "")
+                         fitted_from=fitted[0]["stamp"] if fitted else "", wear=None if now is None else float(now))
         if len(fitted) < MIN_LOGS:
             base.verdict = (f"too few logs for a trend: {len(fitted)} of {MIN_LOGS} since the "
                             f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
@@ -389,7 +396,9 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         weights = akaike_weights(fits)
         named = named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
-        base.model, base.wear = named.model, float(np.median(drawn.key("wear")))
+        base.model = named.model
+        if now is None:  # rows without the filtered wear (a caller's own): the trend's wear now
+            base.wear = float(np.median(drawn.key("wear")))
         base.models = ", ".join(f"{f.model} {w:.2f}" for f, w in zip(fits, weights))
         slope, slope_error = float(named.params[1]), float(np.sqrt(named.cov[1, 1]))
         if slope - z * slope_error <= 0:  # the named model's slope now, as before the model average

@@ -14,7 +14,9 @@ import numpy as np
 from faultgen.data import cells
 from faultgen.monitor import scoring
 
-ALARM_COLUMNS = ("unit", "first_alarm", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
+#: ``first_alarm``: the first of the alarming logs the alarm started from; ``known``: the log on which it
+#: became known (persistent), as a daily run sees it (issue 72).
+ALARM_COLUMNS = ("unit", "first_alarm", "known", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
 
 
@@ -27,7 +29,7 @@ CELL_MAX_CHARS = 4096
 
 def _fmt(value) -> str:
     if isinstance(value, float):
-        return f"{value:.6g}"
+        return f"{value:.6g}" if not np.isnan(value) else ""  # no number (an axis not observable): empty
     if not isinstance(value, str):
         return str(value)
     if len(value) > CELL_MAX_CHARS:
@@ -133,18 +135,20 @@ def _draw(path, monitor, axis_note: str, plt) -> None:
             k = stamps.index(monitor.first_alarm)
             for ax in panels:
                 ax.axvline(k, color="r", lw=1.2)
-            top.text(k, 1.0, f" alarm {monitor.first_alarm}, axis {monitor.source_axis}", color="r", va="bottom")
+            known = f" known {monitor.known}" if monitor.known and monitor.known != monitor.first_alarm else ""
+            top.text(k, 1.0, f" alarm {monitor.first_alarm}{known}, axis {monitor.source_axis}", color="r", va="bottom")
         top.set_yscale("log")
         if twin:
             middle = panels[1]
             for i in range(monitor.n_axes):
-                middle.plot(x, [r[f"wear{i + 1}"] for r in rows], lw=1, label=f"axis {i + 1}")
-            best = [max(r[f"wear{i + 1}_lower"] for i in range(monitor.n_axes)) for r in rows]
+                middle.plot(x, [r.get(f"wear{i + 1}", np.nan) for r in rows], lw=1, label=f"axis {i + 1}")
+            best = [max((v for i in range(monitor.n_axes) if np.isfinite(v := r.get(f"wear{i + 1}_lower", np.nan))),
+                        default=np.nan) for r in rows]
             middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * scoring.WEAR_ALARM_CONFIDENCE:g} % bound")
             middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
             middle.set_ylabel("wear estimate, % of own dry friction")
             middle.legend(fontsize=7, loc="upper left", ncol=4)
-        scores = np.array([[r[f"score{i}"] for i in range(1, monitor.n_axes + 1)] for r in rows])
+        scores = np.array([[r.get(f"score{i}", np.nan) for i in range(1, monitor.n_axes + 1)] for r in rows])
         for i in range(monitor.n_axes):
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
         step = max(1, len(rows) // 8)

@@ -124,6 +124,21 @@ WEAR_INTERVAL = 0.90
 WEAR_ALARM_CONFIDENCE = 0.90
 
 
+#: An axis is **not observable on this program** when one log's :data:`WEAR_INTERVAL` (90 %) interval of
+#: its wear, from the noise at the learning logs' conditions (:meth:`UnitMonitor.wear_interval` of an
+#: unworn axis: 2 x 1.645 standard errors), is wider than this many ``wear_limit``s (40 points at the
+#: default 10 %). Why: the filtered wear's error is about half a log's (:class:`WearTrend`), so at that
+#: width the filtered wear's own 90 % interval on an unworn axis reaches past the limit: the logs
+#: cannot tell the axis unworn from worn to the limit, and its wear, trend and remaining life would be
+#: the noise's (issue 72: a UR5 dispensing program's axis 2, one log's interval 258 points wide, its
+#: filtered wear -36..+11 %). Such an axis gets no wear (empty cells in scores.csv and wear.csv), no
+#: remaining life (rul.csv says why), and does not alarm; the axes of the independent KR210 fleet's
+#: program are 7-8 points wide (0.8 limits).
+NOT_OBSERVABLE_LIMITS = 4.0
+#: What an axis that is not observable is called (rul.csv's verdict, units.csv's reason, the page).
+NOT_OBSERVABLE = "not observable on this program"
+
+
 #: Largest ``wear_limit`` taken, % (a friction ten times its nominal is no longer wear to monitor).
 MAX_WEAR_LIMIT = 1000.0
 #: The fewest logs a unit is learned from (``train``), and the most logs ``train`` and ``persistence``
@@ -178,6 +193,18 @@ class UnitMonitor:
         self.window: deque = deque(maxlen=settings.persistence)
         self.run = 0
         self.first_alarm: str | None = None
+        #: The stamp of the log on which the open alarm became known (persistent), as a daily run sees it.
+        self.known: str | None = None
+        #: The last maintenance or program change (what, stamp, rows before it), or None.
+        self.since: tuple[str, str, int] | None = None
+        #: Whether the unit learns again after a program change (its learning logs are ``relearning``).
+        self.program_changed = False
+        #: (n_axes,) whether each axis is observable on the program (:data:`NOT_OBSERVABLE_LIMITS`)
+        #: and one log's 90 % interval width of each, points (:meth:`_fit`; all observable before it).
+        self.observable_ = np.ones(n_axes, dtype=bool)
+        self.width_ = np.zeros(n_axes)
+        #: Rows of :attr:`rows` standing for the logs learned since a program change, not yet scored.
+        self.placeholders = 0
         self.source_axis: int | None = None
         self.statistic = ""
         self.limit = float("nan")
@@ -209,10 +236,8 @@ class UnitMonitor:
         """The unit runs another program from the log ``stamp`` on (``reason`` says how it was
         found): its open alarm, if any, is closed by it, and the unit learns its normal operation
         again from this log on (``train`` logs), against the twin of the new program."""
-        if self.first_alarm is not None:
-            self.closed.append({**self._open_alarm(), "closed": stamp, "closed_by": reason})
-            self.first_alarm, self.source_axis, self.statistic = None, None, ""
-            self.limit, self.evidence = float("nan"), ""
+        self._close(stamp, reason)
+        self.since, self.program_changed, self.placeholders = ("program change", stamp, len(self.rows)), True, 0
         self.training, self.learned_expectations = [], []
         self.pca, self.relearning, self.run = None, None, 0
         self.window.clear()
@@ -230,16 +255,27 @@ class UnitMonitor:
         if self.tests is not None:
             self.tests.reset()
         if self.pca is None:
-            self.training, self.learned_expectations = [], []
+            self.training, self.learned_expectations, self.placeholders = [], [], 0
             return
-        if self.first_alarm is not None:
-            self.closed.append({**self._open_alarm(), "closed": stamp, "closed_by": f"{event} of axis {axis}"})
-            self.first_alarm, self.source_axis, self.statistic = None, None, ""
-            self.limit, self.evidence = float("nan"), ""
+        self._close(stamp, f"{event} of axis {axis}")
+        self.since = (f"{event} of axis {axis}", stamp, len(self.rows))
         self.run = 0
         self.window.clear()
         self.relearning = []
         self.trend.reset()
+
+    def _close(self, stamp: str, by: str) -> None:
+        """Close the open alarm by ``by`` (a maintenance event or a program change) at ``stamp``; an
+        alarm under way, the wear's lower bound over the limit on the last logs but fewer than
+        ``persistence`` of them, is raised as it stands first and closed with it: a unit whose
+        bound crossed the limit before its gearbox change does not end without an alarm (issue 72)."""
+        if self.first_alarm is None and self.run and self.window and self.window[-1][4] is not None:
+            self._raise(f"not yet persistent ({min(self.run, len(self.window))} of {self.settings.persistence} "
+                        "logs) when it was closed")
+        if self.first_alarm is not None:
+            self.closed.append({**self._open_alarm(), "closed": stamp, "closed_by": by})
+            self.first_alarm, self.known, self.source_axis, self.statistic = None, None, None, ""
+            self.limit, self.evidence = float("nan"), ""
 
     # -- learning -------------------------------------------------------------------------------
     def _fit(self) -> None:
@@ -276,9 +312,17 @@ class UnitMonitor:
             # estimate's squared error times (X'X)^-1; the trend learns it on from later logs
             error = self.wear_estimate(np.zeros_like(self.scale_), self.scale_**2)[1]
             self.trend.set_prior(error[:, None, None] ** 2 * self.gram_inv_[None])
+            # one log's 90 % interval of an unworn axis, from the noise: the rule of NOT_OBSERVABLE_LIMITS
+            self.width_ = 2.0 * NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2) * error
+            self.observable_ = self.width_ <= NOT_OBSERVABLE_LIMITS * self.settings.wear_limit
+        if self.placeholders:  # the rows standing for these logs since a program change
+            del self.rows[-self.placeholders:]
+            self.placeholders = 0
+        phase = "relearning" if self.program_changed else "training"
+        self.program_changed = False
         for stamp, z, r in zip(stamps, Z, R):
             wear = self.wear_estimate(r, self.scale_**2)
-            self._score(stamp, z, phase="training", wear=None if wear is None else (*wear, wear[1], None))
+            self._score(stamp, z, phase=phase, wear=None if wear is None else (*wear, wear[1], None))
 
     def _standardise(self, e: np.ndarray, conditions: np.ndarray) -> np.ndarray:
         x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
@@ -366,6 +410,11 @@ class UnitMonitor:
                 self.learned_expectations.append(np.asarray(expected, dtype=float))
             if len(self.training) == self.settings.train:
                 self._fit()
+            elif self.program_changed:  # listed at once (scored when the learning is complete)
+                self.rows.append({"unit": self.unit, "stamp": stamp, "phase": "relearning", "Q": np.nan,
+                                  "Q_limit": np.nan, "T2": np.nan, "T2_limit": np.nan, "alarm": 0, "ranking": "",
+                                  **{f"score{i + 1}": np.nan for i in range(self.n_axes)}})
+                self.placeholders += 1
             return
         e = np.asarray(residual, dtype=float)
         relearned = self.relearning is not None
@@ -414,7 +463,7 @@ class UnitMonitor:
     def _score(self, stamp: str, z: np.ndarray, phase: str, wear=None) -> None:
         t2, q = (float(v[0]) for v in self.pca.score_samples(z[None]))
         alarm = q > self.pca.q_limit_ or t2 > self.pca.t2_limit_
-        wear_row = {}
+        wear_row, at_once = {}, False
         if wear is not None:
             log_estimate, log_error, trend_error, x = wear
             wear = estimate, error = self.trend.update(log_estimate, trend_error, x)
@@ -424,7 +473,6 @@ class UnitMonitor:
             # the season")
             log_estimate = log_estimate - self.trend.condition_part(x)
             bound = estimate - self.alarm_quantile * error
-            alarm = bool(bound.max() >= self.settings.wear_limit)
             # the interval keeps the log's own error: the filter averages out the scatter from log
             # to log, not the errors that stay for weeks (the learned temperature slopes
             # extrapolated over a season, the calibration's friction), which the learning logs
@@ -435,7 +483,14 @@ class UnitMonitor:
                 wear, low, high, bound, log_estimate, log_error, tested = self._on_tests(
                     stamp, estimate, error, log_estimate, log_error)
                 estimate = wear[0]
-                alarm = bool(bound.max() >= self.settings.wear_limit)
+            seen = self.observable_
+            alarm = bool(np.max(np.where(seen, bound, -np.inf)) >= self.settings.wear_limit)
+            # the lower bound above the limit by its own width (the filtered wear less two of its
+            # quantiles): alarmed at once, persistence cannot hide it (issue 72)
+            at_once = bool(np.max(np.where(seen, 2 * bound - estimate, -np.inf)) >= self.settings.wear_limit)
+            hidden = np.where(seen, 1.0, np.nan)  # an axis not observable has no wear (NOT_OBSERVABLE_LIMITS)
+            estimate, bound, low, high = estimate * hidden, bound * hidden, low * hidden, high * hidden
+            log_estimate, log_error = log_estimate * hidden, log_error * hidden
             wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
                         **{f"wear{i + 1}_lower": float(v) for i, v in enumerate(bound)},
                         **{f"wear{i + 1}_5": float(v) for i, v in enumerate(low)},
@@ -450,19 +505,23 @@ class UnitMonitor:
             self.window.append((stamp, z, t2, q, wear))
             if self.first_alarm is None and self.run >= self.settings.persistence:
                 self._raise()
+            elif self.first_alarm is None and alarm and at_once:
+                self._raise("at once: its lower bound above the limit by more than its own width")
         self.rows.append({"unit": self.unit, "stamp": stamp, "phase": phase, "Q": q, "Q_limit": self.pca.q_limit_,
                           "T2": t2, "T2_limit": self.pca.t2_limit_, "alarm": int(alarm),
                           "ranking": " ".join(str(a) for a in ranking),
                           **{f"score{i + 1}": float(s) for i, s in enumerate(scores)}, **wear_row})
 
-    def _raise(self) -> None:
-        stamps, Z, t2, q, wear = zip(*self.window)
-        self.first_alarm = stamps[0]
-        span = f"mean of {len(stamps)} logs from {stamps[0]} to {stamps[-1]}"
+    def _raise(self, how: str = "") -> None:
+        """The alarm of the last ``run`` monitoring logs (at most ``persistence``): from the first
+        of them, known on the last; ``how`` says how it was raised when not by ``persistence`` logs."""
+        stamps, Z, t2, q, wear = zip(*list(self.window)[-min(self.run, len(self.window)):])
+        self.first_alarm, self.known = stamps[0], stamps[-1]
+        span = f"mean of {len(stamps)} logs from {stamps[0]} to {stamps[-1]}" + (f"; {how}" if how else "")
         if wear[0] is not None:  # the twin: the wear estimate alarmed
             estimate = np.mean([w[0] for w in wear], axis=0)
             bound = np.mean([w[0] - self.alarm_quantile * w[1] for w in wear], axis=0)
-            order = np.argsort(-estimate, kind="stable")
+            order = np.argsort(-np.where(self.observable_, estimate, -np.inf), kind="stable")
             self.source_axis = int(order[0]) + 1
             self.statistic, self.limit = "wear", float(self.settings.wear_limit)
             self.evidence = (f"axis {self.source_axis} wear estimate {estimate[order[0]]:.3g} %, its lower "
@@ -485,7 +544,7 @@ class UnitMonitor:
                          f"({scores[order[0]]:.3g}; next axis {order[1] + 1}: {scores[order[1]]:.3g})")
 
     def _open_alarm(self) -> dict:
-        return {"unit": self.unit, "first_alarm": self.first_alarm or "",
+        return {"unit": self.unit, "first_alarm": self.first_alarm or "", "known": self.known or "",
                 "source_axis": "" if self.source_axis is None else self.source_axis,
                 "statistic": self.statistic, "limit": "" if np.isnan(self.limit) else f"{self.limit:.6g}",
                 "evidence": self.evidence}
@@ -496,10 +555,28 @@ class UnitMonitor:
         if not self.first_alarm:
             row["evidence"] = (f"no persistent alarm in {len(self.rows)} logs" if self.pca is not None else
                                f"still learning: {len(self.training)} of {self.settings.train} logs")
+            if self.since is not None and self.pca is not None:  # after maintenance or a program change
+                what, stamp, before = self.since
+                row["evidence"] = (f"no persistent alarm since the {what} of {stamp} ({len(self.rows) - before} logs "
+                                   f"since, {len(self.rows)} in all)")
+            elif self.since is not None and self.program_changed:
+                row["evidence"] = (f"learning again after the program change of {self.since[1]}: "
+                                   f"{len(self.training)} of {self.settings.train} logs")
             if self.relearning is not None:
                 row["evidence"] += (f"; learning its offset again after maintenance: {len(self.relearning)} of "
                                     f"{self.relearn_logs} logs")
         return row
+
+    def not_observable_note(self) -> str:
+        """The axes not observable on the unit's program in words (:data:`NOT_OBSERVABLE_LIMITS`), or ""."""
+        axes = np.flatnonzero(~self.observable_)
+        if self.pca is None or not len(axes):
+            return ""
+        widths = ", ".join(f"axis {k + 1}: {self.width_[k]:.3g}" for k in axes)
+        return (f"axis {', '.join(str(k + 1) for k in axes)} {NOT_OBSERVABLE} (no wear, trend or remaining life): "
+                f"one log's 90 % interval of the wear is wider than {NOT_OBSERVABLE_LIMITS:g} x the wear limit "
+                f"({NOT_OBSERVABLE_LIMITS * self.settings.wear_limit:g} points; {widths} points), so the logs cannot "
+                "tell it unworn from worn to the limit")
 
     def alarm_rows(self) -> list[dict]:
         """The unit's rows of alarms.csv: every alarm closed by maintenance (``closed``,

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from faultgen.monitor import friction_panel
+from faultgen.monitor import friction_panel, lights
 from faultgen.monitor.html_cells import escaped, number, short
 
 #: Line colours of the axes (plotly's default sequence).
@@ -139,7 +139,7 @@ def figure(unit, settings: dict) -> dict:
                  0.9 - 0.08 * (k % 3))
     if unit.open_alarm and unit.current["first_alarm"] in raw:
         line(raw[unit.current["first_alarm"]], "#d62728", "solid",
-             escaped(f"alarm from {unit.current['first_alarm']}, axis {unit.current['source_axis']}"), 0.97)
+             escaped(f"alarm {lights.alarm_dates(unit.current)}, axis {unit.current['source_axis']}"), 0.97)
     if unit.tests:
         traces, lines, notes = friction_panel.markers(friction_panel.by_axis(unit.tests), [r["stamp"] for r in rows],
                                                       COLOURS, twin)
