@@ -66,7 +66,8 @@ def write_fleet(root: Path, spec: FleetSpec = FleetSpec(), robot: Path | None = 
 def evaluate(truth_path: Path, alarms_path: Path) -> dict[str, dict]:
     """Each unit's outcome from ``truth.csv`` and a monitor's ``alarms.csv``: ``axis`` (worn, 0
     healthy), ``alarm`` (the unit's first first_alarm stamp, closed or open, or ""), ``day`` of the
-    alarm (1-based) and ``wear`` at it (%), ``day10`` / ``day40`` (first day with wear >= 10 / 40 %),
+    alarm (1-based) and ``wear`` at it (%), ``day10`` / ``day40`` (first day with wear >= 10 / 40 %), ``known`` (the stamp the alarm became
+    known on, "" before alarms.csv had it) and ``known_wear`` (the true wear then, % or None),
     ``delay`` (alarm day - day10), ``source`` (the alarm's axis or 0), ``in_window`` (10 % <= wear at
     alarm < 40 %); ``alarms``: every alarm row of the unit (closed ones first, as alarms.csv has them,
     rows without an alarm left out)."""
@@ -85,7 +86,10 @@ def evaluate(truth_path: Path, alarms_path: Path) -> dict[str, dict]:
         day10 = int(np.argmax(wear >= 10)) + 1 if np.any(wear >= 10) else None
         day40 = int(np.argmax(wear >= 40)) + 1 if np.any(wear >= 40) else None
         at = float(wear[day - 1]) if day else None
+        known = row.get("known") or ""  # the log the alarm became known on (issue 72; absent before it)
+        known_wear = float(wear[t["stamps"].index(known)]) if known else None
         out[unit] = {"axis": t["axis"], "alarm": stamp, "day": day, "wear": at, "day10": day10, "day40": day40,
+                     "known": known, "known_wear": known_wear,
                      "delay": (day - day10) if day and day10 else None,
                      "source": int(row["source_axis"]) if row.get("source_axis") else 0,
                      "in_window": at is not None and 10.0 <= at < 40.0, "alarms": rows.get(unit, [])}

@@ -112,6 +112,9 @@ INTERVAL = (0.05, 0.95)
 MIN_RISE_LOGS = 5
 #: ... or two models of at least this weight whose own 5-95 % intervals do not overlap.
 MIN_MODEL_WEIGHT = 0.1
+#: rul.csv's verdict of an axis not observable on the unit's program (no wear: :mod:`faultgen.monitor.scoring`).
+UNOBSERVED = (f"{NOT_OBSERVABLE}: no wear, trend or remaining life (one log's 90 % interval of its wear is wider "
+              "than faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS allows; units.csv says how wide)")
 COLUMNS = ("unit", "axis", "stamp", "time_unit", "wear", "failure_wear", "model", "rul", "rul_5", "rul_95",
            "p_within_horizon", "horizon", "logs_fitted", "fitted_from", "verdict", "models")
 
@@ -365,12 +368,9 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         return (t - t[-1]) / per, wear, np.maximum(error, 1e-9)
 
     for axis in wanted:
-        fitted, fits = block, []
-        now = rows[-1].get(f"wear{axis}")  # wear.csv's of the last log (issue 72: not the trend's)
+        fitted, fits, now = block, [], rows[-1].get(f"wear{axis}")  # now: wear.csv's (issue 72), not the trend's
         if isinstance(now, float) and np.isnan(now):  # faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS
-            out.append(Remaining(unit, axis, stamp, time_unit, f"{NOT_OBSERVABLE}: no wear, trend or remaining life "
-                                 "(one log's 90 % interval of its wear is wider than the rule of "
-                                 "faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS; units.csv)", failure_wear, horizon))
+            out.append(Remaining(unit, axis, stamp, time_unit, UNOBSERVED, failure_wear, horizon))
             continue
         if since is not None and axis == source_axis:
             stamps = [r["stamp"] for r in block]
@@ -396,9 +396,8 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         weights = akaike_weights(fits)
         named = named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
-        base.model = named.model
-        if now is None:  # rows without the filtered wear (a caller's own): the trend's wear now
-            base.wear = float(np.median(drawn.key("wear")))
+        # rows without the filtered wear (a caller's own): the trend's wear now
+        base.model, base.wear = named.model, base.wear if now is not None else float(np.median(drawn.key("wear")))
         base.models = ", ".join(f"{f.model} {w:.2f}" for f, w in zip(fits, weights))
         slope, slope_error = float(named.params[1]), float(np.sqrt(named.cov[1, 1]))
         if slope - z * slope_error <= 0:  # the named model's slope now, as before the model average

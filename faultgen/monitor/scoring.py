@@ -44,7 +44,11 @@ T2 and Q alarm on any change the first logs did not show (drift of the season th
 extrapolate, a new part); the wear estimate only on a change along a wear signature, and its bound
 says how much wear, so a slow wear is called at a level and not when it first leaves the noise.
 Either way, a unit's alarm is persistent from the first of ``persistence`` consecutive alarming
-logs (thesis ch. 3.4.1, :func:`analysis.monitoring.detect_onset`). Each log's axes are ranked: with the twin by how
+logs (thesis ch. 3.4.1, :func:`analysis.monitoring.detect_onset`), known on the last of them
+(``known`` in alarms.csv: the log on which a daily run sees it); with the twin a log whose lower
+bound passes the limit by its own width alarms at once, and an alarm under way when a repair or
+program change comes is closed by it, not forgotten (issue 72). An axis the program does not excite
+is :data:`NOT_OBSERVABLE` (:data:`NOT_OBSERVABLE_LIMITS`): no wear, and it does not alarm. Each log's axes are ranked: with the twin by how
 closely the residual points along each axis's wear signature
 (:func:`analysis.isolation.signature_scores`), without it by each axis's reconstruction-based
 contribution to Q (Alcala and Qin, Automatica 45 (2009) 1593-1600: how much Q falls when the log is
