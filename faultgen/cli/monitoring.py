@@ -121,8 +121,8 @@ def monitor_command(
     results come back and are written here); either way the outputs are those of --jobs 1, bit for
     bit.
 
-    Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, source_axis, statistic, limit, evidence,
-    closed, closed_by),
+    Writes OUT/units.csv, OUT/alarms.csv (unit, first_alarm, known: the log the alarm became known on,
+    source_axis, statistic, limit, evidence, closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
     OUT/wear.csv (per unit, log and axis, with the twin: the wear estimate, % of the axis's own dry
     friction, with its 90 % interval that carries the twin's model uncertainty),

@@ -19,8 +19,10 @@ beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again 
   the relearning after maintenance marked, the friction-test days) and, with friction tests, each
   alarming axis's friction curve, the reference test against the latest
   (:mod:`faultgen.monitor.friction_panel`);
-- the run's settings and the false-alarm statement the command line prints
-  (:func:`false_alarm_statement`).
+- the run's settings and the false-alarm statement the command line prints, where its bound is
+  below 1 (:func:`false_alarm_statement`);
+- each alarm as a daily run sees it: "known K (from F)", the log it became known on and the one it
+  started from (alarms.csv's ``known`` and ``first_alarm``; issue 72).
 
 At 400 px wide (a phone) the table's lines become cards, each cell under its column's name: no
 column leaves the screen (tests/test_r6_page.py checks it in headless Chromium).
