@@ -26,7 +26,7 @@ CELL_MAX_CHARS = report.CELL_MAX_CHARS + 1
 #: Columns holding a unit's or a log's name (a folder's or a file's: at most 255 bytes), and their
 #: longest cell read, characters (with a formula escape): the page repeats a log's stamp in each trace
 #: of its unit's chart.
-NAME_COLUMNS = ("unit", "stamp", "first_alarm", "last_log")
+NAME_COLUMNS = ("unit", "stamp", "first_alarm", "known", "last_log")
 NAME_MAX_CHARS = 256
 
 
