@@ -176,15 +176,17 @@ def monitor_command(
     by_unit = {m.unit: m for m in monitors}
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
-        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if m is not None and m.first_alarm else \
+        alarm = m is not None and m.first_alarm
+        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
         typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
                    f"{', ' + status.model + ' model' if status.model else ''}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
-    typer.echo(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", page.false_alarm_statement(
-        protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1, logs_scored)))))
+    statement = page.false_alarm_statement(protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1,
+                                           logs_scored)  # "" where it says nothing (issue 72)
+    typer.echo(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
     typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
                f"{out / 'rul.csv'}, "
                f"{len(monitors)} charts and the fleet report {out / page.PAGE}")

@@ -198,7 +198,8 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     folder = Path(folder)
     _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
     # ``known`` is new (issue 72): a folder written before it is still read
-    _, alarm_rows = tables.read(folder, "alarms.csv", tuple(c for c in report.ALARM_COLUMNS if c != "known"), max_bytes)
+    required = tuple(c for c in report.ALARM_COLUMNS if c != "known")
+    _, alarm_rows = tables.read(folder, "alarms.csv", required, max_bytes)
     columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
