@@ -146,6 +146,12 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     rul = prognosis.of_monitor(unit, samples=50)
     assert rul[1].verdict.startswith(NOT_OBSERVABLE) and rul[1].wear is None and rul[1].rul is None
     assert not rul[0].verdict.startswith(NOT_OBSERVABLE)
+    # the page: the axis named as such in the unit's panel, no wear number for it
+    report.write_alarms(tmp_path / "alarms.csv", [unit])
+    report.write_units(tmp_path / "units.csv", [UnitStatus("u", "monitored", "twin", "nominal",
+                                                           unit.not_observable_note(), 50, "049")])
+    html = page.build(page.read(tmp_path), {})
+    assert f"<li>axis 2: {NOT_OBSERVABLE} (no wear" in html and "<li>axis 1: " in html
 
 
 def test_rul_csv_wear_is_wear_csv_wear(tmp_path):

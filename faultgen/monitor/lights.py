@@ -46,6 +46,7 @@ from dataclasses import dataclass, field
 from faultgen.data import logfolder
 from faultgen.monitor import life, prognosis
 from faultgen.monitor.html_cells import escaped, number
+from faultgen.monitor.scoring import NOT_OBSERVABLE
 
 #: The lights, in the order the rules are tried and the undated units are listed.
 STATES = ("service due", "watch", "stale", "unknown", "ok")
@@ -266,6 +267,8 @@ def panel_html(unit, lit: Light) -> str:
                  else f"lower 90 % bound {wear.low:.3g} %")
         scale = f", {wear.scale} scale" if len(scales) > 1 else ""
         items.append(f"<li>axis {axis}: {wear.estimate:.3g} % ({escaped(bound)}){escaped(scale)}</li>")
+    items += [f"<li>axis {axis}: {NOT_OBSERVABLE} (no wear: units.csv says why)</li>" for axis in unit.axes()
+              if (w := unit.wear_now(axis)) is not None and not math.isfinite(w.estimate)]  # wear.csv's cells empty
     if items:
         source = "wear.csv" if unit.wear else "scores.csv"
         what = "; ".join(SCALES.get(s, s) for s in sorted(scales))
