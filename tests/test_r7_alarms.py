@@ -8,6 +8,7 @@ synthetic residuals along known wear signatures (each axis's friction torque onl
 checked against a reading of its own rows that does not use its persistence logic."""
 
 import csv
+import io
 from statistics import NormalDist
 
 import numpy as np
@@ -146,6 +147,7 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     rul = prognosis.of_monitor(unit, samples=50)
     assert rul[1].verdict.startswith(NOT_OBSERVABLE) and rul[1].wear is None and rul[1].rul is None
     assert not rul[0].verdict.startswith(NOT_OBSERVABLE)
+    report.chart(io.BytesIO(), unit, "wear signature match")  # an axis without wear drawn as none
     # the page: the axis named as such in the unit's panel, no wear number for it
     report.write_alarms(tmp_path / "alarms.csv", [unit])
     report.write_units(tmp_path / "units.csv", [UnitStatus("u", "monitored", "twin", "nominal",
@@ -185,6 +187,7 @@ def test_a_program_changes_relearning_logs_are_listed_and_counted():
     _feed(unit, np.zeros((12, N_AXES)), rng, first=30)
     assert len(unit.rows) == 42 and [r["phase"] for r in unit.rows[30:]] == ["relearning"] * 12
     assert unit.alarm_row()["evidence"] == f"learning again after the program change of 030: 12 of {SETTINGS.train} logs"
+    report.chart(io.BytesIO(), unit, "wear signature match")  # rows without scores drawn as gaps
     _feed(unit, np.zeros((15, N_AXES)), rng, first=42)
     phases = [r["phase"] for r in unit.rows]
     assert len(phases) == 57 and [r["stamp"] for r in unit.rows] == [f"{i:03d}" for i in range(57)]
