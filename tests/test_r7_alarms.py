@@ -122,11 +122,11 @@ def test_an_alarm_under_way_at_a_gearbox_change_is_closed_by_it_not_forgotten():
 
 
 def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbers(tmp_path):
-    """Axis 2's signature is 1/40 of the others': one log's 90 % interval of its wear is about
+    """Axis 2's signature is 1/50 of the others': one log's 90 % interval of its wear is about
     2 x 1.645 x noise / signature wide (the weighted least squares' standard error of one feature),
-    80 points against 2 for the others; the rule's threshold is 4 wear limits (40 points)."""
+    110 points against 2 for the others; the rule's threshold is 6 wear limits (60 points)."""
     rng = np.random.default_rng(4)
-    per_axis = np.array([0.08, 0.002, 0.08])
+    per_axis = np.array([0.08, 0.0015, 0.08])
     unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(per_axis))
     wear = np.zeros((50, N_AXES))
     wear[30:, 1] = 300.0  # even a huge change along it: the noise's, not wear the logs can tell
