@@ -13,7 +13,8 @@ the measured format or an adapter's):
     logs, then every later log scored in stamp order; a log that cannot be read or replayed is
     skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
     offset is learned again, and a log whose motion left the twin's program starts a new program
-    (:func:`faultgen.monitor.feed.new_program`).
+    (:func:`faultgen.monitor.feed.new_program`; a log of several cycles of the program, at any rate,
+    is the same program: :mod:`faultgen.monitor.cycles`).
 
 Units are scored one after another, in ``jobs`` local processes or on a Dask cluster
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
