@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 
 from faultgen.bench import layouts
-from faultgen.data import measured
+from faultgen.data import logfolder, measured
 from faultgen.model import robots
 from faultgen.monitor import cycles, feed
+from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import unit as unit_module
 
 
 def motion(t: np.ndarray, reach: float = 1.0) -> np.ndarray:
@@ -134,3 +136,27 @@ def test_only_the_real_program_change_is_one_on_the_mixed_fleet(robot, mixed):
                 program = feed.program_of(data)  # the monitor's new program from the change on
         assert changed == ([change["stamp"]] if unit == unit_changed else []), unit
 
+
+
+def test_units_whose_first_logs_hold_other_layouts_of_one_program_share_its_twin(robot, mixed):
+    root, logs = mixed
+    model = robots.load(robot)
+    source = fleet_logs.Source(model)
+    ((unit_changed, (change,)),) = independent_fleet.read_changes(root).items()
+    before = [(u, s) for u in independent_fleet.unit_names(SPEC) for s in independent_fleet.stamps(SPEC)
+              if u != unit_changed or s < change["stamp"]]
+    layouts_seen, programs = {}, []
+    for unit, stamp in before:
+        data = measured.read(logs / unit / f"{stamp}.csv", model, accelerations=False)
+        layouts_seen.setdefault((len(data.t), round(1 / np.median(np.diff(data.t)))), (unit, stamp))
+    assert len(layouts_seen) == 4  # 1 or 2 cycles at 250 or 500 Hz
+    first = None
+    for k, (unit, stamp) in enumerate(layouts_seen.values()):
+        entry = logfolder.LogFile(unit, stamp, 0.0, "time", logs / unit / f"{stamp}.csv", f"{unit}/{stamp}.csv")
+        program = unit_module.program_of(entry, f"u{k}", programs, source)
+        first = first or program
+        assert program == first == ("u0", list(layouts_seen.values())[0][1])  # the first one's program, shared
+    changed = logfolder.LogFile(unit_changed, change["stamp"], 0.0, "time", logs / unit_changed / f"{change['stamp']}.csv",
+                                f"{unit_changed}/{change['stamp']}.csv")
+    assert unit_module.program_of(changed, "other", programs, source) == ("other", change["stamp"])
+    assert len(programs) == 2

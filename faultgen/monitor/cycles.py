@@ -89,12 +89,12 @@ class Program:
                 return cls(t[first] - t[0], q[first], _span(t) / k, k)
         return cls(t - t[0], q, _span(t), 1)
 
-    def log_cycles(self, t, q, cycle=None) -> int | None:
+    def log_cycles(self, t, q, cycle=None, tolerance: float = PROGRAM_CHANGE) -> int | None:
         """How many cycles of this program a log holds (its samples ``t`` (n,) s, angles ``q`` (n, N)
         rad, ``cycle`` column or None), or None when it runs another program: a span that is not a
         whole number of periods (within :data:`PROGRAM_LENGTH`; each cycle of a ``cycle`` column but
-        the log's first and last, which its ends may cut), or a cycle more than
-        :data:`PROGRAM_CHANGE` rad off the program's over the time both cover."""
+        the log's first and last, which its ends may cut), or a cycle more than ``tolerance`` rad
+        (:data:`PROGRAM_CHANGE` by default) off the program's over the time both cover."""
         t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
         if cycle is None:
             k = int(round(_span(t) / self.period))
@@ -107,6 +107,6 @@ class Program:
             inner = parts[1:-1] if len(parts) > 2 else parts
         if any(abs(_span(t[p]) - self.period) > PROGRAM_LENGTH * self.period for p in inner):
             return None
-        if any(_off(t[p] - t[p][0], q[p], self.t, self.q) > PROGRAM_CHANGE for p in inner):
+        if any(_off(t[p] - t[p][0], q[p], self.t, self.q) > tolerance for p in inner):
             return None
         return len(parts)

@@ -217,7 +217,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                            failure_wear, backend)
         source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
-        programs: list[tuple[np.ndarray, tuple[str, str]]] = []
+        programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
                 state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
