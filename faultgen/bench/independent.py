@@ -39,7 +39,10 @@ What is independent and what is ours:
   poses, another motion). Both in ``ROOT/changes.csv`` (``unit, stamp, change, axis``), the truth,
   never read by the monitor.
 - The motion: the robot folder's generated ``pick_place`` cycle (faultgen's planner; the motion is
-  logged, so any would do), one cycle per log.
+  logged, so any would do), one cycle per log at :attr:`FleetSpec.rate` by default; with
+  :attr:`FleetSpec.cycles` and :attr:`FleetSpec.rates` each log holds a drawn number of back-to-back
+  cycles (no ``cycle`` column) at a drawn rate (issue 72 item 8), from a stream of their own
+  (:func:`faultgen.bench.layouts.draws`).
 
 - **Friction tests: the motion faultgen's, the plant ours** (issue 75; none by default): with
   :attr:`FleetSpec.friction_test_every` ``= D`` every unit runs a friction test on days 1, 1 + D,
@@ -78,6 +81,7 @@ from pathlib import Path
 
 import numpy as np
 
+from faultgen.bench import layouts
 from faultgen.data import cells
 from faultgen.model import robots
 from faultgen.operation import jointlog, programs
@@ -137,8 +141,10 @@ class FleetSpec:
     itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
     ``program_changes`` healthy units an unlogged program change; every ``friction_test_every`` days
     (0: never) each unit runs a friction test (module docstring); ``wear_growth`` the exponent of the
-    wear's rise (:func:`wear_percent`; 1, linear, by default). Every draw comes from ``seed``; the
-    defaults draw what the fleet drew before these options existed."""
+    wear's rise (:func:`wear_percent`; 1, linear, by default); each log holds a number of
+    back-to-back cycles drawn from ``cycles`` at a rate drawn from ``rates`` Hz (empty: ``rate``;
+    :func:`faultgen.bench.layouts.draws`). Every draw comes from ``seed``; the defaults draw what the fleet drew before
+    these options existed."""
 
     units: int = 12
     worn: int = 8
@@ -155,8 +161,13 @@ class FleetSpec:
     program_changes: int = 0
     friction_test_every: int = 0
     wear_growth: float = 1.0
+    cycles: tuple[int, ...] = (1,)
+    rates: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
+        cycles, rates = layouts.check(self.cycles, (*self.rates, self.rate), PLAN_RATE)
+        object.__setattr__(self, "cycles", cycles)
+        object.__setattr__(self, "rates", rates[:-1])
         if isinstance(self.wear_growth, bool) or not 1.0 <= float(self.wear_growth) <= 4.0:
             raise ValueError(f"fleet wear_growth = {self.wear_growth!r}: expected the wear's exponent in [1, 4] "
                              "(1: linear from the onset)")
@@ -233,15 +244,14 @@ def changed_program(program, shrink: float = PROGRAM_SHRINK):
     return dataclasses.replace(program, segments=segments)
 
 
-@lru_cache(maxsize=4)
+@lru_cache(maxsize=8)
 def _motion(robot: robots.Robot, rate: float, changed: bool = False):
     """The pick-and-place cycle of ``robot`` (as :func:`write_fleet` resolved its folder;
-    ``changed``: :func:`changed_program`'s) planned at 250 Hz (the planner's 4 ms), taken at ``rate`` Hz."""
-    step = int(round(PLAN_RATE / rate))
-    if step < 1 or abs(PLAN_RATE / step - rate) > 1e-9:
-        raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
+    ``changed``: :func:`changed_program`'s) planned at 250 Hz (the planner's 4 ms), taken at ``rate`` Hz (planned at ``rate`` for a whole
+    multiple of 250 Hz: :func:`faultgen.bench.layouts.plan`)."""
+    dt, step = layouts.plan(rate, PLAN_RATE)
     program = programs.load(robot, "pick_place")
-    path = (changed_program(program) if changed else program).trajectory(PLAN_RATE ** -1)
+    path = (changed_program(program) if changed else program).trajectory(dt)
     q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
     return np.arange(len(q)) / rate, q, qd, qdd
 
@@ -374,11 +384,9 @@ def friction_test_motion(robot: robots.Robot, rate: float):
     (n, N) N m, from the URDF in the robot's folder. ValueError for a rate as :func:`_motion`'s."""
     from faultgen.operation import friction_test
 
-    step = int(round(PLAN_RATE / rate))
-    if step < 1 or abs(PLAN_RATE / step - rate) > 1e-9:
-        raise ValueError(f"rate = {rate!r} Hz; expected 250 Hz divided by a whole number (250, 125, ...)")
+    dt, step = layouts.plan(rate, PLAN_RATE)
     program = programs.parse(friction_test.text(robot), robot, where=f"friction test of {robot.name}")
-    path = program.trajectory(PLAN_RATE ** -1)
+    path = program.trajectory(dt)
     q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
     pin = pinocchio_module()
     model = pinocchio_model(robot.path.parent / "urdf_used.urdf")
@@ -408,16 +416,25 @@ def _levels(spec: FleetSpec, unit: dict, day: int, nominal, jitter: np.ndarray, 
 
 def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
     """A unit's daily draws in the order the writer makes them, one tuple a day: ``(day, stamp,
-    temperature, mass, jitter, changed, noise, angle noise)`` (the last two shaped as the day's motion)."""
+    temperature, mass, jitter, changed, noise, angle noise, cycles, rate)`` (noise and angle noise
+    shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles`` of the motion at ``rate`` Hz; a layout
+    other than one cycle at :attr:`FleetSpec.rate` draws them from its own stream, after the default
+    layout's draws, so that every other draw is the same)."""
     rng = np.random.default_rng(unit["seed"])
     n = model.n_axes
+    days_layout = layouts.draws(spec.cycles, spec.rates, spec.rate, unit["seed"])
     for d, stamp in enumerate(stamps(spec), start=1):
         temperature, mass = day_conditions(unit, d, stamp, rng)
         jitter = np.exp(rng.normal(0.0, JITTER, (3, n)))
         changed = bool(unit["program_day"]) and d >= unit["program_day"]
         shape = _motion(model, spec.rate, changed)[1].shape
-        noise = rng.normal(0.0, 1.0, shape)
-        yield d, stamp, temperature, mass, jitter, changed, noise, rng.normal(0.0, ANGLE_NOISE, shape)
+        noise, angle_noise = rng.normal(0.0, 1.0, shape), rng.normal(0.0, ANGLE_NOISE, shape)
+        cycles, rate = next(days_layout)
+        if (cycles, rate) != (1, spec.rate):
+            other = np.random.default_rng([unit["seed"], 3, d])
+            shape = (cycles * len(_motion(model, rate, changed)[1]), n)
+            noise, angle_noise = other.normal(0.0, 1.0, shape), other.normal(0.0, ANGLE_NOISE, shape)
+        yield d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate
 
 
 def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int) -> tuple:
@@ -490,7 +507,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
         kept = all((folder_of_unit / f"{stamp}.csv").is_file() for stamp in days) and all(
             (folder_of_unit / TEST_FOLDER / f"{days[d - 1]}.csv").is_file() for d in tested)
         folder_of_unit.mkdir(parents=True, exist_ok=True)
-        for d, stamp, temperature, mass, jitter, changed, noise, angle_noise in _days(spec, unit, model):
+        for d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate in _days(spec, unit, model):
             if d in tested:
                 warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n)
                 fc, fs, fv = _levels(spec, unit, d, nominal, test_jitter, warmth)
@@ -501,9 +518,10 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
             if kept:
                 continue  # drawn in one go from its own seed: complete, and as the same seed draws it
             fc, fs, fv = _levels(spec, unit, d, nominal, jitter, temperature)
-            t, q, qd, qdd = _motion(model, spec.rate, changed)
-            tau = (_rigid(model, spec.rate, round(mass, 1), changed) + G**2 * jm * qdd
-                   + G * motor_friction(G * qd, fc, fs, fv))
+            q, qd, qdd, rigid = (np.tile(x, (cycles, 1)) for x in (*_motion(model, rate, changed)[1:],
+                                                                   _rigid(model, rate, round(mass, 1), changed)))
+            t = np.arange(len(q)) / rate  # back-to-back cycles: the next starts a sample after the last ends
+            tau = rigid + G**2 * jm * qdd + G * motor_friction(G * qd, fc, fs, fv)
             tau = tau + noise * NOISE * np.sqrt(np.mean(tau**2, axis=0))
             angles = q + angle_noise
             _write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2), round(mass, 1))

@@ -112,8 +112,9 @@ def monitor_command(
 
     A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
     with closed and closed_by) and the unit learns its offset again from the next logs; a log whose
-    motion left the twin's program (a program change nobody logged) rebuilds the twin on it and the
-    unit learns again, said in units.csv.
+    motion left the twin's program (a program change nobody logged: its cycles match neither the
+    program's cycle nor a whole number of them, at any sample rate; its cycle column, else the
+    program's period, tells them) rebuilds the twin on it and the unit learns again, said in units.csv.
 
     Units in parallel: --jobs N local processes (at most one per unit; a warning above the CPU
     cores), or --scheduler tcp://HOST:PORT, a Dask cluster whose

@@ -17,16 +17,16 @@ import numpy as np
 
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, report
+from faultgen.monitor import cycles, friction_tests, life, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 from faultgen.monitor.unit import Unit, log_of, short, twin_of
 from faultgen.simulation import backends
 
-#: A log whose angles lie more than this off its twin's program, rad, or whose length differs by more
-#: than PROGRAM_LENGTH of it, runs another program (noise and tracking: about 1e-3 rad).
-PROGRAM_CHANGE, PROGRAM_LENGTH = 0.05, 0.05
+#: A log whose cycles' angles lie more than this off its twin's program, rad, or whose span differs by
+#: more than PROGRAM_LENGTH of a whole number of its cycles, runs another program (:mod:`faultgen.monitor.cycles`).
+PROGRAM_CHANGE, PROGRAM_LENGTH = cycles.PROGRAM_CHANGE, cycles.PROGRAM_LENGTH
 
 
 @dataclass(frozen=True)
@@ -110,17 +110,20 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
 
 
 
-def program_changed(q: np.ndarray, program: np.ndarray) -> bool:
-    """Whether a log's angles ``q`` (n, N) trace another motion than the program's (m, N): a length
-    more than :data:`PROGRAM_LENGTH` apart, or an angle more than :data:`PROGRAM_CHANGE` rad off
-    over their common samples (noise and tracking stay far below it)."""
-    n = min(len(q), len(program))
-    if abs(len(q) - len(program)) > PROGRAM_LENGTH * max(len(q), len(program)):
-        return True
-    return bool(np.max(np.abs(q[:n] - program[:n])) > PROGRAM_CHANGE)
+def program_changed(data, program: cycles.Program) -> bool:
+    """Whether a checked log ``data`` (:class:`faultgen.data.measured.MeasuredData`) traces another
+    motion than ``program``'s: its cycles (its ``cycle`` column, else a whole number of the program's
+    periods) match neither the program's cycle nor a multiple of it
+    (:meth:`faultgen.monitor.cycles.Program.log_cycles`; noise and tracking stay far below it)."""
+    return program.log_cycles(data.t, data.q, data.cycle) is None
 
 
-def new_program(unit: Unit, log, reading, twin: Twin, context, source: fleet_logs.Source) -> Twin:
+def program_of(data) -> cycles.Program:
+    """The :class:`faultgen.monitor.cycles.Program` of a checked program log ``data``."""
+    return cycles.Program.of(data.t, data.q, data.cycle)
+
+
+def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source) -> Twin:
     """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
     restarts its learning against it, its open alarm closed by the change; noted in its reason.
 
@@ -134,7 +137,7 @@ def new_program(unit: Unit, log, reading, twin: Twin, context, source: fleet_log
     source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
     unit.monitor.signatures = new.signatures
-    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), reading.q
+    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), program_of(source.get(log).checked())
     unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
                       "replays that log, and the unit learns its normal operation again")
@@ -164,9 +167,9 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         load = _load(parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
             if unit.program_q is None:
-                unit.program_q = np.asarray(source.get(log_of(context.units, *unit.program)).checked().q)
-            if program_changed(reading.q, unit.program_q):
-                twin = new_program(unit, log, reading, twin, context, source)
+                unit.program_q = program_of(source.get(log_of(context.units, *unit.program)).checked())
+            if program_changed(parsed.checked(), unit.program_q):
+                twin = new_program(unit, log, twin, context, source)
         residual, expected = reading.vector, None
         if twin is not None:
             at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE

@@ -13,7 +13,8 @@ the measured format or an adapter's):
     logs, then every later log scored in stamp order; a log that cannot be read or replayed is
     skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
     offset is learned again, and a log whose motion left the twin's program starts a new program
-    (:func:`faultgen.monitor.feed.new_program`).
+    (:func:`faultgen.monitor.feed.new_program`; a log of several cycles of the program, at any rate,
+    is the same program: :mod:`faultgen.monitor.cycles`).
 
 Units are scored one after another, in ``jobs`` local processes or on a Dask cluster
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
@@ -216,7 +217,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                            failure_wear, backend)
         source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
-        programs: list[tuple[np.ndarray, tuple[str, str]]] = []
+        programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
                 state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)

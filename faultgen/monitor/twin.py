@@ -17,12 +17,14 @@ What the monitor asks of it (:class:`Twin`):
   model's own friction (no temperature law on top: the features' change per % grows with the rest
   of the friction) without a part.
 
-The replayed motion is the program log's angles through a cubic Savitzky-Golay filter of
-:data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's
-noise as its reference saturates where the real one did not (issue 60). A replay of measured arm
-angles still asks more of the drives than the run that logged them (it tracks the elastic arm's
-own lag and ripple as its reference): near a drive's limit the twin refuses a part the robot
-carried, and that unit's logs with the part are skipped and named.
+The replayed motion is one cycle of the program log (its first, or with a ``cycle`` column its first
+whole one, when the log holds several: :mod:`faultgen.monitor.cycles`; the cache key then says
+which), its angles through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
+(:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's noise as its reference
+saturates where the real one did not (issue 60). A replay of measured arm angles still asks more
+of the drives than the run that logged them (it tracks the elastic arm's own lag and ripple as its
+reference): near a drive's limit the twin refuses a part the robot carried, and that unit's logs
+with the part are skipped and named.
 
 Every simulated cycle goes through the same feature code as a measured log
 (:func:`faultgen.monitor.logs.features_of` on the simulated angles and arm-side torque, the
@@ -48,6 +50,7 @@ from faultgen import derivatives
 from faultgen.data import cells, measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
+from faultgen.monitor import cycles as program_cycles
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.operation import conditions, faults, wear
@@ -150,7 +153,12 @@ class Twin:
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
                        "moving_speed": fleet_logs.MOVING_SPEED,  # friction_torque's standstill threshold
                        "reference": f"savgol {REFERENCE_WINDOW:g} s"}
-        self._reference = self._smoothed_program(program.sha256, data)
+        one = program_cycles.Program.of(data.t, data.q, data.cycle)
+        if one.cycles == 1:
+            self._reference = self._smoothed_program(program.sha256[:24], data.t, data.q)
+        else:  # a log of several cycles of its program: one replayed (the features are per sample)
+            self._files["cycle"] = f"1 of {one.cycles}"
+            self._reference = self._smoothed_program(f"{program.sha256[:24]}-1of{one.cycles}", one.t, one.q)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         if cycles:
@@ -175,16 +183,16 @@ class Twin:
         self.signatures = np.stack([(self.cycle(at_own, 0.0, axis) - healthy) / WEAR
                                     for axis in range(1, self.robot.n_axes + 1)])
 
-    def _smoothed_program(self, sha256: str, data: measured.MeasuredData) -> Path:
+    def _smoothed_program(self, name: str, t: np.ndarray, q: np.ndarray) -> Path:
         """The program log's motion as the twin replays it: its angles through the Savitzky-Golay
         filter of :data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`), written (again,
         every time: nothing is read back) as ``t, q1..qN`` in the folder ``programs`` beside
         ``cache``. A logged cycle was executed by the real drive, so the twin must not saturate on
         the encoder's noise, which the replay tracks as its reference (faultgen's default 1e-4 rad
         saturated the irb6700's axis 2 on its own pick and place)."""
-        t = np.asarray(data.t, dtype=float)
-        q = derivatives.smoothed(t, np.asarray(data.q, dtype=float), REFERENCE_WINDOW)
-        path = self.cache.parent / "programs" / f"{sha256[:24]}.csv"  # beside the cycles: they hold cycles only
+        t = np.asarray(t, dtype=float)
+        q = derivatives.smoothed(t, np.asarray(q, dtype=float), REFERENCE_WINDOW)
+        path = self.cache.parent / "programs" / f"{name}.csv"  # beside the cycles: they hold cycles only
         with self.folder.writing(path) as tmp:
             np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", comments="", fmt="%.17g",
                        header=cells.line(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))]))

@@ -18,6 +18,7 @@ import numpy as np
 from faultgen.calibrate import plausibility
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
+from faultgen.monitor import cycles
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
@@ -80,7 +81,7 @@ class Unit:
     notes: list[str] = field(default_factory=list)
     maintenance: list[stored.Maintenance] = field(default_factory=list)
     program_changes: list[stored.ProgramChange] = field(default_factory=list)
-    program_q: np.ndarray | None = None  # the program log's angles (read when needed; not kept in the state)
+    program_q: cycles.Program | None = None  # the program's cycle (read when needed; not kept in the state)
     initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
 
 
@@ -263,17 +264,24 @@ def without_payload(calibrated: robots.Robot, out: Path) -> robots.Robot:
 def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_logs.Source) -> tuple[str, str]:
     """The log (unit, stamp) to replay for ``unit`` whose first log is ``first`` (parsed by
     ``source``, which keeps a program for the twins that replay it): an earlier unit's when the
-    motion is the same (:data:`SAME_PROGRAM`), so their twins share simulated cycles.
+    motion is the same (:data:`SAME_PROGRAM`: the same samples, or a whole number of cycles of the
+    earlier one at another rate, :mod:`faultgen.monitor.cycles`), so their twins share simulated
+    cycles. ``programs``: the (checked log, program) of the earlier units' programs, appended to.
 
     Raises
     ------
     ValueError
         The first log cannot be read (file and row named).
     """
-    q = np.asarray(source.get(first).checked().q)
+    data = source.get(first).checked()
+    q = np.asarray(data.q)
     for other, other_program in programs:
-        if other.shape == q.shape and np.max(np.abs(other - q)) < SAME_PROGRAM:
+        other_q = np.asarray(other.q)
+        if other_q.shape == q.shape and np.max(np.abs(other_q - q)) < SAME_PROGRAM:
+            return other_program
+        if other_q.shape != q.shape and cycles.Program.of(other.t, other_q, other.cycle).log_cycles(
+                data.t, q, data.cycle, SAME_PROGRAM) is not None:
             return other_program
     source.keep(first)
-    programs.append((q, (unit, first.stamp)))
+    programs.append((data, (unit, first.stamp)))
     return (unit, first.stamp)
