@@ -180,7 +180,7 @@ def monitor_command(
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
         typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
-                   f"{', ' + status.model + ' model' if status.model else ''}): {what}")
+                   f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
