@@ -157,7 +157,7 @@ def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_mon
     for row in units:
         assert row["status"] == "not monitored" and row["torque_source"] == adapters.COMMANDED_MOMENT
         assert feed.CONSTANT_TORQUE in row["reason"] and "can show no wear" in row["reason"]
-        assert row["logs_scored"] == "0"
+        assert row["logs_scored"] == "0" and "learning" not in row["reason"]
     assert f"ur-02: not monitored (twin, calibrated model; torque: {adapters.COMMANDED_MOMENT})" in result.output
     assert "exit status 3" in result.output
     html = (tmp_path / "out" / page.PAGE).read_text()
@@ -218,6 +218,16 @@ def test_a_twin_fallen_back_to_the_nominal_model_labels_its_wear_so(tmp_path):
     rows = _rows(tmp_path / "units.csv")
     assert [r["wear_scale"] for r in rows] == ["twin", "nominal model"] and "torque_source" not in rows[0]
     assert statuses[1].basis() == "; twin fallback: the twin of the calibrated model failed (qdd)"
+    class Monitor:  # one scored log of two axes, as UnitMonitor.rows holds it
+        def __init__(self, unit):
+            self.unit, self.n_axes = unit, 2
+            self.rows = [{"unit": unit, "stamp": "2026-04-01", "phase": "monitoring",
+                          **{f"wear{k}{end}": 1.0 for k in (1, 2) for end in ("", "_5", "_95", "_lower", "_log")}}]
+
+    report.write_wear(tmp_path / "wear.csv", [Monitor("a"), Monitor("b")], scales=True, nominal={"b"})
+    assert [r["wear_scale"] for r in _rows(tmp_path / "wear.csv")] == ["twin"] * 2 + ["nominal model"] * 2
+    report.write_wear(tmp_path / "plain.csv", [Monitor("a")])
+    assert "wear_scale" not in (tmp_path / "plain.csv").read_text()
     notes = page._source_notes(rows[1])
     assert len(notes) == 1 and "Twin fallback" in notes[0] and not page._source_notes(rows[0])
     assert "nominal model's" in lights.SCALES["nominal model"]

@@ -48,7 +48,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
+from faultgen.monitor.feed import CONSTANT_TORQUE, PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
@@ -389,11 +389,11 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
         reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
     learning = unit.monitor.pca is None
-    if learning:
+    if learning and not any(n.startswith(CONSTANT_TORQUE) for n in unit.notes):  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
-    elif unit.monitor.not_observable_note():
+    elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
     if not unit.entries:
         status = "not monitored"
