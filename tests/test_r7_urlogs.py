@@ -157,7 +157,7 @@ def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_mon
     for row in units:
         assert row["status"] == "not monitored" and row["torque_source"] == adapters.COMMANDED_MOMENT
         assert feed.CONSTANT_TORQUE in row["reason"] and "can show no wear" in row["reason"]
-        assert row["logs_scored"] == "0" and "learning" not in row["reason"]
+        assert row["logs_scored"] == "0" and "learning: " not in row["reason"]
     assert f"ur-02: not monitored (twin, calibrated model; torque: {adapters.COMMANDED_MOMENT})" in result.output
     assert "exit status 3" in result.output
     html = (tmp_path / "out" / page.PAGE).read_text()
