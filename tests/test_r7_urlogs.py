@@ -139,6 +139,7 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
     worn = raised[0]  # the axis, and closed by the gearbox change
     assert worn["source_axis"] == str(WORN_AXIS) and worn["closed_by"] == f"gearbox_change of axis {WORN_AXIS}"
     assert 10.0 <= truth[("ur-01", worn["first_alarm"])] <= 15.0, (worn, truth)
+    assert 10.0 <= truth[("ur-01", worn["known"])] <= 15.0, (worn, truth)  # when a daily run saw it (item 4)
     html = (tmp_path / "out" / page.PAGE).read_text()
     assert f"<b>Torque</b>: {adapters.MEASURED_CURRENT}." in html and "Twin fallback" not in html
 
