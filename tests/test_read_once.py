@@ -100,7 +100,7 @@ def test_the_built_in_adapters_parse_a_held_log_as_their_file_and_open_it_once(t
     with open_counter.opens_under(tmp_path) as counts:
         parsed = fleet_logs.Source(puma, adapter).get(fleet_logs.Log("u1", path.stem, 0.0, "sequence", path, path.name))
     assert dict(counts) == {path.name: 1}
-    by_path = adapter.read(path, puma, accelerations=False)
+    by_path = adapter.read(path, puma)  # the monitor reads with the accelerations its calibration needs (issue 72)
     assert parsed.data.source == path and parsed.data.notes == by_path.notes
     for field in ("t", "q", "qd", "tau"):
         assert np.array_equal(getattr(parsed.data, field), getattr(by_path, field))

@@ -108,7 +108,10 @@ def monitor_command(
 
     Logs in another layout: --format ur-rtde (Universal Robots' RTDE recorder; joint temperatures
     kept; the torque is the measured actual current times --torque-constants, or else the commanded
-    target moment, which units.csv says) or --format voraus, as `faultgen logs import` reads them.
+    target moment, which cannot show wear: units.csv's torque_source says which, and a unit whose
+    torque does not vary from log to log is not monitored) or --format voraus, as `faultgen logs
+    import` reads them. A unit whose twin fell back to the nominal model has its wear in the nominal
+    model's scale: units.csv's and wear.csv's wear_scale say "nominal model".
 
     A repair or gearbox_change in LOGS/events.csv closes the unit's open alarm (alarms.csv keeps it,
     with closed and closed_by) and the unit learns its offset again from the next logs; a log whose
@@ -181,7 +184,7 @@ def monitor_command(
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
         typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
-                   f"{', ' + status.model + ' model' if status.model else ''}): {what}")
+                   f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same

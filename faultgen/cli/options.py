@@ -30,7 +30,8 @@ LogFormat = Annotated[str, typer.Option(
     "Robots' RTDE recorder CSV) or voraus (the voraus-AD Parquet columns; CC BY-NC-SA data: use your own copy).")]
 TorqueConstants = Annotated[str | None, typer.Option(
     metavar="K1,...,KN", help="With --format ur-rtde: N m/A at each joint, to read the torque as the measured "
-    "actual_current_0.. times them (without it: the commanded target_moment_0..).")]
+    "actual_current_0.. times them (without it: the commanded target_moment_0.., which cannot show wear; "
+    "docs/dataset.md, \"Adapters\", on finding the constants).")]
 Jobs = Annotated[int, typer.Option(help="Local worker processes (at most one per run, or per unit of a monitor, is started; more than the CPU cores only slows each down).", min=1, max=1024)]
 
 

@@ -48,6 +48,25 @@ MAX_BYTES = 4 * 2**30
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
 
 
+#: A log's torque source in words (issue 72, item 2): the import's summary, units.csv's
+#: ``torque_source`` and the monitor's page say it (:func:`torque_source`). The commanded moment of a
+#: fixed program is the controller's model of the motion, the same every day whatever the joint's
+#: friction: it cannot show wear.
+MEASURED_CURRENT, COMMANDED_MOMENT = "measured current x torque constant", "commanded moment (cannot show wear)"
+
+
+def torque_source(notes) -> str:
+    """The torque source a log's reader noted (:attr:`faultgen.data.measured.MeasuredData.notes`,
+    the ``ur-rtde`` adapter's "torque from ..." note) as :data:`MEASURED_CURRENT` or
+    :data:`COMMANDED_MOMENT`; "" when no note names one (the measured format: the logged arm torque)."""
+    for note in notes:
+        if note.startswith("torque from actual_current"):
+            return MEASURED_CURRENT
+        if note.startswith("torque from target_moment"):
+            return COMMANDED_MOMENT
+    return ""
+
+
 #: Data rows of the first block read to learn a log's columns before its blocks are read
 #: (:class:`Blocks`).
 PEEK_ROWS = 16
@@ -390,8 +409,9 @@ class URRTDE(Adapter):
             source = "torque from actual_current_i x the torque constants given (measured)"
         elif all(c in names for c in moment):
             torque, scale = moment, [1.0] * n_axes
-            source = ("torque from target_moment_i (the controller's commanded moment, not a measurement; "
-                      "--torque-constants K1,...,KN reads the measured actual_current_i instead)"
+            source = ("torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
+                      "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
+                      "the UR arms' constants: docs/dataset.md, \"Adapters\")"
                       + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
         else:
             raise measured.MeasuredDataError(

@@ -47,7 +47,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen import __version__
-from faultgen.data import logfolder, measured, schema, writer
+from faultgen.data import adapters, logfolder, measured, schema, writer
 from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
@@ -93,6 +93,10 @@ class ImportSummary:
         Bad files passed over (``skip_bad``): name and reason.
     labels : dict
         Logs with a worn axis, logs all healthy, the others (unknown), over the whole dataset.
+    torque : dict
+        Logs read now per torque source, where the log format says which torque it read
+        (:func:`faultgen.data.adapters.torque_source`: measured current x torque constant, or the
+        commanded moment, which cannot show wear).
     written : bool
         False when nothing was new (the dataset was left as it was).
     """
@@ -107,6 +111,7 @@ class ImportSummary:
     skipped: list[tuple[str, str]] = field(default_factory=list)
     labels: dict = field(default_factory=dict)
     written: bool = True
+    torque: dict = field(default_factory=dict)
 
     def __str__(self) -> str:
         records = len(self.imported) + self.kept
@@ -119,6 +124,8 @@ class ImportSummary:
         if self.labels:
             lines.append(f"  labels:        {self.labels.get('worn', 0)} worn, {self.labels.get('healthy', 0)} healthy, "
                          f"{self.labels.get('unknown', 0)} unknown (events.csv; logs without an event are unknown)")
+        for source, count in sorted(self.torque.items()):
+            lines.append(f"  torque:        {source} ({count} log(s) read now)")
         if self.skipped:
             lines.append(f"  skipped:       {len(self.skipped)} bad file(s):")
             lines += [f"    {name}: {reason}" for name, reason in self.skipped]
@@ -432,6 +439,9 @@ def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) 
         rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,
                      "key": key, "period": data.sample_period})
         summary.imported.append(name)
+        source = adapters.torque_source(data.notes)
+        if source:
+            summary.torque[source] = summary.torque.get(source, 0) + 1
         bar.update()
     if old is not None:  # records of files no longer in the folder: kept, in stamp order
         for name, i in position.items():

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.monitoring import varying_columns
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import cycles, friction_tests, life, report
@@ -27,6 +28,11 @@ from faultgen.simulation import backends
 #: A log whose cycles' angles lie more than this off its twin's program, rad, or whose span differs by
 #: more than PROGRAM_LENGTH of a whole number of its cycles, runs another program (:mod:`faultgen.monitor.cycles`).
 PROGRAM_CHANGE, PROGRAM_LENGTH = cycles.PROGRAM_CHANGE, cycles.PROGRAM_LENGTH
+#: A unit's note (units.csv's reason) when a feature of its learning logs is the same in every log
+#: (:func:`constant_torque`): no PCA model can be fitted on it and no wear can show in it (the
+#: ``ur-rtde`` commanded moment of a fixed program, the same every day: issue 72, item 2). The unit is
+#: not monitored, and the fleet goes on (before, the fit's refusal stopped every unit, exit 2).
+CONSTANT_TORQUE = "not monitored: the torque column does not vary from log to log (commanded moment?)"
 
 
 @dataclass(frozen=True)
@@ -92,7 +98,8 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        twin = twin_of(unit, context.units, context.out, twins, False, source, context.backend)
+        constant = next((n for n in unit.notes if n.startswith(CONSTANT_TORQUE)), None)  # an earlier run's
+        twin = constant or twin_of(unit, context.units, context.out, twins, False, source, context.backend)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
         i = 0
@@ -182,11 +189,48 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
+    constant = constant_torque(unit, reading.vector, nominal.n_axes)
+    if constant:
+        return not_monitored(unit, log.stamp, sha256, constant)
     unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
                                      *load))
     return twin
 
+
+
+def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
+    """Why the unit cannot be monitored when the log of feature ``vector`` (its
+    :data:`faultgen.monitor.logs.FEATURES`, by name then axis) completes its learning and a feature
+    is the same in every learning log (:func:`analysis.monitoring.varying_columns`: beyond
+    rounding), which the PCA model cannot standardise: :data:`CONSTANT_TORQUE` and the features;
+    "" otherwise (or before the learning's last log). The features are the residuals plus the
+    twin's expectation, which may vary with the logs' conditions while the torque does not."""
+    monitor = unit.monitor
+    if monitor.pca is not None or len(monitor.training) + 1 < monitor.settings.train:
+        return ""
+    expected = monitor.learned_expectations or [0.0] * len(monitor.training)
+    features = np.stack([e + x for (_, e, _), x in zip(monitor.training, expected)] + [vector])
+    constant = np.setdiff1d(np.arange(features.shape[1]), varying_columns(features))
+    if not constant.size:
+        return ""
+    named = [f"{fleet_logs.FEATURES[j // n_axes]} of axis {j % n_axes + 1}" for j in constant]
+    more = f" and {len(named) - 3} more" if len(named) > 3 else ""
+    return (f"{CONSTANT_TORQUE}: {', '.join(named[:3])}{more} the same in all {len(features)} learning logs, "
+            "which can show no wear")
+
+
+def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:
+    """Take the unit off the monitor (:func:`constant_torque`): its logs scored so far and the log
+    ``stamp`` (its SHA-256 ``sha256``) kept as skipped, its monitor emptied (its status then "not monitored", its reason ``why``);
+    returns the reason its later logs are skipped with, in this run and the next."""
+    skipped = "the unit is not monitored: its torque does not vary from log to log"
+    unit.skipped.extend(stored.Skipped(e.stamp, e.sha256, skipped) for e in unit.entries)
+    unit.skipped.append(stored.Skipped(stamp, sha256, skipped))
+    unit.entries.clear()
+    unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes, unit.monitor.signatures)
+    unit.notes.append(why)
+    return why
 
 
 def _load(data) -> tuple[np.ndarray | None, float]:

@@ -80,6 +80,9 @@ from faultgen.monitor import state as stored
 
 #: ``wear_scale`` of a unit's wear (units.csv, wear.csv): on its friction tests' scale, or its twin's.
 TESTS_SCALE, TWIN_SCALE = "friction test", "twin"
+#: ``wear_scale`` of a unit whose twin fell back to the nominal model (its calibration failed): % of
+#: the nominal model's dry friction, not the unit's own (:func:`faultgen.monitor.loop.monitor`).
+NOMINAL_SCALE = "nominal model"
 #: The columns of ``OUT/tests.csv`` (the friction_fit.csv columns of ``faultgen friction-test``, arm side).
 FIT_COLUMNS = ("temperature_degC", "coulomb_Nm", "coulomb_Nm_low", "coulomb_Nm_high", "static_excess_Nm",
                "stribeck_velocity_rad_s", "viscous_Nms_rad", "viscous_Nms_rad_low", "viscous_Nms_rad_high")

@@ -62,7 +62,10 @@ COLUMNS = ("state", "unit", "service by (5-95 %)", "axis", "wear, % (90 %)", "li
 SCALES = {"friction test": "friction-test scale: the increase of the axis's dry friction over the unit's first "
                            "friction test since its last gearbox change, temperature-corrected",
           "twin": "twin scale: the increase of the axis's dry friction in % of the unit's own, estimated by the "
-                  "production-log twin"}
+                  "production-log twin",
+          "nominal model": "nominal-model scale: the unit's own model's twin failed (its reason says why) and the "
+                           "twin of the nominal model took its place: the increase of the axis's dry friction in % of "
+                           "the nominal model's, not the unit's own"}
 
 CSS = """
 .light{display:inline-block;padding:.1em .5em;border-radius:.8em;font-size:.9em;font-weight:600;white-space:nowrap}
@@ -242,6 +245,8 @@ def wear_cell(unit, axis: int | None) -> str:
         text = f"{wear.estimate:.3g} ({wear.low:.3g} – {wear.high:.3g})"
     else:
         text = f"{wear.estimate:.3g} (≥ {wear.low:.3g})"
+    if wear.scale == "nominal model":  # the twin's fallback, said where the number is (issue 72, item 1)
+        text += ", nominal model"
     return f'<span title="{escaped(SCALES.get(wear.scale, wear.scale))}">{escaped(text)}</span>'
 
 

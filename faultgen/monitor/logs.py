@@ -42,11 +42,14 @@ Reader = Callable[[Path, Robot], measured.MeasuredData]
 
 def reader_of(adapter=None) -> tuple[Reader, tuple[str, ...]]:
     """The reader and the file suffixes of a log format: the measured format's without ``adapter``,
-    else the adapter's (:class:`faultgen.data.adapters.Adapter`, accelerations not estimated: the
-    import's reading of the same files)."""
+    else the adapter's (:class:`faultgen.data.adapters.Adapter`). Either estimates the accelerations,
+    as the measured format's reader does: the one parse of a log serves its features, and, for a
+    unit's first log, the calibration and the twin, which need them (read without them, every
+    ``ur-rtde`` unit's calibrated twin failed on "qdd holds a non-finite value" and fell back to the
+    nominal model: issue 72, item 1)."""
     if adapter is None:
         return measured.read, fleetlogs.SUFFIXES
-    return (lambda path, robot: adapter.read(path, robot, accelerations=False)), adapter.suffixes
+    return adapter.read, adapter.suffixes
 
 
 def fleet(logs_dir: str | Path, suffixes: tuple[str, ...] = fleetlogs.SUFFIXES) -> dict[str, list[Log]]:

@@ -44,12 +44,12 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.data import atomic, fleetlogs, logfolder
+from faultgen.data import adapters, atomic, fleetlogs, logfolder
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
+from faultgen.monitor.feed import CONSTANT_TORQUE, PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
@@ -87,6 +87,17 @@ class UnitStatus:
     reason: str
     logs_scored: int
     last_log: str
+    #: The torque its logs were read from, where the log format says (:func:`faultgen.data.adapters.torque_source`:
+    #: measured current x torque constant, or the commanded moment, which cannot show wear); "" otherwise.
+    torque_source: str = ""
+    #: The fallbacks its twin took (:func:`faultgen.monitor.unit.twin_of`'s notes, also in ``reason``).
+    fallback: str = ""
+
+    def basis(self) -> str:
+        """What the unit's numbers rest on, for the console beside its status: the twin's fallback and
+        the torque source, each where there is one ("" otherwise)."""
+        return "".join(f"; {what}: {text}" for what, text in (("twin fallback", self.fallback),
+                                                              ("torque", self.torque_source)) if text)
 
 
 @dataclass
@@ -240,9 +251,11 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         with atomic.atomic_folder(out) as staging:
             report.write_alarms(staging / "alarms.csv", monitors)
             report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
-            report.write_wear(staging / "wear.csv", monitors, scales=bool(found))
+            nominal_scale = _nominal_scale(state, settings, calibrated_model is not None or calibrate)
+            report.write_wear(staging / "wear.csv", monitors, scales=bool(found) or bool(nominal_scale),
+                              nominal=nominal_scale)
             report.write_units(staging / "units.csv", statuses, scales={
-                m.unit: _scale_of(m) for m in monitors} if found else None)
+                m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors} if found or nominal_scale else None)
             if found:
                 friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
             prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
@@ -339,12 +352,25 @@ def _same_log(path: Path, sha256: str) -> bool:
 
 
 
-def _scale_of(monitor) -> str:
+def _scale_of(monitor, nominal: bool = False) -> str:
     """units.csv's ``wear_scale`` of a unit: ``friction test`` when its last log's wear of some axis
-    is on its tests' scale (:mod:`faultgen.monitor.friction_tests`), ``twin`` otherwise."""
+    is on its tests' scale (:mod:`faultgen.monitor.friction_tests`), else ``nominal model`` for a
+    unit whose twin fell back to the nominal model (``nominal``: :func:`_nominal_scale`), ``twin``
+    otherwise."""
     last = monitor.rows[-1] if monitor.rows else {}
     on_tests = any(last.get(f"wear{k}_scale") == friction_tests.TESTS_SCALE for k in range(1, monitor.n_axes + 1))
-    return friction_tests.TESTS_SCALE if on_tests else friction_tests.TWIN_SCALE
+    return friction_tests.TESTS_SCALE if on_tests else friction_tests.NOMINAL_SCALE if nominal else \
+        friction_tests.TWIN_SCALE
+
+
+def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) -> set[str]:
+    """The units whose wear is in the nominal model's scale though the run asked for each unit's own
+    model (``own_model``: calibrated on its first log, or given): their twin fell back to the
+    nominal model (the reason says why), so their wear is % of the nominal dry friction, not their
+    own (issue 72, item 1: every ``ur-rtde`` unit did, unsaid, while wear.csv said "own")."""
+    if settings.protocol != "twin" or not own_model:
+        return set()
+    return {name for name, unit in state.items() if unit.model == "nominal"}
 
 
 def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=()) -> UnitStatus:
@@ -364,11 +390,11 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
         reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
     learning = unit.monitor.pca is None
-    if learning:
+    if learning and not any(n.startswith(CONSTANT_TORQUE) for n in unit.notes):  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
-    elif unit.monitor.not_observable_note():
+    elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
     if not unit.entries:
         status = "not monitored"
@@ -378,7 +404,8 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         status = "learning" if learning else "monitored"
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
-                      "; ".join(reasons), len(unit.entries), last)
+                      "; ".join(reasons), len(unit.entries), last, adapters.torque_source(unit.notes),
+                      "; ".join(n for n in unit.notes if n.startswith("the twin of the ") and " failed (" in n))
 
 
 def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, list]:

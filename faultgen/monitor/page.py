@@ -326,6 +326,22 @@ def _chart(name: str, fig: dict) -> str:
             f'<script type="application/json" id="figure-{name}">{_script_json(fig)}</script>')
 
 
+def _source_notes(row: dict) -> list[str]:
+    """A unit's panel's words on what its numbers rest on (issue 72, items 1-2): the torque its logs
+    were read from (units.csv's ``torque_source``, a warning for the commanded moment) and a twin that
+    fell back to the nominal model (``wear_scale`` ``nominal model``)."""
+    notes = []
+    source = row.get("torque_source") or ""
+    if source:
+        style = ' class="evidence"' if "cannot show wear" in source else ""
+        notes.append(f"<p{style}><b>Torque</b>: {escaped(source)}.</p>")
+    if row.get("wear_scale") == "nominal model":
+        notes.append('<p class="evidence"><b>Twin fallback</b>: the twin of the unit\'s own model failed (the reason '
+                     "above); the nominal model's twin took its place, so its wear is in % of the nominal model's dry "
+                     "friction, not its own.</p>")
+    return notes
+
+
 def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
     row = unit.row
     model = f", {row['model']} model" if row.get("model") else ""
@@ -336,7 +352,7 @@ def _panel(index: int, unit: Unit, settings: dict, lit: lights.Light) -> str:
              lights.panel_html(unit, lit),
              f"<p>{escaped(row.get('status', ''))} ({escaped(row.get('protocol', ''))}{escaped(model)}); "
              f"{escaped(row.get('logs_scored', ''))} logs scored, the last {escaped(row.get('last_log', '') or '–')}."
-             + (f" {escaped(row['reason'])}." if row.get("reason") else "") + "</p>"]
+             + (f" {escaped(row['reason'])}." if row.get("reason") else "") + "</p>", *_source_notes(row)]
     if unit.open_alarm:
         parts.append(f'<p class="evidence"><b>Open alarm</b> {escaped(lights.alarm_dates(unit.current))} on axis '
                      f'{escaped(unit.current["source_axis"])} ({escaped(unit.current["statistic"])}): '

@@ -41,13 +41,18 @@ def _fmt(value) -> str:
 def write_units(path: Path, statuses, scales: dict[str, str] | None = None) -> None:
     """One row per unit of the fleet folder (:class:`faultgen.monitor.loop.UnitStatus`): its
     status, the protocol and model its monitor uses, why (fallbacks, skipped logs, learning), the
-    logs scored and the last one; with ``scales`` (a fleet with friction tests) also the scale of its
-    wear, ``wear_scale`` (a unit not in it: ``twin``; :mod:`faultgen.monitor.friction_tests`)."""
+    logs scored and the last one; with ``scales`` (a fleet with friction tests, or a unit whose twin
+    fell back to the nominal model) also the scale of its wear, ``wear_scale`` (a unit not in it:
+    ``twin``; :mod:`faultgen.monitor.friction_tests`); where a log format says which torque it read
+    (``ur-rtde``), ``torque_source`` (:func:`faultgen.data.adapters.torque_source`)."""
+    sources = any(getattr(s, "torque_source", "") for s in statuses)
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)
-        writer.writerow(UNIT_COLUMNS + (("wear_scale",) if scales is not None else ()))
+        writer.writerow(UNIT_COLUMNS + (("wear_scale",) if scales is not None else ())
+                        + (("torque_source",) if sources else ()))
         for s in statuses:
             extra = [scales.get(s.unit, "twin")] if scales is not None else []
+            extra += [s.torque_source] if sources else []
             writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS] + extra)
 
 
@@ -81,15 +86,16 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
 
 
-def write_wear(path: Path, monitors, scales: bool = False) -> None:
+def write_wear(path: Path, monitors, scales: bool = False, nominal=frozenset()) -> None:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
     uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
     the lower one-sided 90 % bound of its noise the alarm is judged on (``wear_lower``, as
     ``wearI_lower`` of scores.csv) and the log's own estimate (``wear_log``). Only units with a twin
-    have rows. With ``scales`` (a fleet with friction tests) also each row's ``wear_scale``:
-    ``friction test`` or ``twin`` (:mod:`faultgen.monitor.friction_tests`)."""
+    have rows. With ``scales`` (a fleet with friction tests, or units in ``nominal``) also each
+    row's ``wear_scale``: ``friction test``, ``twin``, or for a unit in ``nominal`` (its twin fell
+    back to the nominal model) ``nominal model`` (:mod:`faultgen.monitor.friction_tests`)."""
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)
         writer.writerow(WEAR_COLUMNS + (("wear_scale",) if scales else ()))
@@ -98,7 +104,8 @@ def write_wear(path: Path, monitors, scales: bool = False) -> None:
                 if "wear1" not in row:
                     continue
                 for axis in range(1, m.n_axes + 1):
-                    extra = [row.get(f"wear{axis}_scale", "twin")] if scales else []
+                    default = "nominal model" if m.unit in nominal else "twin"
+                    extra = [row.get(f"wear{axis}_scale", default)] if scales else []
                     writer.writerow([_fmt(row["unit"]), _fmt(row["stamp"]), row["phase"], axis,
                                      *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower", "_log")),
                                      *extra])
