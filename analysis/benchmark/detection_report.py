@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from analysis import isolation, scoring
-from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED
+from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED, markdown
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
 DETECTION_COLUMNS = {
@@ -210,3 +210,20 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
         parts.append(kept.assign(by=label))
     out = pd.concat(parts).rename_axis("group").reset_index()
     return out.set_index(["by", "group"]).round(2)
+
+
+def detection_text(table: pd.DataFrame, summary: pd.DataFrame, protocol: str = "auto") -> str:
+    """What ``faultgen detect`` prints of a :func:`detection_table` and its :func:`detection_summary`: the
+    table, what its columns mean, the summary with what its false-alarm rate measured (and the runs
+    left out of it), and :func:`detection_advice` (``protocol``: the one asked for)."""
+    lines = [markdown(table, digits=4),
+             "\n".join(f"  {name}: {meaning}" for name, meaning in detection_columns(table).items())]
+    left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
+    rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
+             if left_out else "")
+    lines.append(f"\nsummary ({rests}false_alarm_pct, %: {false_alarm_meaning(table['protocol'])}):")
+    lines.append(markdown(summary, digits=4))
+    advice = detection_advice(table, protocol)
+    if advice:
+        lines.append(advice)
+    return "\n".join(lines)
