@@ -25,7 +25,6 @@ LONG_FUNCTIONS = {
     "faultgen/monitor/loop.py::monitor",
     "faultgen/monitor/unit_chart.py::figure",
     "faultgen/monitor/state.py::read_unit",
-    "faultgen/runs/cluster.py::execute",
     "faultgen/runs/sweep.py::run",
 }
 #: CLI commands whose body is known to be longer (the same day: 6), each to move its policy into the
