@@ -191,7 +191,7 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     other robot of the same model (robot label). With ``train`` (another dataset, its features
     comparable: :func:`analysis.crossdata.check_comparable`), OTM's models are the normal robots of
     ``train`` instead, each serving every robot of ``path`` of its model (column ``reference``:
-    ``<train file>:<run id>``): one-to-many across datasets (issue 46, "another dataset").
+    ``<train file>:<run id>``): one-to-many across datasets.
 
     Returns
     -------

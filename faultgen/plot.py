@@ -104,7 +104,7 @@ TREND_DAYS = 7
 def running_median(values: np.ndarray, days: int = TREND_DAYS) -> np.ndarray:
     """The centred running median of ``values`` (n_days, n) over ``days`` days, NaN where the
     window is not full: at a record's ends a median of three or four days is one part's torque,
-    not the trend (a healthy robot's last day read -33 % on a 20-day fleet, issue 51)."""
+    not the trend (a healthy robot's last day read -33 % on a 20-day fleet)."""
     import pandas as pd
 
     return pd.DataFrame(values).rolling(days, center=True, min_periods=days).median().to_numpy()
