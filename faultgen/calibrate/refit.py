@@ -236,7 +236,7 @@ def calibrated_from(result, nominal: robots.Robot) -> robots.Robot:
     return nominal
 
 
-# -- inside the calibration: the Stribeck hump refined by sysid ------------------
+# -- inside the calibration: the Stribeck hump refined by sysid -----------------------------------
 
 #: Most Levenberg-Marquardt iterations of the refinement (:func:`refine_stribeck`).
 REFINE_ITERATIONS = 50
