@@ -195,7 +195,7 @@ class Grid:
         :class:`~faultgen.operation.faults.FaultSpec`) without ``axes`` runs beside the run without wear.
         """
         fault = options.get("fault")
-        if fault is not None and fault.axis is not None and "axes" not in options:
+        if isinstance(fault, faults.FaultSpec) and fault.axis is not None and "axes" not in options:
             options["axes"] = [0, fault.axis]
         if config is not None:
             grid = cls.from_toml(config)
