@@ -35,6 +35,7 @@ from scipy import signal as scipy_signal
 from tqdm.auto import tqdm
 
 from analysis import registry
+from analysis.benchmark.tables import markdown
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
@@ -190,7 +191,7 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
     other robot of the same model (robot label). With ``train`` (another dataset, its features
     comparable: :func:`analysis.crossdata.check_comparable`), OTM's models are the normal robots of
     ``train`` instead, each serving every robot of ``path`` of its model (column ``reference``:
-    ``<train file>:<run id>``): one-to-many across datasets (issue 46, "another dataset").
+    ``<train file>:<run id>``): one-to-many across datasets.
 
     Returns
     -------
@@ -372,3 +373,38 @@ def figure(cases: pd.DataFrame, out: Path, marked: pd.DataFrame | None = None) -
                  "* Tukey HSD failure vs normal, p < 0.05", fontsize=10)
     fig.savefig(out, dpi=110)
     return out
+
+
+def report(cases: pd.DataFrame, train=None) -> tuple[str, pd.DataFrame | None, pd.DataFrame | None]:
+    """(What ``faultgen training-source`` prints and writes to OUT.md, the ANOVA table, the Tukey HSD
+    table) of a :func:`study`'s ``cases`` (``train``: the other dataset OTM learnt from, if any): the
+    protocol, the design, the descriptors' means, the normal robots' false alarms, a note on saturated
+    limits, and the ANOVA and Tukey HSD (None, said in the text, where a cell is empty)."""
+    protocol = ("protocol: OTO, own history (each robot its own training days); OTM, "
+                + (f"another dataset (each normal robot of {train} of the same model)" if train is not None
+                   else "other robots of this dataset (each normal robot of the same model)"))
+    parts = [protocol,
+             "Design (thesis Table 4.1), test cases:\n\n" + markdown(design(cases)),
+             "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
+             + markdown(group_means(cases)),
+             "Normal robots never fail: their days above the limit are false alarms (nsat) and their lead_time_days "
+             "only how early the first false alarm came. Per training source and signal, their false-alarm share "
+             "of the test days and the cases whose limit is saturated (every test day above it):\n\n"
+             + markdown(normal_false_alarms(cases))]
+    saturated = cases[cases["saturated"] & (cases["condition"] == "normal")]
+    if len(saturated):
+        parts.append(f"Note: the limit is saturated in {len(saturated)} of {int((cases['condition'] == 'normal').sum())} "
+                     "normal-robot cases (all their test days above it: "
+                     + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
+                     + "); there the model does not describe the robot, and a failing robot's alarms in the same "
+                     "cell say nothing about its fault")
+    anova_table = tukey_table = None
+    try:
+        anova_table, tukey_table = anova(cases), tukey(cases)
+    except ValueError as err:  # an empty cell: the cases and means stand, the tests cannot be run
+        parts.append(f"No ANOVA or Tukey HSD: {err}")
+    else:
+        parts += ["Three-way ANOVA, type III (thesis Tables 4.2-4.4):\n\n" + markdown(anova_table),
+                  "Tukey HSD, failure against normal robots per training source and signal type (the starred bars "
+                  "of thesis Figs. 4-4 to 4-6):\n\n" + markdown(failure_vs_normal(tukey_table))]
+    return "\n\n".join(parts), anova_table, tukey_table

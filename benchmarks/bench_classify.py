@@ -91,11 +91,6 @@ def main() -> None:
     args = parser.parse_args()
     steps = {int(k) for k in args.steps.split(",")}
 
-    from analysis import benchmark, classify
-
-    def load() -> str:
-        return f"load {os.getloadavg()[0]:.1f}"
-
     print(f"{time.strftime('%Y-%m-%d %H:%M')} UTC, {os.cpu_count()} cores, {load()} "
           "(1-min average; > cores means the machine is shared)")
     folder = Path(tempfile.mkdtemp(prefix="bench-classify-"))
@@ -118,56 +113,73 @@ def main() -> None:
                 print(f"{what:33s} {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")
                 if sweep is not None:
                     print("  " + ratio_line(what, t, sweep, "the sweep"))
-
         if 2 in steps:
-            inputs = benchmark.classification_inputs(path)
-            rows = classify.PREPROCESSING if args.full else classify.SHORT_TABLE
-            names = [n for n in rows if inputs.estimated is not None or not n.startswith(classify.ESTIMATED)]
-            columns = list(classify.CLASSIFIERS)
-            started, cpu = time.perf_counter(), time.process_time()
-            with threadpool_limits(limits=1):  # as evaluate: one BLAS thread (tiny fits)
-                plain = plain_loop(inputs, names, columns, args.pairs, 0)
-            t_plain, cpu_plain = time.perf_counter() - started, time.process_time() - cpu
-            times, tables = {}, {}
-            for jobs in (1, 2):
-                started, cpu = time.perf_counter(), time.process_time()
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", classify.UndefinedAUCWarning)
-                    tables[jobs] = classify.evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal,
-                                                     estimated=inputs.estimated, preprocessing=names,
-                                                     n_pairs=args.pairs, random_state=0, n_jobs=jobs,
-                                                     return_aucs=True)[1]
-                times[jobs] = time.perf_counter() - started
-                if jobs == 1:
-                    cpu_shared = time.process_time() - cpu
-            same = all(np.array_equal(plain[k], tables[1][k], equal_nan=True)
-                       and np.array_equal(plain[k], tables[2][k], equal_nan=True) for k in plain)
-            print(f"{len(names)} preprocessings x {len(columns)} classifiers x {args.pairs} pairs on {path.name} "
-                  f"({load()}):")
-            print(f"  plain scikit-learn loop, 1 process:     {t_plain:7.1f} s wall, {cpu_plain:7.1f} s CPU")
-            print(f"  shared preprocessing, 1 process:        {times[1]:7.1f} s wall, {cpu_shared:7.1f} s CPU "
-                  f"({cpu_plain / cpu_shared:.2f}x less CPU)")
-            print(f"  shared preprocessing, 2 processes:      {times[2]:7.1f} s   ({t_plain / times[2]:.2f}x)")
-            print(f"  parallel efficiency t(1) / (2 t(2)):    {times[1] / (2 * times[2]):7.2f}")
-            print(f"  same AUC in every cell, all three:      {same}")
-
+            shared_preprocessing(path, args.full, args.pairs)
         if args.fleet is not None:
-            made = None
-            if args.make_fleet:
-                made = timed([*faultgen(), "fleet", "-o", str(args.fleet), "--no-progress", "--overwrite"])
-                print(f"faultgen fleet (default, 26 robots): {made[0]:7.1f} s wall, {made[1]:7.1f} s CPU   ({load()})")
-            if 3 in steps:
-                stacking_check(args.fleet)
-            for flag in ([], ["--full"]) if 4 in steps else ():
-                t = timed([*faultgen(), "classify", str(args.fleet), "--horizon", "3", "--pairs", "0", *flag,
-                           "-o", str(folder / "fleet-cls"), "--no-progress", "--overwrite"])
-                what = f"classify {args.fleet.name} --horizon 3 --pairs 0 {' '.join(flag)}"
-                print(f"{what}: {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")
-                if made is not None:
-                    print("  " + ratio_line(what, t, made, "faultgen fleet"))
+            fleet_steps(args.fleet, args.make_fleet, steps, folder)
         print(f"at the end: {load()}")
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def load() -> str:
+    """The machine's 1-minute load average, in words."""
+    return f"load {os.getloadavg()[0]:.1f}"
+
+
+def shared_preprocessing(path: Path, full: bool, pairs: int) -> None:
+    """Step 2: the table by a plain scikit-learn loop and by classify.evaluate (shared preprocessing) on 1
+    and 2 processes, timed, and whether all three give the same AUC in every cell."""
+    from analysis import benchmark, classify
+
+    inputs = benchmark.classification_inputs(path)
+    rows = classify.PREPROCESSING if full else classify.SHORT_TABLE
+    names = [n for n in rows if inputs.estimated is not None or not n.startswith(classify.ESTIMATED)]
+    columns = list(classify.CLASSIFIERS)
+    started, cpu = time.perf_counter(), time.process_time()
+    with threadpool_limits(limits=1):  # as evaluate: one BLAS thread (tiny fits)
+        plain = plain_loop(inputs, names, columns, pairs, 0)
+    t_plain, cpu_plain = time.perf_counter() - started, time.process_time() - cpu
+    times, tables = {}, {}
+    for jobs in (1, 2):
+        started, cpu = time.perf_counter(), time.process_time()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", classify.UndefinedAUCWarning)
+            tables[jobs] = classify.evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal,
+                                             estimated=inputs.estimated, preprocessing=names,
+                                             n_pairs=pairs, random_state=0, n_jobs=jobs,
+                                             return_aucs=True)[1]
+        times[jobs] = time.perf_counter() - started
+        if jobs == 1:
+            cpu_shared = time.process_time() - cpu
+    same = all(np.array_equal(plain[k], tables[1][k], equal_nan=True)
+               and np.array_equal(plain[k], tables[2][k], equal_nan=True) for k in plain)
+    print(f"{len(names)} preprocessings x {len(columns)} classifiers x {pairs} pairs on {path.name} "
+          f"({load()}):")
+    print(f"  plain scikit-learn loop, 1 process:     {t_plain:7.1f} s wall, {cpu_plain:7.1f} s CPU")
+    print(f"  shared preprocessing, 1 process:        {times[1]:7.1f} s wall, {cpu_shared:7.1f} s CPU "
+          f"({cpu_plain / cpu_shared:.2f}x less CPU)")
+    print(f"  shared preprocessing, 2 processes:      {times[2]:7.1f} s   ({t_plain / times[2]:.2f}x)")
+    print(f"  parallel efficiency t(1) / (2 t(2)):    {times[1] / (2 * times[2]):7.2f}")
+    print(f"  same AUC in every cell, all three:      {same}")
+
+
+def fleet_steps(fleet: Path, make_fleet: bool, steps: set[int], folder: Path) -> None:
+    """Steps 3 and 4 on ``fleet`` (made first, timed, with ``make_fleet``): stacking's inner CV, and
+    `faultgen classify --horizon 3 --pairs 0` timed (by the fleet's time when it was made)."""
+    made = None
+    if make_fleet:
+        made = timed([*faultgen(), "fleet", "-o", str(fleet), "--no-progress", "--overwrite"])
+        print(f"faultgen fleet (default, 26 robots): {made[0]:7.1f} s wall, {made[1]:7.1f} s CPU   ({load()})")
+    if 3 in steps:
+        stacking_check(fleet)
+    for flag in ([], ["--full"]) if 4 in steps else ():
+        t = timed([*faultgen(), "classify", str(fleet), "--horizon", "3", "--pairs", "0", *flag,
+                   "-o", str(folder / "fleet-cls"), "--no-progress", "--overwrite"])
+        what = f"classify {fleet.name} --horizon 3 --pairs 0 {' '.join(flag)}"
+        print(f"{what}: {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")
+        if made is not None:
+            print("  " + ratio_line(what, t, made, "faultgen fleet"))
 
 
 def stacking_check(path: Path) -> None:

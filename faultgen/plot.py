@@ -104,7 +104,7 @@ TREND_DAYS = 7
 def running_median(values: np.ndarray, days: int = TREND_DAYS) -> np.ndarray:
     """The centred running median of ``values`` (n_days, n) over ``days`` days, NaN where the
     window is not full: at a record's ends a median of three or four days is one part's torque,
-    not the trend (a healthy robot's last day read -33 % on a 20-day fleet, issue 51)."""
+    not the trend (a healthy robot's last day read -33 % on a 20-day fleet)."""
     import pandas as pd
 
     return pd.DataFrame(values).rolling(days, center=True, min_periods=days).median().to_numpy()
@@ -129,55 +129,74 @@ def _draw_fleet(data, out: Path) -> Path:
     fig = Figure(figsize=(4.2 * cols, 2.6 * rows + 1.2), layout="constrained")
     panels = fig.subplots(rows, cols, squeeze=False).ravel()
     for ax, run in zip(panels, runs, strict=False):
-        days = run.recorded
-        torque = run.array("mean_abs_torque")
-        base = np.median(torque[:BASELINE_DAYS], axis=0)
-        change = (torque / np.where(base == 0, 1.0, base) - 1.0) * 100.0
-        worn = [a - 1 for a in run.worn_axes]
-        # the parts a robot carries change its torque from day to day: lines through the days
-        # zigzag, so the days are dots and the line is their running median over a week
-        trend = running_median(change)
-        for j in range(change.shape[1]):
-            if j not in worn:
-                ax.plot(days, trend[:, j], "-", lw=0.7, color="0.65")
-        for j in worn:
-            ax.plot(days, change[:, j], ".", ms=3, color="tab:blue", alpha=0.5)
-            ax.plot(days, trend[:, j], "-", lw=1.6, color="tab:blue", label=f"axis {j + 1}")
-        if run.measured:  # each log's label from events.csv, ticked along the top
-            label = run.array("label")
-            for flags, color in ((np.any(label == 1, axis=1), WEAR_COLOR), (np.all(label == 0, axis=1), "0.2")):
-                ax.plot(days[flags], np.full(int(flags.sum()), 0.97), "|", ms=6, color=color,
-                        transform=ax.get_xaxis_transform())
-        if run.has("payload_mass"):  # the part of each day's record: the lighter one ticked
-            mass = run.array("payload_mass")
-            light = mass < mass.max()
-            parts |= bool(light.any())
-            ax.plot(days[light], np.zeros(int(light.sum())), "|", ms=6, color="tab:green",
-                    transform=ax.get_xaxis_transform(), label="lighter part")
-        ax.axhline(0.0, color="0.4", lw=0.6)
-        ax.set_ylabel(CHANGE_LABEL.replace("change of ", "").replace(" [%]", "\nchange [%]"), fontsize=7)
-        ax.tick_params(labelsize=7)
-        ax.grid(alpha=0.3)
-        if run.measured:
-            label = run.array("label")
-            n_worn, n_healthy = int(np.any(label == 1, axis=1).sum()), int(np.all(label == 0, axis=1).sum())
-            state = (f"logs {n_worn} worn" + (f" (axis {', '.join(str(a) for a in run.worn_axes)})" if n_worn else "")
-                     + f", {n_healthy} healthy, {len(label) - n_worn - n_healthy} unknown")
-            ax.set_title(f"{run.id}\n{run.robot}: {state}", fontsize=8, color=WEAR_COLOR if n_worn else "black")
-        else:
-            state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
-            ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
-                         color=WEAR_COLOR if run.failing else "black")
-        if run.failing and not run.measured:
-            twin = ax.twinx()
-            twin.plot(days, run.fault_level, "-", color=WEAR_COLOR, lw=1.2)
-            twin.set_ylim(bottom=0.0)
-            twin.set_ylabel(WEAR_LABEL, color=WEAR_COLOR, fontsize=7)
-            twin.tick_params(axis="y", colors=WEAR_COLOR, labelsize=7)
+        parts |= _fleet_panel(ax, run)
     for ax in panels[len(runs):]:
         ax.set_visible(False)
     for ax in panels[max(0, len(runs) - cols):len(runs)]:
         ax.set_xlabel("log of the record (stamp order)" if imported else "day of the record", fontsize=8)
+    _fleet_title(fig, data, runs, imported, parts)
+    from faultgen.data.atomic import atomic_path
+
+    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
+        fig.savefig(tmp, dpi=100, format="png")
+    return out
+
+
+def _fleet_panel(ax, run: reader.Run) -> bool:
+    """One robot's panel of :func:`_draw_fleet` on ``ax``; whether its records carry a lighter part."""
+    parts = False
+    days = run.recorded
+    torque = run.array("mean_abs_torque")
+    base = np.median(torque[:BASELINE_DAYS], axis=0)
+    change = (torque / np.where(base == 0, 1.0, base) - 1.0) * 100.0
+    worn = [a - 1 for a in run.worn_axes]
+    # the parts a robot carries change its torque from day to day: lines through the days
+    # zigzag, so the days are dots and the line is their running median over a week
+    trend = running_median(change)
+    for j in range(change.shape[1]):
+        if j not in worn:
+            ax.plot(days, trend[:, j], "-", lw=0.7, color="0.65")
+    for j in worn:
+        ax.plot(days, change[:, j], ".", ms=3, color="tab:blue", alpha=0.5)
+        ax.plot(days, trend[:, j], "-", lw=1.6, color="tab:blue", label=f"axis {j + 1}")
+    if run.measured:  # each log's label from events.csv, ticked along the top
+        label = run.array("label")
+        for flags, color in ((np.any(label == 1, axis=1), WEAR_COLOR), (np.all(label == 0, axis=1), "0.2")):
+            ax.plot(days[flags], np.full(int(flags.sum()), 0.97), "|", ms=6, color=color,
+                    transform=ax.get_xaxis_transform())
+    if run.has("payload_mass"):  # the part of each day's record: the lighter one ticked
+        mass = run.array("payload_mass")
+        light = mass < mass.max()
+        parts = bool(light.any())
+        ax.plot(days[light], np.zeros(int(light.sum())), "|", ms=6, color="tab:green",
+                transform=ax.get_xaxis_transform(), label="lighter part")
+    ax.axhline(0.0, color="0.4", lw=0.6)
+    ax.set_ylabel(CHANGE_LABEL.replace("change of ", "").replace(" [%]", "\nchange [%]"), fontsize=7)
+    ax.tick_params(labelsize=7)
+    ax.grid(alpha=0.3)
+    if run.measured:
+        label = run.array("label")
+        n_worn, n_healthy = int(np.any(label == 1, axis=1).sum()), int(np.all(label == 0, axis=1).sum())
+        state = (f"logs {n_worn} worn" + (f" (axis {', '.join(str(a) for a in run.worn_axes)})" if n_worn else "")
+                 + f", {n_healthy} healthy, {len(label) - n_worn - n_healthy} unknown")
+        ax.set_title(f"{run.id}\n{run.robot}: {state}", fontsize=8, color=WEAR_COLOR if n_worn else "black")
+    else:
+        state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
+        ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
+                     color=WEAR_COLOR if run.failing else "black")
+    if run.failing and not run.measured:
+        twin = ax.twinx()
+        twin.plot(days, run.fault_level, "-", color=WEAR_COLOR, lw=1.2)
+        twin.set_ylim(bottom=0.0)
+        twin.set_ylabel(WEAR_LABEL, color=WEAR_COLOR, fontsize=7)
+        twin.tick_params(axis="y", colors=WEAR_COLOR, labelsize=7)
+    return parts
+
+
+def _fleet_title(fig, data, runs: list[reader.Run], imported: bool, parts: bool) -> None:
+    """The title of :func:`_draw_fleet`'s figure: the fleet's ``runs`` (``imported`` from logs or
+    simulated) and how to read their panels (``parts``: whether green ticks mark days with the lighter
+    part)."""
     if imported:
         worn_units = sum(bool(run.worn_axes) for run in runs)
         fig.suptitle(f"{data.path.name}: {len(runs)} units imported from logs ({worn_units} with logs labelled worn "
@@ -192,11 +211,6 @@ def _draw_fleet(data, out: Path) -> Path:
                      f"median over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; "
                      "grey: the other axes); red: the worn axis's true wear; green ticks: days with the lighter part",
                      fontsize=10)
-    from faultgen.data.atomic import atomic_path
-
-    with atomic_path(out) as tmp:  # a full disk or a kill leaves no half-written PNG
-        fig.savefig(tmp, dpi=100, format="png")
-    return out
 
 
 def _draw_run(fig, axes, run: reader.Run) -> None:

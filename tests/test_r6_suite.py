@@ -20,46 +20,17 @@ MAX_COMMAND_LINES = 40
 #: Functions known to be longer (main a355838, 2026-11-26: 31), each to be split: remove one as its
 #: split is merged.
 LONG_FUNCTIONS = {
-    "analysis/benchmark/detection_report.py::detection_advice",
-    "analysis/benchmark/isolation_answers.py::isolation_table",
-    "analysis/classify/evaluation.py::evaluate",
-    "benchmarks/bench_classify.py::main",
-    "faultgen/bench/make.py::make",
     "faultgen/calibrate/loop.py::run",
-    "faultgen/calibrate/refit.py::refit",
-    "faultgen/cli/analysis.py::bench_isolators_command",
-    "faultgen/cli/analysis.py::classify_command",
-    "faultgen/cli/analysis.py::detect_command",
     "faultgen/cli/monitoring.py::monitor_command",
-    "faultgen/cli/robots.py::robots_command",
-    "faultgen/cli/runs.py::fleet_command",
-    "faultgen/cli/runs.py::simulate_command",
-    "faultgen/cli/runs.py::sweep_command",
-    "faultgen/data/card.py::card",
-    "faultgen/data/fleetlogs.py::import_logs",
-    "faultgen/model/builder.py::build",
-    "faultgen/model/builder.py::check_arm",
-    "faultgen/model/folder.py::add",
-    "faultgen/model/folder.py::readme",
-    "faultgen/model/import_dh.py::read_dh",
-    "faultgen/model/import_urdf.py::read_urdf",
-    "faultgen/model/xacro_expressions.py::evaluate",
     "faultgen/monitor/loop.py::monitor",
     "faultgen/monitor/unit_chart.py::figure",
     "faultgen/monitor/state.py::read_unit",
-    "faultgen/plot.py::_draw_fleet",
-    "faultgen/runs/cluster.py::execute",
     "faultgen/runs/sweep.py::run",
 }
 #: CLI commands whose body is known to be longer (the same day: 6), each to move its policy into the
 #: library: remove one as it is merged.
 LONG_COMMANDS = {
-    "faultgen/cli/analysis.py::bench_isolators_command",
-    "faultgen/cli/analysis.py::classify_command",
-    "faultgen/cli/analysis.py::detect_command",
-    "faultgen/cli/analysis.py::training_source_command",
     "faultgen/cli/monitoring.py::monitor_command",
-    "faultgen/cli/runs.py::sweep_command",
 }
 
 

@@ -19,13 +19,13 @@ between them (docs/architecture.md)::
     truth                    a dataset opened; each run's true fault progress and wear levels
     tables                   a table as Markdown, CSV and Markdown files; answers that are no axis
     isolation_answers        Table 6.2's cases and the isolators' answers
-    isolation_scores         accuracy, cases decided, confusion, Table 6.2's Markdown
+    isolation_scores         accuracy, cases decided, confusion, Table 6.2's Markdown, the report
     detection_features       |motor torque| counts -> 12-bin histograms -> KL divergences
     detection                the protocols, the monitors, false alarms held out: Table 3.5
-    detection_report         its columns, summary and advice in words
+    detection_report         its columns, summary and advice in words, the report
     classification_features  Table 5.1's features and labels, the training sets checked
     classification_auc       Table 5.2 judged against chance
-    classification_report    its verdict, printed and tidy forms, caption
+    classification_report    its verdict, printed and tidy forms, caption, the report
     figures                  the PNG figures of all three
 """
 
@@ -48,8 +48,10 @@ from analysis.benchmark.classification_features import (
     imported_labels,
 )
 from analysis.benchmark.classification_report import (
+    classification_across_text,
     classification_caption,
     classification_printed,
+    classification_text,
     classification_tidy,
     classification_verdict,
 )
@@ -78,6 +80,7 @@ from analysis.benchmark.detection_report import (
     detection_advice,
     detection_columns,
     detection_summary,
+    detection_text,
     false_alarm_meaning,
 )
 from analysis.benchmark.figures import (
@@ -103,6 +106,7 @@ from analysis.benchmark.isolation_scores import (
     isolation_decided,
     isolation_levels,
     isolation_markdown,
+    isolation_report,
     level_label,
     starved_isolators,
     table_axes,
@@ -144,11 +148,13 @@ __all__ = [
     "StoredHistograms",
     "axis_label",
     "binned_torque",
+    "classification_across_text",
     "classification_caption",
     "classification_heatmap",
     "classification_inputs",
     "classification_printed",
     "classification_table",
+    "classification_text",
     "classification_tidy",
     "classification_verdict",
     "confusion_figure",
@@ -159,6 +165,7 @@ __all__ = [
     "detection_scale",
     "detection_summary",
     "detection_table",
+    "detection_text",
     "false_alarm_interval",
     "false_alarm_meaning",
     "fault_progress",
@@ -173,6 +180,7 @@ __all__ = [
     "isolation_heatmap",
     "isolation_levels",
     "isolation_markdown",
+    "isolation_report",
     "isolation_table",
     "kl_features",
     "level_cycle",

@@ -3,11 +3,13 @@ verdict against chance, the table as ``faultgen classify`` prints it, its tidy C
 
 from __future__ import annotations
 
+import shlex
+
 import numpy as np
 import pandas as pd
 
 from analysis.benchmark.classification_auc import CHANCE_ALPHA
-from analysis.benchmark.tables import MEASURED_NEXT
+from analysis.benchmark.tables import MEASURED_NEXT, markdown
 
 
 def classification_verdict(table: pd.DataFrame, command: str = "faultgen classify FILE") -> str:
@@ -124,3 +126,28 @@ def classification_caption(table: pd.DataFrame, *, n_pairs: int | None, horizon:
                      f"`{command} --full`.")
     parts += [note.removeprefix("note: ").capitalize() for note in table.attrs.get("notes", [])]
     return " ".join(parts)
+
+
+def classification_text(table: pd.DataFrame, file, *, pairs: int, horizon: int | None, wear_threshold: float,
+                        matched: bool, full: bool, classifiers=None, preprocessing=None) -> str:
+    """What ``faultgen classify FILE`` prints and writes to OUT.md: the printed table, its caption and
+    its verdict against chance, with the command line that reproduces it (its options as given:
+    ``pairs``, 20 by default, 0 all; ``horizon``; ``matched`` days; ``full``; the cells)."""
+    command = " ".join(["faultgen classify", shlex.quote(str(file)),
+                        *([f"--horizon {horizon}"] if horizon is not None else []),
+                        *(["--matched-days"] if matched else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
+                        *(["--full"] if full else []),
+                        *(f"--classifier {c}" for c in classifiers or []),
+                        *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
+    caption = classification_caption(table, n_pairs=pairs or None, horizon=horizon, wear_threshold=wear_threshold,
+                                     matched=matched, command=command, short=not (full or preprocessing))
+    return (markdown(classification_printed(table), digits=3) + "\n\n" + caption + "\n\n"
+            + classification_verdict(table, command))
+
+
+def classification_across_text(table: pd.DataFrame, file, train) -> str:
+    """What ``faultgen classify FILE --train OTHER`` prints and writes to OUT.md: the table of
+    :func:`analysis.crossdata.classification_across` and what its columns mean."""
+    return (markdown(table, digits=3) + f"\n\nprotocol: {table.attrs['protocol']}. auc: the samples of "
+            f"{file} ranked by a model fitted on {train}; null: its mean over label sets with the tested runs' roles "
+            "exchanged (the chance level on these robots); p: the permutation p-value.")

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from analysis import isolation, scoring
-from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED
+from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED, markdown
 
 #: What the columns of :func:`detection_table` mean, printed under it by ``faultgen detect``.
 DETECTION_COLUMNS = {
@@ -89,6 +89,31 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
         notes.append("note: a fleet's robots each learn their own first days (first-cycles, thesis ch. 4 OTO); "
                      "false_alarm_pct is that protocol on the fleet's healthy robots. For monitors learnt from other "
                      "robots, compared with their own, run `faultgen training-source` on a 60-day fleet")
+    notes += _learned_fault_notes(table, imported, seeds)
+    alpha = 100.0 * table.attrs.get("alpha", 0.05)
+    high = table[table["false_alarm_above_alpha"] & ~table["protocol"].str.startswith("same-run")] \
+        if "false_alarm_above_alpha" in table else table.iloc[:0]
+    if len(high):
+        worst = high.loc[high["false_alarm_pct"].idxmax()]
+        notes.append(f"note: in {len(high)} of {len(table)} runs the held-out false-alarm rate is above the nominal "
+                     f"{alpha:g} % by more than its 95 % interval (e.g. {worst['run']}: {worst['false_alarm_pct']:g} %, "
+                     f"interval {worst['false_alarm_ci_pct']} %): the Q limit does not hold on healthy data the monitor "
+                     "did not learn, so alarms come sooner than alpha promises; more training data or --limit-folds "
+                     "helps")
+    notes += _location_notes(table, imported)
+    noisy = table[table["alarms_before_fault_pct"] >= 50]
+    if len(noisy):
+        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the "
+                     + ("first log labelled worn" if imported else "fault begins") + " (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
+                     "detections say little")
+    return "\n".join(notes)
+
+
+def _learned_fault_notes(table: pd.DataFrame, imported: bool, seeds: str) -> list[str]:
+    """The note on runs left out of :func:`detection_advice`'s summary because their monitor learned
+    the fault (trained_on_fault), with a remedy (``seeds``: how to sweep the grid with several seeds);
+    none if there are none."""
+    notes = []
     learned = table[table["trained_on_fault"]] if "trained_on_fault" in table else table.iloc[:0]
     if len(learned):
         begins = table.attrs.get("fault_begins_sample", {})
@@ -112,16 +137,13 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
         notes.append(f"note: {len(learned)} of {len(table)} runs are left out of the summary: {began} inside "
                      f"the samples their monitor learned as normal (trained_on_fault; earliest {where}), so their "
                      f"detections say nothing. {remedy}")
-    alpha = 100.0 * table.attrs.get("alpha", 0.05)
-    high = table[table["false_alarm_above_alpha"] & ~table["protocol"].str.startswith("same-run")] \
-        if "false_alarm_above_alpha" in table else table.iloc[:0]
-    if len(high):
-        worst = high.loc[high["false_alarm_pct"].idxmax()]
-        notes.append(f"note: in {len(high)} of {len(table)} runs the held-out false-alarm rate is above the nominal "
-                     f"{alpha:g} % by more than its 95 % interval (e.g. {worst['run']}: {worst['false_alarm_pct']:g} %, "
-                     f"interval {worst['false_alarm_ci_pct']} %): the Q limit does not hold on healthy data the monitor "
-                     "did not learn, so alarms come sooner than alpha promises; more training data or --limit-folds "
-                     "helps")
+    return notes
+
+
+def _location_notes(table: pd.DataFrame, imported: bool) -> list[str]:
+    """The note on why no detected run of :func:`detection_advice`'s table was located (too few samples
+    before the onset, undecided, another axis); none if one was located or none was detected."""
+    notes = []
     counted = table[~table["trained_on_fault"]] if "trained_on_fault" in table else table
     detected = counted[counted["detected"]]
     if len(detected) and not detected["located"].astype(bool).any():  # located_pct 0: say why
@@ -144,12 +166,7 @@ def detection_advice(table: pd.DataFrame, protocol: str = "auto") -> str:
                 "events.csv)" if imported else "more samples before the onset: record more cycles (--record all)")
         notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): {'; '.join(why)}. Location needs "
                      + more)
-    noisy = table[table["alarms_before_fault_pct"] >= 50]
-    if len(noisy):
-        notes.append(f"note: {len(noisy)} of {len(table)} runs alarm on at least half of their samples before the "
-                     + ("first log labelled worn" if imported else "fault begins") + " (alarms_before_fault_pct): the monitor does not describe their healthy operation, so their "
-                     "detections say little")
-    return "\n".join(notes)
+    return notes
 
 
 def _with_seeds(command: str) -> str:
@@ -193,3 +210,20 @@ def detection_summary(table: pd.DataFrame) -> pd.DataFrame:
         parts.append(kept.assign(by=label))
     out = pd.concat(parts).rename_axis("group").reset_index()
     return out.set_index(["by", "group"]).round(2)
+
+
+def detection_text(table: pd.DataFrame, summary: pd.DataFrame, protocol: str = "auto") -> str:
+    """What ``faultgen detect`` prints of a :func:`detection_table` and its :func:`detection_summary`: the
+    table, what its columns mean, the summary with what its false-alarm rate measured (and the runs
+    left out of it), and :func:`detection_advice` (``protocol``: the one asked for)."""
+    lines = [markdown(table, digits=4),
+             "\n".join(f"  {name}: {meaning}" for name, meaning in detection_columns(table).items())]
+    left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
+    rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
+             if left_out else "")
+    lines.append(f"\nsummary ({rests}false_alarm_pct, %: {false_alarm_meaning(table['protocol'])}):")
+    lines.append(markdown(summary, digits=4))
+    advice = detection_advice(table, protocol)
+    if advice:
+        lines.append(advice)
+    return "\n".join(lines)

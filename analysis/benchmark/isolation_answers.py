@@ -75,48 +75,17 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     from sklearn.base import clone
 
     isolators = dict(isolators or default_isolators())
-    probe = np.random.default_rng(0).standard_normal((200, 6))
-    for name, prototype in isolators.items():  # bad parameters (bins < 2, ...) raise here, named
-        try:
-            fitted = clone(prototype).fit(probe)
-        except ValueError as err:
-            raise ValueError(f"isolator {name}: {err}") from err
-        if not hasattr(fitted, "source_axis_"):
-            raise ValueError(f"isolator {name}: fit(X) set no source_axis_ (the isolator contract of "
-                             "analysis.isolation: 1-based axis, 0 when undecided)")
+    _check_isolators(isolators)
     with opened(path) as data:
         runs = [r for r in data.runs if len(r.worn_axes) <= 1]
-        values = {r.id: r.array(signal) for r in runs}
-        windowed = {r.id: np.zeros(values[r.id].shape[1], dtype=bool) for r in runs}
-        if speed_window:  # the windowed mean where every cycle has samples in the window
-            from analysis.features import speed_window_mean
-
-            for run in runs:
-                inside = speed_window_mean(run.signal("tau_m"), run.signal("qd_m"), *speed_window)
-                run.forget("tau_m", "qd_m")  # large: not kept
-                windowed[run.id] = ~np.isnan(inside).any(axis=0)
-                values[run.id] = np.where(windowed[run.id], inside, values[run.id])
+        values, windowed = _signals(runs, signal, speed_window)
         worn = [r for r in runs if len(r.worn_axes) == 1]
         if not worn:
             raise ValueError(f"{data.path} has no run with exactly one worn axis to isolate")
         imported = all(r.measured for r in data.runs)
         if imported:  # no wear is measured: one case per unit, up to its first log labelled worn
             levels = [LABELLED_WORN]
-        # cycles seen per (setup, level): what the worn runs saw, shown to the healthy runs of the same
-        # robot, program, friction and conditions (reader.Run.setup) too
-        seen: dict[tuple, int] = {}
-        cases = []
-        for run in worn:
-            axis = run.worn_axes[0]
-            grown = fault_progress(run, axis)
-            for level in levels:
-                k = level_cycle(grown, level)
-                if k is not None:
-                    seen.setdefault((run.setup, level), k + 1)
-                    cases.append((run, axis, level, k + 1))
-        for run in runs:
-            if not run.worn_axes:
-                cases += [(run, NO_FAULT, 0.0, n) for (setup, _), n in seen.items() if setup == run.setup]
+        cases = _cases(worn, runs, levels)
     needed = {name: isolation.min_rows(prototype) for name, prototype in isolators.items()}
     rows = []
     for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
@@ -134,6 +103,65 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
     table = pd.DataFrame(rows)
     table.attrs["imported"] = imported
     return table
+
+
+def _check_isolators(isolators: Mapping[str, object]) -> None:
+    """Fit each isolator on a probe: bad parameters (bins < 2, ...) raise here, named.
+
+    Raises
+    ------
+    ValueError
+        Naming the isolator whose fit refuses its parameters or sets no ``source_axis_``.
+    """
+    from sklearn.base import clone
+
+    probe = np.random.default_rng(0).standard_normal((200, 6))
+    for name, prototype in isolators.items():  # bad parameters (bins < 2, ...) raise here, named
+        try:
+            fitted = clone(prototype).fit(probe)
+        except ValueError as err:
+            raise ValueError(f"isolator {name}: {err}") from err
+        if not hasattr(fitted, "source_axis_"):
+            raise ValueError(f"isolator {name}: fit(X) set no source_axis_ (the isolator contract of "
+                             "analysis.isolation: 1-based axis, 0 when undecided)")
+
+
+def _signals(runs: list, signal: str, speed_window: tuple[float, float] | None) -> tuple[dict, dict]:
+    """(run id -> its per-cycle ``signal`` (n_cycles, N), run id -> which of its axes were windowed): with
+    ``speed_window``, the windowed mean |motor torque| where every cycle has samples in the window."""
+    values = {r.id: r.array(signal) for r in runs}
+    windowed = {r.id: np.zeros(values[r.id].shape[1], dtype=bool) for r in runs}
+    if speed_window:  # the windowed mean where every cycle has samples in the window
+        from analysis.features import speed_window_mean
+
+        for run in runs:
+            inside = speed_window_mean(run.signal("tau_m"), run.signal("qd_m"), *speed_window)
+            run.forget("tau_m", "qd_m")  # large: not kept
+            windowed[run.id] = ~np.isnan(inside).any(axis=0)
+            values[run.id] = np.where(windowed[run.id], inside, values[run.id])
+    return values, windowed
+
+
+def _cases(worn: list, runs: list, levels) -> list[tuple]:
+    """The isolation cases ``(run, worn axis or NO_FAULT, level, cycles seen)``: each worn run up to the
+    first cycle at each level, and each run without wear shown as many cycles as the worn runs of its
+    setup (reader.Run.setup) saw at that level."""
+    # cycles seen per (setup, level): what the worn runs saw, shown to the healthy runs of the same
+    # robot, program, friction and conditions (reader.Run.setup) too
+    seen: dict[tuple, int] = {}
+    cases = []
+    for run in worn:
+        axis = run.worn_axes[0]
+        grown = fault_progress(run, axis)
+        for level in levels:
+            k = level_cycle(grown, level)
+            if k is not None:
+                seen.setdefault((run.setup, level), k + 1)
+                cases.append((run, axis, level, k + 1))
+    for run in runs:
+        if not run.worn_axes:
+            cases += [(run, NO_FAULT, 0.0, n) for (setup, _), n in seen.items() if setup == run.setup]
+    return cases
 
 
 def motor_speed_coverage(path, speed_window: tuple[float, float]) -> pd.DataFrame:

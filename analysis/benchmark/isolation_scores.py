@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 
 from analysis import scoring
-from analysis.benchmark.isolation_answers import LABELLED_WORN
-from analysis.benchmark.tables import TOO_FEW_CYCLES, UNDECIDED, axis_label, markdown
+from analysis.benchmark.isolation_answers import LABELLED_WORN, motor_speed_coverage
+from analysis.benchmark.tables import MEASURED_NEXT, TOO_FEW_CYCLES, UNDECIDED, axis_label, markdown
 from analysis.benchmark.truth import NO_FAULT
 
 
@@ -165,3 +165,36 @@ def level_label(level: float, imported: bool = False) -> str:
     """A wear level as the tables and figures print it: "no fault" for 0, "to first worn" on an
     imported dataset, else the percentage (``5``, ``10``)."""
     return "no fault" if level == 0 else "to first worn" if imported else f"{level:g}"
+
+
+def isolation_report(table: pd.DataFrame, path=None, window: tuple[float, float] | None = None) -> str:
+    """What ``faultgen bench-isolators`` prints of an isolation table: with a motor-speed ``window``
+    (rad/s), how it covers the motor speeds of the dataset at ``path``; the accuracy per task and
+    level under :data:`ACCURACY_RULE`, the cases decided, and a note on isolators the dataset starves
+    of cycles (or of logs, for an imported dataset)."""
+    lines = []
+    if window is not None:
+        lines.append(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
+        lines.append(markdown(motor_speed_coverage(path, window), digits=4))
+    imported = bool(table.attrs.get("imported"))
+    if imported:
+        lines.append("units imported from logs: no wear is measured; each worn unit is one case, its logs up to the "
+                     "first labelled worn by events.csv (\"to first worn\"; --levels does not apply)")
+    lines.append(markdown(isolation_levels(table, isolation_accuracy_text(table)), digits=4))
+    lines.append(ACCURACY_RULE + " In the CSV, predicted 0 is undecided and -1 too few cycles (column answer "
+                 "spells it; needed: the isolator's fewest cycles).")
+    lines.append("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
+                 "cycles):")
+    lines.append(markdown(isolation_levels(table, isolation_decided(table)), digits=4))
+    starved = starved_isolators(table)
+    if starved and imported:
+        lines.append(f"note: this dataset lacks logs: with at most {int(table['cycles'].max())} logs per unit up to "
+                     f"its first labelled worn, {', '.join(starved)} named no axis (undecided, or too few logs to run) "
+                     "in most worn cases. These isolators need tens of records (thesis Table 6.2: up to 86) before the "
+                     f"first worn one: longer records of the units; {MEASURED_NEXT}")
+    elif starved:
+        lines.append(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
+                     f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
+                     "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
+                     "use `faultgen sweep --preset j2`, or --record with more cycles")
+    return "\n".join(lines)

@@ -77,28 +77,9 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     X, y, groups, failed, normal = check_inputs(X, y, groups, failed_groups, normal_groups)
     if not is_whole(permutations, 0):
         raise ValueError(f"permutations = {permutations!r}; expected an integer >= 0 (0: no chance level)")
-    if estimated is not None:
-        estimated = np.asarray(estimated, dtype=float)
-        if estimated.ndim == 1:
-            estimated = estimated[:, None]
-        if estimated.ndim != 2 or estimated.shape[0] != X.shape[0]:
-            raise ValueError(f"estimated must have shape ({X.shape[0]}, n_estimated), got {estimated.shape}")
-    if preprocessing is None:
-        names = [n for n in PREPROCESSING if estimated is not None or not n.startswith(ESTIMATED)]
-    else:
-        names = list(preprocessing)
-    for name in names:
-        preprocessing_steps(name)  # unknown tokens fail before any fitting
-        if name.startswith(ESTIMATED) and estimated is None:
-            raise ValueError(f"preprocessing {name!r} needs the estimated quantities (estimated=...)")
-    if isinstance(classifiers, Mapping):
-        models = dict(classifiers)
-    else:
-        models = {}
-        for c in classifiers:
-            if c not in CLASSIFIERS:
-                raise ValueError(f"unknown classifier {c!r}; expected one of: {', '.join(CLASSIFIERS)}")
-            models[c] = c
+    estimated = _estimated(estimated, X)
+    names = _names(preprocessing, estimated)
+    models = _models(classifiers)
     labels = make_labels(y, groups, failed, label_rule)
     X_est = np.hstack([X, estimated]) if estimated is not None else None
     roles = permuted_roles(labels, groups, failed, normal, permutations, random_state) if permutations else []
@@ -111,12 +92,78 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
     # joblib's workers limit theirs alike
-    # loky's workers and trackers start in this folder: no joblib.py of it on their path (issue 61)
+    # loky's workers and trackers start in this folder: no joblib.py of it on their path
     with threadpool_limits(limits=1), children.safe_path():
         results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(tasks)
         per_job = np.array(list(tqdm(results, total=len(jobs), desc="classify", unit="pair", disable=not progress)))
     per_job = per_job.reshape(len(jobs), len(names) * len(models))
-    set_of = np.array([k for k, _ in jobs])
+    aucs, null = _cells(per_job, [k for k, _ in jobs], names, models, len(label_sets))
+    table = _table(aucs, null, names, models, permutations)
+    return (table, aucs) if return_aucs else table
+
+
+def _estimated(estimated, X: np.ndarray) -> np.ndarray | None:
+    """``estimated`` as an array of shape (n_samples, n_estimated), or None.
+
+    Raises
+    ------
+    ValueError
+        If it has other rows than ``X``.
+    """
+    if estimated is not None:
+        estimated = np.asarray(estimated, dtype=float)
+        if estimated.ndim == 1:
+            estimated = estimated[:, None]
+        if estimated.ndim != 2 or estimated.shape[0] != X.shape[0]:
+            raise ValueError(f"estimated must have shape ({X.shape[0]}, n_estimated), got {estimated.shape}")
+    return estimated
+
+
+def _names(preprocessing: Iterable[str] | None, estimated: np.ndarray | None) -> list[str]:
+    """The preprocessing combinations to score: ``preprocessing``, or every key of PREPROCESSING (without
+    the ``+estM`` ones when ``estimated`` is None).
+
+    Raises
+    ------
+    ValueError
+        For an unknown combination, or one starting ``+estM`` without ``estimated``.
+    """
+    if preprocessing is None:
+        names = [n for n in PREPROCESSING if estimated is not None or not n.startswith(ESTIMATED)]
+    else:
+        names = list(preprocessing)
+    for name in names:
+        preprocessing_steps(name)  # unknown tokens fail before any fitting
+        if name.startswith(ESTIMATED) and estimated is None:
+            raise ValueError(f"preprocessing {name!r} needs the estimated quantities (estimated=...)")
+    return names
+
+
+def _models(classifiers: Iterable[str] | Mapping[str, object]) -> dict[str, object]:
+    """Column name -> estimator, or -> its name in CLASSIFIERS.
+
+    Raises
+    ------
+    ValueError
+        For a name not in CLASSIFIERS.
+    """
+    if isinstance(classifiers, Mapping):
+        models = dict(classifiers)
+    else:
+        models = {}
+        for c in classifiers:
+            if c not in CLASSIFIERS:
+                raise ValueError(f"unknown classifier {c!r}; expected one of: {', '.join(CLASSIFIERS)}")
+            models[c] = c
+    return models
+
+
+def _cells(per_job: np.ndarray, set_of: list[int], names: list[str], models: dict,
+           n_sets: int) -> tuple[dict, dict]:
+    """(``(classifier, preprocessing)`` -> the AUCs of the true labels' pairs, -> the mean AUC on each
+    exchanged label set) from ``per_job`` (n_jobs, cells), each job's label set in ``set_of`` (0: the
+    true labels); an UndefinedAUCWarning where pairs have no AUC."""
+    set_of = np.array(set_of)
     cells = [(name, column) for name in names for column in models]
     aucs: dict[tuple[str, str], np.ndarray] = {}
     null: dict[tuple[str, str], np.ndarray] = {}
@@ -124,12 +171,16 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
         for c, (name, column) in enumerate(cells):
             aucs[column, name] = per_job[set_of == 0, c]
-            null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, len(label_sets))])
+            null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, n_sets)])
     n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
     if n_nan - {0}:
         warnings.warn(f"up to {max(n_nan)} held-out pairs per cell have no AUC (one class only); they are "
-                      "left out of mean and std", UndefinedAUCWarning, stacklevel=2)
+                      "left out of mean and std", UndefinedAUCWarning, stacklevel=3)
+    return aucs, null
 
+
+def _table(aucs: dict, null: dict, names: list[str], models: dict, permutations: int) -> pd.DataFrame:
+    """Table 5.2 from the cells' AUCs (:func:`evaluate`'s Returns)."""
     statistics = ["mean", "std", "null", "p"] if permutations else ["mean", "std"]
     columns = pd.MultiIndex.from_product([list(models), statistics], names=["classifier", "statistic"])
     table = pd.DataFrame(index=pd.Index(names, name="preprocessing"), columns=columns, dtype=float)
@@ -143,4 +194,4 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     if permutations:  # each cell's mean AUC per exchanged label set: what its p-value counts against
         table.attrs["null_values"] = {f"{column} {name}": [float(v) for v in values]
                                       for (column, name), values in null.items()}
-    return (table, aucs) if return_aucs else table
+    return table

@@ -210,7 +210,7 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
             aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
     else:
         jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
-        with children.safe_path():  # loky's workers and trackers: no joblib.py of this folder (issue 61)
+        with children.safe_path():  # loky's workers and trackers: no joblib.py of this folder
             aucs = Parallel(n_jobs=n_jobs)(jobs)
     aucs = np.asarray(aucs, dtype=float)
     n_nan = int(np.isnan(aucs).sum())

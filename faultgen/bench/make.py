@@ -273,6 +273,59 @@ def _order(track: str, version: int, n: int) -> np.ndarray:
     return np.random.default_rng(seed).permutation(n)
 
 
+def _check_request(track: tracks.Track, recipe: tracks.Version, size: str, out: Path, jobs: int,
+                   freeze: bool) -> tuple[str, Path]:
+    """Check :func:`make`'s request before any work: return (the numeric profile this process runs,
+    :func:`faultgen.bench.profile.check`; the path of the version's frozen manifest).
+
+    Raises
+    ------
+    ValueError
+        For an unknown size, an ``out`` whose folder does not exist or that is a file, ``jobs`` not a
+        whole number >= 1, a process that cannot be pinned to the version's profile, a version frozen
+        already when ``freeze``, or a track with fleets and no Pinocchio.
+    """
+    if size not in tracks.SIZES:
+        raise ValueError(f"--size {size!r}: expected one of {', '.join(tracks.SIZES)}")
+    if not (out.parent if str(out.parent) else Path(".")).is_dir():
+        raise ValueError(f"-o {out}: folder {out.parent} does not exist")
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"-o {out} is a file; give a folder")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"--jobs {jobs!r}: expected a whole number >= 1")
+    numeric = profile.check(recipe.profile)  # before any work: a process that cannot be pinned any more is refused
+    frozen_path = manifest_path(track.name, recipe.number, size)
+    if freeze and frozen_path.exists():
+        raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
+                         "a new recipe is a new version")
+    if any(recipe.fleets(split, size) for split in tracks.SPLITS):
+        from faultgen.bench import independent
+
+        try:
+            independent.pinocchio_module()
+        except ImportError as err:  # before any sweep; the command line reports a ValueError in one line
+            raise ValueError(f"track {track.name} version {recipe.number}: {err}") from None
+    return numeric, frozen_path
+
+
+def _write_splits(stage: Path, track: tracks.Track, recipe: tracks.Version, size: str, command: str,
+                  train: list[files.Unit], test: list[files.Unit]) -> None:
+    """Write ``train.h5``, ``test_labels.csv`` and ``test.h5`` (without labels) into ``stage``: the units
+    numbered, the test units in the version's shuffled order (:func:`_order`)."""
+    for k, unit in enumerate(train):
+        unit.id = f"train-{k:03d}"
+    test = [test[i] for i in _order(track.name, recipe.number, len(test))]
+    for k, unit in enumerate(test):
+        unit.id = f"test-{k:03d}"
+    attrs = {"track": track.name, "version": recipe.number, "size": size, "licence": track.licence,
+             "faultgen_version": faultgen.__version__, "command": command}
+    files.write(stage / "train.h5", train, {**attrs, "split": "train"})
+    files.write_labels(stage / "test_labels.csv", test)
+    for unit in test:  # the test file holds no label
+        unit.fault_level = unit.worn_axis = unit.fault = None
+    files.write(stage / "test.h5", test, {**attrs, "split": "test"})
+
+
 def make(track_name: str, out: str | Path, version: int | None = None, size: str = "full", jobs: int = 1,
          progress: bool = True, command: str = "", freeze: bool = False) -> dict:
     """Make the benchmark files of a track version in the folder ``out`` and check them.
@@ -311,27 +364,8 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
     """
     track = tracks.load(track_name)
     recipe = track.version(version)
-    if size not in tracks.SIZES:
-        raise ValueError(f"--size {size!r}: expected one of {', '.join(tracks.SIZES)}")
     out = Path(out)
-    if not (out.parent if str(out.parent) else Path(".")).is_dir():
-        raise ValueError(f"-o {out}: folder {out.parent} does not exist")
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"-o {out} is a file; give a folder")
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise ValueError(f"--jobs {jobs!r}: expected a whole number >= 1")
-    numeric = profile.check(recipe.profile)  # before any work: a process that cannot be pinned any more is refused
-    frozen_path = manifest_path(track.name, recipe.number, size)
-    if freeze and frozen_path.exists():
-        raise ValueError(f"track {track.name} version {recipe.number} ({size}) is frozen already ({frozen_path}); "
-                         "a new recipe is a new version")
-    if any(recipe.fleets(split, size) for split in tracks.SPLITS):
-        from faultgen.bench import independent
-
-        try:
-            independent.pinocchio_module()
-        except ImportError as err:  # before any sweep; the command line reports a ValueError in one line
-            raise ValueError(f"track {track.name} version {recipe.number}: {err}") from None
+    numeric, frozen_path = _check_request(track, recipe, size, out, jobs, freeze)
     # the sweeps' runs live beside the output until it is written: a make stopped by Ctrl-C or a kill
     # resumes from the runs it finished when run again (the sweep's own resume)
     sweeps = (out.parent if str(out.parent) else Path(".")) / f".{out.name}.{track.name}-{recipe.number}-{size}.sweeps"
@@ -342,18 +376,7 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         added = add_robots(recipe, sweeps / "robots")
         train = _split_units(recipe, "train", size, sweeps, jobs, progress, command, added)
         test = _split_units(recipe, "test", size, sweeps, jobs, progress, command, added)
-        for k, unit in enumerate(train):
-            unit.id = f"train-{k:03d}"
-        test = [test[i] for i in _order(track.name, recipe.number, len(test))]
-        for k, unit in enumerate(test):
-            unit.id = f"test-{k:03d}"
-        attrs = {"track": track.name, "version": recipe.number, "size": size, "licence": track.licence,
-                     "faultgen_version": faultgen.__version__, "command": command}
-        files.write(stage / "train.h5", train, {**attrs, "split": "train"})
-        files.write_labels(stage / "test_labels.csv", test)
-        for unit in test:  # the test file holds no label
-            unit.fault_level = unit.worn_axis = unit.fault = None
-        files.write(stage / "test.h5", test, {**attrs, "split": "test"})
+        _write_splits(stage, track, recipe, size, command, train, test)
         arrays = hashes(stage)
         manifest = {"track": track.name, "version": recipe.number, "size": size, "faultgen_version": faultgen.__version__,
                     "licence": track.licence, "profile": recipe.profile, "environment": profile.describe(),

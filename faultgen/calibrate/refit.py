@@ -107,6 +107,37 @@ def _optimize(sysid, residual_of, starts, low, high, max_iters: int):
     return x, half, seconds
 
 
+def _entries(result) -> list[tuple]:
+    """The continuous parameters of ``result``'s steps that have a finite standard error, each
+    ``(step, axis or None, name, faultgen's value, its standard error)``."""
+    entries = []
+    for step in result.steps:
+        effect = step.effect
+        where = step.axes if effect.per_axis else [None]
+        for axis in where:
+            values = effect.values(axis)
+            errors = step.standard_errors.get(axis, {})
+            for name, value in values.items():
+                if name in effect.counts or isinstance(value, int):
+                    continue
+                if not np.isfinite(errors.get(name, np.nan)):
+                    continue
+                entries.append((step, axis, name, float(value), float(errors.get(name, 0.0))))
+    return entries
+
+
+def _spec_with(base_xml: str, robot: robots.Robot, entries: list[tuple], vector: np.ndarray) -> mujoco.MjSpec:
+    """The calibrated model's spec (``base_xml``, of ``robot``) with the parameters of ``entries`` set to
+    ``vector``, by each effect's own MJCF form."""
+    spec = mujoco.MjSpec.from_string(base_xml)
+    changed: dict[tuple, dict] = {}
+    for (step, axis, name, _, _), value in zip(entries, vector, strict=True):
+        changed.setdefault((step.effect.id, axis), step.effect.values(axis))[name] = float(value)
+    for (effect_id, axis), values in changed.items():
+        get(effect_id).apply(spec, robot, axis, values)
+    return spec
+
+
 def refit(result, data: measured_io.MeasuredData, nominal: robots.Robot,
           max_iters: int = 30) -> tuple[list[Refit], float, float]:
     """Fit the continuous parameters of ``result``'s steps (a :class:`faultgen.calibrate.Calibration`)
@@ -147,28 +178,10 @@ def refit(result, data: measured_io.MeasuredData, nominal: robots.Robot,
     rows = np.flatnonzero(split.fit.any(axis=1))[::STRIDE]
     mask = split.fit[rows]
 
-    entries = []  # (step, axis or None, name, faultgen value, faultgen se)
-    for step in result.steps:
-        effect = step.effect
-        where = step.axes if effect.per_axis else [None]
-        for axis in where:
-            values = effect.values(axis)
-            errors = step.standard_errors.get(axis, {})
-            for name, value in values.items():
-                if name in effect.counts or isinstance(value, int):
-                    continue
-                if not np.isfinite(errors.get(name, np.nan)):
-                    continue
-                entries.append((step, axis, name, float(value), float(errors.get(name, 0.0))))
+    entries = _entries(result)
 
     def spec_with(vector: np.ndarray) -> mujoco.MjSpec:
-        spec = mujoco.MjSpec.from_string(base_xml)
-        changed: dict[tuple, dict] = {}
-        for (step, axis, name, _, _), value in zip(entries, vector, strict=True):
-            changed.setdefault((step.effect.id, axis), step.effect.values(axis))[name] = float(value)
-        for (effect_id, axis), values in changed.items():
-            get(effect_id).apply(spec, robot, axis, values)
-        return spec
+        return _spec_with(base_xml, robot, entries, vector)
 
     size = int(mask.sum())
 
@@ -223,7 +236,7 @@ def calibrated_from(result, nominal: robots.Robot) -> robots.Robot:
     return nominal
 
 
-# -- inside the calibration: the Stribeck hump refined by sysid (issue 39, item 4) ------------------
+# -- inside the calibration: the Stribeck hump refined by sysid -----------------------------------
 
 #: Most Levenberg-Marquardt iterations of the refinement (:func:`refine_stribeck`).
 REFINE_ITERATIONS = 50

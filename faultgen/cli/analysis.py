@@ -50,6 +50,23 @@ def analysis_input(file: Path, outputs: list[Path], overwrite: bool) -> None:
                          "runs with runs without wear; sweep with --axis 1..6 too")
 
 
+def parse_levels(levels: str) -> list[float]:
+    """``--levels``: wear levels in %, comma-separated, each within 0..500 %.
+
+    Raises
+    ------
+    ValueError
+        Naming the option's value and what was expected.
+    """
+    try:
+        wear_levels = [float(x) for x in levels.split(",")]
+    except ValueError:
+        raise ValueError(f"--levels {levels!r}: expected wear levels in %, comma-separated, e.g. 1,5,10,15") from None
+    if not all(0 < w <= 100 * 5 for w in wear_levels):  # faultgen.operation.wear.MAX_INCREASE
+        raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
+    return wear_levels
+
+
 def training_input(train: Path) -> None:
     """Refuse a ``--train`` dataset that fails validation, before any analysis runs."""
     from faultgen.data import dataset
@@ -59,28 +76,35 @@ def training_input(train: Path) -> None:
         raise ValueError(f"--train {train} fails validation (run `faultgen validate {train}`): {problems[0]}")
 
 
+#: bench-isolators' options.
+SpeedWindow = Annotated[str | None, typer.Option(
+    metavar="LOW,HIGH",
+    help="Average |motor torque| only over samples whose motor speed lies in LOW..HIGH rad/s (thesis ch. "
+         "6.3.2: 50,120); axes that leave the window empty in some cycle keep the whole-cycle mean. Prints "
+         "how the window covers each task's motor speeds.")]
+IsolatorPlugins = Annotated[list[str] | None, typer.Option(
+    "--isolator", metavar="MODULE:CLASS",
+    help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
+         "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
+         "repeat for several. The module is imported and so runs as code: name only modules you trust "
+         "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")]
+TrainBaselineCycles = Annotated[int, typer.Option(help="With --train: the first cycles of each unit its signal is "
+                                                      "centred and scaled by (pca_contribution's reference cycles).",
+                                                 min=2)]
+
+
 @app.command("bench-isolators", cls=Command)
 def bench_isolators_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with runs that wear one axis.")],
     bins: Annotated[list[int] | None, typer.Option("--bins", help="Transfer-entropy bin counts; repeat. Default 5 and 10.", min=2, max=100)] = None,
     levels: Annotated[str, typer.Option(help="Wear levels in %, comma-separated (thesis Table 6.2).")] = "1,5,10,15",
-    speed_window: Annotated[str | None, typer.Option(
-        metavar="LOW,HIGH",
-        help="Average |motor torque| only over samples whose motor speed lies in LOW..HIGH rad/s (thesis ch. "
-             "6.3.2: 50,120); axes that leave the window empty in some cycle keep the whole-cycle mean. Prints "
-             "how the window covers each task's motor speeds.")] = None,
-    plugins: Annotated[list[str] | None, typer.Option(
-        "--isolator", metavar="MODULE:CLASS",
-        help="Also run your own isolator, a scikit-learn estimator setting source_axis_ in fit(X) (see "
-             "analysis.isolation), e.g. mine:MyIsolator for class MyIsolator in mine.py in the current folder; "
-             "repeat for several. The module is imported and so runs as code: name only modules you trust "
-             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
+    speed_window: SpeedWindow = None,
+    plugins: IsolatorPlugins = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-isolation').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
     train: Train = None,
-    baseline: Annotated[int, typer.Option(help="With --train: the first cycles of each unit its signal is centred "
-                                               "and scaled by (pca_contribution's reference cycles).", min=2)] = 20,
+    baseline: TrainBaselineCycles = 20,
 ) -> None:
     """Accuracy of every registered isolator (`faultgen bench baselines`: transfer entropy,
     cross-correlation, Granger, ...) at finding the worn axis, per task and wear level: CSV, Markdown (thesis Table 6.2 layout) and a PNG heatmap.
@@ -96,12 +120,7 @@ def bench_isolators_command(
     from analysis import benchmark
     from analysis import plugins as plugins_
 
-    try:
-        wear_levels = [float(x) for x in levels.split(",")]
-    except ValueError:
-        raise ValueError(f"--levels {levels!r}: expected wear levels in %, comma-separated, e.g. 1,5,10,15") from None
-    if not all(0 < w <= 100 * 5 for w in wear_levels):  # faultgen.operation.wear.MAX_INCREASE
-        raise ValueError(f"--levels {levels!r}: each level must be within 0..500 %")
+    wear_levels = parse_levels(levels)
     stem = out or file.with_name(file.stem + "-isolation")
     confusion_stem = stem.with_name(stem.name + "-confusion")
     written = [stem.with_suffix(".csv"), stem.with_suffix(".md"), stem.with_suffix(".png"),
@@ -125,67 +144,55 @@ def bench_isolators_command(
         confusion = benchmark.isolation_confusion(table)
         csv_cells.escaped(confusion).to_csv(staged(confusion_stem.with_suffix(".csv")))
         benchmark.confusion_figure(confusion, staged(confusion_stem.with_suffix(".png")))
-    if window is not None:
-        typer.echo(f"motor speeds against the window {window[0]:g}-{window[1]:g} rad/s (runs without wear):")
-        typer.echo(benchmark.markdown(benchmark.motor_speed_coverage(file, window), digits=4))
-    imported = bool(table.attrs.get("imported"))
-    if imported:
-        typer.echo("units imported from logs: no wear is measured; each worn unit is one case, its logs up to the "
-                   "first labelled worn by events.csv (\"to first worn\"; --levels does not apply)")
-    accuracy = benchmark.isolation_levels(table, benchmark.isolation_accuracy_text(table))
-    typer.echo(benchmark.markdown(accuracy, digits=4))
-    typer.echo(benchmark.ACCURACY_RULE + " In the CSV, predicted 0 is undecided and -1 too few cycles (column answer "
-               "spells it; needed: the isolator's fewest cycles).")
-    typer.echo("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few cycles):")
-    typer.echo(benchmark.markdown(benchmark.isolation_levels(table, benchmark.isolation_decided(table)), digits=4))
-    starved = benchmark.starved_isolators(table)
-    if starved and imported:
-        typer.echo(f"note: this dataset lacks logs: with at most {int(table['cycles'].max())} logs per unit up to its "
-                   f"first labelled worn, {', '.join(starved)} named no axis (undecided, or too few logs to run) in "
-                   "most worn cases. These isolators need tens of records (thesis Table 6.2: up to 86) before the "
-                   f"first worn one: longer records of the units; {benchmark.MEASURED_NEXT}")
-    elif starved:
-        typer.echo(f"note: this dataset lacks cycles: with at most {int(table['cycles'].max())} recorded cycles per "
-                   f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
-                   "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
-                   "use `faultgen sweep --preset j2`, or --record with more cycles")
+    typer.echo(benchmark.isolation_report(table, file, window))
     typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+#: detect's options.
+DetectProtocol = Annotated[str, typer.Option(
+    help="Where the monitor learns normal operation: other-seeds (runs without wear of the other seeds: other "
+         "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
+         "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (on a fleet "
+         "first-cycles, each robot its own first days; on a sweep other-seeds where the dataset has several "
+         "seeds, else first-cycles where runs are longer than --first, else same-run). The protocol used and "
+         "why is printed.")]
+FirstSamples = Annotated[int | None, typer.Option(
+    help="Samples the first-cycles protocol learns from. Default: 20, or the first half of a run of 20 samples "
+         "or fewer (a 20-day fleet learns its first 10 days).", min=1, max=MAX_SAMPLES, show_default=False)]
+DetectVariance = Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)]
+DetectLimitFolds = Annotated[int, typer.Option(
+    help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
+         "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
+         "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0, max=MAX_FOLDS)]
+Persistence = Annotated[
+    int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
+                      "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1, max=MAX_SAMPLES)
+]
+Period = Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1, max=MAX_CYCLES)]
+DetectorPlugin = Annotated[str | None, typer.Option(
+    "--detector", metavar="MODULE:CLASS",
+    help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
+         "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
+         "current folder). The module is imported and so runs as code: name only modules you trust "
+         "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")]
+DetectorBaseline = Annotated[str | None, typer.Option(
+    help=f"A named detector instead of the PCA monitor: {', '.join(baselines.healthy_detectors())} (`faultgen "
+         "bench baselines`; the classifiers learn labels, so only `bench score` takes them). --variance and "
+         "--alpha are then unused.")]
 
 
 @app.command("detect", cls=Command)
 def detect_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
-    protocol: Annotated[str, typer.Option(
-        help="Where the monitor learns normal operation: other-seeds (runs without wear of the other seeds: other "
-             "units), first-cycles (the first --first samples of the tested run: its first days, thesis ch. 4), "
-             "same-run (the run without wear of the same seed: thesis ch. 3, optimistic) or auto (on a fleet "
-             "first-cycles, each robot its own first days; on a sweep other-seeds where the dataset has several "
-             "seeds, else first-cycles where runs are longer than --first, else same-run). The protocol used and "
-             "why is printed.")] = "auto",
-    first: Annotated[int | None, typer.Option(
-        help="Samples the first-cycles protocol learns from. Default: 20, or the first half of a run of 20 samples "
-             "or fewer (a 20-day fleet learns its first 10 days).", min=1, max=MAX_SAMPLES, show_default=False)] = None,
-    variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.75).", min=0.0, max=1.0)] = 0.75,
+    protocol: DetectProtocol = "auto",
+    first: FirstSamples = None,
+    variance: DetectVariance = 0.75,
     alpha: QAlpha = 0.05,
-    limit_folds: Annotated[int, typer.Option(
-        help="Folds over which the Q limit is estimated out of sample under other-seeds and first-cycles: a limit "
-             "from the training samples alone (0; the thesis's eq. 2.6) alarms on more than ALPHA of new healthy "
-             "data (j2, three seeds: 9.0 % at 5 %; 20 folds: 6.2 %). same-run always uses the thesis's limit.", min=0, max=MAX_FOLDS)] = 20,
-    persistence: Annotated[
-        int, typer.Option(help="Samples in a row above the limit to call an onset. 1 is the thesis's rule, but a 95 % "
-                          "limit is then crossed by 5 % of normal samples, so long runs always alarm early.", min=1, max=MAX_SAMPLES)
-    ] = 3,
-    period: Annotated[int | None, typer.Option(help="Average the histograms of each PERIOD cycles into one sample (60: hours of one-minute cycles, c2).", min=1, max=MAX_CYCLES)] = None,
-    plugin: Annotated[str | None, typer.Option(
-        "--detector", metavar="MODULE:CLASS",
-        help="Your own detector instead of the PCA monitor: a scikit-learn estimator whose fit(X) learns healthy "
-             "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
-             "current folder). The module is imported and so runs as code: name only modules you trust "
-             "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")] = None,
-    baseline: Annotated[str | None, typer.Option(
-        help=f"A named detector instead of the PCA monitor: {', '.join(baselines.healthy_detectors())} (`faultgen "
-             "bench baselines`; the classifiers learn labels, so only `bench score` takes them). --variance and "
-             "--alpha are then unused.")] = None,
+    limit_folds: DetectLimitFolds = 20,
+    persistence: Persistence = 3,
+    period: Period = None,
+    plugin: DetectorPlugin = None,
+    baseline: DetectorBaseline = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -243,17 +250,15 @@ def detect_command(
         benchmark.write_outputs(table, staged(stem))
         csv_cells.escaped(summary).to_csv(staged(summary_csv))
         benchmark.detection_figure(charts, staged(stem.with_suffix(".png")))
-    typer.echo(benchmark.markdown(table, digits=4))
-    typer.echo("\n".join(f"  {name}: {meaning}" for name, meaning in benchmark.detection_columns(table).items()))
-    left_out = int(table["trained_on_fault"].sum()) if "trained_on_fault" in table else 0
-    rests = (f"of {len(table) - left_out} of {len(table)} runs: {left_out} left out, their monitor learned the fault; "
-             if left_out else "")
-    typer.echo(f"\nsummary ({rests}false_alarm_pct, %: {benchmark.false_alarm_meaning(table['protocol'])}):")
-    typer.echo(benchmark.markdown(summary, digits=4))
-    advice = benchmark.detection_advice(table, protocol)
-    if advice:
-        typer.echo(advice)
+    typer.echo(benchmark.detection_text(table, summary, protocol))
     typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+#: training-source's option.
+StudyLimitFolds = Annotated[int, typer.Option(
+    help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
+         "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
+         "many as the training days.", min=0, max=MAX_FOLDS)]
 
 
 @app.command("training-source", cls=Command)
@@ -264,10 +269,7 @@ def training_source_command(
     gap_days: Annotated[int, typer.Option(help="Last days left out, the failure day included (thesis: 5).", min=0, max=MAX_DAYS)] = 5,
     variance: Annotated[float, typer.Option(help="Explained variance that sets the PCA components (thesis: 0.90).", min=0.0, max=1.0)] = 0.90,
     alpha: QAlpha = 0.05,
-    limit_folds: Annotated[int, typer.Option(
-        help="Folds over which the Q limit is estimated out of sample; 0: from the training days alone, the "
-             "thesis's eq. 2.6, which alarms on most test days of normal robots when the features are nearly as "
-             "many as the training days.", min=0, max=MAX_FOLDS)] = 20,
+    limit_folds: StudyLimitFolds = 20,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-training-source').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -286,7 +288,6 @@ def training_source_command(
     \b
       faultgen fleet -o fleet.h5 && faultgen training-source fleet.h5 -o fleet-ch4
     """
-    from analysis import benchmark
     from analysis import training_source as ts
 
     stem = out or file.with_name(file.stem + "-training-source")
@@ -299,35 +300,9 @@ def training_source_command(
     window = ts.Window(training_days, test_days, gap_days)
     cases = ts.study(file, window, variance=variance, alpha=alpha, limit_folds=limit_folds or None,
                      progress=progress, train=train)
-    protocol = ("protocol: OTO, own history (each robot its own training days); OTM, "
-                + (f"another dataset (each normal robot of {train} of the same model)" if train is not None
-                   else "other robots of this dataset (each normal robot of the same model)"))
-    parts = [protocol,
-             "Design (thesis Table 4.1), test cases:\n\n" + benchmark.markdown(ts.design(cases)),
-             "Descriptors of the Q residual over the test days, mean and standard error:\n\n"
-             + benchmark.markdown(ts.group_means(cases)),
-             "Normal robots never fail: their days above the limit are false alarms (nsat) and their lead_time_days "
-             "only how early the first false alarm came. Per training source and signal, their false-alarm share "
-             "of the test days and the cases whose limit is saturated (every test day above it):\n\n"
-             + benchmark.markdown(ts.normal_false_alarms(cases))]
-    saturated = cases[cases["saturated"] & (cases["condition"] == "normal")]
-    if len(saturated):
-        parts.append(f"Note: the limit is saturated in {len(saturated)} of {int((cases['condition'] == 'normal').sum())} "
-                     "normal-robot cases (all their test days above it: "
-                     + ", ".join(f"{s} {k}: {n}" for (s, k), n in saturated.groupby(["source", "signal"]).size().items())
-                     + "); there the model does not describe the robot, and a failing robot's alarms in the same "
-                     "cell say nothing about its fault")
-    anova = tukey = None
-    try:
-        anova, tukey = ts.anova(cases), ts.tukey(cases)
-    except ValueError as err:  # an empty cell: the cases and means stand, the tests cannot be run
-        parts.append(f"No ANOVA or Tukey HSD: {err}")
+    text, anova, tukey = ts.report(cases, train)
+    if tukey is None:  # an empty cell: the cases and means stand, the tests cannot be run
         del paths["anova"], paths["tukey"]
-    else:
-        parts += ["Three-way ANOVA, type III (thesis Tables 4.2-4.4):\n\n" + benchmark.markdown(anova),
-                  "Tukey HSD, failure against normal robots per training source and signal type (the starred bars "
-                  "of thesis Figs. 4-4 to 4-6):\n\n" + benchmark.markdown(ts.failure_vs_normal(tukey))]
-    text = "\n\n".join(parts)
     with atomic.output_set(paths.values()) as staged:  # all outputs, or none
         if tukey is not None:
             csv_cells.escaped(anova).to_csv(staged(paths["anova"]), index=False)
@@ -339,45 +314,60 @@ def training_source_command(
     typer.echo("wrote " + ", ".join(map(str, paths.values())))
 
 
+#: classify's options.
+WearThreshold = Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0, max=500.0)]
+Pairs = Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all (refused when there are more than 100000).", min=0, max=MAX_PAIRS)]
+Horizon = Annotated[int | None, typer.Option(
+    help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
+    "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
+    "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0, max=MAX_DAYS)]
+MatchedDays = Annotated[bool, typer.Option(
+    "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
+    "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
+    "wear put a failing robot's failed days last, so whatever drifts along a record (season, the indicators "
+    "settling) scores without any fault; matched it cannot. No change with --horizon.")]
+Permutations = Annotated[int, typer.Option(
+    help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
+    "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
+    "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0, max=MAX_PERMUTATIONS)]
+Classifiers = Annotated[list[str] | None, typer.Option(
+    "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")]
+Preprocessings = Annotated[list[str] | None, typer.Option(
+    "--preprocessing", help="Only this row of Table 5.2 (control, +diff, +estM+diff+var3+pca, ...); repeat for "
+    "several. Default: see --full.")]
+FullTable = Annotated[bool, typer.Option(
+    "--full", help="Every row: Table 5.2's fifteen and four more (+var5, +diff+var3, +diff+var5+pca, "
+    "+estM+diff+var5+pca), 2 to 3 times the time. Default seven rows, each step alone and the fullest "
+    "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")]
+ClassifySeed = Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.", min=0, max=MAX_SEED)]
+Chance = Annotated[bool, typer.Option(
+    help="Without --permutations, measure each row's chance level on lr (19 label exchanges, about half the "
+    "default table's time again) and judge every cell against it: columns chance, p and above_chance, and a "
+    "verdict line. --no-chance: not measured, no verdict.")]
+PairJobs = Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0, max=1024)]
+TrainBaselineRecords = Annotated[int, typer.Option(help="With --train: the first records of each unit its features "
+                                                       "are centred and scaled by.", min=2)]
+
+
 @app.command("classify", cls=Command)
 def classify_command(
     file: Annotated[Path, typer.Argument(help="A faultgen dataset with worn runs and runs without wear.")],
-    wear_threshold: Annotated[float, typer.Option(help="A cycle is 'failed' when its true wear is at least this, %.", min=0.0, max=500.0)] = 10.0,
-    pairs: Annotated[int, typer.Option(help="Worn/unworn run pairs left out (Procedure 1); 0 = all (refused when there are more than 100000).", min=0, max=MAX_PAIRS)] = 20,
-    horizon: Annotated[int | None, typer.Option(
-        help="The thesis's protocol (ch. 5.3.3): keep each run's samples from HORIZON + 10 to HORIZON before its "
-        "last (T-13 to T-3 for 3; T the failure day of a failing robot), labelled by the robot's state, failing or "
-        "healthy, instead of by --wear-threshold. Table 5.2 used 3.", min=0, max=MAX_DAYS)] = None,
-    matched_days: Annotated[bool, typer.Option(
-        "--matched-days", help="A time control: rank a failing run's failed samples only against the healthy run's "
-        "samples at the same positions in its record (same day of the record), not against earlier days. Labels by "
-        "wear put a failing robot's failed days last, so whatever drifts along a record (season, the indicators "
-        "settling) scores without any fault; matched it cannot. No change with --horizon.")] = False,
-    permutations: Annotated[int, typer.Option(
-        help="Also the chance level of each cell on these robots: the AUC again with the runs' labels exchanged "
-        "this many times (columns 'null', their mean, and 'p', the permutation p-value of the AUC). Each costs as "
-        "much as the table: choose cells with --classifier/--preprocessing. 0 = none.", min=0, max=MAX_PERMUTATIONS)] = 0,
-    classifiers: Annotated[list[str] | None, typer.Option(
-        "--classifier", help="Only this classifier (lr, svm, rf, stacking); repeat for several. Default all.")] = None,
-    preprocessing: Annotated[list[str] | None, typer.Option(
-        "--preprocessing", help="Only this row of Table 5.2 (control, +diff, +estM+diff+var3+pca, ...); repeat for "
-        "several. Default: see --full.")] = None,
-    full: Annotated[bool, typer.Option(
-        "--full", help="Every row: Table 5.2's fifteen and four more (+var5, +diff+var3, +diff+var5+pca, "
-        "+estM+diff+var5+pca), 2 to 3 times the time. Default seven rows, each step alone and the fullest "
-        "combinations: control, +estM, +diff, +pca, +var3, +diff+var3+pca, +estM+diff+var3+pca.")] = False,
-    seed: Annotated[int, typer.Option(help="Seed for the choice of pairs, the permutations and the random forest.", min=0, max=MAX_SEED)] = 0,
-    chance: Annotated[bool, typer.Option(
-        help="Without --permutations, measure each row's chance level on lr (19 label exchanges, about half the "
-        "default table's time again) and judge every cell against it: columns chance, p and above_chance, and a "
-        "verdict line. --no-chance: not measured, no verdict.")] = True,
-    jobs: Annotated[int, typer.Option(help="Held-out pairs fitted in parallel (processes); 0: one per core.", min=0, max=1024)] = 0,
+    wear_threshold: WearThreshold = 10.0,
+    pairs: Pairs = 20,
+    horizon: Horizon = None,
+    matched_days: MatchedDays = False,
+    permutations: Permutations = 0,
+    classifiers: Classifiers = None,
+    preprocessing: Preprocessings = None,
+    full: FullTable = False,
+    seed: ClassifySeed = 0,
+    chance: Chance = True,
+    jobs: PairJobs = 0,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-classification').")] = None,
     overwrite: Overwrite = False,
     progress: Progress = True,
     train: Train = None,
-    baseline: Annotated[int, typer.Option(help="With --train: the first records of each unit its features are "
-                                               "centred and scaled by.", min=2)] = 5,
+    baseline: TrainBaselineRecords = 5,
 ) -> None:
     """AUC of LR, SVM, RF and stacking per preprocessing combination, thesis Table 5.2 layout.
 
@@ -414,52 +404,55 @@ def classify_command(
       faultgen classify fleet.h5 --classifier lr --preprocessing control --preprocessing +diff --permutations 19 -o fleet-lr
       faultgen classify fleet.h5 --matched-days --classifier lr --preprocessing +diff --permutations 19 -o fleet-matched
     """
-    import shlex
-
     from analysis import benchmark
 
-    cells = {"classifiers": classifiers} if classifiers else {}
-    if preprocessing:
-        cells["preprocessing"] = preprocessing
     stem = out or file.with_name(file.stem + "-classification")
-    analysis_input(file, [stem.with_suffix(s) for s in (".csv", ".md", ".png")], overwrite)
+    written = [stem.with_suffix(s) for s in (".csv", ".md", ".png")]
+    analysis_input(file, written, overwrite)
     if train is not None:  # fitted on another dataset, scored on FILE (analysis.crossdata)
-        from analysis import crossdata
-
-        if horizon is not None or matched_days:
-            raise ValueError("--train labels FILE's samples by --wear-threshold; drop --horizon and --matched-days")
-        training_input(train)
-        table = crossdata.classification_across(
-            file, train, wear_threshold=wear_threshold, baseline=baseline, random_state=seed, progress=progress,
-            permutations=permutations or 19, **({"classifiers": classifiers} if classifiers else {}),
-            preprocessing=preprocessing or None)
-        text = (benchmark.markdown(table, digits=3) + f"\n\nprotocol: {table.attrs['protocol']}. auc: the samples of "
-                f"{file} ranked by a model fitted on {train}; null: its mean over label sets with the tested runs' roles "
-                "exchanged (the chance level on these robots); p: the permutation p-value.")
-        csv_cells.escaped(table).to_csv(stem.with_suffix(".csv"))
-        stem.with_suffix(".md").write_text(text + "\n")
-        typer.echo(text)
-        typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md")))
+        classify_on_other(file, train, stem, wear_threshold, baseline, seed, progress, permutations, classifiers,
+                          preprocessing, horizon, matched_days)
         return
+    cells = {k: v for k, v in (("classifiers", classifiers), ("preprocessing", preprocessing)) if v}
     table = benchmark.classification_table(
         file, wear_threshold=wear_threshold, n_pairs=pairs or None, random_state=seed, progress=progress,
         horizon=horizon, permutations=permutations, matched=matched_days, chance=chance, n_jobs=jobs or -1,
         short=not full, **cells)
-    command = " ".join(["faultgen classify", shlex.quote(str(file)), *([f"--horizon {horizon}"] if horizon is not None else []),
-                        *(["--matched-days"] if matched_days else []), *(["--pairs", str(pairs)] if pairs != 20 else []),
-                        *(["--full"] if full else []),
-                        *(f"--classifier {c}" for c in classifiers or []),
-                        *(f"--preprocessing {shlex.quote(p)}" for p in preprocessing or [])])
-    caption = benchmark.classification_caption(table, n_pairs=pairs or None, horizon=horizon,
-                                               wear_threshold=wear_threshold, matched=matched_days,
-                                               command=command, short=not (full or preprocessing))
-    text = (benchmark.markdown(benchmark.classification_printed(table), digits=3) + "\n\n" + caption + "\n\n"
-            + benchmark.classification_verdict(table, command))
-    with atomic.output_set([stem.with_suffix(s) for s in (".csv", ".md", ".png")]) as staged:  # all, or none
+    text = benchmark.classification_text(table, file, pairs=pairs, horizon=horizon, wear_threshold=wear_threshold,
+                                         matched=matched_days, full=full, **cells)
+    with atomic.output_set(written) as staged:  # all, or none
         csv_cells.escaped(benchmark.classification_tidy(table)).to_csv(staged(stem.with_suffix(".csv")), index=False)
         staged(stem.with_suffix(".md")).write_text(text + "\n")
         benchmark.classification_heatmap(table, staged(stem.with_suffix(".png")))
     typer.echo(text)
     typer.echo(f"protocol: units of {file} itself (each pair of held-out runs scored by a model of the others; "
                "--train OTHER.h5 learns from another dataset)")
-    typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md", ".png")))
+    typer.echo("wrote " + ", ".join(map(str, written)))
+
+
+def classify_on_other(file: Path, train: Path, stem: Path, wear_threshold: float, baseline: int, seed: int,
+                      progress: bool, permutations: int, classifiers: list[str] | None,
+                      preprocessing: list[str] | None, horizon: int | None, matched_days: bool) -> None:
+    """``classify --train OTHER``: the classifiers fitted on ``train``, scored on ``file``'s samples
+    labelled by ``wear_threshold`` (:func:`analysis.crossdata.classification_across`); writes
+    STEM.csv and STEM.md.
+
+    Raises
+    ------
+    ValueError
+        With ``horizon`` or ``matched_days`` (another protocol), or a ``train`` that fails validation.
+    """
+    from analysis import benchmark, crossdata
+
+    if horizon is not None or matched_days:
+        raise ValueError("--train labels FILE's samples by --wear-threshold; drop --horizon and --matched-days")
+    training_input(train)
+    table = crossdata.classification_across(
+        file, train, wear_threshold=wear_threshold, baseline=baseline, random_state=seed, progress=progress,
+        permutations=permutations or 19, **({"classifiers": classifiers} if classifiers else {}),
+        preprocessing=preprocessing or None)
+    text = benchmark.classification_across_text(table, file, train)
+    csv_cells.escaped(table).to_csv(stem.with_suffix(".csv"))
+    stem.with_suffix(".md").write_text(text + "\n")
+    typer.echo(text)
+    typer.echo("wrote " + ", ".join(str(stem.with_suffix(s)) for s in (".csv", ".md")))

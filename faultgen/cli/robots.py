@@ -20,39 +20,48 @@ from faultgen.operation import taskgen
 MAX_PAYLOAD = 10_000.0
 
 
+#: The options of `faultgen robots` and `robots add`.
+RobotOrAdd = Annotated[
+    str | None,
+    typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) "
+                        "instead of the list; or `add` to add a robot."),
+]
+AddSource = Annotated[
+    Path | None,
+    typer.Option("--from", help="With `add`: the arm, a URDF, xacro, plain MJCF or DH table (.toml)."),
+]
+AddDrivetrain = Annotated[
+    Path | None,
+    typer.Option(help="With `add`: a drivetrain.toml with some or all drivetrain numbers; the rest are "
+                      "sized."),
+]
+AddPayload = Annotated[
+    float | None,
+    typer.Option(help="With `add`: rated payload in kg, 0..10000 (the datasheet's; the largest industrial arms "
+                      "carry about 2300). The drives are sized to hold and accelerate it; default: the "
+                      "source's, else guessed as 15 % of the moving mass (said as a guess).",
+                 min=0.0, max=MAX_PAYLOAD),
+]
+AddOut = Annotated[
+    Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
+]
+AddPackages = Annotated[
+    list[str] | None,
+    typer.Option(help="With `add`: NAME=DIR, the folder of ROS package NAME, for `package://NAME/...` "
+                      "meshes and xacro's `$(find NAME)` (repeatable). The source reads only its own "
+                      "folder and these."),
+]
+
+
 @app.command("robots", cls=Command)
 def robots_command(
-    name: Annotated[
-        str | None,
-        typer.Argument(help="Show the nominal parameters of this robot (name, robot folder or MJCF file) "
-                            "instead of the list; or `add` to add a robot."),
-    ] = None,
+    name: RobotOrAdd = None,
     new_name: Annotated[str | None, typer.Argument(help="With `add`: the new robot's name.")] = None,
-    source: Annotated[
-        Path | None,
-        typer.Option("--from", help="With `add`: the arm, a URDF, xacro, plain MJCF or DH table (.toml)."),
-    ] = None,
-    drivetrain: Annotated[
-        Path | None,
-        typer.Option(help="With `add`: a drivetrain.toml with some or all drivetrain numbers; the rest are "
-                          "sized."),
-    ] = None,
-    payload: Annotated[
-        float | None,
-        typer.Option(help="With `add`: rated payload in kg, 0..10000 (the datasheet's; the largest industrial arms "
-                          "carry about 2300). The drives are sized to hold and accelerate it; default: the "
-                          "source's, else guessed as 15 % of the moving mass (said as a guess).",
-                     min=0.0, max=MAX_PAYLOAD),
-    ] = None,
-    out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="With `add`: the robot folder to write (new).")
-    ] = None,
-    package: Annotated[
-        list[str] | None,
-        typer.Option(help="With `add`: NAME=DIR, the folder of ROS package NAME, for `package://NAME/...` "
-                          "meshes and xacro's `$(find NAME)` (repeatable). The source reads only its own "
-                          "folder and these."),
-    ] = None,
+    source: AddSource = None,
+    drivetrain: AddDrivetrain = None,
+    payload: AddPayload = None,
+    out: AddOut = None,
+    package: AddPackages = None,
 ) -> None:
     """List the robot models, show one model's nominal parameters, or add a robot from an arm file.
 
@@ -75,13 +84,7 @@ def robots_command(
         if new_name is None or source is None or out is None:
             raise ValueError("robots add needs NAME, --from FILE and -o DIR, e.g. "
                              "faultgen robots add kr210 --from kr210l150.urdf -o kr210")
-        packages = {}
-        for item in package or []:
-            key, sep, value = item.partition("=")
-            if not sep or not key or not value:
-                raise ValueError(f"--package {item!r}; expected NAME=DIR, e.g. "
-                                 "--package kuka_kr210_support=kuka_kr210")
-            packages[key] = Path(value)
+        packages = parse_packages(package or [])
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", importers.GeometryDropped)
             added = folder.add(new_name, source, out, drivetrain=drivetrain, payload=payload,
@@ -110,6 +113,24 @@ def robots_command(
             typer.echo(f"{robot_name:<{width}}  {robot.description}")
         return
     typer.echo(describe(robots.load(name)))
+
+
+def parse_packages(items: list[str]) -> dict[str, Path]:
+    """``--package NAME=DIR`` options: ROS package name -> its folder.
+
+    Raises
+    ------
+    ValueError
+        Naming an item that is not NAME=DIR.
+    """
+    packages = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key or not value:
+            raise ValueError(f"--package {item!r}; expected NAME=DIR, e.g. "
+                             "--package kuka_kr210_support=kuka_kr210")
+        packages[key] = Path(value)
+    return packages
 
 
 def describe(robot: robots.Robot) -> str:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import shlex
 import sys
 from pathlib import Path
@@ -21,40 +20,54 @@ from faultgen.cli.options import (
 )
 
 
+#: simulate's options.
+RunRobot = Annotated[str, typer.Option(
+    "--robot", "--model",
+    help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
+    "model `faultgen calibrate` wrote.")]
+RunTask = Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3), a program file (.toml, `faultgen tasks`) or a joint log to replay (.csv with t, q1..qN in rad, or a log in another --format).")]
+WearSpecs = Annotated[
+    list[str] | None,
+    typer.Option(
+        help="A worn axis as AXIS:KIND:PERCENT[:key=value], e.g. 2:exp4:20 (20 % more Coulomb and static "
+        "friction on axis 2 by the last cycle, thesis eq. 6.6). KIND: exp4, logistic, linear, step. Repeat "
+        "for several axes. No --wear: no wear."
+    ),
+]
+RunCycles = Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.", min=1, max=MAX_CYCLES)]
+RecordCycles = Annotated[
+    str | None,
+    typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
+]
+RunSeed = Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.", min=0, max=MAX_SEED)]
+Disturbance = Annotated[
+    float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).", min=0.0, max=1.0)
+]
+EncoderNoise = Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).", min=0.0, max=0.1)]
+SteppingThreads = Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.", min=0, max=1024)]
+RunFault = Annotated[str | None, typer.Option(
+    help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
+    "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
+    "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
+    "warm-up, nor the motor friction and its parts coulomb, viscous, stribeck: their fault is --wear).")]
+RunOut = Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")]
+
+
 @app.command("simulate", cls=Command)
 def simulate_command(
-    robot: Annotated[str, typer.Option(
-        "--robot", "--model",
-        help="Robot name (see `faultgen robots`), robot folder (from `faultgen robots add`) or MJCF file, e.g. the "
-        "model `faultgen calibrate` wrote.")] = "irb6700",
-    task: Annotated[str, typer.Option(help="pick_place, spot_weld or arc_weld (thesis ch. 6.3.1 tasks 1-3), a program file (.toml, `faultgen tasks`) or a joint log to replay (.csv with t, q1..qN in rad, or a log in another --format).")] = "pick_place",
+    robot: RunRobot = "irb6700",
+    task: RunTask = "pick_place",
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     friction_model: Friction = "lugre",
-    wear: Annotated[
-        list[str] | None,
-        typer.Option(
-            help="A worn axis as AXIS:KIND:PERCENT[:key=value], e.g. 2:exp4:20 (20 % more Coulomb and static "
-            "friction on axis 2 by the last cycle, thesis eq. 6.6). KIND: exp4, logistic, linear, step. Repeat "
-            "for several axes. No --wear: no wear."
-        ),
-    ] = None,
-    cycles: Annotated[int, typer.Option(help="Cycles in the run; wear schedules reach PERCENT at the last one.", min=1, max=MAX_CYCLES)] = 100,
-    record: Annotated[
-        str | None,
-        typer.Option(help="Cycles to simulate and record, e.g. '1,50,100' or '90-100'. Default: all."),
-    ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the disturbance and encoder noise.", min=0, max=MAX_SEED)] = 0,
-    disturbance: Annotated[
-        float, typer.Option(help="Load disturbance std as a fraction of mean |torque| per axis (thesis ch. 3.3.2).", min=0.0, max=1.0)
-    ] = 0.01,
-    encoder_noise: Annotated[float, typer.Option(help="Encoder noise std, rad (thesis ch. 3.3.2).", min=0.0, max=0.1)] = 1e-4,
-    threads: Annotated[int, typer.Option(help="Threads for stepping; 0 uses all CPUs.", min=0, max=1024)] = 0,
-    fault: Annotated[str | None, typer.Option(
-        help="A fault other than friction wear, growing to FINAL by the last cycle: EFFECT:AXIS:PARAMETER:FINAL"
-        "[:key=value,...], e.g. backlash:2:width:0.01 (a 10 mrad dead band on axis 2) or "
-        "cogging:3:amplitude:0.05:poles=8,kind=exp4. Effects: faultgen.effects (not payload, load friction, "
-        "warm-up, nor the motor friction and its parts coulomb, viscous, stribeck: their fault is --wear).")] = None,
+    wear: WearSpecs = None,
+    cycles: RunCycles = 100,
+    record: RecordCycles = None,
+    seed: RunSeed = 0,
+    disturbance: Disturbance = 0.01,
+    encoder_noise: EncoderNoise = 1e-4,
+    threads: SteppingThreads = 0,
+    fault: RunFault = None,
     temperature: Temperature = False,
     dry_share: DryShare = None,
     payloads: PayloadParts = None,
@@ -63,7 +76,7 @@ def simulate_command(
     gear_loss: GearLoss = 0.0,
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
-    out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 file to write.")] = Path("run.h5"),
+    out: RunOut = Path("run.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
 ) -> None:
@@ -130,28 +143,48 @@ def saturation_warning(saturated, task: str, replayed: bool = False) -> str:
     return text
 
 
+#: sweep's options (its grid's fields).
+Preset = Annotated[
+    str | None, typer.Option(help="A named grid: quick (a first look, 21 runs; its time: docs/performance.md), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
+]
+GridConfig = Annotated[
+    Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
+]
+GridRobots = Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")]
+GridTasks = Annotated[list[str] | None, typer.Option("--task", help="Task(s): a thesis task name, a program file (.toml) or a joint log (.csv); repeat for several.")]
+GridAxes = Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.", min=0, max=7)]
+GridWear = Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.", min=0.0, max=500.0)]
+GridSchedules = Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")]
+GridCycles = Annotated[int | None, typer.Option(help="Cycles per run.", min=1, max=MAX_CYCLES)]
+GridRecord = Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")]
+GridSeeds = Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.", min=0, max=MAX_SEED)]
+GridFault = Annotated[str | None, typer.Option(
+    help="Instead of friction wear, a fault (the form of `simulate --fault`): EFFECT:AXIS:PARAMETER:FINAL"
+    "[:key=value,...], AXIS 'each' for every worn axis in turn (e.g. backlash:each:width:0.01 with --axis 0 "
+    "--axis 2 --axis 3) or a number (backlash:2:width:0.01: with no --axis, the grid is the run without wear "
+    "and axis 2).")]
+FeaturesOnly = Annotated[bool | None, typer.Option(
+    "--features-only/--signals", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a "
+    "fraction of the size; detect and classify give the same tables, only bench-isolators --speed-window needs "
+    "the signals), or keep the signals. Default: the preset's (c2: features only), else signals.",
+    show_default=False)]
+SweepOut = Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")]
+
+
 @app.command("sweep", cls=Command)
 def sweep_command(
-    preset: Annotated[
-        str | None, typer.Option(help="A named grid: quick (a first look, 21 runs; its time: docs/performance.md), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
-    ] = None,
-    config: Annotated[
-        Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
-    ] = None,
-    robots_: Annotated[list[str] | None, typer.Option("--robot", help="Robot(s): names, robot folders or MJCF files; repeat for several.")] = None,
-    tasks_: Annotated[list[str] | None, typer.Option("--task", help="Task(s): a thesis task name, a program file (.toml) or a joint log (.csv); repeat for several.")] = None,
-    axes: Annotated[list[int] | None, typer.Option("--axis", help="Worn axis 1..N (N the robot's axes), or 0 for a run without wear; repeat.", min=0, max=7)] = None,
-    increases: Annotated[list[float] | None, typer.Option("--wear-pct", help="Final wear in %; repeat.", min=0.0, max=500.0)] = None,
-    schedules: Annotated[list[str] | None, typer.Option("--schedule", help="exp4, logistic, linear or step; repeat.")] = None,
+    preset: Preset = None,
+    config: GridConfig = None,
+    robots_: GridRobots = None,
+    tasks_: GridTasks = None,
+    axes: GridAxes = None,
+    increases: GridWear = None,
+    schedules: GridSchedules = None,
     friction_model: Friction = None,
-    cycles: Annotated[int | None, typer.Option(help="Cycles per run.", min=1, max=MAX_CYCLES)] = None,
-    record: Annotated[str | None, typer.Option(help="Cycles to record, e.g. '1,50,100' or '90-100'. Default: all.")] = None,
-    seeds: Annotated[list[int] | None, typer.Option("--seed", help="Seed(s); repeat.", min=0, max=MAX_SEED)] = None,
-    fault: Annotated[str | None, typer.Option(
-        help="Instead of friction wear, a fault (the form of `simulate --fault`): EFFECT:AXIS:PARAMETER:FINAL"
-        "[:key=value,...], AXIS 'each' for every worn axis in turn (e.g. backlash:each:width:0.01 with --axis 0 "
-        "--axis 2 --axis 3) or a number (backlash:2:width:0.01: with no --axis, the grid is the run without wear "
-        "and axis 2).")] = None,
+    cycles: GridCycles = None,
+    record: GridRecord = None,
+    seeds: GridSeeds = None,
+    fault: GridFault = None,
     temperature: Temperature = False,
     dry_share: DryShare = None,
     payloads: PayloadParts = None,
@@ -162,16 +195,12 @@ def sweep_command(
     task_pattern: TaskMixPattern = "alternate",
     cycles_per_day: CyclesPerDay = 1,
     start_day: StartDay = 0.0,
-    features_only: Annotated[bool | None, typer.Option(
-        "--features-only/--signals", help="Keep only the per-cycle features and truth, not the 250 Hz signals (a "
-        "fraction of the size; detect and classify give the same tables, only bench-isolators --speed-window needs "
-        "the signals), or keep the signals. Default: the preset's (c2: features only), else signals.",
-        show_default=False)] = None,
+    features_only: FeaturesOnly = None,
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
     backend: Backend = None,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("sweep.h5"),
+    out: SweepOut = Path("sweep.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
 ) -> None:
@@ -193,8 +222,7 @@ def sweep_command(
     from faultgen.runs import sweep
 
     options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
-               "friction": friction_model, "cycles": cycles, "seeds": seeds,
-               "record": record}
+               "friction": friction_model, "cycles": cycles, "seeds": seeds, "record": record}
     options = {k: v for k, v in options.items() if v is not None}  # every option given, whatever its value
     made = conditions_from_options(temperature, payloads, payload_pattern, unit_spread, cycles_per_day, start_day,
                                    task_mix, task_pattern, gear_loss, dry_share)
@@ -203,19 +231,10 @@ def sweep_command(
     if features_only is not None:
         options["signals"] = not features_only
     if fault is not None:
-        options["fault"] = spec = faults.FaultSpec.parse(fault)  # parsed once, here
-        if spec.axis is not None and axes is None:  # a fault on a named axis: beside the run without wear
-            options["axes"] = [0, spec.axis]
+        options["fault"] = faults.FaultSpec.parse(fault)  # parsed once, here
     if record is not None:
         options["record"] = list(parse_cycles(record))
-    if config is not None:
-        grid = sweep.Grid.from_toml(config)
-        if options:
-            grid = dataclasses.replace(grid, **options)
-    elif preset is not None:
-        grid = sweep.Grid.from_preset(preset, **options)
-    else:
-        grid = sweep.Grid(**{"robots": ["irb6700"], "tasks": ["pick_place"], "axes": [0], **options})
+    grid = sweep.Grid.of(preset, config, **options)
     if jobs < 1:
         raise ValueError(f"--jobs {jobs}: expected >= 1")
     check_outputs([out], overwrite)
@@ -234,53 +253,70 @@ def sweep_command(
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
 
+#: fleet's options.
+FleetSize = Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).", min=2, max=10000)]
+Failing = Annotated[int | None, typer.Option(
+    help="Of them, robots whose gearbox fails (thesis: 13 of 26). Default: half of --robots, rounded down.",
+    min=1, max=10000, show_default=False)]
+FleetModels = Annotated[list[str] | None, typer.Option(
+    "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
+    "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
+    "fault whose FINAL suits only it. Parts are sized from each model's rated payload (docs/simulation.md).")]
+FleetDays = Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.", min=6, max=3650)]
+FleetCyclesPerDay = Annotated[int, typer.Option(
+    help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).", min=1, max=24)]
+FailureWear = Annotated[float, typer.Option(
+    help="Coulomb and static friction increase of the failing axis on the failure day, %.", min=0.0,
+    max=500.0)]
+FleetSeed = Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.", min=0, max=MAX_SEED)]
+FleetConditions = Annotated[bool, typer.Option(
+    help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
+    "process and fault.")]
+Without = Annotated[list[str] | None, typer.Option(
+    "--without", metavar="CONDITION", help="Leave one condition out of every robot, the others drawn as in the "
+    "full fleet: thermal (hall climate, warm-up), payloads (the parts) or spread (unit spread); repeat for "
+    "several.", show_default=False)]
+FleetTaskMix = Annotated[bool, typer.Option(
+    "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
+    "its cycles (default: one task per robot).")]
+TaskPool = Annotated[list[str] | None, typer.Option(
+    "--task", help="The tasks robots draw their process from: thesis task names, program files (.toml) or "
+    "joint logs (.csv); repeat for several (default: pick_place, spot_weld, arc_weld).")]
+FleetFault = Annotated[str | None, typer.Option(
+    help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
+    "from its onset day to FINAL on the failure day: EFFECT:each:PARAMETER:FINAL[:key=value,...] (the "
+    "form of `simulate --fault`, AXIS 'each': the drawn axis), e.g. backlash:each:width:0.01; the same FINAL on every model (--robot picks them).")]
+FrictionTestEvery = Annotated[int, typer.Option(
+    "--friction-test-every", metavar="DAYS", help="Each robot also runs its model's friction test "
+    "(`faultgen tasks friction-test`) every DAYS days from day 1: one more run per robot, "
+    "<run>-friction-test, its tests' signals labelled record=friction_test (docs/friction-test.md); "
+    "0: none.", min=0, max=3650)]
+FleetOut = Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")]
+
+
 @app.command("fleet", cls=Command)
 def fleet_command(
-    size: Annotated[int, typer.Option("--robots", help="Robots in the fleet (thesis ch. 5.3.1: 26).", min=2, max=10000)] = 26,
-    failing: Annotated[int | None, typer.Option(
-        help="Of them, robots whose gearbox fails (thesis: 13 of 26). Default: half of --robots, rounded down.",
-        min=1, max=10000, show_default=False)] = None,
-    models: Annotated[list[str] | None, typer.Option(
-        "--robot", help="Robot model(s) of the fleet (names, robot folders or MJCF files, mixed), taken in turn; "
-        "repeat for several (default: irb6700 and puma560). One model makes every robot that model, e.g. for a "
-        "fault whose FINAL suits only it. Parts are sized from each model's rated payload (docs/simulation.md).")] = None,
-    days: Annotated[int, typer.Option(help="Days recorded per robot; a failing robot fails on the last one.", min=6, max=3650)] = 60,
-    cycles_per_day: Annotated[int, typer.Option(
-        help="Cycles simulated per day, reduced to the day's maximum (thesis ch. 5.3.2: 1-4 samples a day).", min=1, max=24)] = 2,
-    failure_wear: Annotated[float, typer.Option(
-        help="Coulomb and static friction increase of the failing axis on the failure day, %.", min=0.0,
-        max=500.0)] = 50.0,
-    seed: Annotated[int, typer.Option(help="Seed of every draw: models, tasks, parts, climate, units, faults, noise.", min=0, max=MAX_SEED)] = 0,
-    conditions: Annotated[bool, typer.Option(
-        help="Each robot's climate, parts and unit spread; --no-conditions: robots differ only by model, "
-        "process and fault.")] = True,
-    without: Annotated[list[str] | None, typer.Option(
-        "--without", metavar="CONDITION", help="Leave one condition out of every robot, the others drawn as in the "
-        "full fleet: thermal (hall climate, warm-up), payloads (the parts) or spread (unit spread); repeat for "
-        "several.", show_default=False)] = None,
-    task_mix: Annotated[bool, typer.Option(
-        "--task-mix", help="Each robot also runs a second task, drawn from the other two, in a random half of "
-        "its cycles (default: one task per robot).")] = False,
-    task_pool: Annotated[list[str] | None, typer.Option(
-        "--task", help="The tasks robots draw their process from: thesis task names, program files (.toml) or "
-        "joint logs (.csv); repeat for several (default: pick_place, spot_weld, arc_weld).")] = None,
+    size: FleetSize = 26,
+    failing: Failing = None,
+    models: FleetModels = None,
+    days: FleetDays = 60,
+    cycles_per_day: FleetCyclesPerDay = 2,
+    failure_wear: FailureWear = 50.0,
+    seed: FleetSeed = 0,
+    conditions: FleetConditions = True,
+    without: Without = None,
+    task_mix: FleetTaskMix = False,
+    task_pool: TaskPool = None,
     friction_model: Friction = "lugre",
     dry_share: DryShare = None,
     gear_loss: GearLoss = 0.0,
-    fault: Annotated[str | None, typer.Option(
-        help="Instead of friction wear, a failing robot's drawn axis gets this fault, growing on the exp4 schedule "
-        "from its onset day to FINAL on the failure day: EFFECT:each:PARAMETER:FINAL[:key=value,...] (the "
-        "form of `simulate --fault`, AXIS 'each': the drawn axis), e.g. backlash:each:width:0.01; the same FINAL on every model (--robot picks them).")] = None,
-    friction_test_every: Annotated[int, typer.Option(
-        "--friction-test-every", metavar="DAYS", help="Each robot also runs its model's friction test "
-        "(`faultgen tasks friction-test`) every DAYS days from day 1: one more run per robot, "
-        "<run>-friction-test, its tests' signals labelled record=friction_test (docs/friction-test.md); "
-        "0: none.", min=0, max=3650)] = 0,
+    fault: FleetFault = None,
+    friction_test_every: FrictionTestEvery = 0,
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
     backend: Backend = None,
-    out: Annotated[Path, typer.Option("--out", "-o", help="Dataset file to write (HDF5).")] = Path("fleet.h5"),
+    out: FleetOut = Path("fleet.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
 ) -> None:

@@ -85,15 +85,25 @@ def card(path: str | Path) -> str:
         lines += _provenance(path, command, written_by, shas)
         return "\n".join(lines)
 
-    lines += [f"## What {wear_pct:g} % wear means", "",
-              (f"{wear_pct:g} % is the largest wear in this dataset. " if largest > 0.05 else
-               f"This dataset has no friction wear; {wear_pct:g} % as an example. ")
-              + f"Wear multiplies an axis's Coulomb and static friction: {wear_pct:g} % wear is "
-              f"{1 + wear_pct / 100:g} times the new gearbox's (`friction_multiplier` "
-              f"{1 + wear_pct / 100:g}; wear_pct = (friction_multiplier - 1) x 100). Viscous friction is "
-              "unchanged. Per axis, the Coulomb friction (positive direction) new and its increase, at the motor "
-              "and at the arm joint (times the gear ratio), the model's nominal values (with a unit spread, "
-              "`dry_friction_factor` scales each unit's):", ""]
+    lines += _wear_meaning(wear_pct, largest, robot_names, first)
+    lines += _labels(measured_robots)
+    lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported, first)
+    lines += _provenance(path, command, written_by, shas)
+    return "\n".join(lines)
+
+
+def _wear_meaning(wear_pct: float, largest: float, robot_names: list[str], first: dict) -> list[str]:
+    """The card's section on what ``wear_pct`` % wear means (``largest``: the dataset's largest wear, %):
+    per robot (its ``first`` run's drivetrain) and axis, the Coulomb friction new and its increase."""
+    lines = [f"## What {wear_pct:g} % wear means", "",
+             (f"{wear_pct:g} % is the largest wear in this dataset. " if largest > 0.05 else
+              f"This dataset has no friction wear; {wear_pct:g} % as an example. ")
+             + f"Wear multiplies an axis's Coulomb and static friction: {wear_pct:g} % wear is "
+             f"{1 + wear_pct / 100:g} times the new gearbox's (`friction_multiplier` "
+             f"{1 + wear_pct / 100:g}; wear_pct = (friction_multiplier - 1) x 100). Viscous friction is "
+             "unchanged. Per axis, the Coulomb friction (positive direction) new and its increase, at the motor "
+             "and at the arm joint (times the gear ratio), the model's nominal values (with a unit spread, "
+             "`dry_friction_factor` scales each unit's):", ""]
     rows = []
     for name in robot_names:
         drive = first[name].drivetrain
@@ -105,24 +115,24 @@ def card(path: str | Path) -> str:
                          f"{100 * rise / float(drive.motor_torque_limit[a]):.2g}"])
     lines += _table(["robot", "axis", "Coulomb new, N m (motor)", f"+{wear_pct:g} %, N m (motor)", "gear ratio",
                      f"+{wear_pct:g} %, N m (arm)", "% of peak motor torque"], rows)
+    return lines
 
-    lines += ["", "## Labels", "",
-              "- `worn_axes`: axes (1-based) that wear or carry the fault; none: a healthy run (a normal robot).",
-              "- `wear_pct` / `Run.wear`: true wear of each axis per sample, % (above); `Run.fault_level`: the "
-              "fault's growth, % (friction wear: the worn axis's wear; another fault: its parameter's share of "
-              "its final change).",
-              "- `Run.fault_begins`: the first sample with the fault above 0; alarms before it are false alarms.",
-              "- `fault`: a fault other than friction wear (effect, parameter, axis, start, final).",
-              "- `seed`: the unit (noise and draws); in a fleet each robot has its own.",
-              "- `conditions`: operating conditions (temperature, parts, task mix, unit spread), when on.",
-              *(["- units imported from measured logs (`faultgen logs import`, task `measured`): no true wear is "
-                 "measured; `label` per log and axis is 1 worn, 0 healthy, -1 unknown, from the logs' events, and "
-                 "`friction_multiplier` holds it as a wear (2 on worn logs, 1 elsewhere)."] if measured_robots else []),
-              ""]
 
-    lines += _arrays_and_edges(names, robot_names, pairs, measured_robots, imported, first)
-    lines += _provenance(path, command, written_by, shas)
-    return "\n".join(lines)
+def _labels(measured_robots: list[str]) -> list[str]:
+    """The card's section on the labels (with the imported units' when ``measured_robots``)."""
+    return ["", "## Labels", "",
+           "- `worn_axes`: axes (1-based) that wear or carry the fault; none: a healthy run (a normal robot).",
+           "- `wear_pct` / `Run.wear`: true wear of each axis per sample, % (above); `Run.fault_level`: the "
+           "fault's growth, % (friction wear: the worn axis's wear; another fault: its parameter's share of "
+           "its final change).",
+           "- `Run.fault_begins`: the first sample with the fault above 0; alarms before it are false alarms.",
+           "- `fault`: a fault other than friction wear (effect, parameter, axis, start, final).",
+           "- `seed`: the unit (noise and draws); in a fleet each robot has its own.",
+           "- `conditions`: operating conditions (temperature, parts, task mix, unit spread), when on.",
+           *(["- units imported from measured logs (`faultgen logs import`, task `measured`): no true wear is "
+              "measured; `label` per log and axis is 1 worn, 0 healthy, -1 unknown, from the logs' events, and "
+              "`friction_multiplier` holds it as a wear (2 on worn logs, 1 elsewhere)."] if measured_robots else []),
+           ""]
 
 
 #: What an imported dataset's arrays hold where the schema speaks of a simulation.

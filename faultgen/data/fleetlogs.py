@@ -268,6 +268,48 @@ class _Previous:
         self.by_stamp = {(unit, key): name for unit, run in self.runs.items()
                          for name, key in zip(run["names"], run["keys"], strict=True)}
 
+    def plan(self, units: dict, summary: ImportSummary, reimport_changed: bool) -> dict[str, list[tuple]]:
+        """What each unit's records will be, in stamp order: ``(key, name, log or None, sha256, name
+        imported under or None)``, kept from this import (``log`` None) or read now; a log is keyed by its
+        unit and stamp, so a file renamed (gzipped) is the record imported before. Logs vanished since
+        the folder was listed and files re-imported go into ``summary``; a unit whose files all left
+        the folder keeps its records.
+
+        Raises
+        ------
+        ValueError
+            For a file changed since it was imported, without ``reimport_changed``.
+        """
+        plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str, str | None]]] = {}
+        for unit, logs in units.items():
+            entries = []
+            for log in logs:
+                try:
+                    digest = sha256(log.path)
+                except OSError as err:  # removed since the folder was listed: skipped, named
+                    summary.skipped.append((log.name, f"{VANISHED} ({err.strerror or err})"))
+                    continue
+                was = self.name_of(log)
+                before = self.files.get(was) if was is not None else None
+                if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
+                    entries.append((log.key, log.name, None if before else log, digest, was))
+                    continue
+                if not reimport_changed:
+                    then = "" if was == log.name else f" as {was}"
+                    raise ValueError(f"{log.path} changed since it was imported{then} into {self.path} "
+                                     f"(SHA-256 {before[:12]}... then, {digest[:12]}... now); put the imported "
+                                     "content back, or give --reimport-changed to import it again")
+                summary.reimported.append(log.name)
+                entries.append((log.key, log.name, log, digest, was))
+            plan[unit] = entries
+        present = {name for entries in plan.values() for entry in entries for name in (entry[1], entry[4]) if name}
+        for unit, run in self.runs.items():  # records whose files left the folder: kept
+            gone = [name for name in run["names"] if name not in present]
+            summary.gone += gone
+            if gone:
+                plan.setdefault(unit, [])
+        return plan
+
     def name_of(self, log: logfolder.LogFile) -> str | None:
         """The file name under which ``log``'s unit and stamp were imported, or None."""
         return log.name if log.name in self.files else self.by_stamp.get((log.unit, log.key))
@@ -333,81 +375,70 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     if not_logs and not skip_bad:
         name, reason = not_logs[0]
         raise ValueError(f"{logs_dir / name}: {reason} (--skip-bad passes over bad files and lists them)")
-    events_path = logs_dir / "events.csv"
-    events = logfolder.read_events(events_path, units, robot.n_axes, logs_dir) if events_path.is_file() else []
-    events_sha = sha256(events_path) if events_path.is_file() else ""
+    events, events_sha = _events(logs_dir, units, robot)
     previous = _Previous(out, robot)
     summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
-
-    # what each unit's records will be, in stamp order: kept from the previous import, or read now;
-    # a log is keyed by its unit and stamp, so a file renamed (gzipped) is the record imported before
-    plan: dict[str, list[tuple[float, str, logfolder.LogFile | None, str, str | None]]] = {}
-    for unit, logs in units.items():
-        entries = []
-        for log in logs:
-            try:
-                digest = sha256(log.path)
-            except OSError as err:  # removed since the folder was listed: skipped, named
-                summary.skipped.append((log.name, f"{VANISHED} ({err.strerror or err})"))
-                continue
-            was = previous.name_of(log)
-            before = previous.files.get(was) if was is not None else None
-            if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
-                entries.append((log.key, log.name, None if before else log, digest, was))
-                continue
-            if not reimport_changed:
-                then = "" if was == log.name else f" as {was}"
-                raise ValueError(f"{log.path} changed since it was imported{then} into {out} (SHA-256 {before[:12]}... "
-                                 f"then, {digest[:12]}... now); put the imported content back, or give "
-                                 "--reimport-changed to import it again")
-            summary.reimported.append(log.name)
-            entries.append((log.key, log.name, log, digest, was))
-        plan[unit] = entries
-    present = {name for entries in plan.values() for entry in entries for name in (entry[1], entry[4]) if name}
-    for unit, run in previous.runs.items():  # records whose files left the folder: kept
-        gone = [name for name in run["names"] if name not in present]
-        summary.gone += gone
-        if gone:
-            plan.setdefault(unit, [])
+    plan = previous.plan(units, summary, reimport_changed)
     new = [entry for entries in plan.values() for entry in entries if entry[2] is not None]
     if previous.files and not new and events_sha == previous.events_sha256:
-        summary.written = False
-        summary.kept = len(previous.files)
-        summary.units = len(previous.runs)
-        return summary
+        summary.written, summary.kept, summary.units = False, len(previous.files), len(previous.runs)
+        return summary  # nothing new: the dataset stays as it is
     check_writable(out)
-
-    by_unit: dict[str, list] = {}
-    for event in events:
-        by_unit.setdefault(event.unit, []).append(event)
-    manifest: dict[str, str] = {}
     with hdf5_writer(out) as f, tqdm(total=len(new), desc="import", unit="log", disable=not progress) as bar:
         writer.write_root(f, 0, command, "")
         f.attrs["complete"] = False
         runs = f.create_group("runs")
-        for unit in sorted(plan):
-            old = previous.records(unit) if unit in previous.runs else None
-            rows = _rows(unit, plan[unit], old, read, robot, speed_limit, skip_bad, summary, bar)
-            if not rows:
-                continue
-            period = previous.runs.get(unit, {}).get("log_period", sensors.LOG_PERIOD)
-            _write_unit(runs, unit, rows, robot, by_unit.get(unit, []), command, summary, period)
-            manifest.update({row["log_file"]: row["sha256"] for row in rows})
+        rows = functools.partial(_rows, read=read, robot=robot, speed_limit=speed_limit, skip_bad=skip_bad,
+                                 summary=summary, bar=bar)
+        manifest = _write_units(runs, plan, previous, rows, robot, events, command, summary)
         if not len(runs):
             raise ValueError(f"{logs_dir}: no log could be imported ({len(summary.skipped)} bad file(s): "
                              f"{summary.skipped[0][0] if summary.skipped else 'none'}...)")
         f.attrs["n_runs"] = len(runs)
-        group = f.create_group(MANIFEST)
-        names = sorted(manifest)
-        group.create_dataset("file", data=np.array(names, dtype=object), dtype=h5py.string_dtype())
-        group.create_dataset("sha256", data=np.array([manifest[n] for n in names], dtype=object),
-                             dtype=h5py.string_dtype())
-        group.attrs.update({"robot": robot.name, "model_sha256": writer.model_hash(robot.path),
-                            "logs": logs_dir.resolve().name, "events_sha256": events_sha,
-                            "faultgen_version": __version__})
+        _write_manifest(f, manifest, robot, logs_dir, events_sha)
         f.attrs["complete"] = True
         summary.units = len(runs)
     return summary
+
+
+def _events(logs_dir: Path, units: dict, robot: robots.Robot) -> tuple[list, str]:
+    """(the events of ``LOGS/events.csv``, its SHA-256), or ([], "") without one."""
+    events_path = logs_dir / "events.csv"
+    events = logfolder.read_events(events_path, units, robot.n_axes, logs_dir) if events_path.is_file() else []
+    return events, sha256(events_path) if events_path.is_file() else ""
+
+
+def _write_units(runs: h5py.Group, plan: dict, previous: _Previous, rows, robot: robots.Robot, events,
+                 command: str, summary: ImportSummary) -> dict[str, str]:
+    """Write each unit of ``plan`` that has records into ``runs`` (``rows(unit, entries, old)``: its
+    records, :func:`_rows`), labelled by its ``events``; return each record's file -> its SHA-256."""
+    by_unit: dict[str, list] = {}
+    for event in events:
+        by_unit.setdefault(event.unit, []).append(event)
+    manifest: dict[str, str] = {}
+    for unit in sorted(plan):
+        old = previous.records(unit) if unit in previous.runs else None
+        unit_rows = rows(unit, plan[unit], old)
+        if not unit_rows:
+            continue
+        period = previous.runs.get(unit, {}).get("log_period", sensors.LOG_PERIOD)
+        _write_unit(runs, unit, unit_rows, robot, by_unit.get(unit, []), command, summary, period)
+        manifest.update({row["log_file"]: row["sha256"] for row in unit_rows})
+    return manifest
+
+
+def _write_manifest(f: h5py.File, manifest: dict[str, str], robot: robots.Robot, logs_dir: Path,
+                    events_sha: str) -> None:
+    """The import's manifest group: every record's file and its SHA-256, the robot and its model's
+    SHA-256, the logs folder's name, the events file's SHA-256 and faultgen's version."""
+    group = f.create_group(MANIFEST)
+    names = sorted(manifest)
+    group.create_dataset("file", data=np.array(names, dtype=object), dtype=h5py.string_dtype())
+    group.create_dataset("sha256", data=np.array([manifest[n] for n in names], dtype=object),
+                         dtype=h5py.string_dtype())
+    group.attrs.update({"robot": robot.name, "model_sha256": writer.model_hash(robot.path),
+                        "logs": logs_dir.resolve().name, "events_sha256": events_sha,
+                        "faultgen_version": __version__})
 
 
 def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) -> list[dict]:

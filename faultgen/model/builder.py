@@ -105,9 +105,34 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
         if joint.type == mujoco.mjtJoint.mjJNT_SLIDE:
             raise ArmError(f"{source}: joint {label!r} is prismatic; faultgen models revolute axes only")
     model = _compile(spec, source)
+    joints = _serial_chain(model, source)
+    _check_links(model, source)
+    return [
+        ArmJoint(
+            _name(model, mujoco.mjtObj.mjOBJ_JOINT, j),
+            _name(model, mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j]),
+            (float(model.jnt_range[j, 0]), float(model.jnt_range[j, 1])),
+        )
+        for j in joints
+    ]
 
+
+def _name(model: mujoco.MjModel, kind: mujoco.mjtObj, i: int) -> str:
+    """The name of element ``i`` of ``kind`` in ``model``, or ``#i`` if it has none."""
+    return mujoco.mj_id2name(model, kind, i) or f"#{i}"
+
+
+def _serial_chain(model: mujoco.MjModel, source: str) -> list[int]:
+    """The compiled arm's joint indices (depth first from the base), after checking they are
+    MIN_AXES..MAX_AXES revolute joints with limits, one per body, in one open serial chain.
+
+    Raises
+    ------
+    ArmError
+        Naming the first joint, body or constraint that is not so.
+    """
     def name(kind: mujoco.mjtObj, i: int) -> str:
-        return mujoco.mj_id2name(model, kind, i) or f"#{i}"
+        return _name(model, kind, i)
 
     for j in range(model.njnt):
         kind = model.jnt_type[j]
@@ -156,6 +181,18 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
                 f"{source}: joint {name(mujoco.mjtObj.mjOBJ_JOINT, j)!r} has range {low!r}..{high!r}; "
                 "expected lower < upper"
             )
+    return joints
+
+
+def _check_links(model: mujoco.MjModel, source: str) -> None:
+    """Check every body that moves with the first joint: one carrying a joint has mass and a
+    positive-definite inertia, any with mass a physical one (each moment <= the sum of the other two).
+
+    Raises
+    ------
+    ArmError
+        Naming the first body that has not.
+    """
     first = model.jnt_bodyid[0]
     for body in range(1, model.nbody):
         moving = body == first
@@ -166,7 +203,7 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
         if not moving:
             continue
         inertia = model.body_inertia[body]
-        bname = name(mujoco.mjtObj.mjOBJ_BODY, body)
+        bname = _name(model, mujoco.mjtObj.mjOBJ_BODY, body)
         carries = model.body_jntnum[body] > 0
         if carries and (model.body_mass[body] <= 0 or np.any(inertia <= 0)):
             raise ArmError(
@@ -180,14 +217,6 @@ def check_arm(spec: mujoco.MjSpec, source: str = "arm") -> list[ArmJoint]:
                 f"{source}: body {bname!r} has principal inertia {inertia.tolist()} kg m^2; expected a "
                 "positive-definite tensor (each moment <= the sum of the other two)"
             )
-    return [
-        ArmJoint(
-            name(mujoco.mjtObj.mjOBJ_JOINT, j),
-            name(mujoco.mjtObj.mjOBJ_BODY, model.jnt_bodyid[j]),
-            (float(model.jnt_range[j, 0]), float(model.jnt_range[j, 1])),
-        )
-        for j in joints
-    ]
 
 
 def _name_everything(spec: mujoco.MjSpec) -> None:
@@ -239,6 +268,19 @@ def build(
     spec = arm.copy()
     spec.copy_during_attach = True  # moving a link in its own spec takes a copy
     _name_everything(spec)
+    arm_home = _strip(spec, n)
+    _add_rotors(spec, joints, drivetrain, source)
+    if not any(site.name == "flange" for site in spec.sites):
+        _add_flange(spec, joints[-1].body)
+    _add_drives(spec, drivetrain)
+    _add_home(spec, joints, drivetrain, arm_home if home is None else np.asarray(home, dtype=float), source)
+    return spec
+
+
+def _strip(spec: mujoco.MjSpec, n: int) -> np.ndarray | None:
+    """Remove from the arm's ``spec`` what the builder replaces (keyframes, actuators, sensors, tendons,
+    contact pairs and excludes, equalities), switch contacts off and set the builder's timestep and
+    integrator. Returns the arm's ``home`` keyframe of ``n`` angles (rad), or None if it has none."""
     arm_home = None
     keys = list(spec.keys)
     for key in keys:
@@ -252,7 +294,19 @@ def build(
         geom.contype, geom.conaffinity = 0, 0
     spec.option.timestep = TIMESTEP
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_DISCRETE
+    return arm_home
 
+
+def _add_rotors(spec: mujoco.MjSpec, joints: list[ArmJoint], drivetrain: Drivetrain, source: str) -> None:
+    """Rename the arm's joints ``joint{i}`` and put each link after a rotor body ``rotor{i}`` (joint
+    ``rotor{i}`` on the arm joint's axis, its armature the motor inertia).
+
+    Raises
+    ------
+    ArmError
+        If the arm already has an element named ``rotor{i}``.
+    """
+    n = len(joints)
     names = {b.name for b in spec.bodies} | {j.name for j in spec.joints}
     arm_names = [j.name for j in joints]
     for i in range(1, n + 1):
@@ -291,8 +345,10 @@ def build(
         target.attach_body(link, "", "")
         spec.delete(link)
 
-    if not any(site.name == "flange" for site in spec.sites):
-        _add_flange(spec, joints[-1].body)
+
+def _add_drives(spec: mujoco.MjSpec, drivetrain: Drivetrain) -> None:
+    """Add each axis's gearbox (tendon ``gearbox{i}``: stiffness and damping between rotor and link),
+    motor (actuator ``motor{i}`` on the rotor, limited to the motor torque) and motor friction."""
     for i, drive in enumerate(drivetrain.axes, start=1):
         tendon = spec.add_tendon(
             name=f"gearbox{i}",
@@ -312,8 +368,12 @@ def build(
     for axis in range(len(drivetrain.axes)):
         friction.apply(spec, None, axis, friction.values(axis))
 
+
+def _add_home(spec: mujoco.MjSpec, joints: list[ArmJoint], drivetrain: Drivetrain, q: np.ndarray | None,
+              source: str) -> None:
+    """Add the keyframe ``home``: the arm at ``q`` (rad; None: zero clipped into each joint's range), each
+    rotor at its gear ratio times its joint's angle."""
     model = _compile(spec, source)
-    q = arm_home if home is None else np.asarray(home, dtype=float)
     if q is None:
         q = np.array([np.clip(0.0, *j.range) for j in joints])
     qpos = np.zeros(model.nq)
@@ -321,7 +381,6 @@ def build(
         qpos[model.joint(f"joint{i}").qposadr[0]] = q[i - 1]
         qpos[model.joint(f"rotor{i}").qposadr[0]] = drive.gear_ratio * q[i - 1]
     spec.add_key(name="home", qpos=qpos.tolist())
-    return spec
 
 
 #: Names of the tool flange body in ROS-Industrial and Menagerie descriptions, in order of preference.

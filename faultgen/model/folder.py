@@ -11,6 +11,7 @@ and the robot loads: an error or a kill leaves no folder that looks complete.
 
 from __future__ import annotations
 
+import contextlib
 import glob
 import math
 import os
@@ -119,29 +120,71 @@ def add(
         (``ArmError``, ``DrivetrainError``, ``ModelError`` or the task generator's) naming the bad
         name, element, axis or key; nothing is written then.
     """
-    if not NAME.match(name):
-        raise ValueError(f"robot name {name!r}; expected a letter, then letters, digits, '_' or '-'")
-    if payload is not None and not (math.isfinite(payload) and 0 <= payload <= limits.MAX_PAYLOAD):
-        raise ValueError(f"payload = {payload!r} kg; expected a number in 0 .. {limits.MAX_PAYLOAD:g} kg")
-    sizing.check_rule(rule)
     out = Path(out)
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
-        raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
+    _check_request(name, payload, rule, out)
     if out.parent.is_dir():
         remove_stale(out)  # a killed add's staging folder, before anything can fail
     arm = importers.read(source, packages)
     n = len(arm.joints)
     given = read_table(drivetrain, n, partial=True) if drivetrain is not None else {}
+    guessed, payload_origin = _payload_origin(payload, arm)
+    result = sizing.sized(arm, given, payload, rule)
+    drive, origin, payload = result.drivetrain, result.origin, result.payload
+    text = _robot_xml(name, source, arm, drive, payload)
+    with _staged(out) as stage:
+        robot = robots.write(stage / f"{name}.xml", text)  # the robot as written: it loads, or nothing is added
+        size = reach(robot)
+        summary, findings = plausibility.report(arm, payload, guessed, result.moving_mass,
+                                                plausibility.radial_reach(robot), result.loads,
+                                                sizing.PAYLOAD_SHARE)
+        (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
+        (stage / "drivetrain.toml").write_text(_drivetrain_toml(name, source, rule, drive, origin, drivetrain, n))
+        if arm.urdf:
+            (stage / "urdf_used.urdf").write_text(arm.urdf)
+        if tasks is not None:
+            (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
+        (stage / "README.md").write_text(
+            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin, (summary, findings),
+                   result.loads, rule)
+        )
+    # the robot read from the staged file, named by the folder it was renamed to (not read again)
+    return Added(out, robots.moved(robot, out / f"{name}.xml"), arm, payload, payload_origin, summary,
+                 tuple(findings), rule)
+
+
+def _payload_origin(payload: float | None, arm: importers.Arm) -> tuple[bool, str]:
+    """(whether the rated payload is to be guessed, where it comes from, in words) for a ``payload``
+    given in kg or None, and the arm's own (NaN if its source gives none)."""
     guessed = payload is None and math.isnan(arm.payload)
-    payload_origin = (
+    return guessed, (
         "given with --payload"
         if payload is not None
         else "from the source"
         if not guessed
         else f"GUESSED: {sizing.PAYLOAD_SHARE * 100:g} % of the moving mass; give --payload KG"
     )
-    result = sizing.sized(arm, given, payload, rule)
-    drive, origin, payload = result.drivetrain, result.origin, result.payload
+
+
+def _check_request(name: str, payload: float | None, rule: int, out: Path) -> None:
+    """Check :func:`add`'s name, payload (kg), sizing rule and output folder before anything is read.
+
+    Raises
+    ------
+    ValueError
+        Naming the value and what was expected.
+    """
+    if not NAME.match(name):
+        raise ValueError(f"robot name {name!r}; expected a letter, then letters, digits, '_' or '-'")
+    if payload is not None and not (math.isfinite(payload) and 0 <= payload <= limits.MAX_PAYLOAD):
+        raise ValueError(f"payload = {payload!r} kg; expected a number in 0 .. {limits.MAX_PAYLOAD:g} kg")
+    sizing.check_rule(rule)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise ValueError(f"{out}: exists and is not an empty folder; choose a new one")
+
+
+def _robot_xml(name: str, source: str | Path, arm: importers.Arm, drive, payload: float) -> str:
+    """The MJCF text of robot ``name``: the arm's meshes replaced by a skeleton (a note in ``arm.notes``),
+    built with ``drive``, its description and rated ``payload`` (kg) recorded in it."""
     dropped = _skeleton(arm.spec, str(source))
     if dropped:
         arm.notes.append(
@@ -153,47 +196,41 @@ def add(
     if not any(t.name == "description" for t in spec.texts):
         spec.add_text(name="description", data=arm.description)
     spec.add_numeric(name=robots.RATED_PAYLOAD, data=[payload])  # kg: the fleet's parts (sizing.fleet_parts)
-    text = builder.to_xml(spec)
+    return builder.to_xml(spec)
 
+
+def _drivetrain_toml(name: str, source: str | Path, rule: int, drive, origin: dict, drivetrain, n: int) -> str:
+    """The ``drivetrain.toml`` of an added robot: every number of ``drive`` with its provenance from
+    ``origin``, the sizing rule, and the gearbox ratings given in the ``drivetrain`` file (if any)."""
+    header = (
+        f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
+        f"{RULE_LINE.format(rule=rule)}\n"
+        f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
+        f"--drivetrain drivetrain.toml -o NEW_FOLDER"
+    )
+    notes = {
+        axis: {k: ("given in --drivetrain" if v == "given" else v) for k, v in keys.items()}
+        for axis, keys in origin.items()
+    }
+    rated = rating.given(drivetrain, n) if drivetrain is not None else {}  # the gearbox ratings given, kept
+    return drive.to_toml(notes=notes, header=header, ratings=rated)
+
+
+@contextlib.contextmanager
+def _staged(out: Path):
+    """A hidden staging folder beside ``out`` (``.NAME.partial-PID@HOST-*``, :func:`remove_stale`'s
+    pattern), renamed to ``out`` when the block ends, removed when it raises or is interrupted."""
     out.parent.mkdir(parents=True, exist_ok=True)
     prefix = f".{out.name}.partial-{os.getpid()}@{socket.gethostname()}-"  # remove_stale's pattern
     stage = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
     try:
-        robot = robots.write(stage / f"{name}.xml", text)  # the robot as written: it loads, or nothing is added
-        size = reach(robot)
-        summary, findings = plausibility.report(arm, payload, guessed, result.moving_mass,
-                                                plausibility.radial_reach(robot), result.loads,
-                                                sizing.PAYLOAD_SHARE)
-        (stage / "scene.xml").write_text(SCENE.format(name=name, center=0.4 * size, extent=1.5 * size))
-        header = (
-            f"Drivetrain of {name}: every number the model uses. Provenance per number in README.md.\n"
-            f"{RULE_LINE.format(rule=rule)}\n"
-            f"Edit and rebuild: faultgen robots add {name} --from {Path(source).name} "
-            f"--drivetrain drivetrain.toml -o NEW_FOLDER"
-        )
-        notes = {
-            axis: {k: ("given in --drivetrain" if v == "given" else v) for k, v in keys.items()}
-            for axis, keys in origin.items()
-        }
-        rated = rating.given(drivetrain, n) if drivetrain is not None else {}  # the gearbox ratings given, kept
-        (stage / "drivetrain.toml").write_text(drive.to_toml(notes=notes, header=header, ratings=rated))
-        if arm.urdf:
-            (stage / "urdf_used.urdf").write_text(arm.urdf)
-        if tasks is not None:
-            (stage / "tasks.toml").write_text(tasks(robot, arm, payload))
-        (stage / "README.md").write_text(
-            readme(name, arm, drive, origin, payload, drivetrain, robot, payload_origin, (summary, findings),
-                   result.loads, rule)
-        )
+        yield stage
         if out.exists():
             out.rmdir()
         stage.rename(out)
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         raise
-    # the robot read from the staged file, named by the folder it was renamed to (not read again)
-    return Added(out, robots.moved(robot, out / f"{name}.xml"), arm, payload, payload_origin, summary,
-                 tuple(findings), rule)
 
 
 def sizing_rule(folder: str | Path) -> int | None:
@@ -310,6 +347,31 @@ def readme(
     """README.md of an added robot: where the arm came from, and per axis where every drivetrain
     number came from (the source file, ``--drivetrain``, or which sizing rule)."""
     n = len(arm.joints)
+    lines = _readme_arm(name, arm, payload, drivetrain, payload_origin, loads)
+    if checked is not None:
+        summary, findings = checked
+        lines += ["", "## Plausibility", "", f"{summary}: "
+                  + (f"{len(findings)} finding(s)." if findings else "nothing implausible found."), ""]
+        lines += [f"- {finding}" for finding in findings]
+    lines += _readme_drivetrain(n, drive, origin, rule)
+    lines += [
+        "",
+        "## Model",
+        "",
+        f"{robot.n_axes} axes. Per axis i: `joint{{i}}` (arm joint), `rotor{{i}}` (motor rotor, "
+        "armature = Jm), "
+        "`gearbox{i}` (fixed tendon, coefficients 1/G and -1, thesis eq. 6.2a), `motor{i}` (torque "
+        "actuator), "
+        "`friction{i}` (motor-side friction numerics); a `home` keyframe and a `flange` site.",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _readme_arm(name: str, arm: importers.Arm, payload: float, drivetrain, payload_origin: str,
+                loads: sizing.Loads | None) -> list[str]:
+    """README.md's lines up to the arm's section: its title, how it was added, its files, the arm's
+    source, rated payload (kg) and joint table, and the changes made while reading it."""
     lines = [
         f"# {name}",
         "",
@@ -353,12 +415,13 @@ def readme(
         )
     if arm.notes:
         lines += ["", "Changes made while reading:", ""] + [f"- {note}" for note in arm.notes]
-    if checked is not None:
-        summary, findings = checked
-        lines += ["", "## Plausibility", "", f"{summary}: "
-                  + (f"{len(findings)} finding(s)." if findings else "nothing implausible found."), ""]
-        lines += [f"- {finding}" for finding in findings]
-    lines += [
+    return lines
+
+
+def _readme_drivetrain(n: int, drive, origin: dict, rule: int | None) -> list[str]:
+    """README.md's drivetrain section: the table of ``drive``'s numbers for ``n`` axes and each one's
+    provenance from ``origin`` (given or the sizing ``rule``)."""
+    lines = [
         "",
         "## Drivetrain (gear ratio, motor inertia, gearbox stiffness and damping, motor torque limit, "
         "motor-side friction)",
@@ -383,18 +446,7 @@ def readme(
         else:
             for i, label in enumerate(labels, start=1):
                 lines.append(f"- {key}, axis {i}: {label.replace('given', 'given in --drivetrain')}")
-    lines += [
-        "",
-        "## Model",
-        "",
-        f"{robot.n_axes} axes. Per axis i: `joint{{i}}` (arm joint), `rotor{{i}}` (motor rotor, "
-        "armature = Jm), "
-        "`gearbox{i}` (fixed tendon, coefficients 1/G and -1, thesis eq. 6.2a), `motor{i}` (torque "
-        "actuator), "
-        "`friction{i}` (motor-side friction numerics); a `home` keyframe and a `flange` site.",
-        "",
-    ]
-    return "\n".join(lines)
+    return lines
 
 
 def _cell(value: float) -> str:

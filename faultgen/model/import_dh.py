@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -60,7 +61,33 @@ def _number(path: Path, where: str, key: str, value, length: int | None = None) 
     return [limits.number(path, where, key, v, low, high, unit) for v in value]
 
 
+class _Link(NamedTuple):
+    """One [[link]] row of a DH table, checked: lengths in m, angles in rad, mass in kg, the centre of
+    mass in m and the inertia tensor (3, 3) in kg m^2 in the link's DH frame, speed and effort limits
+    (NaN: not given)."""
+
+    d: float
+    a: float
+    alpha: float
+    offset: float
+    mass: float
+    com: list[float]
+    tensor: np.ndarray
+    qlim: list[float]
+    speed: float
+    effort: float
+
+
 def read_dh(path: Path) -> Arm:
+    """The arm a DH table (TOML) describes: one MuJoCo body per [[link]] row, standard or modified
+    (Craig) convention.
+
+    Raises
+    ------
+    ArmError
+        If the file is not such a table, a value is missing or out of its bounds, or the arm fails
+        :func:`check_arm`.
+    """
     try:
         data = inputs.read_toml(path, "TOML DH table")
     except inputs.InputError as err:
@@ -83,61 +110,9 @@ def read_dh(path: Path) -> Arm:
     if "gravity" in data:
         spec.option.gravity = _number(path, "top", "gravity", data["gravity"], 3)
     parent: mujoco.MjsBody | mujoco.MjsFrame = spec.worldbody.add_body(name="base")
-    speed, effort = [], []
-    for i, row in enumerate(links, start=1):
-        where = f"link {i}"
-        if not isinstance(row, dict):
-            raise ArmError(f"{path}: {where} must be a table")
-        bad = sorted(set(row) - DH_KEYS)
-        if bad:
-            raise ArmError(
-                f"{path}: {where}: unknown key {bad[0]!r}; expected some of: {', '.join(sorted(DH_KEYS))}"
-            )
-        for key in ("d", "a", "alpha", "mass", "com", "inertia", "qlim"):
-            if key not in row:
-                raise ArmError(
-                    f"{path}: {where}: {key} is missing" + ("; a joint needs limits" if key == "qlim" else "")
-                )
-        d, a, alpha = (_number(path, where, k, row[k]) for k in ("d", "a", "alpha"))
-        offset = _number(path, where, "offset", row.get("offset", 0.0))
-        mass = _number(path, where, "mass", row["mass"])
-        com = _number(path, where, "com", row["com"], 3)
-        inertia = _number(path, where, "inertia", row["inertia"], 6)
-        qlim = _number(path, where, "qlim", row["qlim"], 2)
-        if not qlim[0] < qlim[1]:
-            raise ArmError(f"{path}: {where}: qlim = {qlim!r}; expected lower < upper")
-        tensor = np.array(
-            [
-                [inertia[0], inertia[3], inertia[4]],
-                [inertia[3], inertia[1], inertia[5]],
-                [inertia[4], inertia[5], inertia[2]],
-            ]
-        )
-        if mass <= 0 or np.any(np.linalg.eigvalsh(tensor) <= 0):
-            raise ArmError(
-                f"{path}: {where}: mass {mass!r} kg, inertia {inertia!r} kg m^2; a link needs a positive "
-                "mass and a positive-definite inertia"
-            )
-        speed.append(_number(path, where, "speed", row["speed"]) if "speed" in row else math.nan)
-        effort.append(_number(path, where, "effort", row["effort"]) if "effort" in row else math.nan)
-        if convention == "standard":
-            # T_i = Rz(theta) Tz(d) Tx(a) Rx(alpha): the joint turns link i about z of frame i-1,
-            # the fixed part is a frame dh{i} holding the link's inertial and the next link
-            body = parent.add_body(name=f"link{i}", quat=_quat_z(offset))
-            body.add_joint(name=f"joint{i}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], range=qlim)
-            frame = body.add_frame(name=f"dh{i}", pos=[a, 0.0, d], quat=_quat_x(alpha))
-            inertial_in = frame
-        else:
-            # Craig: T_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta) Tz(d): the body is frame i
-            pos = [a, -d * math.sin(alpha), d * math.cos(alpha)]
-            body = parent.add_body(name=f"link{i}", pos=pos, quat=_quat_mul(_quat_x(alpha), _quat_z(offset)))
-            body.add_joint(name=f"joint{i}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], range=qlim)
-            frame = body.add_frame(name=f"dh{i}")
-            inertial_in = frame
-        # the inertial is written in the DH frame of the link: a massless child body would add a
-        # joint-free body; set the link's own inertial through the frame's pose instead
-        _set_inertial(body, inertial_in, mass, com, tensor)
-        parent = frame
+    rows = [_link(path, i, row) for i, row in enumerate(links, start=1)]
+    for i, link in enumerate(rows, start=1):
+        parent = _add_link(parent, i, link, convention)
     arm_joints = check_arm(spec, str(path))
     payload = (
         _number(path, "top", "rated_payload", data["rated_payload"]) if "rated_payload" in data else math.nan
@@ -147,13 +122,82 @@ def read_dh(path: Path) -> Arm:
         kind="DH table",
         source=path,
         joints=arm_joints,
-        speed_limit=np.array(speed),
-        effort_limit=np.array(effort),
+        speed_limit=np.array([link.speed for link in rows]),
+        effort_limit=np.array([link.effort for link in rows]),
         payload=payload,
         description=limits.text(
             path, "description", data.get("description", f"{name} from the {convention} DH table {path.name}")
         ),
     )
+
+
+def _link(path: Path, i: int, row) -> _Link:
+    """Link ``i``'s row of the DH table at ``path``, checked.
+
+    Raises
+    ------
+    ArmError
+        If it is not a table, has an unknown key, misses one, a value is out of :data:`DH_BOUNDS`, its
+        limits are not lower < upper, or its mass or inertia is not positive (definite).
+    """
+    where = f"link {i}"
+    if not isinstance(row, dict):
+        raise ArmError(f"{path}: {where} must be a table")
+    bad = sorted(set(row) - DH_KEYS)
+    if bad:
+        raise ArmError(
+            f"{path}: {where}: unknown key {bad[0]!r}; expected some of: {', '.join(sorted(DH_KEYS))}"
+        )
+    for key in ("d", "a", "alpha", "mass", "com", "inertia", "qlim"):
+        if key not in row:
+            raise ArmError(
+                f"{path}: {where}: {key} is missing" + ("; a joint needs limits" if key == "qlim" else "")
+            )
+    d, a, alpha = (_number(path, where, k, row[k]) for k in ("d", "a", "alpha"))
+    offset = _number(path, where, "offset", row.get("offset", 0.0))
+    mass = _number(path, where, "mass", row["mass"])
+    com = _number(path, where, "com", row["com"], 3)
+    inertia = _number(path, where, "inertia", row["inertia"], 6)
+    qlim = _number(path, where, "qlim", row["qlim"], 2)
+    if not qlim[0] < qlim[1]:
+        raise ArmError(f"{path}: {where}: qlim = {qlim!r}; expected lower < upper")
+    tensor = np.array(
+        [
+            [inertia[0], inertia[3], inertia[4]],
+            [inertia[3], inertia[1], inertia[5]],
+            [inertia[4], inertia[5], inertia[2]],
+        ]
+    )
+    if mass <= 0 or np.any(np.linalg.eigvalsh(tensor) <= 0):
+        raise ArmError(
+            f"{path}: {where}: mass {mass!r} kg, inertia {inertia!r} kg m^2; a link needs a positive "
+            "mass and a positive-definite inertia"
+        )
+    speed = _number(path, where, "speed", row["speed"]) if "speed" in row else math.nan
+    effort = _number(path, where, "effort", row["effort"]) if "effort" in row else math.nan
+    return _Link(d, a, alpha, offset, mass, com, tensor, qlim, speed, effort)
+
+
+def _add_link(parent, i: int, link: _Link, convention: str) -> mujoco.MjsFrame:
+    """Add link ``i`` (body ``link{i}``, joint ``joint{i}``, DH frame ``dh{i}``) under ``parent`` in the
+    ``convention`` ('standard' or 'modified'); return its DH frame, the next link's parent."""
+    d, a, alpha, offset, qlim = link.d, link.a, link.alpha, link.offset, link.qlim
+    if convention == "standard":
+        # T_i = Rz(theta) Tz(d) Tx(a) Rx(alpha): the joint turns link i about z of frame i-1,
+        # the fixed part is a frame dh{i} holding the link's inertial and the next link
+        body = parent.add_body(name=f"link{i}", quat=_quat_z(offset))
+        body.add_joint(name=f"joint{i}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], range=qlim)
+        frame = body.add_frame(name=f"dh{i}", pos=[a, 0.0, d], quat=_quat_x(alpha))
+    else:
+        # Craig: T_i = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta) Tz(d): the body is frame i
+        pos = [a, -d * math.sin(alpha), d * math.cos(alpha)]
+        body = parent.add_body(name=f"link{i}", pos=pos, quat=_quat_mul(_quat_x(alpha), _quat_z(offset)))
+        body.add_joint(name=f"joint{i}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], range=qlim)
+        frame = body.add_frame(name=f"dh{i}")
+    # the inertial is written in the DH frame of the link: a massless child body would add a
+    # joint-free body; set the link's own inertial through the frame's pose instead
+    _set_inertial(body, frame, link.mass, link.com, link.tensor)
+    return frame
 
 
 def _set_inertial(

@@ -53,6 +53,13 @@ def _resolve_mesh(filename: str, path: Path, packages: dict[str, Path]) -> Path 
 
 
 def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Arm:
+    """The arm a URDF (or expanded xacro) ``text`` read from ``path`` describes, compiled by MuJoCo.
+
+    Raises
+    ------
+    ArmError
+        If it is not a serial chain of 2 to 7 revolute joints with limits, or MuJoCo cannot compile it.
+    """
     root = sources.parse_xml(text, path, ArmError)
     if root.tag != "robot":
         raise ArmError(f"{path}: root element <{root.tag}>; a URDF has <robot>")
@@ -61,8 +68,51 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
         raise ArmError(f"{path}: {links} links; a robot arm description may have at most {mjcf.MAX_LINKS}")
     limits.check_urdf(root, path)
     notes = []
+    names, speed, effort = _revolute_joints(root, path, notes)
+    dropped, named, unnamed = _drop_meshes(root, path, packages, notes)
+    _compiler_options(root)
+    spec, filled = _spec_with_inertials(root, path, notes)
+    try:
+        joints = check_arm(spec, str(path))
+    except ArmError as err:
+        if dropped and unnamed:  # the likely cause: link masses came from meshes left out
+            raise ArmError(
+                f"{err}; {len(dropped)} meshes were left out, those of package {unnamed[0]!r} as no "
+                f"--package {unnamed[0]}=DIR names its folder" + sources.hint(unnamed[0], path.parent)
+            ) from None
+        raise
+    extension = root.find("mujoco")
+    root.remove(extension)
+    for mesh, filename in named.items():  # the written URDF keeps the source's names, no local path
+        mesh.set("filename", filename)
+    urdf = ET.tostring(root, encoding="unicode")
+    return Arm(
+        spec=spec,
+        kind=kind,
+        source=path,
+        joints=joints,
+        speed_limit=np.array([speed.get(j.name, math.nan) for j in joints]),
+        effort_limit=np.array([effort.get(j.name, math.nan) for j in joints]),
+        description=limits.text(path, "robot name", f"{root.get('name', path.stem)} from {kind} {path.name}"),
+        notes=notes,
+        urdf=urdf,
+        mesh_inertials=filled,
+    )
+
+
+def _revolute_joints(
+    root: ET.Element, path: Path, notes: list[str]
+) -> tuple[list[str], dict[str, float], dict[str, float]]:
+    """(the revolute joints' names, their speed limits in rad/s, their effort limits in N m; NaN where
+    not given) of a URDF's serial chain; each joint's ``<dynamics>`` is removed (a note in ``notes``).
+
+    Raises
+    ------
+    ArmError
+        On a closed chain, a floating, planar, prismatic or continuous joint, a revolute one without
+        limits, a mimic joint, or fewer than MIN_AXES or more than MAX_AXES revolute joints.
+    """
     speed, effort, names = {}, {}, []
-    children: dict[str, list[str]] = {}
     parents: dict[str, str] = {}
     for joint in root.iter("joint"):
         name, kind_ = joint.get("name", "?"), joint.get("type", "?")
@@ -105,14 +155,21 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
         if dynamics is not None:
             joint.remove(dynamics)
             notes.append(f"joint {name!r}: <dynamics> dropped (the drivetrain models damping and friction)")
-    for link, parent in parents.items():
-        children.setdefault(parent, []).append(link)
     if not MIN_AXES <= len(names) <= MAX_AXES:
         raise ArmError(
             f"{path}: {len(names)} revolute joints ({', '.join(names) or 'none'}); expected "
             f"{MIN_AXES} to {MAX_AXES} in a serial chain"
         )
-    # geometry MuJoCo cannot load goes, with one warning
+    return names, speed, effort
+
+
+def _drop_meshes(
+    root: ET.Element, path: Path, packages: dict[str, Path], notes: list[str]
+) -> tuple[list[str], dict[ET.Element, str], list[str]]:
+    """Remove the visual and collision elements whose mesh MuJoCo cannot load (not found, or not one of
+    MESH_TYPES), with one GeometryDropped warning and a note; point the others at their resolved files.
+    Return (the dropped file names, each kept ``<mesh>`` -> its name in the source, the packages of
+    dropped meshes no ``--package`` names)."""
     dropped, named, unnamed = [], {}, []
     for link in root.iter("link"):
         for tag in ("visual", "collision"):
@@ -141,11 +198,15 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
                 else ""
             ),
             GeometryDropped,
-            stacklevel=3,
+            stacklevel=4,
         )
         notes.append(f"{len(dropped)} meshes left out: COLLADA or unresolvable (dynamics need no geometry)")
-    # MuJoCo options for the URDF compiler: keep visual geoms, full mesh paths, every link a body;
-    # of the source's own <mujoco> only compiler settings that read no file are kept
+    return dropped, named, unnamed
+
+
+def _compiler_options(root: ET.Element) -> None:
+    """Set MuJoCo's options for the URDF compiler in ``root``: keep visual geoms, full mesh paths, every
+    link a body; of the source's own ``<mujoco>`` only compiler settings that read no file are kept."""
     extension = root.find("mujoco")
     if extension is None:
         extension = ET.SubElement(root, "mujoco")
@@ -160,6 +221,11 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
     compiler.set("strippath", "false")
     compiler.set("discardvisual", "false")
     compiler.set("fusestatic", "false")
+
+
+def _spec_with_inertials(root: ET.Element, path: Path, notes: list[str]) -> tuple[mujoco.MjSpec, list[str]]:
+    """(MuJoCo's spec of ``root``, the links whose missing ``<inertial>`` was computed from their meshes
+    at DENSITY, with a GeometryDropped warning and a note)."""
     spec = _urdf_spec(root, path)
     filled = _fill_inertials(root, spec, path)
     if filled:
@@ -167,7 +233,7 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
             f"{path}: links {', '.join(filled)} have no <inertial>; theirs are computed from their meshes "
             f"at {DENSITY:g} kg/m^3 (MuJoCo's compiler)",
             GeometryDropped,
-            stacklevel=3,
+            stacklevel=4,
         )
         notes.append(
             f"links {', '.join(filled)}: no <inertial> in the URDF; mass, centre of mass and inertia "
@@ -175,32 +241,7 @@ def read_urdf(text: str, path: Path, kind: str, packages: dict[str, Path]) -> Ar
             "(written into urdf_used.urdf)"
         )
         spec = _urdf_spec(root, path)
-    try:
-        joints = check_arm(spec, str(path))
-    except ArmError as err:
-        if dropped and unnamed:  # the likely cause: link masses came from meshes left out
-            raise ArmError(
-                f"{err}; {len(dropped)} meshes were left out, those of package {unnamed[0]!r} as no "
-                f"--package {unnamed[0]}=DIR names its folder" + sources.hint(unnamed[0], path.parent)
-            ) from None
-        raise
-    extension = root.find("mujoco")
-    root.remove(extension)
-    for mesh, filename in named.items():  # the written URDF keeps the source's names, no local path
-        mesh.set("filename", filename)
-    urdf = ET.tostring(root, encoding="unicode")
-    return Arm(
-        spec=spec,
-        kind=kind,
-        source=path,
-        joints=joints,
-        speed_limit=np.array([speed.get(j.name, math.nan) for j in joints]),
-        effort_limit=np.array([effort.get(j.name, math.nan) for j in joints]),
-        description=limits.text(path, "robot name", f"{root.get('name', path.stem)} from {kind} {path.name}"),
-        notes=notes,
-        urdf=urdf,
-        mesh_inertials=filled,
-    )
+    return spec, filled
 
 
 #: Density of the solids a link without <inertial> is taken to be, kg/m^3 (MuJoCo's default).

@@ -49,7 +49,7 @@ MAX_CALL_DEPTH = 50
 MAX_TEXT = 100_000
 # rtb-data's 58 xacros (ABB, KUKA, Franka, Trossen, Clearpath, PUMA; 55 of which expand) need at most
 # 13 macro calls + 6 block insertions + 4 includes (each at most 13, 6, 4), 36 000 characters copied
-# or read, a 25 000-character URDF and 46 characters in one ${...} (2026-11-25)
+# or read, a 25 000-character URDF and 46 characters in one ${...}
 MAX_STEPS = 10_000  # macro calls, block insertions and includes in all
 MAX_COPIED = 20_000_000  # characters those copy or read: twice an included file's MAX_FILE_BYTES
 MAX_OUTPUT = 10_000_000  # characters of the expanded URDF: a URDF file's own bound (sources.MAX_DESCRIPTION_BYTES)

@@ -81,20 +81,7 @@ def evaluate(node: ast.AST, scope, source: str, expander, max_text: int):
     if isinstance(node, ast.BinOp) and type(node.op) in BINARY:
         left = evaluate(node.left, scope, source, expander, max_text)
         right = evaluate(node.right, scope, source, expander, max_text)
-        if isinstance(node.op, ast.Add) and isinstance(left, str) and isinstance(right, str):
-            if len(left) + len(right) > max_text:
-                raise expander.refuse(f"${{{source}}}", f"a string of more than {max_text} characters")
-            return left + right
-        if not all(isinstance(v, (int, float)) for v in (left, right)):
-            raise expander.refuse(f"${{{source}}}", f"{type(node.op).__name__} of {left!r} and {right!r}")
-        if isinstance(node.op, ast.Pow):
-            left, right = float(left), float(right)  # no integer powers of unbounded size
-        result = BINARY[type(node.op)](left, right)
-        # no integers of unbounded size (their arithmetic slows down with their length)
-        result = float(result) if isinstance(result, int) and abs(result) > 2**63 else result
-        if isinstance(result, float) and not math.isfinite(result):
-            raise ArmError(f"{expander.where}: ${{{source}}}: {result} (out of range)")
-        return result
+        return _arithmetic(node.op, left, right, source, expander, max_text)
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd, ast.Not)):
         operand = evaluate(node.operand, scope, source, expander, max_text)
         if isinstance(node.op, ast.Not):
@@ -136,6 +123,26 @@ def evaluate(node: ast.AST, scope, source: str, expander, max_text: int):
         type(node), type(node).__name__
     )
     raise expander.refuse(f"${{{source}}}", f"{kind} {short(ast.unparse(node))!r}")
+
+
+def _arithmetic(op: ast.operator, left, right, source: str, expander, max_text: int):
+    """``left op right`` for an operator of :data:`BINARY` (:func:`evaluate`'s other arguments): on
+    numbers, or the concatenation of two strings of at most ``max_text`` characters together; an
+    integer past 2**63 is taken as a float, a non-finite result refused."""
+    if isinstance(op, ast.Add) and isinstance(left, str) and isinstance(right, str):
+        if len(left) + len(right) > max_text:
+            raise expander.refuse(f"${{{source}}}", f"a string of more than {max_text} characters")
+        return left + right
+    if not all(isinstance(v, (int, float)) for v in (left, right)):
+        raise expander.refuse(f"${{{source}}}", f"{type(op).__name__} of {left!r} and {right!r}")
+    if isinstance(op, ast.Pow):
+        left, right = float(left), float(right)  # no integer powers of unbounded size
+    result = BINARY[type(op)](left, right)
+    # no integers of unbounded size (their arithmetic slows down with their length)
+    result = float(result) if isinstance(result, int) and abs(result) > 2**63 else result
+    if isinstance(result, float) and not math.isfinite(result):
+        raise ArmError(f"{expander.where}: ${{{source}}}: {result} (out of range)")
+    return result
 
 
 def short(text: str, n: int = 60) -> str:

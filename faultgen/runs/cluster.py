@@ -309,17 +309,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     with client:
         if shared:
             _check_shared(client, folder)
-        run_of = {}
-        futures = []
-        for run_id, config in todo:
-            key = task_key(run_id, config, backend)
-            run_of[key] = run_id
-            sent = for_workers(config)
-            if shared:
-                futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
-                                             None if sent is config else config, backend, key=key))
-            else:
-                futures.append(client.submit(simulate_remote, run_id, sent, backend, key=key))
+        run_of, futures = _submit(client, todo, folder, command, shared, backend)
         configs = dict(todo)
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)
@@ -352,6 +342,24 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
                 bar.set_postfix_str(_cluster_state(client), refresh=False)
         if failed:
             raise SweepError(failure_message(failed, len(todo), parts))
+
+
+def _submit(client, todo: list[tuple[str, sim.RunConfig]], folder: Path, command: str, shared: bool,
+            backend: str) -> tuple[dict[str, str], list]:
+    """Submit every run of ``todo`` to ``client``, in order: (task key -> run id, the futures). A run's
+    worker simulates it and sends it back, or with ``shared`` writes its part file into ``folder``."""
+    run_of = {}
+    futures = []
+    for run_id, config in todo:
+        key = task_key(run_id, config, backend)
+        run_of[key] = run_id
+        sent = for_workers(config)
+        if shared:
+            futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
+                                         None if sent is config else config, backend, key=key))
+        else:
+            futures.append(client.submit(simulate_remote, run_id, sent, backend, key=key))
+    return run_of, futures
 
 
 def failure_message(failed: list[str], n_runs: int, parts: Path) -> str:

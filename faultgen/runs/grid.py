@@ -187,6 +187,23 @@ class Grid:
                                  "and axes, or preset = \"quick\" (or j2, c2)")
         return cls.from_preset(preset, **data) if preset else cls(**data)
 
+    @classmethod
+    def of(cls, preset: str | None = None, config: str | Path | None = None, **options) -> Grid:
+        """The grid of ``faultgen sweep``: the TOML file ``config`` (:meth:`from_toml`), else the named
+        ``preset``, each with the fields given in ``options`` replaced; else ``options`` on the run
+        without wear of irb6700 on pick_place. A fault on a named axis (``options["fault"]``, a
+        :class:`~faultgen.operation.faults.FaultSpec`) without ``axes`` runs beside the run without wear.
+        """
+        fault = options.get("fault")
+        if isinstance(fault, faults.FaultSpec) and fault.axis is not None and "axes" not in options:
+            options["axes"] = [0, fault.axis]
+        if config is not None:
+            grid = cls.from_toml(config)
+            return replace(grid, **options) if options else grid
+        if preset is not None:
+            return cls.from_preset(preset, **options)
+        return cls(**{"robots": ["irb6700"], "tasks": ["pick_place"], "axes": [0], **options})
+
     def recorded_cycles(self) -> tuple[int, ...] | None:
         """The ``record`` field as cycle indices (None: all)."""
         if self.record == "all":

@@ -330,7 +330,7 @@ class CtrlC:
         self._previous_handler = signal.getsignal(signal.SIGINT)
         self._main = threading.current_thread() is threading.main_thread()
         # SIGTERM is handled in any case (a sweep started in the background, where SIGINT is
-        # ignored, died on it silently, issue 51); SIGINT only where it raises KeyboardInterrupt
+        # ignored, died on it silently); SIGINT only where it raises KeyboardInterrupt
         self._active = self._main and self._previous_handler is signal.default_int_handler
         if self._main:
             self._previous_hook = sys.unraisablehook
@@ -388,7 +388,7 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
             from joblib._parallel_backends import LokyBackend
 
             # loky starts its workers (`python -m`) and resource trackers (`python -c`) in this folder:
-            # without PYTHONSAFEPATH a joblib.py here ran in each of them (issue 61; faultgen.children)
+            # without PYTHONSAFEPATH a joblib.py here ran in each of them (faultgen.children)
             with children.safe_path():
                 worker.start_resource_tracker()
                 # every worker watches the sweep from its start, idle or not
@@ -440,7 +440,7 @@ def _stop_local_workers() -> None:
             try:
                 stop(kill_workers=True)
                 break
-            except RuntimeError:  # "cannot join thread before it is started" (seen under load, issue 61)
+            except RuntimeError:  # "cannot join thread before it is started" (seen under load)
                 time.sleep(0.05)
         else:
             for process in list((getattr(executor, "_processes", None) or {}).values()):  # it never started
