@@ -48,7 +48,7 @@ from faultgen.bench import baselines, files, prognosers, rul_scores
 from faultgen.data import atomic
 
 #: The failure wear of each version of the track, % (the end of life: docs/bench/prognostics.md).
-FAILURE_WEAR = {1: 40.0}
+FAILURE_WEAR = {1: 40.0, 2: 40.0}
 ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
 #: Where a sample with no end of life enters the metrics: this many records after the prediction.
 HORIZON = 365.0
