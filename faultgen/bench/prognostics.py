@@ -243,12 +243,12 @@ def score(folder: str | Path, prognoser, name: str, allow_modified: bool = False
             "verdict": words, "per_unit": method_rows, "naive_per_unit": naive_rows}
 
 
-def _cell(figure: dict, scale: float = 1.0, digits: int = 2) -> str:
+def _cell(figure: dict, scale: float = 1.0, digits: int = 2, kind: str = "f") -> str:
     value = figure["value"] * scale
     if not np.isfinite(value):
         return "-"
     low, high = (x * scale for x in figure["ci95"])
-    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
+    return f"{value:.{digits}{kind}} [{low:.{digits}{kind}}, {high:.{digits}{kind}}]"
 
 
 HEADER = ("| track | prognoser | alpha-lambda met % [95 % CI] (naive) | relative accuracy at lambda [CI] (naive) | "
@@ -277,7 +277,8 @@ def markdown_row(results: dict, command: str) -> str:
              results["verdict"].split(" (")[0]]
     if int(results["version"]) >= 2:
         cells[3:3] = [f"{_cell(r['late_share'], 100, 0)} ({_cell(n['late_share'], 100, 0)})",
-                      f"{_cell(r['phm08_lambda'])} ({_cell(n['phm08_lambda'])})"]
+                      # three significant digits: a sample with no end of life scores exp(36.5) - 1 (HORIZON days late)
+                      f"{_cell(r['phm08_lambda'], 1, 3, 'g')} ({_cell(n['phm08_lambda'], 1, 3, 'g')})"]
     return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
 
 
