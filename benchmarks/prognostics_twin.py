@@ -2,6 +2,7 @@
 prognostics track's test fleet, scored as `faultgen bench score prognostics` scores a prognoser.
 
     python benchmarks/prognostics_twin.py --data prognostics-full [--size full] [--work DIR]
+    python benchmarks/prognostics_twin.py --data prognostics-v2-full --version 2 [--without-tests]
 
 The twin reads a fleet's raw logs, which a track's ``test.h5`` (features) no longer holds, so this
 script writes the track version's test fleet again with its recipe (the independent simulator,
@@ -16,6 +17,13 @@ The end of life and onset are the fleet's ``truth.csv`` (the same as the track's
 naive prognoser (the train split's lives, from ``--data``'s ``train.h5``) is scored on the same
 days. Metrics, intervals and verdict: :mod:`faultgen.bench.prognostics`. Prints the leaderboard row.
 Not in the track's numeric profile: the fleet's last bits may differ from the track's test split.
+
+Version 2 (friction tests every 14 days, docs/bench/prognostics.md): the fleet is written with its
+tests (``LOGS/<unit>/friction-test/``), which the monitor reads (faultgen.monitor.friction_tests):
+the twin **with tests**, whose ``scores.csv`` wear is on the tests' scale from each unit's first test
+on (each log's estimate times the scale factor the tests up to it gave); ``--without-tests`` moves
+the test folders out of LOGS first (to ``WORK/tests-apart``): the production-log twin on the same
+fleet.
 """
 
 from __future__ import annotations
@@ -49,10 +57,13 @@ def main() -> None:
     parser.add_argument("--data", type=Path, required=True, help="The track's folder of `faultgen bench make`.")
     parser.add_argument("--size", default="full", choices=tracks.SIZES)
     parser.add_argument("--work", type=Path, default=None)
+    parser.add_argument("--version", type=int, default=1, help="The track version (2: with friction tests).")
+    parser.add_argument("--without-tests", action="store_true",
+                        help="Version 2: monitor the production logs only (the test folders moved out of LOGS).")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="prognostics-twin-"))
-    recipe = tracks.load("prognostics").version(1)
-    failure = prognostics.FAILURE_WEAR[1]
+    recipe = tracks.load("prognostics").version(args.version)
+    failure = prognostics.FAILURE_WEAR[args.version]
     started = time.perf_counter()
     robot = make.add_robots(recipe, work / "robots")["kr210"]
     (_, fleet), = recipe.fleets("test", args.size)
@@ -60,6 +71,12 @@ def main() -> None:
     logs, truth_path = independent.write_fleet(work / "fleet", spec, robot)
     n_axes = robots.load(robot).n_axes
     print(f"fleet {spec} written in {time.perf_counter() - started:.0f} s")
+    tested = sorted(logs.glob(f"*/{independent.TEST_FOLDER}"))
+    if args.without_tests:  # the production-log twin: the tests out of the monitor's sight
+        for folder in tested:
+            (work / "tests-apart").mkdir(exist_ok=True)
+            folder.rename(work / "tests-apart" / folder.parent.name)
+    print(f"friction tests given to the monitor: {0 if args.without_tests else len(tested)} units' folders")
     out = work / "monitor"
     command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--no-calibrate", "--failure-wear", f"{failure:g}"]
@@ -102,7 +119,9 @@ def main() -> None:
         naive_rows.append({**extra, **prognostics.unit_metrics(mean_life, eol, onset)})
     print(f"{sum(len(r) for r in twin_rows)} unit rows replayed in {time.perf_counter() - started:.0f} s")
     words, diff = prognostics.verdict(twin_rows, naive_rows)
-    results = {"method": "twin (faultgen monitor)", "track": "prognostics", "version": "1", "size": args.size,
+    method = "twin (faultgen monitor)" if not tested else (
+        "twin, production logs only (faultgen monitor)" if args.without_tests else "twin with friction tests (faultgen monitor)")
+    results = {"method": method, "track": "prognostics", "version": str(args.version), "size": args.size,
                "date": datetime.date.today().isoformat(), "results": prognostics.summary(twin_rows),
                "naive": prognostics.summary(naive_rows), "verdict": words}
     for row in twin_rows:
@@ -110,7 +129,7 @@ def main() -> None:
                                    "ra_lambda", "ph")})
     print(f"verdict: {words}; relative accuracy at lambda minus the naive's: {diff['value']:.2f} "
           f"[{diff['ci95'][0]:.2f}, {diff['ci95'][1]:.2f}]")
-    print(prognostics.HEADER)
+    print(prognostics.header(args.version))
     print(prognostics.markdown_row(results, "python benchmarks/prognostics_twin.py " + " ".join(sys.argv[1:])))
 
 

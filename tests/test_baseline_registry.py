@@ -221,7 +221,7 @@ def test_bench_score_prognostics_takes_a_registered_prognoser_by_name(prognostic
     result = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(prognostics_small),
                                  "--prognoser", "doubling", "-o", str(out)])
     assert result.exit_code == 0, result.output
-    assert "| prognostics v1 (small) | doubling |" in result.output
+    assert "| prognostics v2 (small) | doubling |" in result.output
     written = json.loads(out.with_suffix(".json").read_text())
     direct = prognostics.score(prognostics_small, baseline_example.Doubling(), "doubling")
     assert written["method"] == "doubling"

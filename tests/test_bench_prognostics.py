@@ -18,16 +18,17 @@ from faultgen.bench import baselines, files, independent, make, prognosers, prog
 
 @pytest.fixture(scope="module")
 def small(shared_bench):
-    """Version 1 at its test size, made by the command (in its numeric profile) once a session
-    (conftest.py)."""
+    """The latest version (2: version 1 with friction tests) at its test size, made by the command (in its
+    numeric profile) once a session (conftest.py)."""
     folder = shared_bench("prognostics")
     return folder, json.loads((folder / "manifest.json").read_text())
 
 
 def test_the_track_is_made_again_identical_to_its_frozen_manifest_with_run_to_failure_units(small):
     folder, manifest = small
-    assert manifest["status"] == "checked"  # faultgen/bench/manifests/prognostics-1-small.json
-    assert manifest["arrays"] == json.loads(make.manifest_path("prognostics", 1, "small").read_text())["arrays"]
+    assert manifest["status"] == "checked"  # faultgen/bench/manifests/prognostics-<latest>-small.json
+    frozen = make.manifest_path("prognostics", manifest["version"], "small")
+    assert manifest["arrays"] == json.loads(frozen.read_text())["arrays"]
     train, test = files.read(folder / "train.h5"), files.read(folder / "test.h5")
     assert {(u.robot, u.sample) for u in train} == {("kr210", "cycle")}
     assert {(u.robot, u.sample) for u in test} == {("kr210", "log")}
@@ -113,7 +114,7 @@ def test_the_command_writes_the_row_and_the_verdict(small, tmp_path):
                            "--baseline", "linear", "-o", str(tmp_path / "lin")], capture_output=True, text=True,
                           timeout=600, check=False)
     assert done.returncode == 0, done.stderr
-    assert "| prognostics v1 (small) | linear |" in done.stdout and "verdict: " in done.stdout
+    assert "| prognostics v2 (small) | linear |" in done.stdout and "verdict: " in done.stdout
     saved = json.loads((tmp_path / "lin.json").read_text())
     assert saved["naive"]["ra_lambda"]["units"] == 3 and saved["verdict"] in done.stdout
     refused = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "score", "prognostics", "--data",

@@ -25,6 +25,15 @@ from faultgen import inputs
 from faultgen.data import atomic, cells
 from faultgen.operation.logformat import MAX_CYCLE, PAYLOAD_COLUMN, TEMPERATURE_PREFIX, VALUE_BOUNDS
 
+#: The friction tests' readings (the prognostics track's version 2, docs/bench/prognostics.md): name ->
+#: (unit, layout); on the record of the test's day, 0 on the others (``friction_test`` 1 marks the
+#: records with a test): each axis's dry level with its 95 % interval and viscous coefficient, arm
+#: side, at the test's logged joint temperature (``faultgen friction-test``'s friction_fit.csv).
+TEST_ARRAYS = {
+    "friction_test": ("1", "cycle"), "friction_test_coulomb": ("N m", "cycle, axis"),
+    "friction_test_coulomb_low": ("N m", "cycle, axis"), "friction_test_coulomb_high": ("N m", "cycle, axis"),
+    "friction_test_viscous": ("N m s/rad", "cycle, axis"), "friction_test_temperature": ("degC", "cycle, axis"),
+}
 #: name -> unit of every per-record array a method may read (faultgen's dataset schema): the
 #: per-axis features ("record, axis"), the histograms ("record, axis, bin") and, for a run with
 #: operating conditions, what a plant logs beside them.
@@ -33,6 +42,7 @@ OBSERVABLES = {
     "average_load_torque": "N m", "angle_hist": "1", "speed_hist": "1", "torque_hist": "1",
     "day": "d", "hour": "h", "ambient_temperature": "degC", "joint_temperature": "degC", "payload_mass": "kg",
     "task_index": "1",
+    **{name: unit for name, (unit, _) in TEST_ARRAYS.items()},
 }
 #: The per-axis scalar features a detector sees by default (columns of :meth:`Unit.features`).
 FEATURES = ("mean_abs_torque", "rms_torque", "average_speed", "average_load_torque")
@@ -67,6 +77,9 @@ VALUE_RANGES = {
     "day": (0.0, MAX_CYCLE), "hour": (0.0, 24.0), "ambient_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2],
     "joint_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2], "payload_mass": VALUE_BOUNDS[PAYLOAD_COLUMN][:2],
     "task_index": (0, MAX_CYCLE), "fault_level": (0.0, MAX_FAULT_LEVEL),
+    "friction_test": (0, 1), **dict.fromkeys(("friction_test_coulomb", "friction_test_coulomb_low",
+                                              "friction_test_coulomb_high"), _TAU),
+    "friction_test_viscous": (-1e9, 1e9), "friction_test_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2],
 }
 
 
@@ -209,7 +222,8 @@ def _unit_arrays(path: Path, uid: str, g, labelled: bool) -> tuple[dict, int]:
     arrays = {}
     for name in OBSERVABLES:
         if name in g:
-            shape = tuple(sizes[axis.strip()] for axis in SHAPES[name].split(","))
+            layout = TEST_ARRAYS[name][1] if name in TEST_ARRAYS else SHAPES[name]
+            shape = tuple(sizes[axis.strip()] for axis in layout.split(","))
             arrays[name] = inputs.bounded_dataset(g, name, path, shape, kinds="iu" if name == "cycles" else "fiub")
     if labelled:
         arrays["fault_level"] = inputs.bounded_dataset(g, "fault_level", path, (n,), kinds="fiu")

@@ -193,13 +193,16 @@ def _fleet_units(version: tracks.Version, split: str, size: str, sweeps: Path, a
                  progress: bool) -> list[files.Unit]:
     """The units of the version's ``logs`` parts for ``split``: each fleet written by the independent
     simulator into ``sweeps`` (resuming), imported as ``faultgen logs import`` does (only new logs),
-    and labelled from its truth.csv (wear %, worn axis)."""
-    from faultgen.bench import independent
+    and labelled from its truth.csv (wear %, worn axis); a fleet with friction tests gets their
+    readings on its records (:mod:`faultgen.bench.friction_readings`; truth_tests.csv is never read)."""
+    from faultgen.bench import friction_readings, independent
     from faultgen.data import fleetlogs
+    from faultgen.model import robots
 
     units = []
     for part, fleet in version.fleets(split, size):
         folder = added[fleet["robot"]]
+        model = robots.load(folder)
         spec = independent.FleetSpec(**{k: tuple(v) if isinstance(v, list) else v for k, v in fleet["spec"].items()})
         logs, truth_path = independent.write_fleet(sweeps / f"{split}-{part}", spec, folder)
         dataset = sweeps / f"{split}-{part}.h5"
@@ -215,6 +218,9 @@ def _fleet_units(version: tracks.Version, split: str, size: str, sweeps: Path, a
                 unit.fault_level = known["wear"].astype(float)
                 unit.worn_axis = known["axis"]
                 unit.fault = "friction_wear" if known["axis"] else "none"
+                if spec.friction_test_every:  # the tests' readings on their days' records, never their truth
+                    unit.arrays.update(friction_readings.arrays(logs / run.id / independent.TEST_FOLDER,
+                                                                known["stamps"], model))
                 units.append(unit)
     return units
 

@@ -22,10 +22,11 @@ performance"):
   falls below 0 when the error exceeds the true RUL), and averaged over every prediction (cumulative);
 - **prognostic horizon**: the end of life minus the first prediction meeting the alpha criterion
   (``progpy.metrics.prognostic_horizon``), 0 when none does, in records (days on the track);
-- at lambda (issue 75, :mod:`faultgen.bench.rul_scores`; in the JSON, not yet the leaderboard's
-  row): whether the median is late by more than ALPHA of the true remaining life, whether the 5-95 %
+- at lambda (issue 75, :mod:`faultgen.bench.rul_scores`; in the JSON, and from version 2 in the
+  leaderboard's row): whether the median is late by more than ALPHA of the true remaining life, whether the 5-95 %
   interval covers it, and the PHM 2008 score of the median (summarised as the late share, the
-  covering share and the mean score).
+  covering share and the mean score; from version 2 the late share and the score are columns of
+  the leaderboard's row, :func:`header`).
 
 Over the units: the share meeting alpha-lambda, the mean relative accuracy at lambda and the median
 prognostic horizon, each with a 95 % percentile bootstrap interval over test units
@@ -48,7 +49,7 @@ from faultgen.bench import baselines, files, prognosers, rul_scores
 from faultgen.data import atomic
 
 #: The failure wear of each version of the track, % (the end of life: docs/bench/prognostics.md).
-FAILURE_WEAR = {1: 40.0}
+FAILURE_WEAR = {1: 40.0, 2: 40.0}
 ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
 #: Where a sample with no end of life enters the metrics: this many records after the prediction.
 HORIZON = 365.0
@@ -242,26 +243,42 @@ def score(folder: str | Path, prognoser, name: str, allow_modified: bool = False
             "verdict": words, "per_unit": method_rows, "naive_per_unit": naive_rows}
 
 
-def _cell(figure: dict, scale: float = 1.0, digits: int = 2) -> str:
+def _cell(figure: dict, scale: float = 1.0, digits: int = 2, kind: str = "f") -> str:
     value = figure["value"] * scale
     if not np.isfinite(value):
         return "-"
     low, high = (x * scale for x in figure["ci95"])
-    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
+    return f"{value:.{digits}{kind}} [{low:.{digits}{kind}}, {high:.{digits}{kind}}]"
 
 
 HEADER = ("| track | prognoser | alpha-lambda met % [95 % CI] (naive) | relative accuracy at lambda [CI] (naive) | "
           "prognostic horizon, median days [CI] (naive) | verdict | command | date |")
 
 
+#: From version 2 on (issue 75) the table also gives, at lambda, the share of units whose median is late
+#: by more than alpha and the mean PHM 2008 score of the median (:mod:`faultgen.bench.rul_scores`).
+HEADER_V2 = HEADER.replace(" | verdict |", " | late by more than alpha at lambda, % of units [CI] (naive) | "
+                                          "PHM 2008 score at lambda, mean [CI] (naive) | verdict |")
+
+
+def header(version) -> str:
+    """The leaderboard table's header for the track ``version`` (:data:`HEADER`, :data:`HEADER_V2` from 2)."""
+    return HEADER if int(version) < 2 else HEADER_V2
+
+
 def markdown_row(results: dict, command: str) -> str:
-    """One row of the leaderboard's prognostics table (docs/leaderboard.md) for ``results``."""
+    """One row of the leaderboard's prognostics table (docs/leaderboard.md) for ``results`` (the
+    columns of :func:`header` of its version)."""
     r, n = results["results"], results["naive"]
     track = f"{results['track']} v{results['version']}" + (f" ({results['size']})" if results["size"] != "full" else "")
     cells = [f"{_cell(r['alpha_lambda_share'], 100, 0)} ({_cell(n['alpha_lambda_share'], 100, 0)})",
              f"{_cell(r['ra_lambda'])} ({_cell(n['ra_lambda'])})",
              f"{_cell(r['prognostic_horizon'], 1, 0)} ({_cell(n['prognostic_horizon'], 1, 0)})",
              results["verdict"].split(" (")[0]]
+    if int(results["version"]) >= 2:
+        cells[3:3] = [f"{_cell(r['late_share'], 100, 0)} ({_cell(n['late_share'], 100, 0)})",
+                      # three significant digits: a sample with no end of life scores exp(36.5) - 1 (HORIZON days late)
+                      f"{_cell(r['phm08_lambda'], 1, 3, 'g')} ({_cell(n['phm08_lambda'], 1, 3, 'g')})"]
     return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
 
 
@@ -271,5 +288,6 @@ def write(results: dict, out: str | Path, command: str) -> tuple[Path, Path]:
     json_path, md_path = out.with_name(out.name + ".json"), out.with_name(out.name + ".md")
     with atomic.output_set([json_path, md_path]) as staged:
         staged(json_path).write_text(json.dumps({**results, "command": command}, indent=1) + "\n")
-        staged(md_path).write_text(HEADER + "\n|" + "---|" * 8 + "\n" + markdown_row(results, command) + "\n")
+        top = header(results["version"])
+        staged(md_path).write_text(top + "\n|" + "---|" * (top.count("|") - 1) + "\n" + markdown_row(results, command) + "\n")
     return json_path, md_path

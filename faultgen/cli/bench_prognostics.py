@@ -37,7 +37,7 @@ def score(data: Path, prognoser: str | None, baseline: str | None, out: Path | N
     json_path, md_path = prognostics.write(results, stem, command)
     for line in verdicts.modified_lines(results):
         typer.echo(line)
-    typer.echo(prognostics.HEADER)
+    typer.echo(prognostics.header(results["version"]))
     typer.echo(prognostics.markdown_row(results, command))
     diff = results["ra_lambda_minus_naive"]
     typer.echo(f"verdict: {results['verdict']}; relative accuracy at lambda minus the naive prognoser's (mean life "

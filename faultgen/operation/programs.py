@@ -83,6 +83,7 @@ from faultgen.operation.tasks import (  # noqa: F401
     LogTask,
     ProgramError,
     Task,
+    TextProgram,
     check_step,
 )
 
@@ -123,6 +124,8 @@ def check_name(task: str) -> str:
     if isinstance(task, LogTask):
         if not Path(task.path).is_file():
             raise ValueError(f"task file {task.path!r} does not exist")
+        return task
+    if isinstance(task, TextProgram):  # a program given by its text: no file to look for
         return task
     if not isinstance(task, str) or not task:
         raise ValueError(f"task {task!r}: expected a task name ({', '.join(TASKS)}) or a program file (.toml) "
@@ -173,6 +176,8 @@ def load(robot: Robot, task: str) -> Task:
     check_name(task)
     if task in TASKS:
         return builtin(robot, task)
+    if isinstance(task, TextProgram):
+        return parse(task.text, robot, where=f"program {task}")
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         return read(task, robot)
     # only a replayed log needs the log reader (pandas, h5py, scipy.signal: about 1 s to import,
@@ -189,7 +194,7 @@ def record(task: str) -> dict | None:
     and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); None for a thesis task."""
     if task in TASKS or not is_file_task(task):
         return None
-    data = Path(task).read_bytes()
+    data = task.text.encode() if isinstance(task, TextProgram) else Path(task).read_bytes()
     out = {"file": str(task), "sha256": hashlib.sha256(data).hexdigest()}
     if str(task).lower().endswith(PROGRAM_SUFFIXES):
         text = data.decode()
@@ -556,7 +561,7 @@ def show(robot: Robot, task: str) -> str:
     check_name(task)
     if not str(task).lower().endswith(PROGRAM_SUFFIXES):
         raise ValueError(f"{task}: a joint log has no program text; `faultgen tasks show` prints programs")
-    return Path(task).read_text()
+    return task.text if isinstance(task, TextProgram) else Path(task).read_text()
 
 
 def available(robot: Robot) -> list[tuple[str, str]]:

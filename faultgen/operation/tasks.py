@@ -193,6 +193,31 @@ class LogTask:
                 **{k: list(v) if isinstance(v, tuple) else v for k, v in options.items()}}
 
 
+class TextProgram(str):
+    """A program file given by its text rather than a path (issue 75: a fleet's friction test travels
+    in its runs' configuration, so that two machines or two caches make the same runs). It stands
+    where a program file's path does: ``str()`` is its name, ``<stem>-<SHA-256 of the text, 12 hex>.toml``
+    (a name, not a file: the digest in it makes equal names equal texts), ``text`` the TOML;
+    :func:`faultgen.operation.programs.load` parses the text and
+    :func:`faultgen.operation.programs.record` keeps it, as for a file. Pickles with its text (to a
+    worker process or a cluster's worker)."""
+
+    text: str
+
+    def __new__(cls, stem: str, text: str, *, named: bool = False) -> "TextProgram":
+        import hashlib
+
+        if not isinstance(text, str) or not isinstance(stem, str) or not stem:
+            raise ValueError(f"TextProgram({stem!r}, ...): expected a non-empty name and the program's TOML text")
+        name = stem if named else f"{stem}-{hashlib.sha256(text.encode()).hexdigest()[:12]}.toml"
+        self = super().__new__(cls, name)
+        self.text = text
+        return self
+
+    def __getnewargs_ex__(self):
+        return (str(self), self.text), {"named": True}
+
+
 def check_step(dt) -> float:
     """``dt`` as a float if it is a positive step in s that divides :data:`PLAN_PERIOD` into whole
     steps (e.g. 0.004, 0.002, 0.001, 0.0005), else ValueError saying so."""

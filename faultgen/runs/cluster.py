@@ -45,6 +45,7 @@ import numpy as np
 from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
+from faultgen.operation import programs
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
 from faultgen.simulation import backends
@@ -99,7 +100,7 @@ def for_workers(config: sim.RunConfig) -> sim.RunConfig:
     changes = {}
     if str(config.robot) not in robots.available() and Path(config.robot).exists():
         changes["robot"] = str(Path(config.robot).absolute())
-    if Path(config.task).is_file():
+    if not isinstance(config.task, programs.TextProgram) and Path(config.task).is_file():
         changes["task"] = str(Path(config.task).absolute())
     return replace(config, **changes) if changes else config
 

@@ -28,8 +28,8 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   fault, hall climate, warm-up and unit spread those of the robot's records at that cycle; no part
   carried), with its 250 Hz signals, labelled a test (run attribute ``record = "friction_test"``,
   :data:`faultgen.data.schema.RECORD_ATTRIBUTE`); the typed reader keeps a fleet's tests beside its
-  runs (``Dataset.friction_tests``), not among them. The program is written once per model and
-  content into :func:`friction_test_program`'s folder.
+  runs (``Dataset.friction_tests``), not among them. The program travels in the test runs' configuration
+  as its text (:func:`friction_test_program`: no file, no cache folder).
 
 Labels: a run's ``worn_axes`` (empty: healthy), its wear schedule (``last_cycle`` /
 ``cycles_per_day`` is the failure day) and the true wear per day (``friction_multiplier``); the
@@ -38,11 +38,8 @@ draws of every robot are in the dataset's grid JSON (:meth:`Fleet.to_json`).
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
 from dataclasses import asdict, dataclass, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -121,30 +118,22 @@ CONDITIONS = ("thermal", "payloads", "spread")
 TEST_SUFFIX = "-friction-test"
 
 
-def friction_test_program(robot) -> Path:
-    """The friction test of ``robot`` (a :class:`~faultgen.model.robot.Robot`) as a program file, written
-    once (atomically) and named by the robot and its text's SHA-256: ``<folder>/<robot>-<sha 12>.toml``,
-    the folder ``$FAULTGEN_CACHE/friction-tests`` (default ``$XDG_CACHE_HOME/faultgen`` or
-    ``~/.cache/faultgen``). The same robot gives the same file, so a resumed fleet finds its runs
-    finished; the dataset keeps the program's text. A cluster's workers must see the folder.
+def friction_test_program(robot) -> programs.TextProgram:
+    """The friction test of ``robot`` (a :class:`~faultgen.model.robot.Robot`) as a program given by
+    its text (:class:`faultgen.operation.tasks.TextProgram`, named ``<robot>-<sha 12>.toml`` by the
+    robot and its text's SHA-256): it travels in each test run's configuration, so the runs' keys and
+    files are the same on every machine (a fleet's runs used to name a file written into a cache folder,
+    whose path entered their keys). The same robot gives the same program, so a resumed fleet finds
+    its runs finished; the dataset keeps the program's text.
 
     Raises
     ------
     ValueError
         As :func:`faultgen.operation.friction_test.program` (an axis whose stroke leaves no speed).
-    OSError
-        When the folder cannot be written.
     """
-    from faultgen.data import atomic
     from faultgen.operation import friction_test
 
-    text = friction_test.text(robot)
-    root = os.environ.get("FAULTGEN_CACHE") or Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "faultgen"
-    path = Path(root) / "friction-tests" / f"{robot.name}-{hashlib.sha256(text.encode()).hexdigest()[:12]}.toml"
-    if not path.is_file() or path.read_text() != text:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(path, text)
-    return path
+    return programs.TextProgram(robot.name, friction_test.text(robot))
 
 
 @dataclass(frozen=True)
@@ -407,7 +396,7 @@ class Fleet:
         table = {k: v for k, v in robot["conditions"].items() if k not in ("payloads", "task_mix")}
         test = friction_test_program(daily.model)
         record = tuple((day - 1) * self.cycles_per_day + 1 for day in self.test_days())
-        config = sim.RunConfig(robot=daily.robot, task=str(test), friction=self.friction, wear=daily.wear,
+        config = sim.RunConfig(robot=daily.robot, task=test, friction=self.friction, wear=daily.wear,
                                cycles=daily.cycles, record=record, seed=daily.seed, noise=daily.noise, nthread=1,
                                conditions=conditions.Conditions.from_dict(table), signals=True, fault=daily.fault,
                                resolved=daily.model)
