@@ -104,6 +104,12 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+    # a delay of the torque channels left on the log calibrated: unexplained on the axes it shows on
+    found_delay = delays.shown(data.t, tau, predicted, moving) or {}
+    shifted = found_delay.get("axes", [])
+    if found_delay:
+        channel_delay["shown"] = found_delay
+        channel_delay["line"] = channel_delay.get("line", "") + "; " + shown_words(found_delay)
     after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
 
     out = Path(out)
@@ -154,9 +160,12 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     final_tests = tested(predicted)
     after_steps.append({"after": "calibrated model", "axes": residual_tests.summary(final_tests)})
     # what each unexplained axis's remainder follows (the generic library's terms, in words)
-    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out))
+    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out),
+                                      also=shifted)
     follows = {u["axis"]: remainder.explain(data.t, data.q, data.qd, data.qdd, tau, predicted, nominal.gear_ratio,
-                                            split.fit, split.held_out, u["axis"] - 1) for u in left}
+                                            split.fit, split.held_out, u["axis"] - 1,
+                                            delay=(found_delay["seconds"], found_delay["interval_s"])
+                                            if u["axis"] in shifted else None) for u in left}
     result = Calibration(
         robot=nominal.name,
         measured=str(data.source),
@@ -255,6 +264,17 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
     record["after_correction"] = left.record()
     record["line"] += "; left: " + left.line().removeprefix("channel delay: ")
     return data, record, corrected
+
+
+def shown_words(found: dict) -> str:
+    """The delay check's words on a delay of :func:`faultgen.calibrate.delay.shown`: the axes it is
+    left unexplained on, or why it is not taken for a channel delay."""
+    level = f"{found['level']:.0%}"
+    if not found["channel"]:
+        return (f"not a channel delay: its {level} interval leaves out 0, but moving the torque by it makes the "
+                f"model's error larger ({found['error_before']:.4f} -> {found['error_after']:.4f})")
+    where = f"axes {', '.join(map(str, found['axes']))}" if found["axes"] else "no single axis"
+    return f"at {level} it shows on {where}: left unexplained there unless corrected"
 
 
 #: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`

@@ -142,14 +142,20 @@ class Calibration:
 
     def unexplained(self) -> list[dict]:
         """The axes the calibrated model leaves unexplained: a residual test failed and the axis
-        is above its noise floor (:func:`faultgen.calibrate.residual_tests.unexplained`); each with
-        its tests' statistics and p-values and the effects added on it (with their step)."""
+        is above its noise floor (:func:`faultgen.calibrate.residual_tests.unexplained`), or a delay
+        of the torque channels shows on it (:func:`faultgen.calibrate.delay.shown`; the axis's record then
+        has ``channel_delay``: the log's delay, its interval and level, the rule and the axis's own
+        estimate); each with its tests' statistics and p-values and the effects added on it (with their step)."""
         if self.residual_tests is None:
             return []
-        found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after)
+        shown = (self.delay or {}).get("shown") or {}
+        found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after,
+                                           also=shown.get("axes", []))
         empty = {"terms": [], "explained_share": 0.0, "explained_interval": [0.0, 0.0]}
         return [{**u, "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(self.steps, start=1)
                                 if u["axis"] - 1 in s.axes],
+                 **({"channel_delay": {**{k: shown[k] for k in ("seconds", "interval_s", "level", "rule")},
+                                       "axis": shown["per_axis"][u["axis"]]}} if u["axis"] in shown.get("axes", []) else {}),
                  **{k: v for k, v in self.follows.get(u["axis"], empty).items() if k != "axis"},
                  "not_written": [d for d in self.declined if d["axis"] == u["axis"]]} for u in found]
 
