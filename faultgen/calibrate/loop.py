@@ -329,11 +329,9 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
         if progress:
             print(f"own friction: {effect.id} on axes {axes.numbers(chosen)}, held-out total nrmse "
                   f"{trial.gap['total_nrmse']:.4f}", flush=True)
-    for number, check in held.items():
-        if progress:
-            print(f"own friction: axis {number}'s dry level NOT SEPARABLE on this motion (its 95 % interval "
-                  f"+-{100 * check['share']:.0f} % of nominal; dry and viscous columns at cosine {check['cosine']:.3f}): "
-                  "held at the nominal model's", flush=True)
+    if held and progress:
+        print(f"own friction: the dry level of axes {', '.join(held)} not separable on this motion: held at the nominal "
+              "model's", flush=True)
     return model, predicted, motion
 
 

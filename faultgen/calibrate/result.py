@@ -11,7 +11,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate.effects import Effect
-from faultgen.calibrate import remainder, residual_tests
+from faultgen.calibrate import remainder, residual_tests, separable
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -159,6 +159,16 @@ class Calibration:
                  **{k: v for k, v in self.follows.get(u["axis"], empty).items() if k != "axis"},
                  "not_written": [d for d in self.declined if d["axis"] == u["axis"]]} for u in found]
 
+    def not_separable(self) -> list[dict]:
+        """The parameters this log cannot place, held at the nominal model's: per axis (numbered),
+        ``parameter`` (``coulomb``: the dry level of the own-friction fit,
+        :func:`faultgen.calibrate.loop.own_friction`) and the identifiability check's figures
+        (:func:`faultgen.calibrate.separable.dry_and_viscous`). Empty when every fitted level was
+        separable or none was fitted on every axis."""
+        return [{"axis": int(axis), "parameter": "coulomb", "held_at": "nominal", **check}
+                for s in self.steps if s.evidence.get("every_axis") and s.effect.id == "coulomb"
+                for axis, check in s.evidence.get("not_separable", {}).items()]
+
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
         :data:`faultgen.calibrate.search.SEPARABLE`, :func:`faultgen.calibrate.search.compare`): step number (1..), the effect fitted (the
@@ -206,6 +216,10 @@ class Calibration:
                 for name, motion in step.evidence["separate_by"].items():
                     lines.append(f"   to tell {name} apart: {motion}")
                 lines.append(f"   a designed excitation: faultgen excitation {self.robot} -o excitation.csv")
+        lines += [f"axis {h['axis']}: dry friction NOT SEPARABLE on this motion from the viscous level (its "
+                  f"{separable.LEVEL:.0%} interval " + ("unbounded" if h["share"] is None else
+                                                      f"+-{100 * h['share']:.0f} % of nominal")
+                  + f", accepted {100 * separable.SHARE:.0f} %): held at the nominal model's" for h in self.not_separable()]
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
         for u in self.unexplained():

@@ -2,7 +2,7 @@
 (:func:`dry_and_viscous`): the identifiability check of the joint fit that ``friction_every_axis``
 makes on every moving axis (:func:`faultgen.calibrate.loop.own_friction`).
 
-On a motion of few steady speeds the dry column ``G sign(qd)`` and the viscous column ``G qd`` are
+On a motion of few steady speeds the dry column ``G sign(qd)`` and the viscous column ``G^2 qd`` are
 nearly parallel, and a fit trades one level for the other at little cost: on faultgen's own UR5
 (a unit spread of 15 %, LuGre friction, an arc-weld program) the wrist's dry level came out at
 0.3-0.4 times the plant's with a viscous level 15 times it (issue 72, item 3). The check is the
@@ -37,7 +37,8 @@ def dry_and_viscous(design: np.ndarray, residual: np.ndarray, rows: np.ndarray, 
     Parameters
     ----------
     design : ndarray (n, 2)
-        The dry column (``G sign(qd)``, per N m of motor-side level) and the viscous column (``G qd``).
+        The dry column (``G sign(qd)``, per N m of motor-side level) and the viscous column (``G^2 qd``,
+        per N m s/rad of motor-side level).
     residual : ndarray (n,)
         What the model leaves on the axis, N m (arm side).
     rows : ndarray of bool (n,)
@@ -51,7 +52,8 @@ def dry_and_viscous(design: np.ndarray, residual: np.ndarray, rows: np.ndarray, 
     -------
     dict
         ``separable`` (bool), ``dry_half_width_Nm`` (the 95 % interval's half-width of the motor-side
-        dry level), ``share`` (over ``nominal_dry``), ``cosine`` and ``variance_inflation`` of the two
+        dry level; None: unbounded, the columns parallel or too few samples), ``share`` (over
+        ``nominal_dry``; None likewise), ``cosine`` and ``variance_inflation`` of the two
         columns, ``samples`` (independent), ``rule``.
     """
     x, y = design[rows][::max(1, int(stride))], residual[rows][::max(1, int(stride))]
@@ -63,9 +65,10 @@ def dry_and_viscous(design: np.ndarray, residual: np.ndarray, rows: np.ndarray, 
                        f"{SHARE:.0%} of the nominal dry level either way")}
     gram = x.T @ x
     if n <= 3 or np.linalg.cond(gram) > 1e12:
-        return {**record, "separable": False, "dry_half_width_Nm": float("inf"), "share": float("inf")}
+        return {**record, "separable": False, "dry_half_width_Nm": None, "share": None}
     theta = np.linalg.solve(gram, x.T @ y)
     s2 = float(np.sum((y - x @ theta) ** 2) / (n - 2))
     half = float(student_t.ppf((1 + LEVEL) / 2, n - 2) * np.sqrt(s2 * np.linalg.inv(gram)[0, 0]))
-    share = half / nominal_dry if nominal_dry > 0 else float("inf")
-    return {**record, "separable": bool(share <= SHARE), "dry_half_width_Nm": half, "share": float(share)}
+    share = half / nominal_dry if nominal_dry > 0 else None
+    return {**record, "separable": share is not None and bool(share <= SHARE), "dry_half_width_Nm": half,
+            "share": share}
