@@ -79,7 +79,7 @@ def test_the_log_delay_is_the_first_term_of_an_axis_with_its_value_and_interval(
     fit[: int(0.7 * n)] = True
     held = ~fit
     found = remainder.explain(t, q, qd, qdd, tau, model, np.full(6, 100.0), fit, held, 2,
-                              delay=(0.008, [0.0077, 0.0083]))
+                              log_delay=(0.008, [0.0077, 0.0083]))
     first = found["terms"][0]
     assert first["form"] == "channel_delay" and first["value"] == 0.008 and first["interval"] == [0.0077, 0.0083]
     assert "lags the motion by 8.0 ms (+7.7 .. +8.3 ms)" in first["words"]

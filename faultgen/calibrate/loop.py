@@ -164,7 +164,7 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
                                       also=shifted)
     follows = {u["axis"]: remainder.explain(data.t, data.q, data.qd, data.qdd, tau, predicted, nominal.gear_ratio,
                                             split.fit, split.held_out, u["axis"] - 1,
-                                            delay=(found_delay["seconds"], found_delay["interval_s"])
+                                            log_delay=(found_delay["seconds"], found_delay["interval_s"])
                                             if u["axis"] in shifted else None) for u in left}
     result = Calibration(
         robot=nominal.name,

@@ -216,7 +216,7 @@ def _forward(candidates: list[Group], pool: list[int], y: np.ndarray, fit: np.nd
 
 def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: np.ndarray, model: np.ndarray,
             gear_ratio: np.ndarray, fit: np.ndarray, held: np.ndarray, axis: int,
-            delay: tuple[float, list[float]] | None = None) -> dict:
+            log_delay: tuple[float, list[float]] | None = None) -> dict:
     """What the remainder ``tau - model`` of ``axis`` (0-based) follows (module docstring).
 
     Parameters
@@ -226,7 +226,7 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
     gear_ratio : ndarray (N,)
     fit, held : ndarray of bool (n, N)
         The fitting and held-out samples (:class:`faultgen.calibrate.search.Split`).
-    delay : (float, [float, float]) or None
+    log_delay : (float, [float, float]) or None
         A delay of the log's torque channels, s, and its interval (:func:`faultgen.calibrate.delay.shown`):
         the ``channel_delay`` term at that shift is the first term, whatever its share (a property of
         the log's channels, not of this axis), with the log's value and interval.
@@ -251,12 +251,7 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
                   "held-out part, 95 %; sizes: delete-one-block jackknife, 95 %")}
     if fit.sum() < 50 or held.sum() < 50:
         return record
-    start = []
-    if delay is not None:  # the log's delay in place of the one searched on this axis alone
-        m = model[:, axis]
-        candidates = [g for g in candidates if g.form != "channel_delay"]
-        candidates.append(Group("channel_delay", axis, 0, (np.interp(t - delay[0], t, m) - m)[:, None], delay[0]))
-        start = [len(candidates) - 1]
+    candidates, start = _with_delay(candidates, t, model[:, axis], axis, log_delay)
     selected = _lasso_groups(candidates, y, fit)
     # a selected form brings its other harmonics: the lasso picks among collinear harmonics poorly
     forms = {(candidates[k].form, candidates[k].axis) for k in selected}
@@ -273,14 +268,12 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
         g = candidates[k]
         value, unit = size(g, theta[widths[j]: widths[j + 1]])
         if k in start:  # the log's delay: its own interval
-            spread = None
-        elif g.form == "channel_delay":  # the shift searched again on each replicate's samples
-            spread = [delay(t, model[:, axis], y, keep) for keep in _blocks_left_out(fit)]
+            interval = [float(v) for v in log_delay[1]]
         else:
-            spread = [size(g, r[widths[j]: widths[j + 1]])[0] for r in replicates]
-        if spread is None:
-            interval = [float(v) for v in delay[1]]
-        else:
+            if g.form == "channel_delay":  # the shift searched again on each replicate's samples
+                spread = [delay(t, model[:, axis], y, keep) for keep in _blocks_left_out(fit)]
+            else:
+                spread = [size(g, r[widths[j]: widths[j + 1]])[0] for r in replicates]
             se = float(np.sqrt((len(spread) - 1) / len(spread) * np.sum((np.array(spread) - np.mean(spread)) ** 2)))
             interval = [value - factor * se, value + factor * se]
         resolved = _resolved(candidates, chosen, j, y, fit, held)
@@ -299,6 +292,17 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
                   nrmse_before=float(np.sqrt(np.mean(y[held] ** 2)) / scale),
                   nrmse_after=float(np.sqrt(np.mean(after**2)) / scale))
     return record
+
+
+def _with_delay(candidates: list[Group], t: np.ndarray, model: np.ndarray, axis: int, found) -> tuple[list[Group], list[int]]:
+    """``candidates`` with the log's channel delay ``found`` ((s, interval) or None) in place of the
+    shift searched on this axis alone (``model`` (n,): the axis's model torque, N m), and the index
+    of that group, to be taken first (empty when ``found`` is None)."""
+    if found is None:
+        return candidates, []
+    kept = [g for g in candidates if g.form != "channel_delay"]
+    kept.append(Group("channel_delay", axis, 0, (np.interp(t - found[0], t, model) - model)[:, None], found[0]))
+    return kept, [len(kept) - 1]
 
 
 #: The periodic forms, in words, for a period the log does not resolve.

@@ -12,6 +12,7 @@ import numpy as np
 from faultgen import axes
 from faultgen.calibrate.effects import Effect
 from faultgen.calibrate import remainder, residual_tests, separable
+from faultgen.effects.coulomb import Coulomb
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -161,12 +162,12 @@ class Calibration:
 
     def not_separable(self) -> list[dict]:
         """The parameters this log cannot place, held at the nominal model's: per axis (numbered),
-        ``parameter`` (``coulomb``: the dry level of the own-friction fit,
+        ``parameter`` (the Coulomb effect's id: the dry level of the own-friction fit,
         :func:`faultgen.calibrate.loop.own_friction`) and the identifiability check's figures
         (:func:`faultgen.calibrate.separable.dry_and_viscous`). Empty when every fitted level was
         separable or none was fitted on every axis."""
-        return [{"axis": int(axis), "parameter": "coulomb", "held_at": "nominal", **check}
-                for s in self.steps if s.evidence.get("every_axis") and s.effect.id == "coulomb"
+        return [{"axis": int(axis), "parameter": Coulomb.id, "held_at": "nominal", **check}
+                for s in self.steps if s.evidence.get("every_axis") and s.effect.id == Coulomb.id
                 for axis, check in s.evidence.get("not_separable", {}).items()]
 
     def ambiguous(self) -> list[dict]:
