@@ -57,6 +57,10 @@ def test_a_torque_logged_12_ms_late_is_found_and_corrected(tmp_path, late_log):
     assert found["interval_s"][0] <= LATE <= found["interval_s"][1]
     assert plain.delay["applied_s"] == 0.0  # by default reported only
     assert plain.unexplained(), plain.summary()  # the residual follows the motion
+    # issue 73: the delay named unexplained on every axis it shows on, the log's delay first
+    left = {u["axis"]: u for u in plain.unexplained()}
+    assert plain.delay["shown"]["channel"] and set(plain.delay["shown"]["axes"]) == set(left) == set(range(1, 7))
+    assert all(u["terms"][0]["form"] == "channel_delay" and abs(u["terms"][0]["value"] - LATE) <= 0.002 for u in left.values())
     corrected = calibrate("puma560", late_log, tmp_path / "auto", figure=False, delay="auto")
     assert corrected.delay["applied_s"] == found["seconds"]
     assert corrected.delay["after_correction"]["covers_zero"]

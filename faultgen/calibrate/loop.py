@@ -15,7 +15,7 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate import delay as delays
-from faultgen.calibrate import guard, plausibility, remainder, residual_tests, search
+from faultgen.calibrate import guard, plausibility, remainder, residual_tests, search, separable
 from faultgen.calibrate.effects import Effect, get
 from faultgen.calibrate.improve import backfit, complete, extend, sysid_stribeck
 from faultgen.calibrate.prediction import predicted_motion
@@ -92,8 +92,6 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     nominal = robots.require(robot, "calibrate.loop.run")
     data = measured if isinstance(measured, measured_io.MeasuredData) else measured_io.read(measured, nominal)
     data, channel_delay, (predicted, motion) = check_delay(nominal, data, delay)
-    if progress:
-        print(channel_delay.get("line", channel_delay.get("reason")), flush=True)
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     model = Model.nominal(nominal)
@@ -104,6 +102,16 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
+    # a delay of the torque channels left on the log calibrated: unexplained on the axes it shows on
+    checked = channel_delay.get("after_correction", channel_delay.get("estimate"))
+    # the 99 % interval, from the same bootstrap replicates, holds the 95 % one: no need when that covers 0
+    found_delay = (delays.shown(data.t, tau, predicted, moving) or {}) if checked and not checked["covers_zero"] else {}
+    shifted = found_delay.get("axes", [])
+    if found_delay:
+        channel_delay["shown"] = found_delay
+        channel_delay["line"] = channel_delay.get("line", "") + "; " + shown_words(found_delay)
+    if progress:
+        print(channel_delay.get("line", channel_delay.get("reason")), flush=True)
     after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
 
     out = Path(out)
@@ -154,9 +162,12 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     final_tests = tested(predicted)
     after_steps.append({"after": "calibrated model", "axes": residual_tests.summary(final_tests)})
     # what each unexplained axis's remainder follows (the generic library's terms, in words)
-    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out))
+    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out),
+                                      also=shifted)
     follows = {u["axis"]: remainder.explain(data.t, data.q, data.qd, data.qdd, tau, predicted, nominal.gear_ratio,
-                                            split.fit, split.held_out, u["axis"] - 1) for u in left}
+                                            split.fit, split.held_out, u["axis"] - 1,
+                                            log_delay=(found_delay["seconds"], found_delay["interval_s"])
+                                            if u["axis"] in shifted else None) for u in left}
     result = Calibration(
         robot=nominal.name,
         measured=str(data.source),
@@ -257,6 +268,17 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
     return data, record, corrected
 
 
+def shown_words(found: dict) -> str:
+    """The delay check's words on a delay of :func:`faultgen.calibrate.delay.shown`: the axes it is
+    left unexplained on, or why it is not taken for a channel delay."""
+    level = f"{found['level']:.0%}"
+    if not found["channel"]:
+        return (f"not a channel delay: its {level} interval leaves out 0, but moving the torque by it makes the "
+                f"model's error larger ({found['error_before']:.4f} -> {found['error_after']:.4f})")
+    where = f"axes {', '.join(map(str, found['axes']))}" if found["axes"] else "no single axis"
+    return f"at {level} it shows on {where}: left unexplained there unless corrected"
+
+
 #: Fewest moving samples of an axis (fitting and held-out parts together) for :func:`own_friction`
 #: to fit its dry (Coulomb) and viscous levels.
 OWN_FRICTION_SAMPLES = 200
@@ -273,34 +295,26 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
     reads wear in (issue 59, item 1). Fitted together because on a motion of few steady speeds a
     lower dry level and a higher viscous one give nearly the same torque: a dry level fitted alone
     takes up the viscous one's change. An axis whose joint fit is not admissible (a level below
-    zero) gets its Coulomb level alone. Appended to ``steps`` as one step per effect whose
-    evidence says so (``"every_axis": true``). Returns the model, its prediction and motion."""
+    zero) gets its Coulomb level alone. An axis whose dry level the log cannot place
+    (:func:`faultgen.calibrate.separable.dry_and_viscous`: its interval wider than the unit spread)
+    keeps the ``nominal`` model's dry level (the prior) and gets its viscous level alone; the step's
+    evidence names it (``not_separable``: per axis, the check's figures). Appended to ``steps`` as
+    one step per effect whose evidence says so (``"every_axis": true``). Returns the model, its
+    prediction and motion."""
     coulomb, viscous = get(Coulomb.id), get(Viscous.id)
     moving = split.fit | split.held_out
     rows = moving & (moving.sum(axis=0) >= OWN_FRICTION_SAMPLES)
-    residual = tau - predicted
-    dry, wet = {}, {}
+    dry, wet, held, checks = {}, {}, {}, {}
     for a in np.flatnonzero(rows.any(axis=0)):
-        a = int(a)
-        columns_c = coulomb.columns(motion, a, None)[0]  # (n, 2): both directions, the positive one's excess
-        phi_c, phi_v = columns_c[:, :1], viscous.columns(motion, a, None)[0]
-        # the two directions' difference set back to the nominal model's: the search's per-direction fit
-        # read out of one log is not kept (docs/analysis.md, "Every axis's own friction")
-        f, g = motion.robot.friction, nominal.friction
-        skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
-        r, keep = residual[:, a] - columns_c[:, 1] * skew, rows[:, a]
-        theta = np.linalg.lstsq(np.column_stack([phi_c, phi_v])[keep], r[keep], rcond=None)[0]
-        c = coulomb.params(motion, a, np.array([theta[0], skew]), None)
-        v = viscous.params(motion, a, theta[1:], None)
-        if not (coulomb.admissible(motion, a, c) and viscous.admissible(motion, a, v)):
-            theta = np.linalg.lstsq(phi_c[keep], r[keep], rcond=None)[0]
-            c, v = coulomb.params(motion, a, np.array([theta[0], skew]), None), None
-        if not coulomb.admissible(motion, a, c):
-            continue
-        dry[a] = c
+        c, v, check = _own_axis(int(a), motion, tau - predicted, rows[:, int(a)], nominal, residual_tests.stride(data.t))
+        checks[str(axes.number(int(a)))] = check
+        if c is not None:
+            dry[int(a)] = c
         if v is not None:
-            wet[a] = v
-    if not dry:
+            wet[int(a)] = v
+        if not check["separable"]:
+            held[str(axes.number(int(a)))] = check
+    if not dry and not wet:
         return model, predicted, motion
     rule = ("fitted on every moving axis, always (friction_every_axis; not by model selection), dry and viscous "
             "together on the whole moving record")
@@ -310,12 +324,47 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
         fitted = effect.fitted(model.robot, params)
         chosen = sorted(params)
         trial = judge(model.with_effect(fitted, chosen, path), data, tau, split.held_out)
-        steps.append(Step(fitted, chosen, {"rule": rule, "every_axis": True, "separable": True}, trial.gap, {}))
+        record = {"rule": rule, "every_axis": True, "separable": True, "not_separable": held,
+                  "dry_level_check": checks}
+        steps.append(Step(fitted, chosen, record, trial.gap, {}))
         model, predicted, motion = trial.model, trial.prediction, trial.motion
         if progress:
             print(f"own friction: {effect.id} on axes {axes.numbers(chosen)}, held-out total nrmse "
                   f"{trial.gap['total_nrmse']:.4f}", flush=True)
+    if held and progress:
+        print(f"own friction: the dry level of axes {', '.join(held)} not separable on this motion: held at the nominal "
+              "model's", flush=True)
     return model, predicted, motion
+
+
+def _own_axis(a: int, motion, residual: np.ndarray, keep: np.ndarray, nominal: robots.Robot, stride: int):
+    """One axis of :func:`own_friction`: its Coulomb and viscous parameters (None: not fitted) and
+    the identifiability check of the dry level (:func:`faultgen.calibrate.separable.dry_and_viscous`)."""
+    coulomb, viscous = get(Coulomb.id), get(Viscous.id)
+    columns_c = coulomb.columns(motion, a, None)[0]  # (n, 2): both directions, the positive one's excess
+    phi_c, phi_v = columns_c[:, :1], viscous.columns(motion, a, None)[0]
+    # the two directions' difference set back to the nominal model's: the search's per-direction fit
+    # read out of one log is not kept (docs/analysis.md, "Every axis's own friction")
+    f, g = motion.robot.friction, nominal.friction
+    skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
+    r = residual[:, a] - columns_c[:, 1] * skew
+    design = np.column_stack([phi_c, phi_v])
+    check = separable.dry_and_viscous(design, r, keep, stride, float(g.coulomb_pos[a] + g.coulomb_neg[a]) / 2)
+    if not check["separable"]:  # the dry level at the nominal model's, the viscous level fitted alone
+        to_nominal = float(g.coulomb_neg[a] - f.coulomb_neg[a])
+        c = coulomb.params(motion, a, np.array([to_nominal, skew]), None)
+        theta = np.linalg.lstsq(phi_v[keep], (r - phi_c[:, 0] * to_nominal)[keep], rcond=None)[0]
+        v = viscous.params(motion, a, theta, None)
+        return c, (v if viscous.admissible(motion, a, v) else None), check
+    theta = np.linalg.lstsq(design[keep], r[keep], rcond=None)[0]
+    c = coulomb.params(motion, a, np.array([theta[0], skew]), None)
+    v = viscous.params(motion, a, theta[1:], None)
+    if not (coulomb.admissible(motion, a, c) and viscous.admissible(motion, a, v)):
+        theta = np.linalg.lstsq(phi_c[keep], r[keep], rcond=None)[0]
+        c, v = coulomb.params(motion, a, np.array([theta[0], skew]), None), None
+    if not coulomb.admissible(motion, a, c):
+        return None, None, check
+    return c, v, check
 
 
 def evidence(best: search.Candidate, ranked: list[search.Candidate], residual: np.ndarray,

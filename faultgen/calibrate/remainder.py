@@ -188,12 +188,17 @@ def _lasso_groups(candidates: list[Group], y: np.ndarray, fit: np.ndarray) -> li
     return sorted(set(int(k) for k in chosen))
 
 
-def _forward(candidates: list[Group], pool: list[int], y: np.ndarray, fit: np.ndarray, held: np.ndarray
-             ) -> list[int]:
+def _forward(candidates: list[Group], pool: list[int], y: np.ndarray, fit: np.ndarray, held: np.ndarray,
+             start: list[int] = ()) -> list[int]:
     """Forward selection over the groups of ``pool`` by held-out mean square (least squares on the
-    fitting part), while each closes :data:`MIN_SHARE` of the held-out mean square remainder."""
+    fitting part), while each closes :data:`MIN_SHARE` of the held-out mean square remainder,
+    after the groups of ``start`` (taken first, whatever they close)."""
     total = float(np.mean(y[held] ** 2))
-    chosen, current = [], total
+    chosen = list(start)
+    current = total
+    if chosen:
+        design = np.column_stack([candidates[j].columns for j in chosen])
+        current = float(np.mean((y[held] - _predict(design[held], _ols(design, y, fit))) ** 2))
     while pool and len(chosen) < MAX_TERMS:
         trials = []
         for k in pool:
@@ -210,7 +215,8 @@ def _forward(candidates: list[Group], pool: list[int], y: np.ndarray, fit: np.nd
 
 
 def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: np.ndarray, model: np.ndarray,
-            gear_ratio: np.ndarray, fit: np.ndarray, held: np.ndarray, axis: int) -> dict:
+            gear_ratio: np.ndarray, fit: np.ndarray, held: np.ndarray, axis: int,
+            log_delay: tuple[float, list[float]] | None = None) -> dict:
     """What the remainder ``tau - model`` of ``axis`` (0-based) follows (module docstring).
 
     Parameters
@@ -220,6 +226,10 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
     gear_ratio : ndarray (N,)
     fit, held : ndarray of bool (n, N)
         The fitting and held-out samples (:class:`faultgen.calibrate.search.Split`).
+    log_delay : (float, [float, float]) or None
+        A delay of the log's torque channels, s, and its interval (:func:`faultgen.calibrate.delay.shown`):
+        the ``channel_delay`` term at that shift is the first term, whatever its share (a property of
+        the log's channels, not of this axis), with the log's value and interval.
 
     Returns
     -------
@@ -241,11 +251,13 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
                   "held-out part, 95 %; sizes: delete-one-block jackknife, 95 %")}
     if fit.sum() < 50 or held.sum() < 50:
         return record
+    candidates, start = _with_delay(candidates, t, model[:, axis], axis, log_delay)
     selected = _lasso_groups(candidates, y, fit)
     # a selected form brings its other harmonics: the lasso picks among collinear harmonics poorly
     forms = {(candidates[k].form, candidates[k].axis) for k in selected}
-    pool = [k for k, g in enumerate(candidates) if k in selected or ((g.form, g.axis) in forms and g.order)]
-    chosen = _forward(candidates, pool, y, fit, held)
+    pool = [k for k, g in enumerate(candidates)
+            if k not in start and (k in selected or ((g.form, g.axis) in forms and g.order))]
+    chosen = _forward(candidates, pool, y, fit, held, start)
     design = np.column_stack([candidates[k].columns for k in chosen]) if chosen else np.zeros((len(y), 0))
     widths = np.cumsum([0] + [candidates[k].columns.shape[1] for k in chosen])
     theta = _ols(design, y, fit)
@@ -255,12 +267,15 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
     for j, k in enumerate(chosen):
         g = candidates[k]
         value, unit = size(g, theta[widths[j]: widths[j + 1]])
-        if g.form == "channel_delay":  # the shift searched again on each replicate's samples
-            spread = [delay(t, model[:, axis], y, keep) for keep in _blocks_left_out(fit)]
+        if k in start:  # the log's delay: its own interval
+            interval = [float(v) for v in log_delay[1]]
         else:
-            spread = [size(g, r[widths[j]: widths[j + 1]])[0] for r in replicates]
-        se = float(np.sqrt((len(spread) - 1) / len(spread) * np.sum((np.array(spread) - np.mean(spread)) ** 2)))
-        interval = [value - factor * se, value + factor * se]
+            if g.form == "channel_delay":  # the shift searched again on each replicate's samples
+                spread = [delay(t, model[:, axis], y, keep) for keep in _blocks_left_out(fit)]
+            else:
+                spread = [size(g, r[widths[j]: widths[j + 1]])[0] for r in replicates]
+            se = float(np.sqrt((len(spread) - 1) / len(spread) * np.sum((np.array(spread) - np.mean(spread)) ** 2)))
+            interval = [value - factor * se, value + factor * se]
         resolved = _resolved(candidates, chosen, j, y, fit, held)
         text = words(g, axis, value, interval, unit)
         if not resolved:  # the period is not told apart by the log: the size as an RMS, the range said
@@ -277,6 +292,17 @@ def explain(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: 
                   nrmse_before=float(np.sqrt(np.mean(y[held] ** 2)) / scale),
                   nrmse_after=float(np.sqrt(np.mean(after**2)) / scale))
     return record
+
+
+def _with_delay(candidates: list[Group], t: np.ndarray, model: np.ndarray, axis: int, found) -> tuple[list[Group], list[int]]:
+    """``candidates`` with the log's channel delay ``found`` ((s, interval) or None) in place of the
+    shift searched on this axis alone (``model`` (n,): the axis's model torque, N m), and the index
+    of that group, to be taken first (empty when ``found`` is None)."""
+    if found is None:
+        return candidates, []
+    kept = [g for g in candidates if g.form != "channel_delay"]
+    kept.append(Group("channel_delay", axis, 0, (np.interp(t - found[0], t, model) - model)[:, None], found[0]))
+    return kept, [len(kept) - 1]
 
 
 #: The periodic forms, in words, for a period the log does not resolve.

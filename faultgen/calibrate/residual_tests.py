@@ -129,10 +129,12 @@ def run(t: np.ndarray, residual: np.ndarray, held: np.ndarray, tau: np.ndarray, 
     return records
 
 
-def unexplained(tests: list[dict], tau: np.ndarray, held: np.ndarray, gap_after: dict) -> list[dict]:
+def unexplained(tests: list[dict], tau: np.ndarray, held: np.ndarray, gap_after: dict, also=()) -> list[dict]:
     """The axes the model leaves unexplained: a residual test of :func:`run` failed (``tests``)
     and the axis's held-out nrmse (``gap_after``, :func:`faultgen.calibrate.search.gap`) is above
-    :data:`ABOVE_FLOOR` times its noise floor (measured torque ``tau`` (n, N) on ``held`` (n, N)).
+    :data:`ABOVE_FLOOR` times its noise floor (measured torque ``tau`` (n, N) on ``held`` (n, N));
+    and the axes numbered in ``also`` whatever their tests say (a channel delay shown on them,
+    :func:`faultgen.calibrate.delay.shown`).
 
     Returns
     -------
@@ -145,7 +147,7 @@ def unexplained(tests: list[dict], tau: np.ndarray, held: np.ndarray, gap_after:
     for record in tests:
         a = record["axis"] - 1
         nrmse = float(gap_after["nrmse"][a])
-        if record["failed"] and nrmse > ABOVE_FLOOR * floor[a]:
+        if (record["failed"] and nrmse > ABOVE_FLOOR * floor[a]) or record["axis"] in also:
             found.append({**record, "nrmse": nrmse, "noise_floor": float(floor[a]), "level": LEVEL})
     return found
 
@@ -171,6 +173,11 @@ def line(found: dict) -> str:
         w = found["whiteness"]
         tests.append(f"not white (Ljung-Box Q = {w['statistic']:.1f} over {w['lags']} lags, "
                      f"p = {w['p_adjusted']:.2g})")
+    shown = found.get("channel_delay")
+    if shown is not None:
+        low, high = shown["interval_s"]
+        tests.append(f"its torque logged {1e3 * shown['seconds']:+.1f} ms off the motion ({shown['level']:.0%} interval "
+                     f"{1e3 * low:+.1f} .. {1e3 * high:+.1f} ms; `--delay auto` corrects it)")
     follows = found["follows"]
     if follows is not None:
         v = found["independence"][follows["variable"]]

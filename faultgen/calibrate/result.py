@@ -11,7 +11,8 @@ import numpy as np
 
 from faultgen import axes
 from faultgen.calibrate.effects import Effect
-from faultgen.calibrate import remainder, residual_tests
+from faultgen.calibrate import remainder, residual_tests, separable
+from faultgen.effects.coulomb import Coulomb
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.model import robots
@@ -142,16 +143,32 @@ class Calibration:
 
     def unexplained(self) -> list[dict]:
         """The axes the calibrated model leaves unexplained: a residual test failed and the axis
-        is above its noise floor (:func:`faultgen.calibrate.residual_tests.unexplained`); each with
-        its tests' statistics and p-values and the effects added on it (with their step)."""
+        is above its noise floor (:func:`faultgen.calibrate.residual_tests.unexplained`), or a delay
+        of the torque channels shows on it (:func:`faultgen.calibrate.delay.shown`; the axis's record then
+        has ``channel_delay``: the log's delay, its interval and level, the rule and the axis's own
+        estimate); each with its tests' statistics and p-values and the effects added on it (with their step)."""
         if self.residual_tests is None:
             return []
-        found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after)
+        shown = (self.delay or {}).get("shown") or {}
+        found = residual_tests.unexplained(self.residual_tests, self.tau, self.held_out, self.gap_after,
+                                           also=shown.get("axes", []))
         empty = {"terms": [], "explained_share": 0.0, "explained_interval": [0.0, 0.0]}
         return [{**u, "added": [f"{s.effect.id} (step {k})" for k, s in enumerate(self.steps, start=1)
                                 if u["axis"] - 1 in s.axes],
+                 **({"channel_delay": {**{k: shown[k] for k in ("seconds", "interval_s", "level", "rule")},
+                                       "axis": shown["per_axis"][u["axis"]]}} if u["axis"] in shown.get("axes", []) else {}),
                  **{k: v for k, v in self.follows.get(u["axis"], empty).items() if k != "axis"},
                  "not_written": [d for d in self.declined if d["axis"] == u["axis"]]} for u in found]
+
+    def not_separable(self) -> list[dict]:
+        """The parameters this log cannot place, held at the nominal model's: per axis (numbered),
+        ``parameter`` (the Coulomb effect's id: the dry level of the own-friction fit,
+        :func:`faultgen.calibrate.loop.own_friction`) and the identifiability check's figures
+        (:func:`faultgen.calibrate.separable.dry_and_viscous`). Empty when every fitted level was
+        separable or none was fitted on every axis."""
+        return [{"axis": int(axis), "parameter": Coulomb.id, "held_at": "nominal", **check}
+                for s in self.steps if s.evidence.get("every_axis") and s.effect.id == Coulomb.id
+                for axis, check in s.evidence.get("not_separable", {}).items()]
 
     def ambiguous(self) -> list[dict]:
         """The steps whose effect this log cannot tell apart from another (held-out AIC within
@@ -200,6 +217,10 @@ class Calibration:
                 for name, motion in step.evidence["separate_by"].items():
                     lines.append(f"   to tell {name} apart: {motion}")
                 lines.append(f"   a designed excitation: faultgen excitation {self.robot} -o excitation.csv")
+        lines += [f"axis {h['axis']}: dry friction NOT SEPARABLE on this motion from the viscous level (its "
+                  f"{separable.LEVEL:.0%} interval " + ("unbounded" if h["share"] is None else
+                                                      f"+-{100 * h['share']:.0f} % of nominal")
+                  + f", accepted {100 * separable.SHARE:.0f} %): held at the nominal model's" for h in self.not_separable()]
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
         for u in self.unexplained():
