@@ -100,8 +100,9 @@ def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
     fleet of tests/test_monitor_shipped.py, 3 units, --no-calibrate; measured 2026-11-25)."""
     import independent_fleet
 
+    # two units: a second unit's twin and its cycles would each have resolved the robot again
     robot, logs, _ = independent_fleet.write_fleet(
-        tmp_path / "fleet", independent_fleet.FleetSpec(units=3, worn=1, days=14, seed=5, onset=(12, 13)))
+        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
     loads.clear()  # what building the fleet loaded (robots add checks the folder it writes)
     result = runner.invoke(app, ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"),
                                  "--no-calibrate", "--train", "10", "--persistence", "3", "--no-progress"])
@@ -266,19 +267,27 @@ def test_robots_add_loads_nothing_by_name(tmp_path, loads):
 def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
     """``faultgen monitor`` calibrating each unit's model on its first log: the robot is resolved once
     (the command), each unit's calibrated and twin models come from their writers; the second run
-    on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once."""
+    on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once.
+    The first run also opens every log file once, calibration, program, twin and scoring together
+    (issue 57 item 2; tests/test_read_once.py's calibrated run, merged here: one calibrating run)."""
     import shutil
 
     import independent_fleet
+    import open_counter
 
-    robot, logs, _ = independent_fleet.write_fleet(
-        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
+    spec = independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13))
+    robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", spec)
     loads.clear()
     args = ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"), "--train", "10",
             "--persistence", "3", "--no-progress"]
-    result = runner.invoke(app, args)
+    with open_counter.opens_under(logs) as counts:
+        result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     assert loads == [str(robot)]
+    files = sorted(p.relative_to(logs).as_posix() for p in logs.glob("*/*.csv"))
+    assert len(files) == 2 * spec.days
+    assert {name: counts[name] for name in files} == {name: 1 for name in files}
+    assert set(counts) <= set(files) | {"events.csv"}
     assert (tmp_path / "out" / "units.csv").read_text().count("calibrated") == 2
     cached = sorted((tmp_path / "out" / ".cache" / "calibrated").glob("*/model/*.xml"))
     assert len(cached) == 4  # each unit's calibrated model and its twin model
