@@ -207,33 +207,47 @@ def coulomb_log():
     return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
 
 
-def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, tmp_path, loads):
+@pytest.fixture(scope="module")
+def coulomb_calibration(coulomb_log, tmp_path_factory):
+    """``calibrate("puma560", coulomb_log, OUT)`` run once for the tests below, which only read its
+    result and OUT: (the result, OUT, the names ``robots.load`` was called with during it)."""
+    from faultgen.calibrate import calibrate
+
+    out = tmp_path_factory.mktemp("coulomb") / "out"
+    calls = []
+    load = robots.load
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(robots, "load", lambda name: calls.append(str(name)) or load(name))
+        result = calibrate("puma560", coulomb_log, out, use_sysid=False)
+    return result, out, calls
+
+
+def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, coulomb_calibration):
     """``calibrate`` resolves the nominal robot once (the public entry) and returns the calibrated
     robot it wrote (``Calibration.model``): before, ``calibrate.loop`` loaded the model file it had
     just written to make parameters.json, and ``refit`` loaded it again with the nominal by name."""
     import json
 
-    from faultgen.calibrate import calibrate, parameters, predict
+    from faultgen.calibrate import parameters, predict
 
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    result, out, loads = coulomb_calibration
     assert loads == ["puma560"]
     assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
     reloaded = robots.load(result.model_out)
     assert result.model.path == reloaded.path == result.model_out.resolve()
     assert result.model.digest == reloaded.digest and result.nominal_digest == robots.load("puma560").digest
     assert parameters(result.model) == parameters(reloaded)
-    assert json.loads((tmp_path / "out" / "model" / "parameters.json").read_text()) == json.loads(
+    assert json.loads((out / "model" / "parameters.json").read_text()) == json.loads(
         json.dumps(parameters(reloaded)))
     assert (predict(result.model, coulomb_log) == result.calibrated).all()
 
 
-def test_refit_takes_the_nominal_robot_and_checks_it_is_the_calibrations(coulomb_log, tmp_path):
+def test_refit_takes_the_nominal_robot_and_checks_it_is_the_calibrations(coulomb_log, coulomb_calibration, tmp_path):
     from dataclasses import replace
 
-    from faultgen.calibrate import calibrate
     from faultgen.calibrate.refit import calibrated_from, refit
 
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    result = coulomb_calibration[0]
     puma = robots.load("puma560")
     assert calibrated_from(result, puma) is puma
     with pytest.raises(TypeError, match="expected a Robot, got str 'puma560'"):
