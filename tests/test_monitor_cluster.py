@@ -15,8 +15,9 @@ from typer.testing import CliRunner
 
 from faultgen.cli import app
 
-# three units, 24 days, one of them worn from day 10-11; parts on some days (cycles the workers simulate)
-SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=24, seed=5, onset=(10, 11))
+# two units, 24 days, one of them worn from day 10-11; parts on some days (cycles the workers simulate);
+# with the planted unit98, three units for the two workers
+SPEC = independent_fleet.FleetSpec(units=2, worn=1, days=24, seed=5, onset=(10, 11))
 # the default twin: each unit's model calibrated on its first log (on the workers, sent back with the cache)
 COMMON = ["--train", "10", "--persistence", "3", "--no-progress"]
 

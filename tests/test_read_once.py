@@ -23,7 +23,6 @@ the outputs of before byte for byte (the SHA-256 keys of the state and caches ar
 from pathlib import Path
 
 import fleetlog_folder
-import independent_fleet
 import numpy as np
 import open_counter
 import pandas as pd
@@ -32,24 +31,10 @@ import pytest
 from faultgen import inputs
 from faultgen.data import adapters, measured
 from faultgen.model import robots
-from faultgen.monitor import loop
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor.scoring import Settings
 
-# three units, 20 days (10 learned), one worn from day 16-17: the smallest fleet the twin runs on
-SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=20, seed=5, onset=(16, 17))
-
-
-def test_a_calibrated_monitor_run_opens_every_log_once(tmp_path):
-    robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", SPEC)
-    with open_counter.opens_under(logs) as counts:
-        outcome = loop.monitor(robot, logs, tmp_path / "out", calibrate=True, settings=Settings(train=10, persistence=3),
-                               progress=False)
-    assert [s.model for s in outcome.statuses] == ["calibrated"] * 3  # calibration, program, twin, scoring
-    files = sorted(p.relative_to(logs).as_posix() for p in logs.glob("*/*.csv"))
-    assert len(files) == 3 * SPEC.days
-    assert {name: counts[name] for name in files} == {name: 1 for name in files}
-    assert set(counts) <= set(files) | {"events.csv"}
+# The calibrated monitor run that opens every log once is tests/test_resolve_once.py's
+# test_a_calibrating_monitor_resolves_its_robot_once (one calibrating run counts both).
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".csv.gz", ".h5"])

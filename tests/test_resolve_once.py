@@ -100,8 +100,9 @@ def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
     fleet of tests/test_monitor_shipped.py, 3 units, --no-calibrate; measured 2026-11-25)."""
     import independent_fleet
 
+    # two units: a second unit's twin and its cycles would each have resolved the robot again
     robot, logs, _ = independent_fleet.write_fleet(
-        tmp_path / "fleet", independent_fleet.FleetSpec(units=3, worn=1, days=14, seed=5, onset=(12, 13)))
+        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
     loads.clear()  # what building the fleet loaded (robots add checks the folder it writes)
     result = runner.invoke(app, ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"),
                                  "--no-calibrate", "--train", "10", "--persistence", "3", "--no-progress"])
@@ -206,33 +207,47 @@ def coulomb_log():
     return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
 
 
-def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, tmp_path, loads):
+@pytest.fixture(scope="module")
+def coulomb_calibration(coulomb_log, tmp_path_factory):
+    """``calibrate("puma560", coulomb_log, OUT)`` run once for the tests below, which only read its
+    result and OUT: (the result, OUT, the names ``robots.load`` was called with during it)."""
+    from faultgen.calibrate import calibrate
+
+    out = tmp_path_factory.mktemp("coulomb") / "out"
+    calls = []
+    load = robots.load
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(robots, "load", lambda name: calls.append(str(name)) or load(name))
+        result = calibrate("puma560", coulomb_log, out, use_sysid=False)
+    return result, out, calls
+
+
+def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, coulomb_calibration):
     """``calibrate`` resolves the nominal robot once (the public entry) and returns the calibrated
     robot it wrote (``Calibration.model``): before, ``calibrate.loop`` loaded the model file it had
     just written to make parameters.json, and ``refit`` loaded it again with the nominal by name."""
     import json
 
-    from faultgen.calibrate import calibrate, parameters, predict
+    from faultgen.calibrate import parameters, predict
 
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    result, out, loads = coulomb_calibration
     assert loads == ["puma560"]
     assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
     reloaded = robots.load(result.model_out)
     assert result.model.path == reloaded.path == result.model_out.resolve()
     assert result.model.digest == reloaded.digest and result.nominal_digest == robots.load("puma560").digest
     assert parameters(result.model) == parameters(reloaded)
-    assert json.loads((tmp_path / "out" / "model" / "parameters.json").read_text()) == json.loads(
+    assert json.loads((out / "model" / "parameters.json").read_text()) == json.loads(
         json.dumps(parameters(reloaded)))
     assert (predict(result.model, coulomb_log) == result.calibrated).all()
 
 
-def test_refit_takes_the_nominal_robot_and_checks_it_is_the_calibrations(coulomb_log, tmp_path):
+def test_refit_takes_the_nominal_robot_and_checks_it_is_the_calibrations(coulomb_log, coulomb_calibration, tmp_path):
     from dataclasses import replace
 
-    from faultgen.calibrate import calibrate
     from faultgen.calibrate.refit import calibrated_from, refit
 
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False)
+    result = coulomb_calibration[0]
     puma = robots.load("puma560")
     assert calibrated_from(result, puma) is puma
     with pytest.raises(TypeError, match="expected a Robot, got str 'puma560'"):
@@ -266,19 +281,27 @@ def test_robots_add_loads_nothing_by_name(tmp_path, loads):
 def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
     """``faultgen monitor`` calibrating each unit's model on its first log: the robot is resolved once
     (the command), each unit's calibrated and twin models come from their writers; the second run
-    on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once."""
+    on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once.
+    The first run also opens every log file once, calibration, program, twin and scoring together
+    (issue 57 item 2; tests/test_read_once.py's calibrated run, merged here: one calibrating run)."""
     import shutil
 
     import independent_fleet
+    import open_counter
 
-    robot, logs, _ = independent_fleet.write_fleet(
-        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
+    spec = independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13))
+    robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", spec)
     loads.clear()
     args = ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"), "--train", "10",
             "--persistence", "3", "--no-progress"]
-    result = runner.invoke(app, args)
+    with open_counter.opens_under(logs) as counts:
+        result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     assert loads == [str(robot)]
+    files = sorted(p.relative_to(logs).as_posix() for p in logs.glob("*/*.csv"))
+    assert len(files) == 2 * spec.days
+    assert {name: counts[name] for name in files} == {name: 1 for name in files}
+    assert set(counts) <= set(files) | {"events.csv"}
     assert (tmp_path / "out" / "units.csv").read_text().count("calibrated") == 2
     cached = sorted((tmp_path / "out" / ".cache" / "calibrated").glob("*/model/*.xml"))
     assert len(cached) == 4  # each unit's calibrated model and its twin model
