@@ -1,6 +1,7 @@
 """`faultgen monitor` on a fleet whose logs mix one- and two-cycle logs at 250 and 500 Hz, against the
-same fleet with one cycle at 250 Hz per log (issue 72 item 8, docs/_r7_cycles.md): the program
-changes reported and the time per log (wall and this process's CPU), measured in the same run.
+same fleet with one cycle at 250 Hz per log (issue 72 item 8; docs/analysis.md and
+docs/performance.md, "Logs of several cycles"): the program changes reported and the time per log
+(wall and this process's CPU), measured in the same run.
 
     python benchmarks/monitor_cycles.py [--units 4] [--days 40] [--seed 5] [--work DIR]
 
