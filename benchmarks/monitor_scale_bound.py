@@ -87,7 +87,8 @@ def fleet_logs(work: Path, out: Path) -> list[tuple[float, list[tuple[float, flo
             if r["verdict"].startswith("reference"):  # the first test since the last repair
                 reference[r["unit"]] = sd
                 continue
-            tests.setdefault(r["unit"], []).append((r["stamp"], math.sqrt(max(sd**2 - reference[r["unit"]] ** 2, 1e-12))))
+            own = math.sqrt(max(sd**2 - reference[r["unit"]] ** 2, 1e-12))
+            tests.setdefault(r["unit"], []).append((r["stamp"], own))
     logs = []
     for unit, t in truth.items():
         if not t["axis"]:
