@@ -1,5 +1,5 @@
 """The least median wear error a scale learned from friction tests can give (issue 75, "What it must
-show", bullet 2; docs/_r7_wearacc.md).
+show", bullet 2; docs/analysis.md, "The wear on the friction tests' scale").
 
     python benchmarks/monitor_scale_bound.py --work WORK [--out monitor] [--prior-sd 0.5 0.1 0.05]
                                              [--filter-sd 0 1.6]

@@ -1,5 +1,6 @@
 """The least median wear error of a scale learned from friction tests (benchmarks/monitor_scale_bound.py;
-docs/_r7_wearacc.md): the closed form against a Monte Carlo of the monitor's own kind of fit
+docs/analysis.md, "The wear on the friction tests' scale"): the closed form against a Monte Carlo of the
+monitor's own kind of fit
 (statsmodels WLS with the prior as a pseudo-observation, as faultgen.monitor.friction_tests.Rescale
 fits it), and bad input refused by name."""
 

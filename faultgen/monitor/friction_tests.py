@@ -103,11 +103,11 @@ BETA_PRIOR = 0.005
 #: own error): 2.32, 3.33 points at 0.3 (90 % coverage 96.9, 94.4 %); 2.70, 3.13 at 0.5 (96.3,
 #: 93.3 %); with the offset's prior 10 points, 2.60, 3.12 at 0.5 (100, 95.9 %). Held out (seed 1):
 #: 3.53, 4.37 (89.8, 86.9 %) where the version before read 3.85, 4.72 (99.1, 98.7 %);
-#: docs/_r7_wearacc.md.
+#: docs/analysis.md, "The wear on the friction tests' scale".
 SCALE_PRIOR = 0.3
 #: Standard deviation of the prior of the offset ``b``, points of wear, where the reference test's own
 #: error is not known (otherwise that error: ``b`` is the reference's error, which every later test's
-#: wear shares; docs/_r7_wearacc.md).
+#: wear shares; docs/analysis.md, "The wear on the friction tests' scale").
 OFFSET_PRIOR = 10.0
 #: Smallest scale factor used (a factor fitted below it on an axis whose tests contradict its logs).
 SCALE_MIN = 0.2
