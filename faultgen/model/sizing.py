@@ -170,6 +170,17 @@ class Loads:
     offset: float
 
 
+def _pose_sampling(model: mujoco.MjModel, joints: list) -> tuple:
+    """What both rules' load sampling starts from (constraints off in ``model``): its ``MjData``, the
+    generator (seed :data:`SEED`), the joints' dof and qpos addresses, shape (N,), and their lower and
+    upper limits, rad (or m), shape (N,)."""
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
+    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
+    low, high = np.array([j.range for j in joints]).T
+    return mujoco.MjData(model), np.random.default_rng(SEED), dofs, qadr, low, high
+
+
 def arm_loads_rule1(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[np.ndarray, np.ndarray]:
     """Rule 1's loads: largest gravity torque (rated payload at the last link's origin) and largest
     diagonal of the joint-space inertia over :data:`POSES` poses within the limits, N m and kg m^2,
@@ -187,12 +198,7 @@ def arm_loads_rule1(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[
         load.explicitinertial = True
         load.mass, load.inertia = payload, [0.4 * payload * radius**2] * 3
     model = spec.compile()
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    data = mujoco.MjData(model)
-    rng = np.random.default_rng(SEED)
-    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
-    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
-    low, high = np.array([j.range for j in joints]).T
+    data, rng, dofs, qadr, low, high = _pose_sampling(model, joints)
     gravity, inertia = np.zeros(len(joints)), np.zeros(len(joints))
     full = np.zeros((model.nv, model.nv))
     for _ in range(POSES):
@@ -240,12 +246,7 @@ def arm_loads(arm, payload: float) -> Loads:
     joints = arm.joints
     speed, acceleration = planning_limits(arm)
     model = with_rated_load(arm.spec, joints, payload).compile()
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    data = mujoco.MjData(model)
-    rng = np.random.default_rng(SEED)
-    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
-    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
-    low, high = np.array([j.range for j in joints]).T
+    data, rng, dofs, qadr, low, high = _pose_sampling(model, joints)
     gravity, need = np.zeros(len(joints)), np.zeros(len(joints))
     for _ in range(POSES):
         data.qpos[:], data.qvel[:], data.qacc[:] = 0, 0, 0
