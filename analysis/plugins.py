@@ -69,19 +69,13 @@ def _estimator_class(spec: str) -> type:
         raise PluginError(f"plug-in {spec!r}: expected package.module:Class, e.g. mine:MyIsolator")
     module = sys.modules.get(module_name)
     if module is None:
-        added = os.getcwd() not in sys.path
-        if added:  # the current folder first, for this import only
-            sys.path.insert(0, os.getcwd())
         try:
-            module = importlib.import_module(module_name)
+            module = import_here(module_name)
         except ImportError as err:
             raise PluginError(f"plug-in {spec!r}: cannot import {module_name!r} ({err}); put it in the current "
                               "folder or on PYTHONPATH") from None
         except (Exception, SystemExit) as err:  # SyntaxError, sys.exit(), whatever the module's own code raised
             raise PluginError(f"plug-in {spec!r}: importing {module_name!r} failed: {_what(err)}") from None
-        finally:
-            if added and os.getcwd() in sys.path:
-                sys.path.remove(os.getcwd())
     cls = getattr(module, class_name, None)
     if not isinstance(cls, type):
         raise PluginError(f"plug-in {spec!r}: module {module_name!r} has no class {class_name!r}")
@@ -89,6 +83,19 @@ def _estimator_class(spec: str) -> type:
         raise PluginError(f"plug-in {spec!r}: {class_name} is not a scikit-learn estimator; derive it from "
                           "analysis.isolation.Isolator or sklearn.base.BaseEstimator")
     return cls
+
+
+def import_here(module_name: str):
+    """``importlib.import_module(module_name)`` with the current folder first on ``sys.path`` for this
+    import only (a user's plug-in or prognoser module beside them); raises what the import raises."""
+    added = os.getcwd() not in sys.path
+    if added:
+        sys.path.insert(0, os.getcwd())
+    try:
+        return importlib.import_module(module_name)
+    finally:
+        if added and os.getcwd() in sys.path:
+            sys.path.remove(os.getcwd())
 
 
 def _what(err: BaseException) -> str:

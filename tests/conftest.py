@@ -102,3 +102,21 @@ def figures(monkeypatch):
 
     monkeypatch.setattr(Figure, "savefig", spy)
     return drawn
+
+
+@pytest.fixture(scope="module")
+def coulomb_log():
+    """Three pick-and-place cycles of the PUMA 560 by its inverse dynamics, a Coulomb level
+    raised on axis 3 and 1 % torque noise: the calibration adds one effect."""
+    from faultgen import effects
+    from faultgen.calibrate import synth
+    from faultgen.data import measured
+    from faultgen.model import robots
+
+    robot = robots.load("puma560")
+    motion, tau = synth.nominal_motion(robot, "pick_place", 3)
+    phi, _ = effects.get("coulomb").columns(motion, 2, None)
+    rng = numpy.random.default_rng(3)
+    tau = tau + rng.normal(size=tau.shape) * 0.01 * numpy.sqrt(numpy.mean(tau**2, axis=0))
+    tau[:, 2] += phi[:, 0] * 0.07
+    return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)

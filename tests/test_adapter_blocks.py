@@ -6,6 +6,7 @@ whole read averaged down gives, as a long measured log does (tests/test_longlog.
 import numpy as np
 import pandas as pd
 import pytest
+from test_longlog import _log as long_log
 
 from faultgen.calibrate import decimate, search
 from faultgen.data import adapters, longlog
@@ -21,12 +22,9 @@ def robot():
 
 
 def _signals(n=23_456, seed=0):
-    rng = np.random.default_rng(seed)
-    t = np.arange(n) * 1e-3
-    q = 0.3 * np.sin(2 * np.pi * 0.5 * t[:, None] + np.arange(6))
-    qd = 1.01 * np.gradient(q, t, axis=0)
-    tau = 5 * np.cos(2 * np.pi * 0.5 * t[:, None]) + rng.normal(0, 0.1, (n, 6))
-    return t, q, qd, tau
+    """tests/test_longlog.py's long log, with joint speeds 1 % off the angles' gradient."""
+    t, q, tau = long_log(n, seed)
+    return t, q, 1.01 * np.gradient(q, t, axis=0), tau
 
 
 def _ur_rtde(path, robot):

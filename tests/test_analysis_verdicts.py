@@ -6,6 +6,7 @@ rate above alpha is flagged, located_pct 0 says why, and an isolator is scored b
 import numpy as np
 import pytest
 from sklearn.base import BaseEstimator
+from test_analysis_benchmark import NeverDecides
 from typer.testing import CliRunner
 
 from analysis import benchmark, isolation
@@ -85,12 +86,6 @@ def test_located_pct_of_zero_says_why(sparse):
     assert (table["located_axis"] == benchmark.TOO_FEW_CYCLES).any()  # an onset after two samples
     advice = benchmark.detection_advice(table)
     assert "located_pct is 0 (of 2 detected runs)" in advice and "too few to locate" in advice
-
-
-class NeverDecides(BaseEstimator):
-    def fit(self, X, y=None):
-        self.source_axis_ = 0
-        return self
 
 
 def test_an_isolator_is_scored_by_one_rule_and_not_applicable_where_the_data_is_too_short(sparse):

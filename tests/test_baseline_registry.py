@@ -135,24 +135,25 @@ def small(shared_sweep):
     return shared_sweep("analysis-small", robots=["irb6700"], tasks=["pick_place"], axes=[0, 1, 5], cycles=40)
 
 
-def test_detect_reaches_the_example_as_the_plug_in_of_the_same_class(small, tmp_path):
-    tables = {}
-    for name, option in (("baseline", ["--baseline", "zmean"]),
-                         ("plugin", ["--detector", "baseline_example:ZScoreOfMean"])):
-        result = runner.invoke(app, ["detect", str(small), "--no-progress", *option, "-o", str(tmp_path / name)])
+def detect_twice(dataset, tmp_path, baseline: str, plugin: str) -> dict:
+    """``faultgen detect`` of ``dataset`` with ``--baseline baseline`` and with ``--detector plugin``:
+    ``{"baseline": its CSV, "plugin": its CSV}`` (paths in ``tmp_path``)."""
+    for name, option in (("baseline", ["--baseline", baseline]), ("plugin", ["--detector", plugin])):
+        result = runner.invoke(app, ["detect", str(dataset), "--no-progress", *option, "-o", str(tmp_path / name)])
         assert result.exit_code == 0, result.output
-        tables[name] = pd.read_csv(tmp_path / f"{name}.csv")
+    return {name: tmp_path / f"{name}.csv" for name in ("baseline", "plugin")}
+
+
+def test_detect_reaches_the_example_as_the_plug_in_of_the_same_class(small, tmp_path):
+    tables = {name: pd.read_csv(path)
+              for name, path in detect_twice(small, tmp_path, "zmean", "baseline_example:ZScoreOfMean").items()}
     pd.testing.assert_frame_equal(tables["baseline"], tables["plugin"])
     assert len(tables["baseline"]) == 2 and np.isin(tables["baseline"]["detected"], [True, False]).all()
 
 
 def test_detect_takes_the_pca_baseline_as_its_plug_in_and_refuses_what_learns_labels(small, tmp_path):
-    outputs = {}
-    for name, option in (("baseline", ["--baseline", "pca"]),
-                         ("plugin", ["--detector", "faultgen.bench.baselines:PCADetector"])):
-        result = runner.invoke(app, ["detect", str(small), "--no-progress", *option, "-o", str(tmp_path / name)])
-        assert result.exit_code == 0, result.output
-        outputs[name] = (tmp_path / f"{name}.csv").read_bytes()
+    outputs = {name: path.read_bytes()
+               for name, path in detect_twice(small, tmp_path, "pca", "faultgen.bench.baselines:PCADetector").items()}
     assert outputs["baseline"] == outputs["plugin"]
     for name, message in (("lr", "is a classifier"), ("trend", "is an isolator"), ("nope", "unknown baseline"),
                           ("linear", "is a prognoser"), ("twin", "runs on the test split as raw logs"),

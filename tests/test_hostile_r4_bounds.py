@@ -280,6 +280,8 @@ def test_holding_a_small_log_reserves_its_size_not_the_bound(tmp_path):
 def test_a_linear_segment_past_an_hour_is_refused_before_its_path_is_solved(monkeypatch):
     """A Cartesian segment's duration (its length over its speed) is known before any knot is
     solved: 0.5 m at 0.1 mm/s was solved and sampled first (42 s, 0.57 GB) and then refused."""
+    from test_programs import line_segments
+
     from faultgen.model import robots
     from faultgen.operation import planner, programs
     from faultgen.operation.tasks import ProgramError
@@ -287,15 +289,7 @@ def test_a_linear_segment_past_an_hour_is_refused_before_its_path_is_solved(monk
     text = SLOW_PROGRAM.split("[limits]")[0] + """[tool]
 z = [-0.5, 0.0, -0.866]
 x = [-1.0, 0.0, 0.0]
-[[segment]]
-type = "move"
-pose = [1.55, -0.25, 0.8]
-[[segment]]
-type = "linear"
-to = [1.55, 0.25, 0.8]
-speed = 0.0001
-ramp_time = 0.1
-"""
+""" + line_segments(0.0001, 0.1)
     monkeypatch.setattr(planner.FlangeIK, "follow", lambda *a, **k: pytest.fail("the path was solved"))
     with pytest.raises(ProgramError, match=r"segment 2 \(linear\): the cycle would last 5000\.77 s; a cycle lasts at "
                                            r"most 3600 s \(MAX_CYCLE_DURATION\)"):

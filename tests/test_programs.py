@@ -103,6 +103,20 @@ x = [-1.0, 0.0, 0.0]
 """
 
 
+def line_segments(speed: float, ramp_time: float) -> str:
+    """A program's segments: a move to the start of a 0.5 m line, then along it at ``speed`` m/s,
+    reaching that speed in ``ramp_time`` s."""
+    return f"""[[segment]]
+type = "move"
+pose = [1.55, -0.25, 0.8]
+[[segment]]
+type = "linear"
+to = [1.55, 0.25, 0.8]
+speed = {speed}
+ramp_time = {ramp_time}
+"""
+
+
 def refused(tmp_path, text, robot="irb6700", name="p.toml"):
     """Run `faultgen simulate` on a program; return its message after checking exit 2 and no output."""
     program = write(tmp_path, name, text)
@@ -139,15 +153,7 @@ def test_refuses_a_joint_angle_beyond_its_range_by_how_much(tmp_path):
 
 
 def test_refuses_a_cartesian_move_too_fast_for_the_joint_limits(tmp_path):
-    text = HEAD + """[[segment]]
-type = "move"
-pose = [1.55, -0.25, 0.8]
-[[segment]]
-type = "linear"
-to = [1.55, 0.25, 0.8]
-speed = 3.0
-ramp_time = 0.1
-"""
+    text = HEAD + line_segments(3.0, 0.1)
     message = refused(tmp_path, text)
     assert "segment 2 (linear): at speed = 3.0 m/s axis" in message
     assert "% above its" in message and "limit" in message and "m/s would fit" in message
@@ -362,15 +368,7 @@ def test_linear_and_circular_segments_keep_the_tool_on_the_line_and_the_arc(tmp_
     """Flange positions by MuJoCo forward kinematics of the full model (rotors included), not the IK's
     arm-only model: on the line and on the circle through the three points within 0.5 mm, at the
     commanded tool speed between the ramps."""
-    text = HEAD + """[[segment]]
-type = "move"
-pose = [1.55, -0.25, 0.8]
-[[segment]]
-type = "linear"
-to = [1.55, 0.25, 0.8]
-speed = 0.2
-ramp_time = 0.2
-[[segment]]
+    text = HEAD + line_segments(0.2, 0.2) + """[[segment]]
 type = "circular"
 via = [1.75, 0.45, 0.8]
 to = [1.95, 0.25, 0.8]

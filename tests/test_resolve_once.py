@@ -189,25 +189,6 @@ def test_a_written_model_is_the_robot_a_reload_gives_and_a_moved_one_too(tmp_pat
 
 
 @pytest.fixture(scope="module")
-def coulomb_log():
-    """Three pick-and-place cycles of the PUMA 560 with a Coulomb level raised on axis 3 (as
-    tests/test_calibrate_in_memory.py): the calibration adds one effect."""
-    import numpy as np
-
-    from faultgen import effects
-    from faultgen.calibrate import synth
-    from faultgen.data import measured
-
-    robot = robots.load("puma560")
-    motion, tau = synth.nominal_motion(robot, "pick_place", 3)
-    phi, _ = effects.get("coulomb").columns(motion, 2, None)
-    rng = np.random.default_rng(3)
-    tau = tau + rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
-    tau[:, 2] += phi[:, 0] * 0.07
-    return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
-
-
-@pytest.fixture(scope="module")
 def coulomb_calibration(coulomb_log, tmp_path_factory):
     """``calibrate("puma560", coulomb_log, OUT)`` run once for the tests below, which only read its
     result and OUT: (the result, OUT, the names ``robots.load`` was called with during it)."""

@@ -184,16 +184,30 @@ def test_good_test_urdf_is_accepted(tmp_path):
     assert [j.name for j in importers.read(path).joints] == [f"j{k}" for k in range(6)]
 
 
-def test_mjcf_closed_chain_is_refused(tmp_path):
-    spec = robots.robots_dir() / "puma560" / "arm.xml"
-    text = spec.read_text().replace(
-        "</mujoco>",
-        '<equality><connect name="loop" body1="link6" body2="link2" anchor="0 0 0"/></equality></mujoco>',
-    )
-    path = tmp_path / "arm.xml"
+def edited_puma(path, *edits):
+    """The PUMA 560's MJCF written to ``path`` with each ``(old, new)`` of ``edits`` replaced (each
+    ``old`` stands once in it); gives ``path``."""
+    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
+    for old, new in edits:
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
     path.write_text(text)
-    with pytest.raises(builder.ArmError, match="equality constraint 'loop' closes a chain"):
+    return path
+
+
+def edited_puma_is_refused(tmp_path, old, new, message):
+    """Importing the PUMA 560's MJCF with ``old`` replaced by ``new`` raises ``ArmError`` matching ``message``."""
+    path = edited_puma(tmp_path / "arm.xml", (old, new))
+    with pytest.raises(builder.ArmError, match=message):
         importers.read(path)
+
+
+def test_mjcf_closed_chain_is_refused(tmp_path):
+    edited_puma_is_refused(
+        tmp_path, "</mujoco>",
+        '<equality><connect name="loop" body1="link6" body2="link2" anchor="0 0 0"/></equality></mujoco>',
+        "equality constraint 'loop' closes a chain",
+    )
 
 
 def test_dh_row_without_limits_is_refused(tmp_path):
@@ -239,17 +253,13 @@ def test_xacro_is_expanded_and_its_packages_found_in_the_folders_named(tmp_path)
 
 
 def test_menagerie_style_mjcf_loses_its_actuators_and_joint_friction_and_keeps_its_torque_limits(tmp_path):
-    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
-    text = text.replace(
+    path = edited_puma(tmp_path / "menagerie_like.xml", (
         '<joint name="joint2" class="arm"', '<joint name="joint2" class="arm" damping="3" frictionloss="1"'
-    )
-    text = text.replace(
+    ), (
         "</mujoco>",
         '<actuator><position name="servo2" joint="joint2" kp="100" forcelimited="true" '
         'forcerange="-97 97"/></actuator></mujoco>',
-    )
-    path = tmp_path / "menagerie_like.xml"
-    path.write_text(text)
+    ))
     arm = importers.read(path)
     assert arm.effort_limit[1] == 97.0 and np.isnan(arm.effort_limit[0])
     assert any("joint2" in note and "damping" in note for note in arm.notes)
@@ -281,27 +291,19 @@ def test_robots_of_seven_axes_have_arrays_of_that_length(n, tmp_path):
 
 
 def test_mjcf_floating_base_is_refused(tmp_path):
-    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
-    text = text.replace(
-        '<body name="base" childclass="puma560">',
+    edited_puma_is_refused(
+        tmp_path, '<body name="base" childclass="puma560">',
         '<body name="base" childclass="puma560"><freejoint name="float"/>',
+        "joint 'float' is a free joint: a floating base",
     )
-    path = tmp_path / "arm.xml"
-    path.write_text(text)
-    with pytest.raises(builder.ArmError, match="joint 'float' is a free joint: a floating base"):
-        importers.read(path)
 
 
 def test_mjcf_with_missing_mesh_files_is_read_without_them_and_one_warning(tmp_path):
-    text = (robots.robots_dir() / "puma560" / "arm.xml").read_text()
-    text = text.replace(
-        "<worldbody>", '<asset><mesh name="shell" file="gone/shell.stl"/></asset><worldbody>', 1
+    path = edited_puma(
+        tmp_path / "arm.xml",
+        ("<worldbody>", '<asset><mesh name="shell" file="gone/shell.stl"/></asset><worldbody>'),
+        ('<site name="dh2"/>', '<site name="dh2"/><geom type="mesh" mesh="shell" mass="0"/>'),
     )
-    text = text.replace(
-        '<site name="dh2"/>', '<site name="dh2"/><geom type="mesh" mesh="shell" mass="0"/>', 1
-    )
-    path = tmp_path / "arm.xml"
-    path.write_text(text)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         arm = importers.read(path)

@@ -8,6 +8,7 @@ track version names its rule (``sizing``; rule 1 when it names none).
 import warnings
 
 import pytest
+from test_bench import TINY
 from test_robot_import import PACKAGES, URDFS
 
 from faultgen.bench import make, tracks
@@ -58,18 +59,7 @@ def test_a_robot_folder_records_the_rule_that_sized_it(tmp_path):
         folder.add("kr210", URDFS["kr210"], tmp_path / "zero", packages=PACKAGES, rule=0)
 
 
-TRACK = """
-name = "t"
-summary = "s"
-licence = "CC0-1.0"
-
-[[versions]]
-version = 1
-train_seeds = [0]
-test_seeds = [1]
-[[versions.parts]]
-robots = ["irb6700"]
-
+TRACK = TINY.format(robot="irb6700") + """
 [[versions]]
 version = 2
 like = 1

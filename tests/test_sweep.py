@@ -12,6 +12,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from test_reliability import wait_for
 from typer.testing import CliRunner
 
 from faultgen.cli import app
@@ -105,14 +106,6 @@ def _sweep_command(out: Path, jobs: int = 1) -> list[str]:
             "-o", str(out)]
 
 
-def _wait_for(condition, what: str, seconds: float = 120) -> None:
-    deadline = time.monotonic() + seconds
-    while not condition():
-        if time.monotonic() > deadline:
-            pytest.fail(f"waited {seconds} s for {what}")
-        time.sleep(0.05)
-
-
 def test_a_killed_merge_leaves_debris_that_the_next_sweep_removes_and_reports(tmp_path):
     out = tmp_path / "merged.h5"
     killed_merge = (f"import os, signal\nfrom faultgen.data.atomic import atomic_path\n"
@@ -144,7 +137,7 @@ def test_ctrl_c_stops_the_workers_and_says_what_is_kept_and_how_to_resume(tmp_pa
     proc = subprocess.Popen(_sweep_command(out, jobs=2), cwd=tmp_path, start_new_session=True,
                             preexec_fn=_as_a_terminal_starts_it,  # noqa: PLW1509 (no threads of ours here)
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    _wait_for(lambda: len(list(parts.glob("*.h5"))) >= 1, "a finished run")
+    wait_for(lambda: len(list(parts.glob("*.h5"))) >= 1, "a finished run", 120)
     os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does: every process of the group
     stdout, stderr = proc.communicate(timeout=60)
     kept = len(list(parts.glob("*.h5")))
@@ -231,7 +224,7 @@ def test_a_second_sweep_on_the_same_output_refuses_at_once_naming_the_first(refe
     out = tmp_path / "same.h5"
     first = subprocess.Popen(_sweep_command(out), cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                              text=True)
-    _wait_for(lambda: (sweep.parts_folder(out) / "sweep.json").exists(), "the first sweep to start")
+    wait_for(lambda: (sweep.parts_folder(out) / "sweep.json").exists(), "the first sweep to start", 120)
     second = runner.invoke(app, ["sweep", *SMALL_ARGS, "--no-progress", "-o", str(out)])
     assert second.exit_code == 2, second.output
     assert f"error: another sweep is writing {out}: pid {first.pid} on " in second.output

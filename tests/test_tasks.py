@@ -172,11 +172,17 @@ def test_spot_weld_stops_at_every_weld_point(cycles, loaded, robot):
     assert np.max(np.abs(path.qdd) / task.acceleration_limit) > 0.8
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
-def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
+def arc_weld_seam(cycles, loaded, robot):
+    """``robot``'s arc weld: its task, its path, its seam segment's first and last sample, and the
+    flange positions (m, shape (samples, 3)) along that segment."""
     task, path = cycles[robot, "arc_weld"]
     first, last = seam_segment(path)
-    flange = flange_positions(loaded[robot], path.q[first : last + 1])
+    return task, path, (first, last), flange_positions(loaded[robot], path.q[first : last + 1])
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
+    task, path, (first, last), flange = arc_weld_seam(cycles, loaded, robot)
     target = path.target[first : last + 1]
     assert not np.any(np.isnan(target))
     assert np.max(np.linalg.norm(flange - target, axis=1)) <= 0.5 * MM
@@ -189,10 +195,8 @@ def test_arc_weld_flange_follows_the_seam(cycles, loaded, robot):
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_arc_weld_tool_speed_is_constant_along_the_seam(cycles, loaded, robot):
-    task, path = cycles[robot, "arc_weld"]
+    task, _, _, flange = arc_weld_seam(cycles, loaded, robot)
     v = seam(task)
-    first, last = seam_segment(path)
-    flange = flange_positions(loaded[robot], path.q[first : last + 1])
     velocity = np.gradient(flange, DT, axis=0)
     t = np.arange(len(flange)) * DT
     cruise = (t > v["ramp_time"] + 0.05) & (t < t[-1] - v["ramp_time"] - 0.05)
@@ -211,10 +215,8 @@ def test_arc_weld_tool_speed_is_constant_along_the_seam(cycles, loaded, robot):
 
 @pytest.mark.parametrize("robot", ROBOTS)
 def test_arc_weld_weave_has_the_configured_amplitude_and_frequency(cycles, loaded, robot):
-    task, path = cycles[robot, "arc_weld"]
+    task, _, _, flange = arc_weld_seam(cycles, loaded, robot)
     v = seam(task)
-    first, last = seam_segment(path)
-    flange = flange_positions(loaded[robot], path.q[first : last + 1])
     assert 1 * MM <= v["weave_amplitude"] <= 5 * MM and 1.0 <= v["weave_frequency"] <= 3.0
     for keep, _, across in straight_parts(task, flange):
         lateral = across[keep]

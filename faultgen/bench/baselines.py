@@ -45,6 +45,7 @@ lists the registry without loading scikit-learn.
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 # the registry itself (one for every layer: the monitor's model is in it too), re-exported here
@@ -200,29 +201,17 @@ def _isolator(name: str, **params):
     return isolation.make(name, **params)
 
 
-@register("transfer_entropy", "isolator", "largest summed net transfer entropy (thesis eq. 6.4-6.5)")
-def _transfer_entropy(**params):
-    return _isolator("transfer_entropy", **params)
-
-
-@register("cross_correlation", "isolator", "the axis leading every other in cross-correlation (ch. 3.4.2)")
-def _cross_correlation(**params):
-    return _isolator("cross_correlation", **params)
-
-
-@register("granger", "isolator", "largest summed net pairwise Granger F statistic (Granger 1969)")
-def _granger(**params):
-    return _isolator("granger", **params)
-
-
-@register("trend", "isolator", "the axis whose signal drifts most against its own noise")
-def _trend(**params):
-    return _isolator("trend", **params)
-
-
-@register("pca_contribution", "isolator", "largest contribution to the PCA residual Q (thesis eq. 3.3-3.4)")
-def _pca_contribution(**params):
-    return _isolator("pca_contribution", **params)
+#: analysis.isolation's isolators, registered in this order: (name, summary).
+_ISOLATORS = (
+    ("transfer_entropy", "largest summed net transfer entropy (thesis eq. 6.4-6.5)"),
+    ("cross_correlation", "the axis leading every other in cross-correlation (ch. 3.4.2)"),
+    ("granger", "largest summed net pairwise Granger F statistic (Granger 1969)"),
+    ("trend", "the axis whose signal drifts most against its own noise"),
+    ("pca_contribution", "largest contribution to the PCA residual Q (thesis eq. 3.3-3.4)"),
+)
+for _name, _summary in _ISOLATORS:
+    register(_name, "isolator", _summary)(functools.partial(_isolator, _name))
+del _name, _summary
 
 
 

@@ -21,10 +21,6 @@ builds from the samples.
 
 from __future__ import annotations
 
-import importlib
-import os
-import sys
-
 import numpy as np
 
 from faultgen.bench import files
@@ -76,19 +72,15 @@ def load(spec: str):
         If ``spec`` is not ``module:Class``, the module cannot be imported, it has no such class,
         ``Class()`` raises, or the object lacks ``fit`` or ``predict`` (naming ``spec``).
     """
+    from analysis.plugins import import_here
+
     module_name, _, class_name = str(spec).partition(":")
     if not module_name or not class_name.isidentifier():
         raise ValueError(f"prognoser {spec!r}: expected package.module:Class, e.g. mine:MyPrognoser")
-    added = os.getcwd() not in sys.path
-    if added:
-        sys.path.insert(0, os.getcwd())
     try:
-        module = importlib.import_module(module_name)
+        module = import_here(module_name)
     except (Exception, SystemExit) as err:  # noqa: BLE001 (the user's module may raise anything: named on one line)
         raise ValueError(f"prognoser {spec!r}: importing {module_name!r} failed: {type(err).__name__}: {err}") from None
-    finally:
-        if added and os.getcwd() in sys.path:
-            sys.path.remove(os.getcwd())
     cls = getattr(module, class_name, None)
     if not isinstance(cls, type):
         raise ValueError(f"prognoser {spec!r}: module {module_name!r} has no class {class_name!r}")  # noqa: TRY004 (a wrong spec)

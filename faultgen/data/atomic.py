@@ -35,13 +35,9 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     OSError
         If the folder of ``path`` does not exist.
     """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise OSError(f"cannot write {path}: folder {folder} does not exist")
-    remove_stale(path)
+    path, part = _part_beside(path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder)
+        fd, tmp = tempfile.mkstemp(**part)
     except OSError as err:  # a read-only folder: name the file asked for, not the hidden temporary one
         raise _naming(err, path) from None
     os.close(fd)
@@ -144,13 +140,9 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     OSError
         If the folder of ``path`` does not exist or cannot be written.
     """
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise OSError(f"cannot write {path}: folder {folder} does not exist")
-    remove_stale(path)
+    path, part = _part_beside(path)
     try:
-        staging = Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}@{_host()}.", suffix=".part", dir=folder))
+        staging = Path(tempfile.mkdtemp(**part))
     except OSError as err:  # a read-only folder: name the folder asked for, not the hidden one
         raise _naming(err, path) from None
     try:
@@ -365,6 +357,24 @@ def writer_of(path: str | Path) -> int | None:
     if match is None or match[3] != _host() or not _running(int(match[2])):
         return None
     return int(match[2])
+
+
+def _part_beside(path: str | Path) -> tuple[Path, dict]:
+    """``path`` as a :class:`~pathlib.Path` and the ``tempfile.mkstemp``/``mkdtemp`` arguments of its
+    hidden part (``.<name>.<pid>@<host>.<random>.part`` in its folder), once the folder is checked and
+    the parts a killed writer left are removed (:func:`remove_stale`).
+
+    Raises
+    ------
+    OSError
+        If the folder of ``path`` does not exist.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OSError(f"cannot write {path}: folder {folder} does not exist")
+    remove_stale(path)
+    return path, {"prefix": f".{path.name}.{os.getpid()}@{_host()}.", "suffix": ".part", "dir": folder}
 
 
 def _host() -> str:

@@ -143,28 +143,23 @@ class Run:
         ValueError
             For such an older file whose robot cannot be loaded on this machine.
         """
-        if "drivetrain" not in self._stored:
-            attrs = self._stored.get("attrs", {})
-            self._stored["drivetrain"] = robot_record.drivetrain(attrs, self.robot, self._where)
-        return self._stored["drivetrain"]
+        return self._read_once("drivetrain", lambda attrs: robot_record.drivetrain(attrs, self.robot, self._where))
 
     @property
     def limits(self) -> robot_record.Limits:
         """The limits the run's histograms were binned over (joint range, the robot's and the task's
         speed limit: :class:`faultgen.data.robot_record.Limits`), read on first use. A file written
         before runs stored them gives the robot's, loaded from its files by :attr:`robot` (``from_files``).
-
-        Raises
-        ------
-        faultgen.data.schema.DatasetError
-            If the stored attribute does not read.
-        ValueError
-            For such an older file whose robot cannot be loaded on this machine.
+        Raises as :attr:`drivetrain` does.
         """
-        if "limits" not in self._stored:
-            attrs = self._stored.get("attrs", {})
-            self._stored["limits"] = robot_record.limits(attrs, self.robot, self.task, self._where)
-        return self._stored["limits"]
+        return self._read_once(
+            "limits", lambda attrs: robot_record.limits(attrs, self.robot, self.task, self._where))
+
+    def _read_once(self, key: str, read):
+        """``read(attrs)`` of the run's stored attributes, kept under ``key`` after its first use."""
+        if key not in self._stored:
+            self._stored[key] = read(self._stored.get("attrs", {}))
+        return self._stored[key]
 
     @property
     def _where(self) -> str:

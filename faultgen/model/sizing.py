@@ -170,6 +170,17 @@ class Loads:
     offset: float
 
 
+def _pose_sampling(model: mujoco.MjModel, joints: list) -> tuple:
+    """What both rules' load sampling starts from (constraints off in ``model``): its ``MjData``, the
+    generator (seed :data:`SEED`), the joints' dof and qpos addresses, shape (N,), and their lower and
+    upper limits, rad (or m), shape (N,)."""
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
+    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
+    low, high = np.array([j.range for j in joints]).T
+    return mujoco.MjData(model), np.random.default_rng(SEED), dofs, qadr, low, high
+
+
 def arm_loads_rule1(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[np.ndarray, np.ndarray]:
     """Rule 1's loads: largest gravity torque (rated payload at the last link's origin) and largest
     diagonal of the joint-space inertia over :data:`POSES` poses within the limits, N m and kg m^2,
@@ -187,12 +198,7 @@ def arm_loads_rule1(spec: mujoco.MjSpec, joints: list, payload: float) -> tuple[
         load.explicitinertial = True
         load.mass, load.inertia = payload, [0.4 * payload * radius**2] * 3
     model = spec.compile()
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    data = mujoco.MjData(model)
-    rng = np.random.default_rng(SEED)
-    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
-    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
-    low, high = np.array([j.range for j in joints]).T
+    data, rng, dofs, qadr, low, high = _pose_sampling(model, joints)
     gravity, inertia = np.zeros(len(joints)), np.zeros(len(joints))
     full = np.zeros((model.nv, model.nv))
     for _ in range(POSES):
@@ -240,12 +246,7 @@ def arm_loads(arm, payload: float) -> Loads:
     joints = arm.joints
     speed, acceleration = planning_limits(arm)
     model = with_rated_load(arm.spec, joints, payload).compile()
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
-    data = mujoco.MjData(model)
-    rng = np.random.default_rng(SEED)
-    dofs = np.array([model.joint(j.name).dofadr[0] for j in joints])
-    qadr = np.array([model.joint(j.name).qposadr[0] for j in joints])
-    low, high = np.array([j.range for j in joints]).T
+    data, rng, dofs, qadr, low, high = _pose_sampling(model, joints)
     gravity, need = np.zeros(len(joints)), np.zeros(len(joints))
     for _ in range(POSES):
         data.qpos[:], data.qvel[:], data.qacc[:] = 0, 0, 0
@@ -347,52 +348,72 @@ def sized(arm, given: dict[int, dict[str, float]] | None = None, payload: float 
     if payload is None:
         payload = arm.payload if not math.isnan(arm.payload) else PAYLOAD_SHARE * mass
     loads = arm_loads(arm, payload)
+
+    def torque_limit(k: int, G: float, speed: float, mine_k: dict) -> tuple[float, str]:
+        effort = arm.effort_limit[k]
+        if not math.isnan(effort):
+            return effort / G, f"sized: the source's effort limit {effort:.4g} N m / G (arm side)"
+        value = max(MIN_MOTOR_TORQUE, motor_torque(
+            loads.need[k], G, speed, loads.acceleration[k], mine_k.get("motor_inertia"),
+            mine_k.get("coulomb_pos"), mine_k.get(FRICTION_FIELDS[5])))
+        return value, (
+            f"sized: {MARGIN:g} x (need {loads.need[k]:.4g} N m / G + rotor acceleration + motor "
+            f"friction), at least {MIN_MOTOR_TORQUE:g} N m; need = max |rigid-body torque| over "
+            f"{POSES} poses with every axis at its speed and acceleration limits, a rated load of {payload:.4g} kg, centre of mass "
+            f"{loads.offset:.3g} m out along the flange's z axis, acceleration = speed "
+            f"limit / {RAMP[0]:g} s (main) or {RAMP[1]:g} s (wrist); gravity alone {loads.gravity[k]:.4g} N m"
+        )
+
+    table, origin = _size_axes(arm, given, RULES, lambda k, wrist: loads.speed[k], torque_limit)
+    return Sized(Drivetrain.from_table(table, n, _source(arm)), origin, float(payload), loads, mass, 2)
+
+
+def _source(arm) -> str:
+    """The ``source`` line of a sized drivetrain."""
+    return f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
+
+
+def _size_axes(arm, given: dict[int, dict[str, float]], rules: dict[str, str], speed_of, torque_of) -> tuple[dict, dict]:
+    """The per-axis steps every sizing rule shares: ``({axis: {key: value}}, {axis: {key: note}})``.
+
+    Values in ``given`` are kept (noted "given"); the rest follow ``rules`` (``{key: note}``):
+    the gear ratio from the arm speed ``speed_of(k, wrist)`` (rad/s, axis index ``k`` from 0), the motor
+    torque limit and its note from ``torque_of(k, G, speed, given_k)`` (N m, motor side), and the rest
+    from the torque limit (:func:`_put_from_torque`).
+    """
+    n = len(arm.joints)
     main = main_axes(n)
     table, origin = {}, {}
     for k in range(n):
         axis = k + 1
         wrist = k >= main
-        mine = dict(given.get(axis, {}))
+        mine_k = given.get(axis, {})
+        mine = dict(mine_k)
         notes = {key: "given" for key in mine}
 
         def put(key: str, value: float, mine=mine, notes=notes) -> float:
             if key not in mine:
                 mine[key] = float(value)
-                notes[key] = "sized: " + RULES[key]
+                notes[key] = "sized: " + rules[key]
             return mine[key]
 
         known_speed = not math.isnan(arm.speed_limit[k])
-        speed = loads.speed[k]
+        speed = speed_of(k, wrist)
         G = put("gear_ratio", MOTOR_SPEED / speed)
-        if "gear_ratio" not in given.get(axis, {}):
+        if "gear_ratio" not in mine_k:
             notes["gear_ratio"] += (
                 f" ({speed:.4g} rad/s from the source)"
                 if known_speed
                 else f" (no speed limit in the source: {speed:g} rad/s assumed)"
             )
-        effort = arm.effort_limit[k]
-        mine_k = given.get(axis, {})
-        torque = put(
-            "motor_torque_limit",
-            effort / G if not math.isnan(effort) else max(MIN_MOTOR_TORQUE, motor_torque(
-                loads.need[k], G, speed, loads.acceleration[k], mine_k.get("motor_inertia"),
-                mine_k.get("coulomb_pos"), mine_k.get(FRICTION_FIELDS[5]))),
-        )
+        value, note = torque_of(k, G, speed, mine_k)
+        torque = put("motor_torque_limit", value)
         if "motor_torque_limit" not in mine_k:
-            notes["motor_torque_limit"] = (
-                f"sized: the source's effort limit {effort:.4g} N m / G (arm side)"
-                if not math.isnan(effort)
-                else f"sized: {MARGIN:g} x (need {loads.need[k]:.4g} N m / G + rotor acceleration + motor "
-                f"friction), at least {MIN_MOTOR_TORQUE:g} N m; need = max |rigid-body torque| over "
-                f"{POSES} poses with every axis at its speed and acceleration limits, a rated load of {payload:.4g} kg, centre of mass "
-                f"{loads.offset:.3g} m out along the flange's z axis, acceleration = speed "
-                f"limit / {RAMP[0]:g} s (main) or {RAMP[1]:g} s (wrist); gravity alone {loads.gravity[k]:.4g} N m"
-            )
+            notes["motor_torque_limit"] = note
         _put_from_torque(put, torque, G, wrist)
         table[axis] = {key: mine[key] for key in KEYS}
         origin[axis] = notes
-    source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
-    return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), loads, mass, 2)
+    return table, origin
 
 
 def _put_from_torque(put, torque: float, G: float, wrist: int) -> None:
@@ -423,56 +444,24 @@ def _sized_rule1(arm, given: dict[int, dict[str, float]] | None, payload: float 
     if payload is None:
         payload = arm.payload if not math.isnan(arm.payload) else PAYLOAD_SHARE * moving_mass
     gravity, inertia = arm_loads_rule1(arm.spec, arm.joints, payload)
-    main = main_axes(n)
-    table, origin = {}, {}
-    for k in range(n):
-        axis = k + 1
-        wrist = k >= main
-        mine = dict(given.get(axis, {}))
-        notes = {key: "given" for key in mine}
 
-        def put(key: str, value: float, mine=mine, notes=notes) -> float:
-            if key not in mine:
-                mine[key] = float(value)
-                notes[key] = "sized: " + RULES_1[key]
-            return mine[key]
+    def speed_of(k: int, wrist: bool) -> float:
+        return arm.speed_limit[k] if not math.isnan(arm.speed_limit[k]) else DEFAULT_SPEED[wrist]
 
-        known_speed = not math.isnan(arm.speed_limit[k])
-        speed = arm.speed_limit[k] if known_speed else DEFAULT_SPEED[wrist]
-        G = put("gear_ratio", MOTOR_SPEED / speed)
-        if "gear_ratio" not in given.get(axis, {}):
-            notes["gear_ratio"] += (
-                f" ({speed:.4g} rad/s from the source)"
-                if known_speed
-                else f" (no speed limit in the source: {speed:g} rad/s assumed)"
-            )
+    def torque_limit(k: int, G: float, speed: float, mine_k: dict) -> tuple[float, str]:
         effort = arm.effort_limit[k]
-        peak = (
-            effort if not math.isnan(effort) else GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
+        if not math.isnan(effort):
+            return effort / G, f"sized: the source's effort limit {effort:.4g} N m / G"
+        peak = GRAVITY_MARGIN * gravity[k] + inertia[k] * speed / RAMP_TIME
+        return max(peak / G, MIN_MOTOR_TORQUE), (
+            f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
+            f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
+            f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
+            f"{MIN_MOTOR_TORQUE:g} N m"
         )
-        torque = put(
-            "motor_torque_limit", peak / G if not math.isnan(effort) else max(peak / G, MIN_MOTOR_TORQUE)
-        )
-        if "motor_torque_limit" not in given.get(axis, {}):
-            notes["motor_torque_limit"] = (
-                f"sized: the source's effort limit {effort:.4g} N m / G"
-                if not math.isnan(effort)
-                else f"sized: peak {peak:.4g} N m / G; peak = {GRAVITY_MARGIN:g} x max "
-                f"gravity torque {gravity[k]:.4g} N m (payload {payload:.4g} kg) + max "
-                f"M_ii {inertia[k]:.4g} kg m^2 x speed limit / {RAMP_TIME:g} s, at least "
-                f"{MIN_MOTOR_TORQUE:g} N m"
-            )
-        _put_from_torque(put, torque, G, wrist)
-        table[axis] = {key: mine[key] for key in KEYS}
-        origin[axis] = notes
-    source = f"{arm.source}: the drivetrain sized for it (its speed and torque limits, masses, --drivetrain)"
-    return Sized(Drivetrain.from_table(table, n, source), origin, float(payload), None, moving_mass, 1)
 
-
-#: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3
-#: (aluminium), sets the edge of a cube of that mass. The shares are those of the IRB-6700-like
-#: arm's parts (faultgen.runs.fleet.PARTS: 10-40 and 60-120 kg of 200 kg).
-PART_SHARES, PART_DENSITY = ((0.05, 0.2), (0.3, 0.6)), 2700.0
+    table, origin = _size_axes(arm, given, RULES_1, speed_of, torque_limit)
+    return Sized(Drivetrain.from_table(table, n, _source(arm)), origin, float(payload), None, moving_mass, 1)
 
 
 def fleet_parts(rated_payload: float) -> tuple:
