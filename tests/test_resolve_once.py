@@ -141,6 +141,9 @@ ALLOWED = {
                                                                "(cached_model)")),
     "faultgen/data/robot_record.py": (1, "an earlier run's state", ("a dataset written before drivetrains were "
                                                                     "stored names its robot by its label only")),
+    "faultgen/bench/make.py": (1, "an earlier run's state", ("bench make: the track's robot folder in its sweeps "
+                                                            "folder (added by this make or kept from an earlier "
+                                                            "one), read once per fleet with friction tests")),
     "faultgen/bench/independent.py": (1, "public API", ("write_fleet(), the bench's independent simulator's entry, "
                                                         "takes a robot folder; once per fleet")),
 }

@@ -202,9 +202,10 @@ def _fleet_units(version: tracks.Version, split: str, size: str, sweeps: Path, a
     units = []
     for part, fleet in version.fleets(split, size):
         folder = added[fleet["robot"]]
-        model = robots.load(folder)
         spec = independent.FleetSpec(**{k: tuple(v) if isinstance(v, list) else v for k, v in fleet["spec"].items()})
         logs, truth_path = independent.write_fleet(sweeps / f"{split}-{part}", spec, folder)
+        # the robot folder in the sweeps folder (added now or by an earlier make), read once per fleet with tests
+        model = robots.load(folder) if spec.friction_test_every else None
         dataset = sweeps / f"{split}-{part}.h5"
         fleetlogs.import_logs(logs, dataset, robot=str(folder), progress=progress)
         truth = independent.read_truth(truth_path)
