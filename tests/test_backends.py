@@ -11,6 +11,7 @@ loss per run, where the per-step friction update is handed to ``rollout`` as arr
 """
 
 import dataclasses
+import pickle
 
 import backend_kernel  # noqa: F401  (registers the test-only backend "kernel": held to loop below)
 import numpy as np
@@ -46,7 +47,7 @@ def short_work(name, model_name, backend, gear_loss=0.01):
             model.body_iquat[body].copy())
     return prepared.sim, batch.Work(np.array([1, 7]), plant, prepared.path.q[0], prepared.inputs[: n_steps + 1],
                                     dist, per_log, 1, grips=((PERIODS // 2 * per_log, grip),),
-                                    qd0=prepared.path.qd[0], qdd0=prepared.path.qdd[0], backend=backend)
+                                    qd0=prepared.path.qd[0], qdd0=prepared.path.qdd[0], stepper=backends.get(backend))
 
 
 def step(name, model_name, backend, **plant):
@@ -68,7 +69,7 @@ def assert_as_loop(model, ours, plain):
 
 @pytest.mark.parametrize("name", sorted(robots.available()))
 @pytest.mark.parametrize("model_name", friction.MODELS)
-@pytest.mark.parametrize("backend", [b for b in backends.BACKENDS if b != "loop"])
+@pytest.mark.parametrize("backend", [b for b in backends.STEPPERS if b != "loop"])
 def test_backend_steps_as_the_plain_loop(name, model_name, backend):
     model, plain = step(name, model_name, "loop")
     _, ours = step(name, model_name, backend)
@@ -81,7 +82,7 @@ def stepped(tmp_path_factory):
     return str(stepped_robot.write(tmp_path_factory.mktemp("stepped")))
 
 
-@pytest.mark.parametrize("backend", [b for b in backends.BACKENDS if b != "loop"])
+@pytest.mark.parametrize("backend", [b for b in backends.STEPPERS if b != "loop"])
 def test_backend_steps_the_static_friction_update_as_the_plain_loop(stepped, backend):
     """The per-step update with every kind of term (a drift in time, a transmitted-load and a
     static-load term, a gear loss per run), a grip mid-run: the loop backend and ``kernel`` apply it
@@ -105,7 +106,24 @@ def test_backends_are_different_steppers():
 def test_unknown_backend_is_named():
     config = sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
     with pytest.raises(ValueError, match=r"unknown stepping backend 'gpu'; expected one of batch, loop"):
-        sim.simulate(config, progress=False, backend="gpu")
+        backends.get("gpu")
+    with pytest.raises(ValueError, match=r"'gpu' is not a stepper \(a Stepper object"):
+        sim.simulate(config, progress=False, stepper="gpu")
+
+
+def test_a_stepper_is_a_frozen_picklable_value():
+    """A stepper travels as an object: compared by value, pickled as it is, frozen; BatchStepper's own
+    ``nthread`` (when given) is the threads its batches get, else the run's."""
+    assert backends.get("batch") == backends.BatchStepper() != backends.BatchStepper(2)
+    assert pickle.loads(pickle.dumps(backends.BatchStepper(3))) == backends.BatchStepper(3)
+    assert pickle.loads(pickle.dumps(backends.LoopStepper())) == backends.LoopStepper()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        backends.BatchStepper().nthread = 2
+    assert backends.key_text(backends.BatchStepper()) == ""
+    assert backends.key_text(backends.LoopStepper()) == "backend=loop"  # the text keys had with names
+    assert backends.key_text(backends.BatchStepper(2)) == "backend=batch BatchStepper(nthread=2)"
+    with pytest.raises(ValueError, match="is not a stepping backend"):
+        backends.register(backends.LoopStepper())  # a class is registered, not an instance
 
 
 def test_signal_set_is_defined_once():

@@ -70,7 +70,7 @@ def monitor_command(
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
     scheduler: MonitorScheduler = None,
-    backend: Backend = None,
+    stepper: Backend = None,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -163,7 +163,7 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend,
+                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, stepper=stepper,
                                hours_per_day=hours_per_day)
     except loop.MonitorInterrupted as stopped:  # Ctrl-C, SIGTERM: OUT/.cache keeps the twins made so far
         typer.echo(str(stopped), err=True)

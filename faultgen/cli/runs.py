@@ -199,7 +199,7 @@ def sweep_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
-    backend: Backend = None,
+    stepper: Backend = None,
     out: SweepOut = Path("sweep.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -248,7 +248,7 @@ def sweep_command(
                        "they are")
 
     run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder, backend=backend)
+              shared=shared_folder, stepper=stepper)
     typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
@@ -315,7 +315,7 @@ def fleet_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
-    backend: Backend = None,
+    stepper: Backend = None,
     out: FleetOut = Path("fleet.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -364,14 +364,14 @@ def fleet_command(
                    + (f"; resuming, {done} {'runs' if friction_test_every else 'robots'} already finished" if done else ""))
 
     run_sweep(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder, backend=backend)
+              shared=shared_folder, stepper=stepper)
     typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
                f"  faultgen detect {out}")
 
 
 def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
-              announce, backend: str, shared: bool = False) -> None:
-    """:func:`faultgen.runs.sweep.run` for a command (on the stepping ``backend``), recording the
+              announce, stepper, shared: bool = False) -> None:
+    """:func:`faultgen.runs.sweep.run` for a command (on ``stepper``, a :class:`faultgen.simulation.backends.Stepper`), recording the
     command line in the dataset.
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
     before anything ran, 130 interrupted with the finished runs kept, 1 a run failed. On a
@@ -394,7 +394,7 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
 
     sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
               command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared,
-              on_run=where if scheduler else None, backend=backend)
+              on_run=where if scheduler else None, stepper=stepper)
 
 
 def summary(result, out: Path) -> str:

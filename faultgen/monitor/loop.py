@@ -118,7 +118,7 @@ class Outcome:
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
             progress: bool = True, log_format=None, jobs: int = 1, scheduler: str | None = None,
-            failure_wear: float = prognosis.FAILURE_WEAR, backend: str = backends.DEFAULT,
+            failure_wear: float = prognosis.FAILURE_WEAR, stepper: backends.Stepper | None = None,
             hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
@@ -157,10 +157,10 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     failure_wear : float
         The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
         axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
-    backend : str
-        The stepping backend the twins' cycles are simulated on
-        (:data:`faultgen.simulation.backends.BACKENDS`; with ``jobs`` or ``scheduler``, the workers
-        must know it too). Every backend gives the same outputs to float tolerance.
+    stepper : Stepper, optional
+        What steps the twins' cycles (a :class:`faultgen.simulation.backends.Stepper`; None: the
+        default ``BatchStepper()``; with ``jobs`` or ``scheduler`` it is pickled to the workers, whose
+        processes must be able to import its class). Every stepper gives the same outputs to float tolerance.
     hours_per_day : float
         Operating hours per calendar day between logs, in (0, 24]: ``life.csv``'s consumption
         between logs (:mod:`faultgen.monitor.life`).
@@ -176,7 +176,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
         (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named), ``jobs`` > 1 with a ``scheduler``, an unknown ``backend``, ``hours_per_day``
+        file named), ``jobs`` > 1 with a ``scheduler``, a ``stepper`` that is not a Stepper object, ``hours_per_day``
         outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
         (:mod:`faultgen.model.rating`).
     faultgen.runs.errors.SweepRefused
@@ -196,7 +196,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         cluster.probe(scheduler)
     atomic.check_apart(out, logs_dir)
     prognosis.check_failure_wear(failure_wear)
-    backends.get(backend)
+    stepper = backends.DEFAULT_STEPPER if stepper is None else backends.checked(stepper)
     nominal = robots.load(robot)
     ratings = life.ratings_of(nominal)  # a bad rating refused before any work
     life.check_hours(hours_per_day)
@@ -226,7 +226,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
         confined.mkdir(out / ".cache")
         context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                           failure_wear, backend)
+                           failure_wear, stepper)
         source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
         programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log

@@ -82,7 +82,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
         command: str = "", on_run: Callable[[RunStats], None] | None = None,
         timings: dict | None = None, overwrite: bool = False,
         on_start: Callable[[int, int], None] | None = None, shared: bool = False,
-        backend: str = backends.DEFAULT) -> Path:
+        stepper: backends.Stepper | None = None) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
@@ -110,10 +110,11 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     shared : bool
         With ``scheduler``: the workers write the part files themselves, in the folder of ``out``,
         which they must all see at its absolute path (a shared file system; checked first).
-    backend : str
-        The stepping backend every run is simulated on (:data:`faultgen.simulation.backends.BACKENDS`;
-        the workers must know it: a backend registered outside faultgen, in their processes too).
-        Every backend gives the same dataset to float tolerance; the name is not stored.
+    stepper : Stepper, optional
+        What every run is stepped on (:class:`faultgen.simulation.backends.Stepper`; None: the
+        default ``BatchStepper()``). It is pickled to the workers: a stepper class defined outside
+        faultgen must be importable in their processes too. Every stepper gives the same dataset to
+        float tolerance; it is not stored.
 
     Returns
     -------
@@ -124,7 +125,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     SweepRefused
         Before anything runs, if ``out`` exists (and not ``overwrite``) or another sweep is
         writing it (the message names that sweep: pid, host, start time, command), or for an
-        unknown ``backend`` (the known ones named).
+        ``stepper`` that is not a Stepper object.
     SweepInterrupted
         On Ctrl-C (KeyboardInterrupt): the workers are stopped, and the message says how many
         runs are kept and how to resume.
@@ -138,7 +139,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise SweepRefused(f"jobs {jobs!r}: expected a whole number >= 1")
     try:
-        backends.get(backend)
+        stepper = backends.DEFAULT_STEPPER if stepper is None else backends.checked(stepper)
     except ValueError as err:
         raise SweepRefused(str(err)) from None
     with _lock(out, parts):
@@ -157,7 +158,7 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
                             for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command,
-                                                  shared, bar, backend):
+                                                  shared, bar, stepper):
                                 bar.update(1)
                                 if on_run is not None:
                                     on_run(stats)
@@ -372,17 +373,17 @@ class CtrlC:
 
 
 def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, shared: bool = False,
-             bar=None, backend: str = backends.DEFAULT) -> Iterator[RunStats]:
-    """Run the missing runs on ``backend``; yield the stats of each as it finishes, in completion order."""
+             bar=None, stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Iterator[RunStats]:
+    """Run the missing runs on ``stepper``; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, backend)
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, stepper)
              for run_id, config in todo]
     try:
         if scheduler:
             yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar,
-                                       backend=backend)
+                                       stepper=stepper)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
@@ -393,8 +394,8 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
                 worker.start_resource_tracker()
                 # every worker watches the sweep from its start, idle or not
                 # (:func:`faultgen.runs.worker.watch_parent`)
-                backend = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
-                parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
+                loky = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
+                parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=loky)
                 yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
         if not scheduler:
