@@ -46,6 +46,7 @@ from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.operation import programs
+from faultgen.runs.context import ExecutionContext
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
 from faultgen.simulation import backends
@@ -268,10 +269,9 @@ def _is_handshake(message: bytes) -> bool:
     return isinstance(info, dict) and "pickle-protocol" in info
 
 
-def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, command: str = "",
-            shared: bool = False, bar=None,
-            stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Iterator[RunStats]:
-    """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
+def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: ExecutionContext, command: str = "",
+            shared: bool = False, bar=None) -> Iterator[RunStats]:
+    """Run ``todo`` on the Dask cluster of ``context.scheduler``; yield each run's :class:`RunStats` (with
     the worker's address) once its part file is written, in completion order.
 
     Parameters
@@ -280,17 +280,16 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
         In the order to submit them (longest first).
     parts : Path
         The sweep's part folder (this process's; ``shared``: the workers' too).
-    scheduler : str
-        ``tcp://host:port`` of a Dask scheduler.
+    context : ExecutionContext
+        Its ``scheduler``: ``tcp://host:port`` of a Dask scheduler; its ``stepper``: what the workers
+        step the runs on (:class:`faultgen.simulation.backends.Stepper`, pickled: its class must be
+        importable in their processes); its ``jobs`` is not used.
     command : str
         Provenance stored with every run.
     shared : bool
         The workers write the part files themselves (they must see ``parts`` at its absolute path).
     bar : tqdm, optional
         A progress bar whose postfix shows the workers the scheduler has after each run.
-    stepper : Stepper
-        What the workers step the runs on (:class:`faultgen.simulation.backends.Stepper`, pickled:
-        its class must be importable in their processes).
 
     Raises
     ------
@@ -305,6 +304,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     """
     from distributed import Client, KilledWorker, as_completed
 
+    scheduler = context.scheduler
     probe(scheduler)
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
@@ -314,7 +314,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     with client:
         if shared:
             _check_shared(client, folder)
-        run_of, futures = _submit(client, todo, folder, command, shared, stepper)
+        run_of, futures = _submit(client, todo, folder, command, shared, context.stepper)
         configs = dict(todo)
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)
