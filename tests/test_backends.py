@@ -11,7 +11,6 @@ loss per run, where the per-step friction update is handed to ``rollout`` as arr
 """
 
 import dataclasses
-import pickle
 
 import backend_kernel  # noqa: F401  (registers the test-only backend "kernel": held to loop below)
 import numpy as np
@@ -109,21 +108,6 @@ def test_unknown_backend_is_named():
         backends.get("gpu")
     with pytest.raises(ValueError, match=r"'gpu' is not a stepper \(a Stepper object"):
         sim.simulate(config, progress=False, stepper="gpu")
-
-
-def test_a_stepper_is_a_frozen_picklable_value():
-    """A stepper travels as an object: compared by value, pickled as it is, frozen; BatchStepper's own
-    ``nthread`` (when given) is the threads its batches get, else the run's."""
-    assert backends.get("batch") == backends.BatchStepper() != backends.BatchStepper(2)
-    assert pickle.loads(pickle.dumps(backends.BatchStepper(3))) == backends.BatchStepper(3)
-    assert pickle.loads(pickle.dumps(backends.LoopStepper())) == backends.LoopStepper()
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        backends.BatchStepper().nthread = 2
-    assert backends.key_text(backends.BatchStepper()) == ""
-    assert backends.key_text(backends.LoopStepper()) == "backend=loop"  # the text keys had with names
-    assert backends.key_text(backends.BatchStepper(2)) == "backend=batch BatchStepper(nthread=2)"
-    with pytest.raises(ValueError, match="is not a stepping backend"):
-        backends.register(backends.LoopStepper())  # a class is registered, not an instance
 
 
 def test_signal_set_is_defined_once():
