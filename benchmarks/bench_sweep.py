@@ -28,13 +28,14 @@ from pathlib import Path
 from benchmarks_common import PeakRSS, same_work_seconds  # sibling module
 
 from faultgen.runs import sweep
+from faultgen.runs.context import ExecutionContext
 
 
 def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
     stats, timings = [], {}
     with PeakRSS() as memory:
         started = time.perf_counter()
-        sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", jobs=jobs, progress=False,
+        sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", ExecutionContext(jobs), progress=False,
                   on_run=stats.append, timings=timings)
         wall = time.perf_counter() - started
     return dict(wall=wall, stats=stats, merge=timings["merge"], peak=memory.peak)
@@ -72,7 +73,7 @@ def main() -> None:
               f"{larger['peak'] / 1e6:.0f} MB for {len(big.runs())} runs")
         if args.j2:
             started = time.perf_counter()
-            sweep.run(sweep.Grid.from_preset("j2"), folder / "j2.h5", jobs=2, progress=True)
+            sweep.run(sweep.Grid.from_preset("j2"), folder / "j2.h5", ExecutionContext(2), progress=True)
             print(f"j2 preset, 2 jobs: wall {time.perf_counter() - started:.1f} s")
         print(f"ratio {one['wall'] / limit:.3f}")
     finally:

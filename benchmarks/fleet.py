@@ -24,13 +24,14 @@ from benchmarks_common import PeakRSS  # sibling module
 
 from faultgen.data import dataset
 from faultgen.runs import fleet, sweep
+from faultgen.runs.context import ExecutionContext
 
 
 def timed(plan: fleet.Fleet, jobs: int, out: Path) -> tuple[float, int]:
     """Wall time (s) and peak RSS of the process tree (bytes) of one fleet."""
     with PeakRSS() as memory:
         started = time.perf_counter()
-        sweep.run(plan, out, jobs=jobs, progress=False)
+        sweep.run(plan, out, ExecutionContext(jobs), progress=False)
         wall = time.perf_counter() - started
     return wall, memory.peak
 

@@ -155,7 +155,7 @@ def make_bombs(folder: Path) -> dict[str, Path]:
 
         base = folder / "dataset-base.h5"
         if not base.exists():
-            sweep.run(sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], cycles=2), base, jobs=1,
+            sweep.run(sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], cycles=2), base,
                       progress=False)
         data.write_bytes(base.read_bytes())
         with h5py.File(data, "r+") as f:

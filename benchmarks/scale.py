@@ -39,6 +39,7 @@ from faultgen.data import dataset
 from faultgen.operation.conditions import CycleConditions
 from faultgen.runs import cluster as cluster_module
 from faultgen.runs import fleet, sweep
+from faultgen.runs.context import ExecutionContext
 from faultgen.simulation import stepping as sim
 
 CYCLES_PER_DAY = 2
@@ -56,8 +57,8 @@ def on_cluster(plan, out: Path, workers: int, shared: bool = False) -> dict:
     stats: list[sweep.RunStats] = []
     with local_cluster(workers) as cluster:
         started = time.perf_counter()
-        sweep.run(plan, out, scheduler=cluster.scheduler_address, progress=False, on_run=stats.append,
-                  shared=shared)
+        sweep.run(plan, out, ExecutionContext(scheduler=cluster.scheduler_address), progress=False,
+                  on_run=stats.append, shared=shared)
         wall = time.perf_counter() - started
     return {"wall": wall, "stats": stats, "size": out.stat().st_size,
             "worker_seconds": sum(s.total for s in stats), "writing": sum(s.writing for s in stats),

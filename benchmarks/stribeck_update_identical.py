@@ -83,7 +83,9 @@ def simulate(robot: Path, out: Path) -> None:
                                fault=parse_fault("load_dependent_friction:2:coefficient:0.06", last_cycle=6)),
     }
     for name, (config, backend) in RUNS.items():
-        run = faultgen.simulate(configs[config], progress=False, backend=backend)
+        from faultgen.simulation import backends  # steppers travel as objects since r7; names before
+        given = {"stepper": backends.get(backend)} if hasattr(backends, "STEPPERS") else {"backend": backend}
+        run = faultgen.simulate(configs[config], progress=False, **given)
         arrays = {k: np.asarray(v) for k, v in vars(run).items()
                   if isinstance(v, np.ndarray) and v.dtype.kind in "fiub"}
         np.savez(out / f"{name}.npz", **arrays)

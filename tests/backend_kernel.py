@@ -67,7 +67,8 @@ class KernelRuns:
         return out
 
 
-class KernelBackend(backends.Backend):
+@backends.register
+class KernelBackend(backends.Stepper):
     """:class:`KernelRuns`: the friction update applied from its arrays inside ``rollout``."""
 
     name = "kernel"
@@ -77,5 +78,5 @@ class KernelBackend(backends.Backend):
         return KernelRuns(model, nsim, nthread)
 
 
-#: The registered instance.
-KERNEL = backends.register(KernelBackend())
+#: An instance of it.
+KERNEL = KernelBackend()

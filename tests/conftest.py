@@ -44,7 +44,7 @@ def shared_sweep(tmp_path_factory, worker_id):
         out = folder / f"{name}.h5"
         with FileLock(folder / f"{name}.build-lock"):
             if not out.exists():
-                sweep.run(sweep.Grid(**grid), out, jobs=1, progress=False)
+                sweep.run(sweep.Grid(**grid), out, progress=False)
         return out
 
     return build
@@ -62,7 +62,7 @@ def shared_fleet(tmp_path_factory, worker_id):
         out = folder / f"{name}.h5"
         with FileLock(folder / f"{name}.build-lock"):
             if not out.exists():
-                sweep.run(Fleet(**settings), out, jobs=1, progress=False)
+                sweep.run(Fleet(**settings), out, progress=False)
         return out
 
     return build

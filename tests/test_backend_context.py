@@ -1,6 +1,6 @@
 """A stepping backend reaches sweeps, fleets and the monitor's twin through their execution context
 (issue 57, item 4): the test-only backend of tests/backend_example.py, registered in that file
-alone, is named to :func:`faultgen.runs.sweep.run` (a sweep's grid and a fleet), and to the monitor
+alone, is handed as an object to :func:`faultgen.runs.sweep.run` (a sweep's grid and a fleet), and to the monitor
 (:func:`faultgen.monitor.loop.monitor`, whose context hands it to each twin); it is the one that
 steps, and the outputs are the default backend's to the tolerance of tests/test_backends.py."""
 
@@ -15,6 +15,7 @@ from faultgen.monitor import loop
 from faultgen.monitor.scoring import Settings
 from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.runs import sweep
+from faultgen.runs.context import ExecutionContext
 from faultgen.runs.fleet import Fleet
 from faultgen.simulation import backends
 
@@ -58,10 +59,10 @@ def assert_same_datasets(a, b):
 
 
 def test_the_example_is_registered_by_its_own_file_and_refused_twice_under_its_name():
-    assert backends.get("counting") is COUNTING
-    assert backends.register(COUNTING) is COUNTING  # again: nothing changes
+    assert type(backends.get("counting")) is backend_example.CountingBackend
+    assert backends.register(backend_example.CountingBackend) is backend_example.CountingBackend  # again: no change
     with pytest.raises(ValueError, match="'counting' is already registered"):
-        backends.register(backend_example.CountingBackend())
+        backends.register(type("Other", (backend_example.CountingBackend,), {}))
     with pytest.raises(ValueError, match="not a stepping backend"):
         backends.register("counting")
 
@@ -69,7 +70,8 @@ def test_the_example_is_registered_by_its_own_file_and_refused_twice_under_its_n
 def test_a_sweep_steps_on_the_backend_it_is_given_with_the_default_backends_dataset(tmp_path):
     grid = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0, 2], cycles=3, record=[1, 3])
     default = sweep.run(grid, tmp_path / "default.h5", progress=False)
-    ours, runs = counted(lambda: sweep.run(grid, tmp_path / "counting.h5", progress=False, backend="counting"))
+    ours, runs = counted(lambda: sweep.run(grid, tmp_path / "counting.h5", progress=False,
+                                              context=ExecutionContext(stepper=COUNTING)))
     assert runs == 2 * 2  # two runs of two recorded cycles each
     assert_same_datasets(ours, default)
 
@@ -77,15 +79,18 @@ def test_a_sweep_steps_on_the_backend_it_is_given_with_the_default_backends_data
 def test_a_fleet_steps_on_the_backend_it_is_given_with_the_default_backends_dataset(tmp_path):
     fleet = Fleet(size=2, failing=1, days=6, cycles_per_day=1, models=("puma560",))
     default = sweep.run(fleet, tmp_path / "default.h5", progress=False)
-    ours, runs = counted(lambda: sweep.run(fleet, tmp_path / "counting.h5", progress=False, backend="counting"))
+    ours, runs = counted(lambda: sweep.run(fleet, tmp_path / "counting.h5", progress=False,
+                                              context=ExecutionContext(stepper=COUNTING)))
     assert runs == 2 * 6  # two robots, one cycle a day for six days
     assert_same_datasets(ours, default)
 
 
 def test_an_unknown_backend_is_refused_before_a_sweep_runs(tmp_path):
     grid = sweep.Grid(robots=["puma560"], tasks=["pick_place"], axes=[0], cycles=1)
-    with pytest.raises(sweep.SweepRefused, match="unknown stepping backend 'gpu'; expected one of batch, loop"):
-        sweep.run(grid, tmp_path / "x.h5", progress=False, backend="gpu")
+    with pytest.raises(ValueError, match="'gpu' is not a stepper"):
+        ExecutionContext(stepper="gpu")
+    with pytest.raises(sweep.SweepRefused, match="context 'gpu': expected an ExecutionContext"):
+        sweep.run(grid, tmp_path / "x.h5", "gpu", progress=False)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -93,7 +98,7 @@ def test_the_monitors_twins_step_on_the_backend_it_is_given_with_the_default_bac
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", FLEET)
     out = tmp_path / "out"
     _, runs = counted(lambda: loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False,
-                                           backend="counting"))
+                                           context=ExecutionContext(stepper=COUNTING)))
     cycles = out / ".cache" / "cycles"
     assert runs == len(list(cycles.glob("*.json"))) > len(base_cycles(6))  # every twin cycle, payloads' too
     # the cycles the monitor keeps (the first unit's twin replays its first log) against the default backend's
@@ -107,8 +112,9 @@ def test_the_monitors_twins_step_on_the_backend_it_is_given_with_the_default_bac
 
 
 def test_an_unknown_backend_is_refused_before_the_monitor_or_a_twin_starts(tmp_path):
-    with pytest.raises(ValueError, match="unknown stepping backend 'gpu'; expected one of batch, loop"):
-        loop.monitor("puma560", tmp_path / "logs", tmp_path / "out", progress=False, backend="gpu")
-    with pytest.raises(ValueError, match="unknown stepping backend 'gpu'"):
-        Twin("puma560", tmp_path / "program.csv", tmp_path / "cycles", backend="gpu")
+    with pytest.raises(ValueError, match="'gpu' is not a stepper"):
+        loop.monitor("puma560", tmp_path / "logs", tmp_path / "out", progress=False,
+                     context=ExecutionContext(stepper="gpu"))
+    with pytest.raises(ValueError, match="'gpu' is not a stepper"):
+        Twin("puma560", tmp_path / "program.csv", tmp_path / "cycles", stepper="gpu")
     assert list(tmp_path.iterdir()) == []

@@ -46,7 +46,7 @@ def short_work(name, model_name, backend, gear_loss=0.01):
             model.body_iquat[body].copy())
     return prepared.sim, batch.Work(np.array([1, 7]), plant, prepared.path.q[0], prepared.inputs[: n_steps + 1],
                                     dist, per_log, 1, grips=((PERIODS // 2 * per_log, grip),),
-                                    qd0=prepared.path.qd[0], qdd0=prepared.path.qdd[0], backend=backend)
+                                    qd0=prepared.path.qd[0], qdd0=prepared.path.qdd[0], stepper=backends.get(backend))
 
 
 def step(name, model_name, backend, **plant):
@@ -68,7 +68,7 @@ def assert_as_loop(model, ours, plain):
 
 @pytest.mark.parametrize("name", sorted(robots.available()))
 @pytest.mark.parametrize("model_name", friction.MODELS)
-@pytest.mark.parametrize("backend", [b for b in backends.BACKENDS if b != "loop"])
+@pytest.mark.parametrize("backend", [b for b in backends.STEPPERS if b != "loop"])
 def test_backend_steps_as_the_plain_loop(name, model_name, backend):
     model, plain = step(name, model_name, "loop")
     _, ours = step(name, model_name, backend)
@@ -81,7 +81,7 @@ def stepped(tmp_path_factory):
     return str(stepped_robot.write(tmp_path_factory.mktemp("stepped")))
 
 
-@pytest.mark.parametrize("backend", [b for b in backends.BACKENDS if b != "loop"])
+@pytest.mark.parametrize("backend", [b for b in backends.STEPPERS if b != "loop"])
 def test_backend_steps_the_static_friction_update_as_the_plain_loop(stepped, backend):
     """The per-step update with every kind of term (a drift in time, a transmitted-load and a
     static-load term, a gear loss per run), a grip mid-run: the loop backend and ``kernel`` apply it
@@ -105,7 +105,9 @@ def test_backends_are_different_steppers():
 def test_unknown_backend_is_named():
     config = sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
     with pytest.raises(ValueError, match=r"unknown stepping backend 'gpu'; expected one of batch, loop"):
-        sim.simulate(config, progress=False, backend="gpu")
+        backends.get("gpu")
+    with pytest.raises(ValueError, match=r"'gpu' is not a stepper \(a Stepper object"):
+        sim.simulate(config, progress=False, stepper="gpu")
 
 
 def test_signal_set_is_defined_once():

@@ -27,6 +27,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.runs import sweep
+from faultgen.runs.context import ExecutionContext
 
 REPO = Path(__file__).resolve().parents[1]
 FLEET = dict(size=2, failing=1, days=6, cycles_per_day=1)
@@ -225,7 +226,8 @@ def a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, refer
 
     def client() -> None:
         try:
-            sweep.run(sweep.Grid(**SMALL), "out/k.h5", scheduler=cluster.address, progress=False, on_run=kept.append)
+            sweep.run(sweep.Grid(**SMALL), "out/k.h5", ExecutionContext(scheduler=cluster.address), progress=False,
+                      on_run=kept.append)
         except Exception as err:  # reported below
             failure.append(err)
 

@@ -20,6 +20,7 @@ import pytest
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import loop, scoring
 from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.runs.context import ExecutionContext
 
 # three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
 SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
@@ -705,11 +706,13 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
         for log in sorted(unit.iterdir())[:30]:
             os.link(log, partial / unit.name / log.name)
     out = with_cycles_of(monitored, tmp_path / "out")
-    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                 context=ExecutionContext(jobs=2))
     for unit in logs.iterdir():
         for log in sorted(unit.iterdir())[30:]:
             os.link(log, partial / unit.name / log.name)
-    outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                           context=ExecutionContext(jobs=2))
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
     charts = tuple(p.name for p in monitored.glob("*.png"))
     assert charts
@@ -718,7 +721,8 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     # a rerun with no new log: every unit's chart and remaining life made again in the workers, the same bytes
     for name in charts:
         (out / name).unlink()
-    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                 context=ExecutionContext(jobs=2))
     for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
@@ -730,7 +734,8 @@ def test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_th
     byte, and the same outputs as the one-job run."""
     robot, logs, _ = fleet
     out = tmp_path / "out"
-    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False, jobs=2)
+    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False,
+                 context=ExecutionContext(jobs=2))
     cycles = {p.name: p.read_bytes() for p in (out / ".cache" / "cycles").iterdir()}
     assert cycles == {p.name: p.read_bytes() for p in (monitored / ".cache" / "cycles").iterdir()}
     for name in ("alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "unit01.png"):

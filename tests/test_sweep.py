@@ -19,6 +19,7 @@ from faultgen.cli import app
 from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.runs import sweep, worker
+from faultgen.runs.context import ExecutionContext
 
 runner = CliRunner()
 
@@ -59,7 +60,7 @@ def test_small_sweep_is_valid_and_labelled(reference):
 
 
 def test_parallel_jobs_give_the_same_dataset(reference, tmp_path):
-    out = sweep.run(sweep.Grid(**SMALL), tmp_path / "two_jobs.h5", jobs=2, progress=False)
+    out = sweep.run(sweep.Grid(**SMALL), tmp_path / "two_jobs.h5", ExecutionContext(jobs=2), progress=False)
     assert_same_datasets(reference, out)
 
 
@@ -70,7 +71,7 @@ def test_dask_cluster_on_loopback_gives_the_same_dataset(reference, tmp_path):
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-        out = sweep.run(sweep.Grid(**SMALL), tmp_path / "dask.h5", scheduler=cluster.scheduler_address,
+        out = sweep.run(sweep.Grid(**SMALL), tmp_path / "dask.h5", ExecutionContext(scheduler=cluster.scheduler_address),
                         progress=False)
     assert_same_datasets(reference, out)
 
@@ -247,7 +248,7 @@ def test_resume_simulates_only_the_missing_runs(tmp_path):
     stamps = {run_id: (parts / f"{run_id}.h5").stat().st_mtime_ns for run_id in first}
     (parts / ".stale.h5.abc.part").write_text("left by a killed writer")
     simulated = []
-    sweep.run(grid, out, jobs=1, progress=False,
+    sweep.run(grid, out, progress=False,
               on_run=lambda stats: (simulated.append(stats.run_id),
                                     # finished parts are untouched while the others run
                                     [pytest.fail(f"{r} rewritten") for r in first
@@ -327,13 +328,13 @@ def test_full_disk_keeps_earlier_runs_and_the_same_command_then_finishes(referen
 
     monkeypatch.setattr(dataset, "write_run", write_until_full)
     with pytest.raises(sweep.SweepError, match="No space left on device.*Finished runs are kept"):
-        sweep.run(grid, out, jobs=1, progress=False)
+        sweep.run(grid, out, progress=False)
     parts = sweep.parts_folder(out)
     kept = sorted(parts.glob("*.h5"))
     assert len(kept) == 2 and all(dataset.validate(p) == [] for p in kept)
     assert not list(parts.glob(".*.part")) and not out.exists()
     monkeypatch.setattr(dataset, "write_run", real_write)
-    sweep.run(grid, out, jobs=1, progress=False)
+    sweep.run(grid, out, progress=False)
     assert_same_datasets(reference, out)
 
 

@@ -31,6 +31,7 @@ import numpy as np
 import faultgen
 from faultgen.bench import files, profile, tracks
 from faultgen.data import atomic
+from faultgen.runs.context import ExecutionContext
 
 OUTPUTS = ("train.h5", "test.h5", "test_labels.csv", "manifest.json")
 #: The most bytes an attribute of a unit may declare before :func:`hashes` reads it.
@@ -240,7 +241,7 @@ def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, j
         grid = faultgen.Grid.from_preset(preset, **fields) if preset else faultgen.Grid(**fields)
         out = sweeps / f"{split}-{part}.h5"
         if not out.is_file():  # a sweep's file appears only when it is complete: one made before a stop is kept
-            out = faultgen.run_sweep(grid, out, jobs=jobs, progress=progress, command=command)
+            out = faultgen.run_sweep(grid, out, ExecutionContext(jobs), progress=progress, command=command)
         runs.append(out)
     units = []
     for path in runs:

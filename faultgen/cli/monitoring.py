@@ -70,7 +70,7 @@ def monitor_command(
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
     scheduler: MonitorScheduler = None,
-    backend: Backend = None,
+    stepper: Backend = None,
     twin_temperature: Annotated[bool, typer.Option(
         help="Let the twin's temperature law predict the seasonal change too (default: the unit's learned "
              "slope alone).")] = False,
@@ -152,6 +152,7 @@ def monitor_command(
     from faultgen.model import robots
     from faultgen.monitor import lights, loop, page
     from faultgen.monitor.scoring import Settings
+    from faultgen.runs.context import ExecutionContext
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
     # the monitor resolves its robot itself (faultgen.monitor.loop); here only to check --torque-constants
@@ -163,7 +164,7 @@ def monitor_command(
     try:
         outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
                                twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               jobs=jobs, scheduler=scheduler, failure_wear=failure_wear, backend=backend,
+                               context=ExecutionContext(jobs, scheduler, stepper), failure_wear=failure_wear,
                                hours_per_day=hours_per_day)
     except loop.MonitorInterrupted as stopped:  # Ctrl-C, SIGTERM: OUT/.cache keeps the twins made so far
         typer.echo(str(stopped), err=True)

@@ -78,21 +78,19 @@ MonitorScheduler = Annotated[str | None, typer.Option(
     "scheduler answers is refused in seconds.")]
 
 
-def _backend(value: str | None) -> str:
-    """The ``--backend`` name, checked before any work (typer callback): the default's when not given."""
+def _stepper(value):
+    """The ``--backend`` name resolved, once, to a stepper object before any work (typer callback):
+    :func:`faultgen.simulation.backends.get` of it, the default's when not given."""
     from faultgen.simulation import backends
 
-    if value is None:
-        return backends.DEFAULT
     try:
-        backends.get(value)
+        return backends.get(backends.DEFAULT if value is None else value)
     except ValueError as err:
         raise typer.BadParameter(str(err)) from None
-    return value
 
 
 Backend = Annotated[str | None, typer.Option(
-    "--backend", callback=_backend, show_default=False, help="The stepping backend the simulations run on: "
+    "--backend", callback=_stepper, show_default=False, help="The stepping backend the simulations run on: "
     "batch (mujoco.batch, threaded C; the default) or loop (a plain mj_step loop, slow: the tests' reference); "
     "every backend gives the same outputs to float tolerance (docs/architecture.md, \"Stepping backends\").")]
 

@@ -199,7 +199,7 @@ def sweep_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
-    backend: Backend = None,
+    stepper: Backend = None,
     out: SweepOut = Path("sweep.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -220,6 +220,7 @@ def sweep_command(
     """
     from faultgen.operation import faults
     from faultgen.runs import sweep
+    from faultgen.runs.context import ExecutionContext
 
     options = {"robots": robots_, "tasks": tasks_, "axes": axes, "increases": increases, "schedules": schedules,
                "friction": friction_model, "cycles": cycles, "seeds": seeds, "record": record}
@@ -247,8 +248,8 @@ def sweep_command(
             typer.echo(f"resuming: {done} of {n_runs} runs already finished in {sweep.parts_folder(out)}, kept as "
                        "they are")
 
-    run_sweep(grid, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder, backend=backend)
+    run_sweep(grid, out, context=ExecutionContext(jobs, scheduler, stepper), progress=progress, overwrite=overwrite,
+              announce=announce, shared=shared_folder)
     typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
                f"  faultgen plot {out} -o {out.with_suffix('.png')}")
 
@@ -315,7 +316,7 @@ def fleet_command(
     jobs: Jobs = 2,
     scheduler: Scheduler = None,
     shared_folder: SharedFolder = False,
-    backend: Backend = None,
+    stepper: Backend = None,
     out: FleetOut = Path("fleet.h5"),
     overwrite: Overwrite = False,
     progress: Progress = True,
@@ -340,6 +341,7 @@ def fleet_command(
       faultgen fleet --robots 500 --days 365 --scheduler tcp://10.0.0.5:8786 -o fleet-500.h5
     """
     from faultgen.runs import fleet
+    from faultgen.runs.context import ExecutionContext
 
     chosen = {"models": tuple(models)} if models else {}
     if dry_share is not None:
@@ -363,16 +365,15 @@ def fleet_command(
         typer.echo(f"{robots_} x {days} days -> {out}{where}"
                    + (f"; resuming, {done} {'runs' if friction_test_every else 'robots'} already finished" if done else ""))
 
-    run_sweep(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite, announce=announce,
-              shared=shared_folder, backend=backend)
+    run_sweep(plan, out, context=ExecutionContext(jobs, scheduler, stepper), progress=progress, overwrite=overwrite,
+              announce=announce, shared=shared_folder)
     typer.echo(f"wrote {out}\nanalyse it with:\n  faultgen info {out}\n  faultgen classify {out}\n"
                f"  faultgen detect {out}")
 
 
-def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bool, overwrite: bool,
-              announce, backend: str, shared: bool = False) -> None:
-    """:func:`faultgen.runs.sweep.run` for a command (on the stepping ``backend``), recording the
-    command line in the dataset.
+def run_sweep(plan, out: Path, context, *, progress: bool, overwrite: bool, announce, shared: bool = False) -> None:
+    """:func:`faultgen.runs.sweep.run` for a command (as ``context`` says, a
+    :class:`faultgen.runs.context.ExecutionContext`), recording the command line in the dataset.
     Its errors reach the user through the command's error handler (:class:`Command`): 2 refused
     before anything ran, 130 interrupted with the finished runs kept, 1 a run failed. On a
     cluster, each run's worker is printed as the run is kept."""
@@ -380,21 +381,21 @@ def run_sweep(plan, out: Path, *, jobs: int, scheduler: str | None, progress: bo
 
     from faultgen.runs import sweep
 
-    if scheduler is None:
-        warn_jobs(jobs, "the runs", "about 150 MB")
-    if shared and not scheduler:
+    if context.scheduler is None:
+        warn_jobs(context.jobs, "the runs", "about 150 MB")
+    if shared and not context.scheduler:
         raise ValueError("--shared-folder is for the workers of a Dask cluster: add --scheduler ADDRESS, or drop it")
-    if scheduler:  # a Dask scheduler must answer there, before any work
+    if context.scheduler:  # a Dask scheduler must answer there, before any work
         from faultgen.runs import cluster
 
-        cluster.probe(scheduler)
+        cluster.probe(context.scheduler)
 
     def where(stats) -> None:
         tqdm.write(f"{stats.run_id}: {stats.worker}, {stats.total:.1f} s, worker peak {stats.memory / 1e6:.0f} MB")
 
-    sweep.run(plan, out, jobs=jobs, scheduler=scheduler, progress=progress, overwrite=overwrite,
+    sweep.run(plan, out, context, progress=progress, overwrite=overwrite,
               command=shlex.join(["faultgen", *sys.argv[1:]]), on_start=announce, shared=shared,
-              on_run=where if scheduler else None, backend=backend)
+              on_run=where if context.scheduler else None)
 
 
 def summary(result, out: Path) -> str:

@@ -37,9 +37,9 @@ CONSTANT_TORQUE = "not monitored: the torque column does not vary from log to lo
 
 @dataclass(frozen=True)
 class Context:
-    """What scoring a group of units needs (sent to a worker process as it is); ``backend``: the
-    stepping backend of the twins' cycles (:data:`faultgen.simulation.backends.BACKENDS`; ValueError
-    on construction for one this process does not know)."""
+    """What scoring a group of units needs (sent to a worker process as it is); ``stepper``: what
+    steps the twins' cycles (a :class:`faultgen.simulation.backends.Stepper`; ValueError on
+    construction for anything else)."""
 
     robot: Path
     settings: Settings
@@ -50,10 +50,10 @@ class Context:
     units: dict
     maintenance: dict
     failure_wear: float
-    backend: str = backends.DEFAULT
+    stepper: backends.Stepper = backends.DEFAULT_STEPPER
 
     def __post_init__(self) -> None:
-        backends.get(self.backend)
+        backends.checked(self.stepper)
 
     def new_source(self, nominal: robots.Robot | None = None) -> fleet_logs.Source:
         """A log source of this run holding its robots: ``nominal`` (the robot the run's command or
@@ -99,7 +99,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
         constant = next((n for n in unit.notes if n.startswith(CONSTANT_TORQUE)), None)  # an earlier run's
-        twin = constant or twin_of(unit, context.units, context.out, twins, False, source, context.backend)
+        twin = constant or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
         i = 0
@@ -140,7 +140,7 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source)
         The new program's twin cannot be built (the log is then skipped, named).
     """
     new = Twin(twin.robot, source.get(log), context.out / ".cache" / "cycles", root=context.out,
-               backend=twin.backend)
+               stepper=twin.stepper)
     source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
     unit.monitor.signatures = new.signatures

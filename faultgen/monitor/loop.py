@@ -53,9 +53,9 @@ from faultgen.monitor.feed import CONSTANT_TORQUE, PROGRAM_CHANGE, PROGRAM_LENGT
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
+from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
-from faultgen.simulation import backends
 
 __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "PROGRAM_LENGTH",
            "SAME_PROGRAM", "STATUSES", "Outcome", "UnitStatus", "monitor"]
@@ -117,8 +117,8 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None, jobs: int = 1, scheduler: str | None = None,
-            failure_wear: float = prognosis.FAILURE_WEAR, backend: str = backends.DEFAULT,
+            progress: bool = True, log_format=None, context: ExecutionContext = LOCAL,
+            failure_wear: float = prognosis.FAILURE_WEAR,
             hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
 
@@ -147,20 +147,18 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     progress : bool
     log_format : faultgen.data.adapters.Adapter, optional
         The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
-    jobs : int
-        Local processes scoring units in parallel (groups of units sharing a twin); the outputs are
-        those of one job, bit for bit.
-    scheduler : str, optional
-        ``tcp://HOST:PORT`` (or ``tls://``) of a Dask scheduler whose workers score the units
-        instead (:mod:`faultgen.monitor.remote`): they need faultgen and the robot, not LOGS or
-        OUT; the outputs are those of one local job, bit for bit. Not with ``jobs`` > 1.
+    context : ExecutionContext
+        Where and on what the units are scored (:class:`faultgen.runs.context.ExecutionContext`;
+        default: this process, ``BatchStepper()``): ``jobs`` local processes scoring units in
+        parallel (groups of units sharing a twin), or the ``scheduler``, ``tcp://HOST:PORT`` (or
+        ``tls://``) of a Dask scheduler whose workers score the units instead
+        (:mod:`faultgen.monitor.remote`: they need faultgen and the robot, not LOGS or OUT), not
+        both; and the ``stepper`` that steps the twins' cycles, pickled to the workers (whose
+        processes must be able to import its class). Every one gives the outputs of one local job
+        on the default stepper: bit for bit for jobs and scheduler, to float tolerance for a stepper.
     failure_wear : float
         The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
         axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
-    backend : str
-        The stepping backend the twins' cycles are simulated on
-        (:data:`faultgen.simulation.backends.BACKENDS`; with ``jobs`` or ``scheduler``, the workers
-        must know it too). Every backend gives the same outputs to float tolerance.
     hours_per_day : float
         Operating hours per calendar day between logs, in (0, 24]: ``life.csv``'s consumption
         between logs (:mod:`faultgen.monitor.life`).
@@ -176,17 +174,21 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
         (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, or ``out`` holding a run with other
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named), ``jobs`` > 1 with a ``scheduler``, an unknown ``backend``, ``hours_per_day``
-        outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
+        file named), a ``context`` with ``jobs`` > 1 and a ``scheduler`` or not an ExecutionContext,
+        ``hours_per_day`` outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
         (:mod:`faultgen.model.rating`).
     faultgen.runs.errors.SweepRefused
-        ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
+        The ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
         The scheduler was lost, or a worker has another robot model (nothing is written).
     MonitorInterrupted
         Ctrl-C or SIGTERM while the units were scored (exit code 130 or 143): the workers are
         stopped and the message says what ``out`` keeps (:func:`interrupted`).
     """
+    if not isinstance(context, ExecutionContext):
+        raise ValueError(f"context {context!r}: expected an ExecutionContext(jobs, scheduler, stepper) "
+                         "(faultgen.runs.context)")
+    jobs, scheduler = context.jobs, context.scheduler
     if scheduler is not None and jobs > 1:
         raise ValueError(f"--jobs {jobs} with --scheduler {scheduler}: the cluster's workers score the units in "
                          "parallel; drop --jobs (or --scheduler to score them in local processes)")
@@ -196,7 +198,6 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         cluster.probe(scheduler)
     atomic.check_apart(out, logs_dir)
     prognosis.check_failure_wear(failure_wear)
-    backends.get(backend)
     nominal = robots.load(robot)
     ratings = life.ratings_of(nominal)  # a bad rating refused before any work
     life.check_hours(hours_per_day)
@@ -225,9 +226,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         for name, unit_logs in units.items():
             pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
         confined.mkdir(out / ".cache")
-        context = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                           failure_wear, backend)
-        source = context.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
+        scoring = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
+                           failure_wear, context.stepper)
+        source = scoring.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
         programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
@@ -238,7 +239,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
         idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
         # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
-        with contextlib.closing(map_groups(context, groups, jobs, scheduler, robot, idle, source)) as results:
+        with contextlib.closing(map_groups(scoring, groups, jobs, scheduler, robot, idle, source)) as results:
             for done in results:
                 for name, unit, outputs in done:
                     made[name] = outputs

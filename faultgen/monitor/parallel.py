@@ -25,6 +25,7 @@ from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.monitor.unit import Unit, log_of, model_of
 from faultgen.runs import worker
+from faultgen.simulation.backends import Stepper
 
 
 def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Unit, list]]]:
@@ -51,10 +52,10 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
         try:
             model = model_of(source, unit.model, unit.first, None, context.out, False)  # as twin_of has it
             program = source.get(log_of(context.units, *unit.program))
-            twin = Twin(model, program, cache, root=context.out, cycles=False, backend=context.backend)
+            twin = Twin(model, program, cache, root=context.out, cycles=False, stepper=context.stepper)
             missing = [c for c in base_cycles(twin.robot.n_axes) if not twin.cached(*c)]
             if pool is not None and len(missing) > 1:
-                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.backend, *c)
+                list(pool.map(_twin_cycle, *zip(*[(model, program, cache, context.out, context.stepper, *c)
                                                  for c in missing], strict=True)))
             twin.complete()
         except stored.StateError:
@@ -63,15 +64,15 @@ def prepare_twins(context: Context, groups: list, pool=None, source: fleet_logs.
             continue
 
 
-def _twin_cycle(model: Robot, program: fleet_logs.Parsed, cache: Path, root: Path, backend: str,
+def _twin_cycle(model: Robot, program: fleet_logs.Parsed, cache: Path, root: Path, stepper: Stepper,
                 temperature: float, payload: float, worn_axis: int) -> None:
     """Worker task: one cycle of a shared twin (its robot and its program as this run resolved and
     parsed them, pickled: a robot read from a file is parsed again from it on arrival) into the cache
-    (:meth:`faultgen.monitor.twin.Twin.cycle`), simulated on the stepping ``backend``. A cycle that
+    (:meth:`faultgen.monitor.twin.Twin.cycle`), simulated on ``stepper``. A cycle that
     cannot be simulated (or a cache file refused) is left to the twin made after all of them, which
     says why."""
     try:
-        twin = Twin(model, program, cache, root=root, cycles=False, backend=backend)
+        twin = Twin(model, program, cache, root=root, cycles=False, stepper=stepper)
         twin.cycle(temperature, payload, worn_axis)
     except ValueError:
         return

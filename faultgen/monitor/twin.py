@@ -32,8 +32,8 @@ velocity estimated from the angles as for a log without ``qd``), without sensor 
 gives the expectation). Cycles are cached on disk by what determines them (model file, program
 file, temperature, payload, worn axis), each file holding its key beside the features
 (:func:`faultgen.monitor.state.read_cycle` refuses one whose key differs): units that share a model
-and a program share them. The stepping backend (:mod:`faultgen.simulation.backends`) is not in the
-key: every backend gives the same cycle to float tolerance. The signature cycles a twin has not
+and a program share them. The stepper (:mod:`faultgen.simulation.backends`) is not in the
+key: every stepper gives the same cycle to float tolerance. The signature cycles a twin has not
 cached yet (healthy at the model's own friction and one per worn axis) are stepped together as the
 runs of one batch, which costs little more than one of them (the static friction's update before
 each step is Python, the same for one run or seven): the same bits as one by one
@@ -117,13 +117,13 @@ class Twin:
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
     format's by default), ``cache`` the folder of simulated cycles (created if needed) inside
     ``root`` (default: the folder holding ``cache``, where the replayed motion goes too,
-    ``programs``), out of which no cached file may lead (read or written), ``backend`` the stepping
-    backend its cycles are simulated on (:data:`faultgen.simulation.backends.BACKENDS`).
+    ``programs``), out of which no cached file may lead (read or written), ``stepper`` what steps its
+    cycles (a :class:`faultgen.simulation.backends.Stepper`; the default ``BatchStepper()``).
 
     Raises
     ------
     ValueError
-        An unknown ``backend`` (the known ones named), the program cannot be read (file and row
+        A ``stepper`` that is not a Stepper object, the program cannot be read (file and row
         named), or a base cycle cannot be simulated.
     TypeError
         ``model`` is not a Robot (a name or path: resolve it once with
@@ -133,9 +133,8 @@ class Twin:
     def __init__(self, model: robots.Robot, program: Path | fleet_logs.Parsed, cache: Path,
                  root: Path | None = None,
                  reader: fleet_logs.Reader | None = None, cycles: bool = True,
-                 backend: str = backends.DEFAULT):
-        backends.get(backend)
-        self.backend = backend
+                 stepper: backends.Stepper = backends.DEFAULT_STEPPER):
+        self.stepper = backends.checked(stepper)
         self.robot = robots.require(model, "monitor.twin.Twin")
         self.model = str(self.robot.path)
         self.cache = Path(cache)
@@ -242,7 +241,7 @@ class Twin:
         rows = np.stack([faults.dry_multipliers(setup(temperature, payload, key["worn_axis"])[1].faults(),
                                                 np.array([1]), n)[0] for key, _ in missing])
         config = self._config(temperature, payload, wear.WearPlan({}), cycles=len(missing))
-        result = sim.simulate(config, progress=False, backend=self.backend, dry_multipliers=rows)
+        result = sim.simulate(config, progress=False, stepper=self.stepper, dry_multipliers=rows)
         if result.saturated.size:
             return
         for index, (key, path) in enumerate(missing):
@@ -259,7 +258,7 @@ class Twin:
         if (temperature, payload, worn_axis) in self._refused:  # a part it cannot carry: said once, not simulated again
             raise ValueError(self._refused[temperature, payload, worn_axis])
         config = self._config(temperature, payload, setup(temperature, payload, worn_axis)[1])
-        result = sim.simulate(config, progress=False, backend=self.backend)
+        result = sim.simulate(config, progress=False, stepper=self.stepper)
         if result.saturated.size:
             rated = self.robot.rated_payload
             sized = (f"its drives were sized for a rated payload of {rated:g} kg (`faultgen robots add ... --payload KG` "

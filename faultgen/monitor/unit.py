@@ -107,8 +107,8 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
 
 
 def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: fleet_logs.Source,
-            backend: str = backends.DEFAULT) -> Twin | str | None:
-    """The unit's twin (its cycles simulated on the stepping ``backend``, a known name), or None
+            stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Twin | str | None:
+    """The unit's twin (its cycles simulated on ``stepper``), or None
     for a unit under protocol ``own``; its model comes from :func:`model_of` (the robots of
     ``source``, or the unit's calibration). A unit not yet scored falls back
     through :data:`FALLBACK` when its twin cannot be built (its calibration refused as implausible,
@@ -122,7 +122,7 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
             twin_key = (str(model.path), unit.program)
             if twin_key not in twins:
                 twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
-                                       root=out, backend=backend)
+                                       root=out, stepper=stepper)
             twin = twins[twin_key]
         except stored.StateError:
             raise

@@ -46,6 +46,7 @@ from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.operation import programs
+from faultgen.runs.context import ExecutionContext
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
 from faultgen.simulation import backends
@@ -113,9 +114,10 @@ def _missing_on_worker(config: sim.RunConfig) -> str:
     return ""
 
 
-def simulate_remote(run_id: str, config: sim.RunConfig, backend: str = backends.DEFAULT) -> Outcome:
-    """Worker task: simulate one run on the stepping ``backend`` (ValueError if the worker does not
-    know it) and return it (:class:`Outcome`); writes nothing."""
+def simulate_remote(run_id: str, config: sim.RunConfig,
+                    stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Outcome:
+    """Worker task: simulate one run on ``stepper`` (its class must be importable on the worker) and
+    return it (:class:`Outcome`); writes nothing."""
     from distributed import get_worker
 
     missing = _missing_on_worker(config)
@@ -123,7 +125,7 @@ def simulate_remote(run_id: str, config: sim.RunConfig, backend: str = backends.
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker, or run the sweep there")
     started = time.perf_counter()
-    result = sim.simulate(config, progress=False, backend=backend)
+    result = sim.simulate(config, progress=False, stepper=stepper)
     total = time.perf_counter() - started
     slim = for_transfer(result)
     simulated = result.tau_m.shape[0] * result.t[-1]
@@ -134,8 +136,9 @@ def simulate_remote(run_id: str, config: sim.RunConfig, backend: str = backends.
 
 
 def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str,
-                 labelled: sim.RunConfig | None = None, backend: str = backends.DEFAULT) -> RunStats:
-    """Worker task with a shared file system: simulate one run on the stepping ``backend`` and
+                 labelled: sim.RunConfig | None = None,
+                 stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> RunStats:
+    """Worker task with a shared file system: simulate one run on ``stepper`` and
     write its part file there, labelled with ``labelled`` (the client's configuration)."""
     from distributed import get_worker
 
@@ -143,7 +146,7 @@ def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str,
     if missing:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker")
-    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled, backend=backend)
+    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled, stepper=stepper)
     return replace(stats, worker=get_worker().address, memory=_peak_memory())
 
 
@@ -151,11 +154,12 @@ def _peak_memory() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
 
 
-def task_key(run_id: str, config: sim.RunConfig, backend: str = backends.DEFAULT) -> str:
-    """The Dask key of a run: its id and a digest of its configuration (and of its stepping backend
-    when not the default), so that the dashboard names the run, and two sweeps on one cluster share
-    a task only when it is the same simulation on the same backend."""
-    text = dataset.config_key(config) + ("" if backend == backends.DEFAULT else f"\nbackend={backend}")
+def task_key(run_id: str, config: sim.RunConfig, stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> str:
+    """The Dask key of a run: its id and a digest of its configuration (and of its stepper when not
+    the default: :func:`faultgen.simulation.backends.key_text`), so that the dashboard names the run,
+    and two sweeps on one cluster share a task only when it is the same simulation on the same stepper."""
+    extra = backends.key_text(stepper)
+    text = dataset.config_key(config) + (f"\n{extra}" if extra else "")
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     return f"faultgen-{run_id}-{digest}"
 
@@ -265,9 +269,9 @@ def _is_handshake(message: bytes) -> bool:
     return isinstance(info, dict) and "pickle-protocol" in info
 
 
-def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, command: str = "",
-            shared: bool = False, bar=None, backend: str = backends.DEFAULT) -> Iterator[RunStats]:
-    """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
+def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: ExecutionContext, command: str = "",
+            shared: bool = False, bar=None) -> Iterator[RunStats]:
+    """Run ``todo`` on the Dask cluster of ``context.scheduler``; yield each run's :class:`RunStats` (with
     the worker's address) once its part file is written, in completion order.
 
     Parameters
@@ -276,17 +280,16 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
         In the order to submit them (longest first).
     parts : Path
         The sweep's part folder (this process's; ``shared``: the workers' too).
-    scheduler : str
-        ``tcp://host:port`` of a Dask scheduler.
+    context : ExecutionContext
+        Its ``scheduler``: ``tcp://host:port`` of a Dask scheduler; its ``stepper``: what the workers
+        step the runs on (:class:`faultgen.simulation.backends.Stepper`, pickled: its class must be
+        importable in their processes); its ``jobs`` is not used.
     command : str
         Provenance stored with every run.
     shared : bool
         The workers write the part files themselves (they must see ``parts`` at its absolute path).
     bar : tqdm, optional
         A progress bar whose postfix shows the workers the scheduler has after each run.
-    backend : str
-        The stepping backend the workers simulate on (a name they must know:
-        :data:`faultgen.simulation.backends.BACKENDS` in their processes).
 
     Raises
     ------
@@ -301,6 +304,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     """
     from distributed import Client, KilledWorker, as_completed
 
+    scheduler = context.scheduler
     probe(scheduler)
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
@@ -310,7 +314,7 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
     with client:
         if shared:
             _check_shared(client, folder)
-        run_of, futures = _submit(client, todo, folder, command, shared, backend)
+        run_of, futures = _submit(client, todo, folder, command, shared, context.stepper)
         configs = dict(todo)
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)
@@ -346,20 +350,20 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, scheduler: str, 
 
 
 def _submit(client, todo: list[tuple[str, sim.RunConfig]], folder: Path, command: str, shared: bool,
-            backend: str) -> tuple[dict[str, str], list]:
+            stepper: backends.Stepper) -> tuple[dict[str, str], list]:
     """Submit every run of ``todo`` to ``client``, in order: (task key -> run id, the futures). A run's
     worker simulates it and sends it back, or with ``shared`` writes its part file into ``folder``."""
     run_of = {}
     futures = []
     for run_id, config in todo:
-        key = task_key(run_id, config, backend)
+        key = task_key(run_id, config, stepper)
         run_of[key] = run_id
         sent = for_workers(config)
         if shared:
             futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
-                                         None if sent is config else config, backend, key=key))
+                                         None if sent is config else config, stepper, key=key))
         else:
-            futures.append(client.submit(simulate_remote, run_id, sent, backend, key=key))
+            futures.append(client.submit(simulate_remote, run_id, sent, stepper, key=key))
     return run_of, futures
 
 

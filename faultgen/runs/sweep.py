@@ -34,6 +34,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import Self
 
@@ -42,10 +43,10 @@ from tqdm.auto import tqdm
 from faultgen import children
 from faultgen.data import atomic, dataset
 from faultgen.runs import cluster, worker
+from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepError, SweepInterrupted, SweepRefused
 from faultgen.runs.grid import PRESETS, Grid
 from faultgen.runs.worker import RunStats, simulate_and_write
-from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
 
 __all__ = ["PRESETS", "Grid", "RunStats", "SweepError", "SweepInterrupted", "SweepRefused", "finished_runs",
@@ -78,23 +79,25 @@ def finished_runs(grid: Grid, out: str | Path) -> list[str]:
     return [run_id for run_id, config in grid.runs() if _finished(parts / f"{run_id}.h5", config)]
 
 
-def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None, progress: bool = True,
+def run(grid: Grid, out: str | Path, context: ExecutionContext = LOCAL, progress: bool = True,
         command: str = "", on_run: Callable[[RunStats], None] | None = None,
         timings: dict | None = None, overwrite: bool = False,
-        on_start: Callable[[int, int], None] | None = None, shared: bool = False,
-        backend: str = backends.DEFAULT) -> Path:
+        on_start: Callable[[int, int], None] | None = None, shared: bool = False) -> Path:
     """Simulate every run of ``grid`` and write the dataset ``out``; resume if parts exist.
 
     Parameters
     ----------
     grid : Grid
     out : path of the dataset file to write.
-    jobs : int
-        Local worker processes (joblib); ignored with ``scheduler``.
-    scheduler : str, optional
-        Address of a Dask distributed scheduler (``tcp://host:port``). Its workers send each run
-        back to this process, which writes it (:mod:`faultgen.runs.cluster`): they need not see
-        the folder of ``out``.
+    context : ExecutionContext
+        Where and on what the runs are computed (:class:`faultgen.runs.context.ExecutionContext`;
+        default: this process, ``BatchStepper()``): ``jobs`` local worker processes (joblib),
+        ignored with a ``scheduler``, the address of a Dask distributed scheduler
+        (``tcp://host:port``) whose workers send each run back to this process, which writes it
+        (:mod:`faultgen.runs.cluster`: they need not see the folder of ``out``), and the
+        ``stepper`` every run is stepped on, pickled to the workers (a stepper class defined
+        outside faultgen must be importable in their processes too). Every stepper gives the same
+        dataset to float tolerance; it is not stored.
     progress : bool
         Show a progress bar over runs, with the time left.
     command : str
@@ -108,12 +111,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     on_start : callable, optional
         Called once the sweep holds its output, with (runs in the grid, runs already finished).
     shared : bool
-        With ``scheduler``: the workers write the part files themselves, in the folder of ``out``,
+        With a ``scheduler``: the workers write the part files themselves, in the folder of ``out``,
         which they must all see at its absolute path (a shared file system; checked first).
-    backend : str
-        The stepping backend every run is simulated on (:data:`faultgen.simulation.backends.BACKENDS`;
-        the workers must know it: a backend registered outside faultgen, in their processes too).
-        Every backend gives the same dataset to float tolerance; the name is not stored.
 
     Returns
     -------
@@ -123,8 +122,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     ------
     SweepRefused
         Before anything runs, if ``out`` exists (and not ``overwrite``) or another sweep is
-        writing it (the message names that sweep: pid, host, start time, command), or for an
-        unknown ``backend`` (the known ones named).
+        writing it (the message names that sweep: pid, host, start time, command), or for a
+        ``context`` that is not an ExecutionContext.
     SweepInterrupted
         On Ctrl-C (KeyboardInterrupt): the workers are stopped, and the message says how many
         runs are kept and how to resume.
@@ -135,12 +134,9 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
     out = Path(out)
     plan = grid.runs()
     parts = parts_folder(out)
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise SweepRefused(f"jobs {jobs!r}: expected a whole number >= 1")
-    try:
-        backends.get(backend)
-    except ValueError as err:
-        raise SweepRefused(str(err)) from None
+    if not isinstance(context, ExecutionContext):
+        raise SweepRefused(f"context {context!r}: expected an ExecutionContext(jobs, scheduler, stepper) "
+                           "(faultgen.runs.context)")
     with _lock(out, parts):
         if out.exists() and not overwrite:
             raise SweepRefused(f"{out} exists; pass --overwrite to replace it or choose another output")
@@ -156,8 +152,8 @@ def run(grid: Grid, out: str | Path, jobs: int = 1, scheduler: str | None = None
                     try:
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
-                            for stats in _execute(todo, parts, min(jobs, max(len(todo), 1)), scheduler, command,
-                                                  shared, bar, backend):
+                            jobs = min(context.jobs, max(len(todo), 1))
+                            for stats in _execute(todo, parts, replace(context, jobs=jobs), command, shared, bar):
                                 bar.update(1)
                                 if on_run is not None:
                                     on_run(stats)
@@ -371,18 +367,17 @@ class CtrlC:
             self._resends.append(resend)
 
 
-def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, shared: bool = False,
-             bar=None, backend: str = backends.DEFAULT) -> Iterator[RunStats]:
-    """Run the missing runs on ``backend``; yield the stats of each as it finishes, in completion order."""
+def _execute(todo, parts: Path, context: ExecutionContext, command: str, shared: bool = False,
+             bar=None) -> Iterator[RunStats]:
+    """Run the missing runs as ``context`` says; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, backend)
+    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, context.stepper)
              for run_id, config in todo]
     try:
-        if scheduler:
-            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar,
-                                       backend=backend)
+        if context.scheduler:
+            yield from cluster.execute(todo, parts, context, command, shared=shared, bar=bar)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
@@ -393,17 +388,17 @@ def _execute(todo, parts: Path, jobs: int, scheduler: str | None, command: str, 
                 worker.start_resource_tracker()
                 # every worker watches the sweep from its start, idle or not
                 # (:func:`faultgen.runs.worker.watch_parent`)
-                backend = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
-                parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=backend)
+                loky = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
+                parallel = Parallel(n_jobs=context.jobs, return_as="generator_unordered", backend=loky)
                 yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
-        if not scheduler:
+        if not context.scheduler:
             _stop_local_workers()
         raise
     except RuntimeError as err:
         # an interrupt while loky was starting its manager thread: joblib's abort could not join it
         # ("cannot join thread before it is started") and raised that instead, the interrupt as its context
-        if scheduler or not isinstance(err.__context__, KeyboardInterrupt):
+        if context.scheduler or not isinstance(err.__context__, KeyboardInterrupt):
             raise
         _stop_local_workers()
         raise err.__context__ from None

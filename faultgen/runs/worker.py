@@ -39,9 +39,9 @@ class RunStats:
 
 
 def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
-                       labelled: sim.RunConfig | None = None, backend: str = backends.DEFAULT) -> RunStats:
-    """Worker task: simulate one run on the stepping ``backend`` (a name of
-    :data:`faultgen.simulation.backends.BACKENDS`; ValueError if this process does not know it) and
+                       labelled: sim.RunConfig | None = None,
+                       stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> RunStats:
+    """Worker task: simulate one run on ``stepper`` (a :class:`faultgen.simulation.backends.Stepper`) and
     write it to its part file (atomically), labelled with ``labelled`` (the client's configuration
     when ``config`` names its robot or program by an absolute path for a cluster's workers:
     :func:`faultgen.runs.cluster.for_workers`)."""
@@ -49,7 +49,7 @@ def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: 
     # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
     tqdm.set_lock(threading.RLock())
     started = time.perf_counter()
-    result = sim.simulate(config, progress=False, backend=backend)
+    result = sim.simulate(config, progress=False, stepper=stepper)
     writing = time.perf_counter()
     if labelled is not None:
         result = replace(result, config=labelled)

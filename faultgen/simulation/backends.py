@@ -1,6 +1,8 @@
-"""Stepping backends: what steps a batch of simulations (one per recorded cycle) of one compiled model.
+"""Steppers (stepping backends): what steps a batch of simulations (one per recorded cycle) of one compiled model.
 
-A backend makes the ``runs`` of a batch (:meth:`Backend.new`); the stepping loops of
+A stepper is an object (frozen, picklable: it travels to worker processes and Dask workers as it
+is): :class:`BatchStepper` or :class:`LoopStepper`, or one of a user's. It makes the ``runs`` of a
+batch (:meth:`Stepper.new`); the stepping loops of
 :mod:`faultgen.simulation.batch` and the friction models (:mod:`faultgen.simulation.friction_models`)
 use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s interface faultgen needs:
 
@@ -13,7 +15,7 @@ use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s inte
   components of ``control_spec`` from ``control`` ``(n, nstep, size)`` before each and recording
   the MjData fields ``record`` after each into ``out[name]`` ``(n, nstep, ...)``; a run whose
   warning counters rise stops stepping and repeats its last records. A backend with
-  :attr:`Backend.applies_friction_update` also takes ``update``, a
+  :attr:`Stepper.applies_friction_update` also takes ``update``, a
   :class:`faultgen.simulation.friction_update.FrictionUpdate` of the ``nstep`` steps, and writes its
   friction loss (:func:`faultgen.simulation.friction_update.apply`) before each step, before the
   controls;
@@ -21,8 +23,9 @@ use only the methods of :class:`Runs`, the part of ``mujoco.batch.Batch``'s inte
   its MjData (its state and the last step's kinematics);
 - ``warning``: each run's warning counters, ``(n, mjNWARNING, 2)``.
 
-:data:`BACKENDS` by name (:func:`register` adds one): ``batch`` (``mujoco.batch.Batch``: C threads,
-the default) and ``loop`` (a Python loop of ``mujoco.mj_step`` over one ``MjData`` and one
+:data:`STEPPERS`, the stepper classes by name, is for resolving a name given by a user (the CLI's
+``--backend``) once, at the CLI boundary (:func:`get`; :func:`register` adds a class): ``batch``
+(:class:`BatchStepper`, ``mujoco.batch.Batch``: C threads, the default) and ``loop`` (:class:`LoopStepper`, (a Python loop of ``mujoco.mj_step`` over one ``MjData`` and one
 ``MjModel`` copy per run, deliberately plain: the reference the tests hold ``batch`` to;
 docs/architecture.md, "Stepping backends", says what a GPU backend implements).
 """
@@ -30,7 +33,8 @@ docs/architecture.md, "Stepping backends", says what a GPU backend implements).
 from __future__ import annotations
 
 import copy
-from typing import Protocol
+from dataclasses import dataclass
+from typing import ClassVar, Protocol
 
 import mujoco
 import numpy as np
@@ -63,40 +67,42 @@ class Runs(Protocol):
                 out: dict, update=None) -> dict: ...
 
 
-class Backend:
-    """A way to step a batch of simulations of one model."""
+@dataclass(frozen=True)
+class Stepper:
+    """A way to step a batch of simulations of one model (frozen, picklable: compared by value)."""
 
-    #: The backend's name (:data:`BACKENDS`).
-    name: str
+    #: The stepper's name (:data:`STEPPERS`; the CLI's ``--backend``).
+    name: ClassVar[str]
     #: Whether its runs' ``rollout`` takes a friction ``update`` and applies it before every step
     #: (the static friction model's level); False: the stepping loop steps such a run one step at a
     #: time, applying the update from Python before each (:func:`faultgen.simulation.batch.step`).
-    applies_friction_update: bool = False
+    applies_friction_update: ClassVar[bool] = False
 
     def new(self, model: mujoco.MjModel, nsim: int, nthread: int) -> Runs:
         """``nsim`` simulations of ``model`` at its default state, on ``nthread`` threads where
-        the backend uses threads."""
+        the stepper uses threads (the run's ``nthread``)."""
         raise NotImplementedError
 
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}()"
 
+@dataclass(frozen=True)
+class BatchStepper(Stepper):
+    """``mujoco.batch.Batch``: every run stepped in C, on ``nthread`` threads (0: all CPUs; None, the
+    default: the run's own ``nthread``)."""
 
-class BatchBackend(Backend):
-    """``mujoco.batch.Batch``: every run stepped in C, on ``nthread`` threads (0: all CPUs)."""
-
-    name = "batch"
+    name: ClassVar[str] = "batch"
+    nthread: int | None = None
 
     def new(self, model, nsim, nthread):
-        return mjbatch.Batch(model, nsim=nsim, nthread=nthread)
+        return mjbatch.Batch(model, nsim=nsim, nthread=nthread if self.nthread is None else self.nthread)
 
 
-class LoopBackend(Backend):
+@dataclass(frozen=True)
+class LoopStepper(Stepper):
     """A Python loop of ``mujoco.mj_step``, one ``MjData`` and one ``MjModel`` copy per run (one
-    thread, slow: for checking the other backends, not for runs)."""
+    thread, slow: for checking the other steppers, not for runs)."""
 
-    name = "loop"
-    applies_friction_update = True
+    name: ClassVar[str] = "loop"
+    applies_friction_update: ClassVar[bool] = True
 
     def new(self, model, nsim, nthread):
         return LoopRuns(model, nsim)
@@ -193,42 +199,68 @@ def _set_const(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     mujoco.mj_copyData(data, model, kept)
 
 
-#: The stepping backends by name (:func:`register` adds one).
-BACKENDS: dict[str, Backend] = {}
+#: The stepper classes by name (:func:`register` adds one), for resolving a user's name once.
+STEPPERS: dict[str, type[Stepper]] = {}
 
 
-def register(backend: Backend) -> Backend:
-    """Add ``backend`` (an instance of a :class:`Backend` subclass) to :data:`BACKENDS` under its
-    ``name`` and return it: from then on sweeps, fleets, the cluster's workers and the monitor's twin
-    reach it by that name (a process that has not registered it, a fresh worker process or a Dask
-    worker, does not know it). Registering the same instance again changes nothing.
+def register(stepper: type[Stepper]) -> type[Stepper]:
+    """Add the stepper class ``stepper`` (a :class:`Stepper` subclass, made with no arguments) to
+    :data:`STEPPERS` under its ``name`` and return it (a class decorator): from then on the CLI's
+    ``--backend`` reaches it by that name. Sweeps, fleets, the cluster's workers and the monitor's
+    twin receive the stepper object itself (a worker process unpickles it: its class must be
+    importable there). Registering the same class again changes nothing.
 
     Raises
     ------
     ValueError
-        If ``backend`` is not a :class:`Backend`, its ``name`` is not a non-empty string, or the
-        name is registered to another backend.
+        If ``stepper`` is not a :class:`Stepper` subclass, its ``name`` is not a non-empty string, or
+        the name is registered to another class.
     """
-    if not isinstance(backend, Backend):
-        raise ValueError(f"{backend!r} is not a stepping backend (an instance of a Backend subclass)")
-    name = getattr(backend, "name", None)
+    if not (isinstance(stepper, type) and issubclass(stepper, Stepper)):
+        raise ValueError(f"{stepper!r} is not a stepping backend (a subclass of Stepper)")
+    name = getattr(stepper, "name", None)
     if not isinstance(name, str) or not name:
-        raise ValueError(f"stepping backend {backend!r} has no name (a class attribute name = '...')")
-    if BACKENDS.get(name, backend) is not backend:
-        raise ValueError(f"stepping backend {name!r} is already registered to {BACKENDS[name]!r}")
-    BACKENDS[name] = backend
-    return backend
+        raise ValueError(f"stepping backend {stepper!r} has no name (a class attribute name = '...')")
+    if STEPPERS.get(name, stepper) is not stepper:
+        raise ValueError(f"stepping backend {name!r} is already registered to {STEPPERS[name]!r}")
+    STEPPERS[name] = stepper
+    return stepper
 
 
-register(BatchBackend())
-register(LoopBackend())
+register(BatchStepper)
+register(LoopStepper)
 
-#: The backend runs use unless told otherwise.
+#: The name of the stepper runs use unless told otherwise.
 DEFAULT = "batch"
+#: The stepper runs use unless told otherwise.
+DEFAULT_STEPPER = BatchStepper()
 
 
-def get(name: str) -> Backend:
-    """The stepping backend ``name``; raises ValueError naming it and the known ones."""
-    if name not in BACKENDS:
-        raise ValueError(f"unknown stepping backend {name!r}; expected one of {', '.join(BACKENDS)}")
-    return BACKENDS[name]
+def get(name: str) -> Stepper:
+    """A stepper of the class registered as ``name`` (made with no arguments); raises ValueError
+    naming it and the known ones."""
+    if name not in STEPPERS:
+        raise ValueError(f"unknown stepping backend {name!r}; expected one of {', '.join(STEPPERS)}")
+    return STEPPERS[name]()
+
+
+def key_text(stepper: Stepper) -> str:
+    """What a run key (a Dask task's) records of ``stepper``: nothing for the default, ``backend=NAME``
+    for a stepper made with no arguments (the text keys had when steppers travelled as names), and
+    its repr after that for one made with others."""
+    if stepper == DEFAULT_STEPPER:
+        return ""
+    try:
+        plain = stepper == type(stepper)()
+    except TypeError:  # a stepper class that needs arguments
+        plain = False
+    return f"backend={stepper.name}" + ("" if plain else f" {stepper!r}")
+
+
+def checked(stepper: Stepper) -> Stepper:
+    """``stepper`` when it is a :class:`Stepper`; raises ValueError naming it otherwise (a name: use
+    :func:`get`)."""
+    if not isinstance(stepper, Stepper):
+        raise ValueError(f"{stepper!r} is not a stepper (a Stepper object such as BatchStepper(); a name is "
+                         f"resolved by faultgen.simulation.backends.get, one of {', '.join(STEPPERS)})")
+    return stepper

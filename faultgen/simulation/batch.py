@@ -116,7 +116,7 @@ class Work:
     (n_steps + 1, N, 3), the load disturbance ``dist`` per log period (n, n_log, N), physics steps
     per log period, MuJoCo threads, for a fault the fields it moves and its final value, and for a
     program that grips a part the steps where its mass changes (:func:`apply_grips`), and the
-    stepping backend's name (:data:`faultgen.simulation.backends.BACKENDS`)."""
+    stepper (:class:`faultgen.simulation.backends.Stepper`)."""
 
     cycles: np.ndarray
     plant: Plant
@@ -129,7 +129,7 @@ class Work:
     grips: tuple = ()
     qd0: np.ndarray | None = None
     qdd0: np.ndarray | None = None
-    backend: str = backends.DEFAULT
+    stepper: backends.Stepper = backends.DEFAULT_STEPPER
 
 
 #: True signals at the log times (:data:`faultgen.simulation.signals.TRUE_SIGNALS`), each
@@ -139,9 +139,9 @@ Raw.__doc__ = "True signals at the log times, each ``(n_cycles, n_log, N)``: " +
 
 
 def new_runs(sim, work: Work) -> backends.Runs:
-    """One simulation per recorded cycle on the backend of ``work``, all at the task's start state,
+    """One simulation per recorded cycle on the stepper of ``work``, all at the task's start state,
     with each cycle's plant, fault and dry friction."""
-    runs = backends.get(work.backend).new(sim.model, len(work.cycles), work.nthread)
+    runs = work.stepper.new(sim.model, len(work.cycles), work.nthread)
     runs.bind("qpos")[...], runs.bind("qvel")[...] = start_state(sim.robot, work.q0, work.qd0, work.qdd0)
     runs.bind("act")[...] = 0.0
     work.plant.apply(sim, runs)
@@ -175,7 +175,7 @@ def step(sim, work: Work, bar) -> Raw:
         for name in friction_update.KINEMATICS:  # bound before the call that fills them
             runs.bind(name)
         runs.forward()  # the start state's kinematics, for the first step's load-dependent friction
-    applies = backends.get(work.backend).applies_friction_update
+    applies = work.stepper.applies_friction_update
     in_rollout = schedule is None or (schedule.in_arrays and applies)
     n_sim, n_steps = len(cycles), len(inputs) - 1
     chunk = min(CHUNK_PERIODS * per_log, n_steps)

@@ -8,7 +8,7 @@ unit's gear loss). :class:`FrictionUpdate` holds everything that update reads ex
 NumPy arrays, one chunk of steps at a time, and :func:`apply` is the update: one vectorised
 function of those arrays and the state, over all runs at once, with no effect object in it. A
 batched backend copies the arrays to its device once per chunk and runs :func:`apply` as a kernel
-before each step (:attr:`faultgen.simulation.backends.Backend.applies_friction_update`).
+before each step (:attr:`faultgen.simulation.backends.Stepper.applies_friction_update`).
 :class:`Schedule` makes a batch's updates chunk by chunk. docs/architecture.md, "Stepping backends".
 """
 

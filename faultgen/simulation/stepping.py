@@ -8,7 +8,7 @@ back to back in one simulation (``back_to_back``), each cycle starting from the 
 previous one ended in, as a robot's own log runs on: the hidden-effect logs of the calibration do
 (:mod:`faultgen.calibrate.synth`).
 
-A stepping backend steps the runs (:mod:`faultgen.simulation.backends`: ``mujoco.batch`` by
+A stepper steps the runs (:mod:`faultgen.simulation.backends`: ``mujoco.batch`` by
 default) with the friction model in the MuJoCo model (:mod:`faultgen.simulation.friction_models`:
 ``lugre`` inside MuJoCo, ``stribeck`` set from Python before every step). This module runs a
 configuration; its parts are modules by job: :mod:`~faultgen.simulation.config`
@@ -56,13 +56,13 @@ _prepared = prepared_for
 _ = _prepare, _prepare_variant
 
 
-def simulate(config: RunConfig, progress: bool = True, backend: str = backends.DEFAULT,
+def simulate(config: RunConfig, progress: bool = True, stepper: backends.Stepper | None = None,
              dry_multipliers: np.ndarray | None = None) -> RunResult:
     """Run ``config``: simulate its recorded cycles and return what the monitoring recorded.
 
-    ``backend`` names the stepping backend (:data:`faultgen.simulation.backends.BACKENDS`:
-    ``batch``, MuJoCo's threaded C stepping, or ``loop``, a plain Python loop of ``mj_step`` for
-    checking it); every backend gives the same results to float tolerance.
+    ``stepper`` steps the cycles (a :class:`faultgen.simulation.backends.Stepper`: ``BatchStepper()``,
+    MuJoCo's threaded C stepping, the default when None, or ``LoopStepper()``, a plain Python loop of
+    ``mj_step`` for checking it); every stepper gives the same results to float tolerance.
 
     ``dry_multipliers``: ndarray of shape (n_recorded, N), each recorded cycle's multiplier of
     every axis's dry (Coulomb and static) friction, given instead of friction wear (no wear plan,
@@ -80,24 +80,24 @@ def simulate(config: RunConfig, progress: bool = True, backend: str = backends.D
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     ValueError
-        For an unknown ``backend``; ``dry_multipliers`` not of that shape, not finite and positive,
+        For a ``stepper`` that is not a Stepper object; ``dry_multipliers`` not of that shape, not finite and positive,
         beside friction wear or with daily records.
     """
-    backends.get(backend)
+    stepper = backends.DEFAULT_STEPPER if stepper is None else backends.checked(stepper)
     cycles = config.recorded_cycles
     n_axes = config.model.n_axes
     if dry_multipliers is not None:
         dry_multipliers = _checked_multipliers(config, dry_multipliers, cycles, n_axes)
     conditions = config.conditions.evaluate(config.seed, cycles, n_axes) if config.conditions.active else None
     if not config.daily:
-        return _simulate_cycles(config, cycles, conditions, progress, backend, dry_multipliers)
+        return _simulate_cycles(config, cycles, conditions, progress, stepper, dry_multipliers)
     # daily records: a block of whole days at a time, each reduced to its days before the next is
     # stepped, so that a run's memory does not grow with its days (cycles are independent: the
     # same arrays as all at once, tests/test_fleet.py)
     size = max(1, DAILY_BLOCK_CYCLES // config.conditions.cycles_per_day) * config.conditions.cycles_per_day
     blocks = [np.arange(i, min(i + size, len(cycles))) for i in range(0, len(cycles), size)]
     return _join_days([daily_record(_simulate_cycles(
-        config, cycles[rows], None if conditions is None else take(conditions, rows), progress, backend))
+        config, cycles[rows], None if conditions is None else take(conditions, rows), progress, stepper))
         for rows in blocks])
 
 
@@ -115,17 +115,17 @@ def _checked_multipliers(config: RunConfig, values, cycles: np.ndarray, n_axes: 
 
 
 def _simulate_cycles(config: RunConfig, cycles: np.ndarray, conditions: CycleConditions | None,
-                     progress: bool, backend: str = backends.DEFAULT,
+                     progress: bool, stepper: backends.Stepper = backends.DEFAULT_STEPPER,
                      dry_multipliers: np.ndarray | None = None) -> RunResult:
     """The recorded ``cycles`` of ``config`` with their ``conditions``, every cycle kept (``dry_multipliers``:
     :func:`simulate`'s, checked)."""
     mix = config.conditions.task_mix
     if mix is None:
-        return _simulate_task(config, config.task, cycles, conditions, progress, backend, dry_multipliers)
+        return _simulate_task(config, config.task, cycles, conditions, progress, stepper, dry_multipliers)
     task_of = conditions.tasks(mix)
     groups = [np.flatnonzero(task_of == task) for task in dict.fromkeys(task_of)]
     return merge_tasks(config, groups, [
-        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress, backend,
+        _simulate_task(config, task_of[g[0]], cycles[g], take(conditions, g), progress, stepper,
                        None if dry_multipliers is None else dry_multipliers[g]) for g in groups])
 
 
@@ -152,7 +152,7 @@ def _join_days(blocks: list[RunResult]) -> RunResult:
 
 
 def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, conditions: CycleConditions | None,
-                   progress: bool, backend: str = backends.DEFAULT,
+                   progress: bool, stepper: backends.Stepper = backends.DEFAULT_STEPPER,
                    dry_multipliers: np.ndarray | None = None) -> RunResult:
     """The recorded ``cycles`` of ``config`` that run ``task_name``, with their ``conditions``:
     stepped, measured, their per-cycle features (and torque counts unless daily) computed; each
@@ -194,7 +194,7 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                                  "starts; back_to_back runs need a cycle that returns to its start")
             one = batch.step(sim, Work(cycles[:1], plant.take([0]), path.q[0], chained,
                                      dist.reshape(1, -1, dist.shape[-1]), per_log, config.nthread,
-                                     qd0=path.qd[0], qdd0=path.qdd[0], backend=backend), bar)
+                                     qd0=path.qd[0], qdd0=path.qdd[0], stepper=stepper), bar)
             raw = Raw(**{name: getattr(one, name).reshape(len(cycles), -1, robot.n_axes) for name in TRUE_SIGNALS})
         else:  # the cycles of each payload (its own model and feedforward) in batches of BATCH_CYCLES
             parts = conditions.payload_part if conditions is not None else np.full(len(cycles), -1)
@@ -209,7 +209,7 @@ def _simulate_task(config: RunConfig, task_name: str, cycles: np.ndarray, condit
                     fault = None if in_model is None else (variant.fault_fields, in_model.final)
                     raws.append(batch.step(variant.sim, Work(cycles[g], plant.take(g), path.q[0], variant.inputs,
                                                               dist[g], per_log, config.nthread, fault, variant.grips,
-                                                              path.qd[0], path.qdd[0], backend), bar))
+                                                              path.qd[0], path.qdd[0], stepper), bar))
                     order.append(g)
             back = np.argsort(np.concatenate(order))  # to the order of the cycles
             raw = Raw(**{name: np.concatenate([getattr(r, name) for r in raws])[back] for name in TRUE_SIGNALS})
