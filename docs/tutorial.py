@@ -38,7 +38,8 @@ if TINY:
                          schedules=["exp4"], cycles=24, record="all", seeds=[0, 1])
 else:
     grid = faultgen.Grid.from_preset("quick")
-path = faultgen.run_sweep(grid, "tutorial.h5", jobs=2 if not TINY else 1, progress=False, overwrite=True)
+path = faultgen.run_sweep(grid, "tutorial.h5", context=faultgen.ExecutionContext(jobs=2 if not TINY else 1),
+                          progress=False, overwrite=True)
 print(f"wrote {path}")
 
 # %% [markdown]

@@ -44,6 +44,7 @@ PUBLIC = {
     "write_run": ("faultgen.data.writer", "write_run"),
     "Grid": ("faultgen.runs.grid", "Grid"),
     "run_sweep": ("faultgen.runs.sweep", "run"),
+    "ExecutionContext": ("faultgen.runs.context", "ExecutionContext"),
     "Fleet": ("faultgen.runs.fleet", "Fleet"),
     "robots": ("faultgen.model.robots", None),
 }
