@@ -150,7 +150,7 @@ def monitor_command(
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
     from faultgen.model import robots
-    from faultgen.monitor import lights, loop, page
+    from faultgen.monitor import console, loop
     from faultgen.monitor.scoring import Settings
     from faultgen.runs.context import ExecutionContext
 
@@ -176,30 +176,11 @@ def monitor_command(
     except Exception:  # a refusal or a failure: nothing this run made is left (OUT, OUT/.cache, empty folders above)
         remove_made(made, out)
         raise
-    monitors = outcome.monitors
-    alarmed = [m for m in monitors if m.first_alarm]
-    by_unit = {m.unit: m for m in monitors}
-    for status in outcome.statuses:
-        m = by_unit.get(status.unit)
-        alarm = m is not None and m.first_alarm
-        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
-            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
-        typer.echo(f"{status.unit}: {status.status} ({status.protocol}"
-                   f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
-    logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
-    # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
-    # bounds over a limit the unworn estimate lies below (twin); the report page says the same
-    statement = page.false_alarm_statement(protocol, alpha, persistence, train, monitors[0].n_axes if monitors else 1,
-                                           logs_scored)  # "" where it says nothing (issue 72)
-    typer.echo(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
-    typer.echo(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
-               f"{out / 'rul.csv'}, "
-               f"{len(monitors)} charts and the fleet report {out / page.PAGE}")
-    short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
+    lines, short = console.summary(outcome, settings, out)
+    for line in lines:
+        typer.echo(line)
     if short:
-        typer.echo(f"{len(short)} of {len(outcome.statuses)} units are degraded or not monitored "
-                   f"({', '.join(s.unit for s in short[:5])}{', ...' if len(short) > 5 else ''}): their reasons are "
-                   f"in {out / 'units.csv'}; exit status {loop.EXIT_SOME_UNITS_NOT_MONITORED}", err=True)
+        typer.echo(short, err=True)
         raise typer.Exit(loop.EXIT_SOME_UNITS_NOT_MONITORED)
 
 

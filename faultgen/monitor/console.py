@@ -1,0 +1,43 @@
+"""What ``faultgen monitor`` prints when a run ends: one line per unit (its status, the model its
+twin is of, its alarm or its reason), the fleet's count of alarms beside the chance of a persistent
+alarm on a healthy unit (where that says something), the files written, and the units that are
+degraded or not monitored. Text only: the command prints it (faultgen/cli/monitoring.py)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from faultgen.monitor import lights, page
+from faultgen.monitor.loop import EXIT_SOME_UNITS_NOT_MONITORED
+from faultgen.monitor.scoring import Settings
+
+
+def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
+    """The lines for standard output, and the line for standard error ("" when every unit is
+    monitored), of a finished run's ``outcome`` (:class:`faultgen.monitor.loop.Outcome`: its
+    monitors and statuses) with ``settings``, its outputs in ``out``."""
+    monitors = outcome.monitors
+    alarmed = [m for m in monitors if m.first_alarm]
+    by_unit = {m.unit: m for m in monitors}
+    lines = []
+    for status in outcome.statuses:
+        m = by_unit.get(status.unit)
+        alarm = m is not None and m.first_alarm
+        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
+            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
+        lines.append(f"{status.unit}: {status.status} ({status.protocol}"
+                     f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
+    logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
+    # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
+    # bounds over a limit the unworn estimate lies below (twin); the report page says the same
+    statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,
+                                           monitors[0].n_axes if monitors else 1, logs_scored)  # "" where it says nothing
+    lines.append(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
+    lines.append(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
+                 f"{out / 'rul.csv'}, {len(monitors)} charts and the fleet report {out / page.PAGE}")
+    short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
+    if not short:
+        return lines, ""
+    return lines, (f"{len(short)} of {len(outcome.statuses)} units are degraded or not monitored "
+                   f"({', '.join(s.unit for s in short[:5])}{', ...' if len(short) > 5 else ''}): their reasons are "
+                   f"in {out / 'units.csv'}; exit status {EXIT_SOME_UNITS_NOT_MONITORED}")
