@@ -20,8 +20,12 @@ Not in the track's numeric profile: the fleet's last bits may differ from the tr
 
 Version 2 (friction tests every 14 days, docs/bench/prognostics.md): the fleet is written with its
 tests (``LOGS/<unit>/friction-test/``), which the monitor reads (faultgen.monitor.friction_tests):
-the twin **with tests**, whose ``scores.csv`` wear is on the tests' scale from each unit's first test
-on (each log's estimate times the scale factor the tests up to it gave); ``--without-tests`` moves
+the twin **with tests**. Its replay on a day fits the unit's rows up to that day as the monitor's
+``rul.csv`` would have that day (:func:`faultgen.monitor.friction_tests.on_tests_scale`): every log's
+twin-scale estimate times the factor of the tests up to that day, that factor's error as the
+scale's uncertainty (not ``scores.csv``'s wear, each log on its own day's factor, with the default
+uncertainty); those columns are not in ``scores.csv``, so the rows are the monitor's own, reloaded by
+running it again on its OUT (no new log: its state replayed). ``--without-tests`` moves
 the test folders out of LOGS first (to ``WORK/tests-apart``): the production-log twin on the same
 fleet.
 """
@@ -42,7 +46,7 @@ import numpy as np
 from faultgen import children
 from faultgen.bench import files, independent, make, prognosers, prognostics, tracks
 from faultgen.model import robots
-from faultgen.monitor import prognosis
+from faultgen.monitor import friction_tests, loop, prognosis
 
 #: The monitor's defaults the replay uses (faultgen.monitor.scoring.Settings).
 MONITOR_ALPHA, PERSISTENCE = 0.01, 5
@@ -50,6 +54,20 @@ MONITOR_ALPHA, PERSISTENCE = 0.01, 5
 
 def _floats(row: dict) -> dict:
     return {k: (float(v) if k.startswith("wear") and v != "" else v) for k, v in row.items()}
+
+
+def _failure_days(unit: str, seen: list[dict], n_axes: int, failure: float, first: str, axis: int) -> np.ndarray:
+    """The days (from the first log, 1-based) at which the twin's remaining life on the unit's rows
+    ``seen`` (its logs up to now) puts ``axis``'s wear at ``failure`` %: as the monitor's ``rul.csv``
+    would have that day (on the factor of the tests up to now,
+    :func:`faultgen.monitor.friction_tests.on_tests_scale`); inf beyond the horizon or with no fit."""
+    seen, uncertainty = friction_tests.on_tests_scale(seen, n_axes)
+    (row,) = prognosis.remaining_life(unit, seen, n_axes, alpha=MONITOR_ALPHA, failure_wear=failure, since=first,
+                                      source_axis=axis, axes=[axis],
+                                      **({} if uncertainty is None else {"scale_uncertainty": uncertainty}))
+    if row.distribution is None:
+        return np.array([np.inf])
+    return np.array([np.inf if v is None else len(seen) + float(v) for v in row.distribution.key("failure")])
 
 
 def main() -> None:
@@ -88,6 +106,11 @@ def main() -> None:
     truth = independent.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
         scores = [_floats(r) for r in csv.DictReader(f)]
+    if tested and not args.without_tests:  # the rows' twin-scale wear and factors, which scores.csv leaves out
+        started = time.perf_counter()
+        kept = loop.monitor(robot, logs, out, calibrate=False, failure_wear=failure, progress=False).monitors
+        scores = [row for m in kept for row in m.rows]
+        print(f"the monitor's rows reloaded from OUT's state (no new log): {time.perf_counter() - started:.0f} s")
     with open(out / "alarms.csv", newline="") as f:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
     naive = prognosers.MeanLife().fit(files.read(args.data / "train.h5"), failure)
@@ -107,13 +130,8 @@ def main() -> None:
             record = files.Unit(id=unit, robot="kr210", task="pick_place", sample="log",
                                 arrays={"cycles": days[: int(now)]})
             mean_life[now] = naive.predict(record)
-            samples = np.array([np.inf])
-            if axis and now >= persistent:
-                (row,) = prognosis.remaining_life(unit, rows[: int(now)], n_axes, alpha=MONITOR_ALPHA,
-                                                  failure_wear=failure, since=first, source_axis=axis, axes=[axis])
-                if row.distribution is not None:
-                    samples = np.array([np.inf if v is None else now + float(v) for v in row.distribution.key("failure")])
-            twin[now] = samples
+            twin[now] = _failure_days(unit, rows[: int(now)], n_axes, failure, first, axis) if (
+                axis and now >= persistent) else np.array([np.inf])
         extra = {"unit": unit, "worn_axis": t["axis"], "alarm_axis": axis, "alarm_persistent_day": persistent}
         twin_rows.append({**extra, **prognostics.unit_metrics(twin, eol, onset)})
         naive_rows.append({**extra, **prognostics.unit_metrics(mean_life, eol, onset)})

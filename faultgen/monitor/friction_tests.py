@@ -432,20 +432,35 @@ def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
                                  cell(r.wear), cell(r.lower), cell(r.upper), r.verdict])
 
 
-def remaining_life(monitor, failure_wear: float) -> list:
-    """:func:`faultgen.monitor.prognosis.of_monitor` of a monitor on its tests' scale: each axis's
-    own estimates rescaled by its latest factor, the factor's relative error as the scale's
-    uncertainty (an axis in the twin's scale keeps the default)."""
+def on_tests_scale(rows: list[dict], n_axes: int) -> tuple[list[dict], dict[int, float] | None]:
+    """``rows`` (a monitor's, :attr:`faultgen.monitor.scoring.UnitMonitor.rows`, in order) as
+    :func:`remaining_life` fits them: each axis's own estimates (``wear<k>_log``,
+    ``wear<k>_log_lower``, %) the twin-scale ones times the *last* row's factor, and each axis's
+    scale uncertainty (relative: the last factor's standard error over it; an axis in the twin's
+    scale :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`). A prefix ``rows[:i]`` gives what
+    the monitor said after its ``i``-th log. ``(rows, None)`` unchanged when the last row has no
+    twin-scale columns (no friction test)."""
     from faultgen.monitor import prognosis
 
-    rows = monitor.rows
     if not rows or "wear1_twin_log" not in rows[-1]:
-        return prognosis.of_monitor(monitor, failure_wear)
-    last, axes = rows[-1], range(1, monitor.n_axes + 1)
+        return rows, None
+    last, axes = rows[-1], range(1, n_axes + 1)
     factor = {k: last[f"wear{k}_factor"] for k in axes}
     rescaled = [{**r, **{f"wear{k}{end}": factor[k] * r[f"wear{k}_twin{end}"]
                          for k in axes for end in ("_log", "_log_lower")}} if "wear1_twin_log" in r else r
                 for r in rows]
     uncertainty = {k: last[f"wear{k}_factor_error"] / factor[k] if last[f"wear{k}_scale"] == TESTS_SCALE
                    else prognosis.SCALE_UNCERTAINTY for k in axes}
-    return prognosis.of_monitor(monitor, failure_wear, rows=rescaled, scale_uncertainty=uncertainty)
+    return rescaled, uncertainty
+
+
+def remaining_life(monitor, failure_wear: float) -> list:
+    """:func:`faultgen.monitor.prognosis.of_monitor` of a monitor on its tests' scale
+    (:func:`on_tests_scale`: each axis's own estimates rescaled by its latest factor, the factor's
+    relative error as the scale's uncertainty; an axis in the twin's scale keeps the default)."""
+    from faultgen.monitor import prognosis
+
+    rows, uncertainty = on_tests_scale(monitor.rows, monitor.n_axes)
+    if uncertainty is None:
+        return prognosis.of_monitor(monitor, failure_wear)
+    return prognosis.of_monitor(monitor, failure_wear, rows=rows, scale_uncertainty=uncertainty)
