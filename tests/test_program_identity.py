@@ -154,7 +154,7 @@ def test_the_issues_sweep_written_the_old_way_is_still_paired_by_program(tmp_pat
     edited = _edited(tmp_path)
     path = tmp_path / "mixed.h5"
     sweep.run(sweep.Grid(robots=["irb6700"], tasks=["spot_weld", str(edited)], axes=[0, 2], cycles=4, signals=False),
-              path, jobs=1, progress=False)
+              path, progress=False)
     with h5py.File(path, "a") as f:  # as written before the hash: one label, no program_sha256
         for group in f["runs"].values():
             group.attrs["task"] = "spot_weld"

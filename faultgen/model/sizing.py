@@ -464,6 +464,12 @@ def _sized_rule1(arm, given: dict[int, dict[str, float]] | None, payload: float 
     return Sized(Drivetrain.from_table(table, n, _source(arm)), origin, float(payload), None, moving_mass, 1)
 
 
+#: Fleet parts as shares of the rated payload: (small, big) mass ranges; their density, kg/m^3
+#: (aluminium), sets the edge of a cube of that mass. The shares are those of the IRB-6700-like
+#: arm's parts (faultgen.runs.fleet.PARTS: 10-40 and 60-120 kg of 200 kg).
+PART_SHARES, PART_DENSITY = ((0.05, 0.2), (0.3, 0.6)), 2700.0
+
+
 def fleet_parts(rated_payload: float) -> tuple:
     """Parts of two sizes for a fleet robot of this rated payload (kg), in the form of
     ``faultgen.runs.fleet.PARTS``: ``((small mass range kg, small edge range m), (big ..., big ...))``.
