@@ -211,12 +211,7 @@ def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np
         kg when the log has them.
     """
     tau_m = data.tau / robot.gear_ratio  # arm-side torque referred to the motor side
-    if data.cycle is None:
-        slices = [slice(None)]
-    else:
-        starts = np.flatnonzero(np.diff(data.cycle)) + 1
-        edges = [0, *starts.tolist(), len(data.cycle)]
-        slices = [slice(a, b) for a, b in zip(edges, edges[1:])]
+    slices = [slice(None)] if data.cycle is None else measured.cycle_slices(data.cycle)
     per_cycle = [sensors.cycle_features(data.q[None, s], data.qd[None, s], tau_m[None, s], robot.joint_range,
                                         speed_limit, robot.motor_torque_limit) for s in slices]
     joined = {name: np.concatenate([f[name] for f in per_cycle]) for name in per_cycle[0]}

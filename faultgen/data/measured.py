@@ -416,6 +416,13 @@ def _cycles(where: Path, values: np.ndarray, label, t: np.ndarray) -> np.ndarray
     return values.astype(np.int64)
 
 
+def cycle_slices(cycle: np.ndarray) -> list[slice]:
+    """The rows of each cycle of a checked ``cycle`` column (n,) (:func:`_cycles`): one slice per run
+    of equal values, in order."""
+    edges = [0, *(np.flatnonzero(np.diff(cycle)) + 1).tolist(), len(cycle)]
+    return [slice(a, b) for a, b in zip(edges, edges[1:])]
+
+
 def velocity_rows(n: int, window: int) -> slice:
     """The rows over which given velocities are compared with the derivative of q (away from the ends)."""
     return slice(window, n - window) if n > 4 * window else slice(None)

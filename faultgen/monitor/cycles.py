@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from faultgen.data import measured
+
 #: A log whose angles lie more than this off its program's cycle, rad, or whose cycles' span differs
 #: by more than PROGRAM_LENGTH of the program's period, runs another program (noise and tracking:
 #: about 1e-3 rad).
@@ -55,11 +57,12 @@ def _off(t: np.ndarray, q: np.ndarray, ref_t: np.ndarray, ref_q: np.ndarray) -> 
 def _parts(t: np.ndarray, cycle: np.ndarray | None, k: int) -> list[slice]:
     """The samples of each cycle: the runs of the ``cycle`` column, else ``k`` equal parts of the span."""
     if cycle is not None:
-        edges = [0, *(np.flatnonzero(np.diff(cycle)) + 1).tolist(), len(t)]
+        parts = measured.cycle_slices(cycle)
     else:
         step = _span(t) / k
         edges = [0, *np.searchsorted(t - t[0], step * np.arange(1, k) - 1e-9).tolist(), len(t)]
-    return [slice(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+        parts = [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
+    return [p for p in parts if p.stop > p.start]
 
 
 @dataclass(frozen=True)
