@@ -116,6 +116,8 @@ MODEL_UNCERTAINTY = 0.25
 SCALE_UNCERTAINTY = 0.10
 #: The two-sided interval of each wear estimate in ``wear.csv``.
 WEAR_INTERVAL = 0.90
+#: Its two-sided normal quantile (1.645): the half-width of the interval in standard errors.
+WEAR_INTERVAL_Z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
 #: One-sided confidence with which the filtered wear must have reached ``wear_limit`` for a log to
 #: alarm: its lower bound is the filtered wear less this normal quantile (1.28) of its standard
 #: error (``wearI_lower`` in scores.csv). Before the slope errors were in the trend's state an unworn
@@ -317,7 +319,7 @@ class UnitMonitor:
             error = self.wear_estimate(np.zeros_like(self.scale_), self.scale_**2)[1]
             self.trend.set_prior(error[:, None, None] ** 2 * self.gram_inv_[None])
             # one log's 90 % interval of an unworn axis, from the noise: the rule of NOT_OBSERVABLE_LIMITS
-            self.width_ = 2.0 * NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2) * error
+            self.width_ = 2.0 * WEAR_INTERVAL_Z * error
             self.observable_ = self.width_ <= NOT_OBSERVABLE_LIMITS * self.settings.wear_limit
         if self.placeholders:  # the rows standing for these logs since a program change
             del self.rows[-self.placeholders:]
@@ -370,8 +372,8 @@ class UnitMonitor:
         ``error`` %, both (n_axes,): the estimate -+ the normal quantile times ``sqrt(error^2 +
         (SCALE_UNCERTAINTY estimate)^2)``, the twin's model uncertainty (:data:`SCALE_UNCERTAINTY`,
         a share of the estimate: a scale) beside the noise. Returns (lower, upper), %."""
-        z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
-        half = z * np.sqrt(np.asarray(error) ** 2 + (SCALE_UNCERTAINTY * np.asarray(estimate)) ** 2)
+        half = WEAR_INTERVAL_Z * np.sqrt(np.asarray(error) ** 2
+                                         + (SCALE_UNCERTAINTY * np.asarray(estimate)) ** 2)
         return estimate - half, estimate + half
 
     def _on_tests(self, stamp, estimate, error, log_estimate, log_error):
@@ -379,8 +381,7 @@ class UnitMonitor:
         (with its error) on the unit's friction tests' scale (:mod:`faultgen.monitor.friction_tests`),
         and the row's twin-scale values, factors and scales."""
         factor, factor_error, names = self.tests.at(stamp, estimate, error)
-        z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
-        half = z * np.sqrt((factor * error) ** 2 + (factor_error * estimate) ** 2)
+        half = WEAR_INTERVAL_Z * np.sqrt((factor * error) ** 2 + (factor_error * estimate) ** 2)
         lower = log_estimate - self.bound_quantile * log_error
         row = {**{f"wear{i + 1}_twin_log": float(v) for i, v in enumerate(log_estimate)},
                **{f"wear{i + 1}_twin_log_lower": float(v) for i, v in enumerate(lower)},
