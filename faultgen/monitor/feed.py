@@ -98,7 +98,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        constant = next((n for n in unit.notes if n.startswith(CONSTANT_TORQUE)), None)  # an earlier run's
+        constant = constant_torque_note(unit)  # an earlier run's
         twin = constant or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
@@ -218,6 +218,12 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
     more = f" and {len(named) - 3} more" if len(named) > 3 else ""
     return (f"{CONSTANT_TORQUE}: {', '.join(named[:3])}{more} the same in all {len(features)} learning logs, "
             "which can show no wear")
+
+
+def constant_torque_note(unit: Unit) -> str | None:
+    """The note that took the unit off the monitor (:func:`constant_torque`, in this run or an
+    earlier one), or None."""
+    return next((n for n in unit.notes if n.startswith(CONSTANT_TORQUE)), None)
 
 
 def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:

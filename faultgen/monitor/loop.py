@@ -49,10 +49,11 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import CONSTANT_TORQUE, PROGRAM_CHANGE, PROGRAM_LENGTH, Context
+from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, constant_torque_note
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
-from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, given_model, new_unit
+from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
+                                   new_unit)
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
@@ -391,7 +392,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
         reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
     learning = unit.monitor.pca is None
-    if learning and not any(n.startswith(CONSTANT_TORQUE) for n in unit.notes):  # not learning: off the monitor
+    if learning and constant_torque_note(unit) is None:  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
@@ -406,7 +407,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
                       "; ".join(reasons), len(unit.entries), last, adapters.torque_source(unit.notes),
-                      "; ".join(n for n in unit.notes if n.startswith("the twin of the ") and " failed (" in n))
+                      "; ".join(fallback_notes(unit)))
 
 
 def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, list]:

@@ -106,6 +106,12 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
     return Unit(monitor, kind, program, first_key)
 
 
+def fallback_notes(unit: Unit) -> list[str]:
+    """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`:
+    "the twin of the ... failed (...); ... used")."""
+    return [n for n in unit.notes if n.startswith("the twin of the ") and " failed (" in n]
+
+
 def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: fleet_logs.Source,
             stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Twin | str | None:
     """The unit's twin (its cycles simulated on ``stepper``), or None
