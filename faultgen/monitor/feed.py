@@ -144,7 +144,7 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source)
     source.keep(log)
     unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
     unit.monitor.signatures = new.signatures
-    unit.program, unit.program_q = (unit.monitor.unit, log.stamp), program_of(source.get(log).checked())
+    unit.program, unit.program_cycle = (unit.monitor.unit, log.stamp), program_of(source.get(log).checked())
     unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
                       "replays that log, and the unit learns its normal operation again")
@@ -173,9 +173,9 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         reading = fleet_logs.reading_of(nominal, parsed.checked())
         load = _load(parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
-            if unit.program_q is None:
-                unit.program_q = program_of(source.get(log_of(context.units, *unit.program)).checked())
-            if program_changed(parsed.checked(), unit.program_q):
+            if unit.program_cycle is None:
+                unit.program_cycle = program_of(source.get(log_of(context.units, *unit.program)).checked())
+            if program_changed(parsed.checked(), unit.program_cycle):
                 twin = new_program(unit, log, twin, context, source)
         residual, expected = reading.vector, None
         if twin is not None:

@@ -81,7 +81,7 @@ class Unit:
     notes: list[str] = field(default_factory=list)
     maintenance: list[stored.Maintenance] = field(default_factory=list)
     program_changes: list[stored.ProgramChange] = field(default_factory=list)
-    program_q: cycles.Program | None = None  # the program's cycle (read when needed; not kept in the state)
+    program_cycle: cycles.Program | None = None  # the program's cycle (read when needed, not stored)
     initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
 
 
