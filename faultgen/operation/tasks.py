@@ -27,6 +27,7 @@ convergence").
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -205,8 +206,6 @@ class TextProgram(str):
     text: str
 
     def __new__(cls, stem: str, text: str, *, named: bool = False) -> "TextProgram":
-        import hashlib
-
         if not isinstance(text, str) or not isinstance(stem, str) or not stem:
             raise ValueError(f"TextProgram({stem!r}, ...): expected a non-empty name and the program's TOML text")
         name = stem if named else f"{stem}-{hashlib.sha256(text.encode()).hexdigest()[:12]}.toml"
