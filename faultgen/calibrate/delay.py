@@ -177,8 +177,7 @@ def shown(t: np.ndarray, tau: np.ndarray, predicted: np.ndarray, moving: np.ndar
         return None
     if found.covers_zero:
         return None
-    keep = (t + found.seconds >= t[0]) & (t + found.seconds <= t[-1])
-    moved = np.column_stack([np.interp(t[keep] + found.seconds, t, tau[:, a]) for a in range(tau.shape[1])])
+    keep, moved = moved_torque(t, tau, found.seconds)
     rows = moving[keep]
     scale = np.sqrt(np.mean(tau**2, axis=0))
     scale = np.where(scale > 0, scale, 1.0)
@@ -204,6 +203,14 @@ def shown(t: np.ndarray, tau: np.ndarray, predicted: np.ndarray, moving: np.ndar
                      "leaves out 0 on the same side")}
 
 
+def moved_torque(t: np.ndarray, tau: np.ndarray, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+    """The torque ``tau`` (n, N) sampled at ``t`` (n,) s moved ``seconds`` earlier (``tau(t + seconds)``,
+    linear interpolation): the rows kept (n,) bool, those whose moved torque lies inside the log, and
+    the moved torque on them (k, N)."""
+    keep = (t + seconds >= t[0]) & (t + seconds <= t[-1])
+    return keep, np.column_stack([np.interp(t[keep] + seconds, t, tau[:, a]) for a in range(tau.shape[1])])
+
+
 def shift(data: measured_io.MeasuredData, seconds: float) -> measured_io.MeasuredData:
     """``data`` with its torque columns moved ``seconds`` earlier (``tau(t) <- tau_logged(t + seconds)``,
     linear interpolation: the correction of a torque logged ``seconds`` after the motion; negative:
@@ -220,8 +227,7 @@ def shift(data: measured_io.MeasuredData, seconds: float) -> measured_io.Measure
     span = float(t[-1] - t[0])
     if not np.isfinite(seconds) or abs(seconds) > span / 2:
         raise ValueError(f"--delay {seconds!r} s: expected a finite delay of at most half the log's {span:.3g} s")
-    keep = (t + seconds >= t[0]) & (t + seconds <= t[-1])
-    tau = np.column_stack([np.interp(t[keep] + seconds, t, data.tau[:, a]) for a in range(data.tau.shape[1])])
+    keep, tau = moved_torque(t, data.tau, seconds)
 
     def rows(a):
         return None if a is None else np.asarray(a)[keep]
