@@ -1,10 +1,13 @@
 """Shared by the benchmarks: MuJoCo stepping a run's workload with no Python in the loop (the
-baseline), and the peak memory of a process and its workers."""
+baseline), the peak memory of a process and its workers, and the options of a benchmark's
+independent fleet."""
 
 from __future__ import annotations
 
+import argparse
 import threading
 import time
+from pathlib import Path
 from typing import Self
 
 import mujoco
@@ -15,6 +18,17 @@ from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+
+
+def fleet_options(parser: argparse.ArgumentParser, units: int, worn: int, days: int = 120, seed: int = 0) -> None:
+    """Add the options of a benchmark's independent fleet (tests/independent_fleet.py's ``FleetSpec``)
+    to ``parser``: ``--units``, ``--worn`` (of them, units wearing one axis), ``--days`` (one log a
+    day), ``--seed`` and ``--work`` (the folder to keep the fleet and outputs in; default none)."""
+    parser.add_argument("--units", type=int, default=units)
+    parser.add_argument("--worn", type=int, default=worn)
+    parser.add_argument("--days", type=int, default=days)
+    parser.add_argument("--seed", type=int, default=seed)
+    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
 
 
 def tree_rss() -> int:
