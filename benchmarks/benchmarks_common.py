@@ -1,10 +1,13 @@
 """Shared by the benchmarks: MuJoCo stepping a run's workload with no Python in the loop (the
-baseline), and the peak memory of a process and its workers."""
+baseline), the peak memory of a process and its workers, the options of a benchmark's
+independent fleet, and those of a benchmark over logs of the independent-simulator set."""
 
 from __future__ import annotations
 
+import argparse
 import threading
 import time
+from pathlib import Path
 from typing import Self
 
 import mujoco
@@ -15,6 +18,35 @@ from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+
+
+def fleet_options(parser: argparse.ArgumentParser, units: int, worn: int, days: int = 120, seed: int = 0) -> None:
+    """Add the options of a benchmark's independent fleet (tests/independent_fleet.py's ``FleetSpec``)
+    to ``parser``: ``--units``, ``--worn`` (of them, units wearing one axis), ``--days`` (one log a
+    day), ``--seed`` and ``--work`` (the folder to keep the fleet and outputs in; default none)."""
+    parser.add_argument("--units", type=int, default=units)
+    parser.add_argument("--worn", type=int, default=worn)
+    parser.add_argument("--days", type=int, default=days)
+    parser.add_argument("--seed", type=int, default=seed)
+    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
+
+
+def table_options(parser: argparse.ArgumentParser) -> None:
+    """Add ``--csv`` (write the rows there, as they finish) and ``--from-csv`` (print the table of an
+    earlier run's CSV, run nothing) to ``parser``."""
+    parser.add_argument("--csv", type=Path, help="write the rows here, as they finish")
+    parser.add_argument("--from-csv", type=Path, help="print the table of an earlier run's CSV, run nothing")
+
+
+def chosen_cases(parser: argparse.ArgumentParser, cases: list, parts: list[str]) -> list:
+    """The ``cases`` (objects with a ``name``) whose name contains one of ``parts``, in the order of
+    ``parts`` (every case for none); a parser error naming ``parts`` and the names where none does."""
+    chosen = [c for c in cases if not parts or any(n in c.name for n in parts)]
+    if parts:  # in the order given
+        chosen.sort(key=lambda c: min(k for k, n in enumerate(parts) if n in c.name))
+    if not chosen:
+        parser.error(f"no log name contains any of {parts}; names: {[c.name for c in cases]}")
+    return chosen
 
 
 def tree_rss() -> int:

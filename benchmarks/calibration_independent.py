@@ -31,6 +31,7 @@ from joblib import Parallel, delayed
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_set  # tests/independent_set.py: the set has one definition, shared with the tests
+from benchmarks_common import chosen_cases, table_options  # sibling module
 
 from faultgen import axes
 from faultgen.calibrate import calibrate
@@ -99,17 +100,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--cases", nargs="*", default=[], help="only logs whose name contains one of these")
     parser.add_argument("--jobs", type=int, default=2, help="logs calibrated in parallel (default 2)")
-    parser.add_argument("--csv", type=Path, help="write every log's outcome here")
-    parser.add_argument("--from-csv", type=Path, help="print the table of an earlier run's CSV, run nothing")
+    table_options(parser)
     args = parser.parse_args()
     if args.from_csv:
         print(table(pd.read_csv(args.from_csv)))
         return
-    cases = [c for c in independent_set.CASES if not args.cases or any(n in c.name for n in args.cases)]
-    if args.cases:  # in the order given
-        cases.sort(key=lambda c: min(k for k, n in enumerate(args.cases) if n in c.name))
-    if not cases:
-        parser.error(f"no log name contains any of {args.cases}; names: {[c.name for c in independent_set.CASES]}")
+    cases = chosen_cases(parser, independent_set.CASES, args.cases)
     started = time.perf_counter()
     done = []
     # rows as they finish: a run cut short keeps the logs that finished in the CSV

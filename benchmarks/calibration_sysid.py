@@ -27,6 +27,7 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_set  # tests/independent_set.py
+from benchmarks_common import chosen_cases, table_options  # sibling module
 
 from faultgen.calibrate import MAX_ROWS, calibrate, decimate
 from faultgen.calibrate.refit import refit
@@ -94,15 +95,12 @@ def table(rows: pd.DataFrame) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--cases", nargs="*", default=DEFAULT, help="logs (names or parts of names) to run")
-    parser.add_argument("--csv", type=Path, help="write the rows here")
-    parser.add_argument("--from-csv", type=Path, help="print the table of an earlier run's CSV, run nothing")
+    table_options(parser)
     args = parser.parse_args()
     if args.from_csv:
         print(table(pd.read_csv(args.from_csv)))
         return
-    names = [c.name for c in independent_set.CASES if any(n in c.name for n in args.cases)]
-    if not names:
-        parser.error(f"no log name contains any of {args.cases}")
+    names = [c.name for c in chosen_cases(parser, independent_set.CASES, args.cases)]
     done = []
     for name in names:  # the CSV grows log by log: a run cut short keeps what finished
         done += run(name)

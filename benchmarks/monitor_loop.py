@@ -62,7 +62,7 @@ from faultgen import children
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet  # noqa: E402
 
-from benchmarks_common import PeakRSS  # noqa: E402  (sibling module)
+from benchmarks_common import PeakRSS, fleet_options  # noqa: E402  (sibling module)
 
 PROTOCOLS = {"own": ["--protocol", "own"], "nominal": ["--no-calibrate"], "twin": []}
 
@@ -164,11 +164,7 @@ def digest(folder: Path, names) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--units", type=int, default=12)
-    parser.add_argument("--worn", type=int, default=8)
-    parser.add_argument("--days", type=int, default=120)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
+    fleet_options(parser, units=12, worn=8)
     parser.add_argument("--protocols", default="own,nominal,twin")
     parser.add_argument("--skip-fleet", action="store_true", help="Do not time `faultgen fleet`.")
     parser.add_argument("--repeat", action="store_true", help="Check the same seed gives identical outputs.")

@@ -70,6 +70,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet
+from benchmarks_common import fleet_options  # sibling module
 
 from faultgen import children
 from faultgen.bench import rul_scores
@@ -193,13 +194,9 @@ def run_fleet(args) -> tuple[Path, Path]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--units", type=int, default=6)
-    parser.add_argument("--worn", type=int, default=4)
-    parser.add_argument("--days", type=int, default=120)
-    parser.add_argument("--seed", type=int, default=0)
+    fleet_options(parser, units=6, worn=4)
     parser.add_argument("--final-wear", type=float, default=60.0)
     parser.add_argument("--failure-wear", type=float, default=prognosis.FAILURE_WEAR)
-    parser.add_argument("--work", type=Path, default=None, help="Folder to keep the fleet and outputs in.")
     parser.add_argument("--fleet", type=Path, default=None,
                         help="Score an existing run of benchmarks/monitor_wear_scale.py instead (its WORK: truth.csv "
                              "and the monitor's OUT, --out): the remaining life is recomputed from its scores.csv "

@@ -5,7 +5,7 @@ child started in a folder that holds a ``joblib.py`` or ``typer.py`` (a folder f
 reproduction's output folder) imports that file instead of the package: its code runs with the
 user's rights. Python 3.11's ``-P`` (``PYTHONSAFEPATH=1`` in the environment) leaves that folder
 out; every Python faultgen starts gets the variable, and the flag where faultgen writes the command
-line (issue 61):
+line:
 
 - ``faultgen bench make``'s restart in a numeric profile (:func:`faultgen.bench.profile.restart_pinned`)
   and every ``faultgen reproduce`` step run as a command (:mod:`faultgen.reproduce.runner`, in the

@@ -97,12 +97,16 @@ class AlarmsOnlyRaising(BaseEstimator):
         raise KeyError("no alarms today")
 
 
-class ClassifierTooFewAlarms(ClassifierMixin, BaseEstimator):
-    """A classifier (fitted with labels, outside the plug-in guard) answering two alarms for any X."""
+class _TwoClasses(ClassifierMixin, BaseEstimator):
+    """A classifier fitted to the classes 0 and 1 whatever it is given: the base of the broken ones below."""
 
     def fit(self, X, y=None):
         self.classes_ = np.array([0, 1])
         return self
+
+
+class ClassifierTooFewAlarms(_TwoClasses):
+    """A classifier (fitted with labels, outside the plug-in guard) answering two alarms for any X."""
 
     def decision_function(self, X):
         return np.zeros(len(X))
@@ -111,12 +115,8 @@ class ClassifierTooFewAlarms(ClassifierMixin, BaseEstimator):
         return np.zeros(2, dtype=bool)
 
 
-class ClassifierFlatProbabilities(ClassifierMixin, BaseEstimator):
+class ClassifierFlatProbabilities(_TwoClasses):
     """A classifier whose predict_proba gives one column-less value per record (1-D)."""
-
-    def fit(self, X, y=None):
-        self.classes_ = np.array([0, 1])
-        return self
 
     def predict_proba(self, X):
         return np.zeros(len(X))

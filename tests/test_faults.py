@@ -44,6 +44,11 @@ def test_fault_values_at_known_cycles():
     ("cogging:2:amplitude:0.1:kind=exp4,onset=10", r"exp4 onset 10 is invalid; expected an int in 0..9"),
     ("cogging:2:amplitude:0.1:onset=3", r"linear schedule has no parameter 'onset'"),
     ("cogging:2:amplitude:0.1:kind=exp4,onset=2.5", r"option onset=2.5 is not a whole cycle"),
+    # an absolute fault on the motor friction or one of its parts: their fault is wear (--wear)
+    ("coulomb:2:coulomb_pos:0.5", r"part of the motor friction.*--wear AXIS:KIND:PERCENT"),
+    ("viscous:2:viscous:0.01", r"part of the motor friction"),
+    ("stribeck:2:static:0.1", r"part of the motor friction"),
+    ("motor_friction:2:static:0.1", r"part of the motor friction"),
 ])
 def test_bad_fault_specs_are_refused_with_the_value_named(spec, message):
     with pytest.raises(ValueError, match=message):

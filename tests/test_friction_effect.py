@@ -92,17 +92,6 @@ def test_the_wear_fault_is_the_schedule_bit_for_bit(spec):
     assert np.array_equal(plan.multipliers(k, 6), got)
 
 
-@pytest.mark.parametrize(("spec", "message"), [
-    ("coulomb:2:coulomb_pos:0.5", r"part of the motor friction.*--wear AXIS:KIND:PERCENT"),
-    ("viscous:2:viscous:0.01", r"part of the motor friction"),
-    ("stribeck:2:static:0.1", r"part of the motor friction"),
-    ("motor_friction:2:static:0.1", r"part of the motor friction"),
-])
-def test_an_absolute_fault_on_the_motor_friction_is_refused(spec, message):
-    with pytest.raises(ValueError, match=message):
-        parse_fault(spec, last_cycle=10)
-
-
 def test_relative_faults_are_checked():
     with pytest.raises(ValueError, match=r"motor_friction has no group 'coulomb_pos' \(it has: dry\)"):
         Fault(MotorFriction.id, 2, "coulomb_pos", 0.2, 10, growth="relative")

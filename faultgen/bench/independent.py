@@ -1,6 +1,6 @@
 """A "real" fleet's measured logs made by a simulator that is not faultgen: the test split of the
-sim-to-real track (docs/bench/sim-to-real.md) and the check of ``faultgen monitor`` (issue 46,
-tests/test_monitor.py, benchmarks/monitor_loop.py). faultgen's simulation never uses it.
+sim-to-real track (docs/bench/sim-to-real.md) and the check of ``faultgen monitor``
+(tests/test_monitor.py, benchmarks/monitor_loop.py). faultgen's simulation never uses it.
 
 What is independent and what is ours:
 
@@ -29,7 +29,7 @@ What is independent and what is ours:
 - **Wear: ours**: on a worn unit, one axis (of :attr:`FleetSpec.wearable`) has its Coulomb and
   Stribeck friction grow linearly from an onset day to :attr:`FleetSpec.final_wear` percent on the
   last day.
-- **Maintenance and program changes: ours** (issue 60; none by default): on
+- **Maintenance and program changes: ours** (none by default): on
   :attr:`FleetSpec.gearbox_changes` worn units the worn axis's gearbox is changed
   :data:`CHANGE_DELAY` days after the wear passed :data:`CHANGE_WEAR` %: from that day the axis's
   friction is the folder's nominal one (a new gearbox: no wear, no unit spread), logged in
@@ -41,10 +41,10 @@ What is independent and what is ours:
 - The motion: the robot folder's generated ``pick_place`` cycle (faultgen's planner; the motion is
   logged, so any would do), one cycle per log at :attr:`FleetSpec.rate` by default; with
   :attr:`FleetSpec.cycles` and :attr:`FleetSpec.rates` each log holds a drawn number of back-to-back
-  cycles (no ``cycle`` column) at a drawn rate (issue 72 item 8), from a stream of their own
+  cycles (no ``cycle`` column) at a drawn rate, from a stream of their own
   (:func:`faultgen.bench.layouts.draws`).
 
-- **Friction tests: the motion faultgen's, the plant ours** (issue 75; none by default): with
+- **Friction tests: the motion faultgen's, the plant ours** (none by default): with
   :attr:`FleetSpec.friction_test_every` ``= D`` every unit runs a friction test on days 1, 1 + D,
   1 + 2 D, ...: the motion of ``faultgen tasks friction-test`` for the robot folder
   (:func:`faultgen.operation.friction_test.program`: each axis in turn at constant speeds both ways)

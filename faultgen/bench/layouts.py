@@ -1,4 +1,4 @@
-"""The layout of the independent fleet's logs (:mod:`faultgen.bench.independent`, issue 72 item 8):
+"""The layout of the independent fleet's logs (:mod:`faultgen.bench.independent`):
 the rate a log is taken at (:func:`plan`) and how many back-to-back cycles of the unit's program it
 holds, drawn per log (:func:`draws`)."""
 

@@ -4,7 +4,7 @@ The same faultgen, packages and seed give different last bits on two x86-64 mach
 libraries under NumPy pick their code by the processor: OpenBLAS chooses its kernels at load time
 (the IK of the Cartesian tasks runs through it, so a weld path's joint reference moves), and
 NumPy dispatches its loops and reductions to the widest vector unit it finds (AVX-512 on one
-machine, AVX2 on another: the per-cycle features move). Measured on 2026-11-25: the conditions
+machine, AVX2 on another: the per-cycle features move). Measured: the conditions
 track's small make (version 1) gave its frozen manifest with OpenBLAS's Haswell or Zen kernels and
 40 of 155 differing arrays with its SkylakeX, Cooperlake, SapphireRapids or Sandybridge kernels, on
 one processor; a spot-weld run's features changed again when NumPy's AVX-512 loops were switched
@@ -127,8 +127,8 @@ def restart_pinned(name: str | None, argv: list[str]) -> None:
     """Start this command again in profile ``name`` (replacing this process) unless it runs in it
     already, no profile is asked, or the processor cannot take it. ``argv``: the command's arguments
     after the program (``sys.argv[1:]``). Started as ``python -P -m faultgen.cli`` with
-    ``PYTHONSAFEPATH=1`` (:mod:`faultgen.children`): ``python -m`` alone put the current folder first
-    on the path, and an ``h5py.py`` there ran in the make (issue 61)."""
+    ``PYTHONSAFEPATH=1`` (:mod:`faultgen.children`): ``python -m`` alone puts the current folder first
+    on the path, and an ``h5py.py`` there would run in the make."""
     if name is None or not supported(name) or pinned(name):
         return
     if os.environ.get("_FAULTGEN_PROFILE_RESTART") == name:  # pinned variables that did not take: no loop

@@ -22,7 +22,7 @@ performance"):
   falls below 0 when the error exceeds the true RUL), and averaged over every prediction (cumulative);
 - **prognostic horizon**: the end of life minus the first prediction meeting the alpha criterion
   (``progpy.metrics.prognostic_horizon``), 0 when none does, in records (days on the track);
-- at lambda (issue 75, :mod:`faultgen.bench.rul_scores`; in the JSON, and from version 2 in the
+- at lambda (:mod:`faultgen.bench.rul_scores`; in the JSON, and from version 2 in the
   leaderboard's row): whether the median is late by more than ALPHA of the true remaining life, whether the 5-95 %
   interval covers it, and the PHM 2008 score of the median (summarised as the late share, the
   covering share and the mean score; from version 2 the late share and the score are columns of
@@ -122,7 +122,7 @@ def unit_metrics(profile: dict, eol: float, onset: float) -> dict:
         warnings.simplefilter("ignore")
         out["alpha_lambda"] = bool(alpha_lambda(before, truth, lam, ALPHA, BETA)["failure"])
         at = min(t for t in before if t >= lam)
-        # issue 75 (faultgen.bench.rul_scores): the median late by more than ALPHA, the 5-95 % interval
+        # faultgen.bench.rul_scores: the median late by more than ALPHA, the 5-95 % interval
         # covering the true remaining life, the PHM 2008 score of the median
         low, median, high = np.quantile(finite[at] - at, [0.05, 0.5, 0.95])
         true_rul = max(eol - at, 1e-9)
@@ -255,7 +255,7 @@ HEADER = ("| track | prognoser | alpha-lambda met % [95 % CI] (naive) | relative
           "prognostic horizon, median days [CI] (naive) | verdict | command | date |")
 
 
-#: From version 2 on (issue 75) the table also gives, at lambda, the share of units whose median is late
+#: From version 2 on the table also gives, at lambda, the share of units whose median is late
 #: by more than alpha and the mean PHM 2008 score of the median (:mod:`faultgen.bench.rul_scores`).
 HEADER_V2 = HEADER.replace(" | verdict |", " | late by more than alpha at lambda, % of units [CI] (naive) | "
                                           "PHM 2008 score at lambda, mean [CI] (naive) | verdict |")

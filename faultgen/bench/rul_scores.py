@@ -1,4 +1,4 @@
-"""Scores of a remaining-life prediction as the field gives them, beside ProgPy's metrics (issue 75):
+"""Scores of a remaining-life prediction as the field gives them, beside ProgPy's metrics:
 the PHM 2008 challenge's asymmetric score, a late median, and an interval covering the truth.
 
 - :func:`phm08_score`: per prediction ``d = predicted - true`` remaining life, ``exp(-d / 13) - 1``
@@ -7,12 +7,12 @@ the PHM 2008 challenge's asymmetric score, a late median, and an interval coveri
   challenge's score, which charges a late prediction more than an early one of the same size); 0
   for an exact one, summed over units by the challenge.
 - :func:`late`: the median later than the truth by more than ``alpha`` (0.2) of the true remaining
-  life (the criterion of issue 75: a share of units at most).
+  life (a criterion on the share of units so late).
 - :func:`covers`: the 5-95 % interval holds the true remaining life.
 
 The time unit is the prediction's (days for the monitor's fleets; the challenge's were cycles, so
-its constants 13 and 10 are in cycles there and in days here, as the figures of issue 75 read
-them).
+its constants 13 and 10 are in cycles there and in days here, as the prognostics track's figures
+read them).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import numpy as np
 
 #: The PHM 2008 score's constants for early and late predictions (time units).
 EARLY, LATE = 13.0, 10.0
-#: Late by more than this share of the true remaining life counts as late (issue 75).
+#: Late by more than this share of the true remaining life counts as late.
 ALPHA = 0.2
 
 

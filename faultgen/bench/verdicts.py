@@ -1,4 +1,4 @@
-"""The verdict of every ``faultgen bench score`` figure against what chance gets (issue 59, part 5).
+"""The verdict of every ``faultgen bench score`` figure against what chance gets.
 
 A figure alone says nothing: a detector that alarms on every record "detects" every failing unit.
 Each figure of :mod:`faultgen.bench.score` is therefore judged against the value a method that does
@@ -121,7 +121,7 @@ def records_needed(method) -> tuple[int, str] | None:
     Transfer entropy (:class:`analysis.isolation.TransferEntropyIsolator`, ``bins`` quantile symbols,
     history ``h``) is a plug-in estimate: the transfer from one axis to another is counted only over
     the target's past states (``bins ** h`` of them) seen more than once, so it needs each of them
-    seen a few times: ``3 * bins ** h + h`` records. Measured (2026-11-25) on 6 irb6700 pick-and-place
+    seen a few times: ``3 * bins ** h + h`` records. Measured on 6 irb6700 pick-and-place
     runs of 100 cycles (exp4 to +20 % on each axis in turn, seed 1), transfer entropy on 30 random
     subsets of n cycles each: with 10 bins it named the worn axis on 0 % of them at n = 12 (71 %
     undecided: tied scores), 3 % at 16, 26 % at 21, 50 % at 26, 69 % at 31, 81-84 % at 36-51; with 5

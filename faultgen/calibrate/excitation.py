@@ -63,7 +63,7 @@ ITERATIONS = 8
 #: criterion jumps where a zero crossing of a joint speed passes a sample (the Coulomb and
 #: Stribeck columns hold ``sign(qd)``): a step of 1e-4 (the first cut) saw mostly those jumps, and
 #: L-BFGS-B's line search failed at once (PUMA 560, 5 harmonics: 75.0 -> 75.0 in 976 evaluations);
-#: 1e-2 averages over them (75.0 -> 17.7 in 3 iterations, 244 evaluations; 2026-11-24).
+#: 1e-2 averages over them (75.0 -> 17.7 in 3 iterations, 244 evaluations).
 STEP = 1e-2
 
 

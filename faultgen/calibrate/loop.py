@@ -292,7 +292,7 @@ def own_friction(model: Model, predicted: np.ndarray, motion, steps: list[Step],
     together by least squares to the residual the model leaves, on the whole moving record
     (fitting and held-out parts: no selection is made, so none is held out), and written whatever
     the held-out gap does: the unit's own friction on every axis, the scale ``faultgen monitor``
-    reads wear in (issue 59, item 1). Fitted together because on a motion of few steady speeds a
+    reads wear in. Fitted together because on a motion of few steady speeds a
     lower dry level and a higher viscous one give nearly the same torque: a dry level fitted alone
     takes up the viscous one's change. An axis whose joint fit is not admissible (a level below
     zero) gets its Coulomb level alone. An axis whose dry level the log cannot place

@@ -101,7 +101,7 @@ def check(robot, tau: np.ndarray, predicted: np.ndarray, moving: np.ndarray) -> 
 #: A calibrated Stribeck velocity more than this many times the nominal one (or less than its
 #: inverse) is not a friction the drive has: a hump fitted to something else (a KR210 calibrated on
 #: a log whose only differences from nominal were unit spread and temperature got 216 rad/s,
-#: nominal 10, and its twin saturated two axes; issue 60).
+#: nominal 10, and its twin saturated two axes).
 STRIBECK_RATIO = 10.0
 #: A calibrated dry friction (Coulomb or static, motor side) above this share of the motor's
 #: torque limit leaves the drive too little to move the arm: not a friction a working robot has.

@@ -5,7 +5,7 @@ makes on every moving axis (:func:`faultgen.calibrate.loop.own_friction`).
 On a motion of few steady speeds the dry column ``G sign(qd)`` and the viscous column ``G^2 qd`` are
 nearly parallel, and a fit trades one level for the other at little cost: on faultgen's own UR5
 (a unit spread of 15 %, LuGre friction, an arc-weld program) the wrist's dry level came out at
-0.3-0.4 times the plant's with a viscous level 15 times it (issue 72, item 3). The check is the
+0.3-0.4 times the plant's with a viscous level 15 times it. The check is the
 standard error of the dry level in the joint fit, from the least-squares covariance
 ``s^2 (X^T X)^-1`` (Seber & Lee 2003, *Linear Regression Analysis*, 2nd ed., sec. 3.3) on the
 thinned samples (every ``W``-th, ``W`` the derivative filter's window: the residual's

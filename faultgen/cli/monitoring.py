@@ -169,7 +169,7 @@ def monitor_command(
     except loop.MonitorInterrupted as stopped:  # Ctrl-C, SIGTERM: OUT/.cache keeps the twins made so far
         typer.echo(str(stopped), err=True)
         # ended here, at once: nothing is left to write, and the interpreter's own end (collecting the
-        # objects of MuJoCo, SciPy, matplotlib) took 2-2.5 s more on 2 loaded cores (2026-11-26)
+        # objects of MuJoCo, SciPy, matplotlib) takes 2-2.5 s more on 2 loaded cores
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(stopped.exit_code)

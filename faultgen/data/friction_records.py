@@ -1,4 +1,4 @@
-"""A friction test's records read back as logs (issue 75): a run labelled a friction test
+"""A friction test's records read back as logs: a run labelled a friction test
 (:data:`faultgen.data.schema.RECORD_ATTRIBUTE`; in a fleet, a robot's tests,
 ``faultgen fleet --friction-test-every``) holds one recorded cycle per test with its 250 Hz signals;
 :func:`log` makes one of them the measured log that ``faultgen friction-test`` reads

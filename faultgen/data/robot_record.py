@@ -9,7 +9,7 @@ card of ``faultgen info --card``) take what they need of a robot from here (:cla
 machine without the robot's folder, or with another version of it, as it was written.
 
 Files written before an attribute existed lack it (``n_axes`` and ``drivetrain`` before robots of 5
-to 7 axes, ``limits`` before issue 57): for those runs alone the robot is loaded by the run's
+to 7 axes, ``limits`` before the planning limits were stored): for those runs alone the robot is loaded by the run's
 ``robot`` label (:func:`faultgen.model.robots.load`, the task by its ``task`` label), as every
 analysis did before, and the record says so (``from_files``).
 """
@@ -80,7 +80,7 @@ class Limits:
         them). In a file written before it was stored, the task is loaded by its label when this is
         first read (ValueError if it cannot be).
     from_files : bool
-        True when the run did not store them (a file written before issue 57) and they were read from
+        True when the run did not store them (a file written before the limits were stored) and they were read from
         the robot's files on this machine.
     """
 

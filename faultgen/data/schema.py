@@ -12,10 +12,10 @@ One file holds any number of runs. Layout (h5py; every array carries ``units``, 
                                      a program file's or log's program: name, file, sha256, program_text,
                                      a log's format (not the measured one);
                                      wear JSON, noise JSON) and provenance (faultgen_version,
-                                     model_sha256, log_period, config JSON, command; since robots
-                                     of 5-7 axes: n_axes, drivetrain JSON; since issue 57:
-                                     limits JSON, LIMITS; since issue 75, a friction test's
-                                     run: record = "friction_test", RECORD_ATTRIBUTE)
+                                     model_sha256, log_period, config JSON, command;
+                                     n_axes, drivetrain JSON, limits JSON, LIMITS: older
+                                     files lack them; on a friction test's run:
+                                     record = "friction_test", RECORD_ATTRIBUTE)
         t, cycles, q_ref                       time base, recorded cycles, reference
         q_a, q_m, qd_a, qd_m, tau_m            (n_cycles, n_log, N) logged signals, 250 Hz, N the
                                                robot's axes (attr n_axes; 6 in files before it)
@@ -130,7 +130,7 @@ RUN_ATTRIBUTES = ("robot", "task", "friction_model", "cycles", "seed", "worn_axe
                   "faultgen_version", "model_sha256", "log_period", "config", "command")
 
 
-#: The attribute that labels a run's records as friction tests (issue 75): ``record = "friction_test"``
+#: The attribute that labels a run's records as friction tests: ``record = "friction_test"``
 #: (:data:`FRICTION_TEST`) on a run whose program is a friction test (its ``process`` is ``"friction
 #: test"``: ``faultgen tasks friction-test``, :mod:`faultgen.operation.friction_test`); absent on every
 #: other run (production records, as in files written before it). A fleet's tests

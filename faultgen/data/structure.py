@@ -1,4 +1,4 @@
-"""A dataset's runs checked from their metadata alone, before any array is read (issue 50).
+"""A dataset's runs checked from their metadata alone, before any array is read.
 
 A stranger's file can declare an array of (10^10, 6) float64 in a 76 MB file (447 GiB on read),
 store text where numbers belong, put a group where an array belongs, leave a run group without its

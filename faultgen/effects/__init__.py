@@ -54,7 +54,7 @@ from faultgen.effects.motor_friction import FrictionParameter, MotorFriction
 
 # MuJoCo's default log handler appends each warning (a diverging simulation's "Nan, Inf or huge
 # value in QACC") to MUJOCO_LOG.TXT in the current folder, which a refused or failed command then
-# leaves behind (issue 50). faultgen reports the failure itself, naming the run and axis; MuJoCo's
+# leaves behind. faultgen reports the failure itself, naming the run and axis; MuJoCo's
 # console line stays, its file goes. Set here, in the lowest layer, so that every process that
 # builds or steps a model (the command, its sweep workers, a library user's) has it.
 _log = mujoco.MjLogConfig.get()

@@ -1,4 +1,4 @@
-"""A unit's program as cycles (issue 72 item 8): a log may hold one or several back-to-back cycles
+"""A unit's program as cycles: a log may hold one or several back-to-back cycles
 of the program, at any sample rate, and is the same program when each of its cycles traces the
 program's cycle; only a log whose cycles match neither the program nor a whole number of its
 cycles is another program (an unlogged program change, :func:`faultgen.monitor.feed.new_program`).

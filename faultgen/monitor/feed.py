@@ -30,8 +30,8 @@ from faultgen.simulation import backends
 PROGRAM_CHANGE, PROGRAM_LENGTH = cycles.PROGRAM_CHANGE, cycles.PROGRAM_LENGTH
 #: A unit's note (units.csv's reason) when a feature of its learning logs is the same in every log
 #: (:func:`constant_torque`): no PCA model can be fitted on it and no wear can show in it (the
-#: ``ur-rtde`` commanded moment of a fixed program, the same every day: issue 72, item 2). The unit is
-#: not monitored, and the fleet goes on (before, the fit's refusal stopped every unit, exit 2).
+#: ``ur-rtde`` commanded moment of a fixed program, the same every day). The unit is not monitored,
+#: and the fleet goes on.
 CONSTANT_TORQUE = "not monitored: the torque column does not vary from log to log (commanded moment?)"
 
 

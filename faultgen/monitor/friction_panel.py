@@ -1,5 +1,4 @@
-"""The friction tests in a unit's panel of the monitor's page (``OUT/tests.csv``; issue 75 items 3
-and 6): the test days marked on the wear chart, and the friction curve of each alarming axis, the
+"""The friction tests in a unit's panel of the monitor's page (``OUT/tests.csv``): the test days marked on the wear chart, and the friction curve of each alarming axis, the
 first test against the latest.
 
 ``tests.csv`` has one row per unit, friction test and axis read: ``unit, stamp, axis,

@@ -1,5 +1,5 @@
-"""The fleet table of the monitor's page (``OUT/report.html``, :mod:`faultgen.monitor.page`; issue 75
-item 6): one line per unit that a service engineer reads in ten seconds, as the makers' dashboards
+"""The fleet table of the monitor's page (``OUT/report.html``, :mod:`faultgen.monitor.page`): one
+line per unit that a service engineer reads in ten seconds, as the makers' dashboards
 show it, a state light, the "service by" date with its interval, the axis, its wear with its
 interval, the life consumed by load and the last log, the units ordered by that date.
 
@@ -136,7 +136,7 @@ class Light:
 
 def alarm_dates(alarm: dict) -> str:
     """When an alarm (a row of alarms.csv) became known and the log it started from, in words:
-    "known K (from F)"; "from F" for a folder written before ``known`` (issue 72), or when they are
+    "known K (from F)"; "from F" for a folder written without ``known``, or when they are
     the same log."""
     known, first = alarm.get("known") or "", alarm.get("first_alarm") or ""
     return f"known {known} (from {first})" if known and known != first else f"from {first}"
@@ -245,7 +245,7 @@ def wear_cell(unit, axis: int | None) -> str:
         text = f"{wear.estimate:.3g} ({wear.low:.3g} – {wear.high:.3g})"
     else:
         text = f"{wear.estimate:.3g} (≥ {wear.low:.3g})"
-    if wear.scale == "nominal model":  # the twin's fallback, said where the number is (issue 72, item 1)
+    if wear.scale == "nominal model":  # the twin's fallback, said where the number is
         text += ", nominal model"
     return f'<span title="{escaped(SCALES.get(wear.scale, wear.scale))}">{escaped(text)}</span>'
 

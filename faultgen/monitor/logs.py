@@ -45,8 +45,8 @@ def reader_of(adapter=None) -> tuple[Reader, tuple[str, ...]]:
     else the adapter's (:class:`faultgen.data.adapters.Adapter`). Either estimates the accelerations,
     as the measured format's reader does: the one parse of a log serves its features, and, for a
     unit's first log, the calibration and the twin, which need them (read without them, every
-    ``ur-rtde`` unit's calibrated twin failed on "qdd holds a non-finite value" and fell back to the
-    nominal model: issue 72, item 1)."""
+    ``ur-rtde`` unit's calibrated twin fails on "qdd holds a non-finite value" and falls back to the
+    nominal model)."""
     if adapter is None:
         return measured.read, fleetlogs.SUFFIXES
     return adapter.read, adapter.suffixes

@@ -1,4 +1,4 @@
-"""``faultgen monitor``: a fleet's measured logs in, alarms and the worn axis out (issues 46, 60).
+"""``faultgen monitor``: a fleet's measured logs in, alarms and the worn axis out.
 
 For each unit (a folder of ``LOGS``, its logs in stamp order, :mod:`faultgen.monitor.logs`, in
 the measured format or an adapter's):
@@ -369,7 +369,7 @@ def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) 
     """The units whose wear is in the nominal model's scale though the run asked for each unit's own
     model (``own_model``: calibrated on its first log, or given): their twin fell back to the
     nominal model (the reason says why), so their wear is % of the nominal dry friction, not their
-    own (issue 72, item 1: every ``ur-rtde`` unit did, unsaid, while wear.csv said "own")."""
+    own, and wear.csv says so."""
     if settings.protocol != "twin" or not own_model:
         return set()
     return {name for name, unit in state.items() if unit.model == "nominal"}

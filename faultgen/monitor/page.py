@@ -1,5 +1,4 @@
-"""The monitor's fleet report: ``OUT/report.html``, one page a service engineer opens in a browser
-(issues 58 and 75).
+"""The monitor's fleet report: ``OUT/report.html``, one page a service engineer opens in a browser.
 
 The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
 ``scores.csv`` (:mod:`faultgen.monitor.report`), where present ``wear.csv``, ``rul.csv``,
@@ -22,7 +21,7 @@ beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again 
 - the run's settings and the false-alarm statement the command line prints, where its bound is
   below 1 (:func:`false_alarm_statement`);
 - each alarm as a daily run sees it: "known K (from F)", the log it became known on and the one it
-  started from (alarms.csv's ``known`` and ``first_alarm``; issue 72).
+  started from (alarms.csv's ``known`` and ``first_alarm``).
 
 At 400 px wide (a phone) the table's lines become cards, each cell under its column's name: no
 column leaves the screen (tests/test_r6_page.py checks it in headless Chromium).
@@ -75,7 +74,7 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
     over a limit the unworn wear lies below, ``c`` =
     :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), and an alarm needs ``persistence`` in a
     row, or, with the twin, one log whose bound passes the limit by its own width (<= N (1 - Phi(2
-    z_c)) per log). "" where the bound is 1 or more: it says nothing (issue 72)."""
+    z_c)) per log). "" where the bound is 1 or more: it says nothing."""
     per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * (1.0 - scoring.WEAR_ALARM_CONFIDENCE))
     z = NormalDist().inv_cdf(scoring.WEAR_ALARM_CONFIDENCE)
     at_once = 0.0 if protocol == "own" else n_axes * (1.0 - NormalDist().cdf(2 * z))
@@ -197,7 +196,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     """
     folder = Path(folder)
     _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
-    # ``known`` is new (issue 72): a folder written before it is still read
+    # ``known`` is optional: a folder written without it is still read
     required = tuple(c for c in report.ALARM_COLUMNS if c != "known")
     _, alarm_rows = tables.read(folder, "alarms.csv", required, max_bytes)
     columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
@@ -211,7 +210,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     for r in score_rows:
         if r["unit"] in units:
             units[r["unit"]].scores.append(r)
-    if (folder / "rul.csv").exists():  # remaining useful life (an output since issue 59; optional)
+    if (folder / "rul.csv").exists():  # remaining useful life (optional: older folders lack it)
         for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
                            max_bytes)[1]:
             axis = number(r["axis"])
@@ -226,7 +225,7 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
             axis = number(r["axis"])
             if r["unit"] in units and math.isfinite(axis) and axis == int(axis):
                 units[r["unit"]].wear.setdefault(int(axis), []).append(r)
-    if (folder / "tests.csv").exists():  # friction tests (optional, issue 75: absent, no test data)
+    if (folder / "tests.csv").exists():  # friction tests (optional: absent, no test data)
         for r in tables.read(folder, "tests.csv", friction_panel.REQUIRED, max_bytes)[1]:
             if r["unit"] in units:
                 units[r["unit"]].tests.append(r)
@@ -327,7 +326,7 @@ def _chart(name: str, fig: dict) -> str:
 
 
 def _source_notes(row: dict) -> list[str]:
-    """A unit's panel's words on what its numbers rest on (issue 72, items 1-2): the torque its logs
+    """A unit's panel's words on what its numbers rest on: the torque its logs
     were read from (units.csv's ``torque_source``, a warning for the commanded moment) and a twin that
     fell back to the nominal model (``wear_scale`` ``nominal model``)."""
     notes = []

@@ -1,4 +1,4 @@
-"""Remaining useful life per unit and axis (issue 59): the time until an axis's wear estimate
+"""Remaining useful life per unit and axis: the time until an axis's wear estimate
 reaches a failure wear, as a distribution, from a degradation trend fitted on the unit's wear
 estimates (:mod:`faultgen.monitor.scoring`: per log and axis its own estimate ``wearI_log`` %, of the
 axis's own dry friction, less the part of the learned condition slopes' error at the log's
@@ -22,12 +22,12 @@ Per axis:
    uncertainty in the covariance), and the **power-law rise**, flat and then ``c (t - t0)^p``, ``p``
    in [1, 4] (:func:`faultgen.monitor.trends.fit_power`: a rise that accelerates; ``p`` = 1 is the
    changepoint trend). When neither the changepoint trend nor the power law rises: the line and
-   the exponential of the logs from the first alarm on (the rule before 2026-11-26).
+   the exponential of the logs from the first alarm on (also the rule with ``changepoint=False``).
 3. **Every other axis: the line and the exponential** (:func:`faultgen.monitor.trends.fit_models`),
    each by weighted least squares (``scipy``, weights one over each estimate's variance), written
    with the state now: ``w(t) = w0 + b t`` and ``w(t) = w0 + b (exp(k t) - 1) / k`` (Gebraeel et al.
    2005 with an offset; ``k`` >= 0, an accelerating wear; ``k`` -> 0 is the line).
-   **The model average** (issue 75, 2026-11-26): each model's **Akaike weight** (AICc,
+   **The model average**: each model's **Akaike weight** (AICc,
    ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the variances' common
    scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham & Anderson 2002, ch.
    2.9), and each model's parameters drawn in proportion to it (:func:`sample_counts`), so that the
@@ -53,7 +53,7 @@ Per axis:
    ``inverted_cdf``; a draw beyond the horizon later than any), and the probability of failure
    within the horizon (one minus ProgPy's :func:`progpy.metrics.prob_success`). Below one half:
    **no end of life within the horizon**, without a number.
-7. **Not yet predictable** (issue 75; :func:`unpredictable`): the trend cannot yet tell the
+7. **Not yet predictable** (:func:`unpredictable`): the trend cannot yet tell the
    remaining life, and rul.csv says so in ``verdict`` with its cells empty (the draws' median and
    interval in the words), when (a) fewer than :data:`MIN_RISE_LOGS` (5) logs lie after the
    changepoint trend's changepoint, where the models that date a rise carry at least half the
@@ -62,9 +62,8 @@ Per axis:
    :data:`MIN_MODEL_WEIGHT` (0.1) have 5-95 % intervals of their own that do not overlap (the
    models disagree by more than their intervals). A wide interval alone is not "not yet
    predictable": without a friction test the estimate's scale is uncertain by 10 %, and a life
-   that does not know its scale says so by its width (issue 75); a first version that withheld
-   intervals wider than 3 times their median withheld 4 covering, early answers at lambda on the
-   accelerating fleets. Measured on the independent fleets: docs/analysis.md, "A remaining life
+   that does not know its scale says so by its width; withholding intervals wider than 3 times
+   their median would withhold 4 covering, early answers at lambda on the accelerating fleets. Measured on the independent fleets: docs/analysis.md, "A remaining life
    that does not run late".
 
 Why the fit is not ProgPy's own: ProgPy fits a model's parameters to run-to-failure data by
@@ -74,10 +73,9 @@ trend fitted to a short noisy health-indicator series with the uncertainty of it
 regression, so scipy's least squares with its covariance does that part and ProgPy the prediction,
 its uncertainty types and metrics (``benchmarks/monitor_rul.py``).
 
-The wear is in % of the axis's own dry friction (:mod:`faultgen.monitor.scoring`; before issue 59
-part 1 it was in the twin's scale, 0.5-0.7 % per % of true wear on the independent fleet, and the
-remaining life to a 40 % estimate was late against the true wear: docs/analysis.md, "Remaining
-useful life").
+The wear is in % of the axis's own dry friction (:mod:`faultgen.monitor.scoring`): in the twin's
+scale, 0.5-0.7 % per % of true wear on the independent fleet, the remaining life to a 40 % estimate
+runs late against the true wear (docs/analysis.md, "Remaining useful life").
 """
 
 from __future__ import annotations
@@ -124,7 +122,7 @@ class Remaining:
     """One row of ``rul.csv``: ``unit``, ``axis`` (1..N; None when the unit has no wear estimate),
     computed at ``stamp`` (the last log fitted), in ``time_unit`` ("days" or "logs"); ``wear`` the
     axis's wear at the last log, %, as wear.csv gives it (the filtered wear; the trend's wear now for
-    rows without it; issue 72), ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
+    rows without it), ``model`` (the model named, :func:`named_model`), ``rul`` the median time to
     ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
     ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, ``verdict`` in
     words, ``models`` every model's weight in the average, and ``predictable`` False for "not yet
@@ -159,7 +157,7 @@ class Remaining:
 def import_progpy() -> None:
     """Import ProgPy with matplotlib's settings kept: ``progpy.visualize`` sets global rcParams
     (font size 14, line width 3, ...) when imported, which changed every chart drawn after it in
-    the process (the monitor's charts of later units, 2026-11-25)."""
+    the process (the monitor's charts of later units)."""
     import sys
 
     if "progpy" in sys.modules:
@@ -341,7 +339,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
     first alarm of the open alarm, whose ``source_axis`` gets the model average with the changepoint
     trend and the power-law rise over the whole block (module docstring, 2; ``changepoint`` False:
-    the line and the exponential of the logs from the alarm on, the rule before 2026-11-26) and is
+    the line and the exponential of the logs from the alarm on) and is
     fitted from the alarm on when neither rises;
     ``scale_uncertainty`` the relative standard uncertainty of the estimate's scale carried into the
     time of event (module docstring, 4; 0: none): one number for every axis, a mapping axis (1..N)
@@ -368,7 +366,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         return (t - t[-1]) / per, wear, np.maximum(error, 1e-9)
 
     for axis in wanted:
-        fitted, fits, now = block, [], rows[-1].get(f"wear{axis}")  # now: wear.csv's (issue 72), not the trend's
+        fitted, fits, now = block, [], rows[-1].get(f"wear{axis}")  # now: wear.csv's, not the trend's
         if isinstance(now, float) and np.isnan(now):  # faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS
             out.append(Remaining(unit, axis, stamp, time_unit, UNOBSERVED, failure_wear, horizon))
             continue

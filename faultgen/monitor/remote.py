@@ -1,5 +1,5 @@
 """``faultgen monitor --scheduler``: units scored on a Dask cluster whose workers share no file
-system with this process (issue 60, part 6), as sweeps and fleets are (:mod:`faultgen.runs.cluster`).
+system with this process, as sweeps and fleets are (:mod:`faultgen.runs.cluster`).
 
 A task is one group of units (:func:`faultgen.monitor.parallel.groups_of`) with everything its
 scoring reads (:class:`Shipment`): the bytes of the unit's new logs, of its first log and of the log

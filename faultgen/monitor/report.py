@@ -15,7 +15,7 @@ from faultgen.data import cells
 from faultgen.monitor import scoring
 
 #: ``first_alarm``: the first of the alarming logs the alarm started from; ``known``: the log on which it
-#: became known (persistent), as a daily run sees it (issue 72).
+#: became known (persistent), as a daily run sees it.
 ALARM_COLUMNS = ("unit", "first_alarm", "known", "source_axis", "statistic", "limit", "evidence", "closed", "closed_by")
 SCORE_COLUMNS = ("unit", "stamp", "phase", "Q", "Q_limit", "T2", "T2_limit", "alarm", "ranking")
 

@@ -47,7 +47,7 @@ Either way, a unit's alarm is persistent from the first of ``persistence`` conse
 logs (thesis ch. 3.4.1, :func:`analysis.monitoring.detect_onset`), known on the last of them
 (``known`` in alarms.csv: the log on which a daily run sees it); with the twin a log whose lower
 bound passes the limit by its own width alarms at once, and an alarm under way when a repair or
-program change comes is closed by it, not forgotten (issue 72). An axis the program does not excite
+program change comes is closed by it, not forgotten. An axis the program does not excite
 is :data:`NOT_OBSERVABLE` (:data:`NOT_OBSERVABLE_LIMITS`): no wear, and it does not alarm. Each log's axes are ranked: with the twin by how
 closely the residual points along each axis's wear signature
 (:func:`analysis.isolation.signature_scores`), without it by each axis's reconstruction-based
@@ -85,7 +85,7 @@ PROTOCOLS = ("twin", "own")
 #: imported fleet's) moves by the mean |dry friction| over the motion, what the wear is stated in,
 #: whatever the friction's shape: with it the second independent fleet's (a growing Stribeck hump)
 #: median error fell from 4.37 to 3.90 points and the first law's three fleets' from 2.17, 1.90,
-#: 2.89 to 1.92, 1.84, 2.41 (docs/analysis.md, "Wear in the robot's own scale", 2026-11-26).
+#: 2.89 to 1.92, 1.84, 2.41 (docs/analysis.md, "Wear in the robot's own scale").
 FEATURES = ("rms_torque", "average_load_torque", "friction_torque")
 #: The features each axis's wear (its magnitude, wear.csv) is read on; T2, Q and the ranking of the
 #: axes use all :data:`FEATURES`. The friction torque alone: its change per % of an axis's dry
@@ -136,10 +136,10 @@ WEAR_ALARM_CONFIDENCE = 0.90
 #: default 10 %). Why: the filtered wear's error is about half a log's (:class:`WearTrend`), so at that
 #: width the filtered wear's own 90 % interval on an unworn axis spans -+1.5 limits: it cannot tell the
 #: axis unworn from worn past the limit, and its wear, trend and remaining life would be the noise's
-#: (issue 72: a UR5 dispensing program's axis 2, one log's interval 258 points wide, its filtered wear
+#: (a UR5 dispensing program's axis 2: one log's interval 258 points wide, its filtered wear
 #: -36..+11 %). Such an axis gets no wear (empty cells in scores.csv and wear.csv), no remaining life
 #: (rul.csv says why), and does not alarm. The independent KR210 fleet's axes (first law, seed 0) are
-#: 7.8-23.3 points wide (0.8-2.3 limits): a margin of 2.6 below the rule, 4.3 above it to issue 72's.
+#: 7.8-23.3 points wide (0.8-2.3 limits): a margin of 2.6 below the rule, 4.3 above it to the UR5's.
 NOT_OBSERVABLE_LIMITS = 6.0
 #: What an axis that is not observable is called (rul.csv's verdict, units.csv's reason, the page).
 NOT_OBSERVABLE = "not observable on this program"
@@ -162,7 +162,7 @@ class Settings:
     noise) must reach for the log to alarm; ``alpha`` is the significance of the T2
     and Q limits and of each log's own bound (``wearI_log_lower``).
 
-    The default 10 % is the issue's (issue 59); its alarms on two independent fleets are in
+    The default is 10 %; its alarms on two independent fleets are in
     docs/analysis.md, "Wear in the robot's own scale"."""
 
     protocol: str = "twin"
@@ -274,7 +274,7 @@ class UnitMonitor:
         """Close the open alarm by ``by`` (a maintenance event or a program change) at ``stamp``; an
         alarm under way, the wear's lower bound over the limit on the last logs but fewer than
         ``persistence`` of them, is raised as it stands first and closed with it: a unit whose
-        bound crossed the limit before its gearbox change does not end without an alarm (issue 72)."""
+        bound crossed the limit before its gearbox change does not end without an alarm."""
         if self.first_alarm is None and self.run and self.window and self.window[-1][4] is not None:
             self._raise(f"not yet persistent ({min(self.run, len(self.window))} of {self.settings.persistence} "
                         "logs) when it was closed")
@@ -491,7 +491,7 @@ class UnitMonitor:
             seen = self.observable_
             alarm = bool(np.max(np.where(seen, bound, -np.inf)) >= self.settings.wear_limit)
             # the lower bound above the limit by its own width (the filtered wear less two of its
-            # quantiles): alarmed at once, persistence cannot hide it (issue 72)
+            # quantiles): alarmed at once, persistence cannot hide it
             at_once = bool(np.max(np.where(seen, 2 * bound - estimate, -np.inf)) >= self.settings.wear_limit)
             hidden = np.where(seen, 1.0, np.nan)  # an axis not observable has no wear (NOT_OBSERVABLE_LIMITS)
             estimate, bound, low, high = estimate * hidden, bound * hidden, low * hidden, high * hidden

@@ -39,8 +39,8 @@ from faultgen.data import atomic, logfolder
 from faultgen.data.confined import Confined
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
-#: The state files' format: 2 since the monitor's features per axis are three (``friction_torque``,
-#: 2026-11-26); a state of format 1 holds residuals of two and is refused (a new OUT).
+#: The state files' format: 2, three features per axis (with ``friction_torque``); a state of
+#: format 1 holds residuals of two and is refused (a new OUT).
 FORMAT = "faultgen-monitor-state/2"
 CYCLE_FORMAT = "faultgen-twin-cycle/1"
 CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"

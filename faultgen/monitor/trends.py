@@ -297,8 +297,8 @@ def _fit_line_and_exponential(t, wear, error):
 
 def fit_trend(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     """Both models fitted to the wear estimates ``wear`` (%) at times ``t`` (<= 0, the last 0) with
-    standard errors ``error``; the one of smaller AICc by :data:`AICC_MARGIN` (the rule before the
-    model average of 2026-11-26), None when neither fits."""
+    standard errors ``error``; the one of smaller AICc by :data:`AICC_MARGIN` (a choice of one model,
+    not the model average), None when neither fits."""
     fits = list(_fit_line_and_exponential(t, wear, error))
     if not fits:
         return None

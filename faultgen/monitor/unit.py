@@ -31,13 +31,13 @@ SAME_PROGRAM = 1e-3
 CALIBRATION_STEPS = 3
 #: Whether the unit's calibration fits the dry and viscous friction of every moving axis, always
 #: (:func:`faultgen.calibrate.loop.own_friction`), so each axis's wear is read in % of its own
-#: fitted dry friction rather than the nominal one where the search leaves an axis (issue 59, item 1).
-#: On: on the four fleets of docs/analysis.md ("Wear in the robot's own scale", 2026-11-26; with
+#: fitted dry friction rather than the nominal one where the search leaves an axis.
+#: On: on the four fleets of docs/analysis.md ("Wear in the robot's own scale"; with
 #: ``friction_torque`` among the features and the twin's reference at 35 deg C) the second-law
 #: fleet's median error fell from 3.90 to 2.87 points and its coverage rose from 73.9 to 95.9 %, the
 #: first law's three fleets within their criteria (1.98, 1.72, 2.39 points), no healthy unit
-#: alarming. It was off while the twin's reference was 20 deg C: the shipped irb6700 fleet's unit02
-#: (axis 2's dry level fitted 56 % above nominal, viscous at about half) saturated there with its
+#: alarming. With the twin's reference at 20 deg C it must be off: the shipped irb6700 fleet's unit02
+#: (axis 2's dry level fitted 56 % above nominal, viscous at about half) saturates there with its
 #: 35 kg part (:data:`faultgen.monitor.twin.REFERENCE_TEMPERATURE`).
 OWN_FRICTION = True
 

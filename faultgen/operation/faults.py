@@ -27,7 +27,7 @@ the model; it needs the static friction model, as the gear loss does.
 The motor friction and the calibration's effects that change part of it (Coulomb, viscous,
 Stribeck) take no absolute fault: both friction models set the rotors'
 friction from the robot's nominal friction, so such a fault would move only the MJCF numeric and
-change nothing simulated (before issue 37 it was accepted and silently did that); friction wear is
+change nothing simulated; friction wear is
 their fault.
 """
 

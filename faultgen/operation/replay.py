@@ -23,9 +23,9 @@ The reference (:meth:`Replay.trajectory`):
   the log's times. At rest means every axis below :data:`REST_SPEED` and
   :data:`REST_ACCELERATION`; such an end is set exactly at rest.
 
-Before issue 51 a log that did not start at rest got a run-in, a ramp from rest into its first
-state, which shifted the whole log later in the run: the recorded reference was off the log at the
-recorded times by up to 0.8 rad.
+A log that does not start at rest gets no run-in (a ramp from rest into its first state): one
+would shift the whole log later in the run, and the recorded reference would be off the log at
+the recorded times (by up to 0.8 rad).
 
 The log is read by the measured-log reader (:mod:`faultgen.operation.jointlog`: one parser, one
 set of checks, one derivative estimator; the torque columns are not needed), in blocks
@@ -34,7 +34,7 @@ most one row per physics step of the robot is read whole; a denser one is checke
 it streams by and then replayed as every ``k``-th row from the first, at most one row per step
 (what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
 recorded at that rate (the reference passes through its own samples, time 0 is its first).
-A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``; issue 57) is
+A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``) is
 streamed the same way through its adapter's block reader; read whole (at most a row per physics
 step), its columns are replayed by :func:`from_columns` with the same checks and messages.
 

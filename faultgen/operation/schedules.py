@@ -51,7 +51,7 @@ INT_PARAMS = ("step_cycle", "onset")
 
 #: Largest final wear increase accepted, as a fraction (5: Coulomb and static friction six times
 #: their new level). The thesis's failing gearboxes reach tens of percent (ch. 5-6); far beyond,
-#: the motors saturate and the run no longer follows its task (issue 42: +1e9 gave 781 mrad).
+#: the motors saturate and the run no longer follows its task (+1e9 gave a 781 mrad tracking error).
 MAX_INCREASE = 5.0
 
 

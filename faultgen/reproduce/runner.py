@@ -261,7 +261,7 @@ def _run_step(step: Step, folder: Path, record: dict) -> Outcome:
         sink.write(step.command() + (" --overwrite" if replace else "") + "\n")
         sink.flush()
         # -P and PYTHONSAFEPATH: `python -m` puts its current folder, the output folder here, first on
-        # the path, and an h5py.py or typer.py there would be imported (issue 61; faultgen.children)
+        # the path, and an h5py.py or typer.py there would be imported (faultgen.children)
         child = subprocess.Popen(children.command("-m", "faultgen.cli", *args), cwd=folder,
                                  env=children.environment(), stdout=sink, stderr=subprocess.STDOUT)
         _CHILDREN.add(child)

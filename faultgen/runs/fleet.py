@@ -21,7 +21,7 @@ fleet from one seed and gives its runs to :func:`faultgen.runs.sweep.run`, one r
   duty (average speed and load torque, from which ``analysis.features.duty_indicators`` makes the
   speed and torque indicators); no 250 Hz signals are kept.
 
-- with ``friction_test_every`` ``= D`` (issue 75; 0, none, by default) each robot also runs the
+- with ``friction_test_every`` ``= D`` (0, none, by default) each robot also runs the
   friction test of its model (:func:`faultgen.operation.friction_test.program`, as ``faultgen tasks
   friction-test`` writes it) on days 1, 1 + D, 1 + 2 D, ...: one more run per robot,
   ``<run id>-friction-test``, whose recorded cycles are the first cycle of each test day (its wear,

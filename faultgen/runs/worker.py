@@ -85,7 +85,7 @@ def start_worker(sweep_pid: int) -> None:
     The Ctrl-C of a terminal (SIGINT to the group) likewise: raised in a worker it printed a
     traceback into the sweep's message wherever it landed (in h5py's write of a part, "Process
     LokyProcess-2:" while the worker waited for its next run; tests/test_sweep.py failed on 2 of 6
-    tries, 2026-11-26), so a worker ignores it and the sweep stops its workers (loky kills them)."""
+    tries without this), so a worker ignores it and the sweep stops its workers (loky kills them)."""
     if os.getpid() == sweep_pid:
         return
     if os.getppid() != sweep_pid:
@@ -118,7 +118,7 @@ def watch_parent(sweep_pid: int, period: float = 0.5) -> None:
     """End this worker process within ``period`` s once the sweep's process ``sweep_pid`` is gone.
 
     A killed sweep (SIGKILL, or SIGTERM under a process manager) cannot stop its workers, and
-    loky's workers would go on simulating the rest of the grid, then idle for minutes (issue 42).
+    loky's workers would go on simulating the rest of the grid, then idle for minutes.
     The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
     Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
     (another OS); either way the worker ends at once, its unfinished part left as a hidden
