@@ -3,7 +3,7 @@
 true wear at the alarm, axis and wear error; docs/analysis.md, "Independent UR fleets in the RTDE
 layout").
 
-    python benchmarks/monitor_rtde_fleets.py [--fleet ur5|ur10|both] [--units 4] [--days 36] [--work DIR]
+    python benchmarks/monitor_rtde_fleets.py [--fleet ur5|ur10|both] [--units 6] [--days 40] [--work DIR]
 
 What is independent and what is ours:
 
@@ -155,10 +155,12 @@ def write_rtde(path: Path, t, q, tau, temperature, commanded, constants) -> None
 
 def spec(units: int, days: int, seed: int) -> independent.FleetSpec:
     """Half the units wearing (one axis of 1..6 each, from a day in the first third to 45 % on the last),
-    one gearbox change, parts of at most 0.05 kg (the RTDE layout has no payload), 125 Hz logs."""
+    one gearbox change (logged in events.csv), parts of at most 0.05 kg (the RTDE layout has no
+    payload), 125 Hz logs."""
     return independent.FleetSpec(units=units, worn=max(1, units // 2), days=days, seed=seed,
                                  onset=(TRAIN + 2, max(TRAIN + 2, days // 3)), final_wear=45.0,
-                                 wearable=(1, 2, 3, 4, 5, 6), max_part=0.05, rate=125.0)
+                                 wearable=(1, 2, 3, 4, 5, 6), max_part=0.05, rate=125.0,
+                                 gearbox_changes=1 if days >= 36 else 0)
 
 
 def write_fleet(work: Path, name: str, args) -> tuple[Path, Path, Path]:
@@ -185,19 +187,27 @@ def write_fleet(work: Path, name: str, args) -> tuple[Path, Path, Path]:
 
 
 def wear_error(wear_csv: Path, truth: dict) -> dict[str, float]:
-    """Per worn unit, the median absolute error (percentage points) of wear.csv's filtered wear of its worn
-    axis on monitoring logs whose true wear is above 0."""
+    """Per worn unit, the median absolute error (percentage points) of wear.csv's filtered wear
+    (``wear``, one row per log and axis) of its worn axis on monitoring logs whose true wear is above 0."""
     errors: dict[str, list[float]] = {}
     with open(wear_csv, newline="") as f:
         for row in csv.DictReader(f):
             t = truth.get(row["unit"])
-            if not t or not t["axis"] or row.get("phase") != "monitoring":
+            if not t or not t["axis"] or row["phase"] != "monitoring" or row["axis"] != str(t["axis"]):
                 continue
-            value = row.get(f"wear{t['axis']}", "")
             true = float(t["wear"][t["stamps"].index(row["stamp"])])
-            if value and true > 0:
-                errors.setdefault(row["unit"], []).append(abs(float(value) - true))
+            if row["wear"] and true > 0:
+                errors.setdefault(row["unit"], []).append(abs(float(row["wear"]) - true))
     return {unit: float(np.median(e)) for unit, e in errors.items()}
+
+
+def _model(row: dict) -> str:
+    """units.csv's model, with why a twin fell back from the calibrated one (the reason's first clause)."""
+    model, reason = row.get("model", ""), row.get("reason", "")
+    if "failed (" in reason:
+        why = reason.split("failed (", 1)[1].split("; ")[0].removesuffix(")")
+        model += f"; the calibrated twin failed: {why}"
+    return model
 
 
 def table(name: str, out: Path, truth_path: Path) -> list[str]:
@@ -208,22 +218,24 @@ def table(name: str, out: Path, truth_path: Path) -> list[str]:
         units = {row["unit"]: row for row in csv.DictReader(f)}
     errors = wear_error(out / "wear.csv", truth) if (out / "wear.csv").is_file() else {}
     rows = [f"| {name} unit | worn axis | status (model) | alarm known (first) | true wear at known (first), % "
-            "| alarm axis | median wear error, pp |", "|---|---|---|---|---|---|---|"]
+            "| alarm axis | closed by | median wear error, pp |", "|---|---|---|---|---|---|---|---|"]
     for unit, o in outcome.items():
         u = units.get(unit, {})
         known = f"{o['known_wear']:.1f}" if o["known_wear"] is not None else "-"
         first = f"{o['wear']:.1f}" if o["wear"] is not None else "-"
         error = f"{errors[unit]:.1f}" if unit in errors else "-"
-        rows.append(f"| {unit} | {o['axis'] or 'healthy'} | {u.get('status', 'absent')} ({u.get('model', '')}) "
-                    f"| {o['known'] or '-'} ({o['alarm'] or '-'}) | {known} ({first}) | {o['source'] or '-'} | {error} |")
+        closed = (o["alarms"][0].get("closed_by") or "open") if o["alarms"] else "-"
+        rows.append(f"| {unit} | {o['axis'] or 'healthy'} | {u.get('status', 'absent')} ({_model(u)}) "
+                    f"| {o['known'] or '-'} ({o['alarm'] or '-'}) | {known} ({first}) | {o['source'] or '-'} "
+                    f"| {closed} | {error} |")
     return rows
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fleet", choices=("ur5", "ur10", "both"), default="both")
-    parser.add_argument("--units", type=int, default=4)
-    parser.add_argument("--days", type=int, default=36)
+    parser.add_argument("--units", type=int, default=6)
+    parser.add_argument("--days", type=int, default=40)
     parser.add_argument("--seed", type=int, default=3)
     parser.add_argument("--work", type=Path, default=Path("monitor_rtde_work"))
     args = parser.parse_args()
