@@ -205,7 +205,7 @@ def _model(row: dict) -> str:
     """units.csv's model, with why a twin fell back from the calibrated one (the reason's first clause)."""
     model, reason = row.get("model", ""), row.get("reason", "")
     if "failed (" in reason:
-        why = reason.split("failed (", 1)[1].split("; ")[0].removesuffix(")")
+        why = reason.split("failed (", 1)[1].split("); nominal model")[0]
         model += f"; the calibrated twin failed: {why}"
     return model
 
