@@ -1,7 +1,7 @@
 """Two independent UR fleets in the RTDE recorder's layout through ``faultgen monitor --format ur-rtde``
 (issue 72, "What it must show": two independent fleets in RTDE layout, per fleet a table of status,
 true wear at the alarm, axis and wear error; docs/analysis.md, "Independent UR fleets in the RTDE
-layout").
+recorder's layout").
 
     python benchmarks/monitor_rtde_fleets.py [--fleet ur5|ur10|both] [--units 6] [--days 40] [--work DIR]
 
