@@ -88,7 +88,7 @@ def make_out(out: Path, specs=FLEET, tests: bool = True, scales: bool = True) ->
         days = list(range(s.last - s.logs + 1, s.last + 1))
         units.append([s.name, s.status, "twin", "calibrated", "", len(days), day(s.last)] + ([s.scale] if scales else []))
         first = day(days[-3]) if s.alarm else ""
-        alarms.append([s.name, first, s.alarm or "", "wear" if s.alarm else "", 5.0,
+        alarms.append([s.name, first, first, s.alarm or "", "wear" if s.alarm else "", 5.0,
                        f"axis {s.alarm} wear estimate" if s.alarm else f"no persistent alarm in {len(days)} logs", "", ""])
         for k, d in enumerate(days):
             share = (k + 1) / len(days)

@@ -4,7 +4,8 @@ is stated.
 The scenario, small: a UR5 added from the shipped DH table (docs/examples/ur5_dh.toml), three units
 logging one pick and place a day in the RTDE recorder's layout (space-separated, the recorder's
 column names, joint temperatures, the measured ``actual_current_i`` beside the commanded
-``target_moment_i``), one unit whose axis 2 wears until its gearbox is changed (events.csv). The
+``target_moment_i``), one unit whose axis 2 wears until its gearbox is changed (events.csv), one
+healthy unit whose program changes (pick and place to spot weld) on a day nobody logs. The
 logs are faultgen's own simulation (the conditions on: the season's joint temperature, the unit
 spread, encoder noise), the currents the arm torque over test torque constants (``TORQUE_CONSTANTS``:
 the test's, not Universal Robots' numbers), the commanded moment the same array every day (the
@@ -12,8 +13,10 @@ controller's command of a fixed program).
 
 - With the torque constants every unit is on its calibrated twin (on 6e0facf each fell back to the
   nominal model, "qdd holds a non-finite value", exit 0, wear.csv saying "own"), the worn unit
-  alarms on axis 2 with its alarm closed by the gearbox change, the healthy units are quiet, and
-  units.csv, the console and the page say the torque is the measured current.
+  alarms on axis 2 within 10-15 % true wear with its alarm closed by the gearbox change, the healthy
+  units are quiet, the program change is found on its day (and its logs are relearning), the page
+  lists the units by urgency, and units.csv, the console and the page say the torque is the measured
+  current.
 - Without them the fleet finishes: each unit "not monitored" with why, exit status 3 (on 6e0facf:
   "feature 0 is constant in the training data ... drop it", exit 2, no output).
 """
@@ -23,6 +26,7 @@ from __future__ import annotations
 import csv
 import datetime
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +52,8 @@ TRAIN = 10
 UNWORN, WEARING, AFTER, HEALTHY_DAYS = 11, 14, 6, 15
 WORN_AXIS, FINAL_WEAR = 2, 21.0
 START = datetime.date(2026, 4, 1)
+#: The healthy unit ur-03's program changes, unlogged, after this many days (to this task).
+PROGRAM_DAY, OTHER_TASK = 12, "spot_weld"
 #: Columns of the RTDE recorder's default recipe written beside the ones read (other names, as the
 #: recorder writes them; their values are placeholders).
 OTHER_COLUMNS = ("target_q", "target_qd", "target_current", "actual_TCP_pose", "robot_mode", "safety_mode",
@@ -55,10 +61,10 @@ OTHER_COLUMNS = ("target_q", "target_qd", "target_current", "actual_TCP_pose", "
 runner = CliRunner()
 
 
-def _simulate(robot_dir: Path, seed: int, cycles: int, start_day: float, plan):
+def _simulate(robot_dir: Path, seed: int, cycles: int, start_day: float, plan, task: str = "pick_place"):
     held = conditions.Conditions(thermal=conditions.Temperature(), spread=conditions.UnitSpread(),
                                  cycles_per_day=1, start_day=start_day)
-    config = sim.RunConfig(robot=str(robot_dir), task="pick_place", friction="stribeck", wear=plan, cycles=cycles,
+    config = sim.RunConfig(robot=str(robot_dir), task=task, friction="stribeck", wear=plan, cycles=cycles,
                            seed=seed, noise=sensors.NoiseConfig(), nthread=1, conditions=held, signals=True)
     result = sim.simulate(config, progress=False)
     assert result.saturated.size == 0
@@ -88,24 +94,27 @@ def fleet(tmp_path_factory):
     assert result.exit_code == 0, result.output
     robot_dir, logs = root / "ur5", root / "logs"
     gear = robots.load(robot_dir).gear_ratio
-    commanded = None
+    commanded = {}
     parts = {"ur-01": [(UNWORN, wear.WearPlan({})), (WEARING, wear.WearPlan.from_specs(
                  [f"{WORN_AXIS}:linear:{FINAL_WEAR:g}"], last_cycle=WEARING)), (AFTER, wear.WearPlan({}))],
-             "ur-02": [(HEALTHY_DAYS, wear.WearPlan({}))], "ur-03": [(HEALTHY_DAYS, wear.WearPlan({}))]}
+             "ur-02": [(HEALTHY_DAYS, wear.WearPlan({}))],
+             "ur-03": [(PROGRAM_DAY, wear.WearPlan({})), (HEALTHY_DAYS - PROGRAM_DAY, wear.WearPlan({}), OTHER_TASK)]}
     truth, change = {}, None
     for seed, (unit, runs) in enumerate(parts.items(), start=1):
         day = 0
-        for index, (cycles, plan) in enumerate(runs):
-            run = _simulate(robot_dir, seed, cycles, 91.0 + day, plan)
-            if commanded is None:  # the controller's command of the program: the same every day
-                commanded = run.tau_m[0] * gear
+        for index, (cycles, plan, *task) in enumerate(runs):
+            run = _simulate(robot_dir, seed, cycles, 91.0 + day, plan, *task)
+            # the controller's command of the program: the same every day
+            command = commanded.setdefault(tuple(task), run.tau_m[0] * gear)
             for c in range(cycles):
                 stamp = str(START + datetime.timedelta(days=day + c))
                 _write_rtde(logs / unit / f"{stamp}.csv", run.t, run.q_a[c], run.tau_m[c] * gear,
-                            run.conditions.joint_temperature[c], commanded)
+                            run.conditions.joint_temperature[c], command)
                 truth[(unit, stamp)] = 100.0 * (float(run.friction_multiplier[c, WORN_AXIS - 1]) - 1.0)
             if unit == "ur-01" and index == 2:
                 change = str(START + datetime.timedelta(days=day))
+            if task:  # the unlogged program change: in the truth, not in events.csv
+                truth[(unit, "program change")] = str(START + datetime.timedelta(days=day))
             day += cycles
     (logs / "events.csv").write_text(f"unit,stamp,event,axis\nur-01,{change},gearbox_change,{WORN_AXIS}\n")
     return robot_dir, logs, truth
@@ -128,11 +137,18 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
     assert result.exit_code == 0, result.output
     units = {r["unit"]: r for r in _rows(tmp_path / "out" / "units.csv")}
     assert set(units) == {"ur-01", "ur-02", "ur-03"}
+    changed = truth[("ur-03", "program change")]
     for unit, row in units.items():  # no fallback: every twin is the unit's calibrated model
-        assert (row["status"], row["model"]) == ("monitored", "calibrated"), row
+        status = "learning" if unit == "ur-03" else "monitored"  # ur-03 relearning its new program
+        assert (row["status"], row["model"]) == (status, "calibrated"), row
         assert "failed" not in row["reason"] and "wear_scale" not in row
         assert row["torque_source"] == adapters.MEASURED_CURRENT
-        assert f"{unit}: monitored (twin, calibrated model; torque: {adapters.MEASURED_CURRENT})" in result.output
+        assert f"{unit}: {status} (twin, calibrated model; torque: {adapters.MEASURED_CURRENT})" in result.output
+        # the unlogged program change found on its day, and nowhere else
+        assert row["reason"].count("program changed at ") == (unit == "ur-03"), row
+    assert f"program changed at {changed} (not logged" in units["ur-03"]["reason"]
+    phases = {r["stamp"]: r["phase"] for r in _rows(tmp_path / "out" / "scores.csv") if r["unit"] == "ur-03"}
+    assert {p for s, p in phases.items() if s >= changed} == {"relearning"} and phases[min(phases)] == "training"
     alarms = _rows(tmp_path / "out" / "alarms.csv")
     raised = [r for r in alarms if r["first_alarm"]]
     assert [r["unit"] for r in raised] == ["ur-01"]  # the healthy units quiet
@@ -142,6 +158,11 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
     assert 10.0 <= truth[("ur-01", worn["known"])] <= 15.0, (worn, truth)  # when a daily run saw it (item 4)
     html = (tmp_path / "out" / page.PAGE).read_text()
     assert f"<b>Torque</b>: {adapters.MEASURED_CURRENT}." in html and "Twin fallback" not in html
+    # the page's order by urgency: its units by the "service by" date it shows, the soonest first
+    listed = re.findall(r'href="#unit-\d+">([^<]+)</a></td><td data-column="service by \(5-95 %\)">([^<]*)<', html)
+    assert sorted(u for u, _ in listed) == sorted(units), listed
+    dates = [datetime.date.fromisoformat(d.split()[0]) for _, d in listed]
+    assert dates == sorted(dates), listed
 
 
 def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_monitored(fleet, tmp_path):

@@ -17,7 +17,11 @@ axis each names). Read back per test unit (:func:`answers`):
   detector.
 - **axis named**: the source axis of the unit's first persistent alarm (``alarms.csv``); 0 (undecided)
   without one. A test unit monitored as several units (one per program) names the axis of the
-  earliest alarm among them.
+  alarm among them that became known first: ordered by alarms.csv's ``known`` (the log on which a
+  daily run saw the alarm, issue 72), not by ``first_alarm`` (the first log of the persistence
+  window, a date on which nobody could have seen it); ``first_alarm`` only for a folder written
+  before ``known`` existed. The detection itself never reads alarms.csv: it is the per-log alarm
+  above under the scorer's rule, timed on the log that raises it.
 
 The bench layer does not import the monitor (they are sibling layers): it reads these files.
 """
@@ -91,7 +95,7 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
     for uid, monitored in written.records.items():
         n = n_records[uid]
         score, alarm, seen = np.full(n, floor), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-        first = []  # (record of the alarm's first log, axis)
+        first = []  # (record of the log the alarm became known on, axis)
         for name, records in monitored.items():
             stamps = _stamps(written.logs / name)
             if len(stamps) != len(records):
@@ -103,7 +107,8 @@ def answers(out: Path, written: Written, n_records: dict[str, int]) -> tuple[dic
                 score[at[stamp]] = max(float(row[c]) for c in lower)
                 alarm[at[stamp]] = row["alarm"] == "1"
                 seen[at[stamp]] = True
-            first += [(at[r["first_alarm"]], int(r["source_axis"] or 0)) for r in raised.get(name, [])]
+            first += [(at[r.get("known") or r["first_alarm"]], int(r["source_axis"] or 0))
+                      for r in raised.get(name, [])]
         scores[uid], alarms[uid], answered[uid] = score, alarm, seen
         named[uid] = min(first)[1] if first else 0
     return scores, alarms, named, answered

@@ -95,7 +95,8 @@ def monitor_command(
     the twin a log alarms when the lower 90 % bound of the largest filtered wear reaches
     --wear-limit %; without it (--protocol own) when T2
     or Q is over its limit. A unit alarms from the first of --persistence consecutive alarming
-    logs; its source axis is the one with the largest wear estimate (own: the largest
+    logs, or at once on one log far past (the twin: the bound past the limit by its own width;
+    own: T2 or Q past its limit at alpha^persistence); its source axis is the one with the largest wear estimate (own: the largest
     reconstruction-based contribution to Q, Alcala and Qin 2009).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (its calibrated model,

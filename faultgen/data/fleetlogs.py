@@ -97,6 +97,10 @@ class ImportSummary:
         Logs read now per torque source, where the log format says which torque it read
         (:func:`faultgen.data.adapters.torque_source`: measured current x torque constant, or the
         commanded moment, which cannot show wear).
+    friction_tests : int
+        Friction tests found in the units' ``friction-test`` folders
+        (:func:`faultgen.data.logfolder.scan_tests`): not imported (they are no daily logs; ``faultgen
+        monitor`` reads them), said in the summary.
     written : bool
         False when nothing was new (the dataset was left as it was).
     """
@@ -112,6 +116,7 @@ class ImportSummary:
     labels: dict = field(default_factory=dict)
     written: bool = True
     torque: dict = field(default_factory=dict)
+    friction_tests: int = 0
 
     def __str__(self) -> str:
         records = len(self.imported) + self.kept
@@ -126,6 +131,9 @@ class ImportSummary:
                          f"{self.labels.get('unknown', 0)} unknown (events.csv; logs without an event are unknown)")
         for source, count in sorted(self.torque.items()):
             lines.append(f"  torque:        {source} ({count} log(s) read now)")
+        if self.friction_tests:
+            lines.append(f"  friction tests: {self.friction_tests} found (LOGS/<unit>/{logfolder.TESTS}/): not imported; "
+                         "`faultgen monitor` reads them")
         if self.skipped:
             lines.append(f"  skipped:       {len(self.skipped)} bad file(s):")
             lines += [f"    {name}: {reason}" for name, reason in self.skipped]
@@ -373,6 +381,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     events, events_sha = _events(logs_dir, units, robot)
     previous = _Previous(out, robot)
     summary = ImportSummary(out=out, robot=robot.name, skipped=list(not_logs))
+    summary.friction_tests = sum(map(len, logfolder.scan_tests(logs_dir, units, suffixes)[0].values()))
     plan = previous.plan(units, summary, reimport_changed)
     new = [entry for entries in plan.values() for entry in entries if entry[2] is not None]
     if previous.files and not new and events_sha == previous.events_sha256:

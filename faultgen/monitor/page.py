@@ -73,11 +73,12 @@ def false_alarm_statement(protocol: str, alpha: float, persistence: int, train: 
     twin (T2 or Q) and <= N (1 - c) with it (any of the ``n_axes`` axes' lower one-sided ``c`` bounds
     over a limit the unworn wear lies below, ``c`` =
     :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), and an alarm needs ``persistence`` in a
-    row, or, with the twin, one log whose bound passes the limit by its own width (<= N (1 - Phi(2
-    z_c)) per log). "" where the bound is 1 or more: it says nothing."""
+    row, or one log far past: with the twin one whose bound passes the limit by its own width (<= N
+    (1 - Phi(2 z_c)) per log), without it one whose T2 or Q passes its limit at ``alpha ** persistence``
+    (<= 2 alpha^persistence per log). "" where the bound is 1 or more: it says nothing."""
     per_log = 2 * alpha if protocol == "own" else min(1.0, n_axes * (1.0 - scoring.WEAR_ALARM_CONFIDENCE))
     z = NormalDist().inv_cdf(scoring.WEAR_ALARM_CONFIDENCE)
-    at_once = 0.0 if protocol == "own" else n_axes * (1.0 - NormalDist().cdf(2 * z))
+    at_once = 2 * alpha**persistence if protocol == "own" else n_axes * (1.0 - NormalDist().cdf(2 * z))
     chance = logs_scored * (per_log**persistence + at_once)
     if chance >= 1.0:
         return ""

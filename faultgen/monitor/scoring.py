@@ -46,7 +46,9 @@ says how much wear, so a slow wear is called at a level and not when it first le
 Either way, a unit's alarm is persistent from the first of ``persistence`` consecutive alarming
 logs (thesis ch. 3.4.1, :func:`analysis.monitoring.detect_onset`), known on the last of them
 (``known`` in alarms.csv: the log on which a daily run sees it); with the twin a log whose lower
-bound passes the limit by its own width alarms at once, and an alarm under way when a repair or
+bound passes the limit by its own width alarms at once (without it, a log whose T2 or Q passes its
+limit at ``alpha ** persistence``: as unlikely in normal operation as ``persistence`` independent logs
+in a row past the ``alpha`` limits), and an alarm under way when a repair or
 program change comes is closed by it, not forgotten. An axis the program does not excite
 is :data:`NOT_OBSERVABLE` (:data:`NOT_OBSERVABLE_LIMITS`): no wear, and it does not alarm. Each log's axes are ranked: with the twin by how
 closely the residual points along each axis's wear signature
@@ -147,6 +149,9 @@ NOT_OBSERVABLE = "not observable on this program"
 
 #: Largest ``wear_limit`` taken, % (a friction ten times its nominal is no longer wear to monitor).
 MAX_WEAR_LIMIT = 1000.0
+#: The smallest significance of --protocol own's at-once limits (``alpha ** persistence``; the limits are
+#: quantiles at ``1 - alpha``, which a double tells from 1 to about 1e-16): below it, no at-once rule.
+FAR_ALPHA = 1e-12
 #: The fewest logs a unit is learned from (``train``), and the most logs ``train`` and ``persistence``
 #: may name (years of a log an hour: beyond any fleet's record).
 MIN_TRAIN, MAX_LOGS = 10, 100_000
@@ -197,7 +202,7 @@ class UnitMonitor:
         self.training: list[tuple[str, np.ndarray, float]] = []
         self.pca: PCAMonitor | None = None
         self.window: deque = deque(maxlen=settings.persistence)
-        self.run = 0
+        self.run, self.far_ = 0, None
         self.first_alarm: str | None = None
         #: The stamp of the log on which the open alarm became known (persistent), as a daily run sees it.
         self.known: str | None = None
@@ -304,6 +309,10 @@ class UnitMonitor:
         Z = R / self.scale_
         # the registry's monitor model (analysis.registry: the one detect and training-source build)
         self.pca = registry.make("pca_monitor", variance=self.settings.variance, alpha=self.settings.alpha, cv=5)[1].fit(Z)
+        far = self.settings.alpha**self.settings.persistence  # --protocol own's at-once limits (T2, Q); none
+        far = None if self.signatures is not None or far < FAR_ALPHA else registry.make(  # past FAR_ALPHA
+            "pca_monitor", variance=self.settings.variance, alpha=far, cv=5)[1].fit(Z)
+        self.far_ = None if far is None else (far.t2_limit_, far.q_limit_)
         self.training = []
         self.trend = WearTrend(self.n_axes, X.shape[1])
         if self.signatures is not None:
@@ -510,8 +519,10 @@ class UnitMonitor:
             self.window.append((stamp, z, t2, q, wear))
             if self.first_alarm is None and self.run >= self.settings.persistence:
                 self._raise()
-            elif self.first_alarm is None and alarm and at_once:
-                self._raise("at once: its lower bound above the limit by more than its own width")
+            elif self.first_alarm is None and alarm and (at_once or (self.far_ is not None and (
+                    t2 > self.far_[0] or q > self.far_[1]))):
+                self._raise("at once: " + ("its lower bound above the limit by more than its own width" if at_once else
+                                           f"T2 or Q past its limit at alpha^{self.settings.persistence}"))
         self.rows.append({"unit": self.unit, "stamp": stamp, "phase": phase, "Q": q, "Q_limit": self.pca.q_limit_,
                           "T2": t2, "T2_limit": self.pca.t2_limit_, "alarm": int(alarm),
                           "ranking": " ".join(str(a) for a in ranking),

@@ -4,8 +4,8 @@ panel first opens.
 
 With the twin, each axis's wear at each scored log with its 90 % interval (wear.csv's ``wear_5``,
 ``wear_95``; without wear.csv the lower one-sided 90 % bound of scores.csv) and the wear limit,
-above T2 and Q over their limits; the learning logs shaded, each relearning after maintenance
-shaded and named, the open alarm and every closed one marked, and the friction-test days
+above T2 and Q over their limits; the learning logs shaded, each relearning after maintenance or
+after an unlogged program change (units.csv's reason names its stamp) shaded and named as which, the open alarm and every closed one marked, and the friction-test days
 (:func:`faultgen.monitor.friction_panel.markers`: dotted lines, each axis's test wear a diamond with
 its interval). The wear axis names the scale (units.csv's and wear.csv's ``wear_scale``).
 """
@@ -127,8 +127,9 @@ def figure(unit, settings: dict) -> dict:
 
     for first, last in _spans(phases, "training"):
         band(first, last, "#bbbbbb", "learning")
-    for first, last in _spans(phases, "relearning"):
-        band(first, last, "#f5c27a", "maintenance: offset learned again")
+    for first, last in _spans(phases, "relearning"):  # after a program change (units.csv's reason says so) or maintenance
+        changed = f"program changed at {rows[first]['stamp']} " in (unit.row or {}).get("reason", "")
+        band(first, last, "#f5c27a", "program change: learned again" if changed else "maintenance: offset learned again")
     raw: dict[str, int] = {}  # a stamp's first row: one look-up per alarm (a list's index was rows x alarms)
     for k, r in enumerate(rows):
         raw.setdefault(r["stamp"], k)
