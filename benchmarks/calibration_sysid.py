@@ -30,7 +30,7 @@ import independent_set  # tests/independent_set.py
 
 from faultgen.calibrate import MAX_ROWS, calibrate, decimate
 from faultgen.calibrate.refit import refit
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 DEFAULT = ["puma560-03-payload", "puma560-06-coulomb_per_direction", "puma560-09-load_gravity",

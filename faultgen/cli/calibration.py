@@ -219,7 +219,7 @@ def friction_test_command(
       faultgen friction-test log.csv --robot puma560 -o friction-again --reference friction
     """
     from faultgen.calibrate import friction_report
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
 
     check_output_folder(out, overwrite)

@@ -47,7 +47,8 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen import __version__
-from faultgen.data import adapters, logfolder, measured, schema, writer
+from faultgen.data import logfolder, schema, writer
+from faultgen.logs import formats, measured
 from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
@@ -59,15 +60,15 @@ from faultgen.simulation import sensors
 WORN_MARK = 2.0
 #: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
 MEASURED = schema.MEASURED
-#: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
+#: Suffixes of the logs the measured-format reader takes (:func:`faultgen.logs.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
 #: Why a log listed in the folder was not imported when it vanished before it was read (skipped, named).
 VANISHED = "removed from the folder while it was imported"
 #: The group of the manifest in an imported dataset.
 MANIFEST = "import"
 
-#: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.data.measured.read`, or an
-#: adapter's, :mod:`faultgen.data.adapters`).
+#: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.logs.measured.read`, or an
+#: adapter's, :mod:`faultgen.logs.formats`).
 Reader = Callable[[Path, robots.Robot], measured.MeasuredData]
 
 
@@ -95,7 +96,7 @@ class ImportSummary:
         Logs with a worn axis, logs all healthy, the others (unknown), over the whole dataset.
     torque : dict
         Logs read now per torque source, where the log format says which torque it read
-        (:func:`faultgen.data.adapters.torque_source`: measured current x torque constant, or the
+        (:func:`faultgen.logs.formats.torque_source`: measured current x torque constant, or the
         commanded moment, which cannot show wear).
     written : bool
         False when nothing was new (the dataset was left as it was).
@@ -167,7 +168,7 @@ def read_once(read: Reader, path: Path, robot: robots.Robot) -> tuple[measured.M
     Raises
     ------
     ValueError
-        The reader's refusal (:class:`faultgen.data.measured.MeasuredDataError`, an adapter's), or
+        The reader's refusal (:class:`faultgen.logs.measured.MeasuredDataError`, an adapter's), or
         :class:`faultgen.inputs.InputError` for a path that is not a regular file.
     """
     import tempfile
@@ -197,7 +198,7 @@ def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np
     Parameters
     ----------
     data : MeasuredData
-        The log, checked (:func:`faultgen.data.measured.read`).
+        The log, checked (:func:`faultgen.logs.measured.read`).
     robot : Robot
         Its robot: gear ratio (arm-side torque -> motor torque), joint range, peak motor torque.
     speed_limit : ndarray of shape (N,)
@@ -340,8 +341,8 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     reimport_changed : bool
         Import again a file whose content changed since it was imported; without it, refused.
     reader : callable, optional
-        ``(path, robot) -> MeasuredData`` of one log; default :func:`faultgen.data.measured.read`
-        (an adapter's: :func:`faultgen.data.adapters.reader`).
+        ``(path, robot) -> MeasuredData`` of one log; default :func:`faultgen.logs.measured.read`
+        (an adapter's: :func:`faultgen.logs.formats.reader`).
     suffixes : tuple of str
         The file endings of logs (lower case), the reader's.
     command : str
@@ -355,7 +356,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     ------
     ValueError
         For a bad folder layout or events file (:mod:`faultgen.data.logfolder`), a bad log without
-        ``skip_bad`` (its file and row named: :class:`faultgen.data.measured.MeasuredDataError`), a
+        ``skip_bad`` (its file and row named: :class:`faultgen.logs.measured.MeasuredDataError`), a
         file changed since its import without ``reimport_changed``, an ``out`` that is not an import
         of this robot, or no log to import at all. Nothing is written.
     OSError
@@ -465,7 +466,7 @@ def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) 
         rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,
                      "key": key, "period": data.sample_period})
         summary.imported.append(name)
-        source = adapters.torque_source(data.notes)
+        source = formats.torque_source(data.notes)
         if source:
             summary.torque[source] = summary.torque.get(source, 0) + 1
         bar.update()

@@ -2,12 +2,12 @@
 
 Each adapter maps a foreign file's columns onto the measured format's (``t``, ``q1..qN``,
 ``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
-:func:`faultgen.data.measured.from_columns`, which checks them as it checks a measured log (the
-same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTERS`), chosen with
+:func:`faultgen.logs.measured.from_columns`, which checks them as it checks a measured log (the
+same refusals, by data row). Registered by name (:func:`register`, :data:`FORMATS`), chosen with
 ``--format NAME`` (``logs import``, ``calibrate``, ``monitor``, ``simulate --task LOG``);
-docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`Adapter.columns`)
-or in blocks of rows (:meth:`Adapter.blocks`, :meth:`Adapter.source`: a log too long to read whole,
-calibrated by :mod:`faultgen.data.longlog` or replayed streamed by
+docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`LogFormat.columns`)
+or in blocks of rows (:meth:`LogFormat.blocks`, :meth:`LogFormat.source`: a log too long to read whole,
+calibrated by :mod:`faultgen.logs.longlog` or replayed streamed by
 :mod:`faultgen.operation.replay`) with the same checks and messages; :data:`MEASURED` is the
 measured format's own readers as an adapter (docs/architecture.md, "Log formats").
 
@@ -35,12 +35,12 @@ import numpy as np
 import pandas as pd
 
 from faultgen import inputs
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
-from faultgen.operation import jointlog, logblocks
+from faultgen.logs import blocks, jointlog
 
 #: name -> adapter class.
-ADAPTERS: dict[str, type[Adapter]] = {}
+FORMATS: dict[str, type[LogFormat]] = {}
 #: Largest foreign log read, bytes on disk.
 MAX_BYTES = 4 * 2**30
 #: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
@@ -56,7 +56,7 @@ MEASURED_CURRENT, COMMANDED_MOMENT = "measured current x torque constant", "comm
 
 
 def torque_source(notes) -> str:
-    """The torque source a log's reader noted (:attr:`faultgen.data.measured.MeasuredData.notes`,
+    """The torque source a log's reader noted (:attr:`faultgen.logs.measured.MeasuredData.notes`,
     the ``ur-rtde`` adapter's "torque from ..." note) as :data:`MEASURED_CURRENT` or
     :data:`COMMANDED_MOMENT`; "" when no note names one (the measured format: the logged arm torque)."""
     for note in notes:
@@ -73,20 +73,20 @@ PEEK_ROWS = 16
 
 
 def register(name: str):
-    """Class decorator: register an :class:`Adapter` under ``name`` (its ``--format``)."""
+    """Class decorator: register an :class:`LogFormat` under ``name`` (its ``--format``)."""
     def decorate(cls):
         cls.name = name
-        ADAPTERS[name] = cls
+        FORMATS[name] = cls
         return cls
     return decorate
 
 
 @dataclass(frozen=True)
-class Adapter:
+class LogFormat:
     """Base of a log format: ``suffixes`` (lower case) of the files it reads, and its two readers
     with the same checks and messages: whole (:meth:`columns`, :meth:`read`) and in blocks of rows
     (:meth:`blocks`, :meth:`source`) for a log too long to read whole (the calibration's
-    :mod:`faultgen.data.longlog`, the replay's streaming, :mod:`faultgen.operation.logblocks`).
+    :mod:`faultgen.logs.longlog`, the replay's streaming, :mod:`faultgen.logs.blocks`).
 
     A column-mapping format defines :meth:`convert` alone (one block of the file, its cells as
     floats, mapped onto the measured format's names and units) and :attr:`separator`: the base
@@ -118,7 +118,7 @@ class Adapter:
         raise NotImplementedError
 
     def _maps(self) -> bool:
-        return type(self).convert is not Adapter.convert
+        return type(self).convert is not LogFormat.convert
 
     def frames(self, path: Path | inputs.Held, size: int | None) -> Iterator[tuple[int, pd.DataFrame]]:
         """The delimited-text file ``path`` (:attr:`separator`, a header row; plain or gzip) as
@@ -127,7 +127,7 @@ class Adapter:
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
+        faultgen.logs.measured.MeasuredDataError
             Not a regular file, unreadable as such text, a column named twice in the header, a
             cell that is not a finite number (the data row, column and value named).
         """
@@ -157,7 +157,7 @@ class Adapter:
         """``(columns, label)`` or ``(columns, label, notes)``: the file's columns under the
         measured format's names (dict of ndarray of shape (n,)), the data-row labeller of messages,
         and what the reading chose (which torque source, say), kept in
-        :attr:`faultgen.data.measured.MeasuredData.notes`. The base: :meth:`convert` of the
+        :attr:`faultgen.logs.measured.MeasuredData.notes`. The base: :meth:`convert` of the
         whole file (:meth:`frames`)."""
         if not self._maps():
             raise NotImplementedError(f"log format {self.name}: define convert() or columns()")
@@ -176,7 +176,7 @@ class Adapter:
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
+        faultgen.logs.measured.MeasuredDataError
             What :meth:`columns` refuses, with the same message.
         """
         if self._maps():
@@ -201,20 +201,20 @@ class Adapter:
 
     def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
         """The log ``path`` as blocks of the measured format's columns (:class:`Blocks`: the block
-        source :mod:`faultgen.operation.logblocks` reads), ``motion_only`` as there (``t`` and
+        source :mod:`faultgen.logs.blocks` reads), ``motion_only`` as there (``t`` and
         ``q1..qN``: a replay)."""
         return Blocks(self, Path(path), robot, motion_only)
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
-        """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
-        as :func:`faultgen.data.measured.read`); ``path`` may be held (:attr:`reads_held`)."""
+        """Read and check one log (:func:`faultgen.logs.measured.from_columns`; ``accelerations``
+        as :func:`faultgen.logs.measured.read`); ``path`` may be held (:attr:`reads_held`)."""
         given = path if self.reads_held and isinstance(path, inputs.Held) else inputs.path_of(path)
         columns, label, *notes = self.columns(given, robot)
         return measured.from_columns(columns, robot, inputs.path_of(path), label, accelerations,
                                      notes=notes[0] if notes else ())
 
 
-def make(name: str, **options) -> Adapter:
+def make(name: str, **options) -> LogFormat:
     """The adapter ``name`` with its options.
 
     Raises
@@ -222,10 +222,10 @@ def make(name: str, **options) -> Adapter:
     ValueError
         For an unknown name (the message lists the known ones) or a bad option.
     """
-    if name not in ADAPTERS:
+    if name not in FORMATS:
         raise ValueError(f"unknown log format {name!r}; expected measured (the default) or one of "
-                         f"{', '.join(ADAPTERS)}")
-    cls = ADAPTERS[name]
+                         f"{', '.join(FORMATS)}")
+    cls = FORMATS[name]
     known = [f.name for f in dataclasses.fields(cls) if f.name != "suffixes"]
     unknown = [key for key in options if key not in known]
     if unknown:
@@ -235,21 +235,21 @@ def make(name: str, **options) -> Adapter:
 
 
 class Blocks:
-    """A log read through its format's :meth:`Adapter.blocks` as the block source
-    :mod:`faultgen.operation.logblocks` reads: ``path``, ``wanted`` (the measured format's columns
-    read, in the order of a block's columns: :func:`faultgen.operation.jointlog.select_columns`),
+    """A log read through its format's :meth:`LogFormat.blocks` as the block source
+    :mod:`faultgen.logs.blocks` reads: ``path``, ``wanted`` (the measured format's columns
+    read, in the order of a block's columns: :func:`faultgen.logs.jointlog.select_columns`),
     ``extra`` (none: the adapter chose its columns), ``notes`` (what the reading chose), ``rows``
-    (an upper bound of the data rows, :meth:`Adapter.rows`), ``label`` and :meth:`blocks`. Its first
+    (an upper bound of the data rows, :meth:`LogFormat.rows`), ``label`` and :meth:`blocks`. Its first
     :data:`PEEK_ROWS` rows are read here, to learn the columns.
 
     Raises
     ------
-    faultgen.data.measured.MeasuredDataError
-        A missing column (as :func:`faultgen.data.measured.from_columns` names it), a log of more
-        rows than :data:`faultgen.operation.jointlog.MAX_ROWS`, or what the adapter refuses.
+    faultgen.logs.measured.MeasuredDataError
+        A missing column (as :func:`faultgen.logs.measured.from_columns` names it), a log of more
+        rows than :data:`faultgen.logs.jointlog.MAX_ROWS`, or what the adapter refuses.
     """
 
-    def __init__(self, adapter: Adapter, path: Path, robot: robots.Robot, motion_only: bool = False):
+    def __init__(self, adapter: LogFormat, path: Path, robot: robots.Robot, motion_only: bool = False):
         self.adapter, self.path, self.robot, self.extra = adapter, path, robot, []
         peek = iter(adapter.blocks(path, robot, PEEK_ROWS))
         try:
@@ -270,7 +270,7 @@ class Blocks:
     def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
         """``(start, block)``: the index of the block's first data row and its ``wanted`` columns
         (ndarray of shape (size, len(wanted)), floats; the last block shorter), every cell refused
-        unless finite, as :func:`faultgen.data.measured.from_columns` refuses it."""
+        unless finite, as :func:`faultgen.logs.measured.from_columns` refuses it."""
         start, held, count = 0, [], 0  # held: rows read, not yet yielded (``count`` of them)
         for columns, *_ in self.adapter.blocks(self.path, self.robot, size):
             values = {name: np.asarray(columns[name], dtype=float) for name in self.wanted}
@@ -291,10 +291,10 @@ class Blocks:
 
 
 @dataclass(frozen=True)
-class Measured(Adapter):
-    """The measured format (:mod:`faultgen.data.measured`; ``--format measured``, the default) as an
-    adapter: read whole by :func:`faultgen.data.measured.read`, in blocks by its own block reader
-    (:func:`faultgen.operation.logblocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
+class Measured(LogFormat):
+    """The measured format (:mod:`faultgen.logs.measured`; ``--format measured``, the default) as an
+    adapter: read whole by :func:`faultgen.logs.measured.read`, in blocks by its own block reader
+    (:func:`faultgen.logs.blocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
 
     name = "measured"
     reads_held = True
@@ -308,7 +308,7 @@ class Measured(Adapter):
         return measured.read(path, robot, accelerations)
 
     def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
-        return logblocks.source(Path(path), robot.n_axes, motion_only)
+        return blocks.source(Path(path), robot.n_axes, motion_only)
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         src = self.source(path, robot)
@@ -317,7 +317,7 @@ class Measured(Adapter):
             yield {name: block[:, j] for j, name in enumerate(src.wanted)}, src.label, notes
 
 
-#: The measured format, the default (not in :data:`ADAPTERS`: ``--format measured`` gives no adapter).
+#: The measured format, the default (not in :data:`FORMATS`: ``--format measured`` gives no adapter).
 MEASURED = Measured()
 
 
@@ -363,7 +363,7 @@ def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[
 
 @register("ur-rtde")
 @dataclass(frozen=True)
-class URRTDE(Adapter):
+class URRTDE(LogFormat):
     """Universal Robots' RTDE recorder CSV (module docstring).
 
     Parameters
@@ -497,7 +497,7 @@ def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separato
 @contextmanager
 def _named(path: Path | inputs.Held) -> Iterator[None]:
     """Turn pyarrow's errors reading the Parquet file ``path`` (a truncated or corrupt file) into a
-    :class:`~faultgen.data.measured.MeasuredDataError` that names it."""
+    :class:`~faultgen.logs.measured.MeasuredDataError` that names it."""
     import pyarrow as pa
 
     try:
@@ -509,7 +509,7 @@ def _named(path: Path | inputs.Held) -> Iterator[None]:
 
 @register("voraus")
 @dataclass(frozen=True)
-class Voraus(Adapter):
+class Voraus(LogFormat):
     """The voraus-AD dataset's Parquet layout (module docstring)."""
 
     reads_held = True
@@ -522,7 +522,7 @@ class Voraus(Adapter):
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
+        faultgen.logs.measured.MeasuredDataError
             Naming the file: not a regular file of at most :data:`MAX_BYTES`, or not a Parquet file
             pyarrow reads (truncated: no footer; another format).
         """
@@ -537,7 +537,7 @@ class Voraus(Adapter):
     def _plan(cls, path: Path | inputs.Held, robot: robots.Robot) -> tuple:
         """The file (:meth:`_parquet`), its columns read (refused when missing) and its rows, checked
         from the metadata before any is read against the bound of a log read whole
-        (:func:`faultgen.operation.jointlog.check_whole_rows`; a few MB of constant columns may hold
+        (:func:`faultgen.logs.jointlog.check_whole_rows`; a few MB of constant columns may hold
         10^8 rows, and pyarrow decodes a row group whole even when it is read in batches): every
         path that reads a voraus log (``logs import``, the monitor, ``calibrate``) goes through here."""
         parquet = cls._parquet(path)

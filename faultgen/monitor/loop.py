@@ -44,7 +44,8 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.data import adapters, atomic, fleetlogs, logfolder
+from faultgen.data import atomic, fleetlogs, logfolder
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
@@ -88,7 +89,7 @@ class UnitStatus:
     reason: str
     logs_scored: int
     last_log: str
-    #: The torque its logs were read from, where the log format says (:func:`faultgen.data.adapters.torque_source`:
+    #: The torque its logs were read from, where the log format says (:func:`faultgen.logs.formats.torque_source`:
     #: measured current x torque constant, or the commanded moment, which cannot show wear); "" otherwise.
     torque_source: str = ""
     #: The fallbacks its twin took (:func:`faultgen.monitor.unit.twin_of`'s notes, also in ``reason``).
@@ -146,7 +147,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         The twin also predicts the temperature's effect (the model's own temperature law) instead
         of the unit's learned slope alone.
     progress : bool
-    log_format : faultgen.data.adapters.Adapter, optional
+    log_format : faultgen.logs.formats.LogFormat, optional
         The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
     context : ExecutionContext
         Where and on what the units are scored (:class:`faultgen.runs.context.ExecutionContext`;
@@ -406,7 +407,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         status = "learning" if learning else "monitored"
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
-                      "; ".join(reasons), len(unit.entries), last, adapters.torque_source(unit.notes),
+                      "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
                       "; ".join(fallback_notes(unit)))
 
 

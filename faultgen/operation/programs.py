@@ -106,7 +106,7 @@ def is_file_task(task: str | LogTask) -> bool:
 
 def log_task(task: str, adapter=None) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
-    :class:`faultgen.data.adapters.Adapter`): a :class:`LogTask`; ``task`` itself when ``adapter``
+    :class:`faultgen.logs.formats.LogFormat`): a :class:`LogTask`; ``task`` itself when ``adapter``
     is None (the measured format, or no log). ValueError when ``adapter`` is given with a thesis
     task or a program file (a format reads a joint log)."""
     if adapter is None:
