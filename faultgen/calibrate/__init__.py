@@ -48,7 +48,7 @@ from faultgen.calibrate.plausibility import ImplausibleLogError
 from faultgen.calibrate.prediction import predict
 from faultgen.calibrate.result import Calibration, Step, parameters
 from faultgen.data import atomic
-from faultgen.logs import longlog
+from faultgen.logs import formats, longlog
 from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
@@ -64,7 +64,7 @@ MAX_ROWS = 25_000
 
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-              log_format=None, friction_every_axis: bool = False, figure: bool = True,
+              log_format: formats.LogFormat = formats.MEASURED, friction_every_axis: bool = False, figure: bool = True,
               delay: str | float | None = None, effects: list[str] | None = None) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
@@ -75,8 +75,8 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`faultgen.calibrate.loop.run`).
     ``robot``: the nominal model, a :class:`~faultgen.model.robot.Robot` or a name, robot folder or MJCF
     file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError).
-    ``log_format``: the log's format when not the measured one (a
-    :class:`faultgen.logs.formats.LogFormat`, ``--format NAME``): read through it, whole or, longer
+    ``log_format``: the log's format (a :class:`faultgen.logs.formats.LogFormat`, ``--format NAME``;
+    default the measured one): read through it, whole or, longer
     than :data:`MAX_ROWS`, in blocks (:func:`faultgen.logs.longlog.read`).
     ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
     after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).

@@ -169,8 +169,8 @@ def conditions_from_options(temperature: bool, payloads: str | None, pattern: st
 
 
 def log_adapter(log_format: str, torque_constants: str | None, robot):
-    """The :class:`faultgen.logs.formats.LogFormat` of ``--format`` (None for the measured format)
-    with ``--torque-constants`` parsed and checked against the axes of ``robot``, the command's
+    """The :class:`faultgen.logs.formats.LogFormat` of ``--format`` (from the registry,
+    :data:`faultgen.logs.formats.FORMATS`; ``measured`` its default entry) with ``--torque-constants`` parsed and checked against the axes of ``robot``, the command's
     resolved :class:`~faultgen.model.robot.Robot` (None when no torque constants are given).
 
     Raises
@@ -184,8 +184,6 @@ def log_adapter(log_format: str, torque_constants: str | None, robot):
     if torque_constants is not None and log_format != "ur-rtde":
         raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
                          f"--format {log_format}")
-    if log_format == "measured":
-        return None
     options = {}
     if torque_constants is not None:
         try:

@@ -70,6 +70,9 @@ MANIFEST = "import"
 #: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.logs.measured.read`, or an
 #: adapter's, :mod:`faultgen.logs.formats`).
 Reader = Callable[[Path, robots.Robot], measured.MeasuredData]
+#: The measured format's reader (:data:`faultgen.logs.formats.MEASURED`), without the accelerations
+#: the import's features do not use.
+MEASURED_READER = functools.partial(formats.MEASURED.read, accelerations=False)
 
 
 @dataclass
@@ -318,7 +321,7 @@ class _Previous:
 
 
 def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, progress: bool = True,
-                reimport_changed: bool = False, reader: Reader | None = None, suffixes: tuple[str, ...] = SUFFIXES,
+                reimport_changed: bool = False, reader: Reader = MEASURED_READER, suffixes: tuple[str, ...] = SUFFIXES,
                 command: str = "") -> ImportSummary:
     """Import a fleet's folder of logs into a faultgen dataset (module docstring), atomically.
 
@@ -341,8 +344,9 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     reimport_changed : bool
         Import again a file whose content changed since it was imported; without it, refused.
     reader : callable, optional
-        ``(path, robot) -> MeasuredData`` of one log; default :func:`faultgen.logs.measured.read`
-        (an adapter's: :func:`faultgen.logs.formats.reader`).
+        ``(path, robot) -> MeasuredData`` of one log; default the measured format's
+        (:data:`MEASURED_READER`; another format's: its :meth:`~faultgen.logs.formats.LogFormat.read`
+        without accelerations).
     suffixes : tuple of str
         The file endings of logs (lower case), the reader's.
     command : str
@@ -365,7 +369,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     logs_dir, out = Path(logs_dir), Path(out)
     check_apart(out, logs_dir)  # a dataset inside LOGS would be read back as a file of the folder
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
-    read = reader or functools.partial(measured.read, accelerations=False)
+    read = reader
     speed_limit = programs.robot_limits(robot)[0]
     units, not_logs = logfolder.scan(logs_dir, suffixes)
     if not_logs and not skip_bad:

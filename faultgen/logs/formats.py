@@ -25,7 +25,6 @@ measured format's own readers as an adapter (docs/architecture.md, "Log formats"
 from __future__ import annotations
 
 import dataclasses
-from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -35,14 +34,14 @@ import numpy as np
 import pandas as pd
 
 from faultgen import inputs
-from faultgen.logs import measured
+from faultgen.logs import blocks, delimited, jointlog, measured
 from faultgen.model import robots
-from faultgen.logs import blocks, jointlog
 
-#: name -> adapter class.
+#: name -> log format class, in the order registered: :data:`DEFAULT` first, then ``ur-rtde``,
+#: ``voraus`` and a user's (:func:`register`).
 FORMATS: dict[str, type[LogFormat]] = {}
-#: Largest foreign log read, bytes on disk.
-MAX_BYTES = 4 * 2**30
+#: The format a log is read in when none is named (``--format measured``): :mod:`faultgen.logs.measured`.
+DEFAULT = "measured"
 #: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
 #: about 10: the motor's 0.1 times the gear ratio 101).
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
@@ -132,11 +131,11 @@ class LogFormat:
             cell that is not a finite number (the data row, column and value named).
         """
         what = f"{self.name} log"
-        names, _ = _header(path, what, self.separator, what)
+        names, _ = delimited.header(path, what, self.separator, what)
         if size is None:
             jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
         start = 0
-        for values in _text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
+        for values in delimited.text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
             frame = pd.DataFrame(values, columns=names)
             yield start, frame
             start += len(frame)
@@ -189,6 +188,16 @@ class LogFormat:
         for start in range(0, n, size):
             yield {k: np.asarray(v)[start:start + size] for k, v in columns.items()}, label, tuple(*notes)
 
+    def motion(self, path: Path, robot: robots.Robot) -> tuple:
+        """``(columns, label)`` of the whole log as a replay reads it: ``t`` and ``q1..qN`` used
+        (:func:`faultgen.operation.replay.from_columns`). The base: :meth:`columns`."""
+        return self.columns(path, robot)[:2]
+
+    @property
+    def key(self) -> str:
+        """The format with its options as a cache or a monitor's state records it (its ``repr``)."""
+        return repr(self)
+
     def rows(self, path: Path) -> int:
         """An upper bound of the log's data rows, found before they are parsed. The base: the lines
         of the delimited-text file but its header (:func:`faultgen.inputs.count_lines`)."""
@@ -223,8 +232,8 @@ def make(name: str, **options) -> LogFormat:
         For an unknown name (the message lists the known ones) or a bad option.
     """
     if name not in FORMATS:
-        raise ValueError(f"unknown log format {name!r}; expected measured (the default) or one of "
-                         f"{', '.join(FORMATS)}")
+        raise ValueError(f"unknown log format {name!r}; expected {DEFAULT} (the default) or one of "
+                         f"{', '.join(n for n in FORMATS if n != DEFAULT)}")
     cls = FORMATS[name]
     known = [f.name for f in dataclasses.fields(cls) if f.name != "suffixes"]
     unknown = [key for key in options if key not in known]
@@ -290,6 +299,7 @@ class Blocks:
             yield start, np.concatenate(held)
 
 
+@register(DEFAULT)
 @dataclass(frozen=True)
 class Measured(LogFormat):
     """The measured format (:mod:`faultgen.logs.measured`; ``--format measured``, the default) as an
@@ -304,6 +314,14 @@ class Measured(LogFormat):
         columns, extra, label = jointlog.read_columns(path, robot.n_axes)
         return columns, label, tuple([f"ignored extra columns: {', '.join(extra)}"] if extra else [])
 
+    def motion(self, path: Path, robot: robots.Robot) -> tuple:
+        columns, _, label = jointlog.read_columns(path, robot.n_axes, motion_only=True)  # no torque needed
+        return columns, label
+
+    @property
+    def key(self) -> str:
+        return DEFAULT
+
     def read(self, path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         return measured.read(path, robot, accelerations)
 
@@ -317,48 +335,11 @@ class Measured(LogFormat):
             yield {name: block[:, j] for j, name in enumerate(src.wanted)}, src.label, notes
 
 
-#: The measured format, the default (not in :data:`FORMATS`: ``--format measured`` gives no adapter).
-MEASURED = Measured()
+#: The measured format, the default entry of :data:`FORMATS`.
+MEASURED = FORMATS[DEFAULT]()
 
 
-def _header(path: Path | inputs.Held, what: str, separator: str | None, as_what: str) -> tuple[list[str], str]:
-    """The names in the header of the delimited-text log ``path`` and its separator (``None``:
-    found), the file a regular one (bounded: :data:`MAX_BYTES`, :func:`faultgen.inputs.csv_header`);
-    refused unreadable (as ``as_what``) or with a name twice."""
-    inputs.regular_file(path, what, MAX_BYTES)
-    try:
-        names, separator = inputs.csv_header(path, what, separator=separator)
-    except inputs.InputError as err:
-        raise jointlog.LogBoundError(str(err)) from None
-    except (OSError, UnicodeDecodeError, EOFError) as err:
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: {err}") from err
-    twice = sorted(name for name, count in Counter(names).items() if count > 1)
-    if twice:
-        raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
-                                         "header")
-    return names, separator
 
-
-def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
-    missing = [c for c in wanted if c not in names]
-    if missing:
-        raise measured.MeasuredDataError(f"{path}: missing column(s) {', '.join(missing)} of the {what} layout; found "
-                                         f"{', '.join(names[:40]) or '(none)'}")
-
-
-def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[str, np.ndarray]:
-    """The ``wanted`` columns as floats, refused at the first cell that is not a finite number."""
-    out = {}
-    for name in wanted:
-        values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raw = frame[name].iloc[bad[0]]
-            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else repr(raw)  # inf, not np.float64(inf)
-            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value {shown}; expected "
-                                             "a finite number")
-        out[name] = values
-    return out
 
 
 @register("ur-rtde")
@@ -395,7 +376,7 @@ class URRTDE(LogFormat):
         ``wanted`` (its columns read), ``map`` (measured name -> (its column, factor)) and ``note``
         (the torque source), or refused (a missing column, a name twice)."""
         n_axes = robot.n_axes
-        names, separator = _header(path, "RTDE log", None, "CSV")
+        names, separator = delimited.header(path, "RTDE log", None, "CSV")
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
@@ -419,7 +400,7 @@ class URRTDE(LogFormat):
                 f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
         with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
         wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
-        _require(path, names, wanted, "RTDE recorder")
+        delimited.require(path, names, wanted, "RTDE recorder")
         q_names, qd_names, tau_names = measured.column_names(n_axes)
         mapping = {measured.T_COLUMN: ("timestamp", None)}
         mapping.update({q_names[k]: (q[k], None) for k in axes})
@@ -432,7 +413,7 @@ class URRTDE(LogFormat):
 
     @staticmethod
     def _chunks(path, plan: dict, size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
-        return _text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
+        return delimited.text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
                             plan["wanted"], URRTDE.label, size)
 
     @staticmethod
@@ -455,43 +436,6 @@ class URRTDE(LogFormat):
         for values in self._chunks(path, plan, size):
             yield self._mapped(plan, values), self.label, (plan["note"],)
 
-
-def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separator: str, wanted: list[str], label,
-                 size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
-    """The ``wanted`` columns of a delimited-text log (a header row of ``names``) parsed as numbers,
-    ``size`` rows at a time (default: rows bounded by all the columns, as every column of a row is
-    tokenized, kept or not; only the wanted converted and kept: memory in proportion to the
-    numbers, where reading every cell as text took 7 times the file), refused at the first cell
-    that is not a finite number, found from the text (:func:`_numbers`: the data row, column and
-    value named), or when the text is not such a table (named ``as_what``)."""
-    kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
-    try:
-        with inputs.open_text(path, what, MAX_BYTES) as fh:
-            for frame in pd.read_csv(fh, dtype=float, **kw):
-                values = {name: frame[name].to_numpy(dtype=float) for name in wanted}
-                if not all(bool(np.isfinite(column).all()) for column in values.values()):
-                    break
-                yield values
-            else:
-                return
-    except inputs.InputError:
-        raise
-    except (ValueError, TypeError):  # a cell that is not a number: found from the text below
-        pass
-    start = 0
-    kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
-    try:
-        with inputs.open_text(path, what, MAX_BYTES) as fh:
-            for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
-                _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
-                start += len(frame)
-    except (inputs.InputError, measured.MeasuredDataError):
-        raise
-    except (ValueError, OSError, EOFError) as err:  # pandas's ParserError (an unbalanced quote) is a ValueError
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: "
-                                         f"{' '.join(str(err).split())}") from None
-    raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
 
 
 @contextmanager
@@ -523,13 +467,13 @@ class Voraus(LogFormat):
         Raises
         ------
         faultgen.logs.measured.MeasuredDataError
-            Naming the file: not a regular file of at most :data:`MAX_BYTES`, or not a Parquet file
+            Naming the file: not a regular file of at most :data:`faultgen.logs.delimited.MAX_BYTES`, or not a Parquet file
             pyarrow reads (truncated: no footer; another format).
         """
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
+        inputs.regular_file(path, "voraus-AD log", delimited.MAX_BYTES)
         with _named(path):
             return pq.ParquetFile(pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path)
 
@@ -546,7 +490,7 @@ class Voraus(LogFormat):
         velocity = [f"joint_velocity_{k}" for k in axes]
         wanted = ["time", *(f"joint_position_{k}" for k in axes), *(f"motor_torque_{k}" for k in axes),
                   *(velocity if all(c in names for c in velocity) else [])]
-        _require(path, names, wanted, "voraus-AD")
+        delimited.require(path, names, wanted, "voraus-AD")
         wanted += ["sample"] if "sample" in names else []
         rows = parquet.metadata.num_rows
         jointlog.check_whole_rows(inputs.path_of(path), rows, len(wanted), what="a voraus-AD log")
@@ -569,7 +513,7 @@ class Voraus(LogFormat):
         parquet, wanted, _ = self._plan(path, robot)
         with _named(path):
             frame = parquet.read(columns=wanted).to_pandas()
-        return self._mapped(_numbers(path, frame, wanted, self.label), robot), self.label
+        return self._mapped(delimited.numbers(path, frame, wanted, self.label), robot), self.label
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         parquet, wanted, _ = self._plan(path, robot)
@@ -577,7 +521,7 @@ class Voraus(LogFormat):
         with _named(path):
             batches = parquet.iter_batches(batch_size=size, columns=wanted)
             for batch in batches:
-                values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
+                values = delimited.numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
                 yield self._mapped(values, robot), self.label, ()
                 start += batch.num_rows
 

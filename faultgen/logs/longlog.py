@@ -63,9 +63,9 @@ def motion(qd: np.ndarray, rest_speed: float) -> Motion:
 
 
 def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
-         adapter: formats.LogFormat | None = None) -> tuple[measured.MeasuredData, Motion]:
-    """The log ``path`` in the measured format (:func:`faultgen.logs.measured.read`'s format and
-    checks) or, with ``adapter``, in that format, averaged down to at most ``rows`` rows when
+         adapter: formats.LogFormat = formats.MEASURED) -> tuple[measured.MeasuredData, Motion]:
+    """The log ``path`` in its format ``adapter`` (default the measured format:
+    :func:`faultgen.logs.measured.read`'s format and checks), averaged down to at most ``rows`` rows when
     longer (read in blocks of :data:`BLOCK_ROWS` rows: :meth:`faultgen.logs.formats.LogFormat.source`),
     and its :class:`Motion` at the full rate.
 
@@ -81,7 +81,7 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
         :meth:`~faultgen.logs.formats.LogFormat.read`), naming the file, the column and the data row.
     """
     path = Path(path)
-    fmt = formats.MEASURED if adapter is None else adapter
+    fmt = adapter
     src = fmt.source(path, robot)
     if src.rows <= rows:
         data = fmt.read(path, robot)

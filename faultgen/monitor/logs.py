@@ -20,12 +20,11 @@ import numpy as np
 
 from faultgen import inputs
 from faultgen.data import fleetlogs, logfolder
-from faultgen.logs import measured
+from faultgen.logs import formats, jointlog, measured
 from faultgen.model.robots import Robot
 from faultgen.monitor import scoring
 from faultgen.monitor import state as stored
 from faultgen.operation import programs
-from faultgen.logs import jointlog
 
 #: The features the monitor watches per axis (:data:`faultgen.monitor.scoring.FEATURES`, which says why).
 FEATURES = scoring.FEATURES
@@ -42,15 +41,13 @@ Log = logfolder.LogFile
 Reader = Callable[[Path, Robot], measured.MeasuredData]
 
 
-def reader_of(adapter=None) -> tuple[Reader, tuple[str, ...]]:
-    """The reader and the file suffixes of a log format: the measured format's without ``adapter``,
-    else the adapter's (:class:`faultgen.logs.formats.LogFormat`). Either estimates the accelerations,
+def reader_of(adapter: formats.LogFormat = formats.MEASURED) -> tuple[Reader, tuple[str, ...]]:
+    """The reader and the file suffixes of the log format ``adapter`` (a
+    :class:`faultgen.logs.formats.LogFormat`, the measured one by default). It estimates the accelerations,
     as the measured format's reader does: the one parse of a log serves its features, and, for a
     unit's first log, the calibration and the twin, which need them (read without them, every
     ``ur-rtde`` unit's calibrated twin failed on "qdd holds a non-finite value" and fell back to the
     nominal model: issue 72, item 1)."""
-    if adapter is None:
-        return measured.read, fleetlogs.SUFFIXES
     return adapter.read, adapter.suffixes
 
 
@@ -187,7 +184,7 @@ def parse(path: Path, robot: Robot, reader: Reader = measured.read, held: bool =
 
 class Source:
     """The logs of one ``faultgen monitor`` run, each read once (:func:`parse`) by the format's
-    reader (``log_format`` an adapter, the measured format when None; held unless the adapter reads
+    reader (``log_format``, a :class:`faultgen.logs.formats.LogFormat`; held unless it reads
     only paths: :attr:`faultgen.logs.formats.LogFormat.reads_held`) and kept until :meth:`done` (a
     program, :meth:`keep`, for the run), so a unit's first log serves its program, calibration,
     twin and score from one read. It holds the parsed first log of each unit not yet scored, and
@@ -197,11 +194,12 @@ class Source:
     None without one, or the ValueError its loading raised (each unit then falls back, saying why:
     :func:`faultgen.monitor.unit.twin_of`)."""
 
-    def __init__(self, robot: Robot, log_format=None, given: Robot | ValueError | None = None):
+    def __init__(self, robot: Robot, log_format: formats.LogFormat = formats.MEASURED,
+                 given: Robot | ValueError | None = None):
         self.robot = robot
         self.given = given
         self.reader, _ = reader_of(log_format)
-        self.held = log_format is None or bool(getattr(log_format, "reads_held", False))
+        self.held = bool(log_format.reads_held)
         self._parsed: dict[Path, Parsed] = {}
         self._kept: set[Path] = set()
 

@@ -119,7 +119,7 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None, context: ExecutionContext = LOCAL,
+            progress: bool = True, log_format: formats.LogFormat = formats.MEASURED, context: ExecutionContext = LOCAL,
             failure_wear: float = prognosis.FAILURE_WEAR,
             hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
@@ -148,7 +148,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         of the unit's learned slope alone.
     progress : bool
     log_format : faultgen.logs.formats.LogFormat, optional
-        The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
+        The logs' layout (``ur-rtde``, ``voraus``); the measured format by default.
     context : ExecutionContext
         Where and on what the units are scored (:class:`faultgen.runs.context.ExecutionContext`;
         default: this process, ``BatchStepper()``): ``jobs`` local processes scoring units in
@@ -211,7 +211,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
     key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
-                                 "measured" if log_format is None else repr(log_format))
+                                 log_format.key)
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)

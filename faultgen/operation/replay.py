@@ -58,7 +58,7 @@ from ruckig import ControlInterface, DurationDiscretization, InputParameter, Res
 from scipy.interpolate import CubicSpline
 
 from faultgen.model.robots import Robot
-from faultgen.logs import blocks, jointlog
+from faultgen.logs import blocks, formats, jointlog
 from faultgen.logs.jointlog import MAX_GAP, LogError
 from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath
 
@@ -208,12 +208,12 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
 
 
 def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
-         check_torque: Callable, adapter=None) -> Replay:
-    """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
-    (:mod:`faultgen.logs.jointlog`, no torque columns) or, with ``adapter``, by that log
-    format's readers, streamed (:mod:`faultgen.logs.blocks`) through the format's block
-    source either way; a log of at most a row per physics step then read whole (an adapter's by
-    its ``columns``, checked by :func:`from_columns`).
+         check_torque: Callable, adapter: formats.LogFormat = formats.MEASURED) -> Replay:
+    """Read a joint log to replay on ``robot`` (module docstring) by the readers of its format
+    ``adapter`` (the measured format's by default: :mod:`faultgen.logs.jointlog`, no torque
+    columns), streamed (:mod:`faultgen.logs.blocks`) through the format's block source; a log of
+    at most a row per physics step then read whole (the format's :meth:`~faultgen.logs.formats.LogFormat.motion`,
+    checked by :func:`from_columns`).
 
     Parameters
     ----------
@@ -229,9 +229,9 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         ``check_torque(robot, path, segment_at, fail)`` refusing a reference above the drives'
         capacity: :func:`faultgen.operation.programs.check_torque`.
     adapter : faultgen.logs.formats.LogFormat, optional
-        The log's format other than the measured one: ``source(path, robot, motion_only=True)``
+        The log's format (default :data:`faultgen.logs.formats.MEASURED`): ``source(path, robot, motion_only=True)``
         gives its blocks of the measured format's columns (``t``, ``q1..qN`` used; the block source
-        of :mod:`faultgen.logs.blocks`), ``columns(path, robot)`` the whole file's, which
+        of :mod:`faultgen.logs.blocks`), ``motion(path, robot)`` the whole file's, which
         :func:`from_columns` checks.
 
     Raises
@@ -240,29 +240,25 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         A ValueError naming the file and the row or column: a missing file or column, a non-finite
         value, time that does not increase, a log that is too short, has a gap or runs longer than
         :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
-        With ``adapter``, what its reader refuses too (a ValueError naming the file).
+        What the format's reader refuses too (a ValueError naming the file).
     """
     path = Path(path)
     n_axes = robot.n_axes
-    src = (blocks.source(path, n_axes, motion_only=True) if adapter is None
-           else adapter.source(path, robot, motion_only=True))
+    src = adapter.source(path, robot, motion_only=True)
     times = blocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
     scan = blocks.scan(src, robot, times, BLOCK_ROWS)
     rows = times.rows
     most = _most_rows(times, robot)  # a row per physics step
-    if rows <= most and adapter is not None:  # read whole by the format's reader, as the calibration reads it
-        columns, label = adapter.columns(path, robot)[:2]
+    if rows <= most:  # read whole by the format's reader, as the calibration reads it
+        columns, label = adapter.motion(path, robot)
         return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
-    if rows <= most:  # read whole, as the calibration reads a log
-        columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
-    else:  # denser than the physics step: every k-th row kept while read, once every row is checked
-        times.check(MIN_DURATION, 1 / MAX_GAP)
-        q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
-        jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
-        k = -(-rows // most)
-        columns, label = blocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
-    suffixes = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if adapter is None else adapter.suffixes
-    return _replay(columns, label, path, robot, limits, check_torque, suffixes)
+    # denser than the physics step: every k-th row kept while read, once every row is checked
+    times.check(MIN_DURATION, 1 / MAX_GAP)
+    q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
+    jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
+    k = -(-rows // most)
+    columns, label = blocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
+    return _replay(columns, label, path, robot, limits, check_torque, adapter.suffixes)
 
 
 def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], path: str | Path, robot: Robot,
