@@ -13,9 +13,11 @@ measured format's own readers as an adapter (docs/architecture.md, "Log formats"
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
   ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
-  ``joint_temperatures_0..5`` (deg C, all or none), and the joint torque: with ``torque_constants``
-  given (N m/A at the joint, one per axis), the measured ``actual_current_0..5`` (A) times them;
-  without, the commanded ``target_moment_0..5`` (N m). Which one was taken is the log's note.
+  ``joint_temperatures_0..5`` (deg C, all or none), and the joint torque, the first of: the
+  measured current as torque by the controller's own constants, ``actual_current_as_torque_0..5``
+  (N m; RTDE output of e-Series controllers from PolyScope 5.23); with ``torque_constants`` given
+  (N m/A at the joint, one per axis), the measured ``actual_current_0..5`` (A) times them; the
+  commanded ``target_moment_0..5`` (N m). Which one was taken is the log's note.
 - ``voraus``: the voraus-AD dataset's Parquet layout (Brockmann et al. 2023, CC BY-NC-SA 4.0: never
   shipped with faultgen; read from your copy): ``time`` (s), ``joint_position_1..6`` (rad),
   ``joint_velocity_1..6`` (rad/s) and ``motor_torque_1..6`` (N m at the motor, referred to the
@@ -50,15 +52,20 @@ MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
 #: A log's torque source in words (issue 72, item 2): the import's summary, units.csv's
 #: ``torque_source`` and the monitor's page say it (:func:`torque_source`). The commanded moment of a
 #: fixed program is the controller's model of the motion, the same every day whatever the joint's
-#: friction: it cannot show wear.
+#: friction: it cannot show wear. RTDE's ``actual_current_as_torque`` (PolyScope >= 5.23) is the
+#: measured current turned into torque by the controller's own constants.
 MEASURED_CURRENT, COMMANDED_MOMENT = "measured current x torque constant", "commanded moment (cannot show wear)"
+CURRENT_AS_TORQUE = "current as torque (controller's own constants)"
 
 
 def torque_source(notes) -> str:
     """The torque source a log's reader noted (:attr:`faultgen.logs.measured.MeasuredData.notes`,
-    the ``ur-rtde`` adapter's "torque from ..." note) as :data:`MEASURED_CURRENT` or
-    :data:`COMMANDED_MOMENT`; "" when no note names one (the measured format: the logged arm torque)."""
+    the ``ur-rtde`` format's "torque from ..." note) as :data:`CURRENT_AS_TORQUE`,
+    :data:`MEASURED_CURRENT` or :data:`COMMANDED_MOMENT`; "" when no note names one (the measured
+    format: the logged arm torque)."""
     for note in notes:
+        if note.startswith("torque from actual_current_as_torque"):
+            return CURRENT_AS_TORQUE
         if note.startswith("torque from actual_current"):
             return MEASURED_CURRENT
         if note.startswith("torque from target_moment"):
@@ -351,7 +358,8 @@ class URRTDE(LogFormat):
     ----------
     torque_constants : tuple of float, optional
         N m/A at the joint, per axis: read the torque as ``actual_current_i`` times them when the
-        file has no ``target_moment`` columns.
+        file has no ``actual_current_as_torque`` columns (the controller's own conversion,
+        preferred: :meth:`_torque`).
     """
 
     reads_held = True
@@ -380,24 +388,8 @@ class URRTDE(LogFormat):
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
-        moment = [f"target_moment_{k}" for k in axes]
-        current = [f"actual_current_{k}" for k in axes]
         temperature = [f"joint_temperatures_{k}" for k in axes]
-        if self.torque_constants is not None and all(c in names for c in current):
-            if len(self.torque_constants) != n_axes:
-                raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
-            torque, scale = current, [float(k) for k in self.torque_constants]
-            source = "torque from actual_current_i x the torque constants given (measured)"
-        elif all(c in names for c in moment):
-            torque, scale = moment, [1.0] * n_axes
-            source = ("torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
-                      "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
-                      "the UR arms' constants: docs/dataset.md, \"Adapters\")"
-                      + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
-        else:
-            raise measured.MeasuredDataError(
-                f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
-                f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
+        torque, scale, source = self._torque(path, names, n_axes)
         with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
         wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
         delimited.require(path, names, wanted, "RTDE recorder")
@@ -410,6 +402,36 @@ class URRTDE(LogFormat):
         if with_temperature:
             mapping.update({name: (temperature[k], None) for k, name in enumerate(jointlog.temperature_columns(n_axes))})
         return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
+
+    def _torque(self, path: Path | inputs.Held, names: list[str], n_axes: int) -> tuple[list, list, str]:
+        """The joint torque's columns in the RTDE log's header ``names``, their factors and the
+        note naming the source, the first the file has of: ``actual_current_as_torque_i`` (N m, the
+        measured current as torque by the controller's own constants: RTDE output of e-Series
+        controllers from PolyScope 5.23); ``actual_current_i`` (A) times :attr:`torque_constants`
+        when given; ``target_moment_i`` (N m, commanded). Refused with none of them."""
+        axes = range(n_axes)
+        as_torque = [f"actual_current_as_torque_{k}" for k in axes]
+        current = [f"actual_current_{k}" for k in axes]
+        moment = [f"target_moment_{k}" for k in axes]
+        if all(c in names for c in as_torque):
+            unused = "; the torque constants given are not used" if self.torque_constants is not None else ""
+            return as_torque, [1.0] * n_axes, ("torque from actual_current_as_torque_i (the measured current as "
+                                               f"torque by the controller's own constants){unused}")
+        if self.torque_constants is not None and all(c in names for c in current):
+            if len(self.torque_constants) != n_axes:
+                raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
+            return current, [float(k) for k in self.torque_constants], \
+                "torque from actual_current_i x the torque constants given (measured)"
+        if all(c in names for c in moment):
+            return moment, [1.0] * n_axes, (
+                "torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
+                "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
+                "the UR arms' constants: docs/dataset.md, \"Adapters\")"
+                + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
+        raise measured.MeasuredDataError(
+            f"{inputs.path_of(path)}: no joint torque: expected actual_current_as_torque_0..{n_axes - 1} (N m), "
+            f"target_moment_0..{n_axes - 1} (N m), or actual_current_0..{n_axes - 1} (A) with the torque "
+            "constants given (--torque-constants)")
 
     @staticmethod
     def _chunks(path, plan: dict, size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
