@@ -27,7 +27,8 @@ import numpy as np
 
 from faultgen import children
 from faultgen.calibrate import MAX_ROWS, predict, synth
-from faultgen.data import measured
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 
 ROWS, PERIOD = 1_000_000, 0.004
@@ -47,7 +48,7 @@ def make_log(path: Path, rows: int) -> None:
     tau += np.random.default_rng(0).normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     coulomb = 0.5 * (puma.friction.coulomb_pos[1] + puma.friction.coulomb_neg[1])
     tau[:, 1] += 0.3 * coulomb * puma.gear_ratio[1] * np.sign(qd[:rows, 1])
-    measured.write_csv(path, t, q, tau)
+    logfiles.write_csv(path, t, q, tau)
 
 
 def calibrate(log: Path, out: Path) -> dict:

@@ -40,7 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_set  # tests/independent_set.py: the toolbox's logs
 
 from faultgen.calibrate import calibrate
-from faultgen.data import measured
+from faultgen.data import logfiles
 
 #: The expected first term's form per outside kind.
 FORMS = {"ripple": "arm_periodic", "delay": "channel_delay", "gain": "gain", "drag": "speed_squared",
@@ -145,7 +145,7 @@ def make(case: Case, folder: Path) -> tuple[Path, dict]:
     if not case.velocities:
         frame = frame.drop(columns=[f"qd{k}" for k in range(1, 7)])
     path = folder / f"{case.name}.csv"
-    measured.write_csv(path, frame["t"].to_numpy(), frame[[f"q{k}" for k in range(1, 7)]].to_numpy(),
+    logfiles.write_csv(path, frame["t"].to_numpy(), frame[[f"q{k}" for k in range(1, 7)]].to_numpy(),
                        frame[taus].to_numpy(), qd=frame[[f"qd{k}" for k in range(1, 7)]].to_numpy()
                        if case.velocities else None)
     return path, truth

@@ -26,7 +26,7 @@ import roboticstoolbox as rtb
 from joblib import Parallel, delayed
 
 from faultgen.calibrate import EFFECTS, ImplausibleLogError, plausibility, predict, search, synth
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 
 

@@ -33,7 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_set  # tests/independent_set.py: the set has one definition, shared with the tests
 
 from faultgen.calibrate import calibrate, predict, synth
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 
 GOAL = 60.0

@@ -31,7 +31,7 @@ from benchmarks_common import chosen_cases, table_options  # sibling module
 
 from faultgen.calibrate import MAX_ROWS, calibrate, decimate
 from faultgen.calibrate.refit import refit
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 DEFAULT = ["puma560-03-payload", "puma560-06-coulomb_per_direction", "puma560-09-load_gravity",

@@ -22,7 +22,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import friction_test_log  # noqa: E402
 from faultgen.calibrate import friction_report  # noqa: E402
-from faultgen.data import measured  # noqa: E402
+from faultgen.logs import measured  # noqa: E402
 from faultgen.model import robots  # noqa: E402
 
 

@@ -76,7 +76,7 @@ def make_log(folder: Path, rows: int) -> Path:
     if path.exists():
         return path
     from faultgen.calibrate import predict, synth
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
 
     puma = robots.load("puma560")

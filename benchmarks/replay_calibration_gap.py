@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.calibrate import search
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim

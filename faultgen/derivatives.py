@@ -1,11 +1,11 @@
 """Velocity and acceleration of sampled joint angles by a Savitzky-Golay filter: one estimator for
-the calibration's measured logs (:mod:`faultgen.data.measured`) and for replayed logs
+the calibration's measured logs (:mod:`faultgen.logs.measured`) and for replayed logs
 (:mod:`faultgen.operation.replay`), so both see a log's motion alike.
 
 A cubic (:data:`SAVGOL_ORDER`) least-squares fit over a window of :data:`SAVGOL_WINDOW` = 0.05 s
 (:func:`scipy.signal.savgol_filter`, ``mode="interp"``); when the sample period varies by more than
 :data:`UNIFORM_TOLERANCE`, the signal is first put on a uniform grid at the median period with a
-cubic spline and the derivatives interpolated back (docs in :mod:`faultgen.data.measured`).
+cubic spline and the derivatives interpolated back (docs in :mod:`faultgen.logs.measured`).
 """
 
 from __future__ import annotations

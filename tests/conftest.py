@@ -110,7 +110,7 @@ def coulomb_log():
     raised on axis 3 and 1 % torque noise: the calibration adds one effect."""
     from faultgen import effects
     from faultgen.calibrate import synth
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
 
     robot = robots.load("puma560")

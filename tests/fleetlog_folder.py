@@ -12,7 +12,8 @@ import h5py
 import numpy as np
 import pandas as pd
 
-from faultgen.data import measured
+from faultgen.logs import measured
+from faultgen.data import logfiles
 
 RATE = 250.0  # Hz
 
@@ -41,7 +42,7 @@ def write_log(path: Path, robot, day: int, seed: int, wear: np.ndarray, **kw) ->
     """One log at ``path`` (.csv, .csv.gz or .h5) with a ``cycle`` column."""
     t, q, qd, tau, cycle = log_signals(robot, day, seed, wear, **kw)
     if path.name.endswith((".h5", ".hdf5")):
-        measured.write_hdf5(path, t, q, tau, qd)
+        logfiles.write_hdf5(path, t, q, tau, qd)
         with h5py.File(path, "a") as fh:
             fh["cycle"] = cycle
         return path

@@ -37,7 +37,7 @@ import numpy as np
 import roboticstoolbox as rtb
 import toolbox_robots
 
-from faultgen.data import measured
+from faultgen.data import logfiles
 from faultgen.effects import REST_SPEED
 from faultgen.model import robots
 
@@ -287,7 +287,7 @@ def make(case: Case, folder: str | Path) -> tuple[Path, Hidden]:
     tau += rng.normal(size=tau.shape) * TORQUE_NOISE * np.sqrt(np.mean(tau**2, axis=0))
     q_logged = q + rng.normal(size=q.shape) * ENCODER_NOISE
     path = Path(folder) / f"{case.name}.csv"
-    measured.write_csv(path, t, q_logged, tau, qd=qd if case.velocities else None)
+    logfiles.write_csv(path, t, q_logged, tau, qd=qd if case.velocities else None)
     return path, hidden
 
 

@@ -1,11 +1,11 @@
 """A log format added in one file (issue 57: "adding a log format touches 1 file"): a controller
 export with time in milliseconds, angles in degrees and torques in N m, tab-separated, ``.tsv``.
 
-Importing this module registers it (:func:`faultgen.data.adapters.register`); from then on
+Importing this module registers it (:func:`faultgen.logs.formats.register`); from then on
 ``--format deg-ms`` reads it in ``faultgen logs import``, ``faultgen calibrate``, ``faultgen
 monitor`` and ``faultgen simulate --task LOG`` (the replay), with the measured format's checks
-(:func:`faultgen.data.measured.from_columns`; the replay's, :func:`faultgen.operation.replay.from_columns`). A format
-shipped with faultgen is the same class in ``faultgen/data/adapters.py``. tests/test_log_formats.py
+(:func:`faultgen.logs.measured.from_columns`; the replay's, :func:`faultgen.operation.replay.from_columns`). A format
+shipped with faultgen is the same class in ``faultgen/logs/formats.py``. tests/test_log_formats.py
 uses it.
 """
 
@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from faultgen.data import adapters, measured
+from faultgen.logs import formats, measured
 
 
-@adapters.register("deg-ms")
+@formats.register("deg-ms")
 @dataclass(frozen=True)
-class DegreesMilliseconds(adapters.Adapter):
+class DegreesMilliseconds(formats.LogFormat):
     """``time_ms`` (ms), ``angle_deg_1..N`` (deg), ``torque_Nm_1..N`` (N m at the arm), tab-separated.
 
     The column mapping and units alone (:meth:`convert` of one block of the file, read as

@@ -25,7 +25,7 @@ import pinocchio as pin
 import rtbdata
 
 from faultgen.bench import independent
-from faultgen.data import measured
+from faultgen.data import logfiles
 from faultgen.model import builder, importers, robots
 from faultgen.model.folder import add as add_robot
 from faultgen.operation import programs, taskgen
@@ -93,11 +93,11 @@ def add_kr210(out: Path) -> Path:
 
 def write_log(folder: Path, path: Path, cycles: int, payload: HiddenPayload | None, noise: float = 0.005,
               seed: int = 0) -> Path:
-    """Write the log (:func:`faultgen.data.measured.write_csv`: ``t``, ``q1..qN`` rad,
+    """Write the log (:func:`faultgen.logs.measured.write_csv`: ``t``, ``q1..qN`` rad,
     ``tau1..tauN`` N m at the arm side) of ``cycles`` pick-and-place cycles with the hidden
     ``payload``; Gaussian torque noise of ``noise`` times each axis's torque RMS (seeded)."""
     t, q, qd, qdd = motion(folder, cycles)
     tau = arm_torque(folder, q, qd, qdd, payload)
     rng = np.random.default_rng(seed)
     tau = tau + rng.normal(0.0, 1.0, tau.shape) * noise * np.sqrt(np.mean(tau**2, axis=0))
-    return measured.write_csv(path, t, q, tau)
+    return logfiles.write_csv(path, t, q, tau)

@@ -1,6 +1,6 @@
 """The shipped log formats read in blocks (issue 57 item 2): each registered adapter's block reader
-(:meth:`faultgen.data.adapters.Adapter.source`) gives its whole read's columns, row for row, and a
-long log calibrated through it (:func:`faultgen.data.longlog.read`) gives, bit for bit, what its
+(:meth:`faultgen.logs.formats.LogFormat.source`) gives its whole read's columns, row for row, and a
+long log calibrated through it (:func:`faultgen.logs.longlog.read`) gives, bit for bit, what its
 whole read averaged down gives, as a long measured log does (tests/test_longlog.py)."""
 
 import numpy as np
@@ -9,9 +9,9 @@ import pytest
 from test_longlog import _log as long_log
 
 from faultgen.calibrate import decimate, search
-from faultgen.data import adapters, longlog
+from faultgen.logs import formats, longlog
 from faultgen.model import robots
-from faultgen.operation import jointlog
+from faultgen.logs import jointlog
 
 ROWS = 1000
 
@@ -35,7 +35,7 @@ def _ur_rtde(path, robot):
                **{f"actual_current_{k}": tau[:, k] / constants[k] for k in range(6)},
                **{f"joint_temperatures_{k}": 30 + t / 100 for k in range(6)}}
     pd.DataFrame(columns).to_csv(path, sep=" ", index=False, float_format="%.17g")
-    return path, adapters.make("ur-rtde", torque_constants=tuple(constants))
+    return path, formats.make("ur-rtde", torque_constants=tuple(constants))
 
 
 def _voraus(path, robot):
@@ -45,7 +45,7 @@ def _voraus(path, robot):
              **{f"joint_velocity_{k + 1}": qd[:, k] for k in range(6)},
              **{f"motor_torque_{k + 1}": tau[:, k] / robot.gear_ratio[k] for k in range(6)}}
     pd.DataFrame(table).to_parquet(path, row_group_size=1234)  # batches cut at row groups: blocks re-cut
-    return path, adapters.make("voraus")
+    return path, formats.make("voraus")
 
 
 MAKERS = {"ur-rtde": (_ur_rtde, "log.csv"), "voraus": (_voraus, "log.parquet")}

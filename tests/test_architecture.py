@@ -170,7 +170,7 @@ FIRST_ROUND = {
     "sensors": "faultgen.simulation.sensors",
     "sim": "faultgen.simulation.stepping",
     "dataset": "faultgen.data.dataset",
-    "measured": "faultgen.data.measured",
+    "measured": "faultgen.logs.measured",
     "atomic": "faultgen.data.atomic",
     "sweep": "faultgen.runs.sweep",
 }

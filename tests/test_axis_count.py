@@ -11,7 +11,9 @@ from typer.testing import CliRunner
 
 import axis_robots
 from faultgen.cli import app
-from faultgen.data import dataset, measured
+from faultgen.data import dataset
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.effects import make
 from faultgen.inputs import InputError
 from faultgen.effects.payload import Payload
@@ -161,13 +163,13 @@ def test_measured_logs_have_the_robots_columns(arms, tmp_path):
     t = np.arange(0, 3, 0.004)
     q = robot.home + 0.1 * np.sin(t)[:, None] * np.ones(7)
     tau = robot.inverse_dynamics(q, 0.1 * np.cos(t)[:, None] * np.ones(7), -0.1 * np.sin(t)[:, None] * np.ones(7))
-    path = measured.write_csv(tmp_path / "log.csv", t, q, tau)
+    path = logfiles.write_csv(tmp_path / "log.csv", t, q, tau)
     assert path.read_text().splitlines()[0].split(",")[-1] == "tau7"
     data = measured.read(path, robot)
     assert data.q.shape == (len(t), 7)
     np.testing.assert_array_equal(data.tau, tau)
     with pytest.raises(measured.MeasuredDataError, match=r"missing column\(s\) q7, tau7.*required: t, q1\.\.q7"):
-        measured.read(measured.write_csv(tmp_path / "six.csv", t, q[:, :6], tau[:, :6]), robot)
+        measured.read(logfiles.write_csv(tmp_path / "six.csv", t, q[:, :6], tau[:, :6]), robot)
 
 
 def test_fleet_parts_come_from_the_rated_payload(arms):

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from faultgen.calibrate import calibrate, delay
 from faultgen.cli.main import app
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 
 LATE = 0.012  # s: three samples at the log's 250 Hz

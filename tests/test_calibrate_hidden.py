@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 
 from faultgen.calibrate import EFFECTS, calibrate, synth
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.simulation import stepping as sim
 

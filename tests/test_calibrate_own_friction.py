@@ -10,7 +10,7 @@ import pytest
 
 from faultgen import effects
 from faultgen.calibrate import calibrate, synth
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 
 #: Each axis's true Coulomb level: both directions' nominal levels moved by (RATIO - 1) times the

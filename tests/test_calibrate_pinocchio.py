@@ -15,7 +15,7 @@ import pinocchio_log
 import pytest
 
 from faultgen.calibrate import calibrate, gearbox
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 
 

@@ -12,7 +12,8 @@ from typer.testing import CliRunner
 
 from faultgen.calibrate import ImplausibleLogError, calibrate, plausibility, predict, search, synth
 from faultgen.cli import app
-from faultgen.data import measured
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.effects import get
 from faultgen.model import robots
 
@@ -42,7 +43,7 @@ def test_the_right_robot_is_accepted_and_judged_on_every_axis(excitation):
 def test_a_puma_log_given_as_the_irb_is_refused_from_the_command_line_and_nothing_is_written(tmp_path, excitation):
     """The first round wrote a "calibrated" IRB model with torque offsets of 1208 and 1081 N m here."""
     t, q, tau = puma_log(excitation)
-    log = measured.write_csv(tmp_path / "puma.csv", t, q, tau)
+    log = logfiles.write_csv(tmp_path / "puma.csv", t, q, tau)
     out = tmp_path / "out"
     result = CliRunner().invoke(app, ["calibrate", "--robot", "irb6700", "--measured", str(log), "--out", str(out)])
     assert result.exit_code == 2, result.output

@@ -15,7 +15,7 @@ import pytest
 import roboticstoolbox as rtb  # test dependency, declared in pyproject.toml [test]
 
 from faultgen.calibrate import calibrate, synth
-from faultgen.data import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 
 SEED = 0
@@ -48,7 +48,7 @@ def toolbox_log(tmp_path, robot, motion, hidden):
     rng = np.random.default_rng(SEED)
     tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     q_logged = q + rng.normal(size=q.shape) * 1e-5
-    return measured.write_csv(tmp_path / "toolbox.csv", motion.t, q_logged, tau)
+    return logfiles.write_csv(tmp_path / "toolbox.csv", motion.t, q_logged, tau)
 
 
 @pytest.mark.parametrize("effect", ["payload", "stribeck", "cogging"])
@@ -74,7 +74,7 @@ def test_coulomb_change_in_one_direction_is_fitted_per_direction(tmp_path, path)
     tau[:, k] += robot.gear_ratio[k] * rise * (motion.qd[:, k] > 0)
     rng = np.random.default_rng(SEED)
     tau += rng.normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
-    log = measured.write_csv(tmp_path / "toolbox.csv", motion.t, motion.q + rng.normal(size=motion.q.shape) * 1e-5, tau)
+    log = logfiles.write_csv(tmp_path / "toolbox.csv", motion.t, motion.q + rng.normal(size=motion.q.shape) * 1e-5, tau)
     result = calibrate("puma560", log, tmp_path / "out", figure=False)
     first = result.steps[0]
     assert (first.effect.id, first.axes) == ("coulomb", [k]), result.summary()

@@ -131,7 +131,7 @@ def test_written_file_has_normal_permissions(tmp_path):
 def _toolbox_free_log(tmp_path, seconds=6.0, nan_row=None, degrees=False, drop=None):
     """A short measured log along our PUMA path (nominal torque), optionally broken."""
     from faultgen.calibrate import synth
-    from faultgen.data import measured
+    from faultgen.data import logfiles
 
     robot = robots.load("puma560")
     motion, tau = synth.nominal_motion(robot, "pick_place", 1)
@@ -141,7 +141,7 @@ def _toolbox_free_log(tmp_path, seconds=6.0, nan_row=None, degrees=False, drop=N
         tau[nan_row, 1] = np.nan
     if degrees:
         q = np.degrees(q)
-    path = measured.write_csv(tmp_path / "log.csv", t, q, tau)
+    path = logfiles.write_csv(tmp_path / "log.csv", t, q, tau)
     if drop:
         import pandas as pd
 

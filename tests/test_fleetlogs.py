@@ -18,7 +18,9 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.data import dataset, fleetlogs, logfolder, measured, reader
+from faultgen.data import dataset, fleetlogs, logfolder, reader
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
@@ -81,7 +83,7 @@ def test_a_simulated_cycle_imported_as_a_log_has_the_simulated_features(tmp_path
     result = sim.simulate(sim.RunConfig(robot="puma560", task="pick_place", cycles=1), progress=False)
     folder = tmp_path / "LOGS" / "sim"
     folder.mkdir(parents=True)
-    measured.write_hdf5(folder / "1.h5", result.t, result.q_a[0], result.tau_m[0] * puma.gear_ratio, result.qd_a[0])
+    logfiles.write_hdf5(folder / "1.h5", result.t, result.q_a[0], result.tau_m[0] * puma.gear_ratio, result.qd_a[0])
     fleetlogs.import_logs(tmp_path / "LOGS", tmp_path / "sim.h5", robot=puma, progress=False)
     with reader.open(tmp_path / "sim.h5") as data:
         run = data["sim"]
@@ -338,7 +340,7 @@ def test_a_ur_rtde_recording_imports_as_the_same_signals_in_the_measured_format(
     (tmp_path / "UR" / "cell1").mkdir(parents=True)
     pd.DataFrame(columns).to_csv(tmp_path / "UR" / "cell1" / "2026-03-01.csv", sep=" ", index=False)
     (tmp_path / "M" / "cell1").mkdir(parents=True)
-    measured.write_csv(tmp_path / "M" / "cell1" / "2026-03-01.csv", t, q, tau, qd)
+    logfiles.write_csv(tmp_path / "M" / "cell1" / "2026-03-01.csv", t, q, tau, qd)
     command = ["logs", "import", str(tmp_path / "UR"), "--robot", "puma560", "--format", "ur-rtde", "-o",
                str(tmp_path / "ur.h5"), "--no-progress"]
     if layout == "current":

@@ -15,7 +15,8 @@ import pytest
 import faultgen
 import friction_test_log
 from faultgen.calibrate import friction_report, friction_test
-from faultgen.data import measured
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.operation import friction_test as motion
 from faultgen.operation import programs
@@ -137,7 +138,7 @@ def test_faultgens_own_test_simulated_and_read_end_to_end(tmp_path):
     robot = robots.load("puma560")
     recorded = faultgen.open(data).runs[0]
     q, tau = recorded.signal("q_a")[0], recorded.signal("tau_m")[0] * robot.gear_ratio
-    measured.write_csv(log, np.arange(len(q)) / 250.0, q, tau)
+    logfiles.write_csv(log, np.arange(len(q)) / 250.0, q, tau)
     read = subprocess.run([*CLI, "friction-test", str(log), "--robot", "puma560", "-o", str(out)],
                           capture_output=True, text=True, check=False)
     assert read.returncode == 0, read.stderr

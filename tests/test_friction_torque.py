@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.operation import programs

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 
 import faultgen
 from faultgen import inputs
-from faultgen.data import dataset, longlog, measured
+from faultgen.data import dataset
+from faultgen.logs import longlog, measured
 from faultgen.model import robots
 from faultgen.operation import programs
 

@@ -196,7 +196,7 @@ def test_calibrate_refuses_a_voraus_table_above_the_whole_read_bound_from_its_me
     """``logs import`` refused a voraus table of more rows than a log read whole may have from the
     Parquet metadata; ``calibrate`` streamed it (pyarrow decodes a row group whole: a 14.5 MB file
     took 3.6 GB). Every path that reads a voraus log now checks it in one place."""
-    from faultgen.operation import jointlog
+    from faultgen.logs import jointlog
 
     most = jointlog.whole_rows(len(VORAUS))
     log = _voraus_rows(tmp_path / "long.parquet", most + 1)

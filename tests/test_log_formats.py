@@ -20,9 +20,10 @@ from typer.testing import CliRunner
 import faultgen.calibrate
 from faultgen.calibrate import search
 from faultgen.cli import app
-from faultgen.data import adapters, longlog
+from faultgen.logs import formats, longlog
 from faultgen.model import robots
-from faultgen.operation import jointlog, programs, replay
+from faultgen.operation import programs, replay
+from faultgen.logs import jointlog
 
 runner = CliRunner()
 
@@ -60,9 +61,9 @@ def hidden(tmp_path_factory, puma):
 
 
 def test_the_format_is_one_registered_class():
-    assert adapters.ADAPTERS["deg-ms"] is log_format_example.DegreesMilliseconds
+    assert formats.FORMATS["deg-ms"] is log_format_example.DegreesMilliseconds
     with pytest.raises(ValueError, match="deg-ms"):  # an unknown name lists the registered ones
-        adapters.make("no-such-format")
+        formats.make("no-such-format")
 
 
 def test_logs_import_reads_the_format(fleets, tmp_path):
@@ -138,7 +139,7 @@ def test_calibrate_reads_a_long_log_of_the_format_in_blocks(tmp_path, puma, hidd
     monkeypatch.setattr(longlog, "BLOCK_ROWS", 300)
     monkeypatch.setattr(faultgen.calibrate, "MAX_ROWS", 700)
     _no_whole_read(monkeypatch)
-    example, moves = longlog.read(tsv, puma, 700, search.REST_SPEED, adapters.make("deg-ms"))
+    example, moves = longlog.read(tsv, puma, 700, search.REST_SPEED, formats.make("deg-ms"))
     measured, plain_moves = longlog.read(plain, puma, 700, search.REST_SPEED)
     assert len(example) == len(measured) == 654 and example.notes[-1].startswith("decimated: 1964 rows")
     for name in ("t", "q", "qd", "qdd", "tau"):
@@ -164,7 +165,7 @@ def test_a_bad_cell_deep_in_a_long_log_of_the_format_is_refused_as_its_whole_rea
     lines[row + 1] = "\t".join(cells)
     tsv.write_text("\n".join(lines) + "\n")
     monkeypatch.setattr(longlog, "BLOCK_ROWS", 300)
-    adapter = adapters.make("deg-ms")
+    adapter = formats.make("deg-ms")
     with pytest.raises(jointlog.LogError, match=message) as whole:
         adapter.read(tsv, puma)
     with pytest.raises(jointlog.LogError) as part:
@@ -178,7 +179,7 @@ def test_a_format_of_a_whole_reader_alone_gets_blocks_of_it(puma, hidden):
     tsv = hidden[0]
 
     @dataclasses.dataclass(frozen=True)
-    class Whole(adapters.Adapter):  # not registered: the registry stays the example's
+    class Whole(formats.LogFormat):  # not registered: the registry stays the example's
         name = "whole"
 
         def columns(self, path, robot):
@@ -255,7 +256,7 @@ def test_a_dense_log_in_the_format_replays_as_in_the_measured_format_and_is_refu
     monkeypatch.setattr(replay, "BLOCK_ROWS", 1000)  # streamed in blocks of 1000 rows
     measured = programs.load(puma, str(plain))
     _no_whole_read(monkeypatch)  # the adapter's log streamed through its block reader, never read whole
-    example = programs.load(puma, programs.log_task(str(tsv), adapters.make("deg-ms")))
+    example = programs.load(puma, programs.log_task(str(tsv), formats.make("deg-ms")))
     assert example.name == "dense" and len(example.t) == len(measured.t) == 2001
     for name in ("t", "q", "qd", "qdd"):
         np.testing.assert_array_equal(getattr(example, name), getattr(measured, name), err_msg=name)
@@ -264,7 +265,7 @@ def test_a_dense_log_in_the_format_replays_as_in_the_measured_format_and_is_refu
     gap = log_format_example.write(motion_log(tmp_path / "gap.csv", puma, t, thesis.q[piece]), tmp_path / "gap.tsv")
     with pytest.raises(jointlog.LogError, match=r"gap.tsv: column t jumps by 0.06025 s from data row 3000 \(index "
                                                  r"2999\) to data row 3001 \(index 3000\); expected no interval"):
-        programs.load(puma, programs.log_task(str(gap), adapters.make("deg-ms")))
+        programs.load(puma, programs.log_task(str(gap), formats.make("deg-ms")))
 
 
 def test_simulate_refuses_a_format_for_a_task_that_is_no_log_and_torque_constants_of_another(tmp_path):
@@ -286,7 +287,7 @@ def test_a_log_of_the_format_missing_a_column_is_refused_naming_it_whole_and_in_
     lacks is refused with the file's columns, by the whole read, the calibration's and the replay's."""
     frame = pd.read_csv(hidden[0], sep="\t").drop(columns=["angle_deg_3"])
     frame.to_csv(tmp_path / "missing.tsv", sep="\t", index=False)
-    adapter, log = adapters.make("deg-ms"), tmp_path / "missing.tsv"
+    adapter, log = formats.make("deg-ms"), tmp_path / "missing.tsv"
     message = r"missing\.tsv: missing column 'angle_deg_3' of the deg-ms layout; found time_ms, angle_deg_1, angle_deg_2, "
     for read in (lambda: adapter.read(log, puma), lambda: longlog.read(log, puma, 700, search.REST_SPEED, adapter),
                  lambda: programs.load(puma, programs.log_task(str(log), adapter))):

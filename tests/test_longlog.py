@@ -1,4 +1,4 @@
-"""faultgen.data.longlog: a long measured log read in blocks and averaged down while it is read
+"""faultgen.logs.longlog: a long measured log read in blocks and averaged down while it is read
 (issue 50 item 4) gives, bit for bit, what reading it whole and averaging it after gives, and
 refuses a bad cell or angle anywhere in it with the whole-log reader's own message."""
 
@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from faultgen.calibrate import decimate, search
-from faultgen.data import longlog, measured
+from faultgen.logs import longlog, measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 
 ROWS = 1000
@@ -31,7 +32,7 @@ def test_read_in_blocks_equals_read_whole_then_averaged(tmp_path, robot, monkeyp
     t, q, tau = _log()
     qd = 1.01 * np.gradient(q, t, axis=0) if name.startswith("qd") else None
     path = tmp_path / name
-    (measured.write_hdf5 if name.endswith(".h5") else measured.write_csv)(path, t, q, tau, qd)
+    (logfiles.write_hdf5 if name.endswith(".h5") else logfiles.write_csv)(path, t, q, tau, qd)
     full = measured.read(path, robot)
     whole = decimate(full, ROWS)
     part, motion = longlog.read(path, robot, ROWS, search.REST_SPEED)
@@ -46,7 +47,7 @@ def test_read_in_blocks_equals_read_whole_then_averaged(tmp_path, robot, monkeyp
 
 def test_a_short_log_is_read_whole(tmp_path, robot):
     t, q, tau = _log(n=2500)
-    path = measured.write_csv(tmp_path / "short.csv", t, q, tau)
+    path = logfiles.write_csv(tmp_path / "short.csv", t, q, tau)
     data, motion = longlog.read(path, robot, 3000, search.REST_SPEED)
     np.testing.assert_array_equal(data.qdd, measured.read(path, robot).qdd)
     assert motion.rows == 2500 and not any("decimated" in note for note in data.notes)
@@ -61,7 +62,7 @@ def test_a_bad_cell_deep_in_a_long_log_is_named_as_the_whole_reader_names_it(tmp
                                                                                column, cell, message):
     monkeypatch.setattr(longlog, "BLOCK_ROWS", 3000)
     t, q, tau = _log()
-    path = measured.write_csv(tmp_path / "bad.csv", t, q, tau)
+    path = logfiles.write_csv(tmp_path / "bad.csv", t, q, tau)
     lines = path.read_text().splitlines()
     cells = lines[row + 1].split(",")
     cells[column] = cell

@@ -11,8 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from faultgen.data import measured
-from faultgen.data.measured import MeasuredDataError
+from faultgen.logs import measured
+from faultgen.data import logfiles
+from faultgen.logs.measured import MeasuredDataError
 from faultgen.model import robots
 
 NOISE = 1e-5  # rad, standard deviation of the noise added to q (about a 19-bit arm encoder)
@@ -44,7 +45,7 @@ def good_frame(robot, rate=250.0, duration=3.0, with_qd=False):
     """A valid table as a DataFrame (columns t, q1..q6, [qd1..qd6,] tau1..tau6)."""
     t = np.arange(round(duration * rate) + 1) / rate
     q, qd, _ = sinusoids(robot, t)
-    table = measured._table(t, q, torques(t), qd if with_qd else None)
+    table = logfiles._table(t, q, torques(t), qd if with_qd else None)
     return pd.DataFrame(table)
 
 
@@ -66,7 +67,7 @@ def test_round_trip(tmp_path, puma, name, with_qd):
     q = q + NOISE * rng.standard_normal(q.shape)
     tau = torques(t) + rng.standard_normal(q.shape)
     path = tmp_path / name
-    writer = measured.write_csv if ".csv" in name else measured.write_hdf5
+    writer = logfiles.write_csv if ".csv" in name else logfiles.write_hdf5
     assert writer(path, t, q, tau, qd=qd if with_qd else None) == path
     if name.endswith(".gz"):
         with gzip.open(path, "rt") as fh:
@@ -97,9 +98,9 @@ def test_compression_is_recognised_by_content_not_name(tmp_path, puma):
     t = np.arange(0, 2.5, 1e-3)
     q, _, _ = sinusoids(puma, t)
     tau = torques(t)
-    measured.write_csv(tmp_path / "log.csv.gz", t, q, tau)
+    logfiles.write_csv(tmp_path / "log.csv.gz", t, q, tau)
     (tmp_path / "log.csv.gz").rename(tmp_path / "compressed.csv")  # gzip content, plain name
-    measured.write_csv(tmp_path / "log.csv", t, q, tau)
+    logfiles.write_csv(tmp_path / "log.csv", t, q, tau)
     (tmp_path / "log.csv").rename(tmp_path / "plain.csv.gz")  # plain content, gzip name
     for name in ("compressed.csv", "plain.csv.gz"):
         data = measured.read(tmp_path / name, puma)
@@ -110,7 +111,7 @@ def test_arrow_and_pandas_readers_give_the_same_numbers_to_the_bit(tmp_path):
     """A plain CSV log is parsed by pyarrow, a gzip-compressed one by pandas (jointlog.read_csv):
     the same text gives the same doubles, in every way a logger may print them (17 significant
     digits, fixed decimals, exponents, signs, spaces), and a bad cell is refused the same way."""
-    from faultgen.operation import jointlog
+    from faultgen.logs import jointlog
 
     rng = np.random.default_rng(7)
     values = rng.standard_normal((4000, 4)) * 10.0 ** rng.integers(-12, 12, (4000, 4))
@@ -150,7 +151,7 @@ def test_read_accepts_a_loaded_robot_and_reports_extra_columns(tmp_path, puma):
 def test_hdf5_extra_datasets_and_groups_are_reported(tmp_path, puma):
     path = tmp_path / "extra.h5"
     frame = good_frame(puma)
-    measured.write_hdf5(path, frame["t"], frame[list(measured.column_names(6)[0])], frame[list(measured.column_names(6)[2])])
+    logfiles.write_hdf5(path, frame["t"], frame[list(measured.column_names(6)[0])], frame[list(measured.column_names(6)[2])])
     with h5py.File(path, "a") as fh:
         fh["current1"] = np.zeros(len(frame))
         fh.create_group("meta")
@@ -162,11 +163,11 @@ def test_write_refuses_wrong_suffix_and_shape(tmp_path, puma):
     t = np.arange(10) / 100
     q = np.zeros((10, 6))
     with pytest.raises(ValueError, match=r"write_csv writes \.csv or \.csv\.gz files"):
-        measured.write_csv(tmp_path / "x.txt", t, q, q)
+        logfiles.write_csv(tmp_path / "x.txt", t, q, q)
     with pytest.raises(ValueError, match=r"write_hdf5 writes \.h5 or \.hdf5 files"):
-        measured.write_hdf5(tmp_path / "x.csv", t, q, q)
+        logfiles.write_hdf5(tmp_path / "x.csv", t, q, q)
     with pytest.raises(ValueError, match=r"tau must have shape \(10, 6\), got \(10, 5\)"):
-        measured.write_csv(tmp_path / "x.csv", t, q, q[:, :5])
+        logfiles.write_csv(tmp_path / "x.csv", t, q, q[:, :5])
 
 
 # --------------------------------------------------------------------------------------------
@@ -203,7 +204,7 @@ def test_estimated_derivatives_match_analytic_ones(tmp_path, puma, rate, window,
     rng = np.random.default_rng(2)
     t = np.arange(int(4 * rate)) / rate
     q, qd, qdd = sinusoids(puma, t)
-    path = measured.write_csv(tmp_path / "m.csv", t, q + NOISE * rng.standard_normal(q.shape), torques(t))
+    path = logfiles.write_csv(tmp_path / "m.csv", t, q + NOISE * rng.standard_normal(q.shape), torques(t))
 
     data = measured.read(path, robots.load("puma560"))
 
@@ -499,19 +500,19 @@ def test_hdf5_refusals(tmp_path, puma):
         frame[list(measured.column_names(6)[2])].to_numpy(),
     )
 
-    path = measured.write_hdf5(tmp_path / "nan.h5", t, q, tau)
+    path = logfiles.write_hdf5(tmp_path / "nan.h5", t, q, tau)
     with h5py.File(path, "a") as fh:
         fh["tau4"][41] = np.nan
     with pytest.raises(MeasuredDataError, match=r"data row 42 \(index 41\), column tau4: value NaN"):
         measured.read(path, puma)
 
-    path = measured.write_hdf5(tmp_path / "deg.h5", t, q, tau)
+    path = logfiles.write_hdf5(tmp_path / "deg.h5", t, q, tau)
     with h5py.File(path, "a") as fh:
         fh["q3"].attrs["unit"] = "deg"
     with pytest.raises(MeasuredDataError, match=r"dataset q3 has unit 'deg'; expected 'rad'"):
         measured.read(path, puma)
 
-    path = measured.write_hdf5(tmp_path / "short.h5", t, q, tau)
+    path = logfiles.write_hdf5(tmp_path / "short.h5", t, q, tau)
     with h5py.File(path, "a") as fh:
         del fh["q6"]
         fh["q6"] = q[:-1, 5]

@@ -109,7 +109,7 @@ def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_
     import json
     from datetime import datetime
 
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
     from faultgen.monitor import life
 

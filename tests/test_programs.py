@@ -15,7 +15,8 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.data import dataset, measured
+from faultgen.data import dataset
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.operation import programs, replay, tasks
 from faultgen.operation.wear import WearPlan

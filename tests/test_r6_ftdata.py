@@ -16,7 +16,8 @@ import pytest
 import faultgen
 from faultgen.bench import independent
 from faultgen.calibrate import friction_report
-from faultgen.data import dataset, friction_records, measured, validator, writer
+from faultgen.data import dataset, friction_records, validator, writer
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.operation import friction_test, programs
 from faultgen.runs import fleet

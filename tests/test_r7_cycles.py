@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from faultgen.bench import layouts
-from faultgen.data import logfolder, measured
+from faultgen.data import logfolder
+from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.monitor import cycles, feed
 from faultgen.monitor import logs as fleet_logs

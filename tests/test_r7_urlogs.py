@@ -34,7 +34,7 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.data import adapters
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.monitor import feed, lights, loop, page, report
 from faultgen.monitor import logs as fleet_logs
@@ -142,8 +142,8 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
         status = "learning" if unit == "ur-03" else "monitored"  # ur-03 relearning its new program
         assert (row["status"], row["model"]) == (status, "calibrated"), row
         assert "failed" not in row["reason"] and "wear_scale" not in row
-        assert row["torque_source"] == adapters.MEASURED_CURRENT
-        assert f"{unit}: {status} (twin, calibrated model; torque: {adapters.MEASURED_CURRENT})" in result.output
+        assert row["torque_source"] == formats.MEASURED_CURRENT
+        assert f"{unit}: {status} (twin, calibrated model; torque: {formats.MEASURED_CURRENT})" in result.output
         # the unlogged program change found on its day, and nowhere else
         assert row["reason"].count("program changed at ") == (unit == "ur-03"), row
     assert f"program changed at {changed} (not logged" in units["ur-03"]["reason"]
@@ -157,7 +157,7 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
     assert 10.0 <= truth[("ur-01", worn["first_alarm"])] <= 15.0, (worn, truth)
     assert 10.0 <= truth[("ur-01", worn["known"])] <= 15.0, (worn, truth)  # when a daily run saw it (item 4)
     html = (tmp_path / "out" / page.PAGE).read_text()
-    assert f"<b>Torque</b>: {adapters.MEASURED_CURRENT}." in html and "Twin fallback" not in html
+    assert f"<b>Torque</b>: {formats.MEASURED_CURRENT}." in html and "Twin fallback" not in html
     # the page's order by urgency: its units by the "service by" date it shows, the soonest first
     listed = re.findall(r'href="#unit-\d+">([^<]+)</a></td><td data-column="service by \(5-95 %\)">([^<]*)<', html)
     assert sorted(u for u, _ in listed) == sorted(units), listed
@@ -177,13 +177,13 @@ def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_mon
     units = _rows(tmp_path / "out" / "units.csv")
     assert [r["unit"] for r in units] == ["ur-02", "ur-03"]
     for row in units:
-        assert row["status"] == "not monitored" and row["torque_source"] == adapters.COMMANDED_MOMENT
+        assert row["status"] == "not monitored" and row["torque_source"] == formats.COMMANDED_MOMENT
         assert feed.CONSTANT_TORQUE in row["reason"] and "can show no wear" in row["reason"]
         assert row["logs_scored"] == "0" and "learning: " not in row["reason"]
-    assert f"ur-02: not monitored (twin, calibrated model; torque: {adapters.COMMANDED_MOMENT})" in result.output
+    assert f"ur-02: not monitored (twin, calibrated model; torque: {formats.COMMANDED_MOMENT})" in result.output
     assert "exit status 3" in result.output
     html = (tmp_path / "out" / page.PAGE).read_text()
-    assert f'<p class="evidence"><b>Torque</b>: {adapters.COMMANDED_MOMENT}.</p>' in html
+    assert f'<p class="evidence"><b>Torque</b>: {formats.COMMANDED_MOMENT}.</p>' in html
     # a rerun after a new log: the unit stays off the monitor, its new log skipped with the reason
     os.link(sorted((logs / "ur-02").iterdir())[TRAIN + 1], few / "ur-02" / sorted((logs / "ur-02").iterdir())[TRAIN + 1].name)
     again = _monitor(robot_dir, few, tmp_path / "out")
@@ -202,10 +202,10 @@ def test_the_import_summary_states_the_torque_source(fleet, tmp_path):
     measured = runner.invoke(app, [*command, "-o", str(tmp_path / "a.h5"), "--torque-constants",
                                    ",".join(map(str, TORQUE_CONSTANTS))])
     assert measured.exit_code == 0, measured.output
-    assert f"torque:        {adapters.MEASURED_CURRENT} (2 log(s) read now)" in measured.output
+    assert f"torque:        {formats.MEASURED_CURRENT} (2 log(s) read now)" in measured.output
     commanded = runner.invoke(app, [*command, "-o", str(tmp_path / "b.h5")])
     assert commanded.exit_code == 0, commanded.output
-    assert f"torque:        {adapters.COMMANDED_MOMENT} (2 log(s) read now)" in commanded.output
+    assert f"torque:        {formats.COMMANDED_MOMENT} (2 log(s) read now)" in commanded.output
 
 
 def test_an_adapter_log_is_read_once_with_the_accelerations_the_calibration_needs(fleet):
@@ -213,10 +213,10 @@ def test_an_adapter_log_is_read_once_with_the_accelerations_the_calibration_need
     the measured format's reader estimates them (on 6e0facf: NaN, and every calibrated twin failed)."""
     robot_dir, logs, _ = fleet
     robot = robots.load(robot_dir)
-    read, suffixes = fleet_logs.reader_of(adapters.make("ur-rtde", torque_constants=TORQUE_CONSTANTS))
+    read, suffixes = fleet_logs.reader_of(formats.make("ur-rtde", torque_constants=TORQUE_CONSTANTS))
     data = read(sorted((logs / "ur-01").iterdir())[0], robot)
     assert suffixes == (".csv", ".csv.gz") and np.all(np.isfinite(data.qdd))
-    assert adapters.torque_source(data.notes) == adapters.MEASURED_CURRENT
+    assert formats.torque_source(data.notes) == formats.MEASURED_CURRENT
 
 
 def test_a_twin_fallen_back_to_the_nominal_model_labels_its_wear_so(tmp_path):

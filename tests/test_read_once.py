@@ -29,7 +29,7 @@ import pandas as pd
 import pytest
 
 from faultgen import inputs
-from faultgen.data import adapters, measured
+from faultgen.logs import formats, measured
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 
@@ -81,7 +81,7 @@ def test_the_built_in_adapters_parse_a_held_log_as_their_file_and_open_it_once(t
         table = {"time": t, "sample": cycle, **{f"joint_position_{k + 1}": q[:, k] for k in range(6)},
                  **{f"motor_torque_{k + 1}": tau[:, k] / puma.gear_ratio[k] for k in range(6)}}
         pd.DataFrame(table).to_parquet(path)
-    adapter = adapters.make(name)
+    adapter = formats.make(name)
     with open_counter.opens_under(tmp_path) as counts:
         parsed = fleet_logs.Source(puma, adapter).get(fleet_logs.Log("u1", path.stem, 0.0, "sequence", path, path.name))
     assert dict(counts) == {path.name: 1}

@@ -19,9 +19,12 @@ from typer.testing import CliRunner
 
 from faultgen import inputs
 from faultgen.cli import app
-from faultgen.data import adapters, logfolder, longlog, measured
+from faultgen.data import logfolder
+from faultgen.logs import formats, longlog, measured
+from faultgen.data import logfiles
 from faultgen.model import robots
-from faultgen.operation import jointlog, programs
+from faultgen.operation import programs
+from faultgen.logs import jointlog
 
 runner = CliRunner()
 COLUMNS = ["t", *(f"q{i}" for i in range(1, 7)), *(f"tau{i}" for i in range(1, 7))]
@@ -70,7 +73,7 @@ def test_a_log_with_extra_columns_reads_only_the_wanted_ones_the_same(tmp_path):
     t = np.arange(3000) * 0.002
     q = 0.1 * np.sin(np.outer(t, np.arange(1, 7)))
     tau = np.cos(np.outer(t, np.arange(1, 7)))
-    plain = measured.write_csv(tmp_path / "plain.csv", t, q, tau)
+    plain = logfiles.write_csv(tmp_path / "plain.csv", t, q, tau)
     text = plain.read_text().splitlines()
     wide = [text[0] + ",note,x"] + [line + ",abc,1" for line in text[1:]]
     (tmp_path / "wide.csv").write_text("\n".join(wide) + "\n")
@@ -145,7 +148,7 @@ def test_a_voraus_table_of_more_rows_than_a_whole_read_may_have_is_refused_from_
             writer.write_table(table, row_group_size=rows)
     start = time.perf_counter()
     with pytest.raises(inputs.InputError) as err:
-        adapters.make("voraus").read(path, robots.load("puma560"))
+        formats.make("voraus").read(path, robots.load("puma560"))
     assert time.perf_counter() - start < 2.0
     assert str(err.value).startswith(f"{path}: {groups * rows} rows of 20 columns; a voraus-AD log read whole has at "
                                      f"most {jointlog.whole_rows(20)}")
@@ -167,14 +170,14 @@ def _rtde(path, rows, outputs=80):
 #: (the modules the reader imports on first use and the allocator's arenas not counted as the log's).
 _PEAK_GROWTH = """
 import pathlib, sys
-from faultgen.data import adapters
+from faultgen.logs import formats
 from faultgen.model import robots
 
 def status(key):
     with open("/proc/self/status") as fh:
         return next(int(line.split()[1]) * 1024 for line in fh if line.startswith(key))
 
-adapter, puma = adapters.make("ur-rtde"), robots.load("puma560")
+adapter, puma = formats.make("ur-rtde"), robots.load("puma560")
 adapter.columns(pathlib.Path(sys.argv[1]), puma)
 with open("/proc/self/clear_refs", "w") as fh:
     fh.write("5")  # reset VmHWM to the current resident size
@@ -197,7 +200,7 @@ def test_an_rtde_log_is_read_as_numbers_in_memory_proportional_to_the_numbers_ke
     31 MB more text hold 6 MB more numbers, and must cost less than that text (was 7 times it).
     Measured 7-10 MB (90 MB with every cell read as text), 2026-11-25; an in-process figure depended on which tests had run before."""
     path = _rtde(tmp_path / "rtde.csv", 20_000)
-    columns, _, _ = adapters.make("ur-rtde").columns(path, robots.load("puma560"))
+    columns, _, _ = formats.make("ur-rtde").columns(path, robots.load("puma560"))
     assert set(columns) == {*COLUMNS, *(f"qd{i}" for i in range(1, 7))}
     np.testing.assert_array_equal(columns["t"], np.round(np.arange(20_000) * 0.002, 3))
     longer = _rtde(tmp_path / "longer.csv", 60_000)
@@ -216,7 +219,7 @@ def test_an_rtde_log_with_a_bad_cell_is_refused_by_row(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(measured.MeasuredDataError, match=r"rtde\.csv: data row 2500 \(line 2501\), column "
                                                          r"actual_q_0: value 'oops'"):
-        adapters.make("ur-rtde").columns(path, robots.load("puma560"))
+        formats.make("ur-rtde").columns(path, robots.load("puma560"))
 
 
 def _units():

@@ -175,7 +175,8 @@ def test_export_plot_into_a_read_only_folder_give_one_line(small_run, read_only)
 def moving_log(tmp_path_factory) -> Path:
     """10 s at 250 Hz of the PUMA 560 along the excitation, its torque from the model, 1 % noise."""
     from faultgen.calibrate import predict, synth
-    from faultgen.data import measured
+    from faultgen.logs import measured
+    from faultgen.data import logfiles
     from faultgen.model import robots
 
     puma = robots.load("puma560")
@@ -183,19 +184,19 @@ def moving_log(tmp_path_factory) -> Path:
     tau = predict(puma, measured.from_arrays(t, q, np.zeros_like(q), robot=puma, qd=qd))
     tau += np.random.default_rng(0).normal(size=tau.shape) * 0.01 * np.sqrt(np.mean(tau**2, axis=0))
     path = tmp_path_factory.mktemp("logs") / "moving.csv"
-    measured.write_csv(path, t, q, tau)
+    logfiles.write_csv(path, t, q, tau)
     return path
 
 
 def test_calibrate_refuses_a_log_without_motion_naming_the_joints_and_writes_nothing(tmp_path):
-    from faultgen.data import measured
+    from faultgen.data import logfiles
     from faultgen.model import robots
 
     puma = robots.load("puma560")
     t = np.arange(0, 10, 0.004)
     q = np.tile(puma.joint_range.mean(axis=1), (len(t), 1))
     tau = puma.inverse_dynamics(q, np.zeros_like(q), np.zeros_like(q), t=t)
-    measured.write_csv(tmp_path / "still.csv", t, q, tau)
+    logfiles.write_csv(tmp_path / "still.csv", t, q, tau)
     result = runner.invoke(app, ["calibrate", "--robot", "puma560", "--measured", str(tmp_path / "still.csv"),
                                  "--out", str(tmp_path / "out")])
     assert result.exit_code == 2, result.output
@@ -263,7 +264,7 @@ def test_an_interrupted_calibrate_leaves_nothing_that_blocks_a_rerun(moving_log,
 
 def test_a_long_log_is_averaged_down_and_keeps_the_relation_between_its_columns(moving_log):
     from faultgen import calibrate
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
 
     data = measured.read(moving_log, robots.load("puma560"))

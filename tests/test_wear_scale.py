@@ -10,7 +10,8 @@ import pytest
 from scipy.stats import norm
 
 from faultgen.bench import independent
-from faultgen.data import measured
+from faultgen.logs import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import report
@@ -136,7 +137,7 @@ def test_the_twins_signatures_answer_like_an_independent_unit_per_percent_of_its
                + gear * independent.motor_friction(gear * qd, fc * grow, fs * grow, viscous))
         return fleet_logs.features_of(robot, measured.from_arrays(t, q, tau, robot))
 
-    program = measured.write_csv(tmp_path / "program.csv", t, q, independent._rigid(robot, 125.0, 0.0))
+    program = logfiles.write_csv(tmp_path / "program.csv", t, q, independent._rigid(robot, 125.0, 0.0))
     twin = Twin(robot, program, tmp_path / "cache" / "cycles")
     healthy20 = twin.cycle(20.0, 0.0)
     at20 = np.stack([(twin.cycle(20.0, 0.0, a) - healthy20) / WEAR for a in range(1, 6)])

@@ -23,7 +23,7 @@ import numpy as np
 from faultgen import axes as axis_numbers
 from faultgen import inputs
 from faultgen.data import atomic, cells
-from faultgen.operation.logformat import MAX_CYCLE, PAYLOAD_COLUMN, TEMPERATURE_PREFIX, VALUE_BOUNDS
+from faultgen.logs.columns import MAX_CYCLE, PAYLOAD_COLUMN, TEMPERATURE_PREFIX, VALUE_BOUNDS
 
 #: The friction tests' readings (the prognostics track's version 2, docs/bench/prognostics.md): name ->
 #: (unit, layout); on the record of the test's day, 0 on the others (``friction_test`` 1 marks the
@@ -69,7 +69,7 @@ LABELS_MAX_BYTES = 256 * 2**20
 MAX_FAULT_LEVEL = 500.0
 _TAU, _QD = VALUE_BOUNDS["tau"][:2], VALUE_BOUNDS["qd"][:2]
 #: array -> (low, high) of the values a run or an import writes (the joint logs' bounds,
-#: :data:`faultgen.operation.logformat.VALUE_BOUNDS`; the histograms are shares of a record's
+#: :data:`faultgen.logs.columns.VALUE_BOUNDS`; the histograms are shares of a record's
 #: samples): every value read is finite and within them, so that no metric overflows or turns NaN.
 VALUE_RANGES = {
     "cycles": (0, MAX_CYCLE), "mean_abs_torque": _TAU, "rms_torque": _TAU, "average_load_torque": _TAU,

@@ -32,7 +32,7 @@ def arrays(tests: Path, stamps: list[str], robot) -> dict[str, np.ndarray]:
         :func:`faultgen.calibrate.friction_test.friction_points`).
     """
     from faultgen.calibrate import friction_report
-    from faultgen.data import measured
+    from faultgen.logs import measured
 
     n, n_axes = len(stamps), robot.n_axes
     out = {"friction_test": np.zeros(n, dtype=np.int8),

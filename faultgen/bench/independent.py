@@ -84,7 +84,8 @@ import numpy as np
 from faultgen.bench import layouts
 from faultgen.data import cells
 from faultgen.model import robots
-from faultgen.operation import jointlog, programs
+from faultgen.operation import programs
+from faultgen.logs import jointlog
 
 #: Unit-to-unit spread of each friction parameter (log-normal sigma) and its day-to-day scatter,
 #: drawn per log and parameter and not logged (the state of the lubricant film, the warm-up the

@@ -36,7 +36,7 @@ import numpy as np
 
 from faultgen.bench import files, tracks
 from faultgen.data import cells
-from faultgen.operation import jointlog
+from faultgen.logs import jointlog
 
 #: Largest relative difference (to the feature's scale) between a regenerated unit's features and
 #: its test unit's: other BLAS or NumPy kernels move the last bits (1e-15 rad on a weld path's joint

@@ -3,7 +3,7 @@ missing physical effect, add it to the model, and show the gap shrink.
 
 The workflow (:func:`calibrate`, ``faultgen calibrate``):
 
-1. read and check the measured file (:func:`faultgen.data.measured.read`; velocities and
+1. read and check the measured file (:func:`faultgen.logs.measured.read`; velocities and
    accelerations from a Savitzky-Golay filter when the file has none), and refuse a log the robot
    cannot explain (:mod:`faultgen.calibrate.plausibility`) before writing anything;
 2. predict the torque with the nominal model (:func:`predict`: the inverse dynamics plus what the
@@ -47,8 +47,9 @@ from faultgen.calibrate.loop import run as _calibrate
 from faultgen.calibrate.plausibility import ImplausibleLogError
 from faultgen.calibrate.prediction import predict
 from faultgen.calibrate.result import Calibration, Step, parameters
-from faultgen.data import atomic, longlog
-from faultgen.data import measured as measured_io
+from faultgen.data import atomic
+from faultgen.logs import formats, longlog
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 __all__ = ["EFFECTS", "RESIDUAL_TEST_LEVEL", "Calibration", "Effect", "ImplausibleLogError", "Step", "calibrate", "get",
@@ -63,7 +64,7 @@ MAX_ROWS = 25_000
 
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-              log_format=None, friction_every_axis: bool = False, figure: bool = True,
+              log_format: formats.LogFormat = formats.MEASURED, friction_every_axis: bool = False, figure: bool = True,
               delay: str | float | None = None, effects: list[str] | None = None) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
@@ -74,9 +75,9 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     Stribeck hump's parameters refined by ``mujoco.sysid`` when it is installed (:func:`faultgen.calibrate.loop.run`).
     ``robot``: the nominal model, a :class:`~faultgen.model.robot.Robot` or a name, robot folder or MJCF
     file resolved here, once (:func:`faultgen.model.robots.load`; UnknownRobotError, ModelError).
-    ``log_format``: the log's format when not the measured one (a
-    :class:`faultgen.data.adapters.Adapter`, ``--format NAME``): read through it, whole or, longer
-    than :data:`MAX_ROWS`, in blocks (:func:`faultgen.data.longlog.read`).
+    ``log_format``: the log's format (a :class:`faultgen.logs.formats.LogFormat`, ``--format NAME``;
+    default the measured one): read through it, whole or, longer
+    than :data:`MAX_ROWS`, in blocks (:func:`faultgen.logs.longlog.read`).
     ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
     after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
     ``figure``: draw ``calibration.png`` (False: the other outputs only, as ``faultgen monitor`` caches them).

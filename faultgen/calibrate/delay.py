@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 
 #: Largest delay searched, s, either way (a controller's channels are a few cycles apart).
 MAX_DELAY = 0.1

@@ -14,7 +14,8 @@ import numpy as np
 import pandas as pd
 
 from faultgen.calibrate import friction_fit, friction_test
-from faultgen.data import cells, measured
+from faultgen.data import cells
+from faultgen.logs import measured
 from faultgen.data.atomic import output_set
 from faultgen.model.robots import Robot
 

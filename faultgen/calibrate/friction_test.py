@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from faultgen.data.measured import MeasuredData
+from faultgen.logs.measured import MeasuredData
 from faultgen.model.robots import Robot
 
 #: The reader's minimum: distinct speeds per axis and direction, and steady time per segment, s.

@@ -24,7 +24,7 @@ solved for a guess of the flanks, and again with the flanks the new deflections 
 they agree.
 
 The equation is integrated only on the axes whose locked-arm resonance the measured
-accelerations resolve (:data:`RESOLVED_HZ`; the derivative filter of :func:`faultgen.data.measured.read`
+accelerations resolve (:data:`RESOLVED_HZ`; the derivative filter of :func:`faultgen.logs.measured.read`
 has a pass band of about 20 Hz): a resonance above it rings in the equation, driven by the
 measured motion, while the motor's answering ringing is filtered out of the measured ``qdd``.
 On a stiffer axis (the PUMA 560's; the light wrist axes) the arm follows the motor rigidly,
@@ -52,7 +52,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from faultgen.data import measured
+from faultgen.logs import measured
 from faultgen.effects.backlash import Backlash
 from faultgen.model import robots
 
@@ -67,7 +67,7 @@ MAX_PHASE = 0.5
 MAX_FLANK_CHANGES = 8
 #: Highest locked-arm resonance, Hz (the lowest along the motion, at the arm's largest inertia),
 #: that the spring equation is used for. The accelerations of a measured log come through the
-#: derivative filter (:func:`faultgen.data.measured.read`: Savitzky-Golay, 50 ms window), which keeps
+#: derivative filter (:func:`faultgen.logs.measured.read`: Savitzky-Golay, 50 ms window), which keeps
 #: 80 % of the amplitude at 18 Hz and half at 25 Hz. Above that the motor's ringing against the
 #: arm is not in the measured ``qdd``, and the equation's ringing, driven by the measured motion,
 #: is not what the drive felt: on a PUMA 560 log with a hidden dead band of 14.6 mrad on axis 1

@@ -25,7 +25,7 @@ from faultgen.calibrate.effects import motion as motion_of
 from faultgen.calibrate.prediction import predicted_motion
 from faultgen.calibrate.result import Step
 from faultgen.calibrate.trial import Model, compiled, judge
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 
 #: Backfitting rounds over the steps (:func:`backfit`). On the independent logs with a payload and
 #: friction growing with the load, a second round moved the payload's mass by 0.2 %, a third by 0.

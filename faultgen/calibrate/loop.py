@@ -22,7 +22,7 @@ from faultgen.calibrate.prediction import predicted_motion
 from faultgen.calibrate.result import Calibration, Step, parameters
 from faultgen.calibrate.trial import Model, judge
 from faultgen.data import atomic
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.effects.coulomb import Coulomb
 from faultgen.effects.viscous import Viscous
 from faultgen.model import robots

@@ -11,7 +11,7 @@ import numpy as np
 from faultgen.calibrate import gearbox
 from faultgen.calibrate.effects import Motion
 from faultgen.calibrate.effects import motion as motion_of
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 

@@ -31,7 +31,7 @@ import numpy as np
 from faultgen import axes as axis_numbers
 from faultgen.calibrate import criterion, search
 from faultgen.calibrate.effects import get
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 #: Every how many fitting samples the residual keeps (a shorter residual vector for the solver; the

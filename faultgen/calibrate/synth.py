@@ -29,7 +29,7 @@ import numpy as np
 from faultgen import axes
 from faultgen.calibrate.effects import Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
-from faultgen.data import measured
+from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
@@ -266,5 +266,5 @@ def record(robot: robots.Robot, hidden: Hidden, out: str | Path, task: str = "pi
     tau = np.concatenate(run.tau_m) * G
     rng = np.random.default_rng([seed, 7])
     tau = tau + rng.normal(size=tau.shape) * TORQUE_NOISE * np.sqrt(np.mean(tau**2, axis=0))
-    measured.write_csv(out, t, q, tau)
+    logfiles.write_csv(out, t, q, tau)
     return out

@@ -20,7 +20,7 @@ import numpy as np
 from faultgen.calibrate import search
 from faultgen.calibrate.effects import Effect, Motion
 from faultgen.calibrate.prediction import predicted_motion
-from faultgen.data import measured as measured_io
+from faultgen.logs import measured as measured_io
 from faultgen.model import robots
 
 

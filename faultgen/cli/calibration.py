@@ -88,7 +88,7 @@ def calibrate_command(
         user_effects.load(spec)  # a bad --effects is refused before anything is read or written
     check_output_folder(out, overwrite)
     nominal = robots.load(robot)  # once, for the log's reader and the calibration
-    adapter = log_adapter(log_format, torque_constants, nominal)  # None: the measured format
+    adapter = log_adapter(log_format, torque_constants, nominal)
     result = calibrate.calibrate(nominal, measured, out, max_steps=max_steps, progress=True, use_sysid=sysid,
                                  log_format=adapter, friction_every_axis=fit_friction_all, delay=shift,
                                  effects=effects)
@@ -219,7 +219,7 @@ def friction_test_command(
       faultgen friction-test log.csv --robot puma560 -o friction-again --reference friction
     """
     from faultgen.calibrate import friction_report
-    from faultgen.data import measured
+    from faultgen.logs import measured
     from faultgen.model import robots
 
     check_output_folder(out, overwrite)

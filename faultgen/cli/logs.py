@@ -67,8 +67,7 @@ def import_command(
 
     resolved = robots.load(robot)  # once, for the log reader and the import
     adapter = log_adapter(log_format, torque_constants, resolved)
-    read = {} if adapter is None else {"reader": functools.partial(adapter.read, accelerations=False),
-                                       "suffixes": adapter.suffixes}
+    read = {"reader": functools.partial(adapter.read, accelerations=False), "suffixes": adapter.suffixes}
 
     # the command as provenance, with LOGS given as an absolute path stored by its name: a dataset
     # meant to be shared keeps no path of this machine (docs/reliability.md, "Log folders")

@@ -169,8 +169,8 @@ def conditions_from_options(temperature: bool, payloads: str | None, pattern: st
 
 
 def log_adapter(log_format: str, torque_constants: str | None, robot):
-    """The :class:`faultgen.data.adapters.Adapter` of ``--format`` (None for the measured format)
-    with ``--torque-constants`` parsed and checked against the axes of ``robot``, the command's
+    """The :class:`faultgen.logs.formats.LogFormat` of ``--format`` (from the registry,
+    :data:`faultgen.logs.formats.FORMATS`; ``measured`` its default entry) with ``--torque-constants`` parsed and checked against the axes of ``robot``, the command's
     resolved :class:`~faultgen.model.robot.Robot` (None when no torque constants are given).
 
     Raises
@@ -179,23 +179,21 @@ def log_adapter(log_format: str, torque_constants: str | None, robot):
         An unknown format; torque constants with another format than ur-rtde, not numbers, not one
         per axis or outside their bounds (named).
     """
-    from faultgen.data import adapters
+    from faultgen.logs import formats
 
     if torque_constants is not None and log_format != "ur-rtde":
         raise ValueError(f"--torque-constants reads UR's actual_current columns: give it with --format ur-rtde, not "
                          f"--format {log_format}")
-    if log_format == "measured":
-        return None
     options = {}
     if torque_constants is not None:
         try:
             constants = tuple(float(k) for k in torque_constants.split(","))
         except ValueError:
             constants = ()
-        lo, hi = adapters.MIN_TORQUE_CONSTANT, adapters.MAX_TORQUE_CONSTANT
+        lo, hi = formats.MIN_TORQUE_CONSTANT, formats.MAX_TORQUE_CONSTANT
         n_axes = robot.n_axes
         if len(constants) != n_axes or not all(lo <= k <= hi for k in constants):
             raise ValueError(f"--torque-constants {torque_constants[:200]!r}: expected {n_axes} numbers (the axes "
                              f"of {robot.name}), comma-separated, each {lo:g} .. {hi:g} N m/A at the joint")
         options["torque_constants"] = constants
-    return adapters.make(log_format, **options)
+    return formats.make(log_format, **options)

@@ -106,9 +106,10 @@ def simulate_command(
     if cycles < 1:
         raise ValueError(f"--cycles {cycles}: expected a whole number >= 1")
     loaded = robots.load(robot) if torque_constants is not None else None  # to check --torque-constants only
-    adapter = log_adapter(log_format, torque_constants, loaded)  # None: the measured format, read as before
+    adapter = log_adapter(log_format, torque_constants, loaded)
+    task_of = programs.log_task(task, adapter)  # a LogTask for a log in another format than the default
     config = sim.RunConfig(
-        robot=robot, task=programs.log_task(task, adapter), friction=friction_model,
+        robot=robot, task=task_of, friction=friction_model,
         wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
         record=None if record is None else parse_cycles(record), seed=seed,
         noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
@@ -126,7 +127,7 @@ def simulate_command(
     dataset.write_run(out, result, command=command)
     typer.echo(summary(result, out))
     if result.saturated.size:
-        typer.echo(saturation_warning(result.saturated, task, replayed=adapter is not None), err=True)
+        typer.echo(saturation_warning(result.saturated, task, replayed=isinstance(task_of, programs.LogTask)), err=True)
 
 
 def saturation_warning(saturated, task: str, replayed: bool = False) -> str:

@@ -47,7 +47,8 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen import __version__
-from faultgen.data import adapters, logfolder, measured, schema, writer
+from faultgen.data import logfolder, schema, writer
+from faultgen.logs import formats, measured
 from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
@@ -59,16 +60,19 @@ from faultgen.simulation import sensors
 WORN_MARK = 2.0
 #: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
 MEASURED = schema.MEASURED
-#: Suffixes of the logs the measured-format reader takes (:func:`faultgen.data.measured.read`).
+#: Suffixes of the logs the measured-format reader takes (:func:`faultgen.logs.measured.read`).
 SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
 #: Why a log listed in the folder was not imported when it vanished before it was read (skipped, named).
 VANISHED = "removed from the folder while it was imported"
 #: The group of the manifest in an imported dataset.
 MANIFEST = "import"
 
-#: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.data.measured.read`, or an
-#: adapter's, :mod:`faultgen.data.adapters`).
+#: A reader of one log: ``(path, robot) -> MeasuredData`` (:func:`faultgen.logs.measured.read`, or an
+#: adapter's, :mod:`faultgen.logs.formats`).
 Reader = Callable[[Path, robots.Robot], measured.MeasuredData]
+#: The measured format's reader (:data:`faultgen.logs.formats.MEASURED`), without the accelerations
+#: the import's features do not use.
+MEASURED_READER = functools.partial(formats.MEASURED.read, accelerations=False)
 
 
 @dataclass
@@ -95,7 +99,7 @@ class ImportSummary:
         Logs with a worn axis, logs all healthy, the others (unknown), over the whole dataset.
     torque : dict
         Logs read now per torque source, where the log format says which torque it read
-        (:func:`faultgen.data.adapters.torque_source`: measured current x torque constant, or the
+        (:func:`faultgen.logs.formats.torque_source`: measured current x torque constant, or the
         commanded moment, which cannot show wear).
     friction_tests : int
         Friction tests found in the units' ``friction-test`` folders
@@ -175,7 +179,7 @@ def read_once(read: Reader, path: Path, robot: robots.Robot) -> tuple[measured.M
     Raises
     ------
     ValueError
-        The reader's refusal (:class:`faultgen.data.measured.MeasuredDataError`, an adapter's), or
+        The reader's refusal (:class:`faultgen.logs.measured.MeasuredDataError`, an adapter's), or
         :class:`faultgen.inputs.InputError` for a path that is not a regular file.
     """
     import tempfile
@@ -205,7 +209,7 @@ def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np
     Parameters
     ----------
     data : MeasuredData
-        The log, checked (:func:`faultgen.data.measured.read`).
+        The log, checked (:func:`faultgen.logs.measured.read`).
     robot : Robot
         Its robot: gear ratio (arm-side torque -> motor torque), joint range, peak motor torque.
     speed_limit : ndarray of shape (N,)
@@ -325,7 +329,7 @@ class _Previous:
 
 
 def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, progress: bool = True,
-                reimport_changed: bool = False, reader: Reader | None = None, suffixes: tuple[str, ...] = SUFFIXES,
+                reimport_changed: bool = False, reader: Reader = MEASURED_READER, suffixes: tuple[str, ...] = SUFFIXES,
                 command: str = "") -> ImportSummary:
     """Import a fleet's folder of logs into a faultgen dataset (module docstring), atomically.
 
@@ -348,8 +352,9 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     reimport_changed : bool
         Import again a file whose content changed since it was imported; without it, refused.
     reader : callable, optional
-        ``(path, robot) -> MeasuredData`` of one log; default :func:`faultgen.data.measured.read`
-        (an adapter's: :func:`faultgen.data.adapters.reader`).
+        ``(path, robot) -> MeasuredData`` of one log; default the measured format's
+        (:data:`MEASURED_READER`; another format's: its :meth:`~faultgen.logs.formats.LogFormat.read`
+        without accelerations).
     suffixes : tuple of str
         The file endings of logs (lower case), the reader's.
     command : str
@@ -363,7 +368,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     ------
     ValueError
         For a bad folder layout or events file (:mod:`faultgen.data.logfolder`), a bad log without
-        ``skip_bad`` (its file and row named: :class:`faultgen.data.measured.MeasuredDataError`), a
+        ``skip_bad`` (its file and row named: :class:`faultgen.logs.measured.MeasuredDataError`), a
         file changed since its import without ``reimport_changed``, an ``out`` that is not an import
         of this robot, or no log to import at all. Nothing is written.
     OSError
@@ -372,7 +377,7 @@ def import_logs(logs_dir: Path, out: Path, *, robot, skip_bad: bool = False, pro
     logs_dir, out = Path(logs_dir), Path(out)
     check_apart(out, logs_dir)  # a dataset inside LOGS would be read back as a file of the folder
     robot = robot if isinstance(robot, robots.Robot) else robots.load(robot)
-    read = reader or functools.partial(measured.read, accelerations=False)
+    read = reader
     speed_limit = programs.robot_limits(robot)[0]
     units, not_logs = logfolder.scan(logs_dir, suffixes)
     if not_logs and not skip_bad:
@@ -474,7 +479,7 @@ def _rows(unit, entries, old, read, robot, speed_limit, skip_bad, summary, bar) 
         rows.append({**log_record(data, robot, speed_limit), "log_file": name, "sha256": digest, "stamp": log.stamp,
                      "key": key, "period": data.sample_period})
         summary.imported.append(name)
-        source = adapters.torque_source(data.notes)
+        source = formats.torque_source(data.notes)
         if source:
             summary.torque[source] = summary.torque.get(source, 0) + 1
         bar.update()

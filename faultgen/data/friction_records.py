@@ -15,9 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import atomic, cells, measured
+from faultgen.data import atomic, cells
+from faultgen.logs import measured
 from faultgen.data.reader import Run
-from faultgen.operation import jointlog
+from faultgen.logs import jointlog
 
 
 def _columns(run: Run, index: int) -> dict[str, np.ndarray]:
@@ -46,7 +47,7 @@ def log(run: Run, index: int, robot) -> measured.MeasuredData:
     ------
     ValueError
         For a run that is not a friction test or an index out of range (named), or a log that does
-        not check (:class:`faultgen.data.measured.MeasuredDataError`).
+        not check (:class:`faultgen.logs.measured.MeasuredDataError`).
     """
     return measured.from_columns(_columns(run, index), robot, f"{run.id} test {index + 1}", accelerations=False)
 

@@ -5,8 +5,8 @@ they give each log (what :func:`faultgen.data.fleetlogs.import_logs` reads, docs
     LOGS/
       events.csv                 optional: unit, stamp, event, axis (one row per event)
       <unit>/<stamp>.csv         one log: one or more cycles in the measured format
-      <unit>/<stamp>.csv.gz      (faultgen.data.measured), or the layout of an adapter
-      <unit>/<stamp>.h5          (faultgen.data.adapters)
+      <unit>/<stamp>.csv.gz      (faultgen.logs.measured), or the layout of an adapter
+      <unit>/<stamp>.h5          (faultgen.logs.formats)
       <unit>/friction-test/<stamp>.csv   optional: the unit's friction tests (the same suffixes and
                                  stamps as its logs; never taken as logs: :func:`scan_tests`)
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from faultgen.data import measured
+from faultgen.logs import measured
 
 #: A log whose angles lie more than this off its program's cycle, rad, or whose cycles' span differs
 #: by more than PROGRAM_LENGTH of the program's period, runs another program (noise and tracking:

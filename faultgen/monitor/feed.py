@@ -118,7 +118,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
 
 
 def program_changed(data, program: cycles.Program) -> bool:
-    """Whether a checked log ``data`` (:class:`faultgen.data.measured.MeasuredData`) traces another
+    """Whether a checked log ``data`` (:class:`faultgen.logs.measured.MeasuredData`) traces another
     motion than ``program``'s: its cycles (its ``cycle`` column, else a whole number of the program's
     periods) match neither the program's cycle nor a multiple of it
     (:meth:`faultgen.monitor.cycles.Program.log_cycles`; noise and tracking stay far below it)."""

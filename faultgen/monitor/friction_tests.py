@@ -76,6 +76,7 @@ import numpy as np
 
 from faultgen.calibrate import friction_fit, friction_report
 from faultgen.data import cells, logfolder
+from faultgen.logs import formats
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 
@@ -155,14 +156,15 @@ def _cache_key(robot_sha256: str, sha256: str, log_format: str) -> dict:
     return {"robot": robot_sha256, "test": sha256, "format": log_format, "reader": CACHE_FORMAT}
 
 
-def read_tests(found: dict[str, list], robot, out: Path, log_format=None) -> dict[str, list[FrictionTest]]:
+def read_tests(found: dict[str, list], robot, out: Path,
+               log_format: formats.LogFormat = formats.MEASURED) -> dict[str, list[FrictionTest]]:
     """Each unit's tests read (module docstring), in stamp order: from ``OUT/.cache/friction-tests``
     when an earlier run read the same bytes (checked against its key), else parsed by the logs'
     reader (``log_format``, :func:`faultgen.monitor.logs.reader_of`) and fitted, and cached."""
     reader, _ = fleet_logs.reader_of(log_format)
-    held = log_format is None or bool(getattr(log_format, "reads_held", False))
+    held = bool(log_format.reads_held)
     robot_sha256 = stored.sha256_file(robot.path)
-    fmt = "measured" if log_format is None else repr(log_format)
+    fmt = log_format.key
     confined = stored.out_folder(out)
     root = Path(out) / ".cache" / CACHE
     read: dict[str, list[FrictionTest]] = {}

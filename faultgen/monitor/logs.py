@@ -1,7 +1,7 @@
 """A fleet's measured logs, one at a time, as the monitor reads them: the folder
 (:func:`faultgen.data.logfolder.scan`), each log's record by the import's code
 (:func:`faultgen.data.fleetlogs.log_record`: the per-cycle features of a simulated fleet's daily
-records) and its logged conditions (joint temperature, payload; :mod:`faultgen.data.measured`).
+records) and its logged conditions (joint temperature, payload; :mod:`faultgen.logs.measured`).
 
 Each log is read once in a run (:class:`Source`): its bytes held (:func:`faultgen.inputs.hold`),
 hashed (the SHA-256 the state and the caches key on) and parsed from them by the log format's
@@ -19,11 +19,12 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import inputs
-from faultgen.data import fleetlogs, logfolder, measured
+from faultgen.data import fleetlogs, logfolder
+from faultgen.logs import formats, jointlog, measured
 from faultgen.model.robots import Robot
 from faultgen.monitor import scoring
 from faultgen.monitor import state as stored
-from faultgen.operation import jointlog, programs
+from faultgen.operation import programs
 
 #: The features the monitor watches per axis (:data:`faultgen.monitor.scoring.FEATURES`, which says why).
 FEATURES = scoring.FEATURES
@@ -35,20 +36,18 @@ MOVING_SPEED = 0.01
 Log = logfolder.LogFile
 
 
-#: A log reader: (path, robot) -> the checked log (:func:`faultgen.data.measured.read`, or an
-#: adapter's, :mod:`faultgen.data.adapters`).
+#: A log reader: (path, robot) -> the checked log (:func:`faultgen.logs.measured.read`, or an
+#: adapter's, :mod:`faultgen.logs.formats`).
 Reader = Callable[[Path, Robot], measured.MeasuredData]
 
 
-def reader_of(adapter=None) -> tuple[Reader, tuple[str, ...]]:
-    """The reader and the file suffixes of a log format: the measured format's without ``adapter``,
-    else the adapter's (:class:`faultgen.data.adapters.Adapter`). Either estimates the accelerations,
+def reader_of(adapter: formats.LogFormat = formats.MEASURED) -> tuple[Reader, tuple[str, ...]]:
+    """The reader and the file suffixes of the log format ``adapter`` (a
+    :class:`faultgen.logs.formats.LogFormat`, the measured one by default). It estimates the accelerations,
     as the measured format's reader does: the one parse of a log serves its features, and, for a
     unit's first log, the calibration and the twin, which need them (read without them, every
     ``ur-rtde`` unit's calibrated twin fails on "qdd holds a non-finite value" and falls back to the
     nominal model)."""
-    if adapter is None:
-        return measured.read, fleetlogs.SUFFIXES
     return adapter.read, adapter.suffixes
 
 
@@ -116,7 +115,7 @@ def features_of(robot: Robot, data: measured.MeasuredData) -> np.ndarray:
 
 
 def read(robot: Robot, log: Log, reader: Reader = measured.read) -> Reading:
-    """Read and check one log (``reader``: :func:`faultgen.data.measured.read` by default; errors
+    """Read and check one log (``reader``: :func:`faultgen.logs.measured.read` by default; errors
     name the file and row)."""
     return reading_of(robot, reader(log.path, robot))
 
@@ -129,7 +128,7 @@ def reading_of(robot: Robot, data: measured.MeasuredData) -> Reading:
 
 
 #: Largest log held in memory to be read once, bytes on disk: the bound a log read whole puts on its
-#: kept cells (:data:`faultgen.operation.jointlog.WHOLE_MAX_BYTES`), so holding its bytes at most
+#: kept cells (:data:`faultgen.logs.jointlog.WHOLE_MAX_BYTES`), so holding its bytes at most
 #: doubles what reading it takes. A larger log is parsed from its path (its header, size and rows
 #: each opening it) and hashed by another read.
 HOLD_MAX_BYTES = jointlog.WHOLE_MAX_BYTES
@@ -138,7 +137,7 @@ HOLD_MAX_BYTES = jointlog.WHOLE_MAX_BYTES
 @dataclass(frozen=True, eq=False)
 class Parsed:
     """A log as one read of it found it: ``path``, ``sha256`` (hex, of its bytes) and the checked
-    ``data`` (:class:`faultgen.data.measured.MeasuredData`), or ``error`` (the ``ValueError`` its
+    ``data`` (:class:`faultgen.logs.measured.MeasuredData`), or ``error`` (the ``ValueError`` its
     reading raised, naming the file and row), which :meth:`checked` raises."""
 
     path: Path
@@ -185,8 +184,8 @@ def parse(path: Path, robot: Robot, reader: Reader = measured.read, held: bool =
 
 class Source:
     """The logs of one ``faultgen monitor`` run, each read once (:func:`parse`) by the format's
-    reader (``log_format`` an adapter, the measured format when None; held unless the adapter reads
-    only paths: :attr:`faultgen.data.adapters.Adapter.reads_held`) and kept until :meth:`done` (a
+    reader (``log_format``, a :class:`faultgen.logs.formats.LogFormat`; held unless it reads
+    only paths: :attr:`faultgen.logs.formats.LogFormat.reads_held`) and kept until :meth:`done` (a
     program, :meth:`keep`, for the run), so a unit's first log serves its program, calibration,
     twin and score from one read. It holds the parsed first log of each unit not yet scored, and
     each program. ``robot`` is the run's nominal robot and ``given`` the model given for every unit
@@ -195,11 +194,12 @@ class Source:
     None without one, or the ValueError its loading raised (each unit then falls back, saying why:
     :func:`faultgen.monitor.unit.twin_of`)."""
 
-    def __init__(self, robot: Robot, log_format=None, given: Robot | ValueError | None = None):
+    def __init__(self, robot: Robot, log_format: formats.LogFormat = formats.MEASURED,
+                 given: Robot | ValueError | None = None):
         self.robot = robot
         self.given = given
         self.reader, _ = reader_of(log_format)
-        self.held = log_format is None or bool(getattr(log_format, "reads_held", False))
+        self.held = bool(log_format.reads_held)
         self._parsed: dict[Path, Parsed] = {}
         self._kept: set[Path] = set()
 

@@ -44,7 +44,8 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from faultgen.data import adapters, atomic, fleetlogs, logfolder
+from faultgen.data import atomic, fleetlogs, logfolder
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
@@ -88,7 +89,7 @@ class UnitStatus:
     reason: str
     logs_scored: int
     last_log: str
-    #: The torque its logs were read from, where the log format says (:func:`faultgen.data.adapters.torque_source`:
+    #: The torque its logs were read from, where the log format says (:func:`faultgen.logs.formats.torque_source`:
     #: measured current x torque constant, or the commanded moment, which cannot show wear); "" otherwise.
     torque_source: str = ""
     #: The fallbacks its twin took (:func:`faultgen.monitor.unit.twin_of`'s notes, also in ``reason``).
@@ -118,7 +119,7 @@ class Outcome:
 
 def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
             calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format=None, context: ExecutionContext = LOCAL,
+            progress: bool = True, log_format: formats.LogFormat = formats.MEASURED, context: ExecutionContext = LOCAL,
             failure_wear: float = prognosis.FAILURE_WEAR,
             hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
     """Monitor every unit of ``logs_dir`` (module docstring).
@@ -146,8 +147,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         The twin also predicts the temperature's effect (the model's own temperature law) instead
         of the unit's learned slope alone.
     progress : bool
-    log_format : faultgen.data.adapters.Adapter, optional
-        The logs' layout (``ur-rtde``, ``voraus``); the measured format when None.
+    log_format : faultgen.logs.formats.LogFormat, optional
+        The logs' layout (``ur-rtde``, ``voraus``); the measured format by default.
     context : ExecutionContext
         Where and on what the units are scored (:class:`faultgen.runs.context.ExecutionContext`;
         default: this process, ``BatchStepper()``): ``jobs`` local processes scoring units in
@@ -210,7 +211,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
     key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
-                                 "measured" if log_format is None else repr(log_format))
+                                 log_format.key)
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
     maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
@@ -406,7 +407,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         status = "learning" if learning else "monitored"
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
-                      "; ".join(reasons), len(unit.entries), last, adapters.torque_source(unit.notes),
+                      "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
                       "; ".join(fallback_notes(unit)))
 
 

@@ -44,7 +44,7 @@ def write_units(path: Path, statuses, scales: dict[str, str] | None = None) -> N
     logs scored and the last one; with ``scales`` (a fleet with friction tests, or a unit whose twin
     fell back to the nominal model) also the scale of its wear, ``wear_scale`` (a unit not in it:
     ``twin``; :mod:`faultgen.monitor.friction_tests`); where a log format says which torque it read
-    (``ur-rtde``), ``torque_source`` (:func:`faultgen.data.adapters.torque_source`)."""
+    (``ur-rtde``), ``torque_source`` (:func:`faultgen.logs.formats.torque_source`)."""
     sources = any(getattr(s, "torque_source", "") for s in statuses)
     with open(path, "w", newline="") as f:
         writer = cells.writer(f)

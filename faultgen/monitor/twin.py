@@ -47,7 +47,8 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import derivatives
-from faultgen.data import cells, measured
+from faultgen.data import cells
+from faultgen.logs import measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
 from faultgen.monitor import cycles as program_cycles

@@ -56,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import inputs
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation.ik import tool_rotation
@@ -104,12 +105,13 @@ def is_file_task(task: str | LogTask) -> bool:
     return isinstance(task, LogTask) or name.endswith(PROGRAM_SUFFIXES + REPLAY_SUFFIXES)
 
 
-def log_task(task: str, adapter=None) -> str | LogTask:
+def log_task(task: str, adapter: formats.LogFormat = formats.MEASURED) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
-    :class:`faultgen.data.adapters.Adapter`): a :class:`LogTask`; ``task`` itself when ``adapter``
-    is None (the measured format, or no log). ValueError when ``adapter`` is given with a thesis
-    task or a program file (a format reads a joint log)."""
-    if adapter is None:
+    :class:`faultgen.logs.formats.LogFormat`): a :class:`LogTask`; ``task`` itself in the registry's
+    default format (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program or a thesis
+    task, recorded as named). ValueError when another format is given with a thesis task or a
+    program file (a format reads a joint log)."""
+    if adapter.name == formats.DEFAULT:
         return task
     if task in TASKS or str(task).lower().endswith(PROGRAM_SUFFIXES):
         what = "a thesis task" if task in TASKS else "a program file"
@@ -184,7 +186,7 @@ def load(robot: Robot, task: str) -> Task:
     # which a thesis task or program would spend before its first physics step for nothing)
     from faultgen.operation import replay
 
-    adapter = task.adapter if isinstance(task, LogTask) else None
+    adapter = task.adapter if isinstance(task, LogTask) else formats.MEASURED
     return replay.read(str(task), robot, _limits({}, robot, str(task)), check_torque, adapter=adapter)
 
 

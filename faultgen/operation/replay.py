@@ -3,7 +3,7 @@
 A log is a CSV file (``.csv`` or gzip-compressed ``.csv.gz``, a header row) or an HDF5 file (``.h5``,
 ``.hdf5``; one 1-D dataset per column at the root) with the columns ``t`` (s, strictly increasing)
 and ``q1`` .. ``qN`` (rad, N the robot's axes); other columns are ignored, so the measured-log format
-of ``faultgen calibrate`` (:mod:`faultgen.data.measured`: ``t, q, tau``, optional ``qd``) reads as
+of ``faultgen calibrate`` (:mod:`faultgen.logs.measured`: ``t, q, tau``, optional ``qd``) reads as
 it is.
 
 The reference (:meth:`Replay.trajectory`):
@@ -27,21 +27,21 @@ A log that does not start at rest gets no run-in (a ramp from rest into its firs
 would shift the whole log later in the run, and the recorded reference would be off the log at
 the recorded times (by up to 0.8 rad).
 
-The log is read by the measured-log reader (:mod:`faultgen.operation.jointlog`: one parser, one
+The log is read by the measured-log reader (:mod:`faultgen.logs.jointlog`: one parser, one
 set of checks, one derivative estimator; the torque columns are not needed), in blocks
-(:mod:`faultgen.operation.logblocks`), so memory does not grow with the log's rows: a log of at
+(:mod:`faultgen.logs.blocks`), so memory does not grow with the log's rows: a log of at
 most one row per physics step of the robot is read whole; a denser one is checked row by row as
 it streams by and then replayed as every ``k``-th row from the first, at most one row per step
 (what the reference, sampled at that step, can use), kept as it is read: the log as if it had been
 recorded at that rate (the reference passes through its own samples, time 0 is its first).
-A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``) is
+A log in another registered format (:mod:`faultgen.logs.formats`, ``--format NAME``) is
 streamed the same way through its adapter's block reader; read whole (at most a row per physics
 step), its columns are replayed by :func:`from_columns` with the same checks and messages.
 
-Refused before any simulation (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming
+Refused before any simulation (:class:`faultgen.logs.jointlog.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
 increasing, a log shorter than :data:`MIN_DURATION`, a gap longer than
-:data:`faultgen.operation.jointlog.MAX_GAP`, a log longer than
+:data:`faultgen.logs.jointlog.MAX_GAP`, a log longer than
 :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION` (as soon as a block shows it, before the rest
 is read), an angle outside the joint range (by how much), and a motor torque above the drives'
 capacity.
@@ -58,15 +58,15 @@ from ruckig import ControlInterface, DurationDiscretization, InputParameter, Res
 from scipy.interpolate import CubicSpline
 
 from faultgen.model.robots import Robot
-from faultgen.operation import jointlog, logblocks
-from faultgen.operation.jointlog import MAX_GAP, LogError
+from faultgen.logs import blocks, formats, jointlog
+from faultgen.logs.jointlog import MAX_GAP, LogError
 from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath
 
 #: Shortest log replayed, s (four filter windows); the longest interval between samples is the
-#: measured-log reader's :data:`faultgen.operation.jointlog.MAX_GAP` (the derivative filter's window).
+#: measured-log reader's :data:`faultgen.logs.jointlog.MAX_GAP` (the derivative filter's window).
 MIN_DURATION = 0.2
 #: Rows read at a time: a replay's peak memory is that of its reference at the physics step, so its
-#: blocks are smaller than the calibration's (:data:`faultgen.operation.logblocks.BLOCK_ROWS`).
+#: blocks are smaller than the calibration's (:data:`faultgen.logs.blocks.BLOCK_ROWS`).
 BLOCK_ROWS = 50_000
 #: A log end is at rest when every axis is below these, rad/s and rad/s^2.
 REST_SPEED = 1e-3
@@ -124,7 +124,7 @@ class Replay:
 
         Raises
         ------
-        faultgen.operation.jointlog.LogError
+        faultgen.logs.jointlog.LogError
             If the path leaves the joint ranges or needs more than the drives' torque.
         """
         steps = round(self.duration / dt)
@@ -208,12 +208,12 @@ def _run_out(replay: Replay, q, qd, qdd, dt: float):
 
 
 def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
-         check_torque: Callable, adapter=None) -> Replay:
-    """Read a joint log to replay on ``robot`` (module docstring) by the measured-log reader
-    (:mod:`faultgen.operation.jointlog`, no torque columns) or, with ``adapter``, by that log
-    format's readers, streamed (:mod:`faultgen.operation.logblocks`) through the format's block
-    source either way; a log of at most a row per physics step then read whole (an adapter's by
-    its ``columns``, checked by :func:`from_columns`).
+         check_torque: Callable, adapter: formats.LogFormat = formats.MEASURED) -> Replay:
+    """Read a joint log to replay on ``robot`` (module docstring) by the readers of its format
+    ``adapter`` (the measured format's by default: :mod:`faultgen.logs.jointlog`, no torque
+    columns), streamed (:mod:`faultgen.logs.blocks`) through the format's block source; a log of
+    at most a row per physics step then read whole (the format's :meth:`~faultgen.logs.formats.LogFormat.motion`,
+    checked by :func:`from_columns`).
 
     Parameters
     ----------
@@ -228,48 +228,44 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
     check_torque : callable
         ``check_torque(robot, path, segment_at, fail)`` refusing a reference above the drives'
         capacity: :func:`faultgen.operation.programs.check_torque`.
-    adapter : faultgen.data.adapters.Adapter, optional
-        The log's format other than the measured one: ``source(path, robot, motion_only=True)``
+    adapter : faultgen.logs.formats.LogFormat, optional
+        The log's format (default :data:`faultgen.logs.formats.MEASURED`): ``source(path, robot, motion_only=True)``
         gives its blocks of the measured format's columns (``t``, ``q1..qN`` used; the block source
-        of :mod:`faultgen.operation.logblocks`), ``columns(path, robot)`` the whole file's, which
+        of :mod:`faultgen.logs.blocks`), ``motion(path, robot)`` the whole file's, which
         :func:`from_columns` checks.
 
     Raises
     ------
-    faultgen.operation.jointlog.LogError
+    faultgen.logs.jointlog.LogError
         A ValueError naming the file and the row or column: a missing file or column, a non-finite
         value, time that does not increase, a log that is too short, has a gap or runs longer than
         :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
-        With ``adapter``, what its reader refuses too (a ValueError naming the file).
+        What the format's reader refuses too (a ValueError naming the file).
     """
     path = Path(path)
     n_axes = robot.n_axes
-    src = (logblocks.source(path, n_axes, motion_only=True) if adapter is None
-           else adapter.source(path, robot, motion_only=True))
-    times = logblocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
-    scan = logblocks.scan(src, robot, times, BLOCK_ROWS)
+    src = adapter.source(path, robot, motion_only=True)
+    times = blocks.TimeScan(path, src.label, lambda first, last, rows: _check_length(path, first, last))
+    scan = blocks.scan(src, robot, times, BLOCK_ROWS)
     rows = times.rows
     most = _most_rows(times, robot)  # a row per physics step
-    if rows <= most and adapter is not None:  # read whole by the format's reader, as the calibration reads it
-        columns, label = adapter.columns(path, robot)[:2]
+    if rows <= most:  # read whole by the format's reader, as the calibration reads it
+        columns, label = adapter.motion(path, robot)
         return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
-    if rows <= most:  # read whole, as the calibration reads a log
-        columns, _, label = jointlog.read_columns(path, n_axes, motion_only=True)
-    else:  # denser than the physics step: every k-th row kept while read, once every row is checked
-        times.check(MIN_DURATION, 1 / MAX_GAP)
-        q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
-        jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
-        k = -(-rows // most)
-        columns, label = logblocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
-    suffixes = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES if adapter is None else adapter.suffixes
-    return _replay(columns, label, path, robot, limits, check_torque, suffixes)
+    # denser than the physics step: every k-th row kept while read, once every row is checked
+    times.check(MIN_DURATION, 1 / MAX_GAP)
+    q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
+    jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
+    k = -(-rows // most)
+    columns, label = blocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
+    return _replay(columns, label, path, robot, limits, check_torque, adapter.suffixes)
 
 
 def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], path: str | Path, robot: Robot,
                  limits: tuple[np.ndarray, np.ndarray, np.ndarray], check_torque: Callable,
                  suffixes: tuple[str, ...] = ()) -> Replay:
     """A log already parsed into the measured format's columns (a log format's adapter,
-    :meth:`faultgen.data.adapters.Adapter.columns`), replayed on ``robot`` with the checks and
+    :meth:`faultgen.logs.formats.LogFormat.columns`), replayed on ``robot`` with the checks and
     messages :func:`read` gives a measured log read whole: a missing column, a non-finite value,
     time not increasing, too short, a gap, too long, an angle outside the joint range; a log denser
     than one row per physics step is replayed as every ``k``-th row, as :func:`read` does.
@@ -279,7 +275,7 @@ def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], pa
     columns : dict of str to ndarray of shape (n,)
         ``t`` (s) and ``q1..qN`` (rad) used; other columns ignored.
     label : callable
-        Data row index (0-based) -> its name in messages (:func:`faultgen.operation.jointlog.index_label`).
+        Data row index (0-based) -> its name in messages (:func:`faultgen.logs.jointlog.index_label`).
     path : str or Path
         The file, named in messages; its name less the longest of ``suffixes`` it ends with is the
         replay's :attr:`Replay.name` (less its last suffix when none).
@@ -288,14 +284,14 @@ def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], pa
 
     Raises
     ------
-    faultgen.operation.jointlog.LogError
+    faultgen.logs.jointlog.LogError
         As :func:`read`.
     """
     path = Path(path)
     wanted, _ = jointlog.select_columns(path, list(columns), robot.n_axes, motion_only=True)
     motion = {name: np.asarray(columns[name], dtype=float) for name in wanted}
     jointlog.refuse_non_finite(path, motion, wanted, label)
-    times = logblocks.TimeScan(path, label, lambda first, last, rows: _check_length(path, first, last))
+    times = blocks.TimeScan(path, label, lambda first, last, rows: _check_length(path, first, last))
     if len(motion[jointlog.T_COLUMN]):  # none: refused by the whole-log checks below, as read() refuses it
         times.add(0, motion[jointlog.T_COLUMN])
     most = _most_rows(times, robot)
@@ -309,7 +305,7 @@ def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], pa
     return _replay(motion, label, path, robot, limits, check_torque, suffixes)
 
 
-def _most_rows(times: logblocks.TimeScan, robot: Robot) -> int:
+def _most_rows(times: blocks.TimeScan, robot: Robot) -> int:
     """The rows a log of these ``times`` is replayed with at most: one per physics step."""
     step = robot.model.opt.timestep
     rows = times.rows
@@ -319,7 +315,7 @@ def _most_rows(times: logblocks.TimeScan, robot: Robot) -> int:
 def _replay(columns: dict[str, np.ndarray], label: Callable[[int], str], path: Path, robot: Robot, limits: tuple,
             check_torque: Callable, suffixes: tuple[str, ...]) -> Replay:
     """The :class:`Replay` of a log's ``t`` and ``q`` ``columns`` (at most a row per physics step),
-    checked and differentiated (:func:`faultgen.operation.jointlog.motion`)."""
+    checked and differentiated (:func:`faultgen.logs.jointlog.motion`)."""
     found = jointlog.motion(columns, robot, path, label, [], min_duration=MIN_DURATION, min_rate=1 / MAX_GAP,
                             tolerance=0.0)
     t, q, (qd, qdd) = found["t"], found["q"], found["derivatives"]

@@ -154,7 +154,7 @@ class Task(Protocol):
 @dataclass(frozen=True)
 class LogTask:
     """A joint log to replay that is read through a registered log format
-    (:mod:`faultgen.data.adapters`; ``faultgen simulate --task LOG --format NAME``) instead of the
+    (:mod:`faultgen.logs.formats`; ``faultgen simulate --task LOG --format NAME``) instead of the
     measured format, whose log stays a plain path. It stands where a task name does
     (:func:`faultgen.operation.programs.load` replays it): ``str()`` and ``os.fspath()`` give the
     path as given; hashable, so the task's cached preparations are keyed by path and format.
@@ -164,7 +164,7 @@ class LogTask:
     path : str
         The log file, as given.
     adapter : object
-        The format's adapter (a :class:`faultgen.data.adapters.Adapter`; this layer only calls its
+        The format's adapter (a :class:`faultgen.logs.formats.LogFormat`; this layer only calls its
         ``columns(path, robot)``, reads its ``name``, ``suffixes`` and dataclass fields).
     """
 

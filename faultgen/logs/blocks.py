@@ -1,4 +1,4 @@
-"""A joint log (:mod:`faultgen.operation.jointlog`) read in blocks of rows and averaged down while
+"""A joint log (:mod:`faultgen.logs.jointlog`) read in blocks of rows and averaged down while
 it is read, so that reading a long log takes memory that does not grow with its length
 (docs/reliability.md; docs/calibration.md "Long logs"; issue 50).
 
@@ -23,9 +23,9 @@ order of a block's columns); ``extra``, the file's columns ignored; ``notes``, w
 chose; ``rows``, an upper bound of the data rows, known before they are parsed; ``label``, data
 row index -> its name in messages; and ``blocks(size)``, yielding ``(start, block)``: the index of
 the block's first data row and a float array of shape (size, len(wanted)) (the last block shorter),
-every cell refused unless finite (a :class:`~faultgen.operation.jointlog.LogError` naming the file,
+every cell refused unless finite (a :class:`~faultgen.logs.jointlog.LogError` naming the file,
 the data row and the column). :func:`source` gives the measured format's (:class:`Csv`,
-:class:`Hdf5`); every log format has one (:meth:`faultgen.data.adapters.Adapter.source`).
+:class:`Hdf5`); every log format has one (:meth:`faultgen.logs.formats.LogFormat.source`).
 """
 
 from __future__ import annotations
@@ -41,8 +41,8 @@ import pandas as pd
 from faultgen import inputs
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.model import robots
-from faultgen.operation import jointlog
-from faultgen.operation.jointlog import LogError
+from faultgen.logs import jointlog
+from faultgen.logs.jointlog import LogError
 
 #: Rows read at a time (rounded up to a whole number of averaging blocks).
 BLOCK_ROWS = 200_000
@@ -55,7 +55,7 @@ def block_mean(a: np.ndarray, k: int, m: int) -> np.ndarray:
 
 def source(path: Path, n_axes: int, motion_only: bool = False):
     """The log ``path`` as blocks of its wanted columns (:class:`Csv` or :class:`Hdf5`), its header or
-    datasets checked (:func:`faultgen.operation.jointlog.select_columns`)."""
+    datasets checked (:func:`faultgen.logs.jointlog.select_columns`)."""
     kind = jointlog.kind(path)
     jointlog.regular(path)
     return Csv(path, n_axes, motion_only) if kind == "csv" else Hdf5(path, n_axes, motion_only)
@@ -135,7 +135,7 @@ class Csv:
 
 class Hdf5:
     """An HDF5 log's wanted root datasets in blocks of rows, each checked from its metadata first
-    (:func:`faultgen.operation.jointlog.hdf5_rows`: a dataset not 1-D, of text, of another length or
+    (:func:`faultgen.logs.jointlog.hdf5_rows`: a dataset not 1-D, of text, of another length or
     above MAX_ROWS refused, named)."""
 
     label = staticmethod(jointlog.index_label)
@@ -160,7 +160,7 @@ class Hdf5:
 @dataclass
 class TimeScan:
     """The sample times checked as they stream by, none of them kept: strictly increasing, no
-    interval above :data:`faultgen.operation.jointlog.MAX_GAP`; ``limit(first, last, rows)`` may
+    interval above :data:`faultgen.logs.jointlog.MAX_GAP`; ``limit(first, last, rows)`` may
     refuse the log as soon as a block shows it too long. The sample rate checked is that of the
     median of the blocks' median intervals (the exact median would need every interval at once)."""
 
@@ -193,7 +193,7 @@ class TimeScan:
         self.limit(self.first, self.last, self.rows)
 
     def check(self, min_duration: float, min_rate: float) -> None:
-        """Refuse what :func:`faultgen.operation.jointlog.check_time` refuses on the whole times."""
+        """Refuse what :func:`faultgen.logs.jointlog.check_time` refuses on the whole times."""
         if self.rows < 2:
             raise LogError(f"{self.path}: {self.rows} data row(s); expected at least {min_duration:g} s of data at "
                            f">= {min_rate:g} Hz")

@@ -2,20 +2,22 @@
 
 Each adapter maps a foreign file's columns onto the measured format's (``t``, ``q1..qN``,
 ``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
-:func:`faultgen.data.measured.from_columns`, which checks them as it checks a measured log (the
-same refusals, by data row). Registered by name (:func:`register`, :data:`ADAPTERS`), chosen with
+:func:`faultgen.logs.measured.from_columns`, which checks them as it checks a measured log (the
+same refusals, by data row). Registered by name (:func:`register`, :data:`FORMATS`), chosen with
 ``--format NAME`` (``logs import``, ``calibrate``, ``monitor``, ``simulate --task LOG``);
-docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`Adapter.columns`)
-or in blocks of rows (:meth:`Adapter.blocks`, :meth:`Adapter.source`: a log too long to read whole,
-calibrated by :mod:`faultgen.data.longlog` or replayed streamed by
+docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`LogFormat.columns`)
+or in blocks of rows (:meth:`LogFormat.blocks`, :meth:`LogFormat.source`: a log too long to read whole,
+calibrated by :mod:`faultgen.logs.longlog` or replayed streamed by
 :mod:`faultgen.operation.replay`) with the same checks and messages; :data:`MEASURED` is the
 measured format's own readers as an adapter (docs/architecture.md, "Log formats").
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
   ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
-  ``joint_temperatures_0..5`` (deg C, all or none), and the joint torque: with ``torque_constants``
-  given (N m/A at the joint, one per axis), the measured ``actual_current_0..5`` (A) times them;
-  without, the commanded ``target_moment_0..5`` (N m). Which one was taken is the log's note.
+  ``joint_temperatures_0..5`` (deg C, all or none), and the joint torque, the first of: the
+  measured current as torque by the controller's own constants, ``actual_current_as_torque_0..5``
+  (N m; RTDE output of e-Series controllers from PolyScope 5.23); with ``torque_constants`` given
+  (N m/A at the joint, one per axis), the measured ``actual_current_0..5`` (A) times them; the
+  commanded ``target_moment_0..5`` (N m). Which one was taken is the log's note.
 - ``voraus``: the voraus-AD dataset's Parquet layout (Brockmann et al. 2023, CC BY-NC-SA 4.0: never
   shipped with faultgen; read from your copy): ``time`` (s), ``joint_position_1..6`` (rad),
   ``joint_velocity_1..6`` (rad/s) and ``motor_torque_1..6`` (N m at the motor, referred to the
@@ -25,7 +27,6 @@ measured format's own readers as an adapter (docs/architecture.md, "Log formats"
 from __future__ import annotations
 
 import dataclasses
-from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -35,14 +36,14 @@ import numpy as np
 import pandas as pd
 
 from faultgen import inputs
-from faultgen.data import measured
+from faultgen.logs import blocks, delimited, jointlog, measured
 from faultgen.model import robots
-from faultgen.operation import jointlog, logblocks
 
-#: name -> adapter class.
-ADAPTERS: dict[str, type[Adapter]] = {}
-#: Largest foreign log read, bytes on disk.
-MAX_BYTES = 4 * 2**30
+#: name -> log format class, in the order registered: :data:`DEFAULT` first, then ``ur-rtde``,
+#: ``voraus`` and a user's (:func:`register`).
+FORMATS: dict[str, type[LogFormat]] = {}
+#: The format a log is read in when none is named (``--format measured``): :mod:`faultgen.logs.measured`.
+DEFAULT = "measured"
 #: N m/A: the torque constants at the joint a ``ur-rtde`` log may be read with (a UR joint's is
 #: about 10: the motor's 0.1 times the gear ratio 101).
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
@@ -51,15 +52,20 @@ MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
 #: A log's torque source in words (issue 72, item 2): the import's summary, units.csv's
 #: ``torque_source`` and the monitor's page say it (:func:`torque_source`). The commanded moment of a
 #: fixed program is the controller's model of the motion, the same every day whatever the joint's
-#: friction: it cannot show wear.
+#: friction: it cannot show wear. RTDE's ``actual_current_as_torque`` (PolyScope >= 5.23) is the
+#: measured current turned into torque by the controller's own constants.
 MEASURED_CURRENT, COMMANDED_MOMENT = "measured current x torque constant", "commanded moment (cannot show wear)"
+CURRENT_AS_TORQUE = "current as torque (controller's own constants)"
 
 
 def torque_source(notes) -> str:
-    """The torque source a log's reader noted (:attr:`faultgen.data.measured.MeasuredData.notes`,
-    the ``ur-rtde`` adapter's "torque from ..." note) as :data:`MEASURED_CURRENT` or
-    :data:`COMMANDED_MOMENT`; "" when no note names one (the measured format: the logged arm torque)."""
+    """The torque source a log's reader noted (:attr:`faultgen.logs.measured.MeasuredData.notes`,
+    the ``ur-rtde`` format's "torque from ..." note) as :data:`CURRENT_AS_TORQUE`,
+    :data:`MEASURED_CURRENT` or :data:`COMMANDED_MOMENT`; "" when no note names one (the measured
+    format: the logged arm torque)."""
     for note in notes:
+        if note.startswith("torque from actual_current_as_torque"):
+            return CURRENT_AS_TORQUE
         if note.startswith("torque from actual_current"):
             return MEASURED_CURRENT
         if note.startswith("torque from target_moment"):
@@ -73,20 +79,20 @@ PEEK_ROWS = 16
 
 
 def register(name: str):
-    """Class decorator: register an :class:`Adapter` under ``name`` (its ``--format``)."""
+    """Class decorator: register an :class:`LogFormat` under ``name`` (its ``--format``)."""
     def decorate(cls):
         cls.name = name
-        ADAPTERS[name] = cls
+        FORMATS[name] = cls
         return cls
     return decorate
 
 
 @dataclass(frozen=True)
-class Adapter:
+class LogFormat:
     """Base of a log format: ``suffixes`` (lower case) of the files it reads, and its two readers
     with the same checks and messages: whole (:meth:`columns`, :meth:`read`) and in blocks of rows
     (:meth:`blocks`, :meth:`source`) for a log too long to read whole (the calibration's
-    :mod:`faultgen.data.longlog`, the replay's streaming, :mod:`faultgen.operation.logblocks`).
+    :mod:`faultgen.logs.longlog`, the replay's streaming, :mod:`faultgen.logs.blocks`).
 
     A column-mapping format defines :meth:`convert` alone (one block of the file, its cells as
     floats, mapped onto the measured format's names and units) and :attr:`separator`: the base
@@ -118,7 +124,7 @@ class Adapter:
         raise NotImplementedError
 
     def _maps(self) -> bool:
-        return type(self).convert is not Adapter.convert
+        return type(self).convert is not LogFormat.convert
 
     def frames(self, path: Path | inputs.Held, size: int | None) -> Iterator[tuple[int, pd.DataFrame]]:
         """The delimited-text file ``path`` (:attr:`separator`, a header row; plain or gzip) as
@@ -127,16 +133,16 @@ class Adapter:
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
+        faultgen.logs.measured.MeasuredDataError
             Not a regular file, unreadable as such text, a column named twice in the header, a
             cell that is not a finite number (the data row, column and value named).
         """
         what = f"{self.name} log"
-        names, _ = _header(path, what, self.separator, what)
+        names, _ = delimited.header(path, what, self.separator, what)
         if size is None:
             jointlog.csv_rows(path, len(names), f"a {what}", what)  # whole: bounded by WHOLE_MAX_BYTES
         start = 0
-        for values in _text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
+        for values in delimited.text_chunks(path, what, f"a {what}", names, self.separator, names, self.label, size):
             frame = pd.DataFrame(values, columns=names)
             yield start, frame
             start += len(frame)
@@ -157,7 +163,7 @@ class Adapter:
         """``(columns, label)`` or ``(columns, label, notes)``: the file's columns under the
         measured format's names (dict of ndarray of shape (n,)), the data-row labeller of messages,
         and what the reading chose (which torque source, say), kept in
-        :attr:`faultgen.data.measured.MeasuredData.notes`. The base: :meth:`convert` of the
+        :attr:`faultgen.logs.measured.MeasuredData.notes`. The base: :meth:`convert` of the
         whole file (:meth:`frames`)."""
         if not self._maps():
             raise NotImplementedError(f"log format {self.name}: define convert() or columns()")
@@ -176,7 +182,7 @@ class Adapter:
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
+        faultgen.logs.measured.MeasuredDataError
             What :meth:`columns` refuses, with the same message.
         """
         if self._maps():
@@ -188,6 +194,16 @@ class Adapter:
         n = len(next(iter(columns.values()), ()))
         for start in range(0, n, size):
             yield {k: np.asarray(v)[start:start + size] for k, v in columns.items()}, label, tuple(*notes)
+
+    def motion(self, path: Path, robot: robots.Robot) -> tuple:
+        """``(columns, label)`` of the whole log as a replay reads it: ``t`` and ``q1..qN`` used
+        (:func:`faultgen.operation.replay.from_columns`). The base: :meth:`columns`."""
+        return self.columns(path, robot)[:2]
+
+    @property
+    def key(self) -> str:
+        """The format with its options as a cache or a monitor's state records it (its ``repr``)."""
+        return repr(self)
 
     def rows(self, path: Path) -> int:
         """An upper bound of the log's data rows, found before they are parsed. The base: the lines
@@ -201,20 +217,20 @@ class Adapter:
 
     def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
         """The log ``path`` as blocks of the measured format's columns (:class:`Blocks`: the block
-        source :mod:`faultgen.operation.logblocks` reads), ``motion_only`` as there (``t`` and
+        source :mod:`faultgen.logs.blocks` reads), ``motion_only`` as there (``t`` and
         ``q1..qN``: a replay)."""
         return Blocks(self, Path(path), robot, motion_only)
 
     def read(self, path: Path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
-        """Read and check one log (:func:`faultgen.data.measured.from_columns`; ``accelerations``
-        as :func:`faultgen.data.measured.read`); ``path`` may be held (:attr:`reads_held`)."""
+        """Read and check one log (:func:`faultgen.logs.measured.from_columns`; ``accelerations``
+        as :func:`faultgen.logs.measured.read`); ``path`` may be held (:attr:`reads_held`)."""
         given = path if self.reads_held and isinstance(path, inputs.Held) else inputs.path_of(path)
         columns, label, *notes = self.columns(given, robot)
         return measured.from_columns(columns, robot, inputs.path_of(path), label, accelerations,
                                      notes=notes[0] if notes else ())
 
 
-def make(name: str, **options) -> Adapter:
+def make(name: str, **options) -> LogFormat:
     """The adapter ``name`` with its options.
 
     Raises
@@ -222,10 +238,10 @@ def make(name: str, **options) -> Adapter:
     ValueError
         For an unknown name (the message lists the known ones) or a bad option.
     """
-    if name not in ADAPTERS:
-        raise ValueError(f"unknown log format {name!r}; expected measured (the default) or one of "
-                         f"{', '.join(ADAPTERS)}")
-    cls = ADAPTERS[name]
+    if name not in FORMATS:
+        raise ValueError(f"unknown log format {name!r}; expected {DEFAULT} (the default) or one of "
+                         f"{', '.join(n for n in FORMATS if n != DEFAULT)}")
+    cls = FORMATS[name]
     known = [f.name for f in dataclasses.fields(cls) if f.name != "suffixes"]
     unknown = [key for key in options if key not in known]
     if unknown:
@@ -235,21 +251,21 @@ def make(name: str, **options) -> Adapter:
 
 
 class Blocks:
-    """A log read through its format's :meth:`Adapter.blocks` as the block source
-    :mod:`faultgen.operation.logblocks` reads: ``path``, ``wanted`` (the measured format's columns
-    read, in the order of a block's columns: :func:`faultgen.operation.jointlog.select_columns`),
+    """A log read through its format's :meth:`LogFormat.blocks` as the block source
+    :mod:`faultgen.logs.blocks` reads: ``path``, ``wanted`` (the measured format's columns
+    read, in the order of a block's columns: :func:`faultgen.logs.jointlog.select_columns`),
     ``extra`` (none: the adapter chose its columns), ``notes`` (what the reading chose), ``rows``
-    (an upper bound of the data rows, :meth:`Adapter.rows`), ``label`` and :meth:`blocks`. Its first
+    (an upper bound of the data rows, :meth:`LogFormat.rows`), ``label`` and :meth:`blocks`. Its first
     :data:`PEEK_ROWS` rows are read here, to learn the columns.
 
     Raises
     ------
-    faultgen.data.measured.MeasuredDataError
-        A missing column (as :func:`faultgen.data.measured.from_columns` names it), a log of more
-        rows than :data:`faultgen.operation.jointlog.MAX_ROWS`, or what the adapter refuses.
+    faultgen.logs.measured.MeasuredDataError
+        A missing column (as :func:`faultgen.logs.measured.from_columns` names it), a log of more
+        rows than :data:`faultgen.logs.jointlog.MAX_ROWS`, or what the adapter refuses.
     """
 
-    def __init__(self, adapter: Adapter, path: Path, robot: robots.Robot, motion_only: bool = False):
+    def __init__(self, adapter: LogFormat, path: Path, robot: robots.Robot, motion_only: bool = False):
         self.adapter, self.path, self.robot, self.extra = adapter, path, robot, []
         peek = iter(adapter.blocks(path, robot, PEEK_ROWS))
         try:
@@ -270,7 +286,7 @@ class Blocks:
     def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
         """``(start, block)``: the index of the block's first data row and its ``wanted`` columns
         (ndarray of shape (size, len(wanted)), floats; the last block shorter), every cell refused
-        unless finite, as :func:`faultgen.data.measured.from_columns` refuses it."""
+        unless finite, as :func:`faultgen.logs.measured.from_columns` refuses it."""
         start, held, count = 0, [], 0  # held: rows read, not yet yielded (``count`` of them)
         for columns, *_ in self.adapter.blocks(self.path, self.robot, size):
             values = {name: np.asarray(columns[name], dtype=float) for name in self.wanted}
@@ -290,11 +306,12 @@ class Blocks:
             yield start, np.concatenate(held)
 
 
+@register(DEFAULT)
 @dataclass(frozen=True)
-class Measured(Adapter):
-    """The measured format (:mod:`faultgen.data.measured`; ``--format measured``, the default) as an
-    adapter: read whole by :func:`faultgen.data.measured.read`, in blocks by its own block reader
-    (:func:`faultgen.operation.logblocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
+class Measured(LogFormat):
+    """The measured format (:mod:`faultgen.logs.measured`; ``--format measured``, the default) as an
+    adapter: read whole by :func:`faultgen.logs.measured.read`, in blocks by its own block reader
+    (:func:`faultgen.logs.blocks.source`: CSV or HDF5, ``extra`` its ignored columns)."""
 
     name = "measured"
     reads_held = True
@@ -304,11 +321,19 @@ class Measured(Adapter):
         columns, extra, label = jointlog.read_columns(path, robot.n_axes)
         return columns, label, tuple([f"ignored extra columns: {', '.join(extra)}"] if extra else [])
 
+    def motion(self, path: Path, robot: robots.Robot) -> tuple:
+        columns, _, label = jointlog.read_columns(path, robot.n_axes, motion_only=True)  # no torque needed
+        return columns, label
+
+    @property
+    def key(self) -> str:
+        return DEFAULT
+
     def read(self, path, robot: robots.Robot, accelerations: bool = True) -> measured.MeasuredData:
         return measured.read(path, robot, accelerations)
 
     def source(self, path: str | Path, robot: robots.Robot, motion_only: bool = False):
-        return logblocks.source(Path(path), robot.n_axes, motion_only)
+        return blocks.source(Path(path), robot.n_axes, motion_only)
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         src = self.source(path, robot)
@@ -317,60 +342,24 @@ class Measured(Adapter):
             yield {name: block[:, j] for j, name in enumerate(src.wanted)}, src.label, notes
 
 
-#: The measured format, the default (not in :data:`ADAPTERS`: ``--format measured`` gives no adapter).
-MEASURED = Measured()
+#: The measured format, the default entry of :data:`FORMATS`.
+MEASURED = FORMATS[DEFAULT]()
 
 
-def _header(path: Path | inputs.Held, what: str, separator: str | None, as_what: str) -> tuple[list[str], str]:
-    """The names in the header of the delimited-text log ``path`` and its separator (``None``:
-    found), the file a regular one (bounded: :data:`MAX_BYTES`, :func:`faultgen.inputs.csv_header`);
-    refused unreadable (as ``as_what``) or with a name twice."""
-    inputs.regular_file(path, what, MAX_BYTES)
-    try:
-        names, separator = inputs.csv_header(path, what, separator=separator)
-    except inputs.InputError as err:
-        raise jointlog.LogBoundError(str(err)) from None
-    except (OSError, UnicodeDecodeError, EOFError) as err:
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: {err}") from err
-    twice = sorted(name for name, count in Counter(names).items() if count > 1)
-    if twice:
-        raise measured.MeasuredDataError(f"{path}: column(s) {', '.join(twice[:10])} appear more than once in the "
-                                         "header")
-    return names, separator
 
-
-def _require(path: Path, names: list[str], wanted: list[str], what: str) -> None:
-    missing = [c for c in wanted if c not in names]
-    if missing:
-        raise measured.MeasuredDataError(f"{path}: missing column(s) {', '.join(missing)} of the {what} layout; found "
-                                         f"{', '.join(names[:40]) or '(none)'}")
-
-
-def _numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[str, np.ndarray]:
-    """The ``wanted`` columns as floats, refused at the first cell that is not a finite number."""
-    out = {}
-    for name in wanted:
-        values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            raw = frame[name].iloc[bad[0]]
-            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else repr(raw)  # inf, not np.float64(inf)
-            raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value {shown}; expected "
-                                             "a finite number")
-        out[name] = values
-    return out
 
 
 @register("ur-rtde")
 @dataclass(frozen=True)
-class URRTDE(Adapter):
+class URRTDE(LogFormat):
     """Universal Robots' RTDE recorder CSV (module docstring).
 
     Parameters
     ----------
     torque_constants : tuple of float, optional
         N m/A at the joint, per axis: read the torque as ``actual_current_i`` times them when the
-        file has no ``target_moment`` columns.
+        file has no ``actual_current_as_torque`` columns (the controller's own conversion,
+        preferred: :meth:`_torque`).
     """
 
     reads_held = True
@@ -395,31 +384,15 @@ class URRTDE(Adapter):
         ``wanted`` (its columns read), ``map`` (measured name -> (its column, factor)) and ``note``
         (the torque source), or refused (a missing column, a name twice)."""
         n_axes = robot.n_axes
-        names, separator = _header(path, "RTDE log", None, "CSV")
+        names, separator = delimited.header(path, "RTDE log", None, "CSV")
         axes = range(n_axes)
         q = [f"actual_q_{k}" for k in axes]
         qd = [f"actual_qd_{k}" for k in axes]
-        moment = [f"target_moment_{k}" for k in axes]
-        current = [f"actual_current_{k}" for k in axes]
         temperature = [f"joint_temperatures_{k}" for k in axes]
-        if self.torque_constants is not None and all(c in names for c in current):
-            if len(self.torque_constants) != n_axes:
-                raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
-            torque, scale = current, [float(k) for k in self.torque_constants]
-            source = "torque from actual_current_i x the torque constants given (measured)"
-        elif all(c in names for c in moment):
-            torque, scale = moment, [1.0] * n_axes
-            source = ("torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
-                      "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
-                      "the UR arms' constants: docs/dataset.md, \"Adapters\")"
-                      + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
-        else:
-            raise measured.MeasuredDataError(
-                f"{path}: no joint torque: expected target_moment_0..{n_axes - 1} (N m), or actual_current_0.."
-                f"{n_axes - 1} (A) with the torque constants given (--torque-constants)")
+        torque, scale, source = self._torque(path, names, n_axes)
         with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
         wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
-        _require(path, names, wanted, "RTDE recorder")
+        delimited.require(path, names, wanted, "RTDE recorder")
         q_names, qd_names, tau_names = measured.column_names(n_axes)
         mapping = {measured.T_COLUMN: ("timestamp", None)}
         mapping.update({q_names[k]: (q[k], None) for k in axes})
@@ -430,9 +403,39 @@ class URRTDE(Adapter):
             mapping.update({name: (temperature[k], None) for k, name in enumerate(jointlog.temperature_columns(n_axes))})
         return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
 
+    def _torque(self, path: Path | inputs.Held, names: list[str], n_axes: int) -> tuple[list, list, str]:
+        """The joint torque's columns in the RTDE log's header ``names``, their factors and the
+        note naming the source, the first the file has of: ``actual_current_as_torque_i`` (N m, the
+        measured current as torque by the controller's own constants: RTDE output of e-Series
+        controllers from PolyScope 5.23); ``actual_current_i`` (A) times :attr:`torque_constants`
+        when given; ``target_moment_i`` (N m, commanded). Refused with none of them."""
+        axes = range(n_axes)
+        as_torque = [f"actual_current_as_torque_{k}" for k in axes]
+        current = [f"actual_current_{k}" for k in axes]
+        moment = [f"target_moment_{k}" for k in axes]
+        if all(c in names for c in as_torque):
+            unused = "; the torque constants given are not used" if self.torque_constants is not None else ""
+            return as_torque, [1.0] * n_axes, ("torque from actual_current_as_torque_i (the measured current as "
+                                               f"torque by the controller's own constants){unused}")
+        if self.torque_constants is not None and all(c in names for c in current):
+            if len(self.torque_constants) != n_axes:
+                raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
+            return current, [float(k) for k in self.torque_constants], \
+                "torque from actual_current_i x the torque constants given (measured)"
+        if all(c in names for c in moment):
+            return moment, [1.0] * n_axes, (
+                "torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
+                "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
+                "the UR arms' constants: docs/dataset.md, \"Adapters\")"
+                + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
+        raise measured.MeasuredDataError(
+            f"{inputs.path_of(path)}: no joint torque: expected actual_current_as_torque_0..{n_axes - 1} (N m), "
+            f"target_moment_0..{n_axes - 1} (N m), or actual_current_0..{n_axes - 1} (A) with the torque "
+            "constants given (--torque-constants)")
+
     @staticmethod
     def _chunks(path, plan: dict, size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
-        return _text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
+        return delimited.text_chunks(path, "RTDE log", "an RTDE recorder CSV", plan["names"], plan["separator"],
                             plan["wanted"], URRTDE.label, size)
 
     @staticmethod
@@ -456,48 +459,11 @@ class URRTDE(Adapter):
             yield self._mapped(plan, values), self.label, (plan["note"],)
 
 
-def _text_chunks(path: Path, what: str, as_what: str, names: list[str], separator: str, wanted: list[str], label,
-                 size: int | None = None) -> Iterator[dict[str, np.ndarray]]:
-    """The ``wanted`` columns of a delimited-text log (a header row of ``names``) parsed as numbers,
-    ``size`` rows at a time (default: rows bounded by all the columns, as every column of a row is
-    tokenized, kept or not; only the wanted converted and kept: memory in proportion to the
-    numbers, where reading every cell as text took 7 times the file), refused at the first cell
-    that is not a finite number, found from the text (:func:`_numbers`: the data row, column and
-    value named), or when the text is not such a table (named ``as_what``)."""
-    kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
-    try:
-        with inputs.open_text(path, what, MAX_BYTES) as fh:
-            for frame in pd.read_csv(fh, dtype=float, **kw):
-                values = {name: frame[name].to_numpy(dtype=float) for name in wanted}
-                if not all(bool(np.isfinite(column).all()) for column in values.values()):
-                    break
-                yield values
-            else:
-                return
-    except inputs.InputError:
-        raise
-    except (ValueError, TypeError):  # a cell that is not a number: found from the text below
-        pass
-    start = 0
-    kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
-    try:
-        with inputs.open_text(path, what, MAX_BYTES) as fh:
-            for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):
-                _numbers(path, frame, wanted, lambda i, s=start: label(s + i))
-                start += len(frame)
-    except (inputs.InputError, measured.MeasuredDataError):
-        raise
-    except (ValueError, OSError, EOFError) as err:  # pandas's ParserError (an unbalanced quote) is a ValueError
-        raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: "
-                                         f"{' '.join(str(err).split())}") from None
-    raise measured.MeasuredDataError(f"{path}: cannot read the file as CSV: a cell is not a number")
-
 
 @contextmanager
 def _named(path: Path | inputs.Held) -> Iterator[None]:
     """Turn pyarrow's errors reading the Parquet file ``path`` (a truncated or corrupt file) into a
-    :class:`~faultgen.data.measured.MeasuredDataError` that names it."""
+    :class:`~faultgen.logs.measured.MeasuredDataError` that names it."""
     import pyarrow as pa
 
     try:
@@ -509,7 +475,7 @@ def _named(path: Path | inputs.Held) -> Iterator[None]:
 
 @register("voraus")
 @dataclass(frozen=True)
-class Voraus(Adapter):
+class Voraus(LogFormat):
     """The voraus-AD dataset's Parquet layout (module docstring)."""
 
     reads_held = True
@@ -522,14 +488,14 @@ class Voraus(Adapter):
 
         Raises
         ------
-        faultgen.data.measured.MeasuredDataError
-            Naming the file: not a regular file of at most :data:`MAX_BYTES`, or not a Parquet file
+        faultgen.logs.measured.MeasuredDataError
+            Naming the file: not a regular file of at most :data:`faultgen.logs.delimited.MAX_BYTES`, or not a Parquet file
             pyarrow reads (truncated: no footer; another format).
         """
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        inputs.regular_file(path, "voraus-AD log", MAX_BYTES)
+        inputs.regular_file(path, "voraus-AD log", delimited.MAX_BYTES)
         with _named(path):
             return pq.ParquetFile(pa.BufferReader(path.data) if isinstance(path, inputs.Held) else path)
 
@@ -537,7 +503,7 @@ class Voraus(Adapter):
     def _plan(cls, path: Path | inputs.Held, robot: robots.Robot) -> tuple:
         """The file (:meth:`_parquet`), its columns read (refused when missing) and its rows, checked
         from the metadata before any is read against the bound of a log read whole
-        (:func:`faultgen.operation.jointlog.check_whole_rows`; a few MB of constant columns may hold
+        (:func:`faultgen.logs.jointlog.check_whole_rows`; a few MB of constant columns may hold
         10^8 rows, and pyarrow decodes a row group whole even when it is read in batches): every
         path that reads a voraus log (``logs import``, the monitor, ``calibrate``) goes through here."""
         parquet = cls._parquet(path)
@@ -546,7 +512,7 @@ class Voraus(Adapter):
         velocity = [f"joint_velocity_{k}" for k in axes]
         wanted = ["time", *(f"joint_position_{k}" for k in axes), *(f"motor_torque_{k}" for k in axes),
                   *(velocity if all(c in names for c in velocity) else [])]
-        _require(path, names, wanted, "voraus-AD")
+        delimited.require(path, names, wanted, "voraus-AD")
         wanted += ["sample"] if "sample" in names else []
         rows = parquet.metadata.num_rows
         jointlog.check_whole_rows(inputs.path_of(path), rows, len(wanted), what="a voraus-AD log")
@@ -569,7 +535,7 @@ class Voraus(Adapter):
         parquet, wanted, _ = self._plan(path, robot)
         with _named(path):
             frame = parquet.read(columns=wanted).to_pandas()
-        return self._mapped(_numbers(path, frame, wanted, self.label), robot), self.label
+        return self._mapped(delimited.numbers(path, frame, wanted, self.label), robot), self.label
 
     def blocks(self, path: Path, robot: robots.Robot, size: int) -> Iterator[tuple]:
         parquet, wanted, _ = self._plan(path, robot)
@@ -577,7 +543,7 @@ class Voraus(Adapter):
         with _named(path):
             batches = parquet.iter_batches(batch_size=size, columns=wanted)
             for batch in batches:
-                values = _numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
+                values = delimited.numbers(path, batch.to_pandas(), wanted, lambda i, s=start: self.label(s + i))
                 yield self._mapped(values, robot), self.label, ()
                 start += batch.num_rows
 

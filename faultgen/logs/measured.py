@@ -66,19 +66,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
-from faultgen import axes, inputs
-from faultgen.data import cells
+from faultgen import inputs
 from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
 from faultgen.derivatives import savgol_window as _savgol_window
 from faultgen.model import robots
-from faultgen.operation import jointlog
+from faultgen.logs import jointlog
 
-# The format's names, read and checked by faultgen.operation.jointlog (shared with replayed logs):
-from faultgen.operation.jointlog import (  # noqa: F401 (re-exported)
+# The format's names, read and checked by faultgen.logs.jointlog (shared with replayed logs):
+from faultgen.logs.jointlog import (  # noqa: F401 (re-exported)
     CSV_SUFFIXES,
     CYCLE_COLUMN,
     FULL_TURN_MARGIN,
@@ -99,7 +97,7 @@ from faultgen.operation.jointlog import (  # noqa: F401 (re-exported)
 )
 
 #: Raised for a measured-data file that cannot be used: the joint log's one error type
-#: (:class:`faultgen.operation.jointlog.LogError`, a ValueError naming the file, column and data row).
+#: (:class:`faultgen.logs.jointlog.LogError`, a ValueError naming the file, column and data row).
 MeasuredDataError = jointlog.LogError
 
 
@@ -288,7 +286,7 @@ def from_columns(columns: dict[str, np.ndarray], robot: robots.Robot, source: st
                  label=None, accelerations: bool = True, notes: tuple[str, ...] = ()) -> MeasuredData:
     """Check and complete the columns of a log in another layout, mapped onto this format's names
     (``t``, ``q1..qN``, ``tau1..tauN``, optional ``qd1..qdN``, ``temperature1..N``, ``payload``,
-    ``cycle``; :mod:`faultgen.data.adapters`), exactly as :func:`read` checks a file.
+    ``cycle``; :mod:`faultgen.logs.formats`), exactly as :func:`read` checks a file.
 
     Parameters
     ----------
@@ -317,11 +315,6 @@ def from_columns(columns: dict[str, np.ndarray], robot: robots.Robot, source: st
     values = {name: np.asarray(columns[name], dtype=float) for name in wanted}
     jointlog.refuse_non_finite(where, values, wanted, label)
     return _build(values, robot, where, label, list(notes), accelerations)
-
-
-def _compression(path: Path) -> str | None:
-    """The compression a file written under this name gets: gzip for ``.gz``."""
-    return "gzip" if path.name.lower().endswith(".gz") else None
 
 
 def _columns_from_arrays(where: Path, t, q, tau, qd, n_axes: int) -> dict[str, np.ndarray]:
@@ -392,9 +385,9 @@ def _build(
 
 
 def _cycles(where: Path, values: np.ndarray, label, t: np.ndarray) -> np.ndarray:
-    """The ``cycle`` column as whole numbers 0..:data:`~faultgen.operation.jointlog.MAX_CYCLE` that
+    """The ``cycle`` column as whole numbers 0..:data:`~faultgen.logs.jointlog.MAX_CYCLE` that
     never decrease, each cycle but the log's first and last spanning at least
-    :data:`~faultgen.operation.jointlog.MIN_CYCLE_TIME` s, or refused at the first row that is not."""
+    :data:`~faultgen.logs.jointlog.MIN_CYCLE_TIME` s, or refused at the first row that is not."""
     fractional = np.flatnonzero((values != np.round(values)) | (values < 0) | (values > jointlog.MAX_CYCLE))
     if fractional.size:
         i = int(fractional[0])
@@ -493,96 +486,3 @@ def acceleration(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     (xdd,) = _derivatives(t, np.asarray(x, dtype=float), period, _savgol_window(period, len(t)),
                           _is_uniform(dt, period), orders=(2,))
     return xdd
-
-
-# --------------------------------------------------------------------------------------------
-# Writing
-
-
-def _table(t, q, tau, qd) -> dict[str, np.ndarray]:
-    t = np.asarray(t, dtype=float)
-    if t.ndim != 1:
-        raise ValueError(f"t must have shape (n,), got {t.shape}")
-    n_axes = np.shape(q)[1] if np.ndim(q) == 2 else 0  # the robot's N, as q gives it
-    if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
-        raise ValueError(f"q must have shape ({t.shape[0]}, N), N {axes.MIN_AXES}..{axes.MAX_AXES}, got {np.shape(q)}")
-    q_columns, qd_columns, tau_columns = column_names(n_axes)
-    blocks = (
-        [("q", q, q_columns)]
-        + ([("qd", qd, qd_columns)] if qd is not None else [])
-        + [("tau", tau, tau_columns)]
-    )
-    table = {T_COLUMN: t}
-    for label, arr, names in blocks:
-        arr = np.asarray(arr, dtype=float)
-        if arr.shape != (t.shape[0], n_axes):
-            raise ValueError(f"{label} must have shape ({t.shape[0]}, {n_axes}), got {arr.shape}")
-        table.update({name: arr[:, k] for k, name in enumerate(names)})
-    return table
-
-
-def write_csv(
-    path: str | Path, t: np.ndarray, q: np.ndarray, tau: np.ndarray, qd: np.ndarray | None = None
-) -> Path:
-    """Write measured data as CSV (gzip-compressed when the name ends in ``.csv.gz``).
-
-    Columns ``t, q1..qN[, qd1..qdN], tau1..tauN`` (N the columns of ``q``) with a header row; floats are written with
-    the shortest representation that reads back to the same float64. The values are not
-    checked (so tests can write files that :func:`read` refuses), only the shapes.
-
-    Parameters
-    ----------
-    path : str or Path
-        Ending in ``.csv`` or ``.csv.gz``.
-    t : array_like of shape (n,)
-        Sample times in s.
-    q, tau : array_like of shape (n, N)
-        Arm-side joint angles (rad) and torques (N m), N = 5..7 axes.
-    qd : array_like of shape (n, N), optional
-        Arm-side joint velocities in rad/s; no ``qd`` columns when omitted.
-
-    Returns
-    -------
-    Path
-        The file written.
-
-    Raises
-    ------
-    ValueError
-        If the suffix is not ``.csv`` / ``.csv.gz`` or an array has the wrong shape.
-    """
-    path = Path(path)
-    if not path.name.lower().endswith(CSV_SUFFIXES):
-        raise ValueError(f"{path}: write_csv writes {' or '.join(CSV_SUFFIXES)} files")
-    frame = pd.DataFrame(_table(t, q, tau, qd))
-    # gzip level 6 (zlib's default) writes about as small as 9 in half the time; mtime 0 keeps
-    # the file byte-identical for identical data.
-    compression = {"method": "gzip", "compresslevel": 6, "mtime": 0} if _compression(path) else None
-    cells.escaped(frame).to_csv(path, index=False, compression=compression)
-    return path
-
-
-def write_hdf5(
-    path: str | Path, t: np.ndarray, q: np.ndarray, tau: np.ndarray, qd: np.ndarray | None = None
-) -> Path:
-    """Write measured data as HDF5: one float64 1-D dataset per column at the root, with its unit.
-
-    Parameters and returns as :func:`write_csv`; ``path`` ends in ``.h5`` or ``.hdf5``. Each
-    dataset carries a ``unit`` attribute (``s``, ``rad``, ``rad/s``, ``N m``).
-
-    Raises
-    ------
-    ValueError
-        If the suffix is not ``.h5`` / ``.hdf5`` or an array has the wrong shape.
-    """
-    path = Path(path)
-    if not path.name.lower().endswith(HDF5_SUFFIXES):
-        raise ValueError(f"{path}: write_hdf5 writes {' or '.join(HDF5_SUFFIXES)} files")
-    table = _table(t, q, tau, qd)
-    from faultgen.data.atomic import hdf5_writer
-
-    with hdf5_writer(path) as fh:  # a full disk: OSError, never a crash nor a partial file
-        for name, values in table.items():
-            ds = fh.create_dataset(name, data=values)
-            ds.attrs["unit"] = UNITS[name]
-    return path

@@ -1,8 +1,8 @@
 """The joint-log format as data: the columns of a robot of N axes (``t``, ``q1..qN``, ``qd1..qdN``,
 ``tau1..tauN``, the optional operating conditions) and their units, the file suffixes, the bounds a
 log is held to (rows, memory, sample rate, gaps, duration, values, cycles), and :class:`LogError`.
-The reader (:mod:`faultgen.operation.jointlog`) names all of these too; the format is documented in
-:mod:`faultgen.data.measured`."""
+The reader (:mod:`faultgen.logs.jointlog`) names all of these too; the format is documented in
+:mod:`faultgen.logs.measured`."""
 
 from __future__ import annotations
 
@@ -57,7 +57,7 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 #: row is read, so a small file declaring or holding more (an 8 kB HDF5 log declaring 10^8 rows was
 #: a MemoryError in ``logs import``) is refused. The checks and derivatives of a log read whole take
 #: about three times its columns more (docs/reliability.md); a longer log is for the calibration's
-#: streaming reader (:mod:`faultgen.data.longlog`) or a replay's (:mod:`faultgen.operation.replay`).
+#: streaming reader (:mod:`faultgen.logs.longlog`) or a replay's (:mod:`faultgen.operation.replay`).
 WHOLE_MAX_BYTES = 512 * 2**20
 #: Cells of a CSV log parsed at a time when pandas reads it (a compressed log, or one pyarrow refused).
 CHUNK_CELLS = 4_000_000

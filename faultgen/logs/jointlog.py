@@ -1,9 +1,9 @@
 """A joint log: one implementation of reading, checking and differentiating the logs faultgen takes
-from a robot (the calibration's measured logs, :mod:`faultgen.data.measured`; a replayed log,
+from a robot (the calibration's measured logs, :mod:`faultgen.logs.measured`; a replayed log,
 :mod:`faultgen.operation.replay`, which needs no torque columns).
 
 The format (columns, units, CSV and HDF5 layouts, row numbers in messages) is documented in
-:mod:`faultgen.data.measured`. Every refusal is a :class:`LogError` (a ValueError) naming the file
+:mod:`faultgen.logs.measured`. Every refusal is a :class:`LogError` (a ValueError) naming the file
 and the column and/or data row (1-based, header not counted).
 
 Derivatives: :func:`derivatives` (the Savitzky-Golay estimator of :mod:`faultgen.derivatives` at
@@ -27,7 +27,7 @@ from faultgen import inputs
 from faultgen.derivatives import derivatives as _savgol
 from faultgen.derivatives import is_uniform, savgol_window
 from faultgen.model import robots
-from faultgen.operation.logformat import (  # noqa: F401 (the format's names, also known by the reader's)
+from faultgen.logs.columns import (  # noqa: F401 (the format's names, also known by the reader's)
     CHUNK_CELLS,
     CSV_SUFFIXES,
     CYCLE_COLUMN,
@@ -304,7 +304,7 @@ def hdf5_rows(fh: h5py.File, path: Path, wanted: list[str]) -> int:
     """The rows of the HDF5 log's columns ``wanted``, from their declared metadata only, after checking
     each: a 1-D dataset of numbers (text or a compound refused, never converted), of its column's
     unit when it names one, of at most :data:`MAX_ROWS` rows, all of one length. What the whole read
-    (:func:`read_hdf5`) and the block reader (:class:`faultgen.operation.logblocks`) both check.
+    (:func:`read_hdf5`) and the block reader (:class:`faultgen.logs.blocks`) both check.
 
     Raises
     ------

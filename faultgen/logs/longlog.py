@@ -1,7 +1,7 @@
 """A long measured log read in blocks and averaged down while it is read, so that reading it takes
 memory that does not grow with its length (docs/reliability.md, docs/calibration.md "Long logs").
-A log in another registered format (:mod:`faultgen.data.adapters`, ``--format NAME``) is read the
-same way through its adapter's block reader (:meth:`faultgen.data.adapters.Adapter.source`), with
+A log in another registered format (:mod:`faultgen.logs.formats`, ``--format NAME``) is read the
+same way through its adapter's block reader (:meth:`faultgen.logs.formats.LogFormat.source`), with
 the same checks and messages.
 
 ``faultgen calibrate`` works on at most ``rows`` rows: a longer log is averaged over blocks of
@@ -10,7 +10,7 @@ after took 5.7 GB for 10^7 rows (issue 50). :func:`read` gives the same result i
 the file, :data:`BLOCK_ROWS` rows at a time:
 
 1. the sample times are kept whole (8 bytes a row), every cell is checked (a non-number or
-   non-finite cell refused with its data row, as :func:`faultgen.data.measured.read` does) and,
+   non-finite cell refused with its data row, as :func:`faultgen.logs.measured.read` does) and,
    per column, the rows that decide the angle and torque checks (smallest, largest, largest in
    magnitude, first out of range) are kept; the time, angle and torque checks then run as for a
    short log, on those rows;
@@ -20,8 +20,8 @@ the file, :data:`BLOCK_ROWS` rows at a time:
    the whole-log spline by far less than the filter's own error), the speed checks summed, and
    each block averaged down as it goes.
 
-A log of at most ``rows`` rows is read whole by :func:`faultgen.data.measured.read` (an adapter's log
-by :meth:`faultgen.data.adapters.Adapter.read`).
+A log of at most ``rows`` rows is read whole by :func:`faultgen.logs.measured.read` (an adapter's log
+by :meth:`faultgen.logs.formats.LogFormat.read`).
 """
 
 from __future__ import annotations
@@ -31,15 +31,15 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import adapters, measured
+from faultgen.logs import formats, measured
 from faultgen.derivatives import SAVGOL_ORDER, is_uniform, savgol_window
 from faultgen.model import robots
-from faultgen.operation import jointlog, logblocks
-from faultgen.operation.logblocks import block_mean  # noqa: F401 (re-exported)
+from faultgen.logs import blocks, jointlog
+from faultgen.logs.blocks import block_mean  # noqa: F401 (re-exported)
 
-#: Rows read at a time (:data:`faultgen.operation.logblocks.BLOCK_ROWS`; rounded up to a whole
+#: Rows read at a time (:data:`faultgen.logs.blocks.BLOCK_ROWS`; rounded up to a whole
 #: number of averaging blocks).
-BLOCK_ROWS = logblocks.BLOCK_ROWS
+BLOCK_ROWS = blocks.BLOCK_ROWS
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,10 @@ def motion(qd: np.ndarray, rest_speed: float) -> Motion:
 
 
 def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
-         adapter: adapters.Adapter | None = None) -> tuple[measured.MeasuredData, Motion]:
-    """The log ``path`` in the measured format (:func:`faultgen.data.measured.read`'s format and
-    checks) or, with ``adapter``, in that format, averaged down to at most ``rows`` rows when
-    longer (read in blocks of :data:`BLOCK_ROWS` rows: :meth:`faultgen.data.adapters.Adapter.source`),
+         adapter: formats.LogFormat = formats.MEASURED) -> tuple[measured.MeasuredData, Motion]:
+    """The log ``path`` in its format ``adapter`` (default the measured format:
+    :func:`faultgen.logs.measured.read`'s format and checks), averaged down to at most ``rows`` rows when
+    longer (read in blocks of :data:`BLOCK_ROWS` rows: :meth:`faultgen.logs.formats.LogFormat.source`),
     and its :class:`Motion` at the full rate.
 
     Returns
@@ -76,17 +76,17 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
 
     Raises
     ------
-    faultgen.data.measured.MeasuredDataError
-        As :func:`faultgen.data.measured.read` (an adapter's log: as its
-        :meth:`~faultgen.data.adapters.Adapter.read`), naming the file, the column and the data row.
+    faultgen.logs.measured.MeasuredDataError
+        As :func:`faultgen.logs.measured.read` (an adapter's log: as its
+        :meth:`~faultgen.logs.formats.LogFormat.read`), naming the file, the column and the data row.
     """
     path = Path(path)
-    fmt = adapters.MEASURED if adapter is None else adapter
+    fmt = adapter
     src = fmt.source(path, robot)
     if src.rows <= rows:
         data = fmt.read(path, robot)
         return data, motion(data.qd, rest_speed)
-    first = logblocks.scan(src, robot, size=BLOCK_ROWS)
+    first = blocks.scan(src, robot, size=BLOCK_ROWS)
     t, kept, kept_rows = first.t, first.kept, first.kept_rows
     n = len(t)
     if n <= rows:  # fewer rows than lines (blank lines): read whole, as a short log
@@ -106,12 +106,12 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
     if not uniform:
         notes.append(f"sample period varies ({np.min(np.diff(t)):.6g}..{np.max(np.diff(t)):.6g} s): q resampled "
                      f"at the median period {period:.6g} s with a cubic spline for differentiation (block by block "
-                     "with a margin, faultgen.data.longlog), derivatives interpolated back")
+                     "with a margin, faultgen.logs.longlog), derivatives interpolated back")
     k = -(-n // rows)
     m = n // k
     inner = measured.velocity_rows(n, window)
     sums = _Sums(robot.n_axes, rest_speed, inner.start or 0, inner.stop if inner.stop is not None else n)
-    out = logblocks.averaged(src, robot.n_axes, period, window, uniform, k, m, sums.add, BLOCK_ROWS)
+    out = blocks.averaged(src, robot.n_axes, period, window, uniform, k, m, sums.add, BLOCK_ROWS)
     estimated = qd_names[0] not in index
     if estimated:
         notes.append(f"qd and qdd estimated from q: {filt}")
@@ -126,7 +126,7 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
 
 
 class _Sums:
-    """The speed checks' sums over the rows ``inner`` (:func:`faultgen.data.measured.velocity_verdicts`)
+    """The speed checks' sums over the rows ``inner`` (:func:`faultgen.logs.measured.velocity_verdicts`)
     and the :class:`Motion` at the full rate, block by block."""
 
     def __init__(self, n_axes: int, rest_speed: float, inner_lo: int, inner_hi: int):
