@@ -1,6 +1,7 @@
-"""Adapters: logs in the layouts robots and datasets really have, read into the measured format.
+"""The registry of log formats (:data:`FORMATS`): the measured format, its default entry
+(:data:`DEFAULT`, :data:`MEASURED`), and the layouts robots and datasets really have, read into it.
 
-Each adapter maps a foreign file's columns onto the measured format's (``t``, ``q1..qN``,
+Each other format maps a foreign file's columns onto the measured format's (``t``, ``q1..qN``,
 ``tau1..tauN`` arm side, optional ``qd1..qdN`` and ``cycle``) and hands them to
 :func:`faultgen.logs.measured.from_columns`, which checks them as it checks a measured log (the
 same refusals, by data row). Registered by name (:func:`register`, :data:`FORMATS`), chosen with
@@ -9,7 +10,7 @@ docs/dataset.md, "Adapters", gives each layout. Each reads a log whole (:meth:`L
 or in blocks of rows (:meth:`LogFormat.blocks`, :meth:`LogFormat.source`: a log too long to read whole,
 calibrated by :mod:`faultgen.logs.longlog` or replayed streamed by
 :mod:`faultgen.operation.replay`) with the same checks and messages; :data:`MEASURED` is the
-measured format's own readers as an adapter (docs/architecture.md, "Log formats").
+measured format's own readers as a registered format (docs/architecture.md, "Log formats").
 
 - ``ur-rtde``: Universal Robots' RTDE recorder CSV (comma- or space-separated; ``.csv`` or
   ``.csv.gz``): ``timestamp`` (s), ``actual_q_0..5`` (rad), optional ``actual_qd_0..5`` (rad/s) and
