@@ -289,12 +289,12 @@ CASES_CODE = {
     # what `robots add` reads (expanded, parsed, compiled by MuJoCo); the URDF it would write, its size
     "xacro": ("from faultgen.model import importers",
               "print(len(importers.read({log!r}).urdf), 'characters of urdf_used.urdf', file=sys.stderr)"),
-    "measured": ("from faultgen.data import measured\nfrom faultgen.model import robots", "measured.read({log!r}, robots.load('puma560'), accelerations=False)"),
+    "measured": ("from faultgen.logs import measured\nfrom faultgen.model import robots", "measured.read({log!r}, robots.load('puma560'), accelerations=False)"),
     "logs-import": ("from faultgen.data import fleetlogs",
                     "fleetlogs.import_logs({log!r}, {out!r} + '.h5', robot='puma560', progress=False)"),
-    "voraus": ("from faultgen.data import adapters\nfrom faultgen.model import robots",
+    "voraus": ("from faultgen.logs import formats as adapters\nfrom faultgen.model import robots",
                "adapters.make('voraus').read({log!r}, robots.load('puma560'), accelerations=False)"),
-    "ur-rtde": ("from faultgen.data import adapters\nfrom faultgen.model import robots",
+    "ur-rtde": ("from faultgen.logs import formats as adapters\nfrom faultgen.model import robots",
                 "adapters.make('ur-rtde').read({log!r}, robots.load('puma560'), accelerations=False)"),
     "events": ("from pathlib import Path\nfrom faultgen.data import logfolder",
                "logfolder.read_events(Path({log!r}), {{'u': [logfolder.LogFile('u', '1', 1.0, 'sequence', "
