@@ -81,6 +81,7 @@ from faultgen.operation.tasks import (  # noqa: F401
     JointPath,
     Load,
     LogTask,
+    Motion,
     ProgramError,
     Task,
     TextProgram,
@@ -104,6 +105,12 @@ def is_file_task(task: str | LogTask) -> bool:
     return isinstance(task, LogTask) or name.endswith(PROGRAM_SUFFIXES + REPLAY_SUFFIXES)
 
 
+def is_given_task(task) -> bool:
+    """Whether ``task`` is one the user gave (a program or log file, a program's text, a motion in
+    memory) rather than a thesis task: its path is planned and checked when a run is configured."""
+    return isinstance(task, Motion) or is_file_task(task)
+
+
 def log_task(task: str, adapter=None) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
     :class:`faultgen.data.adapters.Adapter`): a :class:`LogTask`; ``task`` itself when ``adapter``
@@ -125,7 +132,7 @@ def check_name(task: str) -> str:
         if not Path(task.path).is_file():
             raise ValueError(f"task file {task.path!r} does not exist")
         return task
-    if isinstance(task, TextProgram):  # a program given by its text: no file to look for
+    if isinstance(task, TextProgram | Motion):  # a program's text or a motion in memory: no file to look for
         return task
     if not isinstance(task, str) or not task:
         raise ValueError(f"task {task!r}: expected a task name ({', '.join(TASKS)}) or a program file (.toml) "
@@ -141,7 +148,10 @@ def check_name(task: str) -> str:
 
 
 def label(task: str) -> str:
-    """A short name for ``task`` in run ids and progress bars: the thesis name, or the file's stem."""
+    """A short name for ``task`` in run ids and progress bars: the thesis name, or the file's stem
+    (a :class:`Motion`'s name)."""
+    if isinstance(task, Motion):
+        return task.name
     if task in TASKS or not is_file_task(task):
         return task
     if isinstance(task, LogTask):
@@ -174,6 +184,10 @@ def load(robot: Robot, task: str) -> Task:
     """
     robots.require(robot, "programs.load")
     check_name(task)
+    if isinstance(task, Motion):
+        from faultgen.operation import replay
+
+        return replay.Replay.from_motion(task, robot, _limits({}, robot, task.source), check_torque)
     if task in TASKS:
         return builtin(robot, task)
     if isinstance(task, TextProgram):
@@ -191,7 +205,10 @@ def load(robot: Robot, task: str) -> Task:
 def record(task: str) -> dict | None:
     """What a dataset keeps of a file task so the run can be made again: ``name`` (the program's, or
     the log's stem), ``file`` (as given), ``sha256`` of the file's bytes, for a program its ``text``
-    and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); None for a thesis task."""
+    and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); for a :class:`Motion`
+    its ``name``, ``source`` and :attr:`Motion.sha256`; None for a thesis task."""
+    if isinstance(task, Motion):
+        return {"name": task.name, "source": task.source, "sha256": task.sha256}
     if task in TASKS or not is_file_task(task):
         return None
     data = task.text.encode() if isinstance(task, TextProgram) else Path(task).read_bytes()

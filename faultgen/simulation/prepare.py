@@ -84,7 +84,7 @@ def file_stamps(robot: robots.Robot, task: str) -> tuple[int, ...]:
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
                          "with it (the model `faultgen calibrate` writes has one)")
     stamps = (tasks_file.stat().st_mtime_ns,)
-    if programs.is_file_task(task) and not isinstance(task, programs.TextProgram):  # a text has no file to stamp
+    if programs.is_file_task(task) and not isinstance(task, programs.TextProgram):  # a text or motion has no file
         stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
     return stamps
 
