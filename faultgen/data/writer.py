@@ -76,7 +76,7 @@ def limits(robot, task: str | None = None) -> dict | None:
         velocity = programs.robot_limits(robot)[0]
     except programs.ProgramError:
         return None
-    own = task is not None and (task in programs.TASKS or str(task).lower().endswith(programs.PROGRAM_SUFFIXES))
+    own = programs.kind(task) in (programs.THESIS, *programs.PROGRAM_KINDS)
     task_velocity = programs.load(robot, task).velocity_limit if own else velocity
     return {"joint_range": [[float(lo), float(hi)] for lo, hi in robot.joint_range],
             "velocity": [float(v) for v in velocity], "task_velocity": [float(v) for v in task_velocity],
