@@ -81,10 +81,11 @@ class RunSpec:
         for name in ("robot", "stepper"):
             value = getattr(self, name)
             if not isinstance(value, str) or not value:
-                raise TypeError(f"RunSpec {name} = {value!r}: expected a non-empty string (a name or path); "
+                given = repr(value) if isinstance(value, str) else f"a {type(value).__name__}"
+                raise TypeError(f"RunSpec {name} = {given}: expected a non-empty string (a name or path); "
                                 "a resolved object goes into a RunConfig")
         if not isinstance(self.task, str | programs.LogTask | programs.Motion):
-            raise TypeError(f"RunSpec task = {self.task!r}: expected a task name, a program or log path, or a "
+            raise TypeError(f"RunSpec task = a {type(self.task).__name__}: expected a task name, a program or log path, or a "
                             "TextProgram, LogTask or Motion")
 
     def run_fields(self) -> dict:
