@@ -80,48 +80,28 @@ from faultgen.operation.tasks import (  # noqa: F401
     TASKS,
     JointPath,
     Load,
+    FILE_KINDS,
+    FORMAT_LOG,
+    LOG,
+    MOTION,
+    PROGRAM,
+    PROGRAM_KINDS,
+    PROGRAM_SUFFIXES,
+    REPLAY_SUFFIXES,
+    TEXT,
+    THESIS,
     LogTask,
     Motion,
     ProgramError,
     Task,
     TextProgram,
     check_step,
+    kind,
 )
-
-#: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
-PROGRAM_SUFFIXES = (".toml",)
-REPLAY_SUFFIXES = (".csv", ".csv.gz", ".h5", ".hdf5")
-
 
 class ProgramBoundError(ProgramError, inputs.InputError):
     """A program refused before it is checked or planned, by a bound on its size (:data:`MAX_SEGMENTS`):
     a :class:`ProgramError` and a :class:`faultgen.inputs.InputError`."""
-
-
-#: The kinds of task (:func:`kind`): a thesis task of the robot folder's ``tasks.toml``, a program
-#: file, a program's text (:class:`TextProgram`), a joint log file in the measured format, a joint
-#: log in another format (:class:`LogTask`), a motion in memory (:class:`Motion`).
-THESIS, PROGRAM, TEXT, LOG, FORMAT_LOG, MOTION = "thesis", "program", "text", "log", "format-log", "motion"
-#: The kinds that are programs (planned from TOML), and those that name a file of this machine.
-PROGRAM_KINDS, FILE_KINDS = (PROGRAM, TEXT), (PROGRAM, LOG, FORMAT_LOG)
-
-
-def kind(task) -> str | None:
-    """What ``task`` is, one of the kinds above (None: none of them, an unknown name): decided here
-    and nowhere else, by its type and then a file name's suffix (:data:`PROGRAM_SUFFIXES`,
-    :data:`REPLAY_SUFFIXES`). Looks at no file."""
-    if isinstance(task, Motion):
-        return MOTION
-    if isinstance(task, LogTask):
-        return FORMAT_LOG
-    if isinstance(task, TextProgram):
-        return TEXT
-    if not isinstance(task, str) or not task:
-        return None
-    if task in TASKS:
-        return THESIS
-    name = task.lower()
-    return PROGRAM if name.endswith(PROGRAM_SUFFIXES) else LOG if name.endswith(REPLAY_SUFFIXES) else None
 
 
 def is_file_task(task: str | LogTask) -> bool:
