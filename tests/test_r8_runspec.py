@@ -1,4 +1,4 @@
-"""A run built from objects once (issue 74, item 1): the monitor's twin replays its smoothed program
+"""A run built from objects once: the monitor's twin replays its smoothed program
 in memory (a ``Motion``, no CSV written and read back), the hidden-effect log simulates the hidden
 model compiled in memory, a task's kind is decided by ``programs.kind`` alone, the planned tasks are
 cached by content digests, and a run's text (``RunSpec``) resolves into objects (``resolve``).
