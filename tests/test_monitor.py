@@ -561,7 +561,7 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
     assert result.exit_code == 0, result.output
     assert "warning: the drive of axis 2 reached its torque limit" in result.output
     twin = Twin(robot, log, tmp_path / "cache")
-    replayed = sim.simulate(sim.RunConfig(robot="irb6700", task=str(twin._reference), friction="stribeck",
+    replayed = sim.simulate(sim.RunConfig(robot="irb6700", task=twin._reference, friction="stribeck",
                                           wear=wear.WearPlan({}), cycles=1, seed=0,
                                           noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                           signals=True), progress=False)

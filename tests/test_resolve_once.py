@@ -146,6 +146,7 @@ ALLOWED = {
                                                             "one), read once per fleet with friction tests")),
     "faultgen/bench/independent.py": (1, "public API", ("write_fleet(), the bench's independent simulator's entry, "
                                                         "takes a robot folder; once per fleet")),
+    "faultgen/simulation/resolve.py": (1, "public API", "resolve(spec): a run from its text, the robot once"),
 }
 
 
@@ -294,3 +295,67 @@ def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     assert loads[0] == str(robot) and sorted(loads[1:]) == [str(path) for path in cached]
+
+
+# -- a run from its text: robot, task, friction model and stepper each looked up once -------------
+
+
+@pytest.fixture
+def looked_up():
+    """Calls of the four look-ups (``robots.load``, ``programs.load``, ``friction_models.get``,
+    ``backends.get``) while the test runs, counted by their code objects through ``sys.setprofile``:
+    every call is seen, whatever name or alias (``from ... import load``, a stored reference) it
+    goes through."""
+    import sys
+    from collections import Counter
+
+    from faultgen.simulation import backends, friction_models
+
+    codes = {robots.load.__code__: "robot", programs.load.__code__: "task",
+             friction_models.get.__code__: "friction", backends.get.__code__: "stepper"}
+    counts = Counter()
+
+    def profile(frame, event, arg):
+        if event == "call" and frame.f_code in codes:
+            counts[codes[frame.f_code]] += 1
+
+    sys.setprofile(profile)
+    try:
+        yield counts
+    finally:
+        sys.setprofile(None)
+
+
+def _program_file(tmp_path) -> Path:
+    """A program file of content no earlier test planned (the task cache is per process and content)."""
+    path = tmp_path / "weld.toml"
+    text = programs.export(robots.load("puma560"), "spot_weld")
+    path.write_text(text.replace('name = "spot_weld"', 'name = "weld_resolve_once"'))
+    return path
+
+
+def test_a_run_from_its_spec_looks_each_name_up_once(tmp_path, looked_up):
+    """``resolve(spec)`` and the simulation of the run: the robot, the task (a program file), the
+    stepper once; the friction model three times (resolve, RunConfig's check, the model's build: not
+    yet carried as an object, docs/_r8_runspec.md)."""
+    from faultgen.simulation import resolve, spec
+
+    path = _program_file(tmp_path)
+    looked_up.clear()
+    run = resolve.resolve(spec.RunSpec("puma560", str(path), friction="stribeck", cycles=1, stepper="loop"))
+    run.simulate(progress=False)
+    assert dict(looked_up) == {"robot": 1, "task": 1, "stepper": 1, "friction": 3}
+    looked_up.clear()  # the same run again in this process: the task read and planned once per content
+    resolve.resolve(spec.RunSpec("puma560", str(path), friction="stribeck", cycles=1)).simulate(progress=False)
+    assert looked_up["task"] == 0
+
+
+def test_simulate_looks_its_robot_and_task_up_once(tmp_path, looked_up):
+    """``faultgen simulate --task PROGRAM``: the robot and the program once (checked, planned, its
+    dataset's limits and record all from the one read); no stepper by name (the default object)."""
+    path = _program_file(tmp_path)
+    looked_up.clear()
+    result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(path), "--cycles", "1",
+                                 "-o", str(tmp_path / "one.h5")])
+    assert result.exit_code == 0, result.output
+    assert (looked_up["robot"], looked_up["task"], looked_up["stepper"]) == (1, 1, 0), dict(looked_up)

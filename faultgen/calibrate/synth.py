@@ -30,6 +30,7 @@ from faultgen import axes
 from faultgen.calibrate.effects import Effect, Motion, get
 from faultgen.calibrate.effects import motion as motion_of
 from faultgen.data import logfiles
+from faultgen.model import robot as robot_model
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
@@ -215,18 +216,38 @@ def _choose(robot: robots.Robot, effect: str, rng: np.random.Generator, params: 
     return Hidden.of(robot, effect, {a: params[a] for a in chosen}, float(min(sizes[chosen])))
 
 
-def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path) -> Path:
-    """Write the robot's MJCF with ``hidden`` applied, the physics step :data:`TIMESTEP` and the
-    :data:`INTEGRATOR` (and its tasks.toml) into ``folder``."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    spec = mujoco.MjSpec.from_file(str(robot.path))
+def _hide(robot: robots.Robot, hidden: Hidden, spec: mujoco.MjSpec) -> None:
+    """Edit ``spec`` (the robot's) in place: ``hidden`` applied, the physics step :data:`TIMESTEP`
+    and the :data:`INTEGRATOR`."""
     spec.option.timestep = TIMESTEP
     spec.option.integrator = INTEGRATOR
     if hidden.effect is not None:
         hidden.effect.write(spec, robot, hidden.axes)
+
+
+def hidden_model(robot: robots.Robot, hidden: Hidden) -> tuple[str, robots.Robot]:
+    """The robot with ``hidden`` applied, the physics step :data:`TIMESTEP` and the
+    :data:`INTEGRATOR`, edited in memory: ``(text, robot)``, the MJCF text :func:`write_model`
+    writes and the robot compiled from that text in memory (named by ``robot``'s file, whose
+    folder's tasks.toml it plans with; no file read). Compiled from the text, not from the edited
+    spec itself: MuJoCo's XML writer rounds numbers (the puma560's gear ratios in their 7th digit),
+    and the log must be that of the model written beside it, bit for bit."""
+    spec = robot.new_spec()
+    _hide(robot, hidden, spec)
+    text = spec.to_xml()
+    spec = mujoco.MjSpec.from_string(text)
+    spec.modelfiledir = str(robot.path.parent)
+    return text, robot_model.from_spec(spec, robot.path)
+
+
+def write_model(robot: robots.Robot, hidden: Hidden, folder: str | Path, text: str | None = None) -> Path:
+    """Write the robot's MJCF with ``hidden`` applied, the physics step :data:`TIMESTEP` and the
+    :data:`INTEGRATOR` (:func:`hidden_model`'s ``text``, made here when not given) and its
+    tasks.toml into ``folder``."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{robot.name}_hidden.xml"
-    path.write_text(spec.to_xml())
+    path.write_text(hidden_model(robot, hidden)[0] if text is None else text)
     shutil.copyfile(robot.path.parent / "tasks.toml", folder / "tasks.toml")
     return path
 
@@ -235,7 +256,8 @@ def record(robot: robots.Robot, hidden: Hidden, out: str | Path, task: str = "pi
            cycles: int = 4, seed: int = 0, progress: bool = False) -> Path:
     """Simulate ``cycles`` cycles of ``task`` on the robot with ``hidden`` switched on and write
     the log in the measured-data format (CSV, the design document's columns) to ``out``; the
-    model with the hidden effect goes beside it, in ``OUT-STEM_model/``. ``progress`` draws the
+    model with the hidden effect goes beside it, in ``OUT-STEM_model/`` (written, not read back: the
+    run simulates :func:`hidden_model`'s robot, compiled in memory from the text written). ``progress`` draws the
     simulation's progress bar (``faultgen hidden-log``).
 
     Returns
@@ -251,8 +273,9 @@ def record(robot: robots.Robot, hidden: Hidden, out: str | Path, task: str = "pi
     """
     robots.require(robot, "synth.record")
     out = Path(out)
-    model = write_model(robot, hidden, out.parent / f"{out.stem}_model")
-    config = sim.RunConfig(robot=str(model), task=task, friction="stribeck", cycles=cycles, seed=seed,
+    text, model = hidden_model(robot, hidden)
+    write_model(robot, hidden, out.parent / f"{out.stem}_model", text)
+    config = sim.RunConfig(robot=model, task=task, friction="stribeck", cycles=cycles, seed=seed,
                            back_to_back=True)
     run = sim.simulate(config, progress=progress)
     G = robot.gear_ratio

@@ -39,7 +39,7 @@ from faultgen.data.schema import (
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
 from faultgen.operation import programs
-from faultgen.simulation import sensors
+from faultgen.simulation import resolve, sensors
 
 
 def model_hash(path: Path) -> str:
@@ -62,8 +62,8 @@ def limits(robot, task: str | None = None) -> dict | None:
     """The robot's limits a run's histograms were binned over (:data:`LIMITS`), as plain lists:
     ``joint_range`` (N, 2) rad, ``velocity`` (N,) rad/s (the robot folder's ``tasks.toml``
     ``[limits]``, :func:`faultgen.operation.programs.robot_limits`) and ``task_velocity`` (N,) rad/s,
-    the speed limit of ``task`` (a thesis task or a program file, as the simulation loads it,
-    :func:`faultgen.operation.programs.load`; a replayed log and ``None``, a measured log, run to the
+    the speed limit of ``task`` (a thesis task or a program file, as the run read and planned it,
+    :func:`faultgen.simulation.resolve.task`; a replayed log and ``None``, a measured log, run to the
     robot's), with ``units``. None for a robot whose folder has no ``[limits]`` (an MJCF file alone,
     running a program file with its own): the run then does not store them, as files before them.
 
@@ -76,8 +76,8 @@ def limits(robot, task: str | None = None) -> dict | None:
         velocity = programs.robot_limits(robot)[0]
     except programs.ProgramError:
         return None
-    own = task is not None and (task in programs.TASKS or str(task).lower().endswith(programs.PROGRAM_SUFFIXES))
-    task_velocity = programs.load(robot, task).velocity_limit if own else velocity
+    own = programs.kind(task) in (programs.THESIS, *programs.PROGRAM_KINDS)
+    task_velocity = resolve.task(robot, task)[0].velocity_limit if own else velocity  # as the run planned it
     return {"joint_range": [[float(lo), float(hi)] for lo, hi in robot.joint_range],
             "velocity": [float(v) for v in velocity], "task_velocity": [float(v) for v in task_velocity],
             "units": dict(LIMITS)}

@@ -50,7 +50,7 @@ PROGRAM_CHANGED = "program change (not logged: the motion left the twin's progra
 #: (checked before it is parsed): about 0.85 kB per scored log with its load record, so some 20 000 logs (a log an hour for
 #: two years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
 STATE_MAX_BYTES = 16 * 2**20
-#: The entries of ``OUT/.cache`` (module docstring; ``programs``: each twin's replayed motion, written, never read;
+#: The entries of ``OUT/.cache`` (module docstring; ``programs``: the twins' replayed motion, which earlier versions wrote;
 #: ``friction-tests``: the tests' readings, :mod:`faultgen.monitor.friction_tests`).
 CACHE = ("cycles", "calibrated", "programs", "friction-tests")
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its

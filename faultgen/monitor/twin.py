@@ -47,14 +47,13 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import derivatives
-from faultgen.data import cells
 from faultgen.logs import measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
 from faultgen.monitor import cycles as program_cycles
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
-from faultgen.operation import conditions, faults, wear
+from faultgen.operation import conditions, faults, tasks, wear
 from faultgen.simulation import backends, sensors
 from faultgen.simulation import stepping as sim
 
@@ -117,9 +116,9 @@ class Twin:
     SHA-256 keys the cache, its angles are replayed; a log that could not be read raises its
     error) or a path read here by ``reader`` (:data:`faultgen.monitor.logs.Reader`; the measured
     format's by default), ``cache`` the folder of simulated cycles (created if needed) inside
-    ``root`` (default: the folder holding ``cache``, where the replayed motion goes too,
-    ``programs``), out of which no cached file may lead (read or written), ``stepper`` what steps its
-    cycles (a :class:`faultgen.simulation.backends.Stepper`; the default ``BatchStepper()``).
+    ``root`` (default: the folder holding ``cache``), out of which no cached file may lead (read or
+    written), ``stepper`` what steps its cycles (a :class:`faultgen.simulation.backends.Stepper`;
+    the default ``BatchStepper()``). The replayed motion stays in memory (:meth:`_smoothed_program`).
 
     Raises
     ------
@@ -183,20 +182,17 @@ class Twin:
         self.signatures = np.stack([(self.cycle(at_own, 0.0, axis) - healthy) / WEAR
                                     for axis in range(1, self.robot.n_axes + 1)])
 
-    def _smoothed_program(self, name: str, t: np.ndarray, q: np.ndarray) -> Path:
-        """The program log's motion as the twin replays it: its angles through the Savitzky-Golay
-        filter of :data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`), written (again,
-        every time: nothing is read back) as ``t, q1..qN`` in the folder ``programs`` beside
-        ``cache``. A logged cycle was executed by the real drive, so the twin must not saturate on
-        the encoder's noise, which the replay tracks as its reference (faultgen's default 1e-4 rad
-        saturated the irb6700's axis 2 on its own pick and place)."""
+    def _smoothed_program(self, name: str, t: np.ndarray, q: np.ndarray) -> tasks.Motion:
+        """The program log's motion as the twin replays it, in memory (a
+        :class:`faultgen.operation.tasks.Motion` named ``name``, replayed by
+        :meth:`faultgen.operation.replay.Replay.from_motion` with a log's checks): its angles through
+        the Savitzky-Golay filter of :data:`REFERENCE_WINDOW` (:func:`faultgen.derivatives.smoothed`).
+        A logged cycle was executed by the real drive, so the twin must not saturate on the encoder's
+        noise, which the replay tracks as its reference (faultgen's default 1e-4 rad saturated the
+        irb6700's axis 2 on its own pick and place)."""
         t = np.asarray(t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(q, dtype=float), REFERENCE_WINDOW)
-        path = self.cache.parent / "programs" / f"{name}.csv"  # beside the cycles: they hold cycles only
-        with self.folder.writing(path) as tmp:
-            np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", comments="", fmt="%.17g",
-                       header=cells.line(["t", *(f"q{i}" for i in range(1, self.robot.n_axes + 1))]))
-        return path
+        return tasks.Motion(name, t, q, source=f"{self.program} (smoothed, replayed by its twin)")
 
     def _key(self, temperature: float, payload: float, worn_axis: int) -> tuple[dict, Path]:
         """A cycle's cache key and file; :data:`REFERENCE_TEMPERATURE` is the model's own friction
@@ -215,7 +211,7 @@ class Twin:
         """The run of ``cycles`` replayed cycles at ``temperature`` (rounded; None: the model's own
         friction) with a ``payload`` kg part and wear ``plan``, without noise."""
         held, _ = setup(temperature, payload)
-        return sim.RunConfig(robot=self.robot, task=str(self._reference), friction=FRICTION, wear=plan, cycles=cycles,
+        return sim.RunConfig(robot=self.robot, task=self._reference, friction=FRICTION, wear=plan, cycles=cycles,
                              seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                              conditions=held, signals=True)
 

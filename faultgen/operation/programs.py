@@ -81,17 +81,24 @@ from faultgen.operation.tasks import (  # noqa: F401
     TASKS,
     JointPath,
     Load,
+    FILE_KINDS,
+    FORMAT_LOG,
+    LOG,
+    MOTION,
+    PROGRAM,
+    PROGRAM_KINDS,
+    PROGRAM_SUFFIXES,
+    REPLAY_SUFFIXES,
+    TEXT,
+    THESIS,
     LogTask,
+    Motion,
     ProgramError,
     Task,
     TextProgram,
     check_step,
+    kind,
 )
-
-#: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
-PROGRAM_SUFFIXES = (".toml",)
-REPLAY_SUFFIXES = (".csv", ".csv.gz", ".h5", ".hdf5")
-
 
 class ProgramBoundError(ProgramError, inputs.InputError):
     """A program refused before it is checked or planned, by a bound on its size (:data:`MAX_SEGMENTS`):
@@ -99,10 +106,15 @@ class ProgramBoundError(ProgramError, inputs.InputError):
 
 
 def is_file_task(task: str | LogTask) -> bool:
-    """Whether ``task`` names a program or log file (by its suffix, or a :class:`LogTask`) rather
-    than a thesis task."""
-    name = str(task).lower()
-    return isinstance(task, LogTask) or name.endswith(PROGRAM_SUFFIXES + REPLAY_SUFFIXES)
+    """Whether ``task`` is a program or log (a file's, or a program's text) rather than a thesis
+    task or a motion in memory (:func:`kind`)."""
+    return kind(task) in (*PROGRAM_KINDS, LOG, FORMAT_LOG)
+
+
+def is_given_task(task) -> bool:
+    """Whether ``task`` is one the user gave (a program or log file, a program's text, a motion in
+    memory) rather than a thesis task: its path is planned and checked when a run is configured."""
+    return kind(task) not in (THESIS, None)
 
 
 def log_task(task: str, adapter: formats.LogFormat = formats.MEASURED) -> str | LogTask:
@@ -113,8 +125,8 @@ def log_task(task: str, adapter: formats.LogFormat = formats.MEASURED) -> str | 
     program file (a format reads a joint log)."""
     if adapter.name == formats.DEFAULT:
         return task
-    if task in TASKS or str(task).lower().endswith(PROGRAM_SUFFIXES):
-        what = "a thesis task" if task in TASKS else "a program file"
+    if kind(task) in (THESIS, *PROGRAM_KINDS):
+        what = "a thesis task" if kind(task) == THESIS else "a program file"
         raise ValueError(f"log format {adapter.name} reads a joint log to replay; task {str(task)!r} is {what} "
                          "(a format other than measured is for a log only)")
     return LogTask(str(task), adapter)
@@ -123,30 +135,29 @@ def log_task(task: str, adapter: formats.LogFormat = formats.MEASURED) -> str | 
 def check_name(task: str) -> str:
     """``task`` if it is a thesis task name or an existing program / log file, else ValueError naming
     it and what is expected."""
-    if isinstance(task, LogTask):
-        if not Path(task.path).is_file():
-            raise ValueError(f"task file {task.path!r} does not exist")
-        return task
-    if isinstance(task, TextProgram):  # a program given by its text: no file to look for
-        return task
-    if not isinstance(task, str) or not task:
+    found = kind(task)
+    if found is None and (not isinstance(task, str) or not task):
         raise ValueError(f"task {task!r}: expected a task name ({', '.join(TASKS)}) or a program file (.toml) "
                          "or joint log (.csv, .h5)")
-    if task in TASKS:
-        return task
-    if is_file_task(task):
+    if found in FILE_KINDS:
         if not Path(task).is_file():
-            raise ValueError(f"task file {task!r} does not exist")
+            raise ValueError(f"task file {str(task)!r} does not exist")
+        return task
+    if found is not None:  # a thesis task, a program's text or a motion in memory: no file to look for
         return task
     raise ValueError(f"unknown task {task!r}; expected one of: {', '.join(TASKS)}, or a program file (.toml) "
                      "or a joint log (.csv, .h5) to replay")
 
 
 def label(task: str) -> str:
-    """A short name for ``task`` in run ids and progress bars: the thesis name, or the file's stem."""
-    if task in TASKS or not is_file_task(task):
+    """A short name for ``task`` in run ids and progress bars: the thesis name, or the file's stem
+    (a :class:`Motion`'s name)."""
+    found = kind(task)
+    if found == MOTION:
+        return task.name
+    if found in (THESIS, None):
         return task
-    if isinstance(task, LogTask):
+    if found == FORMAT_LOG:
         return task.stem
     name = Path(task).name
     for suffix in sorted(PROGRAM_SUFFIXES + REPLAY_SUFFIXES, key=len, reverse=True):
@@ -176,29 +187,36 @@ def load(robot: Robot, task: str) -> Task:
     """
     robots.require(robot, "programs.load")
     check_name(task)
-    if task in TASKS:
+    found = kind(task)
+    if found == THESIS:
         return builtin(robot, task)
-    if isinstance(task, TextProgram):
+    if found == TEXT:
         return parse(task.text, robot, where=f"program {task}")
-    if str(task).lower().endswith(PROGRAM_SUFFIXES):
+    if found == PROGRAM:
         return read(task, robot)
     # only a replayed log needs the log reader (pandas, h5py, scipy.signal: about 1 s to import,
     # which a thesis task or program would spend before its first physics step for nothing)
     from faultgen.operation import replay
 
-    adapter = task.adapter if isinstance(task, LogTask) else formats.MEASURED
+    if found == MOTION:
+        return replay.Replay.from_motion(task, robot, _limits({}, robot, task.source), check_torque)
+    adapter = task.adapter if found == FORMAT_LOG else formats.MEASURED
     return replay.read(str(task), robot, _limits({}, robot, str(task)), check_torque, adapter=adapter)
 
 
 def record(task: str) -> dict | None:
     """What a dataset keeps of a file task so the run can be made again: ``name`` (the program's, or
     the log's stem), ``file`` (as given), ``sha256`` of the file's bytes, for a program its ``text``
-    and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); None for a thesis task."""
-    if task in TASKS or not is_file_task(task):
+    and for a :class:`LogTask` its ``format`` (:meth:`LogTask.log_format`); for a :class:`Motion`
+    its ``name``, ``source`` and :attr:`Motion.sha256`; None for a thesis task."""
+    found = kind(task)
+    if found == MOTION:
+        return {"name": task.name, "source": task.source, "sha256": task.sha256}
+    if found in (THESIS, None):
         return None
-    data = task.text.encode() if isinstance(task, TextProgram) else Path(task).read_bytes()
+    data = task.text.encode() if found == TEXT else Path(task).read_bytes()
     out = {"file": str(task), "sha256": hashlib.sha256(data).hexdigest()}
-    if str(task).lower().endswith(PROGRAM_SUFFIXES):
+    if found in PROGRAM_KINDS:
         text = data.decode()
         try:
             out["name"] = str(inputs.loads_toml(text, task, "program file").get("name", label(task)))
@@ -207,7 +225,7 @@ def record(task: str) -> dict | None:
         out["text"] = text
     else:
         out["name"] = label(task)
-    if isinstance(task, LogTask):
+    if found == FORMAT_LOG:
         out["format"] = task.log_format()
     return out
 
@@ -561,9 +579,9 @@ def show(robot: Robot, task: str) -> str:
     if task in TASKS:
         return export(robot, task)
     check_name(task)
-    if not str(task).lower().endswith(PROGRAM_SUFFIXES):
+    if kind(task) not in PROGRAM_KINDS:
         raise ValueError(f"{task}: a joint log has no program text; `faultgen tasks show` prints programs")
-    return task.text if isinstance(task, TextProgram) else Path(task).read_text()
+    return task.text if kind(task) == TEXT else Path(task).read_text()
 
 
 def available(robot: Robot) -> list[tuple[str, str]]:

@@ -49,6 +49,7 @@ capacity.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -60,7 +61,7 @@ from scipy.interpolate import CubicSpline
 from faultgen.model.robots import Robot
 from faultgen.logs import blocks, formats, jointlog
 from faultgen.logs.jointlog import MAX_GAP, LogError
-from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath
+from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath, Motion
 
 #: Shortest log replayed, s (four filter windows); the longest interval between samples is the
 #: measured-log reader's :data:`faultgen.logs.jointlog.MAX_GAP` (the derivative filter's window).
@@ -112,6 +113,26 @@ class Replay:
     start: np.ndarray
     robot: Robot = field(repr=False)
     check_torque: Callable = field(repr=False)
+
+    @classmethod
+    def from_motion(cls, motion: Motion, robot: Robot, limits: tuple[np.ndarray, np.ndarray, np.ndarray],
+                    check_torque: Callable) -> Replay:
+        """The replay of a motion given in memory (a :class:`faultgen.operation.tasks.Motion`: its
+        ``t`` s and ``q`` rad), with the checks and messages of a measured log read whole
+        (:func:`from_columns`; its samples named ``sample K``); named ``motion.name``, its source
+        ``motion.source``. ``robot``, ``limits``, ``check_torque``: as :func:`read`.
+
+        Raises
+        ------
+        faultgen.logs.jointlog.LogError
+            As :func:`read`; also for angles of another number of axes than ``robot``'s.
+        """
+        n = robot.n_axes
+        if motion.q.shape[1] != n:
+            raise LogError(f"{motion.source}: {motion.q.shape[1]} angle columns; {robot.name} has {n} axes")
+        columns = {jointlog.T_COLUMN: motion.t, **dict(zip(jointlog.column_names(n)[0], motion.q.T, strict=True))}
+        found = from_columns(columns, lambda i: f"sample {i}", Path(motion.source), robot, limits, check_torque)
+        return dataclasses.replace(found, name=motion.name)
 
     @property
     def duration(self) -> float:

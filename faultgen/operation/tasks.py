@@ -194,6 +194,64 @@ class LogTask:
                 **{k: list(v) if isinstance(v, tuple) else v for k, v in options.items()}}
 
 
+class Motion:
+    """A joint motion to replay, given in memory rather than as a log file: the twin's smoothed
+    program cycle (:mod:`faultgen.monitor.twin`). It stands where a joint log's path does;
+    :func:`faultgen.operation.programs.load` replays it
+    (:meth:`faultgen.operation.replay.Replay.from_motion`) with the checks and messages of a log
+    read whole. Equal, and hashed, by its name and the SHA-256 of its samples (:attr:`sha256`), so
+    the cached preparations of a run are keyed by content; pickles with its samples.
+
+    Parameters
+    ----------
+    name : str
+        What it is called (run ids, progress bars, the replay's :attr:`~faultgen.operation.replay.Replay.name`).
+    t : array_like of shape (n,)
+        Sample times, s.
+    q : array_like of shape (n, N)
+        Arm angles, rad.
+    source : str, optional
+        What messages name as its origin (e.g. the log it was derived from); ``name`` by default.
+
+    Raises
+    ------
+    ValueError
+        An empty name, or ``t`` and ``q`` not of shapes (n,) and (n, N) (the shapes named).
+    """
+
+    __slots__ = ("name", "t", "q", "source", "sha256")
+
+    def __init__(self, name: str, t, q, source: str = "") -> None:
+        t, q = np.array(t, dtype=float), np.array(q, dtype=float)
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"Motion name {name!r}: expected a non-empty string")
+        if t.ndim != 1 or q.ndim != 2 or len(q) != len(t):
+            raise ValueError(f"Motion {name!r}: expected t of shape (n,) and q of shape (n, N), got {t.shape} and {q.shape}")
+        t.setflags(write=False)
+        q.setflags(write=False)
+        digest = hashlib.sha256(repr(q.shape).encode() + t.tobytes() + q.tobytes()).hexdigest()
+        for key, value in zip(self.__slots__, (name, t, q, source or name, digest), strict=True):
+            object.__setattr__(self, key, value)
+
+    def __setattr__(self, key, value):
+        raise AttributeError(f"Motion is read-only ({key})")
+
+    def __reduce__(self):
+        return Motion, (self.name, self.t, self.q, self.source)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Motion) and (self.name, self.sha256) == (other.name, other.sha256)
+
+    def __hash__(self) -> int:
+        return hash((self.name, self.sha256))
+
+    def __str__(self) -> str:
+        return self.name
+
+    def __repr__(self) -> str:
+        return f"Motion({self.name!r}, {len(self.t)} samples x {self.q.shape[1]} axes, sha256 {self.sha256[:12]})"
+
+
 class TextProgram(str):
     """A program file given by its text rather than a path (issue 75: a fleet's friction test travels
     in its runs' configuration, so that two machines or two caches make the same runs). It stands
@@ -215,6 +273,37 @@ class TextProgram(str):
 
     def __getnewargs_ex__(self):
         return (str(self), self.text), {"named": True}
+
+
+#: File suffixes read as programs; the rest of :data:`REPLAY_SUFFIXES` are replayed joint logs.
+PROGRAM_SUFFIXES = (".toml",)
+REPLAY_SUFFIXES = (".csv", ".csv.gz", ".h5", ".hdf5")
+
+
+#: The kinds of task (:func:`kind`): a thesis task of the robot folder's ``tasks.toml``, a program
+#: file, a program's text (:class:`TextProgram`), a joint log file in the measured format, a joint
+#: log in another format (:class:`LogTask`), a motion in memory (:class:`Motion`).
+THESIS, PROGRAM, TEXT, LOG, FORMAT_LOG, MOTION = "thesis", "program", "text", "log", "format-log", "motion"
+#: The kinds that are programs (planned from TOML), and those that name a file of this machine.
+PROGRAM_KINDS, FILE_KINDS = (PROGRAM, TEXT), (PROGRAM, LOG, FORMAT_LOG)
+
+
+def kind(task) -> str | None:
+    """What ``task`` is, one of the kinds above (None: none of them, an unknown name): decided here
+    and nowhere else, by its type and then a file name's suffix (:data:`PROGRAM_SUFFIXES`,
+    :data:`REPLAY_SUFFIXES`). Looks at no file."""
+    if isinstance(task, Motion):
+        return MOTION
+    if isinstance(task, LogTask):
+        return FORMAT_LOG
+    if isinstance(task, TextProgram):
+        return TEXT
+    if not isinstance(task, str) or not task:
+        return None
+    if task in TASKS:
+        return THESIS
+    name = task.lower()
+    return PROGRAM if name.endswith(PROGRAM_SUFFIXES) else LOG if name.endswith(REPLAY_SUFFIXES) else None
 
 
 def check_step(dt) -> float:

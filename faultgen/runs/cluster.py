@@ -49,7 +49,7 @@ from faultgen.operation import programs
 from faultgen.runs.context import ExecutionContext
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
-from faultgen.simulation import backends
+from faultgen.simulation import backends, spec
 from faultgen.simulation import stepping as sim
 
 #: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
@@ -101,8 +101,8 @@ def for_workers(config: sim.RunConfig) -> sim.RunConfig:
     changes = {}
     if str(config.robot) not in robots.available() and Path(config.robot).exists():
         changes["robot"] = str(Path(config.robot).absolute())
-    if not isinstance(config.task, programs.TextProgram) and Path(config.task).is_file():
-        changes["task"] = str(Path(config.task).absolute())
+    if programs.kind(config.task) in programs.FILE_KINDS and Path(config.task).is_file():
+        changes["task"] = spec.absolute_task(config.task)
     return replace(config, **changes) if changes else config
 
 

@@ -107,8 +107,8 @@ class RunConfig:
         robot = self.resolved
         n_axes = robot.n_axes
         programs.check_name(self.task)  # a thesis task, or a program / joint log file
-        if programs.is_file_task(self.task):  # checked before any simulation (segment and value named)
-            prepare.task_path(robot, self.task, *prepare.file_stamps(robot, self.task))
+        if programs.is_given_task(self.task):  # checked before any simulation (segment and value named)
+            prepare.task_path(robot, self.task, *prepare.digests(robot, self.task))
         stepping = friction_models.get(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")

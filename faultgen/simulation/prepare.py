@@ -5,6 +5,7 @@ robot carrying a part or a growing fault."""
 from __future__ import annotations
 
 import functools
+import hashlib
 import json
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -61,48 +62,50 @@ def prepared_for(robot: robots.Robot, task: str, friction_model: str, payload: d
                  fault: Fault | None = None) -> Prepared:
     """:func:`_prepare` of the resolved ``robot`` (a name is resolved once, at the boundary:
     :func:`faultgen.model.robots.load`; TypeError for anything but a :class:`Robot`), renewed when
-    its task file changes; ``payload``: the :class:`faultgen.effects.payload.Payload` parameters of a
+    its task file's content changes (:func:`digests`); ``payload``: the :class:`faultgen.effects.payload.Payload` parameters of a
     part the robot carries; ``fault``: a growing fault to build into the simulated robot
     (:func:`_prepare_variant`)."""
     robots.require(robot, "prepared_for")
-    stamps = file_stamps(robot, task)
+    keys = digests(robot, task)
     if payload is None and fault is None:
-        return _prepare(robot, task, friction_model, *stamps)
+        return _prepare(robot, task, friction_model, *keys)
     key = None if fault is None else json.dumps(fault.to_dict(), sort_keys=True)
     return _prepare_variant(robot, task, friction_model, None if payload is None else tuple(sorted(payload.items())),
-                            key, *stamps)
+                            key, *keys)
 
 
-def file_stamps(robot: robots.Robot, task: str) -> tuple[int, ...]:
-    """Modification times of the robot's task file (and of a program or log file, with its size):
-    what renews the cached preparations (the robot's own model is the :class:`Robot` object they
-    are keyed by, one per file content). Raises ValueError for a model file copied without its
-    ``tasks.toml``."""
+def digests(robot: robots.Robot, task) -> tuple[str, ...]:
+    """SHA-256 of the robot folder's task file (and of a program or log file's bytes): what keys the
+    cached preparations besides the task as given, so that an edited file is planned again and an
+    unchanged one is not, whatever its modification time (the robot's own model is the
+    :class:`Robot` object they are keyed by, one per file content; a program's text and a motion in
+    memory are keyed by their content already). Raises ValueError for a model file copied without
+    its ``tasks.toml``."""
     model_file = robot.path
     tasks_file = model_file.parent / "tasks.toml"
     if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
                          "with it (the model `faultgen calibrate` writes has one)")
-    stamps = (tasks_file.stat().st_mtime_ns,)
-    if programs.is_file_task(task) and not isinstance(task, programs.TextProgram):  # a text has no file to stamp
-        stamps = (*stamps, Path(task).stat().st_mtime_ns, Path(task).stat().st_size)
-    return stamps
+    found = (hashlib.sha256(tasks_file.read_bytes()).hexdigest(),)
+    if programs.kind(task) in programs.FILE_KINDS:
+        found = (*found, hashlib.sha256(Path(task).read_bytes()).hexdigest())
+    return found
 
 
 @functools.lru_cache(maxsize=16)
-def task_path(robot: robots.Robot, task_name: str, *file_stamps: int):
+def task_path(robot: robots.Robot, task_name: str, *digests: str):
     """The task (thesis task, program or replayed log) and its checked path at the robot's physics
-    step, once per process and robot (``file_stamps`` renew it on edits of the task file)."""
+    step, once per process, robot and content (``digests``: :func:`digests`)."""
     task = programs.load(robot, task_name)
     return task, task.trajectory(robot.model.opt.timestep)
 
 
 @functools.lru_cache(maxsize=16)
-def _reference(robot: robots.Robot, task_name: str, *file_stamps: int) -> tuple:
+def _reference(robot: robots.Robot, task_name: str, *digests: str) -> tuple:
     """``(task, path, q_ref, qd_ref, qdd_ref)``: the task's path held to a whole number of log
     periods at the robot's physics step, what every friction model and variant of the robot
     shares (read-only; no simulation model is compiled for it)."""
-    task, path = task_path(robot, task_name, *file_stamps)
+    task, path = task_path(robot, task_name, *digests)
     per_log = int(round(sensors.LOG_PERIOD / robot.model.opt.timestep))
     n_steps = _padded_steps(len(path.t) - 1, per_log)
     arrays = tuple(hold_end(a, n_steps) for a in (path.q, path.qd, path.qdd))
@@ -113,14 +116,14 @@ def _reference(robot: robots.Robot, task_name: str, *file_stamps: int) -> tuple:
 
 @functools.lru_cache(maxsize=16)
 def _prepare_variant(robot: robots.Robot, task_name: str, friction_model: str, payload: tuple | None,
-                     fault: str | None, *file_stamps: int) -> Prepared:
+                     fault: str | None, *digests: str) -> Prepared:
     """The :class:`Prepared` of a robot carrying a payload (``(name, value)`` pairs of the
     :class:`~faultgen.effects.payload.Payload` parameters, written as a body at the flange) and/or
     with a growing fault (a :class:`Fault` as JSON): the nominal task path; a model with the payload
     and the fault's effect in it (at its final value; :attr:`Prepared.fault_fields` move it per
     simulation), and a feedforward with the payload only (the controller knows the load it carries,
     not the fault). No nominal simulation model is compiled for it."""
-    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *file_stamps)
+    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *digests)
     if getattr(path, "loads", ()):
         raise ValueError(f"{task_name} grips and releases a payload within the cycle; it runs without the payload "
                          "condition (--payloads) and without a growing fault")
@@ -191,12 +194,12 @@ def _affine_fields(model_at, start: float, final: float, model, checked: bool = 
 
 
 @functools.lru_cache(maxsize=8)
-def _prepare(robot: robots.Robot, task_name: str, friction_model: str, *file_stamps: int) -> Prepared:
-    """The :class:`Prepared` of a robot, task and friction model, computed once per process and
-    robot object (``file_stamps``, the modification times of the task files, renew it on edits).
+def _prepare(robot: robots.Robot, task_name: str, friction_model: str, *digests: str) -> Prepared:
+    """The :class:`Prepared` of a robot, task and friction model, computed once per process, robot
+    object and content of the task files (``digests``: :func:`digests`).
     Arrays are made read-only so no run can change what the next one gets.
     """
-    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *file_stamps)
+    task, path, q_ref, qd_ref, qdd_ref = _reference(robot, task_name, *digests)
     loads = getattr(path, "loads", ())
     sim = build(robot, friction_model,
                 edit=(lambda spec: programs.add_part(spec, robot, loads[0].params)) if loads else None)
@@ -222,7 +225,7 @@ def cycle_duration(robot: robots.Robot, task: str) -> float:
     cycle): the task's path held to whole log periods, no simulation model compiled for it.
     TypeError for anything but a :class:`~faultgen.model.robot.Robot`."""
     robots.require(robot, "cycle_duration")
-    q_ref = _reference(robot, task, *file_stamps(robot, task))[2]
+    q_ref = _reference(robot, task, *digests(robot, task))[2]
     return (len(q_ref) - 1) * robot.model.opt.timestep
 
 

@@ -1,0 +1,92 @@
+"""A run built from its text once (:func:`resolve`): the one place below the CLI where a run's robot,
+task, friction model and stepper are looked up.
+
+``resolve(spec) -> Run``: the robot by :func:`faultgen.model.robots.load` (one compiled robot per
+file content, its SHA-1), the task by :func:`task` (its kind decided by
+:func:`faultgen.operation.programs.kind`, read and planned at the robot's physics step once per
+process and content: :func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the
+robot's ``tasks.toml`` and of a program or log file, :func:`faultgen.simulation.prepare.digests`,
+not by file times), the friction model by :func:`friction` and the stepper by :func:`stepper`. The
+:class:`Run` holds the objects; :func:`faultgen.simulation.stepping.simulate` steps it
+(``simulate(run.config, stepper=run.stepper)``, or :meth:`Run.simulate`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from faultgen.model import robots
+from faultgen.operation import programs, tasks
+from faultgen.simulation import backends, friction_models, prepare
+from faultgen.simulation.config import RunConfig
+from faultgen.simulation.spec import RunSpec
+
+
+@dataclass(frozen=True)
+class Run:
+    """A run of objects: ``config`` (a :class:`~faultgen.simulation.config.RunConfig` holding the
+    resolved robot; its task checked and planned) and ``stepper`` (a
+    :class:`faultgen.simulation.backends.Stepper`)."""
+
+    config: RunConfig
+    stepper: backends.Stepper
+
+    def simulate(self, progress: bool = True, **options):
+        """:func:`faultgen.simulation.stepping.simulate` of the run on its stepper; ``options`` as there."""
+        from faultgen.simulation import stepping
+
+        return stepping.simulate(self.config, progress=progress, stepper=self.stepper, **options)
+
+
+def robot(name: str) -> robots.Robot:
+    """The robot ``name`` (a known name, a robot folder or an MJCF file): :func:`faultgen.model.robots.load`,
+    one compiled robot per file content. Raises ValueError (UnknownRobotError, ModelError) naming it."""
+    return robots.load(name)
+
+
+def task(robot_: robots.Robot, given) -> tuple[tasks.Task, tasks.JointPath]:
+    """The task ``given`` (a thesis task name, a program or log file, a program's text, a log in
+    another format or a motion in memory: :func:`faultgen.operation.programs.kind`) of ``robot_``
+    and its checked path at the robot's physics step, read and planned once per process, robot and
+    content (:func:`faultgen.simulation.prepare.digests`).
+
+    Raises
+    ------
+    ValueError
+        An unknown task, a missing file, or a task that cannot run on the robot (file, segment and
+        value named).
+    """
+    programs.check_name(given)
+    return prepare.task_path(robot_, given, *prepare.digests(robot_, given))
+
+
+def friction(name: str) -> friction_models.FrictionModel:
+    """The friction model ``name`` (:data:`faultgen.effects.friction.MODELS`); ValueError naming the known ones."""
+    return friction_models.get(name)
+
+
+def stepper(name: str) -> backends.Stepper:
+    """The stepper registered as ``name`` (:data:`faultgen.simulation.backends.STEPPERS`); ValueError
+    naming the known ones."""
+    return backends.get(name)
+
+
+def resolve(spec: RunSpec) -> Run:
+    """The run ``spec`` describes, built from objects (module docstring).
+
+    Raises
+    ------
+    TypeError
+        ``spec`` is not a :class:`~faultgen.simulation.spec.RunSpec`.
+    ValueError
+        An unknown robot, task, friction model or stepper, a file that does not load, or a value
+        :class:`~faultgen.simulation.config.RunConfig` refuses (each named).
+    """
+    if not isinstance(spec, RunSpec):
+        raise TypeError(f"resolve: expected a RunSpec, got {type(spec).__name__}")
+    found = robot(spec.robot)
+    friction(spec.friction)
+    stepping = stepper(spec.stepper)
+    task(found, spec.task)
+    config = RunConfig(robot=spec.robot, resolved=found, **spec.run_fields())
+    return Run(config, stepping)
