@@ -261,8 +261,7 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
     from sklearn.metrics import roc_auc_score
 
     from analysis.benchmark.classification_features import classification_inputs
-    from analysis.classify import (ESTIMATED, SHORT_TABLE, fit_by_run, make_pipeline, null_p_value, permuted_roles,
-                                   score_by_run)
+    from analysis.classify import ESTIMATED, SHORT_TABLE, ByRun, make_pipeline, null_p_value, permuted_roles
 
     with opened(test) as data, opened(train) as source:
         check_comparable(source, data)
@@ -286,10 +285,9 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
     cells = [(p, c) for p in preprocessing for c in classifiers]
     for pre, classifier in tqdm(cells, desc="classify", unit="cell", disable=not progress):
         columns = slice(None) if pre.startswith(ESTIMATED) else slice(0, train_width)
-        model = fit_by_run(make_pipeline(classifier, pre, random_state=random_state), X_train[:, columns],
-                           fitted.y, fitted.groups)
-        scores = score_by_run(model, X_test[:, slice(None) if pre.startswith(ESTIMATED) else slice(0, width)],
-                              tested.groups)
+        method = ByRun(make_pipeline(classifier, pre, random_state=random_state))
+        scores = _across(method, f"{classifier} {pre}", (X_train[:, columns], fitted),
+                         (X_test[:, slice(None) if pre.startswith(ESTIMATED) else slice(0, width)], tested))
         auc = float(roc_auc_score(tested.y, scores))
         null = np.array([roc_auc_score(labels, scores) if 0 < labels.sum() < len(labels) else np.nan
                          for labels, _, _ in null_sets])
@@ -303,3 +301,24 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
                                f"tested on {len(tested.failed)} worn and {len(tested.normal)} unworn runs of "
                                f"{data.path.name}")
     return table
+
+
+def _across(method, name: str, train: tuple, test: tuple) -> np.ndarray:
+    """``method`` fitted on the train dataset's rows and scored on the test dataset's
+    (:func:`analysis.evaluate.evaluate`, the two files as one track split); ``train`` and ``test``
+    each (X (n_rows, n_features), its classification inputs: ``y``, ``groups``). The scores of the
+    test rows, shape (n_test_rows,)."""
+    from analysis.evaluate import Data, TrackSplit, evaluate
+
+    (X_train, fitted), (X_test, tested) = train, test
+    is_test = np.r_[np.zeros(len(X_train), dtype=bool), np.ones(len(X_test), dtype=bool)]
+    groups = np.array([f"train/{g}" for g in fitted.groups] + [f"test/{g}" for g in tested.groups], dtype=object)
+    width = max(X_train.shape[1], X_test.shape[1])
+    X = np.full((len(is_test), width), np.nan)
+    X[~is_test, :X_train.shape[1]], X[is_test, :X_test.shape[1]] = X_train, X_test
+    data = Data(X, groups, np.r_[np.asarray(fitted.y), np.zeros(len(X_test), dtype=np.asarray(fitted.y).dtype)],
+                width=np.where(is_test, X_test.shape[1], X_train.shape[1]))
+    scores = evaluate(method, data, TrackSplit(is_test, np.zeros(len(is_test))), None, name, alarms=False,
+                      test_by="fold")
+    return scores.scores[is_test]
+
