@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from sklearn.base import clone
 from tqdm.auto import tqdm
 
 from analysis import isolation, registry, scoring
 from analysis.benchmark.detection import locate_onset
 from analysis.benchmark.truth import fault_progress, opened
+from analysis.evaluate import Data, TrackSplit, evaluate
 from analysis.features import kl_divergence
 from analysis.monitoring import fit_q_monitor, reconstruction_contributions, varying_columns
 from faultgen.data import reader
@@ -149,25 +149,34 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
         check_comparable(source, data)
         label = protocol(source, first)
         learnt = _long_enough(source.healthy, first, source.path, "run without wear")
-        normal = np.vstack([unit_detection_features(run, first) for run in learnt])
-        used = varying_columns(normal)
-        monitor = (clone(detector).fit(normal[:, used]) if detector is not None
-                   else fit_q_monitor(normal[:, used], registry.make("pca_monitor", variance=variance, alpha=alpha,
-                                                                     statistic="q", cv=limit_folds)[1]))
+        normal = [unit_detection_features(run, first) for run in learnt]
+        used = varying_columns(np.vstack(normal))
         rules = scoring.DETECT_RULES.with_persistence(persistence)  # as detect's: from the fault's first sample
         judged = [run for run in data.healthy if len(run.recorded) > first]
-        flags = [np.asarray(monitor.predict(unit_detection_features(run, first)[first:, used]), dtype=bool)
-                 for run in judged]
+        worn = [r for r in data.runs if len(r.worn_axes) == 1]
+        for run in worn:
+            _long_enough([run], first, data.path, f"tested run ({run.id})")
+        # one track split: the healthy runs of train learnt, the healthy runs of test after their baseline and
+        # the worn runs whole tested, each run on its own (analysis.evaluate)
+        units = ([x[:, used] for x in normal] + [unit_detection_features(r, first)[first:, used] for r in judged]
+                 + [unit_detection_features(r, first)[:, used] for r in worn])
+        ids = [f"train/{r.id}" for r in learnt] + [f"healthy/{r.id}" for r in judged] + [f"worn/{r.id}" for r in worn]
+        records = Data.of_units(units, ids, healthy_units=[True] * (len(learnt) + len(judged)) + [False] * len(worn))
+        is_test = np.repeat([k >= len(learnt) for k in range(len(ids))], [len(x) for x in units])
+        method = detector if detector is not None else registry.make("pca_monitor", variance=variance, alpha=alpha,
+                                                                    statistic="q", cv=limit_folds)[1]
+        found = evaluate(method, records, TrackSplit(is_test, np.zeros(len(is_test))), rules,
+                         type(method).__name__, scores=False, fit=None if detector is not None else fit_q_monitor)
+        monitor = found.fitted[0] if found.fitted else None
+        flags = [found.alarms[records.rows(f"healthy/{run.id}")] for run in judged]
         false_alarm = scoring.false_alarm_rate(flags, rules, scale=100.0)  # the mean of each run's rate
         rows, charts = [], {}
-        for run in tqdm([r for r in data.runs if len(r.worn_axes) == 1], desc="detection", unit="run",
-                        disable=not progress):
+        for run in tqdm(worn, desc="detection", unit="run", disable=not progress):
             axis = run.worn_axes[0]
-            _long_enough([run], first, data.path, f"tested run ({run.id})")
-            features = unit_detection_features(run, first)[:, used]
-            alarms = np.asarray(monitor.predict(features), dtype=bool)
+            tested = records.rows(f"worn/{run.id}")
+            features, alarms = records.features(tested), found.alarms[tested]
             begins = run.fault_begins
-            onset = scoring.onset(alarms, rules, fault_start=begins, skip=first)
+            onset = found.onset(tested, fault_start=begins, skip=first)
             before = scoring.before_fault(alarms, begins, first)
             wear = fault_progress(run, axis) * 100.0 - 100.0
             located = locate_onset(features, onset)
@@ -308,8 +317,6 @@ def _across(method, name: str, train: tuple, test: tuple) -> np.ndarray:
     (:func:`analysis.evaluate.evaluate`, the two files as one track split); ``train`` and ``test``
     each (X (n_rows, n_features), its classification inputs: ``y``, ``groups``). The scores of the
     test rows, shape (n_test_rows,)."""
-    from analysis.evaluate import Data, TrackSplit, evaluate
-
     (X_train, fitted), (X_test, tested) = train, test
     is_test = np.r_[np.zeros(len(X_train), dtype=bool), np.ones(len(X_test), dtype=bool)]
     groups = np.array([f"train/{g}" for g in fitted.groups] + [f"test/{g}" for g in tested.groups], dtype=object)

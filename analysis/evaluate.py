@@ -255,11 +255,13 @@ def _takes_groups(function) -> bool:
     return "groups" in inspect.signature(function).parameters
 
 
-def fit_detector(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray, groups: np.ndarray | None = None):
+def fit_detector(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray, groups: np.ndarray | None = None,
+                 fit=None):
     """A new copy of the detector ``method`` fitted on training records: a classifier
     (``sklearn.base.is_classifier``; a plug-in's class is asked through its ``build()``) ``fit(X, y)``
     on all of them (``fit(X, y, groups=groups)`` where its ``fit`` takes the unit of each record),
-    any other estimator ``fit(X)`` on the ``healthy`` rows. Returns (the fitted object that gives
+    any other estimator ``fit(X)`` on the ``healthy`` rows (``fit(X, estimator)`` where ``fit`` is
+    given, e.g. :func:`analysis.monitoring.fit_q_monitor`). Returns (the fitted object that gives
     alarms, the estimator that gives scores).
 
     Raises
@@ -275,7 +277,8 @@ def fit_detector(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray, grou
         except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
             raise ValueError(f"fit(X, y) of X {X.shape} failed: {type(err).__name__}: {err}") from None
         return inner, inner
-    fitted = clone(method).fit(X[healthy])  # a plug-in: behind its contract guard (analysis.plugins)
+    # a plug-in: behind its contract guard (analysis.plugins)
+    fitted = clone(method).fit(X[healthy]) if fit is None else fit(X[healthy], clone(method))
     return fitted, getattr(fitted, "estimator_", fitted)
 
 
@@ -341,6 +344,9 @@ class Scores:
         Rows some fold tested (a row tested by several folds holds the last fold's answer).
     named : list of (int, object)
         An isolator's answer per fold: (axis named, ``fault_`` or None), :func:`isolate`.
+    fitted : list
+        A detector's fitted object per fold (what gave the alarms: e.g. a monitor whose limits a
+        chart draws).
     """
 
     name: str
@@ -351,6 +357,7 @@ class Scores:
     alarms: np.ndarray
     tested: np.ndarray
     named: list
+    fitted: list = dataclasses.field(default_factory=list)
 
     def of(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(scores, alarms) of the given rows."""
@@ -363,7 +370,8 @@ class Scores:
 
 
 def evaluate(method, data: Data, protocol, rules: scoring.Rules | None, name: str = "method",
-             role: str = "detector", *, alarms: bool = True, test_by: str = "group") -> Scores:
+             role: str = "detector", *, alarms: bool = True, scores: bool = True, test_by: str = "group",
+             fit=None) -> Scores:
     """``method`` fitted and tested on ``data`` as ``protocol`` splits it; its answers as
     :class:`Scores` under ``rules``.
 
@@ -385,8 +393,11 @@ def evaluate(method, data: Data, protocol, rules: scoring.Rules | None, name: st
     name : str
         The method's name in messages.
     role : {"detector", "isolator"}
-    alarms : bool
-        Also a detector's alarms (``predict``); False: scores only, ``Scores.alarms`` all False.
+    alarms, scores : bool
+        Whether a detector's alarms (``predict``) and its scores are asked for (those not: all False,
+        all NaN).
+    fit : callable (X, estimator) -> fitted estimator, or None
+        How a detector that learns healthy records is fitted (None: ``estimator.fit(X)``).
     test_by : {"group", "fold"}
         Test each unit's rows on their own, or each fold's test rows at once.
 
@@ -405,8 +416,8 @@ def evaluate(method, data: Data, protocol, rules: scoring.Rules | None, name: st
     if role == "isolator" and rules is None:
         raise ValueError("an isolator is scored under rules (what 'too few cycles' counts as); got rules=None")
     n = len(data.X)
-    scores, flags, tested = np.full(n, np.nan), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-    folds, named = [], []
+    values, flags, tested = np.full(n, np.nan), np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    folds, named, fits = [], [], []
     for train, test in protocol.split(data.X, data.y, data.groups):
         train, test = np.asarray(train), np.asarray(test)
         folds.append((train, test))
@@ -415,12 +426,14 @@ def evaluate(method, data: Data, protocol, rules: scoring.Rules | None, name: st
             named.append(isolate(method, data.features(test), rules))
             continue
         fitted, inner = fit_detector(method, data.features(train), data.y[train], data.healthy[train],
-                                     data.groups[train])
+                                     data.groups[train], fit)
+        fits.append(fitted)
         test_groups = data.groups[test]
         sets = [test] if test_by == "fold" else [test[test_groups == g] for g in dict.fromkeys(test_groups.tolist())]
         for rows in sets:
             X = data.features(rows)
-            scores[rows] = detector_scores(inner, X, name, data.groups[rows])
+            if scores:
+                values[rows] = detector_scores(inner, X, name, data.groups[rows])
             if alarms:
                 flags[rows] = plugins.alarms(name, fitted, X)
-    return Scores(name, role, rules, folds, scores, flags, tested, named)
+    return Scores(name, role, rules, folds, values, flags, tested, named, fits)
