@@ -10,8 +10,10 @@ where that happens, once:
   and ``get_n_splits(X, y, groups)`` (:class:`sklearn.model_selection.LeaveOneGroupOut`, or one of
   this module's: :class:`TrackSplit`, a bench track's train and test files per robot and task;
   :class:`LeavePairOut`, thesis Procedure 1; :class:`OwnHistory`, an isolator reading the first
-  cycles of the tested run itself). No protocol here puts rows of one group on both sides, except
-  :class:`OwnHistory`, whose method learns the tested unit's own history by design;
+  cycles of the tested run itself; :class:`Given`, folds as given: a training source's days and the
+  days it judges, thesis ch. 4). No protocol here puts rows of one group on both sides, except
+  :class:`OwnHistory` and own-history folds given, whose method learns the tested unit's own
+  history by design;
 - **method**: an unfitted estimator made by :func:`analysis.registry.make` (or a user's plug-in,
   :mod:`analysis.plugins`), in one of the roles ``detector`` (a classifier ``fit(X, y)`` on all
   training records, anything else ``fit(X)`` on the healthy units' records; then per test unit its
@@ -39,7 +41,7 @@ from analysis import scoring
 #: The roles :func:`evaluate` runs (a registry entry's ``role``).
 ROLES = ("detector", "isolator")
 
-__all__ = ["Data", "Scores", "TrackSplit", "LeavePairOut", "OwnHistory", "LeaveOneGroupOut", "evaluate",
+__all__ = ["Data", "Scores", "TrackSplit", "LeavePairOut", "OwnHistory", "Given", "LeaveOneGroupOut", "evaluate",
            "fit_detector", "detector_scores", "isolate"]
 
 
@@ -242,6 +244,20 @@ class OwnHistory(_Splitter):
         for unit, n in self.cases:
             rows = np.flatnonzero(groups == unit)[:n]
             yield rows, rows
+
+
+class Given(_Splitter):
+    """Folds given as they are: ``folds`` a list of (train, test) row indices, e.g. a training
+    source's days learnt and the days of each robot it judges (thesis ch. 4: a robot's own first
+    days, one-to-one, or a normal robot's, one-to-many; the own-history cases put one unit's
+    earlier rows in train and its later ones in test, by design)."""
+
+    def __init__(self, folds: Sequence[tuple]):
+        self.folds = list(folds)
+
+    def split(self, X=None, y=None, groups=None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        for train, test in self.folds:
+            yield np.asarray(train), np.asarray(test)
 
 
 # --- methods ----------------------------------------------------------------------------------------------------
