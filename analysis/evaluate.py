@@ -29,6 +29,7 @@ tables: they format :class:`Scores`.
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from collections.abc import Iterator, Sequence
 from itertools import product
 
@@ -36,7 +37,7 @@ import numpy as np
 from sklearn.base import clone, is_classifier
 from sklearn.model_selection import BaseCrossValidator, LeaveOneGroupOut
 
-from analysis import scoring
+from analysis import plugins, scoring
 
 #: The roles :func:`evaluate` runs (a registry entry's ``role``).
 ROLES = ("detector", "isolator")
@@ -109,8 +110,10 @@ class Data:
         return cls(X, groups, y, healthy, np.repeat(widths, sizes))
 
     def rows(self, group) -> np.ndarray:
-        """The row indices of ``group``, in order."""
-        return np.flatnonzero(self.groups == group)
+        """The row indices of ``group``, in order (empty for a group without rows)."""
+        if "_rows" not in self.__dict__:  # built once: a command asks for every unit's rows
+            object.__setattr__(self, "_rows", _rows_of(self.groups))
+        return self._rows.get(group, np.zeros(0, dtype=int))
 
     def features(self, rows: np.ndarray) -> np.ndarray:
         """``X`` of ``rows``, shape (len(rows), their width).
@@ -125,6 +128,14 @@ class Data:
             raise ValueError(f"records of {len(widths)} feature counts ({', '.join(map(str, widths))}) in one set: "
                              "units of robots with other numbers of axes cannot be fitted together")
         return self.X[rows, :widths[0]] if len(widths) else self.X[rows]
+
+
+def _rows_of(groups: np.ndarray) -> dict:
+    """Group -> its row indices in order, for every group of ``groups`` (one pass)."""
+    rows: dict = {}
+    for i, group in enumerate(np.asarray(groups).tolist()):
+        rows.setdefault(group, []).append(i)
+    return {group: np.asarray(found, dtype=int) for group, found in rows.items()}
 
 
 # --- protocols: scikit-learn splitters ------------------------------------------------------------------------
@@ -240,9 +251,9 @@ class OwnHistory(_Splitter):
     def split(self, X=None, y=None, groups=None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         if groups is None:
             raise ValueError("OwnHistory needs groups: the unit of each record")
-        groups = np.asarray(groups)
+        rows_of = _rows_of(groups)
         for unit, n in self.cases:
-            rows = np.flatnonzero(groups == unit)[:n]
+            rows = rows_of.get(unit, np.zeros(0, dtype=int))[:n]
             yield rows, rows
 
 
@@ -266,8 +277,6 @@ class Given(_Splitter):
 def _takes_groups(function) -> bool:
     """Whether ``function`` takes a ``groups`` keyword (a method that fits or scores run by run,
     :class:`analysis.classify.ByRun`)."""
-    import inspect
-
     return "groups" in inspect.signature(function).parameters
 
 
@@ -308,8 +317,6 @@ def detector_scores(estimator, X: np.ndarray, name: str, groups: np.ndarray | No
     ValueError
         Naming ``name`` when the method raises or gives other than one finite number per record.
     """
-    from analysis import plugins
-
     for method in ("decision_function", "predict_proba"):
         if hasattr(estimator, method):
             call = getattr(estimator, method)
@@ -423,8 +430,6 @@ def evaluate(method, data: Data, protocol, rules: scoring.Rules | None, name: st
         For another role, or what the method's fit or predict raises (named by :func:`fit_detector`,
         :func:`detector_scores`, :func:`analysis.plugins.alarms`).
     """
-    from analysis import plugins
-
     if role not in ROLES:
         raise ValueError(f"role {role!r}; expected one of: {', '.join(ROLES)}")
     if test_by not in ("group", "fold"):

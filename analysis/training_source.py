@@ -37,6 +37,7 @@ from tqdm.auto import tqdm
 
 from analysis import registry
 from analysis.benchmark.tables import markdown
+from analysis.evaluate import Data, Given, evaluate
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
@@ -192,8 +193,6 @@ def _q_residuals(plan: list, kind: str, train: slice, test: slice, model: QModel
     ValueError
         Naming the reference whose model cannot be fitted on the training days.
     """
-    from analysis.evaluate import Data, Given, evaluate
-
     units = {r[0]: r for _, reference, robot in plan if _ == kind for r in (reference, robot)}
     data = Data.of_units([unit[4][kind][0] for unit in units.values()], list(units))
     served = {}

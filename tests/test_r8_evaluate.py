@@ -13,7 +13,7 @@ import pytest
 from sklearn.model_selection import BaseCrossValidator, LeaveOneGroupOut
 
 from analysis import registry, scoring
-from analysis.evaluate import Data, LeavePairOut, OwnHistory, TrackSplit, evaluate
+from analysis.evaluate import Data, Given, LeavePairOut, OwnHistory, TrackSplit, evaluate
 from faultgen.bench import baselines  # noqa: F401  (registers the bench's baselines)
 
 RULES = scoring.BENCH_RULES
@@ -157,3 +157,39 @@ def test_bad_data_and_roles_are_refused_naming_them():
     data, failed, normal = tiny()
     with pytest.raises(ValueError, match="role 'prognoser'"):
         evaluate(registry.make("pca")[1], data, LeavePairOut(failed, normal), RULES, role="prognoser")
+
+
+def test_given_folds_fit_once_and_judge_each_unit_on_its_own_rows():
+    """A training source (thesis ch. 4): u0's first 12 records learnt, the last 12 of u0 (its own
+    history), u1 and u3 judged; the Q model's residuals equal those of the same model fitted by
+    hand, and u3's wear on axis 2 raises its Q above the normal units'."""
+    from analysis.training_source import QModel
+
+    data, _, _ = tiny()
+    first, last = slice(0, 12), slice(12, None)
+    tested = [data.rows(u)[last] for u in ("u0", "u1", "u3")]
+    folds = [(data.rows("u0")[first], np.concatenate(tested))]
+    scores = evaluate(QModel(0.75, 0.05, None), data, Given(folds), None, "q", alarms=False)
+    assert len(scores.folds) == Given(folds).get_n_splits() == 1 and not scores.alarms.any()
+    by_hand = QModel(0.75, 0.05, None).fit(data.X[data.rows("u0")[first]])
+    for rows in tested:
+        np.testing.assert_array_equal(scores.scores[rows], by_hand.decision_function(data.X[rows]))
+    assert np.isnan(scores.scores[data.rows("u2")]).all()
+    assert scores.scores[tested[2]].mean() > max(scores.scores[tested[0]].mean(), scores.scores[tested[1]].mean())
+
+
+def test_a_pipeline_fitted_run_by_run_scores_as_fit_by_run_and_score_by_run():
+    """classify's pipelines (differences taken within each run) through the harness: fitted on the
+    train units with their groups, the test fold scored at once with its groups, as by hand."""
+    from analysis.classify import ByRun, fit_by_run, make_pipeline, score_by_run
+
+    data, failed, normal = tiny()
+    protocol = LeavePairOut(failed, normal, n_pairs=2, random_state=0)
+    scores = evaluate(ByRun(make_pipeline("lr", "+diff")), data, protocol, None, "lr +diff", alarms=False,
+                      test_by="fold")
+    for train, test in protocol.split(data.X, data.y, data.groups):
+        model = fit_by_run(make_pipeline("lr", "+diff"), data.X[train], data.y[train], data.groups[train])
+        np.testing.assert_allclose(scores.scores[test], score_by_run(model, data.X[test], data.groups[test]),
+                                   rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="test_by = 'unit'"):
+        evaluate(ByRun(make_pipeline("lr")), data, protocol, None, test_by="unit")

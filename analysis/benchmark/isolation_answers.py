@@ -13,6 +13,7 @@ from tqdm.auto import tqdm
 from analysis import isolation, scoring
 from analysis.benchmark.tables import axis_label
 from analysis.benchmark.truth import NO_FAULT, fault_progress, level_cycle, opened
+from analysis.evaluate import Data, OwnHistory, evaluate
 from faultgen import axes
 
 #: Wear levels of thesis Table 6.2, in percent.
@@ -72,8 +73,6 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         If an isolator's parameters are invalid (e.g. bins < 2; the message names it), or the
         dataset has no run with exactly one worn axis.
     """
-    from analysis.evaluate import Data, OwnHistory, evaluate
-
     isolators = dict(isolators or default_isolators())
     _check_isolators(isolators)
     with opened(path) as data:

@@ -61,6 +61,7 @@ import numpy as np
 from sklearn.metrics import roc_auc_score, roc_curve
 
 from analysis import scoring
+from analysis.evaluate import Data, OwnHistory, TrackSplit, evaluate
 from faultgen.bench import files, verdicts
 from faultgen.data import atomic
 
@@ -148,8 +149,6 @@ def _chance_share(units: list, parts: bool = False):
 def detector_results(method, name: str, train: list[files.Unit], test: list[files.Unit]) -> dict:
     """Fit ``method`` per robot and task on ``train`` (labelled units) and judge ``test`` (units whose
     labels :func:`faultgen.bench.files.attach_labels` added; the method never sees them)."""
-    from analysis.evaluate import Data, TrackSplit, evaluate
-
     units = [*train, *test]
     data = Data.of_units([u.features() for u in units], [f"{k}:{u.id}" for k, u in enumerate(units)],
                          [u.fault_level >= WORN_PCT for u in units], [u.fault == "none" for u in units])
@@ -204,8 +203,6 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
 def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
     """Each test unit's source axis (and fault, if the isolator names one) from ``method`` fitted on
     its mean absolute motor torque."""
-    from analysis.evaluate import Data, OwnHistory, evaluate
-
     ids = [f"{k}:{unit.id}" for k, unit in enumerate(test)]
     data = Data.of_units([unit.arrays["mean_abs_torque"] for unit in test], ids)
     scores = evaluate(method, data, OwnHistory([(i, None) for i in ids]), RULES, name, role="isolator")
