@@ -4,17 +4,18 @@ subset, optionally time-matched; one pair's AUCs for every (preprocessing, class
 from __future__ import annotations
 
 import warnings
+
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
-from sklearn.base import BaseEstimator, clone
+from sklearn.base import BaseEstimator
 from sklearn.metrics import roc_auc_score
 from threadpoolctl import threadpool_limits
 
-from analysis.classify.by_run import fit_by_run, run_steps, score_by_run
+from analysis.classify.by_run import ByRun, run_steps
 from analysis.classify.labels import make_labels
 from analysis.classify.preprocessing import ESTIMATED, make_pipeline, preprocessing_steps
-from analysis.evaluate import LeavePairOut
+from analysis.evaluate import Data, Given, LeavePairOut, evaluate
 from faultgen import children
 
 
@@ -88,9 +89,18 @@ def _pair_auc(factory, X, labels, groups, fold, matched: bool = False) -> float:
     truth = labels[held][test]
     if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
         return np.nan
-    model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else clone(factory)
-    fit_by_run(model, X[train], labels[train], groups[train])
-    return float(roc_auc_score(truth, score_by_run(model, X[held], groups[held])[test]))
+    model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else factory
+    rows = np.flatnonzero(held)
+    scores = _scores(model, Data(X, groups, labels), train, rows, "leave-pair-out")
+    return float(roc_auc_score(truth, scores[test]))
+
+
+def _scores(model, data: Data, train: np.ndarray, test: np.ndarray, name: str) -> np.ndarray:
+    """The scores of ``data``'s ``test`` rows by ``model`` fitted on its ``train`` rows run by run
+    (:func:`analysis.evaluate.evaluate`, the fold given; :class:`analysis.classify.ByRun`), shape
+    (len(test),)."""
+    found = evaluate(ByRun(model), data, Given([(train, test)]), None, name, alarms=False, test_by="fold")
+    return found.scores[test]
 
 
 def pair_cells(X, X_est, labels, groups, fold, names, models, random_state, matched) -> np.ndarray:
@@ -110,10 +120,14 @@ def pair_cells(X, X_est, labels, groups, fold, names, models, random_state, matc
         steps = [step for _, step in preprocessing_steps(name)]
         X_train = run_steps(steps, data[train], groups[train], labels[train], fit=True)
         X_test = run_steps(steps, data[held], groups[held])
-        for model in models.values():
+        # the preprocessed rows, train then held out, one fold given: every classifier through the harness
+        stacked = Data(np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]],
+                       np.r_[labels[train], labels[held]])
+        n_train = len(X_train)
+        for column, model in models.items():
             clf = make_pipeline(model, "control", random_state=random_state)
-            fit_by_run(clf, X_train, labels[train], groups[train])
-            out[k] = roc_auc_score(truth, score_by_run(clf, X_test, groups[held])[test])
+            scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(stacked.X)), f"{column} {name}")
+            out[k] = roc_auc_score(truth, scores[test])
             k += 1
     return out
 
