@@ -11,4 +11,7 @@
 - :mod:`analysis.benchmark`: all of them over a dataset, in the layouts of Tables 6.2, 3.5, 5.2.
 - :mod:`analysis.registry`: the one registry of named methods (detectors, isolators, prognosers,
   the monitor model ``pca_monitor``) that faultgen's benchmark and monitor both make by name.
+- :mod:`analysis.evaluate`: the one evaluation harness, ``evaluate(method, data, protocol, rules)
+  -> Scores``, protocols as scikit-learn splitters; the commands that judge a method format its
+  scores.
 """

@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from sklearn.base import clone
 from tqdm.auto import tqdm
 
 from analysis import isolation, registry, scoring
 from analysis.benchmark.detection import locate_onset
 from analysis.benchmark.truth import fault_progress, opened
+from analysis.evaluate import Data, TrackSplit, evaluate
 from analysis.features import kl_divergence
 from analysis.monitoring import fit_q_monitor, reconstruction_contributions, varying_columns
 from faultgen.data import reader
@@ -149,25 +149,34 @@ def detection_across(test, train, *, first: int = 20, variance: float = 0.75, al
         check_comparable(source, data)
         label = protocol(source, first)
         learnt = _long_enough(source.healthy, first, source.path, "run without wear")
-        normal = np.vstack([unit_detection_features(run, first) for run in learnt])
-        used = varying_columns(normal)
-        monitor = (clone(detector).fit(normal[:, used]) if detector is not None
-                   else fit_q_monitor(normal[:, used], registry.make("pca_monitor", variance=variance, alpha=alpha,
-                                                                     statistic="q", cv=limit_folds)[1]))
+        normal = [unit_detection_features(run, first) for run in learnt]
+        used = varying_columns(np.vstack(normal))
         rules = scoring.DETECT_RULES.with_persistence(persistence)  # as detect's: from the fault's first sample
         judged = [run for run in data.healthy if len(run.recorded) > first]
-        flags = [np.asarray(monitor.predict(unit_detection_features(run, first)[first:, used]), dtype=bool)
-                 for run in judged]
+        worn = [r for r in data.runs if len(r.worn_axes) == 1]
+        for run in worn:
+            _long_enough([run], first, data.path, f"tested run ({run.id})")
+        # one track split: the healthy runs of train learnt, the healthy runs of test after their baseline and
+        # the worn runs whole tested, each run on its own (analysis.evaluate)
+        units = ([x[:, used] for x in normal] + [unit_detection_features(r, first)[first:, used] for r in judged]
+                 + [unit_detection_features(r, first)[:, used] for r in worn])
+        ids = [f"train/{r.id}" for r in learnt] + [f"healthy/{r.id}" for r in judged] + [f"worn/{r.id}" for r in worn]
+        records = Data.of_units(units, ids, healthy_units=[True] * (len(learnt) + len(judged)) + [False] * len(worn))
+        is_test = np.repeat([k >= len(learnt) for k in range(len(ids))], [len(x) for x in units])
+        method = detector if detector is not None else registry.make("pca_monitor", variance=variance, alpha=alpha,
+                                                                    statistic="q", cv=limit_folds)[1]
+        found = evaluate(method, records, TrackSplit(is_test, np.zeros(len(is_test))), rules,
+                         type(method).__name__, scores=False, fit=None if detector is not None else fit_q_monitor)
+        monitor = found.fitted[0] if found.fitted else None
+        flags = [found.alarms[records.rows(f"healthy/{run.id}")] for run in judged]
         false_alarm = scoring.false_alarm_rate(flags, rules, scale=100.0)  # the mean of each run's rate
         rows, charts = [], {}
-        for run in tqdm([r for r in data.runs if len(r.worn_axes) == 1], desc="detection", unit="run",
-                        disable=not progress):
+        for run in tqdm(worn, desc="detection", unit="run", disable=not progress):
             axis = run.worn_axes[0]
-            _long_enough([run], first, data.path, f"tested run ({run.id})")
-            features = unit_detection_features(run, first)[:, used]
-            alarms = np.asarray(monitor.predict(features), dtype=bool)
+            tested = records.rows(f"worn/{run.id}")
+            features, alarms = records.features(tested), found.alarms[tested]
             begins = run.fault_begins
-            onset = scoring.onset(alarms, rules, fault_start=begins, skip=first)
+            onset = found.onset(tested, fault_start=begins, skip=first)
             before = scoring.before_fault(alarms, begins, first)
             wear = fault_progress(run, axis) * 100.0 - 100.0
             located = locate_onset(features, onset)
@@ -261,8 +270,7 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
     from sklearn.metrics import roc_auc_score
 
     from analysis.benchmark.classification_features import classification_inputs
-    from analysis.classify import (ESTIMATED, SHORT_TABLE, fit_by_run, make_pipeline, null_p_value, permuted_roles,
-                                   score_by_run)
+    from analysis.classify import ESTIMATED, SHORT_TABLE, ByRun, make_pipeline, null_p_value, permuted_roles
 
     with opened(test) as data, opened(train) as source:
         check_comparable(source, data)
@@ -286,10 +294,9 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
     cells = [(p, c) for p in preprocessing for c in classifiers]
     for pre, classifier in tqdm(cells, desc="classify", unit="cell", disable=not progress):
         columns = slice(None) if pre.startswith(ESTIMATED) else slice(0, train_width)
-        model = fit_by_run(make_pipeline(classifier, pre, random_state=random_state), X_train[:, columns],
-                           fitted.y, fitted.groups)
-        scores = score_by_run(model, X_test[:, slice(None) if pre.startswith(ESTIMATED) else slice(0, width)],
-                              tested.groups)
+        method = ByRun(make_pipeline(classifier, pre, random_state=random_state))
+        scores = _across(method, f"{classifier} {pre}", (X_train[:, columns], fitted),
+                         (X_test[:, slice(None) if pre.startswith(ESTIMATED) else slice(0, width)], tested))
         auc = float(roc_auc_score(tested.y, scores))
         null = np.array([roc_auc_score(labels, scores) if 0 < labels.sum() < len(labels) else np.nan
                          for labels, _, _ in null_sets])
@@ -303,3 +310,22 @@ def classification_across(test, train, *, wear_threshold: float = 10.0, baseline
                                f"tested on {len(tested.failed)} worn and {len(tested.normal)} unworn runs of "
                                f"{data.path.name}")
     return table
+
+
+def _across(method, name: str, train: tuple, test: tuple) -> np.ndarray:
+    """``method`` fitted on the train dataset's rows and scored on the test dataset's
+    (:func:`analysis.evaluate.evaluate`, the two files as one track split); ``train`` and ``test``
+    each (X (n_rows, n_features), its classification inputs: ``y``, ``groups``). The scores of the
+    test rows, shape (n_test_rows,)."""
+    (X_train, fitted), (X_test, tested) = train, test
+    is_test = np.r_[np.zeros(len(X_train), dtype=bool), np.ones(len(X_test), dtype=bool)]
+    groups = np.array([f"train/{g}" for g in fitted.groups] + [f"test/{g}" for g in tested.groups], dtype=object)
+    width = max(X_train.shape[1], X_test.shape[1])
+    X = np.full((len(is_test), width), np.nan)
+    X[~is_test, :X_train.shape[1]], X[is_test, :X_test.shape[1]] = X_train, X_test
+    data = Data(X, groups, np.r_[np.asarray(fitted.y), np.zeros(len(X_test), dtype=np.asarray(fitted.y).dtype)],
+                width=np.where(is_test, X_test.shape[1], X_train.shape[1]))
+    scores = evaluate(method, data, TrackSplit(is_test, np.zeros(len(is_test))), None, name, alarms=False,
+                      test_by="fold")
+    return scores.scores[is_test]
+

@@ -32,10 +32,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 from scipy import signal as scipy_signal
+from sklearn.base import BaseEstimator
 from tqdm.auto import tqdm
 
 from analysis import registry
 from analysis.benchmark.tables import markdown
+from analysis.evaluate import Data, Given, evaluate
 from analysis.features import kl_divergence
 from analysis.monitoring import PCAMonitor, fit_q_monitor, varying_columns
 from faultgen.checks import is_whole
@@ -161,6 +163,56 @@ def _fit(X: np.ndarray, variance: float, alpha: float, folds: int | None) -> tup
     return used, fit_q_monitor(X[:, used], made)
 
 
+class QModel(BaseEstimator):
+    """The model of one training source (ch. 4.3.2), an estimator of the evaluation harness
+    (:func:`analysis.evaluate.evaluate`): ``fit(X)`` on the training days' signals (n_days,
+    n_features) removes their linear trends, leaves out the features constant there and fits a Q
+    monitor (the registry's ``pca_monitor``, ``variance``, ``alpha``, ``folds`` its ``cv``) on the
+    rest (``used_``, ``monitor_``); ``decision_function(X)`` is the Q residual of each day, shape
+    (n_days,)."""
+
+    def __init__(self, variance: float = 0.90, alpha: float = 0.05, folds: int | None = 20):
+        self.variance, self.alpha, self.folds = variance, alpha, folds
+
+    def fit(self, X, y=None) -> QModel:
+        self.used_, self.monitor_ = _fit(np.asarray(X), self.variance, self.alpha, self.folds)
+        return self
+
+    def decision_function(self, X) -> np.ndarray:
+        return self.monitor_.score_samples(np.asarray(X)[:, self.used_])[1]
+
+
+def _q_residuals(plan: list, kind: str, train: slice, test: slice, model: QModel, path, window: Window) -> dict:
+    """(reference, robot) -> Q of the robot's test days, for the cases of ``plan`` of signal type
+    ``kind``, each reference's model fitted once (:func:`analysis.evaluate.evaluate`, the folds given:
+    the reference's training days, the test days of every robot it serves); and reference -> the
+    fitted :class:`QModel`.
+
+    Raises
+    ------
+    ValueError
+        Naming the reference whose model cannot be fitted on the training days.
+    """
+    units = {r[0]: r for _, reference, robot in plan if _ == kind for r in (reference, robot)}
+    data = Data.of_units([unit[4][kind][0] for unit in units.values()], list(units))
+    served = {}
+    for k, reference, robot in plan:
+        if k == kind:
+            served.setdefault(reference[0], []).append(robot[0])
+    q, fitted = {}, {}
+    for reference, robots in served.items():
+        tested = [data.rows(robot)[test] for robot in robots]
+        try:
+            scores = evaluate(model, data, Given([(data.rows(reference)[train], np.concatenate(tested))]), None,
+                              "training source", alarms=False)
+        except ValueError as err:
+            raise ValueError(f"{path}: the {kind} model of {reference} cannot be fitted on "
+                             f"{window.training_days} training days ({err}); use more training days") from err
+        fitted[reference] = scores.fitted[0]
+        q.update({(reference, robot): scores.scores[rows] for robot, rows in zip(robots, tested)})
+    return q, fitted
+
+
 def _robots(path, window: Window) -> list[tuple]:
     """(run id, robot label, task, condition, signals) of every run of ``path`` (:func:`signals`)."""
     runs = []
@@ -230,17 +282,12 @@ def study(path, window: Window = Window(), variance: float = 0.90, alpha: float 
         raise ValueError(f"{path}: one-to-many needs a normal robot and another robot of the same model; "
                          + ("this dataset has none. Use a fleet: `faultgen fleet -o fleet.h5`" if other is None else
                             f"{other} has no normal robot of this dataset's models"))
-    models: dict[tuple, tuple] = {}
-    for kind, reference, robot in tqdm(plan, desc="training-source study", unit="case", disable=not progress):
-        key = (kind, reference[0])
-        if key not in models:
-            try:
-                models[key] = _fit(reference[4][kind][0][train], variance, alpha, limit_folds)
-            except ValueError as err:
-                raise ValueError(f"{path}: the {kind} model of {reference[0]} cannot be fitted on "
-                                 f"{window.training_days} training days ({err}); use more training days") from err
-        used, monitor = models[key]
-        q = monitor.score_samples(robot[4][kind][0][test][:, used])[1]
+    model = QModel(variance, alpha, limit_folds)
+    judged = {kind: _q_residuals(plan, kind, train, test, model, path, window)
+              for kind in tqdm(SIGNAL_TYPES, desc="training-source study", unit="signal", disable=not progress)}
+    for kind, reference, robot in plan:
+        q, fitted = judged[kind][0][reference[0], robot[0]], judged[kind][1][reference[0]]
+        used, monitor = fitted.used_, fitted.monitor_
         cases.append(dict(source="OTO" if robot is reference else "OTM", signal=kind, condition=robot[3],
                           robot=robot[0], model=robot[1], task=robot[2], reference=reference[0],
                           features=len(used), components=monitor.n_components_, q_limit=monitor.q_limit_,

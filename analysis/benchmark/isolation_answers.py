@@ -11,8 +11,9 @@ import pandas as pd
 from tqdm.auto import tqdm
 
 from analysis import isolation, scoring
-from analysis.benchmark.tables import TOO_FEW_CYCLES, axis_label
+from analysis.benchmark.tables import axis_label
 from analysis.benchmark.truth import NO_FAULT, fault_progress, level_cycle, opened
+from analysis.evaluate import Data, OwnHistory, evaluate
 from faultgen import axes
 
 #: Wear levels of thesis Table 6.2, in percent.
@@ -72,8 +73,6 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
         If an isolator's parameters are invalid (e.g. bins < 2; the message names it), or the
         dataset has no run with exactly one worn axis.
     """
-    from sklearn.base import clone
-
     isolators = dict(isolators or default_isolators())
     _check_isolators(isolators)
     with opened(path) as data:
@@ -87,19 +86,20 @@ def isolation_table(path, isolators: Mapping[str, object] | None = None, levels:
             levels = [LABELLED_WORN]
         cases = _cases(worn, runs, levels)
     needed = {name: isolation.min_rows(prototype) for name, prototype in isolators.items()}
+    signals = Data.of_units([values[run.id] for run in runs], [run.id for run in runs])
+    protocol = OwnHistory([(run.id, n) for run, _, _, n in cases])  # each case: the run's first n cycles
+    rules = scoring.ISOLATION_TABLE_RULES  # too few cycles: not applicable
+    named = {name: evaluate(prototype, signals, protocol, rules, name, role="isolator").named
+             for name, prototype in tqdm(isolators.items(), desc="isolation", unit="isolator", disable=not progress)}
     rows = []
-    for run, axis, level, n in tqdm(cases, desc="isolation", unit="case", disable=not progress):
-        X = values[run.id][:n]
-        for name, prototype in isolators.items():
-            try:
-                predicted = int(clone(prototype).fit(X).source_axis_)
-            except ValueError:  # too few cycles for this isolator at this level: not isolated
-                predicted = TOO_FEW_CYCLES
+    for k, (run, axis, level, n) in enumerate(cases):
+        for name in isolators:
+            predicted = named[name][k][0]
             rows.append(dict(robot=run.robot, task=run.task, run=run.id, worn_axis=axis,
                              wear_pct=level, cycles=n, isolator=name, predicted=predicted,
                              answer=axis_label(predicted), correct=bool(scoring.isolation_right(predicted, axis)),
                              windowed=" ".join(str(a + 1) for a in np.flatnonzero(windowed[run.id])),
-                             n_axes=X.shape[1], needed=np.nan if needed[name] is None else needed[name]))
+                             n_axes=values[run.id].shape[1], needed=np.nan if needed[name] is None else needed[name]))
     table = pd.DataFrame(rows)
     table.attrs["imported"] = imported
     return table

@@ -38,7 +38,7 @@ This module holds no code: each name lives in the module of its job (docs/archit
 
 from __future__ import annotations
 
-from analysis.classify.by_run import SEQUENCE_STEPS, fit_by_run, run_folds, run_steps, score_by_run
+from analysis.classify.by_run import SEQUENCE_STEPS, ByRun, fit_by_run, run_folds, run_steps, score_by_run
 from analysis.classify.chance import null_p_value, permuted_roles
 from analysis.classify.classifiers import (
     CLASSIFIERS,
@@ -49,15 +49,14 @@ from analysis.classify.classifiers import (
 )
 from analysis.classify.comparison import ALPHA, Comparison, compare_preprocessing
 from analysis.classify.evaluation import evaluate
+from analysis.evaluate import MAX_PAIRS, select_pairs
 from analysis.classify.labels import last_samples, make_labels
 from analysis.classify.leave_pair_out import (
-    MAX_PAIRS,
     UndefinedAUCWarning,
     check_inputs,
     leave_pair_out_auc,
     matched_rows,
     pair_cells,
-    select_pairs,
 )
 from analysis.classify.preprocessing import (
     ESTIMATED,
@@ -78,6 +77,7 @@ __all__ = [
     "PCA_VARIANCE",
     "PREPROCESSING",
     "SEQUENCE_STEPS",
+    "ByRun",
     "SHORT_TABLE",
     "TABLE_5_2",
     "Comparison",

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.ensemble import StackingClassifier
 from sklearn.pipeline import Pipeline
 
@@ -114,3 +115,22 @@ def run_steps(steps: list, X: np.ndarray, groups: np.ndarray, y=None, fit: bool 
         else:
             Xt = step.transform(Xt)
     return Xt
+
+
+class ByRun(ClassifierMixin, BaseEstimator):
+    """``estimator`` (a Pipeline or a classifier) fitted and scored run by run, as the evaluation
+    harness (:func:`analysis.evaluate.evaluate`) takes a method: ``fit(X, y, groups)`` is
+    :func:`fit_by_run` on a clone, ``decision_function(X, groups)`` :func:`score_by_run` (X of shape
+    (n_samples, n_features), groups the run of each row; None: one run). Scores of shape (n_samples,)."""
+
+    def __init__(self, estimator):
+        self.estimator = estimator
+
+    def fit(self, X, y, groups=None):
+        groups = np.zeros(len(X)) if groups is None else groups
+        self.estimator_ = fit_by_run(clone(self.estimator), X, y, groups)
+        self.classes_ = _steps(self.estimator_)[-1].classes_
+        return self
+
+    def decision_function(self, X, groups=None) -> np.ndarray:
+        return score_by_run(self.estimator_, X, np.zeros(len(X)) if groups is None else groups)

@@ -15,7 +15,7 @@ from tqdm.auto import tqdm
 from analysis.classify.chance import null_p_value, permuted_roles
 from analysis.classify.classifiers import CLASSIFIERS
 from analysis.classify.labels import make_labels
-from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, pair_cells, select_pairs
+from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, folds, pair_cells
 from analysis.classify.preprocessing import ESTIMATED, PREPROCESSING, preprocessing_steps
 from faultgen import children
 from faultgen.checks import is_whole
@@ -86,9 +86,9 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
 
     # one job per (label set, held-out pair): every cell of the pair, each preprocessing computed once
     label_sets = [(labels, failed, normal), *roles]
-    jobs = [(k, pair) for k, (_, f, n) in enumerate(label_sets) for pair in select_pairs(f, n, n_pairs, random_state)]
+    jobs = [(k, fold) for k, (_, f, n) in enumerate(label_sets) for fold in folds(f, n, groups, n_pairs, random_state)]
     run = delayed(pair_cells)
-    tasks = (run(X, X_est, label_sets[k][0], groups, pair, names, models, random_state, matched) for k, pair in jobs)
+    tasks = (run(X, X_est, label_sets[k][0], groups, fold, names, models, random_state, matched) for k, fold in jobs)
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
     # joblib's workers limit theirs alike

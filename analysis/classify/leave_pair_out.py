@@ -4,18 +4,18 @@ subset, optionally time-matched; one pair's AUCs for every (preprocessing, class
 from __future__ import annotations
 
 import warnings
-from itertools import product
 
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
-from sklearn.base import BaseEstimator, clone
+from sklearn.base import BaseEstimator
 from sklearn.metrics import roc_auc_score
 from threadpoolctl import threadpool_limits
 
-from analysis.classify.by_run import fit_by_run, run_steps, score_by_run
+from analysis.classify.by_run import ByRun, run_steps
 from analysis.classify.labels import make_labels
 from analysis.classify.preprocessing import ESTIMATED, make_pipeline, preprocessing_steps
+from analysis.evaluate import Data, Given, LeavePairOut, evaluate
 from faultgen import children
 
 
@@ -54,39 +54,6 @@ def check_inputs(X, y, groups, failed_groups, normal_groups):
     return X, y, groups, failed, normal
 
 
-#: Most held-out pairs one evaluation fits (each pair fits every classifier of every combination):
-#: "every pair" of a dataset with more is refused before any fit (``faultgen classify --pairs``).
-MAX_PAIRS = 100_000
-
-
-def select_pairs(failed_groups, normal_groups, n_pairs: int | None = None,
-                 random_state: int | None = 0) -> list[tuple]:
-    """(failed, normal) pairs of Procedure 1: all, failed-major, or ``n_pairs`` of them.
-
-    A subset is drawn without replacement with ``numpy.random.default_rng(random_state)`` and
-    kept in the same order as the full list, so equal arguments give equal pairs.
-
-    Raises
-    ------
-    ValueError
-        If ``n_pairs`` is below 1, or every pair is asked for (``None``, or at least as many as
-        there are) and there are more than :data:`MAX_PAIRS`.
-    """
-    total = len(failed_groups) * len(normal_groups)
-    if (n_pairs is None or n_pairs >= total) and total > MAX_PAIRS:
-        raise ValueError(
-            f"every pair of {len(failed_groups)} worn x {len(normal_groups)} unworn runs is {total} held-out "
-            f"pairs, more than {MAX_PAIRS} (each fits every classifier); draw some with --pairs N (n_pairs)"
-        )
-    pairs = list(product(failed_groups, normal_groups))
-    if n_pairs is None or n_pairs >= len(pairs):
-        return pairs
-    if n_pairs < 1:
-        raise ValueError(f"n_pairs = {n_pairs!r}; expected None or an integer >= 1")
-    chosen = np.sort(np.random.default_rng(random_state).choice(len(pairs), size=n_pairs, replace=False))
-    return [pairs[i] for i in chosen]
-
-
 def matched_rows(labels, groups, pair) -> np.ndarray:
     """Rows a time-matched AUC compares: the failed samples of ``pair``'s failed run and the
     samples of its normal run at the same positions in its record (k-th sample against k-th
@@ -105,26 +72,43 @@ def matched_rows(labels, groups, pair) -> np.ndarray:
     return rows
 
 
-def _pair_auc(factory, X, labels, groups, pair, matched: bool = False) -> float:
-    held = np.isin(groups, list(pair))
-    train = ~held
+def _fold(groups, fold) -> tuple[tuple, np.ndarray, np.ndarray]:
+    """(pair, train rows, held-out rows as a mask) of ``fold``, a (pair, (train, test)) of
+    :class:`analysis.evaluate.LeavePairOut`."""
+    pair, (train, test) = fold
+    held = np.zeros(len(groups), dtype=bool)
+    held[test] = True
+    return pair, train, held
+
+
+def _pair_auc(factory, X, labels, groups, fold, matched: bool = False) -> float:
+    pair, train, held = _fold(groups, fold)
     # the held-out runs are scored whole (differencing needs each sample's predecessor); a
     # time-matched AUC then ranks only the failed samples against the same days of the normal run
     test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
     truth = labels[held][test]
     if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
         return np.nan
-    model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else clone(factory)
-    fit_by_run(model, X[train], labels[train], groups[train])
-    return float(roc_auc_score(truth, score_by_run(model, X[held], groups[held])[test]))
+    model = factory() if callable(factory) and not isinstance(factory, BaseEstimator) else factory
+    rows = np.flatnonzero(held)
+    scores = _scores(model, Data(X, groups, labels), train, rows, "leave-pair-out")
+    return float(roc_auc_score(truth, scores[test]))
 
 
-def pair_cells(X, X_est, labels, groups, pair, names, models, random_state, matched) -> np.ndarray:
+def _scores(model, data: Data, train: np.ndarray, test: np.ndarray, name: str) -> np.ndarray:
+    """The scores of ``data``'s ``test`` rows by ``model`` fitted on its ``train`` rows run by run
+    (:func:`analysis.evaluate.evaluate`, the fold given; :class:`analysis.classify.ByRun`), shape
+    (len(test),)."""
+    found = evaluate(ByRun(model), data, Given([(train, test)]), None, name, alarms=False, test_by="fold")
+    return found.scores[test]
+
+
+def pair_cells(X, X_est, labels, groups, fold, names, models, random_state, matched) -> np.ndarray:
     """AUCs of one held-out pair for every (preprocessing, classifier) cell, in ``product(names,
     models)`` order: each preprocessing fitted once on the training runs, then every classifier on
-    its output. The same numbers as :func:`_pair_auc` on each cell's whole pipeline."""
-    held = np.isin(groups, list(pair))
-    train = ~held
+    its output. The same numbers as :func:`_pair_auc` on each cell's whole pipeline. ``fold``: the
+    pair and its (train, test) rows, as :func:`folds` gives them."""
+    pair, train, held = _fold(groups, fold)
     test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
     truth = labels[held][test]
     out = np.full(len(names) * len(models), np.nan)
@@ -136,12 +120,23 @@ def pair_cells(X, X_est, labels, groups, pair, names, models, random_state, matc
         steps = [step for _, step in preprocessing_steps(name)]
         X_train = run_steps(steps, data[train], groups[train], labels[train], fit=True)
         X_test = run_steps(steps, data[held], groups[held])
-        for model in models.values():
+        # the preprocessed rows, train then held out, one fold given: every classifier through the harness
+        stacked = Data(np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]],
+                       np.r_[labels[train], labels[held]])
+        n_train = len(X_train)
+        for column, model in models.items():
             clf = make_pipeline(model, "control", random_state=random_state)
-            fit_by_run(clf, X_train, labels[train], groups[train])
-            out[k] = roc_auc_score(truth, score_by_run(clf, X_test, groups[held])[test])
+            scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(stacked.X)), f"{column} {name}")
+            out[k] = roc_auc_score(truth, scores[test])
             k += 1
     return out
+
+
+def folds(failed, normal, groups, n_pairs: int | None = None, random_state: int | None = 0) -> list[tuple]:
+    """The held-out pairs of Procedure 1 (:class:`analysis.evaluate.LeavePairOut`, the protocol) with
+    their rows: a list of (pair, (train indices, test indices))."""
+    protocol = LeavePairOut(failed, normal, n_pairs, random_state)
+    return list(zip(protocol.pairs(), protocol.split(groups=groups), strict=True))
 
 
 def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_groups, *,
@@ -168,7 +163,7 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
         Runs with and without wear; runs in neither are always in the training set.
     n_pairs : int or None, default=None
         None: every pair (``len(failed) * len(normal)``). An int: that many pairs, drawn with
-        ``random_state`` (:func:`select_pairs`).
+        ``random_state`` (:func:`analysis.evaluate.select_pairs`).
     random_state : int or None, default=0
         Seed of the pair subset.
     label_rule : None, float or callable, default=None
@@ -189,7 +184,7 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     Returns
     -------
     aucs : ndarray of shape (n_pairs,)
-        One AUC per pair, in the order of :func:`select_pairs`. NaN where it is undefined: the
+        One AUC per pair, in the order of :func:`analysis.evaluate.select_pairs`. NaN where it is undefined: the
         held-out pair has one class only (e.g. the failed run never reaches the wear threshold,
         so all its samples are 0 like the normal run's), or the training runs do. An
         :class:`UndefinedAUCWarning` says how many; aggregate with ``np.nanmean``.
@@ -204,12 +199,13 @@ def leave_pair_out_auc(pipeline_factory, X, y, groups, failed_groups, normal_gro
     """
     X, y, groups, failed, normal = check_inputs(X, y, groups, failed_groups, normal_groups)
     labels = make_labels(y, groups, failed, label_rule)
-    pairs = select_pairs(failed, normal, n_pairs, random_state)
+    held_out = folds(failed, normal, groups, n_pairs, random_state)
+    pairs = [pair for pair, _ in held_out]
     if n_jobs is None:
         with threadpool_limits(limits=1):  # small fits: see evaluate
-            aucs = [_pair_auc(pipeline_factory, X, labels, groups, p, matched) for p in pairs]
+            aucs = [_pair_auc(pipeline_factory, X, labels, groups, f, matched) for f in held_out]
     else:
-        jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, p, matched) for p in pairs)
+        jobs = (delayed(_pair_auc)(pipeline_factory, X, labels, groups, f, matched) for f in held_out)
         with children.safe_path():  # loky's workers and trackers: no joblib.py of this folder
             aucs = Parallel(n_jobs=n_jobs)(jobs)
     aucs = np.asarray(aucs, dtype=float)

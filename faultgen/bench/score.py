@@ -58,10 +58,10 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from sklearn.base import clone, is_classifier
 from sklearn.metrics import roc_auc_score, roc_curve
 
 from analysis import scoring
+from analysis.evaluate import Data, OwnHistory, TrackSplit, evaluate
 from faultgen.bench import files, verdicts
 from faultgen.data import atomic
 
@@ -146,60 +146,23 @@ def _chance_share(units: list, parts: bool = False):
     return (max(random, own), random, own) if parts else max(random, own)
 
 
-def _scores(estimator, X: np.ndarray, name: str) -> np.ndarray:
-    """A detector's score per record: ``decision_function``, else ``predict_proba[:, -1]``, else its
-    alarms (:func:`analysis.plugins.alarms`: the contract ``detect`` holds a plug-in to), each
-    refused with one line naming ``name`` when it raises or is not one finite number per record."""
-    from analysis import plugins
-
-    for method in ("decision_function", "predict_proba"):
-        if hasattr(estimator, method):
-            try:
-                values = np.asarray(getattr(estimator, method)(X), dtype=float)
-            except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
-                raise ValueError(f"{name}: {method}(X) of X {X.shape} failed: {type(err).__name__}: {err}") from None
-            if method == "predict_proba":
-                values = values[:, -1] if values.ndim == 2 and values.shape[1] else np.full(0, np.nan)
-            if values.shape != (len(X),) or not np.isfinite(values).all():
-                raise ValueError(f"{name}: {method}(X) gave shape {values.shape} or non-finite values for X "
-                                 f"{X.shape}; expected one finite score per record")
-            return values
-    return plugins.alarms(name, estimator, X).astype(float)
-
-
-def _fit(method, X: np.ndarray, y: np.ndarray, healthy: np.ndarray):
-    """A new copy of ``method`` fitted on train records (the contract in the module's docstring);
-    returns (fitted object to predict with, the estimator to score with)."""
-    template = method.build() if hasattr(method, "build") else method  # a plug-in: the user's own class
-    if is_classifier(template):
-        try:
-            inner = clone(template).fit(X, y)
-        except Exception as err:  # noqa: BLE001 (a plug-in may raise anything: named on one line)
-            raise ValueError(f"fit(X, y) of X {X.shape} failed: {type(err).__name__}: {err}") from None
-        return inner, inner
-    fitted = clone(method).fit(X[healthy])  # a plug-in: behind its contract guard (analysis.plugins)
-    return fitted, getattr(fitted, "estimator_", fitted)
-
-
 def detector_results(method, name: str, train: list[files.Unit], test: list[files.Unit]) -> dict:
     """Fit ``method`` per robot and task on ``train`` (labelled units) and judge ``test`` (units whose
     labels :func:`faultgen.bench.files.attach_labels` added; the method never sees them)."""
-    from analysis import plugins
-
+    units = [*train, *test]
+    data = Data.of_units([u.features() for u in units], [f"{k}:{u.id}" for k, u in enumerate(units)],
+                         [u.fault_level >= WORN_PCT for u in units], [u.fault == "none" for u in units])
+    sizes = [len(u.fault_level) for u in units]
+    protocol = TrackSplit(np.repeat([k >= len(train) for k in range(len(units))], sizes),
+                          np.repeat([f"{u.robot}/{u.task}" for u in units], sizes))
+    scores = evaluate(method, data, protocol, RULES, name)  # per robot and task: fit on train, judge test
     judged = []
-    for setup in sorted({(u.robot, u.task) for u in test}):
-        own = [u for u in train if (u.robot, u.task) == setup] or train
-        X = np.concatenate([u.features() for u in own])
-        y = np.concatenate([u.fault_level >= WORN_PCT for u in own]).astype(int)
-        healthy = np.concatenate([np.full(len(u.fault_level), u.fault == "none") for u in own])
-        fitted, inner = _fit(method, X, y, healthy)
-        for unit in (u for u in test if (u.robot, u.task) == setup):
-            X_unit = unit.features()
-            scores = _scores(inner, X_unit, name)
-            alarms = plugins.alarms(name, fitted, X_unit)
+    for setup in sorted({(u.robot, u.task) for u in test}):  # the units in the order the folds tested them
+        for k, unit in ((k, u) for k, u in enumerate(test, len(train)) if (u.robot, u.task) == setup):
+            unit_scores, alarms = scores.of(data.rows(f"{k}:{unit.id}"))
             level = unit.fault_level
-            judged.append({"unit": unit, "scores": scores, "alarms": alarms, "positive": level >= WORN_PCT,
-                               "mask": (level >= WORN_PCT) | (level <= 0)})
+            judged.append({"unit": unit, "scores": unit_scores, "alarms": alarms, "positive": level >= WORN_PCT,
+                           "mask": (level >= WORN_PCT) | (level <= 0)})
     delays = []
     for row in judged:
         unit = row["unit"]
@@ -240,15 +203,12 @@ def detector_results(method, name: str, train: list[files.Unit], test: list[file
 def isolator_results(method, name: str, test: list[files.Unit]) -> dict:
     """Each test unit's source axis (and fault, if the isolator names one) from ``method`` fitted on
     its mean absolute motor torque."""
-    answers = []
-    for unit in test:
-        try:
-            fitted = clone(method).fit(unit.arrays["mean_abs_torque"])
-            axis, fault = int(fitted.source_axis_), getattr(getattr(fitted, "estimator_", fitted), "fault_", None)
-        except ValueError:  # the isolator contract's "too few cycles": undecided (RULES)
-            axis, fault = scoring.too_few_answer(RULES), None
-        answers.append({"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes,
-                        "fault": unit.fault, "named_fault": None if fault is None else str(fault)})
+    ids = [f"{k}:{unit.id}" for k, unit in enumerate(test)]
+    data = Data.of_units([unit.arrays["mean_abs_torque"] for unit in test], ids)
+    scores = evaluate(method, data, OwnHistory([(i, None) for i in ids]), RULES, name, role="isolator")
+    answers = [{"unit": unit.id, "worn_axis": unit.worn_axis, "named": axis, "n_axes": unit.n_axes,
+                "fault": unit.fault, "named_fault": None if fault is None else str(fault)}
+               for unit, (axis, fault) in zip(test, scores.named)]
     failing = [a for a in answers if a["worn_axis"]]
     healthy = [a for a in answers if not a["worn_axis"]]
     n_axes = max((a["n_axes"] for a in answers), default=6)
