@@ -3,7 +3,7 @@ its unlogged program change): the page in headless Chromium at 1400 px as well a
 bench's twin naming the axis of the alarm known first, ``--protocol own``'s alarm at once on a log
 far past its limits, a program change's relearning named as such on the chart, and the import
 saying how many friction tests it left to the monitor. The independent UR fleets in the RTDE layout
-are ``benchmarks/monitor_rtde_fleets.py`` (docs/_r8_rtde.md)."""
+are ``benchmarks/monitor_rtde_fleets.py`` (docs/analysis.md, "Independent UR fleets")."""
 
 from __future__ import annotations
 

@@ -337,7 +337,7 @@ def _program_file(tmp_path) -> Path:
 def test_a_run_from_its_spec_looks_each_name_up_once(tmp_path, looked_up):
     """``resolve(spec)`` and the simulation of the run: the robot, the task (a program file), the
     stepper once; the friction model three times (resolve, RunConfig's check, the model's build: not
-    yet carried as an object, docs/_r8_runspec.md)."""
+    yet carried as an object, docs/architecture.md, "How a run is built")."""
     from faultgen.simulation import resolve, spec
 
     path = _program_file(tmp_path)
