@@ -1,5 +1,5 @@
 """Train on one dataset, test on another: the ``--train OTHER.h5`` of ``faultgen detect``,
-``classify`` and ``bench-isolators`` (issue 46 item 2).
+``classify`` and ``bench-isolators``.
 
 Where a monitor learns "normal" from is the question of thesis ch. 4. Every output names its
 protocol (:data:`OWN`, :data:`OTHER`, :data:`TWIN`):

@@ -1,6 +1,6 @@
 """A joint log (:mod:`faultgen.logs.jointlog`) read in blocks of rows and averaged down while
 it is read, so that reading a long log takes memory that does not grow with its length
-(docs/reliability.md; docs/calibration.md "Long logs"; issue 50).
+(docs/reliability.md; docs/calibration.md "Long logs").
 
 Two passes over the file, :data:`BLOCK_ROWS` rows at a time:
 

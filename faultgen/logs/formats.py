@@ -50,7 +50,7 @@ DEFAULT = "measured"
 MIN_TORQUE_CONSTANT, MAX_TORQUE_CONSTANT = 1e-3, 1e4
 
 
-#: A log's torque source in words (issue 72, item 2): the import's summary, units.csv's
+#: A log's torque source in words: the import's summary, units.csv's
 #: ``torque_source`` and the monitor's page say it (:func:`torque_source`). The commanded moment of a
 #: fixed program is the controller's model of the motion, the same every day whatever the joint's
 #: friction: it cannot show wear. RTDE's ``actual_current_as_torque`` (PolyScope >= 5.23) is the

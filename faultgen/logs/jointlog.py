@@ -186,7 +186,7 @@ def joined(parts: list[np.ndarray]) -> np.ndarray:
 
 def _arrow_columns(path: Path, names: list[str], wanted: list[str]) -> dict[str, np.ndarray] | None:
     """The wanted columns of a clean, uncompressed CSV log as float arrays, parsed by pyarrow's
-    multi-threaded reader (the import's largest cost with pandas, issue 46); None for anything
+    multi-threaded reader (the import's largest cost with pandas); None for anything
     else (a gzip-compressed file, a ragged row, a blank line, an empty, non-numeric or
     non-finite cell, text that is not UTF-8), which :func:`read_csv` then reads or refuses
     through pandas with the row named, as before. Same numbers as pandas's parser, bit for bit

@@ -6,7 +6,7 @@ the same checks and messages.
 
 ``faultgen calibrate`` works on at most ``rows`` rows: a longer log is averaged over blocks of
 ``k = ceil(n / rows)`` samples (:func:`block_mean`). Reading the whole log first and averaging it
-after took 5.7 GB for 10^7 rows (issue 50). :func:`read` gives the same result in two passes over
+after took 5.7 GB for 10^7 rows. :func:`read` gives the same result in two passes over
 the file, :data:`BLOCK_ROWS` rows at a time:
 
 1. the sample times are kept whole (8 bytes a row), every cell is checked (a non-number or

@@ -21,7 +21,7 @@ The replayed motion is one cycle of the program log (its first, or with a ``cycl
 whole one, when the log holds several: :mod:`faultgen.monitor.cycles`; the cache key then says
 which), its angles through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
 (:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's noise as its reference
-saturates where the real one did not (issue 60). A replay of measured arm angles still asks more
+saturates where the real one did not. A replay of measured arm angles still asks more
 of the drives than the run that logged them (it tracks the elastic arm's own lag and ripple as its
 reference): near a drive's limit the twin refuses a part the robot carried, and that unit's logs
 with the part are skipped and named.
@@ -76,7 +76,7 @@ FRICTION = "stribeck"
 #: them, s. An irb6700 pick and place with a 35 kg part logged at faultgen's default encoder noise
 #: (1e-4 rad) and replayed with that part: axis 2's peak motor torque 1.0 of its limit (saturated)
 #: as logged, 1.0 through the derivative filter's 0.05 s, 0.942 through 0.1 s, 0.934 replaying the
-#: noise-free log; the original run: 0.861. The filtered angles moved by at most 0.37 mrad (2026-11-25).
+#: noise-free log; the original run: 0.861. The filtered angles moved by at most 0.37 mrad.
 REFERENCE_WINDOW = 0.1
 #: Density of the declared part, kg/m^3 (aluminium), which sets its edge from its mass.
 PART_DENSITY = 2700.0

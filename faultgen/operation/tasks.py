@@ -49,7 +49,7 @@ IK_STEP = 0.01  # s: knot step of the seam IK; the spline interpolates in betwee
 PLAN_PERIOD = 0.004
 #: Longest cycle a task, program or replayed log may make, s, and most samples of its path: checked
 #: before a piece of path is allocated (a ``dwell time = 1e9`` asked for 87 TiB, a program of 10^4
-#: moves took 5.4 GB; issue 50). An hour is far beyond an industrial cycle (seconds to minutes).
+#: moves took 5.4 GB). An hour is far beyond an industrial cycle (seconds to minutes).
 MAX_CYCLE_DURATION = 3600.0
 MAX_CYCLE_SAMPLES = 7_200_000  # an hour at the finest step, 0.5 ms
 SEAM_TOLERANCE = 5e-4  # m: largest allowed flange distance from the commanded seam point
@@ -253,7 +253,7 @@ class Motion:
 
 
 class TextProgram(str):
-    """A program file given by its text rather than a path (issue 75: a fleet's friction test travels
+    """A program file given by its text rather than a path (a fleet's friction test travels
     in its runs' configuration, so that two machines or two caches make the same runs). It stands
     where a program file's path does: ``str()`` is its name, ``<stem>-<SHA-256 of the text, 12 hex>.toml``
     (a name, not a file: the digest in it makes equal names equal texts), ``text`` the TOML;
