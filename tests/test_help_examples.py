@@ -85,6 +85,12 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     if argv[0] == "sweep":
         extra += [] if "--task" in argv else ["--task", "pick_place"]
         extra += [] if "--axis" in argv else ["--axis", "0", "--axis", "2"]
+    if argv[0] == "classify" and page == "classify" and "--classifier" not in argv:
+        # classify's own page: its protocols, rows (--full's nineteen) and outputs on the logistic
+        # regression alone (29 of the 45 s of CPU this file spent in classify went to the other three
+        # classifiers); the fleet page's `classify fleet.h5` runs all four through the command, and
+        # tests/test_classify.py fits every classifier on every row of Table 5.2
+        extra += ["--classifier", "lr"]
     if argv[0] in ("sweep", "fleet", "classify") and not {"--jobs", "--scheduler"} & set(argv):
         # in this test process (2 to 5 s of CPU less than the default's worker processes, on a machine
         # whose cores pytest-xdist's workers fill); an example that chooses --jobs keeps its own
