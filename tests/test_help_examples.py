@@ -9,8 +9,8 @@ kept small (:data:`SMALL`, appended: click takes an option's last value): a ``si
 ``sweep`` records fewer cycles, a sweep that does not choose them one task and two axes, a
 ``fleet`` has fewer robots, days and cycles a day; ``classify`` (on its own page the logistic
 regression alone), ``training-source``, ``excitation`` and ``hidden-log`` do less work; a ``sweep``,
-``fleet`` or ``classify`` that does not choose ``--jobs`` runs in the test's process. The rest of each command line is the example's own.
-A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+``fleet`` or ``classify`` that does not choose ``--jobs`` runs in the test's process. The rest of
+each command line is the example's own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
 """
 
 from __future__ import annotations
