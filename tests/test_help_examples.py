@@ -7,10 +7,10 @@ of its own holding what the docs tell a user to make before it (``quick.h5``, ``
 example that is that same command gets the file made so: same seed, the same file). The data is
 kept small (:data:`SMALL`, appended: click takes an option's last value): a ``simulate`` or
 ``sweep`` records fewer cycles, a sweep that does not choose them one task and two axes, a
-``fleet`` has fewer robots, days and cycles a day; ``classify``, ``training-source``,
-``excitation`` and ``hidden-log`` do less work; a ``sweep``, ``fleet`` or ``classify`` that does not
-choose ``--jobs`` runs in the test's process. The rest of each command line is the example's own.
-A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+``fleet`` has fewer robots, days and cycles a day; ``classify`` (on its own page the logistic
+regression alone), ``training-source``, ``excitation`` and ``hidden-log`` do less work; a ``sweep``,
+``fleet`` or ``classify`` that does not choose ``--jobs`` runs in the test's process. The rest of
+each command line is the example's own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
 """
 
 from __future__ import annotations
@@ -85,6 +85,12 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     if argv[0] == "sweep":
         extra += [] if "--task" in argv else ["--task", "pick_place"]
         extra += [] if "--axis" in argv else ["--axis", "0", "--axis", "2"]
+    if argv[0] == "classify" and page == "classify" and "--classifier" not in argv:
+        # classify's own page: its protocols, rows (--full's nineteen) and outputs on the logistic
+        # regression alone (its four lines: 33 s of CPU with the four classifiers, 21 s with lr);
+        # the fleet page's `classify fleet.h5` runs all four through the command, and
+        # tests/test_classify.py fits every classifier on every row of Table 5.2
+        extra += ["--classifier", "lr"]
     if argv[0] in ("sweep", "fleet", "classify") and not {"--jobs", "--scheduler"} & set(argv):
         # in this test process (2 to 5 s of CPU less than the default's worker processes, on a machine
         # whose cores pytest-xdist's workers fill); an example that chooses --jobs keeps its own

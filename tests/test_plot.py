@@ -152,7 +152,9 @@ def test_a_fleet_is_drawn_per_robot_with_its_wear_against_the_day(shared_fleet, 
     between robots, an axis no robot wears left empty, the title cut). Now one panel per robot."""
     import faultgen
 
-    fleet = shared_fleet("reader-fleet", size=4, failing=2, days=24, cycles_per_day=1)
+    # the small fleet tests/test_fleet.py and tests/test_cluster.py read (built once a session): one
+    # failing robot and one healthy, a panel each (4 robots of 24 days cost 12 s of CPU for two more)
+    fleet = shared_fleet("fleet-small", size=2, failing=1, days=6, cycles_per_day=1)
     out = plot(fleet, tmp_path / "fleet.png")
     assert_png(out)
     (fig,) = figures
