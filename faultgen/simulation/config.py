@@ -13,11 +13,12 @@ from faultgen.operation import programs
 from faultgen.operation.conditions import Conditions
 from faultgen.operation.faults import Fault
 from faultgen.operation.wear import WearPlan
-from faultgen.simulation import friction_models, prepare, sensors
+from faultgen.simulation import friction_models, prepare
+from faultgen.simulation.spec import RunFields
 
 
 @dataclass(frozen=True)
-class RunConfig:
+class RunConfig(RunFields):
     """One run: a robot repeating a task for ``cycles`` cycles while the axes of ``wear`` wear.
 
     Attributes
@@ -80,20 +81,6 @@ class RunConfig:
         ``lugre`` friction model; the message names the value.
     """
 
-    robot: str
-    task: str | programs.LogTask
-    friction: str = "lugre"
-    wear: WearPlan = field(default_factory=lambda: WearPlan({}))
-    cycles: int = 100
-    record: tuple[int, ...] | None = None
-    seed: int = 0
-    noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
-    nthread: int = 0
-    back_to_back: bool = False
-    conditions: Conditions = field(default_factory=Conditions)
-    signals: bool = True
-    daily: bool = False
-    fault: Fault | None = None
     resolved: Robot | None = field(default=None, compare=False, repr=False, kw_only=True)
 
     def __post_init__(self) -> None:

@@ -36,7 +36,29 @@ copyreg.pickle(MappingProxyType, lambda mapping: (read_only, (dict(mapping),)))
 
 
 @dataclass(frozen=True)
-class RunSpec:
+class RunFields:
+    """The values of one run, declared once: :class:`RunSpec` holds them as text,
+    :class:`faultgen.simulation.config.RunConfig` (whose attributes document them) resolved and
+    checked. The same names, meanings and defaults in both."""
+
+    robot: str
+    task: str | programs.TextProgram | programs.LogTask | programs.Motion
+    friction: str = "lugre"
+    wear: WearPlan = field(default_factory=lambda: WearPlan({}))
+    cycles: int = 100
+    record: tuple[int, ...] | None = None
+    seed: int = 0
+    noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
+    nthread: int = 0
+    back_to_back: bool = False
+    conditions: Conditions = field(default_factory=Conditions)
+    signals: bool = True
+    daily: bool = False
+    fault: Fault | None = None
+
+
+@dataclass(frozen=True)
+class RunSpec(RunFields):
     """One run as text (module docstring); the fields of
     :class:`faultgen.simulation.config.RunConfig` (the same names, meanings and defaults), the
     robot and the task as given, and the stepper by name.
@@ -61,20 +83,6 @@ class RunSpec:
         none of the kinds above.
     """
 
-    robot: str
-    task: str | programs.TextProgram | programs.LogTask | programs.Motion
-    friction: str = "lugre"
-    wear: WearPlan = field(default_factory=lambda: WearPlan({}))
-    cycles: int = 100
-    record: tuple[int, ...] | None = None
-    seed: int = 0
-    noise: sensors.NoiseConfig = field(default_factory=sensors.NoiseConfig)
-    nthread: int = 0
-    back_to_back: bool = False
-    conditions: Conditions = field(default_factory=Conditions)
-    signals: bool = True
-    daily: bool = False
-    fault: Fault | None = None
     stepper: str = backends.DEFAULT
 
     def __post_init__(self) -> None:
