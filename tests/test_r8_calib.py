@@ -127,3 +127,22 @@ def test_an_axis_placed_at_twice_its_nominal_dry_level_is_held_and_its_viscous_l
     assert check["held_by"] == "range" and check["level"] == pytest.approx(2.0, abs=0.02), check
     assert c["coulomb_pos"] == pytest.approx(f.coulomb_pos[0]) and c["coulomb_neg"] == pytest.approx(f.coulomb_neg[0])
     assert v is not None and v["viscous"] > f.viscous[0]
+
+
+def test_the_checked_level_is_the_level_written():
+    """The level the range is judged on is the one the own-friction fit writes (both directions'
+    mean), also from a model whose two directions differ from the nominal's."""
+    robot = robots.load("puma560")
+    t, qd1 = _speeds([0.05, 0.3, 0.8, 1.5])
+    qd = np.column_stack([qd1] + [np.zeros_like(qd1)] * 5)
+    f, g = robot.friction, robot.gear_ratio[0]
+    model = SimpleNamespace(gear_ratio=robot.gear_ratio, friction=SimpleNamespace(
+        coulomb_pos=f.coulomb_pos * 1.3, coulomb_neg=f.coulomb_neg * 0.9, viscous=f.viscous, static=f.static))
+    nominal = (f.coulomb_pos[0] + f.coulomb_neg[0]) / 2
+    residual = np.zeros((len(t), 6))
+    residual[:, 0] = g * 0.2 * nominal * np.sign(qd1) + g**2 * 0.3 * f.viscous[0] * qd1
+    residual[:, 0] += np.random.default_rng(1).normal(0.0, 0.01 * np.std(residual[:, 0]), len(t))
+    c, v, check = loop._own_axis(0, SimpleNamespace(robot=model, qd=qd, t=t), residual, np.abs(qd1) > 0, robot, 5)
+    assert check["held_by"] is None, check
+    assert check["fitted_dry_Nm"] == pytest.approx((c["coulomb_pos"] + c["coulomb_neg"]) / 2, rel=1e-9)
+    assert check["level"] * nominal == pytest.approx((c["coulomb_pos"] + c["coulomb_neg"]) / 2, rel=1e-9)
