@@ -349,7 +349,9 @@ def _own_axis(a: int, motion, residual: np.ndarray, keep: np.ndarray, nominal: r
     skew = float((f.coulomb_neg[a] - f.coulomb_pos[a]) - (g.coulomb_neg[a] - g.coulomb_pos[a]))
     r = residual[:, a] - columns_c[:, 1] * skew
     design = np.column_stack([phi_c, phi_v])
-    check = separable.dry_and_viscous(design, r, keep, stride, float(g.coulomb_pos[a] + g.coulomb_neg[a]) / 2)
+    # the model's level both directions' mean with the difference set back to the nominal's (coulomb.params)
+    level = float(f.coulomb_neg[a] - (g.coulomb_neg[a] - g.coulomb_pos[a]) / 2)
+    check = separable.dry_and_viscous(design, r, keep, stride, float(g.coulomb_pos[a] + g.coulomb_neg[a]) / 2, level)
     if not check["separable"]:  # the dry level at the nominal model's, the viscous level fitted alone
         to_nominal = float(g.coulomb_neg[a] - f.coulomb_neg[a])
         c = coulomb.params(motion, a, np.array([to_nominal, skew]), None)

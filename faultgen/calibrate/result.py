@@ -217,10 +217,8 @@ class Calibration:
                 for name, motion in step.evidence["separate_by"].items():
                     lines.append(f"   to tell {name} apart: {motion}")
                 lines.append(f"   a designed excitation: faultgen excitation {self.robot} -o excitation.csv")
-        lines += [f"axis {h['axis']}: dry friction NOT SEPARABLE on this motion from the viscous level (its "
-                  f"{separable.LEVEL:.0%} interval " + ("unbounded" if h["share"] is None else
-                                                      f"+-{100 * h['share']:.0f} % of nominal")
-                  + f", accepted {100 * separable.SHARE:.0f} %): held at the nominal model's" for h in self.not_separable()]
+        lines += [f"axis {h['axis']}: dry friction NOT SEPARABLE: {separable.words(h)}: held at the nominal model's"
+                  for h in self.not_separable()]
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
         for u in self.unexplained():
