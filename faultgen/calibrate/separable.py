@@ -21,7 +21,7 @@ variance inflation ``1 / (1 - c^2)``, ``c`` the cosine between them) and what th
    level no unit of the type has is a trade with something the model leaves, not the unit's
    friction. On the UR5 fleet the joint fit put a wrist's dry level at 1.9 times nominal (truth
    1.07) with a standard error of 4 %: the payload fitted on the same log left a torque in the
-   shape of dry friction on that axis (docs/_r8_calib.md), which no interval from the noise sees.
+   shape of dry friction on that axis (docs/analysis.md, "The range rule"), which no interval from the noise sees.
 
 A level that passes both is *separable* and fitted; otherwise it is held at the nominal model's
 (the prior) and reported not separable on this motion, with the part that failed (``held_by``).
