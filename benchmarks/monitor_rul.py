@@ -219,6 +219,17 @@ def on_scale(rows: list[dict], scale_uncertainty, tested: bool):
     return rescaled, scale_uncertainty if uncertainty is None else uncertainty
 
 
+def unit_rows(scores: list[dict], replayed: dict[str, list[dict]] | None, unit: str) -> tuple[list[dict], bool]:
+    """``unit``'s rows: its replayed monitor rows with friction tests (:func:`replayed_rows`; each
+    prediction then on its latest factor, :func:`on_scale`) and True, else scores.csv's and False."""
+    rows = [r for r in scores if r["unit"] == unit]
+    if replayed is None or unit not in replayed:
+        return rows, False
+    if [r["stamp"] for r in replayed[unit]] != [r["stamp"] for r in rows]:
+        raise SystemExit(f"{unit}: the replayed state's logs are not scores.csv's: is OUT/.state this run's?")
+    return replayed[unit], True
+
+
 def run_fleet(args) -> tuple[Path, Path]:
     """Write the fleet (or resume it in ``--work``) and run the monitor on it; returns (truth.csv, OUT)."""
     work = args.work or Path(tempfile.mkdtemp(prefix="monitor-rul-"))
@@ -335,9 +346,8 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
              replayed: dict[str, list[dict]] | None = None) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
     docstring); prints a block per unit and the fleet's lines, each figure beside the criterion of
-    issue 75 and its verdict; returns the scores of (A) and (B) (each with ``at_lambda``). ``replayed``
-    (:func:`replayed_rows`): the units' monitor rows with friction tests, each prediction's rows then
-    on that prediction's latest factor (:func:`on_scale`), in place of scores.csv's."""
+    issue 75 and its verdict; returns the scores of (A) and (B) (each with ``at_lambda``); ``replayed``:
+    :func:`unit_rows`."""
     truth = independent_fleet.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
         scores = [_floats(r) for r in csv.DictReader(f)]
@@ -357,11 +367,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
             print(f"\n{unit}: worn axis {axis}, alarm {alarm['first_alarm'] or 'none'} on axis "
                   f"{alarm['source_axis'] or '-'}: not scored")
             continue
-        rows = [r for r in scores if r["unit"] == unit]
-        tested = replayed is not None and unit in replayed
-        if tested:
-            assert [r["stamp"] for r in replayed[unit]] == [r["stamp"] for r in rows], unit
-            rows = replayed[unit]
+        rows, tested = unit_rows(scores, replayed, unit)
         stamps = [r["stamp"] for r in rows]
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
         wear = t["wear"]
