@@ -188,12 +188,16 @@ def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
     from faultgen.monitor import state as stored
     from faultgen.monitor.scoring import Settings
 
-    nominal = robots.load(fleet / "kr210")
     _, suffixes = fleet_logs.reader_of(None)
     units = fleet_logs.fleet(fleet / "logs", suffixes)
-    tests = friction_tests.read_tests(friction_tests.find(fleet / "logs", units, suffixes), nominal, out, None)
-    if not any(tests.values()):
+    found = friction_tests.find(fleet / "logs", units, suffixes)
+    if not any(found.values()):
         return None
+    if not (fleet / "kr210").is_dir():
+        raise SystemExit(f"{fleet / 'kr210'}: no robot folder there (benchmarks/monitor_wear_scale.py makes it); "
+                         "expected the fleet's KR210 to replay its monitor's state, or --scores-only")
+    nominal = robots.load(fleet / "kr210")
+    tests = friction_tests.read_tests(found, nominal, out, None)
     n, rows = nominal.n_axes, {}
     for name in units:
         path = out / ".state" / stored.unit_file(name, ".json")
