@@ -10,6 +10,12 @@ The second form scores a run of ``benchmarks/monitor_wear_scale.py`` (its ``WORK
 independent fleets, first law and Stribeck-hump law, 12 units with 8 worn, with the calibrated
 twin, the monitor's default) instead of writing a fleet and running the monitor: the remaining
 life is recomputed from that run's ``scores.csv`` (which does not depend on ``--failure-wear``).
+With friction tests the unit's monitor rows are replayed from ``OUT/.state`` (:func:`replayed_rows`)
+and each prediction fits them on *its* latest factor with that factor's error as the scale's
+uncertainty, as the monitor's own remaining life does
+(:func:`faultgen.monitor.friction_tests.on_tests_scale`); scores.csv keeps each log on the factor of
+its own day, a mosaic whose steps at each test bent the trend (hump law seed 1, unit09: 133.9 days
+where 16.1 remained; docs/_r8_life.md). ``--scores-only``: that mosaic, as before 2026-11-27.
 
 In one run of this script:
 
@@ -60,6 +66,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import subprocess
 import sys
 import tempfile
@@ -171,6 +178,63 @@ def exact_crossing_error(wear: np.ndarray, scale: float, offset: float, start: i
     return (day_of(wear, (failure - offset) / scale) - eol) / (eol - lam)
 
 
+def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
+    """Each unit's monitor rows (``UnitMonitor.rows``, with the twin-scale columns and the factors
+    scores.csv does not keep) of a run of ``benchmarks/monitor_wear_scale.py`` with friction tests:
+    the state in ``out/.state`` replayed with the tests read from ``out``'s cache (the robot
+    ``fleet/kr210``, the logs ``fleet/logs``), as a continued monitor run replays it; None without tests."""
+    from faultgen.model import robots
+    from faultgen.monitor import friction_tests
+    from faultgen.monitor import logs as fleet_logs
+    from faultgen.monitor import state as stored
+    from faultgen.monitor.scoring import Settings
+
+    _, suffixes = fleet_logs.reader_of(None)
+    units = fleet_logs.fleet(fleet / "logs", suffixes)
+    found = friction_tests.find(fleet / "logs", units, suffixes)
+    if not any(found.values()):
+        return None
+    if not (fleet / "kr210").is_dir():
+        raise SystemExit(f"{fleet / 'kr210'}: no robot folder there (benchmarks/monitor_wear_scale.py makes it); "
+                         "expected the fleet's KR210 to replay its monitor's state, or --scores-only")
+    nominal = robots.load(fleet / "kr210")
+    tests = friction_tests.read_tests(found, nominal, out, None)
+    n, rows = nominal.n_axes, {}
+    for name in units:
+        path = out / ".state" / stored.unit_file(name, ".json")
+        key = json.loads(path.read_text())["settings"]
+        kept = stored.read_unit(path, out, name, key, n, len(fleet_logs.FEATURES) * n)
+        settings = Settings(**{k: key[k] for k in ("protocol", "train", "alpha", "variance", "persistence",
+                                                   "wear_limit")})
+        wears, _ = friction_tests.tests_wear(tests.get(name, []), n, ())
+        rescale = friction_tests.Rescale(name, n, wears) if wears else None
+        rows[name] = stored.replay(kept, settings, n, rescale).rows
+    return rows
+
+
+def on_scale(rows: list[dict], scale_uncertainty, tested: bool):
+    """``rows`` and the scale uncertainty as the monitor's remaining life takes them: with friction
+    tests each estimate on the *latest* row's factor and that factor's relative error
+    (:func:`faultgen.monitor.friction_tests.on_tests_scale`), else as given."""
+    from faultgen.monitor import friction_tests
+
+    if not tested:
+        return rows, scale_uncertainty
+    rescaled, uncertainty = friction_tests.on_tests_scale(rows, 6)
+    return rescaled, scale_uncertainty if uncertainty is None else uncertainty
+
+
+def unit_rows(scores: list[dict], replayed: dict[str, list[dict]] | None, unit: str) -> tuple[list[dict], bool]:
+    """``unit``'s rows: its replayed monitor rows with friction tests (:func:`replayed_rows`; each
+    prediction then on its latest factor, :func:`on_scale`) and True, else scores.csv's and False."""
+    rows = [r for r in scores if r["unit"] == unit]
+    if replayed is None or unit not in replayed:
+        return rows, False
+    if [r["stamp"] for r in replayed[unit]] != [r["stamp"] for r in rows]:
+        raise SystemExit(f"{unit}: the replayed state's logs are not scores.csv's: is OUT/.state this run's?")
+    return replayed[unit], True
+
+
 def run_fleet(args) -> tuple[Path, Path]:
     """Write the fleet (or resume it in ``--work``) and run the monitor on it; returns (truth.csv, OUT)."""
     work = args.work or Path(tempfile.mkdtemp(prefix="monitor-rul-"))
@@ -208,13 +272,23 @@ def main() -> None:
     parser.add_argument("--scale-uncertainty", type=float, default=prognosis.SCALE_UNCERTAINTY,
                         help="Relative standard uncertainty of the wear estimate's scale carried into the time of "
                              "event (the monitor's, 0.10; 0 as before 2026-11-26).")
+    parser.add_argument("--scores-only", action="store_true",
+                        help="With --fleet and friction tests: fit scores.csv's estimates, each log on the factor "
+                             "of its own day, with --scale-uncertainty (the benchmark before 2026-11-27), not the "
+                             "replayed rows on the latest factor as the monitor's remaining life takes them.")
     args = parser.parse_args()
+    replayed = None
     if args.fleet is not None:
         truth_path, out = args.fleet / "truth.csv", args.fleet / args.out  # scores.csv does not depend on F
         print(f"scoring the existing run {out} against {truth_path}")
+        if not args.scores_only:
+            replayed = replayed_rows(args.fleet, out)
+            if replayed is not None:
+                print("friction tests: each prediction on its latest factor, the factor's error as the scale's "
+                      "uncertainty (faultgen.monitor.friction_tests.on_tests_scale)")
     else:
         truth_path, out = run_fleet(args)
-    evaluate(truth_path, out, args.failure_wear, not args.from_alarm, args.scale_uncertainty)
+    evaluate(truth_path, out, args.failure_wear, not args.from_alarm, args.scale_uncertainty, replayed)
 
 
 def _at_lambda(predictions: list[tuple[int, prognosis.Remaining]], eol: float, start: float) -> dict:
@@ -237,18 +311,20 @@ def _at_lambda(predictions: list[tuple[int, prognosis.Remaining]], eol: float, s
 
 
 def quiet_axes(truth: dict, scores: list[dict], alarms: dict, failure_wear: float, changepoint: bool,
-               scale_uncertainty) -> None:
+               scale_uncertainty, replayed: dict[str, list[dict]] | None = None) -> None:
     """Every unit's remaining life at its last log as the monitor writes it in rul.csv: the axes that
     do not wear with an end of life within the horizon, the healthy units' within the fleet's span."""
     span = max(len(t["wear"]) for t in truth.values())
     within, healthy, others = [], 0, 0
     for unit, t in truth.items():
-        rows = [r for r in scores if r["unit"] == unit]
+        rows, uncertainty = [r for r in scores if r["unit"] == unit], scale_uncertainty
+        if replayed is not None and unit in replayed:
+            rows, uncertainty = on_scale(replayed[unit], scale_uncertainty, True)
         alarm = alarms[unit]
         source = int(alarm["source_axis"]) if alarm["source_axis"] else None
         for row in prognosis.remaining_life(unit, rows, 6, alpha=MONITOR_ALPHA, failure_wear=failure_wear,
                                             since=alarm["first_alarm"] or None, source_axis=source,
-                                            changepoint=changepoint, scale_uncertainty=scale_uncertainty):
+                                            changepoint=changepoint, scale_uncertainty=uncertainty):
             if row.axis == t["axis"]:
                 continue
             others += 1
@@ -267,17 +343,19 @@ def verdict(ok: bool) -> str:
 
 
 def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool = True,
-             scale_uncertainty: float = prognosis.SCALE_UNCERTAINTY) -> dict[str, list[dict]]:
+             scale_uncertainty: float = prognosis.SCALE_UNCERTAINTY,
+             replayed: dict[str, list[dict]] | None = None) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
     docstring); prints a block per unit and the fleet's lines, each figure beside the criterion of
-    issue 75 and its verdict; returns the scores of (A) and (B) (each with ``at_lambda``)."""
+    issue 75 and its verdict; returns the scores of (A) and (B) (each with ``at_lambda``); ``replayed``:
+    :func:`unit_rows`."""
     truth = independent_fleet.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
         scores = [_floats(r) for r in csv.DictReader(f)]
     with open(out / "alarms.csv", newline="") as f:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
     F, H = failure_wear, prognosis.HORIZON
-    quiet_axes(truth, scores, alarms, F, changepoint, scale_uncertainty)
+    quiet_axes(truth, scores, alarms, F, changepoint, scale_uncertainty, replayed)
     results = {"A": [], "B": []}
     started = time.perf_counter()
     from progpy.predictors import ToEPredictionProfile
@@ -290,12 +368,12 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
             print(f"\n{unit}: worn axis {axis}, alarm {alarm['first_alarm'] or 'none'} on axis "
                   f"{alarm['source_axis'] or '-'}: not scored")
             continue
-        rows = [r for r in scores if r["unit"] == unit]
+        rows, tested = unit_rows(scores, replayed, unit)
         stamps = [r["stamp"] for r in rows]
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
         wear = t["wear"]
         true_eol = day_of(wear, F)  # (A)
-        scale, offset = estimate_line(wear, day, rows, axis)
+        scale, offset = estimate_line(wear, day, on_scale(rows, scale_uncertainty, tested)[0], axis)
         estimate_eol = day_of(wear, (F - offset) / scale)  # (B)
         first = stamps.index(alarm["first_alarm"])
         start = day[stamps[first + PERSISTENCE - 1]]
@@ -304,9 +382,10 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
             now = day[rows[j]["stamp"]]
             if now >= max(true_eol, estimate_eol):  # the metrics take the predictions before the end of life
                 break
-            (row,) = prognosis.remaining_life(unit, rows[: j + 1], 6, alpha=MONITOR_ALPHA, failure_wear=F,
+            upto, uncertainty = on_scale(rows[: j + 1], scale_uncertainty, tested)
+            (row,) = prognosis.remaining_life(unit, upto, 6, alpha=MONITOR_ALPHA, failure_wear=F,
                                               since=alarm["first_alarm"], source_axis=axis, axes=[axis],
-                                              changepoint=changepoint, scale_uncertainty=scale_uncertainty)
+                                              changepoint=changepoint, scale_uncertainty=uncertainty)
             if row.rul is not None:  # a "not yet predictable" or no end of life gives no number
                 profile.add_prediction(now, _absolute(row.distribution, now, H))
             predictions.append((now, row))
