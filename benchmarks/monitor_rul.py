@@ -15,7 +15,7 @@ and each prediction fits them on *its* latest factor with that factor's error as
 uncertainty, as the monitor's own remaining life does
 (:func:`faultgen.monitor.friction_tests.on_tests_scale`); scores.csv keeps each log on the factor of
 its own day, a mosaic whose steps at each test bent the trend (hump law seed 1, unit09: 133.9 days
-where 16.1 remained; docs/_r8_life.md). ``--scores-only``: that mosaic, as before 2026-11-27.
+where 16.1 remained; docs/analysis.md, "Second session of 2026-11-27"). ``--scores-only``: that mosaic, as before 2026-11-27.
 
 In one run of this script:
 

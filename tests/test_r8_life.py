@@ -1,5 +1,6 @@
 """benchmarks/monitor_rul.py scores the remaining life with friction tests as the monitor computes it
-(issue 75; docs/_r8_life.md): each prediction's rows on that prediction's *latest* factor
+(docs/analysis.md, "Second session of 2026-11-27"): each prediction's rows on that prediction's
+*latest* factor
 (faultgen.monitor.friction_tests.on_tests_scale), not each log on the factor of its own day."""
 
 import sys
