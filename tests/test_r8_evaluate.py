@@ -37,10 +37,17 @@ def tiny(seed: int = 0) -> tuple[Data, list[str], list[str]]:
     return Data.of_units(X, units, y, [k < 3 for k in range(6)]), units[3:], units[:3]
 
 
+def _shipped(factory) -> bool:
+    """Whether a registry factory (a function, or a partial of one) is faultgen's or analysis's."""
+    function = getattr(factory, "func", factory)
+    return function.__module__.split(".")[0] in ("faultgen", "analysis")
+
+
 def runnable(role: str) -> list[str]:
-    """The registered names of ``role`` that a command can build (no context); one needing a module
-    not installed here is checked by :func:`test_a_method_needing_a_missing_module_is_refused_by_name`."""
-    names = [n for n in registry.names(role) if registry.get(n).context is None]
+    """The names of ``role`` that faultgen and analysis register and a command can build (no context;
+    a test's own plug-in, registered by another file in the same process, is left out); one needing a
+    module not installed here is checked by :func:`test_a_method_needing_a_missing_module_is_refused_by_name`."""
+    names = [n for n in registry.names(role) if registry.get(n).context is None and _shipped(registry.get(n).factory)]
     return [n for n in names if registry.get(n).needs is None or importlib.util.find_spec(registry.get(n).needs)]
 
 
