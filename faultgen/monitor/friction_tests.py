@@ -98,7 +98,7 @@ LAW_TESTS, LAW_SPAN_K, LAW_AXES = 3, 1.0, 3
 BETA_PRIOR = 0.005
 #: Standard deviation of the prior of the scale factor ``f`` (mean 1: the twin's scale). The factor
 #: that maps the twin's scale best onto the truth was 0.80-1.08 on the first independent fleet's worn
-#: units and 0.50-0.81 on the second's (seed 0, issue 75), and a test reads a dry level to some 3 %
+#: units and 0.50-0.81 on the second's (seed 0), and a test reads a dry level to some 3 %
 #: (the plant's scatter from day to day, not the fit's). Median error of the logs' wear on the
 #: tests' scale (first, second fleet, seed 0; :data:`FORGET` 0.6, the offset's prior the reference's
 #: own error): 2.32, 3.33 points at 0.3 (90 % coverage 96.9, 94.4 %); 2.70, 3.13 at 0.5 (96.3,
