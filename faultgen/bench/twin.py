@@ -18,7 +18,7 @@ axis each names). Read back per test unit (:func:`answers`):
 - **axis named**: the source axis of the unit's first persistent alarm (``alarms.csv``); 0 (undecided)
   without one. A test unit monitored as several units (one per program) names the axis of the
   alarm among them that became known first: ordered by alarms.csv's ``known`` (the log on which a
-  daily run saw the alarm, issue 72), not by ``first_alarm`` (the first log of the persistence
+  daily run saw the alarm), not by ``first_alarm`` (the first log of the persistence
   window, a date on which nobody could have seen it); ``first_alarm`` only for a folder written
   before ``known`` existed. The detection itself never reads alarms.csv: it is the per-log alarm
   above under the scorer's rule, timed on the log that raises it.

@@ -1,4 +1,4 @@
-"""A unit's friction tests in ``faultgen monitor`` (issue 75, item 3): each axis's wear read
+"""A unit's friction tests in ``faultgen monitor``: each axis's wear read
 directly, and the production logs' wear put on the tests' scale.
 
 **The folder.** ``LOGS/<unit>/friction-test/<stamp><suffix>`` (:data:`faultgen.data.logfolder.TESTS`):
