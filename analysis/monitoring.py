@@ -168,9 +168,22 @@ class PCAMonitor(BaseEstimator):
         self.mean_, self.scale_ = mean, scale
         self.eigenvalues_, self.explained_variance_ratio_ = eigenvalues, ratio
         self.components_, self.n_components_, self.n_samples_fit_ = vectors[:, :k].T.copy(), k, m
-        self.t2_limit_ = float(k * (m - 1) / (m - k) * stats.f.ppf(1 - self.alpha, k, m - k))
-        self.q_limit_ = _jackson_mudholkar(theta1, theta2, theta3, self.alpha)
+        self.residual_eigenvalues_ = residual
+        self.t2_limit_, self.q_limit_ = self.limits(self.alpha)
         return self
+
+    def limits(self, alpha: float) -> tuple[float, float]:
+        """The T2 and Q limits (eqs. 2.4 and 2.6, as :meth:`fit` sets ``t2_limit_`` and ``q_limit_``)
+        of the fitted model at another significance ``alpha``: the same components and residual
+        eigenvalues, no second fit. ValueError for ``alpha`` outside (0, 1), or where the
+        Jackson-Mudholkar approximation is undefined."""
+        check_is_fitted(self, "residual_eigenvalues_")
+        if not 0 < alpha < 1:
+            raise ValueError(f"alpha = {alpha!r}; expected a significance level in (0, 1)")
+        k, m = self.n_components_, self.n_samples_fit_
+        theta1, theta2, theta3 = (np.sum(self.residual_eigenvalues_**i) for i in (1, 2, 3))
+        return (float(k * (m - 1) / (m - k) * stats.f.ppf(1 - alpha, k, m - k)),
+                _jackson_mudholkar(theta1, theta2, theta3, alpha))
 
     def _project(self, X) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Standardised X, scores and residuals of X of shape (n_samples, n_features)."""

@@ -269,9 +269,7 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     unit = scoring.UnitMonitor("u", scoring.Settings(protocol="own", train=10), n_axes=1)
     for i in range(10):
         unit.add(f"{i:02d}", rng.normal() * np.ones(4) + 0.1 * rng.normal(size=4), 20.0 + i % 3, 100.0)
-    # the unit's monitor at its alpha, and the at-once rule's at alpha ** persistence, both by the registry
-    far = unit.settings.alpha ** unit.settings.persistence
-    assert calls[-2:] == [{"variance": unit.settings.variance, "alpha": a, "cv": 5} for a in (unit.settings.alpha, far)]
+    assert calls[-1] == {"variance": unit.settings.variance, "alpha": unit.settings.alpha, "cv": 5}
     assert isinstance(unit.pca, PCAMonitor)
     training_source._fit(rng.normal(size=(40, 4)), 0.85, 0.05, None)
     assert calls[-1] == {"variance": 0.85, "alpha": 0.05, "statistic": "q", "cv": None}

@@ -309,10 +309,9 @@ class UnitMonitor:
         Z = R / self.scale_
         # the registry's monitor model (analysis.registry: the one detect and training-source build)
         self.pca = registry.make("pca_monitor", variance=self.settings.variance, alpha=self.settings.alpha, cv=5)[1].fit(Z)
-        far = self.settings.alpha**self.settings.persistence  # --protocol own's at-once limits (T2, Q); none
-        far = None if self.signatures is not None or far < FAR_ALPHA else registry.make(  # past FAR_ALPHA
-            "pca_monitor", variance=self.settings.variance, alpha=far, cv=5)[1].fit(Z)
-        self.far_ = None if far is None else (far.t2_limit_, far.q_limit_)
+        # --protocol own's at-once limits (T2, Q) from the same fitted model; none past FAR_ALPHA
+        far = self.settings.alpha**self.settings.persistence
+        self.far_ = None if self.signatures is not None or far < FAR_ALPHA else self.pca.limits(far)
         self.training = []
         self.trend = WearTrend(self.n_axes, X.shape[1])
         if self.signatures is not None:
