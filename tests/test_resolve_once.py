@@ -336,15 +336,15 @@ def _program_file(tmp_path) -> Path:
 
 def test_a_run_from_its_spec_looks_each_name_up_once(tmp_path, looked_up):
     """``resolve(spec)`` and the simulation of the run: the robot, the task (a program file), the
-    stepper once; the friction model three times (resolve, RunConfig's check, the model's build: not
-    yet carried as an object, docs/architecture.md, "How a run is built")."""
+    stepper once; the friction model twice (RunConfig's check, the model's build: not yet carried as
+    an object, docs/architecture.md, "How a run is built")."""
     from faultgen.simulation import resolve, spec
 
     path = _program_file(tmp_path)
     looked_up.clear()
     run = resolve.resolve(spec.RunSpec("puma560", str(path), friction="stribeck", cycles=1, stepper="loop"))
     run.simulate(progress=False)
-    assert dict(looked_up) == {"robot": 1, "task": 1, "stepper": 1, "friction": 3}
+    assert dict(looked_up) == {"robot": 1, "task": 1, "stepper": 1, "friction": 2}
     looked_up.clear()  # the same run again in this process: the task read and planned once per content
     resolve.resolve(spec.RunSpec("puma560", str(path), friction="stribeck", cycles=1)).simulate(progress=False)
     assert looked_up["task"] == 0

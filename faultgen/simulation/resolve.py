@@ -2,11 +2,13 @@
 task, friction model and stepper are looked up.
 
 ``resolve(spec) -> Run``: the robot by :func:`faultgen.model.robots.load` (one compiled robot per
-file content, its SHA-1), the task by :func:`task` (its kind decided by
+file content, its SHA-1), the task as :func:`task` reads it (its kind decided by
 :func:`faultgen.operation.programs.kind`, read and planned at the robot's physics step once per
 process and content: :func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the
 robot's ``tasks.toml`` and of a program or log file, :func:`faultgen.simulation.prepare.digests`,
-not by file times), the friction model by :func:`friction` and the stepper by :func:`stepper`. The
+not by file times), the stepper by :func:`stepper`; the friction model is looked up by the
+:class:`~faultgen.simulation.config.RunConfig` it builds
+(:func:`faultgen.simulation.friction_models.get`). The
 :class:`Run` holds the objects; :func:`faultgen.simulation.stepping.simulate` steps it
 (``simulate(run.config, stepper=run.stepper)``, or :meth:`Run.simulate`).
 """
@@ -17,7 +19,7 @@ from dataclasses import dataclass
 
 from faultgen.model import robots
 from faultgen.operation import programs, tasks
-from faultgen.simulation import backends, friction_models, prepare
+from faultgen.simulation import backends, prepare
 from faultgen.simulation.config import RunConfig
 from faultgen.simulation.spec import RunSpec
 
@@ -60,11 +62,6 @@ def task(robot_: robots.Robot, given) -> tuple[tasks.Task, tasks.JointPath]:
     return prepare.task_path(robot_, given, *prepare.digests(robot_, given))
 
 
-def friction(name: str) -> friction_models.FrictionModel:
-    """The friction model ``name`` (:data:`faultgen.effects.friction.MODELS`); ValueError naming the known ones."""
-    return friction_models.get(name)
-
-
 def stepper(name: str) -> backends.Stepper:
     """The stepper registered as ``name`` (:data:`faultgen.simulation.backends.STEPPERS`); ValueError
     naming the known ones."""
@@ -85,8 +82,7 @@ def resolve(spec: RunSpec) -> Run:
     if not isinstance(spec, RunSpec):
         raise TypeError(f"resolve: expected a RunSpec, got {type(spec).__name__}")
     found = robot(spec.robot)
-    friction(spec.friction)
     stepping = stepper(spec.stepper)
-    task(found, spec.task)
+    # RunConfig checks and plans the task (as task does) and looks the friction model up: not twice
     config = RunConfig(robot=spec.robot, resolved=found, **spec.run_fields())
     return Run(config, stepping)
