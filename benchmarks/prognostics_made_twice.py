@@ -28,6 +28,7 @@ def main() -> None:
     parser.add_argument("--work", type=Path, default=None)
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="prognostics-twice-"))
+    work.mkdir(parents=True, exist_ok=True)
     manifests = []
     for k in (1, 2):
         out = work / f"made{k}"
