@@ -39,7 +39,8 @@ import pandas as pd
 from faultgen import inputs
 from faultgen.logs import blocks, delimited, jointlog, measured
 from faultgen.logs.columns import (
-    CSV_SUFFIXES, CYCLE_COLUMN, HDF5_SUFFIXES, MAX_ROWS, T_COLUMN, LogBoundError, column_names, temperature_columns,
+    CSV_SUFFIXES, CYCLE_COLUMN, HDF5_SUFFIXES, MAX_ROWS, T_COLUMN, LogBoundError, column_names,
+    temperature_columns,
 )
 from faultgen.model import robots
 
@@ -404,7 +405,8 @@ class URRTDE(LogFormat):
         if with_qd:
             mapping.update({qd_names[k]: (qd[k], None) for k in axes})
         if with_temperature:
-            mapping.update({name: (temperature[k], None) for k, name in enumerate(temperature_columns(n_axes))})
+            mapping.update({name: (temperature[k], None)
+                            for k, name in enumerate(temperature_columns(n_axes))})
         return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
 
     def _torque(self, path: Path | inputs.Held, names: list[str], n_axes: int) -> tuple[list, list, str]:

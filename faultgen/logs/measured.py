@@ -44,9 +44,9 @@ a Savitzky-Golay filter (:func:`scipy.signal.savgol_filter`, ``deriv=1`` / ``der
 ``mode="interp"``): a cubic (:data:`~faultgen.derivatives.SAVGOL_ORDER`) least-squares fit over a
 window of :data:`~faultgen.derivatives.SAVGOL_WINDOW` = 0.05 s, i.e. ``2 round(0.025 / dt) + 1``
 samples at the median sample period ``dt`` (5 samples at 100 Hz, 13 at 250 Hz, 51 at 1 kHz). Its
-pass band reaches about 25-35 Hz (Schafer 2011, "What is a Savitzky-Golay filter?"), well above the joint motion of
-an industrial arm, while encoder noise at hundreds of Hz is rejected. Near both ends the
-polynomial of the first / last window is used, so the first and last ~0.025 s are less
+pass band reaches about 25-35 Hz (Schafer 2011, "What is a Savitzky-Golay filter?"), well above
+the joint motion of an industrial arm, while encoder noise at hundreds of Hz is rejected. Near both
+ends the polynomial of the first / last window is used, so the first and last ~0.025 s are less
 accurate.
 
 The filter coefficients assume equally spaced samples. When the sample period varies by more
@@ -75,7 +75,8 @@ from faultgen.derivatives import savgol_window as _savgol_window
 from faultgen.model import robots
 from faultgen.logs import jointlog
 from faultgen.logs.columns import (
-    CYCLE_COLUMN, MAX_CYCLE, MIN_CYCLE_TIME, PAYLOAD_COLUMN, T_COLUMN, LogError, column_names, temperature_columns,
+    CYCLE_COLUMN, MAX_CYCLE, MIN_CYCLE_TIME, PAYLOAD_COLUMN, T_COLUMN, LogError, column_names,
+    temperature_columns,
 )
 
 #: Raised for a measured-data file that cannot be used: the joint log's one error type
