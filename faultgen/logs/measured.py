@@ -208,10 +208,10 @@ def read(path: str | Path | inputs.Held, robot: robots.Robot, accelerations: boo
         are present; a cell is empty, NaN, infinite or not a number (first such data row and
         column); ``t`` does not strictly increase (the data row where it repeats or goes
         back); the median sample period exceeds 0.01 s (< 100 Hz) or one interval exceeds
-        :data:`MAX_GAP`; the data spans less than 2 s; a ``q`` column looks like degrees
-        ("column q3 looks like degrees (max 170.2); expected rad") or leaves the robot's
-        joint range by more than :data:`JOINT_RANGE_TOLERANCE` (column, row, value, range);
-        a ``qd`` column looks like deg/s.
+        :data:`~faultgen.logs.columns.MAX_GAP`; the data spans less than 2 s; a ``q`` column looks
+        like degrees ("column q3 looks like degrees (max 170.2); expected rad") or leaves the robot's
+        joint range by more than :data:`~faultgen.logs.columns.JOINT_RANGE_TOLERANCE` (column, row,
+        value, range); a ``qd`` column looks like deg/s.
 
     Notes
     -----
