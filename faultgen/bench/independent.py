@@ -85,7 +85,7 @@ from faultgen.bench import layouts
 from faultgen.data import cells
 from faultgen.model import robots
 from faultgen.operation import programs
-from faultgen.logs import jointlog
+from faultgen.logs.columns import PAYLOAD_COLUMN, T_COLUMN, column_names, temperature_columns
 
 #: Unit-to-unit spread of each friction parameter (log-normal sigma) and its day-to-day scatter,
 #: drawn per log and parameter and not logged (the state of the lubricant film, the warm-up the
@@ -472,8 +472,8 @@ def friction_test_truth(unit: str, stamp: str, gear_ratio: np.ndarray, coulomb, 
 
 def log_header(n: int) -> list[str]:
     """The columns of a log of ``n`` axes: t, q1..qN, tau1..tauN, temperature1..N, payload."""
-    q_names, _, tau_names = jointlog.column_names(n)
-    return [jointlog.T_COLUMN, *q_names, *tau_names, *jointlog.temperature_columns(n), jointlog.PAYLOAD_COLUMN]
+    q_names, _, tau_names = column_names(n)
+    return [T_COLUMN, *q_names, *tau_names, *temperature_columns(n), PAYLOAD_COLUMN]
 
 
 def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:

@@ -36,7 +36,7 @@ import numpy as np
 
 from faultgen.bench import files, tracks
 from faultgen.data import cells
-from faultgen.logs import jointlog
+from faultgen.logs.columns import PAYLOAD_COLUMN, T_COLUMN, column_names, temperature_columns
 
 #: Largest relative difference (to the feature's scale) between a regenerated unit's features and
 #: its test unit's: other BLAS or NumPy kernels move the last bits (1e-15 rad on a weld path's joint
@@ -214,14 +214,14 @@ def _write_logs(folder: Path, part: dict) -> None:
     temperatures and payload when the run has them."""
     folder.mkdir(parents=True, exist_ok=True)
     n = part["q"].shape[2]
-    q_names, _, tau_names = jointlog.column_names(n)
-    header = [jointlog.T_COLUMN, *q_names, *tau_names]
+    q_names, _, tau_names = column_names(n)
+    header = [T_COLUMN, *q_names, *tau_names]
     formats = ["%.4f"] + ["%.8f"] * n + ["%.5f"] * n
     has_temperature = part["joint_temperature"] is not None
     if has_temperature:
-        header += list(jointlog.temperature_columns(n))
+        header += list(temperature_columns(n))
         formats += ["%.3f"] * n
-    header.append(jointlog.PAYLOAD_COLUMN)
+    header.append(PAYLOAD_COLUMN)
     formats.append("%.3f")
     t = part["t"]
     for i, cycle in enumerate(part["cycles"]):

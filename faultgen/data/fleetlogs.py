@@ -49,6 +49,7 @@ from tqdm.auto import tqdm
 from faultgen import __version__
 from faultgen.data import logfolder, schema, writer
 from faultgen.logs import formats, measured
+from faultgen.logs.columns import CSV_SUFFIXES, HDF5_SUFFIXES
 from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
 from faultgen.model import robots
@@ -61,7 +62,7 @@ WORN_MARK = 2.0
 #: The ``task`` and ``friction_model`` labels of an imported run, and its ``source`` attribute.
 MEASURED = schema.MEASURED
 #: Suffixes of the logs the measured-format reader takes (:func:`faultgen.logs.measured.read`).
-SUFFIXES = measured.CSV_SUFFIXES + measured.HDF5_SUFFIXES
+SUFFIXES = CSV_SUFFIXES + HDF5_SUFFIXES
 #: Why a log listed in the folder was not imported when it vanished before it was read (skipped, named).
 VANISHED = "removed from the folder while it was imported"
 #: The group of the manifest in an imported dataset.

@@ -18,7 +18,7 @@ import numpy as np
 from faultgen.data import atomic, cells
 from faultgen.logs import measured
 from faultgen.data.reader import Run
-from faultgen.logs import jointlog
+from faultgen.logs.columns import temperature_columns
 
 
 def _columns(run: Run, index: int) -> dict[str, np.ndarray]:
@@ -30,7 +30,7 @@ def _columns(run: Run, index: int) -> dict[str, np.ndarray]:
     gear = np.asarray(run.drivetrain.gear_ratio, dtype=float)
     t = np.asarray(run.array("t"), dtype=float)
     q, tau = run.signal("q_a")[index].astype(float), run.signal("tau_m")[index].astype(float) * gear
-    names = jointlog.temperature_columns(q.shape[1])
+    names = temperature_columns(q.shape[1])
     columns = {"t": t, **{f"q{k + 1}": q[:, k] for k in range(q.shape[1])},
                **{f"tau{k + 1}": tau[:, k] for k in range(q.shape[1])}}
     if run.has("joint_temperature"):

@@ -11,7 +11,7 @@ import pandas as pd
 
 from faultgen import axes
 from faultgen.data import cells
-from faultgen.logs.measured import CSV_SUFFIXES, HDF5_SUFFIXES, T_COLUMN, UNITS, column_names
+from faultgen.logs.columns import CSV_SUFFIXES, HDF5_SUFFIXES, T_COLUMN, UNITS, column_names
 
 
 def _compression(path: Path) -> str | None:

@@ -23,7 +23,7 @@ order of a block's columns); ``extra``, the file's columns ignored; ``notes``, w
 chose; ``rows``, an upper bound of the data rows, known before they are parsed; ``label``, data
 row index -> its name in messages; and ``blocks(size)``, yielding ``(start, block)``: the index of
 the block's first data row and a float array of shape (size, len(wanted)) (the last block shorter),
-every cell refused unless finite (a :class:`~faultgen.logs.jointlog.LogError` naming the file,
+every cell refused unless finite (a :class:`~faultgen.logs.columns.LogError` naming the file,
 the data row and the column). :func:`source` gives the measured format's (:class:`Csv`,
 :class:`Hdf5`); every log format has one (:meth:`faultgen.logs.formats.LogFormat.source`).
 """
@@ -42,7 +42,7 @@ from faultgen import inputs
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.model import robots
 from faultgen.logs import jointlog
-from faultgen.logs.jointlog import LogError
+from faultgen.logs.columns import JOINT_RANGE_TOLERANCE, MAX_GAP, MAX_ROWS, T_COLUMN, LogError, column_names
 
 #: Rows read at a time (rounded up to a whole number of averaging blocks).
 BLOCK_ROWS = 200_000
@@ -81,8 +81,8 @@ class Csv:
         self.wanted, self.extra = (jointlog.select_columns(path, self.names, n_axes, motion_only) if header
                                    else ([], []))
         self.rows = max(lines - 1, 0) if self.wanted else 0  # an upper bound: blank lines count here
-        if self.rows > jointlog.MAX_ROWS:
-            raise LogError(f"{path}: {self.rows} data rows; a log has at most {jointlog.MAX_ROWS} "
+        if self.rows > MAX_ROWS:
+            raise LogError(f"{path}: {self.rows} data rows; a log has at most {MAX_ROWS} "
                            "(MAX_ROWS: a day at 1 kHz)")
 
     def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
@@ -160,7 +160,7 @@ class Hdf5:
 @dataclass
 class TimeScan:
     """The sample times checked as they stream by, none of them kept: strictly increasing, no
-    interval above :data:`faultgen.logs.jointlog.MAX_GAP`; ``limit(first, last, rows)`` may
+    interval above :data:`faultgen.logs.columns.MAX_GAP`; ``limit(first, last, rows)`` may
     refuse the log as soon as a block shows it too long. The sample rate checked is that of the
     median of the blocks' median intervals (the exact median would need every interval at once)."""
 
@@ -201,9 +201,9 @@ class TimeScan:
         if period > (1.0 / min_rate) * (1 + 1e-9):
             raise LogError(f"{self.path}: column t has a median sample period of {period:.6g} s; expected at most "
                            f"{1 / min_rate:g} s (a sample rate of at least {min_rate:g} Hz)")
-        if self.high > jointlog.MAX_GAP * (1 + 1e-9):
+        if self.high > MAX_GAP * (1 + 1e-9):
             raise LogError(f"{self.path}: column t jumps by {self.high:.6g} s from {self.label(self.gap_row - 1)} to "
-                           f"{self.label(self.gap_row)}; expected no interval longer than {jointlog.MAX_GAP:g} s "
+                           f"{self.label(self.gap_row)}; expected no interval longer than {MAX_GAP:g} s "
                            "(the derivative filter window)")
         if self.last - self.first < min_duration:
             raise LogError(f"{self.path}: the data covers {self.last - self.first:.6g} s ({self.rows} data rows); "
@@ -230,11 +230,11 @@ def scan(src, robot: robots.Robot, times: TimeScan | None = None, size: int | No
     if not src.wanted:  # an empty file: the whole-file reader says what is missing
         return Scan(np.empty(0) if times is None else None, np.empty((0, 0)), np.empty(0, dtype=int), times)
     index = {name: j for j, name in enumerate(src.wanted)}
-    names = jointlog.column_names(robot.n_axes)
+    names = column_names(robot.n_axes)
     q_cols, tau_cols = [index[c] for c in names[0]], [index[c] for c in names[2] if c in index]
-    t_col = index[jointlog.T_COLUMN]
+    t_col = index[T_COLUMN]
     low, high = robot.joint_range[:, 0], robot.joint_range[:, 1]
-    tol = jointlog.JOINT_RANGE_TOLERANCE
+    tol = JOINT_RANGE_TOLERANCE
     # the whole times in one array of the declared rows (no list of blocks joined: half the memory),
     # checked as they stream by too, so a log whose times repeat or go back (an HDF5 file declaring
     # 10^8 rows it does not hold reads as zeros) is refused at its first block, not after all of it
@@ -279,8 +279,8 @@ def averaged(src, n_axes: int, period: float, window: int, uniform: bool, k: int
     of ``k`` rows, ``m`` rows each; ``qd`` is the file's when it has ``qd`` columns.
     ``on_block(start, block, qd_est, qd)`` sees each block at the full rate."""
     index = {name: j for j, name in enumerate(src.wanted)}
-    q_names, qd_names, tau_names = jointlog.column_names(n_axes)
-    cols = {"t": [index[jointlog.T_COLUMN]], "q": [index[c] for c in q_names]}
+    q_names, qd_names, tau_names = column_names(n_axes)
+    cols = {"t": [index[T_COLUMN]], "q": [index[c] for c in q_names]}
     if tau_names[0] in index:
         cols["tau"] = [index[c] for c in tau_names]
     qd_cols = [index[c] for c in qd_names] if qd_names[0] in index else None

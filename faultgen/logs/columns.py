@@ -1,8 +1,8 @@
 """The joint-log format as data: the columns of a robot of N axes (``t``, ``q1..qN``, ``qd1..qdN``,
 ``tau1..tauN``, the optional operating conditions) and their units, the file suffixes, the bounds a
 log is held to (rows, memory, sample rate, gaps, duration, values, cycles), and :class:`LogError`.
-The reader (:mod:`faultgen.logs.jointlog`) names all of these too; the format is documented in
-:mod:`faultgen.logs.measured`."""
+Every reader (:mod:`faultgen.logs.jointlog`, :mod:`faultgen.logs.blocks`, the formats) and writer
+imports them from here; the format is documented in :mod:`faultgen.logs.measured`."""
 
 from __future__ import annotations
 

@@ -13,7 +13,8 @@ import numpy as np
 import pandas as pd
 
 from faultgen import inputs
-from faultgen.logs import jointlog, measured
+from faultgen.logs import measured
+from faultgen.logs.columns import CHUNK_CELLS, LogBoundError
 
 #: Largest foreign log read, bytes on disk.
 MAX_BYTES = 4 * 2**30
@@ -27,7 +28,7 @@ def header(path: Path | inputs.Held, what: str, separator: str | None, as_what: 
     try:
         names, separator = inputs.csv_header(path, what, separator=separator)
     except inputs.InputError as err:
-        raise jointlog.LogBoundError(str(err)) from None
+        raise LogBoundError(str(err)) from None
     except (OSError, UnicodeDecodeError, EOFError) as err:
         raise measured.MeasuredDataError(f"{path}: cannot read the file as {as_what}: {err}") from err
     twice = sorted(name for name, count in Counter(names).items() if count > 1)
@@ -68,7 +69,7 @@ def text_chunks(path: Path, what: str, as_what: str, names: list[str], separator
     that is not a finite number, found from the text (:func:`numbers`: the data row, column and
     value named), or when the text is not such a table (named ``as_what``)."""
     kw = {"sep": separator, "header": None, "names": names, "usecols": wanted, "skipinitialspace": True,
-          "skiprows": 1, "chunksize": size or max(1_000, jointlog.CHUNK_CELLS // len(names))}
+          "skiprows": 1, "chunksize": size or max(1_000, CHUNK_CELLS // len(names))}
     try:
         with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=float, **kw):
@@ -83,7 +84,7 @@ def text_chunks(path: Path, what: str, as_what: str, names: list[str], separator
     except (ValueError, TypeError):  # a cell that is not a number: found from the text below
         pass
     start = 0
-    kw["chunksize"] = max(1_000, jointlog.CHUNK_CELLS // len(names))
+    kw["chunksize"] = max(1_000, CHUNK_CELLS // len(names))
     try:
         with inputs.open_text(path, what, MAX_BYTES) as fh:
             for frame in pd.read_csv(fh, dtype=str, keep_default_na=False, **kw):

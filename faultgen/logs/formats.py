@@ -38,6 +38,10 @@ import pandas as pd
 
 from faultgen import inputs
 from faultgen.logs import blocks, delimited, jointlog, measured
+from faultgen.logs.columns import (
+    CSV_SUFFIXES, CYCLE_COLUMN, HDF5_SUFFIXES, MAX_ROWS, T_COLUMN, LogBoundError, column_names,
+    temperature_columns,
+)
 from faultgen.model import robots
 
 #: name -> log format class, in the order registered: :data:`DEFAULT` first, then ``ur-rtde``,
@@ -212,7 +216,7 @@ class LogFormat:
         try:
             return max(inputs.count_lines(path, f"{self.name} log") - 1, 0)
         except inputs.InputError as err:
-            raise jointlog.LogBoundError(str(err)) from None
+            raise LogBoundError(str(err)) from None
         except (OSError, UnicodeDecodeError, EOFError) as err:
             raise measured.MeasuredDataError(f"{path}: cannot read the file: {err}") from err
 
@@ -263,7 +267,7 @@ class Blocks:
     ------
     faultgen.logs.measured.MeasuredDataError
         A missing column (as :func:`faultgen.logs.measured.from_columns` names it), a log of more
-        rows than :data:`faultgen.logs.jointlog.MAX_ROWS`, or what the adapter refuses.
+        rows than :data:`faultgen.logs.columns.MAX_ROWS`, or what the adapter refuses.
     """
 
     def __init__(self, adapter: LogFormat, path: Path, robot: robots.Robot, motion_only: bool = False):
@@ -280,8 +284,8 @@ class Blocks:
         self.notes = tuple(notes[0]) if notes else ()
         self.wanted, _ = jointlog.select_columns(path, list(columns), robot.n_axes, motion_only)
         self.rows = adapter.rows(path)
-        if self.rows > jointlog.MAX_ROWS:
-            raise measured.MeasuredDataError(f"{path}: {self.rows} data rows; a log has at most {jointlog.MAX_ROWS} "
+        if self.rows > MAX_ROWS:
+            raise measured.MeasuredDataError(f"{path}: {self.rows} data rows; a log has at most {MAX_ROWS} "
                                              "(MAX_ROWS: a day at 1 kHz)")
 
     def blocks(self, size: int) -> Iterator[tuple[int, np.ndarray]]:
@@ -316,7 +320,7 @@ class Measured(LogFormat):
 
     name = "measured"
     reads_held = True
-    suffixes: tuple[str, ...] = jointlog.CSV_SUFFIXES + jointlog.HDF5_SUFFIXES
+    suffixes: tuple[str, ...] = CSV_SUFFIXES + HDF5_SUFFIXES
 
     def columns(self, path, robot: robots.Robot) -> tuple:
         columns, extra, label = jointlog.read_columns(path, robot.n_axes)
@@ -394,14 +398,15 @@ class URRTDE(LogFormat):
         with_qd, with_temperature = all(c in names for c in qd), all(c in names for c in temperature)
         wanted = ["timestamp", *q, *torque, *(qd if with_qd else []), *(temperature if with_temperature else [])]
         delimited.require(path, names, wanted, "RTDE recorder")
-        q_names, qd_names, tau_names = measured.column_names(n_axes)
-        mapping = {measured.T_COLUMN: ("timestamp", None)}
+        q_names, qd_names, tau_names = column_names(n_axes)
+        mapping = {T_COLUMN: ("timestamp", None)}
         mapping.update({q_names[k]: (q[k], None) for k in axes})
         mapping.update({tau_names[k]: (torque[k], scale[k]) for k in axes})
         if with_qd:
             mapping.update({qd_names[k]: (qd[k], None) for k in axes})
         if with_temperature:
-            mapping.update({name: (temperature[k], None) for k, name in enumerate(jointlog.temperature_columns(n_axes))})
+            mapping.update({name: (temperature[k], None)
+                            for k, name in enumerate(temperature_columns(n_axes))})
         return {"names": names, "separator": separator, "wanted": wanted, "map": mapping, "note": source}
 
     def _torque(self, path: Path | inputs.Held, names: list[str], n_axes: int) -> tuple[list, list, str]:
@@ -521,15 +526,15 @@ class Voraus(LogFormat):
 
     @staticmethod
     def _mapped(values: dict[str, np.ndarray], robot: robots.Robot) -> dict[str, np.ndarray]:
-        q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
-        out = {measured.T_COLUMN: values["time"]}
+        q_names, qd_names, tau_names = column_names(robot.n_axes)
+        out = {T_COLUMN: values["time"]}
         for k in range(robot.n_axes):
             out[q_names[k]] = values[f"joint_position_{k + 1}"]
             out[tau_names[k]] = values[f"motor_torque_{k + 1}"] * robot.gear_ratio[k]  # motor side -> arm side
             if f"joint_velocity_{k + 1}" in values:
                 out[qd_names[k]] = values[f"joint_velocity_{k + 1}"]
         if "sample" in values:
-            out[measured.CYCLE_COLUMN] = values["sample"]
+            out[CYCLE_COLUMN] = values["sample"]
         return out
 
     def columns(self, path: Path | inputs.Held, robot: robots.Robot):

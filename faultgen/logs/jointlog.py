@@ -27,22 +27,19 @@ from faultgen import inputs
 from faultgen.derivatives import derivatives as _savgol
 from faultgen.derivatives import is_uniform, savgol_window
 from faultgen.model import robots
-from faultgen.logs.columns import (  # noqa: F401 (the format's names, also known by the reader's)
+from faultgen.logs.columns import (
     CHUNK_CELLS,
     CSV_SUFFIXES,
     CYCLE_COLUMN,
     FULL_TURN_MARGIN,
     HDF5_SUFFIXES,
     JOINT_RANGE_TOLERANCE,
-    MAX_CYCLE,
     MAX_GAP,
     MAX_ROWS,
-    MIN_CYCLE_TIME,
     MIN_DURATION,
     MIN_RATE,
     PAYLOAD_COLUMN,
     T_COLUMN,
-    TEMPERATURE_PREFIX,
     UNITS,
     VALUE_BOUNDS,
     WHOLE_MAX_BYTES,

@@ -35,6 +35,7 @@ from faultgen.logs import formats, measured
 from faultgen.derivatives import SAVGOL_ORDER, is_uniform, savgol_window
 from faultgen.model import robots
 from faultgen.logs import blocks, jointlog
+from faultgen.logs.columns import column_names
 from faultgen.logs.blocks import block_mean  # noqa: F401 (re-exported)
 
 #: Rows read at a time (:data:`faultgen.logs.blocks.BLOCK_ROWS`; rounded up to a whole
@@ -95,9 +96,9 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
     label = src.label
     notes = [f"ignored extra columns: {', '.join(src.extra)}"] if src.extra else []
     notes.extend(src.notes)  # what an adapter chose: first, as its whole read has them
-    dt, period = measured.check_time(t, path, label, notes)
+    dt, period = jointlog.check_time(t, path, label, notes)
     index = {name: j for j, name in enumerate(src.wanted)}
-    q_names, qd_names, tau_names = measured.column_names(robot.n_axes)
+    q_names, qd_names, tau_names = column_names(robot.n_axes)
     jointlog.check_angles(path, kept[:, [index[c] for c in q_names]], robot, lambda i: label(int(kept_rows[i])))
     window = savgol_window(period, n)
     uniform = is_uniform(dt, period)

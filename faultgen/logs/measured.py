@@ -41,17 +41,17 @@ Derivative estimation
 ---------------------
 ``qdd`` (always) and ``qd`` (when the file has no ``qd`` columns) are estimated from ``q`` with
 a Savitzky-Golay filter (:func:`scipy.signal.savgol_filter`, ``deriv=1`` / ``deriv=2``,
-``mode="interp"``): a cubic (:data:`SAVGOL_ORDER`) least-squares fit over a window of
-:data:`SAVGOL_WINDOW` = 0.05 s, i.e. ``2 round(0.025 / dt) + 1`` samples at the median sample
-period ``dt`` (5 samples at 100 Hz, 13 at 250 Hz, 51 at 1 kHz). Its pass band reaches about
-25-35 Hz (Schafer 2011, "What is a Savitzky-Golay filter?"), well above the joint motion of
-an industrial arm, while encoder noise at hundreds of Hz is rejected. Near both ends the
-polynomial of the first / last window is used, so the first and last ~0.025 s are less
+``mode="interp"``): a cubic (:data:`~faultgen.derivatives.SAVGOL_ORDER`) least-squares fit over a
+window of :data:`~faultgen.derivatives.SAVGOL_WINDOW` = 0.05 s, i.e. ``2 round(0.025 / dt) + 1``
+samples at the median sample period ``dt`` (5 samples at 100 Hz, 13 at 250 Hz, 51 at 1 kHz). Its
+pass band reaches about 25-35 Hz (Schafer 2011, "What is a Savitzky-Golay filter?"), well above
+the joint motion of an industrial arm, while encoder noise at hundreds of Hz is rejected. Near both
+ends the polynomial of the first / last window is used, so the first and last ~0.025 s are less
 accurate.
 
 The filter coefficients assume equally spaced samples. When the sample period varies by more
-than :data:`UNIFORM_TOLERANCE` (relative), ``q`` is first interpolated with a cubic spline
-(:class:`scipy.interpolate.CubicSpline`, C2, so it adds no kinks to the second derivative)
+than :data:`~faultgen.derivatives.UNIFORM_TOLERANCE` (relative), ``q`` is first interpolated with
+a cubic spline (:class:`scipy.interpolate.CubicSpline`, C2, so it adds no kinks to the second derivative)
 onto a uniform grid at the median period, differentiated there, and the derivatives are
 interpolated back onto the original sample times with a cubic spline. Applying the uniform
 coefficients to jittered samples instead would bias the derivatives in proportion to the
@@ -68,37 +68,20 @@ from pathlib import Path
 import numpy as np
 
 from faultgen import inputs
-from faultgen.derivatives import SAVGOL_ORDER, SAVGOL_WINDOW, UNIFORM_TOLERANCE  # noqa: F401 (re-exported)
+from faultgen.derivatives import SAVGOL_ORDER
 from faultgen.derivatives import derivatives as _derivatives
 from faultgen.derivatives import is_uniform as _is_uniform
 from faultgen.derivatives import savgol_window as _savgol_window
 from faultgen.model import robots
 from faultgen.logs import jointlog
-
-# The format's names, read and checked by faultgen.logs.jointlog (shared with replayed logs):
-from faultgen.logs.jointlog import (  # noqa: F401 (re-exported)
-    CSV_SUFFIXES,
-    CYCLE_COLUMN,
-    FULL_TURN_MARGIN,
-    HDF5_SUFFIXES,
-    JOINT_RANGE_TOLERANCE,
-    MAX_GAP,
-    MAX_ROWS,
-    MIN_DURATION,
-    MIN_RATE,
-    PAYLOAD_COLUMN,
-    T_COLUMN,
-    TEMPERATURE_PREFIX,
-    UNITS,
-    check_time,
-    column_names,
-    hdf5_columns,
+from faultgen.logs.columns import (
+    CYCLE_COLUMN, MAX_CYCLE, MIN_CYCLE_TIME, PAYLOAD_COLUMN, T_COLUMN, LogError, column_names,
     temperature_columns,
 )
 
 #: Raised for a measured-data file that cannot be used: the joint log's one error type
-#: (:class:`faultgen.logs.jointlog.LogError`, a ValueError naming the file, column and data row).
-MeasuredDataError = jointlog.LogError
+#: (:class:`faultgen.logs.columns.LogError`, a ValueError naming the file, column and data row).
+MeasuredDataError = LogError
 
 
 @dataclass(frozen=True, eq=False)
@@ -225,10 +208,10 @@ def read(path: str | Path | inputs.Held, robot: robots.Robot, accelerations: boo
         are present; a cell is empty, NaN, infinite or not a number (first such data row and
         column); ``t`` does not strictly increase (the data row where it repeats or goes
         back); the median sample period exceeds 0.01 s (< 100 Hz) or one interval exceeds
-        :data:`MAX_GAP`; the data spans less than 2 s; a ``q`` column looks like degrees
-        ("column q3 looks like degrees (max 170.2); expected rad") or leaves the robot's
-        joint range by more than :data:`JOINT_RANGE_TOLERANCE` (column, row, value, range);
-        a ``qd`` column looks like deg/s.
+        :data:`~faultgen.logs.columns.MAX_GAP`; the data spans less than 2 s; a ``q`` column looks
+        like degrees ("column q3 looks like degrees (max 170.2); expected rad") or leaves the robot's
+        joint range by more than :data:`~faultgen.logs.columns.JOINT_RANGE_TOLERANCE` (column, row,
+        value, range); a ``qd`` column looks like deg/s.
 
     Notes
     -----
@@ -385,14 +368,14 @@ def _build(
 
 
 def _cycles(where: Path, values: np.ndarray, label, t: np.ndarray) -> np.ndarray:
-    """The ``cycle`` column as whole numbers 0..:data:`~faultgen.logs.jointlog.MAX_CYCLE` that
+    """The ``cycle`` column as whole numbers 0..:data:`~faultgen.logs.columns.MAX_CYCLE` that
     never decrease, each cycle but the log's first and last spanning at least
-    :data:`~faultgen.logs.jointlog.MIN_CYCLE_TIME` s, or refused at the first row that is not."""
-    fractional = np.flatnonzero((values != np.round(values)) | (values < 0) | (values > jointlog.MAX_CYCLE))
+    :data:`~faultgen.logs.columns.MIN_CYCLE_TIME` s, or refused at the first row that is not."""
+    fractional = np.flatnonzero((values != np.round(values)) | (values < 0) | (values > MAX_CYCLE))
     if fractional.size:
         i = int(fractional[0])
         raise MeasuredDataError(f"{where}: {label(i)}, column {CYCLE_COLUMN}: value {values[i]:.6g}; expected a whole "
-                                f"cycle number 0 .. {jointlog.MAX_CYCLE:g}")
+                                f"cycle number 0 .. {MAX_CYCLE:g}")
     back = np.flatnonzero(np.diff(values) < 0)
     if back.size:
         i = int(back[0]) + 1
@@ -400,11 +383,11 @@ def _cycles(where: Path, values: np.ndarray, label, t: np.ndarray) -> np.ndarray
                                 f"{values[i - 1]:g}; expected the samples of each cycle together, cycles in order")
     starts = np.flatnonzero(np.diff(values)) + 1  # the first row of each cycle but the first
     spans = t[starts[1:] - 1] - t[starts[:-1]]  # first to last sample of each cycle between the first and last
-    short = np.flatnonzero(spans < jointlog.MIN_CYCLE_TIME)
+    short = np.flatnonzero(spans < MIN_CYCLE_TIME)
     if short.size:
         i = int(starts[short[0]])
         raise MeasuredDataError(f"{where}: column {CYCLE_COLUMN}: cycle {values[i]:g} from {label(i)} spans "
-                                f"{spans[short[0]]:.6g} s; expected cycles of at least {jointlog.MIN_CYCLE_TIME:g} s "
+                                f"{spans[short[0]]:.6g} s; expected cycles of at least {MIN_CYCLE_TIME:g} s "
                                 "(but the log's first and last)")
     return values.astype(np.int64)
 
@@ -465,8 +448,8 @@ def torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
 
 def acceleration(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Second time derivative of ``x`` by the same Savitzky-Golay filter :func:`read` estimates
-    ``qdd`` with (window :data:`SAVGOL_WINDOW` at the median period, resampled when the period
-    varies): a model signal seen through it can be compared with one made of measured ``qdd``.
+    ``qdd`` with (window :data:`~faultgen.derivatives.SAVGOL_WINDOW` at the median period, resampled
+    when the period varies): a model signal seen through it can be compared with one made of measured ``qdd``.
 
     Parameters
     ----------

@@ -44,6 +44,18 @@ __all__ = ["RATED_PAYLOAD", "ModelError", "Robot", "drivetrain_of", "from_model"
 #: add`` have one; :attr:`Robot.rated_payload`).
 RATED_PAYLOAD = "rated_payload"
 
+
+def _joint_addresses(names: str, kind: str, what: str) -> cached_property:
+    """A cached property of :class:`Robot`: the ``kind`` address (``qposadr`` or ``dofadr``) of each joint
+    named in its attribute ``names``, ``ndarray of shape (N,)``; ``what`` opens its docstring."""
+
+    def addresses(robot: Robot) -> np.ndarray:
+        return np.array([getattr(robot.model.joint(n), kind)[0] for n in getattr(robot, names)])
+
+    addresses.__doc__ = f"{what}, ``ndarray of shape (N,)``."
+    return cached_property(addresses)
+
+
 @dataclass(frozen=True, eq=False)
 class Robot:
     """A compiled robot model and its nominal parameters, all read from the MJCF.
@@ -178,28 +190,10 @@ class Robot:
         """Number of axes N (5 to 7), read from the model (``joint1`` .. ``jointN``)."""
         return len(self.joint_names)
 
-    def _joint_addresses(self, names: tuple[str, ...], kind: str) -> np.ndarray:
-        return np.array([getattr(self.model.joint(n), kind)[0] for n in names])
-
-    @cached_property
-    def arm_qpos(self) -> np.ndarray:
-        """Indices of the arm joints in ``qpos``, ``ndarray of shape (N,)``."""
-        return self._joint_addresses(self.joint_names, "qposadr")
-
-    @cached_property
-    def arm_dof(self) -> np.ndarray:
-        """Indices of the arm joints in ``qvel``, ``ndarray of shape (N,)``."""
-        return self._joint_addresses(self.joint_names, "dofadr")
-
-    @cached_property
-    def rotor_qpos(self) -> np.ndarray:
-        """Indices of the rotor joints in ``qpos``, ``ndarray of shape (N,)``."""
-        return self._joint_addresses(self.rotor_names, "qposadr")
-
-    @cached_property
-    def rotor_dof(self) -> np.ndarray:
-        """Indices of the rotor joints in ``qvel``, ``ndarray of shape (N,)``."""
-        return self._joint_addresses(self.rotor_names, "dofadr")
+    arm_qpos = _joint_addresses("joint_names", "qposadr", "Indices of the arm joints in ``qpos``")
+    arm_dof = _joint_addresses("joint_names", "dofadr", "Indices of the arm joints in ``qvel``")
+    rotor_qpos = _joint_addresses("rotor_names", "qposadr", "Indices of the rotor joints in ``qpos``")
+    rotor_dof = _joint_addresses("rotor_names", "dofadr", "Indices of the rotor joints in ``qvel``")
 
     def rigid_state(self, q: np.ndarray, qd: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Full-model ``qpos`` and ``qvel`` for arm-side angles with an undeflected gearbox.
@@ -490,49 +484,23 @@ def drivetrain_of(robot: Robot) -> drivetrain.Drivetrain:
 
 
 def from_model(model: mujoco.MjModel, path: Path, spec: mujoco.MjSpec | None = None,
-                digest: str | None = None) -> Robot:
+               digest: str | None = None) -> Robot:
     """The :class:`Robot` of a compiled robot ``model`` (``path`` names it), reading its elements
     and nominal parameters; ``spec``: the spec it was compiled from (kept for derived models);
     ``digest``: its file's SHA-1 (:func:`faultgen.model.robots.load`). Raises ModelError naming
     ``path`` and the missing or malformed element."""
-    def require(kind: str, obj_type: mujoco.mjtObj, element: str) -> int:
-        idx = mujoco.mj_name2id(model, obj_type, element)
-        if idx < 0:
-            raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{n_axes}")
-        return idx
-
     n_axes = axes.count(model)
     if not axes.MIN_AXES <= n_axes <= axes.MAX_AXES:
         raise ModelError(f"{path}: {n_axes} arm joints joint1..joint{n_axes}; a robot has "
                          f"{axes.MIN_AXES}..{axes.MAX_AXES} (joint1, joint2, ... in order)")
-    numbers = range(1, n_axes + 1)
-    joint_names = tuple(f"joint{i}" for i in numbers)
-    rotor_names = tuple(f"rotor{i}" for i in numbers)
-    gearbox_names = tuple(f"gearbox{i}" for i in numbers)
-    actuator_names = tuple(f"motor{i}" for i in numbers)
-
-    gear_ratio = np.empty(n_axes)
-    joint_range = np.empty((n_axes, 2))
-    motor_inertia = np.empty(n_axes)
-    torque_limit = np.empty(n_axes)
-    for k in range(n_axes):
-        j = require("joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
-        r = require("joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
-        t = require("tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
-        a = require("actuator", mujoco.mjtObj.mjOBJ_ACTUATOR, actuator_names[k])
-        gear_ratio[k] = _gear_ratio(model, path, t, j, r)
-        if model.actuator_trnid[a, 0] != r or model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
-            raise ModelError(f"{path}: actuator {actuator_names[k]!r} must drive joint {rotor_names[k]!r}")
-        joint_range[k] = model.jnt_range[j]
-        motor_inertia[k] = model.dof_armature[model.jnt_dofadr[r]]
-        torque_limit[k] = np.max(np.abs(model.actuator_ctrlrange[a]))
+    elements = _axis_elements(model, path, n_axes)
+    joint_names = elements["joint_names"]
     # the motor friction is a registered effect read with the others (MotorFriction.read: the
     # numerics friction1..frictionN, all required); the robot holds it as ``friction``
     effects = read_all(model, path)
     friction = effects.pop(MotorFriction.id)
 
-    tendon_ids = [model.tendon(n).id for n in gearbox_names]
-    key = require("keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
+    key = _require(model, path, n_axes, "keyframe", mujoco.mjtObj.mjOBJ_KEY, "home")
     joint_qpos = [model.jnt_qposadr[model.joint(n).id] for n in joint_names]
     description_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "description")
     description = ""
@@ -549,22 +517,57 @@ def from_model(model: mujoco.MjModel, path: Path, spec: mujoco.MjSpec | None = N
         description=description,
         path=path,
         model=model,
-        joint_names=joint_names,
-        rotor_names=rotor_names,
-        gearbox_names=gearbox_names,
-        actuator_names=actuator_names,
-        gear_ratio=gear_ratio,
-        motor_inertia=motor_inertia,
-        gearbox_stiffness=model.tendon_stiffness[tendon_ids].copy(),
-        gearbox_damping=model.tendon_damping[tendon_ids].copy(),
-        joint_range=joint_range,
-        motor_torque_limit=torque_limit,
+        **elements,
         friction=friction,
         home=model.key_qpos[key, joint_qpos].copy(),
         effects=effects,
         digest=digest,
         _spec=spec,
     )
+
+
+def _require(model: mujoco.MjModel, path: Path, n_axes: int, kind: str, obj_type: mujoco.mjtObj,
+             element: str) -> int:
+    """The id of ``model``'s ``kind`` named ``element``, or ModelError naming ``path`` and it."""
+    idx = mujoco.mj_name2id(model, obj_type, element)
+    if idx < 0:
+        raise ModelError(f"{path}: no {kind} named {element!r}; a robot needs {kind}s 1..{n_axes}")
+    return idx
+
+
+def _axis_elements(model: mujoco.MjModel, path: Path, n_axes: int) -> dict:
+    """The :class:`Robot` fields read per axis: the element names (``joint_names``, ``rotor_names``,
+    ``gearbox_names``, ``actuator_names``, each a tuple of ``n_axes``) and the drivetrain numbers
+    read off those elements (``gear_ratio``, ``motor_inertia``, ``gearbox_stiffness``,
+    ``gearbox_damping``, ``motor_torque_limit``: ndarray of shape (N,); ``joint_range``: (N, 2)).
+    Raises ModelError naming ``path`` and the first missing or malformed element."""
+    numbers = range(1, n_axes + 1)
+    joint_names = tuple(f"joint{i}" for i in numbers)
+    rotor_names = tuple(f"rotor{i}" for i in numbers)
+    gearbox_names = tuple(f"gearbox{i}" for i in numbers)
+    actuator_names = tuple(f"motor{i}" for i in numbers)
+
+    gear_ratio = np.empty(n_axes)
+    joint_range = np.empty((n_axes, 2))
+    motor_inertia = np.empty(n_axes)
+    torque_limit = np.empty(n_axes)
+    for k in range(n_axes):
+        j = _require(model, path, n_axes, "joint", mujoco.mjtObj.mjOBJ_JOINT, joint_names[k])
+        r = _require(model, path, n_axes, "joint", mujoco.mjtObj.mjOBJ_JOINT, rotor_names[k])
+        t = _require(model, path, n_axes, "tendon", mujoco.mjtObj.mjOBJ_TENDON, gearbox_names[k])
+        a = _require(model, path, n_axes, "actuator", mujoco.mjtObj.mjOBJ_ACTUATOR, actuator_names[k])
+        gear_ratio[k] = _gear_ratio(model, path, t, j, r)
+        if model.actuator_trnid[a, 0] != r or model.actuator_trntype[a] != mujoco.mjtTrn.mjTRN_JOINT:
+            raise ModelError(f"{path}: actuator {actuator_names[k]!r} must drive joint {rotor_names[k]!r}")
+        joint_range[k] = model.jnt_range[j]
+        motor_inertia[k] = model.dof_armature[model.jnt_dofadr[r]]
+        torque_limit[k] = np.max(np.abs(model.actuator_ctrlrange[a]))
+    tendon_ids = [model.tendon(n).id for n in gearbox_names]
+    return {"joint_names": joint_names, "rotor_names": rotor_names, "gearbox_names": gearbox_names,
+            "actuator_names": actuator_names, "gear_ratio": gear_ratio, "joint_range": joint_range,
+            "motor_inertia": motor_inertia, "motor_torque_limit": torque_limit,
+            "gearbox_stiffness": model.tendon_stiffness[tendon_ids].copy(),
+            "gearbox_damping": model.tendon_damping[tendon_ids].copy()}
 
 
 def _gear_ratio(model: mujoco.MjModel, path: Path, tendon: int, joint: int, rotor: int) -> float:

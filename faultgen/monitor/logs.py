@@ -20,7 +20,8 @@ import numpy as np
 
 from faultgen import inputs
 from faultgen.data import fleetlogs, logfolder
-from faultgen.logs import formats, jointlog, measured
+from faultgen.logs import formats, measured
+from faultgen.logs.columns import WHOLE_MAX_BYTES
 from faultgen.model.robots import Robot
 from faultgen.monitor import scoring
 from faultgen.monitor import state as stored
@@ -128,10 +129,10 @@ def reading_of(robot: Robot, data: measured.MeasuredData) -> Reading:
 
 
 #: Largest log held in memory to be read once, bytes on disk: the bound a log read whole puts on its
-#: kept cells (:data:`faultgen.logs.jointlog.WHOLE_MAX_BYTES`), so holding its bytes at most
+#: kept cells (:data:`faultgen.logs.columns.WHOLE_MAX_BYTES`), so holding its bytes at most
 #: doubles what reading it takes. A larger log is parsed from its path (its header, size and rows
 #: each opening it) and hashed by another read.
-HOLD_MAX_BYTES = jointlog.WHOLE_MAX_BYTES
+HOLD_MAX_BYTES = WHOLE_MAX_BYTES
 
 
 @dataclass(frozen=True, eq=False)

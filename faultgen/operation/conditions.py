@@ -223,11 +223,8 @@ class TaskMix:
         Tasks of :data:`faultgen.operation.tasks.TASKS` or program / joint log files
         (:func:`faultgen.operation.programs.load`); the run's own task must be one of them.
         A task may be listed more than once to run it more often.
-    pattern : str
-        ``alternate`` (tasks in turn), ``blocks`` (``block`` cycles of each in turn) or ``random``
-        (each cycle a task drawn with equal odds from the run's seed).
-    block : int
-        Cycles per block of the ``blocks`` pattern.
+    pattern, block : str, int
+        How the tasks take turns, as the parts of :class:`Payloads` do.
 
     Raises
     ------

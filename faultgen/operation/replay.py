@@ -38,10 +38,10 @@ A log in another registered format (:mod:`faultgen.logs.formats`, ``--format NAM
 streamed the same way through its adapter's block reader; read whole (at most a row per physics
 step), its columns are replayed by :func:`from_columns` with the same checks and messages.
 
-Refused before any simulation (:class:`faultgen.logs.jointlog.LogError`, a ValueError naming
+Refused before any simulation (:class:`faultgen.logs.columns.LogError`, a ValueError naming
 the file, the row or column and the value): a missing column, a non-finite value, time not
 increasing, a log shorter than :data:`MIN_DURATION`, a gap longer than
-:data:`faultgen.logs.jointlog.MAX_GAP`, a log longer than
+:data:`faultgen.logs.columns.MAX_GAP`, a log longer than
 :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION` (as soon as a block shows it, before the rest
 is read), an angle outside the joint range (by how much), and a motor torque above the drives'
 capacity.
@@ -60,11 +60,11 @@ from scipy.interpolate import CubicSpline
 
 from faultgen.model.robots import Robot
 from faultgen.logs import blocks, formats, jointlog
-from faultgen.logs.jointlog import MAX_GAP, LogError
+from faultgen.logs.columns import MAX_GAP, T_COLUMN, LogError, column_names
 from faultgen.operation.tasks import MAX_CYCLE_DURATION, PLAN_PERIOD, JointPath, Motion
 
 #: Shortest log replayed, s (four filter windows); the longest interval between samples is the
-#: measured-log reader's :data:`faultgen.logs.jointlog.MAX_GAP` (the derivative filter's window).
+#: measured-log reader's :data:`faultgen.logs.columns.MAX_GAP` (the derivative filter's window).
 MIN_DURATION = 0.2
 #: Rows read at a time: a replay's peak memory is that of its reference at the physics step, so its
 #: blocks are smaller than the calibration's (:data:`faultgen.logs.blocks.BLOCK_ROWS`).
@@ -124,13 +124,13 @@ class Replay:
 
         Raises
         ------
-        faultgen.logs.jointlog.LogError
+        faultgen.logs.columns.LogError
             As :func:`read`; also for angles of another number of axes than ``robot``'s.
         """
         n = robot.n_axes
         if motion.q.shape[1] != n:
             raise LogError(f"{motion.source}: {motion.q.shape[1]} angle columns; {robot.name} has {n} axes")
-        columns = {jointlog.T_COLUMN: motion.t, **dict(zip(jointlog.column_names(n)[0], motion.q.T, strict=True))}
+        columns = {T_COLUMN: motion.t, **dict(zip(column_names(n)[0], motion.q.T, strict=True))}
         found = from_columns(columns, lambda i: f"sample {i}", Path(motion.source), robot, limits, check_torque)
         return dataclasses.replace(found, name=motion.name)
 
@@ -145,7 +145,7 @@ class Replay:
 
         Raises
         ------
-        faultgen.logs.jointlog.LogError
+        faultgen.logs.columns.LogError
             If the path leaves the joint ranges or needs more than the drives' torque.
         """
         steps = round(self.duration / dt)
@@ -257,7 +257,7 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
 
     Raises
     ------
-    faultgen.logs.jointlog.LogError
+    faultgen.logs.columns.LogError
         A ValueError naming the file and the row or column: a missing file or column, a non-finite
         value, time that does not increase, a log that is too short, has a gap or runs longer than
         :data:`faultgen.operation.tasks.MAX_CYCLE_DURATION`, or an angle outside the joint ranges.
@@ -275,7 +275,7 @@ def read(path: str | Path, robot: Robot, limits: tuple[np.ndarray, np.ndarray, n
         return from_columns(columns, label, path, robot, limits, check_torque, adapter.suffixes)
     # denser than the physics step: every k-th row kept while read, once every row is checked
     times.check(MIN_DURATION, 1 / MAX_GAP)
-    q_cols = [src.wanted.index(c) for c in jointlog.column_names(n_axes)[0]]
+    q_cols = [src.wanted.index(c) for c in column_names(n_axes)[0]]
     jointlog.check_angles(path, scan.kept[:, q_cols], robot, lambda i: src.label(int(scan.kept_rows[i])), 0.0)
     k = -(-rows // most)
     columns, label = blocks.thinned(src, k, BLOCK_ROWS), lambda i: src.label(i * k)
@@ -305,7 +305,7 @@ def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], pa
 
     Raises
     ------
-    faultgen.logs.jointlog.LogError
+    faultgen.logs.columns.LogError
         As :func:`read`.
     """
     path = Path(path)
@@ -313,12 +313,12 @@ def from_columns(columns: dict[str, np.ndarray], label: Callable[[int], str], pa
     motion = {name: np.asarray(columns[name], dtype=float) for name in wanted}
     jointlog.refuse_non_finite(path, motion, wanted, label)
     times = blocks.TimeScan(path, label, lambda first, last, rows: _check_length(path, first, last))
-    if len(motion[jointlog.T_COLUMN]):  # none: refused by the whole-log checks below, as read() refuses it
-        times.add(0, motion[jointlog.T_COLUMN])
+    if len(motion[T_COLUMN]):  # none: refused by the whole-log checks below, as read() refuses it
+        times.add(0, motion[T_COLUMN])
     most = _most_rows(times, robot)
     if times.rows > most:  # denser than the physics step: every k-th row, as read() keeps of a measured log
         times.check(MIN_DURATION, 1 / MAX_GAP)
-        q = np.column_stack([motion[c] for c in jointlog.column_names(robot.n_axes)[0]])
+        q = np.column_stack([motion[c] for c in column_names(robot.n_axes)[0]])
         jointlog.check_angles(path, q, robot, label, 0.0)
         k = -(-times.rows // most)
         kept = {name: np.ascontiguousarray(values[::k]) for name, values in motion.items()}
