@@ -189,7 +189,7 @@ def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
     from faultgen.monitor import state as stored
     from faultgen.monitor.scoring import Settings
 
-    _, suffixes = fleet_logs.reader_of(None)
+    _, suffixes = fleet_logs.reader_of()
     units = fleet_logs.fleet(fleet / "logs", suffixes)
     found = friction_tests.find(fleet / "logs", units, suffixes)
     if not any(found.values()):
