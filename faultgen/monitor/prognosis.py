@@ -90,7 +90,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 from faultgen.monitor.scoring import NOT_OBSERVABLE, SCALE_UNCERTAINTY
-from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, akaike_weights, expm1_over, fit_models
+from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, expm1_over, fit_models, model_weights
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
@@ -391,7 +391,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             base.verdict = "no trend could be fitted"
             out.append(base)
             continue
-        weights = akaike_weights(fits)
+        weights = model_weights(fits)
         named = named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
         # rows without the filtered wear (a caller's own): the trend's wear now
