@@ -75,11 +75,12 @@ def test_model_weights_leave_the_power_laws_nested_models_out_and_temper_the_res
     expected = [0.0, 1 / (1 + math.exp(-0.5)), 0.0, math.exp(-0.5) / (1 + math.exp(-0.5))]
     np.testing.assert_allclose(trends.model_weights(fits), expected)
     assert trends.WEIGHT_RATE == 0.5
-    # without a power law (every axis but an alarm's source): the line and the exponential, tempered
-    np.testing.assert_allclose(trends.model_weights(fits[:2]), [1 / (1 + math.exp(-0.5)),
-                                                                math.exp(-0.5) / (1 + math.exp(-0.5))])
-    # at rate 1 they are the Akaike weights, as before
-    np.testing.assert_allclose(trends.model_weights(fits[:2], rate=1.0), trends.akaike_weights(fits[:2]))
+    # at rate 1: the Akaike weights of the exponential and the power law (dAICc 2)
+    np.testing.assert_allclose(trends.model_weights(fits, rate=1.0), [0.0, 1 / (1 + math.exp(-1)), 0.0,
+                                                                      math.exp(-1) / (1 + math.exp(-1))])
+    # without a power law (every axis but an alarm's source): the Akaike weights of all, as before
+    np.testing.assert_allclose(trends.model_weights(fits[:3]), trends.akaike_weights(fits[:3]))
+    np.testing.assert_allclose(trends.model_weights(fits[:2]), [1 / (1 + math.exp(-1)), math.exp(-1) / (1 + math.exp(-1))])
     np.testing.assert_allclose(trends.model_weights([_fit("linear", np.inf), _fit("power", np.inf)]), [0.0, 1.0])
 
 

@@ -27,10 +27,15 @@ Per axis:
    each by weighted least squares (``scipy``, weights one over each estimate's variance), written
    with the state now: ``w(t) = w0 + b t`` and ``w(t) = w0 + b (exp(k t) - 1) / k`` (Gebraeel et al.
    2005 with an offset; ``k`` >= 0, an accelerating wear; ``k`` -> 0 is the line).
-   **The model average**: each model's **Akaike weight** (AICc,
-   ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the variances' common
-   scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham & Anderson 2002, ch.
-   2.9), and each model's parameters drawn in proportion to it (:func:`sample_counts`), so that the
+   **The model average** (:func:`faultgen.monitor.trends.model_weights`): each model's **Akaike
+   weight** (AICc, ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the
+   variances' common scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham &
+   Anderson 2002, ch. 2.9); on the source axis (2), since 2026-11-27, the average of the
+   exponential and the power law alone (the power law nests the changepoint trend and the line,
+   which stay fitted to date the rise and name the model), their weights at learning rate 1/2,
+   ``exp(-dAICc / 4)`` (:data:`faultgen.monitor.trends.WEIGHT_RATE`; docs/analysis.md,
+   "Accelerating wear without running late"); and each model's parameters drawn in proportion to
+   its weight (:func:`sample_counts`), so that the
    distribution carries the model uncertainty: where the logs cannot tell a line from an
    accelerating rise, part of the draws accelerate and the interval reaches earlier. ``model``
    in rul.csv names the simplest model within 2 of the least AICc (the rule before the average),

@@ -33,9 +33,11 @@ HINGE_MARGINS = (2, 4)
 #: ("safe") Bayesian updates take it for models that are all wrong (Grunwald & van Ommen 2017,
 #: "Inconsistency of Bayesian inference for misspecified linear models, and a proposal for repairing
 #: it", Bayesian Analysis 12(4); Bissiri, Holmes & Walker 2016): every trend here is wrong about
-#: the estimate (its scale bends with the plant's friction law), and at 1 a difference of 4-6 in
-#: AICc between a line and a rise that extrapolate 10 days apart gave the line 0.6-0.8 of the draws
-#: on accelerating wear (docs/analysis.md, "Accelerating wear without running late").
+#: the estimate (its scale bends with the plant's friction law: on accelerating wear the estimate
+#: rose less steeply than the true wear), and at 1 the power law and the exponential, which
+#: extrapolate 5-10 days apart there, split the draws by AICc differences of a few units that are
+#: the friction law's as much as the wear's. Applied to the source axis's average only
+#: (:func:`model_weights`; docs/analysis.md, "Accelerating wear without running late").
 WEIGHT_RATE = 0.5
 #: How much smaller the exponential's AICc must be for it to be taken over the line (Burnham &
 #: Anderson 2002, ch. 2.6: models within 2 of the best have substantial support; the simpler is kept).
@@ -257,16 +259,19 @@ def akaike_weights(fits: list[Fit], rate: float = 1.0) -> np.ndarray:
 
 
 def model_weights(fits: list[Fit], rate: float = WEIGHT_RATE) -> np.ndarray:
-    """The model average's weights of ``fits`` (:mod:`faultgen.monitor.prognosis`, 3): where the
-    power-law rise is among them, the models it nests get none (the changepoint trend is its ``p`` =
-    1; the line over the block a rise from its start, ``p`` = 1 at the largest age), so the
-    average is the exponential's and the power law's, whose exponent carries the line's and the
-    hinge's shapes with its uncertainty instead of an Occam bonus for a slope that cannot
-    accelerate; the others' weights :func:`akaike_weights` at ``rate`` (:data:`WEIGHT_RATE`). The
-    nested models are still fitted: the hinge dates the rise, and ``model`` names the simplest
-    within 2 of the least AICc (:func:`faultgen.monitor.prognosis.named_model`). Shape (len(fits),)."""
-    nested = any(f.model == "power" for f in fits)
-    kept = [i for i, f in enumerate(fits) if not (nested and f.model in ("linear", "changepoint"))]
+    """The model average's weights of ``fits`` (:mod:`faultgen.monitor.prognosis`, 3). Where the
+    power-law rise is among them (an open alarm's source axis), the models it nests get none (the
+    changepoint trend is its ``p`` = 1; the line over the block nearly a rise from its start, ``p`` =
+    1 at the largest age), so the average is the exponential's and the power law's, whose exponent
+    carries the line's and the hinge's shapes with its uncertainty instead of an Occam bonus for a
+    rise that cannot accelerate, and their weights are :func:`akaike_weights` at ``rate``
+    (:data:`WEIGHT_RATE`); the nested models are still fitted: the hinge dates the rise, and
+    ``model`` names the simplest within 2 of the least AICc
+    (:func:`faultgen.monitor.prognosis.named_model`). Otherwise (the line and the exponential of
+    every other axis) the Akaike weights, as before. Shape (len(fits),)."""
+    if not any(f.model == "power" for f in fits):
+        return akaike_weights(fits)
+    kept = [i for i, f in enumerate(fits) if f.model not in ("linear", "changepoint")]
     out = np.zeros(len(fits))
     out[kept] = akaike_weights([fits[i] for i in kept], rate)
     return out
