@@ -124,7 +124,9 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
     # numbers cover (18 of 19 before)
     assert covered >= 0.8 * numbers and numbers >= 0.75 * draws, (covered, numbers)
     assert named >= 0.8 * draws, named
-    assert np.median(widths["hinge"]) < 0.75 * np.median(widths["from the alarm"]), widths
+    # narrower than from the alarm: 0.80 of it since the power law's exponent carries the hinge's
+    # draws (2026-11-27, docs/_r9_life.md; below 0.75 before)
+    assert np.median(widths["hinge"]) < 0.85 * np.median(widths["from the alarm"]), widths
 
 
 def test_a_hinge_that_does_not_rise_falls_back_to_the_fit_from_the_alarm():
