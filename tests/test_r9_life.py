@@ -50,19 +50,12 @@ def _predict(shape: str, noise: float, seed: int) -> tuple[prognosis.Remaining, 
 
 def _judge(shape: str, noise: float, seeds) -> tuple[int, int, int, list[float]]:
     """Over the ``seeds``: the rows with a number, covering the truth, late by more than 20 %, and
-    each number's median over the true remaining life."""
-    numbers = covered = late = 0
-    ratios = []
-    for seed in seeds:
-        row, truth = _predict(shape, noise, seed)
-        if row.rul is None:
-            assert row.verdict.startswith("not yet predictable"), row.verdict
-            continue
-        numbers += 1
-        covered += rul_scores.covers(row.rul_5, row.rul_95, truth)
-        late += rul_scores.late(row.rul, truth)
-        ratios.append(row.rul / truth)
-    return numbers, covered, late, ratios
+    each number's median over the true remaining life (a row without one is "not yet predictable")."""
+    found = [_predict(shape, noise, seed) for seed in seeds]
+    assert all(r.verdict.startswith("not yet predictable") for r, _ in found if r.rul is None), found
+    found = [(r, truth) for r, truth in found if r.rul is not None]
+    return (len(found), sum(rul_scores.covers(r.rul_5, r.rul_95, truth) for r, truth in found),
+            sum(rul_scores.late(r.rul, truth) for r, truth in found), [r.rul / truth for r, truth in found])
 
 
 def _fit(model: str, aicc: float) -> trends.Fit:
