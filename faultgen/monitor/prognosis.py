@@ -27,10 +27,15 @@ Per axis:
    each by weighted least squares (``scipy``, weights one over each estimate's variance), written
    with the state now: ``w(t) = w0 + b t`` and ``w(t) = w0 + b (exp(k t) - 1) / k`` (Gebraeel et al.
    2005 with an offset; ``k`` >= 0, an accelerating wear; ``k`` -> 0 is the line).
-   **The model average**: each model's **Akaike weight** (AICc,
-   ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the variances' common
-   scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham & Anderson 2002, ch.
-   2.9), and each model's parameters drawn in proportion to it (:func:`sample_counts`), so that the
+   **The model average** (:func:`faultgen.monitor.trends.model_weights`): each model's **Akaike
+   weight** (AICc, ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the
+   variances' common scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham &
+   Anderson 2002, ch. 2.9); on the source axis (2), since 2026-11-27, the average of the
+   exponential and the power law alone (the power law nests the changepoint trend and the line,
+   which stay fitted to date the rise and name the model), their weights at learning rate 1/2,
+   ``exp(-dAICc / 4)`` (:data:`faultgen.monitor.trends.WEIGHT_RATE`; docs/analysis.md,
+   "Accelerating wear without running late"); and each model's parameters drawn in proportion to
+   its weight (:func:`sample_counts`), so that the
    distribution carries the model uncertainty: where the logs cannot tell a line from an
    accelerating rise, part of the draws accelerate and the interval reaches earlier. ``model``
    in rul.csv names the simplest model within 2 of the least AICc (the rule before the average),
@@ -90,7 +95,7 @@ import numpy as np
 
 from faultgen.data import cells, logfolder
 from faultgen.monitor.scoring import NOT_OBSERVABLE, SCALE_UNCERTAINTY
-from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, akaike_weights, expm1_over, fit_models
+from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, expm1_over, fit_models, model_weights
 
 #: Default failure wear, % of the axis's own dry friction: the end of life the remaining life counts to.
 FAILURE_WEAR = 40.0
@@ -391,7 +396,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             base.verdict = "no trend could be fitted"
             out.append(base)
             continue
-        weights = akaike_weights(fits)
+        weights = model_weights(fits)
         named = named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
         # rows without the filtered wear (a caller's own): the trend's wear now

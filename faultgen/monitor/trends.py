@@ -28,6 +28,17 @@ POWER_GRID = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0)
 #: The hinge's changepoint is looked for between the logs this far from either end of the block
 #: (the 3rd log and the 5th from the last: a flat stretch and a rise of at least a few logs each).
 HINGE_MARGINS = (2, 4)
+#: The learning rate of the model average's weights (:func:`model_weights`): each model's weight
+#: ``exp(-WEIGHT_RATE dAICc / 2)`` normalised, the Akaike weights at 1. One half, as the generalised
+#: ("safe") Bayesian updates take it for models that are all wrong (Grunwald & van Ommen 2017,
+#: "Inconsistency of Bayesian inference for misspecified linear models, and a proposal for repairing
+#: it", Bayesian Analysis 12(4); Bissiri, Holmes & Walker 2016): every trend here is wrong about
+#: the estimate (its scale bends with the plant's friction law: on accelerating wear the estimate
+#: rose less steeply than the true wear), and at 1 the power law and the exponential, which
+#: extrapolate 5-10 days apart there, split the draws by AICc differences of a few units that are
+#: the friction law's as much as the wear's. Applied to the source axis's average only
+#: (:func:`model_weights`; docs/analysis.md, "Accelerating wear without running late").
+WEIGHT_RATE = 0.5
 #: How much smaller the exponential's AICc must be for it to be taken over the line (Burnham &
 #: Anderson 2002, ch. 2.6: models within 2 of the best have substantial support; the simpler is kept).
 AICC_MARGIN = 2.0
@@ -229,19 +240,41 @@ def _wls(x: np.ndarray, wear: np.ndarray, weight: np.ndarray):
     return params, np.einsum("mn,n->m", residual**2, weight)
 
 
-def akaike_weights(fits: list[Fit]) -> np.ndarray:
-    """The Akaike weights of ``fits`` (Burnham & Anderson 2002, ch. 2.9): ``exp(-dAICc / 2)``
-    normalised (``scipy.special.softmax``), a fit of infinite AICc weight 0; all equal when none is
-    finite. Shape (len(fits),)."""
+def akaike_weights(fits: list[Fit], rate: float = 1.0) -> np.ndarray:
+    """The Akaike weights of ``fits`` (Burnham & Anderson 2002, ch. 2.9): ``exp(-rate dAICc / 2)``
+    normalised (``scipy.special.softmax``; ``rate`` 1 the Akaike weights, below 1 a tempered
+    likelihood, :data:`WEIGHT_RATE`), a fit of infinite AICc weight 0; all equal when none is
+    finite. Shape (len(fits),). ValueError for a ``rate`` not in (0, 1]."""
     from scipy.special import softmax
 
+    if not 0.0 < rate <= 1.0:
+        raise ValueError(f"rate = {rate!r}: expected the weights' learning rate in (0, 1] (1: the Akaike weights)")
     aicc = np.array([f.aicc for f in fits], dtype=float)
     finite = np.isfinite(aicc)
     if not finite.any():
         return np.full(len(fits), 1.0 / len(fits))
     weights = np.zeros(len(fits))
-    weights[finite] = softmax(-0.5 * (aicc[finite] - aicc[finite].min()))
+    weights[finite] = softmax(-0.5 * rate * (aicc[finite] - aicc[finite].min()))
     return weights
+
+
+def model_weights(fits: list[Fit], rate: float = WEIGHT_RATE) -> np.ndarray:
+    """The model average's weights of ``fits`` (:mod:`faultgen.monitor.prognosis`, 3). Where the
+    power-law rise is among them (an open alarm's source axis), the models it nests get none (the
+    changepoint trend is its ``p`` = 1; the line over the block nearly a rise from its start, ``p`` =
+    1 at the largest age), so the average is the exponential's and the power law's, whose exponent
+    carries the line's and the hinge's shapes with its uncertainty instead of an Occam bonus for a
+    rise that cannot accelerate, and their weights are :func:`akaike_weights` at ``rate``
+    (:data:`WEIGHT_RATE`); the nested models are still fitted: the hinge dates the rise, and
+    ``model`` names the simplest within 2 of the least AICc
+    (:func:`faultgen.monitor.prognosis.named_model`). Otherwise (the line and the exponential of
+    every other axis) the Akaike weights, as before. Shape (len(fits),)."""
+    if not any(f.model == "power" for f in fits):
+        return akaike_weights(fits)
+    kept = [i for i, f in enumerate(fits) if f.model not in ("linear", "changepoint")]
+    out = np.zeros(len(fits))
+    out[kept] = akaike_weights([fits[i] for i in kept], rate)
+    return out
 
 
 def fit_models(t: np.ndarray, wear: np.ndarray, error: np.ndarray, changepoint: bool = False) -> list[Fit]:
