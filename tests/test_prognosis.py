@@ -120,12 +120,12 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
         fit = trends.fit_hinge(t, wear, np.full(70, NOISE))
         assert abs(fit.changepoint - (-30.0)) < 6.0 and abs(fit.params[1] - 0.5) < 0.15, fit
     # a 90 % interval; since the average of the exponential and the power law on the source axis
-    # (2026-11-27, docs/_r9_life.md) 4 of 20 are "not yet predictable" (1 before) and 14 of the 16
+    # (2026-11-27, docs/analysis.md "Accelerating wear without running late") 4 of 20 are "not yet predictable" (1 before) and 14 of the 16
     # numbers cover (18 of 19 before)
     assert covered >= 0.8 * numbers and numbers >= 0.75 * draws, (covered, numbers)
     assert named >= 0.8 * draws, named
     # narrower than from the alarm: 0.80 of it since the power law's exponent carries the hinge's
-    # draws (2026-11-27, docs/_r9_life.md; below 0.75 before)
+    # draws (2026-11-27, docs/analysis.md "Accelerating wear without running late"; below 0.75 before)
     assert np.median(widths["hinge"]) < 0.85 * np.median(widths["from the alarm"]), widths
 
 

@@ -5,7 +5,7 @@ rate 1/2) against values computed by hand, and the remaining life of synthetic r
 of the failure wear is known: an exact quadratic rise's crossing within its interval, noisy
 quadratic rises late less often than under the Akaike weights of every model (the rule before), a
 linear rise not made early by more than a measured factor; the same seed, the same bytes. The check
-against independent fleets is benchmarks/monitor_rul.py (docs/_r9_life.md)."""
+against independent fleets is benchmarks/monitor_rul.py (docs/analysis.md, "Accelerating wear without running late")."""
 
 import datetime
 import math
