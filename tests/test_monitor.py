@@ -66,9 +66,9 @@ def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_hea
 
 def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
     """The fleet again from the same seed: identical logs, byte for byte. Identical outputs from the
-    same logs (alarms, scores, rul, wear, life, units and charts, byte for byte, in a run of its own)
-    are test_two_jobs_give_the_outputs_of_one's and test_new_logs_are_scored_without_redoing_the_old's
-    assertions; a run here on logs equal to the fleet's checked nothing more (docs/performance.md)."""
+    same logs (alarms, scores, rul, wear, life, units and charts, byte for byte, in runs of their own
+    on an empty cache) are test_two_jobs_give_the_outputs_of_one's assertions; a run here on logs
+    equal to the fleet's checked nothing more (docs/performance.md)."""
     robot, first_logs, _ = fleet
     _, logs, _ = independent_fleet.write_fleet(tmp_path / "again", SPEC, robot=robot)
     assert sorted(p.relative_to(logs) for p in logs.rglob("*.csv")) == \
@@ -140,30 +140,6 @@ def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_
             assert float(r["duty_pct_per_day"]) == pytest.approx(np.mean(per_day[-life.WINDOW:]), rel=1e-5)
             assert float(r["consumed_pct"]) > 0 and r["since"] == entries[0]["stamp"] and r["stamp"] == entries[-1]["stamp"]
         assert life.table_cell(mine).split(":")[0] in page
-
-
-def test_new_logs_are_scored_without_redoing_the_old(fleet, monitored, tmp_path):
-    robot, logs, _ = fleet
-    partial = tmp_path / "logs"
-    keep = 25
-    for unit in logs.iterdir():
-        (partial / unit.name).mkdir(parents=True)
-        for log in sorted(unit.iterdir())[:keep]:
-            os.link(log, partial / unit.name / log.name)
-    out = with_cycles_of(monitored, tmp_path / "out")
-    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False)
-    first = (out / "scores.csv").read_text().splitlines()
-    assert len(first) == 1 + SPEC.units * keep
-    for unit in logs.iterdir():  # the rest of the month arrives
-        for log in sorted(unit.iterdir())[keep:]:
-            os.link(log, partial / unit.name / log.name)
-    before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
-    scored = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False).monitors
-    assert all(len(m.rows) == SPEC.days for m in scored)
-    # the old rows are kept as they were, the new ones equal a run over the whole folder at once
-    assert (out / "scores.csv").read_text() == (monitored / "scores.csv").read_text()
-    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
-    assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
 
 
 def test_a_log_older_than_the_last_scored_is_named_and_not_scored(fleet, monitored, tmp_path):
@@ -699,7 +675,9 @@ def test_ur_rtde_recordings_are_monitored_with_their_joint_temperatures(fleet, t
 
 def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     """`--jobs 2` scores groups of units in two processes; the outputs are those of one job, bit
-    for bit, and a rerun after more logs arrived scores only those (issue 60, part 6). The first run
+    for bit, and a rerun after more logs arrived scores only those (issue 60, part 6): the old rows
+    kept as they were, the new ones equal a run over the whole folder at once, no simulated cycle
+    redone (this test took over test_new_logs_are_scored_without_redoing_the_old). The first run
     starts on an empty cache: it simulates the shared twin's cycles in its two worker processes
     (faultgen.monitor.parallel.prepare_twins), not one after another, and they are the one-job run's
     cycle files, byte for byte (this test took over
@@ -713,12 +691,15 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     out = tmp_path / "out"
     loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
                  context=ExecutionContext(jobs=2))
-    for unit in logs.iterdir():
+    assert len((out / "scores.csv").read_text().splitlines()) == 1 + SPEC.units * 30
+    for unit in logs.iterdir():  # the rest of the month arrives
         for log in sorted(unit.iterdir())[30:]:
             os.link(log, partial / unit.name / log.name)
+    before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
     outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
                            context=ExecutionContext(jobs=2))
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
+    assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
     cycles = {p.name: p.read_bytes() for p in (out / ".cache" / "cycles").iterdir()}
     assert cycles == {p.name: p.read_bytes() for p in (monitored / ".cache" / "cycles").iterdir()}
     charts = tuple(p.name for p in monitored.glob("*.png"))
