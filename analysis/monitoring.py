@@ -230,6 +230,19 @@ class PCAMonitor(BaseEstimator):
             return np.eye(P.shape[0]) - P @ P.T
         return (P / self.eigenvalues_[: self.n_components_]) @ P.T
 
+    def _rbc_terms(self, statistic: str, groups) -> tuple:
+        """``(M, groups, inverses)`` of :func:`reconstruction_contributions` for this fit: the index
+        matrix and each group's ``(Xi^T M Xi)^+``, computed once per fit, statistic and groups (a
+        monitor scoring one log at a time asked for the same pseudo-inverses on every log)."""
+        key = (statistic, None if groups is None else tuple(tuple(g.tolist()) for g in groups))
+        cache = self.__dict__.get("_rbc_cache")
+        if cache is None or cache[0] is not self.components_:  # a new fit: new components
+            cache = self.__dict__["_rbc_cache"] = (self.components_, {})
+        if key not in cache[1]:
+            M = self.index_matrix(statistic)
+            cache[1][key] = (M, groups, None if groups is None else group_inverses(M, groups))
+        return cache[1][key]
+
     def contributions(self, X, statistic: str = "q", method: str = "complete", groups=None) -> np.ndarray:
         """Contribution of each feature (or group of features) to Q or T2, for isolating the feature
         behind an alarm.
@@ -280,7 +293,7 @@ class PCAMonitor(BaseEstimator):
         Z, T, E = self._project(X)
         groups = None if groups is None else _check_groups(groups, Z.shape[1])
         if method == "rbc":
-            return reconstruction_contributions(Z, self.index_matrix(statistic), groups)
+            return reconstruction_contributions(Z, *self._rbc_terms(statistic, groups))
         if statistic == "q":
             complete = E**2
         else:
@@ -291,7 +304,15 @@ class PCAMonitor(BaseEstimator):
         return np.stack([squared[:, g].sum(axis=1) for g in groups], axis=1)
 
 
-def reconstruction_contributions(Z, M, groups=None) -> np.ndarray:
+def group_inverses(M, groups) -> list[np.ndarray]:
+    """Each group's ``(Xi^T M Xi)^+`` (:func:`reconstruction_contributions`), in the order of
+    ``groups`` (index sequences, checked)."""
+    M = np.asarray(M, dtype=float)
+    return [np.linalg.pinv(M[np.ix_(g, g)], rcond=1e-12, hermitian=True)
+            for g in _check_groups(groups, M.shape[0])]
+
+
+def reconstruction_contributions(Z, M, groups=None, inverses=None) -> np.ndarray:
     """Reconstruction-based contributions (RBC) of each variable, or group of variables, to the
     fault detection index ``z M z^T`` (Alcala and Qin, Automatica 45 (2009) 1593-1600):
     ``RBC_i = (xi_i^T M z)^2 / (xi_i^T M xi_i)`` for variable ``i``, and ``z M Xi (Xi^T M
@@ -308,6 +329,9 @@ def reconstruction_contributions(Z, M, groups=None) -> np.ndarray:
         Symmetric positive semi-definite matrix of the index (:meth:`PCAMonitor.index_matrix`).
     groups : sequence of index sequences, or None
         Sets of variables reconstructed together; None: each variable alone.
+    inverses : list of ndarray, or None
+        With ``groups``: each group's ``(Xi^T M Xi)^+`` as :func:`group_inverses` gives them
+        (computed here when None).
 
     Returns
     -------
@@ -331,9 +355,10 @@ def reconstruction_contributions(Z, M, groups=None) -> np.ndarray:
         seen = diagonal > tol
         return np.where(seen, MZ**2 / np.where(seen, diagonal, 1.0), 0.0)
     out = np.empty((Z.shape[0], len(groups)))
-    for column, g in enumerate(_check_groups(groups, n)):
+    groups = _check_groups(groups, n)
+    inverses = group_inverses(M, groups) if inverses is None else inverses  # (Xi^T M Xi)^+
+    for column, (g, inverse) in enumerate(zip(groups, inverses, strict=True)):
         A = MZ[:, g]  # Xi^T M z per sample
-        inverse = np.linalg.pinv(M[np.ix_(g, g)], rcond=1e-12, hermitian=True)  # (Xi^T M Xi)^+
         out[:, column] = np.einsum("si,ij,sj->s", A, inverse, A)
     return np.clip(out, 0.0, None)
 

@@ -17,8 +17,14 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 
 FLEETS = {
+    # three units, 36 days: its two healthy units are the regression check of the trend's innovation
+    # gate (docs/analysis.md: one log of a healthy unit of this fleet carried the filtered wear over
+    # the limit without it)
     "irb6700": shipped_fleet.ShippedFleet(robot="irb6700", parts=(15.0, 35.0)),
-    "puma560": shipped_fleet.ShippedFleet(robot="puma560", parts=(1.0, 2.5)),  # rated 2.5 kg
+    # two units, 28 days (the suite's time, docs/performance.md): the healthy unit 01 logs no payload
+    # column, the worn unit 02 wears from day 14 (after the 14 learning logs) to 60 % on day 28
+    "puma560": shipped_fleet.ShippedFleet(robot="puma560", parts=(1.0, 2.5), units=2, days=28,  # rated 2.5 kg
+                                          no_payload=1),
 }
 
 
@@ -29,7 +35,7 @@ def test_the_readmes_monitor_example_on_a_fleet_of_a_shipped_robot(robot, tmp_pa
     assert "payload" not in (logs / shipped_fleet.unit_name(spec.no_payload)).glob("*.csv").__next__().read_text()[:300]
     out = tmp_path / "monitor"
     # the README's command (on the irb6700; the PUMA 560's twins on the nominal model, to keep the
-    # suite short); 36 days of logs, so 14 learning logs and 3 in a row instead of 28 and 5
+    # suite short); 36 days of logs (28 for the PUMA), so 14 learning logs and 3 in a row instead of 28 and 5
     result = CliRunner().invoke(app, ["monitor", str(logs), "--robot", robot, "-o", str(out), "--train", "14",
                                       "--persistence", "3", "--no-progress",
                                       *(["--no-calibrate"] if robot == "puma560" else [])])

@@ -84,6 +84,8 @@ WALK = textwrap.dedent(r'''
         results.append({"file": rel, "exit": done.exit_code, "output": done.output[-600:], "hits": hits[:],
                         "unchanged": copy.read_bytes() == before, "link_kept": (out / rel).is_symlink()})
         hits.clear()
+    # a new OUT with the first run's twin cycles (not simulated again: the run's processes are the check)
+    shutil.copytree(base / ".cache" / "cycles", work / "jobs" / ".cache" / "cycles")
     done = runner.invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(work / "jobs"), "--no-calibrate",
                                "--jobs", "2"])
     report.write_text(json.dumps({"results": results, "starts": starts, "jobs_exit": done.exit_code,

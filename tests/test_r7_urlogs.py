@@ -168,14 +168,16 @@ def test_every_ur_unit_is_on_its_calibrated_twin_and_the_worn_one_alarms_on_its_
 def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_monitored(fleet, tmp_path):
     robot_dir, logs, _ = fleet
     few = tmp_path / "logs"
-    for unit in ("ur-02", "ur-03"):  # the learning logs of two units: enough to tell
+    # the learning logs of one unit: enough to tell (each unit is judged on its own logs; a unit taken
+    # off the monitor and the run going on to the next: tests/test_monitor.py's planted units)
+    for unit in ("ur-02",):
         (few / unit).mkdir(parents=True)
         for log in sorted((logs / unit).iterdir())[:TRAIN + 1]:
             os.link(log, few / unit / log.name)
     result = _monitor(robot_dir, few, tmp_path / "out")
     assert result.exit_code == loop.EXIT_SOME_UNITS_NOT_MONITORED, result.output
     units = _rows(tmp_path / "out" / "units.csv")
-    assert [r["unit"] for r in units] == ["ur-02", "ur-03"]
+    assert [r["unit"] for r in units] == ["ur-02"]
     for row in units:
         assert row["status"] == "not monitored" and row["torque_source"] == formats.COMMANDED_MOMENT
         assert feed.CONSTANT_TORQUE in row["reason"] and "can show no wear" in row["reason"]
