@@ -2,12 +2,17 @@
 
 The "measured" torque is the toolbox's own recursive Newton-Euler (``rne``, its rigid-body
 parameters, reflected motor inertia and Coulomb + viscous friction) along our pick-and-place
-path, four cycles at 250 Hz, with one effect added by the toolbox or by a formula written here
+path, two cycles at 250 Hz, with one effect added by the toolbox or by a formula written here
 (not by our effect classes): a payload (``Puma560.payload``), a Stribeck hump, cogging. Sizes and
 axes are drawn as in :mod:`faultgen.calibrate.synth`; 1 % torque noise and 1e-5 rad encoder
 noise are added. The workflow gets the CSV and the robot name only. The null log and payloads
 with their centre of mass off the flange are in the independent test set
 (tests/test_calibrate_independent.py), along a Fourier excitation.
+
+Two cycles since 2026-11-27 (four before; the held-out part is then most of the second cycle): the
+first step and the bounds held as on four (held-out gap after / before, two cycles against four:
+payload 0.067 / 0.069, the mass within 0.17 % on both; Stribeck 0.053 / 0.047; cogging 0.103 /
+0.105), at half the calibration's time.
 """
 
 import numpy as np
@@ -24,7 +29,7 @@ SEED = 0
 @pytest.fixture(scope="module")
 def path():
     robot = robots.load("puma560")
-    motion, _ = synth.nominal_motion(robot, "pick_place", 4)
+    motion, _ = synth.nominal_motion(robot, "pick_place", 2)
     return robot, motion
 
 
