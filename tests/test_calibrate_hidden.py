@@ -182,9 +182,8 @@ def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
     tie of the search's ranking: payload first before the convergence work (0.2372 -> 0.1191 ->
     0.0129), Coulomb first since (0.2366 -> 0.1304 -> 0.0124; -> 0.0118 since the payload carries
     its inertia; four cycles); on two cycles 0.2438 -> 0.1353 -> 0.0119, mass 2.2085 kg, Coulomb
-    +0.02999 N m; on the one cycle of this test (since 2026-11-27) Coulomb first, then the payload,
-    mass 2.2060 kg, Coulomb +0.02998 N m, the gap after 0.049 of the gap before. Both are found,
-    with their values."""
+    +0.02999 N m; on the one cycle of this test (since 2026-11-27) mass 2.2060 kg, Coulomb
+    +0.02998 N m, the gap after 0.049 of the gap before. Both are found, with their values."""
     robot = robots.load("puma560")
     payload = synth.Hidden.of(robot, "payload", {None: {"mass": 2.2}})
     with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
