@@ -34,7 +34,8 @@ CYCLES = {"effect": 1, "coulomb": 2}
 def path():
     """The robot and its nominal motion along the path, by test (:data:`CYCLES`)."""
     robot = robots.load("puma560")
-    return robot, {test: synth.nominal_motion(robot, "pick_place", cycles)[0] for test, cycles in CYCLES.items()}
+    motions = {test: synth.nominal_motion(robot, "pick_place", cycles)[0] for test, cycles in CYCLES.items()}
+    return robot, motions
 
 
 def toolbox_log(tmp_path, robot, motion, hidden):
