@@ -104,10 +104,10 @@ def figures(monkeypatch):
     return drawn
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def coulomb_log():
     """Three pick-and-place cycles of the PUMA 560 by its inverse dynamics, a Coulomb level
-    raised on axis 3 and 1 % torque noise: the calibration adds one effect."""
+    raised on axis 3 and 1 % torque noise: the calibration adds one effect (read only)."""
     from faultgen import effects
     from faultgen.calibrate import synth
     from faultgen.logs import measured
@@ -120,3 +120,31 @@ def coulomb_log():
     tau = tau + rng.normal(size=tau.shape) * 0.01 * numpy.sqrt(numpy.mean(tau**2, axis=0))
     tau[:, 2] += phi[:, 0] * 0.07
     return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
+
+
+# -- scal (r9): the Coulomb log's calibration, run once per worker ------------------------------
+@pytest.fixture(scope="session")
+def coulomb_calibration(coulomb_log, tmp_path_factory):
+    """``calibrate("puma560", coulomb_log, OUT, use_sysid=False)`` run once per worker for the tests
+    that only read its result and OUT (tests/test_resolve_once.py, tests/test_calibrate_in_memory.py;
+    before, each file ran it): (the result, OUT, the names ``robots.load`` was called with during
+    it, the MJCF files written during it, whatever their name: atomic writes go to a .part file)."""
+    import pathlib
+
+    from faultgen.calibrate import calibrate
+    from faultgen.model import robots
+
+    out = tmp_path_factory.mktemp("coulomb") / "out"
+    calls, writes = [], []
+    load, write_text = robots.load, pathlib.Path.write_text
+
+    def counted(self, data, *args, **kwargs):
+        if "<mujoco" in data:
+            writes.append(self)
+        return write_text(self, data, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(robots, "load", lambda name: calls.append(str(name)) or load(name))
+        patch.setattr(pathlib.Path, "write_text", counted)
+        result = calibrate("puma560", coulomb_log, out, use_sysid=False)
+    return result, out, calls, writes

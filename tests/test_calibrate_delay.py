@@ -7,7 +7,7 @@ whose interval covers 0 and nothing unexplained."""
 import numpy as np
 import pandas as pd
 import pytest
-from independent_set import CASES, make
+from independent_set import CASES, judge, make
 from typer.testing import CliRunner
 
 from faultgen.calibrate import calibrate, delay
@@ -40,8 +40,12 @@ def late_log(tmp_path_factory):
 
 @pytest.mark.parametrize("name", ["puma560-01-none", "irb6700-01-none"])
 def test_a_null_log_has_no_delay_and_nothing_unexplained(tmp_path, name):
-    path, _ = make(case(name), tmp_path)
+    """Also the null case of tests/test_calibrate_independent.py (the same log, the same call, merged
+    here: one calibration): nothing is named."""
+    path, hidden = make(case(name), tmp_path)
     result = calibrate(case(name).robot, path, tmp_path / "out", figure=False)
+    verdict = judge(hidden, result)
+    assert verdict["named"] and result.steps == [], f"hidden {verdict['hidden']}\n{result.summary()}"
     found = result.report()["channel_delay"]
     assert found["estimate"]["covers_zero"] and found["applied_s"] == 0.0, found["line"]
     assert result.unexplained() == [], result.summary()

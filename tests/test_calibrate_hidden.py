@@ -3,18 +3,21 @@
 For every effect id, :mod:`faultgen.calibrate.synth` switches the effect on at a randomly drawn
 size on random axes (seed 0 for every case, fixed before looking at the outcome; one more case,
 IRB-6700-like backlash of seed 4, because it failed in the accuracy benchmark), simulates
-two closed-loop cycles of the pick-and-place task with sensor noise, and writes the measured
-CSV; the workflow gets only that file and the robot name. It must name the hidden effect first,
-on the hidden axes, and cut the held-out total nrmse at least in half. Without a hidden effect
-it must name nothing, on four cycles (more data makes a false finding more likely).
+one or two closed-loop cycles of the pick-and-place task with sensor noise (:data:`TWO_CYCLES`), and
+writes the measured CSV; the workflow gets only that file and the robot name. It must name the
+hidden effect first, on the hidden axes, and cut the held-out total nrmse at least in half. Without
+a hidden effect it must name nothing, on four cycles (more data makes a false finding more likely).
 
 The suite runs each effect on one robot (alternating, so each robot carries half of them), plus
 the case with a robot-specific bound below and the nothing-hidden log of both: one case costs
 25-40 s on this machine at two cycles (45-75 s at four) and the whole grid was two thirds of the
 suite's time. Every effect on both robots and five seeds, on four-cycle logs, is
 ``benchmarks/calibration_accuracy.py`` (docs/calibration.md, "Accuracy on hidden effects"), whose
-seed-0 rows are the cases left out here. At two cycles the held-out part is one cycle; every case
-passed its bound at four cycles too (2026-11-23, before the change to two).
+seed-0 rows are the cases left out here. At two cycles the held-out part is most of the second
+cycle; every case passed its bound at four cycles too (2026-11-23, before the change to two). A
+case whose effect one cycle already shows runs on one (2026-11-27): the held-out part is then the
+last 30 % of that cycle, a part of the motion the fit did not see, and the same bounds hold there
+(:data:`TWO_CYCLES` names the cases that keep two, and why).
 
 Backlash on the PUMA 560 is named but cannot halve the gap: its stiff gearboxes make a dead band
 a small effect on the drive torque (4-9 % of the waist's torque RMS at 5-20 mrad), and the
@@ -45,6 +48,20 @@ CASES.append(("irb6700", "backlash", 4))
 #: The PUMA 560's payload case is calibrated by test_outputs_follow_the_contract_and_the_model_runs,
 #: which holds it to the same checks (one calibration, not two).
 CONTRACT_CASE = ("puma560", "payload", SEED)
+#: Cycles of a case's log: one, but two where one cycle does not show the effect well enough to
+#: name it and halve the gap (2026-11-27, seed 0 unless given): IRB-6700-like cogging (one
+#: cycle: ratio 0.546), PUMA 560 backlash (one cycle: nothing named, the gap before 0.0151 near the
+#: floor) and IRB-6700-like backlash of seed 4 (one cycle: found on axis 2 only, hidden on 1 and 2).
+#: The one-cycle cases passed with their ratio at most 0.17 (PUMA 560 load-dependent friction 0.162,
+#: the others 0.027-0.076).
+TWO_CYCLES = {("irb6700", "cogging", 0), ("puma560", "backlash", 0), ("irb6700", "backlash", 4)}
+
+
+def cycles_of(robot_name, effect, seed):
+    """Cycles of the log of a hidden-effect case (:data:`TWO_CYCLES`)."""
+    return 2 if (robot_name, effect, seed) in TWO_CYCLES else 1
+
+
 #: Required held-out gap ratio (after / before): the issue's "at least in half" ...
 HALF = 0.5
 #: ... except where it cannot be met. PUMA 560 backlash: the floor is more than half the gap
@@ -61,9 +78,11 @@ assert all((robot_name, effect, SEED) in CASES for robot_name, effect in SHORT),
 FLOOR = {"puma560": 0.015, "irb6700": 0.015}
 
 
-def hidden_case(tmp_path, robot_name, effect, seed=SEED, cycles=2, figure=False):
+def hidden_case(tmp_path, robot_name, effect, seed=SEED, cycles=None, figure=False):
     """The hidden effect drawn, its log recorded and calibrated; ``figure``: calibration.png drawn too
-    (only where a test looks at it: about 1.6 s a calibration of six axes)."""
+    (only where a test looks at it: about 1.6 s a calibration of six axes); ``cycles``: the case's own
+    (:func:`cycles_of`) unless given."""
+    cycles = cycles_of(robot_name, effect, seed) if cycles is None else cycles
     robot = robots.load(robot_name)
     hidden = synth.draw(robot, effect, np.random.default_rng(seed))
     path = synth.record(robot, hidden, tmp_path / "measured.csv", seed=seed, cycles=cycles)
@@ -87,7 +106,11 @@ def test_hidden_effect_is_named_on_its_axes_and_the_gap_halves(tmp_path, robot_n
 
 @pytest.mark.parametrize("robot_name", ["puma560", "irb6700"])
 def test_nothing_hidden_names_nothing(tmp_path, robot_name):
+    """Also what test_measured_file_is_what_the_reader_accepts checked (merged here 2026-11-27, on
+    this log instead of a one-cycle log of its own): the log written is what the reader accepts."""
     _, result = hidden_case(tmp_path, robot_name, None, cycles=4)
+    data = measured.read(tmp_path / "measured.csv", robots.load(robot_name))
+    assert data.duration > 7.0 and data.velocity_estimated
     assert result.steps == [], result.summary()
     assert result.gap_before["total_nrmse"] < FLOOR[robot_name]
     assert result.gap_after == result.gap_before
@@ -153,27 +176,21 @@ def test_same_seed_same_bytes(tmp_path):
         (tmp_path / "two" / "model" / "irb6700_calibrated.xml").read_bytes()
 
 
-def test_measured_file_is_what_the_reader_accepts(tmp_path):
-    robot = robots.load("puma560")
-    path = synth.record(robot, synth.Hidden(None), tmp_path / "m.csv", cycles=1, seed=1)
-    data = measured.read(path, robot)
-    assert data.duration > 7.0 and data.velocity_estimated
-
-
 def test_two_hidden_effects_are_found_one_after_the_other(tmp_path):
     """The loop repeats until nothing is significant: a payload and Coulomb friction on axis 5
     (the worked example of docs/calibration.md), and then it stops. Which comes first is a near
     tie of the search's ranking: payload first before the convergence work (0.2372 -> 0.1191 ->
     0.0129), Coulomb first since (0.2366 -> 0.1304 -> 0.0124; -> 0.0118 since the payload carries
-    its inertia; four cycles); on the two cycles of this test 0.2438 -> 0.1353 -> 0.0119, mass
-    2.2085 kg, Coulomb +0.02999 N m. Both are found, with their values."""
+    its inertia; four cycles); on two cycles 0.2438 -> 0.1353 -> 0.0119, mass 2.2085 kg, Coulomb
+    +0.02999 N m; on the one cycle of this test (since 2026-11-27) mass 2.2060 kg, Coulomb
+    +0.02998 N m, the gap after 0.049 of the gap before. Both are found, with their values."""
     robot = robots.load("puma560")
     payload = synth.Hidden.of(robot, "payload", {None: {"mass": 2.2}})
     with_payload = robots.load(synth.write_model(robot, payload, tmp_path / "payload_model"))
     friction = robot.friction  # both of axis 5's Coulomb levels 0.03 N m higher
     coulomb = synth.Hidden.of(robot, "coulomb", {4: {"coulomb_pos": friction.coulomb_pos[4] + 0.03,
                                                      "coulomb_neg": friction.coulomb_neg[4] + 0.03}})
-    path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3, cycles=2)
+    path = synth.record(with_payload, coulomb, tmp_path / "measured.csv", seed=3, cycles=1)
     result = calibrate("puma560", path, tmp_path / "out", figure=False)
     found = {s.effect.id: s for s in result.steps}
     assert sorted((s.effect.id, s.axes) for s in result.steps) == [("coulomb", [4]), ("payload", [0, 1, 2, 3, 4, 5])]

@@ -7,27 +7,18 @@ calibration of the log below wrote MJCF text twice (the forward step's trial, th
 log with two effects many more times (the backfitting and extension trials and their undoing).
 """
 
-import pathlib
-
 import numpy as np
 import pytest
 
 from faultgen import effects
-from faultgen.calibrate import calibrate, predict
+from faultgen.calibrate import predict
 from faultgen.model import robots
 
 
-def test_one_calibration_writes_the_model_file_once(coulomb_log, tmp_path, monkeypatch):
-    writes = []
-    write_text = pathlib.Path.write_text
-
-    def counted(self, data, *args, **kwargs):
-        if "<mujoco" in data:  # an MJCF file, whatever its name (atomic writes go to a .part file)
-            writes.append(self)
-        return write_text(self, data, *args, **kwargs)
-
-    monkeypatch.setattr(pathlib.Path, "write_text", counted)
-    result = calibrate("puma560", coulomb_log, tmp_path / "out", use_sysid=False, figure=False)
+def test_one_calibration_writes_the_model_file_once(coulomb_log, coulomb_calibration):
+    """The Coulomb log's calibration (conftest.py's ``coulomb_calibration``, which counts the MJCF
+    files written during it, whatever their name) writes one model file."""
+    result, _, _, writes = coulomb_calibration
     assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
     assert len(writes) == 1, [str(p) for p in writes]
     # the file written is the model the search judged: loaded back, it predicts what the search kept

@@ -192,21 +192,6 @@ def test_a_written_model_is_the_robot_a_reload_gives_and_a_moved_one_too(tmp_pat
         robots.moved(written, tmp_path / "final" / "arm.xml")
 
 
-@pytest.fixture(scope="module")
-def coulomb_calibration(coulomb_log, tmp_path_factory):
-    """``calibrate("puma560", coulomb_log, OUT)`` run once for the tests below, which only read its
-    result and OUT: (the result, OUT, the names ``robots.load`` was called with during it)."""
-    from faultgen.calibrate import calibrate
-
-    out = tmp_path_factory.mktemp("coulomb") / "out"
-    calls = []
-    load = robots.load
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(robots, "load", lambda name: calls.append(str(name)) or load(name))
-        result = calibrate("puma560", coulomb_log, out, use_sysid=False)
-    return result, out, calls
-
-
 def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(coulomb_log, coulomb_calibration):
     """``calibrate`` resolves the nominal robot once (the public entry) and returns the calibrated
     robot it wrote (``Calibration.model``): before, ``calibrate.loop`` loaded the model file it had
@@ -215,7 +200,7 @@ def test_a_calibration_resolves_its_robot_once_and_returns_the_model_it_wrote(co
 
     from faultgen.calibrate import parameters, predict
 
-    result, out, loads = coulomb_calibration
+    result, out, loads, _ = coulomb_calibration
     assert loads == ["puma560"]
     assert [(s.effect.id, s.axes) for s in result.steps] == [("coulomb", [2])]
     reloaded = robots.load(result.model_out)
