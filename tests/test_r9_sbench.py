@@ -1,6 +1,7 @@
-"""Issue 74 (the suite's time), round 9, the bench, sweep and cluster tests: the bench scorer's ROC
-curves (faultgen.bench.score._roc, the path every bootstrap resample of `faultgen bench score` takes)
-against scikit-learn's, which they replace there, bit for bit."""
+"""Issue 74 (the suite's time), round 9, the bench, sweep and cluster tests: the two library paths
+made faster. The bench scorer's ROC curves (faultgen.bench.score._roc, the path every bootstrap
+resample of `faultgen bench score` takes) against scikit-learn's, which they replace there, bit for
+bit; and a sweep run's garbage collection (faultgen.runs.worker.run_memory)."""
 
 from __future__ import annotations
 
@@ -57,3 +58,34 @@ def test_the_scorers_auroc_of_units_is_sklearns_and_a_non_finite_score_is_named(
     units[0]["scores"][units[0]["mask"].argmax()] = np.nan
     with pytest.raises(ValueError, match="NaN"):
         score._auroc(units)
+
+
+def test_a_runs_cyclic_garbage_is_collected_at_its_end_and_nothing_stays_frozen():
+    """faultgen.runs.worker.run_memory, around every run of a sweep: what was alive before the run is
+    frozen during it (left out of the run's collection), the run's own cyclic garbage is collected when
+    it ends, and everything is thawed after it, also when the run fails."""
+    import gc
+    import weakref
+
+    from faultgen.runs import worker
+
+    class Node:
+        pass
+
+    freed = []
+    old = Node()
+    old.cycle = old
+    weakref.finalize(old, freed.append, "old")
+    assert gc.get_freeze_count() == 0
+    with worker.run_memory():
+        assert gc.get_freeze_count() > 0 and gc.is_tracked(old)
+        made = Node()
+        made.cycle = made
+        weakref.finalize(made, freed.append, "made")
+        del made, old  # both now cyclic garbage: the run's own, and one from before the run
+    assert freed == ["made"] and gc.get_freeze_count() == 0
+    gc.collect()  # thawed: the older garbage goes at the next full collection
+    assert freed == ["made", "old"]
+    with pytest.raises(RuntimeError), worker.run_memory():
+        raise RuntimeError("a run that failed")
+    assert gc.get_freeze_count() == 0
