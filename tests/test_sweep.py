@@ -67,7 +67,7 @@ def test_parallel_jobs_give_the_same_dataset(reference, tmp_path):
 # The small sweep on a Dask cluster on loopback equal to the reference: tests/test_cluster.py's
 # `sweep_and_fleet_equal_the_local_ones` (the command on a `dask scheduler` and two `dask worker` processes
 # on 127.0.0.1) and `a_worker_killed_mid_run_loses_only_that_run_to_another_worker` (the library's
-# ExecutionContext(scheduler=...)); a LocalCluster started here for the same check cost 8 s of CPU.
+# ExecutionContext(scheduler=...)). A LocalCluster started here for the same check is gone.
 
 
 def test_sigkill_then_same_command_finishes_without_redoing_finished_runs(reference, tmp_path):
