@@ -110,14 +110,15 @@ def test_an_exact_prognoser_meets_every_metric_and_is_judged_above_the_naive_one
 
 def test_the_command_writes_the_row_and_the_verdict(small, tmp_path):
     folder, _ = small
-    runner = CliRunner()  # in this process, as the other `bench score` tests run it (2 s of CPU a command less)
+    runner = CliRunner()  # in this process, as the other `bench score` tests run it
     done = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(folder), "--baseline", "linear",
                                "-o", str(tmp_path / "lin")])
     assert done.exit_code == 0, done.output
     assert "| prognostics v2 (small) | linear |" in done.stdout and "verdict: " in done.stdout
     saved = json.loads((tmp_path / "lin.json").read_text())
     assert saved["naive"]["ra_lambda"]["units"] == 3 and saved["verdict"] in done.stdout
-    refused = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(folder), "--baseline", "pca"])
+    refused = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(folder),
+                                  "--baseline", "pca"])
     assert refused.exit_code != 0 and "unknown prognostics baseline 'pca'" in refused.stderr
 
 

@@ -144,7 +144,8 @@ def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_ro
     written again, tied by features, `faultgen monitor --no-calibrate`, scored against the frozen
     manifest; both rows printed and their JSON written."""
     data = shared_bench("sim-to-real")
-    truth = {u.id: u.worn_axis for u in files.attach_labels(files.read(data / "test.h5"), data / "test_labels.csv")}
+    labelled = files.attach_labels(files.read(data / "test.h5"), data / "test_labels.csv")
+    truth = {u.id: u.worn_axis for u in labelled}
     done = subprocess.run([sys.executable, str(ROOT / "benchmarks/twin_baseline.py"), "--track", "sim-to-real",
                            "--data", str(data), "--work", str(tmp_path / "work"), "--no-calibrate",
                            "-o", str(tmp_path / "score-twin")],
@@ -152,7 +153,8 @@ def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_ro
     assert done.returncode == 0, done.stderr[-3000:]
     rows = [line for line in done.stdout.splitlines() if line.startswith("| sim-to-real v2 (small) | twin")]
     assert len(rows) == 2 and rows[0].split(" | ")[2] != "-" and rows[1].split(" | ")[7].endswith("(chance 16.7)")
-    written = [json.loads((tmp_path / f"score-twin-{role}.json").read_text()) for role in ("detector", "isolator")]
+    written = [json.loads((tmp_path / f"score-twin-{role}.json").read_text())
+               for role in ("detector", "isolator")]
     assert all(w["comparable"] is True for w in written)  # the folder is the track's frozen version
     detector, isolator = (w["results"] for w in written)
     assert sorted(u["unit"] for u in detector["per_unit"]) == sorted(k for k, v in truth.items() if v)

@@ -102,8 +102,8 @@ def _figure(units: list, statistic, chance: float | None = None) -> dict:
 def _roc(labels: np.ndarray, scores: np.ndarray, drop_intermediate: bool) -> tuple[np.ndarray, np.ndarray]:
     """The ROC curve (fpr, tpr) of ``scores`` (n,) against binary ``labels`` (n,: 1 or True positive),
     bit for bit what ``sklearn.metrics.roc_curve`` returns for them (its :func:`_interval` resamples
-    spent 95 % of a score in sklearn's input checks: 2.5 s of CPU a detector on the thesis track's test
-    size). The counts of positives and negatives scoring at or above each distinct score are whole
+    spent over 90 % of a score in sklearn's input checks: 2.5 s of CPU a detector on the thesis track's
+    test size). The counts of positives and negatives scoring at or above each distinct score are whole
     numbers, exact in float64 whatever the order of tied scores, and the rates, the dropped collinear
     points and the leading (0, 0) follow sklearn 1.9's ``roc_curve``; tests/test_r9_sbench.py compares
     the two. Needs both classes; a non-finite score goes to sklearn, which names it (ValueError)."""
@@ -112,7 +112,7 @@ def _roc(labels: np.ndarray, scores: np.ndarray, drop_intermediate: bool) -> tup
         fpr, tpr, _ = roc_curve(labels, scores, drop_intermediate=drop_intermediate)
         return fpr, tpr
     order = np.argsort(scores, kind="stable")[::-1]
-    at = np.r_[np.nonzero(np.diff(scores[order]))[0], scores.size - 1]  # the last record of each distinct score
+    at = np.r_[np.nonzero(np.diff(scores[order]))[0], scores.size - 1]  # each distinct score's last record
     tps = np.cumsum(np.asarray(labels, dtype=np.float64)[order] == 1.0, dtype=np.float64)[at]
     fps = 1 + at.astype(np.float64) - tps
     if drop_intermediate and fps.size > 2:
