@@ -6,14 +6,14 @@ known in closed form; the prognoser contract's errors."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from typing import ClassVar
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 from faultgen.bench import baselines, files, independent, make, prognosers, prognostics
+from faultgen.cli import app
 
 
 @pytest.fixture(scope="module")
@@ -110,16 +110,16 @@ def test_an_exact_prognoser_meets_every_metric_and_is_judged_above_the_naive_one
 
 def test_the_command_writes_the_row_and_the_verdict(small, tmp_path):
     folder, _ = small
-    done = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "score", "prognostics", "--data", str(folder),
-                           "--baseline", "linear", "-o", str(tmp_path / "lin")], capture_output=True, text=True,
-                          timeout=600, check=False)
-    assert done.returncode == 0, done.stderr
+    runner = CliRunner()  # in this process, as the other `bench score` tests run it
+    done = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(folder), "--baseline", "linear",
+                               "-o", str(tmp_path / "lin")])
+    assert done.exit_code == 0, done.output
     assert "| prognostics v2 (small) | linear |" in done.stdout and "verdict: " in done.stdout
     saved = json.loads((tmp_path / "lin.json").read_text())
     assert saved["naive"]["ra_lambda"]["units"] == 3 and saved["verdict"] in done.stdout
-    refused = subprocess.run([sys.executable, "-m", "faultgen.cli", "bench", "score", "prognostics", "--data",
-                              str(folder), "--baseline", "pca"], capture_output=True, text=True, timeout=600, check=False)
-    assert refused.returncode != 0 and "unknown prognostics baseline 'pca'" in refused.stderr
+    refused = runner.invoke(app, ["bench", "score", "prognostics", "--data", str(folder),
+                                  "--baseline", "pca"])
+    assert refused.exit_code != 0 and "unknown prognostics baseline 'pca'" in refused.stderr
 
 
 def _unit(uid, law, days, axis, rng, failure=40.0):

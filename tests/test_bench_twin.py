@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from faultgen.bench import files, make, rawlogs, recorded, score, tracks, twin
+from faultgen.bench import files, rawlogs, recorded, score, twin
 from faultgen.operation.conditions import Conditions, Payloads, TaskMix
 from faultgen.simulation import stepping
 
@@ -138,34 +138,25 @@ def test_a_task_mix_run_simulated_task_by_task_gives_the_tracks_cycles():
             np.testing.assert_allclose(part["features"][name], mixed.features[name][part["rows"]], rtol=1e-9, atol=1e-9)
 
 
-def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_row(tmp_path):
-    """The small sim-to-real track's test split (the independent simulator's fleet, written by make's own
-    code, in make's seeded order) and the script on it: the fleet written again, tied by features,
-    `faultgen monitor --no-calibrate`, scored; both rows printed and their JSON written."""
-    recipe = tracks.load("sim-to-real").version(2)
-    sweeps = tmp_path / "made"
-    added = make.add_robots(recipe, sweeps / "robots")
-    units = make._fleet_units(recipe, "test", "small", sweeps, added, progress=False)
-    units = [units[i] for i in make._order("sim-to-real", 2, len(units))]
-    data = tmp_path / "data"
-    data.mkdir()
-    attrs = {"track": "sim-to-real", "version": 2, "size": "small"}
-    for k, unit in enumerate(units):
-        unit.id = f"test-{k:03d}"
-    truth = {u.id: u.worn_axis for u in units}
-    files.write(data / "train.h5", units, {**attrs, "split": "train"})  # the twin reads no train file
-    files.write_labels(data / "test_labels.csv", units)
-    for unit in units:
-        unit.fault_level = unit.worn_axis = unit.fault = None
-    files.write(data / "test.h5", units, {**attrs, "split": "test"})
+def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_row(shared_bench, tmp_path):
+    """The small sim-to-real track as `faultgen bench make` made it (conftest.py's shared_bench: its test
+    split the independent simulator's fleet, in make's seeded order) and the script on it: the fleet
+    written again, tied by features, `faultgen monitor --no-calibrate`, scored against the frozen
+    manifest; both rows printed and their JSON written."""
+    data = shared_bench("sim-to-real")
+    labelled = files.attach_labels(files.read(data / "test.h5"), data / "test_labels.csv")
+    truth = {u.id: u.worn_axis for u in labelled}
     done = subprocess.run([sys.executable, str(ROOT / "benchmarks/twin_baseline.py"), "--track", "sim-to-real",
-                           "--data", str(data), "--work", str(tmp_path / "work"), "--no-calibrate", "--allow-modified"],
+                           "--data", str(data), "--work", str(tmp_path / "work"), "--no-calibrate",
+                           "-o", str(tmp_path / "score-twin")],
                           capture_output=True, text=True, timeout=600, cwd=tmp_path)
     assert done.returncode == 0, done.stderr[-3000:]
     rows = [line for line in done.stdout.splitlines() if line.startswith("| sim-to-real v2 (small) | twin")]
     assert len(rows) == 2 and rows[0].split(" | ")[2] != "-" and rows[1].split(" | ")[7].endswith("(chance 16.7)")
-    detector = json.loads((data / "score-twin-detector.json").read_text())["results"]
-    isolator = json.loads((data / "score-twin-isolator.json").read_text())["results"]
+    written = [json.loads((tmp_path / f"score-twin-{role}.json").read_text())
+               for role in ("detector", "isolator")]
+    assert all(w["comparable"] is True for w in written)  # the folder is the track's frozen version
+    detector, isolator = (w["results"] for w in written)
     assert sorted(u["unit"] for u in detector["per_unit"]) == sorted(k for k, v in truth.items() if v)
     assert {a["unit"]: a["worn_axis"] for a in isolator["per_unit"]} == truth
     # what the twin does on this fleet (seed 2: units wearing axes 1 and 3, one healthy): it names both

@@ -190,6 +190,7 @@ def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder, loca
     result = runner.invoke(app, ["sweep", *SMALL_ARGS, "--scheduler", cluster.address, "--no-progress",
                                  "-o", "out/s.h5"])
     assert result.exit_code == 0, result.output
+    assert cluster.address.startswith("tcp://127.0.0.1:")  # on loopback
     assert f"6 runs -> out/s.h5 on {cluster.address}" in result.output
     went = where_runs_went(result.output)
     assert sorted(went) == dataset.list_runs(reference)

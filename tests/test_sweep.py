@@ -64,16 +64,10 @@ def test_parallel_jobs_give_the_same_dataset(reference, tmp_path):
     assert_same_datasets(reference, out)
 
 
-def test_dask_cluster_on_loopback_gives_the_same_dataset(reference, tmp_path):
-    """A real Dask scheduler and two worker processes on 127.0.0.1."""
-    from distributed import LocalCluster
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster:
-        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
-        out = sweep.run(sweep.Grid(**SMALL), tmp_path / "dask.h5", ExecutionContext(scheduler=cluster.scheduler_address),
-                        progress=False)
-    assert_same_datasets(reference, out)
+# The small sweep on a Dask cluster on loopback equal to the reference: tests/test_cluster.py's
+# `sweep_and_fleet_equal_the_local_ones` (the command on a `dask scheduler` and two `dask worker` processes
+# on 127.0.0.1) and `a_worker_killed_mid_run_loses_only_that_run_to_another_worker` (the library's
+# ExecutionContext(scheduler=...)). A LocalCluster started here for the same check is gone.
 
 
 def test_sigkill_then_same_command_finishes_without_redoing_finished_runs(reference, tmp_path):

@@ -48,7 +48,7 @@ from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.runs.context import ExecutionContext
 from faultgen.runs.errors import SweepError, SweepRefused
-from faultgen.runs.worker import RunStats, release_memory, simulate_and_write
+from faultgen.runs.worker import RunStats, run_memory, simulate_and_write
 from faultgen.simulation import backends, spec
 from faultgen.simulation import stepping as sim
 
@@ -124,13 +124,13 @@ def simulate_remote(run_id: str, config: sim.RunConfig,
     if missing:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker, or run the sweep there")
-    started = time.perf_counter()
-    result = sim.simulate(config, progress=False, stepper=stepper)
-    total = time.perf_counter() - started
-    slim = for_transfer(result)
-    simulated = result.tau_m.shape[0] * result.t[-1]
-    del result
-    release_memory()
+    with run_memory():
+        started = time.perf_counter()
+        result = sim.simulate(config, progress=False, stepper=stepper)
+        total = time.perf_counter() - started
+        slim = for_transfer(result)
+        simulated = result.tau_m.shape[0] * result.t[-1]
+        del result
     return Outcome(slim, get_worker().address, dataset.model_hash(config.model.path), __version__,
                    simulated, total, slim.stepping_time, _peak_memory())
 
