@@ -58,8 +58,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import trapezoid
-from sklearn.metrics import roc_curve
+from sklearn.metrics import roc_auc_score, roc_curve
 
 from analysis import scoring
 from analysis.evaluate import Data, OwnHistory, TrackSplit, evaluate
@@ -99,36 +98,12 @@ def _figure(units: list, statistic, chance: float | None = None) -> dict:
     return out
 
 
-def _roc(labels: np.ndarray, scores: np.ndarray, drop_intermediate: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The ROC curve (fpr, tpr) of ``scores`` (n,) against binary ``labels`` (n,: 1 or True positive),
-    bit for bit what ``sklearn.metrics.roc_curve`` returns for them (its :func:`_interval` resamples
-    spent over 90 % of a score in sklearn's input checks: 2.5 s of CPU a detector on the thesis track's
-    test size). The counts of positives and negatives scoring at or above each distinct score are whole
-    numbers, exact in float64 whatever the order of tied scores, and the rates, the dropped collinear
-    points and the leading (0, 0) follow sklearn 1.9's ``roc_curve``; tests/test_r9_sbench.py compares
-    the two. Needs both classes; a non-finite score goes to sklearn, which names it (ValueError)."""
-    scores = np.asarray(scores, dtype=np.float64 if np.asarray(scores).dtype == bool else None)
-    if not np.isfinite(scores).all():
-        fpr, tpr, _ = roc_curve(labels, scores, drop_intermediate=drop_intermediate)
-        return fpr, tpr
-    order = np.argsort(scores, kind="stable")[::-1]
-    at = np.r_[np.nonzero(np.diff(scores[order]))[0], scores.size - 1]  # each distinct score's last record
-    tps = np.cumsum(np.asarray(labels, dtype=np.float64)[order] == 1.0, dtype=np.float64)[at]
-    fps = 1 + at.astype(np.float64) - tps
-    if drop_intermediate and fps.size > 2:
-        kept = np.r_[True, np.logical_or(np.diff(fps, 2), np.diff(tps, 2)), True]
-        fps, tps = fps[kept], tps[kept]
-    fps, tps = np.r_[0.0, fps], np.r_[0.0, tps]
-    return fps / fps[-1], tps / tps[-1]
-
-
 def _auroc(units: list) -> float:
     scores = np.concatenate([u["scores"][u["mask"]] for u in units])
     labels = np.concatenate([u["positive"][u["mask"]] for u in units])
     if labels.all() or not labels.any():
         return float("nan")
-    fpr, tpr = _roc(labels, scores, drop_intermediate=True)
-    return float(trapezoid(tpr, fpr))  # sklearn.metrics.auc of an increasing fpr
+    return float(roc_auc_score(labels, scores))
 
 
 def _detection_at_far(units: list) -> float:
@@ -141,8 +116,8 @@ def _detection_at_far(units: list) -> float:
     positives = np.concatenate(worn) if worn else np.zeros(0)
     if not negatives.size or not positives.size:
         return float("nan")
-    fpr, tpr = _roc(np.r_[np.zeros(negatives.size), np.ones(positives.size)], np.r_[negatives, positives],
-                    drop_intermediate=False)
+    fpr, tpr, _ = roc_curve(np.r_[np.zeros(negatives.size), np.ones(positives.size)], np.r_[negatives, positives],
+                            drop_intermediate=False)
     last = np.r_[np.diff(fpr) > 0, True]  # per false-positive rate its highest true-positive rate
     return float(np.interp(FAR, fpr[last], tpr[last]))
 

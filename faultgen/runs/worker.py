@@ -176,13 +176,17 @@ def run_memory():
     of objects) is frozen (``gc.freeze``) until the run's collection is done, then thawed
     (``gc.unfreeze``): a full collection over it cost 0.17 s of CPU a run in a process that had
     imported faultgen's commands (a fifth of a 6-run sweep's CPU). An older object that became garbage
-    during the run is left to Python's next automatic collection, as between runs."""
-    gc.freeze()
+    during the run is left to Python's next automatic collection, as between runs. Where the process
+    had frozen objects of its own, they are left as they are and the collection is a full one."""
+    own = not gc.get_freeze_count()
+    if own:
+        gc.freeze()
     try:
         yield
     finally:
         release_memory()
-        gc.unfreeze()
+        if own:
+            gc.unfreeze()
 
 
 def release_memory() -> None:
