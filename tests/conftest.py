@@ -120,3 +120,33 @@ def coulomb_log():
     tau = tau + rng.normal(size=tau.shape) * 0.01 * numpy.sqrt(numpy.mean(tau**2, axis=0))
     tau[:, 2] += phi[:, 0] * 0.07
     return measured.from_arrays(motion.t, motion.q, tau, robot=robot, qd=motion.qd)
+
+
+# -- shelp (r9): a fleet made by the `faultgen fleet` command, once per session ------------------------
+
+@pytest.fixture(scope="session")
+def shared_fleet_command(tmp_path_factory, worker_id):
+    """``shared_fleet_command(*options)``: ``(path, output)``: the fleet ``faultgen fleet OPTIONS
+    --jobs 1 --no-progress -o PATH`` writes, and what the command printed, run in the test process
+    once per test session, as :func:`shared_sweep` builds sweeps (tests/test_new_user.py's small
+    fleet and tests/test_reader.py's fleet are the same command: each built it before). Tests only
+    read the file; one that writes beside it copies it."""
+    import re
+
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+
+    folder = shared_folder(tmp_path_factory, worker_id, "shared-fleet-commands")
+
+    def build(*options: str) -> tuple[Path, str]:
+        name = "fleet" + re.sub(r"[^A-Za-z0-9]+", "-", " ".join(options))
+        out, printed = folder / f"{name}.h5", folder / f"{name}.out"
+        with FileLock(folder / f"{name}.build-lock"):
+            if not printed.exists():
+                result = CliRunner().invoke(app, ["fleet", *options, "--jobs", "1", "--no-progress", "-o", str(out)])
+                assert result.exit_code == 0, result.output
+                printed.write_text(result.output)
+        return out, printed.read_text()
+
+    return build
