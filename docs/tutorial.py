@@ -30,12 +30,12 @@ print(f"faultgen {faultgen.__version__}, {'tiny grid' if TINY else 'quick preset
 #
 # The quick preset: the IRB-6700-like robot doing each task with no wear and with each axis
 # worn by 20 % on the exp4 schedule over 100 cycles, every tenth cycle recorded. The tiny grid:
-# one task, no wear and two worn axes, two seeds (two units), 24 cycles.
+# one task, no wear and two worn axes, two seeds (two units), 12 cycles.
 
 # %%
 if TINY:
     grid = faultgen.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], increases=[20.0],
-                         schedules=["exp4"], cycles=24, record="all", seeds=[0, 1])
+                         schedules=["exp4"], cycles=12, record="all", seeds=[0, 1])
 else:
     grid = faultgen.Grid.from_preset("quick")
 path = faultgen.run_sweep(grid, "tutorial.h5", context=faultgen.ExecutionContext(jobs=2 if not TINY else 1),
