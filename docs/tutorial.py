@@ -116,8 +116,8 @@ print(benchmark.detection_advice(detected) or "no notes: the table stands as it 
 # from scores far above 0.5. So each row's chance level is measured (lr with the runs' labels
 # exchanged 19 times: column `chance`), lr's AUC gets its permutation p-value, and
 # `above_chance` says whether it beats chance at the 5 % level. High AUCs can still be at
-# chance (the tiny grid printed lr 0.95-1.00 against a chance level of 0.85-0.87, p 0.1 and
-# 0.65 on 2026-11-24): the verdict line says so, and what would help.
+# chance (the tiny grid printed lr 0.98-1.00 against a chance level of 0.92-0.93, p 0.15 and
+# 0.2 on 2026-11-27): the verdict line says so, and what would help.
 
 # %%
 table = benchmark.classification_table(path, classifiers=["lr", "svm"], preprocessing=["control", "+diff"],
