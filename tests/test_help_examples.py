@@ -100,10 +100,13 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     return [*argv, *extra]
 
 
-def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path], bench=None) -> None:
+def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path], bench=None,
+             fleets=None) -> None:
     """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments.
     ``bench``: conftest.py's ``shared_bench``, whose folders are made by the command a ``bench make``
-    line becomes here when it gives no other option (``bench make TRACK --size small -o OUT``)."""
+    line becomes here when it gives no other option (``bench make TRACK --size small -o OUT``).
+    ``fleets``: conftest.py's ``shared_fleet_command``, which runs a ``fleet`` line's command (its
+    options, the small-data ones last) once per session for the pages and test files that run it."""
     for part in line.split("&&"):
         words = shlex.split(part, comments=True)
         target = None
@@ -128,6 +131,10 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             # without the score-NAME outputs other tests added
             shutil.copytree(bench(argv[2]), options["-o"], ignore=shutil.ignore_patterns("score-*", ".*"))
             continue
+        fleet = fleet_options(argv) if fleets is not None else None
+        if fleet is not None:
+            shutil.copy(fleets(*[word for option in fleet.items() for word in option])[0], outputs[0])
+            continue
         if words[1:3] == ["bench", "make"]:  # as a command: it starts itself again in the track's numeric profile
             done = subprocess.run([sys.executable, "-m", "faultgen.cli", *argv],
                                   check=False, capture_output=True, text=True, timeout=600)
@@ -139,6 +146,23 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             output = result.output
         if target:
             Path(target).write_text(output)
+
+
+def fleet_options(argv: list[str]) -> dict[str, str] | None:
+    """The options of a ``fleet`` command line ``argv`` (after :func:`small`) but ``-o`` and ``--jobs 1``,
+    one value each, as click reads them (an option given again by the small-data options: its last
+    value); None for a line that conftest.py's ``shared_fleet_command`` does not run so (a scheduler,
+    another ``--jobs``, a flag or an option given twice by the example itself)."""
+    names = argv[1::2]
+    if argv[0] != "fleet" or "--scheduler" in argv or not len(argv) % 2 or not all(n.startswith("-") for n in names):
+        return None
+    if {name for name in names if names.count(name) > 1} - {"--robots", "--days", "--cycles-per-day"}:
+        return None
+    options = dict(zip(names, argv[2::2], strict=True))
+    if options.pop("--jobs", None) != "1" or "-o" not in options:
+        return None
+    options.pop("-o")
+    return options
 
 
 # -- what the docs tell a user to make before the examples ------------------------------------------
@@ -210,7 +234,7 @@ def test_every_help_page_has_examples_and_they_are_all_read():
 
 
 @pytest.mark.parametrize("page", sorted(PAGES))
-def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, monkeypatch):
+def test_the_examples_of_a_help_page_run(page, made, shared_bench, shared_fleet_command, tmp_path, monkeypatch):
     lines = PAGES[page]
     needed = {word for line in lines for word in re.split(r"[\s:/=]+", line) if word in MADE}
     needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
@@ -228,7 +252,7 @@ def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, mon
         scheduler = cluster.scheduler_address
     try:
         for line in lines:
-            run_line(line, page, scheduler, made_files, shared_bench)
+            run_line(line, page, scheduler, made_files, shared_bench, shared_fleet_command)
     finally:
         if scheduler:
             cluster.close()
