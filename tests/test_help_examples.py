@@ -11,6 +11,9 @@ kept small (:data:`SMALL`, appended: click takes an option's last value): a ``si
 regression alone), ``training-source``, ``excitation`` and ``hidden-log`` do less work; a ``sweep``,
 ``fleet`` or ``classify`` that does not choose ``--jobs`` runs in the test's process. The rest of
 each command line is the example's own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+A ``fleet`` line's command runs through conftest.py's ``shared_fleet_command``: once per session for the
+pages and test files that run the same one. ``sweep --preset j2 --jobs 2 -o j2.h5`` gets the j2.h5 that its
+documented command made (a sweep's bits do not depend on ``--jobs``).
 """
 
 from __future__ import annotations
@@ -120,8 +123,10 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             path = Path(produced)  # the example makes it: a file the docs' earlier step made is remade here
             if path.is_file():
                 path.unlink()
-        same = [name for name in outputs if name in made_files and shlex.split(MADE[name]) == words]
+        same = [name for name in outputs if name in made_files and without_jobs(shlex.split(MADE[name])) == without_jobs(words)]
         if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
+            # (--jobs aside: `sweep --preset j2 --jobs 2` makes j2.h5's bits on any number of jobs, which
+            # tests/test_sweep.py's test_parallel_jobs_give_the_same_dataset checks on 2 jobs against 1)
             shutil.copy(made_files[same[0]], same[0])
             continue
         argv = small(words[1:], page, scheduler)
@@ -148,6 +153,14 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             output = result.output
         if target:
             Path(target).write_text(output)
+
+
+def without_jobs(words: list[str]) -> list[str]:
+    """A ``sweep`` command's ``words`` without its ``--jobs N`` (other commands' words as they are)."""
+    if "sweep" not in words[:2] or "--jobs" not in words:
+        return words
+    at = words.index("--jobs")
+    return words[:at] + words[at + 2:]
 
 
 def fleet_options(argv: list[str]) -> dict[str, str] | None:
