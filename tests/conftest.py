@@ -133,6 +133,7 @@ def shared_fleet_command(tmp_path_factory, worker_id):
     two test files made with the same command (test_new_user.py and test_reader.py; test_fleet.py
     and the fleet page of test_help_examples.py) are made once. Tests only read the file; one that
     writes beside it copies it."""
+    import hashlib
     import re
 
     from typer.testing import CliRunner
@@ -145,7 +146,8 @@ def shared_fleet_command(tmp_path_factory, worker_id):
         pairs = dict(zip(options[::2], options[1::2], strict=True))
         assert len(pairs) * 2 == len(options) and all(name.startswith("--") for name in pairs), options
         argv = [word for name in sorted(pairs) for word in (name, pairs[name])]
-        name = "fleet" + re.sub(r"[^A-Za-z0-9.]+", "-", " ".join(argv))
+        digest = hashlib.sha256("\0".join(argv).encode()).hexdigest()[:12]  # names that fold alike stay apart
+        name = "fleet" + re.sub(r"[^A-Za-z0-9.]+", "-", " ".join(argv))[:80] + "-" + digest
         out, printed = folder / f"{name}.h5", folder / f"{name}.out"
         with FileLock(folder / f"{name}.build-lock"):
             if not printed.exists():
