@@ -30,12 +30,12 @@ print(f"faultgen {faultgen.__version__}, {'tiny grid' if TINY else 'quick preset
 #
 # The quick preset: the IRB-6700-like robot doing each task with no wear and with each axis
 # worn by 20 % on the exp4 schedule over 100 cycles, every tenth cycle recorded. The tiny grid:
-# one task, no wear and two worn axes, two seeds (two units), 24 cycles.
+# one task, no wear and two worn axes, two seeds (two units), 12 cycles.
 
 # %%
 if TINY:
     grid = faultgen.Grid(robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], increases=[20.0],
-                         schedules=["exp4"], cycles=24, record="all", seeds=[0, 1])
+                         schedules=["exp4"], cycles=12, record="all", seeds=[0, 1])
 else:
     grid = faultgen.Grid.from_preset("quick")
 path = faultgen.run_sweep(grid, "tutorial.h5", context=faultgen.ExecutionContext(jobs=2 if not TINY else 1),
@@ -116,8 +116,8 @@ print(benchmark.detection_advice(detected) or "no notes: the table stands as it 
 # from scores far above 0.5. So each row's chance level is measured (lr with the runs' labels
 # exchanged 19 times: column `chance`), lr's AUC gets its permutation p-value, and
 # `above_chance` says whether it beats chance at the 5 % level. High AUCs can still be at
-# chance (the tiny grid printed lr 0.95-1.00 against a chance level of 0.85-0.87, p 0.1 and
-# 0.65 on 2026-11-24): the verdict line says so, and what would help.
+# chance (the tiny grid printed lr 0.98-1.00 against a chance level of 0.92-0.93, p 0.15 and
+# 0.2 on 2026-11-27): the verdict line says so, and what would help.
 
 # %%
 table = benchmark.classification_table(path, classifiers=["lr", "svm"], preprocessing=["control", "+diff"],

@@ -148,3 +148,40 @@ def coulomb_calibration(coulomb_log, tmp_path_factory):
         patch.setattr(pathlib.Path, "write_text", counted)
         result = calibrate("puma560", coulomb_log, out, use_sysid=False)
     return result, out, calls, writes
+
+
+# -- shelp (r9): a fleet made by the `faultgen fleet` command, once per session ------------------------
+
+@pytest.fixture(scope="session")
+def shared_fleet_command(tmp_path_factory, worker_id):
+    """``shared_fleet_command(*options)``: ``(path, output)``: the fleet ``faultgen fleet OPTIONS
+    --jobs 1 --no-progress -o PATH`` writes, and what the command printed, run in the test process
+    once per test session, as :func:`shared_sweep` builds sweeps. ``options``: pairs of an option
+    and its value, each option once; their order does not matter (the same fleet). The fleets that
+    two test files made with the same command (test_new_user.py and test_reader.py; test_fleet.py
+    and the fleet page of test_help_examples.py) are made once. Tests only read the file; one that
+    writes beside it copies it."""
+    import hashlib
+    import re
+
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+
+    folder = shared_folder(tmp_path_factory, worker_id, "shared-fleet-commands")
+
+    def build(*options: str) -> tuple[Path, str]:
+        pairs = dict(zip(options[::2], options[1::2], strict=True))
+        assert len(pairs) * 2 == len(options) and all(name.startswith("--") for name in pairs), options
+        argv = [word for name in sorted(pairs) for word in (name, pairs[name])]
+        digest = hashlib.sha256("\0".join(argv).encode()).hexdigest()[:12]  # names that fold alike stay apart
+        name = "fleet" + re.sub(r"[^A-Za-z0-9.]+", "-", " ".join(argv))[:80] + "-" + digest
+        out, printed = folder / f"{name}.h5", folder / f"{name}.out"
+        with FileLock(folder / f"{name}.build-lock"):
+            if not printed.exists():
+                result = CliRunner().invoke(app, ["fleet", *argv, "--jobs", "1", "--no-progress", "-o", str(out)])
+                assert result.exit_code == 0, result.output
+                printed.write_text(result.output)
+        return out, printed.read_text()
+
+    return build

@@ -132,7 +132,7 @@ def test_a_small_fleet_runs_validates_and_repeats_bit_for_bit(tmp_path, shared_f
             np.testing.assert_array_equal(first[name], again[name], err_msg=name)
 
 
-def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path):
+def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(shared_fleet_command):
     """--gear-loss adds each unit's gear loss to its spread and changes nothing else the fleet
     draws; the default fleet's settings are stored as before; each robot's file carries its
     unit's draw, and the small fleet validates."""
@@ -141,11 +141,10 @@ def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path)
         assert other["conditions"]["spread"].pop("gear_loss") == 0.1
         assert one == other
     assert "gear_loss" not in json.loads(Fleet().to_json())["fleet"]
-    out = tmp_path / "lossy.h5"
-    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
-                                      "--friction", "stribeck", "--gear-loss", "0.1", "--jobs", "1", "--no-progress",
-                                      "-o", str(out)])
-    assert result.exit_code == 0, result.output
+    # the command (--jobs 1), run once for this test and the fleet page's example (test_help_examples.py);
+    # 2 robots: 1 failing
+    out, _ = shared_fleet_command("--robots", "2", "--days", "6", "--cycles-per-day", "1", "--friction", "stribeck",
+                                  "--gear-loss", "0.1")
     assert dataset.validate(out) == []
     fleet = Fleet(size=2, failing=1, days=6, cycles_per_day=1, friction="stribeck", gear_loss=0.1)
     for run_id, config in fleet.runs():
@@ -154,7 +153,7 @@ def test_a_fleet_with_a_gear_loss_keeps_every_other_draw_and_labels_it(tmp_path)
         assert config.friction == "stribeck" and np.all(arrays["gear_loss"] > 0)
 
 
-def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(tmp_path):
+def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(shared_fleet_command):
     """--fault: each failing robot's drawn axis gets the fault instead of friction wear, growing on
     exp4 from its drawn onset day to FINAL on the failure day; the healthy robots, every draw and
     the default fleet's stored settings are unchanged; the file validates and labels the fault's
@@ -169,10 +168,9 @@ def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(tm
         onset = (robot["onset_day"] - 1) * 2
         assert (config.fault.effect, config.fault.axis, config.fault.kind) == ("backlash", robot["axis"], "exp4")
         assert config.fault.values(np.array([0, onset, config.cycles])) == pytest.approx([0.0, 0.0, 0.01])
-    out = tmp_path / "backlash.h5"
-    result = CliRunner().invoke(app, ["fleet", "--robots", "2", "--failing", "1", "--days", "6", "--cycles-per-day", "1",
-                                      "--fault", "backlash:each:width:0.01", "--jobs", "1", "--no-progress", "-o", str(out)])
-    assert result.exit_code == 0, result.output
+    # the command (--jobs 1), run once for this test and the fleet page's example; 2 robots: 1 failing
+    out, _ = shared_fleet_command("--robots", "2", "--days", "6", "--cycles-per-day", "1",
+                                  "--fault", "backlash:each:width:0.01")
     assert dataset.validate(out) == []
     small = Fleet(size=2, failing=1, days=6, cycles_per_day=1, fault="backlash:each:width:0.01")
     failing = next((run_id, config) for run_id, config in small.runs() if config.fault is not None)

@@ -165,9 +165,12 @@ ARRAY_EDITS = st.sampled_from(["delete", "text", "group", "external", "huge", "s
 
 @pytest.fixture(scope="module")
 def small(shared_sweep, tmp_path_factory):
-    """The shared small sweep, and a copy of it beside which each edited file is written (the target
-    of the external links and virtual datasets: a file those readers must never open)."""
-    path = shared_sweep("analysis-small", robots=["irb6700"], tasks=["pick_place"], axes=[0, 1, 5], cycles=40)
+    """A shared small sweep, and a copy of it beside which each edited file is written (the target
+    of the external links and virtual datasets: a file those readers must never open). The sweep is
+    tests/test_export.py's (2 runs, 3 recorded cycles each, 2.7 MB: every run array and attribute the
+    40-cycle analysis sweep of 35 MB has, the first run worn), copied once an example."""
+    path = shared_sweep("export-small", robots=["irb6700"], tasks=["spot_weld"], axes=[0, 3], cycles=20,
+                        record=[1, 10, 20])
     folder = tmp_path_factory.mktemp("fuzz-datasets")
     shutil.copy(path, folder / "other.h5")
     return path, folder

@@ -11,6 +11,9 @@ kept small (:data:`SMALL`, appended: click takes an option's last value): a ``si
 regression alone), ``training-source``, ``excitation`` and ``hidden-log`` do less work; a ``sweep``,
 ``fleet`` or ``classify`` that does not choose ``--jobs`` runs in the test's process. The rest of
 each command line is the example's own. A ``--scheduler`` address is replaced by the address of a local Dask cluster.
+A ``fleet`` line's command runs through conftest.py's ``shared_fleet_command``: once per session for the
+pages and test files that run the same one. ``sweep --preset j2 --jobs 2 -o j2.h5`` gets the j2.h5 that its
+documented command made (a sweep's bits do not depend on ``--jobs``).
 """
 
 from __future__ import annotations
@@ -41,12 +44,15 @@ runner = CliRunner()
 SMALL = {"simulate": ["--cycles", "2", "--record", "1-2"], "sweep": ["--cycles", "10", "--record", "1-10"],
          "fleet": ["--robots", "2", "--days", "6", "--cycles-per-day", "1"], "hidden-log": ["--cycles", "1"],
          "excitation": ["--iterations", "1", "--starts", "2"],
-         # three held-out pairs of failing and healthy robots, not every pair (the slowest examples)
-         "classify": ["--pairs", "3"],
+         # one held-out pair of a failing and a healthy robot, not every pair (the slowest examples:
+         # every row's classifiers and its 19 label exchanges still fit and print, on one pair)
+         "classify": ["--pairs", "1"],
          # the thesis's window (40 + 15 + 5 days) on the small fleet's 16
          "training-source": ["--training-days", "8", "--test-days", "4", "--gap-days", "2"]}
-#: The fleets the docs analyse: enough robots and days for classify's leave-pair-out and horizon.
-ANALYSED_FLEETS = {"fleet.h5": ["--robots", "8", "--days", "16", "--cycles-per-day", "1"],
+#: The fleets the docs analyse: enough robots and days for classify's leave-pair-out and horizon (6
+#: robots, 3 failing: with a pair held out, the fewest that leave 5 failed samples to train on; 5 leave
+#: 3, and classify refuses; horizon 3 needs 14 days).
+ANALYSED_FLEETS = {"fleet.h5": ["--robots", "6", "--days", "16", "--cycles-per-day", "1"],
                    "fleet8.h5": ["--robots", "4", "--days", "12", "--cycles-per-day", "1"]}
 
 
@@ -99,10 +105,13 @@ def small(argv: list[str], page: str, scheduler: str | None) -> list[str]:
     return [*argv, *extra]
 
 
-def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path], bench=None) -> None:
+def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, Path], bench=None,
+             fleets=None) -> None:
     """One example line: commands joined by ``&&``, an optional ``> FILE``, ``#`` comments.
     ``bench``: conftest.py's ``shared_bench``, whose folders are made by the command a ``bench make``
-    line becomes here when it gives no other option (``bench make TRACK --size small -o OUT``)."""
+    line becomes here when it gives no other option (``bench make TRACK --size small -o OUT``).
+    ``fleets``: conftest.py's ``shared_fleet_command``, which runs a ``fleet`` line's command (its
+    options, the small-data ones last) once per session for the pages and test files that run it."""
     for part in line.split("&&"):
         words = shlex.split(part, comments=True)
         target = None
@@ -114,8 +123,10 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             path = Path(produced)  # the example makes it: a file the docs' earlier step made is remade here
             if path.is_file():
                 path.unlink()
-        same = [name for name in outputs if name in made_files and shlex.split(MADE[name]) == words]
+        same = [name for name in outputs if name in made_files and without_jobs(shlex.split(MADE[name])) == without_jobs(words)]
         if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
+            # (--jobs aside: `sweep --preset j2 --jobs 2` makes j2.h5's bits on any number of jobs, which
+            # tests/test_sweep.py's test_parallel_jobs_give_the_same_dataset checks on 2 jobs against 1)
             shutil.copy(made_files[same[0]], same[0])
             continue
         argv = small(words[1:], page, scheduler)
@@ -126,6 +137,10 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             # its example, and on any number of jobs a make gives the frozen bits or fails): its folder,
             # without the score-NAME outputs other tests added
             shutil.copytree(bench(argv[2]), options["-o"], ignore=shutil.ignore_patterns("score-*", ".*"))
+            continue
+        fleet = fleet_options(argv) if fleets is not None else None
+        if fleet is not None:
+            shutil.copy(fleets(*[word for option in fleet.items() for word in option])[0], outputs[0])
             continue
         if words[1:3] == ["bench", "make"]:  # as a command: it starts itself again in the track's numeric profile
             done = subprocess.run([sys.executable, "-m", "faultgen.cli", *argv],
@@ -138,6 +153,31 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
             output = result.output
         if target:
             Path(target).write_text(output)
+
+
+def without_jobs(words: list[str]) -> list[str]:
+    """A ``sweep`` command's ``words`` without its ``--jobs N`` (other commands' words as they are)."""
+    if "sweep" not in words[:2] or "--jobs" not in words:
+        return words
+    at = words.index("--jobs")
+    return words[:at] + words[at + 2:]
+
+
+def fleet_options(argv: list[str]) -> dict[str, str] | None:
+    """The options of a ``fleet`` command line ``argv`` (after :func:`small`) but ``-o`` and ``--jobs 1``,
+    one value each, as click reads them (an option given again by the small-data options: its last
+    value); None for a line that conftest.py's ``shared_fleet_command`` does not run so (a scheduler,
+    another ``--jobs``, a flag or an option given twice by the example itself)."""
+    names = argv[1::2]
+    if argv[0] != "fleet" or "--scheduler" in argv or not len(argv) % 2 or not all(n.startswith("-") for n in names):
+        return None
+    if {name for name in names if names.count(name) > 1} - {"--robots", "--days", "--cycles-per-day"}:
+        return None
+    options = dict(zip(names, argv[2::2], strict=True))
+    if options.pop("--jobs", None) != "1" or "-o" not in options:
+        return None
+    options.pop("-o")
+    return options
 
 
 # -- what the docs tell a user to make before the examples ------------------------------------------
@@ -209,7 +249,7 @@ def test_every_help_page_has_examples_and_they_are_all_read():
 
 
 @pytest.mark.parametrize("page", sorted(PAGES))
-def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, monkeypatch):
+def test_the_examples_of_a_help_page_run(page, made, shared_bench, shared_fleet_command, tmp_path, monkeypatch):
     lines = PAGES[page]
     needed = {word for line in lines for word in re.split(r"[\s:/=]+", line) if word in MADE}
     needed |= {"mine.py"} if any("mine:" in line for line in lines) else set()
@@ -227,7 +267,7 @@ def test_the_examples_of_a_help_page_run(page, made, shared_bench, tmp_path, mon
         scheduler = cluster.scheduler_address
     try:
         for line in lines:
-            run_line(line, page, scheduler, made_files, shared_bench)
+            run_line(line, page, scheduler, made_files, shared_bench, shared_fleet_command)
     finally:
         if scheduler:
             cluster.close()

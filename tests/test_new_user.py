@@ -2,6 +2,7 @@
 every command, and a distribution name a user can install."""
 
 import re
+import shutil
 import tomllib
 from pathlib import Path
 
@@ -54,15 +55,15 @@ def test_the_failing_robots_follow_the_fleet_size():
     assert Fleet(size=8, failing=3, days=20).failing == 3
 
 
-def test_a_small_fleet_and_the_detect_it_suggests_run_and_say_their_protocol(tmp_path):
+def test_a_small_fleet_and_the_detect_it_suggests_run_and_say_their_protocol(shared_fleet_command, tmp_path):
     """`faultgen fleet --robots N --days D` (on 41791db: --failing 13 refused any fleet under 14
     robots) and then the `faultgen detect` it suggests (on 41791db: "protocol same-run needs the
     run without wear" on a fleet of 20 days or fewer): auto picks first-cycles, fits --first to
     the fleet's days and says so."""
-    out = tmp_path / "f.h5"
-    result = invoke("fleet", "--robots", "4", "--days", "12", "--cycles-per-day", "1", "--jobs", "1", "-o", str(out))
-    assert result.exit_code == 0, result.output
-    assert f"faultgen detect {out}" in result.output
+    made, printed = shared_fleet_command("--robots", "4", "--days", "12", "--cycles-per-day", "1")  # --jobs 1
+    assert f"faultgen detect {made}" in printed
+    out = tmp_path / "f.h5"  # detect writes beside the fleet: a copy
+    shutil.copy(made, out)
     result = invoke("detect", str(out))
     assert result.exit_code == 0, result.output
     assert ("protocol auto -> first-cycles: a fleet: each robot is a unit of its own and learns its first 6 days"
@@ -158,7 +159,6 @@ def test_the_dataset_docs_snippets_run_and_their_shapes_are_right(shared_sweep, 
     axis 1): every line runs (a name used before it is defined fails), and each expression whose
     comment starts with a shape or a value gives it (on 41791db: run_id undefined, 1712 samples)."""
     import ast
-    import shutil
 
     quick = shared_sweep("docs-quick", **{**sweep.PRESETS["quick"], "tasks": ["pick_place"], "axes": [0, 1]})
     shutil.copy(quick, tmp_path / "quick.h5")
@@ -292,11 +292,13 @@ def test_the_quick_sweeps_time_is_given_in_one_place():
     assert set(places) == {"performance.md"}, places  # its table, and the baseline of its ratio tables
 
 
-def test_the_calibration_example_writes_only_into_its_out_folder(tmp_path):
+def test_the_calibration_example_writes_only_into_its_out_folder(tmp_path, monkeypatch, capfd):
     """`benchmarks/calibration_example.py --out DIR` overwrote the tracked
     docs/images/calibration_example.png (41791db); with a one-cycle log it runs and leaves the
-    checkout as it was."""
+    checkout as it was. The script runs in this process, as `python SCRIPT` runs it (its own
+    `faultgen calibrate` child is a process of its own, as before)."""
     import os
+    import runpy
     import subprocess
     import sys
 
@@ -306,11 +308,12 @@ def test_the_calibration_example_writes_only_into_its_out_folder(tmp_path):
 
     image = ROOT / "docs/images/calibration_example.png"
     before, stamp = status(), image.stat().st_mtime_ns
-    result = subprocess.run([sys.executable, str(ROOT / "benchmarks/calibration_example.py"), "--out", "ex",
-                             "--cycles", "1"], cwd=tmp_path, capture_output=True, text=True,
-                            env={**os.environ,
-                                 "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])})
-    assert result.returncode == 0, result.stdout + result.stderr
-    assert "figure: ex/calibration/calibration.png" in result.stdout
+    script = ROOT / "benchmarks/calibration_example.py"
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "argv", [str(script), "--out", "ex", "--cycles", "1"])
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    capfd.readouterr()
+    runpy.run_path(str(script), run_name="__main__")  # raises if the script or its calibrate fails
+    assert "figure: ex/calibration/calibration.png" in capfd.readouterr().out
     assert (tmp_path / "ex/calibration/report.json").is_file()
     assert image.stat().st_mtime_ns == stamp and status() == before

@@ -19,9 +19,10 @@ def small(shared_sweep):
 
 
 @pytest.fixture(scope="module")
-def fleet(shared_fleet):
-    """Four robots, two failing from a drawn onset day, 24 daily records each."""
-    return shared_fleet("reader-fleet", size=4, failing=2, days=24, cycles_per_day=1)
+def fleet(shared_fleet_command):
+    """Four robots, two failing from a drawn onset day, 12 daily records each (tests/test_new_user.py's
+    small fleet: made once by the command for both)."""
+    return shared_fleet_command("--robots", "4", "--days", "12", "--cycles-per-day", "1")[0]
 
 
 @pytest.mark.parametrize("which", ["small", "fleet"])

@@ -107,15 +107,15 @@ def test_training_source_command_on_a_small_fleet(tmp_path):
     runner = CliRunner()
     fleet = tmp_path / "fleet.h5"
     # seed 0: two IRB robots fail, one IRB and two PUMA robots stay normal, so every cell has cases
-    result = runner.invoke(app, ["fleet", "--robots", "5", "--failing", "2", "--days", "14", "--cycles-per-day", "1",
+    result = runner.invoke(app, ["fleet", "--robots", "5", "--failing", "2", "--days", "10", "--cycles-per-day", "1",
                                  "--jobs", "1", "--no-progress", "-o", str(fleet)])
     assert result.exit_code == 0, result.output
     stem = tmp_path / "ch4"
     refused = runner.invoke(app, ["training-source", str(fleet), "-o", str(stem), "--no-progress"])
     assert refused.exit_code == 2
-    assert "has 14 records, the study needs 60" in refused.output and "faultgen fleet" in refused.output
+    assert "has 10 records, the study needs 60" in refused.output and "faultgen fleet" in refused.output
     assert not list(tmp_path.glob("ch4*"))
-    args = ["training-source", str(fleet), "-o", str(stem), "--training-days", "9", "--test-days", "3", "--gap-days",
+    args = ["training-source", str(fleet), "-o", str(stem), "--training-days", "6", "--test-days", "3", "--gap-days",
             "1", "--no-progress"]
 
     def disk_full(cases, out, marked=None):  # the last of the five writes fails as on a full disk
