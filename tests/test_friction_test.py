@@ -5,23 +5,23 @@ and what the reader refuses."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 
 import numpy as np
 import pandas as pd
 import pytest
+from typer.testing import CliRunner
 
 import faultgen
 import friction_test_log
 from faultgen.calibrate import friction_report, friction_test
+from faultgen.cli import app
 from faultgen.logs import measured
 from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.operation import friction_test as motion
 from faultgen.operation import programs
 
-CLI = [sys.executable, "-m", "faultgen.cli"]
+runner = CliRunner()
 
 
 def _steady_runs(qd: np.ndarray, dt: float) -> list[tuple[float, float]]:
@@ -127,30 +127,29 @@ def test_a_log_without_a_test_is_refused_naming_the_minimum(tmp_path):
 def test_faultgens_own_test_simulated_and_read_end_to_end(tmp_path):
     """`tasks friction-test` writes a short test, `simulate --task` runs it, `friction-test` reads the
     log (arm angle, motor torque x G) and writes its files; the dry and viscous levels agree with the
-    drivetrain's (not independent: the same model simulated and read, a check of the plumbing)."""
+    drivetrain's (not independent: the same model simulated and read, a check of the plumbing). The
+    commands run through the in-process CLI runner, as the refusals below (a child process each only
+    started Python again; tests/capped.py's one_line_refusal checks refusals of `python -m faultgen.cli`)."""
     program, data, log, out = (tmp_path / name for name in ("t.toml", "t.h5", "t.csv", "out"))
-    made = subprocess.run([*CLI, "tasks", "friction-test", "puma560", "--axes", "2", "--speeds", "4", "-o",
-                           str(program)], capture_output=True, text=True, check=False)
-    assert made.returncode == 0 and "friction test of puma560" in made.stdout and " s (" in made.stdout, made.stderr
-    run = subprocess.run([*CLI, "simulate", "--robot", "puma560", "--task", str(program), "--cycles", "1", "-o",
-                          str(data)], capture_output=True, text=True, check=False)
-    assert run.returncode == 0, run.stderr
+    made = runner.invoke(app, ["tasks", "friction-test", "puma560", "--axes", "2", "--speeds", "4", "-o", str(program)])
+    assert made.exit_code == 0 and "friction test of puma560" in made.stdout and " s (" in made.stdout, made.output
+    run = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(program), "--cycles", "1", "-o", str(data)])
+    assert run.exit_code == 0, run.output
     robot = robots.load("puma560")
     recorded = faultgen.open(data).runs[0]
     q, tau = recorded.signal("q_a")[0], recorded.signal("tau_m")[0] * robot.gear_ratio
     logfiles.write_csv(log, np.arange(len(q)) / 250.0, q, tau)
-    read = subprocess.run([*CLI, "friction-test", str(log), "--robot", "puma560", "-o", str(out)],
-                          capture_output=True, text=True, check=False)
-    assert read.returncode == 0, read.stderr
+    read = runner.invoke(app, ["friction-test", str(log), "--robot", "puma560", "-o", str(out)])
+    assert read.exit_code == 0, read.output
     assert "axis 2 (" in read.stdout and "(95 %, arm side)" in read.stdout
     assert sorted(p.name for p in out.iterdir()) == ["friction_axis2.png", "friction_curve.csv", "friction_fit.csv"]
     fit = pd.read_csv(out / "friction_fit.csv").iloc[0]
     G, f = robot.gear_ratio[1], robot.friction
     assert fit["coulomb_Nm"] == pytest.approx(G * (f.coulomb_pos[1] + f.coulomb_neg[1]) / 2, rel=0.02)
     assert fit["viscous_Nms_rad"] == pytest.approx(G**2 * f.viscous[1], rel=0.05)
-    again = subprocess.run([*CLI, "friction-test", str(log), "--robot", "puma560", "-o", str(tmp_path / "again"),
-                            "--reference", str(out)], capture_output=True, text=True, check=False)
-    assert again.returncode == 0, again.stderr
+    again = runner.invoke(app, ["friction-test", str(log), "--robot", "puma560", "-o", str(tmp_path / "again"),
+                                "--reference", str(out)])
+    assert again.exit_code == 0, again.output
 
 
 @pytest.mark.parametrize(("args", "message"), [
@@ -159,13 +158,12 @@ def test_faultgens_own_test_simulated_and_read_end_to_end(tmp_path):
     (["tasks", "friction-test", "puma560", "--speeds", "2"], "error: speeds = 2: expected a whole number"),
 ])
 def test_bad_input_is_refused_in_one_line(args, message):
-    result = subprocess.run([*CLI, *args], capture_output=True, text=True, check=False)
-    assert result.returncode == 2
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, result.output
     assert result.stderr.strip().splitlines() == [result.stderr.strip()] and result.stderr.startswith(message)
 
 
 def test_a_reference_that_is_no_output_folder_is_refused(tmp_path, independent_logs):
-    result = subprocess.run([*CLI, "friction-test", str(independent_logs[20.0]), "--robot", "irb6700", "-o",
-                             str(tmp_path / "o"), "--reference", str(tmp_path)], capture_output=True, text=True,
-                            check=False)
-    assert result.returncode == 2 and "a folder without friction_fit.csv" in result.stderr
+    result = runner.invoke(app, ["friction-test", str(independent_logs[20.0]), "--robot", "irb6700", "-o",
+                                 str(tmp_path / "o"), "--reference", str(tmp_path)])
+    assert result.exit_code == 2 and "a folder without friction_fit.csv" in result.stderr, result.output
