@@ -30,7 +30,7 @@ Per axis:
    **The model average** (:func:`faultgen.monitor.trends.model_weights`): each model's **Akaike
    weight** (AICc, ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the
    variances' common scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham &
-   Anderson 2002, ch. 2.9); on the source axis (2), since 2026-11-27, the average of the
+   Anderson 2002, ch. 2.9); on the source axis (2), the average of the
    exponential and the power law alone (the power law nests the changepoint trend and the line,
    which stay fitted to date the rise and name the model), their weights at learning rate 1/2,
    ``exp(-dAICc / 4)`` (:data:`faultgen.monitor.trends.WEIGHT_RATE`; docs/analysis.md,
