@@ -1,5 +1,6 @@
 """Issue 74 (the suite's time), round 9: a sweep run's garbage collection
-(faultgen.runs.worker.run_memory) looks only at what the run made and leaves nothing frozen."""
+(faultgen.runs.worker.run_memory, through faultgen.collection.young_only) looks only at what the run
+made and leaves nothing frozen; a process's own freeze is left as it is."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import weakref
 
 import pytest
 
+from faultgen import collection
 from faultgen.runs import worker
 
 
@@ -35,3 +37,28 @@ def test_a_runs_cyclic_garbage_is_collected_at_its_end_and_nothing_stays_frozen(
     with pytest.raises(RuntimeError), worker.run_memory():
         raise RuntimeError("a run that failed")
     assert gc.get_freeze_count() == 0
+
+
+def test_a_process_that_froze_its_own_objects_keeps_them_frozen_and_collects_in_full():
+    """Where the process had frozen objects itself, young_only neither freezes more nor thaws them, and
+    a collection inside the block is a full one (a run's garbage still goes at its end)."""
+    class Node:
+        pass
+
+    freed = []
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        with worker.run_memory():
+            assert gc.get_freeze_count() == frozen
+            made = Node()
+            made.cycle = made
+            weakref.finalize(made, freed.append, "made")
+            del made
+        assert freed == ["made"] and gc.get_freeze_count() == frozen
+        with collection.young_only():
+            assert gc.get_freeze_count() == frozen
+        assert gc.get_freeze_count() == frozen
+    finally:
+        gc.unfreeze()
+

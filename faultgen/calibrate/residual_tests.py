@@ -36,14 +36,13 @@ the rule by which the search keeps an axis open.
 
 from __future__ import annotations
 
-import gc
-
 import numpy as np
 from scipy.stats import norm
 from statsmodels.stats.diagnostic import acorr_ljungbox
 from statsmodels.stats.multitest import multipletests
 
 from faultgen import axes as axis_numbers
+from faultgen import collection
 from faultgen.calibrate.criterion import noise_floor
 from faultgen.calibrate.search import ABOVE_FLOOR
 from faultgen.derivatives import savgol_window
@@ -195,21 +194,11 @@ def line(found: dict) -> str:
 
 
 def _holm(pvalues: list[float]) -> tuple:
-    """statsmodels' ``multipletests(pvalues, alpha=LEVEL, method="holm")``, its result unchanged.
-
-    Its Holm branch ends with ``gc.collect()``, a full collection of the calling process: 0.76 s
-    of a 5.3 s calibration (4 calls, a 2-cycle IRB-6700-like log, 2026-11-27), more in a larger
-    process. The objects that exist before the call are frozen during it (``gc.freeze``), so that
-    collection looks only at what the call made; they are handed back to the collector after it
-    (not where the process had frozen objects of its own: those are left as they are).
-    """
-    if gc.get_freeze_count():
+    """statsmodels' ``multipletests(pvalues, alpha=LEVEL, method="holm")``, its result unchanged. Its
+    Holm branch ends with a full ``gc.collect()``; run inside :func:`faultgen.collection.young_only`,
+    that collection looks only at what the call made."""
+    with collection.young_only():
         return multipletests(pvalues, alpha=LEVEL, method="holm")
-    gc.freeze()
-    try:
-        return multipletests(pvalues, alpha=LEVEL, method="holm")
-    finally:
-        gc.unfreeze()
 
 
 def _ljung_box(x: np.ndarray) -> tuple[float, float]:

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from tqdm.auto import tqdm
 
+from faultgen import collection
 from faultgen.data import dataset
 from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
@@ -171,22 +172,13 @@ def quiet_unraisable_interrupts() -> None:
 @contextlib.contextmanager
 def run_memory():
     """Around one run: the run's freed memory given back to the OS at its end (:func:`release_memory`),
-    with the garbage collector looking at the objects made during the run only. What was alive when
-    the run started (modules, prepared models; in a test session or a notebook, hundreds of thousands
-    of objects) is frozen (``gc.freeze``) until the run's collection is done, then thawed
-    (``gc.unfreeze``): a full collection over it cost 0.17 s of CPU a run in a process that had
-    imported faultgen's commands (a fifth of a 6-run sweep's CPU). An older object that became garbage
-    during the run is left to Python's next automatic collection, as between runs. Where the process
-    had frozen objects of its own, they are left as they are and the collection is a full one."""
-    own = not gc.get_freeze_count()
-    if own:
-        gc.freeze()
-    try:
-        yield
-    finally:
-        release_memory()
-        if own:
-            gc.unfreeze()
+    its collection looking at the objects made during the run only (:func:`faultgen.collection.young_only`:
+    what was alive when the run started, modules and prepared models, is left out of it)."""
+    with collection.young_only():
+        try:
+            yield
+        finally:
+            release_memory()
 
 
 def release_memory() -> None:
