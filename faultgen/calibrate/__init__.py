@@ -50,6 +50,7 @@ from faultgen.calibrate.result import Calibration, Step, parameters
 from faultgen.data import atomic
 from faultgen.logs import formats, longlog
 from faultgen.logs import measured as measured_io
+from faultgen.logs.blocks import block_mean
 from faultgen.model import robots
 
 __all__ = ["EFFECTS", "RESIDUAL_TEST_LEVEL", "Calibration", "Effect", "ImplausibleLogError", "Step", "calibrate", "get",
@@ -135,7 +136,7 @@ def decimate(data: measured_io.MeasuredData, rows: int) -> measured_io.MeasuredD
     m = n // k
 
     def blocks(a: np.ndarray) -> np.ndarray:
-        return longlog.block_mean(a, k, m)
+        return block_mean(a, k, m)
 
     note = longlog.decimation_note(n, k, m, MAX_ROWS)
     return measured_io.MeasuredData(t=blocks(data.t), q=blocks(data.q), qd=blocks(data.qd), qdd=blocks(data.qdd),

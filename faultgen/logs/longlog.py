@@ -5,7 +5,7 @@ same way through its adapter's block reader (:meth:`faultgen.logs.formats.LogFor
 the same checks and messages.
 
 ``faultgen calibrate`` works on at most ``rows`` rows: a longer log is averaged over blocks of
-``k = ceil(n / rows)`` samples (:func:`block_mean`). Reading the whole log first and averaging it
+``k = ceil(n / rows)`` samples (:func:`faultgen.logs.blocks.block_mean`). Reading the whole log first and averaging it
 after took 5.7 GB for 10^7 rows. :func:`read` gives the same result in two passes over
 the file, :data:`BLOCK_ROWS` rows at a time:
 
@@ -36,7 +36,6 @@ from faultgen.derivatives import SAVGOL_ORDER, is_uniform, savgol_window
 from faultgen.model import robots
 from faultgen.logs import blocks, jointlog
 from faultgen.logs.columns import column_names
-from faultgen.logs.blocks import block_mean  # noqa: F401 (re-exported)
 
 #: Rows read at a time (:data:`faultgen.logs.blocks.BLOCK_ROWS`; rounded up to a whole
 #: number of averaging blocks).
