@@ -330,14 +330,17 @@ def _propagate(drawn, failure_wear: float, horizon: float):
     return result.time_of_event
 
 
-def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float:
+def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float | None:
     """The relative standard uncertainty of ``axis``'s (1..``n_axes``) wear scale from
     ``scale_uncertainty``: one number for every axis, a mapping axis -> number (an axis not in it
-    gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers.
+    gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers;
+    None for None (no friction test: the twin's log-normal prior, :func:`scale_draws`).
     ValueError naming the value when a number is not in [0, :data:`MAX_SCALE_UNCERTAINTY`] or the
     sequence's length is not ``n_axes``. Above 1 is allowed: a scale read from one or two friction
     tests may be that uncertain (:mod:`faultgen.monitor.friction_tests`); each draw's scale is kept
     at 0.05 or more."""
+    if scale_uncertainty is None:
+        return None
     if isinstance(scale_uncertainty, Mapping):
         for key in scale_uncertainty:
             if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 1 <= key <= n_axes:
@@ -372,17 +375,14 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     trend and the power-law rise over the whole block (module docstring, 2; ``changepoint`` False:
     the line and the exponential of the logs from the alarm on) and is
     fitted from the alarm on when neither rises;
-    ``scale_uncertainty`` the uncertainty of the estimate's scale carried into the time of event
-    (module docstring, 4): None (the default, no friction test) the twin's scale on every axis,
-    log-normal with :data:`TWIN_SCALE_LOG_SD` (:func:`scale_draws`); or a relative standard
-    uncertainty (a friction test's factor's; 0: none): one number for every axis, a mapping axis
-    (1..N) -> number (an axis not in it: :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`) or a
-    sequence of ``n_axes`` numbers (:func:`scale_of_axis`); ``axes`` (1..N) the axes wanted, all when None. A
+    ``scale_uncertainty`` the estimate's scale's (module docstring, 4; :func:`scale_draws`): None (no
+    friction test) log-normal, :data:`TWIN_SCALE_LOG_SD`; else a test's relative one (0: none), one
+    number, a mapping axis (1..N) -> number (an axis not in it: ``scoring.SCALE_UNCERTAINTY``) or
+    ``n_axes`` numbers (:func:`scale_of_axis`); ``axes`` (1..N) the axes wanted, all when None. A
     unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
     check_failure_wear(failure_wear)
     wanted = list(range(1, n_axes + 1)) if axes is None else list(axes)
-    uncertainty = {axis: None if scale_uncertainty is None else scale_of_axis(scale_uncertainty, axis, n_axes)
-                   for axis in wanted}
+    uncertainty = {axis: scale_of_axis(scale_uncertainty, axis, n_axes) for axis in wanted}
     stamp = rows[-1]["stamp"] if rows else ""
     if not rows or "wear1_log" not in rows[0]:
         why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
