@@ -280,7 +280,7 @@ def scale_draws(rng: np.random.Generator, samples: int, scale_uncertainty: float
     test's factor: its error is symmetric about the factor), ones for 0, and ``exp(TWIN_SCALE_LOG_SD
     z)`` for None, the twin's scale without a test: a factor 1/2 as likely as a factor 2, so that a
     wide prior widens the interval both ways and keeps its median at the scale 1 (a normal of the
-    same spread would put 1 draw in 60 below 0.1, a crossing due now, and reach 1.74 at its 95 %
+    same spread would put 1 draw in 44 below 0.1, a crossing due now, and reach 1.74 at its 95 %
     where the log-normal's 5-95 % is 0.48-2.10)."""
     if scale_uncertainty is None:
         return np.exp(TWIN_SCALE_LOG_SD * rng.standard_normal(samples))
