@@ -290,11 +290,12 @@ def scale_draws(rng: np.random.Generator, samples: int, scale_uncertainty: float
 
 
 def time_of_event(fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0,
-                  scale_uncertainty: float = SCALE_UNCERTAINTY, weights=None):
+                  scale_uncertainty: float | None = SCALE_UNCERTAINTY, weights=None):
     """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
     under ``fit`` (a :class:`~faultgen.monitor.trends.Fit`, or a list of them drawn in proportion to
     ``weights``, the model average), the estimate's scale uncertain by ``scale_uncertainty`` (module
-    docstring, 4-5): ``UnweightedSamples`` with key ``failure`` (None beyond ``horizon``)."""
+    docstring, 4-5; None: the twin's log-normal prior, :func:`scale_draws`): ``UnweightedSamples``
+    with key ``failure`` (None beyond ``horizon``)."""
     fits = [fit] if isinstance(fit, Fit) else list(fit)
     drawn, _ = _state_samples(fits, [1.0] * len(fits) if weights is None else weights, samples, seed,
                               scale_uncertainty)
