@@ -269,9 +269,11 @@ def main() -> None:
     parser.add_argument("--from-alarm", action="store_true",
                         help="Fit the alarm's source axis from its alarm on, not with the changepoint trend over its "
                              "whole block (the monitor's rule before 2026-11-26).")
-    parser.add_argument("--scale-uncertainty", type=float, default=prognosis.SCALE_UNCERTAINTY,
+    parser.add_argument("--scale-uncertainty", type=float, default=None,
                         help="Relative standard uncertainty of the wear estimate's scale carried into the time of "
-                             "event (the monitor's, 0.10; 0 as before 2026-11-26).")
+                             "event, drawn normal (0.10 before 2026-11-27; 0 as before 2026-11-26); default: the "
+                             "monitor's, log-normal with faultgen.monitor.prognosis.TWIN_SCALE_LOG_SD without "
+                             "friction tests.")
     parser.add_argument("--scores-only", action="store_true",
                         help="With --fleet and friction tests: fit scores.csv's estimates, each log on the factor "
                              "of its own day, with --scale-uncertainty (the benchmark before 2026-11-27), not the "
@@ -343,7 +345,7 @@ def verdict(ok: bool) -> str:
 
 
 def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool = True,
-             scale_uncertainty: float = prognosis.SCALE_UNCERTAINTY,
+             scale_uncertainty: float | None = None,
              replayed: dict[str, list[dict]] | None = None) -> dict[str, list[dict]]:
     """Score the remaining life of every worn unit of the run ``out`` against ``truth_path`` (module
     docstring); prints a block per unit and the fleet's lines, each figure beside the criterion of

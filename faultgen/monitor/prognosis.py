@@ -45,9 +45,10 @@ Per axis:
    it is above one (the stated standard errors are a floor), sampled (:data:`SAMPLES` draws in all,
    multivariate normal, seeded; the exponential's ``k`` and the power law's ``p`` and ``t0`` kept in
    their bounds) into ProgPy's :class:`progpy.uncertain_data.UnweightedSamples` of the state now,
-   each draw with a **scale** of the wear estimate from a normal of mean 1 and standard deviation
-   ``scale_uncertainty`` (the monitor's :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`, 0.10,
-   without friction tests; per axis where a test gives it): the estimate is the wear times a scale
+   each draw with a **scale** of the wear estimate: without friction tests log-normal, median 1,
+   log standard deviation :data:`TWIN_SCALE_LOG_SD` (0.45: the twin's scale measured across friction
+   laws; :func:`scale_draws`); where a test gives it, per axis, a normal of mean 1 and standard
+   deviation ``scale_uncertainty``, the test's factor's relative error: the estimate is the wear times a scale
    the unit's logs cannot tell, so the wear reaches the failure wear when the estimate reaches
    the failure wear times that scale. More logs average the trend's scatter away, not the scale.
 5. **Propagation**: ProgPy's :class:`progpy.predictors.MonteCarlo` runs each draw through
@@ -66,7 +67,8 @@ Per axis:
    end lies beyond the horizon (the trend cannot bound the life); or (c) two models of weight >=
    :data:`MIN_MODEL_WEIGHT` (0.1) have 5-95 % intervals of their own that do not overlap (the
    models disagree by more than their intervals). A wide interval alone is not "not yet
-   predictable": without a friction test the estimate's scale is uncertain by 10 %, and a life
+   predictable": without a friction test the estimate's scale is uncertain by a factor of about
+   1.6 (one log standard deviation), and a life
    that does not know its scale says so by its width; withholding intervals wider than 3 times
    their median would withhold 4 covering, early answers at lambda on the accelerating fleets. Measured on the independent fleets: docs/analysis.md, "A remaining life
    that does not run late".
@@ -107,6 +109,14 @@ HORIZON = 365.0
 MIN_LOGS = 5
 #: Largest relative standard uncertainty of a wear scale taken (:func:`scale_of_axis`).
 MAX_SCALE_UNCERTAINTY = 10.0
+#: Without a friction test (``scale_uncertainty=None``, the monitor's default): the standard
+#: deviation of the natural log of the wear estimate's scale (the twin's estimate per % of true
+#: wear), drawn log-normal with median 1: the spread of that scale measured on the independent
+#: fleets' friction laws, the root mean square of ``ln(scale)`` over the worn units of the law where
+#: it is widest (exponential hump 0.446 over 8 units; first law 0.101 over 40, Lorentzian hump 0.121
+#: over 24): a new plant's law is not known, so the prior is as wide as the widest law measured
+#: (docs/analysis.md, "A remaining life that knows it does not know its scale").
+TWIN_SCALE_LOG_SD = 0.45
 #: Draws of the fitted parameters propagated to a time of event.
 SAMPLES = 1000
 #: The interval given: 5 and 95 % quantiles of the time of event.
@@ -243,10 +253,12 @@ def _states(fit: Fit, drawn: np.ndarray) -> np.ndarray:
     return states
 
 
-def _state_samples(fits, weights, samples: int, seed: int, scale_uncertainty: float):
+def _state_samples(fits, weights, samples: int, seed: int, scale_uncertainty: float | None):
     """The model average's draws (module docstring, 4): each fit's parameters drawn in proportion to
     its weight (:func:`sample_counts`), with a scale of the wear estimate drawn from a normal of mean
-    1 and standard deviation ``scale_uncertainty`` (at least 0.05), as ProgPy's ``UnweightedSamples``
+    1 and standard deviation ``scale_uncertainty`` (at least 0.05; a friction test's factor), or,
+    where ``scale_uncertainty`` is None (no friction test), log-normal of median 1 and log standard
+    deviation :data:`TWIN_SCALE_LOG_SD` (:func:`scale_draws`), as ProgPy's ``UnweightedSamples``
     of the state now; and each draw's model index (shape (samples,))."""
     import_progpy()
     from progpy.uncertain_data import UnweightedSamples
@@ -256,19 +268,34 @@ def _state_samples(fits, weights, samples: int, seed: int, scale_uncertainty: fl
     states = np.concatenate([_states(f, rng.multivariate_normal(f.params, f.cov, size=c, method="eigh"))
                              for f, c in zip(fits, counts)])
     labels = np.repeat(np.arange(len(fits)), counts)
-    scale = np.maximum(1.0 + scale_uncertainty * rng.standard_normal(samples), 0.05) if scale_uncertainty else \
-        np.ones(samples)
+    scale = scale_draws(rng, samples, scale_uncertainty)
     names = ("wear", "slope", "growth", "age", "power")
     return UnweightedSamples([{**dict(zip(names, map(float, x))), "scale": float(c)}
                               for x, c in zip(states, scale)]), labels
 
 
+def scale_draws(rng: np.random.Generator, samples: int, scale_uncertainty: float | None) -> np.ndarray:
+    """``samples`` draws of the wear estimate's scale (shape (samples,), from ``rng``'s standard
+    normals ``z``): ``max(1 + s z, 0.05)`` for a relative standard uncertainty ``s`` (a friction
+    test's factor: its error is symmetric about the factor), ones for 0, and ``exp(TWIN_SCALE_LOG_SD
+    z)`` for None, the twin's scale without a test: a factor 1/2 as likely as a factor 2, so that a
+    wide prior widens the interval both ways and keeps its median at the scale 1 (a normal of the
+    same spread would put 1 draw in 44 below 0.1, a crossing due now, and reach 1.74 at its 95 %
+    where the log-normal's 5-95 % is 0.48-2.10)."""
+    if scale_uncertainty is None:
+        return np.exp(TWIN_SCALE_LOG_SD * rng.standard_normal(samples))
+    if not scale_uncertainty:
+        return np.ones(samples)
+    return np.maximum(1.0 + scale_uncertainty * rng.standard_normal(samples), 0.05)
+
+
 def time_of_event(fit, failure_wear: float, horizon: float = HORIZON, samples: int = SAMPLES, seed: int = 0,
-                  scale_uncertainty: float = SCALE_UNCERTAINTY, weights=None):
+                  scale_uncertainty: float | None = SCALE_UNCERTAINTY, weights=None):
     """ProgPy's Monte Carlo prediction of the time from now until the wear reaches ``failure_wear``
     under ``fit`` (a :class:`~faultgen.monitor.trends.Fit`, or a list of them drawn in proportion to
     ``weights``, the model average), the estimate's scale uncertain by ``scale_uncertainty`` (module
-    docstring, 4-5): ``UnweightedSamples`` with key ``failure`` (None beyond ``horizon``)."""
+    docstring, 4-5; None: the twin's log-normal prior, :func:`scale_draws`): ``UnweightedSamples``
+    with key ``failure`` (None beyond ``horizon``)."""
     fits = [fit] if isinstance(fit, Fit) else list(fit)
     drawn, _ = _state_samples(fits, [1.0] * len(fits) if weights is None else weights, samples, seed,
                               scale_uncertainty)
@@ -304,14 +331,17 @@ def _propagate(drawn, failure_wear: float, horizon: float):
     return result.time_of_event
 
 
-def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float:
+def scale_of_axis(scale_uncertainty, axis: int, n_axes: int) -> float | None:
     """The relative standard uncertainty of ``axis``'s (1..``n_axes``) wear scale from
     ``scale_uncertainty``: one number for every axis, a mapping axis -> number (an axis not in it
-    gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers.
+    gets :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`), or a sequence of ``n_axes`` numbers;
+    None for None (no friction test: the twin's log-normal prior, :func:`scale_draws`).
     ValueError naming the value when a number is not in [0, :data:`MAX_SCALE_UNCERTAINTY`] or the
     sequence's length is not ``n_axes``. Above 1 is allowed: a scale read from one or two friction
     tests may be that uncertain (:mod:`faultgen.monitor.friction_tests`); each draw's scale is kept
     at 0.05 or more."""
+    if scale_uncertainty is None:
+        return None
     if isinstance(scale_uncertainty, Mapping):
         for key in scale_uncertainty:
             if isinstance(key, bool) or not isinstance(key, (int, np.integer)) or not 1 <= key <= n_axes:
@@ -335,7 +365,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                    keys: dict[str, float] | None = None, kind: str | None = None, since: str | None = None,
                    source_axis: int | None = None, horizon: float = HORIZON, samples: int = SAMPLES,
                    seed: int = 0, axes: list[int] | None = None, changepoint: bool = True,
-                   scale_uncertainty=SCALE_UNCERTAINTY) -> list[Remaining]:
+                   scale_uncertainty=None) -> list[Remaining]:
     """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
     rows (``UnitMonitor.rows``: ``stamp``, ``phase``, each log's own wear estimate ``wearI_log`` and its
     lower bound ``wearI_log_lower``, not the filtered ``wearI``, whose errors are not independent from
@@ -346,10 +376,10 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     trend and the power-law rise over the whole block (module docstring, 2; ``changepoint`` False:
     the line and the exponential of the logs from the alarm on) and is
     fitted from the alarm on when neither rises;
-    ``scale_uncertainty`` the relative standard uncertainty of the estimate's scale carried into the
-    time of event (module docstring, 4; 0: none): one number for every axis, a mapping axis (1..N)
-    -> number (an axis not in it: :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`) or a sequence
-    of ``n_axes`` numbers (:func:`scale_of_axis`); ``axes`` (1..N) the axes wanted, all when None. A
+    ``scale_uncertainty`` the estimate's scale's (module docstring, 4; :func:`scale_draws`): None (no
+    friction test) log-normal, :data:`TWIN_SCALE_LOG_SD`; else a test's relative one (0: none), one
+    number, a mapping axis (1..N) -> number (an axis not in it: ``scoring.SCALE_UNCERTAINTY``) or
+    ``n_axes`` numbers (:func:`scale_of_axis`); ``axes`` (1..N) the axes wanted, all when None. A
     unit without wear estimates (still learning, or protocol own) gets one row with axis None."""
     check_failure_wear(failure_wear)
     wanted = list(range(1, n_axes + 1)) if axes is None else list(axes)
