@@ -14,8 +14,9 @@ A track version that names a profile (``profile = "x86-64-v3"`` in its recipe) i
 pinned through the environment the libraries read when they load: OpenBLAS's Haswell kernels (AVX2
 and FMA, which every x86-64-v3 processor has: Intel since 2013, AMD since 2017) on one thread, and
 NumPy without its dispatch targets above x86-64-v3. They must be set before NumPy is imported, so
-``faultgen bench make`` starts itself again with them (:func:`restart_pinned`; :func:`restart_early`
-does it before the command line's modules load, which would be loaded again); a Python session
+``faultgen bench make`` starts itself again with them (:func:`restart_pinned`; :func:`restart_early`,
+called by ``faultgen.cli`` as it loads, does it before the command line's modules load, which the new
+process loads again); a Python session
 that imported NumPy without them is refused by :func:`check` with the variables to set. Other
 processors (ARM, x86 without AVX2) or another BLAS (MKL) cannot take the profile: the make runs
 as it is and its manifest check may fail there.
@@ -147,14 +148,24 @@ _MAKE_VALUED = frozenset({"--out", "-o", "--version", "--size", "--jobs"})
 _MAKE_FLAGS = frozenset({"--freeze", "--no-freeze", "--progress", "--no-progress"})
 
 
-def restart_early(argv: list[str]) -> None:
-    """:func:`restart_pinned` for ``faultgen bench make TRACK [OPTIONS]`` (``argv``: ``sys.argv[1:]``),
-    called before the command line's modules are imported: the restarted process imports them once,
-    where a restart from the command's body imported them twice (about 2 s of CPU). The track and
-    ``--version`` are read from ``argv`` with the command's options; anything else (``--help``, an
+def command_line() -> list[str] | None:
+    """This process's arguments after the program when the process is faultgen's command line itself:
+    ``python -m faultgen.cli ARGS`` (while Python imports the package to run it, ``sys.argv[0]`` is
+    ``-m``) or the ``faultgen`` script; None in a program that imports ``faultgen.cli``."""
+    if (sys.argv[0] == "-m" and "faultgen.cli" in sys.orig_argv) or os.path.basename(sys.argv[0]) == "faultgen":
+        return sys.argv[1:]
+    return None
+
+
+def restart_early(argv: list[str] | None) -> None:
+    """:func:`restart_pinned` for ``faultgen bench make TRACK [OPTIONS]`` (``argv``: the arguments after
+    the program, :func:`command_line`; None: not the command line, nothing to do), called by
+    ``faultgen.cli`` before its command modules are imported: the restarted process imports them
+    once, where a restart from the command's body imported them twice (about 2 s of CPU). The track
+    and ``--version`` are read from ``argv`` with the command's options; anything else (``--help``, an
     option it does not know, a second argument, a track or version that does not load) returns
     without a restart, and the command itself restarts or names the problem as before."""
-    if argv[:2] != ["bench", "make"]:
+    if argv is None or argv[:2] != ["bench", "make"]:
         return
     track, version, words = None, None, iter(argv[2:])
     for word in words:
