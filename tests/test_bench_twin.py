@@ -10,6 +10,7 @@ import json
 import sys
 from pathlib import Path
 
+import bench_plugins
 import numpy as np
 import pytest
 
@@ -151,6 +152,7 @@ def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_ro
     truth = {u.id: u.worn_axis for u in labelled}
     script = ROOT / "benchmarks/twin_baseline.py"
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(score, "RESAMPLES", bench_plugins.FEW_RESAMPLES)  # the script's scorer; no interval read
     monkeypatch.setattr(sys, "argv", [str(script), "--track", "sim-to-real", "--data", str(data), "--work",
                                       str(tmp_path / "work"), "--no-calibrate", "-o", str(tmp_path / "score-twin")])
     capsys.readouterr()
