@@ -1,5 +1,5 @@
 """Round 10 (helper sbench): `faultgen bench make` restarts in its version's numeric profile before
-the command line's modules load (faultgen.bench.profile.restart_early, called by ``python -m
+the command line's modules load (faultgen.bench.restart.restart_early, called by ``python -m
 faultgen.cli``); the command's own restart stays behind it for what the early one leaves."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from faultgen import children
-from faultgen.bench import profile, tracks
+from faultgen.bench import profile, restart, tracks
 
 
 @pytest.mark.parametrize(("argv", "restarted"), [
@@ -37,7 +37,7 @@ def test_the_early_restart_reads_the_track_and_version_as_the_command_does(monke
     restart_early hands nothing and leaves the command to it."""
     calls = []
     monkeypatch.setattr(profile, "restart_pinned", lambda name, args: calls.append((name, args)))
-    profile.restart_early(argv)
+    restart.restart_early(argv)
     assert calls == ([] if restarted == "left" else [(restarted, argv)])
     if restarted not in (None, "left"):  # the same profile the command reads from the track file
         assert tracks.load(next(w for w in argv[2:] if w in tracks.names())).version().profile == restarted
@@ -84,4 +84,4 @@ def test_python_m_faultgen_cli_restarts_a_profiled_make_before_the_commands_load
 def test_only_the_command_line_itself_restarts(monkeypatch, argv, orig, command):
     monkeypatch.setattr(sys, "argv", argv)
     monkeypatch.setattr(sys, "orig_argv", orig)
-    assert profile.command_line() == command
+    assert restart.command_line() == command

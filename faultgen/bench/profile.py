@@ -14,9 +14,9 @@ A track version that names a profile (``profile = "x86-64-v3"`` in its recipe) i
 pinned through the environment the libraries read when they load: OpenBLAS's Haswell kernels (AVX2
 and FMA, which every x86-64-v3 processor has: Intel since 2013, AMD since 2017) on one thread, and
 NumPy without its dispatch targets above x86-64-v3. They must be set before NumPy is imported, so
-``faultgen bench make`` starts itself again with them (:func:`restart_pinned`; :func:`restart_early`,
-called by ``faultgen.cli`` as it loads, does it before the command line's modules load, which the new
-process loads again); a Python session
+``faultgen bench make`` starts itself again with them (:func:`restart_pinned`;
+:func:`faultgen.bench.restart.restart_early`, called by ``faultgen.cli`` as it loads, does it before the
+command line's modules load, which the new process loads again); a Python session
 that imported NumPy without them is refused by :func:`check` with the variables to set. Other
 processors (ARM, x86 without AVX2) or another BLAS (MKL) cannot take the profile: the make runs
 as it is and its manifest check may fail there.
@@ -141,52 +141,3 @@ def restart_pinned(name: str | None, argv: list[str]) -> None:
     command = children.command("-m", "faultgen.cli", *argv)
     os.execve(command[0], command, env)
 
-
-#: ``faultgen bench make``'s options (faultgen/cli/bench.py) that take a value, and its flags, as
-#: :func:`restart_early` reads them.
-_MAKE_VALUED = frozenset({"--out", "-o", "--version", "--size", "--jobs"})
-_MAKE_FLAGS = frozenset({"--freeze", "--no-freeze", "--progress", "--no-progress"})
-
-
-def command_line() -> list[str] | None:
-    """This process's arguments after the program when the process is faultgen's command line itself:
-    ``python -m faultgen.cli ARGS`` (while Python imports the package to run it, ``sys.argv[0]`` is
-    ``-m``) or the ``faultgen`` script; None in a program that imports ``faultgen.cli``."""
-    if (sys.argv[0] == "-m" and "faultgen.cli" in sys.orig_argv) or os.path.basename(sys.argv[0]) == "faultgen":
-        return sys.argv[1:]
-    return None
-
-
-def restart_early(argv: list[str] | None) -> None:
-    """:func:`restart_pinned` for ``faultgen bench make TRACK [OPTIONS]`` (``argv``: the arguments after
-    the program, :func:`command_line`; None: not the command line, nothing to do), called by
-    ``faultgen.cli`` before its command modules are imported: the restarted process imports them
-    once, where a restart from the command's body imported them twice (about 2 s of CPU). The track
-    and ``--version`` are read from ``argv`` with the command's options; anything else (``--help``, an
-    option it does not know, a second argument, a track or version that does not load) returns
-    without a restart, and the command itself restarts or names the problem as before."""
-    if argv is None or argv[:2] != ["bench", "make"]:
-        return
-    track, version, words = None, None, iter(argv[2:])
-    for word in words:
-        name, eq, attached = word.partition("=")
-        if name in _MAKE_VALUED:
-            value = attached if eq else next(words, None)
-            if value is None:
-                return
-            version = value if name == "--version" else version
-        elif word.startswith("-") and word not in _MAKE_FLAGS:
-            return
-        elif not word.startswith("-"):
-            if track is not None:
-                return
-            track = word
-    if track is None:
-        return
-    from faultgen.bench import tracks  # here: tracks imports this module
-
-    try:
-        wanted = tracks.load(track).version(None if version is None else int(version)).profile
-    except ValueError:
-        return
-    restart_pinned(wanted, argv)

@@ -15,7 +15,7 @@ it (MuJoCo's import of ``glfw`` runs ``python -c`` to check its library's versio
 multiprocessing), then leaves the current folder off its path, as the children faultgen starts
 itself with ``-P`` do (:mod:`faultgen.children`). Run as the command line, ``faultgen bench make`` of
 a version with a numeric profile starts again in it here, before the command modules load
-(:func:`faultgen.bench.profile.restart_early`).
+(:func:`faultgen.bench.restart.restart_early`).
 """
 
 import os
@@ -24,9 +24,9 @@ from faultgen import children
 
 os.environ.update(children.SAFE_PATH)
 
-from faultgen.bench import profile as _profile  # noqa: E402  (light: NumPy only for a make's profile)
+from faultgen.bench import restart as _restart  # noqa: E402  (light: NumPy only for a make's profile)
 
-_profile.restart_early(_profile.command_line())  # `faultgen bench make`: restarted before the commands load
+_restart.restart_early(_restart.command_line())  # `faultgen bench make`: restarted before the commands load
 
 from faultgen.cli.main import app  # noqa: E402  (after the environment is safe for the libraries' children)
 from faultgen.cli import (robots, programs, runs, calibration, data, logs, monitoring, reporting,  # noqa: E402
