@@ -32,6 +32,12 @@ def make_small(track: str, folder: Path) -> dict:
     return json.loads((folder / "manifest.json").read_text())
 
 
+#: Bootstrap resamples of `bench score` (faultgen.bench.score.RESAMPLES, 1000) in the tests that read
+#: no interval or verdict of a score: what the method is shown, a command's plumbing, a row's cells.
+#: The intervals themselves are checked on the scorer's 1000 (tests/test_bench.py: the random scorers'
+#: intervals hold 0.5 and lie below the PCA baseline's, an isolator's interval holds its value).
+FEW_RESAMPLES = 20
+
 #: Every call the spy saw: ("fit", X, y) or ("decision_function", X) or ("predict", X).
 CALLS: list[tuple] = []
 

@@ -24,6 +24,7 @@ import re
 from pathlib import Path
 
 import baseline_example
+import bench_plugins
 import numpy as np
 import pandas as pd
 import pytest
@@ -113,7 +114,8 @@ def thesis_small(shared_bench):
     return shared_bench("thesis")
 
 
-def test_bench_score_and_the_leaderboard_reach_the_example(thesis_small, tmp_path):
+def test_bench_score_and_the_leaderboard_reach_the_example(thesis_small, tmp_path, monkeypatch):
+    monkeypatch.setattr(score, "RESAMPLES", bench_plugins.FEW_RESAMPLES)  # the command's and the class's: equal
     out = tmp_path / "zmean"
     result = runner.invoke(app, ["bench", "score", "thesis", "--data", str(thesis_small), "--baseline", "zmean",
                                  "-o", str(out)])

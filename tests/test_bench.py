@@ -119,8 +119,9 @@ def test_random_scores_are_at_chance_and_the_pca_baseline_beats_them(thesis_smal
     assert 0.0 <= good["results"]["false_alarm_rate"]["value"] <= 1.0
 
 
-def test_the_method_sees_only_the_train_files_labels(thesis_small):
+def test_the_method_sees_only_the_train_files_labels(thesis_small, monkeypatch):
     folder, _ = thesis_small
+    monkeypatch.setattr(score, "RESAMPLES", bench_plugins.FEW_RESAMPLES)  # no figure is read here
     bench_plugins.CALLS.clear()
     score.score(folder, plugins.load("bench_plugins:Spy", "detector"), "spy", "detector")
     train = files.read(folder / "train.h5")
@@ -145,8 +146,9 @@ def test_an_isolator_is_scored_against_its_chance(thesis_small):
     assert results["ci95"][0] <= results["value"] <= results["ci95"][1]
 
 
-def test_the_commands(thesis_small, tmp_path):
+def test_the_commands(thesis_small, tmp_path, monkeypatch):
     folder, _ = thesis_small
+    monkeypatch.setattr(score, "RESAMPLES", bench_plugins.FEW_RESAMPLES)  # no interval is read here
     result = runner.invoke(app, ["bench", "list"])
     assert result.exit_code == 0 and "sim-to-real: train on faultgen's simulation" in result.output
     assert "CC0-1.0" in result.output

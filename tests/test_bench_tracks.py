@@ -44,13 +44,54 @@ def test_sim_to_real_is_made_against_its_frozen_manifest_with_the_fleet_as_the_t
     assert sum(axis > 0 for axis, _ in truth.values()) == 2 and all(len(u.arrays["cycles"]) == 24 for u in test)
 
 
+#: sim-to-real version 1's recipe (its third-party robot, its faultgen part and its fleet part of kind
+#: logs) at a smaller test size: one 3-cycle train run and a fleet of 2 units over 4 days.
+STOPPABLE = """name = "stoppable"
+summary = "sim-to-real version 1 at a smaller test size"
+licence = "CC0-1.0"
+[[versions]]
+version = 1
+train_seeds = [0, 1]
+test_seeds = [2]
+small = { axes = [2], cycles = 3, seeds = [0] }
+[[versions.robots]]
+name = "kr210"
+from = "rtbdata:xacro/kuka_description/kuka_kr210/urdf/kr210l150.urdf"
+packages = { kuka_kr210_support = "rtbdata:xacro/kuka_description/kuka_kr210" }
+[[versions.parts]]
+name = "faultgen"
+robots = ["kr210"]
+tasks = ["pick_place"]
+axes = [0, 1, 2, 3, 4, 5]
+increases = [60.0]
+schedules = ["linear"]
+cycles = 120
+test_seeds = []
+conditions = { thermal = {}, payloads = { masses = [10.0, 30.0], sizes = [0.1547, 0.2231], pattern = "random" }, \
+spread = {}, cycles_per_day = 1, start_day = 0.0 }
+[[versions.parts]]
+name = "fleet"
+kind = "logs"
+robot = "kr210"
+task = "pick_place"
+fleet = { units = 12, worn = 8, days = 120, onset = [20, 50], final_wear = 60.0 }
+small = { units = 2, worn = 1, days = 4, onset = [2, 3] }
+train_seeds = []
+"""
+
+
 def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path, monkeypatch):
     """Stopped (Ctrl-C) at the import of the fleet's logs: the train sweep and the fleet are done and kept
     beside the output; the make run again makes neither again and gives the manifest of a make never
-    stopped. In this process (to stop it), so version 1 (no numeric profile), checked against a make
-    of this process rather than the frozen manifest (made on one kind of processor)."""
+    stopped. In this process (to stop it), so a version without a numeric profile, checked against a
+    make of this process rather than a frozen manifest (made on one kind of processor): sim-to-real
+    version 1's recipe at a smaller size (:data:`STOPPABLE`; the sizes do not enter the resume)."""
+    folder = tmp_path / "tracks"
+    folder.mkdir()
+    (folder / "stoppable.toml").write_text(STOPPABLE)
+    monkeypatch.setattr(tracks, "_folder", lambda: folder)
     monkeypatch.setattr(make, "manifest_path", lambda t, v, s: tmp_path / f"{t}-{v}-{s}.json")
-    unstopped = make.make("sim-to-real", tmp_path / "unstopped", version=1, size="small", progress=False)
+    unstopped = make.make("stoppable", tmp_path / "unstopped", size="small", progress=False)
     real_import = fleetlogs.import_logs
     seen = []
 
@@ -59,11 +100,11 @@ def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path
 
     monkeypatch.setattr(fleetlogs, "import_logs", stopped)
     with pytest.raises(KeyboardInterrupt):
-        make.make("sim-to-real", tmp_path / "out", version=1, size="small", progress=False)
+        make.make("stoppable", tmp_path / "out", size="small", progress=False)
     assert not (tmp_path / "out").exists()
-    sweeps = tmp_path / ".out.sim-to-real-1-small.sweeps"
+    sweeps = tmp_path / ".out.stoppable-1-small.sweeps"
     done = sorted(p for p in sweeps.rglob("*") if p.is_file() and p.suffix in (".h5", ".csv", ".xml"))
-    assert sweeps / "train-faultgen.h5" in done and len([p for p in done if p.parent.name.startswith("unit")]) == 72
+    assert sweeps / "train-faultgen.h5" in done and len([p for p in done if p.parent.name.startswith("unit")]) == 8
     before = {p: os.stat(p).st_mtime_ns for p in done}
 
     def spy(*args, **kwargs):  # at the import, everything made before the stop is as it was
@@ -71,9 +112,11 @@ def test_a_stopped_make_resumes_from_the_sweep_and_the_logs_it_finished(tmp_path
         return real_import(*args, **kwargs)
 
     monkeypatch.setattr(fleetlogs, "import_logs", spy)
-    manifest = make.make("sim-to-real", tmp_path / "out", version=1, size="small", progress=False)
+    manifest = make.make("stoppable", tmp_path / "out", size="small", progress=False)
     assert len(seen) == 1 and [p.name for p in before if seen[0][p] != before[p]] == []
     assert manifest["arrays"] == unstopped["arrays"] and not sweeps.exists()
+    made = {key.split("/")[2] for key in manifest["arrays"] if "/units/" in key and "@" not in key}
+    assert made == {"train-000", "test-000", "test-001"}
 
 
 def test_a_logs_part_must_name_an_added_robot_and_a_source_must_be_installed():

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
 import sys
 from pathlib import Path
 
+import bench_plugins
 import numpy as np
 import pytest
 
@@ -138,20 +138,26 @@ def test_a_task_mix_run_simulated_task_by_task_gives_the_tracks_cycles():
             np.testing.assert_allclose(part["features"][name], mixed.features[name][part["rows"]], rtol=1e-9, atol=1e-9)
 
 
-def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_row(shared_bench, tmp_path):
+def test_the_twin_on_the_small_sim_to_real_fleet_goes_through_the_scorer_to_a_row(shared_bench, tmp_path,
+                                                                                  monkeypatch, capsys):
     """The small sim-to-real track as `faultgen bench make` made it (conftest.py's shared_bench: its test
     split the independent simulator's fleet, in make's seeded order) and the script on it: the fleet
     written again, tied by features, `faultgen monitor --no-calibrate`, scored against the frozen
-    manifest; both rows printed and their JSON written."""
+    manifest; both rows printed and their JSON written. The script runs in this process, as `python
+    SCRIPT` runs it (its `faultgen monitor` is a process of its own, as before)."""
+    import runpy
+
     data = shared_bench("sim-to-real")
     labelled = files.attach_labels(files.read(data / "test.h5"), data / "test_labels.csv")
     truth = {u.id: u.worn_axis for u in labelled}
-    done = subprocess.run([sys.executable, str(ROOT / "benchmarks/twin_baseline.py"), "--track", "sim-to-real",
-                           "--data", str(data), "--work", str(tmp_path / "work"), "--no-calibrate",
-                           "-o", str(tmp_path / "score-twin")],
-                          capture_output=True, text=True, timeout=600, cwd=tmp_path)
-    assert done.returncode == 0, done.stderr[-3000:]
-    rows = [line for line in done.stdout.splitlines() if line.startswith("| sim-to-real v2 (small) | twin")]
+    script = ROOT / "benchmarks/twin_baseline.py"
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(score, "RESAMPLES", bench_plugins.FEW_RESAMPLES)  # the script's scorer; no interval read
+    monkeypatch.setattr(sys, "argv", [str(script), "--track", "sim-to-real", "--data", str(data), "--work",
+                                      str(tmp_path / "work"), "--no-calibrate", "-o", str(tmp_path / "score-twin")])
+    capsys.readouterr()
+    runpy.run_path(str(script), run_name="__main__")  # raises SystemExit if the script or its monitor fails
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| sim-to-real v2 (small) | twin")]
     assert len(rows) == 2 and rows[0].split(" | ")[2] != "-" and rows[1].split(" | ")[7].endswith("(chance 16.7)")
     written = [json.loads((tmp_path / f"score-twin-{role}.json").read_text())
                for role in ("detector", "isolator")]
