@@ -14,9 +14,7 @@ A track version that names a profile (``profile = "x86-64-v3"`` in its recipe) i
 pinned through the environment the libraries read when they load: OpenBLAS's Haswell kernels (AVX2
 and FMA, which every x86-64-v3 processor has: Intel since 2013, AMD since 2017) on one thread, and
 NumPy without its dispatch targets above x86-64-v3. They must be set before NumPy is imported, so
-``faultgen bench make`` starts itself again with them (:func:`restart_pinned`;
-:func:`faultgen.bench.restart.restart_early`, called by ``faultgen.cli`` as it loads, does it before the
-command line's modules load, which the new process loads again); a Python session
+``faultgen bench make`` starts itself again with them (:func:`restart_pinned`); a Python session
 that imported NumPy without them is refused by :func:`check` with the variables to set. Other
 processors (ARM, x86 without AVX2) or another BLAS (MKL) cannot take the profile: the make runs
 as it is and its manifest check may fail there.
@@ -140,4 +138,3 @@ def restart_pinned(name: str | None, argv: list[str]) -> None:
     sys.stderr.flush()
     command = children.command("-m", "faultgen.cli", *argv)
     os.execve(command[0], command, env)
-

@@ -13,9 +13,7 @@ Importing it sets ``PYTHONSAFEPATH=1`` in this process's environment (:data:`fau
 before any library is imported: every Python a library starts from the command, however it starts
 it (MuJoCo's import of ``glfw`` runs ``python -c`` to check its library's version; loky, Dask,
 multiprocessing), then leaves the current folder off its path, as the children faultgen starts
-itself with ``-P`` do (:mod:`faultgen.children`). Run as the command line, ``faultgen bench make`` of
-a version with a numeric profile starts again in it here, before the command modules load
-(:func:`faultgen.bench.restart.restart_early`).
+itself with ``-P`` do (:mod:`faultgen.children`).
 """
 
 import os
@@ -23,10 +21,6 @@ import os
 from faultgen import children
 
 os.environ.update(children.SAFE_PATH)
-
-from faultgen.bench import restart as _restart  # noqa: E402  (light: NumPy only for a make's profile)
-
-_restart.restart_early(_restart.command_line())  # `faultgen bench make`: restarted before the commands load
 
 from faultgen.cli.main import app  # noqa: E402  (after the environment is safe for the libraries' children)
 from faultgen.cli import (robots, programs, runs, calibration, data, logs, monitoring, reporting,  # noqa: E402
