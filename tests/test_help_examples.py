@@ -221,16 +221,21 @@ MADE = {
 
 
 @pytest.fixture(scope="session")
-def made(tmp_path_factory, worker_id):
-    """``made(name)``: the path of a file of :data:`MADE`, made once per session."""
+def made(tmp_path_factory, worker_id, shared_fleet_command):
+    """``made(name)``: the path of a file of :data:`MADE`, made once per session; a fleet by
+    conftest.py's ``shared_fleet_command`` (tests/test_training_source.py reads the same fleet.h5)."""
     folder = shared_folder(tmp_path_factory, worker_id, "help-examples-made")
 
     def make(name: str) -> Path:
         with FileLock(folder / f"{name}.lock"):
             if not (folder / name).exists():
                 maker = MADE[name]
+                fleet = None if callable(maker) else fleet_options(small(shlex.split(maker)[1:], "", None))
                 if callable(maker):
                     maker(folder)
+                elif fleet is not None:
+                    shutil.copy(shared_fleet_command(*[word for option in fleet.items() for word in option])[0],
+                                folder / name)
                 else:
                     with contextlib.chdir(folder):
                         result = runner.invoke(app, small(shlex.split(maker)[1:], "", None))
