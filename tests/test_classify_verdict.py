@@ -19,8 +19,8 @@ ROWS = ["control", "+var3"]
 @pytest.fixture(scope="module")
 def seeds3(shared_sweep):
     """j2-like on a small scale: pick and place, no wear and axes 2 and 5 worn by 20 % (exp4), three
-    seeds (units), 10 cycles all recorded, no signals: 9 runs, 3 of them without wear."""
-    return shared_sweep("verdict-seeds", robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=10,
+    seeds (units), 6 cycles all recorded, no signals: 9 runs, 3 of them without wear."""
+    return shared_sweep("verdict-seeds", robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=6,
                         seeds=[0, 1, 2], signals=False)
 
 

@@ -191,16 +191,27 @@ def test_features_only_runs_say_what_they_lack(tmp_path):
                       conditions=c.Conditions(spread=c.UnitSpread(), cycles_per_day=2))
 
 
-def test_a_features_only_sweep_is_small_and_isolates(tmp_path):
+@pytest.fixture(scope="module")
+def with_and_without_signals(tmp_path_factory):
+    """One small sweep made twice, with its signals and features-only (``signals=False``): the PUMA 560's
+    spot weld, no wear and axes 0 and 2 worn +60 % over 12 cycles, all recorded; (full, light) paths,
+    read only (the features-only tests below both read it: before, each made a pair of its own)."""
+    from faultgen.runs import sweep
+
+    folder = tmp_path_factory.mktemp("signals")
+    common = {"robots": ["puma560"], "tasks": ["spot_weld"], "axes": [0, 2], "cycles": 12, "increases": [60.0]}
+    full, light = folder / "full.h5", folder / "light.h5"
+    sweep.run(sweep.Grid(**common), full, progress=False)
+    sweep.run(sweep.Grid(**common, signals=False), light, progress=False)
+    return full, light
+
+
+def test_a_features_only_sweep_is_small_and_isolates(with_and_without_signals):
     """`faultgen sweep --features-only`: no signals in the file, a fraction of the size, and the
     isolation benchmark runs on the stored per-cycle features."""
     from analysis import benchmark
-    from faultgen.runs import sweep
 
-    common = {"robots": ["puma560"], "tasks": ["spot_weld"], "axes": [0, 2], "cycles": 20, "record": [5, 10, 15, 20]}
-    full, light = tmp_path / "full.h5", tmp_path / "light.h5"
-    sweep.run(sweep.Grid(**common), full, progress=False)
-    sweep.run(sweep.Grid(**common, signals=False), light, progress=False)
+    full, light = with_and_without_signals
     assert dataset.validate(light) == []
     assert light.stat().st_size < 0.2 * full.stat().st_size
     table = benchmark.isolation_table(light, progress=False)
@@ -220,19 +231,15 @@ def test_the_c2_preset_keeps_features_only_unless_asked_for_signals(tmp_path):
             assert ("tau_m" in run) is has_signals and "torque_counts" in run, flag
 
 
-def test_detection_gives_the_same_table_with_and_without_signals(tmp_path):
+def test_detection_gives_the_same_table_with_and_without_signals(with_and_without_signals, tmp_path):
     """The stored fine torque counts equal those computed from the stored signals, bit for bit, so
     `faultgen detect` gives the same table on a features-only sweep as on the same sweep with signals
     (the scale of its bins rounded to whole percent of the peak torque, the training maximum inside
     the last bin)."""
     from analysis import benchmark
     from faultgen.model import robots
-    from faultgen.runs import sweep
 
-    common = {"robots": ["puma560"], "tasks": ["spot_weld"], "axes": [0, 2], "cycles": 12, "increases": [60.0]}
-    full, light = tmp_path / "full.h5", tmp_path / "light.h5"
-    sweep.run(sweep.Grid(**common), full, progress=False)
-    sweep.run(sweep.Grid(**common, signals=False), light, progress=False)
+    full, light = with_and_without_signals
     peak = robots.load("puma560").motor_torque_limit
     for run_id in dataset.list_runs(full):
         signals, _ = dataset.read_run(full, run_id, names=("tau_m", "torque_counts"))

@@ -43,7 +43,9 @@ runner = CliRunner()
 #: example's own options otherwise. A sweep records 10 cycles, as the quick preset does.
 SMALL = {"simulate": ["--cycles", "2", "--record", "1-2"], "sweep": ["--cycles", "10", "--record", "1-10"],
          "fleet": ["--robots", "2", "--days", "6", "--cycles-per-day", "1"], "hidden-log": ["--cycles", "1"],
-         "excitation": ["--iterations", "1", "--starts", "2"],
+         # the optimiser's one iteration on the same design (puma560, 5 harmonics, 2 starts): 5 s of CPU;
+         # tests/test_calibrate_selection.py checks it (limits, at rest, conditioned better than its start)
+         "excitation": ["--iterations", "0", "--starts", "2"],
          # one held-out pair of a failing and a healthy robot, not every pair (the slowest examples:
          # every row's classifiers and its 19 label exchanges still fit and print, on one pair)
          "classify": ["--pairs", "1"],
@@ -221,16 +223,21 @@ MADE = {
 
 
 @pytest.fixture(scope="session")
-def made(tmp_path_factory, worker_id):
-    """``made(name)``: the path of a file of :data:`MADE`, made once per session."""
+def made(tmp_path_factory, worker_id, shared_fleet_command):
+    """``made(name)``: the path of a file of :data:`MADE`, made once per session; a fleet by
+    conftest.py's ``shared_fleet_command`` (tests/test_training_source.py reads the same fleet.h5)."""
     folder = shared_folder(tmp_path_factory, worker_id, "help-examples-made")
 
     def make(name: str) -> Path:
         with FileLock(folder / f"{name}.lock"):
             if not (folder / name).exists():
                 maker = MADE[name]
+                fleet = None if callable(maker) else fleet_options(small(shlex.split(maker)[1:], "", None))
                 if callable(maker):
                     maker(folder)
+                elif fleet is not None:
+                    shutil.copy(shared_fleet_command(*[word for option in fleet.items() for word in option])[0],
+                                folder / name)
                 else:
                     with contextlib.chdir(folder):
                         result = runner.invoke(app, small(shlex.split(maker)[1:], "", None))

@@ -2,6 +2,8 @@
 hand sums of squares, Tukey's HSD against SciPy's, and `faultgen training-source` on a small fleet."""
 
 import errno
+import shutil
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -103,17 +105,17 @@ def test_tukey_agrees_with_scipy():
     assert len(pairs) == 3 * 6
 
 
-def test_training_source_command_on_a_small_fleet(tmp_path):
+def test_training_source_command_on_a_small_fleet(tmp_path, shared_fleet_command):
     runner = CliRunner()
     fleet = tmp_path / "fleet.h5"
-    # seed 0: two IRB robots fail, one IRB and two PUMA robots stay normal, so every cell has cases
-    result = runner.invoke(app, ["fleet", "--robots", "5", "--failing", "2", "--days", "10", "--cycles-per-day", "1",
-                                 "--jobs", "1", "--no-progress", "-o", str(fleet)])
-    assert result.exit_code == 0, result.output
+    # the docs' small fleet (`faultgen fleet --robots 6 --days 16 --cycles-per-day 1`, made once a session
+    # for this test and tests/test_help_examples.py's fleet.h5), seed 0: one IRB and two PUMA robots fail,
+    # two IRB robots and one PUMA stay normal, so every cell has cases
+    shutil.copy(shared_fleet_command("--robots", "6", "--days", "16", "--cycles-per-day", "1")[0], fleet)
     stem = tmp_path / "ch4"
     refused = runner.invoke(app, ["training-source", str(fleet), "-o", str(stem), "--no-progress"])
     assert refused.exit_code == 2
-    assert "has 10 records, the study needs 60" in refused.output and "faultgen fleet" in refused.output
+    assert "has 16 records, the study needs 60" in refused.output and "faultgen fleet" in refused.output
     assert not list(tmp_path.glob("ch4*"))
     args = ["training-source", str(fleet), "-o", str(stem), "--training-days", "6", "--test-days", "3", "--gap-days",
             "1", "--no-progress"]
@@ -134,14 +136,14 @@ def test_training_source_command_on_a_small_fleet(tmp_path):
     labels = dataset.labels(fleet)
     failing = {row["run"]: len(row["worn_axes"]) > 0 for row in labels}
     model = {row["run"]: row["robot"] for row in labels}
-    expected = {("OTO", "failure"): 2, ("OTO", "normal"): 3, ("OTM", "failure"): 0, ("OTM", "normal"): 0}
+    expected = {("OTO", "failure"): 3, ("OTO", "normal"): 3, ("OTM", "failure"): 0, ("OTM", "normal"): 0}
     for reference in (r for r in failing if not failing[r]):  # every normal robot models the others of its model
         for robot in (r for r in failing if r != reference and model[r] == model[reference]):
             expected[("OTM", "failure" if failing[robot] else "normal")] += 1
     for signal in ts.SIGNAL_TYPES:
         counts = cases[cases["signal"] == signal].groupby(["source", "condition"]).size().to_dict()
         assert counts == expected
-    assert expected[("OTM", "failure")] == 2 and expected[("OTM", "normal")] == 2
+    assert expected[("OTM", "failure")] == 4 and expected[("OTM", "normal")] == 2
     assert cases["nsat"].between(0, 3).all() and cases["lead_time_days"].between(0, 3).all()
     oto = cases[cases["source"] == "OTO"]
     assert (oto["robot"] == oto["reference"]).all()
