@@ -102,7 +102,8 @@ class Backlash(Effect):
         robot = motion.robot
         current, shift = self._current(motion, end)
         change = motion.compliance(robot, motion.t[:end], motion.q[:end], motion.load[:end], widths) - current
-        return change + (widths - self.current(robot).width)[:, None, :] * shift
+        change += (widths - self.current(robot).width)[:, None, :] * shift  # in place: one (m, n, N) array less
+        return change
 
     def _current(self, motion, end: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The current model's gearbox torque (:attr:`Motion.compliance`) and the quasi-static
