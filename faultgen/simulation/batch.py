@@ -240,12 +240,16 @@ def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dic
     ``k`` from 0 at ``start``), recorded into ``out`` (the friction level first, then a grip, the
     set-points and the disturbance). The disturbance, constant over a log period, is written when
     it changes (MuJoCo keeps ``qfrc_applied`` from step to step); columns are views where their
-    indices are evenly spaced (:func:`faultgen.simulation.friction_update.as_slice`)."""
+    indices are evenly spaced (:func:`faultgen.simulation.friction_update.as_slice`). ``qvel`` is
+    recorded after every step (the divergence check and the applied torque read them), the other
+    fields only after the last step of each log period, the rows :func:`step` reads (the others
+    keep what the buffers held)."""
     robot, per_log, inputs, dist = sim.robot, work.per_log, work.inputs, work.dist
     ctrl = _columns(runs.bind("ctrl"), sim.drive_ctrl)
     applied = _columns(runs.bind("qfrc_applied"), robot.arm_dof)
     grip_steps = {at for at, _ in work.grips}
-    records = [(out[name], runs.bind(name)) for name in out]
+    velocity, qvel = out["qvel"], runs.bind("qvel")
+    logged = [(out[name], runs.bind(name)) for name in out if name != "qvel"]
     period = None
     for k, at in enumerate(range(start, stop)):
         set_level(k)
@@ -256,8 +260,10 @@ def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dic
             period = at // per_log
             applied(dist[:, period])
         runs.step()
-        for record, values in records:
-            record[:, k] = values
+        velocity[:, k] = qvel
+        if k % per_log == per_log - 1:
+            for record, values in logged:
+                record[:, k] = values
 
 
 def _columns(values: np.ndarray, index: np.ndarray):
