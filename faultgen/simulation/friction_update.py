@@ -154,7 +154,7 @@ def writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematic
     they are evenly spaced, the larger Coulomb level, one Coulomb level where both directions'
     are the same bits (no branch on the speed's sign), one level where the chunk's does not change
     with the step, and buffers for the exact operations (absolute value, quotient, sum, product),
-    so a step costs a few NumPy calls. The transcendental ones (power, exp) run on fresh arrays as
+    so a step costs a few NumPy calls; the larger level at rest is put in only when a speed is 0. The transcendental ones (power, exp) run on fresh arrays as
     in :func:`apply`; ``|v / v_s|`` is taken as ``|v| / |v_s|`` and ``-(x^g)`` negated in place,
     both exact in IEEE arithmetic."""
     u = update
@@ -169,6 +169,10 @@ def writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematic
     direct = isinstance(rotor, slice) and not len(u.load_static)
     target = frictionloss[:, rotor] if direct else None
 
+    def coulomb(v: np.ndarray) -> np.ndarray:  # apply's choice; a speed of exactly 0 is rare: fixed after
+        level = np.where(v > 0, cp, cn)  # (NaN takes cn, not the larger: its loss is NaN either way)
+        return np.where(v == 0, larger, level) if np.count_nonzero(v) < v.size else level
+
     def write(k: int) -> None:
         v = qvel[:, rotor]
         np.abs(v, out=scaled)
@@ -177,7 +181,7 @@ def writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematic
         np.negative(term, out=term)
         term = np.exp(term)
         np.multiply(static, term, out=term)
-        np.add(cp if one_coulomb else np.where(v > 0, cp, np.where(v < 0, cn, larger)), term, out=term)
+        np.add(cp if one_coulomb else coulomb(v), term, out=term)
         level = level0 if one_level else u.level[:, k]
         if direct:
             np.multiply(term, level, out=target)
