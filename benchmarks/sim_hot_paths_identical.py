@@ -68,11 +68,9 @@ def cli(*args: str) -> None:
 
 
 def main(out: Path) -> None:
-    from faultgen.calibrate import calibrate, gearbox, synth
-    from faultgen.effects.backlash import Backlash
+    from faultgen.calibrate import calibrate, synth
     from faultgen.model import robots
     from faultgen.monitor.twin import Twin
-    from faultgen.operation import programs
 
     import faultgen
 
@@ -123,7 +121,16 @@ def main(out: Path) -> None:
     cli("fleet", "--robots", "2", "--failing", "1", "--robot", "puma560", "--days", "6", "--cycles-per-day", "1",
         "--friction-test-every", "2", "--seed", "2", "--jobs", "1", "--no-progress", "-o", str(path))
     put("fleet_friction_tests", h5_digest(path))
-    # the functions on seeded inputs
+    functions(put, puma, irb)
+    put("all", hashlib.sha256("\n".join(lines).encode()).hexdigest())
+
+
+def functions(put, puma, irb) -> None:
+    """The functions on seeded inputs, each line through ``put(name, sha256)``."""
+    from faultgen.calibrate import gearbox
+    from faultgen.effects.backlash import Backlash
+    from faultgen.operation import programs
+
     rng = np.random.default_rng(0)
     for robot in (puma, irb):
         n, N = 400, robot.n_axes
@@ -154,7 +161,6 @@ def main(out: Path) -> None:
         f = robot.friction
         put(f"stribeck_{robot.name}", digest(f.stribeck_level(v), f.stribeck_level(v, rng.uniform(1, 2, (n, N))),
                                              f.stribeck_torque(v)))
-    put("all", hashlib.sha256("\n".join(lines).encode()).hexdigest())
 
 
 if __name__ == "__main__":
