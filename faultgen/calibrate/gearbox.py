@@ -49,6 +49,8 @@ The rigid contact against an event-located ODE solution: within 0.1 % of the wid
 
 from __future__ import annotations
 
+import hashlib
+
 import numba
 import numpy as np
 
@@ -122,7 +124,7 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
     if width.shape[-1:] != (load.shape[1],) or width.ndim > 2 or np.any(width < 0):
         raise ValueError(f"backlash must be widths >= 0 rad of shape ({load.shape[1]},) or (m, {load.shape[1]}); "
                          f"got {width!r}")
-    mass = robot.arm_mass_matrix(q)
+    mass = _arm_mass(robot, q)
     K, D = robot.gearbox_stiffness, robot.gearbox_damping
     steps, substeps = _substeps(t)
     is_dynamic = _dynamic(robot, mass, float(np.max(steps)) / substeps)
@@ -146,6 +148,27 @@ def compliance_torque(robot: robots.Robot, t: np.ndarray, q: np.ndarray, load: n
         acceleration = measured.acceleration(t, e)[:, which.reshape(len(widths), len(stiff))]  # (n, m, s)
         out -= np.einsum("nja,nma->mnj", mass[:, :, stiff], acceleration)
     return out if width.ndim == 2 else out[0]
+
+
+#: The arm's inertia matrices along the last motion :func:`compliance_torque` was given, by robot
+#: and the bits of ``q``: a backlash search evaluates hundreds of dead-band sets along one motion,
+#: and :meth:`Robot.arm_mass_matrix` (four MuJoCo calls a sample) was recomputed for each call.
+_LAST_MASS: dict = {}
+
+
+def _arm_mass(robot: robots.Robot, q: np.ndarray) -> np.ndarray:
+    """:meth:`Robot.arm_mass_matrix` of ``q`` (n, N), read-only, computed once for the last motion
+    (:data:`_LAST_MASS`)."""
+    q = np.ascontiguousarray(q, dtype=float)
+    key = (id(robot), q.shape, hashlib.sha1(q.tobytes()).hexdigest())
+    hit = _LAST_MASS.get(key)
+    if hit is not None and hit[0] is robot:
+        return hit[1]
+    mass = robot.arm_mass_matrix(q)
+    mass.setflags(write=False)
+    _LAST_MASS.clear()
+    _LAST_MASS[key] = (robot, mass)
+    return mass
 
 
 def contact_deflection(t: np.ndarray, inertia: np.ndarray, damping: np.ndarray, width: np.ndarray,
@@ -197,7 +220,7 @@ def dynamic_axes(robot: robots.Robot, t: np.ndarray, q: np.ndarray) -> np.ndarra
     (:data:`RESOLVED_HZ`) and the sub-steps follow (:data:`MAX_PHASE`); the others follow the
     motor rigidly, or by rigid contact inside a dead band."""
     steps, substeps = _substeps(np.asarray(t, dtype=float))
-    return _dynamic(robot, robot.arm_mass_matrix(q), float(np.max(steps)) / substeps)
+    return _dynamic(robot, _arm_mass(robot, q), float(np.max(steps)) / substeps)
 
 
 def _substeps(t: np.ndarray) -> tuple[np.ndarray, int]:

@@ -116,6 +116,12 @@ class MotorFriction(Effect):
             raise ValueError(f"friction fields have different numbers of axes: {sorted(sizes)}")
         super().__init__(n_axes=n_axes, **values)
 
+    @property
+    def _one_coulomb(self) -> bool:
+        """Whether both directions' Coulomb levels have the same bits: the level of a speed's
+        direction is then that level, with no branch on the sign (the same bits as one)."""
+        return self.coulomb_pos.tobytes() == self.coulomb_neg.tobytes()
+
     @classmethod
     def from_rows(cls, rows: np.ndarray) -> MotorFriction:
         """Build from an ``ndarray of shape (N, 8)`` whose columns are :data:`FIELDS`."""
@@ -185,7 +191,7 @@ class MotorFriction(Effect):
         """
         v = np.asarray(v_m, dtype=float)
         sign = np.sign(v)
-        coulomb = np.where(v > 0, self.coulomb_pos, self.coulomb_neg)
+        coulomb = self.coulomb_pos if self._one_coulomb else np.where(v > 0, self.coulomb_pos, self.coulomb_neg)
         stribeck = self.static * np.exp(-np.abs(v / self.stribeck_velocity) ** self.stribeck_exponent)
         return (coulomb + stribeck) * sign + self.viscous * v
 
@@ -207,8 +213,11 @@ class MotorFriction(Effect):
             N m at the motor side, >= 0.
         """
         v = np.asarray(v_m, dtype=float)
-        coulomb = np.where(v > 0, self.coulomb_pos, np.where(v < 0, self.coulomb_neg,
-                                                                np.maximum(self.coulomb_pos, self.coulomb_neg)))
+        if self._one_coulomb:
+            coulomb = self.coulomb_pos
+        else:
+            coulomb = np.where(v > 0, self.coulomb_pos, np.where(v < 0, self.coulomb_neg,
+                                                                    np.maximum(self.coulomb_pos, self.coulomb_neg)))
         stribeck = self.static * np.exp(-np.abs(v / self.stribeck_velocity) ** self.stribeck_exponent)
         return (coulomb + stribeck) * multiplier
 

@@ -30,6 +30,7 @@ import dataclasses
 import hashlib
 import math
 from dataclasses import dataclass
+from itertools import chain
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
@@ -52,6 +53,7 @@ PLAN_PERIOD = 0.004
 #: moves took 5.4 GB). An hour is far beyond an industrial cycle (seconds to minutes).
 MAX_CYCLE_DURATION = 3600.0
 MAX_CYCLE_SAMPLES = 7_200_000  # an hour at the finest step, 0.5 ms
+SAMPLE_BLOCK = 4096  # samples of a ruckig move converted to arrays at a time (ptp)
 SEAM_TOLERANCE = 5e-4  # m: largest allowed flange distance from the commanded seam point
 SEAM_LIMIT_TOLERANCE = 0.01  # relative excess over a velocity/acceleration limit allowed on the seam
 LIMIT_TOLERANCE = 1e-9  # relative (velocity, acceleration) and rad (position) elsewhere
@@ -369,8 +371,14 @@ def ptp(q_from: np.ndarray, q_to: np.ndarray, velocity: np.ndarray, acceleration
     check_cycle_length(elapsed + trajectory.duration, dt, where)
     steps = round(trajectory.duration / dt)
     q, qd, qdd = np.empty((steps + 1, n)), np.zeros((steps + 1, n)), np.zeros((steps + 1, n))
-    for k in range(steps):  # into the arrays: a list of ruckig's samples took 15 times their memory
-        q[k], qd[k], qdd[k] = trajectory.at_time(k * dt)
+    # into the arrays a block of samples at a time (a list of ruckig's samples took 15 times their
+    # memory; one row assignment per sample cost twice ruckig's own evaluation)
+    at_time = trajectory.at_time
+    for first in range(0, steps, SAMPLE_BLOCK):
+        last = min(first + SAMPLE_BLOCK, steps)
+        values = chain.from_iterable(chain.from_iterable(at_time(k * dt) for k in range(first, last)))
+        block = np.fromiter(values, dtype=float, count=(last - first) * 3 * n).reshape(last - first, 3, n)
+        q[first:last], qd[first:last], qdd[first:last] = block[:, 0], block[:, 1], block[:, 2]
     q[steps] = q_to
     return q, qd, qdd
 

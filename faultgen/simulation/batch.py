@@ -138,10 +138,26 @@ Raw = make_dataclass("Raw", [(name, np.ndarray) for name in TRUE_SIGNALS])
 Raw.__doc__ = "True signals at the log times, each ``(n_cycles, n_log, N)``: " + ", ".join(TRUE_SIGNALS) + "."
 
 
-def new_runs(sim, work: Work) -> backends.Runs:
-    """One simulation per recorded cycle on the stepper of ``work``, all at the task's start state,
-    with each cycle's plant, fault and dry friction."""
-    runs = work.stepper.new(sim.model, len(work.cycles), work.nthread)
+#: Runs per thread below which a batch stepped one step at a time from Python (:func:`_step_each`)
+#: takes fewer threads than its ``nthread`` asks: handing a few runs' single step to a thread pool
+#: costs more than the step. On the shared 2-core machine (2026-11-27, loaded) the static friction
+#: model's 4 / 16 / 48 PUMA 560 runs on 2 threads took 2.7 / 1.6 / 1.2 times the CPU time of one
+#: thread, and longer wall time. MuJoCo's batch gives the same bits at any thread count.
+STEP_RUNS_PER_THREAD = 16
+
+
+def step_threads(nthread: int, n_sim: int) -> int:
+    """Threads for ``n_sim`` runs stepped one step at a time, for a run's ``nthread`` (0: all
+    CPUs): at most one per :data:`STEP_RUNS_PER_THREAD` runs, at least one."""
+    most = max(1, n_sim // STEP_RUNS_PER_THREAD)
+    return most if nthread == 0 else min(nthread, most)
+
+
+def new_runs(sim, work: Work, nthread: int | None = None) -> backends.Runs:
+    """One simulation per recorded cycle on the stepper of ``work`` (on ``nthread`` threads; the
+    run's ``nthread`` by default), all at the task's start state, with each cycle's plant, fault
+    and dry friction."""
+    runs = work.stepper.new(sim.model, len(work.cycles), work.nthread if nthread is None else nthread)
     runs.bind("qpos")[...], runs.bind("qvel")[...] = start_state(sim.robot, work.q0, work.qd0, work.qdd0)
     runs.bind("act")[...] = 0.0
     work.plant.apply(sim, runs)
@@ -169,15 +185,15 @@ def step(sim, work: Work, bar) -> Raw:
     robot, model, friction = sim.robot, sim.model, sim.stepping
     cycles, inputs, dist, per_log = work.cycles, work.inputs, work.dist, work.per_log
     viscous = robot.friction.viscous * work.plant.viscous[:, None, :]
-    runs = new_runs(sim, work)
     schedule = friction.schedule(sim, work)
+    applies = work.stepper.applies_friction_update
+    in_rollout = schedule is None or (schedule.in_arrays and applies)
+    n_sim, n_steps = len(cycles), len(inputs) - 1
+    runs = new_runs(sim, work, work.nthread if in_rollout else step_threads(work.nthread, n_sim))
     if schedule is not None and schedule.reads_start_state:
         for name in friction_update.KINEMATICS:  # bound before the call that fills them
             runs.bind(name)
         runs.forward()  # the start state's kinematics, for the first step's load-dependent friction
-    applies = work.stepper.applies_friction_update
-    in_rollout = schedule is None or (schedule.in_arrays and applies)
-    n_sim, n_steps = len(cycles), len(inputs) - 1
     chunk = min(CHUNK_PERIODS * per_log, n_steps)
     # buffers reused by every chunk: rollout inputs and per-substep records
     control_in = np.zeros((n_sim, chunk, model.nu + model.nv))
@@ -222,19 +238,49 @@ def step(sim, work: Work, bar) -> Raw:
 def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dict) -> None:
     """Steps ``start`` to ``stop`` one at a time, the friction level set before each (``set_level(k)``,
     ``k`` from 0 at ``start``), recorded into ``out`` (the friction level first, then a grip, the
-    set-points and the disturbance)."""
-    robot, per_log = sim.robot, work.per_log
-    ctrl, applied = runs.bind("ctrl"), runs.bind("qfrc_applied")
-    bound = {name: runs.bind(name) for name in out}
+    set-points and the disturbance). The disturbance, constant over a log period, is written when
+    it changes (MuJoCo keeps ``qfrc_applied`` from step to step); columns are views where their
+    indices are evenly spaced (:func:`faultgen.simulation.friction_update.as_slice`). ``qvel`` is
+    recorded after every step (the divergence check and the applied torque read them), the other
+    fields only after the last step of each log period, the rows :func:`step` reads (the others
+    keep what the buffers held)."""
+    robot, per_log, inputs, dist = sim.robot, work.per_log, work.inputs, work.dist
+    ctrl = _columns(runs.bind("ctrl"), sim.drive_ctrl)
+    applied = _columns(runs.bind("qfrc_applied"), robot.arm_dof)
+    grip_steps = {at for at, _ in work.grips}
+    velocity, qvel = out["qvel"], runs.bind("qvel")
+    logged = [(out[name], runs.bind(name)) for name in out if name != "qvel"]
+    period = None
     for k, at in enumerate(range(start, stop)):
         set_level(k)
-        if work.grips:
+        if at in grip_steps:
             apply_grips(runs, work.grips, at)
-        ctrl[:, sim.drive_ctrl] = work.inputs[at]
-        applied[:, robot.arm_dof] = work.dist[:, at // per_log]
+        ctrl(inputs[at])
+        if at // per_log != period:
+            period = at // per_log
+            applied(dist[:, period])
         runs.step()
-        for name, values in bound.items():
-            out[name][:, k] = values
+        velocity[:, k] = qvel
+        if k % per_log == per_log - 1:
+            for record, values in logged:
+                record[:, k] = values
+
+
+def _columns(values: np.ndarray, index: np.ndarray):
+    """``put(x)``: ``values[:, index] = x`` (``index`` of any shape), through a view where the
+    indices are evenly spaced."""
+    flat = friction_update.as_slice(np.ravel(index))
+    if isinstance(flat, slice):
+        view = values[:, flat]
+        shaped = view.reshape(len(values), *np.shape(index))
+        if np.shares_memory(shaped, values):
+            def put(x):
+                shaped[...] = x
+            return put
+
+    def put_indexed(x):
+        values[:, index] = x
+    return put_indexed
 
 
 def apply_grips(runs, grips: tuple, step: int) -> None:

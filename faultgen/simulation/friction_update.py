@@ -110,13 +110,19 @@ def apply(update: FrictionUpdate, k: int, qvel: np.ndarray, qpos: np.ndarray,
     ``(nsim, N)``: the formula of :class:`FrictionUpdate`, from ``qvel`` ``(nsim, nv)`` (rad/s),
     ``qpos`` ``(nsim, nq)`` and, when :attr:`FrictionUpdate.reads_kinematics`, ``kinematics``: the
     :data:`KINEMATICS` fields ``(nsim, nbody, 3)``, ``(nsim, njnt, 3)``, ``(nsim, njnt, 3)`` of the
-    last step (of ``mj_forward`` before the first)."""
+    last step (of ``mj_forward`` before the first). The reference of :func:`writer`, which
+    computes the same bits with less Python per step."""
     u = update
     v = qvel[:, u.rotor_dof]
     coulomb = np.where(v > 0, u.coulomb_pos,
                        np.where(v < 0, u.coulomb_neg, np.maximum(u.coulomb_pos, u.coulomb_neg)))
     stribeck = u.static_friction * np.exp(-np.abs(v / u.stribeck_velocity) ** u.stribeck_exponent)
-    loss = (coulomb + stribeck) * u.level[:, k]
+    return _with_load(u, (coulomb + stribeck) * u.level[:, k], qpos, kinematics)
+
+
+def _with_load(u: FrictionUpdate, loss: np.ndarray, qpos: np.ndarray, kinematics: tuple | None) -> np.ndarray:
+    """``loss`` plus the load-dependent terms of :class:`FrictionUpdate` (a new array; ``loss``
+    itself when there are none)."""
     if len(u.load_static):
         G = u.gear_ratio
         transmitted = u.stiffness * (qpos[:, u.rotor_qpos] / G - qpos[:, u.arm_qpos])
@@ -126,6 +132,63 @@ def apply(update: FrictionUpdate, k: int, qvel: np.ndarray, qpos: np.ndarray,
             load = np.where(uses_static, static, transmitted) if np.any(uses_static) else transmitted
             loss = loss + u.load_outer[:, t] * (u.load_inner[:, t] * np.abs(load) / G)
     return loss
+
+
+def as_slice(indices: np.ndarray) -> slice | np.ndarray:
+    """``indices`` (1-D, int) as the slice that picks the same elements, where they are evenly
+    spaced and increasing (indexing with it gives a view, not a copy); else ``indices``."""
+    i = np.asarray(indices)
+    if len(i) == 0 or (len(i) > 1 and (i[1] <= i[0] or np.any(np.diff(i) != i[1] - i[0]))):
+        return i
+    step = int(i[1] - i[0]) if len(i) > 1 else 1
+    return slice(int(i[0]), int(i[-1]) + 1, step)
+
+
+def writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematics: tuple | None,
+           frictionloss: np.ndarray) -> Callable[[int], None]:
+    """``write(k)``: :func:`apply` of ``update`` at step ``k`` written into ``frictionloss``
+    ``(nsim, nv)`` at the rotors, the same bits, from the live ``qvel``, ``qpos`` and
+    ``kinematics`` (the per-step fallback of a backend that does not apply the update itself).
+
+    What does not change from step to step is done here once: the rotor columns as views where
+    they are evenly spaced, the larger Coulomb level, one Coulomb level where both directions'
+    are the same bits (no branch on the speed's sign), one level where the chunk's does not change
+    with the step, and buffers for the exact operations (absolute value, quotient, sum, product),
+    so a step costs a few NumPy calls; the larger level at rest is put in only when a speed is 0. The transcendental ones (power, exp) run on fresh arrays as
+    in :func:`apply`; ``|v / v_s|`` is taken as ``|v| / |v_s|`` and ``-(x^g)`` negated in place,
+    both exact in IEEE arithmetic."""
+    u = update
+    rotor = as_slice(u.rotor_dof)
+    cp, cn = u.coulomb_pos, u.coulomb_neg
+    one_coulomb = cp.tobytes() == cn.tobytes()  # then np.where picks these bits whatever the speed
+    larger = np.maximum(cp, cn)
+    speed_scale, exponent, static = np.abs(u.stribeck_velocity), u.stribeck_exponent, u.static_friction
+    one_level = u.nstep > 0 and u.level.strides[1] == 0  # broadcast over the steps: the same every step
+    level0 = u.level[:, 0] if one_level else None
+    scaled = np.empty((u.level.shape[0], len(u.rotor_dof)))
+    direct = isinstance(rotor, slice) and not len(u.load_static)
+    target = frictionloss[:, rotor] if direct else None
+
+    def coulomb(v: np.ndarray) -> np.ndarray:  # apply's choice; a speed of exactly 0 is rare: fixed after
+        level = np.where(v > 0, cp, cn)  # (NaN takes cn, not the larger: its loss is NaN either way)
+        return np.where(v == 0, larger, level) if np.count_nonzero(v) < v.size else level
+
+    def write(k: int) -> None:
+        v = qvel[:, rotor]
+        np.abs(v, out=scaled)
+        np.divide(scaled, speed_scale, out=scaled)
+        term = scaled ** exponent
+        np.negative(term, out=term)
+        term = np.exp(term)
+        np.multiply(static, term, out=term)
+        np.add(cp if one_coulomb else coulomb(v), term, out=term)
+        level = level0 if one_level else u.level[:, k]
+        if direct:
+            np.multiply(term, level, out=target)
+        else:
+            frictionloss[:, rotor] = _with_load(u, np.multiply(term, level, out=term), qpos, kinematics)
+
+    return write
 
 
 def _overrides(effect: Effect, method: str) -> bool:
@@ -205,15 +268,17 @@ class Schedule:
         robot, rotor = self.robot, update.rotor_dof
         frictionloss, qvel, qpos = runs.expand("dof_frictionloss"), runs.bind("qvel"), runs.bind("qpos")
         kinematics = tuple(runs.bind(name) for name in KINEMATICS) if self.reads_start_state else None
+        write = writer(update, qvel, qpos, kinematics, frictionloss)
+        if not self.python_extras:
+            return write
 
         def static_load() -> np.ndarray:
             return robot.static_load_of(*kinematics, qpos)
 
         def set_level(k: int) -> None:
-            frictionloss[:, rotor] = apply(update, k, qvel, qpos, kinematics)
-            if self.python_extras:
-                deflection = qpos[:, robot.rotor_qpos] / robot.gear_ratio - qpos[:, robot.arm_qpos]
-                for effect in self.python_extras:
-                    frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
+            write(k)
+            deflection = qpos[:, robot.rotor_qpos] / robot.gear_ratio - qpos[:, robot.arm_qpos]
+            for effect in self.python_extras:
+                frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
 
         return set_level
