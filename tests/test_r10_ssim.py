@@ -60,10 +60,10 @@ def test_as_slice_picks_the_same_elements():
                                              and len(set(np.diff(index))) <= 1)
 
 
-def test_a_batch_stepped_one_step_at_a_time_takes_a_thread_per_sixteen_runs():
+def test_a_batch_stepped_one_step_at_a_time_on_all_cpus_takes_a_thread_per_sixteen_runs():
     assert batch.STEP_RUNS_PER_THREAD == 16
     assert [batch.step_threads(0, n) for n in (1, 4, 16, 31, 32, 100)] == [1, 1, 1, 1, 2, 6]
-    assert [batch.step_threads(4, n) for n in (1, 40, 100)] == [1, 2, 4]
+    assert [batch.step_threads(4, n) for n in (1, 40, 100)] == [4, 4, 4]  # the user's choice kept
     assert batch.step_threads(1, 1000) == 1
 
 

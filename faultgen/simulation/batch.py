@@ -139,7 +139,7 @@ Raw.__doc__ = "True signals at the log times, each ``(n_cycles, n_log, N)``: " +
 
 
 #: Runs per thread below which a batch stepped one step at a time from Python (:func:`_step_each`)
-#: takes fewer threads than its ``nthread`` asks: handing a few runs' single step to a thread pool
+#: on all CPUs (``nthread`` 0, the default) takes fewer threads: handing a few runs' single step to a thread pool
 #: costs more than the step. On the shared 2-core machine (2026-11-27, loaded) the static friction
 #: model's 4 / 16 / 48 PUMA 560 runs on 2 threads took 2.7 / 1.6 / 1.2 times the CPU time of one
 #: thread, and longer wall time. MuJoCo's batch gives the same bits at any thread count.
@@ -147,10 +147,9 @@ STEP_RUNS_PER_THREAD = 16
 
 
 def step_threads(nthread: int, n_sim: int) -> int:
-    """Threads for ``n_sim`` runs stepped one step at a time, for a run's ``nthread`` (0: all
-    CPUs): at most one per :data:`STEP_RUNS_PER_THREAD` runs, at least one."""
-    most = max(1, n_sim // STEP_RUNS_PER_THREAD)
-    return most if nthread == 0 else min(nthread, most)
+    """Threads for ``n_sim`` runs stepped one step at a time, for a run's ``nthread``: for 0 (all
+    CPUs) one per :data:`STEP_RUNS_PER_THREAD` runs, at least one; a number the user chose is kept."""
+    return max(1, n_sim // STEP_RUNS_PER_THREAD) if nthread == 0 else nthread
 
 
 def new_runs(sim, work: Work, nthread: int | None = None) -> backends.Runs:
