@@ -21,6 +21,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from test_monitor_cluster import a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job, local_monitor_run
 from test_sweep import SMALL, SMALL_ARGS, assert_same_datasets
 from typer.testing import CliRunner
 
@@ -106,10 +107,15 @@ def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(re
                                                                                 monkeypatch, subtests):
     """One test on one cluster (pytest-xdist would start a cluster in each of its workers that
     got one of several tests), each case a subtest: a sweep and a fleet equal the local ones, a
-    shared folder, a worker killed mid-run, the client killed mid-run."""
+    shared folder, a worker killed mid-run, the client killed mid-run, and the monitor's outputs on
+    the cluster equal one local job's (tests/test_monitor_cluster.py's case, in a folder of its own)."""
     client_folder = tmp_path / "client"  # the client's working directory, OUT in out/; no worker gets its path
     (client_folder / "out").mkdir(parents=True)
     (tmp_path / "cluster").mkdir()
+    # the local one-job references, made before the cluster starts (its processes idle meanwhile): the
+    # small fleet, built once a session (tests/test_fleet.py compares with it too), and the monitor case's run
+    local_fleet = shared_fleet("fleet-small", **FLEET)
+    monitored = local_monitor_run(tmp_path / "monitor")
     monkeypatch.chdir(client_folder)
     cluster = Cluster(tmp_path / "cluster")
     try:
@@ -120,10 +126,14 @@ def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(re
                      a_killed_client_resumes_to_the_same_dataset,
                      a_relative_robot_folder_and_program_run_on_the_workers):
             with subtests.test(case.__name__.replace("_", " ")):
-                # the local fleet on one job, built once a session (tests/test_fleet.py compares with it too)
-                local = {"local_fleet": shared_fleet("fleet-small", **FLEET)} \
-                    if case is sweep_and_fleet_equal_the_local_ones else {}
+                local = {"local_fleet": local_fleet} if case is sweep_and_fleet_equal_the_local_ones else {}
                 case(cluster, reference, client_folder, **local)
+        case = a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job  # the victim worker is gone
+        with subtests.test(case.__name__.replace("_", " ")):
+            try:
+                case(cluster, monitored, monkeypatch)
+            finally:
+                monkeypatch.chdir(client_folder)
     finally:
         cluster.close()
 
