@@ -5,7 +5,7 @@ relative to its own working directory, so a worker given either path would look 
 folder, where neither is: the units' logs and cached twins go to the workers as bytes, and their
 results come back. The outputs are those of the local ``--jobs 1`` run, byte for byte.
 
-The cluster case, :func:`a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job`,
+The cluster case, :func:`a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs`,
 runs as a subtest of tests/test_cluster.py's one cluster test, on the cluster its sweeps and fleets
 ran on (a scheduler and two workers started once for both files: the suite's time)."""
 
@@ -41,7 +41,7 @@ def _linked(source: Path, target: Path, days: slice) -> None:
 def local_monitor_run(tmp_path: Path) -> dict:
     """The fleet (two units and the planted unit98) and the local ``--jobs 1`` run on every log, in
     ``tmp_path`` (an empty folder): made before the cluster starts, which then does not wait on it.
-    Returns what :func:`a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job` needs."""
+    Returns what :func:`a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs` needs."""
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", SPEC)
     # a planted unit whose every log the reader refuses, naming the log's path as the client has it
     (logs / "unit98").mkdir()
@@ -62,7 +62,7 @@ def local_monitor_run(tmp_path: Path) -> dict:
     return {"robot": robot, "logs": logs, "client": client, "remote": remote, "local": local}
 
 
-def a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job(cluster, local: dict, monkeypatch):
+def a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs(cluster, local: dict, monkeypatch):
     """The local run on every log (``local``: :func:`local_monitor_run`'s) against two runs on the
     cluster (``cluster``: tests/test_cluster.py's :class:`Cluster` with its two workers, w1 and w2),
     the second after the rest of the logs arrived (it scores only those): every output but the cache
@@ -82,7 +82,8 @@ def a_monitor_without_a_shared_folder_gives_the_outputs_of_one_local_job(cluster
     grown = _outputs(remote / "remote")
     for chart in (remote / "remote").glob("*.png"):
         chart.unlink()
-    idle = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])  # no new log: the charts made again there
+    # no new log: the charts made again there
+    idle = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
     assert idle.exit_code == 3, idle.output
     both = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "other", *COMMON,
                                     "--scheduler", cluster.address, "--jobs", "2"])

@@ -141,7 +141,9 @@ def _figure(height: float):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    figures = _FIGURES.__dict__
+    figures = getattr(_FIGURES, "by_height", None)
+    if figures is None:
+        figures = _FIGURES.by_height = {}
     if height not in figures:
         figures[height] = Figure(figsize=(9, height), dpi=DPI)
         FigureCanvasAgg(figures[height])
