@@ -148,6 +148,8 @@ def _figure(height: float):
         figures[height] = Figure(figsize=(9, height), dpi=DPI)
         FigureCanvasAgg(figures[height])
     fig = figures[height]
+    for ax in fig.axes:  # removed, not cleared first (Figure.clear clears each Axes it then removes)
+        fig.delaxes(ax)
     fig.clear()
     fig.set_layout_engine("constrained")
     return fig
