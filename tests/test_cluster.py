@@ -21,7 +21,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from test_sweep import SMALL, SMALL_ARGS, assert_same_datasets
+from test_monitor_cluster import (
+    a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs as monitor_case,
+    local_monitor_run,
+)
+from test_sweep import GRID, GRID_ARGS, assert_same_datasets
 from typer.testing import CliRunner
 
 from faultgen.cli import app
@@ -98,18 +102,23 @@ class Cluster:
 
 @pytest.fixture
 def reference(shared_sweep) -> Path:
-    """The small sweep of tests/test_sweep.py on one local job (built once per session)."""
-    return shared_sweep("sweep-reference", **SMALL)
+    """:data:`GRID`'s sweep on one local job (tests/test_plot.py's, built once per session)."""
+    return shared_sweep("s", **GRID)
 
 
 def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(reference, shared_fleet, tmp_path,
                                                                                 monkeypatch, subtests):
     """One test on one cluster (pytest-xdist would start a cluster in each of its workers that
     got one of several tests), each case a subtest: a sweep and a fleet equal the local ones, a
-    shared folder, a worker killed mid-run, the client killed mid-run."""
+    shared folder, a worker killed mid-run, the client killed mid-run, and the monitor's outputs on
+    the cluster equal one local job's (tests/test_monitor_cluster.py's case, in a folder of its own)."""
     client_folder = tmp_path / "client"  # the client's working directory, OUT in out/; no worker gets its path
     (client_folder / "out").mkdir(parents=True)
     (tmp_path / "cluster").mkdir()
+    # the local one-job references, made before the cluster starts (its processes idle meanwhile): the
+    # small fleet, built once a session (tests/test_fleet.py compares with it too), and the monitor case's run
+    local_fleet = shared_fleet("fleet-small", **FLEET)
+    monitored = local_monitor_run(tmp_path / "monitor")
     monkeypatch.chdir(client_folder)
     cluster = Cluster(tmp_path / "cluster")
     try:
@@ -120,10 +129,14 @@ def test_sweeps_and_fleets_on_a_cluster_that_shares_no_folder_with_the_client(re
                      a_killed_client_resumes_to_the_same_dataset,
                      a_relative_robot_folder_and_program_run_on_the_workers):
             with subtests.test(case.__name__.replace("_", " ")):
-                # the local fleet on one job, built once a session (tests/test_fleet.py compares with it too)
-                local = {"local_fleet": shared_fleet("fleet-small", **FLEET)} \
-                    if case is sweep_and_fleet_equal_the_local_ones else {}
+                local = {"local_fleet": local_fleet} if case is sweep_and_fleet_equal_the_local_ones else {}
                 case(cluster, reference, client_folder, **local)
+        # on w1 and w2 (the victim worker is gone)
+        with subtests.test(monitor_case.__name__.replace("_", " ")):
+            try:
+                monitor_case(cluster, monitored, monkeypatch)
+            finally:
+                monkeypatch.chdir(client_folder)
     finally:
         cluster.close()
 
@@ -187,11 +200,11 @@ def where_runs_went(output: str) -> dict[str, str]:
 
 def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder, local_fleet):
     runner = CliRunner()
-    result = runner.invoke(app, ["sweep", *SMALL_ARGS, "--scheduler", cluster.address, "--no-progress",
+    result = runner.invoke(app, ["sweep", *GRID_ARGS, "--scheduler", cluster.address, "--no-progress",
                                  "-o", "out/s.h5"])
     assert result.exit_code == 0, result.output
     assert cluster.address.startswith("tcp://127.0.0.1:")  # on loopback
-    assert f"6 runs -> out/s.h5 on {cluster.address}" in result.output
+    assert f"4 runs -> out/s.h5 on {cluster.address}" in result.output
     went = where_runs_went(result.output)
     assert sorted(went) == dataset.list_runs(reference)
     assert set(went.values()) <= set(cluster.workers().values())
@@ -209,7 +222,7 @@ def sweep_and_fleet_equal_the_local_ones(cluster, reference, client_folder, loca
 
 
 def with_a_shared_folder_the_workers_write_the_parts(cluster, reference, client_folder):
-    result = CliRunner().invoke(app, ["sweep", *SMALL_ARGS[:4], "--axis", "0", "--axis", "5", *SMALL_ARGS[-4:],
+    result = CliRunner().invoke(app, ["sweep", *GRID_ARGS[:4], "--axis", "0", "--axis", "2", *GRID_ARGS[-4:],
                                       "--scheduler", cluster.address, "--shared-folder", "--no-progress",
                                       "-o", "out/shared.h5"])
     assert result.exit_code == 0, result.output
@@ -227,8 +240,8 @@ def a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, refer
 
     def client() -> None:
         try:
-            sweep.run(sweep.Grid(**SMALL), "out/k.h5", ExecutionContext(scheduler=cluster.address), progress=False,
-                      on_run=kept.append)
+            sweep.run(sweep.Grid(**GRID), "out/k.h5", ExecutionContext(scheduler=cluster.address),
+                      progress=False, on_run=kept.append)
         except Exception as err:  # reported below
             failure.append(err)
 
@@ -249,7 +262,7 @@ def a_worker_killed_mid_run_loses_only_that_run_to_another_worker(cluster, refer
 
 
 def a_killed_client_resumes_to_the_same_dataset(cluster, reference, client_folder):
-    command = [sys.executable, "-m", "faultgen.cli", "sweep", *SMALL_ARGS, "--scheduler", cluster.address,
+    command = [sys.executable, "-m", "faultgen.cli", "sweep", *GRID_ARGS, "--scheduler", cluster.address,
                "--no-progress", "-o", "out/c.h5"]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     proc = subprocess.Popen(command, cwd=client_folder, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
@@ -260,14 +273,14 @@ def a_killed_client_resumes_to_the_same_dataset(cluster, reference, client_folde
     proc.wait()
     assert not Path("out/c.h5").exists()  # nothing that looks finished
     kept = sorted(parts.glob("*.h5"))
-    assert 1 <= len(kept) < 6
+    assert 1 <= len(kept) < 4
     assert all(dataset.validate(part) == [] for part in kept)
 
-    result = CliRunner().invoke(app, ["sweep", *SMALL_ARGS, "--scheduler", cluster.address, "--no-progress",
+    result = CliRunner().invoke(app, ["sweep", *GRID_ARGS, "--scheduler", cluster.address, "--no-progress",
                                       "-o", "out/c.h5"])
     assert result.exit_code == 0, result.output
-    assert f"resuming: {len(kept)} of 6 runs already finished" in result.output
-    assert len(where_runs_went(result.output)) == 6 - len(kept)  # the kept runs are not simulated again
+    assert f"resuming: {len(kept)} of 4 runs already finished" in result.output
+    assert len(where_runs_went(result.output)) == 4 - len(kept)  # the kept runs are not simulated again
     assert dataset.validate("out/c.h5") == []
     assert_same_datasets(reference, Path("out/c.h5"))
 

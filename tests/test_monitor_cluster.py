@@ -3,14 +3,17 @@
 temporary folder (tests/test_cluster.py's :class:`Cluster`). The client names LOGS and OUT
 relative to its own working directory, so a worker given either path would look in its own
 folder, where neither is: the units' logs and cached twins go to the workers as bytes, and their
-results come back. The outputs are those of the local ``--jobs 1`` run, byte for byte."""
+results come back. The outputs are those of the local ``--jobs 1`` run, byte for byte.
+
+The cluster case, :func:`a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs`,
+runs as a subtest of tests/test_cluster.py's one cluster test, on the cluster its sweeps and fleets
+ran on (a scheduler and two workers started once for both files: the suite's time)."""
 
 import os
 from pathlib import Path
 
 import independent_fleet
 import pytest
-from test_cluster import Cluster
 from typer.testing import CliRunner
 
 from faultgen.cli import app
@@ -35,11 +38,10 @@ def _linked(source: Path, target: Path, days: slice) -> None:
             os.link(log, target / unit.name / log.name)
 
 
-def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tmp_path, monkeypatch):
-    """The local run on every log against two runs on the cluster, the second after the rest of the
-    logs arrived (it scores only those): every output but the cache the same bytes, the state
-    included; the cluster's workers simulated the parts' twin cycles and sent them back. A third
-    run with no new log makes every chart again on the workers, the same bytes."""
+def local_monitor_run(tmp_path: Path) -> dict:
+    """The fleet (two units and the planted unit98) and the local ``--jobs 1`` run on every log, in
+    ``tmp_path`` (an empty folder): made before the cluster starts, which then does not wait on it.
+    Returns what :func:`a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs` needs."""
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", SPEC)
     # a planted unit whose every log the reader refuses, naming the log's path as the client has it
     (logs / "unit98").mkdir()
@@ -50,31 +52,41 @@ def test_a_cluster_without_a_shared_folder_gives_the_outputs_of_one_local_job(tm
     client, remote = tmp_path / "client", tmp_path / "remote"  # each a working directory with its own logs/
     _linked(logs, client / "logs", slice(None))
     _linked(logs, remote / "logs", slice(0, 16))  # the cluster's: 16 days, then all of them
-    (tmp_path / "cluster").mkdir()
-    monkeypatch.chdir(client)
     robot = str(robot)  # an added robot's folder: the workers see it at the same path (the same machine)
-    local = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "local", *COMMON])
-    assert local.exit_code == 3, local.output  # unit98 is not monitored
-    monkeypatch.chdir(remote)
-    cluster = Cluster(tmp_path / "cluster")
+    here = Path.cwd()
+    os.chdir(client)
     try:
-        for name in ("w1", "w2"):
-            cluster.start_worker(name)
-        on_cluster = ["--robot", robot, "-o", "remote", *COMMON, "--scheduler", cluster.address]
-        first = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
-        assert first.exit_code == 3, first.output
-        _linked(logs, remote / "logs", slice(16, None))
-        again = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
-        assert again.exit_code == 3, again.output
-        grown = _outputs(remote / "remote")
-        for chart in (remote / "remote").glob("*.png"):
-            chart.unlink()
-        idle = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])  # no new log: the charts made again there
-        assert idle.exit_code == 3, idle.output
-        both = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "other", *COMMON,
-                                        "--scheduler", cluster.address, "--jobs", "2"])
+        local = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "local", *COMMON])
     finally:
-        cluster.close()
+        os.chdir(here)
+    return {"robot": robot, "logs": logs, "client": client, "remote": remote, "local": local}
+
+
+def a_monitor_without_a_shared_folder_gives_one_local_jobs_outputs(cluster, local: dict, monkeypatch):
+    """The local run on every log (``local``: :func:`local_monitor_run`'s) against two runs on the
+    cluster (``cluster``: tests/test_cluster.py's :class:`Cluster` with its two workers, w1 and w2),
+    the second after the rest of the logs arrived (it scores only those): every output but the cache
+    the same bytes, the state included; the cluster's workers simulated the parts' twin cycles and
+    sent them back. A third run with no new log makes every chart again on the workers, the same
+    bytes. ``monkeypatch`` changes the working directory (the caller's restores it)."""
+    robot, logs, client, remote = local["robot"], local["logs"], local["client"], local["remote"]
+    assert local["local"].exit_code == 3, local["local"].output  # unit98 is not monitored
+    monkeypatch.chdir(remote)
+    assert sorted(cluster.workers()) == ["w1", "w2"]
+    on_cluster = ["--robot", robot, "-o", "remote", *COMMON, "--scheduler", cluster.address]
+    first = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
+    assert first.exit_code == 3, first.output
+    _linked(logs, remote / "logs", slice(16, None))
+    again = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
+    assert again.exit_code == 3, again.output
+    grown = _outputs(remote / "remote")
+    for chart in (remote / "remote").glob("*.png"):
+        chart.unlink()
+    # no new log: the charts made again there
+    idle = CliRunner().invoke(app, ["monitor", "logs", *on_cluster])
+    assert idle.exit_code == 3, idle.output
+    both = CliRunner().invoke(app, ["monitor", "logs", "--robot", robot, "-o", "other", *COMMON,
+                                    "--scheduler", cluster.address, "--jobs", "2"])
     expected = _outputs(client / "local")
     assert {"units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "report.html", "unit01.png",
             ".state/unit01.json", ".state/unit98.json"} <= set(expected)

@@ -7,6 +7,7 @@ are written as numbers."""
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -121,14 +122,44 @@ def chart(path, monitor, axis_note: str) -> None:
     import matplotlib.pyplot as plt
 
     with plt.style.context("default"):  # whatever another library set globally (ProgPy sets fonts on import)
-        _draw(path, monitor, axis_note, plt)
+        _draw(path, monitor, axis_note)
 
 
-def _draw(path, monitor, axis_note: str, plt) -> None:
+#: This thread's figures, by height (inches): one per chart size, cleared for each chart, so that its
+#: canvas's renderer, with the text sizes and mathtext (the log axis's labels) it has laid out, serves
+#: the next chart of that size (:func:`_figure`).
+_FIGURES = threading.local()
+#: The charts' resolution, dots per inch.
+DPI = 90
+
+
+def _figure(height: float):
+    """This thread's figure of 9 x ``height`` inches at :data:`DPI`, cleared, with constrained layout
+    (matplotlib's Agg canvas; no pyplot figure). The same bytes as a new figure's: the chart's
+    laying out and drawing set everything it depends on, and a renderer keeps only caches of the
+    sizes of texts in a font (matplotlib's ``_get_text_metrics_with_cache``, the mathtext parser's)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figures = getattr(_FIGURES, "by_height", None)
+    if figures is None:
+        figures = _FIGURES.by_height = {}
+    if height not in figures:
+        figures[height] = Figure(figsize=(9, height), dpi=DPI)
+        FigureCanvasAgg(figures[height])
+    fig = figures[height]
+    for ax in fig.axes:  # removed, not cleared first (Figure.clear clears each Axes it then removes)
+        fig.delaxes(ax)
+    fig.clear()
+    fig.set_layout_engine("constrained")
+    return fig
+
+
+def _draw(path, monitor, axis_note: str) -> None:
     rows = monitor.rows
     twin = bool(rows) and "wear1" in rows[0]
-    fig, panels = plt.subplots(3 if twin else 2, 1, figsize=(9, 8.5 if twin else 6), sharex=True,
-                               constrained_layout=True)
+    fig = _figure(8.5 if twin else 6)
+    panels = fig.subplots(3 if twin else 2, 1, sharex=True)
     top, bottom = panels[0], panels[-1]
     if rows:
         x = np.arange(len(rows))
@@ -169,5 +200,8 @@ def _draw(path, monitor, axis_note: str, plt) -> None:
     if rows:
         top.legend(fontsize=7, loc="upper left")
         bottom.legend(fontsize=7, loc="upper left", ncol=3)
-    fig.savefig(path, format="png", dpi=90, metadata={"Software": None})
-    plt.close(fig)
+    # laid out here, then saved without a layout engine: savefig would otherwise draw the figure
+    # twice, once without output to lay it out (the same positions, the same bytes)
+    fig.get_layout_engine().execute(fig)
+    fig.set_layout_engine("none")
+    fig.savefig(path, format="png", dpi=DPI, metadata={"Software": None})
