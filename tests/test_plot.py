@@ -10,13 +10,15 @@ import pytest
 
 from faultgen.data import dataset
 from faultgen.plot import plot
+from test_sweep import GRID
 
 
 @pytest.fixture(scope="module")
 def sweep_file(shared_sweep):
-    """Two tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 are recorded: 4 runs."""
-    return shared_sweep("s", robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0],
-                        cycles=20, record=[1, 10, 20])
+    """Two tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 are recorded: 4 runs
+    (tests/test_sweep.py's :data:`GRID`: test_sweep.py and test_cluster.py read the same shared sweep,
+    which is built from whichever file asks first)."""
+    return shared_sweep("s", **GRID)
 
 
 def _subset(source, path, runs: dict):
