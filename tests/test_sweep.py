@@ -29,8 +29,9 @@ SMALL = dict(robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2, 
 SMALL_ARGS = ["--robot", "irb6700", "--task", "pick_place", "--task", "spot_weld", "--axis", "0", "--axis", "2",
               "--axis", "5", "--wear-pct", "20", "--cycles", "30", "--record", "1,15,30"]
 
-# the shared sweep "s" of tests/test_plot.py, test_cluster.py and this file (built once a session): 2 tasks x (no wear, axis 2 worn by 20 %), 20 cycles of
-# which 3 recorded, 4 runs; and the command's options that make the same grid
+# the shared sweep "s" of tests/test_plot.py, test_cluster.py and this file (built once a session):
+# 2 tasks x (no wear, axis 2 worn by 20 %), 20 cycles of which 3 recorded, 4 runs; and the command's
+# options that make the same grid
 GRID = dict(robots=["irb6700"], tasks=["pick_place", "spot_weld"], axes=[0, 2], increases=[20.0], cycles=20,
             record=[1, 10, 20])
 GRID_ARGS = ["--robot", "irb6700", "--task", "pick_place", "--task", "spot_weld", "--axis", "0",
