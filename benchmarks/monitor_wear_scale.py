@@ -132,13 +132,18 @@ def main() -> None:
     parser.add_argument("--no-calibrate", action="store_true")
     parser.add_argument("--friction-test-every", type=int, default=0, metavar="DAYS",
                         help="Each unit also runs a friction test every DAYS days (0: none, the default).")
+    parser.add_argument("--test-scatter", type=float, default=independent_fleet.independent.JITTER, metavar="SIGMA",
+                        help="The friction tests' day-to-day friction scatter, log-normal sigma (default: a log's, "
+                             f"{independent_fleet.independent.JITTER:g}; faultgen.bench.independent.FleetSpec.test_jitter). "
+                             "A fleet already in WORK is kept: a new scatter wants a new WORK.")
     parser.add_argument("--wear-growth", type=float, default=1.0,
                         help="The wear's exponent from its onset (faultgen.bench.independent.wear_percent; 1 linear).")
     args = parser.parse_args()
     work = args.work or Path(tempfile.mkdtemp(prefix="wear-scale-"))
     robot = args.robot or pinocchio_log.add_kr210(work / "kr210")
     spec = independent_fleet.FleetSpec(units=12, worn=8, days=120, seed=args.seed,
-                                       friction_test_every=args.friction_test_every, wear_growth=args.wear_growth)
+                                       friction_test_every=args.friction_test_every, wear_growth=args.wear_growth,
+                                       test_jitter=args.test_scatter)
     if args.law == "first":
         _, logs, truth = independent_fleet.write_fleet(work, spec, robot=robot)
     elif (work / "truth.csv").is_file() and (not spec.friction_test_every or (work / "truth_tests.csv").is_file()):

@@ -156,7 +156,7 @@ def write_fleet(root: Path, spec: ind.FleetSpec, robot: Path, law: str = LAWS[0]
                            round(mass, 1))
             rows.append([unit["unit"], stamp, unit["axis"], f"{truth:.4f}"])
             if d in tested:
-                warmth, test_jitter, test_rng = ind.friction_test_draws(unit, d, temperature, n)
+                warmth, test_jitter, test_rng = ind.friction_test_draws(unit, d, temperature, n, spec.test_jitter)
                 c, s, v, b = levels(law, nominal, unit, wear, test_jitter, warmth)
                 ind.write_friction_test(folder_of_unit / ind.TEST_FOLDER / f"{stamp}.csv", header, model, spec.rate,
                                         lambda w, c=c, s=s, v=v, b=b: dry_friction(w, c, s, v, law) + b * w,
@@ -184,12 +184,15 @@ def main() -> None:
     parser.add_argument("--days", type=int, default=120)
     parser.add_argument("--friction-test-every", type=int, default=0, metavar="DAYS",
                         help="A friction test every DAYS days per unit (0: none).")
+    parser.add_argument("--test-scatter", type=float, default=ind.JITTER, metavar="SIGMA",
+                        help="The friction tests' day-to-day friction scatter, log-normal sigma (default: a log's, "
+                             f"{ind.JITTER:g}).")
     parser.add_argument("--law", choices=LAWS, default=LAWS[0])
     parser.add_argument("--robot", type=Path, default=None, help="The KR210 folder (made in ROOT/kr210 if not given).")
     args = parser.parse_args()
     robot = args.robot or pinocchio_log.add_kr210(args.root / "kr210")
     spec = ind.FleetSpec(units=args.units, worn=args.worn, days=args.days, seed=args.seed,
-                         friction_test_every=args.friction_test_every)
+                         friction_test_every=args.friction_test_every, test_jitter=args.test_scatter)
     logs, truth = write_fleet(args.root, spec, robot, args.law)
     print(f"{logs}\n{truth}")
 

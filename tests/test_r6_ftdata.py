@@ -150,3 +150,22 @@ def test_an_independent_units_test_reads_its_plants_friction_and_leaves_its_logs
 def test_a_negative_test_interval_is_refused_by_name():
     with pytest.raises(ValueError, match=r"^fleet friction_test_every = -1: expected a whole number >= 0$"):
         independent.FleetSpec(units=2, worn=1, friction_test_every=-1)
+
+
+def test_a_tests_scatter_scales_the_same_draws_and_a_bad_one_is_refused_by_name():
+    """``FleetSpec.test_jitter``: the default is a log's scatter (the fleets drawn before the option
+    existed are the same); another scatter scales the same standard normal draws (a fleet compared
+    at two scatters differs in that alone), and its temperature and noise stream are unchanged."""
+    spec = independent.FleetSpec(units=2, worn=1, seed=3)
+    assert spec.test_jitter == independent.JITTER == 0.03
+    unit = independent._units(spec, 6)[0]
+    temperature = np.full(6, 31.0)
+    warm, log_jitter, rng = independent.friction_test_draws(unit, 15, temperature, 6)
+    same = independent.friction_test_draws(unit, 15, temperature, 6, scatter=independent.JITTER)
+    less = independent.friction_test_draws(unit, 15, temperature, 6, scatter=0.01)
+    assert np.array_equal(same[1], log_jitter) and np.array_equal(less[0], warm)
+    assert np.allclose(np.log(less[1]), np.log(log_jitter) / 3, rtol=1e-12, atol=0)
+    assert less[2].random() == rng.random()  # the test's noise draws follow unchanged
+    for bad in (-0.01, 0.6, True):
+        with pytest.raises(ValueError, match=rf"^fleet test_jitter = {bad!r}: expected a friction test's scatter "):
+            independent.FleetSpec(test_jitter=bad)

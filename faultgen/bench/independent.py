@@ -141,7 +141,9 @@ class FleetSpec:
     up to ``max_part`` kg (``rated_part``: the fleet's heaviest part drawn is made ``max_part``
     itself, the rated payload carried); ``gearbox_changes`` worn units get a new gearbox on the worn axis and
     ``program_changes`` healthy units an unlogged program change; every ``friction_test_every`` days
-    (0: never) each unit runs a friction test (module docstring); ``wear_growth`` the exponent of the
+    (0: never) each unit runs a friction test (module docstring), its friction scattering by
+    ``test_jitter`` (log-normal sigma, as :data:`JITTER` for a log: the test's repeatability, by
+    default a log's; a protocol with its own warm-up may repeat better); ``wear_growth`` the exponent of the
     wear's rise (:func:`wear_percent`; 1, linear, by default); each log holds a number of
     back-to-back cycles drawn from ``cycles`` at a rate drawn from ``rates`` Hz (empty: ``rate``;
     :func:`faultgen.bench.layouts.draws`). Every draw comes from ``seed``; the defaults draw what the fleet drew before
@@ -161,6 +163,7 @@ class FleetSpec:
     gearbox_changes: int = 0
     program_changes: int = 0
     friction_test_every: int = 0
+    test_jitter: float = JITTER
     wear_growth: float = 1.0
     cycles: tuple[int, ...] = (1,)
     rates: tuple[float, ...] = ()
@@ -177,6 +180,9 @@ class FleetSpec:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"fleet {name} = {value!r}: expected a whole number >= {low}")
+        if isinstance(self.test_jitter, bool) or not 0.0 <= float(self.test_jitter) <= 0.5:
+            raise ValueError(f"fleet test_jitter = {self.test_jitter!r}: expected a friction test's scatter "
+                             "(log-normal sigma) in [0, 0.5]")
         if self.worn > self.units:
             raise ValueError(f"fleet worn = {self.worn}: more than its {self.units} units")
         onset = tuple(self.onset)
@@ -438,13 +444,16 @@ def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
         yield d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate
 
 
-def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int) -> tuple:
+def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int,
+                        scatter: float = JITTER) -> tuple:
     """A friction test's draws on ``day`` (1-based), from the stream of the unit's seed and the day:
     its joint temperature, deg C (N,: the day's ``temperature`` warm, the hall's, without the unit's
-    warm-up rise, cold; :data:`COLD_SHARE`), its per-log ``jitter`` (3, N) and the generator of its noise."""
+    warm-up rise, cold; :data:`COLD_SHARE`), its per-log ``jitter`` (3, N; log-normal, sigma ``scatter``:
+    :attr:`FleetSpec.test_jitter`, the same standard normal draws at any ``scatter``) and the generator
+    of its noise."""
     rng = np.random.default_rng([unit["seed"], 1, day])
     cold = rng.random() < COLD_SHARE
-    jitter = np.exp(rng.normal(0.0, JITTER, (3, n_axes)))
+    jitter = np.exp(rng.normal(0.0, scatter, (3, n_axes)))
     return (temperature - unit["rise"] if cold else np.asarray(temperature, dtype=float)), jitter, rng
 
 
@@ -510,7 +519,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
         folder_of_unit.mkdir(parents=True, exist_ok=True)
         for d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate in _days(spec, unit, model):
             if d in tested:
-                warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n)
+                warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n, spec.test_jitter)
                 fc, fs, fv = _levels(spec, unit, d, nominal, test_jitter, warmth)
                 test_rows += friction_test_truth(unit["unit"], stamp, G, fc, fv, warmth)
                 if not kept:
