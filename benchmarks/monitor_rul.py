@@ -198,7 +198,7 @@ def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
         raise SystemExit(f"{fleet / 'kr210'}: no robot folder there (benchmarks/monitor_wear_scale.py makes it); "
                          "expected the fleet's KR210 to replay its monitor's state, or --scores-only")
     nominal = robots.load(fleet / "kr210")
-    tests = friction_tests.read_tests(found, nominal, out, None)
+    tests = friction_tests.read_tests(found, nominal, out)
     n, rows = nominal.n_axes, {}
     for name in units:
         path = out / ".state" / stored.unit_file(name, ".json")

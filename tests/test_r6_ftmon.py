@@ -210,3 +210,25 @@ def test_the_logs_are_put_on_the_tests_scale_by_the_factor_their_tests_give():
         f, error, names = scale.at(stamp, np.array([1.25 * w, 0.3]), np.array([0.5, 0.5]))
     assert abs(f[0] - 0.8) < 2 * error[0] and error[0] < 0.08, (f, error)
     assert names == [friction_tests.TESTS_SCALE, friction_tests.TWIN_SCALE] and f[1] == 1.0 and error[1] == 0.0
+
+
+def test_the_rul_benchmark_replays_the_monitors_rows_with_their_factors(fleet, monitored):
+    """benchmarks/monitor_rul.py's ``replayed_rows`` (the twin-scale columns and factors scores.csv does
+    not keep): the state replayed with the tests from the cache gives the wear the run wrote."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import monitor_rul
+
+    root, robot, logs, _ = fleet
+    assert robot == root / "kr210" and logs == root / "logs"
+    replayed = monitor_rul.replayed_rows(root, monitored)
+    written = {(r["unit"], r["stamp"], int(r["axis"])): float(r["wear"]) for r in rows(monitored / "wear.csv")}
+    pairs = []
+    for unit, unit_rows in replayed.items():
+        for r in unit_rows:
+            for k in range(1, 7):
+                if f"wear{k}_factor" in r:
+                    pairs.append((written[(unit, r["stamp"], k)], r[f"wear{k}"]))
+    assert len(pairs) >= 12 * 6 and all(math.isclose(a, b, rel_tol=1e-5, abs_tol=1e-4) for a, b in pairs), pairs[:5]
+    assert {r["wear1_scale"] for r in replayed["unit02"] if "wear1_scale" in r} == {friction_tests.TESTS_SCALE}
