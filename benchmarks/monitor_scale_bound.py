@@ -1,7 +1,7 @@
 """The least median wear error a scale learned from friction tests can give (issue 75, "What it must
 show", bullet 2; docs/analysis.md, "The wear on the friction tests' scale").
 
-    python benchmarks/monitor_scale_bound.py --work WORK [--out monitor] [--prior-sd 0.5 0.1 0.05]
+    python benchmarks/monitor_scale_bound.py --work WORK [--out monitor] [--prior-sd 0.5 0.3 0.1 0.05]
                                              [--filter-sd 0 1.6]
 
 ``WORK`` is a run of ``benchmarks/monitor_wear_scale.py --friction-test-every D`` (its ``truth.csv``
@@ -21,8 +21,8 @@ Analysis*, 3rd ed., ch. 14)::
 normal with standard deviation ``sqrt((w r)^2 + e^2)`` (``w`` its true wear, ``e`` the filter's own
 error, ``--filter-sd``), so its median absolute error is ``0.6745`` times that. The median of these
 over the worn axes' logs with true wear in [10, 40] % is what any estimator of this form can reach
-at best on that fleet; ``p = 0.5`` is the monitor's prior (:data:`faultgen.monitor.friction_tests.SCALE_PRIOR`),
-smaller ``p`` a twin whose scale is known that well before any test.
+at best on that fleet; ``p = 0.3`` is the monitor's prior (:data:`faultgen.monitor.friction_tests.SCALE_PRIOR`;
+0.5 before 2026-11-27), smaller ``p`` a twin whose scale is known that well before any test.
 """
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--work", type=Path, required=True)
     parser.add_argument("--out", default="monitor")
-    parser.add_argument("--prior-sd", type=float, nargs="+", default=[0.5, 0.1, 0.05])
+    parser.add_argument("--prior-sd", type=float, nargs="+", default=[0.5, 0.3, 0.1, 0.05])
     parser.add_argument("--filter-sd", type=float, nargs="+", default=[0.0, 1.6])
     args = parser.parse_args()
     logs = fleet_logs(args.work, args.work / args.out)
