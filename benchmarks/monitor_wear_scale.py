@@ -2,6 +2,7 @@
 
     python benchmarks/monitor_wear_scale.py --law first|hump|hump-lorentzian [--seed 0] [--work DIR] [--robot DIR]
                                             [--out monitor] [--no-calibrate] [--friction-test-every DAYS]
+                                            [--test-scatter SIGMA]
 
 In one run of this script:
 
@@ -15,7 +16,9 @@ In one run of this script:
   the truth is the increase of the worn axis's dry friction in % of the unit's own. With
   ``--friction-test-every DAYS`` each unit also runs faultgen's friction test every DAYS days
   through the fleet's own dynamics and friction law (``LOGS/<unit>/friction-test/<stamp>.csv``, their
-  truth in ``WORK/truth_tests.csv``; :mod:`faultgen.bench.independent`). A fleet already
+  truth in ``WORK/truth_tests.csv``; :mod:`faultgen.bench.independent`), their friction scattering
+from day to day by ``--test-scatter`` (default a log's, 3 %; docs/analysis.md, "Fifth session of
+2026-11-27"). A fleet already
   there is kept (its units are drawn from the seed: the same files);
 - ``faultgen monitor LOGS --robot KR210 -o WORK/OUT`` (the calibrated twin, the default; an OUT of
   an earlier run is continued, so a rerun only rewrites the outputs), timed;
