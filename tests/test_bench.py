@@ -70,7 +70,8 @@ def test_tracks_have_disjoint_train_and_test_seeds_and_the_slot_says_what_it_nee
         track = tracks.load(name)
         for version in track.versions.values():
             seeds = {split: {s for _, g in version.grids(split) for s in g["seeds"]}
-                     | {f["spec"]["seed"] for _, f in version.fleets(split)} for split in tracks.SPLITS}
+                     | {f["spec"]["seed"] for _, f in version.fleets(split)}
+                     | {r["seed"] for _, r in version.records(split)} for split in tracks.SPLITS}
             assert seeds["train"] and seeds["test"] and not seeds["train"] & seeds["test"]
     slot = tracks.parse({"name": "x", "summary": "s", "licence": "CC0-1.0", "needs": "a fleet"}, "x.toml")
     with pytest.raises(ValueError, match="no version yet: a fleet"):

@@ -34,6 +34,8 @@ TEST_ARRAYS = {
     "friction_test_coulomb_low": ("N m", "cycle, axis"), "friction_test_coulomb_high": ("N m", "cycle, axis"),
     "friction_test_viscous": ("N m s/rad", "cycle, axis"), "friction_test_temperature": ("degC", "cycle, axis"),
 }
+#: The duty of the day a unit logs (the prognostics track's version 3): name -> (unit, layout).
+DUTY_ARRAYS = {"speed_override": ("1", "cycle"), "operating_hours": ("h", "cycle")}
 #: name -> unit of every per-record array a method may read (faultgen's dataset schema): the
 #: per-axis features ("record, axis"), the histograms ("record, axis, bin") and, for a run with
 #: operating conditions, what a plant logs beside them.
@@ -42,7 +44,7 @@ OBSERVABLES = {
     "average_load_torque": "N m", "angle_hist": "1", "speed_hist": "1", "torque_hist": "1",
     "day": "d", "hour": "h", "ambient_temperature": "degC", "joint_temperature": "degC", "payload_mass": "kg",
     "task_index": "1",
-    **{name: unit for name, (unit, _) in TEST_ARRAYS.items()},
+    **{name: unit for name, (unit, _) in {**TEST_ARRAYS, **DUTY_ARRAYS}.items()},
 }
 #: The per-axis scalar features a detector sees by default (columns of :meth:`Unit.features`).
 FEATURES = ("mean_abs_torque", "rms_torque", "average_speed", "average_load_torque")
@@ -80,6 +82,7 @@ VALUE_RANGES = {
     "friction_test": (0, 1), **dict.fromkeys(("friction_test_coulomb", "friction_test_coulomb_low",
                                               "friction_test_coulomb_high"), _TAU),
     "friction_test_viscous": (-1e9, 1e9), "friction_test_temperature": VALUE_BOUNDS[TEMPERATURE_PREFIX][:2],
+    "speed_override": (0.0, 2.0), "operating_hours": (0.0, 24.0),
 }
 
 
@@ -222,7 +225,8 @@ def _unit_arrays(path: Path, uid: str, g, labelled: bool) -> tuple[dict, int]:
     arrays = {}
     for name in OBSERVABLES:
         if name in g:
-            layout = TEST_ARRAYS[name][1] if name in TEST_ARRAYS else SHAPES[name]
+            extra = {**TEST_ARRAYS, **DUTY_ARRAYS}
+            layout = extra[name][1] if name in extra else SHAPES[name]
             shape = tuple(sizes[axis.strip()] for axis in layout.split(","))
             arrays[name] = inputs.bounded_dataset(g, name, path, shape, kinds="iu" if name == "cycles" else "fiub")
     if labelled:

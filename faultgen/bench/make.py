@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 import faultgen
-from faultgen.bench import files, profile, tracks
+from faultgen.bench import files, profile, prognostics_v3, tracks
 from faultgen.data import atomic
 from faultgen.runs.context import ExecutionContext
 
@@ -58,7 +58,8 @@ def hashes(folder: Path) -> dict[str, str]:
     from faultgen import inputs
 
     out = {}
-    for name in ("train.h5", "test.h5"):
+    # a version with test variants (prognostics v3) has test-<variant>.h5 beside test.h5
+    for name in ("train.h5", "test.h5", *sorted(p.name for p in folder.glob("test-*.h5"))):
         path = files.folder_file(folder / name, "benchmark file")
         with inputs.open_hdf5(path, "benchmark file of `faultgen bench make`") as f:  # nothing read from another file
             for uid in f["units"]:
@@ -247,7 +248,18 @@ def _split_units(version: tracks.Version, split: str, size: str, sweeps: Path, j
     for path in runs:
         with faultgen.open(path) as data:
             units += [_unit(run) for run in data]
-    return units + _fleet_units(version, split, size, sweeps, added, progress)
+    return units + _fleet_units(version, split, size, sweeps, added, progress) + _record_units(
+        version, split, size, (prognostics_v3.DEFAULT_VARIANT,))[prognostics_v3.DEFAULT_VARIANT]
+
+
+def _record_units(version: tracks.Version, split: str, size: str, names: tuple[str, ...]) -> dict[str, list[files.Unit]]:
+    """The units of the version's ``records`` parts for ``split`` (:mod:`faultgen.bench.prognostics_v3`)
+    in each variant of ``names``: variant -> units (empty lists for a version without such parts)."""
+    out: dict[str, list[files.Unit]] = {name: [] for name in names}
+    for _, spec in version.records(split, size):
+        for name, units in prognostics_v3.split_units(spec, names).items():
+            out[name] += units
+    return out
 
 
 def _why(track: tracks.Track, recipe: tracks.Version, numeric: str, frozen: dict | None, here: dict) -> str:
@@ -317,12 +329,14 @@ def _check_request(track: tracks.Track, recipe: tracks.Version, size: str, out: 
 
 
 def _write_splits(stage: Path, track: tracks.Track, recipe: tracks.Version, size: str, command: str,
-                  train: list[files.Unit], test: list[files.Unit]) -> None:
+                  train: list[files.Unit], test: list[files.Unit], variants: dict | None = None) -> None:
     """Write ``train.h5``, ``test_labels.csv`` and ``test.h5`` (without labels) into ``stage``: the units
-    numbered, the test units in the version's shuffled order (:func:`_order`)."""
+    numbered, the test units in the version's shuffled order (:func:`_order`); each of ``variants``
+    (name -> the same test units seen otherwise, in the same order) as ``test-<name>.h5``."""
     for k, unit in enumerate(train):
         unit.id = f"train-{k:03d}"
-    test = [test[i] for i in _order(track.name, recipe.number, len(test))]
+    order = _order(track.name, recipe.number, len(test))
+    test = [test[i] for i in order]
     for k, unit in enumerate(test):
         unit.id = f"test-{k:03d}"
     attrs = {"track": track.name, "version": recipe.number, "size": size, "licence": track.licence,
@@ -332,6 +346,11 @@ def _write_splits(stage: Path, track: tracks.Track, recipe: tracks.Version, size
     for unit in test:  # the test file holds no label
         unit.fault_level = unit.worn_axis = unit.fault = None
     files.write(stage / "test.h5", test, {**attrs, "split": "test"})
+    for name, units in (variants or {}).items():
+        seen = [units[i] for i in order]
+        for k, unit in enumerate(seen):
+            unit.id, unit.fault_level, unit.worn_axis, unit.fault = f"test-{k:03d}", None, None, None
+        files.write(stage / f"test-{name}.h5", seen, {**attrs, "split": "test", "variant": name})
 
 
 def make(track_name: str, out: str | Path, version: int | None = None, size: str = "full", jobs: int = 1,
@@ -384,7 +403,9 @@ def make(track_name: str, out: str | Path, version: int | None = None, size: str
         added = add_robots(recipe, sweeps / "robots")
         train = _split_units(recipe, "train", size, sweeps, jobs, progress, command, added)
         test = _split_units(recipe, "test", size, sweeps, jobs, progress, command, added)
-        _write_splits(stage, track, recipe, size, command, train, test)
+        others = tuple(n for n in prognostics_v3.VARIANTS if n != prognostics_v3.DEFAULT_VARIANT)
+        variants = {name: units for name, units in _record_units(recipe, "test", size, others).items() if units}
+        _write_splits(stage, track, recipe, size, command, train, test, variants)
         arrays = hashes(stage)
         manifest = {"track": track.name, "version": recipe.number, "size": size, "faultgen_version": faultgen.__version__,
                     "licence": track.licence, "profile": recipe.profile, "environment": profile.describe(),

@@ -19,6 +19,11 @@ third-party file as a user adds them (``faultgen robots add NAME --from FILE --p
 ``name``, ``from`` and ``packages``, each file given as ``python_package:path/inside`` (an installed
 data package such as rtb-data's ``rtbdata``); a part names them as any robot.
 
+A part of kind ``records`` (``kind = "records"``) is a fleet's daily records drawn at the record
+level (:mod:`faultgen.bench.prognostics_v3`, the prognostics track's version 3), one fleet per seed of
+its split (``records``: ``failing`` and optionally ``days``, ``onset``, ``life_days``; ``small``
+overrides it); its test split is written in every variant of that module's ``VARIANTS``.
+
 A version may name the numeric ``profile`` it is made in (:mod:`faultgen.bench.profile`: the same
 bits on two machines), and may be ``like`` an earlier version: its recipe (parts, seeds, small,
 robots, sizing) with the version's own keys over it. A version's ``sizing`` is the drivetrain sizing
@@ -55,6 +60,7 @@ DEFAULT_SIZING = 1
 SIZING_RULES = (1, 2)
 _ROBOT_KEYS = {"name", "from", "packages"}
 _LOGS_KEYS = {"name", "kind", "robot", "task", "fleet", "small", "train_seeds", "test_seeds"}
+_RECORDS_KEYS = {"name", "kind", "records", "small", "train_seeds", "test_seeds"}
 #: Keys of a part that are not :class:`faultgen.Grid` fields.
 _PART_KEYS = ("name", "kind", "small", "train_seeds", "test_seeds")
 
@@ -105,7 +111,7 @@ class Version:
             raise ValueError(f"size {size!r}: expected one of {', '.join(SIZES)}")
         out = []
         for k, part in enumerate(self.parts):
-            if part.get("kind", "grid") == "logs":
+            if part.get("kind", "grid") != "grid":
                 continue
             fields = {key: value for key, value in part.items() if key not in _PART_KEYS}
             fields["seeds"] = self._seeds(part, split)
@@ -135,6 +141,22 @@ class Version:
             for seed in self._seeds(part, split):
                 out.append((f"{part.get('name', f'part{k + 1}')}-{seed}",
                             {"robot": part["robot"], "task": part["task"], "spec": {**spec, "seed": seed}}))
+        return out
+
+    def records(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
+        """(part name, spec) of each part of kind ``records`` for ``split`` at ``size``, one per seed:
+        the part's ``records`` table (its ``small`` over it) with the seed
+        (:func:`faultgen.bench.prognostics_v3.split_units`)."""
+        if split not in SPLITS or size not in SIZES:
+            raise ValueError(f"split {split!r}, size {size!r}: expected one of {', '.join(SPLITS)} and of "
+                             f"{', '.join(SIZES)}")
+        out = []
+        for k, part in enumerate(self.parts):
+            if part.get("kind", "grid") != "records":
+                continue
+            spec = {**dict(part.get("records", {})), **(dict(part.get("small", {})) if size == "small" else {})}
+            out += [(f"{part.get('name', f'part{k + 1}')}-{seed}", {**spec, "seed": seed})
+                    for seed in self._seeds(part, split)]
         return out
 
 
@@ -229,7 +251,8 @@ def parse(data: dict, source: str) -> Track:
             raise ValueError(f"{source}: version {number}: no [[versions.parts]]")
         _check_robots_and_logs(version, f"{source}: version {number}")
         seeds = {split: {s for _, grid in version.grids(split) for s in grid["seeds"]}
-                 | {fleet["spec"]["seed"] for _, fleet in version.fleets(split)} for split in SPLITS}
+                 | {fleet["spec"]["seed"] for _, fleet in version.fleets(split)}
+                 | {spec["seed"] for _, spec in version.records(split)} for split in SPLITS}
         shared = sorted(seeds["train"] & seeds["test"])
         if shared or not seeds["train"] or not seeds["test"]:
             raise ValueError(f"{source}: version {number}: train seeds {sorted(seeds['train'])} and test seeds "
@@ -252,8 +275,15 @@ def _check_robots_and_logs(version: Version, where: str) -> None:
         added.add(robot["name"])
     for part in version.parts:
         kind = part.get("kind", "grid")
-        if kind not in ("grid", "logs"):
-            raise ValueError(f"{where}: part {part.get('name')!r}: kind {kind!r}: expected grid or logs")
+        if kind not in ("grid", "logs", "records"):
+            raise ValueError(f"{where}: part {part.get('name')!r}: kind {kind!r}: expected grid, logs or records")
+        if kind == "records":
+            bad = sorted(set(part) - _RECORDS_KEYS)
+            if bad or not isinstance(part.get("records"), dict):
+                raise ValueError(f"{where}: records part {part.get('name')!r}: "
+                                 + (f"unknown key {bad[0]!r}; expected: {', '.join(sorted(_RECORDS_KEYS))}" if bad
+                                    else "expected a records table (failing, and days, onset, life_days)"))
+            continue
         if kind != "logs":
             continue
         bad = sorted(set(part) - _LOGS_KEYS)

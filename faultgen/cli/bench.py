@@ -146,6 +146,9 @@ def score_command(
     allow_modified: Annotated[bool, typer.Option(
         "--allow-modified", help="Score a folder that differs from the track version's frozen manifest anyway: "
         "warned, each differing file and array named, and the verdict marked NOT COMPARABLE.")] = False,
+    variant: Annotated[str | None, typer.Option(
+        help="The prognostics track's version 3: the test split's variant (test-VARIANT.h5: scatter-7, "
+             "noscatter-none, ...; default test.h5, scatter-14).")] = None,
 ) -> None:
     """Score a detector or an isolator on a track's test units: AUROC, false-alarm rate on healthy
     units, detection rate at 5 % false alarms, the share of failing units detected beside what
@@ -172,7 +175,7 @@ def score_command(
     if track == "prognostics" or prognoser:  # remaining useful life: its own contract and metrics
         from faultgen.cli import bench_prognostics
 
-        return bench_prognostics.score(data, prognoser, baseline, out, allow_modified)
+        return bench_prognostics.score(data, prognoser, baseline, out, allow_modified, variant)
     from analysis import plugins
     from faultgen.bench import score
 
