@@ -214,8 +214,10 @@ def score(folder: str | Path, prognoser, name: str, allow_modified: bool = False
     if made.get("track") != TRACK:
         raise ValueError(f"{folder} holds track {made.get('track')!r}, not {TRACK!r}")
     if made["version"] not in FAILURE_WEAR:
-        raise ValueError(f"{folder}: prognostics version {made['version']}; this faultgen scores versions "
-                         f"{', '.join(map(str, FAILURE_WEAR))}")
+        raise ValueError(f"{folder}: prognostics version {made['version']}; this module scores versions "
+                         f"{', '.join(map(str, FAILURE_WEAR))}"
+                         + ("; version 3 is scored by faultgen.bench.rul_v3.score (the command routes it there)"
+                            if made["version"] == 3 else ""))
     failure = FAILURE_WEAR[made["version"]]
     labelled = files.attach_labels(test, folder / "test_labels.csv")
     checked = make.compare(folder, made, allow_modified)

@@ -24,7 +24,8 @@ integrates it; ``p`` = 10/3 for the RV gears of axes 1-3, 3 for the strain-wave 
 ``x(t) = u sum_{onset..t} duty / LIFE_DAYS`` with ``u`` the unit factor (log-normal, sigma
 :data:`UNIT_SIGMA`), and its wear ``FAILURE_WEAR G(x)`` % of its dry friction, ``G`` one of
 :data:`LAWS` (linear ``x``, power ``x^1.5`` and ``x^2``, exponential ``(e^{kx} - 1) / (e^k - 1)``,
-``k`` = :data:`EXP_K`), all reaching the failure wear at ``x = 1``: the end of life. A unit whose
+``k`` = :data:`EXP_K`), all reaching the failure wear at ``x = 1``: the end of life (the wear grows on
+after it, capped at :data:`WEAR_CAP`, to the record's end, which does not tell the end of life). A unit whose
 wear does not reach it within its record is censored; :data:`HEALTHY_SHARE` of the units wear no
 axis.
 
@@ -48,6 +49,8 @@ import numpy as np
 from faultgen.bench import files
 
 FAILURE_WEAR = 40.0
+#: The wear grows on after the end of life (the records go on to the record's end) up to this, %.
+WEAR_CAP = 100.0
 LAWS = ("linear", "power1.5", "power2", "exponential")
 EXP_K = 3.0
 ONSET = (5, 150)
@@ -164,7 +167,7 @@ def truth(seed: int, index: int, days: tuple[int, int] = RECORD_DAYS, onset: tup
     if axis:
         duty = relative_duty(payload, override, hours)[:, axis - 1]
         age = factor * np.cumsum(np.where(np.arange(1, n + 1) >= start, duty, 0.0)) / life_days
-        wear = np.minimum(FAILURE_WEAR * growth(law, age), files.MAX_FAULT_LEVEL)
+        wear = np.minimum(FAILURE_WEAR * growth(law, age), WEAR_CAP)
         reached = np.flatnonzero(wear >= FAILURE_WEAR)
         eol = int(reached[0]) + 1 if reached.size else None
     return Truth(index, n, payload, override, hours, axis, law, start, factor, wear, eol)
