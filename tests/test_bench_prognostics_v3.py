@@ -132,7 +132,7 @@ def test_paired_verdicts_take_each_score_on_its_better_side():
     assert rul_v3.compare(mixed, _rows({0: 0.1, 1: 0.9, 2: 0.1, 3: 0.9}), bad, "wear25")["ra"]["verdict"] == \
         "not distinguishable"
     summary = rul_v3.summary(good, bad, "wear25")
-    assert summary["skill"]["value"] == pytest.approx(1 - 1.1 / 8.6)
+    assert summary["skill"]["value"] == pytest.approx(1 - 1.2 / 8.6)  # mean absolute errors 1.2 and 8.6 days
     low, high = summary["ra"]["ci95"]
     assert low < summary["ra"]["value"] < high
 

@@ -306,11 +306,11 @@ def score(folder: str | Path, prognoser, name: str, allow_modified: bool = False
             "baselines": {b: results_for(b, per_method) for b in BASELINES if b != name}}
 
 
-def _cell(figure: dict | None, scale: float = 1.0, digits: int = 2) -> str:
+def _cell(figure: dict | None, scale: float = 1.0, digits: int = 2, kind: str = "f") -> str:
     if not figure or not np.isfinite(figure["value"]):
         return "-"
     low, high = (x * scale for x in figure["ci95"])
-    return f"{figure['value'] * scale:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
+    return f"{figure['value'] * scale:.{digits}{kind}} [{low:.{digits}{kind}}, {high:.{digits}{kind}}]"
 
 
 def _versus(diff: dict | None) -> str:
@@ -333,7 +333,7 @@ def markdown_row(results: dict, command: str) -> str:
     others = " / ".join(f"{results['anchors'][a]['results']['ra']['value']:.2f}" for a in ("wear20", "wear30", "saxena"))
     best = f"{head['best_other']}: {_versus(head['vs_best']['ra'])}" if head["best_other"] else "-"
     cells = [_cell(r["ra"]), _versus(head["vs_naive"]["ra"]) if results["method"] != "mean_life" else "(the naive)",
-             best, _cell(r["alpha_lambda"], 100, 0), _cell(r["late_share"], 100, 0), _cell(r["phm08"], 1, 3),
+             best, _cell(r["alpha_lambda"], 100, 0), _cell(r["late_share"], 100, 0), _cell(r["phm08"], 1, 3, "g"),
              _cell(r["skill"]), others, _cell(results["no_eol_share"], 100, 0)]
     return f"| {track} | {results['method']} | " + " | ".join(cells) + f" | `{command}` | {results['date']} |"
 

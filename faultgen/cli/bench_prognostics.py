@@ -72,7 +72,7 @@ def score_v3(data: Path, name: str, out: Path | None, allow_modified: bool, vari
     from faultgen.bench import prognosers, prognostics, rul_v3, verdicts
 
     method = None if name in rul_v3.BASELINES else prognosers.load(name) if ":" in name else prognostics.baseline(name)
-    stem = out or data / f"score-{name.replace(':', '.')}" + (f"-{variant}" if variant else "")
+    stem = out or data / (f"score-{name.replace(':', '.')}" + (f"-{variant}" if variant else ""))
     results = rul_v3.score(data, method, name, allow_modified, variant)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     json_path, md_path = rul_v3.write(results, stem, command)
