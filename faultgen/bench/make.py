@@ -13,7 +13,9 @@ or a kill resumes from the runs it finished when run again, and are removed afte
 from the frozen manifest too. A version's third-party robots (``[[versions.robots]]``) are added into
 that folder first, and a part of kind ``logs`` is a fleet written there by the independent simulator
 (:mod:`faultgen.bench.independent`) and imported as ``faultgen logs import`` does, its labels from the
-simulator's truth. A version with a numeric ``profile`` is made in it (:mod:`faultgen.bench.profile`),
+simulator's truth; a part of kind ``records`` is a record-level fleet
+(:mod:`faultgen.bench.prognostics_v3`), whose test split is also written in each other variant as
+``test-<variant>.h5`` (hashed into the manifest beside ``test.h5``). A version with a numeric ``profile`` is made in it (:mod:`faultgen.bench.profile`),
 and every manifest records the environment that made it (machine, BLAS kernels, NumPy's dispatch,
 package versions), which a failed check compares with its own.
 """
