@@ -205,3 +205,21 @@ def test_a_records_part_is_checked_when_the_track_is_read():
                          "x")
     assert track.version(1).records("test") == [("p-1", {"failing": 2, "seed": 1})]
     assert track.version(1).grids("test") == []
+
+
+def test_a_variant_of_another_version_and_a_unit_without_duty_are_refused_by_name(tmp_path):
+    from typer.testing import CliRunner
+
+    from faultgen.cli import app
+
+    unit = _unit(20, np.zeros(20))
+    unit.fault_level = unit.worn_axis = unit.fault = None
+    files.write(tmp_path / "test.h5", [unit], {"track": "prognostics", "version": 2, "size": "small"})
+    result = CliRunner().invoke(app, ["bench", "score", "prognostics", "--data", str(tmp_path), "--baseline",
+                                      "mean_life", "--variant", "scatter-7"])
+    assert result.exit_code != 0
+    assert "--variant scatter-7: only the prognostics track's version 3 has test variants" in result.output
+    bare = _unit(20, np.where(np.arange(20) >= 10, 40.0, 0.0))  # runs to failure on day 11
+    del bare.arrays["speed_override"], bare.arrays["operating_hours"]
+    with pytest.raises(ValueError, match="unit u: no speed_override, operating_hours: the load-based baselines"):
+        prognosers_v3.LoadLife().fit([bare], 40.0)
