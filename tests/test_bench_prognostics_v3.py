@@ -223,3 +223,30 @@ def test_a_variant_of_another_version_and_a_unit_without_duty_are_refused_by_nam
     del bare.arrays["speed_override"], bare.arrays["operating_hours"]
     with pytest.raises(ValueError, match="unit u: no speed_override, operating_hours: the load-based baselines"):
         prognosers_v3.LoadLife().fit([bare], 40.0)
+
+
+def _tested(wear, axis: int = 2, every: int = 7) -> files.Unit:
+    """:func:`_unit` with a noise-free friction test every ``every`` days: each axis's dry level
+    (1 + wear/100) exp(-0.012 (T - 20)) at a joint temperature swinging over 14-26 degC."""
+    unit = _unit(len(wear), wear, axis)
+    n = len(wear)
+    temp = np.repeat((20.0 + 6.0 * np.sin(np.arange(n) / 9.0))[:, None], 6, axis=1)
+    dry = np.ones((n, 6)) * prognostics_v3.DRY
+    dry[:, axis - 1] *= 1.0 + np.asarray(wear) / 100.0
+    on = np.arange(n) % every == 0
+    unit.arrays.update(friction_test=on.astype(np.int8), friction_test_coulomb=np.where(
+        on[:, None], dry * np.exp(-0.012 * (temp - 20.0)), 0.0), friction_test_temperature=np.where(on[:, None], temp, 0.0))
+    return unit
+
+
+def test_the_tests_fit_learns_the_temperature_slope_and_finds_the_end_of_life_of_clean_tests():
+    day = np.arange(1, 201)
+    age = np.clip(day - 19, 0, None) / 90.0  # onset day 20, end of life on day 109 at duty 1 a day
+    train = [_tested(40.0 * prognostics_v3.growth(law, age)) for law in prognostics_v3.LAWS]
+    model = prognosers_v3.TestsFit().fit(train, 40.0)
+    assert model.slope_ == pytest.approx(-0.012, rel=1e-6)
+    unit = _tested(40.0 * prognostics_v3.growth("power1.5", age))
+    assert model.predict(rul_v3._shown(unit, 25, False)) is None  # four tests, no wear yet
+    drawn = model.predict(rul_v3._shown(unit, 80, False))  # wear 22 % on day 80
+    assert np.median(drawn) == pytest.approx(109.0, abs=0.1 * (109 - 80))  # within 10 % of the 29 days left
+    assert model.predict(rul_v3._shown(_unit(200, age * 0), 80, False)) is None  # no tests, no prediction

@@ -1,5 +1,6 @@
 """The prognostics track version 3's own baselines beside the naive and the health-index fits
-(:mod:`faultgen.bench.degradation`): the load-based rated life and the oracle.
+(:mod:`faultgen.bench.degradation`): the load-based rated life, a fit of the friction tests
+(:class:`TestsFit`, below) and the oracle.
 
 - :class:`LoadLife` (``load_life``): the rated life of the gears by their load, as a maker's
   catalogue gives it (``L = L_n (n_N / n_av) (T_N / T_av)^p``, the law
@@ -128,3 +129,77 @@ class Oracle:
         if c <= 0 or rate <= 0:
             return np.array([np.inf])
         return np.array([min(now + max(1.0 / c - age[-1], 0.0) / rate, MAX_TIME)])
+
+
+#: The friction tests' fit (:class:`TestsFit`): scales of the wear age (1 / duty-days to the end of
+#: life), onsets tried at most, draws of its distribution, and the fitted wear now (%) it predicts from.
+SCALES = np.geomspace(1 / 3000.0, 1 / 15.0, 90)
+ONSETS = 40
+DRAWS = 200
+DETECT = 8.0
+
+
+class TestsFit:
+    """A condition-based prognoser on the friction tests (``tests_fit``; not the twin).
+
+    From the train split it learns the dry friction's temperature slope ``b`` (least squares of each
+    test's log level, its true wear taken out, on its temperature, per unit and axis centred). On a
+    test unit, each test's level ``y = log(dry) - b (T - 20)`` per axis; the axis whose last three
+    tests rose most over its first three; on it the model ``y = L0 + log(1 + 0.4 G(c (A - A0)+))`` with
+    ``A`` the cumulative logged duty (the load-life law of the card), fitted on a grid of every growth
+    law of :data:`prognostics_v3.LAWS`, :data:`SCALES` for ``c`` and up to :data:`ONSETS` onsets
+    ``A0`` (``L0`` at its least-squares value): the grid's likelihood under a Gaussian noise of the
+    best fit's variance weighs it, and :data:`DRAWS` draws from it (seeded by the records shown) give
+    the end of life ``A = A0 + 1/c`` at the last :data:`WINDOW` days' duty. No prediction with fewer
+    than 4 tests or while the best fit's wear now is under :data:`DETECT` %."""
+
+    def fit(self, units: list[files.Unit], failure_wear: float) -> TestsFit:
+        xs, ys = [], []
+        for unit in units:
+            on = np.flatnonzero(np.asarray(unit.arrays.get("friction_test", ()), dtype=bool))
+            if on.size < 3 or unit.fault_level is None:
+                continue
+            wear = np.zeros((on.size, 6))
+            if unit.worn_axis:
+                wear[:, unit.worn_axis - 1] = np.asarray(unit.fault_level)[on]
+            level = np.log(np.maximum(np.asarray(unit.arrays["friction_test_coulomb"])[on], 1e-9)) - np.log1p(wear / 100)
+            temp = np.asarray(unit.arrays["friction_test_temperature"])[on]
+            xs.append(temp - temp.mean(axis=0))
+            ys.append(level - level.mean(axis=0))
+        if not xs:
+            raise ValueError("tests_fit: no train unit with three friction tests")
+        x, y = np.concatenate(xs).ravel(), np.concatenate(ys).ravel()
+        self.slope_, self.failure_wear = float(x @ y / (x @ x)), failure_wear
+        return self
+
+    def predict(self, unit: files.Unit):
+        on = np.flatnonzero(np.asarray(unit.arrays.get("friction_test", ()), dtype=bool))
+        if on.size < 4:
+            return None
+        level = np.log(np.maximum(np.asarray(unit.arrays["friction_test_coulomb"])[on], 1e-9))
+        level -= self.slope_ * (np.asarray(unit.arrays["friction_test_temperature"])[on] - 20.0)
+        axis = int(np.argmax(level[-3:].mean(axis=0) - np.median(level[:3], axis=0)))
+        y = level[:, axis]
+        duty = _duty(unit)
+        cumulative = np.cumsum(duty[:, axis])
+        onsets = np.unique(cumulative[np.linspace(0, on[-1], min(ONSETS, on[-1] + 1)).astype(int)]) - 1e-9
+        age = np.maximum(cumulative[on][None, :] - onsets[:, None], 0.0)  # (onsets, tests)
+        fits = []
+        for law in prognostics_v3.LAWS:
+            shape = np.log1p(self.failure_wear / 100.0 * prognostics_v3.growth(law, SCALES[:, None, None] * age[None]))
+            residual = y - shape
+            residual -= residual.mean(axis=-1, keepdims=True)  # L0 at its least-squares value
+            fits.append((np.sum(residual ** 2, axis=-1), shape[..., -1]))  # (scales, onsets)
+        sse = np.stack([f[0] for f in fits])  # (laws, scales, onsets)
+        now_wear = 100.0 * np.expm1(np.stack([f[1] for f in fits]))
+        best = np.unravel_index(int(np.argmin(sse)), sse.shape)
+        if now_wear[best] < DETECT:
+            return None
+        variance = max(float(sse[best]) / max(on.size - 3, 1), 1e-12)
+        weight = np.exp(-(sse - sse[best]) / (2.0 * variance)).ravel()
+        picked = np.random.default_rng(len(unit.arrays["cycles"])).choice(weight.size, DRAWS, p=weight / weight.sum())
+        _, scale, start = np.unravel_index(picked, sse.shape)
+        now = float(unit.arrays["cycles"][-1])
+        rate = _rate(unit, duty)[axis]
+        left = np.maximum(onsets[start] + 1.0 / SCALES[scale] - cumulative[-1], 0.0)
+        return np.minimum(now + left / rate, MAX_TIME) if rate > 0 else np.full(DRAWS, np.inf)

@@ -4,9 +4,9 @@ other baseline.
 
 **Who is scored.** The method, and beside it every baseline of :data:`BASELINES`: the naive
 (``mean_life``, :class:`~faultgen.bench.prognosers.MeanLife`), the load-based rated life
-(``load_life``) and the oracle (``oracle``, the ceiling, which reads the labels:
-:mod:`faultgen.bench.prognosers_v3`), the linear and exponential fits of a health index
-(:mod:`faultgen.bench.degradation`). Each learns from ``train.h5`` and is shown a test unit's
+(``load_life``), a fit of the friction tests' wear (``tests_fit``; not the twin) and the oracle
+(``oracle``, the ceiling, which reads the labels): :mod:`faultgen.bench.prognosers_v3`; the linear and
+exponential fits of a health index (:mod:`faultgen.bench.degradation`). Each learns from ``train.h5`` and is shown a test unit's
 records up to the time of prediction (the oracle with their labels).
 
 **When (lambda).** Per run-to-failure test unit (its wear reaches :data:`FAILURE_WEAR` within its
@@ -53,7 +53,7 @@ HORIZON = 365.0
 GRID = 6
 NO_EOL_BEFORE = 30
 RESAMPLES = 2000
-BASELINES = ("mean_life", "load_life", "linear", "exponential", "oracle")
+BASELINES = ("mean_life", "load_life", "linear", "exponential", "tests_fit", "oracle")
 #: The baselines that read the labels of the records shown (never a submission).
 LABELLED = ("oracle",)
 #: Score -> (key of the per-unit row, whether higher is better).
@@ -67,7 +67,7 @@ def baseline(name: str):
 
     made = {"mean_life": prognosers.MeanLife, "load_life": prognosers_v3.LoadLife,
             "linear": degradation.LinearDegradation, "exponential": degradation.ExponentialDegradation,
-            "oracle": prognosers_v3.Oracle}.get(name)
+            "tests_fit": prognosers_v3.TestsFit, "oracle": prognosers_v3.Oracle}.get(name)
     if made is None:
         raise ValueError(f"prognostics v3 baseline {name!r}; expected one of {', '.join(BASELINES)}")
     return made()
