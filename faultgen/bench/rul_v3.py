@@ -330,7 +330,8 @@ def markdown_row(results: dict, command: str) -> str:
     size = "" if results.get("size") == "full" else f" ({results.get('size')})"
     variant = results.get("variant", "scatter-14")
     track = f"prognostics v3{size}" + ("" if variant == "scatter-14" else f" {variant}")
-    others = " / ".join(f"{results['anchors'][a]['results']['ra']['value']:.2f}" for a in ("wear20", "wear30", "saxena"))
+    others = " / ".join(_cell({**results["anchors"][a]["results"]["ra"], "ci95": [0.0, 0.0]}).split(" [")[0]
+                        for a in ("wear20", "wear30", "saxena"))
     best = f"{head['best_other']}: {_versus(head['vs_best']['ra'])}" if head["best_other"] else "-"
     cells = [_cell(r["ra"]), _versus(head["vs_naive"]["ra"]) if results["method"] != "mean_life" else "(the naive)",
              best, _cell(r["alpha_lambda"], 100, 0), _cell(r["late_share"], 100, 0), _cell(r["phm08"], 1, 3, "g"),
