@@ -186,7 +186,7 @@ def test_the_command_scores_v3_with_every_baseline_and_its_variants(v3_small, tm
     assert written["comparable"] is True and written["variant"] == "noscatter-none"
     assert set(written["baselines"]) == set(rul_v3.BASELINES) - {"oracle"}
     head = written["anchors"][rul_v3.HEADLINE]
-    assert head["results"]["ra"]["units"] == 3 and head["best_other"] in ("load_life", "linear", "exponential")
+    assert head["results"]["ra"]["units"] == 3 and head["best_other"] in ("load_life", "linear", "exponential", "tests_fit")
     # the naive against itself: a difference of 0 on every unit
     naive = written["baselines"]["mean_life"]["anchors"][rul_v3.HEADLINE]["vs_naive"]["ra"]
     assert naive["value"] == 0 and naive["verdict"] == "not distinguishable"
