@@ -120,9 +120,9 @@ def test_the_logs_scatter_scales_the_same_draws_and_leaves_the_others_be(kr210):
     model = robots.load(kr210)
     unit = independent._units(CELL, 6)[0]
     days = {s: next(independent._days(dataclasses.replace(CELL, log_jitter=s), unit, model)) for s in (0.03, 0.015)}
-    assert np.allclose(np.log(days[0.015]["jitter"]), np.log(days[0.03]["jitter"]) / 2, rtol=1e-12, atol=0)
+    assert np.allclose(np.log(days[0.015].jitter), np.log(days[0.03].jitter) / 2, rtol=1e-12, atol=0)
     for key in ("temperature", "mass", "noise", "program", "phase", "span"):
-        assert np.array_equal(days[0.015][key], days[0.03][key])
+        assert np.array_equal(getattr(days[0.015], key), getattr(days[0.03], key))
 
 
 def test_the_tests_truth_carries_the_dry_laws_temperature(written, kr210):

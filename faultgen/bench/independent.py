@@ -371,10 +371,30 @@ def _levels(spec: FleetSpec, unit: dict, day: int, nominal, jitter: np.ndarray, 
     return fc, fs, fv
 
 
+@dataclass(frozen=True)
+class Day:
+    """One day's draws of a unit (:func:`_days`): its day (1-based) and stamp, joint ``temperature``
+    (N,) deg C, part ``mass`` kg, friction ``jitter`` (3, N), whether its program ``changed``, the
+    log's ``noise`` and ``angle_noise`` (n, N), and its layout: whole ``cycles`` at ``rate`` Hz of
+    ``program`` (0-based), or ``span`` cycles (None: whole cycles) from ``phase``."""
+
+    day: int
+    stamp: str
+    temperature: np.ndarray
+    mass: float
+    jitter: np.ndarray
+    changed: bool
+    noise: np.ndarray
+    angle_noise: np.ndarray
+    cycles: int
+    rate: float
+    program: int
+    phase: float
+    span: float | None
+
+
 def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
-    """A unit's daily draws in the order the writer makes them, one dict a day: ``day, stamp,
-    temperature, mass, jitter, changed, noise, angle_noise, cycles, rate, program, phase, span``
-    (noise and angle noise shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles``
+    """A unit's daily draws in the order the writer makes them, one :class:`Day` a day (noise and angle noise shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles``
     of the motion at ``rate`` Hz, or the ``span`` of cycles from ``phase`` of the day's ``program``
     (:func:`faultgen.bench.cell.day_layouts`); a layout other than one cycle of program 0 at
     :attr:`FleetSpec.rate` draws them from its own stream, after the default layout's draws, so that
@@ -396,9 +416,7 @@ def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
             length = len(_motion(model, rate, changed, cell.VARIANT_SHRINK[program])[1])
             shape = (cycles * length if span is None else cell.samples(length, phase, span)[1], n)
             noise, angle_noise = other.normal(0.0, 1.0, shape), other.normal(0.0, ANGLE_NOISE, shape)
-        yield {"day": d, "stamp": stamp, "temperature": temperature, "mass": mass, "jitter": jitter,
-               "changed": changed, "noise": noise, "angle_noise": angle_noise, "cycles": cycles, "rate": rate,
-               "program": program, "phase": phase, "span": span}
+        yield Day(d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate, program, phase, span)
 
 
 def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int,
@@ -460,7 +478,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
             (folder_of_unit / TEST_FOLDER / f"{days[d - 1]}.csv").is_file() for d in tested)
         folder_of_unit.mkdir(parents=True, exist_ok=True)
         for day in _days(spec, unit, model):
-            d, stamp, temperature = day["day"], day["stamp"], day["temperature"]
+            d, stamp, temperature = day.day, day.stamp, day.temperature
             if d in tested:
                 warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n, spec.test_jitter)
                 fc, fs, fv = _levels(spec, unit, d, nominal, test_jitter, warmth)
@@ -468,10 +486,10 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
                 if not kept:
                     write_friction_test(folder_of_unit / TEST_FOLDER / f"{stamp}.csv", header, model, spec.rate,
                                lambda w, fc=fc, fs=fs, fv=fv: motor_friction(w, fc, fs, fv), warmth, rng)
-            program_rows.append([unit["unit"], stamp, day["program"],
-                                 f"{day['cycles'] if day['span'] is None else day['span']:.4f}", f"{day['phase']:.4f}"])
+            program_rows.append([unit["unit"], stamp, day.program,
+                                 f"{day.cycles if day.span is None else day.span:.4f}", f"{day.phase:.4f}"])
             if not kept:  # a kept unit: drawn in one go from its own seed, complete, as the same seed draws it
-                levels = _levels(spec, unit, d, nominal, day["jitter"], temperature)
+                levels = _levels(spec, unit, d, nominal, day.jitter, temperature)
                 _write_day(folder_of_unit / f"{stamp}.csv", header, model, day, levels)
     truth = root / "truth.csv"
     _write_table(truth, TRUTH_COLUMNS, truth_rows(spec, n))
@@ -488,22 +506,22 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     return logs, truth
 
 
-def _write_day(path: Path, header, model: robots.Robot, day: dict, levels) -> None:
-    """Write one daily log (a dict of :func:`_days`) at ``path``: the day's program at its rate, whole
+def _write_day(path: Path, header, model: robots.Robot, day: Day, levels) -> None:
+    """Write one daily log (a :class:`Day`) at ``path``: the day's program at its rate, whole
     back-to-back cycles or its span from its phase (:func:`faultgen.bench.cell.cut`), the arm-side
     torque Pinocchio's RNEA with the day's part plus the reflected motor inertia plus ``G f(G qd)``
     at the motor-side friction ``levels`` (Coulomb, static, viscous), and the noise model."""
-    G, jm, rate, changed = model.gear_ratio, model.motor_inertia, day["rate"], day["changed"]
-    shrink, mass = cell.VARIANT_SHRINK[day["program"]], round(day["mass"], 1)
+    G, jm, rate, changed = model.gear_ratio, model.motor_inertia, day.rate, day.changed
+    shrink, mass = cell.VARIANT_SHRINK[day.program], round(day.mass, 1)
     cycle = (*_motion(model, rate, changed, shrink)[1:], _rigid(model, rate, mass, changed, shrink))
-    if day["span"] is None:
-        q, qd, qdd, rigid = (np.tile(x, (day["cycles"], 1)) for x in cycle)
+    if day.span is None:
+        q, qd, qdd, rigid = (np.tile(x, (day.cycles, 1)) for x in cycle)
     else:
-        q, qd, qdd, rigid = (cell.cut(x, day["phase"], day["span"]) for x in cycle)
+        q, qd, qdd, rigid = (cell.cut(x, day.phase, day.span) for x in cycle)
     t = np.arange(len(q)) / rate  # back-to-back cycles: the next starts a sample after the last ends
     tau = rigid + G**2 * jm * qdd + G * motor_friction(G * qd, *levels)
-    tau = tau + day["noise"] * NOISE * np.sqrt(np.mean(tau**2, axis=0))
-    _write_csv(path, header, t, q + day["angle_noise"], tau, np.round(day["temperature"], 2), mass)
+    tau = tau + day.noise * NOISE * np.sqrt(np.mean(tau**2, axis=0))
+    _write_csv(path, header, t, q + day.angle_noise, tau, np.round(day.temperature, 2), mass)
 
 
 def _write_table(path: Path, columns, rows) -> None:
