@@ -18,17 +18,19 @@ comparison). A fleet already there is kept (the same seed draws the same files).
 
 ``--monitor``: ``faultgen monitor LOGS --robot WORK/kr210 -o OUT`` on each fleet, timed, killed past
 ``--timeout`` s (then it has written nothing: the monitor writes its outputs at the end; its console
-with its progress is in ``OUT.console.txt``); printed:
-the time per log, the units monitored (units.csv's status), the program changes it reported (its
-notes "program changed at") against those the truth has (a unit meeting a program it had not run
-before, ``truth_programs.csv``), and the worn units' first alarm against the true wear. Each figure
-with its verdict against the issue's criterion. Results: docs/analysis.md, "A real cell: the baseline".
+with its progress is in ``OUT.console.txt``); printed: the CPU time per log (the monitor's and its
+children's: on a shared machine the wall time is not its own), the units monitored (units.csv's
+status), the program changes it reported (its notes "program changed at") against those the truth
+has (a unit meeting a program it had not run before, ``truth_programs.csv``), and the worn units'
+first alarm against the true wear. Each figure with its verdict against the issue's criterion.
+Results: docs/analysis.md, "A real cell: the baseline".
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import resource
 import subprocess
 import sys
 import time
@@ -75,21 +77,27 @@ def new_programs(root: Path) -> dict[str, list[str]]:
     return out
 
 
-def run_monitor(logs: Path, robot: Path, out: Path, timeout: float, jobs: int) -> tuple[float, int | None]:
-    """``faultgen monitor`` on ``logs``: (wall time s, exit status or None when killed past ``timeout``)."""
+def run_monitor(logs: Path, robot: Path, out: Path, timeout: float, jobs: int) -> tuple[float, float, int | None]:
+    """``faultgen monitor`` on ``logs``: (wall time s, CPU time s of it and its children, exit status
+    or None when killed past ``timeout``). On a shared machine the CPU time is the figure to compare."""
     command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
                "--jobs", str(jobs)]
-    started = time.perf_counter()
+    started, cpu = time.perf_counter(), _children_cpu()
     console = out.with_name(out.name + ".console.txt")  # its progress, read when it was killed
     try:
         with open(console, "w") as sink:
             result = subprocess.run(command, env=children.environment(), stdout=sink, stderr=subprocess.STDOUT,
                                     text=True, timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
-        return time.perf_counter() - started, None
+        return time.perf_counter() - started, _children_cpu() - cpu, None
     if result.returncode not in (0, 3):
         raise SystemExit(f"{' '.join(command)} failed ({result.returncode}):\n{console.read_text()[-3000:]}")
-    return time.perf_counter() - started, result.returncode
+    return time.perf_counter() - started, _children_cpu() - cpu, result.returncode
+
+
+def _children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def summary(root: Path, out: Path, fleet: independent.FleetSpec) -> list[str]:
@@ -147,13 +155,14 @@ def main() -> None:
               f"{time.perf_counter() - started:.0f} s ({logs})")
         if not args.monitor:
             continue
-        wall, code = run_monitor(logs, robot, root / "monitor", args.timeout, args.jobs)
+        wall, cpu, code = run_monitor(logs, robot, root / "monitor", args.timeout, args.jobs)
         n = fleet.units * fleet.days
         if code is None:
-            print(f"  faultgen monitor killed after {wall:.0f} s (--timeout): no outputs; more than "
-                  f"{wall / n:.1f} s per log ({n} logs)")
+            print(f"  faultgen monitor killed after {wall:.0f} s (--timeout; the CPU time of a killed run is not "
+                  f"counted): no outputs; more than {wall / n:.1f} s wall per log ({n} logs)")
             continue
-        print(f"  faultgen monitor: exit {code}, {wall:.0f} s, {wall / n:.2f} s per log ({n} logs, --jobs {args.jobs})")
+        print(f"  faultgen monitor: exit {code}, {wall:.0f} s wall, {cpu:.0f} s CPU: {cpu / n:.2f} s CPU per log "
+              f"({n} logs, --jobs {args.jobs})")
         for line in summary(root, root / "monitor", fleet):
             print(line)
 
