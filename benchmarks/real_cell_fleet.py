@@ -3,7 +3,7 @@
 options in :mod:`faultgen.bench.cell`), and optionally today's ``faultgen monitor`` run on one.
 
     python benchmarks/real_cell_fleet.py WORK [--scatter 0.015 0.03] [--units 12] [--worn 8] [--days 120]
-        [--seed 0] [--one-program] [--monitor] [--timeout S] [--jobs N]
+        [--seed 0] [--one-program] [--rates 3 0.3] [--monitor] [--timeout S] [--jobs N]
 
 Each fleet, ``WORK/scatter-<sigma>[-one-program]/``: KR210 units (rtb-data's KR210 L150, added as
 ``faultgen robots add`` adds it, in ``WORK/kr210``) logging once a day; the cell has 3 programs (the
@@ -14,7 +14,9 @@ the record to 60 % on the last; the dry friction falling 0.4 % per kelvin and th
 generator's law (deterministic); the friction of each log and each test scattering from day to day
 by ``--scatter`` (log-normal sigma, both alike; the issue's 1.5 % and 3 %). ``--one-program``: the
 same fleets with every unit on the pick and place alone and one whole cycle a log (the issue's
-comparison). A fleet already there is kept (the same seed draws the same files).
+comparison). ``--rates 3 0.3``: the first two worn units wear 3 and 0.3 points a day from their onset
+instead (the issue's fast and slow wear; ``-rates`` in the folder's name). A fleet already there is
+kept (the same seed draws the same files).
 
 ``--monitor``: ``faultgen monitor LOGS --robot WORK/kr210 -o OUT`` on each fleet, timed, killed past
 ``--timeout`` s (then it has written nothing: the monitor writes its outputs at the end; its console
@@ -51,13 +53,14 @@ MONITORED_BY, ALARM = 40, (8.0, 15.0)
 
 
 def spec(scatter: float, units: int = 12, worn: int = 8, days: int = 120, seed: int = 0,
-         one_program: bool = False) -> independent.FleetSpec:
-    """The issue's fleet at ``scatter`` (module docstring); ``one_program``: one program, whole cycles."""
+         one_program: bool = False, rates: tuple[float, ...] = ()) -> independent.FleetSpec:
+    """The issue's fleet at ``scatter`` (module docstring); ``one_program``: one program, whole cycles;
+    ``rates``: the first worn units' wear in points a day."""
     cell_options = {} if one_program else {"programs": PROGRAMS, "unit_programs": UNIT_PROGRAMS, "span": SPAN}
     return independent.FleetSpec(
         units=units, worn=worn, days=days, seed=seed, onset=(max(days // 6, 1), max(days * 5 // 12, 1)),
         friction_test_every=TEST_EVERY, wear_laws=cell.WEAR_LAWS, log_jitter=scatter, test_jitter=scatter,
-        dry_per_k=DRY_PER_K, **cell_options)
+        dry_per_k=DRY_PER_K, wear_rates=tuple(rates), **cell_options)
 
 
 def new_programs(root: Path) -> dict[str, list[str]]:
@@ -139,6 +142,7 @@ def main() -> None:
     parser.add_argument("--days", type=int, default=120)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--one-program", action="store_true")
+    parser.add_argument("--rates", type=float, nargs="*", default=[])
     parser.add_argument("--monitor", action="store_true")
     parser.add_argument("--timeout", type=float, default=3600.0)
     parser.add_argument("--jobs", type=int, default=1)
@@ -147,8 +151,8 @@ def main() -> None:
     if not (robot / "drivetrain.toml").is_file():
         pinocchio_log.add_kr210(robot)
     for scatter in args.scatter:
-        fleet = spec(scatter, args.units, args.worn, args.days, args.seed, args.one_program)
-        root = args.work / f"scatter-{scatter:g}{'-one-program' if args.one_program else ''}"
+        fleet = spec(scatter, args.units, args.worn, args.days, args.seed, args.one_program, tuple(args.rates))
+        root = args.work / f"scatter-{scatter:g}{'-one-program' if args.one_program else ''}{'-rates' if args.rates else ''}"
         started = time.perf_counter()
         logs, _ = independent.write_fleet(root, fleet, robot)
         print(f"fleet {root.name}: {fleet.units} units x {fleet.days} days written in "

@@ -103,6 +103,19 @@ def test_the_worn_units_follow_the_laws_in_turn(written):
     assert truth[units[0]["unit"]]["wear"][-1] == pytest.approx(CELL.final_wear)
 
 
+def test_the_first_worn_units_wear_at_their_rates_and_the_others_by_their_laws():
+    spec = dataclasses.replace(CELL, days=30, wear_rates=(3.0, 0.3))
+    units = [u for u in independent._units(spec, 6) if u["axis"]]
+    truth = {}
+    for unit, _, _, wear in independent.truth_rows(spec):
+        truth.setdefault(unit, []).append(float(wear))
+    for unit, rate in zip(units, (3.0, 0.3)):
+        days = np.arange(1, 31)
+        assert np.allclose(truth[unit["unit"]], rate * np.clip(days - unit["onset"], 0, None), atol=1e-4)
+    assert truth[units[2]["unit"]][-1] == pytest.approx(spec.final_wear)  # the third by its law
+    assert [u["rate"] for u in independent._units(CELL, 6)] == [None] * 3
+
+
 def test_the_dry_friction_falls_with_temperature_by_its_law_and_the_viscous_as_before():
     unit = independent._units(CELL, 6)[0]
     nominal = (np.ones(6), np.full(6, 0.5), np.full(6, 0.01))
@@ -150,9 +163,11 @@ def test_the_tests_truth_carries_the_dry_laws_temperature(written, kr210):
     ("wear_laws", ("cubic",), r"^fleet wear_laws = \('cubic',\): expected laws among linear, quadratic, exponential$"),
     ("log_jitter", 0.6, r"^fleet log_jitter = 0\.6: expected a daily log's friction scatter"),
     ("dry_per_k", 0.1, r"^fleet dry_per_k = 0\.1: expected the dry friction's fall per kelvin in \[0, 0\.02\]$"),
+    ("wear_rates", (3.0, 1.0, 1.0, 1.0), r"^fleet wear_rates = \(3\.0, 1\.0, 1\.0, 1\.0\): expected at most 3 \(the worn"),
+    ("wear_rates", (0.0,), r"^fleet wear_rates = \(0\.0,\): expected at most"),
 ])
 def test_a_bad_cell_setting_is_refused_by_name(field, value, message):
-    settings = {"programs": 2} if field == "unit_programs" else {}
+    settings = {"unit_programs": {"programs": 2}, "wear_rates": {"worn": 3}}.get(field, {})
     with pytest.raises(ValueError, match=message):
         independent.FleetSpec(**{**settings, field: value})
 

@@ -13,7 +13,9 @@ bit for bit:
   holds ``s`` cycles' worth of samples, ``s`` drawn uniformly in ``[a, b]``, starting at a phase
   drawn uniformly in ``[0, 1)`` of the cycle (:func:`cut`): a controller's buffer, cut where it was cut.
 - **Wear laws**: linear, quadratic and exponential (:func:`wear_fraction`), given to the worn units
-  in turn (:attr:`~faultgen.bench.independent.FleetSpec.wear_laws`).
+  in turn (:attr:`~faultgen.bench.independent.FleetSpec.wear_laws`); or a rate in points a day from
+  the onset on the first worn units (:attr:`~faultgen.bench.independent.FleetSpec.wear_rates`: a
+  fast wear of 3 points a day, a slow one of 0.3).
 
 Every draw here comes from streams of their own (``[seed, 4, unit index]`` for a unit's programs,
 ``[unit seed, 4]`` for its days), so that the fleet's other draws are the same whatever is chosen.
@@ -52,7 +54,7 @@ def wear_fraction(law: str, x: float) -> float:
 
 def check(spec) -> dict:
     """The cell's settings of ``spec`` (a :class:`~faultgen.bench.independent.FleetSpec`) checked:
-    ``{"wear_laws", "unit_programs", "span"}`` as tuples; ValueError naming a bad one."""
+    ``{"wear_laws", "unit_programs", "span", "wear_rates"}`` as tuples; ValueError naming a bad one."""
     laws = tuple(spec.wear_laws)
     for law in laws:
         if law not in WEAR_LAWS:
@@ -72,7 +74,12 @@ def check(spec) -> dict:
     if span and tuple(spec.cycles) != (1,):
         raise ValueError(f"fleet span = {spec.span!r} with cycles = {spec.cycles!r}: a log holds a span or whole "
                          "cycles, not both")
-    return {"wear_laws": laws, "unit_programs": counts, "span": span}
+    rates = tuple(spec.wear_rates)
+    if len(rates) > spec.worn or not all(isinstance(r, (int, float)) and not isinstance(r, bool) and 0 < r <= 100
+                                         for r in rates):
+        raise ValueError(f"fleet wear_rates = {spec.wear_rates!r}: expected at most {spec.worn} (the worn units) "
+                         "rates in points a day, each in (0, 100]")
+    return {"wear_laws": laws, "unit_programs": counts, "span": span, "wear_rates": tuple(float(r) for r in rates)}
 
 
 def unit_programs(spec, index: int) -> tuple[int, ...]:

@@ -155,7 +155,8 @@ class FleetSpec:
     ``log_jitter``; ``dry_per_k`` the dry friction's fall per kelvin above 20 deg C (a deterministic
     law, as the viscous one, :data:`VISCOUS_PER_K`; 0 by default); ``wear_growth`` the exponent of the
     wear's rise (:func:`wear_percent`; 1, linear, by default), or ``wear_laws`` the laws given to the
-    worn units in turn (:data:`faultgen.bench.cell.WEAR_LAWS`); each log holds a number of
+    worn units in turn (:data:`faultgen.bench.cell.WEAR_LAWS`), the first worn units wearing
+    ``wear_rates`` points a day from their onset instead (a fast and a slow wear); each log holds a number of
     back-to-back cycles drawn from ``cycles`` at a rate drawn from ``rates`` Hz (empty: ``rate``;
     :func:`faultgen.bench.layouts.draws`), or with ``span`` ``(a, b)`` a span of ``a``-``b`` cycles
     from a random phase; the cell has ``programs`` programs, each unit running as many as
@@ -186,6 +187,7 @@ class FleetSpec:
     programs: int = 1
     unit_programs: tuple[int, ...] = (1,)
     span: tuple[float, ...] = ()
+    wear_rates: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         for name, value in cell.check(self).items():
@@ -263,7 +265,7 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
             "seed": int(rng.integers(2**31)),
             "new_part_day": int(rng.integers(spec.days * 5 // 12, spec.days * 2 // 3 + 1)),
             "new_weeks": rng.integers(0, 3, spec.days // 7 + 1),
-            "gearbox_day": 0, "program_day": 0, "law": None, "programs": cell.unit_programs(spec, i),
+            "gearbox_day": 0, "program_day": 0, "law": None, "rate": None, "programs": cell.unit_programs(spec, i),
         })
     if spec.rated_part:  # the heaviest part drawn becomes the heaviest allowed
         unit, k = max(((u, k) for u in out for k in range(3)), key=lambda uk: uk[0]["parts"][uk[1]])
@@ -273,8 +275,10 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
     worn_units = [u for u in out if u["axis"]]
     for k, u in enumerate(worn_units if spec.wear_laws else ()):  # the laws in turn, no draw
         u["law"] = spec.wear_laws[k % len(spec.wear_laws)]
+    for u, rate in zip(worn_units, spec.wear_rates):  # the first worn units at their rates, no draw
+        u["rate"] = rate
     for u in [worn_units[k] for k in sorted(changes.permutation(len(worn_units))[: spec.gearbox_changes])]:
-        passed = next((d for d in range(1, spec.days + 1) if wear_percent(spec, u["onset"], d, u["law"]) >= CHANGE_WEAR), None)
+        passed = next((d for d in range(1, spec.days + 1) if wear_percent(spec, u["onset"], d, u["law"], u["rate"]) >= CHANGE_WEAR), None)
         if passed is None or passed + CHANGE_DELAY > spec.days:
             raise ValueError(f"fleet gearbox_changes: {u['unit']}'s wear passes {CHANGE_WEAR:g} % on day {passed}, "
                              f"less than {CHANGE_DELAY} days before the last ({spec.days}); expected more days")
@@ -285,13 +289,16 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
     return out
 
 
-def wear_percent(spec: FleetSpec, onset: int, day: int, law: str | None = None) -> float:
-    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): from the
-    onset to ``final_wear`` on the last day, by ``law`` (:func:`faultgen.bench.cell.wear_fraction`
-    of the share of the time since the onset) or, None, as the power ``wear_growth`` of that share
-    (1: linear; 2: its rate growing in proportion to that time)."""
+def wear_percent(spec: FleetSpec, onset: int, day: int, law: str | None = None, rate: float | None = None) -> float:
+    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): ``rate``
+    points a day since the onset (:attr:`FleetSpec.wear_rates`), else from the onset to
+    ``final_wear`` on the last day, by ``law`` (:func:`faultgen.bench.cell.wear_fraction` of the
+    share of the time since the onset) or, None, as the power ``wear_growth`` of that share (1:
+    linear; 2: its rate growing in proportion to that time)."""
     if day < onset:
         return 0.0
+    if rate is not None:
+        return rate * (day - onset)
     if law is not None:
         return spec.final_wear * cell.wear_fraction(law, (day - onset) / max(spec.days - onset, 1))
     if spec.wear_growth == 1.0:
@@ -303,7 +310,7 @@ def _wear(spec: FleetSpec, unit: dict, day: int) -> float:
     """A unit's true wear on ``day``: 0 on a healthy unit and from its gearbox change on."""
     if not unit["axis"] or (unit["gearbox_day"] and day >= unit["gearbox_day"]):
         return 0.0
-    return wear_percent(spec, unit["onset"], day, unit["law"])
+    return wear_percent(spec, unit["onset"], day, unit["law"], unit["rate"])
 
 
 def truth_rows(spec: FleetSpec, n_axes: int = 6) -> list[list]:
