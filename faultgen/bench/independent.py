@@ -401,8 +401,9 @@ class Day:
 
 
 def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
-    """A unit's daily draws in the order the writer makes them, one :class:`Day` a day (noise and angle noise shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles``
-    of the motion at ``rate`` Hz, or the ``span`` of cycles from ``phase`` of the day's ``program``
+    """A unit's daily draws in the order the writer makes them, one :class:`Day` a day (noise and
+    angle noise shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles`` of the
+    motion at ``rate`` Hz, or the ``span`` of cycles from ``phase`` of the day's ``program``
     (:func:`faultgen.bench.cell.day_layouts`); a layout other than one cycle of program 0 at
     :attr:`FleetSpec.rate` draws them from its own stream, after the default layout's draws, so that
     every other draw is the same)."""
