@@ -110,8 +110,10 @@ def test_the_defaults_follow_the_sizing_rules_and_the_catalogues():
     ratings = rating.of_robot(robot)
     assert [r.gearbox_type for r in ratings] == ["cycloid"] * 3 + ["strain-wave"] * 3
     assert all(r.defaults == rating.KEYS for r in ratings)
-    # axis 2: motor torque limit 1.855 N m x G 107.815 / 2.5; cycloid 15 rpm, 6000 h
-    assert ratings[1].rated_torque == pytest.approx(1.855 * 107.815 / 2.5)
+    # axis 2: its gear output's peak (about 104 N m) within RV-6E's 2.5 x 58 N m; cycloid 15 rpm, 6000 h
+    assert ratings[1].rated_torque == 58.0 and not ratings[1].unrated
+    # axis 4 (strain-wave): motor torque limit 0.29 N m x G 76.0364 / 2.5
+    assert ratings[3].rated_torque == pytest.approx(robot.motor_torque_limit[3] * 76.0364 / 2.5, rel=1e-4)
     assert ratings[1].rated_speed == pytest.approx(15 * 2 * math.pi / 60) and ratings[1].rated_life == 6000
     # axis 4: strain-wave, 2000 rpm at the input over G 76.0364, 7000 h
     assert ratings[3].rated_speed == pytest.approx(2000 * 2 * math.pi / 60 / 76.0364) and ratings[3].rated_life == 7000

@@ -124,12 +124,15 @@ def test_life_csv_gives_each_axis_the_life_its_load_consumed_and_the_page_shows_
         data = measured.read(first, nominal)
         ratings = life.ratings_of(nominal)
         shares = life.consumed(np.reshape(entries[0]["load"], (2, -1)), ratings)
-        assert shares == pytest.approx(life.consumption(data.t, data.qd, data.tau, ratings), rel=1e-12)
+        assert shares == pytest.approx(life.consumption(data.t, data.qd, data.tau, ratings), rel=1e-12, nan_ok=True)
         assert entries[0]["duration_s"] == data.t[-1] - data.t[0]
         mine = [r for r in rows if r["unit"] == unit]
         for r in mine:
             k = int(r["axis"]) - 1
             g = ratings[k]
+            if g.unrated:  # no catalogue size carries the KR210's main axes (issue 90): no consumption, no date
+                assert r["consumed_pct"] == r["days_left"] == "" and r["verdict"] == g.unrated
+                continue
             p = 0 if g.gearbox_type == "strain-wave" else 1  # the row of that exponent's integral
             shares = [e["load"][p * nominal.n_axes + k] / (g.rated_speed * g.rated_torque ** g.exponent * g.rated_life
                                                            * 3600) for e in entries]

@@ -13,7 +13,9 @@
   that ``bench score``, ``detect``, ``bench-isolators`` and ``bench baselines`` read (the PCA one's
   class in :mod:`~faultgen.bench.pca_detector`).
 - :mod:`~faultgen.bench.independent`: the sim-to-real track's test fleet, made by another simulator
-  (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use).
+  (Pinocchio's rigid-body dynamics, friction, conditions and wear in forms faultgen does not use;
+  its plant in :mod:`~faultgen.bench.plant`, a real cell's programs, cut logs and wear laws in
+  :mod:`~faultgen.bench.cell`).
 - :mod:`~faultgen.bench.rawlogs`, :mod:`~faultgen.bench.twin`, :mod:`~faultgen.bench.recorded`:
   ``faultgen monitor``'s twin as a baseline: a track's test split written again as raw logs, the
   monitor's outputs read as per-unit answers, and answers made elsewhere scored by :mod:`score`.

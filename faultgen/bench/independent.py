@@ -10,15 +10,19 @@ What is independent and what is ours:
   faultgen as a user would (``faultgen robots add kr210 --from kr210l150.urdf``; the bench adds it
   with the track version's sizing rule, :func:`faultgen.bench.make.add_robots`: its drives, and so
   this simulator's friction and motor inertia, are the folder's); the payload a box at
-  the flange (the URDF's ``tool0`` frame) placed by Pinocchio (:func:`pinocchio_model`).
+  the flange (the URDF's ``tool0`` frame) placed by Pinocchio (:func:`pinocchio_model`). The plant's
+  dynamics, motions and friction law are in :mod:`faultgen.bench.plant`.
 - **Motor-side friction: ours, written here, in a form faultgen does not use**: at motor speed
   ``w = G qd`` (rad/s), ``f(w) = (Fc + Fs / (1 + (w / ws)^2)) (2 / pi) atan(w / we) + Fv(T) w``
   (a Lorentzian Stribeck hump and an arctangent sign, where faultgen's eq. 6.3 has an exponential
   hump and its own smoothing), referred to the arm through the gear ratio, ``G f(G qd)``; viscous
   friction falling with the joint temperature, ``Fv(T) = Fv0 exp(-VISCOUS_PER_K (T - 20 C))``
-  (an Andrade-like law, ours). The magnitudes of ``Fc``, ``Fs``, ``Fv0`` are the robot folder's
+  (an Andrade-like law, ours); with :attr:`FleetSpec.dry_per_k` the dry levels ``Fc``, ``Fs`` fall
+  as ``1 - dry_per_k (T - 20 C)`` (none by default). Both laws are deterministic: what scatters is
+  the day's draw below. The magnitudes of ``Fc``, ``Fs``, ``Fv0`` are the robot folder's
   nominal ones (``drivetrain.toml``), each unit drawing its own (log-normal, :data:`SPREAD`), each
-  log scattering about them (:data:`JITTER`); the reflected motor inertia ``G^2 Jm qdd`` with the folder's
+  log scattering about them, dry and viscous alike (log-normal, :attr:`FleetSpec.log_jitter`, by
+  default :data:`JITTER`; a friction test by its own :attr:`FleetSpec.test_jitter`); the reflected motor inertia ``G^2 Jm qdd`` with the folder's
   ``Jm``.
 - **Conditions: ours**: a seasonal hall temperature (each unit its own mean and swing, on the
   calendar of its stamps: January cold) plus the joints' warm-up; a product change every week
@@ -27,8 +31,9 @@ What is independent and what is ours:
   (a new product) among them; Gaussian torque noise (:data:`NOISE` of each axis's
   torque RMS) and angle noise.
 - **Wear: ours**: on a worn unit, one axis (of :attr:`FleetSpec.wearable`) has its Coulomb and
-  Stribeck friction grow linearly from an onset day to :attr:`FleetSpec.final_wear` percent on the
-  last day.
+  Stribeck friction grow from an onset day to :attr:`FleetSpec.final_wear` percent on the last day,
+  linearly by default (:attr:`FleetSpec.wear_growth` a power, :attr:`FleetSpec.wear_laws` linear,
+  quadratic or exponential laws: :func:`faultgen.bench.cell.wear_fraction`).
 - **Maintenance and program changes: ours** (none by default): on
   :attr:`FleetSpec.gearbox_changes` worn units the worn axis's gearbox is changed
   :data:`CHANGE_DELAY` days after the wear passed :data:`CHANGE_WEAR` %: from that day the axis's
@@ -43,7 +48,10 @@ What is independent and what is ours:
   :attr:`FleetSpec.cycles` and :attr:`FleetSpec.rates` each log holds a drawn number of back-to-back
   cycles (no ``cycle`` column) at a drawn rate, from a stream of their own
   (:func:`faultgen.bench.layouts.draws`).
-
+- **A real cell: ours** (off by default; :mod:`faultgen.bench.cell`): :attr:`FleetSpec.programs`
+  variants of the pick and place in the cell, each unit running a subset (:attr:`FleetSpec.unit_programs`),
+  one a day; logs of a random span of cycles from a random phase (:attr:`FleetSpec.span`). Their
+  truth per log in ``ROOT/truth_programs.csv`` (:data:`PROGRAM_COLUMNS`), never read by the monitor.
 - **Friction tests: the motion faultgen's, the plant ours** (none by default): with
   :attr:`FleetSpec.friction_test_every` ``= D`` every unit runs a friction test on days 1, 1 + D,
   1 + 2 D, ...: the motion of ``faultgen tasks friction-test`` for the robot folder
@@ -71,42 +79,45 @@ Needs Pinocchio (``pin``, the ``bench`` extra: ``pip install 'faultgen-robots[be
 from __future__ import annotations
 
 import csv
-import dataclasses
 import datetime
 import io
 import os
 from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from faultgen.bench import layouts
+from faultgen.bench import cell, layouts, plant
+from faultgen.bench.plant import (  # noqa: F401  (the plant's names, read as this module's by tests and benchmarks)
+    ANGLE_NOISE,
+    FLANGE_FRAME,
+    NOISE,
+    PART_DENSITY,
+    PLAN_RATE,
+    PROGRAM_SHRINK,
+    SIGN_SPEED,
+    STRIBECK_SPEED,
+    changed_program,
+    friction_test_motion,
+    motor_friction,
+    pinocchio_model,
+    pinocchio_module,
+    write_friction_test,
+)
 from faultgen.data import cells
 from faultgen.model import robots
-from faultgen.operation import programs
 from faultgen.logs.columns import PAYLOAD_COLUMN, T_COLUMN, column_names, temperature_columns
 
+_motion, _rigid, _write_csv = plant.motion, plant.rigid, plant.write_csv
 #: Unit-to-unit spread of each friction parameter (log-normal sigma) and its day-to-day scatter,
 #: drawn per log and parameter and not logged (the state of the lubricant film, the warm-up the
 #: log's hour caught): ours. At 1 % the features of a log repeat to about 0.3 %, and the monitor
-#: flagged worn units at 3-8 % wear, before the issue's window (docs/analysis.md).
+#: flagged worn units at 3-8 % wear, before the issue's window (docs/analysis.md). The scatter of the
+#: logs and of the tests are :attr:`FleetSpec.log_jitter` and :attr:`FleetSpec.test_jitter`.
 SPREAD = 0.15
 JITTER = 0.03
-#: Stribeck speed and sign-smoothing speed of the motor-side friction, rad/s at the motor.
-STRIBECK_SPEED = 8.0
-SIGN_SPEED = 0.5
 #: Viscous friction's fall per kelvin of joint temperature (ours: gear oil thins as it warms).
 VISCOUS_PER_K = 0.02
-#: Torque noise per sample, a share of each axis's torque RMS; angle noise, rad.
-NOISE = 0.005
-ANGLE_NOISE = 1e-5
-#: The parts are aluminium cubes hanging from the flange (their centre half an edge from it, along
-#: the z axis of the URDF's ``tool0`` frame, as faultgen's payload condition places a part): the
-#: load data a robot's program declares, which the monitor is told. Their masses (5-35 kg) keep
-#: faultgen's twin of the motion within its drives' capacity (the KR210's axis 6: 366 N m at the arm,
-#: which the twin reached with a 60 kg part, Pinocchio's dynamics needing about 230 N m).
-PART_DENSITY = 2700.0
 #: Axes that may wear by default (the KR210's axis 6 motor sized by rule 1 is rated 3 N m: its
 #: friction is at the noise floor).
 WEARABLE = (1, 2, 3, 4, 5)
@@ -114,14 +125,11 @@ WEARABLE = (1, 2, 3, 4, 5)
 MAX_PART = 35.0
 #: A gearbox change comes this many days after the worn axis's wear passed CHANGE_WEAR percent.
 CHANGE_WEAR, CHANGE_DELAY = 20.0, 10
-#: A changed program's pick and place targets lie this share of the way from its start pose to the old ones.
-PROGRAM_SHRINK = 0.7
 #: The columns of changes.csv (the truth of the gearbox and program changes).
 CHANGE_COLUMNS = ("unit", "stamp", "change", "axis")
-#: The flange frame of the URDF (ROS-Industrial's ``tool0``); faultgen's builder puts its ``flange`` site there.
-FLANGE_FRAME = "tool0"
-#: The rate the motion is planned at, Hz (the planner's 4 ms, the thesis's sampling period).
-PLAN_RATE = 250.0
+#: The columns of truth_programs.csv (a cell of several programs or logs cut anywhere: :mod:`faultgen.bench.cell`):
+#: per log its program (0-based), the cycles its samples span and the phase of a cycle it starts at.
+PROGRAM_COLUMNS = ("unit", "stamp", "program", "span_cycles", "phase")
 #: The columns of truth.csv.
 TRUTH_COLUMNS = ("unit", "stamp", "worn_axis", "wear_percent")
 #: A unit's friction tests are in this folder of its log folder.
@@ -143,11 +151,17 @@ class FleetSpec:
     ``program_changes`` healthy units an unlogged program change; every ``friction_test_every`` days
     (0: never) each unit runs a friction test (module docstring), its friction scattering by
     ``test_jitter`` (log-normal sigma, as :data:`JITTER` for a log: the test's repeatability, by
-    default a log's; a protocol with its own warm-up may repeat better); ``wear_growth`` the exponent of the
-    wear's rise (:func:`wear_percent`; 1, linear, by default); each log holds a number of
+    default a log's; a protocol with its own warm-up may repeat better) and a daily log's by
+    ``log_jitter``; ``dry_per_k`` the dry friction's fall per kelvin above 20 deg C (a deterministic
+    law, as the viscous one, :data:`VISCOUS_PER_K`; 0 by default); ``wear_growth`` the exponent of the
+    wear's rise (:func:`wear_percent`; 1, linear, by default), or ``wear_laws`` the laws given to the
+    worn units in turn (:data:`faultgen.bench.cell.WEAR_LAWS`), the first worn units wearing
+    ``wear_rates`` points a day from their onset instead (a fast and a slow wear); each log holds a number of
     back-to-back cycles drawn from ``cycles`` at a rate drawn from ``rates`` Hz (empty: ``rate``;
-    :func:`faultgen.bench.layouts.draws`). Every draw comes from ``seed``; the defaults draw what the fleet drew before
-    these options existed."""
+    :func:`faultgen.bench.layouts.draws`), or with ``span`` ``(a, b)`` a span of ``a``-``b`` cycles
+    from a random phase; the cell has ``programs`` programs, each unit running as many as
+    ``unit_programs`` gives it in turn, one a day (:mod:`faultgen.bench.cell`). Every draw comes from
+    ``seed``; the defaults draw what the fleet drew before these options existed."""
 
     units: int = 12
     worn: int = 8
@@ -167,8 +181,17 @@ class FleetSpec:
     wear_growth: float = 1.0
     cycles: tuple[int, ...] = (1,)
     rates: tuple[float, ...] = ()
+    log_jitter: float = JITTER
+    dry_per_k: float = 0.0
+    wear_laws: tuple[str, ...] = ()
+    programs: int = 1
+    unit_programs: tuple[int, ...] = (1,)
+    span: tuple[float, ...] = ()
+    wear_rates: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
+        for name, value in cell.check(self).items():
+            object.__setattr__(self, name, value)
         cycles, rates = layouts.check(self.cycles, (*self.rates, self.rate), PLAN_RATE)
         object.__setattr__(self, "cycles", cycles)
         object.__setattr__(self, "rates", rates[:-1])
@@ -180,9 +203,13 @@ class FleetSpec:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise ValueError(f"fleet {name} = {value!r}: expected a whole number >= {low}")
-        if isinstance(self.test_jitter, bool) or not 0.0 <= float(self.test_jitter) <= 0.5:
-            raise ValueError(f"fleet test_jitter = {self.test_jitter!r}: expected a friction test's scatter "
-                             "(log-normal sigma) in [0, 0.5]")
+        for name, what in (("test_jitter", "a friction test's"), ("log_jitter", "a daily log's friction")):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not 0.0 <= float(value) <= 0.5:
+                raise ValueError(f"fleet {name} = {value!r}: expected {what} scatter (log-normal sigma) in [0, 0.5]")
+        if isinstance(self.dry_per_k, bool) or not 0.0 <= float(self.dry_per_k) <= 0.02:
+            raise ValueError(f"fleet dry_per_k = {self.dry_per_k!r}: expected the dry friction's fall per kelvin "
+                             "in [0, 0.02]")
         if self.worn > self.units:
             raise ValueError(f"fleet worn = {self.worn}: more than its {self.units} units")
         onset = tuple(self.onset)
@@ -207,31 +234,6 @@ class FleetSpec:
                              f"{self.units - self.worn} healthy units")
 
 
-def pinocchio_module():
-    """The ``pinocchio`` module; ImportError naming the extra that installs it."""
-    try:
-        import pinocchio
-    except ImportError:
-        raise ImportError("the independent simulator needs Pinocchio: pip install 'faultgen-robots[bench]' "
-                          "(or: pip install pin)") from None
-    return pinocchio
-
-
-def pinocchio_model(urdf: Path, mass: float = 0.0, com=(0.0, 0.0, 0.0), size=(0.0, 0.0, 0.0)):
-    """Pinocchio's model (``pin.Model``) of ``urdf``, with a solid box of ``mass`` kg, centre ``com``
-    (m, flange frame) and edges ``size`` (m) added to the inertia of the body that carries the flange
-    frame (:data:`FLANGE_FRAME`)."""
-    pin = pinocchio_module()
-    model = pin.buildModelFromUrdf(str(urdf))
-    if mass > 0:
-        frame = model.frames[model.getFrameId(FLANGE_FRAME)]
-        box = pin.Inertia.FromBox(mass, *size)
-        at_flange = pin.SE3(np.eye(3), np.asarray(com, dtype=float)).act(box)
-        joint = frame.parentJoint
-        model.inertias[joint] = model.inertias[joint] + frame.placement.act(at_flange)
-    return model
-
-
 def unit_names(spec: FleetSpec) -> list[str]:
     return [f"unit{i + 1:02d}" for i in range(spec.units)]
 
@@ -239,46 +241,6 @@ def unit_names(spec: FleetSpec) -> list[str]:
 def stamps(spec: FleetSpec) -> list[str]:
     first = datetime.date.fromisoformat(spec.start)
     return [(first + datetime.timedelta(days=d)).isoformat() for d in range(spec.days)]
-
-
-def changed_program(program, shrink: float = PROGRAM_SHRINK):
-    """``program`` (a :class:`faultgen.operation.programs.Program`) with every joint-space target
-    ``to`` moved to ``start + shrink (to - start)``: the same cycle between other poses."""
-    start = np.asarray(program.start, dtype=float)
-    segments = tuple(
-        dataclasses.replace(s, values={**s.values, "to": start + shrink * (np.asarray(s.values["to"]) - start)})
-        if s.type == "move" and "to" in s.values else s for s in program.segments)
-    return dataclasses.replace(program, segments=segments)
-
-
-@lru_cache(maxsize=8)
-def _motion(robot: robots.Robot, rate: float, changed: bool = False):
-    """The pick-and-place cycle of ``robot`` (as :func:`write_fleet` resolved its folder;
-    ``changed``: :func:`changed_program`'s) planned at 250 Hz (the planner's 4 ms), taken at ``rate`` Hz (planned at ``rate`` for a whole
-    multiple of 250 Hz: :func:`faultgen.bench.layouts.plan`)."""
-    dt, step = layouts.plan(rate, PLAN_RATE)
-    program = programs.load(robot, "pick_place")
-    path = (changed_program(program) if changed else program).trajectory(dt)
-    q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
-    return np.arange(len(q)) / rate, q, qd, qdd
-
-
-@lru_cache(maxsize=128)
-def _rigid(robot: robots.Robot, rate: float, mass: float, changed: bool = False) -> np.ndarray:
-    """Pinocchio's RNEA torque of the motion with a part of ``mass`` kg (:data:`PART_DENSITY`), from
-    the URDF in the robot's folder."""
-    pin = pinocchio_module()
-    _, q, qd, qdd = _motion(robot, rate, changed)
-    edge = (mass / PART_DENSITY) ** (1 / 3)
-    model = pinocchio_model(robot.path.parent / "urdf_used.urdf", mass, (0.0, 0.0, edge / 2), (edge, edge, edge))
-    data = model.createData()
-    return np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
-
-
-def motor_friction(w: np.ndarray, coulomb, static, viscous) -> np.ndarray:
-    """Motor-side friction torque, N m, at motor speed ``w`` rad/s (module docstring's form)."""
-    hump = coulomb + static / (1.0 + (w / STRIBECK_SPEED) ** 2)
-    return hump * (2.0 / np.pi) * np.arctan(w / SIGN_SPEED) + viscous * w
 
 
 def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
@@ -303,7 +265,7 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
             "seed": int(rng.integers(2**31)),
             "new_part_day": int(rng.integers(spec.days * 5 // 12, spec.days * 2 // 3 + 1)),
             "new_weeks": rng.integers(0, 3, spec.days // 7 + 1),
-            "gearbox_day": 0, "program_day": 0,
+            "gearbox_day": 0, "program_day": 0, "law": None, "rate": None, "programs": cell.unit_programs(spec, i),
         })
     if spec.rated_part:  # the heaviest part drawn becomes the heaviest allowed
         unit, k = max(((u, k) for u in out for k in range(3)), key=lambda uk: uk[0]["parts"][uk[1]])
@@ -311,8 +273,12 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
     # the changes from a stream of their own: without them, the draws above are the fleet's before
     changes = np.random.default_rng([spec.seed, 0, 1])
     worn_units = [u for u in out if u["axis"]]
+    for k, u in enumerate(worn_units if spec.wear_laws else ()):  # the laws in turn, no draw
+        u["law"] = spec.wear_laws[k % len(spec.wear_laws)]
+    for u, rate in zip(worn_units, spec.wear_rates):  # the first worn units at their rates, no draw
+        u["rate"] = rate
     for u in [worn_units[k] for k in sorted(changes.permutation(len(worn_units))[: spec.gearbox_changes])]:
-        passed = next((d for d in range(1, spec.days + 1) if wear_percent(spec, u["onset"], d) >= CHANGE_WEAR), None)
+        passed = next((d for d in range(1, spec.days + 1) if wear_percent(spec, u["onset"], d, u["law"], u["rate"]) >= CHANGE_WEAR), None)
         if passed is None or passed + CHANGE_DELAY > spec.days:
             raise ValueError(f"fleet gearbox_changes: {u['unit']}'s wear passes {CHANGE_WEAR:g} % on day {passed}, "
                              f"less than {CHANGE_DELAY} days before the last ({spec.days}); expected more days")
@@ -323,12 +289,18 @@ def _units(spec: FleetSpec, n_axes: int) -> list[dict]:
     return out
 
 
-def wear_percent(spec: FleetSpec, onset: int, day: int) -> float:
-    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): from the
-    onset to ``final_wear`` on the last day, as the power ``wear_growth`` of the time since the onset
-    (1: linear; 2: its rate growing in proportion to that time)."""
+def wear_percent(spec: FleetSpec, onset: int, day: int, law: str | None = None, rate: float | None = None) -> float:
+    """True wear (% increase of Coulomb and Stribeck friction) on day ``day`` (1-based): ``rate``
+    points a day since the onset (:attr:`FleetSpec.wear_rates`), else from the onset to
+    ``final_wear`` on the last day, by ``law`` (:func:`faultgen.bench.cell.wear_fraction` of the
+    share of the time since the onset) or, None, as the power ``wear_growth`` of that share (1:
+    linear; 2: its rate growing in proportion to that time)."""
     if day < onset:
         return 0.0
+    if rate is not None:
+        return rate * (day - onset)
+    if law is not None:
+        return spec.final_wear * cell.wear_fraction(law, (day - onset) / max(spec.days - onset, 1))
     if spec.wear_growth == 1.0:
         return spec.final_wear * (day - onset) / max(spec.days - onset, 1)
     return spec.final_wear * ((day - onset) / max(spec.days - onset, 1)) ** spec.wear_growth
@@ -338,7 +310,7 @@ def _wear(spec: FleetSpec, unit: dict, day: int) -> float:
     """A unit's true wear on ``day``: 0 on a healthy unit and from its gearbox change on."""
     if not unit["axis"] or (unit["gearbox_day"] and day >= unit["gearbox_day"]):
         return 0.0
-    return wear_percent(spec, unit["onset"], day)
+    return wear_percent(spec, unit["onset"], day, unit["law"], unit["rate"])
 
 
 def truth_rows(spec: FleetSpec, n_axes: int = 6) -> list[list]:
@@ -383,29 +355,11 @@ def friction_test_days(spec: FleetSpec) -> list[int]:
     return list(range(1, spec.days + 1, every)) if every else []
 
 
-@lru_cache(maxsize=4)
-def friction_test_motion(robot: robots.Robot, rate: float):
-    """The friction test of ``robot`` (:func:`faultgen.operation.friction_test.program`, as ``faultgen
-    tasks friction-test`` writes it) planned at 250 Hz and taken at ``rate`` Hz: ``t`` (n,) s, ``q``,
-    ``qd``, ``qdd`` (n, N) rad, rad/s, rad/s^2, and Pinocchio's RNEA torque of it without a part
-    (n, N) N m, from the URDF in the robot's folder. ValueError for a rate as :func:`_motion`'s."""
-    from faultgen.operation import friction_test
-
-    dt, step = layouts.plan(rate, PLAN_RATE)
-    program = programs.parse(friction_test.text(robot), robot, where=f"friction test of {robot.name}")
-    path = program.trajectory(dt)
-    q, qd, qdd = (x[::step] for x in (path.q, path.qd, path.qdd))
-    pin = pinocchio_module()
-    model = pinocchio_model(robot.path.parent / "urdf_used.urdf")
-    data = model.createData()
-    rigid = np.array([pin.rnea(model, data, q[k], qd[k], qdd[k]) for k in range(len(q))])
-    return np.arange(len(q)) / rate, q, qd, qdd, rigid
-
-
 def _levels(spec: FleetSpec, unit: dict, day: int, nominal, jitter: np.ndarray, temperature) -> tuple:
     """A unit's motor-side Coulomb, static and viscous levels on ``day`` (1-based), each (N,): the
     ``nominal`` ones times the unit's spread (the nominal on a changed gearbox's axis), the wear on
-    the worn axis's dry friction, the log's ``jitter`` (3, N), the viscous law at ``temperature`` deg C."""
+    the worn axis's dry friction, the log's ``jitter`` (3, N), the viscous law (and with
+    :attr:`FleetSpec.dry_per_k` the dry one) at ``temperature`` deg C."""
     fc0, fs0, fv0 = nominal
     wear = _wear(spec, unit, day)
     grow = np.ones(len(fc0))
@@ -418,30 +372,59 @@ def _levels(spec: FleetSpec, unit: dict, day: int, nominal, jitter: np.ndarray, 
     fc = fc0 * spread[0] * grow * jitter[0]
     fs = fs0 * spread[1] * grow * jitter[1]
     fv = fv0 * spread[2] * jitter[2] * np.exp(-VISCOUS_PER_K * (temperature - 20.0))
+    if spec.dry_per_k:  # the dry level's deterministic law in temperature
+        fall = 1.0 - spec.dry_per_k * (np.asarray(temperature, dtype=float) - 20.0)
+        fc, fs = fc * fall, fs * fall
     return fc, fs, fv
 
 
+@dataclass(frozen=True)
+class Day:
+    """One day's draws of a unit (:func:`_days`): its day (1-based) and stamp, joint ``temperature``
+    (N,) deg C, part ``mass`` kg, friction ``jitter`` (3, N), whether its program ``changed``, the
+    log's ``noise`` and ``angle_noise`` (n, N), and its layout: whole ``cycles`` at ``rate`` Hz of
+    ``program`` (0-based), or ``span`` cycles (None: whole cycles) from ``phase``."""
+
+    day: int
+    stamp: str
+    temperature: np.ndarray
+    mass: float
+    jitter: np.ndarray
+    changed: bool
+    noise: np.ndarray
+    angle_noise: np.ndarray
+    cycles: int
+    rate: float
+    program: int
+    phase: float
+    span: float | None
+
+
 def _days(spec: FleetSpec, unit: dict, model: robots.Robot):
-    """A unit's daily draws in the order the writer makes them, one tuple a day: ``(day, stamp,
-    temperature, mass, jitter, changed, noise, angle noise, cycles, rate)`` (noise and angle noise
-    shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles`` of the motion at ``rate`` Hz; a layout
-    other than one cycle at :attr:`FleetSpec.rate` draws them from its own stream, after the default
-    layout's draws, so that every other draw is the same)."""
+    """A unit's daily draws in the order the writer makes them, one :class:`Day` a day (noise and
+    angle noise shaped as the day's log: :func:`faultgen.bench.layouts.draws`'s ``cycles`` of the
+    motion at ``rate`` Hz, or the ``span`` of cycles from ``phase`` of the day's ``program``
+    (:func:`faultgen.bench.cell.day_layouts`); a layout other than one cycle of program 0 at
+    :attr:`FleetSpec.rate` draws them from its own stream, after the default layout's draws, so that
+    every other draw is the same)."""
     rng = np.random.default_rng(unit["seed"])
     n = model.n_axes
     days_layout = layouts.draws(spec.cycles, spec.rates, spec.rate, unit["seed"])
+    days_program = cell.day_layouts(spec, unit["seed"], unit["programs"])
     for d, stamp in enumerate(stamps(spec), start=1):
         temperature, mass = day_conditions(unit, d, stamp, rng)
-        jitter = np.exp(rng.normal(0.0, JITTER, (3, n)))
+        jitter = np.exp(rng.normal(0.0, spec.log_jitter, (3, n)))
         changed = bool(unit["program_day"]) and d >= unit["program_day"]
         shape = _motion(model, spec.rate, changed)[1].shape
         noise, angle_noise = rng.normal(0.0, 1.0, shape), rng.normal(0.0, ANGLE_NOISE, shape)
         cycles, rate = next(days_layout)
-        if (cycles, rate) != (1, spec.rate):
+        program, phase, span = next(days_program)
+        if (cycles, rate, program, span) != (1, spec.rate, 0, None):
             other = np.random.default_rng([unit["seed"], 3, d])
-            shape = (cycles * len(_motion(model, rate, changed)[1]), n)
+            length = len(_motion(model, rate, changed, cell.VARIANT_SHRINK[program])[1])
+            shape = (cycles * length if span is None else cell.samples(length, phase, span)[1], n)
             noise, angle_noise = other.normal(0.0, 1.0, shape), other.normal(0.0, ANGLE_NOISE, shape)
-        yield d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate
+        yield Day(d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate, program, phase, span)
 
 
 def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: int,
@@ -455,21 +438,6 @@ def friction_test_draws(unit: dict, day: int, temperature: np.ndarray, n_axes: i
     cold = rng.random() < COLD_SHARE
     jitter = np.exp(rng.normal(0.0, scatter, (3, n_axes)))
     return (temperature - unit["rise"] if cold else np.asarray(temperature, dtype=float)), jitter, rng
-
-
-def write_friction_test(path: Path, header, model: robots.Robot, rate: float, friction, temperature: np.ndarray,
-               rng: np.random.Generator) -> None:
-    """Write one friction test log (:func:`friction_test_motion` at ``rate`` Hz) at ``path``: the arm-side torque
-    Pinocchio's RNEA plus the reflected motor inertia plus ``G friction(G qd)`` (``friction``: the
-    plant's motor-side law at motor speeds (n, N), N m), the noise model of the daily logs drawn from
-    ``rng``, ``temperature`` (N,) deg C logged (rounded to 0.01) and payload 0."""
-    G, jm = model.gear_ratio, model.motor_inertia
-    t, q, qd, qdd, rigid = friction_test_motion(model, rate)
-    tau = rigid + G**2 * jm * qdd + G * friction(G * qd)
-    tau = tau + rng.normal(0.0, 1.0, tau.shape) * NOISE * np.sqrt(np.mean(tau**2, axis=0))
-    angles = q + rng.normal(0.0, ANGLE_NOISE, q.shape)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    _write_csv(path, header, t, angles, tau, np.round(temperature, 2), 0.0)
 
 
 def friction_test_truth(unit: str, stamp: str, gear_ratio: np.ndarray, coulomb, viscous, temperature) -> list[list]:
@@ -511,13 +479,14 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     days = stamps(spec)
     tested = set(friction_test_days(spec))
     units = _units(spec, n)
-    test_rows = []
+    test_rows, program_rows = [], []
     for unit in units:
         folder_of_unit = logs / unit["unit"]
         kept = all((folder_of_unit / f"{stamp}.csv").is_file() for stamp in days) and all(
             (folder_of_unit / TEST_FOLDER / f"{days[d - 1]}.csv").is_file() for d in tested)
         folder_of_unit.mkdir(parents=True, exist_ok=True)
-        for d, stamp, temperature, mass, jitter, changed, noise, angle_noise, cycles, rate in _days(spec, unit, model):
+        for day in _days(spec, unit, model):
+            d, stamp, temperature = day.day, day.stamp, day.temperature
             if d in tested:
                 warmth, test_jitter, rng = friction_test_draws(unit, d, temperature, n, spec.test_jitter)
                 fc, fs, fv = _levels(spec, unit, d, nominal, test_jitter, warmth)
@@ -525,16 +494,11 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
                 if not kept:
                     write_friction_test(folder_of_unit / TEST_FOLDER / f"{stamp}.csv", header, model, spec.rate,
                                lambda w, fc=fc, fs=fs, fv=fv: motor_friction(w, fc, fs, fv), warmth, rng)
-            if kept:
-                continue  # drawn in one go from its own seed: complete, and as the same seed draws it
-            fc, fs, fv = _levels(spec, unit, d, nominal, jitter, temperature)
-            q, qd, qdd, rigid = (np.tile(x, (cycles, 1)) for x in (*_motion(model, rate, changed)[1:],
-                                                                   _rigid(model, rate, round(mass, 1), changed)))
-            t = np.arange(len(q)) / rate  # back-to-back cycles: the next starts a sample after the last ends
-            tau = rigid + G**2 * jm * qdd + G * motor_friction(G * qd, fc, fs, fv)
-            tau = tau + noise * NOISE * np.sqrt(np.mean(tau**2, axis=0))
-            angles = q + angle_noise
-            _write_csv(folder_of_unit / f"{stamp}.csv", header, t, angles, tau, np.round(temperature, 2), round(mass, 1))
+            program_rows.append([unit["unit"], stamp, day.program,
+                                 f"{day.cycles if day.span is None else day.span:.4f}", f"{day.phase:.4f}"])
+            if not kept:  # a kept unit: drawn in one go from its own seed, complete, as the same seed draws it
+                levels = _levels(spec, unit, d, nominal, day.jitter, temperature)
+                _write_day(folder_of_unit / f"{stamp}.csv", header, model, day, levels)
     truth = root / "truth.csv"
     _write_table(truth, TRUTH_COLUMNS, truth_rows(spec, n))
     if tested:
@@ -545,7 +509,27 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     programs_ = [[u["unit"], days[u["program_day"] - 1], "program_change", ""] for u in units if u["program_day"]]
     if events or programs_:
         _write_table(root / "changes.csv", CHANGE_COLUMNS, sorted(events + programs_))
+    if spec.programs > 1 or spec.span:  # the truth of a cell's programs and cut logs
+        _write_table(root / "truth_programs.csv", PROGRAM_COLUMNS, program_rows)
     return logs, truth
+
+
+def _write_day(path: Path, header, model: robots.Robot, day: Day, levels) -> None:
+    """Write one daily log (a :class:`Day`) at ``path``: the day's program at its rate, whole
+    back-to-back cycles or its span from its phase (:func:`faultgen.bench.cell.cut`), the arm-side
+    torque Pinocchio's RNEA with the day's part plus the reflected motor inertia plus ``G f(G qd)``
+    at the motor-side friction ``levels`` (Coulomb, static, viscous), and the noise model."""
+    G, jm, rate, changed = model.gear_ratio, model.motor_inertia, day.rate, day.changed
+    shrink, mass = cell.VARIANT_SHRINK[day.program], round(day.mass, 1)
+    cycle = (*_motion(model, rate, changed, shrink)[1:], _rigid(model, rate, mass, changed, shrink))
+    if day.span is None:
+        q, qd, qdd, rigid = (np.tile(x, (day.cycles, 1)) for x in cycle)
+    else:
+        q, qd, qdd, rigid = (cell.cut(x, day.phase, day.span) for x in cycle)
+    t = np.arange(len(q)) / rate  # back-to-back cycles: the next starts a sample after the last ends
+    tau = rigid + G**2 * jm * qdd + G * motor_friction(G * qd, *levels)
+    tau = tau + day.noise * NOISE * np.sqrt(np.mean(tau**2, axis=0))
+    _write_csv(path, header, t, q + day.angle_noise, tau, np.round(day.temperature, 2), mass)
 
 
 def _write_table(path: Path, columns, rows) -> None:
@@ -571,16 +555,6 @@ def read_changes(root: Path) -> dict[str, list[dict]]:
                 out.setdefault(row["unit"], []).append(
                     {"stamp": row["stamp"], "change": row["change"], "axis": int(row["axis"]) if row["axis"] else 0})
     return out
-
-
-def _write_csv(path: Path, header, t, q, tau, temperature, mass) -> None:
-    rows = len(t)
-    table = np.hstack([t[:, None], q, tau, np.broadcast_to(temperature, (rows, len(temperature))),
-                       np.full((rows, 1), mass)])
-    formats = ["%.4f"] + ["%.6f"] * q.shape[1] + ["%.4f"] * tau.shape[1] + ["%.2f"] * len(temperature) + ["%.1f"]
-    part = path.with_name(path.name + ".part")  # no reader lists it (a log ends in .csv)
-    np.savetxt(part, table, fmt=formats, delimiter=",", header=cells.line(header), comments="")
-    os.replace(part, path)
 
 
 def read_truth(path: Path) -> dict[str, dict]:

@@ -165,7 +165,8 @@ def gearbox_lines(robot: robots.Robot, label: int) -> list[str]:
         marks = ["*" if key in r.defaults else "" for r in ratings]
         every = all(marks)
         used += [key] if any(marks) else []
-        cells = "".join(f"{(v if isinstance(v, str) else f'{v:.5g}') + ('' if every else m):>12}"
+        cells = "".join(f"{(v if isinstance(v, str) else 'none' if v != v else f'{v:.5g}') + ('' if every else m):>12}"
                         for v, m in zip((getattr(r, key) for r in ratings), marks))
         lines.append(f"{title + (' (default)' if every else ''):<{label}}{cells}")
-    return lines + [f"(default, or * where others are given) {key}: {rating.RULES[key]}" for key in used]
+    return (lines + [f"(default, or * where others are given) {key}: {rating.RULES[key]}" for key in used]
+            + [f"axis {k}: {r.unrated}" for k, r in enumerate(ratings, start=1) if r.unrated])

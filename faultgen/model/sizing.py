@@ -126,6 +126,21 @@ def main_axes(n_axes: int) -> int:
     return max(3, n_axes - 3)
 
 
+def output_peak(drive, axis: int, n_axes: int) -> float:
+    """The peak torque the gear output of axis ``axis`` (1-based, of ``n_axes``) carries, N m, as the
+    sizing rule set its motor (:func:`motor_torque` read backwards): ``G (T / MARGIN - Jm G a - (Fc +
+    Fv G qd_max))`` with ``qd_max = MOTOR_SPEED / G`` and ``a = qd_max / RAMP`` (main or wrist axes):
+    the rated load held and accelerated along the planning limits, without the rotor's acceleration
+    and the motor's friction (motor side, not through the gear). ``drive`` an
+    :class:`~faultgen.model.drivetrain.AxisDrive`; at least 0."""
+    G = drive.gear_ratio
+    speed = MOTOR_SPEED / G
+    acceleration = speed / (RAMP[0] if axis <= main_axes(n_axes) else RAMP[1])
+    motor_side = drive.motor_torque_limit / MARGIN - drive.motor_inertia * G * acceleration \
+        - (drive.coulomb_pos + drive.viscous * G * speed)
+    return max(float(G * motor_side), 0.0)
+
+
 def load_offset(payload: float) -> float:
     """Distance of the rated load's centre of mass from the flange, m, for a payload of ``payload``
     kg (:data:`LOAD_OFFSET_REF`, :data:`LOAD_OFFSET_BOUNDS`: load diagrams' rating point)."""

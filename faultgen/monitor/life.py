@@ -30,7 +30,12 @@ of that axis or of every axis: a ``repair`` leaves the gearbox's bearings, and t
 were), else from the unit's first log (what ran before it is not known: the row says so). The
 **duty** is the mean consumption per day over the last :data:`WINDOW` logs since then, and the
 **days left** the time to 100 % at that duty. :func:`service_by` sets a unit's "service by" as the
-earlier of that and the condition-based remaining life (``rul.csv``).
+earlier of that and the condition-based remaining life (``rul.csv``). Beyond :data:`HORIZON_DAYS`
+(30 years) from the last log no days left and no date are given (the row says "not within 30
+years"): a rated life read from defaults or a light duty cannot carry a date that far, and no page or
+CSV shows one (:func:`date_after`). An axis without a rated torque
+(:attr:`faultgen.model.rating.GearboxRating.unrated`: no catalogue size fits its load) gets no
+consumption and no date: its row says why and how to give one.
 """
 
 from __future__ import annotations
@@ -52,6 +57,9 @@ from faultgen.monitor.html_cells import number
 HOURS_PER_DAY = 16.0
 #: Logs whose mean consumption per day is the unit's recent duty.
 WINDOW = 10
+#: The farthest a load-based life or any service date is given, years and days from the last log.
+HORIZON_YEARS = 30
+HORIZON_DAYS = HORIZON_YEARS * 365.25
 #: The life exponents a log's load is integrated with (:func:`load_integrals`): strain-wave, cycloid.
 EXPONENTS = tuple(rating.EXPONENTS.values())
 #: Events that fit a new gearbox (its consumption starts again at 0).
@@ -164,9 +172,12 @@ class LifeRow:
 
     def cells(self) -> list:
         r = self.rating
-        return [self.unit, self.axis, r.gearbox_type, r.exponent, r.rated_torque, r.rated_speed, r.rated_life,
-                " ".join(r.defaults), self.since, self.consumed, self.duty, self.days_left, self.hours_per_day,
-                self.logs, self.stamp, self.verdict]
+
+        def known(x):  # no rating: empty cells, not nan
+            return None if isinstance(x, float) and math.isnan(x) else x
+        return [self.unit, self.axis, r.gearbox_type, r.exponent, known(r.rated_torque), r.rated_speed, r.rated_life,
+                " ".join(r.defaults), self.since, known(self.consumed), known(self.duty), self.days_left,
+                self.hours_per_day, self.logs, self.stamp, self.verdict]
 
 
 def _key(stamp: str, unit: str) -> tuple[float, str]:
@@ -206,8 +217,14 @@ def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOU
             per_day = share / e.duration * hours_per_day * 3600.0 * 100.0  # % per day
             total += per_day * days
             rates.append(per_day)
+        if r.unrated:  # no rated torque: no consumption, no date
+            rows.append(LifeRow(unit, axis, r, since, math.nan, math.nan, None, hours_per_day, len(rates),
+                                entries[-1].stamp if entries else "", r.unrated))
+            continue
         duty = float(np.mean(rates[-window:])) if rates else 0.0
         left = (100.0 - total) / duty if duty > 0 else None
+        if left is not None and left > HORIZON_DAYS:
+            left = None  # not within the horizon: no number, no date (module docstring)
         rows.append(LifeRow(unit, axis, r, since, total, duty, left, hours_per_day, len(rates),
                             entries[-1].stamp if entries else "", ""))
         rows[-1].verdict = _verdict(rows[-1], bool(changes), missing, window)
@@ -223,7 +240,10 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     left_out = f" ({missing} logs without a load record left out: a state written before it)" if missing else ""
     if not row.logs:
         return text + ": no log with a load record since" + left_out
-    if row.days_left is None:
+    if row.days_left is None and row.duty > 0:
+        text += (f"; at {row.duty:.3g} % per day ({row.hours_per_day:g} h of operation a day) 100 % not within "
+                 f"{HORIZON_YEARS} years of the last log: no date given")
+    elif row.days_left is None:
         text += "; no load in the last logs: no end of the rated life at this duty"
     elif row.days_left <= 0:
         text += f"; past the rated life (100 %), at {row.duty:.3g} % per day"
@@ -287,7 +307,9 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
 
 def date_after(last_stamp: str, days: float) -> str:
     """The day ``days`` after ``last_stamp``: an ISO date for date stamps, else "in N days" (a
-    sequence step counts as a day)."""
+    sequence step counts as a day); "not within 30 years" beyond :data:`HORIZON_DAYS`."""
+    if not days <= HORIZON_DAYS:
+        return f"not within {HORIZON_YEARS} years"
     try:
         key, kind = _key(last_stamp, "unit")
     except ValueError:
@@ -321,7 +343,9 @@ def table_cell(rows: list[dict]) -> str:
         return ""
     r, consumed = max(found, key=lambda f: f[1])
     days = number(r.get("days_left"))
-    left = ("no load" if not math.isfinite(days) else "past the rated life" if days <= 0 else f"{days:.0f} days left")
+    duty = number(r.get("duty_pct_per_day"))
+    left = ((f"not within {HORIZON_YEARS} years" if math.isfinite(duty) and duty > 0 else "no load")
+            if not math.isfinite(days) else "past the rated life" if days <= 0 else f"{days:.0f} days left")
     return f"axis {r.get('axis')}: {consumed:.3g} % ({left})"
 
 
