@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -192,6 +193,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         follows=follows,
         declined=declined,
     )
+    if data.source is not None:
+        from faultgen.calibrate import synth  # the simulator's own logs (hidden-log): why an axis is left
+
+        result = replace(result, why_unexplained=synth.simulator_remainder(data.source, result.unexplained(), nominal))
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     if figure:
         from faultgen.calibrate import figure as figures
