@@ -94,10 +94,12 @@ class Group:
 
 
 def groups(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: np.ndarray, model: np.ndarray,
-           gear_ratio: np.ndarray, axis: int, fit: np.ndarray) -> list[Group]:
+           gear_ratio: np.ndarray, axis: int, fit: np.ndarray, drift: bool = True) -> list[Group]:
     """The generic candidate library of ``axis`` (0-based): module docstring. Arrays (n, N):
     angles rad, speeds rad/s, accelerations rad/s^2, measured and model torque N m; ``t`` (n,) s;
-    ``gear_ratio`` (N,); ``fit`` (n,) bool: the samples the delay is searched on."""
+    ``gear_ratio`` (N,); ``fit`` (n,) bool: the samples the delay is searched on; ``drift``: with the
+    drifts in time (False: the library the search's guard weighs effects against, whose warm-up
+    effect is a drift in time itself)."""
     a = axis
     x, v = q[:, a], qd[:, a]
     s = np.sign(v)
@@ -110,8 +112,9 @@ def groups(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: n
               Group("speed_squared", a, 0, (v * np.abs(v))[:, None]), Group("speed_cubed", a, 0, (v**3)[:, None])]
     found += [Group("position_friction", a, k, np.column_stack([s, s * np.sin(k * x), s * np.cos(k * x)]))
               for k in range(1, FRICTION_HARMONICS + 1)]
-    hours = (t - t[0]) / 3600.0
-    found += [Group("speed_drift", a, 0, (v * hours)[:, None]), Group("dry_drift", a, 0, (s * hours)[:, None])]
+    if drift:
+        hours = (t - t[0]) / 3600.0
+        found += [Group("speed_drift", a, 0, (v * hours)[:, None]), Group("dry_drift", a, 0, (s * hours)[:, None])]
     m, y = model[:, a], tau[:, a] - model[:, a]
     d = delay(t, m, y, fit)
     found += [Group("channel_delay", a, 0, (np.interp(t - d, t, m) - m)[:, None], d),
