@@ -107,21 +107,43 @@ def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
     return out
 
 
+def heat_values(table: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, str]:
+    """What :func:`classification_heatmap` colours: per cell (preprocessing x classifier) its mean AUC
+    minus the chance level of its row (the cell's measured chance, ``null``; else the mean of the row's
+    measured ones; else 0.5), and which cells are greyed out (judged and not above chance: an AUC of
+    0.95 against a chance of 0.89 is no result). Returns ``(delta, grey, what)``: arrays of the
+    table's shape (rows x classifiers) and the words on the chance level used."""
+    means = table.xs("mean", axis=1, level=-1).to_numpy(dtype=float)
+    if "null" not in table.columns.get_level_values(-1):
+        return means - 0.5, np.zeros(means.shape, dtype=bool), "0.5, chance not measured"
+    null = table.xs("null", axis=1, level=-1).to_numpy(dtype=float)
+    with np.errstate(all="ignore"):
+        row = np.array([np.nanmean(r) if np.isfinite(r).any() else 0.5 for r in null])
+    chance = np.where(np.isfinite(null), null, row[:, None])
+    above = table.xs("above", axis=1, level=-1)
+    grey = np.array([[a is not None and not (isinstance(a, float) and np.isnan(a)) and not bool(a) for a in r]
+                     for r in above.to_numpy(dtype=object)], dtype=bool).reshape(means.shape)
+    return means - chance, grey, "the row's measured chance level"
+
+
 def classification_heatmap(table: pd.DataFrame, out: Path) -> Path:
-    """PNG heatmap of a classification table's mean AUC (preprocessing x classifier), coloured
-    around the chance level (the mean of the measured ones, else 0.5, said in the title), the
-    value in each cell, its p and a star where it is above chance, where measured."""
-    from matplotlib.colors import TwoSlopeNorm
+    """PNG heatmap of a classification table's mean AUC (preprocessing x classifier), coloured by the
+    AUC minus its row's chance level (:func:`heat_values`: red above it, blue below), the cells judged
+    not above chance grey; the value in each cell, its p and a star where it is above chance, where
+    measured."""
+    from matplotlib import colormaps
+    from matplotlib.colors import Normalize
     from matplotlib.figure import Figure
 
     means = table.xs("mean", axis=1, level=-1)
     measured = "null" in table.columns.get_level_values(-1)
-    centre = float(np.nanmean(table.xs("null", axis=1, level=-1).to_numpy(dtype=float))) if measured else 0.5
-    what = "mean of the measured chance levels" if measured else "0.5, chance not measured"
+    delta, grey, what = heat_values(table)
     fig = Figure(figsize=(1.3 * means.shape[1] + 3.2, 0.38 * means.shape[0] + 1.8))
     ax = fig.subplots()
-    image = ax.imshow(means.to_numpy(dtype=float), cmap="RdBu_r", aspect="auto",
-                      norm=TwoSlopeNorm(vcenter=min(max(centre, 0.01), 0.99), vmin=0.0, vmax=1.0))
+    cmap = colormaps["RdBu_r"].with_extremes(bad="lightgrey")
+    span = max(0.05, float(np.nanmax(np.abs(np.where(grey, np.nan, delta)), initial=0.0)))
+    image = ax.imshow(np.ma.masked_array(delta, mask=grey | ~np.isfinite(delta)), cmap=cmap, aspect="auto",
+                      norm=Normalize(vmin=-span, vmax=span))
     ax.set_xticks(range(means.shape[1]), means.columns)
     ax.set_yticks(range(means.shape[0]), means.index, fontsize=8)
     for i in range(means.shape[0]):
@@ -133,7 +155,7 @@ def classification_heatmap(table: pd.DataFrame, out: Path) -> Path:
                 if pd.notna(above) and pd.notna(p):  # not judged: None or NaN (NaN is truthy), no p, no star
                     text += f"\np {p:.2f}" + (" *" if bool(above) else "")
             ax.text(j, i, text, ha="center", va="center", fontsize=7)
-    fig.colorbar(image, ax=ax, label=f"AUC (white: {centre:.2f}, {what})")
+    fig.colorbar(image, ax=ax, label=f"AUC minus chance ({what}); grey: not above chance")
     title = "leave-pair-out AUC per preprocessing and classifier"
     if measured:
         above = int((table.xs("above", axis=1, level=-1) == True).to_numpy().sum())  # noqa: E712 (None: not judged)

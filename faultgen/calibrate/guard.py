@@ -74,7 +74,7 @@ def decline(candidate: search.Candidate, axis: int, data, tau: np.ndarray, befor
     """The record of ``candidate`` declined on ``axis`` (0-based) when a single generic group explains
     at least :data:`MORE` times its held-out nrmse drop of the remainder ``tau - before``; else None."""
     fit, held = split.fit[:, axis], split.held_out[:, axis]
-    library = remainder.groups(data.t, data.q, data.qd, data.qdd, tau, before, gear_ratio, axis, fit)
+    library = remainder.groups(data.t, data.q, data.qd, data.qdd, tau, before, gear_ratio, axis, fit, drift=False)
     best, gain, theta = remainder.best_single(library, tau[:, axis] - before[:, axis], fit, held, scale)
     effect_gain = float(candidate.gain[axis])
     if best is None or gain < MORE * max(effect_gain, 0.0):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -104,8 +105,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     plausibility.check(nominal, tau, predicted, moving)  # before anything is written
     # a delay of the torque channels left on the log calibrated: unexplained on the axes it shows on
     checked = channel_delay.get("after_correction", channel_delay.get("estimate"))
-    # the 99 % interval, from the same bootstrap replicates, holds the 95 % one: no need when that covers 0
-    found_delay = (delays.shown(data.t, tau, predicted, moving) or {}) if checked and not checked["covers_zero"] else {}
+    # the 99 % interval, from the same bootstrap replicates, holds the 95 % one: no need when that covers 0;
+    # nor for a delay whose correction would raise the held-out gap (delays.verify)
+    taken = checked and not checked["covers_zero"] and checked.get("verified", {}).get("lowers", True)
+    found_delay = (delays.shown(data.t, tau, predicted, moving) or {}) if taken else {}
     shifted = found_delay.get("axes", [])
     if found_delay:
         channel_delay["shown"] = found_delay
@@ -190,6 +193,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         follows=follows,
         declined=declined,
     )
+    if data.source is not None:
+        from faultgen.calibrate import synth  # the simulator's own logs (hidden-log): why an axis is left
+
+        result = replace(result, why_unexplained=synth.simulator_remainder(data.source, result.unexplained(), nominal))
     atomic.write_text(out / "report.json", json.dumps(result.report(), indent=2) + "\n")
     if figure:
         from faultgen.calibrate import figure as figures
@@ -250,7 +257,9 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
     if found is None:
         record["reason"] = "channel delay: not estimated, the log is too short"
     else:
-        record.update(estimate=found.record(), line=found.line())
+        checked = None if found.covers_zero else delays.verify(data.t, data.tau, given[0], data.qd, found.seconds)
+        record.update(estimate={**found.record(), **({"verified": checked} if checked else {})},
+                      line=found.line(checked))
     if delay is None:
         return data, record, given
     seconds = found.seconds if delay == "auto" else float(delay)
@@ -263,8 +272,9 @@ def check_delay(nominal: robots.Robot, data: measured_io.MeasuredData, delay: st
         left = delays.estimate(data.t, data.tau, corrected[0])
     except ValueError:
         return data, record, corrected
-    record["after_correction"] = left.record()
-    record["line"] += "; left: " + left.line().removeprefix("channel delay: ")
+    again = None if left.covers_zero else delays.verify(data.t, data.tau, corrected[0], data.qd, left.seconds)
+    record["after_correction"] = {**left.record(), **({"verified": again} if again else {})}
+    record["line"] += "; left: " + left.line(again).removeprefix("channel delay: ")
     return data, record, corrected
 
 

@@ -18,6 +18,8 @@ columns fitted together):
   the shift ``d`` (up to :data:`MAX_DELAY` either way) that fits the remainder best on the fitting
   part (a time shift of the torque channels; the first-order term ``-d tau_model'`` fails where the
   friction steps at a speed reversal);
+* ``speed_drift``, ``dry_drift``: ``qd_a t``, ``sign(qd_a) t`` (t in hours from the log's start: a
+  viscous or dry friction drifting in time, as with the oil's temperature);
 * ``acceleration``: ``qdd_a`` (a time shift of the motion's second derivative; an inertia the model lacks);
 * ``gain``: the measured torque ``tau_a`` (a gain ``g``: ``tau = g tau_model`` leaves
   ``tau - tau_model = (1 - 1/g) tau``);
@@ -92,10 +94,12 @@ class Group:
 
 
 def groups(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: np.ndarray, model: np.ndarray,
-           gear_ratio: np.ndarray, axis: int, fit: np.ndarray) -> list[Group]:
+           gear_ratio: np.ndarray, axis: int, fit: np.ndarray, drift: bool = True) -> list[Group]:
     """The generic candidate library of ``axis`` (0-based): module docstring. Arrays (n, N):
     angles rad, speeds rad/s, accelerations rad/s^2, measured and model torque N m; ``t`` (n,) s;
-    ``gear_ratio`` (N,); ``fit`` (n,) bool: the samples the delay is searched on."""
+    ``gear_ratio`` (N,); ``fit`` (n,) bool: the samples the delay is searched on; ``drift``: with the
+    drifts in time (False: the library the search's guard weighs effects against, whose warm-up
+    effect is a drift in time itself)."""
     a = axis
     x, v = q[:, a], qd[:, a]
     s = np.sign(v)
@@ -108,6 +112,9 @@ def groups(t: np.ndarray, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, tau: n
               Group("speed_squared", a, 0, (v * np.abs(v))[:, None]), Group("speed_cubed", a, 0, (v**3)[:, None])]
     found += [Group("position_friction", a, k, np.column_stack([s, s * np.sin(k * x), s * np.cos(k * x)]))
               for k in range(1, FRICTION_HARMONICS + 1)]
+    if drift:
+        hours = (t - t[0]) / 3600.0
+        found += [Group("speed_drift", a, 0, (v * hours)[:, None]), Group("dry_drift", a, 0, (s * hours)[:, None])]
     m, y = model[:, a], tau[:, a] - model[:, a]
     d = delay(t, m, y, fit)
     found += [Group("channel_delay", a, 0, (np.interp(t - d, t, m) - m)[:, None], d),
@@ -382,7 +389,8 @@ def size(group: Group, theta: np.ndarray) -> tuple[float, str]:
     if group.form == "gain":
         return float(1.0 / (1.0 - theta[0])) if theta[0] < 1 else float("inf"), "1"
     units = {"speed": "N m s/rad", "dry": "N m", "speed_squared": "N m s^2/rad^2", "speed_cubed": "N m s^3/rad^3",
-             "acceleration": "kg m^2", "cross_speed": "N m s/rad", "cross_acceleration": "kg m^2"}
+             "acceleration": "kg m^2", "cross_speed": "N m s/rad", "cross_acceleration": "kg m^2",
+             "speed_drift": "N m s/rad per h", "dry_drift": "N m per h"}
     return float(theta[0]), units[group.form]
 
 
@@ -410,6 +418,8 @@ def words(group: Group, axis: int, value: float, interval: list[float] | None, u
         text = {"speed": f"proportional to the speed of axis {b}", "dry": f"a step with the direction of axis {b}",
                 "speed_squared": f"grows with the speed squared on axis {b}",
                 "speed_cubed": f"grows with the speed cubed on axis {b}",
+                "speed_drift": f"viscous friction of axis {b} drifting in time (as with the oil's temperature)",
+                "dry_drift": f"dry friction of axis {b} drifting in time (as with the oil's temperature)",
                 "acceleration": f"follows the acceleration of axis {b} (an inertia the model lacks)",
                 "cross_speed": f"follows the speed of axis {b} (cross-axis coupling)",
                 "cross_acceleration": f"follows the acceleration of axis {b} (cross-axis coupling)"}[form]

@@ -102,6 +102,9 @@ class Calibration:
     declined : list of dict
         Library effects not written on an axis because a generic term explains more of its
         remainder (no forced fit, :func:`faultgen.calibrate.guard.check`).
+    why_unexplained : str or None
+        Why the unexplained axes are left, where the calibration knows it (faultgen's own null log,
+        :func:`faultgen.calibrate.synth.simulator_remainder`); None otherwise.
     """
 
     robot: str
@@ -124,6 +127,7 @@ class Calibration:
     delay: dict | None = None
     follows: dict = field(default_factory=dict)
     declined: list[dict] = field(default_factory=list)
+    why_unexplained: str | None = None
 
     def report(self) -> dict:
         """The ``report.json`` record of the design document."""
@@ -139,6 +143,7 @@ class Calibration:
             "residual_tests": self.tests_after_steps,
             "channel_delay": self.delay,
             "not_written": self.declined,
+            **({"why_unexplained": self.why_unexplained} if self.why_unexplained else {}),
         }
 
     def unexplained(self) -> list[dict]:
@@ -226,6 +231,8 @@ class Calibration:
             lines.append(remainder.line(u))
             lines += [f"   not written on axis {d['axis']}: {d['effect']} (held-out nrmse drop {d['effect_gain_nrmse']:.4f}; "
                       f"{d['generic_words']} alone: {d['generic_gain_nrmse']:.4f})" for d in u["not_written"]]
+        if self.why_unexplained and self.unexplained():
+            lines.append(self.why_unexplained)
         # the static model: for a per-step friction update, or a Stribeck curve MuJoCo's LuGre
         # (Gaussian only) cannot represent
         static_only = any(s.effect.stepped for s in self.steps) or any(

@@ -110,7 +110,9 @@ def simulate_command(
     task_of = programs.log_task(task, adapter)  # a LogTask for a log in another format than the default
     config = sim.RunConfig(
         robot=robot, task=task_of, friction=friction_model,
-        wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles), cycles=cycles,
+        wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles,
+                                             n_axes=(loaded or robots.load(robot)).n_axes if wear else None),
+        cycles=cycles,
         record=None if record is None else parse_cycles(record), seed=seed,
         noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
         conditions=conditions_from_options(temperature, payloads, payload_pattern, unit_spread, cycles_per_day,

@@ -109,7 +109,8 @@ class FlangeIK:
         self.configuration = mink.Configuration(self.model, np.asarray(posture, float))
         self.frame = mink.FrameTask(FLANGE, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
         self.posture = mink.PostureTask(self.model, cost=POSTURE_COST)
-        self.posture.set_target(np.asarray(posture, float))
+        self._posture = np.asarray(posture, float)
+        self.posture.set_target(self._posture)
         self.limits = [mink.ConfigurationLimit(self.model)]
         self._data = mujoco.MjData(self.model)
         self._site = self.model.site(FLANGE).id
@@ -186,8 +187,9 @@ class FlangeIK:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint path that moves the flange through points at knot times, from rest to rest.
 
-        IK is solved at every knot, each from the previous solution, and a cubic spline with
-        zero end velocities runs through the solutions; its derivatives give velocity and
+        IK is solved at every knot, each from the previous solution (on a redundant arm, N > 6,
+        with the posture task pulling toward that solution: the arm does not move along its null
+        space between knots), and a cubic spline with zero end velocities runs through the solutions; its derivatives give velocity and
         acceleration, and the first and last samples are set exactly at rest.
 
         Parameters
@@ -214,11 +216,21 @@ class FlangeIK:
             If IK fails at a knot; the message names the knot.
         """
         solutions = [np.asarray(q_start, float)]
-        for k in range(1, len(knots)):
-            try:
-                solutions.append(self.solve(points[k], rotation, solutions[-1]))
-            except ValueError as err:
-                raise ValueError(f"IK knot {k} (t = {knots[k]:.3f} s): {err}") from err
+        # A redundant arm (N > 6) has a null space: a posture task pulling toward the program's start
+        # would move the arm along it between knots (a Panda: axes 1 and 3 0.2 deg apart inside the
+        # first 10 ms knot, issue 88), so there each knot's posture target is the previous solution.
+        redundant = self.model.nv > 6
+        try:
+            for k in range(1, len(knots)):
+                if redundant:
+                    self.posture.set_target(solutions[-1])
+                try:
+                    solutions.append(self.solve(points[k], rotation, solutions[-1]))
+                except ValueError as err:
+                    raise ValueError(f"IK knot {k} (t = {knots[k]:.3f} s): {err}") from err
+        finally:
+            if redundant:
+                self.posture.set_target(self._posture)
         spline = CubicSpline(knots, np.array(solutions), bc_type="clamped", axis=0)
         q, qd, qdd = spline(t), spline(t, 1), spline(t, 2)
         q[0], q[-1] = solutions[0], solutions[-1]

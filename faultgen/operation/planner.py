@@ -203,11 +203,27 @@ class Planner:
     def _follow(self, s: Segment, geometry, weave_amplitude: float, weave_frequency: float) -> None:
         """The tool along ``geometry`` at the segment's speed: IK every :data:`IK_STEP` from the path's
         last angles, a clamped cubic spline through the solutions (thesis task 3's seam)."""
-        speed, ramp_time = s.values["speed"], s.values["ramp_time"]
+        speed = s.values["speed"]
+        planned = self._along(s, geometry, weave_amplitude, weave_frequency, speed)
+        if isinstance(planned, str):
+            self.fail(s, planned)
+        q, qd, qdd, target, points = planned
+        problem = self._over_limits(qd, qdd, speed)
+        if problem is not None:
+            self.fail(s, problem + self._fitting_speed(s, geometry, weave_amplitude, weave_frequency, speed, qd, qdd))
+        self.path.add(s.label, q, qd, qdd, target=target, tolerance=SEAM_LIMIT_TOLERANCE)
+        # the last knot's point (not the last sample's): the next segment starts from it, as task 3's retract
+        rotation = self.p.tool_rotation
+        self.target = points[-1] if not np.any(self.p.tool_offset) else points[-1] + rotation @ self.p.tool_offset
+
+    def _along(self, s: Segment, geometry, weave_amplitude: float, weave_frequency: float, speed: float):
+        """The joint path of :meth:`_follow` at ``speed`` (m/s): ``(q, qd, qdd, target, knot points)``, or
+        the problem (str) that stops it (too short for its ramps, IK failing, the flange off the path)."""
+        ramp_time = s.values["ramp_time"]
         length = geometry.length
         if length / speed < ramp_time + PLAN_PERIOD:
-            self.fail(s, f"the path is {length:.4g} m long: at {speed} m/s it takes {length / speed:.3g} s, "
-                      f"not enough for a ramp_time of {ramp_time} s up and down; lower ramp_time or speed")
+            return (f"the path is {length:.4g} m long: at {speed} m/s it takes {length / speed:.3g} s, "
+                    f"not enough for a ramp_time of {ramp_time} s up and down; lower ramp_time or speed")
         duration = math.ceil((length / speed + ramp_time) / PLAN_PERIOD - 1e-9) * PLAN_PERIOD
         half_periods = max(1, round(2 * weave_frequency * length / speed))
         rotation = self.p.tool_rotation
@@ -227,38 +243,68 @@ class Planner:
         try:
             q, qd, qdd = ik.follow(knots, points, rotation, self.path.last, t)
         except ValueError as err:
-            self.fail(s, f"{err}")
+            return f"{err}"
         target = tool_path(t)
         deviation = ik.deviation(q, target)
         k = int(np.argmax(deviation))
         if deviation[k] > SEAM_TOLERANCE:
-            self.fail(s, f"IK leaves the flange {deviation[k] * 1e3:.3f} mm from the path at t = {k * dt:.3f} s "
-                      f"into the segment, more than the tolerance of {SEAM_TOLERANCE * 1e3} mm (a point near the "
-                      "edge of the workspace or a wrist singularity)")
-        self._check_speed(s, qd, qdd, speed)
-        self.path.add(s.label, q, qd, qdd, target=target, tolerance=SEAM_LIMIT_TOLERANCE)
-        # the last knot's point (not the last sample's): the next segment starts from it, as task 3's retract
-        self.target = points[-1] if not np.any(self.p.tool_offset) else points[-1] + rotation @ self.p.tool_offset
+            return (f"IK leaves the flange {deviation[k] * 1e3:.3f} mm from the path at t = {k * dt:.3f} s "
+                    f"into the segment, more than the tolerance of {SEAM_TOLERANCE * 1e3} mm (a point near the "
+                    "edge of the workspace or a wrist singularity)")
+        return q, qd, qdd, target, points
 
     def flange_target_rows(self, points: np.ndarray) -> np.ndarray:
         if np.any(self.p.tool_offset):
             return points - (self.p.tool_rotation @ self.p.tool_offset)[None]
         return points
 
-    def _check_speed(self, s: Segment, qd: np.ndarray, qdd: np.ndarray, speed: float) -> None:
-        """Refuse a Cartesian segment that needs more than a joint's speed or acceleration limit."""
+    def _ratios(self, qd: np.ndarray, qdd: np.ndarray) -> tuple[int, float, float]:
+        """The axis nearest its limits and its speed and acceleration over them."""
         ratio_v = np.max(np.abs(qd), axis=0) / self.p.velocity_limit
         ratio_a = np.max(np.abs(qdd), axis=0) / self.p.acceleration_limit
         axis = int(np.argmax(np.maximum(ratio_v, ratio_a)))
-        worst = max(ratio_v[axis], ratio_a[axis])
-        if worst > 1 + SEAM_LIMIT_TOLERANCE:
-            fit = speed / max(ratio_v[axis], np.sqrt(ratio_a[axis]))
-            kind = "velocity" if ratio_v[axis] >= ratio_a[axis] else "acceleration"
-            limit = (self.p.velocity_limit if kind == "velocity" else self.p.acceleration_limit)[axis]
-            unit = "deg/s" if kind == "velocity" else "deg/s^2"
-            self.fail(s, f"at speed = {speed} m/s axis {axis + 1} needs {worst * np.degrees(limit):.4g} {unit}, "
-                      f"{(worst - 1) * 100:.0f} % above its {kind} limit of {np.degrees(limit):.4g} {unit}; a speed "
-                      f"of about {fit:.3g} m/s would fit")
+        return axis, float(ratio_v[axis]), float(ratio_a[axis])
+
+    def _over_limits(self, qd: np.ndarray, qdd: np.ndarray, speed: float) -> str | None:
+        """A Cartesian segment's need beyond a joint's speed or acceleration limit, in words; None within."""
+        axis, ratio_v, ratio_a = self._ratios(qd, qdd)
+        worst = max(ratio_v, ratio_a)
+        if worst <= 1 + SEAM_LIMIT_TOLERANCE:
+            return None
+        kind = "velocity" if ratio_v >= ratio_a else "acceleration"
+        limit = (self.p.velocity_limit if kind == "velocity" else self.p.acceleration_limit)[axis]
+        unit = "deg/s" if kind == "velocity" else "deg/s^2"
+        return (f"at speed = {speed} m/s axis {axis + 1} needs {worst * np.degrees(limit):.4g} {unit}, "
+                f"{(worst - 1) * 100:.0f} % above its {kind} limit of {np.degrees(limit):.4g} {unit}")
+
+    #: Tries of :meth:`_fitting_speed`, and the margin each asks for below the limits.
+    SPEED_TRIES, SPEED_MARGIN = 4, 0.98
+
+    def _fitting_speed(self, s: Segment, geometry, weave_amplitude: float, weave_frequency: float, speed: float,
+                       qd: np.ndarray, qdd: np.ndarray) -> str:
+        """The advice after :meth:`_over_limits`: a speed planned and checked before it is given. The
+        first try scales the speed by the joint speeds' and accelerations' excess (``v / max(ratio_v,
+        sqrt(ratio_a))``, exact for a path whose time is stretched); each next by the excess the try
+        before left (linear: the ramps' acceleration grows with the speed), up to :data:`SPEED_TRIES`.
+        None fitting: the words that no slower speed was found to fit (a need that does not scale with
+        the speed, such as the arm changing posture along the line)."""
+        _, ratio_v, ratio_a = self._ratios(qd, qdd)
+        fit = speed / max(ratio_v, np.sqrt(ratio_a))
+        tried = []
+        for _ in range(self.SPEED_TRIES):
+            tried.append(fit)
+            try:
+                planned = self._along(s, geometry, weave_amplitude, weave_frequency, fit)
+            except CycleTooLong:
+                break  # slower still is longer still
+            if isinstance(planned, str):
+                break
+            if self._over_limits(planned[1], planned[2], fit) is None:
+                return f"; a speed of about {fit:.3g} m/s would fit (planned and checked)"
+            _, ratio_v, ratio_a = self._ratios(planned[1], planned[2])
+            fit = self.SPEED_MARGIN * fit / max(ratio_v, ratio_a)
+        return (f"; no slower speed was found to fit (planned at {', '.join(f'{v:.3g}' for v in tried)} m/s): the "
+                "need does not shrink with the speed; try another start pose or tool orientation")
 
     # -- checks over the whole cycle --
 

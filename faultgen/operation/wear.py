@@ -70,11 +70,12 @@ class WearPlan:
         object.__setattr__(self, "schedules", MappingProxyType(dict(sorted(checked.items()))))
 
     @classmethod
-    def from_specs(cls, specs: Iterable[str], last_cycle: int) -> WearPlan:
-        """Build from command-line specs (see :func:`parse_wear`); an axis may appear once."""
+    def from_specs(cls, specs: Iterable[str], last_cycle: int, n_axes: int | None = None) -> WearPlan:
+        """Build from command-line specs (see :func:`parse_wear`; ``n_axes``: the robot's N, the
+        axes checked against it); an axis may appear once."""
         schedules, seen = {}, {}
         for spec in specs:
-            axis, schedule = parse_wear(spec, last_cycle)
+            axis, schedule = parse_wear(spec, last_cycle, n_axes)
             if axis in seen:
                 raise ValueError(
                     f"axis {axis} has two wear specs, {seen[axis]!r} and {spec!r}; give one per axis"
@@ -138,7 +139,7 @@ class WearPlan:
         }
 
 
-def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
+def parse_wear(spec: str, last_cycle: int, n_axes: int | None = None) -> tuple[int, Schedule]:
     """Parse a command-line wear spec ``AXIS:KIND:PERCENT[:key=value,...]``.
 
     Parameters
@@ -148,11 +149,14 @@ def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
         ``"5:step:20:step_cycle=40"``. PERCENT is in percent; options are :attr:`Schedule.params`.
     last_cycle : int
         Cycle at which the increase is reached, normally the run's number of cycles.
+    n_axes : int, optional
+        The robot's number of axes N: AXIS must be in 1..N (omitted: 1..7, and a run holds it to
+        its robot's N).
 
     Returns
     -------
     axis : int
-        1-based axis number, 1..7 (a run holds it to its robot's N).
+        1-based axis number.
     schedule : Schedule
 
     Raises
@@ -188,6 +192,6 @@ def parse_wear(spec: str, last_cycle: int) -> tuple[int, Schedule]:
                 expected = "an int" if key in INT_PARAMS else "a number"
                 raise fail(f"option {key}={value} is not {expected}") from None
     try:
-        return _check_axis(axis), Schedule(kind, percent / 100.0, last_cycle, params)
+        return axes.check(axis, n_axes), Schedule(kind, percent / 100.0, last_cycle, params)
     except ValueError as err:
         raise fail(str(err)) from None
