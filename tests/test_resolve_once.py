@@ -147,6 +147,9 @@ ALLOWED = {
     "faultgen/bench/independent.py": (1, "public API", ("write_fleet(), the bench's independent simulator's entry, "
                                                         "takes a robot folder; once per fleet")),
     "faultgen/simulation/resolve.py": (1, "public API", "resolve(spec): a run from its text, the robot once"),
+    "faultgen/calibrate/synth.py": (1, "an earlier run's state", ("calibrate: the model hidden-log wrote beside its "
+                                                                 "log, read once to see that nothing is hidden in it "
+                                                                 "(simulator_remainder)")),
 }
 
 
