@@ -22,7 +22,6 @@ import argparse
 import os
 import statistics
 import subprocess
-import sys
 import time
 
 from faultgen import children
@@ -73,7 +72,7 @@ def main() -> None:
     wall = {name: statistics.median(t for t, _ in runs) for name, runs in times.items()}
     cpu = {name: statistics.median(c for _, c in runs) for name, runs in times.items()}
     base = wall["python -c pass"]
-    print(f"{sys.executable}, {args.repeat} starts each (interleaved), medians; load average "
+    print(f"{children.command()[0]}, {args.repeat} starts each (interleaved), medians; load average "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     for name in times:
         print(f"{name:<40} wall {wall[name]:6.3f} s (+{wall[name] - base:.3f} s over python -c pass)   "
