@@ -102,6 +102,16 @@ def test_an_unknown_name_is_no_command():
     assert app.click_command("no-such-command") is None
 
 
+def test_a_command_the_table_does_not_name_is_still_found(monkeypatch):
+    monkeypatch.setattr(app, "_commands", list(app.registered_commands))  # restored after the test
+
+    @app.command("not-in-the-table")
+    def added() -> None:
+        """Added without its line in the table."""
+
+    assert app.click_command("not-in-the-table").callback.__name__ == "added"
+
+
 def pages() -> list[list[str]]:
     """Every command path's ``--help``, the bare ``faultgen``, and unknown and misspelt commands."""
     group = typer.main.get_command(app)

@@ -122,11 +122,11 @@ class LazyTyper(typer.Typer):
             self._lazy = lazy
 
     def click_command(self, name: str) -> click.Command | None:
-        """The click command (or group) ``name`` as typer builds it, its module imported first;
-        None for a name not in :data:`COMMANDS`."""
-        if name not in COMMANDS:
-            return None
-        import_module(COMMANDS[name][0])
+        """The click command (or group) ``name`` as typer builds it, its module imported first
+        (every command module for a name not in :data:`COMMANDS`: a command added without its line
+        in the table still runs); None for a name no module registers."""
+        for module in [COMMANDS[name][0]] if name in COMMANDS else MODULES:
+            import_module(module)
         for info in self._commands:
             if (info.name or typer.main.get_command_name(info.callback.__name__)) == name:
                 return typer.main.get_command_from_info(info, pretty_exceptions_short=self.pretty_exceptions_short,
@@ -136,7 +136,9 @@ class LazyTyper(typer.Typer):
                 return typer.main.get_group_from_info(info, pretty_exceptions_short=self.pretty_exceptions_short,
                                                       rich_markup_mode=self.rich_markup_mode,
                                                       suggest_commands=self.suggest_commands)
-        raise LookupError(f"faultgen.cli.{COMMANDS[name][0]} registers no command {name!r} (faultgen/cli/table.py)")
+        if name in COMMANDS:
+            raise LookupError(f"faultgen.cli.{COMMANDS[name][0]} registers no command {name!r} (faultgen/cli/table.py)")
+        return None
 
 
 class _Commands(MutableMapping):
