@@ -223,13 +223,18 @@ def transfer_entropy(source, target, history: int = 1) -> float:
         )
     if not (np.issubdtype(source.dtype, np.integer) and np.issubdtype(target.dtype, np.integer)):
         raise ValueError(f"transfer_entropy: symbols must be integers, got {source.dtype} and {target.dtype}")
-    low, high = min(source.min(), target.min()), max(source.max(), target.max())
+    from analysis import te_counts  # numba: compiled loops, imported when first used
+
+    source, target = np.ascontiguousarray(source, np.int64), np.ascontiguousarray(target, np.int64)  # one compiled form
+    low, high = te_counts.value_range(source, target)
     if low >= 0 and (high + 1) ** (2 * history + 1) <= _MAX_STATES:
-        src, tgt, base = source.astype(np.int64), target.astype(np.int64), int(high) + 1
+        src, tgt, base = source, target, int(high) + 1
     else:  # relabelling the symbols 0..b-1 changes no probability and shrinks the histogram
         _, codes = np.unique(np.concatenate([source, target]), return_inverse=True)
         src, tgt, base = codes[: source.size], codes[source.size :], int(codes.max()) + 1
-    return float(_te_matrix(src[None], tgt[None], base, history)[0, 0])
+    n_past = _check_states(base, history)  # the counts of _te_matrix, in one compiled pass
+    counts = te_counts.joint_counts(src, tgt, base, history).reshape(1, base, n_past, n_past)
+    return float(_te_bits(counts)[0] / (source.size - history))
 
 
 def _te_matrix(sources: np.ndarray, targets: np.ndarray, base: int, history: int) -> np.ndarray:

@@ -8,7 +8,11 @@ axes 1.., two seeds, every cycle recorded):
 - throughput: simulated seconds per wall second per core, on 1 job;
 - C limit: the same runs' stepping as one ``Batch.rollout`` call each (same set-points and
   disturbances, no Python in the loop, one thread), and the sweep's wall time over it;
-- parallel efficiency on 2 jobs: t(1 job) / (2 t(2 jobs));
+- parallel efficiency on 2 jobs: t(1 job) / (2 t(2 jobs)); and, less moved by other work on a
+  shared machine, the CPU time (this process and its workers, user + system) of each: CPU(1 job) /
+  CPU(2 jobs) bounds the efficiency on 2 idle cores from above (at best the two cores are busy all
+  through t(2 jobs); 1 job runs in this process, on one core), and the difference is what the
+  2 jobs do more: the workers' start-up (their imports, the robot's compile) and the merge;
 - HDF5 share: time writing part files plus the final merge, over the workers' busy time;
 - peak memory (RSS of this process and its workers) for the grid and for a grid three times
   larger: it must not grow with the number of runs;
@@ -20,6 +24,7 @@ The last line is ``ratio <float>``: sweep wall time on 1 job over the C limit (g
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import tempfile
 import time
@@ -31,14 +36,33 @@ from faultgen.runs import sweep
 from faultgen.runs.context import ExecutionContext
 
 
+def tree_cpu() -> float:
+    """CPU seconds (user + system) of this process, its ended children and its live ones (the
+    sweep's workers, which loky keeps for the next sweep)."""
+    import psutil
+
+    me = psutil.Process()
+    own = me.cpu_times()
+    total = own.user + own.system + own.children_user + own.children_system
+    for child in me.children(recursive=True):
+        try:
+            times = child.cpu_times()
+        except psutil.Error:  # ended meanwhile: counted in children_* once reaped
+            continue
+        total += times.user + times.system
+    return total
+
+
 def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
     stats, timings = [], {}
     with PeakRSS() as memory:
+        cpu = tree_cpu()
         started = time.perf_counter()
         sweep.run(grid, folder / f"sweep-{jobs}-{len(grid.runs())}.h5", ExecutionContext(jobs), progress=False,
                   on_run=stats.append, timings=timings)
         wall = time.perf_counter() - started
-    return dict(wall=wall, stats=stats, merge=timings["merge"], peak=memory.peak)
+        cpu = tree_cpu() - cpu
+    return dict(wall=wall, cpu=cpu, stats=stats, merge=timings["merge"], peak=memory.peak)
 
 
 def main() -> None:
@@ -68,6 +92,9 @@ def main() -> None:
               f"HDF5 {writing:.2f} s")
         print(f"C limit (one Batch.rollout per run, 1 thread): {limit:.2f} s")
         print(f"2 jobs: wall {two['wall']:.2f} s, parallel efficiency {one['wall'] / (2 * two['wall']):.3f}")
+        print(f"CPU (process and workers): 1 job {one['cpu']:.2f} s, 2 jobs {two['cpu']:.2f} s "
+              f"(+{two['cpu'] - one['cpu']:.2f} s: workers' start-up, merge); efficiency bound on 2 idle cores "
+              f"{one['cpu'] / two['cpu']:.3f}; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
         print(f"HDF5 share of busy time (1 job): {writing / (busy + one['merge']):.3f}")
         print(f"peak memory, 2 jobs: {two['peak'] / 1e6:.0f} MB for {len(grid.runs())} runs, "
               f"{larger['peak'] / 1e6:.0f} MB for {len(big.runs())} runs")

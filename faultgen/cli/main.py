@@ -1,4 +1,5 @@
-"""The ``faultgen`` command group: its help, ``--version``, and nothing else."""
+"""The ``faultgen`` command group: its help, ``--version``, and nothing else (its commands are in
+the table of :mod:`faultgen.cli.table`, each imported when it is run)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,9 @@ from typing import Annotated
 import typer
 
 from faultgen import __version__
-from faultgen.cli.base import Group
+from faultgen.cli.table import LazyTyper
 
-app = typer.Typer(
-    cls=Group,
+app = LazyTyper(
     help=(
         "Simulate wear faults in industrial robots and analyse them.\n\n"
         "A first dataset: `faultgen sweep --preset quick -o quick.h5`, then `faultgen info quick.h5` and "

@@ -4,17 +4,15 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
 
 from faultgen.cli.base import Command
 from faultgen.cli.main import app
-from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
-from faultgen.effects.friction import UNITS as FRICTION_UNITS
-from faultgen.model import folder, importers, rating, robots
-from faultgen.operation import taskgen
+
+if TYPE_CHECKING:
+    from faultgen.model.robot import Robot
 
 #: The largest rated payload `robots add --payload` takes, kg.
 MAX_PAYLOAD = 10_000.0
@@ -80,7 +78,12 @@ def robots_command(
       faultgen robots add ur5 --from ur5_dh.toml --drivetrain my_drives.toml -o ur5
       faultgen robots add kr120 --from kuka_kr120/urdf/kr120r2500pro.xacro --package kuka_kr120_support=kuka_kr120 -o kr120
     """
+    from faultgen.model import robots
+
     if name == "add":
+        from faultgen.model import folder, importers
+        from faultgen.operation import taskgen
+
         if new_name is None or source is None or out is None:
             raise ValueError("robots add needs NAME, --from FILE and -o DIR, e.g. "
                              "faultgen robots add kr210 --from kr210l150.urdf -o kr210")
@@ -133,8 +136,13 @@ def parse_packages(items: list[str]) -> dict[str, Path]:
     return packages
 
 
-def describe(robot: robots.Robot) -> str:
+def describe(robot: Robot) -> str:
     """A per-axis table of a robot's nominal parameters, SI units."""
+    import numpy as np
+
+    from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
+    from faultgen.effects.friction import UNITS as FRICTION_UNITS
+
     rows = [
         ("gear ratio G", "1", robot.gear_ratio),
         ("motor inertia Jm", "kg m^2", robot.motor_inertia),
@@ -155,9 +163,11 @@ def describe(robot: robots.Robot) -> str:
     return head + "\n".join(lines + gearbox_lines(robot, label))
 
 
-def gearbox_lines(robot: robots.Robot, label: int) -> list[str]:
+def gearbox_lines(robot: Robot, label: int) -> list[str]:
     """The gearbox rating rows (:mod:`faultgen.model.rating`): a row of defaults labelled
     ``(default)``, a default among given values marked ``*``; each default's rule below."""
+    from faultgen.model import rating
+
     ratings = rating.of_robot(robot)
     lines, used = [], []
     for key, title in (("gearbox_type", "gearbox type"), ("rated_torque", "rated torque [N m]"),
