@@ -127,3 +127,24 @@ def test_a_rerun_after_a_kill_between_two_renames_gets_the_state_back_before_it_
     stored.checked_out(out)
     assert _state(out) == "old" and (out / "units.csv").read_text() == "old"
     assert [p.name for p in out.iterdir() if p.name.endswith(".part")] == []
+
+
+def test_a_rename_that_fails_between_the_two_gives_the_old_state_back(tmp_path, monkeypatch):
+    """Without the exchange, the old state is moved aside before the new one goes in: when that
+    second rename fails (a full or failing disk), the old state is put back, never removed with the stage."""
+    out = _old_out(tmp_path)
+    real = os.replace
+
+    def failing(src, dst, **kw):
+        if Path(dst) == out / ".state" and Path(src).parent.parent == out and Path(src).parent.name != ".replaced":
+            raise OSError(5, "Input/output error", str(src))  # the new state's rename in, not the give-back
+        return real(src, dst, **kw)
+
+    monkeypatch.setattr(atomic, "exchange", lambda a, b: False)
+    monkeypatch.setattr(os, "replace", failing)
+    with pytest.raises(OSError, match="Input/output error"):
+        with atomic.atomic_folder(out) as stage:
+            (stage / ".state").mkdir()
+            (stage / ".state" / "u1.json").write_text("new")
+    assert _state(out) == "old"
+    assert [p.name for p in out.iterdir() if p.name.endswith(".part")] == []

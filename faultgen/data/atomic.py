@@ -168,7 +168,13 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
         else:
             os.replace(staging, path)
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        try:
+            if part["dir"] == path:  # a rename that failed between the two of a folder: the old one back
+                _give_back(staging / REPLACED, path)
+        except OSError:  # kept in the stage, which the next write of path gives back (remove_stale)
+            pass
+        else:
+            shutil.rmtree(staging, ignore_errors=True)
 
 
 #: The folder of a stage (:func:`atomic_folder`) that keeps the entries it replaced where the file
@@ -197,7 +203,8 @@ _renameat2 = None
 def exchange(a: str | Path, b: str | Path) -> bool:
     """Swap the entries ``a`` and ``b`` (of one file system) in one system call: Linux's
     ``renameat2(RENAME_EXCHANGE)`` (glibc 2.28, kernel 3.15), through ctypes. True when swapped;
-    False where the system or the file system has no such call (macOS, musl, NFS, ...), nothing done.
+    False where the system or the file system has no such call (macOS, musl, NFS, some overlayfs), nothing
+    done.
 
     Raises
     ------
@@ -225,7 +232,7 @@ def exchange(a: str | Path, b: str | Path) -> bool:
     if _renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
         return True
     code = ctypes.get_errno()
-    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.ENOTSUP):
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EXDEV):  # overlayfs: EXDEV
         return False
     raise OSError(code, os.strerror(code), str(a), None, str(b))
 
