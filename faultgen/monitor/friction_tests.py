@@ -244,7 +244,8 @@ def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
         wrong = "a number beyond a float's range"
     if wrong or any(f["axis"] < 1 for f in fits):
         raise stored.StateError(f"{path}: the cached reading of the friction test {log.name} holds "
-                                f"{wrong or 'an axis below 1'}, which no test reads; delete it (the test is read again)")
+                                f"{wrong or 'an axis below 1'}, which no test reads; delete it (the test is read "
+                                "again)")
     return FrictionTest(log.stamp, log.key, key["test"], tuple({c: (int(f[c]) if c == "axis" else float(f[c]))
                                                        for c in ("axis", *FIT_COLUMNS)} for f in fits), error)
 
@@ -354,10 +355,10 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
             corrected = np.isfinite(dt)
             d = math.log(fit["coulomb_Nm"]) - math.log(f0["coulomb_Nm"]) - (law.beta * dt if corrected else 0.0)
             if test is not t0 and not abs(d) <= LN_FACTOR_MAX:  # no wear: another gear, channel or unit
-                rows.append(AxisWear(test.stamp, test.key, k, fit, math.nan, math.nan, math.nan, math.nan, math.nan,
-                                     f"dry level {fit['coulomb_Nm']:.4g} N m, e^{d:.3g} times {t0.stamp}'s "
-                                     f"{f0['coulomb_Nm']:.4g} N m: no wear reads so (another gearbox, torque channel or "
-                                     "unit?)"))
+                verdict = (f"dry level {fit['coulomb_Nm']:.4g} N m against {t0.stamp}'s {f0['coulomb_Nm']:.4g} N m, a "
+                           f"factor of e^{d:.3g} after the temperature correction: beyond any wear (another gearbox, "
+                           "torque channel or unit?); no wear")
+                rows.append(AxisWear(test.stamp, test.key, k, fit, *[math.nan] * 5, verdict))
                 continue
             if test is t0:
                 sd = own = error0
