@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.data import reader
+from faultgen.figure_text import plain
 
 TORQUE_LABEL = "mean |motor torque| [N m]"
 CHANGE_LABEL = "change of mean |motor torque| [%]"
@@ -179,10 +180,11 @@ def _fleet_panel(ax, run: reader.Run) -> bool:
         n_worn, n_healthy = int(np.any(label == 1, axis=1).sum()), int(np.all(label == 0, axis=1).sum())
         state = (f"logs {n_worn} worn" + (f" (axis {', '.join(str(a) for a in run.worn_axes)})" if n_worn else "")
                  + f", {n_healthy} healthy, {len(label) - n_worn - n_healthy} unknown")
-        ax.set_title(f"{run.id}\n{run.robot}: {state}", fontsize=8, color=WEAR_COLOR if n_worn else "black")
+        ax.set_title(plain(f"{run.id}\n{run.robot}: {state}"), fontsize=8,
+                     color=WEAR_COLOR if n_worn else "black")
     else:
         state = (f"fails, axis {', '.join(str(a) for a in run.worn_axes)}" if run.failing else "healthy")
-        ax.set_title(f"{run.id}\n{run.robot}, {run.task}: {state}", fontsize=8,
+        ax.set_title(plain(f"{run.id}\n{run.robot}, {run.task}: {state}"), fontsize=8,
                      color=WEAR_COLOR if run.failing else "black")
     if run.failing and not run.measured:
         twin = ax.twinx()
@@ -199,14 +201,14 @@ def _fleet_title(fig, data, runs: list[reader.Run], imported: bool, parts: bool)
     part)."""
     if imported:
         worn_units = sum(bool(run.worn_axes) for run in runs)
-        fig.suptitle(f"{data.path.name}: {len(runs)} units imported from logs ({worn_units} with logs labelled worn "
-                     f"by events.csv), one panel each\nchange of each axis's mean |motor torque| per log from its "
+        fig.suptitle(f"{plain(data.path.name)}: {len(runs)} units imported from logs ({worn_units} with logs "
+                     f"labelled worn by events.csv), one panel each\nchange of each axis's mean |motor torque| per log from its "
                      f"first {BASELINE_DAYS} logs, running median over {TREND_DAYS} logs where the window is whole\n"
                      "(grey: axes without a log labelled worn; blue: the axis with worn logs, its logs as dots)\n"
                      "ticks along the top: logs labelled worn (red) and healthy (black), none: unknown"
                      + ("; green ticks: logs with the lighter part" if parts else ""), fontsize=10)
     else:
-        fig.suptitle(f"{data.path.name}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
+        fig.suptitle(f"{plain(data.path.name)}: {len(runs)} robots ({len(data.failing)} failing), one panel each\n"
                      f"change of each axis's daily mean |motor torque| from its first {BASELINE_DAYS} days, running "
                      f"median over {TREND_DAYS} days where the week is whole\n(blue: the worn axis, its days as dots; "
                      "grey: the other axes); red: the worn axis's true wear; green ticks: days with the lighter part",
@@ -232,7 +234,7 @@ def _draw_run(fig, axes, run: reader.Run) -> None:
             twin.set_ylim(bottom=min(0.0, wear[:, j].min()))
             ax.set_title(f"axis {j + 1} (worn)", color=WEAR_COLOR)
     key = "blue dots: mean |motor torque| per cycle" + (", red line: true wear" if run.worn_axes else "")
-    fig.suptitle(f"{run_title(run)}\n{key}")
+    fig.suptitle(plain(f"{run_title(run)}\n{key}"))
     fig.tight_layout()
 
 
@@ -259,7 +261,7 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
             own_first |= against_own
             name = run.task if len(robot_names) == 1 else f"{run.robot}, {run.task}"
             (line,) = ax.plot(wear, change, marker="o", ms=3, ls=styles[run.robot], color=colors[run.task])
-            legend.setdefault(name, line)
+            legend.setdefault(plain(name), line)
             worn_here = True
         if most > 0:
             ax.set_xlim(-0.03 * most, 1.03 * most)  # the same wear range in every panel
@@ -271,7 +273,8 @@ def _draw_sweep(fig, axes, data: reader.Dataset) -> None:
     reference = "the unworn run of the same program, conditions and seed (dashed line at 0)"
     if own_first:
         reference += "; runs without one: their own first recorded cycle"
-    fig.suptitle(f"{data.path.name}: robots {', '.join(robot_names)}, {len(runs)} runs\nchange of the worn axis's mean "
+    fig.suptitle(f"{plain(data.path.name)}: robots {plain(', '.join(robot_names))}, {len(runs)} runs\n"
+                 "change of the worn axis's mean "
                  f"|motor torque| per cycle against {reference}")
     rows = -(-len(order) // 6)
     fig.tight_layout(rect=(0, 0.035 * rows + 0.01, 1, 1))

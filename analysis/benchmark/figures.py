@@ -10,6 +10,7 @@ import pandas as pd
 
 from analysis.benchmark.classification_auc import CHANCE_ALPHA
 from analysis.benchmark.isolation_scores import isolation_accuracy, level_label
+from faultgen.figure_text import plain
 
 
 def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
@@ -33,8 +34,8 @@ def confusion_figure(confusion: pd.DataFrame, out: Path) -> Path:
                             color="white" if share[i, j] > 0.6 else "black", fontsize=8)
         ax.set_xticks(range(values.shape[1]), ["undec.", *map(str, range(1, values.shape[1] - 1)), "short"],
                       fontsize=8)
-        ax.set_yticks(range(values.shape[0]), matrix.index, fontsize=8)
-        ax.set(title=name, xlabel="named axis", ylabel="true worn axis")
+        ax.set_yticks(range(values.shape[0]), [plain(i) for i in matrix.index], fontsize=8)
+        ax.set(title=plain(name), xlabel="named axis", ylabel="true worn axis")
     for ax in panels[len(isolators):]:
         ax.set_visible(False)
     fig.suptitle("isolation confusion: true worn axis (none = run without wear) x named axis "
@@ -52,10 +53,11 @@ def isolation_heatmap(table: pd.DataFrame, out: Path) -> Path:
     fig = Figure(figsize=(max(6.0, 0.7 * accuracy.shape[1] + 2), 0.5 * accuracy.shape[0] + 2))
     ax = fig.subplots()
     image = ax.imshow(accuracy.to_numpy(dtype=float), vmin=0, vmax=100, cmap="viridis", aspect="auto")
-    ax.set_yticks(range(accuracy.shape[0]), accuracy.index)
+    ax.set_yticks(range(accuracy.shape[0]), [plain(i) for i in accuracy.index])
     imported = bool(table.attrs.get("imported"))
-    ax.set_xticks(range(accuracy.shape[1]), [f"{t} {level_label(w, imported)}" + (" %" if w and not imported else "")
-                                             for t, w in accuracy.columns], fontsize=8, rotation=35, ha="right")
+    ax.set_xticks(range(accuracy.shape[1]), [plain(f"{t} {level_label(w, imported)}")
+                                             + (" %" if w and not imported else "") for t, w in accuracy.columns],
+                  fontsize=8, rotation=35, ha="right")
     for i in range(accuracy.shape[0]):
         for j in range(accuracy.shape[1]):
             value = accuracy.iat[i, j]
@@ -96,7 +98,7 @@ def detection_figure(charts: dict, out: Path, most: int = 40) -> Path:
             if chart["onset"] is not None:
                 ax.axvline(x[chart["onset"]], color="C3", lw=1.2)
             ax.set_ylabel({"q": "Q", "t2": "T2"}[name])
-            ax.set_title(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})", fontsize=8)
+            ax.set_title(plain(f"{run_id} (axis {chart['worn_axis']}, {chart['protocol']})"), fontsize=8)
     for ax in panels[-1]:
         ax.set_xlabel("cycle (a day in a fleet)")
     count = (f"all {len(charts)} worn runs" if len(shown) == len(charts)
@@ -144,8 +146,8 @@ def classification_heatmap(table: pd.DataFrame, out: Path) -> Path:
     span = max(0.05, float(np.nanmax(np.abs(np.where(grey, np.nan, delta)), initial=0.0)))
     image = ax.imshow(np.ma.masked_array(delta, mask=grey | ~np.isfinite(delta)), cmap=cmap, aspect="auto",
                       norm=Normalize(vmin=-span, vmax=span))
-    ax.set_xticks(range(means.shape[1]), means.columns)
-    ax.set_yticks(range(means.shape[0]), means.index, fontsize=8)
+    ax.set_xticks(range(means.shape[1]), [plain(c) for c in means.columns])
+    ax.set_yticks(range(means.shape[0]), [plain(i) for i in means.index], fontsize=8)
     for i in range(means.shape[0]):
         for j in range(means.shape[1]):
             text = f"{means.iat[i, j]:.2f}"

@@ -10,6 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from faultgen.figure_text import plain
+
 
 def save(result, path: str | Path) -> Path:
     """Draw ``result`` (a :class:`faultgen.calibrate.Calibration`) into a PNG at ``path``.
@@ -41,9 +43,9 @@ def save(result, path: str | Path) -> Path:
     delay = "" if found is None else (
         f"\nchannel delay {1e3 * found['seconds']:+.1f} ms ({1e3 * found['interval_s'][0]:+.1f} .. "
         f"{1e3 * found['interval_s'][1]:+.1f} ms), torque moved {1e3 * result.delay['applied_s']:+.1f} ms")
-    fig.suptitle(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
-                 f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
-                 f"{result.gap_after['total_nrmse']:.3f}{delay}{ambiguous}{unexplained}", fontsize=11,
+    fig.suptitle(plain(f"{result.robot}: {Path(result.measured).name}; added {added}\n"
+                       f"held-out total nrmse {result.gap_before['total_nrmse']:.3f} -> "
+                       f"{result.gap_after['total_nrmse']:.3f}{delay}{ambiguous}{unexplained}"), fontsize=11,
                  color="tab:red" if left_over else "black")
     for axis in range(n_axes):
         left, right = axes[axis]

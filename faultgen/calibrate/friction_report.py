@@ -36,7 +36,7 @@ def read(log: measured.MeasuredData, robot: Robot) -> Reading:
     :func:`faultgen.calibrate.friction_test.friction_points`."""
     points, notes = friction_test.friction_points(log, robot)
     fits = friction_fit.fit(points, robot.gear_ratio)
-    return Reading(friction_fit.points_table(points, fits), fits, tuple(notes))
+    return Reading(friction_fit.points_table(points, fits), fits, (*notes, *sign_notes(fits)))
 
 
 def reference_fits(path: Path, robot: Robot) -> pd.DataFrame:
@@ -105,3 +105,12 @@ def write(reading: Reading, out: Path, reference: pd.DataFrame | None = None) ->
             _figure(staged(target), a, reading.points[reading.points["axis"] == a],
                     reading.fits[reading.fits["axis"] == a].iloc[0], ref)
     return Reading(reading.points, reading.fits, reading.notes, tuple(targets))
+
+
+def sign_notes(fits: pd.DataFrame) -> list[str]:
+    """A note for each axis of ``fits`` (friction_fit.csv's table) whose dry level is read below 0:
+    friction opposes motion, so a negative level is a sign error in the log or a side error."""
+    return [f"axis {int(r['axis'])}: dry friction read negative ({r['coulomb_Nm']:.4g} N m): a likely sign error "
+            f"(tau{int(r['axis'])} or q{int(r['axis'])} negated against the other) or side error (a motor-side torque "
+            "referred to the arm through a gear ratio of the wrong sign); check the log's sign convention"
+            for _, r in fits.iterrows() if r["coulomb_Nm"] < 0]

@@ -9,6 +9,7 @@ import os
 import re
 import shutil
 import socket
+import sys
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
@@ -128,19 +129,32 @@ def output_set(paths: Iterable[str | Path]) -> Iterator[Callable[[str | Path], P
 
 @contextmanager
 def atomic_folder(path: str | Path) -> Iterator[Path]:
-    """Yield a new hidden folder beside ``path`` to write into; when the block succeeds it is
-    renamed to ``path`` (one rename: all or nothing). If ``path`` is an existing folder, each entry
-    written replaces the entry of that name in it (one rename each; other files of ``path`` are
-    kept). On any exception the new folder is removed and ``path`` is untouched; a
-    kill leaves only the hidden folder (``.<name>.<pid>@<host>.<random>.part``), which the next
-    write of ``path`` removes (:func:`remove_stale`).
+    """Yield a new hidden folder to write into; when the block succeeds its entries become those of
+    ``path``. A new ``path`` is staged beside it and renamed into place whole (one rename: all or
+    nothing). An existing folder ``path`` is staged *inside* it (``path/.<name>.<pid>@<host>.<random>.part``),
+    on its own file system: a folder that is a mount point of its own (a docker or k8s volume, NFS)
+    or that lies in a read-only folder is written like any other (a rename out of it fails with
+    EXDEV, a folder beside it cannot be made). Each entry written then replaces the entry of that
+    name in ``path`` (other entries of ``path`` are kept) in one system call: a file by a rename, a
+    folder (``OUT/.state``) by an exchange with the old one (:func:`exchange`) so that ``path`` has
+    the old entry or the new one at every instant. Where a file system cannot exchange, the old
+    folder is moved into ``.replaced`` in the stage and the new one renamed in its place: a kill
+    between the two leaves the old one there, and the next write of ``path`` (:func:`remove_stale`)
+    moves it back before anything reads ``path``. On any exception the stage is removed and ``path``
+    is untouched; a kill leaves only the stage, which the next write of ``path`` removes.
 
     Raises
     ------
     OSError
-        If the folder of ``path`` does not exist or cannot be written.
+        If the folder of a new ``path`` does not exist, or the stage cannot be made (naming ``path``).
     """
-    path, part = _part_beside(path)
+    path = Path(path)
+    if path.is_dir():
+        remove_stale(path)
+        name = path.absolute().name
+        part = {"prefix": f".{name}.{os.getpid()}@{_host()}.", "suffix": ".part", "dir": path}
+    else:
+        path, part = _part_beside(path)
     try:
         staging = Path(tempfile.mkdtemp(**part))
     except OSError as err:  # a read-only folder: name the folder asked for, not the hidden one
@@ -148,58 +162,137 @@ def atomic_folder(path: str | Path) -> Iterator[Path]:
     try:
         os.chmod(staging, 0o777 & ~_umask())
         yield staging
-        if path.is_dir():  # keep what else the folder holds: replace only what was written, entry by entry
-            aside = staging / ".replaced"
-            aside.mkdir()
+        if part["dir"] == path:  # keep what else the folder holds: replace only what was written, entry by entry
             for entry in sorted(staging.iterdir()):
-                if entry == aside:
-                    continue
-                target = path / entry.name
-                if target.exists() or target.is_symlink():
-                    os.replace(target, aside / entry.name)
-                os.replace(entry, target)
-            shutil.rmtree(staging, ignore_errors=True)
+                _put(entry, path / entry.name, staging / REPLACED)
         else:
             os.replace(staging, path)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+    finally:
+        try:
+            if part["dir"] == path:  # a rename that failed between the two of a folder: the old one back
+                _give_back(staging / REPLACED, path)
+        except OSError:  # kept in the stage, which the next write of path gives back (remove_stale)
+            pass
+        else:
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+#: The folder of a stage (:func:`atomic_folder`) that keeps the entries it replaced where the file
+#: system cannot exchange two folders: what :func:`remove_stale` moves back after a kill.
+REPLACED = ".replaced"
+
+
+def _put(entry: Path, target: Path, aside: Path) -> None:
+    """``entry`` in place of ``target`` in one system call where the file system allows it
+    (:func:`atomic_folder`); a replaced folder that cannot be exchanged goes to ``aside`` first."""
+    def folder(p: Path) -> bool:
+        return p.is_dir() and not p.is_symlink()
+
+    if not (target.exists() or target.is_symlink()) or not (folder(entry) or folder(target)):
+        os.replace(entry, target)  # nothing there, or a file onto a file or a link: one rename
+    elif not exchange(entry, target):
+        aside.mkdir(exist_ok=True)
+        os.replace(target, aside / entry.name)
+        os.replace(entry, target)
+
+
+_RENAME_EXCHANGE, _AT_FDCWD = 2, -100
+_renameat2 = None
+
+
+def exchange(a: str | Path, b: str | Path) -> bool:
+    """Swap the entries ``a`` and ``b`` (of one file system) in one system call: Linux's
+    ``renameat2(RENAME_EXCHANGE)`` (glibc 2.28, kernel 3.15), through ctypes. True when swapped;
+    False where the system or the file system has no such call (macOS, musl, NFS, some overlayfs), nothing
+    done.
+
+    Raises
+    ------
+    OSError
+        Any other failure of the call (naming ``a`` and ``b``).
+    """
+    global _renameat2
+    if _renameat2 is None:
+        _renameat2 = False
+        if sys.platform.startswith("linux"):
+            import ctypes
+
+            try:
+                call = ctypes.CDLL(None, use_errno=True).renameat2
+            except (AttributeError, OSError):
+                pass
+            else:
+                call.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+                call.restype = ctypes.c_int
+                _renameat2 = call
+    if not _renameat2:
+        return False
+    import ctypes
+
+    if _renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.ENOTSUP, errno.EXDEV):  # overlayfs: EXDEV
+        return False
+    raise OSError(code, os.strerror(code), str(a), None, str(b))
 
 
 def remove_stale(path: str | Path) -> list[Path]:
-    """Remove the temporary files of ``path`` (:func:`atomic_path`) whose writer was killed.
+    """Remove the temporary files and folders of ``path`` (:func:`atomic_path`, :func:`output_set`,
+    :func:`atomic_folder`: beside ``path``, and inside it when it is a folder) whose writer was killed.
 
-    A temporary file is stale when its writer ran on this host and no process with its pid runs
-    any more. Files of a running writer, of another host (a shared file system) or not named by
-    :func:`atomic_path` are left alone. Each removal is logged (logger ``faultgen.data.atomic``,
-    level WARNING, so it is printed unless logging is configured otherwise).
+    A temporary entry is stale when its writer ran on this host and no process with its pid runs
+    any more. Entries of a running writer, of another host (a shared file system), links (faultgen
+    never makes one there: a link with such a name is passed over, never followed) and entries not
+    named so are left alone. A stage of :func:`atomic_folder` killed between the two renames of a
+    folder that could not be exchanged gives back what it replaced (:data:`REPLACED`) where
+    ``path`` lacks it: a state a run had not replaced is never deleted. Each removal is logged
+    (logger ``faultgen.data.atomic``, level WARNING, so it is printed unless logging is configured
+    otherwise).
 
     Returns
     -------
     list of Path
-        The files removed.
+        The files and folders removed.
     """
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
-    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d+)@(.+)\.[^.]+\.part")
+    places = [(folder, path.name)]
+    if path.is_dir():  # an existing folder's stages lie inside it (atomic_folder)
+        places.append((path, path.absolute().name))
     removed = []
-    for candidate in folder.glob(f".{glob.escape(path.name)}.*.part"):
-        match = pattern.fullmatch(candidate.name)
-        if match is None or match[2] != _host() or _running(int(match[1])):
-            continue
-        try:
-            if candidate.is_dir():  # a folder written whole (:func:`atomic_folder`)
-                size = sum(f.stat().st_size for f in candidate.rglob("*") if f.is_file())
-                shutil.rmtree(candidate)
-            else:
-                size = candidate.stat().st_size
-                candidate.unlink()
-        except FileNotFoundError:  # removed by another writer meanwhile
-            continue
-        log.warning("removed %s (%.1f MB), an unfinished write of %s left by a killed process (pid %s)",
-                    candidate, size / 1e6, path.name, match[1])
-        removed.append(candidate)
+    for where, name in places:
+        pattern = re.compile(rf"\.{re.escape(name)}\.(\d+)@(.+)\.[^.]+\.part")
+        for candidate in sorted(where.glob(f".{glob.escape(name)}.*.part")):
+            match = pattern.fullmatch(candidate.name)
+            if match is None or candidate.is_symlink() or match[2] != _host() or _running(int(match[1])):
+                continue
+            try:
+                if candidate.is_dir():  # a folder written whole, or a stage (atomic_folder, output_set)
+                    _give_back(candidate / REPLACED, path)
+                    size = sum(f.lstat().st_size for f in candidate.rglob("*") if f.is_file() and not f.is_symlink())
+                    shutil.rmtree(candidate)
+                else:
+                    size = candidate.stat().st_size
+                    candidate.unlink()
+            except FileNotFoundError:  # removed by another writer meanwhile
+                continue
+            log.warning("removed %s (%.1f MB), an unfinished write of %s left by a killed process (pid %s)",
+                        candidate, size / 1e6, path.name, match[1])
+            removed.append(candidate)
     return removed
+
+
+def _give_back(replaced: Path, path: Path) -> None:
+    """Move each entry of a killed stage's ``replaced`` folder (:data:`REPLACED`) back into the
+    folder ``path`` where ``path`` has no entry of its name (the kill came between its two renames)."""
+    if not replaced.is_dir() or replaced.is_symlink() or not path.is_dir():
+        return
+    for entry in sorted(replaced.iterdir()):
+        target = path / entry.name
+        if not (target.exists() or target.is_symlink()):
+            os.replace(entry, target)
+            log.warning("restored %s, which a process killed while replacing it had moved aside", target)
 
 
 class _WriteSink:

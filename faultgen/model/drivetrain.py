@@ -78,14 +78,17 @@ RATING_UNITS = {
     "rated_life": "h at rated torque and speed, L10",
 }
 RATING_KEYS = tuple(RATING_UNITS)
-#: Bounds of the numbers, (low, high), exclusive of 0: far outside any robot gear (rated torques
-#: 1 .. 10^5 N m, output speeds 0.1 .. 10 rad/s, lives 10^3 .. 10^5 h).
-RATING_BOUNDS = {"rated_torque": (0.0, 1e7), "rated_speed": (0.0, 1e4), "rated_life": (0.0, 1e7)}
+#: Bounds of the numbers, (low, high), inclusive: far outside any robot gear (rated torques
+#: 1 .. 10^5 N m, output speeds 0.1 .. 10 rad/s, lives 10^3 .. 10^5 h), and within them the rated-life
+#: formula stays representable (:func:`faultgen.monitor.life.consumed`: its denominator
+#: ``n_N T_N^p L_n 3600`` at least 3.6e-26, so a log's share of life stays finite, where a rated torque
+#: of 1e-300 made it 0 and the share inf or NaN).
+RATING_BOUNDS = {"rated_torque": (1e-6, 1e7), "rated_speed": (1e-6, 1e4), "rated_life": (1e-3, 1e7)}
 
 
 def check_rating(key: str, value) -> str | float:
     """``value`` of rating key ``key`` checked: a type of :data:`GEARBOX_EXPONENTS`, or a finite
-    number > 0 within :data:`RATING_BOUNDS`.
+    number within :data:`RATING_BOUNDS`.
 
     Raises
     ------
@@ -98,9 +101,10 @@ def check_rating(key: str, value) -> str | float:
         return value
     low, high = RATING_BOUNDS[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-            or not low < value <= high:
+            or not low <= value <= high:
         raise DrivetrainError(f"{key} = {str(value)[:40] if isinstance(value, str) else value!r}; expected a finite "
-                              f"number > {low:g} and <= {high:g} ({RATING_UNITS[key]})")
+                              f"number > 0, from {low:g} to {high:g} ({RATING_UNITS[key]}; the rated-life formula's "
+                              "range)")
     return float(value)
 
 

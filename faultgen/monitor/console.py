@@ -33,8 +33,10 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,
                                            monitors[0].n_axes if monitors else 1, logs_scored)  # "" where it says nothing
     lines.append(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
-    lines.append(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
-                 f"{out / 'rul.csv'}, {len(monitors)} charts and the fleet report {out / page.PAGE}")
+    tables = ("units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "life.csv",
+              *(("tests.csv",) if outcome.tests else ()))
+    lines.append(f"wrote {', '.join(str(out / name) for name in tables)}, {len(monitors)} charts and the fleet report "
+                 f"{out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]
     if not short:
         return lines, ""

@@ -117,6 +117,14 @@ SCALE_MIN = 0.2
 FORGET = 0.6
 #: The cache of the tests' readings in OUT, its entries' format and largest size, bytes.
 CACHE, CACHE_FORMAT, CACHE_MAX_BYTES = "friction-tests", "faultgen-friction-test-reading/1", 2**20
+#: The range of a reading's values (cached or fresh): torques and torque per speed at most this in
+#: magnitude (N m, N m s/rad, rad/s; 1000 times a large robot's gearbox torque), a temperature within
+#: :data:`TEMPERATURE_RANGE` degC, a dry level below :data:`MIN_DRY_NM` read as none (no wear): the
+#: wear's arithmetic stays within floating point (a ratio of dry levels below 1e16).
+VALUE_MAX, TEMPERATURE_RANGE, MIN_DRY_NM = 1e7, (-273.15, 1000.0), 1e-9
+#: A test's dry level (temperature-corrected) over its reference's beyond ``exp(+-LN_FACTOR_MAX)`` (a
+#: factor of 1e6) reads no wear: another gearbox, torque channel or unit.
+LN_FACTOR_MAX = math.log(1e6)
 #: The fit's interval (friction_fit's 95 %) as a standard error: its half width over this.
 FIT_Z = float(NormalDist().inv_cdf(0.5 + friction_fit.LEVEL / 2))
 
@@ -200,7 +208,22 @@ def _reading(parsed: fleet_logs.Parsed, robot, log) -> FrictionTest:
         text = " ".join(str(err).split())
         return FrictionTest(log.stamp, log.key, parsed.sha256, error=text[:300])
     rows = tuple({"axis": int(r["axis"]), **{c: float(r[c]) for c in FIT_COLUMNS}} for _, r in fits.iterrows())
+    wrong = next(filter(None, map(out_of_range, rows)), "")
+    if wrong:
+        return FrictionTest(log.stamp, log.key, parsed.sha256, error=f"its fit gives {wrong}")
     return FrictionTest(log.stamp, log.key, parsed.sha256, rows)
+
+
+def out_of_range(fit: dict) -> str:
+    """Why a reading's ``fit`` of one axis (``axis`` and :data:`FIT_COLUMNS`) holds a value no test
+    reads (:data:`VALUE_MAX`, :data:`TEMPERATURE_RANGE`: infinite, or beyond them; NaN is a value
+    the fit leaves out), naming the axis, column and value; "" when none."""
+    for column in FIT_COLUMNS:
+        value = fit[column]
+        low, high = TEMPERATURE_RANGE if column == "temperature_degC" else (-VALUE_MAX, VALUE_MAX)
+        if not (math.isnan(value) or low <= value <= high):
+            return f"axis {fit['axis']} {column} = {value:g}, outside {low:g}..{high:g}"
+    return ""
 
 
 def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
@@ -214,6 +237,15 @@ def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
     if not ok:
         raise stored.StateError(f"{path}: not the cached reading of the friction test {log.name}; delete it (the test "
                                 "is read again)")
+    try:
+        wrong = next(filter(None, (out_of_range({c: float(f[c]) for c in FIT_COLUMNS} | {"axis": f["axis"]})
+                                   for f in fits)), "")
+    except OverflowError:  # an integer beyond a float's range
+        wrong = "a number beyond a float's range"
+    if wrong or any(f["axis"] < 1 for f in fits):
+        raise stored.StateError(f"{path}: the cached reading of the friction test {log.name} holds "
+                                f"{wrong or 'an axis below 1'}, which no test reads; delete it (the test is read "
+                                "again)")
     return FrictionTest(log.stamp, log.key, key["test"], tuple({c: (int(f[c]) if c == "axis" else float(f[c]))
                                                        for c in ("axis", *FIT_COLUMNS)} for f in fits), error)
 
@@ -303,7 +335,7 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
             mine[-1].append((test, fit))
     series = {}
     for k, mine in segments.items():  # the law from each axis's tests since its last repair
-        good = [(t, f) for t, f in mine[-1] if f["coulomb_Nm"] > 0]
+        good = [(t, f) for t, f in mine[-1] if f["coulomb_Nm"] > MIN_DRY_NM]
         series[k] = (np.array([f["temperature_degC"] for _, f in good]), np.log([f["coulomb_Nm"] for _, f in good]))
     if not segments:
         return [], None
@@ -311,17 +343,23 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
     z = NormalDist().inv_cdf(0.5 + INTERVAL / 2)
     rows = []
     for k, items in ((k, items) for k, mine in sorted(segments.items()) for items in mine):
-        reference = next(((t, f) for t, f in items if f["coulomb_Nm"] > 0), None)
+        reference = next(((t, f) for t, f in items if f["coulomb_Nm"] > MIN_DRY_NM), None)
         for test, fit in items:
-            if reference is None or fit["coulomb_Nm"] <= 0:
+            if reference is None or not fit["coulomb_Nm"] > MIN_DRY_NM:
                 rows.append(AxisWear(test.stamp, test.key, k, fit, math.nan, math.nan, math.nan, math.nan, math.nan,
-                                     "no positive dry level read: no wear"))
+                                     no_wear_verdict(k, fit["coulomb_Nm"])))
                 continue
             t0, f0 = reference
             error0 = _spread(f0, law)
             dt = fit["temperature_degC"] - f0["temperature_degC"]
             corrected = np.isfinite(dt)
-            d = math.log(fit["coulomb_Nm"] / f0["coulomb_Nm"]) - (law.beta * dt if corrected else 0.0)
+            d = math.log(fit["coulomb_Nm"]) - math.log(f0["coulomb_Nm"]) - (law.beta * dt if corrected else 0.0)
+            if test is not t0 and not abs(d) <= LN_FACTOR_MAX:  # no wear: another gear, channel or unit
+                verdict = (f"dry level {fit['coulomb_Nm']:.4g} N m against {t0.stamp}'s {f0['coulomb_Nm']:.4g} N m, a "
+                           f"factor of e^{d:.3g} after the temperature correction: beyond any wear (another gearbox, "
+                           "torque channel or unit?); no wear")
+                rows.append(AxisWear(test.stamp, test.key, k, fit, *[math.nan] * 5, verdict))
+                continue
             if test is t0:
                 sd = own = error0
                 verdict = f"reference: the first test since the axis's last repair (temperature law {law.source})"
@@ -334,10 +372,25 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
                               if corrected else ", no temperature logged: not corrected"))
             sd = sd if np.isfinite(sd) else math.nan
             rows.append(AxisWear(test.stamp, test.key, k, fit, 100 * (math.exp(d) - 1),
-                                 100 * (math.exp(d - z * sd) - 1), 100 * (math.exp(d + z * sd) - 1), sd, error0,
+                                 100 * (_exp(d - z * sd) - 1), 100 * (_exp(d + z * sd) - 1), sd, error0,
                                  verdict, test is t0, own))
     rows.sort(key=lambda r: (r.key, r.axis))
     return rows, law
+
+
+def _exp(x: float) -> float:
+    """``exp(x)``, inf where it leaves floating point (an interval's end of a test read loosely)."""
+    return math.inf if x >= 709.0 else math.exp(x)  # NaN stays NaN
+
+
+def no_wear_verdict(axis: int, coulomb: float) -> str:
+    """tests.csv's verdict on a test of ``axis`` whose dry level ``coulomb`` (N m, arm side) is no
+    positive one: a negative level names its likely cause."""
+    if coulomb < 0:
+        return (f"dry level read negative ({coulomb:.4g} N m): a likely sign error (tau{axis} or q{axis} "
+                f"negated against the other) or side error (a motor-side torque referred to the arm through a "
+                f"gear ratio of the wrong sign); check the log's sign convention; no wear")
+    return "no positive dry level read: no wear"
 
 
 def _spread(fit: dict, law: Law) -> float:

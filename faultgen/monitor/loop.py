@@ -105,10 +105,12 @@ class UnitStatus:
 @dataclass
 class Outcome:
     """What :func:`monitor` did: each unit's ``monitors`` (:class:`UnitMonitor`) and ``statuses``
-    (:class:`UnitStatus`), in the fleet folder's order."""
+    (:class:`UnitStatus`), in the fleet folder's order; ``tests``: whether it wrote ``tests.csv``
+    (the fleet has friction tests)."""
 
     monitors: list[UnitMonitor]
     statuses: list[UnitStatus]
+    tests: bool = False
 
     @property
     def exit_status(self) -> int:
@@ -279,7 +281,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
                                                        unit.maintenance, unit.program_changes))
-    return Outcome(monitors, statuses)
+    return Outcome(monitors, statuses, tests=bool(found))
 
 
 

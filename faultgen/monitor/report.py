@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.data import cells
+from faultgen.figure_text import plain
 from faultgen.monitor import scoring
 
 #: ``first_alarm``: the first of the alarming logs the alarm started from; ``known``: the log on which it
@@ -174,7 +175,8 @@ def _draw(path, monitor, axis_note: str) -> None:
             for ax in panels:
                 ax.axvline(k, color="r", lw=1.2)
             known = f" known {monitor.known}" if monitor.known and monitor.known != monitor.first_alarm else ""
-            top.text(k, 1.0, f" alarm {monitor.first_alarm}{known}, axis {monitor.source_axis}", color="r", va="bottom")
+            top.text(k, 1.0, plain(f" alarm {monitor.first_alarm}{known}, axis {monitor.source_axis}"), color="r",
+                     va="bottom")
         top.set_yscale("log")
         if twin:
             middle = panels[1]
@@ -190,12 +192,12 @@ def _draw(path, monitor, axis_note: str) -> None:
         for i in range(monitor.n_axes):
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
         step = max(1, len(rows) // 8)
-        bottom.set_xticks(x[::step], stamps[::step], rotation=30, ha="right", fontsize=8)
+        bottom.set_xticks(x[::step], [plain(s) for s in stamps[::step]], rotation=30, ha="right", fontsize=8)
     else:
         top.text(0.5, 0.5, "no log scored: see units.csv", ha="center", va="center", transform=top.transAxes)
     top.set_ylabel("statistic / its limit")
     protocol = "twin" if monitor.signatures is not None else "own"
-    top.set_title(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)")
+    top.set_title(plain(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)"))
     bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'RBC of Q'})")
     if rows:
         top.legend(fontsize=7, loc="upper left")

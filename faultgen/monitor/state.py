@@ -257,13 +257,21 @@ def out_folder(out: str | Path) -> Confined:
 
 def checked_out(out: str | Path) -> Confined:
     """:func:`out_folder` after checking, before a run reads or writes anything there, that OUT's
-    ``.state``, ``.cache`` and each :data:`CACHE` entry, where they exist, lead inside OUT.
+    ``.state``, ``.cache`` and each :data:`CACHE` entry, where they exist, lead inside OUT, and that an
+    existing OUT takes new files (a read-only OUT refused before the work, not after it). A killed
+    run's stage in OUT is removed first (:func:`faultgen.data.atomic.remove_stale`), giving back a
+    ``.state`` it had moved aside and not replaced, so that the state read is the last one written.
 
     Raises
     ------
     StateError
         One of them is a link leading outside OUT (named).
+    OSError
+        OUT is on a read-only file system, takes no new file or is full (:func:`faultgen.data.atomic.check_writable`).
     """
+    if Path(out).is_dir():
+        atomic.remove_stale(out)
+        atomic.check_writable(Path(out) / ".state")
     confined = out_folder(out)
     for entry in (".state", ".cache", *(f".cache/{name}" for name in CACHE)):
         confined.path(Path(out) / entry)
