@@ -1,6 +1,7 @@
 """What ``faultgen monitor`` prints when a run ends: one line per unit (its status, the model its
 twin is of, its alarm or its reason), the fleet's count of alarms beside the chance of a persistent
-alarm on a healthy unit (where that says something), the files written, and the units that are
+alarm on a healthy unit (where that says something), what was passed over (files that are not logs,
+events rows of no unit), the files written, and the units that are
 degraded or not monitored. Text only: the command prints it (faultgen/cli/monitoring.py)."""
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from faultgen.monitor import lights, page
+from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor.loop import EXIT_SOME_UNITS_NOT_MONITORED
 from faultgen.monitor.scoring import Settings
 
@@ -33,6 +35,12 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,
                                            monitors[0].n_axes if monitors else 1, logs_scored)  # "" where it says nothing
     lines.append(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
+    passed = getattr(outcome, "passed_over", [])
+    if passed:
+        name, reason = passed[0]
+        more = f" (and {len(passed) - 1} more)" if len(passed) > 1 else ""
+        lines.append(f"passed over {len(passed)} entries of the logs folder: {fleet_logs.passed_entry(name, reason)}"
+                     f"{more}; a unit folder's are named in the unit's reason in {out / 'units.csv'}")
     lines.append(f"wrote {out / 'units.csv'}, {out / 'alarms.csv'}, {out / 'scores.csv'}, {out / 'wear.csv'}, "
                  f"{out / 'rul.csv'}, {len(monitors)} charts and the fleet report {out / page.PAGE}")
     short = [s for s in outcome.statuses if s.status in ("degraded", "not monitored")]

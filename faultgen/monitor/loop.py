@@ -38,7 +38,7 @@ run is skipped, named: neither stops the fleet.
 from __future__ import annotations
 
 import contextlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +54,7 @@ from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, const
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
-                                   new_unit)
+                                   new_unit, refused_note)
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
@@ -105,10 +105,13 @@ class UnitStatus:
 @dataclass
 class Outcome:
     """What :func:`monitor` did: each unit's ``monitors`` (:class:`UnitMonitor`) and ``statuses``
-    (:class:`UnitStatus`), in the fleet folder's order."""
+    (:class:`UnitStatus`), in the fleet folder's order, and what it ``passed_over``."""
 
     monitors: list[UnitMonitor]
     statuses: list[UnitStatus]
+    #: ``(name, reason)`` of each file of the folder passed over (not a log, not a friction test:
+    #: ``<unit>/<file>``) and each row of ``events.csv`` that names no unit (``events.csv``).
+    passed_over: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def exit_status(self) -> int:
@@ -204,8 +207,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     ratings = life.ratings_of(nominal)  # a bad rating refused before any work
     life.check_hours(hours_per_day)
     _, suffixes = fleet_logs.reader_of(log_format)
-    units = fleet_logs.fleet(logs_dir, suffixes)
-    found = friction_tests.find(logs_dir, units, suffixes)  # a bad test refused before any work
+    passed: list[tuple[str, str]] = []  # files that are not logs or tests, events rows of no unit: named
+    units = fleet_logs.fleet(logs_dir, suffixes, passed)
+    found = friction_tests.find(logs_dir, units, suffixes, passed)
     out = Path(out)
     calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
@@ -214,7 +218,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                  log_format.key)
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
-    maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
+    maintenance, stopped = _maintenance_events(Path(logs_dir), units, nominal.n_axes, passed)
     tests = friction_tests.read_tests(found, nominal, out, log_format)  # each test read once, cached
     wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ()))
              for name, read in tests.items()}
@@ -225,8 +229,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
     with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
         pending, stale = {}, {}
-        for name, unit_logs in units.items():
-            pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
+        for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
+            pending[name], stale[name] = ([], []) if name in stopped else _pending(name, unit_logs, state.get(name))
         confined.mkdir(out / ".cache")
         scoring = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                            failure_wear, context.stepper)
@@ -250,7 +254,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                         bar.update(len(pending[name]))
         bar.close()
         monitors = [state[name].monitor for name in units if name in state]
-        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
+        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ()),
+                            fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
+                            stopped.get(name, "")) for name in units]
         with atomic.atomic_folder(out) as staging:
             report.write_alarms(staging / "alarms.csv", monitors)
             report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
@@ -262,7 +268,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             if found:
                 friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
             prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
-            life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
+            # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
+            life.write_life(staging / "life.csv", [row for name in units if name in state and state[name].entries
+                                                   for row in life.of_unit(
                 name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
             page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
@@ -279,7 +287,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
                                                        unit.maintenance, unit.program_changes))
-    return Outcome(monitors, statuses)
+    return Outcome(monitors, statuses, passed)
 
 
 
@@ -376,14 +384,20 @@ def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) 
     return {name for name, unit in state.items() if unit.model == "nominal"}
 
 
-def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=()) -> UnitStatus:
+def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=(), passed: str = "",
+            stopped: str = "") -> UnitStatus:
     """The unit's row of units.csv (:class:`UnitStatus`); ``stale``: notes on logs handled by an
     earlier run that changed or left the folder, or new logs older than them (:func:`_pending`),
-    which make it degraded; ``tests``: its friction tests read (those that could not be read named)."""
+    which make it degraded; ``tests``: its friction tests read (those that could not be read named);
+    ``passed``: the note on its files passed over (not logs: named, its status as without them);
+    ``stopped``: its bad row of events.csv, which leaves it not monitored in this run (none of its
+    logs scored, its earlier state kept)."""
+    first = [f"not monitored: {stopped} (its new logs are scored once the row is corrected)"] if stopped else []
     if unit is None:
-        return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
+        return UnitStatus(name, "not monitored", settings.protocol, "", "; ".join([*first, passed] if first or passed
+                                                                                  else ["no log"]), 0, "")
     protocol = "own" if unit.model == "none" else "twin"
-    reasons = [*unit.notes, *stale]
+    reasons = [*first, *unit.notes, *stale, *filter(None, [passed])]
     unread = [t for t in tests if t.error]
     if unread:
         more = f" (and {len(unread) - 1} more)" if len(unread) > 1 else ""
@@ -393,35 +407,47 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
         reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
     learning = unit.monitor.pca is None
-    if learning and constant_torque_note(unit) is None:  # not learning: off the monitor
+    refused = refused_note(unit) is not None  # its first log refused: no model used
+    if learning and constant_torque_note(unit) is None and not refused:  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
     elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
-    if not unit.entries:
+    if not unit.entries or stopped:
         status = "not monitored"
     elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
         status = "learning" if learning else "monitored"
     last = unit.entries[-1].stamp if unit.entries else ""
-    return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
+    return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
                       "; ".join(fallback_notes(unit)))
 
 
-def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, list]:
+def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
+                        passed: list | None = None) -> tuple[dict[str, list], dict[str, str]]:
     """Each unit's repairs and gearbox changes of ``LOGS/events.csv`` (none without the file), in
-    stamp order (:func:`faultgen.data.logfolder.read_events`; a bad file stops the run, named)."""
+    stamp order (:func:`faultgen.data.logfolder.read_events`), and the units a bad row stops: unit ->
+    the row named and why (the first; "(and N more)"). A row that names no unit of the folder is
+    added to ``passed``; a bad file (its header, its encoding, a link out) stops the run, named."""
     path = logs_dir / "events.csv"
     if not path.exists():
-        return {}
+        return {}, {}
     found: dict[str, list] = {}
-    for event in logfolder.read_events(path, units, n_axes, folder=logs_dir):
+    bad: list[tuple[str, str]] = []
+    for event in logfolder.read_events(path, units, n_axes, folder=logs_dir, bad=bad):
         if event.event in MAINTENANCE:
             found.setdefault(event.unit, []).append(event)
-    return {unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()}
+    stopped: dict[str, list[str]] = {}
+    for unit, message in bad:
+        if unit:
+            stopped.setdefault(unit, []).append(message)
+        elif passed is not None:
+            passed.append((path.name, message))
+    return ({unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()},
+            {unit: rows[0] + (f" (and {len(rows) - 1} more)" if len(rows) > 1 else "") for unit, rows in stopped.items()})
 
 
 

@@ -103,7 +103,56 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
         return Unit(monitor, "none", None, first_key,
                      notes=[f"its first log cannot be replayed ({short(err)}): protocol own"])
     kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
-    return Unit(monitor, kind, program, first_key)
+    unit = Unit(monitor, kind, program, first_key)
+    try:
+        plausible(nominal, source.get(first).checked())
+    except plausibility.ImplausibleLogError as err:
+        refuse(unit, err)
+    return unit
+
+
+#: The start of the note (units.csv's reason) of a unit whose first log the nominal model cannot
+#: explain (:func:`plausible`, the calibration's own check): the unit is not monitored, whatever
+#: model was asked for: a twin of any model would read its torque in the wrong scale (a log
+#: logged motor-side read 0.16 % wear where the truth was 44 %).
+REFUSED = "not monitored: its first log is refused"
+
+
+def plausible(nominal: robots.Robot, data) -> None:
+    """Refuse a unit's first log (checked, :class:`faultgen.logs.measured.MeasuredData`) that the
+    ``nominal`` model cannot explain, as ``faultgen calibrate`` refuses it, with its message
+    (:func:`faultgen.calibrate.plausibility.check` on the nominal model's torque along the log's
+    motion; a log longer than :data:`faultgen.calibrate.MAX_ROWS` averaged down first, as the
+    calibration does). Whatever model the unit's twin is of: a refusal is the unit's error, never a
+    reason to fall back to another model.
+
+    Raises
+    ------
+    faultgen.calibrate.plausibility.ImplausibleLogError
+        Motor-side torque, another robot's log, a torque column in another unit or sign.
+    """
+    from faultgen.calibrate import MAX_ROWS, decimate, search
+    from faultgen.calibrate.prediction import predicted_motion
+
+    data = decimate(data, MAX_ROWS) if len(data) > MAX_ROWS else data
+    tau = np.asarray(data.tau)
+    plausibility.check(nominal, tau, predicted_motion(nominal, data)[0], np.abs(data.qd) >= search.REST_SPEED)
+
+
+def refuse(unit: Unit, err: ValueError) -> str:
+    """Take ``unit`` off the monitor for its first log's refusal ``err`` (:data:`REFUSED`, the
+    message kept whole): noted in its reason; returns the reason its logs are skipped with."""
+    unit.notes.append(f"{REFUSED} ({unit.first[0]}): {' '.join(str(err).split())}")
+    return REFUSED_SKIP
+
+
+#: The reason each log of a unit refused (:data:`REFUSED`) is skipped with.
+REFUSED_SKIP = "the unit is not monitored: its first log is refused (the unit's reason says why)"
+
+
+def refused_note(unit: Unit) -> str | None:
+    """The note that took ``unit`` off the monitor for its first log (:func:`refuse`), or None."""
+    return next((n for n in unit.notes if n.startswith(REFUSED)), None)
 
 
 def fallback_notes(unit: Unit) -> list[str]:
@@ -132,6 +181,10 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
             twin = twins[twin_key]
         except stored.StateError:
             raise
+        except plausibility.ImplausibleLogError as err:  # the log refused: the unit's error, never a fallback
+            if unit.entries:
+                return f"the twin of the {KIND_NAMES[unit.model]} cannot be built again ({short(err)})"
+            return refuse(unit, err)
         except ValueError as err:
             if unit.entries:
                 return f"the twin of the {KIND_NAMES[unit.model]} cannot be built again ({short(err)})"
