@@ -25,8 +25,11 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
         alarm = m is not None and m.first_alarm
+        # the fallbacks are said once, beside the status (status.basis), not again in the reason
+        reason = status.reason.replace(status.fallback, "").replace("; ; ", "; ").strip("; ") if status.fallback \
+            else status.reason
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
-            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
+            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
                      f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)

@@ -403,9 +403,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         more = f" (and {len(unread) - 1} more)" if len(unread) > 1 else ""
         reasons.append(f"{len(unread)} friction tests not read: {unread[0].stamp}: {unread[0].error}{more}")
     if unit.skipped:
-        first = unit.skipped[0]
-        more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
-        reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
+        reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
     if learning and constant_torque_note(unit) is None and not refused:  # not learning: off the monitor
@@ -424,6 +422,25 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
                       "; ".join(fallback_notes(unit)))
+
+
+#: Most distinct reasons a unit's reason names for its skipped logs (:func:`skipped_note`).
+SKIPPED_REASONS = 3
+
+
+def skipped_note(skipped: list) -> str:
+    """A unit's note on its skipped logs (each with ``stamp`` and ``reason``): their count, and each
+    distinct reason once, with the first log skipped for it and how many more were (at most
+    :data:`SKIPPED_REASONS`; the logs of the other reasons counted): an empty first log and a part
+    the twin cannot carry are both said, and one reason of many logs only once."""
+    groups: dict[str, list] = {}
+    for log in skipped:
+        groups.setdefault(log.reason, []).append(log)
+    shown = [f"{logs[0].stamp}: {reason}" + (f" (and {len(logs) - 1} more)" if len(logs) > 1 else "")
+             for reason, logs in list(groups.items())[:SKIPPED_REASONS]]
+    rest = sum(len(logs) for logs in list(groups.values())[SKIPPED_REASONS:])
+    others = f"; and {rest} more for {len(groups) - SKIPPED_REASONS} other reasons" if rest else ""
+    return f"{len(skipped)} logs skipped: {'; '.join(shown)}{others}"
 
 
 def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
