@@ -226,7 +226,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     def scale_of(name: str):
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
-    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
+    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of, nominal.name)
     with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
         pending, stale = {}, {}
         for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
@@ -469,7 +469,7 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
 
 
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
-                scale_of=lambda name: None) -> dict[str, Unit]:
+                scale_of=lambda name: None, robot: str = "") -> dict[str, Unit]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
     looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
@@ -486,7 +486,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         path = folder / stored.unit_file(name, ".json")
         if not (path.exists() or path.is_symlink()):
             continue
-        kept = stored.read_unit(path, out, name, key, n_axes, n_features)
+        kept = stored.read_unit(path, out, name, key, n_axes, n_features, robot)
         if not (kept.entries or kept.skipped):
             continue
         state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,
