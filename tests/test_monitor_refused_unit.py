@@ -172,3 +172,12 @@ def test_the_same_angles_at_another_pace_are_another_program(tmp_path):
     assert units_module.program_of(log["a"], "a", programs, source) == ("a", "1")
     assert units_module.program_of(log["b"], "b", programs, source) == ("b", "1")
     assert units_module.program_of(log["c"], "c", programs, source) == ("a", "1")
+
+
+def test_a_given_model_that_does_not_load_is_refused_not_replaced_by_the_nominal_model(fleet, tmp_path):
+    bad = tmp_path / "puma560_calibrated.xml"
+    bad.write_text("<mujoco><worldbody><body name='x'><joint/></body></worldbody>")  # not closed
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match=r"^--calibrated .*puma560_calibrated\.xml: the model does not load \("):
+        loop.monitor("puma560", fleet, out, calibrated=bad, settings=Settings(train=10, persistence=3), progress=False)
+    assert not out.exists()

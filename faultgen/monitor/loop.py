@@ -131,6 +131,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     model, then the nominal model, then ``--protocol own``: the unit against its own first logs),
     and a log that cannot be read or that the twin cannot replay is skipped; both are named in
     ``units.csv`` (:class:`UnitStatus`) and the unit's state keeps them, so a rerun does not try again.
+    A unit whose first log the nominal model cannot explain (motor-side torque, another robot: the
+    calibration's plausibility check, :func:`faultgen.monitor.unit.plausible`) is not monitored, with
+    that message, whatever the model: a refusal is never a reason to fall back. A file in a unit
+    folder that is not a log (``notes.txt``) is passed over and named (:attr:`Outcome.passed_over`,
+    the unit's reason); a bad row of ``events.csv`` leaves its unit not monitored in this run, the
+    row named, its earlier state kept (a row that names no unit is passed over, named).
 
     Parameters
     ----------
@@ -141,7 +147,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     out : str or Path
         Output folder; an earlier run's output there is continued (its settings must match).
     calibrated : path, optional
-        A ``faultgen calibrate`` output folder (or its model file) used as every unit's model.
+        A ``faultgen calibrate`` output folder (or its model file) used as every unit's model; one
+        that does not load is refused before any unit is scored (never the nominal model instead).
     calibrate : bool
         Without ``calibrated``: calibrate each unit's model on its first log (True) or use the
         nominal model (False). Only the ``twin`` protocol uses a model.
@@ -181,7 +188,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
         file named), a ``context`` with ``jobs`` > 1 and a ``scheduler`` or not an ExecutionContext,
         ``hours_per_day`` outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
-        (:mod:`faultgen.model.rating`).
+        (:mod:`faultgen.model.rating`), a ``calibrated`` model that does not load, a bad ``events.csv``
+        as a whole (its header, encoding, a link out of ``logs_dir``).
     faultgen.runs.errors.SweepRefused
         The ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
@@ -231,10 +239,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         pending, stale = {}, {}
         for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
             pending[name], stale[name] = ([], []) if name in stopped else _pending(name, unit_logs, state.get(name))
-        confined.mkdir(out / ".cache")
         scoring = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                            failure_wear, context.stepper)
         source = scoring.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
+        if isinstance(source.given, ValueError):  # a given model refused: the run's error, never the nominal model instead
+            raise ValueError(f"--calibrated {calibrated}: the model does not load ({source.given})")
+        confined.mkdir(out / ".cache")
         programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
