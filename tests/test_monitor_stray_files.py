@@ -54,6 +54,8 @@ def test_a_stray_file_and_a_bad_events_row_stop_nothing_else_and_are_named(tmp_p
     stray = _linked(logs, tmp_path / "stray" / "LOGS")
     (stray / "u1" / "notes.txt").write_text("the operator's notes\n")
     os.link(logs / "u1" / "2026-03-05.csv", stray / "u1" / "backup copy.csv")  # a log's bytes under no stamp
+    (stray / "u3" / "friction-test").mkdir()
+    (stray / "u3" / "friction-test" / "readme.md").write_text("tests go here\n")  # no test yet: as no folder
     (stray / "events.csv").write_text(GOOD_EVENTS + "u2,2026-03-04,replaced,1\nu9,2026-03-04,repair,1\n")
     out = tmp_path / "stray" / "out"
     result = _monitor(stray, out)
@@ -69,10 +71,13 @@ def test_a_stray_file_and_a_bad_events_row_stop_nothing_else_and_are_named(tmp_p
              "(2026-03-01), an ISO date and time (2026-03-01T08:30:00 or 2026-03-01T08-30-00) nor a sequence "
              "number (17) (and 1 more)")
     assert units["u1"] == {**before["u1"], "reason": "; ".join(filter(None, (before["u1"]["reason"], named)))}
-    assert before["u1"]["status"] == "monitored" and units["u3"] == before["u3"]
+    assert before["u1"]["status"] == "monitored"
+    assert units["u3"] == {**before["u3"], "reason": "; ".join(filter(None, (
+        before["u3"]["reason"], "1 files passed over, not logs: u3/friction-test/readme.md: not a friction test: "
+                                "expected <stamp>.csv or <stamp>.csv.gz or <stamp>.h5 or <stamp>.hdf5")))}, units["u3"]
     # and on the console, with the events row that names no unit
-    assert "passed over 3 entries of the logs folder: u1/backup copy.csv: stamp 'backup copy'" in result.output
-    assert "u1/notes.txt" not in result.output or "(and 2 more)" in result.output
+    assert "passed over 4 entries of the logs folder: u1/backup copy.csv: stamp 'backup copy'" in result.output
+    assert "(and 3 more)" in result.output
     assert "u2: not monitored" in result.output and "events.csv: line 3: event 'replaced'" in result.output
     # every other unit's outputs: byte for byte those of the run without the stray file and the bad row
     for name in OUTPUTS[:-1]:
@@ -86,8 +91,8 @@ def test_a_stray_file_and_a_bad_events_row_stop_nothing_else_and_are_named(tmp_p
 
     # the row corrected: the stopped unit is scored as in the clean run, the others kept
     (stray / "events.csv").write_text(GOOD_EVENTS)
-    (stray / "u1" / "notes.txt").unlink()
-    (stray / "u1" / "backup copy.csv").unlink()
+    for path in ("u1/notes.txt", "u1/backup copy.csv", "u3/friction-test/readme.md"):
+        (stray / path).unlink()
     result = _monitor(stray, out)
     assert result.exit_code == 0, result.output
     for name in OUTPUTS:

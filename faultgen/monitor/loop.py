@@ -407,7 +407,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         return UnitStatus(name, "not monitored", settings.protocol, "", "; ".join([*first, passed] if first or passed
                                                                                   else ["no log"]), 0, "")
     protocol = "own" if unit.model == "none" else "twin"
-    reasons = [*first, *unit.notes, *stale, *filter(None, [passed])]
+    reasons = [*first, *unit.notes, *stale]
     unread = [t for t in tests if t.error]
     if unread:
         more = f" (and {len(unread) - 1} more)" if len(unread) > 1 else ""
@@ -428,6 +428,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         status = "degraded"
     else:
         status = "learning" if learning else "monitored"
+    reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
