@@ -219,7 +219,7 @@ class Twin:
     def _features(self, result: sim.RunResult, index: int = 0) -> np.ndarray:
         """The feature vector of simulated cycle ``index`` of ``result``, as a measured log's."""
         data = measured.from_arrays(result.t, result.q_a[index], result.tau_m[index] * self.robot.gear_ratio,
-                                    self.robot, source=f"twin of {self.program.name}")
+                                    self.robot, source="a cycle of the twin")
         return fleet_logs.features_of(self.robot, data)
 
     def _simulate_together(self, cycles: list[tuple[float, float, int]]) -> None:
