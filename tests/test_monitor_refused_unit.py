@@ -93,7 +93,7 @@ def test_a_unit_logged_motor_side_is_not_monitored_with_the_calibrations_message
     assert (m2["status"], m2["logs_scored"], m2["model"]) == ("not monitored", "0", ""), m2
     assert f"not monitored: its first log is refused (2026-03-01): {message}" in m2["reason"], m2["reason"]
     assert "fall" not in m2["reason"] and "nominal model" not in m2["reason"], m2["reason"]
-    assert f"m2: not monitored (twin): not monitored: its first log is refused (2026-03-01): {message}" in \
+    assert f"m2: not monitored (twin): its first log is refused (2026-03-01): {message}" in \
         " ".join(result.output.split())
     # no wear, no life, no "service by" for it: a grey light, never green
     assert _rows(out / "rul.csv")["m2"][0]["verdict"] == "no log scored: no wear estimate"

@@ -78,7 +78,7 @@ def test_a_stray_file_and_a_bad_events_row_stop_nothing_else_and_are_named(tmp_p
     # and on the console, with the events row that names no unit
     assert "passed over 4 entries of the logs folder: u1/backup copy.csv: stamp 'backup copy'" in result.output
     assert "(and 3 more)" in result.output
-    assert "u2: not monitored" in result.output and "events.csv: line 3: event 'replaced'" in result.output
+    assert "u2: not monitored (own): events.csv: line 3: event 'replaced'" in result.output
     # every other unit's outputs: byte for byte those of the run without the stray file and the bad row
     for name in OUTPUTS[:-1]:
         a, b = _rows(clean / name), _rows(out / name)

@@ -28,6 +28,7 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
         # the fallbacks are said once, beside the status (status.basis), not again in the reason
         reason = status.reason.replace(status.fallback, "").replace("; ; ", "; ").strip("; ") if status.fallback \
             else status.reason
+        reason = reason.removeprefix(f"{status.status}: ")  # "not monitored: ..." beside the status said once
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
