@@ -18,9 +18,13 @@ from faultgen.data import logfiles
 RATE = 250.0  # Hz
 
 
-def log_signals(robot, day: int, seed: int, wear: np.ndarray, cycles: int = 2, cycle_time: float = 1.5):
+def log_signals(robot, day: int, seed: int, wear: np.ndarray, cycles: int = 2, cycle_time: float = 1.5,
+                model: bool = False):
     """(t, q, qd, tau, cycle) of one log: ``cycles`` cycles of ``cycle_time`` s; ``wear`` (N,) the
-    relative Coulomb friction increase of each axis."""
+    relative Coulomb friction increase of each axis. ``model``: the torque the robot's rigid model
+    needs along the motion (its inverse dynamics) in place of the gravity-like term, a log the
+    calibration's plausibility check takes as the robot's (the monitor's twin refuses any other
+    since issue 88)."""
     rng = np.random.default_rng([seed, day])
     n = int(cycles * cycle_time * RATE)
     t = np.arange(n) / RATE
@@ -32,7 +36,12 @@ def log_signals(robot, day: int, seed: int, wear: np.ndarray, cycles: int = 2, c
     qd = half * w * np.cos(w * t[:, None] + phase)
     limit = robot.gear_ratio * robot.motor_torque_limit
     coulomb = 0.05 * limit * (1 + wear)
-    tau = 0.2 * limit * np.cos(q) + coulomb * np.tanh(qd / 0.05) + 0.02 * limit * qd
+    if model:
+        qdd = -half * w**2 * np.sin(w * t[:, None] + phase)
+        rigid = robot.inverse_dynamics(q, qd, qdd, friction=False)
+    else:
+        rigid = 0.2 * limit * np.cos(q)
+    tau = rigid + coulomb * np.tanh(qd / 0.05) + 0.02 * limit * qd
     tau = tau + 0.002 * limit * rng.standard_normal(tau.shape)
     cycle = (t // cycle_time).astype(int) + 1
     return t, q, qd, tau, cycle
@@ -54,9 +63,10 @@ def write_log(path: Path, robot, day: int, seed: int, wear: np.ndarray, **kw) ->
 
 
 def write_fleet(folder: Path, robot, units: int = 3, days: int = 12, worn: dict | None = None,
-                start: date = date(2026, 3, 1), suffix: str = ".csv") -> Path:
+                start: date = date(2026, 3, 1), suffix: str = ".csv", model: bool = False) -> Path:
     """``units`` units x ``days`` daily logs under ``folder``; ``worn`` maps a unit index to
-    (axis 1..N, onset day index, wear per day); units are named ``u1``, ``u2``, ..."""
+    (axis 1..N, onset day index, wear per day); units are named ``u1``, ``u2``, ...; ``model``: the
+    torque of the robot's model (:func:`log_signals`), for the twin."""
     worn = worn or {}
     for u in range(units):
         unit = folder / f"u{u + 1}"
@@ -66,5 +76,5 @@ def write_fleet(folder: Path, robot, units: int = 3, days: int = 12, worn: dict 
             if u in worn:
                 axis, onset, rate = worn[u]
                 wear[axis - 1] = max(0.0, d - onset) * rate
-            write_log(unit / f"{(start + timedelta(days=d)).isoformat()}{suffix}", robot, d, u, wear)
+            write_log(unit / f"{(start + timedelta(days=d)).isoformat()}{suffix}", robot, d, u, wear, model=model)
     return folder

@@ -450,7 +450,9 @@ def _planted(logs: Path, root: Path) -> Path:
     """A copy of the fleet folder (hard links) with two more units made of unit01's logs: unit98's
     declare an 8000 kg part, which the log reader refuses (its bound is 1000 kg), and unit99's run
     three times faster (9 times the accelerations) 2 mrad off unit01's angles, a motion no KR210
-    model's drives follow (its replay is refused above the planning limits)."""
+    model's drives follow (its replay is refused above the planning limits), with three times its
+    torque (the calibration's plausibility check, which the monitor runs on every first log since
+    issue 88, refuses unit01's torque along that motion: 0.12-0.14 x the model's)."""
     copy = root / "logs"
     for unit in logs.iterdir():
         (copy / unit.name).mkdir(parents=True)
@@ -465,10 +467,13 @@ def _planted(logs: Path, root: Path) -> Path:
         heavy = [row.rsplit(",", 1)[0] + ",8000" for row in rows]
         (copy / "unit98" / log.name).write_text("\n".join([header, *heavy]) + "\n")
         fast = []
+        torque = [k for k, name in enumerate(names) if name.startswith("tau")]
         for row in rows:
             cells = row.split(",")
             cells[0] = repr(float(cells[0]) / 3)
             cells[1] = repr(float(cells[1]) + 0.002)
+            for k in torque:  # three times the torque: one the arm could give that motion (issue 88: else refused)
+                cells[k] = repr(3 * float(cells[k]))
             fast.append(",".join(cells))
         (copy / "unit99" / log.name).write_text("\n".join([header, *fast]) + "\n")
     return copy

@@ -25,8 +25,9 @@ from faultgen.model import robots
 
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory):
-    """3 units x 12 daily logs of irb6700 (synthetic, tests/fleetlog_folder.py)."""
-    return fleetlog_folder.write_fleet(tmp_path_factory.mktemp("fleet") / "logs", robots.load("irb6700"))
+    """3 units x 12 daily logs of irb6700 (synthetic, tests/fleetlog_folder.py; the model's torque,
+    which the twin takes: issue 88)."""
+    return fleetlog_folder.write_fleet(tmp_path_factory.mktemp("fleet") / "logs", robots.load("irb6700"), model=True)
 
 
 def monitor(logs: Path, out: Path, mark: str, **popen) -> subprocess.Popen:

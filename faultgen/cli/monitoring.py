@@ -102,7 +102,11 @@ def monitor_command(
     No unit stops the fleet: a unit whose twin cannot be built falls back (its calibrated model,
     then its own friction on the nominal model, then the nominal model, then --protocol own), and
     a log that cannot be read or replayed is skipped; OUT/units.csv gives every unit's status
-    (monitored, learning, degraded, not monitored), protocol, model and the reason. Exit status: 0 when every unit is monitored or
+    (monitored, learning, degraded, not monitored), protocol, model and the reason. A unit whose
+    first log `faultgen calibrate` would refuse (torque logged motor-side, another robot's log) is
+    not monitored, with that message, never against a fallback model; a file in a unit folder that
+    is not a log is passed over and named; a bad row of events.csv stops its unit only, the row
+    named. Exit status: 0 when every unit is monitored or
     still learning, 3 when some unit is degraded or not monitored (every output still written),
     2 when the run is refused before any work (bad option, robot, folder or OUT). OUT must lie apart
     from LOGS (neither inside it nor holding it); a run that fails leaves no OUT it made.

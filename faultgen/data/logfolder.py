@@ -289,27 +289,31 @@ def _kind(path: Path) -> str:
 
 
 def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,
-                folder: Path | None = None) -> list[Event]:
+                folder: Path | None = None, bad: list[tuple[str, str]] | None = None) -> list[Event]:
     """The rows of ``events.csv`` (module docstring), checked against the units' logs.
 
     Parameters
     ----------
     folder : Path, optional
         The logs folder the file must lie in (links followed); default the file's own folder.
+    bad : list, optional
+        Where a bad row goes instead of stopping the read (``faultgen monitor``: a bad row stops its
+        unit only): ``(unit, message)``, the message naming the file by its name and the row's line,
+        ``unit`` "" for a row that names no unit of ``units``; the row itself passed over.
 
     Raises
     ------
     ValueError
-        Naming the file and line: a header other than :data:`EVENT_COLUMNS`, a unit without a folder,
-        a stamp that does not parse or is of another kind than the unit's logs, an unknown event,
-        an axis outside 1..N (empty only for ``healthy``); a file whose link leads out of ``folder``
-        (before it is read: nothing of it is quoted).
+        Naming the file and line: a header other than :data:`EVENT_COLUMNS`; without ``bad``, a row
+        with a unit without a folder, a stamp that does not parse or is of another kind than the
+        unit's logs, an unknown event, an axis outside 1..N (empty only for ``healthy``); a file
+        whose link leads out of ``folder`` (before it is read: nothing of it is quoted).
     """
     path = inputs.within(path, Path(path).parent if folder is None else folder, FOLDER)
     inputs.regular_file(path, "events file", EVENTS_MAX_BYTES)
     try:
         with inputs.open_bytes(path, "events file", EVENTS_MAX_BYTES) as fh:
-            return _events(path, fh, units, n_axes)
+            return _events(path, fh, units, n_axes, bad)
     except UnicodeDecodeError:
         inputs.read_text(path, "events file", EVENTS_MAX_BYTES)  # refuses it naming the byte offset in the file
         raise
@@ -317,7 +321,7 @@ def read_events(path: Path, units: dict[str, list[LogFile]], n_axes: int,
         raise ValueError(f"{path}: cannot read the events: {err}") from None
 
 
-def _events(path: Path, fh, units: dict[str, list[LogFile]], n_axes: int) -> list[Event]:
+def _events(path: Path, fh, units: dict[str, list[LogFile]], n_axes: int, bad: list | None = None) -> list[Event]:
     """The events of the open ``events.csv`` (:func:`read_events`), read row by row (no list of rows)."""
     reader = csv.reader(io.TextIOWrapper(fh, encoding="utf-8-sig", newline=""))
     first = next(reader, None)
@@ -330,29 +334,40 @@ def _events(path: Path, fh, units: dict[str, list[LogFile]], n_axes: int) -> lis
     for line, row in enumerate(reader, start=2):
         if not any(cell.strip() for cell in row):
             continue
-        where = f"{path}: line {line}"
-        if len(row) != len(EVENT_COLUMNS):
-            raise ValueError(f"{where}: {len(row)} fields; expected {len(EVENT_COLUMNS)} ({','.join(EVENT_COLUMNS)})")
-        unit, stamp, event, axis = (cell.strip() for cell in row)
-        if unit not in units:
-            raise ValueError(f"{where}: unit {unit!r} has no folder of logs; units: {', '.join(sorted(units))}")
-        key, kind = parse_stamp(stamp, where)
-        logs = units[unit]
-        if logs and kind != logs[0].kind:
-            raise ValueError(f"{where}: stamp {stamp!r} is a {kind} stamp, but the logs of {unit} have {logs[0].kind} "
-                             "stamps")
-        if event not in EVENTS:
-            raise ValueError(f"{where}: event {event!r}; expected one of {', '.join(EVENTS)}")
-        if axis == "" and event == "healthy":
-            number = 0
-        else:
-            try:
-                number = axes.check(int(axis), n_axes)
-            except ValueError:
-                raise ValueError(f"{where}: axis {axis!r}; expected an axis 1..{n_axes}"
-                                 + (" (or empty: every axis)" if event == "healthy" else "")) from None
-        events.append(Event(shared[unit], stamp, key, kind, shared[event], number, line))
+        try:
+            events.append(_event(row, line, units, n_axes, shared))
+        except ValueError as err:
+            if bad is None:
+                raise ValueError(f"{path}: {err}") from None
+            unit = row[0].strip() if row else ""
+            bad.append((unit if unit in units else "", f"{path.name}: {err}"))
     return events
+
+
+def _event(row: list[str], line: int, units: dict[str, list[LogFile]], n_axes: int, shared: dict) -> Event:
+    """The event of ``row`` (line ``line`` of the events file); ValueError naming the line."""
+    where = f"line {line}"
+    if len(row) != len(EVENT_COLUMNS):
+        raise ValueError(f"{where}: {len(row)} fields; expected {len(EVENT_COLUMNS)} ({','.join(EVENT_COLUMNS)})")
+    unit, stamp, event, axis = (cell.strip() for cell in row)
+    if unit not in units:
+        raise ValueError(f"{where}: unit {unit!r} has no folder of logs; units: {', '.join(sorted(units))}")
+    key, kind = parse_stamp(stamp, where)
+    logs = units[unit]
+    if logs and kind != logs[0].kind:
+        raise ValueError(f"{where}: stamp {stamp!r} is a {kind} stamp, but the logs of {unit} have {logs[0].kind} "
+                         "stamps")
+    if event not in EVENTS:
+        raise ValueError(f"{where}: event {event!r}; expected one of {', '.join(EVENTS)}")
+    if axis == "" and event == "healthy":
+        number = 0
+    else:
+        try:
+            number = axes.check(int(axis), n_axes)
+        except ValueError:
+            raise ValueError(f"{where}: axis {axis!r}; expected an axis 1..{n_axes}"
+                             + (" (or empty: every axis)" if event == "healthy" else "")) from None
+    return Event(shared[unit], stamp, key, kind, shared[event], number, line)
 
 
 def labels(keys: np.ndarray, events: list[Event], n_axes: int) -> np.ndarray:

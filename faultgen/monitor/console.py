@@ -1,6 +1,7 @@
 """What ``faultgen monitor`` prints when a run ends: one line per unit (its status, the model its
 twin is of, its alarm or its reason), the fleet's count of alarms beside the chance of a persistent
-alarm on a healthy unit (where that says something), the files written, and the units that are
+alarm on a healthy unit (where that says something), what was passed over (files that are not logs,
+events rows of no unit), the files written, and the units that are
 degraded or not monitored. Text only: the command prints it (faultgen/cli/monitoring.py)."""
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from faultgen.monitor import lights, page
+from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor.loop import EXIT_SOME_UNITS_NOT_MONITORED
 from faultgen.monitor.scoring import Settings
 
@@ -23,8 +25,12 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
         alarm = m is not None and m.first_alarm
+        # the fallbacks are said once, beside the status (status.basis), not again in the reason
+        reason = status.reason.replace(status.fallback, "").replace("; ; ", "; ").strip("; ") if status.fallback \
+            else status.reason
+        reason = reason.removeprefix(f"{status.status}: ")  # "not monitored: ..." beside the status said once
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
-            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else status.reason
+            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
                      f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
     logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
@@ -33,6 +39,12 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,
                                            monitors[0].n_axes if monitors else 1, logs_scored)  # "" where it says nothing
     lines.append(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
+    passed = getattr(outcome, "passed_over", [])
+    if passed:
+        name, reason = passed[0]
+        more = f" (and {len(passed) - 1} more)" if len(passed) > 1 else ""
+        lines.append(f"passed over {len(passed)} entries of the logs folder: {fleet_logs.passed_entry(name, reason)}"
+                     f"{more}; a unit folder's are named in the unit's reason in {out / 'units.csv'}")
     tables = ("units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "life.csv",
               *(("tests.csv",) if outcome.tests else ()))
     lines.append(f"wrote {', '.join(str(out / name) for name in tables)}, {len(monitors)} charts and the fleet report "

@@ -22,7 +22,7 @@ from faultgen.monitor import cycles, friction_tests, life, report
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
-from faultgen.monitor.unit import Unit, log_of, short, twin_of
+from faultgen.monitor.unit import REFUSED_SKIP, Unit, log_of, refused_note, short, twin_of
 from faultgen.simulation import backends
 
 #: A log whose cycles' angles lie more than this off its twin's program, rad, or whose span differs by
@@ -98,8 +98,8 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        constant = constant_torque_note(unit)  # an earlier run's
-        twin = constant or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
+        off = constant_torque_note(unit) or (REFUSED_SKIP if refused_note(unit) else None)  # an earlier run's
+        twin = off or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
         i = 0

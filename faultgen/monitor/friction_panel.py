@@ -176,11 +176,12 @@ def curve_figure(rows: list[dict], axis: int) -> dict | None:
         data.append({"type": "scatter", "mode": "lines", "x": speeds, "y": [short(f) for f in mid],
                      "line": {"width": 2, "color": colour}, "name": name, "legendgroup": name,
                      "hovertemplate": "%{x:.3g} rad/s: %{y:.4g} N m<extra>" + name + "</extra>"})
-    note = "" if last is not first else " (one test: nothing to compare yet)"
+    note = "" if last is not first else "<br>" + escaped("(one test: nothing to compare yet)")
+    # the title below plotly's toolbar (its top 26 px), which covered it at 400 px
     return {"data": data, "layout": {
-        "height": 360, "margin": {"l": 60, "r": 20, "t": 40, "b": 110}, "showlegend": True,
-        "title": {"text": escaped(f"axis {axis}: friction torque, arm side{note}"), "font": {"size": 13}, "x": 0.01,
-                  "xanchor": "left"},
+        "height": 360, "margin": {"l": 60, "r": 20, "t": 72, "b": 110}, "showlegend": True,
+        "title": {"text": escaped(f"axis {axis}: friction torque, arm side") + note, "font": {"size": 13}, "x": 0.01,
+                  "xanchor": "left", "y": 1 - 30 / 360, "yref": "container", "yanchor": "top"},
         "legend": {"orientation": "h", "y": -0.45, "font": {"size": 10}},
         "xaxis": {"title": {"text": "speed, rad/s"}, "rangemode": "tozero"},
         "yaxis": {"title": {"text": "friction, N m"}, "rangemode": "tozero"}}}

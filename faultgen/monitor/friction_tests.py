@@ -142,12 +142,18 @@ class FrictionTest:
     error: str = ""
 
 
-def find(logs_dir: Path, units: dict[str, list], suffixes: tuple[str, ...]) -> dict[str, list]:
+def find(logs_dir: Path, units: dict[str, list], suffixes: tuple[str, ...],
+         passed: list[tuple[str, str]] | None = None) -> dict[str, list]:
     """Each unit's tests (:func:`faultgen.data.logfolder.scan_tests`), units without a test folder
-    or with an empty one left out (a fleet without tests is monitored as before them). ValueError,
-    before any work, for a file there that is not a test (named, as a unit's
-    logs are: :func:`faultgen.monitor.logs.fleet`) or stamps of another kind than the unit's logs."""
+    or with an empty one left out (a fleet without tests is monitored as before them). A file there
+    that is not a test is passed over and added to ``passed`` (``(name, reason)``, as a unit's logs
+    are: :func:`faultgen.monitor.logs.fleet`); without ``passed``, ValueError before any work naming
+    it. ValueError for stamps of another kind than the unit's logs."""
     found, bad = logfolder.scan_tests(Path(logs_dir), list(units), suffixes)
+    if passed is not None:  # a link out of the folder is refused, never passed over
+        passed.extend((name, reason.replace("not a log", "not a friction test")) for name, reason in bad
+                      if reason != logfolder.LINK_OUT)
+        bad = [(name, reason) for name, reason in bad if reason == logfolder.LINK_OUT]
     if bad:
         name, reason = bad[0]
         more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""

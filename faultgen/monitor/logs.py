@@ -52,22 +52,45 @@ def reader_of(adapter: formats.LogFormat = formats.MEASURED) -> tuple[Reader, tu
     return adapter.read, adapter.suffixes
 
 
-def fleet(logs_dir: str | Path, suffixes: tuple[str, ...] = fleetlogs.SUFFIXES) -> dict[str, list[Log]]:
+def fleet(logs_dir: str | Path, suffixes: tuple[str, ...] = fleetlogs.SUFFIXES,
+          passed: list[tuple[str, str]] | None = None) -> dict[str, list[Log]]:
     """The units of a fleet folder and each unit's logs (files ending in one of ``suffixes``) in
-    stamp order.
+    stamp order. A file in a unit folder that is not a log (``notes.txt``, ``backup copy.csv``: no
+    stamp) is passed over as hidden files are, and added to ``passed`` as ``(name, reason)`` (its
+    name in the folder, ``<unit>/<file>``), to be named; without ``passed`` it is refused, and so
+    is a log whose link leads out of the folder (:data:`faultgen.data.logfolder.LINK_OUT`) always.
 
     Raises
     ------
     ValueError
-        As :func:`faultgen.data.logfolder.scan`, or for a file in a unit folder that is not a log
-        (named, with what was expected).
+        As :func:`faultgen.data.logfolder.scan`, for a log linked out of the folder, or (without
+        ``passed``) for a file in a unit folder that is not a log (named, with what was expected).
     """
-    units, bad = logfolder.scan(Path(logs_dir), suffixes)
+    units, found = logfolder.scan(Path(logs_dir), suffixes)
+    # a link out of the folder is refused, never passed over: the folder must hold what it shows
+    bad = found if passed is None else [(name, reason) for name, reason in found if reason == logfolder.LINK_OUT]
     if bad:
         name, reason = bad[0]
         more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
         raise ValueError(f"{Path(logs_dir) / name}: {reason}{more}")
+    if passed is not None:
+        passed.extend(found)
     return {unit: logs for unit, logs in units.items() if logs}
+
+
+def passed_note(passed: list[tuple[str, str]]) -> str:
+    """A unit's note on its files passed over (:func:`fleet`'s ``passed``, the unit's own): how many,
+    the first named with why, "" for none."""
+    if not passed:
+        return ""
+    name, reason = passed[0]
+    more = f" (and {len(passed) - 1} more)" if len(passed) > 1 else ""
+    return f"{len(passed)} files passed over, not logs: {passed_entry(name, reason)}{more}"
+
+
+def passed_entry(name: str, reason: str) -> str:
+    """One entry passed over, ``name: reason`` (a reason that names it already, as a stamp's does, as it is)."""
+    return reason if reason.startswith(f"{name}: ") else f"{name}: {reason}"
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ run is skipped, named: neither stops the fleet.
 from __future__ import annotations
 
 import contextlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +54,7 @@ from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, const
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
-                                   new_unit)
+                                   new_unit, refused_note)
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
@@ -106,10 +106,13 @@ class UnitStatus:
 class Outcome:
     """What :func:`monitor` did: each unit's ``monitors`` (:class:`UnitMonitor`) and ``statuses``
     (:class:`UnitStatus`), in the fleet folder's order; ``tests``: whether it wrote ``tests.csv``
-    (the fleet has friction tests)."""
+    (the fleet has friction tests); what it ``passed_over``."""
 
     monitors: list[UnitMonitor]
     statuses: list[UnitStatus]
+    #: ``(name, reason)`` of each file of the folder passed over (not a log, not a friction test:
+    #: ``<unit>/<file>``) and each row of ``events.csv`` that names no unit (``events.csv``).
+    passed_over: list[tuple[str, str]] = field(default_factory=list)
     tests: bool = False
 
     @property
@@ -130,6 +133,12 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     model, then the nominal model, then ``--protocol own``: the unit against its own first logs),
     and a log that cannot be read or that the twin cannot replay is skipped; both are named in
     ``units.csv`` (:class:`UnitStatus`) and the unit's state keeps them, so a rerun does not try again.
+    A unit whose first log the nominal model cannot explain (motor-side torque, another robot: the
+    calibration's plausibility check, :func:`faultgen.monitor.unit.plausible`) is not monitored, with
+    that message, whatever the model: a refusal is never a reason to fall back. A file in a unit
+    folder that is not a log (``notes.txt``) is passed over and named (:attr:`Outcome.passed_over`,
+    the unit's reason); a bad row of ``events.csv`` leaves its unit not monitored in this run, the
+    row named, its earlier state kept (a row that names no unit is passed over, named).
 
     Parameters
     ----------
@@ -140,7 +149,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     out : str or Path
         Output folder; an earlier run's output there is continued (its settings must match).
     calibrated : path, optional
-        A ``faultgen calibrate`` output folder (or its model file) used as every unit's model.
+        A ``faultgen calibrate`` output folder (or its model file) used as every unit's model; one
+        that does not load is refused before any unit is scored (never the nominal model instead).
     calibrate : bool
         Without ``calibrated``: calibrate each unit's model on its first log (True) or use the
         nominal model (False). Only the ``twin`` protocol uses a model.
@@ -180,7 +190,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
         file named), a ``context`` with ``jobs`` > 1 and a ``scheduler`` or not an ExecutionContext,
         ``hours_per_day`` outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
-        (:mod:`faultgen.model.rating`).
+        (:mod:`faultgen.model.rating`), a ``calibrated`` model that does not load, a bad ``events.csv``
+        as a whole (its header, encoding, a link out of ``logs_dir``).
     faultgen.runs.errors.SweepRefused
         The ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
     faultgen.runs.errors.SweepError
@@ -206,8 +217,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     ratings = life.ratings_of(nominal)  # a bad rating refused before any work
     life.check_hours(hours_per_day)
     _, suffixes = fleet_logs.reader_of(log_format)
-    units = fleet_logs.fleet(logs_dir, suffixes)
-    found = friction_tests.find(logs_dir, units, suffixes)  # a bad test refused before any work
+    passed: list[tuple[str, str]] = []  # files that are not logs or tests, events rows of no unit: named
+    units = fleet_logs.fleet(logs_dir, suffixes, passed)
+    found = friction_tests.find(logs_dir, units, suffixes, passed)
     out = Path(out)
     calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
@@ -216,7 +228,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                  log_format.key)
     n_features = len(fleet_logs.FEATURES) * nominal.n_axes
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
-    maintenance = _maintenance_events(Path(logs_dir), units, nominal.n_axes)
+    maintenance, stopped = _maintenance_events(Path(logs_dir), units, nominal.n_axes, passed)
     tests = friction_tests.read_tests(found, nominal, out, log_format)  # each test read once, cached
     wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ()))
              for name, read in tests.items()}
@@ -224,15 +236,17 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     def scale_of(name: str):
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
-    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of)
+    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of, nominal.name)
     with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
         pending, stale = {}, {}
-        for name, unit_logs in units.items():
-            pending[name], stale[name] = _pending(name, unit_logs, state.get(name))
-        confined.mkdir(out / ".cache")
+        for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
+            pending[name], stale[name] = ([], []) if name in stopped else _pending(name, unit_logs, state.get(name))
         scoring = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
                            failure_wear, context.stepper)
         source = scoring.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
+        if isinstance(source.given, ValueError):  # a given model refused: the run's error, never the nominal model instead
+            raise ValueError(f"--calibrated {calibrated}: the model does not load ({source.given})")
+        confined.mkdir(out / ".cache")
         programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
@@ -252,7 +266,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                         bar.update(len(pending[name]))
         bar.close()
         monitors = [state[name].monitor for name in units if name in state]
-        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ())) for name in units]
+        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ()),
+                            fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
+                            stopped.get(name, "")) for name in units]
         with atomic.atomic_folder(out) as staging:
             report.write_alarms(staging / "alarms.csv", monitors)
             report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
@@ -264,7 +280,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             if found:
                 friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
             prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
-            life.write_life(staging / "life.csv", [row for name in units if name in state for row in life.of_unit(
+            # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
+            life.write_life(staging / "life.csv", [row for name in units if name in state and state[name].entries
+                                                   for row in life.of_unit(
                 name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
             page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
@@ -281,7 +299,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
                                                        unit.maintenance, unit.program_changes))
-    return Outcome(monitors, statuses, tests=bool(found))
+    return Outcome(monitors, statuses, passed, tests=bool(found))
 
 
 
@@ -378,57 +396,93 @@ def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) 
     return {name for name, unit in state.items() if unit.model == "nominal"}
 
 
-def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=()) -> UnitStatus:
+def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=(), passed: str = "",
+            stopped: str = "") -> UnitStatus:
     """The unit's row of units.csv (:class:`UnitStatus`); ``stale``: notes on logs handled by an
     earlier run that changed or left the folder, or new logs older than them (:func:`_pending`),
-    which make it degraded; ``tests``: its friction tests read (those that could not be read named)."""
+    which make it degraded; ``tests``: its friction tests read (those that could not be read named);
+    ``passed``: the note on its files passed over (not logs: named, its status as without them);
+    ``stopped``: its bad row of events.csv, which leaves it not monitored in this run (none of its
+    logs scored, its earlier state kept)."""
+    first = [f"not monitored: {stopped} (its new logs are scored once the row is corrected)"] if stopped else []
     if unit is None:
-        return UnitStatus(name, "not monitored", settings.protocol, "", "no log", 0, "")
+        return UnitStatus(name, "not monitored", settings.protocol, "", "; ".join([*first, passed] if first or passed
+                                                                                  else ["no log"]), 0, "")
     protocol = "own" if unit.model == "none" else "twin"
-    reasons = [*unit.notes, *stale]
+    reasons = [*first, *unit.notes, *stale]
     unread = [t for t in tests if t.error]
     if unread:
         more = f" (and {len(unread) - 1} more)" if len(unread) > 1 else ""
         reasons.append(f"{len(unread)} friction tests not read: {unread[0].stamp}: {unread[0].error}{more}")
     if unit.skipped:
-        first = unit.skipped[0]
-        more = f" (and {len(unit.skipped) - 1} more)" if len(unit.skipped) > 1 else ""
-        reasons.append(f"{len(unit.skipped)} logs skipped: {first.stamp}: {first.reason}{more}")
+        reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
-    if learning and constant_torque_note(unit) is None:  # not learning: off the monitor
+    refused = refused_note(unit) is not None  # its first log refused: no model used
+    if learning and constant_torque_note(unit) is None and not refused:  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
     elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
-    if not unit.entries:
+    if not unit.entries or stopped:
         status = "not monitored"
     elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
         status = "learning" if learning else "monitored"
+    reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
-    return UnitStatus(name, status, protocol, unit.model if unit.model != "none" else "",
+    return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
                       "; ".join(fallback_notes(unit)))
 
 
-def _maintenance_events(logs_dir: Path, units: dict, n_axes: int) -> dict[str, list]:
+#: Most distinct reasons a unit's reason names for its skipped logs (:func:`skipped_note`).
+SKIPPED_REASONS = 3
+
+
+def skipped_note(skipped: list) -> str:
+    """A unit's note on its skipped logs (each with ``stamp`` and ``reason``): their count, and each
+    distinct reason once, with the first log skipped for it and how many more were (at most
+    :data:`SKIPPED_REASONS`; the logs of the other reasons counted): an empty first log and a part
+    the twin cannot carry are both said, and one reason of many logs only once."""
+    groups: dict[str, list] = {}
+    for log in skipped:
+        groups.setdefault(log.reason, []).append(log)
+    shown = [f"{logs[0].stamp}: {reason}" + (f" (and {len(logs) - 1} more)" if len(logs) > 1 else "")
+             for reason, logs in list(groups.items())[:SKIPPED_REASONS]]
+    rest = sum(len(logs) for logs in list(groups.values())[SKIPPED_REASONS:])
+    others = f"; and {rest} more for {len(groups) - SKIPPED_REASONS} other reasons" if rest else ""
+    return f"{len(skipped)} logs skipped: {'; '.join(shown)}{others}"
+
+
+def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
+                        passed: list | None = None) -> tuple[dict[str, list], dict[str, str]]:
     """Each unit's repairs and gearbox changes of ``LOGS/events.csv`` (none without the file), in
-    stamp order (:func:`faultgen.data.logfolder.read_events`; a bad file stops the run, named)."""
+    stamp order (:func:`faultgen.data.logfolder.read_events`), and the units a bad row stops: unit ->
+    the row named and why (the first; "(and N more)"). A row that names no unit of the folder is
+    added to ``passed``; a bad file (its header, its encoding, a link out) stops the run, named."""
     path = logs_dir / "events.csv"
     if not path.exists():
-        return {}
+        return {}, {}
     found: dict[str, list] = {}
-    for event in logfolder.read_events(path, units, n_axes, folder=logs_dir):
+    bad: list[tuple[str, str]] = []
+    for event in logfolder.read_events(path, units, n_axes, folder=logs_dir, bad=bad):
         if event.event in MAINTENANCE:
             found.setdefault(event.unit, []).append(event)
-    return {unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()}
+    stopped: dict[str, list[str]] = {}
+    for unit, message in bad:
+        if unit:
+            stopped.setdefault(unit, []).append(message)
+        elif passed is not None:
+            passed.append((path.name, message))
+    return ({unit: sorted(events, key=lambda e: e.key) for unit, events in found.items()},
+            {unit: rows[0] + (f" (and {len(rows) - 1} more)" if len(rows) > 1 else "") for unit, rows in stopped.items()})
 
 
 
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
-                scale_of=lambda name: None) -> dict[str, Unit]:
+                scale_of=lambda name: None, robot: str = "") -> dict[str, Unit]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
     looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
@@ -445,7 +499,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         path = folder / stored.unit_file(name, ".json")
         if not (path.exists() or path.is_symlink()):
             continue
-        kept = stored.read_unit(path, out, name, key, n_axes, n_features)
+        kept = stored.read_unit(path, out, name, key, n_axes, n_features, robot)
         if not (kept.entries or kept.skipped):
             continue
         state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,

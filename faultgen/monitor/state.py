@@ -344,7 +344,19 @@ def _load(log: dict, path: Path, where: str, n_axes: int) -> tuple[np.ndarray | 
     return load, duration
 
 
-def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int) -> UnitState:
+def setting_moved(key: str, then, now, robot: str = "") -> str:
+    """A setting of a state that differs from the run's, for its refusal: the robot's and a given
+    model's file by what they are and the first 12 hex digits of each SHA-256 (the run's robot named
+    ``robot``), any other by its values."""
+    if key in ("robot", "model") and isinstance(then, str) and isinstance(now, str) and len(then) == len(now) == 64:
+        what = f"the robot model{f' {robot}' if robot else ''}" if key == "robot" else "the given --calibrated model"
+        return (f"{what}: its model file is not the one the state was made with (SHA-256 {str(then)[:12]}... then, "
+                f"{now[:12]}... now: another robot or an edited model file)")
+    return f"{key} {then!r} (now {now!r})"
+
+
+def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int,
+              robot: str = "") -> UnitState:
     """Read and check the state of ``unit`` written by :func:`write_unit`: every value one a run
     writes (stamps that parse, the logs' in increasing order and each stamp handled once, SHA-256s
     of 64 hex digits, finite numbers where a run writes them: a temperature finite or NaN (not
@@ -356,7 +368,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
     StateError
         The file is a link leading outside ``root`` or not a regular file, is above :data:`STATE_MAX_BYTES`, is not
         such a state, belongs to another unit or to other settings (the differing settings named),
-        or holds a value of the wrong type, length or range (named).
+        or holds a value of the wrong type, length or range (named; a changed model file by what it
+        is, the robot ``robot`` by its name, not by a digest alone: :func:`setting_moved`).
     """
     refuse = f"; score the logs into a new OUT (or delete {path.parent} to start this one again)"
     d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
@@ -367,7 +380,7 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         raise StateError(f"{path}: the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}{refuse}")
     if d.get("settings") != settings:
         theirs = d.get("settings") if isinstance(d.get("settings"), dict) else {}
-        moved = [f"{k} {theirs.get(k)!r} (now {v!r})" for k, v in settings.items() if theirs.get(k) != v]
+        moved = [setting_moved(k, theirs.get(k), v, robot) for k, v in settings.items() if theirs.get(k) != v]
         raise StateError(f"{path}: holds a monitor run with other settings or inputs: "
                                 f"{', '.join(moved) or 'unknown keys'}{refuse}")
     program = d.get("program")

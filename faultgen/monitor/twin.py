@@ -192,7 +192,8 @@ class Twin:
         irb6700's axis 2 on its own pick and place)."""
         t = np.asarray(t, dtype=float)
         q = derivatives.smoothed(t, np.asarray(q, dtype=float), REFERENCE_WINDOW)
-        return tasks.Motion(name, t, q, source=f"{self.program} (smoothed, replayed by its twin)")
+        # the program is named by no path: units that run it share the twin, and each one's reason names its own log
+        return tasks.Motion(name, t, q, source="the program's log (smoothed, replayed by the twin)")
 
     def _key(self, temperature: float, payload: float, worn_axis: int) -> tuple[dict, Path]:
         """A cycle's cache key and file; :data:`REFERENCE_TEMPERATURE` is the model's own friction
@@ -218,7 +219,7 @@ class Twin:
     def _features(self, result: sim.RunResult, index: int = 0) -> np.ndarray:
         """The feature vector of simulated cycle ``index`` of ``result``, as a measured log's."""
         data = measured.from_arrays(result.t, result.q_a[index], result.tau_m[index] * self.robot.gear_ratio,
-                                    self.robot, source=f"twin of {self.program.name}")
+                                    self.robot, source="a cycle of the twin")
         return fleet_logs.features_of(self.robot, data)
 
     def _simulate_together(self, cycles: list[tuple[float, float, int]]) -> None:
@@ -261,7 +262,7 @@ class Twin:
             sized = (f"its drives were sized for a rated payload of {rated:g} kg (`faultgen robots add ... --payload KG` "
                      "sizes an added robot for the one you know)" if np.isfinite(rated) else "")
             self._refused[temperature, payload, worn_axis] = (
-                f"the twin of {self.program.name} with a {payload:g} kg part (aluminium cube at the flange) saturates "
+                f"the twin with a {payload:g} kg part (aluminium cube at the flange) saturates "
                 f"the drive of axis {', '.join(map(str, result.saturated))}: the model cannot carry that part along "
                 f"this motion; {sized + '; ' if sized else ''}check the log's payload column (kg) and the model")
             raise ValueError(self._refused[temperature, payload, worn_axis])

@@ -88,28 +88,108 @@ class Unit:
 
 def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
               source: fleet_logs.Source) -> Unit:
-    """A unit seen for the first time: its program (the log its twin replays) and the kind of model
-    asked for (given, calibrated on its first log, nominal); protocol ``own`` without a twin or
-    when its first log cannot be read. The model itself is made with the twin (:func:`twin_of`),
-    which falls back when it cannot be. The first log is read here, once (``source``)."""
+    """A unit seen for the first time: its first log (with the twin, its first log that can be read:
+    an empty or broken log before it is skipped, named, and the twin built on the next), its program
+    (the log its twin replays) and the kind of model asked for (given, calibrated on its first log,
+    nominal); protocol ``own`` without a twin or when no log of it can be read. A first log the
+    nominal model cannot explain takes the unit off the monitor (:func:`plausible`, :func:`refuse`),
+    whatever the model, and is no program for other units. The model itself is made with the twin
+    (:func:`twin_of`), which falls back when it cannot be. The first log is read here, once
+    (``source``)."""
     monitor = UnitMonitor(name, settings, nominal.n_axes)
     first = units[name][0]
+    if settings.protocol == "twin":
+        first = next((log for log in units[name] if source.get(log).error is None), first)
     first_key = (first.stamp, source.get(first).sha256)
     if settings.protocol != "twin":
         return Unit(monitor, "none", None, first_key)
+    kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
+    if source.get(first).error is None:
+        try:
+            plausible(nominal, source.get(first).checked())
+        except plausibility.ImplausibleLogError as err:
+            unit = Unit(monitor, kind, None, first_key)
+            refuse(unit, err)
+            return unit
     try:
         program = program_of(first, name, programs, source)
     except ValueError as err:
         return Unit(monitor, "none", None, first_key,
-                     notes=[f"its first log cannot be replayed ({short(err)}): protocol own"])
-    kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
+                     notes=[f"no log of it can be read to replay ({short(err)}): protocol own"])
     return Unit(monitor, kind, program, first_key)
+
+
+#: The start of the note (units.csv's reason) of a unit whose first log the nominal model cannot
+#: explain (:func:`plausible`, the calibration's own check): the unit is not monitored, whatever
+#: model was asked for: a twin of any model would read its torque in the wrong scale (a log
+#: logged motor-side read 0.16 % wear where the truth was 44 %).
+REFUSED = "not monitored: its first log is refused"
+
+
+def plausible(nominal: robots.Robot, data) -> None:
+    """Refuse a unit's first log (checked, :class:`faultgen.logs.measured.MeasuredData`) that the
+    ``nominal`` model cannot explain, as ``faultgen calibrate`` refuses it, with its message
+    (:func:`faultgen.calibrate.plausibility.check` on the nominal model's torque along the log's
+    motion; a log longer than :data:`faultgen.calibrate.MAX_ROWS` averaged down first, as the
+    calibration does). Whatever model the unit's twin is of: a refusal is the unit's error, never a
+    reason to fall back to another model.
+
+    Raises
+    ------
+    faultgen.calibrate.plausibility.ImplausibleLogError
+        Motor-side torque, another robot's log, a torque column in another unit or sign.
+    """
+    from faultgen.calibrate import MAX_ROWS, decimate, search
+    from faultgen.calibrate.prediction import predicted_motion
+
+    data = decimate(data, MAX_ROWS) if len(data) > MAX_ROWS else data
+    tau = np.asarray(data.tau)
+    plausibility.check(nominal, tau, predicted_motion(nominal, data)[0], np.abs(data.qd) >= search.REST_SPEED)
+
+
+def refuse(unit: Unit, err: ValueError) -> str:
+    """Take ``unit`` off the monitor for its first log's refusal ``err`` (:data:`REFUSED`, the
+    message kept whole): noted in its reason; returns the reason its logs are skipped with."""
+    unit.notes.append(f"{REFUSED} ({unit.first[0]}): {' '.join(str(err).split())}")
+    return REFUSED_SKIP
+
+
+#: The reason each log of a unit refused (:data:`REFUSED`) is skipped with.
+REFUSED_SKIP = "the unit is not monitored: its first log is refused (the unit's reason says why)"
+
+
+def refused_note(unit: Unit) -> str | None:
+    """The note that took ``unit`` off the monitor for its first log (:func:`refuse`), or None."""
+    return next((n for n in unit.notes if n.startswith(REFUSED)), None)
 
 
 def fallback_notes(unit: Unit) -> list[str]:
     """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`:
-    "the twin of the ... failed (...); ... used")."""
-    return [n for n in unit.notes if n.startswith("the twin of the ") and " failed (" in n]
+    "the twin of the ... failed (...); ... used", or "the twins of the ... failed (...)")."""
+    return [n for n in unit.notes if n.startswith(("the twin of the ", "the twins of the ")) and " failed (" in n]
+
+
+def chain_notes(tried: list[tuple[str, str]], final: str) -> list[str]:
+    """The notes of a twin's fallbacks: ``tried``, the kinds of model (:data:`FALLBACK`) whose twin
+    failed, in order, each with its error; ``final`` the kind used at last. Kinds that failed one
+    after another on the same error share one note that says it once, with their count (a replay
+    no model can follow fails alike for each: three times 300 characters before)."""
+    groups: list[tuple[list[str], str]] = []
+    for kind, error in tried:
+        if groups and groups[-1][1] == error:
+            groups[-1][0].append(kind)
+        else:
+            groups.append(([kind], error))
+    notes = []
+    for i, (kinds, error) in enumerate(groups):
+        then = KIND_NAMES[groups[i + 1][0][0] if i + 1 < len(groups) else final]
+        if len(kinds) == 1:
+            notes.append(f"the twin of the {KIND_NAMES[kinds[0]]} failed ({error}); {then} used")
+            continue
+        names = [KIND_NAMES[k] for k in kinds]
+        notes.append(f"the twins of the {', the '.join(names[:-1])} and the {names[-1]} failed ({len(kinds)} times, "
+                     f"each on the same: {error}); {then} used")
+    return notes
 
 
 def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: fleet_logs.Source,
@@ -120,7 +200,12 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
     through :data:`FALLBACK` when its twin cannot be built (its calibration refused as implausible,
     say: to its own friction on the nominal model, then to the nominal model, then to protocol ``own``);
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
-    its new logs are skipped with it. Each fallback is noted in the unit's reason."""
+    its new logs are skipped with it. Each fallback is noted in the unit's reason, the kinds that
+    failed on the same error in one note (:func:`chain_notes`). A first log refused by the
+    calibration (:class:`faultgen.calibrate.plausibility.ImplausibleLogError`) is no reason to fall
+    back: the unit is taken off the monitor (:func:`refuse`) and the reason returned."""
+    tried: list[tuple[str, str]] = []  # (kind, error) that failed in this call, noted by chain_notes
+    start = len(unit.notes)
     while unit.model != "none":
         try:
             first_log = next((g for g in units[unit.monitor.unit] if g.stamp == unit.first[0]), None)
@@ -132,14 +217,18 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
             twin = twins[twin_key]
         except stored.StateError:
             raise
+        except plausibility.ImplausibleLogError as err:  # the log refused: the unit's error, never a fallback
+            if unit.entries:
+                return f"the twin of the {KIND_NAMES[unit.model]} cannot be built again ({short(err)})"
+            return refuse(unit, err)
         except ValueError as err:
             if unit.entries:
                 return f"the twin of the {KIND_NAMES[unit.model]} cannot be built again ({short(err)})"
             fallback = FALLBACK[unit.model]
             if fallback == "friction" and not OWN_FRICTION:
                 fallback = "nominal"
-            unit.notes.append(f"the twin of the {KIND_NAMES[unit.model]} failed ({short(err)}); "
-                              f"{KIND_NAMES[fallback]} used")
+            tried.append((unit.model, short(err)))
+            unit.notes[start:] = chain_notes(tried, fallback)
             unit.model = fallback
             continue
         if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
@@ -267,10 +356,20 @@ def without_payload(calibrated: robots.Robot, out: Path) -> robots.Robot:
     return robots.write(target, spec.to_xml(), confined.write_text)
 
 
+def same_times(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two logs of as many samples are sampled at the same times from their starts (within
+    half the shortest sample interval): the same angles at another pace are another program (a
+    motion three times faster asks nine times the torque of inertia)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(a) < 2:
+        return True
+    return bool(np.max(np.abs((a - a[0]) - (b - b[0]))) <= 0.5 * np.min(np.diff(a)))
+
+
 def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_logs.Source) -> tuple[str, str]:
     """The log (unit, stamp) to replay for ``unit`` whose first log is ``first`` (parsed by
     ``source``, which keeps a program for the twins that replay it): an earlier unit's when the
-    motion is the same (:data:`SAME_PROGRAM`: the same samples, or a whole number of cycles of the
+    motion is the same (:data:`SAME_PROGRAM`: the same samples at the same times, :func:`same_times`, or a whole number of cycles of the
     earlier one at another rate, :mod:`faultgen.monitor.cycles`), so their twins share simulated
     cycles. ``programs``: the (checked log, program) of the earlier units' programs, appended to.
 
@@ -283,7 +382,7 @@ def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_l
     q = np.asarray(data.q)
     for other, other_program in programs:
         other_q = np.asarray(other.q)
-        if other_q.shape == q.shape and np.max(np.abs(other_q - q)) < SAME_PROGRAM:
+        if other_q.shape == q.shape and np.max(np.abs(other_q - q)) < SAME_PROGRAM and same_times(other.t, data.t):
             return other_program
         if other_q.shape != q.shape and cycles.Program.of(other.t, other_q, other.cycle).log_cycles(
                 data.t, q, data.cycle, SAME_PROGRAM) is not None:

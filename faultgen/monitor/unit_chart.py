@@ -121,8 +121,10 @@ def figure(unit, settings: dict) -> dict:
     def line(at: int, colour: str, dash: str, text: str, y: float) -> None:
         shapes.append({"type": "line", "xref": "x", "yref": "paper", "x0": at, "x1": at, "y0": 0, "y1": 1,
                        "line": {"color": colour, "width": 1.5, "dash": dash}})
-        side = "right" if at > len(rows) / 2 else "left"  # the label inside the chart, on the side with room
-        annotations.append({"x": at, "xref": "x", "xanchor": side, "y": y, "yref": "paper", "text": text,
+        # the label inside the chart, on the side with room, in lines short enough for half a 400 px chart
+        side = "right" if at > (len(rows) - 1) / 2 else "left"
+        annotations.append({"x": at, "xref": "x", "xanchor": side, "y": y, "yref": "paper", "yanchor": "top",
+                            "align": side, "text": text,
                             "showarrow": False, "font": {"size": 10, "color": colour}, "bgcolor": "rgba(255,255,255,0.7)"})
 
     for first, last in _spans(phases, "training"):
@@ -136,11 +138,12 @@ def figure(unit, settings: dict) -> dict:
     for k, alarm in enumerate(unit.closed):
         if alarm["first_alarm"] in raw:
             line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
-                 escaped(f"alarm, axis {alarm['source_axis']}: closed by {alarm['closed_by']} ({alarm['closed']})"),
-                 0.9 - 0.08 * (k % 3))
+                 escaped(f"alarm, axis {alarm['source_axis']}:") + "<br>"
+                 + escaped(f"closed by {alarm['closed_by']} ({alarm['closed']})"), 0.9 - 0.1 * (k % 3))
     if unit.open_alarm and unit.current["first_alarm"] in raw:
         line(raw[unit.current["first_alarm"]], "#d62728", "solid",
-             escaped(f"alarm {lights.alarm_dates(unit.current)}, axis {unit.current['source_axis']}"), 0.97)
+             escaped(f"alarm, axis {unit.current['source_axis']}:") + "<br>" + escaped(lights.alarm_dates(unit.current)),
+             0.97)
     if unit.tests:
         traces, lines, notes = friction_panel.markers(friction_panel.by_axis(unit.tests), [r["stamp"] for r in rows],
                                                       COLOURS, twin)
@@ -149,7 +152,7 @@ def figure(unit, settings: dict) -> dict:
         annotations += notes
     step = max(1, len(rows) // 8)
     layout = {
-        "height": 560 if twin else 340, "margin": {"l": 60, "r": 20, "t": 30, "b": 90},
+        "height": 560 if twin else 340, "margin": {"l": 72, "r": 20, "t": 30, "b": 90},
         "hovermode": "closest", "showlegend": True,
         "legend": {"orientation": "h", "y": -0.2 if twin else -0.35, "font": {"size": 10}},
         "xaxis": {"tickvals": x[::step], "ticktext": stamps[::step], "tickangle": -30,
@@ -158,10 +161,12 @@ def figure(unit, settings: dict) -> dict:
     }
     if twin:
         scale = {unit.wear_now(i).scale for i in range(1, n_axes + 1) if unit.wear_now(i) is not None}
-        title = "wear, % (friction-test scale)" if scale == {"friction test"} else (
-            "wear estimate, % of own dry friction" if scale <= {"twin"} else "wear, % (test or twin scale: panel)")
-        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": title}}
-        layout["yaxis2"] = {"domain": [0.0, 0.38], "type": "log", "title": {"text": "statistic / its limit"}}
+        # each title in two short lines: one line of the longest ran past its panel into the other's at 400 px
+        title = "wear, %<br>friction-test scale" if scale == {"friction test"} else (
+            "wear estimate, %<br>of own dry friction" if scale <= {"twin"} else "wear, %<br>test or twin scale: panel")
+        layout["yaxis"] = {"domain": [0.45, 1.0], "title": {"text": title, "font": {"size": 12}}}
+        layout["yaxis2"] = {"domain": [0.0, 0.38], "type": "log",
+                            "title": {"text": "statistic /<br>its limit", "font": {"size": 12}}}
     else:
         layout["yaxis"] = {"type": "log", "title": {"text": "statistic / its limit"}}
     return {"data": data, "layout": layout}
