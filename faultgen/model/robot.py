@@ -173,7 +173,10 @@ class Robot:
         simulation model, a robot carrying a part). Raises ModelError if the robot was pickled and
         its file has changed since."""
         if self._spec is None:
-            if self.digest is None or hashlib.sha1(self.path.read_bytes()).hexdigest() != self.digest:
+            from faultgen.model import sources
+
+            data = sources.read_bytes(self.path, what="robot MJCF", error=ModelError)  # bounded, size first
+            if self.digest is None or hashlib.sha1(data).hexdigest() != self.digest:
                 raise ModelError(f"{self.path}: changed since the robot was read; load it again")
             object.__setattr__(self, "_spec", mujoco.MjSpec.from_file(str(self.path)))
         return self._spec.copy()
