@@ -339,20 +339,16 @@ class _Previous:
         for unit, logs in units.items():
             entries = []
             for log in logs:
-                was = self.name_of(log)
-                before = self.files.get(was) if was is not None else None
-                if before is None:  # new: hashed as it is read (read_once), its size bound first
-                    entries.append((log.key, log.name, log, "", was))
-                    continue
-                try:
+                try:  # bounded: its size first (a file above the bound is refused unread, by read_once)
                     digest = sha256(log.path)
                 except (OSError, ValueError) as err:
-                    if log.path.exists() or log.path.is_symlink():  # not a regular file, above the bound
-                        digest, unread = "", str(err).removeprefix(f"{log.path}: ")
-                    else:  # removed since the folder was listed: skipped, named
-                        summary.skipped.append((log.name, f"{VANISHED} ({getattr(err, 'strerror', None) or err})"))
+                    if not (log.path.exists() or log.path.is_symlink()):  # removed since the folder was listed
+                        summary.skipped.append((log.name, f"{VANISHED} ({getattr(err, 'strerror', None) or 'no such file'})"))
                         continue
-                if before == digest or (was != log.name and content_sha256(log.path) == before):
+                    digest, unread = "", str(err).removeprefix(f"{log.path}: ")  # not a regular file, too large
+                was = self.name_of(log)
+                before = self.files.get(was) if was is not None else None
+                if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
                     entries.append((log.key, log.name, None if before else log, digest, was))
                     continue
                 if not reimport_changed:

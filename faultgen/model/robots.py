@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import hashlib
 import re
 import shutil
 from collections.abc import Callable
@@ -181,10 +180,9 @@ def _folder_model(folder: Path) -> Path:
 
 
 def _digest(path: Path) -> str:
-    """SHA-1 of a robot MJCF's bytes, read through :mod:`faultgen.inputs`: a regular file of at most
-    :data:`faultgen.model.sources.MAX_DESCRIPTION_BYTES`, its size checked before the read (a 20 GiB
-    sparse MJCF in a ``--robot`` folder was read whole: a MemoryError). ModelError otherwise."""
-    return hashlib.sha1(sources.read_bytes(path, what="robot MJCF", error=ModelError)).hexdigest()
+    """SHA-1 of a robot MJCF's bytes through :mod:`faultgen.inputs` (:func:`faultgen.model.sources.sha1_of`:
+    its size checked before the read; a 20 GiB sparse MJCF was read whole, a MemoryError). ModelError otherwise."""
+    return sources.sha1_of(path, ModelError)
 
 
 @functools.lru_cache(maxsize=32)
