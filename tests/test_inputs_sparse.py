@@ -316,3 +316,23 @@ def test_a_task_that_is_no_regular_file_is_named_for_what_it_is(tmp_path, make, 
     missing = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(tmp_path / "gone.toml"),
                                   "--cycles", "1", "-o", str(tmp_path / "o.h5")])
     assert missing.exit_code == 2 and "does not exist" in missing.output, missing.output
+
+
+def test_a_sparse_model_planted_in_outs_calibration_cache_is_refused_unread(tmp_path):
+    """A cached calibration's model is hashed to check it against its record: a sparse one above the
+    bound is refused by its size, never read (it was hashed whole, 5 GiB of zeros here)."""
+    import json
+
+    from faultgen.monitor import state as stored
+
+    root = tmp_path / "OUT"
+    model = robot_copy(root / ".cache" / "calibrated" / ("d" * 24) / "model", "puma560_calibrated.xml")
+    record = root / ".cache" / "calibrated" / f"{'d' * 24}.json"
+    key = {"nominal": "n", "log": "l"}
+    record.write_text(json.dumps({"format": stored.CALIBRATION_FORMAT, "key": key, "model": "0" * 64}))
+    planted = sparse(model / "puma560_calibrated.xml", columns.LOG_MAX_BYTES + 2**30)
+    before = io_bytes()
+    with pytest.raises(inputs.InputError, match=rf"puma560_calibrated\.xml: {columns.LOG_MAX_BYTES + 2**30} bytes; a "
+                                                rf"file is read up to {columns.LOG_MAX_BYTES} bytes"):
+        stored.read_calibration(record, root, key, planted)
+    assert io_bytes()[0] - before[0] < MIB
