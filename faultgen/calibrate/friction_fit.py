@@ -119,11 +119,55 @@ def points_table(points: list[Point], fits: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def read_fits(path: Path) -> pd.DataFrame:
-    """A ``friction_fit.csv`` written by :func:`fit` (a reference test's), read back; ValueError
-    naming the file and the missing columns when it is not one."""
-    table = pd.read_csv(path)
+#: Size bound of a reference ``friction_fit.csv`` read back (:func:`read_fits`), bytes: one row per
+#: axis of some 20 numbers, under 4 kB as :func:`fit`'s rows are written.
+FITS_MAX_BYTES = 2**20
+
+
+def read_fits(path: Path, folder: Path | None = None) -> pd.DataFrame:
+    """A ``friction_fit.csv`` written by :func:`fit` (a reference test's), read back through
+    :mod:`faultgen.inputs`: a regular file (inside ``folder`` when given: a link out of it is
+    refused, never read) of at most :data:`FITS_MAX_BYTES`, checked on its size before the read,
+    UTF-8; ``axis`` a whole number from 1 and each of :data:`PARAMETERS` a number, or empty
+    (NaN: not fitted). Was read by pandas unguarded: a text cell was a TypeError traceback in the
+    figure, a link out of the folder was followed, a 362 MB file accepted.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        (a ValueError) Naming the file and what is wrong: not a regular file, a link out of
+        ``folder``, too large, not a CSV table, missing columns, or the row and column of a cell
+        that is not a number.
+    """
+    import io
+
+    from faultgen import inputs
+
+    if folder is not None:
+        inputs.within(path, folder, "reference folder")
+    text = inputs.read_text(path, "friction_fit.csv", FITS_MAX_BYTES)
+    try:
+        table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+        raise inputs.InputError(f"{path}: not a CSV table ({' '.join(str(err).split())[:200]}); a friction_fit.csv "
+                                "written by `faultgen friction-test` is expected") from None
     missing = [c for c in ("axis", *PARAMETERS) if c not in table.columns]
     if missing:
-        raise ValueError(f"{path}: not a friction_fit.csv (no columns {', '.join(missing)})")
+        raise inputs.InputError(f"{path}: not a friction_fit.csv (no columns {', '.join(missing)})")
+    for column in ("axis", *PARAMETERS):
+        cells = table[column].str.strip()
+        empty = ((cells == "") | (cells.str.lower() == "nan")).to_numpy()
+        values = pd.to_numeric(cells.where(~empty, "nan"), errors="coerce").to_numpy(dtype=float)
+        if column == "axis":
+            ok = np.isfinite(values) & (values >= 1) & (values == np.round(values))
+        else:
+            ok = np.isfinite(values) | empty
+        bad = np.flatnonzero(~ok)
+        if bad.size:
+            raw = str(table[column].iloc[bad[0]])
+            shown = repr(raw) if len(raw) <= 40 else f"{raw[:40]!r}... ({len(raw)} characters)"
+            expected = "a whole axis number from 1" if column == "axis" else "a finite number, or empty (not fitted)"
+            raise inputs.InputError(f"{path}: row {bad[0] + 1} (line {bad[0] + 2}), column {column}: {shown}; "
+                                    f"expected {expected}")
+        table[column] = values.astype(int) if column == "axis" else values
     return table

@@ -44,10 +44,10 @@ def reference_fits(path: Path, robot: Robot) -> pd.DataFrame:
     friction_fit.csv) or a test log, read here. ValueError for a folder without friction_fit.csv."""
     path = Path(path)
     if path.is_dir():
-        if not (path / "friction_fit.csv").is_file():
+        if not ((path / "friction_fit.csv").exists() or (path / "friction_fit.csv").is_symlink()):
             raise ValueError(f"--reference {path}: a folder without friction_fit.csv; expected a "
                              "`faultgen friction-test` output folder or a test log")
-        return friction_fit.read_fits(path / "friction_fit.csv")
+        return friction_fit.read_fits(path / "friction_fit.csv", path)  # bounded, a link out of the folder refused
     return read(measured.read(path, robot, accelerations=False), robot).fits
 
 

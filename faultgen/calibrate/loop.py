@@ -8,13 +8,12 @@ once, at the end, with its parameter table, ``report.json`` and the figure.
 from __future__ import annotations
 
 import json
-import shutil
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from faultgen import axes
+from faultgen import axes, inputs
 from faultgen.calibrate import delay as delays
 from faultgen.calibrate import guard, plausibility, remainder, residual_tests, search, separable
 from faultgen.calibrate.effects import Effect, get
@@ -122,8 +121,8 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     model_dir.mkdir(parents=True, exist_ok=True)
     model_out = model_dir / f"{nominal.name}_calibrated.xml"  # every trial is named as the model written
     tasks_file = nominal.path.parent / "tasks.toml"
-    if tasks_file.is_file():
-        shutil.copyfile(tasks_file, model_dir / "tasks.toml")
+    if tasks_file.is_file():  # copied through faultgen.inputs: its size bound first (a sparse one was copied whole)
+        (model_dir / "tasks.toml").write_bytes(inputs.read_bytes(tasks_file, "tasks file", inputs.TOML_MAX_BYTES))
     gap_before = search.gap(tau, predicted, split.held_out)
     steps: list[Step] = []
     befores: list[Effect] = []  # each step's effect as the model held it before the step

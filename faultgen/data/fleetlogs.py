@@ -48,7 +48,7 @@ from tqdm.auto import tqdm
 
 from faultgen import __version__
 from faultgen.data import logfolder, schema, writer
-from faultgen.logs import formats, measured
+from faultgen.logs import columns, formats, measured
 from faultgen.logs.columns import CSV_SUFFIXES, HDF5_SUFFIXES
 from faultgen.data.atomic import check_apart, check_writable, hdf5_writer
 from faultgen.data.opening import attr, open_file
@@ -145,24 +145,30 @@ class ImportSummary:
         return "\n".join(lines)
 
 
-def sha256(path: Path) -> str:
-    """SHA-256 of a file's content, hex, read in blocks."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+def sha256(path: Path, max_bytes: int | None = None) -> str:
+    """SHA-256 of a file's content, hex, read in blocks: a regular file of at most ``max_bytes``
+    bytes (default :data:`faultgen.logs.columns.LOG_MAX_BYTES`), checked on its size before any read
+    (:func:`faultgen.inputs.sha256_of`: a sparse file's apparent size is never read).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Naming the file: missing, not a regular file, or above the bound."""
+    from faultgen import inputs
+
+    return inputs.sha256_of(path, "log", columns.LOG_MAX_BYTES if max_bytes is None else max_bytes)
 
 
 def content_sha256(path: Path) -> str | None:
     """SHA-256 of a log's content: its bytes, inflated when it is gzip-compressed (with the bomb
     check of :func:`faultgen.inputs.open_bytes`), so a log gzipped after its import has the digest
-    it was imported under; None for a file that cannot be read so."""
+    it was imported under; None for a file that cannot be read so, or is above
+    :data:`faultgen.logs.columns.LOG_MAX_BYTES` on disk (checked on its size before any read)."""
     from faultgen import inputs
 
     digest = hashlib.sha256()
     try:
-        with inputs.open_bytes(path, "log") as fh:
+        with inputs.open_bytes(path, "log", columns.LOG_MAX_BYTES) as fh:
             for block in iter(lambda: fh.read(1 << 20), b""):
                 digest.update(block)
     except (OSError, ValueError, EOFError):
@@ -171,36 +177,77 @@ def content_sha256(path: Path) -> str | None:
 
 
 def read_once(read: Reader, path: Path, robot: robots.Robot) -> tuple[measured.MeasuredData, str]:
-    """``read(path, robot)`` on the bytes of ``path`` read once, and their SHA-256: the file is
-    copied into a private temporary folder while it is hashed, and the copy is parsed, so the
+    """``read(path, robot)`` on the bytes of ``path`` read once, and their SHA-256, so that the
     digest is that of exactly the content parsed, even when the log is replaced meanwhile (read
     twice, a log replaced between the hash and the parse was stored under the old content's
-    digest). A refusal names ``path``, never the copy.
+    digest). A refusal names ``path``.
+
+    The size bound (:data:`faultgen.logs.columns.LOG_MAX_BYTES`) is checked on the file's size
+    before anything is read, and nothing is ever written to measure a file: a log of at most
+    :data:`faultgen.logs.columns.WHOLE_MAX_BYTES` is held in memory (:func:`faultgen.inputs.hold`),
+    parsed from those bytes by a reader that takes them (:attr:`faultgen.logs.formats.LogFormat.
+    reads_held`; a plug-in reader of paths gets a private copy of them); a larger one is parsed
+    from its path and hashed after, refused when the file changed meanwhile (its inode, size or
+    modification time). (It was copied whole into TMPDIR before any bound: a sparse log of 1 GiB
+    apparent, 0 bytes on disk, wrote 1 GiB there before its refusal.)
 
     Raises
     ------
     ValueError
         The reader's refusal (:class:`faultgen.logs.measured.MeasuredDataError`, an adapter's), or
-        :class:`faultgen.inputs.InputError` for a path that is not a regular file.
+        :class:`faultgen.inputs.InputError` for a path that is not a regular file, a file above the
+        bound, or one that changed while it was read.
     """
-    import tempfile
-
     from faultgen import inputs
 
     path = Path(path)
-    digest = hashlib.sha256()
-    with tempfile.TemporaryDirectory(prefix="faultgen-log-") as folder:
-        copy = Path(folder) / path.name  # the same name: readers go by its suffix
-        with open(inputs.regular_file(path, "log"), "rb") as source, open(copy, "wb") as sink:
-            for block in iter(lambda: source.read(1 << 20), b""):
-                digest.update(block)
-                sink.write(block)
+    size = inputs.size_of(inputs.regular_file(path, "log", columns.LOG_MAX_BYTES))
+    if size <= columns.WHOLE_MAX_BYTES:
         try:
-            data = read(copy, robot)
+            held = inputs.hold(path, "log", columns.WHOLE_MAX_BYTES)
+        except inputs.InputError:
+            if not path.is_file():
+                raise
+        else:  # held: parsed from the bytes hashed
+            return _parse_held(read, held, robot), held.sha256
+    before = _identity(path)
+    data = read(path, robot)
+    digest = sha256(path)
+    if _identity(path) != before:
+        raise inputs.InputError(f"{path}: changed while it was read (its size or modification time); import it "
+                                "again once it is written")
+    return data, digest
+
+
+def _identity(path: Path) -> tuple[int, int, int, int]:
+    info = path.stat()
+    return info.st_dev, info.st_ino, info.st_size, info.st_mtime_ns
+
+
+def _reads_held(read: Reader) -> bool:
+    """Whether ``read`` is a log format's reader (a bound :meth:`faultgen.logs.formats.LogFormat.read`,
+    or a ``functools.partial`` of one) that takes a file's bytes held (:attr:`reads_held`)."""
+    func = read.func if isinstance(read, functools.partial) else read
+    return bool(getattr(getattr(func, "__self__", None), "reads_held", False))
+
+
+def _parse_held(read: Reader, held, robot: robots.Robot) -> measured.MeasuredData:
+    """``read`` on the bytes ``held``: handed over as they are to a reader that takes them, else
+    written to a private temporary folder (at most :data:`faultgen.logs.columns.WHOLE_MAX_BYTES`,
+    the held bytes) and read from there, a refusal naming the log, never the copy."""
+    if _reads_held(read):
+        return read(held, robot)
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="faultgen-log-") as folder:
+        copy = Path(folder) / held.name  # the same name: readers go by its suffix
+        copy.write_bytes(held.data)
+        try:
+            return read(copy, robot)
         except ValueError as err:  # name the log, not its copy
-            err.args = tuple(a.replace(str(copy), str(path)) if isinstance(a, str) else a for a in err.args) or err.args
+            err.args = tuple(a.replace(str(copy), str(held.path)) if isinstance(a, str) else a
+                             for a in err.args) or err.args
             raise
-    return data, digest.hexdigest()
 
 
 def log_record(data: measured.MeasuredData, robot: robots.Robot, speed_limit: np.ndarray) -> dict[str, np.ndarray]:
@@ -292,11 +339,13 @@ class _Previous:
         for unit, logs in units.items():
             entries = []
             for log in logs:
-                try:
+                try:  # bounded: its size first (a file above the bound is refused unread, by read_once)
                     digest = sha256(log.path)
-                except OSError as err:  # removed since the folder was listed: skipped, named
-                    summary.skipped.append((log.name, f"{VANISHED} ({err.strerror or err})"))
-                    continue
+                except (OSError, ValueError) as err:
+                    if not (log.path.exists() or log.path.is_symlink()):  # removed since the folder was listed
+                        summary.skipped.append((log.name, f"{VANISHED} ({getattr(err, 'strerror', None) or 'no such file'})"))
+                        continue
+                    digest, unread = "", str(err).removeprefix(f"{log.path}: ")  # not a regular file, too large
                 was = self.name_of(log)
                 before = self.files.get(was) if was is not None else None
                 if before is None or before == digest or (was != log.name and content_sha256(log.path) == before):
@@ -304,8 +353,9 @@ class _Previous:
                     continue
                 if not reimport_changed:
                     then = "" if was == log.name else f" as {was}"
+                    now = f"{digest[:12]}... now" if digest else f"now {unread}"
                     raise ValueError(f"{log.path} changed since it was imported{then} into {self.path} "
-                                     f"(SHA-256 {before[:12]}... then, {digest[:12]}... now); put the imported "
+                                     f"(SHA-256 {before[:12]}... then, {now}); put the imported "
                                      "content back, or give --reimport-changed to import it again")
                 summary.reimported.append(log.name)
                 entries.append((log.key, log.name, log, digest, was))
@@ -415,7 +465,7 @@ def _events(logs_dir: Path, units: dict, robot: robots.Robot) -> tuple[list, str
     """(the events of ``LOGS/events.csv``, its SHA-256), or ([], "") without one."""
     events_path = logs_dir / "events.csv"
     events = logfolder.read_events(events_path, units, robot.n_axes, logs_dir) if events_path.is_file() else []
-    return events, sha256(events_path) if events_path.is_file() else ""
+    return events, sha256(events_path, logfolder.EVENTS_MAX_BYTES) if events_path.is_file() else ""
 
 
 def _write_units(runs: h5py.Group, plan: dict, previous: _Previous, rows, robot: robots.Robot, events,

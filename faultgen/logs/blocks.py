@@ -72,7 +72,7 @@ class Csv:
         self.path = path
         header = jointlog.header(path)  # bounded: CSV_MAX_COLUMNS, CSV_HEADER_MAX_BYTES
         try:
-            lines = inputs.count_lines(path, "joint log")
+            lines = inputs.count_lines(path, "joint log", inputs.CSV_ROW_MAX_BYTES)
         except inputs.InputError as err:
             raise LogError(str(err)) from None
         except (OSError, UnicodeDecodeError, EOFError) as err:

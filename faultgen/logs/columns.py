@@ -59,6 +59,11 @@ HDF5_SUFFIXES = (".h5", ".hdf5")
 #: about three times its columns more (docs/reliability.md); a longer log is for the calibration's
 #: streaming reader (:mod:`faultgen.logs.longlog`) or a replay's (:mod:`faultgen.operation.replay`).
 WHOLE_MAX_BYTES = 512 * 2**20
+#: Largest log file any reader takes, bytes on disk (its ``st_size``, checked before the file is
+#: read, hashed or copied: a sparse file's apparent size costs nothing to make, ``truncate -s 2T``,
+#: and was read whole before it was refused). A log read whole keeps at most :data:`WHOLE_MAX_BYTES`
+#: of its columns; its text, with columns faultgen does not read, may be a few times that.
+LOG_MAX_BYTES = 4 * 2**30
 #: Cells of a CSV log parsed at a time when pandas reads it (a compressed log, or one pyarrow refused).
 CHUNK_CELLS = 4_000_000
 

@@ -14,10 +14,11 @@ import pandas as pd
 
 from faultgen import inputs
 from faultgen.logs import measured
-from faultgen.logs.columns import CHUNK_CELLS, LogBoundError
+from faultgen.logs.columns import CHUNK_CELLS, LOG_MAX_BYTES, LogBoundError
+from faultgen.logs.jointlog import shown_cell
 
-#: Largest foreign log read, bytes on disk.
-MAX_BYTES = 4 * 2**30
+#: Largest foreign log read, bytes on disk (:data:`faultgen.logs.columns.LOG_MAX_BYTES`, every log's).
+MAX_BYTES = LOG_MAX_BYTES
 
 
 def header(path: Path | inputs.Held, what: str, separator: str | None, as_what: str) -> tuple[list[str], str]:
@@ -53,7 +54,7 @@ def numbers(path: Path, frame: pd.DataFrame, wanted: list[str], label) -> dict[s
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             raw = frame[name].iloc[bad[0]]
-            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else repr(raw)  # inf, not np.float64(inf)
+            shown = repr(float(raw)) if isinstance(raw, (float, np.floating)) else shown_cell(str(raw))  # inf, not np.float64(inf)
             raise measured.MeasuredDataError(f"{path}: {label(int(bad[0]))}, column {name}: value {shown}; expected "
                                              "a finite number")
         out[name] = values

@@ -214,7 +214,7 @@ class LogFormat:
         """An upper bound of the log's data rows, found before they are parsed. The base: the lines
         of the delimited-text file but its header (:func:`faultgen.inputs.count_lines`)."""
         try:
-            return max(inputs.count_lines(path, f"{self.name} log") - 1, 0)
+            return max(inputs.count_lines(path, f"{self.name} log", inputs.CSV_ROW_MAX_BYTES) - 1, 0)
         except inputs.InputError as err:
             raise LogBoundError(str(err)) from None
         except (OSError, UnicodeDecodeError, EOFError) as err:

@@ -72,7 +72,7 @@ def csv_rows(path: Path, n_columns: int, what: str = "a log", label: str = "join
     try:
         if not inputs.is_gzip(path) and inputs.size_of(path) <= whole_rows(n_columns):
             return
-        lines = inputs.count_lines(path, label)
+        lines = inputs.count_lines(path, label, inputs.CSV_ROW_MAX_BYTES)
     except inputs.InputError as err:
         raise LogError(str(err)) from None
     check_whole_rows(path, max(lines - 1, 0), n_columns, what=what)
@@ -248,7 +248,19 @@ def _numbers_from_text(path: Path, read_kw: dict, wanted: list[str]) -> dict[str
     return {name: joined(parts[name])[: last_filled + 1] for name in wanted}
 
 
+#: Characters of a bad cell quoted in a refusal; a longer one is cut, its length said (a sparse
+#: log's hole read as one cell of NUL bytes put 256 MiB of them into one message).
+CELL_SHOWN = 40
+
+
+def shown_cell(raw: str) -> str:
+    """``repr`` of a cell, cut at :data:`CELL_SHOWN` characters (its length then said)."""
+    return repr(raw) if len(raw) <= CELL_SHOWN else f"{raw[:CELL_SHOWN]!r}... ({len(raw)} characters)"
+
+
 def describe_bad_cell(raw: str) -> str:
+    if len(raw) > CELL_SHOWN:
+        return f"value {shown_cell(raw)} is not a number"
     if raw == "":
         return "empty cell; expected a number"
     if raw.lower() in ("nan", "-nan", "+nan", "na", "n/a", "null", "none", "#n/a"):

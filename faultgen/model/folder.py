@@ -26,6 +26,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from faultgen import inputs
 from faultgen.model import builder, importers, limits, plausibility, rating, robots, sizing
 from faultgen.model.drivetrain import KEYS, UNITS, read_table
 
@@ -240,7 +241,7 @@ def sizing_rule(folder: str | Path) -> int | None:
     path = Path(folder) / "drivetrain.toml"
     if not path.is_file():
         return None
-    for line in path.read_text().splitlines():
+    for line in inputs.read_text(path, "drivetrain file", inputs.TOML_MAX_BYTES).splitlines():  # size first
         if not line.startswith("#"):
             break
         match = RULE_RECORD.search(line)

@@ -23,7 +23,6 @@ inverse dynamics add the friction's eq. 6.3 torque and the effects' torques.
 
 from __future__ import annotations
 
-import hashlib
 import threading
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -36,7 +35,7 @@ from faultgen import axes
 from faultgen.effects.base import ModelError, read_all
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.motor_friction import MotorFriction
-from faultgen.model import drivetrain
+from faultgen.model import drivetrain, sources
 
 __all__ = ["RATED_PAYLOAD", "ModelError", "Robot", "drivetrain_of", "from_model", "from_spec"]
 
@@ -173,7 +172,7 @@ class Robot:
         simulation model, a robot carrying a part). Raises ModelError if the robot was pickled and
         its file has changed since."""
         if self._spec is None:
-            if self.digest is None or hashlib.sha1(self.path.read_bytes()).hexdigest() != self.digest:
+            if self.digest is None or sources.sha1_of(self.path, ModelError) != self.digest:  # bounded, size first
                 raise ModelError(f"{self.path}: changed since the robot was read; load it again")
             object.__setattr__(self, "_spec", mujoco.MjSpec.from_file(str(self.path)))
         return self._spec.copy()

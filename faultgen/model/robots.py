@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import hashlib
 import re
 import shutil
 from collections.abc import Callable
@@ -97,7 +96,7 @@ def load(name: str | Path) -> Robot:
         listing = ", ".join(known) or "(none found in " + str(robots_dir()) + ")"
         raise UnknownRobotError(f"unknown robot {str(name)!r}; known robots: {listing}")
     path = path.resolve()
-    return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+    return _cached(path, _digest(path))
 
 
 def write(path: str | Path, text: str, writer: Callable[[Path, str], object] | None = None) -> Robot:
@@ -119,7 +118,7 @@ def write(path: str | Path, text: str, writer: Callable[[Path, str], object] | N
     path = Path(path)
     (writer or Path.write_text)(path, text)
     path = path.resolve()
-    return _cached(path, hashlib.sha1(path.read_bytes()).hexdigest())
+    return _cached(path, _digest(path))
 
 
 def moved(robot: Robot, path: str | Path) -> Robot:
@@ -134,7 +133,7 @@ def moved(robot: Robot, path: str | Path) -> Robot:
         If ``robot`` was not read from a file or ``path`` does not hold that file's bytes (its SHA-1).
     """
     path = Path(path).resolve()
-    digest = hashlib.sha1(path.read_bytes()).hexdigest() if path.is_file() else None
+    digest = _digest(path) if path.is_file() else None
     if robot.digest is None or digest != robot.digest:
         raise ModelError(f"{path}: not the file the robot {robot.name!r} was read from ({robot.path}), unchanged; "
                          "load it with faultgen.model.robots.load")
@@ -178,6 +177,12 @@ def _folder_model(folder: Path) -> Path:
         raise UnknownRobotError(f"{folder}: not a robot folder; expected {own.name} or exactly one robot "
                                 f".xml (found: {found})")
     return candidates[0]
+
+
+def _digest(path: Path) -> str:
+    """SHA-1 of a robot MJCF's bytes through :mod:`faultgen.inputs` (:func:`faultgen.model.sources.sha1_of`:
+    its size checked before the read; a 20 GiB sparse MJCF was read whole, a MemoryError). ModelError otherwise."""
+    return sources.sha1_of(path, ModelError)
 
 
 @functools.lru_cache(maxsize=32)

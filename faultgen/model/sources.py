@@ -8,6 +8,7 @@ cannot pull in ``/etc/passwd``, ``~/.ssh`` or ``/dev/zero``.
 
 from __future__ import annotations
 
+import hashlib
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -51,6 +52,12 @@ def read_bytes(
         return inputs.read_bytes(path, what, limit)
     except inputs.InputError as err:
         raise error(str(err)) from None
+
+
+def sha1_of(path: str | Path, error: type[ValueError] = ValueError, what: str = "robot MJCF") -> str:
+    """SHA-1 (hex) of a description's bytes, read by :func:`read_bytes` (a regular file of at most
+    :data:`MAX_DESCRIPTION_BYTES`, its size checked first: a 20 GiB sparse MJCF was read whole)."""
+    return hashlib.sha1(read_bytes(path, what=what, error=error)).hexdigest()
 
 
 def read_text(

@@ -74,6 +74,7 @@ from statistics import NormalDist
 
 import numpy as np
 
+from faultgen import inputs
 from faultgen.calibrate import friction_fit, friction_report
 from faultgen.data import cells, logfolder
 from faultgen.logs import formats
@@ -185,10 +186,13 @@ def read_tests(found: dict[str, list], robot, out: Path,
     for unit, tests in found.items():
         read[unit] = []
         for log in tests:
-            try:
-                digest = stored.sha256_file(log.path)
+            try:  # its size first: a sparse test of terabytes apparent is refused unread
+                digest = fleet_logs.log_sha256(log.path)
             except OSError as err:
                 read[unit].append(FrictionTest(log.stamp, log.key, "", error=f"cannot be read ({err.strerror or err})"))
+                continue
+            except inputs.InputError as err:
+                read[unit].append(FrictionTest(log.stamp, log.key, "", error=str(err)[:300]))
                 continue
             key = _cache_key(robot_sha256, digest, fmt)
             path = root / f"{stored.key_name(key)}.json"

@@ -20,7 +20,7 @@ import numpy as np
 
 from faultgen import inputs
 from faultgen.data import fleetlogs, logfolder
-from faultgen.logs import formats, measured
+from faultgen.logs import columns, formats, measured
 from faultgen.logs.columns import WHOLE_MAX_BYTES
 from faultgen.model.robots import Robot
 from faultgen.monitor import scoring
@@ -158,6 +158,17 @@ def reading_of(robot: Robot, data: measured.MeasuredData) -> Reading:
 HOLD_MAX_BYTES = WHOLE_MAX_BYTES
 
 
+def log_sha256(path: Path) -> str:
+    """SHA-256 of a log's (or friction test's) bytes, hex, its size checked first and the read
+    bounded by it (:data:`faultgen.logs.columns.LOG_MAX_BYTES`, :func:`faultgen.inputs.sha256_of`).
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Naming the file: missing, not a regular file, or above the bound (never read then)."""
+    return inputs.sha256_of(path, "joint log", columns.LOG_MAX_BYTES)
+
+
 @dataclass(frozen=True, eq=False)
 class Parsed:
     """A log as one read of it found it: ``path``, ``sha256`` (hex, of its bytes) and the checked
@@ -188,15 +199,21 @@ def parse(path: Path, robot: Robot, reader: Reader = measured.read, held: bool =
     path = Path(path)
     source = path
     try:
-        if held and path.stat().st_size <= HOLD_MAX_BYTES:
+        size = path.stat().st_size
+        if size > columns.LOG_MAX_BYTES:  # on its size, before any read: a sparse file's apparent size is free
+            return Parsed(path, "", None, inputs.InputError(
+                f"{path}: {size} bytes; a joint log is read up to {columns.LOG_MAX_BYTES} bytes (LOG_MAX_BYTES)"))
+        if held and size <= HOLD_MAX_BYTES:
             try:
                 source = inputs.hold(path, "joint log", HOLD_MAX_BYTES)
             except inputs.InputError:
                 source = path  # grown past the bound since its size was read: read from the path
-        sha256 = source.sha256 if isinstance(source, inputs.Held) else stored.sha256_file(path)
+        sha256 = source.sha256 if isinstance(source, inputs.Held) else log_sha256(path)
     except OSError as err:
         return Parsed(path, "", None, inputs.InputError(f"{path}: cannot be read ({err.strerror or err}); it was "
                                                         "removed or replaced since the logs folder was listed"))
+    except inputs.InputError as err:  # grown past LOG_MAX_BYTES, or no longer a regular file
+        return Parsed(path, "", None, err)
     try:
         return Parsed(path, sha256, reader(source, robot))
     except ValueError as err:

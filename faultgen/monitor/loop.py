@@ -45,7 +45,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.data import atomic, fleetlogs, logfolder
-from faultgen.logs import formats
+from faultgen.logs import columns, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
@@ -367,10 +367,13 @@ def _pending(name: str, unit_logs: list, unit: Unit | None) -> tuple[list, list[
 def _same_log(path: Path, sha256: str) -> bool:
     """Whether the log at ``path`` is the one scored with SHA-256 ``sha256``: the same bytes, or
     the same content gzipped (:func:`faultgen.data.fleetlogs.content_sha256`); False for a file
-    that cannot be read."""
+    that cannot be read. Its size is checked first (:data:`faultgen.logs.columns.LOG_MAX_BYTES`):
+    a file above it is never read, the same log when it was above it when handled (``sha256`` empty)."""
     try:
-        return stored.sha256_file(path) == sha256 or fleetlogs.content_sha256(path) == sha256
-    except OSError:
+        if path.stat().st_size > columns.LOG_MAX_BYTES:  # never read: the same when it was too large then too
+            return sha256 == ""
+        return fleet_logs.log_sha256(path) == sha256 or fleetlogs.content_sha256(path) == sha256
+    except (OSError, ValueError):
         return False
 
 

@@ -32,7 +32,9 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from faultgen import inputs
 from faultgen.data.confined import Confined
+from faultgen.logs import columns
 from faultgen.model import robots
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
@@ -297,4 +299,5 @@ def _logs_of(context: Context, group: list) -> dict[str, bytes]:
         wanted += [log for log in mine if log.stamp == unit.first[0]]
         if unit.program is not None:
             wanted += [log for log in context.units.get(unit.program[0], []) if log.stamp == unit.program[1]]
-    return {log.name: Path(log.path).read_bytes() for log in wanted}
+    # through faultgen.inputs: the size bound first (a sparse log was read whole here: a MemoryError)
+    return {log.name: inputs.read_bytes(log.path, "joint log", columns.LOG_MAX_BYTES) for log in wanted}

@@ -66,12 +66,12 @@ class StateError(inputs.InputError):
 
 
 def sha256_file(path: str | Path) -> str:
-    """SHA-256 of a file's bytes, hex."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(2**20), b""):
-            digest.update(block)
-    return digest.hexdigest()
+    """SHA-256 of a file's bytes (a robot model, a log), hex, through :func:`faultgen.inputs.sha256_of`:
+    a regular file of at most :data:`faultgen.logs.columns.LOG_MAX_BYTES`, its size checked before
+    the read (a sparse file of terabytes apparent was hashed whole). InputError naming the file otherwise."""
+    from faultgen.logs.columns import LOG_MAX_BYTES
+
+    return inputs.sha256_of(path, "file", LOG_MAX_BYTES)
 
 
 #: Longest unit name kept as it is in a file name of OUT (``<unit>.png``, ``.state/<unit>.json``),

@@ -93,6 +93,7 @@ from faultgen.operation.tasks import (  # noqa: F401
     THESIS,
     LogTask,
     Motion,
+    check_file, file_bytes, file_sha256,  # a file task read through faultgen.inputs, bounded
     ProgramError,
     Task,
     TextProgram,
@@ -140,9 +141,7 @@ def check_name(task: str) -> str:
         raise ValueError(f"task {task!r}: expected a task name ({', '.join(TASKS)}) or a program file (.toml) "
                          "or joint log (.csv, .h5)")
     if found in FILE_KINDS:
-        if not Path(task).is_file():
-            raise ValueError(f"task file {str(task)!r} does not exist")
-        return task
+        return check_file(task)  # missing, or what it is instead (a FIFO, a link to /dev/zero)
     if found is not None:  # a thesis task, a program's text or a motion in memory: no file to look for
         return task
     raise ValueError(f"unknown task {task!r}; expected one of: {', '.join(TASKS)}, or a program file (.toml) "
@@ -214,8 +213,9 @@ def record(task: str) -> dict | None:
         return {"name": task.name, "source": task.source, "sha256": task.sha256}
     if found in (THESIS, None):
         return None
-    data = task.text.encode() if found == TEXT else Path(task).read_bytes()
-    out = {"file": str(task), "sha256": hashlib.sha256(data).hexdigest()}
+    data = task.text.encode() if found == TEXT else file_bytes(task)  # bounded, size first; None: a log
+    digest = hashlib.sha256(data).hexdigest() if data is not None else file_sha256(task)
+    out = {"file": str(task), "sha256": digest}
     if found in PROGRAM_KINDS:
         text = data.decode()
         try:
@@ -581,7 +581,7 @@ def show(robot: Robot, task: str) -> str:
     check_name(task)
     if kind(task) not in PROGRAM_KINDS:
         raise ValueError(f"{task}: a joint log has no program text; `faultgen tasks show` prints programs")
-    return task.text if kind(task) == TEXT else Path(task).read_text()
+    return task.text if kind(task) == TEXT else inputs.read_text(task, "program file", inputs.TOML_MAX_BYTES)
 
 
 def available(robot: Robot) -> list[tuple[str, str]]:

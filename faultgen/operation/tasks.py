@@ -37,6 +37,9 @@ from typing import TYPE_CHECKING, Protocol, runtime_checkable
 import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
+from faultgen import inputs
+from faultgen.logs.columns import LOG_MAX_BYTES
+
 if TYPE_CHECKING:
     from faultgen.model.robots import Robot
 
@@ -306,6 +309,35 @@ def kind(task) -> str | None:
         return THESIS
     name = task.lower()
     return PROGRAM if name.endswith(PROGRAM_SUFFIXES) else LOG if name.endswith(REPLAY_SUFFIXES) else None
+
+
+def check_file(task: str) -> str:
+    """``task`` (a program file or joint log) if it names a regular file, looked at without opening
+    it; ValueError saying that it does not exist, or what it is instead (a FIFO, a link to a device
+    such as ``/dev/zero``, a folder: :func:`faultgen.inputs.regular_file`)."""
+    if not (Path(task).exists() or Path(task).is_symlink()):
+        raise ValueError(f"task file {str(task)!r} does not exist")
+    inputs.regular_file(task, "task file")
+    return task
+
+
+def file_bytes(task: str) -> bytes | None:
+    """A program file's bytes, read through :mod:`faultgen.inputs` (a regular file of at most
+    :data:`faultgen.inputs.TOML_MAX_BYTES`, its size checked before the read); None for a joint
+    log (hashed in blocks: :func:`file_sha256`). InputError naming the file otherwise."""
+    if kind(task) != PROGRAM:
+        return None
+    return inputs.read_bytes(task, "program file", inputs.TOML_MAX_BYTES)
+
+
+def file_sha256(task: str) -> str:
+    """SHA-256 (hex) of a file task's bytes: a program file's (:func:`file_bytes`) or a joint log's,
+    read in blocks up to :data:`faultgen.logs.columns.LOG_MAX_BYTES`, its size checked first (a
+    sparse file of 20 GiB apparent was read whole: a MemoryError). InputError naming the file."""
+    data = file_bytes(task)
+    if data is not None:
+        return hashlib.sha256(data).hexdigest()
+    return inputs.sha256_of(str(task), "joint log", LOG_MAX_BYTES)
 
 
 def check_step(dt) -> float:

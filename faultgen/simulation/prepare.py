@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from faultgen import effects
+from faultgen import effects, inputs
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
 from faultgen.operation import programs, tasks
@@ -86,9 +86,11 @@ def digests(robot: robots.Robot, task) -> tuple[str, ...]:
     if not tasks_file.is_file():  # a model file copied without its tasks: say so, not FileNotFoundError
         raise ValueError(f"{tasks_file}: no tasks file beside the model {model_file}; copy the robot's tasks.toml "
                          "with it (the model `faultgen calibrate` writes has one)")
-    found = (hashlib.sha256(tasks_file.read_bytes()).hexdigest(),)
+    # through faultgen.inputs, each size checked before the read (a sparse 20 GiB tasks.toml or
+    # program file was read whole here: a MemoryError)
+    found = (hashlib.sha256(inputs.read_bytes(tasks_file, "tasks file", inputs.TOML_MAX_BYTES)).hexdigest(),)
     if programs.kind(task) in programs.FILE_KINDS:
-        found = (*found, hashlib.sha256(Path(task).read_bytes()).hexdigest())
+        found = (*found, programs.file_sha256(task))
     return found
 
 
