@@ -5,7 +5,7 @@ numeric profile), its two manifests' arrays compared with each other and with th
     python benchmarks/prognostics_made_twice.py [--version 2] [--size full] [--work DIR]
 
 Issue 75, item 7: "prognostics track v2 made twice with identical manifests" (the full size: some 15-30
-minutes a make on a loaded 2-core machine; the test size is tests/test_r7_track2.py's).
+minutes a make on a loaded 2-core machine; the test size is tests/test_bench_prognostics_v2.py's).
 """
 
 from __future__ import annotations

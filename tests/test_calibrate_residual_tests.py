@@ -107,7 +107,7 @@ def test_a_ripple_outside_the_library_is_left_unexplained_on_its_axis(tmp_path):
     """roboticstoolbox's PUMA 560 (puma560-01-none) with a torque ripple periodic in axis 2's arm
     angle, 3 periods a revolution, 6 % of the axis's RMS torque (the library's cogging is periodic in
     the motor angle): axis 2, and only it, is left unexplained. The torque offset the search fits
-    there is not written since issue 73 (no forced fit, tests/test_r6_calib.py); with it, axis 2's
+    there is not written since issue 73 (no forced fit, tests/test_calibrate_open_world.py); with it, axis 2's
     held-out nrmse was 1.6x the median axis's, which the earlier 3x-median rule missed."""
     path, _ = make(next(c for c in CASES if c.name == "puma560-01-none"), tmp_path)
     frame = pd.read_csv(path)

@@ -2,14 +2,14 @@
 unit chart stays beside its own panel (one line of the longest ran past it into the other's), an
 alarm's label stays inside the chart (an alarm in the middle of the logs, known two days after it
 started, ran off the right edge), and plotly's toolbar leaves the friction curve's title free.
-The OUT folder is written by hand (tests/test_r6_page.py's ``make_out``); Debian's headless
+The OUT folder is written by hand (tests/test_monitor_page_lights.py's ``make_out``); Debian's headless
 Chromium (tests/test_report_page.py's fixture)."""
 
 from __future__ import annotations
 
 import csv
 
-from test_r6_page import Spec, day, make_out
+from test_monitor_page_lights import Spec, day, make_out
 from test_report_page import browser  # noqa: F401  (the headless Chromium fixture)
 
 from faultgen.monitor import page

@@ -24,7 +24,7 @@ beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again 
   started from (alarms.csv's ``known`` and ``first_alarm``).
 
 At 400 px wide (a phone) the table's lines become cards, each cell under its column's name: no
-column leaves the screen (tests/test_r6_page.py checks it in headless Chromium).
+column leaves the screen (tests/test_monitor_page_lights.py checks it in headless Chromium).
 
 It is one self-contained file that works offline: plotly.js is embedded once (no CDN, no server),
 each unit's chart is kept as JSON in the page and drawn when its panel is first opened (a page of

@@ -44,7 +44,7 @@ def _predict(shape: str, noise: float, seed: int) -> tuple[prognosis.Remaining, 
     noisy = wear + np.random.default_rng(seed).normal(0.0, noise, DAYS)
     rows = _rows(noisy, noise)
     # the scale drawn as when these figures were measured (normal, 10 %): the trend's rule is tested
-    # here; the no-test prior since (log-normal, prognosis.TWIN_SCALE_LOG_SD) in tests/test_r10_life.py
+    # here; the no-test prior since (log-normal, prognosis.TWIN_SCALE_LOG_SD) in tests/test_life_unknown_scale.py
     (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
                                       since=rows[int(np.argmax(wear >= 12.0))]["stamp"],
                                       scale_uncertainty=prognosis.SCALE_UNCERTAINTY)

@@ -1,4 +1,4 @@
-"""Issue 72's remaining criteria (the UR5 scenario itself is tests/test_r7_urlogs.py's fixture, with
+"""Issue 72's remaining criteria (the UR5 scenario itself is tests/test_monitor_ur_logs.py's fixture, with
 its unlogged program change): the page in headless Chromium at 1400 px as well as 400 px, the
 bench's twin naming the axis of the alarm known first, ``--protocol own``'s alarm at once on a log
 far past its limits, a program change's relearning named as such on the chart, and the import
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_r6_page import FLEET, SETTINGS, Spec, make_out
+from test_monitor_page_lights import FLEET, SETTINGS, Spec, make_out
 from test_report_page import browser  # noqa: F401  (the headless Chromium fixture)
 
 import fleetlog_folder
@@ -40,7 +40,7 @@ def out(tmp_path_factory) -> Path:
 def test_every_column_is_on_screen_at_1400_and_400_px(out, browser, width):  # noqa: F811
     """No column right of the window or cut, no sideways scrolling, every chart within the width;
     with FAULTGEN_SCREENSHOT=1 the page at 1400 px saved as docs/report-page-1400.png and a unit's panel
-    as docs/report-unit-1400.png (the 400 px one is tests/test_r6_page.py's docs/report-page-400.png)."""
+    as docs/report-unit-1400.png (the 400 px one is tests/test_monitor_page_lights.py's docs/report-page-400.png)."""
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import WebDriverWait
 
