@@ -1,13 +1,14 @@
 """Classification speed: `faultgen classify` against a plain scikit-learn loop and the sweep that made the data.
 
-    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--fleet fleet.h5 [--make-fleet]] [--steps 1,2,3,4]
+    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--fleet fleet.h5 [--make-fleet]] [--steps 1,2,3,4,5]
 
 In one run of this script:
 
 1. ``faultgen sweep --preset quick`` writes quick.h5 (timed; skipped with --dataset), then
    ``faultgen classify quick.h5`` with its defaults (timed, as a user runs it: the seven rows of
-   ``analysis.classify.SHORT_TABLE``, pairs in parallel on every core, the cheap chance estimate
-   included) and ``classify --full`` (every row); the ratios classify / sweep, wall and CPU;
+   ``analysis.classify.SHORT_TABLE``, pairs in parallel on every core, each row's chance level
+   on lr included) and ``classify --full`` (every row); the ratios classify / sweep, wall and CPU, and
+   whether the default table meets the target, at most the sweep's time (1.0x) in both;
 2. on the same inputs and pairs, every cell of the default table (of every row with --full)
    three ways:
    - plain: a scikit-learn loop, each (cell, pair) its whole pipeline cloned, fitted and scored
@@ -22,6 +23,10 @@ In one run of this script:
 4. with --fleet: the thesis protocol ``faultgen classify FLEET --horizon 3 --pairs 0``, default
    rows and --full, timed; with --make-fleet FLEET is first made by ``faultgen fleet`` (timed,
    about 12 min on two idle cores) and the ratios printed.
+5. the work of ``faultgen classify`` with its defaults counted on one process (:func:`counted_work`):
+   model fits per cell, PCA fits and stateless steps per held-out pair, tasks and the bytes the
+   largest ships, each against what the protocol needs (counts, not times;
+   tests/test_classify_work_counts.py runs it at a tiny size);
 
 Wall times on a shared machine are upper bounds; ratios of commands timed in one run hold
 better, and CPU time (user + system, workers included) best. The script prints ``uptime``'s load.
@@ -80,6 +85,158 @@ def plain_loop(inputs, names, classifiers, n_pairs, seed) -> dict:
     return aucs
 
 
+#: The model classes whose fits are counted (a fit inside another counted one, stacking's base
+#: classifiers, is the outer model's), by the column name of their classifier; PCA is the one
+#: preprocessing step fitted on data, Difference and WindowConcat the stateless run-by-run ones.
+COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "StackingClassifier": "stacking",
+           "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence"}
+
+
+def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
+    """``faultgen classify PATH``'s evaluation (:func:`analysis.benchmark.classification_table`, the
+    chance estimate included; ``kwargs`` go to it) on one process, every model fit and every task of
+    the worker pool counted, beside what the protocol needs (counts, not times).
+
+    The protocol (thesis Procedure 1, docs/analysis.md): per cell (row, classifier) and label set
+    (the true labels; with the chance estimate also the 19 exchanged sets, for the judged
+    classifier only), one fit per held-out pair whose training runs and held-out runs both have
+    both classes; a row's PCA fitted once per held-out pair of runs (the same training runs in every
+    label set), its stateless steps run twice per held-out pair (training runs, held-out runs);
+    one task per held-out pair of runs, shipping the features, the runs, the labels of each of its
+    label sets and the names, nothing more.
+
+    Returns
+    -------
+    dict with ``fits`` and ``needed``: ``{"lr" | "svm" | "rf" | "stacking": fits per cell, "pca":
+    per +pca row and held-out pair, "sequence": per stateless step and held-out pair, "tasks":
+    tasks}``; ``bytes``: the largest task's pickled arguments and ``bytes_needed`` the most it
+    needs; ``table`` the table.
+    """
+    import pickle
+    from contextlib import ExitStack
+    from unittest import mock
+
+    from analysis import benchmark, classify
+    from analysis.classify import evaluation
+
+    counts: dict[str, int] = dict.fromkeys(set(COUNTED.values()) | {"tasks"}, 0)
+    shipped: list[tuple[int, tuple]] = []
+    depth = [0]
+
+    def counting(method, name):
+        def fit(self, *args, **kw):
+            depth[0] += 1
+            try:
+                if depth[0] == 1:
+                    counts[name] += 1
+                return method(self, *args, **kw)
+            finally:
+                depth[0] -= 1
+        return fit
+
+    def task(*args):
+        counts["tasks"] += 1
+        shipped.append((len(pickle.dumps(args, protocol=pickle.HIGHEST_PROTOCOL)), args))
+        return original(*args)
+
+    original = evaluation.pair_cells
+    classes = _counted_classes()
+    with ExitStack() as stack:
+        for cls in classes:  # fit, and fit_transform where the class has its own (PCA)
+            for method in ("fit", *(["fit_transform"] if "fit_transform" in vars(cls) else [])):
+                stack.enter_context(mock.patch.object(cls, method, counting(getattr(cls, method), COUNTED[cls.__name__])))
+        stack.enter_context(mock.patch.object(evaluation, "pair_cells", task))
+        table = benchmark.classification_table(path, n_pairs=n_pairs, progress=False, n_jobs=1, **kwargs)
+    needed = protocol_needs(path, table, n_pairs, kwargs.get("random_state", 0), kwargs.get("wear_threshold", 10.0))
+    columns = list(dict.fromkeys(table.columns.get_level_values(0)))
+    fits = {c: counts[c] / len(table.index) for c in columns}
+    fits.update(pca=counts["pca"] / max(needed.pop("pca_rows"), 1), sequence=counts["sequence"] / max(needed.pop("steps"), 1),
+                tasks=counts["tasks"])
+    inputs = benchmark.classification_inputs(path, kwargs.get("wear_threshold", 10.0))
+    over = [(size, task_bytes_needed(inputs, list(table.index), len(args[4]))) for size, args in shipped]
+    most = max(over, key=lambda t: t[0] - t[1])
+    return {"fits": fits, "needed": needed, "bytes": most[0], "bytes_needed": most[1], "table": table}
+
+
+def _counted_classes() -> list[type]:
+    from sklearn.decomposition import PCA
+    from sklearn.ensemble import RandomForestClassifier, StackingClassifier
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.svm import SVC
+
+    from analysis.features import Difference, WindowConcat
+
+    return [LogisticRegression, SVC, RandomForestClassifier, StackingClassifier, PCA, Difference, WindowConcat]
+
+
+def protocol_needs(path: Path, table, n_pairs: int, seed: int, wear_threshold: float) -> dict:
+    """What the protocol needs for ``table`` (:func:`counted_work`): fits per cell per classifier,
+    per +pca row and held-out pair, per stateless step and held-out pair, and the tasks; from the
+    dataset's labels, the exchanged label sets and the pairs each draws."""
+    from analysis import benchmark, classify
+
+    inputs = benchmark.classification_inputs(path, wear_threshold)
+    labels = classify.make_labels(inputs.y, inputs.groups, inputs.failed)
+    sets = [(labels, inputs.failed, inputs.normal)]
+    if table.attrs.get("chance_source") is not None:
+        sets += classify.permuted_roles(labels, inputs.groups, inputs.failed, inputs.normal, table.attrs["permutations"],
+                                        seed)
+    judged = table.attrs.get("chance_source")
+    valid, held_out = [], set()
+    for k, (y, failed, normal) in enumerate(sets):
+        for pair in classify.select_pairs(failed, normal, n_pairs, seed):
+            held = np.isin(inputs.groups, list(pair))
+            held_out.add(frozenset(pair))
+            if len(set(y[~held])) == 2 and len(set(y[held])) == 2:
+                valid.append((k, frozenset(pair)))
+    needed = {}
+    for column in dict.fromkeys(table.columns.get_level_values(0)):
+        in_sets = {k for k in range(len(sets)) if k == 0 or judged in ("cell", column)}
+        needed[column] = sum(1 for k, _ in valid if k in in_sets)
+    fitted_pairs = len({pair for _, pair in valid})
+    rows = list(table.index)
+    needed["pca"] = fitted_pairs
+    needed["pca_rows"] = sum("+pca" in row for row in rows)
+    needed["sequence"] = 2 * fitted_pairs
+    needed["steps"] = sum(isinstance(step, classify.SEQUENCE_STEPS) for row in rows
+                          for _, step in classify.preprocessing_steps(row))
+    needed["tasks"] = len(held_out)
+    return needed
+
+
+def task_bytes_needed(inputs, rows: list[str], n_sets: int) -> int:
+    """The most a task of :func:`counted_work` needs to ship, bytes: the features and the estimated
+    block where ``rows`` use them, the run of each sample and the labels of each of its ``n_sets``
+    label sets, pickled, and 2 KiB for the names, its pair and the settings."""
+    import pickle
+
+    from analysis.classify import ESTIMATED, make_labels
+
+    labels = make_labels(inputs.y, inputs.groups, inputs.failed)
+    data = (inputs.X if any(not r.startswith(ESTIMATED) for r in rows) else None,
+            inputs.estimated if any(r.startswith(ESTIMATED) for r in rows) else None,
+            inputs.groups, [labels.copy() for _ in range(n_sets)])  # each set its own array
+    return len(pickle.dumps(data, protocol=pickle.HIGHEST_PROTOCOL)) + 2048
+
+
+def print_counts(path: Path, pairs: int) -> None:
+    """Step 5: :func:`counted_work` on ``path`` (classify's defaults, ``pairs`` pairs), each count
+    beside what the protocol needs, with its verdict."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        found = counted_work(path, n_pairs=pairs, chance=True, short=True)
+    print(f"work of `faultgen classify {path.name} --pairs {pairs}` counted (one process), against what the protocol needs:")
+    for key, value in found["fits"].items():
+        need = found["needed"][key]
+        what = {"tasks": "tasks", "pca": "PCA fits per +pca row"}.get(key, f"{key} fits per cell")
+        if key == "sequence":
+            what = "stateless step runs per step"
+        print(f"  {what:34s} {value:8g} (needed {need:g}): {'as needed' if value == need else 'NOT AS NEEDED'}")
+    ok = found["bytes"] <= found["bytes_needed"]
+    print(f"  {'bytes shipped, largest task':34s} {found['bytes']:8d} (needed at most {found['bytes_needed']}): "
+          f"{'within' if ok else 'MORE THAN NEEDED'}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--dataset", type=Path, help="An existing dataset (default: make quick.h5, timed).")
@@ -87,7 +244,7 @@ def main() -> None:
     parser.add_argument("--fleet", type=Path, help="A fleet for steps 3 and 4.")
     parser.add_argument("--make-fleet", action="store_true", help="Make --fleet first with `faultgen fleet`, timed.")
     parser.add_argument("--pairs", type=int, default=20, help="Held-out pairs of step 2 (classify's default, 20).")
-    parser.add_argument("--steps", default="1,2,3,4", help="Steps to run (3 and 4 need --fleet); default all.")
+    parser.add_argument("--steps", default="1,2,3,4,5", help="Steps to run (3 and 4 need --fleet); default all.")
     args = parser.parse_args()
     steps = {int(k) for k in args.steps.split(",")}
 
@@ -97,7 +254,7 @@ def main() -> None:
     try:
         path = args.dataset
         sweep = None
-        if path is None and steps & {1, 2}:
+        if path is None and steps & {1, 2, 5}:
             path = folder / "quick.h5"
             command = [*faultgen(), "sweep", "--preset", "quick", "-o", str(path), "--no-progress"]
             if 1 in steps:
@@ -113,6 +270,12 @@ def main() -> None:
                 print(f"{what:33s} {t[0]:7.1f} s wall, {t[1]:7.1f} s CPU   ({load()})")
                 if sweep is not None:
                     print("  " + ratio_line(what, t, sweep, "the sweep"))
+                    if not flag:  # the target: the default table at most the sweep's time, wall and CPU
+                        worst = max(t[0] / sweep[0], t[1] / sweep[1])
+                        print(f"  target <= 1.0x the sweep, wall and CPU: {'met' if worst <= 1.0 else 'NOT MET'} "
+                              f"({worst:.2f}x at worst)")
+        if 5 in steps:
+            print_counts(path, args.pairs)
         if 2 in steps:
             shared_preprocessing(path, args.full, args.pairs)
         if args.fleet is not None:

@@ -37,7 +37,6 @@ from analysis.benchmark.classification_auc import (
     CHANCE_PERMUTATIONS,
     STACKING_WORN_RUNS,
     classification_table,
-    row_chance,
     with_verdict,
 )
 from analysis.benchmark.classification_features import (
@@ -189,7 +188,6 @@ __all__ = [
     "markdown",
     "motor_speed_coverage",
     "opened",
-    "row_chance",
     "sample_histograms",
     "starved_isolators",
     "table_axes",

@@ -32,8 +32,9 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
     robot; T-13 to T-3), features computed over the whole record first, and every kept sample of a
     worn run is labelled 1 (the robot's state), of an unworn run 0. With ``chance`` (and no
     ``permutations``) every row's chance level is measured on :data:`CHANCE_CLASSIFIER`
-    (:func:`row_chance`) and every cell judged against it; with ``permutations`` each cell against
-    its own; either way :func:`with_verdict` adds the chance level, the p-value and
+    (:data:`CHANCE_PERMUTATIONS` label exchanges, in the same evaluation as the table: its cells on
+    the true labels are the table's, and each held-out pair's preprocessing is shared) and every
+    cell judged against it; with ``permutations`` each cell against its own; either way :func:`with_verdict` adds the chance level, the p-value and
     ``above_chance``, and ``attrs`` hold ``pairs`` (held-out pairs scored) and ``chance_source``
     ("cell": every cell measured; a classifier's name: only its cells, the default; None: not measured). With ``short`` (and no ``preprocessing``) only the rows of
     :data:`analysis.classify.SHORT_TABLE` the dataset has (no "+estM" ones without the duty).
@@ -46,28 +47,25 @@ def classification_table(path, wear_threshold: float = 10.0, n_pairs: int | None
         run and its samples), or the training sets would lack a class (see
         :func:`_check_training_sets`).
     """
-    from analysis.classify import ESTIMATED, SHORT_TABLE, evaluate, select_pairs
+    from analysis.classify import CLASSIFIERS, ESTIMATED, SHORT_TABLE, evaluate, select_pairs
 
     inputs = classification_inputs(path, wear_threshold, horizon)
     dropped = _without_stacking(path, inputs, kwargs)
     if short and kwargs.get("preprocessing") is None:
         kwargs["preprocessing"] = [n for n in SHORT_TABLE
                                    if inputs.estimated is not None or not n.startswith(ESTIMATED)]
+    judged = None
+    if chance and not kwargs.get("permutations"):  # the cheapest classifier's cells, each against its own chance level
+        columns = list(kwargs.get("classifiers") or CLASSIFIERS)
+        judged = CHANCE_CLASSIFIER if CHANCE_CLASSIFIER in columns else columns[0]
+        kwargs.update(permutations=CHANCE_PERMUTATIONS, null_of=[judged])
     table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, n_pairs=n_pairs,
                      random_state=random_state, progress=progress, estimated=inputs.estimated, **kwargs)
     null_values = {key: np.array(v) for key, v in table.attrs.pop("null_values", {}).items()}
-    source = "cell" if null_values else None
-    if chance and not null_values:  # the cheapest classifier's cells, each against its own chance level
-        columns = list(dict.fromkeys(table.columns.get_level_values(0)))
-        judged = CHANCE_CLASSIFIER if CHANCE_CLASSIFIER in columns else columns[0]
-        rows = list(table.index)
-        measured = row_chance(inputs, rows, n_pairs=n_pairs, random_state=random_state, n_jobs=kwargs.get("n_jobs"),
-                              matched=kwargs.get("matched", False), classifier=judged)
-        null_values = {f"{judged} {row}": measured[row] for row in rows}
-        source = judged
     table = with_verdict(table, null_values)
     table.attrs.update(pairs=len(select_pairs(inputs.failed, inputs.normal, n_pairs, random_state)),
-                       chance_source=source, imported=inputs.imported, notes=[dropped] if dropped else [])
+                       chance_source=judged or ("cell" if null_values else None), imported=inputs.imported,
+                       notes=[dropped] if dropped else [])
     return table
 
 
@@ -128,29 +126,6 @@ CHANCE_CLASSIFIER = "lr"
 
 #: A cell is above chance when its permutation p-value is at most this.
 CHANCE_ALPHA = 0.05
-
-
-def row_chance(inputs: ClassificationInputs, rows: list[str], n_pairs: int | None = 20, random_state: int = 0,
-               permutations: int = CHANCE_PERMUTATIONS, n_jobs: int | None = None, matched: bool = False,
-               classifier: str = CHANCE_CLASSIFIER) -> dict[str, np.ndarray]:
-    """The chance level of each preprocessing row on these robots: the mean leave-pair-out AUC of
-    ``classifier`` on ``permutations`` label sets with the runs' roles exchanged
-    (:func:`analysis.classify.permuted_roles`), on the same pairs as the table.
-
-    Robots of one kind (process, model) look alike, so chance is not 0.5. It is measured on one
-    classifier per row; one that fits runs more closely (rf, stacking) may have a higher chance
-    level, which ``faultgen classify --permutations K`` measures cell by cell.
-
-    Returns
-    -------
-    dict: row -> ndarray of shape (permutations,), the exchanged mean AUCs.
-    """
-    from analysis.classify import evaluate
-
-    table = evaluate(inputs.X, inputs.y, inputs.groups, inputs.failed, inputs.normal, classifiers=[classifier],
-                     preprocessing=rows, estimated=inputs.estimated, n_pairs=n_pairs, random_state=random_state,
-                     permutations=permutations, n_jobs=n_jobs, matched=matched)
-    return {row: np.array(table.attrs["null_values"][f"{classifier} {row}"]) for row in rows}
 
 
 def with_verdict(table: pd.DataFrame, null_values: Mapping[str, np.ndarray]) -> pd.DataFrame:

@@ -23,15 +23,33 @@ def _steps(estimator) -> list:
 
 
 def _per_run(step, X: np.ndarray, groups: np.ndarray) -> np.ndarray:
-    """``step.fit_transform`` on each run's rows on its own, rows back in their places."""
-    out = None
-    for g in pd.unique(groups):
-        idx = np.flatnonzero(groups == g)
-        part = np.asarray(step.fit_transform(X[idx]))
-        if out is None:
-            out = np.empty((X.shape[0], *part.shape[1:]), dtype=part.dtype)
-        out[idx] = part
-    return out
+    """What ``step.fit_transform`` gives on each run's rows on its own, rows back in their places:
+    ``X`` checked once (``step.fit``), then every run at once by row index (each row's predecessor
+    in its run; a run's first row is its own), the same numbers bit for bit."""
+    X = np.asarray(X, dtype=float)
+    step.fit(X)
+    previous = previous_rows(groups)
+    if isinstance(step, Difference):  # |X_k - X_(k-1)|, 0 for a run's first row
+        out = np.abs(X - X[previous])
+        out[previous == np.arange(len(X))] = 0.0
+        return out
+    lags = [np.arange(len(X))]  # WindowConcat: lag l is the l-th predecessor, a run's first row repeated
+    for _ in range(int(step.width) - 1):
+        lags.append(previous[lags[-1]])
+    return np.hstack([X[rows] for rows in reversed(lags)])
+
+
+def previous_rows(groups) -> np.ndarray:
+    """The row before each row in its run (``groups``: the run of each row, each run's rows in time
+    order), a run's first row its own index; shape (n_rows,)."""
+    codes = pd.factorize(np.asarray(groups))[0]
+    order = np.argsort(codes, kind="stable")
+    before = np.r_[order[:1], order[:-1]]
+    first = np.r_[True, codes[order][1:] != codes[order][:-1]] if len(order) else np.zeros(0, dtype=bool)
+    before[first] = order[first]
+    previous = np.empty(len(codes), dtype=int)
+    previous[order] = before
+    return previous
 
 
 def _transform(estimator, X, groups, y=None, fit: bool = False) -> tuple[np.ndarray, object]:

@@ -15,8 +15,9 @@ from tqdm.auto import tqdm
 from analysis.classify.chance import null_p_value, permuted_roles
 from analysis.classify.classifiers import CLASSIFIERS
 from analysis.classify.labels import make_labels
-from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, folds, pair_cells
+from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, pair_cells
 from analysis.classify.preprocessing import ESTIMATED, PREPROCESSING, preprocessing_steps
+from analysis.evaluate import LeavePairOut
 from faultgen import children
 from faultgen.checks import is_whole
 
@@ -25,7 +26,8 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
              classifiers: Iterable[str] | Mapping[str, object] = tuple(CLASSIFIERS),
              preprocessing: Iterable[str] | None = None, *, estimated=None, n_pairs: int | None = None,
              random_state: int | None = 0, label_rule=None, matched: bool = False, n_jobs: int | None = None,
-             permutations: int = 0, return_aucs: bool = False, progress: bool = False):
+             permutations: int = 0, null_of: Iterable[str] | None = None, return_aucs: bool = False,
+             progress: bool = False):
     """Mean and standard deviation of leave-pair-out AUC per combination and classifier, Table 5.2.
 
     Every combination and classifier is scored by :func:`leave_pair_out_auc` on the same pairs.
@@ -51,6 +53,9 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
         sets with the runs' roles exchanged (:func:`permuted_roles`, the same sets for every
         cell), reported as their mean (column ``"null"``) and the permutation p-value of the
         observed mean (``"p"``, :func:`null_p_value`). Costs ``K`` times the table.
+    null_of : iterable of str or None, default=None
+        With ``permutations``, the classifiers (columns) whose cells get a chance level; the
+        others' ``"null"`` and ``"p"`` are NaN and they have no ``null_values``. None: every one.
     return_aucs : bool, default=False
         Also return ``{(classifier, preprocessing): ndarray of AUCs}``, the input of
         :func:`compare_preprocessing`.
@@ -72,7 +77,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     ValueError
         As :func:`leave_pair_out_auc`; for an unknown classifier or combination; for ``+estM``
         without ``estimated``, or ``estimated`` with other rows than ``X``; for ``permutations``
-        not an integer >= 0.
+        not an integer >= 0; for a ``null_of`` name that is not a classifier column.
     """
     X, y, groups, failed, normal = check_inputs(X, y, groups, failed_groups, normal_groups)
     if not is_whole(permutations, 0):
@@ -80,26 +85,62 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     estimated = _estimated(estimated, X)
     names = _names(preprocessing, estimated)
     models = _models(classifiers)
+    judged = _null_of(null_of, models)
     labels = make_labels(y, groups, failed, label_rule)
-    X_est = np.hstack([X, estimated]) if estimated is not None else None
     roles = permuted_roles(labels, groups, failed, normal, permutations, random_state) if permutations else []
-
-    # one job per (label set, held-out pair): every cell of the pair, each preprocessing computed once
     label_sets = [(labels, failed, normal), *roles]
-    jobs = [(k, fold) for k, (_, f, n) in enumerate(label_sets) for fold in folds(f, n, groups, n_pairs, random_state)]
-    run = delayed(pair_cells)
-    tasks = (run(X, X_est, label_sets[k][0], groups, fold, names, models, random_state, matched) for k, fold in jobs)
+    jobs = [(k, pair) for k, (_, f, n) in enumerate(label_sets)
+            for pair in LeavePairOut(f, n, n_pairs, random_state).pairs()]
+    tasks = _tasks(X, estimated, groups, label_sets, jobs, names, models, judged, random_state, matched)
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
     # joblib's workers limit theirs alike
     # loky's workers and trackers start in this folder: no joblib.py of it on their path
     with threadpool_limits(limits=1), children.safe_path():
-        results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(tasks)
-        per_job = np.array(list(tqdm(results, total=len(jobs), desc="classify", unit="pair", disable=not progress)))
-    per_job = per_job.reshape(len(jobs), len(names) * len(models))
-    aucs, null = _cells(per_job, [k for k, _ in jobs], names, models, len(label_sets))
+        results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(
+            delayed(pair_cells)(*args) for _, args in tasks)
+        per_task = list(tqdm(results, total=len(tasks), desc="classify", unit="pair", disable=not progress))
+    per_job = np.full((len(jobs), len(names) * len(models)), np.nan)
+    for (members, _), found in zip(tasks, per_task, strict=True):
+        per_job[members] = found
+    aucs, null = _cells(per_job, [k for k, _ in jobs], names, models, judged, len(label_sets))
     table = _table(aucs, null, names, models, permutations)
     return (table, aucs) if return_aucs else table
+
+
+def _null_of(null_of: Iterable[str] | None, models: dict) -> list[str]:
+    """The columns whose cells get a chance level: ``null_of``, or every one of ``models``.
+
+    Raises
+    ------
+    ValueError
+        For a name that is not a column.
+    """
+    judged = list(models) if null_of is None else list(null_of)
+    for column in judged:
+        if column not in models:
+            raise ValueError(f"null_of names {column!r}, not a classifier here; expected some of: {', '.join(models)}")
+    return judged
+
+
+def _tasks(X, estimated, groups, label_sets: list, jobs: list, names: list[str], models: dict, judged: list[str],
+           random_state, matched: bool) -> list[tuple[list[int], tuple]]:
+    """One task per held-out pair of runs, whatever the label set (the same training runs, so the
+    same preprocessing): (the indices of its ``jobs``, the arguments of :func:`pair_cells`), in the
+    order of each pair's first job. A task ships the features only once, and the estimated block
+    only where a name needs it (:func:`pair_cells` appends it)."""
+    by_pair: dict[frozenset, list[int]] = {}
+    for j, (_, pair) in enumerate(jobs):
+        by_pair.setdefault(frozenset(pair), []).append(j)
+    columns = [list(models), *[judged] * (len(label_sets) - 1)]  # the true labels: every cell
+    features = X if any(not n.startswith(ESTIMATED) for n in names) else None
+    extra = estimated if any(n.startswith(ESTIMATED) for n in names) else None
+    tasks = []
+    for members in by_pair.values():
+        sets = [(label_sets[jobs[j][0]][0], jobs[j][1], columns[jobs[j][0]]) for j in members]
+        tasks.append((members, (features, extra, groups, jobs[members[0]][1], sets, names, models, random_state,
+                                matched)))
+    return tasks
 
 
 def _estimated(estimated, X: np.ndarray) -> np.ndarray | None:
@@ -158,11 +199,11 @@ def _models(classifiers: Iterable[str] | Mapping[str, object]) -> dict[str, obje
     return models
 
 
-def _cells(per_job: np.ndarray, set_of: list[int], names: list[str], models: dict,
+def _cells(per_job: np.ndarray, set_of: list[int], names: list[str], models: dict, judged: list[str],
            n_sets: int) -> tuple[dict, dict]:
     """(``(classifier, preprocessing)`` -> the AUCs of the true labels' pairs, -> the mean AUC on each
-    exchanged label set) from ``per_job`` (n_jobs, cells), each job's label set in ``set_of`` (0: the
-    true labels); an UndefinedAUCWarning where pairs have no AUC."""
+    exchanged label set, for the ``judged`` classifiers) from ``per_job`` (n_jobs, cells), each job's
+    label set in ``set_of`` (0: the true labels); an UndefinedAUCWarning where pairs have no AUC."""
     set_of = np.array(set_of)
     cells = [(name, column) for name in names for column in models]
     aucs: dict[tuple[str, str], np.ndarray] = {}
@@ -171,7 +212,8 @@ def _cells(per_job: np.ndarray, set_of: list[int], names: list[str], models: dic
         warnings.filterwarnings("ignore", "Mean of empty slice", RuntimeWarning)  # a permutation without AUC
         for c, (name, column) in enumerate(cells):
             aucs[column, name] = per_job[set_of == 0, c]
-            null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, n_sets)])
+            if column in judged:
+                null[column, name] = np.array([np.nanmean(per_job[set_of == k, c]) for k in range(1, n_sets)])
     n_nan = {int(np.isnan(a).sum()) for a in aucs.values()}
     if n_nan - {0}:
         warnings.warn(f"up to {max(n_nan)} held-out pairs per cell have no AUC (one class only); they are "
@@ -188,7 +230,7 @@ def _table(aucs: dict, null: dict, names: list[str], models: dict, permutations:
         valid = a[~np.isnan(a)]
         table.loc[name, (column, "mean")] = valid.mean() if valid.size else np.nan
         table.loc[name, (column, "std")] = valid.std(ddof=1) if valid.size > 1 else np.nan
-        if permutations:
+        if permutations and (column, name) in null:
             table.loc[name, (column, "null")] = np.nanmean(null[column, name])
             table.loc[name, (column, "p")] = null_p_value(table.loc[name, (column, "mean")], null[column, name])
     if permutations:  # each cell's mean AUC per exchanged label set: what its p-value counts against

@@ -103,32 +103,59 @@ def _scores(model, data: Data, train: np.ndarray, test: np.ndarray, name: str) -
     return found.scores[test]
 
 
-def pair_cells(X, X_est, labels, groups, fold, names, models, random_state, matched) -> np.ndarray:
-    """AUCs of one held-out pair for every (preprocessing, classifier) cell, in ``product(names,
-    models)`` order: each preprocessing fitted once on the training runs, then every classifier on
-    its output. The same numbers as :func:`_pair_auc` on each cell's whole pipeline. ``fold``: the
-    pair and its (train, test) rows, as :func:`folds` gives them."""
-    pair, train, held = _fold(groups, fold)
-    test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
-    truth = labels[held][test]
-    out = np.full(len(names) * len(models), np.nan)
-    if np.unique(labels[train]).size < 2 or np.unique(truth).size < 2:
+def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random_state, matched) -> np.ndarray:
+    """AUCs of one held-out pair of runs for every (preprocessing, classifier) cell under each of
+    ``label_sets``, in ``product(names, models)`` order: each preprocessing fitted once on the
+    training runs (its steps learn no labels: the same for every label set), then every classifier
+    a label set asks for on its output, through the harness. The same numbers as :func:`_pair_auc`
+    on each cell's whole pipeline.
+
+    Parameters
+    ----------
+    X : ndarray of shape (n_samples, n_features) or None
+        None when every name starts with ``+estM``.
+    estimated : ndarray of shape (n_samples, n_estimated) or None
+        Appended to ``X`` for the ``+estM`` names (None when there are none).
+    groups : ndarray of shape (n_samples,)
+    held_out : (run, run)
+        The pair held out (:class:`analysis.evaluate.LeavePairOut`: the model learns every other run).
+    label_sets : list of (labels, (failed, normal), classifiers)
+        The labels of each set, its pair in that order (the failed run's failed samples for
+        ``matched``) and the columns of ``models`` to fit on them.
+
+    Returns
+    -------
+    ndarray of shape (len(label_sets), len(names) * len(models))
+        NaN for a cell not asked for, and for every cell of a label set whose pair or training runs
+        have one class only.
+    """
+    train, test_rows = next(LeavePairOut([held_out[0]], [held_out[1]]).split(groups=groups))
+    held = np.zeros(len(groups), dtype=bool)
+    held[test_rows] = True
+    out = np.full((len(label_sets), len(names) * len(models)), np.nan)
+    scored = []  # (index, labels, rows compared, truth, classifiers) of the sets with both classes
+    for i, (labels, pair, columns) in enumerate(label_sets):
+        test = matched_rows(labels, groups, pair)[held] if matched else slice(None)
+        truth = labels[held][test]
+        if np.unique(labels[train]).size == 2 and np.unique(truth).size == 2:
+            scored.append((i, labels, test, truth, set(columns)))
+    if not scored:
         return out
-    k = 0
-    for name in names:
+    X_est = None if estimated is None else (estimated if X is None else np.hstack([X, estimated]))
+    for r, name in enumerate(names):
         data = X_est if name.startswith(ESTIMATED) else X
         steps = [step for _, step in preprocessing_steps(name)]
-        X_train = run_steps(steps, data[train], groups[train], labels[train], fit=True)
+        X_train = run_steps(steps, data[train], groups[train], fit=True)
         X_test = run_steps(steps, data[held], groups[held])
-        # the preprocessed rows, train then held out, one fold given: every classifier through the harness
-        stacked = Data(np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]],
-                       np.r_[labels[train], labels[held]])
-        n_train = len(X_train)
-        for column, model in models.items():
-            clf = make_pipeline(model, "control", random_state=random_state)
-            scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(stacked.X)), f"{column} {name}")
-            out[k] = roc_auc_score(truth, scores[test])
-            k += 1
+        rows, run_of, n_train = np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]], len(X_train)
+        for i, labels, test, truth, columns in scored:
+            # the preprocessed rows, train then held out, one fold given: each classifier through the harness
+            stacked = Data(rows, run_of, np.r_[labels[train], labels[held]])
+            for c, (column, model) in enumerate(models.items()):
+                if column in columns:
+                    clf = make_pipeline(model, "control", random_state=random_state)
+                    scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(rows)), f"{column} {name}")
+                    out[i, r * len(models) + c] = roc_auc_score(truth, scores[test])
     return out
 
 

@@ -1,0 +1,66 @@
+"""`faultgen classify`'s evaluation does the work its protocol needs and no more (issue 89): model fits
+per cell, PCA fits and stateless steps per held-out pair, tasks and the bytes each ships, counted by
+benchmarks/bench_classify.py's `counted_work` at a tiny size (counts, not times)."""
+
+import importlib.util
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from analysis.classify import evaluation
+
+ROWS = ["control", "+estM+diff+var3+pca"]
+
+
+def _bench():
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_classify.py"
+    spec = importlib.util.spec_from_file_location("bench_classify", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def seeds3(shared_sweep):
+    """9 runs (3 seeds; no wear, axis 2 or 5 worn by 20 %), 6 cycles each, no signals."""
+    return shared_sweep("verdict-seeds", robots=["irb6700"], tasks=["pick_place"], axes=[0, 2, 5], cycles=6,
+                        seeds=[0, 1, 2], signals=False)
+
+
+def _counted(path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return _bench().counted_work(path, n_pairs=1, chance=True, preprocessing=ROWS)
+
+
+def test_fits_tasks_and_bytes_are_what_the_protocol_needs(seeds3):
+    found = _counted(seeds3)
+    table = found["table"]
+    assert list(table.index) == ROWS and table.attrs["chance_source"] == "lr"
+    assert set(found["fits"]) == {"lr", "svm", "rf", "stacking", "pca", "sequence", "tasks"}
+    # 1 pair: each classifier once on the true labels, lr also on each of the 19 exchanged sets
+    assert found["needed"]["svm"] == found["needed"]["rf"] == found["needed"]["stacking"] == 1
+    assert 1 < found["needed"]["lr"] <= 20
+    assert found["fits"] == found["needed"]
+    # one task per held-out pair of runs: 6 worn x 3 unworn runs make 18 pairs, fewer than the 20 label sets
+    assert found["needed"]["tasks"] <= 18
+    assert 0 < found["bytes"] <= found["bytes_needed"]
+    assert np.isfinite(table.loc["control", ("lr", "p")])
+
+
+def test_a_task_per_label_set_and_pair_shipping_more_is_caught(seeds3, monkeypatch):
+    """As before issue 89: one task per (label set, pair), the preprocessing fitted again for every
+    label set that holds out the same runs, and each task shipping a second copy of the features (the
+    old tasks shipped them twice, with the estimated block): the counts say more than the protocol needs."""
+    tasks, cells = evaluation._tasks, evaluation.pair_cells
+    monkeypatch.setattr(evaluation, "pair_cells", lambda *args: cells(*args[:-1]))
+    monkeypatch.setattr(evaluation, "_tasks", lambda X, *args: [([j], (*task[:4], [task[4][i]], *task[5:], X.copy()))
+                                                                for members, task in tasks(X, *args)
+                                                                for i, j in enumerate(members)])
+    found = _counted(seeds3)
+    assert found["fits"]["tasks"] > found["needed"]["tasks"]
+    assert found["fits"]["pca"] > found["needed"]["pca"] and found["fits"]["sequence"] > found["needed"]["sequence"]
+    assert all(found["fits"][c] == found["needed"][c] for c in ("lr", "svm", "rf", "stacking"))
+    assert found["bytes"] > found["bytes_needed"]
