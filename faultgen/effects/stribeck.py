@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import minimize
 
 from faultgen.effects.base import REST_SPEED, register
 from faultgen.effects.motor_friction import FrictionParameter
@@ -152,6 +151,8 @@ class Stribeck(FrictionParameter):
                        key=lambda h: sse(*h))
         else:
             best = start
+        from scipy.optimize import minimize  # a fit's, not a simulation's: scipy.optimize kept out of a run's import
+
         found = minimize(refined, [np.log(best[0]), best[1]], method="Nelder-Mead",
                          options={"xatol": 1e-3, "fatol": 1e-9 * yy, "maxiter": 200})
         if found.fun < min(OUTSIDE, sse(*best)):

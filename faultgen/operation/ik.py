@@ -11,10 +11,8 @@ from __future__ import annotations
 
 import itertools
 
-import mink
 import mujoco
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from faultgen.model.robots import Robot
 
@@ -105,6 +103,8 @@ class FlangeIK:
     """
 
     def __init__(self, robot: Robot, posture: np.ndarray) -> None:
+        import mink  # qpsolvers and scipy: for a Cartesian path's planning, not a run's import
+
         self.model = arm_model(robot)
         self.configuration = mink.Configuration(self.model, np.asarray(posture, float))
         self.frame = mink.FrameTask(FLANGE, "site", position_cost=1.0, orientation_cost=1.0, lm_damping=1.0)
@@ -144,6 +144,8 @@ class FlangeIK:
             If the iteration does not reach the tolerances (target out of reach or past a
             joint limit); the message gives the remaining position and orientation error.
         """
+        import mink
+
         target = mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rotation), position)
         self.frame.set_target(target)
         config = self.configuration
@@ -167,6 +169,8 @@ class FlangeIK:
         joint ranges, in any orientation: the iteration of :meth:`solve` on the position alone, from
         ``q_init``, the range centres and ``starts`` angles drawn uniformly within the ranges (a fixed
         seed), the smallest of the local minima (a joint limit can stop one start short)."""
+        import mink
+
         frame = mink.FrameTask(FLANGE, "site", position_cost=1.0, orientation_cost=0.0, lm_damping=1.0)
         target = np.asarray(position, float)
         frame.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.identity(), target))
@@ -231,6 +235,8 @@ class FlangeIK:
         finally:
             if redundant:
                 self.posture.set_target(self._posture)
+        from scipy.interpolate import CubicSpline  # imports scipy.optimize: not at a run's import
+
         spline = CubicSpline(knots, np.array(solutions), bc_type="clamped", axis=0)
         q, qd, qdd = spline(t), spline(t, 1), spline(t, 2)
         q[0], q[-1] = solutions[0], solutions[-1]

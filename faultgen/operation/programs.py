@@ -52,11 +52,11 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from faultgen import inputs
-from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.model.robots import Robot
 from faultgen.operation.ik import tool_rotation
@@ -101,6 +101,10 @@ from faultgen.operation.tasks import (  # noqa: F401
     kind,
 )
 
+if TYPE_CHECKING:  # the log reader imports pandas and scipy.signal: only a log task needs it
+    from faultgen.logs import formats
+
+
 class ProgramBoundError(ProgramError, inputs.InputError):
     """A program refused before it is checked or planned, by a bound on its size (:data:`MAX_SEGMENTS`):
     a :class:`ProgramError` and a :class:`faultgen.inputs.InputError`."""
@@ -118,13 +122,16 @@ def is_given_task(task) -> bool:
     return kind(task) not in (THESIS, None)
 
 
-def log_task(task: str, adapter: formats.LogFormat = formats.MEASURED) -> str | LogTask:
+def log_task(task: str, adapter: formats.LogFormat | None = None) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
-    :class:`faultgen.logs.formats.LogFormat`): a :class:`LogTask`; ``task`` itself in the registry's
-    default format (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program or a thesis
-    task, recorded as named). ValueError when another format is given with a thesis task or a
-    program file (a format reads a joint log)."""
-    if adapter.name == formats.DEFAULT:
+    :class:`faultgen.logs.formats.LogFormat`; None: :data:`faultgen.logs.formats.MEASURED`): a
+    :class:`LogTask`; ``task`` itself in the registry's default format
+    (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program or a thesis task, recorded as
+    named). ValueError when another format is given with a thesis task or a program file (a format
+    reads a joint log)."""
+    from faultgen.logs import formats
+
+    if adapter is None or adapter.name == formats.DEFAULT:
         return task
     if kind(task) in (THESIS, *PROGRAM_KINDS):
         what = "a thesis task" if kind(task) == THESIS else "a program file"
@@ -195,6 +202,7 @@ def load(robot: Robot, task: str) -> Task:
         return read(task, robot)
     # only a replayed log needs the log reader (pandas, h5py, scipy.signal: about 1 s to import,
     # which a thesis task or program would spend before its first physics step for nothing)
+    from faultgen.logs import formats
     from faultgen.operation import replay
 
     if found == MOTION:
