@@ -64,15 +64,7 @@ from faultgen.operation.ik import tool_rotation
 # re-exported: the names callers (replay, the simulation's preparation) know programs by
 from faultgen.operation.planner import GRIP_BODY, TORQUE_CAPACITY, Planner, Segment, add_part, check_torque  # noqa: F401
 from faultgen.operation.program_format import (
-    BUILTIN_KEYS,
-    LIMIT_BOUNDS,
-    LIMIT_KEYS,
-    MAX_SEGMENTS,
-    PROGRAM_PROCESSES,
-    SEGMENT_KEYS,
-    TOOL_KEYS,
-    TOP_KEYS,
-    dumps,
+    BUILTIN_KEYS, LIMIT_BOUNDS, LIMIT_KEYS, MAX_SEGMENTS, PROGRAM_PROCESSES, SEGMENT_KEYS, TOOL_KEYS, TOP_KEYS, dumps,
 )
 from faultgen.operation.tables import Table
 from faultgen.operation.tasks import (  # noqa: F401
@@ -101,7 +93,7 @@ from faultgen.operation.tasks import (  # noqa: F401
     kind,
 )
 
-if TYPE_CHECKING:  # the log reader imports pandas and scipy.signal: only a log task needs it
+if TYPE_CHECKING:
     from faultgen.logs import formats
 
 
@@ -124,12 +116,11 @@ def is_given_task(task) -> bool:
 
 def log_task(task: str, adapter: formats.LogFormat | None = None) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
-    :class:`faultgen.logs.formats.LogFormat`; None: :data:`faultgen.logs.formats.MEASURED`): a
-    :class:`LogTask`; ``task`` itself in the registry's default format
-    (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program or a thesis task, recorded as
-    named). ValueError when another format is given with a thesis task or a program file (a format
-    reads a joint log)."""
-    from faultgen.logs import formats
+    :class:`faultgen.logs.formats.LogFormat`, None: measured): a :class:`LogTask`; ``task`` itself in
+    the registry's default format (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program
+    or a thesis task, recorded as named). ValueError when another format is given with a thesis task
+    or a program file (a format reads a joint log)."""
+    from faultgen.logs import formats  # the log reader (pandas, scipy.signal): for a log task only
 
     if adapter is None or adapter.name == formats.DEFAULT:
         return task
