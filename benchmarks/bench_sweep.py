@@ -1,6 +1,6 @@
 """Sweep throughput, its ratio to MuJoCo's C stepping, parallel efficiency, HDF5 share, memory.
 
-    python benchmarks/bench_sweep.py [--cycles 20] [--axes 4] [--j2]
+    python benchmarks/bench_sweep.py [--cycles 20] [--axes 4] [--j2] [--no-larger]
 
 In one run of this script, on a grid of IRB-6700-like pick-and-place runs (no wear and worn
 axes 1.., two seeds, every cycle recorded):
@@ -13,9 +13,11 @@ axes 1.., two seeds, every cycle recorded):
   CPU(2 jobs) bounds the efficiency on 2 idle cores from above (at best the two cores are busy all
   through t(2 jobs); 1 job runs in this process, on one core), and the difference is what the
   2 jobs do more: the workers' start-up (their imports, the robot's compile) and the merge;
+- a worker's start: the CPU time of a fresh ``python -P -c "import faultgen.runs.worker"`` (median
+  of 3) against ``python -P -c pass``, the fixed cost each worker of the 2 jobs adds;
 - HDF5 share: time writing part files plus the final merge, over the workers' busy time;
 - peak memory (RSS of this process and its workers) for the grid and for a grid three times
-  larger: it must not grow with the number of runs;
+  larger: it must not grow with the number of runs (--no-larger: not run);
 - with --j2: wall time of the j2 preset on 2 jobs (thesis ch. 6: 21 runs x 100 cycles).
 
 The last line is ``ratio <float>``: sweep wall time on 1 job over the C limit (goal <= 1.25).
@@ -25,13 +27,17 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
+import statistics
+import subprocess
 import tempfile
 import time
 from pathlib import Path
 
 from benchmarks_common import PeakRSS, same_work_seconds  # sibling module
 
+from faultgen import children
 from faultgen.runs import sweep
 from faultgen.runs.context import ExecutionContext
 
@@ -53,6 +59,17 @@ def tree_cpu() -> float:
     return total
 
 
+def import_cpu(code: str, repeat: int = 3) -> float:
+    """Median CPU seconds (user + system) of a fresh ``python -P -c CODE``."""
+    times = []
+    for _ in range(repeat):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run(children.command("-c", code), env=children.environment(), check=True)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        times.append(after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return statistics.median(times)
+
+
 def timed_sweep(grid: sweep.Grid, jobs: int, folder: Path) -> dict:
     stats, timings = [], {}
     with PeakRSS() as memory:
@@ -70,6 +87,7 @@ def main() -> None:
     parser.add_argument("--cycles", type=int, default=20, help="cycles per run, all recorded")
     parser.add_argument("--axes", type=int, default=4, help="no wear + worn axes 1..AXES-1 (2..7), x 2 seeds")
     parser.add_argument("--j2", action="store_true", help="also time the j2 preset on 2 jobs")
+    parser.add_argument("--no-larger", action="store_true", help="leave out the memory check's larger grid")
     args = parser.parse_args()
     # equal runs, an even number of them: the fair test of 2 jobs; the larger grid has three times
     # as many runs of the same size, so only the number of runs changes
@@ -80,7 +98,8 @@ def main() -> None:
     try:
         one = timed_sweep(grid, 1, folder)
         two = timed_sweep(grid, 2, folder)
-        larger = timed_sweep(big, 2, folder)
+        larger = None if args.no_larger else timed_sweep(big, 2, folder)
+        start, bare = import_cpu("import faultgen.runs.worker"), import_cpu("pass")
         limit = sum(same_work_seconds(config) for _, config in grid.runs())
         simulated = sum(s.simulated for s in one["stats"])
         busy = sum(s.total for s in one["stats"])
@@ -95,9 +114,11 @@ def main() -> None:
         print(f"CPU (process and workers): 1 job {one['cpu']:.2f} s, 2 jobs {two['cpu']:.2f} s "
               f"(+{two['cpu'] - one['cpu']:.2f} s: workers' start-up, merge); efficiency bound on 2 idle cores "
               f"{one['cpu'] / two['cpu']:.3f}; load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+        print(f"a worker's start: import faultgen.runs.worker {start:.2f} s CPU (median of 3; python -c pass "
+              f"{bare:.2f} s)")
         print(f"HDF5 share of busy time (1 job): {writing / (busy + one['merge']):.3f}")
-        print(f"peak memory, 2 jobs: {two['peak'] / 1e6:.0f} MB for {len(grid.runs())} runs, "
-              f"{larger['peak'] / 1e6:.0f} MB for {len(big.runs())} runs")
+        print(f"peak memory, 2 jobs: {two['peak'] / 1e6:.0f} MB for {len(grid.runs())} runs"
+              + ("" if larger is None else f", {larger['peak'] / 1e6:.0f} MB for {len(big.runs())} runs"))
         if args.j2:
             started = time.perf_counter()
             sweep.run(sweep.Grid.from_preset("j2"), folder / "j2.h5", ExecutionContext(2), progress=True)
