@@ -53,15 +53,17 @@ def test_the_reader_divides_a_motor_side_speed_column_by_the_gear_ratio_and_says
     frame = pd.read_csv(joint)
     frame["qd4"] = np.rad2deg(frame["qd4"])
     frame.to_csv(tmp_path / "deg.csv", index=False)
-    with pytest.raises(measured.MeasuredDataError, match=r"column qd4 looks like deg/s \(it is 57\.\d+ times"):
+    deg_per_s = r"column qd4 looks like deg/s \(it is 57\.\d+ times"
+    with pytest.raises(measured.MeasuredDataError, match=deg_per_s):
         measured.read(tmp_path / "deg.csv", puma)
 
 
 def test_a_ratio_that_is_deg_per_s_and_a_gear_ratio_alike_is_refused_and_a_slow_axis_not_judged():
     ratio = np.array([57.0, 57.0, 100.0])
     power, cross = np.array([1.0, 1.0, 1e-9]), np.array([57.3, 1.0, 100e-9])
-    with pytest.raises(measured.MeasuredDataError, match=r"x\.csv: column qd1 is 57\.3 times the derivative of "
-                                                         r"q1: deg/s or the motor's speed \(axis 1's gear ratio 57\)"):
+    both = (r"x\.csv: column qd1 is 57\.3 times the derivative of q1: deg/s or the motor's speed "
+            r"\(axis 1's gear ratio 57\)")
+    with pytest.raises(measured.MeasuredDataError, match=both):
         measured.velocity_verdicts(Path("x.csv"), power, cross, 1, ratio)
     power[0], cross[0] = 1.0, 1.0
     assert measured.velocity_verdicts(Path("x.csv"), power, cross, 1, ratio) == []  # axis 3 too slow to judge
@@ -74,23 +76,25 @@ def _rows(path: Path) -> dict[str, list[dict]]:
     return {unit: [r for r in rows if r["unit"] == unit] for unit in {r["unit"] for r in rows}}
 
 
-def test_a_fleet_logged_motor_side_consumes_what_the_joint_side_fleet_does_and_says_it_converted(tmp_path, puma):
+def test_a_fleet_logged_motor_side_consumes_what_the_joint_side_fleet_does_and_says_so(tmp_path, puma):
     logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=1, days=4)
     for log in sorted((logs / "u1").iterdir()):
         _motor_side(log, logs / "m1" / log.name, puma)
     out = tmp_path / "out"
-    result = runner.invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(out), "--protocol", "own",
-                                 "--train", "10", "--persistence", "2"])
+    result = runner.invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(out),
+                                 "--protocol", "own", "--train", "10", "--persistence", "2"])
     assert result.exit_code == 0, result.output
     life = _rows(out / "life.csv")
     assert [r["axis"] for r in life["m1"]] == [str(k) for k in range(1, 7)]
     for joint, motor in zip(life["u1"], life["m1"]):
         assert float(joint["consumed_pct"]) > 0
         for column in ("consumed_pct", "duty_pct_per_day"):
-            assert float(motor[column]) == pytest.approx(float(joint[column]), rel=1e-6), (column, motor["axis"])
+            same = pytest.approx(float(joint[column]), rel=1e-6)
+            assert float(motor[column]) == same, (column, joint["axis"])
         k = motor["axis"]
-        assert (f"speeds joint side: column qd{k} logged motor-side from log 2026-03-01 on, divided by the gear "
-                f"ratio before its load was counted (the reader: column qd{k} is motor-side: ") in motor["verdict"]
+        said = (f"speeds joint side: column qd{k} logged motor-side from log 2026-03-01 on, divided by the "
+                f"gear ratio before its load was counted (the reader: column qd{k} is motor-side: ")
+        assert said in motor["verdict"], motor["verdict"]
         assert "motor-side" not in joint["verdict"] and "the reader" not in joint["verdict"]
     units = _rows(out / "units.csv")
     reason = units["m1"][0]["reason"]

@@ -480,12 +480,13 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
         degrees = 40.0 <= slope <= 80.0
         if motor[k] and abs(slope / DEG_PER_RAD - 1.0) <= MOTOR_SIDE_TOLERANCE:
             raise MeasuredDataError(
-                f"{where}: column {name} is {slope:.4g} times the derivative of {q_columns[k]}: deg/s or the motor's "
-                f"speed (axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}) alike; expected rad/s at the joint")
+                f"{where}: column {name} is {slope:.4g} times the derivative of {q_columns[k]}: deg/s or "
+                f"the motor's speed (axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}) alike; expected rad/s at "
+                "the joint")
         if motor[k]:
             notes.append(
-                f"column {name} {MOTOR_SIDE}: {slope:.4g} times the derivative of {q_columns[k]}, axis {k + 1}'s gear "
-                f"ratio {gear_ratio[k]:.4g}; divided by it to the joint side (rad/s)")
+                f"column {name} {MOTOR_SIDE}: {slope:.4g} times the derivative of {q_columns[k]}, "
+                f"axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}; divided by it to the joint side (rad/s)")
             continue
         if degrees:
             raise MeasuredDataError(

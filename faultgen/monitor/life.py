@@ -253,8 +253,8 @@ def column_notes(notes, axis: int) -> str:
             continue
         stamp, said = found.groups()
         if measured.MOTOR_SIDE in said:
-            out.append(f"speeds joint side: column qd{axis} logged motor-side from log {stamp} on, divided by the "
-                       f"gear ratio before its load was counted (the reader: {said})")
+            out.append(f"speeds joint side: column qd{axis} logged motor-side from log {stamp} on, divided "
+                       f"by the gear ratio before its load was counted (the reader: {said})")
         else:
             out.append(f"the reader of log {stamp}: {said}; the load counted as logged")
     return "".join(f"; {text}" for text in out)
