@@ -117,7 +117,9 @@ def read(path: str | Path, robot: robots.Robot, rows: int, rest_speed: float,
         notes.append(f"qd and qdd estimated from q: {filt}")
     else:
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
-        notes.extend(measured.velocity_verdicts(path, sums.power, sums.cross, sums.size))
+        notes.extend(measured.velocity_verdicts(path, sums.power, sums.cross, sums.size, robot.gear_ratio))
+        sides = measured.speed_sides(sums.power, sums.cross, sums.size, robot.gear_ratio)
+        out["qd"], sums.peak = out["qd"] / sides, sums.peak / sides  # a motor-side column to the joint side
     notes.extend(measured.torque_notes(kept[:, [index[c] for c in tau_names]], robot))
     notes.append(decimation_note(n, k, m, rows))
     data = measured.MeasuredData(t=out["t"], q=out["q"], qd=out["qd"], qdd=out["qdd"], tau=out["tau"],

@@ -57,11 +57,19 @@ interpolated back onto the original sample times with a cubic spline. Applying t
 coefficients to jittered samples instead would bias the derivatives in proportion to the
 timing error. Given ``qd`` columns are used as they are (not filtered); ``qdd`` is always
 taken from ``q``. Torque is used as it is.
+
+Given ``qd`` columns are checked against the derivative of ``q`` (their least-squares ratio over the
+log, :func:`velocity_verdicts`): about 57.3 (deg/s) is refused; about the axis's gear ratio G
+(within :data:`MOTOR_SIDE_TOLERANCE`) is the motor's speed, a controller's motor-side export: the
+column is divided by G to the joint side and the note says so (``column qdK is motor-side: ...``,
+:func:`motor_side_speeds`); a ratio that could be either is refused; any other ratio outside
+0.8..1.25 is noted ("check its sign and unit") and used as it is.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -345,7 +353,9 @@ def _build(
     else:
         qd = np.column_stack([columns[c] for c in qd_columns])
         notes.append(f"qd from the file; qdd estimated from q: {filt}")
-        notes.extend(_check_velocities(where, qd, qd_est, window))
+        verdicts, sides = _check_velocities(where, qd, qd_est, window, robot.gear_ratio)
+        notes.extend(verdicts)
+        qd = qd / sides  # a motor-side column to the joint side
     notes.extend(torque_notes(tau, robot))
     temperature = (np.column_stack([columns[c] for c in temperature_columns(robot.n_axes)])
                    if temperature_columns(robot.n_axes)[0] in columns else None)
@@ -404,24 +414,81 @@ def velocity_rows(n: int, window: int) -> slice:
     return slice(window, n - window) if n > 4 * window else slice(None)
 
 
-def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: int) -> list[str]:
-    """Refuse qd columns in deg/s; note columns that disagree with the derivative of q."""
+def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: int,
+                      gear_ratio: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Refuse qd columns in deg/s; note columns that disagree with the derivative of q; find the
+    motor-side ones (:func:`velocity_verdicts`)."""
     inner = velocity_rows(qd.shape[0], window)
     given, est = qd[inner], qd_est[inner]
-    return velocity_verdicts(where, np.einsum("ij,ij->j", est, est), np.einsum("ij,ij->j", est, given), len(est))
+    power, cross = np.einsum("ij,ij->j", est, est), np.einsum("ij,ij->j", est, given)
+    return (velocity_verdicts(where, power, cross, len(est), gear_ratio),
+            speed_sides(power, cross, len(est), gear_ratio))
 
 
-def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: int) -> list[str]:
+#: How near a ``qd`` column's ratio to the derivative of its ``q`` must come to the axis's gear
+#: ratio G (relative) to be read as the motor's speed, ``G qd`` (:func:`speed_sides`); the ratio is
+#: a least-squares slope over the log, within 1 % of G on a motor-side column of any log the reader
+#: takes (tests/test_life_motor_side.py).
+MOTOR_SIDE_TOLERANCE = 0.05
+#: The ratio of deg/s to rad/s.
+DEG_PER_RAD = 180.0 / np.pi
+#: The words of the note on a ``qd`` column read as motor-side: ``column qdK is motor-side: ...``.
+MOTOR_SIDE = "is motor-side"
+
+
+def _slopes(power: np.ndarray, cross: np.ndarray, size: int) -> np.ndarray:
+    """Per axis the given speed's least-squares ratio to the derivative of q; NaN where the axis
+    moves too little to judge (RMS below 1e-3 rad/s)."""
+    power = np.asarray(power, dtype=float)
+    moving = power / max(size, 1) >= 1e-6
+    return np.where(moving, np.asarray(cross, dtype=float) / np.where(moving, power, 1.0), np.nan)
+
+
+def _motor_side(slopes: np.ndarray, gear_ratio: np.ndarray | None) -> np.ndarray:
+    """Per axis, whether its ``qd`` column is the motor's speed: ``|slope|`` within
+    :data:`MOTOR_SIDE_TOLERANCE` of a gear ratio that is no ratio of the joint's own (0.8..1.25)."""
+    if gear_ratio is None:
+        return np.zeros(len(slopes), dtype=bool)
+    g = np.asarray(gear_ratio, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return (np.abs(np.abs(slopes) / g - 1.0) <= MOTOR_SIDE_TOLERANCE) & ((g < 0.8) | (g > 1.25))
+
+
+def speed_sides(power: np.ndarray, cross: np.ndarray, size: int, gear_ratio: np.ndarray) -> np.ndarray:
+    """What each given ``qd`` column is divided by to be the joint's speed, shape (N,): the axis's
+    gear ratio where the column is the motor's speed (:func:`velocity_verdicts` notes it), else 1.
+    Sums as :func:`velocity_verdicts`."""
+    g = np.asarray(gear_ratio, dtype=float)
+    return np.where(_motor_side(_slopes(power, cross, size), g), g, 1.0)
+
+
+def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: int,
+                      gear_ratio: np.ndarray | None = None) -> list[str]:
     """:func:`_check_velocities` from the sums over its rows: per axis, ``power`` = sum of the
-    estimated speed squared, ``cross`` = sum of estimated times given speed, over ``size`` rows."""
+    estimated speed squared, ``cross`` = sum of estimated times given speed, over ``size`` rows.
+    With the robot's ``gear_ratio`` (N,), a column about G times the derivative of q
+    (:data:`MOTOR_SIDE_TOLERANCE`) is noted motor-side (:data:`MOTOR_SIDE`; the reader divides it by
+    G: :func:`speed_sides`), and one that could be motor-side or deg/s alike is refused."""
     notes = []
     q_columns, qd_columns, _ = column_names(len(power))
+    slopes = _slopes(power, cross, size)
+    motor = _motor_side(slopes, gear_ratio)
     for k, name in enumerate(qd_columns):
-        power_k = float(power[k])
-        if power_k / max(size, 1) < 1e-6:  # RMS below 1e-3 rad/s: too little motion to judge
+        slope = float(slopes[k])
+        if not math.isfinite(slope):  # too little motion to judge
             continue
-        slope = float(cross[k] / power_k)
-        if 40.0 <= slope <= 80.0:
+        degrees = 40.0 <= slope <= 80.0
+        if motor[k] and abs(slope / DEG_PER_RAD - 1.0) <= MOTOR_SIDE_TOLERANCE:
+            raise MeasuredDataError(
+                f"{where}: column {name} is {slope:.4g} times the derivative of {q_columns[k]}: deg/s or "
+                f"the motor's speed (axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}) alike; expected rad/s at "
+                "the joint")
+        if motor[k]:
+            notes.append(
+                f"column {name} {MOTOR_SIDE}: {slope:.4g} times the derivative of {q_columns[k]}, "
+                f"axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}; divided by it to the joint side (rad/s)")
+            continue
+        if degrees:
             raise MeasuredDataError(
                 f"{where}: column {name} looks like deg/s (it is {slope:.4g} times the derivative of "
                 f"{q_columns[k]}); expected rad/s"
@@ -431,6 +498,13 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
                 f"column {name} is {slope:.3g} times the derivative of {q_columns[k]}; check its sign and unit"
             )
     return notes
+
+
+def motor_side_speeds(notes) -> tuple[int, ...]:
+    """The axes (1-based) whose ``qd`` column a log's reader found motor-side and divided by the
+    gear ratio, from its ``notes`` (:data:`MOTOR_SIDE`, as :func:`velocity_verdicts` words it)."""
+    found = (re.match(rf"column qd(\d+) {MOTOR_SIDE}: ", note) for note in notes)
+    return tuple(sorted({int(m.group(1)) for m in found if m}))
 
 
 def torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:

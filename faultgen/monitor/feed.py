@@ -189,6 +189,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
+    unit.notes.extend(fleet_logs.log_notes(log.stamp, reading.notes, unit.notes))  # each column's kind once
     constant = constant_torque(unit, reading.vector, nominal.n_axes)
     if constant:
         return not_monitored(unit, log.stamp, sha256, constant)

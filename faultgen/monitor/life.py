@@ -16,7 +16,12 @@ integrals over a log's samples (trapezoidal, ``numpy.trapezoid``),
 
     consumed = integral (|qd| / n_N) (|tau| / T_N)^p dt / L_n        (:func:`consumption`)
 
-with ``qd`` (rad/s) and ``tau`` (N m) the log's arm-side speed and torque, the gear's output. A
+with ``qd`` (rad/s) and ``tau`` (N m) the log's arm-side speed and torque, the gear's output (a
+``qd`` column logged motor-side, ``G`` times the joint's speed, is divided by the gear ratio ``G``
+by the log's reader, :func:`faultgen.logs.measured.velocity_verdicts`, which notes it: without it
+the consumption would be ``G`` times too high; a unit whose first log's torque is motor-side is not
+monitored, :func:`faultgen.monitor.unit.refuse`). The reader's notes on an axis's columns end its
+verdict (:func:`column_notes`). A
 standing axis consumes nothing (the bearings turn with the output). A unit's state keeps each scored
 log's ``integral |qd| |tau|^p dt`` for both exponents (:func:`load_integrals`), not its share, so
 each run judges the whole history against the ratings the robot's ``drivetrain.toml`` gives now.
@@ -42,6 +47,7 @@ from __future__ import annotations
 
 import html
 import math
+import re
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from functools import lru_cache
@@ -50,6 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.data import cells, logfolder
+from faultgen.logs import measured
 from faultgen.model import rating
 from faultgen.monitor.html_cells import number
 
@@ -191,12 +198,13 @@ def check_hours(hours_per_day: float) -> None:
 
 
 def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOURS_PER_DAY,
-            window: int = WINDOW) -> list[LifeRow]:
+            window: int = WINDOW, notes=()) -> list[LifeRow]:
     """Each axis's row of ``life.csv`` from a unit's scored logs (``entries``: each with ``stamp``,
     ``load`` of :func:`load_integrals` or None, ``duration`` s) and its ``maintenance``
     (``stamp``, ``event``, ``axis``, ``at``: the index of the first entry after it); module
     docstring. An entry without a load record (a state written before it) is left out, counted in
-    the verdict."""
+    the verdict. ``notes``: the unit's notes, whose notes of the log reader on an axis's columns
+    (:func:`faultgen.monitor.logs.log_notes`) end that axis's verdict (:func:`column_notes`)."""
     check_hours(hours_per_day)
     rows = []
     for axis, r in enumerate(ratings, start=1):
@@ -228,7 +236,28 @@ def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOU
         rows.append(LifeRow(unit, axis, r, since, total, duty, left, hours_per_day, len(rates),
                             entries[-1].stamp if entries else "", ""))
         rows[-1].verdict = _verdict(rows[-1], bool(changes), missing, window)
+    for row in rows:
+        row.verdict += column_notes(notes, row.axis)
     return rows
+
+
+def column_notes(notes, axis: int) -> str:
+    """What the log reader said of ``axis``'s speed and torque columns (the unit's ``notes`` of the form
+    ``log STAMP: column qdK ...`` or ``... tauK ...``, :func:`faultgen.monitor.logs.log_notes`), as
+    the end of its verdict: a speed column read motor-side as converted with the gear ratio before
+    the load was counted, any other note as the reader's; "" without one."""
+    out = []
+    for note in notes:
+        found = re.match(rf"log (.+?): (column (?:qd|tau){axis} .*)", note)
+        if not found:
+            continue
+        stamp, said = found.groups()
+        if measured.MOTOR_SIDE in said:
+            out.append(f"speeds joint side: column qd{axis} logged motor-side from log {stamp} on, divided "
+                       f"by the gear ratio before its load was counted (the reader: {said})")
+        else:
+            out.append(f"the reader of log {stamp}: {said}; the load counted as logged")
+    return "".join(f"; {text}" for text in out)
 
 
 def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:

@@ -283,7 +283,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
             # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
             life.write_life(staging / "life.csv", [row for name in units if name in state and state[name].entries
                                                    for row in life.of_unit(
-                name, state[name].entries, state[name].maintenance, ratings, hours_per_day)])
+                name, state[name].entries, state[name].maintenance, ratings, hours_per_day,
+                notes=state[name].notes)])
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
             page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
                        logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
