@@ -141,3 +141,37 @@ def test_a_sparse_step_record_is_no_record_and_the_output_it_claims_is_refused(t
     assert io_bytes()[0] - before[0] < MIB
     (tmp_path / runner.RECORDS / step.record_name).write_text("[" * 200_000)
     assert runner._read_record(step, tmp_path) is None  # a RecursionError traceback before
+
+
+# -- the robot's files read again elsewhere --------------------------------------------------------
+
+
+def test_a_datasets_model_hash_refuses_a_model_swapped_for_a_sparse_file(robot):
+    """``model_sha256`` (every run of a sweep, every import) hashed the MJCF whole after the load."""
+    from faultgen.data import dataset
+    from faultgen.inputs import InputError
+
+    import hashlib
+
+    assert dataset.model_hash(robot.path) == hashlib.sha256(robot.path.read_bytes()).hexdigest()
+    sparse(robot.path, 20 * GIB)
+    before = io_bytes()
+    with address_space(), pytest.raises(InputError, match=rf"{20 * GIB} bytes; a robot MJCF is read up to"):
+        dataset.model_hash(robot.path)
+    assert io_bytes()[0] - before[0] < MIB
+
+
+def test_a_copy_with_another_timestep_reads_the_tasks_file_bounded(robot, tmp_path, monkeypatch):
+    """``with_timestep`` copied the robot's ``tasks.toml`` whole (``shutil.copyfile``): the bound
+    lowered to 1 MiB and the file made 64 MiB sparse, it is refused, nothing copied."""
+    from faultgen import inputs
+
+    made = robots.with_timestep(robot.path, 0.002, tmp_path / "copy")
+    assert (made.parent / "tasks.toml").read_bytes() == (robot.path.parent / "tasks.toml").read_bytes()
+    assert 'timestep="0.002"' in made.read_text()
+    monkeypatch.setattr(inputs, "TOML_MAX_BYTES", MIB)
+    sparse(robot.path.parent / "tasks.toml", 64 * MIB)
+    before = io_bytes()
+    with pytest.raises(robots.ModelError, match=rf"tasks\.toml: {64 * MIB} bytes; a tasks file is read up to {MIB}"):
+        robots.with_timestep(robot.path, 0.002, tmp_path / "again")
+    assert sum(io_bytes()) - sum(before) < MIB
