@@ -29,7 +29,7 @@ import mujoco
 import numpy as np
 
 from faultgen import axes as axis_numbers
-from faultgen.calibrate import criterion, search
+from faultgen.calibrate import criterion, search, trial
 from faultgen.calibrate.effects import get
 from faultgen.logs import measured as measured_io
 from faultgen.model import robots
@@ -170,7 +170,7 @@ def refit(result, data: measured_io.MeasuredData, nominal: robots.Robot,
     nominal = calibrated_from(result, nominal)
     robot = result.model
     model_path = Path(robot.path)
-    base_xml = model_path.read_text()
+    base_xml = trial.file_text(robot)  # read once, bounded, checked to be the file the robot was compiled from
     split = search.Split.of(data.t, data.qd)
     tau = np.asarray(data.tau)
     scale = criterion.rms(tau, split.held_out)

@@ -10,6 +10,7 @@ model the written file loads.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +22,7 @@ from faultgen.calibrate import search
 from faultgen.calibrate.effects import Effect, Motion
 from faultgen.calibrate.prediction import predicted_motion
 from faultgen.logs import measured as measured_io
-from faultgen.model import robots
+from faultgen.model import robots, sources
 
 
 @dataclass(frozen=True)
@@ -46,8 +47,16 @@ class Model:
 
     @classmethod
     def nominal(cls, robot: robots.Robot) -> Model:
-        """The nominal model: ``robot`` as loaded (:func:`faultgen.model.robots.load`) and its file."""
-        return cls(Path(robot.path).read_text(), robot, mujoco.MjSpec.from_file(str(robot.path)).to_xml())
+        """The nominal model: ``robot`` as loaded (:func:`faultgen.model.robots.load`) and its file's
+        text (:func:`file_text`: read once, bounded); the text to edit is the loaded spec's, so the
+        file is not parsed again.
+
+        Raises
+        ------
+        ModelError
+            As :func:`file_text`.
+        """
+        return cls(file_text(robot), robot, robot.new_spec().to_xml())
 
     def spec(self) -> mujoco.MjSpec:
         """A fresh ``MjSpec`` of the model, to edit."""
@@ -63,6 +72,28 @@ class Model:
     def with_effect(self, effect: Effect, axes: list[int] | None, path: Path) -> Model:
         """The model with ``effect`` written on ``axes`` (array indices; :meth:`Effect.write`)."""
         return self.edited(lambda spec, robot: effect.write(spec, robot, axes), path)
+
+
+def file_text(robot: robots.Robot) -> str:
+    """The text of ``robot``'s MJCF file, read once and bounded (a regular file of at most
+    :data:`faultgen.model.sources.MAX_DESCRIPTION_BYTES`, its size checked before the read: a file
+    swapped for a sparse one of 20 GiB since the robot was loaded was read whole), and checked to be
+    the file the robot was compiled from (its SHA-1, :attr:`Robot.digest`, where known).
+
+    Raises
+    ------
+    ModelError
+        Naming the file: not a regular file, above the bound, changed since the robot was loaded,
+        or not UTF-8 text.
+    """
+    path = Path(robot.path)
+    data = sources.read_bytes(path, what="robot MJCF", error=robots.ModelError)
+    if robot.digest is not None and hashlib.sha1(data).hexdigest() != robot.digest:
+        raise robots.ModelError(f"{path}: changed since the robot was read; load it again")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise robots.ModelError(f"{path}: not UTF-8 text at byte {err.start}; a robot MJCF is UTF-8") from None
 
 
 def compiled(spec: mujoco.MjSpec, path: Path) -> Model:

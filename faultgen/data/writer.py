@@ -8,7 +8,6 @@ last, so no half-written file looks finished.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from collections.abc import Iterable
 from dataclasses import asdict
@@ -17,7 +16,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from faultgen import __version__
+from faultgen import __version__, inputs
 from faultgen.data.atomic import hdf5_writer
 from faultgen.data.opening import open_file
 from faultgen.data.schema import (
@@ -38,13 +37,16 @@ from faultgen.data.schema import (
 )
 from faultgen.effects.friction import FIELDS as FRICTION_FIELDS
 from faultgen.effects.friction import UNITS as FRICTION_UNITS
+from faultgen.model import sources
 from faultgen.operation import programs
 from faultgen.simulation import resolve, sensors
 
 
 def model_hash(path: Path) -> str:
-    """SHA-256 of a robot's MJCF file, hex."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    """SHA-256 of a robot's MJCF file, hex, hashed in blocks up to the loader's bound
+    (:func:`faultgen.inputs.sha256_of`: a file swapped for a sparse one since the load is refused on
+    its size, an InputError naming it, not read whole)."""
+    return inputs.sha256_of(path, "robot MJCF", sources.MAX_DESCRIPTION_BYTES)
 
 
 def drivetrain(robot) -> dict:

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import mujoco
 
+from faultgen import inputs
 from faultgen.effects.base import ModelError
 from faultgen.model import drivetrain, limits, mjcf, sources
 from faultgen.model.builder import ArmError
@@ -223,12 +224,13 @@ def with_timestep(name: str | Path, timestep: float, folder: str | Path) -> Path
         raise ValueError(f"timestep = {timestep!r} s; expected a positive step that divides 4 ms")
     source = load(name).path
     text, count = re.subn(r'(<option\b[^>]*\btimestep=")[^"]*(")', rf"\g<1>{timestep!r}\g<2>",
-                          source.read_text(), count=1)
+                          sources.read_text(source, what="robot MJCF", error=ModelError), count=1)  # bounded
     if not count:
         raise ValueError(f"{source}: no <option timestep=\"...\"> to change")
     target = Path(folder) / source.stem
     target.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(source.parent / "tasks.toml", target / "tasks.toml")
+    (target / "tasks.toml").write_bytes(sources.read_bytes(source.parent / "tasks.toml", inputs.TOML_MAX_BYTES,
+                                                           "tasks file", ModelError))  # bounded, not copied whole
     if (source.parent / "meshes").is_dir():  # an added robot's meshes, named relative to its MJCF
         shutil.copytree(source.parent / "meshes", target / "meshes", dirs_exist_ok=True)
     (target / source.name).write_text(text)

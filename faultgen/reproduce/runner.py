@@ -21,7 +21,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from faultgen import children
+from faultgen import children, inputs
 
 
 @dataclass(frozen=True)
@@ -112,6 +112,8 @@ def check_plan(steps: Sequence[Step]) -> None:
 
 #: The folder of the steps' records, in the reproduction's folder.
 RECORDS = ".steps"
+#: Size bound of one step's record (its command, outputs and settings: a few kB), bytes.
+RECORD_MAX_BYTES = 2**20
 
 
 def records(steps: Sequence[Step]) -> dict[str, dict]:
@@ -130,11 +132,14 @@ def _digest(record: dict) -> str:
 
 
 def _read_record(step: Step, folder: Path) -> dict | None:
-    """The record of ``step`` in ``folder``: ``{"record": ..., "state": "running"|"done"}``, or None."""
+    """The record of ``step`` in ``folder``: ``{"record": ..., "state": "running"|"done"}``, or None
+    when there is none or it cannot be read: read through :func:`faultgen.inputs.read_text` (a
+    regular file of at most :data:`RECORD_MAX_BYTES`, its size checked first: a sparse record
+    planted in the folder was read whole)."""
     path = folder / RECORDS / step.record_name
     try:
-        found = json.loads(path.read_text())
-    except (OSError, ValueError):
+        found = json.loads(inputs.read_text(path, "step record", RECORD_MAX_BYTES))
+    except (OSError, ValueError, RecursionError):  # InputError is a ValueError
         return None
     return found if isinstance(found, dict) else None
 

@@ -40,7 +40,7 @@ from typing import Self
 
 from tqdm.auto import tqdm
 
-from faultgen import children
+from faultgen import children, inputs
 from faultgen.data import atomic, dataset
 from faultgen.runs import cluster, worker
 from faultgen.runs.context import LOCAL, ExecutionContext
@@ -269,13 +269,19 @@ def _claim(out: Path, parts: Path, command: str) -> Iterator[None]:
         record.unlink(missing_ok=True)
 
 
+#: Size bound of a sweep's record ``<parts>/sweep.json`` (a pid, a host, a time and the command line), bytes.
+HOLDER_MAX_BYTES = 2**20
+
+
 def _describe_holder(parts: Path) -> str:
-    """'pid 123 on host, started 2026-11-22T12:00:00+00:00: faultgen sweep ...', from the record."""
+    """'pid 123 on host, started 2026-11-22T12:00:00+00:00: faultgen sweep ...', from the record, read
+    through :func:`faultgen.inputs.read_text` (a regular file of at most :data:`HOLDER_MAX_BYTES`, its
+    size checked first: a sparse record planted in OUT's part folder was read whole)."""
     try:
-        holder = json.loads((parts / "sweep.json").read_text())
+        holder = json.loads(inputs.read_text(parts / "sweep.json", "sweep record", HOLDER_MAX_BYTES))
         text = f"pid {holder['pid']} on {holder['host']}, started {holder['started']}"
         return text + (f": {holder['command']}" if holder.get("command") else "")
-    except (OSError, ValueError, KeyError):
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
         return "a sweep that has not named itself yet"
 
 
