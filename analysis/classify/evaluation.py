@@ -9,6 +9,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from sklearn.base import BaseEstimator
 from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
@@ -186,10 +187,14 @@ def _models(classifiers: Iterable[str] | Mapping[str, object]) -> dict[str, obje
     Raises
     ------
     ValueError
-        For a name not in CLASSIFIERS.
+        For a name not in CLASSIFIERS, or an estimator with a parameter scikit-learn rejects
+        (:func:`check_parameters`).
     """
     if isinstance(classifiers, Mapping):
         models = dict(classifiers)
+        for model in models.values():  # the workers skip scikit-learn's parameter checks per fit
+            if not isinstance(model, str):
+                check_parameters(model)
     else:
         models = {}
         for c in classifiers:
@@ -237,3 +242,20 @@ def _table(aucs: dict, null: dict, names: list[str], models: dict, permutations:
         table.attrs["null_values"] = {f"{column} {name}": [float(v) for v in values]
                                       for (column, name), values in null.items()}
     return table
+
+
+def check_parameters(estimator) -> None:
+    """scikit-learn's check of the parameters of ``estimator`` and of every estimator in it (a
+    Pipeline's steps, a stack's members), done once here: :func:`pair_cells` fits with
+    ``skip_parameter_validation``.
+
+    Raises
+    ------
+    ValueError
+        scikit-learn's ``InvalidParameterError`` (a ValueError) naming the parameter, its value and
+        what it accepts.
+    """
+    nested = [estimator, *estimator.get_params(deep=True).values()] if hasattr(estimator, "get_params") else []
+    for part in nested:
+        if isinstance(part, BaseEstimator) and hasattr(part, "_parameter_constraints"):
+            part._validate_params()
