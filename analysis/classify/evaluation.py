@@ -9,6 +9,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from sklearn.base import BaseEstimator
 from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
@@ -92,6 +93,17 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     jobs = [(k, pair) for k, (_, f, n) in enumerate(label_sets)
             for pair in LeavePairOut(f, n, n_pairs, random_state).pairs()]
     tasks = _tasks(X, estimated, groups, label_sets, jobs, names, models, judged, random_state, matched)
+    per_job = np.full((len(jobs), len(names) * len(models)), np.nan)
+    for (members, _), found in zip(tasks, _run(tasks, n_jobs, progress), strict=True):
+        per_job[members] = found
+    aucs, null = _cells(per_job, [k for k, _ in jobs], names, models, judged, len(label_sets))
+    table = _table(aucs, null, names, models, permutations)
+    return (table, aucs) if return_aucs else table
+
+
+def _run(tasks: list, n_jobs: int | None, progress: bool) -> list[np.ndarray]:
+    """:func:`pair_cells` of each of ``tasks`` (:func:`_tasks`), in their order, on ``n_jobs``
+    processes (None: 1)."""
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
     # joblib's workers limit theirs alike
@@ -99,13 +111,7 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
     with threadpool_limits(limits=1), children.safe_path():
         results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(
             delayed(pair_cells)(*args) for _, args in tasks)
-        per_task = list(tqdm(results, total=len(tasks), desc="classify", unit="pair", disable=not progress))
-    per_job = np.full((len(jobs), len(names) * len(models)), np.nan)
-    for (members, _), found in zip(tasks, per_task, strict=True):
-        per_job[members] = found
-    aucs, null = _cells(per_job, [k for k, _ in jobs], names, models, judged, len(label_sets))
-    table = _table(aucs, null, names, models, permutations)
-    return (table, aucs) if return_aucs else table
+        return list(tqdm(results, total=len(tasks), desc="classify", unit="pair", disable=not progress))
 
 
 def _null_of(null_of: Iterable[str] | None, models: dict) -> list[str]:
@@ -186,10 +192,14 @@ def _models(classifiers: Iterable[str] | Mapping[str, object]) -> dict[str, obje
     Raises
     ------
     ValueError
-        For a name not in CLASSIFIERS.
+        For a name not in CLASSIFIERS, or an estimator with a parameter scikit-learn rejects
+        (:func:`check_parameters`).
     """
     if isinstance(classifiers, Mapping):
         models = dict(classifiers)
+        for model in models.values():  # the workers skip scikit-learn's parameter checks per fit
+            if not isinstance(model, str):
+                check_parameters(model)
     else:
         models = {}
         for c in classifiers:
@@ -237,3 +247,20 @@ def _table(aucs: dict, null: dict, names: list[str], models: dict, permutations:
         table.attrs["null_values"] = {f"{column} {name}": [float(v) for v in values]
                                       for (column, name), values in null.items()}
     return table
+
+
+def check_parameters(estimator) -> None:
+    """scikit-learn's check of the parameters of ``estimator`` and of every estimator in it (a
+    Pipeline's steps, a stack's members), done once here: :func:`pair_cells` fits with
+    ``skip_parameter_validation``.
+
+    Raises
+    ------
+    ValueError
+        scikit-learn's ``InvalidParameterError`` (a ValueError) naming the parameter, its value and
+        what it accepts.
+    """
+    nested = [estimator, *estimator.get_params(deep=True).values()] if hasattr(estimator, "get_params") else []
+    for part in nested:
+        if isinstance(part, BaseEstimator) and hasattr(part, "_parameter_constraints"):
+            part._validate_params()

@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
+from sklearn import config_context
 from sklearn.base import BaseEstimator
 from sklearn.metrics import roc_auc_score
 from threadpoolctl import threadpool_limits
@@ -15,6 +16,7 @@ from threadpoolctl import threadpool_limits
 from analysis.classify.by_run import ByRun, run_steps
 from analysis.classify.labels import make_labels
 from analysis.classify.preprocessing import ESTIMATED, make_pipeline, preprocessing_steps
+from analysis.classify.roc import binary_auc
 from analysis.evaluate import Data, Given, LeavePairOut, evaluate
 from faultgen import children
 
@@ -142,6 +144,17 @@ def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random
     if not scored:
         return out
     X_est = None if estimated is None else (estimated if X is None else np.hstack([X, estimated]))
+    # each classifier built once (the harness fits a clone per cell); its parameters are classify's
+    # own or checked by evaluate's caller, so scikit-learn's parameter checks are skipped per fit
+    classifiers = {column: make_pipeline(model, "control", random_state=random_state) for column, model in models.items()}
+    with config_context(skip_parameter_validation=True):
+        _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers)
+    return out
+
+
+def _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers) -> None:
+    """:func:`pair_cells`'s AUCs into ``out`` (label set, cell): each preprocessing fitted once on the
+    training runs, then each classifier of each label set in ``scored`` on its output."""
     for r, name in enumerate(names):
         data = X_est if name.startswith(ESTIMATED) else X
         steps = [step for _, step in preprocessing_steps(name)]
@@ -151,12 +164,10 @@ def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random
         for i, labels, test, truth, columns in scored:
             # the preprocessed rows, train then held out, one fold given: each classifier through the harness
             stacked = Data(rows, run_of, np.r_[labels[train], labels[held]])
-            for c, (column, model) in enumerate(models.items()):
+            for c, (column, clf) in enumerate(classifiers.items()):
                 if column in columns:
-                    clf = make_pipeline(model, "control", random_state=random_state)
                     scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(rows)), f"{column} {name}")
-                    out[i, r * len(models) + c] = roc_auc_score(truth, scores[test])
-    return out
+                    out[i, r * len(classifiers) + c] = binary_auc(truth, scores[test])
 
 
 def folds(failed, normal, groups, n_pairs: int | None = None, random_state: int | None = 0) -> list[tuple]:
