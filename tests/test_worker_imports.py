@@ -52,9 +52,9 @@ def test_a_worker_imports_and_runs_a_thesis_task_without_scipy_pandas_or_mink(tm
         assert (run.id, run.robot, run.task, run.seed, list(run.worn_axes)) == (run_id, "irb6700", "pick_place", 0, [1])
 
 
-def test_a_log_task_without_a_format_is_read_as_measured(tmp_path):
+def test_a_log_task_in_the_default_format_is_the_task_itself(tmp_path):
     log = tmp_path / "log.csv"
-    assert programs.log_task(str(log)) == programs.log_task(str(log), formats.MEASURED) == str(log)
-    assert programs.log_task("pick_place") == "pick_place"
+    assert programs.log_task(str(log), formats.MEASURED) == str(log)
+    assert programs.log_task("pick_place", formats.MEASURED) == "pick_place"
     other = programs.log_task(str(log), formats.make("ur-rtde"))
     assert isinstance(other, programs.LogTask) and other.adapter.name == "ur-rtde"

@@ -114,15 +114,15 @@ def is_given_task(task) -> bool:
     return kind(task) not in (THESIS, None)
 
 
-def log_task(task: str, adapter: formats.LogFormat | None = None) -> str | LogTask:
+def log_task(task: str, adapter: formats.LogFormat) -> str | LogTask:
     """The task ``task`` with its log read through the log format ``adapter`` (a
-    :class:`faultgen.logs.formats.LogFormat`, None: measured): a :class:`LogTask`; ``task`` itself in
+    :class:`faultgen.logs.formats.LogFormat`): a :class:`LogTask`; ``task`` itself in
     the registry's default format (:data:`faultgen.logs.formats.DEFAULT`: a measured log, a program
     or a thesis task, recorded as named). ValueError when another format is given with a thesis task
     or a program file (a format reads a joint log)."""
     from faultgen.logs import formats  # the log reader (pandas, scipy.signal): for a log task only
 
-    if adapter is None or adapter.name == formats.DEFAULT:
+    if adapter.name == formats.DEFAULT:
         return task
     if kind(task) in (THESIS, *PROGRAM_KINDS):
         what = "a thesis task" if kind(task) == THESIS else "a program file"
