@@ -286,10 +286,15 @@ def markdown_row(results: dict, command: str) -> str:
 
 def write(results: dict, out: str | Path, command: str) -> tuple[Path, Path]:
     """``OUT.json`` (the results) and ``OUT.md`` (the table's header and its row), as one set."""
+    return write_set(results, out, command, header(results["version"]), markdown_row(results, command))
+
+
+def write_set(results: dict, out: str | Path, command: str, top: str, row: str) -> tuple[Path, Path]:
+    """``OUT.json`` (``results`` with ``command``) and ``OUT.md`` (the table's header ``top``, its rule
+    and ``row``), written as one set (:func:`faultgen.data.atomic.output_set`); any version's scorer."""
     out = Path(out)
     json_path, md_path = out.with_name(out.name + ".json"), out.with_name(out.name + ".md")
     with atomic.output_set([json_path, md_path]) as staged:
         staged(json_path).write_text(json.dumps({**results, "command": command}, indent=1) + "\n")
-        top = header(results["version"])
-        staged(md_path).write_text(top + "\n|" + "---|" * (top.count("|") - 1) + "\n" + markdown_row(results, command) + "\n")
+        staged(md_path).write_text(top + "\n|" + "---|" * (top.count("|") - 1) + "\n" + row + "\n")
     return json_path, md_path

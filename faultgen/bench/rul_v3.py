@@ -340,15 +340,8 @@ def markdown_row(results: dict, command: str) -> str:
 
 
 def write(results: dict, out: str | Path, command: str) -> tuple[Path, Path]:
-    """``OUT.json`` (the results) and ``OUT.md`` (the table's header and its row), as one set."""
-    import json
+    """``OUT.json`` (the results) and ``OUT.md`` (the table's header and its row), as one set
+    (:func:`faultgen.bench.prognostics.write_set`, v1 and v2's writer)."""
+    from faultgen.bench import prognostics
 
-    from faultgen.data import atomic
-
-    out = Path(out)
-    json_path, md_path = out.with_name(out.name + ".json"), out.with_name(out.name + ".md")
-    with atomic.output_set([json_path, md_path]) as staged:
-        staged(json_path).write_text(json.dumps({**results, "command": command}, indent=1) + "\n")
-        staged(md_path).write_text(HEADER + "\n|" + "---|" * (HEADER.count("|") - 1) + "\n"
-                                   + markdown_row(results, command) + "\n")
-    return json_path, md_path
+    return prognostics.write_set(results, out, command, HEADER, markdown_row(results, command))
