@@ -16,6 +16,7 @@ from faultgen.cli import app
 from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.operation.ik import FlangeIK, tool_rotation
+from test_programs import line_segments
 
 DT = 0.004  # s
 READY = [0, -17.19, 0, -126.05, 0, 114.59, 45]  # deg: the Panda's "ready" pose (roboticstoolbox's qr)
@@ -111,17 +112,7 @@ def test_an_advised_speed_is_planned_and_checked(tmp_path):
     head = '[tool]\nz = [-0.5, 0.0, -0.866]\nx = [-1.0, 0.0, 0.0]\n'
 
     def program(speed):
-        return programs.parse(f"""name = "fast"
-start = [0, 20, 15, 0, 80, 0]
-{head}[[segment]]
-type = "move"
-pose = [1.55, -0.25, 0.8]
-[[segment]]
-type = "linear"
-to = [1.55, 0.25, 0.8]
-speed = {speed}
-ramp_time = 0.1
-""", robot)
+        return programs.parse(f'name = "fast"\nstart = [0, 20, 15, 0, 80, 0]\n{head}' + line_segments(speed, 0.1), robot)
 
     with pytest.raises(ValueError) as refused:
         program(3.0).trajectory(DT)
