@@ -1,7 +1,8 @@
 """Issue 85: the prognostics track's version 3 (lives set by duty and unit, mixed growth laws, censored
 and healthy units, test variants) made against its frozen manifest, its generator against hand
 computations, and its scoring (scores at lambda, paired bootstrap verdicts, the load-life and oracle
-baselines) against hand-built units."""
+baselines) against hand-built units; the twin emulated from its measured error (its readings' error,
+its tests' factor, its alarm, its rows scored by the monitor's remaining life)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from faultgen.bench import files, make, prognosers_v3, prognostics_v3, rul_v3, tracks
+from faultgen.bench import files, make, prognosers, prognosers_v3, prognostics_v3, rul_v3, tracks, twin_emulator
 
 
 @pytest.fixture(scope="module")
@@ -250,3 +251,75 @@ def test_the_tests_fit_learns_the_temperature_slope_and_finds_the_end_of_life_of
     drawn = model.predict(rul_v3._shown(unit, 80, False))  # wear 22 % on day 80
     assert np.median(drawn) == pytest.approx(109.0, abs=0.1 * (109 - 80))  # within 10 % of the 29 days left
     assert model.predict(rul_v3._shown(_unit(200, age * 0), 80, False)) is None  # no tests, no prediction
+
+
+def _alarm_by_loop(wear: np.ndarray):
+    """:func:`twin_emulator.known_alarm` written again as a loop over the logs (an independent reference)."""
+    p, run = twin_emulator.PERSISTENCE, np.zeros(wear.shape[1], dtype=int)
+    for i in range(p - 1, len(wear)):
+        lower = wear[i - p + 1:i + 1].mean(axis=0) - twin_emulator.ALARM_Z * twin_emulator.FILTER_SD
+        run = np.where(lower >= twin_emulator.WEAR_LIMIT, run + 1, 0)
+        if (run >= p).any():
+            return int(np.argmax(run >= p)) + 1, i - p + 1, i
+    return None
+
+
+def test_the_emulated_twins_readings_have_the_error_stated_from_the_monitors_measured_one(v3_small):
+    test = files.attach_labels(files.read(v3_small / "test.h5"), v3_small / "test_labels.csv")
+    error = np.concatenate([(twin_emulator.readings(u, 0) - twin_emulator.twin_scale(0, u.id)
+                             * twin_emulator.true_wear(u)).ravel() for u in test])
+    assert error.size > 1000 and abs(error.mean()) < 4 * twin_emulator.LOG_SD / np.sqrt(error.size)
+    assert error.std() == pytest.approx(twin_emulator.LOG_SD, rel=0.08)
+    scales = np.log([twin_emulator.twin_scale(0, f"unit-{k}") for k in range(2000)])
+    assert abs(scales.mean()) < 0.02 and scales.std() == pytest.approx(twin_emulator.SCALE_LOG_SD, rel=0.06)
+    for unit in test:  # a prefix reads what the whole record read on its days; the alarm as a loop finds it
+        full = twin_emulator.readings(unit, 0)
+        np.testing.assert_array_equal(twin_emulator.readings(rul_v3._shown(unit, 30, True), 0),
+                                      full[:30])
+        assert twin_emulator.known_alarm(full) == _alarm_by_loop(full)
+        if unit.worn_axis and twin_emulator.known_alarm(full):
+            assert twin_emulator.known_alarm(full)[0] == unit.worn_axis
+    worn = next(u for u in test if u.worn_axis and (u.fault_level >= 40).any())
+    n = int(np.argmax(worn.fault_level >= 40)) + 1
+    f, error = twin_emulator.factor(rul_v3._shown(worn, n, True), 0, worn.worn_axis)
+    # the tests take the twin's scale out: f times the scale is 1 within 3 of the factor's stated errors
+    assert abs(f * twin_emulator.twin_scale(0, worn.id) - 1.0) < 3 * error and error < twin_emulator.FACTOR_PRIOR
+    # the factor is the mixed estimate (Theil & Goldberger): least squares of [1/p, y_j/s] on [1/p, x_j/s]
+    days = worn.arrays["cycles"][:n][(worn.arrays["cycles"][:n] - 1) % 14 == 0]
+    truth = worn.fault_level[np.searchsorted(worn.arrays["cycles"], days)]
+    x = twin_emulator.twin_scale(0, worn.id) * truth + twin_emulator.FILTER_SD * twin_emulator._rng(
+        0, worn.id, 3).standard_normal(400)[days - 1]
+    y = truth + twin_emulator.TEST_SD * twin_emulator._rng(0, worn.id, 2).standard_normal(400)[days - 1]
+    p, s = twin_emulator.FACTOR_PRIOR, twin_emulator.TEST_SD
+    design, target = np.r_[1 / p, x / s][:, None], np.r_[1 / p, y / s]
+    assert f == pytest.approx(np.linalg.lstsq(design, target, rcond=None)[0][0], rel=1e-12)
+    assert error * f == pytest.approx(np.sqrt(np.linalg.inv(design.T @ design)[0, 0]), rel=1e-12)
+    with pytest.raises(ValueError, match="emulated twin reads the true wear"):
+        twin_emulator.readings(prognosers.prefix(worn, 5), 0)
+
+
+def test_the_emulated_twins_rows_are_scored_with_the_monitors_remaining_life(v3_small):
+    from faultgen.monitor import prognosis
+
+    train = files.read(v3_small / "train.h5")
+    test = files.attach_labels(files.read(v3_small / "test.h5"), v3_small / "test_labels.csv")
+    twins = {"without tests": twin_emulator.EmulatedTwin(prognosis.remaining_life, samples=100),
+             "with tests": twin_emulator.EmulatedTwin(prognosis.remaining_life, 14, samples=100)}
+    per_method = {"mean_life": rul_v3.rows_of(prognosers.MeanLife(), "mean_life", train, test)}
+    for name, twin in twins.items():
+        per_method[name] = rul_v3.rows_of(twin, name, train, test, labelled=twin.reads_labels)
+    for name in twins:
+        results = {**rul_v3.results_for(name, per_method), "size": "small", "date": "2026-11-27"}
+        assert results["anchors"][rul_v3.HEADLINE]["best_other"] == ({*twins} - {name}).pop()
+        assert results["verdict"].endswith("(relative accuracy at lambda = wear25, paired 95 % intervals)")
+        row = rul_v3.markdown_row(results, "cmd")
+        assert row.startswith(f"| prognostics v3 (small) | {name} | ") and row.count("|") == rul_v3.HEADER.count("|")
+        assert results["no_eol_share"]["value"] == 1.0  # the healthy unit never alarms
+    for unit in test:  # before the known alarm no end of life; from it on, the remaining life's draws
+        known = twin_emulator.known_alarm(twin_emulator.readings(unit, 0))
+        if known:
+            assert twins["with tests"].predict(rul_v3._shown(unit, known[2], True)) is None
+            drawn = twins["with tests"].predict(rul_v3._shown(unit, known[2] + 1, True))
+            assert drawn.shape == (100,) and (drawn >= unit.arrays["cycles"][known[2]]).all()
+    with pytest.raises(ValueError, match="tests_every = -1"):
+        twin_emulator.EmulatedTwin(prognosis.remaining_life, -1)

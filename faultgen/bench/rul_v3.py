@@ -54,7 +54,9 @@ GRID = 6
 NO_EOL_BEFORE = 30
 RESAMPLES = 2000
 BASELINES = ("mean_life", "load_life", "linear", "exponential", "tests_fit", "oracle")
-#: The baselines that read the labels of the records shown (never a submission).
+#: The baselines that read the labels of the records shown (never a submission); a method passed to
+#: :func:`score_all` with ``reads_labels`` True is shown them too (the emulated twins,
+#: :mod:`faultgen.bench.twin_emulator`).
 LABELLED = ("oracle",)
 #: Score -> (key of the per-unit row, whether higher is better).
 SCORES = {"ra": ("ra", True), "alpha_lambda": ("al", True), "late_share": ("late", False),
@@ -283,7 +285,8 @@ def score_all(folder: str | Path, methods: dict, variant: str | None = None) -> 
     out = {}
     for label in (*BASELINES, *[m for m in methods if m not in BASELINES]):
         method = methods.get(label) or baseline(label)
-        out[label] = rows_of(method, label, train, labelled, label in LABELLED)
+        reads = label in LABELLED or getattr(method, "reads_labels", False)
+        out[label] = rows_of(method, label, train, labelled, reads)
     return out, {**made, "variant": variant or prognostics_v3.DEFAULT_VARIANT}
 
 
