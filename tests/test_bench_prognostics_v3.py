@@ -283,17 +283,18 @@ def test_the_emulated_twins_readings_have_the_error_stated_from_the_monitors_mea
     n = int(np.argmax(worn.fault_level >= 40)) + 1
     f, error = twin_emulator.factor(rul_v3._shown(worn, n, True), 0, worn.worn_axis)
     # the tests take the twin's scale out: f times the scale is 1 within 3 of the factor's stated errors
-    assert abs(f * twin_emulator.twin_scale(0, worn.id) - 1.0) < 3 * error and error < twin_emulator.FACTOR_PRIOR
-    # the factor is the mixed estimate (Theil & Goldberger): least squares of [1/p, y_j/s] on [1/p, x_j/s]
+    assert abs(f * twin_emulator.twin_scale(0, worn.id) - 1.0) < 3 * error < 3 * twin_emulator.FACTOR_PRIOR
+    # the monitor's fit y = b + f x with its priors and forgetting, by the normal equations written out
     days = worn.arrays["cycles"][:n][(worn.arrays["cycles"][:n] - 1) % 14 == 0]
     truth = worn.fault_level[np.searchsorted(worn.arrays["cycles"], days)]
     x = twin_emulator.twin_scale(0, worn.id) * truth + twin_emulator.FILTER_SD * twin_emulator._rng(
         0, worn.id, 3).standard_normal(400)[days - 1]
     y = truth + twin_emulator.TEST_SD * twin_emulator._rng(0, worn.id, 2).standard_normal(400)[days - 1]
-    p, s = twin_emulator.FACTOR_PRIOR, twin_emulator.TEST_SD
-    design, target = np.r_[1 / p, x / s][:, None], np.r_[1 / p, y / s]
-    assert f == pytest.approx(np.linalg.lstsq(design, target, rcond=None)[0][0], rel=1e-12)
-    assert error * f == pytest.approx(np.sqrt(np.linalg.inv(design.T @ design)[0, 0]), rel=1e-12)
+    w = 0.6 ** np.arange(len(days) - 1, -1, -1) / twin_emulator.TEST_SD ** 2
+    normal = np.array([[w.sum() + 1 / 10.0 ** 2, w @ x], [w @ x, w @ x ** 2 + 1 / 0.5 ** 2]])
+    b_f = np.linalg.solve(normal, [w @ y, w @ (x * y) + 1 / 0.5 ** 2])
+    assert f == pytest.approx(b_f[1], rel=1e-9)
+    assert error * f == pytest.approx(np.sqrt(np.linalg.inv(normal)[1, 1]), rel=1e-9)
     with pytest.raises(ValueError, match="emulated twin reads the true wear"):
         twin_emulator.readings(prognosers.prefix(worn, 5), 0)
 

@@ -23,12 +23,11 @@ those readings. It is not the monitor run on logs: its rows say "emulated" (docs
   :data:`PERSISTENCE` alarming logs in a row, its source axis the axis that alarmed, its first alarm
   the first of them. Before the known alarm the twin gives no end of life (as
   ``benchmarks/prognostics_twin.py`` scores the twin of versions 1 and 2);
-- **with friction tests** (days 1, 15, 29, ...: :data:`TESTS_EVERY`): each test reads the worn axis's
-  wear to :data:`TEST_SD` points; the factor ``f`` from the twin's scale to the tests' is the posterior
-  of ``y_j = f x_j`` over the tests so far (``y_j`` a test's wear, ``x_j`` the twin's filtered wear on
-  the test's day, ``s w + N(0, FILTER_SD)``), with the monitor's prior ``f ~ N(1, FACTOR_PRIOR^2)``:
-  the bound estimator of "Why the median error does not reach 1.5 points" (through the origin,
-  ``b`` = 0; the monitor's offset and forgetting of 0.6 per later test left out). Every reading is
+- **with friction tests** (days 1, 15, 29, ...: :data:`TESTS_EVERY`): each test reads the axis's
+  wear to :data:`TEST_SD` points; the factor ``f`` from the twin's scale to the tests' is the monitor's
+  fit of ``y_j = b + f x_j`` over the tests so far (``y_j`` a test's wear, ``x_j`` the twin's filtered
+  wear on the test's day, ``s w + N(0, FILTER_SD)``) with its priors and forgetting (:func:`factor`;
+  the fit's reduced chi-square scaling left out). Every reading is
   then ``f`` times the twin's, its error ``f`` times :data:`LOG_SD`, and the remaining life's scale
   uncertainty the factor's relative error (as ``benchmarks/prognostics_twin.py`` passes the monitor's,
   ``friction_tests.on_tests_scale``). Without tests the remaining life draws the monitor's log-normal
@@ -65,9 +64,10 @@ FILTER_SD = 1.6
 #: One friction test's reading of its day's wear, points: the same section ("a test reads its day's
 #: wear to some 3.3 points" at the plant's 3 % daily scatter).
 TEST_SD = 3.3
-#: The monitor's prior of the factor from the twin's scale to the tests' (``f ~ N(1, 0.5^2)``): "Friction
-#: tests in the monitor", "The logs on the tests' scale".
-FACTOR_PRIOR = 0.5
+#: The monitor's fit of the tests' wear ``y`` on the twin's ``x``, ``y = b + f x``: the priors ``f ~ N(1,
+#: 0.5^2)`` and ``b ~ N(0, 10^2)`` (points) and each test weighed by 0.6 per later test: "Friction tests in
+#: the monitor", "The logs on the tests' scale".
+FACTOR_PRIOR, OFFSET_PRIOR, FORGETTING = 0.5, 10.0, 0.6
 #: The monitor's defaults: ``--wear-limit`` (%), the alarm's one-sided 90 % bound (errors), persistence
 #: (logs) and ``--alpha`` (each log's own bound): "Wear in the robot's own scale".
 WEAR_LIMIT, ALARM_Z, PERSISTENCE, ALPHA = 10.0, 1.2816, 5, 0.01
@@ -133,7 +133,10 @@ def known_alarm(wear: np.ndarray) -> tuple[int, int, int] | None:
 
 def factor(unit: files.Unit, seed: int, axis: int, every: int = TESTS_EVERY) -> tuple[float, float] | None:
     """(factor ``f``, its relative standard error) of ``axis`` (1..6) from the friction tests on days 1,
-    1 + ``every``, ... up to ``unit``'s last record (module docstring), or None without a test."""
+    1 + ``every``, ... up to ``unit``'s last record (module docstring), or None without a test: the
+    monitor's fit ``y = b + f x`` by mixed estimation (Theil & Goldberger 1961: least squares with the
+    priors ``f ~ N(1,`` :data:`FACTOR_PRIOR` ``^2)``, ``b ~ N(0,`` :data:`OFFSET_PRIOR` ``^2)`` as rows),
+    each test weighed by its error :data:`TEST_SD` and by :data:`FORGETTING` per later test."""
     days = _days(unit)
     tested = np.flatnonzero((days - 1) % every == 0)
     if not tested.size:
@@ -142,10 +145,13 @@ def factor(unit: files.Unit, seed: int, axis: int, every: int = TESTS_EVERY) -> 
     test = truth + TEST_SD * _rng(seed, unit.id, _TEST).standard_normal(MAX_DAY)[days[tested] - 1]
     x = twin_scale(seed, unit.id) * truth + FILTER_SD * _rng(seed, unit.id, _FILTER).standard_normal(MAX_DAY)[
         days[tested] - 1]
-    precision = 1.0 / FACTOR_PRIOR ** 2 + float(x @ x) / TEST_SD ** 2
-    mean = (1.0 / FACTOR_PRIOR ** 2 + float(x @ test) / TEST_SD ** 2) / precision
-    mean = max(mean, 0.05)  # the monitor keeps each draw's scale at 0.05 or more
-    return mean, min(precision ** -0.5 / mean, 10.0)
+    weight = np.sqrt(FORGETTING ** np.arange(tested.size - 1, -1, -1)) / TEST_SD
+    design = np.vstack([[1.0 / OFFSET_PRIOR, 0.0], [0.0, 1.0 / FACTOR_PRIOR],
+                        weight[:, None] * np.column_stack([np.ones_like(x), x])])
+    target = np.r_[0.0, 1.0 / FACTOR_PRIOR, weight * test]
+    (_, mean), error = np.linalg.lstsq(design, target, rcond=None)[0], np.linalg.inv(design.T @ design)[1, 1] ** 0.5
+    mean = max(float(mean), 0.05)  # the monitor keeps each draw's scale at 0.05 or more
+    return mean, min(float(error) / mean, 10.0)
 
 
 def rows(unit: files.Unit, wear: np.ndarray, f: float = 1.0) -> tuple[list[dict], dict[str, float]]:
