@@ -1,5 +1,6 @@
 """The twin **emulated from its measured error** on the prognostics track's version 3 (issue 85):
-``twin_emulated`` (production logs only) and ``twin_emulated_tests14`` (a friction test every 14 days).
+:class:`EmulatedTwin` without friction tests (production logs only) and with a test every 14 days
+(``benchmarks/prognostics_v3_score.py --twins`` names them on the leaderboard).
 
 **Why an emulator.** ``faultgen monitor`` reads a fleet's raw logs (the torques of each cycle); version
 3 holds daily records drawn from a load model (:mod:`faultgen.bench.prognostics_v3`) and no raw log,
@@ -21,7 +22,8 @@ those readings. It is not the monitor run on logs: its rows say "emulated" (docs
   the filter's own error :data:`FILTER_SD`, alarms on a log when its lower one-sided 90 % bound
   (:data:`ALARM_Z`) reaches :data:`WEAR_LIMIT`; the alarm is persistent (known) on the last of
   :data:`PERSISTENCE` alarming logs in a row, its source axis the axis that alarmed, its first alarm
-  the first of them. Before the known alarm the twin gives no end of life (as
+  the first of them (judged in the twin's scale, with tests too). Before the known alarm the twin
+  gives no end of life (as
   ``benchmarks/prognostics_twin.py`` scores the twin of versions 1 and 2);
 - **with friction tests** (days 1, 15, 29, ...: :data:`TESTS_EVERY`): each test reads the axis's
   wear to :data:`TEST_SD` points; the factor ``f`` from the twin's scale to the tests' is the monitor's
