@@ -215,7 +215,7 @@ def _checked(t, q) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError("a log with a non-finite time or angle: expected finite t s and q rad")
     if np.any(np.diff(t) <= 0):
         k = int(np.flatnonzero(np.diff(t) <= 0)[0])
-        raise ValueError(f"a log's time at sample {k + 1} ({t[k + 1]!r} s) does not follow {t[k]!r} s: "
+        raise ValueError(f"a log's time at sample {k + 1} ({t[k + 1]:g} s) does not follow {t[k]:g} s: "
                          "expected strictly increasing times")
     return t, q
 
