@@ -46,7 +46,8 @@ import numpy as np
 from faultgen.logs.measured import cycle_slices
 
 #: The largest RMS angle difference, rad, of a log from a program it runs (every axis and sample at
-#: the best shift); the cell's part variants lie 0.1-0.3 rad apart, noise and tracking about 1e-3 rad.
+#: the best shift); the independent KR210 cell's part variants lie 0.5-1.8 rad apart (docs/analysis.md),
+#: noise and tracking about 1e-3 rad.
 TOLERANCE = 0.02
 #: The least RMS spread of a log's path about its mean, rad, for its program to be told (a log of a
 #: robot standing still matches every program that passes its pose).
