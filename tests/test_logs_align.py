@@ -75,7 +75,7 @@ def test_every_log_runs_the_program_its_truth_says_and_a_new_one_is_reported_onl
             assert truth_of[name] == log["program"]
             if not new:  # the others lie far outside the tolerance: the programs are told apart with margin
                 assert p.recognition.fits[0].rms < align.TOLERANCE / 20
-                assert all(f.rms > 5 * align.TOLERANCE for f in p.recognition.fits[1:])
+                assert all(f.window > 5 * align.TOLERANCE for f in p.recognition.fits[1:])
 
 
 def test_a_new_programs_period_is_found_from_its_first_log_within_a_sample(placed, fleet):
@@ -262,3 +262,23 @@ def test_a_noisy_log_resampled_at_a_rate_that_does_not_divide_the_cycle_is_the_s
     placed = align.place(t, q, [align.learn("p", log["t"], log["q"])])
     assert placed.recognition.program == "p" and placed.recognition.fits[0].rms < align.TOLERANCE / 4
     assert all(abs((b - a) - 0.8 * length) <= 1 for a, b in placed.cycles.spans)
+
+
+def test_a_cycle_off_the_program_is_set_apart_and_the_others_kept(placed):
+    """A log whose second whole cycle leaves the path (axis 1 0.3 rad off over its middle third: a jog)
+    is still of its program (it runs it for a whole period elsewhere): that cycle is set apart as
+    off, the others are its whole cycles; a log off the path throughout is refused as off the program."""
+    log, p, _, known = next((log, p, truth_of, known) for rows in placed.values() for log, p, truth_of, known in rows
+                            if p.cycles and len(p.cycles.spans) >= 2)
+    t, q = log["t"], log["q"]
+    reference = next(r for r in known if r.name == p.cycles.program)
+    clean = p.cycles.spans
+    a, b = clean[1]
+    jogged = q.copy()
+    jogged[a + (b - a) // 3: a + 2 * (b - a) // 3, 0] += 0.3
+    again = align.place(t, jogged, [reference])
+    assert again.recognition.program == reference.name
+    assert [(c.start, c.stop) for c in again.cycles.off] == [(a, b)]
+    assert again.cycles.spans == [s for s in clean if s != (a, b)]
+    off = align.whole_cycles(t, q + 0.1, reference)
+    assert off.why is align.Why.OFF_PROGRAM and f"rad RMS off program {reference.name!r}" in off.detail

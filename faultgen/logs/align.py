@@ -8,7 +8,8 @@ rad, any span from any phase, any sample rate) is compared with each reference b
 shift of the reference's cycle along the log (the log resampled linearly onto the reference's step;
 every shift's mean squared angle difference at once by FFT cross-correlation, the best refined to a
 fraction of a sample by a parabola): the RMS angle difference at that shift, rad, over every axis and
-sample, is the log's distance from the program. A log runs the program within :data:`TOLERANCE` of it
+sample, is the log's distance from the program (:attr:`Fit.rms`; :attr:`Fit.window` over the log's best
+stretch of one period). A log runs the program within :data:`TOLERANCE` of it over a whole period
 (:func:`recognise`); within the tolerance of none it runs a new program, of two or more it is
 ambiguous, and a log that barely moves (its path's RMS spread under :data:`MIN_MOTION`) tells no
 program apart. Nothing but the motion is read: never a log's name, position or ``cycle`` column.
@@ -122,12 +123,15 @@ class Reference:
 
 @dataclass(frozen=True)
 class Fit:
-    """A log against one program: ``program`` (its name), ``rms`` rad, and ``shift``: the reference
-    sample (fractional, in [0, m)) at the log's first sample."""
+    """A log against one program: ``program`` (its name), ``rms`` rad over the whole log, ``shift``:
+    the reference sample (fractional, in [0, m)) at the log's first sample, and ``window``: the RMS,
+    rad, over the log's best stretch of one period at that shift (the whole log's under a period): a
+    log that runs the program for a whole period is of it even where it leaves it elsewhere (a stop)."""
 
     program: str
     rms: float
     shift: float
+    window: float
 
 
 @dataclass(frozen=True)
@@ -265,11 +269,6 @@ def _at(r: np.ndarray, positions: np.ndarray) -> np.ndarray:
     return r[low] * (1.0 - w) + r[(low + 1) % m] * w
 
 
-def _rms(x: np.ndarray, r: np.ndarray, first: float) -> float:
-    """RMS difference, rad, of ``x`` (k, N) from the cycle ``r`` at positions ``first, first + 1, ...``."""
-    return float(np.sqrt(np.mean((x - _at(r, first + np.arange(len(x)))) ** 2))) if len(x) else 0.0
-
-
 def fit(t, q, program: Reference) -> Fit:
     """The log (``t`` (n,) s, ``q`` (n, N) rad) against ``program``: the best circular shift of its
     cycle along the log and the RMS angle difference there (module docstring). ValueError for a
@@ -282,22 +281,27 @@ def fit(t, q, program: Reference) -> Fit:
     d = _shift_distances(x, program.q)
     m, best = len(d), int(np.argmin(d))
     shift = (best + _vertex(d[best - 1], d[best], d[(best + 1) % m])) % m
-    return Fit(program.name, _rms(x, program.q, shift), float(shift))
+    squares = np.mean((x - _at(program.q, shift + np.arange(len(x)))) ** 2, axis=1)
+    rms = float(np.sqrt(np.mean(squares)))
+    if len(x) <= m:
+        return Fit(program.name, rms, float(shift), rms)
+    sums = np.concatenate([[0.0], np.cumsum(squares)])
+    return Fit(program.name, rms, float(shift), float(np.sqrt(np.min(sums[m:] - sums[:-m]) / m)))
 
 
 def recognise(t, q, programs, tolerance: float = TOLERANCE) -> Recognition:
     """Which of ``programs`` (:class:`Reference` s, the unit's known programs) the log (``t`` (n,) s,
     ``q`` (n, N) rad) runs, from its motion alone: the one within ``tolerance`` rad RMS (default
-    :data:`TOLERANCE`) of it (:func:`fit`); :attr:`Status.NEW` when none is, AMBIGUOUS when several
+    :data:`TOLERANCE`) of it over a whole period of the log (:attr:`Fit.window`, :func:`fit`); :attr:`Status.NEW` when none is, AMBIGUOUS when several
     are, STILL for a log that barely moves. ValueError for a malformed log or tolerance."""
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise ValueError(f"tolerance {tolerance!r} rad: expected a positive angle")
     t, q = _checked(t, q)
     spread = _spread(q)
-    fits = tuple(sorted((fit(t, q, p) for p in programs), key=lambda f: f.rms))
+    fits = tuple(sorted((fit(t, q, p) for p in programs), key=lambda f: f.window))
     if spread < MIN_MOTION:
         return Recognition(Status.STILL, None, fits, spread)
-    near = [f for f in fits if f.rms <= tolerance]
+    near = [f for f in fits if f.window <= tolerance]
     if len(near) == 1:
         return Recognition(Status.KNOWN, near[0].program, fits, spread)
     return Recognition(Status.AMBIGUOUS if near else Status.NEW, None, fits, spread)
@@ -373,9 +377,9 @@ def whole_cycles(t, q, program: Reference, cycle=None, tolerance: float = TOLERA
     m, step = len(program.q), program.step
     positions = f.shift + (t - t[0]) / step
     hint = check_hint(t, cycle, positions, m, program.period)
-    if f.rms > tolerance:
-        return NoWholeCycle(Why.OFF_PROGRAM, f"{f.rms:.3f} rad RMS off program {program.name!r} at its best shift "
-                            f"(tolerance {tolerance:g} rad)", program.name, hint)
+    if f.window > tolerance:
+        return NoWholeCycle(Why.OFF_PROGRAM, f"{f.window:.3f} rad RMS off program {program.name!r} at its best "
+                            f"shift (tolerance {tolerance:g} rad)", program.name, hint)
     count = int(np.ceil(_log_span(t) / program.period)) + 2
     edges = _index(t, t[0] + (np.arange(count) * m - f.shift) * step)
     resid = np.mean((q - _at(program.q, positions)) ** 2, axis=1)
@@ -386,6 +390,9 @@ def whole_cycles(t, q, program: Reference, cycle=None, tolerance: float = TOLERA
         return NoWholeCycle(why, f"the log spans {span:.3f} s from phase {f.shift / m:.3f} of program "
                             f"{program.name!r}'s {program.period:.3f} s cycle: no whole cycle inside", program.name, hint)
     cycles = [Cycle(a, b, float(np.sqrt(np.mean(resid[a:b])))) for a, b in inside]
+    if all(c.rms > tolerance for c in cycles):
+        return NoWholeCycle(Why.OFF_PROGRAM, f"every whole cycle more than {tolerance:g} rad RMS off program "
+                            f"{program.name!r}", program.name, hint)
     return Cycles(program.name, tuple(c for c in cycles if c.rms <= tolerance),
                   tuple(c for c in cycles if c.rms > tolerance),
                   _fragment(0, inside[0][0], positions, resid, m, tolerance),
@@ -515,7 +522,7 @@ def place(t, q, programs, cycle=None, name: str | None = None, tolerance: float 
     why = Why.STILL if found.status is Status.STILL else Why.AMBIGUOUS
     detail = (f"the path spreads {found.spread:.4f} rad RMS: too little motion to tell its program"
               if why is Why.STILL else "within the tolerance of " + ", ".join(
-                  f"{f.program!r} ({f.rms:.3f} rad)" for f in found.fits if f.rms <= tolerance))
+                  f"{f.program!r} ({f.window:.3f} rad)" for f in found.fits if f.window <= tolerance))
     return Placement(found, None, NoWholeCycle(why, detail), None)
 
 
