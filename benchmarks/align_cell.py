@@ -13,7 +13,8 @@ truth has (a unit's first log of each of its programs), the learned periods' err
 length error and whether each unit's program is always cut at one phase, the logs with no whole
 cycle against those the truth says hold none (given that phase), the fragments used and dropped,
 and the CPU time per log of :func:`~faultgen.logs.align.place` (recognition, alignment and, on a
-program's first log, learning) against the monitor's 0.32 s a log on the one-program fleet. Results: docs/analysis.md.
+program's first log, learning) against the monitor's 0.32 s a log on the one-program fleet.
+Results: docs/analysis.md.
 """
 
 from __future__ import annotations

@@ -292,8 +292,9 @@ def fit(t, q, program: Reference) -> Fit:
 def recognise(t, q, programs, tolerance: float = TOLERANCE) -> Recognition:
     """Which of ``programs`` (:class:`Reference` s, the unit's known programs) the log (``t`` (n,) s,
     ``q`` (n, N) rad) runs, from its motion alone: the one within ``tolerance`` rad RMS (default
-    :data:`TOLERANCE`) of it over a whole period of the log (:attr:`Fit.window`, :func:`fit`); :attr:`Status.NEW` when none is, AMBIGUOUS when several
-    are, STILL for a log that barely moves. ValueError for a malformed log or tolerance."""
+    :data:`TOLERANCE`) of it over a whole period of the log (:attr:`Fit.window`, :func:`fit`);
+    :attr:`Status.NEW` when none is, AMBIGUOUS when several are, STILL for a log that barely moves.
+    ValueError for a malformed log or tolerance."""
     if not (np.isfinite(tolerance) and tolerance > 0):
         raise ValueError(f"tolerance {tolerance!r} rad: expected a positive angle")
     t, q = _checked(t, q)
@@ -480,7 +481,8 @@ def learn(name: str, t, q, cycle=None, tolerance: float = TOLERANCE) -> Referenc
     x = _grid(t, q, step)
     bins = np.arange(len(x)) % m
     count = np.bincount(bins, minlength=m)
-    cycle_q = np.column_stack([np.bincount(bins, x[:, a], minlength=m) for a in range(x.shape[1])]) / count[:, None]
+    sums = np.column_stack([np.bincount(bins, x[:, a], minlength=m) for a in range(x.shape[1])])
+    cycle_q = sums / count[:, None]
     positions = (t - t[0]) / step
     hint = check_hint(t, cycle, positions, m, found)
     if hint.verdict is HintVerdict.AGREES:
