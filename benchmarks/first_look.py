@@ -49,7 +49,7 @@ def timed(command: list[str], log: Path) -> tuple[float, float]:
 
 
 def load() -> str:
-    return " ".join(os.getloadavg().__repr__().strip("()").split(", "))
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 def rows(path: Path) -> list[dict]:
