@@ -59,6 +59,22 @@ def test_a_folder_of_other_files_is_refused_unless_overwrite_and_an_earlier_outp
     assert result.exit_code == 2 and "is not a folder" in result.output and (tmp_path / "file").read_text() == "x"
 
 
+def test_a_mount_point_holding_only_lost_and_found_is_written_as_an_empty_folder(fleet, tmp_path):
+    mount = tmp_path / "mnt"  # an ext4 mount point: mkfs made lost+found, the user nothing
+    (mount / "lost+found").mkdir(parents=True)
+    result = _monitor(fleet, mount)
+    assert result.exit_code == 0, result.output
+    assert (mount / "alarms.csv").is_file() and not any((mount / "lost+found").iterdir())
+    other = tmp_path / "other"  # lost+found beside a file of the user's: refused as before
+    (other / "lost+found").mkdir(parents=True)
+    (other / "notes.txt").write_text("mine\n")
+    result = _monitor(fleet, other)
+    assert result.exit_code == 2 and f"{other} holds files" in result.output, result.output
+    (tmp_path / "third" / "lost+found").parent.mkdir()
+    (tmp_path / "third" / "lost+found").write_text("a file of that name is the user's\n")
+    assert _monitor(fleet, tmp_path / "third").exit_code == 2
+
+
 @pytest.mark.parametrize("where", ["LOGS", "LOGS/mon", "LOGS/u1", "LOGS/../LOGS/mon", ".", "link"])
 def test_an_output_that_is_inside_or_holds_the_logs_folder_is_refused_naming_both(fleet, tmp_path, where):
     logs = tmp_path / "LOGS"

@@ -97,3 +97,22 @@ def test_a_stray_file_and_a_bad_events_row_stop_nothing_else_and_are_named(tmp_p
     assert result.exit_code == 0, result.output
     for name in OUTPUTS:
         assert (out / name).read_bytes() == (clean / name).read_bytes(), name
+
+
+def test_a_stray_file_at_the_top_of_the_logs_folder_is_passed_over_and_named(tmp_path):
+    logs = fleetlog_folder.write_fleet(tmp_path / "clean" / "LOGS", robots.load("puma560"), units=2, days=4)
+    clean = tmp_path / "clean" / "out"
+    assert _monitor(logs, clean).exit_code == 0
+    stray = _linked(logs, tmp_path / "stray" / "LOGS")
+    (stray / "notes.txt").write_text("the operator's notes\n")
+    out = tmp_path / "stray" / "out"
+    result = _monitor(stray, out)
+    assert result.exit_code == 0, result.output
+    assert ("passed over 1 entries of the logs folder: notes.txt: not a log: a file at the top of the logs folder; "
+            "expected one folder per unit") in result.output
+    for name in OUTPUTS:  # every unit as without it
+        assert (out / name).read_bytes() == (clean / name).read_bytes(), name
+    # `logs import` lists it with the other bad files: refused naming it, or passed over with --skip-bad
+    result = runner.invoke(app, ["logs", "import", str(stray), "--robot", "puma560", "-o", str(tmp_path / "f.h5")])
+    assert result.exit_code == 2 and f"{stray / 'notes.txt'}: not a log: a file at the top" in result.output, \
+        result.output

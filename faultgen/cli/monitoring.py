@@ -206,7 +206,8 @@ def is_monitor_output(folder: Path) -> bool:
 def check_monitor_out(out: Path, logs: Path, overwrite: bool) -> None:
     """Refuse, before any work, an OUT that is LOGS, lies inside it or holds it
     (:func:`faultgen.data.atomic.check_apart`), is a file, or is a folder holding files that is
-    not an earlier monitor run's output (:func:`is_monitor_output`: continued) unless ``overwrite``.
+    not an earlier monitor run's output (:func:`is_monitor_output`: continued) unless ``overwrite``;
+    a folder holding only a ``lost+found`` folder (an ext4 mount point) counts as empty.
 
     Raises
     ------
@@ -218,7 +219,9 @@ def check_monitor_out(out: Path, logs: Path, overwrite: bool) -> None:
     atomic.check_apart(out, logs)
     if (out.exists() or out.is_symlink()) and not out.is_dir():
         raise ValueError(f"{out} is a file; --out expects a folder to write the results into")
-    if out.is_dir() and any(out.iterdir()) and not is_monitor_output(out) and not overwrite:
+    # an ext4 mount's lost+found (made by mkfs, not by a user) leaves a mount point empty
+    held = out.is_dir() and any(e.name != "lost+found" or not e.is_dir() or e.is_symlink() for e in out.iterdir())
+    if held and not is_monitor_output(out) and not overwrite:
         raise ValueError(f"{out} holds files and is not an earlier monitor run's output (no {out / '.state'}); pass "
                          "--overwrite to write into it (replacing its files of the outputs' names) or choose another "
                          "--out")

@@ -148,7 +148,8 @@ def saturation_warning(saturated, task: str, replayed: bool = False) -> str:
 
 #: sweep's options (its grid's fields).
 Preset = Annotated[
-    str | None, typer.Option(help="A named grid: quick (a first look, 21 runs; its time: docs/performance.md), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
+    str | None, typer.Option(help="A named grid: quick (a first look at the data, 21 runs; its time: docs/performance.md), first-look (the "
+    "README's first analyses: bench-isolators, detect, classify; 14 runs of spot welding, 2 seeds, cycles 41-100), j2 (thesis ch. 6, 3-6 min), c2 (thesis ch. 3, 70 min or more, features only); times on 2 cores, by the machine.")
 ]
 GridConfig = Annotated[
     Path | None, typer.Option(help="A TOML file whose keys are the grid fields below (and optionally preset).")
@@ -253,8 +254,21 @@ def sweep_command(
 
     run_sweep(grid, out, context=ExecutionContext(jobs, scheduler, stepper), progress=progress, overwrite=overwrite,
               announce=announce, shared=shared_folder)
-    typer.echo(f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
-               f"  faultgen plot {out} -o {out.with_suffix('.png')}")
+    typer.echo(next_steps(preset, out))
+
+
+def next_steps(preset: str | None, out: Path) -> str:
+    """What ``sweep`` prints when done: how to look at ``out``, and for the ``first-look`` preset the
+    README's first analyses (for ``quick``, the preset that carries them)."""
+    text = (f"wrote {out}\nlook at it with:\n  faultgen info {out}\n  faultgen validate {out}\n"
+            f"  faultgen plot {out} -o {out.with_suffix('.png')}")
+    if preset == "first-look":
+        text += (f"\nanalyse it with (each result beside its chance level):\n  faultgen bench-isolators {out}\n"
+                 f"  faultgen detect {out}\n  faultgen classify {out}")
+    elif preset == "quick":
+        text += ("\nits 10 cycles per run are too few for the analyses; for those: faultgen sweep --preset first-look "
+                 "-o first-look.h5")
+    return text
 
 
 #: fleet's options.

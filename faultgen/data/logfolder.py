@@ -164,16 +164,17 @@ def stamp_of(name: str, suffixes: tuple[str, ...]) -> str | None:
 def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFile]], list[tuple[str, str]]]:
     """The logs of ``folder``, per unit in stamp order, and the files that are not logs.
 
-    Hidden entries (``.name``) are passed over. A file in a unit folder whose name has none of
-    ``suffixes``, whose stamp does not parse or whose link leads out of ``folder`` (:data:`LINK_OUT`:
-    not read) is returned in the second list as ``(name, reason)``.
+    Hidden entries (``.name``) are passed over. A file at the top of ``folder`` other than
+    ``events.csv``, and a file in a unit folder whose name has none of ``suffixes``, whose stamp
+    does not parse or whose link leads out of ``folder`` (:data:`LINK_OUT`: not read), is returned
+    in the second list as ``(name, reason)``.
 
     Raises
     ------
     ValueError
         If ``folder`` is not a folder or holds no unit folder; a unit folder or ``events.csv`` whose
         link leads out of ``folder`` (:class:`faultgen.inputs.InputError`, nothing behind it listed);
-        a file other than ``events.csv`` at its top; an ``events.csv`` that is not a regular file; an
+        an ``events.csv`` that is not a regular file; an
         entry that is neither a file nor a folder (a FIFO, a broken link); a unit folder or log whose
         name is not UTF-8; two logs of one unit with the same stamp; one unit's stamps of both kinds.
     """
@@ -191,9 +192,10 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
                 raise ValueError(f"{entry}: {_kind(entry)}; the events file must be a regular file (unit, stamp, "
                                  "event, axis)")
             continue
-        if entry.is_file():
-            raise ValueError(f"{entry}: a file at the top of the logs folder; expected one folder per unit "
-                             "(LOGS/<unit>/<stamp>.csv) and optionally events.csv")
+        if entry.is_file():  # a stray file (notes.txt) is listed with the files that are not logs
+            bad.append((entry.name, "not a log: a file at the top of the logs folder; expected one folder per "
+                                    "unit (LOGS/<unit>/<stamp>.csv) and optionally events.csv"))
+            continue
         if not entry.is_dir():
             raise ValueError(f"{entry}: neither a unit folder nor events.csv ({_kind(entry)}); expected "
                              "one folder per unit (LOGS/<unit>/<stamp>.csv) and optionally events.csv")

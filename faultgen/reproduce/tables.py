@@ -17,6 +17,10 @@ import pandas as pd
 from faultgen.reproduce import thesis
 from faultgen.reproduce.plan import REDUCTIONS as REDUCTIONS_TEXT
 
+#: Largest output of a step a table reads, bytes: the steps write tables of kilobytes (the j2
+#: isolation table, the largest, about 100 kB); a file past this is not one of theirs.
+CSV_MAX_BYTES = 64 * 2**20
+
 #: Thesis task label per faultgen task, and the order of docs/reproduction.md's comparisons.
 LABEL = {task: label for label, task in thesis.TASKS.items()}
 
@@ -34,6 +38,27 @@ class Part:
     verdict: str
     reduced: str = ""
     steps: tuple[str, ...] = ()
+
+
+def _csv(path: Path) -> pd.DataFrame:
+    """A step's CSV output read through :func:`faultgen.inputs.read_text` (a regular file, at most
+    :data:`CSV_MAX_BYTES`, UTF-8), then parsed by pandas.
+
+    Raises
+    ------
+    faultgen.inputs.InputError
+        Naming the file: not a regular file, too large, not UTF-8, or not a CSV table.
+    """
+    import io
+
+    from faultgen import inputs
+
+    text = inputs.read_text(path, "reproduction step's CSV output", CSV_MAX_BYTES)
+    try:
+        return pd.read_csv(io.StringIO(text))
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+        raise inputs.InputError(f"{path}: not a CSV table ({' '.join(str(err).split())[:200]}); expected the "
+                                "output of the reproduction's step that writes it") from None
 
 
 def _md(frame: pd.DataFrame) -> str:
@@ -55,7 +80,7 @@ def _range(values) -> str:
 
 
 def table_6_2(folder: Path) -> Part:
-    frame = pd.read_csv(folder / "j2-isolation.csv")
+    frame = _csv(folder / "j2-isolation.csv")
     acc = _accuracy(frame)
     te10 = frame[(frame["isolator"] == "te10") & (frame["worn_axis"] > 0)]
     rows = []
@@ -102,8 +127,8 @@ def _word(claims: list[bool]) -> str:
 
 
 def speed_window(folder: Path) -> Part:
-    whole = _accuracy(pd.read_csv(folder / "j2-isolation.csv"))
-    window = _accuracy(pd.read_csv(folder / "j2-window.csv"))
+    whole = _accuracy(_csv(folder / "j2-isolation.csv"))
+    window = _accuracy(_csv(folder / "j2-window.csv"))
     rows = []
     for (label, level), (_, t10, t5, cc) in thesis.TABLE_6_2.items():
         key = (thesis.TASKS[label], float(level))
@@ -138,7 +163,7 @@ def _slash(*values) -> str:
 
 
 def bins(folder: Path) -> Part:
-    acc = _accuracy(pd.read_csv(folder / "j2-bins.csv"))
+    acc = _accuracy(_csv(folder / "j2-bins.csv"))
     task = "pick_place" if "pick_place" in acc.index.get_level_values("task") else acc.index[0][0]
     te = acc.loc[task][[c for c in acc.columns if c.startswith("te")]]
     te = te[sorted(te.columns, key=lambda c: int(c[2:]))].T
@@ -161,7 +186,7 @@ def bins(folder: Path) -> Part:
 
 
 def table_6_1(folder: Path) -> Part:
-    table = pd.read_csv(folder / "j2-table-6-1.csv")
+    table = _csv(folder / "j2-table-6-1.csv")
     seed = table["seed"].min()
     first = table[table["seed"] == seed]
     task = "pick_place" if "pick_place" in set(first["task"]) else first["task"].iloc[0]
@@ -194,7 +219,7 @@ def table_6_1(folder: Path) -> Part:
 
 
 def detection_j2(folder: Path) -> Part:
-    frame = pd.read_csv(folder / "j2-detection.csv")
+    frame = _csv(folder / "j2-detection.csv")
     worn = frame[frame["worn_axis"] > 0]
     shown = worn[["task", "worn_axis", "detected", "onset", "onset_wear_pct", "located_axis", "located"]]
     detected = int(worn["detected"].sum())
@@ -219,7 +244,7 @@ def detection_held_out(folder: Path) -> Part:
               "first": "first-cycles, 20 folds"}
     rows = []
     for name, label in labels.items():
-        summary = pd.read_csv(folder / f"j2s3-{name}-summary.csv")
+        summary = _csv(folder / f"j2s3-{name}-summary.csv")
         row = summary[summary["by"] == "all"].iloc[0]
         rows.append({"protocol": label, "runs": row["runs"], "false alarms (%)": row["false_alarm_pct"],
                      "detected (%)": row["detected_pct"], "median onset wear (%)": row["median_onset_wear_pct"],
@@ -242,7 +267,7 @@ def detection_held_out(folder: Path) -> Part:
 
 
 def detection_c2(folder: Path) -> Part:
-    frame = pd.read_csv(folder / "c2-detection.csv")
+    frame = _csv(folder / "c2-detection.csv")
     worn = frame[frame["worn_axis"] > 0].copy()
     cells = {}
     for _, row in worn.iterrows():
@@ -281,11 +306,11 @@ def training_source(folder: Path) -> Part:
         anova_path = folder / f"{stem}-anova.csv"
         if not anova_path.exists():  # no ANOVA where a cell had no case (the tiny scale)
             continue
-        anova = pd.read_csv(anova_path)
+        anova = _csv(anova_path)
         pivot = anova[anova["term"] != "Error"].pivot(index="term", columns="descriptor", values="p")
         for term, values in pivot.iterrows():
             p_rows.append({"term": term, "fleet": label, **{f"p {d} ours": values.get(d) for d in ts.DESCRIPTORS}})
-        diff = ts.failure_vs_normal(pd.read_csv(folder / f"{stem}-tukey.csv"))
+        diff = ts.failure_vs_normal(_csv(folder / f"{stem}-tukey.csv"))
         found = diff[diff["different"]]
         for descriptor, cell in thesis.TUKEY_4.items():
             mine = found[found["descriptor"] == descriptor]
@@ -319,7 +344,7 @@ def training_source(folder: Path) -> Part:
 
 
 def classification(folder: Path, stem: str, title: str, why: str, steps: tuple[str, ...]) -> Part:
-    tidy = pd.read_csv(folder / f"{stem}.csv")
+    tidy = _csv(folder / f"{stem}.csv")
     rows = []
     for prep, group in tidy.groupby("preprocessing", sort=False):
         row = {"preprocessing": prep}

@@ -21,6 +21,9 @@ from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 
 #: Named grids. quick: a small grid for a first look (under a minute on 2 cores).
+#: first-look: quick's spot-weld runs, two seeds, cycles 41-100 recorded, features only: the README's
+#: first analyses (bench-isolators, detect with other-seeds, classify) on one dataset (issue 88;
+#: docs/performance.md, "A first look").
 #: j2: thesis ch. 6 (IRB 6700, 3 tasks, no wear + each axis, exp4 to +20 % over 100 cycles).
 #: c2: thesis ch. 3 (PUMA 560, 3 tasks x 6 axes x {10, 20} % logistic over 120 hours of one-minute
 #: cycles, the first ten cycles of every hour recorded, as the torque of ch. 3.4 is sampled); features
@@ -28,6 +31,8 @@ from faultgen.simulation import stepping as sim
 PRESETS = {
     "quick": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
                   schedules=["exp4"], cycles=100, record=list(range(10, 101, 10))),
+    "first-look": dict(robots=["irb6700"], tasks=["spot_weld"], axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
+                       schedules=["exp4"], cycles=100, record=list(range(41, 101)), seeds=[0, 1], signals=False),
     "j2": dict(robots=["irb6700"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[20.0],
                schedules=["exp4"], cycles=100, record="all"),
     "c2": dict(robots=["puma560"], tasks=list(tasks.TASKS), axes=[0, 1, 2, 3, 4, 5, 6], increases=[10.0, 20.0],
