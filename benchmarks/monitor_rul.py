@@ -81,15 +81,11 @@ from benchmarks_common import fleet_options  # sibling module
 
 from faultgen import children
 from faultgen.bench import rul_scores
-from faultgen.monitor import prognosis
+from faultgen.monitor import prognosis, tables
 
 ALPHA, BETA, LAMBDA = 0.2, 0.5, 0.5
 #: The monitor's defaults the benchmark replays (faultgen.monitor.scoring.Settings).
 MONITOR_ALPHA, PERSISTENCE = 0.01, 5
-
-
-def _floats(row: dict) -> dict:
-    return {k: (float(v) if k.startswith("wear") and v != "" else v) for k, v in row.items()}
 
 
 def _absolute(toe, t_prediction: float, horizon: float):
@@ -163,8 +159,8 @@ def estimate_line(wear: np.ndarray, day: dict[str, int], rows: list[dict], axis:
     """The scale and offset of ``axis``'s wear estimate on the true wear: the least-squares line of
     its monitoring ``rows``' ``wear<axis>`` (scores.csv) on the true ``wear`` (one value a day, %;
     ``day``: stamp -> day, 1-based) where the true wear is past 5 %."""
-    past = [(wear[day[r["stamp"]] - 1], float(r[f"wear{axis}"])) for r in rows
-            if r["phase"] == "monitoring" and wear[day[r["stamp"]] - 1] >= 5]
+    past = [(wear[day[r.stamp] - 1], float(r.wear.estimate[axis - 1])) for r in rows
+            if r.phase == "monitoring" and wear[day[r.stamp] - 1] >= 5]
     scale, offset = np.polyfit(*zip(*past), 1)
     return float(scale), float(offset)
 
@@ -227,10 +223,10 @@ def on_scale(rows: list[dict], scale_uncertainty, tested: bool):
 def unit_rows(scores: list[dict], replayed: dict[str, list[dict]] | None, unit: str) -> tuple[list[dict], bool]:
     """``unit``'s rows: its replayed monitor rows with friction tests (:func:`replayed_rows`; each
     prediction then on its latest factor, :func:`on_scale`) and True, else scores.csv's and False."""
-    rows = [r for r in scores if r["unit"] == unit]
+    rows = [r for r in scores if r.unit == unit]
     if replayed is None or unit not in replayed:
         return rows, False
-    if [r["stamp"] for r in replayed[unit]] != [r["stamp"] for r in rows]:
+    if [r.stamp for r in replayed[unit]] != [r.stamp for r in rows]:
         raise SystemExit(f"{unit}: the replayed state's logs are not scores.csv's: is OUT/.state this run's?")
     return replayed[unit], True
 
@@ -319,7 +315,7 @@ def quiet_axes(truth: dict, scores: list[dict], alarms: dict, failure_wear: floa
     span = max(len(t["wear"]) for t in truth.values())
     within, healthy, others = [], 0, 0
     for unit, t in truth.items():
-        rows, uncertainty = [r for r in scores if r["unit"] == unit], scale_uncertainty
+        rows, uncertainty = [r for r in scores if r.unit == unit], scale_uncertainty
         if replayed is not None and unit in replayed:
             rows, uncertainty = on_scale(replayed[unit], scale_uncertainty, True)
         alarm = alarms[unit]
@@ -353,7 +349,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
     :func:`unit_rows`."""
     truth = independent_fleet.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
-        scores = [_floats(r) for r in csv.DictReader(f)]
+        scores = tables.log_rows(list(csv.DictReader(f)))
     with open(out / "alarms.csv", newline="") as f:
         alarms = {r["unit"]: r for r in csv.DictReader(f)}
     F, H = failure_wear, prognosis.HORIZON
@@ -371,7 +367,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
                   f"{alarm['source_axis'] or '-'}: not scored")
             continue
         rows, tested = unit_rows(scores, replayed, unit)
-        stamps = [r["stamp"] for r in rows]
+        stamps = [r.stamp for r in rows]
         day = {s: i + 1 for i, s in enumerate(t["stamps"])}  # day 1 = the first log
         wear = t["wear"]
         true_eol = day_of(wear, F)  # (A)
@@ -381,7 +377,7 @@ def evaluate(truth_path: Path, out: Path, failure_wear: float, changepoint: bool
         start = day[stamps[first + PERSISTENCE - 1]]
         profile, predictions = ToEPredictionProfile(), []
         for j in range(first + PERSISTENCE - 1, len(rows)):
-            now = day[rows[j]["stamp"]]
+            now = day[rows[j].stamp]
             if now >= max(true_eol, estimate_eol):  # the metrics take the predictions before the end of life
                 break
             upto, uncertainty = on_scale(rows[: j + 1], scale_uncertainty, tested)

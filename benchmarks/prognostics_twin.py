@@ -46,14 +46,10 @@ import numpy as np
 from faultgen import children
 from faultgen.bench import files, independent, make, prognosers, prognostics, tracks
 from faultgen.model import robots
-from faultgen.monitor import friction_tests, loop, prognosis
+from faultgen.monitor import friction_tests, loop, prognosis, tables
 
 #: The monitor's defaults the replay uses (faultgen.monitor.scoring.Settings).
 MONITOR_ALPHA, PERSISTENCE = 0.01, 5
-
-
-def _floats(row: dict) -> dict:
-    return {k: (float(v) if k.startswith("wear") and v != "" else v) for k, v in row.items()}
 
 
 def _failure_days(unit: str, seen: list[dict], n_axes: int, failure: float, first: str, axis: int) -> np.ndarray:
@@ -105,7 +101,7 @@ def main() -> None:
     print(f"faultgen monitor --no-calibrate --failure-wear {failure:g}: {time.perf_counter() - started:.0f} s")
     truth = independent.read_truth(truth_path)
     with open(out / "scores.csv", newline="") as f:
-        scores = [_floats(r) for r in csv.DictReader(f)]
+        scores = tables.log_rows(list(csv.DictReader(f)))
     if tested and not args.without_tests:  # the rows' twin-scale wear and factors, which scores.csv leaves out
         started = time.perf_counter()
         kept = loop.monitor(robot, logs, out, calibrate=False, failure_wear=failure, progress=False).monitors
@@ -120,8 +116,8 @@ def main() -> None:
         days = np.arange(1, len(t["stamps"]) + 1, dtype=float)
         eol = float(days[np.flatnonzero(t["wear"] >= failure)[0]])
         onset = float(days[np.flatnonzero(t["wear"] > 0)[0]])
-        rows = [r for r in scores if r["unit"] == unit]
-        day = {r["stamp"]: i + 1 for i, r in enumerate(rows)}
+        rows = [r for r in scores if r.unit == unit]
+        day = {r.stamp: i + 1 for i, r in enumerate(rows)}
         alarm = alarms.get(unit, {})
         first, axis = alarm.get("first_alarm") or None, int(alarm.get("source_axis") or 0)
         persistent = (day[first] + PERSISTENCE - 1) if first in day else np.inf

@@ -1,6 +1,7 @@
 """Issue 75, item 7 (track2): the prognostics track's version 2 (friction tests in the test split)
 and the fleet's friction-test program carried as text (no cache path in a run's configuration)."""
 
+import dataclasses
 import json
 import os
 from collections import Counter
@@ -151,23 +152,24 @@ def test_on_tests_scale_puts_every_log_of_a_prefix_on_its_last_factor_as_rul_csv
     monitor's rul.csv would have that day: every log's twin-scale estimate times the last row's
     factor (not each log's own, scores.csv's), the factor's relative error as the scale's
     uncertainty; an axis in the twin's scale keeps the monitor's default; no test: unchanged."""
-    from faultgen.monitor import friction_tests, scoring
+    from faultgen.monitor import friction_tests, scoring, tables
 
     def row(day, twin, factor, error, scale):
-        return {"stamp": f"2026-01-{day:02d}", "wear1_twin_log": twin, "wear1_twin_log_lower": twin - 2.0,
+        return {"stamp": f"2026-01-{day:02d}", "phase": "monitoring", "wear1_twin_log": twin, "wear1_twin_log_lower": twin - 2.0,
                 "wear1_factor": factor, "wear1_factor_error": error, "wear1_scale": scale,
                 "wear1_log": factor * twin, "wear1_log_lower": factor * (twin - 2.0),
                 "wear2_twin_log": 1.0, "wear2_twin_log_lower": 0.0, "wear2_factor": 1.0, "wear2_factor_error": 0.0,
                 "wear2_scale": friction_tests.TWIN_SCALE, "wear2_log": 1.0, "wear2_log_lower": 0.0}
 
-    rows = [row(1, 10.0, 0.5, 0.1, friction_tests.TESTS_SCALE), row(2, 20.0, 0.8, 0.2, friction_tests.TESTS_SCALE),
-            row(3, 30.0, 1.25, 0.25, friction_tests.TESTS_SCALE)]
+    rows = tables.log_rows([row(1, 10.0, 0.5, 0.1, friction_tests.TESTS_SCALE),
+                            row(2, 20.0, 0.8, 0.2, friction_tests.TESTS_SCALE),
+                            row(3, 30.0, 1.25, 0.25, friction_tests.TESTS_SCALE)])
     seen, uncertainty = friction_tests.on_tests_scale(rows[:2], 2)
-    assert [r["wear1_log"] for r in seen] == pytest.approx([8.0, 16.0])  # 0.8 x (10, 20), not (5, 16)
-    assert [r["wear1_log_lower"] for r in seen] == pytest.approx([6.4, 14.4])
+    assert [r.wear.log[0] for r in seen] == pytest.approx([8.0, 16.0])  # 0.8 x (10, 20), not (5, 16)
+    assert [r.wear.log_lower[0] for r in seen] == pytest.approx([6.4, 14.4])
     assert uncertainty == pytest.approx({1: 0.25, 2: scoring.SCALE_UNCERTAINTY})
     seen, uncertainty = friction_tests.on_tests_scale(rows, 2)
-    assert [r["wear1_log"] for r in seen] == pytest.approx([12.5, 25.0, 37.5]) and uncertainty[1] == pytest.approx(0.2)
-    assert rows[0]["wear1_log"] == pytest.approx(5.0)  # the monitor's rows untouched
-    plain = [{k: v for k, v in r.items() if "_twin_" not in k} for r in rows]
+    assert [r.wear.log[0] for r in seen] == pytest.approx([12.5, 25.0, 37.5]) and uncertainty[1] == pytest.approx(0.2)
+    assert rows[0].wear.log[0] == pytest.approx(5.0)  # the monitor's rows untouched
+    plain = [dataclasses.replace(r, wear=dataclasses.replace(r.wear, tests=None)) for r in rows]
     assert friction_tests.on_tests_scale(plain, 2) == (plain, None)

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import stats
 
 from faultgen.bench import rul_scores
-from faultgen.monitor import prognosis, scoring, trends
+from faultgen.monitor import prognosis, scoring, tables, trends
 
 ALPHA = 0.01
 Z = NormalDist().inv_cdf(1 - ALPHA)
@@ -77,7 +77,7 @@ def test_a_known_lines_crossing_spreads_as_the_log_normal_and_keeps_its_median()
 def _rows(wear, noise: float) -> list[dict]:
     day = datetime.date.fromisoformat("2026-01-05")
     return [{"stamp": (day + datetime.timedelta(days=i)).isoformat(), "phase": "monitoring",
-             "wear1_log": float(w), "wear1_log_lower": float(w - Z * noise)} for i, w in enumerate(wear)]
+             "wear1": float(w), "wear1_log": float(w), "wear1_log_lower": float(w - Z * noise)} for i, w in enumerate(wear)]
 
 
 def _reading_high(seed: int, scale_uncertainty):
@@ -88,7 +88,7 @@ def _reading_high(seed: int, scale_uncertainty):
     truth = rate * np.maximum(t - onset, 0.0)
     estimate = 1.5 * truth + np.random.default_rng(seed).normal(0.0, 1.0, days)
     rows = _rows(estimate, 1.0)
-    (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
+    (row,) = prognosis.remaining_life("u", tables.log_rows(rows), 1, alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
                                       since=rows[int(np.argmax(estimate >= 12.0))]["stamp"],
                                       scale_uncertainty=scale_uncertainty)
     return row, onset + F / rate - (days - 1)

@@ -273,11 +273,11 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
         unit.add(f"{i:03d}", rng.normal(0, 0.1, 18) + wear * signatures[1], 30.0, 100.0, np.zeros(18))
     assert unit.first_alarm is not None and unit.source_axis == 2 and unit.statistic == "wear"
     first = int(unit.first_alarm)
-    rows = {r["stamp"]: r for r in unit.rows}
+    rows = {r.stamp: r for r in unit.rows}
     limit = unit.settings.wear_limit
     assert limit == 10.0
-    assert all(max(rows[f"{k:03d}"][f"wear{a}_lower"] for a in range(1, 7)) >= limit for k in range(first, first + 5))
-    assert max(rows[f"{first - 1:03d}"][f"wear{a}_lower"] for a in range(1, 7)) < limit  # else it began earlier
+    assert all(max(rows[f"{k:03d}"].wear.lower) >= limit for k in range(first, first + 5))
+    assert max(rows[f"{first - 1:03d}"].wear.lower) < limit  # else it began earlier
     true_wear = (first - 60) * 0.5
     assert limit <= true_wear < limit + 10.0, true_wear
     assert "axis 2 wear estimate" in unit.alarm_row()["evidence"]

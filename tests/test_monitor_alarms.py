@@ -51,7 +51,7 @@ def _ramp(n: int, axis: int, onset: int, rate: float) -> np.ndarray:
 
 
 def _monitoring(unit):
-    return [r for r in unit.rows if r["phase"] == "monitoring"]
+    return [r for r in unit.rows if r.phase == "monitoring"]
 
 
 def _reference(rows, limit: float = SETTINGS.wear_limit, persistence: int = SETTINGS.persistence):
@@ -60,13 +60,12 @@ def _reference(rows, limit: float = SETTINGS.wear_limit, persistence: int = SETT
     lower bound passes it by its own width (the bound less the filtered wear's distance to it)."""
     run = 0
     for k, r in enumerate(rows):
-        lower = np.array([r[f"wear{a}_lower"] for a in range(1, N_AXES + 1)])
-        wear = np.array([r[f"wear{a}"] for a in range(1, N_AXES + 1)])
+        lower, wear = r.wear.lower, r.wear.estimate
         run = run + 1 if lower.max() >= limit else 0
         far = run and (2 * lower - wear).max() >= limit
         if run >= persistence or far:
             run = min(run, persistence)
-            return rows[k - run + 1]["stamp"], r["stamp"], bool(far and run < persistence)
+            return rows[k - run + 1].stamp, r.stamp, bool(far and run < persistence)
     return None, None, False
 
 
@@ -78,7 +77,7 @@ def test_the_alarm_is_known_on_the_fifth_alarming_log_and_starts_from_the_first(
     _feed(unit, _ramp(200, 2, 35, 0.1), rng, noise=0.15)
     first, known, at_once = _reference(_monitoring(unit))
     assert (unit.first_alarm, unit.known, at_once) == (first, known, False)
-    stamps = [r["stamp"] for r in unit.rows]
+    stamps = [r.stamp for r in unit.rows]
     assert stamps.index(known) - stamps.index(first) == SETTINGS.persistence - 1
     row = unit.alarm_row()
     assert (row["first_alarm"], row["known"], row["source_axis"]) == (first, known, 2)
@@ -93,7 +92,7 @@ def test_a_lower_bound_past_the_limit_by_its_own_width_alarms_at_once():
     _feed(unit, wear, rng)
     first, known, at_once = _reference(_monitoring(unit))
     assert (unit.first_alarm, unit.known, at_once, unit.source_axis) == (first, known, True, 1)
-    stamps = [r["stamp"] for r in unit.rows]
+    stamps = [r.stamp for r in unit.rows]
     assert "040" <= first and stamps.index(known) - stamps.index(first) < SETTINGS.persistence - 1
     assert "at once" in unit.evidence
 
@@ -104,11 +103,11 @@ def test_an_alarm_under_way_at_a_gearbox_change_is_closed_by_it_not_forgotten():
     wear = _ramp(200, 3, 35, 0.1)
 
     def two_alarming(u):
-        return len(u.rows) >= 2 and u.rows[-1]["alarm"] and u.rows[-2]["alarm"] and u.rows[-1]["phase"] == "monitoring"
+        return len(u.rows) >= 2 and u.rows[-1].alarm and u.rows[-2].alarm and u.rows[-1].phase == "monitoring"
 
     _feed(unit, wear, rng, stop=two_alarming, noise=0.15)
     assert unit.first_alarm is None and unit.run == 2
-    first, last = unit.rows[-2]["stamp"], unit.rows[-1]["stamp"]
+    first, last = unit.rows[-2].stamp, unit.rows[-1].stamp
     change = f"{len(unit.rows):03d}"
     unit.maintenance(change, "gearbox change", 3)
     closed, current = unit.alarm_rows()
@@ -135,8 +134,9 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     np.testing.assert_allclose(unit.width_, 2 * z * NOISE / per_axis, rtol=0.35)
     assert unit.observable_.tolist() == [True, False, True]
     assert unit.width_[1] > NOT_OBSERVABLE_LIMITS * SETTINGS.wear_limit > unit.width_[0]
-    assert all(np.isnan(r["wear2"]) and np.isnan(r["wear2_log"]) and np.isfinite(r["wear1"]) for r in unit.rows)
-    assert not any(r["alarm"] for r in unit.rows) and unit.first_alarm is None
+    assert all(np.isnan(r.wear.estimate[1]) and np.isnan(r.wear.log[1]) and np.isfinite(r.wear.estimate[0])
+               for r in unit.rows)
+    assert not any(r.alarm for r in unit.rows) and unit.first_alarm is None
     assert "axis 2 " + NOT_OBSERVABLE in unit.not_observable_note()
     report.write_wear(tmp_path / "wear.csv", [unit])
     report.write_scores(tmp_path / "scores.csv", [unit], N_AXES)
@@ -185,14 +185,14 @@ def test_a_program_changes_relearning_logs_are_listed_and_counted():
     _feed(unit, np.zeros((30, N_AXES)), rng)
     unit.restart("030", "program change")
     _feed(unit, np.zeros((12, N_AXES)), rng, first=30)
-    assert len(unit.rows) == 42 and [r["phase"] for r in unit.rows[30:]] == ["relearning"] * 12
+    assert len(unit.rows) == 42 and [r.phase for r in unit.rows[30:]] == ["relearning"] * 12
     assert unit.alarm_row()["evidence"] == f"learning again after the program change of 030: 12 of {SETTINGS.train} logs"
     report.chart(io.BytesIO(), unit, "wear signature match")  # rows without scores drawn as gaps
     _feed(unit, np.zeros((15, N_AXES)), rng, first=42)
-    phases = [r["phase"] for r in unit.rows]
-    assert len(phases) == 57 and [r["stamp"] for r in unit.rows] == [f"{i:03d}" for i in range(57)]
+    phases = [r.phase for r in unit.rows]
+    assert len(phases) == 57 and [r.stamp for r in unit.rows] == [f"{i:03d}" for i in range(57)]
     assert phases[30:] == ["relearning"] * SETTINGS.train + ["monitoring"] * 7
-    assert all(np.isfinite(r["Q"]) for r in unit.rows)
+    assert all(np.isfinite(r.Q) for r in unit.rows)
     assert unit.alarm_row()["evidence"].startswith("no persistent alarm since the program change of 030 (27 logs")
 
 

@@ -227,8 +227,8 @@ def test_the_rul_benchmark_replays_the_monitors_rows_with_their_factors(fleet, m
     pairs = []
     for unit, unit_rows in replayed.items():
         for r in unit_rows:
-            for k in range(1, 7):
-                if f"wear{k}_factor" in r:
-                    pairs.append((written[(unit, r["stamp"], k)], r[f"wear{k}"]))
+            if r.wear is not None and r.wear.tests is not None:
+                pairs += [(written[(unit, r.stamp, k + 1)], float(r.wear.estimate[k])) for k in range(6)]
     assert len(pairs) >= 12 * 6 and all(math.isclose(a, b, rel_tol=1e-5, abs_tol=1e-4) for a, b in pairs), pairs[:5]
-    assert {r["wear1_scale"] for r in replayed["unit02"] if "wear1_scale" in r} == {friction_tests.TESTS_SCALE}
+    assert {r.wear.tests.scale[0] for r in replayed["unit02"] if r.wear is not None and r.wear.tests is not None} == \
+        {friction_tests.TESTS_SCALE}

@@ -11,7 +11,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import monitor_rul  # noqa: E402
 
-from faultgen.monitor import friction_tests, prognosis  # noqa: E402
+from faultgen.monitor import friction_tests, prognosis, tables  # noqa: E402
 
 
 def _rows(factors, twin):
@@ -26,7 +26,7 @@ def _rows(factors, twin):
                     f"wear{k}_factor_error": 0.05 * fk, f"wear{k}_scale": friction_tests.TESTS_SCALE,
                     f"wear{k}_log": fk * xk, f"wear{k}_log_lower": fk * (xk - 2.0), f"wear{k}": fk * xk}
         rows.append(row)
-    return rows
+    return tables.log_rows(rows)
 
 
 def test_each_prediction_on_its_latest_factor():
@@ -35,8 +35,8 @@ def test_each_prediction_on_its_latest_factor():
     rows = _rows(factors, twin)
     rescaled, uncertainty = monitor_rul.on_scale(rows[:12], 0.1, True)
     # the first 12 logs on the 12th log's factor (0.5), its relative error as the scale's uncertainty
-    assert np.allclose([r["wear1_log"] for r in rescaled], 0.5 * twin[:12])
-    assert np.allclose([r["wear1_log_lower"] for r in rescaled], 0.5 * (twin[:12] - 2.0))
+    assert np.allclose([r.wear.log[0] for r in rescaled], 0.5 * twin[:12])
+    assert np.allclose([r.wear.log_lower[0] for r in rescaled], 0.5 * (twin[:12] - 2.0))
     assert np.isclose(uncertainty[1], 0.05)
     # without tests: the rows and the given uncertainty as they are
     same, given = monitor_rul.on_scale(rows, 0.1, False)

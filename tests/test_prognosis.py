@@ -10,7 +10,7 @@ from statistics import NormalDist
 import numpy as np
 import pytest
 
-from faultgen.monitor import prognosis, trends
+from faultgen.monitor import prognosis, tables, trends
 
 ALPHA = 0.01
 Z = NormalDist().inv_cdf(1 - ALPHA)
@@ -22,12 +22,12 @@ SAMPLES = 200  # draws of the fit per prediction (the monitor takes prognosis.SA
 def _rows(wear: np.ndarray, start: str = "2026-01-05", sequence: bool = False) -> list[dict]:
     day = datetime.date.fromisoformat(start)
     return [{"stamp": str(100 + i) if sequence else (day + datetime.timedelta(days=i)).isoformat(),
-             "phase": "monitoring", "wear1_log": float(w), "wear1_log_lower": float(w - Z * NOISE)}
+             "phase": "monitoring", "wear1": float(w), "wear1_log": float(w), "wear1_log_lower": float(w - Z * NOISE)}
             for i, w in enumerate(wear)]
 
 
 def _one(rows: list[dict], **options) -> prognosis.Remaining:
-    (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, **options)
+    (row,) = prognosis.remaining_life("u", tables.log_rows(rows), 1, alpha=ALPHA, samples=SAMPLES, **options)
     return row
 
 
@@ -178,13 +178,13 @@ def test_maintenance_restarts_the_trend_and_too_few_logs_say_so():
     assert row.logs_fitted == 19 and row.fitted_from == rows[21]["stamp"]
     row = _one(rows[:24])
     assert row.rul is None and row.verdict.startswith("too few logs for a trend: 3 of 5"), row.verdict
-    (unit,) = prognosis.remaining_life("u", [], 6, alpha=ALPHA)
+    (unit,) = prognosis.remaining_life("u", tables.log_rows([]), 6, alpha=ALPHA)
     assert unit.axis is None and "learning" in unit.verdict
     own = [{"stamp": "2026-01-05", "phase": "monitoring", "Q": 1.0}]
-    (unit,) = prognosis.remaining_life("u", own, 6, alpha=ALPHA)
+    (unit,) = prognosis.remaining_life("u", tables.log_rows(own), 6, alpha=ALPHA)
     assert unit.axis is None and "protocol own" in unit.verdict
     with pytest.raises(ValueError, match="failure_wear"):
-        prognosis.remaining_life("u", rows, 1, alpha=ALPHA, failure_wear=0.0)
+        prognosis.remaining_life("u", tables.log_rows(rows), 1, alpha=ALPHA, failure_wear=0.0)
 
 
 def test_the_same_rows_give_the_same_distribution():

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from faultgen.bench import rul_scores
-from faultgen.monitor import prognosis, trends
+from faultgen.monitor import prognosis, tables, trends
 
 ALPHA = 0.01
 Z = NormalDist().inv_cdf(1 - ALPHA)
@@ -29,14 +29,14 @@ def _rows(wear, n_axes: int = 1) -> list[dict]:
     for i, w in enumerate(wear):
         row = {"stamp": (day + datetime.timedelta(days=i)).isoformat(), "phase": "monitoring"}
         for a in range(1, n_axes + 1):
-            row.update({f"wear{a}_log": float(w), f"wear{a}_log_lower": float(w - Z * NOISE)})
+            row.update({f"wear{a}": float(w), f"wear{a}_log": float(w), f"wear{a}_log_lower": float(w - Z * NOISE)})
         rows.append(row)
     return rows
 
 
 def _alarmed(rows, alarm: int, **options) -> prognosis.Remaining:
     """The open alarm's source axis (axis 1) at the last log: the model average over the whole block."""
-    (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, since=rows[alarm]["stamp"],
+    (row,) = prognosis.remaining_life("u", tables.log_rows(rows), 1, alpha=ALPHA, samples=SAMPLES, since=rows[alarm]["stamp"],
                                       source_axis=1, **options)
     return row
 
@@ -119,10 +119,10 @@ def test_a_rise_too_short_or_too_slow_is_not_yet_predictable_and_a_flat_one_has_
     assert not row.predictable and row.distribution is not None
     # a slow rise whose 95 % end lies beyond the horizon
     slow = 0.03 * t + rng.normal(0, NOISE, 45)
-    (row,) = prognosis.remaining_life("u", _rows(slow), 1, alpha=0.2, samples=SAMPLES)
+    (row,) = prognosis.remaining_life("u", tables.log_rows(_rows(slow)), 1, alpha=0.2, samples=SAMPLES)
     assert row.rul is None and ("not yet predictable" in row.verdict or "no end of life" in row.verdict), row.verdict
     # flat: the trend can tell, there is no end of life within the horizon
-    (row,) = prognosis.remaining_life("u", _rows(rng.normal(0, NOISE, 45)), 1, alpha=ALPHA, samples=SAMPLES)
+    (row,) = prognosis.remaining_life("u", tables.log_rows(_rows(rng.normal(0, NOISE, 45))), 1, alpha=ALPHA, samples=SAMPLES)
     assert row.rul is None and "no end of life within the horizon" in row.verdict, row.verdict
 
 
@@ -147,7 +147,7 @@ def test_the_scale_uncertainty_per_axis():
     rows = _rows(0.5 * np.arange(50.0) + rng.normal(0, NOISE, 50), n_axes=2)
 
     def rows_of(u):
-        return prognosis.remaining_life("u", rows, 2, alpha=ALPHA, samples=SAMPLES, scale_uncertainty=u)
+        return prognosis.remaining_life("u", tables.log_rows(rows), 2, alpha=ALPHA, samples=SAMPLES, scale_uncertainty=u)
 
     one, two = rows_of({1: 0.0, 2: 0.3})
     assert one.rul_95 - one.rul_5 < 0.5 * (two.rul_95 - two.rul_5), (one, two)

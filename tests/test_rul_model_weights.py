@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from faultgen.bench import rul_scores
-from faultgen.monitor import prognosis, trends
+from faultgen.monitor import prognosis, tables, trends
 
 ALPHA = 0.01
 Z = NormalDist().inv_cdf(1 - ALPHA)
@@ -29,7 +29,7 @@ SLOPE = 0.6  # % per day: 20 % at the last log, 40 % 32.7 days later
 def _rows(wear, noise: float) -> list[dict]:
     day = datetime.date.fromisoformat("2026-01-05")
     return [{"stamp": (day + datetime.timedelta(days=i)).isoformat(), "phase": "monitoring",
-             "wear1_log": float(w), "wear1_log_lower": float(w - Z * noise)} for i, w in enumerate(wear)]
+             "wear1": float(w), "wear1_log": float(w), "wear1_log_lower": float(w - Z * noise)} for i, w in enumerate(wear)]
 
 
 def _predict(shape: str, noise: float, seed: int) -> tuple[prognosis.Remaining, float]:
@@ -45,7 +45,7 @@ def _predict(shape: str, noise: float, seed: int) -> tuple[prognosis.Remaining, 
     rows = _rows(noisy, noise)
     # the scale drawn as when these figures were measured (normal, 10 %): the trend's rule is tested
     # here; the no-test prior since (log-normal, prognosis.TWIN_SCALE_LOG_SD) in tests/test_life_unknown_scale.py
-    (row,) = prognosis.remaining_life("u", rows, 1, alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
+    (row,) = prognosis.remaining_life("u", tables.log_rows(rows), 1, alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
                                       since=rows[int(np.argmax(wear >= 12.0))]["stamp"],
                                       scale_uncertainty=prognosis.SCALE_UNCERTAINTY)
     return row, truth
@@ -119,7 +119,7 @@ def test_the_same_seed_gives_the_same_bytes(tmp_path):
     written = []
     for seed in (4, 4, 5):
         row, _ = _predict("quadratic", 3.5, 4)
-        (again,) = prognosis.remaining_life("u", _rows([0.0] * 30 + [0.02 * i**2 for i in range(35)], 3.5), 1,
+        (again,) = prognosis.remaining_life("u", tables.log_rows(_rows([0.0] * 30 + [0.02 * i**2 for i in range(35)], 3.5)), 1,
                                             alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
                                             since="2026-02-28")
         path = tmp_path / f"rul{len(written)}.csv"

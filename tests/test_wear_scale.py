@@ -58,8 +58,8 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
             unit.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
-            error = (row[f"wear{axis}_log"] - row[f"wear{axis}_log_lower"]) / unit.bound_quantile
-            z.append(row[f"wear{axis}_log"] / error)
+            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.bound_quantile
+            z.append(row.wear.log[axis - 1] / error)
     return unit, np.array(z)
 
 

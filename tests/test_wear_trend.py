@@ -73,20 +73,20 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 30, 0) * 0.8 * signatures[1], 30.0, 0.0,
                  np.zeros(18))
     rows = unit.rows
-    log = np.array([[r[f"wear{a}_log"] for a in range(1, 7)] for r in rows])
-    error = np.array([[r[f"wear{a}_log"] - r[f"wear{a}_log_lower"] for a in range(1, 7)] for r in rows])
+    log = np.array([r.wear.log for r in rows])
+    error = np.array([r.wear.log - r.wear.log_lower for r in rows])
     trend = WearTrend(6)
     expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile) for k in range(len(rows))])
-    np.testing.assert_allclose([[r[f"wear{a}"] for a in range(1, 7)] for r in rows], expected[:, 0], rtol=1e-12)
-    assert rows[-1]["wear2"] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
+    np.testing.assert_allclose([r.wear.estimate for r in rows], expected[:, 0], rtol=1e-12)
+    assert rows[-1].wear.estimate[1] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
     # the alarm is judged on the filtered wear's lower one-sided 90 % bound (WEAR_ALARM_CONFIDENCE),
     # each log's own bound stays 1 - alpha
     assert unit.alarm_quantile == pytest.approx(1.2816, abs=1e-4) and WEAR_ALARM_CONFIDENCE == 0.90
-    lower = np.array([[r[f"wear{a}_lower"] for a in range(1, 7)] for r in rows])
+    lower = np.array([r.wear.lower for r in rows])
     np.testing.assert_allclose(lower, expected[:, 0] - unit.alarm_quantile * expected[:, 1], rtol=1e-9, atol=1e-9)
-    monitoring = [k for k, r in enumerate(rows) if r["phase"] == "monitoring"]
-    assert [rows[k]["alarm"] for k in monitoring] == [int(lower[k].max() >= 10.0) for k in monitoring]
-    assert any(rows[k]["alarm"] for k in monitoring) and unit.first_alarm is not None
+    monitoring = [k for k, r in enumerate(rows) if r.phase == "monitoring"]
+    assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= 10.0) for k in monitoring]
+    assert any(rows[k].alarm for k in monitoring) and unit.first_alarm is not None
 
 
 def test_maintenance_restarts_the_trend():
@@ -99,7 +99,7 @@ def test_maintenance_restarts_the_trend():
     assert unit.trend.state is None
     residual = rng.normal(0, 0.05, 18)
     unit.add("051", residual, 30.0, 0.0, np.zeros(18))
-    assert unit.rows[-1]["wear2"] == pytest.approx(unit.rows[-1]["wear2_log"])  # a new trend starts at the log
+    assert unit.rows[-1].wear.estimate[1] == pytest.approx(unit.rows[-1].wear.log[1])  # a new trend starts at the log
 
 
 def test_a_single_outlying_log_does_not_move_the_trend_and_three_in_a_row_restart_it():
@@ -279,4 +279,4 @@ def test_the_monitors_own_estimate_of_a_log_is_its_estimate_less_the_slope_error
         row = unit.rows[-1]
         part = unit.trend.condition_part(x)
         assert np.any(np.abs(part) > 1e-6)
-        np.testing.assert_allclose([row[f"wear{a}_log"] for a in range(1, 7)], own - part, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(row.wear.log, own - part, rtol=1e-9, atol=1e-9)

@@ -33,7 +33,7 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
                      f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
-    logs_scored = max((sum(r["phase"] == "monitoring" for r in m.rows) for m in monitors), default=0)
+    logs_scored = max((sum(r.phase == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
     statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,

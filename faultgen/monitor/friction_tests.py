@@ -66,6 +66,7 @@ in the twin's scale (``wear_scale`` ``twin``).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
@@ -497,25 +498,25 @@ def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
                                  cell(r.wear), cell(r.lower), cell(r.upper), r.verdict])
 
 
-def on_tests_scale(rows: list[dict], n_axes: int) -> tuple[list[dict], dict[int, float] | None]:
-    """``rows`` (a monitor's, :attr:`faultgen.monitor.scoring.UnitMonitor.rows`, in order) as
-    :func:`remaining_life` fits them: each axis's own estimates (``wear<k>_log``,
-    ``wear<k>_log_lower``, %) the twin-scale ones times the *last* row's factor, and each axis's
-    scale uncertainty (relative: the last factor's standard error over it; an axis in the twin's
-    scale :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`). A prefix ``rows[:i]`` gives what
-    the monitor said after its ``i``-th log. ``(rows, None)`` unchanged when the last row has no
-    twin-scale columns (no friction test)."""
+def on_tests_scale(rows: list, n_axes: int) -> tuple[list, dict[int, float] | None]:
+    """``rows`` (a monitor's :class:`faultgen.monitor.record.LogRow`, in order) as
+    :func:`remaining_life` fits them: each axis's own estimates (``wear.log``, ``wear.log_lower``,
+    %) the twin-scale ones times the *last* row's factor, and each axis's scale uncertainty
+    (relative: the last factor's standard error over it; an axis in the twin's scale
+    :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`). A prefix ``rows[:i]`` gives what the
+    monitor said after its ``i``-th log. ``(rows, None)`` unchanged when the last row has no
+    twin-scale values (no friction test)."""
     from faultgen.monitor import prognosis
 
-    if not rows or "wear1_twin_log" not in rows[-1]:
+    last = rows[-1].wear.tests if rows and rows[-1].wear is not None else None
+    if last is None:
         return rows, None
-    last, axes = rows[-1], range(1, n_axes + 1)
-    factor = {k: last[f"wear{k}_factor"] for k in axes}
-    rescaled = [{**r, **{f"wear{k}{end}": factor[k] * r[f"wear{k}_twin{end}"]
-                         for k in axes for end in ("_log", "_log_lower")}} if "wear1_twin_log" in r else r
-                for r in rows]
-    uncertainty = {k: last[f"wear{k}_factor_error"] / factor[k] if last[f"wear{k}_scale"] == TESTS_SCALE
-                   else prognosis.SCALE_UNCERTAINTY for k in axes}
+    factor = last.factor
+    rescaled = [dataclasses.replace(r, wear=r.wear.with_log(factor * r.wear.tests.twin_log,
+                                                            factor * r.wear.tests.twin_log_lower))
+                if r.wear is not None and r.wear.tests is not None else r for r in rows]
+    uncertainty = {k + 1: float(last.factor_error[k] / factor[k]) if last.scale[k] == TESTS_SCALE
+                   else prognosis.SCALE_UNCERTAINTY for k in range(n_axes)}
     return rescaled, uncertainty
 
 

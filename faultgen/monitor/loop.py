@@ -384,8 +384,8 @@ def _scale_of(monitor, nominal: bool = False) -> str:
     is on its tests' scale (:mod:`faultgen.monitor.friction_tests`), else ``nominal model`` for a
     unit whose twin fell back to the nominal model (``nominal``: :func:`_nominal_scale`), ``twin``
     otherwise."""
-    last = monitor.rows[-1] if monitor.rows else {}
-    on_tests = any(last.get(f"wear{k}_scale") == friction_tests.TESTS_SCALE for k in range(1, monitor.n_axes + 1))
+    last = monitor.rows[-1].wear if monitor.rows else None
+    on_tests = last is not None and last.tests is not None and friction_tests.TESTS_SCALE in last.tests.scale
     return friction_tests.TESTS_SCALE if on_tests else friction_tests.NOMINAL_SCALE if nominal else \
         friction_tests.TWIN_SCALE
 

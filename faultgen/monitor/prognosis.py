@@ -367,8 +367,8 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                    seed: int = 0, axes: list[int] | None = None, changepoint: bool = True,
                    scale_uncertainty=None) -> list[Remaining]:
     """Each axis's remaining life (:class:`Remaining`, axes 1..``n_axes``) from a unit's monitor
-    rows (``UnitMonitor.rows``: ``stamp``, ``phase``, each log's own wear estimate ``wearI_log`` and its
-    lower bound ``wearI_log_lower``, not the filtered ``wearI``, whose errors are not independent from
+    rows (:class:`faultgen.monitor.record.LogRow`: ``stamp``, ``phase``, each log's own wear estimate
+    ``wear.log`` and its lower bound ``wear.log_lower``, not the filtered ``wear.estimate``, whose errors are not independent from
     log to log as the trend's fit assumes) with the monitor's
     ``alpha``; ``keys`` the stamps' time keys and ``kind`` theirs
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed from the stamps when None); ``since`` the
@@ -384,8 +384,8 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     check_failure_wear(failure_wear)
     wanted = list(range(1, n_axes + 1)) if axes is None else list(axes)
     uncertainty = {axis: scale_of_axis(scale_uncertainty, axis, n_axes) for axis in wanted}
-    stamp = rows[-1]["stamp"] if rows else ""
-    if not rows or "wear1_log" not in rows[0]:
+    stamp = rows[-1].stamp if rows else ""
+    if not rows or rows[0].wear is None:
         why = "still learning: no wear estimate yet" if not rows else "no wear estimate (protocol own: no twin)"
         return [Remaining(unit, None, stamp, "", why, failure_wear, horizon)]
     block, keys, kind = monitoring_block(unit, rows, keys, kind)
@@ -395,18 +395,18 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     out = []
 
     def series(logs, axis):
-        wear = np.array([r[f"wear{axis}_log"] for r in logs], dtype=float)
-        error = (wear - np.array([r[f"wear{axis}_log_lower"] for r in logs], dtype=float)) / z
-        t = np.array([keys[r["stamp"]] for r in logs], dtype=float)
+        wear = np.array([r.wear.log[axis - 1] for r in logs], dtype=float)
+        error = (wear - np.array([r.wear.log_lower[axis - 1] for r in logs], dtype=float)) / z
+        t = np.array([keys[r.stamp] for r in logs], dtype=float)
         return (t - t[-1]) / per, wear, np.maximum(error, 1e-9)
 
     for axis in wanted:
-        fitted, fits, now = block, [], rows[-1].get(f"wear{axis}")  # now: wear.csv's, not the trend's
+        fitted, fits, now = block, [], None if rows[-1].wear is None else rows[-1].wear.estimate[axis - 1]
         if isinstance(now, float) and np.isnan(now):  # faultgen.monitor.scoring.NOT_OBSERVABLE_LIMITS
             out.append(Remaining(unit, axis, stamp, time_unit, UNOBSERVED, failure_wear, horizon))
             continue
         if since is not None and axis == source_axis:
-            stamps = [r["stamp"] for r in block]
+            stamps = [r.stamp for r in block]
             if changepoint and since in stamps and len(block) >= MIN_LOGS:  # the whole block, flat then rising
                 fits = fit_models(*series(block, axis), changepoint=True)
                 if not any(f.changepoint is not None for f in fits):
@@ -414,7 +414,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             if not fits:  # the logs from the alarm on
                 fitted = block[stamps.index(since):] if since in stamps else block
         base = Remaining(unit, axis, stamp, time_unit, "", failure_wear, horizon, logs_fitted=len(fitted),
-                         fitted_from=fitted[0]["stamp"] if fitted else "", wear=None if now is None else float(now))
+                         fitted_from=fitted[0].stamp if fitted else "", wear=None if now is None else float(now))
         if len(fitted) < MIN_LOGS:
             base.verdict = (f"too few logs for a trend: {len(fitted)} of {MIN_LOGS} since the "
                             f"{'first alarm' if fitted is not block else 'learning or the last maintenance'}")
@@ -443,19 +443,19 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
     return out
 
 
-def monitoring_block(unit: str, rows: list[dict], keys: dict[str, float] | None, kind: str | None):
+def monitoring_block(unit: str, rows: list, keys: dict[str, float] | None, kind: str | None):
     """The unit's monitoring rows since its last maintenance (the rows after the last that is not
     of phase ``monitoring``), their stamps' time ``keys`` and ``kind``
     (:func:`faultgen.data.logfolder.parse_stamp`; parsed when ``keys`` is None)."""
     block = []
     for row in reversed(rows):
-        if row["phase"] != "monitoring":
+        if row.phase != "monitoring":
             break
         block.append(row)
     block.reverse()
     if keys is None:
-        parsed = [logfolder.parse_stamp(r["stamp"], f"{unit}/{r['stamp']}") for r in block]
-        keys = {r["stamp"]: key for r, (key, _) in zip(block, parsed)}
+        parsed = [logfolder.parse_stamp(r.stamp, f"{unit}/{r.stamp}") for r in block]
+        keys = {r.stamp: key for r, (key, _) in zip(block, parsed)}
         kind = parsed[0][1] if parsed else kind
     return block, keys, kind
 

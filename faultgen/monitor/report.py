@@ -82,7 +82,20 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
         writer.writerow(columns)
         for m in monitors:
             for row in m.rows:
-                writer.writerow([_fmt(row.get(c, "")) for c in columns])
+                cells_ = score_cells(row)
+                writer.writerow([_fmt(cells_.get(c, "")) for c in columns])
+
+
+def score_cells(row) -> dict:
+    """scores.csv's cells of a :class:`faultgen.monitor.record.LogRow`, by column name."""
+    out = {"unit": row.unit, "stamp": row.stamp, "phase": row.phase, "Q": row.Q, "Q_limit": row.Q_limit, "T2": row.T2,
+           "T2_limit": row.T2_limit, "alarm": row.alarm, "ranking": " ".join(str(a) for a in row.ranking),
+           **{f"score{i + 1}": float(v) for i, v in enumerate(row.scores)}}
+    if row.wear is not None:
+        w = row.wear
+        for end, values in (("", w.estimate), ("_lower", w.lower), ("_log", w.log), ("_log_lower", w.log_lower)):
+            out.update({f"wear{i + 1}{end}": float(v) for i, v in enumerate(values)})
+    return out
 
 
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
@@ -103,13 +116,14 @@ def write_wear(path: Path, monitors, scales: bool = False, nominal=frozenset()) 
         writer.writerow(WEAR_COLUMNS + (("wear_scale",) if scales else ()))
         for m in monitors:
             for row in m.rows:
-                if "wear1" not in row:
+                w = row.wear
+                if w is None:
                     continue
-                for axis in range(1, m.n_axes + 1):
+                for k in range(m.n_axes):
                     default = "nominal model" if m.unit in nominal else "twin"
-                    extra = [row.get(f"wear{axis}_scale", default)] if scales else []
-                    writer.writerow([_fmt(row["unit"]), _fmt(row["stamp"]), row["phase"], axis,
-                                     *(_fmt(row[f"wear{axis}{end}"]) for end in ("", "_5", "_95", "_lower", "_log")),
+                    extra = [w.tests.scale[k] if w.tests is not None else default] if scales else []
+                    writer.writerow([_fmt(row.unit), _fmt(row.stamp), row.phase, k + 1,
+                                     *(_fmt(float(v[k])) for v in (w.estimate, w.p5, w.p95, w.lower, w.log)),
                                      *extra])
 
 
@@ -158,18 +172,19 @@ def _figure(height: float):
 
 def _draw(path, monitor, axis_note: str) -> None:
     rows = monitor.rows
-    twin = bool(rows) and "wear1" in rows[0]
+    twin = bool(rows) and rows[0].wear is not None
     fig = _figure(8.5 if twin else 6)
     panels = fig.subplots(3 if twin else 2, 1, sharex=True)
     top, bottom = panels[0], panels[-1]
     if rows:
         x = np.arange(len(rows))
         for name, style in (("Q", "-"), ("T2", "--")):
-            top.plot(x, [r[name] / r[f"{name}_limit"] for r in rows], style, lw=1, label=f"{name} / limit")
+            top.plot(x, [getattr(r, name) / getattr(r, f"{name}_limit") for r in rows], style, lw=1,
+                     label=f"{name} / limit")
         top.axhline(1.0, color="k", lw=0.8, label="limit (alpha {:g})".format(monitor.settings.alpha))
-        training = sum(r["phase"] == "training" for r in rows)
+        training = sum(r.phase == "training" for r in rows)
         top.axvspan(-0.5, training - 0.5, color="0.9", label="learning (own first logs)")
-        stamps = [r["stamp"] for r in rows]
+        stamps = [r.stamp for r in rows]
         if monitor.first_alarm:
             k = stamps.index(monitor.first_alarm)
             for ax in panels:
@@ -180,15 +195,16 @@ def _draw(path, monitor, axis_note: str) -> None:
         top.set_yscale("log")
         if twin:
             middle = panels[1]
+            nan = np.full(monitor.n_axes, np.nan)
+            wear = [(r.wear.estimate, r.wear.lower) if r.wear is not None else (nan, nan) for r in rows]
             for i in range(monitor.n_axes):
-                middle.plot(x, [r.get(f"wear{i + 1}", np.nan) for r in rows], lw=1, label=f"axis {i + 1}")
-            best = [max((v for i in range(monitor.n_axes) if np.isfinite(v := r.get(f"wear{i + 1}_lower", np.nan))),
-                        default=np.nan) for r in rows]
+                middle.plot(x, [w[0][i] for w in wear], lw=1, label=f"axis {i + 1}")
+            best = [max((v for v in w[1] if np.isfinite(v)), default=np.nan) for w in wear]
             middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * scoring.WEAR_ALARM_CONFIDENCE:g} % bound")
             middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
             middle.set_ylabel("wear estimate, % of own dry friction")
             middle.legend(fontsize=7, loc="upper left", ncol=4)
-        scores = np.array([[r.get(f"score{i}", np.nan) for i in range(1, monitor.n_axes + 1)] for r in rows])
+        scores = np.array([r.scores for r in rows])
         for i in range(monitor.n_axes):
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
         step = max(1, len(rows) // 8)

@@ -74,6 +74,7 @@ import numpy as np
 from analysis import registry
 from analysis.isolation import signature_scores
 from analysis.monitoring import PCAMonitor
+from faultgen.monitor import record
 from faultgen.monitor.wear_trend import WearTrend
 
 PROTOCOLS = ("twin", "own")
@@ -220,7 +221,7 @@ class UnitMonitor:
         self.statistic = ""
         self.limit = float("nan")
         self.evidence = ""
-        self.rows: list[dict] = []
+        self.rows: list[record.LogRow] = []
         self.last_stamp: str | None = None
         self.learned_expectations: list[np.ndarray] = []
         #: Alarms closed by a maintenance event, oldest first (rows of alarms.csv).
@@ -391,11 +392,8 @@ class UnitMonitor:
         factor, factor_error, names = self.tests.at(stamp, estimate, error)
         half = WEAR_INTERVAL_Z * np.sqrt((factor * error) ** 2 + (factor_error * estimate) ** 2)
         lower = log_estimate - self.bound_quantile * log_error
-        row = {**{f"wear{i + 1}_twin_log": float(v) for i, v in enumerate(log_estimate)},
-               **{f"wear{i + 1}_twin_log_lower": float(v) for i, v in enumerate(lower)},
-               **{f"wear{i + 1}_factor": float(v) for i, v in enumerate(factor)},
-               **{f"wear{i + 1}_factor_error": float(v) for i, v in enumerate(factor_error)},
-               **{f"wear{i + 1}_scale": v for i, v in enumerate(names)}}
+        row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
+                                tuple(names))
         rescaled = (factor * estimate, factor * error)
         return (rescaled, rescaled[0] - half, rescaled[0] + half, rescaled[0] - self.alarm_quantile * rescaled[1],
                 factor * log_estimate, factor * log_error, row)
@@ -424,9 +422,7 @@ class UnitMonitor:
             if len(self.training) == self.settings.train:
                 self._fit()
             elif self.program_changed:  # listed at once (scored when the learning is complete)
-                self.rows.append({"unit": self.unit, "stamp": stamp, "phase": "relearning", "Q": np.nan,
-                                  "Q_limit": np.nan, "T2": np.nan, "T2_limit": np.nan, "alarm": 0, "ranking": "",
-                                  **{f"score{i + 1}": np.nan for i in range(self.n_axes)}})
+                self.rows.append(record.listed(self.unit, stamp, self.n_axes))
                 self.placeholders += 1
             return
         e = np.asarray(residual, dtype=float)
@@ -476,7 +472,7 @@ class UnitMonitor:
     def _score(self, stamp: str, z: np.ndarray, phase: str, wear=None) -> None:
         t2, q = (float(v[0]) for v in self.pca.score_samples(z[None]))
         alarm = q > self.pca.q_limit_ or t2 > self.pca.t2_limit_
-        wear_row, at_once = {}, False
+        wear_row, at_once = None, False
         if wear is not None:
             log_estimate, log_error, trend_error, x = wear
             wear = estimate, error = self.trend.update(log_estimate, trend_error, x)
@@ -491,7 +487,7 @@ class UnitMonitor:
             # extrapolated over a season, the calibration's friction), which the learning logs
             # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
             low, high = self.wear_interval(estimate, log_error)
-            tested = {}
+            tested = None
             if self.tests is not None:  # on the unit's friction tests' scale
                 wear, low, high, bound, log_estimate, log_error, tested = self._on_tests(
                     stamp, estimate, error, log_estimate, log_error)
@@ -504,13 +500,8 @@ class UnitMonitor:
             hidden = np.where(seen, 1.0, np.nan)  # an axis not observable has no wear (NOT_OBSERVABLE_LIMITS)
             estimate, bound, low, high = estimate * hidden, bound * hidden, low * hidden, high * hidden
             log_estimate, log_error = log_estimate * hidden, log_error * hidden
-            wear_row = {**{f"wear{i + 1}": float(v) for i, v in enumerate(estimate)},
-                        **{f"wear{i + 1}_lower": float(v) for i, v in enumerate(bound)},
-                        **{f"wear{i + 1}_5": float(v) for i, v in enumerate(low)},
-                        **{f"wear{i + 1}_95": float(v) for i, v in enumerate(high)},
-                        **{f"wear{i + 1}_log": float(v) for i, v in enumerate(log_estimate)},
-                        **{f"wear{i + 1}_log_lower": float(v)
-                           for i, v in enumerate(log_estimate - self.bound_quantile * log_error)}, **tested}
+            wear_row = record.AxisWear(*(np.asarray(v, dtype=float) for v in (
+                estimate, bound, low, high, log_estimate, log_estimate - self.bound_quantile * log_error)), tested)
         scores = self.axis_scores(z)
         ranking = np.argsort(-scores, kind="stable") + 1
         if phase == "monitoring":
@@ -522,10 +513,9 @@ class UnitMonitor:
                     t2 > self.far_[0] or q > self.far_[1]))):
                 self._raise("at once: " + ("its lower bound above the limit by more than its own width" if at_once else
                                            f"T2 or Q past its limit at alpha^{self.settings.persistence}"))
-        self.rows.append({"unit": self.unit, "stamp": stamp, "phase": phase, "Q": q, "Q_limit": self.pca.q_limit_,
-                          "T2": t2, "T2_limit": self.pca.t2_limit_, "alarm": int(alarm),
-                          "ranking": " ".join(str(a) for a in ranking),
-                          **{f"score{i + 1}": float(s) for i, s in enumerate(scores)}, **wear_row})
+        self.rows.append(record.LogRow(self.unit, stamp, phase, q, self.pca.q_limit_, t2, self.pca.t2_limit_,
+                                       int(alarm), tuple(int(a) for a in ranking), np.asarray(scores, dtype=float),
+                                       wear_row))
 
     def _raise(self, how: str = "") -> None:
         """The alarm of the last ``run`` monitoring logs (at most ``persistence``): from the first

@@ -10,10 +10,12 @@ import csv
 import io
 from pathlib import Path
 
+import numpy as np
+
 from faultgen import inputs
 from faultgen.axes import MAX_AXES
 from faultgen.data import cells
-from faultgen.monitor import report
+from faultgen.monitor import record, report
 
 #: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv,
 #: life.csv, wear.csv, tests.csv), bytes, checked before it is read: scores.csv has a row of about
@@ -82,3 +84,42 @@ def read(folder: Path, name: str, required: tuple[str, ...],
     except csv.Error as err:
         raise inputs.InputError(f"{path}: row {reader.line_num}: not a CSV row the monitor writes ({err})") from None
     return columns, rows
+
+
+def _axis_values(row: dict, end: str, n_axes: int) -> np.ndarray:
+    return np.array([_number(row.get(f"wear{k}{end}")) for k in range(1, n_axes + 1)], dtype=float)
+
+
+def _number(value) -> float:
+    return float("nan") if value is None or value == "" else float(value)
+
+
+def log_row(row: dict) -> record.LogRow:
+    """A :class:`faultgen.monitor.record.LogRow` from a row of scores.csv's columns (read back, or
+    written so by a benchmark or test): ``stamp``, ``phase``, optional ``unit``, ``Q``, ``T2`` and
+    limits, ``alarm``, ``ranking``, ``scoreI``, and the twin's ``wearI``, ``wearI_lower``, ``wearI_5``,
+    ``wearI_95``, ``wearI_log``, ``wearI_log_lower`` (with friction tests also ``wearI_twin_log``,
+    ``wearI_twin_log_lower``, ``wearI_factor``, ``wearI_factor_error``, ``wearI_scale``); a missing
+    number is NaN."""
+    axes = [int(k[4:-4]) for k in row if k.startswith("wear") and k.endswith("_log") and k[4:-4].isdigit()]
+    scores = [int(k[5:]) for k in row if k.startswith("score") and k[5:].isdigit()]
+    n_axes = max(axes + scores, default=0)
+    wear = None
+    if any(row.get(f"wear{k}{end}") not in (None, "") for k in axes for end in ("", "_log")):
+        tests = None
+        if "wear1_twin_log" in row:
+            tests = record.TestsScale(*(_axis_values(row, end, n_axes) for end in (
+                "_twin_log", "_twin_log_lower", "_factor", "_factor_error")),
+                tuple(row.get(f"wear{k}_scale", "") for k in range(1, n_axes + 1)))
+        wear = record.AxisWear(*(_axis_values(row, end, n_axes) for end in ("", "_lower", "_5", "_95", "_log",
+                                                                             "_log_lower")), tests)
+    ranking = tuple(int(a) for a in str(row.get("ranking", "")).split())
+    return record.LogRow(row.get("unit", ""), row["stamp"], row["phase"],
+                         *(_number(row.get(c)) for c in ("Q", "Q_limit", "T2", "T2_limit")),
+                         0 if row.get("alarm") in (None, "") else int(float(row["alarm"])), ranking,
+                         np.array([_number(row.get(f"score{k}")) for k in range(1, n_axes + 1)]), wear)
+
+
+def log_rows(rows: list[dict]) -> list[record.LogRow]:
+    """:func:`log_row` of each row."""
+    return [log_row(r) for r in rows]
