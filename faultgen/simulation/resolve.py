@@ -2,15 +2,17 @@
 task, friction model and stepper are looked up.
 
 ``resolve(spec) -> Run``: the robot by :func:`faultgen.model.robots.load` (one compiled robot per
-file content, its SHA-1), the task as :func:`task` reads it (its kind decided by
-:func:`faultgen.operation.programs.kind`, read and planned at the robot's physics step once per
-process and content: :func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the
-robot's ``tasks.toml`` and of a program or log file, :func:`faultgen.simulation.prepare.digests`,
-not by file times), the stepper by :func:`stepper`; the friction model is looked up by the
+file content, its SHA-1), or the one the caller already holds (``resolved``); the task as
+:func:`task` reads it (its kind decided by :func:`faultgen.operation.programs.kind`, read and
+planned at the robot's physics step once per process and content:
+:func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the robot's ``tasks.toml``
+and of a program or log file, :func:`faultgen.simulation.prepare.digests`, not by file times); the
+stepper by :func:`stepper`; the friction model is looked up by the
 :class:`~faultgen.simulation.config.RunConfig` it builds
-(:func:`faultgen.simulation.friction_models.get`). The
-:class:`Run` holds the objects; :func:`faultgen.simulation.stepping.simulate` steps it
-(``simulate(run.config, stepper=run.stepper)``, or :meth:`Run.simulate`).
+(:func:`faultgen.simulation.friction_models.get`). The :class:`Run` holds the objects;
+:func:`faultgen.simulation.stepping.simulate` steps it (``simulate(run.config,
+stepper=run.stepper)``, or :meth:`Run.simulate`). Every command that simulates builds its runs
+here (docs/architecture.md, "Every command's runs through resolve").
 """
 
 from __future__ import annotations
