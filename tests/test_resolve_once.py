@@ -343,11 +343,12 @@ def test_a_run_from_its_spec_looks_each_name_up_once(tmp_path, looked_up):
 
 
 def test_simulate_looks_its_robot_and_task_up_once(tmp_path, looked_up):
-    """``faultgen simulate --task PROGRAM``: the robot and the program once (checked, planned, its
-    dataset's limits and record all from the one read); no stepper by name (the default object)."""
+    """``faultgen simulate --task PROGRAM``: the robot, the program (checked, planned, its dataset's
+    limits and record all from the one read) and the stepper once, by ``resolve(RunSpec)`` (issue 84
+    item 5: the stepper rides on the resolved run, found by its spec's name, the default)."""
     path = _program_file(tmp_path)
     looked_up.clear()
     result = runner.invoke(app, ["simulate", "--robot", "puma560", "--task", str(path), "--cycles", "1",
                                  "-o", str(tmp_path / "one.h5")])
     assert result.exit_code == 0, result.output
-    assert (looked_up["robot"], looked_up["task"], looked_up["stepper"]) == (1, 1, 0), dict(looked_up)
+    assert (looked_up["robot"], looked_up["task"], looked_up["stepper"]) == (1, 1, 1), dict(looked_up)

@@ -18,6 +18,7 @@ from faultgen.runs import cluster
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import Run
 
 
 def test_a_stepper_is_a_frozen_picklable_value():
@@ -37,9 +38,10 @@ def test_a_task_key_keeps_the_text_it_had_with_names():
     def key(extra: str) -> str:  # main's task_key: the config key, then "backend=NAME" unless the default
         return "faultgen-r1-" + hashlib.sha256((dataset.config_key(config) + extra).encode()).hexdigest()[:16]
 
-    assert cluster.task_key("r1", config) == cluster.task_key("r1", config, backends.BatchStepper()) == key("")
-    assert cluster.task_key("r1", config, backends.LoopStepper()) == key("\nbackend=loop")
-    assert cluster.task_key("r1", config, backends.BatchStepper(2)) == key("\nbackend=batch BatchStepper(nthread=2)")
+    assert cluster.task_key("r1", Run(config, backends.DEFAULT_STEPPER)) == key("")
+    assert cluster.task_key("r1", Run(config, backends.BatchStepper())) == key("")
+    assert cluster.task_key("r1", Run(config, backends.LoopStepper())) == key("\nbackend=loop")
+    assert cluster.task_key("r1", Run(config, backends.BatchStepper(2))) == key("\nbackend=batch BatchStepper(nthread=2)")
 
 
 def test_an_execution_context_checks_its_values_and_names_them():

@@ -20,6 +20,8 @@ from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.runs import sweep, worker
 from faultgen.runs.context import ExecutionContext
+from faultgen.simulation import backends
+from faultgen.simulation.resolve import Run
 
 runner = CliRunner()
 
@@ -252,7 +254,7 @@ def test_resume_simulates_only_the_missing_runs(tmp_path):
     plan = dict(grid.runs())
     first = list(plan)[:3]
     for run_id in first:
-        sweep.simulate_and_write(run_id, plan[run_id], parts / f"{run_id}.h5")
+        sweep.simulate_and_write(run_id, Run(plan[run_id], backends.DEFAULT_STEPPER), parts / f"{run_id}.h5")
     stamps = {run_id: (parts / f"{run_id}.h5").stat().st_mtime_ns for run_id in first}
     (parts / ".stale.h5.abc.part").write_text("left by a killed writer")
     simulated = []
@@ -272,7 +274,7 @@ def test_a_part_of_another_configuration_is_redone(tmp_path):
     parts.mkdir()
     run_id, _ = grid.runs()[0]
     other = sweep.Grid(**{**SMALL, "record": [1, 30]}).runs()[0][1]
-    sweep.simulate_and_write(run_id, other, parts / f"{run_id}.h5")
+    sweep.simulate_and_write(run_id, Run(other, backends.DEFAULT_STEPPER), parts / f"{run_id}.h5")
     assert run_id not in sweep.finished_runs(grid, out)
 
 

@@ -27,7 +27,8 @@ from pathlib import Path
 import faultgen.runs.worker as worker
 seen = [sorted(sys.modules)]
 for run_id, config in pickle.loads(Path(sys.argv[1]).read_bytes()):
-    worker.simulate_and_write(run_id, config, Path(sys.argv[2]) / f"{run_id}.h5")
+    worker.simulate_and_write(run_id, worker.Run(config, worker.sim.backends.DEFAULT_STEPPER),
+                              Path(sys.argv[2]) / f"{run_id}.h5")
 seen.append(sorted(sys.modules))
 import faultgen.logs.formats
 seen.append(sorted(sys.modules))

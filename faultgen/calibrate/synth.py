@@ -35,6 +35,8 @@ from faultgen.model import robots
 from faultgen.operation import programs
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 #: Range of the effect's torque RMS over the axis's nominal torque RMS.
 SIZE_RANGE = (0.5, 1.2)
@@ -308,11 +310,11 @@ def record(robot: robots.Robot, hidden: Hidden, out: str | Path, task: str = "pi
     out = Path(out)
     text, model = hidden_model(robot, hidden)
     write_model(robot, hidden, out.parent / f"{out.stem}_model", text)
-    config = sim.RunConfig(robot=model, task=task, friction="stribeck", cycles=cycles, seed=seed,
-                           back_to_back=True)
-    run = sim.simulate(config, progress=progress)
+    spec = RunSpec(robot=robots.source_of(model), task=task, friction="stribeck", cycles=cycles, seed=seed,
+                   back_to_back=True)
+    run = resolve(spec, resolved=model).simulate(progress=progress)
     G = robot.gear_ratio
-    duration = sim.cycle_duration(config.model, task)
+    duration = sim.cycle_duration(model, task)
     t = np.concatenate([(c - 1) * duration + run.t for c in run.cycles])
     t = t - t[0]
     # MuJoCo computes a step's drive torque from the state at the step's start, and the log

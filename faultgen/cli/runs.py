@@ -100,18 +100,19 @@ def simulate_command(
     from faultgen.operation import programs
     from faultgen.operation import wear as wear_module
     from faultgen.simulation import sensors
-    from faultgen.simulation import stepping as sim
+    from faultgen.simulation.resolve import resolve
+    from faultgen.simulation.spec import RunSpec
 
     check_outputs([out], overwrite)
     if cycles < 1:
         raise ValueError(f"--cycles {cycles}: expected a whole number >= 1")
-    loaded = robots.load(robot) if torque_constants is not None else None  # to check --torque-constants only
+    loaded = robots.load(robot)  # once, for the options that need its axes and the run
     adapter = log_adapter(log_format, torque_constants, loaded)
     task_of = programs.log_task(task, adapter)  # a LogTask for a log in another format than the default
-    config = sim.RunConfig(
+    run = resolve(RunSpec(
         robot=robot, task=task_of, friction=friction_model,
         wear=wear_module.WearPlan.from_specs(wear or [], last_cycle=cycles,
-                                             n_axes=(loaded or robots.load(robot)).n_axes if wear else None),
+                                             n_axes=loaded.n_axes if wear else None),
         cycles=cycles,
         record=None if record is None else parse_cycles(record), seed=seed,
         noise=sensors.NoiseConfig(disturbance=disturbance, encoder=encoder_noise), nthread=threads,
@@ -119,12 +120,12 @@ def simulate_command(
                                            start_day, gear_loss=gear_loss, dry_share=dry_share)
         or conditions_module.Conditions(),
         fault=None if fault is None else faults_module.parse_fault(fault, last_cycle=cycles),
-        resolved=loaded,
-    )
+    ), resolved=loaded)
+    config = run.config
     from faultgen.data import atomic
 
     atomic.check_writable(out, dataset.estimated_size(config))  # a read-only or full disk: before simulating
-    result = sim.simulate(config, progress=progress)
+    result = run.simulate(progress=progress)
     command = shlex.join(["faultgen", *sys.argv[1:]])
     dataset.write_run(out, result, command=command)
     typer.echo(summary(result, out))

@@ -211,10 +211,12 @@ class Twin:
     def _config(self, temperature: float | None, payload: float, plan: wear.WearPlan, cycles: int = 1) -> sim.RunConfig:
         """The run of ``cycles`` replayed cycles at ``temperature`` (rounded; None: the model's own
         friction) with a ``payload`` kg part and wear ``plan``, without noise."""
+        from faultgen.simulation.resolve import RunSpec, resolve
+
         held, _ = setup(temperature, payload)
-        return sim.RunConfig(robot=self.robot, task=self._reference, friction=FRICTION, wear=plan, cycles=cycles,
-                             seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
-                             conditions=held, signals=True)
+        return resolve(RunSpec(robot=robots.source_of(self.robot), task=self._reference, friction=FRICTION, wear=plan,
+                               cycles=cycles, seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0),
+                               nthread=1, conditions=held, signals=True), resolved=self.robot).config
 
     def _features(self, result: sim.RunResult, index: int = 0) -> np.ndarray:
         """The feature vector of simulated cycle ``index`` of ``result``, as a measured log's."""

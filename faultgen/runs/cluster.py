@@ -51,6 +51,7 @@ from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, run_memory, simulate_and_write
 from faultgen.simulation import backends, spec
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import Run
 
 #: The run arrays of shape (cycle, sample, axis): the 250 Hz signals.
 SIGNALS = tuple(name for name, (_, axes, _) in dataset.ARRAYS.items() if axes == dataset.SIGNAL_AXES)
@@ -114,19 +115,19 @@ def _missing_on_worker(config: sim.RunConfig) -> str:
     return ""
 
 
-def simulate_remote(run_id: str, config: sim.RunConfig,
-                    stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Outcome:
-    """Worker task: simulate one run on ``stepper`` (its class must be importable on the worker) and
-    return it (:class:`Outcome`); writes nothing."""
+def simulate_remote(run_id: str, run: Run) -> Outcome:
+    """Worker task: simulate one resolved run on its stepper (whose class must be importable on the
+    worker) and return it (:class:`Outcome`); writes nothing."""
     from distributed import get_worker
 
+    config = run.config
     missing = _missing_on_worker(config)
     if missing:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker, or run the sweep there")
     with run_memory():
         started = time.perf_counter()
-        result = sim.simulate(config, progress=False, stepper=stepper)
+        result = run.simulate(progress=False)
         total = time.perf_counter() - started
         slim = for_transfer(result)
         simulated = result.tau_m.shape[0] * result.t[-1]
@@ -135,18 +136,16 @@ def simulate_remote(run_id: str, config: sim.RunConfig,
                    simulated, total, slim.stepping_time, _peak_memory())
 
 
-def write_shared(run_id: str, config: sim.RunConfig, part: str, command: str,
-                 labelled: sim.RunConfig | None = None,
-                 stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> RunStats:
-    """Worker task with a shared file system: simulate one run on ``stepper`` and
-    write its part file there, labelled with ``labelled`` (the client's configuration)."""
+def write_shared(run_id: str, run: Run, part: str, command: str, labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task with a shared file system: simulate one resolved run on its stepper and write its
+    part file there, labelled with ``labelled`` (the client's configuration)."""
     from distributed import get_worker
 
-    missing = _missing_on_worker(config)
+    missing = _missing_on_worker(run.config)
     if missing:
         raise FileNotFoundError(f"worker {get_worker().address} has no {missing} (the robot or program path as the "
                                 "client sees it): put it at the same path on every worker")
-    stats = simulate_and_write(run_id, config, Path(part), command, labelled=labelled, stepper=stepper)
+    stats = simulate_and_write(run_id, run, Path(part), command, labelled=labelled)
     return replace(stats, worker=get_worker().address, memory=_peak_memory())
 
 
@@ -154,12 +153,13 @@ def _peak_memory() -> int:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kB on Linux
 
 
-def task_key(run_id: str, config: sim.RunConfig, stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> str:
-    """The Dask key of a run: its id and a digest of its configuration (and of its stepper when not
-    the default: :func:`faultgen.simulation.backends.key_text`), so that the dashboard names the run,
-    and two sweeps on one cluster share a task only when it is the same simulation on the same stepper."""
-    extra = backends.key_text(stepper)
-    text = dataset.config_key(config) + (f"\n{extra}" if extra else "")
+def task_key(run_id: str, run: Run) -> str:
+    """The Dask key of a resolved run: its id and a digest of its configuration (and of its stepper
+    when not the default: :func:`faultgen.simulation.backends.key_text`), so that the dashboard names
+    the run, and two sweeps on one cluster share a task only when it is the same simulation on the
+    same stepper."""
+    extra = backends.key_text(run.stepper)
+    text = dataset.config_key(run.config) + (f"\n{extra}" if extra else "")
     digest = hashlib.sha256(text.encode()).hexdigest()[:16]
     return f"faultgen-{run_id}-{digest}"
 
@@ -351,19 +351,20 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: Executi
 
 def _submit(client, todo: list[tuple[str, sim.RunConfig]], folder: Path, command: str, shared: bool,
             stepper: backends.Stepper) -> tuple[dict[str, str], list]:
-    """Submit every run of ``todo`` to ``client``, in order: (task key -> run id, the futures). A run's
-    worker simulates it and sends it back, or with ``shared`` writes its part file into ``folder``."""
+    """Submit every run of ``todo`` to ``client``, in order, each sent as a resolved run on ``stepper``
+    (:class:`~faultgen.simulation.resolve.Run`): (task key -> run id, the futures). A run's worker
+    simulates it and sends it back, or with ``shared`` writes its part file into ``folder``."""
     run_of = {}
     futures = []
     for run_id, config in todo:
-        key = task_key(run_id, config, stepper)
+        key = task_key(run_id, Run(config, stepper))  # the client's configuration, as the dashboard shows it
+        sent = Run(for_workers(config), stepper)
         run_of[key] = run_id
-        sent = for_workers(config)
         if shared:
             futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
-                                         None if sent is config else config, stepper, key=key))
+                                         None if sent.config is config else config, key=key))
         else:
-            futures.append(client.submit(simulate_remote, run_id, sent, stepper, key=key))
+            futures.append(client.submit(simulate_remote, run_id, sent, key=key))
     return run_of, futures
 
 

@@ -52,6 +52,8 @@ from faultgen.operation import conditions, faults, programs, tasks, wear
 from faultgen.operation.conditions import check_number
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 #: Parts of two sizes of the shipped robot models: (mass range kg, edge range m) of the small and
 #: the big part. Ours, sized to each model's rated load (IRB-6700-like: 200 kg; PUMA 560: 2.5 kg).
@@ -376,10 +378,10 @@ class Fleet:
                 onset = (robot["onset_day"] - 1) * self.cycles_per_day
                 plan = wear.WearPlan({robot["axis"]: wear.Schedule("exp4", float(f"{self.failure_wear:g}") / 100.0,
                                                                     cycles, {"onset": onset})})
-            config = sim.RunConfig(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
-                                   cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
-                                   conditions=conditions.Conditions.from_dict(robot["conditions"]),
-                                   signals=False, daily=True, fault=fault, resolved=resolved[robot["model"]])
+            config = resolve(RunSpec(robot=robot["model"], task=robot["task"], friction=self.friction, wear=plan,
+                                     cycles=cycles, seed=robot["seed"], noise=sensors.NoiseConfig(), nthread=1,
+                                     conditions=conditions.Conditions.from_dict(robot["conditions"]),
+                                     signals=False, daily=True, fault=fault), resolved=resolved[robot["model"]]).config
             out.append((robot["run"], config))
             if self.friction_test_every:
                 out.append(self._tests(robot, config))
@@ -396,10 +398,10 @@ class Fleet:
         table = {k: v for k, v in robot["conditions"].items() if k not in ("payloads", "task_mix")}
         test = friction_test_program(daily.model)
         record = tuple((day - 1) * self.cycles_per_day + 1 for day in self.test_days())
-        config = sim.RunConfig(robot=daily.robot, task=test, friction=self.friction, wear=daily.wear,
-                               cycles=daily.cycles, record=record, seed=daily.seed, noise=daily.noise, nthread=1,
-                               conditions=conditions.Conditions.from_dict(table), signals=True, fault=daily.fault,
-                               resolved=daily.model)
+        config = resolve(RunSpec(robot=daily.robot, task=test, friction=self.friction, wear=daily.wear,
+                                 cycles=daily.cycles, record=record, seed=daily.seed, noise=daily.noise, nthread=1,
+                                 conditions=conditions.Conditions.from_dict(table), signals=True, fault=daily.fault),
+                         resolved=daily.model).config
         return robot["run"] + TEST_SUFFIX, config
 
     def _fault(self, axis: int, onset_day: int) -> faults.Fault:

@@ -19,6 +19,8 @@ from faultgen.operation import faults, programs, tasks, wear
 from faultgen.operation.conditions import Conditions
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 #: Named grids. quick: a small grid for a first look (under a minute on 2 cores).
 #: first-look: quick's spot-weld runs, two seeds, cycles 41-100 recorded, features only: the README's
@@ -262,10 +264,10 @@ class Grid:
                 if run_id in out and out[run_id].task != task:
                     raise ValueError(f"tasks {out[run_id].task!r} and {task!r} would both make run {run_id!r}; "
                                      "give the program files different file names")
-                out[run_id] = sim.RunConfig(
+                out[run_id] = resolve(RunSpec(
                     robot=robot, task=task, friction=self.friction, wear=plan, cycles=self.cycles, record=record,
-                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault,
-                    resolved=resolved[str(robot)])
+                    seed=seed, noise=noise, nthread=1, conditions=conditions, signals=bool(self.signals), fault=fault),
+                    resolved=resolved[str(robot)]).config
         return list(out.items())
 
     def _check_programs(self, resolved: dict) -> None:

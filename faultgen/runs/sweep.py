@@ -48,6 +48,7 @@ from faultgen.runs.errors import SweepError, SweepInterrupted, SweepRefused
 from faultgen.runs.grid import PRESETS, Grid
 from faultgen.runs.worker import RunStats, simulate_and_write
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import Run
 
 __all__ = ["PRESETS", "Grid", "RunStats", "SweepError", "SweepInterrupted", "SweepRefused", "finished_runs",
            "lock_path", "parts_folder", "run", "simulate_and_write"]
@@ -379,7 +380,7 @@ def _execute(todo, parts: Path, context: ExecutionContext, command: str, shared:
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, config, parts.absolute() / f"{run_id}.h5", command, None, context.stepper)
+    calls = [(run_id, Run(config, context.stepper), parts.absolute() / f"{run_id}.h5", command)
              for run_id, config in todo]
     try:
         if context.scheduler:

@@ -20,8 +20,8 @@ from tqdm.auto import tqdm
 
 from faultgen import collection
 from faultgen.data import dataset
-from faultgen.simulation import backends
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import Run
 
 
 @dataclass(frozen=True)
@@ -40,19 +40,19 @@ class RunStats:
     memory: int = 0
 
 
-def simulate_and_write(run_id: str, config: sim.RunConfig, part: Path, command: str = "",
-                       labelled: sim.RunConfig | None = None,
-                       stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> RunStats:
-    """Worker task: simulate one run on ``stepper`` (a :class:`faultgen.simulation.backends.Stepper`) and
-    write it to its part file (atomically), labelled with ``labelled`` (the client's configuration
-    when ``config`` names its robot or program by an absolute path for a cluster's workers:
-    :func:`faultgen.runs.cluster.for_workers`)."""
+def simulate_and_write(run_id: str, run: Run, part: Path, command: str = "",
+                       labelled: sim.RunConfig | None = None) -> RunStats:
+    """Worker task: simulate one resolved run (:class:`faultgen.simulation.resolve.Run`: its
+    configuration on its stepper) and write it to its part file (atomically), labelled with
+    ``labelled`` (the client's configuration when the run names its robot or program by an absolute
+    path for a cluster's workers: :func:`faultgen.runs.cluster.for_workers`). The run arrives
+    pickled without its compiled robot (:meth:`RunConfig.__getstate__`): resolved here once."""
     # A worker draws no progress bar: a thread lock for tqdm, not its default process-shared one (a
     # named semaphore, reported as leaked at exit when a Ctrl-C makes the sweep stop its workers).
     tqdm.set_lock(threading.RLock())
     with run_memory():
         started = time.perf_counter()
-        result = sim.simulate(config, progress=False, stepper=stepper)
+        result = run.simulate(progress=False)
         writing = time.perf_counter()
         if labelled is not None:
             result = replace(result, config=labelled)

@@ -2,15 +2,17 @@
 task, friction model and stepper are looked up.
 
 ``resolve(spec) -> Run``: the robot by :func:`faultgen.model.robots.load` (one compiled robot per
-file content, its SHA-1), the task as :func:`task` reads it (its kind decided by
-:func:`faultgen.operation.programs.kind`, read and planned at the robot's physics step once per
-process and content: :func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the
-robot's ``tasks.toml`` and of a program or log file, :func:`faultgen.simulation.prepare.digests`,
-not by file times), the stepper by :func:`stepper`; the friction model is looked up by the
+file content, its SHA-1), or the one the caller already holds (``resolved``); the task as
+:func:`task` reads it (its kind decided by :func:`faultgen.operation.programs.kind`, read and
+planned at the robot's physics step once per process and content:
+:func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the robot's ``tasks.toml``
+and of a program or log file, :func:`faultgen.simulation.prepare.digests`, not by file times); the
+stepper by :func:`stepper`; the friction model is looked up by the
 :class:`~faultgen.simulation.config.RunConfig` it builds
-(:func:`faultgen.simulation.friction_models.get`). The
-:class:`Run` holds the objects; :func:`faultgen.simulation.stepping.simulate` steps it
-(``simulate(run.config, stepper=run.stepper)``, or :meth:`Run.simulate`).
+(:func:`faultgen.simulation.friction_models.get`). The :class:`Run` holds the objects;
+:func:`faultgen.simulation.stepping.simulate` steps it (``simulate(run.config,
+stepper=run.stepper)``, or :meth:`Run.simulate`). Every command that simulates builds its runs
+here (docs/architecture.md, "Every command's runs through resolve").
 """
 
 from __future__ import annotations
@@ -68,20 +70,26 @@ def stepper(name: str) -> backends.Stepper:
     return backends.get(name)
 
 
-def resolve(spec: RunSpec) -> Run:
-    """The run ``spec`` describes, built from objects (module docstring).
+def resolve(spec: RunSpec, resolved: robots.Robot | None = None) -> Run:
+    """The run ``spec`` describes, built from objects (module docstring). ``resolved``: the robot
+    ``spec.robot`` names, already resolved by the caller (a grid or fleet resolves each robot once
+    for all its runs; a model compiled in memory, such as a hidden-effect model or a unit's twin,
+    whose ``spec.robot`` is :func:`faultgen.model.robots.source_of` it); loaded here when omitted.
 
     Raises
     ------
     TypeError
-        ``spec`` is not a :class:`~faultgen.simulation.spec.RunSpec`.
+        ``spec`` is not a :class:`~faultgen.simulation.spec.RunSpec`, ``resolved`` not a Robot.
     ValueError
         An unknown robot, task, friction model or stepper, a file that does not load, or a value
         :class:`~faultgen.simulation.config.RunConfig` refuses (each named).
     """
     if not isinstance(spec, RunSpec):
         raise TypeError(f"resolve: expected a RunSpec, got {type(spec).__name__}")
-    found = robot(spec.robot)
+    if resolved is not None and not isinstance(resolved, robots.Robot):
+        raise TypeError(f"resolve: resolved = a {type(resolved).__name__}; expected a Robot (or None to load "
+                        f"{spec.robot!r})")
+    found = robot(spec.robot) if resolved is None else resolved
     stepping = stepper(spec.stepper)
     # RunConfig checks and plans the task (as task does) and looks the friction model up: not twice
     config = RunConfig(robot=spec.robot, resolved=found, **spec.run_fields())

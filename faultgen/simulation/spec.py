@@ -78,9 +78,9 @@ class RunSpec(RunFields):
     Raises
     ------
     TypeError
-        A robot or stepper that is not a non-empty string (a :class:`Robot` or a Stepper object is
-        already resolved: build the run from objects with :class:`RunConfig` instead), a task that is
-        none of the kinds above.
+        A robot or stepper that is not a non-empty string (a :class:`Robot` already resolved is given
+        to :func:`~faultgen.simulation.resolve.resolve` as ``resolved``, this spec naming it by
+        :func:`faultgen.model.robots.source_of`), a task that is none of the kinds above.
     """
 
     stepper: str = backends.DEFAULT
@@ -91,7 +91,7 @@ class RunSpec(RunFields):
             if not isinstance(value, str) or not value:
                 given = repr(value) if isinstance(value, str) else f"a {type(value).__name__}"
                 raise TypeError(f"RunSpec {name} = {given}: expected a non-empty string (a name or path); "
-                                "a resolved object goes into a RunConfig")
+                                "a resolved robot is given to resolve(spec, resolved=ROBOT)")
         if not isinstance(self.task, str | programs.LogTask | programs.Motion):
             raise TypeError(f"RunSpec task = a {type(self.task).__name__}: expected a task name, a program or log path, or a "
                             "TextProgram, LogTask or Motion")
