@@ -87,9 +87,10 @@ def plain_loop(inputs, names, classifiers, n_pairs, seed) -> dict:
 
 #: The model classes whose fits are counted (a fit inside another counted one, stacking's base
 #: classifiers, is the outer model's), by the column name of their classifier; PCA is the one
-#: preprocessing step fitted on data, Difference and WindowConcat the stateless run-by-run ones.
+#: preprocessing step fitted on data, Difference and WindowConcat the stateless run-by-run ones,
+#: StandardScaler the classifiers' scaling (shared by them and by the label sets) and PCA's.
 COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "StackingClassifier": "stacking",
-           "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence"}
+           "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence", "StandardScaler": "scale"}
 
 
 def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
@@ -101,15 +102,17 @@ def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
     (the true labels; with the chance estimate also the 19 exchanged sets, for the judged
     classifier only), one fit per held-out pair whose training runs and held-out runs both have
     both classes; a row's PCA fitted once per held-out pair of runs (the same training runs in every
-    label set), its stateless steps run twice per held-out pair (training runs, held-out runs);
+    label set), its stateless steps run twice per held-out pair (training runs, held-out runs), one
+    StandardScaler per row and held-out pair for every classifier that scales (learning no labels:
+    shared by the label sets and the classifiers) and +pca's own;
     one task per held-out pair of runs, shipping the features, the runs, the labels of each of its
     label sets and the names, nothing more.
 
     Returns
     -------
     dict with ``fits`` and ``needed``: ``{"lr" | "svm" | "rf" | "stacking": fits per cell, "pca":
-    per +pca row and held-out pair, "sequence": per stateless step and held-out pair, "tasks":
-    tasks}``; ``bytes``: the largest task's pickled arguments and ``bytes_needed`` the most it
+    per +pca row and held-out pair, "sequence": per stateless step and held-out pair, "scale":
+    StandardScaler fits per row, "tasks": tasks}``; ``bytes``: the largest task's pickled arguments and ``bytes_needed`` the most it
     needs; ``table`` the table.
     """
     import pickle
@@ -151,7 +154,7 @@ def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
     columns = list(dict.fromkeys(table.columns.get_level_values(0)))
     fits = {c: counts[c] / len(table.index) for c in columns}
     fits.update(pca=counts["pca"] / max(needed.pop("pca_rows"), 1), sequence=counts["sequence"] / max(needed.pop("steps"), 1),
-                tasks=counts["tasks"])
+                scale=counts["scale"] / len(table.index), tasks=counts["tasks"])
     inputs = benchmark.classification_inputs(path, kwargs.get("wear_threshold", 10.0))
     over = [(size, task_bytes_needed(inputs, list(table.index), len(args[4]))) for size, args in shipped]
     most = max(over, key=lambda t: t[0] - t[1])
@@ -162,11 +165,13 @@ def _counted_classes() -> list[type]:
     from sklearn.decomposition import PCA
     from sklearn.ensemble import RandomForestClassifier, StackingClassifier
     from sklearn.linear_model import LogisticRegression
+    from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVC
 
     from analysis.features import Difference, WindowConcat
 
-    return [LogisticRegression, SVC, RandomForestClassifier, StackingClassifier, PCA, Difference, WindowConcat]
+    return [LogisticRegression, SVC, RandomForestClassifier, StackingClassifier, PCA, Difference, WindowConcat,
+            StandardScaler]
 
 
 def protocol_needs(path: Path, table, n_pairs: int, seed: int, wear_threshold: float) -> dict:
@@ -197,6 +202,9 @@ def protocol_needs(path: Path, table, n_pairs: int, seed: int, wear_threshold: f
     rows = list(table.index)
     needed["pca"] = fitted_pairs
     needed["pca_rows"] = sum("+pca" in row for row in rows)
+    # per row and held-out pair: one scaling for every classifier that scales (all but rf), one in +pca
+    scaled = any(column != "rf" for column in table.columns.get_level_values(0))
+    needed["scale"] = fitted_pairs * sum(scaled + ("+pca" in row) for row in rows) / len(rows)
     needed["sequence"] = 2 * fitted_pairs
     needed["steps"] = sum(isinstance(step, classify.SEQUENCE_STEPS) for row in rows
                           for _, step in classify.preprocessing_steps(row))
@@ -228,7 +236,8 @@ def print_counts(path: Path, pairs: int) -> None:
     print(f"work of `faultgen classify {path.name} --pairs {pairs}` counted (one process), against what the protocol needs:")
     for key, value in found["fits"].items():
         need = found["needed"][key]
-        what = {"tasks": "tasks", "pca": "PCA fits per +pca row"}.get(key, f"{key} fits per cell")
+        what = {"tasks": "tasks", "pca": "PCA fits per +pca row", "scale": "StandardScaler fits per row"}.get(
+            key, f"{key} fits per cell")
         if key == "sequence":
             what = "stateless step runs per step"
         print(f"  {what:34s} {value:8g} (needed {need:g}): {'as needed' if value == need else 'NOT AS NEEDED'}")

@@ -39,11 +39,14 @@ def test_fits_tasks_and_bytes_are_what_the_protocol_needs(seeds3):
     found = _counted(seeds3)
     table = found["table"]
     assert list(table.index) == ROWS and table.attrs["chance_source"] == "lr"
-    assert set(found["fits"]) == {"lr", "svm", "rf", "stacking", "pca", "sequence", "tasks"}
+    assert set(found["fits"]) == {"lr", "svm", "rf", "stacking", "pca", "sequence", "scale", "tasks"}
     # 1 pair: each classifier once on the true labels, lr also on each of the 19 exchanged sets
     assert found["needed"]["svm"] == found["needed"]["rf"] == found["needed"]["stacking"] == 1
     assert 1 < found["needed"]["lr"] <= 20
     assert found["fits"] == found["needed"]
+    # the classifiers' scaling once per row and held-out pair (lr's 20 label sets, svm and stacking
+    # share it), and +pca's own: 1.5 per row and pair on these two rows
+    assert found["needed"]["scale"] == 1.5 * found["needed"]["pca"]
     # one task per held-out pair of runs: 6 worn x 3 unworn runs make 18 pairs, fewer than the 20 label sets
     assert found["needed"]["tasks"] <= 18
     assert 0 < found["bytes"] <= found["bytes_needed"]
@@ -62,5 +65,6 @@ def test_a_task_per_label_set_and_pair_shipping_more_is_caught(seeds3, monkeypat
     found = _counted(seeds3)
     assert found["fits"]["tasks"] > found["needed"]["tasks"]
     assert found["fits"]["pca"] > found["needed"]["pca"] and found["fits"]["sequence"] > found["needed"]["sequence"]
+    assert found["fits"]["scale"] > found["needed"]["scale"]
     assert all(found["fits"][c] == found["needed"][c] for c in ("lr", "svm", "rf", "stacking"))
     assert found["bytes"] > found["bytes_needed"]

@@ -9,8 +9,10 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 from sklearn import config_context
-from sklearn.base import BaseEstimator
+from sklearn.base import BaseEstimator, clone
 from sklearn.metrics import roc_auc_score
+from sklearn.pipeline import Pipeline
+from sklearn.preprocessing import StandardScaler
 from threadpoolctl import threadpool_limits
 
 from analysis.classify.by_run import ByRun, run_steps
@@ -154,20 +156,78 @@ def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random
 
 def _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers) -> None:
     """:func:`pair_cells`'s AUCs into ``out`` (label set, cell): each preprocessing fitted once on the
-    training runs, then each classifier of each label set in ``scored`` on its output."""
+    training runs, then each classifier's leading label-free steps (:func:`label_free_head`) once,
+    shared by the label sets and by the classifiers with the same steps, then the rest of each
+    classifier of each label set in ``scored`` on their output."""
+    asked = set().union(*(columns for *_, columns in scored))
+    heads = {column: label_free_head(clf) for column, clf in classifiers.items() if column in asked}
     for r, name in enumerate(names):
         data = X_est if name.startswith(ESTIMATED) else X
         steps = [step for _, step in preprocessing_steps(name)]
         X_train = run_steps(steps, data[train], groups[train], fit=True)
         X_test = run_steps(steps, data[held], groups[held])
         rows, run_of, n_train = np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]], len(X_train)
-        for i, labels, test, truth, columns in scored:
-            # the preprocessed rows, train then held out, one fold given: each classifier through the harness
-            stacked = Data(rows, run_of, np.r_[labels[train], labels[held]])
-            for c, (column, clf) in enumerate(classifiers.items()):
-                if column in columns:
-                    scores = _scores(clf, stacked, np.arange(n_train), np.arange(n_train, len(rows)), f"{column} {name}")
-                    out[i, r * len(classifiers) + c] = binary_auc(truth, scores[test])
+        inputs = _head_outputs(heads, rows, n_train)
+        # rows checked finite here once, not by every fit's and prediction's input checks
+        with config_context(assume_finite=all(np.isfinite(Xc).all() for Xc, _ in inputs.values())):
+            _classify(out, r, name, inputs, run_of, n_train, train, held, scored, list(classifiers))
+
+
+def _classify(out, r, name, inputs, run_of, n_train, train, held, scored, classifiers) -> None:
+    """Row ``r`` of ``out``: each classifier asked for by each label set of ``scored`` on ``inputs``
+    (:func:`_head_outputs`), through the harness, and its AUC."""
+    for i, labels, test, truth, columns in scored:
+        # the preprocessed rows, train then held out, one fold given: each classifier through the harness
+        y = np.r_[labels[train], labels[held]]
+        for c, column in enumerate(classifiers):
+            if column in columns:
+                Xc, tail = inputs[column]
+                scores = _scores(tail, Data(Xc, run_of, y), np.arange(n_train), np.arange(n_train, len(Xc)),
+                                 f"{column} {name}")
+                out[i, r * len(classifiers) + c] = binary_auc(truth, scores[test])
+
+
+#: Steps that learn no labels and look at no neighbouring rows: a classifier's leading ones are
+#: fitted once per held-out pair and row, for every label set (the class itself, not a subclass).
+LABEL_FREE = (StandardScaler,)
+
+
+def label_free_head(model) -> tuple[list, object]:
+    """(the leading :data:`LABEL_FREE` steps of a Pipeline ``model``, what follows them: its last
+    step alone or a Pipeline of the rest); ``([], model)`` for any other model. Fitting the head on
+    the training rows and the rest on its output is what fitting ``model`` does, number for number."""
+    if not isinstance(model, Pipeline):
+        return [], model
+    k = 0
+    while k < len(model.steps) - 1 and type(model.steps[k][1]) in LABEL_FREE:
+        k += 1
+    rest = model.steps[k:]
+    return [step for _, step in model.steps[:k]], rest[0][1] if len(rest) == 1 else Pipeline(rest)
+
+
+def _head_outputs(heads: dict, rows: np.ndarray, n_train: int) -> dict:
+    """Column -> (``rows``, the first ``n_train`` the training rows, through its head fitted on the
+    training rows, its tail); a head fitted once for every column whose head has the same steps
+    and parameters. The rows taken as the harness takes them (a copy of each fold's rows)."""
+    done: dict[str, np.ndarray] = {}
+    out = {}
+    for column, (head, tail) in heads.items():
+        key = repr([(type(step), sorted(step.get_params(deep=False).items())) for step in head])
+        if key not in done:
+            done[key] = _through(head, rows, n_train) if head else rows
+        out[column] = done[key], tail
+    return out
+
+
+def _through(head: list, rows: np.ndarray, n_train: int) -> np.ndarray:
+    """``rows`` through clones of ``head``'s steps fitted on the first ``n_train`` (fit_transform),
+    the rest transformed, each part a copy of its rows as the harness takes a fold's."""
+    train, test = rows[np.arange(n_train)], rows[np.arange(n_train, len(rows))]
+    for step in head:
+        step = clone(step)
+        train = step.fit_transform(train)
+        test = step.transform(test)
+    return np.vstack([train, test])
 
 
 def folds(failed, normal, groups, n_pairs: int | None = None, random_state: int | None = 0) -> list[tuple]:
