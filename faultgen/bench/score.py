@@ -61,6 +61,7 @@ import numpy as np
 from sklearn.metrics import roc_auc_score, roc_curve
 
 from analysis import scoring
+from analysis.classify.roc import binary_auc
 from analysis.evaluate import Data, OwnHistory, TrackSplit, evaluate
 from faultgen.bench import files, verdicts
 from faultgen.data import atomic
@@ -103,7 +104,24 @@ def _auroc(units: list) -> float:
     labels = np.concatenate([u["positive"][u["mask"]] for u in units])
     if labels.all() or not labels.any():
         return float("nan")
-    return float(roc_auc_score(labels, scores))
+    if not np.isfinite(scores).all():  # scikit-learn's own error, naming what is wrong
+        return float(roc_auc_score(labels, scores))
+    return binary_auc(labels, scores)  # roc_auc_score's float without its checks: 1000 bootstrap resamples
+
+
+def _roc(truth: np.ndarray, scores: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``roc_curve(truth, scores, drop_intermediate=False)``'s false- and true-positive rates, the
+    same floats, by scikit-learn's steps (1.6-1.9) without its input checks (the bootstrap calls it
+    1000 times on arrays :func:`_detection_at_far` checked): the scores in descending order, the
+    positives and negatives counted up to the last row of each distinct score (whole numbers, exact
+    whatever the order within ties), a point (0, 0) first, each count divided by its total.
+    ``truth``: 0/1, both present; ``scores``: finite."""
+    order = np.argsort(scores, kind="stable")[::-1]
+    ranked = scores[order]
+    ends = np.append(np.flatnonzero(np.diff(ranked)), ranked.size - 1)
+    tps = np.cumsum(truth[order].astype(float))[ends]
+    fps = 1 + ends.astype(float) - tps
+    return np.append(0.0, fps) / fps[-1], np.append(0.0, tps) / tps[-1]
 
 
 def _detection_at_far(units: list) -> float:
@@ -116,9 +134,13 @@ def _detection_at_far(units: list) -> float:
     positives = np.concatenate(worn) if worn else np.zeros(0)
     if not negatives.size or not positives.size:
         return float("nan")
-    fpr, tpr, _ = roc_curve(np.r_[np.zeros(negatives.size), np.ones(positives.size)], np.r_[negatives, positives],
-                            drop_intermediate=False)
-    last = np.r_[np.diff(fpr) > 0, True]  # per false-positive rate its highest true-positive rate
+    truth = np.concatenate((np.zeros(negatives.size), np.ones(positives.size)))
+    scores = np.concatenate((negatives, positives))
+    if np.isfinite(scores).all():
+        fpr, tpr = _roc(truth, scores)
+    else:  # scikit-learn's own error, naming what is wrong
+        fpr, tpr, _ = roc_curve(truth, scores, drop_intermediate=False)
+    last = np.append(np.diff(fpr) > 0, True)  # per false-positive rate its highest true-positive rate
     return float(np.interp(FAR, fpr[last], tpr[last]))
 
 
