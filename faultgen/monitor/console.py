@@ -21,7 +21,8 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     monitors = outcome.monitors
     alarmed = [m for m in monitors if m.first_alarm]
     by_unit = {m.unit: m for m in monitors}
-    lines = []
+    lines = [f"events.csv changed for {unit} since the last run: re-scored from its first log (the earliest event "
+             f"added, changed or removed: {since})" for unit, since in getattr(outcome, "rescored", [])]
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
         alarm = m is not None and m.first_alarm

@@ -114,6 +114,9 @@ class Outcome:
     #: ``<unit>/<file>``) and each row of ``events.csv`` that names no unit (``events.csv``).
     passed_over: list[tuple[str, str]] = field(default_factory=list)
     tests: bool = False
+    #: ``(unit, stamp)`` of each unit scored again from its first log because the events of
+    #: ``events.csv`` its saved state was scored with changed since (the earliest event changed).
+    rescored: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def exit_status(self) -> int:
@@ -237,6 +240,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
     state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of, nominal.name)
+    rescored = events_changed(state, maintenance, stopped)  # those units scored again from their first log
     with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
         pending, stale = {}, {}
         for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
@@ -251,6 +255,7 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
                 state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
+                _keep_program(state[name], rescored.get(name))
                 state[name].monitor.tests = scale_of(name)
         groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
         bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
@@ -300,7 +305,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
                                                        unit.maintenance, unit.program_changes))
-    return Outcome(monitors, statuses, passed, tests=bool(found))
+    return Outcome(monitors, statuses, passed, tests=bool(found),
+                   rescored=[(name, since) for name, (since, _, _) in rescored.items()])
 
 
 
@@ -511,3 +517,38 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
                             list(kept.program_changes), initial_signatures=kept.signatures)
     return state
 
+
+def events_changed(state: dict[str, Unit], maintenance: dict, stopped: dict) -> dict[str, tuple]:
+    """Drop from ``state`` each unit whose saved maintenance differs from the events of
+    ``events.csv`` now (``maintenance``) that its scored or skipped logs would have been given (those
+    stamped at or before its last one): the unit is scored again from its first log, as a fresh run
+    scores it. Returns unit -> (the stamp of the earliest event added, changed or removed, its
+    program, its first log); a unit a bad ``events.csv`` row stops keeps its state.
+
+    From its first log rather than from that day: a state's notes and skipped logs are not kept by
+    day, so cutting it at a day could not promise the outputs of a fresh run."""
+    changed = {}
+    for name, unit in list(state.items()):
+        if name in stopped:
+            continue
+        last = max(logfolder.parse_stamp(e.stamp, name)[0] for e in (*unit.entries, *unit.skipped))
+        now: list[tuple[str, str, int]] = []
+        for event in maintenance.get(name, ()):  # each given once (faultgen.monitor.feed.score_group)
+            if event.key <= last and (event.stamp, event.event, event.axis) not in now:
+                now.append((event.stamp, event.event, event.axis))
+        then = [m.identity for m in unit.maintenance]
+        if now == then:
+            continue
+        i = next((i for i, (a, b) in enumerate(zip(now, then)) if a != b), min(len(now), len(then)))
+        since = min((x[i][0] for x in (now, then) if i < len(x)), key=lambda s: logfolder.parse_stamp(s, name)[0])
+        changed[name] = (since, unit.program, unit.first)
+        del state[name]
+    return changed
+
+
+def _keep_program(unit: Unit, kept: tuple | None) -> None:
+    """A unit scored again (:func:`events_changed`) replays the program its first run found (an
+    earlier unit's log, which this run's new units alone would not offer), when its first log is
+    the same."""
+    if kept is not None and unit.program is not None and kept[1] is not None and tuple(unit.first) == tuple(kept[2]):
+        unit.program = kept[1]
