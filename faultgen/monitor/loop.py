@@ -50,7 +50,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, constant_torque_note
+from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
@@ -299,7 +299,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        unit.monitor.signatures if unit.initial_signatures is None
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
-                                                       unit.maintenance, unit.program_changes))
+                                                       unit.maintenance, unit.program_changes,
+                                                       unit.torque_source, unit.off_monitor))
     return Outcome(monitors, statuses, passed, tests=bool(found))
 
 
@@ -422,7 +423,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
-    if learning and constant_torque_note(unit) is None and not refused:  # not learning: off the monitor
+    if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
@@ -437,7 +438,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
-                      "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
+                      "; ".join(reasons), len(unit.entries), last, unit.torque_source,
                       "; ".join(fallback_notes(unit)))
 
 
@@ -508,6 +509,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
             continue
         state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,
                             list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
-                            list(kept.program_changes), initial_signatures=kept.signatures)
+                            list(kept.program_changes), initial_signatures=kept.signatures,
+                            torque_source=kept.torque_source, off_monitor=kept.off_monitor)
     return state
 
