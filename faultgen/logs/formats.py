@@ -422,8 +422,9 @@ class URRTDE(LogFormat):
         moment = [f"target_moment_{k}" for k in axes]
         if all(c in names for c in as_torque):
             unused = "; the torque constants given are not used" if self.torque_constants is not None else ""
-            return as_torque, [1.0] * n_axes, TorqueNote("torque from actual_current_as_torque_i (the measured current "
-                                                          f"as torque by the controller's own constants){unused}", CURRENT_AS_TORQUE)
+            return as_torque, [1.0] * n_axes, TorqueNote(
+                "torque from actual_current_as_torque_i (the measured current as torque by the controller's own "
+                f"constants){unused}", CURRENT_AS_TORQUE)
         if self.torque_constants is not None and all(c in names for c in current):
             if len(self.torque_constants) != n_axes:
                 raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")

@@ -286,8 +286,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 name, state[name].entries, state[name].maintenance, ratings, hours_per_day,
                 notes=state[name].notes)])
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-            page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
-                       logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
+            page.write(staging, settings, table_max_bytes=None, rows=[r for m in monitors for r in m.rows],
+                       robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,  # its own tables
+                       model=model_source, twin_temperature=twin_temperature)
             for m in monitors:
                 (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
             (staging / ".state").mkdir()
