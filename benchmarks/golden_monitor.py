@@ -31,6 +31,7 @@ import argparse
 import hashlib
 import json
 import shutil
+import tempfile
 import sys
 from pathlib import Path
 
@@ -149,11 +150,14 @@ def manifest(outs: dict[str, Path], work: Path) -> dict[str, str]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--work", type=Path, default=Path("golden_monitor_work"))
+    parser.add_argument("--work", type=Path, help="run in this folder (emptied first) and keep it; "
+                        "default: a temporary folder, removed at the end (never the checkout)")
     parser.add_argument("-o", "--output", type=Path, help="write the manifest here (JSON)")
     parser.add_argument("--check", type=Path, help="compare with this manifest; exit 1 on any difference")
     args = parser.parse_args()
-    files = manifest(run_all(args.work), args.work)
+    with tempfile.TemporaryDirectory(prefix="golden-monitor-") as temporary:
+        work = args.work or Path(temporary) / "work"
+        files = manifest(run_all(work), work)
     if args.output:
         args.output.write_text(json.dumps(files, indent=1, sort_keys=True) + "\n")
     if args.check:

@@ -306,7 +306,7 @@ def test_a_unit_of_many_logs_and_closed_alarms_is_charted_in_linear_time():
              "T2_limit": "2", "score1": "0.1"} for k in range(40_000)]
     closed = [{"first_alarm": r["stamp"], "source_axis": "1", "closed_by": "repair", "closed": r["stamp"]}
               for r in rows]
-    unit = page.Unit({"unit": "u", "status": "monitored", "last_log": rows[-1]["stamp"]}, scores=rows, closed=closed)
+    unit = page.Unit({"unit": "u", "status": "monitored", "last_log": rows[-1]["stamp"]}, scores=tables.log_rows(rows), closed=closed)
     start = time.perf_counter()
     chart = page.figure(unit, {})
     assert time.perf_counter() - start < 5.0

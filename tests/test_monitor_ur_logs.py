@@ -192,6 +192,7 @@ def test_without_torque_constants_the_fleet_finishes_and_says_why_no_unit_is_mon
     assert again.exit_code == loop.EXIT_SOME_UNITS_NOT_MONITORED, again.output
     row = _rows(tmp_path / "out" / "units.csv")[0]
     assert row["status"] == "not monitored" and f"{TRAIN + 2} logs skipped" in row["reason"]
+    assert row["torque_source"] == formats.COMMANDED_MOMENT  # kept in the unit's state, not read from its notes
 
 
 def test_the_import_summary_states_the_torque_source(fleet, tmp_path):

@@ -211,6 +211,17 @@ def test_report_builds_the_page_again_from_an_output_folder(written, tmp_path):
     assert f"note: {out / 'life.csv'} is missing: the page shows no life consumed by load" in result.output
 
 
+def test_the_page_from_a_runs_typed_rows_is_the_page_from_scores_csv(written, tmp_path):
+    """page.write given the typed rows (record.LogRow, as a run hands it its own) draws the page that
+    `faultgen report` draws from scores.csv, byte for byte: here the twin's wear, alarms, maintenance."""
+    out = shutil.copytree(written, tmp_path / "OUT")
+    rows = tables.log_rows(tables.read(out, "scores.csv", report.SCORE_COLUMNS)[1])
+    assert rows and all(r.wear is not None for r in rows)
+    (out / page.PAGE).unlink()
+    page.write(out, SETTINGS, rows=rows, robot="irb6700", logs="/data/LOGS", model="per-unit", twin_temperature=False)
+    assert (out / page.PAGE).read_bytes() == (written / page.PAGE).read_bytes()
+
+
 def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):
     import plotly.graph_objects as go
 
@@ -248,6 +259,10 @@ def test_monitor_writes_the_page(tmp_path):
         assert str(tmp_path) not in (out / name).read_text(), name
     statement = next(line for line in result.output.splitlines() if "Chance of a persistent alarm" in line)
     assert html.escape(statement) in (out / page.PAGE).read_text()
+    again = shutil.copytree(out, tmp_path / "again")  # the run's page (its rows in memory) is the one read back
+    (again / page.PAGE).unlink()
+    assert CliRunner().invoke(app, ["report", str(again)]).exit_code == 0
+    assert (again / page.PAGE).read_bytes() == (out / page.PAGE).read_bytes()
 
 
 def test_the_remaining_life_is_in_the_table_and_the_units_panel(written, tmp_path):

@@ -63,19 +63,20 @@ MEASURED_CURRENT, COMMANDED_MOMENT = "measured current x torque constant", "comm
 CURRENT_AS_TORQUE = "current as torque (controller's own constants)"
 
 
+class TorqueNote(str):
+    """A reader's note naming the log's torque source (``ur-rtde``'s "torque from ..."), its
+    :attr:`source` one of :data:`CURRENT_AS_TORQUE`, :data:`MEASURED_CURRENT`, :data:`COMMANDED_MOMENT`."""
+
+    def __new__(cls, text: str, source: str = ""):  # the default: unpickled, its source set after
+        note = super().__new__(cls, text)
+        note.source = source
+        return note
+
+
 def torque_source(notes) -> str:
-    """The torque source a log's reader noted (:attr:`faultgen.logs.measured.MeasuredData.notes`,
-    the ``ur-rtde`` format's "torque from ..." note) as :data:`CURRENT_AS_TORQUE`,
-    :data:`MEASURED_CURRENT` or :data:`COMMANDED_MOMENT`; "" when no note names one (the measured
-    format: the logged arm torque)."""
-    for note in notes:
-        if note.startswith("torque from actual_current_as_torque"):
-            return CURRENT_AS_TORQUE
-        if note.startswith("torque from actual_current"):
-            return MEASURED_CURRENT
-        if note.startswith("torque from target_moment"):
-            return COMMANDED_MOMENT
-    return ""
+    """The source of the :class:`TorqueNote` among a log's ``notes`` (:attr:`faultgen.logs.measured.
+    MeasuredData.notes`); "" when none names one (the measured format: the logged arm torque)."""
+    return next((note.source for note in notes if isinstance(note, TorqueNote)), "")
 
 
 #: Data rows of the first block read to learn a log's columns before its blocks are read
@@ -421,19 +422,20 @@ class URRTDE(LogFormat):
         moment = [f"target_moment_{k}" for k in axes]
         if all(c in names for c in as_torque):
             unused = "; the torque constants given are not used" if self.torque_constants is not None else ""
-            return as_torque, [1.0] * n_axes, ("torque from actual_current_as_torque_i (the measured current as "
-                                               f"torque by the controller's own constants){unused}")
+            return as_torque, [1.0] * n_axes, TorqueNote(
+                "torque from actual_current_as_torque_i (the measured current as torque by the controller's own "
+                f"constants){unused}", CURRENT_AS_TORQUE)
         if self.torque_constants is not None and all(c in names for c in current):
             if len(self.torque_constants) != n_axes:
                 raise ValueError(f"{len(self.torque_constants)} torque constants for a robot of {n_axes} axes")
-            return current, [float(k) for k in self.torque_constants], \
-                "torque from actual_current_i x the torque constants given (measured)"
+            return current, [float(k) for k in self.torque_constants], TorqueNote(
+                "torque from actual_current_i x the torque constants given (measured)", MEASURED_CURRENT)
         if all(c in names for c in moment):
-            return moment, [1.0] * n_axes, (
+            return moment, [1.0] * n_axes, TorqueNote(
                 "torque from target_moment_i (the controller's commanded moment, not a measurement: it cannot "
                 "show wear; --torque-constants K1,...,KN reads the measured actual_current_i instead, "
                 "the UR arms' constants: docs/dataset.md, \"Adapters\")"
-                + (" (the file has actual_current_i)" if all(c in names for c in current) else ""))
+                + (" (the file has actual_current_i)" if all(c in names for c in current) else ""), COMMANDED_MOMENT)
         raise measured.MeasuredDataError(
             f"{inputs.path_of(path)}: no joint torque: expected actual_current_as_torque_0..{n_axes - 1} (N m), "
             f"target_moment_0..{n_axes - 1} (N m), or actual_current_0..{n_axes - 1} (A) with the torque "

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.monitoring import varying_columns
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import cycles, friction_tests, life, report
@@ -98,7 +99,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     nominal = source.robot
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
-        off = constant_torque_note(unit) or (REFUSED_SKIP if refused_note(unit) else None)  # an earlier run's
+        off = unit.off_monitor or (REFUSED_SKIP if refused_note(unit) else None)  # an earlier run's
         twin = off or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
@@ -188,7 +189,8 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         unit.skipped.append(stored.Skipped(log.stamp, sha256, short(err)))
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
-        unit.notes.extend(n for n in reading.notes if n.startswith("torque from"))
+        unit.notes.extend(n for n in reading.notes if isinstance(n, formats.TorqueNote))
+        unit.torque_source = formats.torque_source(reading.notes)
     unit.notes.extend(fleet_logs.log_notes(log.stamp, reading.notes, unit.notes))  # each column's kind once
     constant = constant_torque(unit, reading.vector, nominal.n_axes)
     if constant:
@@ -221,12 +223,6 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
             "which can show no wear")
 
 
-def constant_torque_note(unit: Unit) -> str | None:
-    """The note that took the unit off the monitor (:func:`constant_torque`, in this run or an
-    earlier one), or None."""
-    return next((n for n in unit.notes if n.startswith(CONSTANT_TORQUE)), None)
-
-
 def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:
     """Take the unit off the monitor (:func:`constant_torque`): its logs scored so far and the log
     ``stamp`` (its SHA-256 ``sha256``) kept as skipped, its monitor emptied (its status then "not monitored", its reason ``why``);
@@ -237,6 +233,7 @@ def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:
     unit.entries.clear()
     unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes, unit.monitor.signatures)
     unit.notes.append(why)
+    unit.off_monitor = why
     return why
 
 

@@ -125,7 +125,7 @@ def alarming_axes(unit, wear_limit: float) -> list[int]:
     if unit.scores and math.isfinite(wear_limit):
         last = unit.scores[-1]
         for axis in unit.axes():
-            if number(last.get(f"wear{axis}_lower")) >= wear_limit:
+            if last.wear_at(axis, "lower") >= wear_limit:
                 axes.add(axis)
     return sorted(axes)
 

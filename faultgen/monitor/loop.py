@@ -50,7 +50,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context, constant_torque_note
+from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
@@ -291,8 +291,9 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                 name, state[name].entries, state[name].maintenance, ratings, hours_per_day,
                 notes=state[name].notes)])
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-            page.write(staging, settings, table_max_bytes=None, robot=Path(str(robot)).name,  # its own tables
-                       logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
+            page.write(staging, settings, table_max_bytes=None, rows=[r for m in monitors for r in m.rows],
+                       robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,  # its own tables
+                       model=model_source, twin_temperature=twin_temperature)
             for m in monitors:
                 (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
             (staging / ".state").mkdir()
@@ -304,7 +305,8 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
                                                        unit.monitor.signatures if unit.initial_signatures is None
                                                        else unit.initial_signatures, unit.entries,
                                                        unit.model, unit.first, unit.skipped, unit.notes,
-                                                       unit.maintenance, unit.program_changes))
+                                                       unit.maintenance, unit.program_changes,
+                                                       unit.torque_source, unit.off_monitor))
     return Outcome(monitors, statuses, passed, tests=bool(found),
                    rescored=[(name, since) for name, (since, _, _) in rescored.items()])
 
@@ -428,7 +430,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
-    if learning and constant_torque_note(unit) is None and not refused:  # not learning: off the monitor
+    if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
         again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
                  if unit.monitor.program_changed else "")
         reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
@@ -443,7 +445,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
-                      "; ".join(reasons), len(unit.entries), last, formats.torque_source(unit.notes),
+                      "; ".join(reasons), len(unit.entries), last, unit.torque_source,
                       "; ".join(fallback_notes(unit)))
 
 
@@ -514,7 +516,8 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
             continue
         state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,
                             list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
-                            list(kept.program_changes), initial_signatures=kept.signatures)
+                            list(kept.program_changes), initial_signatures=kept.signatures,
+                            torque_source=kept.torque_source, off_monitor=kept.off_monitor)
     return state
 
 

@@ -4,7 +4,8 @@ The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`
 ``scores.csv`` (:mod:`faultgen.monitor.report`), where present ``wear.csv``, ``rul.csv``,
 ``life.csv`` and ``tests.csv`` (the friction tests), and the run's settings (a small dict, kept
 beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
-(:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`). It holds:
+(:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`); scores.csv's rows are typed
+(:class:`faultgen.monitor.record.LogRow`), the run's own handed over by the run. It holds:
 
 - the fleet table (:mod:`faultgen.monitor.lights`, where its rules are stated): one line per unit,
   a state light (service due, watch, stale, unknown, ok: colour and word), the "service by" date
@@ -42,7 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from faultgen.data import atomic
-from faultgen.monitor import friction_panel, life, lights, report, scoring, tables
+from faultgen.monitor import friction_panel, life, lights, record, report, scoring, tables
 from faultgen.monitor.html_cells import escaped, number
 from faultgen.monitor.run_settings import SETTINGS, settings_dict
 from faultgen.monitor.unit_chart import figure
@@ -112,7 +113,7 @@ class Unit:
     row: dict
     current: dict | None = None
     closed: list[dict] = field(default_factory=list)
-    scores: list[dict] = field(default_factory=list)
+    scores: list[record.LogRow] = field(default_factory=list)  # its scored logs (scores.csv's rows)
     remaining: dict[int, dict] = field(default_factory=dict)  # axis -> its row of rul.csv
     life: list[dict] = field(default_factory=list)  # its rows of life.csv
     wear: dict[int, list[dict]] = field(default_factory=dict)  # axis -> its rows of wear.csv, in order
@@ -133,22 +134,20 @@ class Unit:
     def axis_wear(self) -> tuple[int, float, float] | None:
         """The axis whose wear the table shows and its last log's wear estimate and lower bound, %:
         the alarm's axis, else the axis with the largest lower bound; None without the twin."""
-        if not self.scores or not self.scores[-1].get("wear1"):
+        if not self.scores or math.isnan(self.scores[-1].wear_at(1)):
             return None
         last = self.scores[-1]
         axis = number(self.current["source_axis"]) if self.open_alarm else math.nan
         axis = int(axis) if math.isfinite(axis) and axis == int(axis) else None
-        if axis is None or f"wear{axis}" not in last:
-            lowers = {i: number(last[k]) for i in range(1, 1000) if (k := f"wear{i}_lower") in last}
-            if not lowers:
-                return None
+        if axis is None or not 1 <= axis <= len(last.wear.estimate):
+            lowers = {i: last.wear_at(i, "lower") for i in range(1, len(last.wear.estimate) + 1)}
             axis = max(lowers, key=lambda i: -math.inf if math.isnan(lowers[i]) else lowers[i])
-        return axis, number(last[f"wear{axis}"]), number(last[f"wear{axis}_lower"])
+        return axis, last.wear_at(axis), last.wear_at(axis, "lower")
 
     def axes(self) -> list[int]:
         """The unit's axes (1..N of scores.csv's ``scoreI`` columns, else of wear.csv)."""
         if self.scores:
-            return [i for i in range(1, 1000) if f"score{i}" in self.scores[-1]] or sorted(self.wear)
+            return list(range(1, len(self.scores[-1].scores) + 1)) or sorted(self.wear)
         return sorted(self.wear)
 
     def wear_now(self, axis: int) -> WearNow | None:
@@ -160,9 +159,9 @@ class Unit:
             r = self.wear[axis][-1]
             return WearNow(number(r.get("wear")), number(r.get("wear_5")), number(r.get("wear_95")), True,
                            r.get("wear_scale") or scale)
-        if self.scores and self.scores[-1].get(f"wear{axis}"):
+        if self.scores and not math.isnan(self.scores[-1].wear_at(axis)):
             last = self.scores[-1]
-            return WearNow(number(last[f"wear{axis}"]), number(last.get(f"wear{axis}_lower")), math.nan, False, scale)
+            return WearNow(last.wear_at(axis), last.wear_at(axis, "lower"), math.nan, False, scale)
         return None
 
     def attention(self) -> tuple:
@@ -184,11 +183,12 @@ class Fleet:
     twin: bool
 
 
-def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
+def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES, rows=None) -> Fleet:
     """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``; and
     ``rul.csv``, ``life.csv``, ``wear.csv``, ``tests.csv`` where present), each table read by
     :func:`faultgen.monitor.tables.read` (``max_bytes`` as there), in the order of
-    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`).
+    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`). ``rows``: the
+    run's :class:`faultgen.monitor.record.LogRow` that scores.csv holds (its rows read back otherwise).
 
     Raises
     ------
@@ -200,7 +200,8 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
     # ``known`` is optional: a folder written without it is still read
     required = tuple(c for c in report.ALARM_COLUMNS if c != "known")
     _, alarm_rows = tables.read(folder, "alarms.csv", required, max_bytes)
-    columns, score_rows = tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)
+    score_rows = ([r.tabled() for r in rows] if rows is not None else
+                  tables.log_rows(tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)[1]))
     units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
     for r in alarm_rows:
         unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
@@ -209,8 +210,8 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
         else:
             unit.current = r
     for r in score_rows:
-        if r["unit"] in units:
-            units[r["unit"]].scores.append(r)
+        if r.unit in units:
+            units[r.unit].scores.append(r)
     if (folder / "rul.csv").exists():  # remaining useful life (optional: older folders lack it)
         for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
                            max_bytes)[1]:
@@ -230,9 +231,9 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fl
         for r in tables.read(folder, "tests.csv", friction_panel.REQUIRED, max_bytes)[1]:
             if r["unit"] in units:
                 units[r["unit"]].tests.append(r)
-    n_axes = sum(1 for c in columns if c.startswith("score") and c[5:].isdigit())
+    n_axes = max((len(r.scores) for r in score_rows), default=0)
     ordered = sorted(units.values(), key=Unit.attention)
-    return Fleet(ordered, n_axes if alarm_rows else 1, "wear1" in columns)
+    return Fleet(ordered, n_axes if alarm_rows else 1, any(r.wear is not None for r in score_rows))
 
 
 # -- the page ---------------------------------------------------------------------------------------
@@ -405,7 +406,7 @@ def build(fleet: Fleet, settings: dict) -> str:
                + f"; {alarmed} with an open alarm.")
     statement = ""
     if all(isinstance(settings.get(k), (int, float)) for k in ("alpha", "persistence", "train")):
-        logs_scored = max((sum(r["phase"] == "monitoring" for r in u.scores) for u in monitors), default=0)
+        logs_scored = max((sum(r.phase == "monitoring" for r in u.scores) for u in monitors), default=0)
         statement = " ".join(filter(None, (f"{alarmed} of {len(monitors)} units alarm.", false_alarm_statement(
             str(settings.get("protocol", "twin")), float(settings["alpha"]), int(settings["persistence"]),
             int(settings["train"]), fleet.n_axes, logs_scored))))
@@ -458,7 +459,7 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES,
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES, rows=None,
           **extra) -> Path:
     """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
@@ -466,7 +467,7 @@ def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = ta
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
     ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`;
     None for the tables a monitor run has just written: their rows are in its memory already, and a
-    large fleet's page is written).
+    large fleet's page is written); ``rows``: the run's rows of scores.csv (:func:`read`).
 
     Raises
     ------
@@ -481,7 +482,7 @@ def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = ta
     folder = Path(folder)
     settings = settings_dict(settings, extra)
     page = folder / PAGE
-    _write(page, build(read(folder, table_max_bytes), settings))
+    _write(page, build(read(folder, table_max_bytes, rows), settings))
     if settings:
         _write(folder / SETTINGS, json.dumps(settings, indent=1, sort_keys=True) + "\n")
     return page

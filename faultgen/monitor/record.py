@@ -63,6 +63,20 @@ class LogRow:
     scores: np.ndarray
     wear: AxisWear | None = None
 
+    def wear_at(self, axis: int, name: str = "estimate") -> float:
+        """Field ``name`` of :attr:`wear` at ``axis`` (1-based), %; NaN without the twin or that axis."""
+        values = getattr(self.wear, name, ())
+        return float(values[axis - 1]) if 1 <= axis <= len(values) else np.nan
+
+    def tabled(self) -> LogRow:
+        """This row at the output tables' 6 significant digits (:mod:`faultgen.monitor.report`): the
+        page drawn from a run's rows is the one ``faultgen report OUT`` draws from its scores.csv."""
+        six = lambda values: np.array([float(f"{v:.6g}") for v in np.ravel(values)])  # noqa: E731
+        wear = self.wear and dataclasses.replace(self.wear, **{f.name: six(getattr(self.wear, f.name)) for f in
+                                                               dataclasses.fields(self.wear) if f.name != "tests"})
+        return dataclasses.replace(self, scores=six(self.scores), wear=wear, **{
+            k: float(f"{getattr(self, k):.6g}") for k in ("Q", "Q_limit", "T2", "T2_limit")})
+
 
 def listed(unit: str, stamp: str, n_axes: int) -> LogRow:
     """A log listed while its unit learns again after a program change (scored when the learning

@@ -187,6 +187,8 @@ class UnitState:
     notes: list[str] = field(default_factory=list)
     maintenance: list[Maintenance] = field(default_factory=list)
     program_changes: list[ProgramChange] = field(default_factory=list)
+    torque_source: str = ""  # its logs' torque source (faultgen.logs.formats.torque_source); "" unnamed
+    off_monitor: str = ""  # why it was taken off the monitor; "" while on it
 
 
 def replay(state: UnitState, settings: Settings, n_axes: int, tests=None) -> UnitMonitor:
@@ -230,6 +232,7 @@ def write_unit(path: Path, state: UnitState) -> None:
         "format": FORMAT, "unit": state.unit, "settings": state.settings,
         "program": list(state.program) if state.program else None,
         "model": state.model, "first": list(state.first), "notes": list(state.notes),
+        "torque_source": state.torque_source, "off_monitor": state.off_monitor,
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
         "program_changes": [{"stamp": c.stamp, "program": list(c.program), "at": c.at,
@@ -404,6 +407,9 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
     _digest(first[1], path, "first[1]", refuse, empty=True)
     if not (isinstance(notes, list) and all(isinstance(n, str) for n in notes)):
         raise StateError(f"{path}: notes is not a list of texts{refuse}")
+    facts = {k: d.get(k, "") for k in ("torque_source", "off_monitor")}  # "": a state written before they were kept
+    if not all(isinstance(v, str) for v in facts.values()):
+        raise StateError(f"{path}: torque_source or off_monitor is not a text{refuse}")
     if not (isinstance(skipped, list) and all(
             isinstance(k, dict) and all(isinstance(k.get(f), str) for f in ("stamp", "sha256", "reason"))
             for k in skipped)):
@@ -481,7 +487,8 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
                              f"scored{refuse}")
     return UnitState(unit, settings, tuple(program) if program else None, signatures, entries, model, tuple(first),
                      [Skipped(k["stamp"], k["sha256"], k["reason"]) for k in skipped], list(notes),
-                     [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance], program_changes)
+                     [Maintenance(m["stamp"], m["event"], m["axis"], m["at"]) for m in maintenance], program_changes,
+                     **facts)
 
 
 def write_cycle(path: Path, root: Path, key: dict, features: np.ndarray) -> None:

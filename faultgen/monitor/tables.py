@@ -90,8 +90,11 @@ def _axis_values(row: dict, end: str, n_axes: int) -> np.ndarray:
     return np.array([_number(row.get(f"wear{k}{end}")) for k in range(1, n_axes + 1)], dtype=float)
 
 
-def _number(value) -> float:
-    return float("nan") if value is None or value == "" else float(value)
+def _number(value) -> float:  # a cell that is no number (empty, or planted text): NaN, as the page reads it
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return float("nan")
 
 
 def log_row(row: dict) -> record.LogRow:
@@ -101,7 +104,7 @@ def log_row(row: dict) -> record.LogRow:
     ``wearI_95``, ``wearI_log``, ``wearI_log_lower`` (with friction tests also ``wearI_twin_log``,
     ``wearI_twin_log_lower``, ``wearI_factor``, ``wearI_factor_error``, ``wearI_scale``); a missing
     number is NaN."""
-    axes = [int(k[4:-4]) for k in row if k.startswith("wear") and k.endswith("_log") and k[4:-4].isdigit()]
+    axes = [int(a) for k in row if k.startswith("wear") and (a := k[4:].split("_")[0]).isdigit()]
     scores = [int(k[5:]) for k in row if k.startswith("score") and k[5:].isdigit()]
     n_axes = max(axes + scores, default=0)
     wear = None
@@ -113,10 +116,10 @@ def log_row(row: dict) -> record.LogRow:
                 tuple(row.get(f"wear{k}_scale", "") for k in range(1, n_axes + 1)))
         wear = record.AxisWear(*(_axis_values(row, end, n_axes) for end in ("", "_lower", "_5", "_95", "_log",
                                                                              "_log_lower")), tests)
-    ranking = tuple(int(a) for a in str(row.get("ranking", "")).split())
+    ranking = tuple(int(a) for a in str(row.get("ranking", "")).split() if a.isdigit())
     return record.LogRow(row.get("unit", ""), row["stamp"], row["phase"],
                          *(_number(row.get(c)) for c in ("Q", "Q_limit", "T2", "T2_limit")),
-                         0 if row.get("alarm") in (None, "") else int(float(row["alarm"])), ranking,
+                         int(a) if np.isfinite(a := _number(row.get("alarm"))) else 0, ranking,
                          np.array([_number(row.get(f"score{k}")) for k in range(1, n_axes + 1)]), wear)
 
 

@@ -83,6 +83,8 @@ class Unit:
     program_changes: list[stored.ProgramChange] = field(default_factory=list)
     program_cycle: cycles.Program | None = None  # the program's cycle (read when needed, not stored)
     initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
+    torque_source: str = ""  # its logs' torque source, as the reader chose it (formats.torque_source); "" unnamed
+    off_monitor: str = ""  # why it was taken off the monitor (feed.constant_torque); "" while on it
 
 
 

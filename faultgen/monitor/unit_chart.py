@@ -42,7 +42,7 @@ def _spans(phases: list[str], phase: str) -> list[tuple[int, int]]:
     return spans
 
 
-def _interval(unit, axis: int, rows: list[dict]) -> tuple[list, list] | None:
+def _interval(unit, axis: int, rows: list) -> tuple[list, list] | None:
     """An axis's 90 % interval of wear.csv along the unit's scored logs (``wear_5``, ``wear_95``),
     matched by stamp (a stamp's rows in order); None without wear.csv's rows of the axis."""
     found: dict[str, list[dict]] = {}
@@ -53,8 +53,8 @@ def _interval(unit, axis: int, rows: list[dict]) -> tuple[list, list] | None:
     seen: dict[str, int] = {}
     low, high = [], []
     for r in rows:
-        k = seen[r["stamp"]] = seen.get(r["stamp"], -1) + 1
-        match = found.get(r["stamp"], [])
+        k = seen[r.stamp] = seen.get(r.stamp, -1) + 1
+        match = found.get(r.stamp, [])
         w = match[min(k, len(match) - 1)] if match else {}
         low.append(short(number(w.get("wear_5"))))
         high.append(short(number(w.get("wear_95"))))
@@ -67,18 +67,18 @@ def figure(unit, settings: dict) -> dict:
     ``wear_limit``, ``alpha``)."""
     rows = unit.scores
     x = list(range(len(rows)))
-    stamps = [escaped(r["stamp"]) for r in rows]
-    twin = bool(rows) and bool(rows[0].get("wear1"))
+    stamps = [escaped(r.stamp) for r in rows]
+    twin = bool(rows) and not math.isnan(rows[0].wear_at(1))
     data, shapes, annotations = [], [], []
     stat_axis = "y2" if twin else "y"
-    n_axes = sum(1 for k in rows[0] if k.startswith("score") and k[5:].isdigit()) if rows else 0
+    n_axes = len(rows[0].scores) if rows else 0
     if twin:
         for i in range(1, n_axes + 1):
             colour = COLOURS[(i - 1) % len(COLOURS)]
-            wear = [short(number(r.get(f"wear{i}"))) for r in rows]
+            wear = [short(r.wear_at(i)) for r in rows]
             interval = _interval(unit, i, rows)
             if interval is None:  # no wear.csv: the lower one-sided bound of scores.csv
-                lower = [short(number(r.get(f"wear{i}_lower"))) for r in rows]
+                lower = [short(r.wear_at(i, "lower")) for r in rows]
                 data.append({"type": "scatter", "mode": "lines", "x": x, "y": lower, "line": {"width": 0, "color": colour},
                              "legendgroup": f"axis{i}", "showlegend": False, "name": f"axis {i} lower bound",
                              "customdata": stamps, "hovertemplate": "%{customdata}: lower bound %{y:.3g} %<extra></extra>"})
@@ -100,7 +100,7 @@ def figure(unit, settings: dict) -> dict:
                          "line": {"color": "black", "dash": "dash", "width": 1}, "name": f"wear limit {limit:g} %",
                          "hoverinfo": "skip"})
     for name, dash, colour in (("Q", "solid", "#1f3a93"), ("T2", "dot", "#9467bd")):
-        ratio = [short(number(r[name]) / number(r[f"{name}_limit"])) if number(r[f"{name}_limit"]) else None
+        ratio = [short(getattr(r, name) / getattr(r, f"{name}_limit")) if getattr(r, f"{name}_limit") else None
                  for r in rows]
         data.append({"type": "scatter", "mode": "lines", "x": x, "y": ratio, "yaxis": stat_axis,
                      "line": {"width": 1.2, "dash": dash, "color": colour}, "name": f"{name} / its limit", "customdata": stamps,
@@ -110,7 +110,7 @@ def figure(unit, settings: dict) -> dict:
         data.append({"type": "scatter", "mode": "lines", "x": [-0.5, len(rows) - 0.5], "y": [1, 1], "yaxis": stat_axis,
                      "line": {"color": "black", "width": 1}, "hoverinfo": "skip",
                      "name": "limit" + (f" (alpha {alpha:g})" if isinstance(alpha, (int, float)) else "")})
-    phases = [r["phase"] for r in rows]
+    phases = [r.phase for r in rows]
 
     def band(first: int, last: int, colour: str, text: str) -> None:
         shapes.append({"type": "rect", "xref": "x", "yref": "paper", "x0": first - 0.5, "x1": last + 0.5, "y0": 0,
@@ -130,11 +130,11 @@ def figure(unit, settings: dict) -> dict:
     for first, last in _spans(phases, "training"):
         band(first, last, "#bbbbbb", "learning")
     for first, last in _spans(phases, "relearning"):  # after a program change (units.csv's reason says so) or maintenance
-        changed = f"program changed at {rows[first]['stamp']} " in (unit.row or {}).get("reason", "")
+        changed = f"program changed at {rows[first].stamp} " in (unit.row or {}).get("reason", "")
         band(first, last, "#f5c27a", "program change: learned again" if changed else "maintenance: offset learned again")
     raw: dict[str, int] = {}  # a stamp's first row: one look-up per alarm (a list's index was rows x alarms)
     for k, r in enumerate(rows):
-        raw.setdefault(r["stamp"], k)
+        raw.setdefault(r.stamp, k)
     for k, alarm in enumerate(unit.closed):
         if alarm["first_alarm"] in raw:
             line(raw[alarm["first_alarm"]], "#7f7f7f", "dash",
@@ -145,7 +145,7 @@ def figure(unit, settings: dict) -> dict:
              escaped(f"alarm, axis {unit.current['source_axis']}:") + "<br>" + escaped(lights.alarm_dates(unit.current)),
              0.97)
     if unit.tests:
-        traces, lines, notes = friction_panel.markers(friction_panel.by_axis(unit.tests), [r["stamp"] for r in rows],
+        traces, lines, notes = friction_panel.markers(friction_panel.by_axis(unit.tests), [r.stamp for r in rows],
                                                       COLOURS, twin)
         data += traces
         shapes += lines
