@@ -30,6 +30,8 @@ import h5py
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+from faultgen import children  # noqa: E402  (the checkout's own, before any installed copy)
 
 #: The commands, each ``(name, arguments after faultgen)``, run in this order in one folder.
 COMMANDS = [
@@ -92,7 +94,7 @@ def run_all(folder: Path) -> dict:
     for name, args in COMMANDS:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         started = time.perf_counter()
-        done = subprocess.run([sys.executable, "-m", "faultgen.cli", *args], cwd=folder, env=env,
+        done = subprocess.run(children.command("-m", "faultgen.cli", *args), cwd=folder, env=env,
                               capture_output=True, text=True)
         wall = time.perf_counter() - started
         after = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -45,6 +45,7 @@ of prediction, and the two twins share the twin's scale and log noise (paired).
 from __future__ import annotations
 
 import zlib
+from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
@@ -156,18 +157,37 @@ def factor(unit: files.Unit, seed: int, axis: int, every: int = TESTS_EVERY) -> 
     return mean, min(float(error) / mean, 10.0)
 
 
-def rows(unit: files.Unit, wear: np.ndarray, f: float = 1.0) -> tuple[list[dict], dict[str, float]]:
-    """The monitor's rows (``stamp``, ``phase``, ``wearI_log``, ``wearI_log_lower``) of the readings
-    ``wear`` times ``f``, and their stamps' time keys (seconds)."""
+@dataclass(frozen=True)
+class Wear:
+    """What :func:`faultgen.monitor.prognosis.remaining_life` reads of a monitor row's wear
+    (:class:`faultgen.monitor.record.AxisWear`, which this layer may not import): each log's own
+    estimate ``log`` and its lower bound ``log_lower``, (n_axes,) %; no filtered estimate (``estimate``
+    None on every axis: the emulator has none)."""
+
+    log: np.ndarray
+    log_lower: np.ndarray
+    estimate: tuple = (None,) * N_AXES
+
+
+@dataclass(frozen=True)
+class Row:
+    """One emulated log as the monitor's row (:class:`faultgen.monitor.record.LogRow`'s ``stamp``,
+    ``phase`` and ``wear``)."""
+
+    stamp: str
+    phase: str
+    wear: Wear
+
+
+def rows(unit: files.Unit, wear: np.ndarray, f: float = 1.0) -> tuple[list[Row], dict[str, float]]:
+    """The monitor's rows (:class:`Row`) of the readings ``wear`` (n_days, n_axes) % times ``f``, and
+    their stamps' time keys (seconds)."""
     z = NormalDist().inv_cdf(1.0 - ALPHA)
     out, keys = [], {}
     for day, values in zip(_days(unit), wear):
         stamp = f"day{day:04d}"
-        row = {"stamp": stamp, "phase": "monitoring"}
-        for a in range(N_AXES):
-            row[f"wear{a + 1}_log"] = f * float(values[a])
-            row[f"wear{a + 1}_log_lower"] = f * float(values[a] - z * LOG_SD)
-        out.append(row)
+        values = np.asarray(values, dtype=float)
+        out.append(Row(stamp, "monitoring", Wear(f * values, f * (values - z * LOG_SD))))
         keys[stamp] = float(day) * 86400.0
     return out, keys
 
@@ -202,7 +222,7 @@ class EmulatedTwin:
         f, uncertainty = fitted if fitted else (1.0, None)
         logs, keys = rows(unit, wear, f)
         (row,) = self.trend(unit.id, logs, N_AXES, alpha=ALPHA, failure_wear=self.failure_wear, keys=keys,
-                            kind=logfolder.TIME, since=logs[first]["stamp"], source_axis=axis, axes=[axis],
+                            kind=logfolder.TIME, since=logs[first].stamp, source_axis=axis, axes=[axis],
                             samples=self.samples, scale_uncertainty=uncertainty)
         if row.distribution is None:
             return np.array([np.inf])
