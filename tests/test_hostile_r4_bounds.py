@@ -44,8 +44,8 @@ def _monitor_output(out: Path, reason: str = "", n_axes: int = 6) -> Path:
     """A small monitor output folder (one unit, three scored logs), written by the monitor's writers
     except scores.csv, whose ``n_axes`` score columns are written directly."""
     out.mkdir(parents=True, exist_ok=True)
-    report.write_units(out / "units.csv", [UnitStatus("weld-01", "monitored", "own", "", reason, 3, "2026-03-03")])
-    report.write_alarms(out / "alarms.csv", [])
+    report.units_table([UnitStatus("weld-01", "monitored", "own", "", reason, 3, "2026-03-03")]).write(out)
+    report.alarms_table([]).write(out)
     with open(out / "scores.csv", "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow([*report.SCORE_COLUMNS, *(f"score{i}" for i in range(1, n_axes + 1))])

@@ -138,8 +138,8 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
                for r in unit.rows)
     assert not any(r.alarm for r in unit.rows) and unit.first_alarm is None
     assert "axis 2 " + NOT_OBSERVABLE in unit.not_observable_note()
-    report.write_wear(tmp_path / "wear.csv", [unit])
-    report.write_scores(tmp_path / "scores.csv", [unit], N_AXES)
+    report.wear_table([unit]).write(tmp_path)
+    report.scores_table([unit], N_AXES).write(tmp_path)
     wear_rows = list(csv.DictReader(open(tmp_path / "wear.csv")))
     assert {r["wear"] for r in wear_rows if r["axis"] == "2"} == {""}
     assert all(r["wear"] for r in wear_rows if r["axis"] != "2")
@@ -149,9 +149,9 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     assert not rul[0].verdict.startswith(NOT_OBSERVABLE)
     report.chart(io.BytesIO(), unit, "wear signature match")  # an axis without wear drawn as none
     # the page: the axis named as such in the unit's panel, no wear number for it
-    report.write_alarms(tmp_path / "alarms.csv", [unit])
-    report.write_units(tmp_path / "units.csv", [UnitStatus("u", "monitored", "twin", "nominal",
-                                                           unit.not_observable_note(), 50, "049")])
+    report.alarms_table([unit]).write(tmp_path)
+    report.units_table([UnitStatus("u", "monitored", "twin", "nominal", unit.not_observable_note(), 50,
+                                   "049")]).write(tmp_path)
     html = page.build(page.read(tmp_path), {})
     assert f"<li>axis 2: {NOT_OBSERVABLE} (no wear" in html and "<li>axis 1: " in html
 
@@ -160,8 +160,8 @@ def test_rul_csv_wear_is_wear_csv_wear(tmp_path):
     rng = np.random.default_rng(5)
     unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(70, 1, 30, 0.8), rng)
-    report.write_wear(tmp_path / "wear.csv", [unit])
-    prognosis.write_rul(tmp_path / "rul.csv", prognosis.of_monitor(unit, samples=100))
+    report.wear_table([unit]).write(tmp_path)
+    prognosis.rul_table(prognosis.of_monitor(unit, samples=100)).write(tmp_path)
     last = {r["axis"]: r["wear"] for r in csv.DictReader(open(tmp_path / "wear.csv")) if r["stamp"] == "069"}
     rul = {r["axis"]: r["wear"] for r in csv.DictReader(open(tmp_path / "rul.csv"))}
     assert rul == last and len(rul) == N_AXES
@@ -201,9 +201,9 @@ def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tm
     rng = np.random.default_rng(1)
     unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(200, 2, 35, 0.1), rng, noise=0.15)
-    report.write_alarms(tmp_path / "alarms.csv", [unit])
-    report.write_scores(tmp_path / "scores.csv", [unit], N_AXES)
-    report.write_units(tmp_path / "units.csv", [UnitStatus("u", "monitored", "twin", "nominal", "", 200, "199")])
+    report.alarms_table([unit]).write(tmp_path)
+    report.scores_table([unit], N_AXES).write(tmp_path)
+    report.units_table([UnitStatus("u", "monitored", "twin", "nominal", "", 200, "199")]).write(tmp_path)
     if not known:  # an output folder written before the column
         rows = list(csv.DictReader(open(tmp_path / "alarms.csv")))
         with open(tmp_path / "alarms.csv", "w", newline="") as f:

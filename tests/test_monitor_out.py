@@ -99,12 +99,12 @@ def test_an_output_that_is_inside_or_holds_the_logs_folder_is_refused_naming_bot
 
 
 def test_a_run_that_fails_leaves_no_output_folder_it_made_and_keeps_one_that_was_there(fleet, tmp_path, monkeypatch):
-    from faultgen.monitor import report
+    from faultgen.monitor import record
 
-    def full_disk(path, *args, **kwargs):
+    def full_disk(table, *args, **kwargs):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(report, "write_units", full_disk)
+    monkeypatch.setattr(record.Table, "write", full_disk)
     out = tmp_path / "new" / "out"  # two folders the run makes
     result = _monitor(fleet, out)
     assert result.exit_code == 1 and "No space left on device" in result.output, result.output

@@ -239,7 +239,7 @@ def test_a_twin_fallen_back_to_the_nominal_model_labels_its_wear_so(tmp_path):
     statuses = [loop.UnitStatus("a", "monitored", "twin", "calibrated", "", 3, "x"),
                 loop.UnitStatus("b", "monitored", "twin", "nominal", "the twin of the calibrated model failed (qdd); "
                                 "nominal model used", 3, "x", "", "the twin of the calibrated model failed (qdd)")]
-    report.write_units(tmp_path / "units.csv", statuses, scales={"a": "twin", "b": "nominal model"})
+    report.units_table(statuses, scales={"a": "twin", "b": "nominal model"}).write(tmp_path)
     rows = _rows(tmp_path / "units.csv")
     assert [r["wear_scale"] for r in rows] == ["twin", "nominal model"] and "torque_source" not in rows[0]
     assert statuses[1].basis() == "; twin fallback: the twin of the calibrated model failed (qdd)"
@@ -250,10 +250,9 @@ def test_a_twin_fallen_back_to_the_nominal_model_labels_its_wear_so(tmp_path):
                                           **{f"wear{k}{end}": 1.0 for k in (1, 2)
                                              for end in ("", "_5", "_95", "_lower", "_log")}}])
 
-    report.write_wear(tmp_path / "wear.csv", [Monitor("a"), Monitor("b")], scales=True, nominal={"b"})
+    report.wear_table([Monitor("a"), Monitor("b")], scales=True, nominal={"b"}).write(tmp_path)
     assert [r["wear_scale"] for r in _rows(tmp_path / "wear.csv")] == ["twin"] * 2 + ["nominal model"] * 2
-    report.write_wear(tmp_path / "plain.csv", [Monitor("a")])
-    assert "wear_scale" not in (tmp_path / "plain.csv").read_text()
+    assert "wear_scale" not in report.wear_table([Monitor("a")]).columns
     notes = page._source_notes(rows[1])
     assert len(notes) == 1 and "Twin fallback" in notes[0] and not page._source_notes(rows[0])
     assert "nominal model's" in lights.SCALES["nominal model"]

@@ -200,8 +200,7 @@ def test_rul_csv_has_a_row_per_unit_and_axis_with_empty_cells_where_there_is_no_
     worn = _one(_rows(0.7 * np.arange(40) + rng.normal(0, NOISE, 40)))
     flat = _one(_rows(rng.normal(0, NOISE, 40)))
     flat.unit = "=cmd"  # a unit folder a spreadsheet would take for a formula
-    path = tmp_path / "rul.csv"
-    prognosis.write_rul(path, [worn, flat])
+    path = prognosis.rul_table([worn, flat]).write(tmp_path)
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
         assert tuple(reader.fieldnames) == prognosis.COLUMNS

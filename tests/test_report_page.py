@@ -46,8 +46,8 @@ def _feed(monitor: UnitMonitor, days: int, wear, seed: int, repair: int | None =
         monitor.add(f"2026-03-{day + 1:02d}", residual, float("nan"), 0.0)
 
 
-def make_output(out: Path) -> Path:
-    """A monitor output folder (units.csv, alarms.csv, scores.csv) of :data:`UNITS`."""
+def make_tables() -> tuple[list, list[UnitMonitor]]:
+    """The tables (units.csv, alarms.csv, scores.csv) of :data:`UNITS` in memory, and their monitors."""
     signatures = np.random.default_rng(0).standard_normal((N_AXES, N_FEATURES))
     monitors = [UnitMonitor(name, SETTINGS, N_AXES, signatures) for name in UNITS[:5]]
     _feed(monitors[0], 30, lambda d: max(0.0, d - 14) * 1.5, seed=1)  # wears from day 15
@@ -60,10 +60,14 @@ def make_output(out: Path) -> Path:
                            "" if m.pca is not None else f"learning: {len(m.training)} of 10 logs", len(m.rows) or
                            len(m.training), m.last_stamp) for m in monitors]
     statuses.append(UnitStatus(UNITS[5], "not monitored", "twin", "", "no log", 0, ""))
+    return [report.alarms_table(monitors), report.scores_table(monitors, N_AXES), report.units_table(statuses)], monitors
+
+
+def make_output(out: Path) -> Path:
+    """A monitor output folder (units.csv, alarms.csv, scores.csv) of :data:`UNITS`."""
     out.mkdir(parents=True, exist_ok=True)
-    report.write_alarms(out / "alarms.csv", monitors)
-    report.write_scores(out / "scores.csv", monitors, N_AXES)
-    report.write_units(out / "units.csv", statuses)
+    for table in make_tables()[0]:
+        table.write(out)
     return out
 
 
@@ -211,14 +215,20 @@ def test_report_builds_the_page_again_from_an_output_folder(written, tmp_path):
     assert f"note: {out / 'life.csv'} is missing: the page shows no life consumed by load" in result.output
 
 
-def test_the_page_from_a_runs_typed_rows_is_the_page_from_scores_csv(written, tmp_path):
-    """page.write given the typed rows (record.LogRow, as a run hands it its own) draws the page that
-    `faultgen report` draws from scores.csv, byte for byte: here the twin's wear, alarms, maintenance."""
-    out = shutil.copytree(written, tmp_path / "OUT")
-    rows = tables.log_rows(tables.read(out, "scores.csv", report.SCORE_COLUMNS)[1])
+def test_the_page_from_the_tables_in_memory_is_the_page_from_the_files(written, tmp_path):
+    """page.write given the fleet of the tables a run holds (record.Table.records; its typed rows,
+    record.LogRow, at the tables' digits) draws the page that `faultgen report` draws from the files,
+    byte for byte, reading none: here the twin's wear, alarms, maintenance, and unit names a
+    spreadsheet would take for a formula (written escaped, read back unescaped) or HTML."""
+    made, monitors = make_tables()
+    rows = [r.tabled() for m in monitors for r in m.rows]
     assert rows and all(r.wear is not None for r in rows)
-    (out / page.PAGE).unlink()
-    page.write(out, SETTINGS, rows=rows, robot="irb6700", logs="/data/LOGS", model="per-unit", twin_temperature=False)
+    fleet = page.fleet_of({t.name: t.records() for t in made}, rows)
+    assert [u.name for u in fleet.units] == [u.name for u in page.read(written).units] and "=new-cell" in UNITS
+    out = tmp_path / "OUT"
+    out.mkdir()
+    page.write(out, SETTINGS, fleet=fleet, robot="irb6700", logs="/data/LOGS", model="per-unit", twin_temperature=False)
+    assert sorted(p.name for p in out.iterdir()) == [page.PAGE, page.SETTINGS]
     assert (out / page.PAGE).read_bytes() == (written / page.PAGE).read_bytes()
 
 
@@ -240,9 +250,11 @@ def test_every_chart_is_a_valid_plotly_figure_with_escaped_text(written):
     assert "maintenance: offset learned again" in texts and any("closed by repair of axis 2" in t for t in texts)
 
 
-def test_monitor_writes_the_page(tmp_path):
+def test_monitor_writes_the_page(tmp_path, monkeypatch):
     """The monitor itself writes report.html and settings.json with its outputs (protocol own, a
-    small synthetic fleet: `faultgen monitor ... --no-progress`)."""
+    small synthetic fleet: `faultgen monitor ... --no-progress`), from the tables it holds: it opens
+    none of its output tables for reading (issue 84 item 4), and `faultgen report` draws the same page
+    from the files."""
     sys.path.insert(0, str(Path(__file__).parent))
     import fleetlog_folder
 
@@ -250,9 +262,31 @@ def test_monitor_writes_the_page(tmp_path):
 
     logs = fleetlog_folder.write_fleet(tmp_path / "LOGS", robots.load("puma560"), units=2, days=12)
     out = tmp_path / "OUT"
-    result = CliRunner().invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(out), "--protocol",
-                                      "own", "--train", "10", "--no-progress"])
+    outputs = {"units.csv", "alarms.csv", "scores.csv", "wear.csv", "rul.csv", "life.csv", "tests.csv"}
+    read_back = []
+
+    def watched(real):
+        def open_(file, mode="r", *args, **kwargs):
+            if Path(str(file)).name in outputs and not any(c in mode for c in "wax+"):
+                read_back.append(str(file))
+            return real(file, mode, *args, **kwargs)
+        return open_
+
+    def refused(folder, name, *args, **kwargs):
+        read_back.append(f"tables.read {name}")
+        raise AssertionError(f"the run read back {name}")
+
+    with monkeypatch.context() as patched:
+        import builtins
+        import io
+
+        patched.setattr(builtins, "open", watched(builtins.open))
+        patched.setattr(io, "open", watched(io.open))
+        patched.setattr(tables, "read", refused)
+        result = CliRunner().invoke(app, ["monitor", str(logs), "--robot", "puma560", "-o", str(out), "--protocol",
+                                          "own", "--train", "10", "--no-progress"])
     assert result.exit_code == 0, result.output
+    assert read_back == [] and outputs - {"tests.csv"} <= {p.name for p in out.iterdir()}
     assert str(out / page.PAGE) in result.output
     assert run_settings.read_settings(out)["protocol"] == "own"
     for name in (page.PAGE, page.SETTINGS):  # LOGS by its name: a page meant to be shared holds no path of ours

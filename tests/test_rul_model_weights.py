@@ -122,8 +122,6 @@ def test_the_same_seed_gives_the_same_bytes(tmp_path):
         (again,) = prognosis.remaining_life("u", tables.log_rows(_rows([0.0] * 30 + [0.02 * i**2 for i in range(35)], 3.5)), 1,
                                             alpha=ALPHA, samples=SAMPLES, seed=seed, source_axis=1,
                                             since="2026-02-28")
-        path = tmp_path / f"rul{len(written)}.csv"
-        prognosis.write_rul(path, [row, again])
-        written.append(path.read_bytes())
+        written.append(prognosis.rul_table([row, again]).write(tmp_path).read_bytes())
     assert written[0] == written[1]
     assert written[0] != written[2]

@@ -88,8 +88,8 @@ def test_wear_csv_holds_each_log_and_axis_estimate_with_its_interval_as_scores_c
     for i in range(40):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
         own.add(f"{i:03d}", rng.normal(0, 0.05, 18), 30.0, 0.0)
-    report.write_wear(tmp_path / "wear.csv", [unit, own])
-    report.write_scores(tmp_path / "scores.csv", [unit, own], 6)
+    report.wear_table([unit, own]).write(tmp_path)
+    report.scores_table([unit, own], 6).write(tmp_path)
     with open(tmp_path / "wear.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     with open(tmp_path / "scores.csv", newline="") as f:

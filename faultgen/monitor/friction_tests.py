@@ -61,7 +61,7 @@ read so far give it: a later test may move an earlier log's wear a little. The r
 the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
 in the twin's scale (``wear_scale`` ``twin``).
 
-``OUT/tests.csv`` (:func:`write_tests`, :data:`COLUMNS`): one row per unit, test and axis read.
+``OUT/tests.csv`` (:func:`tests_table`, :data:`COLUMNS`): one row per unit, test and axis read.
 """
 
 from __future__ import annotations
@@ -81,6 +81,7 @@ from faultgen.data import cells, logfolder
 from faultgen.logs import formats
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
+from faultgen.monitor.record import Table
 
 #: ``wear_scale`` of a unit's wear (units.csv, wear.csv): on its friction tests' scale, or its twin's.
 TESTS_SCALE, TWIN_SCALE = "friction test", "twin"
@@ -482,20 +483,16 @@ class Rescale:
         return factor, float(np.sqrt(cov[1, 1]))
 
 
-def write_tests(path: Path, wears: dict[str, list[AxisWear]]) -> None:
+def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
     """``OUT/tests.csv`` (:data:`COLUMNS`): per unit, test and axis read, in stamp order; empty cells
     where there is no number."""
 
     def cell(value) -> str:  # no number: empty, NaN included
         return cells.figure(None if isinstance(value, float) and not math.isfinite(value) else value)
 
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(COLUMNS)
-        for unit, rows in wears.items():
-            for r in rows:
-                writer.writerow([unit, r.stamp, r.axis, *(cell(r.fit[c]) for c in FIT_COLUMNS),
-                                 cell(r.wear), cell(r.lower), cell(r.upper), r.verdict])
+    return Table("tests.csv", COLUMNS, [[unit, r.stamp, r.axis, *(cell(r.fit[c]) for c in FIT_COLUMNS), cell(r.wear),
+                                         cell(r.lower), cell(r.upper), r.verdict]
+                                        for unit, rows in wears.items() for r in rows])
 
 
 def on_tests_scale(rows: list, n_axes: int) -> tuple[list, dict[int, float] | None]:

@@ -51,7 +51,6 @@ import re
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
@@ -59,6 +58,7 @@ from faultgen.data import cells, logfolder
 from faultgen.logs import measured
 from faultgen.model import rating
 from faultgen.monitor.html_cells import number
+from faultgen.monitor.record import Table
 
 #: Operating hours per calendar day the consumption between logs assumes (two 8 h shifts).
 HOURS_PER_DAY = 16.0
@@ -282,14 +282,10 @@ def _verdict(row: LifeRow, changed: bool, missing: int, window: int) -> str:
     return text + left_out
 
 
-def write_life(path: Path, rows: list[LifeRow]) -> None:
+def life_table(rows: list[LifeRow]) -> Table:
     """``life.csv``: one row per unit and axis (:data:`COLUMNS`; ``days_left`` empty without load;
     ``defaults`` the rating keys that are defaults, space separated)."""
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(COLUMNS)
-        for row in rows:
-            writer.writerow([cells.figure(v) for v in row.cells()])
+    return Table("life.csv", COLUMNS, [[cells.figure(v) for v in row.cells()] for row in rows])
 
 
 @dataclass(frozen=True)

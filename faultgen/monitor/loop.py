@@ -274,26 +274,26 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
         statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ()),
                             fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
                             stopped.get(name, "")) for name in units]
+        nominal_scale = _nominal_scale(state, settings, calibrated_model is not None or calibrate)
+        written = [report.alarms_table(monitors), report.scores_table(monitors, nominal.n_axes),
+                   report.wear_table(monitors, scales=bool(found) or bool(nominal_scale), nominal=nominal_scale),
+                   report.units_table(statuses, scales={m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors}
+                                      if found or nominal_scale else None),
+                   *([friction_tests.tests_table({name: wears[name][0] for name in units if name in wears})]
+                     if found else []),
+                   prognosis.rul_table([row for m in monitors for row in made[m.unit][1]]),
+                   # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
+                   life.life_table([row for name in units if name in state and state[name].entries
+                                    for row in life.of_unit(name, state[name].entries, state[name].maintenance, ratings,
+                                                            hours_per_day, notes=state[name].notes)])]
+        # the page from the tables in memory (none read back), as `faultgen report OUT` draws it from the files
+        fleet = page.fleet_of({t.name: t.records() for t in written}, [r.tabled() for m in monitors for r in m.rows])
         with atomic.atomic_folder(out) as staging:
-            report.write_alarms(staging / "alarms.csv", monitors)
-            report.write_scores(staging / "scores.csv", monitors, nominal.n_axes)
-            nominal_scale = _nominal_scale(state, settings, calibrated_model is not None or calibrate)
-            report.write_wear(staging / "wear.csv", monitors, scales=bool(found) or bool(nominal_scale),
-                              nominal=nominal_scale)
-            report.write_units(staging / "units.csv", statuses, scales={
-                m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors} if found or nominal_scale else None)
-            if found:
-                friction_tests.write_tests(staging / "tests.csv", {name: wears[name][0] for name in units if name in wears})
-            prognosis.write_rul(staging / "rul.csv", [row for m in monitors for row in made[m.unit][1]])
-            # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
-            life.write_life(staging / "life.csv", [row for name in units if name in state and state[name].entries
-                                                   for row in life.of_unit(
-                name, state[name].entries, state[name].maintenance, ratings, hours_per_day,
-                notes=state[name].notes)])
+            for table in written:
+                table.write(staging)
             # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-            page.write(staging, settings, table_max_bytes=None, rows=[r for m in monitors for r in m.rows],
-                       robot=Path(str(robot)).name, logs=Path(logs_dir).resolve().name,  # its own tables
-                       model=model_source, twin_temperature=twin_temperature)
+            page.write(staging, settings, fleet=fleet, robot=Path(str(robot)).name,
+                       logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
             for m in monitors:
                 (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
             (staging / ".state").mkdir()

@@ -3,9 +3,11 @@
 The page is built from the monitor's outputs alone, ``units.csv``, ``alarms.csv`` and
 ``scores.csv`` (:mod:`faultgen.monitor.report`), where present ``wear.csv``, ``rul.csv``,
 ``life.csv`` and ``tests.csv`` (the friction tests), and the run's settings (a small dict, kept
-beside it as ``OUT/settings.json``), so ``faultgen report OUT`` builds it again from an output folder
-(:func:`write`, :func:`faultgen.monitor.run_settings.read_settings`); scores.csv's rows are typed
-(:class:`faultgen.monitor.record.LogRow`), the run's own handed over by the run. It holds:
+beside it as ``OUT/settings.json``): a monitor run draws it from the tables it holds and writes
+(:class:`faultgen.monitor.record.Table`, :func:`fleet_of`), reading none back; ``faultgen report OUT``
+draws the same page again from an output folder's files (:func:`read`,
+:func:`faultgen.monitor.run_settings.read_settings`); scores.csv's rows are typed
+(:class:`faultgen.monitor.record.LogRow`). It holds:
 
 - the fleet table (:mod:`faultgen.monitor.lights`, where its rules are stated): one line per unit,
   a state light (service due, watch, stale, unknown, ok: colour and word), the "service by" date
@@ -183,12 +185,20 @@ class Fleet:
     twin: bool
 
 
-def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES, rows=None) -> Fleet:
+#: The columns the page needs of each table it is drawn from (``known`` of alarms.csv is optional: a
+#: folder written without it is still read); rul.csv, life.csv, wear.csv and tests.csv may be absent
+#: (a run before them, a fleet without friction tests).
+REQUIRED = {"units.csv": report.UNIT_COLUMNS, "alarms.csv": tuple(c for c in report.ALARM_COLUMNS if c != "known"),
+            "rul.csv": ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
+            "life.csv": ("unit", "axis", "consumed_pct", "days_left", "verdict"), "wear.csv": report.WEAR_COLUMNS,
+            "tests.csv": friction_panel.REQUIRED}
+
+
+def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES) -> Fleet:
     """The units of a monitor output folder (``units.csv``, ``alarms.csv``, ``scores.csv``; and
     ``rul.csv``, ``life.csv``, ``wear.csv``, ``tests.csv`` where present), each table read by
-    :func:`faultgen.monitor.tables.read` (``max_bytes`` as there), in the order of
-    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`). ``rows``: the
-    run's :class:`faultgen.monitor.record.LogRow` that scores.csv holds (its rows read back otherwise).
+    :func:`faultgen.monitor.tables.read` (``max_bytes`` as there): ``faultgen report OUT``'s
+    :func:`fleet_of` (a monitor run gives it the tables it holds instead).
 
     Raises
     ------
@@ -196,13 +206,22 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES, rows=
         A file is missing, a link out of the folder, or a table refused by that reader (named).
     """
     folder = Path(folder)
-    _, unit_rows = tables.read(folder, "units.csv", report.UNIT_COLUMNS, max_bytes)
-    # ``known`` is optional: a folder written without it is still read
-    required = tuple(c for c in report.ALARM_COLUMNS if c != "known")
-    _, alarm_rows = tables.read(folder, "alarms.csv", required, max_bytes)
-    score_rows = ([r.tabled() for r in rows] if rows is not None else
-                  tables.log_rows(tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)[1]))
-    units = {r["unit"]: Unit(r) for r in unit_rows if r.get("unit") is not None}
+    found = {name: tables.read(folder, name, REQUIRED[name], max_bytes)[1] for name in ("units.csv", "alarms.csv")}
+    score_rows = tables.log_rows(tables.read(folder, "scores.csv", report.SCORE_COLUMNS, max_bytes)[1])
+    for name in ("rul.csv", "life.csv", "wear.csv", "tests.csv"):  # optional: older folders lack them
+        if (folder / name).exists():
+            found[name] = tables.read(folder, name, REQUIRED[name], max_bytes)[1]
+    return fleet_of(found, score_rows)
+
+
+def fleet_of(found: dict[str, list[dict]], score_rows: list[record.LogRow]) -> Fleet:
+    """The fleet of the page from the rows of its tables by file name (text cells by column, as
+    :func:`faultgen.monitor.tables.read` gives them or :meth:`faultgen.monitor.record.Table.records`;
+    units.csv and alarms.csv required, the others of :data:`REQUIRED` where present) and scores.csv's
+    typed rows (:class:`faultgen.monitor.record.LogRow`), its units in the order of
+    :meth:`Unit.attention` (the page orders them by :mod:`faultgen.monitor.lights`)."""
+    units = {r["unit"]: Unit(r) for r in found["units.csv"] if r.get("unit") is not None}
+    alarm_rows = found["alarms.csv"]
     for r in alarm_rows:
         unit = units.setdefault(r["unit"], Unit({"unit": r["unit"], "status": "", "last_log": ""}))
         if r.get("closed"):
@@ -212,25 +231,20 @@ def read(folder: str | Path, max_bytes: int | None = tables.CSV_MAX_BYTES, rows=
     for r in score_rows:
         if r.unit in units:
             units[r.unit].scores.append(r)
-    if (folder / "rul.csv").exists():  # remaining useful life (optional: older folders lack it)
-        for r in tables.read(folder, "rul.csv", ("unit", "axis", "rul", "rul_5", "rul_95", "time_unit", "verdict"),
-                           max_bytes)[1]:
-            axis = number(r["axis"])
-            if r["unit"] in units and math.isfinite(axis):
-                units[r["unit"]].remaining[int(axis)] = r
-    if (folder / "life.csv").exists():  # the rated life consumed by load (optional: a run before it has none)
-        for r in tables.read(folder, "life.csv", ("unit", "axis", "consumed_pct", "days_left", "verdict"), max_bytes)[1]:
-            if r["unit"] in units:
-                units[r["unit"]].life.append(r)
-    if (folder / "wear.csv").exists():  # the wear's 90 % interval and scale (optional: a run before it has none)
-        for r in tables.read(folder, "wear.csv", report.WEAR_COLUMNS, max_bytes)[1]:
-            axis = number(r["axis"])
-            if r["unit"] in units and math.isfinite(axis) and axis == int(axis):
-                units[r["unit"]].wear.setdefault(int(axis), []).append(r)
-    if (folder / "tests.csv").exists():  # friction tests (optional: absent, no test data)
-        for r in tables.read(folder, "tests.csv", friction_panel.REQUIRED, max_bytes)[1]:
-            if r["unit"] in units:
-                units[r["unit"]].tests.append(r)
+    for r in found.get("rul.csv", ()):  # remaining useful life
+        axis = number(r["axis"])
+        if r["unit"] in units and math.isfinite(axis):
+            units[r["unit"]].remaining[int(axis)] = r
+    for r in found.get("life.csv", ()):  # the rated life consumed by load
+        if r["unit"] in units:
+            units[r["unit"]].life.append(r)
+    for r in found.get("wear.csv", ()):  # the wear's 90 % interval and scale
+        axis = number(r["axis"])
+        if r["unit"] in units and math.isfinite(axis) and axis == int(axis):
+            units[r["unit"]].wear.setdefault(int(axis), []).append(r)
+    for r in found.get("tests.csv", ()):  # friction tests
+        if r["unit"] in units:
+            units[r["unit"]].tests.append(r)
     n_axes = max((len(r.scores) for r in score_rows), default=0)
     ordered = sorted(units.values(), key=Unit.attention)
     return Fleet(ordered, n_axes if alarm_rows else 1, any(r.wear is not None for r in score_rows))
@@ -459,15 +473,15 @@ def _write(path: Path, text: str) -> None:
         tmp.write_bytes(text.encode("utf-8"))
 
 
-def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES, rows=None,
-          **extra) -> Path:
-    """Write ``folder/report.html`` from the monitor outputs in ``folder`` and the run's
+def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = tables.CSV_MAX_BYTES,
+          fleet: Fleet | None = None, **extra) -> Path:
+    """Write ``folder/report.html`` from ``fleet`` (a monitor run's, :func:`fleet_of` the tables it
+    holds) or else the monitor outputs in ``folder`` (:func:`read`), and the run's
     ``settings`` (a :class:`faultgen.monitor.scoring.Settings` or a dict; ``extra`` adds to it: the
     robot, the logs folder, the model source), kept beside it as ``folder/settings.json`` (unless empty).
     Both files are written whole or not at all (:func:`faultgen.data.atomic.atomic_path`), UTF-8.
-    ``table_max_bytes``: each table's size bound (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`;
-    None for the tables a monitor run has just written: their rows are in its memory already, and a
-    large fleet's page is written); ``rows``: the run's rows of scores.csv (:func:`read`).
+    ``table_max_bytes``: each table's size bound when read (:data:`faultgen.monitor.tables.CSV_MAX_BYTES`;
+    None: no bound).
 
     Raises
     ------
@@ -482,7 +496,7 @@ def write(folder: str | Path, settings=None, *, table_max_bytes: int | None = ta
     folder = Path(folder)
     settings = settings_dict(settings, extra)
     page = folder / PAGE
-    _write(page, build(read(folder, table_max_bytes, rows), settings))
+    _write(page, build(fleet if fleet is not None else read(folder, table_max_bytes), settings))
     if settings:
         _write(folder / SETTINGS, json.dumps(settings, indent=1, sort_keys=True) + "\n")
     return page

@@ -6,7 +6,7 @@ conditions as the trend had learned it by then (the season the slopes extrapolat
 would take for wear), and its lower ``1 - alpha`` bound ``wearI_log_lower``; the estimate's
 standard error is ``(wearI_log - wearI_log_lower) / z``, ``z`` the standard normal's ``1 - alpha``
 quantile; not the wear filtered over the logs, ``wearI``, whose errors are not independent). Recomputed from the
-unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`write_rul`).
+unit's rows at every run, so it follows every new log; ``OUT/rul.csv`` (:func:`rul_table`).
 
 Per axis:
 
@@ -90,12 +90,12 @@ from __future__ import annotations
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from statistics import NormalDist
 
 import numpy as np
 
 from faultgen.data import cells, logfolder
+from faultgen.monitor.record import Table
 from faultgen.monitor.scoring import NOT_OBSERVABLE, SCALE_UNCERTAINTY
 from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, expm1_over, fit_models, model_weights
 
@@ -556,16 +556,7 @@ def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, rows: list[dict] | N
                           **options)
 
 
-def write_rul(path: Path, rows: list[Remaining]) -> None:
+def rul_table(rows: list[Remaining]) -> Table:
     """``rul.csv``: one row per unit and axis (:data:`COLUMNS`; empty cells where there is no
     number: no fit, or beyond the horizon)."""
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(COLUMNS)
-        for row in rows:
-            writer.writerow([cells.figure(getattr(row, c)) for c in COLUMNS])
-
-
-def write(path: Path, monitors, failure_wear: float = FAILURE_WEAR) -> None:
-    """``rul.csv`` of every unit's monitor (:func:`of_monitor`, :func:`write_rul`)."""
-    write_rul(path, [row for m in monitors for row in of_monitor(m, failure_wear)])
+    return Table("rul.csv", COLUMNS, [[cells.figure(getattr(row, c)) for c in COLUMNS] for row in rows])

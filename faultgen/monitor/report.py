@@ -1,4 +1,6 @@
-"""The monitor's outputs: ``units.csv``, ``alarms.csv``, ``scores.csv`` and one control chart per unit.
+"""The monitor's outputs: ``units.csv``, ``alarms.csv``, ``scores.csv``, ``wear.csv`` (each a
+:class:`faultgen.monitor.record.Table` made from what the run holds, written from it and shown on the
+page from it) and one control chart per unit.
 
 Text cells that a spreadsheet would take for a formula (starting with ``=``, ``+``, ``-``, ``@``, a
 tab or a carriage return: a unit folder named ``=HYPERLINK(...)``) are written with a leading
@@ -8,13 +10,12 @@ are written as numbers."""
 from __future__ import annotations
 
 import threading
-from pathlib import Path
 
 import numpy as np
 
-from faultgen.data import cells
 from faultgen.figure_text import plain
 from faultgen.monitor import scoring
+from faultgen.monitor.record import Table
 
 #: ``first_alarm``: the first of the alarming logs the alarm started from; ``known``: the log on which it
 #: became known (persistent), as a daily run sees it.
@@ -37,38 +38,34 @@ def _fmt(value) -> str:
     if len(value) > CELL_MAX_CHARS:
         cut = CELL_MAX_CHARS - 40
         value = f"{value[:cut]} ... ({len(value) - cut} more characters)"
-    return value  # neutralised by cells.writer
+    return value  # neutralised by faultgen.data.cells.writer
 
 
-def write_units(path: Path, statuses, scales: dict[str, str] | None = None) -> None:
-    """One row per unit of the fleet folder (:class:`faultgen.monitor.loop.UnitStatus`): its
+def units_table(statuses, scales: dict[str, str] | None = None) -> Table:
+    """``units.csv``: one row per unit of the fleet folder (:class:`faultgen.monitor.loop.UnitStatus`): its
     status, the protocol and model its monitor uses, why (fallbacks, skipped logs, learning), the
     logs scored and the last one; with ``scales`` (a fleet with friction tests, or a unit whose twin
     fell back to the nominal model) also the scale of its wear, ``wear_scale`` (a unit not in it:
     ``twin``; :mod:`faultgen.monitor.friction_tests`); where a log format says which torque it read
     (``ur-rtde``), ``torque_source`` (:func:`faultgen.logs.formats.torque_source`)."""
     sources = any(getattr(s, "torque_source", "") for s in statuses)
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(UNIT_COLUMNS + (("wear_scale",) if scales is not None else ())
-                        + (("torque_source",) if sources else ()))
-        for s in statuses:
-            extra = [scales.get(s.unit, "twin")] if scales is not None else []
-            extra += [s.torque_source] if sources else []
-            writer.writerow([_fmt(getattr(s, c)) for c in UNIT_COLUMNS] + extra)
+    columns = UNIT_COLUMNS + (("wear_scale",) if scales is not None else ()) + (("torque_source",) if sources else ())
+    rows = []
+    for s in statuses:
+        extra = [scales.get(s.unit, "twin")] if scales is not None else []
+        extra += [s.torque_source] if sources else []
+        rows.append([_fmt(getattr(s, c)) for c in UNIT_COLUMNS] + extra)
+    return Table("units.csv", columns, rows)
 
 
-def write_alarms(path: Path, monitors) -> None:
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(ALARM_COLUMNS)
-        for m in monitors:
-            for row in m.alarm_rows():
-                writer.writerow([_fmt(row[c]) for c in ALARM_COLUMNS])
+def alarms_table(monitors) -> Table:
+    """``alarms.csv``: each unit's alarms (:meth:`faultgen.monitor.scoring.UnitMonitor.alarm_rows`)."""
+    return Table("alarms.csv", ALARM_COLUMNS, [[_fmt(row[c]) for c in ALARM_COLUMNS] for m in monitors
+                                               for row in m.alarm_rows()])
 
 
-def write_scores(path: Path, monitors, n_axes: int) -> None:
-    """Every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
+def scores_table(monitors, n_axes: int) -> Table:
+    """``scores.csv``: every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
     logs, :class:`faultgen.monitor.wear_trend.WearTrend`), its lower one-sided 90 % bound
     (``wearI_lower``, :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), what the alarm is judged
     on, and the log's own estimate (less the learned slope errors' part at its conditions,
@@ -77,13 +74,12 @@ def write_scores(path: Path, monitors, n_axes: int) -> None:
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
     if any(m.signatures is not None for m in monitors):
         columns += tuple(f"wear{i}{end}" for end in ("", "_lower", "_log", "_log_lower") for i in range(1, n_axes + 1))
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(columns)
-        for m in monitors:
-            for row in m.rows:
-                cells_ = score_cells(row)
-                writer.writerow([_fmt(cells_.get(c, "")) for c in columns])
+    rows = []
+    for m in monitors:
+        for row in m.rows:
+            cells_ = score_cells(row)
+            rows.append([_fmt(cells_.get(c, "")) for c in columns])
+    return Table("scores.csv", columns, rows)
 
 
 def score_cells(row) -> dict:
@@ -101,7 +97,7 @@ def score_cells(row) -> dict:
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
 
 
-def write_wear(path: Path, monitors, scales: bool = False, nominal=frozenset()) -> None:
+def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
@@ -111,20 +107,18 @@ def write_wear(path: Path, monitors, scales: bool = False, nominal=frozenset()) 
     have rows. With ``scales`` (a fleet with friction tests, or units in ``nominal``) also each
     row's ``wear_scale``: ``friction test``, ``twin``, or for a unit in ``nominal`` (its twin fell
     back to the nominal model) ``nominal model`` (:mod:`faultgen.monitor.friction_tests`)."""
-    with open(path, "w", newline="") as f:
-        writer = cells.writer(f)
-        writer.writerow(WEAR_COLUMNS + (("wear_scale",) if scales else ()))
-        for m in monitors:
-            for row in m.rows:
-                w = row.wear
-                if w is None:
-                    continue
-                for k in range(m.n_axes):
-                    default = "nominal model" if m.unit in nominal else "twin"
-                    extra = [w.tests.scale[k] if w.tests is not None else default] if scales else []
-                    writer.writerow([_fmt(row.unit), _fmt(row.stamp), row.phase, k + 1,
-                                     *(_fmt(float(v[k])) for v in (w.estimate, w.p5, w.p95, w.lower, w.log)),
-                                     *extra])
+    rows = []
+    for m in monitors:
+        for row in m.rows:
+            w = row.wear
+            if w is None:
+                continue
+            for k in range(m.n_axes):
+                default = "nominal model" if m.unit in nominal else "twin"
+                extra = [w.tests.scale[k] if w.tests is not None else default] if scales else []
+                rows.append([_fmt(row.unit), _fmt(row.stamp), row.phase, k + 1,
+                             *(_fmt(float(v[k])) for v in (w.estimate, w.p5, w.p95, w.lower, w.log)), *extra])
+    return Table("wear.csv", WEAR_COLUMNS + (("wear_scale",) if scales else ()), rows)
 
 
 def chart(path, monitor, axis_note: str) -> None:

@@ -1,8 +1,10 @@
 """The monitor's tables read back (``units.csv``, ``alarms.csv``, ``scores.csv``, ``rul.csv``,
 ``life.csv``, ``wear.csv``, ``tests.csv`` of a monitor output folder): by one bounded, checked reader
-(:func:`read`), for the fleet report (:mod:`faultgen.monitor.page`). A table is a stranger's file
-when ``faultgen report`` is given a folder: its size is checked before it is read, every cell's
-length and the number of axes as it is parsed; each refusal names the file and the row or column."""
+(:func:`read`), for ``faultgen report OUT`` only (:func:`faultgen.monitor.page.read`; a monitor run
+draws its page from the tables it holds, :class:`faultgen.monitor.record.Table`). A table is a
+stranger's file when ``faultgen report`` is given a folder: its size is checked before it is read,
+every cell's length and the number of axes as it is parsed; each refusal names the file and the row
+or column."""
 
 from __future__ import annotations
 
@@ -14,8 +16,8 @@ import numpy as np
 
 from faultgen import inputs
 from faultgen.axes import MAX_AXES
-from faultgen.data import cells
 from faultgen.monitor import record, report
+from faultgen.monitor.record import unescaped
 
 #: Size bound of each table the page is read from (units.csv, alarms.csv, scores.csv, rul.csv,
 #: life.csv, wear.csv, tests.csv), bytes, checked before it is read: scores.csv has a row of about
@@ -32,15 +34,10 @@ NAME_COLUMNS = ("unit", "stamp", "first_alarm", "known", "last_log")
 NAME_MAX_CHARS = 256
 
 
-def unescaped(cell: str) -> str:
-    """A text cell as it was before the CSV writer's formula escape (:mod:`faultgen.data.cells`)."""
-    return cell[1:] if cell.startswith("'") and cell[1:].startswith(cells.FORMULA) else cell
-
-
 def read(folder: Path, name: str, required: tuple[str, ...],
          max_bytes: int | None = CSV_MAX_BYTES) -> tuple[list[str], list[dict]]:
     """The header and rows of ``folder/name``, text cells unescaped, read whole after checking its
-    size (``max_bytes``; None: the tables a monitor run just wrote, whose rows it holds already),
+    size (``max_bytes``; None: no bound),
     then parsed with every cell's length checked (:data:`CELL_MAX_CHARS`,
     :data:`NAME_MAX_CHARS` for :data:`NAME_COLUMNS`) and at most :data:`faultgen.axes.MAX_AXES`
     ``scoreI`` columns.
