@@ -77,3 +77,7 @@ def test_a_run_config_from_a_name_loads_nothing_when_constructed(monkeypatch):
         resolve(RunSpec("puma560", "pick_place", wear=worn, cycles=3), resolved=robot)
     with pytest.raises(ValueError, match="no_such_model"):
         resolve(RunSpec("puma560", "pick_place", friction="no_such_model", cycles=3), resolved=robot)
+    from faultgen.simulation import stepping
+
+    with pytest.raises(ValueError, match="axis 7 is out of range"):  # built from a name: checked when simulated
+        stepping.simulate(RunConfig("puma560", "pick_place", wear=worn, cycles=3), progress=False)
