@@ -27,6 +27,8 @@ from benchmarks_common import hold_seconds, same_work_seconds, simulated_seconds
 from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 
 def main() -> None:
@@ -39,8 +41,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
 
-    config = sim.RunConfig(robot=args.robot, task=args.task, friction=args.friction, wear=WearPlan({}),
-                           cycles=args.cycles, seed=0, nthread=args.threads)
+    config = resolve(RunSpec(robot=args.robot, task=args.task, friction=args.friction, wear=WearPlan({}),
+                             cycles=args.cycles, seed=0, nthread=args.threads)).config
     sim.simulate(config, progress=False)  # warm-up
     sim_seconds = simulated_seconds(config)
     ours, same, hold = [], [], []

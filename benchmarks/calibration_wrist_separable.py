@@ -59,15 +59,17 @@ def simulate(robot_folder: Path, seed: int, friction: str, payload: bool, out: P
     from faultgen.operation import conditions, wear
     from faultgen.simulation import sensors
     from faultgen.simulation import stepping
+    from faultgen.simulation.resolve import resolve
+    from faultgen.simulation.spec import RunSpec
 
     robot = robots.load(str(robot_folder))
     task = TASKS[(seed - 1) % len(TASKS)]
     payloads = conditions.Payloads((1.5, 3.5), (0.08, 0.11), "blocks", 1) if payload else None
     held = conditions.Conditions(thermal=conditions.Temperature(), payloads=payloads, spread=conditions.UnitSpread(),
                                  cycles_per_day=1, start_day=91.0)
-    config = stepping.RunConfig(robot=str(robot_folder), task=task, friction=friction, wear=wear.WearPlan({}),
-                                cycles=1, seed=seed, noise=sensors.NoiseConfig(), nthread=1, conditions=held,
-                                signals=True)
+    config = resolve(RunSpec(robot=str(robot_folder), task=task, friction=friction, wear=wear.WearPlan({}),
+                             cycles=1, seed=seed, noise=sensors.NoiseConfig(), nthread=1, conditions=held,
+                             signals=True), resolved=robot).config
     run = stepping.simulate(config, progress=False)
     n = robot.n_axes
     names = ["t", *(f"q{k}" for k in range(1, n + 1)), *(f"tau{k}" for k in range(1, n + 1)),

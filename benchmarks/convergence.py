@@ -47,6 +47,8 @@ from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 #: Steps as multiples of the model's own: coarser to show where it breaks, finer for the limit.
 FACTORS = (2.0, 1.0, 0.5, 0.25, 0.125)
@@ -58,11 +60,11 @@ CYCLES = 100
 def features(robot_file: Path, task: str, friction: str) -> dict[str, np.ndarray]:
     """Per-axis features of one run at the step of ``robot_file``; NaN when it diverges or the
     model refuses the step (``friction.check_lugre_step``)."""
-    config = sim.RunConfig(
+    config = resolve(RunSpec(
         robot=str(robot_file), task=task, friction=friction, cycles=CYCLES, record=(1, CYCLES),
         wear=WearPlan.from_specs([f"{axis}:exp4:20" for axis in range(1, 7)], last_cycle=CYCLES),
         noise=sensors.NoiseConfig(0.0, 0.0), nthread=1,
-    )
+    )).config
     try:
         sim.build(robots.load(robot_file), friction)
     except ValueError as err:  # a step the model refuses (friction.check_lugre_step)

@@ -277,9 +277,9 @@ CASES_CODE = {
     "calibrate": ("from faultgen.calibrate import calibrate", "calibrate('puma560', {log!r}, {out!r})"),
     "replay": ("from faultgen.operation import programs\nfrom faultgen.model import robots",
                "programs.load(robots.load('puma560'), {log!r}).trajectory(robots.load('puma560').model.opt.timestep)"),
-    "simulate": ("from faultgen.simulation import stepping",
-                 ("stepping.simulate(stepping.RunConfig(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1), "
-                  "progress=False)")),
+    "simulate": ("from faultgen.simulation.resolve import resolve\nfrom faultgen.simulation.spec import RunSpec",
+                 ("resolve(RunSpec(robot='puma560', task={log!r}, cycles=1, seed=0, nthread=1))"
+                  ".simulate(progress=False)")),
     "drivetrain": ("from faultgen.model import drivetrain", "drivetrain.read({log!r}, 6)"),
     "dh": ("from pathlib import Path\nfrom faultgen.model import import_dh", "import_dh.read_dh(Path({log!r}))"),
     "program": ("from faultgen.operation import programs\nfrom faultgen.model import robots",

@@ -26,6 +26,8 @@ from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 
 def main() -> None:
@@ -36,8 +38,8 @@ def main() -> None:
     report = json.loads((args.folder / "calibration" / "report.json").read_text())
     robot = robots.load("puma560")
     data = measured.read(log, robot)
-    config = sim.RunConfig(robot="puma560", task=str(log), cycles=1, seed=0, friction="stribeck",
-                           noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0))
+    config = resolve(RunSpec(robot="puma560", task=str(log), cycles=1, seed=0, friction="stribeck",
+                             noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0)), resolved=robot).config
     result = sim.simulate(config, progress=False)
     t_log = data.t - data.t[0]  # the run starts at the log's first sample (faultgen.operation.replay)
     inside = t_log <= result.t[-1]

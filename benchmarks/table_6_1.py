@@ -22,12 +22,14 @@ import numpy as np
 from faultgen.operation import tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import stepping as sim
+from faultgen.simulation.resolve import resolve
+from faultgen.simulation.spec import RunSpec
 
 
 def last_cycle(task: str, worn_axis: int, friction: str, seed: int) -> sim.RunResult:
     wear = WearPlan.from_specs([f"{worn_axis}:exp4:20"] if worn_axis else [], last_cycle=100)
-    config = sim.RunConfig(robot="irb6700", task=task, friction=friction, wear=wear, cycles=100,
-                           record=(100,), seed=seed)
+    config = resolve(RunSpec(robot="irb6700", task=task, friction=friction, wear=wear, cycles=100,
+                             record=(100,), seed=seed)).config
     return sim.simulate(config, progress=False)
 
 

@@ -22,6 +22,7 @@ from faultgen.model import robots
 from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 
 @dataclass(frozen=True)
@@ -66,7 +67,7 @@ def write_fleet(root: Path, spec: ShippedFleet = ShippedFleet()) -> tuple[Path, 
         held = conditions.Conditions(thermal=conditions.Temperature(),
                                      payloads=conditions.Payloads(spec.parts, sizes, "blocks", spec.block),
                                      spread=conditions.UnitSpread(), cycles_per_day=1, start_day=spec.start_day)
-        config = sim.RunConfig(robot=spec.robot, task=spec.task, friction="stribeck", wear=plan, cycles=spec.days,
+        config = run_config(robot=spec.robot, task=spec.task, friction="stribeck", wear=plan, cycles=spec.days,
                                seed=spec.seed * 1000 + i, noise=sensors.NoiseConfig(), nthread=1, conditions=held,
                                signals=True)
         result = sim.simulate(config, progress=False)

@@ -23,6 +23,7 @@ from faultgen.operation.wear import WearPlan
 from faultgen.model import sizing
 from faultgen.runs import fleet
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 runner = CliRunner()
 
@@ -86,12 +87,12 @@ def test_effects_are_sized_by_the_robot(arms):
 
 def test_wear_and_faults_are_held_to_the_robots_axes(arms):
     with pytest.raises(ValueError, match=r"^axis 7 is out of range 1\.\.6$"):
-        sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan.from_specs(["7:exp4:20"], 10), cycles=10)
+        run_config(robot="puma560", task="pick_place", wear=WearPlan.from_specs(["7:exp4:20"], 10), cycles=10)
     with pytest.raises(ValueError, match=r"^axis 6 is out of range 1\.\.5$"):
-        sim.RunConfig(robot=str(arms[5]), task="pick_place", wear=WearPlan.from_specs(["6:exp4:20"], 10), cycles=10)
+        run_config(robot=str(arms[5]), task="pick_place", wear=WearPlan.from_specs(["6:exp4:20"], 10), cycles=10)
     with pytest.raises(ValueError, match=r"fault axis 7 is out of range 1\.\.6"):
-        sim.RunConfig(robot="puma560", task="pick_place", fault=parse_fault("backlash:7:width:0.01", 10), cycles=10)
-    config = sim.RunConfig(robot=str(arms[7]), task="pick_place", wear=WearPlan.from_specs(["7:exp4:20"], 10),
+        run_config(robot="puma560", task="pick_place", fault=parse_fault("backlash:7:width:0.01", 10), cycles=10)
+    config = run_config(robot=str(arms[7]), task="pick_place", wear=WearPlan.from_specs(["7:exp4:20"], 10),
                            cycles=10)
     assert config.wear.multipliers(np.array([10]), 7)[0, 6] == pytest.approx(1.2)
 
@@ -131,7 +132,7 @@ def test_seven_axis_simulate_validate_and_isolate(arms, tmp_path):
 
 
 def test_the_validator_uses_the_runs_own_axes(arms, tmp_path):
-    result = sim.simulate(sim.RunConfig(robot=str(arms[5]), task="pick_place", cycles=1, signals=False),
+    result = sim.simulate(run_config(robot=str(arms[5]), task="pick_place", cycles=1, signals=False),
                           progress=False)
     path = dataset.write_run(tmp_path / "five.h5", result)
     assert dataset.validate(path) == []
@@ -203,7 +204,7 @@ def test_classification_refuses_to_pool_robots_of_different_axis_counts(arms, tm
 
     parts = []
     for n in (5, 7):
-        result = sim.simulate(sim.RunConfig(robot=str(arms[n]), task="pick_place", cycles=1, signals=False),
+        result = sim.simulate(run_config(robot=str(arms[n]), task="pick_place", cycles=1, signals=False),
                               progress=False)
         parts.append((f"puma{n}", dataset.write_run(tmp_path / f"{n}.h5", result)))
     mixed = dataset.merge(parts, tmp_path / "mixed.h5")

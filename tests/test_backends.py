@@ -24,6 +24,7 @@ from faultgen.model import robots
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import backends, batch, friction_models, prepare, results, signals
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 PERIODS = 12  # log periods stepped (48 ms): a few seconds for the whole file
 
@@ -103,7 +104,7 @@ def test_backends_are_different_steppers():
 
 
 def test_unknown_backend_is_named():
-    config = sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
+    config = run_config(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
     with pytest.raises(ValueError, match=r"unknown stepping backend 'gpu'; expected one of batch, loop"):
         backends.get("gpu")
     with pytest.raises(ValueError, match=r"'gpu' is not a stepper \(a Stepper object"):

@@ -17,6 +17,7 @@ import pytest
 from faultgen.bench import files, rawlogs, recorded, score, twin
 from faultgen.operation.conditions import Conditions, Payloads, TaskMix
 from faultgen.simulation import stepping
+from resolved_runs import run_config
 
 ROOT = Path(__file__).resolve().parents[1]
 N = 6
@@ -126,7 +127,7 @@ def test_a_task_mix_run_simulated_task_by_task_gives_the_tracks_cycles():
     with their signals, are the same cycles: the same features as the mixed run's."""
     mix = Conditions(payloads=Payloads(masses=(30.0, 90.0), sizes=(0.3, 0.4), pattern="random"),
                      task_mix=TaskMix(tasks=("pick_place", "spot_weld"), pattern="alternate"), cycles_per_day=10)
-    config = stepping.RunConfig(robot="irb6700", task="pick_place", cycles=3, seed=3, nthread=1, conditions=mix,
+    config = run_config(robot="irb6700", task="pick_place", cycles=3, seed=3, nthread=1, conditions=mix,
                                 signals=False)
     mixed = stepping.simulate(config, progress=False)
     parts = rawlogs._simulate(config, stepping)

@@ -36,6 +36,7 @@ from faultgen.calibrate import EFFECTS, calibrate, synth
 from faultgen.logs import measured
 from faultgen.model import robots
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 SEED = 0
 #: Each effect on one robot, alternating in the order of EFFECTS (this order puts PUMA 560
@@ -176,7 +177,7 @@ def test_outputs_follow_the_contract_and_the_model_runs(tmp_path):
     nominal = robots.load("puma560")
     added = model.model.body("payload1").mass[0]
     assert added == pytest.approx(mass, rel=1e-5)
-    run = sim.simulate(sim.RunConfig(robot=report["model_out"], task="pick_place", cycles=1), progress=False)
+    run = sim.simulate(run_config(robot=report["model_out"], task="pick_place", cycles=1), progress=False)
     assert np.all(np.isfinite(run.tau_m))
     assert np.sum(model.model.body_mass) == pytest.approx(np.sum(nominal.model.body_mass) + mass, rel=1e-5)
     written = json.loads((out / "model" / "parameters.json").read_text())

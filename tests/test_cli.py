@@ -14,6 +14,7 @@ from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 runner = CliRunner()
 
@@ -69,7 +70,7 @@ def test_simulate_writes_a_file_that_reads_back(tmp_path):
     np.testing.assert_array_equal(arrays["cycles"], [1, 100])
     np.testing.assert_allclose(arrays["friction_multiplier"][:, 1], [np.exp(np.log(1.2) / 1e8), 1.2])
     # the file holds exactly what the library returns for the same configuration
-    config = sim.RunConfig(robot="irb6700", task="spot_weld", wear=WearPlan.from_specs(["2:exp4:20"], 100),
+    config = run_config(robot="irb6700", task="spot_weld", wear=WearPlan.from_specs(["2:exp4:20"], 100),
                            record=(1, 100), seed=3)
     direct = sim.simulate(config, progress=False)
     for name, (_, axes, _) in dataset.ARRAYS.items():

@@ -21,6 +21,7 @@ from faultgen.operation import wear
 from faultgen.runs import sweep
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 QUIET = sensors.NoiseConfig(0.0, 0.0)
 
@@ -169,16 +170,16 @@ def test_unit_spread_draws_are_seeded_and_have_the_stated_spread():
     (lambda: c.Payloads((1.0,), (0.1,), pattern="zig"), r"payload pattern 'zig'"),
     (lambda: c.UnitSpread(dry_friction=0.9), r"unit spread dry_friction = 0.9"),
     (lambda: c.UnitSpread(gear_loss=-0.1), r"unit spread gear_loss = -0.1: expected a number within 0..0.5"),
-    (lambda: sim.RunConfig("puma560", "pick_place", conditions=c.Conditions(spread=c.UnitSpread(gear_loss=0.1))),
+    (lambda: run_config("puma560", "pick_place", conditions=c.Conditions(spread=c.UnitSpread(gear_loss=0.1))),
      r"unit spread gear_loss = 0.1 needs the static friction model \(friction='stribeck'"),
     (lambda: c.TaskMix(()), r"task mix: no task given"),
     (lambda: c.TaskMix(("pick_place", "welding")), r"task mix: unknown task 'welding'"),
     (lambda: c.TaskMix(("pick_place",), pattern="zig"), r"task mix pattern 'zig'"),
     (lambda: c.TaskMix(("pick_place",), pattern="blocks", block=0), r"task mix block = 0"),
-    (lambda: sim.RunConfig("puma560", "arc_weld", signals=False,
+    (lambda: run_config("puma560", "arc_weld", signals=False,
                            conditions=c.Conditions(task_mix=c.TaskMix(("pick_place", "spot_weld")))),
      r"task 'arc_weld' is not in the task mix \(pick_place, spot_weld\)"),
-    (lambda: sim.RunConfig("puma560", "pick_place", conditions=c.Conditions(task_mix=c.TaskMix(("pick_place",)))),
+    (lambda: run_config("puma560", "pick_place", conditions=c.Conditions(task_mix=c.TaskMix(("pick_place",)))),
      r"a task mix \(pick_place\) keeps no signals"),
     (lambda: c.Conditions(cycles_per_day=0), r"cycles_per_day = 0"),
     (lambda: c.Conditions(hours=(8, 16)), r"hours = \(8, 16\): expected 1 \(cycles_per_day\) times of day"),
@@ -201,7 +202,7 @@ def test_friction_applied_is_the_law_with_the_written_labels(tmp_path):
     fast-sliding sample is eq. 6.3 with the labelled dry and viscous multipliers (within 1 %: the
     logged speed is a 4 ms backward difference); the multipliers differ from 1 by up to 30 %."""
     conditions = c.Conditions(thermal=c.Temperature(), spread=c.UnitSpread())
-    config = sim.RunConfig("irb6700", "pick_place", "stribeck", cycles=3, nthread=1, seed=2, noise=QUIET,
+    config = run_config("irb6700", "pick_place", "stribeck", cycles=3, nthread=1, seed=2, noise=QUIET,
                            conditions=conditions)
     dataset.write_run(tmp_path / "run.h5", sim.simulate(config, progress=False))
     arrays, attrs = dataset.read_run(tmp_path / "run.h5")
@@ -226,7 +227,7 @@ def test_a_units_gear_loss_is_the_load_dependent_friction_effect_with_the_writte
     deflection are those of the step after the one the level was set on), and it raises the
     friction of the loaded axes (a run without the loss has eq. 6.3 alone)."""
     spread = c.UnitSpread(dry_friction=0.0, viscous_friction=0.0, link_mass=0.0, gear_loss=0.3)
-    config = sim.RunConfig("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5, noise=QUIET,
+    config = run_config("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5, noise=QUIET,
                            conditions=c.Conditions(spread=spread))
     path = dataset.write_run(tmp_path / "lossy.h5", sim.simulate(config, progress=False))
     assert dataset.validate(path) == []
@@ -244,7 +245,7 @@ def test_a_units_gear_loss_is_the_load_dependent_friction_effect_with_the_writte
     fast = np.abs(v) > 20
     error = np.abs(arrays["tau_f"][0] - expected)[fast] / np.abs(expected[fast])
     assert np.percentile(error, 99) < 0.01
-    plain = sim.simulate(sim.RunConfig("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5,
+    plain = sim.simulate(run_config("puma560", "pick_place", "stribeck", cycles=1, nthread=1, seed=5,
                                        noise=QUIET), progress=False)
     raised = np.mean(np.abs(arrays["tau_f"][0]), axis=0) / np.mean(np.abs(plain.tau_f[0]), axis=0)
     assert raised[1] > 1.05, raised  # the shoulder carries the arm's weight
@@ -272,15 +273,15 @@ def test_a_cycle_carrying_a_part_is_a_run_of_the_robot_with_that_part(tmp_path):
     part (the controller knows it in both), within 0.2 %; the empty cycle is the nominal run."""
     robot = robots.load("irb6700")
     parts = c.Payloads((0.0, 60.0), (0.0, 0.3))
-    switching = sim.simulate(sim.RunConfig("irb6700", "spot_weld", cycles=2, nthread=1, noise=QUIET,
+    switching = sim.simulate(run_config("irb6700", "spot_weld", cycles=2, nthread=1, noise=QUIET,
                                            conditions=c.Conditions(payloads=parts)), progress=False)
     spec = mujoco.MjSpec.from_file(str(robot.path))
     effects.make("payload", **parts.parameters(1)).write(spec, robot)
     folder = shutil.copytree(robot.path.parent, tmp_path / "irb6700")  # with its tasks.toml
     (folder / "carrying.xml").write_text(spec.to_xml())
-    carrying = sim.simulate(sim.RunConfig(str(folder / "carrying.xml"), "spot_weld", cycles=2, record=(2,), nthread=1,
+    carrying = sim.simulate(run_config(str(folder / "carrying.xml"), "spot_weld", cycles=2, record=(2,), nthread=1,
                                           noise=QUIET), progress=False)
-    nominal = sim.simulate(sim.RunConfig("irb6700", "spot_weld", cycles=1, nthread=1, noise=QUIET), progress=False)
+    nominal = sim.simulate(run_config("irb6700", "spot_weld", cycles=1, nthread=1, noise=QUIET), progress=False)
     assert switching.conditions.payload_mass.tolist() == [0.0, 60.0]
     mean = switching.features["mean_abs_torque"]
     np.testing.assert_allclose(mean[0], nominal.features["mean_abs_torque"][0], rtol=1e-9)
@@ -289,9 +290,9 @@ def test_a_cycle_carrying_a_part_is_a_run_of_the_robot_with_that_part(tmp_path):
 
 
 def test_runs_without_conditions_keep_their_keys_and_files():
-    config = sim.RunConfig("puma560", "pick_place", cycles=2)
+    config = run_config("puma560", "pick_place", cycles=2)
     assert "conditions" not in json.loads(dataset.config_key(config))
-    with_spread = sim.RunConfig("puma560", "pick_place", cycles=2, conditions=c.Conditions(spread=c.UnitSpread()))
+    with_spread = run_config("puma560", "pick_place", cycles=2, conditions=c.Conditions(spread=c.UnitSpread()))
     key = json.loads(dataset.config_key(with_spread))["conditions"]
     assert key["spread"]["dry_friction"] == 0.15 and "task_mix" not in key  # keys from before the task mix
     assert "gear_loss" not in key["spread"]  # nor the gear loss, when it is off
@@ -304,8 +305,8 @@ def test_a_task_mix_runs_each_cycle_as_a_run_of_its_task(tmp_path):
     plan = wear.WearPlan.from_specs(["2:exp4:30"], last_cycle=4)
     common = {"robot": "puma560", "wear": plan, "cycles": 4, "nthread": 1, "seed": 3, "signals": False}
     mix = c.Conditions(task_mix=c.TaskMix(("spot_weld", "pick_place")))
-    mixed = sim.simulate(sim.RunConfig(task="pick_place", conditions=mix, **common), progress=False)
-    alone = {task: sim.simulate(sim.RunConfig(task=task, **common), progress=False)
+    mixed = sim.simulate(run_config(task="pick_place", conditions=mix, **common), progress=False)
+    alone = {task: sim.simulate(run_config(task=task, **common), progress=False)
              for task in ("spot_weld", "pick_place")}
     assert mixed.conditions.task_index.tolist() == [0, 1, 0, 1] and mixed.cycles.tolist() == [1, 2, 3, 4]
     assert mixed.tau_m.shape == (4, 0, 6) and np.array_equal(mixed.q_ref, alone["pick_place"].q_ref)

@@ -13,6 +13,7 @@ from faultgen.effects import friction
 from faultgen.model import robots
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 JM = 0.006  # kg m^2, the IRB-6700-like arm's axis-1 rotor
 H = 0.0005
@@ -62,7 +63,7 @@ def test_lugre_refuses_bristle_damping_and_too_stiff_bristles():
 
 def cycle_features(robot: str, friction_model: str, timestep: float, folder) -> dict[str, np.ndarray]:
     path = robots.with_timestep(robot, timestep, folder / f"{robot}_{timestep}")
-    config = sim.RunConfig(robot=str(path), task="pick_place", friction=friction_model, cycles=1,
+    config = run_config(robot=str(path), task="pick_place", friction=friction_model, cycles=1,
                            noise=sensors.NoiseConfig(0.0, 0.0), nthread=1)
     run = sim.simulate(config, progress=False)
     return {"mean|tau|": np.mean(np.abs(run.tau_m[0]), axis=0),

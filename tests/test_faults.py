@@ -12,6 +12,7 @@ from faultgen.operation.faults import parse_fault
 from faultgen.runs import sweep
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 QUIET = sensors.NoiseConfig(0.0, 0.0)
 
@@ -70,9 +71,9 @@ def test_a_growing_fault_at_a_cycle_is_the_model_compiled_at_its_value(robot_nam
     rest = spec.split(":", 4)[4:] or [""]
     exact = parse_fault(f"{effect}:{axis}:{parameter}:{value!r}" + (f":{rest[0]}" if rest[0] else ""), last_cycle=cycle)
     common = {"task": "spot_weld", "record": (cycle,), "nthread": 1, "noise": QUIET}
-    run = sim.simulate(sim.RunConfig(robot_name, cycles=5, fault=fault, **common), progress=False)
-    compiled = sim.simulate(sim.RunConfig(robot_name, cycles=cycle, fault=exact, **common), progress=False)
-    nominal = sim.simulate(sim.RunConfig(robot_name, cycles=5, **common), progress=False)
+    run = sim.simulate(run_config(robot_name, cycles=5, fault=fault, **common), progress=False)
+    compiled = sim.simulate(run_config(robot_name, cycles=cycle, fault=exact, **common), progress=False)
+    nominal = sim.simulate(run_config(robot_name, cycles=5, **common), progress=False)
     scale = np.max(np.abs(compiled.tau_m))
     assert np.max(np.abs(run.tau_m - compiled.tau_m)) < 1e-9 * scale
     worn = fault.axis - 1
@@ -93,8 +94,8 @@ def test_a_growing_load_dependent_friction_at_a_cycle_is_a_unit_gear_loss_of_tha
     value = float(fault.values(np.array([4]))[0])
     assert value == pytest.approx(0.048)
     common = {"task": "pick_place", "friction": "stribeck", "record": (4,), "nthread": 1, "noise": QUIET}
-    run = sim.simulate(sim.RunConfig("irb6700", cycles=5, fault=fault, **common), progress=False)
-    nominal = sim.simulate(sim.RunConfig("irb6700", cycles=5, **common), progress=False)
+    run = sim.simulate(run_config("irb6700", cycles=5, fault=fault, **common), progress=False)
+    nominal = sim.simulate(run_config("irb6700", cycles=5, **common), progress=False)
     plain = Plant.of
 
     def with_gear_loss(*args, **kwargs):
@@ -102,7 +103,7 @@ def test_a_growing_load_dependent_friction_at_a_cycle_is_a_unit_gear_loss_of_tha
         return Plant(plant.dry, plant.viscous, plant.link_mass, plant.fault, np.array([0, value, 0, 0, 0, 0]))
 
     monkeypatch.setattr(sim.Plant, "of", staticmethod(with_gear_loss))
-    unit = sim.simulate(sim.RunConfig("irb6700", cycles=5, **common), progress=False)
+    unit = sim.simulate(run_config("irb6700", cycles=5, **common), progress=False)
     for name in ("tau_f", "tau_m"):
         a, b, c = (getattr(r, name)[..., 1] for r in (run, unit, nominal))
         assert np.max(np.abs(a - b)) < 1e-9 * np.max(np.abs(b))
@@ -116,7 +117,7 @@ def test_a_growing_load_dependent_friction_needs_the_static_model_and_its_transm
     assert fault.in_plant and not parse_fault("backlash:2:width:0.01", last_cycle=5).in_plant
     with pytest.raises(ValueError, match=r"growing load_dependent_friction fault needs the static friction model "
                                          r"\(friction='stribeck', --friction stribeck\)"):
-        sim.RunConfig("irb6700", "pick_place", cycles=5, fault=fault)
+        run_config("irb6700", "pick_place", cycles=5, fault=fault)
     with pytest.raises(ValueError, match=r"transmitted-load form .*gravity_load = 0"):
         parse_fault("load_dependent_friction:2:coefficient:0.06:gravity_load=1", last_cycle=5)
     with pytest.raises(ValueError, match=r"transmitted-load form .*got parameter 'gravity_load'"):

@@ -16,6 +16,7 @@ from faultgen.operation import wear
 from faultgen.runs.fleet import Fleet
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 
 def test_the_fleet_draws_half_failing_robots_of_both_models():
@@ -94,8 +95,8 @@ def test_a_daily_record_is_the_days_maximum():
     plan = wear.WearPlan.from_specs(["2:exp4:40:onset=1"], last_cycle=6)
     common = {"robot": "puma560", "task": "spot_weld", "wear": plan, "cycles": 6, "nthread": 1, "seed": 4,
               "conditions": conditions}
-    cycles = sim.simulate(sim.RunConfig(**common), progress=False)
-    days = sim.simulate(sim.RunConfig(**common, signals=False, daily=True), progress=False)
+    cycles = sim.simulate(run_config(**common), progress=False)
+    days = sim.simulate(run_config(**common, signals=False, daily=True), progress=False)
     assert days.cycles.tolist() == [1, 2, 3] and days.tau_m.shape == (3, 0, 6)
 
     def pairs(a):
@@ -180,14 +181,14 @@ def test_a_fleet_with_another_fault_grows_it_from_the_onset_day_and_labels_it(sh
 
 
 def test_features_only_runs_say_what_they_lack(tmp_path):
-    config = sim.RunConfig("puma560", "pick_place", cycles=2, nthread=1, signals=False,
+    config = run_config("puma560", "pick_place", cycles=2, nthread=1, signals=False,
                            noise=sensors.NoiseConfig(0.0, 0.0))
     dataset.write_run(tmp_path / "f.h5", sim.simulate(config, progress=False))
     assert dataset.validate(tmp_path / "f.h5") == []
     with pytest.raises(dataset.DatasetError, match="recorded without signals"):
         dataset.read_run(tmp_path / "f.h5", names=("tau_m",))
     with pytest.raises(ValueError, match="daily records need every cycle recorded, no signals and whole days"):
-        sim.RunConfig("puma560", "pick_place", cycles=3, daily=True, signals=False,
+        run_config("puma560", "pick_place", cycles=3, daily=True, signals=False,
                       conditions=c.Conditions(spread=c.UnitSpread(), cycles_per_day=2))
 
 

@@ -28,6 +28,7 @@ from faultgen.simulation import stepping as sim
 
 sys.path.insert(0, str(Path(__file__).parent))
 import fleetlog_folder  # noqa: E402
+from resolved_runs import run_config
 
 runner = CliRunner()
 FEATURES = ("mean_abs_torque", "rms_torque", "average_speed", "average_load_torque", "angle_hist", "speed_hist",
@@ -80,7 +81,7 @@ def test_a_simulated_cycle_imported_as_a_log_has_the_simulated_features(tmp_path
     """The same code, checked end to end: a cycle simulated with its signals, written as a measured
     log (arm-side torque = motor torque x gear ratio), imported, gives the features the simulation
     recorded for it (up to the rounding of the torque's product and quotient)."""
-    result = sim.simulate(sim.RunConfig(robot="puma560", task="pick_place", cycles=1), progress=False)
+    result = sim.simulate(run_config(robot="puma560", task="pick_place", cycles=1), progress=False)
     folder = tmp_path / "LOGS" / "sim"
     folder.mkdir(parents=True)
     logfiles.write_hdf5(folder / "1.h5", result.t, result.q_a[0], result.tau_m[0] * puma.gear_ratio, result.qd_a[0])

@@ -11,7 +11,7 @@ from faultgen.effects.motor_friction import FIELDS, MotorFriction
 from faultgen.model import robots
 from faultgen.operation.faults import Fault, dry_multipliers, parse_fault
 from faultgen.operation.wear import Schedule, WearPlan
-from faultgen.simulation.config import RunConfig
+from resolved_runs import run_config
 
 
 def test_motor_friction_is_a_registered_effect_but_no_calibration_candidate():
@@ -117,8 +117,8 @@ def test_a_fault_beside_wear_on_the_same_axis():
     relative friction fault given as the run's fault is refused: friction wear is given as wear."""
     wear = WearPlan.from_specs(["2:exp4:20"], last_cycle=10)
     backlash = parse_fault("backlash:2:width:0.01", last_cycle=10)
-    config = RunConfig("puma560", "pick_place", wear=wear, cycles=10, fault=backlash)
+    config = run_config("puma560", "pick_place", wear=wear, cycles=10, fault=backlash)
     assert config.faults == (*wear.faults(), backlash)
     with pytest.raises(ValueError, match=r"friction wear, given as wear"):
-        RunConfig("puma560", "pick_place", cycles=10, fault=wear.faults()[0])
+        run_config("puma560", "pick_place", cycles=10, fault=wear.faults()[0])
     assert Schedule("exp4", 0.2, 10) == wear.faults()[0].schedule

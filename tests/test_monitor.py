@@ -21,6 +21,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import loop, scoring
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.runs.context import ExecutionContext
+from resolved_runs import run_config
 
 # three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
 SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
@@ -533,7 +534,7 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
     from faultgen.simulation import stepping as sim
 
     robot = robots.load("irb6700")
-    run = sim.simulate(sim.RunConfig(robot="irb6700", task="pick_place", friction="stribeck", wear=wear.WearPlan({}),
+    run = sim.simulate(run_config(robot="irb6700", task="pick_place", friction="stribeck", wear=wear.WearPlan({}),
                                      cycles=1, seed=1, noise=sensors.NoiseConfig(encoder=1e-4), nthread=1,
                                      signals=True), progress=False)
     assert run.saturated.size == 0
@@ -549,7 +550,7 @@ def test_the_twin_of_a_log_with_faultgens_own_encoder_noise_does_not_saturate(tm
     assert result.exit_code == 0, result.output
     assert "warning: the drive of axis 2 reached its torque limit" in result.output
     twin = Twin(robot, log, tmp_path / "cache")
-    replayed = sim.simulate(sim.RunConfig(robot="irb6700", task=twin._reference, friction="stribeck",
+    replayed = sim.simulate(run_config(robot="irb6700", task=twin._reference, friction="stribeck",
                                           wear=wear.WearPlan({}), cycles=1, seed=0,
                                           noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                           signals=True), progress=False)

@@ -27,6 +27,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import loop
 from faultgen.monitor import unit as units_module
 from faultgen.monitor.scoring import Settings
+from resolved_runs import run_config
 
 runner = CliRunner()
 OUTPUTS = ("alarms.csv", "scores.csv", "wear.csv", "rul.csv", "life.csv", "units.csv")
@@ -50,7 +51,7 @@ def fleet(tmp_path_factory) -> Path:
     from faultgen.simulation import stepping as sim
 
     robot = robots.load("puma560")
-    run = sim.simulate(sim.RunConfig(robot="puma560", task="pick_place", friction="stribeck", wear=wear.WearPlan({}),
+    run = sim.simulate(run_config(robot="puma560", task="pick_place", friction="stribeck", wear=wear.WearPlan({}),
                                      cycles=3, seed=1, noise=sensors.NoiseConfig(), nthread=1, signals=True),
                        progress=False)
     logs = tmp_path_factory.mktemp("refused") / "LOGS"

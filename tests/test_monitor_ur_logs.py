@@ -41,6 +41,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 UR5_DH = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 #: N m/A at the joint, the test's (the log's current is its arm torque over them).
@@ -64,7 +65,7 @@ runner = CliRunner()
 def _simulate(robot_dir: Path, seed: int, cycles: int, start_day: float, plan, task: str = "pick_place"):
     held = conditions.Conditions(thermal=conditions.Temperature(), spread=conditions.UnitSpread(),
                                  cycles_per_day=1, start_day=start_day)
-    config = sim.RunConfig(robot=str(robot_dir), task=task, friction="stribeck", wear=plan, cycles=cycles,
+    config = run_config(robot=str(robot_dir), task=task, friction="stribeck", wear=plan, cycles=cycles,
                            seed=seed, noise=sensors.NoiseConfig(), nthread=1, conditions=held, signals=True)
     result = sim.simulate(config, progress=False)
     assert result.saturated.size == 0

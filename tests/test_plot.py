@@ -11,6 +11,7 @@ import pytest
 from faultgen.data import dataset
 from faultgen.plot import plot
 from test_sweep import GRID
+from resolved_runs import run_config
 
 
 @pytest.fixture(scope="module")
@@ -104,7 +105,7 @@ def test_a_simulated_run_is_titled_by_what_it_is(tmp_path, figures):
     from faultgen.operation.wear import WearPlan
     from faultgen.simulation import stepping as sim
 
-    config = sim.RunConfig(robot="puma560", task="spot_weld", wear=WearPlan.from_specs(["3:linear:10"], 4),
+    config = run_config(robot="puma560", task="spot_weld", wear=WearPlan.from_specs(["3:linear:10"], 4),
                            cycles=4, record=(1, 4), seed=7)
     out = tmp_path / "one.h5"
     dataset.write_run(out, sim.simulate(config, progress=False))  # stored as the file's default run id

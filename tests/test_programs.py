@@ -22,6 +22,7 @@ from faultgen.operation import programs, replay, tasks
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 ROBOTS = ["puma560", "irb6700"]
 runner = CliRunner()
@@ -55,7 +56,7 @@ def test_exported_task_files_give_the_same_motor_torque(tmp_path, robot):
         out = tmp_path / f"{robot}-{name}.toml"
         result = runner.invoke(app, ["tasks", "export", robot, name, "-o", str(out)])
         assert result.exit_code == 0, result.output
-        runs = [sim.simulate(sim.RunConfig(robot=robot, task=task, cycles=2, record=(2,), seed=3,
+        runs = [sim.simulate(run_config(robot=robot, task=task, cycles=2, record=(2,), seed=3,
                                            wear=WearPlan.from_specs(["2:exp4:20"], last_cycle=2)), progress=False)
                 for task in (name, str(out))]
         np.testing.assert_array_equal(runs[0].tau_m, runs[1].tau_m, err_msg=f"{robot} {name}")
@@ -343,7 +344,7 @@ def test_a_gripped_payload_loads_the_simulated_arm_as_its_inverse_dynamics_says(
     for mass in (100.0, 1e-6):
         file = write(tmp_path, f"grip{mass:g}.toml", GRIP.format(mass=mass))
         # no load disturbance: its level follows the cycle's mean torque, which the part raises
-        config = sim.RunConfig(robot="irb6700", task=str(file), cycles=1, seed=0, nthread=1,
+        config = run_config(robot="irb6700", task=str(file), cycles=1, seed=0, nthread=1,
                                noise=sensors.NoiseConfig(disturbance=0.0))
         runs.append(sim.simulate(config, progress=False))
         paths.append(programs.read(file, robot).trajectory(robot.model.opt.timestep))

@@ -11,11 +11,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-import faultgen
 from faultgen.model import rating, robots, sizing
 from faultgen.model.robot import drivetrain_of
 from faultgen.monitor import life
 from faultgen.simulation import stepping
+from resolved_runs import run_config
 
 
 def _peak_by_hand(drive, wrist: bool) -> float:
@@ -70,7 +70,7 @@ def test_a_rated_torque_given_replaces_the_missing_catalogue_size(tmp_path):
 
 
 def test_the_irb6700s_pick_and_place_16_h_a_day_consumes_1_to_50_percent_of_axes_1_to_3_a_year():
-    config = faultgen.RunConfig(robot="irb6700", task="pick_place", cycles=2, record=(1,), signals=True, seed=0)
+    config = run_config(robot="irb6700", task="pick_place", cycles=2, record=(1,), signals=True, seed=0)
     result = stepping.simulate(config, progress=False)
     t, q = result.t, result.q_a[0]
     tau = result.tau_m[0] * config.model.gear_ratio  # arm side

@@ -53,3 +53,31 @@ def test_a_run_travels_to_a_worker_without_its_compiled_robot():
     assert back.config.resolved is None and back.config == run.config and back.stepper == backends.LoopStepper()
     assert back.config.model.digest == run.config.model.digest  # loaded again where it arrives
     assert isinstance(back, Run)
+
+
+def test_a_run_config_from_a_name_loads_nothing_when_constructed(monkeypatch):
+    """scikit-learn's rule (issue 84, item 5): constructing a RunConfig loads no robot, reads and plans
+    no task and looks no friction model up; resolve does, and refuses what the robot refuses."""
+    from faultgen.operation import programs
+    from faultgen.operation.wear import WearPlan
+    from faultgen.simulation import friction_models, prepare
+    from faultgen.simulation.config import RunConfig
+
+    robot = robots.load("puma560")
+    for module, name in [(robots, "load"), (prepare, "task_path"), (programs, "check_name"),
+                         (friction_models, "get")]:
+        monkeypatch.setattr(module, name, lambda *a, _n=name, **k: pytest.fail(f"{_n} called on construction"))
+    worn = WearPlan.from_specs(["7:exp4:20"], 3)  # axis 7 of a 6-axis robot: the robot's check, not the values'
+    config = RunConfig("puma560", "no_such_task.toml", friction="no_such_model", wear=worn, cycles=3)
+    assert config.resolved is None and config.robot == "puma560" and config.cycles == 3
+    with pytest.raises(ValueError, match="cycles = 0"):  # the values are still checked
+        RunConfig("puma560", "pick_place", cycles=0)
+    monkeypatch.undo()
+    with pytest.raises(ValueError, match="axis 7 is out of range"):
+        resolve(RunSpec("puma560", "pick_place", wear=worn, cycles=3), resolved=robot)
+    with pytest.raises(ValueError, match="no_such_model"):
+        resolve(RunSpec("puma560", "pick_place", friction="no_such_model", cycles=3), resolved=robot)
+    from faultgen.simulation import stepping
+
+    with pytest.raises(ValueError, match="axis 7 is out of range"):  # built from a name: checked when simulated
+        stepping.simulate(RunConfig("puma560", "pick_place", wear=worn, cycles=3), progress=False)

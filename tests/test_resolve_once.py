@@ -129,8 +129,9 @@ ALLOWED = {
     "faultgen/calibrate/__init__.py": (1, "public API", "calibrate() takes a name or a Robot, resolved once"),
     "faultgen/data/fleetlogs.py": (1, "public API", "import_logs() takes a name or a Robot, resolved once"),
     "faultgen/runs/grid.py": (1, "public API", "a Grid (sweep) names its robots; each resolved once for every run"),
-    "faultgen/simulation/config.py": (2, "public API", ("RunConfig(robot=name), once on construction; and as a "
-                                                        "worker: a RunConfig unpickled (its robot sent as the name)")),
+    "faultgen/simulation/config.py": (1, "worker", ("RunConfig.model, once: a RunConfig unpickled (its robot sent "
+                                                    "as the name) or built from a name; construction loads "
+                                                    "nothing")),
     "faultgen/monitor/loop.py": (1, "public API", "monitor(), the library entry: the robot, once per run"),
     "faultgen/monitor/feed.py": (2, "worker", ("Context.new_source, where each process's robots are resolved: for "
                                                "monitor() the --calibrated model; for a worker (loky, Dask) sent the "

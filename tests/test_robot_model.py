@@ -15,6 +15,7 @@ from faultgen.model import robots
 from faultgen.operation.wear import WearPlan
 from faultgen.simulation import prepare
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 
 def fields(model: mujoco.MjModel) -> dict:
@@ -23,29 +24,29 @@ def fields(model: mujoco.MjModel) -> dict:
 
 def test_a_config_holds_the_robot_given_and_records_its_name():
     robot = robots.load("puma560")
-    config = sim.RunConfig(robot=robot, task="pick_place", cycles=2)
+    config = run_config(robot=robot, task="pick_place", cycles=2)
     assert config.model is robot and config.robot == "puma560"
-    by_name = sim.RunConfig(robot="puma560", task="pick_place", cycles=2)
+    by_name = run_config(robot="puma560", task="pick_place", cycles=2)
     assert by_name.model is robot and by_name == config  # the same run, whichever way it was named
 
 
 def test_a_config_of_an_edited_robot_records_its_path(tmp_path):
     robot = robots.load("puma560").edited(lambda spec: None)
-    config = sim.RunConfig(robot=robot, task="pick_place", cycles=2)
+    config = run_config(robot=robot, task="pick_place", cycles=2)
     assert config.model is robot and config.robot == str(robot.path) and robot.digest is None
 
 
 def test_a_given_robot_is_not_resolved_again(monkeypatch):
     robot = robots.load("puma560")
     monkeypatch.setattr(robots, "load", lambda name: pytest.fail(f"resolved {name!r} again"))
-    config = sim.RunConfig(robot="puma560", task="pick_place", cycles=2, resolved=robot)
+    config = run_config(robot="puma560", task="pick_place", cycles=2, resolved=robot)
     assert dataclasses.replace(config, seed=3).model is robot
     assert sim.cycle_duration(config.model, config.task) > 0
 
 
 def test_a_pickled_config_leaves_the_robot_behind_and_resolves_it_once_there():
     """As Dask sends it to a worker (cloudpickle: a WearPlan's read-only mapping needs it)."""
-    config = sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan.from_specs(["2:exp4:20"], 2), cycles=2)
+    config = run_config(robot="puma560", task="pick_place", wear=WearPlan.from_specs(["2:exp4:20"], 2), cycles=2)
     state = config.__getstate__()
     assert state["resolved"] is None and config.resolved is not None
     back = cloudpickle.loads(cloudpickle.dumps(config))
@@ -85,6 +86,6 @@ def test_a_spec_handed_out_is_a_copy():
 
 def test_a_config_of_a_robot_edited_in_memory_takes_it_along_when_pickled():
     robot = robots.load("puma560").edited(lambda spec: setattr(spec.option, "timestep", 0.0005))
-    config = sim.RunConfig(robot=robot, task="pick_place", cycles=2)
+    config = run_config(robot=robot, task="pick_place", cycles=2)
     back = cloudpickle.loads(cloudpickle.dumps(config))
     assert back.resolved is not None and back.model.model.opt.timestep == 0.0005

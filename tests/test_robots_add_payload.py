@@ -25,6 +25,7 @@ from faultgen.operation import conditions, taskgen, wear
 from faultgen.operation.tasks import TASKS
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 #: Robot, rated payload (kg, the makers' datasheets) and the ROS package its meshes name.
 RATED = {"kr210": (150.0, "kuka_kr210_support"), "iiwa14": (14.0, "kuka_lbr_iiwa_support")}
@@ -51,7 +52,7 @@ def test_the_rated_payload_given_is_carried_on_every_task_without_saturating(nam
     assert part.parameters(0)["com_z"] == load["com_z"] == sizing.load_offset(payload)  # the documented offset
     peaks = {}
     for task in TASKS:  # one cycle of each, the rated load at the flange
-        config = sim.RunConfig(robot=str(out), task=task, friction="lugre", wear=wear.WearPlan({}), cycles=1,
+        config = run_config(robot=str(out), task=task, friction="lugre", wear=wear.WearPlan({}), cycles=1,
                                seed=0, noise=sensors.NoiseConfig(disturbance=0.0, encoder=0.0), nthread=1,
                                conditions=conditions.Conditions(payloads=part))
         simulated = sim.simulate(config, progress=False)

@@ -12,11 +12,12 @@ from faultgen.operation.wear import WearPlan
 from faultgen.simulation import control
 from faultgen.simulation import stepping as sim
 from faultgen.simulation.sensors import NoiseConfig
+from resolved_runs import run_config
 
 
 def run(task="pick_place", wear=(), robot="irb6700", friction="lugre", **kwargs):
     plan = WearPlan.from_specs(list(wear), last_cycle=kwargs.get("cycles", 100))
-    return sim.simulate(sim.RunConfig(robot=robot, task=task, friction=friction, wear=plan, **kwargs),
+    return sim.simulate(run_config(robot=robot, task=task, friction=friction, wear=plan, **kwargs),
                         progress=False)
 
 
@@ -123,7 +124,7 @@ def test_bad_configuration_is_refused_before_simulation(kwargs, match):
     config = dict(robot="irb6700", task="pick_place", wear=WearPlan({}), cycles=100)
     config.update(kwargs)
     with pytest.raises(ValueError, match=match):
-        sim.RunConfig(**config)
+        run_config(**config)
 
 
 def test_tracking_error_is_reported_per_task():
@@ -172,7 +173,7 @@ def test_back_to_back_cycles_carry_the_state_over():
 def test_back_to_back_refuses_wear_and_a_record_subset(kwargs):
     config = dict(robot="irb6700", task="pick_place", cycles=3, back_to_back=True) | kwargs
     with pytest.raises(ValueError, match="back_to_back runs step every cycle in one simulation without wear"):
-        sim.RunConfig(**config)
+        run_config(**config)
 
 
 def test_a_cycle_starts_at_rest_on_the_loaded_flank_of_its_backlash(tmp_path):

@@ -17,8 +17,8 @@ from faultgen.operation.wear import WearPlan
 from faultgen.runs import cluster
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.simulation import backends
-from faultgen.simulation import stepping as sim
 from faultgen.simulation.resolve import Run
+from resolved_runs import run_config
 
 
 def test_a_stepper_is_a_frozen_picklable_value():
@@ -33,7 +33,7 @@ def test_a_stepper_is_a_frozen_picklable_value():
 
 
 def test_a_task_key_keeps_the_text_it_had_with_names():
-    config = sim.RunConfig(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
+    config = run_config(robot="puma560", task="pick_place", wear=WearPlan({}), cycles=1, seed=0)
 
     def key(extra: str) -> str:  # main's task_key: the config key, then "backend=NAME" unless the default
         return "faultgen-r1-" + hashlib.sha256((dataset.config_key(config) + extra).encode()).hexdigest()[:16]

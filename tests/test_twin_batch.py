@@ -11,6 +11,7 @@ from faultgen.model import robots
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin, setup
 from faultgen.operation.wear import Schedule, WearPlan
 from faultgen.simulation import stepping as sim
+from resolved_runs import run_config
 
 
 @pytest.fixture(scope="module")
@@ -43,13 +44,13 @@ def test_the_signature_cycles_of_one_batch_are_the_bits_of_one_by_one(program, t
 
 def test_dry_multipliers_are_refused_with_a_wear_plan_or_the_wrong_shape(program):
     robot, _ = program
-    config = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0)
+    config = run_config(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0)
     with pytest.raises(ValueError, match=r"^dry_multipliers of shape \(2, 5\): expected finite numbers > 0 of "
                                          r"shape \(2, 6\), one row per recorded cycle and a column per axis$"):
         sim.simulate(config, progress=False, dry_multipliers=np.ones((2, 5)))
     with pytest.raises(ValueError, match=r"^dry_multipliers of shape \(2, 6\): expected finite numbers > 0"):
         sim.simulate(config, progress=False, dry_multipliers=np.zeros((2, 6)))
-    worn = sim.RunConfig(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0,
+    worn = run_config(robot=robot, task="pick_place", friction="stribeck", cycles=2, seed=0,
                          wear=WearPlan({2: Schedule("exp4", 0.2, 2)}))
     with pytest.raises(ValueError, match=r"^dry_multipliers are given instead of a wear plan and without daily "
                                          r"records; this run has friction wear \(a wear plan or a fault\)$"):

@@ -14,7 +14,8 @@ and :func:`faultgen.runs.sweep.run` merges the parts as it does for local worker
 - a run that raises (a simulation that diverged) is not retried, as the simulation is
   deterministic; the other runs go on and are kept, and the sweep then fails naming it.
 
-A task is a run id and its :class:`RunConfig`. A robot or program given as a relative path (a
+A task is a run id and its resolved run (:class:`~faultgen.simulation.resolve.Run`: the
+:class:`RunConfig` and the stepper it is stepped on). A robot or program given as a relative path (a
 robot folder ``kr6``, a program ``mine.toml``) is sent as this process's absolute path
 (:func:`for_workers`): a worker runs in a folder of its own, so it must see that path (the same
 machine, or the folder at the same path on every worker); the part files are labelled with the
@@ -46,7 +47,6 @@ from faultgen import __version__
 from faultgen.data import dataset
 from faultgen.model import robots
 from faultgen.operation import programs
-from faultgen.runs.context import ExecutionContext
 from faultgen.runs.errors import SweepError, SweepRefused
 from faultgen.runs.worker import RunStats, run_memory, simulate_and_write
 from faultgen.simulation import backends, spec
@@ -269,21 +269,21 @@ def _is_handshake(message: bytes) -> bool:
     return isinstance(info, dict) and "pickle-protocol" in info
 
 
-def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: ExecutionContext, command: str = "",
+def execute(todo: list[tuple[str, Run]], parts: Path, scheduler: str, command: str = "",
             shared: bool = False, bar=None) -> Iterator[RunStats]:
-    """Run ``todo`` on the Dask cluster of ``context.scheduler``; yield each run's :class:`RunStats` (with
+    """Run ``todo`` on the Dask cluster of ``scheduler``; yield each run's :class:`RunStats` (with
     the worker's address) once its part file is written, in completion order.
 
     Parameters
     ----------
-    todo : list of (run id, RunConfig)
-        In the order to submit them (longest first).
+    todo : list of (run id, Run)
+        The resolved runs (:class:`~faultgen.simulation.resolve.Run`: the configuration and the
+        stepper the workers step it on, pickled: its class must be importable in their processes),
+        in the order to submit them (longest first).
     parts : Path
         The sweep's part folder (this process's; ``shared``: the workers' too).
-    context : ExecutionContext
-        Its ``scheduler``: ``tcp://host:port`` of a Dask scheduler; its ``stepper``: what the workers
-        step the runs on (:class:`faultgen.simulation.backends.Stepper`, pickled: its class must be
-        importable in their processes); its ``jobs`` is not used.
+    scheduler : str
+        ``tcp://host:port`` of a Dask scheduler.
     command : str
         Provenance stored with every run.
     shared : bool
@@ -304,7 +304,6 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: Executi
     """
     from distributed import Client, KilledWorker, as_completed
 
-    scheduler = context.scheduler
     probe(scheduler)
     try:
         client = Client(scheduler, timeout="10s", set_as_default=False)
@@ -314,8 +313,8 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: Executi
     with client:
         if shared:
             _check_shared(client, folder)
-        run_of, futures = _submit(client, todo, folder, command, shared, context.stepper)
-        configs = dict(todo)
+        run_of, futures = _submit(client, todo, folder, command, shared)
+        configs = {run_id: run.config for run_id, run in todo}
         failed: list[str] = []
         finished = as_completed(futures, loop=client.loop)
         del futures  # as_completed holds each future until it is handed out: a written run's result is freed
@@ -349,20 +348,20 @@ def execute(todo: list[tuple[str, sim.RunConfig]], parts: Path, context: Executi
             raise SweepError(failure_message(failed, len(todo), parts))
 
 
-def _submit(client, todo: list[tuple[str, sim.RunConfig]], folder: Path, command: str, shared: bool,
-            stepper: backends.Stepper) -> tuple[dict[str, str], list]:
-    """Submit every run of ``todo`` to ``client``, in order, each sent as a resolved run on ``stepper``
-    (:class:`~faultgen.simulation.resolve.Run`): (task key -> run id, the futures). A run's worker
-    simulates it and sends it back, or with ``shared`` writes its part file into ``folder``."""
+def _submit(client, todo: list[tuple[str, Run]], folder: Path, command: str,
+            shared: bool) -> tuple[dict[str, str], list]:
+    """Submit every resolved run of ``todo`` (:class:`~faultgen.simulation.resolve.Run`, its stepper
+    on it) to ``client``, in order: (task key -> run id, the futures). A run's worker simulates it
+    and sends it back, or with ``shared`` writes its part file into ``folder``."""
     run_of = {}
     futures = []
-    for run_id, config in todo:
-        key = task_key(run_id, Run(config, stepper))  # the client's configuration, as the dashboard shows it
-        sent = Run(for_workers(config), stepper)
+    for run_id, run in todo:
+        key = task_key(run_id, run)  # the client's configuration, as the dashboard shows it
+        sent = replace(run, config=for_workers(run.config))
         run_of[key] = run_id
         if shared:
             futures.append(client.submit(write_shared, run_id, sent, str(folder / f"{run_id}.h5"), command,
-                                         None if sent.config is config else config, key=key))
+                                         None if sent.config is run.config else run.config, key=key))
         else:
             futures.append(client.submit(simulate_remote, run_id, sent, key=key))
     return run_of, futures

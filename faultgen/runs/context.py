@@ -26,7 +26,10 @@ class ExecutionContext:
         workers compute instead of local processes; None: local.
     stepper : Stepper
         What steps the simulations (:class:`faultgen.simulation.backends.Stepper`; default
-        ``BatchStepper()``), pickled to the workers as it is.
+        ``BatchStepper()``), pickled to the workers as it is. A sweep puts it on every run once,
+        where it starts (:func:`faultgen.runs.sweep.run`: a
+        :class:`~faultgen.simulation.resolve.Run` each); the layers below take the runs, not a
+        stepper.
 
     Raises
     ------

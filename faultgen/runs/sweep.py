@@ -34,7 +34,6 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import replace
 from pathlib import Path
 from typing import Self
 
@@ -96,8 +95,10 @@ def run(grid: Grid, out: str | Path, context: ExecutionContext = LOCAL, progress
         ignored with a ``scheduler``, the address of a Dask distributed scheduler
         (``tcp://host:port``) whose workers send each run back to this process, which writes it
         (:mod:`faultgen.runs.cluster`: they need not see the folder of ``out``), and the
-        ``stepper`` every run is stepped on, pickled to the workers (a stepper class defined
-        outside faultgen must be importable in their processes too). Every stepper gives the same
+        ``stepper`` every run is stepped on, put on each run here once (a resolved run,
+        :class:`~faultgen.simulation.resolve.Run`, is what the layers below and the workers take),
+        pickled to the workers (a stepper class defined outside faultgen must be importable in their
+        processes too). Every stepper gives the same
         dataset to float tolerance; it is not stored.
     progress : bool
         Show a progress bar over runs, with the time left.
@@ -133,18 +134,19 @@ def run(grid: Grid, out: str | Path, context: ExecutionContext = LOCAL, progress
         what to do); every finished run stays in the part folder for the next attempt.
     """
     out = Path(out)
-    plan = grid.runs()
     parts = parts_folder(out)
     if not isinstance(context, ExecutionContext):
         raise SweepRefused(f"context {context!r}: expected an ExecutionContext(jobs, scheduler, stepper) "
                            "(faultgen.runs.context)")
+    # the stepper put on every run, once: below here each run carries it (a Run), no layer takes a stepper
+    plan = [(run_id, Run(config, context.stepper)) for run_id, config in grid.runs()]
     with _lock(out, parts):
         if out.exists() and not overwrite:
             raise SweepRefused(f"{out} exists; pass --overwrite to replace it or choose another output")
         try:
             _prepare(out, parts)
             with _claim(out, parts, command):
-                todo = [(run_id, config) for run_id, config in plan if not _finished(parts / f"{run_id}.h5", config)]
+                todo = [(run_id, run) for run_id, run in plan if not _finished(parts / f"{run_id}.h5", run.config)]
                 todo.sort(key=_expected_cost, reverse=True)  # longest first: workers finish close together
                 _check_space(out, parts, plan, todo)
                 if on_start is not None:
@@ -154,7 +156,7 @@ def run(grid: Grid, out: str | Path, context: ExecutionContext = LOCAL, progress
                         with tqdm(total=len(plan), initial=len(plan) - len(todo), unit="run", disable=not progress,
                                   desc=f"sweep {out.name}") as bar:
                             jobs = min(context.jobs, max(len(todo), 1))
-                            for stats in _execute(todo, parts, replace(context, jobs=jobs), command, shared, bar):
+                            for stats in _execute(todo, parts, jobs, context.scheduler, command, shared, bar):
                                 bar.update(1)
                                 if on_run is not None:
                                     on_run(stats)
@@ -236,8 +238,8 @@ def _remove_if_empty(folder: Path) -> None:
 
 def _check_space(out: Path, parts: Path, plan, todo) -> None:
     """Refuse, before any run, a sweep whose parts and merged dataset would not fit on the disk."""
-    needed = sum(dataset.estimated_size(config) for _, config in todo)
-    needed += sum(dataset.estimated_size(config) for _, config in plan)  # the merged dataset
+    needed = sum(dataset.estimated_size(run.config) for _, run in todo)
+    needed += sum(dataset.estimated_size(run.config) for _, run in plan)  # the merged dataset
     try:
         atomic.check_writable(parts / "x.h5", needed)
     except OSError as err:
@@ -286,9 +288,9 @@ def _describe_holder(parts: Path) -> str:
         return "a sweep that has not named itself yet"
 
 
-def _expected_cost(item: tuple[str, sim.RunConfig]) -> float:
+def _expected_cost(item: tuple[str, Run]) -> float:
     """Simulated seconds of a run: recorded cycles times the task's cycle time."""
-    config = item[1]
+    config = item[1].config
     return len(config.recorded_cycles) * sim.cycle_duration(config.model, config.task)
 
 
@@ -374,17 +376,17 @@ class CtrlC:
             self._resends.append(resend)
 
 
-def _execute(todo, parts: Path, context: ExecutionContext, command: str, shared: bool = False,
-             bar=None) -> Iterator[RunStats]:
-    """Run the missing runs as ``context`` says; yield the stats of each as it finishes, in completion order."""
+def _execute(todo: list[tuple[str, Run]], parts: Path, jobs: int, scheduler: str | None, command: str,
+             shared: bool = False, bar=None) -> Iterator[RunStats]:
+    """Run the missing runs (each on its own stepper) on ``jobs`` local processes, or on the Dask
+    cluster of ``scheduler``; yield the stats of each as it finishes, in completion order."""
     if not todo:
         return
     # absolute: a worker process keeps the folder it started in, which need not be this one's now
-    calls = [(run_id, Run(config, context.stepper), parts.absolute() / f"{run_id}.h5", command)
-             for run_id, config in todo]
+    calls = [(run_id, run, parts.absolute() / f"{run_id}.h5", command) for run_id, run in todo]
     try:
-        if context.scheduler:
-            yield from cluster.execute(todo, parts, context, command, shared=shared, bar=bar)
+        if scheduler:
+            yield from cluster.execute(todo, parts, scheduler, command, shared=shared, bar=bar)
         else:
             from joblib import Parallel, delayed
             from joblib._parallel_backends import LokyBackend
@@ -396,16 +398,16 @@ def _execute(todo, parts: Path, context: ExecutionContext, command: str, shared:
                 # every worker watches the sweep from its start, idle or not
                 # (:func:`faultgen.runs.worker.watch_parent`)
                 loky = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
-                parallel = Parallel(n_jobs=context.jobs, return_as="generator_unordered", backend=loky)
+                parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=loky)
                 yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:
-        if not context.scheduler:
+        if not scheduler:
             _stop_local_workers()
         raise
     except RuntimeError as err:
         # an interrupt while loky was starting its manager thread: joblib's abort could not join it
         # ("cannot join thread before it is started") and raised that instead, the interrupt as its context
-        if context.scheduler or not isinstance(err.__context__, KeyboardInterrupt):
+        if scheduler or not isinstance(err.__context__, KeyboardInterrupt):
             raise
         _stop_local_workers()
         raise err.__context__ from None

@@ -1,4 +1,6 @@
-"""One run's configuration (:class:`RunConfig`), validated on construction."""
+"""One run's configuration (:class:`RunConfig`): values only, checked without a robot on
+construction; :func:`faultgen.simulation.resolve.resolve` loads the robot, plans the task and checks
+the run against them."""
 
 from __future__ import annotations
 
@@ -9,11 +11,10 @@ import numpy as np
 from faultgen.checks import MAX_SEED, is_whole
 from faultgen.model import robots
 from faultgen.model.robot import Robot
-from faultgen.operation import programs
 from faultgen.operation.conditions import Conditions
 from faultgen.operation.faults import Fault
 from faultgen.operation.wear import WearPlan
-from faultgen.simulation import friction_models, prepare
+from faultgen.simulation import friction_models
 from faultgen.simulation.spec import RunFields
 
 
@@ -63,40 +64,42 @@ class RunConfig(RunFields):
         day's maximum (thesis ch. 5.3.2; :func:`daily_record`), instead of every cycle; every
         cycle is simulated, no signals are kept.
     resolved : Robot, optional (keyword only)
-        The robot :attr:`robot` names, already resolved by the caller (a grid or fleet resolves
-        each robot once for all its runs); resolved here (:func:`faultgen.model.robots.load`) when
-        omitted. Not compared; not pickled when read from a file (a worker resolves :attr:`robot`
-        again, once), pickled when edited in memory (no file holds it).
+        The robot :attr:`robot` names, already resolved (:func:`faultgen.simulation.resolve.resolve`
+        gives it); when omitted, :attr:`model` loads it on first use (a worker that received the run
+        pickled, :func:`faultgen.model.robots.load`). Not compared; not pickled when read from a file
+        (a worker resolves :attr:`robot` again, once), pickled when edited in memory (no file holds it).
+
+    Construction does no work (scikit-learn's rule): nothing is loaded, read, planned or looked up.
+    Build a run with :func:`faultgen.simulation.resolve.resolve`, which loads the robot, checks and
+    plans the task and checks the run against both (:meth:`check`); one built here from a name
+    is checked against its robot when simulated.
 
     Raises
     ------
     ValueError
-        On construction, for an unknown robot or an invalid robot file (e.g. a negative friction
-        parameter), an unknown task or friction model, cycles < 1, a recorded cycle outside
-        1..cycles, a negative seed or nthread, ``back_to_back`` with wear, operating conditions,
-        a fault or a ``record`` subset, ``daily`` with a ``record`` subset, signals, or cycles that
-        are not whole days, a relative fault as ``fault`` (friction wear is ``wear``), a fault
-        whose last cycle is not the run's or whose effect the robot already carries, a task mix
-        without the run's task or with signals, or a unit spread with a gear loss under the
-        ``lugre`` friction model; the message names the value.
+        On construction: cycles < 1, a recorded cycle outside 1..cycles, a negative seed or nthread,
+        ``back_to_back`` with wear, operating conditions, a fault or a ``record`` subset, ``daily``
+        with a ``record`` subset, signals, or cycles that are not whole days, a relative fault as
+        ``fault`` (friction wear is ``wear``), a fault whose last cycle is not the run's, a task mix
+        without the run's task or with signals. By :meth:`check` (:func:`resolve`): an unknown
+        friction model, an axis out of range, a fault whose effect the robot already carries, a
+        growing in-plant fault or a unit spread with a gear loss under the ``lugre`` friction
+        model. By :func:`resolve`: an unknown robot or an invalid robot file, an unknown task. The
+        message names the value.
+    TypeError
+        On construction: a wear plan, conditions, fault or ``resolved`` of the wrong type.
     """
 
     resolved: Robot | None = field(default=None, compare=False, repr=False, kw_only=True)
 
     def __post_init__(self) -> None:
+        # no work on construction (scikit-learn's rule): nothing loaded, read, planned or looked up;
+        # the values checked here need no robot, the rest :meth:`check` (resolve, simulate)
         if isinstance(self.robot, Robot):
             object.__setattr__(self, "resolved", self.robot)
             object.__setattr__(self, "robot", robots.source_of(self.robot))
-        elif self.resolved is None:  # UnknownRobotError / ModelError (ValueErrors) name the problem
-            object.__setattr__(self, "resolved", robots.load(self.robot))
-        elif not isinstance(self.resolved, Robot):
+        elif self.resolved is not None and not isinstance(self.resolved, Robot):
             raise TypeError(f"resolved: expected a Robot, got {type(self.resolved).__name__}")
-        robot = self.resolved
-        n_axes = robot.n_axes
-        programs.check_name(self.task)  # a thesis task, or a program / joint log file
-        if programs.is_given_task(self.task):  # checked before any simulation (segment and value named)
-            prepare.task_path(robot, self.task, *prepare.digests(robot, self.task))
-        stepping = friction_models.get(self.friction)
         if not is_whole(self.cycles, 1):
             raise ValueError(f"cycles = {self.cycles!r}; expected a whole number >= 1")
         if self.record is not None:
@@ -111,30 +114,30 @@ class RunConfig(RunFields):
             raise ValueError(f"seed = {self.seed!r}; expected a whole number in 0 .. {MAX_SEED}")
         if not isinstance(self.wear, WearPlan):
             raise TypeError(f"wear: expected a WearPlan, got {type(self.wear).__name__}")
-        self.wear.check(n_axes)  # "axis 7 is out of range 1..6"
         if self.nthread < 0:
             raise ValueError(f"nthread = {self.nthread!r}; expected >= 0 (0 uses all CPUs)")
         if not isinstance(self.conditions, Conditions):
             raise TypeError(f"conditions: expected a Conditions, got {type(self.conditions).__name__}")
-        if self.fault is not None:
-            if not isinstance(self.fault, Fault):
-                raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
-            if self.fault.relative:
-                raise ValueError(f"fault {self.fault.to_dict()} is relative growth of the motor friction: friction wear, "
-                                 "given as wear (WearPlan, --wear AXIS:KIND:PERCENT), whose labels and truth array the "
-                                 "dataset keeps")
-            self.fault.check(n_axes)
-            if self.fault.last_cycle != self.cycles:
-                raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
-            if self.fault.effect in robot.effects and np.any(robot.effects[self.fault.effect].active()):
-                raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
-                                 "needs a robot without it")
-            if self.back_to_back:
-                raise ValueError("a fault grows from cycle to cycle: run the cycles independently (no back_to_back)")
-            if self.fault.in_plant and not stepping.per_step:
-                raise ValueError(f"a growing {self.fault.effect} fault needs the static friction model "
-                                 "(friction='stribeck', --friction stribeck): friction growing with the load is "
-                                 "updated every step from Python, and the lugre model runs inside MuJoCo")
+        self._check_fault()
+        self._check_together()
+
+    def _check_fault(self) -> None:
+        """:attr:`fault`'s checks that need no robot."""
+        if self.fault is None:
+            return
+        if not isinstance(self.fault, Fault):
+            raise TypeError(f"fault: expected a Fault, got {type(self.fault).__name__}")
+        if self.fault.relative:
+            raise ValueError(f"fault {self.fault.to_dict()} is relative growth of the motor friction: friction wear, "
+                             "given as wear (WearPlan, --wear AXIS:KIND:PERCENT), whose labels and truth array the "
+                             "dataset keeps")
+        if self.fault.last_cycle != self.cycles:
+            raise ValueError(f"fault last_cycle {self.fault.last_cycle} differs from the run's {self.cycles} cycles")
+        if self.back_to_back:
+            raise ValueError("a fault grows from cycle to cycle: run the cycles independently (no back_to_back)")
+
+    def _check_together(self) -> None:
+        """The values that exclude one another: back to back, a task mix, daily records."""
         if self.back_to_back and (self.wear.schedules or self.conditions.active
                                   or self.record not in (None, tuple(range(1, self.cycles + 1)))):
             raise ValueError("back_to_back runs step every cycle in one simulation without wear or operating "
@@ -148,16 +151,34 @@ class RunConfig(RunFields):
         if mix is not None and self.signals:
             raise ValueError(f"a task mix ({', '.join(mix.tasks)}) keeps no signals: cycles of different tasks differ "
                              "in length; record features only (--features-only, signals=False)")
-        spread = self.conditions.spread
-        if spread is not None and spread.gear_loss > 0 and not stepping.per_step:
-            raise ValueError(f"unit spread gear_loss = {spread.gear_loss!r} needs the static friction model "
-                             "(friction='stribeck', --friction stribeck): friction growing with the load is "
-                             "updated every step from Python, and the lugre model runs inside MuJoCo")
         if self.daily:
             per_day = self.conditions.cycles_per_day
             if self.record is not None or self.signals or self.cycles % per_day:
                 raise ValueError(f"daily records need every cycle recorded, no signals and whole days: got record = "
                                  f"{self.record!r}, signals = {self.signals}, {self.cycles} cycles at {per_day} a day")
+
+    def check(self, robot: Robot) -> None:
+        """The checks that need the robot (:attr:`model`) and the friction model, looked up here
+        (:func:`faultgen.simulation.friction_models.get`): :func:`faultgen.simulation.resolve.resolve`
+        calls it before any run starts, :func:`faultgen.simulation.stepping.simulate` before
+        stepping a configuration that holds no robot yet (built from a name, or unpickled). Raises ValueError (the friction model unknown, an axis out of range, a fault the
+        robot already carries, or one the ``lugre`` model cannot grow; each named)."""
+        stepping = friction_models.get(self.friction)
+        self.wear.check(robot.n_axes)  # "axis 7 is out of range 1..6"
+        if self.fault is not None:
+            self.fault.check(robot.n_axes)
+            if self.fault.effect in robot.effects and np.any(robot.effects[self.fault.effect].active()):
+                raise ValueError(f"{self.robot} already carries {self.fault.effect}; a growing {self.fault.effect} fault "
+                                 "needs a robot without it")
+            if self.fault.in_plant and not stepping.per_step:
+                raise ValueError(f"a growing {self.fault.effect} fault needs the static friction model "
+                                 "(friction='stribeck', --friction stribeck): friction growing with the load is "
+                                 "updated every step from Python, and the lugre model runs inside MuJoCo")
+        spread = self.conditions.spread
+        if spread is not None and spread.gear_loss > 0 and not stepping.per_step:
+            raise ValueError(f"unit spread gear_loss = {spread.gear_loss!r} needs the static friction model "
+                             "(friction='stribeck', --friction stribeck): friction growing with the load is "
+                             "updated every step from Python, and the lugre model runs inside MuJoCo")
 
     @property
     def model(self) -> Robot:

@@ -7,9 +7,10 @@ file content, its SHA-1), or the one the caller already holds (``resolved``); th
 planned at the robot's physics step once per process and content:
 :func:`faultgen.simulation.prepare.task_path`, keyed by the SHA-256 of the robot's ``tasks.toml``
 and of a program or log file, :func:`faultgen.simulation.prepare.digests`, not by file times); the
-stepper by :func:`stepper`; the friction model is looked up by the
-:class:`~faultgen.simulation.config.RunConfig` it builds
-(:func:`faultgen.simulation.friction_models.get`). The :class:`Run` holds the objects;
+stepper by :func:`stepper`; the friction model by :meth:`RunConfig.check
+<faultgen.simulation.config.RunConfig.check>` (:func:`faultgen.simulation.friction_models.get`), which
+checks the run against the robot. A :class:`~faultgen.simulation.config.RunConfig` loads and plans
+nothing when constructed: this is the one place that does. The :class:`Run` holds the objects;
 :func:`faultgen.simulation.stepping.simulate` steps it (``simulate(run.config,
 stepper=run.stepper)``, or :meth:`Run.simulate`). Every command that simulates builds its runs
 here (docs/architecture.md, "Every command's runs through resolve").
@@ -91,6 +92,9 @@ def resolve(spec: RunSpec, resolved: robots.Robot | None = None) -> Run:
                         f"{spec.robot!r})")
     found = robot(spec.robot) if resolved is None else resolved
     stepping = stepper(spec.stepper)
-    # RunConfig checks and plans the task (as task does) and looks the friction model up: not twice
+    programs.check_name(spec.task)  # a thesis task, or a program / joint log file
+    if programs.is_given_task(spec.task):  # planned before any simulation (segment and value named)
+        task(found, spec.task)
     config = RunConfig(robot=spec.robot, resolved=found, **spec.run_fields())
+    config.check(found)  # the friction model looked up, the run checked against the robot
     return Run(config, stepping)

@@ -80,10 +80,13 @@ def simulate(config: RunConfig, progress: bool = True, stepper: backends.Stepper
     SimulationDiverged
         If a cycle's state becomes non-finite or MuJoCo raises a warning; names cycle and axis.
     ValueError
-        For a ``stepper`` that is not a Stepper object; ``dry_multipliers`` not of that shape, not finite and positive,
-        beside friction wear or with daily records.
+        For a run its robot refuses (:meth:`RunConfig.check`), a ``stepper`` that is not a Stepper
+        object; ``dry_multipliers`` not of that shape, not finite and positive, beside friction wear
+        or with daily records.
     """
     stepper = backends.DEFAULT_STEPPER if stepper is None else backends.checked(stepper)
+    if config.resolved is None:  # not from resolve (which checked it): built from a name, or unpickled
+        config.check(config.model)
     cycles = config.recorded_cycles
     n_axes = config.model.n_axes
     if dry_multipliers is not None:
