@@ -98,11 +98,10 @@ class UnitStatus:
     programs: str = ""
 
     def basis(self) -> str:
-        """What the unit's numbers rest on, for the console beside its status: the twin's fallback,
-        the torque source and the program mix, each where there is one ("" otherwise)."""
+        """What the unit's numbers rest on, for the console beside its status: the twin's fallback and
+        the torque source, each where there is one ("" otherwise)."""
         return "".join(f"; {what}: {text}" for what, text in (("twin fallback", self.fallback),
-                                                              ("torque", self.torque_source),
-                                                              ("programs", self.programs)) if text)
+                                                              ("torque", self.torque_source)) if text)
 
 
 @dataclass
@@ -433,6 +432,8 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
+    latest = unit.entries[-1].program if unit.entries else 0  # the program it runs now learning too: learning
+    still = learning or programs.learning(unit.monitor, latest)
     if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
         reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
     elif not learning and unit.monitor.not_observable_note():
@@ -445,7 +446,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
-        status = "learning" if learning else "monitored"
+        status = "learning" if still else "monitored"
     reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",

@@ -279,6 +279,13 @@ class Baselines:
                 self.offsets[k - 1] = (np.zeros(monitor.n_axes), np.zeros(monitor.n_axes))
 
 
+def learning(monitor, program: int) -> bool:
+    """Whether the unit's program ``program`` (0: its first) is still learning its baseline."""
+    if program == 0:
+        return monitor.pca is None
+    return baselines_of(monitor).saved[program - 1]["pca"] is None
+
+
 def baselines_of(monitor) -> Baselines:
     """The :class:`Baselines` of a unit's monitor (made empty on first use)."""
     if not hasattr(monitor, "program_baselines"):
