@@ -161,26 +161,31 @@ def scored(data, span: tuple[int, int]):
     return replace(data, **arrays)
 
 
-def first_cycle(t, q, cycle=None) -> tuple[np.ndarray, np.ndarray, int]:
+def first_cycle(t, q, cycle=None) -> tuple[np.ndarray, np.ndarray, str]:
     """What a twin replays of its program log (``t`` (n,) s, ``q`` (n, N) rad, ``cycle`` column or
-    None): its first whole cycle (``t`` from its start, ``q``) and how many whole cycles the log
-    holds; the whole log and 1 when it is one cycle.
+    None): its first whole cycle (``t`` from its start, ``q``) and what it is, for the twin's cache
+    key: "" for the whole log (one cycle), ``"1 of K"`` for the first of a log of K whole cycles,
+    ``"samples A:B"`` for a whole cycle inside a log cut anywhere, and ``"reference"`` for the
+    program's reference cycle itself (the log folded at its period and averaged, from rest:
+    :func:`reference_of`) when the log holds no whole cycle from the program's start.
 
     Raises
     ------
     ValueError
-        No program or no whole cycle can be found in the log."""
+        No program can be learned from the log."""
     t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
     reference = reference_of(t, q, cycle)
     cut = align.whole_cycles(t, q, reference, cycle)
     if isinstance(cut, align.NoWholeCycle):
-        raise ValueError(f"the program log has no whole cycle to replay: {refusal_text(cut)}")
+        if cut.why is not align.Why.CUT_INSIDE:
+            raise ValueError(f"the program log has no whole cycle to replay: {refusal_text(cut)}")
+        return reference.step * np.arange(len(reference.q)), reference.q, "reference"
     start, stop, count = whole_span(cut, len(t))
-    if count == 1 and (start, stop) == (0, len(t)):
-        return t - t[0], q, 1
+    if (start, stop) == (0, len(t)):
+        return (t - t[0], q, "") if count == 1 else (t[:cut.cycles[0].stop] - t[0], q[:cut.cycles[0].stop],
+                                                     f"1 of {count}")
     first = cut.cycles[0]
-    a = 0 if first.start <= EDGE_SAMPLES else first.start
-    return t[a:first.stop] - t[a], q[a:first.stop], len(cut.cycles)
+    return t[first.start:first.stop] - t[first.start], q[first.start:first.stop], f"samples {first.start}:{first.stop}"
 
 
 def same_program(earlier_t, earlier_q, earlier_cycle, t, q) -> bool:

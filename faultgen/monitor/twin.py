@@ -152,12 +152,13 @@ class Twin:
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
                        "moving_speed": fleet_logs.MOVING_SPEED,  # friction_torque's standstill threshold
                        "reference": f"savgol {REFERENCE_WINDOW:g} s"}
-        t, q, count = unit_programs.first_cycle(data.t, data.q, data.cycle)
-        if count == 1:
+        t, q, which = unit_programs.first_cycle(data.t, data.q, data.cycle)
+        if not which:
             self._reference = self._smoothed_program(program.sha256[:24], data.t, data.q)
-        else:  # a log of several cycles of its program: one replayed (the features are per sample)
-            self._files["cycle"] = f"1 of {count}"
-            self._reference = self._smoothed_program(f"{program.sha256[:24]}-1of{count}", t, q)
+        else:  # a log of several cycles of its program, or cut anywhere: one cycle replayed (the features are per sample)
+            self._files["cycle"] = which
+            name = which.replace(" of ", "of").replace("samples ", "s").replace(":", "-")
+            self._reference = self._smoothed_program(f"{program.sha256[:24]}-{name}", t, q)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         if cycles:
