@@ -1,5 +1,6 @@
 """What ``faultgen monitor`` prints when a run ends: one line per unit (its status, the model its
-twin is of, its alarm or its reason, and its program mix where it ran several programs), the fleet's count of alarms beside the chance of a persistent
+twin is of, its alarm or its reason, and its program mix where it ran several programs), the
+fleet's count of alarms beside the chance of a persistent
 alarm on a healthy unit (where that says something), what was passed over (files that are not logs,
 events rows of no unit), the files written, and the units that are
 degraded or not monitored. Text only: the command prints it (faultgen/cli/monitoring.py)."""

@@ -19,7 +19,8 @@ What the monitor asks of it (:class:`Twin`):
 
 The replayed motion is one cycle of the program log (its first, or with a ``cycle`` column its first
 whole one as the motion places it, when the log holds several or is cut anywhere:
-:func:`faultgen.monitor.programs.first_cycle`; the cache key then says which), its angles through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
+:func:`faultgen.monitor.programs.first_cycle`; the cache key then says which), its angles
+through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
 (:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's noise as its reference
 saturates where the real one did not. A replay of measured arm angles still asks more
 of the drives than the run that logged them (it tracks the elastic arm's own lag and ripple as its
@@ -155,7 +156,7 @@ class Twin:
         t, q, which = unit_programs.first_cycle(data.t, data.q, data.cycle)
         if not which:
             self._reference = self._smoothed_program(program.sha256[:24], data.t, data.q)
-        else:  # a log of several cycles of its program, or cut anywhere: one cycle replayed (the features are per sample)
+        else:  # a log of several cycles, or cut anywhere: one cycle replayed (the features are per sample)
             self._files["cycle"] = which
             name = which.replace(" of ", "of").replace("samples ", "s").replace(":", "-")
             self._reference = self._smoothed_program(f"{program.sha256[:24]}-{name}", t, q)
