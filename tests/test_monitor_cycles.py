@@ -1,7 +1,7 @@
-"""A log holding several cycles of the unit's program is the same program (issue 72 item 8,
-faultgen.monitor.cycles): cycles found from the program's period (or the log's ``cycle`` column),
-a program change declared only when a log's cycles match neither the program nor a whole number of
-its cycles, in time rather than samples (250 and 500 Hz logs of one program). Checked on motions
+"""A log holding several cycles of the unit's program is the same program (issue 72 item 8, now
+faultgen.monitor.programs over faultgen.logs.align): the program recognised from the motion, its
+whole cycles scored, a program change declared only when a log's motion matches none of the unit's
+programs, in time rather than samples (250 and 500 Hz logs of one program). Checked on motions
 made here (a reference cycle tiled and resampled by hand) and on the independent generator's mixed
 fleet (faultgen.bench.independent's ``cycles`` and ``rates``: Pinocchio's dynamics, one unlogged
 program change on a known day), whose default fleets stay the same file for file."""
@@ -14,7 +14,8 @@ from faultgen.bench import layouts
 from faultgen.data import logfolder
 from faultgen.logs import measured
 from faultgen.model import robots
-from faultgen.monitor import cycles, feed
+from faultgen.logs import align
+from faultgen.monitor import programs
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import unit as unit_module
 from faultgen.monitor.twin import Twin
@@ -36,42 +37,50 @@ def log(rate: float, k: int, reach: float = 1.0, noise: float = 1e-4, seed: int 
     return np.arange(k * n) / rate, q, np.repeat(np.arange(k), n)
 
 
+def _scored(t, q, reference, cycle=None):
+    """The samples of a log the monitor scores: (start, stop) or None (faultgen.monitor.programs.span_of)."""
+    return programs.span_of(t, align.whole_cycles(t, q, reference, cycle), reference.period)
+
+
 @pytest.mark.parametrize("program_rate, program_cycles", [(250.0, 1), (500.0, 1), (250.0, 2), (500.0, 3)])
 def test_a_log_of_whole_cycles_at_any_rate_is_the_program(program_rate, program_cycles):
     t, q, _ = log(program_rate, program_cycles)
-    program = cycles.Program.of(t, q)
-    assert program.cycles == program_cycles
-    assert program.period == pytest.approx(4.0, rel=1e-9)
+    program = programs.reference_of(t, q)
+    assert program.period == pytest.approx(4.0, rel=1e-3)
+    assert programs.first_cycle(t, q)[2] == ("" if program_cycles == 1 else f"1 of {program_cycles}")
     for rate in (250.0, 500.0, 125.0):
         for k in (1, 2, 3):
             t, q, cycle = log(rate, k, seed=k)
-            assert program.log_cycles(t, q) == k, (rate, k)
-            assert program.log_cycles(t, q, cycle) == k, (rate, k)
+            assert align.recognise(t, q, [program]).status is align.Status.KNOWN, (rate, k)
+            assert _scored(t, q, program) == (0, len(t)), (rate, k)  # every sample scored
+            assert _scored(t, q, program, cycle) == (0, len(t)), (rate, k)
 
 
-def test_another_motion_or_a_span_that_is_no_whole_number_of_cycles_is_another_program():
-    program = cycles.Program.of(*log(250.0, 1)[:2])
+def test_another_motion_is_another_program_and_a_part_of_a_cycle_is_not_scored():
+    program = programs.reference_of(*log(250.0, 1)[:2])
     # other targets (70 % of the way: the generator's program change), one cycle or two
     for k in (1, 2):
         t, q, cycle = log(250.0, k, reach=0.7)
-        assert program.log_cycles(t, q) is None and program.log_cycles(t, q, cycle) is None
-    # a cycle and a half, or a cycle stretched by 10 % (a slower program): no whole number of periods
+        assert align.recognise(t, q, [program]).status is align.Status.NEW
+    # a cycle stretched by 10 % (a slower program): another program
+    t, q, _ = log(250.0, 1)
+    assert align.recognise(t * 1.1, q, [program]).status is align.Status.NEW
+    # a cycle and a half: the program, one cycle of it scored
     t, q, _ = log(500.0, 3)
     half = len(t) // 2
-    assert program.log_cycles(t[:half], q[:half]) is None
-    t, q, _ = log(250.0, 1)
-    assert program.log_cycles(t * 1.1, q) is None
-    # the second of two cycles off the program: the log's every cycle is compared, not its first
+    start, stop = _scored(t[:half], q[:half], program)
+    assert (stop - start) / 500.0 == pytest.approx(4.0, abs=0.01)
+    # the second of two cycles off the program: only the first is scored
     t, q, cycle = log(250.0, 2)
     q[cycle == 1] = log(250.0, 1, reach=0.7)[1]
-    assert program.log_cycles(t, q) is None and program.log_cycles(t, q, cycle) is None
+    assert _scored(t, q, program) == (0, 1000)
 
 
 def test_a_one_cycle_program_is_not_taken_for_several():
     t, q, _ = log(250.0, 1)
-    program = cycles.Program.of(t, q)
-    assert program.cycles == 1 and program.period == pytest.approx(4.0)
-    assert len(program.t) == len(t)
+    program = programs.reference_of(t, q)
+    assert program.period == pytest.approx(4.0) and len(program.q) == len(t)
+    assert programs.first_cycle(t, q)[2] == ""
 
 
 # a 2-unit iiwa 14 fleet of 12 days, logs of 1 or 2 cycles at 250 or 500 Hz, the healthy unit's
@@ -129,13 +138,14 @@ def test_only_the_real_program_change_is_one_on_the_mixed_fleet(robot, mixed):
     ((unit_changed, (change,)),) = independent_fleet.read_changes(root).items()
     for unit in independent_fleet.unit_names(SPEC):
         stamps = independent_fleet.stamps(SPEC)
-        program = feed.program_of(measured.read(logs / unit / f"{stamps[0]}.csv", model, accelerations=False))
+        first = measured.read(logs / unit / f"{stamps[0]}.csv", model, accelerations=False)
+        known = [programs.reference_of(first.t, first.q, first.cycle)]
         changed = []
         for stamp in stamps[1:]:
             data = measured.read(logs / unit / f"{stamp}.csv", model, accelerations=False)
-            if feed.program_changed(data, program):
+            if align.recognise(data.t, data.q, known).status is align.Status.NEW:
                 changed.append(stamp)
-                program = feed.program_of(data)  # the monitor's new program from the change on
+                known.append(programs.reference_of(data.t, data.q, data.cycle, f"program {len(known) + 1}"))
         assert changed == ([change["stamp"]] if unit == unit_changed else []), unit
 
 

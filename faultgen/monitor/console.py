@@ -1,5 +1,6 @@
 """What ``faultgen monitor`` prints when a run ends: one line per unit (its status, the model its
-twin is of, its alarm or its reason), the fleet's count of alarms beside the chance of a persistent
+twin is of, its alarm or its reason, and its program mix where it ran several programs), the
+fleet's count of alarms beside the chance of a persistent
 alarm on a healthy unit (where that says something), what was passed over (files that are not logs,
 events rows of no unit), the files written, and the units that are
 degraded or not monitored. Text only: the command prints it (faultgen/cli/monitoring.py)."""
@@ -32,8 +33,9 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
         reason = reason.removeprefix(f"{status.status}: ")  # "not monitored: ..." beside the status said once
         what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
+        mix = f"; programs: {status.programs}" if status.programs and status.programs not in what else ""
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
-                     f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}")
+                     f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}{mix}")
     logs_scored = max((sum(r.phase == "monitoring" for r in m.rows) for m in monitors), default=0)
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same

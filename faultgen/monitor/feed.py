@@ -16,19 +16,20 @@ from pathlib import Path
 import numpy as np
 
 from analysis.monitoring import varying_columns
-from faultgen.logs import formats
+from faultgen.logs import align, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import cycles, friction_tests, life, report
+from faultgen.monitor import friction_tests, life, report
+from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 from faultgen.monitor.unit import REFUSED_SKIP, Unit, log_of, refused_note, short, twin_of
 from faultgen.simulation import backends
 
-#: A log whose cycles' angles lie more than this off its twin's program, rad, or whose span differs by
-#: more than PROGRAM_LENGTH of a whole number of its cycles, runs another program (:mod:`faultgen.monitor.cycles`).
-PROGRAM_CHANGE, PROGRAM_LENGTH = cycles.PROGRAM_CHANGE, cycles.PROGRAM_LENGTH
+#: A log more than this RMS angle off each of its unit's programs over a whole cycle, rad, runs a program
+#: new to the unit (:func:`faultgen.logs.align.recognise`).
+PROGRAM_CHANGE = align.TOLERANCE
 #: A unit's note (units.csv's reason) when a feature of its learning logs is the same in every log
 #: (:func:`constant_torque`): no PCA model can be fitted on it and no wear can show in it (the
 #: ``ur-rtde`` commanded moment of a fixed program, the same every day). The unit is not monitored,
@@ -110,30 +111,78 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
                 i += 1
                 if (event.stamp, event.event, event.axis) not in given:
                     given.add((event.stamp, event.event, event.axis))
-                    unit.monitor.maintenance(event.stamp, event.event, event.axis)
+                    unit_programs.baselines_of(unit.monitor).maintenance(unit.monitor, event.stamp, event.event,
+                                                                         event.axis)
                     unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
             twin = score_log(unit, log, nominal, twin, context.twin_temperature, source, context)
+    for _, unit, _ in group:
+        unit.program_twins.clear()  # made again where needed: a unit travels back from a worker without them
     return [(name, unit, unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
 
 
 
-def program_changed(data, program: cycles.Program) -> bool:
-    """Whether a checked log ``data`` (:class:`faultgen.logs.measured.MeasuredData`) traces another
-    motion than ``program``'s: its cycles (its ``cycle`` column, else a whole number of the program's
-    periods) match neither the program's cycle nor a multiple of it
-    (:meth:`faultgen.monitor.cycles.Program.log_cycles`; noise and tracking stay far below it)."""
-    return program.log_cycles(data.t, data.q, data.cycle) is None
+def references(unit: Unit, units: dict, source: fleet_logs.Source) -> list[align.Reference]:
+    """The references of the unit's programs in the order met (:attr:`Unit.references`), learned
+    from their logs (:func:`faultgen.monitor.programs.reference_of`) when first needed in a run."""
+    if unit.references is None:
+        logs = [unit.program] + [c.program for c in unit.program_changes]
+        unit.references = []
+        for k, (owner, stamp) in enumerate(logs):
+            data = source.get(log_of(units, owner, stamp)).checked()
+            unit.references.append(unit_programs.reference_of(data.t, data.q, data.cycle, f"program {k + 1}"))
+    return unit.references
 
 
-def program_of(data) -> cycles.Program:
-    """The :class:`faultgen.monitor.cycles.Program` of a checked program log ``data``."""
-    return cycles.Program.of(data.t, data.q, data.cycle)
+def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source):
+    """The program of a checked log ``data`` of ``unit`` (:func:`faultgen.logs.align.place` among
+    its programs), the part of it scored (its whole cycles: :func:`faultgen.monitor.programs.scored`)
+    and that program's twin: ``(program index, data scored, twin)``; a program new to the unit is
+    added (:func:`new_program`). A log of no whole cycle of a program gives why (a str: it is skipped).
+
+    Raises
+    ------
+    ValueError
+        A new program's twin cannot be built (the log is then skipped, named).
+    """
+    known = references(unit, context.units, source)
+    found = align.recognise(data.t, data.q, known)
+    if found.status is align.Status.KNOWN:
+        k = next(i for i, r in enumerate(known) if r.name == found.program)
+        reference = known[k]
+    elif found.status is align.Status.NEW:
+        k = len(known)
+        try:
+            reference = unit_programs.reference_of(data.t, data.q, data.cycle, f"program {k + 1}")
+        except ValueError as err:
+            return f"no whole cycle: a new program that cannot be learned ({short(err)})"
+    else:
+        return unit_programs.refusal_text(align.place(data.t, data.q, known, data.cycle).refusal)
+    cut = align.whole_cycles(data.t, data.q, reference, data.cycle)
+    span = unit_programs.span_of(data.t, cut, reference.period)
+    if span is None:
+        return unit_programs.refusal_text(cut)
+    if k == len(known):
+        new_program(unit, log, twin, context, source, reference)
+    return k, unit_programs.scored(data, span), twin if k == 0 else program_twin(unit, k, twin, context, source)
 
 
-def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source) -> Twin:
-    """The twin of the program ``log`` starts (an unlogged program change): the unit's monitor
-    restarts its learning against it, its open alarm closed by the change; noted in its reason.
+def program_twin(unit: Unit, k: int, twin: Twin, context, source: fleet_logs.Source) -> Twin:
+    """The twin of the unit's program ``k`` (>= 1), made once a run (:attr:`Unit.program_twins`) on
+    the model of its first program's ``twin``."""
+    if k not in unit.program_twins:
+        owner, stamp = unit.program_changes[k - 1].program
+        unit.program_twins[k] = Twin(twin.robot, source.get(log_of(context.units, owner, stamp)),
+                                     context.out / ".cache" / "cycles", root=context.out, stepper=twin.stepper)
+        source.keep(log_of(context.units, owner, stamp))
+    return unit.program_twins[k]
+
+
+def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source, reference: align.Reference) -> int:
+    """A program new to the unit from ``log`` on (its motion within the tolerance of none of its
+    programs): reported once (a program change, noted in its reason), its twin made on that log,
+    its own baseline learned on its own first logs while the other programs' logs are scored
+    (:class:`faultgen.monitor.programs.Baselines`). Returns its index.
 
     Raises
     ------
@@ -143,13 +192,17 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source)
     new = Twin(twin.robot, source.get(log), context.out / ".cache" / "cycles", root=context.out,
                stepper=twin.stepper)
     source.keep(log)
-    unit.monitor.restart(log.stamp, stored.PROGRAM_CHANGED)
-    unit.monitor.signatures = new.signatures
-    unit.program, unit.program_cycle = (unit.monitor.unit, log.stamp), program_of(source.get(log).checked())
-    unit.program_changes.append(stored.ProgramChange(log.stamp, unit.program, len(unit.entries), new.signatures))
-    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion left the twin's program): the twin "
-                      "replays that log, and the unit learns its normal operation again")
-    return new
+    k = len(unit.references)
+    unit.references.append(reference)
+    unit.program_twins[k] = new
+    unit.program_changes.append(stored.ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
+                                                     new.signatures))
+    unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
+    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
+                      f"none of the unit's {k} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
+                      "twin replays that log, and it learns its own normal operation on its own first logs while the "
+                      "other programs' logs are scored")
+    return k
 
 
 def score_log(unit: Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
@@ -170,18 +223,20 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     if isinstance(twin, str):
         unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
         return twin
+    program, data, program_twin = 0, parsed.checked() if parsed.error is None else None, twin
     try:
-        reading = fleet_logs.reading_of(nominal, parsed.checked())
         load = _load(parsed.checked())
         if twin is not None and context is not None and unit.program is not None:
-            if unit.program_cycle is None:
-                unit.program_cycle = program_of(source.get(log_of(context.units, *unit.program)).checked())
-            if program_changed(parsed.checked(), unit.program_cycle):
-                twin = new_program(unit, log, twin, context, source)
+            placed = place(unit, log, data, twin, context, source)
+            if isinstance(placed, str):
+                unit.skipped.append(stored.Skipped(log.stamp, sha256, placed))
+                return twin
+            program, data, program_twin = placed
+        reading = fleet_logs.reading_of(nominal, data)
         residual, expected = reading.vector, None
-        if twin is not None:
+        if program_twin is not None:
             at = reading.temperature if twin_temperature else REFERENCE_TEMPERATURE
-            expected = twin.expected(at, reading.payload)
+            expected = program_twin.expected(at, reading.payload)
             residual = residual - expected
     except stored.StateError:
         raise
@@ -192,12 +247,13 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         unit.notes.extend(n for n in reading.notes if isinstance(n, formats.TorqueNote))
         unit.torque_source = formats.torque_source(reading.notes)
     unit.notes.extend(fleet_logs.log_notes(log.stamp, reading.notes, unit.notes))  # each column's kind once
-    constant = constant_torque(unit, reading.vector, nominal.n_axes)
+    constant = constant_torque(unit, reading.vector, nominal.n_axes) if program == 0 else ""
     if constant:
         return not_monitored(unit, log.stamp, sha256, constant)
-    unit.monitor.add(log.stamp, residual, reading.temperature, reading.payload, expected)
+    unit_programs.baselines_of(unit.monitor).run(unit.monitor, program, lambda: unit.monitor.add(
+        log.stamp, residual, reading.temperature, reading.payload, expected))
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
-                                     *load))
+                                     *load, program))
     return twin
 
 

@@ -12,9 +12,9 @@ the measured format or an adapter's):
 (c)-(d) the unit's monitor (:class:`faultgen.monitor.scoring.UnitMonitor`): learned on the first
     logs, then every later log scored in stamp order; a log that cannot be read or replayed is
     skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
-    offset is learned again, and a log whose motion left the twin's program starts a new program
-    (:func:`faultgen.monitor.feed.new_program`; a log of several cycles of the program, at any rate,
-    is the same program: :mod:`faultgen.monitor.cycles`).
+    offset is learned again; each log is placed among the unit's programs by its motion and scored
+    on its whole cycles against its program's own baseline and twin, a program new to the unit
+    learning its own (:mod:`faultgen.monitor.programs`, :func:`faultgen.monitor.feed.place`).
 
 Units are scored one after another, in ``jobs`` local processes or on a Dask cluster
 (:func:`faultgen.monitor.parallel.map_groups`), with the same outputs.
@@ -48,9 +48,9 @@ from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.logs import columns, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, page, prognosis, report
+from faultgen.monitor import friction_tests, life, page, prognosis, programs, report
 from faultgen.monitor import state as stored
-from faultgen.monitor.feed import PROGRAM_CHANGE, PROGRAM_LENGTH, Context
+from faultgen.monitor.feed import PROGRAM_CHANGE, Context
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
@@ -59,8 +59,8 @@ from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
 
-__all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "PROGRAM_LENGTH",
-           "SAME_PROGRAM", "STATUSES", "Outcome", "UnitStatus", "monitor"]
+__all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", "PROGRAM_CHANGE", "SAME_PROGRAM",
+           "STATUSES", "Outcome", "UnitStatus", "monitor"]
 
 
 
@@ -94,6 +94,8 @@ class UnitStatus:
     torque_source: str = ""
     #: The fallbacks its twin took (:func:`faultgen.monitor.unit.twin_of`'s notes, also in ``reason``).
     fallback: str = ""
+    #: Its program mix where it ran several programs (:func:`faultgen.monitor.programs.mix`); "" otherwise.
+    programs: str = ""
 
     def basis(self) -> str:
         """What the unit's numbers rest on, for the console beside its status: the twin's fallback and
@@ -430,23 +432,26 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(skipped_note(unit.skipped))
     learning = unit.monitor.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
+    latest = unit.entries[-1].program if unit.entries else 0  # the program it runs now learning too: learning
+    still = learning or programs.learning(unit.monitor, latest)
     if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
-        again = (f" again after the program change of {unit.monitor.since[1]} (listed as relearning)"
-                 if unit.monitor.program_changed else "")
-        reasons.append(f"learning{again}: {len(unit.monitor.training)} of {settings.train} logs")
+        reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
     elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
+    count = 1 + len(unit.program_changes)
+    mix = programs.mix_note(unit.monitor, unit.entries, count)
+    reasons += [mix] if mix else []
     if not unit.entries or stopped:
         status = "not monitored"
     elif unit.skipped or stale or protocol != settings.protocol:  # another model (said in the reason) is not degraded
         status = "degraded"
     else:
-        status = "learning" if learning else "monitored"
+        status = "learning" if still else "monitored"
     reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, unit.torque_source,
-                      "; ".join(fallback_notes(unit)))
+                      "; ".join(fallback_notes(unit)), programs.mix(unit.entries, count) if count > 1 else "")
 
 
 #: Most distinct reasons a unit's reason names for its skipped logs (:func:`skipped_note`).

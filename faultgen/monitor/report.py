@@ -47,13 +47,17 @@ def units_table(statuses, scales: dict[str, str] | None = None) -> Table:
     logs scored and the last one; with ``scales`` (a fleet with friction tests, or a unit whose twin
     fell back to the nominal model) also the scale of its wear, ``wear_scale`` (a unit not in it:
     ``twin``; :mod:`faultgen.monitor.friction_tests`); where a log format says which torque it read
-    (``ur-rtde``), ``torque_source`` (:func:`faultgen.logs.formats.torque_source`)."""
+    (``ur-rtde``), ``torque_source`` (:func:`faultgen.logs.formats.torque_source`); where a unit
+    ran several programs, ``programs`` (its program mix: :func:`faultgen.monitor.programs.mix`)."""
     sources = any(getattr(s, "torque_source", "") for s in statuses)
-    columns = UNIT_COLUMNS + (("wear_scale",) if scales is not None else ()) + (("torque_source",) if sources else ())
+    mixes = any(getattr(s, "programs", "") for s in statuses)  # a unit of several programs: each one's logs
+    columns = (UNIT_COLUMNS + (("wear_scale",) if scales is not None else ()) + (("torque_source",) if sources else ())
+               + (("programs",) if mixes else ()))
     rows = []
     for s in statuses:
         extra = [scales.get(s.unit, "twin")] if scales is not None else []
         extra += [s.torque_source] if sources else []
+        extra += [s.programs] if mixes else []
         rows.append([_fmt(getattr(s, c)) for c in UNIT_COLUMNS] + extra)
     return Table("units.csv", columns, rows)
 

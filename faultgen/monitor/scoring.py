@@ -330,8 +330,9 @@ class UnitMonitor:
             # one log's 90 % interval of an unworn axis, from the noise: the rule of NOT_OBSERVABLE_LIMITS
             self.width_ = 2.0 * WEAR_INTERVAL_Z * error
             self.observable_ = self.width_ <= NOT_OBSERVABLE_LIMITS * self.settings.wear_limit
-        if self.placeholders:  # the rows standing for these logs since a program change
-            del self.rows[-self.placeholders:]
+        if self.placeholders:  # the rows standing for these logs since a program change (by stamp: another
+            learned = set(stamps)  # program's logs may lie between them, faultgen.monitor.programs)
+            self.rows[:] = [row for row in self.rows if row.stamp not in learned]
             self.placeholders = 0
         phase = "relearning" if self.program_changed else "training"
         self.program_changed = False

@@ -37,6 +37,7 @@ import numpy as np
 from faultgen import inputs
 from faultgen.data import atomic, logfolder
 from faultgen.data.confined import Confined
+from faultgen.monitor import programs
 from faultgen.monitor.scoring import Settings, UnitMonitor
 
 #: The state files' format: 2, three features per axis (with ``friction_torque``); a state of
@@ -44,8 +45,6 @@ from faultgen.monitor.scoring import Settings, UnitMonitor
 FORMAT = "faultgen-monitor-state/2"
 CYCLE_FORMAT = "faultgen-twin-cycle/1"
 CALIBRATION_FORMAT = "faultgen-monitor-calibration/1"
-#: How a program change that nobody logged closes an open alarm (alarms.csv ``closed_by``).
-PROGRAM_CHANGED = "program change (not logged: the motion left the twin's program)"
 #: Size bound of one unit's state file, written (:func:`write_unit` refuses a larger one) and read back
 #: (checked before it is parsed): about 0.85 kB per scored log with its load record, so some 20 000 logs (a log an hour for
 #: two years). ``json`` takes up to 27 times the file's size to parse (a file of empty lists): 0.44 GB.
@@ -122,6 +121,7 @@ class Entry:
     expected: np.ndarray | None
     load: np.ndarray | None = None
     duration: float = math.nan
+    program: int = 0  # the unit's program it ran: 0 its first, k the k-th of program_changes
 
 
 @dataclass(frozen=True)
@@ -192,9 +192,9 @@ class UnitState:
 
 
 def replay(state: UnitState, settings: Settings, n_axes: int, tests=None) -> UnitMonitor:
-    """A :class:`UnitMonitor` fed ``state``'s entries in order: the monitor the run that wrote
-    ``state`` ended with (``tests``: its friction tests' scale, :attr:`UnitMonitor.tests`, given
-    before the entries)."""
+    """A :class:`UnitMonitor` fed ``state``'s entries in order, each with its program's baseline
+    (:mod:`faultgen.monitor.programs`): the monitor the run that wrote ``state`` ended with
+    (``tests``: its friction tests' scale, :attr:`UnitMonitor.tests`, given before the entries)."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
     monitor.tests = tests
     maintenance: dict[int, list[Maintenance]] = {}
@@ -203,16 +203,27 @@ def replay(state: UnitState, settings: Settings, n_axes: int, tests=None) -> Uni
     changes: dict[int, list[ProgramChange]] = {}
     for c in state.program_changes:
         changes.setdefault(c.at, []).append(c)
+    baselines = programs.baselines_of(monitor)
     for i, e in enumerate(state.entries):
         for m in maintenance.get(i, ()):
-            monitor.maintenance(m.stamp, m.event, m.axis)
+            baselines.maintenance(monitor, m.stamp, m.event, m.axis)
         for c in changes.get(i, ()):
-            monitor.restart(c.stamp, PROGRAM_CHANGED)
-            monitor.signatures = c.signatures
-        monitor.add(e.stamp, e.residual, e.temperature, e.payload, e.expected)
+            baselines.new(monitor, c.signatures)
+        baselines.run(monitor, e.program, lambda e=e: monitor.add(e.stamp, e.residual, e.temperature, e.payload,
+                                                                  e.expected))
     for m in maintenance.get(len(state.entries), ()):
-        monitor.maintenance(m.stamp, m.event, m.axis)
+        baselines.maintenance(monitor, m.stamp, m.event, m.axis)
     return monitor
+
+
+def _program(log: dict, path: Path, where: str, known: int) -> int:
+    """A stored log's program index (0 when not written: the unit's first), checked against the
+    ``known`` programs after the first."""
+    program = log.get("program", 0)
+    if isinstance(program, bool) or not isinstance(program, int) or not 0 <= program <= known:
+        raise StateError(f"{path}: {where}.program = {str(program)[:40]!r}; expected a program index 0..{known} "
+                         "(0: the unit's first program, k: its k-th program change)")
+    return program
 
 
 def _floats(values) -> list[float]:
@@ -241,7 +252,8 @@ def write_unit(path: Path, state: UnitState) -> None:
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
                   "expected": None if e.expected is None else _floats(e.expected),
-                  **({} if e.load is None else {"load": _floats(e.load), "duration_s": float(e.duration)})}
+                  **({} if e.load is None else {"load": _floats(e.load), "duration_s": float(e.duration)}),
+                  **({"program": e.program} if e.program else {})}
                  for e in state.entries],
     }
     text = json.dumps(document, separators=(",", ":"))
@@ -474,7 +486,7 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
             _number(log.get("temperature_C"), path, f"{where}.temperature_C"),
             _number(log.get("payload_kg"), path, f"{where}.payload_kg"),
             None if expected is None else _vector(expected, path, f"{where}.expected", n_features),
-            *_load(log, path, where, n_axes)))
+            *_load(log, path, where, n_axes), _program(log, path, where, len(changes))))
         if not math.isfinite(entries[-1].payload):
             raise StateError(f"{path}: {where}.payload_kg is not a finite number{refuse}")
         if math.isinf(entries[-1].temperature):  # NaN: not logged

@@ -18,8 +18,9 @@ What the monitor asks of it (:class:`Twin`):
   of the friction) without a part.
 
 The replayed motion is one cycle of the program log (its first, or with a ``cycle`` column its first
-whole one, when the log holds several: :mod:`faultgen.monitor.cycles`; the cache key then says
-which), its angles through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
+whole one as the motion places it, when the log holds several or is cut anywhere:
+:func:`faultgen.monitor.programs.first_cycle`; the cache key then says which), its angles
+through a cubic Savitzky-Golay filter of :data:`REFERENCE_WINDOW`
 (:func:`faultgen.derivatives.smoothed`): a drive tracking an encoder's noise as its reference
 saturates where the real one did not. A replay of measured arm angles still asks more
 of the drives than the run that logged them (it tracks the elastic arm's own lag and ripple as its
@@ -50,7 +51,7 @@ from faultgen import derivatives
 from faultgen.logs import measured
 from faultgen.effects import temperature as temperature_law
 from faultgen.model import robots
-from faultgen.monitor import cycles as program_cycles
+from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.operation import conditions, faults, tasks, wear
@@ -152,12 +153,13 @@ class Twin:
                        "friction": FRICTION, "wear": WEAR, "features": list(fleet_logs.FEATURES),
                        "moving_speed": fleet_logs.MOVING_SPEED,  # friction_torque's standstill threshold
                        "reference": f"savgol {REFERENCE_WINDOW:g} s"}
-        one = program_cycles.Program.of(data.t, data.q, data.cycle)
-        if one.cycles == 1:
+        t, q, which = unit_programs.first_cycle(data.t, data.q, data.cycle)
+        if not which:
             self._reference = self._smoothed_program(program.sha256[:24], data.t, data.q)
-        else:  # a log of several cycles of its program: one replayed (the features are per sample)
-            self._files["cycle"] = f"1 of {one.cycles}"
-            self._reference = self._smoothed_program(f"{program.sha256[:24]}-1of{one.cycles}", one.t, one.q)
+        else:  # a log of several cycles, or cut anywhere: one cycle replayed (the features are per sample)
+            self._files["cycle"] = which
+            name = which.replace(" of ", "of").replace("samples ", "s").replace(":", "-")
+            self._reference = self._smoothed_program(f"{program.sha256[:24]}-{name}", t, q)
         self._healthy: dict[float, np.ndarray] = {}
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         if cycles:

@@ -18,15 +18,15 @@ import numpy as np
 from faultgen.calibrate import plausibility
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
-from faultgen.monitor import cycles
 from faultgen.monitor import logs as fleet_logs
+from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import Twin
 from faultgen.simulation import backends
 
 #: Two units run the same program when their first logs have the same samples and angles within this, rad.
-SAME_PROGRAM = 1e-3
+SAME_PROGRAM = unit_programs.SAME_PROGRAM
 #: Effects searched when a unit's model is calibrated on its first log (faultgen.calibrate).
 CALIBRATION_STEPS = 3
 #: Whether the unit's calibration fits the dry and viscous friction of every moving axis, always
@@ -81,7 +81,10 @@ class Unit:
     notes: list[str] = field(default_factory=list)
     maintenance: list[stored.Maintenance] = field(default_factory=list)
     program_changes: list[stored.ProgramChange] = field(default_factory=list)
-    program_cycle: cycles.Program | None = None  # the program's cycle (read when needed, not stored)
+    #: The references of its programs, in the order met (learned from their logs when needed, not
+    #: stored: :mod:`faultgen.monitor.programs`), and the twins of its programs after the first.
+    references: list | None = None
+    program_twins: dict = field(default_factory=dict)
     initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
     torque_source: str = ""  # its logs' torque source, as the reader chose it (formats.torque_source); "" unnamed
     off_monitor: str = ""  # why it was taken off the monitor (feed.constant_torque); "" while on it
@@ -372,7 +375,7 @@ def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_l
     """The log (unit, stamp) to replay for ``unit`` whose first log is ``first`` (parsed by
     ``source``, which keeps a program for the twins that replay it): an earlier unit's when the
     motion is the same (:data:`SAME_PROGRAM`: the same samples at the same times, :func:`same_times`, or a whole number of cycles of the
-    earlier one at another rate, :mod:`faultgen.monitor.cycles`), so their twins share simulated
+    earlier one at another rate, :func:`faultgen.monitor.programs.same_program`), so their twins share simulated
     cycles. ``programs``: the (checked log, program) of the earlier units' programs, appended to.
 
     Raises
@@ -386,8 +389,7 @@ def program_of(first: fleet_logs.Log, unit: str, programs: list, source: fleet_l
         other_q = np.asarray(other.q)
         if other_q.shape == q.shape and np.max(np.abs(other_q - q)) < SAME_PROGRAM and same_times(other.t, data.t):
             return other_program
-        if other_q.shape != q.shape and cycles.Program.of(other.t, other_q, other.cycle).log_cycles(
-                data.t, q, data.cycle, SAME_PROGRAM) is not None:
+        if other_q.shape != q.shape and unit_programs.same_program(other.t, other_q, other.cycle, data.t, q):
             return other_program
     source.keep(first)
     programs.append((data, (unit, first.stamp)))
