@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy  # noqa: F401  (load the BLAS library before limiting it)
 import pytest
+import typer.testing
 from filelock import FileLock
 from threadpoolctl import threadpool_limits
 
@@ -35,6 +36,38 @@ def pytest_collection_finish(session):
 
 if os.environ.get("PYTEST_XDIST_WORKER"):
     threadpool_limits(1)
+
+
+def _registered(app) -> list:
+    """What a typer app's click command is built from: the app, its callback, commands and groups
+    (and theirs), the objects themselves (a command a test registers, or a list it swaps in, is
+    another build)."""
+    parts = [app, app.registered_callback, *app.registered_commands]
+    for group in app.registered_groups:
+        parts += [group, *(_registered(group.typer_instance) if group.typer_instance else [])]
+    return parts
+
+
+def _built_once(build):
+    """typer's ``CliRunner.invoke`` builds the click command from the typer app at every call
+    (``typer.testing._get_command``: 0.09 s of CPU for faultgen's app, 2026-11-27, idle; the suite
+    invokes it several hundred times). The same app with the same registrations gives the same
+    command, and a click command keeps no state between its runs (each run has its own
+    ``click.Context``): built once, here, as tests/test_help_examples.py and tests/test_cli_fuzz.py
+    did for their own loops. ``typer.main.get_command`` itself still builds afresh."""
+    built = {}
+
+    def get(app):
+        parts = _registered(app)
+        key = tuple(map(id, parts))
+        if key not in built:
+            built[key] = (parts, build(app))  # the objects kept alive: no other takes their ids
+        return built[key][1]
+
+    return get
+
+
+typer.testing._get_command = _built_once(typer.testing._get_command)
 
 
 def shared_folder(tmp_path_factory, worker_id: str, name: str) -> Path:
