@@ -18,7 +18,7 @@ from filelock import FileLock
 from threadpoolctl import threadpool_limits
 
 # Compiled code is kept (``__pycache__``, ignored by git) even where the environment says not to
-# (``PYTHONDONTWRITEBYTECODE=1`` on the machine that runs CI): faultgen's modules are compiled here
+# (``PYTHONDONTWRITEBYTECODE=1`` on the machine that runs CI): the packages' modules are compiled here
 # once, and the test files' rewritten asserts kept while the tests are collected, so the other
 # pytest-xdist worker and every child Python the tests start (the command line, loky's and Dask's
 # workers), which read what is there, do not compile them again (2026-11-27: collecting the tests
@@ -27,7 +27,8 @@ from threadpoolctl import threadpool_limits
 # there; the children keep the environment: they read, they do not write.
 _DONT_WRITE_BYTECODE = sys.dont_write_bytecode
 sys.dont_write_bytecode = False
-compileall.compile_dir(Path(__file__).resolve().parents[1] / "faultgen", quiet=1)
+for _package in ("faultgen", "analysis"):
+    compileall.compile_dir(Path(__file__).resolve().parents[1] / _package, quiet=1)
 
 
 def pytest_collection_finish(session):
@@ -50,7 +51,7 @@ def _registered(app) -> list:
 
 def _built_once(build):
     """typer's ``CliRunner.invoke`` builds the click command from the typer app at every call
-    (``typer.testing._get_command``: 0.09 s of CPU for faultgen's app, 2026-11-27, idle; the suite
+    (``typer.testing._get_command``: 0.09 s of CPU for faultgen's app, 2026-11-27, load 10; the suite
     invokes it several hundred times). The same app with the same registrations gives the same
     command, and a click command keeps no state between its runs (each run has its own
     ``click.Context``): built once, here, as tests/test_help_examples.py and tests/test_cli_fuzz.py
