@@ -482,7 +482,7 @@ class UnitMonitor:
             # would otherwise take for wear (docs/analysis.md, "The log's own estimate without
             # the season")
             log_estimate = log_estimate - self.trend.condition_part(x)
-            bound = bounds.lower_bound(estimate, error, SCALE_UNCERTAINTY, self.alarm_quantile)  # the scale's doubt in
+            bound = bounds.lower_bound(estimate, error, SCALE_UNCERTAINTY, self.alarm_quantile)  # with the scale's doubt
             # the interval keeps the log's own error: the filter averages out the scatter from log
             # to log, not the errors that stay for weeks (the learned temperature slopes
             # extrapolated over a season, the calibration's friction), which the learning logs
