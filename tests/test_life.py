@@ -100,6 +100,11 @@ def test_service_by_is_the_earlier_of_the_load_and_the_condition_based_life():
     life_rows = [{"axis": "1", "days_left": "40"}, {"axis": "2", "days_left": ""}]
     rul_rows = [{"axis": "2", "rul": "12.4", "time_unit": "days"}]
     assert life.service_by("2026-03-01", life_rows, rul_rows) == ("2026-03-13", "condition: axis 2's wear")
+    # the condition-based life at its 5 % quantile, never the median (issue 90)
+    rul_rows = [{"axis": "2", "rul": "12.4", "rul_5": "6.6", "rul_95": "30", "time_unit": "days"}]
+    assert life.service_by("2026-03-01", life_rows, rul_rows) == ("2026-03-07", "condition: axis 2's wear, its 5 % quantile")
+    window = life.service_window(life_rows, rul_rows)
+    assert (window.days, window.low, window.high) == (6.6, 6.6, 30.0)
     assert life.service_by("2026-03-01", life_rows, []) == ("2026-04-10", "load: axis 1's rated life")
     assert life.service_by("17", life_rows, []) == ("in 40 days", "load: axis 1's rated life")
     assert life.service_by("2026-03-01", [], []) == ("", "")

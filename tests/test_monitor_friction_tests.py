@@ -196,7 +196,7 @@ def test_the_temperature_law_is_learned_past_a_worn_axis_and_corrects_each_test(
 
 def test_the_logs_are_put_on_the_tests_scale_by_the_factor_their_tests_give():
     """The twin's wear reads 1.25 times the tests' (a factor 0.8) with a test's offset of 3 points:
-    the fitted factor is 0.8 within its error, and the prior's 1 where the tests say nothing."""
+    the fitted factor is 0.8 within its error, and the prior's 1 -+ its doubt where the tests say nothing."""
     true = np.array([0.0, 0.0, 5.0, 12.0, 20.0, 28.0, 37.0, 45.0])
     rng = np.random.default_rng(1)
     stamps = [f"2026-01-{2 * j + 1:02d}" for j in range(len(true))]
@@ -209,7 +209,9 @@ def test_the_logs_are_put_on_the_tests_scale_by_the_factor_their_tests_give():
     for stamp, w in zip(stamps, true):
         f, error, names = scale.at(stamp, np.array([1.25 * w, 0.3]), np.array([0.5, 0.5]))
     assert abs(f[0] - 0.8) < 2 * error[0] and error[0] < 0.08, (f, error)
-    assert names == [friction_tests.TESTS_SCALE, friction_tests.TWIN_SCALE] and f[1] == 1.0 and error[1] == 0.0
+    # an axis no test told: the prior's factor with the prior's doubt (issue 90: the bound carries it)
+    assert names == [friction_tests.TESTS_SCALE, friction_tests.TWIN_SCALE] and f[1] == 1.0
+    assert error[1] == friction_tests.SCALE_PRIOR
 
 
 def test_the_rul_benchmark_replays_the_monitors_rows_with_their_factors(fleet, monitored):

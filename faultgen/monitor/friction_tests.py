@@ -61,7 +61,11 @@ read so far give it: a later test may move an earlier log's wear a little. The r
 the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
 in the twin's scale (``wear_scale`` ``twin``).
 
-``OUT/tests.csv`` (:func:`tests_table`, :data:`COLUMNS`): one row per unit, test and axis read.
+``OUT/tests.csv`` (:func:`tests_table`, :data:`COLUMNS`): one row per unit, test and axis read;
+``scatter_percent`` the axis's day-to-day scatter as the unit's tests show it (the standard deviation
+of ``ln c`` about the axis's own temperature law, %: :attr:`Law.scatter`; empty for an axis with fewer
+than :data:`LAW_TESTS` tests over :data:`LAW_SPAN_K`), the plant's scatter that every test's and
+log's read carries (issue 90; the logs' own on the learning days: the alarm's evidence).
 """
 
 from __future__ import annotations
@@ -91,7 +95,7 @@ NOMINAL_SCALE = "nominal model"
 #: The columns of ``OUT/tests.csv`` (the friction_fit.csv columns of ``faultgen friction-test``, arm side).
 FIT_COLUMNS = ("temperature_degC", "coulomb_Nm", "coulomb_Nm_low", "coulomb_Nm_high", "static_excess_Nm",
                "stribeck_velocity_rad_s", "viscous_Nms_rad", "viscous_Nms_rad_low", "viscous_Nms_rad_high")
-COLUMNS = ("unit", "stamp", "axis", *FIT_COLUMNS, "wear", "wear_lower", "wear_upper", "verdict")
+COLUMNS = ("unit", "stamp", "axis", *FIT_COLUMNS, "wear", "wear_lower", "wear_upper", "verdict", "scatter_percent")
 #: The two-sided interval of a test's wear and of the logs' wear on the tests' scale.
 INTERVAL = 0.90
 #: The temperature law: tests per axis (since its last repair) and their temperature span, K, an
@@ -265,13 +269,16 @@ def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
 @dataclass
 class Law:
     """A unit's temperature law (module docstring): ``beta`` 1/K, its standard error ``error`` 1/K,
-    the test-to-test ``repeatability`` (relative standard deviation; NaN when not known) and how it
-    was learned (``source``, in words)."""
+    the test-to-test ``repeatability`` (relative standard deviation; NaN when not known), how it
+    was learned (``source``, in words) and each axis's own scatter about its law (``scatter``: axis ->
+    relative standard deviation, the plant's day-to-day scatter as that axis's tests show it; the
+    axes with :data:`LAW_TESTS` tests over :data:`LAW_SPAN_K`)."""
 
     beta: float
     error: float
     repeatability: float
     source: str
+    scatter: dict = field(default_factory=dict)
 
 
 def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
@@ -279,8 +286,8 @@ def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
     last repair (module docstring)."""
     from scipy import stats
 
-    slopes, errors, scatter = [], [], []
-    for t, y in series.values():
+    slopes, errors, scatter, axes = [], [], [], {}
+    for axis, (t, y) in series.items():
         ok = np.isfinite(t) & np.isfinite(y)
         t, y = t[ok], y[ok]
         if len(t) < LAW_TESTS or np.ptp(t) < LAW_SPAN_K:
@@ -290,16 +297,18 @@ def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
         errors.append(fit.stderr)
         if len(t) > 2:
             scatter.append(float(np.sqrt(np.sum((y - fit.intercept - fit.slope * t) ** 2) / (len(t) - 2))))
+            axes[axis] = scatter[-1]
     repeatability = float(np.median(scatter)) if len(scatter) >= LAW_AXES else math.nan
     if not slopes:
         return Law(0.0, BETA_PRIOR, repeatability, f"no axis with {LAW_TESTS} tests over {LAW_SPAN_K:g} K: "
-                                                     f"not corrected (+-{100 * BETA_PRIOR:g} %/K)")
+                                                     f"not corrected (+-{100 * BETA_PRIOR:g} %/K)", axes)
     beta, noise = float(np.median(slopes)), float(np.median(errors))
     spread = 1.4826 * float(np.median(np.abs(np.array(slopes) - beta))) if len(slopes) > 2 else 0.0
     # the median's own error (1.2533 sigma / sqrt(n) for a normal sample) and the axes' own laws'
     # spread beyond what their noise explains
     error = float(np.sqrt((1.2533 * noise) ** 2 / len(slopes) + max(0.0, spread**2 - noise**2)))
-    return Law(beta, error, repeatability, f"{100 * beta:+.2f} +- {100 * error:.2f} %/K (median of {len(slopes)} axes)")
+    return Law(beta, error, repeatability, f"{100 * beta:+.2f} +- {100 * error:.2f} %/K (median of {len(slopes)} axes)",
+               axes)
 
 
 @dataclass
@@ -319,6 +328,7 @@ class AxisWear:
     verdict: str
     reference: bool = False
     own_error: float = math.nan  # its own error in ln, the reference's apart (what the scale's fit weighs it by)
+    scatter: float = math.nan  # the axis's tests' scatter about the unit's temperature law, relative (Law.scatter)
 
 
 def _relative_error(fit: dict) -> float:
@@ -386,6 +396,7 @@ def tests_wear(tests: list[FrictionTest], n_axes: int, maintenance=()) -> tuple[
             rows.append(AxisWear(test.stamp, test.key, k, fit, 100 * (math.exp(d) - 1),
                                  100 * (_exp(d - z * sd) - 1), 100 * (_exp(d + z * sd) - 1), sd, error0,
                                  verdict, test is t0, own))
+    rows = [dataclasses.replace(r, scatter=law.scatter.get(r.axis, math.nan)) for r in rows]
     rows.sort(key=lambda r: (r.key, r.axis))
     return rows, law
 
@@ -453,7 +464,8 @@ class Rescale:
             self.pairs.setdefault(w.axis, []).append((w.wear, sy, float(source[0][w.axis - 1]),
                                                       float(source[1][w.axis - 1])))
         self.last = (key, np.asarray(wear, dtype=float), np.asarray(error, dtype=float))
-        factor, factor_error = np.ones(self.n_axes), np.zeros(self.n_axes)
+        # an axis no test has paired yet: the twin's scale, known to the factor's prior (module bounds)
+        factor, factor_error = np.ones(self.n_axes), np.full(self.n_axes, SCALE_PRIOR)
         names = [TWIN_SCALE] * self.n_axes
         for k, pairs in self.pairs.items():
             if pairs:
@@ -491,7 +503,7 @@ def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
         return cells.figure(None if isinstance(value, float) and not math.isfinite(value) else value)
 
     return Table("tests.csv", COLUMNS, [[unit, r.stamp, r.axis, *(cell(r.fit[c]) for c in FIT_COLUMNS), cell(r.wear),
-                                         cell(r.lower), cell(r.upper), r.verdict]
+                                         cell(r.lower), cell(r.upper), r.verdict, cell(100 * r.scatter)]
                                         for unit, rows in wears.items() for r in rows])
 
 

@@ -304,7 +304,10 @@ class Service:
 
 def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | None:
     """The earlier of the load-based days left (rows of life.csv, as read: text cells) and the
-    condition-based remaining life (rows of rul.csv in days), with its interval: each end the
+    condition-based remaining life (rows of rul.csv in days) **at its 5 % quantile** (``rul_5``: the
+    day by which 5 % of the wear's paths have reached the failure wear, the wear's 95 % path: a
+    planner who services then is late on 1 unit in 20, where a median is late on every other; issue
+    90; the median where ``rul_5`` is empty), with its interval: each end the
     earliest of the sources' ends (the rated-life formula gives one number, so a load-based source
     is its own ends; a condition-based one its ``rul_5``, ``rul_95``, an empty ``rul_95`` beyond the
     horizon). The upper end so holds with at least the sources' 95 %: the minimum of the times is
@@ -319,9 +322,10 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
         days = number(r.get("rul"))
         if math.isfinite(days) and r.get("time_unit") == "days":
             low, high = number(r.get("rul_5")), number(r.get("rul_95"))
-            found.append((days, min(days, low) if math.isfinite(low) else days,
-                          max(days, high) if math.isfinite(high) else math.inf,
-                          f"condition: axis {r.get('axis')}'s wear", r.get("axis")))
+            early = min(days, low) if math.isfinite(low) else days
+            found.append((early, early, max(days, high) if math.isfinite(high) else math.inf,
+                          f"condition: axis {r.get('axis')}'s wear" + (", its 5 % quantile" if early < days else ""),
+                          r.get("axis")))
     if not found:
         return None
     days, _, _, why, axis = min(found, key=lambda f: f[0])

@@ -20,7 +20,8 @@ order (:data:`STATES`; every rule it meets is named on hover and in its panel):
 - **ok**: none of these.
 
 **"service by"** is the earlier of the load-based life (life.csv's days left) and the
-condition-based remaining life (rul.csv, in days), counted from the unit's last log
+condition-based remaining life at its 5 % quantile (rul.csv's ``rul_5``, in days: the day the wear's
+95 % path reaches the failure wear, never a median; issue 90), counted from the unit's last log
 (:func:`faultgen.monitor.life.service_window`), with its interval: each end the earliest of the
 sources' 5 % and 95 % ends (the rated-life formula gives one number: a load-based source is its own
 ends). A date for date stamps, "in N days" for sequence numbers.

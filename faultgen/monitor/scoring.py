@@ -74,7 +74,7 @@ import numpy as np
 from analysis import registry
 from analysis.isolation import signature_scores
 from analysis.monitoring import PCAMonitor
-from faultgen.monitor import record
+from faultgen.monitor import bounds, record
 from faultgen.monitor.wear_trend import WearTrend
 
 PROTOCOLS = ("twin", "own")
@@ -231,6 +231,7 @@ class UnitMonitor:
         #: (n_axes,) each axis's wear estimate's scatter on the learning logs over its stated
         #: standard error, at least 1 (:meth:`_fit`; 1 before it).
         self.dispersion_ = np.ones(n_axes)
+        self.day_scatter_ = np.full(n_axes, np.nan)  # each axis's reads' day-to-day scatter, points (bounds.day_scatter)
         #: Each axis's wear filtered over the logs (the wear reported and alarmed on).
         self.trend = WearTrend(n_axes)
         #: The unit's friction tests' scale (:class:`faultgen.monitor.friction_tests.Rescale`), or
@@ -321,6 +322,7 @@ class UnitMonitor:
             # moves an axis's features together, along its signature) widens every later error
             self.dispersion_ = np.ones(self.n_axes)
             z = np.stack([w / e for w, e in (self.wear_estimate(r, self.scale_**2) for r in R)])
+            self.day_scatter_ = bounds.day_scatter(z * self.wear_estimate(R[0], self.scale_**2)[1])  # points
             self.dispersion_ = np.maximum(1.0, np.sqrt((z**2).sum(axis=0) / (len(R) - 1 - X.shape[1])))
             # the learned slopes' error along each axis's wear signature (% of wear per unit of
             # condition): the estimate is linear in the residual, so its covariance is the wear
@@ -382,21 +384,20 @@ class UnitMonitor:
         ``error`` %, both (n_axes,): the estimate -+ the normal quantile times ``sqrt(error^2 +
         (SCALE_UNCERTAINTY estimate)^2)``, the twin's model uncertainty (:data:`SCALE_UNCERTAINTY`,
         a share of the estimate: a scale) beside the noise. Returns (lower, upper), %."""
-        half = WEAR_INTERVAL_Z * np.sqrt(np.asarray(error) ** 2
-                                         + (SCALE_UNCERTAINTY * np.asarray(estimate)) ** 2)
-        return estimate - half, estimate + half
+        return bounds.interval(estimate, bounds.standard_error(error, estimate, SCALE_UNCERTAINTY), WEAR_INTERVAL_Z)
 
     def _on_tests(self, stamp, estimate, error, log_estimate, log_error):
         """The filtered wear (with its error), its interval, alarm bound and the log's own estimate
         (with its error) on the unit's friction tests' scale (:mod:`faultgen.monitor.friction_tests`),
         and the row's twin-scale values, factors and scales."""
         factor, factor_error, names = self.tests.at(stamp, estimate, error)
-        half = WEAR_INTERVAL_Z * np.sqrt((factor * error) ** 2 + (factor_error * estimate) ** 2)
+        wear, doubt = factor * estimate, factor_error / factor  # the scale's doubt, relative (module bounds)
+        low, high = bounds.interval(wear, bounds.standard_error(factor * error, wear, doubt), WEAR_INTERVAL_Z)
         lower = log_estimate - self.bound_quantile * log_error
         row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
                                 tuple(names))
         rescaled = (factor * estimate, factor * error)
-        return (rescaled, rescaled[0] - half, rescaled[0] + half, rescaled[0] - self.alarm_quantile * rescaled[1],
+        return (rescaled, low, high, bounds.lower_bound(wear, factor * error, doubt, self.alarm_quantile),
                 factor * log_estimate, factor * log_error, row)
 
     # -- ranking --------------------------------------------------------------------------------
@@ -482,17 +483,18 @@ class UnitMonitor:
             # would otherwise take for wear (docs/analysis.md, "The log's own estimate without
             # the season")
             log_estimate = log_estimate - self.trend.condition_part(x)
-            bound = estimate - self.alarm_quantile * error
+            bound = bounds.lower_bound(estimate, error, SCALE_UNCERTAINTY, self.alarm_quantile)  # with the scale's doubt
             # the interval keeps the log's own error: the filter averages out the scatter from log
             # to log, not the errors that stay for weeks (the learned temperature slopes
             # extrapolated over a season, the calibration's friction), which the learning logs
             # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
-            low, high = self.wear_interval(estimate, log_error)
+            low, high = self.wear_interval(estimate, np.maximum(log_error, error))  # the filter's lag widens it
             tested = None
             if self.tests is not None:  # on the unit's friction tests' scale
                 wear, low, high, bound, log_estimate, log_error, tested = self._on_tests(
                     stamp, estimate, error, log_estimate, log_error)
                 estimate = wear[0]
+            wear = (estimate, (estimate - bound) / self.alarm_quantile)  # the bound's error, as _raise reads it
             seen = self.observable_
             alarm = bool(np.max(np.where(seen, bound, -np.inf)) >= self.settings.wear_limit)
             # the lower bound above the limit by its own width (the filtered wear less two of its
@@ -533,8 +535,9 @@ class UnitMonitor:
             self.evidence = (f"axis {self.source_axis} wear estimate {estimate[order[0]]:.3g} %, its lower "
                              f"{100 * WEAR_ALARM_CONFIDENCE:g} % bound {bound[order[0]]:.3g} % ({span}) >= limit "
                              f"{self.limit:g} % (% of the axis's own dry friction, weighted least squares of the friction "
-                             f"torques along each axis's wear signature, filtered over the logs); next axis {order[1] + 1}: "
-                             f"{estimate[order[1]]:.3g} %")
+                             f"torques along each axis's wear signature, filtered over the logs; the bound carries the scale's "
+                             f"doubt and its reads' day-to-day scatter, {self.day_scatter_[order[0]]:.2g} points on its "
+                             f"learning days); next axis {order[1] + 1}: {estimate[order[1]]:.3g} %")
             return
         mean = np.mean(Z, axis=0)
         scores = self.axis_scores(mean)

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from faultgen.monitor import bounds
+
 #: % of wear per log, per log: the standard deviation of the change of an axis's wear rate from one
 #: log to the next in the local linear trend through which each log's wear estimate is filtered
 #: (:class:`WearTrend`). The independent fleet's worn axes grow 0.5-1 % per log (60 % over 60-100
@@ -51,18 +53,34 @@ class WearTrend:
     trend for weeks, where a single log's alarm waits for ``persistence`` logs); :data:`OUTLIER_RUN`
     such logs in a row are a step, not outliers: the trend restarts at the last of them.
 
+    The rate's process noise is adapted to the evidence (:func:`faultgen.monitor.bounds.adapted_rate_variance`:
+    covariance matching over the last :data:`faultgen.monitor.bounds.ADAPT_WINDOW` innovations not gated
+    out, never below :data:`WEAR_RATE_CHANGE`), and the predicted covariance of the wear and its rate
+    faded where those innovations are larger than their stated spread (:func:`faultgen.monitor.bounds.fading_factor`): where the wear grows faster than the trend predicts (3
+    points a day against a filter tuned on 0.5-1), the innovations keep one sign, the rate's variance
+    grows with them, the trend follows the wear within a few logs and its error (the interval) widens
+    with the growth it did not foresee; with a fixed variance the estimate lagged the truth by 4-9 points
+    (issue 90).
+
     Parameters
     ----------
     n_axes : int
     n_regressors : int
         The conditions whose slopes' error is in the state (0: none).
+    adaptive : bool
+        Whether the rate's process noise and the fading are adapted (False: the fixed local linear
+        trend of :data:`WEAR_RATE_CHANGE`, the filter before issue 90).
     """
 
-    def __init__(self, n_axes: int, n_regressors: int = 0):
-        self.n_axes, self.n_regressors = n_axes, n_regressors
+    def __init__(self, n_axes: int, n_regressors: int = 0, adaptive: bool = True):
+        self.n_axes, self.n_regressors, self.adaptive = n_axes, n_regressors, adaptive
         self.state: np.ndarray | None = None  # (n_axes, 2 + k): wear %, rate % per log, slope errors
         self.covariance: np.ndarray | None = None  # (n_axes, 2 + k, 2 + k)
         self.gated = np.zeros(n_axes, dtype=int)  # consecutive logs gated out, per axis
+        # the last innovations and their normalised squares (n_axes, 2), NaN where gated out or restarted
+        self.recent: list[np.ndarray] = []
+        self.rate_variance = np.full(n_axes, WEAR_RATE_CHANGE**2)  # the rate's process variance, adapted
+        self.fading = np.ones(n_axes)  # the predicted covariance's fading factor, adapted
         # the slope errors' mean and covariance a new trend starts from
         self.slope_mean = np.zeros((n_axes, n_regressors))
         self.slope_covariance = np.zeros((n_axes, n_regressors, n_regressors))
@@ -83,6 +101,8 @@ class WearTrend:
             self.slope_covariance = self.covariance[:, 2:, 2:].copy()
         self.state = self.covariance = None
         self.gated = np.zeros(self.n_axes, dtype=int)
+        self.recent, self.rate_variance = [], np.full(self.n_axes, WEAR_RATE_CHANGE**2)
+        self.fading = np.ones(self.n_axes)
 
     def update(self, estimate: np.ndarray, error: np.ndarray,
                conditions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -101,7 +121,8 @@ class WearTrend:
         step[0, 1] = 1.0
         state = self.state @ step.T
         covariance = step @ self.covariance @ step.T
-        covariance[:, 1, 1] += WEAR_RATE_CHANGE**2
+        covariance[:, :2, :2] *= self.fading[:, None, None]
+        covariance[:, 1, 1] += self.rate_variance
         innovation = estimate - state @ design
         cross = covariance @ design  # (n_axes, 2 + k): P H'
         spread = cross @ design + variance
@@ -111,6 +132,16 @@ class WearTrend:
         covariance = covariance - gain[:, :, None] * cross[:, None, :]
         self.gated = np.where(gated, self.gated + 1, 0)
         restart = self.gated >= OUTLIER_RUN
+        seen = np.where(gated | restart, np.nan, innovation)  # what the adaptation sees
+        self.recent = [*self.recent, np.c_[seen, seen**2 / spread]][-bounds.ADAPT_WINDOW:]
+        for past in self.recent[:-1]:
+            past[restart] = np.nan
+        recent = np.array(self.recent)  # (w, n_axes, 2): innovations and their normalised squares
+        if not self.adaptive:
+            recent = np.full_like(recent, np.nan)
+        self.fading = bounds.fading_factor(recent[..., 1])
+        self.rate_variance = np.where(self.fading > 1.0, bounds.adapted_rate_variance(
+            WEAR_RATE_CHANGE**2, cross[:, 1] / spread, recent[..., 0]), WEAR_RATE_CHANGE**2)
         if restart.any():
             fresh_state, fresh_covariance = self._start(estimate, variance, x, state[:, 2:], covariance[:, 2:, 2:])
             state[restart], covariance[restart] = fresh_state[restart], fresh_covariance[restart]

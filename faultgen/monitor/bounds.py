@@ -1,0 +1,115 @@
+"""The doubts a log's wear carries, put together (issue 90, "Daily scatter, honest bounds"): the
+arithmetic of the wear's 90 % interval and of the lower bound an alarm is judged on
+(:class:`faultgen.monitor.scoring.UnitMonitor`), the plant's day-to-day scatter an axis shows, and
+the filter's adapted process noise (:class:`faultgen.monitor.wear_trend.WearTrend`).
+
+**The sources** (each a standard deviation in points of wear, % of the axis's own dry friction):
+
+- the **noise** of the wear read: the filtered wear's own error (the filter's: the logs' scatter
+  averaged over the logs, widened where the filter's process noise was adapted to a fast wear,
+  :func:`adapted_rate_variance`), or the log's own where the errors that stay for weeks count
+  (the twin's scale: a month's learned slopes extrapolated over a season, the calibration);
+- the **scale**: the wear read is the robot's wear times a factor the logs cannot tell, ``f``, known
+  to a relative standard error ``s``: before a friction test that tells it (an informative test,
+  one that sees the wear) the prior's (:data:`faultgen.monitor.friction_tests.SCALE_PRIOR` with
+  tests, :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY` without), after it the fitted factor's
+  (:class:`faultgen.monitor.friction_tests.Rescale`). It is a share of the wear: ``s x`` points at a
+  read of ``x`` (:func:`standard_error`);
+- the **plant's day-to-day scatter**: a day's friction scatters about its level (the lubricant film,
+  the warm-up), which moves a log's read and a test's alike; it is in the noise the unit learns on
+  its healthy learning days (each log's read scatters by it), stated per axis by
+  :func:`day_scatter` (logs) and by the tests' scatter about the unit's temperature law
+  (``scatter_percent`` in ``tests.csv``).
+
+**The interval** is the read -+ ``z`` times the root of the sum of their squares (independent
+sources; :func:`interval`), ``z`` the 90 % two-sided normal quantile; **the lower bound** an alarm is
+judged on is the read less the one-sided quantile times the same root with the filter's noise
+(:func:`lower_bound`): the scale's doubt included, so a read 1.5 times the truth before the first
+informative test does not give a bound above the truth (issue 90: "wear estimate 12.2 %, its lower 90 %
+bound 11.8 %" at 8.0 % true wear, the bound without the scale).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Logs over which the filter's innovations are averaged to adapt its rate's process noise
+#: (:func:`adapted_rate_variance`).
+ADAPT_WINDOW = 3
+#: The mean normalised squared innovation over :data:`ADAPT_WINDOW` logs past which the trend is
+#: adapted (:func:`fading_factor`, and the rate's process noise by :func:`adapted_rate_variance`):
+#: the chi-square's 99 % quantile with 3 degrees of freedom over 3 (11.345 / 3), so a trend that
+#: describes its logs is adapted on 1 log in 100. On synthetic ramps (/tmp script of 2026-11-27, in
+#: tests/test_monitor_bounds.py): a wear of 0.5-1 point a log read to 3-4 points, RMS error 1.50
+#: against the fixed trend's 1.47 (at the 95 % quantile 1.59); 3 points a log read to 1.5 points,
+#: the 90 % interval covering 88 % of the logs at 10-40 % (fixed: 19 %), the mean lag 0.2 point
+#: (fixed: 3.0); read to 3.5 points, 70 % and 2.1 (fixed: 1 % and 6.5).
+FADING_THRESHOLD = 11.345 / 3
+
+
+def standard_error(noise: np.ndarray, estimate: np.ndarray, scale: np.ndarray | float) -> np.ndarray:
+    """The wear read's standard error, points (n_axes,): ``sqrt(noise^2 + (scale estimate)^2)``,
+    ``noise`` points, ``estimate`` % and ``scale`` the scale's relative standard error (a number or
+    (n_axes,)). NaN where any input is."""
+    noise, estimate = np.asarray(noise, dtype=float), np.asarray(estimate, dtype=float)
+    return np.sqrt(noise**2 + (np.asarray(scale, dtype=float) * estimate) ** 2)
+
+
+def interval(estimate: np.ndarray, error: np.ndarray, z: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(estimate - z error, estimate + z error)``, % (module docstring)."""
+    estimate, error = np.asarray(estimate, dtype=float), np.asarray(error, dtype=float)
+    return estimate - z * error, estimate + z * error
+
+
+def lower_bound(estimate: np.ndarray, noise: np.ndarray, scale: np.ndarray | float, z: float) -> np.ndarray:
+    """The lower one-sided bound an alarm is judged on: ``estimate - z`` :func:`standard_error`
+    (``noise`` the filtered wear's own error, ``scale`` the scale's relative standard error), %."""
+    return np.asarray(estimate, dtype=float) - z * standard_error(noise, estimate, scale)
+
+
+def day_scatter(reads: np.ndarray) -> np.ndarray:
+    """Each axis's day-to-day scatter of its wear read on the unit's healthy learning days, points
+    (n_axes,): the sample standard deviation of ``reads`` (m logs, n_axes), the logs' wear reads
+    about the learned offset and slopes (their mean and conditions' part taken out: ddof 1). It is
+    the plant's scatter of dry friction from one day to the next (a 1.5 % scatter reads about 1.5
+    points at no wear) with the read's own noise in it (on a plant without scatter it is that noise
+    alone). NaN with fewer than 2 logs."""
+    reads = np.asarray(reads, dtype=float)
+    if reads.ndim != 2 or len(reads) < 2:
+        return np.full(reads.shape[-1] if reads.ndim == 2 else 0, np.nan)
+    return np.std(reads, axis=0, ddof=1)
+
+
+def adapted_rate_variance(floor: float, gains: np.ndarray, innovations: np.ndarray) -> np.ndarray:
+    """The rate's process variance for the next log, per axis (n_axes,), by covariance matching
+    (Mohamed & Schwarz 1999, "Adaptive Kalman filtering for INS/GPS", J. Geodesy 73, eq. 28:
+    ``Q = K C K'``, ``C`` the innovations' covariance over a window): the rate's gain squared times
+    the mean squared innovation of the last logs, at least ``floor`` (the filter's fixed variance,
+    :data:`faultgen.monitor.wear_trend.WEAR_RATE_CHANGE` squared). ``gains`` (n_axes,): the rate's
+    gain at the last log (whether or not it was gated out); ``innovations`` (w, n_axes): the last
+    ``w`` innovations, points (NaN: left out, as a log gated out). Where the wear grows faster than the trend predicts, the innovations
+    keep one sign and grow, the rate's process noise with them, and the trend follows the wear
+    within a few logs; where the trend describes the logs the variance stays at its floor."""
+    innovations = np.asarray(innovations, dtype=float).reshape(-1, np.size(gains))
+    seen = np.isfinite(innovations)
+    count = seen.sum(axis=0)
+    mean = np.where(seen, innovations, 0.0) ** 2
+    mean = mean.sum(axis=0) / np.maximum(count, 1)
+    matched = np.where(count > 0, np.asarray(gains, dtype=float) ** 2 * mean, floor)
+    return np.maximum(floor, np.nan_to_num(matched, nan=floor))
+
+
+def fading_factor(normalised: np.ndarray) -> np.ndarray:
+    """The factor (n_axes,) >= 1 by which the wear's and its rate's predicted covariance is
+    multiplied at the next log (a fading-memory filter, Sorenson & Sacks 1971; the factor from the
+    innovations, Xia et al. 1994, "Adaptive fading Kalman filter with an application", Automatica
+    30): the mean of the last logs' normalised squared innovations (``normalised`` (w, n_axes): each
+    innovation squared over its stated variance; NaN left out) where it passes
+    :data:`FADING_THRESHOLD`, else 1. A lagging trend's innovations are several of their stated
+    standard deviations; fading its covariance lets the next logs move it, and its stated error
+    carries the lag."""
+    normalised = np.asarray(normalised, dtype=float)
+    seen = np.isfinite(normalised)
+    count = seen.sum(axis=0)
+    mean = np.where(seen, normalised, 0.0).sum(axis=0) / np.maximum(count, 1)
+    return np.where((count > 0) & (mean > FADING_THRESHOLD), mean, 1.0)
