@@ -223,7 +223,6 @@ def detect_command(
       faultgen sweep --preset quick --seed 0 --seed 1 -o quick-seeds.h5
       faultgen detect quick-seeds.h5 --protocol other-seeds -o quick-seeds-detection
       faultgen detect quick.h5 --baseline pca -o quick-pca     # iforest, ecod: the bench extra (pyod)
-      faultgen detect first-look.h5 --locate contribution
     """
     from analysis import benchmark
     from analysis import plugins as plugins_
