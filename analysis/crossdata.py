@@ -221,8 +221,7 @@ class ReferencePCAContribution(isolation.PCAContributionIsolator):
         self.scale_ = np.where(std > 0, std, 1.0)
         reference = np.asarray(self.reference, dtype=float)
         _, sv, vt = np.linalg.svd(reference - reference.mean(axis=0), full_matrices=False)
-        explained = np.cumsum(sv**2) / max((sv**2).sum(), np.finfo(float).tiny)
-        self.n_components_ = min(int(np.searchsorted(explained, self.variance - 1e-12) + 1), X.shape[1] - 1)
+        self.n_components_ = isolation.kept_components(sv, self.variance, X.shape[1])
         self.components_ = vt[: self.n_components_]
         Z = (X[self.n_reference:] - self.mean_) / self.scale_
         residual_projector = np.eye(X.shape[1]) - self.components_.T @ self.components_

@@ -499,12 +499,15 @@ class PCAContributionIsolator(Isolator):
 
     The first ``n_reference`` cycles (normal operation) are standardised (their mean and
     standard deviation; a constant column is scaled by 1) and decomposed by SVD; the first m
-    components explaining >= ``variance`` of their variance are kept (m at most n_axes - 1, so
-    a residual remains). For the later cycles, E = Z (I - P_m P_m^T) and ``scores_[i] = mean over
+    components explaining >= ``variance`` of their variance are kept, m at most n_axes - 2
+    (:func:`kept_components`), so that a residual space of at least two directions remains. For
+    the later cycles, E = Z (I - P_m P_m^T) and ``scores_[i] = mean over
     cycles of E[:, i]**2 / (1 - sum_j P[j, i]**2)``: how much Q falls when axis i is
     reconstructed (:func:`analysis.monitoring.reconstruction_contributions`). Axis i's share of Q,
     ``E[:, i]**2`` alone, smears a fault over the axes correlated with it. With one residual
-    direction (m = n_axes - 1) every axis's score is the whole Q: a tie, source axis 0.
+    direction every axis's score would be the whole Q, a tie by construction: on six weakly
+    correlated per-cycle signals 90 % of the variance needs five components, and before the cap
+    (issue 88) the isolator named no axis on any run of the first-look preset.
 
     Parameters
     ----------
@@ -541,13 +544,21 @@ class PCAContributionIsolator(Isolator):
         std = reference.std(axis=0, ddof=1)
         self.scale_ = np.where(std > 0, std, 1.0)
         _, sv, vt = np.linalg.svd((reference - self.mean_) / self.scale_, full_matrices=False)
-        explained = np.cumsum(sv**2) / max((sv**2).sum(), np.finfo(float).tiny)
-        m = int(np.searchsorted(explained, self.variance - 1e-12) + 1)
-        self.n_components_ = min(m, X.shape[1] - 1)
+        self.n_components_ = kept_components(sv, self.variance, X.shape[1])
         self.components_ = vt[: self.n_components_]
         Z = (X[self.n_reference :] - self.mean_) / self.scale_
         residual_projector = np.eye(X.shape[1]) - self.components_.T @ self.components_
         return reconstruction_contributions(Z, residual_projector).mean(axis=0)
+
+
+def kept_components(singular_values, variance: float, n_axes: int) -> int:
+    """Principal components a PCA-contribution isolator keeps: the fewest whose share of the
+    variance (``singular_values`` squared) reaches ``variance``, at most ``n_axes - 2`` (none for
+    two axes). Reconstruction-based contributions to Q need a residual space of two directions or
+    more to rank axes: in one, every axis's contribution is the whole Q (a tie)."""
+    power = np.asarray(singular_values, dtype=float) ** 2
+    explained = np.cumsum(power) / max(power.sum(), np.finfo(float).tiny)
+    return min(int(np.searchsorted(explained, variance - 1e-12) + 1), max(n_axes - 2, 0))
 
 
 def signature_scores(residual, signatures) -> np.ndarray:

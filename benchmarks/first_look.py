@@ -11,8 +11,9 @@ that outlive their waits are not counted), and each analysis's result against it
 - bench-isolators: per isolator, the accuracy on the worn runs (every task and wear level the
   isolator ran on) against 1/N, N the robot's axes (naming an axis at random); the runs without
   wear are not part of this figure (the isolator's table gives them, "no fault").
-- detect: the share of worn runs detected against the held-out false-alarm rate (a monitor that
-  alarms at random detects at about its false-alarm rate), and the share located against 1/N.
+- detect (``--locate contribution``, as the README runs it): the share of worn runs detected against
+  the held-out false-alarm rate (a monitor that alarms at random detects at about its false-alarm
+  rate), and the share located against 1/N.
 - classify: the cells above their row's chance level (the command's own verdict, its
   ``above_chance`` column).
 
@@ -72,13 +73,14 @@ def isolation_verdict(path: Path) -> tuple[bool, str]:
 
 
 def detection_verdict(path: Path, n_axes: int) -> tuple[bool, str]:
-    """The 'all' row of the detection summary: detected against false alarms, located against 1/N."""
+    """The 'all' row of the detection summary: detected against false alarms, located against 1/N;
+    above chance when both are."""
     every = [r for r in rows(path) if r.get("group") == "all"][-1]
     detected, false_alarms = float(every["detected_pct"]), float(every["false_alarm_pct"])
     located = float(every["located_pct"])
     text = (f"  detected {detected:.1f} % of worn runs against {false_alarms:.2f} % false alarms on healthy runs; "
             f"located {located:.1f} % against {100 / n_axes:.1f} % by chance")
-    return detected > false_alarms, text
+    return detected > false_alarms and located > 100 / n_axes, text
 
 
 def classification_verdict(path: Path) -> tuple[bool, str]:
@@ -105,7 +107,7 @@ def main() -> None:
                                 "-o", str(data)], work / "sweep.log")
     stem = work / data.stem
     steps = {"bench-isolators": ["bench-isolators", str(data), "-o", f"{stem}-isolation"],
-             "detect": ["detect", str(data), "-o", f"{stem}-detection"],
+             "detect": ["detect", str(data), "--locate", "contribution", "-o", f"{stem}-detection"],
              "classify": ["classify", str(data), "-o", f"{stem}-classification"]}
     for name, command in steps.items():
         times[name] = timed([*faultgen, *command, "--no-progress", "--overwrite"], work / f"{name}.log")

@@ -39,6 +39,7 @@ def test_the_sweep_names_the_analyses_of_the_first_look_and_points_quick_to_it()
     out = Path("first-look.h5")
     text = cli_runs.next_steps("first-look", out)
     assert all(f"faultgen {c} first-look.h5" in text for c in ("bench-isolators", "detect", "classify")), text
+    assert "faultgen detect first-look.h5 --locate contribution" in text  # cross-correlation locates none there
     assert "faultgen sweep --preset first-look" in cli_runs.next_steps("quick", Path("quick.h5"))
     other = Path("j2.h5")
     assert "analyse" not in cli_runs.next_steps(None, other) and "first-look" not in cli_runs.next_steps("j2", other)

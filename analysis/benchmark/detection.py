@@ -21,7 +21,8 @@ from analysis.benchmark.detection_features import (
 )
 from analysis.benchmark.tables import TOO_FEW_CYCLES, UNDECIDED
 from analysis.benchmark.truth import fault_progress, opened
-from analysis.monitoring import fit_q_monitor, varying_columns
+from analysis.monitoring import fit_q_monitor, reconstruction_contributions, varying_columns
+from faultgen import axes
 from faultgen.checks import is_whole
 from faultgen.data import reader
 
@@ -33,6 +34,14 @@ from faultgen.data import reader
 #: on a sweep other-seeds where the dataset has them, else first-cycles where the run has more
 #: samples than it learns from, else same-run where the run without wear of the seed exists.
 PROTOCOLS = ("auto", "other-seeds", "first-cycles", "same-run")
+
+
+#: How a detected onset is located (``faultgen detect --locate``): cross-correlation: the axis whose
+#: KL features lead every other axis's up to the onset (thesis ch. 3.4.2, Table 3.5; it needs the
+#: fault to travel from the worn axis to the others, :func:`locate_onset`); contribution: the axis
+#: with the largest reconstruction-based contribution to the PCA monitor's combined index at the
+#: samples that raised the alarm (:func:`locate_by_contribution`).
+LOCATIONS = ("cross-correlation", "contribution")
 
 
 #: The samples first-cycles learns from when ``first`` is not given; a run with no more samples
@@ -54,7 +63,8 @@ def fitted_first(first: int | None, n_samples: int) -> int:
 
 def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persistence: int = 1,
                     period: int | None = None, progress: bool = True, detector=None, protocol: str = "auto",
-                    first: int | None = None, limit_folds: int | None = 20, return_charts: bool = False):
+                    first: int | None = None, limit_folds: int | None = 20, return_charts: bool = False,
+                    locate: str = "cross-correlation"):
     """Onset of wear by PCA monitoring and its location, per worn run (thesis ch. 3.4, Table 3.5),
     with the false-alarm rate on healthy data the monitor did not learn from.
 
@@ -85,8 +95,10 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
     one fold per training sample (:class:`~analysis.monitoring.PCAMonitor` ``cv``; None: in-sample,
     eq. 2.6 as in the thesis):
     j2, three seeds, other-seeds, alpha 5 %: 9.0 % false alarms in-sample, 6.2 % with 20 folds;
-    same-run always uses the in-sample limit; its location is the axis the
-    cross-correlation isolator names (ch. 3.4.2) on the KL features up to that sample.
+    same-run always uses the in-sample limit. The onset is located as ``locate`` says
+    (:data:`LOCATIONS`): by default the axis the cross-correlation isolator names (ch. 3.4.2) on the
+    KL features up to that sample; ``"contribution"`` (the PCA monitor only) the axis of the largest
+    contribution to its combined index at the onset's samples.
 
     The false-alarm rate is the mean of each one's share of alarm samples (``"per_run_mean"``) over
     the runs without wear that the monitor did not learn from (:func:`false_alarm_meaning`): under
@@ -118,17 +130,29 @@ def detection_table(path, variance: float = 0.75, alpha: float = 0.05, persisten
         If ``protocol`` is unknown, or the dataset lacks the healthy data it needs (the message
         says what is missing and which protocol or grid provides it).
     """
+    _check_settings(protocol, limit_folds, locate, detector)
+    with opened(path) as data:
+        table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
+                                   limit_folds, locate)
+        table.attrs.update(dataset_kind=data.kind, command=data.command, first=first, limit_folds=limit_folds,
+                           alpha=alpha, protocol_reasons=charts.pop("_reasons"), locate=locate,
+                           imported=bool(data.runs) and all(run.measured for run in data.runs),
+                           n_axes=max((c["n_axes"] for c in charts.values()), default=0))
+    return (table, charts) if return_charts else table
+
+
+def _check_settings(protocol: str, limit_folds, locate: str, detector) -> None:
+    """Refuse an unknown ``protocol`` or ``locate``, a ``limit_folds`` that is not None or >= 2, and
+    location by contribution with a ``detector`` (it has no Q and T2 to take contributions to)."""
     if protocol not in PROTOCOLS:
         raise ValueError(f"unknown protocol {protocol!r}; expected one of: {', '.join(PROTOCOLS)}")
     if limit_folds is not None and not is_whole(limit_folds, 2):
         raise ValueError(f"limit_folds = {limit_folds!r}; expected None (the in-sample Q limit) or a number of folds >= 2")
-    with opened(path) as data:
-        table, charts = _detection(data, variance, alpha, persistence, period, progress, detector, protocol, first,
-                                   limit_folds)
-        table.attrs.update(dataset_kind=data.kind, command=data.command, first=first, limit_folds=limit_folds,
-                           alpha=alpha, protocol_reasons=charts.pop("_reasons"),
-                           imported=bool(data.runs) and all(run.measured for run in data.runs))
-    return (table, charts) if return_charts else table
+    if locate not in LOCATIONS:
+        raise ValueError(f"unknown location method {locate!r}; expected one of: {', '.join(LOCATIONS)}")
+    if locate == "contribution" and detector is not None:
+        raise ValueError("--locate contribution takes contributions to the PCA monitor's Q and T2; another detector "
+                         "has none: use --locate cross-correlation")
 
 
 def _auto_protocol(kind: str, others: list, own, n_samples: int, first: int | None) -> tuple[str, str]:
@@ -157,13 +181,20 @@ class _Work:
     set (``monitors``) and that monitor's false-alarm rate on the healthy runs it did not learn from
     (``false_alarms``)."""
 
-    def __init__(self, data: reader.Dataset, variance, alpha, period, detector, limit_folds, rules):
-        self.path, self.healthy = data.path, data.healthy
+    def __init__(self, data: reader.Dataset, variance, alpha, period, detector, limit_folds, rules, locate):
+        self.path, self.healthy, self.locate = data.path, data.healthy, locate
         self.variance, self.alpha, self.period, self.rules = variance, alpha, period, rules
         self.detector, self.limit_folds = detector, limit_folds
         self.torque: dict[str, np.ndarray | StoredHistograms] = {}
         self.monitors: dict[tuple, tuple] = {}
         self.false_alarms: dict[tuple, tuple] = {}
+
+    def located(self, features: np.ndarray, used: np.ndarray, monitor, onset: int | None) -> int:
+        """The axis (1..N) an onset is located at, as ``locate`` says (:data:`LOCATIONS`), from a
+        run's KL ``features`` (n_samples, N), the monitor that judged it and the features it used."""
+        if self.locate == "contribution":
+            return locate_by_contribution(features, used, monitor, onset, self.rules.persistence)
+        return locate_onset(features, onset)
 
     def torque_of(self, run: reader.Run) -> np.ndarray | StoredHistograms:
         """A run's per-cycle |motor torque| counts (:func:`torque_record`), read once."""
@@ -265,9 +296,9 @@ class _Work:
 
 
 def _detection(data: reader.Dataset, variance, alpha, persistence, period, progress, detector, protocol, first,
-               limit_folds) -> tuple[pd.DataFrame, dict]:
+               limit_folds, locate) -> tuple[pd.DataFrame, dict]:
     rules = scoring.DETECT_RULES.with_persistence(persistence)  # the onset from the fault's first sample
-    work = _Work(data, variance, alpha, period, detector, limit_folds, rules)
+    work = _Work(data, variance, alpha, period, detector, limit_folds, rules, locate)
     healthy = work.healthy
     far: dict[str, tuple] = {}  # runs whose Q limit lies FAR_LIMIT times above every Q they were tested on
     rows, charts, reasons = [], {}, {}
@@ -308,7 +339,7 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
                                                       n_first)
         false_alarm, n_normal, (low, high) = work.false_alarms[key]
         wear = fault_progress(run, axis) * 100.0 - 100.0
-        located = locate_onset(worn, onset)
+        located = work.located(worn, used, monitor, onset)
         rows.append(dict(robot=run.robot, task=run.task, run=run.id, seed=run.seed,
                          worn_axis=axis, final_wear_pct=round(float(wear[-1]), 2), protocol=used_protocol,
                          trained_on=trained_on, false_alarm_pct=round(false_alarm, 2), false_alarm_runs=n_normal,
@@ -334,7 +365,8 @@ def _detection(data: reader.Dataset, variance, alpha, persistence, period, progr
             if tested.size and monitor.q_limit_ >= FAR_LIMIT * max(float(tested.max()), 1e-300):
                 far[run.id] = (float(monitor.q_limit_), float(tested.min()), float(tested.max()), trained_on)
         charts[run.id] = dict(chart, trained=skip, onset=onset, begins=None if begins is None else int(groups[begins]),
-                              protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis)
+                              protocol=used_protocol, robot=run.robot, task=run.task, worn_axis=axis,
+                              n_axes=worn.shape[1])
     table = pd.DataFrame(rows)
     # what detection_advice needs: the sample each fault begins at (what --first must stay below)
     table.attrs["fault_begins_sample"] = {r: c["begins"] for r, c in charts.items() if c["begins"] is not None}
@@ -354,6 +386,24 @@ def locate_onset(features: np.ndarray, onset: int | None) -> int:
         return int(isolation.make("cross_correlation").fit(features[: onset + 1]).source_axis_)
     except ValueError:
         return TOO_FEW_CYCLES
+
+
+def locate_by_contribution(features: np.ndarray, used: np.ndarray, monitor, onset: int | None,
+                           persistence: int = 1) -> int:
+    """The axis (1..N) whose KL feature has the largest reconstruction-based contribution (Alcala and
+    Qin, Automatica 45 (2009) 1593-1600) to the combined index ``Q / Q_limit + T2 / T2_limit`` (Yue
+    and Qin 2001) of the fitted :class:`~analysis.monitoring.PCAMonitor` ``monitor``, averaged over
+    the samples that raised the alarm (``onset`` .. ``onset + persistence - 1``); ``used``: the
+    columns of ``features`` (n_samples, N) the monitor learned. :data:`UNDECIDED` without an onset or
+    on a tie. Q alone cannot rank the axes when the monitor keeps all but one component (every
+    axis's contribution is then the whole Q), as on six weakly correlated KL features at 75 %."""
+    if onset is None:
+        return UNDECIDED
+    index = monitor.index_matrix("q") / monitor.q_limit_ + monitor.index_matrix("t2") / monitor.t2_limit_
+    alarm = (features[onset: onset + persistence][:, used] - monitor.mean_) / monitor.scale_
+    scores = reconstruction_contributions(alarm, index).mean(axis=0)
+    best = np.flatnonzero(np.isclose(scores, scores.max(), rtol=1e-9, atol=1e-12))
+    return axes.number(int(used[best[0]])) if best.size == 1 and np.isfinite(scores).all() else UNDECIDED
 
 
 #: A Q limit this many times the largest Q of the samples a run is tested on (two decades) is said

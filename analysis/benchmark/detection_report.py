@@ -146,7 +146,10 @@ def _location_notes(table: pd.DataFrame, imported: bool) -> list[str]:
     notes = []
     counted = table[~table["trained_on_fault"]] if "trained_on_fault" in table else table
     detected = counted[counted["detected"]]
-    if len(detected) and not detected["located"].astype(bool).any():  # located_pct 0: say why
+    if len(detected) and not detected["located"].astype(bool).any() and table.attrs.get("locate") == "contribution":
+        notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): the largest contribution to the "
+                     "monitor's Q and T2 at the alarm was another axis's, or tied")
+    elif len(detected) and not detected["located"].astype(bool).any():  # located_pct 0: say why
         need = isolation.min_rows(isolation.make("cross_correlation"))
         short = detected[detected["located_axis"] == TOO_FEW_CYCLES]
         undecided = detected[detected["located_axis"] == UNDECIDED]
@@ -167,6 +170,26 @@ def _location_notes(table: pd.DataFrame, imported: bool) -> list[str]:
         notes.append(f"note: located_pct is 0 (of {len(detected)} detected runs): {'; '.join(why)}. Location needs "
                      + more)
     return notes
+
+
+def location_verdict(table: pd.DataFrame) -> str:
+    """The share of detected runs (those the summary counts) located at their worn axis, against naming
+    one of the robot's N axes at random (1/N; N from the table's ``n_axes`` attribute, else the
+    largest worn axis): a one-sided binomial test at 5 %, and its verdict."""
+    from scipy.stats import binomtest
+
+    counted = table[~table["trained_on_fault"]] if "trained_on_fault" in table else table
+    detected = counted[counted["detected"].astype(bool)] if len(counted) else counted
+    method = table.attrs.get("locate", "cross-correlation")
+    if not len(detected):
+        return f"location ({method}): no detected run to locate"
+    n_axes = int(table.attrs.get("n_axes") or table["worn_axis"].max())
+    located = int(detected["located"].astype(bool).sum())
+    p = binomtest(located, len(detected), 1.0 / n_axes, alternative="greater").pvalue
+    verdict = "above chance" if p < 0.05 else "not above chance"
+    return (f"location ({method}): {located} of {len(detected)} detected runs located at the worn axis "
+            f"({100.0 * located / len(detected):.1f} %) against {100.0 / n_axes:.1f} % naming one of {n_axes} axes "
+            f"at random (binomial p = {p:.2g}): {verdict}")
 
 
 def _with_seeds(command: str) -> str:
@@ -223,6 +246,7 @@ def detection_text(table: pd.DataFrame, summary: pd.DataFrame, protocol: str = "
              if left_out else "")
     lines.append(f"\nsummary ({rests}false_alarm_pct, %: {false_alarm_meaning(table['protocol'])}):")
     lines.append(markdown(summary, digits=4))
+    lines.append(location_verdict(table))
     advice = detection_advice(table, protocol)
     if advice:
         lines.append(advice)

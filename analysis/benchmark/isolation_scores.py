@@ -186,6 +186,7 @@ def isolation_report(table: pd.DataFrame, path=None, window: tuple[float, float]
     lines.append("\ncases in which each isolator named an axis, right or wrong (%; the rest undecided or too few "
                  "cycles):")
     lines.append(markdown(isolation_levels(table, isolation_decided(table)), digits=4))
+    lines.append(isolation_verdicts(table))
     starved = starved_isolators(table)
     if starved and imported:
         lines.append(f"note: this dataset lacks logs: with at most {int(table['cycles'].max())} logs per unit up to "
@@ -197,4 +198,26 @@ def isolation_report(table: pd.DataFrame, path=None, window: tuple[float, float]
                      f"run, {', '.join(starved)} named no axis (undecided, or too few cycles to run) in most worn "
                      "cases. These isolators need tens of cycles (thesis Table 6.2: up to 86, every cycle recorded): "
                      "use `faultgen sweep --preset j2`, or --record with more cycles")
+    return "\n".join(lines)
+
+
+def isolation_verdicts(table: pd.DataFrame) -> str:
+    """Per isolator, its accuracy over every worn case it ran on (all tasks and levels; the runs
+    without wear are the table's "no fault" rows) against naming one of the robot's N axes at random
+    (1/N): a one-sided binomial test at 5 %, and its verdict."""
+    from scipy.stats import binomtest
+
+    n_axes = table_axes(table)
+    worn = table[(table["worn_axis"] != NO_FAULT) & (table["predicted"] != TOO_FEW_CYCLES)]
+    lines = [f"worn cases, every level, against {100.0 / n_axes:.1f} % (one of {n_axes} axes at random; "
+             "one-sided binomial test at 5 %):"]
+    for name in dict.fromkeys(table["isolator"]):
+        cases = worn[worn["isolator"] == name]
+        if not len(cases):
+            lines.append(f"  {name}: no worn case with enough cycles: not judged")
+            continue
+        right = int(cases["correct"].sum())
+        p = binomtest(right, len(cases), 1.0 / n_axes, alternative="greater").pvalue
+        lines.append(f"  {name}: {right} of {len(cases)} ({100.0 * right / len(cases):.1f} %), p = {p:.2g}: "
+                     + ("above chance" if p < 0.05 else "not above chance"))
     return "\n".join(lines)

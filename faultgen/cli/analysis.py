@@ -175,6 +175,11 @@ DetectorPlugin = Annotated[str | None, typer.Option(
          "samples and whose predict(X) gives one alarm per sample, e.g. mine:MyDetector (mine.py in the "
          "current folder). The module is imported and so runs as code: name only modules you trust "
          "(docs/reliability.md, \"Threat model\"); one that fails or breaks the contract is refused, named.")]
+DetectLocate = Annotated[str, typer.Option(
+    help="How a detected onset is located: cross-correlation (the axis whose features lead all others', thesis "
+         "ch. 3.4.2; it needs the fault to travel from the worn axis to the others) or contribution (the axis with "
+         "the largest reconstruction-based contribution to the PCA monitor's Q and T2 at the alarm; the PCA monitor "
+         "only). The share located is printed against chance.")]
 DetectorBaseline = Annotated[str | None, typer.Option(
     help=f"A named detector instead of the PCA monitor: {', '.join(baselines.healthy_detectors())} (`faultgen "
          "bench baselines`; the classifiers learn labels, so only `bench score` takes them). --variance and "
@@ -191,6 +196,7 @@ def detect_command(
     limit_folds: DetectLimitFolds = 20,
     persistence: Persistence = 3,
     period: Period = None,
+    locate: DetectLocate = "cross-correlation",
     plugin: DetectorPlugin = None,
     baseline: DetectorBaseline = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="Output stem (default: FILE without .h5 + '-detection').")] = None,
@@ -232,9 +238,9 @@ def detect_command(
     if train is not None:  # another dataset learns normal operation (analysis.crossdata)
         from analysis import crossdata
 
-        if protocol != "auto" or period is not None:
+        if protocol != "auto" or period is not None or locate != "cross-correlation":
             raise ValueError("--train sets the protocol (another dataset, each unit referred to its own first --first "
-                             "records); drop --protocol and --period")
+                             "records) and locates by cross-correlation; drop --protocol, --period and --locate")
         training_input(train)
         table, charts = crossdata.detection_across(
             file, train, first=first, variance=variance, alpha=alpha, persistence=persistence,
@@ -242,7 +248,8 @@ def detect_command(
     else:
         table, charts = benchmark.detection_table(
             file, variance=variance, alpha=alpha, persistence=persistence, period=period, progress=progress,
-            detector=detector, protocol=protocol, first=first, limit_folds=limit_folds or None, return_charts=True)
+            detector=detector, protocol=protocol, first=first, limit_folds=limit_folds or None, return_charts=True,
+            locate=locate)
     for used, reason in table.attrs.get("protocol_reasons", {}).items():
         typer.echo(f"protocol auto -> {used}: {reason}")
     summary = benchmark.detection_summary(table)

@@ -265,7 +265,7 @@ def next_steps(preset: str | None, out: Path) -> str:
             f"  faultgen plot {out} -o {out.with_suffix('.png')}")
     if preset == "first-look":
         text += (f"\nanalyse it with (each result beside its chance level):\n  faultgen bench-isolators {out}\n"
-                 f"  faultgen detect {out}\n  faultgen classify {out}")
+                 f"  faultgen detect {out} --locate contribution\n  faultgen classify {out}")
     elif preset == "quick":
         text += ("\nits 10 cycles per run are too few for the analyses; for those: faultgen sweep --preset first-look "
                  "-o first-look.h5")
