@@ -225,7 +225,7 @@ def _checked(t, q) -> tuple[np.ndarray, np.ndarray]:
     return t, q
 
 
-def _grid(t: np.ndarray, q: np.ndarray, step: float) -> np.ndarray:
+def resampled(t: np.ndarray, q: np.ndarray, step: float) -> np.ndarray:
     """The log resampled linearly every ``step`` s from its first sample: (k, N) rad."""
     times = t[0] + step * np.arange(int(np.floor((t[-1] - t[0]) / step + 1e-9)) + 1)
     return np.column_stack([np.interp(times, t, q[:, a]) for a in range(q.shape[1])])
@@ -277,7 +277,7 @@ def fit(t, q, program: Reference) -> Fit:
     if q.shape[1] != program.q.shape[1]:
         raise ValueError(f"a log of {q.shape[1]} axes against program {program.name!r} of "
                          f"{program.q.shape[1]}: expected the same axes")
-    x = _grid(t, q, program.step)
+    x = resampled(t, q, program.step)
     d = _shift_distances(x, program.q)
     m, best = len(d), int(np.argmin(d))
     shift = (best + _vertex(d[best - 1], d[best], d[(best + 1) % m])) % m
@@ -319,7 +319,7 @@ def _index(t: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.round(where).astype(int)
 
 
-def _log_span(t: np.ndarray) -> float:
+def log_span(t: np.ndarray) -> float:
     """The time a log covers, s: its last sample's time minus its first, plus one median step."""
     return float(t[-1] - t[0] + np.median(np.diff(t)))
 
@@ -381,12 +381,12 @@ def whole_cycles(t, q, program: Reference, cycle=None, tolerance: float = TOLERA
     if f.window > tolerance:
         return NoWholeCycle(Why.OFF_PROGRAM, f"{f.window:.3f} rad RMS off program {program.name!r} at its best "
                             f"shift (tolerance {tolerance:g} rad)", program.name, hint)
-    count = int(np.ceil(_log_span(t) / program.period)) + 2
+    count = int(np.ceil(log_span(t) / program.period)) + 2
     edges = _index(t, t[0] + (np.arange(count) * m - f.shift) * step)
     resid = np.mean((q - _at(program.q, positions)) ** 2, axis=1)
     inside = [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if a >= 0 and b <= len(t)]
     if not inside:
-        span = _log_span(t)
+        span = log_span(t)
         why = Why.SHORTER_THAN_A_CYCLE if span < program.period else Why.CUT_INSIDE
         return NoWholeCycle(why, f"the log spans {span:.3f} s from phase {f.shift / m:.3f} of program "
                             f"{program.name!r}'s {program.period:.3f} s cycle: no whole cycle inside", program.name, hint)
@@ -422,7 +422,7 @@ def period(t, q, tolerance: float = TOLERANCE) -> float | NoWholeCycle:
         return NoWholeCycle(Why.STILL, f"the path spreads {_spread(q):.4f} rad RMS: too little motion "
                             f"(at least {MIN_MOTION:g} rad) to find a period")
     step = float(np.median(np.diff(t)))
-    x = _grid(t, q, step)
+    x = resampled(t, q, step)
     d = _lag_distances(x)
     n, limit = len(x), int(len(x) / (1.0 + MIN_OVERLAP))
     away = np.flatnonzero(d > (2.0 * tolerance) ** 2)
@@ -478,7 +478,7 @@ def learn(name: str, t, q, cycle=None, tolerance: float = TOLERANCE) -> Referenc
         return found
     m = int(round(found / float(np.median(np.diff(t)))))
     step = found / m
-    x = _grid(t, q, step)
+    x = resampled(t, q, step)
     bins = np.arange(len(x)) % m
     count = np.bincount(bins, minlength=m)
     sums = np.column_stack([np.bincount(bins, x[:, a], minlength=m) for a in range(x.shape[1])])

@@ -55,18 +55,11 @@ BASELINE = ("signatures", "training", "learned_expectations", "pca", "far_", "me
             "relearning", "program_changed", "placeholders")
 
 
-def _resampled(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, float]:
-    """The log's angles at its median step from its first sample: (n, N) rad and the step, s."""
-    step = float(np.median(np.diff(t)))
-    times = t[0] + step * np.arange(int(np.floor((t[-1] - t[0]) / step + 1e-9)) + 1)
-    return np.column_stack([np.interp(times, t, q[:, a]) for a in range(q.shape[1])]), step
-
-
 def _starts_a_cycle(t: np.ndarray, q: np.ndarray, period: float) -> bool:
     """Whether a log seems to start where its program's cycle starts: it spans a whole number of
     periods (within :data:`EDGE`) and its mean joint speed over its first
     :data:`faultgen.logs.align.REST_WINDOW` s is under :data:`START_REST` of its top (at rest)."""
-    k = (t[-1] - t[0] + np.median(np.diff(t))) / period
+    k = align.log_span(t) / period
     if round(k) < 1 or abs(k - round(k)) > EDGE:
         return False
     w = max(1, int(np.searchsorted(t - t[0], align.REST_WINDOW)))
@@ -90,7 +83,8 @@ def reference_of(t, q, cycle=None, name: str = "program 1") -> align.Reference:
     if isinstance(found, align.NoWholeCycle):
         if found.why is not align.Why.NO_PERIOD:
             raise ValueError(f"no program can be learned from the log: {found.why.value} ({found.detail})")
-        grid, step = _resampled(t, q)
+        step = float(np.median(np.diff(t)))
+        grid = align.resampled(t, q, step)
         return align.Reference(name, grid, step * len(grid))
     if (align.check_hint(t, cycle, np.zeros(len(t)), len(found.q), found.period).verdict is not align.HintVerdict.AGREES
             and _starts_a_cycle(t, q, found.period)):
@@ -120,7 +114,7 @@ def periods(t, period: float) -> int:
     """How many whole periods of ``period`` s a log of samples ``t`` (n,) s spans (a span short of a
     whole number by under :data:`EDGE` of a period counts it)."""
     t = np.asarray(t, dtype=float)
-    return int(np.floor((t[-1] - t[0] + np.median(np.diff(t))) / period + EDGE))
+    return int(np.floor(align.log_span(t) / period + EDGE))
 
 
 def window(t, period: float, count: int) -> tuple[int, int]:
@@ -196,7 +190,7 @@ def same_program(earlier_t, earlier_q, earlier_cycle, t, q) -> bool:
     except ValueError:  # a log that barely moves: no program to share
         return False
     t = np.asarray(t, dtype=float)
-    k = (t[-1] - t[0] + np.median(np.diff(t))) / reference.period
+    k = align.log_span(t) / reference.period
     return round(k) >= 1 and abs(k - round(k)) <= EDGE and align.fit(t, q, reference).rms <= SAME_PROGRAM
 
 
