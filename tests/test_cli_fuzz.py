@@ -13,8 +13,6 @@ import typing
 
 import pytest
 import typer
-import typer.main
-import typer.testing
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
@@ -77,15 +75,6 @@ def numeric_options() -> list[tuple[str, str]]:
 
 OPTIONS = numeric_options()
 
-
-@pytest.fixture(scope="module", autouse=True)
-def _command_built_once():
-    """typer's runner builds the click command from the app at every call (70 ms, most of a case's
-    time); the fuzz builds it once."""
-    built = typer.main.get_command(app)
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(typer.testing, "_get_command", lambda _: built, raising=False)
-        yield
 
 VALUES = st.one_of(
     st.integers(min_value=-(10**40), max_value=10**40).map(str),

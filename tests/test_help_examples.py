@@ -28,7 +28,6 @@ from pathlib import Path
 
 import pytest
 import rtbdata
-import typer.testing
 from conftest import shared_folder
 from filelock import FileLock
 from typer.main import get_command
@@ -73,9 +72,7 @@ def pages() -> dict[str, list[str]]:
             if lines:
                 out[" ".join(path)] = lines
 
-    with pytest.MonkeyPatch.context() as patch:  # the click command built once, not once a page (2 s)
-        patch.setattr(typer.testing, "_get_command", lambda _: built)
-        walk(built, [])
+    walk(built, [])  # the runner's command is built once per session (tests/conftest.py, _built_once)
     return out
 
 
