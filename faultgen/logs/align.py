@@ -521,11 +521,17 @@ def place(t, q, programs, cycle=None, name: str | None = None, tolerance: float 
         if isinstance(reference, NoWholeCycle):
             return Placement(found, None, reference, None)
         return _placed(found, whole_cycles(t, q, reference, cycle, tolerance), reference)
+    return Placement(found, None, untold(found, tolerance), None)
+
+
+def untold(found: Recognition, tolerance: float = TOLERANCE) -> NoWholeCycle:
+    """Why a log whose recognition ``found`` is neither a known nor a new program (still, or within
+    ``tolerance`` of several) is not scored."""
     why = Why.STILL if found.status is Status.STILL else Why.AMBIGUOUS
     detail = (f"the path spreads {found.spread:.4f} rad RMS: too little motion to tell its program"
               if why is Why.STILL else "within the tolerance of " + ", ".join(
                   f"{f.program!r} ({f.window:.3f} rad)" for f in found.fits if f.window <= tolerance))
-    return Placement(found, None, NoWholeCycle(why, detail), None)
+    return NoWholeCycle(why, detail)
 
 
 def _placed(found: Recognition, cut: Cycles | NoWholeCycle, learned: Reference | None) -> Placement:

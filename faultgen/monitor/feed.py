@@ -157,7 +157,7 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source)
         except ValueError as err:
             return f"no whole cycle: a new program that cannot be learned ({short(err)})"
     else:
-        return unit_programs.refusal_text(align.place(data.t, data.q, known, data.cycle).refusal)
+        return unit_programs.refusal_text(align.untold(found))
     cut = align.whole_cycles(data.t, data.q, reference, data.cycle)
     span = unit_programs.span_of(data.t, cut, reference.period)
     if span is None:
