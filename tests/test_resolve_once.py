@@ -93,17 +93,26 @@ def test_below_the_boundary_a_name_is_a_type_error(loads, call):
     assert loads == []  # refused, not resolved
 
 
-def test_the_monitor_resolves_its_robot_once(tmp_path, loads):
+@pytest.fixture(scope="module")
+def kr210_fleet(tmp_path_factory):
+    """``(spec, robot folder, logs)``: the independent KR 210 fleet both monitor tests below run on
+    (two units: a second unit's twin and its cycles would each have resolved the robot again),
+    written once for the module (each test wrote the same one before; the monitor reads the robot
+    folder and the logs and writes only into its OUT)."""
+    import independent_fleet
+
+    spec = independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13))
+    robot, logs, _ = independent_fleet.write_fleet(tmp_path_factory.mktemp("kr210") / "fleet", spec)
+    return spec, robot, logs
+
+
+def test_the_monitor_resolves_its_robot_once(tmp_path, loads, kr210_fleet):
     """``faultgen monitor`` on the nominal model: the robot folder is resolved once, by the command
     (`monitor.loop`), and the twins and their cycles take that Robot. Before: once by the command,
     once per unit's twin and once per simulated cycle's ``RunConfig`` (24 in all on the IRB 6700
     fleet of tests/test_monitor_shipped.py, 3 units, --no-calibrate; measured 2026-11-25)."""
-    import independent_fleet
-
-    # two units: a second unit's twin and its cycles would each have resolved the robot again
-    robot, logs, _ = independent_fleet.write_fleet(
-        tmp_path / "fleet", independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13)))
-    loads.clear()  # what building the fleet loaded (robots add checks the folder it writes)
+    _, robot, logs = kr210_fleet
+    loads.clear()  # nothing is loaded before the command (the fleet was built outside ``loads``)
     result = runner.invoke(app, ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"),
                                  "--no-calibrate", "--train", "10", "--persistence", "3", "--no-progress"])
     assert result.exit_code == 0, result.output
@@ -252,7 +261,7 @@ def test_robots_add_loads_nothing_by_name(tmp_path, loads):
     assert (added.robot.path, added.robot.digest, added.robot.name) == (again.path, again.digest, again.name)
 
 
-def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
+def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads, kr210_fleet):
     """``faultgen monitor`` calibrating each unit's model on its first log: the robot is resolved once
     (the command), each unit's calibrated and twin models come from their writers; the second run
     on the same OUT reads what the first cached (``monitor.unit.cached_model``), each file once.
@@ -260,11 +269,9 @@ def test_a_calibrating_monitor_resolves_its_robot_once(tmp_path, loads):
     (issue 57 item 2; tests/test_read_once.py's calibrated run, merged here: one calibrating run)."""
     import shutil
 
-    import independent_fleet
     import open_counter
 
-    spec = independent_fleet.FleetSpec(units=2, worn=1, days=14, seed=5, onset=(12, 13))
-    robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", spec)
+    spec, robot, logs = kr210_fleet
     loads.clear()
     args = ["monitor", str(logs), "--robot", str(robot), "-o", str(tmp_path / "out"), "--train", "10",
             "--persistence", "3", "--no-progress"]
