@@ -309,11 +309,12 @@ def select_columns(path: Path, names: list[str], n_axes: int, motion_only: bool 
     return wanted, extra
 
 
-def hdf5_rows(fh: h5py.File, path: Path, wanted: list[str]) -> int:
+def hdf5_rows(fh, path: Path, wanted: list[str]) -> int:
     """The rows of the HDF5 log's columns ``wanted``, from their declared metadata only, after checking
     each: a 1-D dataset of numbers (text or a compound refused, never converted), of its column's
     unit when it names one, of at most :data:`MAX_ROWS` rows, all of one length. What the whole read
-    (:func:`read_hdf5`) and the block reader (:class:`faultgen.logs.blocks`) both check.
+    (:func:`read_hdf5`) and the block reader (:class:`faultgen.logs.blocks`) both check. ``fh``: the
+    open ``h5py.File``, or a mapping of (at least) the names ``wanted`` to its datasets.
 
     Raises
     ------
@@ -327,7 +328,8 @@ def hdf5_rows(fh: h5py.File, path: Path, wanted: list[str]) -> int:
             raise LogError(f"{path}: dataset {name} has shape {ds.shape}; expected a 1-D dataset (n,)")
         if ds.dtype.kind not in "fiu":
             raise LogError(f"{path}: dataset {name} has dtype {ds.dtype}; expected numbers")
-        unit = ds.attrs.get("unit", ds.attrs.get("units"))
+        attrs = ds.attrs  # a membership test, not a failed look-up (h5py's error path) per column
+        unit = attrs["unit"] if "unit" in attrs else attrs["units"] if "units" in attrs else None
         if unit is not None:
             unit = unit.decode() if isinstance(unit, bytes) else str(unit)
             if _unit_key(unit) != _unit_key(UNITS[name]):
@@ -346,13 +348,14 @@ def hdf5_rows(fh: h5py.File, path: Path, wanted: list[str]) -> int:
 def read_hdf5(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[str, np.ndarray], list[str], object]:
     with open_hdf5(path) as fh:
         wanted, extra = hdf5_columns(fh, path, n_axes, motion_only)
+        datasets = {name: fh[name] for name in wanted}  # each looked up once
         columns = {}
-        length = hdf5_rows(fh, path, wanted)
+        length = hdf5_rows(datasets, path, wanted)
         # from the declared shapes and element sizes, before any row is read
-        cell = max(fh[name].dtype.itemsize for name in wanted) if wanted else 8
+        cell = max(ds.dtype.itemsize for ds in datasets.values()) if wanted else 8
         check_whole_rows(path, length, len(wanted), cell)
         for name in wanted:
-            columns[name] = np.asarray(fh[name][()], dtype=float)
+            columns[name] = np.asarray(datasets[name][()], dtype=float)
     refuse_non_finite(path, columns, wanted, index_label)
     return columns, extra, index_label
 
@@ -360,9 +363,9 @@ def read_hdf5(path: Path, n_axes: int, motion_only: bool = False) -> tuple[dict[
 def hdf5_columns(fh: h5py.File, path: Path, n_axes: int, motion_only: bool = False) -> tuple[list[str], list[str]]:
     """The root datasets to read (required, plus all qd when present) and the extra ones (groups
     among them, marked); refuse missing columns, naming the groups at the root that hold none."""
-    names = list(fh.keys())
-    datasets = [n for n in names if isinstance(fh[n], h5py.Dataset)]
-    groups = [n for n in names if isinstance(fh[n], h5py.Group)]
+    objects = {n: fh[n] for n in fh.keys()}  # each looked up once
+    datasets = [n for n, obj in objects.items() if isinstance(obj, h5py.Dataset)]
+    groups = [n for n, obj in objects.items() if isinstance(obj, h5py.Group)]
     try:
         wanted, extra = select_columns(path, datasets, n_axes, motion_only)
     except LogError as err:
