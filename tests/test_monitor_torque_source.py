@@ -13,9 +13,10 @@ were scored against the first source's baseline and units.csv named only the fir
   are never scored against the first source's; the worn unit still alarms on axis 2, within
   8-15 % true wear; units.csv's ``torque_source`` names both sources and the day of the switch.
 - The same unit's logs switched to the commanded moment only (``target_moment_i``, the controller's
-  command of its fixed program, the same every day): the switch reported, the commanded logs not
-  scored against the measured baseline, and, as their own baseline can show no wear, skipped with
-  why; the unit stays on its measured baseline; units.csv names both sources.
+  command of its fixed program, the same every day), scored in two runs: the switch reported, the
+  commanded logs not scored against the measured baseline, and, as their own baseline can show no
+  wear, skipped with why (the unit degraded, exit status 3; before issue 90: monitored, no alarm,
+  exit 0); units.csv names both sources.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from __future__ import annotations
 import csv
 import datetime
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -158,11 +160,20 @@ def test_a_switch_to_the_controllers_current_as_torque_learns_its_own_baseline_a
 
 
 def test_a_switch_to_the_commanded_moment_is_never_scored_against_the_measured_baseline(fleet, tmp_path):
+    """Scored in two runs (the second continuing from the first's state, the switch in the first): the
+    source of each baseline is kept in the unit's state."""
     robot_dir, days, _ = fleet
-    out = tmp_path / "out"
-    result = _monitor(robot_dir, _logs(days, tmp_path / "logs", "commanded"), out)
+    out, every, logs = tmp_path / "out", _logs(days, tmp_path / "all", "commanded") / "ur-01", tmp_path / "logs" / "ur-01"
+    logs.mkdir(parents=True)
+    for k, (stamp, *_) in enumerate(days):
+        if k == SWITCH + 3:
+            first = _monitor(robot_dir, logs.parent, out)
+            assert first.exit_code == 0, first.output  # learning its new baseline
+        os.link(every / f"{stamp}.csv", logs / f"{stamp}.csv")
+    result = _monitor(robot_dir, logs.parent, out)
     switch = days[SWITCH][0]
     (row,) = _rows(out / "units.csv")
+    assert row["reason"].count("torque source changed") == 1
     assert f"torque source changed at {switch}: {formats.COMMANDED_MOMENT} (before: {formats.MEASURED_CURRENT})" \
         in row["reason"]
     assert row["torque_source"] == f"{formats.MEASURED_CURRENT}, {formats.COMMANDED_MOMENT} from {switch}"

@@ -242,7 +242,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     try:
         load = _load(parsed.checked())
         torque = formats.torque_source(data.notes)  # this log's (the reader chooses it per file)
-        if not unit.entries:  # the unit's first source: its first baseline's
+        if not unit.entries or not unit.torque_source:  # its first baseline's (unnamed in a state from before)
             unit.torque_source = torque
         if twin is not None and context is not None and unit.program is not None:
             placed = place(unit, log, data, twin, context, source, torque)
