@@ -19,7 +19,7 @@ from analysis.monitoring import varying_columns
 from faultgen.logs import align, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, report
+from faultgen.monitor import friction_tests, life, report, sources
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
@@ -123,22 +123,29 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
 
 
 def references(unit: Unit, units: dict, source: fleet_logs.Source) -> list[align.Reference]:
-    """The references of the unit's programs in the order met (:attr:`Unit.references`), learned
-    from their logs (:func:`faultgen.monitor.programs.reference_of`) when first needed in a run."""
+    """The references of the unit's baselines in the order met (:attr:`Unit.references`), learned
+    from their logs (:func:`faultgen.monitor.programs.reference_of`) when first needed in a run; a
+    baseline of a program's other torque source has its program's (:mod:`faultgen.monitor.sources`)."""
     if unit.references is None:
         logs = [unit.program] + [c.program for c in unit.program_changes]
-        unit.references = []
-        for k, (owner, stamp) in enumerate(logs):
-            data = source.get(log_of(units, owner, stamp)).checked()
-            unit.references.append(unit_programs.reference_of(data.t, data.q, data.cycle, f"program {k + 1}"))
+        unit.references, learned = [], {}
+        for owner, stamp in logs:
+            if (owner, stamp) not in learned:
+                data = source.get(log_of(units, owner, stamp)).checked()
+                learned[owner, stamp] = unit_programs.reference_of(data.t, data.q, data.cycle,
+                                                                   f"program {len(learned) + 1}")
+            unit.references.append(learned[owner, stamp])
     return unit.references
 
 
-def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source):
+def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source, torque: str = ""):
     """The program of a checked log ``data`` of ``unit`` (:func:`faultgen.logs.align.place` among
     its programs), the part of it scored (its whole cycles: :func:`faultgen.monitor.programs.scored`)
-    and that program's twin: ``(program index, data scored, twin)``; a program new to the unit is
-    added (:func:`new_program`). A log of no whole cycle of a program gives why (a str: it is skipped).
+    and that program's twin: ``(baseline index, data scored, twin)``, the baseline that of the
+    program and the log's torque source ``torque`` (:mod:`faultgen.monitor.sources`); a program new
+    to the unit is added (:func:`new_program`), a known program's new source starts its baseline
+    (:func:`faultgen.monitor.sources.change`). A log of no whole cycle of a program gives why (a
+    str: it is skipped).
 
     Raises
     ------
@@ -146,14 +153,15 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source)
         A new program's twin cannot be built (the log is then skipped, named).
     """
     known = references(unit, context.units, source)
-    found = align.recognise(data.t, data.q, known)
+    found = align.recognise(data.t, data.q, sources.distinct(known))
     if found.status is align.Status.KNOWN:
         k = next(i for i, r in enumerate(known) if r.name == found.program)
         reference = known[k]
     elif found.status is align.Status.NEW:
         k = len(known)
         try:
-            reference = unit_programs.reference_of(data.t, data.q, data.cycle, f"program {k + 1}")
+            reference = unit_programs.reference_of(data.t, data.q, data.cycle,
+                                                   f"program {len(sources.distinct(known)) + 1}")
         except ValueError as err:
             return f"no whole cycle: a new program that cannot be learned ({short(err)})"
     else:
@@ -163,8 +171,13 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source)
     if span is None:
         return unit_programs.refusal_text(cut)
     if k == len(known):
-        new_program(unit, log, twin, context, source, reference)
-    return k, unit_programs.scored(data, span), twin if k == 0 else program_twin(unit, k, twin, context, source)
+        new_program(unit, log, twin, context, source, reference, torque)
+    k_twin = twin if k == 0 else program_twin(unit, k, twin, context, source)
+    baseline = sources.baseline_of(unit, k, torque)
+    if baseline is None:
+        baseline = sources.change(unit, log, k, torque, k_twin.signatures,
+                                  lambda s: unit_programs.baselines_of(unit.monitor).new(unit.monitor, s))
+    return baseline, unit_programs.scored(data, span), k_twin
 
 
 def program_twin(unit: Unit, k: int, twin: Twin, context, source: fleet_logs.Source) -> Twin:
@@ -178,11 +191,12 @@ def program_twin(unit: Unit, k: int, twin: Twin, context, source: fleet_logs.Sou
     return unit.program_twins[k]
 
 
-def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source, reference: align.Reference) -> int:
+def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source, reference: align.Reference,
+                torque: str = "") -> int:
     """A program new to the unit from ``log`` on (its motion within the tolerance of none of its
     programs): reported once (a program change, noted in its reason), its twin made on that log,
     its own baseline learned on its own first logs while the other programs' logs are scored
-    (:class:`faultgen.monitor.programs.Baselines`). Returns its index.
+    (:class:`faultgen.monitor.programs.Baselines`), for the log's torque source ``torque``. Returns its index.
 
     Raises
     ------
@@ -193,13 +207,14 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source,
                stepper=twin.stepper)
     source.keep(log)
     k = len(unit.references)
+    count = len(sources.distinct(unit.references))
     unit.references.append(reference)
     unit.program_twins[k] = new
     unit.program_changes.append(stored.ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
-                                                     new.signatures))
+                                                     new.signatures, torque))
     unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
-                      f"none of the unit's {k} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
+                      f"none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
                       "twin replays that log, and it learns its own normal operation on its own first logs while the "
                       "other programs' logs are scored")
     return k
@@ -226,8 +241,11 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     program, data, program_twin = 0, parsed.checked() if parsed.error is None else None, twin
     try:
         load = _load(parsed.checked())
+        torque = formats.torque_source(data.notes)  # this log's (the reader chooses it per file)
+        if not unit.entries or not unit.torque_source:  # its first baseline's (unnamed in a state from before)
+            unit.torque_source = torque
         if twin is not None and context is not None and unit.program is not None:
-            placed = place(unit, log, data, twin, context, source)
+            placed = place(unit, log, data, twin, context, source, torque)
             if isinstance(placed, str):
                 unit.skipped.append(stored.Skipped(log.stamp, sha256, placed))
                 return twin
@@ -245,11 +263,14 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if isinstance(n, formats.TorqueNote))
-        unit.torque_source = formats.torque_source(reading.notes)
     unit.notes.extend(fleet_logs.log_notes(log.stamp, reading.notes, unit.notes))  # each column's kind once
     constant = constant_torque(unit, reading.vector, nominal.n_axes) if program == 0 else ""
     if constant:
         return not_monitored(unit, log.stamp, sha256, constant)
+    constant = later_constant(unit, program, reading.vector, nominal.n_axes)
+    if constant:  # a later baseline (a program's, a torque source's) that can show no wear: its logs skipped
+        unit.skipped.append(stored.Skipped(log.stamp, sha256, constant))
+        return twin
     unit_programs.baselines_of(unit.monitor).run(unit.monitor, program, lambda: unit.monitor.add(
         log.stamp, residual, reading.temperature, reading.payload, expected))
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
@@ -277,6 +298,18 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
     more = f" and {len(named) - 3} more" if len(named) > 3 else ""
     return (f"{CONSTANT_TORQUE}: {', '.join(named[:3])}{more} the same in all {len(features)} learning logs, "
             "which can show no wear")
+
+
+def later_constant(unit: Unit, program: int, vector: np.ndarray, n_axes: int) -> str:
+    """:func:`constant_torque` for the unit's baseline ``program`` after the first (a new program's,
+    a torque source's: the commanded moment of a fixed program the same every day): its logs are
+    then skipped with the reason, the unit's other baselines go on; "" otherwise (and for ``program`` 0)."""
+    if program == 0:
+        return ""
+    found = []
+    unit_programs.baselines_of(unit.monitor).run(unit.monitor, program,
+                                                 lambda: found.append(constant_torque(unit, vector, n_axes)))
+    return found[0] and f"the baseline begun at {unit.program_changes[program - 1].stamp} cannot be learned: {found[0].removeprefix('not monitored: ')}"
 
 
 def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:

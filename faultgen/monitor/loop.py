@@ -48,7 +48,7 @@ from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.logs import columns, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, page, prognosis, programs, report
+from faultgen.monitor import friction_tests, life, page, prognosis, programs, report, sources
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, Context
 from faultgen.monitor.parallel import groups_of, map_groups
@@ -439,7 +439,7 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
     count = 1 + len(unit.program_changes)
-    mix = programs.mix_note(unit.monitor, unit.entries, count)
+    mix = sources.relabel(unit, programs.mix_note(unit.monitor, unit.entries, count))
     reasons += [mix] if mix else []
     if not unit.entries or stopped:
         status = "not monitored"
@@ -450,8 +450,8 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
     reasons += [passed] if passed else []  # last: its status is as without them
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
-                      "; ".join(reasons), len(unit.entries), last, unit.torque_source,
-                      "; ".join(fallback_notes(unit)), programs.mix(unit.entries, count) if count > 1 else "")
+                      "; ".join(reasons), len(unit.entries), last, sources.seen(unit),
+                      "; ".join(fallback_notes(unit)), sources.relabel(unit, programs.mix(unit.entries, count)) if count > 1 else "")
 
 
 #: Most distinct reasons a unit's reason names for its skipped logs (:func:`skipped_note`).

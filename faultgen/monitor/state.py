@@ -154,12 +154,15 @@ class Maintenance:
 class ProgramChange:
     """The unit ran another program from log ``stamp`` on (not logged: its motion left the twin's
     program); its monitor restarted before its entry number ``at`` with the twin of ``program``
-    (unit, stamp) and that twin's ``signatures`` (n_axes, n_features)."""
+    (unit, stamp) and that twin's ``signatures`` (n_axes, n_features); ``source`` the torque source
+    of its logs (:mod:`faultgen.monitor.sources`: a change of source alone is a program change on
+    the program's own log), "" when unnamed (written only when named)."""
 
     stamp: str
     program: tuple[str, str]
     at: int
     signatures: np.ndarray
+    source: str = ""
 
 
 #: A unit's model kinds: a given calibrated model, its own calibration, its own friction on the
@@ -247,7 +250,8 @@ def write_unit(path: Path, state: UnitState) -> None:
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
         "program_changes": [{"stamp": c.stamp, "program": list(c.program), "at": c.at,
-                             "signatures": [_floats(row) for row in c.signatures]} for c in state.program_changes],
+                             "signatures": [_floats(row) for row in c.signatures],
+                             **({"source": c.source} if c.source else {})} for c in state.program_changes],
         "signatures": None if state.signatures is None else [_floats(row) for row in state.signatures],
         "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
@@ -455,13 +459,14 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         if not (isinstance(c, dict) and isinstance(c.get("stamp"), str) and isinstance(c.get("at"), int)
                 and not isinstance(c.get("at"), bool) and c["at"] >= 0 and isinstance(c.get("program"), list)
                 and len(c["program"]) == 2 and all(isinstance(p, str) for p in c["program"])
-                and isinstance(c.get("signatures"), list) and len(c["signatures"]) == n_axes):
+                and isinstance(c.get("signatures"), list) and len(c["signatures"]) == n_axes
+                and isinstance(c.get("source", ""), str)):
             raise StateError(f"{path}: program_changes[{i}] is not {{stamp, program, at, signatures}}{refuse}")
         rows = np.stack([_vector(r, path, f"program_changes[{i}].signatures row {k + 1}", n_features)
                          for k, r in enumerate(c["signatures"])])
         _stamp(c["stamp"], path, f"program_changes[{i}].stamp", refuse)
         _stamp(c["program"][1], path, f"program_changes[{i}].program[1]", refuse)
-        program_changes.append(ProgramChange(c["stamp"], tuple(c["program"]), c["at"], rows))
+        program_changes.append(ProgramChange(c["stamp"], tuple(c["program"]), c["at"], rows, c.get("source", "")))
     if (model == "none") != (program is None):
         raise StateError(f"{path}: model {model!r} with program {program!r}{refuse}")
     logs = d.get("logs")
