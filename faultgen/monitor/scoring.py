@@ -391,13 +391,12 @@ class UnitMonitor:
         (with its error) on the unit's friction tests' scale (:mod:`faultgen.monitor.friction_tests`),
         and the row's twin-scale values, factors and scales."""
         factor, factor_error, names = self.tests.at(stamp, estimate, error)
-        wear, doubt = factor * estimate, factor_error / factor  # the scale's doubt, relative (module bounds)
-        low, high = bounds.interval(wear, bounds.standard_error(factor * error, wear, doubt), WEAR_INTERVAL_Z)
+        wear, sd = self.tests.wear(estimate, error, factor, factor_error)  # the scale's doubt in it (module bounds)
+        low, high = bounds.interval(wear, sd, WEAR_INTERVAL_Z)
         lower = log_estimate - self.bound_quantile * log_error
         row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
                                 tuple(names))
-        rescaled = (factor * estimate, factor * error)
-        return (rescaled, low, high, bounds.lower_bound(wear, factor * error, doubt, self.alarm_quantile),
+        return ((wear, factor * error), low, high, wear - self.alarm_quantile * sd,
                 factor * log_estimate, factor * log_error, row)
 
     # -- ranking --------------------------------------------------------------------------------
