@@ -67,9 +67,9 @@ class Context:
                    maintenance, run.failure_wear, run.stepper)
 
     def new_source(self, nominal: robots.Robot | None = None) -> fleet_logs.Source:
-        """A log source of this run holding its robots: ``nominal`` (the robot the run's command or
-        library call resolved), else :attr:`robot` resolved here, for a worker that did not inherit
-        the run's source (loky, Dask); and the model given for every unit (:attr:`calibrated`),
+        """A log source of this run in a worker that did not inherit the run's own
+        (:meth:`faultgen.monitor.run.MonitorRun.new_source`; loky, Dask), holding its robots:
+        ``nominal`` (the robot the worker resolved), else :attr:`robot` resolved here; and the model given for every unit (:attr:`calibrated`),
         resolved here once, or the ValueError its loading raised, which each unit's twin falls back
         from (:func:`faultgen.monitor.unit.twin_of`)."""
         nominal = robots.load(self.robot) if nominal is None else nominal

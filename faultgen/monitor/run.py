@@ -18,7 +18,6 @@ from faultgen.monitor import life, prognosis
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings
-from faultgen.monitor.unit import given_model
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.simulation import backends
 
@@ -138,3 +137,15 @@ def _check_context(context: ExecutionContext) -> None:
         from faultgen.runs import cluster
 
         cluster.probe(context.scheduler)
+
+
+def given_model(calibrated: str | Path) -> Path:
+    """The model file of a ``faultgen calibrate`` output folder (or the file itself)."""
+    path = Path(calibrated)
+    if path.is_dir():
+        found = sorted((path / "model").glob("*_calibrated.xml")) or sorted(path.glob("*_calibrated.xml"))
+        if not found:
+            raise ValueError(f"{path}: no model/<robot>_calibrated.xml; give a `faultgen calibrate` output "
+                             "folder or its model file")
+        path = found[0]
+    return path

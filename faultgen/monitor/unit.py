@@ -266,18 +266,6 @@ def log_of(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fle
 
 
 
-def given_model(calibrated: str | Path) -> Path:
-    """The model file of a ``faultgen calibrate`` output folder (or the file itself)."""
-    path = Path(calibrated)
-    if path.is_dir():
-        found = sorted((path / "model").glob("*_calibrated.xml")) or sorted(path.glob("*_calibrated.xml"))
-        if not found:
-            raise ValueError(f"{path}: no model/<robot>_calibrated.xml; give a `faultgen calibrate` output "
-                             "folder or its model file")
-        path = found[0]
-    return path
-
-
 def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first_log: fleet_logs.Log | None,
              out: Path, progress: bool) -> robots.Robot:
     """The robot a unit's twin simulates, of ``kind``: "nominal" and "given" (``--calibrated``) are
