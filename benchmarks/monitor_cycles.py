@@ -24,6 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet  # noqa: E402
 
 from faultgen.monitor import loop  # noqa: E402
+from faultgen.monitor.run import resolve_run  # noqa: E402
 from faultgen.monitor.scoring import Settings  # noqa: E402
 
 
@@ -50,7 +51,8 @@ def main() -> None:
                                                                        kind == "mixed"), robot)
         out = root / f"out-{time.strftime('%Y%m%dT%H%M%S')}"
         wall, cpu = time.perf_counter(), time.process_time()
-        loop.monitor(robot, logs, out, calibrate=False, settings=Settings(train=10, persistence=3), progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=Settings(train=10, persistence=3),
+                                 progress=False))
         wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
         n = args.units * args.days
         with open(out / "units.csv", newline="") as f:

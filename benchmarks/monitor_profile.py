@@ -28,6 +28,7 @@ import independent_fleet  # noqa: E402
 from monitor_cycles import spec  # noqa: E402  (sibling module)
 
 from faultgen.monitor import loop  # noqa: E402
+from faultgen.monitor.run import resolve_run  # noqa: E402
 from faultgen.monitor.scoring import Settings  # noqa: E402
 
 
@@ -47,8 +48,8 @@ def main() -> None:
     n = args.units * args.days
 
     def run(tag: str) -> None:
-        loop.monitor(robot, logs, root / f"out-{tag}-{time.strftime('%Y%m%dT%H%M%S')}", calibrate=False,
-                     settings=Settings(train=10, persistence=3), progress=False)
+        loop.monitor(resolve_run(robot, logs, root / f"out-{tag}-{time.strftime('%Y%m%dT%H%M%S')}", calibrate=False,
+                                 settings=Settings(train=10, persistence=3), progress=False))
 
     wall, cpu = time.perf_counter(), time.process_time()
     run("plain")

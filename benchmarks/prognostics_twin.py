@@ -47,6 +47,7 @@ from faultgen import children
 from faultgen.bench import files, independent, make, prognosers, prognostics, tracks
 from faultgen.model import robots
 from faultgen.monitor import friction_tests, loop, prognosis, tables
+from faultgen.monitor.run import resolve_run
 
 #: The monitor's defaults the replay uses (faultgen.monitor.scoring.Settings).
 MONITOR_ALPHA, PERSISTENCE = 0.01, 5
@@ -104,7 +105,8 @@ def main() -> None:
         scores = tables.log_rows(list(csv.DictReader(f)))
     if tested and not args.without_tests:  # the rows' twin-scale wear and factors, which scores.csv leaves out
         started = time.perf_counter()
-        kept = loop.monitor(robot, logs, out, calibrate=False, failure_wear=failure, progress=False).monitors
+        kept = loop.monitor(resolve_run(robot, logs, out, calibrate=False, failure_wear=failure,
+                                        progress=False)).monitors
         scores = [row for m in kept for row in m.rows]
         print(f"the monitor's rows reloaded from OUT's state (no new log): {time.perf_counter() - started:.0f} s")
     with open(out / "alarms.csv", newline="") as f:

@@ -12,6 +12,7 @@ import backend_example
 import independent_fleet
 from faultgen.model import robots
 from faultgen.monitor import loop
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.runs import sweep
@@ -97,8 +98,8 @@ def test_an_unknown_backend_is_refused_before_a_sweep_runs(tmp_path):
 def test_the_monitors_twins_step_on_the_backend_it_is_given_with_the_default_backends_cycles(tmp_path):
     robot, logs, _ = independent_fleet.write_fleet(tmp_path / "fleet", FLEET)
     out = tmp_path / "out"
-    _, runs = counted(lambda: loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False,
-                                           context=ExecutionContext(stepper=COUNTING)))
+    _, runs = counted(lambda: loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS,
+                                                       progress=False, context=ExecutionContext(stepper=COUNTING))))
     cycles = out / ".cache" / "cycles"
     assert runs == len(list(cycles.glob("*.json"))) > len(base_cycles(6))  # every twin cycle, payloads' too
     # the cycles the monitor keeps (the first unit's twin replays its first log) against the default backend's
@@ -113,8 +114,8 @@ def test_the_monitors_twins_step_on_the_backend_it_is_given_with_the_default_bac
 
 def test_an_unknown_backend_is_refused_before_the_monitor_or_a_twin_starts(tmp_path):
     with pytest.raises(ValueError, match="'gpu' is not a stepper"):
-        loop.monitor("puma560", tmp_path / "logs", tmp_path / "out", progress=False,
-                     context=ExecutionContext(stepper="gpu"))
+        loop.monitor(resolve_run("puma560", tmp_path / "logs", tmp_path / "out", progress=False,
+                                 context=ExecutionContext(stepper="gpu")))
     with pytest.raises(ValueError, match="'gpu' is not a stepper"):
         Twin("puma560", tmp_path / "program.csv", tmp_path / "cycles", stepper="gpu")
     assert list(tmp_path.iterdir()) == []

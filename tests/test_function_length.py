@@ -22,7 +22,6 @@ MAX_COMMAND_LINES = 40
 LONG_FUNCTIONS = {
     "faultgen/calibrate/loop.py::run",
     "faultgen/cli/monitoring.py::monitor_command",
-    "faultgen/monitor/loop.py::monitor",
     "faultgen/monitor/unit_chart.py::figure",
     "faultgen/monitor/state.py::read_unit",
     "faultgen/runs/sweep.py::run",

@@ -198,8 +198,8 @@ def test_a_failed_monitor_keeps_another_runs_outputs_in_the_new_parent_they_shar
     logs.mkdir()
     new = tmp_path / "new"
 
-    def other_run_finishes_then_this_one_fails(robot, logs_dir, out, **kw):
-        (Path(out) / ".cache").mkdir(parents=True)  # this run's cache, as loop.monitor makes it
+    def other_run_finishes_then_this_one_fails(run):
+        (run.out / ".cache").mkdir(parents=True)  # this run's cache, as loop.monitor makes it
         if other_run:
             (new / "a").mkdir()
             (new / "a" / "units.csv").write_text("unit,status\n")

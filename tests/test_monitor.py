@@ -19,6 +19,7 @@ import pytest
 
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import loop, scoring
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.runs.context import ExecutionContext
 from resolved_runs import run_config
@@ -39,7 +40,7 @@ def fleet(tmp_path_factory):
 def monitored(fleet, tmp_path_factory):
     robot, logs, truth = fleet
     out = tmp_path_factory.mktemp("monitor") / "out"
-    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     return out
 
 
@@ -155,9 +156,9 @@ def test_a_log_older_than_the_last_scored_is_named_and_not_scored(fleet, monitor
     files = sorted(units[0].iterdir())
     for log in [files[0], *files[2:16]]:
         os.link(log, folder / log.name)
-    loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False))
     os.link(files[1], folder / files[1].name)
-    again = loop.monitor(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False)
+    again = loop.monitor(resolve_run(robot, folder.parent, out, calibrate=False, settings=SETTINGS, progress=False))
     assert f"not scored (logs are scored in stamp order): unit01/{files[1].name}" in again.statuses[0].reason
     assert again.statuses[0].logs_scored == 15 and again.statuses[0].status == "degraded"
 
@@ -196,7 +197,7 @@ def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
         Settings(protocol="magic")
     (tmp_path / "logs").mkdir()
     with pytest.raises(ValueError, match="no unit folders"):
-        loop.monitor(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False)
+        loop.monitor(resolve_run(robot, tmp_path / "logs", tmp_path / "out", calibrate=False, progress=False))
     assert not (tmp_path / "out").exists()
 
 
@@ -331,7 +332,7 @@ def test_a_planted_pickle_in_the_state_is_refused_unread(fleet, monitored, tmp_p
         path.unlink()
     (out / ".state" / "unit01.pkl").write_bytes(pickle.dumps(_Planted(marker)))
     with pytest.raises(ValueError, match=r"unit01\.pkl.*pickle.*not read"):
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     assert not marker.exists()
 
 
@@ -346,19 +347,20 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
     assert all(len(log["sha256"]) == 64 for log in state["logs"])
     out = _copy_of(monitored, tmp_path / "out")
     with pytest.raises(ValueError, match=r"unit01\.json: holds a monitor run with other settings.*persistence 3 \(now 4\)"):
-        loop.monitor(robot, logs, out, calibrate=False, settings=Settings(train=14, persistence=4), progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=Settings(train=14, persistence=4),
+                                 progress=False))
     state["logs"][3]["residual"] = state["logs"][3]["residual"][:-1]
     (out / ".state" / files[0].name).write_text(json.dumps(state))
     n_features = len(fleet_logs.FEATURES) * 6  # per axis of the KR210
     with pytest.raises(ValueError, match=rf"unit01\.json: logs\[3\]\.residual is not a list of {n_features} numbers"):
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     # a state an earlier faultgen wrote (format 1: two features per axis) is refused, saying what to do
     state["format"] = "faultgen-monitor-state/1"
     (out / ".state" / files[0].name).write_text(json.dumps(state))
     with pytest.raises(ValueError, match=r"unit01\.json: format 'faultgen-monitor-state/1', expected "
                                          r"'faultgen-monitor-state/2' \(a state written by another version of "
                                          r"faultgen.*score the logs into a new OUT"):
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
 
 
 def test_a_states_log_load_is_checked_and_a_state_written_without_loads_still_loads(fleet, monitored, tmp_path):
@@ -377,11 +379,11 @@ def test_a_states_log_load_is_checked_and_a_state_written_without_loads_still_lo
         bad["logs"][2]["load"] = load
         path.write_text(json.dumps(bad))
         with pytest.raises(ValueError, match=rf"unit01\.json: {match}"):
-            loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+            loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     for log in state["logs"]:
         del log["load"], log["duration_s"]
     path.write_text(json.dumps(state))
-    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     with open(out / "life.csv", newline="") as f:
         rows = [r for r in csv.DictReader(f) if r["unit"] == "unit01"]
     rated = [r for r in rows if r["consumed_pct"] != ""]  # the KR210's main axes have no rating (issue 90)
@@ -399,7 +401,7 @@ def test_a_scored_log_that_changed_since_is_named_and_its_score_kept(fleet, moni
     out = _copy_of(monitored, tmp_path / "out")
     log = sorted((copied / "unit02").iterdir())[5]
     log.write_text(log.read_text().replace("\n1", "\n2", 1))
-    again = loop.monitor(robot, copied, out, calibrate=False, settings=SETTINGS, progress=False)
+    again = loop.monitor(resolve_run(robot, copied, out, calibrate=False, settings=SETTINGS, progress=False))
     status = next(s for s in again.statuses if s.unit == "unit02")
     assert f"1 logs changed since an earlier run scored or skipped them (its results kept): unit02/{log.name}" \
         in status.reason and status.status == "degraded"
@@ -420,13 +422,13 @@ def test_a_cached_cycle_of_another_key_or_leading_outside_is_refused_and_never_e
     cycle["key"]["payload_kg"] = 1.0 + cycle["key"]["payload_kg"]
     cycles[0].write_text(json.dumps(cycle))
     with pytest.raises(ValueError, match=rf"{cycles[0].name}: not the cached twin cycle of"):
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     secret = tmp_path / "secret.json"
     secret.write_text('{"format": "MARKER-4f1c", "key": {}}')
     cycles[0].unlink()
     cycles[0].symlink_to(secret)
     with pytest.raises(ValueError, match="a link leading outside") as refused:
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     assert "MARKER" not in str(refused.value)
 
 
@@ -513,7 +515,7 @@ def test_units_no_model_can_simulate_are_named_and_every_other_unit_is_scored_as
         kept = [line for line in (out / name).read_text().splitlines() if not line.startswith(("unit98,", "unit99,"))]
         assert kept == (monitored / name).read_text().splitlines(), name
     # the rerun keeps the skipped logs and the fallback: nothing to do, the same verdicts
-    again = loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+    again = loop.monitor(resolve_run(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False))
     assert {s.unit: s.status for s in again.statuses if s.unit in ("unit98", "unit99")} == \
         {"unit98": "not monitored", "unit99": "degraded"}
     assert again.exit_status == loop.EXIT_SOME_UNITS_NOT_MONITORED
@@ -614,7 +616,7 @@ def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(
     (copy / "events.csv").write_text(f"unit,stamp,event,axis\n{worn},{after[0].stem},gearbox_change,"
                                      f"{outcome[worn]['axis']}\n")
     out = with_cycles_of(monitored, tmp_path / "out")
-    loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False))
     with open(out / "alarms.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == 2, rows
@@ -631,10 +633,10 @@ def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(
         os.link(log, split / worn / log.name)
     shutil.copy(copy / "events.csv", split / "events.csv")
     again = with_cycles_of(monitored, tmp_path / "again")
-    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for log in after:
         os.link(log, split / worn / log.name)
-    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for name in ("alarms.csv", "scores.csv"):
         assert (again / name).read_text() == (out / name).read_text(), name
 
@@ -701,15 +703,15 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
         for log in sorted(unit.iterdir())[:30]:
             os.link(log, partial / unit.name / log.name)
     out = tmp_path / "out"
-    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
-                 context=ExecutionContext(jobs=2))
+    loop.monitor(resolve_run(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                             context=ExecutionContext(jobs=2)))
     assert len((out / "scores.csv").read_text().splitlines()) == 1 + SPEC.units * 30
     for unit in logs.iterdir():  # the rest of the month arrives
         for log in sorted(unit.iterdir())[30:]:
             os.link(log, partial / unit.name / log.name)
     before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
-    outcome = loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
-                           context=ExecutionContext(jobs=2))
+    outcome = loop.monitor(resolve_run(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                                       context=ExecutionContext(jobs=2)))
     assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
     assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
     cycles = {p.name: p.read_bytes() for p in (out / ".cache" / "cycles").iterdir()}
@@ -721,8 +723,8 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     # a rerun with no new log: every unit's chart and remaining life made again in the workers, the same bytes
     for name in charts:
         (out / name).unlink()
-    loop.monitor(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
-                 context=ExecutionContext(jobs=2))
+    loop.monitor(resolve_run(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
+                             context=ExecutionContext(jobs=2)))
     for name in (*charts, "alarms.csv", "scores.csv", "units.csv", "rul.csv", "wear.csv", "life.csv"):
         assert (out / name).read_bytes() == (monitored / name).read_bytes(), name
 
@@ -754,7 +756,7 @@ def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(
             turned.append(",".join(cells))
         (copy / healthy / log.name).write_text("\n".join([header, *turned]) + "\n")
     out = with_cycles_of(monitored, tmp_path / "out")
-    loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False))
     with open(out / "units.csv", newline="") as f:
         row = next(csv.DictReader(f))
     assert row["status"] == "monitored" and f"program changed at {files[20].stem}" in row["reason"], row
@@ -768,10 +770,10 @@ def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(
     for log in sorted((copy / healthy).iterdir())[:25]:
         os.link(log, split / healthy / log.name)
     again = with_cycles_of(monitored, tmp_path / "again")
-    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for log in sorted((copy / healthy).iterdir())[25:]:
         os.link(log, split / healthy / log.name)
-    loop.monitor(robot, split, again, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for name in ("alarms.csv", "scores.csv", "units.csv"):
         assert (again / name).read_text() == (out / name).read_text(), name
 
@@ -781,7 +783,9 @@ def test_a_unit_whose_twin_cannot_be_built_falls_back_through_its_own_friction_t
     """The fallback chain of a calibrated unit (faultgen.monitor.unit.FALLBACK): each kind's failure
     is noted and the next is tried, the unit's own friction on the nominal model before the nominal
     model (issue 59: a calibration refused as implausible kept none of the unit's own friction)."""
+    from faultgen.logs import formats
     from faultgen.model import robots
+    from faultgen.monitor import feed, prognosis
     from faultgen.monitor import unit as units_module
 
     robot, logs, _ = fleet
@@ -798,7 +802,9 @@ def test_a_unit_whose_twin_cannot_be_built_falls_back_through_its_own_friction_t
     name = sorted(units)[0]
     unit = units_module.new_unit(name, units, nominal, SETTINGS, None, True, [], source)
     assert unit.model == "calibrated"
-    assert units_module.twin_of(unit, units, tmp_path, {}, False, source) is None
+    context = feed.Context(nominal.path, SETTINGS, None, tmp_path, False, formats.MEASURED, units, {},
+                           prognosis.FAILURE_WEAR)  # the fleet's logs, the cache's folder, the default stepper
+    assert units_module.twin_of(unit, context, {}, False, source) is None
     assert tried == ["calibrated", "friction", "nominal"] and unit.model == "none"
     assert unit.notes == [
         "the twin of the calibrated model failed (the calibrated twin refused for this test); nominal model with "

@@ -12,6 +12,7 @@ import independent_fleet
 import pytest
 
 from faultgen.monitor import console, feed, loop
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 
 # two units, 20 days, one worn from day 11-12 (small: the twin's cycles simulated once, then copied)
@@ -27,7 +28,7 @@ def fleet(tmp_path_factory):
     robot, logs, _ = independent_fleet.write_fleet(root, SPEC)
     units = sorted(p.name for p in logs.iterdir() if p.is_dir())
     cycles = tmp_path_factory.mktemp("cycles") / "out"
-    loop.monitor(robot, logs, cycles, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, logs, cycles, calibrate=False, settings=SETTINGS, progress=False))
     return robot, logs, units, cycles
 
 
@@ -54,7 +55,7 @@ def _run(fleet, logs: Path, out: Path, cycles_from: Path):
     robot = fleet[0]
     if not (out / ".cache").exists():
         shutil.copytree(cycles_from / ".cache" / "cycles", out / ".cache" / "cycles")
-    return loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    return loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
 
 
 def _stamps(logs: Path, unit: str) -> list[str]:

@@ -19,6 +19,7 @@ from faultgen.data import logfolder
 from faultgen.monitor import friction_tests, loop
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 
 # two units, 18 days, one worn from day 11 (60 % on day 18); tests on days 1, 9 and 17
@@ -44,7 +45,7 @@ def fleet(tmp_path_factory):
 def monitored(fleet, tmp_path_factory):
     _, robot, logs, _ = fleet
     out = tmp_path_factory.mktemp("monitor") / "out"
-    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     return out
 
 
@@ -124,14 +125,14 @@ def test_a_test_is_read_once_and_a_tampered_reading_is_refused(fleet, monitored,
         raise AssertionError("a cached test was read again")
 
     monkeypatch.setattr(friction_report, "read", never)
-    loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     for name in ("tests.csv", "wear.csv", "units.csv", "alarms.csv", "rul.csv"):
         assert filecmp.cmp(out / name, monitored / name, shallow=False), name
     cached = sorted((out / ".cache" / friction_tests.CACHE).glob("*.json"))
     assert len(cached) == 2 * 3 + 1  # every test of both units, and the bad one with its reason
     cached[0].write_text(cached[0].read_text().replace('"fits"', '"fitz"'))
     with pytest.raises(stored.StateError, match=cached[0].name):
-        loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
 
 
 def test_without_tests_every_output_is_that_of_a_fleet_with_an_empty_test_folder(fleet, monitored, tmp_path):
@@ -145,7 +146,7 @@ def test_without_tests_every_output_is_that_of_a_fleet_with_an_empty_test_folder
                 (copy / unit / "friction-test").mkdir()
         out = tmp_path / name / "out"
         shutil.copytree(monitored / ".cache" / "cycles", out / ".cache" / "cycles")  # the twin's cycles, not simulated again
-        loop.monitor(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False)
+        loop.monitor(resolve_run(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False))
         outs.append(out)
     files = sorted(p.relative_to(outs[0]) for p in outs[0].rglob("*") if p.is_file() and ".cache" not in p.parts)
     assert files == sorted(p.relative_to(outs[1]) for p in outs[1].rglob("*") if p.is_file() and ".cache" not in p.parts)

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from faultgen.monitor import loop
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 
 # two units, 40 days: unit01 or unit02 worn from day 11 (20 % passed on day 14, gearbox change on
@@ -38,7 +39,7 @@ def fleet(tmp_path_factory):
 def monitored(fleet, tmp_path_factory):
     robot, logs, _, _ = fleet
     out = tmp_path_factory.mktemp("monitor") / "out"
-    outcome = loop.monitor(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False)
+    outcome = loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
     return out, outcome
 
 

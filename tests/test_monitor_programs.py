@@ -19,6 +19,7 @@ from faultgen.logs import align
 from faultgen.monitor import feed, loop, programs
 from faultgen.monitor import state as stored
 from faultgen.monitor import unit as unit_module
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 
 RATE = 125.0
@@ -71,7 +72,8 @@ def cell(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(feed, "Twin", Counted)
         patch.setattr(unit_module, "Twin", Counted)
-        outcome = loop.monitor(robot, logs, root / "out", calibrate=False, settings=SETTINGS, progress=False)
+        outcome = loop.monitor(resolve_run(robot, logs, root / "out", calibrate=False, settings=SETTINGS,
+                                           progress=False))
     return {"root": root, "logs": logs, "truth": truth, "out": root / "out", "outcome": outcome, "made": made,
             "period": period, "short": paths[-2].stem}
 

@@ -13,6 +13,7 @@ import pytest
 
 from faultgen.model import robots
 from faultgen.monitor import loop
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import FEATURES, Settings, UnitMonitor
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -51,8 +52,8 @@ def write_step_fleet(root: Path, robot) -> Path:
 def step_fleet(tmp_path_factory):
     root = tmp_path_factory.mktemp("step")
     logs = write_step_fleet(root / "logs", robots.load("puma560"))
-    outcome = loop.monitor("puma560", logs, root / "out", calibrate=False, progress=False,
-                           settings=Settings(protocol="own", train=28, persistence=5))
+    outcome = loop.monitor(resolve_run("puma560", logs, root / "out", calibrate=False, progress=False,
+                                       settings=Settings(protocol="own", train=28, persistence=5)))
     return root / "out", outcome
 
 

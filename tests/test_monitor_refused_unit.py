@@ -22,10 +22,12 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
+from faultgen.logs import formats
 from faultgen.model import robots
+from faultgen.monitor import feed, loop, prognosis
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import loop
 from faultgen.monitor import unit as units_module
+from faultgen.monitor.run import resolve_run
 from faultgen.monitor.scoring import Settings
 from resolved_runs import run_config
 
@@ -149,7 +151,9 @@ def test_a_replay_failure_of_every_fallback_is_said_once_with_its_count(tmp_path
     monkeypatch.setattr(units_module, "model_of", failing)
     monkeypatch.setattr(units_module, "plausible", lambda nominal, data: None, raising=False)
     unit = units_module.new_unit("u1", units, robot, Settings(), None, True, [], source)
-    assert units_module.twin_of(unit, units, tmp_path, {}, False, source) is None
+    context = feed.Context(robot.path, Settings(), None, tmp_path, False, formats.MEASURED, units, {},
+                           prognosis.FAILURE_WEAR)  # the fleet's logs, the cache's folder, the default stepper
+    assert units_module.twin_of(unit, context, {}, False, source) is None
     assert unit.notes == [f"the twins of the calibrated model, the nominal model with the unit's own friction and the "
                           f"nominal model failed (3 times, each on the same: {error}); protocol own used"]
     assert units_module.fallback_notes(unit) == unit.notes
@@ -180,5 +184,6 @@ def test_a_given_model_that_does_not_load_is_refused_not_replaced_by_the_nominal
     bad.write_text("<mujoco><worldbody><body name='x'><joint/></body></worldbody>")  # not closed
     out = tmp_path / "out"
     with pytest.raises(ValueError, match=r"^--calibrated .*puma560_calibrated\.xml: the model does not load \("):
-        loop.monitor("puma560", fleet, out, calibrated=bad, settings=Settings(train=10, persistence=3), progress=False)
+        loop.monitor(resolve_run("puma560", fleet, out, calibrated=bad, settings=Settings(train=10, persistence=3),
+                                 progress=False))
     assert not out.exists()

@@ -108,7 +108,7 @@ def kr210_fleet(tmp_path_factory):
 
 def test_the_monitor_resolves_its_robot_once(tmp_path, loads, kr210_fleet):
     """``faultgen monitor`` on the nominal model: the robot folder is resolved once, by the command
-    (`monitor.loop`), and the twins and their cycles take that Robot. Before: once by the command,
+    (`monitor.run.resolve_run`), and the twins and their cycles take that Robot. Before: once by the command,
     once per unit's twin and once per simulated cycle's ``RunConfig`` (24 in all on the IRB 6700
     fleet of tests/test_monitor_shipped.py, 3 units, --no-calibrate; measured 2026-11-25)."""
     _, robot, logs = kr210_fleet
@@ -141,10 +141,10 @@ ALLOWED = {
     "faultgen/simulation/config.py": (1, "worker", ("RunConfig.model, once: a RunConfig unpickled (its robot sent "
                                                     "as the name) or built from a name; construction loads "
                                                     "nothing")),
-    "faultgen/monitor/loop.py": (1, "public API", "monitor(), the library entry: the robot, once per run"),
-    "faultgen/monitor/feed.py": (2, "worker", ("Context.new_source, where each process's robots are resolved: for "
-                                               "monitor() the --calibrated model; for a worker (loky, Dask) sent the "
-                                               "run as paths, the robot and that model; once each")),
+    "faultgen/monitor/run.py": (2, "public API", ("resolve_run(), the monitor's entry (the command's and a library "
+                                                 "caller's): the robot and the --calibrated model, once per run")),
+    "faultgen/monitor/feed.py": (2, "worker", ("Context.new_source, where a worker (loky, Dask) sent the run as "
+                                               "paths resolves the robot and the --calibrated model, once each")),
     "faultgen/monitor/remote.py": (1, "worker", "a Dask worker: the robot sent as a name, once (saying what to install)"),
     "faultgen/monitor/unit.py": (1, "an earlier run's state", ("a calibrated or twin model the monitor cached in "
                                                                "OUT/.cache (checked against its record), read once "

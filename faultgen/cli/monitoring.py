@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from pathlib import Path
@@ -154,23 +155,24 @@ def monitor_command(
     \b
       faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own
     """
-    from faultgen.model import robots
     from faultgen.monitor import console, loop
+    from faultgen.monitor.run import resolve_run
     from faultgen.monitor.scoring import Settings
     from faultgen.runs.context import ExecutionContext
 
     settings = Settings(protocol=protocol, train=train, alpha=alpha, persistence=persistence, wear_limit=wear_limit)
-    # the monitor resolves its robot itself (faultgen.monitor.loop); here only to check --torque-constants
-    adapter = log_adapter(log_format, torque_constants, robots.load(robot) if torque_constants is not None else None)
     check_monitor_out(out, logs, overwrite)
     if scheduler is None:  # at most one worker per unit is started (faultgen.monitor.parallel.map_groups)
         warn_jobs(jobs, "the units", "400-600 MB")
     made = missing_folders(out / ".cache")  # what the run creates first: OUT/.cache, OUT and folders above it when new
     try:
-        outcome = loop.monitor(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
-                               twin_temperature=twin_temperature, progress=progress, log_format=adapter,
-                               context=ExecutionContext(jobs, scheduler, stepper), failure_wear=failure_wear,
-                               hours_per_day=hours_per_day)
+        # the run resolved once, the robot loaded there (--torque-constants checked against its axes)
+        run = resolve_run(robot, logs, out, calibrated=calibrated, calibrate=calibrate, settings=settings,
+                          twin_temperature=twin_temperature, progress=progress,
+                          log_format=functools.partial(log_adapter, log_format, torque_constants),
+                          context=ExecutionContext(jobs, scheduler, stepper), failure_wear=failure_wear,
+                          hours_per_day=hours_per_day)
+        outcome = loop.monitor(run)
     except loop.MonitorInterrupted as stopped:  # Ctrl-C, SIGTERM: OUT/.cache keeps the twins made so far
         typer.echo(str(stopped), err=True)
         # ended here, at once: nothing is left to write, and the interpreter's own end (collecting the

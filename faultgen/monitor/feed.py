@@ -39,9 +39,10 @@ CONSTANT_TORQUE = "not monitored: the torque column does not vary from log to lo
 
 @dataclass(frozen=True)
 class Context:
-    """What scoring a group of units needs (sent to a worker process as it is); ``stepper``: what
-    steps the twins' cycles (a :class:`faultgen.simulation.backends.Stepper`; ValueError on
-    construction for anything else)."""
+    """What scoring a group of units needs (sent to a worker process as it is), made from the
+    resolved run (:meth:`of`): its paths, settings and log format, the fleet's ``units`` (their
+    logs) and ``maintenance`` events; ``stepper``: what steps the twins' cycles (the run's, a
+    :class:`faultgen.simulation.backends.Stepper`; ValueError on construction for anything else)."""
 
     robot: Path
     settings: Settings
@@ -57,10 +58,18 @@ class Context:
     def __post_init__(self) -> None:
         backends.checked(self.stepper)
 
+    @classmethod
+    def of(cls, run, units: dict, maintenance: dict) -> Context:
+        """What a worker needs of ``run`` (a :class:`faultgen.monitor.run.MonitorRun`: its robot and
+        given model as paths, each worker resolving them once, :meth:`new_source`) to score the
+        fleet's ``units`` (unit -> its logs) with their ``maintenance`` events."""
+        return cls(run.robot.path, run.settings, run.calibrated, run.out, run.twin_temperature, run.log_format, units,
+                   maintenance, run.failure_wear, run.stepper)
+
     def new_source(self, nominal: robots.Robot | None = None) -> fleet_logs.Source:
-        """A log source of this run holding its robots: ``nominal`` (the robot the run's command or
-        library call resolved), else :attr:`robot` resolved here, for a worker that did not inherit
-        the run's source (loky, Dask); and the model given for every unit (:attr:`calibrated`),
+        """A log source of this run in a worker that did not inherit the run's own
+        (:meth:`faultgen.monitor.run.MonitorRun.new_source`; loky, Dask), holding its robots:
+        ``nominal`` (the robot the worker resolved), else :attr:`robot` resolved here; and the model given for every unit (:attr:`calibrated`),
         resolved here once, or the ValueError its loading raised, which each unit's twin falls back
         from (:func:`faultgen.monitor.unit.twin_of`)."""
         nominal = robots.load(self.robot) if nominal is None else nominal
@@ -101,7 +110,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
     twins: dict[tuple, Twin] = {}
     for name, unit, unit_logs in group:
         off = unit.off_monitor or (REFUSED_SKIP if refused_note(unit) else None)  # an earlier run's
-        twin = off or twin_of(unit, context.units, context.out, twins, False, source, context.stepper)
+        twin = off or twin_of(unit, context, twins, False, source)
         events = context.maintenance.get(name, ())  # in stamp order, as the logs: each looked at once
         given = {m.identity for m in unit.maintenance}
         i = 0

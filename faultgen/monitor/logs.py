@@ -253,8 +253,8 @@ class Source:
     program, :meth:`keep`, for the run), so a unit's first log serves its program, calibration,
     twin and score from one read. It holds the parsed first log of each unit not yet scored, and
     each program. ``robot`` is the run's nominal robot and ``given`` the model given for every unit
-    (``--calibrated``), each resolved once where this process's source was made (the run's command
-    or library call, or a worker: :meth:`faultgen.monitor.feed.Context.new_source`); ``given`` is
+    (``--calibrated``), each resolved once where this process's source was made (the run's
+    :func:`faultgen.monitor.run.resolve_run`, or a worker: :meth:`faultgen.monitor.feed.Context.new_source`); ``given`` is
     None without one, or the ValueError its loading raised (each unit then falls back, saying why:
     :func:`faultgen.monitor.unit.twin_of`)."""
 

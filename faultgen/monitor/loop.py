@@ -41,21 +41,18 @@ import contextlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 from tqdm.auto import tqdm
 
 from faultgen.data import atomic, fleetlogs, logfolder
-from faultgen.logs import columns, formats
-from faultgen.model import robots
+from faultgen.logs import columns
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, page, prognosis, programs, report, sources
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, Context
 from faultgen.monitor.parallel import groups_of, map_groups
+from faultgen.monitor.run import MonitorRun
 from faultgen.monitor.scoring import Settings, UnitMonitor
-from faultgen.monitor.unit import (CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, given_model,
-                                   new_unit, refused_note)
-from faultgen.runs.context import LOCAL, ExecutionContext
+from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, new_unit, refused_note
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
 
@@ -127,12 +124,10 @@ class Outcome:
         return EXIT_SOME_UNITS_NOT_MONITORED if bad else 0
 
 
-def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibrated: str | Path | None = None,
-            calibrate: bool = True, settings: Settings = Settings(), twin_temperature: bool = False,
-            progress: bool = True, log_format: formats.LogFormat = formats.MEASURED, context: ExecutionContext = LOCAL,
-            failure_wear: float = prognosis.FAILURE_WEAR,
-            hours_per_day: float = life.HOURS_PER_DAY) -> Outcome:
-    """Monitor every unit of ``logs_dir`` (module docstring).
+def monitor(run: MonitorRun) -> Outcome:
+    """Monitor every unit of the run's logs folder (module docstring); ``run`` as
+    :func:`faultgen.monitor.run.resolve_run` resolved it (the robot, the settings, the log format,
+    the given model, the execution context: checked before any work).
 
     No unit stops the fleet: a unit whose twin cannot be built falls back (the calibrated or given
     model, then the nominal model, then ``--protocol own``: the unit against its own first logs),
@@ -143,174 +138,124 @@ def monitor(robot: str | Path, logs_dir: str | Path, out: str | Path, *, calibra
     that message, whatever the model: a refusal is never a reason to fall back. A file in a unit
     folder that is not a log (``notes.txt``) is passed over and named (:attr:`Outcome.passed_over`,
     the unit's reason); a bad row of ``events.csv`` leaves its unit not monitored in this run, the
-    row named, its earlier state kept (a row that names no unit is passed over, named).
-
-    Parameters
-    ----------
-    robot : str or Path
-        The robot the logs were recorded on (name, folder or MJCF).
-    logs_dir : str or Path
-        ``LOGS/<unit>/<stamp>.csv``.
-    out : str or Path
-        Output folder; an earlier run's output there is continued (its settings must match).
-    calibrated : path, optional
-        A ``faultgen calibrate`` output folder (or its model file) used as every unit's model; one
-        that does not load is refused before any unit is scored (never the nominal model instead).
-    calibrate : bool
-        Without ``calibrated``: calibrate each unit's model on its first log (True) or use the
-        nominal model (False). Only the ``twin`` protocol uses a model.
-    settings : Settings
-    twin_temperature : bool
-        The twin also predicts the temperature's effect (the model's own temperature law) instead
-        of the unit's learned slope alone.
-    progress : bool
-    log_format : faultgen.logs.formats.LogFormat, optional
-        The logs' layout (``ur-rtde``, ``voraus``); the measured format by default.
-    context : ExecutionContext
-        Where and on what the units are scored (:class:`faultgen.runs.context.ExecutionContext`;
-        default: this process, ``BatchStepper()``): ``jobs`` local processes scoring units in
-        parallel (groups of units sharing a twin), or the ``scheduler``, ``tcp://HOST:PORT`` (or
-        ``tls://``) of a Dask scheduler whose workers score the units instead
-        (:mod:`faultgen.monitor.remote`: they need faultgen and the robot, not LOGS or OUT), not
-        both; and the ``stepper`` that steps the twins' cycles, pickled to the workers (whose
-        processes must be able to import its class). Every one gives the outputs of one local job
-        on the default stepper: bit for bit for jobs and scheduler, to float tolerance for a stepper.
-    failure_wear : float
-        The wear estimate, % of the axis's own dry friction, that ends an axis's life: ``rul.csv`` gives each
-        axis's remaining life until it (:mod:`faultgen.monitor.prognosis`).
-    hours_per_day : float
-        Operating hours per calendar day between logs, in (0, 24]: ``life.csv``'s consumption
-        between logs (:mod:`faultgen.monitor.life`).
-
-    Returns
-    -------
-    Outcome
-        Each unit's monitor and status; :attr:`Outcome.exit_status` for the command line.
+    row named, its earlier state kept (a row that names no unit is passed over, named). Every
+    execution context gives the outputs of one local job on the default stepper: bit for bit for
+    jobs and scheduler, to float tolerance for a stepper.
 
     Raises
     ------
+    TypeError
+        ``run`` is not a :class:`~faultgen.monitor.run.MonitorRun`.
     ValueError
-        Before any work, for the run as a whole: ``out`` that is, lies in or holds ``logs_dir``
-        (:func:`faultgen.data.atomic.check_apart`), the robot, the fleet folder, or ``out`` holding a run with other
-        settings or a state or cache that does not match them (:mod:`faultgen.monitor.state`, the
-        file named), a ``context`` with ``jobs`` > 1 and a ``scheduler`` or not an ExecutionContext,
-        ``hours_per_day`` outside (0, 24] or a bad gearbox rating in the robot's ``drivetrain.toml``
-        (:mod:`faultgen.model.rating`), a ``calibrated`` model that does not load, a bad ``events.csv``
-        as a whole (its header, encoding, a link out of ``logs_dir``).
-    faultgen.runs.errors.SweepRefused
-        The ``scheduler`` is malformed or no Dask scheduler answers there (before any unit is scored).
+        Before any unit is scored: the fleet folder, ``out`` holding a run with other settings or a
+        state or cache that does not match them (:mod:`faultgen.monitor.state`, the file named), a
+        bad ``events.csv`` as a whole (its header, encoding, a link out of the logs folder).
     faultgen.runs.errors.SweepError
         The scheduler was lost, or a worker has another robot model (nothing is written).
     MonitorInterrupted
         Ctrl-C or SIGTERM while the units were scored (exit code 130 or 143): the workers are
         stopped and the message says what ``out`` keeps (:func:`interrupted`).
     """
-    if not isinstance(context, ExecutionContext):
-        raise ValueError(f"context {context!r}: expected an ExecutionContext(jobs, scheduler, stepper) "
-                         "(faultgen.runs.context)")
-    jobs, scheduler = context.jobs, context.scheduler
-    if scheduler is not None and jobs > 1:
-        raise ValueError(f"--jobs {jobs} with --scheduler {scheduler}: the cluster's workers score the units in "
-                         "parallel; drop --jobs (or --scheduler to score them in local processes)")
-    if scheduler is not None:  # a Dask scheduler must answer there, before any work
-        from faultgen.runs import cluster
-
-        cluster.probe(scheduler)
-    atomic.check_apart(out, logs_dir)
-    prognosis.check_failure_wear(failure_wear)
-    nominal = robots.load(robot)
-    ratings = life.ratings_of(nominal)  # a bad rating refused before any work
-    life.check_hours(hours_per_day)
-    _, suffixes = fleet_logs.reader_of(log_format)
+    if not isinstance(run, MonitorRun):
+        raise TypeError(f"expected a MonitorRun (faultgen.monitor.run.resolve_run), got {type(run).__name__}")
+    n_axes, out = run.robot.n_axes, run.out
+    _, suffixes = fleet_logs.reader_of(run.log_format)
     passed: list[tuple[str, str]] = []  # files that are not logs or tests, events rows of no unit: named
-    units = fleet_logs.fleet(logs_dir, suffixes, passed)
-    found = friction_tests.find(logs_dir, units, suffixes, passed)
-    out = Path(out)
-    calibrated_model = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
-    model_source = "nominal" if settings.protocol != "twin" else (
-        stored.sha256_file(calibrated_model) if calibrated_model is not None else "per-unit" if calibrate else "nominal")
-    key = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
-                                 log_format.key)
-    n_features = len(fleet_logs.FEATURES) * nominal.n_axes
+    units = fleet_logs.fleet(run.logs, suffixes, passed)
+    found = friction_tests.find(run.logs, units, suffixes, passed)
     confined = stored.checked_out(out)  # no link in OUT leads out: refused before anything is read or written
-    maintenance, stopped = _maintenance_events(Path(logs_dir), units, nominal.n_axes, passed)
-    tests = friction_tests.read_tests(found, nominal, out, log_format)  # each test read once, cached
-    wears = {name: friction_tests.tests_wear(read, nominal.n_axes, maintenance.get(name, ()))
-             for name, read in tests.items()}
+    maintenance, stopped = _maintenance_events(run.logs, units, n_axes, passed)
+    tests = friction_tests.read_tests(found, run.robot, out, run.log_format)  # each test read once, cached
+    wears = {name: friction_tests.tests_wear(read, n_axes, maintenance.get(name, ())) for name, read in tests.items()}
 
     def scale_of(name: str):
-        return friction_tests.Rescale(name, nominal.n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
+        return friction_tests.Rescale(name, n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
 
-    state = _load_state(out, units, key, settings, nominal.n_axes, n_features, scale_of, nominal.name)
+    state = _load_state(out, units, run.digest, run.settings, n_axes, run.n_features, scale_of, run.robot.name)
     rescored = events_changed(state, maintenance, stopped)  # those units scored again from their first log
     with told_on_interrupt(out, state):  # Ctrl-C, SIGTERM: the workers stopped, what OUT keeps said
         pending, stale = {}, {}
         for name, unit_logs in units.items():  # a unit with a bad events row: none of its logs this run
             pending[name], stale[name] = ([], []) if name in stopped else _pending(name, unit_logs, state.get(name))
-        scoring = Context(nominal.path, settings, calibrated_model, out, twin_temperature, log_format, units, maintenance,
-                           failure_wear, context.stepper)
-        source = scoring.new_source(nominal)  # the robots, each resolved once; each log read once, parsed data passed on
-        if isinstance(source.given, ValueError):  # a given model refused: the run's error, never the nominal model instead
-            raise ValueError(f"--calibrated {calibrated}: the model does not load ({source.given})")
+        source = run.new_source()  # the robots, each resolved once; each log read once, parsed data passed on
         confined.mkdir(out / ".cache")
         programs: list[tuple[object, tuple[str, str]]] = []  # (checked program log, (unit, stamp))
         for name, unit_logs in pending.items():  # in the folder's order: a unit may replay an earlier one's log
             if unit_logs and name not in state:
-                state[name] = new_unit(name, units, nominal, settings, calibrated_model, calibrate, programs, source)
+                state[name] = new_unit(name, units, run.robot, run.settings, run.calibrated, run.calibrate, programs,
+                                       source)
                 _keep_program(state[name], rescored.get(name))
                 state[name].monitor.tests = scale_of(name)
-        groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
-        bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not progress)
-        made: dict[str, tuple[bytes, list]] = {}  # unit -> its chart (PNG) and rows of rul.csv, made where it was scored
-        idle = [state[name].monitor for name in units if name in state and not pending[name]]  # no new log
-        # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
-        with contextlib.closing(map_groups(scoring, groups, jobs, scheduler, robot, idle, source)) as results:
-            for done in results:
-                for name, unit, outputs in done:
-                    made[name] = outputs
-                    if unit is not None:
-                        state[name] = unit
-                        bar.update(len(pending[name]))
-        bar.close()
-        monitors = [state[name].monitor for name in units if name in state]
-        statuses = [_status(name, state.get(name), settings, stale[name], tests.get(name, ()),
+        made = _score_units(run, Context.of(run, units, maintenance), state, pending, source)
+        statuses = [_status(name, state.get(name), run.settings, stale[name], tests.get(name, ()),
                             fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
                             stopped.get(name, "")) for name in units]
-        nominal_scale = _nominal_scale(state, settings, calibrated_model is not None or calibrate)
-        written = [report.alarms_table(monitors), report.scores_table(monitors, nominal.n_axes),
-                   report.wear_table(monitors, scales=bool(found) or bool(nominal_scale), nominal=nominal_scale),
-                   report.units_table(statuses, scales={m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors}
-                                      if found or nominal_scale else None),
-                   *([friction_tests.tests_table({name: wears[name][0] for name in units if name in wears})]
-                     if found else []),
-                   prognosis.rul_table([row for m in monitors for row in made[m.unit][1]]),
-                   # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
-                   life.life_table([row for name in units if name in state and state[name].entries
-                                    for row in life.of_unit(name, state[name].entries, state[name].maintenance, ratings,
-                                                            hours_per_day, notes=state[name].notes)])]
-        # the page from the tables in memory (none read back), as `faultgen report OUT` draws it from the files
-        fleet = page.fleet_of({t.name: t.records() for t in written}, [r.tabled() for m in monitors for r in m.rows])
-        with atomic.atomic_folder(out) as staging:
-            for table in written:
-                table.write(staging)
-            # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
-            page.write(staging, settings, fleet=fleet, robot=Path(str(robot)).name,
-                       logs=Path(logs_dir).resolve().name, model=model_source, twin_temperature=twin_temperature)
-            for m in monitors:
-                (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
-            (staging / ".state").mkdir()
-            for name in units:
-                if name in state:
-                    unit = state[name]
-                    stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
-                                      stored.UnitState(name, key, unit.program,
-                                                       unit.monitor.signatures if unit.initial_signatures is None
-                                                       else unit.initial_signatures, unit.entries,
-                                                       unit.model, unit.first, unit.skipped, unit.notes,
-                                                       unit.maintenance, unit.program_changes,
-                                                       unit.torque_source, unit.off_monitor))
-    return Outcome(monitors, statuses, passed, tests=bool(found),
+        _write_outputs(run, units, state, statuses, made, {name: wears[name][0] for name in units if name in wears}
+                       if found else None)
+    return Outcome([state[name].monitor for name in units if name in state], statuses, passed, tests=bool(found),
                    rescored=[(name, since) for name, (since, _, _) in rescored.items()])
+
+
+def _score_units(run: MonitorRun, scoring: Context, state: dict[str, Unit], pending: dict[str, list],
+                 source: fleet_logs.Source) -> dict[str, tuple[bytes, list]]:
+    """Score each unit's ``pending`` logs (:func:`faultgen.monitor.parallel.map_groups`, on the run's
+    execution context), updating ``state``; returns unit -> its chart (PNG) and rows of rul.csv,
+    made where it was scored (a unit with no new log too)."""
+    groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
+    bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not run.progress)
+    made: dict[str, tuple[bytes, list]] = {}
+    idle = [state[name].monitor for name in pending if name in state and not pending[name]]  # no new log
+    # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
+    with contextlib.closing(map_groups(run, scoring, groups, idle, source)) as results:
+        for done in results:
+            for name, unit, outputs in done:
+                made[name] = outputs
+                if unit is not None:
+                    state[name] = unit
+                    bar.update(len(pending[name]))
+    bar.close()
+    return made
+
+
+def _write_outputs(run: MonitorRun, units: dict, state: dict[str, Unit], statuses: list[UnitStatus],
+                   made: dict[str, tuple[bytes, list]], wears: dict | None) -> None:
+    """Write the run's outputs into ``run.out`` together (:func:`faultgen.data.atomic.atomic_folder`):
+    each table from memory, the page drawn from the same tables, each unit's chart and state;
+    ``wears``: each unit's friction tests' wear when the fleet has friction tests (tests.csv), else None."""
+    monitors = [state[name].monitor for name in units if name in state]
+    nominal_scale = _nominal_scale(state, run.settings, run.own_model)
+    scales = wears is not None or bool(nominal_scale)
+    written = [report.alarms_table(monitors), report.scores_table(monitors, run.robot.n_axes),
+               report.wear_table(monitors, scales=scales, nominal=nominal_scale),
+               report.units_table(statuses, scales={m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors}
+                                  if scales else None),
+               *([friction_tests.tests_table(wears)] if wears is not None else []),
+               prognosis.rul_table([row for m in monitors for row in made[m.unit][1]]),
+               # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
+               life.life_table([row for name in units if name in state and state[name].entries
+                                for row in life.of_unit(name, state[name].entries, state[name].maintenance, run.ratings,
+                                                        run.hours_per_day, notes=state[name].notes)])]
+    # the page from the tables in memory (none read back), as `faultgen report OUT` draws it from the files
+    fleet = page.fleet_of({t.name: t.records() for t in written}, [r.tabled() for m in monitors for r in m.rows])
+    with atomic.atomic_folder(run.out) as staging:
+        for table in written:
+            table.write(staging)
+        # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
+        page.write(staging, run.settings, fleet=fleet, robot=Path(str(run.named)).name,
+                   logs=run.logs.resolve().name, model=run.model_source, twin_temperature=run.twin_temperature)
+        for m in monitors:
+            (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
+        (staging / ".state").mkdir()
+        for name in units:
+            if name in state:
+                unit = state[name]
+                stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
+                                  stored.UnitState(name, run.digest, unit.program,
+                                                   unit.monitor.signatures if unit.initial_signatures is None
+                                                   else unit.initial_signatures, unit.entries,
+                                                   unit.model, unit.first, unit.skipped, unit.notes,
+                                                   unit.maintenance, unit.program_changes,
+                                                   unit.torque_source, unit.off_monitor))
 
 
 

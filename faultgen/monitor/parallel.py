@@ -116,27 +116,28 @@ def stop(pool) -> None:
         child.kill()  # reaped by the pool's own thread
 
 
-def map_groups(context: Context, groups: list, jobs: int = 1, scheduler: str | None = None,
-               robot: str | Path | None = None, idle: list | tuple = (), source: fleet_logs.Source | None = None):
-    """Each group scored (:func:`score_group`), then each ``idle`` monitor's (a unit with no new log)
-    chart and remaining life made (:func:`idle_outputs`), yielded in that order: in this process;
-    in ``jobs`` local processes when ``jobs`` > 1 (on Linux forked from this one, after the shared
-    twins are simulated: :func:`prepare_twins`, and the scoring's imports made: :func:`preload`;
-    elsewhere joblib's loky, started without the user's folders on their path:
+def map_groups(run, context: Context, groups: list, idle: list | tuple = (), source: fleet_logs.Source | None = None):
+    """Each group of ``run`` (a :class:`faultgen.monitor.run.MonitorRun`) scored (:func:`score_group`,
+    on its workers' ``context``), then each ``idle`` monitor's (a unit with no new log) chart and
+    remaining life made (:func:`idle_outputs`), yielded in that order, on the run's execution
+    context (``run.context``): in this process; in ``jobs`` local processes when ``jobs`` > 1 (on
+    Linux forked from this one, after the shared twins are simulated: :func:`prepare_twins`, and
+    the scoring's imports made: :func:`preload`; elsewhere joblib's loky, started without the user's folders on their path:
     :func:`faultgen.children.safe_path`; either way each worker ends within a second of this process,
     as a sweep's do: :func:`faultgen.runs.worker.watch_parent`); or on the Dask cluster of ``scheduler``
-    (:func:`faultgen.monitor.remote.execute`; ``robot`` as the user named it). Every group's
+    (:func:`faultgen.monitor.remote.execute`; the robot as the user named it). Every group's
     arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit.
     ``source``: the run's logs as read so far (:class:`faultgen.monitor.logs.Source`), which this
     process and forked workers read from; loky's and Dask's workers read the logs they score."""
     idle = list(idle)
+    jobs, scheduler = run.context.jobs, run.context.scheduler
     source = source if source is not None else context.new_source()
     if scheduler is not None:
         if groups:
             prepare_twins(context, groups, source=source)
         from faultgen.monitor import remote
 
-        yield from remote.execute(context, groups, scheduler, context.robot if robot is None else robot, idle)
+        yield from remote.execute(context, groups, scheduler, run.named, idle)
         return
     if jobs <= 1 or len(groups) + len(idle) <= 1:
         yield from (score_group(context, group, source) for group in groups)

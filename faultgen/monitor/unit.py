@@ -23,7 +23,6 @@ from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import Twin
-from faultgen.simulation import backends
 
 #: Two units run the same program when their first logs have the same samples and angles within this, rad.
 SAME_PROGRAM = unit_programs.SAME_PROGRAM
@@ -197,11 +196,12 @@ def chain_notes(tried: list[tuple[str, str]], final: str) -> list[str]:
     return notes
 
 
-def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: fleet_logs.Source,
-            stepper: backends.Stepper = backends.DEFAULT_STEPPER) -> Twin | str | None:
-    """The unit's twin (its cycles simulated on ``stepper``), or None
-    for a unit under protocol ``own``; its model comes from :func:`model_of` (the robots of
-    ``source``, or the unit's calibration). A unit not yet scored falls back
+def twin_of(unit: Unit, context, twins: dict, progress: bool, source: fleet_logs.Source) -> Twin | str | None:
+    """The unit's twin (its program among the fleet's logs, ``context.units``, its cycles cached in
+    ``context.out`` and simulated on the run's ``context.stepper``: a
+    :class:`faultgen.monitor.feed.Context`), or None for a unit under protocol ``own``; its model
+    comes from :func:`model_of` (the robots of ``source``, or the unit's calibration). A unit not
+    yet scored falls back
     through :data:`FALLBACK` when its twin cannot be built (its calibration refused as implausible,
     say: to its own friction on the nominal model, then to the nominal model, then to protocol ``own``);
     a unit already scored against a twin that cannot be built again gets the reason (a str), and
@@ -211,6 +211,7 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
     back: the unit is taken off the monitor (:func:`refuse`) and the reason returned."""
     tried: list[tuple[str, str]] = []  # (kind, error) that failed in this call, noted by chain_notes
     start = len(unit.notes)
+    units, out = context.units, context.out
     while unit.model != "none":
         try:
             first_log = next((g for g in units[unit.monitor.unit] if g.stamp == unit.first[0]), None)
@@ -218,7 +219,7 @@ def twin_of(unit: Unit, units, out: Path, twins: dict, progress: bool, source: f
             twin_key = (str(model.path), unit.program)
             if twin_key not in twins:
                 twins[twin_key] = Twin(model, source.get(log_of(units, *unit.program)), out / ".cache" / "cycles",
-                                       root=out, stepper=stepper)
+                                       root=out, stepper=context.stepper)
             twin = twins[twin_key]
         except stored.StateError:
             raise
@@ -263,18 +264,6 @@ def log_of(units: dict[str, list[fleet_logs.Log]], unit: str, stamp: str) -> fle
     raise ValueError(f"the log {unit}/{stamp} that an earlier run scored or replays is no longer in the fleet folder; "
                      "put it back or score this folder into a new OUT")
 
-
-
-def given_model(calibrated: str | Path) -> Path:
-    """The model file of a ``faultgen calibrate`` output folder (or the file itself)."""
-    path = Path(calibrated)
-    if path.is_dir():
-        found = sorted((path / "model").glob("*_calibrated.xml")) or sorted(path.glob("*_calibrated.xml"))
-        if not found:
-            raise ValueError(f"{path}: no model/<robot>_calibrated.xml; give a `faultgen calibrate` output "
-                             "folder or its model file")
-        path = found[0]
-    return path
 
 
 def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first_log: fleet_logs.Log | None,

@@ -1,7 +1,7 @@
 """Where and on what a set of runs is computed: :class:`ExecutionContext`.
 
 Sweeps and fleets (:func:`faultgen.runs.sweep.run`, :func:`faultgen.runs.cluster.execute`) and the
-monitor (:func:`faultgen.monitor.loop.monitor`) take one instead of separate ``jobs``,
+monitor (:func:`faultgen.monitor.run.resolve_run`) take one instead of separate ``jobs``,
 ``scheduler`` and stepper parameters; none of the three changes an output (docs/architecture.md,
 "Stepping backends")."""
 
