@@ -15,11 +15,14 @@ fed to the axis's one filter.
   a part of at most :data:`EDGE_SAMPLES` samples is the rounding of a boundary and is scored with
   the cycle beside it. A log with no whole cycle is skipped with its reason
   (:func:`refusal_text`).
-- **Baselines.** Each program has its own baseline (the offset, slopes, noise, PCA model and wear
-  signatures :class:`faultgen.monitor.scoring.UnitMonitor` learns on a program's first ``train``
-  logs: :data:`BASELINE`); the unit's monitor holds its first program's between logs, and a log of
-  another program is fed with that program's baseline swapped in (:class:`Baselines`). The alarm
-  (its run of alarming logs), the rows and the friction tests are the unit's.
+- **Baselines.** The unit learns once it has ``train`` logs in all, its programs' together
+  (:func:`pool`, :mod:`faultgen.monitor.learning`): each program met by then with at least
+  ``relearn_logs`` of them its own offset, all of them one set of condition slopes, noise and PCA
+  model; each program its own wear signatures (its twin's). A program met later, or with fewer
+  logs in that learning, learns only its offset on its own first ``relearn_logs`` logs (as a unit
+  after maintenance does) and borrows the rest. Each program's :data:`BASELINE` is swapped in for
+  its logs (:class:`Baselines`); the unit's monitor holds its first program's between logs. The
+  alarm (its run of alarming logs), the rows and the friction tests are the unit's.
 - **One filter per axis.** Every program's per-log wear estimate of an axis goes to the unit's one
   :class:`faultgen.monitor.wear_trend.WearTrend` with that program's own standard error (an axis a
   program barely excites has a large one and moves the filter little: the Kalman update's
