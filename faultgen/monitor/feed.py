@@ -204,8 +204,9 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source,
                 torque: str = "") -> int:
     """A program new to the unit from ``log`` on (its motion within the tolerance of none of its
     programs): reported once (a program change, noted in its reason), its twin made on that log,
-    its own baseline learned on its own first logs while the other programs' logs are scored
-    (:class:`faultgen.monitor.programs.Baselines`), for the log's torque source ``torque``. Returns its index.
+    its offset learned on its own first logs (pooled into the unit's learning while the unit learns),
+    the other programs' logs scored meanwhile (:class:`faultgen.monitor.programs.Baselines`), for the
+    log's torque source ``torque``. Returns its index.
 
     Raises
     ------
@@ -224,8 +225,8 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source,
     unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
                       f"none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
-                      "twin replays that log, and it learns its own normal operation on its own first logs while the "
-                      "other programs' logs are scored")
+                      "twin replays that log; it learns its offset on its own first logs (pooled into the unit's "
+                      "learning while the unit learns), the other programs' logs scored meanwhile")
     return k
 
 

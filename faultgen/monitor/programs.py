@@ -15,11 +15,14 @@ fed to the axis's one filter.
   a part of at most :data:`EDGE_SAMPLES` samples is the rounding of a boundary and is scored with
   the cycle beside it. A log with no whole cycle is skipped with its reason
   (:func:`refusal_text`).
-- **Baselines.** Each program has its own baseline (the offset, slopes, noise, PCA model and wear
-  signatures :class:`faultgen.monitor.scoring.UnitMonitor` learns on a program's first ``train``
-  logs: :data:`BASELINE`); the unit's monitor holds its first program's between logs, and a log of
-  another program is fed with that program's baseline swapped in (:class:`Baselines`). The alarm
-  (its run of alarming logs), the rows and the friction tests are the unit's.
+- **Baselines.** The unit learns once it has ``train`` logs in all, its programs' together
+  (:func:`pool`, :mod:`faultgen.monitor.learning`): each program met by then with at least
+  ``relearn_logs`` of them its own offset, all of them one set of condition slopes, noise and PCA
+  model; each program its own wear signatures (its twin's). A program met later, or with fewer
+  logs in that learning, learns only its offset on its own first ``relearn_logs`` logs (as a unit
+  after maintenance does) and borrows the rest. Each program's :data:`BASELINE` is swapped in for
+  its logs (:class:`Baselines`); the unit's monitor holds its first program's between logs. The
+  alarm (its run of alarming logs), the rows and the friction tests are the unit's.
 - **One filter per axis.** Every program's per-log wear estimate of an axis goes to the unit's one
   :class:`faultgen.monitor.wear_trend.WearTrend` with that program's own standard error (an axis a
   program barely excites has a large one and moves the filter little: the Kalman update's
@@ -36,6 +39,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from faultgen.logs import align
+from faultgen.monitor.learning import fit_shared, fit_signatures, score_learning, shared
+from faultgen.monitor.wear_trend import WearTrend
 
 #: A log's span short of a whole number of periods by under this share of a period counts it.
 EDGE = align.HINT_SLACK
@@ -52,7 +57,7 @@ SAME_PROGRAM = 1e-3
 #: (learned on the program's own first logs), swapped per log by :class:`Baselines`.
 BASELINE = ("signatures", "training", "learned_expectations", "pca", "far_", "mean_", "condition_mean_",
             "regressors_", "slope_", "gram_inv_", "learned_", "scale_", "dispersion_", "observable_", "width_",
-            "relearning", "program_changed", "placeholders")
+            "relearning", "program_changed", "placeholders", "borrowed_", "day_scatter_")
 
 
 def _starts_a_cycle(t: np.ndarray, q: np.ndarray, period: float) -> bool:
@@ -236,6 +241,8 @@ class Baselines:
 
         fresh = UnitMonitor(monitor.unit, monitor.settings, monitor.n_axes, signatures)
         fresh.program_changed = True  # its learning logs listed as they come, then scored as relearning
+        if monitor.pca is not None:  # the unit has learned: the new program learns its offset alone
+            fresh.borrowed_ = monitor.shared_
         self.saved.append({name: getattr(fresh, name, None) for name in BASELINE})
         self.offsets.append(None)
         return len(self.saved)
@@ -245,7 +252,16 @@ class Baselines:
         as the monitor holds it); the rows sorted by stamp after a program learns."""
         if program == 0:
             call()
-            return
+        else:
+            self._run(monitor, program, call)
+        if monitor.pca is None and self.saved and self.learning_logs(monitor) >= monitor.settings.train:
+            pool(monitor, self)
+
+    def learning_logs(self, monitor) -> int:
+        """The unit's learning logs in all, every program's (before the unit has learned)."""
+        return len(monitor.training) + sum(len(b["training"]) for b in self.saved)
+
+    def _run(self, monitor, program: int, call) -> None:
         first = {name: getattr(monitor, name, None) for name in BASELINE}
         trend = monitor.trend
         for name, value in self.saved[program - 1].items():
@@ -278,6 +294,57 @@ class Baselines:
                 self.offsets[k - 1] = (np.zeros(monitor.n_axes), np.zeros(monitor.n_axes))
 
 
+def pool(monitor, baselines: Baselines) -> None:
+    """Learn the unit's baseline on the learning logs of all its programs (``train`` in all: module
+    docstring of :mod:`faultgen.monitor.learning`): each program with at least ``relearn_logs`` of
+    them (and the first, always) its own offset, all of them the slopes, noise and PCA model; a
+    program with fewer learns its offset on its own (:func:`faultgen.monitor.learning.fit_offset`).
+    The learning logs' rows are scored in stamp order, each on its program's baseline."""
+    from faultgen.monitor.scoring import FAR_ALPHA, NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL_Z
+
+    parts = [monitor.training] + [b["training"] for b in baselines.saved]
+    pooled = [k for k, logs in enumerate(parts) if k == 0 or len(logs) >= monitor.relearn_logs]
+    logs = sorted(((s, i, e, c) for i, k in enumerate(pooled) for s, e, c in parts[k]), key=lambda log: log[0])
+    groups = np.array([i for _, i, _, _ in logs])
+    monitor.training = [(s, e, c) for s, _, e, c in logs]
+    R, offsets = fit_shared(monitor, FAR_ALPHA, groups)
+    common = monitor.shared_ = shared(monitor, R, len(R) - len(pooled) - len(monitor.regressors_))
+    counts = np.bincount(groups)
+    monitor.training, monitor.learned_ = [], int(counts[0])
+    monitor.trend = WearTrend(monitor.n_axes, len(monitor.regressors_))
+    if monitor.signatures is not None:
+        error = fit_signatures(monitor, R, common["dof"], WEAR_INTERVAL_Z, NOT_OBSERVABLE_LIMITS)
+        monitor.trend.set_prior(error[:, None, None] ** 2 * monitor.gram_inv_[None])
+    zero = np.zeros(monitor.n_axes)
+    for i, k in enumerate(pooled[1:], 1):
+        baselines.offsets[k - 1] = (zero, zero)  # learned with the first: its wear read from the same start
+        baselines.run(monitor, k, lambda i=i: _learned_with(monitor, common, offsets[i], int(counts[i])))
+    for k in range(1, len(parts)):
+        if k not in pooled:
+            baselines.saved[k - 1]["borrowed_"] = common
+    learned = {s for s, _, _, _ in logs}
+    monitor.rows[:] = [row for row in monitor.rows if row.stamp not in learned]
+    for j, (stamp, i, _, _) in enumerate(logs):
+        baselines.run(monitor, pooled[i], lambda j=j, stamp=stamp: score_learning(monitor, [stamp], R[j:j + 1],
+                                                                                   "training"))
+    monitor.rows.sort(key=lambda row: row.stamp)
+
+
+def _learned_with(monitor, common: dict, offset: np.ndarray, count: int) -> None:
+    """A program's baseline learned with the unit's first (:func:`pool`): the unit's ``common``
+    parts (:data:`faultgen.monitor.learning.SHARED`), its own ``offset`` (n_features,) from its
+    ``count`` learning logs, and its signatures' parts on the pooled residuals."""
+    from faultgen.monitor.scoring import NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL_Z
+
+    for name, value in common.items():
+        if name not in ("R", "dof"):
+            setattr(monitor, name, value)
+    monitor.mean_, monitor.learned_, monitor.training = offset, count, []
+    monitor.program_changed, monitor.placeholders = False, 0
+    if monitor.signatures is not None:
+        fit_signatures(monitor, common["R"], common["dof"], WEAR_INTERVAL_Z, NOT_OBSERVABLE_LIMITS)
+
+
 def learning(monitor, program: int) -> bool:
     """Whether the unit's program ``program`` (0: its first) is still learning its baseline."""
     if program == 0:
@@ -305,6 +372,7 @@ def mix_note(monitor, entries, count: int) -> str:
     if count < 2:
         return ""
     saved = baselines_of(monitor).saved
-    learning = [f"program {k + 2} learning: {len(b['training'])} of {monitor.settings.train} logs"
+    learning = [f"program {k + 2} learning: {len(b['training'])} of "
+                f"{monitor.settings.train if b['borrowed_'] is None else monitor.relearn_logs} logs"
                 for k, b in enumerate(saved) if b["pca"] is None]
     return "; ".join([f"programs: {mix(entries, count)}", *learning])

@@ -71,10 +71,9 @@ from statistics import NormalDist
 
 import numpy as np
 
-from analysis import registry
 from analysis.isolation import signature_scores
 from analysis.monitoring import PCAMonitor
-from faultgen.monitor import bounds, record
+from faultgen.monitor import bounds, learning, record
 from faultgen.monitor.wear_trend import WearTrend
 
 PROTOCOLS = ("twin", "own")
@@ -232,6 +231,10 @@ class UnitMonitor:
         #: standard error, at least 1 (:meth:`_fit`; 1 before it).
         self.dispersion_ = np.ones(n_axes)
         self.day_scatter_ = np.full(n_axes, np.nan)  # each axis's reads' day-to-day scatter, points (bounds.day_scatter)
+        #: A program met after the unit learned: what it borrows of the unit's baseline
+        #: (:func:`faultgen.monitor.learning.shared`), its own offset learned against it
+        #: (:func:`faultgen.monitor.learning.fit_offset`); else None.
+        self.borrowed_: dict | None = None
         #: Each axis's wear filtered over the logs (the wear reported and alarmed on).
         self.trend = WearTrend(n_axes)
         #: The unit's friction tests' scale (:class:`faultgen.monitor.friction_tests.Rescale`), or
@@ -292,55 +295,8 @@ class UnitMonitor:
 
     # -- learning -------------------------------------------------------------------------------
     def _fit(self) -> None:
-        stamps = [s for s, _, _ in self.training]
-        E = np.stack([e for _, e, _ in self.training])
-        C = np.array([c for _, _, c in self.training])  # (m, 2): temperature, payload
-        self.mean_ = E.mean(axis=0)
-        # the conditions that vary over the learning logs (and are logged) become regressors
-        finite = np.all(np.isfinite(C), axis=0)
-        self.condition_mean_ = np.where(finite, np.nanmean(np.where(np.isfinite(C), C, 0.0), axis=0), 0.0)
-        self.regressors_ = np.flatnonzero(finite & (np.ptp(np.where(np.isfinite(C), C, 0.0), axis=0) > 0))
-        X = C[:, self.regressors_] - self.condition_mean_[self.regressors_]
-        self.slope_ = np.linalg.lstsq(X, E - self.mean_, rcond=None)[0] if X.shape[1] else np.zeros((0, E.shape[1]))
-        R = E - self.mean_ - X @ self.slope_
-        # (X'X)^-1 of the centred conditions: a later log's leverage (the prediction interval)
-        self.gram_inv_ = np.linalg.pinv(X.T @ X) if X.shape[1] else np.zeros((0, 0))
-        self.learned_ = len(E)
-        scale = np.sqrt((R**2).sum(axis=0) / (len(R) - 1 - X.shape[1]))
-        self.scale_ = np.where(scale > 0, scale, 1.0)
-        Z = R / self.scale_
-        # the registry's monitor model (analysis.registry: the one detect and training-source build)
-        self.pca = registry.make("pca_monitor", variance=self.settings.variance, alpha=self.settings.alpha, cv=5)[1].fit(Z)
-        # --protocol own's at-once limits (T2, Q) from the same fitted model; none past FAR_ALPHA
-        far = self.settings.alpha**self.settings.persistence
-        self.far_ = None if self.signatures is not None or far < FAR_ALPHA else self.pca.limits(far)
-        self.training = []
-        self.trend = WearTrend(self.n_axes, X.shape[1])
-        if self.signatures is not None:
-            # the learning logs are unworn: their wear estimates' scatter over the stated standard
-            # error (a feature's noise is not independent of the others': a log's friction scatter
-            # moves an axis's features together, along its signature) widens every later error
-            self.dispersion_ = np.ones(self.n_axes)
-            z = np.stack([w / e for w, e in (self.wear_estimate(r, self.scale_**2) for r in R)])
-            self.day_scatter_ = bounds.day_scatter(z * self.wear_estimate(R[0], self.scale_**2)[1])  # points
-            self.dispersion_ = np.maximum(1.0, np.sqrt((z**2).sum(axis=0) / (len(R) - 1 - X.shape[1])))
-            # the learned slopes' error along each axis's wear signature (% of wear per unit of
-            # condition): the estimate is linear in the residual, so its covariance is the wear
-            # estimate's squared error times (X'X)^-1; the trend learns it on from later logs
-            error = self.wear_estimate(np.zeros_like(self.scale_), self.scale_**2)[1]
-            self.trend.set_prior(error[:, None, None] ** 2 * self.gram_inv_[None])
-            # one log's 90 % interval of an unworn axis, from the noise: the rule of NOT_OBSERVABLE_LIMITS
-            self.width_ = 2.0 * WEAR_INTERVAL_Z * error
-            self.observable_ = self.width_ <= NOT_OBSERVABLE_LIMITS * self.settings.wear_limit
-        if self.placeholders:  # the rows standing for these logs since a program change (by stamp: another
-            learned = set(stamps)  # program's logs may lie between them, faultgen.monitor.programs)
-            self.rows[:] = [row for row in self.rows if row.stamp not in learned]
-            self.placeholders = 0
-        phase = "relearning" if self.program_changed else "training"
-        self.program_changed = False
-        for stamp, z, r in zip(stamps, Z, R):
-            wear = self.wear_estimate(r, self.scale_**2)
-            self._score(stamp, z, phase=phase, wear=None if wear is None else (*wear, wear[1], None))
+        """Learn the baseline on :attr:`training` (:func:`faultgen.monitor.learning.fit`)."""
+        learning.fit(self, FAR_ALPHA, WEAR_INTERVAL_Z, NOT_OBSERVABLE_LIMITS)
 
     def _standardise(self, e: np.ndarray, conditions: np.ndarray) -> np.ndarray:
         x = np.nan_to_num(conditions[self.regressors_] - self.condition_mean_[self.regressors_])
@@ -420,7 +376,7 @@ class UnitMonitor:
             self.training.append((stamp, np.asarray(residual, dtype=float), conditions))
             if expected is not None:
                 self.learned_expectations.append(np.asarray(expected, dtype=float))
-            if len(self.training) == self.settings.train:
+            if len(self.training) == (self.settings.train if self.borrowed_ is None else self.relearn_logs):
                 self._fit()
             elif self.program_changed:  # listed at once (scored when the learning is complete)
                 self.rows.append(record.listed(self.unit, stamp, self.n_axes))
