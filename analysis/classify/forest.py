@@ -105,8 +105,9 @@ class _Grower:
         indices = np.random.RandomState(seed).randint(0, n_samples, n_samples).astype(np.int32)
         weight = np.bincount(indices, minlength=n_samples).astype(np.float64)
         min_weight_leaf = tree.min_weight_fraction_leaf * np.sum(weight)
-        splitter = DENSE_SPLITTERS[tree.splitter](self.criterion(1, self.n_classes), self.max_features, self.leaf,
-                                                  min_weight_leaf, np.random.RandomState(seed), None)
+        criterion = self.criterion(1, self.n_classes)  # a fresh one per tree, as each tree's fit makes
+        splitter = DENSE_SPLITTERS[tree.splitter](criterion, self.max_features, self.leaf, min_weight_leaf,
+                                                  np.random.RandomState(seed), None)
         tree.n_features_in_, tree.n_outputs_, tree.max_features_ = X.shape[1], 1, self.max_features
         tree.tree_ = Tree(X.shape[1], self.n_classes, 1)
         builder = DepthFirstTreeBuilder(splitter, self.split, self.leaf, min_weight_leaf, self.depth,
