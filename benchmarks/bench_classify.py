@@ -1,14 +1,16 @@
 """Classification speed: `faultgen classify` against a plain scikit-learn loop and the sweep that made the data.
 
-    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--fleet fleet.h5 [--make-fleet]] [--steps 1,2,3,4,5]
+    python benchmarks/bench_classify.py [--dataset quick.h5] [--full] [--no-full] [--fleet fleet.h5 [--make-fleet]]
+                                        [--steps 1,2,3,4,5]
 
 In one run of this script:
 
 1. ``faultgen sweep --preset quick`` writes quick.h5 (timed; skipped with --dataset), then
    ``faultgen classify quick.h5`` with its defaults (timed, as a user runs it: the seven rows of
    ``analysis.classify.SHORT_TABLE``, pairs in parallel on every core, each row's chance level
-   on lr included) and ``classify --full`` (every row); the ratios classify / sweep, wall and CPU, and
-   whether the default table meets the target, at most the sweep's time (1.0x) in both;
+   on lr included) and ``classify --full`` (every row; not with --no-full); the ratios classify /
+   sweep, wall and CPU, and whether the default table meets the target, at most the sweep's time
+   (1.0x) in both;
 2. on the same inputs and pairs, every cell of the default table (of every row with --full)
    three ways:
    - plain: a scikit-learn loop, each (cell, pair) its whole pipeline cloned, fitted and scored
@@ -89,8 +91,9 @@ def plain_loop(inputs, names, classifiers, n_pairs, seed) -> dict:
 #: classifiers, is the outer model's), by the column name of their classifier; PCA is the one
 #: preprocessing step fitted on data, Difference and WindowConcat the stateless run-by-run ones,
 #: StandardScaler the classifiers' scaling (shared by them and by the label sets) and PCA's.
-COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "StackingClassifier": "stacking",
-           "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence", "StandardScaler": "scale"}
+COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "Forest": "rf",
+           "StackingClassifier": "stacking", "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence",
+           "StandardScaler": "scale"}
 
 
 def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
@@ -168,9 +171,10 @@ def _counted_classes() -> list[type]:
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVC
 
+    from analysis.classify.forest import Forest
     from analysis.features import Difference, WindowConcat
 
-    return [LogisticRegression, SVC, RandomForestClassifier, StackingClassifier, PCA, Difference, WindowConcat,
+    return [LogisticRegression, SVC, RandomForestClassifier, Forest, StackingClassifier, PCA, Difference, WindowConcat,
             StandardScaler]
 
 
@@ -252,6 +256,8 @@ def main() -> None:
     parser.add_argument("--full", action="store_true", help="Step 2 on every row (default: classify's seven).")
     parser.add_argument("--fleet", type=Path, help="A fleet for steps 3 and 4.")
     parser.add_argument("--make-fleet", action="store_true", help="Make --fleet first with `faultgen fleet`, timed.")
+    parser.add_argument("--no-full", action="store_true",
+                        help="Step 1 without `classify --full` (the default table only).")
     parser.add_argument("--pairs", type=int, default=20, help="Held-out pairs of step 2 (classify's default, 20).")
     parser.add_argument("--steps", default="1,2,3,4,5", help="Steps to run (3 and 4 need --fleet); default all.")
     args = parser.parse_args()
@@ -272,7 +278,7 @@ def main() -> None:
             else:
                 subprocess.run(command, env=children.environment(), check=True, stdout=subprocess.DEVNULL)
         if 1 in steps:
-            for flag in ([], ["--full"]):
+            for flag in ([], *([] if args.no_full else [["--full"]])):
                 t = timed([*faultgen(), "classify", str(path), *flag, "-o", str(folder / "cls"), "--no-progress",
                            "--overwrite"])
                 what = f"faultgen classify {' '.join(flag) or '(defaults)'}"
