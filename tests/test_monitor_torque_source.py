@@ -47,6 +47,8 @@ TORQUE_CONSTANTS = (12.0, 12.0, 12.0, 9.0, 9.0, 9.0)
 CONTROLLER = (1.04, 0.97, 1.05, 1.03, 0.96, 1.04)
 #: Logs a baseline learns from (the monitor's fewest).
 TRAIN = 10
+#: The logs a baseline met after the unit learned learns its offset on (UnitMonitor.relearn_logs).
+RELEARN = max(5, TRAIN // 4)
 #: Days unworn, then days of axis 2's linear wear to FINAL_WEAR %; the source switches on day SWITCH.
 UNWORN, WEARING, WORN_AXIS, FINAL_WEAR = 2 * TRAIN + 1, 10, 2, 20.0
 SWITCH = TRAIN + 1
@@ -146,13 +148,14 @@ def test_a_switch_to_the_controllers_current_as_torque_learns_its_own_baseline_a
     assert row["status"] == "monitored" and "program changed" not in row["reason"]
     assert row["programs"] == f"program 1 ({formats.MEASURED_CURRENT}): {SWITCH} logs, " \
                               f"program 1 ({formats.CURRENT_AS_TORQUE}): {len(days) - SWITCH} logs"
-    # the logs from the switch on: their own baseline (1), learned on their own first TRAIN logs
+    # the logs from the switch on: their own baseline (1), its offset learned on their own first logs (a
+    # quarter of TRAIN, at least 5: as a program met after the unit learned), the rest borrowed
     state = json.loads((out / ".state" / "ur-01.json").read_text())
     assert [log.get("program", 0) for log in state["logs"]] == [0] * SWITCH + [1] * (len(days) - SWITCH)
     assert [(c["stamp"], c["source"]) for c in state["program_changes"]] == [(switch, formats.CURRENT_AS_TORQUE)]
     assert state["program_changes"][0]["program"] == state["program"]  # the same program, the same twin
     phases = [r["phase"] for r in _rows(out / "scores.csv")]
-    assert phases == ["training"] * TRAIN + ["monitoring"] + ["relearning"] * TRAIN + ["monitoring"] * WEARING
+    assert phases == ["training"] * TRAIN + ["monitoring"] + ["relearning"] * RELEARN + ["monitoring"] * (WEARING + TRAIN - RELEARN)
     # the worn unit alarms on its worn axis, in time
     (alarm,) = [r for r in _rows(out / "alarms.csv") if r["first_alarm"]]
     assert alarm["source_axis"] == str(WORN_AXIS)
@@ -178,15 +181,15 @@ def test_a_switch_to_the_commanded_moment_is_never_scored_against_the_measured_b
         in row["reason"]
     assert row["torque_source"] == f"{formats.MEASURED_CURRENT}, {formats.COMMANDED_MOMENT} from {switch}"
     # its own baseline cannot be learned (the command is the same every day): every later log skipped with why
-    skipped = len(days) - SWITCH - (TRAIN - 1)
-    assert f"{skipped} logs skipped: {days[SWITCH + TRAIN - 1][0]}: the baseline begun at {switch} cannot be learned: " \
+    skipped = len(days) - SWITCH - (RELEARN - 1)
+    assert f"{skipped} logs skipped: {days[SWITCH + RELEARN - 1][0]}: the baseline begun at {switch} cannot be learned: " \
            f"{feed.CONSTANT_TORQUE.removeprefix('not monitored: ')}" in row["reason"], row["reason"]
     # degraded, and said so by the exit status (before issue 90: "monitored", exit 0, no alarm)
     assert row["status"] == "degraded" and result.exit_code == loop.EXIT_SOME_UNITS_NOT_MONITORED, result.output
     assert row["programs"] == f"program 1 ({formats.MEASURED_CURRENT}): {SWITCH} logs, " \
-                              f"program 1 ({formats.COMMANDED_MOMENT}): {TRAIN - 1} logs"
+                              f"program 1 ({formats.COMMANDED_MOMENT}): {RELEARN - 1} logs"
     state = json.loads((out / ".state" / "ur-01.json").read_text())
-    assert [log.get("program", 0) for log in state["logs"]] == [0] * SWITCH + [1] * (TRAIN - 1)
+    assert [log.get("program", 0) for log in state["logs"]] == [0] * SWITCH + [1] * (RELEARN - 1)
     # no log of the commanded moment scored against the measured baseline: no alarm, no monitoring row after it
     scores = _rows(out / "scores.csv")
     assert all(r["phase"] != "monitoring" for r in scores if r["stamp"] >= switch)

@@ -297,7 +297,7 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
     "" otherwise (or before the learning's last log). The features are the residuals plus the
     twin's expectation, which may vary with the logs' conditions while the torque does not."""
     monitor = unit.monitor
-    if monitor.pca is not None or len(monitor.training) + 1 < monitor.settings.train:
+    if monitor.pca is not None or len(monitor.training) + 1 < monitor.learning_logs:
         return ""
     expected = monitor.learned_expectations or [0.0] * len(monitor.training)
     features = np.stack([e + x for (_, e, _), x in zip(monitor.training, expected)] + [vector])

@@ -247,6 +247,12 @@ class UnitMonitor:
         a quarter of ``train``, at least 5."""
         return max(5, self.settings.train // 4)
 
+    @property
+    def learning_logs(self) -> int:
+        """The logs this baseline learns on: ``train``, or :attr:`relearn_logs` for a program (or torque
+        source) met after the unit learned, which learns its offset alone (``borrowed_``)."""
+        return self.settings.train if self.borrowed_ is None else self.relearn_logs
+
     # -- a new program ---------------------------------------------------------------------------
     def restart(self, stamp: str, reason: str) -> None:
         """The unit runs another program from the log ``stamp`` on (``reason`` says how it was
@@ -376,7 +382,7 @@ class UnitMonitor:
             self.training.append((stamp, np.asarray(residual, dtype=float), conditions))
             if expected is not None:
                 self.learned_expectations.append(np.asarray(expected, dtype=float))
-            if len(self.training) == (self.settings.train if self.borrowed_ is None else self.relearn_logs):
+            if len(self.training) == self.learning_logs:
                 self._fit()
             elif self.program_changed:  # listed at once (scored when the learning is complete)
                 self.rows.append(record.listed(self.unit, stamp, self.n_axes))
