@@ -83,7 +83,12 @@ def test_bound_share_coverage_and_median_error():
             ("u2", 1): [wear_row(STAMPS[9], 11, 9, 13, 10.0)]}  # healthy at the limit: bound above truth 0
     below, alarms = bounds.bound_below(TRUTH, wear, 10.0)
     assert (below, alarms) == (1, 4)
-    assert rct.bound_row(below, alarms)[1:] == ("25.0 % (1 of 4 alarming log-axes)", False)
+    assert rct.bound_row(below, alarms)[1:] == ("25.0 % (1 of 4)", False)
+    alarm_rows = [{"unit": "u1", "first_alarm": STAMPS[3], "source_axis": "2"},  # 10.5 over 10: above
+                  {"unit": "u1", "first_alarm": STAMPS[5], "source_axis": "2"},  # 17 under 20: below
+                  {"unit": "u2", "first_alarm": STAMPS[9], "source_axis": "1"},  # 10 over 0: above
+                  {"unit": "u2", "first_alarm": STAMPS[0], "source_axis": "1"}]  # no wear row that day: not counted
+    assert rct.alarms_below(TRUTH, wear, alarm_rows) == (1, 3)
     assert rct.bound_row(19, 20)[2] and not rct.bound_row(0, 0)[2]
     per_unit = bounds.window_logs(TRUTH, wear)
     assert per_unit == {"u1": [(True, 2.0), (True, 1.0), (False, 6.0)]}
