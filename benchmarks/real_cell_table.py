@@ -198,7 +198,7 @@ def lambda_outcome(t: dict, known: str, predict) -> dict:
     row = predict(after[0])
     day, true = days[after[0]], eol - days[after[0]]
     if row.rul is None:
-        return {"eol": eol, "day": day, "true": true, "why": f"no remaining life: {row.verdict[:60]}"}
+        return {"eol": eol, "day": day, "true": true, "why": f"day {day}: no remaining life ({row.verdict[:90]})"}
     early = row.rul if row.rul_5 is None else row.rul_5
     return {"eol": eol, "lambda": lam, "day": day, "true": true, "median": row.rul, "service_by": day + early,
             "ok": day + early <= eol, "within": abs(row.rul - true) <= WITHIN * true,

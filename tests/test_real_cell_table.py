@@ -126,7 +126,7 @@ def test_lambda_service_by_within_and_phm():
     assert late["service_by"] == 11.0 and not late["ok"] and late["late"] and not late["within"]
     assert rct.lambda_outcome(TRUTH["u1"], "", predict)["why"] == "no alarm"
     none = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(None, None))
-    assert "median" not in none and none["why"].startswith("no remaining life")
+    assert "median" not in none and none["why"].startswith("day 7: no remaining life")
     rows = rct.lambda_rows({"u1": o, "u3": late}, clean=False)
     assert [r[2] for r in rows] == [False, True, None]
     assert rows[0][1].startswith("1 of 2") and rows[1][1] == "1 of 2; late by more than 20 %: 1"
