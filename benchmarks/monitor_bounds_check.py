@@ -50,27 +50,78 @@ def read_wear(out: Path) -> dict[tuple[str, int], list[dict]]:
     return rows
 
 
+def true_wear(t: dict, axis: int) -> dict[str, float]:
+    """Stamp -> the true wear of ``axis`` of a unit's truth ``t`` (:func:`independent.read_truth`; an unworn axis: 0)."""
+    return dict(zip(t["stamps"], t["wear"] if t["axis"] == axis else np.zeros(len(t["stamps"]))))
+
+
+def bound_below(truth: dict, wear: dict, limit: float) -> tuple[int, int]:
+    """(log-axes whose lower bound is at or below the true wear, log-axes whose lower bound is at or
+    past ``limit``: the alarming ones), over the monitoring rows ``wear`` (:func:`read_wear`)."""
+    below = alarms = 0
+    for (unit, axis), rows in wear.items():
+        true = true_wear(truth[unit], axis)
+        for r in rows:
+            w, lower = true.get(r["stamp"]), float(r["wear_lower"])
+            if w is not None and lower >= limit:
+                alarms += 1
+                below += lower <= w
+    return below, alarms
+
+
+def window_logs(truth: dict, wear: dict) -> dict[str, list[tuple[bool, float]]]:
+    """Per worn unit, each of its worn axis's monitoring logs at SPAN % true wear: (its 90 % interval
+    holds the truth, the absolute error of its wear, points)."""
+    out: dict[str, list[tuple[bool, float]]] = {}
+    for (unit, axis), rows in wear.items():
+        t = truth[unit]
+        if t["axis"] != axis:
+            continue
+        true = true_wear(t, axis)
+        for r in rows:
+            w = true.get(r["stamp"])
+            if w is not None and SPAN[0] <= w <= SPAN[1]:
+                inside = float(r["wear_5"]) <= w <= float(r["wear_95"])
+                out.setdefault(unit, []).append((inside, abs(float(r["wear"]) - w)))
+    return out
+
+
+def first_alarms(truth: dict, alarm_rows: list[dict]) -> dict[str, tuple[str, int | None, float | None]]:
+    """Per unit its first alarm (alarms.csv rows with one): (stamp or "", its source axis, the true wear
+    of the unit's worn axis that day or None)."""
+    out = {}
+    for unit, t in truth.items():
+        mine = sorted((r for r in alarm_rows if r["unit"] == unit and r["first_alarm"]), key=lambda r: r["first_alarm"])
+        first = mine[0]["first_alarm"] if mine else ""
+        axis = int(mine[0]["source_axis"]) if mine and mine[0]["source_axis"] else None
+        out[unit] = (first, axis, dict(zip(t["stamps"], t["wear"])).get(first) if t["axis"] else None)
+    return out
+
+
+def rate(t: dict) -> float:
+    """A unit's largest daily wear growth, points a day (0 for a healthy one)."""
+    return float(np.max(np.diff(t["wear"]))) if t["axis"] and len(t["wear"]) > 1 else 0.0
+
+
+def alarm_in_window(wear: float | None, fast: bool) -> bool:
+    """The first alarm's criterion at its true wear: ALARM, before ALARM[1] for a unit wearing faster than 1 point a day."""
+    return wear is not None and (wear < ALARM[1] if fast else ALARM[0] <= wear <= ALARM[1])
+
+
+def read_alarms(out: Path) -> list[dict]:
+    with open(out / "alarms.csv", newline="") as f:
+        return [r for r in csv.DictReader(f) if r["first_alarm"]]
+
+
 def check(fleet: Path, out: Path, scatter: float, limit: float) -> list[str]:
     """The lines with verdicts (module docstring)."""
     truth = independent.read_truth(fleet / "truth.csv")
     wear = read_wear(out)
-    below, alarms, covered, errors, lines = 0, 0, [], [], []
-    per_unit: dict[str, list[bool]] = {}
-    for (unit, axis), rows in wear.items():
-        t = truth[unit]
-        true = dict(zip(t["stamps"], t["wear"] if t["axis"] == axis else np.zeros(len(t["stamps"]))))
-        for r in rows:
-            w, lower = true.get(r["stamp"]), float(r["wear_lower"])
-            if w is None:
-                continue
-            if lower >= limit:
-                alarms += 1
-                below += lower <= w
-            if t["axis"] == axis and SPAN[0] <= w <= SPAN[1]:
-                inside = float(r["wear_5"]) <= w <= float(r["wear_95"])
-                covered.append(inside)
-                per_unit.setdefault(unit, []).append(inside)
-                errors.append(abs(float(r["wear"]) - w))
+    below, alarms = bound_below(truth, wear, limit)
+    per_unit = window_logs(truth, wear)
+    covered = [c for logs in per_unit.values() for c, _ in logs]
+    errors = [e for logs in per_unit.values() for _, e in logs]
+    lines = []
     share = below / alarms if alarms else float("nan")
     lines.append(f"alarm bound below truth: {below} of {alarms} alarming log-axes ({100 * share:.1f} %) "
                  f"({verdict(alarms > 0 and share >= BOUND_SHARE)}: >= {100 * BOUND_SHARE:g} %)")
@@ -82,21 +133,17 @@ def check(fleet: Path, out: Path, scatter: float, limit: float) -> list[str]:
     median = float(np.median(errors)) if errors else float("nan")
     lines.append(f"median wear error there: {median:.2f} points"
                  + (f" ({verdict(median <= target)}: <= {target:g})" if target is not None else ""))
-    with open(out / "alarms.csv", newline="") as f:
-        alarm_rows = [r for r in csv.DictReader(f) if r["first_alarm"]]
+    firsts = first_alarms(truth, read_alarms(out))
     for unit, t in sorted(truth.items()):
-        first = min((r["first_alarm"] for r in alarm_rows if r["unit"] == unit), default="")
-        w = dict(zip(t["stamps"], t["wear"])).get(first)
+        first, _, w = firsts[unit]
         if not t["axis"]:
             lines.append(f"  {unit} (healthy): {'alarm ' + first + ' (NOT met' if first else 'quiet (met'}: healthy quiet)")
             continue
-        rate = float(np.max(np.diff(t["wear"]))) if len(t["wear"]) > 1 else 0.0
-        fast = rate > 1.0
-        ok = w is not None and (w < ALARM[1] if fast else ALARM[0] <= w <= ALARM[1])
-        cov = per_unit.get(unit, [])
+        fast = rate(t) > 1.0
+        cov = [c for c, _ in per_unit.get(unit, [])]
         cov_text = f"{100 * np.mean(cov):.0f} % of {len(cov)}" if cov else "no log"
-        lines.append(f"  {unit} (axis {t['axis']}, up to {rate:.2g} points a day): first alarm {first or 'none'}"
-                     f"{'' if w is None else f' at {w:.1f} % true wear'} ({verdict(ok)}: "
+        lines.append(f"  {unit} (axis {t['axis']}, up to {rate(t):.2g} points a day): first alarm {first or 'none'}"
+                     f"{'' if w is None else f' at {w:.1f} % true wear'} ({verdict(alarm_in_window(w, fast))}: "
                      f"{'< 15' if fast else f'{ALARM[0]:g}-{ALARM[1]:g}'} %); coverage {cov_text} "
                      f"({verdict(bool(cov) and COVERAGE[0] <= np.mean(cov) <= COVERAGE[1])})")
     return lines

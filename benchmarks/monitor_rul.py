@@ -174,11 +174,12 @@ def exact_crossing_error(wear: np.ndarray, scale: float, offset: float, start: i
     return (day_of(wear, (failure - offset) / scale) - eol) / (eol - lam)
 
 
-def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
+def replayed_rows(fleet: Path, out: Path, robot: Path | None = None) -> dict[str, list[dict]] | None:
     """Each unit's monitor rows (``UnitMonitor.rows``, with the twin-scale columns and the factors
     scores.csv does not keep) of a run of ``benchmarks/monitor_wear_scale.py`` with friction tests:
     the state in ``out/.state`` replayed with the tests read from ``out``'s cache (the robot
-    ``fleet/kr210``, the logs ``fleet/logs``), as a continued monitor run replays it; None without tests."""
+    ``robot``, default ``fleet/kr210``, the logs ``fleet/logs``), as a continued monitor run replays it;
+    None without tests."""
     from faultgen.model import robots
     from faultgen.monitor import friction_tests
     from faultgen.monitor import logs as fleet_logs
@@ -190,10 +191,11 @@ def replayed_rows(fleet: Path, out: Path) -> dict[str, list[dict]] | None:
     found = friction_tests.find(fleet / "logs", units, suffixes)
     if not any(found.values()):
         return None
-    if not (fleet / "kr210").is_dir():
-        raise SystemExit(f"{fleet / 'kr210'}: no robot folder there (benchmarks/monitor_wear_scale.py makes it); "
+    robot = fleet / "kr210" if robot is None else robot
+    if not robot.is_dir():
+        raise SystemExit(f"{robot}: no robot folder there (benchmarks/monitor_wear_scale.py makes it); "
                          "expected the fleet's KR210 to replay its monitor's state, or --scores-only")
-    nominal = robots.load(fleet / "kr210")
+    nominal = robots.load(robot)
     tests = friction_tests.read_tests(found, nominal, out)
     n, rows = nominal.n_axes, {}
     for name in units:

@@ -1,0 +1,154 @@
+"""The judging functions of benchmarks/real_cell_table.py (issue 90's tables) and the shared ones of
+benchmarks/monitor_bounds_check.py, on a hand-made truth and monitor output of three units whose every
+figure is worked out by hand below."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+import monitor_bounds_check as bounds  # noqa: E402
+import real_cell_table as rct  # noqa: E402
+
+STAMPS = [f"2026-01-{d:02d}" for d in range(1, 11)]
+#: u1 wears axis 2 by 5 points a day from day 3 (day 10: 40 %); u2 healthy; u3 wears axis 1 by 3 a day from day 2.
+TRUTH = {
+    "u1": {"axis": 2, "stamps": STAMPS, "wear": np.array([0, 0, 5, 10, 15, 20, 25, 30, 35, 40], dtype=float)},
+    "u2": {"axis": 0, "stamps": STAMPS, "wear": np.zeros(10)},
+    "u3": {"axis": 1, "stamps": STAMPS, "wear": 3.0 * np.maximum(np.arange(10) - 1, 0)},
+}
+
+
+def wear_row(stamp, wear, low, high, lower):
+    return {"stamp": stamp, "wear": str(wear), "wear_5": str(low), "wear_95": str(high), "wear_lower": str(lower)}
+
+
+def test_monitored_by_day_40_is_per_unit_first_monitoring_log():
+    scores = [{"unit": "u1", "stamp": STAMPS[0], "phase": "training"},
+              {"unit": "u1", "stamp": STAMPS[3], "phase": "monitoring"},
+              {"unit": "u1", "stamp": STAMPS[4], "phase": "monitoring"},
+              {"unit": "u2", "stamp": STAMPS[1], "phase": "monitoring"},
+              {"unit": "u3", "stamp": STAMPS[0], "phase": "training"}]
+    first = rct.first_monitored(scores)
+    assert first == {"u1": STAMPS[3], "u2": STAMPS[1], "u3": ""}
+    _, figure, ok = rct.monitored_row(TRUTH, first)
+    assert not ok and "2 of 3" in figure and "u3 never" in figure
+    _, _, ok = rct.monitored_row({"u1": TRUTH["u1"]}, first)
+    assert ok
+
+
+def test_program_changes_against_the_truths_new_programs():
+    units = [{"unit": "u1", "reason": "program changed at 2026-01-07 (not logged: ...); program changed at "
+                                      "2026-01-09 (...)", "programs": ""},
+             {"unit": "u2", "reason": "", "programs": ""}]
+    reported = rct.reported_changes(units)
+    assert reported == {"u1": ["2026-01-07", "2026-01-09"], "u2": []}
+    assert rct.changes_row(reported, {"u1": ["2026-01-09", "2026-01-07"]})[2]
+    _, figure, ok = rct.changes_row(reported, {"u1": ["2026-01-07"]})
+    assert not ok and "u1 (2 vs 1)" in figure
+
+
+def test_first_alarms_window_and_healthy_quiet():
+    alarms = [{"unit": "u1", "first_alarm": STAMPS[5], "source_axis": "2"},  # 20 %: too late
+              {"unit": "u1", "first_alarm": STAMPS[3], "source_axis": "2"},  # 10 %: the first, in the window
+              {"unit": "u3", "first_alarm": STAMPS[5], "source_axis": "1"}]  # 12 % at 3 points a day: < 15
+    firsts = bounds.first_alarms(TRUTH, alarms)
+    assert firsts["u1"] == (STAMPS[3], 2, 10.0) and firsts["u2"] == ("", None, None)
+    assert bounds.rate(TRUTH["u3"]) == 3.0 and bounds.rate(TRUTH["u2"]) == 0.0
+    (_, figure, ok), (_, quiet, ok_quiet) = rct.alarm_rows(TRUTH, firsts)
+    assert ok and "2 of 2" in figure and ok_quiet and "1 of 1 quiet" in quiet
+    wrong_axis = bounds.first_alarms(TRUTH, [{**alarms[1], "source_axis": "3"}, alarms[2],
+                                             {"unit": "u2", "first_alarm": STAMPS[9], "source_axis": "4"}])
+    (_, figure, ok), (_, quiet, ok_quiet) = rct.alarm_rows(TRUTH, wrong_axis)
+    assert not ok and "(axis 3)" in figure and not ok_quiet and "u2" in quiet
+    assert not bounds.alarm_in_window(7.9, False) and bounds.alarm_in_window(7.9, True)
+    # a unit at 0.5 point a day as its wear reaches 8 %: the window 8-15 %, not "before 15 %"
+    slow = {"u4": {"axis": 3, "stamps": STAMPS, "wear": np.array([0, 4, 6, 7.5, 8, 8.5, 9, 30, 60, 90.0])}}
+    assert rct.growth_at(slow["u4"], 8.0) == 0.5 and rct.growth_at(TRUTH["u3"], 8.0) == 3.0
+    assert not rct.alarm_rows(slow, {"u4": (STAMPS[3], 3, 7.5)})[0][2]
+    assert rct.alarm_rows(slow, {"u4": (STAMPS[4], 3, 8.0)})[0][2]
+    assert not bounds.alarm_in_window(15.1, True) and not bounds.alarm_in_window(None, False)
+
+
+def test_bound_share_coverage_and_median_error():
+    wear = {("u1", 2): [wear_row(STAMPS[3], 12, 8, 16, 10.5),    # 10 % true: covered, error 2, bound above truth
+                        wear_row(STAMPS[5], 19, 17, 21, 17.0),   # 20 %: covered, error 1, bound below
+                        wear_row(STAMPS[7], 36, 33, 39, 33.0)],  # 30 %: not covered, error 6, bound above
+            ("u1", 3): [wear_row(STAMPS[7], 1, -2, 4, -1.0)],   # an unworn axis: not in the window's logs
+            ("u2", 1): [wear_row(STAMPS[9], 11, 9, 13, 10.0)]}  # healthy at the limit: bound above truth 0
+    below, alarms = bounds.bound_below(TRUTH, wear, 10.0)
+    assert (below, alarms) == (1, 4)
+    assert rct.bound_row(below, alarms)[1:] == ("25.0 % (1 of 4)", False)
+    alarm_rows = [{"unit": "u1", "first_alarm": STAMPS[3], "source_axis": "2"},  # 10.5 over 10: above
+                  {"unit": "u1", "first_alarm": STAMPS[5], "source_axis": "2"},  # 17 under 20: below
+                  {"unit": "u2", "first_alarm": STAMPS[9], "source_axis": "1"},  # 10 over 0: above
+                  {"unit": "u2", "first_alarm": STAMPS[0], "source_axis": "1"}]  # no wear row that day: not counted
+    assert rct.alarms_below(TRUTH, wear, alarm_rows) == (1, 3)
+    assert rct.bound_row(19, 20)[2] and not rct.bound_row(0, 0)[2]
+    per_unit = bounds.window_logs(TRUTH, wear)
+    assert per_unit == {"u1": [(True, 2.0), (True, 1.0), (False, 6.0)]}
+    (_, median, ok_median), (_, cover, ok_cover) = rct.error_rows(per_unit, 0.03, 1.6)
+    assert median.startswith("2.00 points over 3 logs (<= 2.10") and ok_median
+    assert cover.startswith("66.7 %") and not ok_cover
+
+
+def test_the_median_criterion_per_scatter():
+    assert rct.median_target(0.0, None) == 1.5
+    assert rct.median_target(0.015, 1.2) == pytest.approx(1.7)
+    assert rct.median_target(0.015, 2.6) == 2.0
+    assert rct.median_target(0.03, 2.6) == pytest.approx(3.1)
+    assert rct.median_target(0.03, None) is None
+
+
+def remaining(rul, rul_5):
+    return SimpleNamespace(rul=rul, rul_5=rul_5, verdict="")
+
+
+def test_lambda_service_by_within_and_phm():
+    # u1 reaches 40 % on day 10 (eol 10); alarm known on day 4: lambda 4 + 0.5 x 6 = day 7, true 3 days
+    asked = []
+
+    def predict(stamp):
+        asked.append(stamp)
+        return remaining(3.5, 2.0)
+
+    o = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], predict)
+    assert asked == [STAMPS[6]]
+    assert (o["eol"], o["day"], o["true"], o["service_by"]) == (10.0, 7, 3.0, 9.0)
+    assert o["ok"] and o["within"] and not o["late"]
+    assert o["phm08"] == pytest.approx(np.exp(0.5 / 10) - 1)
+    late = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(4.0, None))  # no 5 %: the median
+    assert late["service_by"] == 11.0 and not late["ok"] and late["late"] and not late["within"]
+    assert rct.lambda_outcome(TRUTH["u1"], "", predict)["why"] == "no alarm"
+    none = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(None, None))
+    assert "median" not in none and none["why"].startswith("day 7: no remaining life")
+    rows = rct.lambda_rows({"u1": o, "u3": late}, clean=False)
+    assert [r[2] for r in rows] == [False, True, None]
+    assert rows[0][1].startswith("1 of 2") and rows[1][1] == "1 of 2; late by more than 20 %: 1"
+    assert rows[2][1] == f"{o['phm08'] + late['phm08']:.2f} over 2 units"
+    clean = rct.lambda_rows({f"u{i}": o for i in range(6)} | {"u7": late, "u8": none}, clean=True)
+    assert "at least 6 of 8, late on none" in clean[1][0] and not clean[1][2]
+
+
+def test_rates_units_and_the_cpu_ratio():
+    per_unit = {"u3": [(True, 1.0)] * 9 + [(False, 1.0)]}
+    firsts = {"u1": (STAMPS[4], 2, 15.0), "u2": ("", None, None), "u3": (STAMPS[5], 1, 12.0)}
+    rows = rct.rates_rows(TRUTH, firsts, per_unit)  # u1's 5 points a day is not one of RATES
+    assert [(r[1], r[2]) for r in rows] == [("90 % of 10 logs", True), ("2026-01-06 at 12.0 %", True)]
+    lines = rct.ratio_lines({"scatter-0.015": 0.3, "scatter-0.015-one-program": 0.25, "scatter-0.015-rates": 0.5,
+                             "scatter-0.03": 0.2, "scatter-0.03-one-program": None})
+    assert lines == ["- scatter-0.015 / its one-program fleet: CPU time per log 0.300 / 0.250 s = 1.20x (met: at "
+                     "most 1.5x)"]
+    assert rct.ratio_lines({"scatter-0.03": 0.4, "scatter-0.03-one-program": 0.25}) == [
+        "- scatter-0.03 / its one-program fleet: CPU time per log 0.400 / 0.250 s = 1.60x (NOT met: at most 1.5x)"]
+
+
+def test_a_fleet_folder_not_named_for_its_scatter_is_refused():
+    assert rct.scatter_of(Path("/x/scatter-0.015-one-program")) == 0.015
+    with pytest.raises(SystemExit, match="expected a fleet folder named scatter-<sigma>"):
+        rct.scatter_of(Path("/x/fleet"))
