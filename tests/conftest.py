@@ -144,6 +144,23 @@ def shared_bench(tmp_path_factory, worker_id):
 
 
 @pytest.fixture
+def loads(monkeypatch):
+    """The names ``faultgen.model.robots.load`` is called with while the test runs (a counting
+    wrapper on the module attribute, which every caller resolves through: tests/test_resolve_once.py)."""
+    from faultgen.model import robots
+
+    calls = []
+    load = robots.load
+
+    def counting(name):
+        calls.append(str(name))
+        return load(name)
+
+    monkeypatch.setattr(robots, "load", counting)
+    return calls
+
+
+@pytest.fixture
 def figures(monkeypatch):
     """The figures plot() draws, kept for inspection when it saves them."""
     from matplotlib.figure import Figure

@@ -21,20 +21,6 @@ from faultgen.runs.context import ExecutionContext
 from faultgen.simulation import backends
 
 
-@pytest.fixture
-def loads(monkeypatch):
-    """The names ``robots.load`` is called with while the test runs."""
-    calls = []
-    load = robots.load
-
-    def counting(name):
-        calls.append(str(name))
-        return load(name)
-
-    monkeypatch.setattr(robots, "load", counting)
-    return calls
-
-
 def _one_unit(tmp_path):
     """A fleet folder of one unit whose only log has no torque column: the run finishes at once,
     the unit not monitored (its reason names the missing columns)."""

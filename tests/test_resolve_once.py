@@ -23,20 +23,6 @@ ROOT = Path(__file__).resolve().parents[1]
 runner = CliRunner()
 
 
-@pytest.fixture
-def loads(monkeypatch):
-    """The names ``robots.load`` is called with while the test runs."""
-    calls = []
-    load = robots.load
-
-    def counting(name):
-        calls.append(str(name))
-        return load(name)
-
-    monkeypatch.setattr(robots, "load", counting)
-    return calls
-
-
 def _copies_of_load(path: Path) -> list[str]:
     """Where ``path`` binds the resolver to a name of its own (``from ... import load``, ``f = robots.load``,
     ``from faultgen import load_robot``): a copy a wrapper on the module attribute would not see."""

@@ -162,7 +162,8 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source,
         A new program's twin cannot be built (the log is then skipped, named).
     """
     known = references(unit, context.units, source)
-    found = align.recognise(data.t, data.q, sources.distinct(known))
+    programs = sources.distinct(known)  # one reference a program (a source change repeats its program's)
+    found = align.recognise(data.t, data.q, programs)
     if found.status is align.Status.KNOWN:
         k = next(i for i, r in enumerate(known) if r.name == found.program)
         reference = known[k]
@@ -170,7 +171,7 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source,
         k = len(known)
         try:
             reference = unit_programs.reference_of(data.t, data.q, data.cycle,
-                                                   f"program {len(sources.distinct(known)) + 1}")
+                                                   f"program {len(programs) + 1}")
         except ValueError as err:
             return f"no whole cycle: a new program that cannot be learned ({short(err)})"
     else:
@@ -286,7 +287,6 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
                                      *load, program))
     return twin
-
 
 
 def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
