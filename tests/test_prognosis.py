@@ -124,9 +124,12 @@ def test_the_hinge_fits_the_whole_block_its_interval_covers_the_crossing_and_is_
     # numbers cover (18 of 19 before)
     assert covered >= 0.8 * numbers and numbers >= 0.75 * draws, (covered, numbers)
     assert named >= 0.8 * draws, named
-    # narrower than from the alarm: 0.80 of it since the power law's exponent carries the hinge's
-    # draws (2026-11-27, docs/analysis.md "Accelerating wear without running late"; below 0.75 before)
-    assert np.median(widths["hinge"]) < 0.85 * np.median(widths["from the alarm"]), widths
+    # no wider than from the alarm: 0.80 of it since the power law's exponent carries the hinge's
+    # draws (2026-11-27, docs/analysis.md "Accelerating wear without running late"; below 0.75 before);
+    # 0.97 of it since the exponential rise after a flat stretch joined the average and the service-by
+    # end is the earliest credible model's (2026-11-28, issue 90, docs/analysis.md "Issue 90:
+    # service-by dates that are not late": a rise the logs cannot tell from an accelerating one)
+    assert np.median(widths["hinge"]) < np.median(widths["from the alarm"]), widths
 
 
 def test_a_hinge_that_does_not_rise_falls_back_to_the_fit_from_the_alarm():

@@ -21,7 +21,10 @@ Per axis:
    the last, :data:`faultgen.monitor.trends.HINGE_MARGINS`, refined between its neighbours, its
    uncertainty in the covariance), and the **power-law rise**, flat and then ``c (t - t0)^p``, ``p``
    in [1, 4] (:func:`faultgen.monitor.trends.fit_power`: a rise that accelerates; ``p`` = 1 is the
-   changepoint trend). When neither the changepoint trend nor the power law rises: the line and
+   changepoint trend), and the **onset exponential**, flat and then exponential
+   (:func:`faultgen.monitor.rul_forecast.fit_onset_exponential`: the power law's bounded exponent
+   bends too slowly for an exponential wear, and the exponential over the whole block cannot be flat
+   before the rise). When neither the changepoint trend nor the power law rises: the line and
    the exponential of the logs from the first alarm on (also the rule with ``changepoint=False``).
 3. **Every other axis: the line and the exponential** (:func:`faultgen.monitor.trends.fit_models`),
    each by weighted least squares (``scipy``, weights one over each estimate's variance), written
@@ -31,7 +34,7 @@ Per axis:
    weight** (AICc, ``statsmodels.tools.eval_measures.aicc``, of the Gaussian likelihood with the
    variances' common scale fitted, on the same logs; ``exp(-dAICc / 2)`` normalised, Burnham &
    Anderson 2002, ch. 2.9); on the source axis (2), the average of the
-   exponential and the power law alone (the power law nests the changepoint trend and the line,
+   exponentials and the power law alone (the power law nests the changepoint trend and the line,
    which stay fitted to date the rise and name the model), their weights at learning rate 1/2,
    ``exp(-dAICc / 4)`` (:data:`faultgen.monitor.trends.WEIGHT_RATE`; docs/analysis.md,
    "Accelerating wear without running late"); and each model's parameters drawn in proportion to
@@ -56,7 +59,9 @@ Per axis:
    model) up to :data:`HORIZON` days (logs), its event ``failure`` met at wear >= the failure wear
    times the draw's scale, the step ending on the crossing, so a time of event is exact.
 6. **The row**: the median time of event, its 5 and 95 % quantiles (``numpy.quantile``,
-   ``inverted_cdf``; a draw beyond the horizon later than any), and the probability of failure
+   ``inverted_cdf``; a draw beyond the horizon later than any; on the source axis (2) the 5 % end,
+   the service-by date, no later than that of any model of weight >= 0.01 alone,
+   :func:`faultgen.monitor.rul_forecast.credible_low`, the verdict saying so), and the probability of failure
    within the horizon (one minus ProgPy's :func:`progpy.metrics.prob_success`). Below one half:
    **no end of life within the horizon**, without a number.
 7. **Not yet predictable** (:func:`unpredictable`): the trend cannot yet tell the
@@ -95,6 +100,7 @@ from statistics import NormalDist
 import numpy as np
 
 from faultgen.data import cells, logfolder
+from faultgen.monitor import rul_forecast
 from faultgen.monitor.record import Table
 from faultgen.monitor.scoring import NOT_OBSERVABLE, SCALE_UNCERTAINTY
 from faultgen.monitor.trends import AICC_MARGIN, MODELS, POWER_MAX, Fit, expm1_over, fit_models, model_weights
@@ -244,7 +250,7 @@ def _states(fit: Fit, drawn: np.ndarray) -> np.ndarray:
     the power law's age and exponent kept within the bounds it was fitted in."""
     m = len(drawn)
     states = np.column_stack([drawn[:, 0], drawn[:, 1], np.zeros(m), np.ones(m), np.ones(m)])
-    if fit.model == "exponential":  # accelerating (fitted with k >= 0)
+    if fit.model in ("exponential", rul_forecast.ONSET):  # accelerating (fitted with k >= 0)
         states[:, 2] = np.maximum(drawn[:, 2], 0.0)
     elif fit.model == "power":
         low, high = fit.limits
@@ -408,7 +414,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
         if since is not None and axis == source_axis:
             stamps = [r.stamp for r in block]
             if changepoint and since in stamps and len(block) >= MIN_LOGS:  # the whole block, flat then rising
-                fits = fit_models(*series(block, axis), changepoint=True)
+                fits = rul_forecast.with_onset(fit_models(*series(block, axis), changepoint=True), *series(block, axis))
                 if not any(f.changepoint is not None for f in fits):
                     fits = []
             if not fits:  # the logs from the alarm on
@@ -426,8 +432,7 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
             base.verdict = "no trend could be fitted"
             out.append(base)
             continue
-        weights = model_weights(fits)
-        named = named_model(fits)
+        weights, named = model_weights(fits), named_model(fits)
         drawn, labels = _state_samples(fits, weights, samples, seed, uncertainty[axis])
         # rows without the filtered wear (a caller's own): the trend's wear now
         base.model, base.wear = named.model, base.wear if now is not None else float(np.median(drawn.key("wear")))
@@ -438,8 +443,9 @@ def remaining_life(unit: str, rows: list[dict], n_axes: int, *, alpha: float, fa
                             f"0 at alpha {alpha:g}): no end of life within the horizon ({horizon:g} {time_unit})")
             out.append(base)
             continue
-        toe = _propagate(drawn, failure_wear, horizon)
-        out.append(_summarise(base, fits, weights, labels, toe, horizon, series(fitted, axis)[0]))
+        row = _summarise(base, fits, weights, labels, _propagate(drawn, failure_wear, horizon), horizon,
+                         series(fitted, axis)[0])
+        out.append(_credible_low(row, fits, weights, labels, seed, uncertainty[axis]))
     return out
 
 
@@ -467,7 +473,34 @@ def named_model(fits) -> Fit:
     :data:`faultgen.monitor.trends.AICC_MARGIN` of the least, as the rule before the average chose."""
     least = min(f.aicc for f in fits)
     near = [f for f in fits if f.aicc <= least + AICC_MARGIN] or fits
-    return min(near, key=lambda f: (len(f.params) + (f.changepoint is not None), MODELS.index(f.model)))
+    return min(near, key=lambda f: (len(f.params) + (f.changepoint is not None),
+                                  MODELS.index(f.model) if f.model in MODELS else len(MODELS)))
+
+
+def _values(toe) -> np.ndarray:
+    """ProgPy's times of event as numbers (``inf`` beyond the horizon, 0 for a crossing due now)."""
+    values = np.array([np.inf if v is None else float(v) for v in toe.key("failure")])
+    values[values < 1e-6] = 0.0  # crossed already: the first step's length
+    return values
+
+
+def _credible_low(row: Remaining, fits, weights, labels, seed: int, scale_uncertainty: float | None) -> Remaining:
+    """``row``, on the source axis's average (the power law among ``fits``) with a number, its
+    service-by end lowered to the earliest credible model's own 5 % end
+    (:func:`faultgen.monitor.rul_forecast.credible_low`), the verdict saying so where it is earlier."""
+    if row.rul is None or not any(f.model == "power" for f in fits):
+        return row
+
+    def own(i):
+        return _values(time_of_event(fits[i], row.failure_wear, row.horizon, rul_forecast.CREDIBLE_SAMPLES,
+                                     seed + 1 + i, scale_uncertainty))
+
+    low, model, weight = rul_forecast.credible_low(_values(row.distribution), labels, fits, weights, own)
+    if low < row.rul_5:
+        row.verdict += (f"; service by its {row.rul_5:.3g} {row.time_unit} lowered to {low:.3g} {row.time_unit}, "
+                        f"the 5 % end of the {model} trend of weight {weight:.2f} alone")
+        row.rul_5 = low
+    return row
 
 
 def _quantiles(values: np.ndarray) -> np.ndarray:
@@ -501,8 +534,7 @@ def _summarise(row: Remaining, fits, weights, labels, toe, horizon: float, times
     import_progpy()
     from progpy.metrics import prob_success
 
-    values = np.array([np.inf if v is None else float(v) for v in toe.key("failure")])
-    values[values < 1e-6] = 0.0  # crossed already: the first step's length
+    values = _values(toe)
     low, mid, high = _quantiles(values)
     row.distribution = toe
     row.p_within_horizon = 1.0 - float(prob_success(toe, horizon)["failure"])
