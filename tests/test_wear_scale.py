@@ -55,7 +55,7 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
         residual = rng.normal(0, 0.05, 18) + rng.normal(0, scatter) * signatures[axis - 1]
         unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(18))
         if i == 39 and not correct:
-            unit.dispersion_ = np.ones(6)
+            unit.baseline.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
             error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.bound_quantile
@@ -71,11 +71,11 @@ def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_sho
     spreads, uncorrected = [], []
     for seed in range(4):
         unit, z = _unit_with_scatter_along(3, 3.0, seed=seed)
-        assert unit.dispersion_[2] > 1.5, unit.dispersion_
+        assert unit.baseline.dispersion_[2] > 1.5, unit.baseline.dispersion_
         spreads.append(np.std(z))
         uncorrected.append(np.std(_unit_with_scatter_along(3, 3.0, seed=seed, correct=False)[1]))
         quiet, _ = _unit_with_scatter_along(3, 0.0, seed=seed)
-        assert np.all(quiet.dispersion_ <= 1.3), quiet.dispersion_
+        assert np.all(quiet.baseline.dispersion_ <= 1.3), quiet.baseline.dispersion_
     assert 0.85 <= np.mean(spreads) <= 1.25, spreads
     assert np.mean(uncorrected) > 2.0, uncorrected
 
