@@ -15,13 +15,14 @@ from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import report
+from faultgen.monitor.wear import WearEstimator
 from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_INTERVAL, Settings, UnitMonitor
 from faultgen.monitor.twin import WEAR, Twin
 
 
 def test_the_interval_is_the_estimate_with_its_noise_and_the_scale_uncertainty():
     estimate, error = np.array([20.0, 0.0, -4.0]), np.array([2.0, 3.0, 1.0])
-    low, high = UnitMonitor.wear_interval(estimate, error)
+    low, high = WearEstimator.wear_interval(estimate, error)
     half = norm.ppf(0.5 + WEAR_INTERVAL / 2) * np.sqrt(error**2 + (SCALE_UNCERTAINTY * estimate) ** 2)
     np.testing.assert_allclose(low, estimate - half)
     np.testing.assert_allclose(high, estimate + half)
@@ -36,7 +37,7 @@ def test_the_interval_covers_nine_in_ten_when_the_scale_is_off_by_its_stated_unc
     truth = rng.uniform(10.0, 40.0, 4000)
     error = rng.uniform(0.5, 3.0, truth.size)
     estimate = truth * rng.normal(1.0, SCALE_UNCERTAINTY, truth.size) + rng.normal(0.0, 1.0, truth.size) * error
-    low, high = UnitMonitor.wear_interval(estimate, error)
+    low, high = WearEstimator.wear_interval(estimate, error)
     covered = np.mean((low <= truth) & (truth <= high))
     assert 0.86 <= covered <= 0.94, covered
     noise_only = np.mean(np.abs(estimate - truth) <= norm.ppf(0.95) * error)
@@ -58,7 +59,7 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
             unit.baseline.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
-            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.bound_quantile
+            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.wear.bound_quantile
             z.append(row.wear.log[axis - 1] / error)
     return unit, np.array(z)
 

@@ -77,7 +77,7 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
     log = np.array([r.wear.log for r in rows])
     error = np.array([r.wear.log - r.wear.log_lower for r in rows])
     trend = WearTrend(6)
-    expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile) for k in range(len(rows))])
+    expected = np.array([trend.update(log[k], error[k] / unit.wear.bound_quantile) for k in range(len(rows))])
     np.testing.assert_allclose([r.wear.estimate for r in rows], expected[:, 0], rtol=1e-12)
     assert rows[-1].wear.estimate[1] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
     # the alarm is judged on the filtered wear's lower one-sided 90 % bound (WEAR_ALARM_CONFIDENCE),
@@ -99,7 +99,7 @@ def test_maintenance_restarts_the_trend():
     for i in range(50):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
     unit.maintenance("050", "gearbox change", 2)
-    assert unit.trend.state is None
+    assert unit.wear.trend.state is None
     residual = rng.normal(0, 0.05, 18)
     unit.add("051", residual, 30.0, 0.0, np.zeros(18))
     assert unit.rows[-1].wear.estimate[1] == pytest.approx(unit.rows[-1].wear.log[1])  # a new trend starts at the log
@@ -223,15 +223,15 @@ def test_the_monitor_puts_its_learned_slopes_error_in_the_trend():
     unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(20):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    assert unit.trend.n_regressors == 2
+    assert unit.wear.trend.n_regressors == 2
     error = unit.baseline.wear_estimate(np.zeros(18), unit.baseline.scale_**2)[1]
-    np.testing.assert_allclose(unit.trend.covariance[:, 2:, 2:],
+    np.testing.assert_allclose(unit.wear.trend.covariance[:, 2:, 2:],
                                error[:, None, None] ** 2 * unit.baseline.gram_inv_[None], rtol=1e-12)
     for i in range(20, 40):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 25.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    learned = unit.trend.state[:, 2:].copy()
+    learned = unit.wear.trend.state[:, 2:].copy()
     unit.maintenance("040", "repair", 1)
-    np.testing.assert_array_equal(unit.trend.slope_mean, learned)
+    np.testing.assert_array_equal(unit.wear.trend.slope_mean, learned)
 
 
 def test_the_logs_own_estimate_less_the_learned_slope_errors_drifts_less_with_the_season():
@@ -280,6 +280,6 @@ def test_the_monitors_own_estimate_of_a_log_is_its_estimate_less_the_slope_error
         factor = unit.baseline.prediction_factor(np.array([temperature, 0.0]))
         own = unit.baseline.wear_estimate(residual - unit.baseline.mean_ - x @ unit.baseline.slope_, (unit.baseline.scale_ * factor) ** 2)[0]
         row = unit.rows[-1]
-        part = unit.trend.condition_part(x)
+        part = unit.wear.trend.condition_part(x)
         assert np.any(np.abs(part) > 1e-6)
         np.testing.assert_allclose(row.wear.log, own - part, rtol=1e-9, atol=1e-9)

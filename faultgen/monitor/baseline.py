@@ -58,7 +58,7 @@ WEAR_INTERVAL = 0.90
 WEAR_INTERVAL_Z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
 
 #: An axis is **not observable on this program** when one log's :data:`WEAR_INTERVAL` (90 %) interval of
-#: its wear, from the noise at the learning logs' conditions (:meth:`~faultgen.monitor.scoring.UnitMonitor.wear_interval` of an
+#: its wear, from the noise at the learning logs' conditions (:meth:`~faultgen.monitor.wear.WearEstimator.wear_interval` of an
 #: unworn axis: 2 x 1.645 standard errors), is wider than this many ``wear_limit``s (60 points at the
 #: default 10 %). Why: the filtered wear's error is about half a log's (:class:`~faultgen.monitor.wear_trend.WearTrend`), so at that
 #: width the filtered wear's own 90 % interval on an unworn axis spans -+1.5 limits: it cannot tell the

@@ -185,7 +185,7 @@ def monitor(run: MonitorRun) -> Outcome:
                 state[name] = new_unit(name, units, run.robot, run.settings, run.calibrated, run.calibrate, programs,
                                        source)
                 _keep_program(state[name], rescored.get(name))
-                state[name].monitor.tests = scale_of(name)
+                state[name].monitor.wear.tests = scale_of(name)
         made = _score_units(run, Context.of(run, units, maintenance), state, pending, source)
         statuses = [_status(name, state.get(name), run.settings, stale[name], tests.get(name, ()),
                             fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),

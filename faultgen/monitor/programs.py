@@ -254,13 +254,13 @@ class Baselines:
         return len(monitor.baseline.training) + sum(len(b.training) for b in self.saved)
 
     def _run(self, monitor, program: int, call) -> None:
-        first, trend = monitor.baseline, monitor.trend
+        first, trend = monitor.baseline, monitor.wear.trend
         monitor.baseline = self.saved[program - 1]
         offset = self.offsets[program - 1]
         if offset is None and trend.state is not None:
             offset = (trend.state[:, 0].copy(), trend.covariance[:, 0, 0].copy())
         zero = np.zeros(monitor.n_axes)
-        monitor.trend = _Fused(trend, *(offset if offset is not None else (zero, zero)))
+        monitor.wear.trend = _Fused(trend, *(offset if offset is not None else (zero, zero)))
         learning = monitor.baseline.pca is None
         try:
             call()
@@ -268,7 +268,7 @@ class Baselines:
             if learning and monitor.baseline.pca is not None:  # learned: its rows join the unit's in stamp order
                 self.offsets[program - 1] = offset
                 monitor.rows.sort(key=lambda row: row.stamp)
-            monitor.baseline, monitor.trend = first, trend
+            monitor.baseline, monitor.wear.trend = first, trend
 
     def maintenance(self, monitor, stamp: str, event: str, axis: int) -> None:
         """A repair or gearbox change given to every program's baseline
@@ -298,7 +298,8 @@ def pool(monitor, baselines: Baselines) -> None:
     common = monitor.shared_ = first.shared(R, len(R) - len(pooled) - len(first.regressors_))
     counts = np.bincount(groups)
     first.training, first.learned_ = [], int(counts[0])
-    monitor.start_trend(None if first.signatures is None else first.fit_signatures(R, common["dof"]))
+    error = None if first.signatures is None else first.fit_signatures(R, common["dof"])
+    monitor.wear.start(len(first.regressors_), error, first.gram_inv_)
     zero = np.zeros(monitor.n_axes)
     for i, k in enumerate(pooled[1:], 1):
         baselines.offsets[k - 1] = (zero, zero)  # learned with the first: its wear read from the same start

@@ -105,7 +105,7 @@ def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
-    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
+    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.wear.WearEstimator.wear_interval`),
     the lower one-sided 90 % bound the alarm is judged on, the filter's error and the scale's doubt
     together (``wear_lower``, as ``wearI_lower`` of scores.csv; :mod:`faultgen.monitor.bounds`) and the log's own estimate (``wear_log``). Only units with a twin
     have rows. With ``scales`` (a fleet with friction tests, or units in ``nominal``) also each

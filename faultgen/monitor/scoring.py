@@ -34,7 +34,7 @@ over each feature's variance: its noise times the prediction factor, squared, pl
 uncertainty of :data:`MODEL_UNCERTAINTY` of its predicted change; the estimate's standard error is
 one over the root of the summed weights: the fault-magnitude estimate of a known fault direction,
 Gertler 1998 ch. 8; Basseville & Nikiforov 1993 ch. 7), each axis's estimates are filtered over
-the logs through a local linear trend (:class:`WearTrend`: a log's estimate scatters by 3-4 % of
+the logs through a local linear trend (:class:`~faultgen.monitor.wear_trend.WearTrend`: a log's estimate scatters by 3-4 % of
 wear, the filtered wear by about half that) whose state also holds the error of the learned
 condition slopes along each axis's signature, learned on from every later log (slopes learned on a
 month's narrow temperature range, extrapolated over a season, moved an unworn axis's wear by up to
@@ -60,16 +60,14 @@ continues where the last one stopped.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from statistics import NormalDist
 
 import numpy as np
 
-from faultgen.monitor import bounds, record
+from faultgen.monitor import record
 # the stages' constants live with their stages; named here too, as the monitor's (noqa: re-exported)
-from faultgen.monitor.alarm import WEAR_ALARM_CONFIDENCE, AlarmRule, alarm_quantile  # noqa: F401
-from faultgen.monitor.baseline import (FEATURES, NOT_OBSERVABLE_LIMITS, WEAR_FEATURES, WEAR_INTERVAL,  # noqa: F401
-                                       WEAR_INTERVAL_Z, Baseline)
-from faultgen.monitor.wear_trend import WearTrend
+from faultgen.monitor.alarm import WEAR_ALARM_CONFIDENCE, AlarmRule  # noqa: F401
+from faultgen.monitor.baseline import FEATURES, NOT_OBSERVABLE_LIMITS, WEAR_FEATURES, WEAR_INTERVAL, Baseline  # noqa: F401
+from faultgen.monitor.wear import SCALE_UNCERTAINTY, WearEstimator  # noqa: F401
 
 PROTOCOLS = ("twin", "own")
 #: Share of the twin's predicted change of a feature, from the nearest condition the unit's
@@ -77,18 +75,6 @@ PROTOCOLS = ("twin", "own")
 #: (an earlier draw of it, parts of 125 and 27 kg): the twin's change of the KR210's mean |torque|
 #: between the two parts was within 2-12 % of Pinocchio's on axes 1-4 and 6, 57 % off on axis 5.
 MODEL_UNCERTAINTY = 0.25
-
-
-#: Relative standard uncertainty of the wear signature's scale: how far the change of a unit's
-#: features per % of its own dry friction may lie from its twin's, which the 90 % interval of each
-#: wear estimate carries beside the noise (:meth:`UnitMonitor.wear_interval`). What it rests on
-#: (docs/analysis.md, "Wear in the robot's own scale"): the signature's scale moved by 0.89-1.08
-#: between the friction states of the independent fleet's units (their joints at 20-40 deg C, no
-#: part or 25 kg) against the twin at the model's own friction, noise-free; and a calibrated
-#: model's dry friction of the worn axis was 0.90-0.97 of the unit's own on seed 0 of that fleet
-#: (the calibration fits some axes' Coulomb friction; the others stay nominal, 15 % unit spread).
-#: Chosen on seeds 0 and 1 of that fleet, checked on a held-out seed and a second friction law.
-SCALE_UNCERTAINTY = 0.10
 
 
 #: What an axis that is not observable is called (rul.csv's verdict, units.csv's reason, the page).
@@ -140,8 +126,8 @@ class Settings:
 class UnitMonitor:
     """The monitor of one unit (module docstring), as stages over its :attr:`rows`: the program's
     :attr:`baseline` (:class:`faultgen.monitor.baseline.Baseline`; a later program's is swapped in
-    for its logs by :class:`faultgen.monitor.programs.Baselines`), the wear filter :attr:`trend`
-    (:class:`WearTrend`) with the friction tests' scale :attr:`tests`, and the :attr:`alarm` rule
+    for its logs by :class:`faultgen.monitor.programs.Baselines`), the :attr:`wear`
+    (:class:`faultgen.monitor.wear.WearEstimator`: its filter and friction tests' scale), and the :attr:`alarm` rule
     (:class:`faultgen.monitor.alarm.AlarmRule`). ``signatures`` (n_axes, n_features): the first
     program's wear signatures in feature units per % (protocol ``twin``), or None."""
 
@@ -156,11 +142,7 @@ class UnitMonitor:
         #: What the unit's programs met later borrow of its first program's learned baseline
         #: (:meth:`faultgen.monitor.baseline.Baseline.shared`), or None before it learned.
         self.shared_: dict | None = None
-        #: Each axis's wear filtered over the logs (the wear reported and alarmed on).
-        self.trend = WearTrend(n_axes)
-        #: The unit's friction tests' scale (:class:`faultgen.monitor.friction_tests.Rescale`), or
-        #: None: the wear in the twin's scale.
-        self.tests = None
+        self.wear = WearEstimator(settings, n_axes)
 
     # -- a new program ---------------------------------------------------------------------------
     def restart(self, stamp: str, reason: str) -> None:
@@ -173,8 +155,8 @@ class UnitMonitor:
         b.training, b.learned_expectations = [], []
         b.pca, b.relearning = None, None
         self.alarm.reset()
-        if self.tests is not None:
-            self.tests.reset()
+        if self.wear.tests is not None:
+            self.wear.tests.reset()
 
     # -- maintenance ----------------------------------------------------------------------------
     def maintenance(self, stamp: str, event: str, axis: int) -> None:
@@ -184,8 +166,8 @@ class UnitMonitor:
         ``relearn_logs`` logs, which are scored but do not alarm; its slopes, noise and PCA
         model stay. The wear estimate of every axis, the changed one's first, restarts from the new
         offset. During the first learning the learning restarts."""
-        if self.tests is not None:
-            self.tests.reset()
+        if self.wear.tests is not None:
+            self.wear.tests.reset()
         b = self.baseline
         if b.pca is None:
             b.training, b.learned_expectations, b.placeholders = [], [], 0
@@ -194,25 +176,18 @@ class UnitMonitor:
         self.since = (f"{event} of axis {axis}", stamp, len(self.rows))
         self.alarm.reset()
         b.relearning = []
-        self.trend.reset()
+        self.wear.trend.reset()
 
     # -- learning -------------------------------------------------------------------------------
     def _fit(self) -> None:
         """Learn the baseline on its training logs (:meth:`faultgen.monitor.baseline.Baseline.fit`) and
-        score them; the unit's first program's also starts the wear filter (:meth:`start_trend`) and
+        score them; the unit's first program's also starts the wear filter (:meth:`WearEstimator.start`) and
         keeps what the programs met later borrow (:attr:`shared_`)."""
         stamps, R, error, common = self.baseline.fit()
         if common is not None:
             self.shared_ = common
-            self.start_trend(error)
+            self.wear.start(len(self.baseline.regressors_), error, self.baseline.gram_inv_)
         self.score_learning(stamps, R)
-
-    def start_trend(self, error: np.ndarray | None) -> None:
-        """The wear filter started on the learned baseline, the learned slopes' error in its state
-        (``error`` (n_axes,): an unworn axis's wear standard error; None without a twin)."""
-        self.trend = WearTrend(self.n_axes, len(self.baseline.regressors_))
-        if error is not None:
-            self.trend.set_prior(error[:, None, None] ** 2 * self.baseline.gram_inv_[None])
 
     def score_learning(self, stamps: list[str], R: np.ndarray, phase: str | None = None) -> None:
         """The rows of the learning logs ``stamps`` (residuals ``R`` less offset and slopes), in place of
@@ -228,27 +203,6 @@ class UnitMonitor:
         for stamp, r in zip(stamps, R):
             wear = b.wear_estimate(r, b.scale_**2)
             self._score(stamp, r / b.scale_, phase=phase, wear=None if wear is None else (*wear, wear[1], None))
-
-    @staticmethod
-    def wear_interval(estimate: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The :data:`WEAR_INTERVAL` (90 %) interval of wear ``estimate`` % whose noise has standard
-        ``error`` %, both (n_axes,): the estimate -+ the normal quantile times ``sqrt(error^2 +
-        (SCALE_UNCERTAINTY estimate)^2)``, the twin's model uncertainty (:data:`SCALE_UNCERTAINTY`,
-        a share of the estimate: a scale) beside the noise. Returns (lower, upper), %."""
-        return bounds.interval(estimate, bounds.standard_error(error, estimate, SCALE_UNCERTAINTY), WEAR_INTERVAL_Z)
-
-    def _on_tests(self, stamp, estimate, error, log_estimate, log_error):
-        """The filtered wear (with its error), its interval, alarm bound and the log's own estimate
-        (with its error) on the unit's friction tests' scale (:mod:`faultgen.monitor.friction_tests`),
-        and the row's twin-scale values, factors and scales."""
-        factor, factor_error, names = self.tests.at(stamp, estimate, error)
-        wear, sd = self.tests.wear(estimate, error, factor, factor_error)  # the scale's doubt in it (module bounds)
-        low, high = bounds.interval(wear, sd, WEAR_INTERVAL_Z)
-        lower = log_estimate - self.bound_quantile * log_error
-        row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
-                                tuple(names))
-        return ((wear, factor * error), low, high, wear - alarm_quantile() * sd,
-                factor * log_estimate, factor * log_error, row)
 
     # -- scoring --------------------------------------------------------------------------------
     def add(self, stamp: str, residual: np.ndarray, temperature: float, payload: float,
@@ -276,9 +230,9 @@ class UnitMonitor:
             if len(b.relearning) == b.relearn_logs:
                 b.learn_offset(*(np.stack(logs) for logs in zip(*b.relearning)))
                 b.relearning = None
-                self.trend.reset()  # the wear restarts from the new offset
-                if self.tests is not None:
-                    self.tests.reset()
+                self.wear.trend.reset()  # the wear restarts from the new offset
+                if self.wear.tests is not None:
+                    self.wear.tests.reset()
         factor = b.prediction_factor(conditions)
         z = b.standardise(e, conditions) / factor
         variance = (b.scale_ * factor) ** 2
@@ -299,47 +253,13 @@ class UnitMonitor:
             wear = (*wear, trend_error, x)
         self._score(stamp, z, phase="relearning" if relearned else "monitoring", wear=wear)
 
-    @property
-    def bound_quantile(self) -> float:
-        """The standard normal's ``1 - alpha`` quantile: the lower bound of a log's own wear
-        estimate (``wearI_log_lower``) is the estimate minus this many standard errors."""
-        return float(NormalDist().inv_cdf(1.0 - self.settings.alpha))
-
     def _score(self, stamp: str, z: np.ndarray, phase: str, wear=None) -> None:
         b = self.baseline
         t2, q = (float(v[0]) for v in b.pca.score_samples(z[None]))
         alarm = q > b.pca.q_limit_ or t2 > b.pca.t2_limit_
         wear_row, at_once = None, False
         if wear is not None:
-            log_estimate, log_error, trend_error, x = wear
-            wear = estimate, error = self.trend.update(log_estimate, trend_error, x)
-            # the log's own estimate less the slope errors' part at its conditions, as learned up
-            # to it: the season the learned slopes extrapolate, which the remaining life's trend
-            # would otherwise take for wear (docs/analysis.md, "The log's own estimate without
-            # the season")
-            log_estimate = log_estimate - self.trend.condition_part(x)
-            bound = bounds.lower_bound(estimate, error, SCALE_UNCERTAINTY, alarm_quantile())  # with the scale's doubt
-            # the interval keeps the log's own error: the filter averages out the scatter from log
-            # to log, not the errors that stay for weeks (the learned temperature slopes
-            # extrapolated over a season, the calibration's friction), which the learning logs
-            # cannot tell apart (docs/analysis.md, "Wear in the robot's own scale")
-            low, high = self.wear_interval(estimate, np.maximum(log_error, error))  # the filter's lag widens it
-            tested = None
-            if self.tests is not None:  # on the unit's friction tests' scale
-                wear, low, high, bound, log_estimate, log_error, tested = self._on_tests(
-                    stamp, estimate, error, log_estimate, log_error)
-                estimate = wear[0]
-            wear = (estimate, (estimate - bound) / alarm_quantile())  # the bound's error, as the alarm reads it
-            seen = b.observable_
-            alarm = bool(np.max(np.where(seen, bound, -np.inf)) >= self.settings.wear_limit)
-            # the lower bound above the limit by its own width (the filtered wear less two of its
-            # quantiles): alarmed at once, persistence cannot hide it
-            at_once = bool(np.max(np.where(seen, 2 * bound - estimate, -np.inf)) >= self.settings.wear_limit)
-            hidden = np.where(seen, 1.0, np.nan)  # an axis not observable has no wear (NOT_OBSERVABLE_LIMITS)
-            estimate, bound, low, high = estimate * hidden, bound * hidden, low * hidden, high * hidden
-            log_estimate, log_error = log_estimate * hidden, log_error * hidden
-            wear_row = record.AxisWear(*(np.asarray(v, dtype=float) for v in (
-                estimate, bound, low, high, log_estimate, log_estimate - self.bound_quantile * log_error)), tested)
+            wear, alarm, at_once, wear_row = self.wear.read(stamp, wear, b.observable_)
         scores = b.axis_scores(z)
         ranking = np.argsort(-scores, kind="stable") + 1
         if phase == "monitoring":
