@@ -210,12 +210,12 @@ def _synthetic_unit(seed: int, wear: float, interval: bool) -> bool:
     slope, direction = rng.normal(0, 1, 12), np.abs(rng.normal(0, 1, 12))
     unit = UnitMonitor("u", Settings(protocol="own"), n_axes=6)
     if not interval:
-        unit.prediction_factor = lambda conditions: 1.0
+        unit.baseline.prediction_factor = lambda conditions: 1.0
     for i in range(90):
         temperature = rng.uniform(*((20, 24) if i < 28 else (26, 34)))
         residual = slope * temperature + rng.normal(0, 1, 12) + wear * 0.2 * max(i - 40, 0) * direction
         unit.add(f"{i:03d}", residual, temperature, 100.0)
-    return unit.first_alarm is not None
+    return unit.alarm.first_alarm is not None
 
 
 def test_warmer_logs_than_the_learning_ones_do_not_alarm_a_healthy_unit_and_a_worn_one_still_alarms():
@@ -235,8 +235,8 @@ def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_
     for i, t in enumerate(temperatures):
         unit.add(f"{i:02d}", rng.normal(0, 1, 3) + t, t, 100.0)
     sxx = np.sum((temperatures - temperatures.mean()) ** 2)
-    assert unit.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
-    assert unit.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
+    assert unit.baseline.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
+    assert unit.baseline.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
 
 
 def test_the_wear_estimate_is_weighted_least_squares_of_the_friction_torques_along_each_signature():
@@ -248,19 +248,19 @@ def test_the_wear_estimate_is_weighted_least_squares_of_the_friction_torques_alo
     rng = np.random.default_rng(1)
     signatures = rng.normal(0, 1, (6, 18))
     unit = UnitMonitor("u", Settings(), n_axes=6, signatures=signatures)
-    np.testing.assert_array_equal(unit.wear_columns(), np.arange(12, 18))
+    np.testing.assert_array_equal(unit.baseline.wear_columns(), np.arange(12, 18))
     variance = rng.uniform(0.5, 2.0, 18)
-    estimate, error = unit.wear_estimate(7.0 * signatures[2], variance)
+    estimate, error = unit.baseline.wear_estimate(7.0 * signatures[2], variance)
     assert estimate[2] == pytest.approx(7.0)
     assert error[2] == pytest.approx(1.0 / np.sqrt(np.sum(signatures[2, 12:] ** 2 / variance[12:])))
-    estimate4, error4 = unit.wear_estimate(7.0 * signatures[2], 4.0 * variance)
+    estimate4, error4 = unit.baseline.wear_estimate(7.0 * signatures[2], 4.0 * variance)
     np.testing.assert_allclose(estimate4, estimate)
     np.testing.assert_allclose(error4, 2.0 * error)
     other = np.where(np.arange(18) < 12, rng.normal(0, 1, 18), 0.0)  # only the RMS and load torques change
-    np.testing.assert_allclose(unit.wear_estimate(7.0 * signatures[2] + other, variance)[0], estimate, rtol=1e-12)
-    assert UnitMonitor("u", Settings(protocol="own"), n_axes=6).wear_estimate(signatures[2], variance) is None
+    np.testing.assert_allclose(unit.baseline.wear_estimate(7.0 * signatures[2] + other, variance)[0], estimate, rtol=1e-12)
+    assert UnitMonitor("u", Settings(protocol="own"), n_axes=6).baseline.wear_estimate(signatures[2], variance) is None
     with pytest.raises(ValueError, match=r"wear signatures of shape \(6, 12\); expected \(6, 18\)"):
-        UnitMonitor("u", Settings(), n_axes=6, signatures=signatures[:, :12]).wear_estimate(np.zeros(12), np.ones(12))
+        UnitMonitor("u", Settings(), n_axes=6, signatures=signatures[:, :12]).baseline.wear_estimate(np.zeros(12), np.ones(12))
 
 
 def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit():
@@ -273,8 +273,8 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
     for i in range(200):
         wear = max(i - 60, 0) * 0.5
         unit.add(f"{i:03d}", rng.normal(0, 0.1, 18) + wear * signatures[1], 30.0, 100.0, np.zeros(18))
-    assert unit.first_alarm is not None and unit.source_axis == 2 and unit.statistic == "wear"
-    first = int(unit.first_alarm)
+    assert unit.alarm.first_alarm is not None and unit.alarm.source_axis == 2 and unit.alarm.statistic == "wear"
+    first = int(unit.alarm.first_alarm)
     rows = {r.stamp: r for r in unit.rows}
     limit = unit.settings.wear_limit
     assert limit == 10.0

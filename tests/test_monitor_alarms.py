@@ -38,8 +38,8 @@ def _feed(unit: UnitMonitor, wear: np.ndarray, rng, first: int = 0, stop=None, n
     """Logs ``first``.. with true wear ``wear`` (n_logs, n_axes) %, stamps their index, features with
     ``noise``; ``stop(unit)`` True ends the feed after a log."""
     for i, w in enumerate(wear):
-        unit.add(f"{first + i:03d}", rng.normal(0, noise, unit.signatures.shape[1]) + w @ unit.signatures, 30.0, 0.0,
-                 np.zeros(unit.signatures.shape[1]))
+        unit.add(f"{first + i:03d}", rng.normal(0, noise, unit.baseline.signatures.shape[1]) + w @ unit.baseline.signatures, 30.0, 0.0,
+                 np.zeros(unit.baseline.signatures.shape[1]))
         if stop is not None and stop(unit):
             return
 
@@ -76,7 +76,7 @@ def test_the_alarm_is_known_on_the_fifth_alarming_log_and_starts_from_the_first(
     unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(200, 2, 35, 0.1), rng, noise=0.15)
     first, known, at_once = _reference(_monitoring(unit))
-    assert (unit.first_alarm, unit.known, at_once) == (first, known, False)
+    assert (unit.alarm.first_alarm, unit.alarm.known, at_once) == (first, known, False)
     stamps = [r.stamp for r in unit.rows]
     assert stamps.index(known) - stamps.index(first) == SETTINGS.persistence - 1
     row = unit.alarm_row()
@@ -91,10 +91,10 @@ def test_a_lower_bound_past_the_limit_by_its_own_width_alarms_at_once():
     wear[40:, 0] = np.linspace(40.0, 60.0, 20)  # a gearbox damaged at once
     _feed(unit, wear, rng)
     first, known, at_once = _reference(_monitoring(unit))
-    assert (unit.first_alarm, unit.known, at_once, unit.source_axis) == (first, known, True, 1)
+    assert (unit.alarm.first_alarm, unit.alarm.known, at_once, unit.alarm.source_axis) == (first, known, True, 1)
     stamps = [r.stamp for r in unit.rows]
     assert "040" <= first and stamps.index(known) - stamps.index(first) < SETTINGS.persistence - 1
-    assert "at once" in unit.evidence
+    assert "at once" in unit.alarm.evidence
 
 
 def test_an_alarm_under_way_at_a_gearbox_change_is_closed_by_it_not_forgotten():
@@ -106,7 +106,7 @@ def test_an_alarm_under_way_at_a_gearbox_change_is_closed_by_it_not_forgotten():
         return len(u.rows) >= 2 and u.rows[-1].alarm and u.rows[-2].alarm and u.rows[-1].phase == "monitoring"
 
     _feed(unit, wear, rng, stop=two_alarming, noise=0.15)
-    assert unit.first_alarm is None and unit.run == 2
+    assert unit.alarm.first_alarm is None and unit.alarm.run == 2
     first, last = unit.rows[-2].stamp, unit.rows[-1].stamp
     change = f"{len(unit.rows):03d}"
     unit.maintenance(change, "gearbox change", 3)
@@ -131,12 +131,12 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     wear[30:, 1] = 300.0  # even a huge change along it: the noise's, not wear the logs can tell
     _feed(unit, wear, rng)
     z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
-    np.testing.assert_allclose(unit.width_, 2 * z * NOISE / per_axis, rtol=0.35)
-    assert unit.observable_.tolist() == [True, False, True]
-    assert unit.width_[1] > NOT_OBSERVABLE_LIMITS * SETTINGS.wear_limit > unit.width_[0]
+    np.testing.assert_allclose(unit.baseline.width_, 2 * z * NOISE / per_axis, rtol=0.35)
+    assert unit.baseline.observable_.tolist() == [True, False, True]
+    assert unit.baseline.width_[1] > NOT_OBSERVABLE_LIMITS * SETTINGS.wear_limit > unit.baseline.width_[0]
     assert all(np.isnan(r.wear.estimate[1]) and np.isnan(r.wear.log[1]) and np.isfinite(r.wear.estimate[0])
                for r in unit.rows)
-    assert not any(r.alarm for r in unit.rows) and unit.first_alarm is None
+    assert not any(r.alarm for r in unit.rows) and unit.alarm.first_alarm is None
     assert "axis 2 " + NOT_OBSERVABLE in unit.not_observable_note()
     report.wear_table([unit]).write(tmp_path)
     report.scores_table([unit], N_AXES).write(tmp_path)
@@ -211,7 +211,7 @@ def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tm
             writer.writeheader()
             writer.writerows(rows)
     html = page.build(page.read(tmp_path), {"protocol": "twin", "alpha": 0.01, "persistence": 5, "train": 20})
-    when = f"known {unit.known} (from {unit.first_alarm})" if known else f"from {unit.first_alarm}"
+    when = f"known {unit.alarm.known} (from {unit.alarm.first_alarm})" if known else f"from {unit.alarm.first_alarm}"
     assert f"<b>Open alarm</b> {when} on axis 2" in html
     assert f"open alarm {when} on axis 2" in html  # the light's rule
     assert "1 of 1 units alarm.</p>" in html  # the chance statement says nothing here: left out

@@ -134,13 +134,13 @@ def _far_limits(training: np.ndarray) -> tuple[float, float]:
 def test_protocol_own_alarms_at_once_on_a_log_past_its_limits_at_alpha_to_the_persistence():
     unit, training = _own(step=60.0)
     t2_far, q_far = _far_limits(training)
-    assert unit.far_ == pytest.approx((t2_far, q_far), rel=1e-9)
+    assert unit.baseline.far_ == pytest.approx((t2_far, q_far), rel=1e-9)
     rows = [r for r in unit.rows if r.phase == "monitoring"]
     # the reference: the first log past either far limit, read off the rows
     past = [r.stamp for r in rows if r.T2 > t2_far or r.Q > q_far]
     assert past and past[0] == "030"
-    assert (unit.first_alarm, unit.known) == ("030", "030")
-    assert f"at once: T2 or Q past its limit at alpha^{OWN.persistence}" in unit.evidence
+    assert (unit.alarm.first_alarm, unit.alarm.known) == ("030", "030")
+    assert f"at once: T2 or Q past its limit at alpha^{OWN.persistence}" in unit.alarm.evidence
     assert not [r for r in rows if r.stamp < "030" and r.alarm]  # quiet before it
 
 
@@ -151,8 +151,8 @@ def test_protocol_own_waits_for_persistence_below_its_far_limits():
     alarming = [r.stamp for r in rows if r.alarm]
     assert alarming[:OWN.persistence] == [f"{k:03d}" for k in range(30, 30 + OWN.persistence)]
     assert all(r.T2 <= t2_far and r.Q <= q_far for r in rows)  # never far past
-    assert (unit.first_alarm, unit.known) == ("030", f"{30 + OWN.persistence - 1:03d}")
-    assert "at once" not in unit.evidence
+    assert (unit.alarm.first_alarm, unit.alarm.known) == ("030", f"{30 + OWN.persistence - 1:03d}")
+    assert "at once" not in unit.alarm.evidence
 
 
 def test_a_program_changes_relearning_is_named_so_on_the_chart_and_maintenances_as_before(tmp_path):

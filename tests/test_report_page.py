@@ -42,7 +42,7 @@ def _feed(monitor: UnitMonitor, days: int, wear, seed: int, repair: int | None =
     for day in range(days):
         if day == repair:
             monitor.maintenance(f"2026-03-{day + 1:02d} 06:00", "repair", 2)
-        residual = rng.standard_normal(N_FEATURES) + wear(day) * monitor.signatures[1]
+        residual = rng.standard_normal(N_FEATURES) + wear(day) * monitor.baseline.signatures[1]
         monitor.add(f"2026-03-{day + 1:02d}", residual, float("nan"), 0.0)
 
 
@@ -55,10 +55,10 @@ def make_tables() -> tuple[list, list[UnitMonitor]]:
     _feed(monitors[2], 30, lambda d: 0.0 if d < 12 or d >= 20 else 25.0, seed=3, repair=20)  # repaired
     _feed(monitors[3], 30, lambda d: 0.0, seed=4)
     _feed(monitors[4], 6, lambda d: 0.0, seed=5)  # still learning
-    assert monitors[0].first_alarm and monitors[2].closed and not monitors[2].first_alarm
-    statuses = [UnitStatus(m.unit, "monitored" if m.pca is not None else "learning", "twin", "calibrated",
-                           "" if m.pca is not None else f"learning: {len(m.training)} of 10 logs", len(m.rows) or
-                           len(m.training), m.last_stamp) for m in monitors]
+    assert monitors[0].alarm.first_alarm and monitors[2].alarm.closed and not monitors[2].alarm.first_alarm
+    statuses = [UnitStatus(m.unit, "monitored" if m.baseline.pca is not None else "learning", "twin", "calibrated",
+                           "" if m.baseline.pca is not None else f"learning: {len(m.baseline.training)} of 10 logs", len(m.rows) or
+                           len(m.baseline.training), m.last_stamp) for m in monitors]
     statuses.append(UnitStatus(UNITS[5], "not monitored", "twin", "", "no log", 0, ""))
     return [report.alarms_table(monitors), report.scores_table(monitors, N_AXES), report.units_table(statuses)], monitors
 

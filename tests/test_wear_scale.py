@@ -15,13 +15,14 @@ from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import report
+from faultgen.monitor.wear import WearEstimator
 from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_INTERVAL, Settings, UnitMonitor
 from faultgen.monitor.twin import WEAR, Twin
 
 
 def test_the_interval_is_the_estimate_with_its_noise_and_the_scale_uncertainty():
     estimate, error = np.array([20.0, 0.0, -4.0]), np.array([2.0, 3.0, 1.0])
-    low, high = UnitMonitor.wear_interval(estimate, error)
+    low, high = WearEstimator.wear_interval(estimate, error)
     half = norm.ppf(0.5 + WEAR_INTERVAL / 2) * np.sqrt(error**2 + (SCALE_UNCERTAINTY * estimate) ** 2)
     np.testing.assert_allclose(low, estimate - half)
     np.testing.assert_allclose(high, estimate + half)
@@ -36,7 +37,7 @@ def test_the_interval_covers_nine_in_ten_when_the_scale_is_off_by_its_stated_unc
     truth = rng.uniform(10.0, 40.0, 4000)
     error = rng.uniform(0.5, 3.0, truth.size)
     estimate = truth * rng.normal(1.0, SCALE_UNCERTAINTY, truth.size) + rng.normal(0.0, 1.0, truth.size) * error
-    low, high = UnitMonitor.wear_interval(estimate, error)
+    low, high = WearEstimator.wear_interval(estimate, error)
     covered = np.mean((low <= truth) & (truth <= high))
     assert 0.86 <= covered <= 0.94, covered
     noise_only = np.mean(np.abs(estimate - truth) <= norm.ppf(0.95) * error)
@@ -55,10 +56,10 @@ def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool
         residual = rng.normal(0, 0.05, 18) + rng.normal(0, scatter) * signatures[axis - 1]
         unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(18))
         if i == 39 and not correct:
-            unit.dispersion_ = np.ones(6)
+            unit.baseline.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
-            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.bound_quantile
+            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.wear.bound_quantile
             z.append(row.wear.log[axis - 1] / error)
     return unit, np.array(z)
 
@@ -71,11 +72,11 @@ def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_sho
     spreads, uncorrected = [], []
     for seed in range(4):
         unit, z = _unit_with_scatter_along(3, 3.0, seed=seed)
-        assert unit.dispersion_[2] > 1.5, unit.dispersion_
+        assert unit.baseline.dispersion_[2] > 1.5, unit.baseline.dispersion_
         spreads.append(np.std(z))
         uncorrected.append(np.std(_unit_with_scatter_along(3, 3.0, seed=seed, correct=False)[1]))
         quiet, _ = _unit_with_scatter_along(3, 0.0, seed=seed)
-        assert np.all(quiet.dispersion_ <= 1.3), quiet.dispersion_
+        assert np.all(quiet.baseline.dispersion_ <= 1.3), quiet.baseline.dispersion_
     assert 0.85 <= np.mean(spreads) <= 1.25, spreads
     assert np.mean(uncorrected) > 2.0, uncorrected
 

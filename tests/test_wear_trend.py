@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from statsmodels.tsa.statespace.mlemodel import MLEModel
 
+from faultgen.monitor.alarm import alarm_quantile
 from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_ALARM_CONFIDENCE, Settings, UnitMonitor
 from faultgen.monitor.wear_trend import OUTLIER_GATE, OUTLIER_RUN, WEAR_RATE_CHANGE, WearTrend
 
@@ -76,19 +77,19 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
     log = np.array([r.wear.log for r in rows])
     error = np.array([r.wear.log - r.wear.log_lower for r in rows])
     trend = WearTrend(6)
-    expected = np.array([trend.update(log[k], error[k] / unit.bound_quantile) for k in range(len(rows))])
+    expected = np.array([trend.update(log[k], error[k] / unit.wear.bound_quantile) for k in range(len(rows))])
     np.testing.assert_allclose([r.wear.estimate for r in rows], expected[:, 0], rtol=1e-12)
     assert rows[-1].wear.estimate[1] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
     # the alarm is judged on the filtered wear's lower one-sided 90 % bound (WEAR_ALARM_CONFIDENCE),
     # each log's own bound stays 1 - alpha
-    assert unit.alarm_quantile == pytest.approx(1.2816, abs=1e-4) and WEAR_ALARM_CONFIDENCE == 0.90
+    assert alarm_quantile() == pytest.approx(1.2816, abs=1e-4) and WEAR_ALARM_CONFIDENCE == 0.90
     lower = np.array([r.wear.lower for r in rows])
     # the bound carries the scale's doubt beside the filter's error (issue 90: faultgen.monitor.bounds)
     doubt = np.sqrt(expected[:, 1] ** 2 + (SCALE_UNCERTAINTY * expected[:, 0]) ** 2)
-    np.testing.assert_allclose(lower, expected[:, 0] - unit.alarm_quantile * doubt, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(lower, expected[:, 0] - alarm_quantile() * doubt, rtol=1e-9, atol=1e-9)
     monitoring = [k for k, r in enumerate(rows) if r.phase == "monitoring"]
     assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= 10.0) for k in monitoring]
-    assert any(rows[k].alarm for k in monitoring) and unit.first_alarm is not None
+    assert any(rows[k].alarm for k in monitoring) and unit.alarm.first_alarm is not None
 
 
 def test_maintenance_restarts_the_trend():
@@ -98,7 +99,7 @@ def test_maintenance_restarts_the_trend():
     for i in range(50):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
     unit.maintenance("050", "gearbox change", 2)
-    assert unit.trend.state is None
+    assert unit.wear.trend.state is None
     residual = rng.normal(0, 0.05, 18)
     unit.add("051", residual, 30.0, 0.0, np.zeros(18))
     assert unit.rows[-1].wear.estimate[1] == pytest.approx(unit.rows[-1].wear.log[1])  # a new trend starts at the log
@@ -222,15 +223,15 @@ def test_the_monitor_puts_its_learned_slopes_error_in_the_trend():
     unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(20):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    assert unit.trend.n_regressors == 2
-    error = unit.wear_estimate(np.zeros(18), unit.scale_**2)[1]
-    np.testing.assert_allclose(unit.trend.covariance[:, 2:, 2:],
-                               error[:, None, None] ** 2 * unit.gram_inv_[None], rtol=1e-12)
+    assert unit.wear.trend.n_regressors == 2
+    error = unit.baseline.wear_estimate(np.zeros(18), unit.baseline.scale_**2)[1]
+    np.testing.assert_allclose(unit.wear.trend.covariance[:, 2:, 2:],
+                               error[:, None, None] ** 2 * unit.baseline.gram_inv_[None], rtol=1e-12)
     for i in range(20, 40):
         unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 25.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    learned = unit.trend.state[:, 2:].copy()
+    learned = unit.wear.trend.state[:, 2:].copy()
     unit.maintenance("040", "repair", 1)
-    np.testing.assert_array_equal(unit.trend.slope_mean, learned)
+    np.testing.assert_array_equal(unit.wear.trend.slope_mean, learned)
 
 
 def test_the_logs_own_estimate_less_the_learned_slope_errors_drifts_less_with_the_season():
@@ -275,10 +276,10 @@ def test_the_monitors_own_estimate_of_a_log_is_its_estimate_less_the_slope_error
         temperature = 24.0 + rng.normal(0, 1.0)
         residual = rng.normal(0, 0.05, 18)
         unit.add(f"{i:03d}", residual, temperature, 0.0, np.zeros(18))
-        x = np.array([temperature]) - unit.condition_mean_[unit.regressors_]
-        factor = unit.prediction_factor(np.array([temperature, 0.0]))
-        own = unit.wear_estimate(residual - unit.mean_ - x @ unit.slope_, (unit.scale_ * factor) ** 2)[0]
+        x = np.array([temperature]) - unit.baseline.condition_mean_[unit.baseline.regressors_]
+        factor = unit.baseline.prediction_factor(np.array([temperature, 0.0]))
+        own = unit.baseline.wear_estimate(residual - unit.baseline.mean_ - x @ unit.baseline.slope_, (unit.baseline.scale_ * factor) ** 2)[0]
         row = unit.rows[-1]
-        part = unit.trend.condition_part(x)
+        part = unit.wear.trend.condition_part(x)
         assert np.any(np.abs(part) > 1e-6)
         np.testing.assert_allclose(row.wear.log, own - part, rtol=1e-9, atol=1e-9)

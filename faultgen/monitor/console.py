@@ -20,18 +20,18 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     monitored), of a finished run's ``outcome`` (:class:`faultgen.monitor.loop.Outcome`: its
     monitors and statuses) with ``settings``, its outputs in ``out``."""
     monitors = outcome.monitors
-    alarmed = [m for m in monitors if m.first_alarm]
+    alarmed = [m for m in monitors if m.alarm.first_alarm]
     by_unit = {m.unit: m for m in monitors}
     lines = [f"events.csv changed for {unit} since the last run: re-scored from its first log (the earliest event "
              f"added, changed or removed: {since})" for unit, since in getattr(outcome, "rescored", [])]
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
-        alarm = m is not None and m.first_alarm
+        alarm = m is not None and m.alarm.first_alarm
         # the fallbacks are said once, beside the status (status.basis), not again in the reason
         reason = status.reason.replace(status.fallback, "").replace("; ; ", "; ").strip("; ") if status.fallback \
             else status.reason
         reason = reason.removeprefix(f"{status.status}: ")  # "not monitored: ..." beside the status said once
-        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.source_axis}" if alarm else \
+        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.alarm.source_axis}" if alarm else \
             m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
         mix = f"; programs: {status.programs}" if status.programs and status.programs not in what else ""
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"

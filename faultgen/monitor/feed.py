@@ -87,7 +87,7 @@ def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list
     rul.csv (:func:`faultgen.monitor.friction_tests.remaining_life`: on the unit's friction tests'
     scale when it has tests, else :func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
     they are made in parallel too."""
-    note = "wear signature match" if monitor.signatures is not None else "RBC of Q"
+    note = "wear signature match" if monitor.baseline.signatures is not None else "RBC of Q"
     buffer = io.BytesIO()
     report.chart(buffer, monitor, note)
     return buffer.getvalue(), friction_tests.remaining_life(monitor, failure_wear)
@@ -296,11 +296,11 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
     rounding), which the PCA model cannot standardise: :data:`CONSTANT_TORQUE` and the features;
     "" otherwise (or before the learning's last log). The features are the residuals plus the
     twin's expectation, which may vary with the logs' conditions while the torque does not."""
-    monitor = unit.monitor
-    if monitor.pca is not None or len(monitor.training) + 1 < monitor.learning_logs:
+    baseline = unit.monitor.baseline
+    if baseline.pca is not None or len(baseline.training) + 1 < baseline.learning_logs:
         return ""
-    expected = monitor.learned_expectations or [0.0] * len(monitor.training)
-    features = np.stack([e + x for (_, e, _), x in zip(monitor.training, expected)] + [vector])
+    expected = baseline.learned_expectations or [0.0] * len(baseline.training)
+    features = np.stack([e + x for (_, e, _), x in zip(baseline.training, expected)] + [vector])
     constant = np.setdiff1d(np.arange(features.shape[1]), varying_columns(features))
     if not constant.size:
         return ""
@@ -330,7 +330,8 @@ def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:
     unit.skipped.extend(stored.Skipped(e.stamp, e.sha256, skipped) for e in unit.entries)
     unit.skipped.append(stored.Skipped(stamp, sha256, skipped))
     unit.entries.clear()
-    unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes, unit.monitor.signatures)
+    unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes,
+                               unit.monitor.baseline.signatures)
     unit.notes.append(why)
     unit.off_monitor = why
     return why

@@ -185,7 +185,7 @@ def monitor(run: MonitorRun) -> Outcome:
                 state[name] = new_unit(name, units, run.robot, run.settings, run.calibrated, run.calibrate, programs,
                                        source)
                 _keep_program(state[name], rescored.get(name))
-                state[name].monitor.tests = scale_of(name)
+                state[name].monitor.wear.tests = scale_of(name)
         made = _score_units(run, Context.of(run, units, maintenance), state, pending, source)
         statuses = [_status(name, state.get(name), run.settings, stale[name], tests.get(name, ()),
                             fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
@@ -251,7 +251,7 @@ def _write_outputs(run: MonitorRun, units: dict, state: dict[str, Unit], statuse
                 unit = state[name]
                 stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
                                   stored.UnitState(name, run.digest, unit.program,
-                                                   unit.monitor.signatures if unit.initial_signatures is None
+                                                   unit.monitor.baseline.signatures if unit.initial_signatures is None
                                                    else unit.initial_signatures, unit.entries,
                                                    unit.model, unit.first, unit.skipped, unit.notes,
                                                    unit.maintenance, unit.program_changes,
@@ -375,12 +375,12 @@ def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] =
         reasons.append(f"{len(unread)} friction tests not read: {unread[0].stamp}: {unread[0].error}{more}")
     if unit.skipped:
         reasons.append(skipped_note(unit.skipped))
-    learning = unit.monitor.pca is None
+    learning = unit.monitor.baseline.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
     latest = unit.entries[-1].program if unit.entries else 0  # the program it runs now learning too: learning
     still = learning or programs.learning(unit.monitor, latest)
     if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
-        reasons.append(f"learning: {len(unit.monitor.training)} of {settings.train} logs")
+        reasons.append(f"learning: {len(unit.monitor.baseline.training)} of {settings.train} logs")
     elif not learning and unit.monitor.not_observable_note():
         reasons.append(unit.monitor.not_observable_note())
     count = 1 + len(unit.program_changes)

@@ -579,12 +579,12 @@ def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, rows: list[dict] | N
     """:func:`remaining_life` of a :class:`faultgen.monitor.scoring.UnitMonitor`: its rows (or
     ``rows``, the same put on another scale), alpha and open alarm; a unit that scored no log at
     all (not monitored, every log skipped) is said so, not "still learning"."""
-    if not monitor.rows and not monitor.training:
+    if not monitor.rows and not monitor.baseline.training:
         return [Remaining(monitor.unit, None, "", "", "no log scored: no wear estimate", failure_wear,
                           options.get("horizon", HORIZON))]
     return remaining_life(monitor.unit, monitor.rows if rows is None else rows, monitor.n_axes,
                           alpha=monitor.settings.alpha,
-                          failure_wear=failure_wear, since=monitor.first_alarm, source_axis=monitor.source_axis,
+                          failure_wear=failure_wear, since=monitor.alarm.first_alarm, source_axis=monitor.alarm.source_axis,
                           **options)
 
 

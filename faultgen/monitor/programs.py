@@ -16,12 +16,12 @@ fed to the axis's one filter.
   the cycle beside it. A log with no whole cycle is skipped with its reason
   (:func:`refusal_text`).
 - **Baselines.** The unit learns once it has ``train`` logs in all, its programs' together
-  (:func:`pool`, :mod:`faultgen.monitor.learning`): each program met by then with at least
+  (:func:`pool`, :mod:`faultgen.monitor.baseline`): each program met by then with at least
   ``relearn_logs`` of them its own offset, all of them one set of condition slopes, noise and PCA
   model; each program its own wear signatures (its twin's). A program met later, or with fewer
   logs in that learning, learns only its offset on its own first ``relearn_logs`` logs (as a unit
-  after maintenance does) and borrows the rest. Each program's :data:`BASELINE` is swapped in for
-  its logs (:class:`Baselines`); the unit's monitor holds its first program's between logs. The
+  after maintenance does) and borrows the rest. Each program's
+  :class:`~faultgen.monitor.baseline.Baseline` is swapped in for its logs (:class:`Baselines`); the unit's monitor holds its first program's between logs. The
   alarm (its run of alarming logs), the rows and the friction tests are the unit's.
 - **One filter per axis.** Every program's per-log wear estimate of an axis goes to the unit's one
   :class:`faultgen.monitor.wear_trend.WearTrend` with that program's own standard error (an axis a
@@ -39,8 +39,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from faultgen.logs import align
-from faultgen.monitor.learning import fit_shared, fit_signatures, score_learning, shared
-from faultgen.monitor.wear_trend import WearTrend
+from faultgen.monitor.baseline import Baseline
 
 #: A log's span short of a whole number of periods by under this share of a period counts it.
 EDGE = align.HINT_SLACK
@@ -53,11 +52,6 @@ EDGE_SAMPLES = 2
 START_REST = 0.1
 #: Two units' first logs run the same program (they share its twin) within this RMS angle, rad.
 SAME_PROGRAM = 1e-3
-#: The attributes of :class:`faultgen.monitor.scoring.UnitMonitor` that are a program's baseline
-#: (learned on the program's own first logs), swapped per log by :class:`Baselines`.
-BASELINE = ("signatures", "training", "learned_expectations", "pca", "far_", "mean_", "condition_mean_",
-            "regressors_", "slope_", "gram_inv_", "learned_", "scale_", "dispersion_", "observable_", "width_",
-            "relearning", "program_changed", "placeholders", "borrowed_", "day_scatter_")
 
 
 def _starts_a_cycle(t: np.ndarray, q: np.ndarray, period: float) -> bool:
@@ -229,21 +223,19 @@ class _Fused:
 @dataclass
 class Baselines:
     """The baselines of a unit's programs after the first (``saved[k - 1]``: program ``k``'s
-    :data:`BASELINE` attributes between its logs) and, once each has learned, the filtered wear at
+    :class:`faultgen.monitor.baseline.Baseline`) and, once each has learned, the filtered wear at
     its learning (``offsets[k - 1]``: (estimate, variance) per axis, or None before)."""
 
-    saved: list[dict] = field(default_factory=list)
+    saved: list[Baseline] = field(default_factory=list)
     offsets: list[tuple[np.ndarray, np.ndarray] | None] = field(default_factory=list)
 
     def new(self, monitor, signatures: np.ndarray | None) -> int:
         """A new program's baseline, empty (learning from its next log), with ``signatures``: its index."""
-        from faultgen.monitor.scoring import UnitMonitor
-
-        fresh = UnitMonitor(monitor.unit, monitor.settings, monitor.n_axes, signatures)
+        # the unit has learned: the new program learns its offset alone
+        fresh = Baseline(monitor.settings, monitor.n_axes, signatures,
+                         monitor.shared_ if monitor.baseline.pca is not None else None)
         fresh.program_changed = True  # its learning logs listed as they come, then scored as relearning
-        if monitor.pca is not None:  # the unit has learned: the new program learns its offset alone
-            fresh.borrowed_ = monitor.shared_
-        self.saved.append({name: getattr(fresh, name, None) for name in BASELINE})
+        self.saved.append(fresh)
         self.offsets.append(None)
         return len(self.saved)
 
@@ -254,34 +246,29 @@ class Baselines:
             call()
         else:
             self._run(monitor, program, call)
-        if monitor.pca is None and self.saved and self.learning_logs(monitor) >= monitor.settings.train:
+        if monitor.baseline.pca is None and self.saved and self.learning_logs(monitor) >= monitor.settings.train:
             pool(monitor, self)
 
     def learning_logs(self, monitor) -> int:
         """The unit's learning logs in all, every program's (before the unit has learned)."""
-        return len(monitor.training) + sum(len(b["training"]) for b in self.saved)
+        return len(monitor.baseline.training) + sum(len(b.training) for b in self.saved)
 
     def _run(self, monitor, program: int, call) -> None:
-        first = {name: getattr(monitor, name, None) for name in BASELINE}
-        trend = monitor.trend
-        for name, value in self.saved[program - 1].items():
-            setattr(monitor, name, value)
+        first, trend = monitor.baseline, monitor.wear.trend
+        monitor.baseline = self.saved[program - 1]
         offset = self.offsets[program - 1]
         if offset is None and trend.state is not None:
             offset = (trend.state[:, 0].copy(), trend.covariance[:, 0, 0].copy())
         zero = np.zeros(monitor.n_axes)
-        monitor.trend = _Fused(trend, *(offset if offset is not None else (zero, zero)))
-        learning = monitor.pca is None
+        monitor.wear.trend = _Fused(trend, *(offset if offset is not None else (zero, zero)))
+        learning = monitor.baseline.pca is None
         try:
             call()
         finally:
-            self.saved[program - 1] = {name: getattr(monitor, name, None) for name in BASELINE}
-            if learning and monitor.pca is not None:  # learned: its rows join the unit's in stamp order
+            if learning and monitor.baseline.pca is not None:  # learned: its rows join the unit's in stamp order
                 self.offsets[program - 1] = offset
                 monitor.rows.sort(key=lambda row: row.stamp)
-            for name, value in first.items():
-                setattr(monitor, name, value)
-            monitor.trend = trend
+            monitor.baseline, monitor.wear.trend = first, trend
 
     def maintenance(self, monitor, stamp: str, event: str, axis: int) -> None:
         """A repair or gearbox change given to every program's baseline
@@ -296,60 +283,41 @@ class Baselines:
 
 def pool(monitor, baselines: Baselines) -> None:
     """Learn the unit's baseline on the learning logs of all its programs (``train`` in all: module
-    docstring of :mod:`faultgen.monitor.learning`): each program with at least ``relearn_logs`` of
-    them (and the first, always) its own offset, all of them the slopes, noise and PCA model; a
-    program with fewer learns its offset on its own (:func:`faultgen.monitor.learning.fit_offset`).
-    The learning logs' rows are scored in stamp order, each on its program's baseline."""
-    from faultgen.monitor.scoring import FAR_ALPHA, NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL_Z
-
-    parts = [monitor.training] + [b["training"] for b in baselines.saved]
-    pooled = [k for k, logs in enumerate(parts) if k == 0 or len(logs) >= monitor.relearn_logs]
+    docstring of :mod:`faultgen.monitor.baseline`): each program with at least ``relearn_logs`` of
+    them (and the first, always) its own offset, all of them the slopes, noise and PCA model
+    (:meth:`~faultgen.monitor.baseline.Baseline.learn_with`); a program with fewer learns its offset
+    on its own (:meth:`~faultgen.monitor.baseline.Baseline.fit_offset`). The learning logs' rows are
+    scored in stamp order, each on its program's baseline."""
+    first = monitor.baseline
+    parts = [first.training] + [b.training for b in baselines.saved]
+    pooled = [k for k, logs in enumerate(parts) if k == 0 or len(logs) >= first.relearn_logs]
     logs = sorted(((s, i, e, c) for i, k in enumerate(pooled) for s, e, c in parts[k]), key=lambda log: log[0])
     groups = np.array([i for _, i, _, _ in logs])
-    monitor.training = [(s, e, c) for s, _, e, c in logs]
-    R, offsets = fit_shared(monitor, FAR_ALPHA, groups)
-    common = monitor.shared_ = shared(monitor, R, len(R) - len(pooled) - len(monitor.regressors_))
+    first.training = [(s, e, c) for s, _, e, c in logs]
+    R, offsets = first.fit_shared(groups)
+    common = monitor.shared_ = first.shared(R, len(R) - len(pooled) - len(first.regressors_))
     counts = np.bincount(groups)
-    monitor.training, monitor.learned_ = [], int(counts[0])
-    monitor.trend = WearTrend(monitor.n_axes, len(monitor.regressors_))
-    if monitor.signatures is not None:
-        error = fit_signatures(monitor, R, common["dof"], WEAR_INTERVAL_Z, NOT_OBSERVABLE_LIMITS)
-        monitor.trend.set_prior(error[:, None, None] ** 2 * monitor.gram_inv_[None])
+    first.training, first.learned_ = [], int(counts[0])
+    error = None if first.signatures is None else first.fit_signatures(R, common["dof"])
+    monitor.wear.start(len(first.regressors_), error, first.gram_inv_)
     zero = np.zeros(monitor.n_axes)
     for i, k in enumerate(pooled[1:], 1):
         baselines.offsets[k - 1] = (zero, zero)  # learned with the first: its wear read from the same start
-        baselines.run(monitor, k, lambda i=i: _learned_with(monitor, common, offsets[i], int(counts[i])))
+        baselines.saved[k - 1].learn_with(common, offsets[i], int(counts[i]))
     for k in range(1, len(parts)):
         if k not in pooled:
-            baselines.saved[k - 1]["borrowed_"] = common
+            baselines.saved[k - 1].borrowed_ = common
     learned = {s for s, _, _, _ in logs}
     monitor.rows[:] = [row for row in monitor.rows if row.stamp not in learned]
     for j, (stamp, i, _, _) in enumerate(logs):
-        baselines.run(monitor, pooled[i], lambda j=j, stamp=stamp: score_learning(monitor, [stamp], R[j:j + 1],
-                                                                                   "training"))
+        baselines.run(monitor, pooled[i], lambda j=j, stamp=stamp: monitor.score_learning([stamp], R[j:j + 1],
+                                                                                          "training"))
     monitor.rows.sort(key=lambda row: row.stamp)
-
-
-def _learned_with(monitor, common: dict, offset: np.ndarray, count: int) -> None:
-    """A program's baseline learned with the unit's first (:func:`pool`): the unit's ``common``
-    parts (:data:`faultgen.monitor.learning.SHARED`), its own ``offset`` (n_features,) from its
-    ``count`` learning logs, and its signatures' parts on the pooled residuals."""
-    from faultgen.monitor.scoring import NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL_Z
-
-    for name, value in common.items():
-        if name not in ("R", "dof"):
-            setattr(monitor, name, value)
-    monitor.mean_, monitor.learned_, monitor.training = offset, count, []
-    monitor.program_changed, monitor.placeholders = False, 0
-    if monitor.signatures is not None:
-        fit_signatures(monitor, common["R"], common["dof"], WEAR_INTERVAL_Z, NOT_OBSERVABLE_LIMITS)
 
 
 def learning(monitor, program: int) -> bool:
     """Whether the unit's program ``program`` (0: its first) is still learning its baseline."""
-    if program == 0:
-        return monitor.pca is None
-    return baselines_of(monitor).saved[program - 1]["pca"] is None
+    return (monitor.baseline if program == 0 else baselines_of(monitor).saved[program - 1]).pca is None
 
 
 def baselines_of(monitor) -> Baselines:
@@ -372,7 +340,6 @@ def mix_note(monitor, entries, count: int) -> str:
     if count < 2:
         return ""
     saved = baselines_of(monitor).saved
-    learning = [f"program {k + 2} learning: {len(b['training'])} of "
-                f"{monitor.settings.train if b['borrowed_'] is None else monitor.relearn_logs} logs"
-                for k, b in enumerate(saved) if b["pca"] is None]
+    learning = [f"program {k + 2} learning: {len(b.training)} of {b.learning_logs} logs"
+                for k, b in enumerate(saved) if b.pca is None]
     return "; ".join([f"programs: {mix(entries, count)}", *learning])

@@ -76,7 +76,7 @@ def scores_table(monitors, n_axes: int) -> Table:
     :meth:`faultgen.monitor.wear_trend.WearTrend.condition_part`) and its lower ``1 - alpha`` bound
     (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
-    if any(m.signatures is not None for m in monitors):
+    if any(m.baseline.signatures is not None for m in monitors):
         columns += tuple(f"wear{i}{end}" for end in ("", "_lower", "_log", "_log_lower") for i in range(1, n_axes + 1))
     rows = []
     for m in monitors:
@@ -105,7 +105,7 @@ def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
     """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
-    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.scoring.UnitMonitor.wear_interval`),
+    uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.wear.WearEstimator.wear_interval`),
     the lower one-sided 90 % bound the alarm is judged on, the filter's error and the scale's doubt
     together (``wear_lower``, as ``wearI_lower`` of scores.csv; :mod:`faultgen.monitor.bounds`) and the log's own estimate (``wear_log``). Only units with a twin
     have rows. With ``scales`` (a fleet with friction tests, or units in ``nominal``) also each
@@ -183,12 +183,13 @@ def _draw(path, monitor, axis_note: str) -> None:
         training = sum(r.phase == "training" for r in rows)
         top.axvspan(-0.5, training - 0.5, color="0.9", label="learning (own first logs)")
         stamps = [r.stamp for r in rows]
-        if monitor.first_alarm:
-            k = stamps.index(monitor.first_alarm)
+        alarm = monitor.alarm
+        if alarm.first_alarm:
+            k = stamps.index(alarm.first_alarm)
             for ax in panels:
                 ax.axvline(k, color="r", lw=1.2)
-            known = f" known {monitor.known}" if monitor.known and monitor.known != monitor.first_alarm else ""
-            top.text(k, 1.0, plain(f" alarm {monitor.first_alarm}{known}, axis {monitor.source_axis}"), color="r",
+            known = f" known {alarm.known}" if alarm.known and alarm.known != alarm.first_alarm else ""
+            top.text(k, 1.0, plain(f" alarm {alarm.first_alarm}{known}, axis {alarm.source_axis}"), color="r",
                      va="bottom")
         top.set_yscale("log")
         if twin:
@@ -210,7 +211,7 @@ def _draw(path, monitor, axis_note: str) -> None:
     else:
         top.text(0.5, 0.5, "no log scored: see units.csv", ha="center", va="center", transform=top.transAxes)
     top.set_ylabel("statistic / its limit")
-    protocol = "twin" if monitor.signatures is not None else "own"
+    protocol = "twin" if monitor.baseline.signatures is not None else "own"
     top.set_title(plain(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)"))
     bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'RBC of Q'})")
     if rows:

@@ -199,7 +199,7 @@ def replay(state: UnitState, settings: Settings, n_axes: int, tests=None) -> Uni
     (:mod:`faultgen.monitor.programs`): the monitor the run that wrote ``state`` ended with
     (``tests``: its friction tests' scale, :attr:`UnitMonitor.tests`, given before the entries)."""
     monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
-    monitor.tests = tests
+    monitor.wear.tests = tests
     maintenance: dict[int, list[Maintenance]] = {}
     for m in state.maintenance:  # grouped by entry, in their order: each looked at once
         maintenance.setdefault(m.at, []).append(m)

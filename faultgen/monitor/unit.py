@@ -237,11 +237,11 @@ def twin_of(unit: Unit, context, twins: dict, progress: bool, source: fleet_logs
             unit.notes[start:] = chain_notes(tried, fallback)
             unit.model = fallback
             continue
-        if unit.monitor.signatures is not None and not np.array_equal(unit.monitor.signatures, twin.signatures):
+        if unit.monitor.baseline.signatures is not None and not np.array_equal(unit.monitor.baseline.signatures, twin.signatures):
             raise stored.StateError(f"{out / '.state' / (unit.monitor.unit + '.json')}: its wear signatures are not those of "
                              f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
                              "into a new OUT")
-        unit.monitor.signatures = twin.signatures
+        unit.monitor.baseline.signatures = twin.signatures
         if unit.initial_signatures is None and not unit.program_changes:
             unit.initial_signatures = twin.signatures
         return twin
