@@ -358,7 +358,7 @@ class UnitMonitor:
         lower = log_estimate - self.bound_quantile * log_error
         row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
                                 tuple(names))
-        return ((wear, factor * error), low, high, wear - self.alarm_quantile * sd,
+        return ((wear, factor * error), low, high, self.tests.floored(wear - self.alarm_quantile * sd),
                 factor * log_estimate, factor * log_error, row)
 
     # -- ranking --------------------------------------------------------------------------------
