@@ -3,7 +3,7 @@
 options in :mod:`faultgen.bench.cell`), and optionally today's ``faultgen monitor`` run on one.
 
     python benchmarks/real_cell_fleet.py WORK [--scatter 0.015 0.03] [--units 12] [--worn 8] [--days 120]
-        [--seed 0] [--one-program] [--rates 3 0.3] [--monitor] [--timeout S] [--jobs N]
+        [--seed 0] [--one-program] [--rates 3 0.3] [--onset 45 50] [--monitor] [--timeout S] [--jobs N]
 
 Each fleet, ``WORK/scatter-<sigma>[-one-program]/``: KR210 units (rtb-data's KR210 L150, added as
 ``faultgen robots add`` adds it, in ``WORK/kr210``) logging once a day; the cell has 3 programs (the
@@ -15,8 +15,10 @@ generator's law (deterministic); the friction of each log and each test scatteri
 by ``--scatter`` (log-normal sigma, both alike; the issue's 1.5 % and 3 %). ``--one-program``: the
 same fleets with every unit on the pick and place alone and one whole cycle a log (the issue's
 comparison). ``--rates 3 0.3``: the first two worn units wear 3 and 0.3 points a day from their onset
-instead (the issue's fast and slow wear; ``-rates`` in the folder's name). A fleet already there is
-kept (the same seed draws the same files).
+instead (the issue's fast and slow wear; ``-rates`` in the folder's name). ``--onset A B``: the worn
+units' onset drawn in days A-B instead (``-onset-A-B`` in the folder's name; e.g. 45 50: a fast wear
+that begins after the unit has learned, about its 30th day). A fleet already there is kept (the same
+seed draws the same files).
 
 ``--monitor``: ``faultgen monitor LOGS --robot WORK/kr210 -o OUT`` on each fleet, timed, killed past
 ``--timeout`` s (then it has written nothing: the monitor writes its outputs at the end; its console
@@ -53,12 +55,14 @@ MONITORED_BY, ALARM = 40, (8.0, 15.0)
 
 
 def spec(scatter: float, units: int = 12, worn: int = 8, days: int = 120, seed: int = 0,
-         one_program: bool = False, rates: tuple[float, ...] = ()) -> independent.FleetSpec:
+         one_program: bool = False, rates: tuple[float, ...] = (),
+         onset: tuple[int, int] | None = None) -> independent.FleetSpec:
     """The issue's fleet at ``scatter`` (module docstring); ``one_program``: one program, whole cycles;
-    ``rates``: the first worn units' wear in points a day."""
+    ``rates``: the first worn units' wear in points a day; ``onset``: the days the worn units' onset
+    is drawn in (None: the first 1/6-5/12 of the record)."""
     cell_options = {} if one_program else {"programs": PROGRAMS, "unit_programs": UNIT_PROGRAMS, "span": SPAN}
     return independent.FleetSpec(
-        units=units, worn=worn, days=days, seed=seed, onset=(max(days // 6, 1), max(days * 5 // 12, 1)),
+        units=units, worn=worn, days=days, seed=seed, onset=onset or (max(days // 6, 1), max(days * 5 // 12, 1)),
         friction_test_every=TEST_EVERY, wear_laws=cell.WEAR_LAWS, log_jitter=scatter, test_jitter=scatter,
         dry_per_k=DRY_PER_K, wear_rates=tuple(rates), **cell_options)
 
@@ -143,6 +147,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--one-program", action="store_true")
     parser.add_argument("--rates", type=float, nargs="*", default=[])
+    parser.add_argument("--onset", type=int, nargs=2, default=None, metavar=("FIRST", "LAST"))
     parser.add_argument("--monitor", action="store_true")
     parser.add_argument("--timeout", type=float, default=3600.0)
     parser.add_argument("--jobs", type=int, default=1)
@@ -151,8 +156,10 @@ def main() -> None:
     if not (robot / "drivetrain.toml").is_file():
         pinocchio_log.add_kr210(robot)
     for scatter in args.scatter:
-        fleet = spec(scatter, args.units, args.worn, args.days, args.seed, args.one_program, tuple(args.rates))
-        root = args.work / f"scatter-{scatter:g}{'-one-program' if args.one_program else ''}{'-rates' if args.rates else ''}"
+        onset = tuple(args.onset) if args.onset else None
+        fleet = spec(scatter, args.units, args.worn, args.days, args.seed, args.one_program, tuple(args.rates), onset)
+        root = args.work / (f"scatter-{scatter:g}{'-one-program' if args.one_program else ''}"
+                            f"{'-rates' if args.rates else ''}{f'-onset-{onset[0]}-{onset[1]}' if onset else ''}")
         started = time.perf_counter()
         logs, _ = independent.write_fleet(root, fleet, robot)
         print(f"fleet {root.name}: {fleet.units} units x {fleet.days} days written in "

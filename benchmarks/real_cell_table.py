@@ -4,7 +4,7 @@
     python benchmarks/real_cell_table.py FLEET OUT [FLEET OUT ...] [--monitor] [--robot DIR] [--limit 10]
 
 ``FLEET`` a fleet folder (``logs/``, ``truth.csv``, ``truth_programs.csv``, ``truth_tests.csv``; its
-scatter read from its name, ``scatter-<sigma>[-one-program][-rates]``), ``OUT`` the monitor's output
+scatter read from its name, ``scatter-<sigma>[-one-program][-rates][-onset-A-B]``), ``OUT`` the monitor's output
 folder of it; ``--monitor``: run ``faultgen monitor FLEET/logs --robot ROBOT -o OUT --jobs 1`` first
 (:func:`real_cell_fleet.run_monitor`), its wall and CPU time (the monitor's and its children's,
 ``resource.getrusage``) kept in ``OUT.timing.json`` beside ``OUT`` for later runs of this script.
@@ -323,7 +323,7 @@ def table(fleet: Path, out: Path, robot: Path, limit: float) -> tuple[list[str],
     logs = sum(len(t["stamps"]) for t in truth.values())
     cpu = cpu_row(out, logs)
     rows += [cpu] if cpu else []
-    rows += rates_rows(truth, firsts, per_unit) if fleet.name.endswith("-rates") else []
+    rows += rates_rows(truth, firsts, per_unit) if "-rates" in fleet.name else []
     lines = [f"**{fleet.name}** ({fleet} / {out}; remaining life from {source})", "",
              "| criterion | measured | verdict |", "| --- | --- | --- |"]
     lines += [f"| {c} | {f} | {verdict(ok)} |" for c, f, ok in rows]

@@ -198,3 +198,34 @@ def test_a_fast_wear_is_read_at_its_test_and_the_test_stays_in_the_factor():
     factor, error, _ = scale.at("2026-01-06", np.array([17.0]), np.array([1.0]))
     wear, sd = scale.wear(np.array([17.0]), np.array([1.0]), factor, error)
     assert wear[0] == pytest.approx(factor[0] * 17.0) and factor[0] > 1.2
+
+
+def test_a_tests_read_is_taken_less_its_offset_and_its_bound_floors_the_later_logs():
+    """Issue 90 (the first alarm before 15 %): a test read into its log at once is taken less the
+    offset ``b`` the tests before the wear tell (4 tests at no wear reading 3 points high, then 12 %
+    read as 15: its log reads 12.9, main's 14.6); and its log's lower 90 % bound stays a floor of the
+    later logs' until the next test (a wear does not fall): two logs after a test at 16 % the bound
+    stays 13.7 where the factor alone gives 12.6-13.0, so the alarm persists from the test's log."""
+    true = np.array([0.0, 0.0, 0.0, 0.0, 12.0])
+    stamps, wears = _test_wears(true, 3.0)
+    scale = Rescale("u", 1, wears)
+    for stamp, x in zip(stamps, true):
+        factor, error, _ = scale.at(stamp, np.array([x]), np.array([0.7]))
+    wear, sd = scale.wear(np.array([12.0]), np.array([0.7]), factor, error)
+    assert abs(wear[0] - 12.0) < 1.0 and abs(wear[0] - 12.0) < Z90 * sd[0]
+    stamps, wears = _test_wears(np.array([0.0, 0.0, 16.0]), 0.0)
+    scale = Rescale("u", 1, wears)
+    for stamp, x in zip(stamps, (0.0, 0.0, 16.0)):
+        factor, error, _ = scale.at(stamp, np.array([x]), np.array([0.7]))
+    wear, sd = scale.wear(np.array([16.0]), np.array([0.7]), factor, error)
+    floor = scale.floored(wear - Z90_ONE_SIDED * sd)[0]
+    assert floor == pytest.approx(wear[0] - Z90_ONE_SIDED * sd[0]) and floor > 13.0
+    for stamp, x in (("2026-01-06", 15.0), ("2026-01-07", 15.5), ("2026-01-08", 19.0)):
+        factor, error, _ = scale.at(stamp, np.array([x]), np.array([0.7]))
+        wear, sd = scale.wear(np.array([x]), np.array([0.7]), factor, error)
+        own = wear[0] - Z90_ONE_SIDED * sd[0]
+        assert wear[0] == pytest.approx(factor[0] * x)  # the test is in the factor alone
+        assert scale.floored(np.array([own]))[0] == pytest.approx(max(own, floor))
+    assert own > floor  # the logs' own bound takes over as the wear grows
+    scale.reset(1)  # a repair: no floor
+    assert scale.floored(np.array([1.0]))[0] == 1.0

@@ -444,8 +444,10 @@ class Rescale:
     last: tuple[float, np.ndarray, np.ndarray] | None = None  # key, twin-scale wear and error of the last log
     done: int = 0  # wears paired so far
     offset_sd: dict[int, float] = field(default_factory=dict)  # axis -> its reference test's own error, points
-    # axis -> its last test read at once (bounds.test_read): (f, s_f) before it, (y, s_y, x_t, e_t), its log's key
+    # axis -> its last test read at once (bounds.test_read): (f, s_f) before it, (y - b, s_y, x_t, e_t), its log
     read: dict[int, tuple] = field(default_factory=dict)
+    floors: dict[int, float] = field(default_factory=dict)  # axis -> the alarm's bound on its last test's log
+    tested: set = field(default_factory=set)  # axes whose test was read into the last log (floored)
 
     def reset(self, axis: int = 0) -> None:
         """Forget the pairs of ``axis`` (0: every axis): a repair, a new program."""
@@ -453,6 +455,7 @@ class Rescale:
             if axis in (0, k):
                 self.pairs[k] = []
                 self.read.pop(k, None)
+                self.floors.pop(k, None)
 
     def at(self, stamp: str, wear: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """The factor ``f`` (n_axes,) and its standard error for the log ``stamp`` whose filtered wear
@@ -468,16 +471,17 @@ class Rescale:
             if w.log_error != w.log_error or source is None:
                 continue
             if w.reference:
-                self.pairs[w.axis] = []
-                self.read.pop(w.axis, None)
+                self.reset(w.axis)
             sy = 100 * (1 + w.wear / 100) * w.own_error
             if w.reference_error == w.reference_error and w.reference_error > 0:
                 self.offset_sd[w.axis] = 100 * w.reference_error
             x = (float(source[0][w.axis - 1]), float(source[1][w.axis - 1]))
             if not w.reference:  # the test read at once (bounds.test_read), on the factor known before it
-                before = self.fit(w.axis) if self.pairs.get(w.axis) else (1.0, SCALE_PRIOR)
-                self.read[w.axis] = (before, (w.wear, 100 * (1 + w.wear / 100) * w.log_error, *x),
-                                     key if w.key == key else self.last[0])
+                before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
+                    ((1.0, SCALE_PRIOR), (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))  # less the offset b
+                test = (w.wear - offset[0], float(np.hypot(sy, offset[1])), *x)
+                self.read[w.axis] = (before, test, key if w.key == key else self.last[0])
+                self.floors.pop(w.axis, None)
             self.pairs.setdefault(w.axis, []).append((w.wear, sy, *x))
         self.last = (key, np.asarray(wear, dtype=float), np.asarray(error, dtype=float))
         # an axis no test has paired yet: the twin's scale, known to the factor's prior (module bounds)
@@ -496,19 +500,37 @@ class Rescale:
         -+ ``sqrt((f e)^2 + (s_f x)^2)`` (``factor``, ``factor_error``), or, on the log a test of the
         axis was paired with (a test since its reference), that test read into it at once
         (:func:`faultgen.monitor.bounds.test_read`, on the factor known before the test). On the later
-        logs the test is in the factor alone: carried on by the logs' growth since the test, a fast
-        unit's lagging filter at the test read as a scale (tried on the small clean fleet of seed 0: the
-        fast unit read 53.7 % at 39 % true wear)."""
+        logs the test is in the factor alone (carried on by the logs' growth, a fast unit's lagging filter
+        was read as a scale: on the small clean fleet of seed 0, 53.7 % at 39 % true wear), its log's
+        bound a floor of theirs (:meth:`floored`). The test is read less the offset ``b`` its pairs tell."""
         wear, error = np.asarray(wear, dtype=float), np.asarray(error, dtype=float)
         value = factor * wear
         sd = np.asarray(bounds.standard_error(factor * error, value, factor_error / factor), dtype=float)
+        self.tested = set()
         for k, (before, test, logged) in self.read.items():
-            if logged == self.last[0]:  # the test's own log (carried on, a lagging filter's x_t reads as scale)
+            if logged == self.last[0]:  # the test's own log
                 value[k - 1], sd[k - 1] = bounds.test_read(before, (wear[k - 1], error[k - 1]), test, True)
+                self.tested.add(k)
         return value, sd
+
+    def floored(self, bound: np.ndarray) -> np.ndarray:
+        """The alarm's lower ``bound`` (n_axes,) of the log :meth:`wear` was last called for, each axis's
+        at least the one on its last test's log (which sets it) until its next test or repair: a wear
+        does not fall, so a lower bound of it then is one of every later day's, as likely true."""
+        bound = np.array(bound, dtype=float)
+        for k in self.tested:
+            self.floors[k] = float(bound[k - 1])
+        for k, floor in self.floors.items():
+            if k not in self.tested and floor > bound[k - 1]:
+                bound[k - 1] = floor
+        return bound
 
     def fit(self, axis: int) -> tuple[float, float]:
         """The factor of ``axis`` and its standard error from its pairs (module docstring)."""
+        return self._fitted(axis)[0]
+
+    def _fitted(self, axis: int) -> tuple[tuple[float, float], tuple[float, float]]:
+        """(The factor, its standard error), (the offset ``b``, points, its) of ``axis`` (module docstring)."""
         import statsmodels.api as sm
 
         pairs = np.array(self.pairs[axis], dtype=float)
@@ -529,7 +551,7 @@ class Rescale:
         if len(y) > 2:
             chi2 = float(np.sum(weights[: len(y)] * (y - design[: len(y)] @ result.params) ** 2) / (len(y) - 2))
             cov = cov * max(1.0, chi2)
-        return factor, float(np.sqrt(cov[1, 1]))
+        return (factor, float(np.sqrt(cov[1, 1]))), (float(result.params[0]), float(np.sqrt(cov[0, 0])))
 
 
 def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
