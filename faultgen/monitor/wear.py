@@ -107,4 +107,5 @@ class WearEstimator:
         lower = log_estimate - self.bound_quantile * log_error
         row = record.TestsScale(*(np.asarray(v, dtype=float) for v in (log_estimate, lower, factor, factor_error)),
                                 tuple(names))
-        return wear, low, high, self.tests.floored(wear - alarm_quantile() * sd), factor * log_estimate, factor * log_error, row
+        floor = self.tests.floored(wear - alarm_quantile() * sd)  # right after tests.wear, for the same log
+        return wear, low, high, floor, factor * log_estimate, factor * log_error, row
