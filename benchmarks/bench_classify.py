@@ -91,9 +91,8 @@ def plain_loop(inputs, names, classifiers, n_pairs, seed) -> dict:
 #: classifiers, is the outer model's), by the column name of their classifier; PCA is the one
 #: preprocessing step fitted on data, Difference and WindowConcat the stateless run-by-run ones,
 #: StandardScaler the classifiers' scaling (shared by them and by the label sets) and PCA's.
-COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "Forest": "rf",
-           "StackingClassifier": "stacking", "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence",
-           "StandardScaler": "scale"}
+COUNTED = {"LogisticRegression": "lr", "SVC": "svm", "RandomForestClassifier": "rf", "StackingClassifier": "stacking",
+           "PCA": "pca", "Difference": "sequence", "WindowConcat": "sequence", "StandardScaler": "scale"}
 
 
 def counted_work(path: Path, n_pairs: int = 20, **kwargs) -> dict:
@@ -171,10 +170,9 @@ def _counted_classes() -> list[type]:
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVC
 
-    from analysis.classify.forest import Forest
     from analysis.features import Difference, WindowConcat
 
-    return [LogisticRegression, SVC, RandomForestClassifier, Forest, StackingClassifier, PCA, Difference, WindowConcat,
+    return [LogisticRegression, SVC, RandomForestClassifier, StackingClassifier, PCA, Difference, WindowConcat,
             StandardScaler]
 
 

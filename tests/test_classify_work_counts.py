@@ -68,3 +68,26 @@ def test_a_task_per_label_set_and_pair_shipping_more_is_caught(seeds3, monkeypat
     assert found["fits"]["scale"] > found["needed"]["scale"]
     assert all(found["fits"][c] == found["needed"][c] for c in ("lr", "svm", "rf", "stacking"))
     assert found["bytes"] > found["bytes_needed"]
+
+
+def test_one_clone_of_the_classifier_per_fit_through_the_harness(monkeypatch):
+    """A cell's classifier is cloned once per fit: the harness's clone of the ``ByRun`` wrapper shares
+    its unfitted estimator (``ByRun.__sklearn_clone__``), which ``ByRun.fit`` clones (before: deep
+    clones by both, two per fit); the estimator given is never fitted."""
+    from sklearn.base import clone
+    from sklearn.linear_model import LogisticRegression
+
+    from analysis.classify import ByRun
+    from analysis.classify.leave_pair_out import _scores
+    from analysis.evaluate import Data
+
+    made = []
+    original = LogisticRegression.__sklearn_clone__
+    monkeypatch.setattr(LogisticRegression, "__sklearn_clone__", lambda self: made.append(1) or original(self))
+    rng = np.random.default_rng(0)
+    X, y = rng.normal(size=(40, 3)), np.r_[np.zeros(20, dtype=int), np.ones(20, dtype=int)]
+    model = LogisticRegression()
+    scores = _scores(model, Data(X, np.repeat(np.arange(8), 5), y), np.arange(30), np.arange(30, 40), "lr")
+    assert len(made) == 1 and scores.shape == (10,) and not hasattr(model, "coef_")
+    wrapper = ByRun(model)
+    assert clone(wrapper).estimator is model and clone(wrapper) is not wrapper

@@ -6,13 +6,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from sklearn.ensemble import StackingClassifier
+from sklearn.ensemble import RandomForestClassifier, StackingClassifier
 from sklearn.linear_model import LogisticRegression
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
-
-from analysis.classify.forest import Forest
 
 
 def _lr(random_state: int | None = 0) -> LogisticRegression:
@@ -37,9 +35,8 @@ def support_vector_machine(random_state: int | None = 0) -> Pipeline:
 
 
 def random_forest(random_state: int | None = 0) -> Pipeline:
-    """Random forest of 100 trees, seeded; trees need no scaling. A :class:`analysis.classify.forest.Forest`:
-    scikit-learn's ``RandomForestClassifier`` fitted without its per-tree Python, the same trees."""
-    return Pipeline([("rf", Forest(n_estimators=100, random_state=random_state))])
+    """Random forest of 100 trees, seeded; trees need no scaling."""
+    return Pipeline([("rf", RandomForestClassifier(n_estimators=100, random_state=random_state))])
 
 
 def stacking(random_state: int | None = 0, inner_cv: str = "run") -> Pipeline:
