@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from faultgen.monitor.trends import Fit, expm1_over
+from faultgen.monitor.trends import Fit, expm1_over, information_criterion
 
 #: The name of the exponential rise after a flat stretch (:func:`fit_onset_exponential`).
 ONSET = "onset exponential"
@@ -51,8 +51,6 @@ def fit_onset_exponential(t: np.ndarray, wear: np.ndarray, error: np.ndarray, ag
     the rise, and the AICc then counts that misfit of the flat stretch against it (module docstring,
     1). None when it cannot be fitted."""
     from scipy.optimize import least_squares
-
-    from faultgen.monitor.trends import information_criterion
 
     t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
     best = None
