@@ -164,10 +164,20 @@ def test_a_log_older_than_the_last_scored_is_named_and_not_scored(fleet, monitor
 
 
 def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
-    robot, logs, _ = fleet
+    """Two of the fleet's three units (unit01, whose program the twin replays, and the worn unit02):
+    the third, healthy like unit01, would only add its 40 logs to the rerun's scoring."""
+    import json
+
+    robot, whole, _ = fleet
+    logs = tmp_path / "logs"
+    for unit in ("unit01", "unit02"):
+        (logs / unit).mkdir(parents=True)
+        for log in (whole / unit).iterdir():
+            os.link(log, logs / unit / log.name)
     out = with_cycles_of(monitored, tmp_path / "out")
     cycles = out / ".cache" / "cycles"
-    for path in sorted(cycles.iterdir())[:2]:  # two of the twin's cycles to simulate again
+    shared = [p for p in sorted(cycles.iterdir()) if json.loads(p.read_text())["key"]["payload_kg"] == 0.0]
+    for path in shared[:2]:  # two of the twin's cycles (without a part: every run needs them) to simulate again
         path.unlink()
     left = len(list(cycles.iterdir()))
     command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
@@ -188,7 +198,8 @@ def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitor
 
     result = CliRunner().invoke(app, command[3:])
     assert result.exit_code == 0, result.output[-2000:]
-    assert (out / "alarms.csv").read_text() == (monitored / "alarms.csv").read_text()
+    kept = [line for line in (monitored / "alarms.csv").read_text().splitlines() if not line.startswith("unit03,")]
+    assert (out / "alarms.csv").read_text().splitlines() == kept and len(kept) == 3
 
 
 def test_bad_settings_and_an_empty_folder_are_refused(fleet, tmp_path):
@@ -632,7 +643,9 @@ def test_a_gearbox_change_closes_the_alarm_and_the_unit_learns_its_offset_again(
     for log in before:
         os.link(log, split / worn / log.name)
     shutil.copy(copy / "events.csv", split / "events.csv")
-    again = with_cycles_of(monitored, tmp_path / "again")
+    # the first run's cycles: its twin replays the worn unit's program, which the fixture's run (its twin on
+    # unit01's) never simulated; content-addressed, so the split runs read the cycles they would simulate
+    again = with_cycles_of(out, tmp_path / "again")
     loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for log in after:
         os.link(log, split / worn / log.name)
@@ -656,7 +669,7 @@ def test_ur_rtde_recordings_are_monitored_with_their_joint_temperatures(fleet, t
 
     robot, logs, _ = fleet
     rtde, plain = tmp_path / "rtde", tmp_path / "plain"
-    for log in sorted(logs.rglob("*.csv"))[::2]:  # every other day: 20 logs a unit
+    for log in sorted(logs.glob("unit0[12]/*.csv"))[::2]:  # two units (of the three), every other day: 20 logs a unit
         header, *rows = log.read_text().splitlines()
         names = header.split(",")
         table = np.array([[float(c) for c in row.split(",")] for row in rows])
@@ -692,17 +705,27 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     for bit, and a rerun after more logs arrived scores only those (issue 60, part 6): the old rows
     kept as they were, the new ones equal a run over the whole folder at once, no simulated cycle
     redone (this test took over test_new_logs_are_scored_without_redoing_the_old). The first run
-    starts on an empty cache: it simulates the shared twin's cycles in its two worker processes
-    (faultgen.monitor.parallel.prepare_twins), not one after another, and they are the one-job run's
-    cycle files, byte for byte (this test took over
-    test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_the_outputs_of_one)."""
+    starts on a cache missing two of the shared twin's cycles (worn axes 1 and 2) and two of its
+    cycles with a part: it simulates the two shared ones in its two worker processes
+    (faultgen.monitor.parallel.prepare_twins), not one after another, the others where a unit
+    needs them, and they are the one-job run's cycle files, byte for byte (this test took over
+    test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_the_outputs_of_one; an
+    empty cache, all 15 cycles simulated again, took the same paths at 3 times the CPU)."""
+    import json
+
     robot, logs, _ = fleet
     partial = tmp_path / "logs"
     for unit in logs.iterdir():
         (partial / unit.name).mkdir(parents=True)
         for log in sorted(unit.iterdir())[:30]:
             os.link(log, partial / unit.name / log.name)
-    out = tmp_path / "out"
+    out = with_cycles_of(monitored, tmp_path / "out")
+    keys = {p: json.loads(p.read_text())["key"] for p in (out / ".cache" / "cycles").iterdir()}
+    shared = [p for p, key in keys.items() if key["worn_axis"] in (1, 2) and key["payload_kg"] == 0.0]
+    parts = sorted((p for p, key in keys.items() if key["payload_kg"] > 0.0), key=lambda p: keys[p]["payload_kg"])
+    assert len(shared) == 2 and len(parts) >= 2, keys
+    for path in [*shared, *parts[:2]]:
+        path.unlink()
     loop.monitor(resolve_run(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
                              context=ExecutionContext(jobs=2)))
     assert len((out / "scores.csv").read_text().splitlines()) == 1 + SPEC.units * 30
@@ -771,7 +794,9 @@ def test_an_unlogged_program_change_rebuilds_the_twin_and_the_unit_learns_again(
     (split / healthy).mkdir(parents=True)
     for log in sorted((copy / healthy).iterdir())[:25]:
         os.link(log, split / healthy / log.name)
-    again = with_cycles_of(monitored, tmp_path / "again")
+    # the first run's cycles, the rebuilt twin's among them (content-addressed: the cycles the split runs
+    # would simulate again)
+    again = with_cycles_of(out, tmp_path / "again")
     loop.monitor(resolve_run(robot, split, again, calibrate=False, settings=SETTINGS, progress=False))
     for log in sorted((copy / healthy).iterdir())[25:]:
         os.link(log, split / healthy / log.name)
