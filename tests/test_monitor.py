@@ -709,8 +709,8 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     cycles with a part: it simulates the two shared ones in its two worker processes
     (faultgen.monitor.parallel.prepare_twins), not one after another, the others where a unit
     needs them, and they are the one-job run's cycle files, byte for byte (this test took over
-    test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_the_outputs_of_one; an
-    empty cache, all 15 cycles simulated again, took the same paths at 3 times the CPU)."""
+    test_two_jobs_on_an_empty_cache_simulate_the_shared_twin_in_both_and_give_the_outputs_of_one; until
+    2026-11-28 this run started on an empty cache and simulated all 15 cycles again on the same paths)."""
     import json
 
     robot, logs, _ = fleet
