@@ -27,6 +27,9 @@ from resolved_runs import run_config
 # three units, 40 days, one of them worn from day 16-17 (10 % on day 20-21, 40 % on day 32-33)
 SPEC = independent_fleet.FleetSpec(units=3, worn=1, days=40, seed=5, onset=(16, 17))
 SETTINGS = Settings(train=14, persistence=3)
+#: The units of the killed run and of the planted folder: unit01, whose program the twin replays, and the
+#: worn unit02 (unit03, healthy like unit01, would only add its 40 logs and its charts to their runs).
+KEPT = ("unit01", "unit02")
 
 
 @pytest.fixture(scope="module")
@@ -164,20 +167,19 @@ def test_a_log_older_than_the_last_scored_is_named_and_not_scored(fleet, monitor
 
 
 def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitored, tmp_path):
-    """Two of the fleet's three units (unit01, whose program the twin replays, and the worn unit02):
-    the third, healthy like unit01, would only add its 40 logs to the rerun's scoring."""
+    """On the fleet's :data:`KEPT` units."""
     import json
 
     robot, whole, _ = fleet
     logs = tmp_path / "logs"
-    for unit in ("unit01", "unit02"):
+    for unit in KEPT:
         (logs / unit).mkdir(parents=True)
         for log in (whole / unit).iterdir():
             os.link(log, logs / unit / log.name)
     out = with_cycles_of(monitored, tmp_path / "out")
     cycles = out / ".cache" / "cycles"
     shared = [p for p in sorted(cycles.iterdir()) if json.loads(p.read_text())["key"]["payload_kg"] == 0.0]
-    for path in shared[:2]:  # two of the twin's cycles (without a part: every run needs them) to simulate again
+    for path in shared[:2]:  # two of the twin's cycles to simulate again (without a part: every run needs them)
         path.unlink()
     left = len(list(cycles.iterdir()))
     command = [sys.executable, "-m", "faultgen.cli", "monitor", str(logs), "--robot", str(robot), "-o", str(out),
@@ -198,7 +200,8 @@ def test_a_killed_monitor_leaves_no_output_and_the_rerun_finishes(fleet, monitor
 
     result = CliRunner().invoke(app, command[3:])
     assert result.exit_code == 0, result.output[-2000:]
-    kept = [line for line in (monitored / "alarms.csv").read_text().splitlines() if not line.startswith("unit03,")]
+    kept = [line for line in (monitored / "alarms.csv").read_text().splitlines()
+            if not line.startswith("unit03,")]
     assert (out / "alarms.csv").read_text().splitlines() == kept and len(kept) == 3
 
 
@@ -464,14 +467,14 @@ def test_a_cached_calibration_is_checked_against_its_record(tmp_path):
 # -- no unit stops the fleet (issue 60) -----------------------------------------------------------------
 
 def _planted(logs: Path, root: Path) -> Path:
-    """A copy of the fleet folder (hard links) with two more units made of unit01's logs: unit98's
-    declare an 8000 kg part, which the log reader refuses (its bound is 1000 kg), and unit99's run
+    """A copy of the fleet's :data:`KEPT` units (hard links) with two more units made of unit01's logs:
+    unit98's declare an 8000 kg part, which the log reader refuses (its bound is 1000 kg), and unit99's run
     three times faster (9 times the accelerations) 2 mrad off unit01's angles, a motion no KR210
     model's drives follow (its replay is refused above the planning limits), with three times its
     torque (the calibration's plausibility check, which the monitor runs on every first log since
     issue 88, refuses unit01's torque along that motion: 0.12-0.14 x the model's)."""
     copy = root / "logs"
-    for unit in logs.iterdir():
+    for unit in (logs / name for name in KEPT):
         (copy / unit.name).mkdir(parents=True)
         for log in unit.iterdir():
             os.link(log, copy / unit.name / log.name)
@@ -519,12 +522,13 @@ def test_units_no_model_can_simulate_are_named_and_every_other_unit_is_scored_as
     assert "protocol own used" in units["unit99"]["reason"]
     assert units["unit99"]["logs_scored"] == str(SPEC.days)
     assert {u: r["status"] for u, r in units.items() if u not in ("unit98", "unit99")} == \
-        {u.name: "monitored" for u in logs.iterdir()}
+        dict.fromkeys(KEPT, "monitored")
     assert "unit98" in result.output and "exit status 3" in result.output
     # every other unit: its rows of alarms.csv and scores.csv as in the run without the planted units
     for name in ("alarms.csv", "scores.csv"):
         kept = [line for line in (out / name).read_text().splitlines() if not line.startswith(("unit98,", "unit99,"))]
-        assert kept == (monitored / name).read_text().splitlines(), name
+        assert kept == [line for line in (monitored / name).read_text().splitlines()
+                        if not line.startswith("unit03,")], name
     # the rerun keeps the skipped logs and the fallback: nothing to do, the same verdicts
     again = loop.monitor(resolve_run(robot, copy, out, calibrate=False, settings=SETTINGS, progress=False))
     assert {s.unit: s.status for s in again.statuses if s.unit in ("unit98", "unit99")} == \
@@ -669,7 +673,7 @@ def test_ur_rtde_recordings_are_monitored_with_their_joint_temperatures(fleet, t
 
     robot, logs, _ = fleet
     rtde, plain = tmp_path / "rtde", tmp_path / "plain"
-    for log in sorted(logs.glob("unit0[12]/*.csv"))[::2]:  # two units (of the three), every other day: 20 logs a unit
+    for log in sorted(logs.glob("unit0[12]/*.csv"))[::2]:  # two units, every other day: 20 logs a unit
         header, *rows = log.read_text().splitlines()
         names = header.split(",")
         table = np.array([[float(c) for c in row.split(",")] for row in rows])
@@ -722,7 +726,8 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     out = with_cycles_of(monitored, tmp_path / "out")
     keys = {p: json.loads(p.read_text())["key"] for p in (out / ".cache" / "cycles").iterdir()}
     shared = [p for p, key in keys.items() if key["worn_axis"] in (1, 2) and key["payload_kg"] == 0.0]
-    parts = sorted((p for p, key in keys.items() if key["payload_kg"] > 0.0), key=lambda p: keys[p]["payload_kg"])
+    parts = sorted((p for p, key in keys.items() if key["payload_kg"] > 0.0),
+                   key=lambda p: keys[p]["payload_kg"])
     assert len(shared) == 2 and len(parts) >= 2, keys
     for path in [*shared, *parts[:2]]:
         path.unlink()
