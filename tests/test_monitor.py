@@ -71,9 +71,11 @@ def test_the_worn_unit_alarms_in_its_window_with_the_worn_axis_first_and_the_hea
 
 def test_same_seed_gives_identical_outputs(fleet, monitored, tmp_path):
     """The fleet again from the same seed: identical logs, byte for byte. Identical outputs from the
-    same logs (alarms, scores, rul, wear, life, units and charts, byte for byte, in runs of their own
-    on an empty cache) are test_two_jobs_give_the_outputs_of_one's assertions; a run here on logs
-    equal to the fleet's checked nothing more (docs/performance.md)."""
+    same logs (alarms, scores, rul, wear, life, units and charts, byte for byte) are
+    test_two_jobs_give_the_outputs_of_one's assertions (a run of its own that simulates four of the
+    twin's cycles again in its workers); two runs each on an empty cache, every output but the cache
+    the same bytes, are tests/test_monitor_cluster.py's (the local run and the cluster's); a run here
+    on logs equal to the fleet's checked nothing more (docs/performance.md)."""
     robot, first_logs, _ = fleet
     _, logs, _ = independent_fleet.write_fleet(tmp_path / "again", SPEC, robot=robot)
     assert sorted(p.relative_to(logs) for p in logs.rglob("*.csv")) == \
