@@ -125,8 +125,9 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
         same = [name for name in outputs if name in made_files and without_jobs(shlex.split(MADE[name])) == without_jobs(words)]
         if same:  # the documented command a file of MADE was made by: same seed, the same file bit for bit
             # (--jobs aside: `sweep --preset j2 --jobs 2` makes j2.h5's bits on any number of jobs, which
-            # tests/test_sweep.py's test_parallel_jobs_give_the_same_dataset checks on 2 jobs against 1)
-            shutil.copy(made_files[same[0]], same[0])
+            # tests/test_sweep.py's test_parallel_jobs_give_the_same_dataset checks on 2 jobs against 1;
+            # --no-progress aside: it silences the progress on stderr, not what is written)
+            (shutil.copytree if made_files[same[0]].is_dir() else shutil.copy)(made_files[same[0]], same[0])
             continue
         argv = small(words[1:], page, scheduler)
         options = dict(zip(argv[3::2], argv[4::2], strict=True)) if argv[:2] == ["bench", "make"] and len(argv) % 2 else {}
@@ -155,7 +156,9 @@ def run_line(line: str, page: str, scheduler: str | None, made_files: dict[str, 
 
 
 def without_jobs(words: list[str]) -> list[str]:
-    """A ``sweep`` command's ``words`` without its ``--jobs N`` (other commands' words as they are)."""
+    """``words`` without ``--no-progress``, and a ``sweep`` command's without its ``--jobs N`` (other
+    commands' ``--jobs`` as it is)."""
+    words = [word for word in words if word != "--no-progress"]
     if "sweep" not in words[:2] or "--jobs" not in words:
         return words
     at = words.index("--jobs")
@@ -216,6 +219,9 @@ MADE = {
     "mine.py": mine_py,
     # docs/dataset.md's layout, "A fleet's logs": three units' daily logs, an onset on one in events.csv
     "LOGS": logs_folder,
+    # the same command on two pages each (logs and logs import; monitor and report): made once, from LOGS
+    "fleet-logs.h5": "faultgen logs import LOGS --robot irb6700 -o fleet-logs.h5",
+    "monitor-own": "faultgen monitor LOGS --robot irb6700 -o monitor-own --protocol own",
 }
 
 
@@ -226,9 +232,11 @@ def made(tmp_path_factory, worker_id, shared_fleet_command):
     folder = shared_folder(tmp_path_factory, worker_id, "help-examples-made")
 
     def make(name: str) -> Path:
+        maker = MADE[name]
+        for source in [] if callable(maker) else [w for w in shlex.split(maker) if w in MADE and w != name]:
+            make(source)  # what the command reads (LOGS), made first in the same folder
         with FileLock(folder / f"{name}.lock"):
             if not (folder / name).exists():
-                maker = MADE[name]
                 fleet = None if callable(maker) else fleet_options(small(shlex.split(maker)[1:], "", None))
                 if callable(maker):
                     maker(folder)
@@ -279,8 +287,9 @@ def test_the_examples_of_a_help_page_run(page, made, shared_bench, shared_fleet_
     # (but your own sources: a robot folder of `robots add`, a program of `tasks export` or `tasks friction-test`)
     sources = {w[w.index("-o") + 1] for line in lines for part in line.split("&&")
                if (w := shlex.split(part, comments=True))[1:3] in (["robots", "add"], ["tasks", "export"], ["tasks", "friction-test"])}
+    copied = {name for name in needed if not any(f"-o {name}" in line for line in lines)}
     written = sorted(p.name + ("/" if p.is_dir() else "") for p in tmp_path.iterdir()
-                     if p.name not in needed | sources and p.name != "__pycache__")
+                     if p.name not in copied | sources and p.name != "__pycache__")
     if written:
         check = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "--no-index", "-v", "-n", *written],
                                capture_output=True, text=True)
