@@ -91,3 +91,32 @@ def test_one_clone_of_the_classifier_per_fit_through_the_harness(monkeypatch):
     assert len(made) == 1 and scores.shape == (10,) and not hasattr(model, "coef_")
     wrapper = ByRun(model)
     assert clone(wrapper).estimator is model and clone(wrapper) is not wrapper
+
+
+def test_a_named_classifier_is_made_anew_per_fit_not_cloned(monkeypatch):
+    """``pair_cells`` makes each fit of a named classifier anew (``ByRun(..., make)``): no scikit-learn
+    clone of it per fit (before: one, whose ``get_params`` reads the signature every time), one fit per
+    label set, and the same AUC, bit for bit, as the cell's whole pipeline cloned and fitted
+    (:func:`_pair_auc`, scikit-learn's own clone)."""
+    from sklearn.linear_model import LogisticRegression
+
+    from analysis.classify.leave_pair_out import _pair_auc, folds, pair_cells
+    from analysis.classify.preprocessing import make_pipeline
+
+    rng = np.random.default_rng(3)
+    groups = np.repeat(np.arange(8), 6)
+    labels = np.where((groups < 4) & (np.tile(np.arange(6), 8) >= 3), 1, 0)
+    X = rng.normal(size=(48, 3)) + labels[:, None]
+    swapped = np.where((groups >= 4) & (np.tile(np.arange(6), 8) >= 3), 1, 0)  # the runs' roles exchanged
+    fold = folds([0], [4], groups)[0]
+    made, fitted = [], []
+    original_clone, original_fit = LogisticRegression.__sklearn_clone__, LogisticRegression.fit
+    monkeypatch.setattr(LogisticRegression, "__sklearn_clone__", lambda self: made.append(1) or original_clone(self))
+    monkeypatch.setattr(LogisticRegression, "fit", lambda self, *a, **k: fitted.append(1) or original_fit(self, *a, **k))
+    sets = [(labels, (0, 4), ["lr"]), (swapped, (4, 0), ["lr"])]
+    found = pair_cells(X, None, groups, (0, 4), sets, ["control", "+diff"], {"lr": "lr"}, 0, False)
+    assert made == [] and len(fitted) == 4 and found.shape == (2, 2)
+    for c, name in enumerate(["control", "+diff"]):
+        expected = _pair_auc(lambda name=name: make_pipeline("lr", name), X, labels, groups, fold)
+        assert found[0, c] == expected and len(made) == c + 1  # the reference does clone
+    assert np.isfinite(found).all()

@@ -139,19 +139,26 @@ class ByRun(ClassifierMixin, BaseEstimator):
     """``estimator`` (a Pipeline or a classifier) fitted and scored run by run, as the evaluation
     harness (:func:`analysis.evaluate.evaluate`) takes a method: ``fit(X, y, groups)`` is
     :func:`fit_by_run` on a clone, ``decision_function(X, groups)`` :func:`score_by_run` (X of shape
-    (n_samples, n_features), groups the run of each row; None: one run). Scores of shape (n_samples,)."""
+    (n_samples, n_features), groups the run of each row; None: one run). Scores of shape (n_samples,).
 
-    def __init__(self, estimator):
+    ``make`` (None, or a callable without arguments): a new unfitted estimator with ``estimator``'s
+    parameters, what ``fit`` fits instead of a clone (scikit-learn's ``clone`` reads the parameters
+    through ``inspect.signature`` at every call; building anew does not: the same fit, number for
+    number, for a caller that builds ``estimator`` the same way)."""
+
+    def __init__(self, estimator, make=None):
         self.estimator = estimator
+        self.make = make
 
     def __sklearn_clone__(self):
-        # scikit-learn's clone protocol (>= 1.3): fit clones ``estimator`` and never changes it, so
-        # a clone shares it unfitted instead of deep-copying it first (one deep clone per fit less)
-        return type(self)(self.estimator)
+        # scikit-learn's clone protocol (>= 1.3): fit clones (or makes) ``estimator`` and never
+        # changes it, so a clone shares it unfitted instead of deep-copying it first
+        return type(self)(self.estimator, self.make)
 
     def fit(self, X, y, groups=None):
         groups = np.zeros(len(X)) if groups is None else groups
-        self.estimator_ = fit_by_run(clone(self.estimator), X, y, groups)
+        fresh = clone(self.estimator) if self.make is None else self.make()
+        self.estimator_ = fit_by_run(fresh, X, y, groups)
         self.classes_ = _steps(self.estimator_)[-1].classes_
         return self
 

@@ -4,6 +4,7 @@ subset, optionally time-matched; one pair's AUCs for every (preprocessing, class
 from __future__ import annotations
 
 import warnings
+from functools import partial
 
 import numpy as np
 import pandas as pd
@@ -99,11 +100,11 @@ def _pair_auc(factory, X, labels, groups, fold, matched: bool = False) -> float:
     return float(roc_auc_score(truth, scores[test]))
 
 
-def _scores(model, data: Data, train: np.ndarray, test: np.ndarray, name: str) -> np.ndarray:
+def _scores(model, data: Data, train: np.ndarray, test: np.ndarray, name: str, make=None) -> np.ndarray:
     """The scores of ``data``'s ``test`` rows by ``model`` fitted on its ``train`` rows run by run
-    (:func:`analysis.evaluate.evaluate`, the fold given; :class:`analysis.classify.ByRun`), shape
-    (len(test),)."""
-    found = evaluate(ByRun(model), data, Given([(train, test)]), None, name, alarms=False, test_by="fold")
+    (:func:`analysis.evaluate.evaluate`, the fold given; :class:`analysis.classify.ByRun`, ``make``
+    its way to a new ``model``), shape (len(test),)."""
+    found = evaluate(ByRun(model, make), data, Given([(train, test)]), None, name, alarms=False, test_by="fold")
     return found.scores[test]
 
 
@@ -149,42 +150,54 @@ def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random
     # each classifier built once (the harness fits a clone per cell); its parameters are classify's
     # own or checked by evaluate's caller, so scikit-learn's parameter checks are skipped per fit
     classifiers = {column: make_pipeline(model, "control", random_state=random_state) for column, model in models.items()}
+    # a named classifier's fits are built anew (scikit-learn's clone reads every parameter by
+    # inspect.signature: 2800 LR fits in the default run), a caller's estimator cloned
+    builds = {column: partial(_built_tail, model, random_state) if isinstance(model, str) else None
+              for column, model in models.items()}
     with config_context(skip_parameter_validation=True):
-        _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers)
+        _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers, builds)
     return out
 
 
-def _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers) -> None:
+def _built_tail(name: str, random_state):
+    """A new unfitted classifier ``name`` (:data:`CLASSIFIERS`) without its :func:`label_free_head`,
+    what cloning that tail of :func:`pair_cells`'s pipeline gives (the same parameters)."""
+    return label_free_head(make_pipeline(name, "control", random_state=random_state))[1]
+
+
+def _fill_cells(out, X, X_est, groups, train, held, scored, names, classifiers, builds) -> None:
     """:func:`pair_cells`'s AUCs into ``out`` (label set, cell): each preprocessing fitted once on the
     training runs, then each classifier's leading label-free steps (:func:`label_free_head`) once,
     shared by the label sets and by the classifiers with the same steps, then the rest of each
-    classifier of each label set in ``scored`` on their output."""
+    classifier of each label set in ``scored`` on their output (built by ``builds[column]`` where
+    not None, else cloned)."""
     asked = set().union(*(columns for *_, columns in scored))
     heads = {column: label_free_head(clf) for column, clf in classifiers.items() if column in asked}
+    keys = _head_keys(heads)
     for r, name in enumerate(names):
         data = X_est if name.startswith(ESTIMATED) else X
         steps = [step for _, step in preprocessing_steps(name)]
         X_train = run_steps(steps, data[train], groups[train], fit=True)
         X_test = run_steps(steps, data[held], groups[held])
         rows, run_of, n_train = np.vstack([X_train, X_test]), np.r_[groups[train], groups[held]], len(X_train)
-        inputs = _head_outputs(heads, rows, n_train)
+        inputs = _head_outputs(heads, keys, rows, n_train)
         # rows checked finite here once, not by every fit's and prediction's input checks
         with config_context(assume_finite=all(np.isfinite(Xc).all() for Xc, _ in inputs.values())):
-            _classify(out, r, name, inputs, run_of, n_train, train, held, scored, list(classifiers))
+            _classify(out, r, name, inputs, run_of, n_train, train, held, scored, builds)
 
 
-def _classify(out, r, name, inputs, run_of, n_train, train, held, scored, classifiers) -> None:
-    """Row ``r`` of ``out``: each classifier asked for by each label set of ``scored`` on ``inputs``
-    (:func:`_head_outputs`), through the harness, and its AUC."""
+def _classify(out, r, name, inputs, run_of, n_train, train, held, scored, builds) -> None:
+    """Row ``r`` of ``out``: each classifier (the keys of ``builds``, in order) asked for by each label
+    set of ``scored`` on ``inputs`` (:func:`_head_outputs`), through the harness, and its AUC."""
     for i, labels, test, truth, columns in scored:
         # the preprocessed rows, train then held out, one fold given: each classifier through the harness
         y = np.r_[labels[train], labels[held]]
-        for c, column in enumerate(classifiers):
+        for c, column in enumerate(builds):
             if column in columns:
                 Xc, tail = inputs[column]
                 scores = _scores(tail, Data(Xc, run_of, y), np.arange(n_train), np.arange(n_train, len(Xc)),
-                                 f"{column} {name}")
-                out[i, r * len(classifiers) + c] = binary_auc(truth, scores[test])
+                                 f"{column} {name}", builds[column])
+                out[i, r * len(builds) + c] = binary_auc(truth, scores[test])
 
 
 #: Steps that learn no labels and look at no neighbouring rows: a classifier's leading ones are
@@ -205,17 +218,23 @@ def label_free_head(model) -> tuple[list, object]:
     return [step for _, step in model.steps[:k]], rest[0][1] if len(rest) == 1 else Pipeline(rest)
 
 
-def _head_outputs(heads: dict, rows: np.ndarray, n_train: int) -> dict:
+def _head_keys(heads: dict) -> dict:
+    """Column -> what its head is (its steps' types and parameters): heads with the same key are
+    the same steps, fitted once (:func:`_head_outputs`)."""
+    return {column: repr([(type(step), sorted(step.get_params(deep=False).items())) for step in head])
+            for column, (head, _) in heads.items()}
+
+
+def _head_outputs(heads: dict, keys: dict, rows: np.ndarray, n_train: int) -> dict:
     """Column -> (``rows``, the first ``n_train`` the training rows, through its head fitted on the
-    training rows, its tail); a head fitted once for every column whose head has the same steps
-    and parameters. The rows taken as the harness takes them (a copy of each fold's rows)."""
+    training rows, its tail); a head fitted once for every column with the same key (:func:`_head_keys`).
+    The rows taken as the harness takes them (a copy of each fold's rows)."""
     done: dict[str, np.ndarray] = {}
     out = {}
     for column, (head, tail) in heads.items():
-        key = repr([(type(step), sorted(step.get_params(deep=False).items())) for step in head])
-        if key not in done:
-            done[key] = _through(head, rows, n_train) if head else rows
-        out[column] = done[key], tail
+        if keys[column] not in done:
+            done[keys[column]] = _through(head, rows, n_train) if head else rows
+        out[column] = done[keys[column]], tail
     return out
 
 
