@@ -181,7 +181,7 @@ def replayed_rows(fleet: Path, out: Path, robot: Path | None = None) -> dict[str
     ``robot``, default ``fleet/kr210``, the logs ``fleet/logs``), as a continued monitor run replays it;
     None without tests."""
     from faultgen.model import robots
-    from faultgen.monitor import friction_tests
+    from faultgen.monitor import friction_tests, history
     from faultgen.monitor import logs as fleet_logs
     from faultgen.monitor import state as stored
     from faultgen.monitor.scoring import Settings
@@ -201,12 +201,12 @@ def replayed_rows(fleet: Path, out: Path, robot: Path | None = None) -> dict[str
     for name in units:
         path = out / ".state" / stored.unit_file(name, ".json")
         key = json.loads(path.read_text())["settings"]
-        kept = stored.read_unit(path, out, name, key, n, len(fleet_logs.FEATURES) * n)
+        kept = history.read_unit(path, out, name, key, n, len(fleet_logs.FEATURES) * n)
         settings = Settings(**{k: key[k] for k in ("protocol", "train", "alpha", "variance", "persistence",
                                                    "wear_limit")})
         wears, _ = friction_tests.tests_wear(tests.get(name, []), n, ())
         rescale = friction_tests.Rescale(name, n, wears) if wears else None
-        rows[name] = stored.replay(kept, settings, n, rescale).rows
+        rows[name] = history.replay(kept, settings, n, rescale).rows
     return rows
 
 

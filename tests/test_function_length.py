@@ -23,7 +23,6 @@ LONG_FUNCTIONS = {
     "faultgen/calibrate/loop.py::run",
     "faultgen/cli/monitoring.py::monitor_command",
     "faultgen/monitor/unit_chart.py::figure",
-    "faultgen/monitor/state.py::read_unit",
     "faultgen/runs/sweep.py::run",
 }
 #: CLI commands whose body is known to be longer: none (6 on 2026-11-26, each since moved its policy

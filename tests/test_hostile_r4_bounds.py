@@ -93,7 +93,7 @@ def test_a_state_file_above_what_a_run_writes_is_refused_before_it_is_parsed(tmp
     """A state at the former 64 MiB bound cost 1.9 GB to parse (a file of empty lists); the bound is
     now what a run writes (:data:`~faultgen.monitor.state.STATE_MAX_BYTES`, 16 MiB: 0.44 GB at worst),
     checked on the file's size before ``json`` sees it, and no run writes a state it would refuse."""
-    from faultgen.monitor import state
+    from faultgen.monitor import history, state
 
     path = tmp_path / ".state" / "weld-01.json"
     path.parent.mkdir()
@@ -101,10 +101,10 @@ def test_a_state_file_above_what_a_run_writes_is_refused_before_it_is_parsed(tmp
     monkeypatch.setattr(state.json, "loads", lambda text: pytest.fail("the state was parsed"))
     bound = state.STATE_MAX_BYTES
     with pytest.raises(state.StateError, match=rf"{path}: \d+ bytes; a monitor state is read up to {bound}"):
-        state.read_unit(path, tmp_path, "weld-01", {}, 6, 18)
-    big = state.UnitState("weld-01", {}, None, None, [], notes=["x" * state.STATE_MAX_BYTES])
+        history.read_unit(path, tmp_path, "weld-01", {}, 6, 18)
+    big = history.UnitHistory("weld-01", notes=["x" * state.STATE_MAX_BYTES])
     with pytest.raises(state.StateError, match=r"weld-01\.json: the state of weld-01 would be \d+ bytes"):
-        state.write_unit(tmp_path / ".state" / "weld-01.json", big)
+        history.write_unit(tmp_path / ".state" / "weld-01.json", big, {})
     assert path.stat().st_size > state.STATE_MAX_BYTES  # the file there was left as it was
 
 

@@ -198,7 +198,7 @@ def test_a_switch_to_the_commanded_moment_is_never_scored_against_the_measured_b
 
 def test_units_csv_names_the_sources_seen_in_order():
     """:func:`faultgen.monitor.sources.seen` on planted units: one source, a few changes, a mix."""
-    from faultgen.monitor.state import Entry, ProgramChange
+    from faultgen.monitor.history import Entry, ProgramChange
 
     class Planted:
         def __init__(self, sources_of_logs):

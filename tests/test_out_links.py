@@ -20,7 +20,7 @@ from faultgen.inputs import InputError
 from faultgen.model import robots
 from faultgen.monitor import remote, unit
 from faultgen.monitor import state as stored
-from faultgen.monitor.unit import Unit
+from faultgen.monitor.history import UnitHistory
 
 sys.path.insert(0, str(Path(__file__).parent))
 import shipped_fleet
@@ -143,7 +143,7 @@ def test_the_scheduler_cache_refuses_a_calibration_record_linked_out_and_sends_n
     secret = tmp_path / "secret.json"
     secret.write_text(json.dumps({"MARKER": 1}))
     (out / ".cache" / "calibrated" / f"{digest}.json").symlink_to(secret)
-    member = Unit(None, "calibrated", ("u1", "s"), ("s", first))
+    member = UnitHistory("u1", "calibrated", ("u1", "s"), ("s", first))
     with pytest.raises(stored.StateError, match=f"{digest}.json: a link leading outside") as refused:
         _scheduler_cache(out).for_unit(member, nominal, first)
     assert "MARKER" not in str(refused.value)

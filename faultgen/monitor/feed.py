@@ -22,9 +22,10 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, report, sources
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
+from faultgen.monitor.history import Entry, Maintenance, ProgramChange, Skipped, UnitHistory
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
-from faultgen.monitor.unit import REFUSED_SKIP, Unit, log_of, refused_note, short, twin_of
+from faultgen.monitor.unit import REFUSED_SKIP, log_of, refused_note, short, twin_of
 from faultgen.simulation import backends
 
 #: A log more than this RMS angle off each of its unit's programs over a whole cycle, rad, runs a program
@@ -99,8 +100,8 @@ def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:
     return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
 
 
-def score_group(context: Context, group: list[tuple[str, Unit, list]],
-                source: fleet_logs.Source | None = None) -> list[tuple[str, Unit, tuple]]:
+def score_group(context: Context, group: list[tuple[str, UnitHistory, list]],
+                source: fleet_logs.Source | None = None) -> list[tuple[str, UnitHistory, tuple]]:
     """Score each unit's new logs in stamp order against the group's twin, a unit's maintenance
     events given before the first log at or after them; returns the units with their chart and
     remaining life (:func:`unit_outputs`). ``source``: the run's logs as read so far (this
@@ -122,7 +123,7 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
                     given.add((event.stamp, event.event, event.axis))
                     unit_programs.baselines_of(unit.monitor).maintenance(unit.monitor, event.stamp, event.event,
                                                                          event.axis)
-                    unit.maintenance.append(stored.Maintenance(event.stamp, event.event, event.axis,
+                    unit.maintenance.append(Maintenance(event.stamp, event.event, event.axis,
                                                                len(unit.entries)))
             twin = score_log(unit, log, nominal, twin, context.twin_temperature, source, context)
     for _, unit, _ in group:
@@ -131,8 +132,8 @@ def score_group(context: Context, group: list[tuple[str, Unit, list]],
 
 
 
-def references(unit: Unit, units: dict, source: fleet_logs.Source) -> list[align.Reference]:
-    """The references of the unit's baselines in the order met (:attr:`Unit.references`), learned
+def references(unit: UnitHistory, units: dict, source: fleet_logs.Source) -> list[align.Reference]:
+    """The references of the unit's baselines in the order met (:attr:`UnitHistory.references`), learned
     from their logs (:func:`faultgen.monitor.programs.reference_of`) when first needed in a run; a
     baseline of a program's other torque source has its program's (:mod:`faultgen.monitor.sources`)."""
     if unit.references is None:
@@ -147,7 +148,7 @@ def references(unit: Unit, units: dict, source: fleet_logs.Source) -> list[align
     return unit.references
 
 
-def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source, torque: str = ""):
+def place(unit: UnitHistory, log, data, twin: Twin, context, source: fleet_logs.Source, torque: str = ""):
     """The program of a checked log ``data`` of ``unit`` (:func:`faultgen.logs.align.place` among
     its programs), the part of it scored (its whole cycles: :func:`faultgen.monitor.programs.scored`)
     and that program's twin: ``(baseline index, data scored, twin)``, the baseline that of the
@@ -190,8 +191,8 @@ def place(unit: Unit, log, data, twin: Twin, context, source: fleet_logs.Source,
     return baseline, unit_programs.scored(data, span), k_twin
 
 
-def program_twin(unit: Unit, k: int, twin: Twin, context, source: fleet_logs.Source) -> Twin:
-    """The twin of the unit's program ``k`` (>= 1), made once a run (:attr:`Unit.program_twins`) on
+def program_twin(unit: UnitHistory, k: int, twin: Twin, context, source: fleet_logs.Source) -> Twin:
+    """The twin of the unit's program ``k`` (>= 1), made once a run (:attr:`UnitHistory.program_twins`) on
     the model of its first program's ``twin``."""
     if k not in unit.program_twins:
         owner, stamp = unit.program_changes[k - 1].program
@@ -201,7 +202,7 @@ def program_twin(unit: Unit, k: int, twin: Twin, context, source: fleet_logs.Sou
     return unit.program_twins[k]
 
 
-def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source, reference: align.Reference,
+def new_program(unit: UnitHistory, log, twin: Twin, context, source: fleet_logs.Source, reference: align.Reference,
                 torque: str = "") -> int:
     """A program new to the unit from ``log`` on (its motion within the tolerance of none of its
     programs): reported once (a program change, noted in its reason), its twin made on that log,
@@ -221,7 +222,7 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source,
     count = len(sources.distinct(unit.references))
     unit.references.append(reference)
     unit.program_twins[k] = new
-    unit.program_changes.append(stored.ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
+    unit.program_changes.append(ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
                                                      new.signatures, torque))
     unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
@@ -231,7 +232,7 @@ def new_program(unit: Unit, log, twin: Twin, context, source: fleet_logs.Source,
     return k
 
 
-def score_log(unit: Unit, log, nominal, twin: Twin | str | None, twin_temperature: bool,
+def score_log(unit: UnitHistory, log, nominal, twin: Twin | str | None, twin_temperature: bool,
                source: fleet_logs.Source, context=None) -> Twin | str | None:
     """Feed one log (read once by ``source``, then forgotten unless a program keeps it) to the
     unit's monitor; a log that cannot be read, or that the twin cannot replay (``twin`` a str: the
@@ -244,10 +245,10 @@ def score_log(unit: Unit, log, nominal, twin: Twin | str | None, twin_temperatur
         source.done(log)
 
 
-def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_temperature: bool, source, context):
+def _score(unit: UnitHistory, log, parsed: fleet_logs.Parsed, nominal, twin, twin_temperature: bool, source, context):
     sha256 = parsed.sha256
     if isinstance(twin, str):
-        unit.skipped.append(stored.Skipped(log.stamp, sha256, twin))
+        unit.skipped.append(Skipped(log.stamp, sha256, twin))
         return twin
     program, data, program_twin = 0, parsed.checked() if parsed.error is None else None, twin
     try:
@@ -258,7 +259,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         if twin is not None and context is not None and unit.program is not None:
             placed = place(unit, log, data, twin, context, source, torque)
             if isinstance(placed, str):
-                unit.skipped.append(stored.Skipped(log.stamp, sha256, placed))
+                unit.skipped.append(Skipped(log.stamp, sha256, placed))
                 return twin
             program, data, program_twin = placed
         reading = fleet_logs.reading_of(nominal, data)
@@ -270,7 +271,7 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
     except stored.StateError:
         raise
     except ValueError as err:
-        unit.skipped.append(stored.Skipped(log.stamp, sha256, short(err)))
+        unit.skipped.append(Skipped(log.stamp, sha256, short(err)))
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
         unit.notes.extend(n for n in reading.notes if isinstance(n, formats.TorqueNote))
@@ -280,16 +281,16 @@ def _score(unit: Unit, log, parsed: fleet_logs.Parsed, nominal, twin, twin_tempe
         return not_monitored(unit, log.stamp, sha256, constant)
     constant = later_constant(unit, program, reading.vector, nominal.n_axes)
     if constant:  # a later baseline (a program's, a torque source's) that can show no wear: its logs skipped
-        unit.skipped.append(stored.Skipped(log.stamp, sha256, constant))
+        unit.skipped.append(Skipped(log.stamp, sha256, constant))
         return twin
     unit_programs.baselines_of(unit.monitor).run(unit.monitor, program, lambda: unit.monitor.add(
         log.stamp, residual, reading.temperature, reading.payload, expected))
-    unit.entries.append(stored.Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
+    unit.entries.append(Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
                                      *load, program))
     return twin
 
 
-def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
+def constant_torque(unit: UnitHistory, vector: np.ndarray, n_axes: int) -> str:
     """Why the unit cannot be monitored when the log of feature ``vector`` (its
     :data:`faultgen.monitor.logs.FEATURES`, by name then axis) completes its learning and a feature
     is the same in every learning log (:func:`analysis.monitoring.varying_columns`: beyond
@@ -310,7 +311,7 @@ def constant_torque(unit: Unit, vector: np.ndarray, n_axes: int) -> str:
             "which can show no wear")
 
 
-def later_constant(unit: Unit, program: int, vector: np.ndarray, n_axes: int) -> str:
+def later_constant(unit: UnitHistory, program: int, vector: np.ndarray, n_axes: int) -> str:
     """:func:`constant_torque` for the unit's baseline ``program`` after the first (a new program's,
     a torque source's: the commanded moment of a fixed program the same every day): its logs are
     then skipped with the reason, the unit's other baselines go on; "" otherwise (and for ``program`` 0)."""
@@ -322,13 +323,13 @@ def later_constant(unit: Unit, program: int, vector: np.ndarray, n_axes: int) ->
     return found[0] and f"the baseline begun at {unit.program_changes[program - 1].stamp} cannot be learned: {found[0].removeprefix('not monitored: ')}"
 
 
-def not_monitored(unit: Unit, stamp: str, sha256: str, why: str) -> str:
+def not_monitored(unit: UnitHistory, stamp: str, sha256: str, why: str) -> str:
     """Take the unit off the monitor (:func:`constant_torque`): its logs scored so far and the log
     ``stamp`` (its SHA-256 ``sha256``) kept as skipped, its monitor emptied (its status then "not monitored", its reason ``why``);
     returns the reason its later logs are skipped with, in this run and the next."""
     skipped = "the unit is not monitored: its torque does not vary from log to log"
-    unit.skipped.extend(stored.Skipped(e.stamp, e.sha256, skipped) for e in unit.entries)
-    unit.skipped.append(stored.Skipped(stamp, sha256, skipped))
+    unit.skipped.extend(Skipped(e.stamp, e.sha256, skipped) for e in unit.entries)
+    unit.skipped.append(Skipped(stamp, sha256, skipped))
     unit.entries.clear()
     unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes,
                                unit.monitor.baseline.signatures)

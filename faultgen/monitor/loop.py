@@ -46,13 +46,14 @@ from tqdm.auto import tqdm
 from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.logs import columns
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, page, prognosis, programs, report, sources
+from faultgen.monitor import friction_tests, history, life, page, prognosis, programs, report, sources
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, Context
+from faultgen.monitor.history import UnitHistory
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.run import MonitorRun
 from faultgen.monitor.scoring import Settings, UnitMonitor
-from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, Unit, fallback_notes, new_unit, refused_note
+from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, fallback_notes, new_unit, refused_note
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
 
@@ -65,7 +66,7 @@ __all__ = ["CALIBRATION_STEPS", "EXIT_SOME_UNITS_NOT_MONITORED", "MAINTENANCE", 
 #: still written); 0 when every unit is monitored or still learning, 2 a refusal before any work.
 EXIT_SOME_UNITS_NOT_MONITORED = 3
 #: Events of ``events.csv`` after which a unit's offset is learned again and its open alarm closed.
-MAINTENANCE = stored.MAINTENANCE
+MAINTENANCE = history.MAINTENANCE
 #: A unit's status in units.csv.
 #: ``degraded``: under protocol own where the twin was asked for, or with logs skipped; a unit whose
 #: twin uses the nominal model because its calibration failed or was implausible is ``monitored``,
@@ -196,7 +197,7 @@ def monitor(run: MonitorRun) -> Outcome:
                    rescored=[(name, since) for name, (since, _, _) in rescored.items()])
 
 
-def _score_units(run: MonitorRun, scoring: Context, state: dict[str, Unit], pending: dict[str, list],
+def _score_units(run: MonitorRun, scoring: Context, state: dict[str, UnitHistory], pending: dict[str, list],
                  source: fleet_logs.Source) -> dict[str, tuple[bytes, list]]:
     """Score each unit's ``pending`` logs (:func:`faultgen.monitor.parallel.map_groups`, on the run's
     execution context), updating ``state``; returns unit -> its chart (PNG) and rows of rul.csv,
@@ -217,7 +218,7 @@ def _score_units(run: MonitorRun, scoring: Context, state: dict[str, Unit], pend
     return made
 
 
-def _write_outputs(run: MonitorRun, units: dict, state: dict[str, Unit], statuses: list[UnitStatus],
+def _write_outputs(run: MonitorRun, units: dict, state: dict[str, UnitHistory], statuses: list[UnitStatus],
                    made: dict[str, tuple[bytes, list]], wears: dict | None) -> None:
     """Write the run's outputs into ``run.out`` together (:func:`faultgen.data.atomic.atomic_folder`):
     each table from memory, the page drawn from the same tables, each unit's chart and state;
@@ -248,14 +249,7 @@ def _write_outputs(run: MonitorRun, units: dict, state: dict[str, Unit], statuse
         (staging / ".state").mkdir()
         for name in units:
             if name in state:
-                unit = state[name]
-                stored.write_unit(staging / ".state" / stored.unit_file(name, ".json"),
-                                  stored.UnitState(name, run.digest, unit.program,
-                                                   unit.monitor.baseline.signatures if unit.initial_signatures is None
-                                                   else unit.initial_signatures, unit.entries,
-                                                   unit.model, unit.first, unit.skipped, unit.notes,
-                                                   unit.maintenance, unit.program_changes,
-                                                   unit.torque_source, unit.off_monitor))
+                history.write_unit(staging / ".state" / stored.unit_file(name, ".json"), state[name], run.digest)
 
 
 
@@ -265,7 +259,7 @@ class MonitorInterrupted(SweepInterrupted):
 
 
 @contextlib.contextmanager
-def told_on_interrupt(out: Path, state: dict[str, Unit]):
+def told_on_interrupt(out: Path, state: dict[str, UnitHistory]):
     """Within it, Ctrl-C or SIGTERM (:class:`faultgen.runs.sweep.CtrlC`) raises
     :class:`MonitorInterrupted`, which says what ``out`` keeps (:func:`interrupted`) from the
     earlier run's ``state`` as it is on entry."""
@@ -294,7 +288,7 @@ def interrupted(out: Path, units: int, last: str, terminated: bool) -> MonitorIn
                               "this run's new logs are not scored; run the same command to score them", code)
 
 
-def _pending(name: str, unit_logs: list, unit: Unit | None) -> tuple[list, list[str]]:
+def _pending(name: str, unit_logs: list, unit: UnitHistory | None) -> tuple[list, list[str]]:
     """The logs of ``name`` not yet scored (or skipped) by the run whose state is ``unit``: those
     stamped after the last log it handled; and notes naming the logs it handled that changed or
     left the folder since (their earlier scores kept: a log gzipped since, the same content, is not
@@ -345,7 +339,7 @@ def _scale_of(monitor, nominal: bool = False) -> str:
         friction_tests.TWIN_SCALE
 
 
-def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) -> set[str]:
+def _nominal_scale(state: dict[str, UnitHistory], settings: Settings, own_model: bool) -> set[str]:
     """The units whose wear is in the nominal model's scale though the run asked for each unit's own
     model (``own_model``: calibrated on its first log, or given): their twin fell back to the
     nominal model (the reason says why), so their wear is % of the nominal dry friction, not their
@@ -355,7 +349,7 @@ def _nominal_scale(state: dict[str, Unit], settings: Settings, own_model: bool) 
     return {name for name, unit in state.items() if unit.model == "nominal"}
 
 
-def _status(name: str, unit: Unit | None, settings: Settings, stale: list[str] = (), tests=(), passed: str = "",
+def _status(name: str, unit: UnitHistory | None, settings: Settings, stale: list[str] = (), tests=(), passed: str = "",
             stopped: str = "") -> UnitStatus:
     """The unit's row of units.csv (:class:`UnitStatus`); ``stale``: notes on logs handled by an
     earlier run that changed or left the folder, or new logs older than them (:func:`_pending`),
@@ -444,9 +438,9 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
 
 
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
-                scale_of=lambda name: None, robot: str = "") -> dict[str, Unit]:
+                scale_of=lambda name: None, robot: str = "") -> dict[str, UnitHistory]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
-    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.state.replay`).
+    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.history.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
     itself was checked to lead inside ``out`` by the caller (:func:`faultgen.monitor.state.checked_out`)."""
     folder = out / ".state"
@@ -461,17 +455,15 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         path = folder / stored.unit_file(name, ".json")
         if not (path.exists() or path.is_symlink()):
             continue
-        kept = stored.read_unit(path, out, name, key, n_axes, n_features, robot)
+        kept = history.read_unit(path, out, name, key, n_axes, n_features, robot)
         if not (kept.entries or kept.skipped):
             continue
-        state[name] = Unit(stored.replay(kept, settings, n_axes, scale_of(name)), kept.model, kept.program, kept.first,
-                            list(kept.entries), list(kept.skipped), list(kept.notes), list(kept.maintenance),
-                            list(kept.program_changes), initial_signatures=kept.signatures,
-                            torque_source=kept.torque_source, off_monitor=kept.off_monitor)
+        kept.monitor = history.replay(kept, settings, n_axes, scale_of(name))
+        state[name] = kept
     return state
 
 
-def events_changed(state: dict[str, Unit], maintenance: dict, stopped: dict) -> dict[str, tuple]:
+def events_changed(state: dict[str, UnitHistory], maintenance: dict, stopped: dict) -> dict[str, tuple]:
     """Drop from ``state`` each unit whose saved maintenance differs from the events of
     ``events.csv`` now (``maintenance``) that its scored or skipped logs would have been given (those
     stamped at or before its last one): the unit is scored again from its first log, as a fresh run
@@ -499,7 +491,7 @@ def events_changed(state: dict[str, Unit], maintenance: dict, stopped: dict) -> 
     return changed
 
 
-def _keep_program(unit: Unit, kept: tuple | None) -> None:
+def _keep_program(unit: UnitHistory, kept: tuple | None) -> None:
     """A unit scored again (:func:`events_changed`) replays the program its first run found (an
     earlier unit's log, which this run's new units alone would not offer), when its first log is
     the same."""

@@ -22,13 +22,14 @@ from faultgen.model.robot import Robot
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
+from faultgen.monitor.history import UnitHistory
 from faultgen.monitor.twin import Twin, base_cycles
-from faultgen.monitor.unit import Unit, log_of, model_of
+from faultgen.monitor.unit import log_of, model_of
 from faultgen.runs import worker
 from faultgen.simulation.backends import Stepper
 
 
-def groups_of(pending: dict[str, tuple[Unit, list]]) -> list[list[tuple[str, Unit, list]]]:
+def groups_of(pending: dict[str, tuple[UnitHistory, list]]) -> list[list[tuple[str, UnitHistory, list]]]:
     """The units to score, one group each, in the folder's order (a twin's simulated cycles are
     shared through the disk cache: :func:`prepare_twins` simulates them once before)."""
     return [[(name, unit, logs)] for name, (unit, logs) in pending.items()]

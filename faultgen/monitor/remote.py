@@ -38,7 +38,8 @@ from faultgen.logs import columns
 from faultgen.model import robots
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
-from faultgen.monitor.unit import Unit, calibration_key
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.unit import calibration_key
 
 #: Size bound of one file of a cached calibration's folder (its model, report and the robot's
 #: assets: meshes of an added robot are a few MB).
@@ -135,7 +136,7 @@ def _put_back(text: str, paths: dict[str, str]) -> str:
     return text
 
 
-def _unit_put_back(unit: Unit, paths: dict[str, str]) -> Unit:
+def _unit_put_back(unit: UnitHistory, paths: dict[str, str]) -> UnitHistory:
     """``unit`` with this worker's paths replaced by the client's in its notes and skipped logs' reasons."""
     unit.notes = [_put_back(note, paths) for note in unit.notes]
     unit.skipped = [replace(s, reason=_put_back(s.reason, paths)) for s in unit.skipped]
@@ -164,7 +165,7 @@ class Cache:
             model = ""  # not a cycle: the worker's own check refuses it, if it is read
         self.by_model.setdefault(model, {})[name] = data
 
-    def for_unit(self, unit: Unit, nominal_sha256: str, first_sha256: str) -> dict[str, bytes]:
+    def for_unit(self, unit: UnitHistory, nominal_sha256: str, first_sha256: str) -> dict[str, bytes]:
         """The cache files a unit's scoring may read: the cycles of the nominal model, of a given
         model and of its cached calibration (with that calibration's folder and record)."""
         files: dict[str, bytes] = {}

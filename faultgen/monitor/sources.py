@@ -5,9 +5,9 @@ header) is part of what a baseline is for, as the program is.
 
 - **Baselines by program and source.** A unit's baselines are its programs' (:mod:`faultgen.monitor.
   programs`): baseline 0 its first program's, read from its first log's source
-  (:attr:`faultgen.monitor.unit.Unit.torque_source`); baseline ``k`` the ``k``-th of its
-  :attr:`~faultgen.monitor.unit.Unit.program_changes`, of the source it records
-  (:attr:`faultgen.monitor.state.ProgramChange.source`). A log of a known program read from a
+  (:attr:`faultgen.monitor.history.UnitHistory.torque_source`); baseline ``k`` the ``k``-th of its
+  :attr:`~faultgen.monitor.history.UnitHistory.program_changes`, of the source it records
+  (:attr:`faultgen.monitor.history.ProgramChange.source`). A log of a known program read from a
   source that program has no baseline for starts one (:func:`change`): a program change whose
   program log is the program's own (the same motion, the same twin), learned on its own first logs
   as a new program's baseline is, while the unit's other baselines go on; a log is never scored
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import re
 
-from faultgen.monitor import state as stored
+from faultgen.monitor import history
 
 #: More source changes than this in a unit's scored logs are named as a mix (each source and its
 #: count of logs) rather than one by one (:func:`seen`).
@@ -57,7 +57,7 @@ def baseline_of(unit, motion: int, source: str) -> int | None:
 
 
 def distinct(references: list) -> list:
-    """``references`` (:attr:`faultgen.monitor.unit.Unit.references`, one per baseline) without the
+    """``references`` (:attr:`faultgen.monitor.history.UnitHistory.references`, one per baseline) without the
     repeats a source change adds (the same object as its program's): one per program, in order."""
     return [r for i, r in enumerate(references) if all(r is not other for other in references[:i])]
 
@@ -70,7 +70,7 @@ def change(unit, log, motion: int, source: str, signatures, changed) -> int:
     before it. Returns its index."""
     before = of_baseline(unit, unit.entries[-1].program) if unit.entries else unit.torque_source
     unit.references.append(unit.references[motion])
-    unit.program_changes.append(stored.ProgramChange(log.stamp, program_log(unit, motion), len(unit.entries),
+    unit.program_changes.append(history.ProgramChange(log.stamp, program_log(unit, motion), len(unit.entries),
                                                      signatures, source))
     changed(signatures)
     name = unit.references[motion].name

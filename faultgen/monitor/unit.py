@@ -1,5 +1,5 @@
-"""A unit of ``faultgen monitor`` (:func:`faultgen.monitor.loop.monitor`): what is kept of it between
-logs and runs (:class:`Unit`), its program (the log its twin replays, shared with an earlier unit
+"""A unit of ``faultgen monitor`` (:func:`faultgen.monitor.loop.monitor`): its record, made here for a
+unit seen for the first time (:func:`new_unit`, a :class:`faultgen.monitor.history.UnitHistory`), its program (the log its twin replays, shared with an earlier unit
 that runs the same motion: :func:`program_of`), its model (given, calibrated on its first log and
 cached, or nominal: :func:`model_of`) and its twin with the fallbacks (calibrated or given model ->
 nominal model -> protocol own: :func:`twin_of`). Logs come parsed from the run's
@@ -9,7 +9,6 @@ nominal model -> protocol own: :func:`twin_of`). Logs come parsed from the run's
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
@@ -21,6 +20,7 @@ from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
+from faultgen.monitor.history import UnitHistory
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import Twin
 
@@ -66,32 +66,8 @@ def calibration_key(nominal_sha256: str, first_sha256: str, kind: str = "calibra
     return key
 
 
-@dataclass
-class Unit:
-    """What the monitor keeps of a unit: its monitor, the kind of model its twin uses, its program, its
-    first log, the logs scored and skipped, its reason's notes, maintenance and program changes."""
-
-    monitor: UnitMonitor
-    model: str  # "given", "calibrated", "nominal" or "none" (protocol own)
-    program: tuple[str, str] | None  # (unit, stamp) of the log the twin replays
-    first: tuple[str, str]  # (stamp, SHA-256) of the unit's first log, which its calibration is made from
-    entries: list[stored.Entry] = field(default_factory=list)
-    skipped: list[stored.Skipped] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    maintenance: list[stored.Maintenance] = field(default_factory=list)
-    program_changes: list[stored.ProgramChange] = field(default_factory=list)
-    #: The references of its programs, in the order met (learned from their logs when needed, not
-    #: stored: :mod:`faultgen.monitor.programs`), and the twins of its programs after the first.
-    references: list | None = None
-    program_twins: dict = field(default_factory=dict)
-    initial_signatures: np.ndarray | None = None  # the first program's twin's, which a replay starts with
-    torque_source: str = ""  # its logs' torque source, as the reader chose it (formats.torque_source); "" unnamed
-    off_monitor: str = ""  # why it was taken off the monitor (feed.constant_torque); "" while on it
-
-
-
 def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibrate: bool, programs: list,
-              source: fleet_logs.Source) -> Unit:
+              source: fleet_logs.Source) -> UnitHistory:
     """A unit seen for the first time: its first log (with the twin, its first log that can be read:
     an empty or broken log before it is skipped, named, and the twin built on the next), its program
     (the log its twin replays) and the kind of model asked for (given, calibrated on its first log,
@@ -101,26 +77,29 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
     (:func:`twin_of`), which falls back when it cannot be. The first log is read here, once
     (``source``)."""
     monitor = UnitMonitor(name, settings, nominal.n_axes)
+
+    def unit(kind: str, program: tuple[str, str] | None, notes=()) -> UnitHistory:
+        return UnitHistory(name, kind, program, first_key, notes=list(notes), monitor=monitor)
+
     first = units[name][0]
     if settings.protocol == "twin":
         first = next((log for log in units[name] if source.get(log).error is None), first)
     first_key = (first.stamp, source.get(first).sha256)
     if settings.protocol != "twin":
-        return Unit(monitor, "none", None, first_key)
+        return unit("none", None)
     kind = "given" if calibrated_model is not None else "calibrated" if calibrate else "nominal"
     if source.get(first).error is None:
         try:
             plausible(nominal, source.get(first).checked())
         except plausibility.ImplausibleLogError as err:
-            unit = Unit(monitor, kind, None, first_key)
-            refuse(unit, err)
-            return unit
+            refused = unit(kind, None)
+            refuse(refused, err)
+            return refused
     try:
         program = program_of(first, name, programs, source)
     except ValueError as err:
-        return Unit(monitor, "none", None, first_key,
-                     notes=[f"no log of it can be read to replay ({short(err)}): protocol own"])
-    return Unit(monitor, kind, program, first_key)
+        return unit("none", None, [f"no log of it can be read to replay ({short(err)}): protocol own"])
+    return unit(kind, program)
 
 
 #: The start of the note (units.csv's reason) of a unit whose first log the nominal model cannot
@@ -151,7 +130,7 @@ def plausible(nominal: robots.Robot, data) -> None:
     plausibility.check(nominal, tau, predicted_motion(nominal, data)[0], np.abs(data.qd) >= search.REST_SPEED)
 
 
-def refuse(unit: Unit, err: ValueError) -> str:
+def refuse(unit: UnitHistory, err: ValueError) -> str:
     """Take ``unit`` off the monitor for its first log's refusal ``err`` (:data:`REFUSED`, the
     message kept whole): noted in its reason; returns the reason its logs are skipped with."""
     unit.notes.append(f"{REFUSED} ({unit.first[0]}): {' '.join(str(err).split())}")
@@ -162,12 +141,12 @@ def refuse(unit: Unit, err: ValueError) -> str:
 REFUSED_SKIP = "the unit is not monitored: its first log is refused (the unit's reason says why)"
 
 
-def refused_note(unit: Unit) -> str | None:
+def refused_note(unit: UnitHistory) -> str | None:
     """The note that took ``unit`` off the monitor for its first log (:func:`refuse`), or None."""
     return next((n for n in unit.notes if n.startswith(REFUSED)), None)
 
 
-def fallback_notes(unit: Unit) -> list[str]:
+def fallback_notes(unit: UnitHistory) -> list[str]:
     """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`:
     "the twin of the ... failed (...); ... used", or "the twins of the ... failed (...)")."""
     return [n for n in unit.notes if n.startswith(("the twin of the ", "the twins of the ")) and " failed (" in n]
@@ -196,7 +175,7 @@ def chain_notes(tried: list[tuple[str, str]], final: str) -> list[str]:
     return notes
 
 
-def twin_of(unit: Unit, context, twins: dict, progress: bool, source: fleet_logs.Source) -> Twin | str | None:
+def twin_of(unit: UnitHistory, context, twins: dict, progress: bool, source: fleet_logs.Source) -> Twin | str | None:
     """The unit's twin (its program among the fleet's logs, ``context.units``, its cycles cached in
     ``context.out`` and simulated on the run's ``context.stepper``: a
     :class:`faultgen.monitor.feed.Context`), or None for a unit under protocol ``own``; its model
@@ -242,8 +221,8 @@ def twin_of(unit: Unit, context, twins: dict, progress: bool, source: fleet_logs
                              f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
                              "into a new OUT")
         unit.monitor.baseline.signatures = twin.signatures
-        if unit.initial_signatures is None and not unit.program_changes:
-            unit.initial_signatures = twin.signatures
+        if unit.signatures is None and not unit.program_changes:
+            unit.signatures = twin.signatures
         return twin
     unit.program = None
     return None
