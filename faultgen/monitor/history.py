@@ -1,20 +1,11 @@
-"""One record per unit of ``faultgen monitor`` (:class:`UnitHistory`) and its JSON, the monitor's
-saved state ``OUT/.state/<unit>.json`` (:func:`write_unit`, :func:`read_unit`; format :data:`FORMAT`).
-
-The record holds what a unit's monitor was fed, as typed fields: its facts (model kind, program,
-first log, its logs' torque source, why it was taken off the monitor), one :class:`Entry` per
-scored log (stamp, the log's SHA-256, its residual, mean joint temperature, payload, the twin's
-expectation, its load and the program it ran), the logs skipped, the maintenance events and program
-changes given to its monitor (each before an entry number) and its reason's notes. A rerun replays
-the entries into a new :class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same
-arithmetic in the same order, so the continued monitor is bit for bit the one the earlier run ended
-with. The record names logs by unit and stamp inside ``LOGS``, never by a path.
-
-An output folder may come from someone else (docs/reliability.md, "Threat model: output folders"):
-the file is read inside ``OUT`` only, bounded by :data:`faultgen.monitor.state.STATE_MAX_BYTES`
-before it is parsed, and every value checked at the boundary (:func:`read_unit`): a refusal is a
-:class:`faultgen.monitor.state.StateError` naming the file, the field, its value and what was
-expected, and saying what to do.
+"""One record per unit of ``faultgen monitor`` (:class:`UnitHistory`: what its monitor was fed, as
+typed fields) and its JSON, the saved state ``OUT/.state/<unit>.json`` (:func:`write_unit`,
+:func:`read_unit`). A rerun replays its entries into a new
+:class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same arithmetic in the same
+order, so the continued monitor is bit for bit the one the earlier run ended with. An output folder
+may come from someone else (docs/reliability.md, "Threat model: output folders"): the file is read
+inside ``OUT`` only, bounded by :data:`faultgen.monitor.state.STATE_MAX_BYTES` before it is parsed,
+every value checked (:func:`read_unit`), logs named by unit and stamp, never by a path.
 """
 
 from __future__ import annotations
