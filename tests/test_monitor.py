@@ -374,7 +374,7 @@ def test_the_state_is_json_and_one_of_other_settings_is_refused_naming_the_setti
     state["format"] = "faultgen-monitor-state/1"
     (out / ".state" / files[0].name).write_text(json.dumps(state))
     with pytest.raises(ValueError, match=r"unit01\.json: format 'faultgen-monitor-state/1', expected "
-                                         r"'faultgen-monitor-state/2' \(a state written by another version of "
+                                         r"'faultgen-monitor-state/3' \(a state written by another version of "
                                          r"faultgen.*score the logs into a new OUT"):
         loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
 

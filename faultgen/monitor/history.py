@@ -1,20 +1,11 @@
-"""One record per unit of ``faultgen monitor`` (:class:`UnitHistory`) and its JSON, the monitor's
-saved state ``OUT/.state/<unit>.json`` (:func:`write_unit`, :func:`read_unit`; format :data:`FORMAT`).
-
-The record holds what a unit's monitor was fed, as typed fields: its facts (model kind, program,
-first log, its logs' torque source, why it was taken off the monitor), one :class:`Entry` per
-scored log (stamp, the log's SHA-256, its residual, mean joint temperature, payload, the twin's
-expectation, its load and the program it ran), the logs skipped, the maintenance events and program
-changes given to its monitor (each before an entry number) and its reason's notes. A rerun replays
-the entries into a new :class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same
-arithmetic in the same order, so the continued monitor is bit for bit the one the earlier run ended
-with. The record names logs by unit and stamp inside ``LOGS``, never by a path.
-
-An output folder may come from someone else (docs/reliability.md, "Threat model: output folders"):
-the file is read inside ``OUT`` only, bounded by :data:`faultgen.monitor.state.STATE_MAX_BYTES`
-before it is parsed, and every value checked at the boundary (:func:`read_unit`): a refusal is a
-:class:`faultgen.monitor.state.StateError` naming the file, the field, its value and what was
-expected, and saying what to do.
+"""One record per unit of ``faultgen monitor`` (:class:`UnitHistory`: what its monitor was fed, as
+typed fields) and its JSON, the saved state ``OUT/.state/<unit>.json`` (:func:`write_unit`,
+:func:`read_unit`). A rerun replays its entries into a new
+:class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same arithmetic in the same
+order, so the continued monitor is bit for bit the one the earlier run ended with. An output folder
+may come from someone else (docs/reliability.md, "Threat model: output folders"): the file is read
+inside ``OUT`` only, bounded by :data:`faultgen.monitor.state.STATE_MAX_BYTES` before it is parsed,
+every value checked (:func:`read_unit`), logs named by unit and stamp, never by a path.
 """
 
 from __future__ import annotations
@@ -31,12 +22,35 @@ from faultgen.monitor import programs
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.state import STATE_MAX_BYTES, StateError, _floats, _load_json, _vector, inside
 
-#: The state files' format: 2, three features per axis (with ``friction_torque``); a state of
-#: format 1 holds residuals of two and is refused (a new OUT).
-FORMAT = "faultgen-monitor-state/2"
+#: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`); a state
+#: of format 2 (notes as bare text, whose kind was recovered by matching their start) or 1 (residuals
+#: of two features per axis) is refused (a new OUT).
+FORMAT = "faultgen-monitor-state/3"
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
 #: offset is learned again and its open alarm closed.
 MAINTENANCE = ("repair", "gearbox_change")
+
+
+#: The kinds of a unit's notes that a run acts on (:class:`Note`): its twin fell back to another
+#: model (:func:`faultgen.monitor.unit.chain_notes`), its first log refused and the unit taken off
+#: the monitor (:func:`faultgen.monitor.unit.refuse`).
+FALLBACK, REFUSED = "fallback", "refused"
+NOTE_KINDS = ("", FALLBACK, REFUSED)
+
+
+class Note(str):
+    """A note of a unit's reason (units.csv), as written, with its ``kind`` (:data:`NOTE_KINDS`; ""
+    a note nothing acts on), so that no fact is recovered from its text."""
+
+    def __new__(cls, text: str, kind: str = ""):  # the default: unpickled, its kind set after
+        note = super().__new__(cls, text)
+        note.kind = kind
+        return note
+
+
+def kind_of(note: str) -> str:
+    """The kind of one of a unit's notes: a :class:`Note`'s, "" for any other text."""
+    return note.kind if isinstance(note, Note) else ""
 
 
 @dataclass(frozen=True)
@@ -128,7 +142,7 @@ class UnitHistory:
     signatures: np.ndarray | None = None
     entries: list[Entry] = field(default_factory=list)
     skipped: list[Skipped] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # its reason's notes, in order (:class:`Note` where acted on)
     maintenance: list[Maintenance] = field(default_factory=list)
     program_changes: list[ProgramChange] = field(default_factory=list)
     torque_source: str = ""
@@ -194,7 +208,8 @@ def write_unit(path: Path, state: UnitHistory, settings: dict) -> None:
     document = {
         "format": FORMAT, "unit": state.unit, "settings": settings,
         "program": list(state.program) if state.program else None,
-        "model": state.model, "first": list(state.first), "notes": list(state.notes),
+        "model": state.model, "first": list(state.first),
+        "notes": [{"text": str(n), **({"kind": kind_of(n)} if kind_of(n) else {})} for n in state.notes],
         "torque_source": state.torque_source, "off_monitor": state.off_monitor,
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
@@ -316,7 +331,8 @@ class _Check:
         """The format, the unit and the settings are the run's."""
         if d.get("format") != FORMAT:
             raise self.fail(f"format {str(d.get('format'))[:40]!r}, expected {FORMAT!r} (a state written by "
-                            "another version of faultgen, whose monitor watched other features)")
+                            "another version of faultgen: format 2 kept a unit's notes as bare text, 1 other "
+                            "features)")
         if d.get("unit") != unit:
             raise self.fail(f"the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}")
         if d.get("settings") != settings:
@@ -346,13 +362,15 @@ class _Check:
             raise self.fail("first is not [stamp, sha256]")
         self.stamp(first[0], "first[0]")
         _digest(first[1], path, "first[1]", self.refuse, empty=True)
-        if not (isinstance(notes, list) and all(isinstance(n, str) for n in notes)):
-            raise self.fail("notes is not a list of texts")
+        if not (isinstance(notes, list) and all(isinstance(n, dict) and isinstance(n.get("text"), str)
+                                                and n.get("kind", "") in NOTE_KINDS for n in notes)):
+            raise self.fail(f"notes is not a list of {{text, kind}} (kind one of {', '.join(NOTE_KINDS[1:])} "
+                            "or none)")
         facts = {k: d.get(k, "") for k in ("torque_source", "off_monitor")}  # "": a state written before they were kept
         if not all(isinstance(v, str) for v in facts.values()):
             raise self.fail("torque_source or off_monitor is not a text")
         return UnitHistory(unit, model, tuple(program) if program else None, tuple(first), signatures,
-                           notes=list(notes), **facts)
+                           notes=[Note(n["text"], n.get("kind", "")) for n in notes], **facts)
 
     def skipped(self, skipped, handled: dict) -> list[Skipped]:
         if not (isinstance(skipped, list) and all(

@@ -36,6 +36,7 @@ from faultgen import inputs
 from faultgen.data.confined import Confined
 from faultgen.logs import columns
 from faultgen.model import robots
+from faultgen.monitor import history
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.history import UnitHistory
@@ -138,7 +139,7 @@ def _put_back(text: str, paths: dict[str, str]) -> str:
 
 def _unit_put_back(unit: UnitHistory, paths: dict[str, str]) -> UnitHistory:
     """``unit`` with this worker's paths replaced by the client's in its notes and skipped logs' reasons."""
-    unit.notes = [_put_back(note, paths) for note in unit.notes]
+    unit.notes = [history.Note(_put_back(note, paths), history.kind_of(note)) for note in unit.notes]
     unit.skipped = [replace(s, reason=_put_back(s.reason, paths)) for s in unit.skipped]
     return unit
 

@@ -1,5 +1,6 @@
-"""A unit of ``faultgen monitor`` (:func:`faultgen.monitor.loop.monitor`): its record, made here for a
-unit seen for the first time (:func:`new_unit`, a :class:`faultgen.monitor.history.UnitHistory`), its program (the log its twin replays, shared with an earlier unit
+"""A unit of ``faultgen monitor`` (:func:`faultgen.monitor.loop.monitor`): its record, made here for
+a unit seen for the first time (:func:`new_unit`, a :class:`faultgen.monitor.history.UnitHistory`),
+its program (the log its twin replays, shared with an earlier unit
 that runs the same motion: :func:`program_of`), its model (given, calibrated on its first log and
 cached, or nominal: :func:`model_of`) and its twin with the fallbacks (calibrated or given model ->
 nominal model -> protocol own: :func:`twin_of`). Logs come parsed from the run's
@@ -17,6 +18,7 @@ import numpy as np
 from faultgen.calibrate import plausibility
 from faultgen.effects.payload import Payload
 from faultgen.model import robots
+from faultgen.monitor import history
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
@@ -133,7 +135,7 @@ def plausible(nominal: robots.Robot, data) -> None:
 def refuse(unit: UnitHistory, err: ValueError) -> str:
     """Take ``unit`` off the monitor for its first log's refusal ``err`` (:data:`REFUSED`, the
     message kept whole): noted in its reason; returns the reason its logs are skipped with."""
-    unit.notes.append(f"{REFUSED} ({unit.first[0]}): {' '.join(str(err).split())}")
+    unit.notes.append(history.Note(f"{REFUSED} ({unit.first[0]}): {' '.join(str(err).split())}", history.REFUSED))
     return REFUSED_SKIP
 
 
@@ -143,16 +145,16 @@ REFUSED_SKIP = "the unit is not monitored: its first log is refused (the unit's 
 
 def refused_note(unit: UnitHistory) -> str | None:
     """The note that took ``unit`` off the monitor for its first log (:func:`refuse`), or None."""
-    return next((n for n in unit.notes if n.startswith(REFUSED)), None)
+    return next((n for n in unit.notes if history.kind_of(n) == history.REFUSED), None)
 
 
 def fallback_notes(unit: UnitHistory) -> list[str]:
-    """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`:
-    "the twin of the ... failed (...); ... used", or "the twins of the ... failed (...)")."""
-    return [n for n in unit.notes if n.startswith(("the twin of the ", "the twins of the ")) and " failed (" in n]
+    """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`,
+    :func:`chain_notes`)."""
+    return [n for n in unit.notes if history.kind_of(n) == history.FALLBACK]
 
 
-def chain_notes(tried: list[tuple[str, str]], final: str) -> list[str]:
+def chain_notes(tried: list[tuple[str, str]], final: str) -> list[history.Note]:
     """The notes of a twin's fallbacks: ``tried``, the kinds of model (:data:`FALLBACK`) whose twin
     failed, in order, each with its error; ``final`` the kind used at last. Kinds that failed one
     after another on the same error share one note that says it once, with their count (a replay
@@ -167,11 +169,12 @@ def chain_notes(tried: list[tuple[str, str]], final: str) -> list[str]:
     for i, (kinds, error) in enumerate(groups):
         then = KIND_NAMES[groups[i + 1][0][0] if i + 1 < len(groups) else final]
         if len(kinds) == 1:
-            notes.append(f"the twin of the {KIND_NAMES[kinds[0]]} failed ({error}); {then} used")
+            notes.append(history.Note(f"the twin of the {KIND_NAMES[kinds[0]]} failed ({error}); {then} used",
+                                      history.FALLBACK))
             continue
         names = [KIND_NAMES[k] for k in kinds]
-        notes.append(f"the twins of the {', the '.join(names[:-1])} and the {names[-1]} failed ({len(kinds)} times, "
-                     f"each on the same: {error}); {then} used")
+        notes.append(history.Note(f"the twins of the {', the '.join(names[:-1])} and the {names[-1]} failed "
+                                  f"({len(kinds)} times, each on the same: {error}); {then} used", history.FALLBACK))
     return notes
 
 
