@@ -147,8 +147,9 @@ def pair_cells(X, estimated, groups, held_out, label_sets, names, models, random
     if not scored:
         return out
     X_est = None if estimated is None else (estimated if X is None else np.hstack([X, estimated]))
-    # each classifier built once (the harness fits a clone per cell); its parameters are classify's
-    # own or checked by evaluate's caller, so scikit-learn's parameter checks are skipped per fit
+    # each classifier built once (the harness fits a new one per cell, made or cloned: below); its
+    # parameters are classify's own or checked by evaluate's caller, so scikit-learn's parameter
+    # checks are skipped per fit
     classifiers = {column: make_pipeline(model, "control", random_state=random_state) for column, model in models.items()}
     # a named classifier's fits are built anew (scikit-learn's clone reads every parameter by
     # inspect.signature: 2800 LR fits in the default run), a caller's estimator cloned
