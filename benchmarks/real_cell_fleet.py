@@ -84,11 +84,13 @@ def new_programs(root: Path) -> dict[str, list[str]]:
     return out
 
 
-def run_monitor(logs: Path, robot: Path, out: Path, timeout: float, jobs: int) -> tuple[float, float, int | None]:
-    """``faultgen monitor`` on ``logs``: (wall time s, CPU time s of it and its children, exit status
-    or None when killed past ``timeout``). On a shared machine the CPU time is the figure to compare."""
+def run_monitor(logs: Path, robot: Path, out: Path, timeout: float, jobs: int,
+                options: tuple[str, ...] = ()) -> tuple[float, float, int | None]:
+    """``faultgen monitor`` on ``logs`` (more of its ``options`` after the others): (wall time s, CPU
+    time s of it and its children, exit status or None when killed past ``timeout``). On a shared
+    machine the CPU time is the figure to compare."""
     command = [*children.command("-m", "faultgen.cli"), "monitor", str(logs), "--robot", str(robot), "-o", str(out),
-               "--jobs", str(jobs)]
+               "--jobs", str(jobs), *options]
     started, cpu = time.perf_counter(), _children_cpu()
     console = out.with_name(out.name + ".console.txt")  # its progress, read when it was killed
     try:

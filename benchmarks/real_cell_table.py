@@ -8,7 +8,8 @@ scatter read from its name, ``scatter-<sigma>[-one-program][-rates][-onset-A-B]`
 folder of it; ``--monitor``: run ``faultgen monitor FLEET/logs --robot ROBOT -o OUT --jobs 1`` first
 (:func:`real_cell_fleet.run_monitor`), its wall and CPU time (the monitor's and its children's,
 ``resource.getrusage``) kept in ``OUT.timing.json`` beside ``OUT`` for later runs of this script.
-``--robot``: default ``FLEET/../kr210``. The rows, each with its figure and verdict (met / NOT met):
+``--robot``: default ``FLEET/../kr210``; ``--limit``: the wear limit the
+monitor ran with (``--monitor`` passes it on as ``--wear-limit``; default the monitor's, 10 %). The rows, each with its figure and verdict (met / NOT met):
 
 - every unit monitored by its 40th day (per unit the first log ``scores.csv`` scores as monitoring);
 - program changes reported (units.csv's "program changed at" stamps) exactly where the unit meets a
@@ -55,6 +56,7 @@ import monitor_scale_bound
 import real_cell_fleet
 
 from faultgen.bench import independent, rul_scores
+from faultgen.monitor.scoring import Settings
 
 #: The issue's criteria: monitored by day, lambda, failure wear %, within, medians within on at least
 #: this share (without scatter: this many of the worn units), the CPU ratio, the rates of bullet 2.
@@ -350,7 +352,9 @@ def main() -> None:
     parser.add_argument("pairs", type=Path, nargs="+", metavar="FLEET OUT")
     parser.add_argument("--monitor", action="store_true", help="run faultgen monitor FLEET/logs -o OUT first (--jobs 1)")
     parser.add_argument("--robot", type=Path, default=None, help="the robot folder (default FLEET/../kr210)")
-    parser.add_argument("--limit", type=float, default=10.0, help="the wear limit of the monitor's alarm, %%")
+    parser.add_argument("--limit", type=float, default=Settings().wear_limit,
+                        help="the wear limit of the monitor's alarm, %% (--monitor: passed on as --wear-limit; "
+                             "default the monitor's, %(default)g)")
     parser.add_argument("--timeout", type=float, default=7200.0)
     args = parser.parse_args()
     if len(args.pairs) % 2:
@@ -359,7 +363,8 @@ def main() -> None:
     for fleet, out in zip(args.pairs[::2], args.pairs[1::2]):
         robot = args.robot or fleet.parent / "kr210"
         if args.monitor:
-            wall, cpu, code = real_cell_fleet.run_monitor(fleet / "logs", robot, out, args.timeout, 1)
+            wall, cpu, code = real_cell_fleet.run_monitor(fleet / "logs", robot, out, args.timeout, 1,
+                                                               ("--wear-limit", f"{args.limit:g}"))
             out.with_name(out.name + ".timing.json").write_text(json.dumps(
                 {"wall_s": wall, "cpu_s": cpu, "exit": code, "jobs": 1}))
             if code is None:

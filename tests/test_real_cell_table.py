@@ -152,3 +152,21 @@ def test_a_fleet_folder_not_named_for_its_scatter_is_refused():
     assert rct.scatter_of(Path("/x/scatter-0.015-one-program")) == 0.015
     with pytest.raises(SystemExit, match="expected a fleet folder named scatter-<sigma>"):
         rct.scatter_of(Path("/x/fleet"))
+
+
+@pytest.mark.parametrize("given, passed", [(["--limit", "8"], "8"), ([], "10")])
+def test_monitor_runs_with_the_tables_limit_as_its_wear_limit(monkeypatch, tmp_path, capsys, given, passed):
+    """``--monitor --limit L`` runs ``faultgen monitor ... --wear-limit L``, so the table judges the bound at
+    the limit the alarms were raised at; without ``--limit`` both take the monitor's default (10 %)."""
+    calls = []
+
+    def run_monitor(logs, robot, out, timeout, jobs, options=()):
+        calls.append(options)
+        return 12.0, 3.0, None  # killed past --timeout: no table, nothing else read
+
+    monkeypatch.setattr(rct.real_cell_fleet, "run_monitor", run_monitor)
+    monkeypatch.setattr(sys, "argv", ["real_cell_table.py", str(tmp_path / "fleet"), str(tmp_path / "out"),
+                                      "--monitor", *given])
+    rct.main()
+    assert calls == [("--wear-limit", passed)]
+    assert "faultgen monitor killed after 12 s" in capsys.readouterr().out
