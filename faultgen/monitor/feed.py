@@ -124,7 +124,7 @@ def score_group(context: Context, group: list[tuple[str, UnitHistory, list]],
                     unit_programs.baselines_of(unit.monitor).maintenance(unit.monitor, event.stamp, event.event,
                                                                          event.axis)
                     unit.maintenance.append(Maintenance(event.stamp, event.event, event.axis,
-                                                               len(unit.entries)))
+                                                        len(unit.entries)))
             twin = score_log(unit, log, nominal, twin, context.twin_temperature, source, context)
     for _, unit, _ in group:
         unit.program_twins.clear()  # made again where needed: a unit travels back from a worker without them
@@ -223,7 +223,7 @@ def new_program(unit: UnitHistory, log, twin: Twin, context, source: fleet_logs.
     unit.references.append(reference)
     unit.program_twins[k] = new
     unit.program_changes.append(ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
-                                                     new.signatures, torque))
+                                              new.signatures, torque))
     unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
     unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
                       f"none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
@@ -286,7 +286,7 @@ def _score(unit: UnitHistory, log, parsed: fleet_logs.Parsed, nominal, twin, twi
     unit_programs.baselines_of(unit.monitor).run(unit.monitor, program, lambda: unit.monitor.add(
         log.stamp, residual, reading.temperature, reading.payload, expected))
     unit.entries.append(Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
-                                     *load, program))
+                              *load, program))
     return twin
 
 

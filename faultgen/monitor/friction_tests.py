@@ -252,7 +252,7 @@ def out_of_range(fit: dict) -> str:
 
 def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
     """A cached reading, checked (a :class:`faultgen.monitor.state.StateError` naming the file otherwise)."""
-    d = stored._load_json(stored.inside(path, out), "cached friction test reading", CACHE_MAX_BYTES)
+    d = stored.load_json(stored.inside(path, out), "cached friction test reading", CACHE_MAX_BYTES)
     fits, error = d.get("fits"), d.get("error")
     ok = d.get("format") == CACHE_FORMAT and d.get("key") == key and isinstance(error, str) and isinstance(fits, list)
     ok = ok and all(isinstance(f, dict) and isinstance(f.get("axis"), int) and not isinstance(f.get("axis"), bool)

@@ -20,7 +20,7 @@ import numpy as np
 from faultgen.data import atomic, logfolder
 from faultgen.monitor import programs
 from faultgen.monitor.scoring import Settings, UnitMonitor
-from faultgen.monitor.state import STATE_MAX_BYTES, StateError, _floats, _load_json, _vector, inside
+from faultgen.monitor.state import STATE_MAX_BYTES, StateError, floats, load_json, checked_vector, inside
 
 #: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`); a state
 #: of format 2 (notes as bare text, whose kind was recovered by matching their start) or 1 (residuals
@@ -205,6 +205,7 @@ def write_unit(path: Path, state: UnitHistory, settings: dict) -> None:
         The state would be larger than :data:`STATE_MAX_BYTES` (a later run could not read it back);
         nothing is written.
     """
+    signatures = state.saved_signatures()
     document = {
         "format": FORMAT, "unit": state.unit, "settings": settings,
         "program": list(state.program) if state.program else None,
@@ -214,13 +215,13 @@ def write_unit(path: Path, state: UnitHistory, settings: dict) -> None:
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
         "program_changes": [{"stamp": c.stamp, "program": list(c.program), "at": c.at,
-                             "signatures": [_floats(row) for row in c.signatures],
+                             "signatures": [floats(row) for row in c.signatures],
                              **({"source": c.source} if c.source else {})} for c in state.program_changes],
-        "signatures": None if state.saved_signatures() is None else [_floats(row) for row in state.saved_signatures()],
-        "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": _floats(e.residual),
+        "signatures": None if signatures is None else [floats(row) for row in signatures],
+        "logs": [{"stamp": e.stamp, "sha256": e.sha256, "residual": floats(e.residual),
                   "temperature_C": float(e.temperature), "payload_kg": float(e.payload),
-                  "expected": None if e.expected is None else _floats(e.expected),
-                  **({} if e.load is None else {"load": _floats(e.load), "duration_s": float(e.duration)}),
+                  "expected": None if e.expected is None else floats(e.expected),
+                  **({} if e.load is None else {"load": floats(e.load), "duration_s": float(e.duration)}),
                   **({"program": e.program} if e.program else {})}
                  for e in state.entries],
     }
@@ -261,7 +262,7 @@ def _load(log: dict, path: Path, where: str, n_axes: int) -> tuple[np.ndarray | 
     >= 0, the duration > 0."""
     if "load" not in log and "duration_s" not in log:
         return None, math.nan
-    load = _vector(log.get("load"), path, f"{where}.load", 2 * n_axes).reshape(2, n_axes)
+    load = checked_vector(log.get("load"), path, f"{where}.load", 2 * n_axes).reshape(2, n_axes)
     duration = _number(log.get("duration_s"), path, f"{where}.duration_s")
     if np.any(load < 0) or not (math.isfinite(duration) and duration > 0):
         raise StateError(f"{path}: {where}: load below 0 or duration_s not a finite number > 0")
@@ -296,7 +297,7 @@ def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_
         is, the robot ``robot`` by its name, not by a digest alone: :func:`setting_moved`).
     """
     check = _Check(path, f"; score the logs into a new OUT (or delete {path.parent} to start this one again)")
-    d = _load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
+    d = load_json(inside(path, root), "monitor state", STATE_MAX_BYTES)
     check.belongs(d, unit, settings, robot)
     history = check.facts(d, unit, n_axes, n_features)
     handled: dict[float, str] = {}  # stamp key -> where: each log is scored or skipped once
@@ -353,7 +354,7 @@ class _Check:
         if signatures is not None:
             if not (isinstance(signatures, list) and len(signatures) == n_axes):
                 raise self.fail(f"signatures is not a list of {n_axes} rows")
-            signatures = np.stack([_vector(row, path, f"signatures row {i + 1}", n_features)
+            signatures = np.stack([checked_vector(row, path, f"signatures row {i + 1}", n_features)
                                    for i, row in enumerate(signatures)])
         model, first, notes = d.get("model"), d.get("first"), d.get("notes")
         if model not in MODELS:
@@ -412,7 +413,7 @@ class _Check:
                     and isinstance(c.get("signatures"), list) and len(c["signatures"]) == n_axes
                     and isinstance(c.get("source", ""), str)):
                 raise self.fail(f"program_changes[{i}] is not {{stamp, program, at, signatures}}")
-            rows = np.stack([_vector(r, self.path, f"program_changes[{i}].signatures row {k + 1}", n_features)
+            rows = np.stack([checked_vector(r, self.path, f"program_changes[{i}].signatures row {k + 1}", n_features)
                              for k, r in enumerate(c["signatures"])])
             self.stamp(c["stamp"], f"program_changes[{i}].stamp")
             self.stamp(c["program"][1], f"program_changes[{i}].program[1]")
@@ -442,10 +443,10 @@ class _Check:
     def entry(self, log: dict, where: str, n_axes: int, n_features: int, known: int) -> Entry:
         path, expected = self.path, log.get("expected")
         entry = Entry(
-            log["stamp"], log["sha256"], _vector(log.get("residual"), path, f"{where}.residual", n_features),
+            log["stamp"], log["sha256"], checked_vector(log.get("residual"), path, f"{where}.residual", n_features),
             _number(log.get("temperature_C"), path, f"{where}.temperature_C"),
             _number(log.get("payload_kg"), path, f"{where}.payload_kg"),
-            None if expected is None else _vector(expected, path, f"{where}.expected", n_features),
+            None if expected is None else checked_vector(expected, path, f"{where}.expected", n_features),
             *_load(log, path, where, n_axes), _program(log, path, where, known))
         if not math.isfinite(entry.payload):
             raise self.fail(f"{where}.payload_kg is not a finite number")

@@ -71,7 +71,7 @@ def change(unit, log, motion: int, source: str, signatures, changed) -> int:
     before = of_baseline(unit, unit.entries[-1].program) if unit.entries else unit.torque_source
     unit.references.append(unit.references[motion])
     unit.program_changes.append(history.ProgramChange(log.stamp, program_log(unit, motion), len(unit.entries),
-                                                     signatures, source))
+                                                      signatures, source))
     changed(signatures)
     name = unit.references[motion].name
     unit.notes.append(f"torque source changed at {log.stamp}: {source or 'the logged torque'} (before: "

@@ -93,7 +93,8 @@ def settings_digest(settings: Settings, model: str, twin_temperature: bool, robo
             "format": log_format}
 
 
-def _floats(values) -> list[float]:
+def floats(values) -> list[float]:
+    """``values`` (any shape) flattened to Python floats, as the state files write them (JSON)."""
     return [float(v) for v in np.ravel(values)]
 
 
@@ -132,7 +133,14 @@ def inside(path: Path, root: Path) -> Path:
     return out_folder(root).path(path)
 
 
-def _load_json(path: Path, what: str, max_bytes: int) -> dict:
+def load_json(path: Path, what: str, max_bytes: int) -> dict:
+    """The JSON object of the file ``path`` (a ``what``: named in the error), read up to ``max_bytes``.
+
+    Raises
+    ------
+    StateError
+        The file cannot be read, is larger than ``max_bytes``, is not JSON or not a JSON object.
+    """
     try:
         text = inputs.read_text(path, what, max_bytes)
     except inputs.InputError as err:
@@ -146,7 +154,15 @@ def _load_json(path: Path, what: str, max_bytes: int) -> dict:
     return document
 
 
-def _vector(value, path: Path, name: str, length: int, finite: bool = True) -> np.ndarray:
+def checked_vector(value, path: Path, name: str, length: int, finite: bool = True) -> np.ndarray:
+    """``value`` read from the file ``path`` as an array of shape (``length``,), its field ``name``
+    named in the error.
+
+    Raises
+    ------
+    StateError
+        ``value`` is not a list of ``length`` numbers, or (``finite``) holds NaN or an infinity.
+    """
     if not (isinstance(value, list) and len(value) == length
             and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
         raise StateError(f"{path}: {name} is not a list of {length} numbers")
@@ -159,7 +175,7 @@ def _vector(value, path: Path, name: str, length: int, finite: bool = True) -> n
 def write_cycle(path: Path, root: Path, key: dict, features: np.ndarray) -> None:
     """Cache one simulated cycle's ``features`` beside the ``key`` that determined them, at ``path``
     inside ``root`` (:func:`out_folder`: a link leading out is refused, nothing written)."""
-    out_folder(root).write_text(path, json.dumps({"format": CYCLE_FORMAT, "key": key, "features": _floats(features)}))
+    out_folder(root).write_text(path, json.dumps({"format": CYCLE_FORMAT, "key": key, "features": floats(features)}))
 
 
 def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray:
@@ -170,11 +186,11 @@ def read_cycle(path: Path, root: Path, key: dict, n_features: int) -> np.ndarray
     StateError
         The file is a link leading outside ``root``, is not a cached cycle of ``key`` or its features are not ``n_features`` finite numbers.
     """
-    d = _load_json(inside(path, root), "cached twin cycle", CYCLE_MAX_BYTES)
+    d = load_json(inside(path, root), "cached twin cycle", CYCLE_MAX_BYTES)
     if d.get("format") != CYCLE_FORMAT or d.get("key") != key:
         raise StateError(f"{path}: not the cached twin cycle of {key} (another model, program or condition); "
                                 "delete it (the twin simulates it again)")
-    return _vector(d.get("features"), path, "features", n_features)
+    return checked_vector(d.get("features"), path, "features", n_features)
 
 
 def write_calibration(path: Path, root: Path, key: dict, model: Path) -> None:
@@ -195,7 +211,7 @@ def read_calibration(path: Path, root: Path, key: dict, model: Path) -> None:
         The record or the model is a link out of ``root``, the record belongs to another key, or
         the model file is missing or is not the one the record was written for.
     """
-    d = _load_json(inside(path, root), "cached calibration record", CYCLE_MAX_BYTES)
+    d = load_json(inside(path, root), "cached calibration record", CYCLE_MAX_BYTES)
     fix = f"; delete {path} and {path.with_suffix('')} (the unit is calibrated again)"
     if d.get("format") != CALIBRATION_FORMAT or d.get("key") != key:
         raise StateError(f"{path}: not the calibration of this robot and log{fix}")
