@@ -9,6 +9,7 @@ checked against a reading of its own rows that does not use its persistence logi
 
 import csv
 import io
+import os
 from statistics import NormalDist
 
 import numpy as np
@@ -215,3 +216,35 @@ def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tm
     assert f"<b>Open alarm</b> {when} on axis 2" in html
     assert f"open alarm {when} on axis 2" in html  # the light's rule
     assert "1 of 1 units alarm.</p>" in html  # the chance statement says nothing here: left out
+
+
+
+def test_forked_workers_draw_on_figures_of_their_own():
+    """``--jobs``' forked workers (:mod:`faultgen.monitor.parallel`) draw charts at the same time in a
+    process that has drawn some: each draws on a figure of its own and gives the parent's bytes.
+    Until 2026-11-28 a worker drew on the parent's figure, whose mathtext layouts kept fonts reading
+    the font file through a file offset all the workers share: side by side they read each other's
+    glyph bytes, and a CI run failed with ``FT_Load_Glyph ... too many hints``
+    (:func:`faultgen.monitor.report._forget_figures`). The race itself is rare (a script of two
+    forked children drawing a log axis 40 times each: 2 bad draws in each), so the test asserts its
+    cause: the parent's figure in the child."""
+    rng = np.random.default_rng(7)
+    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    _feed(unit, _ramp(40, 1, 25, 0.8), rng)
+
+    def png() -> bytes:
+        buffer = io.BytesIO()
+        report.chart(buffer, unit, "wear signature match")
+        return buffer.getvalue()
+
+    expected = png()  # drawn on this process's figure, its log axis's mathtext laid out
+    parents = list(report._FIGURES.by_height.values())
+    pid = os.fork()
+    if pid == 0:  # the child exits with 1 if it drew other bytes, + 2 if on a figure of the parent's
+        try:
+            drawn = png()
+            figures = report._FIGURES.by_height.values()
+            os._exit((drawn != expected) + 2 * any(f is p for f in figures for p in parents))
+        finally:
+            os._exit(4)
+    assert os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) == 0

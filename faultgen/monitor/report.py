@@ -9,6 +9,7 @@ are written as numbers."""
 
 from __future__ import annotations
 
+import os
 import threading
 
 import numpy as np
@@ -144,6 +145,21 @@ def chart(path, monitor, axis_note: str) -> None:
 _FIGURES = threading.local()
 #: The charts' resolution, dots per inch.
 DPI = 90
+
+
+def _forget_figures() -> None:
+    """In a forked child (``--jobs``' workers, :mod:`faultgen.monitor.parallel`): no figure of the
+    parent's. A figure the parent drew keeps, in its renderer's mathtext layouts, the parent's fonts
+    (matplotlib's ``FT2Font``), which read the font file through a file offset the parent and every
+    forked child share: two children drawing at once read each other's glyph bytes (``FT_Load_Glyph
+    ... failed with error 0x16: too many hints``, or wrong pixels). matplotlib empties its own font
+    cache at a fork for that reason (``matplotlib.font_manager``)."""
+    global _FIGURES
+    _FIGURES = threading.local()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_figures)
 
 
 def _figure(height: float):
