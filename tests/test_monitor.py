@@ -851,7 +851,8 @@ def test_a_unit_whose_twin_cannot_be_built_falls_back_through_its_own_friction_t
 def test_the_own_friction_fallback_fits_every_moving_axis_dry_and_viscous_level_on_the_nominal_model(fleet, tmp_path):
     """Kind "friction": no search, the nominal model's Stribeck hump and direction skew kept, every
     moving axis's dry (Coulomb) and viscous level fitted to the unit's first log (the fleet's units
-    spread 15 % about the nominal friction), cached under its own key and read back the same."""
+    spread 15 % about the nominal friction), cached under its own key and read back the same, and not
+    read back for the logs read in another format."""
     from faultgen.model import robots
     from faultgen.monitor import state as stored
     from faultgen.monitor import unit as units_module
@@ -877,3 +878,9 @@ def test_the_own_friction_fallback_fits_every_moving_axis_dry_and_viscous_level_
     again = units_module.model_of(source, "friction", key, None, tmp_path, False)  # the cache, not the log
     assert again.path == made.path
     np.testing.assert_array_equal(again.friction.coulomb_pos, f.coulomb_pos)
+    # the logs read in another format (other torque columns of the same files): not that calibration
+    from faultgen.logs import formats
+
+    other = fleet_logs.Source(nominal, formats.make("ur-rtde", torque_constants=(1.0,) * nominal.n_axes))
+    with pytest.raises(ValueError, match="its calibration is not cached"):
+        units_module.model_of(other, "friction", key, None, tmp_path, False)

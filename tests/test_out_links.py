@@ -145,7 +145,7 @@ def test_the_scheduler_cache_refuses_a_calibration_record_linked_out_and_sends_n
     (out / ".cache" / "calibrated" / f"{digest}.json").symlink_to(secret)
     member = UnitHistory("u1", "calibrated", ("u1", "s"), ("s", first))
     with pytest.raises(stored.StateError, match=f"{digest}.json: a link leading outside") as refused:
-        _scheduler_cache(out).for_unit(member, nominal, first)
+        _scheduler_cache(out).for_unit(member, nominal, first, "measured")
     assert "MARKER" not in str(refused.value)
 
 

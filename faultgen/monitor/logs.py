@@ -264,6 +264,7 @@ class Source:
         self.given = given
         self.reader, _ = reader_of(log_format)
         self.held = bool(log_format.reads_held)
+        self.format_key = log_format.key
         self._parsed: dict[Path, Parsed] = {}
         self._kept: set[Path] = set()
 

@@ -166,13 +166,14 @@ class Cache:
             model = ""  # not a cycle: the worker's own check refuses it, if it is read
         self.by_model.setdefault(model, {})[name] = data
 
-    def for_unit(self, unit: UnitHistory, nominal_sha256: str, first_sha256: str) -> dict[str, bytes]:
+    def for_unit(self, unit: UnitHistory, nominal_sha256: str, first_sha256: str, log_format: str) -> dict[str, bytes]:
         """The cache files a unit's scoring may read: the cycles of the nominal model, of a given
-        model and of its cached calibration (with that calibration's folder and record)."""
+        model and of its cached calibration (with that calibration's folder and record; ``log_format``
+        the run's :attr:`faultgen.logs.formats.LogFormat.key`)."""
         files: dict[str, bytes] = {}
         models = set(self.base)
         if unit.model in ("calibrated", "friction"):
-            key = calibration_key(nominal_sha256, first_sha256, unit.model)
+            key = calibration_key(nominal_sha256, first_sha256, unit.model, log_format)
             digest = stored.key_name(key)
             record, folder = self.root / "calibrated" / f"{digest}.json", self.root / "calibrated" / digest
             if record.is_file() and folder.is_dir():
@@ -287,7 +288,7 @@ def _context_of(context: Context, group: list) -> Context:
 def _shipment(context: Context, cache: Cache, group: list, nominal_sha256: str) -> Shipment:
     files: dict[str, bytes] = {}
     for _, unit, _ in group:
-        files.update(cache.for_unit(unit, nominal_sha256, unit.first[1]))
+        files.update(cache.for_unit(unit, nominal_sha256, unit.first[1], context.log_format.key))
     return Shipment(_logs_of(context, group), files)
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from faultgen.calibrate import plausibility
 from faultgen.effects.payload import Payload
+from faultgen.logs import formats
 from faultgen.model import robots
 from faultgen.monitor import history
 from faultgen.monitor import logs as fleet_logs
@@ -58,11 +59,16 @@ def calibration_steps(kind: str) -> int:
     return 0 if kind == "friction" else CALIBRATION_STEPS
 
 
-def calibration_key(nominal_sha256: str, first_sha256: str, kind: str = "calibrated") -> dict:
+def calibration_key(nominal_sha256: str, first_sha256: str, kind: str = "calibrated",
+                    log_format: str = formats.DEFAULT) -> dict:
     """The key of a unit's cached calibration of ``kind`` ("calibrated" or "friction"): the nominal
-    model's and the first log's SHA-256, the search's length (:func:`calibration_steps`) and, when
-    on, :data:`OWN_FRICTION` (a calibration without it keeps its key)."""
+    model's and the first log's SHA-256, the search's length (:func:`calibration_steps`), the logs'
+    format with its options (:attr:`faultgen.logs.formats.LogFormat.key`: other torque constants read
+    other torques from the same file) and, when on, :data:`OWN_FRICTION` (a calibration of the
+    default format or without it keeps its key)."""
     key = {"robot": nominal_sha256, "log": first_sha256, "steps": calibration_steps(kind)}
+    if log_format != formats.DEFAULT:
+        key["format"] = log_format
     if OWN_FRICTION:
         key["friction"] = "every axis: one dry level and viscous"
     return key
@@ -277,7 +283,7 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
         if not isinstance(source.given, robots.Robot):
             raise ValueError(str(source.given) if source.given is not None else "no --calibrated model given")
         return source.given
-    key = calibration_key(stored.sha256_file(nominal.path), first[1], kind)
+    key = calibration_key(stored.sha256_file(nominal.path), first[1], kind, source.format_key)
     digest = stored.key_name(key)
     confined = stored.out_folder(out)
     root = out / ".cache" / "calibrated"
