@@ -24,8 +24,8 @@ from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.state import STATE_MAX_BYTES, StateError, floats, load_json, checked_vector, inside
 
 #: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`; a column note
-#: with its log and the reader's note too: a plain note in a state written before, not in life.csv's
-#: verdict); a state of format 2 (notes as bare text, whose kind was recovered by matching their start)
+#: with its log and the reader's note too: plain in a state written before, so noted again from the next
+#: log); a state of format 2 (notes as bare text, whose kind was recovered by matching their start)
 #: or 1 (residuals of two features per axis) is refused (a new OUT).
 FORMAT = "faultgen-monitor-state/3"
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
