@@ -102,7 +102,7 @@ def test_a_state_file_above_what_a_run_writes_is_refused_before_it_is_parsed(tmp
     bound = state.STATE_MAX_BYTES
     with pytest.raises(state.StateError, match=rf"{path}: \d+ bytes; a monitor state is read up to {bound}"):
         history.read_unit(path, tmp_path, "weld-01", {}, 6, 18)
-    big = history.UnitHistory("weld-01", notes=["x" * state.STATE_MAX_BYTES])
+    big = history.UnitHistory("weld-01", notes=[history.Note("x" * state.STATE_MAX_BYTES)])
     with pytest.raises(state.StateError, match=r"weld-01\.json: the state of weld-01 would be \d+ bytes"):
         history.write_unit(tmp_path / ".state" / "weld-01.json", big, {})
     assert path.stat().st_size > state.STATE_MAX_BYTES  # the file there was left as it was

@@ -12,6 +12,7 @@ import pickle
 import numpy as np
 import pytest
 
+from faultgen.logs import measured
 from faultgen.monitor import history, unit
 from faultgen.monitor.history import Entry, Maintenance, Note, ProgramChange, Skipped, UnitHistory
 from faultgen.monitor.state import StateError
@@ -28,7 +29,10 @@ def _record() -> UnitHistory:
                      3.0, rng.normal(size=N_FEATURES), np.abs(rng.normal(size=(2, N_AXES))), 60.0, int(d == 3))
                for d in (1, 2, 3)]
     return UnitHistory("u1", "nominal", ("u0", "2026-01-01"), ("2026-01-01", "1" * 64), signatures, entries,
-                       [Skipped("2026-01-04", "", "unreadable")], [*fell_back, "log 2026-01-02: column qd1 planted"],
+                       [Skipped("2026-01-04", "", "unreadable")],
+                       [*fell_back, Note("log 2026-01-02: column qd1 planted"), Note(
+                           "log 2026-01-03: column qd2 planted", history.COLUMN, "2026-01-03",
+                           measured.ColumnNote("column qd2 planted", 2, measured.SPEED_RATIO))],
                        [Maintenance("2026-01-02", "repair", 2, 1)],
                        [ProgramChange("2026-01-03", ("u1", "2026-01-03"), 2, signatures + 1, "a source")],
                        torque_source="a source")
@@ -62,7 +66,11 @@ def test_a_record_is_read_back_field_for_field_with_its_notes_kinds(tmp_path):
     assert back.monitor is None and back.program_twins == {}
     history.write_unit(path, back, SETTINGS)
     assert path.read_bytes() == written  # written again byte for byte: nothing lost or reordered
-    assert [history.kind_of(n) for n in back.notes] == [history.FALLBACK, ""]
+    assert [n.kind for n in back.notes] == [history.FALLBACK, "", history.COLUMN]
+    said = back.notes[2]  # the reader's column note: its log, axis and kind as fields, not read from its text
+    assert (said.log, said.column, said.column.axis, said.column.kind) == ("2026-01-03", "column qd2 planted", 2,
+                                                                          measured.SPEED_RATIO)
+    assert back.notes[1].column is None
     assert unit.fallback_notes(back) == [record.notes[0]] and unit.refused_note(back) is None
     for was, now in zip(record.entries, back.entries):
         for name in ("residual", "expected", "load"):
@@ -74,7 +82,7 @@ def test_a_note_s_kind_is_its_own_not_its_text(tmp_path):
     """A note that reads like a fallback is not one; a refusal's note is found by its kind alone,
     after a round trip and a pickle (a worker's result)."""
     record = UnitHistory("u1", first=("2026-01-01", ""), model="none",
-                         notes=["the twin of the given model failed (typed by hand); nominal model used"])
+                         notes=[Note("the twin of the given model failed (typed by hand); nominal model used")])
     unit.refuse(record, ValueError("a planted refusal"))
     back = pickle.loads(pickle.dumps(_read(tmp_path, _write(tmp_path, record))))
     assert unit.fallback_notes(back) == []
@@ -86,6 +94,11 @@ def test_a_note_s_kind_is_its_own_not_its_text(tmp_path):
     ("notes", ["bare text"], "notes is not a list of {text, kind}"),
     ("notes", [{"text": "x", "kind": "planted"}], "notes is not a list of {text, kind}"),
     ("model", "planted", "model 'planted' is not one of given"),
+    ("notes", [{"text": "log 2026-01-02: column qd3 x", "kind": "column", "log": "2026-01-02",
+                "column": {"text": "column qd3 x", "axis": 3, "kind": measured.SPEED_RATIO}}],
+     "notes[0].column is not {text, axis 1..2, kind}"),
+    ("notes", [{"text": "log x: column qd1 x", "kind": "column", "log": "x",
+                "column": {"text": "column qd1 x", "axis": 1, "kind": measured.SPEED_RATIO}}], "notes[0].log"),
 ])
 def test_a_planted_value_is_refused_naming_the_file_and_field(tmp_path, key, value, said):
     path = _write(tmp_path, _record())
@@ -99,4 +112,4 @@ def test_a_planted_value_is_refused_naming_the_file_and_field(tmp_path, key, val
 
 def test_a_written_note_is_plain_json_text_with_its_kind():
     note = Note("the twin of the calibrated model failed (x); nominal model used", history.FALLBACK)
-    assert note == str(note) and history.kind_of(note) == history.FALLBACK and history.kind_of(str(note)) == ""
+    assert note == str(note) and note.kind == history.FALLBACK and note.column is None

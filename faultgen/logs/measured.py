@@ -69,7 +69,6 @@ column is divided by G to the joint side and the note says so (``column qdK is m
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -124,7 +123,8 @@ class MeasuredData:
         The cycle of each sample (the ``cycle`` column: whole, never decreasing), None without.
     notes : tuple of str
         Remarks that did not refuse the data: ignored extra columns, the derivative filter
-        used, resampling, sampling gaps, suspicious torque magnitudes.
+        used, resampling, sampling gaps, suspicious torque magnitudes; one on a speed or torque
+        column a :class:`ColumnNote` (its axis and kind as fields).
 
     All arrays are read-only.
     """
@@ -432,8 +432,20 @@ def _check_velocities(where: Path, qd: np.ndarray, qd_est: np.ndarray, window: i
 MOTOR_SIDE_TOLERANCE = 0.05
 #: The ratio of deg/s to rad/s.
 DEG_PER_RAD = 180.0 / np.pi
-#: The words of the note on a ``qd`` column read as motor-side: ``column qdK is motor-side: ...``.
-MOTOR_SIDE = "is motor-side"
+#: The kinds of a reader's :class:`ColumnNote`: a ``qd`` column read as the motor's speed (divided by the
+#: gear ratio), one of another ratio to ``q``'s derivative (kept), a ``tau`` column above 1.5 x the arm's limit.
+MOTOR_SIDE_SPEED, SPEED_RATIO, TORQUE_ABOVE_LIMIT = "motor-side speed", "speed ratio", "torque above limit"
+COLUMN_KINDS = (MOTOR_SIDE_SPEED, SPEED_RATIO, TORQUE_ABOVE_LIMIT)
+
+
+class ColumnNote(str):
+    """A reader's note on a column of axis ``axis`` (1-based; :attr:`MeasuredData.notes`), as written,
+    with its ``kind`` (:data:`COLUMN_KINDS`): what it is about is read from these, never from its text."""
+
+    def __new__(cls, text: str, axis: int = 0, kind: str = ""):  # the defaults: unpickled, set after
+        note = super().__new__(cls, text)
+        note.axis, note.kind = axis, kind
+        return note
 
 
 def _slopes(power: np.ndarray, cross: np.ndarray, size: int) -> np.ndarray:
@@ -467,8 +479,8 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
     """:func:`_check_velocities` from the sums over its rows: per axis, ``power`` = sum of the
     estimated speed squared, ``cross`` = sum of estimated times given speed, over ``size`` rows.
     With the robot's ``gear_ratio`` (N,), a column about G times the derivative of q
-    (:data:`MOTOR_SIDE_TOLERANCE`) is noted motor-side (:data:`MOTOR_SIDE`; the reader divides it by
-    G: :func:`speed_sides`), and one that could be motor-side or deg/s alike is refused."""
+    (:data:`MOTOR_SIDE_TOLERANCE`) is noted motor-side (a :class:`ColumnNote` of kind :data:`MOTOR_SIDE_SPEED`;
+    the reader divides it by G: :func:`speed_sides`), and one that could be motor-side or deg/s alike is refused."""
     notes = []
     q_columns, qd_columns, _ = column_names(len(power))
     slopes = _slopes(power, cross, size)
@@ -484,9 +496,9 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
                 f"the motor's speed (axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}) alike; expected rad/s at "
                 "the joint")
         if motor[k]:
-            notes.append(
-                f"column {name} {MOTOR_SIDE}: {slope:.4g} times the derivative of {q_columns[k]}, "
-                f"axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}; divided by it to the joint side (rad/s)")
+            notes.append(ColumnNote(f"column {name} is motor-side: {slope:.4g} times the derivative of {q_columns[k]}, "
+                                    f"axis {k + 1}'s gear ratio {gear_ratio[k]:.4g}; divided by it to the joint side "
+                                    "(rad/s)", k + 1, MOTOR_SIDE_SPEED))
             continue
         if degrees:
             raise MeasuredDataError(
@@ -494,17 +506,15 @@ def velocity_verdicts(where: Path, power: np.ndarray, cross: np.ndarray, size: i
                 f"{q_columns[k]}); expected rad/s"
             )
         if not 0.8 <= slope <= 1.25:
-            notes.append(
-                f"column {name} is {slope:.3g} times the derivative of {q_columns[k]}; check its sign and unit"
-            )
+            notes.append(ColumnNote(f"column {name} is {slope:.3g} times the derivative of {q_columns[k]}; check its "
+                                    "sign and unit", k + 1, SPEED_RATIO))
     return notes
 
 
 def motor_side_speeds(notes) -> tuple[int, ...]:
     """The axes (1-based) whose ``qd`` column a log's reader found motor-side and divided by the
-    gear ratio, from its ``notes`` (:data:`MOTOR_SIDE`, as :func:`velocity_verdicts` words it)."""
-    found = (re.match(rf"column qd(\d+) {MOTOR_SIDE}: ", note) for note in notes)
-    return tuple(sorted({int(m.group(1)) for m in found if m}))
+    gear ratio, from its ``notes`` (their :class:`ColumnNote` of kind :data:`MOTOR_SIDE_SPEED`)."""
+    return tuple(sorted({n.axis for n in notes if isinstance(n, ColumnNote) and n.kind == MOTOR_SIDE_SPEED}))
 
 
 def torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
@@ -513,10 +523,9 @@ def torque_notes(tau: np.ndarray, robot: robots.Robot) -> list[str]:
     for k, name in enumerate(column_names(robot.n_axes)[2]):
         peak = float(np.max(np.abs(tau[:, k])))
         if peak > 1.5 * limit[k]:
-            notes.append(
-                f"column {name} reaches {peak:.4g} N m, above 1.5 x the arm-side torque limit "
-                f"{limit[k]:.4g} N m (gear ratio x motor limit); check its unit and side"
-            )
+            notes.append(ColumnNote(f"column {name} reaches {peak:.4g} N m, above 1.5 x the arm-side torque limit "
+                                    f"{limit[k]:.4g} N m (gear ratio x motor limit); check its unit and side",
+                                    k + 1, TORQUE_ABOVE_LIMIT))
     return notes
 
 

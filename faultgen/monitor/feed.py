@@ -22,7 +22,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import friction_tests, life, report, sources
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
-from faultgen.monitor.history import Entry, Maintenance, ProgramChange, Skipped, UnitHistory
+from faultgen.monitor.history import Entry, Maintenance, Note, ProgramChange, Skipped, UnitHistory
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 from faultgen.monitor.unit import REFUSED_SKIP, log_of, refused_note, short, twin_of
@@ -225,10 +225,10 @@ def new_program(unit: UnitHistory, log, twin: Twin, context, source: fleet_logs.
     unit.program_changes.append(ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
                                               new.signatures, torque))
     unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
-    unit.notes.append(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS of "
-                      f"none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s cycle; its "
-                      "twin replays that log; it learns its offset on its own first logs (pooled into the unit's "
-                      "learning while the unit learns), the other programs' logs scored meanwhile")
+    unit.notes.append(Note(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS "
+                           f"of none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s "
+                           "cycle; its twin replays that log; it learns its offset on its own first logs (pooled into "
+                           "the unit's learning while the unit learns), the other programs' logs scored meanwhile"))
     return k
 
 
@@ -274,7 +274,7 @@ def _score(unit: UnitHistory, log, parsed: fleet_logs.Parsed, nominal, twin, twi
         unit.skipped.append(Skipped(log.stamp, sha256, short(err)))
         return twin
     if not unit.entries and not unit.skipped:  # what the reader chose (an adapter's torque source), said once
-        unit.notes.extend(n for n in reading.notes if isinstance(n, formats.TorqueNote))
+        unit.notes.extend(Note(n) for n in reading.notes if isinstance(n, formats.TorqueNote))
     unit.notes.extend(fleet_logs.log_notes(log.stamp, reading.notes, unit.notes))  # each column's kind once
     constant = constant_torque(unit, reading.vector, nominal.n_axes) if program == 0 else ""
     if constant:
@@ -333,7 +333,7 @@ def not_monitored(unit: UnitHistory, stamp: str, sha256: str, why: str) -> str:
     unit.entries.clear()
     unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes,
                                unit.monitor.baseline.signatures)
-    unit.notes.append(why)
+    unit.notes.append(Note(why))
     unit.off_monitor = why
     return why
 

@@ -18,13 +18,15 @@ from pathlib import Path
 import numpy as np
 
 from faultgen.data import atomic, logfolder
+from faultgen.logs import measured
 from faultgen.monitor import programs
 from faultgen.monitor.scoring import Settings, UnitMonitor
 from faultgen.monitor.state import STATE_MAX_BYTES, StateError, floats, load_json, checked_vector, inside
 
-#: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`); a state
-#: of format 2 (notes as bare text, whose kind was recovered by matching their start) or 1 (residuals
-#: of two features per axis) is refused (a new OUT).
+#: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`; a column note
+#: with its log and the reader's note too: plain in a state written before, so noted again from the next
+#: log); a state of format 2 (notes as bare text, whose kind was recovered by matching their start)
+#: or 1 (residuals of two features per axis) is refused (a new OUT).
 FORMAT = "faultgen-monitor-state/3"
 #: Events of ``events.csv`` given to a unit's monitor (and kept in its state): after them its
 #: offset is learned again and its open alarm closed.
@@ -33,24 +35,21 @@ MAINTENANCE = ("repair", "gearbox_change")
 
 #: The kinds of a unit's notes that a run acts on (:class:`Note`): its twin fell back to another
 #: model (:func:`faultgen.monitor.unit.chain_notes`), its first log refused and the unit taken off
-#: the monitor (:func:`faultgen.monitor.unit.refuse`).
-FALLBACK, REFUSED = "fallback", "refused"
-NOTE_KINDS = ("", FALLBACK, REFUSED)
+#: the monitor (:func:`faultgen.monitor.unit.refuse`), a log reader's note on a column (``log STAMP:
+#: note``, :func:`faultgen.monitor.logs.log_notes`; life.csv's verdict of its axis ends with it).
+FALLBACK, REFUSED, COLUMN = "fallback", "refused", "column"
+NOTE_KINDS = ("", FALLBACK, REFUSED, COLUMN)
 
 
 class Note(str):
     """A note of a unit's reason (units.csv), as written, with its ``kind`` (:data:`NOTE_KINDS`; ""
-    a note nothing acts on), so that no fact is recovered from its text."""
+    a note nothing acts on), so that no fact is recovered from its text; one of kind :data:`COLUMN`
+    with the ``log`` (stamp) and the reader's ``column`` note (:class:`faultgen.logs.measured.ColumnNote`)."""
 
-    def __new__(cls, text: str, kind: str = ""):  # the default: unpickled, its kind set after
-        note = super().__new__(cls, text)
-        note.kind = kind
+    def __new__(cls, text: str, kind: str = "", log: str = "", column: measured.ColumnNote | None = None):
+        note = super().__new__(cls, text)  # the defaults: unpickled, its fields set after
+        note.kind, note.log, note.column = kind, log, column
         return note
-
-
-def kind_of(note: str) -> str:
-    """The kind of one of a unit's notes: a :class:`Note`'s, "" for any other text."""
-    return note.kind if isinstance(note, Note) else ""
 
 
 @dataclass(frozen=True)
@@ -142,7 +141,7 @@ class UnitHistory:
     signatures: np.ndarray | None = None
     entries: list[Entry] = field(default_factory=list)
     skipped: list[Skipped] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)  # its reason's notes, in order (:class:`Note` where acted on)
+    notes: list[Note] = field(default_factory=list)  # its reason's notes, in order
     maintenance: list[Maintenance] = field(default_factory=list)
     program_changes: list[ProgramChange] = field(default_factory=list)
     torque_source: str = ""
@@ -210,7 +209,9 @@ def write_unit(path: Path, state: UnitHistory, settings: dict) -> None:
         "format": FORMAT, "unit": state.unit, "settings": settings,
         "program": list(state.program) if state.program else None,
         "model": state.model, "first": list(state.first),
-        "notes": [{"text": str(n), **({"kind": kind_of(n)} if kind_of(n) else {})} for n in state.notes],
+        "notes": [{"text": str(n), **({"kind": n.kind} if n.kind else {}), **({} if n.column is None else {
+            "log": n.log, "column": {"text": str(n.column), "axis": n.column.axis, "kind": n.column.kind}})}
+                  for n in state.notes],
         "torque_source": state.torque_source, "off_monitor": state.off_monitor,
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
@@ -367,11 +368,23 @@ class _Check:
                                                 and n.get("kind", "") in NOTE_KINDS for n in notes)):
             raise self.fail(f"notes is not a list of {{text, kind}} (kind one of {', '.join(NOTE_KINDS[1:])} "
                             "or none)")
+        notes = [self.column(n, i, n_axes) if n.get("kind") == COLUMN else Note(n["text"], n.get("kind", ""))
+                 for i, n in enumerate(notes)]
         facts = {k: d.get(k, "") for k in ("torque_source", "off_monitor")}  # "": a state written before they were kept
         if not all(isinstance(v, str) for v in facts.values()):
             raise self.fail("torque_source or off_monitor is not a text")
         return UnitHistory(unit, model, tuple(program) if program else None, tuple(first), signatures,
-                           notes=[Note(n["text"], n.get("kind", "")) for n in notes], **facts)
+                           notes=notes, **facts)
+
+    def column(self, note: dict, i: int, n_axes: int) -> Note:
+        """A note of kind :data:`COLUMN`: its log's stamp and the reader's note on an axis 1..``n_axes``."""
+        said = note.get("column")
+        if not (isinstance(said, dict) and isinstance(said.get("text"), str) and type(said.get("axis")) is int
+                and 1 <= said["axis"] <= n_axes and said.get("kind") in measured.COLUMN_KINDS):
+            raise self.fail(f"notes[{i}].column is not {{text, axis 1..{n_axes}, kind}} (kind one of "
+                            f"{', '.join(measured.COLUMN_KINDS)})")
+        self.stamp(note.get("log"), f"notes[{i}].log")
+        return Note(note["text"], COLUMN, note["log"], measured.ColumnNote(said["text"], said["axis"], said["kind"]))
 
     def skipped(self, skipped, handled: dict) -> list[Skipped]:
         if not (isinstance(skipped, list) and all(

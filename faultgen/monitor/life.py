@@ -21,10 +21,10 @@ with ``qd`` (rad/s) and ``tau`` (N m) the log's arm-side speed and torque, the g
 by the log's reader, :func:`faultgen.logs.measured.velocity_verdicts`, which notes it: without it
 the consumption would be ``G`` times too high; a unit whose first log's torque is motor-side is not
 monitored, :func:`faultgen.monitor.unit.refuse`). The reader's notes on an axis's columns end its
-verdict (:func:`column_notes`). A
-standing axis consumes nothing (the bearings turn with the output). A unit's state keeps each scored
-log's ``integral |qd| |tau|^p dt`` for both exponents (:func:`load_integrals`), not its share, so
-each run judges the whole history against the ratings the robot's ``drivetrain.toml`` gives now.
+verdict (:func:`column_notes`). A standing axis consumes nothing (the bearings turn with the output). A
+unit's state keeps each scored log's ``integral |qd| |tau|^p dt`` for both exponents
+(:func:`load_integrals`), not its share, so each run judges the whole history against the ratings
+the robot's ``drivetrain.toml`` gives now.
 
 A log records minutes of a unit's operation, not all of it, so the monitor counts each log as the
 unit's duty from the log before it up to it: the log's consumption per second of operation times
@@ -47,7 +47,6 @@ from __future__ import annotations
 
 import html
 import math
-import re
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from functools import lru_cache
@@ -242,21 +241,19 @@ def of_unit(unit: str, entries, maintenance, ratings, hours_per_day: float = HOU
 
 
 def column_notes(notes, axis: int) -> str:
-    """What the log reader said of ``axis``'s speed and torque columns (the unit's ``notes`` of the form
-    ``log STAMP: column qdK ...`` or ``... tauK ...``, :func:`faultgen.monitor.logs.log_notes`), as
-    the end of its verdict: a speed column read motor-side as converted with the gear ratio before
-    the load was counted, any other note as the reader's; "" without one."""
+    """What the log reader said of ``axis``'s speed and torque columns (the unit's ``notes`` of kind
+    :data:`faultgen.monitor.history.COLUMN`, :func:`faultgen.monitor.logs.log_notes`: picked by
+    their fields), as the end of its verdict: a speed column read motor-side as converted with the
+    gear ratio before the load was counted, any other note as the reader's; "" without one."""
     out = []
     for note in notes:
-        found = re.match(rf"log (.+?): (column (?:qd|tau){axis} .*)", note)
-        if not found:
+        if note.column is None or note.column.axis != axis:
             continue
-        stamp, said = found.groups()
-        if measured.MOTOR_SIDE in said:
-            out.append(f"speeds joint side: column qd{axis} logged motor-side from log {stamp} on, divided "
-                       f"by the gear ratio before its load was counted (the reader: {said})")
+        if note.column.kind == measured.MOTOR_SIDE_SPEED:
+            out.append(f"speeds joint side: column qd{axis} logged motor-side from log {note.log} on, divided "
+                       f"by the gear ratio before its load was counted (the reader: {note.column})")
         else:
-            out.append(f"the reader of log {stamp}: {said}; the load counted as logged")
+            out.append(f"the reader of log {note.log}: {note.column}; the load counted as logged")
     return "".join(f"; {text}" for text in out)
 
 

@@ -23,7 +23,7 @@ from faultgen.data import fleetlogs, logfolder
 from faultgen.logs import columns, formats, measured
 from faultgen.logs.columns import WHOLE_MAX_BYTES
 from faultgen.model.robots import Robot
-from faultgen.monitor import scoring
+from faultgen.monitor import history, scoring
 from faultgen.monitor import state as stored
 from faultgen.operation import programs
 
@@ -105,27 +105,19 @@ class Reading:
     q: np.ndarray | None = None  # (n, N) rad: the log's angles, which tell a program change
 
 
-def log_notes(stamp: str, notes, kept) -> list[str]:
-    """The reader's notes on the columns of the log ``stamp`` (its ``notes``: those starting
-    ``column ``, a speed column divided by the gear ratio from the motor side
-    (:data:`faultgen.logs.measured.MOTOR_SIDE`), one of another ratio or sign, a torque above the arm's
-    limit) that the unit keeps (``kept``, its notes so far) as ``log STAMP: note``, each column's
-    kind of note once: the first log that showed it named, later logs saying the same adding nothing."""
-    said = {_note_key(n.split(": ", 1)[1]) for n in kept if n.startswith("log ") and ": column " in n}
+def log_notes(stamp: str, notes, kept) -> list[history.Note]:
+    """The unit's notes (``log STAMP: note``, kind :data:`faultgen.monitor.history.COLUMN`) of the reader's
+    notes on the columns of the log ``stamp`` (its ``notes``' :class:`faultgen.logs.measured.ColumnNote`: a
+    speed column divided by the gear ratio from the motor side, one of another ratio or sign, a torque
+    above the arm's limit) that the unit keeps (``kept``, its notes so far), each axis's kind of note
+    once, by their fields: the first log that showed it named, later logs saying the same adding nothing."""
+    said = {(n.column.axis, n.column.kind) for n in kept if n.kind == history.COLUMN}
     out = []
     for note in notes:
-        key = _note_key(note)
-        if note.startswith("column ") and key not in said:
-            said.add(key)
-            out.append(f"log {stamp}: {note}")
+        if isinstance(note, measured.ColumnNote) and (note.axis, note.kind) not in said:
+            said.add((note.axis, note.kind))
+            out.append(history.Note(f"log {stamp}: {note}", history.COLUMN, stamp, note))
     return out
-
-
-def _note_key(note: str) -> tuple[str, str]:
-    """A column note's column and kind (motor-side, a torque too high, another ratio)."""
-    words = note.split()
-    kind = ("motor-side" if measured.MOTOR_SIDE in note else "reaches" if "reaches" in words else "ratio")
-    return (words[1] if len(words) > 1 else "", kind)
 
 
 def feature_vector(record: dict[str, np.ndarray]) -> np.ndarray:

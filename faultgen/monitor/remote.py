@@ -139,7 +139,7 @@ def _put_back(text: str, paths: dict[str, str]) -> str:
 
 def _unit_put_back(unit: UnitHistory, paths: dict[str, str]) -> UnitHistory:
     """``unit`` with this worker's paths replaced by the client's in its notes and skipped logs' reasons."""
-    unit.notes = [history.Note(_put_back(note, paths), history.kind_of(note)) for note in unit.notes]
+    unit.notes = [history.Note(_put_back(note, paths), note.kind, note.log, note.column) for note in unit.notes]
     unit.skipped = [replace(s, reason=_put_back(s.reason, paths)) for s in unit.skipped]
     return unit
 

@@ -74,9 +74,9 @@ def change(unit, log, motion: int, source: str, signatures, changed) -> int:
                                                       signatures, source))
     changed(signatures)
     name = unit.references[motion].name
-    unit.notes.append(f"torque source changed at {log.stamp}: {source or 'the logged torque'} (before: "
-                      f"{before or 'the logged torque'}); {name}'s logs of this source learn their own baseline on "
-                      "their own first logs, never scored against the other source's")
+    unit.notes.append(history.Note(f"torque source changed at {log.stamp}: {source or 'the logged torque'} (before: "
+                                   f"{before or 'the logged torque'}); {name}'s logs of this source learn their own "
+                                   "baseline on their own first logs, never scored against the other source's"))
     return len(unit.program_changes)
 
 

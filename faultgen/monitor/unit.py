@@ -106,7 +106,7 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
     try:
         program = program_of(first, name, programs, source)
     except ValueError as err:
-        return unit("none", None, [f"no log of it can be read to replay ({short(err)}): protocol own"])
+        return unit("none", None, [history.Note(f"no log of it can be read to replay ({short(err)}): protocol own")])
     return unit(kind, program)
 
 
@@ -149,15 +149,15 @@ def refuse(unit: UnitHistory, err: ValueError) -> str:
 REFUSED_SKIP = "the unit is not monitored: its first log is refused (the unit's reason says why)"
 
 
-def refused_note(unit: UnitHistory) -> str | None:
+def refused_note(unit: UnitHistory) -> history.Note | None:
     """The note that took ``unit`` off the monitor for its first log (:func:`refuse`), or None."""
-    return next((n for n in unit.notes if history.kind_of(n) == history.REFUSED), None)
+    return next((n for n in unit.notes if n.kind == history.REFUSED), None)
 
 
-def fallback_notes(unit: UnitHistory) -> list[str]:
+def fallback_notes(unit: UnitHistory) -> list[history.Note]:
     """The unit's notes that say its twin fell back to another model (written by :func:`twin_of`,
     :func:`chain_notes`)."""
-    return [n for n in unit.notes if history.kind_of(n) == history.FALLBACK]
+    return [n for n in unit.notes if n.kind == history.FALLBACK]
 
 
 def chain_notes(tried: list[tuple[str, str]], final: str) -> list[history.Note]:
