@@ -2,7 +2,7 @@
 a fleet made by ``benchmarks/real_cell_fleet.py`` (``truth.csv``) and a ``faultgen monitor`` output
 folder of it (``wear.csv``, ``alarms.csv``).
 
-    python benchmarks/monitor_bounds_check.py FLEET OUT [--scatter S] [--limit 10]
+    python benchmarks/monitor_bounds_check.py FLEET OUT [--scatter S] [--limit 8]
     python benchmarks/monitor_bounds_check.py FLEET OUT --run   # runs faultgen monitor LOGS -o OUT first
 
 Printed, each with its verdict against the issue's criterion:
@@ -30,6 +30,7 @@ import numpy as np
 
 from faultgen import children
 from faultgen.bench import independent
+from faultgen.monitor.scoring import Settings
 
 #: The issue's criteria: the bound's share, the coverage's band, the first alarm's window, % true wear.
 BOUND_SHARE, COVERAGE, ALARM, SPAN = 0.95, (0.80, 0.97), (8.0, 15.0), (10.0, 40.0)
@@ -154,7 +155,8 @@ def main() -> None:
     parser.add_argument("fleet", type=Path)
     parser.add_argument("out", type=Path)
     parser.add_argument("--scatter", type=float, default=None, help="the fleet's scatter (default: from its name)")
-    parser.add_argument("--limit", type=float, default=10.0)
+    parser.add_argument("--limit", type=float, default=Settings().wear_limit,
+                        help="the wear limit the monitor ran with, %% (default: the monitor's, as --run uses)")
     parser.add_argument("--run", action="store_true", help="run faultgen monitor on FLEET/logs into OUT first")
     parser.add_argument("--robot", type=Path, default=None, help="the robot (default: FLEET/../kr210)")
     args = parser.parse_args()

@@ -1,7 +1,7 @@
 """Issue 90's tables ("What it must show"): a ``faultgen monitor`` run on each fleet of
 ``benchmarks/real_cell_fleet.py`` judged against every criterion of the issue, one markdown table a fleet.
 
-    python benchmarks/real_cell_table.py FLEET OUT [FLEET OUT ...] [--monitor] [--robot DIR] [--limit 10]
+    python benchmarks/real_cell_table.py FLEET OUT [FLEET OUT ...] [--monitor] [--robot DIR] [--limit 8]
 
 ``FLEET`` a fleet folder (``logs/``, ``truth.csv``, ``truth_programs.csv``, ``truth_tests.csv``; its
 scatter read from its name, ``scatter-<sigma>[-one-program][-rates][-onset-A-B]``), ``OUT`` the monitor's output
@@ -9,7 +9,7 @@ folder of it; ``--monitor``: run ``faultgen monitor FLEET/logs --robot ROBOT -o 
 (:func:`real_cell_fleet.run_monitor`), its wall and CPU time (the monitor's and its children's,
 ``resource.getrusage``) kept in ``OUT.timing.json`` beside ``OUT`` for later runs of this script.
 ``--robot``: default ``FLEET/../kr210``; ``--limit``: the wear limit the
-monitor ran with (``--monitor`` passes it on as ``--wear-limit``; default the monitor's, 10 %). The rows, each with its figure and verdict (met / NOT met):
+monitor ran with (``--monitor`` passes it on as ``--wear-limit``; default the monitor's, 8 %). The rows, each with its figure and verdict (met / NOT met):
 
 - every unit monitored by its 40th day (per unit the first log ``scores.csv`` scores as monitoring);
 - program changes reported (units.csv's "program changed at" stamps) exactly where the unit meets a

@@ -59,14 +59,15 @@ WEAR_INTERVAL_Z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
 
 #: An axis is **not observable on this program** when one log's :data:`WEAR_INTERVAL` (90 %) interval of
 #: its wear, from the noise at the learning logs' conditions (:meth:`~faultgen.monitor.wear.WearEstimator.wear_interval` of an
-#: unworn axis: 2 x 1.645 standard errors), is wider than this many ``wear_limit``s (60 points at the
-#: default 10 %). Why: the filtered wear's error is about half a log's (:class:`~faultgen.monitor.wear_trend.WearTrend`), so at that
+#: unworn axis: 2 x 1.645 standard errors), is wider than this many ``wear_limit``s (48 points at the
+#: default 8 %). Why: the filtered wear's error is about half a log's (:class:`~faultgen.monitor.wear_trend.WearTrend`), so at that
 #: width the filtered wear's own 90 % interval on an unworn axis spans -+1.5 limits: it cannot tell the
 #: axis unworn from worn past the limit, and its wear, trend and remaining life would be the noise's
 #: (a UR5 dispensing program's axis 2: one log's interval 258 points wide, its filtered wear
 #: -36..+11 %). Such an axis gets no wear (empty cells in scores.csv and wear.csv), no remaining life
 #: (rul.csv says why), and does not alarm. The independent KR210 fleet's axes (first law, seed 0) are
-#: 7.8-23.3 points wide (0.8-2.3 limits): a margin of 2.6 below the rule, 4.3 above it to the UR5's.
+#: 7.8-23.3 points wide (1.0-2.9 limits of 8 %): a margin of 2.1 below the rule, 5.4 above it to the
+#: UR5's (at the earlier default of 10 %: 0.8-2.3 limits, margins 2.6 and 4.3).
 NOT_OBSERVABLE_LIMITS = 6.0
 
 #: The smallest significance of --protocol own's at-once limits (``alpha ** persistence``; the limits are
