@@ -47,8 +47,8 @@ test's wear shares; ``s0`` that test's own standard error in points, :data:`OFFS
 not known; the tests before the wear fix it), each test weighed by its own error and the twin-scale
 wear's error times ``f`` (weighed at ``f = 1``, then again at the fitted ``f``) and by the factor's
 drift since the test, :data:`SCALE_DRIFT` times ``x_j`` per later test (the twin's scale may change
-with the wear; a test before the wear keeps telling ``b``); its covariance scaled by the reduced
-chi-square of the tests when above one.
+with the wear; a test before the wear keeps telling ``b``); the tests' variances (``b``'s prior's too) times
+their reduced chi-square when above one, never ``f``'s prior (issue 90: a factor only its prior told).
 A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
@@ -534,24 +534,24 @@ class Rescale:
         import statsmodels.api as sm
 
         pairs = np.array(self.pairs[axis], dtype=float)
-        y, sy, x, sx = pairs.T
+        (y, sy, x, sx), n = pairs.T, len(pairs)
         sb = self.offset_sd.get(axis, OFFSET_PRIOR)
         design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
         target = np.r_[y, 1.0, 0.0]
-        # the factor a random walk of SCALE_DRIFT a test: an earlier pair's y misses by that drift times
-        # its x per later test; a pair before the wear (x about 0) keeps telling the offset
+        # the factor a random walk of SCALE_DRIFT a test: an earlier pair's y misses by it times its x per
+        # later test; a pair before the wear (x about 0) keeps telling the offset
         drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2
         factor = 1.0
         for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
-            weights = np.r_[1.0 / np.maximum(sy**2 + (factor * sx) ** 2 + drift, 1e-6), 1.0 / SCALE_PRIOR**2,
-                            1.0 / sb**2]
+            weights = np.r_[1.0 / np.maximum(sy**2 + (factor * sx) ** 2 + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / sb**2]
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)
-        cov = np.asarray(result.cov_params())
-        if len(y) > 2:
-            chi2 = float(np.sum(weights[: len(y)] * (y - design[: len(y)] @ result.params) ** 2) / (len(y) - 2))
-            cov = cov * max(1.0, chi2)
-        return (factor, float(np.sqrt(cov[1, 1]))), (float(result.params[0]), float(np.sqrt(cov[0, 0])))
+        if n > 2 and (chi2 := float(np.sum(weights[:n] * (y - design[:n] @ result.params) ** 2) / (n - 2))) > 1.0:
+            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests' errors, not f's prior
+            result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
+            factor = max(float(result.params[1]), SCALE_MIN)
+        sd = np.sqrt(np.diag(np.asarray(result.cov_params())))
+        return (factor, float(sd[1])), (float(result.params[0]), float(sd[0]))
 
 
 def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
