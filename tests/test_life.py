@@ -104,7 +104,8 @@ def test_service_by_is_the_earlier_of_the_load_and_the_condition_based_life():
     rul_rows = [{"axis": "2", "rul": "12.4", "rul_5": "6.6", "rul_95": "30", "time_unit": "days"}]
     assert life.service_by("2026-03-01", life_rows, rul_rows) == ("2026-03-07", "condition: axis 2's wear, its 5 % quantile")
     window = life.service_window(life_rows, rul_rows)
-    assert (window.days, window.low, window.high) == (6.6, 6.6, 30.0)
+    assert (window.days, window.low, window.high, window.basis) == (6.6, 6.6, 30.0, "wear")
+    assert life.service_window(life_rows, []).basis == "load"
     assert life.service_by("2026-03-01", life_rows, []) == ("2026-04-10", "load: axis 1's rated life")
     assert life.service_by("17", life_rows, []) == ("in 40 days", "load: axis 1's rated life")
     assert life.service_by("2026-03-01", [], []) == ("", "")

@@ -290,13 +290,15 @@ class Service:
     """A unit's "service by" in days from its last log (:func:`service_window`): ``days`` the
     earliest source, ``low`` and ``high`` the earliest of the sources' 5 % and 95 % ends (a
     load-based life is one number, its own ends; ``math.inf`` beyond the horizon), ``why`` the
-    source that sets ``days`` in words, ``axis`` its axis."""
+    source that sets ``days`` in words, ``axis`` its axis, ``basis`` that source's kind: "load" (the
+    rated life) or "wear" (the condition-based remaining life)."""
 
     days: float
     low: float
     high: float
     why: str
     axis: int | None
+    basis: str
 
 
 def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | None:
@@ -314,7 +316,7 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
         days = number(r.get("days_left"))
         if math.isfinite(days):
             days = max(days, 0.0)
-            found.append((days, days, days, f"load: axis {r.get('axis')}'s rated life", r.get("axis")))
+            found.append((days, days, days, f"load: axis {r.get('axis')}'s rated life", r.get("axis"), "load"))
     for r in rul_rows:
         days = number(r.get("rul"))
         if math.isfinite(days) and r.get("time_unit") == "days":
@@ -322,13 +324,13 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
             early = min(days, low) if math.isfinite(low) else days
             found.append((early, early, max(days, high) if math.isfinite(high) else math.inf,
                           f"condition: axis {r.get('axis')}'s wear" + (", its 5 % quantile" if early < days else ""),
-                          r.get("axis")))
+                          r.get("axis"), "wear"))
     if not found:
         return None
-    days, _, _, why, axis = min(found, key=lambda f: f[0])
+    days, _, _, why, axis, basis = min(found, key=lambda f: f[0])
     axis = number(axis)
     return Service(days, min(f[1] for f in found), min(f[2] for f in found), why,
-                   int(axis) if math.isfinite(axis) and axis == int(axis) else None)
+                   int(axis) if math.isfinite(axis) and axis == int(axis) else None, basis)
 
 
 def date_after(last_stamp: str, days: float) -> str:

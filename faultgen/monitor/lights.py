@@ -233,8 +233,7 @@ def service_cell(unit, lit: Light) -> str:
         low = _short_date(life.date_after(last, service.low), date)
         high = _short_date(life.date_after(last, service.high), date) if math.isfinite(service.high) else "later"
         interval = f"{low} – {high}"
-    source = "wear" if service.why.startswith("condition") else "load"
-    return f'{escaped(date)} <small class="muted">{escaped(interval)}; by {source}, axis {escaped(service.axis)}</small>'
+    return f'{escaped(date)} <small class="muted">{escaped(interval)}; by {service.basis}, axis {escaped(service.axis)}</small>'
 
 
 def wear_cell(unit, axis: int | None) -> str:
