@@ -88,7 +88,7 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
     doubt = np.sqrt(expected[:, 1] ** 2 + (SCALE_UNCERTAINTY * expected[:, 0]) ** 2)
     np.testing.assert_allclose(lower, expected[:, 0] - alarm_quantile() * doubt, rtol=1e-9, atol=1e-9)
     monitoring = [k for k, r in enumerate(rows) if r.phase == "monitoring"]
-    assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= 10.0) for k in monitoring]
+    assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= unit.settings.wear_limit) for k in monitoring]
     assert any(rows[k].alarm for k in monitoring) and unit.alarm.first_alarm is not None
 
 
