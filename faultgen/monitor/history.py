@@ -51,6 +51,15 @@ class Note(str):
         note.kind, note.log, note.column = kind, log, column
         return note
 
+    def document(self) -> dict:
+        """The note as the saved state writes it: ``text``, ``kind`` unless "", and for a column note its
+        ``log`` and the reader's ``column`` note (``text``, ``axis``, ``kind``; read back by :func:`read_unit`)."""
+        out = {"text": str(self), **({"kind": self.kind} if self.kind else {})}
+        if self.column is not None:
+            out.update(log=self.log, column={"text": str(self.column), "axis": self.column.axis,
+                                             "kind": self.column.kind})
+        return out
+
 
 @dataclass(frozen=True)
 class Entry:
@@ -209,9 +218,7 @@ def write_unit(path: Path, state: UnitHistory, settings: dict) -> None:
         "format": FORMAT, "unit": state.unit, "settings": settings,
         "program": list(state.program) if state.program else None,
         "model": state.model, "first": list(state.first),
-        "notes": [{"text": str(n), **({"kind": n.kind} if n.kind else {}), **({} if n.column is None else {
-            "log": n.log, "column": {"text": str(n.column), "axis": n.column.axis, "kind": n.column.kind}})}
-                  for n in state.notes],
+        "notes": [n.document() for n in state.notes],
         "torque_source": state.torque_source, "off_monitor": state.off_monitor,
         "skipped": [{"stamp": k.stamp, "sha256": k.sha256, "reason": k.reason} for k in state.skipped],
         "maintenance": [{"stamp": m.stamp, "event": m.event, "axis": m.axis, "at": m.at} for m in state.maintenance],
