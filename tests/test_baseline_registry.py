@@ -252,7 +252,7 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     from analysis import registry, training_source
     from analysis.monitoring import PCAMonitor
     from faultgen.bench.pca_detector import PCADetector
-    from faultgen.monitor import scoring
+    from faultgen.monitor import scoring, steps
 
     assert baselines.REGISTRY is registry.REGISTRY and baselines.make is registry.make
     role, made = baselines.make("pca_monitor", variance=0.8, alpha=0.01, cv=5)

@@ -130,18 +130,6 @@ def pool(unit: UnitHistory) -> None:
     unit.rows.sort(key=lambda row: row.stamp)
 
 
-def _fit(unit: UnitHistory) -> None:
-    """Learn the baseline on its training logs (:meth:`faultgen.monitor.baseline.Baseline.fit`) and
-    score them; the unit's first program's also starts the wear filter (:meth:`WearEstimator.start`)
-    and keeps what the programs met later borrow (``shared``)."""
-    s = unit.stages
-    stamps, R, error, common = s.baseline.fit()
-    if common is not None:
-        s.shared = common
-        s.wear.start(len(s.baseline.regressors_), error, s.baseline.gram_inv_)
-    score_learning(unit, stamps, R)
-
-
 def score_learning(unit: UnitHistory, stamps: list[str], R: np.ndarray, phase: str | None = None) -> None:
     """The rows of the learning logs ``stamps`` (residuals ``R`` less offset and slopes), in place of
     those listed for them since a program change; ``phase`` "relearning" after a program change,
@@ -169,8 +157,12 @@ def add(unit: UnitHistory, stamp: str, residual: np.ndarray, temperature: float,
         b.training.append((stamp, np.asarray(residual, dtype=float), conditions))
         if expected is not None:
             b.learned_expectations.append(np.asarray(expected, dtype=float))
-        if len(b.training) == b.learning_logs:
-            _fit(unit)
+        if len(b.training) == b.learning_logs:  # learned (Baseline.fit), its logs scored; the first program's
+            stamps, R, error, common = b.fit()  # also starts the wear filter and keeps what later ones borrow
+            if common is not None:
+                s.shared = common
+                s.wear.start(len(b.regressors_), error, b.gram_inv_)
+            score_learning(unit, stamps, R)
         elif b.program_changed:  # listed at once (scored when the learning is complete)
             unit.rows.append(record.listed(unit.unit, stamp, s.n_axes))
             b.placeholders += 1
