@@ -56,7 +56,7 @@ def make_tables() -> tuple[list, list[UnitHistory]]:
     _feed(monitors[2], 30, lambda d: 0.0 if d < 12 or d >= 20 else 25.0, seed=3, repair=20)  # repaired
     _feed(monitors[3], 30, lambda d: 0.0, seed=4)
     _feed(monitors[4], 6, lambda d: 0.0, seed=5)  # still learning
-    assert monitors[0].alarm.first_alarm and monitors[2].alarm.closed and not monitors[2].alarm.first_alarm
+    assert monitors[0].stages.alarm.first_alarm and monitors[2].stages.alarm.closed and not monitors[2].stages.alarm.first_alarm
     statuses = [UnitStatus(m.unit, "monitored" if m.stages.baseline.pca is not None else "learning", "twin", "calibrated",
                            "" if m.stages.baseline.pca is not None else f"learning: {len(m.stages.baseline.training)} of 10 logs", len(m.rows) or
                            len(m.stages.baseline.training),
