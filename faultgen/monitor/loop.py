@@ -441,7 +441,7 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
                 scale_of=lambda name: None, robot: str = "") -> dict[str, UnitHistory]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
-    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.history.replay`).
+    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.steps.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
     itself was checked to lead inside ``out`` by the caller (:func:`faultgen.monitor.state.checked_out`)."""
     folder = out / ".state"
