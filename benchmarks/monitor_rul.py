@@ -175,13 +175,13 @@ def exact_crossing_error(wear: np.ndarray, scale: float, offset: float, start: i
 
 
 def replayed_rows(fleet: Path, out: Path, robot: Path | None = None) -> dict[str, list[dict]] | None:
-    """Each unit's monitor rows (``UnitMonitor.rows``, with the twin-scale columns and the factors
+    """Each unit's monitor rows (``UnitHistory.rows``, with the twin-scale columns and the factors
     scores.csv does not keep) of a run of ``benchmarks/monitor_wear_scale.py`` with friction tests:
     the state in ``out/.state`` replayed with the tests read from ``out``'s cache (the robot
     ``robot``, default ``fleet/kr210``, the logs ``fleet/logs``), as a continued monitor run replays it;
     None without tests."""
     from faultgen.model import robots
-    from faultgen.monitor import friction_tests, history
+    from faultgen.monitor import friction_tests, history, steps
     from faultgen.monitor import logs as fleet_logs
     from faultgen.monitor import state as stored
     from faultgen.monitor.scoring import Settings
@@ -206,7 +206,7 @@ def replayed_rows(fleet: Path, out: Path, robot: Path | None = None) -> dict[str
                                                    "wear_limit")})
         wears, _ = friction_tests.tests_wear(tests.get(name, []), n, ())
         rescale = friction_tests.Rescale(name, n, wears) if wears else None
-        rows[name] = history.replay(kept, settings, n, rescale).rows
+        rows[name] = steps.replay(kept, settings, n, rescale).rows
     return rows
 
 

@@ -106,7 +106,7 @@ def main() -> None:
     if tested and not args.without_tests:  # the rows' twin-scale wear and factors, which scores.csv leaves out
         started = time.perf_counter()
         kept = loop.monitor(resolve_run(robot, logs, out, calibrate=False, failure_wear=failure,
-                                        progress=False)).monitors
+                                        progress=False)).units
         scores = [row for m in kept for row in m.rows]
         print(f"the monitor's rows reloaded from OUT's state (no new log): {time.perf_counter() - started:.0f} s")
     with open(out / "alarms.csv", newline="") as f:

@@ -252,7 +252,7 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     from analysis import registry, training_source
     from analysis.monitoring import PCAMonitor
     from faultgen.bench.pca_detector import PCADetector
-    from faultgen.monitor import scoring
+    from faultgen.monitor import scoring, steps
 
     assert baselines.REGISTRY is registry.REGISTRY and baselines.make is registry.make
     role, made = baselines.make("pca_monitor", variance=0.8, alpha=0.01, cv=5)
@@ -268,11 +268,11 @@ def test_the_monitor_model_is_made_through_the_one_registry_by_every_layer_that_
     # does not ask the registry back)
     fitted = PCADetector().fit(rng.normal(size=(60, 5))).monitor_
     assert fitted.get_params() == entry.factory(variance=0.75, alpha=0.05).get_params() and not calls
-    unit = scoring.UnitMonitor("u", scoring.Settings(protocol="own", train=10), n_axes=1)
+    unit = steps.start("u", scoring.Settings(protocol="own", train=10), n_axes=1)
     for i in range(10):
-        unit.add(f"{i:02d}", rng.normal() * np.ones(4) + 0.1 * rng.normal(size=4), 20.0 + i % 3, 100.0)
-    assert calls[-1] == {"variance": unit.settings.variance, "alpha": unit.settings.alpha, "cv": 5}
-    assert isinstance(unit.baseline.pca, PCAMonitor)
+        steps.add(unit, f"{i:02d}", rng.normal() * np.ones(4) + 0.1 * rng.normal(size=4), 20.0 + i % 3, 100.0)
+    assert calls[-1] == {"variance": unit.stages.settings.variance, "alpha": unit.stages.settings.alpha, "cv": 5}
+    assert isinstance(unit.stages.baseline.pca, PCAMonitor)
     training_source._fit(rng.normal(size=(40, 4)), 0.85, 0.05, None)
     assert calls[-1] == {"variance": 0.85, "alpha": 0.05, "statistic": "q", "cv": None}
     n = len(calls)

@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import loop, scoring
+from faultgen.monitor import loop, scoring, steps
 from faultgen.monitor.run import resolve_run
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.scoring import Settings
 from faultgen.runs.context import ExecutionContext
 from resolved_runs import run_config
 
@@ -224,14 +224,14 @@ def _synthetic_unit(seed: int, wear: float, interval: bool) -> bool:
     Returns whether it raised a persistent alarm."""
     rng = np.random.default_rng(seed)
     slope, direction = rng.normal(0, 1, 12), np.abs(rng.normal(0, 1, 12))
-    unit = UnitMonitor("u", Settings(protocol="own"), n_axes=6)
+    unit = steps.start("u", Settings(protocol="own"), n_axes=6)
     if not interval:
-        unit.baseline.prediction_factor = lambda conditions: 1.0
+        unit.stages.baseline.prediction_factor = lambda conditions: 1.0
     for i in range(90):
         temperature = rng.uniform(*((20, 24) if i < 28 else (26, 34)))
         residual = slope * temperature + rng.normal(0, 1, 12) + wear * 0.2 * max(i - 40, 0) * direction
-        unit.add(f"{i:03d}", residual, temperature, 100.0)
-    return unit.alarm.first_alarm is not None
+        steps.add(unit, f"{i:03d}", residual, temperature, 100.0)
+    return unit.stages.alarm.first_alarm is not None
 
 
 def test_warmer_logs_than_the_learning_ones_do_not_alarm_a_healthy_unit_and_a_worn_one_still_alarms():
@@ -246,13 +246,13 @@ def test_warmer_logs_than_the_learning_ones_do_not_alarm_a_healthy_unit_and_a_wo
 
 def test_the_prediction_interval_is_one_plus_the_learning_mean_inside_and_grows_outside():
     rng = np.random.default_rng(0)
-    unit = UnitMonitor("u", Settings(protocol="own", train=10), n_axes=1)
+    unit = steps.start("u", Settings(protocol="own", train=10), n_axes=1)
     temperatures = np.linspace(20.0, 24.0, 10)
     for i, t in enumerate(temperatures):
-        unit.add(f"{i:02d}", rng.normal(0, 1, 3) + t, t, 100.0)
+        steps.add(unit, f"{i:02d}", rng.normal(0, 1, 3) + t, t, 100.0)
     sxx = np.sum((temperatures - temperatures.mean()) ** 2)
-    assert unit.baseline.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
-    assert unit.baseline.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
+    assert unit.stages.baseline.prediction_factor(np.array([22.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10))
+    assert unit.stages.baseline.prediction_factor(np.array([30.0, 100.0])) == pytest.approx(np.sqrt(1 + 1 / 10 + 8.0**2 / sxx))
 
 
 def test_the_wear_estimate_is_weighted_least_squares_of_the_friction_torques_along_each_signature():
@@ -263,20 +263,20 @@ def test_the_wear_estimate_is_weighted_least_squares_of_the_friction_torques_alo
     assert scoring.FEATURES[2] == "friction_torque" and scoring.WEAR_FEATURES == ("friction_torque",)
     rng = np.random.default_rng(1)
     signatures = rng.normal(0, 1, (6, 18))
-    unit = UnitMonitor("u", Settings(), n_axes=6, signatures=signatures)
-    np.testing.assert_array_equal(unit.baseline.wear_columns(), np.arange(12, 18))
+    unit = steps.start("u", Settings(), n_axes=6, signatures=signatures)
+    np.testing.assert_array_equal(unit.stages.baseline.wear_columns(), np.arange(12, 18))
     variance = rng.uniform(0.5, 2.0, 18)
-    estimate, error = unit.baseline.wear_estimate(7.0 * signatures[2], variance)
+    estimate, error = unit.stages.baseline.wear_estimate(7.0 * signatures[2], variance)
     assert estimate[2] == pytest.approx(7.0)
     assert error[2] == pytest.approx(1.0 / np.sqrt(np.sum(signatures[2, 12:] ** 2 / variance[12:])))
-    estimate4, error4 = unit.baseline.wear_estimate(7.0 * signatures[2], 4.0 * variance)
+    estimate4, error4 = unit.stages.baseline.wear_estimate(7.0 * signatures[2], 4.0 * variance)
     np.testing.assert_allclose(estimate4, estimate)
     np.testing.assert_allclose(error4, 2.0 * error)
     other = np.where(np.arange(18) < 12, rng.normal(0, 1, 18), 0.0)  # only the RMS and load torques change
-    np.testing.assert_allclose(unit.baseline.wear_estimate(7.0 * signatures[2] + other, variance)[0], estimate, rtol=1e-12)
-    assert UnitMonitor("u", Settings(protocol="own"), n_axes=6).baseline.wear_estimate(signatures[2], variance) is None
+    np.testing.assert_allclose(unit.stages.baseline.wear_estimate(7.0 * signatures[2] + other, variance)[0], estimate, rtol=1e-12)
+    assert steps.start("u", Settings(protocol="own"), n_axes=6).stages.baseline.wear_estimate(signatures[2], variance) is None
     with pytest.raises(ValueError, match=r"wear signatures of shape \(6, 12\); expected \(6, 18\)"):
-        UnitMonitor("u", Settings(), n_axes=6, signatures=signatures[:, :12]).baseline.wear_estimate(np.zeros(12), np.ones(12))
+        steps.start("u", Settings(), n_axes=6, signatures=signatures[:, :12]).stages.baseline.wear_estimate(np.zeros(12), np.ones(12))
 
 
 def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit():
@@ -285,20 +285,20 @@ def test_a_twin_unit_alarms_when_the_lower_bound_of_its_wear_reaches_the_limit()
     # not before the true wear itself is at the limit
     rng = np.random.default_rng(2)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05  # feature units per %
-    unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=40), n_axes=6, signatures=signatures)
     for i in range(200):
         wear = max(i - 60, 0) * 0.5
-        unit.add(f"{i:03d}", rng.normal(0, 0.1, 18) + wear * signatures[1], 30.0, 100.0, np.zeros(18))
-    assert unit.alarm.first_alarm is not None and unit.alarm.source_axis == 2 and unit.alarm.statistic == "wear"
-    first = int(unit.alarm.first_alarm)
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.1, 18) + wear * signatures[1], 30.0, 100.0, np.zeros(18))
+    assert unit.stages.alarm.first_alarm is not None and unit.stages.alarm.source_axis == 2 and unit.stages.alarm.statistic == "wear"
+    first = int(unit.stages.alarm.first_alarm)
     rows = {r.stamp: r for r in unit.rows}
-    limit = unit.settings.wear_limit
+    limit = unit.stages.settings.wear_limit
     assert limit == 8.0
     assert all(max(rows[f"{k:03d}"].wear.lower) >= limit for k in range(first, first + 5))
     assert max(rows[f"{first - 1:03d}"].wear.lower) < limit  # else it began earlier
     true_wear = (first - 60) * 0.5
     assert limit <= true_wear < limit + 10.0, true_wear
-    assert "axis 2 wear estimate" in unit.alarm_row()["evidence"]
+    assert "axis 2 wear estimate" in steps.alarm_row(unit)["evidence"]
 
 
 @pytest.mark.parametrize(("temperature", "payload", "worn_axis"), [(None, 0.0, 0), (20.0, 0.0, 3), (0.0, 12.5, 0),
@@ -742,7 +742,7 @@ def test_two_jobs_give_the_outputs_of_one(fleet, monitored, tmp_path):
     before = {p: p.stat().st_mtime_ns for p in (out / ".cache" / "cycles").iterdir()}
     outcome = loop.monitor(resolve_run(robot, partial, out, calibrate=False, settings=SETTINGS, progress=False,
                                        context=ExecutionContext(jobs=2)))
-    assert all(len(m.rows) == SPEC.days for m in outcome.monitors)
+    assert all(len(m.rows) == SPEC.days for m in outcome.units)
     assert {p: p.stat().st_mtime_ns for p in before} == before  # no simulated cycle redone
     cycles = {p.name: p.read_bytes() for p in (out / ".cache" / "cycles").iterdir()}
     assert cycles == {p.name: p.read_bytes() for p in (monitored / ".cache" / "cycles").iterdir()}

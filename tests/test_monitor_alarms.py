@@ -3,7 +3,7 @@
 wear's lower bound passes the limit by its own width, an alarm under way closed by a gearbox change,
 an axis the program does not excite called not observable (no wear, trend or remaining life),
 rul.csv's wear that of wear.csv, the chance statement only where it says something, and a program
-change's relearning logs listed as such. On :class:`faultgen.monitor.scoring.UnitMonitor` fed
+change's relearning logs listed as such. On a unit's record (:func:`faultgen.monitor.steps.start`) fed
 synthetic residuals along known wear signatures (each axis's friction torque only), the alarms
 checked against a reading of its own rows that does not use its persistence logic."""
 
@@ -15,10 +15,10 @@ from statistics import NormalDist
 import numpy as np
 import pytest
 
-from faultgen.monitor import lights, page, prognosis, report
+from faultgen.monitor import lights, page, prognosis, report, steps
 from faultgen.monitor.loop import UnitStatus
-from faultgen.monitor.scoring import (FEATURES, NOT_OBSERVABLE, NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL, Settings,
-                                      UnitMonitor)
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.scoring import FEATURES, NOT_OBSERVABLE, NOT_OBSERVABLE_LIMITS, WEAR_INTERVAL, Settings
 
 N_AXES = 3
 NOISE = 0.05  # feature noise (N m)
@@ -35,12 +35,12 @@ def _signatures(per_axis: np.ndarray) -> np.ndarray:
     return signatures
 
 
-def _feed(unit: UnitMonitor, wear: np.ndarray, rng, first: int = 0, stop=None, noise: float = NOISE) -> None:
+def _feed(unit: UnitHistory, wear: np.ndarray, rng, first: int = 0, stop=None, noise: float = NOISE) -> None:
     """Logs ``first``.. with true wear ``wear`` (n_logs, n_axes) %, stamps their index, features with
     ``noise``; ``stop(unit)`` True ends the feed after a log."""
     for i, w in enumerate(wear):
-        unit.add(f"{first + i:03d}", rng.normal(0, noise, unit.baseline.signatures.shape[1]) + w @ unit.baseline.signatures, 30.0, 0.0,
-                 np.zeros(unit.baseline.signatures.shape[1]))
+        steps.add(unit, f"{first + i:03d}", rng.normal(0, noise, unit.stages.baseline.signatures.shape[1]) + w @ unit.stages.baseline.signatures, 30.0, 0.0,
+                 np.zeros(unit.stages.baseline.signatures.shape[1]))
         if stop is not None and stop(unit):
             return
 
@@ -74,51 +74,51 @@ def test_the_alarm_is_known_on_the_fifth_alarming_log_and_starts_from_the_first(
     """A slow ramp (0.1 % per log) read with 3 points of error a log: the bound crosses the limit
     long before it passes it by its own width, so persistence makes the alarm."""
     rng = np.random.default_rng(1)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(200, 2, 35, 0.1), rng, noise=0.15)
     first, known, at_once = _reference(_monitoring(unit))
-    assert (unit.alarm.first_alarm, unit.alarm.known, at_once) == (first, known, False)
+    assert (unit.stages.alarm.first_alarm, unit.stages.alarm.known, at_once) == (first, known, False)
     stamps = [r.stamp for r in unit.rows]
     assert stamps.index(known) - stamps.index(first) == SETTINGS.persistence - 1
-    row = unit.alarm_row()
+    row = steps.alarm_row(unit)
     assert (row["first_alarm"], row["known"], row["source_axis"]) == (first, known, 2)
     assert lights.alarm_dates(row) == f"known {known} (from {first})"
 
 
 def test_a_lower_bound_past_the_limit_by_its_own_width_alarms_at_once():
     rng = np.random.default_rng(2)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     wear = np.zeros((60, N_AXES))
     wear[40:, 0] = np.linspace(40.0, 60.0, 20)  # a gearbox damaged at once
     _feed(unit, wear, rng)
     first, known, at_once = _reference(_monitoring(unit))
-    assert (unit.alarm.first_alarm, unit.alarm.known, at_once, unit.alarm.source_axis) == (first, known, True, 1)
+    assert (unit.stages.alarm.first_alarm, unit.stages.alarm.known, at_once, unit.stages.alarm.source_axis) == (first, known, True, 1)
     stamps = [r.stamp for r in unit.rows]
     assert "040" <= first and stamps.index(known) - stamps.index(first) < SETTINGS.persistence - 1
-    assert "at once" in unit.alarm.evidence
+    assert "at once" in unit.stages.alarm.evidence
 
 
 def test_an_alarm_under_way_at_a_gearbox_change_is_closed_by_it_not_forgotten():
     rng = np.random.default_rng(3)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     wear = _ramp(200, 3, 35, 0.1)
 
     def two_alarming(u):
         return len(u.rows) >= 2 and u.rows[-1].alarm and u.rows[-2].alarm and u.rows[-1].phase == "monitoring"
 
     _feed(unit, wear, rng, stop=two_alarming, noise=0.15)
-    assert unit.alarm.first_alarm is None and unit.alarm.run == 2
+    assert unit.stages.alarm.first_alarm is None and unit.stages.alarm.run == 2
     first, last = unit.rows[-2].stamp, unit.rows[-1].stamp
     change = f"{len(unit.rows):03d}"
-    unit.maintenance(change, "gearbox change", 3)
-    closed, current = unit.alarm_rows()
+    steps.maintenance(unit, change, "gearbox change", 3)
+    closed, current = steps.alarm_rows(unit)
     assert (closed["first_alarm"], closed["known"], closed["source_axis"]) == (first, last, 3)
     assert closed["closed"] == change and closed["closed_by"] == "gearbox change of axis 3"
     assert f"not yet persistent (2 of {SETTINGS.persistence} logs)" in closed["evidence"]
     assert current["first_alarm"] == "" and current["evidence"].startswith(
         f"no persistent alarm since the gearbox change of axis 3 of {change}"), current
     _feed(unit, np.zeros((8, N_AXES)), rng, first=len(unit.rows))
-    assert "(8 logs since" in unit.alarm_row()["evidence"]
+    assert "(8 logs since" in steps.alarm_row(unit)["evidence"]
 
 
 def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbers(tmp_path):
@@ -127,18 +127,18 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     110 points against 2 for the others; the rule's threshold is 6 wear limits (60 points)."""
     rng = np.random.default_rng(4)
     per_axis = np.array([0.08, 0.0015, 0.08])
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(per_axis))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(per_axis))
     wear = np.zeros((50, N_AXES))
     wear[30:, 1] = 300.0  # even a huge change along it: the noise's, not wear the logs can tell
     _feed(unit, wear, rng)
     z = NormalDist().inv_cdf(0.5 + WEAR_INTERVAL / 2)
-    np.testing.assert_allclose(unit.baseline.width_, 2 * z * NOISE / per_axis, rtol=0.35)
-    assert unit.baseline.observable_.tolist() == [True, False, True]
-    assert unit.baseline.width_[1] > NOT_OBSERVABLE_LIMITS * SETTINGS.wear_limit > unit.baseline.width_[0]
+    np.testing.assert_allclose(unit.stages.baseline.width_, 2 * z * NOISE / per_axis, rtol=0.35)
+    assert unit.stages.baseline.observable_.tolist() == [True, False, True]
+    assert unit.stages.baseline.width_[1] > NOT_OBSERVABLE_LIMITS * SETTINGS.wear_limit > unit.stages.baseline.width_[0]
     assert all(np.isnan(r.wear.estimate[1]) and np.isnan(r.wear.log[1]) and np.isfinite(r.wear.estimate[0])
                for r in unit.rows)
-    assert not any(r.alarm for r in unit.rows) and unit.alarm.first_alarm is None
-    assert "axis 2 " + NOT_OBSERVABLE in unit.not_observable_note()
+    assert not any(r.alarm for r in unit.rows) and unit.stages.alarm.first_alarm is None
+    assert "axis 2 " + NOT_OBSERVABLE in steps.not_observable_note(unit.stages)
     report.wear_table([unit]).write(tmp_path)
     report.scores_table([unit], N_AXES).write(tmp_path)
     wear_rows = list(csv.DictReader(open(tmp_path / "wear.csv")))
@@ -151,7 +151,7 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
     report.chart(io.BytesIO(), unit, "wear signature match")  # an axis without wear drawn as none
     # the page: the axis named as such in the unit's panel, no wear number for it
     report.alarms_table([unit]).write(tmp_path)
-    report.units_table([UnitStatus("u", "monitored", "twin", "nominal", unit.not_observable_note(), 50,
+    report.units_table([UnitStatus("u", "monitored", "twin", "nominal", steps.not_observable_note(unit.stages), 50,
                                    "049")]).write(tmp_path)
     html = page.build(page.read(tmp_path), {})
     assert f"<li>axis 2: {NOT_OBSERVABLE} (no wear" in html and "<li>axis 1: " in html
@@ -159,7 +159,7 @@ def test_an_axis_the_program_does_not_excite_is_not_observable_and_gets_no_numbe
 
 def test_rul_csv_wear_is_wear_csv_wear(tmp_path):
     rng = np.random.default_rng(5)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(70, 1, 30, 0.8), rng)
     report.wear_table([unit]).write(tmp_path)
     prognosis.rul_table(prognosis.of_monitor(unit, samples=100)).write(tmp_path)
@@ -182,25 +182,25 @@ def test_the_chance_statement_only_where_it_says_something():
 
 def test_a_program_changes_relearning_logs_are_listed_and_counted():
     rng = np.random.default_rng(6)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, np.zeros((30, N_AXES)), rng)
-    unit.restart("030", "program change")
+    steps.restart(unit, "030", "program change")
     _feed(unit, np.zeros((12, N_AXES)), rng, first=30)
     assert len(unit.rows) == 42 and [r.phase for r in unit.rows[30:]] == ["relearning"] * 12
-    assert unit.alarm_row()["evidence"] == f"learning again after the program change of 030: 12 of {SETTINGS.train} logs"
+    assert steps.alarm_row(unit)["evidence"] == f"learning again after the program change of 030: 12 of {SETTINGS.train} logs"
     report.chart(io.BytesIO(), unit, "wear signature match")  # rows without scores drawn as gaps
     _feed(unit, np.zeros((15, N_AXES)), rng, first=42)
     phases = [r.phase for r in unit.rows]
     assert len(phases) == 57 and [r.stamp for r in unit.rows] == [f"{i:03d}" for i in range(57)]
     assert phases[30:] == ["relearning"] * SETTINGS.train + ["monitoring"] * 7
     assert all(np.isfinite(r.Q) for r in unit.rows)
-    assert unit.alarm_row()["evidence"].startswith("no persistent alarm since the program change of 030 (27 logs")
+    assert steps.alarm_row(unit)["evidence"].startswith("no persistent alarm since the program change of 030 (27 logs")
 
 
 @pytest.mark.parametrize("known", [True, False])
 def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tmp_path, known):
     rng = np.random.default_rng(1)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(200, 2, 35, 0.1), rng, noise=0.15)
     report.alarms_table([unit]).write(tmp_path)
     report.scores_table([unit], N_AXES).write(tmp_path)
@@ -212,7 +212,7 @@ def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tm
             writer.writeheader()
             writer.writerows(rows)
     html = page.build(page.read(tmp_path), {"protocol": "twin", "alpha": 0.01, "persistence": 5, "train": 20})
-    when = f"known {unit.alarm.known} (from {unit.alarm.first_alarm})" if known else f"from {unit.alarm.first_alarm}"
+    when = f"known {unit.stages.alarm.known} (from {unit.stages.alarm.first_alarm})" if known else f"from {unit.stages.alarm.first_alarm}"
     assert f"<b>Open alarm</b> {when} on axis 2" in html
     assert f"open alarm {when} on axis 2" in html  # the light's rule
     assert "1 of 1 units alarm.</p>" in html  # the chance statement says nothing here: left out
@@ -229,7 +229,7 @@ def test_forked_workers_draw_on_figures_of_their_own():
     forked children drawing a log axis 40 times each: 2 bad draws in each), so the test asserts its
     cause: the parent's figure in the child."""
     rng = np.random.default_rng(7)
-    unit = UnitMonitor("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
+    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
     _feed(unit, _ramp(40, 1, 25, 0.8), rng)
 
     def png() -> bytes:

@@ -99,7 +99,7 @@ def test_an_unchanged_events_csv_keeps_the_state_and_scores_only_the_new_logs(fl
     score_log = feed.score_log
 
     def counted(unit, log, *args, **kwargs):
-        scored.append(f"{unit.monitor.unit}/{log.stamp}")
+        scored.append(f"{unit.unit}/{log.stamp}")
         return score_log(unit, log, *args, **kwargs)
 
     monkeypatch.setattr(feed, "score_log", counted)

@@ -63,7 +63,7 @@ def test_a_record_is_read_back_field_for_field_with_its_notes_kinds(tmp_path):
         [(c.stamp, c.program, c.at, c.source) for c in record.program_changes]
     assert [(e.stamp, e.sha256, e.payload, e.duration, e.program) for e in back.entries] == \
         [(e.stamp, e.sha256, e.payload, e.duration, e.program) for e in record.entries]
-    assert back.monitor is None and back.program_twins == {}
+    assert back.stages is None and back.rows == [] and back.program_twins == {}
     history.write_unit(path, back, SETTINGS)
     assert path.read_bytes() == written  # written again byte for byte: nothing lost or reordered
     assert [n.kind for n in back.notes] == [history.FALLBACK, "", history.COLUMN]

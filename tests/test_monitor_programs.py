@@ -16,7 +16,7 @@ import pytest
 
 from faultgen.bench import independent
 from faultgen.logs import align
-from faultgen.monitor import feed, loop, programs
+from faultgen.monitor import feed, loop, programs, steps
 from faultgen.monitor import state as stored
 from faultgen.monitor import unit as unit_module
 from faultgen.monitor.run import resolve_run
@@ -173,20 +173,18 @@ def _feed(days, seed=0, train=15):
     """A synthetic unit fed the program of each day of ``days`` (0, 1, 2: met in that order), a log a day:
     each program's own offset (far apart: what the twin's residual keeps of its model's error on that
     motion), the shared temperature slope and noise. Returns the monitor, its baselines and the logs."""
-    from faultgen.monitor.scoring import UnitMonitor
-
     rng = np.random.default_rng(seed)
     offsets = rng.normal(0.0, 5.0, (3, 6))
-    monitor = UnitMonitor("u", Settings(train=train, persistence=3), 2, _signatures(0))
-    baselines = programs.baselines_of(monitor)
+    monitor = steps.start("u", Settings(train=train, persistence=3), 2, _signatures(0))
+    baselines = monitor.stages.programs
     logs = []
     for day, k in enumerate(days):
         if k == len(baselines.saved) + 1:
-            baselines.new(monitor, _signatures(k))
+            baselines.new(monitor.stages, _signatures(k))
         temperature = 25.0 + 8.0 * np.sin(day / 5.0)
         residual = offsets[k] + SLOPE * (temperature - 25.0) + rng.normal(0.0, 0.01, 6)
         stamp = f"2026-01-{day + 1:02d}" if day < 31 else f"2026-02-{day - 30:02d}"
-        baselines.run(monitor, k, lambda: monitor.add(stamp, residual, temperature, 10.0))
+        steps.run(monitor, k, lambda: steps.add(monitor, stamp, residual, temperature, 10.0))
         logs.append((stamp, k, residual, temperature))
     return monitor, baselines, logs
 
@@ -194,7 +192,7 @@ def _feed(days, seed=0, train=15):
 def test_a_unit_alternating_three_programs_is_monitored_after_train_logs_in_all():
     days = [0, 1, 2] * 8  # a program a day in turn
     monitor, baselines, logs = _feed(days)
-    assert monitor.baseline.pca is not None and all(b.pca is not None for b in baselines.saved)
+    assert monitor.stages.baseline.pca is not None and all(b.pca is not None for b in baselines.saved)
     phases = [(row.stamp, row.phase) for row in monitor.rows]
     assert phases == [(s, "training") for s, _, _, _ in logs[:15]] + [(s, "monitoring") for s, _, _, _ in logs[15:]]
     # the offsets and the shared slope: the dummy-variable least squares of the 15 learning logs (fixed effects)
@@ -202,28 +200,28 @@ def test_a_unit_alternating_three_programs_is_monitored_after_train_logs_in_all(
     T = np.array([t for _, _, _, t in logs[:15]])
     design = np.column_stack([np.eye(3)[k], T - T.mean()])
     solution = np.linalg.lstsq(design, np.stack([e for _, _, e, _ in logs[:15]]), rcond=None)[0]
-    learned = [monitor.baseline.mean_] + [b.mean_ for b in baselines.saved]
+    learned = [monitor.stages.baseline.mean_] + [b.mean_ for b in baselines.saved]
     np.testing.assert_allclose(np.stack(learned), solution[:3], atol=1e-9)
-    np.testing.assert_allclose(monitor.baseline.slope_[0], solution[3], atol=1e-9)
-    assert all(b.pca is monitor.baseline.pca and b.learned_ == 5 for b in baselines.saved)
+    np.testing.assert_allclose(monitor.stages.baseline.slope_[0], solution[3], atol=1e-9)
+    assert all(b.pca is monitor.stages.baseline.pca and b.learned_ == 5 for b in baselines.saved)
     wear = np.stack([row.wear.log for row in monitor.rows if row.phase == "monitoring"])
-    assert np.all(np.abs(wear) < 5.0) and monitor.alarm.first_alarm is None  # each program read on its own offset
+    assert np.all(np.abs(wear) < 5.0) and monitor.stages.alarm.first_alarm is None  # each program read on its own offset
 
 
 def test_a_program_met_after_learning_is_scored_after_its_short_relearning():
     days = [0] * 15 + [1, 0] * 7  # program 2 from day 16, every other day
     monitor, baselines, logs = _feed(days, seed=1)
     (saved,) = baselines.saved
-    relearn = monitor.baseline.relearn_logs
-    assert relearn == 5 and saved.pca is monitor.baseline.pca and saved.slope_ is monitor.baseline.slope_
+    relearn = monitor.stages.baseline.relearn_logs
+    assert relearn == 5 and saved.pca is monitor.stages.baseline.pca and saved.slope_ is monitor.stages.baseline.slope_
     second = [(s, e, t) for s, k, e, t in logs if k == 1]
     phases = {row.stamp: row.phase for row in monitor.rows}
     assert [phases[s] for s, _, _ in second] == ["relearning"] * relearn + ["monitoring"] * (len(second) - relearn)
     assert [phases[s] for s, k, _, _ in logs[15:] if k == 0] == ["monitoring"] * 7  # program 1 scored throughout
-    own = np.stack([e - (t - monitor.baseline.condition_mean_[0]) * monitor.baseline.slope_[0] for _, e, t in second[:relearn]])
+    own = np.stack([e - (t - monitor.stages.baseline.condition_mean_[0]) * monitor.stages.baseline.slope_[0] for _, e, t in second[:relearn]])
     np.testing.assert_allclose(saved.mean_, own.mean(axis=0), atol=1e-12)
     assert [row.stamp for row in monitor.rows] == sorted(row.stamp for row in monitor.rows)
-    assert "learning" not in programs.mix_note(monitor, [], 2)  # learned: no longer listed as learning
+    assert "learning" not in programs.mix_note(monitor.stages, [], 2)  # learned: no longer listed as learning
 
 
 def test_a_program_with_too_few_logs_in_the_pooled_learning_learns_its_offset_after():
@@ -231,5 +229,5 @@ def test_a_program_with_too_few_logs_in_the_pooled_learning_learns_its_offset_af
     monitor, baselines, logs = _feed(days, seed=2)
     (saved,) = baselines.saved
     phases = [row.phase for row in monitor.rows if row.stamp in {s for s, k, _, _ in logs if k == 1}]
-    assert phases == ["relearning"] * 5 and saved.pca is monitor.baseline.pca
+    assert phases == ["relearning"] * 5 and saved.pca is monitor.stages.baseline.pca
     assert [row.phase for row in monitor.rows if row.stamp == logs[-1][0]] == ["monitoring"]

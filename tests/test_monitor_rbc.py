@@ -12,9 +12,9 @@ import pandas as pd
 import pytest
 
 from faultgen.model import robots
-from faultgen.monitor import loop
+from faultgen.monitor import loop, steps
 from faultgen.monitor.run import resolve_run
-from faultgen.monitor.scoring import FEATURES, Settings, UnitMonitor
+from faultgen.monitor.scoring import FEATURES, Settings
 
 sys.path.insert(0, str(Path(__file__).parent))
 import fleetlog_folder  # noqa: E402
@@ -65,13 +65,13 @@ def test_the_step_fleet_alarm_names_axis_2_by_rbc_where_the_share_of_q_names_axi
     assert alarms["u1"]["source_axis"] == "2", alarms["u1"]
     assert "axis 2 first by reconstruction-based contribution to Q" in alarms["u1"]["evidence"]
     # the same alarm's logs ranked by each axis's share of Q (the complete decomposition, before RBC)
-    unit = next(m for m in outcome.monitors if m.unit == "u1")
-    mean = np.mean([z for _, z, *_ in unit.alarm.window], axis=0)[None]
-    axes = [np.arange(len(FEATURES)) * unit.n_axes + a for a in range(unit.n_axes)]
-    share = unit.baseline.pca.contributions(mean, "q", groups=axes)[0]
+    unit = next(m for m in outcome.units if m.unit == "u1")
+    mean = np.mean([z for _, z, *_ in unit.stages.alarm.window], axis=0)[None]
+    axes = [np.arange(len(FEATURES)) * unit.stages.n_axes + a for a in range(unit.stages.n_axes)]
+    share = unit.stages.baseline.pca.contributions(mean, "q", groups=axes)[0]
     assert np.argmax(share) + 1 == 3, share
-    np.testing.assert_allclose(unit.baseline.axis_scores(mean),
-                               unit.baseline.pca.contributions(mean, "q", method="rbc", groups=axes)[0])
+    np.testing.assert_allclose(unit.stages.baseline.axis_scores(mean),
+                               unit.stages.baseline.pca.contributions(mean, "q", method="rbc", groups=axes)[0])
 
 
 def _unit_with_a_step_on_axis_2(seed: int, share_of_q: bool) -> int | None:
@@ -80,16 +80,16 @@ def _unit_with_a_step_on_axis_2(seed: int, share_of_q: bool) -> int | None:
     after 40 logs a step along axis 2's three features grows by one noise standard deviation a log.
     Returns the source axis of its alarm (None without one)."""
     rng = np.random.default_rng(seed)
-    unit = UnitMonitor("u", Settings(protocol="own", train=28, persistence=5), n_axes=6)
+    unit = steps.start("u", Settings(protocol="own", train=28, persistence=5), n_axes=6)
     if share_of_q:
-        unit.baseline.axis_scores = lambda z: unit.baseline.pca.contributions(np.atleast_2d(z), "q").mean(axis=0).reshape(-1, 6).sum(0)
+        unit.stages.baseline.axis_scores = lambda z: unit.stages.baseline.pca.contributions(np.atleast_2d(z), "q").mean(axis=0).reshape(-1, 6).sum(0)
     axis2, axis3 = np.arange(3) * 6 + 1, np.arange(3) * 6 + 2
     for i in range(60):
         residual, load = rng.normal(0, 1, 18), rng.normal()
         residual[axis2] = load + 0.1 * rng.normal(size=3) + max(0, i - 39)
         residual[axis3] = load + rng.normal(size=3)
-        unit.add(f"{i:03d}", residual, float("nan"), float("nan"))
-    return unit.alarm.source_axis
+        steps.add(unit, f"{i:03d}", residual, float("nan"), float("nan"))
+    return unit.stages.alarm.source_axis
 
 
 def test_a_step_along_an_axis_correlated_with_another_is_named_right_by_rbc_on_every_draw():

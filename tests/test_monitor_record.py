@@ -8,16 +8,17 @@ import io
 import numpy as np
 import pytest
 
-from faultgen.monitor import record, report, tables
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor import record, report, steps, tables
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.scoring import Settings
 
 
-def _unit(seed: int = 4) -> UnitMonitor:
+def _unit(seed: int = 4) -> UnitHistory:
     rng = np.random.default_rng(seed)
     signatures = np.abs(rng.normal(0, 1, (3, 9))) * 0.05
-    unit = UnitMonitor("u", Settings(train=12), n_axes=3, signatures=signatures)
+    unit = steps.start("u", Settings(train=12), n_axes=3, signatures=signatures)
     for i in range(30):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 9) + max(i - 15, 0) * signatures[1], 30.0, 0.0, np.zeros(9))
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 9) + max(i - 15, 0) * signatures[1], 30.0, 0.0, np.zeros(9))
     return unit
 
 

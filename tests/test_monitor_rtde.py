@@ -23,8 +23,9 @@ from faultgen.bench import twin
 from faultgen.bench.rawlogs import Written
 from faultgen.data import fleetlogs
 from faultgen.model import robots
-from faultgen.monitor import lights, page
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor import lights, page, steps
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.scoring import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -112,16 +113,16 @@ N_FEATURES = 9  # 3 per axis of 3
 OWN = Settings(protocol="own", train=20)
 
 
-def _own(step: float, seed: int = 4, n: int = 40, at: int = 30) -> tuple[UnitMonitor, np.ndarray]:
+def _own(step: float, seed: int = 4, n: int = 40, at: int = 30) -> tuple[UnitHistory, np.ndarray]:
     """An own-protocol monitor fed ``n`` logs of correlated Gaussian residuals, feature 0 stepped by
     ``step`` standard deviations from log ``at``; returns it and its learning logs' residuals."""
     rng = np.random.default_rng(seed)
     mixing = np.eye(N_FEATURES) + 0.4 * rng.normal(size=(N_FEATURES, N_FEATURES))
     residuals = rng.normal(size=(n, N_FEATURES)) @ mixing
     residuals[at:, 0] += step * residuals[:OWN.train, 0].std(ddof=1)
-    unit = UnitMonitor("u", OWN, 3)
+    unit = steps.start("u", OWN, 3)
     for k, e in enumerate(residuals):
-        unit.add(f"{k:03d}", e, 30.0, 0.0)
+        steps.add(unit, f"{k:03d}", e, 30.0, 0.0)
     return unit, residuals[:OWN.train]
 
 
@@ -134,13 +135,13 @@ def _far_limits(training: np.ndarray) -> tuple[float, float]:
 def test_protocol_own_alarms_at_once_on_a_log_past_its_limits_at_alpha_to_the_persistence():
     unit, training = _own(step=60.0)
     t2_far, q_far = _far_limits(training)
-    assert unit.baseline.far_ == pytest.approx((t2_far, q_far), rel=1e-9)
+    assert unit.stages.baseline.far_ == pytest.approx((t2_far, q_far), rel=1e-9)
     rows = [r for r in unit.rows if r.phase == "monitoring"]
     # the reference: the first log past either far limit, read off the rows
     past = [r.stamp for r in rows if r.T2 > t2_far or r.Q > q_far]
     assert past and past[0] == "030"
-    assert (unit.alarm.first_alarm, unit.alarm.known) == ("030", "030")
-    assert f"at once: T2 or Q past its limit at alpha^{OWN.persistence}" in unit.alarm.evidence
+    assert (unit.stages.alarm.first_alarm, unit.stages.alarm.known) == ("030", "030")
+    assert f"at once: T2 or Q past its limit at alpha^{OWN.persistence}" in unit.stages.alarm.evidence
     assert not [r for r in rows if r.stamp < "030" and r.alarm]  # quiet before it
 
 
@@ -151,8 +152,8 @@ def test_protocol_own_waits_for_persistence_below_its_far_limits():
     alarming = [r.stamp for r in rows if r.alarm]
     assert alarming[:OWN.persistence] == [f"{k:03d}" for k in range(30, 30 + OWN.persistence)]
     assert all(r.T2 <= t2_far and r.Q <= q_far for r in rows)  # never far past
-    assert (unit.alarm.first_alarm, unit.alarm.known) == ("030", f"{30 + OWN.persistence - 1:03d}")
-    assert "at once" not in unit.alarm.evidence
+    assert (unit.stages.alarm.first_alarm, unit.stages.alarm.known) == ("030", f"{30 + OWN.persistence - 1:03d}")
+    assert "at once" not in unit.stages.alarm.evidence
 
 
 def test_a_program_changes_relearning_is_named_so_on_the_chart_and_maintenances_as_before(tmp_path):

@@ -47,7 +47,7 @@ TORQUE_CONSTANTS = (12.0, 12.0, 12.0, 9.0, 9.0, 9.0)
 CONTROLLER = (1.04, 0.97, 1.05, 1.03, 0.96, 1.04)
 #: Logs a baseline learns from (the monitor's fewest).
 TRAIN = 10
-#: The logs a baseline met after the unit learned learns its offset on (UnitMonitor.relearn_logs).
+#: The logs a baseline met after the unit learned learns its offset on (Baseline.relearn_logs).
 RELEARN = max(5, TRAIN // 4)
 #: Days unworn, then days of axis 2's linear wear to FINAL_WEAR %; the source switches on day SWITCH.
 UNWORN, WEARING, WORN_AXIS, FINAL_WEAR = 2 * TRAIN + 1, 10, 2, 20.0

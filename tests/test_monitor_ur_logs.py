@@ -36,7 +36,7 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 from faultgen.logs import formats
 from faultgen.model import robots
-from faultgen.monitor import feed, lights, loop, page, report, tables
+from faultgen.monitor import feed, lights, loop, page, report, scoring, steps, tables
 from faultgen.monitor import logs as fleet_logs
 from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
@@ -244,12 +244,12 @@ def test_a_twin_fallen_back_to_the_nominal_model_labels_its_wear_so(tmp_path):
     rows = _rows(tmp_path / "units.csv")
     assert [r["wear_scale"] for r in rows] == ["twin", "nominal model"] and "torque_source" not in rows[0]
     assert statuses[1].basis() == "; twin fallback: the twin of the calibrated model failed (qdd)"
-    class Monitor:  # one scored log of two axes, as UnitMonitor.rows holds it
-        def __init__(self, unit):
-            self.unit, self.n_axes = unit, 2
-            self.rows = tables.log_rows([{"unit": unit, "stamp": "2026-04-01", "phase": "monitoring",
-                                          **{f"wear{k}{end}": 1.0 for k in (1, 2)
-                                             for end in ("", "_5", "_95", "_lower", "_log")}}])
+    def Monitor(name):  # a unit's record of one scored log of two axes (its rows)
+        unit = steps.start(name, scoring.Settings(), 2)
+        unit.rows = tables.log_rows([{"unit": name, "stamp": "2026-04-01", "phase": "monitoring",
+                                      **{f"wear{k}{end}": 1.0 for k in (1, 2)
+                                         for end in ("", "_5", "_95", "_lower", "_log")}}])
+        return unit
 
     report.wear_table([Monitor("a"), Monitor("b")], scales=True, nominal={"b"}).write(tmp_path)
     assert [r["wear_scale"] for r in _rows(tmp_path / "wear.csv")] == ["twin"] * 2 + ["nominal model"] * 2

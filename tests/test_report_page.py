@@ -2,7 +2,7 @@
 real browser: Debian's headless Chromium driven by Selenium (chromedriver), both from the
 package registry (`.ci/run` installs them with apt-get; Selenium is pointed at them, so it never
 downloads a browser or a driver of its own). The page comes from a small monitor output made
-directly: :class:`~faultgen.monitor.scoring.UnitMonitor` objects fed synthetic residuals (a worn
+directly: :class:`~faultgen.monitor.history.UnitHistory` records fed synthetic residuals (a worn
 unit, a healthy one, one whose alarm a repair closed, one still learning, one never scored, and
 one named like an HTML injection), written by the monitor's own CSV writers.
 
@@ -23,9 +23,10 @@ import pytest
 from typer.testing import CliRunner
 
 from faultgen.cli import app
-from faultgen.monitor import page, report, run_settings, tables
+from faultgen.monitor import page, report, run_settings, steps, tables
 from faultgen.monitor.loop import UnitStatus
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.scoring import Settings
 
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM, CHROMEDRIVER = Path("/usr/bin/chromium"), Path("/usr/bin/chromedriver")
@@ -35,30 +36,31 @@ HOSTILE = "press<img src=x onerror=alert(1)>"  # a folder name a stranger's LOGS
 UNITS = ("weld-07", "weld-02", "paint-11", HOSTILE, "=new-cell", "spare-01")
 
 
-def _feed(monitor: UnitMonitor, days: int, wear, seed: int, repair: int | None = None) -> None:
+def _feed(monitor: UnitHistory, days: int, wear, seed: int, repair: int | None = None) -> None:
     """``days`` daily logs: noise (1 per feature) plus ``wear(day)`` % along axis 2's signature;
     a repair of axis 2 before day ``repair``."""
     rng = np.random.default_rng(seed)
     for day in range(days):
         if day == repair:
-            monitor.maintenance(f"2026-03-{day + 1:02d} 06:00", "repair", 2)
-        residual = rng.standard_normal(N_FEATURES) + wear(day) * monitor.baseline.signatures[1]
-        monitor.add(f"2026-03-{day + 1:02d}", residual, float("nan"), 0.0)
+            steps.maintenance(monitor, f"2026-03-{day + 1:02d} 06:00", "repair", 2)
+        residual = rng.standard_normal(N_FEATURES) + wear(day) * monitor.stages.baseline.signatures[1]
+        steps.add(monitor, f"2026-03-{day + 1:02d}", residual, float("nan"), 0.0)
 
 
-def make_tables() -> tuple[list, list[UnitMonitor]]:
+def make_tables() -> tuple[list, list[UnitHistory]]:
     """The tables (units.csv, alarms.csv, scores.csv) of :data:`UNITS` in memory, and their monitors."""
     signatures = np.random.default_rng(0).standard_normal((N_AXES, N_FEATURES))
-    monitors = [UnitMonitor(name, SETTINGS, N_AXES, signatures) for name in UNITS[:5]]
+    monitors = [steps.start(name, SETTINGS, N_AXES, signatures) for name in UNITS[:5]]
     _feed(monitors[0], 30, lambda d: max(0.0, d - 14) * 1.5, seed=1)  # wears from day 15
     _feed(monitors[1], 30, lambda d: 0.0, seed=2)
     _feed(monitors[2], 30, lambda d: 0.0 if d < 12 or d >= 20 else 25.0, seed=3, repair=20)  # repaired
     _feed(monitors[3], 30, lambda d: 0.0, seed=4)
     _feed(monitors[4], 6, lambda d: 0.0, seed=5)  # still learning
-    assert monitors[0].alarm.first_alarm and monitors[2].alarm.closed and not monitors[2].alarm.first_alarm
-    statuses = [UnitStatus(m.unit, "monitored" if m.baseline.pca is not None else "learning", "twin", "calibrated",
-                           "" if m.baseline.pca is not None else f"learning: {len(m.baseline.training)} of 10 logs", len(m.rows) or
-                           len(m.baseline.training), m.last_stamp) for m in monitors]
+    assert monitors[0].stages.alarm.first_alarm and monitors[2].stages.alarm.closed and not monitors[2].stages.alarm.first_alarm
+    statuses = [UnitStatus(m.unit, "monitored" if m.stages.baseline.pca is not None else "learning", "twin", "calibrated",
+                           "" if m.stages.baseline.pca is not None else f"learning: {len(m.stages.baseline.training)} of 10 logs", len(m.rows) or
+                           len(m.stages.baseline.training),
+                           m.rows[-1].stamp if m.rows else m.stages.baseline.training[-1][0]) for m in monitors]
     statuses.append(UnitStatus(UNITS[5], "not monitored", "twin", "", "no log", 0, ""))
     return [report.alarms_table(monitors), report.scores_table(monitors, N_AXES), report.units_table(statuses)], monitors
 

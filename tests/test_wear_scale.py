@@ -14,9 +14,10 @@ from faultgen.logs import measured
 from faultgen.data import logfiles
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import report
+from faultgen.monitor import report, steps
 from faultgen.monitor.wear import WearEstimator
-from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_INTERVAL, Settings, UnitMonitor
+from faultgen.monitor.history import UnitHistory
+from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_INTERVAL, Settings
 from faultgen.monitor.twin import WEAR, Twin
 
 
@@ -44,22 +45,22 @@ def test_the_interval_covers_nine_in_ten_when_the_scale_is_off_by_its_stated_unc
     assert noise_only < 0.75, noise_only  # 0.62: far from the 0.9 it claims
 
 
-def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool = True) -> tuple[UnitMonitor, np.ndarray]:
+def _unit_with_scatter_along(axis: int, scatter: float, seed: int, correct: bool = True) -> tuple[UnitHistory, np.ndarray]:
     """A twin unit whose every log scatters ``scatter`` % of wear along ``axis``'s signature (a
     log's friction scatter) beside independent noise; 40 learning logs, 200 healthy logs after.
     Returns the monitor and the later logs' wear estimates over their errors on that axis."""
     rng = np.random.default_rng(seed)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("u", Settings(train=40), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=40), n_axes=6, signatures=signatures)
     z = []
     for i in range(240):
         residual = rng.normal(0, 0.05, 18) + rng.normal(0, scatter) * signatures[axis - 1]
-        unit.add(f"{i:03d}", residual, 30.0, 100.0, np.zeros(18))
+        steps.add(unit, f"{i:03d}", residual, 30.0, 100.0, np.zeros(18))
         if i == 39 and not correct:
-            unit.baseline.dispersion_ = np.ones(6)
+            unit.stages.baseline.dispersion_ = np.ones(6)
         if i >= 40:
             row = unit.rows[-1]
-            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.wear.bound_quantile
+            error = (row.wear.log[axis - 1] - row.wear.log_lower[axis - 1]) / unit.stages.wear.bound_quantile
             z.append(row.wear.log[axis - 1] / error)
     return unit, np.array(z)
 
@@ -72,11 +73,11 @@ def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_sho
     spreads, uncorrected = [], []
     for seed in range(4):
         unit, z = _unit_with_scatter_along(3, 3.0, seed=seed)
-        assert unit.baseline.dispersion_[2] > 1.5, unit.baseline.dispersion_
+        assert unit.stages.baseline.dispersion_[2] > 1.5, unit.stages.baseline.dispersion_
         spreads.append(np.std(z))
         uncorrected.append(np.std(_unit_with_scatter_along(3, 3.0, seed=seed, correct=False)[1]))
         quiet, _ = _unit_with_scatter_along(3, 0.0, seed=seed)
-        assert np.all(quiet.baseline.dispersion_ <= 1.3), quiet.baseline.dispersion_
+        assert np.all(quiet.stages.baseline.dispersion_ <= 1.3), quiet.stages.baseline.dispersion_
     assert 0.85 <= np.mean(spreads) <= 1.25, spreads
     assert np.mean(uncorrected) > 2.0, uncorrected
 
@@ -84,11 +85,11 @@ def test_a_scatter_along_a_signature_widens_the_error_to_what_the_later_logs_sho
 def test_wear_csv_holds_each_log_and_axis_estimate_with_its_interval_as_scores_csv(tmp_path):
     rng = np.random.default_rng(5)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("unit01", Settings(train=20), n_axes=6, signatures=signatures)
-    own = UnitMonitor("unit02", Settings(protocol="own", train=20), n_axes=6)
+    unit = steps.start("unit01", Settings(train=20), n_axes=6, signatures=signatures)
+    own = steps.start("unit02", Settings(protocol="own", train=20), n_axes=6)
     for i in range(40):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
-        own.add(f"{i:03d}", rng.normal(0, 0.05, 18), 30.0, 0.0)
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
+        steps.add(own, f"{i:03d}", rng.normal(0, 0.05, 18), 30.0, 0.0)
     report.wear_table([unit, own]).write(tmp_path)
     report.scores_table([unit, own], 6).write(tmp_path)
     with open(tmp_path / "wear.csv", newline="") as f:

@@ -7,7 +7,8 @@ import pytest
 from statsmodels.tsa.statespace.mlemodel import MLEModel
 
 from faultgen.monitor.alarm import alarm_quantile
-from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_ALARM_CONFIDENCE, Settings, UnitMonitor
+from faultgen.monitor import steps
+from faultgen.monitor.scoring import SCALE_UNCERTAINTY, WEAR_ALARM_CONFIDENCE, Settings
 from faultgen.monitor.wear_trend import OUTLIER_GATE, OUTLIER_RUN, WEAR_RATE_CHANGE, WearTrend
 
 
@@ -69,15 +70,15 @@ def test_on_wear_ramps_the_filter_halves_the_error_and_states_it():
 def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate():
     rng = np.random.default_rng(5)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(60):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 30, 0) * 0.8 * signatures[1], 30.0, 0.0,
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 30, 0) * 0.8 * signatures[1], 30.0, 0.0,
                  np.zeros(18))
     rows = unit.rows
     log = np.array([r.wear.log for r in rows])
     error = np.array([r.wear.log - r.wear.log_lower for r in rows])
     trend = WearTrend(6)
-    expected = np.array([trend.update(log[k], error[k] / unit.wear.bound_quantile) for k in range(len(rows))])
+    expected = np.array([trend.update(log[k], error[k] / unit.stages.wear.bound_quantile) for k in range(len(rows))])
     np.testing.assert_allclose([r.wear.estimate for r in rows], expected[:, 0], rtol=1e-12)
     assert rows[-1].wear.estimate[1] == pytest.approx(29 * 0.8, abs=3.0)  # the planted 23.2 %
     # the alarm is judged on the filtered wear's lower one-sided 90 % bound (WEAR_ALARM_CONFIDENCE),
@@ -88,20 +89,20 @@ def test_the_monitor_reports_the_filtered_wear_and_keeps_each_logs_own_estimate(
     doubt = np.sqrt(expected[:, 1] ** 2 + (SCALE_UNCERTAINTY * expected[:, 0]) ** 2)
     np.testing.assert_allclose(lower, expected[:, 0] - alarm_quantile() * doubt, rtol=1e-9, atol=1e-9)
     monitoring = [k for k, r in enumerate(rows) if r.phase == "monitoring"]
-    assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= unit.settings.wear_limit) for k in monitoring]
-    assert any(rows[k].alarm for k in monitoring) and unit.alarm.first_alarm is not None
+    assert [rows[k].alarm for k in monitoring] == [int(lower[k].max() >= unit.stages.settings.wear_limit) for k in monitoring]
+    assert any(rows[k].alarm for k in monitoring) and unit.stages.alarm.first_alarm is not None
 
 
 def test_maintenance_restarts_the_trend():
     rng = np.random.default_rng(6)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(50):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
-    unit.maintenance("050", "gearbox change", 2)
-    assert unit.wear.trend.state is None
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18) + max(i - 25, 0) * signatures[1], 30.0, 0.0, np.zeros(18))
+    steps.maintenance(unit, "050", "gearbox change", 2)
+    assert unit.stages.wear.trend.state is None
     residual = rng.normal(0, 0.05, 18)
-    unit.add("051", residual, 30.0, 0.0, np.zeros(18))
+    steps.add(unit, "051", residual, 30.0, 0.0, np.zeros(18))
     assert unit.rows[-1].wear.estimate[1] == pytest.approx(unit.rows[-1].wear.log[1])  # a new trend starts at the log
 
 
@@ -220,18 +221,18 @@ def test_the_monitor_puts_its_learned_slopes_error_in_the_trend():
     times (X'X)^-1 of the learning logs' centred conditions, and kept across maintenance."""
     rng = np.random.default_rng(7)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(20):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    assert unit.wear.trend.n_regressors == 2
-    error = unit.baseline.wear_estimate(np.zeros(18), unit.baseline.scale_**2)[1]
-    np.testing.assert_allclose(unit.wear.trend.covariance[:, 2:, 2:],
-                               error[:, None, None] ** 2 * unit.baseline.gram_inv_[None], rtol=1e-12)
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
+    assert unit.stages.wear.trend.n_regressors == 2
+    error = unit.stages.baseline.wear_estimate(np.zeros(18), unit.stages.baseline.scale_**2)[1]
+    np.testing.assert_allclose(unit.stages.wear.trend.covariance[:, 2:, 2:],
+                               error[:, None, None] ** 2 * unit.stages.baseline.gram_inv_[None], rtol=1e-12)
     for i in range(20, 40):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 25.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
-    learned = unit.wear.trend.state[:, 2:].copy()
-    unit.maintenance("040", "repair", 1)
-    np.testing.assert_array_equal(unit.wear.trend.slope_mean, learned)
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18), 25.0 + rng.normal(0, 1.0), [10.0, 25.0][i % 2], np.zeros(18))
+    learned = unit.stages.wear.trend.state[:, 2:].copy()
+    steps.maintenance(unit, "040", "repair", 1)
+    np.testing.assert_array_equal(unit.stages.wear.trend.slope_mean, learned)
 
 
 def test_the_logs_own_estimate_less_the_learned_slope_errors_drifts_less_with_the_season():
@@ -269,17 +270,17 @@ def test_the_logs_own_estimate_less_the_learned_slope_errors_drifts_less_with_th
 def test_the_monitors_own_estimate_of_a_log_is_its_estimate_less_the_slope_errors_part():
     rng = np.random.default_rng(8)
     signatures = np.abs(rng.normal(0, 1, (6, 18))) * 0.05
-    unit = UnitMonitor("u", Settings(train=20), n_axes=6, signatures=signatures)
+    unit = steps.start("u", Settings(train=20), n_axes=6, signatures=signatures)
     for i in range(20):
-        unit.add(f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), 0.0, np.zeros(18))
+        steps.add(unit, f"{i:03d}", rng.normal(0, 0.05, 18), 20.0 + rng.normal(0, 1.0), 0.0, np.zeros(18))
     for i in range(20, 40):
         temperature = 24.0 + rng.normal(0, 1.0)
         residual = rng.normal(0, 0.05, 18)
-        unit.add(f"{i:03d}", residual, temperature, 0.0, np.zeros(18))
-        x = np.array([temperature]) - unit.baseline.condition_mean_[unit.baseline.regressors_]
-        factor = unit.baseline.prediction_factor(np.array([temperature, 0.0]))
-        own = unit.baseline.wear_estimate(residual - unit.baseline.mean_ - x @ unit.baseline.slope_, (unit.baseline.scale_ * factor) ** 2)[0]
+        steps.add(unit, f"{i:03d}", residual, temperature, 0.0, np.zeros(18))
+        x = np.array([temperature]) - unit.stages.baseline.condition_mean_[unit.stages.baseline.regressors_]
+        factor = unit.stages.baseline.prediction_factor(np.array([temperature, 0.0]))
+        own = unit.stages.baseline.wear_estimate(residual - unit.stages.baseline.mean_ - x @ unit.stages.baseline.slope_, (unit.stages.baseline.scale_ * factor) ** 2)[0]
         row = unit.rows[-1]
-        part = unit.wear.trend.condition_part(x)
+        part = unit.stages.wear.trend.condition_part(x)
         assert np.any(np.abs(part) > 1e-6)
         np.testing.assert_allclose(row.wear.log, own - part, rtol=1e-9, atol=1e-9)

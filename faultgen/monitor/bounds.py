@@ -1,6 +1,6 @@
 """The doubts a log's wear carries, put together (issue 90, "Daily scatter, honest bounds"): the
 arithmetic of the wear's 90 % interval and of the lower bound an alarm is judged on
-(:class:`faultgen.monitor.scoring.UnitMonitor`), the plant's day-to-day scatter an axis shows, and
+(:class:`faultgen.monitor.wear.WearEstimator`), the plant's day-to-day scatter an axis shows, and
 the filter's adapted process noise (:class:`faultgen.monitor.wear_trend.WearTrend`).
 
 **The sources** (each a standard deviation in points of wear, % of the axis's own dry friction):

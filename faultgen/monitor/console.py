@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from faultgen.monitor import lights, page
+from faultgen.monitor import lights, page, steps
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor.loop import EXIT_SOME_UNITS_NOT_MONITORED
 from faultgen.monitor.scoring import Settings
@@ -18,21 +18,21 @@ from faultgen.monitor.scoring import Settings
 def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     """The lines for standard output, and the line for standard error ("" when every unit is
     monitored), of a finished run's ``outcome`` (:class:`faultgen.monitor.loop.Outcome`: its
-    monitors and statuses) with ``settings``, its outputs in ``out``."""
-    monitors = outcome.monitors
-    alarmed = [m for m in monitors if m.alarm.first_alarm]
+    units' records and statuses) with ``settings``, its outputs in ``out``."""
+    monitors = outcome.units
+    alarmed = [m for m in monitors if m.stages.alarm.first_alarm]
     by_unit = {m.unit: m for m in monitors}
     lines = [f"events.csv changed for {unit} since the last run: re-scored from its first log (the earliest event "
              f"added, changed or removed: {since})" for unit, since in getattr(outcome, "rescored", [])]
     for status in outcome.statuses:
         m = by_unit.get(status.unit)
-        alarm = m is not None and m.alarm.first_alarm
+        alarm = m is not None and m.stages.alarm.first_alarm
         # the fallbacks are said once, beside the status (status.basis), not again in the reason
         reason = status.reason.replace(status.fallback, "").replace("; ; ", "; ").strip("; ") if status.fallback \
             else status.reason
         reason = reason.removeprefix(f"{status.status}: ")  # "not monitored: ..." beside the status said once
-        what = f"alarm {lights.alarm_dates(m.alarm_row())}, axis {m.alarm.source_axis}" if alarm else \
-            m.alarm_row()["evidence"] if m is not None and status.status == "monitored" else reason
+        what = f"alarm {lights.alarm_dates(steps.alarm_row(m))}, axis {m.stages.alarm.source_axis}" if alarm else \
+            steps.alarm_row(m)["evidence"] if m is not None and status.status == "monitored" else reason
         mix = f"; programs: {status.programs}" if status.programs and status.programs not in what else ""
         lines.append(f"{status.unit}: {status.status} ({status.protocol}"
                      f"{', ' + status.model + ' model' if status.model else ''}{status.basis()}): {what}{mix}")
@@ -40,7 +40,7 @@ def summary(outcome, settings: Settings, out: Path) -> tuple[list[str], str]:
     # a log's chance of alarming on a healthy unit: T2 or Q (own), or any of the N axes' lower
     # bounds over a limit the unworn estimate lies below (twin); the report page says the same
     statement = page.false_alarm_statement(settings.protocol, settings.alpha, settings.persistence, settings.train,
-                                           monitors[0].n_axes if monitors else 1, logs_scored)  # "" where it says nothing
+                                           monitors[0].stages.n_axes if monitors else 1, logs_scored)  # "" where it says nothing
     lines.append(" ".join(filter(None, (f"{len(alarmed)} of {len(monitors)} units alarm.", statement))))
     passed = getattr(outcome, "passed_over", [])
     if passed:

@@ -19,11 +19,11 @@ from analysis.monitoring import varying_columns
 from faultgen.logs import align, formats
 from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, life, report, sources
+from faultgen.monitor import friction_tests, life, report, sources, steps
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.history import Entry, Maintenance, Note, ProgramChange, Skipped, UnitHistory
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.scoring import Settings, Stages
 from faultgen.monitor.twin import REFERENCE_TEMPERATURE, Twin
 from faultgen.monitor.unit import REFUSED_SKIP, log_of, refused_note, short, twin_of
 from faultgen.simulation import backends
@@ -83,21 +83,21 @@ class Context:
         return fleet_logs.Source(nominal, self.log_format, given)
 
 
-def unit_outputs(monitor: UnitMonitor, failure_wear: float) -> tuple[bytes, list]:
+def unit_outputs(unit: UnitHistory, failure_wear: float) -> tuple[bytes, list]:
     """A unit's control chart (PNG bytes, :func:`faultgen.monitor.report.chart`) and its rows of
     rul.csv (:func:`faultgen.monitor.friction_tests.remaining_life`: on the unit's friction tests'
     scale when it has tests, else :func:`faultgen.monitor.prognosis.of_monitor`): made where the unit was scored, so that
     they are made in parallel too."""
-    note = "wear signature match" if monitor.baseline.signatures is not None else "RBC of Q"
+    note = "wear signature match" if unit.stages.baseline.signatures is not None else "RBC of Q"
     buffer = io.BytesIO()
-    report.chart(buffer, monitor, note)
-    return buffer.getvalue(), friction_tests.remaining_life(monitor, failure_wear)
+    report.chart(buffer, unit, note)
+    return buffer.getvalue(), friction_tests.remaining_life(unit, failure_wear)
 
 
-def idle_outputs(monitor: UnitMonitor, failure_wear: float) -> list:
+def idle_outputs(unit: UnitHistory, failure_wear: float) -> list:
     """The chart and rows of rul.csv of a unit with no new log (:func:`unit_outputs`), as
     :func:`score_group` returns a unit's: ``[(unit, None, outputs)]`` (None: its state unchanged)."""
-    return [(monitor.unit, None, unit_outputs(monitor, failure_wear))]
+    return [(unit.unit, None, unit_outputs(unit, failure_wear))]
 
 
 def score_group(context: Context, group: list[tuple[str, UnitHistory, list]],
@@ -121,14 +121,13 @@ def score_group(context: Context, group: list[tuple[str, UnitHistory, list]],
                 i += 1
                 if (event.stamp, event.event, event.axis) not in given:
                     given.add((event.stamp, event.event, event.axis))
-                    unit_programs.baselines_of(unit.monitor).maintenance(unit.monitor, event.stamp, event.event,
-                                                                         event.axis)
+                    steps.maintenance(unit, event.stamp, event.event, event.axis)
                     unit.maintenance.append(Maintenance(event.stamp, event.event, event.axis,
                                                         len(unit.entries)))
             twin = score_log(unit, log, nominal, twin, context.twin_temperature, source, context)
     for _, unit, _ in group:
         unit.program_twins.clear()  # made again where needed: a unit travels back from a worker without them
-    return [(name, unit, unit_outputs(unit.monitor, context.failure_wear)) for name, unit, _ in group]
+    return [(name, unit, unit_outputs(unit, context.failure_wear)) for name, unit, _ in group]
 
 
 
@@ -187,7 +186,7 @@ def place(unit: UnitHistory, log, data, twin: Twin, context, source: fleet_logs.
     baseline = sources.baseline_of(unit, k, torque)
     if baseline is None:
         baseline = sources.change(unit, log, k, torque, k_twin.signatures,
-                                  lambda s: unit_programs.baselines_of(unit.monitor).new(unit.monitor, s))
+                                  lambda s: unit.stages.programs.new(unit.stages, s))
     return baseline, unit_programs.scored(data, span), k_twin
 
 
@@ -222,9 +221,9 @@ def new_program(unit: UnitHistory, log, twin: Twin, context, source: fleet_logs.
     count = len(sources.distinct(unit.references))
     unit.references.append(reference)
     unit.program_twins[k] = new
-    unit.program_changes.append(ProgramChange(log.stamp, (unit.monitor.unit, log.stamp), len(unit.entries),
+    unit.program_changes.append(ProgramChange(log.stamp, (unit.unit, log.stamp), len(unit.entries),
                                               new.signatures, torque))
-    unit_programs.baselines_of(unit.monitor).new(unit.monitor, new.signatures)
+    unit.stages.programs.new(unit.stages, new.signatures)
     unit.notes.append(Note(f"program changed at {log.stamp} (not logged: its motion within {align.TOLERANCE:g} rad RMS "
                            f"of none of the unit's {count} program(s)): {reference.name}, a {reference.period:.3f} s "
                            "cycle; its twin replays that log; it learns its offset on its own first logs (pooled into "
@@ -283,8 +282,8 @@ def _score(unit: UnitHistory, log, parsed: fleet_logs.Parsed, nominal, twin, twi
     if constant:  # a later baseline (a program's, a torque source's) that can show no wear: its logs skipped
         unit.skipped.append(Skipped(log.stamp, sha256, constant))
         return twin
-    unit_programs.baselines_of(unit.monitor).run(unit.monitor, program, lambda: unit.monitor.add(
-        log.stamp, residual, reading.temperature, reading.payload, expected))
+    steps.run(unit, program, lambda: steps.add(unit, log.stamp, residual, reading.temperature, reading.payload,
+                                               expected))
     unit.entries.append(Entry(log.stamp, sha256, residual, reading.temperature, reading.payload, expected,
                               *load, program))
     return twin
@@ -297,7 +296,7 @@ def constant_torque(unit: UnitHistory, vector: np.ndarray, n_axes: int) -> str:
     rounding), which the PCA model cannot standardise: :data:`CONSTANT_TORQUE` and the features;
     "" otherwise (or before the learning's last log). The features are the residuals plus the
     twin's expectation, which may vary with the logs' conditions while the torque does not."""
-    baseline = unit.monitor.baseline
+    baseline = unit.stages.baseline
     if baseline.pca is not None or len(baseline.training) + 1 < baseline.learning_logs:
         return ""
     expected = baseline.learned_expectations or [0.0] * len(baseline.training)
@@ -318,21 +317,20 @@ def later_constant(unit: UnitHistory, program: int, vector: np.ndarray, n_axes: 
     if program == 0:
         return ""
     found = []
-    unit_programs.baselines_of(unit.monitor).run(unit.monitor, program,
-                                                 lambda: found.append(constant_torque(unit, vector, n_axes)))
+    steps.run(unit, program, lambda: found.append(constant_torque(unit, vector, n_axes)))
     return found[0] and f"the baseline begun at {unit.program_changes[program - 1].stamp} cannot be learned: {found[0].removeprefix('not monitored: ')}"
 
 
 def not_monitored(unit: UnitHistory, stamp: str, sha256: str, why: str) -> str:
     """Take the unit off the monitor (:func:`constant_torque`): its logs scored so far and the log
-    ``stamp`` (its SHA-256 ``sha256``) kept as skipped, its monitor emptied (its status then "not monitored", its reason ``why``);
+    ``stamp`` (its SHA-256 ``sha256``) kept as skipped, its stages and rows emptied (its status then "not monitored", its reason ``why``);
     returns the reason its later logs are skipped with, in this run and the next."""
     skipped = "the unit is not monitored: its torque does not vary from log to log"
     unit.skipped.extend(Skipped(e.stamp, e.sha256, skipped) for e in unit.entries)
     unit.skipped.append(Skipped(stamp, sha256, skipped))
     unit.entries.clear()
-    unit.monitor = UnitMonitor(unit.monitor.unit, unit.monitor.settings, unit.monitor.n_axes,
-                               unit.monitor.baseline.signatures)
+    stages = unit.stages
+    unit.stages, unit.rows = Stages.new(unit.unit, stages.settings, stages.n_axes, stages.baseline.signatures), []
     unit.notes.append(Note(why))
     unit.off_monitor = why
     return why

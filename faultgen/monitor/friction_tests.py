@@ -594,7 +594,7 @@ def remaining_life(monitor, failure_wear: float) -> list:
     relative error as the scale's uncertainty; an axis in the twin's scale keeps the default)."""
     from faultgen.monitor import prognosis
 
-    rows, uncertainty = on_tests_scale(monitor.rows, monitor.n_axes)
+    rows, uncertainty = on_tests_scale(monitor.rows, monitor.stages.n_axes)
     if uncertainty is None:
         return prognosis.of_monitor(monitor, failure_wear)
     return prognosis.of_monitor(monitor, failure_wear, rows=rows, scale_uncertainty=uncertainty)

@@ -1,8 +1,8 @@
 """One record per unit of ``faultgen monitor`` (:class:`UnitHistory`: what its monitor was fed, as
 typed fields) and its JSON, the saved state ``OUT/.state/<unit>.json`` (:func:`write_unit`,
-:func:`read_unit`). A rerun replays its entries into a new
-:class:`~faultgen.monitor.scoring.UnitMonitor` (:func:`replay`): the same arithmetic in the same
-order, so the continued monitor is bit for bit the one the earlier run ended with. An output folder
+:func:`read_unit`). A rerun replays its entries into new stages
+(:func:`faultgen.monitor.steps.replay`): the same arithmetic in the same order, so the continued
+monitor is bit for bit the one the earlier run ended with. An output folder
 may come from someone else (docs/reliability.md, "Threat model: output folders"): the file is read
 inside ``OUT`` only, bounded by :data:`faultgen.monitor.state.STATE_MAX_BYTES` before it is parsed,
 every value checked (:func:`read_unit`), logs named by unit and stamp, never by a path.
@@ -19,8 +19,8 @@ import numpy as np
 
 from faultgen.data import atomic, logfolder
 from faultgen.logs import measured
-from faultgen.monitor import programs
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.record import LogRow
+from faultgen.monitor.scoring import Stages
 from faultgen.monitor.state import STATE_MAX_BYTES, StateError, floats, load_json, checked_vector, inside
 
 #: The state files' format: 3, each note of a unit's reason with its kind (:class:`Note`; a column note
@@ -93,7 +93,7 @@ class Skipped:
 @dataclass(frozen=True)
 class Maintenance:
     """A repair or gearbox change (``event``) of ``axis`` at ``stamp``, given to the unit's monitor
-    before its entry number ``at`` (:meth:`faultgen.monitor.scoring.UnitMonitor.maintenance`)."""
+    before its entry number ``at`` (:func:`faultgen.monitor.steps.maintenance`)."""
 
     stamp: str
     event: str
@@ -138,10 +138,11 @@ class UnitHistory:
     (:func:`faultgen.logs.formats.torque_source`; "" unnamed) and why it was taken ``off_monitor``
     ("" while on it).
 
-    Not saved, rebuilt by a run: ``monitor`` the stages fed its entries (:func:`replay`), the
-    ``references`` of its programs in the order met (learned from their logs when needed:
-    :mod:`faultgen.monitor.programs`) and the twins of its programs after the first
-    (``program_twins``)."""
+    Not saved, rebuilt by a run: ``stages`` fed its entries (:class:`~faultgen.monitor.scoring.Stages`,
+    :func:`faultgen.monitor.steps.replay`), the ``rows`` they made (each log's
+    :class:`~faultgen.monitor.record.LogRow`, in stamp order), the ``references`` of its programs in
+    the order met (learned from their logs when needed: :mod:`faultgen.monitor.programs`) and the
+    twins of its programs after the first (``program_twins``)."""
 
     unit: str
     model: str = "nominal"
@@ -155,41 +156,17 @@ class UnitHistory:
     program_changes: list[ProgramChange] = field(default_factory=list)
     torque_source: str = ""
     off_monitor: str = ""
-    monitor: UnitMonitor | None = field(default=None, repr=False, compare=False)
+    stages: Stages | None = field(default=None, repr=False, compare=False)
+    rows: list[LogRow] = field(default_factory=list, repr=False, compare=False)
     references: list | None = field(default=None, repr=False, compare=False)
     program_twins: dict = field(default_factory=dict, repr=False, compare=False)
 
     def saved_signatures(self) -> np.ndarray | None:
         """The signatures a replay starts with: its first program's twin's, or, when none was
-        kept, those its monitor holds."""
-        if self.signatures is None and self.monitor is not None:
-            return self.monitor.baseline.signatures
+        kept, those its stages hold."""
+        if self.signatures is None and self.stages is not None:
+            return self.stages.baseline.signatures
         return self.signatures
-
-
-def replay(state: UnitHistory, settings: Settings, n_axes: int, tests=None) -> UnitMonitor:
-    """A :class:`UnitMonitor` fed ``state``'s entries in order, each with its program's baseline
-    (:mod:`faultgen.monitor.programs`): the monitor the run that wrote ``state`` ended with
-    (``tests``: its friction tests' scale, :attr:`UnitMonitor.tests`, given before the entries)."""
-    monitor = UnitMonitor(state.unit, settings, n_axes, state.signatures)
-    monitor.wear.tests = tests
-    maintenance: dict[int, list[Maintenance]] = {}
-    for m in state.maintenance:  # grouped by entry, in their order: each looked at once
-        maintenance.setdefault(m.at, []).append(m)
-    changes: dict[int, list[ProgramChange]] = {}
-    for c in state.program_changes:
-        changes.setdefault(c.at, []).append(c)
-    baselines = programs.baselines_of(monitor)
-    for i, e in enumerate(state.entries):
-        for m in maintenance.get(i, ()):
-            baselines.maintenance(monitor, m.stamp, m.event, m.axis)
-        for c in changes.get(i, ()):
-            baselines.new(monitor, c.signatures)
-        baselines.run(monitor, e.program, lambda e=e: monitor.add(e.stamp, e.residual, e.temperature, e.payload,
-                                                                  e.expected))
-    for m in maintenance.get(len(state.entries), ()):
-        baselines.maintenance(monitor, m.stamp, m.event, m.axis)
-    return monitor
 
 
 def _program(log: dict, path: Path, where: str, known: int) -> int:
@@ -290,10 +267,10 @@ def setting_moved(key: str, then, now, robot: str = "") -> str:
 
 def read_unit(path: Path, root: Path, unit: str, settings: dict, n_axes: int, n_features: int,
               robot: str = "") -> UnitHistory:
-    """Read and check the record of ``unit`` written by :func:`write_unit` (its ``monitor`` left
-    None: :func:`replay` makes it): every value one a run writes (stamps that parse, the logs' in
-    increasing order and each stamp handled once, SHA-256s of 64 hex digits, finite numbers where a
-    run writes them: a temperature finite or NaN (not logged), a maintenance event of
+    """Read and check the record of ``unit`` written by :func:`write_unit` (its ``stages`` left None:
+    :func:`faultgen.monitor.steps.replay` makes them): every value one a run writes (stamps that
+    parse, the logs' in increasing order and each stamp handled once, SHA-256s of 64 hex digits,
+    finite numbers where a run writes them: a temperature finite or NaN (not logged), a maintenance event of
     :data:`MAINTENANCE` on an axis 1..``n_axes``, given before an entry that exists).
 
     Raises

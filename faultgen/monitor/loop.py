@@ -9,7 +9,8 @@ the measured format or an adapter's):
     at each payload the logs declare, healthy and with each axis in turn worn; a unit whose twin
     cannot be built falls back to the nominal model, then to protocol own
     (:func:`faultgen.monitor.unit.twin_of`);
-(c)-(d) the unit's monitor (:class:`faultgen.monitor.scoring.UnitMonitor`): learned on the first
+(c)-(d) the unit's monitor (the stages of :mod:`faultgen.monitor.scoring` in its record, fed by
+    :mod:`faultgen.monitor.steps`): learned on the first
     logs, then every later log scored in stamp order; a log that cannot be read or replayed is
     skipped, a repair or gearbox change of ``events.csv`` closes the open alarm and the unit's
     offset is learned again; each log is placed among the unit's programs by its motion and scored
@@ -46,13 +47,13 @@ from tqdm.auto import tqdm
 from faultgen.data import atomic, fleetlogs, logfolder
 from faultgen.logs import columns
 from faultgen.monitor import logs as fleet_logs
-from faultgen.monitor import friction_tests, history, life, page, prognosis, programs, report, sources
+from faultgen.monitor import friction_tests, history, life, page, prognosis, programs, report, sources, steps
 from faultgen.monitor import state as stored
 from faultgen.monitor.feed import PROGRAM_CHANGE, Context
 from faultgen.monitor.history import UnitHistory
 from faultgen.monitor.parallel import groups_of, map_groups
 from faultgen.monitor.run import MonitorRun
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.scoring import Settings
 from faultgen.monitor.unit import CALIBRATION_STEPS, SAME_PROGRAM, fallback_notes, new_unit, refused_note
 from faultgen.runs.errors import SweepInterrupted
 from faultgen.runs.sweep import CtrlC, Terminated
@@ -104,11 +105,11 @@ class UnitStatus:
 
 @dataclass
 class Outcome:
-    """What :func:`monitor` did: each unit's ``monitors`` (:class:`UnitMonitor`) and ``statuses``
-    (:class:`UnitStatus`), in the fleet folder's order; ``tests``: whether it wrote ``tests.csv``
+    """What :func:`monitor` did: each unit's record (``units``, :class:`~faultgen.monitor.history.UnitHistory`:
+    its stages and rows too) and ``statuses`` (:class:`UnitStatus`), in the fleet folder's order; ``tests``: whether it wrote ``tests.csv``
     (the fleet has friction tests); what it ``passed_over``."""
 
-    monitors: list[UnitMonitor]
+    units: list[UnitHistory]
     statuses: list[UnitStatus]
     #: ``(name, reason)`` of each file of the folder passed over (not a log, not a friction test:
     #: ``<unit>/<file>``) and each row of ``events.csv`` that names no unit (``events.csv``).
@@ -186,14 +187,14 @@ def monitor(run: MonitorRun) -> Outcome:
                 state[name] = new_unit(name, units, run.robot, run.settings, run.calibrated, run.calibrate, programs,
                                        source)
                 _keep_program(state[name], rescored.get(name))
-                state[name].monitor.wear.tests = scale_of(name)
+                state[name].stages.wear.tests = scale_of(name)
         made = _score_units(run, Context.of(run, units, maintenance), state, pending, source)
         statuses = [_status(name, state.get(name), run.settings, stale[name], tests.get(name, ()),
                             fleet_logs.passed_note([p for p in passed if p[0].startswith(f"{name}/")]),
                             stopped.get(name, "")) for name in units]
         _write_outputs(run, units, state, statuses, made, {name: wears[name][0] for name in units if name in wears}
                        if found else None)
-    return Outcome([state[name].monitor for name in units if name in state], statuses, passed, tests=bool(found),
+    return Outcome([state[name] for name in units if name in state], statuses, passed, tests=bool(found),
                    rescored=[(name, since) for name, (since, _, _) in rescored.items()])
 
 
@@ -205,7 +206,7 @@ def _score_units(run: MonitorRun, scoring: Context, state: dict[str, UnitHistory
     groups = groups_of({name: (state[name], logs) for name, logs in pending.items() if logs})
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not run.progress)
     made: dict[str, tuple[bytes, list]] = {}
-    idle = [state[name].monitor for name in pending if name in state and not pending[name]]  # no new log
+    idle = [state[name] for name in pending if name in state and not pending[name]]  # no new log
     # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
     with contextlib.closing(map_groups(run, scoring, groups, idle, source)) as results:
         for done in results:
@@ -223,28 +224,28 @@ def _write_outputs(run: MonitorRun, units: dict, state: dict[str, UnitHistory], 
     """Write the run's outputs into ``run.out`` together (:func:`faultgen.data.atomic.atomic_folder`):
     each table from memory, the page drawn from the same tables, each unit's chart and state;
     ``wears``: each unit's friction tests' wear when the fleet has friction tests (tests.csv), else None."""
-    monitors = [state[name].monitor for name in units if name in state]
+    records = [state[name] for name in units if name in state]
     nominal_scale = _nominal_scale(state, run.settings, run.own_model)
     scales = wears is not None or bool(nominal_scale)
-    written = [report.alarms_table(monitors), report.scores_table(monitors, run.robot.n_axes),
-               report.wear_table(monitors, scales=scales, nominal=nominal_scale),
-               report.units_table(statuses, scales={m.unit: _scale_of(m, m.unit in nominal_scale) for m in monitors}
+    written = [report.alarms_table(records), report.scores_table(records, run.robot.n_axes),
+               report.wear_table(records, scales=scales, nominal=nominal_scale),
+               report.units_table(statuses, scales={m.unit: _scale_of(m, m.unit in nominal_scale) for m in records}
                                   if scales else None),
                *([friction_tests.tests_table(wears)] if wears is not None else []),
-               prognosis.rul_table([row for m in monitors for row in made[m.unit][1]]),
+               prognosis.rul_table([row for m in records for row in made[m.unit][1]]),
                # a unit that scored no log (not monitored) has no life consumed to tell: no row, never "0 %"
                life.life_table([row for name in units if name in state and state[name].entries
                                 for row in life.of_unit(name, state[name].entries, state[name].maintenance, run.ratings,
                                                         run.hours_per_day, notes=state[name].notes)])]
     # the page from the tables in memory (none read back), as `faultgen report OUT` draws it from the files
-    fleet = page.fleet_of({t.name: t.records() for t in written}, [r.tabled() for m in monitors for r in m.rows])
+    fleet = page.fleet_of({t.name: t.records() for t in written}, [r.tabled() for m in records for r in m.rows])
     with atomic.atomic_folder(run.out) as staging:
         for table in written:
             table.write(staging)
         # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
         page.write(staging, run.settings, fleet=fleet, robot=Path(str(run.named)).name,
                    logs=run.logs.resolve().name, model=run.model_source, twin_temperature=run.twin_temperature)
-        for m in monitors:
+        for m in records:
             (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()
         for name in units:
@@ -328,12 +329,12 @@ def _same_log(path: Path, sha256: str) -> bool:
 
 
 
-def _scale_of(monitor, nominal: bool = False) -> str:
+def _scale_of(unit: UnitHistory, nominal: bool = False) -> str:
     """units.csv's ``wear_scale`` of a unit: ``friction test`` when its last log's wear of some axis
     is on its tests' scale (:mod:`faultgen.monitor.friction_tests`), else ``nominal model`` for a
     unit whose twin fell back to the nominal model (``nominal``: :func:`_nominal_scale`), ``twin``
     otherwise."""
-    last = monitor.rows[-1].wear if monitor.rows else None
+    last = unit.rows[-1].wear if unit.rows else None
     on_tests = last is not None and last.tests is not None and friction_tests.TESTS_SCALE in last.tests.scale
     return friction_tests.TESTS_SCALE if on_tests else friction_tests.NOMINAL_SCALE if nominal else \
         friction_tests.TWIN_SCALE
@@ -369,16 +370,16 @@ def _status(name: str, unit: UnitHistory | None, settings: Settings, stale: list
         reasons.append(f"{len(unread)} friction tests not read: {unread[0].stamp}: {unread[0].error}{more}")
     if unit.skipped:
         reasons.append(skipped_note(unit.skipped))
-    learning = unit.monitor.baseline.pca is None
+    learning = unit.stages.baseline.pca is None
     refused = refused_note(unit) is not None  # its first log refused: no model used
     latest = unit.entries[-1].program if unit.entries else 0  # the program it runs now learning too: learning
-    still = learning or programs.learning(unit.monitor, latest)
+    still = learning or programs.learning(unit.stages, latest)
     if learning and not unit.off_monitor and not refused:  # not learning: off the monitor
-        reasons.append(f"learning: {len(unit.monitor.baseline.training)} of {settings.train} logs")
-    elif not learning and unit.monitor.not_observable_note():
-        reasons.append(unit.monitor.not_observable_note())
+        reasons.append(f"learning: {len(unit.stages.baseline.training)} of {settings.train} logs")
+    elif not learning and steps.not_observable_note(unit.stages):
+        reasons.append(steps.not_observable_note(unit.stages))
     count = 1 + len(unit.program_changes)
-    mix = sources.relabel(unit, programs.mix_note(unit.monitor, unit.entries, count))
+    mix = sources.relabel(unit, programs.mix_note(unit.stages, unit.entries, count))
     reasons += [mix] if mix else []
     if not unit.entries or stopped:
         status = "not monitored"
@@ -440,7 +441,7 @@ def _maintenance_events(logs_dir: Path, units: dict, n_axes: int,
 def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: int, n_features: int,
                 scale_of=lambda name: None, robot: str = "") -> dict[str, UnitHistory]:
     """The earlier run's state of every unit of the fleet folder that has one (a state file is
-    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.history.replay`).
+    looked for by the unit's name, never listed), replayed (:func:`faultgen.monitor.steps.replay`).
     A state left by an earlier faultgen (``*.pkl``) is refused unread: pickles run code. ``.state``
     itself was checked to lead inside ``out`` by the caller (:func:`faultgen.monitor.state.checked_out`)."""
     folder = out / ".state"
@@ -458,7 +459,7 @@ def _load_state(out: Path, units: dict, key: dict, settings: Settings, n_axes: i
         kept = history.read_unit(path, out, name, key, n_axes, n_features, robot)
         if not (kept.entries or kept.skipped):
             continue
-        kept.monitor = history.replay(kept, settings, n_axes, scale_of(name))
+        steps.replay(kept, settings, n_axes, scale_of(name))
         state[name] = kept
     return state
 

@@ -574,17 +574,17 @@ def check_failure_wear(failure_wear: float) -> None:
                          "estimate, % of the axis's own dry friction, counted as the end of an axis's life)")
 
 
-def of_monitor(monitor, failure_wear: float = FAILURE_WEAR, rows: list[dict] | None = None,
+def of_monitor(unit, failure_wear: float = FAILURE_WEAR, rows: list[dict] | None = None,
                **options) -> list[Remaining]:
-    """:func:`remaining_life` of a :class:`faultgen.monitor.scoring.UnitMonitor`: its rows (or
-    ``rows``, the same put on another scale), alpha and open alarm; a unit that scored no log at
-    all (not monitored, every log skipped) is said so, not "still learning"."""
-    if not monitor.rows and not monitor.baseline.training:
-        return [Remaining(monitor.unit, None, "", "", "no log scored: no wear estimate", failure_wear,
+    """:func:`remaining_life` of a unit's record (:class:`faultgen.monitor.history.UnitHistory`): its
+    rows (or ``rows``, the same put on another scale), alpha and open alarm; a unit that scored no
+    log at all (not monitored, every log skipped) is said so, not "still learning"."""
+    stages = unit.stages
+    if not unit.rows and not stages.baseline.training:
+        return [Remaining(unit.unit, None, "", "", "no log scored: no wear estimate", failure_wear,
                           options.get("horizon", HORIZON))]
-    return remaining_life(monitor.unit, monitor.rows if rows is None else rows, monitor.n_axes,
-                          alpha=monitor.settings.alpha,
-                          failure_wear=failure_wear, since=monitor.alarm.first_alarm, source_axis=monitor.alarm.source_axis,
+    return remaining_life(unit.unit, unit.rows if rows is None else rows, stages.n_axes, alpha=stages.settings.alpha,
+                          failure_wear=failure_wear, since=stages.alarm.first_alarm, source_axis=stages.alarm.source_axis,
                           **options)
 
 

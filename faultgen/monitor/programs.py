@@ -16,19 +16,20 @@ fed to the axis's one filter.
   the cycle beside it. A log with no whole cycle is skipped with its reason
   (:func:`refusal_text`).
 - **Baselines.** The unit learns once it has ``train`` logs in all, its programs' together
-  (:func:`pool`, :mod:`faultgen.monitor.baseline`): each program met by then with at least
-  ``relearn_logs`` of them its own offset, all of them one set of condition slopes, noise and PCA
-  model; each program its own wear signatures (its twin's). A program met later, or with fewer
+  (:func:`faultgen.monitor.steps.pool`, :mod:`faultgen.monitor.baseline`): each program met by then
+  with at least ``relearn_logs`` of them its own offset, all of them one set of condition slopes,
+  noise and PCA model; each program its own wear signatures (its twin's). A program met later, or with fewer
   logs in that learning, learns only its offset on its own first ``relearn_logs`` logs (as a unit
   after maintenance does) and borrows the rest. Each program's
-  :class:`~faultgen.monitor.baseline.Baseline` is swapped in for its logs (:class:`Baselines`); the unit's monitor holds its first program's between logs. The
+  :class:`~faultgen.monitor.baseline.Baseline` is swapped in for its logs (:class:`Baselines`,
+  :func:`faultgen.monitor.steps.run`); the unit's stages hold its first program's between logs. The
   alarm (its run of alarming logs), the rows and the friction tests are the unit's.
 - **One filter per axis.** Every program's per-log wear estimate of an axis goes to the unit's one
   :class:`faultgen.monitor.wear_trend.WearTrend` with that program's own standard error (an axis a
   program barely excites has a large one and moves the filter little: the Kalman update's
   inverse-variance weighting). A program learned after the first reads the wear since its
   learning; the filtered wear at its learning (and its variance) is added to each of its
-  estimates (:class:`_Fused`). Its condition slopes' error is not in the filter's state (only the
+  estimates (:class:`Fused`). Its condition slopes' error is not in the filter's state (only the
   first program's is).
 """
 
@@ -201,7 +202,7 @@ def refusal_text(refusal: align.NoWholeCycle) -> str:
     return f"no whole cycle{against}: {refusal.why.value}"
 
 
-class _Fused:
+class Fused:
     """The unit's wear filter as a program learned after the first feeds it: each of the program's
     estimates plus the filtered wear at its learning (``offset``, its variance ``variance``, both
     (n_axes,)), with no condition slopes (only the first program's are in the filter's state)."""
@@ -229,102 +230,22 @@ class Baselines:
     saved: list[Baseline] = field(default_factory=list)
     offsets: list[tuple[np.ndarray, np.ndarray] | None] = field(default_factory=list)
 
-    def new(self, monitor, signatures: np.ndarray | None) -> int:
-        """A new program's baseline, empty (learning from its next log), with ``signatures``: its index."""
+    def new(self, stages, signatures: np.ndarray | None) -> int:
+        """A new program's baseline, empty (learning from its next log), with ``signatures``, among the unit's
+        ``stages`` (:class:`faultgen.monitor.scoring.Stages`): its index."""
         # the unit has learned: the new program learns its offset alone
-        fresh = Baseline(monitor.settings, monitor.n_axes, signatures,
-                         monitor.shared_ if monitor.baseline.pca is not None else None)
+        fresh = Baseline(stages.settings, stages.n_axes, signatures,
+                         stages.shared if stages.baseline.pca is not None else None)
         fresh.program_changed = True  # its learning logs listed as they come, then scored as relearning
         self.saved.append(fresh)
         self.offsets.append(None)
         return len(self.saved)
 
-    def run(self, monitor, program: int, call) -> None:
-        """``call()`` (a method of ``monitor``) with program ``program``'s baseline (0: the first's,
-        as the monitor holds it); the rows sorted by stamp after a program learns."""
-        if program == 0:
-            call()
-        else:
-            self._run(monitor, program, call)
-        if monitor.baseline.pca is None and self.saved and self.learning_logs(monitor) >= monitor.settings.train:
-            pool(monitor, self)
 
-    def learning_logs(self, monitor) -> int:
-        """The unit's learning logs in all, every program's (before the unit has learned)."""
-        return len(monitor.baseline.training) + sum(len(b.training) for b in self.saved)
-
-    def _run(self, monitor, program: int, call) -> None:
-        first, trend = monitor.baseline, monitor.wear.trend
-        monitor.baseline = self.saved[program - 1]
-        offset = self.offsets[program - 1]
-        if offset is None and trend.state is not None:
-            offset = (trend.state[:, 0].copy(), trend.covariance[:, 0, 0].copy())
-        zero = np.zeros(monitor.n_axes)
-        monitor.wear.trend = _Fused(trend, *(offset if offset is not None else (zero, zero)))
-        learning = monitor.baseline.pca is None
-        try:
-            call()
-        finally:
-            if learning and monitor.baseline.pca is not None:  # learned: its rows join the unit's in stamp order
-                self.offsets[program - 1] = offset
-                monitor.rows.sort(key=lambda row: row.stamp)
-            monitor.baseline, monitor.wear.trend = first, trend
-
-    def maintenance(self, monitor, stamp: str, event: str, axis: int) -> None:
-        """A repair or gearbox change given to every program's baseline
-        (:meth:`faultgen.monitor.scoring.UnitMonitor.maintenance`): each learns its offset again,
-        and the wear its later programs read from then on starts at 0."""
-        monitor.maintenance(stamp, event, axis)
-        for k in range(1, len(self.saved) + 1):
-            self.run(monitor, k, lambda: monitor.maintenance(stamp, event, axis))
-            if self.offsets[k - 1] is not None:
-                self.offsets[k - 1] = (np.zeros(monitor.n_axes), np.zeros(monitor.n_axes))
-
-
-def pool(monitor, baselines: Baselines) -> None:
-    """Learn the unit's baseline on the learning logs of all its programs (``train`` in all: module
-    docstring of :mod:`faultgen.monitor.baseline`): each program with at least ``relearn_logs`` of
-    them (and the first, always) its own offset, all of them the slopes, noise and PCA model
-    (:meth:`~faultgen.monitor.baseline.Baseline.learn_with`); a program with fewer learns its offset
-    on its own (:meth:`~faultgen.monitor.baseline.Baseline.fit_offset`). The learning logs' rows are
-    scored in stamp order, each on its program's baseline."""
-    first = monitor.baseline
-    parts = [first.training] + [b.training for b in baselines.saved]
-    pooled = [k for k, logs in enumerate(parts) if k == 0 or len(logs) >= first.relearn_logs]
-    logs = sorted(((s, i, e, c) for i, k in enumerate(pooled) for s, e, c in parts[k]), key=lambda log: log[0])
-    groups = np.array([i for _, i, _, _ in logs])
-    first.training = [(s, e, c) for s, _, e, c in logs]
-    R, offsets = first.fit_shared(groups)
-    common = monitor.shared_ = first.shared(R, len(R) - len(pooled) - len(first.regressors_))
-    counts = np.bincount(groups)
-    first.training, first.learned_ = [], int(counts[0])
-    error = None if first.signatures is None else first.fit_signatures(R, common["dof"])
-    monitor.wear.start(len(first.regressors_), error, first.gram_inv_)
-    zero = np.zeros(monitor.n_axes)
-    for i, k in enumerate(pooled[1:], 1):
-        baselines.offsets[k - 1] = (zero, zero)  # learned with the first: its wear read from the same start
-        baselines.saved[k - 1].learn_with(common, offsets[i], int(counts[i]))
-    for k in range(1, len(parts)):
-        if k not in pooled:
-            baselines.saved[k - 1].borrowed_ = common
-    learned = {s for s, _, _, _ in logs}
-    monitor.rows[:] = [row for row in monitor.rows if row.stamp not in learned]
-    for j, (stamp, i, _, _) in enumerate(logs):
-        baselines.run(monitor, pooled[i], lambda j=j, stamp=stamp: monitor.score_learning([stamp], R[j:j + 1],
-                                                                                          "training"))
-    monitor.rows.sort(key=lambda row: row.stamp)
-
-
-def learning(monitor, program: int) -> bool:
-    """Whether the unit's program ``program`` (0: its first) is still learning its baseline."""
-    return (monitor.baseline if program == 0 else baselines_of(monitor).saved[program - 1]).pca is None
-
-
-def baselines_of(monitor) -> Baselines:
-    """The :class:`Baselines` of a unit's monitor (made empty on first use)."""
-    if not hasattr(monitor, "program_baselines"):
-        monitor.program_baselines = Baselines()
-    return monitor.program_baselines
+def learning(stages, program: int) -> bool:
+    """Whether the unit's program ``program`` (0: its first) is still learning its baseline (``stages``:
+    :class:`faultgen.monitor.scoring.Stages`)."""
+    return (stages.baseline if program == 0 else stages.programs.saved[program - 1]).pca is None
 
 
 def mix(entries, count: int) -> str:
@@ -334,12 +255,12 @@ def mix(entries, count: int) -> str:
     return ", ".join(f"program {k + 1}: {int(n)} logs" for k, n in enumerate(logs))
 
 
-def mix_note(monitor, entries, count: int) -> str:
+def mix_note(stages, entries, count: int) -> str:
     """A unit's note on its programs when it has run more than one (:func:`mix`, and each later
-    program still learning its baseline), else ""."""
+    program of its ``stages`` still learning its baseline), else ""."""
     if count < 2:
         return ""
-    saved = baselines_of(monitor).saved
+    saved = stages.programs.saved
     learning = [f"program {k + 2} learning: {len(b.training)} of {b.learning_logs} logs"
                 for k, b in enumerate(saved) if b.pca is None]
     return "; ".join([f"programs: {mix(entries, count)}", *learning])

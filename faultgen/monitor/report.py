@@ -15,7 +15,7 @@ import threading
 import numpy as np
 
 from faultgen.figure_text import plain
-from faultgen.monitor import scoring
+from faultgen.monitor import scoring, steps
 from faultgen.monitor.record import Table
 
 #: ``first_alarm``: the first of the alarming logs the alarm started from; ``known``: the log on which it
@@ -63,24 +63,24 @@ def units_table(statuses, scales: dict[str, str] | None = None) -> Table:
     return Table("units.csv", columns, rows)
 
 
-def alarms_table(monitors) -> Table:
-    """``alarms.csv``: each unit's alarms (:meth:`faultgen.monitor.scoring.UnitMonitor.alarm_rows`)."""
-    return Table("alarms.csv", ALARM_COLUMNS, [[_fmt(row[c]) for c in ALARM_COLUMNS] for m in monitors
-                                               for row in m.alarm_rows()])
+def alarms_table(units) -> Table:
+    """``alarms.csv``: each unit's alarms (``units``: their records; :func:`faultgen.monitor.steps.alarm_rows`)."""
+    return Table("alarms.csv", ALARM_COLUMNS, [[_fmt(row[c]) for c in ALARM_COLUMNS] for m in units
+                                               for row in steps.alarm_rows(m)])
 
 
-def scores_table(monitors, n_axes: int) -> Table:
-    """``scores.csv``: every scored log's row; with the twin also each axis's wear, % (``wearI``: filtered over the
+def scores_table(units, n_axes: int) -> Table:
+    """``scores.csv``: every scored log's row (``units``: their records); with the twin also each axis's wear, % (``wearI``: filtered over the
     logs, :class:`faultgen.monitor.wear_trend.WearTrend`), its lower one-sided 90 % bound
     (``wearI_lower``, :data:`faultgen.monitor.scoring.WEAR_ALARM_CONFIDENCE`), what the alarm is judged
     on, and the log's own estimate (less the learned slope errors' part at its conditions,
     :meth:`faultgen.monitor.wear_trend.WearTrend.condition_part`) and its lower ``1 - alpha`` bound
     (``wearI_log``, ``wearI_log_lower``), what the remaining life is fitted on."""
     columns = SCORE_COLUMNS + tuple(f"score{i}" for i in range(1, n_axes + 1))
-    if any(m.baseline.signatures is not None for m in monitors):
+    if any(m.stages.baseline.signatures is not None for m in units):
         columns += tuple(f"wear{i}{end}" for end in ("", "_lower", "_log", "_log_lower") for i in range(1, n_axes + 1))
     rows = []
-    for m in monitors:
+    for m in units:
         for row in m.rows:
             cells_ = score_cells(row)
             rows.append([_fmt(cells_.get(c, "")) for c in columns])
@@ -102,8 +102,8 @@ def score_cells(row) -> dict:
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
 
 
-def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
-    """``wear.csv``: per unit, scored log and axis (1..N), the wear, % increase of the axis's dry
+def wear_table(units, scales: bool = False, nominal=frozenset()) -> Table:
+    """``wear.csv``: per unit (``units``: their records), scored log and axis (1..N), the wear, % increase of the axis's dry
     friction in % of the unit's own (``wear``: filtered over the logs so far,
     :class:`faultgen.monitor.wear_trend.WearTrend`), its 90 % interval with the twin's model
     uncertainty (``wear_5``, ``wear_95``; :meth:`faultgen.monitor.wear.WearEstimator.wear_interval`),
@@ -113,12 +113,12 @@ def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
     row's ``wear_scale``: ``friction test``, ``twin``, or for a unit in ``nominal`` (its twin fell
     back to the nominal model) ``nominal model`` (:mod:`faultgen.monitor.friction_tests`)."""
     rows = []
-    for m in monitors:
+    for m in units:
         for row in m.rows:
             w = row.wear
             if w is None:
                 continue
-            for k in range(m.n_axes):
+            for k in range(m.stages.n_axes):
                 default = "nominal model" if m.unit in nominal else "twin"
                 extra = [w.tests.scale[k] if w.tests is not None else default] if scales else []
                 rows.append([_fmt(row.unit), _fmt(row.stamp), row.phase, k + 1,
@@ -126,8 +126,8 @@ def wear_table(monitors, scales: bool = False, nominal=frozenset()) -> Table:
     return Table("wear.csv", WEAR_COLUMNS + (("wear_scale",) if scales else ()), rows)
 
 
-def chart(path, monitor, axis_note: str) -> None:
-    """The unit's control chart: T2 and Q over their limits per log, the persistent alarm, with the
+def chart(path, unit, axis_note: str) -> None:
+    """The control chart of ``unit`` (its record): T2 and Q over their limits per log, the persistent alarm, with the
     twin each axis's wear estimate with the limit its lower bound is judged against, and each
     axis's isolation score."""
     import matplotlib
@@ -136,7 +136,7 @@ def chart(path, monitor, axis_note: str) -> None:
     import matplotlib.pyplot as plt
 
     with plt.style.context("default"):  # whatever another library set globally (ProgPy sets fonts on import)
-        _draw(path, monitor, axis_note)
+        _draw(path, unit, axis_note)
 
 
 #: This thread's figures, by height (inches): one per chart size, cleared for each chart, so that its
@@ -184,8 +184,8 @@ def _figure(height: float):
     return fig
 
 
-def _draw(path, monitor, axis_note: str) -> None:
-    rows = monitor.rows
+def _draw(path, unit, axis_note: str) -> None:
+    rows, stages = unit.rows, unit.stages
     twin = bool(rows) and rows[0].wear is not None
     fig = _figure(8.5 if twin else 6)
     panels = fig.subplots(3 if twin else 2, 1, sharex=True)
@@ -195,11 +195,11 @@ def _draw(path, monitor, axis_note: str) -> None:
         for name, style in (("Q", "-"), ("T2", "--")):
             top.plot(x, [getattr(r, name) / getattr(r, f"{name}_limit") for r in rows], style, lw=1,
                      label=f"{name} / limit")
-        top.axhline(1.0, color="k", lw=0.8, label="limit (alpha {:g})".format(monitor.settings.alpha))
+        top.axhline(1.0, color="k", lw=0.8, label="limit (alpha {:g})".format(stages.settings.alpha))
         training = sum(r.phase == "training" for r in rows)
         top.axvspan(-0.5, training - 0.5, color="0.9", label="learning (own first logs)")
         stamps = [r.stamp for r in rows]
-        alarm = monitor.alarm
+        alarm = stages.alarm
         if alarm.first_alarm:
             k = stamps.index(alarm.first_alarm)
             for ax in panels:
@@ -210,25 +210,25 @@ def _draw(path, monitor, axis_note: str) -> None:
         top.set_yscale("log")
         if twin:
             middle = panels[1]
-            nan = np.full(monitor.n_axes, np.nan)
+            nan = np.full(stages.n_axes, np.nan)
             wear = [(r.wear.estimate, r.wear.lower) if r.wear is not None else (nan, nan) for r in rows]
-            for i in range(monitor.n_axes):
+            for i in range(stages.n_axes):
                 middle.plot(x, [w[0][i] for w in wear], lw=1, label=f"axis {i + 1}")
             best = [max((v for v in w[1] if np.isfinite(v)), default=np.nan) for w in wear]
             middle.plot(x, best, "k:", lw=1, label=f"largest lower {100 * scoring.WEAR_ALARM_CONFIDENCE:g} % bound")
-            middle.axhline(monitor.settings.wear_limit, color="k", lw=0.8, label="wear limit")
+            middle.axhline(stages.settings.wear_limit, color="k", lw=0.8, label="wear limit")
             middle.set_ylabel("wear estimate, % of own dry friction")
             middle.legend(fontsize=7, loc="upper left", ncol=4)
         scores = np.array([r.scores for r in rows])
-        for i in range(monitor.n_axes):
+        for i in range(stages.n_axes):
             bottom.plot(x, scores[:, i], lw=1, label=f"axis {i + 1}")
         step = max(1, len(rows) // 8)
         bottom.set_xticks(x[::step], [plain(s) for s in stamps[::step]], rotation=30, ha="right", fontsize=8)
     else:
         top.text(0.5, 0.5, "no log scored: see units.csv", ha="center", va="center", transform=top.transAxes)
     top.set_ylabel("statistic / its limit")
-    protocol = "twin" if monitor.baseline.signatures is not None else "own"
-    top.set_title(plain(f"{monitor.unit}: PCA monitor of the per-log features ({protocol} protocol)"))
+    protocol = "twin" if stages.baseline.signatures is not None else "own"
+    top.set_title(plain(f"{unit.unit}: PCA monitor of the per-log features ({protocol} protocol)"))
     bottom.set_ylabel(f"isolation score ({axis_note if protocol == 'twin' else 'RBC of Q'})")
     if rows:
         top.legend(fontsize=7, loc="upper left")

@@ -1,4 +1,5 @@
-"""One unit's monitor, fed its logs one at a time in stamp order (:class:`UnitMonitor`).
+"""One unit's monitor, fed its logs one at a time in stamp order: its :class:`Stages` in its record,
+the steps over them in :mod:`faultgen.monitor.steps`.
 
 A log arrives as its residual: the features minus the twin's expectation at the log's payload
 (protocol ``twin``), or the features themselves (protocol ``own``). The first ``train`` logs are
@@ -53,20 +54,20 @@ axis's share of Q, thesis eq. 3.3-3.4, smears a fault over the axes whose featur
 with it).
 
 State is small and bounded per log (a row of scores each); a rerun on a grown folder rebuilds the
-monitor by feeding it the stored inputs again (:mod:`faultgen.monitor.state`: JSON, no pickle) and
+stages and rows by feeding them the stored inputs again (:func:`faultgen.monitor.steps.replay`) and
 continues where the last one stopped.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from faultgen.monitor import record
 # the stages' constants live with their stages; named here too, as the monitor's (noqa: re-exported)
 from faultgen.monitor.alarm import WEAR_ALARM_CONFIDENCE, AlarmRule  # noqa: F401
 from faultgen.monitor.baseline import FEATURES, NOT_OBSERVABLE_LIMITS, WEAR_FEATURES, WEAR_INTERVAL, Baseline  # noqa: F401
+from faultgen.monitor.programs import Baselines
 from faultgen.monitor.wear import SCALE_UNCERTAINTY, WearEstimator  # noqa: F401
 
 PROTOCOLS = ("twin", "own")
@@ -125,182 +126,30 @@ class Settings:
                              "wear, % of the axis's own dry friction, the estimate must be sure of before a log alarms)")
 
 
-class UnitMonitor:
-    """The monitor of one unit (module docstring), as stages over its :attr:`rows`: the program's
-    :attr:`baseline` (:class:`faultgen.monitor.baseline.Baseline`; a later program's is swapped in
-    for its logs by :class:`faultgen.monitor.programs.Baselines`), the :attr:`wear`
-    (:class:`faultgen.monitor.wear.WearEstimator`: its filter and friction tests' scale), and the :attr:`alarm` rule
-    (:class:`faultgen.monitor.alarm.AlarmRule`). ``signatures`` (n_axes, n_features): the first
-    program's wear signatures in feature units per % (protocol ``twin``), or None."""
+@dataclass
+class Stages:
+    """The stage objects one unit's logs are fed through, held by its record
+    (:attr:`faultgen.monitor.history.UnitHistory.stages`; the steps: :mod:`faultgen.monitor.steps`):
+    the program's ``baseline`` (:class:`~faultgen.monitor.baseline.Baseline`; a later program's, of
+    ``programs``, swapped in for its logs), the ``wear`` estimator
+    (:class:`~faultgen.monitor.wear.WearEstimator`: its filter and friction tests' scale), the
+    ``alarm`` rule (:class:`~faultgen.monitor.alarm.AlarmRule`); ``since`` the last maintenance or
+    program change (what, stamp, rows before it) or None; ``shared`` what the programs met later
+    borrow of the first program's learned baseline (:meth:`~faultgen.monitor.baseline.Baseline.shared`),
+    or None before it learned."""
 
-    def __init__(self, unit: str, settings: Settings, n_axes: int, signatures: np.ndarray | None = None):
-        self.unit, self.settings, self.n_axes = unit, settings, n_axes
-        self.baseline = Baseline(settings, n_axes, signatures)
-        self.alarm = AlarmRule(unit, settings)
-        #: The last maintenance or program change (what, stamp, rows before it), or None.
-        self.since: tuple[str, str, int] | None = None
-        self.rows: list[record.LogRow] = []
-        self.last_stamp: str | None = None
-        #: What the unit's programs met later borrow of its first program's learned baseline
-        #: (:meth:`faultgen.monitor.baseline.Baseline.shared`), or None before it learned.
-        self.shared_: dict | None = None
-        self.wear = WearEstimator(settings, n_axes)
+    settings: Settings
+    n_axes: int
+    baseline: Baseline
+    wear: WearEstimator
+    alarm: AlarmRule
+    programs: Baselines = field(default_factory=Baselines)
+    since: tuple[str, str, int] | None = None
+    shared: dict | None = None
 
-    # -- a new program ---------------------------------------------------------------------------
-    def restart(self, stamp: str, reason: str) -> None:
-        """The unit runs another program from the log ``stamp`` on (``reason`` says how it was
-        found): its open alarm, if any, is closed by it, and the unit learns its normal operation
-        again from this log on (``train`` logs), against the twin of the new program."""
-        b = self.baseline
-        self.alarm.close(b, stamp, reason)
-        self.since, b.program_changed, b.placeholders = ("program change", stamp, len(self.rows)), True, 0
-        b.training, b.learned_expectations = [], []
-        b.pca, b.relearning = None, None
-        self.alarm.reset()
-        if self.wear.tests is not None:
-            self.wear.tests.reset()
-
-    # -- maintenance ----------------------------------------------------------------------------
-    def maintenance(self, stamp: str, event: str, axis: int) -> None:
-        """A repair or gearbox change (``event``) on ``axis`` (1..N) logged at ``stamp``, before the
-        next log: the open alarm, if any, is closed by it (kept in the alarm's ``closed``), and the
-        unit's offset (the residual's mean, every feature's) is learned again from the next
-        ``relearn_logs`` logs, which are scored but do not alarm; its slopes, noise and PCA
-        model stay. The wear estimate of every axis, the changed one's first, restarts from the new
-        offset. During the first learning the learning restarts."""
-        if self.wear.tests is not None:
-            self.wear.tests.reset()
-        b = self.baseline
-        if b.pca is None:
-            b.training, b.learned_expectations, b.placeholders = [], [], 0
-            return
-        self.alarm.close(b, stamp, f"{event} of axis {axis}")
-        self.since = (f"{event} of axis {axis}", stamp, len(self.rows))
-        self.alarm.reset()
-        b.relearning = []
-        self.wear.trend.reset()
-
-    # -- learning -------------------------------------------------------------------------------
-    def _fit(self) -> None:
-        """Learn the baseline on its training logs (:meth:`faultgen.monitor.baseline.Baseline.fit`) and
-        score them; the unit's first program's also starts the wear filter (:meth:`WearEstimator.start`) and
-        keeps what the programs met later borrow (:attr:`shared_`)."""
-        stamps, R, error, common = self.baseline.fit()
-        if common is not None:
-            self.shared_ = common
-            self.wear.start(len(self.baseline.regressors_), error, self.baseline.gram_inv_)
-        self.score_learning(stamps, R)
-
-    def score_learning(self, stamps: list[str], R: np.ndarray, phase: str | None = None) -> None:
-        """The rows of the learning logs ``stamps`` (residuals ``R`` less offset and slopes), in place of
-        those listed for them since a program change; ``phase`` "relearning" after a program change,
-        else "training" (None: as the baseline's ``program_changed`` says)."""
-        b = self.baseline
-        if b.placeholders:  # the rows standing for these logs since a program change (by stamp: another
-            learned = set(stamps)  # program's logs may lie between them, faultgen.monitor.programs)
-            self.rows[:] = [row for row in self.rows if row.stamp not in learned]
-            b.placeholders = 0
-        phase = phase or ("relearning" if b.program_changed else "training")
-        b.program_changed = False
-        for stamp, r in zip(stamps, R):
-            wear = b.wear_estimate(r, b.scale_**2)
-            self._score(stamp, r / b.scale_, phase=phase, wear=None if wear is None else (*wear, wear[1], None))
-
-    # -- scoring --------------------------------------------------------------------------------
-    def add(self, stamp: str, residual: np.ndarray, temperature: float, payload: float,
-            expected: np.ndarray | None = None) -> None:
-        """Take the next log (``stamp`` later than every earlier one): its residual (n_features,),
-        mean joint temperature (deg C, NaN when not logged), payload (kg) and the twin's expected
-        features at its conditions (n_features,; None without a twin)."""
-        self.last_stamp = stamp
-        b = self.baseline
-        conditions = np.array([temperature, payload], dtype=float)
-        if b.pca is None:
-            b.training.append((stamp, np.asarray(residual, dtype=float), conditions))
-            if expected is not None:
-                b.learned_expectations.append(np.asarray(expected, dtype=float))
-            if len(b.training) == b.learning_logs:
-                self._fit()
-            elif b.program_changed:  # listed at once (scored when the learning is complete)
-                self.rows.append(record.listed(self.unit, stamp, self.n_axes))
-                b.placeholders += 1
-            return
-        e = np.asarray(residual, dtype=float)
-        relearned = b.relearning is not None
-        if relearned:
-            b.relearning.append((e, conditions))
-            if len(b.relearning) == b.relearn_logs:
-                b.learn_offset(*(np.stack(logs) for logs in zip(*b.relearning)))
-                b.relearning = None
-                self.wear.trend.reset()  # the wear restarts from the new offset
-                if self.wear.tests is not None:
-                    self.wear.tests.reset()
-        factor = b.prediction_factor(conditions)
-        z = b.standardise(e, conditions) / factor
-        variance = (b.scale_ * factor) ** 2
-        if expected is not None and b.learned_expectations:
-            # the twin's prediction of a change from every condition learned from is trusted to
-            # MODEL_UNCERTAINTY of its size: that much is added to the residual's noise
-            change = np.min(np.abs(np.stack(b.learned_expectations) - expected), axis=0)
-            z = z / np.sqrt(1.0 + (MODEL_UNCERTAINTY * change / b.scale_) ** 2)
-            variance = variance + (MODEL_UNCERTAINTY * change) ** 2
-        x = b.centred(conditions)
-        wear = b.wear_estimate(e - b.mean_ - x @ b.slope_, variance)
-        if wear is not None:
-            # the trend carries the slopes' error in its state (WearTrend): its measurement's
-            # error is the noise without the prediction interval's part from the slopes
-            # (the offset's share, 1/m, stays: the trend's start carries it)
-            noise = variance - (b.scale_ * factor) ** 2 + b.scale_**2 * (1.0 + 1.0 / b.learned_)
-            trend_error = b.wear_estimate(np.zeros_like(e), noise)[1]
-            wear = (*wear, trend_error, x)
-        self._score(stamp, z, phase="relearning" if relearned else "monitoring", wear=wear)
-
-    def _score(self, stamp: str, z: np.ndarray, phase: str, wear=None) -> None:
-        b = self.baseline
-        t2, q = (float(v[0]) for v in b.pca.score_samples(z[None]))
-        alarm = q > b.pca.q_limit_ or t2 > b.pca.t2_limit_
-        wear_row, at_once = None, False
-        if wear is not None:
-            wear, alarm, at_once, wear_row = self.wear.read(stamp, wear, b.observable_)
-        scores = b.axis_scores(z)
-        ranking = np.argsort(-scores, kind="stable") + 1
-        if phase == "monitoring":
-            self.alarm.step(b, stamp, z, t2, q, wear, alarm, at_once)
-        self.rows.append(record.LogRow(self.unit, stamp, phase, q, b.pca.q_limit_, t2, b.pca.t2_limit_,
-                                       int(alarm), tuple(int(a) for a in ranking), np.asarray(scores, dtype=float),
-                                       wear_row))
-
-    def alarm_row(self) -> dict:
-        """The unit's current row of alarms.csv: its open alarm, or why there is none."""
-        b = self.baseline
-        row = {**self.alarm.open_alarm(), "closed": "", "closed_by": ""}
-        if not self.alarm.first_alarm:
-            row["evidence"] = (f"no persistent alarm in {len(self.rows)} logs" if b.pca is not None else
-                               f"still learning: {len(b.training)} of {self.settings.train} logs")
-            if self.since is not None and b.pca is not None:  # after maintenance or a program change
-                what, stamp, before = self.since
-                row["evidence"] = (f"no persistent alarm since the {what} of {stamp} ({len(self.rows) - before} logs "
-                                   f"since, {len(self.rows)} in all)")
-            elif self.since is not None and b.program_changed:
-                row["evidence"] = (f"learning again after the program change of {self.since[1]}: "
-                                   f"{len(b.training)} of {self.settings.train} logs")
-            if b.relearning is not None:
-                row["evidence"] += (f"; learning its offset again after maintenance: {len(b.relearning)} of "
-                                    f"{b.relearn_logs} logs")
-        return row
-
-    def not_observable_note(self) -> str:
-        """The axes not observable on the unit's program in words (:data:`NOT_OBSERVABLE_LIMITS`), or ""."""
-        axes = np.flatnonzero(~self.baseline.observable_)
-        if self.baseline.pca is None or not len(axes):
-            return ""
-        widths = ", ".join(f"axis {k + 1}: {self.baseline.width_[k]:.3g}" for k in axes)
-        return (f"axis {', '.join(str(k + 1) for k in axes)} {NOT_OBSERVABLE} (no wear, trend or remaining life): "
-                f"one log's 90 % interval of the wear is wider than {NOT_OBSERVABLE_LIMITS:g} x the wear limit "
-                f"({NOT_OBSERVABLE_LIMITS * self.settings.wear_limit:g} points; {widths} points), so the logs cannot "
-                "tell it unworn from worn to the limit")
-
-    def alarm_rows(self) -> list[dict]:
-        """The unit's rows of alarms.csv: every alarm closed by maintenance (``closed``,
-        ``closed_by``), then its current row (:meth:`alarm_row`)."""
-        return [*self.alarm.closed, self.alarm_row()]
+    @classmethod
+    def new(cls, unit: str, settings: Settings, n_axes: int, signatures: np.ndarray | None = None) -> Stages:
+        """Unit ``unit``'s stages before its first log; ``signatures`` (n_axes, n_features): its first
+        program's wear signatures in feature units per % (protocol ``twin``), or None."""
+        return cls(settings, n_axes, Baseline(settings, n_axes, signatures), WearEstimator(settings, n_axes),
+                   AlarmRule(unit, settings))

@@ -24,7 +24,7 @@ from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import programs as unit_programs
 from faultgen.monitor import state as stored
 from faultgen.monitor.history import UnitHistory
-from faultgen.monitor.scoring import Settings, UnitMonitor
+from faultgen.monitor.scoring import Settings, Stages
 from faultgen.monitor.twin import Twin
 
 #: Two units run the same program when their first logs have the same samples and angles within this, rad.
@@ -84,10 +84,10 @@ def new_unit(name, units, nominal, settings: Settings, calibrated_model, calibra
     whatever the model, and is no program for other units. The model itself is made with the twin
     (:func:`twin_of`), which falls back when it cannot be. The first log is read here, once
     (``source``)."""
-    monitor = UnitMonitor(name, settings, nominal.n_axes)
+    stages = Stages.new(name, settings, nominal.n_axes)
 
     def unit(kind: str, program: tuple[str, str] | None, notes=()) -> UnitHistory:
-        return UnitHistory(name, kind, program, first_key, notes=list(notes), monitor=monitor)
+        return UnitHistory(name, kind, program, first_key, notes=list(notes), stages=stages)
 
     first = units[name][0]
     if settings.protocol == "twin":
@@ -202,7 +202,7 @@ def twin_of(unit: UnitHistory, context, twins: dict, progress: bool, source: fle
     units, out = context.units, context.out
     while unit.model != "none":
         try:
-            first_log = next((g for g in units[unit.monitor.unit] if g.stamp == unit.first[0]), None)
+            first_log = next((g for g in units[unit.unit] if g.stamp == unit.first[0]), None)
             model = model_of(source, unit.model, unit.first, first_log, out, progress)
             twin_key = (str(model.path), unit.program)
             if twin_key not in twins:
@@ -225,11 +225,12 @@ def twin_of(unit: UnitHistory, context, twins: dict, progress: bool, source: fle
             unit.notes[start:] = chain_notes(tried, fallback)
             unit.model = fallback
             continue
-        if unit.monitor.baseline.signatures is not None and not np.array_equal(unit.monitor.baseline.signatures, twin.signatures):
-            raise stored.StateError(f"{out / '.state' / (unit.monitor.unit + '.json')}: its wear signatures are not those of "
-                             f"the twin of {unit.monitor.unit} now (another model or program); score this folder "
+        baseline = unit.stages.baseline
+        if baseline.signatures is not None and not np.array_equal(baseline.signatures, twin.signatures):
+            raise stored.StateError(f"{out / '.state' / (unit.unit + '.json')}: its wear signatures are not those of "
+                             f"the twin of {unit.unit} now (another model or program); score this folder "
                              "into a new OUT")
-        unit.monitor.baseline.signatures = twin.signatures
+        baseline.signatures = twin.signatures
         if unit.signatures is None and not unit.program_changes:
             unit.signatures = twin.signatures
         return twin

@@ -1,6 +1,6 @@
 """Each axis's wear filtered over a unit's logs (:class:`WearTrend`): the Kalman
 filter of a local linear trend, with the learned condition slopes' error as regression effects in
-its state, through which :class:`faultgen.monitor.scoring.UnitMonitor` passes each log's wear
+its state, through which :class:`faultgen.monitor.wear.WearEstimator` passes each log's wear
 estimate (docs/analysis.md, "Wear in the robot's own scale")."""
 
 from __future__ import annotations
