@@ -210,7 +210,7 @@ def test_the_shift_distances_are_the_direct_sums():
     for n, m in ((50, 13), (9, 13), (40, 40)):
         x, r = rng.normal(size=(n, 3)), rng.normal(size=(m, 3))
         direct = [np.mean((x - r[(np.arange(n) + s) % m]) ** 2) for s in range(m)]
-        assert np.allclose(align._shift_distances(x, r), direct, rtol=1e-10, atol=1e-12)
+        assert np.allclose(align._shift_distances(x, align.Reference("r", r, float(m))), direct, rtol=1e-10, atol=1e-12)
     x = rng.normal(size=(60, 2))
     direct = [np.mean((x[: 60 - k] - x[k:]) ** 2) for k in range(60)]
     assert np.allclose(align._lag_distances(x), direct, rtol=1e-9, atol=1e-12)

@@ -1,7 +1,10 @@
 """A twin's signature cycles (the healthy cycle at the model's own friction and one per worn axis)
 simulated together as one batch (``stepping.simulate``'s ``dry_multipliers``) are the bits of the
 same cycles simulated one by one, as the twin did before (and still does for a cycle asked alone);
-``dry_multipliers`` refuses what it cannot mean, by name."""
+``dry_multipliers`` refuses what it cannot mean, by name. A twin reads (or simulates) each cycle
+once and keeps it (issue 87 item 2: no re-read of the twin per log)."""
+
+import json
 
 import numpy as np
 import pytest
@@ -67,3 +70,22 @@ def test_the_reference_temperature_leaves_the_models_friction_as_it_is(program, 
     assert held.thermal is not None
     warm = sim.simulate(twin._config(REFERENCE_TEMPERATURE, 0.0, plan), progress=False)
     np.testing.assert_allclose(twin._features(warm), twin.cycle(float("nan"), 0.0), rtol=1e-12, atol=0)
+
+
+def test_a_cycle_is_read_once_a_twin_and_a_new_twin_checks_the_file(program, tmp_path):
+    robot, log = program
+    cache = tmp_path / "cycles"
+    twin = Twin(robot, log, cache, cycles=False)
+    own = float("nan")
+    first = twin.cycle(own, 0.0)  # simulated and cached
+    (path,) = cache.glob("*.json")
+    stored = json.loads(path.read_text())
+    np.testing.assert_array_equal(first, stored["features"])
+    first[:] = 0.0  # a caller's change to what it was handed stays its own
+    stored["key"]["payload_kg"] = 1.0  # the file tampered with after it was read
+    path.write_text(json.dumps(stored))
+    again = twin.cycle(own, 0.0)
+    np.testing.assert_array_equal(again, json.loads(path.read_text())["features"])
+    assert again is not twin.cycle(own, 0.0)
+    with pytest.raises(ValueError, match=rf"{path.name}: not the cached twin cycle of"):
+        Twin(robot, log, cache, cycles=False).cycle(own, 0.0)  # read again by a new twin, and checked

@@ -40,6 +40,7 @@ the period and reads as a new program.
 from __future__ import annotations
 
 import enum
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,6 +120,18 @@ class Reference:
     def step(self) -> float:
         """The reference's sample step, s."""
         return self.period / len(self.q)
+
+    @functools.cached_property
+    def spectra(self) -> tuple[list[np.ndarray], np.ndarray]:
+        """The real FFTs every :func:`fit` against this program takes of its cycle: each axis's
+        column of :attr:`q` and the sum of their squares (the same calls, computed once a reference,
+        not once a log; not pickled with it)."""
+        return [np.fft.rfft(self.q[:, a]) for a in range(self.q.shape[1])], np.fft.rfft(np.sum(self.q * self.q, axis=1))
+
+    def __getstate__(self) -> dict:
+        state = dict(self.__dict__)
+        state.pop("spectra", None)  # made again where needed
+        return state
 
 
 @dataclass(frozen=True)
@@ -237,20 +250,22 @@ def _spread(q: np.ndarray) -> float:
 
 
 def _circular(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``sum_k a[k] b[(k + s) mod m]`` for every ``s`` in [0, m) (1-D arrays of length m)."""
-    m = len(a)
-    return np.fft.irfft(np.conj(np.fft.rfft(a)) * np.fft.rfft(b), m)
+    """``sum_k a[k] b[(k + s) mod m]`` for every ``s`` in [0, m): ``a`` (m,) and ``b`` the real FFT
+    (``np.fft.rfft``) of the other array of length m."""
+    return np.fft.irfft(np.conj(np.fft.rfft(a)) * b, len(a))
 
 
-def _shift_distances(x: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """The mean squared angle difference, rad^2, between ``x`` (n, N) and the cycle ``r`` (m, N)
-    repeated, log sample ``i`` against reference sample ``(i + s) mod m``, for every ``s`` in [0, m)."""
+def _shift_distances(x: np.ndarray, program: Reference) -> np.ndarray:
+    """The mean squared angle difference, rad^2, between ``x`` (n, N) and the cycle ``r`` (m, N) of
+    ``program`` repeated, log sample ``i`` against reference sample ``(i + s) mod m``, for every ``s``
+    in [0, m) (the cycle's FFTs :attr:`Reference.spectra`)."""
+    r, (columns, squares) = program.q, program.spectra
     m, n = len(r), len(x)
     bins = np.arange(n) % m
     folded = np.column_stack([np.bincount(bins, x[:, a], minlength=m) for a in range(x.shape[1])])
     count = np.bincount(bins, minlength=m).astype(float)
-    cross = sum(_circular(folded[:, a], r[:, a]) for a in range(r.shape[1]))
-    total = np.sum(x * x) + _circular(count, np.sum(r * r, axis=1)) - 2.0 * cross
+    cross = sum(_circular(folded[:, a], columns[a]) for a in range(r.shape[1]))
+    total = np.sum(x * x) + _circular(count, squares) - 2.0 * cross
     return np.maximum(total, 0.0) / x.size
 
 
@@ -278,7 +293,7 @@ def fit(t, q, program: Reference) -> Fit:
         raise ValueError(f"a log of {q.shape[1]} axes against program {program.name!r} of "
                          f"{program.q.shape[1]}: expected the same axes")
     x = resampled(t, q, program.step)
-    d = _shift_distances(x, program.q)
+    d = _shift_distances(x, program)
     m, best = len(d), int(np.argmin(d))
     shift = (best + _vertex(d[best - 1], d[best], d[(best + 1) % m])) % m
     squares = np.mean((x - _at(program.q, shift + np.arange(len(x)))) ** 2, axis=1)
@@ -367,14 +382,29 @@ def _fragment(start: int, stop: int, positions, resid, m: int, tolerance: float)
     return Fragment(start, stop, float(positions[start] % m / m), rms, use)
 
 
-def whole_cycles(t, q, program: Reference, cycle=None, tolerance: float = TOLERANCE) -> Cycles | NoWholeCycle:
+def known_fit(found: Recognition, programs) -> Fit | None:
+    """The :class:`Fit` :func:`recognise` made (``found``) of a log against the program it knows it
+    runs, among the ``programs`` it was given, for :func:`whole_cycles` (``fitted``: not fitted
+    again); None when ``found`` is not KNOWN or two of ``programs`` bear its name."""
+    if found.status is not Status.KNOWN or sum(p.name == found.program for p in programs) != 1:
+        return None
+    return next(f for f in found.fits if f.program == found.program)
+
+
+def whole_cycles(t, q, program: Reference, cycle=None, tolerance: float = TOLERANCE,
+                 fitted: Fit | None = None) -> Cycles | NoWholeCycle:
     """The whole cycles of ``program`` in a log (``t`` (n,) s, ``q`` (n, N) rad, at any phase and
     span), its leading and trailing fragments and what was done with each, and its ``cycle`` column
     (n,) checked as a hint (:func:`check_hint`; never used over the motion): a :class:`Cycles`, or a
     :class:`NoWholeCycle` with its reason (the log more than ``tolerance`` rad RMS off the program,
-    shorter than a cycle, or cut so that no whole cycle lies inside). ValueError for a malformed log."""
+    shorter than a cycle, or cut so that no whole cycle lies inside). ``fitted``: this log's
+    :func:`fit` against ``program`` already made (:func:`known_fit`: the same numbers), else it is
+    fitted here. ValueError for a malformed log, or a ``fitted`` of another program."""
     t, q = _checked(t, q)
-    f = fit(t, q, program)
+    if fitted is not None and fitted.program != program.name:
+        raise ValueError(f"a fit against program {fitted.program!r} given for program {program.name!r}: "
+                         "expected the log's fit against the program it is cut by")
+    f = fit(t, q, program) if fitted is None else fitted
     m, step = len(program.q), program.step
     positions = f.shift + (t - t[0]) / step
     hint = check_hint(t, cycle, positions, m, program.period)
@@ -514,7 +544,7 @@ def place(t, q, programs, cycle=None, name: str | None = None, tolerance: float 
     found = recognise(t, q, programs, tolerance)
     if found.status is Status.KNOWN:
         program = next(p for p in programs if p.name == found.program)
-        cut = whole_cycles(t, q, program, cycle, tolerance)
+        cut = whole_cycles(t, q, program, cycle, tolerance, known_fit(found, programs))
         return _placed(found, cut, None)
     if found.status is Status.NEW:
         reference = learn(name or f"program {len(programs) + 1}", t, q, cycle, tolerance)

@@ -176,7 +176,7 @@ def place(unit: UnitHistory, log, data, twin: Twin, context, source: fleet_logs.
             return f"no whole cycle: a new program that cannot be learned ({short(err)})"
     else:
         return unit_programs.refusal_text(align.untold(found))
-    cut = align.whole_cycles(data.t, data.q, reference, data.cycle)
+    cut = align.whole_cycles(data.t, data.q, reference, data.cycle, fitted=align.known_fit(found, programs))
     span = unit_programs.span_of(data.t, cut, reference.period)
     if span is None:
         return unit_programs.refusal_text(cut)

@@ -161,6 +161,7 @@ class Twin:
             name = which.replace(" of ", "of").replace("samples ", "s").replace(":", "-")
             self._reference = self._smoothed_program(f"{program.sha256[:24]}-{name}", t, q)
         self._healthy: dict[float, np.ndarray] = {}
+        self._cycles: dict[tuple, np.ndarray] = {}  # (temperature key, payload, worn axis) -> features, read or simulated once
         self._refused: dict[tuple, str] = {}  # (temperature, payload, worn_axis) -> why it cannot be simulated
         if cycles:
             self.complete()
@@ -251,9 +252,20 @@ class Twin:
 
     def cycle(self, temperature: float, payload: float, worn_axis: int = 0) -> np.ndarray:
         """The feature vector of one replayed cycle at ``temperature`` deg C (NaN: the model's
-        nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %."""
+        nominal friction) with a part of ``payload`` kg, ``worn_axis`` (1..N) at :data:`WEAR` %: read
+        from the cache (checked) or simulated the first time this twin is asked, then kept in memory
+        (a copy returned each time: a twin is not read again per log)."""
         key, path = self._key(temperature, payload, worn_axis)
         temperature = key["temperature_C"]
+        held = (temperature, key["payload_kg"], key["worn_axis"])
+        if held not in self._cycles:
+            self._cycles[held] = self._read_or_simulate(key, path)
+        return self._cycles[held].copy()
+
+    def _read_or_simulate(self, key: dict, path: Path) -> np.ndarray:
+        """The features of the cycle of cache ``key`` (at ``path``): read and checked when cached,
+        else simulated and cached (:meth:`cycle`)."""
+        temperature, payload, worn_axis = key["temperature_C"], key["payload_kg"], key["worn_axis"]
         n_features = len(fleet_logs.FEATURES) * self.robot.n_axes
         if path.exists() or path.is_symlink():
             return stored.read_cycle(path, self.root, key, n_features)
