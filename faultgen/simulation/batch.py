@@ -255,15 +255,15 @@ def _step_each(sim, work: Work, runs, write, start: int, stop: int, out: dict) -
     ours = isinstance(write, friction_update.Writer)
     update, rest = (write.arrays, write.rest) if ours else (friction_kernel.NO_UPDATE, write)
     args = (per_log, ours and write.compiled, runs.bind("ctrl"), drive_ctrl, inputs, runs.bind("qfrc_applied"),
-            arm_dof, dist, qvel, velocity)
-    before = friction_kernel.before_step
+            arm_dof, dist, qvel, velocity, *update)
+    before, step_all = friction_kernel.before_step, runs.step
     for k, at in enumerate(range(start, stop)):
-        before(k, *update, at, *args)
+        before(k, at, *args)
         if rest is not None:
             rest(k)
         if at in grip_steps:
             apply_grips(runs, work.grips, at)
-        runs.step()
+        step_all()
         if k % per_log == per_log - 1:
             for record, values in logged:
                 record[:, k] = values

@@ -38,8 +38,9 @@ _W = {d: types.Array(types.float64, d, "A") for d in (2, 3)}
 _I = {d: types.Array(types.int64, d, "A", readonly=True) for d in (1, 2)}
 #: k, qvel, qpos, level, axis, cols, load, target
 _FRICTION = (types.int64, _R[2], _R[2], _R[3], _R[2], _I[2], _R[4], _W[2])
-#: ... , at, per_log, friction, ctrl, drive_ctrl, inputs, applied, arm_dof, dist, speeds, velocity
-_INPUTS = (types.int64, types.int64, types.boolean, _W[2], _I[2], _R[3], _W[2], _I[1], _R[3], _R[2], _W[3])
+#: k, at, per_log, friction, ctrl, drive_ctrl, inputs, applied, arm_dof, dist, speeds, velocity
+_INPUTS = (types.int64, types.int64, types.int64, types.boolean, _W[2], _I[2], _R[3], _W[2], _I[1], _R[3], _R[2],
+           _W[3])
 
 #: Arguments of :func:`write` for no run (:func:`before_step` without the friction loss).
 NO_UPDATE = (np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0, 0)), np.zeros((8, 0)), np.zeros((4, 0), np.int64),
@@ -106,14 +107,14 @@ def write(k, qvel, qpos, level, axis, cols, load, target):
     _friction(k, qvel, qpos, level, axis, cols, load, target)
 
 
-@numba.njit(_FRICTION + _INPUTS, cache=True)
-def before_step(k, qvel, qpos, level, axis, cols, load, target,
-                at, per_log, friction, ctrl, drive_ctrl, inputs, applied, arm_dof, dist, speeds, velocity):
+@numba.njit(_INPUTS + _FRICTION[1:], cache=True)
+def before_step(k, at, per_log, friction, ctrl, drive_ctrl, inputs, applied, arm_dof, dist, speeds, velocity,
+                qvel, qpos, level, axis, cols, load, target):
     """What a per-step loop does before MuJoCo's step ``at`` (``k`` of its chunk): the last step's
-    velocities ``speeds`` (the live ``qvel``) into ``velocity[:, k - 1]`` (from the second step on), the friction loss
-    (:func:`_friction`, where ``friction``), the set-points ``ctrl[:, drive_ctrl] = inputs[at]``
-    and, at a log period's first step or the chunk's first, the disturbance
-    ``applied[:, arm_dof] = dist[:, at // per_log]``."""
+    velocities ``speeds`` (the live ``qvel``) into ``velocity[:, k - 1]`` (from the second step
+    on), the friction loss (:func:`_friction` of the last seven arguments, where ``friction``), the
+    set-points ``ctrl[:, drive_ctrl] = inputs[at]`` and, at a log period's first step or the
+    chunk's first, the disturbance ``applied[:, arm_dof] = dist[:, at // per_log]``."""
     nsim = ctrl.shape[0]
     if k > 0:
         for i in range(nsim):
