@@ -15,7 +15,7 @@ from faultgen.calibrate import gearbox
 from faultgen.effects.motor_friction import MotorFriction
 from faultgen.model import robots
 from faultgen.operation import tasks
-from faultgen.simulation import batch, friction_update
+from faultgen.simulation import batch, friction_kernel, friction_update
 
 
 @pytest.fixture(scope="module")
@@ -24,11 +24,14 @@ def stepped(tmp_path_factory):
     return str(stepped_robot.write(tmp_path_factory.mktemp("stepped")))
 
 
+@pytest.mark.parametrize("compiled", [True, False])
 @pytest.mark.parametrize("name", ["puma560", "irb6700", "stepped"])
-def test_the_writer_writes_the_bits_of_apply(name, stepped):
+def test_the_writer_writes_the_bits_of_apply(name, compiled, stepped, monkeypatch):
     """Asymmetric (PUMA 560) and one-valued (IRB-6700-like) Coulomb levels, a gear loss and, on the
     stepped robot, a drift in time (a level changing every step) and a static-load term, runs at
-    rest and moving: the friction loss ``writer`` puts in the model is ``apply``'s."""
+    rest and moving: the friction loss ``writer`` puts in the model is ``apply``'s, compiled
+    (friction_kernel) and through NumPy."""
+    monkeypatch.setattr(friction_kernel, "numpy_bits", lambda: compiled)
     sim, work = short_work(stepped if name == "stepped" else name, "stribeck", "batch",
                            gear_loss=np.array([np.linspace(0.01, 0.05, 6), np.linspace(0.08, 0.02, 6)]))
     runs = batch.new_runs(sim, work)
@@ -41,6 +44,7 @@ def test_the_writer_writes_the_bits_of_apply(name, stepped):
     update = schedule.chunk(10, 40)
     loss = runs.expand("dof_frictionloss")
     write = friction_update.writer(update, qvel, runs.bind("qpos"), kinematics, loss)
+    assert write.compiled == compiled
     for k in (0, 13, 29):
         expected = friction_update.apply(update, k, qvel, runs.bind("qpos"), kinematics)
         write(k)

@@ -234,52 +234,50 @@ def step(sim, work: Work, bar) -> Raw:
     return Raw(**logs)
 
 
-def _step_each(sim, work: Work, runs, set_level, start: int, stop: int, out: dict) -> None:
-    """Steps ``start`` to ``stop`` one at a time, the friction level set before each (``set_level(k)``,
-    ``k`` from 0 at ``start``), recorded into ``out`` (the friction level first, then a grip, the
-    set-points and the disturbance). The disturbance, constant over a log period, is written when
-    it changes (MuJoCo keeps ``qfrc_applied`` from step to step); columns are views where their
-    indices are evenly spaced (:func:`faultgen.simulation.friction_update.as_slice`). ``qvel`` is
-    recorded after every step (the divergence check and the applied torque read them), the other
-    fields only after the last step of each log period, the rows :func:`step` reads (the others
-    keep what the buffers held)."""
+def _step_each(sim, work: Work, runs, write, start: int, stop: int, out: dict) -> None:
+    """Steps ``start`` to ``stop`` one at a time, recorded into ``out``. Before each MuJoCo step
+    one compiled call (:func:`faultgen.simulation.friction_kernel.before_step`) records the last
+    step's ``qvel`` (the divergence check and the applied torque read it after every step), writes
+    the friction loss (the compiled update of ``write``, a :class:`friction_update.Writer`, ``k``
+    from 0 at ``start``), the set-points and, where a log period starts, the disturbance (constant
+    over the period; MuJoCo keeps ``qfrc_applied`` from step to step); then Python adds what
+    ``write`` leaves to it (``write.rest``; ``write(k)`` itself where it is a plain function) and a
+    grip. The other fields are recorded after the last step of each log period, the rows
+    :func:`step` reads (the others keep what the buffers held)."""
+    from faultgen.simulation import friction_kernel
     robot, per_log, inputs, dist = sim.robot, work.per_log, work.inputs, work.dist
-    ctrl = _columns(runs.bind("ctrl"), sim.drive_ctrl)
-    applied = _columns(runs.bind("qfrc_applied"), robot.arm_dof)
+    drive_ctrl, arm_dof = np.asarray(sim.drive_ctrl, np.int64), np.asarray(robot.arm_dof, np.int64)
+    _check_inputs(inputs, dist, drive_ctrl, (len(work.cycles), (stop - 1) // per_log + 1, len(arm_dof)), stop)
     grip_steps = {at for at, _ in work.grips}
     velocity, qvel = out["qvel"], runs.bind("qvel")
     logged = [(out[name], runs.bind(name)) for name in out if name != "qvel"]
-    period = None
+    # a plain set_level(k) (a friction model's own schedule) runs from Python, after the compiled call
+    ours = isinstance(write, friction_update.Writer)
+    update, rest = (write.arrays, write.rest) if ours else (friction_kernel.NO_UPDATE, write)
+    args = (per_log, ours and write.compiled, runs.bind("ctrl"), drive_ctrl, inputs, runs.bind("qfrc_applied"),
+            arm_dof, dist, qvel, velocity, *update)
+    before, step_all = friction_kernel.before_step, runs.step
     for k, at in enumerate(range(start, stop)):
-        set_level(k)
+        before(k, at, *args)
+        if rest is not None:
+            rest(k)
         if at in grip_steps:
             apply_grips(runs, work.grips, at)
-        ctrl(inputs[at])
-        if at // per_log != period:
-            period = at // per_log
-            applied(dist[:, period])
-        runs.step()
-        velocity[:, k] = qvel
+        step_all()
         if k % per_log == per_log - 1:
             for record, values in logged:
                 record[:, k] = values
+    velocity[:, stop - start - 1] = qvel
 
 
-def _columns(values: np.ndarray, index: np.ndarray):
-    """``put(x)``: ``values[:, index] = x`` (``index`` of any shape), through a view where the
-    indices are evenly spaced."""
-    flat = friction_update.as_slice(np.ravel(index))
-    if isinstance(flat, slice):
-        view = values[:, flat]
-        shaped = view.reshape(len(values), *np.shape(index))
-        if np.shares_memory(shaped, values):
-            def put(x):
-                shaped[...] = x
-            return put
-
-    def put_indexed(x):
-        values[:, index] = x
-    return put_indexed
+def _check_inputs(inputs: np.ndarray, dist: np.ndarray, drive_ctrl: np.ndarray, periods: tuple, stop: int) -> None:
+    """Refuse set-points ``inputs`` of fewer than ``stop`` steps or not of ``drive_ctrl``'s shape,
+    and disturbances ``dist`` of other runs or axes than ``periods`` or fewer periods (the compiled
+    call does not check its indices)."""
+    if len(inputs) < stop or inputs.shape[1:] != drive_ctrl.shape or dist.shape[0] != periods[0] or \
+            dist.shape[1] < periods[1] or dist.shape[2] != periods[2]:
+        raise ValueError(f"steps up to {stop} need ({stop}, {', '.join(map(str, drive_ctrl.shape))}) set-points "
+                         f"and {periods} disturbances (runs, log periods, axes); got {inputs.shape} and {dist.shape}")
 
 
 def apply_grips(runs, grips: tuple, step: int) -> None:

@@ -144,11 +144,96 @@ def as_slice(indices: np.ndarray) -> slice | np.ndarray:
     return slice(int(i[0]), int(i[-1]) + 1, step)
 
 
+@dataclass(frozen=True)
+class Writer:
+    """``write(k)``, made by :func:`writer`: the friction loss of step ``k`` of a chunk into the
+    model. ``arrays`` are the compiled update's arguments after ``k``
+    (:func:`faultgen.simulation.friction_kernel.write`, which a stepping loop may call inside its
+    own kernel: :func:`faultgen.simulation.friction_kernel.before_step`), ``compiled`` whether
+    that update is the one written, ``rest`` what Python adds after it (the static-load terms,
+    the NumPy update where the compiled one would not give NumPy's bits, a plug-in's extra), or
+    None."""
+
+    arrays: tuple
+    compiled: bool
+    rest: Callable[[int], None] | None
+    kernel: Callable
+
+    def __call__(self, k: int) -> None:
+        if self.compiled:
+            self.kernel(k, *self.arrays)
+        if self.rest is not None:
+            self.rest(k)
+
+    def then(self, more: Callable[[int], None]) -> Writer:
+        """This writer with ``more(k)`` run after it."""
+        rest = self.rest
+        if rest is None:
+            return replace(self, rest=more)
+
+        def both(k: int) -> None:
+            rest(k)
+            more(k)
+        return replace(self, rest=both)
+
+
 def writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematics: tuple | None,
-           frictionloss: np.ndarray) -> Callable[[int], None]:
+           frictionloss: np.ndarray) -> Writer:
     """``write(k)``: :func:`apply` of ``update`` at step ``k`` written into ``frictionloss``
     ``(nsim, nv)`` at the rotors, the same bits, from the live ``qvel``, ``qpos`` and
     ``kinematics`` (the per-step fallback of a backend that does not apply the update itself).
+
+    The update is compiled (:mod:`faultgen.simulation.friction_kernel`: one call a step, the same
+    operations in the same order on each element) where its ``exp`` and ``**`` give NumPy's bits
+    (:func:`faultgen.simulation.friction_kernel.matches_numpy`); elsewhere NumPy's calls
+    (:func:`_numpy_writer`). A static-load term (:attr:`FrictionUpdate.reads_kinematics`) is
+    added from Python after the compiled part (all load terms then, in their order, as in
+    :func:`apply`); the transmitted-load ones are compiled."""
+    from faultgen.simulation import friction_kernel
+    u = update
+    nsim, n = u.level.shape[0], len(u.rotor_dof)
+    _check_sizes(u, qvel, qpos, frictionloss)
+    axis = np.array([u.coulomb_pos, u.coulomb_neg, np.maximum(u.coulomb_pos, u.coulomb_neg),
+                     np.abs(u.stribeck_velocity), u.stribeck_exponent, u.static_friction, u.gear_ratio,
+                     u.stiffness], dtype=float)
+    compiled = friction_kernel.numpy_bits()
+    rest = None if compiled else _numpy_writer(u, qvel, qpos, kinematics, frictionloss)
+    if u.reads_kinematics:  # the compiled part into a buffer; every load term from Python
+        target, columns, load = np.empty((nsim, n)), np.arange(n), np.zeros((2, nsim, 0, n))
+        rest = rest or _loads_after(u, target, qpos, kinematics, frictionloss)
+    else:
+        target, columns = frictionloss, u.rotor_dof
+        load = np.stack([u.load_inner, u.load_outer]).astype(float, copy=False)
+    cols = np.array([u.rotor_dof, u.rotor_qpos, u.arm_qpos, columns], dtype=np.int64)
+    return Writer((qvel, qpos, u.level, axis, cols, load, target), compiled, rest, friction_kernel.write)
+
+
+def _loads_after(u: FrictionUpdate, loss: np.ndarray, qpos: np.ndarray, kinematics: tuple,
+                 frictionloss: np.ndarray) -> Callable[[int], None]:
+    """``add(k)``: the rotors' friction loss set to ``loss`` (the compiled part, written before)
+    plus every load term (:func:`_with_load`)."""
+    rotor = as_slice(u.rotor_dof)
+
+    def add(k: int) -> None:
+        frictionloss[:, rotor] = _with_load(u, loss, qpos, kinematics)
+    return add
+
+
+def _check_sizes(u: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, frictionloss: np.ndarray) -> None:
+    """Refuse state arrays that do not hold ``u``'s runs and columns (the compiled update does
+    not check its indices)."""
+    nsim = u.level.shape[0]
+    for name, values, index in (("qvel", qvel, u.rotor_dof), ("qpos", qpos, u.rotor_qpos),
+                                ("qpos", qpos, u.arm_qpos), ("frictionloss", frictionloss, u.rotor_dof)):
+        if values.ndim != 2 or values.shape[0] != nsim or (len(index) and not 0 <= np.min(index) <= np.max(index)
+                                                           < values.shape[1]):
+            raise ValueError(f"{name} has shape {values.shape}; expected ({nsim}, > {np.max(index, initial=-1)}) "
+                             f"for the update's {nsim} runs")
+
+
+def _numpy_writer(update: FrictionUpdate, qvel: np.ndarray, qpos: np.ndarray, kinematics: tuple | None,
+                  frictionloss: np.ndarray) -> Callable[[int], None]:
+    """:func:`writer`'s step as NumPy calls, where the compiled one would not give NumPy's bits.
 
     What does not change from step to step is done here once: the rotor columns as views where
     they are evenly spaced, the larger Coulomb level, one Coulomb level where both directions'
@@ -261,10 +346,10 @@ class Schedule:
                 level = level * effect.dry_friction_factor(time.reshape(-1, 1)).reshape(nsim, stop - start, n)
         return replace(self.base, level=level)
 
-    def setter(self, runs, update: FrictionUpdate) -> Callable[[int], None]:
-        """``set_level(k)``: :func:`apply` of ``update`` into ``runs``' friction loss before step
-        ``k`` of its chunk, then the :attr:`python_extras` (the stepping loop's fallback for a
-        backend that does not apply the update itself, and for a plug-in's extra)."""
+    def setter(self, runs, update: FrictionUpdate) -> Writer:
+        """``set_level(k)`` (a :class:`Writer`): :func:`apply` of ``update`` into ``runs``' friction
+        loss before step ``k`` of its chunk, then the :attr:`python_extras` (the stepping loop's
+        fallback for a backend that does not apply the update itself, and for a plug-in's extra)."""
         robot, rotor = self.robot, update.rotor_dof
         frictionloss, qvel, qpos = runs.expand("dof_frictionloss"), runs.bind("qvel"), runs.bind("qpos")
         kinematics = tuple(runs.bind(name) for name in KINEMATICS) if self.reads_start_state else None
@@ -275,10 +360,9 @@ class Schedule:
         def static_load() -> np.ndarray:
             return robot.static_load_of(*kinematics, qpos)
 
-        def set_level(k: int) -> None:
-            write(k)
+        def extras(k: int) -> None:
             deflection = qpos[:, robot.rotor_qpos] / robot.gear_ratio - qpos[:, robot.arm_qpos]
             for effect in self.python_extras:
                 frictionloss[:, rotor] += effect.dry_friction_extra(robot, deflection, static_load)
 
-        return set_level
+        return write.then(extras)
