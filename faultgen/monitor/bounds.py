@@ -31,6 +31,8 @@ bound 11.8 %" at 8.0 % true wear, the bound without the scale).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 #: Logs over which the filter's innovations are averaged to adapt its rate's process noise
@@ -45,6 +47,9 @@ ADAPT_WINDOW = 3
 #: the 90 % interval covering 88 % of the logs at 10-40 % (fixed: 19 %), the mean lag 0.2 point
 #: (fixed: 3.0); read to 3.5 points, 70 % and 2.1 (fixed: 1 % and 6.5).
 FADING_THRESHOLD = 11.345 / 3
+#: The confidence of the upper limit by which a fit whose residuals scatter less than their stated
+#: errors narrows them (:func:`upper_ratio`): the 90 % the monitor states its intervals and bound at.
+RATIO_LEVEL = 0.90
 
 
 def standard_error(noise: np.ndarray, estimate: np.ndarray, scale: np.ndarray | float) -> np.ndarray:
@@ -78,6 +83,24 @@ def day_scatter(reads: np.ndarray) -> np.ndarray:
     if reads.ndim != 2 or len(reads) < 2:
         return np.full(reads.shape[-1] if reads.ndim == 2 else 0, np.nan)
     return np.std(reads, axis=0, ddof=1)
+
+
+def upper_ratio(residual: np.ndarray, variance: np.ndarray, dof: int, level: float = RATIO_LEVEL) -> float:
+    """The factor (<= 1) by which a fit's stated ``variance`` (n,) is narrowed where its ``residual`` (n,)
+    scatters less than it states: the upper ``level`` confidence limit of their ratio, ``dof chi2 / q``
+    (``chi2`` the reduced chi-square ``sum(residual^2 / variance) / dof``, ``q`` the chi-square's ``1 -
+    level`` quantile on ``dof`` degrees of freedom, ``scipy.stats.chi2.ppf``: the confidence limit of a
+    normal sample's variance, e.g. Montgomery & Runger 2014, ch. 8.3), where it is below one, else 1 (and
+    where ``dof`` < 1 or any value is not finite). The variances are narrowed only as far as the residuals
+    show at that confidence: with 1 degree of freedom only where ``chi2`` is below 0.016; a residual that
+    also carries what ``variance`` leaves out (a drift) only makes the limit larger."""
+    from scipy import stats
+
+    residual, variance = np.asarray(residual, dtype=float), np.asarray(variance, dtype=float)
+    chi2 = float(np.sum(residual**2 / np.maximum(variance, 1e-12)) / dof) if dof >= 1 else math.nan
+    if not np.isfinite(chi2):
+        return 1.0
+    return float(min(1.0, dof * chi2 / stats.chi2.ppf(1.0 - level, dof)))
 
 
 def adapted_rate_variance(floor: float, gains: np.ndarray, innovations: np.ndarray) -> np.ndarray:

@@ -45,10 +45,10 @@ priors of mixed estimation (Theil & Goldberger 1961: one pseudo-observation each
 :data:`SCALE_PRIOR` ``^2)`` and ``b ~ N(0, s0^2)`` (``b``: the reference test's own error, which every
 test's wear shares; ``s0`` that test's own standard error in points, :data:`OFFSET_PRIOR` where it is
 not known; the tests before the wear fix it), each test weighed by its own error and the twin-scale
-wear's error times ``f`` (weighed at ``f = 1``, then again at the fitted ``f``) and by the factor's
-drift since the test, :data:`SCALE_DRIFT` times ``x_j`` per later test (the twin's scale may change
-with the wear; a test before the wear keeps telling ``b``); the tests' variances (``b``'s prior's too) times
-their reduced chi-square when above one, never ``f``'s prior (issue 90: a factor only its prior told).
+wear's error times ``f`` (weighed at ``f = 1``, then at the fitted ``f``) and by the factor's drift since
+the test, :data:`SCALE_DRIFT` times ``x_j`` per later test (the twin's scale may change with the wear; a test
+before the wear keeps telling ``b``); the tests' variances (``b``'s prior's too) times their reduced chi-square if
+above one, their measured part's upper 90 % limit if below (:func:`.bounds.upper_ratio`), never ``f``'s prior.
 A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
@@ -123,12 +123,11 @@ OFFSET_PRIOR = 10.0
 SCALE_MIN = 0.2
 #: The factor's random walk, its standard deviation per test (the twin's scale need not be one number
 #: over the whole wear: on the second independent fleet it grew with the wear): an earlier pair's
-#: variance grows by ``(SCALE_DRIFT x)^2`` per later test. Before 2026-11-28 each earlier pair's
-#: weight was multiplied by 0.6 (``FORGET``) per later test, whatever its ``x``: the pairs before the
-#: wear, which alone tell the offset ``b`` (the reference test's own error, shared by every later
-#: test), were forgotten, and the offset went into the factor (issue 90: on the small 1.5 % fleet of
-#: seed 0 a reference test 2.8 % low read the worn axis 3-4 points high and its alarm's bound above
-#: the truth). 0.06 gives a pair at ``x`` 20 % (read to 1.5 points) the weight 0.6 gave it after one test.
+#: variance grows by ``(SCALE_DRIFT x)^2`` per later test. Before 2026-11-28 each earlier pair's weight
+#: was multiplied by 0.6 (``FORGET``) per later test, whatever its ``x``: the pairs before the wear, which
+#: alone tell the offset ``b`` (the reference test's error, shared by every later test), were forgotten and
+#: the offset went into the factor (issue 90: on the small 1.5 % fleet of seed 0 a reference test 2.8 % low
+#: read the worn axis 3-4 points high). 0.06: a pair at ``x`` 20 % weighs what 0.6 gave it after one test.
 SCALE_DRIFT = 0.06
 #: The cache of the tests' readings in OUT, its entries' format and largest size, bytes.
 CACHE, CACHE_FORMAT, CACHE_MAX_BYTES = "friction-tests", "faultgen-friction-test-reading/1", 2**20
@@ -489,7 +488,7 @@ class Rescale:
         names = [TWIN_SCALE] * self.n_axes
         for k, pairs in self.pairs.items():
             if pairs:
-                factor[k - 1], factor_error[k - 1] = self.fit(k)
+                factor[k - 1], factor_error[k - 1] = self._fitted(k)[0]
                 names[k - 1] = TESTS_SCALE
         return factor, factor_error, names
 
@@ -525,10 +524,6 @@ class Rescale:
                 bound[k - 1] = floor
         return bound
 
-    def fit(self, axis: int) -> tuple[float, float]:
-        """The factor of ``axis`` and its standard error from its pairs (module docstring)."""
-        return self._fitted(axis)[0]
-
     def _fitted(self, axis: int) -> tuple[tuple[float, float], tuple[float, float]]:
         """(The factor, its standard error), (the offset ``b``, points, its) of ``axis`` (module docstring)."""
         import statsmodels.api as sm
@@ -543,11 +538,16 @@ class Rescale:
         drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2
         factor = 1.0
         for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
-            weights = np.r_[1.0 / np.maximum(sy**2 + (factor * sx) ** 2 + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / sb**2]
+            measured = sy**2 + (factor * sx) ** 2  # the tests' and the twin-scale wear's errors, the drift apart
+            weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / sb**2]
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)
-        if n > 2 and (chi2 := float(np.sum(weights[:n] * (y - design[:n] @ result.params) ** 2) / (n - 2))) > 1.0:
-            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests' errors, not f's prior
+        residual = y - design[:n] @ result.params
+        if (chi2 := float(np.sum(weights[:n] * residual**2) / (n - 2)) if n > 2 else 1.0) > 1.0:
+            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior
+        elif (ratio := bounds.upper_ratio(residual, measured, n - 2)) < 1.0:  # they scatter less than stated
+            weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / (ratio * sb**2)]
+        if chi2 > 1.0 or ratio < 1.0:
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)
         sd = np.sqrt(np.diag(np.asarray(result.cov_params())))
