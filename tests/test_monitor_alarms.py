@@ -180,23 +180,6 @@ def test_the_chance_statement_only_where_it_says_something():
     assert f"<= {42 * (0.1**5 + once):.2g} " in text and f"at <= {once:.2g}" in text
 
 
-def test_a_program_changes_relearning_logs_are_listed_and_counted():
-    rng = np.random.default_rng(6)
-    unit = steps.start("u", SETTINGS, N_AXES, _signatures(np.full(N_AXES, 0.05)))
-    _feed(unit, np.zeros((30, N_AXES)), rng)
-    steps.restart(unit, "030", "program change")
-    _feed(unit, np.zeros((12, N_AXES)), rng, first=30)
-    assert len(unit.rows) == 42 and [r.phase for r in unit.rows[30:]] == ["relearning"] * 12
-    assert steps.alarm_row(unit)["evidence"] == f"learning again after the program change of 030: 12 of {SETTINGS.train} logs"
-    report.chart(io.BytesIO(), unit, "wear signature match")  # rows without scores drawn as gaps
-    _feed(unit, np.zeros((15, N_AXES)), rng, first=42)
-    phases = [r.phase for r in unit.rows]
-    assert len(phases) == 57 and [r.stamp for r in unit.rows] == [f"{i:03d}" for i in range(57)]
-    assert phases[30:] == ["relearning"] * SETTINGS.train + ["monitoring"] * 7
-    assert all(np.isfinite(r.Q) for r in unit.rows)
-    assert steps.alarm_row(unit)["evidence"].startswith("no persistent alarm since the program change of 030 (27 logs")
-
-
 @pytest.mark.parametrize("known", [True, False])
 def test_the_page_says_when_the_alarm_was_known_and_reads_a_folder_without_it(tmp_path, known):
     rng = np.random.default_rng(1)

@@ -2,8 +2,9 @@
 record (:class:`~faultgen.monitor.history.UnitHistory`): each log fed (:func:`add`, with its
 program's baseline: :func:`run`) through the record's :class:`~faultgen.monitor.scoring.Stages`
 appends its :class:`~faultgen.monitor.record.LogRow` to the record's ``rows``; maintenance
-(:func:`maintenance`) and a program change (:func:`restart`) given between logs; the unit's rows of
-alarms.csv (:func:`alarm_rows`); and the record's entries fed again (:func:`replay`)."""
+(:func:`maintenance`) given between logs (a new program learns its own baseline:
+:class:`faultgen.monitor.programs.Baselines`); the unit's rows of alarms.csv (:func:`alarm_rows`);
+and the record's entries fed again (:func:`replay`)."""
 
 from __future__ import annotations
 
@@ -18,20 +19,6 @@ from faultgen.monitor.scoring import MODEL_UNCERTAINTY, NOT_OBSERVABLE, NOT_OBSE
 def start(unit: str, settings: Settings, n_axes: int, signatures: np.ndarray | None = None) -> UnitHistory:
     """A record of ``unit`` before its first log, with its stages (:meth:`Stages.new`)."""
     return UnitHistory(unit, stages=Stages.new(unit, settings, n_axes, signatures))
-
-
-def restart(unit: UnitHistory, stamp: str, reason: str) -> None:
-    """The unit runs another program from the log ``stamp`` on (``reason`` says how it was found):
-    its open alarm, if any, is closed by it, and the unit learns its normal operation again from
-    this log on (``train`` logs), against the twin of the new program."""
-    s, b = unit.stages, unit.stages.baseline
-    s.alarm.close(b, stamp, reason)
-    s.since, b.program_changed, b.placeholders = ("program change", stamp, len(unit.rows)), True, 0
-    b.training, b.learned_expectations = [], []
-    b.pca, b.relearning = None, None
-    s.alarm.reset()
-    if s.wear.tests is not None:
-        s.wear.tests.reset()
 
 
 def maintenance(unit: UnitHistory, stamp: str, event: str, axis: int) -> None:
@@ -221,13 +208,10 @@ def alarm_row(unit: UnitHistory) -> dict:
     if not s.alarm.first_alarm:
         row["evidence"] = (f"no persistent alarm in {len(rows)} logs" if b.pca is not None else
                            f"still learning: {len(b.training)} of {train} logs")
-        if s.since is not None and b.pca is not None:  # after maintenance or a program change
+        if s.since is not None and b.pca is not None:  # after maintenance
             what, stamp, before = s.since
             row["evidence"] = (f"no persistent alarm since the {what} of {stamp} ({len(rows) - before} logs "
                                f"since, {len(rows)} in all)")
-        elif s.since is not None and b.program_changed:
-            row["evidence"] = (f"learning again after the program change of {s.since[1]}: "
-                               f"{len(b.training)} of {train} logs")
         if b.relearning is not None:
             row["evidence"] += (f"; learning its offset again after maintenance: {len(b.relearning)} of "
                                 f"{b.relearn_logs} logs")
