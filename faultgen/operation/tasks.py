@@ -38,7 +38,7 @@ import numpy as np
 from ruckig import DurationDiscretization, InputParameter, Result, Ruckig, Trajectory
 
 from faultgen import inputs
-from faultgen.logs.columns import LOG_MAX_BYTES
+from faultgen.logs import columns as log_columns
 
 if TYPE_CHECKING:
     from faultgen.model.robots import Robot
@@ -337,7 +337,7 @@ def file_sha256(task: str) -> str:
     data = file_bytes(task)
     if data is not None:
         return hashlib.sha256(data).hexdigest()
-    return inputs.sha256_of(str(task), "joint log", LOG_MAX_BYTES)
+    return inputs.sha256_of(str(task), "joint log", log_columns.LOG_MAX_BYTES)
 
 
 def check_step(dt) -> float:
