@@ -1,6 +1,7 @@
 """What the UR monitor tests share: the UR5 robot folder (``robots add`` of the shipped DH table)
-and one log in the RTDE recorder's layout."""
+and one log in the RTDE recorder's layout (also benchmarks/monitor_rtde_fleets.py's)."""
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -31,4 +32,6 @@ def write_rtde(path: Path, t, columns: dict, others=()) -> None:
         names += [f"{name}_{k}" for k in range(6)] if six else [name]
         values += [np.zeros(len(t))] * (6 if six else 1)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, np.column_stack(values), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
+    part = path.with_name(path.name + ".part")  # a killed writer leaves no log that looks complete
+    np.savetxt(part, np.column_stack(values), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
+    os.replace(part, path)
