@@ -47,6 +47,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import independent_fleet  # noqa: E402
+import ur_rtde_logs  # noqa: E402
 
 from faultgen import children  # noqa: E402
 from faultgen.bench import independent  # noqa: E402
@@ -138,19 +139,9 @@ def add_arm(work: Path, name: str) -> Path:
 def write_rtde(path: Path, t, q, tau, temperature, commanded, constants) -> None:
     """One log in the RTDE recorder's layout (module docstring): ``t`` (n,) s, ``q`` (n, 6) rad, ``tau``
     and ``commanded`` (n, 6) N m at the joint, ``temperature`` (6,) deg C, ``constants`` (6,) N m/A."""
-    names, columns = ["timestamp"], [t]
-    for name, values in (("actual_q", q), ("actual_current", tau / np.asarray(constants)),
-                         ("target_moment", commanded), ("joint_temperatures", np.broadcast_to(temperature, q.shape))):
-        names += [f"{name}_{k}" for k in range(6)]
-        columns += list(np.asarray(values).T)
-    for name in OTHER_COLUMNS:
-        wide = name.startswith(("target", "actual"))
-        names += [f"{name}_{k}" for k in range(6)] if wide else [name]
-        columns += [np.zeros(len(t))] * (6 if wide else 1)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    part = path.with_name(path.name + ".part")
-    np.savetxt(part, np.column_stack(columns), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
-    os.replace(part, path)
+    ur_rtde_logs.write_rtde(path, t, {"actual_q": q, "actual_current": tau / np.asarray(constants),
+                                      "target_moment": commanded,
+                                      "joint_temperatures": np.broadcast_to(temperature, q.shape)}, OTHER_COLUMNS)
 
 
 def spec(units: int, days: int, seed: int) -> independent.FleetSpec:

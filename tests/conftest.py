@@ -257,3 +257,11 @@ def shared_fleet_command(tmp_path_factory, worker_id):
         return out, printed.read_text()
 
     return build
+
+
+@pytest.fixture(scope="module")
+def puma():
+    """The shipped PUMA 560, loaded once per test file (a file may define its own ``puma``)."""
+    from faultgen.model import robots
+
+    return robots.load("puma560")

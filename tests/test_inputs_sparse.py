@@ -50,11 +50,6 @@ def sparse(path: Path, size: int, head: bytes = b"") -> Path:
     return path
 
 
-@pytest.fixture(scope="module")
-def puma():
-    return robots.load("puma560")
-
-
 @pytest.fixture
 def logs(tmp_path, puma):
     return fleetlog_folder.write_fleet(tmp_path / "LOGS", puma, units=1, days=3)

@@ -15,7 +15,6 @@ from typer.testing import CliRunner
 
 from faultgen.cli import app
 from faultgen.data import fleetlogs, logfolder, reader
-from faultgen.model import robots
 from faultgen.monitor import logs as fleet_logs
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -24,11 +23,6 @@ import fleetlog_folder
 runner = CliRunner()
 MARKER = "MARKER-4f1c9e-not-for-your-eyes"
 LINKS_RULE = "links must stay inside the folder"
-
-
-@pytest.fixture(scope="module")
-def puma():
-    return robots.load("puma560")
 
 
 @pytest.fixture

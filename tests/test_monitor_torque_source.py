@@ -39,8 +39,8 @@ from faultgen.operation import wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 from resolved_runs import run_config
+from ur_rtde_logs import add_ur5, write_rtde
 
-UR5_DH = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 #: N m/A at the joint given on the command line (the log's current is its arm torque over them).
 TORQUE_CONSTANTS = (12.0, 12.0, 12.0, 9.0, 9.0, 9.0)
 #: The controller's own constants over the given ones: its current as torque is the arm torque times these.
@@ -74,24 +74,11 @@ def _simulate(robot_dir: Path, cycles: int, plan):
     return result
 
 
-def _write(path: Path, t, q, columns: dict) -> None:
-    """One log in the RTDE recorder's layout (space-separated, its column names): ``actual_q`` and
-    ``columns`` (name -> (n, 6) array)."""
-    names, values = ["timestamp"], [t]
-    for name, array in (("actual_q", q), *columns.items()):
-        names += [f"{name}_{k}" for k in range(6)]
-        values += list(np.asarray(array).T)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, np.column_stack(values), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
-
-
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory):
     """(robot folder, days: [(stamp, t, q, arm torque (n, 6) N m)], true wear % of axis 2 per stamp)."""
     root = tmp_path_factory.mktemp("sourcefleet")
-    result = runner.invoke(app, ["robots", "add", "ur5", "--from", str(UR5_DH), "-o", str(root / "ur5")])
-    assert result.exit_code == 0, result.output
-    robot_dir = root / "ur5"
+    robot_dir = add_ur5(root)
     (root / "short.toml").write_text(PROGRAM)
     gear = robots.load(robot_dir).gear_ratio
     days, truth = [], {}
@@ -117,7 +104,7 @@ def _logs(days, folder: Path, after: str) -> Path:
                        "actual_current_as_torque": tau * np.asarray(CONTROLLER)}
         else:
             columns = {"target_moment": command}
-        _write(folder / "ur-01" / f"{stamp}.csv", t, q, columns)
+        write_rtde(folder / "ur-01" / f"{stamp}.csv", t, {"actual_q": q, **columns})
     return folder
 
 

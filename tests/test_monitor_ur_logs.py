@@ -42,8 +42,8 @@ from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 from resolved_runs import run_config
+from ur_rtde_logs import add_ur5, write_rtde
 
-UR5_DH = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
 #: N m/A at the joint, the test's (the log's current is its arm torque over them).
 TORQUE_CONSTANTS = (12.0, 12.0, 12.0, 9.0, 9.0, 9.0)
 #: Logs a unit learns from (the monitor's fewest).
@@ -73,27 +73,18 @@ def _simulate(robot_dir: Path, seed: int, cycles: int, start_day: float, plan, t
 
 
 def _write_rtde(path: Path, t, q, tau, temperature, commanded) -> None:
-    """One log in the RTDE recorder's layout: space-separated, its column names."""
-    names, columns = ["timestamp"], [t]
-    for name, values in (("actual_q", q), ("actual_current", tau / np.asarray(TORQUE_CONSTANTS)),
-                         ("target_moment", commanded),
-                         ("joint_temperatures", np.broadcast_to(temperature, q.shape))):
-        names += [f"{name}_{k}" for k in range(6)]
-        columns += list(np.asarray(values).T)
-    for name in OTHER_COLUMNS:
-        names += [f"{name}_{k}" for k in range(6)] if name.startswith(("target", "actual")) else [name]
-        columns += [np.zeros(len(t))] * (6 if name.startswith(("target", "actual")) else 1)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    np.savetxt(path, np.column_stack(columns), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
+    """One UR log: positions, motor currents, the commanded torque, joint temperatures and the
+    recorder's other columns (zeros)."""
+    write_rtde(path, t, {"actual_q": q, "actual_current": tau / np.asarray(TORQUE_CONSTANTS),
+                         "target_moment": commanded,
+                         "joint_temperatures": np.broadcast_to(temperature, q.shape)}, OTHER_COLUMNS)
 
 
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory):
     """(robot folder, logs folder, true wear % of the worn unit's axis 2 per stamp)."""
     root = tmp_path_factory.mktemp("urfleet")
-    result = runner.invoke(app, ["robots", "add", "ur5", "--from", str(UR5_DH), "-o", str(root / "ur5")])
-    assert result.exit_code == 0, result.output
-    robot_dir, logs = root / "ur5", root / "logs"
+    robot_dir, logs = add_ur5(root), root / "logs"
     gear = robots.load(robot_dir).gear_ratio
     commanded = {}
     parts = {"ur-01": [(UNWORN, wear.WearPlan({})), (WEARING, wear.WearPlan.from_specs(

@@ -73,6 +73,20 @@ def import_module(name: str):
     return importlib.import_module(f"faultgen.cli.{name}")
 
 
+def _loaded_first(name: str) -> property:
+    """A registration list of the app (stored as ``name``): read, every command module is imported
+    first; set, stored as it is."""
+
+    def read(self):
+        self._load_all()
+        return getattr(self, name)
+
+    def store(self, value) -> None:
+        setattr(self, name, value)
+
+    return property(read, store)
+
+
 class LazyTyper(typer.Typer):
     """The ``faultgen`` typer app. Run, it imports only the module of the command it runs; read as
     an app (its registered commands and groups), it imports every command module first."""
@@ -85,23 +99,8 @@ class LazyTyper(typer.Typer):
         group = kwargs.pop("cls", None) or LazyGroup
         super().__init__(cls=type(group.__name__, (group,), {"typer_app": self}), **kwargs)
 
-    @property
-    def registered_commands(self):
-        self._load_all()
-        return self._commands
-
-    @registered_commands.setter
-    def registered_commands(self, value) -> None:
-        self._commands = value
-
-    @property
-    def registered_groups(self):
-        self._load_all()
-        return self._groups
-
-    @registered_groups.setter
-    def registered_groups(self, value) -> None:
-        self._groups = value
+    registered_commands = _loaded_first("_commands")
+    registered_groups = _loaded_first("_groups")
 
     def _load_all(self) -> None:
         if self._lazy or self._loaded:
