@@ -36,7 +36,9 @@ HERE = Path(__file__).resolve().parents[1]
 def measure(checkout: Path, work: Path, fleet: str, units: int, days: int) -> float:
     """CPU seconds per log of one monitor run of ``checkout`` on the fleet (made under ``work``)."""
     env = {**os.environ, "PYTHONPATH": str(checkout), "OMP_NUM_THREADS": "1"}
-    out = subprocess.run([sys.executable, __file__, "--child", fleet, str(units), str(days), str(work)], env=env,
+    from faultgen import children  # -P: the child puts no script or current folder on its path
+
+    out = subprocess.run(children.command(__file__, "--child", fleet, str(units), str(days), str(work)), env=env,
                          cwd=checkout, capture_output=True, text=True, check=False)
     rows = [line for line in out.stdout.splitlines() if line.startswith("CPU ")]
     if out.returncode or not rows:
