@@ -80,12 +80,11 @@ def ur_fleet(root: Path) -> tuple[Path, Path, str]:
     import datetime
 
     import test_monitor_ur_logs as ur
+    import ur_rtde_logs
     from faultgen.model import robots
     from faultgen.operation import wear
 
-    result = CliRunner().invoke(app, ["robots", "add", "ur5", "--from", str(ur.UR5_DH), "-o", str(root / "ur5")])
-    assert result.exit_code == 0, result.output
-    robot_dir, logs = root / "ur5", root / "logs"
+    robot_dir, logs = ur_rtde_logs.add_ur5(root), root / "logs"
     gear = robots.load(robot_dir).gear_ratio
     plans = {"ur-01": [(6, wear.WearPlan({})), (6, wear.WearPlan.from_specs(["2:linear:30"], last_cycle=6))],
              "ur-02": [(12, wear.WearPlan({}))]}
