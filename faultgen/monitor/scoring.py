@@ -133,8 +133,8 @@ class Stages:
     the program's ``baseline`` (:class:`~faultgen.monitor.baseline.Baseline`; a later program's, of
     ``programs``, swapped in for its logs), the ``wear`` estimator
     (:class:`~faultgen.monitor.wear.WearEstimator`: its filter and friction tests' scale), the
-    ``alarm`` rule (:class:`~faultgen.monitor.alarm.AlarmRule`); ``since`` the last maintenance or
-    program change (what, stamp, rows before it) or None; ``shared`` what the programs met later
+    ``alarm`` rule (:class:`~faultgen.monitor.alarm.AlarmRule`); ``since`` the last maintenance
+    (what, stamp, rows before it; :func:`faultgen.monitor.steps.maintenance`) or None; ``shared`` what the programs met later
     borrow of the first program's learned baseline (:meth:`~faultgen.monitor.baseline.Baseline.shared`),
     or None before it learned."""
 
