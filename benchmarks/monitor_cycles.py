@@ -35,20 +35,29 @@ def spec(units: int, days: int, seed: int, mixed: bool) -> independent_fleet.Fle
                                        rated_part=True, program_changes=1, rate=250.0, **layout)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--units", type=int, default=4)
-    parser.add_argument("--days", type=int, default=40)
+def arguments(doc: str, units: int, days: int, work: str) -> argparse.ArgumentParser:
+    """The fleet's options (``--units``, ``--days``, ``--seed``, ``--work``) of a benchmark on this fleet."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--units", type=int, default=units)
+    parser.add_argument("--days", type=int, default=days)
     parser.add_argument("--seed", type=int, default=5)
-    parser.add_argument("--work", type=Path, default=Path("monitor_cycles_work"))
-    args = parser.parse_args()
-    robot = args.work / "iiwa14"
+    parser.add_argument("--work", type=Path, default=Path(work))
+    return parser
+
+
+def fleet(work: Path, root: Path, units: int, days: int, seed: int, mixed: bool) -> tuple[Path, Path]:
+    """(robot folder, logs folder): the iiwa 14 added under ``work`` once, the fleet written under ``root``."""
+    robot = work / "iiwa14"
     if not robot.is_dir():
         independent_fleet.add_robot(robot, "iiwa14", payload=14.0)
+    return robot, independent_fleet.independent.write_fleet(root, spec(units, days, seed, mixed), robot)[0]
+
+
+def main() -> None:
+    args = arguments(__doc__, 4, 40, "monitor_cycles_work").parse_args()
     for kind in ("mixed", "plain"):
         root = args.work / kind
-        logs, _ = independent_fleet.independent.write_fleet(root, spec(args.units, args.days, args.seed,
-                                                                       kind == "mixed"), robot)
+        robot, logs = fleet(args.work, root, args.units, args.days, args.seed, kind == "mixed")
         out = root / f"out-{time.strftime('%Y%m%dT%H%M%S')}"
         wall, cpu = time.perf_counter(), time.process_time()
         loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=Settings(train=10, persistence=3),

@@ -50,17 +50,15 @@ def child(fleet: str, units: int, days: int, work: Path) -> None:
     """One measurement in this process (its ``PYTHONPATH`` the checkout): prints ``CPU <s per log>``."""
     sys.path[:0] = [str(Path.cwd() / "tests"), str(Path.cwd() / "benchmarks")]
     import independent_fleet
-    from monitor_cycles import spec
+    from monitor_cycles import fleet as iiwa_fleet
 
     from faultgen.monitor import loop
     from faultgen.monitor.run import resolve_run
     from faultgen.monitor.scoring import Settings
 
     if fleet == "iiwa":
-        robot, root = work / "iiwa14", work / f"iiwa-{units}x{days}"
-        if not robot.is_dir():
-            independent_fleet.add_robot(robot, "iiwa14", payload=14.0)
-        logs, _ = independent_fleet.independent.write_fleet(root, spec(units, days, 5, True), robot)
+        root = work / f"iiwa-{units}x{days}"
+        robot, logs = iiwa_fleet(work, root, units, days, 5, True)
     else:
         root = work / f"kr210-{units}x{days}"
         robot, logs = root / "kr210", root / "logs"

@@ -13,7 +13,6 @@ code more than compiled code: the seconds per log are printed with and without i
 
 from __future__ import annotations
 
-import argparse
 import cProfile
 import io
 import os
@@ -23,9 +22,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-import independent_fleet  # noqa: E402
-from monitor_cycles import spec  # noqa: E402  (sibling module)
+from monitor_cycles import arguments, fleet  # noqa: E402  (sibling module)
 
 from faultgen.monitor import loop  # noqa: E402
 from faultgen.monitor.run import resolve_run  # noqa: E402
@@ -33,18 +30,11 @@ from faultgen.monitor.scoring import Settings  # noqa: E402
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--units", type=int, default=2)
-    parser.add_argument("--days", type=int, default=16)
-    parser.add_argument("--seed", type=int, default=5)
+    parser = arguments(__doc__, 2, 16, "monitor_profile_work")
     parser.add_argument("--top", type=int, default=25)
-    parser.add_argument("--work", type=Path, default=Path("monitor_profile_work"))
     args = parser.parse_args()
-    robot = args.work / "iiwa14"
-    if not robot.is_dir():
-        independent_fleet.add_robot(robot, "iiwa14", payload=14.0)
     root = args.work / "mixed"
-    logs, _ = independent_fleet.independent.write_fleet(root, spec(args.units, args.days, args.seed, True), robot)
+    robot, logs = fleet(args.work, root, args.units, args.days, args.seed, True)
     n = args.units * args.days
 
     def run(tag: str) -> None:

@@ -124,40 +124,29 @@ class Version:
             out.append((str(part.get("name", f"part{k + 1}")), fields))
         return out
 
+    def _per_seed(self, kind: str, table: str, split: str, size: str) -> list[tuple[str, dict, dict]]:
+        """(part name and seed, the part, its ``table`` with its ``small`` over it at ``size`` and the seed) of
+        each part of ``kind``, one per seed of ``split``; raises ``ValueError`` for an unknown split or size."""
+        if split not in SPLITS or size not in SIZES:
+            raise ValueError(f"split {split!r}, size {size!r}: expected one of {', '.join(SPLITS)} and of "
+                             f"{', '.join(SIZES)}")
+        return [(f"{part.get('name', f'part{k + 1}')}-{seed}", part,
+                 {**part.get(table, {}), **(part.get("small", {}) if size == "small" else {}), "seed": seed})
+                for k, part in enumerate(self.parts) if part.get("kind", "grid") == kind
+                for seed in self._seeds(part, split)]
+
     def fleets(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
         """(part name, fleet) of each part of kind ``logs`` for ``split`` at ``size``, one per seed:
         ``{"robot", "task", "spec"}``, ``spec`` the :class:`~faultgen.bench.independent.FleetSpec`
         fields with the seed."""
-        if split not in SPLITS or size not in SIZES:
-            raise ValueError(f"split {split!r}, size {size!r}: expected one of {', '.join(SPLITS)} and of "
-                             f"{', '.join(SIZES)}")
-        out = []
-        for k, part in enumerate(self.parts):
-            if part.get("kind", "grid") != "logs":
-                continue
-            spec = dict(part.get("fleet", {}))
-            if size == "small":
-                spec.update(part.get("small", {}))
-            for seed in self._seeds(part, split):
-                out.append((f"{part.get('name', f'part{k + 1}')}-{seed}",
-                            {"robot": part["robot"], "task": part["task"], "spec": {**spec, "seed": seed}}))
-        return out
+        return [(name, {"robot": part["robot"], "task": part["task"], "spec": spec})
+                for name, part, spec in self._per_seed("logs", "fleet", split, size)]
 
     def records(self, split: str, size: str = "full") -> list[tuple[str, dict]]:
         """(part name, spec) of each part of kind ``records`` for ``split`` at ``size``, one per seed:
         the part's ``records`` table (its ``small`` over it) with the seed
         (:func:`faultgen.bench.prognostics_v3.split_units`)."""
-        if split not in SPLITS or size not in SIZES:
-            raise ValueError(f"split {split!r}, size {size!r}: expected one of {', '.join(SPLITS)} and of "
-                             f"{', '.join(SIZES)}")
-        out = []
-        for k, part in enumerate(self.parts):
-            if part.get("kind", "grid") != "records":
-                continue
-            spec = {**dict(part.get("records", {})), **(dict(part.get("small", {})) if size == "small" else {})}
-            out += [(f"{part.get('name', f'part{k + 1}')}-{seed}", {**spec, "seed": seed})
-                    for seed in self._seeds(part, split)]
-        return out
+        return [(name, spec) for name, _, spec in self._per_seed("records", "records", split, size)]
 
 
 @dataclass(frozen=True)
