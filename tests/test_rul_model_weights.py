@@ -125,3 +125,21 @@ def test_the_same_seed_gives_the_same_bytes(tmp_path):
         written.append(prognosis.rul_table([row, again]).write(tmp_path).read_bytes())
     assert written[0] == written[1]
     assert written[0] != written[2]
+
+
+def test_an_exponential_faster_than_the_logs_spacing_is_not_fitted():
+    """A flat series with a step at its last log (as after a gearbox change): an exponential with a time
+    constant of 1/18 day under daily logs is a step, not a trend (its b and k trade off: variance 1e15),
+    and took the whole model average from the line by its AICc before; it is left out, the line stays
+    (a slower exponential, the rise of a quadratic, is still fitted)."""
+    rng = np.random.default_rng(0)
+    t = np.arange(-19.0, 1.0)
+    wear = 2.0 + 0.3 * rng.standard_normal(t.size)
+    wear[-1] = -4.0
+    fits = trends.fit_models(t, wear, np.full(t.size, 0.5))
+    assert [f.model for f in fits] == ["linear"]
+    assert trends.model_weights(fits) == pytest.approx([1.0])
+    rise = 0.02 * np.clip(t + 19.0 - 5.0, 0.0, None) ** 2
+    slow = trends.fit_models(t, rise + 0.05 * rng.standard_normal(t.size), np.full(t.size, 0.05))
+    exponential = next(f for f in slow if f.model == "exponential")
+    assert 0.0 < exponential.params[2] < 1.0 and np.all(np.linalg.eigvalsh(exponential.cov) < 1e6)

@@ -282,7 +282,9 @@ def fit_models(t: np.ndarray, wear: np.ndarray, error: np.ndarray, changepoint: 
     ``changepoint``): the line, the exponential, and with ``changepoint`` the hinge and the power
     law, each with its AICc on the same logs (the model average's weights, :func:`akaike_weights`).
     A hinge or power law whose slope now is not positive is left out (a trend that has stopped
-    rising is the line's or the exponential's)."""
+    rising is the line's or the exponential's), and so is an exponential whose time constant ``1/k``
+    is shorter than the logs' median spacing (a step at the last log: its ``b`` and ``k`` trade off,
+    their variance unbounded, and its AICc took the average from the line)."""
     fits = list(_fit_line_and_exponential(t, wear, error))
     if changepoint:
         for fit in (fit_hinge(t, wear, error), fit_power(t, wear, error)):
@@ -322,6 +324,8 @@ def _fit_line_and_exponential(t, wear, error):
         cov = _widened(cov, chi2, len(t) - n_params)
         if not (np.all(np.isfinite(params)) and np.all(np.isfinite(cov))):
             continue
+        if name == "exponential" and params[2] * float(np.median(np.diff(t))) > 1.0:
+            continue  # a time constant shorter than the logs' spacing: a step at the last log, b and k unidentified
         found = Fit(name, params, cov, information_criterion(residual, error, n_params))
         if name == "linear":
             linear = found
