@@ -284,3 +284,24 @@ def test_the_monitors_own_estimate_of_a_log_is_its_estimate_less_the_slope_error
         part = unit.stages.wear.trend.condition_part(x)
         assert np.any(np.abs(part) > 1e-6)
         np.testing.assert_allclose(row.wear.log, own - part, rtol=1e-9, atol=1e-9)
+
+
+def test_the_covariance_stays_symmetric_and_positive_where_the_fading_grows_it():
+    """Wear growing 0-10 points a log with jumps every seventh log: the adapted fading reaches 10 and more
+    and multiplies the predicted covariance each log; the update's rounding asymmetry (K_i c_j against
+    K_j c_i) grew with it to a wear variance of -983 and a NaN error before. Now every axis's covariance is
+    symmetric and positive semi-definite at every log, and every stated error finite."""
+    rng = np.random.default_rng(1)
+    trend, wear = WearTrend(6), np.zeros(6)
+    rates = np.array([0.0, 0.5, 3.0, 6.0, 1.0, 10.0])
+    fading = []
+    for log in range(200):
+        wear = wear + rates * (log > 20) + (rng.standard_normal(6) * 3 if log % 7 == 0 else 0)
+        _, error = trend.update(wear + rng.standard_normal(6) * 1.3, np.full(6, 1.3))
+        covariance = trend.covariance
+        assert np.array_equal(covariance, np.swapaxes(covariance, 1, 2)), log
+        largest = np.abs(covariance).max()
+        assert np.linalg.eigvalsh(covariance).min() >= -1e-9 * largest, log
+        assert np.all(np.isfinite(error)), log
+        fading.append(trend.fading.max())
+    assert max(fading) > 5.0  # the case the test is about: a fading well above one

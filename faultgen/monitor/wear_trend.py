@@ -130,6 +130,7 @@ class WearTrend:
         gain = np.where(gated[:, None], 0.0, cross / spread[:, None])  # (n_axes, 2 + k)
         state = state + gain * innovation[:, None]
         covariance = covariance - gain[:, :, None] * cross[:, None, :]
+        covariance = 0.5 * (covariance + np.swapaxes(covariance, 1, 2))  # rounding's asymmetry, which fading > 1 grows
         self.gated = np.where(gated, self.gated + 1, 0)
         restart = self.gated >= OUTLIER_RUN
         seen = np.where(gated | restart, np.nan, innovation)  # what the adaptation sees
