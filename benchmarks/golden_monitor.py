@@ -96,8 +96,8 @@ def ur_fleet(root: Path) -> tuple[Path, Path, str]:
             command = run.tau_m[0] * gear if command is None else command
             for c in range(cycles):
                 stamp = str(ur.START + datetime.timedelta(days=day + c))
-                ur._write_rtde(logs / unit / f"{stamp}.csv", run.t, run.q_a[c], run.tau_m[c] * gear,
-                               run.conditions.joint_temperature[c], command)
+                ur_rtde_logs.write_ur_log(logs / unit / f"{stamp}.csv", run.t, run.q_a[c], run.tau_m[c] * gear,
+                                          run.conditions.joint_temperature[c], command, ur.TORQUE_CONSTANTS)
             day += cycles
     return robot_dir, logs, ",".join(f"{k:g}" for k in ur.TORQUE_CONSTANTS)
 

@@ -19,8 +19,8 @@ What is independent and what is ours:
   wear and noise of :mod:`faultgen.bench.independent` (Lorentzian Stribeck hump, arctangent sign,
   viscous friction falling with joint temperature; unlike faultgen's eq. 6.3). The RTDE layout, as
   the adapter reads it, carries no payload, so the parts are kept negligible (``max_part`` 0.05 kg).
-- **The logs**: each day's log written in the RTDE recorder's layout (:func:`write_rtde`: space-separated,
-  ``timestamp``, ``actual_q_i``, ``actual_current_i`` = the arm torque over torque constants of ours
+- **The logs**: each day's log written in the RTDE recorder's layout (`tests/ur_rtde_logs.write_ur_log`:
+  space-separated, ``timestamp``, ``actual_q_i``, ``actual_current_i`` = the arm torque over torque constants of ours
   (:data:`TORQUE_CONSTANTS`: NOT Universal Robots' numbers), ``target_moment_i`` (the first log's
   torque, the same every day, as a fixed program's command is), ``joint_temperatures_i`` and
   placeholder columns the recorder's default recipe has). The truth (truth.csv) is never read by the monitor.
@@ -57,9 +57,6 @@ UR5_DH = ROOT / "docs/examples/ur5_dh.toml"
 #: N m/A at the joint per fleet: ours, chosen (about a UR joint's order: motor constant times gear
 #: ratio), not Universal Robots' numbers.
 TORQUE_CONSTANTS = {"ur5": (11.0, 11.0, 11.0, 8.5, 8.5, 8.5), "ur10": (14.0, 14.0, 12.0, 8.5, 8.5, 8.5)}
-#: Columns of the recorder's default recipe written beside the ones read (placeholder values).
-OTHER_COLUMNS = ("target_q", "target_qd", "target_current", "actual_TCP_pose", "robot_mode", "safety_mode",
-                 "speed_scaling", "actual_main_voltage", "actual_robot_current", "actual_joint_voltage")
 #: The monitor's learning logs.
 TRAIN = 10
 
@@ -136,14 +133,6 @@ def add_arm(work: Path, name: str) -> Path:
     return folder
 
 
-def write_rtde(path: Path, t, q, tau, temperature, commanded, constants) -> None:
-    """One log in the RTDE recorder's layout (module docstring): ``t`` (n,) s, ``q`` (n, 6) rad, ``tau``
-    and ``commanded`` (n, 6) N m at the joint, ``temperature`` (6,) deg C, ``constants`` (6,) N m/A."""
-    ur_rtde_logs.write_rtde(path, t, {"actual_q": q, "actual_current": tau / np.asarray(constants),
-                                      "target_moment": commanded,
-                                      "joint_temperatures": np.broadcast_to(temperature, q.shape)}, OTHER_COLUMNS)
-
-
 def spec(units: int, days: int, seed: int) -> independent.FleetSpec:
     """Half the units wearing (one axis of 1..6 each, from a day in the first third to 45 % on the last),
     one gearbox change (logged in events.csv), parts of at most 0.05 kg (the RTDE layout has no
@@ -171,7 +160,7 @@ def write_fleet(work: Path, name: str, args) -> tuple[Path, Path, Path]:
             if commanded is None:
                 commanded = tau.copy()
             if not target.is_file():
-                write_rtde(target, t, q, tau, temperature, commanded, TORQUE_CONSTANTS[name])
+                ur_rtde_logs.write_ur_log(target, t, q, tau, temperature, commanded, TORQUE_CONSTANTS[name])
     if (logs / "events.csv").is_file():
         (rtde / "events.csv").write_bytes((logs / "events.csv").read_bytes())
     return robot, rtde, truth

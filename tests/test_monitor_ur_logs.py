@@ -42,7 +42,7 @@ from faultgen.operation import conditions, wear
 from faultgen.simulation import sensors
 from faultgen.simulation import stepping as sim
 from resolved_runs import run_config
-from ur_rtde_logs import add_ur5, write_rtde
+from ur_rtde_logs import add_ur5, write_ur_log
 
 #: N m/A at the joint, the test's (the log's current is its arm torque over them).
 TORQUE_CONSTANTS = (12.0, 12.0, 12.0, 9.0, 9.0, 9.0)
@@ -55,10 +55,6 @@ WORN_AXIS, FINAL_WEAR = 2, 21.0
 START = datetime.date(2026, 4, 1)
 #: The healthy unit ur-03's program changes, unlogged, after this many days (to this task).
 PROGRAM_DAY, OTHER_TASK = 12, "spot_weld"
-#: Columns of the RTDE recorder's default recipe written beside the ones read (other names, as the
-#: recorder writes them; their values are placeholders).
-OTHER_COLUMNS = ("target_q", "target_qd", "target_current", "actual_TCP_pose", "robot_mode", "safety_mode",
-                 "speed_scaling", "actual_main_voltage", "actual_robot_current", "actual_joint_voltage")
 runner = CliRunner()
 
 
@@ -70,14 +66,6 @@ def _simulate(robot_dir: Path, seed: int, cycles: int, start_day: float, plan, t
     result = sim.simulate(config, progress=False)
     assert result.saturated.size == 0
     return result
-
-
-def _write_rtde(path: Path, t, q, tau, temperature, commanded) -> None:
-    """One UR log: positions, motor currents, the commanded torque, joint temperatures and the
-    recorder's other columns (zeros)."""
-    write_rtde(path, t, {"actual_q": q, "actual_current": tau / np.asarray(TORQUE_CONSTANTS),
-                         "target_moment": commanded,
-                         "joint_temperatures": np.broadcast_to(temperature, q.shape)}, OTHER_COLUMNS)
 
 
 @pytest.fixture(scope="module")
@@ -100,8 +88,8 @@ def fleet(tmp_path_factory):
             command = commanded.setdefault(tuple(task), run.tau_m[0] * gear)
             for c in range(cycles):
                 stamp = str(START + datetime.timedelta(days=day + c))
-                _write_rtde(logs / unit / f"{stamp}.csv", run.t, run.q_a[c], run.tau_m[c] * gear,
-                            run.conditions.joint_temperature[c], command)
+                write_ur_log(logs / unit / f"{stamp}.csv", run.t, run.q_a[c], run.tau_m[c] * gear,
+                             run.conditions.joint_temperature[c], command, TORQUE_CONSTANTS)
                 truth[(unit, stamp)] = 100.0 * (float(run.friction_multiplier[c, WORN_AXIS - 1]) - 1.0)
             if unit == "ur-01" and index == 2:
                 change = str(START + datetime.timedelta(days=day))

@@ -10,6 +10,9 @@ from typer.testing import CliRunner
 from faultgen.cli import app
 
 UR5_DH = Path(__file__).resolve().parents[1] / "docs/examples/ur5_dh.toml"
+#: Columns of the RTDE recorder's default recipe written beside the ones read, as zeros (placeholders).
+OTHER_COLUMNS = ("target_q", "target_qd", "target_current", "actual_TCP_pose", "robot_mode", "safety_mode",
+                 "speed_scaling", "actual_main_voltage", "actual_robot_current", "actual_joint_voltage")
 
 
 def add_ur5(root: Path) -> Path:
@@ -35,3 +38,12 @@ def write_rtde(path: Path, t, columns: dict, others=()) -> None:
     part = path.with_name(path.name + ".part")  # a killed writer leaves no log that looks complete
     np.savetxt(part, np.column_stack(values), delimiter=" ", header=" ".join(names), comments="", fmt="%.9g")
     os.replace(part, path)
+
+
+def write_ur_log(path: Path, t, q, tau, temperature, commanded, constants) -> None:
+    """One UR log: ``t`` (n,) s, positions ``q`` (n, 6) rad, motor currents (the arm torque ``tau`` (n, 6)
+    N m over ``constants`` (6,) N m/A), the ``commanded`` torque (n, 6) N m, joint ``temperature`` (6,)
+    deg C, and :data:`OTHER_COLUMNS` as zeros."""
+    write_rtde(path, t, {"actual_q": q, "actual_current": tau / np.asarray(constants),
+                         "target_moment": commanded, "joint_temperatures": np.broadcast_to(temperature, q.shape)},
+               OTHER_COLUMNS)
