@@ -117,20 +117,33 @@ class Event:
     line: int
 
 
+class StampError(ValueError):
+    """A stamp that does not parse (:func:`parse_stamp`): ``where`` it was found, and ``reason`` (what is
+    wrong with it and what was expected); its message is ``"where: reason"``. Its ``args`` are the two, so
+    it pickles (a worker process's error reaches the parent as it was raised)."""
+
+    def __init__(self, where: str, reason: str):
+        super().__init__(where, reason)
+        self.where, self.reason = where, reason
+
+    def __str__(self) -> str:
+        return f"{self.where}: {self.reason}"
+
+
 def parse_stamp(text: str, where: str) -> tuple[float, str]:
     """``(key, kind)`` of a stamp (module docstring).
 
     Raises
     ------
-    ValueError
-        If ``text`` is neither an ISO date or date-time nor a whole number of at most
+    StampError
+        (a ValueError) If ``text`` is neither an ISO date or date-time nor a whole number of at most
         :data:`MAX_SEQUENCE_DIGITS` ASCII digits; names ``where``.
     """
     if text.isdigit():  # ASCII digits only: "²" and "٣" are digits to str.isdigit, not to a sequence
         if not (text.isascii() and len(text) <= MAX_SEQUENCE_DIGITS):
-            raise ValueError(f"{where}: stamp {_shown(text)}: expected a sequence number of at most "
-                             f"{MAX_SEQUENCE_DIGITS} digits 0-9 (17), an ISO date (2026-03-01) or an ISO date and time "
-                             "(2026-03-01T08:30:00)")
+            raise StampError(where, f"stamp {_shown(text)}: expected a sequence number of at most "
+                             f"{MAX_SEQUENCE_DIGITS} digits 0-9 (17), an ISO date (2026-03-01) or an ISO "
+                             "date and time (2026-03-01T08:30:00)")
         return float(int(text)), SEQUENCE
     match = _DATE_TIME.fullmatch(text)
     try:
@@ -141,8 +154,9 @@ def parse_stamp(text: str, where: str) -> tuple[float, str]:
             moment = datetime.fromisoformat(day if hour is None else f"{day}T{hour}:{minute}:{second or '00'}")
         key = (moment if moment.tzinfo is not None else moment.replace(tzinfo=timezone.utc)).timestamp()
     except (ValueError, OverflowError):
-        raise ValueError(f"{where}: stamp {_shown(text)} is neither an ISO date (2026-03-01), an ISO date and time "
-                         "(2026-03-01T08:30:00 or 2026-03-01T08-30-00) nor a sequence number (17)") from None
+        raise StampError(where, f"stamp {_shown(text)} is neither an ISO date (2026-03-01), an ISO date "
+                         "and time (2026-03-01T08:30:00 or 2026-03-01T08-30-00) nor a sequence number "
+                         "(17)") from None
     return key, TIME
 
 
@@ -226,8 +240,8 @@ def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, ba
             continue
         try:
             key, kind = parse_stamp(stamp, name)
-        except ValueError as err:
-            bad.append((name, str(err)))
+        except StampError as err:
+            bad.append((name, err.reason))
             continue
         logs.append(LogFile(unit, stamp, key, kind, path, name))
     kinds = {log.kind for log in logs}

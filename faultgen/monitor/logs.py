@@ -89,8 +89,8 @@ def passed_note(passed: list[tuple[str, str]]) -> str:
 
 
 def passed_entry(name: str, reason: str) -> str:
-    """One entry passed over, ``name: reason`` (a reason that names it already, as a stamp's does, as it is)."""
-    return reason if reason.startswith(f"{name}: ") else f"{name}: {reason}"
+    """One entry passed over, ``name: reason``."""
+    return f"{name}: {reason}"
 
 
 @dataclass(frozen=True)
