@@ -2,7 +2,9 @@
 listing carries the file's name and the reason apart (a typed :class:`~faultgen.data.logfolder.StampError`),
 and every message names the file once. Before, the reason was the parser's whole message, which
 began with the name: `faultgen logs import` printed it twice ("u1/backup copy.csv: u1/backup
-copy.csv: stamp ..."), and the monitor's note recovered it by matching the start of the text."""
+copy.csv: stamp ..."), and the monitor's note recovered it by matching the start of the text. A
+file in a unit's friction-test folder is "not a friction test" where it is listed (before, the
+monitor replaced "not a log" in the listing's text)."""
 
 from __future__ import annotations
 
@@ -45,3 +47,11 @@ def test_a_listing_names_each_bad_stamp_once(folder):
         fleetlogs.import_logs(folder, folder.parent / "f.h5", robot="puma560", progress=False)
     assert str(refused.value).count("1234567890123456789.csv") == 1, refused.value
     assert not (folder.parent / "f.h5").exists()
+
+
+def test_a_test_folders_stray_file_is_named_not_a_friction_test_where_it_is_listed(folder):
+    (folder / "u1/friction-test").mkdir()
+    (folder / "u1/friction-test/readme.md").write_text("how the tests were run")
+    _, bad = logfolder.scan_tests(folder, ["u1"], (".csv",))  # said so by the listing, not replaced in its text after
+    assert bad == [("u1/friction-test/readme.md", "not a friction test: expected <stamp>.csv")]
+    assert logfolder.scan(folder, (".csv",))[1][-1] == ("u1/backup copy.csv", REASON)  # the logs' listing as before

@@ -219,10 +219,11 @@ def scan(folder: Path, suffixes: tuple[str, ...]) -> tuple[dict[str, list[LogFil
     return units, bad
 
 
-def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, bad: list) -> list[LogFile]:
+def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, bad: list,
+             what: str = "log") -> list[LogFile]:
     """The logs of the folder ``where`` (a unit's, or its :data:`TESTS` folder) in stamp order, the
-    files that are not logs added to ``bad`` (:func:`scan`'s rules); a unit's :data:`TESTS` folder
-    is passed over (its tests are no logs: :func:`scan_tests`)."""
+    files that are not logs added to ``bad`` (:func:`scan`'s rules; a file without a stamp is "not a
+    ``what``"); a unit's :data:`TESTS` folder is passed over (its tests are no logs: :func:`scan_tests`)."""
     logs = []
     for path in sorted(where.iterdir()):
         if path.name.startswith("."):
@@ -236,7 +237,7 @@ def _listing(where: Path, folder: Path, suffixes: tuple[str, ...], unit: str, ba
             continue
         stamp = stamp_of(path.name, suffixes) if path.is_file() else None
         if stamp is None:
-            bad.append((name, f"not a log: expected <stamp>{' or <stamp>'.join(suffixes)}"))
+            bad.append((name, f"not a {what}: expected <stamp>{' or <stamp>'.join(suffixes)}"))
             continue
         try:
             key, kind = parse_stamp(stamp, name)
@@ -280,7 +281,7 @@ def scan_tests(folder: Path, units,
         if not where.is_dir():
             raise ValueError(f"{where}: {_kind(where)}; expected a folder of the unit's friction tests "
                              f"(LOGS/<unit>/{TESTS}/<stamp>.csv)")
-        found[unit] = _listing(where, folder, suffixes, unit, bad)
+        found[unit] = _listing(where, folder, suffixes, unit, bad, "friction test")
     return found, bad
 
 

@@ -165,13 +165,12 @@ def find(logs_dir: Path, units: dict[str, list], suffixes: tuple[str, ...],
     it. ValueError for stamps of another kind than the unit's logs."""
     found, bad = logfolder.scan_tests(Path(logs_dir), list(units), suffixes)
     if passed is not None:  # a link out of the folder is refused, never passed over
-        passed.extend((name, reason.replace("not a log", "not a friction test")) for name, reason in bad
-                      if reason != logfolder.LINK_OUT)
+        passed.extend((name, reason) for name, reason in bad if reason != logfolder.LINK_OUT)
         bad = [(name, reason) for name, reason in bad if reason == logfolder.LINK_OUT]
     if bad:
         name, reason = bad[0]
         more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
-        raise ValueError(f"{Path(logs_dir) / name}: {reason.replace('not a log', 'not a friction test')}{more}")
+        raise ValueError(f"{Path(logs_dir) / name}: {reason}{more}")
     for unit, tests in found.items():
         logs = units[unit]
         if tests and logs and tests[0].kind != logs[0].kind:
