@@ -248,19 +248,22 @@ def learning(stages, program: int) -> bool:
     return (stages.baseline if program == 0 else stages.programs.saved[program - 1]).pca is None
 
 
-def mix(entries, count: int) -> str:
+def mix(entries, count: int, names: list[str] | None = None) -> str:
     """A unit's program mix: each of its ``count`` programs (in the order met) and its scored logs,
-    e.g. ``"program 1: 12 logs, program 2: 9 logs"`` (``entries`` with a ``program`` index)."""
+    e.g. ``"program 1: 12 logs, program 2: 9 logs"`` (``entries`` with a ``program`` index); ``names``:
+    each baseline's name (:func:`faultgen.monitor.sources.labels`), ``"program K"`` by default."""
+    names = names or [f"program {k + 1}" for k in range(count)]
     logs = np.bincount([e.program for e in entries], minlength=count) if entries else np.zeros(count, int)
-    return ", ".join(f"program {k + 1}: {int(n)} logs" for k, n in enumerate(logs))
+    return ", ".join(f"{names[k]}: {int(n)} logs" for k, n in enumerate(logs))
 
 
-def mix_note(stages, entries, count: int) -> str:
+def mix_note(stages, entries, count: int, names: list[str] | None = None) -> str:
     """A unit's note on its programs when it has run more than one (:func:`mix`, and each later
-    program of its ``stages`` still learning its baseline), else ""."""
+    program of its ``stages`` still learning its baseline), else ""; ``names`` as :func:`mix`'s."""
     if count < 2:
         return ""
+    names = names or [f"program {k + 1}" for k in range(count)]
     saved = stages.programs.saved
-    learning = [f"program {k + 2} learning: {len(b.training)} of {b.learning_logs} logs"
+    learning = [f"{names[k + 1]} learning: {len(b.training)} of {b.learning_logs} logs"
                 for k, b in enumerate(saved) if b.pca is None]
-    return "; ".join([f"programs: {mix(entries, count)}", *learning])
+    return "; ".join([f"programs: {mix(entries, count, names)}", *learning])

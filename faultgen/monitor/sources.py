@@ -21,8 +21,6 @@ header) is part of what a baseline is for, as the program is.
 
 from __future__ import annotations
 
-import re
-
 from faultgen.monitor import history
 
 #: More source changes than this in a unit's scored logs are named as a mix (each source and its
@@ -114,12 +112,3 @@ def labels(unit) -> list[str]:
         names = [f"{name} ({of_baseline(unit, k) or 'the logged torque'})" for k, name in enumerate(names)]
     return names
 
-
-def relabel(unit, text: str) -> str:
-    """``text`` (:func:`faultgen.monitor.programs.mix`, ``mix_note``: ``"program K"`` naming baseline
-    ``K - 1``) with each baseline named by :func:`labels`; ``text`` itself where no source changed."""
-    names = labels(unit)
-    if names == [f"program {k + 1}" for k in range(len(names))]:
-        return text
-    return re.sub(r"\bprogram (\d+)\b", lambda m: names[int(m.group(1)) - 1] if int(m.group(1)) <= len(names)
-                  else m.group(0), text)
