@@ -378,9 +378,8 @@ def _status(name: str, unit: UnitHistory | None, settings: Settings, stale: list
         reasons.append(f"learning: {len(unit.stages.baseline.training)} of {settings.train} logs")
     elif not learning and steps.not_observable_note(unit.stages):
         reasons.append(steps.not_observable_note(unit.stages))
-    count = 1 + len(unit.program_changes)
-    names = sources.labels(unit)
-    mix = programs.mix_note(unit.stages, unit.entries, count, names)
+    names = sources.labels(unit)  # one per baseline: 1 + the program changes
+    mix = programs.mix_note(unit.stages, unit.entries, names)
     reasons += [mix] if mix else []
     if not unit.entries or stopped:
         status = "not monitored"
@@ -392,7 +391,7 @@ def _status(name: str, unit: UnitHistory | None, settings: Settings, stale: list
     last = unit.entries[-1].stamp if unit.entries else ""
     return UnitStatus(name, status, protocol, unit.model if unit.model != "none" and not refused else "",
                       "; ".join(reasons), len(unit.entries), last, sources.seen(unit),
-                      "; ".join(fallback_notes(unit)), programs.mix(unit.entries, count, names) if count > 1 else "")
+                      "; ".join(fallback_notes(unit)), programs.mix(unit.entries, names) if len(names) > 1 else "")
 
 
 #: Most distinct reasons a unit's reason names for its skipped logs (:func:`skipped_note`).

@@ -248,22 +248,21 @@ def learning(stages, program: int) -> bool:
     return (stages.baseline if program == 0 else stages.programs.saved[program - 1]).pca is None
 
 
-def mix(entries, count: int, names: list[str] | None = None) -> str:
-    """A unit's program mix: each of its ``count`` programs (in the order met) and its scored logs,
-    e.g. ``"program 1: 12 logs, program 2: 9 logs"`` (``entries`` with a ``program`` index); ``names``:
-    each baseline's name (:func:`faultgen.monitor.sources.labels`), ``"program K"`` by default."""
-    names = names or [f"program {k + 1}" for k in range(count)]
+def mix(entries, names: list[str]) -> str:
+    """A unit's program mix: each of its programs (in the order met, ``names``: each baseline's name,
+    :func:`faultgen.monitor.sources.labels`) and its scored logs, e.g. ``"program 1: 12 logs, program 2:
+    9 logs"`` (``entries`` with a ``program`` index)."""
+    count = len(names)
     logs = np.bincount([e.program for e in entries], minlength=count) if entries else np.zeros(count, int)
     return ", ".join(f"{names[k]}: {int(n)} logs" for k, n in enumerate(logs))
 
 
-def mix_note(stages, entries, count: int, names: list[str] | None = None) -> str:
+def mix_note(stages, entries, names: list[str]) -> str:
     """A unit's note on its programs when it has run more than one (:func:`mix`, and each later
     program of its ``stages`` still learning its baseline), else ""; ``names`` as :func:`mix`'s."""
-    if count < 2:
+    if len(names) < 2:
         return ""
-    names = names or [f"program {k + 1}" for k in range(count)]
     saved = stages.programs.saved
     learning = [f"{names[k + 1]} learning: {len(b.training)} of {b.learning_logs} logs"
                 for k, b in enumerate(saved) if b.pca is None]
-    return "; ".join([f"programs: {mix(entries, count, names)}", *learning])
+    return "; ".join([f"programs: {mix(entries, names)}", *learning])
