@@ -471,7 +471,7 @@ def write_fleet(root: Path, spec: FleetSpec, robot: Path) -> tuple[Path, Path]:
     """
     root = Path(root)
     model = robots.load(Path(robot))  # the independent simulator's entry: its robot folder, resolved once
-    G, jm, nominal = model.gear_ratio, model.motor_inertia, model.friction
+    G, nominal = model.gear_ratio, model.friction
     nominal = tuple(np.asarray(x, dtype=float) for x in (nominal.coulomb_pos, nominal.static, nominal.viscous))
     n = model.n_axes
     logs = root / "logs"

@@ -24,7 +24,6 @@ from faultgen.logs import columns, formats, measured
 from faultgen.logs.columns import WHOLE_MAX_BYTES
 from faultgen.model.robots import Robot
 from faultgen.monitor import history, scoring
-from faultgen.monitor import state as stored
 from faultgen.operation import programs
 
 #: The features the monitor watches per axis (:data:`faultgen.monitor.scoring.FEATURES`, which says why).

@@ -8,7 +8,6 @@ import functools
 import hashlib
 import json
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 
