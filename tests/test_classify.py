@@ -418,13 +418,19 @@ def test_evaluate_gives_table_5_2_layout():
                           n_pairs=1)
 
 
-def test_evaluate_fits_each_preprocessing_once_per_pair_and_gives_the_per_cell_aucs_in_parallel():
+def test_evaluate_fits_each_preprocessing_once_per_pair_and_gives_the_per_cell_aucs_in_parallel(monkeypatch):
     """Issue 40: one job per held-out pair, every cell of it on a preprocessing fitted once, on two
-    processes: the same AUC in every cell as Procedure 1 run cell by cell with whole pipelines."""
+    processes (on Linux forked from this one, issue 89): the same AUC in every cell as Procedure 1
+    run cell by cell with whole pipelines."""
+    from faultgen import pools
+
+    pooled, forked_pool = [], pools.forked_pool
+    monkeypatch.setattr(pools, "forked_pool", lambda n_jobs: pooled.append(n_jobs) or forked_pool(n_jobs))
     X, y, groups, failed, normal = runs(n_failed=4, n_normal=3, n_cycles=18)
     names = ["control", "+diff+pca+var3", "+diff+var3+pca"]
     _, aucs = classify.evaluate(X, y, groups, failed, normal, preprocessing=names, n_pairs=3, random_state=0,
                                 n_jobs=2, return_aucs=True)
+    assert pooled == ([2] if pools.FORK else [])  # elsewhere joblib's loky
     for (column, name), got in aucs.items():
         expected = classify.leave_pair_out_auc(classify.make_pipeline(column, name), X, y, groups, failed, normal,
                                                n_pairs=3, random_state=0)

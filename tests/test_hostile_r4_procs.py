@@ -20,7 +20,7 @@ from typer.testing import CliRunner
 
 import fleetlog_folder
 from test_reliability import marked  # every process carrying the test's environment mark
-from faultgen import children
+from faultgen import children, pools
 from faultgen.cli import app
 from faultgen.model import robots
 
@@ -143,7 +143,7 @@ def workers_of(pid: int) -> list[psutil.Process]:
 def test_a_killed_monitor_leaves_no_worker_running(small_fleet, tmp_path, how):
     """`monitor --jobs 2` killed (its own process only, as `kill PID` does) while its two forked
     workers score units: both end within a second or two (PR_SET_PDEATHSIG, and a thread watching
-    the parent: faultgen.runs.worker.watch_parent). Before, they waited on the task queue for good,
+    the parent: faultgen.pools.watch_parent). Before, they waited on the task queue for good,
     400-600 MB each."""
     mark = str(tmp_path)
     proc = subprocess.Popen(children.command("-m", "faultgen.cli", "monitor", str(small_fleet), "--robot", "irb6700",
@@ -175,7 +175,7 @@ def test_monitor_jobs_above_the_units_and_cores_starts_one_worker_per_unit_and_w
             started.append(max_workers)
             super().__init__(max_workers, *args, **kw)
 
-    monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", Counted)
+    monkeypatch.setattr(pools, "ProcessPoolExecutor", Counted)  # the pool faultgen.pools.forked_pool makes
     monkeypatch.setattr(os, "cpu_count", lambda: 2)
     result = runner.invoke(app, ["monitor", str(small_fleet), "--robot", "irb6700", "-o", str(tmp_path / "out"),
                                  "--protocol", "own", "--jobs", "1024", "--no-progress"])

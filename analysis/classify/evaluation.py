@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Iterable, Mapping
+from functools import partial
 
 import numpy as np
 import pandas as pd
-from joblib import Parallel, delayed
+from joblib import Parallel, delayed, effective_n_jobs
 from sklearn.base import BaseEstimator
 from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
@@ -19,7 +20,7 @@ from analysis.classify.labels import make_labels
 from analysis.classify.leave_pair_out import UndefinedAUCWarning, check_inputs, pair_cells
 from analysis.classify.preprocessing import ESTIMATED, PREPROCESSING, preprocessing_steps
 from analysis.evaluate import LeavePairOut
-from faultgen import children
+from faultgen import children, pools
 from faultgen.checks import is_whole
 
 
@@ -103,15 +104,22 @@ def evaluate(X, y, groups, failed_groups, normal_groups,
 
 def _run(tasks: list, n_jobs: int | None, progress: bool) -> list[np.ndarray]:
     """:func:`pair_cells` of each of ``tasks`` (:func:`_tasks`), in their order, on ``n_jobs``
-    processes (None: 1)."""
+    processes (None: 1; -1: one per core): on Linux forked from this one
+    (:func:`faultgen.pools.forked_pool`: they start with its imports, scikit-learn's, SciPy's and
+    pandas', which a fresh interpreter takes 2-3 s of CPU to make again), elsewhere joblib's loky."""
     # these fits are small (hundreds of samples): a BLAS thread pool per process only contends for
     # the cores (quick.h5, a loaded 2-core machine: LR 0.5 s a fit with the pool, 0.02 s without);
-    # joblib's workers limit theirs alike
+    # forked workers inherit this limit, joblib's workers limit theirs alike
     # loky's workers and trackers start in this folder: no joblib.py of it on their path
     with threadpool_limits(limits=1), children.safe_path():
+        workers = min(effective_n_jobs(n_jobs if n_jobs is not None else 1), len(tasks))
+        bar = partial(tqdm, total=len(tasks), desc="classify", unit="pair", disable=not progress)
+        if workers > 1 and pools.FORK:
+            with pools.forked_pool(workers) as pool:
+                return list(bar(pool.map(pair_cells, *zip(*(args for _, args in tasks), strict=True))))
         results = Parallel(n_jobs=n_jobs if n_jobs is not None else 1, return_as="generator")(
             delayed(pair_cells)(*args) for _, args in tasks)
-        return list(tqdm(results, total=len(tasks), desc="classify", unit="pair", disable=not progress))
+        return list(bar(results))
 
 
 def _null_of(null_of: Iterable[str] | None, models: dict) -> list[str]:

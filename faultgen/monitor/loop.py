@@ -207,7 +207,7 @@ def _score_units(run: MonitorRun, scoring: Context, state: dict[str, UnitHistory
     bar = tqdm(total=sum(len(v) for v in pending.values()), desc="monitor", unit="log", disable=not run.progress)
     made: dict[str, tuple[bytes, list]] = {}
     idle = [state[name] for name in pending if name in state and not pending[name]]  # no new log
-    # closed at once on an interrupt, which stops its workers (faultgen.monitor.parallel.stop)
+    # closed at once on an interrupt, which stops its workers (faultgen.pools.stop)
     with contextlib.closing(map_groups(run, scoring, groups, idle, source)) as results:
         for done in results:
             for name, unit, outputs in done:

@@ -9,15 +9,15 @@ imports the scoring code again (faultgen, MuJoCo, SciPy, matplotlib, ProgPy), 2-
 an idle core and about 13 s at a load average of 8, which was most of ``--jobs 2``'s loss on a
 small fleet (docs/performance.md); joblib's fork-based backend (``multiprocessing``) yields no
 results before the last, so the standard library's ``ProcessPoolExecutor`` with the fork context
-is used, its tasks a group's index into what the workers inherit.
+is used (:func:`faultgen.pools.forked_pool`), its tasks a group's index into what the workers inherit.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
+from faultgen import pools
 from faultgen.model.robot import Robot
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
@@ -25,7 +25,6 @@ from faultgen.monitor.feed import Context, idle_outputs, score_group
 from faultgen.monitor.history import UnitHistory
 from faultgen.monitor.twin import Twin, base_cycles
 from faultgen.monitor.unit import log_of, model_of
-from faultgen.runs import worker
 from faultgen.simulation.backends import Stepper
 
 
@@ -105,18 +104,6 @@ def preload() -> None:
     prognosis.import_progpy()
 
 
-def stop(pool) -> None:
-    """Stop a forked pool at once: its queued tasks cancelled and its workers (this process's
-    ``multiprocessing`` children) killed, not waited for: a unit being scored would otherwise hold a
-    Ctrl-C for as long as its scoring takes. Nothing they made is kept (the monitor writes its
-    outputs only once every unit is scored)."""
-    import multiprocessing
-
-    pool.shutdown(wait=False, cancel_futures=True)
-    for child in multiprocessing.active_children():
-        child.kill()  # reaped by the pool's own thread
-
-
 def map_groups(run, context: Context, groups: list, idle: list | tuple = (), source: fleet_logs.Source | None = None):
     """Each group of ``run`` (a :class:`faultgen.monitor.run.MonitorRun`) scored (:func:`score_group`,
     on its workers' ``context``), then each ``idle`` monitor's (a unit with no new log) chart and
@@ -125,7 +112,7 @@ def map_groups(run, context: Context, groups: list, idle: list | tuple = (), sou
     Linux forked from this one, after the shared twins are simulated: :func:`prepare_twins`, and
     the scoring's imports made: :func:`preload`; elsewhere joblib's loky, started without the user's folders on their path:
     :func:`faultgen.children.safe_path`; either way each worker ends within a second of this process,
-    as a sweep's do: :func:`faultgen.runs.worker.watch_parent`); or on the Dask cluster of ``scheduler``
+    as a sweep's do: :func:`faultgen.pools.watch_parent`); or on the Dask cluster of ``scheduler``
     (:func:`faultgen.monitor.remote.execute`; the robot as the user named it). Every group's
     arithmetic is the same wherever it runs, so the outputs are those of one job, bit for bit.
     ``source``: the run's logs as read so far (:class:`faultgen.monitor.logs.Source`), which this
@@ -145,33 +132,23 @@ def map_groups(run, context: Context, groups: list, idle: list | tuple = (), sou
         yield from (idle_outputs(m, context.failure_wear) for m in idle)
         return
     n_jobs = min(jobs, len(groups) + len(idle))
-    if sys.platform.startswith("linux"):
+    if pools.FORK:
         # Forked workers start with this process's imports and state (faultgen, MuJoCo, SciPy,
         # matplotlib, ProgPy: 2-3 s of a fresh interpreter's start on an idle core, 13 s at a load
         # average of 8), and read the context and groups from it: a task is an index. They
         # simulate the shared twins' cycles first (in ``jobs`` processes, not one after another).
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
         preload()
         _SHARED.update(context=context, groups=groups, idle=idle, source=source)
         # each worker ends within a second of this process, whatever ended it (SIGKILL, SIGTERM), as the
         # sweep's do (forked workers waiting on the task queue would otherwise run on for good), and
-        # leaves a Ctrl-C or SIGTERM of the process group to this process (faultgen.runs.worker.start_worker)
-        pool = ProcessPoolExecutor(n_jobs, mp_context=multiprocessing.get_context("fork"),
-                                   initializer=worker.start_worker, initargs=(os.getpid(),))
-        stopped = False
+        # leaves a Ctrl-C or SIGTERM of the process group to this process (faultgen.pools.start_worker); an
+        # interrupt or a failure stops them at once (faultgen.pools.stop)
         try:
-            if groups:
-                prepare_twins(context, groups, pool, source)
-            yield from pool.map(_score_shared, range(len(groups) + len(idle)))
-        except BaseException:  # Ctrl-C, SIGTERM, a failure, or the caller closing this generator
-            stopped = True
-            stop(pool)
-            raise
+            with pools.forked_pool(n_jobs) as pool:
+                if groups:
+                    prepare_twins(context, groups, pool, source)
+                yield from pool.map(_score_shared, range(len(groups) + len(idle)))
         finally:
-            if not stopped:
-                pool.shutdown()
             _SHARED.clear()
         return
     if groups:
@@ -184,5 +161,5 @@ def map_groups(run, context: Context, groups: list, idle: list | tuple = (), sou
     tasks = [delayed(score_group)(context, group) for group in groups]
     tasks += [delayed(idle_outputs)(m, context.failure_wear) for m in idle]
     with children.safe_path():  # elsewhere (no fork): loky's fresh workers, without the user's folders on their path
-        backend = LokyBackend(initializer=worker.watch_parent, initargs=(os.getpid(),))
+        backend = LokyBackend(initializer=pools.watch_parent, initargs=(os.getpid(),))
         yield from Parallel(n_jobs=n_jobs, return_as="generator", backend=backend)(tasks)

@@ -13,7 +13,7 @@ same output refuses at once, naming the first. The kernel releases the lock of a
 the next one takes it over (and says so). The lock file is removed when the sweep ends.
 
 Whatever ends the sweep's own process (Ctrl-C, SIGTERM, SIGKILL), its local workers end too:
-each watches its parent and exits within a second of it (:func:`faultgen.runs.worker.watch_parent`); a SIGTERM is
+each watches its parent and exits within a second of it (:func:`faultgen.pools.watch_parent`); a SIGTERM is
 handled as a Ctrl-C (the workers are stopped, the message says what is kept and how to resume).
 """
 
@@ -39,7 +39,7 @@ from typing import Self
 
 from tqdm.auto import tqdm
 
-from faultgen import children, inputs
+from faultgen import children, inputs, pools
 from faultgen.data import atomic, dataset
 from faultgen.runs import cluster, worker
 from faultgen.runs.context import LOCAL, ExecutionContext
@@ -396,8 +396,8 @@ def _execute(todo: list[tuple[str, Run]], parts: Path, jobs: int, scheduler: str
             with children.safe_path():
                 worker.start_resource_tracker()
                 # every worker watches the sweep from its start, idle or not
-                # (:func:`faultgen.runs.worker.watch_parent`)
-                loky = LokyBackend(initializer=worker.start_worker, initargs=(os.getpid(),))
+                # (:func:`faultgen.pools.watch_parent`)
+                loky = LokyBackend(initializer=pools.start_worker, initargs=(os.getpid(),))
                 parallel = Parallel(n_jobs=jobs, return_as="generator_unordered", backend=loky)
                 yield from parallel(delayed(worker.in_worker)(os.getpid(), *call) for call in calls)
     except KeyboardInterrupt:

@@ -1,6 +1,6 @@
 """What a local worker process of a sweep does: simulate one run and write its part file
 (:func:`simulate_and_write`), and stay tied to the sweep that started it: it ends within a second
-of the sweep's process (:func:`watch_parent`), leaves a group-wide SIGTERM and Ctrl-C to the sweep,
+of the sweep's process (:func:`faultgen.pools.watch_parent`), leaves a group-wide SIGTERM and Ctrl-C to the sweep,
 and gives its freed memory back to the OS after each run."""
 
 from __future__ import annotations
@@ -78,28 +78,9 @@ def in_worker(sweep_pid: int, *call) -> RunStats:
     return simulate_and_write(*call)
 
 
-def start_worker(sweep_pid: int) -> None:
-    """A loky worker's initializer: watch the sweep's process from the worker's start; a worker
-    whose sweep ended while it started (it has another parent already) ends at once. A SIGTERM
-    sent to the whole process group (``timeout``, a process manager, a closed terminal) is the
-    sweep's to handle: it stops its workers and says what is kept and how to resume; a worker that
-    ended on it first left loky's semaphores for Python to report as leaked, and the sweep no word.
-    The Ctrl-C of a terminal (SIGINT to the group) likewise: raised in a worker it printed a
-    traceback into the sweep's message wherever it landed (in h5py's write of a part, "Process
-    LokyProcess-2:" while the worker waited for its next run; tests/test_sweep.py failed on 2 of 6
-    tries without this), so a worker ignores it and the sweep stops its workers (loky kills them)."""
-    if os.getpid() == sweep_pid:
-        return
-    if os.getppid() != sweep_pid:
-        os._exit(1)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    watch_parent(sweep_pid)
-
-
 def start_resource_tracker() -> None:
     """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
-    workers do (:func:`start_worker`): a group-wide SIGTERM must not end it before the sweep has
+    workers do (:func:`faultgen.pools.start_worker`): a group-wide SIGTERM must not end it before the sweep has
     stopped its workers and released their semaphores (it then reports them as leaked). It ends
     when the sweep's process does."""
     from joblib.externals.loky.backend import resource_tracker
@@ -111,47 +92,6 @@ def start_resource_tracker() -> None:
         resource_tracker.ensure_running()
     finally:
         signal.signal(signal.SIGTERM, previous)
-
-
-_WATCHED: set[int] = set()
-
-
-def watch_parent(sweep_pid: int, period: float = 0.5) -> None:
-    """End this worker process within ``period`` s once the sweep's process ``sweep_pid`` is gone.
-
-    A killed sweep (SIGKILL, or SIGTERM under a process manager) cannot stop its workers, and
-    loky's workers would go on simulating the rest of the grid, then idle for minutes.
-    The kernel is asked to send this process SIGKILL when its parent ends (``PR_SET_PDEATHSIG``,
-    Linux), and a daemon thread checks every ``period`` s that the parent is still ``sweep_pid``
-    (another OS); either way the worker ends at once, its unfinished part left as a hidden
-    temporary file that the next sweep removes. Set once per worker process, from its start (the
-    loky initializer :func:`start_worker`); a process whose parent is not the sweep's is left
-    alone.
-    """
-    if sweep_pid in _WATCHED or os.getppid() != sweep_pid:  # not a worker the sweep started: nothing to watch
-        return
-    _WATCHED.add(sweep_pid)
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):  # not Linux: the thread below does it
-        pass
-    if os.getppid() != sweep_pid:  # the sweep ended before the request was made
-        os._exit(1)
-
-    def watch() -> None:
-        while True:
-            time.sleep(period)
-            try:
-                os.kill(sweep_pid, 0)
-            except ProcessLookupError:
-                os._exit(1)
-            except PermissionError:
-                pass
-            if os.getppid() != sweep_pid:  # orphaned (reparented to init or a subreaper): the sweep is gone
-                os._exit(1)
-
-    threading.Thread(target=watch, name="faultgen-watch-sweep", daemon=True).start()
 
 
 def quiet_unraisable_interrupts() -> None:
