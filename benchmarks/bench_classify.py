@@ -251,6 +251,7 @@ def print_counts(path: Path, pairs: int) -> None:
 
 
 def sweep_command(path: Path) -> list[str]:
+    """``faultgen sweep --preset quick`` into ``path`` (replacing it: step 1 makes it again with --repeat)."""
     return [*faultgen(), "sweep", "--preset", "quick", "-o", str(path), "--no-progress", "--overwrite"]
 
 
@@ -272,8 +273,7 @@ def step_one(path: Path, folder: Path, make: bool, full: bool) -> tuple[float, f
             print("  " + ratio_line(what, t, sweep, "the sweep"))
             if not flag:  # the target: the default table at most the sweep's time, wall and CPU
                 ratios = (t[0] / sweep[0], t[1] / sweep[1])
-                print(f"  target <= 1.0x the sweep, wall and CPU: {'met' if max(ratios) <= 1.0 else 'NOT MET'} "
-                      f"({max(ratios):.2f}x at worst)")
+                print(f"  target <= 1.0x the sweep, wall and CPU: {verdict(max(ratios))}")
     return ratios
 
 
@@ -281,12 +281,16 @@ def repeated_verdict(ratios: list[tuple[float, float]]) -> str:
     """The target judged on the median of step 1's repeated pairs (one run's ratio moves by 0.2-0.3
     from one minute to the next on a 2-core machine: docs/performance.md, issue 89), with the range."""
     wall, cpu = np.array(ratios).T
-    worst = max(np.median(wall), np.median(cpu))
     met = sum(max(r) <= 1.0 for r in ratios)
     return (f"over {len(ratios)} pairs of sweep and classify, one after the other: classify / sweep wall "
             f"{np.median(wall):.2f} (median; {wall.min():.2f}-{wall.max():.2f}), CPU {np.median(cpu):.2f} "
             f"({cpu.min():.2f}-{cpu.max():.2f}); target <= 1.0x on the medians: "
-            f"{'met' if worst <= 1.0 else 'NOT MET'} ({worst:.2f}x at worst); met by {met} of {len(ratios)} pairs alone")
+            f"{verdict(max(np.median(wall), np.median(cpu)))}; met by {met} of {len(ratios)} pairs alone")
+
+
+def verdict(worst: float) -> str:
+    """The target's verdict on the worse of a wall and a CPU ratio to the sweep (at most 1.0x)."""
+    return f"{'met' if worst <= 1.0 else 'NOT MET'} ({worst:.2f}x at worst)"
 
 
 def main() -> None:

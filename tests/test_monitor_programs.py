@@ -221,7 +221,8 @@ def test_a_program_met_after_learning_is_scored_after_its_short_relearning():
     own = np.stack([e - (t - monitor.stages.baseline.condition_mean_[0]) * monitor.stages.baseline.slope_[0] for _, e, t in second[:relearn]])
     np.testing.assert_allclose(saved.mean_, own.mean(axis=0), atol=1e-12)
     assert [row.stamp for row in monitor.rows] == sorted(row.stamp for row in monitor.rows)
-    assert "learning" not in programs.mix_note(monitor.stages, [], ["program 1", "program 2"])  # learned: no longer listed as learning
+    # learned: no longer listed as learning
+    assert "learning" not in programs.mix_note(monitor.stages, [], ["program 1", "program 2"])
 
 
 def test_a_program_with_too_few_logs_in_the_pooled_learning_learns_its_offset_after():

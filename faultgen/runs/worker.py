@@ -1,7 +1,7 @@
 """What a local worker process of a sweep does: simulate one run and write its part file
 (:func:`simulate_and_write`), and stay tied to the sweep that started it: it ends within a second
-of the sweep's process (:func:`faultgen.pools.watch_parent`), leaves a group-wide SIGTERM and Ctrl-C to the sweep,
-and gives its freed memory back to the OS after each run."""
+of the sweep's process (:func:`faultgen.pools.watch_parent`), leaves a group-wide SIGTERM and Ctrl-C
+to the sweep, and gives its freed memory back to the OS after each run."""
 
 from __future__ import annotations
 
@@ -80,9 +80,9 @@ def in_worker(sweep_pid: int, *call) -> RunStats:
 
 def start_resource_tracker() -> None:
     """Start loky's resource tracker (a process of its own, started once) ignoring SIGTERM, as the
-    workers do (:func:`faultgen.pools.start_worker`): a group-wide SIGTERM must not end it before the sweep has
-    stopped its workers and released their semaphores (it then reports them as leaked). It ends
-    when the sweep's process does."""
+    workers do (:func:`faultgen.pools.start_worker`): a group-wide SIGTERM must not end it before the
+    sweep has stopped its workers and released their semaphores (it then reports them as leaked). It
+    ends when the sweep's process does."""
     from joblib.externals.loky.backend import resource_tracker
 
     if threading.current_thread() is not threading.main_thread():
