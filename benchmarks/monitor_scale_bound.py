@@ -68,15 +68,14 @@ def median_error_bound(logs: list[tuple[float, list[tuple[float, float]]]], prio
     return float(np.median(each))
 
 
-def fleet_logs(work: Path, out: Path) -> list[tuple[float, list[tuple[float, float]]]]:
-    """The worn axes' logs in the window with the tests up to each (:func:`median_error_bound`):
-    the true wear from ``truth.csv``, each test's own error from ``OUT/tests.csv`` (its 90 %
-    interval in ``ln``, the reference test's variance taken off)."""
-    import independent_fleet
-
-    truth = independent_fleet.read_truth(work / "truth.csv")
+def own_test_errors(truth: dict, out: Path) -> dict[str, list[tuple[str, float, float]]]:
+    """Each worn unit's friction tests of its worn axis after its reference, ``{unit: [(stamp, own
+    relative error, read %), ...]}`` from ``OUT/tests.csv``: a test's 90 % interval in ``ln`` as a
+    standard deviation, the reference test's variance taken off (its offset is known to the estimators
+    here), and its wear read against the reference.
+    ``truth`` as :func:`faultgen.bench.independent.read_truth` gives it."""
     z = float(stats.norm.ppf(0.95))
-    tests: dict[str, list[tuple[str, float]]] = {}  # unit -> (stamp, own error in ln), worn axis only
+    tests: dict[str, list[tuple[str, float, float]]] = {}
     reference: dict[str, float] = {}
     with open(out / "tests.csv", newline="") as f:
         for r in csv.DictReader(f):
@@ -88,7 +87,18 @@ def fleet_logs(work: Path, out: Path) -> list[tuple[float, list[tuple[float, flo
                 reference[r["unit"]] = sd
                 continue
             own = math.sqrt(max(sd**2 - reference[r["unit"]] ** 2, 1e-12))
-            tests.setdefault(r["unit"], []).append((r["stamp"], own))
+            tests.setdefault(r["unit"], []).append((r["stamp"], own, float(r["wear"])))
+    return tests
+
+
+def fleet_logs(work: Path, out: Path) -> list[tuple[float, list[tuple[float, float]]]]:
+    """The worn axes' logs in the window with the tests up to each (:func:`median_error_bound`):
+    the true wear from ``truth.csv``, each test's own error from ``OUT/tests.csv``
+    (:func:`own_test_errors`) in points at its true wear."""
+    import independent_fleet
+
+    truth = independent_fleet.read_truth(work / "truth.csv")
+    tests = own_test_errors(truth, out)
     logs = []
     for unit, t in truth.items():
         if not t["axis"]:
@@ -96,7 +106,8 @@ def fleet_logs(work: Path, out: Path) -> list[tuple[float, list[tuple[float, flo
         true = dict(zip(t["stamps"], t["wear"]))
         for stamp, wear in true.items():
             if WINDOW[0] <= wear <= WINDOW[1]:
-                seen = [(true[s], 100 * (1 + true[s] / 100) * e) for s, e in tests.get(unit, []) if s <= stamp]
+                seen = [(true[s], 100 * (1 + true[s] / 100) * e)
+                        for s, e, _ in tests.get(unit, []) if s <= stamp]
                 logs.append((wear, seen))
     return logs
 
