@@ -122,19 +122,22 @@ def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prio
 
 def measured_error_ratio(fleet: Path, out: Path) -> tuple[float, int]:
     """How the worn axes' tests after the wear began scatter against the truth, in their stated errors:
-    (the root mean square of ``(ln(1 + y/100) - ln(1 + b/100) - ln(1 + w/100)) / s``, the tests counted),
-    ``y`` a test's read, ``w`` its true wear, ``s`` its own error in ``ln``
-    (:func:`monitor_scale_bound.own_test_errors`), ``b`` the mean read of the unit's tests at no true wear
-    (its reference's offset as those tests tell it; 0 without one). 1: the tests are as good as they
-    say; the ``--error-ratio`` to draw them with. (nan, 0) without such a test."""
+    (the root mean square of ``(ln(1 + y/100) - b - ln(1 + w/100)) / sqrt(s^2 + s_b^2)``, the tests
+    counted), ``y`` a test's read, ``w`` its true wear, ``s`` its own error in ``ln``
+    (:func:`monitor_scale_bound.own_test_errors`), ``b`` the mean ``ln(1 + y/100)`` of the unit's tests
+    at no true wear (its reference's offset as those tests tell it) and ``s_b`` its standard error from
+    theirs; units without such a test are left out. 1: the tests are as good as they say; the
+    ``--error-ratio`` to draw them with. (nan, 0) without such a test."""
     truth = independent.read_truth(fleet / "truth.csv")
     z = []
     for unit, tests in monitor_scale_bound.own_test_errors(truth, out).items():
         true = dict(zip(truth[unit]["stamps"], truth[unit]["wear"]))
-        seen = [(true[s], e, y) for s, e, y in tests if s in true]
-        offset = np.mean([y for w, _, y in seen if w == 0] or [0.0])
-        z += [(np.log1p(y / 100) - np.log1p(offset / 100) - np.log1p(w / 100)) / e
-              for w, e, y in seen if w > 0]
+        seen = [(true[s], e, np.log1p(y / 100)) for s, e, y in tests if s in true]
+        healthy = np.array([(e, y) for w, e, y in seen if w == 0]).reshape(-1, 2)
+        if not len(healthy):
+            continue
+        offset, offset_var = healthy[:, 1].mean(), np.sum(healthy[:, 0] ** 2) / len(healthy) ** 2
+        z += [(y - offset - np.log1p(w / 100)) / np.sqrt(e**2 + offset_var) for w, e, y in seen if w > 0]
     return (float(np.sqrt(np.mean(np.square(z)))) if z else float("nan")), len(z)
 
 

@@ -118,11 +118,14 @@ def test_the_measured_error_ratio_is_one_for_tests_that_scatter_as_they_say(tmp_
     truth = ceiling.independent.read_truth(fleet / "truth.csv")
     own = monitor_scale_bound.own_test_errors(truth, out)
     reads, sign = {}, 1.0
-    for unit, tests in own.items():  # each worn test one stated error off, up and down in turn; offset 2 %
+    for unit, tests in own.items():  # each worn test one error off, up and down in turn, on an offset of 2 %
         true = dict(zip(truth[unit]["stamps"], truth[unit]["wear"]))
+        healthy = [e for stamp, e, _ in tests if true[stamp] == 0]  # the offset's error: their mean's
+        offset_var = sum(e**2 for e in healthy) / len(healthy) ** 2
         for stamp, e, _ in tests:
             w = true[stamp]
-            reads[unit, stamp] = 2.0 if w == 0 else 100 * ((1 + w / 100) * 1.02 * np.exp(sign * e) - 1)
+            off = sign * np.sqrt(e**2 + offset_var)
+            reads[unit, stamp] = 2.0 if w == 0 else 100 * ((1 + w / 100) * 1.02 * np.exp(off) - 1)
             sign = -sign if w else sign
     with open(out / "tests.csv", newline="") as f:
         rows = list(csv.DictReader(f))
