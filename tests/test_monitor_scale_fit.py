@@ -69,24 +69,26 @@ def _reference(y, sy, x, sx, sb, whole=False, narrow=True):
 
 
 def test_pairs_before_the_wear_that_scatter_widen_the_offset_not_the_factor():
-    """The fast unit's case: the reference and three tests before the wear scatter about their offset
-    by a reduced chi-square of 2.2; the factor's error stays the prior's (0.299; the whole covariance
-    scaled by the chi-square, as before: 0.446 here, 0.367 on the fleet, which kept the bound of the
+    """The fast unit's case: three tests before the wear scatter about their offset by a reduced
+    chi-square of 4.3 (the reference, which reads 0 by definition, is not a pair since 2026-11-29: 2.2
+    with it); the factor's error stays the prior's (0.2998; the whole covariance scaled by the
+    chi-square: 0.618 here, 0.446 with the reference's pair, 0.367 on the fleet, which kept the bound of the
     fast unit's log at 18 % true wear below an 8 % limit), the offset's is widened as before (its
     estimate and error within 0.2 %); all against numpy's normal equations."""
     scale = _rescale()
     (factor, factor_error), (offset, offset_error) = scale._fitted(1)
-    sy = 100 * (1 + READS / 100) * OWN_ERROR
-    sx = np.full(len(READS), TWIN_ERROR)
-    f, sf, b, sb, chi2 = _reference(READS, sy, TWIN, sx, 100 * REFERENCE_ERROR)
+    reads, twin = READS[1:], TWIN[1:]  # the reference reads 0 by definition: not a pair (its error is b's prior)
+    sy = 100 * (1 + reads / 100) * OWN_ERROR
+    sx = np.full(len(reads), TWIN_ERROR)
+    f, sf, b, sb, chi2 = _reference(reads, sy, twin, sx, 100 * REFERENCE_ERROR)
     assert chi2 > 2.0  # the case is one of scatter beyond the stated errors
     assert (factor, factor_error, offset, offset_error) == pytest.approx((f, sf, b, sb), rel=1e-9)
     assert SCALE_PRIOR * 0.95 < factor_error <= SCALE_PRIOR
-    unscaled = _reference(READS, sy * 1e-3, TWIN, sx * 1e-3, 100 * REFERENCE_ERROR)
+    unscaled = _reference(reads, sy * 1e-3, twin, sx * 1e-3, 100 * REFERENCE_ERROR)
     assert unscaled[3] < offset_error  # the offset's error did widen with the scatter
     # the fast unit on the log of 18 % true wear (twin scale 13.93 -+ 1.24): its bound passes 8 %
     # with the prior's doubt, not with the whole covariance scaled by the chi-square
-    whole = _reference(READS, sy, TWIN, sx, 100 * REFERENCE_ERROR, whole=True)
+    whole = _reference(reads, sy, twin, sx, 100 * REFERENCE_ERROR, whole=True)
     assert whole[1] > 1.3 * SCALE_PRIOR and (offset, offset_error) == pytest.approx(whole[2:4], rel=2e-3)
     assert bound_at(factor, factor_error) > 8.0 > bound_at(whole[0], whole[1])
 
@@ -179,3 +181,22 @@ def test_pairs_narrowed_by_their_upper_limit_still_cover_the_factor_on_a_monte_c
             stated.append(_reference(y, sy, x, sx, CLEAN_OFFSET_ERROR, narrow=False)[1])
         assert np.mean(covered) >= 0.88, (share, np.mean(covered))
         assert bool(np.median(widths) < 0.5 * np.median(stated)) == narrower, (share, np.median(widths), np.median(stated))
+
+
+def test_the_reference_test_is_no_pair_a_noisy_first_log_does_not_move_the_factor():
+    """The reference reads 0 by definition (each later test's wear is against it); its own error is the
+    offset ``b``, which ``b``'s prior already carries. Paired with its log's twin-scale wear it told
+    ``b + f x = 0``: on the 3 % fleet's unit05 (axis 2, /tmp/f90, 2026-11-29) the first log read -6.27 -+ 3.46
+    and the factor fell to 0.897 on the reference alone, 0.93 after the first worn test, and its first
+    alarm came at 23.0 % true wear (18.1 % without the pair). Now the axis is on the tests' scale at the
+    factor's prior until a test after the reference pairs."""
+    stamps = ["2026-01-05", "2026-01-19"]
+    wears = [friction_tests.AxisWear(s, logfolder.parse_stamp(s, "u")[0], 1, {}, y, y - 5, y + 5, 0.033, 0.033,
+                                     "", j == 0, 0.033) for j, (s, y) in enumerate(zip(stamps, [0.0, -6.5]))]
+    scale = Rescale("u", 1, wears)
+    factor, error, names = scale.at(stamps[0], np.array([-6.27]), np.array([3.46]))
+    assert (factor[0], error[0], names) == (1.0, SCALE_PRIOR, [friction_tests.TESTS_SCALE])
+    assert scale.pairs == {1: []} and scale.offset_sd[1] == pytest.approx(3.3)
+    factor, error, names = scale.at(stamps[1], np.array([-0.6]), np.array([1.7]))
+    assert len(scale.pairs[1]) == 1 and names == [friction_tests.TESTS_SCALE]
+    assert (factor[0], error[0]) == scale._fitted(1)[0]

@@ -39,7 +39,8 @@ lubricant film, that no fit of one test sees).
 
 **The logs on the tests' scale** (:class:`Rescale`): per axis, the tests' wear ``y_j`` against the
 monitor's own wear in the twin's scale ``x_j`` at the test's day (the filtered wear of the last log
-at or before it, :class:`faultgen.monitor.wear_trend.WearTrend`) is the line ``y = b + f x``, fitted
+at or before it, :class:`faultgen.monitor.wear_trend.WearTrend`), the tests after the reference (0 by
+definition, its error ``b``'s prior), is the line ``y = b + f x``, fitted
 by weighted least squares (``statsmodels`` WLS, weights one over ``var y_j + var x_j``) with the
 priors of mixed estimation (Theil & Goldberger 1961: one pseudo-observation each) ``f ~ N(1,``
 :data:`SCALE_PRIOR` ``^2)`` and ``b ~ N(0, s0^2)`` (``b``: the reference test's own error, which every
@@ -108,11 +109,7 @@ BETA_PRIOR = 0.005
 #: Standard deviation of the prior of the scale factor ``f`` (mean 1: the twin's scale). The factor
 #: that maps the twin's scale best onto the truth was 0.80-1.08 on the first independent fleet's worn
 #: units and 0.50-0.81 on the second's (seed 0), and a test reads a dry level to some 3 %
-#: (the plant's scatter from day to day, not the fit's). Median error of the logs' wear on the
-#: tests' scale (first, second fleet, seed 0; ``FORGET`` 0.6, the offset's prior the reference's
-#: own error): 2.32, 3.33 points at 0.3 (90 % coverage 96.9, 94.4 %); 2.70, 3.13 at 0.5 (96.3,
-#: 93.3 %); with the offset's prior 10 points, 2.60, 3.12 at 0.5 (100, 95.9 %). Held out (seed 1):
-#: 3.53, 4.37 (89.8, 86.9 %) where the version before read 3.85, 4.72 (99.1, 98.7 %);
+#: (the plant's scatter from day to day, not the fit's). Median errors at 0.3 and 0.5, and held out:
 #: docs/analysis.md, "The wear on the friction tests' scale".
 SCALE_PRIOR = 0.3
 #: Standard deviation of the prior of the offset ``b``, points of wear, where the reference test's own
@@ -446,14 +443,15 @@ class Rescale:
     read: dict[int, tuple] = field(default_factory=dict)
     floors: dict[int, float] = field(default_factory=dict)  # axis -> the alarm's bound on its last test's log
     tested: set = field(default_factory=set)  # axes whose test was read into the last log (floored)
+    referenced: set = field(default_factory=set)  # axes whose reference test came since their last reset
 
     def reset(self, axis: int = 0) -> None:
         """Forget the pairs of ``axis`` (0: every axis): a repair, a new program."""
-        for k in list(self.pairs):
-            if axis in (0, k):
-                self.pairs[k] = []
-                self.read.pop(k, None)
-                self.floors.pop(k, None)
+        for k in list(self.pairs) if axis == 0 else [axis]:
+            self.pairs[k] = []
+            self.read.pop(k, None)
+            self.floors.pop(k, None)
+            self.referenced.discard(k)
 
     def at(self, stamp: str, wear: np.ndarray, error: np.ndarray) -> tuple[np.ndarray, np.ndarray, list[str]]:
         """The factor ``f`` (n_axes,) and its standard error for the log ``stamp`` whose filtered wear
@@ -468,27 +466,30 @@ class Rescale:
                 source = None  # a test before the first log scored: nothing to pair it with
             if w.log_error != w.log_error or source is None:
                 continue
-            if w.reference:
-                self.reset(w.axis)
-            sy = 100 * (1 + w.wear / 100) * w.own_error
             if w.reference_error == w.reference_error and w.reference_error > 0:
                 self.offset_sd[w.axis] = 100 * w.reference_error
+            if w.reference:  # reads 0 by definition: its error is the offset b (its prior), not a pair's
+                self.reset(w.axis)
+                self.referenced.add(w.axis)
+                continue
+            sy = 100 * (1 + w.wear / 100) * w.own_error
             x = (float(source[0][w.axis - 1]), float(source[1][w.axis - 1]))
-            if not w.reference:  # the test read at once (bounds.test_read), on the factor known before it
-                before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
-                    ((1.0, SCALE_PRIOR), (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))  # less the offset b
-                test = (w.wear - offset[0], float(np.hypot(sy, offset[1])), *x)
-                self.read[w.axis] = (before, test, key if w.key == key else self.last[0])
-                self.floors.pop(w.axis, None)
+            # the test read at once (bounds.test_read), on the factor known before it, less the offset b
+            before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
+                ((1.0, SCALE_PRIOR), (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))
+            test = (w.wear - offset[0], float(np.hypot(sy, offset[1])), *x)
+            self.read[w.axis] = (before, test, key if w.key == key else self.last[0])
+            self.floors.pop(w.axis, None)
             self.pairs.setdefault(w.axis, []).append((w.wear, sy, *x))
         self.last = (key, np.asarray(wear, dtype=float), np.asarray(error, dtype=float))
         # an axis no test has paired yet: the twin's scale, known to the factor's prior (module bounds)
         factor, factor_error = np.ones(self.n_axes), np.full(self.n_axes, SCALE_PRIOR)
         names = [TWIN_SCALE] * self.n_axes
-        for k, pairs in self.pairs.items():
+        for k, pairs in self.pairs.items():  # an axis with its reference only: on its scale, at the prior
+            if pairs or k in self.referenced:
+                names[k - 1] = TESTS_SCALE
             if pairs:
                 factor[k - 1], factor_error[k - 1] = self._fitted(k)[0]
-                names[k - 1] = TESTS_SCALE
         return factor, factor_error, names
 
     def wear(self, wear: np.ndarray, error: np.ndarray, factor: np.ndarray,
@@ -497,10 +498,9 @@ class Rescale:
         error, points (both (n_axes,)), from its twin-scale filtered ``wear`` % -+ ``error`` %: ``f x``
         -+ ``sqrt((f e)^2 + (s_f x)^2)`` (``factor``, ``factor_error``), or, on the log a test of the
         axis was paired with (a test since its reference), that test read into it at once
-        (:func:`faultgen.monitor.bounds.test_read`, on the factor known before the test). On the later
-        logs the test is in the factor alone (carried on by the logs' growth, a fast unit's lagging filter
-        was read as a scale: on the small clean fleet of seed 0, 53.7 % at 39 % true wear), its log's
-        bound a floor of theirs (:meth:`floored`). The test is read less the offset ``b`` its pairs tell."""
+        (:func:`faultgen.monitor.bounds.test_read`, on the factor known before the test), less the offset
+        ``b`` its pairs tell. On the later logs the test is in the factor alone (carried on by the logs'
+        growth, a fast unit's lagging filter was read as a scale), its log's bound a floor of theirs."""
         wear, error = np.asarray(wear, dtype=float), np.asarray(error, dtype=float)
         value = factor * wear
         sd = np.asarray(bounds.standard_error(factor * error, value, factor_error / factor), dtype=float)
