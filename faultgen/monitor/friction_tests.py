@@ -49,7 +49,8 @@ not known; the tests before the wear fix it), each test weighed by its own error
 wear's error times ``f`` (weighed at ``f = 1``, then at the fitted ``f``) and by the factor's drift since
 the test, :data:`SCALE_DRIFT` times ``x_j`` per later test (the twin's scale may change with the wear; a test
 before the wear keeps telling ``b``); the tests' variances (``b``'s prior's too) times their reduced chi-square if
-above one, their measured part's upper 90 % limit if below (:func:`.bounds.upper_ratio`), never ``f``'s prior.
+above one, their measured part's upper 90 % limit if below (:func:`.bounds.upper_ratio`), never ``f``'s prior
+(the degrees of freedom: the pairs less their leverages, the priors fitting part of the line).
 A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
@@ -532,8 +533,7 @@ class Rescale:
         sb = self.offset_sd.get(axis, OFFSET_PRIOR)
         design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
         target = np.r_[y, 1.0, 0.0]
-        # the factor a random walk of SCALE_DRIFT a test: an earlier pair's y misses by it times its x per
-        # later test; a pair before the wear (x about 0) keeps telling the offset
+        # the factor a random walk (SCALE_DRIFT a test): an earlier pair's y misses by it times its x a later test
         drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2
         factor = 1.0
         for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
@@ -542,9 +542,10 @@ class Rescale:
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)
         residual = y - design[:n] @ result.params
-        if (chi2 := float(np.sum(weights[:n] * residual**2) / (n - 2)) if n > 2 else 1.0) > 1.0:
+        dof = n - float(np.sum(weights[:n, None] * (design[:n] @ np.asarray(result.cov_params())) * design[:n]))
+        if (chi2 := float(np.sum(weights[:n] * residual**2) / dof) if dof >= 1 else 1.0) > 1.0:
             weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior
-        elif (ratio := bounds.upper_ratio(residual, measured, n - 2)) < 1.0:  # they scatter less than stated
+        elif (ratio := bounds.upper_ratio(residual, measured, dof)) < 1.0:  # they scatter less than stated
             weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / (ratio * sb**2)]
         if chi2 > 1.0 or ratio < 1.0:
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
