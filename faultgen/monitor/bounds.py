@@ -85,15 +85,16 @@ def day_scatter(reads: np.ndarray) -> np.ndarray:
     return np.std(reads, axis=0, ddof=1)
 
 
-def upper_ratio(residual: np.ndarray, variance: np.ndarray, dof: int, level: float = RATIO_LEVEL) -> float:
+def upper_ratio(residual: np.ndarray, variance: np.ndarray, dof: float, level: float = RATIO_LEVEL) -> float:
     """The factor (<= 1) by which a fit's stated ``variance`` (n,) is narrowed where its ``residual`` (n,)
     scatters less than it states: the upper ``level`` confidence limit of their ratio, ``dof chi2 / q``
     (``chi2`` the reduced chi-square ``sum(residual^2 / variance) / dof``, ``q`` the chi-square's ``1 -
     level`` quantile on ``dof`` degrees of freedom, ``scipy.stats.chi2.ppf``: the confidence limit of a
     normal sample's variance, e.g. Montgomery & Runger 2014, ch. 8.3), where it is below one, else 1 (and
-    where ``dof`` < 1 or any value is not finite). The variances are narrowed only as far as the residuals
-    show at that confidence: with 1 degree of freedom only where ``chi2`` is below 0.016; a residual that
-    also carries what ``variance`` leaves out (a drift) only makes the limit larger."""
+    where ``dof`` < 1 or any value is not finite; ``dof`` may be fractional: a fit with priors). The
+    variances are narrowed only as far as the residuals show at that confidence: with 1 degree of freedom
+    only where ``chi2`` is below 0.016; a residual that also carries what ``variance`` leaves out (a drift)
+    only makes the limit larger."""
     from scipy import stats
 
     residual, variance = np.asarray(residual, dtype=float), np.asarray(variance, dtype=float)
