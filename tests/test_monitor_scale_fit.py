@@ -159,7 +159,7 @@ def test_pairs_well_within_their_errors_narrow_the_factor_by_their_upper_confide
     scale.offset_sd[1] = CLEAN_OFFSET_ERROR
     (factor, factor_error), (offset, offset_error) = scale._fitted(1)
     y, sy, x, sx = CLEAN.T
-    f, sf, b, sb, chi2 = _reference(y, sy, x, sx, CLEAN_OFFSET_ERROR, narrow=False)  # as main fitted it
+    f, sf, _, _, chi2 = _reference(y, sy, x, sx, CLEAN_OFFSET_ERROR, narrow=False)  # as main fitted it
     assert chi2 < 0.05 and sf == pytest.approx(0.0147, abs=2e-4)
     assert (factor, factor_error, offset, offset_error) == pytest.approx(
         _reference(y, sy, x, sx, CLEAN_OFFSET_ERROR)[:4], rel=1e-3)
