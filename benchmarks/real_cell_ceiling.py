@@ -23,7 +23,8 @@ A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the m
 :func:`faultgen.monitor.alarm.alarm_quantile`) reaches the limit, at once (the monitor waits for
 nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
-tests known that day, less the day (``monitor_rul.day_of``). Each unit is drawn ``--draws`` times
+tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
+``real_cell_table.lambda_outcome``. Each unit is drawn ``--draws`` times
 (the tests' errors); a fleet's chances are over the same draws, units independent.
 
 The monitor reads its twin with noise and lag and learns the offset: an estimator of this form with
@@ -38,6 +39,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -45,7 +47,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import monitor_bounds_check as bounds  # sibling modules
 import monitor_rul
 import monitor_scale_bound
-from real_cell_table import FAILURE_WEAR, LAMBDA, WITHIN, growth_at
+from real_cell_table import FAILURE_WEAR, WITHIN, growth_at, lambda_outcome
 
 from faultgen.bench import independent
 from faultgen.monitor.alarm import alarm_quantile
@@ -84,15 +86,12 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
     first = np.where(fires.any(axis=1), fires.argmax(axis=1), n)  # log index
     alarm = np.where(first < n, wear[np.minimum(first, n - 1)], np.inf)
     fast = growth_at({"wear": wear}, bounds.ALARM[0]) > 1.0
-    eol = monitor_rul.day_of(wear, FAILURE_WEAR)  # day 1 = log 0
+    truth = {"stamps": list(range(1, n + 1)), "wear": np.asarray(wear, dtype=float)}  # a log's stamp its day
     within, late = np.zeros(n_draws, bool), np.zeros(n_draws, bool)
-    for m in np.flatnonzero(first < n):
-        day = int(np.ceil(first[m] + 1 + LAMBDA * (eol - first[m] - 1)))
-        if day >= eol or day > n:
-            continue
-        true = eol - day
-        predicted = monitor_rul.day_of(factor[m, day - 1] * x, FAILURE_WEAR) - day
-        within[m], late[m] = abs(predicted - true) <= WITHIN * true, predicted - true > WITHIN * true
+    for m in np.flatnonzero(first < n):  # the table's lambda day and verdicts; f x reaching the failure wear
+        outcome = lambda_outcome(truth, int(first[m]) + 1, lambda day, m=m: SimpleNamespace(
+            rul=monitor_rul.day_of(factor[m, day - 1] * x, FAILURE_WEAR) - day, rul_5=None))
+        within[m], late[m] = outcome.get("within", False), outcome.get("late", False)
     return {"alarm": alarm, "in_window": np.array([bounds.alarm_in_window(a, fast) for a in alarm]),
             "within": within, "late": late}
 
