@@ -3,7 +3,7 @@ alarm at 8-15 % true wear and the remaining life within 20 % at lambda 0.5, as c
 and per fleet, from the fleet's truth and its friction tests' own errors.
 
     python benchmarks/real_cell_ceiling.py FLEET OUT [FLEET OUT ...] [--twin-factor 1 1.2] [--draws 4000]
-        [--seed 0] [--limit 8] [--prior-sd 0.3] [--error-ratio 1]
+        [--seed 0] [--limit 8] [--prior-sd 0.3] [--prior-mean 1] [--error-ratio 1]
 
 ``FLEET`` a fleet of ``benchmarks/real_cell_fleet.py`` (``truth.csv``), ``OUT`` a ``faultgen monitor``
 output of it (``tests.csv``: each test's own error, :func:`monitor_scale_bound.own_test_errors`).
@@ -16,9 +16,10 @@ factor on the plant, ``--twin-factor``; 1: a twin that reads the truth), with no
 reference test's offset known; each test ``y_j = w_j + e_j`` with its own error ``s_j`` (normal, the
 test's stated error at its true wear; ``--error-ratio``: drawn that many times it, the estimator
 still told the stated one: tests that scatter more than they say). ``f`` is the Bayesian regression
-through the origin of the tests on ``x`` under the monitor's prior ``N(1, p^2)`` (``--prior-sd``, the
-monitor's :data:`faultgen.monitor.friction_tests.SCALE_PRIOR`; Gelman et al., *Bayesian Data Analysis*, 3rd
-ed., ch. 14): precision ``1/p^2 + sum x_j^2 / s_j^2``, mean ``(1/p^2 + sum x_j y_j / s_j^2)`` over it.
+through the origin of the tests on ``x`` under the monitor's prior ``N(m, p^2)`` (``--prior-mean``, 1, and
+``--prior-sd``, the monitor's :data:`faultgen.monitor.friction_tests.SCALE_PRIOR`; or a fleet's,
+``faultgen monitor --scale-prior``; Gelman et al., *Bayesian Data Analysis*, 3rd ed., ch. 14): precision
+``1/p^2 + sum x_j^2 / s_j^2``, mean ``(m/p^2 + sum x_j y_j / s_j^2)`` over it.
 A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the monitor's
 :func:`faultgen.monitor.alarm.alarm_quantile`) reaches the limit, at once (the monitor waits for
 nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
@@ -56,7 +57,7 @@ from faultgen.monitor.scoring import Settings
 
 
 def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np.ndarray,
-                 prior_sd: float) -> tuple[np.ndarray, np.ndarray]:
+                 prior_sd: float, prior_mean: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """The factor's posterior mean and standard deviation on every log, each (n_draws, n_logs): ``x``
     (n_logs,) the twin's read, %; ``tests`` ``(log index, true wear %, error points)``; ``draws``
     (n_draws, n_tests) the tests' errors, points. ValueError for a prior_sd not above 0."""
@@ -64,7 +65,7 @@ def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np
         raise ValueError(f"prior_sd {prior_sd!r}: expected a number above 0")
     n = len(x)
     precision = np.full((len(draws), n), prior_sd**-2)
-    weighted = precision.copy()
+    weighted = prior_mean * precision
     for j, (log, wear, error) in enumerate(tests):
         precision[:, log:] += x[log] ** 2 / error**2
         weighted[:, log:] += (x[log] * (wear + draws[:, j]) / error**2)[:, None]
@@ -72,7 +73,7 @@ def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np
 
 
 def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_factor: float,
-                 errors: np.ndarray, limit: float, prior_sd: float) -> dict:
+                 errors: np.ndarray, limit: float, prior_sd: float, prior_mean: float = 1.0) -> dict:
     """One worn unit's draws (module docstring): ``wear`` its true wear a log (n_logs,), %, ``tests``
     its worn axis's tests ``(log index, true wear %, stated error points)``, ``errors`` (n_draws,
     n_tests) what each test read above its true wear in each draw, points. A dict: ``alarm`` the true
@@ -81,7 +82,7 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
     if not twin_factor > 0:
         raise ValueError(f"twin_factor {twin_factor!r}: expected a number above 0")
     x, n, n_draws = np.asarray(wear, dtype=float) / twin_factor, len(wear), len(errors)
-    factor, sd = factor_draws(x, tests, errors, prior_sd)
+    factor, sd = factor_draws(x, tests, errors, prior_sd, prior_mean)
     fires = x * (factor - alarm_quantile() * sd) >= limit
     first = np.where(fires.any(axis=1), fires.argmax(axis=1), n)  # log index
     alarm = np.where(first < n, wear[np.minimum(first, n - 1)], np.inf)
@@ -97,7 +98,8 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
 
 
 def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prior_sd: float, *,
-                  draws: int = 4000, seed: int = 0, error_ratio: float = 1.0) -> dict[str, dict]:
+                  draws: int = 4000, seed: int = 0, error_ratio: float = 1.0,
+                  prior_mean: float = 1.0) -> dict[str, dict]:
     """:func:`unit_chances` of every worn unit of ``fleet``: ``draws`` draws of the tests' errors,
     ``error_ratio`` times their stated ones (each unit its own stream of ``seed``, units in name order).
     ValueError for draws below 1 or an error_ratio not above 0."""
@@ -115,7 +117,7 @@ def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prio
                  for s, e, _ in own.get(unit, []) if s in log]
         errors = np.random.default_rng(stream).standard_normal((draws, len(tests)))
         errors *= error_ratio * np.array([s for _, _, s in tests])
-        result[unit] = unit_chances(t["wear"], tests, twin_factor, errors, limit, prior_sd)
+        result[unit] = unit_chances(t["wear"], tests, twin_factor, errors, limit, prior_sd, prior_mean)
     return result
 
 
@@ -176,6 +178,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--limit", type=float, default=Settings().wear_limit)
     parser.add_argument("--prior-sd", type=float, default=SCALE_PRIOR)
+    parser.add_argument("--prior-mean", type=float, default=1.0, help="the factor's prior mean (default 1)")
     parser.add_argument("--error-ratio", type=float, default=1.0,
                         help="the tests' errors drawn this many times their stated ones (default 1)")
     args = parser.parse_args()
@@ -187,9 +190,11 @@ def main() -> None:
               "stated errors about the truth (root mean square; 1: as stated; pass it as --error-ratio)\n")
         for c in args.twin_factor:
             chances = fleet_chances(fleet, out, c, args.limit, args.prior_sd, draws=args.draws,
-                                    seed=args.seed, error_ratio=args.error_ratio)
+                                    seed=args.seed, error_ratio=args.error_ratio, prior_mean=args.prior_mean)
             drawn = f", the tests' errors x {args.error_ratio:g}" if args.error_ratio != 1 else ""
-            title = fleet.name + drawn
+            prior = (f", prior {args.prior_mean:g} +- {args.prior_sd:g}"
+                     if (args.prior_mean, args.prior_sd) != (1.0, SCALE_PRIOR) else "")
+            title = fleet.name + drawn + prior
             print("\n".join(table(title, chances, c)) + "\n", flush=True)
 
 

@@ -6,6 +6,7 @@ The full-size figures: ``benchmarks/monitor_wear_scale.py --friction-test-every 
 
 import csv
 import filecmp
+import json
 import math
 import shutil
 from pathlib import Path
@@ -16,7 +17,7 @@ import pytest
 
 from faultgen.calibrate import friction_report
 from faultgen.data import logfolder
-from faultgen.monitor import friction_tests, loop
+from faultgen.monitor import friction_tests, loop, scale_prior
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.run import resolve_run
@@ -235,3 +236,27 @@ def test_the_rul_benchmark_replays_the_monitors_rows_with_their_factors(fleet, m
     assert len(pairs) >= 12 * 6 and all(math.isclose(a, b, rel_tol=1e-5, abs_tol=1e-4) for a, b in pairs), pairs[:5]
     assert {r.wear.tests.scale[0] for r in replayed["unit02"] if r.wear is not None and r.wear.tests is not None} == \
         {friction_tests.TESTS_SCALE}
+
+
+def test_a_fleets_scale_prior_sets_the_untold_factor_and_belongs_to_the_state(fleet, monitored, tmp_path):
+    """wear.csv gives each log-axis's factor onto the tests' scale and its error (the default prior's 1 -+ 0.3
+    where no test has told it); a run given a fleet's prior (``--scale-prior``,
+    :mod:`faultgen.monitor.scale_prior`) starts there instead and says so in settings.json; continuing its
+    folder without it, or learning a prior from a run with one worn unit, is refused by name."""
+    _, robot, logs, _ = fleet
+    first = {r["axis"]: r for r in reversed(rows(monitored / "wear.csv")) if r["unit"] == "unit02"}
+    assert {(r["scale_factor"], r["scale_factor_sd"]) for r in first.values()} == {("1", "0.3")}
+    out = tmp_path / "prior"
+    loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False,
+                             scale_prior=scale_prior.ScalePrior(1.2, 0.1)))
+    first = {r["axis"]: r for r in reversed(rows(out / "wear.csv")) if r["unit"] == "unit02"}
+    assert {(r["scale_factor"], r["scale_factor_sd"]) for r in first.values()} == {("1.2", "0.1")}
+    settings = json.loads((out / "settings.json").read_text())
+    assert (settings["scale_prior_mean"], settings["scale_prior_sd"]) == (1.2, 0.1)
+    with pytest.raises(stored.StateError, match=r"other settings or inputs: scale_prior_mean 1\.2 \(now"):
+        loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
+    with pytest.raises(ValueError, match="1 units' axes whose friction tests saw their wear.*at least 3"):
+        resolve_run(robot, logs, tmp_path / "again", calibrate=False, settings=SETTINGS,
+                    scale_prior=monitored)
+    with pytest.raises(ValueError, match="the run's own output folder; expected another run's"):
+        resolve_run(robot, logs, monitored, calibrate=False, settings=SETTINGS, scale_prior=monitored)

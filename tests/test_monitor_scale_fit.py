@@ -30,7 +30,7 @@ def _rescale() -> Rescale:
     return scale
 
 
-def _reference(y, sy, x, sx, sb, whole=False, narrow=True):
+def _reference(y, sy, x, sx, sb, whole=False, narrow=True, prior=(1.0, SCALE_PRIOR), discount=True):
     """The same mixed estimation by numpy alone (normal equations): the pairs and the priors ``f ~
     N(1, SCALE_PRIOR^2)``, ``b ~ N(0, sb^2)``, weighed at f = 1 then at the fitted f; the pairs'
     variances and the offset prior's (a test's error too) times their reduced chi-square where it is
@@ -38,9 +38,11 @@ def _reference(y, sy, x, sx, sb, whole=False, narrow=True):
     the fit before issue 90's fast-wear change); below one, ``narrow``: the pairs' measured variances (the
     drift's apart) and the offset prior's times the upper 90 % confidence limit of their ratio where it is
     below one (main: not narrowed); the pairs' degrees of freedom their number less their leverages
-    (the priors fit part of the line). Returns f, s_f, b, s_b, chi2."""
+    (the priors fit part of the line); ``prior`` the factor's (mean, sd), a fleet's widened with the
+    chi-square up to the default's (``discount`` False: held as it is). Returns f, s_f, b, s_b, chi2."""
     design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
-    target = np.r_[y, 1.0, 0.0]
+    (mean, prior_sd), factor = prior, prior[0]
+    target = np.r_[y, mean, 0.0]
     drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2
 
     def solve(weights):
@@ -48,10 +50,9 @@ def _reference(y, sy, x, sx, sb, whole=False, narrow=True):
         cov = np.linalg.inv(normal)
         return cov @ design.T @ (weights * target), cov
 
-    factor = 1.0
     for _ in range(2):
         factor_weighed = factor
-        weights = np.r_[1.0 / (sy**2 + (factor * sx) ** 2 + drift), 1.0 / SCALE_PRIOR**2, 1.0 / sb**2]
+        weights = np.r_[1.0 / (sy**2 + (factor * sx) ** 2 + drift), 1.0 / prior_sd**2, 1.0 / sb**2]
         params, cov = solve(weights)
         factor = params[1]
     n = len(y)
@@ -66,9 +67,11 @@ def _reference(y, sy, x, sx, sb, whole=False, narrow=True):
     elif chi2 > 1.0:
         weights[:n] /= chi2
         weights[-1] /= chi2
+        if discount:  # a fleet's prior, up to the default's
+            weights[n] = 1.0 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR) ** 2)
         params, cov = solve(weights)
     elif ratio < 1.0:
-        weights = np.r_[1.0 / (ratio * measured + drift), 1.0 / SCALE_PRIOR**2, 1.0 / (ratio * sb**2)]
+        weights = np.r_[1.0 / (ratio * measured + drift), 1.0 / prior_sd**2, 1.0 / (ratio * sb**2)]
         params, cov = solve(weights)
     return params[1], np.sqrt(cov[1, 1]), params[0], np.sqrt(cov[0, 0]), chi2
 
@@ -116,6 +119,49 @@ def test_pairs_within_their_errors_are_fitted_as_before():
     assert (factor, factor_error, offset, offset_error) == pytest.approx((f, sf, b, sb), rel=1e-9)
 
 
+
+@pytest.mark.parametrize("prior", [(1.2, 0.12), (0.8, 0.05)])
+def test_a_fleets_prior_is_the_factors_pseudo_observation(prior):
+    """A fleet's scale prior (``--scale-prior``, :mod:`faultgen.monitor.scale_prior`) enters the fit as the
+    factor's pseudo-observation at its mean with its sd, the pairs weighed at its mean first: against numpy's
+    normal equations; an axis no test has paired reads the prior itself."""
+    scale = _rescale()
+    scale.prior = prior
+    pairs = (np.array([0.3, -0.2, 6.1, 14.0]), np.full(4, 2.0), np.array([0.1, -0.2, 5.0, 11.0]))
+    scale.pairs[1] = [(w, s, x, TWIN_ERROR) for w, s, x in zip(*pairs)]
+    (factor, factor_error), (offset, offset_error) = scale._fitted(1)
+    f, sf, b, sb, chi2 = _reference(*pairs[:2], pairs[2], np.full(4, TWIN_ERROR), 100 * REFERENCE_ERROR,
+                                    prior=prior)
+    assert (factor, factor_error, offset, offset_error) == pytest.approx((f, sf, b, sb), rel=1e-9)
+    default = _reference(*pairs[:2], pairs[2], np.full(4, TWIN_ERROR), 100 * REFERENCE_ERROR)
+    assert factor_error < default[1]  # a narrower prior: a narrower factor
+    fresh = Rescale("u", 2, [], prior=prior)
+    assert (chi2 > 1.0) == (prior == (0.8, 0.05))  # the narrow prior far from the pairs' line: a conflict
+    factor, factor_error, _ = fresh.at("2026-01-01", np.zeros(2), np.ones(2))
+    assert list(factor) == [prior[0]] * 2 and list(factor_error) == [prior[1]] * 2
+
+
+def test_a_healthy_axis_whose_twin_drifts_gives_a_fleets_prior_back_its_doubt():
+    """The 3 % fleet's healthy unit09, axis 5, its eight pairs at its last log (a trace of ``Rescale``
+    under ``--scale-prior`` of the 1.5 % fleet, 1.005 +- 0.149; 2026-11-29): its tests read -1 to -10 %
+    about an offset of some -8 (its reference read high) while the twin-scale wear drifted to 11-15 % with
+    no wear. Held as it is, the fleet's prior kept the factor at 0.79 +- 0.13 and the bound of a log at
+    x = 14 passed 8 %: a healthy unit alarmed (5 logs from 2026-04-28). The pairs' chi-square above one
+    (their line does not hold on this axis) widens a fleet's prior with the tests' errors, up to the
+    default's: the factor falls to the tests' 0.69 with a doubt of 0.16 and the bound stays under 8 %."""
+    pairs = np.array([(-7.68, 3.281, -1.643, 1.446), (-5.271, 3.207, 0.738, 1.417),
+                      (-3.16, 3.431, -0.549, 1.371), (-10.414, 3.037, 4.126, 1.632),
+                      (-5.658, 3.262, 5.743, 1.365), (-2.969, 3.32, 6.088, 1.569),
+                      (-0.936, 3.393, 11.003, 1.7), (-5.871, 3.262, 14.845, 1.524)])
+    scale = _rescale()
+    scale.pairs[1], scale.offset_sd[1], scale.prior = [tuple(p) for p in pairs], 3.38, (1.005, 0.149)
+    (factor, factor_error), _ = scale._fitted(1)
+    ref = _reference(*pairs.T, 3.38, prior=(1.005, 0.149))
+    assert ref[4] > 1.0 and (factor, factor_error) == pytest.approx(ref[:2], rel=1e-9)
+    assert factor == pytest.approx(0.694, abs=1e-3) and factor_error == pytest.approx(0.160, abs=1e-3)
+    assert bound_at(factor, factor_error, x=14.0, e=1.6) < 8.0
+    held = _reference(*pairs.T, 3.38, prior=(1.005, 0.149), discount=False)  # the prior held against them
+    assert held[0] > 0.75 and held[1] < 0.14 and bound_at(*held[:2], x=14.0, e=1.6) > 8.0
 
 
 # issue 90, "the interval where the plant does not scatter" (2026-11-28): unit03 of the clean one-program

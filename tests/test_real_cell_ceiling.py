@@ -53,6 +53,21 @@ def test_without_a_test_that_sees_the_wear_the_alarm_waits_for_the_priors_thresh
         assert draws["in_window"].all() == (expected <= 15.0)
 
 
+def test_a_fleets_prior_about_the_twins_factor_moves_the_threshold_to_the_limit():
+    """With the prior centred on the twin's factor c (``faultgen monitor --scale-prior``) the bound
+    x (c - z p) passes 8 % at a true wear of 8 c / (c - z p): 9.53 % at c 1.2, p 0.15 (the ramp's first
+    whole point past it: 10 %), where the default prior N(1, 0.3^2) waits for 13.0 c (15.6: 16 %)."""
+    threshold = 8.0 * 1.2 / (1.2 - alarm_quantile() * 0.15)
+    assert threshold == pytest.approx(9.53, abs=0.01)
+    errors = np.random.default_rng(3).normal(0.0, 3.0, (50, 2))
+    tests = [(5, 0.0, 3.0), (19, 0.0, 3.0)]
+    fleet = ceiling.unit_chances(RAMP, tests, 1.2, errors, 8.0, 0.15, prior_mean=1.2)
+    default = ceiling.unit_chances(RAMP, tests, 1.2, errors, 8.0, 0.3)
+    assert np.all(fleet["alarm"] == np.ceil(threshold)) and np.all(default["alarm"] == 16.0)
+    factor, sd = ceiling.factor_draws(RAMP / 1.2, tests, errors, 0.15, 1.2)
+    assert (factor[0, 30], sd[0, 30]) == (1.2, 0.15)  # tests at no wear tell nothing: the prior
+
+
 def test_an_exact_scale_alarms_at_the_limit_and_gives_the_remaining_life_exactly():
     tests = [(24, 5.0, 1e-4), (26, 7.0, 1e-4)]  # tests without error tell the factor 1.25 before the alarm
     errors = np.random.default_rng(2).normal(0.0, 1e-4, (20, 2))

@@ -69,6 +69,12 @@ def monitor_command(
     hours_per_day: Annotated[float, typer.Option(
         help="Operating hours per calendar day between a unit's logs (a log records minutes of its work): "
              "OUT/life.csv's rated-life consumption between logs.", min=0.1, max=24.0)] = 16.0,
+    scale_prior: Annotated[Path | None, typer.Option(
+        help="The output folder of another monitor run on the same robot whose friction tests saw some "
+             "units' wear: the factor that puts the twin's wear on the tests' scale is learned there (a "
+             "normal prediction over its units' factors) and is this run's prior in place of 1 +- 0.3, so that an "
+             "alarm before a test sees the wear can come nearer the limit; not OUT itself (docs/analysis.md, "
+             "\"Issue 90: a fleet's scale prior\").")] = None,
     log_format: LogFormat = "measured",
     torque_constants: TorqueConstants = None,
     jobs: Jobs = 1,
@@ -173,7 +179,9 @@ def monitor_command(
                           twin_temperature=twin_temperature, progress=progress,
                           log_format=functools.partial(log_adapter, log_format, torque_constants),
                           context=ExecutionContext(jobs, scheduler, stepper), failure_wear=failure_wear,
-                          hours_per_day=hours_per_day)
+                          hours_per_day=hours_per_day, scale_prior=scale_prior)
+        if run.scale_prior is not None:
+            typer.echo(run.scale_prior.note())
         outcome = loop.monitor(run)
     except loop.MonitorInterrupted as stopped:  # Ctrl-C, SIGTERM: OUT/.cache keeps the twins made so far
         typer.echo(str(stopped), err=True)

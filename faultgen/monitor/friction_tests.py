@@ -49,8 +49,8 @@ not known; the tests before the wear fix it), each test weighed by its own error
 wear's error times ``f`` (weighed at ``f = 1``, then at the fitted ``f``) and by the factor's drift since
 the test, :data:`SCALE_DRIFT` times ``x_j`` per later test (the twin's scale may change with the wear; a test
 before the wear keeps telling ``b``); the tests' variances (``b``'s prior's too) times their reduced chi-square if
-above one, their measured part's upper 90 % limit if below (:func:`.bounds.upper_ratio`), never ``f``'s prior
-(the degrees of freedom: the pairs less their leverages, the priors fitting part of the line).
+above one, their measured part's upper 90 % limit if below (:func:`.bounds.upper_ratio`), never ``f``'s prior,
+but a fleet's up to the default's (:mod:`.scale_prior`; the degrees of freedom: the pairs less their leverages).
 A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log: what the monitor
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
@@ -429,9 +429,9 @@ def _spread(fit: dict, law: Law) -> float:
 
 @dataclass
 class Rescale:
-    """The factors that put a unit's wear on its tests' scale (module docstring), fed the monitor's
-    wear in the twin's scale log by log (:meth:`at`): ``wears`` the tests' :class:`AxisWear` in
-    stamp order, ``kind`` the stamps' kind (:func:`faultgen.data.logfolder.parse_stamp`)."""
+    """The factors that put a unit's wear on its tests' scale (module docstring), fed the twin-scale wear log by log
+    (:meth:`at`): ``wears`` the tests' :class:`AxisWear` in stamp order; ``prior`` the factor's (mean, standard
+    deviation): ``(1,`` :data:`SCALE_PRIOR` ``)``, or a fleet's (:mod:`faultgen.monitor.scale_prior`)."""
 
     unit: str
     n_axes: int
@@ -445,6 +445,7 @@ class Rescale:
     floors: dict[int, float] = field(default_factory=dict)  # axis -> the alarm's bound on its last test's log
     tested: set = field(default_factory=set)  # axes whose test was read into the last log (floored)
     referenced: set = field(default_factory=set)  # axes whose reference test came since their last reset
+    prior: tuple[float, float] = (1.0, SCALE_PRIOR)
 
     def reset(self, axis: int = 0) -> None:
         """Forget the pairs of ``axis`` (0: every axis): a repair, a new program."""
@@ -477,14 +478,14 @@ class Rescale:
             x = (float(source[0][w.axis - 1]), float(source[1][w.axis - 1]))
             # the test read at once (bounds.test_read), on the factor known before it, less the offset b
             before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
-                ((1.0, SCALE_PRIOR), (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))
+                (self.prior, (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))
             test = (w.wear - offset[0], float(np.hypot(sy, offset[1])), *x)
             self.read[w.axis] = (before, test, key if w.key == key else self.last[0])
             self.floors.pop(w.axis, None)
             self.pairs.setdefault(w.axis, []).append((w.wear, sy, *x))
         self.last = (key, np.asarray(wear, dtype=float), np.asarray(error, dtype=float))
         # an axis no test has paired yet: the twin's scale, known to the factor's prior (module bounds)
-        factor, factor_error = np.ones(self.n_axes), np.full(self.n_axes, SCALE_PRIOR)
+        factor, factor_error = np.full(self.n_axes, self.prior[0]), np.full(self.n_axes, self.prior[1])
         names = [TWIN_SCALE] * self.n_axes
         for k, pairs in self.pairs.items():  # an axis with its reference only: on its scale, at the prior
             if pairs or k in self.referenced:
@@ -530,23 +531,22 @@ class Rescale:
 
         pairs = np.array(self.pairs[axis], dtype=float)
         (y, sy, x, sx), n = pairs.T, len(pairs)
-        sb = self.offset_sd.get(axis, OFFSET_PRIOR)
+        sb, factor = self.offset_sd.get(axis, OFFSET_PRIOR), self.prior[0]
         design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
-        target = np.r_[y, 1.0, 0.0]
-        # the factor a random walk (SCALE_DRIFT a test): an earlier pair's y misses by it times its x a later test
-        drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2
-        factor = 1.0
+        prior_sd, target = self.prior[1], np.r_[y, self.prior[0], 0.0]
+        drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2  # the factor's random walk: SCALE_DRIFT x a test
         for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
             measured = sy**2 + (factor * sx) ** 2  # the tests' and the twin-scale wear's errors, the drift apart
-            weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / sb**2]
+            weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / prior_sd**2, 1 / sb**2]
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)
         residual = y - design[:n] @ result.params
         dof = n - float(np.sum(weights[:n, None] * (design[:n] @ np.asarray(result.cov_params())) * design[:n]))
         if (chi2 := float(np.sum(weights[:n] * residual**2) / dof) if dof >= 1 else 1.0) > 1.0:
-            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior
+            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior...
+            weights[n] = 1 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR) ** 2)  # ...but a fleet's, to 0.3
         elif (ratio := bounds.upper_ratio(residual, measured, dof)) < 1.0:  # they scatter less than stated
-            weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / SCALE_PRIOR**2, 1 / (ratio * sb**2)]
+            weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / prior_sd**2, 1 / (ratio * sb**2)]
         if chi2 > 1.0 or ratio < 1.0:
             result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
             factor = max(float(result.params[1]), SCALE_MIN)

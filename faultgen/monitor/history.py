@@ -323,7 +323,8 @@ class _Check:
             raise self.fail(f"the state of unit {str(d.get('unit'))[:40]!r}, expected {unit!r}")
         if d.get("settings") != settings:
             theirs = d.get("settings") if isinstance(d.get("settings"), dict) else {}
-            moved = [setting_moved(k, theirs.get(k), v, robot) for k, v in settings.items() if theirs.get(k) != v]
+            moved = [setting_moved(k, theirs.get(k), settings.get(k), robot) for k in {**settings, **theirs}
+                     if theirs.get(k) != settings.get(k)]  # a key of either (a --scale-prior given or not)
             raise self.fail(f"holds a monitor run with other settings or inputs: {', '.join(moved) or 'unknown keys'}")
 
     def facts(self, d: dict, unit: str, n_axes: int, n_features: int) -> UnitHistory:

@@ -171,7 +171,10 @@ def monitor(run: MonitorRun) -> Outcome:
     wears = {name: friction_tests.tests_wear(read, n_axes, maintenance.get(name, ())) for name, read in tests.items()}
 
     def scale_of(name: str):
-        return friction_tests.Rescale(name, n_axes, wears[name][0]) if wears.get(name, ([],))[0] else None
+        if not wears.get(name, ([],))[0]:
+            return None
+        return friction_tests.Rescale(name, n_axes, wears[name][0], **(
+            {"prior": run.scale_prior.pair} if run.scale_prior is not None else {}))
 
     state = _load_state(out, units, run.digest, run.settings, n_axes, run.n_features, scale_of, run.robot.name)
     rescored = events_changed(state, maintenance, stopped)  # those units scored again from their first log
@@ -244,7 +247,9 @@ def _write_outputs(run: MonitorRun, units: dict, state: dict[str, UnitHistory], 
             table.write(staging)
         # LOGS by its name: a report meant to be shared keeps no path of this machine (as `logs import`)
         page.write(staging, run.settings, fleet=fleet, robot=Path(str(run.named)).name,
-                   logs=run.logs.resolve().name, model=run.model_source, twin_temperature=run.twin_temperature)
+                   logs=run.logs.resolve().name, model=run.model_source,
+                   twin_temperature=run.twin_temperature,
+                   **{k: v for k, v in run.digest.items() if k.startswith("scale_prior")})
         for m in records:
             (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()

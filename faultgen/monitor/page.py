@@ -64,6 +64,8 @@ SETTING_NAMES = {
     "persistence": "consecutive alarming logs that make an alarm (with the twin, one log whose lower bound passes the limit by its own width alarms at once)",
     "wear_limit": "wear limit, % of the axis's own dry friction: the lower bound of the wear, filtered over the logs, must reach to alarm",
     "twin_temperature": "the twin's temperature law predicts the seasonal change",
+    "scale_prior_mean": "the factor onto the friction tests' scale, its prior's mean (--scale-prior; 1)",
+    "scale_prior_sd": "its prior's standard deviation (--scale-prior; default 0.3)",
 }
 #: Order of the fleet table: what needs attention first (an open alarm before any status).
 ATTENTION = ("degraded", "not monitored", "learning", "monitored")

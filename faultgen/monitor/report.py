@@ -100,6 +100,8 @@ def score_cells(row) -> dict:
 
 
 WEAR_COLUMNS = ("unit", "stamp", "phase", "axis", "wear", "wear_5", "wear_95", "wear_lower", "wear_log")
+#: wear.csv's columns with friction tests (or a unit on the nominal model's scale).
+SCALE_COLUMNS = ("wear_scale", "scale_factor", "scale_factor_sd")
 
 
 def wear_table(units, scales: bool = False, nominal=frozenset()) -> Table:
@@ -111,7 +113,9 @@ def wear_table(units, scales: bool = False, nominal=frozenset()) -> Table:
     together (``wear_lower``, as ``wearI_lower`` of scores.csv; :mod:`faultgen.monitor.bounds`) and the log's own estimate (``wear_log``). Only units with a twin
     have rows. With ``scales`` (a fleet with friction tests, or units in ``nominal``) also each
     row's ``wear_scale``: ``friction test``, ``twin``, or for a unit in ``nominal`` (its twin fell
-    back to the nominal model) ``nominal model`` (:mod:`faultgen.monitor.friction_tests`)."""
+    back to the nominal model) ``nominal model`` (:mod:`faultgen.monitor.friction_tests`), and on the
+    tests' scale the factor that puts the twin's wear on it with its standard error (``scale_factor``,
+    ``scale_factor_sd``; :class:`faultgen.monitor.friction_tests.Rescale`), else empty."""
     rows = []
     for m in units:
         for row in m.rows:
@@ -120,10 +124,12 @@ def wear_table(units, scales: bool = False, nominal=frozenset()) -> Table:
                 continue
             for k in range(m.stages.n_axes):
                 default = "nominal model" if m.unit in nominal else "twin"
-                extra = [w.tests.scale[k] if w.tests is not None else default] if scales else []
+                t = w.tests
+                extra = ([t.scale[k], *(_fmt(float(v[k])) for v in (t.factor, t.factor_error))]
+                         if t is not None else [default, "", ""]) if scales else []
                 rows.append([_fmt(row.unit), _fmt(row.stamp), row.phase, k + 1,
                              *(_fmt(float(v[k])) for v in (w.estimate, w.p5, w.p95, w.lower, w.log)), *extra])
-    return Table("wear.csv", WEAR_COLUMNS + (("wear_scale",) if scales else ()), rows)
+    return Table("wear.csv", WEAR_COLUMNS + (SCALE_COLUMNS if scales else ()), rows)
 
 
 def chart(path, unit, axis_note: str) -> None:

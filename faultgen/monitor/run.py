@@ -17,6 +17,8 @@ from faultgen.model.robot import Robot
 from faultgen.monitor import life, prognosis
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
+from faultgen.monitor.scale_prior import ScalePrior
+from faultgen.monitor.scale_prior import learn as learn_prior
 from faultgen.monitor.scoring import Settings
 from faultgen.runs.context import LOCAL, ExecutionContext
 from faultgen.simulation import backends
@@ -59,6 +61,8 @@ class MonitorRun:
     #: Operating hours per calendar day between logs, in (0, 24] (life.csv).
     hours_per_day: float = life.HOURS_PER_DAY
     progress: bool = True
+    #: The friction tests' scale factor's prior learned from another run (``--scale-prior``), or None.
+    scale_prior: ScalePrior | None = None
 
     @property
     def stepper(self) -> backends.Stepper:
@@ -85,18 +89,21 @@ def resolve_run(robot: str | Path | Robot, logs: str | Path, out: str | Path, *,
                 progress: bool = True,
                 log_format: formats.LogFormat | Callable[[Robot], formats.LogFormat] = formats.MEASURED,
                 context: ExecutionContext = LOCAL, failure_wear: float = prognosis.FAILURE_WEAR,
-                hours_per_day: float = life.HOURS_PER_DAY) -> MonitorRun:
+                hours_per_day: float = life.HOURS_PER_DAY,
+                scale_prior: str | Path | ScalePrior | None = None) -> MonitorRun:
     """The run of :func:`faultgen.monitor.loop.monitor` resolved, before any work (each argument is
     the :class:`MonitorRun` field of its name; ``robot`` a name, folder or MJCF loaded here once, or
     a Robot the caller resolved; ``log_format`` a format, or what makes it from the robot, as the
-    command line's ``--torque-constants`` are checked against its axes).
+    command line's ``--torque-constants`` are checked against its axes; ``scale_prior`` a ScalePrior or
+    the output folder of another run to learn it from, :func:`faultgen.monitor.scale_prior.learn`).
 
     Raises
     ------
     ValueError
         ``context`` not an ExecutionContext or with ``jobs`` > 1 and a ``scheduler``; ``out`` that
         is, lies in or holds ``logs`` (:func:`faultgen.data.atomic.check_apart`); ``failure_wear``
-        or ``hours_per_day`` out of range; the robot, a bad gearbox rating in its ``drivetrain.toml``
+        or ``hours_per_day`` out of range; a ``scale_prior`` folder that is ``out`` or that it cannot be
+        learned from; the robot, a bad gearbox rating in its ``drivetrain.toml``
         (:mod:`faultgen.model.rating`), the log format; a ``calibrated`` model that does not load.
     faultgen.runs.errors.SweepRefused
         The ``scheduler`` is malformed or no Dask scheduler answers there.
@@ -111,8 +118,13 @@ def resolve_run(robot: str | Path | Robot, logs: str | Path, out: str | Path, *,
     given_path = given_model(calibrated) if settings.protocol == "twin" and calibrated is not None else None
     model_source = "nominal" if settings.protocol != "twin" else (
         stored.sha256_file(given_path) if given_path is not None else "per-unit" if calibrate else "nominal")
+    if scale_prior is not None and not isinstance(scale_prior, ScalePrior):
+        if Path(scale_prior).resolve() == Path(out).resolve():
+            raise ValueError(f"--scale-prior {scale_prior}: the run's own output folder; expected another "
+                             "run's (a unit would be its own prior, and the prior would move with every run)")
+        scale_prior = learn_prior(scale_prior)
     digest = stored.settings_digest(settings, model_source, twin_temperature, stored.sha256_file(nominal.path),
-                                    log_format.key)
+                                    log_format.key, scale_prior.pair if scale_prior is not None else None)
     given = None
     if given_path is not None:
         try:
@@ -121,7 +133,7 @@ def resolve_run(robot: str | Path | Robot, logs: str | Path, out: str | Path, *,
             raise ValueError(f"--calibrated {calibrated}: the model does not load ({err})") from None
     return MonitorRun(nominal, robot.path if isinstance(robot, Robot) else robot, Path(logs), Path(out), settings,
                       log_format, ratings, given_path, given, calibrate, model_source, digest, twin_temperature,
-                      context, failure_wear, hours_per_day, progress)
+                      context, failure_wear, hours_per_day, progress, scale_prior)
 
 
 def _check_context(context: ExecutionContext) -> None:

@@ -90,6 +90,8 @@ SETTING_VALUES = {
     "persistence": (_setting_count(1, scoring.MAX_LOGS), f"a whole number of logs 1..{scoring.MAX_LOGS}"),
     "wear_limit": (_setting_number(0.0, scoring.MAX_WEAR_LIMIT, True), f"a wear in (0, {scoring.MAX_WEAR_LIMIT:g}] %"),
     "twin_temperature": (lambda v: isinstance(v, bool), "true or false"),
+    **{name: (_setting_number(0.0, math.inf, False), "a finite number above 0")
+       for name in ("scale_prior_mean", "scale_prior_sd")},
     **{name: (_setting_text, "a text of at most 4096 characters") for name in ("robot", "logs", "model", "format")},
 }
 

@@ -84,13 +84,15 @@ def key_name(key: dict) -> str:
 
 
 def settings_digest(settings: Settings, model: str, twin_temperature: bool, robot_sha256: str,
-                    log_format: str = "measured") -> dict:
+                    log_format: str = "measured", scale_prior: tuple[float, float] | None = None) -> dict:
     """What a state belongs to, as a JSON-able dict: the monitor's settings, the model source
     ("nominal", "per-unit" or the SHA-256 of a given calibrated model), whether the twin predicts
-    the temperature's effect, the SHA-256 of the robot's MJCF and the logs' format (with its
-    options)."""
+    the temperature's effect, the SHA-256 of the robot's MJCF, the logs' format (with its
+    options) and, where given, the scale factor's prior (mean, sd; :mod:`faultgen.monitor.scale_prior`)."""
+    names = ("scale_prior_mean", "scale_prior_sd")
+    prior = {} if scale_prior is None else dict(zip(names, map(float, scale_prior), strict=True))
     return {**asdict(settings), "model": model, "twin_temperature": bool(twin_temperature), "robot": robot_sha256,
-            "format": log_format}
+            "format": log_format, **prior}
 
 
 def floats(values) -> list[float]:
