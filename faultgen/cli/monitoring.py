@@ -143,7 +143,8 @@ def monitor_command(
     source_axis, statistic, limit, evidence, closed, closed_by),
     OUT/scores.csv (per unit and log: Q, T2, their limits, the axis ranking and scores),
     OUT/wear.csv (per unit, log and axis, with the twin: the wear estimate, % of the axis's own dry
-    friction, with its 90 % interval that carries the twin's model uncertainty),
+    friction, with its 90 % interval that carries the twin's model uncertainty; with friction tests
+    the factor onto their scale, scale_factor, which another run's --scale-prior learns from),
     OUT/rul.csv (per unit and axis, with the twin: the remaining life until the wear estimate reaches
     --failure-wear, in days or logs, with a 5-95 % interval and the trend model, or "no end of life
     within the horizon"), OUT/life.csv (per unit and axis: the % of its gearbox's rated life the
