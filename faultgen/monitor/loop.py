@@ -249,7 +249,7 @@ def _write_outputs(run: MonitorRun, units: dict, state: dict[str, UnitHistory], 
         page.write(staging, run.settings, fleet=fleet, robot=Path(str(run.named)).name,
                    logs=run.logs.resolve().name, model=run.model_source,
                    twin_temperature=run.twin_temperature,
-                   **{k: v for k, v in run.digest.items() if k.startswith("scale_prior")})
+                   **stored.prior_settings(None if run.scale_prior is None else run.scale_prior.pair))
         for m in records:
             (staging / stored.unit_file(m.unit, ".png")).write_bytes(made[m.unit][0])
         (staging / ".state").mkdir()

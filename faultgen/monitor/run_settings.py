@@ -12,6 +12,7 @@ from pathlib import Path
 
 from faultgen import inputs
 from faultgen.monitor import scoring
+from faultgen.monitor.state import SCALE_PRIOR_KEYS
 
 #: The run's settings beside it (what ``faultgen report`` builds the page again with).
 SETTINGS = "settings.json"
@@ -90,8 +91,7 @@ SETTING_VALUES = {
     "persistence": (_setting_count(1, scoring.MAX_LOGS), f"a whole number of logs 1..{scoring.MAX_LOGS}"),
     "wear_limit": (_setting_number(0.0, scoring.MAX_WEAR_LIMIT, True), f"a wear in (0, {scoring.MAX_WEAR_LIMIT:g}] %"),
     "twin_temperature": (lambda v: isinstance(v, bool), "true or false"),
-    **{name: (_setting_number(0.0, math.inf, False), "a finite number above 0")
-       for name in ("scale_prior_mean", "scale_prior_sd")},
+    **{name: (_setting_number(0.0, math.inf, False), "a finite number above 0") for name in SCALE_PRIOR_KEYS},
     **{name: (_setting_text, "a text of at most 4096 characters") for name in ("robot", "logs", "model", "format")},
 }
 

@@ -89,10 +89,18 @@ def settings_digest(settings: Settings, model: str, twin_temperature: bool, robo
     ("nominal", "per-unit" or the SHA-256 of a given calibrated model), whether the twin predicts
     the temperature's effect, the SHA-256 of the robot's MJCF, the logs' format (with its
     options) and, where given, the scale factor's prior (mean, sd; :mod:`faultgen.monitor.scale_prior`)."""
-    names = ("scale_prior_mean", "scale_prior_sd")
-    prior = {} if scale_prior is None else dict(zip(names, map(float, scale_prior), strict=True))
     return {**asdict(settings), "model": model, "twin_temperature": bool(twin_temperature), "robot": robot_sha256,
-            "format": log_format, **prior}
+            "format": log_format, **prior_settings(scale_prior)}
+
+
+#: The keys of a fleet's scale prior (``--scale-prior``: mean, sd) in the digest and settings.json.
+SCALE_PRIOR_KEYS = ("scale_prior_mean", "scale_prior_sd")
+
+
+def prior_settings(scale_prior: tuple[float, float] | None) -> dict:
+    """The digest's and settings.json's entries of a scale prior (mean, sd): :data:`SCALE_PRIOR_KEYS`;
+    none without one (the default prior)."""
+    return {} if scale_prior is None else dict(zip(SCALE_PRIOR_KEYS, map(float, scale_prior), strict=True))
 
 
 def floats(values) -> list[float]:
