@@ -55,11 +55,9 @@ A log's wear in the tests' scale is ``f x`` (``f`` from the tests up to the log:
 knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % interval
 ``f x -+ z sqrt(f^2 e^2 + s_f^2 x^2)``, ``e`` the filtered wear's own error: the factor's error
 ``s_f`` in place of the twin's :data:`faultgen.monitor.scoring.SCALE_UNCERTAINTY`, and the filter's
-error in place of the log's own (which the twin's scale keeps for the errors that stay for weeks:
-the tests' scale takes them, the slow ones, as the factor's; with the log's own the interval
-covered 99.7 % of the first independent fleet's logs, with the filter's 97.7 %, at a prior of
-0.15). The tests' wear (and so each factor) uses the temperature law as all of the unit's tests
-read so far give it: a later test may move an earlier log's wear a little. The remaining life
+error in place of the log's own (the errors that stay for weeks are the factor's on the tests' scale;
+measured in docs/analysis.md). The tests' wear (and so each factor) uses the temperature law as all of
+the unit's tests read so far give it: a later test may move an earlier log's wear a little. The remaining life
 (:func:`remaining_life`) gets each axis's series rescaled by its latest ``f`` and ``s_f / f`` as
 the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
 in the twin's scale (``wear_scale`` ``twin``).
@@ -121,11 +119,9 @@ OFFSET_PRIOR = 10.0
 SCALE_MIN = 0.2
 #: The factor's random walk, its standard deviation per test (the twin's scale need not be one number
 #: over the whole wear: on the second independent fleet it grew with the wear): an earlier pair's
-#: variance grows by ``(SCALE_DRIFT x)^2`` per later test. Before 2026-11-28 each earlier pair's weight
-#: was multiplied by 0.6 (``FORGET``) per later test, whatever its ``x``: the pairs before the wear, which
-#: alone tell the offset ``b`` (the reference test's error, shared by every later test), were forgotten and
-#: the offset went into the factor (issue 90: on the small 1.5 % fleet of seed 0 a reference test 2.8 % low
-#: read the worn axis 3-4 points high). 0.06: a pair at ``x`` 20 % weighs what 0.6 gave it after one test.
+#: variance grows by ``(SCALE_DRIFT x)^2`` per later test, so that the pairs before the wear keep telling
+#: the offset ``b`` (0.06: a pair at ``x`` 20 % weighs what the earlier forgetting's 0.6 gave it after one
+#: test; docs/analysis.md, "the factor is a random walk").
 SCALE_DRIFT = 0.06
 #: The cache of the tests' readings in OUT, its entries' format and largest size, bytes.
 CACHE, CACHE_FORMAT, CACHE_MAX_BYTES = "friction-tests", "faultgen-friction-test-reading/1", 2**20
@@ -308,8 +304,7 @@ def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
                                                      f"not corrected (+-{100 * BETA_PRIOR:g} %/K)", axes)
     beta, noise = float(np.median(slopes)), float(np.median(errors))
     spread = 1.4826 * float(np.median(np.abs(np.array(slopes) - beta))) if len(slopes) > 2 else 0.0
-    # the median's own error (1.2533 sigma / sqrt(n) for a normal sample) and the axes' own laws'
-    # spread beyond what their noise explains
+    # the median's own error (1.2533 sigma / sqrt(n), a normal sample's), the axes' laws' spread beyond noise
     error = float(np.sqrt((1.2533 * noise) ** 2 / len(slopes) + max(0.0, spread**2 - noise**2)))
     return Law(beta, error, repeatability, f"{100 * beta:+.2f} +- {100 * error:.2f} %/K (median of {len(slopes)} axes)",
                axes)
@@ -446,6 +441,7 @@ class Rescale:
     tested: set = field(default_factory=set)  # axes whose test was read into the last log (floored)
     referenced: set = field(default_factory=set)  # axes whose reference test came since their last reset
     prior: tuple[float, float] = (1.0, SCALE_PRIOR)
+    fits: dict[int, tuple] = field(default_factory=dict)  # axis -> (its pairs, offset and prior; its fit)
 
     def reset(self, axis: int = 0) -> None:
         """Forget the pairs of ``axis`` (0: every axis): a repair, a new program."""
@@ -526,32 +522,38 @@ class Rescale:
         return bound
 
     def _fitted(self, axis: int) -> tuple[tuple[float, float], tuple[float, float]]:
-        """(The factor, its standard error), (the offset ``b``, points, its) of ``axis`` (module docstring)."""
-        import statsmodels.api as sm
+        """(The factor, its sd), (the offset ``b``, points, its sd) of ``axis``; refitted on a test's day."""
+        key = (tuple(self.pairs[axis]), self.offset_sd.get(axis, OFFSET_PRIOR), self.prior)
+        if self.fits.get(axis, (None,))[0] != key:
+            self.fits[axis] = (key, _fit(*key))
+        return self.fits[axis][1]
 
-        pairs = np.array(self.pairs[axis], dtype=float)
-        (y, sy, x, sx), n = pairs.T, len(pairs)
-        sb, factor = self.offset_sd.get(axis, OFFSET_PRIOR), self.prior[0]
-        design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
-        prior_sd, target = self.prior[1], np.r_[y, self.prior[0], 0.0]
-        drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2  # the factor's random walk: SCALE_DRIFT x a test
-        for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
-            measured = sy**2 + (factor * sx) ** 2  # the tests' and the twin-scale wear's errors, the drift apart
-            weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / prior_sd**2, 1 / sb**2]
-            result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
-            factor = max(float(result.params[1]), SCALE_MIN)
-        residual = y - design[:n] @ result.params
-        dof = n - float(np.sum(weights[:n, None] * (design[:n] @ np.asarray(result.cov_params())) * design[:n]))
-        if (chi2 := float(np.sum(weights[:n] * residual**2) / dof) if dof >= 1 else 1.0) > 1.0:
-            weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior...
-            weights[n] = 1 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR) ** 2)  # ...but a fleet's, to 0.3
-        elif (ratio := bounds.upper_ratio(residual, measured, dof)) < 1.0:  # they scatter less than stated
-            weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / prior_sd**2, 1 / (ratio * sb**2)]
-        if chi2 > 1.0 or ratio < 1.0:
-            result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
-            factor = max(float(result.params[1]), SCALE_MIN)
-        sd = np.sqrt(np.diag(np.asarray(result.cov_params())))
-        return (factor, float(sd[1])), (float(result.params[0]), float(sd[0]))
+
+def _fit(pairs: tuple, sb: float, prior: tuple) -> tuple[tuple[float, float], tuple[float, float]]:
+    """:meth:`Rescale._fitted` of ``pairs`` (y, sy, x, sx), offset prior ``sb``, factor ``prior``."""
+    import statsmodels.api as sm
+
+    (y, sy, x, sx), n, (factor, prior_sd) = np.array(pairs, dtype=float).T, len(pairs), prior
+    design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
+    target = np.r_[y, prior[0], 0.0]
+    drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2  # the factor's random walk: SCALE_DRIFT x a test
+    for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
+        measured = sy**2 + (factor * sx) ** 2  # the tests' and the twin-scale wear's errors, the drift apart
+        weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / prior_sd**2, 1 / sb**2]
+        result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
+        factor = max(float(result.params[1]), SCALE_MIN)
+    residual = y - design[:n] @ result.params
+    dof = n - float(np.sum(weights[:n, None] * (design[:n] @ np.asarray(result.cov_params())) * design[:n]))
+    if (chi2 := float(np.sum(weights[:n] * residual**2) / dof) if dof >= 1 else 1.0) > 1.0:
+        weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior...
+        weights[n] = 1 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR) ** 2)  # ...but a fleet's, to 0.3
+    elif (ratio := bounds.upper_ratio(residual, measured, dof)) < 1.0:  # they scatter less than stated
+        weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / prior_sd**2, 1 / (ratio * sb**2)]
+    if chi2 > 1.0 or ratio < 1.0:
+        result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
+        factor = max(float(result.params[1]), SCALE_MIN)
+    sd = np.sqrt(np.diag(np.asarray(result.cov_params())))
+    return (factor, float(sd[1])), (float(result.params[0]), float(sd[0]))
 
 
 def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
@@ -594,7 +596,5 @@ def remaining_life(monitor, failure_wear: float) -> list:
     relative error as the scale's uncertainty; an axis in the twin's scale keeps the default)."""
     from faultgen.monitor import prognosis
 
-    rows, uncertainty = on_tests_scale(monitor.rows, monitor.stages.n_axes)
-    if uncertainty is None:
-        return prognosis.of_monitor(monitor, failure_wear)
+    rows, uncertainty = on_tests_scale(monitor.rows, monitor.stages.n_axes)  # (rows, None): as they are
     return prognosis.of_monitor(monitor, failure_wear, rows=rows, scale_uncertainty=uncertainty)
