@@ -112,14 +112,15 @@ def test_each_axis_states_its_tests_scatter_about_the_temperature_law():
 
 def _test_wears(true, offset, reference_error=0.02, own_error=0.014):
     """One axis's tests (friction_tests.AxisWear) every other day: the reference reads 0, each later
-    test the true wear plus ``offset`` (the reference's own error, which every later test shares)."""
+    test's dry level ``1 + offset/100`` times the truth's (the reference read that much low, which every
+    later test shares): its wear ``w + offset (1 + w/100)``, % of the reference's level."""
     from faultgen.data import logfolder
     from faultgen.monitor import friction_tests
 
     stamps = [f"2026-01-{2 * j + 1:02d}" for j in range(len(true))]
     wears = []
     for j, (stamp, w) in enumerate(zip(stamps, true)):
-        y = w + offset if j else 0.0
+        y = w + offset * (1 + w / 100) if j else 0.0
         wears.append(friction_tests.AxisWear(stamp, logfolder.parse_stamp(stamp, "u")[0], 1, {}, y, y - 2, y + 2,
                                              own_error, reference_error, "", j == 0, own_error))
     return stamps, wears
@@ -130,7 +131,7 @@ def test_a_reference_tests_offset_told_before_the_wear_is_not_read_as_wear():
     of the worn axis 3-4 points high, the alarm's bound above the truth): the pairs before the wear
     alone tell the offset ``b``; the factor's drift (``SCALE_DRIFT``) weighs a pair down by its ``x``,
     so they are not forgotten and the offset does not go into the factor. Twin scale = truth, 5 tests
-    before the wear, then 8 to 48 %, each later test 3 points high: the logs on the tests' scale read
+    before the wear, then 8 to 48 %, each later test's level 3 % high: the logs on the tests' scale read
     within 1.5 points of 48 % (each earlier pair's weight times 0.6 a test, as before: 2.4 points)."""
     true = np.array([0.0] * 5 + [6.0 * k for k in range(1, 9)])
     stamps, wears = _test_wears(true, 3.0)
@@ -203,7 +204,7 @@ def test_a_fast_wear_is_read_at_its_test_and_the_test_stays_in_the_factor():
 def test_a_tests_read_is_taken_less_its_offset_and_its_bound_floors_the_later_logs():
     """Issue 90 (the first alarm before 15 %): a test read into its log at once is taken less the
     offset ``b`` the tests before the wear tell (4 tests at no wear reading 3 points high, then 12 %
-    read as 15: its log reads 12.9, main's 14.6); and its log's lower 90 % bound stays a floor of the
+    read as 15.4: its log reads 12.5, 12.9 with the offset additive, 14.6 before the offset was taken); and its log's lower 90 % bound stays a floor of the
     later logs' until the next test (a wear does not fall): two logs after a test at 16 % the bound
     stays 13.7 where the factor alone gives 12.6-13.0, so the alarm persists from the test's log."""
     true = np.array([0.0, 0.0, 0.0, 0.0, 12.0])

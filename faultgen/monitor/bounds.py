@@ -35,6 +35,9 @@ import math
 
 import numpy as np
 
+#: The smallest level ``1 + b/100`` of a reference test over its axis's true level taken
+#: (:func:`reference_factor`; a reference read 10 times too high, no test reads).
+LEVEL_MIN = 0.1
 #: Logs over which the filter's innovations are averaged to adapt its rate's process noise
 #: (:func:`adapted_rate_variance`).
 ADAPT_WINDOW = 3
@@ -171,3 +174,31 @@ def test_read(scale: tuple, twin: tuple, test: tuple, same_log: bool) -> tuple[n
         fused, variance = w * f * x + (1 - w) * (y + f * (x - xt)), (va * vb - cov**2) / d
     ok = np.isfinite(fused) & np.isfinite(variance) & (d > 0)
     return np.where(ok, fused, f * x), np.sqrt(np.where(ok, np.maximum(variance, 0.0), va))
+
+
+def reference_level(offset: float) -> float:
+    """``1 + b/100``: the reference test's dry level over the axis's own, at least :data:`LEVEL_MIN`,
+    from the offset ``b`` (points) its later tests all share (:func:`reference_factor`)."""
+    return max(1.0 + float(offset) / 100.0, LEVEL_MIN)
+
+
+def reference_factor(params, cov, least: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """``((f, s_f), (b, s_b))`` from the tests' line ``y = b + F x`` (``params`` ``(b, F)``, ``cov``
+    their 2 x 2 covariance): the reference test's error is a factor on every later test's dry level,
+    ``1 + y/100 = (1 + b/100) (1 + f x/100)``, so the line's slope is ``F = f (1 + b/100)`` and the
+    wear's factor ``f = F / (1 + b/100)`` (at least ``least``), its error by the delta method. Taken as
+    the factor, ``F`` carried the reference's error into every wear (issue 90, seed 1's unit06: a
+    reference 2.5 scatters low read its wear 4-8 % high)."""
+    b, slope = (float(v) for v in params)
+    level = reference_level(b)
+    gradient = np.array([-slope / (100.0 * level**2), 1.0 / level])
+    variance = float(gradient @ np.asarray(cov, dtype=float) @ gradient)
+    return (max(slope / level, least), math.sqrt(variance)), (b, math.sqrt(float(np.asarray(cov)[0, 0])))
+
+
+def less_reference(wear: float, error: float, offset: float, offset_error: float) -> tuple[float, float]:
+    """A test's wear ``wear`` -+ ``error`` % less the reference's ``offset`` -+ ``offset_error`` points
+    (:func:`reference_factor`): ``(y - b) / (1 + b/100)`` and its standard error (the two independent)."""
+    level = reference_level(offset)
+    spread = float(np.hypot(error, offset_error * (1.0 + wear / 100.0) / level))
+    return (wear - offset) / level, spread / level

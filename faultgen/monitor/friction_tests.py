@@ -40,10 +40,12 @@ lubricant film, that no fit of one test sees).
 **The logs on the tests' scale** (:class:`Rescale`): per axis, the tests' wear ``y_j`` against the
 monitor's own wear in the twin's scale ``x_j`` at the test's day (the filtered wear of the last log
 at or before it, :class:`faultgen.monitor.wear_trend.WearTrend`), the tests after the reference (0 by
-definition, its error ``b``'s prior), is the line ``y = b + f x``, fitted
-by weighted least squares (``statsmodels`` WLS, weights one over ``var y_j + var x_j``) with the
-priors of mixed estimation (Theil & Goldberger 1961: one pseudo-observation each) ``f ~ N(1,``
-:data:`SCALE_PRIOR` ``^2)`` and ``b ~ N(0, s0^2)`` (``b``: the reference test's own error, which every
+definition, its error ``b``'s prior), is the line ``y = b + F x``, ``F = f (1 + b/100)`` (the
+reference's error is a factor on every later test's dry level: ``f`` is
+:func:`.bounds.reference_factor`'s), fitted by weighted least squares (``statsmodels`` WLS, weights
+one over ``var y_j + var x_j``) with the priors of mixed estimation (Theil & Goldberger 1961: one
+pseudo-observation each) ``f ~ N(1,`` :data:`SCALE_PRIOR` ``^2)`` (on ``F``, times ``1 + b/100`` of
+the fit before) and ``b ~ N(0, s0^2)`` (``b``: the reference test's own error, which every
 test's wear shares; ``s0`` that test's own standard error in points, :data:`OFFSET_PRIOR` where it is
 not known; the tests before the wear fix it), each test weighed by its own error and the twin-scale
 wear's error times ``f`` (weighed at ``f = 1``, then at the fitted ``f``) and by the factor's drift since
@@ -58,9 +60,8 @@ knew then), the alarm judged on it (``f`` times the lower bound), and its 90 % i
 error in place of the log's own (the errors that stay for weeks are the factor's on the tests' scale;
 measured in docs/analysis.md). The tests' wear (and so each factor) uses the temperature law as all of
 the unit's tests read so far give it: a later test may move an earlier log's wear a little. The remaining life
-(:func:`remaining_life`) gets each axis's series rescaled by its latest ``f`` and ``s_f / f`` as
-the scale's uncertainty. An axis no test read, and every log before the unit's first test, stay
-in the twin's scale (``wear_scale`` ``twin``).
+(:func:`remaining_life`) gets each axis's series rescaled by its latest ``f`` and ``s_f / f`` as the
+scale's uncertainty. An axis no test read, and every log before its unit's first test, stay twin-scale.
 
 ``OUT/tests.csv`` (:func:`tests_table`, :data:`COLUMNS`): one row per unit, test and axis read;
 ``scatter_percent`` the axis's day-to-day scatter as the unit's tests show it (the standard deviation
@@ -435,7 +436,7 @@ class Rescale:
     last: tuple[float, np.ndarray, np.ndarray] | None = None  # key, twin-scale wear and error of the last log
     done: int = 0  # wears paired so far
     offset_sd: dict[int, float] = field(default_factory=dict)  # axis -> its reference test's own error, points
-    # axis -> its last test read at once (bounds.test_read): (f, s_f) before it, (y - b, s_y, x_t, e_t), its log
+    # axis -> its last test read at once (bounds.test_read): (f, s_f) before, (y less b, s_y, x_t, e_t), log
     read: dict[int, tuple] = field(default_factory=dict)
     floors: dict[int, float] = field(default_factory=dict)  # axis -> the alarm's bound on its last test's log
     tested: set = field(default_factory=set)  # axes whose test was read into the last log (floored)
@@ -459,11 +460,9 @@ class Rescale:
         while self.done < len(self.wears) and self.wears[self.done].key <= key:
             w = self.wears[self.done]
             self.done += 1
-            source = (wear, error) if w.key == key or self.last is None else self.last[1:]
-            if self.last is None and w.key < key:
-                source = None  # a test before the first log scored: nothing to pair it with
-            if w.log_error != w.log_error or source is None:
+            if w.log_error != w.log_error or (self.last is None and w.key < key):  # before any log: no pair
                 continue
+            source = (wear, error) if w.key == key or self.last is None else self.last[1:]
             if w.reference_error == w.reference_error and w.reference_error > 0:
                 self.offset_sd[w.axis] = 100 * w.reference_error
             if w.reference:  # reads 0 by definition: its error is the offset b (its prior), not a pair's
@@ -475,7 +474,7 @@ class Rescale:
             # the test read at once (bounds.test_read), on the factor known before it, less the offset b
             before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
                 (self.prior, (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))
-            test = (w.wear - offset[0], float(np.hypot(sy, offset[1])), *x)
+            test = (*bounds.less_reference(w.wear, sy, *offset), *x)
             self.read[w.axis] = (before, test, key if w.key == key else self.last[0])
             self.floors.pop(w.axis, None)
             self.pairs.setdefault(w.axis, []).append((w.wear, sy, *x))
@@ -537,23 +536,23 @@ def _fit(pairs: tuple, sb: float, prior: tuple) -> tuple[tuple[float, float], tu
     design = np.vstack([np.column_stack([np.ones_like(x), x]), [[0.0, 1.0], [1.0, 0.0]]])
     target = np.r_[y, prior[0], 0.0]
     drift = np.arange(len(y))[::-1] * (SCALE_DRIFT * x) ** 2  # the factor's random walk: SCALE_DRIFT x a test
-    for _ in range(2):  # x's error enters y's as f times it: weighed at the prior's f, then at the fitted one
+    for _ in range(2):  # x's error enters y's as F times it: weighed at the prior's f, then at the fitted F
         measured = sy**2 + (factor * sx) ** 2  # the tests' and the twin-scale wear's errors, the drift apart
         weights = np.r_[1.0 / np.maximum(measured + drift, 1e-6), 1 / prior_sd**2, 1 / sb**2]
         result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
-        factor = max(float(result.params[1]), SCALE_MIN)
+        factor, level = max(float(result.params[1]), SCALE_MIN), bounds.reference_level(result.params[0])
+        target[n], prior_sd = prior[0] * level, prior[1] * level  # f's prior, on F = f (1 + b/100)
     residual = y - design[:n] @ result.params
     dof = n - float(np.sum(weights[:n, None] * (design[:n] @ np.asarray(result.cov_params())) * design[:n]))
     if (chi2 := float(np.sum(weights[:n] * residual**2) / dof) if dof >= 1 else 1.0) > 1.0:
         weights[:n], weights[-1] = weights[:n] / chi2, weights[-1] / chi2  # the tests', not f's prior...
-        weights[n] = 1 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR) ** 2)  # ...but a fleet's, to 0.3
+        weights[n] = 1 / min(prior_sd**2 * chi2, max(prior_sd, SCALE_PRIOR * level) ** 2)  # ...a fleet's, 0.3
     elif (ratio := bounds.upper_ratio(residual, measured, dof)) < 1.0:  # they scatter less than stated
         weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / prior_sd**2, 1 / (ratio * sb**2)]
     if chi2 > 1.0 or ratio < 1.0:
         result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
         factor = max(float(result.params[1]), SCALE_MIN)
-    sd = np.sqrt(np.diag(np.asarray(result.cov_params())))
-    return (factor, float(sd[1])), (float(result.params[0]), float(sd[0]))
+    return bounds.reference_factor(result.params, result.cov_params(), SCALE_MIN)
 
 
 def tests_table(wears: dict[str, list[AxisWear]]) -> Table:
