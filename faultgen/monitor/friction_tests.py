@@ -471,7 +471,7 @@ class Rescale:
                 continue
             sy = 100 * (1 + w.wear / 100) * w.own_error
             x = (float(source[0][w.axis - 1]), float(source[1][w.axis - 1]))
-            # the test read at once (bounds.test_read), on the factor known before it, less the offset b
+            # the test read at once (bounds.test_read), on the factor known before it, less the reference's b
             before, offset = self._fitted(w.axis) if self.pairs.get(w.axis) else \
                 (self.prior, (0.0, self.offset_sd.get(w.axis, OFFSET_PRIOR)))
             test = (*bounds.less_reference(w.wear, sy, *offset), *x)
@@ -495,9 +495,10 @@ class Rescale:
         error, points (both (n_axes,)), from its twin-scale filtered ``wear`` % -+ ``error`` %: ``f x``
         -+ ``sqrt((f e)^2 + (s_f x)^2)`` (``factor``, ``factor_error``), or, on the log a test of the
         axis was paired with (a test since its reference), that test read into it at once
-        (:func:`faultgen.monitor.bounds.test_read`, on the factor known before the test), less the offset
-        ``b`` its pairs tell. On the later logs the test is in the factor alone (carried on by the logs'
-        growth, a fast unit's lagging filter was read as a scale), its log's bound a floor of theirs."""
+        (:func:`faultgen.monitor.bounds.test_read`, on the factor known before the test), less the reference's
+        error ``b`` its pairs tell (:func:`.bounds.less_reference`). On the later logs the test is in the
+        factor alone (carried on by the logs' growth, a fast unit's lagging filter was read as a scale),
+        its log's bound a floor of theirs."""
         wear, error = np.asarray(wear, dtype=float), np.asarray(error, dtype=float)
         value = factor * wear
         sd = np.asarray(bounds.standard_error(factor * error, value, factor_error / factor), dtype=float)
