@@ -214,7 +214,7 @@ def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, 
     within = [u for u, o in dated.items() if o["within"]]
     late = [u for u, o in dated.items() if o["late"]]
     each = "; ".join(f"{u} " + (f"day {o['day']}: {o['median']:.0f} (true {o['true']:.0f}), by day "
-                                f"{o['service_by']:.0f} (failure {o['eol']:.0f})" if "median" in o else o["why"])
+                                f"{o['service_by']:.1f} (failure {o['eol']:.1f})" if "median" in o else o["why"])
                      for u, o in sorted(outcomes.items()))
     need = CLEAN_WITHIN if clean else int(np.ceil(HALF * n))
     rows = [("at lambda 0.5 the service-by date not after the failure day, every worn unit",

@@ -130,6 +130,7 @@ def test_lambda_service_by_within_and_phm():
     rows = rct.lambda_rows({"u1": o, "u3": late}, clean=False)
     assert [r[2] for r in rows] == [False, True, None]
     assert rows[0][1].startswith("1 of 2") and rows[1][1] == "1 of 2; late by more than 20 %: 1"
+    assert "by day 11.0 (failure 10.0)" in rows[0][1]  # the service by's day to a tenth: a fraction late shows
     assert rows[2][1] == f"{o['phm08'] + late['phm08']:.2f} over 2 units"
     clean = rct.lambda_rows({f"u{i}": o for i in range(6)} | {"u7": late, "u8": none}, clean=True)
     assert "at least 6 of 8, late on none" in clean[1][0] and not clean[1][2]
