@@ -552,7 +552,6 @@ def _fit(pairs: tuple, sb: float, prior: tuple) -> tuple[tuple[float, float], tu
         weights = np.r_[1.0 / np.maximum(ratio * measured + drift, 1e-6), 1 / prior_sd**2, 1 / (ratio * sb**2)]
     if chi2 > 1.0 or ratio < 1.0:
         result = sm.WLS(target, design, weights=weights).fit(cov_type="fixed scale")
-        factor = max(float(result.params[1]), SCALE_MIN)
     return bounds.reference_factor(result.params, result.cov_params(), SCALE_MIN)
 
 
