@@ -1,9 +1,10 @@
 """What a monitor of faultgen's form could reach at best on a real-cell fleet (issue 90): the first
-alarm at 8-15 % true wear and the remaining life within 20 % at lambda 0.5, as chances, per worn unit
-and per fleet, from the fleet's truth and its friction tests' own errors.
+alarm at 8-15 % true wear, the remaining life within 20 % at lambda 0.5 and the alarm's bound below the
+truth on at least 95 % of alarming log-axes, as chances, per worn unit and per fleet, from the fleet's
+truth and its friction tests' own errors.
 
     python benchmarks/real_cell_ceiling.py FLEET OUT [FLEET OUT ...] [--twin-factor 1 1.2] [--draws 4000]
-        [--seed 0] [--limit 8] [--prior-sd 0.3] [--prior-mean 1] [--error-ratio 1]
+        [--seed 0] [--limit 8] [--prior-sd 0.3] [--prior-mean 1] [--error-ratio 1] [--confidence 0.9]
 
 ``FLEET`` a fleet of ``benchmarks/real_cell_fleet.py`` (``truth.csv``), ``OUT`` a ``faultgen monitor``
 output of it (``tests.csv``: each test's own error, :func:`monitor_scale_bound.own_test_errors`).
@@ -21,7 +22,7 @@ through the origin of the tests on ``x`` under the monitor's prior ``N(m, p^2)``
 ``faultgen monitor --scale-prior``; Gelman et al., *Bayesian Data Analysis*, 3rd ed., ch. 14): precision
 ``1/p^2 + sum x_j^2 / s_j^2``, mean ``(m/p^2 + sum x_j y_j / s_j^2)`` over it.
 A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the monitor's
-:func:`faultgen.monitor.alarm.alarm_quantile`) reaches the limit, at once (the monitor waits for
+:func:`faultgen.monitor.alarm.alarm_quantile`; ``--confidence``: another) reaches the limit, at once (the monitor waits for
 nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
 tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
@@ -40,6 +41,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from statistics import NormalDist
 from types import SimpleNamespace
 
 import numpy as np
@@ -54,6 +56,8 @@ from faultgen.bench import independent
 from faultgen.monitor.alarm import alarm_quantile
 from faultgen.monitor.friction_tests import SCALE_PRIOR
 from faultgen.monitor.scoring import Settings
+
+HONEST = 0.95  # the issue's share of alarms whose lower bound lies below the true wear
 
 
 def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np.ndarray,
@@ -73,17 +77,23 @@ def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np
 
 
 def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_factor: float,
-                 errors: np.ndarray, limit: float, prior_sd: float, prior_mean: float = 1.0) -> dict:
+                 errors: np.ndarray, limit: float, prior_sd: float, prior_mean: float = 1.0,
+                 z: float | None = None) -> dict:
     """One worn unit's draws (module docstring): ``wear`` its true wear a log (n_logs,), %, ``tests``
     its worn axis's tests ``(log index, true wear %, stated error points)``, ``errors`` (n_draws,
     n_tests) what each test read above its true wear in each draw, points. A dict: ``alarm`` the true
     wear at each draw's first alarm (inf: none), ``in_window``, ``within`` and ``late`` booleans a
-    draw. ValueError for a twin_factor not above 0."""
+    draw, ``alarming`` and ``below`` the logs a draw whose bound is at or past the limit and, of them,
+    those whose bound lies below the true wear, ``first_below`` whether the first alarming log's does
+    (True without an alarm). ``z`` the bound's normal quantile (default the monitor's
+    :func:`faultgen.monitor.alarm.alarm_quantile`). ValueError for a twin_factor not above 0."""
     if not twin_factor > 0:
         raise ValueError(f"twin_factor {twin_factor!r}: expected a number above 0")
     x, n, n_draws = np.asarray(wear, dtype=float) / twin_factor, len(wear), len(errors)
     factor, sd = factor_draws(x, tests, errors, prior_sd, prior_mean)
-    fires = x * (factor - alarm_quantile() * sd) >= limit
+    bound = x * (factor - (alarm_quantile() if z is None else z) * sd)
+    fires = bound >= limit
+    below = fires & (bound < wear)
     first = np.where(fires.any(axis=1), fires.argmax(axis=1), n)  # log index
     alarm = np.where(first < n, wear[np.minimum(first, n - 1)], np.inf)
     fast = growth_at({"wear": wear}, bounds.ALARM[0]) > 1.0
@@ -94,12 +104,13 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
             rul=monitor_rul.day_of(factor[m, day - 1] * x, FAILURE_WEAR) - day, rul_5=None))
         within[m], late[m] = outcome.get("within", False), outcome.get("late", False)
     return {"alarm": alarm, "in_window": np.array([bounds.alarm_in_window(a, fast) for a in alarm]),
-            "within": within, "late": late}
+            "within": within, "late": late, "alarming": fires.sum(axis=1), "below": below.sum(axis=1),
+            "first_below": below[np.arange(n_draws), np.minimum(first, n - 1)] | (first == n)}
 
 
 def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prior_sd: float, *,
                   draws: int = 4000, seed: int = 0, error_ratio: float = 1.0,
-                  prior_mean: float = 1.0) -> dict[str, dict]:
+                  prior_mean: float = 1.0, z: float | None = None) -> dict[str, dict]:
     """:func:`unit_chances` of every worn unit of ``fleet``: ``draws`` draws of the tests' errors,
     ``error_ratio`` times their stated ones (each unit its own stream of ``seed``, units in name order).
     ValueError for draws below 1 or an error_ratio not above 0."""
@@ -117,7 +128,7 @@ def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prio
                  for s, e, _ in own.get(unit, []) if s in log]
         errors = np.random.default_rng(stream).standard_normal((draws, len(tests)))
         errors *= error_ratio * np.array([s for _, _, s in tests])
-        result[unit] = unit_chances(t["wear"], tests, twin_factor, errors, limit, prior_sd, prior_mean)
+        result[unit] = unit_chances(t["wear"], tests, twin_factor, errors, limit, prior_sd, prior_mean, z)
     return result
 
 
@@ -166,7 +177,16 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
     half = (f"- the median within {100 * WITHIN:g} % at lambda on at least {need} of {len(chances)}: chance "
             f"{(within.sum(axis=0) >= need).mean():.2f} (units within: {counts(within)}; late by more than "
             f"{100 * WITHIN:g} %: {counts(late)})")
-    lines += ["", every, half]
+    alarming = np.sum([c["alarming"] for c in chances.values()], axis=0)
+    fraction = np.sum([c["below"] for c in chances.values()], axis=0) / np.maximum(alarming, 1)
+    low, high = np.percentile(fraction, [5, 95])
+    first = np.array([c["first_below"] for c in chances.values()])
+    honest = (f"- the bound below the truth on >= {100 * HONEST:g} % of alarming log-axes: chance "
+              f"{(fraction >= HONEST).mean():.2f} (the fleet's fraction: mean {100 * fraction.mean():.1f} %, "
+              f"5-95 %: {100 * low:.1f}-{100 * high:.1f} %); on every first alarm: chance "
+              f"{first.all(axis=0).mean():.2f}; with every first alarm in the window: chance "
+              f"{(window.all(axis=0) & (fraction >= HONEST)).mean():.2f}")
+    lines += ["", every, half, honest]
     return lines
 
 
@@ -179,22 +199,28 @@ def main() -> None:
     parser.add_argument("--limit", type=float, default=Settings().wear_limit)
     parser.add_argument("--prior-sd", type=float, default=SCALE_PRIOR)
     parser.add_argument("--prior-mean", type=float, default=1.0, help="the factor's prior mean (default 1)")
+    parser.add_argument("--confidence", type=float, default=None,
+                        help="the bound's one-sided confidence (default the monitor's alarm, 0.90)")
     parser.add_argument("--error-ratio", type=float, default=1.0,
                         help="the tests' errors drawn this many times their stated ones (default 1)")
     args = parser.parse_args()
     if len(args.pairs) % 2:
         parser.error(f"expected pairs FLEET OUT; got {len(args.pairs)} paths")
+    if args.confidence is not None and not 0.5 < args.confidence < 1:
+        parser.error(f"--confidence {args.confidence!r}: expected a number between 0.5 and 1")
+    z = None if args.confidence is None else NormalDist().inv_cdf(args.confidence)
     for fleet, out in zip(args.pairs[::2], args.pairs[1::2]):
         ratio, n = measured_error_ratio(fleet, out)
         print(f"{fleet.name}: the worn axes' {n} tests after the wear began scatter {ratio:.2f} times their "
               "stated errors about the truth (root mean square; 1: as stated; pass it as --error-ratio)\n")
         for c in args.twin_factor:
             chances = fleet_chances(fleet, out, c, args.limit, args.prior_sd, draws=args.draws,
-                                    seed=args.seed, error_ratio=args.error_ratio, prior_mean=args.prior_mean)
+                                    seed=args.seed, error_ratio=args.error_ratio, prior_mean=args.prior_mean, z=z)
             drawn = f", the tests' errors x {args.error_ratio:g}" if args.error_ratio != 1 else ""
             prior = (f", prior {args.prior_mean:g} +- {args.prior_sd:g}"
                      if (args.prior_mean, args.prior_sd) != (1.0, SCALE_PRIOR) else "")
-            title = fleet.name + drawn + prior
+            confidence = f", a {100 * args.confidence:g} % bound" if args.confidence is not None else ""
+            title = fleet.name + drawn + prior + confidence
             print("\n".join(table(title, chances, c)) + "\n", flush=True)
 
 

@@ -1,7 +1,7 @@
 """What a monitor of faultgen's form could reach at best on a real-cell fleet
 (benchmarks/real_cell_ceiling.py, issue 90): the factor's posterior against statsmodels' WLS with the
 prior as a pseudo-observation and against monitor_scale_bound's closed form, the first alarm at the
-prior's threshold (known values), an exact scale giving the remaining life exactly, the same seed the
+prior's threshold and the bound below or above the truth (known values), an exact scale giving the remaining life exactly, the same seed the
 same chances, the tests' measured scatter, and bad input refused by name."""
 
 from __future__ import annotations
@@ -76,6 +76,24 @@ def test_an_exact_scale_alarms_at_the_limit_and_gives_the_remaining_life_exactly
     assert draws["within"].all() and not draws["late"].any()
 
 
+@pytest.mark.parametrize(("c", "z", "below"), [
+    (1.0, None, True),  # bound x (1 - 1.28 x 0.3) = 0.62 w: below the truth on every alarming log
+    (0.5, None, False),  # a twin reading twice the truth: 2 w x 0.62 = 1.23 w, above on every one
+    (0.7, None, True),  # w / 0.7 x 0.62 = 0.88 w
+    (0.7, 0.5, False),  # a 69 % bound: w / 0.7 x (1 - 0.5 x 0.3) = 1.21 w
+    (0.7, 1.96, True),  # a 97.5 % bound: 0.59 w
+])
+def test_the_bound_below_the_truth_on_known_values(c, z, below):
+    """Without a test that sees the wear the factor is the prior's 1 +- 0.3 on every log, so the bound is
+    x (1 - z 0.3) = w (1 - z 0.3) / c: below the truth on every alarming log or on none."""
+    tests = [(5, 0.0, 3.0), (19, 0.0, 3.0)]
+    errors = np.random.default_rng(4).normal(0.0, 3.0, (30, 2))
+    draws = ceiling.unit_chances(RAMP, tests, c, errors, 8.0, 0.3, z=z)
+    assert np.all(draws["alarming"] > 0)
+    assert np.all(draws["below"] == (draws["alarming"] if below else 0))
+    assert np.all(draws["first_below"] == below)
+
+
 def _fleet(root: Path) -> Path:
     fleet, out = root / "scatter-0.03", root / "out"
     fleet.mkdir()
@@ -116,6 +134,8 @@ def test_the_same_seed_gives_the_same_chances_and_a_table(tmp_path):
     assert any(line.startswith("- every worn unit's first alarm in the window: chance ") for line in lines)
     half = "- the median within 20 % at lambda on at least 1 of 2: chance "
     assert any(line.startswith(half) for line in lines)
+    honest = "- the bound below the truth on >= 95 % of alarming log-axes: chance "
+    assert any(line.startswith(honest) for line in lines)
 
 
 @pytest.mark.parametrize(("call", "message"), [
