@@ -5,6 +5,7 @@ truth and its friction tests' own errors.
 
     python benchmarks/real_cell_ceiling.py FLEET OUT [FLEET OUT ...] [--twin-factor 1 1.2] [--draws 4000]
         [--seed 0] [--limit 8] [--prior-sd 0.3] [--prior-mean 1] [--error-ratio 1] [--confidence 0.9]
+        [--actual]
 
 ``FLEET`` a fleet of ``benchmarks/real_cell_fleet.py`` (``truth.csv``), ``OUT`` a ``faultgen monitor``
 output of it (``tests.csv``: each test's own error, :func:`monitor_scale_bound.own_test_errors`).
@@ -27,7 +28,9 @@ nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm 
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
 tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
 ``real_cell_table.lambda_outcome``. Each unit is drawn ``--draws`` times
-(the tests' errors); a fleet's chances are over the same draws, units independent.
+(the tests' errors); a fleet's chances are over the same draws, units independent. ``--actual``: one
+draw, the errors the fleet's own tests made (read against the truth, the reference's offset as its
+healthy tests tell it): whether a unit the monitor misses is missed by this estimator on the same tests.
 
 The monitor reads its twin with noise and lag and learns the offset: an estimator of this form with
 an honest bound and that much more doubt does not expect better chances than these, so a criterion
@@ -110,10 +113,11 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
 
 def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prior_sd: float, *,
                   draws: int = 4000, seed: int = 0, error_ratio: float = 1.0,
-                  prior_mean: float = 1.0, z: float | None = None) -> dict[str, dict]:
+                  prior_mean: float = 1.0, z: float | None = None, actual: bool = False) -> dict[str, dict]:
     """:func:`unit_chances` of every worn unit of ``fleet``: ``draws`` draws of the tests' errors,
-    ``error_ratio`` times their stated ones (each unit its own stream of ``seed``, units in name order).
-    ValueError for draws below 1 or an error_ratio not above 0."""
+    ``error_ratio`` times their stated ones (each unit its own stream of ``seed``, units in name order);
+    ``actual``: one draw, the errors the fleet's tests made (:func:`actual_errors`). ValueError for
+    draws below 1 or an error_ratio not above 0."""
     if draws < 1 or not error_ratio > 0:
         raise ValueError(f"draws {draws!r}, error_ratio {error_ratio!r}: expected at least 1 and above 0")
     truth = independent.read_truth(fleet / "truth.csv")
@@ -124,12 +128,25 @@ def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prio
         if not t["axis"]:
             continue
         log = {s: i for i, s in enumerate(t["stamps"])}
-        tests = [(log[s], float(t["wear"][log[s]]), 100 * (1 + t["wear"][log[s]] / 100) * e)
-                 for s, e, _ in own.get(unit, []) if s in log]
-        errors = np.random.default_rng(stream).standard_normal((draws, len(tests)))
-        errors *= error_ratio * np.array([s for _, _, s in tests])
+        seen = [(s, e, y) for s, e, y in own.get(unit, []) if s in log]
+        tests = [(log[s], float(t["wear"][log[s]]), 100 * (1 + t["wear"][log[s]] / 100) * e) for s, e, _ in seen]
+        if actual:
+            errors = actual_errors([(w, y) for (_, w, _), (_, _, y) in zip(tests, seen)])[None, :]
+        else:
+            errors = np.random.default_rng(stream).standard_normal((draws, len(tests)))
+            errors *= error_ratio * np.array([s for _, _, s in tests])
         result[unit] = unit_chances(t["wear"], tests, twin_factor, errors, limit, prior_sd, prior_mean, z)
     return result
+
+
+def actual_errors(tests: list[tuple[float, float]]) -> np.ndarray:
+    """What each of a unit's tests ``(true wear %, read %)`` read above its true wear, points, once its
+    reference's offset is taken off as its tests at no true wear tell it (the mean of their ``ln(1 +
+    y/100)``, 0 without one) and as a factor: ``100 ((1 + y/100) / (1 + b/100) - 1) - w``
+    (:func:`faultgen.monitor.bounds.less_reference`'s reading with ``b`` known)."""
+    healthy = [np.log1p(y / 100) for w, y in tests if w == 0]
+    offset = float(np.mean(healthy)) if healthy else 0.0
+    return np.array([100 * np.expm1(np.log1p(y / 100) - offset) - w for w, y in tests])
 
 
 def measured_error_ratio(fleet: Path, out: Path) -> tuple[float, int]:
@@ -151,6 +168,25 @@ def measured_error_ratio(fleet: Path, out: Path) -> tuple[float, int]:
         offset, offset_var = healthy[:, 1].mean(), np.sum(healthy[:, 0] ** 2) / len(healthy) ** 2
         z += [(y - offset - np.log1p(w / 100)) / np.sqrt(e**2 + offset_var) for w, e, y in seen if w > 0]
     return (float(np.sqrt(np.mean(np.square(z)))) if z else float("nan")), len(z)
+
+
+def actual_table(name: str, outcome: dict[str, dict], twin_factor: float) -> list[str]:
+    """The ideal estimator on the errors the fleet's tests made (``fleet_chances(..., actual=True)``):
+    per worn unit its first alarm and whether the remaining life at lambda is within 20 %, late or
+    early, as a markdown list. Not its bound: that takes the offset as known, which these errors
+    (read about the healthy tests' mean) are not."""
+    lines = [f"**{name}**, twin factor {twin_factor:g}, the fleet's own test errors", ""]
+    for unit, c in sorted(outcome.items()):
+        life = "within 20 %" if c["within"][0] else ("late" if c["late"][0] else "early")
+        lines.append(f"- {unit}: first alarm at {c['alarm'][0]:.1f} % true wear "
+                     f"({'in' if c['in_window'][0] else 'out of'} the window), at lambda {life}")
+    def count(key: str) -> int:
+        return sum(bool(c[key][0]) for c in outcome.values())
+
+    summary = (f"- first alarms in the window: {count('in_window')} of {len(outcome)}; the remaining life at "
+               f"lambda within {100 * WITHIN:g} %: {count('within')}, late by more: {count('late')}")
+    lines += ["", summary]
+    return lines
 
 
 def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
@@ -201,6 +237,8 @@ def main() -> None:
     parser.add_argument("--prior-mean", type=float, default=1.0, help="the factor's prior mean (default 1)")
     parser.add_argument("--confidence", type=float, default=None,
                         help="the bound's one-sided confidence (default the monitor's alarm, 0.90)")
+    parser.add_argument("--actual", action="store_true",
+                        help="one draw: the errors the fleet's own tests made (is it the monitor or the draw?)")
     parser.add_argument("--error-ratio", type=float, default=1.0,
                         help="the tests' errors drawn this many times their stated ones (default 1)")
     args = parser.parse_args()
@@ -215,13 +253,14 @@ def main() -> None:
               "stated errors about the truth (root mean square; 1: as stated; pass it as --error-ratio)\n")
         for c in args.twin_factor:
             chances = fleet_chances(fleet, out, c, args.limit, args.prior_sd, draws=args.draws,
-                                    seed=args.seed, error_ratio=args.error_ratio, prior_mean=args.prior_mean, z=z)
+                                    seed=args.seed, error_ratio=args.error_ratio, prior_mean=args.prior_mean, z=z,
+                                    actual=args.actual)
             drawn = f", the tests' errors x {args.error_ratio:g}" if args.error_ratio != 1 else ""
             prior = (f", prior {args.prior_mean:g} +- {args.prior_sd:g}"
                      if (args.prior_mean, args.prior_sd) != (1.0, SCALE_PRIOR) else "")
             confidence = f", a {100 * args.confidence:g} % bound" if args.confidence is not None else ""
             title = fleet.name + drawn + prior + confidence
-            print("\n".join(table(title, chances, c)) + "\n", flush=True)
+            print("\n".join((actual_table if args.actual else table)(title, chances, c)) + "\n", flush=True)
 
 
 if __name__ == "__main__":

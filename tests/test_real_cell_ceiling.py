@@ -138,6 +138,31 @@ def test_the_same_seed_gives_the_same_chances_and_a_table(tmp_path):
     assert any(line.startswith(honest) for line in lines)
 
 
+def test_the_actual_errors_take_off_the_reference_as_a_factor():
+    offset = np.mean(np.log1p([0.02, 0.04]))  # two tests at no true wear read 2 and 4 %
+    exact = 100 * (1.10 * np.exp(offset) - 1)  # a test at 10 % true wear read through that reference exactly
+    errors = ceiling.actual_errors([(0.0, 2.0), (0.0, 4.0), (10.0, exact), (20.0, 25.0)])
+    assert errors[2] == pytest.approx(0.0, abs=1e-12)
+    assert errors[0] == pytest.approx(-errors[1], rel=0.02)  # about the healthy tests' mean
+    assert errors[3] == pytest.approx(100 * (1.25 / np.exp(offset) - 1) - 20.0)
+    np.testing.assert_allclose(ceiling.actual_errors([(5.0, 7.0), (9.0, 8.0)]), [2.0, -1.0])  # no healthy test
+
+
+def test_the_fleets_own_test_errors_are_one_draw(tmp_path):
+    fleet = _fleet(tmp_path)  # its tests read the true wear exactly: no error
+    actual = ceiling.fleet_chances(fleet, tmp_path / "out", 1.0, 8.0, 0.3, actual=True)
+    truth = ceiling.independent.read_truth(fleet / "truth.csv")
+    for unit, outcome in actual.items():
+        assert len(outcome["alarm"]) == 1
+        log = {s: i for i, s in enumerate(truth[unit]["stamps"])}
+        tests = [(log[s], float(truth[unit]["wear"][log[s]]), 100 * (1 + truth[unit]["wear"][log[s]] / 100) * e)
+                 for s, e, _ in monitor_scale_bound.own_test_errors(truth, tmp_path / "out")[unit]]
+        exact = ceiling.unit_chances(truth[unit]["wear"], tests, 1.0, np.zeros((1, len(tests))), 8.0, 0.3)
+        assert outcome["alarm"][0] == exact["alarm"][0]
+    lines = ceiling.actual_table(fleet.name, actual, 1.0)
+    assert lines[-1].startswith("- first alarms in the window: ")
+
+
 @pytest.mark.parametrize(("call", "message"), [
     (lambda: ceiling.unit_chances(RAMP, [], 0.0, np.zeros((5, 0)), 8.0, 0.3), "twin_factor 0.0"),
     (lambda: ceiling.factor_draws(RAMP, [], np.zeros((5, 0)), 0.0), "prior_sd 0.0"),
