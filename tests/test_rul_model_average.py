@@ -108,6 +108,34 @@ def test_the_power_law_fit_recovers_its_parameters():
                                w_now + b * (np.maximum(t, -age) - 0.0), atol=1e-9)
 
 
+def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed():
+    """A quadratic rise from 60 days before the last log, fitted on the last 50 (the unit learning before
+    them): the start and the power recovered, the day the wear reaches 40 % (21.65 days on) not late
+    (21.1 days on this draw); held to a start among the logs (trends.BEFORE_FIRST empty) the fit takes
+    a later start and a flatter power (1.58) and reaches 40 % 2.8 days late."""
+    rng = np.random.default_rng(5)
+    t = np.arange(50.0) - 49.0
+    wear = 0.006 * (t + 60.0) ** 2 + rng.normal(0, 0.3, 50)
+    crossing = np.sqrt(40.0 / 0.006) - 60.0
+    ahead = np.linspace(0.0, 40.0, 4001)
+
+    def reaches(fit) -> float:
+        return float(ahead[np.argmax(trends.power_curve(ahead, *fit.params) >= 40.0)])
+
+    fit = trends.fit_power(t, wear, np.full(50, 0.3))
+    _, _, age, p = fit.params
+    errors = np.sqrt(np.diag(fit.cov))
+    assert abs(age - 60.0) < 3.5 * errors[2] and abs(p - 2.0) < 3.5 * errors[3], (age, p, errors)
+    assert crossing - 2.0 <= reaches(fit) <= crossing + 0.5, reaches(fit)  # early rather than late
+    held = trends.BEFORE_FIRST
+    try:
+        trends.BEFORE_FIRST = np.array([])
+        late = trends.fit_power(t, wear, np.full(50, 0.3))
+    finally:
+        trends.BEFORE_FIRST = held
+    assert late.params[2] <= 47.0 and reaches(late) > crossing + 1.0, (late.params, reaches(late))
+
+
 def test_a_rise_too_short_or_too_slow_is_not_yet_predictable_and_a_flat_one_has_no_end_of_life():
     t = np.arange(45.0)
     rng = np.random.default_rng(1)

@@ -25,6 +25,13 @@ MODELS = ("linear", "exponential", "changepoint", "power")
 POWER_MAX = 4.0
 #: The exponents of the power law's starting grid (refined by least squares).
 POWER_GRID = (1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0)
+#: The power law's rise may have begun before the first log fitted (while the unit learned, its wear
+#: then read as its baseline): a second fit looks for its start also this many times the logs' span
+#: before the last log, at most twice that span, and the fit of lower AICc is kept (a quadratic rise
+#: from day 25 of a unit fitted from day 33 was held to a later start and a flatter power, and its
+#: service-by date came a day after the failure: docs/analysis.md, "a rise begun before the first log
+#: fitted").
+BEFORE_FIRST = np.array([1.1, 1.25, 1.5, 2.0])
 #: The hinge's changepoint is looked for between the logs this far from either end of the block
 #: (the 3rd log and the 5th from the last: a flat stretch and a rise of at least a few logs each).
 HINGE_MARGINS = (2, 4)
@@ -177,15 +184,14 @@ def power_curve(t, w_now, b, age, p):
 
 def fit_power(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     """The power-law rise (:func:`power_curve`; ``w = a + c (t - t0)_+^p``, ``p`` in [1,
-    :data:`POWER_MAX`], the rise's start ``t0`` = -age among the logs the changepoint trend looks at,
-    :data:`HINGE_MARGINS`) fitted to ``wear`` (%) at times ``t`` (<= 0, the last 0) with standard
-    errors ``error``: weighted least squares of (``w_now``, ``b``) on a grid of the logs' ages and
-    :data:`POWER_GRID`, the best refined over all four parameters within those bounds
-    (``scipy.optimize.least_squares``), the covariance the Gauss-Newton one there, scaled by the
-    reduced chi-square when above one. :class:`Fit` ``power`` with ``params`` (w_now, b, age, p)
-    and ``changepoint`` -age; None when it cannot be fitted."""
-    from scipy.optimize import least_squares
-
+    :data:`POWER_MAX`]) fitted to ``wear`` (%) at times ``t`` (<= 0, the last 0) with standard errors
+    ``error``, its start ``t0`` = -age among the logs the changepoint trend looks at
+    (:data:`HINGE_MARGINS`) and, a second fit, also before the first log (:data:`BEFORE_FIRST`): the
+    one of lower AICc (the first on a tie; either where the other cannot be fitted). Each: weighted
+    least squares of (``w_now``, ``b``) on a grid of the ages and :data:`POWER_GRID`, the best refined
+    over all four parameters within those bounds (``scipy.optimize.least_squares``), the covariance
+    the Gauss-Newton one there, scaled by the reduced chi-square when above one. :class:`Fit`
+    ``power`` with ``params`` (w_now, b, age, p) and ``changepoint`` -age; None when neither fits."""
     t, wear, error = (np.asarray(v, dtype=float) for v in (t, wear, error))
     n = len(t)
     first, last = HINGE_MARGINS[0], n - 1 - HINGE_MARGINS[1]
@@ -195,6 +201,17 @@ def fit_power(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     ages = ages[ages > 0]
     if not ages.size:
         return None
+    within = _power_over(t, wear, error, ages)
+    before = _power_over(t, wear, error, np.r_[ages, -t[0] * BEFORE_FIRST]) if BEFORE_FIRST.size else None
+    if before is None or (within is not None and not before.aicc < within.aicc):
+        return within
+    return before
+
+
+def _power_over(t: np.ndarray, wear: np.ndarray, error: np.ndarray, ages: np.ndarray) -> Fit | None:
+    """:func:`fit_power` with the rise's start looked for at ``ages`` (> 0) and refined between them."""
+    from scipy.optimize import least_squares
+
     weight = 1.0 / error**2
     grid = [(a, p) for a in ages for p in POWER_GRID]
     basis = np.stack([(np.maximum(a + t, 0.0) ** p - a**p) / (p * a ** (p - 1.0)) for a, p in grid])
@@ -218,8 +235,7 @@ def fit_power(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
         cov = np.linalg.inv(jacobian.T @ jacobian)
     except (ValueError, np.linalg.LinAlgError):
         return None
-    chi2_found = float(np.sum(found.fun**2))
-    cov = _widened(cov, chi2_found, n - 4)
+    cov = _widened(cov, float(np.sum(found.fun**2)), len(t) - 4)
     if not (np.all(np.isfinite(found.x)) and np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
         return None
     residual = wear - power_curve(t, *found.x)
