@@ -23,8 +23,8 @@ through the origin of the tests on ``x`` under the monitor's prior ``N(m, p^2)``
 ``faultgen monitor --scale-prior``; Gelman et al., *Bayesian Data Analysis*, 3rd ed., ch. 14): precision
 ``1/p^2 + sum x_j^2 / s_j^2``, mean ``(m/p^2 + sum x_j y_j / s_j^2)`` over it.
 A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the monitor's
-:func:`faultgen.monitor.alarm.alarm_quantile`; ``--confidence``: another) reaches the limit, at once (the monitor waits for
-nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
+:func:`faultgen.monitor.alarm.alarm_quantile`; ``--confidence``: another) reaches the limit, at once
+(the monitor waits for nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
 tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
 ``real_cell_table.lambda_outcome``. Each unit is drawn ``--draws`` times
@@ -180,6 +180,7 @@ def actual_table(name: str, outcome: dict[str, dict], twin_factor: float) -> lis
         life = "within 20 %" if c["within"][0] else ("late" if c["late"][0] else "early")
         lines.append(f"- {unit}: first alarm at {c['alarm'][0]:.1f} % true wear "
                      f"({'in' if c['in_window'][0] else 'out of'} the window), at lambda {life}")
+
     def count(key: str) -> int:
         return sum(bool(c[key][0]) for c in outcome.values())
 

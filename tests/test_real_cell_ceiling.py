@@ -1,8 +1,9 @@
 """What a monitor of faultgen's form could reach at best on a real-cell fleet
 (benchmarks/real_cell_ceiling.py, issue 90): the factor's posterior against statsmodels' WLS with the
 prior as a pseudo-observation and against monitor_scale_bound's closed form, the first alarm at the
-prior's threshold and the bound below or above the truth (known values), an exact scale giving the remaining life exactly, the same seed the
-same chances, the tests' measured scatter, and bad input refused by name."""
+prior's threshold and the bound below or above the truth (known values), an exact scale giving the
+remaining life exactly, the same seed the same chances, the tests' measured scatter and actual errors,
+and bad input refused by name."""
 
 from __future__ import annotations
 

@@ -108,7 +108,7 @@ def test_the_power_law_fit_recovers_its_parameters():
                                w_now + b * (np.maximum(t, -age) - 0.0), atol=1e-9)
 
 
-def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed():
+def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed(monkeypatch):
     """A quadratic rise from 60 days before the last log, fitted on the last 50 (the unit learning before
     them): the start and the power recovered, the day the wear reaches 40 % (21.65 days on) not late
     (21.1 days on this draw); held to a start among the logs (trends.BEFORE_FIRST empty) the fit takes
@@ -127,12 +127,8 @@ def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed():
     errors = np.sqrt(np.diag(fit.cov))
     assert abs(age - 60.0) < 3.5 * errors[2] and abs(p - 2.0) < 3.5 * errors[3], (age, p, errors)
     assert crossing - 2.0 <= reaches(fit) <= crossing + 0.5, reaches(fit)  # early rather than late
-    held = trends.BEFORE_FIRST
-    try:
-        trends.BEFORE_FIRST = np.array([])
-        late = trends.fit_power(t, wear, np.full(50, 0.3))
-    finally:
-        trends.BEFORE_FIRST = held
+    monkeypatch.setattr(trends, "BEFORE_FIRST", np.array([]))
+    late = trends.fit_power(t, wear, np.full(50, 0.3))
     assert late.params[2] <= 47.0 and reaches(late) > crossing + 1.0, (late.params, reaches(late))
 
 
