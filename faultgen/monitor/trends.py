@@ -202,7 +202,7 @@ def fit_power(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     if not ages.size:
         return None
     within = _power_over(t, wear, error, ages)
-    before = _power_over(t, wear, error, np.r_[ages, -t[0] * BEFORE_FIRST]) if BEFORE_FIRST.size else None
+    before = _power_over(t, wear, error, np.r_[ages, -t[0] * BEFORE_FIRST])
     if before is None or (within is not None and not before.aicc < within.aicc):
         return within
     return before
