@@ -66,7 +66,7 @@ MAX_ROWS = 25_000
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
               log_format: formats.LogFormat = formats.MEASURED, friction_every_axis: bool = False, figure: bool = True,
-              delay: str | float | None = None, effects: list[str] | None = None) -> Calibration:
+              delay: str | float | None = None, effects: list[str] | None = None, tests: bool = True) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A
@@ -82,6 +82,9 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     ``friction_every_axis``: the dry (Coulomb) and viscous friction levels of every moving axis fitted
     after the search, always (:func:`faultgen.calibrate.loop.own_friction`; ``--fit-friction-all``).
     ``figure``: draw ``calibration.png`` (False: the other outputs only, as ``faultgen monitor`` caches them).
+    ``tests``: run the residual tests and explain the unexplained axes (False: the report's
+    ``unexplained`` and ``residual_tests`` are null, as ``faultgen monitor`` caches them;
+    :func:`faultgen.calibrate.loop.run`).
     ``delay``: the channel delay's correction (None: reported only; "auto": the estimate; a number
     of seconds; :func:`faultgen.calibrate.loop.check_delay`).
     ``effects``: a user's own effect classes, ``module:Class`` or ``path/file.py:Class`` each
@@ -90,11 +93,11 @@ def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_
     The result holds the calibrated robot as written to ``out`` (:attr:`Calibration.model`)."""
     with user_effects.loaded(effects):  # the library as it was afterwards
         return _calibrate_with(robot, measured, out, max_steps, progress, use_sysid, log_format,
-                               friction_every_axis, figure, delay)
+                               friction_every_axis, figure, delay, tests)
 
 
 def _calibrate_with(robot, measured, out, max_steps, progress, use_sysid, log_format, friction_every_axis, figure,
-                    delay) -> Calibration:
+                    delay, tests) -> Calibration:
     nominal = robot if isinstance(robot, robots.Robot) else robots.load(robot)  # a boundary: once
     if isinstance(measured, measured_io.MeasuredData):
         data, moves = measured, longlog.motion(measured.qd, search.REST_SPEED)
@@ -114,7 +117,7 @@ def _calibrate_with(robot, measured, out, max_steps, progress, use_sysid, log_fo
     out.parent.mkdir(parents=True, exist_ok=True)
     with atomic.atomic_folder(out) as staging:
         result = _calibrate(nominal, data, staging, max_steps=max_steps, progress=progress, use_sysid=use_sysid,
-                             friction_every_axis=friction_every_axis, figure=figure, delay=delay)
+                             friction_every_axis=friction_every_axis, figure=figure, delay=delay, tests=tests)
         result = replace(result, model_out=out / result.model_out.relative_to(staging))
         atomic.write_text(staging / "report.json", json.dumps(result.report(), indent=2) + "\n")
     return replace(result, model=robots.moved(result.model, result.model_out))  # the folder renamed into place

@@ -33,7 +33,8 @@ MAX_STEPS = 6
 
 def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
         max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
-        friction_every_axis: bool = False, figure: bool = True, delay: str | float | None = None) -> Calibration:
+        friction_every_axis: bool = False, figure: bool = True, delay: str | float | None = None,
+        tests: bool = True) -> Calibration:
     """Run the calibration workflow and write its outputs into ``out``. Every model tried is
     compiled in memory (:mod:`faultgen.calibrate.trial`); the model kept is written once, at the end.
 
@@ -68,6 +69,13 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         The channel delay check (:mod:`faultgen.calibrate.delay`), made on every log before the
         search and reported: None reports it only; ``"auto"`` moves the torque columns by the
         estimate; a number by that many seconds (positive: the torque was logged late).
+    tests : bool
+        Run the residual tests (:mod:`faultgen.calibrate.residual_tests`) of the nominal model, after
+        each step and of the calibrated model, and explain what each unexplained axis's remainder
+        follows (:func:`faultgen.calibrate.remainder.explain`): they choose nothing, they report
+        (about 1.4 s on a KR210 log of three cycles; a log too short to test costs nothing). False:
+        the report says they were not run (``unexplained`` and ``residual_tests`` null);
+        ``faultgen monitor`` calibrates its units without them (it reads only the model).
 
     Returns
     -------
@@ -96,8 +104,15 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     tau = np.asarray(data.tau)
     model = Model.nominal(nominal)
 
-    def tested(prediction: np.ndarray) -> list[dict]:
-        return residual_tests.run(data.t, tau - prediction, split.held_out, tau, data.q, data.qd, data.qdd)
+    after_steps: list[dict] = []  # the tests' summary of the nominal model, after each step and calibrated
+
+    def tested(after: str, prediction: np.ndarray) -> list[dict] | None:
+        """The residual tests of ``prediction`` (None: not run), their summary kept under ``after``."""
+        if not tests:
+            return None
+        found = residual_tests.run(data.t, tau - prediction, split.held_out, tau, data.q, data.qd, data.qdd)
+        after_steps.append({"after": after, "axes": residual_tests.summary(found)})
+        return found
 
     nominal_prediction = predicted
     moving = np.abs(data.qd) >= search.REST_SPEED
@@ -114,7 +129,7 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         channel_delay["line"] = channel_delay.get("line", "") + "; " + shown_words(found_delay)
     if progress:
         print(channel_delay.get("line", channel_delay.get("reason")), flush=True)
-    after_steps = [{"after": "nominal model", "axes": residual_tests.summary(tested(predicted))}]
+    tested("nominal model", predicted)
 
     out = Path(out)
     model_dir = out / "model"
@@ -142,8 +157,7 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
         befores.append(best.effect.current(model.robot))
         model, predicted, motion = trial.model, trial.prediction, trial.motion
         steps.append(Step(best.effect, on, evidence(best, ranked, residual, split), after, errors))
-        after_steps.append({"after": f"step {k + 1}: {best.effect.id}",
-                            "axes": residual_tests.summary(tested(predicted))})
+        tested(f"step {k + 1}: {best.effect.id}", predicted)
         if progress:
             print(f"step {k + 1}: {best.effect.id} on axes {axes.numbers(on)}, held-out total nrmse "
                   f"{previous['total_nrmse']:.4f} -> {after['total_nrmse']:.4f}", flush=True)
@@ -161,11 +175,10 @@ def run(robot: robots.Robot, measured: str | Path | measured_io.MeasuredData, ou
     calibrated = robots.write(model_out, model.text, atomic.write_text)
     atomic.write_text(model_dir / "parameters.json", json.dumps(parameters(calibrated), indent=2) + "\n")
 
-    final_tests = tested(predicted)
-    after_steps.append({"after": "calibrated model", "axes": residual_tests.summary(final_tests)})
+    final_tests = tested("calibrated model", predicted)
     # what each unexplained axis's remainder follows (the generic library's terms, in words)
-    left = residual_tests.unexplained(final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out),
-                                      also=shifted)
+    left = [] if final_tests is None else residual_tests.unexplained(
+        final_tests, tau, split.held_out, search.gap(tau, predicted, split.held_out), also=shifted)
     follows = {u["axis"]: remainder.explain(data.t, data.q, data.qd, data.qdd, tau, predicted, nominal.gear_ratio,
                                             split.fit, split.held_out, u["axis"] - 1,
                                             log_delay=(found_delay["seconds"], found_delay["interval_s"])

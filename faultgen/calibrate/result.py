@@ -139,8 +139,9 @@ class Calibration:
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
             "ambiguous": self.ambiguous(),
-            "unexplained": self.unexplained(),
-            "residual_tests": self.tests_after_steps,
+            # null: the residual tests were not run (faultgen.calibrate.loop.run's ``tests``), so nothing is known
+            "unexplained": None if self.residual_tests is None else self.unexplained(),
+            "residual_tests": None if self.residual_tests is None else self.tests_after_steps,
             "channel_delay": self.delay,
             "not_written": self.declined,
             **({"why_unexplained": self.why_unexplained} if self.why_unexplained else {}),

@@ -264,12 +264,12 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
     every moving axis's own dry and viscous friction fitted on the nominal model
     (:func:`faultgen.calibrate.loop.own_friction`), the fallback of a calibration whose search fitted
     something implausible (a Stribeck velocity 20 x nominal: docs/analysis.md, "A calibration refused
-    as implausible"). Both are cached (the model and report, not the calibration's figure, which
-    nothing reads there and cost 1.6 s a unit) in ``OUT/.cache/calibrated`` under
-    the digest of the nominal model, the log and the search's length, beside a record of the
-    calibrated model's SHA-256 that a later run checks; the robot is that model without its log's
-    part (:func:`without_payload`), as its writer returned it (or, cached, as an earlier run wrote
-    it: :func:`cached_model`).
+    as implausible"). Both are cached (the model and report, not the calibration's figure nor its
+    residual tests, which nothing reads there and cost 1.6 s and up to 1.4 s a unit) in
+    ``OUT/.cache/calibrated`` under the digest of the nominal model, the log and the search's
+    length, beside a record of the calibrated model's SHA-256 that a later run checks; the robot is
+    that model without its log's part (:func:`without_payload`), as its writer returned it (or,
+    cached, as an earlier run wrote it: :func:`cached_model`).
 
     Raises
     ------
@@ -305,7 +305,8 @@ def model_of(source: fleet_logs.Source, kind: str, first: tuple[str, str], first
             warnings.simplefilter("ignore")
             calibrated = run_calibration(nominal, source.get(first_log).checked(), folder,
                                          max_steps=calibration_steps(kind), progress=False,
-                                         friction_every_axis=OWN_FRICTION or kind == "friction", figure=False).model
+                                         friction_every_axis=OWN_FRICTION or kind == "friction", figure=False,
+                                         tests=False).model
         stored.write_calibration(record, out, key, model)
     implausible = plausibility.implausible_parameters(nominal, calibrated)
     if implausible:
