@@ -108,7 +108,11 @@ def test_a_ripple_outside_the_library_is_left_unexplained_on_its_axis(tmp_path):
     angle, 3 periods a revolution, 6 % of the axis's RMS torque (the library's cogging is periodic in
     the motor angle): axis 2, and only it, is left unexplained. The torque offset the search fits
     there is not written since issue 73 (no forced fit, tests/test_calibrate_open_world.py); with it, axis 2's
-    held-out nrmse was 1.6x the median axis's, which the earlier 3x-median rule missed."""
+    held-out nrmse was 1.6x the median axis's, which the earlier 3x-median rule missed.
+
+    Without the tests (``tests=False``, as ``faultgen monitor`` calibrates its units): they choose
+    nothing, so the model and parameters written are byte for byte the same; the report says null
+    where it names axis 2, never an empty list (nothing unexplained)."""
     path, _ = make(next(c for c in CASES if c.name == "puma560-01-none"), tmp_path)
     frame = pd.read_csv(path)
     frame["tau2"] += 0.06 * np.sqrt(np.mean(frame["tau2"] ** 2)) * np.sin(3 * frame["q2"])
@@ -118,22 +122,11 @@ def test_a_ripple_outside_the_library_is_left_unexplained_on_its_axis(tmp_path):
     assert found["axis"] == 2 and "whiteness" in found["failed"], result.summary()
     assert found["nrmse"] > 1.5 * found["noise_floor"]
     assert not any(1 in s.axes for s in result.steps) and "torque_offset" in {d["effect"] for d in found["not_written"]}
-
-
-def test_without_the_tests_the_same_model_and_a_report_that_says_they_were_not_run(tmp_path):
-    """``calibrate(..., tests=False)`` (as ``faultgen monitor`` calibrates its units): the residual
-    tests choose nothing, so the model and parameters written are byte for byte those of a
-    calibration with them; its report says null where it would name the unexplained axis (the same
-    log as above: axis 2 left unexplained with the tests), never an empty list (nothing unexplained)."""
-    path, _ = make(next(c for c in CASES if c.name == "puma560-01-none"), tmp_path)
-    frame = pd.read_csv(path)
-    frame["tau2"] += 0.06 * np.sqrt(np.mean(frame["tau2"] ** 2)) * np.sin(3 * frame["q2"])
-    frame.to_csv(path, index=False)
-    tested = calibrate("puma560", path, tmp_path / "tested", figure=False)
     untested = calibrate("puma560", path, tmp_path / "untested", figure=False, tests=False)
     for name in ("puma560_calibrated.xml", "parameters.json"):
-        assert (tmp_path / "tested" / "model" / name).read_bytes() == (tmp_path / "untested" / "model" / name).read_bytes()
-    with_tests, without = tested.report(), untested.report()
+        assert (tmp_path / "out" / "model" / name).read_bytes() == \
+            (tmp_path / "untested" / "model" / name).read_bytes()
+    with_tests, without = result.report(), untested.report()
     assert [u["axis"] for u in with_tests["unexplained"]] == [2] and with_tests["residual_tests"]
     assert without["unexplained"] is None and without["residual_tests"] is None
     assert without["steps"] == with_tests["steps"] and without["gap_after"] == with_tests["gap_after"]

@@ -66,7 +66,8 @@ MAX_ROWS = 25_000
 def calibrate(robot: str | Path | robots.Robot, measured: str | Path | measured_io.MeasuredData, out: str | Path,
               max_steps: int = MAX_STEPS, progress: bool = False, use_sysid: bool = True,
               log_format: formats.LogFormat = formats.MEASURED, friction_every_axis: bool = False, figure: bool = True,
-              delay: str | float | None = None, effects: list[str] | None = None, tests: bool = True) -> Calibration:
+              delay: str | float | None = None, effects: list[str] | None = None,
+              tests: bool = True) -> Calibration:
     """:func:`faultgen.calibrate.loop.run` into a hidden folder beside ``out``, renamed to ``out`` once every output
     is written (:func:`faultgen.data.atomic.atomic_folder`): a failed, refused or interrupted run
     leaves nothing at ``out`` (an existing ``out`` untouched) and nothing that blocks a rerun. A

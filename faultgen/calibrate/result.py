@@ -139,7 +139,7 @@ class Calibration:
             "gap_after": self.gap_after,
             "model_out": str(self.model_out),
             "ambiguous": self.ambiguous(),
-            # null: the residual tests were not run (faultgen.calibrate.loop.run's ``tests``), so nothing is known
+            # null: the residual tests were not run (faultgen.calibrate.loop.run's tests=False): nothing known
             "unexplained": None if self.residual_tests is None else self.unexplained(),
             "residual_tests": None if self.residual_tests is None else self.tests_after_steps,
             "channel_delay": self.delay,
