@@ -112,7 +112,7 @@ def test_a_ripple_outside_the_library_is_left_unexplained_on_its_axis(tmp_path):
 
     Without the tests (``tests=False``, as ``faultgen monitor`` calibrates its units): they choose
     nothing, so the model and parameters written are byte for byte the same; the report says null
-    where it names axis 2, never an empty list (nothing unexplained)."""
+    where it names axis 2, never an empty list (nothing unexplained), and the summary says so."""
     path, _ = make(next(c for c in CASES if c.name == "puma560-01-none"), tmp_path)
     frame = pd.read_csv(path)
     frame["tau2"] += 0.06 * np.sqrt(np.mean(frame["tau2"] ** 2)) * np.sin(3 * frame["q2"])
@@ -129,4 +129,5 @@ def test_a_ripple_outside_the_library_is_left_unexplained_on_its_axis(tmp_path):
     with_tests, without = result.report(), untested.report()
     assert [u["axis"] for u in with_tests["unexplained"]] == [2] and with_tests["residual_tests"]
     assert without["unexplained"] is None and without["residual_tests"] is None
+    assert "residual tests not run" in untested.summary() and "residual tests not run" not in result.summary()
     assert without["steps"] == with_tests["steps"] and without["gap_after"] == with_tests["gap_after"]

@@ -227,6 +227,8 @@ class Calibration:
                   for h in self.not_separable()]
         lines.append(f"gap {self.gap_before['total_nrmse']:.4f} -> {self.gap_after['total_nrmse']:.4f}; "
                      f"model: {self.model_out}")
+        if self.residual_tests is None:  # as the report's null: not "nothing unexplained"
+            lines.append("residual tests not run (tests=False): what the model leaves unexplained is not known")
         for u in self.unexplained():
             lines.append(residual_tests.line(u))
             lines.append(remainder.line(u))
