@@ -98,7 +98,7 @@ def test_an_axis_no_test_has_told_keeps_the_scale_prior():
 def test_each_axis_states_its_tests_scatter_about_the_temperature_law():
     """tests.csv's ``scatter_percent``: each axis's scatter of ``ln c`` about its own line in the
     temperature (the residuals' standard deviation, 2 parameters fitted), against numpy's polyfit."""
-    from faultgen.monitor.friction_tests import learn_law
+    from faultgen.monitor.temperature_law import learn_law
 
     rng = np.random.default_rng(4)
     t = rng.uniform(15.0, 35.0, 9)
@@ -108,6 +108,54 @@ def test_each_axis_states_its_tests_scatter_about_the_temperature_law():
         residual = y - np.polyval(np.polyfit(x, y, 1), x)
         assert law.scatter[k] == pytest.approx(np.sqrt(np.sum(residual**2) / (x.size - 2)), rel=1e-9)
     assert law.scatter[1] < law.scatter[3]
+
+
+def test_a_worn_axis_states_the_scatter_of_its_tests_before_its_wear():
+    """The scatter stated per axis, and the repeatability every test's error carries, are the plant's,
+    not the wear (issue 90, item 3: "estimated from the unit's own healthy days and tests"): a unit of
+    six axes, nine tests 14 days apart, the dry level falling 0.4 %/K with a 1.5 % scatter from test to
+    test; axis 3 worn from the fifth test (0, 7, 14, .. 35 %), axis 1's reference test 3 % low (every
+    later test reads it 3 % high: no wear, its tests all kept). On main 15a11aa axis 3 stated its wear
+    as the plant's scatter, 8.9 %. Each axis's scatter against numpy's polyfit on the tests kept (axis
+    3's first four: the fifth, at 7 % wear, is 5.4 repeatabilities above them; every test of the
+    others), the repeatability against statsmodels' OLS of every kept test with a line per axis (ISO
+    5725-2's pooled repeatability: the regression's residual standard deviation)."""
+    import statsmodels.api as sm
+
+    from faultgen.monitor.temperature_law import HEALTHY_Z, healthy_tests, learn_law
+
+    rng = np.random.default_rng(7)
+    t = 22.0 + 8.0 * np.sin(np.arange(9) / 2.0)
+    wear = np.clip(7.0 * (np.arange(9) - 3), 0.0, None)
+    series = {}
+    for k in range(1, 7):
+        y = np.log(100.0 * k) - 0.004 * t + rng.normal(0.0, 0.015, 9)
+        if k == 1:
+            y[0] -= 0.03
+        if k == 3:
+            y += np.log1p(wear / 100)
+        series[k] = (t, y)
+    law = learn_law(series)
+    assert law.beta == pytest.approx(-0.004, abs=0.002)
+    median = float(np.median([np.sqrt(np.sum((y - np.polyval(np.polyfit(t, y, 1), t)) ** 2) / 7)
+                              for _, y in series.values()]))
+    kept = {k: healthy_tests(x, y, law.beta, median) for k, (x, y) in series.items()}
+    assert kept == {1: 9, 2: 9, 3: 4, 4: 9, 5: 9, 6: 9}
+    for k, (x, y) in series.items():
+        n = kept[k]
+        residual = y[:n] - np.polyval(np.polyfit(x[:n], y[:n], 1), x[:n])
+        assert law.scatter[k] == pytest.approx(np.sqrt(np.sum(residual**2) / (n - 2)), rel=1e-9)
+    rows = [(k, x[j], y[j]) for k, (x, y) in series.items() for j in range(kept[k])]
+    design = np.array([[float(a == k) * v for k in series for v in (1.0, x)] for a, x, _ in rows])
+    ols = sm.OLS(np.array([r[2] for r in rows]), design).fit()
+    assert law.repeatability == pytest.approx(np.sqrt(ols.scale), rel=1e-9)
+    assert law.repeatability == pytest.approx(0.015, rel=0.3) and max(law.scatter.values()) < 0.03
+    # the fifth test of axis 3 against the four before it, in the axes' median scatter (the cut: HEALTHY_Z)
+    level = series[3][1] - law.beta * t
+    assert (level[4] - level[:4].mean()) / (median * np.sqrt(1.25)) > HEALTHY_Z
+    # every test counted, as main did: the wear is stated as the plant's scatter
+    residual = series[3][1] - np.polyval(np.polyfit(t, series[3][1], 1), t)
+    assert np.sqrt(np.sum(residual**2) / 7) > 0.08
 
 
 def _test_wears(true, offset, reference_error=0.02, own_error=0.014):

@@ -255,7 +255,7 @@ def test_a_fleets_scale_prior_sets_the_untold_factor_and_belongs_to_the_state(fl
     assert (settings["scale_prior_mean"], settings["scale_prior_sd"]) == (1.2, 0.1)
     with pytest.raises(stored.StateError, match=r"other settings or inputs: scale_prior_mean 1\.2 \(now"):
         loop.monitor(resolve_run(robot, logs, out, calibrate=False, settings=SETTINGS, progress=False))
-    with pytest.raises(ValueError, match="1 units' axes whose friction tests saw their wear.*at least 3"):
+    with pytest.raises(ValueError, match="0 units' axes whose friction tests saw their wear.*at least 3"):
         resolve_run(robot, logs, tmp_path / "again", calibrate=False, settings=SETTINGS,
                     scale_prior=monitored)
     with pytest.raises(ValueError, match="the run's own output folder; expected another run's"):

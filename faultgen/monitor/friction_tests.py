@@ -22,20 +22,25 @@ the reference's temperature ``T0`` by the unit's own **temperature law** ``ln c 
 
     wear = 100 (exp(ln c - ln c0 - beta (T - T0)) - 1)  %
 
-``beta`` is learned from the unit's own tests: the median over its axes of each axis's least-squares
-slope of ``ln c`` on ``T`` (``scipy.stats.linregress``; axes with at least :data:`LAW_TESTS` tests
-spanning at least :data:`LAW_SPAN_K` K), the median so that the worn axis, whose slope carries its
-wear (the season and the wear both grow), does not move it; its standard error ``s_beta`` the
+``beta`` is learned from the unit's own tests (:mod:`.temperature_law`): the median over its axes of
+each axis's least-squares slope of ``ln c`` on ``T`` (``scipy.stats.linregress``; axes with at least
+:data:`.temperature_law.LAW_TESTS` tests spanning at least :data:`.temperature_law.LAW_SPAN_K` K), the
+median so that the worn axis, whose slope carries its wear (the season and the wear both grow), does
+not move it; its standard error ``s_beta`` the
 median's own (``1.2533 s / sqrt(n)``, ``s`` the median of the ``n`` slopes' standard errors: the
 median of a normal sample) and the axes' scatter about the median (1.4826 times the median absolute
-deviation) beyond ``s``, the axes' own laws, together. Without such axes ``beta`` is 0 with ``s_beta`` =
-:data:`BETA_PRIOR` (a stated assumption: dry friction moves by some 0.5 %/K, Bittencourt 2014);
+deviation) beyond ``s``, the axes' own laws, together. Without such axes ``beta`` is 0 with ``s_beta``
+= :data:`.temperature_law.BETA_PRIOR` (a stated assumption: dry friction moves by some 0.5 %/K,
+Bittencourt 2014);
 without logged temperatures no correction is made. The **90 % interval** (:data:`INTERVAL`) is that
 of ``ln c - ln c0 - beta (T - T0)`` with the variance ``v + v0 + s_beta^2 (T - T0)^2``, ``v`` the
 larger of the fit's own (``(coulomb_Nm_high - coulomb_Nm_low) / (2 1.96 c)``, squared) and the
-unit's test-to-test repeatability (the median over its axes of the scatter of ``ln c`` about each
-axis's temperature law, when at least :data:`LAW_AXES` axes give it: what a test's day adds, the
-lubricant film, that no fit of one test sees).
+unit's test-to-test repeatability (the pooled standard deviation of ``ln c`` about each axis's own
+temperature law, ISO 5725-2's, when at least :data:`.temperature_law.LAW_AXES` axes give it: what a
+test's day adds, the lubricant film, that no fit of one test sees), each axis counted on its tests
+before its wear shows (:func:`.temperature_law.healthy_tests`: up to the first test whose corrected dry
+level lies :data:`.temperature_law.HEALTHY_Z` of the axes' median scatter above the axis's earlier
+tests), so that it is the plant's scatter, not a worn axis's wear.
 
 **The logs on the tests' scale** (:class:`Rescale`): per axis, the tests' wear ``y_j`` against the
 monitor's own wear in the twin's scale ``x_j`` at the test's day (the filtered wear of the last log
@@ -65,9 +70,10 @@ scale's uncertainty. An axis no test read, and every log before its unit's first
 
 ``OUT/tests.csv`` (:func:`tests_table`, :data:`COLUMNS`): one row per unit, test and axis read;
 ``scatter_percent`` the axis's day-to-day scatter as the unit's tests show it (the standard deviation
-of ``ln c`` about the axis's own temperature law, %: :attr:`Law.scatter`; empty for an axis with fewer
-than :data:`LAW_TESTS` tests over :data:`LAW_SPAN_K`), the plant's scatter that every test's and
-log's read carries (issue 90; the logs' own on the learning days: the alarm's evidence).
+of ``ln c`` about the axis's own temperature law over its tests before its wear shows, %:
+:attr:`Law.scatter`; empty for an axis with fewer than :data:`.temperature_law.LAW_TESTS` such tests
+over :data:`.temperature_law.LAW_SPAN_K`), the plant's scatter that every test's and log's read carries
+(issue 90; the logs' own on the learning days: the alarm's evidence).
 """
 
 from __future__ import annotations
@@ -89,6 +95,7 @@ from faultgen.monitor import bounds
 from faultgen.monitor import logs as fleet_logs
 from faultgen.monitor import state as stored
 from faultgen.monitor.record import Table
+from faultgen.monitor.temperature_law import Law, learn_law
 
 #: ``wear_scale`` of a unit's wear (units.csv, wear.csv): on its friction tests' scale, or its twin's.
 TESTS_SCALE, TWIN_SCALE = "friction test", "twin"
@@ -101,11 +108,6 @@ FIT_COLUMNS = ("temperature_degC", "coulomb_Nm", "coulomb_Nm_low", "coulomb_Nm_h
 COLUMNS = ("unit", "stamp", "axis", *FIT_COLUMNS, "wear", "wear_lower", "wear_upper", "verdict", "scatter_percent")
 #: The two-sided interval of a test's wear and of the logs' wear on the tests' scale.
 INTERVAL = 0.90
-#: The temperature law: tests per axis (since its last repair) and their temperature span, K, an
-#: axis needs for its slope; axes whose scatter about their law gives the repeatability.
-LAW_TESTS, LAW_SPAN_K, LAW_AXES = 3, 1.0, 3
-#: Standard error of the temperature law's slope, 1/K, when the unit's tests cannot tell it.
-BETA_PRIOR = 0.005
 #: Standard deviation of the prior of the scale factor ``f`` (mean 1: the twin's scale). The factor
 #: that maps the twin's scale best onto the truth was 0.80-1.08 on the first independent fleet's worn
 #: units and 0.50-0.81 on the second's (seed 0), and a test reads a dry level to some 3 %
@@ -265,50 +267,6 @@ def _cached(path: Path, out: Path, key: dict, log) -> FrictionTest:
                                 "again)")
     return FrictionTest(log.stamp, log.key, key["test"], tuple({c: (int(f[c]) if c == "axis" else float(f[c]))
                                                        for c in ("axis", *FIT_COLUMNS)} for f in fits), error)
-
-
-@dataclass
-class Law:
-    """A unit's temperature law (module docstring): ``beta`` 1/K, its standard error ``error`` 1/K,
-    the test-to-test ``repeatability`` (relative standard deviation; NaN when not known), how it
-    was learned (``source``, in words) and each axis's own scatter about its law (``scatter``: axis ->
-    relative standard deviation, the plant's day-to-day scatter as that axis's tests show it; the
-    axes with :data:`LAW_TESTS` tests over :data:`LAW_SPAN_K`)."""
-
-    beta: float
-    error: float
-    repeatability: float
-    source: str
-    scatter: dict = field(default_factory=dict)
-
-
-def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
-    """The temperature law of a unit from each axis's tests ``{axis: (T degC, ln c)}`` since its
-    last repair (module docstring)."""
-    from scipy import stats
-
-    slopes, errors, scatter, axes = [], [], [], {}
-    for axis, (t, y) in series.items():
-        ok = np.isfinite(t) & np.isfinite(y)
-        t, y = t[ok], y[ok]
-        if len(t) < LAW_TESTS or np.ptp(t) < LAW_SPAN_K:
-            continue
-        fit = stats.linregress(t, y)
-        slopes.append(fit.slope)
-        errors.append(fit.stderr)
-        if len(t) > 2:
-            scatter.append(float(np.sqrt(np.sum((y - fit.intercept - fit.slope * t) ** 2) / (len(t) - 2))))
-            axes[axis] = scatter[-1]
-    repeatability = float(np.median(scatter)) if len(scatter) >= LAW_AXES else math.nan
-    if not slopes:
-        return Law(0.0, BETA_PRIOR, repeatability, f"no axis with {LAW_TESTS} tests over {LAW_SPAN_K:g} K: "
-                                                     f"not corrected (+-{100 * BETA_PRIOR:g} %/K)", axes)
-    beta, noise = float(np.median(slopes)), float(np.median(errors))
-    spread = 1.4826 * float(np.median(np.abs(np.array(slopes) - beta))) if len(slopes) > 2 else 0.0
-    # the median's own error (1.2533 sigma / sqrt(n), a normal sample's), the axes' laws' spread beyond noise
-    error = float(np.sqrt((1.2533 * noise) ** 2 / len(slopes) + max(0.0, spread**2 - noise**2)))
-    return Law(beta, error, repeatability, f"{100 * beta:+.2f} +- {100 * error:.2f} %/K (median of {len(slopes)} axes)",
-               axes)
 
 
 @dataclass
