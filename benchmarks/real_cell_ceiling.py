@@ -1,7 +1,8 @@
 """What a monitor of faultgen's form could reach at best on a real-cell fleet (issue 90): the first
-alarm at 8-15 % true wear, the remaining life within 20 % at lambda 0.5 and the alarm's bound below the
-truth on at least 95 % of alarming log-axes, as chances, per worn unit and per fleet, from the fleet's
-truth and its friction tests' own errors.
+alarm at 8-15 % true wear, the remaining life within 20 % at lambda 0.5, the alarm's bound below the
+truth on at least 95 % of alarming log-axes and the 90 % interval covering 80-97 % of the worn axes' logs
+at 10-40 % true wear (the fleet's, and each unit's: the criterion of the units of a rate of their own), as
+chances, per worn unit and per fleet, from the fleet's truth and its friction tests' own errors.
 
     python benchmarks/real_cell_ceiling.py FLEET OUT [FLEET OUT ...] [--twin-factor 1 1.2] [--draws 4000]
         [--seed 0] [--limit 8] [--prior-sd 0.3] [--prior-mean 1] [--error-ratio 1] [--confidence 0.9]
@@ -24,7 +25,8 @@ through the origin of the tests on ``x`` under the monitor's prior ``N(m, p^2)``
 ``1/p^2 + sum x_j^2 / s_j^2``, mean ``(m/p^2 + sum x_j y_j / s_j^2)`` over it.
 A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the monitor's
 :func:`faultgen.monitor.alarm.alarm_quantile`; ``--confidence``: another) reaches the limit, at once
-(the monitor waits for nothing longer with the twin). At lambda 0.5 (half-way from its own first alarm to the true failure
+(the monitor waits for nothing longer with the twin); its 90 % interval is ``x (f -+ 1.645 sd_f)`` (the
+monitor's :data:`faultgen.monitor.friction_tests.INTERVAL`). At lambda 0.5 (half-way from its own first alarm to the true failure
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
 tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
 ``real_cell_table.lambda_outcome``. Each unit is drawn ``--draws`` times
@@ -57,10 +59,11 @@ from real_cell_table import FAILURE_WEAR, WITHIN, growth_at, lambda_outcome
 
 from faultgen.bench import independent
 from faultgen.monitor.alarm import alarm_quantile
-from faultgen.monitor.friction_tests import SCALE_PRIOR
+from faultgen.monitor.friction_tests import INTERVAL, SCALE_PRIOR
 from faultgen.monitor.scoring import Settings
 
 HONEST = 0.95  # the issue's share of alarms whose lower bound lies below the true wear
+COVERAGE = bounds.COVERAGE  # the issue's share of the logs at 10-40 % that the 90 % interval holds the truth on
 
 
 def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np.ndarray,
@@ -88,7 +91,8 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
     wear at each draw's first alarm (inf: none), ``in_window``, ``within`` and ``late`` booleans a
     draw, ``alarming`` and ``below`` the logs a draw whose bound is at or past the limit and, of them,
     those whose bound lies below the true wear, ``first_below`` whether the first alarming log's does
-    (True without an alarm). ``z`` the bound's normal quantile (default the monitor's
+    (True without an alarm), ``spanned`` the logs at 10-40 % true wear (``bounds.SPAN``) and ``covered``
+    those a draw's 90 % interval holds the truth on. ``z`` the bound's normal quantile (default the monitor's
     :func:`faultgen.monitor.alarm.alarm_quantile`). ValueError for a twin_factor not above 0."""
     if not twin_factor > 0:
         raise ValueError(f"twin_factor {twin_factor!r}: expected a number above 0")
@@ -97,6 +101,9 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
     bound = x * (factor - (alarm_quantile() if z is None else z) * sd)
     fires = bound >= limit
     below = fires & (bound < wear)
+    half = NormalDist().inv_cdf(0.5 + INTERVAL / 2) * sd * x  # the 90 % interval's half width
+    span = (wear >= bounds.SPAN[0]) & (wear <= bounds.SPAN[1])
+    covered = (np.abs(factor * x - wear) <= half) & span
     first = np.where(fires.any(axis=1), fires.argmax(axis=1), n)  # log index
     alarm = np.where(first < n, wear[np.minimum(first, n - 1)], np.inf)
     fast = growth_at({"wear": wear}, bounds.ALARM[0]) > 1.0
@@ -108,7 +115,8 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
         within[m], late[m] = outcome.get("within", False), outcome.get("late", False)
     return {"alarm": alarm, "in_window": np.array([bounds.alarm_in_window(a, fast) for a in alarm]),
             "within": within, "late": late, "alarming": fires.sum(axis=1), "below": below.sum(axis=1),
-            "first_below": below[np.arange(n_draws), np.minimum(first, n - 1)] | (first == n)}
+            "first_below": below[np.arange(n_draws), np.minimum(first, n - 1)] | (first == n),
+            "spanned": int(span.sum()), "covered": covered.sum(axis=1)}
 
 
 def fleet_chances(fleet: Path, out: Path, twin_factor: float, limit: float, prior_sd: float, *,
@@ -173,8 +181,8 @@ def measured_error_ratio(fleet: Path, out: Path) -> tuple[float, int]:
 def actual_table(name: str, outcome: dict[str, dict], twin_factor: float) -> list[str]:
     """The ideal estimator on the errors the fleet's tests made (``fleet_chances(..., actual=True)``):
     per worn unit its first alarm and whether the remaining life at lambda is within 20 %, late or
-    early, as a markdown list. Not its bound: that takes the offset as known, which these errors
-    (read about the healthy tests' mean) are not."""
+    early, as a markdown list. Not its bound nor its interval's coverage: they take the offset as known,
+    which these errors (read about the healthy tests' mean) are not."""
     lines = [f"**{name}**, twin factor {twin_factor:g}, the fleet's own test errors", ""]
     for unit, c in sorted(outcome.items()):
         life = "within 20 %" if c["within"][0] else ("late" if c["late"][0] else "early")
@@ -194,12 +202,12 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
     """A markdown table of one fleet at one twin factor: per worn unit, then the fleet's chances of the
     issue's two criteria (every unit in the window; the median within 20 % on at least half)."""
     header = ("| unit | true wear at first alarm, median (5-95 %) | P(first alarm in window) "
-              "| P(within 20 % at lambda) | P(late by > 20 %) |")
-    lines = [f"**{name}**, twin factor {twin_factor:g}", "", header, "| --- | --- | --- | --- | --- |"]
+              "| P(within 20 % at lambda) | P(late by > 20 %) | P(its logs covered 80-97 %) |")
+    lines = [f"**{name}**, twin factor {twin_factor:g}", "", header, "| --- | --- | --- | --- | --- | --- |"]
     for unit, c in sorted(chances.items()):
         q = np.percentile(c["alarm"], [50, 5, 95])
         lines.append(f"| {unit} | {q[0]:.1f} ({q[1]:.1f}-{q[2]:.1f}) | {c['in_window'].mean():.2f} | "
-                     f"{c['within'].mean():.2f} | {c['late'].mean():.2f} |")
+                     f"{c['within'].mean():.2f} | {c['late'].mean():.2f} | {coverage_chance(c):.2f} |")
     window = np.array([c["in_window"] for c in chances.values()])
     within = np.array([c["within"] for c in chances.values()])
     late = np.array([c["late"] for c in chances.values()])
@@ -223,8 +231,27 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
               f"5-95 %: {100 * low:.1f}-{100 * high:.1f} %); on every first alarm: chance "
               f"{first.all(axis=0).mean():.2f}; with every first alarm in the window: chance "
               f"{(window.all(axis=0) & (fraction >= HONEST)).mean():.2f}")
-    lines += ["", every, half, honest]
+    spanned = sum(c["spanned"] for c in chances.values())
+    share = np.sum([c["covered"] for c in chances.values()], axis=0) / max(spanned, 1)
+    low, high = np.percentile(share, [5, 95])
+    cover = (f"- the 90 % interval covering {100 * COVERAGE[0]:g}-{100 * COVERAGE[1]:g} % of the worn axes' "
+             f"{spanned} logs at 10-40 %: chance {in_coverage(share).mean():.2f} (the fleet's coverage: mean "
+             f"{100 * share.mean():.1f} %, 5-95 %: {100 * low:.1f}-{100 * high:.1f} %)")
+    lines += ["", every, half, honest, cover]
     return lines
+
+
+def in_coverage(share: np.ndarray) -> np.ndarray:
+    """Whether each coverage (a share of logs) lies in the issue's 80-97 % (``bounds.COVERAGE``)."""
+    return (share >= COVERAGE[0]) & (share <= COVERAGE[1])
+
+
+def coverage_chance(chances: dict) -> float:
+    """The chance that one unit's 90 % interval covers 80-97 % of its logs at 10-40 % (the criterion of
+    a unit of a rate of its own); NaN for a unit with no such log."""
+    if not chances["spanned"]:
+        return float("nan")
+    return float(in_coverage(chances["covered"] / chances["spanned"]).mean())
 
 
 def main() -> None:

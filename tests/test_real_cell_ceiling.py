@@ -1,7 +1,7 @@
 """What a monitor of faultgen's form could reach at best on a real-cell fleet
 (benchmarks/real_cell_ceiling.py, issue 90): the factor's posterior against statsmodels' WLS with the
 prior as a pseudo-observation and against monitor_scale_bound's closed form, the first alarm at the
-prior's threshold and the bound below or above the truth (known values), an exact scale giving the
+prior's threshold, the bound below or above the truth and the interval's coverage (known values), an exact scale giving the
 remaining life exactly, the same seed the same chances, the tests' measured scatter and actual errors,
 and bad input refused by name."""
 
@@ -119,6 +119,19 @@ def _fleet(root: Path) -> Path:
     return fleet
 
 
+@pytest.mark.parametrize(("c", "covered"), [(1.0, True), (1.45, True), (1.55, False), (0.55, True), (0.45, False)])
+def test_the_interval_covers_the_truth_on_known_values(c, covered):
+    """Without a test that sees the wear the factor is its prior, 1 -+ 0.3, and the 90 % interval
+    ``(w / c) (1 -+ 1.6449 x 0.3)`` = ``(w / c) [0.5065, 1.4935]`` holds the true wear ``w`` on every log
+    at 10-40 % when ``c`` lies in [0.5065, 1.4935] and on none outside: a unit's coverage is 100 % or
+    nothing, never in 80-97 %, however honest the interval (its error is one number for all its logs)."""
+    tests = [(19, 0.0, 3.0)]
+    draws = ceiling.unit_chances(RAMP, tests, c, np.zeros((3, 1)), 8.0, 0.3)
+    assert draws["spanned"] == 31  # the logs at 10, 11, .. 40 %
+    np.testing.assert_array_equal(draws["covered"], 31 if covered else 0)
+    assert ceiling.coverage_chance(draws) == 0.0  # 100 % or none: never in 80-97 %
+
+
 def test_the_same_seed_gives_the_same_chances_and_a_table(tmp_path):
     fleet = _fleet(tmp_path)
     truth = ceiling.independent.read_truth(fleet / "truth.csv")
@@ -137,6 +150,8 @@ def test_the_same_seed_gives_the_same_chances_and_a_table(tmp_path):
     assert any(line.startswith(half) for line in lines)
     honest = "- the bound below the truth on >= 95 % of alarming log-axes: chance "
     assert any(line.startswith(honest) for line in lines)
+    cover = "- the 90 % interval covering 80-97 % of the worn axes' "
+    assert any(line.startswith(cover) for line in lines)
 
 
 def test_the_actual_errors_take_off_the_reference_as_a_factor():
@@ -160,6 +175,7 @@ def test_the_fleets_own_test_errors_are_one_draw(tmp_path):
                  for s, e, _ in monitor_scale_bound.own_test_errors(truth, tmp_path / "out")[unit]]
         exact = ceiling.unit_chances(truth[unit]["wear"], tests, 1.0, np.zeros((1, len(tests))), 8.0, 0.3)
         assert outcome["alarm"][0] == exact["alarm"][0]
+        assert outcome["covered"][0] == outcome["spanned"]  # tests without error, a twin reading the truth
     lines = ceiling.actual_table(fleet.name, actual, 1.0)
     assert lines[-1].startswith("- first alarms in the window: ")
 
