@@ -26,13 +26,12 @@ the reference's temperature ``T0`` by the unit's own **temperature law** ``ln c 
 each axis's least-squares slope of ``ln c`` on ``T`` (``scipy.stats.linregress``; axes with at least
 :data:`.temperature_law.LAW_TESTS` tests spanning at least :data:`.temperature_law.LAW_SPAN_K` K), the
 median so that the worn axis, whose slope carries its wear (the season and the wear both grow), does
-not move it; its standard error ``s_beta`` the
-median's own (``1.2533 s / sqrt(n)``, ``s`` the median of the ``n`` slopes' standard errors: the
-median of a normal sample) and the axes' scatter about the median (1.4826 times the median absolute
-deviation) beyond ``s``, the axes' own laws, together. Without such axes ``beta`` is 0 with ``s_beta``
-= :data:`.temperature_law.BETA_PRIOR` (a stated assumption: dry friction moves by some 0.5 %/K,
-Bittencourt 2014);
-without logged temperatures no correction is made. The **90 % interval** (:data:`INTERVAL`) is that
+not move it; its standard error ``s_beta`` the median's own (``1.2533 s / sqrt(n)``, ``s`` the median
+of the ``n`` slopes' standard errors: the median of a normal sample) and the axes' scatter about the
+median (1.4826 times the median absolute deviation) beyond ``s``, the axes' own laws, together.
+Without such axes ``beta`` is 0 with ``s_beta`` = :data:`.temperature_law.BETA_PRIOR` (a stated
+assumption: dry friction moves by some 0.5 %/K, Bittencourt 2014); without logged temperatures no
+correction is made. The **90 % interval** (:data:`INTERVAL`) is that
 of ``ln c - ln c0 - beta (T - T0)`` with the variance ``v + v0 + s_beta^2 (T - T0)^2``, ``v`` the
 larger of the fit's own (``(coulomb_Nm_high - coulomb_Nm_low) / (2 1.96 c)``, squared) and the
 unit's test-to-test repeatability (the pooled standard deviation of ``ln c`` about each axis's own

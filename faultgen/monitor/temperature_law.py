@@ -15,8 +15,8 @@ import numpy as np
 #: axis needs for its slope; axes whose scatter about their law gives the repeatability.
 LAW_TESTS, LAW_SPAN_K, LAW_AXES = 3, 1.0, 3
 #: A test whose dry level lies this many repeatabilities above its axis's earlier tests ends the axis's
-#: healthy tests, which alone teach the scatter and the repeatability (:func:`healthy_tests`; a healthy axis's
-#: test passes it with a chance of 0.13 %).
+#: healthy tests, which alone teach the scatter and the repeatability (:func:`healthy_tests`; a healthy
+#: axis's test passes it with a chance of 0.13 %).
 HEALTHY_Z = 3.0
 #: Standard error of the temperature law's slope, 1/K, when the unit's tests cannot tell it.
 BETA_PRIOR = 0.005
@@ -44,13 +44,13 @@ def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
     so that it is the plant's and not a worn axis's wear."""
     from scipy import stats
 
-    slopes, errors, fits = [], [], {}
-    for axis, (t, y) in series.items():
+    slopes, errors = [], []
+    for t, y in series.values():
         t, y = _finite(t, y)
         if len(t) >= LAW_TESTS and np.ptp(t) >= LAW_SPAN_K:
-            fits[axis] = stats.linregress(t, y)
-            slopes.append(fits[axis].slope)
-            errors.append(fits[axis].stderr)
+            fit = stats.linregress(t, y)
+            slopes.append(fit.slope)
+            errors.append(fit.stderr)
     # each axis's tests before its wear shows, judged at the law of every test and the axes' median
     # scatter about it (which a worn axis, one of several, does not move)
     everything = _scatter({axis: _finite(*xy) for axis, xy in series.items()})[0]
