@@ -190,6 +190,9 @@ def test_the_temperature_law_is_learned_past_a_worn_axis_and_corrects_each_test(
             assert by[(float(j), k)].wear == pytest.approx(expected, rel=1e-9, abs=1e-9)
     worn = [by[(float(j), 2)] for j in range(9)]
     assert all(r.lower <= w <= r.upper for r, w in zip(worn[1:], wear[1:])), [(r.lower, r.upper) for r in worn]
+    # the worn axis's stated scatter is that of its three tests before the wear (1 % planted), not its wear
+    # (main 15a11aa: every test counted, 8.5 %)
+    assert {r.scatter for r in worn} == {law.scatter[2]} and law.scatter[2] < 0.03, law.scatter
     # a gearbox change of axis 2 at the 6th test starts its tests again there
     change = logfolder.Event("unit", "x", 5.0, logfolder.TIME, "gearbox_change", 2, 2)
     after, _ = friction_tests.tests_wear(tests, 6, [change])
