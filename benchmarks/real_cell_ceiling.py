@@ -63,7 +63,6 @@ from faultgen.monitor.friction_tests import INTERVAL, SCALE_PRIOR
 from faultgen.monitor.scoring import Settings
 
 HONEST = 0.95  # the issue's share of alarms whose lower bound lies below the true wear
-COVERAGE = bounds.COVERAGE  # the issue's share of the logs at 10-40 % that the 90 % interval holds the truth on
 
 
 def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np.ndarray,
@@ -234,7 +233,8 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
     spanned = sum(c["spanned"] for c in chances.values())
     share = np.sum([c["covered"] for c in chances.values()], axis=0) / max(spanned, 1)
     low, high = np.percentile(share, [5, 95])
-    cover = (f"- the 90 % interval covering {100 * COVERAGE[0]:g}-{100 * COVERAGE[1]:g} % of the worn axes' "
+    low_share, high_share = bounds.COVERAGE
+    cover = (f"- the 90 % interval covering {100 * low_share:g}-{100 * high_share:g} % of the worn axes' "
              f"{spanned} logs at 10-40 %: chance {in_coverage(share).mean():.2f} (the fleet's coverage: mean "
              f"{100 * share.mean():.1f} %, 5-95 %: {100 * low:.1f}-{100 * high:.1f} %)")
     lines += ["", every, half, honest, cover]
@@ -243,7 +243,7 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
 
 def in_coverage(share: np.ndarray) -> np.ndarray:
     """Whether each coverage (a share of logs) lies in the issue's 80-97 % (``bounds.COVERAGE``)."""
-    return (share >= COVERAGE[0]) & (share <= COVERAGE[1])
+    return (share >= bounds.COVERAGE[0]) & (share <= bounds.COVERAGE[1])
 
 
 def coverage_chance(chances: dict) -> float:

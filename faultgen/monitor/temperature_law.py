@@ -44,24 +44,24 @@ def learn_law(series: dict[int, tuple[np.ndarray, np.ndarray]]) -> Law:
     so that it is the plant's and not a worn axis's wear."""
     from scipy import stats
 
-    slopes, errors = [], []
+    slopes, errors, everything = [], [], []  # each axis's slope, its error and scatter, on every test
     for t, y in series.values():
         t, y = _finite(t, y)
         if len(t) >= LAW_TESTS and np.ptp(t) >= LAW_SPAN_K:
             fit = stats.linregress(t, y)
             slopes.append(fit.slope)
             errors.append(fit.stderr)
+            everything.append(math.sqrt(np.sum((y - fit.intercept - fit.slope * t) ** 2) / (len(t) - 2)))
     # each axis's tests before its wear shows, judged at the law of every test and the axes' median
     # scatter about it (which a worn axis, one of several, does not move)
-    everything = _scatter({axis: _finite(*xy) for axis, xy in series.items()})[0]
-    first = float(np.median(list(everything.values()))) if len(everything) >= LAW_AXES else math.nan
+    first = float(np.median(everything)) if len(everything) >= LAW_AXES else math.nan
     beta = float(np.median(slopes)) if slopes else 0.0
     scatter, repeatability = _scatter({axis: _finite(t[:n], y[:n]) for axis, (t, y) in series.items()
                                        for n in [healthy_tests(t, y, beta, first)]})
     if not slopes:
         return Law(0.0, BETA_PRIOR, repeatability, f"no axis with {LAW_TESTS} tests over {LAW_SPAN_K:g} K: "
                                                      f"not corrected (+-{100 * BETA_PRIOR:g} %/K)", scatter)
-    beta, noise = float(np.median(slopes)), float(np.median(errors))
+    noise = float(np.median(errors))
     spread = 1.4826 * float(np.median(np.abs(np.array(slopes) - beta))) if len(slopes) > 2 else 0.0
     # the median's own error (1.2533 sigma / sqrt(n), a normal sample's), the axes' laws' spread beyond noise
     error = float(np.sqrt((1.2533 * noise) ** 2 / len(slopes) + max(0.0, spread**2 - noise**2)))
