@@ -136,6 +136,39 @@ def test_lambda_service_by_within_and_phm():
     assert "at least 6 of 8, late on none" in clean[1][0] and not clean[1][2]
 
 
+def test_the_median_with_the_wear_on_its_log_known():
+    # the same trend put on the true level: at_level multiplies the worn axis's filtered and own wear
+    # (and the own bound) by the truth over the last filtered estimate, every other axis untouched
+    from faultgen.monitor.record import AxisWear, LogRow
+
+    def row(stamp, estimate, log):
+        e, g = np.array([estimate, 5.0]), np.array([log, 6.0])
+        return LogRow("u1", stamp, "monitoring", 0, 1, 0, 1, 0, (), np.zeros(2),
+                      AxisWear(e, e - 1, e - 2, e + 2, g, g - 1.5))
+
+    rows = [row(STAMPS[0], 10.0, 11.0), row(STAMPS[1], 20.0, 19.0)]
+    put = rct.at_level(rows, 1, 30.0)
+    assert [r.wear.estimate.tolist() for r in put] == [[15.0, 5.0], [30.0, 5.0]]
+    assert [r.wear.log.tolist() for r in put] == [[16.5, 6.0], [28.5, 6.0]]
+    assert [r.wear.log_lower.tolist() for r in put] == [[14.25, 4.5], [26.25, 4.5]]
+    assert rct.at_level([row(STAMPS[0], 0.0, 1.0)], 1, 30.0)[0].wear.log[0] == 1.0  # no level to scale
+    # lambda on day 7 (true wear 25 %, 3 days left): the monitor's 5 is late, the known level's 3.5 within
+    asked = []
+
+    def known(stamp, wear):
+        asked.append((stamp, wear))
+        return remaining(3.5, 2.0)
+
+    o = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(5.0, 2.0), known)
+    assert asked == [(STAMPS[6], pytest.approx(float(TRUTH["u1"]["wear"][6])))]
+    assert not o["within"] and o["within_known"]
+    rows = rct.lambda_rows({"u1": o, "u3": rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(3.0, 2.0),
+                                                              lambda s, w: remaining(None, None))}, clean=False)
+    assert rows[3][1:] == ("1 of 2 (monitor: 1)", None) and "wear on that log known" in rows[3][0]
+    assert len(rct.lambda_rows({"u1": rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(3.0, 2.0))},
+                               clean=False)) == 3  # without predict_known: no such row
+
+
 def test_rates_units_and_the_cpu_ratio():
     per_unit = {"u3": [(True, 1.0)] * 9 + [(False, 1.0)]}
     firsts = {"u1": (STAMPS[4], 2, 15.0), "u2": ("", None, None), "u3": (STAMPS[5], 1, 12.0)}
