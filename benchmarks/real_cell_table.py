@@ -193,8 +193,8 @@ def lambda_outcome(t: dict, known: str, predict, predict_known=None) -> dict:
     ``predict(stamp)`` gives the monitor's :class:`prognosis.Remaining` of the worn axis on that
     log; ``predict_known(stamp, wear)`` (optional) the same with the axis's wear on that log put on
     the true ``wear`` % (:func:`at_level`). A dict: eol, lambda, day, true, median, service_by (day), ok
-    (service by not after eol), within, late, phm08, and with ``predict_known`` within_known (its
-    median within 20 %; False without one); or a ``why`` when there is none."""
+    (service by not after eol), within, late, phm08, or a ``why`` where the monitor gives none; with
+    ``predict_known`` and a log at lambda, within_known (its median within 20 %; False without one)."""
     days, eol = day_index(t), monitor_rul.day_of(t["wear"], FAILURE_WEAR)
     if not known or known not in days:
         return {"eol": eol, "why": "no alarm"}
@@ -205,16 +205,16 @@ def lambda_outcome(t: dict, known: str, predict, predict_known=None) -> dict:
         return {"eol": eol, "why": f"no log at lambda (day {lam:.1f})"}
     row = predict(after[0])
     day, true = days[after[0]], eol - days[after[0]]
-    if row.rul is None:
-        return {"eol": eol, "day": day, "true": true, "why": f"day {day}: no remaining life ({row.verdict[:90]})"}
-    early = row.rul if row.rul_5 is None else row.rul_5
-    out = {"eol": eol, "lambda": lam, "day": day, "true": true, "median": row.rul, "service_by": day + early,
-           "ok": day + early <= eol, "within": abs(row.rul - true) <= WITHIN * true,
-           "late": rul_scores.late(row.rul, true, WITHIN), "phm08": float(rul_scores.phm08_score(row.rul, true))}
+    out = {"eol": eol, "day": day, "true": true}
     if predict_known is not None:
         level = predict_known(after[0], float(t["wear"][t["stamps"].index(after[0])])).rul
         out["within_known"] = level is not None and abs(level - true) <= WITHIN * true
-    return out
+    if row.rul is None:
+        return out | {"why": f"day {day}: no remaining life ({row.verdict[:90]})"}
+    early = row.rul if row.rul_5 is None else row.rul_5
+    return out | {"lambda": lam, "median": row.rul, "service_by": day + early, "ok": day + early <= eol,
+                  "within": abs(row.rul - true) <= WITHIN * true, "late": rul_scores.late(row.rul, true, WITHIN),
+                  "phm08": float(rul_scores.phm08_score(row.rul, true))}
 
 
 def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, bool]]:
@@ -235,8 +235,8 @@ def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, 
              len(within) >= need and (not clean or not late))]
     phm = [o["phm08"] for o in dated.values()]
     rows.append(("PHM 2008 score at lambda (sum of the medians')", f"{sum(phm):.2f} over {len(phm)} units", None))
-    if any("within_known" in o for o in dated.values()):
-        known = [u for u, o in dated.items() if o.get("within_known")]
+    if any("within_known" in o for o in outcomes.values()):
+        known = [u for u, o in outcomes.items() if o.get("within_known")]
         rows.append((f"at lambda the median within {100 * WITHIN:g} % with the wear on that log known (the monitor's "
                      "trend of its own logs put on the true level: what the scale's error costs)",
                      f"{len(known)} of {n} (monitor: {len(within)})", None))

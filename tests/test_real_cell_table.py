@@ -165,6 +165,10 @@ def test_the_median_with_the_wear_on_its_log_known():
     rows = rct.lambda_rows({"u1": o, "u3": rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(3.0, 2.0),
                                                               lambda s, w: remaining(None, None))}, clean=False)
     assert rows[3][1:] == ("1 of 2 (monitor: 1)", None) and "wear on that log known" in rows[3][0]
+    # a unit the monitor gives no number at lambda still counts where its known level gives one
+    none = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(None, None), known)
+    assert "median" not in none and none["within_known"]
+    assert rct.lambda_rows({"u1": o, "u2": none}, clean=False)[3][1] == "2 of 2 (monitor: 0)"
     assert len(rct.lambda_rows({"u1": rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(3.0, 2.0))},
                                clean=False)) == 3  # without predict_known: no such row
 
