@@ -193,8 +193,9 @@ def lambda_outcome(t: dict, known: str, predict, predict_known=None) -> dict:
     ``predict(stamp)`` gives the monitor's :class:`prognosis.Remaining` of the worn axis on that
     log; ``predict_known(stamp, wear)`` (optional) the same with the axis's wear on that log put on
     the true ``wear`` % (:func:`at_level`). A dict: eol, lambda, day, true, median, service_by (day), ok
-    (service by not after eol), within, late, phm08, or a ``why`` where the monitor gives none; with
-    ``predict_known`` and a log at lambda, within_known (its median within 20 %; False without one)."""
+    (service by not after eol), within, late, phm08; a ``why`` where the monitor gives no median
+    (with service_by and ok where it gives a 5 % end alone); with ``predict_known`` and a log at
+    lambda, within_known (its median within 20 %; False without one)."""
     days, eol = day_index(t), monitor_rul.day_of(t["wear"], FAILURE_WEAR)
     if not known or known not in days:
         return {"eol": eol, "why": "no alarm"}
@@ -209,12 +210,14 @@ def lambda_outcome(t: dict, known: str, predict, predict_known=None) -> dict:
     if predict_known is not None:
         level = predict_known(after[0], float(t["wear"][t["stamps"].index(after[0])])).rul
         out["within_known"] = level is not None and abs(level - true) <= WITHIN * true
-    if row.rul is None:
+    if row.rul is None and row.rul_5 is None:
         return out | {"why": f"day {day}: no remaining life ({row.verdict[:90]})"}
     early = row.rul if row.rul_5 is None else row.rul_5
-    return out | {"lambda": lam, "median": row.rul, "service_by": day + early, "ok": day + early <= eol,
-                  "within": abs(row.rul - true) <= WITHIN * true, "late": rul_scores.late(row.rul, true, WITHIN),
-                  "phm08": float(rul_scores.phm08_score(row.rul, true))}
+    out |= {"lambda": lam, "service_by": day + early, "ok": day + early <= eol}
+    if row.rul is None:  # a service-by end without a median (its 95 % end beyond the horizon)
+        return out | {"why": f"day {day}: no median ({row.verdict[:60]})"}
+    return out | {"median": row.rul, "within": abs(row.rul - true) <= WITHIN * true,
+                  "late": rul_scores.late(row.rul, true, WITHIN), "phm08": float(rul_scores.phm08_score(row.rul, true))}
 
 
 def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, bool]]:
@@ -224,7 +227,8 @@ def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, 
     within = [u for u, o in dated.items() if o["within"]]
     late = [u for u, o in dated.items() if o["late"]]
     each = "; ".join(f"{u} " + (f"day {o['day']}: {o['median']:.0f} (true {o['true']:.0f}), by day "
-                                f"{o['service_by']:.1f} (failure {o['eol']:.1f})" if "median" in o else o["why"])
+                                f"{o['service_by']:.1f} (failure {o['eol']:.1f})" if "median" in o else o["why"]
+                                + (f", by day {o['service_by']:.1f} (failure {o['eol']:.1f})" if "ok" in o else ""))
                      for u, o in sorted(outcomes.items()))
     need = CLEAN_WITHIN if clean else int(np.ceil(HALF * n))
     rows = [("at lambda 0.5 the service-by date not after the failure day, every worn unit",

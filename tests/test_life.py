@@ -106,6 +106,13 @@ def test_service_by_is_the_earlier_of_the_load_and_the_condition_based_life():
     window = life.service_window(life_rows, rul_rows)
     assert (window.days, window.low, window.high, window.basis) == (6.6, 6.6, 30.0, "wear")
     assert life.service_window(life_rows, []).basis == "load"
+    # a median not yet predictable (its 95 % end beyond the horizon) with its 5 % end given: that end
+    only_low = [{"axis": "2", "rul": "", "rul_5": "3.5", "rul_95": "", "time_unit": "days"}]
+    window = life.service_window(life_rows, only_low)
+    assert (window.days, window.low, window.high, window.axis) == (3.5, 3.5, 40.0, 2)  # the upper end: the load's
+    assert life.service_window([], only_low).high == math.inf
+    assert life.service_by("2026-03-01", life_rows, only_low) == ("2026-03-04", "condition: axis 2's wear, its 5 % quantile")
+    assert life.service_window([], [{"axis": "2", "rul": "", "rul_5": "", "time_unit": "days"}]) is None
     assert life.service_by("2026-03-01", life_rows, []) == ("2026-04-10", "load: axis 1's rated life")
     assert life.service_by("17", life_rows, []) == ("in 40 days", "load: axis 1's rated life")
     assert life.service_by("2026-03-01", [], []) == ("", "")

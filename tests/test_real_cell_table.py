@@ -127,6 +127,11 @@ def test_lambda_service_by_within_and_phm():
     assert rct.lambda_outcome(TRUTH["u1"], "", predict)["why"] == "no alarm"
     none = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(None, None))
     assert "median" not in none and none["why"].startswith("day 7: no remaining life")
+    # a 5 % end without a median (the 95 % end beyond the horizon): a service-by date, no median
+    low = rct.lambda_outcome(TRUTH["u1"], STAMPS[3], lambda s: remaining(None, 2.5))
+    assert (low["service_by"], low["ok"]) == (9.5, True) and "median" not in low and low["why"].startswith("day 7: no median")
+    assert rct.lambda_rows({"u1": low}, clean=False)[0][1].endswith("by day 9.5 (failure 10.0))")
+    assert rct.lambda_rows({"u1": low}, clean=False)[0][2] and rct.lambda_rows({"u1": none}, clean=False)[0][2] is False
     rows = rct.lambda_rows({"u1": o, "u3": late}, clean=False)
     assert [r[2] for r in rows] == [False, True, None]
     assert rows[0][1].startswith("1 of 2") and rows[1][1] == "1 of 2; late by more than 20 %: 1"

@@ -150,6 +150,22 @@ def test_a_rise_too_short_or_too_slow_is_not_yet_predictable_and_a_flat_one_has_
     assert row.rul is None and "no end of life within the horizon" in row.verdict, row.verdict
 
 
+def test_a_life_whose_upper_end_alone_is_unbounded_gives_its_service_by_end():
+    """Condition (b) alone (module docstring of prognosis, 7): a slow line, 0.12 % a day, 5.3 % at its
+    last log (40 % about 289 days later): the median and the 95 % end are withheld, the 5 % end, the
+    service-by end, is the draws' own 5 % quantile and comes before the line's crossing."""
+    rng = np.random.default_rng(1)
+    t = np.arange(45.0)
+    (row,) = prognosis.remaining_life("u", tables.log_rows(_rows(0.12 * t + rng.normal(0, NOISE, 45))), 1,
+                                      alpha=ALPHA, samples=SAMPLES)
+    assert row.rul is None and row.rul_95 is None and not row.predictable, row
+    assert row.verdict.startswith("not yet predictable: the 95 % end") and "service by its 5 % end" in row.verdict
+    times = np.array([np.inf if v is None else float(v) for v in row.distribution.key("failure")])
+    assert np.mean(np.isinf(times)) > 0.05  # more than 5 % of the draws beyond the horizon
+    assert row.rul_5 == pytest.approx(np.quantile(times, 0.05, method="inverted_cdf"))
+    assert 0 < row.rul_5 < (40.0 - 0.12 * 44) / 0.12
+
+
 def test_the_rule_of_not_yet_predictable_on_hand_made_draws():
     """:func:`prognosis.unpredictable`: two models whose intervals do not overlap, a light model
     apart, an agreeing pair, a wide interval (predictable), one beyond the horizon, a short rise."""

@@ -306,7 +306,8 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
     condition-based remaining life (rows of rul.csv in days) **at its 5 % quantile** (``rul_5``: the
     day by which 5 % of the wear's paths have reached the failure wear, the wear's 95 % path: a
     planner who services then is late on 1 unit in 20, where a median is late on every other; issue
-    90; the median where ``rul_5`` is empty), with its interval: each end the
+    90; the median where ``rul_5`` is empty; ``rul_5`` where the median is, "not yet predictable"
+    with its 95 % end beyond the horizon, :mod:`faultgen.monitor.prognosis`), with its interval: each end the
     earliest of the sources' ends (the rated-life formula gives one number, so a load-based source
     is its own ends; a condition-based one its ``rul_5``, ``rul_95``, an empty ``rul_95`` beyond the
     horizon). The upper end so holds with at least the sources' 95 %: the minimum of the times is
@@ -318,13 +319,12 @@ def service_window(life_rows: list[dict], rul_rows: list[dict]) -> Service | Non
             days = max(days, 0.0)
             found.append((days, days, days, f"load: axis {r.get('axis')}'s rated life", r.get("axis"), "load"))
     for r in rul_rows:
-        days = number(r.get("rul"))
-        if math.isfinite(days) and r.get("time_unit") == "days":
-            low, high = number(r.get("rul_5")), number(r.get("rul_95"))
-            early = min(days, low) if math.isfinite(low) else days
-            found.append((early, early, max(days, high) if math.isfinite(high) else math.inf,
-                          f"condition: axis {r.get('axis')}'s wear" + (", its 5 % quantile" if early < days else ""),
-                          r.get("axis"), "wear"))
+        days, low, high = (number(r.get(k)) for k in ("rul", "rul_5", "rul_95"))
+        ends = [v for v in (days, low) if math.isfinite(v)]  # rul_5 alone: the median not yet predictable
+        if ends and r.get("time_unit") == "days":
+            early, late = min(ends), max(ends + [high]) if math.isfinite(high) else math.inf
+            found.append((early, early, late, f"condition: axis {r.get('axis')}'s wear"
+                          + (", its 5 % quantile" if not early >= days else ""), r.get("axis"), "wear"))
     if not found:
         return None
     days, _, _, why, axis, basis = min(found, key=lambda f: f[0])

@@ -69,7 +69,8 @@ Per axis:
    interval in the words), when (a) fewer than :data:`MIN_RISE_LOGS` (5) logs lie after the
    changepoint trend's changepoint, where the models that date a rise carry at least half the
    weight (a slope from 4 logs is the noise's: the monitor's persistence is 5 logs); (b) the 95 %
-   end lies beyond the horizon (the trend cannot bound the life); or (c) two models of weight >=
+   end lies beyond the horizon (the trend cannot bound the life; without (a) and (c) its lower end,
+   ``rul_5``, the service-by end a planner reads first, is still given; issue 90); or (c) two models of weight >=
    :data:`MIN_MODEL_WEIGHT` (0.1) have 5-95 % intervals of their own that do not overlap (the
    models disagree by more than their intervals). A wide interval alone is not "not yet
    predictable": without a friction test the estimate's scale is uncertain by a factor of about
@@ -147,7 +148,8 @@ class Remaining:
     ``failure_wear`` and ``rul_5``, ``rul_95`` its 5-95 % interval (None beyond the horizon),
     ``p_within_horizon``, ``horizon``, the ``logs_fitted`` from ``fitted_from``, ``verdict`` in
     words, ``models`` every model's weight in the average, and ``predictable`` False for "not yet
-    predictable" (no number; module docstring, 7). ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
+    predictable" (no median; ``rul_5`` alone where only the 95 % end is beyond the horizon; module
+    docstring, 7). ``distribution``: ProgPy's time of event, from the last log (``UnweightedSamples`` with
     key ``failure``), for scoring; None without a fit."""
 
     unit: str
@@ -485,10 +487,10 @@ def _values(toe) -> np.ndarray:
 
 
 def _credible_low(row: Remaining, fits, weights, labels, seed: int, scale_uncertainty: float | None) -> Remaining:
-    """``row``, on the source axis's average (the power law among ``fits``) with a number, its
-    service-by end lowered to the earliest credible model's own 5 % end
+    """``row``, on the source axis's average (the power law among ``fits``) with a service-by end
+    (``rul_5``), that end lowered to the earliest credible model's own 5 % end
     (:func:`faultgen.monitor.rul_forecast.credible_low`), the verdict saying so where it is earlier."""
-    if row.rul is None or not any(f.model == "power" for f in fits):
+    if row.rul_5 is None or not any(f.model == "power" for f in fits):
         return row
 
     def own(i):
@@ -559,6 +561,9 @@ def _summarise(row: Remaining, fits, weights, labels, toe, horizon: float, times
         row.predictable = False
         row.verdict = (f"not yet predictable: {why} (median {mid:.3g} {unit}, 5-95 %: {low:.3g} {unit} to {upper}; "
                        f"{row.logs_fitted} logs; {models})")
+        if not np.isfinite(high) and not unpredictable(fits, weights, labels, values, low, mid, mid, since_rise):
+            row.rul_5 = float(low)  # only the upper end unbounded: the service-by end holds (module docstring, 7)
+            row.verdict += f"; service by its 5 % end, {low:.3g} {unit}"
         return row
     row.rul, row.rul_5 = float(mid), float(low)
     row.rul_95 = float(high)
