@@ -41,7 +41,12 @@ def test_v3_small_is_made_identical_to_its_frozen_manifest_with_every_variant(v3
     # the units a split holds are the generator's, in the make's shuffled order (small: 3 failing units per seed)
     spec = dict(tracks.load("prognostics").version(3).records("test", "small")[0][1])
     expected = prognostics_v3.split_units(spec)[prognostics_v3.DEFAULT_VARIANT]
-    assert sorted(tuple(u.fault_level) for u in test) == sorted(tuple(u.fault_level) for u in expected)
+    # made here, outside the make's numeric profile (faultgen.bench.profile): where NumPy runs its own AVX-512
+    # loops the same units' levels differ from the make's in their last bits, so equal to rounding
+    got, want = (sorted((np.asarray(u.fault_level, dtype=float) for u in units), key=lambda a: tuple(np.round(a, 6)))
+                 for units in (test, expected))
+    assert len(got) == len(want) and all(a.shape == b.shape for a, b in zip(got, want))
+    assert all(np.allclose(a, b, rtol=1e-12, atol=1e-12) for a, b in zip(got, want))
     assert sum(u.worn_axis > 0 and (u.fault_level >= 40).any() for u in test) == 3
     for unit in test:  # what a method reads: the duty of the day beside the torques
         assert {"payload_mass", "speed_override", "operating_hours", "mean_abs_torque"} <= set(unit.arrays)

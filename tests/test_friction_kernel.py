@@ -2,7 +2,8 @@
 issue 87): ``friction_update.writer`` writes the bits of ``friction_update.apply`` on random
 states (both signs, exact zeros of both signs, tiny and huge speeds, NaN), one and two Coulomb
 levels, one level for the chunk and one per step, several runs, with and without transmitted-load
-terms, compiled and through its NumPy fallback; when the compiled update is used; the boundary
+terms, compiled and through its NumPy fallback (compiled on a machine whose NumPy runs its own AVX-512
+exp and pow, where the compiled update is not used: to within 4 ulp); when the compiled update is used; the boundary
 checks. Whole runs (static-load terms, grips, the stepping loop) against the plain loop:
 tests/test_backends.py, tests/test_friction_update.py, tests/test_sim_hot_paths.py."""
 
@@ -12,6 +13,10 @@ import pytest
 from faultgen.simulation import batch, friction_kernel, friction_update
 
 NSIM, N, NSTEP, NV = 3, 6, 5, 14
+#: Where NumPy dispatches exp and pow to its own AVX-512 code, the kernel's C-library calls differ from its
+#: by rounding: at most this many units in the last place on each loss (a sum of positive terms; measured on
+#: an AVX-512 Xeon, NumPy 2.4.6, numba 0.68.1, 2026-11-29: 26 of the values differ, by at most 2).
+MAX_ULP = 4
 
 
 def update(rng, one_coulomb: bool, per_step: bool, terms: int) -> friction_update.FrictionUpdate:
@@ -60,6 +65,11 @@ def test_the_writer_writes_apply_bits_on_random_states(compiled, one_coulomb, pe
         got = loss[:, u.rotor_dof]
         np.testing.assert_array_equal(np.isnan(got), np.isnan(expected))
         finite = ~np.isnan(expected)
+        if compiled and not friction_kernel.matches_numpy():
+            # NumPy's own SIMD exp and pow here (an AVX-512 target, not friction_kernel.LIBM_TARGETS): the
+            # kernel, which the stepping loop does not use on such a machine, gives its values to rounding
+            np.testing.assert_array_max_ulp(got[finite], expected[finite], maxulp=MAX_ULP)
+            continue
         assert got[finite].tobytes() == expected[finite].tobytes(), (trial, got - expected)
     others = np.setdiff1d(np.arange(NV), u.rotor_dof)
     assert np.all(loss[:, others] == 7.0)  # only the rotors' columns written
