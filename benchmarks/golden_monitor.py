@@ -167,7 +167,8 @@ def pin() -> None:
         return
     env = children.environment({**profile.PROFILES[PROFILE], "_FAULTGEN_PROFILE_RESTART": PROFILE})
     sys.stdout.flush()
-    os.execve(sys.executable, [sys.executable, str(Path(__file__).resolve()), *sys.argv[1:]], env)
+    command = children.command(str(Path(__file__).resolve()), *sys.argv[1:])
+    os.execve(command[0], command, env)
 
 
 def main() -> int:
