@@ -35,7 +35,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import shutil
 import tempfile
 import sys
@@ -158,17 +157,10 @@ PROFILE = "x86-64-v3"
 
 
 def pin() -> None:
-    """Start this script again in :data:`PROFILE` (replacing this process) unless it runs in it, the
-    processor cannot take it, or a restart did not take it (no loop)."""
-    from faultgen import children
+    """Start this script again in :data:`PROFILE` (:func:`faultgen.bench.profile.restart_pinned`)."""
     from faultgen.bench import profile
 
-    if not profile.supported(PROFILE) or profile.pinned(PROFILE) or os.environ.get("_FAULTGEN_PROFILE_RESTART"):
-        return
-    env = children.environment({**profile.PROFILES[PROFILE], "_FAULTGEN_PROFILE_RESTART": PROFILE})
-    sys.stdout.flush()
-    command = children.command(str(Path(__file__).resolve()), *sys.argv[1:])
-    os.execve(command[0], command, env)
+    profile.restart_pinned(PROFILE, sys.argv[1:], (str(Path(__file__).resolve()),))
 
 
 def main() -> int:

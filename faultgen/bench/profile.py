@@ -123,10 +123,11 @@ def check(name: str | None) -> str:
                      f"or start Python with {assignments}")
 
 
-def restart_pinned(name: str | None, argv: list[str]) -> None:
+def restart_pinned(name: str | None, argv: list[str], program: tuple[str, ...] = ("-m", "faultgen.cli")) -> None:
     """Start this command again in profile ``name`` (replacing this process) unless it runs in it
     already, no profile is asked, or the processor cannot take it. ``argv``: the command's arguments
-    after the program (``sys.argv[1:]``). Started as ``python -P -m faultgen.cli`` with
+    after the program (``sys.argv[1:]``); ``program`` what Python runs (default the CLI; a script's
+    absolute path for a script). Started as ``python -P PROGRAM`` with
     ``PYTHONSAFEPATH=1`` (:mod:`faultgen.children`): ``python -m`` alone puts the current folder first
     on the path, and an ``h5py.py`` there would run in the make."""
     if name is None or not supported(name) or pinned(name):
@@ -136,5 +137,5 @@ def restart_pinned(name: str | None, argv: list[str]) -> None:
     env = children.environment({**PROFILES[name], "_FAULTGEN_PROFILE_RESTART": name})
     sys.stdout.flush()
     sys.stderr.flush()
-    command = children.command("-m", "faultgen.cli", *argv)
+    command = children.command(*program, *argv)
     os.execve(command[0], command, env)
