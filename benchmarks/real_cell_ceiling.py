@@ -26,7 +26,7 @@ through the origin of the tests on ``x`` under the monitor's prior ``N(m, p^2)``
 A log alarms when its one-sided 90 % lower bound ``x (f - z sd_f)`` (``z`` the monitor's
 :func:`faultgen.monitor.alarm.alarm_quantile`; ``--confidence``: another) reaches the limit, at once
 (the monitor waits for nothing longer with the twin); its 90 % interval is ``x (f -+ 1.645 sd_f)`` (the
-monitor's :data:`faultgen.monitor.friction_tests.INTERVAL`). At lambda 0.5 (half-way from its own first alarm to the true failure
+monitor's :data:`faultgen.monitor.baseline.WEAR_INTERVAL`). At lambda 0.5 (half-way from its own first alarm to the true failure
 day, 40 %) it knows the trend's shape exactly: the remaining life is the day ``f x`` reaches 40 % on the
 tests known that day, less the day (``monitor_rul.day_of``), judged by the table's own
 ``real_cell_table.lambda_outcome``. Each unit is drawn ``--draws`` times
@@ -59,7 +59,8 @@ from real_cell_table import FAILURE_WEAR, WITHIN, growth_at, lambda_outcome
 
 from faultgen.bench import independent
 from faultgen.monitor.alarm import alarm_quantile
-from faultgen.monitor.friction_tests import INTERVAL, SCALE_PRIOR
+from faultgen.monitor.baseline import WEAR_INTERVAL_Z
+from faultgen.monitor.friction_tests import SCALE_PRIOR
 from faultgen.monitor.scoring import Settings
 
 HONEST = 0.95  # the share of alarms whose lower bound lies below the true wear
@@ -100,7 +101,7 @@ def unit_chances(wear: np.ndarray, tests: list[tuple[int, float, float]], twin_f
     bound = x * (factor - (alarm_quantile() if z is None else z) * sd)
     fires = bound >= limit
     below = fires & (bound < wear)
-    half = NormalDist().inv_cdf(0.5 + INTERVAL / 2) * sd * x  # the 90 % interval's half width
+    half = WEAR_INTERVAL_Z * sd * x  # the 90 % interval's half width, the monitor's wear interval's z
     span = (wear >= bounds.SPAN[0]) & (wear <= bounds.SPAN[1])
     covered = (np.abs(factor * x - wear) <= half) & span
     first = np.where(fires.any(axis=1), fires.argmax(axis=1), n)  # log index
