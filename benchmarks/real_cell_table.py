@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -294,8 +295,6 @@ def at_level(rows: list, axis: int, level: float) -> list:
     filtered and each log's own with its bound, times ``level`` over the last row's filtered
     estimate: the same trend, its level on the last log ``level`` %. Unchanged where that estimate
     is not above 0."""
-    import dataclasses
-
     now = float(rows[-1].wear.estimate[axis - 1])
     if not now > 0:
         return rows
