@@ -132,6 +132,44 @@ def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed(monkeypa
     assert late.params[2] <= 47.0 and reaches(late) > crossing + 1.0, (late.params, reaches(late))
 
 
+def test_the_fits_covariance_is_the_weighted_least_squares_one_where_the_logs_fix_every_parameter():
+    """trends.gauss_newton_cov on a line's design (residuals over their errors) against statsmodels' WLS
+    (its unscaled covariance, (X^T W X)^-1), and on a well-fixed power law's Jacobian against the plain
+    inverse it replaces."""
+    import statsmodels.api as sm
+
+    rng = np.random.default_rng(11)
+    t = np.arange(40.0) - 39.0
+    error = rng.uniform(0.5, 2.0, 40)
+    x = np.column_stack([np.ones(40), t])
+    reference = sm.WLS(rng.normal(size=40), x, weights=1.0 / error**2).fit().normalized_cov_params
+    np.testing.assert_allclose(trends.gauss_newton_cov(x / error[:, None]), reference, rtol=1e-10)
+    jacobian = rng.normal(size=(60, 4)) * np.array([1.0, 30.0, 0.1, 5.0])
+    np.testing.assert_allclose(trends.gauss_newton_cov(jacobian), np.linalg.inv(jacobian.T @ jacobian), rtol=1e-9)
+
+
+def test_a_power_law_whose_start_the_logs_do_not_fix_is_drawn_at_its_fitted_start():
+    """An exact line over 60 logs: the power law fits it with its exponent at 1 and its start before the
+    first log, where the start moves nothing. The plain inverse of J^T J put a standard deviation of
+    about 10^8 days on the start and a negative eigenvalue (-0.24) beside it, so NumPy's draws warned
+    "covariance is not symmetric positive-semidefinite" (it did in `faultgen monitor`'s console on the
+    independent fleets); the pseudo-inverse gives the start no variance, the others theirs."""
+    import warnings
+
+    t = np.arange(60.0) - 59.0
+    fit = trends.fit_power(t, 10.0 + 0.5 * (t + 59.0), np.ones(60))
+    w_now, b, age, p = fit.params
+    assert p == pytest.approx(1.0, abs=1e-9) and age > 59.0, fit.params  # the case: a line, begun before the logs
+    eigenvalues = np.linalg.eigvalsh(fit.cov)
+    assert np.allclose(fit.cov, fit.cov.T, rtol=1e-12, atol=0.0) and eigenvalues[0] >= -1e-12 * eigenvalues[-1], eigenvalues
+    errors = np.sqrt(np.diag(fit.cov))
+    assert errors[2] < 1e-6 and 0.1 < errors[0] < 1.0 and 0.005 < errors[1] < 0.05 and 0.01 < errors[3] < 0.2, errors
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        drawn = np.random.default_rng(0).multivariate_normal(fit.params, fit.cov, size=1000, method="eigh")
+    assert np.ptp(drawn[:, 2]) < 1e-4 and np.std(drawn[:, 3]) == pytest.approx(errors[3], rel=0.1)
+
+
 def test_a_rise_too_short_or_too_slow_is_not_yet_predictable_and_a_flat_one_has_no_end_of_life():
     t = np.arange(45.0)
     rng = np.random.default_rng(1)

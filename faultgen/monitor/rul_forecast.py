@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from faultgen.monitor.trends import Fit, expm1_over, information_criterion
+from faultgen.monitor.trends import Fit, expm1_over, gauss_newton_cov, information_criterion
 
 #: The name of the exponential rise after a flat stretch (:func:`fit_onset_exponential`).
 ONSET = "onset exponential"
@@ -69,8 +69,8 @@ def fit_onset_exponential(t: np.ndarray, wear: np.ndarray, error: np.ndarray, ag
     if best is None:
         return None
     try:
-        cov = np.linalg.inv(best.jac.T @ best.jac) * max(1.0, 2.0 * best.cost / max(len(t) - 4, 1))
-    except np.linalg.LinAlgError:
+        cov = gauss_newton_cov(best.jac) * max(1.0, 2.0 * best.cost / max(len(t) - 4, 1))
+    except (ValueError, np.linalg.LinAlgError):
         return None
     if not (np.all(np.isfinite(best.x)) and np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
         return None

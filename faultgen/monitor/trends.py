@@ -83,6 +83,30 @@ class Fit:
     limits: tuple | None = None
 
 
+#: Singular values of a fit's Jacobian at or below this share of its largest count as zero in the
+#: fit's covariance (:func:`gauss_newton_cov`): scipy's ``least_squares`` differentiates by forward
+#: differences, good to about the square root of the machine epsilon of the Jacobian's scale, so a
+#: direction the logs fix no better than that is one they do not fix. The power law whose exponent
+#: sits at 1 with its rise begun before the first log is such a fit: its start moves nothing, and
+#: the plain inverse put 10^9 days of standard deviation on it, a negative eigenvalue from rounding
+#: beside it, and an exponent drawn over -0.9 to 2.9 (docs/analysis.md, "a fit's covariance where
+#: the logs do not fix a parameter").
+JACOBIAN_RTOL = float(np.sqrt(np.finfo(float).eps))
+
+
+def gauss_newton_cov(jacobian: np.ndarray) -> np.ndarray:
+    """The Gauss-Newton covariance ``(J^T J)^+`` of a least-squares fit's parameters from its
+    Jacobian ``J`` (n, k) of the residuals divided by their standard errors: ``J^+ (J^+)^T`` with
+    ``J``'s pseudo-inverse through its singular value decomposition (``scipy.linalg.pinv``, the way
+    ``scipy.optimize.curve_fit`` computes its ``pcov``), singular values at or below
+    :data:`JACOBIAN_RTOL` of the largest taken as zero: a direction the data do not fix gets no
+    variance instead of an unbounded one. Shape (k, k), symmetric positive semi-definite."""
+    from scipy.linalg import pinv
+
+    inverse = pinv(np.asarray(jacobian, dtype=float), atol=0.0, rtol=JACOBIAN_RTOL)
+    return inverse @ inverse.T
+
+
 def _widened(cov: np.ndarray, chi2: float, dof: int) -> np.ndarray:
     """``cov`` scaled by the reduced chi-square ``chi2 / dof`` when it is above one (the scatter
     about the trend larger than the stated errors; :mod:`faultgen.monitor.prognosis`, 4); as given
@@ -145,8 +169,8 @@ def fit_hinge(t: np.ndarray, wear: np.ndarray, error: np.ndarray) -> Fit | None:
     # being b before tc and 0 after it
     jacobian = np.column_stack([np.ones(n), np.maximum(t, tc), np.where(t < tc, b, 0.0)])
     try:
-        cov = np.linalg.inv(jacobian.T @ (jacobian * weight[:, None]))
-    except np.linalg.LinAlgError:
+        cov = gauss_newton_cov(jacobian * np.sqrt(weight)[:, None])
+    except (ValueError, np.linalg.LinAlgError):
         return None
     cov = _widened(cov, chi2_tc, n - 3)
     if not (np.all(np.isfinite(cov)) and np.all(np.diag(cov) >= 0)):
@@ -231,8 +255,7 @@ def _power_over(t: np.ndarray, wear: np.ndarray, error: np.ndarray, ages: np.nda
             warnings.simplefilter("ignore")
             found = least_squares(lambda q: (power_curve(t, *q) - wear) / error, start, bounds=(low, high),
                                   x_scale="jac", method="trf")
-        jacobian = found.jac
-        cov = np.linalg.inv(jacobian.T @ jacobian)
+        cov = gauss_newton_cov(found.jac)
     except (ValueError, np.linalg.LinAlgError):
         return None
     cov = _widened(cov, float(np.sum(found.fun**2)), len(t) - 4)
