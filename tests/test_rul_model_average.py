@@ -134,8 +134,8 @@ def test_a_power_law_rise_begun_before_the_first_log_fitted_is_followed(monkeypa
 
 def test_the_fits_covariance_is_the_weighted_least_squares_one_where_the_logs_fix_every_parameter():
     """trends.gauss_newton_cov on a line's design (residuals over their errors) against statsmodels' WLS
-    (its unscaled covariance, (X^T W X)^-1), and on a well-fixed power law's Jacobian against the plain
-    inverse it replaces."""
+    (its unscaled covariance, (X^T W X)^-1), and on a well-conditioned Jacobian against the plain inverse
+    of J^T J it replaces."""
     import statsmodels.api as sm
 
     rng = np.random.default_rng(11)

@@ -88,7 +88,7 @@ class Fit:
 #: differences, good to about the square root of the machine epsilon of the Jacobian's scale, so a
 #: direction the logs fix no better than that is one they do not fix. The power law whose exponent
 #: sits at 1 with its rise begun before the first log is such a fit: its start moves nothing, and
-#: the plain inverse put 10^9 days of standard deviation on it, a negative eigenvalue from rounding
+#: the plain inverse put 6.8e8 days of standard deviation on it, a negative eigenvalue from rounding
 #: beside it, and an exponent drawn over -0.9 to 2.9 (docs/analysis.md, "a fit's covariance where
 #: the logs do not fix a parameter").
 JACOBIAN_RTOL = float(np.sqrt(np.finfo(float).eps))
