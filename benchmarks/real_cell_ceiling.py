@@ -63,8 +63,6 @@ from faultgen.monitor.baseline import WEAR_INTERVAL_Z
 from faultgen.monitor.friction_tests import SCALE_PRIOR
 from faultgen.monitor.scoring import Settings
 
-HONEST = 0.95  # the share of alarms whose lower bound lies below the true wear
-
 
 def factor_draws(x: np.ndarray, tests: list[tuple[int, float, float]], draws: np.ndarray,
                  prior_sd: float, prior_mean: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -226,11 +224,11 @@ def table(name: str, chances: dict[str, dict], twin_factor: float) -> list[str]:
     fraction = np.sum([c["below"] for c in chances.values()], axis=0) / np.maximum(alarming, 1)
     low, high = np.percentile(fraction, [5, 95])
     first = np.array([c["first_below"] for c in chances.values()])
-    honest = (f"- the bound below the truth on >= {100 * HONEST:g} % of alarming log-axes: chance "
-              f"{(fraction >= HONEST).mean():.2f} (the fleet's fraction: mean {100 * fraction.mean():.1f} %, "
+    honest = (f"- the bound below the truth on >= {100 * bounds.BOUND_SHARE:g} % of alarming log-axes: chance "
+              f"{(fraction >= bounds.BOUND_SHARE).mean():.2f} (the fleet's fraction: mean {100 * fraction.mean():.1f} %, "
               f"5-95 %: {100 * low:.1f}-{100 * high:.1f} %); on every first alarm: chance "
               f"{first.all(axis=0).mean():.2f}; with every first alarm in the window: chance "
-              f"{(window.all(axis=0) & (fraction >= HONEST)).mean():.2f}")
+              f"{(window.all(axis=0) & (fraction >= bounds.BOUND_SHARE)).mean():.2f}")
     spanned = sum(c["spanned"] for c in chances.values())
     share = np.sum([c["covered"] for c in chances.values()], axis=0) / max(spanned, 1)
     low, high = np.percentile(share, [5, 95])

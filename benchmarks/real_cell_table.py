@@ -227,9 +227,9 @@ def lambda_rows(outcomes: dict[str, dict], clean: bool) -> list[tuple[str, str, 
     after = [u for u, o in outcomes.items() if not o.get("ok")]
     within = [u for u, o in dated.items() if o["within"]]
     late = [u for u, o in dated.items() if o["late"]]
-    each = "; ".join(f"{u} " + (f"day {o['day']}: {o['median']:.0f} (true {o['true']:.0f}), by day "
-                                f"{o['service_by']:.1f} (failure {o['eol']:.1f})" if "median" in o else o["why"]
-                                + (f", by day {o['service_by']:.1f} (failure {o['eol']:.1f})" if "ok" in o else ""))
+    each = "; ".join(f"{u} "
+                     + (f"day {o['day']}: {o['median']:.0f} (true {o['true']:.0f})" if "median" in o else o["why"])
+                     + (f", by day {o['service_by']:.1f} (failure {o['eol']:.1f})" if "ok" in o else "")
                      for u, o in sorted(outcomes.items()))
     need = CLEAN_WITHIN if clean else int(np.ceil(HALF * n))
     rows = [("at lambda 0.5 the service-by date not after the failure day, every worn unit",
