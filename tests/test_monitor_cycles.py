@@ -194,3 +194,27 @@ def test_the_twin_of_a_log_of_two_cycles_replays_one_and_expects_what_a_one_cycl
     # the two logs' motions differ by their angle noise only (1e-5 rad), which the replay tracks: the
     # twins of two one-cycle logs of a unit differed by up to 0.35 % per feature (2026-11-27)
     np.testing.assert_allclose(healthy[1], healthy[0], rtol=1e-2)
+
+
+@pytest.mark.parametrize("short", [1, 2, 10, 15])
+def test_a_log_a_part_of_a_period_short_of_three_cycles_is_scored_on_whole_cycles(short):
+    """A log cut at a phase 0.3 of the cycle and ``short`` samples (of 1000 a period) short of three
+    cycles: one or two samples short (a period's rounding to a sample) it counts as three periods and
+    is scored whole; 10 or 15 short (1 and 1.5 % of a period, which the 2 % tolerance once counted) it
+    is scored on its two whole cycles, over which a per-sample mean (here the mean |qd|, the viscous
+    friction's weight) is the cycle's, where over the whole log it is not (main before: all of it)."""
+    program = programs.reference_of(*log(250.0, 1)[:2])
+    n = 1000
+    t1, q1, _ = log(250.0, 1, noise=0.0)
+    cycle_mean = np.mean(np.abs(np.gradient(q1, t1, axis=0)), axis=0)
+    t, q, _ = log(250.0, 4, noise=0.0)
+    qd = np.gradient(q, t, axis=0)
+    first, last = int(0.3 * n), int(0.3 * n) + 3 * n - short
+    start, stop = _scored(t[first:last] - t[first], q[first:last], program)
+    if short <= programs.EDGE_SAMPLES:
+        assert (start, stop) == (0, last - first)
+        return
+    assert (start, stop) == (n - first % n, 3 * n - first % n)  # the two whole cycles inside
+    relative = lambda s: np.max(np.abs(np.mean(np.abs(qd[first:last][s]), axis=0) / cycle_mean - 1.0))
+    assert relative(slice(start, stop)) < 1e-4
+    assert relative(slice(None)) > 2e-3
